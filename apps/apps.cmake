@@ -1,0 +1,1 @@
+fcm_add_app(fcm-sim apps/fcm-sim.c)

@@ -1,0 +1,9 @@
+/* fcm — finite cell method for embedded deformable solids. Umbrella header. */
+#ifndef FCM_FCM_H
+#define FCM_FCM_H
+
+#include "fcm/core.h"
+#include "fcm/element.h"
+#include "fcm/quad.h"
+
+#endif /* FCM_FCM_H */

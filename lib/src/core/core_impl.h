@@ -1,0 +1,100 @@
+/* fcm core, internal part: the error idiom, allocation and logging helpers
+ * every module uses. Not installed. */
+#ifndef FCM_CORE_IMPL_H
+#define FCM_CORE_IMPL_H
+
+#include "fcm/core.h"
+
+#include <limits.h>
+#include <stdarg.h>
+
+#if defined(__GNUC__)
+#define FCM__PRINTF(f, a) __attribute__((format(printf, f, a)))
+#else
+#define FCM__PRINTF(f, a)
+#endif
+
+/* Record a new error in ctx (replacing any previous one, starting a fresh
+ * traceback at file:line), log it at FCM_LOG_ERROR and return `code`.
+ * Thread safe: concurrent errors keep one of them. ctx may be NULL. */
+fcm_status fcm__error(fcm_ctx *ctx, fcm_status code, const char *file, int line, const char *func,
+                      const char *fmt, ...) FCM__PRINTF(6, 7);
+
+/* Append a traceback frame to the recorded error. */
+void fcm__trace(fcm_ctx *ctx, const char *file, int line, const char *func);
+
+/* Format a message and pass it to the log callback when level is enabled. */
+void fcm__log(const fcm_ctx *ctx, fcm_log_level level, const char *fmt, ...) FCM__PRINTF(3, 4);
+
+/* Zero-filled array of n elements of `size` bytes through ctx's allocator.
+ * Returns NULL on overflow or allocation failure (and records FCM_ERR_ALLOC).
+ * n == 0 still returns a valid (1-byte) allocation. */
+void *fcm__calloc(fcm_ctx *ctx, size_t n, size_t size);
+
+/* Release memory from fcm__calloc; accepts NULL. */
+void fcm__free(fcm_ctx *ctx, void *ptr);
+
+/* Grow or shrink an fcm__calloc array, preserving min(old_n, new_n) elements and
+ * zero-filling the rest. On failure *ptr is unchanged. */
+fcm_status fcm__resize(fcm_ctx *ctx, void **ptr, size_t old_n, size_t new_n, size_t size);
+
+/* Checked narrowing of a global index to int (LAPACK, GLPK, CHOLMOD sizes). */
+fcm_status fcm__index_to_int(fcm_ctx *ctx, fcm_index v, const char *what, int *out);
+
+/* ---- the one error idiom: every function has `fcm_status st` and `cleanup:` ---- */
+
+/* Fail with `code` and a formatted message unless `cond` holds. */
+#define FCM_CHECK(cond, ctx, code, ...)                                                            \
+  do {                                                                                             \
+    if (!(cond)) {                                                                                 \
+      st = fcm__error((ctx), (code), __FILE__, __LINE__, __func__, __VA_ARGS__);                  \
+      goto cleanup;                                                                                \
+    }                                                                                              \
+  } while (0)
+
+/* Propagate a failing status from `call`, adding a traceback frame. */
+#define FCM_TRY(ctx, call)                                                                         \
+  do {                                                                                             \
+    st = (call);                                                                                   \
+    if (st != FCM_OK) {                                                                            \
+      fcm__trace((ctx), __FILE__, __LINE__, __func__);                                             \
+      goto cleanup;                                                                                \
+    }                                                                                              \
+  } while (0)
+
+/* Allocate `n` zeroed elements of *p's type into p, or fail with FCM_ERR_ALLOC. */
+#define FCM_ALLOC(ctx, n, p)                                                                       \
+  do {                                                                                             \
+    (p) = fcm__calloc((ctx), (size_t)(n), sizeof *(p));                                            \
+    if (!(p)) {                                                                                    \
+      st = FCM_ERR_ALLOC;                                                                          \
+      fcm__trace((ctx), __FILE__, __LINE__, __func__);                                             \
+      goto cleanup;                                                                                \
+    }                                                                                              \
+  } while (0)
+
+/* Free and reset to NULL. */
+#define FCM_FREE(ctx, p)                                                                           \
+  do {                                                                                             \
+    fcm__free((ctx), (p));                                                                         \
+    (p) = NULL;                                                                                    \
+  } while (0)
+
+/* Internal invariant; compiled out of release (NDEBUG) builds. */
+#ifdef NDEBUG
+#define FCM_ASSERT(cond, ctx) ((void)0)
+#else
+#define FCM_ASSERT(cond, ctx)                                                                      \
+  do {                                                                                             \
+    if (!(cond)) {                                                                                 \
+      st = fcm__error((ctx), FCM_ERR_INTERNAL, __FILE__, __LINE__, __func__,                      \
+                      "assertion failed: %s", #cond);                                              \
+      goto cleanup;                                                                                \
+    }                                                                                              \
+  } while (0)
+#endif
+
+#define FCM_MIN(a, b) ((a) < (b) ? (a) : (b))
+#define FCM_MAX(a, b) ((a) > (b) ? (a) : (b))
+
+#endif /* FCM_CORE_IMPL_H */

@@ -1,0 +1,232 @@
+/* The fcm context: allocator hook with live-allocation count, log callback,
+ * last error with traceback, status strings. */
+#include "core_impl.h"
+
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define FCM__MAX_FRAMES 32
+#define FCM__MSG_LEN 1024
+
+typedef struct fcm_frame {
+  const char *file;
+  const char *func;
+  int line;
+} fcm_frame;
+
+struct fcm_ctx {
+  fcm_ctx_options opts;
+  atomic_llong live;
+  fcm_status err_status;
+  char err_msg[FCM__MSG_LEN];
+  fcm_frame frames[FCM__MAX_FRAMES];
+  int nframes;
+  int frames_dropped;
+};
+
+#define FCM_STATUS_STR_(name, msg) msg,
+static const char *const status_msgs[] = {FCM_STATUS_LIST(FCM_STATUS_STR_)};
+#undef FCM_STATUS_STR_
+
+const char *fcm_status_str(fcm_status st)
+{
+  if ((int)st < 0 || st >= FCM_STATUS_COUNT_) return "unknown status";
+  return status_msgs[st];
+}
+
+static void *sys_alloc(void *user, size_t size)
+{
+  (void)user;
+  return malloc(size);
+}
+
+static void sys_release(void *user, void *ptr)
+{
+  (void)user;
+  free(ptr);
+}
+
+fcm_ctx_options fcm_ctx_options_default(void)
+{
+  fcm_ctx_options o;
+  memset(&o, 0, sizeof o);
+  o.log_level = FCM_LOG_WARNING;
+  return o;
+}
+
+fcm_status fcm_ctx_create(const fcm_ctx_options *opts, fcm_ctx **out)
+{
+  fcm_ctx_options o = opts ? *opts : fcm_ctx_options_default();
+  if (!out) return FCM_ERR_ARG;
+  *out = NULL;
+  if (!o.allocator.alloc != !o.allocator.release) return FCM_ERR_ARG;
+  if (!o.allocator.alloc) {
+    o.allocator.alloc = sys_alloc;
+    o.allocator.release = sys_release;
+    o.allocator.user = NULL;
+  }
+  fcm_ctx *ctx = o.allocator.alloc(o.allocator.user, sizeof *ctx);
+  if (!ctx) return FCM_ERR_ALLOC;
+  memset(ctx, 0, sizeof *ctx);
+  ctx->opts = o;
+  atomic_init(&ctx->live, 0);
+  ctx->err_status = FCM_OK;
+  *out = ctx;
+  return FCM_OK;
+}
+
+void fcm_ctx_destroy(fcm_ctx **ctx)
+{
+  if (!ctx || !*ctx) return;
+  fcm_allocator a = (*ctx)->opts.allocator;
+  a.release(a.user, *ctx);
+  *ctx = NULL;
+}
+
+long long fcm_ctx_live_allocations(const fcm_ctx *ctx)
+{
+  return ctx ? atomic_load(&((fcm_ctx *)ctx)->live) : 0;
+}
+
+fcm_status fcm_ctx_error_status(const fcm_ctx *ctx) { return ctx ? ctx->err_status : FCM_OK; }
+
+const char *fcm_ctx_error_message(const fcm_ctx *ctx) { return ctx ? ctx->err_msg : ""; }
+
+void fcm_ctx_error_clear(fcm_ctx *ctx)
+{
+  if (!ctx) return;
+#pragma omp critical(fcm_error)
+  {
+    ctx->err_status = FCM_OK;
+    ctx->err_msg[0] = '\0';
+    ctx->nframes = 0;
+    ctx->frames_dropped = 0;
+  }
+}
+
+void fcm_ctx_error_view(const fcm_ctx *ctx, FILE *stream)
+{
+  if (!ctx || !stream || ctx->err_status == FCM_OK) return;
+  fprintf(stream, "fcm error: %s (%s)\n", ctx->err_msg, fcm_status_str(ctx->err_status));
+  for (int i = 0; i < ctx->nframes; i++)
+    fprintf(stream, "  [%d] %s() at %s:%d\n", i, ctx->frames[i].func, ctx->frames[i].file,
+            ctx->frames[i].line);
+  if (ctx->frames_dropped) fprintf(stream, "  ... %d more frames\n", ctx->frames_dropped);
+}
+
+/* Keep only the path below lib/ (or the base name) so tracebacks stay short. */
+static const char *short_file(const char *file)
+{
+  const char *p = strstr(file, "lib/src/");
+  if (p) return p + 8;
+  const char *s = strrchr(file, '/');
+  return s ? s + 1 : file;
+}
+
+static void push_frame(fcm_ctx *ctx, const char *file, int line, const char *func)
+{
+  if (ctx->nframes < FCM__MAX_FRAMES) {
+    fcm_frame *f = &ctx->frames[ctx->nframes++];
+    f->file = short_file(file);
+    f->line = line;
+    f->func = func;
+  } else {
+    ctx->frames_dropped++;
+  }
+}
+
+static void log_message(const fcm_ctx *ctx, fcm_log_level level, const char *msg)
+{
+  if (ctx && ctx->opts.log && level <= ctx->opts.log_level)
+    ctx->opts.log(ctx->opts.log_user, level, msg);
+}
+
+fcm_status fcm__error(fcm_ctx *ctx, fcm_status code, const char *file, int line, const char *func,
+                      const char *fmt, ...)
+{
+  if (!ctx) return code;
+  char msg[FCM__MSG_LEN];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+#pragma omp critical(fcm_error)
+  {
+    ctx->err_status = code;
+    memcpy(ctx->err_msg, msg, sizeof msg);
+    ctx->nframes = 0;
+    ctx->frames_dropped = 0;
+    push_frame(ctx, file, line, func);
+  }
+  log_message(ctx, FCM_LOG_ERROR, msg);
+  return code;
+}
+
+void fcm__trace(fcm_ctx *ctx, const char *file, int line, const char *func)
+{
+  if (!ctx) return;
+#pragma omp critical(fcm_error)
+  push_frame(ctx, file, line, func);
+}
+
+void fcm__log(const fcm_ctx *ctx, fcm_log_level level, const char *fmt, ...)
+{
+  if (!ctx || !ctx->opts.log || level > ctx->opts.log_level) return;
+  char msg[FCM__MSG_LEN];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+  ctx->opts.log(ctx->opts.log_user, level, msg);
+}
+
+void *fcm__calloc(fcm_ctx *ctx, size_t n, size_t size)
+{
+  if (size && n > SIZE_MAX / size) {
+    fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
+               "allocation of %zu elements of %zu bytes overflows size_t", n, size);
+    return NULL;
+  }
+  size_t bytes = n * size;
+  if (bytes == 0) bytes = 1;
+  void *p = ctx->opts.allocator.alloc(ctx->opts.allocator.user, bytes);
+  if (!p) {
+    fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
+               "out of memory allocating %zu bytes", bytes);
+    return NULL;
+  }
+  memset(p, 0, bytes);
+  atomic_fetch_add(&ctx->live, 1);
+  return p;
+}
+
+void fcm__free(fcm_ctx *ctx, void *ptr)
+{
+  if (!ptr) return;
+  ctx->opts.allocator.release(ctx->opts.allocator.user, ptr);
+  atomic_fetch_sub(&ctx->live, 1);
+}
+
+fcm_status fcm__resize(fcm_ctx *ctx, void **ptr, size_t old_n, size_t new_n, size_t size)
+{
+  fcm_status st = FCM_OK;
+  unsigned char *fresh = fcm__calloc(ctx, new_n, size);
+  FCM_CHECK(fresh, ctx, FCM_ERR_ALLOC, "out of memory resizing an array to %zu elements", new_n);
+  if (*ptr) memcpy(fresh, *ptr, FCM_MIN(old_n, new_n) * size);
+  fcm__free(ctx, *ptr);
+  *ptr = fresh;
+cleanup:
+  return st;
+}
+
+fcm_status fcm__index_to_int(fcm_ctx *ctx, fcm_index v, const char *what, int *out)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(v >= 0 && v <= INT_MAX, ctx, FCM_ERR_UNSUPPORTED,
+            "%s = %lld does not fit the 32-bit integer range [0, %d] of the solver interface",
+            what, (long long)v, INT_MAX);
+  *out = (int)v;
+cleanup:
+  return st;
+}

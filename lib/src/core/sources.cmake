@@ -1,0 +1,1 @@
+list(APPEND FCM_SOURCES lib/src/core/ctx.c lib/src/core/timer.c)

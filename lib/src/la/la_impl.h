@@ -1,0 +1,54 @@
+/* Dense linear algebra adapter over BLAS/LAPACK (internal). All matrices are
+ * column-major with an explicit leading dimension; sizes are int as in LAPACK.
+ * Every LAPACK `info` is mapped to a status with a message naming the routine. */
+#ifndef FCM_LA_IMPL_H
+#define FCM_LA_IMPL_H
+
+#include "core/core_impl.h"
+
+/* C = alpha op(A) op(B) + beta C, op = 'N' or 'T'. */
+void fcm__gemm(char transa, char transb, int m, int n, int k, double alpha, const double *a,
+               int lda, const double *b, int ldb, double beta, double *c, int ldc);
+
+/* y = alpha op(A) x + beta y, A is m x n. */
+void fcm__gemv(char trans, int m, int n, double alpha, const double *a, int lda, const double *x,
+               double beta, double *y);
+
+/* Symmetric eigen-decomposition of the n x n matrix A (lower triangle read).
+ * w receives the eigenvalues in ascending order; with want_vectors the columns of
+ * A are overwritten by orthonormal eigenvectors. FCM_ERR_LAPACK if it fails to
+ * converge, FCM_ERR_NUMERIC on NaN/Inf input. */
+fcm_status fcm__syev(fcm_ctx *ctx, int want_vectors, int n, double *a, int lda, double *w);
+
+/* Eigenvalues (ascending, into d) and optionally eigenvectors (z, n x n, ldz) of
+ * the symmetric tridiagonal matrix with diagonal d[0..n) and off-diagonal
+ * e[0..n-1) (e is destroyed). z == NULL: eigenvalues only. */
+fcm_status fcm__stev(fcm_ctx *ctx, int n, double *d, double *e, double *z, int ldz);
+
+/* Thin SVD A = U diag(s) Vt of the m x n matrix A (destroyed), k = min(m, n):
+ * s[k] descending, U m x k (ldu), Vt k x n (ldvt); U or Vt may be NULL. */
+fcm_status fcm__gesvd(fcm_ctx *ctx, int m, int n, double *a, int lda, double *s, double *u,
+                      int ldu, double *vt, int ldvt);
+
+/* LU factorization with partial pivoting in place; FCM_ERR_SINGULAR names the
+ * zero pivot. ipiv has n entries. */
+fcm_status fcm__getrf(fcm_ctx *ctx, int n, double *a, int lda, int *ipiv);
+
+/* Solve A X = B with the factors of fcm__getrf; B is n x nrhs (ldb). */
+fcm_status fcm__getrs(fcm_ctx *ctx, int n, int nrhs, const double *lu, int lda, const int *ipiv,
+                      double *b, int ldb);
+
+/* Cholesky A = L L^T in place (lower); FCM_ERR_SINGULAR if not positive definite. */
+fcm_status fcm__potrf(fcm_ctx *ctx, int n, double *a, int lda);
+
+/* Solve A X = B with the factor of fcm__potrf. */
+fcm_status fcm__potrs(fcm_ctx *ctx, int n, int nrhs, const double *l, int lda, double *b, int ldb);
+
+/* Minimum-norm least-squares solution of min ||A x - b|| for the m x n matrix A
+ * (destroyed) through the SVD (LAPACK dgelsd). B is max(m,n) x nrhs (ldb) and
+ * receives the n x nrhs solution. Singular values below rcond * s_max count as
+ * zero (rcond < 0: machine precision); *rank receives the effective rank (may be NULL). */
+fcm_status fcm__lstsq(fcm_ctx *ctx, int m, int n, int nrhs, double *a, int lda, double *b, int ldb,
+                      double rcond, int *rank);
+
+#endif /* FCM_LA_IMPL_H */

@@ -1,0 +1,213 @@
+/* The one adapter to BLAS (cblas) and LAPACK (LAPACKE): column-major wrappers
+ * whose workspace comes from the context allocator and whose `info` codes become
+ * fcm statuses with messages. */
+#include "la/la_impl.h"
+
+#include <cblas.h>
+#include <lapacke.h>
+#include <math.h>
+
+_Static_assert(sizeof(lapack_int) == sizeof(int), "fcm expects 32-bit LAPACK integers");
+
+static CBLAS_TRANSPOSE cblas_trans(char t) { return (t == 'T' || t == 't') ? CblasTrans : CblasNoTrans; }
+
+void fcm__gemm(char transa, char transb, int m, int n, int k, double alpha, const double *a,
+               int lda, const double *b, int ldb, double beta, double *c, int ldc)
+{
+  if (m <= 0 || n <= 0) return;
+  cblas_dgemm(CblasColMajor, cblas_trans(transa), cblas_trans(transb), m, n, k, alpha, a, lda, b,
+              ldb, beta, c, ldc);
+}
+
+void fcm__gemv(char trans, int m, int n, double alpha, const double *a, int lda, const double *x,
+               double beta, double *y)
+{
+  if (m <= 0 || n <= 0) return;
+  cblas_dgemv(CblasColMajor, cblas_trans(trans), m, n, alpha, a, lda, x, 1, beta, y, 1);
+}
+
+/* FCM_ERR_NUMERIC unless every entry of the m x n matrix is finite. */
+static fcm_status check_finite(fcm_ctx *ctx, const char *routine, int m, int n, const double *a,
+                               int lda)
+{
+  fcm_status st = FCM_OK;
+  for (int j = 0; j < n; j++)
+    for (int i = 0; i < m; i++)
+      FCM_CHECK(isfinite(a[i + (size_t)j * lda]), ctx, FCM_ERR_NUMERIC,
+                "%s: input entry (%d, %d) is %g", routine, i, j, a[i + (size_t)j * lda]);
+cleanup:
+  return st;
+}
+
+/* Map a LAPACKE return value for the routine that gave it. */
+static fcm_status lapack_info(fcm_ctx *ctx, const char *routine, lapack_int info)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(info != LAPACK_WORK_MEMORY_ERROR && info != LAPACK_TRANSPOSE_MEMORY_ERROR, ctx,
+            FCM_ERR_ALLOC, "%s: LAPACKE ran out of memory", routine);
+  FCM_CHECK(info >= 0, ctx, FCM_ERR_ARG, "%s: argument %d had an illegal value", routine,
+            (int)-info);
+  FCM_CHECK(info == 0, ctx, FCM_ERR_LAPACK, "%s: failed with info = %d", routine, (int)info);
+cleanup:
+  return st;
+}
+
+fcm_status fcm__syev(fcm_ctx *ctx, int want_vectors, int n, double *a, int lda, double *w)
+{
+  fcm_status st = FCM_OK;
+  double *work = NULL, qwork;
+  lapack_int *iwork = NULL, qiwork, info;
+  char jobz = want_vectors ? 'V' : 'N';
+  FCM_CHECK(n >= 0 && lda >= FCM_MAX(1, n), ctx, FCM_ERR_ARG, "syev: n = %d, lda = %d", n, lda);
+  if (n == 0) goto cleanup;
+  FCM_TRY(ctx, check_finite(ctx, "dsyevd", n, n, a, lda));
+  info = LAPACKE_dsyevd_work(LAPACK_COL_MAJOR, jobz, 'L', n, a, lda, w, &qwork, -1, &qiwork, -1);
+  FCM_TRY(ctx, lapack_info(ctx, "dsyevd (workspace query)", info));
+  FCM_ALLOC(ctx, (size_t)qwork + 1, work);
+  FCM_ALLOC(ctx, (size_t)qiwork + 1, iwork);
+  info = LAPACKE_dsyevd_work(LAPACK_COL_MAJOR, jobz, 'L', n, a, lda, w, work, (lapack_int)qwork,
+                             iwork, qiwork);
+  FCM_CHECK(info <= 0, ctx, FCM_ERR_LAPACK,
+            "dsyevd: eigenvalue iteration failed to converge (info = %d) for n = %d", (int)info,
+            n);
+  FCM_TRY(ctx, lapack_info(ctx, "dsyevd", info));
+cleanup:
+  fcm__free(ctx, work);
+  fcm__free(ctx, iwork);
+  return st;
+}
+
+fcm_status fcm__stev(fcm_ctx *ctx, int n, double *d, double *e, double *z, int ldz)
+{
+  fcm_status st = FCM_OK;
+  double *work = NULL;
+  lapack_int info;
+  FCM_CHECK(n >= 0, ctx, FCM_ERR_ARG, "stev: n = %d must be non-negative", n);
+  if (n == 0) goto cleanup;
+  FCM_TRY(ctx, check_finite(ctx, "dstev", n, 1, d, n));
+  if (n > 1) FCM_TRY(ctx, check_finite(ctx, "dstev", n - 1, 1, e, n - 1));
+  FCM_ALLOC(ctx, (size_t)FCM_MAX(1, 2 * n - 2), work);
+  info = LAPACKE_dstev_work(LAPACK_COL_MAJOR, z ? 'V' : 'N', n, d, e, z, z ? ldz : 1, work);
+  FCM_CHECK(info <= 0, ctx, FCM_ERR_LAPACK,
+            "dstev: %d off-diagonal elements failed to converge (n = %d)", (int)info, n);
+  FCM_TRY(ctx, lapack_info(ctx, "dstev", info));
+cleanup:
+  fcm__free(ctx, work);
+  return st;
+}
+
+fcm_status fcm__gesvd(fcm_ctx *ctx, int m, int n, double *a, int lda, double *s, double *u,
+                      int ldu, double *vt, int ldvt)
+{
+  fcm_status st = FCM_OK;
+  double *work = NULL, qwork, dummy = 0.0;
+  lapack_int info;
+  char jobu = u ? 'S' : 'N', jobvt = vt ? 'S' : 'N';
+  FCM_CHECK(m >= 0 && n >= 0 && lda >= FCM_MAX(1, m), ctx, FCM_ERR_ARG,
+            "gesvd: m = %d, n = %d, lda = %d", m, n, lda);
+  if (m == 0 || n == 0) goto cleanup;
+  FCM_TRY(ctx, check_finite(ctx, "dgesvd", m, n, a, lda));
+  if (!u) u = &dummy, ldu = 1;
+  if (!vt) vt = &dummy, ldvt = 1;
+  info = LAPACKE_dgesvd_work(LAPACK_COL_MAJOR, jobu, jobvt, m, n, a, lda, s, u, ldu, vt, ldvt,
+                             &qwork, -1);
+  FCM_TRY(ctx, lapack_info(ctx, "dgesvd (workspace query)", info));
+  FCM_ALLOC(ctx, (size_t)qwork + 1, work);
+  info = LAPACKE_dgesvd_work(LAPACK_COL_MAJOR, jobu, jobvt, m, n, a, lda, s, u, ldu, vt, ldvt,
+                             work, (lapack_int)qwork);
+  FCM_CHECK(info <= 0, ctx, FCM_ERR_LAPACK,
+            "dgesvd: %d superdiagonals failed to converge (%d x %d matrix)", (int)info, m, n);
+  FCM_TRY(ctx, lapack_info(ctx, "dgesvd", info));
+cleanup:
+  fcm__free(ctx, work);
+  return st;
+}
+
+fcm_status fcm__getrf(fcm_ctx *ctx, int n, double *a, int lda, int *ipiv)
+{
+  fcm_status st = FCM_OK;
+  lapack_int info;
+  FCM_CHECK(n >= 0 && lda >= FCM_MAX(1, n), ctx, FCM_ERR_ARG, "getrf: n = %d, lda = %d", n, lda);
+  if (n == 0) goto cleanup;
+  FCM_TRY(ctx, check_finite(ctx, "dgetrf", n, n, a, lda));
+  info = LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, n, n, a, lda, ipiv);
+  FCM_CHECK(info <= 0, ctx, FCM_ERR_SINGULAR,
+            "dgetrf: matrix is singular, pivot U(%d,%d) is exactly zero (n = %d)", (int)info - 1,
+            (int)info - 1, n);
+  FCM_TRY(ctx, lapack_info(ctx, "dgetrf", info));
+cleanup:
+  return st;
+}
+
+fcm_status fcm__getrs(fcm_ctx *ctx, int n, int nrhs, const double *lu, int lda, const int *ipiv,
+                      double *b, int ldb)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(n >= 0 && nrhs >= 0 && lda >= FCM_MAX(1, n) && ldb >= FCM_MAX(1, n), ctx, FCM_ERR_ARG,
+            "getrs: n = %d, nrhs = %d, lda = %d, ldb = %d", n, nrhs, lda, ldb);
+  if (n == 0 || nrhs == 0) goto cleanup;
+  FCM_TRY(ctx, lapack_info(ctx, "dgetrs",
+                           LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', n, nrhs, lu, lda, ipiv, b,
+                                               ldb)));
+cleanup:
+  return st;
+}
+
+fcm_status fcm__potrf(fcm_ctx *ctx, int n, double *a, int lda)
+{
+  fcm_status st = FCM_OK;
+  lapack_int info;
+  FCM_CHECK(n >= 0 && lda >= FCM_MAX(1, n), ctx, FCM_ERR_ARG, "potrf: n = %d, lda = %d", n, lda);
+  if (n == 0) goto cleanup;
+  FCM_TRY(ctx, check_finite(ctx, "dpotrf", n, n, a, lda));
+  info = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', n, a, lda);
+  FCM_CHECK(info <= 0, ctx, FCM_ERR_SINGULAR,
+            "dpotrf: matrix is not positive definite (leading minor of order %d, n = %d)",
+            (int)info, n);
+  FCM_TRY(ctx, lapack_info(ctx, "dpotrf", info));
+cleanup:
+  return st;
+}
+
+fcm_status fcm__potrs(fcm_ctx *ctx, int n, int nrhs, const double *l, int lda, double *b, int ldb)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(n >= 0 && nrhs >= 0 && lda >= FCM_MAX(1, n) && ldb >= FCM_MAX(1, n), ctx, FCM_ERR_ARG,
+            "potrs: n = %d, nrhs = %d, lda = %d, ldb = %d", n, nrhs, lda, ldb);
+  if (n == 0 || nrhs == 0) goto cleanup;
+  FCM_TRY(ctx, lapack_info(ctx, "dpotrs",
+                           LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'L', n, nrhs, l, lda, b, ldb)));
+cleanup:
+  return st;
+}
+
+fcm_status fcm__lstsq(fcm_ctx *ctx, int m, int n, int nrhs, double *a, int lda, double *b, int ldb,
+                      double rcond, int *rank)
+{
+  fcm_status st = FCM_OK;
+  double *s = NULL, *work = NULL, qwork;
+  lapack_int *iwork = NULL, qiwork, info, r = 0;
+  FCM_CHECK(m >= 0 && n >= 0 && nrhs >= 0 && lda >= FCM_MAX(1, m) && ldb >= FCM_MAX(1, FCM_MAX(m, n)),
+            ctx, FCM_ERR_ARG, "lstsq: m = %d, n = %d, nrhs = %d, lda = %d, ldb = %d", m, n, nrhs,
+            lda, ldb);
+  if (m == 0 || n == 0 || nrhs == 0) goto cleanup;
+  FCM_TRY(ctx, check_finite(ctx, "dgelsd", m, n, a, lda));
+  FCM_TRY(ctx, check_finite(ctx, "dgelsd", m, nrhs, b, ldb));
+  FCM_ALLOC(ctx, (size_t)FCM_MIN(m, n), s);
+  info = LAPACKE_dgelsd_work(LAPACK_COL_MAJOR, m, n, nrhs, a, lda, b, ldb, s, rcond, &r, &qwork,
+                             -1, &qiwork);
+  FCM_TRY(ctx, lapack_info(ctx, "dgelsd (workspace query)", info));
+  FCM_ALLOC(ctx, (size_t)qwork + 1, work);
+  FCM_ALLOC(ctx, (size_t)qiwork + 1, iwork);
+  info = LAPACKE_dgelsd_work(LAPACK_COL_MAJOR, m, n, nrhs, a, lda, b, ldb, s, rcond, &r, work,
+                             (lapack_int)qwork, iwork);
+  FCM_CHECK(info <= 0, ctx, FCM_ERR_LAPACK, "dgelsd: SVD failed to converge (info = %d)",
+            (int)info);
+  FCM_TRY(ctx, lapack_info(ctx, "dgelsd", info));
+cleanup:
+  if (rank) *rank = (int)r;
+  fcm__free(ctx, s);
+  fcm__free(ctx, work);
+  fcm__free(ctx, iwork);
+  return st;
+}
