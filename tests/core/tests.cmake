@@ -1,0 +1,2 @@
+fcm_add_test(core_ctx tests/core/ctx.c)
+fcm_add_test(core_errors tests/core/errors.c)
