@@ -5,8 +5,8 @@
  *
  *         3                                             7-----14-----6
  *        /|\          Tet10 mid-edge nodes:            /|           /|
- *       / | \           4:(0,1)  5:(1,2)  6:(0,2)     15 19        13 18
- *      7  9  8          7:(0,3)  8:(1,3)  9:(2,3)    /  |         /  |
+ *       / | \           4:(0,1)  5:(1,2)  6:(2,0)     15 19        13 18
+ *      7  8  9          7:(0,3)  8:(1,3)  9:(2,3)    /  |         /  |
  *     /   |   \                                     4-----12-----5   |
  *    0 -6-|----2        Hex20 mid-edge nodes:       |   3-----10-|---2
  *     \   |   /          8:(0,1)  9:(1,2) 10:(2,3)  16 /         17 /
@@ -111,13 +111,15 @@ FCM_API double fcm_element_jacobian(fcm_element_type type, const double *X, cons
  * parallelepiped (with mid-edge nodes at midpoints for Hex20). */
 FCM_API int fcm_element_is_affine(fcm_element_type type, const double *X, double rtol);
 
-/** Inverse map: find xi with x(xi) = x. Closed form for affine cells; otherwise
- * Newton from the reference centroid with a backtracking step.
+/** Inverse map: find xi with x(xi) = x. Closed form for affine cells
+ * (fcm_element_is_affine with rtol 1e-13); otherwise Newton from the reference
+ * centroid with a backtracking (Armijo) line search.
  * @param[in]  ctx  error messages go here (may be NULL)
  * @param[in]  X    nodal coordinates, num_nodes x 3
  * @param[in]  x    physical point (may lie outside the cell)
  * @param[out] xi   reference coordinates
- * @return FCM_OK; FCM_ERR_GEOMETRY when the Jacobian is singular on the path;
+ * @return FCM_OK; FCM_ERR_ARG (invalid type, NULL or non-finite arguments);
+ *         FCM_ERR_GEOMETRY when the cell is degenerate or the Jacobian is singular on the path;
  *         FCM_ERR_NOT_CONVERGED when |x(xi) - x| <= 1e-13 * cell size is not reached
  *         in 50 iterations (xi then holds the last iterate). No allocation. */
 FCM_API fcm_status fcm_element_inverse_map(fcm_ctx *ctx, fcm_element_type type, const double *X,
