@@ -1,0 +1,110 @@
+/* fcm — finite element spaces on a background mesh and assembly of linear
+ * elasticity: DOF map (3 unknowns per active node), the sparse pattern built
+ * once with per-cell scatter offsets, parallel deterministic assembly of
+ * stiffness, consistent mass and body force, symmetric Dirichlet elimination. */
+#ifndef FCM_FEM_H
+#define FCM_FEM_H
+
+#include "fcm/core.h"
+#include "fcm/la.h"
+#include "fcm/mesh.h"
+#include "fcm/quad.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** A vector-valued (3 components) Lagrange space on the active cells of a mesh.
+ * DOF numbering: node n (if active) owns DOFs 3k, 3k+1, 3k+2 with k its rank
+ * among the active nodes (ascending node id), components x, y, z. */
+typedef struct fcm_space fcm_space;
+
+/** Create the space on `mesh` and build the matrix pattern, the per-cell
+ * scatter offsets and a cell colouring (no two cells of a colour share a node).
+ * @param[in]  ctx         context; must outlive the space
+ * @param[in]  mesh        borrowed: must outlive the space and stay unchanged
+ * @param[in]  cell_active num_cells flags (copied), or NULL for all cells. A node is
+ *                         active when an active cell uses it; inactive nodes get no DOFs.
+ * @param[out] space       the new space, NULL on failure
+ * @return FCM_OK, FCM_ERR_ARG (NULL, no active cell), FCM_ERR_UNSUPPORTED (more
+ * DOFs than 32-bit column indices hold), FCM_ERR_ALLOC. Allocates O(nnz). */
+FCM_API fcm_status fcm_space_create(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                    const unsigned char *cell_active, fcm_space **space);
+
+/** Destroy the space; accepts NULL and `*space == NULL`, sets `*space = NULL`. */
+FCM_API void fcm_space_destroy(fcm_space **space);
+
+/** Number of DOFs (3 x active nodes). */
+FCM_API fcm_index fcm_space_num_dofs(const fcm_space *space);
+/** First DOF of a node (its x component), or -1 for an inactive or out-of-range node. */
+FCM_API fcm_index fcm_space_node_dof(const fcm_space *space, fcm_index node);
+/** Number of colours of the assembly colouring. */
+FCM_API int fcm_space_num_colors(const fcm_space *space);
+/** The mesh the space was built on. */
+FCM_API const fcm_mesh *fcm_space_mesh(const fcm_space *space);
+
+/** Create a symmetric CSR matrix with the space's pattern and zero values.
+ * @return FCM_OK, FCM_ERR_ALLOC. Release with fcm_csr_destroy(). */
+FCM_API fcm_status fcm_space_matrix_create(const fcm_space *space, fcm_csr **A);
+
+/** Isotropic linear elastic material. */
+typedef struct fcm_elastic {
+  double young;   /**< Young's modulus E > 0 */
+  double poisson; /**< Poisson's ratio, -1 < nu < 0.5 */
+  double density; /**< mass density rho >= 0 (mass and body force) */
+} fcm_elastic;
+
+/** Lame parameters of (E, nu): lambda = E nu / ((1 + nu)(1 - 2 nu)), mu = E / (2 (1 + nu)).
+ * @return FCM_OK, FCM_ERR_ARG (E <= 0, nu outside (-1, 0.5), non-finite), message names the range. */
+FCM_API fcm_status fcm_elastic_lame(fcm_ctx *ctx, const fcm_elastic *mat, double *lambda,
+                                    double *mu);
+
+/** Quadrature strengths for assembly; 0 selects the element's defaults
+ * (fcm_element_info stiffness_strength / mass_strength). */
+typedef struct fcm_assembly_options {
+  int stiffness_strength; /**< stiffness and body force */
+  int mass_strength;      /**< consistent mass */
+} fcm_assembly_options;
+
+/** Defaults: both strengths 0 (element defaults). */
+FCM_API fcm_assembly_options fcm_assembly_options_default(void);
+
+/** Add the linear elastic stiffness K to A (A must come from
+ * fcm_space_matrix_create() of this space). Cells are processed colour by colour,
+ * in parallel within a colour, so the result is bitwise independent of the
+ * number of threads. @return FCM_OK, FCM_ERR_ARG (bad material, wrong matrix),
+ * FCM_ERR_GEOMETRY (det J <= 0 at a quadrature point: the message names the cell),
+ * FCM_ERR_ALLOC. Allocates per-thread element buffers. */
+FCM_API fcm_status fcm_assemble_stiffness(fcm_space *space, const fcm_elastic *mat,
+                                          const fcm_assembly_options *opts, fcm_csr *A);
+
+/** Add the consistent mass matrix (rho N_a N_b I) to A. Status codes as above. */
+FCM_API fcm_status fcm_assemble_mass(fcm_space *space, const fcm_elastic *mat,
+                                     const fcm_assembly_options *opts, fcm_csr *A);
+
+/** Add the body force of a uniform acceleration `accel` (e.g. gravity),
+ * f_a += integral of rho accel N_a, to f (num_dofs entries). Status codes as above. */
+FCM_API fcm_status fcm_assemble_body_force(fcm_space *space, const fcm_elastic *mat,
+                                           const double accel[3],
+                                           const fcm_assembly_options *opts, double *f);
+
+/** Impose u[dofs[k]] = values[k] on the symmetric system A u = b by elimination
+ * that keeps A symmetric: b_i -= A_ic g_c for free rows, row and column c are
+ * zeroed except the diagonal (kept, or 1 if it is not positive), b_c = A_cc g_c.
+ * @param[in] dofs    ncon distinct DOF indices in [0, num_dofs)
+ * @param[in] values  ncon prescribed values, or NULL for zeros
+ * @return FCM_OK, FCM_ERR_ARG (index out of range, duplicate, non-square A), FCM_ERR_ALLOC.
+ * Allocates O(num_dofs) workspace. */
+FCM_API fcm_status fcm_space_apply_dirichlet(const fcm_space *space, fcm_index ncon,
+                                             const fcm_index *dofs, const double *values,
+                                             fcm_csr *A, double *b);
+
+/** Interpolate a displacement field given per DOF at reference point `xi` of
+ * `cell`: u = sum_a N_a(xi) u_a (inactive cells: FCM_ERR_ARG). No allocation. */
+FCM_API fcm_status fcm_space_eval(const fcm_space *space, fcm_index cell, const double xi[3],
+                                  const double *u, double value[3]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* FCM_FEM_H */

@@ -1,0 +1,34 @@
+/* fem module internals: the space layout shared by space.c and assemble.c. */
+#ifndef FCM_FEM_IMPL_H
+#define FCM_FEM_IMPL_H
+
+#include "core/core_impl.h"
+#include "fcm/fem.h"
+
+struct fcm_space {
+  fcm_ctx *ctx;
+  const fcm_mesh *mesh;
+  fcm_element_type type;
+  int nn;                  /* nodes per cell */
+  fcm_index num_cells;
+  fcm_index num_nodes;
+  unsigned char *active;   /* num_cells */
+  fcm_index *node_dof;     /* num_nodes: first DOF or -1 */
+  fcm_index num_dofs;
+  /* Node graph of active nodes (by active rank): node_ptr[k]..node_ptr[k+1] are
+   * the ranks of the nodes sharing a cell with node k (itself included), sorted. */
+  fcm_index *node_ptr;
+  fcm_index *node_adj;
+  /* Scalar CSR pattern: the three rows of node k each hold 3 columns per neighbour. */
+  fcm_index *row_ptr; /* num_dofs + 1 */
+  int *col_idx;
+  /* Per cell, nn x nn offsets: the position of neighbour b in node a's row of the node
+   * graph, so entry (3ka+i, 3kb+j) lives at row_ptr[3ka+i] + 3 off[a][b] + j. */
+  int *cell_off;
+  /* Cells grouped by colour: color_ptr[c]..color_ptr[c+1] index color_cells. */
+  int num_colors;
+  fcm_index *color_ptr;
+  fcm_index *color_cells;
+};
+
+#endif /* FCM_FEM_IMPL_H */
