@@ -1,0 +1,5 @@
+fcm_add_test(io_vtu_roundtrip tests/io/vtu_roundtrip.c)
+fcm_add_test(io_vtu_errors tests/io/vtu_errors.c)
+fcm_add_test(io_atomic tests/io/atomic.c)
+fcm_add_test(io_pvd tests/io/pvd.c)
+fcm_add_test(io_alloc_failure tests/io/alloc_failure.c)
