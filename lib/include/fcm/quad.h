@@ -41,14 +41,18 @@ FCM_API fcm_status fcm_rule_create_computed(fcm_ctx *ctx, fcm_shape shape, int s
 
 /** n-point Gauss–Jacobi rule on [-1, 1] for the weight (1-x)^alpha (1+x)^beta
  * (alpha, beta > -1), exact for degree 2n-1; alpha = beta = 0 is Gauss–Legendre.
- * Nodes ascending. @return FCM_OK, FCM_ERR_ARG (n < 1 or n > 200, alpha or beta <= -1),
- * FCM_ERR_LAPACK, FCM_ERR_ALLOC. The rule's shape is FCM_SHAPE_LINE. */
+ * Nodes ascending. @return FCM_OK, FCM_ERR_ARG (n < 1 or n > 200, alpha or beta <= -1
+ * or not finite, weight mass not representable), FCM_ERR_LAPACK, FCM_ERR_NUMERIC (a node or
+ * weight came out non-finite, non-positive or outside the interval), FCM_ERR_ALLOC.
+ * The rule's shape is FCM_SHAPE_LINE and its strength 2n-1 (degree, against the weight). */
 FCM_API fcm_status fcm_rule_create_gauss_jacobi(fcm_ctx *ctx, int n, double alpha, double beta,
                                                 fcm_rule **rule);
 
 /** Copy caller arrays into a new rule (origin FCM_RULE_USER).
  * @param[in] points  n x dim coordinates; @param[in] weights n weights.
- * @return FCM_OK, FCM_ERR_ARG (n < 0, NULL arrays with n > 0, non-finite values), FCM_ERR_ALLOC. */
+ * n = 0 (NULL arrays allowed) gives an empty rule.
+ * @return FCM_OK, FCM_ERR_ARG (shape invalid, strength outside [0, FCM_RULE_MAX_STRENGTH],
+ *         n < 0, NULL arrays with n > 0, non-finite values), FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_rule_create_from_arrays(fcm_ctx *ctx, fcm_shape shape, int strength, int n,
                                                const double *points, const double *weights,
                                                fcm_rule **rule);

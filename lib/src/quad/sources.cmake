@@ -1,1 +1,1 @@
-list(APPEND FCM_SOURCES)
+list(APPEND FCM_SOURCES lib/src/quad/gauss.c lib/src/quad/product.c lib/src/quad/rule.c lib/src/quad/tables.c)
