@@ -5,6 +5,7 @@
 #include "fcm/core.h"
 #include "fcm/element.h"
 #include "fcm/io.h"
+#include "fcm/mesh.h"
 #include "fcm/quad.h"
 
 #endif /* FCM_FCM_H */

@@ -1,0 +1,144 @@
+/* fcm — background meshes: nodes and cells of one element type (Tet4, Tet10, Hex8,
+ * Hex20; VTK node order, see fcm/element.h), face adjacency and boundary faces,
+ * structured box generators, the Gmsh MSH reader, and geometric checks.
+ *
+ * Storage: coordinates num_nodes x 3 (row-major, coords[3*a + d]); connectivity
+ * num_cells x nodes_per_cell (cells[npc*c + a], 0-based node ids). A mesh is
+ * immutable after creation; every const accessor is thread safe. */
+#ifndef FCM_MESH_H
+#define FCM_MESH_H
+
+#include "fcm/core.h"
+#include "fcm/element.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** A background mesh (opaque). */
+typedef struct fcm_mesh fcm_mesh;
+
+/** Create a mesh by copying caller arrays; builds the face adjacency and the
+ * boundary-face list (hash of sorted face corners, O(num_cells)).
+ * @param[in]  ctx       context (allocation, errors)
+ * @param[in]  type      element type of every cell
+ * @param[in]  num_nodes number of nodes (>= 0); @param[in] coords num_nodes x 3, copied
+ * @param[in]  num_cells number of cells (>= 0); @param[in] cells num_cells x nodes_per_cell
+ *                       node ids in [0, num_nodes), VTK order, copied
+ * @param[out] mesh      the new mesh, NULL on failure
+ * @return FCM_OK; FCM_ERR_ARG (NULL pointers, bad type, negative counts, non-finite
+ *         coordinate, node id out of range, node repeated within a cell);
+ *         FCM_ERR_GEOMETRY (a face shared by more than two cells); FCM_ERR_ALLOC.
+ * Allocates; release with fcm_mesh_destroy(). Thread safe. */
+FCM_API fcm_status fcm_mesh_create(fcm_ctx *ctx, fcm_element_type type, fcm_index num_nodes,
+                                   const double *coords, fcm_index num_cells,
+                                   const fcm_index *cells, fcm_mesh **mesh);
+
+/** Structured grid of n[0] x n[1] x n[2] cubes over the box [lo, hi].
+ * Hex8/Hex20: one hexahedron per cube. Tet4/Tet10: each cube split into 6 tetrahedra
+ * around its diagonal lo-corner -> hi-corner (Kuhn/Freudenthal split, the same in every
+ * cube, hence conforming). Numbering: grid corner (i,j,k) is node i + (n0+1)(j + (n1+1)k);
+ * cube (i,j,k) is q = i + n0 (j + n1 k); hex cell q, or tet cells 6q..6q+5. Quadratic
+ * types add one node at the midpoint of every edge, numbered after the corners in the
+ * order edges are first met (cells ascending, local edges ascending); neighbours share it.
+ * @param[in] lo, hi box corners (lo[d] < hi[d], finite); @param[in] n cells per axis (>= 1)
+ * @param[out] mesh  the new mesh, NULL on failure
+ * @return FCM_OK, FCM_ERR_ARG (bad type, box or counts, count overflow), FCM_ERR_ALLOC.
+ * Allocates; release with fcm_mesh_destroy(). Thread safe. */
+FCM_API fcm_status fcm_mesh_create_box(fcm_ctx *ctx, fcm_element_type type, const double lo[3],
+                                       const double hi[3], const fcm_index n[3], fcm_mesh **mesh);
+
+/** Read a Gmsh MSH file, ASCII version 4.1 or 2.x (2.0, 2.1, 2.2). Volume elements of
+ * Gmsh types 4 (tet4), 11 (tet10), 5 (hex8) and 17 (hex20) become the cells, in file
+ * order, reordered from Gmsh's to VTK's node order; lower-dimensional elements (points,
+ * lines, triangles, quadrangles, ...) and unknown sections are skipped. Node tags may be
+ * sparse and unordered; nodes not used by any volume element are dropped, the others
+ * keep their file order.
+ * @param[in]  path file name; @param[out] mesh the new mesh, NULL on failure
+ * @return FCM_OK; FCM_ERR_IO (cannot open/read the file); FCM_ERR_FORMAT (malformed
+ *         content or unknown version: the message says "path:line: expected ...");
+ *         FCM_ERR_UNSUPPORTED (binary file, other volume element types, mixed volume
+ *         types, no volume elements); FCM_ERR_GEOMETRY, FCM_ERR_ALLOC as fcm_mesh_create().
+ * Allocates; release with fcm_mesh_destroy(). Thread safe (numbers are parsed with
+ * strtod, i.e. in the C locale's number format). */
+FCM_API fcm_status fcm_mesh_create_from_gmsh(fcm_ctx *ctx, const char *path, fcm_mesh **mesh);
+
+/** Destroy a mesh; accepts NULL and `*mesh == NULL`, sets `*mesh = NULL`. */
+FCM_API void fcm_mesh_destroy(fcm_mesh **mesh);
+
+/** Accessors (mesh must not be NULL). Pointers stay valid for the life of the mesh.
+ * fcm_mesh_coords: num_nodes x 3; fcm_mesh_cells: num_cells x nodes_per_cell. */
+FCM_API fcm_element_type fcm_mesh_element_type(const fcm_mesh *mesh);
+FCM_API const fcm_element_info *fcm_mesh_element_info(const fcm_mesh *mesh);
+FCM_API int fcm_mesh_nodes_per_cell(const fcm_mesh *mesh);
+FCM_API fcm_index fcm_mesh_num_nodes(const fcm_mesh *mesh);
+FCM_API fcm_index fcm_mesh_num_cells(const fcm_mesh *mesh);
+FCM_API const double *fcm_mesh_coords(const fcm_mesh *mesh);
+FCM_API const fcm_index *fcm_mesh_cells(const fcm_mesh *mesh);
+
+/** Gather the nodal coordinates of `cell` (in [0, num_cells)) into X (nodes_per_cell x 3),
+ * ready for fcm_element_map()/fcm_element_jacobian(). No allocation; thread safe. */
+FCM_API void fcm_mesh_cell_coords(const fcm_mesh *mesh, fcm_index cell, double *X);
+
+/** Face adjacency: num_cells x num_faces (num_faces of the element info: 4 or 6);
+ * entry [nf*c + f] is the cell across local face f of cell c, or -1 on the boundary.
+ * Faces are matched by their corner nodes. */
+FCM_API const fcm_index *fcm_mesh_neighbors(const fcm_mesh *mesh);
+
+/** Number of boundary faces (faces with no neighbour). */
+FCM_API fcm_index fcm_mesh_num_boundary_faces(const fcm_mesh *mesh);
+
+/** Boundary faces as pairs (cell, local face): entries [2*i] and [2*i + 1], ordered by
+ * cell then local face. The face's nodes (corners, then mid-edge nodes for quadratic
+ * types) are cells[npc*cell + info->face_nodes[face][k]], k < info->face_num_nodes[face];
+ * for a positively oriented cell their corners run counter-clockwise seen from outside. */
+FCM_API const fcm_index *fcm_mesh_boundary_faces(const fcm_mesh *mesh);
+
+/** Axis-aligned bounding box of all nodes (lo = +inf, hi = -inf for an empty mesh). */
+FCM_API void fcm_mesh_bounding_box(const fcm_mesh *mesh, double lo[3], double hi[3]);
+
+/** Nodes inside the closed box [lo - tol, hi + tol] (all three axes). A plane such as
+ * x = 0 is the box lo = (0, -HUGE_VAL, -HUGE_VAL), hi = (0, HUGE_VAL, HUGE_VAL).
+ * @param[in]  lo, hi   box corners (lo[d] <= hi[d]; infinities allowed, no NaN)
+ * @param[in]  tol      absolute tolerance >= 0
+ * @param[in]  capacity length of `nodes`; @param[out] nodes the first min(count, capacity)
+ *                      matching ids, ascending (may be NULL when capacity is 0)
+ * @param[out] count    the number of matching nodes (call with capacity 0 to size `nodes`)
+ * @return FCM_OK or FCM_ERR_ARG. No allocation; thread safe. */
+FCM_API fcm_status fcm_mesh_nodes_in_box(fcm_ctx *ctx, const fcm_mesh *mesh, const double lo[3],
+                                         const double hi[3], double tol, fcm_index capacity,
+                                         fcm_index *nodes, fcm_index *count);
+
+/** Check that det J > 0 at every corner of every cell and at `num_points` caller-supplied
+ * reference points (e.g. a quadrature rule's points: fcm_rule_points()).
+ * @param[in]  points  num_points x 3 reference coordinates (NULL when num_points is 0)
+ * @param[out] min_det smallest det J met (may be NULL); on failure the failing value
+ * @return FCM_OK; FCM_ERR_GEOMETRY naming the first failing cell, the point and det J
+ *         (the check stops there); FCM_ERR_ARG. No allocation; thread safe. */
+FCM_API fcm_status fcm_mesh_validate(fcm_ctx *ctx, const fcm_mesh *mesh, int num_points,
+                                     const double *points, double *min_det);
+
+/** Whether `cell` is a convex polyhedron with planar faces and straight edges, the shape
+ * cut-cell quadrature needs. Tolerances are rtol * (diagonal of the cell's bounding box):
+ * every face's corners lie within it of the face plane (Newell normal through the corner
+ * centroid); every corner of the cell lies on the inner side of every face plane (outward
+ * normals from the element's face order, so an inverted cell is not convex); for Tet10 and
+ * Hex20 each mid-edge node lies within it of the straight edge, strictly inside the middle
+ * half of the edge (so the edge map is one-to-one). Returns 1 or 0; no allocation. */
+FCM_API int fcm_mesh_cell_is_convex(const fcm_mesh *mesh, fcm_index cell, double rtol);
+
+/** fcm_mesh_cell_is_convex() for every cell.
+ * @param[in]  rtol          relative tolerance (>= 0, e.g. 1e-10)
+ * @param[out] is_convex     num_cells flags (1 convex, 0 not); may be NULL
+ * @param[out] num_nonconvex number of cells flagged 0; may be NULL
+ * @return FCM_OK or FCM_ERR_ARG. No allocation; thread safe. */
+FCM_API fcm_status fcm_mesh_convex_cells(fcm_ctx *ctx, const fcm_mesh *mesh, double rtol,
+                                         unsigned char *is_convex, fcm_index *num_nonconvex);
+
+/** Print type, counts, bounding box and boundary-face count to `stream`. */
+FCM_API void fcm_mesh_view(const fcm_mesh *mesh, FILE *stream);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* FCM_MESH_H */

@@ -1,0 +1,56 @@
+/* fcm mesh, internal part: the mesh struct and helpers shared by the mesh
+ * sources (generators and readers hand over arrays they allocated). */
+#ifndef FCM_MESH_IMPL_H
+#define FCM_MESH_IMPL_H
+
+#include "core/core_impl.h"
+#include "fcm/mesh.h"
+
+#include <stdint.h>
+
+struct fcm_mesh {
+  fcm_ctx *ctx;
+  fcm_element_type type;
+  const fcm_element_info *info;
+  int npc; /* nodes per cell */
+  fcm_index num_nodes;
+  fcm_index num_cells;
+  double *coords;       /* num_nodes x 3 */
+  fcm_index *cells;     /* num_cells x npc */
+  fcm_index *neighbors; /* num_cells x info->num_faces, -1 on the boundary */
+  fcm_index num_boundary;
+  fcm_index *boundary; /* num_boundary x 2: (cell, local face) */
+};
+
+/* Create a mesh that takes ownership of `*coords` and `*cells` (allocated with
+ * fcm__calloc on ctx): on return, success or failure, both are NULL (freed on
+ * failure). Validates like fcm_mesh_create(). */
+fcm_status fcm__mesh_create_take(fcm_ctx *ctx, fcm_element_type type, fcm_index num_nodes,
+                                 double **coords, fcm_index num_cells, fcm_index **cells,
+                                 fcm_mesh **mesh);
+
+/* Turn a linear mesh (Tet4 or Hex8 arrays) into its quadratic version (Tet10 or
+ * Hex20): one new node at the midpoint of every edge, shared between cells, numbered
+ * after the existing nodes in the order the edges are first met. Allocates
+ * *new_coords and *new_cells on ctx; the inputs are not modified. */
+fcm_status fcm__mesh_add_mid_edge_nodes(fcm_ctx *ctx, fcm_element_type linear_type,
+                                        fcm_index num_nodes, const double *coords,
+                                        fcm_index num_cells, const fcm_index *cells,
+                                        fcm_index *new_num_nodes, double **new_coords,
+                                        fcm_index **new_cells);
+
+/* Smallest power of two >= 2n (at least 16): capacity of an open-addressing table. */
+fcm_status fcm__mesh_hash_capacity(fcm_ctx *ctx, fcm_index n, size_t *cap);
+
+/* 64-bit mixing (splitmix64 finalizer) for the hash tables. */
+static inline uint64_t fcm__mesh_mix(uint64_t h)
+{
+  h ^= h >> 30;
+  h *= 0xbf58476d1ce4e5b9ULL;
+  h ^= h >> 27;
+  h *= 0x94d049bb133111ebULL;
+  h ^= h >> 31;
+  return h;
+}
+
+#endif /* FCM_MESH_IMPL_H */
