@@ -4,6 +4,7 @@
 
 #include "fcm/core.h"
 #include "fcm/element.h"
+#include "fcm/la.h"
 #include "fcm/io.h"
 #include "fcm/mesh.h"
 #include "fcm/quad.h"

@@ -5,8 +5,10 @@
 #define FCM_LA_IMPL_H
 
 #include "core/core_impl.h"
+#include "fcm/la.h"
 
-/* C = alpha op(A) op(B) + beta C, op = 'N' or 'T'. */
+/* C = alpha op(A) op(B) + beta C, op = 'N' or 'T'. Sizes are not checked: the
+ * caller passes valid leading dimensions (cblas would print on bad ones). */
 void fcm__gemm(char transa, char transb, int m, int n, int k, double alpha, const double *a,
                int lda, const double *b, int ldb, double beta, double *c, int ldc);
 
@@ -38,7 +40,8 @@ fcm_status fcm__getrf(fcm_ctx *ctx, int n, double *a, int lda, int *ipiv);
 fcm_status fcm__getrs(fcm_ctx *ctx, int n, int nrhs, const double *lu, int lda, const int *ipiv,
                       double *b, int ldb);
 
-/* Cholesky A = L L^T in place (lower); FCM_ERR_SINGULAR if not positive definite. */
+/* Cholesky A = L L^T in place (lower triangle read and overwritten);
+ * FCM_ERR_SINGULAR naming the leading minor if not positive definite. */
 fcm_status fcm__potrf(fcm_ctx *ctx, int n, double *a, int lda);
 
 /* Solve A X = B with the factor of fcm__potrf. */
@@ -50,5 +53,39 @@ fcm_status fcm__potrs(fcm_ctx *ctx, int n, int nrhs, const double *l, int lda, d
  * zero (rcond < 0: machine precision); *rank receives the effective rank (may be NULL). */
 fcm_status fcm__lstsq(fcm_ctx *ctx, int m, int n, int nrhs, double *a, int lda, double *b, int ldb,
                       double rcond, int *rank);
+
+/* ---- sparse ---- */
+
+/* The CSR matrix (public type fcm_csr, layout documented in fcm/la.h). */
+struct fcm_csr {
+  fcm_ctx *ctx;
+  fcm_index nrows, ncols, nnz;
+  fcm_index *row_ptr; /* nrows + 1 */
+  int *col_idx;       /* nnz, sorted and unique per row */
+  double *values;     /* nnz */
+  fcm_csr_kind kind;
+  int owned; /* 1: the arrays were allocated through ctx; 0: borrowed (fcm_csr_wrap) */
+};
+
+/* One table per sparse direct-solver adapter (cholmod_adapter.c,
+ * umfpack_adapter.c); fcm_direct (direct.c) checks arguments and phases, counts
+ * and times, and calls these. `impl` is the adapter's state. The adapter sets
+ * info->factor_nnz, factor_flops, rcond and failed_column; the caller the
+ * counters and timings, except `analyses`, which the adapter increments each
+ * time the library really computes a symbolic analysis. */
+typedef struct fcm__direct_ops {
+  const char *name;
+  /* Take the pattern of the square matrix A (its values are not read). */
+  fcm_status (*create)(fcm_ctx *ctx, const fcm_csr *A, void **impl);
+  fcm_status (*analyze)(fcm_ctx *ctx, void *impl, fcm_direct_info *info);
+  /* Values are finite (checked by the caller). On failure no factor is kept. */
+  fcm_status (*factor)(fcm_ctx *ctx, void *impl, const double *values, fcm_direct_info *info);
+  /* x may equal b. */
+  fcm_status (*solve)(fcm_ctx *ctx, void *impl, const double *b, double *x);
+  void (*destroy)(fcm_ctx *ctx, void *impl); /* accepts impl == NULL */
+} fcm__direct_ops;
+
+extern const fcm__direct_ops fcm__cholmod_ops;
+extern const fcm__direct_ops fcm__umfpack_ops;
 
 #endif /* FCM_LA_IMPL_H */

@@ -26,17 +26,24 @@ void fcm__gemv(char trans, int m, int n, double alpha, const double *a, int lda,
   cblas_dgemv(CblasColMajor, cblas_trans(trans), m, n, alpha, a, lda, x, 1, beta, y, 1);
 }
 
-/* FCM_ERR_NUMERIC unless every entry of the m x n matrix is finite. */
-static fcm_status check_finite(fcm_ctx *ctx, const char *routine, int m, int n, const double *a,
-                               int lda)
+/* FCM_ERR_NUMERIC unless every entry of the m x n matrix (with lower_only, of
+ * its lower triangle, the part symmetric routines read) is finite. */
+static fcm_status check_finite_part(fcm_ctx *ctx, const char *routine, int m, int n,
+                                    const double *a, int lda, int lower_only)
 {
   fcm_status st = FCM_OK;
   for (int j = 0; j < n; j++)
-    for (int i = 0; i < m; i++)
+    for (int i = lower_only ? j : 0; i < m; i++)
       FCM_CHECK(isfinite(a[i + (size_t)j * lda]), ctx, FCM_ERR_NUMERIC,
                 "%s: input entry (%d, %d) is %g", routine, i, j, a[i + (size_t)j * lda]);
 cleanup:
   return st;
+}
+
+static fcm_status check_finite(fcm_ctx *ctx, const char *routine, int m, int n, const double *a,
+                               int lda)
+{
+  return check_finite_part(ctx, routine, m, n, a, lda, 0);
 }
 
 /* Map a LAPACKE return value for the routine that gave it. */
@@ -60,7 +67,7 @@ fcm_status fcm__syev(fcm_ctx *ctx, int want_vectors, int n, double *a, int lda, 
   char jobz = want_vectors ? 'V' : 'N';
   FCM_CHECK(n >= 0 && lda >= FCM_MAX(1, n), ctx, FCM_ERR_ARG, "syev: n = %d, lda = %d", n, lda);
   if (n == 0) goto cleanup;
-  FCM_TRY(ctx, check_finite(ctx, "dsyevd", n, n, a, lda));
+  FCM_TRY(ctx, check_finite_part(ctx, "dsyevd", n, n, a, lda, 1));
   info = LAPACKE_dsyevd_work(LAPACK_COL_MAJOR, jobz, 'L', n, a, lda, w, &qwork, -1, &qiwork, -1);
   FCM_TRY(ctx, lapack_info(ctx, "dsyevd (workspace query)", info));
   FCM_ALLOC(ctx, (size_t)qwork + 1, work);
@@ -83,6 +90,8 @@ fcm_status fcm__stev(fcm_ctx *ctx, int n, double *d, double *e, double *z, int l
   double *work = NULL;
   lapack_int info;
   FCM_CHECK(n >= 0, ctx, FCM_ERR_ARG, "stev: n = %d must be non-negative", n);
+  FCM_CHECK(!z || ldz >= FCM_MAX(1, n), ctx, FCM_ERR_ARG, "stev: ldz = %d must be >= n = %d", ldz,
+            n);
   if (n == 0) goto cleanup;
   FCM_TRY(ctx, check_finite(ctx, "dstev", n, 1, d, n));
   if (n > 1) FCM_TRY(ctx, check_finite(ctx, "dstev", n - 1, 1, e, n - 1));
@@ -105,6 +114,11 @@ fcm_status fcm__gesvd(fcm_ctx *ctx, int m, int n, double *a, int lda, double *s,
   char jobu = u ? 'S' : 'N', jobvt = vt ? 'S' : 'N';
   FCM_CHECK(m >= 0 && n >= 0 && lda >= FCM_MAX(1, m), ctx, FCM_ERR_ARG,
             "gesvd: m = %d, n = %d, lda = %d", m, n, lda);
+  /* Checked here so that LAPACK's xerbla (which prints) is never reached. */
+  FCM_CHECK(!u || ldu >= FCM_MAX(1, m), ctx, FCM_ERR_ARG, "gesvd: ldu = %d must be >= m = %d",
+            ldu, m);
+  FCM_CHECK(!vt || ldvt >= FCM_MAX(1, FCM_MIN(m, n)), ctx, FCM_ERR_ARG,
+            "gesvd: ldvt = %d must be >= min(m, n) = %d", ldvt, FCM_MIN(m, n));
   if (m == 0 || n == 0) goto cleanup;
   FCM_TRY(ctx, check_finite(ctx, "dgesvd", m, n, a, lda));
   if (!u) u = &dummy, ldu = 1;
@@ -159,7 +173,7 @@ fcm_status fcm__potrf(fcm_ctx *ctx, int n, double *a, int lda)
   lapack_int info;
   FCM_CHECK(n >= 0 && lda >= FCM_MAX(1, n), ctx, FCM_ERR_ARG, "potrf: n = %d, lda = %d", n, lda);
   if (n == 0) goto cleanup;
-  FCM_TRY(ctx, check_finite(ctx, "dpotrf", n, n, a, lda));
+  FCM_TRY(ctx, check_finite_part(ctx, "dpotrf", n, n, a, lda, 1));
   info = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', n, a, lda);
   FCM_CHECK(info <= 0, ctx, FCM_ERR_SINGULAR,
             "dpotrf: matrix is not positive definite (leading minor of order %d, n = %d)",

@@ -1,4 +1,5 @@
-/* Small fixed-size 3x3 helpers for hot loops (internal, header-only).
+/* Small fixed-size 3x3 helpers for hot loops (internal). The inline ones live
+ * here; the iterative decompositions (eigen, SVD, polar) are in mat3.c.
  * Matrices are row-major double[9]: A[3*i + j]. */
 #ifndef FCM_MAT3_H
 #define FCM_MAT3_H
@@ -78,5 +79,26 @@ static inline double fcm__mat3_norm(const double A[9])
   for (int i = 0; i < 9; i++) s += A[i] * A[i];
   return sqrt(s);
 }
+
+/* Symmetric eigen-decomposition A = Q diag(lambda) Q^T of the symmetric part
+ * (A + A^T)/2 by cyclic Jacobi rotations, iterated until every off-diagonal entry
+ * is negligible against its diagonal pair (relative accuracy ~ machine epsilon).
+ * lambda ascending; the columns of Q (Q[3*i + k] = component i of eigenvector k)
+ * are orthonormal and right-handed (det Q = +1). Returns the number of sweeps
+ * (>= 0), or -1 for NaN/Inf input (lambda = NaN, Q = I). No allocation. */
+int fcm__mat3_sym_eig(const double A[9], double lambda[3], double Q[9]);
+
+/* Singular value decomposition F = U diag(sigma) V^T, rotation variant: U and V
+ * are proper rotations (det +1), sigma[0] >= sigma[1] >= |sigma[2]|, and sigma[2]
+ * carries the sign of det F (negative for inverted F). One-sided Jacobi on the
+ * columns of F, to machine precision, robust for rank-deficient F. Returns the
+ * number of sweeps (>= 0), or -1 for NaN/Inf input (sigma = NaN, U = V = I). */
+int fcm__mat3_svd(const double F[9], double U[9], double sigma[3], double V[9]);
+
+/* Polar decomposition F = R S with R a proper rotation (det R = +1, also for
+ * det F <= 0) and S = V diag(sigma) V^T symmetric (positive definite when
+ * det F > 0; its smallest eigenvalue is negative when det F < 0). Built from
+ * fcm__mat3_svd, whose return value it passes on. */
+int fcm__mat3_polar(const double F[9], double R[9], double S[9]);
 
 #endif /* FCM_MAT3_H */

@@ -1,0 +1,174 @@
+/* The one adapter to CHOLMOD (SuiteSparse 5.x): supernodal Cholesky L L^T of a
+ * symmetric positive definite CSR matrix through the SuiteSparse_long interface.
+ *
+ * Our CSR arrays of a symmetric A, read as compressed columns, are A itself; we
+ * hand CHOLMOD stype = +1 (only entries with row <= column are read), so both
+ * stored triangles are fine. The symbolic analysis (fill-reducing ordering,
+ * supernodes) is done once; each factorization reuses it with new values. CHOLMOD
+ * never prints (Common->print = 0, no error handler): its Common->status is
+ * mapped to fcm statuses after every call. */
+#include "la/la_impl.h"
+
+#include <cholmod.h>
+#include <string.h>
+
+_Static_assert(sizeof(SuiteSparse_long) == sizeof(fcm_index),
+               "fcm expects SuiteSparse_long to be 64-bit like fcm_index");
+
+typedef struct chol {
+  cholmod_common c;
+  int started;
+  cholmod_sparse A;          /* header over ap, ai (and the values during factor) */
+  SuiteSparse_long *ap, *ai; /* the pattern, as CHOLMOD's integer type */
+  cholmod_factor *L;         /* symbolic after analyze, numeric after factor */
+  cholmod_dense *X, *Y, *E;  /* solve workspaces, allocated once by cholmod_l_solve2 */
+  fcm_index n;
+} chol;
+
+/* Map CHOLMOD's status after a failed or warned call in `phase`. */
+static fcm_status map_status(fcm_ctx *ctx, const chol *h, const char *phase)
+{
+  fcm_status st = FCM_OK;
+  int s = h->c.status;
+  long long n = (long long)h->n;
+  FCM_CHECK(s != CHOLMOD_OUT_OF_MEMORY, ctx, FCM_ERR_ALLOC, "cholmod %s: out of memory (n = %lld)",
+            phase, n);
+  FCM_CHECK(s != CHOLMOD_TOO_LARGE, ctx, FCM_ERR_UNSUPPORTED,
+            "cholmod %s: problem too large, integer overflow (n = %lld)", phase, n);
+  FCM_CHECK(s != CHOLMOD_NOT_INSTALLED, ctx, FCM_ERR_UNSUPPORTED,
+            "cholmod %s: required CHOLMOD module not installed", phase);
+  FCM_CHECK(s != CHOLMOD_INVALID, ctx, FCM_ERR_INTERNAL, "cholmod %s: invalid input (n = %lld)",
+            phase, n);
+  FCM_CHECK(s >= CHOLMOD_OK, ctx, FCM_ERR_INTERNAL, "cholmod %s: failed with status %d", phase, s);
+cleanup:
+  return st;
+}
+
+static void chol_destroy(fcm_ctx *ctx, void *impl)
+{
+  chol *h = impl;
+  if (!h) return;
+  if (h->started) {
+    cholmod_l_free_factor(&h->L, &h->c);
+    cholmod_l_free_dense(&h->X, &h->c);
+    cholmod_l_free_dense(&h->Y, &h->c);
+    cholmod_l_free_dense(&h->E, &h->c);
+    cholmod_l_finish(&h->c);
+  }
+  fcm__free(ctx, h->ap);
+  fcm__free(ctx, h->ai);
+  fcm__free(ctx, h);
+}
+
+static fcm_status chol_create(fcm_ctx *ctx, const fcm_csr *A, void **impl)
+{
+  fcm_status st = FCM_OK;
+  chol *h = NULL;
+  FCM_ALLOC(ctx, 1, h);
+  h->n = A->nrows;
+  FCM_ALLOC(ctx, A->nrows + 1, h->ap);
+  FCM_ALLOC(ctx, A->nnz, h->ai);
+  for (fcm_index i = 0; i <= A->nrows; i++)
+    h->ap[i] = (SuiteSparse_long)A->row_ptr[i];
+  for (fcm_index p = 0; p < A->nnz; p++)
+    h->ai[p] = (SuiteSparse_long)A->col_idx[p];
+  FCM_CHECK(cholmod_l_start(&h->c), ctx, FCM_ERR_INTERNAL, "cholmod start: failed with status %d",
+            h->c.status);
+  h->started = 1;
+  h->c.print = 0;
+  h->c.error_handler = NULL;
+  h->c.supernodal = CHOLMOD_SUPERNODAL;
+  h->c.quick_return_if_not_posdef = 1; /* a failed factor is discarded anyway */
+
+  cholmod_sparse *S = &h->A;
+  S->nrow = (size_t)A->nrows;
+  S->ncol = (size_t)A->nrows;
+  S->nzmax = (size_t)A->nnz;
+  S->p = h->ap;
+  S->i = h->ai;
+  S->nz = NULL;
+  S->x = NULL;
+  S->z = NULL;
+  S->stype = 1;
+  S->itype = CHOLMOD_LONG;
+  S->xtype = CHOLMOD_PATTERN;
+  S->dtype = CHOLMOD_DOUBLE;
+  S->sorted = 1;
+  S->packed = 1;
+  *impl = h;
+  h = NULL;
+cleanup:
+  chol_destroy(ctx, h);
+  return st;
+}
+
+static fcm_status chol_analyze(fcm_ctx *ctx, void *impl, fcm_direct_info *info)
+{
+  fcm_status st = FCM_OK;
+  chol *h = impl;
+  h->c.status = CHOLMOD_OK;
+  h->L = cholmod_l_analyze(&h->A, &h->c);
+  if (!h->L) FCM_TRY(ctx, map_status(ctx, h, "analyze"));
+  FCM_CHECK(h->L, ctx, FCM_ERR_INTERNAL, "cholmod analyze: no factor returned (status %d)",
+            h->c.status);
+  info->analyses++;
+  info->factor_nnz = h->c.lnz;
+  info->factor_flops = h->c.fl;
+cleanup:
+  return st;
+}
+
+static fcm_status chol_factor(fcm_ctx *ctx, void *impl, const double *values, fcm_direct_info *info)
+{
+  fcm_status st = FCM_OK;
+  chol *h = impl;
+  h->A.x = (void *)values; /* read only: cholmod_l_factorize does not write A */
+  h->A.xtype = CHOLMOD_REAL;
+  h->c.status = CHOLMOD_OK;
+  int ok = cholmod_l_factorize(&h->A, h->L, &h->c);
+  h->A.x = NULL;
+  h->A.xtype = CHOLMOD_PATTERN;
+  if (h->c.status == CHOLMOD_NOT_POSDEF) {
+    /* L->minor is the failing column in the permuted order; report the original. */
+    size_t k = h->L->minor;
+    const SuiteSparse_long *perm = h->L->Perm;
+    fcm_index col = (k < (size_t)h->n) ? (perm ? (fcm_index)perm[k] : (fcm_index)k) : -1;
+    info->failed_column = col;
+    FCM_CHECK(0, ctx, FCM_ERR_SINGULAR,
+              "cholmod factor: matrix is not positive definite (pivot of column %lld, n = %lld); "
+              "an indefinite symmetric matrix needs umfpack",
+              (long long)col, (long long)h->n);
+  }
+  if (!ok || h->c.status < CHOLMOD_OK) FCM_TRY(ctx, map_status(ctx, h, "factor"));
+  FCM_CHECK(ok, ctx, FCM_ERR_INTERNAL, "cholmod factor: failed with status %d", h->c.status);
+  info->factor_nnz = h->c.lnz;
+  info->factor_flops = h->c.fl;
+  info->rcond = cholmod_l_rcond(h->L, &h->c);
+cleanup:
+  return st;
+}
+
+static fcm_status chol_solve(fcm_ctx *ctx, void *impl, const double *b, double *x)
+{
+  fcm_status st = FCM_OK;
+  chol *h = impl;
+  cholmod_dense B;
+  B.nrow = (size_t)h->n;
+  B.ncol = 1;
+  B.nzmax = (size_t)h->n;
+  B.d = (size_t)h->n;
+  B.x = (void *)b; /* read only */
+  B.z = NULL;
+  B.xtype = CHOLMOD_REAL;
+  B.dtype = CHOLMOD_DOUBLE;
+  h->c.status = CHOLMOD_OK;
+  int ok = cholmod_l_solve2(CHOLMOD_A, h->L, &B, NULL, &h->X, NULL, &h->Y, &h->E, &h->c);
+  if (!ok || h->c.status < CHOLMOD_OK) FCM_TRY(ctx, map_status(ctx, h, "solve"));
+  FCM_CHECK(ok, ctx, FCM_ERR_INTERNAL, "cholmod solve: failed with status %d", h->c.status);
+  memcpy(x, h->X->x, (size_t)h->n * sizeof *x);
+cleanup:
+  return st;
+}
+
+const fcm__direct_ops fcm__cholmod_ops = {"cholmod",   chol_create, chol_analyze,
+                                          chol_factor, chol_solve,  chol_destroy};
