@@ -8,6 +8,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#if defined(__GNUC__)
+__attribute__((unused))
+#endif
 static int test_failures_ = 0;
 
 #define TEST_FAIL_(...)                                                                            \

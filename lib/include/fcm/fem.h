@@ -59,12 +59,33 @@ typedef struct fcm_elastic {
 FCM_API fcm_status fcm_elastic_lame(fcm_ctx *ctx, const fcm_elastic *mat, double *lambda,
                                     double *mu);
 
-/** Quadrature strengths for assembly; 0 selects the element's defaults
- * (fcm_element_info stiffness_strength / mass_strength). */
+/** Quadrature strengths for assembly on full cells; 0 selects the default rule of
+ * fcm_element_standard_rule(). */
 typedef struct fcm_assembly_options {
   int stiffness_strength; /**< stiffness and body force */
   int mass_strength;      /**< consistent mass */
 } fcm_assembly_options;
+
+/** Which element integral a standard rule is for. */
+typedef enum fcm_integrand {
+  FCM_INTEGRAND_STIFFNESS = 0, /**< gradients times gradients; also body force */
+  FCM_INTEGRAND_MASS = 1       /**< shape functions times shape functions */
+} fcm_integrand;
+
+/** The rule used on uncut (full) cells of `type` for `integrand`.
+ * strength <= 0 selects the default: for tetrahedra the catalogue rule
+ * (fcm_rule_create) of the element's stiffness_strength or mass_strength; for
+ * hexahedra the Gauss-Legendre tensor rule with order+1 points per direction
+ * (2^3 for Hex8, 3^3 for Hex20), which integrates both the stiffness and the mass
+ * of an affine cell exactly and keeps the patch test exact on distorted cells —
+ * total-degree rules of the element strengths do neither (the Hex20 stiffness
+ * integrand has total degree 6 but degree 4 per direction).
+ * strength > 0 selects the catalogue rule of that strength for either shape.
+ * @return FCM_OK, FCM_ERR_ARG (invalid type, strength > FCM_RULE_MAX_STRENGTH), FCM_ERR_ALLOC.
+ * Allocates *rule; release with fcm_rule_destroy(). Thread safe. */
+FCM_API fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type,
+                                             fcm_integrand integrand, int strength,
+                                             fcm_rule **rule);
 
 /** Defaults: both strengths 0 (element defaults). */
 FCM_API fcm_assembly_options fcm_assembly_options_default(void);

@@ -38,12 +38,33 @@ typedef struct tabulation {
   double *dN;      /* nq x nn x 3 */
 } tabulation;
 
-static fcm_status tabulate(fcm_space *s, int strength, fcm_rule **rule, tabulation *t)
+fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type, fcm_integrand integrand,
+                                     int strength, fcm_rule **rule)
+{
+  fcm_status st = FCM_OK;
+  const fcm_element_info *info = fcm_element_get_info(type);
+  FCM_CHECK(info, ctx, FCM_ERR_ARG, "standard rule: invalid element type %d", (int)type);
+  FCM_CHECK(integrand == FCM_INTEGRAND_STIFFNESS || integrand == FCM_INTEGRAND_MASS, ctx,
+            FCM_ERR_ARG, "standard rule: invalid integrand %d", (int)integrand);
+  if (strength > 0)
+    FCM_TRY(ctx, fcm_rule_create(ctx, info->shape, strength, rule));
+  else if (info->shape == FCM_SHAPE_HEX) /* order+1 points per direction: strength 2*order+1 */
+    FCM_TRY(ctx, fcm_rule_create_computed(ctx, info->shape, 2 * info->order + 1, rule));
+  else
+    FCM_TRY(ctx, fcm_rule_create(ctx, info->shape,
+                                 integrand == FCM_INTEGRAND_MASS ? info->mass_strength
+                                                                 : info->stiffness_strength,
+                                 rule));
+cleanup:
+  return st;
+}
+
+static fcm_status tabulate(fcm_space *s, fcm_integrand integrand, int strength, fcm_rule **rule,
+                           tabulation *t)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
-  const fcm_element_info *info = fcm_element_get_info(s->type);
-  FCM_TRY(ctx, fcm_rule_create(ctx, info->shape, strength, rule));
+  FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, integrand, strength, rule));
   t->nq = fcm_rule_num_points(*rule);
   t->nn = s->nn;
   t->w = fcm_rule_weights(*rule);
@@ -89,16 +110,22 @@ static double physical_gradients(const tabulation *t, int q, const double *X, do
 }
 
 /* Element matrix (3nn x 3nn, row-major) or vector (3nn) of one cell; returns the
- * first non-positive det J met (1 when all are positive). */
+ * first non-positive det J met (1 when all are positive). `H` is scratch of
+ * (3nn)^2 entries.
+ * Stiffness: with v the 3nn-vector of all physical gradients at a point, the
+ * sums H = sum_q w_q det J_q v v^T (a symmetric rank-one update per point, the
+ * only work that grows with the number of points) give the isotropic element
+ * matrix K_(a,i)(b,j) = lambda H_(a,i)(b,j) + mu H_(a,j)(b,i) + mu delta_ij
+ * sum_k H_(a,k)(b,k), assembled once per cell. */
 static double cell_kernel(const kernel_data *kd, const tabulation *t, const double *X, double *g,
-                          double *Ke)
+                          double *H, double *Ke)
 {
   int nn = t->nn, ndof = 3 * nn;
   double bad = 1.0;
   if (kd->kind == KERNEL_BODY_FORCE)
     memset(Ke, 0, sizeof *Ke * (size_t)ndof);
   else
-    memset(Ke, 0, sizeof *Ke * (size_t)ndof * ndof);
+    memset(H, 0, sizeof *H * (size_t)ndof * ndof);
   for (int q = 0; q < t->nq; q++) {
     double det = physical_gradients(t, q, X, g);
     if (!(det > 0.0)) {
@@ -108,37 +135,47 @@ static double cell_kernel(const kernel_data *kd, const tabulation *t, const doub
     double wd = t->w[q] * det;
     const double *N = t->N + (size_t)q * nn;
     if (kd->kind == KERNEL_STIFFNESS) {
-      double l = wd * kd->lambda, m = wd * kd->mu;
-      for (int a = 0; a < nn; a++) {
-        const double *ga = g + 3 * a;
-        for (int b = a; b < nn; b++) {
-          const double *gb = g + 3 * b;
-          double dot = m * (ga[0] * gb[0] + ga[1] * gb[1] + ga[2] * gb[2]);
-          for (int i = 0; i < 3; i++) {
-            double *row = Ke + (size_t)(3 * a + i) * ndof + 3 * b;
-            for (int j = 0; j < 3; j++) row[j] += l * ga[i] * gb[j] + m * ga[j] * gb[i];
-            row[i] += dot;
-          }
-        }
+      for (int r = 0; r < ndof; r++) {
+        double sr = wd * g[r], *Hr = H + (size_t)r * ndof;
+        for (int c = r; c < ndof; c++) Hr[c] += sr * g[c];
       }
     } else if (kd->kind == KERNEL_MASS) {
-      double r = wd * kd->rho;
-      for (int a = 0; a < nn; a++)
-        for (int b = a; b < nn; b++) {
-          double v = r * N[a] * N[b];
-          for (int i = 0; i < 3; i++) Ke[(size_t)(3 * a + i) * ndof + 3 * b + i] += v;
-        }
+      double rw = wd * kd->rho;
+      for (int a = 0; a < nn; a++) {
+        double sa = rw * N[a], *Ha = H + (size_t)a * nn;
+        for (int b = a; b < nn; b++) Ha[b] += sa * N[b];
+      }
     } else {
       for (int a = 0; a < nn; a++)
         for (int i = 0; i < 3; i++) Ke[3 * a + i] += wd * kd->rho * kd->accel[i] * N[a];
     }
   }
-  if (kd->kind != KERNEL_BODY_FORCE) /* mirror the upper node blocks */
+  if (kd->kind == KERNEL_BODY_FORCE) return bad;
+  memset(Ke, 0, sizeof *Ke * (size_t)ndof * ndof);
+  if (kd->kind == KERNEL_STIFFNESS) {
+    double l = kd->lambda, m = kd->mu;
+    for (int r = 0; r < ndof; r++) /* complete H from its upper triangle */
+      for (int c = 0; c < r; c++) H[(size_t)r * ndof + c] = H[(size_t)c * ndof + r];
     for (int a = 0; a < nn; a++)
-      for (int b = 0; b < a; b++)
-        for (int i = 0; i < 3; i++)
-          for (int j = 0; j < 3; j++)
-            Ke[(size_t)(3 * a + i) * ndof + 3 * b + j] = Ke[(size_t)(3 * b + j) * ndof + 3 * a + i];
+      for (int b = a; b < nn; b++) {
+        const double *Hab = H + (size_t)(3 * a) * ndof + 3 * b; /* block (a, b) of H */
+        double tr = m * (Hab[0] + Hab[ndof + 1] + Hab[2 * ndof + 2]);
+        for (int i = 0; i < 3; i++) {
+          double *row = Ke + (size_t)(3 * a + i) * ndof + 3 * b;
+          for (int j = 0; j < 3; j++) row[j] = l * Hab[i * ndof + j] + m * Hab[j * ndof + i];
+          row[i] += tr;
+        }
+      }
+  } else {
+    for (int a = 0; a < nn; a++)
+      for (int b = a; b < nn; b++)
+        for (int i = 0; i < 3; i++) Ke[(size_t)(3 * a + i) * ndof + 3 * b + i] = H[(size_t)a * nn + b];
+  }
+  for (int a = 0; a < nn; a++) /* mirror the upper node blocks */
+    for (int b = 0; b < a; b++)
+      for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+          Ke[(size_t)(3 * a + i) * ndof + 3 * b + j] = Ke[(size_t)(3 * b + j) * ndof + 3 * a + i];
   return bad;
 }
 
@@ -153,23 +190,25 @@ static fcm_status assemble(fcm_space *s, const kernel_data *kd, int strength, do
   tabulation t = {0, 0, NULL, NULL, NULL};
   double *work = NULL;
   int nn = s->nn, ndof = 3 * nn, nthreads = omp_get_max_threads();
-  size_t per_thread = (size_t)nn * 3 * 3 + (size_t)ndof * ndof + (size_t)nn * 3;
+  size_t per_thread = (size_t)nn * 3 * 3 + 2 * (size_t)ndof * ndof + (size_t)nn * 3;
   fcm_index bad_cell = -1;
   double bad_det = 1.0;
   const fcm_index *cells = fcm_mesh_cells(s->mesh);
-  FCM_TRY(ctx, tabulate(s, strength, &rule, &t));
+  FCM_TRY(ctx, tabulate(s, kd->kind == KERNEL_MASS ? FCM_INTEGRAND_MASS : FCM_INTEGRAND_STIFFNESS,
+                        strength, &rule, &t));
   FCM_ALLOC(ctx, per_thread * (size_t)nthreads, work);
   for (int color = 0; color < s->num_colors; color++) {
     fcm_index c0 = s->color_ptr[color], c1 = s->color_ptr[color + 1];
 #pragma omp parallel num_threads(nthreads)
     {
       double *X = work + per_thread * (size_t)omp_get_thread_num();
-      double *Ke = X + (size_t)nn * 3, *g = Ke + (size_t)ndof * ndof;
+      double *Ke = X + (size_t)nn * 3, *H = Ke + (size_t)ndof * ndof;
+      double *g = H + (size_t)ndof * ndof;
 #pragma omp for schedule(static)
       for (fcm_index k = c0; k < c1; k++) {
         fcm_index c = s->color_cells[k];
         fcm_mesh_cell_coords(s->mesh, c, X);
-        double det = cell_kernel(kd, &t, X, g, Ke);
+        double det = cell_kernel(kd, &t, X, g, H, Ke);
         if (!(det > 0.0)) {
 #pragma omp critical(fcm_assemble_bad)
           if (bad_cell < 0 || c < bad_cell) bad_cell = c, bad_det = det;
@@ -225,8 +264,6 @@ cleanup:
   return st;
 }
 
-static int strength_or(int requested, int dflt) { return requested > 0 ? requested : dflt; }
-
 fcm_status fcm_assemble_stiffness(fcm_space *s, const fcm_elastic *mat,
                                   const fcm_assembly_options *opts, fcm_csr *A)
 {
@@ -235,10 +272,7 @@ fcm_status fcm_assemble_stiffness(fcm_space *s, const fcm_elastic *mat,
   fcm_assembly_options o = opts ? *opts : fcm_assembly_options_default();
   FCM_TRY(s->ctx, fcm_elastic_lame(s->ctx, mat, &kd.lambda, &kd.mu));
   FCM_TRY(s->ctx, check_matrix(s, A));
-  FCM_TRY(s->ctx, assemble(s, &kd,
-                           strength_or(o.stiffness_strength,
-                                       fcm_element_get_info(s->type)->stiffness_strength),
-                           fcm_csr_get_values(A), NULL));
+  FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, fcm_csr_get_values(A), NULL));
 cleanup:
   return st;
 }
@@ -252,9 +286,7 @@ fcm_status fcm_assemble_mass(fcm_space *s, const fcm_elastic *mat,
   FCM_TRY(s->ctx, fcm_elastic_lame(s->ctx, mat, NULL, NULL));
   FCM_TRY(s->ctx, check_matrix(s, A));
   kd.rho = mat->density;
-  FCM_TRY(s->ctx, assemble(s, &kd,
-                           strength_or(o.mass_strength, fcm_element_get_info(s->type)->mass_strength),
-                           fcm_csr_get_values(A), NULL));
+  FCM_TRY(s->ctx, assemble(s, &kd, o.mass_strength, fcm_csr_get_values(A), NULL));
 cleanup:
   return st;
 }
@@ -271,10 +303,7 @@ fcm_status fcm_assemble_body_force(fcm_space *s, const fcm_elastic *mat, const d
             "body force: acceleration (%g, %g, %g) is not finite", accel[0], accel[1], accel[2]);
   kd.rho = mat->density;
   memcpy(kd.accel, accel, sizeof kd.accel);
-  FCM_TRY(s->ctx, assemble(s, &kd,
-                           strength_or(o.stiffness_strength,
-                                       fcm_element_get_info(s->type)->stiffness_strength),
-                           NULL, f));
+  FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, NULL, f));
 cleanup:
   return st;
 }
