@@ -4,9 +4,13 @@
 
 #include "fcm/core.h"
 #include "fcm/element.h"
+#include "fcm/fem.h"
 #include "fcm/la.h"
+#include "fcm/material.h"
 #include "fcm/io.h"
 #include "fcm/mesh.h"
 #include "fcm/quad.h"
+#include "fcm/solve.h"
+#include "fcm/simplify.h"
 
 #endif /* FCM_FCM_H */
