@@ -10,6 +10,7 @@
 #include "fcm/io.h"
 #include "fcm/mesh.h"
 #include "fcm/quad.h"
+#include "fcm/rulegen.h"
 #include "fcm/solve.h"
 #include "fcm/simplify.h"
 
