@@ -92,6 +92,7 @@ typedef struct ws {
   int m, d, nc, M, cap;
   const fcm_rulegen_options *opts;
   double *J, *J2;      /* current and trial Jacobian */
+  double *Js;          /* column-scaled Jacobian of the last factorization */
   double *K, *Kf;      /* Gram matrix and its damped Cholesky factor */
   double *r, *r2;      /* residuals (M) */
   double *y, *dlt, *scale;
@@ -168,9 +169,60 @@ static double max_step(const ws *s, int n, const double *x, const double *w, con
   return tmax;
 }
 
+/* Solve for the step with the current factorization: dlt (unscaled) from the
+ * residual r, the scaled Jacobian Js and the damped Gram factor Kf. */
+static fcm_status solve_step(ws *s, int n, const double *r)
+{
+  fcm_status st = FCM_OK;
+  const int M = s->M, nc = s->nc, nv = n * nc;
+  const int under = nv >= M, sz = under ? M : nv;
+  if (under) {
+    for (int j = 0; j < M; j++) s->y[j] = -r[j];
+    FCM_TRY(s->ctx, fcm__potrs(s->ctx, sz, 1, s->Kf, sz, s->y, sz));
+    fcm__gemv('T', M, nv, 1.0, s->Js, M, s->y, 0.0, s->dlt);
+    for (int i = 0; i < n; i++)
+      if (s->frozen[i])
+        for (int k = 0; k < nc; k++) s->dlt[nc * i + k] = 0.0;
+  } else {
+    fcm__gemv('T', M, nv, -1.0, s->Js, M, r, 0.0, s->dlt);
+    for (int i = 0; i < n; i++)
+      if (s->frozen[i])
+        for (int k = 0; k < nc; k++) s->dlt[nc * i + k] = 0.0;
+    FCM_TRY(s->ctx, fcm__potrs(s->ctx, sz, 1, s->Kf, sz, s->dlt, sz));
+  }
+  for (int c = 0; c < nv; c++) s->dlt[c] /= s->scale[c];
+cleanup:
+  return st;
+}
+
+/* Trial state (x, w) + tau dlt into (x2, w2), its Jacobian into J2 and residual r2. */
+static void trial(ws *s, int n, const double *x, const double *w, double tau, double *f2,
+                  double *rinf2)
+{
+  const int d = s->d, nc = s->nc;
+  for (int i = 0; i < n; i++) {
+    for (int k = 0; k < d; k++)
+      s->x2[(size_t)d * i + k] = x[(size_t)d * i + k] + tau * s->dlt[(size_t)nc * i + k];
+    s->w2[i] = w[i] + tau * s->dlt[(size_t)nc * i + d];
+  }
+  build(s, n, s->x2, s->w2, s->J2, s->r2, f2, rinf2);
+}
+
+/* Make the trial state current. */
+static void accept(ws *s, int n, double *x, double *w)
+{
+  double *t;
+  memcpy(x, s->x2, sizeof(double) * (size_t)s->d * n);
+  memcpy(w, s->w2, sizeof(double) * (size_t)n);
+  t = s->J, s->J = s->J2, s->J2 = t;
+  t = s->r, s->r = s->r2, s->r2 = t;
+}
+
 /* Levenberg–Marquardt on (x, w) with n points, in place. *converged = 1 when
  * max |r_j| <= tol was reached (then s->J, s->r hold the final state). With
- * tol < 0 it only polishes: up to max_iter decreasing steps. */
+ * tol < 0 it only polishes: up to max_iter decreasing steps. After a full step
+ * the factorization is reused for chord steps while they contract the residual
+ * by 4 or more; otherwise the Jacobian and its Gram matrix are refreshed. */
 static fcm_status lm_solve(ws *s, int n, double *x, double *w, double tol, int max_iter,
                            int *converged, double *rinf_out)
 {
@@ -178,7 +230,7 @@ static fcm_status lm_solve(ws *s, int n, double *x, double *w, double tol, int m
   const int M = s->M, d = s->d, nc = s->nc, nv = n * nc;
   const int under = nv >= M, sz = under ? M : nv;
   double f, rinf, lambda = 1e-8;
-  int slow = 0;
+  int slow = 0, have_factor = 0;
   *converged = 0;
   build(s, n, x, w, s->J, s->r, &f, &rinf);
   for (int it = 0;; it++) {
@@ -188,6 +240,21 @@ static fcm_status lm_solve(ws *s, int n, double *x, double *w, double tol, int m
     }
     if (it >= max_iter || !isfinite(f)) break;
     s->iterations++;
+    if (have_factor) { /* chord step with the previous factorization */
+      int block;
+      FCM_TRY(s->ctx, solve_step(s, n, s->r));
+      if (max_step(s, n, x, w, s->dlt, &block) >= 1.0) {
+        double f2, rinf2;
+        trial(s, n, x, w, 1.0, &f2, &rinf2);
+        if (f2 < 0.25 * f) {
+          accept(s, n, x, w);
+          f = f2;
+          rinf = rinf2;
+          continue;
+        }
+      }
+      have_factor = 0;
+    }
     /* scaling: one factor for all coordinate columns, one for all weight columns
      * (per-column scaling would let tiny-weight points fly to the boundary) */
     double sx = 0.0, sw = 0.0;
@@ -203,14 +270,15 @@ static fcm_status lm_solve(ws *s, int n, double *x, double *w, double tol, int m
     sx = sx > 0.0 ? sqrt(sx / (n * d)) : 1.0;
     sw = sw > 0.0 ? sqrt(sw / n) : 1.0;
     for (int c = 0; c < nv; c++) {
-      double *col = s->J + (size_t)M * c;
+      const double *col = s->J + (size_t)M * c;
+      double *out = s->Js + (size_t)M * c;
       s->scale[c] = (c % nc == d) ? sw : sx;
-      for (int j = 0; j < M; j++) col[j] /= s->scale[c];
+      for (int j = 0; j < M; j++) out[j] = col[j] / s->scale[c];
     }
     if (under)
-      fcm__gemm('N', 'T', M, M, nv, 1.0, s->J, M, s->J, M, 0.0, s->K, sz);
+      fcm__gemm('N', 'T', M, M, nv, 1.0, s->Js, M, s->Js, M, 0.0, s->K, sz);
     else
-      fcm__gemm('T', 'N', nv, nv, M, 1.0, s->J, M, s->J, M, 0.0, s->K, sz);
+      fcm__gemm('T', 'N', nv, nv, M, 1.0, s->Js, M, s->Js, M, 0.0, s->K, sz);
     double diag = 0.0;
     for (int k = 0; k < sz; k++) diag += s->K[(size_t)k * sz + k];
     diag /= sz;
@@ -227,27 +295,13 @@ static fcm_status lm_solve(ws *s, int n, double *x, double *w, double tol, int m
         continue;
       }
       FCM_TRY(s->ctx, fst);
-      if (under) {
-        for (int j = 0; j < M; j++) s->y[j] = -s->r[j];
-        FCM_TRY(s->ctx, fcm__potrs(s->ctx, sz, 1, s->Kf, sz, s->y, sz));
-        fcm__gemv('T', M, nv, 1.0, s->J, M, s->y, 0.0, s->dlt);
-        for (int i = 0; i < n; i++)
-          if (s->frozen[i])
-            for (int k = 0; k < nc; k++) s->dlt[nc * i + k] = 0.0;
-      } else {
-        fcm__gemv('T', M, nv, -1.0, s->J, M, s->r, 0.0, s->dlt);
-        for (int i = 0; i < n; i++)
-          if (s->frozen[i])
-            for (int k = 0; k < nc; k++) s->dlt[nc * i + k] = 0.0;
-        FCM_TRY(s->ctx, fcm__potrs(s->ctx, sz, 1, s->Kf, sz, s->dlt, sz));
-      }
-      for (int c = 0; c < nv; c++) s->dlt[c] /= s->scale[c];
+      FCM_TRY(s->ctx, solve_step(s, n, s->r));
       int block;
       double tau = max_step(s, n, x, w, s->dlt, &block);
       if (tau < 1.0 && block >= 0 && nfrozen < FREEZE_MAX && nfrozen < n - 1) {
         /* a point would leave the domain (or its weight vanish): hold it fixed
          * for this step and let the others absorb the correction */
-        const double *jb = s->J + (size_t)M * nc * block;
+        const double *jb = s->Js + (size_t)M * nc * block;
         s->frozen[block] = 1;
         nfrozen++;
         if (under) {
@@ -265,24 +319,13 @@ static fcm_status lm_solve(ws *s, int n, double *x, double *w, double tol, int m
         lambda *= 10.0;
         continue;
       }
-      for (int i = 0; i < n; i++) {
-        for (int k = 0; k < d; k++)
-          s->x2[(size_t)d * i + k] = x[(size_t)d * i + k] + tau * s->dlt[(size_t)nc * i + k];
-        s->w2[i] = w[i] + tau * s->dlt[(size_t)nc * i + d];
-      }
       double f2, rinf2;
-      build(s, n, s->x2, s->w2, s->J2, s->r2, &f2, &rinf2);
+      trial(s, n, x, w, tau, &f2, &rinf2);
       if (f2 < f) {
         accepted = 1;
         slow = (f2 > 0.5 * f) ? slow + 1 : 0;
-        memcpy(x, s->x2, sizeof(double) * (size_t)d * n);
-        memcpy(w, s->w2, sizeof(double) * (size_t)n);
-        double *t = s->J;
-        s->J = s->J2;
-        s->J2 = t;
-        t = s->r;
-        s->r = s->r2;
-        s->r2 = t;
+        have_factor = tau == 1.0;
+        accept(s, n, x, w);
         f = f2;
         rinf = rinf2;
         lambda = FCM_MAX(lambda / 10.0, 1e-10);
@@ -290,7 +333,7 @@ static fcm_status lm_solve(ws *s, int n, double *x, double *w, double tol, int m
         lambda *= 10.0;
       }
     }
-    if (tol >= 0.0 && slow >= 10) break;
+    if (tol >= 0.0 && slow >= 6) break; /* a failing attempt stalls */
   }
 cleanup:
   *rinf_out = rinf;
@@ -377,6 +420,7 @@ fcm_status fcm__rulegen_eliminate(fcm_ctx *ctx, fcm_shape shape, int m, int n0, 
   const size_t nvmax = (size_t)n0 * s.nc, szmax = FCM_MIN((size_t)s.M, nvmax);
   FCM_ALLOC(ctx, (size_t)s.M * nvmax, s.J);
   FCM_ALLOC(ctx, (size_t)s.M * nvmax, s.J2);
+  FCM_ALLOC(ctx, (size_t)s.M * nvmax, s.Js);
   FCM_ALLOC(ctx, szmax * szmax, s.K);
   FCM_ALLOC(ctx, szmax * szmax, s.Kf);
   FCM_ALLOC(ctx, s.M, s.r);
@@ -468,6 +512,7 @@ fcm_status fcm__rulegen_eliminate(fcm_ctx *ctx, fcm_shape shape, int m, int n0, 
 cleanup:
   fcm__free(ctx, s.J);
   fcm__free(ctx, s.J2);
+  fcm__free(ctx, s.Js);
   fcm__free(ctx, s.K);
   fcm__free(ctx, s.Kf);
   fcm__free(ctx, s.r);
