@@ -1,1 +1,1 @@
-list(APPEND FCM_SOURCES)
+list(APPEND FCM_SOURCES lib/src/material/material.c lib/src/material/material_svd.c)
