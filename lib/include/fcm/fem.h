@@ -6,7 +6,9 @@
 #define FCM_FEM_H
 
 #include "fcm/core.h"
+#include "fcm/embed.h"
 #include "fcm/la.h"
+#include "fcm/material.h"
 #include "fcm/mesh.h"
 #include "fcm/quad.h"
 
@@ -30,6 +32,21 @@ typedef struct fcm_space fcm_space;
  * DOFs than 32-bit column indices hold), FCM_ERR_ALLOC. Allocates O(nnz). */
 FCM_API fcm_status fcm_space_create(fcm_ctx *ctx, const fcm_mesh *mesh,
                                     const unsigned char *cell_active, fcm_space **space);
+
+/** Create the space of an embedded (FCM) problem: the active cells are those
+ * `rules` does not drop; assembly integrates cut cells with their own rules from
+ * `rules` (stiffness rule for stiffness, forces and energy; mass rule for mass;
+ * stabilization points included) and full cells with the standard rule.
+ * @param[in] rules borrowed: must outlive the space; built on `mesh`
+ * @return as fcm_space_create(), and FCM_ERR_ARG when `rules` belongs to another mesh. */
+FCM_API fcm_status fcm_space_create_embedded(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                             const fcm_cell_rules *rules, fcm_space **space);
+
+/** The cell rules of an embedded space, or NULL. */
+FCM_API const fcm_cell_rules *fcm_space_cell_rules(const fcm_space *space);
+
+/** Whether `cell` carries unknowns (1) or was left out (0, also out of range). */
+FCM_API int fcm_space_cell_active(const fcm_space *space, fcm_index cell);
 
 /** Destroy the space; accepts NULL and `*space == NULL`, sets `*space = NULL`. */
 FCM_API void fcm_space_destroy(fcm_space **space);
@@ -108,6 +125,37 @@ FCM_API fcm_status fcm_assemble_mass(fcm_space *space, const fcm_elastic *mat,
 FCM_API fcm_status fcm_assemble_body_force(fcm_space *space, const fcm_elastic *mat,
                                            const double accel[3],
                                            const fcm_assembly_options *opts, double *f);
+
+/** A vector field evaluated at a physical point x; `normal` is the unit outward
+ * normal for surface fields and NULL for volume fields. Writes value[3]. Called
+ * concurrently from several threads. */
+typedef void (*fcm_field_fn)(void *user, const double x[3], const double normal[3],
+                             double value[3]);
+
+/** Add the load of a body force density b(x) (force per volume), f_a += int b N_a.
+ * @return as fcm_assemble_body_force(). */
+FCM_API fcm_status fcm_assemble_body_force_field(fcm_space *space, fcm_field_fn field, void *user,
+                                                 const fcm_assembly_options *opts, double *f);
+
+/** Add the load of a surface traction t(x, n) on the embedded boundary,
+ * f_a += int_{boundary} t N_a, with the surface rules of the space's cell rules.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, no surface rules: build the rules with
+ * surface_strength >= 0), FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_assemble_surface_traction(fcm_space *space, fcm_field_fn traction,
+                                                 void *user, double *f);
+
+/** Hyperelastic energy, internal force and tangent at the displacement u:
+ * E = sum over points of w det J Psi(F), F = I + grad u; force_i = dE/du_i (added
+ * to `force`); tangent = d^2E/du^2 (added to `tangent`, space pattern).
+ * @param[in]  mat     from fcm_material_setup() (its project_psd is honoured)
+ * @param[in]  u       num_dofs displacements
+ * @param[out] energy  may be NULL; @param[in,out] force may be NULL; tangent may be NULL
+ * @return FCM_OK, FCM_ERR_ARG, FCM_ERR_NUMERIC (the material gave NaN/Inf: the
+ * message names the cell), FCM_ERR_GEOMETRY, FCM_ERR_ALLOC. Deterministic for any
+ * number of threads (energy summed per cell in cell order). */
+FCM_API fcm_status fcm_assemble_hyperelastic(fcm_space *space, const fcm_material_params *mat,
+                                             const double *u, const fcm_assembly_options *opts,
+                                             double *energy, double *force, fcm_csr *tangent);
 
 /** Impose u[dofs[k]] = values[k] on the symmetric system A u = b by elimination
  * that keeps A symmetric: b_i -= A_ic g_c for free rows, row and column c are

@@ -1,7 +1,10 @@
-/* Assembly of linear elasticity on a space: element kernels for stiffness,
- * consistent mass and body force, and the colour-by-colour parallel scatter. */
+/* Assembly on a space: element kernels for linear stiffness, consistent mass,
+ * body force, hyperelastic energy/force/tangent and surface traction, on the
+ * standard rule of full cells or the per-cell rules of cut cells, scattered
+ * colour by colour in parallel (deterministic for any thread count). */
 #include "fem/fem_impl.h"
 #include "la/mat3.h"
+#include "material/material_impl.h"
 
 #include <math.h>
 #include <omp.h>
@@ -30,14 +33,6 @@ fcm_assembly_options fcm_assembly_options_default(void)
   return o;
 }
 
-/* Shape values and reference gradients of the element tabulated at a rule's points. */
-typedef struct tabulation {
-  int nq, nn;
-  const double *w; /* nq weights (borrowed from the rule) */
-  double *N;       /* nq x nn */
-  double *dN;      /* nq x nn x 3 */
-} tabulation;
-
 fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type, fcm_integrand integrand,
                                      int strength, fcm_rule **rule)
 {
@@ -59,22 +54,38 @@ cleanup:
   return st;
 }
 
-static fcm_status tabulate(fcm_space *s, fcm_integrand integrand, int strength, fcm_rule **rule,
-                           tabulation *t)
+/* The points of one cell's rule with the shape functions evaluated there. */
+typedef struct cell_rule {
+  int nq;
+  const double *w;  /* nq weights; det J_K(xi) still to be applied */
+  const double *N;  /* nq x nn */
+  const double *dN; /* nq x nn x 3 reference gradients */
+} cell_rule;
+
+/* Shape values and reference gradients of the element at the standard rule's points. */
+typedef struct tabulation {
+  fcm_rule *rule;
+  cell_rule r;
+  double *N, *dN;
+} tabulation;
+
+static fcm_status tabulate(fcm_space *s, fcm_integrand integrand, int strength, tabulation *t)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
-  FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, integrand, strength, rule));
-  t->nq = fcm_rule_num_points(*rule);
-  t->nn = s->nn;
-  t->w = fcm_rule_weights(*rule);
-  FCM_ALLOC(ctx, (size_t)t->nq * t->nn, t->N);
-  FCM_ALLOC(ctx, (size_t)t->nq * t->nn * 3, t->dN);
-  const double *pts = fcm_rule_points(*rule);
-  for (int q = 0; q < t->nq; q++) {
-    fcm_element_eval_shape(s->type, pts + 3 * q, t->N + (size_t)q * t->nn);
-    fcm_element_eval_grad(s->type, pts + 3 * q, t->dN + (size_t)q * t->nn * 3);
+  FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, integrand, strength, &t->rule));
+  int nq = fcm_rule_num_points(t->rule);
+  const double *pts = fcm_rule_points(t->rule);
+  FCM_ALLOC(ctx, (size_t)nq * s->nn, t->N);
+  FCM_ALLOC(ctx, (size_t)nq * s->nn * 3, t->dN);
+  for (int q = 0; q < nq; q++) {
+    fcm_element_eval_shape(s->type, pts + 3 * q, t->N + (size_t)q * s->nn);
+    fcm_element_eval_grad(s->type, pts + 3 * q, t->dN + (size_t)q * s->nn * 3);
   }
+  t->r.nq = nq;
+  t->r.w = fcm_rule_weights(t->rule);
+  t->r.N = t->N;
+  t->r.dN = t->dN;
 cleanup:
   return st;
 }
@@ -83,79 +94,182 @@ static void tabulation_free(fcm_ctx *ctx, tabulation *t)
 {
   FCM_FREE(ctx, t->N);
   FCM_FREE(ctx, t->dN);
+  fcm_rule_destroy(&t->rule);
+}
+
+/* The rule of `cell`: the tabulated standard rule for full cells, else the cell's own
+ * points from the embedded rules, evaluated into Nbuf/dNbuf (max_cut_points entries). */
+static cell_rule get_cell_rule(const fcm_space *s, const tabulation *t, fcm_rule_kind kind,
+                               fcm_index cell, double *Nbuf, double *dNbuf)
+{
+  if (!s->rules || fcm_cell_rules_class(s->rules, cell) == FCM_CELL_UNCUT) return t->r;
+  cell_rule r = {0, NULL, Nbuf, dNbuf};
+  const double *pts = NULL;
+  fcm_cell_rules_get(s->rules, cell, kind, &r.nq, &pts, &r.w, NULL);
+  for (int q = 0; q < r.nq; q++) {
+    fcm_element_eval_shape(s->type, pts + 3 * q, Nbuf + (size_t)q * s->nn);
+    fcm_element_eval_grad(s->type, pts + 3 * q, dNbuf + (size_t)q * s->nn * 3);
+  }
+  return r;
 }
 
 /* What a kernel computes for one cell. */
-typedef enum kernel_kind { KERNEL_STIFFNESS, KERNEL_MASS, KERNEL_BODY_FORCE } kernel_kind;
+typedef enum kernel_kind {
+  KERNEL_STIFFNESS,   /* linear elastic K */
+  KERNEL_MASS,        /* consistent mass */
+  KERNEL_BODY_FORCE,  /* rho * accel, or a force density field */
+  KERNEL_HYPERELASTIC /* energy, internal force and tangent at a displacement */
+} kernel_kind;
 
 typedef struct kernel_data {
   kernel_kind kind;
   double lambda, mu, rho;
   double accel[3];
+  fcm_field_fn field; /* body force density b(X) (per volume), replaces rho*accel */
+  void *field_user;
+  const fcm_material_params *mat;
+  const double *u; /* displacement per DOF */
+  int want_force, want_tangent;
 } kernel_data;
 
-/* Jacobian at tabulated point q: physical gradients g (nn x 3) and det J. */
-static double physical_gradients(const tabulation *t, int q, const double *X, double *g)
+/* Jacobian at point q of rule r: physical gradients g (nn x 3); returns det J. */
+static double physical_gradients(const cell_rule *r, int nn, int q, const double *X, double *g)
 {
-  const double *dN = t->dN + (size_t)q * t->nn * 3;
+  const double *dN = r->dN + (size_t)q * nn * 3;
   double J[9] = {0}, Ji[9] = {0};
-  for (int a = 0; a < t->nn; a++)
+  for (int a = 0; a < nn; a++)
     for (int i = 0; i < 3; i++)
       for (int j = 0; j < 3; j++) J[3 * i + j] += X[3 * a + i] * dN[3 * a + j];
   double det = fcm__mat3_inv(J, Ji);
   if (!(det > 0.0)) return det;
-  for (int a = 0; a < t->nn; a++)
-    fcm__mat3_tmulv(Ji, dN + 3 * a, g + 3 * a);
+  for (int a = 0; a < nn; a++) fcm__mat3_tmulv(Ji, dN + 3 * a, g + 3 * a);
   return det;
 }
 
-/* Element matrix (3nn x 3nn, row-major) or vector (3nn) of one cell; returns the
- * first non-positive det J met (1 when all are positive). `H` is scratch of
- * (3nn)^2 entries.
- * Stiffness: with v the 3nn-vector of all physical gradients at a point, the
- * sums H = sum_q w_q det J_q v v^T (a symmetric rank-one update per point, the
- * only work that grows with the number of points) give the isotropic element
- * matrix K_(a,i)(b,j) = lambda H_(a,i)(b,j) + mu H_(a,j)(b,i) + mu delta_ij
- * sum_k H_(a,k)(b,k), assembled once per cell. */
-static double cell_kernel(const kernel_data *kd, const tabulation *t, const double *X, double *g,
-                          double *H, double *Ke)
+/* Fill the lower node blocks of a symmetric element matrix from the upper ones. */
+static void mirror_blocks(int nn, double *Ke)
 {
-  int nn = t->nn, ndof = 3 * nn;
-  double bad = 1.0;
-  if (kd->kind == KERNEL_BODY_FORCE)
-    memset(Ke, 0, sizeof *Ke * (size_t)ndof);
-  else
+  int ndof = 3 * nn;
+  for (int a = 0; a < nn; a++)
+    for (int b = 0; b < a; b++)
+      for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+          Ke[(size_t)(3 * a + i) * ndof + 3 * b + j] = Ke[(size_t)(3 * b + j) * ndof + 3 * a + i];
+}
+
+/* Per-thread scratch of a kernel. */
+typedef struct scratch {
+  double *X;   /* nn x 3 nodal coordinates */
+  double *ue;  /* 3nn cell displacement */
+  double *g;   /* nn x 3 physical gradients */
+  double *H;   /* (3nn)^2 */
+  double *Ke;  /* (3nn)^2 */
+  double *fe;  /* 3nn */
+  double *Nb;  /* max_cut_points x nn */
+  double *dNb; /* max_cut_points x nn x 3 */
+} scratch;
+
+/* Outcome of a cell kernel. */
+typedef struct cell_result {
+  double energy;
+  double bad_det; /* 1 when every det J > 0, else the first offending value */
+  int nonfinite;  /* the material returned NaN/Inf */
+} cell_result;
+
+/* Element matrix Ke (3nn x 3nn, row-major) and/or vector fe (3nn) of one cell.
+ * Linear stiffness: with v the 3nn-vector of all physical gradients at a point,
+ * H = sum_q w_q det J_q v v^T (one symmetric rank-one update per point, the only
+ * work that grows with the number of points) gives the isotropic element matrix
+ * K_(a,i)(b,j) = lambda H_(a,i)(b,j) + mu H_(a,j)(b,i) + mu delta_ij sum_k H_(a,k)(b,k).
+ * Hyperelastic: F = I + sum_a u_a (x) g_a; f_(a,i) = sum_q wd P_iJ g_aJ and
+ * K_(a,i)(b,k) = sum_q wd g_aJ A_iJkL g_bL with A = dP/dF. */
+static cell_result cell_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
+{
+  int ndof = 3 * nn;
+  cell_result res = {0.0, 1.0, 0};
+  double *g = w->g, *H = w->H, *Ke = w->Ke, *fe = w->fe;
+  int matrix = kd->kind == KERNEL_STIFFNESS || kd->kind == KERNEL_MASS ||
+               (kd->kind == KERNEL_HYPERELASTIC && kd->want_tangent);
+  if (kd->kind == KERNEL_STIFFNESS || kd->kind == KERNEL_MASS)
     memset(H, 0, sizeof *H * (size_t)ndof * ndof);
-  for (int q = 0; q < t->nq; q++) {
-    double det = physical_gradients(t, q, X, g);
+  if (matrix) memset(Ke, 0, sizeof *Ke * (size_t)ndof * ndof);
+  memset(fe, 0, sizeof *fe * (size_t)ndof);
+  for (int q = 0; q < r->nq; q++) {
+    double det = physical_gradients(r, nn, q, w->X, g);
     if (!(det > 0.0)) {
-      bad = det;
-      break;
+      res.bad_det = det;
+      return res;
     }
-    double wd = t->w[q] * det;
-    const double *N = t->N + (size_t)q * nn;
-    if (kd->kind == KERNEL_STIFFNESS) {
-      for (int r = 0; r < ndof; r++) {
-        double sr = wd * g[r], *Hr = H + (size_t)r * ndof;
-        for (int c = r; c < ndof; c++) Hr[c] += sr * g[c];
+    double wd = r->w[q] * det;
+    const double *N = r->N + (size_t)q * nn;
+    switch (kd->kind) {
+    case KERNEL_STIFFNESS:
+      for (int a = 0; a < ndof; a++) {
+        double sa = wd * g[a], *Ha = H + (size_t)a * ndof;
+        for (int b = a; b < ndof; b++) Ha[b] += sa * g[b];
       }
-    } else if (kd->kind == KERNEL_MASS) {
+      break;
+    case KERNEL_MASS: {
       double rw = wd * kd->rho;
       for (int a = 0; a < nn; a++) {
         double sa = rw * N[a], *Ha = H + (size_t)a * nn;
         for (int b = a; b < nn; b++) Ha[b] += sa * N[b];
       }
-    } else {
+    } break;
+    case KERNEL_BODY_FORCE: {
+      double b[3] = {kd->rho * kd->accel[0], kd->rho * kd->accel[1], kd->rho * kd->accel[2]};
+      if (kd->field) {
+        double x[3] = {0, 0, 0};
+        for (int a = 0; a < nn; a++)
+          for (int i = 0; i < 3; i++) x[i] += N[a] * w->X[3 * a + i];
+        kd->field(kd->field_user, x, NULL, b);
+      }
       for (int a = 0; a < nn; a++)
-        for (int i = 0; i < 3; i++) Ke[3 * a + i] += wd * kd->rho * kd->accel[i] * N[a];
+        for (int i = 0; i < 3; i++) fe[3 * a + i] += wd * b[i] * N[a];
+    } break;
+    case KERNEL_HYPERELASTIC: {
+      double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, psi = 0.0, P[9], A[81];
+      for (int a = 0; a < nn; a++)
+        for (int i = 0; i < 3; i++)
+          for (int j = 0; j < 3; j++) F[3 * i + j] += w->ue[3 * a + i] * g[3 * a + j];
+      fcm__material_eval(kd->mat, F, &psi, P, kd->want_tangent ? A : NULL);
+      int finite = isfinite(psi);
+      for (int k = 0; k < 9; k++) finite &= isfinite(P[k]);
+      if (!finite) {
+        res.nonfinite = 1;
+        return res;
+      }
+      res.energy += wd * psi;
+      for (int a = 0; a < nn; a++) {
+        const double *ga = g + 3 * a;
+        for (int i = 0; i < 3; i++)
+          fe[3 * a + i] += wd * (P[3 * i] * ga[0] + P[3 * i + 1] * ga[1] + P[3 * i + 2] * ga[2]);
+      }
+      if (!kd->want_tangent) break;
+      for (int b = 0; b < nn; b++) {
+        /* C[i][J][k] = wd sum_L A_iJkL g_bL, then K_(a,i)(b,k) += sum_J g_aJ C[i][J][k] */
+        const double *gb = g + 3 * b;
+        double C[27];
+        for (int m = 0; m < 27; m++) {
+          const double *Am = A + 3 * m;
+          C[m] = wd * (Am[0] * gb[0] + Am[1] * gb[1] + Am[2] * gb[2]);
+        }
+        for (int a = 0; a <= b; a++) {
+          const double *ga = g + 3 * a;
+          for (int i = 0; i < 3; i++) {
+            double *row = Ke + (size_t)(3 * a + i) * ndof + 3 * b;
+            for (int k = 0; k < 3; k++)
+              row[k] += ga[0] * C[9 * i + k] + ga[1] * C[9 * i + 3 + k] + ga[2] * C[9 * i + 6 + k];
+          }
+        }
+      }
+    } break;
     }
   }
-  if (kd->kind == KERNEL_BODY_FORCE) return bad;
-  memset(Ke, 0, sizeof *Ke * (size_t)ndof * ndof);
   if (kd->kind == KERNEL_STIFFNESS) {
     double l = kd->lambda, m = kd->mu;
-    for (int r = 0; r < ndof; r++) /* complete H from its upper triangle */
-      for (int c = 0; c < r; c++) H[(size_t)r * ndof + c] = H[(size_t)c * ndof + r];
+    for (int a = 0; a < ndof; a++) /* complete H from its upper triangle */
+      for (int b = 0; b < a; b++) H[(size_t)a * ndof + b] = H[(size_t)b * ndof + a];
     for (int a = 0; a < nn; a++)
       for (int b = a; b < nn; b++) {
         const double *Hab = H + (size_t)(3 * a) * ndof + 3 * b; /* block (a, b) of H */
@@ -166,84 +280,141 @@ static double cell_kernel(const kernel_data *kd, const tabulation *t, const doub
           row[i] += tr;
         }
       }
-  } else {
+  } else if (kd->kind == KERNEL_MASS) {
     for (int a = 0; a < nn; a++)
       for (int b = a; b < nn; b++)
         for (int i = 0; i < 3; i++) Ke[(size_t)(3 * a + i) * ndof + 3 * b + i] = H[(size_t)a * nn + b];
   }
-  for (int a = 0; a < nn; a++) /* mirror the upper node blocks */
-    for (int b = 0; b < a; b++)
-      for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-          Ke[(size_t)(3 * a + i) * ndof + 3 * b + j] = Ke[(size_t)(3 * b + j) * ndof + 3 * a + i];
-  return bad;
+  if (matrix) mirror_blocks(nn, Ke);
+  return res;
 }
 
-/* Run the kernel over all active cells colour by colour and scatter into the
- * matrix values `vals` (pattern of the space) or the vector `vec`. */
+/* Add the element matrix of `cell` into the values of the space's pattern. */
+static void scatter_matrix(const fcm_space *s, fcm_index cell, const double *Ke, double *vals)
+{
+  int nn = s->nn, ndof = 3 * nn;
+  const fcm_index *cn = fcm_mesh_cells(s->mesh) + cell * nn;
+  const int *off = s->cell_off + (size_t)cell * nn * nn;
+  for (int a = 0; a < nn; a++) {
+    fcm_index da = s->node_dof[cn[a]];
+    for (int i = 0; i < 3; i++) {
+      double *dst = vals + s->row_ptr[da + i];
+      const double *src = Ke + (size_t)(3 * a + i) * ndof;
+      for (int b = 0; b < nn; b++) {
+        double *d = dst + 3 * off[a * nn + b];
+        d[0] += src[3 * b];
+        d[1] += src[3 * b + 1];
+        d[2] += src[3 * b + 2];
+      }
+    }
+  }
+}
+
+/* Add the element vector of `cell` into the global vector. */
+static void scatter_vector(const fcm_space *s, fcm_index cell, const double *fe, double *vec)
+{
+  const fcm_index *cn = fcm_mesh_cells(s->mesh) + cell * s->nn;
+  for (int a = 0; a < s->nn; a++) {
+    fcm_index da = s->node_dof[cn[a]];
+    for (int i = 0; i < 3; i++) vec[da + i] += fe[3 * a + i];
+  }
+}
+
+/* Per-thread scratch for `nthreads` threads. */
+static fcm_status scratch_alloc(const fcm_space *s, int nthreads, double **mem, scratch **sc)
+{
+  fcm_status st = FCM_OK;
+  int nn = s->nn, ndof = 3 * nn;
+  size_t mq = (size_t)FCM_MAX(s->max_cut_points, 1);
+  size_t per = 3 * (size_t)nn + 2 * (size_t)ndof + 3 * (size_t)nn + 2 * (size_t)ndof * ndof +
+               mq * nn * 4;
+  FCM_ALLOC(s->ctx, per * (size_t)nthreads, *mem);
+  FCM_ALLOC(s->ctx, nthreads, *sc);
+  for (int t = 0; t < nthreads; t++) {
+    double *p = *mem + per * (size_t)t;
+    scratch *w = *sc + t;
+    w->X = p, p += 3 * nn;
+    w->ue = p, p += ndof;
+    w->fe = p, p += ndof;
+    w->g = p, p += 3 * nn;
+    w->H = p, p += (size_t)ndof * ndof;
+    w->Ke = p, p += (size_t)ndof * ndof;
+    w->Nb = p, p += mq * nn;
+    w->dNb = p;
+  }
+cleanup:
+  return st;
+}
+
+/* Run the kernel over all active cells colour by colour (parallel within a colour)
+ * and scatter into the matrix values `vals` and/or the vector `vec`; the energy
+ * (hyperelastic kernel) is summed per cell in cell order. */
 static fcm_status assemble(fcm_space *s, const kernel_data *kd, int strength, double *vals,
-                           double *vec)
+                           double *vec, double *energy)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
-  fcm_rule *rule = NULL;
-  tabulation t = {0, 0, NULL, NULL, NULL};
-  double *work = NULL;
-  int nn = s->nn, ndof = 3 * nn, nthreads = omp_get_max_threads();
-  size_t per_thread = (size_t)nn * 3 * 3 + 2 * (size_t)ndof * ndof + (size_t)nn * 3;
+  tabulation t;
+  double *mem = NULL;
+  scratch *sc = NULL;
+  int nn = s->nn, nthreads = omp_get_max_threads();
   fcm_index bad_cell = -1;
   double bad_det = 1.0;
-  const fcm_index *cells = fcm_mesh_cells(s->mesh);
-  FCM_TRY(ctx, tabulate(s, kd->kind == KERNEL_MASS ? FCM_INTEGRAND_MASS : FCM_INTEGRAND_STIFFNESS,
-                        strength, &rule, &t));
-  FCM_ALLOC(ctx, per_thread * (size_t)nthreads, work);
+  int bad_numeric = 0;
+  fcm_rule_kind kind = kd->kind == KERNEL_MASS ? FCM_RULE_MASS : FCM_RULE_STIFFNESS;
+  memset(&t, 0, sizeof t);
+  FCM_TRY(ctx, tabulate(s, kind == FCM_RULE_MASS ? FCM_INTEGRAND_MASS : FCM_INTEGRAND_STIFFNESS,
+                        strength, &t));
+  FCM_TRY(ctx, scratch_alloc(s, nthreads, &mem, &sc));
   for (int color = 0; color < s->num_colors; color++) {
     fcm_index c0 = s->color_ptr[color], c1 = s->color_ptr[color + 1];
 #pragma omp parallel num_threads(nthreads)
     {
-      double *X = work + per_thread * (size_t)omp_get_thread_num();
-      double *Ke = X + (size_t)nn * 3, *H = Ke + (size_t)ndof * ndof;
-      double *g = H + (size_t)ndof * ndof;
-#pragma omp for schedule(static)
+      scratch *w = sc + omp_get_thread_num();
+#pragma omp for schedule(dynamic, 16)
       for (fcm_index k = c0; k < c1; k++) {
         fcm_index c = s->color_cells[k];
-        fcm_mesh_cell_coords(s->mesh, c, X);
-        double det = cell_kernel(kd, &t, X, g, H, Ke);
-        if (!(det > 0.0)) {
+        fcm_mesh_cell_coords(s->mesh, c, w->X);
+        if (kd->u) {
+          const fcm_index *cn = fcm_mesh_cells(s->mesh) + c * nn;
+          for (int a = 0; a < nn; a++)
+            memcpy(w->ue + 3 * a, kd->u + s->node_dof[cn[a]], 3 * sizeof(double));
+        }
+        cell_rule r = get_cell_rule(s, &t, kind, c, w->Nb, w->dNb);
+        cell_result res = cell_kernel(kd, &r, nn, w);
+        if (!(res.bad_det > 0.0) || res.nonfinite) {
 #pragma omp critical(fcm_assemble_bad)
-          if (bad_cell < 0 || c < bad_cell) bad_cell = c, bad_det = det;
+          if (bad_cell < 0 || c < bad_cell) {
+            bad_cell = c;
+            bad_det = res.bad_det;
+            bad_numeric = res.nonfinite;
+          }
           continue;
         }
-        const fcm_index *cn = cells + c * nn;
-        const int *off = s->cell_off + (size_t)c * nn * nn;
-        for (int a = 0; a < nn; a++) {
-          fcm_index da = s->node_dof[cn[a]];
-          for (int i = 0; i < 3; i++) {
-            if (vec) {
-              vec[da + i] += Ke[3 * a + i];
-              continue;
-            }
-            double *dst = vals + s->row_ptr[da + i];
-            const double *src = Ke + (size_t)(3 * a + i) * ndof;
-            for (int b = 0; b < nn; b++) {
-              double *d = dst + 3 * off[a * nn + b];
-              d[0] += src[3 * b];
-              d[1] += src[3 * b + 1];
-              d[2] += src[3 * b + 2];
-            }
-          }
-        }
+        s->cell_energy[c] = res.energy;
+        if (vals) scatter_matrix(s, c, w->Ke, vals);
+        if (vec) scatter_vector(s, c, w->fe, vec);
       }
     }
+    FCM_CHECK(bad_cell < 0 || !bad_numeric, ctx, FCM_ERR_NUMERIC,
+              "assembly: the material returned NaN or infinity in cell %lld (deformation "
+              "gradient not finite or outside the model's domain)",
+              (long long)bad_cell);
     FCM_CHECK(bad_cell < 0, ctx, FCM_ERR_GEOMETRY,
               "assembly: cell %lld has det J = %g <= 0 at a quadrature point (inverted or "
               "degenerate %s)",
               (long long)bad_cell, bad_det, fcm_element_get_info(s->type)->name);
   }
+  if (energy) {
+    double e = 0.0;
+    for (fcm_index c = 0; c < s->num_cells; c++)
+      if (s->active[c]) e += s->cell_energy[c];
+    *energy = e;
+  }
 cleanup:
   tabulation_free(ctx, &t);
-  fcm_rule_destroy(&rule);
-  fcm__free(ctx, work);
+  fcm__free(ctx, mem);
+  fcm__free(ctx, sc);
   return st;
 }
 
@@ -268,11 +439,13 @@ fcm_status fcm_assemble_stiffness(fcm_space *s, const fcm_elastic *mat,
                                   const fcm_assembly_options *opts, fcm_csr *A)
 {
   fcm_status st = FCM_OK;
-  kernel_data kd = {KERNEL_STIFFNESS, 0, 0, 0, {0, 0, 0}};
+  kernel_data kd;
   fcm_assembly_options o = opts ? *opts : fcm_assembly_options_default();
+  memset(&kd, 0, sizeof kd);
+  kd.kind = KERNEL_STIFFNESS;
   FCM_TRY(s->ctx, fcm_elastic_lame(s->ctx, mat, &kd.lambda, &kd.mu));
   FCM_TRY(s->ctx, check_matrix(s, A));
-  FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, fcm_csr_get_values(A), NULL));
+  FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, fcm_csr_get_values(A), NULL, NULL));
 cleanup:
   return st;
 }
@@ -281,12 +454,14 @@ fcm_status fcm_assemble_mass(fcm_space *s, const fcm_elastic *mat,
                              const fcm_assembly_options *opts, fcm_csr *A)
 {
   fcm_status st = FCM_OK;
-  kernel_data kd = {KERNEL_MASS, 0, 0, 0, {0, 0, 0}};
+  kernel_data kd;
   fcm_assembly_options o = opts ? *opts : fcm_assembly_options_default();
+  memset(&kd, 0, sizeof kd);
+  kd.kind = KERNEL_MASS;
   FCM_TRY(s->ctx, fcm_elastic_lame(s->ctx, mat, NULL, NULL));
   FCM_TRY(s->ctx, check_matrix(s, A));
   kd.rho = mat->density;
-  FCM_TRY(s->ctx, assemble(s, &kd, o.mass_strength, fcm_csr_get_values(A), NULL));
+  FCM_TRY(s->ctx, assemble(s, &kd, o.mass_strength, fcm_csr_get_values(A), NULL, NULL));
 cleanup:
   return st;
 }
@@ -295,16 +470,101 @@ fcm_status fcm_assemble_body_force(fcm_space *s, const fcm_elastic *mat, const d
                                    const fcm_assembly_options *opts, double *f)
 {
   fcm_status st = FCM_OK;
-  kernel_data kd = {KERNEL_BODY_FORCE, 0, 0, 0, {0, 0, 0}};
+  kernel_data kd;
   fcm_assembly_options o = opts ? *opts : fcm_assembly_options_default();
+  memset(&kd, 0, sizeof kd);
+  kd.kind = KERNEL_BODY_FORCE;
   FCM_TRY(s->ctx, fcm_elastic_lame(s->ctx, mat, NULL, NULL));
   FCM_CHECK(f && accel, s->ctx, FCM_ERR_ARG, "body force: NULL vector or acceleration");
   FCM_CHECK(isfinite(accel[0]) && isfinite(accel[1]) && isfinite(accel[2]), s->ctx, FCM_ERR_ARG,
             "body force: acceleration (%g, %g, %g) is not finite", accel[0], accel[1], accel[2]);
   kd.rho = mat->density;
   memcpy(kd.accel, accel, sizeof kd.accel);
-  FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, NULL, f));
+  FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, NULL, f, NULL));
 cleanup:
+  return st;
+}
+
+fcm_status fcm_assemble_body_force_field(fcm_space *s, fcm_field_fn field, void *user,
+                                         const fcm_assembly_options *opts, double *f)
+{
+  fcm_status st = FCM_OK;
+  kernel_data kd;
+  fcm_assembly_options o = opts ? *opts : fcm_assembly_options_default();
+  memset(&kd, 0, sizeof kd);
+  kd.kind = KERNEL_BODY_FORCE;
+  FCM_CHECK(f && field, s->ctx, FCM_ERR_ARG, "body force field: NULL vector or field");
+  kd.field = field;
+  kd.field_user = user;
+  FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, NULL, f, NULL));
+cleanup:
+  return st;
+}
+
+fcm_status fcm_assemble_hyperelastic(fcm_space *s, const fcm_material_params *mat, const double *u,
+                                     const fcm_assembly_options *opts, double *energy,
+                                     double *force, fcm_csr *tangent)
+{
+  fcm_status st = FCM_OK;
+  kernel_data kd;
+  fcm_assembly_options o = opts ? *opts : fcm_assembly_options_default();
+  memset(&kd, 0, sizeof kd);
+  FCM_CHECK(mat && u, s->ctx, FCM_ERR_ARG, "hyperelastic: NULL material or displacement");
+  if (tangent) FCM_TRY(s->ctx, check_matrix(s, tangent));
+  kd.kind = KERNEL_HYPERELASTIC;
+  kd.mat = mat;
+  kd.u = u;
+  kd.want_force = force != NULL;
+  kd.want_tangent = tangent != NULL;
+  FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, tangent ? fcm_csr_get_values(tangent) : NULL,
+                           force, energy));
+cleanup:
+  return st;
+}
+
+fcm_status fcm_assemble_surface_traction(fcm_space *s, fcm_field_fn traction, void *user,
+                                         double *f)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  double *mem = NULL;
+  scratch *sc = NULL;
+  int nn = s->nn, nthreads = omp_get_max_threads();
+  FCM_CHECK(f && traction, ctx, FCM_ERR_ARG, "surface traction: NULL vector or traction");
+  FCM_CHECK(s->rules && fcm_cell_rules_surface_strength(s->rules) >= 0, ctx, FCM_ERR_ARG,
+            "surface traction: the space has no surface rules (build the cell rules with "
+            "surface_strength >= 0)");
+  FCM_TRY(ctx, scratch_alloc(s, nthreads, &mem, &sc));
+  for (int color = 0; color < s->num_colors; color++) {
+    fcm_index c0 = s->color_ptr[color], c1 = s->color_ptr[color + 1];
+#pragma omp parallel num_threads(nthreads)
+    {
+      scratch *w = sc + omp_get_thread_num();
+#pragma omp for schedule(dynamic, 16)
+      for (fcm_index k = c0; k < c1; k++) {
+        fcm_index c = s->color_cells[k];
+        int np = 0;
+        const double *pts = NULL, *wts = NULL, *nrm = NULL;
+        fcm_cell_rules_get_surface(s->rules, c, &np, &pts, &wts, &nrm, NULL);
+        if (np == 0) continue;
+        fcm_mesh_cell_coords(s->mesh, c, w->X);
+        memset(w->fe, 0, sizeof(double) * 3 * (size_t)nn);
+        for (int q = 0; q < np; q++) {
+          double x[3] = {0, 0, 0}, tq[3] = {0, 0, 0};
+          fcm_element_eval_shape(s->type, pts + 3 * q, w->Nb);
+          for (int a = 0; a < nn; a++)
+            for (int i = 0; i < 3; i++) x[i] += w->Nb[a] * w->X[3 * a + i];
+          traction(user, x, nrm + 3 * q, tq);
+          for (int a = 0; a < nn; a++)
+            for (int i = 0; i < 3; i++) w->fe[3 * a + i] += wts[q] * w->Nb[a] * tq[i];
+        }
+        scatter_vector(s, c, w->fe, f);
+      }
+    }
+  }
+cleanup:
+  fcm__free(ctx, mem);
+  fcm__free(ctx, sc);
   return st;
 }
 

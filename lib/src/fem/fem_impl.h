@@ -29,6 +29,11 @@ struct fcm_space {
   int num_colors;
   fcm_index *color_ptr;
   fcm_index *color_cells;
+  /* Embedded case: per-cell rules of cut cells (borrowed), the most points any cut
+   * cell has in either rule, and the per-cell energies of the last assembly. */
+  const fcm_cell_rules *rules;
+  int max_cut_points;
+  double *cell_energy; /* num_cells */
 };
 
 #endif /* FCM_FEM_IMPL_H */

@@ -170,8 +170,9 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigned char *cell_active,
-                            fcm_space **out)
+/* Shared by fcm_space_create() and fcm_space_create_embedded(). */
+static fcm_status space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigned char *cell_active,
+                               const fcm_cell_rules *rules, fcm_space **out)
 {
   fcm_status st = FCM_OK;
   fcm_space *s = NULL;
@@ -182,13 +183,24 @@ fcm_status fcm_space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigned c
   FCM_ALLOC(ctx, 1, s);
   s->ctx = ctx;
   s->mesh = mesh;
+  s->rules = rules;
   s->type = fcm_mesh_element_type(mesh);
   s->nn = fcm_mesh_nodes_per_cell(mesh);
   s->num_cells = fcm_mesh_num_cells(mesh);
   s->num_nodes = fcm_mesh_num_nodes(mesh);
   FCM_ALLOC(ctx, s->num_cells, s->active);
+  FCM_ALLOC(ctx, s->num_cells, s->cell_energy);
   for (fcm_index c = 0; c < s->num_cells; c++) {
     s->active[c] = cell_active ? (cell_active[c] != 0) : 1;
+    if (rules) {
+      fcm_cell_class cls = fcm_cell_rules_class(rules, c);
+      s->active[c] = cls != FCM_CELL_DROPPED;
+      for (int k = 0; k < FCM_RULE_KIND_COUNT && cls == FCM_CELL_CUT; k++) {
+        int np = 0;
+        FCM_TRY(ctx, fcm_cell_rules_get(rules, c, (fcm_rule_kind)k, &np, NULL, NULL, NULL));
+        s->max_cut_points = FCM_MAX(s->max_cut_points, np);
+      }
+    }
     nactive_cells += s->active[c];
   }
   FCM_CHECK(nactive_cells > 0, ctx, FCM_ERR_ARG, "space: none of the %lld cells is active",
@@ -221,12 +233,38 @@ cleanup:
   return st;
 }
 
+fcm_status fcm_space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigned char *cell_active,
+                            fcm_space **out)
+{
+  return space_create(ctx, mesh, cell_active, NULL, out);
+}
+
+fcm_status fcm_space_create_embedded(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                     const fcm_cell_rules *rules, fcm_space **out)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(out, ctx, FCM_ERR_ARG, "space: output pointer is NULL");
+  *out = NULL;
+  FCM_CHECK(mesh && rules, ctx, FCM_ERR_ARG, "space: mesh or cell rules is NULL");
+  FCM_CHECK(fcm_cell_rules_num_cells(rules) == fcm_mesh_num_cells(mesh) &&
+                fcm_cell_rules_element_type(rules) == fcm_mesh_element_type(mesh),
+            ctx, FCM_ERR_ARG,
+            "space: the cell rules (%lld cells) were not built on this mesh (%lld cells)",
+            (long long)fcm_cell_rules_num_cells(rules), (long long)fcm_mesh_num_cells(mesh));
+  FCM_TRY(ctx, space_create(ctx, mesh, NULL, rules, out));
+cleanup:
+  return st;
+}
+
+const fcm_cell_rules *fcm_space_cell_rules(const fcm_space *s) { return s->rules; }
+
 void fcm_space_destroy(fcm_space **sp)
 {
   if (!sp || !*sp) return;
   fcm_space *s = *sp;
   fcm_ctx *ctx = s->ctx;
   fcm__free(ctx, s->active);
+  fcm__free(ctx, s->cell_energy);
   fcm__free(ctx, s->node_dof);
   fcm__free(ctx, s->node_ptr);
   fcm__free(ctx, s->node_adj);
@@ -247,6 +285,11 @@ fcm_index fcm_space_node_dof(const fcm_space *s, fcm_index node)
 }
 
 int fcm_space_num_colors(const fcm_space *s) { return s->num_colors; }
+
+int fcm_space_cell_active(const fcm_space *s, fcm_index cell)
+{
+  return cell >= 0 && cell < s->num_cells && s->active[cell];
+}
 
 const fcm_mesh *fcm_space_mesh(const fcm_space *s) { return s->mesh; }
 
