@@ -1,1 +1,1 @@
-list(APPEND FCM_SOURCES)
+list(APPEND FCM_SOURCES lib/src/solve/krylov.c lib/src/solve/jacobi.c lib/src/solve/schwarz.c)

@@ -1,0 +1,449 @@
+/* Additive Schwarz preconditioner on blocks of DOFs (cut cells): dense block gather,
+ * reflected and clamped eigen-inverse per block, Jacobi on the remaining DOFs.
+ *
+ * Longva et al. 2020, "Higher-order finite elements for embedded simulation", §5.2,
+ * eq. (13)-(14), after de Prenter et al. (2017, 2019): S = sum_K R_K^T S_K R_K + D^{-1},
+ * S_K = V diag(s_k) V^T from C_K = R_K C R_K^T = V diag(lambda_k) V^T with
+ * s_k = 1/|lambda_k| for |lambda_k| >= eps lambda_max and, below, either 1/(eps lambda_max)
+ * (clamp, the authors' code) or eps/lambda_max (eq. 14 as printed). The blocks are built in
+ * parallel (one block per thread at a time) and applied colour by colour (blocks of one
+ * colour share no DOF), so z = S r does not depend on the number of threads. */
+#include "solve/solve_impl.h"
+
+#include <math.h>
+#include <omp.h>
+#include <string.h>
+
+/* Largest block: m^2 must fit LAPACK's int. */
+#define MAX_BLOCK 46340
+/* Apply in parallel from this many stored block entries (multiply-adds) on. */
+#define APPLY_PARALLEL_WORK 65536
+
+struct fcm_schwarz {
+  fcm_ctx *ctx;
+  fcm_index n;
+  fcm_schwarz_options opts;
+  fcm_index num_blocks;
+  fcm_index *block_ptr; /* num_blocks + 1 */
+  fcm_index *dofs;      /* block_ptr[num_blocks] */
+  size_t *s_off;        /* num_blocks + 1 offsets into S */
+  double *S;            /* dense S_K, m x m each (symmetric) */
+  int max_m;
+  int num_colors;
+  fcm_index *color_ptr; /* num_colors + 1 */
+  fcm_index *color_blocks;
+  unsigned char *inside; /* n: DOF belongs to a block */
+  double *dinv;          /* n: 1/|c_ii| outside the blocks, 0 inside */
+  fcm_schwarz_info info;
+  int ready;
+};
+
+fcm_schwarz_options fcm_schwarz_options_default(void)
+{
+  fcm_schwarz_options o;
+  o.epsilon = 1e-13;
+  o.clamp = FCM_SCHWARZ_CLAMP;
+  return o;
+}
+
+void fcm_schwarz_destroy(fcm_schwarz **P)
+{
+  if (!P || !*P) return;
+  fcm_schwarz *p = *P;
+  fcm_ctx *ctx = p->ctx;
+  fcm__free(ctx, p->block_ptr);
+  fcm__free(ctx, p->dofs);
+  fcm__free(ctx, p->s_off);
+  fcm__free(ctx, p->S);
+  fcm__free(ctx, p->color_ptr);
+  fcm__free(ctx, p->color_blocks);
+  fcm__free(ctx, p->inside);
+  fcm__free(ctx, p->dinv);
+  fcm__free(ctx, p);
+  *P = NULL;
+}
+
+/* Greedy colouring in block order: a block takes the smallest colour not used by an
+ * earlier block sharing one of its DOFs. */
+static fcm_status color_blocks(fcm_schwarz *P)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_index n = P->n, nb = P->num_blocks;
+  fcm_index *inc_ptr = NULL, *inc = NULL, *fill = NULL, *mark = NULL;
+  int *color = NULL;
+  FCM_ALLOC(ctx, n + 1, inc_ptr);
+  FCM_ALLOC(ctx, P->block_ptr[nb], inc);
+  FCM_ALLOC(ctx, FCM_MAX(n, nb), fill); /* per DOF, then per colour (<= nb colours) */
+  FCM_ALLOC(ctx, nb, color);
+  FCM_ALLOC(ctx, nb + 1, mark);
+  /* DOF -> blocks containing it (ascending) */
+  for (fcm_index p = 0; p < P->block_ptr[nb]; p++)
+    inc_ptr[P->dofs[p] + 1]++;
+  for (fcm_index i = 0; i < n; i++)
+    inc_ptr[i + 1] += inc_ptr[i];
+  for (fcm_index b = 0; b < nb; b++)
+    for (fcm_index p = P->block_ptr[b]; p < P->block_ptr[b + 1]; p++) {
+      fcm_index d = P->dofs[p];
+      inc[inc_ptr[d] + fill[d]++] = b;
+    }
+  int ncol = 0;
+  for (fcm_index b = 0; b < nb; b++) {
+    for (fcm_index p = P->block_ptr[b]; p < P->block_ptr[b + 1]; p++) {
+      fcm_index d = P->dofs[p];
+      for (fcm_index q = inc_ptr[d]; q < inc_ptr[d + 1] && inc[q] < b; q++)
+        mark[color[inc[q]]] = b + 1;
+    }
+    int c = 0;
+    while (mark[c] == b + 1)
+      c++;
+    color[b] = c;
+    ncol = FCM_MAX(ncol, c + 1);
+  }
+  P->num_colors = ncol;
+  FCM_ALLOC(ctx, ncol + 1, P->color_ptr);
+  FCM_ALLOC(ctx, FCM_MAX(nb, 1), P->color_blocks);
+  for (fcm_index b = 0; b < nb; b++)
+    P->color_ptr[color[b] + 1]++;
+  for (int c = 0; c < ncol; c++)
+    P->color_ptr[c + 1] += P->color_ptr[c];
+  for (fcm_index c = 0; c < ncol; c++)
+    fill[c] = 0;
+  for (fcm_index b = 0; b < nb; b++)
+    P->color_blocks[P->color_ptr[color[b]] + fill[color[b]]++] = b;
+cleanup:
+  fcm__free(ctx, inc_ptr);
+  fcm__free(ctx, inc);
+  fcm__free(ctx, fill);
+  fcm__free(ctx, color);
+  fcm__free(ctx, mark);
+  return st;
+}
+
+/* Why one block failed during the parallel setup. */
+typedef enum block_fail { FAIL_NONE, FAIL_NONFINITE, FAIL_ZERO, FAIL_LAPACK } block_fail;
+
+typedef struct block_stats {
+  fcm_index negative, clamped;
+} block_stats;
+
+/* Gather C_K into a (m x m), eigendecompose, and write S_K. */
+static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *vals, fcm_index b,
+                              double *a, double *w, block_stats *bs, block_fail *fail)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_index *d = P->dofs + P->block_ptr[b];
+  const int m = (int)(P->block_ptr[b + 1] - P->block_ptr[b]);
+  double *S = P->S + P->s_off[b];
+  for (int j = 0; j < m; j++)
+    for (int i = 0; i < m; i++) {
+      fcm_index p = fcm_csr_get_position(C, d[i], d[j]);
+      double v = p >= 0 ? vals[p] : 0.0;
+      if (!isfinite(v)) {
+        *fail = FAIL_NONFINITE;
+        return FCM_ERR_NUMERIC;
+      }
+      a[i + (size_t)j * m] = v;
+    }
+  st = fcm__syev(ctx, 1, m, a, m, w);
+  if (st != FCM_OK) {
+    *fail = st == FCM_ERR_ALLOC ? FAIL_NONE : FAIL_LAPACK;
+    return st;
+  }
+  const double lmax = FCM_MAX(fabs(w[0]), fabs(w[m - 1]));
+  if (!(lmax > 0.0)) {
+    *fail = FAIL_ZERO;
+    return FCM_ERR_SINGULAR;
+  }
+  const double eps = P->opts.epsilon, tau = eps * lmax;
+  const double small = P->opts.clamp == FCM_SCHWARZ_PAPER ? eps / lmax : 1.0 / tau;
+  for (int k = 0; k < m; k++) {
+    double l = fabs(w[k]);
+    if (w[k] < 0.0) bs->negative++;
+    if (l >= tau) {
+      w[k] = 1.0 / l;
+    } else {
+      w[k] = small;
+      bs->clamped++;
+    }
+  }
+  /* S_K = V diag(s) V^T, upper triangle computed, mirrored */
+  for (int i = 0; i < m; i++)
+    for (int j = i; j < m; j++) {
+      double s = 0.0;
+      for (int k = 0; k < m; k++)
+        s += a[i + (size_t)k * m] * w[k] * a[j + (size_t)k * m];
+      S[(size_t)i * m + j] = S[(size_t)j * m + i] = s;
+    }
+  return st;
+}
+
+fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P ? P->ctx : NULL;
+  double *work = NULL;
+  fcm_index nr = -1, nc = -1;
+  double t0 = fcm_wtime();
+  FCM_CHECK(P && C, ctx, FCM_ERR_ARG, "schwarz_setup: NULL argument");
+  fcm_csr_get_size(C, &nr, &nc, NULL);
+  FCM_CHECK(nr == P->n && nc == P->n, ctx, FCM_ERR_ARG,
+            "schwarz_setup: matrix is %lld x %lld, the preconditioner was created for %lld x %lld",
+            (long long)nr, (long long)nc, (long long)P->n, (long long)P->n);
+  P->ready = 0;
+  const double *vals = fcm_csr_get_values((fcm_csr *)C); /* read only */
+  fcm_index fallbacks = 0;
+  for (fcm_index i = 0; i < P->n; i++) {
+    if (P->inside[i]) {
+      P->dinv[i] = 0.0;
+      continue;
+    }
+    fcm_index p = fcm_csr_get_position(C, i, i);
+    double dii = p >= 0 ? vals[p] : 0.0;
+    FCM_CHECK(isfinite(dii), ctx, FCM_ERR_NUMERIC,
+              "schwarz: diagonal entry of row %lld (outside all blocks) is %g", (long long)i, dii);
+    FCM_CHECK(dii != 0.0, ctx, FCM_ERR_SINGULAR,
+              "schwarz: diagonal entry of row %lld (outside all blocks) is zero", (long long)i);
+    if (dii < 0.0) fallbacks++;
+    P->dinv[i] = 1.0 / fabs(dii);
+  }
+
+  const fcm_index nb = P->num_blocks;
+  const int nt = omp_get_max_threads();
+  const size_t per_thread = (size_t)P->max_m * (size_t)P->max_m + (size_t)P->max_m;
+  fcm_index bad = -1, negative = 0, clamped = 0;
+  fcm_status bad_st = FCM_OK;
+  block_fail bad_fail = FAIL_NONE;
+  if (nb > 0) FCM_ALLOC(ctx, per_thread * (size_t)nt, work);
+#pragma omp parallel num_threads(nt) if (nb > 1) reduction(+ : negative, clamped)
+  if (nb > 0) {
+    double *a = work + per_thread * (size_t)omp_get_thread_num();
+    double *w = a + (size_t)P->max_m * (size_t)P->max_m;
+#pragma omp for schedule(dynamic, 1)
+    for (fcm_index b = 0; b < nb; b++) {
+      block_stats bs = {0, 0};
+      block_fail fail = FAIL_NONE;
+      fcm_status s = build_block(P, C, vals, b, a, w, &bs, &fail);
+      negative += bs.negative;
+      clamped += bs.clamped;
+      if (s != FCM_OK) {
+#pragma omp critical(fcm_schwarz_bad)
+        if (bad < 0 || b < bad) {
+          bad = b;
+          bad_st = s;
+          bad_fail = fail;
+        }
+      }
+    }
+  }
+  if (bad >= 0) {
+    const fcm_index *d = P->dofs + P->block_ptr[bad];
+    const long long m = (long long)(P->block_ptr[bad + 1] - P->block_ptr[bad]);
+    FCM_CHECK(bad_fail != FAIL_NONFINITE, ctx, FCM_ERR_NUMERIC,
+              "schwarz: block %lld (%lld DOFs, first DOF %lld) contains NaN or Inf", (long long)bad,
+              m, (long long)d[0]);
+    FCM_CHECK(bad_fail != FAIL_ZERO, ctx, FCM_ERR_SINGULAR,
+              "schwarz: block %lld (%lld DOFs, first DOF %lld) is zero (all eigenvalues 0)",
+              (long long)bad, m, (long long)d[0]);
+    FCM_CHECK(bad_fail != FAIL_LAPACK, ctx, bad_st,
+              "schwarz: eigendecomposition of block %lld (%lld DOFs) failed: %s", (long long)bad, m,
+              fcm_status_str(bad_st));
+    st = bad_st; /* allocation failure inside dsyevd, already recorded */
+    fcm__trace(ctx, __FILE__, __LINE__, __func__);
+    goto cleanup;
+  }
+  P->info.negative_eigenvalues = negative;
+  P->info.clamped_eigenvalues = clamped;
+  P->info.jacobi_fallbacks = fallbacks;
+  P->info.setup_time = fcm_wtime() - t0;
+  P->ready = 1;
+cleanup:
+  fcm__free(ctx, work);
+  return st;
+}
+
+fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
+                              const fcm_index *block_ptr, const fcm_index *block_dofs,
+                              const fcm_schwarz_options *opts, fcm_schwarz **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_schwarz *P = NULL;
+  fcm_index *stamp = NULL;
+  fcm_index nr = -1, nc = -1;
+  FCM_CHECK(out, ctx, FCM_ERR_ARG, "schwarz_create: output pointer is NULL");
+  *out = NULL;
+  FCM_CHECK(C, ctx, FCM_ERR_ARG, "schwarz_create: matrix is NULL");
+  fcm_csr_get_size(C, &nr, &nc, NULL);
+  FCM_CHECK(nr == nc, ctx, FCM_ERR_ARG, "schwarz_create: matrix is %lld x %lld, not square",
+            (long long)nr, (long long)nc);
+  FCM_CHECK(num_blocks >= 0, ctx, FCM_ERR_ARG, "schwarz_create: num_blocks = %lld must be >= 0",
+            (long long)num_blocks);
+  FCM_CHECK(num_blocks == 0 || (block_ptr && block_dofs), ctx, FCM_ERR_ARG,
+            "schwarz_create: block_ptr or block_dofs is NULL with %lld blocks",
+            (long long)num_blocks);
+  fcm_schwarz_options o = opts ? *opts : fcm_schwarz_options_default();
+  FCM_CHECK(o.epsilon > 0.0 && o.epsilon < 1.0, ctx, FCM_ERR_ARG,
+            "schwarz_create: epsilon = %g out of range (0, 1)", o.epsilon);
+  FCM_CHECK(o.clamp == FCM_SCHWARZ_CLAMP || o.clamp == FCM_SCHWARZ_PAPER, ctx, FCM_ERR_ARG,
+            "schwarz_create: clamp = %d is not FCM_SCHWARZ_CLAMP (%d) or FCM_SCHWARZ_PAPER (%d)",
+            (int)o.clamp, (int)FCM_SCHWARZ_CLAMP, (int)FCM_SCHWARZ_PAPER);
+  if (num_blocks > 0)
+    FCM_CHECK(block_ptr[0] == 0, ctx, FCM_ERR_ARG, "schwarz_create: block_ptr[0] = %lld must be 0",
+              (long long)block_ptr[0]);
+  int max_m = 0;
+  for (fcm_index b = 0; b < num_blocks; b++) {
+    fcm_index m = block_ptr[b + 1] - block_ptr[b];
+    FCM_CHECK(m >= 1 && m <= MAX_BLOCK, ctx, FCM_ERR_ARG,
+              "schwarz_create: block %lld has %lld DOFs, valid range [1, %d]", (long long)b,
+              (long long)m, MAX_BLOCK);
+    max_m = FCM_MAX(max_m, (int)m);
+  }
+  /* DOFs in range and distinct within each block */
+  FCM_ALLOC(ctx, nr, stamp);
+  for (fcm_index b = 0; b < num_blocks; b++)
+    for (fcm_index p = block_ptr[b]; p < block_ptr[b + 1]; p++) {
+      fcm_index d = block_dofs[p];
+      FCM_CHECK(d >= 0 && d < nr, ctx, FCM_ERR_ARG,
+                "schwarz_create: block %lld: DOF %lld out of range [0, %lld)", (long long)b,
+                (long long)d, (long long)nr);
+      FCM_CHECK(stamp[d] != b + 1, ctx, FCM_ERR_ARG,
+                "schwarz_create: block %lld lists DOF %lld twice", (long long)b, (long long)d);
+      stamp[d] = b + 1;
+    }
+
+  FCM_ALLOC(ctx, 1, P);
+  P->ctx = ctx;
+  P->n = nr;
+  P->opts = o;
+  P->num_blocks = num_blocks;
+  P->max_m = max_m;
+  const fcm_index total = num_blocks > 0 ? block_ptr[num_blocks] : 0;
+  FCM_ALLOC(ctx, num_blocks + 1, P->block_ptr);
+  FCM_ALLOC(ctx, FCM_MAX(total, 1), P->dofs);
+  FCM_ALLOC(ctx, num_blocks + 1, P->s_off);
+  FCM_ALLOC(ctx, nr, P->inside);
+  FCM_ALLOC(ctx, nr, P->dinv);
+  for (fcm_index b = 0; b < num_blocks; b++) {
+    fcm_index m = block_ptr[b + 1] - block_ptr[b];
+    P->block_ptr[b + 1] = block_ptr[b + 1];
+    P->s_off[b + 1] = P->s_off[b] + (size_t)m * (size_t)m;
+  }
+  for (fcm_index p = 0; p < total; p++) {
+    P->dofs[p] = block_dofs[p];
+    P->inside[block_dofs[p]] = 1;
+  }
+  FCM_ALLOC(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->S);
+  FCM_TRY(ctx, color_blocks(P));
+  P->info.num_blocks = num_blocks;
+  P->info.block_dofs = total;
+  P->info.max_block_size = max_m;
+  P->info.num_colors = P->num_colors;
+  for (fcm_index i = 0; i < nr; i++)
+    P->info.outside_dofs += !P->inside[i];
+  FCM_TRY(ctx, fcm_schwarz_setup(P, C));
+  *out = P;
+  P = NULL;
+cleanup:
+  fcm__free(ctx, stamp);
+  fcm_schwarz_destroy(&P);
+  return st;
+}
+
+fcm_status fcm_schwarz_create_from_space(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *C,
+                                         const unsigned char *cell_flag,
+                                         const fcm_schwarz_options *opts, fcm_schwarz **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *block_ptr = NULL, *dofs = NULL;
+  FCM_CHECK(out, ctx, FCM_ERR_ARG, "schwarz_create_from_space: output pointer is NULL");
+  *out = NULL;
+  FCM_CHECK(space && cell_flag, ctx, FCM_ERR_ARG,
+            "schwarz_create_from_space: space or cell_flag is NULL");
+  const fcm_mesh *mesh = fcm_space_mesh(space);
+  const fcm_index ncell = fcm_mesh_num_cells(mesh);
+  const int npc = fcm_mesh_nodes_per_cell(mesh);
+  const fcm_index *cells = fcm_mesh_cells(mesh);
+  fcm_index nb = 0;
+  for (fcm_index c = 0; c < ncell; c++)
+    nb += cell_flag[c] != 0;
+  FCM_ALLOC(ctx, nb + 1, block_ptr);
+  FCM_ALLOC(ctx, FCM_MAX(nb * 3 * npc, 1), dofs);
+  fcm_index b = 0;
+  for (fcm_index c = 0; c < ncell; c++) {
+    if (!cell_flag[c]) continue;
+    fcm_index *bd = dofs + b * 3 * npc;
+    for (int a = 0; a < npc; a++) {
+      fcm_index node = cells[c * npc + a];
+      fcm_index d = fcm_space_node_dof(space, node);
+      FCM_CHECK(d >= 0, ctx, FCM_ERR_ARG,
+                "schwarz_create_from_space: cell %lld is flagged but inactive (node %lld has no "
+                "DOFs)",
+                (long long)c, (long long)node);
+      for (int i = 0; i < 3; i++)
+        bd[3 * a + i] = d + i;
+    }
+    b++;
+    block_ptr[b] = b * 3 * npc;
+  }
+  FCM_TRY(ctx, fcm_schwarz_create(ctx, C, nb, block_ptr, dofs, opts, out));
+cleanup:
+  fcm__free(ctx, block_ptr);
+  fcm__free(ctx, dofs);
+  return st;
+}
+
+fcm_status fcm_schwarz_apply(const fcm_schwarz *P, const double *r, double *z)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P ? P->ctx : NULL;
+  FCM_CHECK(P, ctx, FCM_ERR_ARG, "schwarz_apply: preconditioner is NULL");
+  FCM_CHECK(P->ready, ctx, FCM_ERR_ARG, "schwarz_apply: the last setup failed");
+  FCM_CHECK((r && z) || P->n == 0, ctx, FCM_ERR_ARG, "schwarz_apply: r or z is NULL");
+  FCM_CHECK(!r || r != z, ctx, FCM_ERR_ARG, "schwarz_apply: r and z must be different arrays");
+  const fcm_index n = P->n;
+  const double *dinv = P->dinv;
+  const int par = n >= FCM__SOLVE_PARALLEL_MIN || P->s_off[P->num_blocks] >= APPLY_PARALLEL_WORK;
+  /* One team; the implicit barrier after each colour orders the contributions to z. */
+#pragma omp parallel if (par)
+  {
+#pragma omp for schedule(static)
+    for (fcm_index i = 0; i < n; i++)
+      z[i] = dinv[i] * r[i];
+    for (int c = 0; c < P->num_colors; c++) {
+      const fcm_index k0 = P->color_ptr[c], k1 = P->color_ptr[c + 1];
+      /* blocks of one colour touch disjoint entries of z */
+#pragma omp for schedule(static)
+      for (fcm_index k = k0; k < k1; k++) {
+        const fcm_index b = P->color_blocks[k];
+        const fcm_index *d = P->dofs + P->block_ptr[b];
+        const int m = (int)(P->block_ptr[b + 1] - P->block_ptr[b]);
+        const double *S = P->S + P->s_off[b];
+        for (int i = 0; i < m; i++) {
+          const double *row = S + (size_t)i * m;
+          double s = 0.0;
+          for (int j = 0; j < m; j++)
+            s += row[j] * r[d[j]];
+          z[d[i]] += s;
+        }
+      }
+    }
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm_schwarz_operator(void *user, const double *r, double *z)
+{
+  return fcm_schwarz_apply((const fcm_schwarz *)user, r, z);
+}
+
+void fcm_schwarz_get_info(const fcm_schwarz *P, fcm_schwarz_info *info)
+{
+  if (!info) return;
+  if (!P) {
+    memset(info, 0, sizeof *info);
+    return;
+  }
+  *info = P->info;
+}

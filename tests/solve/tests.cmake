@@ -1,0 +1,7 @@
+fcm_add_test(solve_cg_laplace tests/solve/cg_laplace.c)
+fcm_add_test(solve_minres_indefinite tests/solve/minres_indefinite.c)
+fcm_add_test(solve_krylov_errors tests/solve/krylov_errors.c)
+fcm_add_test(solve_jacobi tests/solve/jacobi.c)
+fcm_add_test(solve_schwarz tests/solve/schwarz.c)
+fcm_add_test(solve_schwarz_space tests/solve/schwarz_space.c)
+fcm_add_test(solve_alloc_failure tests/solve/alloc_failure.c)
