@@ -26,6 +26,7 @@ static void usage(FILE *f)
           "  --out DIR        output directory (default quadrature_tables)\n"
           "  --starts K       try K start rules (computed rules of strength m, m+2, ...) and keep\n"
           "                   the smallest result (default 1)\n"
+          "  --from-next      also start from the table of strength m+1 in DIR, if present\n"
           "  --candidates N   single points tried per removal before stopping (default 12)\n"
           "  --iterations N   Levenberg-Marquardt iterations per attempt (default 60)\n"
           "  --batch F        largest fraction of points removed at once early on (default 0.05)\n"
@@ -83,6 +84,49 @@ static int existing_points(const char *path)
   return n;
 }
 
+/* Read a table file written by this program as a user rule of the file's strength;
+ * returns NULL when the file is absent or malformed. */
+static fcm_rule *read_table(fcm_ctx *ctx, const char *path, fcm_shape shape)
+{
+  FILE *f = fopen(path, "r");
+  char line[1024];
+  int n = -1, strength = -1, rows = 0, dim = fcm_shape_dim(shape), ok = 1;
+  double *x = NULL, *w = NULL;
+  fcm_rule *rule = NULL;
+  if (!f) return NULL;
+  while (ok && fgets(line, sizeof line, f)) {
+    if (line[0] == '#') {
+      if (sscanf(line, "# points: %d", &n) == 1 && n > 0) {
+        x = calloc((size_t)n * dim, sizeof *x);
+        w = calloc((size_t)n, sizeof *w);
+        ok = x && w;
+      }
+      sscanf(line, "# strength: %d", &strength);
+      continue;
+    }
+    char *p = line, *end;
+    double v[4];
+    int k = 0;
+    for (; k <= dim; k++, p = end)
+      if (v[k] = strtod(p, &end), end == p) break;
+    if (k == 0) continue;
+    ok = k == dim + 1 && x && rows < n;
+    if (!ok) break;
+    for (int d = 0; d < dim; d++) x[rows * dim + d] = v[d];
+    w[rows++] = v[dim];
+  }
+  fclose(f);
+  if (ok && rows == n && strength >= 0 &&
+      fcm_rule_create_from_arrays(ctx, shape, strength, n, x, w, &rule) != FCM_OK) {
+    fcm_ctx_error_view(ctx, stderr);
+    fcm_ctx_error_clear(ctx);
+  }
+  if (!rule) fprintf(stderr, "fcm-rulegen: cannot use %s as a start rule\n", path);
+  free(x);
+  free(w);
+  return rule;
+}
+
 static int ensure_dir(const char *path)
 {
   if (mkdir(path, 0777) == 0 || errno == EEXIST) return 1;
@@ -135,7 +179,7 @@ static int write_table(const char *path, const fcm_rule *rule, const char *start
 
 typedef struct config {
   const char *out;
-  int starts, force, dry_run;
+  int starts, from_next, force, dry_run;
   fcm_rulegen_options opts;
 } config;
 
@@ -149,17 +193,25 @@ static int generate(fcm_ctx *ctx, const config *cfg, fcm_shape shape, int m)
   int best_start_n = 0, best_start_m = 0, ok = 1;
   double t0 = fcm_wtime();
   memset(&best_info, 0, sizeof best_info);
-  for (int s = 0; s < cfg->starts; s++) {
+  for (int s = 0; s < cfg->starts + cfg->from_next; s++) {
     int ms = m + 2 * s;
     fcm_rule *start = NULL, *rule = NULL;
     fcm_rulegen_info info;
     progress_state ps = {sname, m, -1e30};
     fcm_rulegen_options o = cfg->opts;
+    char start_desc[160];
     o.progress = progress;
     o.progress_user = &ps;
-    if (fcm_rule_create_computed(ctx, shape, ms, &start) != FCM_OK) {
+    if (s == cfg->starts) { /* the stored table of strength m + 1 */
+      snprintf(path, sizeof path, "%s/%s/%s_%02d.txt", cfg->out, sname, sname, m + 1);
+      if (!(start = read_table(ctx, path, shape))) continue;
+      ms = fcm_rule_strength(start);
+      snprintf(start_desc, sizeof start_desc, "table %s_%02d", sname, m + 1);
+    } else if (fcm_rule_create_computed(ctx, shape, ms, &start) != FCM_OK) {
       fcm_ctx_error_view(ctx, stderr);
       return 0;
+    } else {
+      snprintf(start_desc, sizeof start_desc, "%s", fcm_rule_description(start));
     }
     fcm_status st = fcm_rule_eliminate_nodes(ctx, start, m, &o, &info, &rule);
     if (st != FCM_OK) {
@@ -168,7 +220,7 @@ static int generate(fcm_ctx *ctx, const config *cfg, fcm_shape shape, int m)
       fcm_ctx_error_clear(ctx);
     } else {
       fprintf(stderr, "  %s %2d: start %s (%d points): %d points, residual %.1e, %.1f s\n",
-              sname, m, fcm_rule_description(start), fcm_rule_num_points(start),
+              sname, m, start_desc, fcm_rule_num_points(start),
               fcm_rule_num_points(rule), info.residual, info.seconds);
       if (!best || fcm_rule_num_points(rule) < fcm_rule_num_points(best) ||
           (fcm_rule_num_points(rule) == fcm_rule_num_points(best) &&
@@ -177,7 +229,7 @@ static int generate(fcm_ctx *ctx, const config *cfg, fcm_shape shape, int m)
         best = rule;
         rule = NULL;
         best_info = info;
-        snprintf(best_desc, sizeof best_desc, "%s", fcm_rule_description(start));
+        snprintf(best_desc, sizeof best_desc, "%s", start_desc);
         best_start_n = fcm_rule_num_points(start);
         best_start_m = ms;
       }
@@ -186,7 +238,10 @@ static int generate(fcm_ctx *ctx, const config *cfg, fcm_shape shape, int m)
     fcm_rule_destroy(&start);
   }
   double seconds = fcm_wtime() - t0;
-  if (!best) return 0;
+  if (!best) { /* reported above; go on with the other tables */
+    fprintf(stderr, "fcm-rulegen: no rule for %s strength %d\n", sname, m);
+    return 1;
+  }
   snprintf(dir, sizeof dir, "%s/%s", cfg->out, sname);
   snprintf(path, sizeof path, "%s/%s_%02d.txt", dir, sname, m);
   int old = existing_points(path), n = fcm_rule_num_points(best);
@@ -239,6 +294,8 @@ int main(int argc, char **argv)
       return 0;
     } else if (!strcmp(a, "--force")) {
       cfg.force = 1;
+    } else if (!strcmp(a, "--from-next")) {
+      cfg.from_next = 1;
     } else if (!strcmp(a, "--dry-run")) {
       cfg.dry_run = 1;
     } else if (!v) {
@@ -261,7 +318,7 @@ int main(int argc, char **argv)
       cfg.out = v;
       i++;
     } else if (!strcmp(a, "--starts")) {
-      bad = !parse_int(v, &cfg.starts) || cfg.starts < 1;
+      bad = !parse_int(v, &cfg.starts) || cfg.starts < 0;
       i++;
     } else if (!strcmp(a, "--candidates")) {
       bad = !parse_int(v, &cfg.opts.max_candidates);
@@ -293,6 +350,10 @@ int main(int argc, char **argv)
     shapes[nshapes++] = FCM_SHAPE_HEX;
     shapes[nshapes++] = FCM_SHAPE_TRI;
     shapes[nshapes++] = FCM_SHAPE_QUAD;
+  }
+  if (cfg.starts == 0 && !cfg.from_next) {
+    fprintf(stderr, "fcm-rulegen: --starts 0 needs --from-next\n");
+    return 2;
   }
   if (mlo < 1 || mhi < mlo || mhi > 40) {
     fprintf(stderr, "fcm-rulegen: strength range %d:%d outside [1, 40]\n", mlo, mhi);
