@@ -501,8 +501,20 @@ fcm_status fcm__rulegen_eliminate(fcm_ctx *ctx, fcm_shape shape, int m, int n0, 
     }
   }
 
-  /* final polish: a few more steps while the residual decreases */
-  FCM_TRY(ctx, lm_solve(&s, n, x, w, -1.0, 4, &converged, &rinf));
+  /* final polish: a few more steps, kept when they lower the max residual */
+  {
+    double r0, f0, rp;
+    build(&s, n, x, w, s.J, s.r, &f0, &r0);
+    memcpy(xt, x, sizeof(double) * (size_t)n * s.d);
+    memcpy(wt, w, sizeof(double) * (size_t)n);
+    FCM_TRY(ctx, lm_solve(&s, n, xt, wt, -1.0, 4, &converged, &rp));
+    if (rp < r0) {
+      memcpy(x, xt, sizeof(double) * (size_t)n * s.d);
+      memcpy(w, wt, sizeof(double) * (size_t)n);
+      r0 = rp;
+    }
+    rinf = r0;
+  }
   fill_info(info, &s, n, x, w, rinf, t0);
   for (int i = 0; i < n; i++) w[i] *= meas;
   *n_out = n;
