@@ -1,1 +1,3 @@
-list(APPEND FCM_SOURCES)
+list(APPEND FCM_SOURCES lib/src/scene/json_adapter.c lib/src/scene/schema.c
+                        lib/src/scene/effects.c lib/src/scene/scene.c
+                        lib/src/scene/default_scene.c)

@@ -1,0 +1,349 @@
+/* fcm — scene files: a JSON description of a simulation (background mesh, embedded
+ * geometry, material, quadrature, solver, time stepping, output and a list of effects)
+ * parsed, validated and held as plain read-only data. The schema, with every key, type,
+ * default, range and unit, is documented in apps/scenes/README.md.
+ *
+ * An fcm_scene is an opaque object; its sections come back as pointers to plain structs
+ * (enums, doubles, fixed arrays, strings and arrays owned by the scene). They are
+ * read-only and stay valid until fcm_scene_destroy(). Units are SI throughout (m, s, kg,
+ * Pa, rad). Parsing never creates, opens for writing or touches any output file. */
+#ifndef FCM_SCENE_H
+#define FCM_SCENE_H
+
+#include "fcm/core.h"
+#include "fcm/element.h"
+#include "fcm/la.h"
+#include "fcm/material.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------------ sections */
+
+/** Where the background mesh comes from. */
+typedef enum fcm_scene_background_kind {
+  FCM_SCENE_BACKGROUND_GRID = 0, /**< a structured grid over a box (fcm_mesh_create_box) */
+  FCM_SCENE_BACKGROUND_MESH      /**< a Gmsh file (fcm_mesh_create_from_gmsh) */
+} fcm_scene_background_kind;
+
+/** The background mesh ("background"). */
+typedef struct fcm_scene_background {
+  fcm_scene_background_kind kind;
+  fcm_element_type element; /**< GRID: the element type; MESH: FCM_ELEMENT_COUNT (file's) */
+  double min[3], max[3];    /**< GRID: box corners, min[d] < max[d] */
+  fcm_index cells[3];       /**< GRID: cells per axis, >= 1 */
+  const char *mesh;         /**< MESH: the file, resolved against the scene file's directory;
+                                 GRID: NULL */
+} fcm_scene_background;
+
+/** What the embedded geometry is. */
+typedef enum fcm_scene_geometry_kind {
+  FCM_SCENE_GEOMETRY_NONE = 0,    /**< none: plain FEM, the background mesh is the body */
+  FCM_SCENE_GEOMETRY_BOX,         /**< fcm_geometry_create_box() */
+  FCM_SCENE_GEOMETRY_BALL,        /**< fcm_geometry_create_ball() */
+  FCM_SCENE_GEOMETRY_HEMISPHERE,  /**< fcm_geometry_create_hemisphere() */
+  FCM_SCENE_GEOMETRY_HOLLOW_BALL, /**< fcm_geometry_create_hollow_ball() */
+  FCM_SCENE_GEOMETRY_TUBE,        /**< fcm_geometry_create_tube() */
+  FCM_SCENE_GEOMETRY_GMSH,        /**< fcm_geometry_create_from_gmsh() */
+  FCM_SCENE_GEOMETRY_TETGEN,      /**< fcm_geometry_create_from_tetgen() */
+  FCM_SCENE_GEOMETRY_KIND_COUNT
+} fcm_scene_geometry_kind;
+
+/** The embedded geometry ("geometry"); members not used by `kind` are zero. */
+typedef struct fcm_scene_geometry {
+  fcm_scene_geometry_kind kind;
+  double min[3], max[3];             /**< BOX corners, min[d] < max[d] */
+  fcm_index cells[3];                /**< BOX: cubes per axis (6 tets each) */
+  double center[3];                  /**< BALL, HEMISPHERE, HOLLOW_BALL, TUBE */
+  double radius;                     /**< BALL, HEMISPHERE */
+  double inner_radius, outer_radius; /**< HOLLOW_BALL, TUBE */
+  double hole_radius;                /**< HOLLOW_BALL (0: no holes) */
+  double length;                     /**< TUBE */
+  int axis;                          /**< TUBE: 0 (x), 1 (y), 2 (z) */
+  int resolution; /**< BALL, HEMISPHERE: cubes per radius; HOLLOW_BALL: quads per patch edge */
+  int layers;     /**< HOLLOW_BALL: radial layers */
+  int radial_cells, angular_cells, axial_cells; /**< TUBE */
+  const char *mesh;    /**< GMSH: the .msh file; TETGEN: the .node file (resolved paths) */
+  const char *ele;     /**< TETGEN: the .ele file */
+  int has_transform;   /**< 1: map the created geometry by x -> A x + b */
+  double transform[9]; /**< A, row-major: rotation times scale (identity when none) */
+  double offset[3];    /**< b */
+} fcm_scene_geometry;
+
+/** Rule simplification method (names "auto", "lp", "recombine"; fcm/simplify.h). */
+typedef enum fcm_scene_simplify_method {
+  FCM_SCENE_SIMPLIFY_AUTO = 0,
+  FCM_SCENE_SIMPLIFY_LP,
+  FCM_SCENE_SIMPLIFY_RECOMBINE
+} fcm_scene_simplify_method;
+
+/** Which matrices get cut-cell stabilization ("mass_stiffness", "mass", "off"). */
+typedef enum fcm_scene_stabilization {
+  FCM_SCENE_STABILIZATION_MASS_STIFFNESS = 0,
+  FCM_SCENE_STABILIZATION_MASS,
+  FCM_SCENE_STABILIZATION_OFF
+} fcm_scene_stabilization;
+
+/** Quadrature settings ("quadrature"). */
+typedef struct fcm_scene_quadrature {
+  int stiffness_strength; /**< [0, 20]; -1 (default): the element's default */
+  int mass_strength;      /**< [0, 20]; -1 (default): the element's default */
+  int surface_strength;   /**< [0, 20]; -1 (default): automatic (the stiffness strength when a
+                               traction or pressure effect is present, else no surface rules) */
+  int simplify;           /**< 1 (default): simplify cut-cell rules; 0: keep them */
+  fcm_scene_simplify_method simplify_method; /**< default AUTO */
+  fcm_scene_stabilization stabilization;     /**< default MASS_STIFFNESS */
+  double stabilization_alpha;                /**< (0, 1], default 1e-6 */
+  double min_fraction; /**< cells with smaller volume fraction are dropped; [0, 1),
+                            default 1e-4 */
+} fcm_scene_quadrature;
+
+/** Linear solver of the Newton steps ("direct", "minres", "cg"). */
+typedef enum fcm_scene_linear_solver {
+  FCM_SCENE_SOLVER_DIRECT = 0,
+  FCM_SCENE_SOLVER_MINRES,
+  FCM_SCENE_SOLVER_CG
+} fcm_scene_linear_solver;
+
+/** Preconditioner of the Krylov solvers ("none", "jacobi", "block_jacobi", "schwarz"). */
+typedef enum fcm_scene_preconditioner {
+  FCM_SCENE_PRECONDITIONER_NONE = 0,
+  FCM_SCENE_PRECONDITIONER_JACOBI,
+  FCM_SCENE_PRECONDITIONER_BLOCK_JACOBI,
+  FCM_SCENE_PRECONDITIONER_SCHWARZ
+} fcm_scene_preconditioner;
+
+/** Solver settings ("solver"). */
+typedef struct fcm_scene_solver {
+  fcm_scene_linear_solver method;          /**< default DIRECT */
+  fcm_direct_method direct;                /**< default FCM_DIRECT_CHOLMOD */
+  fcm_scene_preconditioner preconditioner; /**< Krylov only; default SCHWARZ */
+  double schwarz_threshold;  /**< cut cells with volume fraction below it get a block; (0, 1],
+                                  default 0.5 */
+  double schwarz_epsilon;    /**< relative eigenvalue threshold; (0, 1), default 1e-13 */
+  int schwarz_paper_clamp;   /**< 0 (default, "clamp"): 1/(eps lambda_max); 1 ("paper") */
+  double rtol;               /**< Krylov relative tolerance; [0, 1), default 1e-8 */
+  double atol;               /**< Krylov absolute tolerance; >= 0, default 0 */
+  int max_iterations;        /**< Krylov iterations; >= 1, default 1000 */
+  double newton_rtol;        /**< ||M a - f|| <= newton_rtol ||M a_rep||; (0, 1), default 1e-5 */
+  int newton_max_iterations; /**< >= 1, default 100 */
+  int line_search;           /**< 1 (default): backtracking line search */
+  int project_psd;           /**< 1: project element tangents to PSD; default 0 */
+  double representative_acceleration; /**< |a_rep| in m/s^2, > 0, default 9.81 */
+  int threads;                        /**< OpenMP threads, >= 0; 0 (default): the OpenMP default */
+} fcm_scene_solver;
+
+/** Time integrators ("backward_euler"). */
+typedef enum fcm_scene_integrator { FCM_SCENE_INTEGRATOR_BACKWARD_EULER = 0 } fcm_scene_integrator;
+
+/** Time stepping ("time"). */
+typedef struct fcm_scene_time {
+  int is_static;                   /**< 1: quasi-static equilibrium at each step (no inertia) */
+  fcm_scene_integrator integrator; /**< default BACKWARD_EULER (dynamic scenes) */
+  double dt;                       /**< step in s, > 0, default 1/60 */
+  fcm_index num_steps;             /**< steps to take (>= 1), from "steps" or "duration" */
+  double duration;                 /**< num_steps * dt: the simulated time in s */
+  int load_steps;                  /**< static: load increments per step, >= 1, default 1 */
+} fcm_scene_time;
+
+/** Output settings ("output"). */
+typedef struct fcm_scene_output {
+  const char *directory; /**< default "fcm-output"; relative to the working directory */
+  int frame_interval;    /**< write every frame_interval-th step (>= 1, default 1) */
+  int write_background;  /**< 1 (default): write the deformed background mesh */
+  int write_surface;     /**< 1 (default): write the deformed embedded surface */
+} fcm_scene_output;
+
+/* ------------------------------------------------------------------- regions */
+
+/** Kinds of region. */
+typedef enum fcm_region_kind {
+  FCM_REGION_ALL = 0,    /**< everything (an effect without "region", where allowed) */
+  FCM_REGION_BOX,        /**< min - tol <= x <= max + tol, componentwise */
+  FCM_REGION_HALF_SPACE, /**< (x - point) . normal >= -tol, normal a unit vector */
+  FCM_REGION_NODES       /**< an explicit list of background-mesh node ids */
+} fcm_region_kind;
+
+/** A region of space or a node set. */
+typedef struct fcm_region {
+  fcm_region_kind kind;
+  double min[3], max[3];      /**< BOX: corners, min[d] <= max[d] (equal: a plane) */
+  double point[3], normal[3]; /**< HALF_SPACE: a point on the plane, unit normal into it */
+  double tolerance;           /**< BOX, HALF_SPACE: absolute, >= 0, default 1e-9 m */
+  fcm_index num_nodes;        /**< NODES: count >= 1 */
+  const fcm_index *nodes;     /**< NODES: 0-based ids, ascending, distinct (owned by the scene;
+                                   their range is checked against the mesh by the caller) */
+} fcm_region;
+
+/** Whether the point x lies in the region: 1 or 0. ALL contains every point; NODES none
+ * (membership is by node id). No allocation; thread safe. */
+FCM_API int fcm_region_contains(const fcm_region *region, const double x[3]);
+
+/* ------------------------------------------------------------------- effects */
+
+/** Effect types, in the order of the one effect table (see fcm_effect_type_name()). */
+typedef enum fcm_effect_type {
+  FCM_EFFECT_GRAVITY = 0,      /**< "gravity": body force rho g */
+  FCM_EFFECT_FIXED,            /**< "fixed": zero displacement on a region */
+  FCM_EFFECT_MOTION,           /**< "motion": prescribed translation and rotation */
+  FCM_EFFECT_INITIAL_VELOCITY, /**< "initial_velocity": v0 + omega x (X - c) */
+  FCM_EFFECT_DAMPING,          /**< "damping": Rayleigh D = mass M + stiffness K */
+  FCM_EFFECT_TRACTION,         /**< "traction": force per area on the embedded boundary */
+  FCM_EFFECT_PRESSURE,         /**< "pressure": p along the inward normal of the boundary */
+  FCM_EFFECT_TYPE_COUNT
+} fcm_effect_type;
+
+/** Name of an effect type as written in scene files ("gravity", ...), or NULL. */
+FCM_API const char *fcm_effect_type_name(fcm_effect_type type);
+
+typedef struct fcm_effect_gravity {
+  double acceleration[3]; /**< m/s^2, default (0, 0, -9.81) */
+} fcm_effect_gravity;
+
+typedef struct fcm_effect_fixed {
+  fcm_region region;
+  int components[3]; /**< 1: that displacement component is held (default all) */
+} fcm_effect_fixed;
+
+/** Prescribed motion: with tau = clamp(t - start, 0, end - start), every point X of the
+ * region is at c + R(axis, angular_speed tau) (X - c) + velocity tau, where R(a, phi) is
+ * the right-handed rotation by phi about the unit axis a. Held at tau = 0 before start;
+ * after end held at the final position, or released (no constraint) when `release`. */
+typedef struct fcm_effect_motion {
+  fcm_region region;
+  double velocity[3];   /**< m/s, default 0 */
+  double axis[3];       /**< unit axis, default (0, 0, 1) */
+  double center[3];     /**< a point of the axis, default 0 */
+  double angular_speed; /**< rad/s (sign by the right-hand rule), default 0 */
+  double start;         /**< s, >= 0, default 0 */
+  double end;           /**< s, > start; default HUGE_VAL (the whole run) */
+  int release;          /**< 1: no constraint after end; default 0 */
+} fcm_effect_motion;
+
+/** Initial velocity v(X) = velocity + angular_velocity x (X - c) on the region (default
+ * ALL); c = center, or the embedded body's centre of mass when center_of_mass is 1. */
+typedef struct fcm_effect_initial_velocity {
+  fcm_region region;
+  double velocity[3];         /**< m/s, default 0 */
+  double angular_velocity[3]; /**< rad/s, default 0 */
+  double center[3];           /**< used when center_of_mass is 0 */
+  int center_of_mass;         /**< 1 (default, no "center" key): c = centre of mass */
+} fcm_effect_initial_velocity;
+
+/** Rayleigh damping D = mass M + stiffness K. */
+typedef struct fcm_effect_damping {
+  double mass;      /**< 1/s, >= 0, default 0 */
+  double stiffness; /**< s, >= 0, default 0 */
+} fcm_effect_damping;
+
+/** Traction (force per reference area) on the part of the embedded boundary in the
+ * region, during start <= t <= end. */
+typedef struct fcm_effect_traction {
+  fcm_region region;  /**< BOX or HALF_SPACE */
+  double traction[3]; /**< Pa */
+  double start, end;  /**< s; default 0 and HUGE_VAL */
+} fcm_effect_traction;
+
+/** Pressure on the part of the embedded boundary in the region (force -p n per area, n the
+ * outward normal: positive pressure pushes inward), during start <= t <= end. */
+typedef struct fcm_effect_pressure {
+  fcm_region region; /**< BOX or HALF_SPACE */
+  double pressure;   /**< Pa, any sign */
+  double start, end; /**< s; default 0 and HUGE_VAL */
+} fcm_effect_pressure;
+
+/** One effect of the scene: a tagged union. */
+typedef struct fcm_effect {
+  fcm_effect_type type; /**< selects the member */
+  int index;            /**< position in the scene's "effects" array */
+  union {
+    fcm_effect_gravity gravity;
+    fcm_effect_fixed fixed;
+    fcm_effect_motion motion;
+    fcm_effect_initial_velocity initial_velocity;
+    fcm_effect_damping damping;
+    fcm_effect_traction traction;
+    fcm_effect_pressure pressure;
+  };
+} fcm_effect;
+
+/** Displacement u = x(t) - X of the point X under a motion effect at time t (formula at
+ * fcm_effect_motion). No allocation; thread safe. */
+FCM_API void fcm_effect_motion_eval(const fcm_effect_motion *motion, const double X[3], double t,
+                                    double u[3]);
+
+/** Whether a motion effect constrains its region at time t: 1 unless released and
+ * t > end. */
+FCM_API int fcm_effect_motion_active(const fcm_effect_motion *motion, double t);
+
+/** Initial velocity at X: velocity + angular_velocity x (X - c), with c = `com` (the
+ * body's centre of mass, computed by the caller) when iv->center_of_mass, else iv->center.
+ * `com` may be NULL when iv->center_of_mass is 0. No allocation; thread safe. */
+FCM_API void fcm_effect_initial_velocity_eval(const fcm_effect_initial_velocity *iv,
+                                              const double X[3], const double com[3], double v[3]);
+
+/* --------------------------------------------------------------------- scene */
+
+/** A parsed and validated scene (opaque; the sections are plain read-only data). */
+typedef struct fcm_scene fcm_scene;
+
+/** Read, parse and validate a scene file. Relative file names inside it are resolved
+ * against the directory of `path`; referenced mesh files must exist and be readable.
+ * @param[in]  ctx   context (allocation, errors); must outlive the scene
+ * @param[in]  path  the JSON file
+ * @param[out] scene the new scene, NULL on failure
+ * @return FCM_OK; FCM_ERR_IO (the file or a referenced mesh cannot be read: the message
+ *         names the path and the system error); FCM_ERR_FORMAT (malformed JSON:
+ *         "path:line:column: ..."); FCM_ERR_ARG (unknown key or effect, wrong type, value
+ *         out of range, missing key: "path: effects[2].motion.end: expected ..., got ...",
+ *         unknown keys list the allowed ones); FCM_ERR_ALLOC. Allocates through ctx (the
+ *         JSON parser allocates its temporary tree with malloc). Thread safe. */
+FCM_API fcm_status fcm_scene_create_from_file(fcm_ctx *ctx, const char *path, fcm_scene **scene);
+
+/** Parse and validate a scene from a NUL-terminated JSON text.
+ * @param[in]  source_name name used in messages (NULL: "<string>"); relative file names in
+ *             the scene are resolved against its directory part (none: the working directory)
+ * Otherwise as fcm_scene_create_from_file(). */
+FCM_API fcm_status fcm_scene_create_from_string(fcm_ctx *ctx, const char *json_text,
+                                                const char *source_name, fcm_scene **scene);
+
+/** The built-in default scene: a small twisting hollow cylinder (Longva et al. 2020 §6.2,
+ * scaled down: Hex20 FCM, one end pushed in, the other twisted). Static NUL-terminated
+ * JSON text; never NULL. */
+FCM_API const char *fcm_scene_default_json(void);
+
+/** fcm_scene_create_from_string(ctx, fcm_scene_default_json(), "<default>", scene). */
+FCM_API fcm_status fcm_scene_create_default(fcm_ctx *ctx, fcm_scene **scene);
+
+/** Destroy a scene; accepts NULL and `*scene == NULL`, sets `*scene = NULL`. */
+FCM_API void fcm_scene_destroy(fcm_scene **scene);
+
+/** Accessors (scene must not be NULL). Pointers stay valid for the life of the scene;
+ * the data are read-only. Thread safe. */
+FCM_API const char *fcm_scene_name(const fcm_scene *scene);        /**< "name" or file stem */
+FCM_API const char *fcm_scene_description(const fcm_scene *scene); /**< "" when none */
+FCM_API const char *fcm_scene_source(const fcm_scene *scene);      /**< file or source name */
+FCM_API const fcm_scene_background *fcm_scene_get_background(const fcm_scene *scene);
+FCM_API const fcm_scene_geometry *fcm_scene_get_geometry(const fcm_scene *scene);
+FCM_API const fcm_material *fcm_scene_get_material(const fcm_scene *scene);
+FCM_API const fcm_scene_quadrature *fcm_scene_get_quadrature(const fcm_scene *scene);
+FCM_API const fcm_scene_solver *fcm_scene_get_solver(const fcm_scene *scene);
+FCM_API const fcm_scene_time *fcm_scene_get_time(const fcm_scene *scene);
+FCM_API const fcm_scene_output *fcm_scene_get_output(const fcm_scene *scene);
+
+/** Number of effects, and effect i (in [0, num_effects); NULL out of range), in file order. */
+FCM_API int fcm_scene_num_effects(const fcm_scene *scene);
+FCM_API const fcm_effect *fcm_scene_get_effect(const fcm_scene *scene, int i);
+
+/** Number of effects of `type` in the scene (0: that effect costs nothing). */
+FCM_API int fcm_scene_count_effects(const fcm_scene *scene, fcm_effect_type type);
+
+/** Print a normalized summary (every section with defaults filled in and units, then the
+ * effects) to `stream`. */
+FCM_API void fcm_scene_view(const fcm_scene *scene, FILE *stream);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* FCM_SCENE_H */

@@ -1,0 +1,528 @@
+/* The effect table (one entry per effect type: name, parser/validator, scene rules,
+ * printer), region parsing, and the closed-form evaluation of motions and velocities. */
+#include "scene/scene_impl.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#define COUNT(a) ((int)(sizeof(a) / sizeof *(a)))
+
+/* Node ids are read as JSON numbers: integers up to 2^53 are exact. */
+#define MAX_NODE_ID 9007199254740991LL
+
+/* ---------------------------------------------------------------- regions */
+
+int fcm_region_contains(const fcm_region *r, const double x[3])
+{
+  switch (r->kind) {
+  case FCM_REGION_ALL:
+    return 1;
+  case FCM_REGION_BOX:
+    for (int d = 0; d < 3; d++)
+      if (!(x[d] >= r->min[d] - r->tolerance && x[d] <= r->max[d] + r->tolerance)) return 0;
+    return 1;
+  case FCM_REGION_HALF_SPACE: {
+    double s = 0.0;
+    for (int d = 0; d < 3; d++)
+      s += (x[d] - r->point[d]) * r->normal[d];
+    return s >= -r->tolerance;
+  }
+  default:
+    return 0;
+  }
+}
+
+static int cmp_index(const void *a, const void *b)
+{
+  fcm_index x = *(const fcm_index *)a, y = *(const fcm_index *)b;
+  return (x > y) - (x < y);
+}
+
+static fcm_status read_box(fcm__scene_parser *p, const fcm__json *box, fcm_region *r)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"min", "max", "tolerance"};
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, box, keys, COUNT(keys)));
+  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, box, "min", 1, FCM__ANY, r->min));
+  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, box, "max", 1, FCM__ANY, r->max));
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, box, "tolerance", 0, FCM__NONNEGATIVE, &r->tolerance));
+  for (int d = 0; d < 3; d++)
+    SCENE_CHECK(r->min[d] <= r->max[d], p, FCM_ERR_ARG,
+                "expected min[%d] <= max[%d], got min[%d] = %g > max[%d] = %g", d, d, d, r->min[d],
+                d, r->max[d]);
+  r->kind = FCM_REGION_BOX;
+cleanup:
+  return st;
+}
+
+static fcm_status read_half_space(fcm__scene_parser *p, const fcm__json *hs, fcm_region *r)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"point", "normal", "tolerance"};
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, hs, keys, COUNT(keys)));
+  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, hs, "point", 1, FCM__ANY, r->point));
+  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, hs, "normal", 1, FCM__ANY, r->normal));
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, hs, "tolerance", 0, FCM__NONNEGATIVE, &r->tolerance));
+  double n =
+      sqrt(r->normal[0] * r->normal[0] + r->normal[1] * r->normal[1] + r->normal[2] * r->normal[2]);
+  {
+    size_t old = fcm__scene_path_push_key(p, "normal");
+    SCENE_CHECK(n > 0.0 && isfinite(n), p, FCM_ERR_ARG,
+                "expected a non-zero vector, got (%g, %g, %g)", r->normal[0], r->normal[1],
+                r->normal[2]);
+    fcm__scene_path_pop(p, old);
+  }
+  for (int d = 0; d < 3; d++)
+    r->normal[d] /= n;
+  r->kind = FCM_REGION_HALF_SPACE;
+cleanup:
+  return st;
+}
+
+static fcm_status read_nodes(fcm__scene_parser *p, const fcm__json *arr, fcm_region *r)
+{
+  fcm_status st = FCM_OK;
+  char got[96];
+  fcm_index *ids = NULL;
+  fcm__scene_describe(arr, got, sizeof got);
+  int n = fcm__json_get_kind(arr) == FCM__JSON_ARRAY ? fcm__json_size(arr) : 0;
+  SCENE_CHECK(n > 0, p, FCM_ERR_ARG,
+              "expected a non-empty array of node ids (integers in [0, %lld]), got %s", MAX_NODE_ID,
+              got);
+  ids = fcm__scene_alloc(p->scene, (size_t)n, sizeof *ids);
+  if (!ids) {
+    st = FCM_ERR_ALLOC;
+    fcm__trace(p->ctx, __FILE__, __LINE__, __func__);
+    goto cleanup;
+  }
+  int i = 0;
+  for (const fcm__json *c = fcm__json_child(arr); c; c = fcm__json_next(c), i++) {
+    size_t old = fcm__scene_path_push_index(p, i);
+    fcm__scene_describe(c, got, sizeof got);
+    double x = fcm__json_get_kind(c) == FCM__JSON_NUMBER ? fcm__json_number(c) : -1.0;
+    SCENE_CHECK(isfinite(x) && x >= 0 && x == floor(x) && x <= (double)MAX_NODE_ID, p, FCM_ERR_ARG,
+                "expected a node id (an integer in [0, %lld]), got %s", MAX_NODE_ID, got);
+    ids[i] = (fcm_index)x;
+    fcm__scene_path_pop(p, old);
+  }
+  qsort(ids, (size_t)n, sizeof *ids, cmp_index);
+  for (i = 1; i < n; i++)
+    SCENE_CHECK(ids[i] != ids[i - 1], p, FCM_ERR_ARG,
+                "expected distinct node ids, got %lld more than once", (long long)ids[i]);
+  r->kind = FCM_REGION_NODES;
+  r->num_nodes = n;
+  r->nodes = ids;
+cleanup:
+  return st;
+}
+
+fcm_status fcm__scene_read_region(fcm__scene_parser *p, const fcm__json *obj, const char *key,
+                                  int required, int allow_nodes, fcm_region *out)
+{
+  fcm_status st = FCM_OK;
+  const fcm__json *v = NULL;
+  static const char *const kinds[] = {"box", "half_space", "nodes"};
+  size_t old = p->path_len;
+  fcm_region r;
+  memset(&r, 0, sizeof r);
+  r.kind = FCM_REGION_ALL;
+  r.tolerance = 1e-9;
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, obj, key, required, &v));
+  if (!v) {
+    *out = r;
+    return FCM_OK;
+  }
+  fcm__scene_path_push_key(p, key);
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, v, kinds, allow_nodes ? 3 : 2));
+  SCENE_CHECK(fcm__json_size(v) == 1, p, FCM_ERR_ARG,
+              "expected an object with exactly one of %s, got %d keys",
+              allow_nodes ? "\"box\", \"half_space\", \"nodes\"" : "\"box\", \"half_space\"",
+              fcm__json_size(v));
+  const fcm__json *c = fcm__json_child(v);
+  const char *kind = fcm__json_key(c);
+  size_t o = fcm__scene_path_push_key(p, kind);
+  if (!strcmp(kind, "box"))
+    FCM_TRY(p->ctx, read_box(p, c, &r));
+  else if (!strcmp(kind, "half_space"))
+    FCM_TRY(p->ctx, read_half_space(p, c, &r));
+  else
+    FCM_TRY(p->ctx, read_nodes(p, c, &r));
+  fcm__scene_path_pop(p, o);
+  *out = r;
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
+void fcm__scene_region_view(const fcm_region *r, FILE *f)
+{
+  switch (r->kind) {
+  case FCM_REGION_ALL:
+    fprintf(f, "the whole body");
+    break;
+  case FCM_REGION_BOX:
+    fprintf(f, "box [%g, %g] x [%g, %g] x [%g, %g] (tol %g)", r->min[0], r->max[0], r->min[1],
+            r->max[1], r->min[2], r->max[2], r->tolerance);
+    break;
+  case FCM_REGION_HALF_SPACE:
+    fprintf(f, "half-space (x - (%g, %g, %g)) . (%g, %g, %g) >= 0 (tol %g)", r->point[0],
+            r->point[1], r->point[2], r->normal[0], r->normal[1], r->normal[2], r->tolerance);
+    break;
+  case FCM_REGION_NODES:
+    fprintf(f, "%lld nodes (ids %lld..%lld)", (long long)r->num_nodes, (long long)r->nodes[0],
+            (long long)r->nodes[r->num_nodes - 1]);
+    break;
+  }
+}
+
+/* ---------------------------------------------------------------- time windows */
+
+/* "start" (>= 0, default 0) and "end" (> start, default HUGE_VAL). */
+static fcm_status read_window(fcm__scene_parser *p, const fcm__json *obj, double *start,
+                              double *end)
+{
+  fcm_status st = FCM_OK;
+  *start = 0.0;
+  *end = HUGE_VAL;
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, obj, "start", 0, FCM__NONNEGATIVE, start));
+  FCM_TRY(p->ctx,
+          fcm__scene_read_number(p, obj, "end", 0, (fcm__range){*start, HUGE_VAL, 1, 1}, end));
+cleanup:
+  return st;
+}
+
+static void view_window(double start, double end, FILE *f)
+{
+  if (end < HUGE_VAL)
+    fprintf(f, ", t in [%g, %g] s", start, end);
+  else if (start > 0.0)
+    fprintf(f, ", from t = %g s", start);
+}
+
+/* ---------------------------------------------------------------- the effects */
+
+static fcm_status parse_gravity(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"acceleration"};
+  fcm_effect_gravity *g = &e->gravity;
+  g->acceleration[0] = g->acceleration[1] = 0.0;
+  g->acceleration[2] = -9.81;
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "acceleration", 0, FCM__ANY, g->acceleration));
+cleanup:
+  return st;
+}
+
+static void view_gravity(const fcm_effect *e, FILE *f)
+{
+  const double *a = e->gravity.acceleration;
+  fprintf(f, "acceleration (%g, %g, %g) m/s^2", a[0], a[1], a[2]);
+}
+
+static fcm_status parse_fixed(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"region", "components"};
+  fcm_effect_fixed *x = &e->fixed;
+  const char *comp = NULL;
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+  FCM_TRY(p->ctx, fcm__scene_read_region(p, o, "region", 1, 1, &x->region));
+  FCM_TRY(p->ctx, fcm__scene_read_string(p, o, "components", 0, &comp));
+  x->components[0] = x->components[1] = x->components[2] = 1;
+  if (comp) {
+    int seen[3] = {0, 0, 0}, ok = strlen(comp) <= 3;
+    for (const char *c = comp; *c && ok; c++) {
+      int d = *c == 'x' ? 0 : *c == 'y' ? 1 : *c == 'z' ? 2 : -1;
+      ok = d >= 0 && !seen[d];
+      if (ok) seen[d] = 1;
+    }
+    size_t old = fcm__scene_path_push_key(p, "components");
+    SCENE_CHECK(ok, p, FCM_ERR_ARG,
+                "expected distinct letters from \"xyz\" (e.g. \"xz\"), got \"%.40s\"", comp);
+    fcm__scene_path_pop(p, old);
+    for (int d = 0; d < 3; d++)
+      x->components[d] = seen[d];
+  }
+cleanup:
+  return st;
+}
+
+static void view_fixed(const fcm_effect *e, FILE *f)
+{
+  const int *c = e->fixed.components;
+  fprintf(f, "components %s%s%s on ", c[0] ? "x" : "", c[1] ? "y" : "", c[2] ? "z" : "");
+  fcm__scene_region_view(&e->fixed.region, f);
+}
+
+static fcm_status parse_motion(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"region", "velocity", "rotation", "start", "end", "release"};
+  static const char *const rkeys[] = {"axis", "center", "speed"};
+  fcm_effect_motion *m = &e->motion;
+  const fcm__json *rot = NULL;
+  m->axis[2] = 1.0;
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+  FCM_TRY(p->ctx, fcm__scene_read_region(p, o, "region", 1, 1, &m->region));
+  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "velocity", 0, FCM__ANY, m->velocity));
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "rotation", 0, &rot));
+  if (rot) {
+    size_t old = fcm__scene_path_push_key(p, "rotation");
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, rot, rkeys, COUNT(rkeys)));
+    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, rot, "axis", 0, FCM__ANY, m->axis));
+    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, rot, "center", 0, FCM__ANY, m->center));
+    FCM_TRY(p->ctx, fcm__scene_read_number(p, rot, "speed", 1, FCM__ANY, &m->angular_speed));
+    double n = sqrt(m->axis[0] * m->axis[0] + m->axis[1] * m->axis[1] + m->axis[2] * m->axis[2]);
+    fcm__scene_path_push_key(p, "axis");
+    SCENE_CHECK(n > 0.0 && isfinite(n), p, FCM_ERR_ARG,
+                "expected a non-zero vector, got (%g, %g, %g)", m->axis[0], m->axis[1], m->axis[2]);
+    for (int d = 0; d < 3; d++)
+      m->axis[d] /= n;
+    fcm__scene_path_pop(p, old);
+  }
+  FCM_TRY(p->ctx, read_window(p, o, &m->start, &m->end));
+  FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "release", 0, &m->release));
+  if (m->release) {
+    size_t old = fcm__scene_path_push_key(p, "release");
+    SCENE_CHECK(m->end < HUGE_VAL, p, FCM_ERR_ARG,
+                "true needs an \"end\" time (the region is released after it)");
+    fcm__scene_path_pop(p, old);
+  }
+cleanup:
+  return st;
+}
+
+static void view_motion(const fcm_effect *e, FILE *f)
+{
+  const fcm_effect_motion *m = &e->motion;
+  fprintf(f, "velocity (%g, %g, %g) m/s", m->velocity[0], m->velocity[1], m->velocity[2]);
+  if (m->angular_speed != 0.0)
+    fprintf(f, ", rotation %g rad/s about (%g, %g, %g) through (%g, %g, %g)", m->angular_speed,
+            m->axis[0], m->axis[1], m->axis[2], m->center[0], m->center[1], m->center[2]);
+  view_window(m->start, m->end, f);
+  if (m->end < HUGE_VAL) fprintf(f, ", then %s", m->release ? "released" : "held");
+  fprintf(f, "; on ");
+  fcm__scene_region_view(&m->region, f);
+}
+
+static fcm_status parse_initial_velocity(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"region", "velocity", "angular_velocity", "center"};
+  fcm_effect_initial_velocity *v = &e->initial_velocity;
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+  FCM_TRY(p->ctx, fcm__scene_read_region(p, o, "region", 0, 1, &v->region));
+  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "velocity", 0, FCM__ANY, v->velocity));
+  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "angular_velocity", 0, FCM__ANY, v->angular_velocity));
+  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "center", 0, FCM__ANY, v->center));
+  v->center_of_mass = fcm__json_member(o, "center") == NULL;
+cleanup:
+  return st;
+}
+
+static void view_initial_velocity(const fcm_effect *e, FILE *f)
+{
+  const fcm_effect_initial_velocity *v = &e->initial_velocity;
+  fprintf(f, "velocity (%g, %g, %g) m/s, angular (%g, %g, %g) rad/s about ", v->velocity[0],
+          v->velocity[1], v->velocity[2], v->angular_velocity[0], v->angular_velocity[1],
+          v->angular_velocity[2]);
+  if (v->center_of_mass)
+    fprintf(f, "the centre of mass");
+  else
+    fprintf(f, "(%g, %g, %g)", v->center[0], v->center[1], v->center[2]);
+  fprintf(f, "; on ");
+  fcm__scene_region_view(&v->region, f);
+}
+
+static fcm_status parse_damping(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"mass", "stiffness"};
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "mass", 0, FCM__NONNEGATIVE, &e->damping.mass));
+  FCM_TRY(p->ctx,
+          fcm__scene_read_number(p, o, "stiffness", 0, FCM__NONNEGATIVE, &e->damping.stiffness));
+cleanup:
+  return st;
+}
+
+static void view_damping(const fcm_effect *e, FILE *f)
+{
+  fprintf(f, "Rayleigh D = %g M + %g K", e->damping.mass, e->damping.stiffness);
+}
+
+static fcm_status parse_traction(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"region", "value", "start", "end"};
+  fcm_effect_traction *t = &e->traction;
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+  FCM_TRY(p->ctx, fcm__scene_read_region(p, o, "region", 1, 0, &t->region));
+  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "value", 1, FCM__ANY, t->traction));
+  FCM_TRY(p->ctx, read_window(p, o, &t->start, &t->end));
+cleanup:
+  return st;
+}
+
+static void view_traction(const fcm_effect *e, FILE *f)
+{
+  const fcm_effect_traction *t = &e->traction;
+  fprintf(f, "(%g, %g, %g) Pa", t->traction[0], t->traction[1], t->traction[2]);
+  view_window(t->start, t->end, f);
+  fprintf(f, "; on the boundary in ");
+  fcm__scene_region_view(&t->region, f);
+}
+
+static fcm_status parse_pressure(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"region", "value", "start", "end"};
+  fcm_effect_pressure *q = &e->pressure;
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+  FCM_TRY(p->ctx, fcm__scene_read_region(p, o, "region", 1, 0, &q->region));
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "value", 1, FCM__ANY, &q->pressure));
+  FCM_TRY(p->ctx, read_window(p, o, &q->start, &q->end));
+cleanup:
+  return st;
+}
+
+static void view_pressure(const fcm_effect *e, FILE *f)
+{
+  const fcm_effect_pressure *q = &e->pressure;
+  fprintf(f, "%g Pa", q->pressure);
+  view_window(q->start, q->end, f);
+  fprintf(f, "; on the boundary in ");
+  fcm__scene_region_view(&q->region, f);
+}
+
+/* The one table. Order = enum fcm_effect_type. */
+static const fcm__effect_type effect_types[FCM_EFFECT_TYPE_COUNT] = {
+    {FCM_EFFECT_GRAVITY, "gravity", "uniform body force density rho g", 1, 1, parse_gravity,
+     view_gravity},
+    {FCM_EFFECT_FIXED, "fixed", "zero displacement of a region", 0, 1, parse_fixed, view_fixed},
+    {FCM_EFFECT_MOTION, "motion", "prescribed translation and rotation of a region", 0, 1,
+     parse_motion, view_motion},
+    {FCM_EFFECT_INITIAL_VELOCITY, "initial_velocity", "linear and angular initial velocity", 0, 0,
+     parse_initial_velocity, view_initial_velocity},
+    {FCM_EFFECT_DAMPING, "damping", "Rayleigh damping", 1, 0, parse_damping, view_damping},
+    {FCM_EFFECT_TRACTION, "traction", "traction on the embedded boundary", 0, 1, parse_traction,
+     view_traction},
+    {FCM_EFFECT_PRESSURE, "pressure", "pressure on the embedded boundary", 0, 1, parse_pressure,
+     view_pressure},
+};
+
+const fcm__effect_type *fcm__scene_effect_type(fcm_effect_type type)
+{
+  if ((int)type < 0 || type >= FCM_EFFECT_TYPE_COUNT) return NULL;
+  return &effect_types[type];
+}
+
+const fcm__effect_type *fcm__scene_effect_type_find(const char *name)
+{
+  for (int i = 0; i < FCM_EFFECT_TYPE_COUNT; i++)
+    if (!strcmp(effect_types[i].name, name)) return &effect_types[i];
+  return NULL;
+}
+
+const char *fcm_effect_type_name(fcm_effect_type type)
+{
+  const fcm__effect_type *t = fcm__scene_effect_type(type);
+  return t ? t->name : NULL;
+}
+
+fcm_status fcm__scene_read_effects(fcm__scene_parser *p, const fcm__json *root)
+{
+  fcm_status st = FCM_OK;
+  fcm_scene *s = p->scene;
+  const fcm__json *arr = fcm__json_member(root, "effects");
+  char got[96], names[256];
+  int counts[FCM_EFFECT_TYPE_COUNT] = {0}, first[FCM_EFFECT_TYPE_COUNT] = {0};
+  size_t old = p->path_len;
+  if (!arr) return FCM_OK;
+  {
+    size_t used = 0;
+    for (int i = 0; i < FCM_EFFECT_TYPE_COUNT; i++)
+      used += (size_t)snprintf(names + used, sizeof names - used, "%s\"%s\"", i ? ", " : "",
+                               effect_types[i].name);
+  }
+  fcm__scene_path_push_key(p, "effects");
+  fcm__scene_describe(arr, got, sizeof got);
+  SCENE_CHECK(fcm__json_get_kind(arr) == FCM__JSON_ARRAY, p, FCM_ERR_ARG,
+              "expected an array of effects (objects like {\"gravity\": {}}), got %s", got);
+  int n = fcm__json_size(arr);
+  if (n == 0) goto cleanup;
+  s->effects = fcm__scene_alloc(s, (size_t)n, sizeof *s->effects);
+  if (!s->effects) {
+    st = FCM_ERR_ALLOC;
+    fcm__trace(p->ctx, __FILE__, __LINE__, __func__);
+    goto cleanup;
+  }
+  int i = 0;
+  for (const fcm__json *c = fcm__json_child(arr); c; c = fcm__json_next(c), i++) {
+    size_t o = fcm__scene_path_push_index(p, i);
+    fcm__scene_describe(c, got, sizeof got);
+    if (fcm__json_get_kind(c) == FCM__JSON_OBJECT)
+      snprintf(got, sizeof got, "an object with %d keys", fcm__json_size(c));
+    SCENE_CHECK(fcm__json_get_kind(c) == FCM__JSON_OBJECT && fcm__json_size(c) == 1, p, FCM_ERR_ARG,
+                "expected an object with one key naming the effect (one of %s), got %s", names,
+                got);
+    const fcm__json *params = fcm__json_child(c);
+    const char *name = fcm__json_key(params);
+    const fcm__effect_type *type = fcm__scene_effect_type_find(name);
+    fcm__scene_path_push_key(p, name);
+    SCENE_CHECK(type, p, FCM_ERR_ARG, "unknown effect; allowed effects: %s", names);
+    fcm__scene_describe(params, got, sizeof got);
+    SCENE_CHECK(fcm__json_get_kind(params) == FCM__JSON_OBJECT, p, FCM_ERR_ARG,
+                "expected an object of parameters ({} for the defaults), got %s", got);
+    fcm_effect *e = &s->effects[i];
+    e->type = type->type;
+    e->index = i;
+    FCM_TRY(p->ctx, type->parse(p, params, e));
+    SCENE_CHECK(type->max_count == 0 || counts[type->type] < type->max_count, p, FCM_ERR_ARG,
+                "at most %d %s effect per scene; effects[%d] is one already", type->max_count,
+                type->name, first[type->type]);
+    SCENE_CHECK(type->allowed_static || !s->time.is_static, p, FCM_ERR_ARG,
+                "not allowed in a static scene (time.static is true)");
+    if (counts[type->type]++ == 0) first[type->type] = i;
+    s->num_effects = i + 1;
+    fcm__scene_path_pop(p, o);
+  }
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
+/* ---------------------------------------------------------------- evaluation */
+
+void fcm_effect_motion_eval(const fcm_effect_motion *m, const double X[3], double t, double u[3])
+{
+  double tau = t - m->start;
+  if (!(tau > 0.0)) tau = 0.0;
+  if (tau > m->end - m->start) tau = m->end - m->start;
+  const double *a = m->axis;
+  double r[3] = {X[0] - m->center[0], X[1] - m->center[1], X[2] - m->center[2]};
+  double phi = m->angular_speed * tau, c = cos(phi), s = sin(phi);
+  double ar = a[0] * r[0] + a[1] * r[1] + a[2] * r[2];
+  double axr[3] = {a[1] * r[2] - a[2] * r[1], a[2] * r[0] - a[0] * r[2], a[0] * r[1] - a[1] * r[0]};
+  for (int d = 0; d < 3; d++) {
+    double Rr = r[d] * c + axr[d] * s + a[d] * ar * (1.0 - c); /* Rodrigues */
+    u[d] = Rr - r[d] + m->velocity[d] * tau;
+  }
+}
+
+int fcm_effect_motion_active(const fcm_effect_motion *m, double t)
+{
+  return !(m->release && t > m->end);
+}
+
+void fcm_effect_initial_velocity_eval(const fcm_effect_initial_velocity *iv, const double X[3],
+                                      const double com[3], double v[3])
+{
+  const double *c = iv->center_of_mass && com ? com : iv->center;
+  const double *w = iv->angular_velocity;
+  double r[3] = {X[0] - c[0], X[1] - c[1], X[2] - c[2]};
+  v[0] = iv->velocity[0] + w[1] * r[2] - w[2] * r[1];
+  v[1] = iv->velocity[1] + w[2] * r[0] - w[0] * r[2];
+  v[2] = iv->velocity[2] + w[0] * r[1] - w[1] * r[0];
+}

@@ -1,0 +1,913 @@
+/* Scene objects: reading a scene file, parsing and validating every section (effects are
+ * in effects.c), the accessors and the normalized summary printed by fcm_scene_view(). */
+#define _POSIX_C_SOURCE 200809L
+#include "scene/scene_impl.h"
+
+#include <errno.h>
+#include <stdalign.h>
+#include <stddef.h>
+#include <string.h>
+
+#define COUNT(a) ((int)(sizeof(a) / sizeof *(a)))
+
+/* ---------------------------------------------------------------- ownership */
+
+struct fcm__scene_block {
+  fcm__scene_block *next;
+  alignas(max_align_t) unsigned char data[];
+};
+
+void *fcm__scene_alloc(fcm_scene *s, size_t n, size_t size)
+{
+  if (size != 0 && n > (SIZE_MAX - sizeof(fcm__scene_block)) / size) {
+    fcm__error(s->ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
+               "scene: allocation of %zu x %zu bytes overflows", n, size);
+    return NULL;
+  }
+  fcm__scene_block *b = fcm__calloc(s->ctx, 1, sizeof *b + n * size);
+  if (!b) return NULL;
+  b->next = s->blocks;
+  s->blocks = b;
+  return b->data;
+}
+
+void fcm_scene_destroy(fcm_scene **scene)
+{
+  if (!scene || !*scene) return;
+  fcm_scene *s = *scene;
+  while (s->blocks) {
+    fcm__scene_block *next = s->blocks->next;
+    fcm__free(s->ctx, s->blocks);
+    s->blocks = next;
+  }
+  fcm__free(s->ctx, s);
+  *scene = NULL;
+}
+
+/* ---------------------------------------------------------------- name lists */
+
+static const char *const element_names[] = {"tet4", "tet10", "hex8", "hex20"};
+static const char *const model_names[] = {"linear", "stvk", "corotated", "snh",
+                                          "stable_neo_hookean"};
+static const fcm_material_model model_values[] = {
+    FCM_MATERIAL_LINEAR, FCM_MATERIAL_STVK, FCM_MATERIAL_COROTATED, FCM_MATERIAL_STABLE_NEO_HOOKEAN,
+    FCM_MATERIAL_STABLE_NEO_HOOKEAN};
+static const char *const shape_names[] = {"box", "ball", "hemisphere", "hollow_ball", "tube"};
+static const char *const axis_names[] = {"x", "y", "z"};
+static const char *const simplify_names[] = {"auto", "lp", "recombine"};
+static const char *const stabilization_names[] = {"mass_stiffness", "mass", "off"};
+static const char *const solver_names[] = {"direct", "minres", "cg"};
+static const char *const direct_names[] = {"cholmod", "umfpack"};
+static const char *const preconditioner_names[] = {"none", "jacobi", "block_jacobi", "schwarz"};
+static const char *const clamp_names[] = {"clamp", "paper"};
+static const char *const integrator_names[] = {"backward_euler"};
+
+/* Read a choice into an enum of any integer type. */
+#define READ_CHOICE(p, obj, key, required, names, out)                                             \
+  do {                                                                                             \
+    int ch_ = (int)(out);                                                                          \
+    FCM_TRY((p)->ctx,                                                                              \
+            fcm__scene_read_choice((p), (obj), (key), (required), (names), COUNT(names), &ch_));   \
+    (out) = ch_;                                                                                   \
+  } while (0)
+
+/* Read an integer member into an int-like destination. */
+#define READ_INT(p, obj, key, required, lo, hi, out)                                               \
+  do {                                                                                             \
+    long long v_ = (long long)(out);                                                               \
+    FCM_TRY((p)->ctx, fcm__scene_read_int((p), (obj), (key), (required), (lo), (hi), &v_));        \
+    (out) = (int)v_;                                                                               \
+  } while (0)
+
+/* Push a key for the checks of one section; popped at cleanup by the caller's `old`. */
+#define ENTER(p, key) fcm__scene_path_push_key((p), (key))
+
+/* ---------------------------------------------------------------- background */
+
+static fcm_status read_background(fcm__scene_parser *p, const fcm__json *root)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"element", "box", "cells", "mesh"};
+  static const char *const box_keys[] = {"min", "max"};
+  fcm_scene_background *b = &p->scene->background;
+  const fcm__json *o = NULL, *box = NULL;
+  size_t old = p->path_len;
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "background", 1, &o));
+  ENTER(p, "background");
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+  if (fcm__json_member(o, "mesh")) {
+    for (int i = 0; i < 3; i++) {
+      if (!fcm__json_member(o, keys[i])) continue;
+      fcm__scene_path_push_key(p, keys[i]);
+      SCENE_CHECK(0, p, FCM_ERR_ARG,
+                  "not allowed with \"mesh\" (the mesh file sets the element type and cells)");
+    }
+    b->kind = FCM_SCENE_BACKGROUND_MESH;
+    b->element = FCM_ELEMENT_COUNT;
+    FCM_TRY(p->ctx, fcm__scene_read_file(p, o, "mesh", 1, NULL, &b->mesh));
+    goto cleanup;
+  }
+  SCENE_CHECK(fcm__json_member(o, "box"), p, FCM_ERR_ARG,
+              "expected either \"box\" (with \"element\" and \"cells\") for a generated grid "
+              "or \"mesh\" (a Gmsh file)");
+  b->kind = FCM_SCENE_BACKGROUND_GRID;
+  READ_CHOICE(p, o, "element", 1, element_names, b->element);
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "box", 1, &box));
+  {
+    size_t o2 = ENTER(p, "box");
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, box, box_keys, COUNT(box_keys)));
+    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, box, "min", 1, FCM__ANY, b->min));
+    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, box, "max", 1, FCM__ANY, b->max));
+    for (int d = 0; d < 3; d++)
+      SCENE_CHECK(b->min[d] < b->max[d], p, FCM_ERR_ARG,
+                  "expected min[%d] < max[%d], got min[%d] = %g >= max[%d] = %g", d, d, d,
+                  b->min[d], d, b->max[d]);
+    fcm__scene_path_pop(p, o2);
+  }
+  FCM_TRY(p->ctx, fcm__scene_read_ivec3(p, o, "cells", 1, 1, 1000000, b->cells));
+  {
+    double total = (double)b->cells[0] * (double)b->cells[1] * (double)b->cells[2];
+    fcm__scene_path_push_key(p, "cells");
+    SCENE_CHECK(total <= 1e8, p, FCM_ERR_ARG, "expected at most 1e8 cells in total, got %.0f",
+                total);
+  }
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
+/* ---------------------------------------------------------------- geometry */
+
+static fcm_status read_transform(fcm__scene_parser *p, const fcm__json *o, fcm_scene_geometry *g)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"scale", "rotation", "translation"};
+  static const char *const rkeys[] = {"axis", "angle"};
+  const fcm__json *t = NULL, *rot = NULL;
+  double scale[3] = {1, 1, 1}, axis[3] = {0, 0, 1}, angle = 0.0, offset[3] = {0, 0, 0};
+  size_t old = p->path_len;
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "transform", 0, &t));
+  if (!t) return FCM_OK;
+  ENTER(p, "transform");
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, t, keys, COUNT(keys)));
+  const fcm__json *sc = fcm__json_member(t, "scale");
+  if (sc && fcm__json_get_kind(sc) == FCM__JSON_NUMBER) {
+    FCM_TRY(p->ctx, fcm__scene_read_number(p, t, "scale", 1, FCM__POSITIVE, &scale[0]));
+    scale[1] = scale[2] = scale[0];
+  } else {
+    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, t, "scale", 0, FCM__POSITIVE, scale));
+  }
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, t, "rotation", 0, &rot));
+  if (rot) {
+    size_t o2 = ENTER(p, "rotation");
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, rot, rkeys, COUNT(rkeys)));
+    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, rot, "axis", 1, FCM__ANY, axis));
+    FCM_TRY(p->ctx, fcm__scene_read_number(p, rot, "angle", 1, FCM__ANY, &angle));
+    double n = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
+    fcm__scene_path_push_key(p, "axis");
+    SCENE_CHECK(n > 0.0 && isfinite(n), p, FCM_ERR_ARG,
+                "expected a non-zero vector, got (%g, %g, %g)", axis[0], axis[1], axis[2]);
+    for (int d = 0; d < 3; d++)
+      axis[d] /= n;
+    fcm__scene_path_pop(p, o2);
+  }
+  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, t, "translation", 0, FCM__ANY, offset));
+  /* A = R(axis, angle) diag(scale): Rodrigues' formula, column j scaled by scale[j]. */
+  double c = cos(angle), s = sin(angle), *a = axis;
+  double R[9] = {c + a[0] * a[0] * (1 - c),        a[0] * a[1] * (1 - c) - a[2] * s,
+                 a[0] * a[2] * (1 - c) + a[1] * s, a[1] * a[0] * (1 - c) + a[2] * s,
+                 c + a[1] * a[1] * (1 - c),        a[1] * a[2] * (1 - c) - a[0] * s,
+                 a[2] * a[0] * (1 - c) - a[1] * s, a[2] * a[1] * (1 - c) + a[0] * s,
+                 c + a[2] * a[2] * (1 - c)};
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      g->transform[3 * i + j] = R[3 * i + j] * scale[j];
+  memcpy(g->offset, offset, sizeof offset);
+  g->has_transform = 1;
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
+static fcm_status read_geometry(fcm__scene_parser *p, const fcm__json *root)
+{
+  fcm_status st = FCM_OK;
+  static const char *const any_keys[] = {
+      "shape",  "mesh",   "tetgen",       "transform",     "min",          "max",         "cells",
+      "center", "radius", "resolution",   "inner_radius",  "outer_radius", "hole_radius", "layers",
+      "axis",   "length", "radial_cells", "angular_cells", "axial_cells"};
+  static const char *const box_keys[] = {"shape", "min", "max", "cells", "transform"};
+  static const char *const ball_keys[] = {"shape", "center", "radius", "resolution", "transform"};
+  static const char *const hollow_keys[] = {"shape",        "center",      "inner_radius",
+                                            "outer_radius", "hole_radius", "resolution",
+                                            "layers",       "transform"};
+  static const char *const tube_keys[] = {
+      "shape",  "center",       "axis",          "inner_radius", "outer_radius",
+      "length", "radial_cells", "angular_cells", "axial_cells",  "transform"};
+  static const char *const mesh_keys[] = {"mesh", "transform"};
+  static const char *const tetgen_keys[] = {"tetgen", "transform"};
+  fcm_scene_geometry *g = &p->scene->geometry;
+  const fcm__json *o = NULL;
+  size_t old = p->path_len;
+  for (int i = 0; i < 9; i++)
+    g->transform[i] = (i % 4 == 0);
+  g->kind = FCM_SCENE_GEOMETRY_NONE;
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "geometry", 0, &o));
+  if (!o) return FCM_OK;
+  ENTER(p, "geometry");
+  /* Typos first (against every geometry key), then the keys of the chosen kind. */
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, any_keys, COUNT(any_keys)));
+  int nd = !!fcm__json_member(o, "shape") + !!fcm__json_member(o, "mesh") +
+           !!fcm__json_member(o, "tetgen");
+  SCENE_CHECK(nd == 1, p, FCM_ERR_ARG,
+              "expected exactly one of \"shape\" (a procedural shape), \"mesh\" (a Gmsh file) "
+              "or \"tetgen\" (a TetGen base name), got %d of them",
+              nd);
+  if (fcm__json_member(o, "mesh")) {
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, o, mesh_keys, COUNT(mesh_keys)));
+    g->kind = FCM_SCENE_GEOMETRY_GMSH;
+    FCM_TRY(p->ctx, fcm__scene_read_file(p, o, "mesh", 1, NULL, &g->mesh));
+  } else if (fcm__json_member(o, "tetgen")) {
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, o, tetgen_keys, COUNT(tetgen_keys)));
+    g->kind = FCM_SCENE_GEOMETRY_TETGEN;
+    FCM_TRY(p->ctx, fcm__scene_read_file(p, o, "tetgen", 1, ".node", &g->mesh));
+    FCM_TRY(p->ctx, fcm__scene_read_file(p, o, "tetgen", 1, ".ele", &g->ele));
+  } else {
+    int shape = 0;
+    FCM_TRY(p->ctx,
+            fcm__scene_read_choice(p, o, "shape", 1, shape_names, COUNT(shape_names), &shape));
+    g->kind = (fcm_scene_geometry_kind)(FCM_SCENE_GEOMETRY_BOX + shape);
+    switch (g->kind) {
+    case FCM_SCENE_GEOMETRY_BOX:
+      FCM_TRY(p->ctx, fcm__scene_check_object(p, o, box_keys, COUNT(box_keys)));
+      FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "min", 1, FCM__ANY, g->min));
+      FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "max", 1, FCM__ANY, g->max));
+      for (int d = 0; d < 3; d++)
+        SCENE_CHECK(g->min[d] < g->max[d], p, FCM_ERR_ARG,
+                    "expected min[%d] < max[%d], got min[%d] = %g >= max[%d] = %g", d, d, d,
+                    g->min[d], d, g->max[d]);
+      g->cells[0] = g->cells[1] = g->cells[2] = 1;
+      FCM_TRY(p->ctx, fcm__scene_read_ivec3(p, o, "cells", 0, 1, 10000, g->cells));
+      break;
+    case FCM_SCENE_GEOMETRY_BALL:
+    case FCM_SCENE_GEOMETRY_HEMISPHERE:
+      FCM_TRY(p->ctx, fcm__scene_check_object(p, o, ball_keys, COUNT(ball_keys)));
+      FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "center", 0, FCM__ANY, g->center));
+      FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "radius", 1, FCM__POSITIVE, &g->radius));
+      g->resolution = 4;
+      READ_INT(p, o, "resolution", 0, 1, 1000, g->resolution);
+      break;
+    case FCM_SCENE_GEOMETRY_HOLLOW_BALL:
+      FCM_TRY(p->ctx, fcm__scene_check_object(p, o, hollow_keys, COUNT(hollow_keys)));
+      FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "center", 0, FCM__ANY, g->center));
+      FCM_TRY(p->ctx,
+              fcm__scene_read_number(p, o, "outer_radius", 1, FCM__POSITIVE, &g->outer_radius));
+      FCM_TRY(p->ctx,
+              fcm__scene_read_number(p, o, "inner_radius", 1,
+                                     (fcm__range){0.0, g->outer_radius, 1, 1}, &g->inner_radius));
+      FCM_TRY(p->ctx,
+              fcm__scene_read_number(p, o, "hole_radius", 0,
+                                     (fcm__range){0.0, g->outer_radius, 0, 1}, &g->hole_radius));
+      g->resolution = 8;
+      g->layers = 2;
+      READ_INT(p, o, "resolution", 0, 1, 1000, g->resolution);
+      READ_INT(p, o, "layers", 0, 1, 1000, g->layers);
+      break;
+    default: /* tube */
+      FCM_TRY(p->ctx, fcm__scene_check_object(p, o, tube_keys, COUNT(tube_keys)));
+      FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "center", 0, FCM__ANY, g->center));
+      g->axis = 2;
+      READ_CHOICE(p, o, "axis", 0, axis_names, g->axis);
+      FCM_TRY(p->ctx,
+              fcm__scene_read_number(p, o, "outer_radius", 1, FCM__POSITIVE, &g->outer_radius));
+      FCM_TRY(p->ctx,
+              fcm__scene_read_number(p, o, "inner_radius", 1,
+                                     (fcm__range){0.0, g->outer_radius, 1, 1}, &g->inner_radius));
+      FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "length", 1, FCM__POSITIVE, &g->length));
+      g->radial_cells = 2;
+      g->angular_cells = 24;
+      g->axial_cells = 16;
+      READ_INT(p, o, "radial_cells", 0, 1, 10000, g->radial_cells);
+      READ_INT(p, o, "angular_cells", 0, 6, 10000, g->angular_cells);
+      READ_INT(p, o, "axial_cells", 0, 1, 10000, g->axial_cells);
+      break;
+    }
+  }
+  FCM_TRY(p->ctx, read_transform(p, o, g));
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
+/* ---------------------------------------------------------------- material */
+
+static fcm_status read_material(fcm__scene_parser *p, const fcm__json *root)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"model", "young", "poisson", "density"};
+  fcm_material *m = &p->scene->material;
+  const fcm__json *o = NULL;
+  size_t old = p->path_len;
+  int model = 3; /* "snh" */
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "material", 1, &o));
+  ENTER(p, "material");
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+  FCM_TRY(p->ctx,
+          fcm__scene_read_choice(p, o, "model", 0, model_names, COUNT(model_names), &model));
+  m->model = model_values[model];
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "young", 1, FCM__POSITIVE, &m->young));
+  FCM_TRY(p->ctx,
+          fcm__scene_read_number(p, o, "poisson", 1, (fcm__range){-1.0, 0.5, 1, 1}, &m->poisson));
+  m->density = 1000.0;
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "density", 0, FCM__NONNEGATIVE, &m->density));
+  /* The material module's own rule must agree with the ranges above. */
+  FCM_ASSERT(fcm_material_validate(NULL, m) == FCM_OK, p->ctx);
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
+/* ---------------------------------------------------------------- quadrature */
+
+static fcm_status read_quadrature(fcm__scene_parser *p, const fcm__json *root)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"stiffness_strength", "mass_strength",   "surface_strength",
+                                     "simplify",           "simplify_method", "stabilization",
+                                     "min_fraction"};
+  static const char *const skeys[] = {"mode", "alpha"};
+  fcm_scene_quadrature *q = &p->scene->quadrature;
+  const fcm__json *o = NULL, *stab = NULL;
+  size_t old = p->path_len;
+  q->stiffness_strength = q->mass_strength = q->surface_strength = -1;
+  q->simplify = 1;
+  q->simplify_method = FCM_SCENE_SIMPLIFY_AUTO;
+  q->stabilization = FCM_SCENE_STABILIZATION_MASS_STIFFNESS;
+  q->stabilization_alpha = 1e-6;
+  q->min_fraction = 1e-4;
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "quadrature", 0, &o));
+  if (!o) return FCM_OK;
+  ENTER(p, "quadrature");
+  size_t here = p->path_len;
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+  READ_INT(p, o, "stiffness_strength", 0, 0, 20, q->stiffness_strength);
+  READ_INT(p, o, "mass_strength", 0, 0, 20, q->mass_strength);
+  READ_INT(p, o, "surface_strength", 0, 0, 20, q->surface_strength);
+  FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "simplify", 0, &q->simplify));
+  READ_CHOICE(p, o, "simplify_method", 0, simplify_names, q->simplify_method);
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "stabilization", 0, &stab));
+  if (stab) {
+    ENTER(p, "stabilization");
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, stab, skeys, COUNT(skeys)));
+    READ_CHOICE(p, stab, "mode", 0, stabilization_names, q->stabilization);
+    FCM_TRY(p->ctx, fcm__scene_read_number(p, stab, "alpha", 0, (fcm__range){0.0, 1.0, 1, 0},
+                                           &q->stabilization_alpha));
+    fcm__scene_path_pop(p, here);
+  }
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "min_fraction", 0, (fcm__range){0.0, 1.0, 0, 1},
+                                         &q->min_fraction));
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
+/* ---------------------------------------------------------------- solver */
+
+static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"method",         "direct", "preconditioner",
+                                     "schwarz",        "rtol",   "atol",
+                                     "max_iterations", "newton", "threads"};
+  static const char *const skeys[] = {"threshold", "epsilon", "clamp"};
+  static const char *const nkeys[] = {"rtol", "max_iterations", "line_search", "project_psd",
+                                      "representative_acceleration"};
+  fcm_scene_solver *s = &p->scene->solver;
+  const fcm__json *o = NULL, *sw = NULL, *nw = NULL;
+  size_t old = p->path_len;
+  s->method = FCM_SCENE_SOLVER_DIRECT;
+  s->direct = FCM_DIRECT_CHOLMOD;
+  s->preconditioner = FCM_SCENE_PRECONDITIONER_SCHWARZ;
+  s->schwarz_threshold = 0.5;
+  s->schwarz_epsilon = 1e-13;
+  s->rtol = 1e-8;
+  s->max_iterations = 1000;
+  s->newton_rtol = 1e-5;
+  s->newton_max_iterations = 100;
+  s->line_search = 1;
+  s->representative_acceleration = 9.81;
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "solver", 0, &o));
+  if (!o) return FCM_OK;
+  ENTER(p, "solver");
+  size_t here = p->path_len;
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+  READ_CHOICE(p, o, "method", 0, solver_names, s->method);
+  READ_CHOICE(p, o, "direct", 0, direct_names, s->direct);
+  READ_CHOICE(p, o, "preconditioner", 0, preconditioner_names, s->preconditioner);
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "schwarz", 0, &sw));
+  if (sw) {
+    ENTER(p, "schwarz");
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, sw, skeys, COUNT(skeys)));
+    FCM_TRY(p->ctx, fcm__scene_read_number(p, sw, "threshold", 0, (fcm__range){0.0, 1.0, 1, 0},
+                                           &s->schwarz_threshold));
+    FCM_TRY(p->ctx, fcm__scene_read_number(p, sw, "epsilon", 0, (fcm__range){0.0, 1.0, 1, 1},
+                                           &s->schwarz_epsilon));
+    READ_CHOICE(p, sw, "clamp", 0, clamp_names, s->schwarz_paper_clamp);
+    fcm__scene_path_pop(p, here);
+  }
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "rtol", 0, (fcm__range){0.0, 1.0, 0, 1}, &s->rtol));
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "atol", 0, FCM__NONNEGATIVE, &s->atol));
+  READ_INT(p, o, "max_iterations", 0, 1, 1000000000, s->max_iterations);
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "newton", 0, &nw));
+  if (nw) {
+    ENTER(p, "newton");
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, nw, nkeys, COUNT(nkeys)));
+    FCM_TRY(p->ctx, fcm__scene_read_number(p, nw, "rtol", 0, (fcm__range){0.0, 1.0, 1, 1},
+                                           &s->newton_rtol));
+    READ_INT(p, nw, "max_iterations", 0, 1, 1000000, s->newton_max_iterations);
+    FCM_TRY(p->ctx, fcm__scene_read_bool(p, nw, "line_search", 0, &s->line_search));
+    FCM_TRY(p->ctx, fcm__scene_read_bool(p, nw, "project_psd", 0, &s->project_psd));
+    FCM_TRY(p->ctx, fcm__scene_read_number(p, nw, "representative_acceleration", 0, FCM__POSITIVE,
+                                           &s->representative_acceleration));
+    fcm__scene_path_pop(p, here);
+  }
+  READ_INT(p, o, "threads", 0, 0, 4096, s->threads);
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
+/* ---------------------------------------------------------------- time */
+
+static fcm_status read_time(fcm__scene_parser *p, const fcm__json *root)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"static",   "integrator", "dt",
+                                     "duration", "steps",      "load_steps"};
+  fcm_scene_time *t = &p->scene->time;
+  const fcm__json *o = NULL;
+  size_t old = p->path_len;
+  double duration = 0.0;
+  long long steps = 0;
+  size_t here = 0;
+  t->is_static = 0;
+  t->integrator = FCM_SCENE_INTEGRATOR_BACKWARD_EULER;
+  t->dt = 1.0 / 60.0;
+  t->load_steps = 1;
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "time", 0, &o));
+  if (o) {
+    ENTER(p, "time");
+    here = p->path_len;
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+    FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "static", 0, &t->is_static));
+    READ_CHOICE(p, o, "integrator", 0, integrator_names, t->integrator);
+    FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "dt", 0, FCM__POSITIVE, &t->dt));
+    FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "duration", 0, FCM__POSITIVE, &duration));
+    FCM_TRY(p->ctx, fcm__scene_read_int(p, o, "steps", 0, 1, 1000000000, &steps));
+    READ_INT(p, o, "load_steps", 0, 1, 1000000, t->load_steps);
+    SCENE_CHECK(!(duration > 0.0 && steps > 0), p, FCM_ERR_ARG,
+                "expected either \"duration\" or \"steps\", got both");
+    if (fcm__json_member(o, "load_steps")) {
+      fcm__scene_path_push_key(p, "load_steps");
+      SCENE_CHECK(t->is_static, p, FCM_ERR_ARG, "only for static scenes (\"static\": true)");
+      fcm__scene_path_pop(p, here);
+    }
+    if (fcm__json_member(o, "integrator")) {
+      fcm__scene_path_push_key(p, "integrator");
+      SCENE_CHECK(!t->is_static, p, FCM_ERR_ARG, "not used by static scenes (\"static\": true)");
+      fcm__scene_path_pop(p, here);
+    }
+  }
+  if (steps == 0 && !(duration > 0.0)) {
+    if (t->is_static)
+      steps = 1;
+    else
+      duration = 1.0;
+  }
+  if (steps == 0) {
+    /* A duration that is a whole number of steps up to rounding keeps that number. */
+    double n = duration / t->dt, r = floor(n + 0.5);
+    double count = fabs(n - r) <= 1e-9 * FCM_MAX(r, 1.0) ? r : ceil(n);
+    if (o) fcm__scene_path_push_key(p, fcm__json_member(o, "duration") ? "duration" : "dt");
+    SCENE_CHECK(count >= 1.0 && count <= 1e9, p, FCM_ERR_ARG,
+                "expected at most 1e9 steps of dt = %g, got duration / dt = %g", t->dt, n);
+    steps = (long long)FCM_MAX(count, 1.0);
+  }
+  t->num_steps = (fcm_index)steps;
+  t->duration = (double)steps * t->dt;
+  SCENE_CHECK(isfinite(t->duration), p, FCM_ERR_ARG,
+              "expected a finite simulated time, got steps * dt = %g", t->duration);
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
+/* ---------------------------------------------------------------- output */
+
+static fcm_status read_output(fcm__scene_parser *p, const fcm__json *root)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"directory", "frame_interval", "background", "surface"};
+  fcm_scene_output *out = &p->scene->output;
+  const fcm__json *o = NULL;
+  size_t old = p->path_len;
+  out->directory = "fcm-output";
+  out->frame_interval = 1;
+  out->write_background = 1;
+  out->write_surface = 1;
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "output", 0, &o));
+  if (!o) return FCM_OK;
+  ENTER(p, "output");
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+  FCM_TRY(p->ctx, fcm__scene_read_string(p, o, "directory", 0, &out->directory));
+  READ_INT(p, o, "frame_interval", 0, 1, 1000000000, out->frame_interval);
+  FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "background", 0, &out->write_background));
+  FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "surface", 0, &out->write_surface));
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
+/* ---------------------------------------------------------------- the whole scene */
+
+/* Whether a name is usable in file names: [A-Za-z0-9_.-], 1..64 characters, not "." or "..". */
+static int valid_name(const char *s)
+{
+  size_t n = strlen(s);
+  if (n == 0 || n > 64 || !strcmp(s, ".") || !strcmp(s, "..")) return 0;
+  for (; *s; s++)
+    if (!((*s >= 'a' && *s <= 'z') || (*s >= 'A' && *s <= 'Z') || (*s >= '0' && *s <= '9') ||
+          *s == '_' || *s == '-' || *s == '.'))
+      return 0;
+  return 1;
+}
+
+/* The stem of a path's last component ("dir/x.json" -> "x"); "scene" if that is not a
+ * valid name. */
+static fcm_status default_name(fcm__scene_parser *p, const char *source, const char **out)
+{
+  fcm_status st = FCM_OK;
+  const char *b = strrchr(source, '/');
+  b = b ? b + 1 : source;
+  size_t n = strlen(b);
+  const char *dot = strrchr(b, '.');
+  if (dot && dot != b) n = (size_t)(dot - b);
+  if (n > 64) n = 64;
+  char buf[65];
+  memcpy(buf, b, n);
+  buf[n] = '\0';
+  if (!valid_name(buf)) strcpy(buf, "scene");
+  FCM_TRY(p->ctx, fcm__scene_strdup(p, buf, out));
+cleanup:
+  return st;
+}
+
+static fcm_status parse_root(fcm__scene_parser *p, const fcm__json *root)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"version",  "name",     "description", "background",
+                                     "geometry", "material", "quadrature",  "solver",
+                                     "time",     "output",   "effects"};
+  fcm_scene *s = p->scene;
+  long long version = 1;
+  SCENE_CHECK(fcm__json_get_kind(root) == FCM__JSON_OBJECT, p, FCM_ERR_ARG,
+              "expected a JSON object at the top level");
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, root, keys, COUNT(keys)));
+  FCM_TRY(p->ctx, fcm__scene_read_int(p, root, "version", 0, 1, 1, &version));
+  FCM_TRY(p->ctx, fcm__scene_read_string(p, root, "name", 0, &s->name));
+  if (s->name) {
+    fcm__scene_path_push_key(p, "name");
+    SCENE_CHECK(valid_name(s->name), p, FCM_ERR_ARG,
+                "expected 1 to 64 characters from [A-Za-z0-9_.-] (it names output files), "
+                "got \"%.64s\"",
+                s->name);
+    fcm__scene_path_pop(p, 0);
+  } else {
+    FCM_TRY(p->ctx, default_name(p, p->source, &s->name));
+  }
+  s->description = "";
+  FCM_TRY(p->ctx, fcm__scene_read_string(p, root, "description", 0, &s->description));
+  FCM_TRY(p->ctx, read_background(p, root));
+  FCM_TRY(p->ctx, read_geometry(p, root));
+  FCM_TRY(p->ctx, read_material(p, root));
+  FCM_TRY(p->ctx, read_quadrature(p, root));
+  FCM_TRY(p->ctx, read_solver(p, root));
+  FCM_TRY(p->ctx, read_time(p, root));
+  FCM_TRY(p->ctx, read_output(p, root));
+  FCM_TRY(p->ctx, fcm__scene_read_effects(p, root));
+cleanup:
+  return st;
+}
+
+/* 1-based line and column (in bytes) of a byte offset. */
+static void line_column(const char *text, size_t offset, long *line, long *col)
+{
+  *line = 1;
+  *col = 1;
+  for (size_t i = 0; i < offset; i++) {
+    if (text[i] == '\n') {
+      (*line)++;
+      *col = 1;
+    } else {
+      (*col)++;
+    }
+  }
+}
+
+/* Parse `length` bytes of text (NUL at text[length]) into a new scene. */
+static fcm_status create(fcm_ctx *ctx, const char *text, size_t length, const char *source,
+                         fcm_scene **out)
+{
+  fcm_status st = FCM_OK;
+  fcm__json *root = NULL;
+  fcm_scene *s = NULL;
+  fcm__scene_parser p;
+  memset(&p, 0, sizeof p);
+  p.ctx = ctx;
+  p.source = source;
+  FCM_ALLOC(ctx, 1, s);
+  s->ctx = ctx;
+  p.scene = s;
+  FCM_TRY(ctx, fcm__scene_strdup(&p, source, &s->source));
+  p.source = s->source;
+  {
+    /* Relative file names are resolved against the source's directory part. */
+    const char *slash = strrchr(source, '/');
+    size_t n = slash ? (size_t)(slash - source) + 1 : 0;
+    char *dir = fcm__scene_alloc(s, n + 1, 1);
+    if (!dir) {
+      st = FCM_ERR_ALLOC;
+      fcm__trace(ctx, __FILE__, __LINE__, __func__);
+      goto cleanup;
+    }
+    memcpy(dir, source, n);
+    p.base_dir = dir;
+  }
+  size_t nul = strlen(text);
+  if (nul < length) {
+    long line, col;
+    line_column(text, nul, &line, &col);
+    FCM_CHECK(0, ctx, FCM_ERR_FORMAT, "%s:%ld:%ld: malformed JSON: NUL byte in the text", source,
+              line, col);
+  }
+  size_t at = 0;
+  root = fcm__json_parse(text, length, &at);
+  if (!root) {
+    long line, col;
+    char near[32];
+    size_t k = 0, a = at, b = at;
+    line_column(text, at, &line, &col);
+    /* Up to 12 characters either side of the position, within its line. */
+    while (a > 0 && at - a < 12 && text[a - 1] != '\n')
+      a--;
+    while (b < length && b - at < 12 && text[b] != '\n')
+      b++;
+    for (size_t i = a; i < b; i++)
+      near[k++] = ((unsigned char)text[i] < 0x20 || text[i] == 0x7f) ? ' ' : text[i];
+    near[k] = '\0';
+    if (at >= length)
+      FCM_CHECK(0, ctx, FCM_ERR_FORMAT, "%s:%ld:%ld: malformed JSON: unexpected end of input",
+                source, line, col);
+    FCM_CHECK(0, ctx, FCM_ERR_FORMAT,
+              "%s:%ld:%ld: malformed JSON near '%s' (JSON has no comments, trailing commas, "
+              "NaN or Infinity)",
+              source, line, col, near);
+  }
+  FCM_TRY(ctx, parse_root(&p, root));
+  *out = s;
+  s = NULL;
+cleanup:
+  fcm__json_delete(root);
+  fcm_scene_destroy(&s);
+  return st;
+}
+
+fcm_status fcm_scene_create_from_string(fcm_ctx *ctx, const char *json_text,
+                                        const char *source_name, fcm_scene **scene)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(scene, ctx, FCM_ERR_ARG, "scene: output pointer is NULL");
+  *scene = NULL;
+  FCM_CHECK(ctx && json_text, ctx, FCM_ERR_ARG, "scene: %s is NULL", ctx ? "json_text" : "ctx");
+  FCM_TRY(ctx,
+          create(ctx, json_text, strlen(json_text), source_name ? source_name : "<string>", scene));
+cleanup:
+  return st;
+}
+
+/* Thread-safe text of a system error (the XSI strerror_r). */
+static void sys_error(int err, char *buf, size_t len)
+{
+  if (strerror_r(err, buf, len) != 0) snprintf(buf, len, "system error %d", err);
+}
+
+fcm_status fcm_scene_create_from_file(fcm_ctx *ctx, const char *path, fcm_scene **scene)
+{
+  fcm_status st = FCM_OK;
+  FILE *f = NULL;
+  char *text = NULL, err[128];
+  size_t cap = 0, len = 0;
+  FCM_CHECK(scene, ctx, FCM_ERR_ARG, "scene: output pointer is NULL");
+  *scene = NULL;
+  FCM_CHECK(ctx && path, ctx, FCM_ERR_ARG, "scene: %s is NULL", ctx ? "path" : "ctx");
+  f = fopen(path, "rb");
+  if (!f) {
+    sys_error(errno, err, sizeof err);
+    FCM_CHECK(0, ctx, FCM_ERR_IO, "%s: cannot open the scene file: %s", path, err);
+  }
+  for (;;) {
+    if (len + 1 >= cap) {
+      size_t ncap = cap ? 2 * cap : 4096;
+      FCM_CHECK(ncap > cap && ncap <= ((size_t)1 << 30), ctx, FCM_ERR_IO,
+                "%s: scene file larger than 1 GiB", path);
+      FCM_TRY(ctx, fcm__resize(ctx, (void **)&text, cap, ncap, 1));
+      cap = ncap;
+    }
+    size_t got = fread(text + len, 1, cap - 1 - len, f);
+    len += got;
+    if (got == 0) break;
+  }
+  if (ferror(f)) {
+    sys_error(errno, err, sizeof err);
+    FCM_CHECK(0, ctx, FCM_ERR_IO, "%s: cannot read the scene file: %s", path, err);
+  }
+  text[len] = '\0';
+  FCM_TRY(ctx, create(ctx, text, len, path, scene));
+cleanup:
+  if (f) fclose(f);
+  fcm__free(ctx, text);
+  return st;
+}
+
+/* ---------------------------------------------------------------- accessors */
+
+const char *fcm_scene_name(const fcm_scene *s)
+{
+  return s->name;
+}
+const char *fcm_scene_description(const fcm_scene *s)
+{
+  return s->description;
+}
+const char *fcm_scene_source(const fcm_scene *s)
+{
+  return s->source;
+}
+const fcm_scene_background *fcm_scene_get_background(const fcm_scene *s)
+{
+  return &s->background;
+}
+const fcm_scene_geometry *fcm_scene_get_geometry(const fcm_scene *s)
+{
+  return &s->geometry;
+}
+const fcm_material *fcm_scene_get_material(const fcm_scene *s)
+{
+  return &s->material;
+}
+const fcm_scene_quadrature *fcm_scene_get_quadrature(const fcm_scene *s)
+{
+  return &s->quadrature;
+}
+const fcm_scene_solver *fcm_scene_get_solver(const fcm_scene *s)
+{
+  return &s->solver;
+}
+const fcm_scene_time *fcm_scene_get_time(const fcm_scene *s)
+{
+  return &s->time;
+}
+const fcm_scene_output *fcm_scene_get_output(const fcm_scene *s)
+{
+  return &s->output;
+}
+int fcm_scene_num_effects(const fcm_scene *s)
+{
+  return s->num_effects;
+}
+
+const fcm_effect *fcm_scene_get_effect(const fcm_scene *s, int i)
+{
+  return (i >= 0 && i < s->num_effects) ? &s->effects[i] : NULL;
+}
+
+int fcm_scene_count_effects(const fcm_scene *s, fcm_effect_type type)
+{
+  int n = 0;
+  for (int i = 0; i < s->num_effects; i++)
+    n += s->effects[i].type == type;
+  return n;
+}
+
+/* ---------------------------------------------------------------- view */
+
+static void view_strength(FILE *f, const char *what, int m)
+{
+  if (m >= 0)
+    fprintf(f, " %s %d", what, m);
+  else
+    fprintf(f, " %s default", what);
+}
+
+void fcm_scene_view(const fcm_scene *s, FILE *f)
+{
+  const fcm_scene_background *b = &s->background;
+  const fcm_scene_geometry *g = &s->geometry;
+  const fcm_scene_quadrature *q = &s->quadrature;
+  const fcm_scene_solver *so = &s->solver;
+  const fcm_scene_time *t = &s->time;
+  fprintf(f, "scene %s (%s)\n", s->name, s->source);
+  if (s->description[0]) fprintf(f, "  %s\n", s->description);
+  if (b->kind == FCM_SCENE_BACKGROUND_GRID)
+    fprintf(f, "background: %s grid %lld x %lld x %lld over [%g, %g] x [%g, %g] x [%g, %g] m\n",
+            element_names[b->element], (long long)b->cells[0], (long long)b->cells[1],
+            (long long)b->cells[2], b->min[0], b->max[0], b->min[1], b->max[1], b->min[2],
+            b->max[2]);
+  else
+    fprintf(f, "background: mesh %s\n", b->mesh);
+  fprintf(f, "geometry: ");
+  switch (g->kind) {
+  case FCM_SCENE_GEOMETRY_NONE:
+    fprintf(f, "none (plain FEM on the background mesh)");
+    break;
+  case FCM_SCENE_GEOMETRY_BOX:
+    fprintf(f, "box [%g, %g] x [%g, %g] x [%g, %g] m, %lld x %lld x %lld cubes", g->min[0],
+            g->max[0], g->min[1], g->max[1], g->min[2], g->max[2], (long long)g->cells[0],
+            (long long)g->cells[1], (long long)g->cells[2]);
+    break;
+  case FCM_SCENE_GEOMETRY_BALL:
+  case FCM_SCENE_GEOMETRY_HEMISPHERE:
+    fprintf(f, "%s centre (%g, %g, %g) radius %g m, resolution %d",
+            g->kind == FCM_SCENE_GEOMETRY_BALL ? "ball" : "hemisphere", g->center[0], g->center[1],
+            g->center[2], g->radius, g->resolution);
+    break;
+  case FCM_SCENE_GEOMETRY_HOLLOW_BALL:
+    fprintf(f,
+            "hollow ball centre (%g, %g, %g) radii %g..%g m, holes %g m, resolution %d, "
+            "%d layers",
+            g->center[0], g->center[1], g->center[2], g->inner_radius, g->outer_radius,
+            g->hole_radius, g->resolution, g->layers);
+    break;
+  case FCM_SCENE_GEOMETRY_TUBE:
+    fprintf(f, "tube centre (%g, %g, %g) along %s, radii %g..%g m, length %g m, %d x %d x %d cells",
+            g->center[0], g->center[1], g->center[2], axis_names[g->axis], g->inner_radius,
+            g->outer_radius, g->length, g->radial_cells, g->angular_cells, g->axial_cells);
+    break;
+  case FCM_SCENE_GEOMETRY_GMSH:
+    fprintf(f, "mesh %s", g->mesh);
+    break;
+  default:
+    fprintf(f, "tetgen %s, %s", g->mesh, g->ele);
+    break;
+  }
+  if (g->has_transform)
+    fprintf(f, ", mapped by x -> A x + b, A = [%g %g %g; %g %g %g; %g %g %g], b = (%g, %g, %g)",
+            g->transform[0], g->transform[1], g->transform[2], g->transform[3], g->transform[4],
+            g->transform[5], g->transform[6], g->transform[7], g->transform[8], g->offset[0],
+            g->offset[1], g->offset[2]);
+  fprintf(f, "\n");
+  fprintf(f, "material: %s, E = %g Pa, nu = %g, rho = %g kg/m^3\n",
+          fcm_material_model_name(s->material.model), s->material.young, s->material.poisson,
+          s->material.density);
+  fprintf(f, "quadrature: strengths");
+  view_strength(f, "stiffness", q->stiffness_strength);
+  view_strength(f, "mass", q->mass_strength);
+  if (q->surface_strength >= 0)
+    view_strength(f, "surface", q->surface_strength);
+  else
+    fprintf(f, " surface automatic");
+  fprintf(f, "; simplify %s (%s); stabilization %s alpha %g; min fraction %g\n",
+          q->simplify ? "on" : "off", simplify_names[q->simplify_method],
+          stabilization_names[q->stabilization], q->stabilization_alpha, q->min_fraction);
+  fprintf(f, "solver: %s", solver_names[so->method]);
+  if (so->method == FCM_SCENE_SOLVER_DIRECT)
+    fprintf(f, " (%s)", direct_names[so->direct]);
+  else {
+    fprintf(f, " preconditioner %s", preconditioner_names[so->preconditioner]);
+    if (so->preconditioner == FCM_SCENE_PRECONDITIONER_SCHWARZ)
+      fprintf(f, " (threshold %g, epsilon %g, %s)", so->schwarz_threshold, so->schwarz_epsilon,
+              clamp_names[so->schwarz_paper_clamp]);
+    fprintf(f, ", rtol %g, atol %g, at most %d iterations", so->rtol, so->atol, so->max_iterations);
+  }
+  fprintf(f,
+          "; Newton rtol %g, at most %d iterations, line search %s, PSD projection %s, "
+          "|a_rep| %g m/s^2; threads %d\n",
+          so->newton_rtol, so->newton_max_iterations, so->line_search ? "on" : "off",
+          so->project_psd ? "on" : "off", so->representative_acceleration, so->threads);
+  if (t->is_static)
+    fprintf(f, "time: static, %lld step(s) of %g s, %d load step(s) each\n",
+            (long long)t->num_steps, t->dt, t->load_steps);
+  else
+    fprintf(f, "time: %s, %lld steps of dt = %g s, %g s in all\n", integrator_names[t->integrator],
+            (long long)t->num_steps, t->dt, t->duration);
+  fprintf(f, "output: %s, every %d step(s), background %s, surface %s\n", s->output.directory,
+          s->output.frame_interval, s->output.write_background ? "yes" : "no",
+          s->output.write_surface ? "yes" : "no");
+  fprintf(f, "effects: %d\n", s->num_effects);
+  for (int i = 0; i < s->num_effects; i++) {
+    const fcm__effect_type *type = fcm__scene_effect_type(s->effects[i].type);
+    fprintf(f, "  [%d] %s: ", i, type->name);
+    type->view(&s->effects[i], f);
+    fprintf(f, "\n");
+  }
+}

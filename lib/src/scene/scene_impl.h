@@ -1,0 +1,191 @@
+/* fcm scene, internal part: the JSON tree adapter (cJSON is touched only in
+ * json_adapter.c), the typed readers that name JSON paths in errors, and the effect table. */
+#ifndef FCM_SCENE_IMPL_H
+#define FCM_SCENE_IMPL_H
+
+#include "core/core_impl.h"
+#include "fcm/scene.h"
+
+#include <math.h>
+
+/* ---------------------------------------------------------------- JSON tree */
+
+/* A node of a parsed JSON document (a cJSON item underneath). */
+typedef struct fcm__json fcm__json;
+
+typedef enum fcm__json_kind {
+  FCM__JSON_NULL = 0,
+  FCM__JSON_BOOL,
+  FCM__JSON_NUMBER,
+  FCM__JSON_STRING,
+  FCM__JSON_ARRAY,
+  FCM__JSON_OBJECT,
+  FCM__JSON_INVALID
+} fcm__json_kind;
+
+/* Parse `length` bytes of `text` (NUL-terminated at text[length]). On failure returns
+ * NULL and sets *error_offset to the byte offset where parsing stopped. The tree is
+ * allocated with malloc by the parser library; release it with fcm__json_delete(). */
+fcm__json *fcm__json_parse(const char *text, size_t length, size_t *error_offset);
+void fcm__json_delete(fcm__json *root);
+
+fcm__json_kind fcm__json_get_kind(const fcm__json *node);
+/* Member name of an object member, NULL otherwise. */
+const char *fcm__json_key(const fcm__json *node);
+/* Value of a number (inf for overflowing literals such as 1e999). */
+double fcm__json_number(const fcm__json *node);
+int fcm__json_bool(const fcm__json *node);
+const char *fcm__json_string(const fcm__json *node);
+/* First child of an array or object, and the next sibling; NULL at the end. */
+const fcm__json *fcm__json_child(const fcm__json *node);
+const fcm__json *fcm__json_next(const fcm__json *node);
+/* Number of children of an array or object. */
+int fcm__json_size(const fcm__json *node);
+/* Member of an object by exact (case-sensitive) name, the first one; NULL if absent. */
+const fcm__json *fcm__json_member(const fcm__json *object, const char *key);
+
+/* ---------------------------------------------------------------- the scene */
+
+typedef struct fcm__scene_block fcm__scene_block;
+
+struct fcm_scene {
+  fcm_ctx *ctx;
+  fcm__scene_block *blocks; /* every allocation owned by the scene, freed at destroy */
+  const char *name, *description, *source;
+  fcm_scene_background background;
+  fcm_scene_geometry geometry;
+  fcm_material material;
+  fcm_scene_quadrature quadrature;
+  fcm_scene_solver solver;
+  fcm_scene_time time;
+  fcm_scene_output output;
+  int num_effects;
+  fcm_effect *effects;
+};
+
+/* Zeroed array of n elements of `size` bytes owned by the scene (freed with it). Records
+ * FCM_ERR_ALLOC and returns NULL on failure. */
+void *fcm__scene_alloc(fcm_scene *scene, size_t n, size_t size);
+
+/* ---------------------------------------------------------------- the parser */
+
+#define FCM__SCENE_PATH_LEN 256
+
+/* State of one parse: where errors go and the JSON path of the value being read. */
+typedef struct fcm__scene_parser {
+  fcm_ctx *ctx;
+  fcm_scene *scene;
+  const char *source;   /* name in messages */
+  const char *base_dir; /* prefix for relative file names ("" or ending in '/') */
+  char path[FCM__SCENE_PATH_LEN];
+  size_t path_len;
+} fcm__scene_parser;
+
+/* Record an error "<source>: <path>: <message>" (or "<source>: <message>" at the root). */
+fcm_status fcm__scene_error(fcm__scene_parser *p, fcm_status code, const char *file, int line,
+                            const char *func, const char *fmt, ...) FCM__PRINTF(6, 7);
+
+/* FCM_CHECK with the JSON path of the parser in the message. */
+#define SCENE_CHECK(cond, p, code, ...)                                                            \
+  do {                                                                                             \
+    if (!(cond)) {                                                                                 \
+      st = fcm__scene_error((p), (code), __FILE__, __LINE__, __func__, __VA_ARGS__);               \
+      goto cleanup;                                                                                \
+    }                                                                                              \
+  } while (0)
+
+/* Append ".key" (or "key" at the root) or "[i]" to the path; return the old length to
+ * pass to fcm__scene_path_pop(). */
+size_t fcm__scene_path_push_key(fcm__scene_parser *p, const char *key);
+size_t fcm__scene_path_push_index(fcm__scene_parser *p, int index);
+void fcm__scene_path_pop(fcm__scene_parser *p, size_t old_len);
+
+/* Short description of a JSON value for messages: 3.5, "text", true, null, an array, ... */
+void fcm__scene_describe(const fcm__json *node, char *buf, size_t len);
+
+/* A closed, open or half-open interval of numbers; +-HUGE_VAL for none. */
+typedef struct fcm__range {
+  double lo, hi;
+  int lo_open, hi_open;
+} fcm__range;
+
+/* Ranges used often. */
+#define FCM__ANY         ((fcm__range){-HUGE_VAL, HUGE_VAL, 1, 1})
+#define FCM__POSITIVE    ((fcm__range){0.0, HUGE_VAL, 1, 1})
+#define FCM__NONNEGATIVE ((fcm__range){0.0, HUGE_VAL, 0, 1})
+
+/* "a finite number > 0", "a finite number in (-1, 0.5)", ... */
+void fcm__scene_range_text(fcm__range r, char *buf, size_t len);
+
+/* The typed readers. Each reads member `key` of `obj`: when the member is absent and
+ * `required` is 0 the output keeps the value the caller put there (the default); when it
+ * is absent and required, or present with the wrong type or out of range, it fails with
+ * FCM_ERR_ARG naming the JSON path, the allowed values and what it got. */
+fcm_status fcm__scene_read_number(fcm__scene_parser *p, const fcm__json *obj, const char *key,
+                                  int required, fcm__range range, double *out);
+fcm_status fcm__scene_read_int(fcm__scene_parser *p, const fcm__json *obj, const char *key,
+                               int required, long long lo, long long hi, long long *out);
+fcm_status fcm__scene_read_bool(fcm__scene_parser *p, const fcm__json *obj, const char *key,
+                                int required, int *out);
+/* String copied into the scene; non-empty, no control characters. */
+fcm_status fcm__scene_read_string(fcm__scene_parser *p, const fcm__json *obj, const char *key,
+                                  int required, const char **out);
+/* Array of 3 numbers, each in `range`. */
+fcm_status fcm__scene_read_vec3(fcm__scene_parser *p, const fcm__json *obj, const char *key,
+                                int required, fcm__range range, double out[3]);
+/* Array of 3 integers in [lo, hi]. */
+fcm_status fcm__scene_read_ivec3(fcm__scene_parser *p, const fcm__json *obj, const char *key,
+                                 int required, long long lo, long long hi, fcm_index out[3]);
+/* One of `n` names; *out is its index. */
+fcm_status fcm__scene_read_choice(fcm__scene_parser *p, const fcm__json *obj, const char *key,
+                                  int required, const char *const *names, int n, int *out);
+/* A member that must be an object; *out NULL when absent and optional. */
+fcm_status fcm__scene_read_object(fcm__scene_parser *p, const fcm__json *obj, const char *key,
+                                  int required, const fcm__json **out);
+/* A file name resolved against the scene's directory and copied into the scene; the file
+ * must be a readable regular file (FCM_ERR_IO naming the resolved path otherwise).
+ * `suffix` (may be NULL) is appended to the name before the check (TetGen base names). */
+fcm_status fcm__scene_read_file(fcm__scene_parser *p, const fcm__json *obj, const char *key,
+                                int required, const char *suffix, const char **out);
+
+/* `node` (at the current path) must be an object whose member names are all in
+ * `allowed` (n names) and distinct; otherwise FCM_ERR_ARG listing the allowed names. */
+fcm_status fcm__scene_check_object(fcm__scene_parser *p, const fcm__json *node,
+                                   const char *const *allowed, int n);
+
+/* Copy a string into the scene. */
+fcm_status fcm__scene_strdup(fcm__scene_parser *p, const char *s, const char **out);
+
+/* ---------------------------------------------------------------- regions and effects */
+
+/* Parse a region object at member `key` of obj (absent and optional: kind ALL). With
+ * `allow_nodes` 0 a node set is rejected (surface effects need positions). */
+fcm_status fcm__scene_read_region(fcm__scene_parser *p, const fcm__json *obj, const char *key,
+                                  int required, int allow_nodes, fcm_region *out);
+
+/* The one effect table: each effect type has a name, a parser/validator that fills the
+ * union member of an fcm_effect from the effect's parameter object (the path already ends
+ * in "effects[i].<name>"), scene-level rules, and a summary printer. The simulation
+ * pipeline attaches its contribution hooks (setup, per-step constraints and forces) to
+ * this same table, so that only the effects named in a scene are computed. */
+typedef struct fcm__effect_type {
+  fcm_effect_type type;
+  const char *name;
+  const char *summary; /* one line for documentation and listings */
+  int max_count;       /* 0: any number per scene; else at most this many */
+  int allowed_static;  /* 0: an error in a static scene (needs inertia) */
+  fcm_status (*parse)(fcm__scene_parser *p, const fcm__json *params, fcm_effect *effect);
+  void (*view)(const fcm_effect *effect, FILE *stream);
+} fcm__effect_type;
+
+/* Entry of `type`, or NULL; entry by name, or NULL. */
+const fcm__effect_type *fcm__scene_effect_type(fcm_effect_type type);
+const fcm__effect_type *fcm__scene_effect_type_find(const char *name);
+
+/* Parse the "effects" array (absent: no effects) into p->scene. */
+fcm_status fcm__scene_read_effects(fcm__scene_parser *p, const fcm__json *root);
+
+/* Print a region on one line (no newline). */
+void fcm__scene_region_view(const fcm_region *r, FILE *stream);
+
+#endif /* FCM_SCENE_IMPL_H */

@@ -1,0 +1,121 @@
+/* Shared helpers of the scene tests: a scene that sets every key, a failing allocator,
+ * temporary directories and files. */
+#ifndef FCM_TEST_SCENE_UTIL_H
+#define FCM_TEST_SCENE_UTIL_H
+
+#define _POSIX_C_SOURCE 200809L
+#include "fcm/fcm.h"
+#include "test.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+/* Every top-level key and every effect type, with values that differ from the defaults
+ * and from each other, so that a value landing in the wrong field is noticed. */
+static const char full_scene_json[] =
+    "{\n"
+    "  \"version\": 1,\n"
+    "  \"name\": \"full-scene.v1\",\n"
+    "  \"description\": \"every key set\",\n"
+    "  \"background\": {\"element\": \"tet10\", \"box\": {\"min\": [-1, -2, -3], "
+    "\"max\": [4, 5, 6]}, \"cells\": [2, 3, 4]},\n"
+    "  \"geometry\": {\"shape\": \"tube\", \"center\": [0.5, 1.5, 2.5], \"axis\": \"x\",\n"
+    "    \"inner_radius\": 0.25, \"outer_radius\": 0.75, \"length\": 3, \"radial_cells\": 3,\n"
+    "    \"angular_cells\": 12, \"axial_cells\": 7,\n"
+    "    \"transform\": {\"scale\": [1, 2, 3], \"rotation\": {\"axis\": [0, 0, 2], "
+    "\"angle\": 1.5707963267948966},\n"
+    "      \"translation\": [7, 8, 9]}},\n"
+    "  \"material\": {\"model\": \"stvk\", \"young\": 2.5e6, \"poisson\": 0.35, "
+    "\"density\": 1200},\n"
+    "  \"quadrature\": {\"stiffness_strength\": 5, \"mass_strength\": 7, \"surface_strength\": 6,\n"
+    "    \"simplify\": false, \"simplify_method\": \"recombine\",\n"
+    "    \"stabilization\": {\"mode\": \"mass\", \"alpha\": 1e-8}, \"min_fraction\": 0.001},\n"
+    "  \"solver\": {\"method\": \"minres\", \"direct\": \"umfpack\", \"preconditioner\": "
+    "\"block_jacobi\",\n"
+    "    \"schwarz\": {\"threshold\": 0.25, \"epsilon\": 1e-12, \"clamp\": \"paper\"},\n"
+    "    \"rtol\": 1e-6, \"atol\": 1e-12, \"max_iterations\": 321,\n"
+    "    \"newton\": {\"rtol\": 1e-4, \"max_iterations\": 17, \"line_search\": false,\n"
+    "      \"project_psd\": true, \"representative_acceleration\": 10},\n"
+    "    \"threads\": 3},\n"
+    "  \"time\": {\"static\": false, \"integrator\": \"backward_euler\", \"dt\": 0.02, "
+    "\"duration\": 1.5},\n"
+    "  \"output\": {\"directory\": \"out/full\", \"frame_interval\": 4, \"background\": false,\n"
+    "    \"surface\": false},\n"
+    "  \"effects\": [\n"
+    "    {\"gravity\": {\"acceleration\": [0, -9.81, 0]}},\n"
+    "    {\"fixed\": {\"region\": {\"nodes\": [5, 3, 11]}, \"components\": \"zx\"}},\n"
+    "    {\"motion\": {\"region\": {\"box\": {\"min\": [-1, -2, -3], \"max\": [4, -2, 6], "
+    "\"tolerance\": 0.01}},\n"
+    "      \"velocity\": [0.1, 0.2, 0.3], \"rotation\": {\"axis\": [0, 3, 0], \"center\": [1, 0, "
+    "1],\n"
+    "      \"speed\": -0.5}, \"start\": 0.25, \"end\": 1.25, \"release\": true}},\n"
+    "    {\"initial_velocity\": {\"region\": {\"half_space\": {\"point\": [0, 0, 1], "
+    "\"normal\": [0, 0, -2]}},\n"
+    "      \"velocity\": [1, 2, 3], \"angular_velocity\": [0.5, -0.5, 2], "
+    "\"center\": [1, 1, 1]}},\n"
+    "    {\"damping\": {\"mass\": 0.1, \"stiffness\": 0.02}},\n"
+    "    {\"traction\": {\"region\": {\"box\": {\"min\": [3, -2, -3], \"max\": [4, 5, 6]}},\n"
+    "      \"value\": [10, 20, 30], \"start\": 0.5}},\n"
+    "    {\"pressure\": {\"region\": {\"half_space\": {\"point\": [0, 4, 0], "
+    "\"normal\": [0, 1, 0]}},\n"
+    "      \"value\": -250, \"end\": 1}},\n"
+    "    {\"initial_velocity\": {\"velocity\": [0, 0, -1]}}\n"
+    "  ]\n"
+    "}\n";
+
+/* Allocator failing the fail_at-th allocation after arming (fail_at < 0: never). */
+typedef struct failing {
+  long count;
+  long fail_at;
+} failing;
+
+static inline void *failing_alloc(void *user, size_t size)
+{
+  failing *f = user;
+  if (f->fail_at >= 0 && f->count++ == f->fail_at) return NULL;
+  return malloc(size);
+}
+
+static inline void failing_release(void *user, void *ptr)
+{
+  (void)user;
+  free(ptr);
+}
+
+static inline fcm_ctx *failing_ctx(failing *f)
+{
+  fcm_ctx_options opts = fcm_ctx_options_default();
+  opts.allocator.alloc = failing_alloc;
+  opts.allocator.release = failing_release;
+  opts.allocator.user = f;
+  fcm_ctx *ctx = NULL;
+  f->count = 0;
+  f->fail_at = -1;
+  if (fcm_ctx_create(&opts, &ctx) != FCM_OK) return NULL;
+  return ctx;
+}
+
+/* Write `n` bytes to a file; returns 0 on success. */
+static inline int write_bytes(const char *path, const char *data, size_t n)
+{
+  FILE *fp = fopen(path, "wb");
+  if (!fp) return 1;
+  int bad = fwrite(data, 1, n, fp) != n;
+  bad |= fclose(fp) != 0;
+  return bad;
+}
+
+static inline int write_text(const char *path, const char *text)
+{
+  return write_bytes(path, text, strlen(text));
+}
+
+/* A fresh directory under /tmp (template in buf, at least 32 bytes); NULL on failure. */
+static inline char *make_temp_dir(char *buf, size_t len)
+{
+  snprintf(buf, len, "/tmp/fcm-scene-XXXXXX");
+  return mkdtemp(buf);
+}
+
+#endif

@@ -1,0 +1,8 @@
+# Scene files: the example scenes and the built-in default parse and validate; a table of
+# bad inputs (each error class, with status and JSON path); full-key parsing and the
+# motion/velocity formulas; allocation-failure torture.
+fcm_add_test(scene_parse tests/scene/parse.c)
+fcm_add_test(scene_errors tests/scene/errors.c)
+fcm_add_test(scene_alloc tests/scene/alloc.c)
+fcm_add_test(scene_default tests/scene/default.c)
+fcm_add_test(scene_examples tests/scene/examples.c ARGS ${PROJECT_SOURCE_DIR}/apps/scenes)
