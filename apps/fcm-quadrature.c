@@ -1,5 +1,6 @@
 /* fcm-quadrature: quadrature studies and reports. Subcommands are listed in one
  * table; `tables` reports (and with --check re-verifies) the stored rule tables. */
+#include "fcm-quadrature.h"
 #include <fcm/fcm.h>
 
 #include <math.h>
@@ -225,6 +226,10 @@ typedef struct subcommand {
 } subcommand;
 
 static const subcommand commands[] = {
+    {"accuracy", "Longva Fig. 4: monomials over a rotated cuboid, initial vs simplified",
+     fcm_quadrature_cmd_accuracy},
+    {"embed", "embed a geometry in a background grid, print the cut-cell rule statistics",
+     fcm_quadrature_cmd_embed},
     {"tables", "stored rule tables: counts vs best published, --check re-verifies", cmd_tables},
 };
 

@@ -1,0 +1,417 @@
+/* fcm-quadrature subcommands on embedded rules: `accuracy` (Longva et al. 2020
+ * Fig. 4: monomials over a rotated cuboid in [-1,1]^3, initial vs simplified
+ * rules) and `embed` (a background grid, an embedded geometry, the statistics). */
+#include "fcm-quadrature.h"
+
+#include <fcm/fcm.h>
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------------ helpers */
+
+static int parse_num(const char *opt, const char *s, double lo, double hi, double *out)
+{
+  char *end = NULL;
+  errno = 0;
+  double v = s ? strtod(s, &end) : NAN;
+  if (!s || errno || end == s || *end || !isfinite(v) || v < lo || v > hi) {
+    fprintf(stderr, "fcm-quadrature: %s: '%s' is not a number in [%g, %g]\n", opt, s ? s : "",
+            lo, hi);
+    return 0;
+  }
+  *out = v;
+  return 1;
+}
+
+static int parse_int(const char *opt, const char *s, int lo, int hi, int *out)
+{
+  double v;
+  if (!parse_num(opt, s, lo, hi, &v)) return 0;
+  if (v != floor(v)) {
+    fprintf(stderr, "fcm-quadrature: %s: '%s' is not a whole number\n", opt, s);
+    return 0;
+  }
+  *out = (int)v;
+  return 1;
+}
+
+/* Open FILE.tmp for writing; fcm_quadrature_commit() renames it over FILE. */
+static FILE *open_tmp(const char *path, char *tmp, size_t cap)
+{
+  snprintf(tmp, cap, "%s.tmp", path);
+  FILE *f = fopen(tmp, "w");
+  if (!f) fprintf(stderr, "fcm-quadrature: cannot write '%s': %s\n", tmp, strerror(errno));
+  return f;
+}
+
+static int commit_tmp(FILE *f, const char *tmp, const char *path)
+{
+  int bad = ferror(f);
+  if (fclose(f) != 0) bad = 1;
+  if (bad || rename(tmp, path) != 0) {
+    fprintf(stderr, "fcm-quadrature: cannot write '%s': %s\n", path, strerror(errno));
+    remove(tmp);
+    return 0;
+  }
+  return 1;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+/* -------------------------------------------------------------- accuracy */
+
+/* The cuboid in its local frame: [lo, hi] with lo > 0 so no monomial integral
+ * vanishes; mapped into [-1,1]^3 by x = R y + t (R a rotation, centre near 0). */
+static const double cub_lo[3] = {0.30, 0.45, 0.20}, cub_hi[3] = {1.05, 1.00, 0.80};
+
+/* Rotation by angle about a unit axis (Rodrigues), row-major. */
+static void rotation(const double axis[3], double angle, double R[9])
+{
+  double n = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
+  double k[3] = {axis[0] / n, axis[1] / n, axis[2] / n}, c = cos(angle), s = sin(angle);
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) R[3 * i + j] = (1 - c) * k[i] * k[j] + (i == j ? c : 0.0);
+  R[1] -= s * k[2], R[2] += s * k[1], R[3] += s * k[2];
+  R[5] -= s * k[0], R[6] -= s * k[1], R[7] += s * k[0];
+}
+
+/* Relative errors of the rule (cell 0 of `rules`, identity map) on every monomial
+ * y^a of total degree <= m in the cuboid frame y = R^T (x - t). */
+static int monomial_errors(const fcm_cell_rules *rules, int m, const double R[9],
+                           const double t[3], double *err, int *npts)
+{
+  int np = 0, count = 0;
+  const double *pts = NULL, *w = NULL;
+  if (fcm_cell_rules_get(rules, 0, FCM_RULE_STIFFNESS, &np, &pts, &w, NULL) != FCM_OK) return -1;
+  *npts = np;
+  for (int a = 0; a <= m; a++)
+    for (int b = 0; a + b <= m; b++)
+      for (int c = 0; a + b + c <= m; c++) {
+        int e[3] = {a, b, c};
+        double exact = 1.0, q = 0.0;
+        for (int d = 0; d < 3; d++)
+          exact *= (pow(cub_hi[d], e[d] + 1) - pow(cub_lo[d], e[d] + 1)) / (e[d] + 1);
+        for (int p = 0; p < np; p++) {
+          double x[3], y[3];
+          for (int d = 0; d < 3; d++) x[d] = pts[3 * p + d] - t[d];
+          for (int d = 0; d < 3; d++) y[d] = R[d] * x[0] + R[3 + d] * x[1] + R[6 + d] * x[2];
+          /* reference [-1,1]^3 = physical [-1,1]^3: det J = 1 */
+          q += w[p] * pow(y[0], a) * pow(y[1], b) * pow(y[2], c);
+        }
+        err[count++] = fabs(q - exact) / fabs(exact);
+      }
+  return count;
+}
+
+static void accuracy_usage(FILE *f)
+{
+  fprintf(f, "usage: fcm-quadrature accuracy [--max-strength M] [--csv FILE]\n"
+             "\n"
+             "Longva et al. 2020, Fig. 4: a cuboid, rotated and translated, embedded in the\n"
+             "reference hexahedron [-1,1]^3. For every strength m = 1..M, every monomial of\n"
+             "total degree <= m in the cuboid's local frame (translated so that no integral\n"
+             "vanishes) is integrated with the initial cut-cell rule (tetrahedralized\n"
+             "intersection) and the simplified rule (<= (m+3 choose 3) positive points), and\n"
+             "compared with its analytic value.\n"
+             "\n"
+             "  --max-strength M   1..20 (default 10)\n"
+             "  --csv FILE         write strength,rule,points,max_rel_error,median_rel_error\n");
+}
+
+int fcm_quadrature_cmd_accuracy(int argc, char **argv)
+{
+  int maxm = 10, rc = 1;
+  const char *csv = NULL;
+  for (int i = 0; i < argc; i++) {
+    if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
+      accuracy_usage(stdout);
+      return 0;
+    } else if (!strcmp(argv[i], "--max-strength")) {
+      if (!parse_int("--max-strength", i + 1 < argc ? argv[++i] : NULL, 1, 20, &maxm)) return 2;
+    } else if (!strcmp(argv[i], "--csv")) {
+      if (i + 1 >= argc) {
+        fprintf(stderr, "fcm-quadrature: --csv needs a file name\n");
+        return 2;
+      }
+      csv = argv[++i];
+    } else {
+      fprintf(stderr, "fcm-quadrature accuracy: unknown option '%s' (see --help)\n", argv[i]);
+      return 2;
+    }
+  }
+  fcm_ctx *ctx = NULL;
+  fcm_mesh *cell = NULL;
+  fcm_geometry *box = NULL, *cuboid = NULL;
+  double *err = NULL;
+  FILE *out = NULL;
+  char tmp[4096];
+  const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, axis[3] = {1.0, 2.0, 0.5};
+  const fcm_index one[3] = {1, 1, 1}, nb[3] = {2, 2, 2};
+  double R[9], t[3], c[3];
+  rotation(axis, 0.7, R);
+  for (int d = 0; d < 3; d++) c[d] = 0.5 * (cub_lo[d] + cub_hi[d]);
+  for (int d = 0; d < 3; d++) /* the cuboid's centre goes to (0.03, -0.02, 0.05) */
+    t[d] = (d == 0 ? 0.03 : d == 1 ? -0.02 : 0.05) - (R[3 * d] * c[0] + R[3 * d + 1] * c[1] + R[3 * d + 2] * c[2]);
+  if (fcm_ctx_create(NULL, &ctx) != FCM_OK) return 1;
+  if (fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, one, &cell) != FCM_OK ||
+      fcm_geometry_create_box(ctx, cub_lo, cub_hi, nb, &box) != FCM_OK ||
+      fcm_geometry_create_transformed(ctx, box, R, t, &cuboid) != FCM_OK) {
+    fcm_ctx_error_view(ctx, stderr);
+    goto done;
+  }
+  {
+    double glo[3], ghi[3];
+    fcm_geometry_bounding_box(cuboid, glo, ghi);
+    for (int d = 0; d < 3; d++)
+      if (glo[d] <= -1 || ghi[d] >= 1) {
+        fprintf(stderr, "fcm-quadrature: internal: the cuboid leaves [-1,1]^3\n");
+        goto done;
+      }
+  }
+  err = malloc(sizeof *err * 2000);
+  if (!err) goto done;
+  if (csv && !(out = open_tmp(csv, tmp, sizeof tmp))) goto done;
+  if (out) fprintf(out, "strength,rule,points,max_rel_error,median_rel_error\n");
+  printf("%8s %10s %7s %7s %14s %14s\n", "strength", "rule", "points", "M", "max_rel_err",
+         "median_rel_err");
+  for (int m = 1; m <= maxm; m++) {
+    for (int simplify = 0; simplify <= 1; simplify++) {
+      fcm_cell_rules_options ro = fcm_cell_rules_options_default();
+      fcm_cell_rules *rules = NULL;
+      ro.strength[FCM_RULE_STIFFNESS] = m;
+      ro.strength[FCM_RULE_MASS] = m;
+      ro.simplify = simplify;
+      ro.stabilization.mode = FCM_STABILIZATION_OFF;
+      if (fcm_cell_rules_create(ctx, cell, cuboid, &ro, &rules) != FCM_OK) {
+        fcm_ctx_error_view(ctx, stderr);
+        goto done;
+      }
+      int np = 0, count = monomial_errors(rules, m, R, t, err, &np);
+      const fcm_cell_rules_stats *st = fcm_cell_rules_get_stats(rules);
+      int fallback = st->simplify_fallbacks[FCM_RULE_STIFFNESS] > 0;
+      fcm_cell_rules_destroy(&rules);
+      if (count <= 0) goto done;
+      double mx = 0.0;
+      for (int k = 0; k < count; k++) mx = fmax(mx, err[k]);
+      qsort(err, (size_t)count, sizeof *err, cmp_double);
+      double med = count % 2 ? err[count / 2] : 0.5 * (err[count / 2 - 1] + err[count / 2]);
+      const char *name = simplify ? "simplified" : "initial";
+      printf("%8d %10s %7d %7d %14.3e %14.3e%s\n", m, name, np, (m + 1) * (m + 2) * (m + 3) / 6,
+             mx, med, fallback ? "  (simplification fell back)" : "");
+      if (out) fprintf(out, "%d,%s,%d,%.6e,%.6e\n", m, name, np, mx, med);
+      fflush(stdout);
+    }
+  }
+  if (out) {
+    FILE *f = out;
+    out = NULL;
+    if (!commit_tmp(f, tmp, csv)) goto done;
+  }
+  rc = 0;
+done:
+  if (out) {
+    fclose(out);
+    remove(tmp);
+  }
+  free(err);
+  fcm_geometry_destroy(&cuboid);
+  fcm_geometry_destroy(&box);
+  fcm_mesh_destroy(&cell);
+  fcm_ctx_destroy(&ctx);
+  return rc;
+}
+
+/* ----------------------------------------------------------------- embed */
+
+static void embed_usage(FILE *f)
+{
+  fprintf(f,
+          "usage: fcm-quadrature embed --element {tet4,tet10,hex8,hex20}\n"
+          "           --box X0 Y0 Z0 X1 Y1 Z1 --cells NX NY NZ --geometry FILE|SHAPE\n"
+          "           --strength M [--mass-strength M] [--no-simplify] [--stabilization A]\n"
+          "           [--min-fraction PHI] [--dump FILE]\n"
+          "\n"
+          "Builds the background grid, embeds the geometry, builds the cut-cell rules and\n"
+          "prints their statistics (cells per class, points before and after\n"
+          "simplification, fallbacks, residual, volumes, time per phase).\n"
+          "\n"
+          "  --geometry FILE   Gmsh .msh (tetrahedra), or TetGen FILE.node (with FILE.ele)\n"
+          "  --geometry SHAPE  ball:CX,CY,CZ,R,N | hemisphere:CX,CY,CZ,R,N |\n"
+          "                    box:X0,Y0,Z0,X1,Y1,Z1,N\n"
+          "  --strength M      stiffness rule strength 1..20 (mass: --mass-strength,\n"
+          "                    default the element's mass strength)\n"
+          "  --no-simplify     keep the initial (tetrahedralized) rules\n"
+          "  --stabilization A append the full cell's rule x A to cut cells (0: off;\n"
+          "                    default 1e-6)\n"
+          "  --min-fraction P  drop cells with volume fraction below P (default 1e-4)\n"
+          "  --dump FILE       one line per stiffness point:\n"
+          "                    cell xi eta zeta X Y Z w_ref w_phys flag\n"
+          "                    (w_phys = w_ref |J|; flag 0 embedded, 1 stabilization)\n");
+}
+
+/* Procedural geometry "name:a,b,c,..." or a file. */
+static fcm_status load_geometry(fcm_ctx *ctx, const char *spec, fcm_geometry **g)
+{
+  double v[8];
+  int n = 0;
+  const char *colon = strchr(spec, ':');
+  if (colon && !strchr(spec, '/') && colon - spec <= 12) {
+    char name[16] = {0};
+    memcpy(name, spec, (size_t)(colon - spec));
+    const char *p = colon + 1;
+    while (*p && n < 8) {
+      char *end = NULL;
+      v[n++] = strtod(p, &end);
+      if (end == p) return FCM_ERR_ARG;
+      p = *end == ',' ? end + 1 : end;
+      if (*end && *end != ',') return FCM_ERR_ARG;
+    }
+    if (!strcmp(name, "ball") && n == 5) return fcm_geometry_create_ball(ctx, v, v[3], (int)v[4], g);
+    if (!strcmp(name, "hemisphere") && n == 5)
+      return fcm_geometry_create_hemisphere(ctx, v, v[3], (int)v[4], g);
+    if (!strcmp(name, "box") && n == 7) {
+      fcm_index nn[3] = {(fcm_index)v[6], (fcm_index)v[6], (fcm_index)v[6]};
+      return fcm_geometry_create_box(ctx, v, v + 3, nn, g);
+    }
+    return FCM_ERR_ARG;
+  }
+  size_t len = strlen(spec);
+  if (len > 5 && !strcmp(spec + len - 5, ".node")) {
+    char ele[4096];
+    snprintf(ele, sizeof ele, "%.*s.ele", (int)(len - 5), spec);
+    return fcm_geometry_create_from_tetgen(ctx, spec, ele, g);
+  }
+  return fcm_geometry_create_from_gmsh(ctx, spec, g);
+}
+
+int fcm_quadrature_cmd_embed(int argc, char **argv)
+{
+  fcm_element_type type = FCM_ELEMENT_COUNT;
+  double box[6] = {0, 0, 0, 0, 0, 0}, alpha = 1e-6, phimin = 1e-4;
+  int cells[3] = {0, 0, 0}, strength = 0, mstrength = 0, simplify = 1, have_box = 0, rc = 1;
+  const char *geometry = NULL, *dump = NULL;
+  for (int i = 0; i < argc; i++) {
+    const char *a = argv[i];
+    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+      embed_usage(stdout);
+      return 0;
+    } else if (!strcmp(a, "--element")) {
+      if (i + 1 >= argc || fcm_element_type_from_name(argv[i + 1], &type) != FCM_OK) {
+        fprintf(stderr, "fcm-quadrature: --element needs one of tet4, tet10, hex8, hex20\n");
+        return 2;
+      }
+      i++;
+    } else if (!strcmp(a, "--box")) {
+      for (int d = 0; d < 6; d++)
+        if (!parse_num("--box", i + 1 < argc ? argv[++i] : NULL, -1e12, 1e12, &box[d])) return 2;
+      have_box = 1;
+    } else if (!strcmp(a, "--cells")) {
+      for (int d = 0; d < 3; d++)
+        if (!parse_int("--cells", i + 1 < argc ? argv[++i] : NULL, 1, 100000, &cells[d])) return 2;
+    } else if (!strcmp(a, "--geometry")) {
+      geometry = i + 1 < argc ? argv[++i] : NULL;
+    } else if (!strcmp(a, "--strength")) {
+      if (!parse_int("--strength", i + 1 < argc ? argv[++i] : NULL, 1, 20, &strength)) return 2;
+    } else if (!strcmp(a, "--mass-strength")) {
+      if (!parse_int("--mass-strength", i + 1 < argc ? argv[++i] : NULL, 1, 20, &mstrength))
+        return 2;
+    } else if (!strcmp(a, "--no-simplify")) {
+      simplify = 0;
+    } else if (!strcmp(a, "--stabilization")) {
+      if (!parse_num("--stabilization", i + 1 < argc ? argv[++i] : NULL, 0, 1, &alpha)) return 2;
+    } else if (!strcmp(a, "--min-fraction")) {
+      if (!parse_num("--min-fraction", i + 1 < argc ? argv[++i] : NULL, 0, 1, &phimin)) return 2;
+    } else if (!strcmp(a, "--dump")) {
+      dump = i + 1 < argc ? argv[++i] : NULL;
+      if (!dump) {
+        fprintf(stderr, "fcm-quadrature: --dump needs a file name\n");
+        return 2;
+      }
+    } else {
+      fprintf(stderr, "fcm-quadrature embed: unknown option '%s' (see --help)\n", a);
+      return 2;
+    }
+  }
+  const char *missing = type == FCM_ELEMENT_COUNT ? "--element"
+                        : !have_box               ? "--box"
+                        : !cells[0]               ? "--cells"
+                        : !geometry               ? "--geometry"
+                        : !strength               ? "--strength"
+                                                  : NULL;
+  if (missing) {
+    fprintf(stderr, "fcm-quadrature embed: %s is required (see --help)\n", missing);
+    return 2;
+  }
+  for (int d = 0; d < 3; d++)
+    if (!(box[d] < box[d + 3])) {
+      fprintf(stderr, "fcm-quadrature embed: --box: X0 Y0 Z0 must be below X1 Y1 Z1\n");
+      return 2;
+    }
+  fcm_ctx *ctx = NULL;
+  fcm_mesh *mesh = NULL;
+  fcm_geometry *geom = NULL;
+  fcm_cell_rules *rules = NULL;
+  FILE *out = NULL;
+  char tmp[4096];
+  if (fcm_ctx_create(NULL, &ctx) != FCM_OK) return 1;
+  const fcm_index n[3] = {cells[0], cells[1], cells[2]};
+  if (fcm_mesh_create_box(ctx, type, box, box + 3, n, &mesh) != FCM_OK) {
+    fcm_ctx_error_view(ctx, stderr);
+    goto done;
+  }
+  fcm_status st = load_geometry(ctx, geometry, &geom);
+  if (st != FCM_OK) {
+    if (fcm_ctx_error_status(ctx) != FCM_OK)
+      fcm_ctx_error_view(ctx, stderr);
+    else
+      fprintf(stderr, "fcm-quadrature embed: --geometry '%s': not a readable file or a shape "
+                      "spec (see --help)\n", geometry);
+    rc = 2;
+    goto done;
+  }
+  fcm_cell_rules_options ro = fcm_cell_rules_options_default();
+  ro.strength[FCM_RULE_STIFFNESS] = strength;
+  if (mstrength) ro.strength[FCM_RULE_MASS] = mstrength;
+  ro.simplify = simplify;
+  ro.min_fraction = phimin;
+  if (alpha > 0)
+    ro.stabilization.alpha = alpha;
+  else
+    ro.stabilization.mode = FCM_STABILIZATION_OFF;
+  fprintf(stderr, "fcm-quadrature embed: %lld background cells, %lld embedded cells ...\n",
+          (long long)fcm_mesh_num_cells(mesh), (long long)fcm_geometry_num_cells(geom));
+  if (fcm_cell_rules_create(ctx, mesh, geom, &ro, &rules) != FCM_OK) {
+    fcm_ctx_error_view(ctx, stderr);
+    goto done;
+  }
+  fcm_cell_rules_view(rules, stdout);
+  if (dump) {
+    if (!(out = open_tmp(dump, tmp, sizeof tmp))) goto done;
+    if (fcm_cell_rules_view_points(rules, mesh, FCM_RULE_STIFFNESS, out) != FCM_OK) {
+      fcm_ctx_error_view(ctx, stderr);
+      goto done;
+    }
+    FILE *f = out;
+    out = NULL;
+    if (!commit_tmp(f, tmp, dump)) goto done;
+  }
+  rc = 0;
+done:
+  if (out) {
+    fclose(out);
+    remove(tmp);
+  }
+  fcm_cell_rules_destroy(&rules);
+  fcm_geometry_destroy(&geom);
+  fcm_mesh_destroy(&mesh);
+  fcm_ctx_destroy(&ctx);
+  return rc;
+}
