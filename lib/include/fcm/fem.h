@@ -173,6 +173,23 @@ FCM_API fcm_status fcm_space_apply_dirichlet(const fcm_space *space, fcm_index n
 FCM_API fcm_status fcm_space_eval(const fcm_space *space, fcm_index cell, const double xi[3],
                                   const double *u, double value[3]);
 
+/** Locate physical points: for each X[i] the lowest-numbered active cell containing it
+ * (tolerance 1e-10 in reference coordinates) and its reference coordinates xi. A point in
+ * no active cell (an embedded surface vertex in a dropped cell, or outside the mesh) gets
+ * the active cell with the nearest bounding-box centre and xi outside the reference
+ * element: the field there is the polynomial extrapolation of that cell.
+ * @param[out] cell n cells; @param[out] xi n x 3; @param[out] extrapolated n flags or NULL
+ * @return FCM_OK, FCM_ERR_ARG, FCM_ERR_GEOMETRY (no active cell, degenerate cell),
+ * FCM_ERR_ALLOC. Allocates a search tree per call (do it once, then interpolate often). */
+FCM_API fcm_status fcm_space_locate(const fcm_space *space, fcm_index n, const double *X,
+                                    fcm_index *cell, double *xi, int *extrapolated);
+
+/** values[3i..3i+3) = sum_a N_a(xi_i) u_a in cell[i] (from fcm_space_locate()).
+ * @return FCM_OK, FCM_ERR_ARG (an inactive or out-of-range cell). No allocation. */
+FCM_API fcm_status fcm_space_interpolate(const fcm_space *space, fcm_index n,
+                                         const fcm_index *cell, const double *xi,
+                                         const double *u, double *values);
+
 #ifdef __cplusplus
 }
 #endif

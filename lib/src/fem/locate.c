@@ -1,0 +1,184 @@
+/* Locating physical points in the active cells of a space and evaluating the
+ * discrete field there; points outside every active cell (an embedded surface in
+ * a dropped cell) are extrapolated from the nearest active cell. */
+#include "fem/fem_impl.h"
+
+#include <math.h>
+#include <omp.h>
+#include <string.h>
+
+/* Whether xi lies in the reference element, with tolerance tol. */
+static int inside_reference(fcm_shape shape, const double xi[3], double tol)
+{
+  if (shape == FCM_SHAPE_TET)
+    return xi[0] >= -tol && xi[1] >= -tol && xi[2] >= -tol && xi[0] + xi[1] + xi[2] <= 1 + tol;
+  return fabs(xi[0]) <= 1 + tol && fabs(xi[1]) <= 1 + tol && fabs(xi[2]) <= 1 + tol;
+}
+
+enum { MAX_CANDIDATES = 256 };
+
+/* Locate one point: the lowest-numbered active cell containing it, else the active
+ * cell with the nearest centroid among those near it (extrapolated = 1). */
+static fcm_status locate_one(const fcm_space *s, const fcm_aabb_tree *tree,
+                             const fcm_index *tree_cell, const double *centroid, double reach,
+                             const double p[3], fcm_index *ids, fcm_index *cell, double xi[3],
+                             int *extrapolated)
+{
+  fcm_status st = FCM_OK;
+  double X[3 * FCM_ELEMENT_MAX_NODES];
+  fcm_index *many = NULL;
+  const fcm_element_info *info = fcm_element_get_info(s->type);
+  fcm_index count = 0;
+  FCM_TRY(s->ctx, fcm_aabb_tree_query(tree, p, p, MAX_CANDIDATES, ids, &count));
+  for (fcm_index k = 0; k < FCM_MIN(count, (fcm_index)MAX_CANDIDATES); k++) {
+    fcm_index c = tree_cell[ids[k]];
+    fcm_mesh_cell_coords(s->mesh, c, X);
+    if (fcm_element_inverse_map(NULL, s->type, X, p, xi) == FCM_OK &&
+        inside_reference(info->shape, xi, 1e-10)) {
+      *cell = c;
+      *extrapolated = 0;
+      goto cleanup;
+    }
+  }
+  /* not inside any active cell: the nearest centroid within a growing box */
+  for (double r = reach;; r *= 2.0) {
+    double lo[3] = {p[0] - r, p[1] - r, p[2] - r}, hi[3] = {p[0] + r, p[1] + r, p[2] + r};
+    FCM_TRY(s->ctx, fcm_aabb_tree_query(tree, lo, hi, MAX_CANDIDATES, ids, &count));
+    if (count == 0 && r < 1e6 * reach) continue;
+    FCM_CHECK(count > 0, s->ctx, FCM_ERR_GEOMETRY,
+              "locate: no active cell near the point (%g, %g, %g)", p[0], p[1], p[2]);
+    const fcm_index *cand = ids;
+    if (count > MAX_CANDIDATES) { /* a crowded box: fetch all of them */
+      FCM_ALLOC(s->ctx, count, many);
+      FCM_TRY(s->ctx, fcm_aabb_tree_query(tree, lo, hi, count, many, &count));
+      cand = many;
+    }
+    double best = HUGE_VAL;
+    for (fcm_index k = 0; k < count; k++) {
+      const double *cc = centroid + 3 * cand[k];
+      double d = (cc[0] - p[0]) * (cc[0] - p[0]) + (cc[1] - p[1]) * (cc[1] - p[1]) +
+                 (cc[2] - p[2]) * (cc[2] - p[2]);
+      if (d < best) best = d, *cell = tree_cell[cand[k]];
+    }
+    break;
+  }
+  fcm_mesh_cell_coords(s->mesh, *cell, X);
+  /* Newton outside a curved cell may not converge; then extrapolate with the map
+   * linearized at the reference centre: xi = xi_c + J(xi_c)^{-1} (p - x(xi_c)). */
+  if (fcm_element_inverse_map(NULL, s->type, X, p, xi) != FCM_OK) {
+    double xc[3], J[9], d[3];
+    double c0 = info->shape == FCM_SHAPE_TET ? 0.25 : 0.0, ref[3] = {c0, c0, c0};
+    fcm_element_map(s->type, X, ref, xc);
+    double det = fcm_element_jacobian(s->type, X, ref, J);
+    FCM_CHECK(det != 0.0, s->ctx, FCM_ERR_GEOMETRY, "locate: degenerate cell %lld",
+              (long long)*cell);
+    for (int k = 0; k < 3; k++) d[k] = p[k] - xc[k];
+    /* Cramer's rule on J dxi = d */
+    for (int k = 0; k < 3; k++) {
+      double Jk[9];
+      memcpy(Jk, J, sizeof Jk);
+      for (int i = 0; i < 3; i++) Jk[3 * i + k] = d[i];
+      double dk = Jk[0] * (Jk[4] * Jk[8] - Jk[5] * Jk[7]) - Jk[1] * (Jk[3] * Jk[8] - Jk[5] * Jk[6]) +
+                  Jk[2] * (Jk[3] * Jk[7] - Jk[4] * Jk[6]);
+      xi[k] = ref[k] + dk / det;
+    }
+  }
+  *extrapolated = 1;
+cleanup:
+  fcm__free(s->ctx, many);
+  return st;
+}
+
+fcm_status fcm_space_locate(const fcm_space *s, fcm_index n, const double *X, fcm_index *cell,
+                            double *xi, int *extrapolated)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  fcm_aabb_tree *tree = NULL;
+  double *boxes = NULL, *centroid = NULL;
+  fcm_index *tree_cell = NULL, *ids = NULL, nact = 0, failed = -1;
+  double reach = 0.0;
+  int nthreads = omp_get_max_threads();
+  FCM_CHECK(n >= 0 && (n == 0 || (X && cell && xi)), ctx, FCM_ERR_ARG,
+            "locate: n = %lld with NULL arrays", (long long)n);
+  for (fcm_index c = 0; c < s->num_cells; c++) nact += s->active[c];
+  FCM_ALLOC(ctx, 6 * nact, boxes);
+  FCM_ALLOC(ctx, 3 * nact, centroid);
+  FCM_ALLOC(ctx, nact, tree_cell);
+  FCM_ALLOC(ctx, (size_t)MAX_CANDIDATES * nthreads, ids);
+  {
+    double Xc[3 * FCM_ELEMENT_MAX_NODES];
+    fcm_index k = 0;
+    for (fcm_index c = 0; c < s->num_cells; c++) {
+      if (!s->active[c]) continue;
+      double *b = boxes + 6 * k;
+      fcm_mesh_cell_coords(s->mesh, c, Xc);
+      for (int d = 0; d < 3; d++) b[d] = HUGE_VAL, b[3 + d] = -HUGE_VAL;
+      for (int a = 0; a < s->nn; a++)
+        for (int d = 0; d < 3; d++) {
+          b[d] = fmin(b[d], Xc[3 * a + d]);
+          b[3 + d] = fmax(b[3 + d], Xc[3 * a + d]);
+        }
+      for (int d = 0; d < 3; d++) {
+        centroid[3 * k + d] = 0.5 * (b[d] + b[3 + d]);
+        reach = fmax(reach, b[3 + d] - b[d]);
+      }
+      tree_cell[k++] = c;
+    }
+  }
+  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nact, boxes, &tree));
+#pragma omp parallel num_threads(nthreads)
+  {
+    fcm_index *my_ids = ids + (size_t)MAX_CANDIDATES * omp_get_thread_num();
+#pragma omp for schedule(dynamic, 64)
+    for (fcm_index i = 0; i < n; i++) {
+      int ex = 0;
+      if (locate_one(s, tree, tree_cell, centroid, reach, X + 3 * i, my_ids, cell + i, xi + 3 * i,
+                     &ex) != FCM_OK) {
+#pragma omp critical(fcm_locate)
+        if (failed < 0 || i < failed) failed = i;
+        continue;
+      }
+      if (extrapolated) extrapolated[i] = ex;
+    }
+  }
+  FCM_CHECK(failed < 0, ctx, FCM_ERR_GEOMETRY, "locate: point %lld (%g, %g, %g) has no cell",
+            (long long)failed, X[3 * failed], X[3 * failed + 1], X[3 * failed + 2]);
+cleanup:
+  fcm_aabb_tree_destroy(&tree);
+  fcm__free(ctx, boxes);
+  fcm__free(ctx, centroid);
+  fcm__free(ctx, tree_cell);
+  fcm__free(ctx, ids);
+  return st;
+}
+
+fcm_status fcm_space_interpolate(const fcm_space *s, fcm_index n, const fcm_index *cell,
+                                 const double *xi, const double *u, double *values)
+{
+  fcm_status st = FCM_OK;
+  fcm_index bad = -1;
+  FCM_CHECK(n >= 0 && (n == 0 || (cell && xi && u && values)), s->ctx, FCM_ERR_ARG,
+            "interpolate: n = %lld with NULL arrays", (long long)n);
+#pragma omp parallel for schedule(static)
+  for (fcm_index i = 0; i < n; i++) {
+    fcm_index c = cell[i];
+    if (c < 0 || c >= s->num_cells || !s->active[c]) {
+#pragma omp critical(fcm_interpolate)
+      if (bad < 0 || i < bad) bad = i;
+      continue;
+    }
+    double N[FCM_ELEMENT_MAX_NODES], v[3] = {0, 0, 0};
+    fcm_element_eval_shape(s->type, xi + 3 * i, N);
+    const fcm_index *cn = fcm_mesh_cells(s->mesh) + c * s->nn;
+    for (int a = 0; a < s->nn; a++) {
+      const double *ua = u + s->node_dof[cn[a]];
+      for (int d = 0; d < 3; d++) v[d] += N[a] * ua[d];
+    }
+    memcpy(values + 3 * i, v, sizeof v);
+  }
+  FCM_CHECK(bad < 0, s->ctx, FCM_ERR_ARG, "interpolate: point %lld names cell %lld, which is "
+            "out of range or inactive", (long long)bad, (long long)cell[bad]);
+cleanup:
+  return st;
+}
