@@ -1,1 +1,1 @@
-list(APPEND FCM_SOURCES)
+list(APPEND FCM_SOURCES lib/src/sim/integrator.c lib/src/sim/newton.c lib/src/sim/linsolve.c)

@@ -1,0 +1,304 @@
+/* fcm — time integration of hyperelastic solids on a space (DESIGN §8): static Newton with
+ * load steps and backward Euler on the incremental potential, Newton with a backtracking
+ * line search on the energy, the stopping rule of Longva et al. (2020) §6, optional Rayleigh
+ * damping, prescribed motion of node sets, direct (CHOLMOD -> UMFPACK) or Krylov solves.
+ *
+ * Phases: fcm_integrator_create() -> configure (fcm_integrator_add_*, set_state) ->
+ * fcm_integrator_setup() (assembles the mass and the loads, allocates everything, analyzes
+ * the matrix) -> fcm_integrator_step() many times -> fcm_integrator_destroy().
+ *
+ * Backward Euler (unknown u = u_{n+1}, step h, D the damping matrix):
+ *   E(u) = 1/2 (u - u^)^T M (u - u^)/h^2 + Psi(u) - f_ext(t_{n+1})^T u
+ *          + 1/(2h) (u - u_n)^T D (u - u_n),     u^ = u_n + h v_n,
+ *   v_{n+1} = (u_{n+1} - u_n)/h. Its gradient is M v' - f_total (v' = (v_{n+1} - v_n)/h).
+ * Rayleigh damping C = alpha_M M + beta_K K is linearized as D = alpha_M M + beta_K K+(u_n):
+ * the tangent at the start of the (sub)step, projected to positive semi-definite and held
+ * fixed during the step, so the damping force D v_{n+1} derives from the quadratic term above
+ * (the Newton system stays symmetric, the line search sees a true energy, and D >= 0
+ * dissipates). Static: E(u) = Psi(u) - f_ext^T u. */
+#ifndef FCM_SIM_H
+#define FCM_SIM_H
+
+#include "fcm/core.h"
+#include "fcm/fem.h"
+#include "fcm/la.h"
+#include "fcm/material.h"
+#include "fcm/solve.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Integrator kinds. */
+typedef enum fcm_integrator_kind {
+  FCM_INTEGRATOR_STATIC = 0,        /**< equilibrium Psi'(u) = f_ext, load steps, no inertia */
+  FCM_INTEGRATOR_BACKWARD_EULER = 1 /**< implicit Euler on the incremental potential */
+} fcm_integrator_kind;
+
+/** Newton stopping rules (g = gradient of E restricted to the free DOFs, 2-norm). */
+typedef enum fcm_newton_tolerance {
+  /** ||g|| <= tol ||M a_rep|| (Longva et al. §6: ||M v' - f_total|| <= 1e-5 ||M a_rep||);
+   * a_rep is a uniform acceleration of magnitude rep_acceleration (M with free rows). */
+  FCM_NEWTON_TOL_REPRESENTATIVE = 0,
+  /** ||g|| <= max(tol R, atol), R = max(||g|| at the start of the Newton solve,
+   * ||f_int||, ||f_ext||) at the current iterate (force scale of the balance). */
+  FCM_NEWTON_TOL_RELATIVE = 1
+} fcm_newton_tolerance;
+
+/** Linear solver of the Newton systems. */
+typedef enum fcm_linear_solver {
+  FCM_LINEAR_DIRECT = 0, /**< CHOLMOD; on "not positive definite" UMFPACK */
+  FCM_LINEAR_CG = 1,     /**< preconditioned CG (SPD systems) */
+  FCM_LINEAR_MINRES = 2  /**< preconditioned MINRES (symmetric, possibly indefinite) */
+} fcm_linear_solver;
+
+/** Preconditioner of the Krylov solvers. */
+typedef enum fcm_preconditioner {
+  FCM_PRECOND_NONE = 0,
+  FCM_PRECOND_JACOBI = 1,       /**< inverse |diagonal| */
+  FCM_PRECOND_BLOCK_JACOBI = 2, /**< inverse nodal 3x3 blocks */
+  FCM_PRECOND_SCHWARZ = 3       /**< additive Schwarz on cut cells with phi < schwarz_theta */
+} fcm_preconditioner;
+
+/** A Newton iteration as reported to the monitor. */
+typedef struct fcm_newton_event {
+  double time;            /**< end time of the (sub)step being solved */
+  int iteration;          /**< 0: the initial guess; k: after the k-th update */
+  double residual;        /**< ||g|| on the free DOFs */
+  double tolerance;       /**< the threshold of the stopping rule */
+  double energy;          /**< E(u) of the (sub)step */
+  double step_length;     /**< line-search factor of the update (0 at iteration 0) */
+  int linear_iterations;  /**< Krylov iterations of the update (0: direct or iteration 0) */
+  int constraints_met;    /**< 1 when every constrained DOF sits on its prescribed value */
+} fcm_newton_event;
+
+/** Monitor callback, called after every Newton iteration (must not call the integrator). */
+typedef void (*fcm_newton_monitor_fn)(void *user, const fcm_newton_event *event);
+
+/** Options; initialize with fcm_integrator_options_default(). */
+typedef struct fcm_integrator_options {
+  fcm_integrator_kind kind;   /**< default BACKWARD_EULER */
+  double dt;                  /**< step > 0: time step, or the pseudo-time of a static step
+                                   (default 1/60) */
+  int load_steps;             /**< static: increments per step, >= 1 (default 1) */
+  int max_halvings;           /**< retries of a failed (sub)step with half the increment,
+                                   0..20 (default 4) */
+  int newton_max_iterations;  /**< >= 1 (default 100) */
+  fcm_newton_tolerance tolerance_mode; /**< default FCM_NEWTON_TOL_REPRESENTATIVE */
+  double newton_tolerance;    /**< tol in (0, 1) (default 1e-5) */
+  double newton_atol;         /**< RELATIVE mode: absolute floor >= 0 (default 0) */
+  double rep_acceleration;    /**< |a_rep| >= 0 in m/s^2; 0 (default): the magnitude of the
+                                   first gravity load, or 9.81 without gravity. Its direction
+                                   is that gravity's, else (1, 1, 1)/sqrt 3 */
+  int line_search;            /**< 1 (default): backtracking on E; 0: full Newton steps */
+  double armijo;              /**< sufficient decrease c in (0, 0.5) (default 1e-4) */
+  double backtrack;           /**< step factor in (0, 1) (default 0.5) */
+  int max_backtracks;         /**< >= 0 (default 20) */
+  int project_psd;            /**< 1: PSD-projected element tangents (default 0). Without it,
+                                   a non-descent Newton direction is recomputed once with the
+                                   projected tangent (counted as a projection fallback) */
+  fcm_linear_solver linear_solver;  /**< default FCM_LINEAR_DIRECT */
+  fcm_direct_method direct_method;  /**< first direct method (default CHOLMOD; UMFPACK: LU only) */
+  fcm_preconditioner preconditioner; /**< Krylov only (default JACOBI) */
+  double krylov_rtol;         /**< in [0, 1) (default 1e-8) */
+  double krylov_atol;         /**< >= 0 (default 0) */
+  int krylov_max_iterations;  /**< >= 1 (default 1000) */
+  double schwarz_theta;       /**< cut cells with volume fraction below it get a block, (0, 1]
+                                   (default 0.5) */
+  fcm_schwarz_options schwarz; /**< default fcm_schwarz_options_default() */
+  double rayleigh_mass;       /**< alpha_M >= 0 in 1/s (default 0) */
+  double rayleigh_stiffness;  /**< beta_K >= 0 in s (default 0) */
+  fcm_assembly_options assembly; /**< strengths on full cells (default element defaults) */
+  fcm_newton_monitor_fn monitor; /**< NULL (default) or a callback */
+  void *monitor_user;
+} fcm_integrator_options;
+
+/** The defaults listed on each member. */
+FCM_API fcm_integrator_options fcm_integrator_options_default(void);
+
+/** Why a step ended (the reason of the last attempt). */
+typedef enum fcm_step_reason {
+  FCM_STEP_NONE = 0,             /**< no step taken */
+  FCM_STEP_CONVERGED,            /**< the stopping rule holds and the constraints are met */
+  FCM_STEP_MAX_NEWTON,           /**< newton_max_iterations reached */
+  FCM_STEP_LINE_SEARCH_FAILED,   /**< no sufficient decrease in max_backtracks halvings, or
+                                      no descent direction */
+  FCM_STEP_LINEAR_SOLVER_FAILED, /**< direct: both factorizations failed; Krylov: no usable
+                                      iterate */
+  FCM_STEP_NONFINITE             /**< NaN/Inf in a load, the energy, the gradient or a solve */
+} fcm_step_reason;
+
+/** Name of a reason ("converged", "max-newton", "line-search-failed",
+ * "linear-solver-failed", "nonfinite", "none"), or "unknown". Static string. */
+FCM_API const char *fcm_step_reason_str(fcm_step_reason reason);
+
+/** What one fcm_integrator_step() did. Per-step counts cover every attempt of the step;
+ * total_* are cumulative since setup. */
+typedef struct fcm_step_info {
+  fcm_step_reason reason;      /**< CONVERGED on success; else the last failure */
+  int newton_iterations;       /**< Newton updates (all attempts) */
+  int line_search_backtracks;  /**< step-length halvings */
+  long long linear_iterations; /**< Krylov iterations (0 with the direct solver) */
+  double residual;             /**< final ||g|| of the last attempt */
+  double tolerance;            /**< its threshold */
+  double dt;                   /**< length of the last (sub)step: time (dynamics) or
+                                    pseudo-time (static) */
+  int halvings;                /**< halvings needed (0: the step went through at once) */
+  int substeps;                /**< accepted (sub)steps (static: load increments) */
+  int failed_attempts;         /**< (sub)step attempts that were rejected */
+  double time;                 /**< time after the step (unchanged on failure) */
+  double kinetic_energy;       /**< 1/2 v^T M v (0 for static) */
+  double elastic_energy;       /**< Psi(u) */
+  double external_work;        /**< f_ext(t)^T u */
+  double total_energy;         /**< kinetic + elastic - external work */
+  int tangent_assemblies;      /**< tangent assemblies (Newton and damping matrices) */
+  int factorizations;          /**< numeric factorizations or preconditioner setups */
+  int direct_fallbacks;        /**< CHOLMOD "not positive definite" -> UMFPACK */
+  int projection_fallbacks;    /**< non-descent directions recomputed with PSD tangents */
+  int inexact_solves;          /**< Krylov solves stopped early whose iterate was used */
+  long long total_analyses;        /**< symbolic analyses (CHOLMOD and UMFPACK) */
+  long long total_factorizations;  /**< numeric factorizations / preconditioner setups */
+  long long total_direct_fallbacks;
+  double time_assembly;        /**< seconds: energy, force, tangent and damping assembly */
+  double time_factor;          /**< seconds: factorization or preconditioner setup */
+  double time_solve;           /**< seconds: triangular or Krylov solves */
+  double time_total;           /**< seconds of the whole step */
+} fcm_step_info;
+
+/** A scalar function of time, e.g. the time scaling of a load. */
+typedef double (*fcm_time_fn)(void *user, double t);
+
+/** Prescribed motion of a node set: with tau = clamp(t - start, 0, end - start), a node with
+ * reference position X is at x(t) = c + R(axis, angular_speed tau) (X - c) + velocity tau
+ * (R: right-handed rotation about the unit axis through the centre c), i.e.
+ * u = x(t) - X. After `end` the nodes are held, or free when `release` is set. Only the
+ * components with components[i] != 0 are constrained. fcm_motion_default(): fixed (u = 0). */
+typedef struct fcm_motion {
+  double velocity[3];   /**< translation velocity (default 0) */
+  double center[3];     /**< a point of the rotation axis (default 0) */
+  double axis[3];       /**< rotation axis, normalized by the integrator (default (0, 0, 1)) */
+  double angular_speed; /**< rad/s, sign by the right-hand rule (default 0) */
+  double start;         /**< motion starts (default 0) */
+  double end;           /**< motion stops, >= start (default HUGE_VAL) */
+  int release;          /**< 1: unconstrained after end (default 0: held) */
+  int components[3];    /**< constrained components (default all 1) */
+} fcm_motion;
+
+/** A fixed motion: all components held at the reference position. */
+FCM_API fcm_motion fcm_motion_default(void);
+
+/** Prescribed displacement u (3) and velocity v (3, may be NULL) of the reference point X
+ * under `motion` at time t (any axis length; a zero axis means no rotation). Pure. */
+FCM_API void fcm_motion_eval(const fcm_motion *motion, const double X[3], double t, double u[3],
+                             double v[3]);
+
+/** An integrator on a space (opaque). */
+typedef struct fcm_integrator fcm_integrator;
+
+/** Create an integrator with zero displacement and velocity at t = 0.
+ * @param[in]  ctx   context; must outlive the integrator
+ * @param[in]  space borrowed (plain or embedded); must outlive the integrator. Assembly
+ *                   writes per-cell scratch into it: one integrator per space at a time
+ * @param[in]  mat   the material (copied; validated here)
+ * @param[in]  opts  copied; NULL for defaults (validated by fcm_integrator_setup())
+ * @param[out] integ the new integrator, NULL on failure
+ * @return FCM_OK, FCM_ERR_ARG (NULL, invalid material), FCM_ERR_ALLOC. Allocates O(n). */
+FCM_API fcm_status fcm_integrator_create(fcm_ctx *ctx, fcm_space *space, const fcm_material *mat,
+                                         const fcm_integrator_options *opts,
+                                         fcm_integrator **integ);
+
+/** Destroy; accepts NULL and `*integ == NULL`, sets `*integ = NULL`. */
+FCM_API void fcm_integrator_destroy(fcm_integrator **integ);
+
+/** Add gravity: body force rho a, times scale(t) when `scale` is given (else 1). Before
+ * setup. @return FCM_OK, FCM_ERR_ARG (non-finite a, after setup), FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_integrator_add_gravity(fcm_integrator *integ, const double accel[3],
+                                              fcm_time_fn scale, void *scale_user);
+
+/** Add a body force density b(x) (force per volume; fcm_assemble_body_force_field()),
+ * times scale(t). `user` must outlive the setup. Before setup. Codes as above. */
+FCM_API fcm_status fcm_integrator_add_body_force(fcm_integrator *integ, fcm_field_fn field,
+                                                 void *user, fcm_time_fn scale, void *scale_user);
+
+/** Add a surface traction t(x, n) on the embedded boundary (fcm_assemble_surface_traction();
+ * the space needs surface rules), times scale(t). Before setup. Codes as above. */
+FCM_API fcm_status fcm_integrator_add_traction(fcm_integrator *integ, fcm_field_fn traction,
+                                               void *user, fcm_time_fn scale, void *scale_user);
+
+/** Prescribe the motion of `num_nodes` mesh nodes (copied; nodes without DOFs, e.g. of
+ * dropped cells, are skipped). A DOF may belong to one constraint only (checked at setup).
+ * Before setup. @param[out] id the constraint's index (may be NULL)
+ * @return FCM_OK, FCM_ERR_ARG (node out of range, bad motion: the message names the member),
+ * FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_integrator_add_constraint(fcm_integrator *integ, fcm_index num_nodes,
+                                                 const fcm_index *nodes, const fcm_motion *motion,
+                                                 int *id);
+
+/** Validate the options, build the constrained DOF list, assemble the mass matrix and the
+ * loads, allocate every work array and solver, and run the symbolic analysis (direct).
+ * Constrained DOFs get their prescribed velocity at the current time.
+ * @return FCM_OK, FCM_ERR_ARG (option out of range: named; DOF constrained twice; zero
+ * representative force: set the density or use the relative rule), errors of the assembly
+ * and of the solvers, FCM_ERR_ALLOC. Allocates; a second call is FCM_ERR_ARG. */
+FCM_API fcm_status fcm_integrator_setup(fcm_integrator *integ);
+
+/** Advance by one step of options.dt (static: solve the equilibrium at t + dt, ramping the
+ * loads from those of the last accepted step — zero before the first — in load_steps
+ * increments). A failed (sub)step is retried from its start with half the increment, at
+ * most max_halvings times. On failure the state (u, v, t, step count) stays at the last
+ * accepted step. No allocation by the integrator itself after setup (the assembly and
+ * the first UMFPACK fallback allocate).
+ * @param[out] info may be NULL
+ * @return FCM_OK; FCM_ERR_NOT_CONVERGED (info->reason says why; the message gives the time,
+ * the residual and the tolerance); FCM_ERR_NUMERIC (NaN/Inf in a load, or the last attempt
+ * met NaN/Inf); FCM_ERR_ARG (not set up); FCM_ERR_ALLOC and other hard errors. */
+FCM_API fcm_status fcm_integrator_step(fcm_integrator *integ, fcm_step_info *info);
+
+/** Number of DOFs (the length of u and v). */
+FCM_API fcm_index fcm_integrator_num_dofs(const fcm_integrator *integ);
+/** Current time and number of accepted steps. */
+FCM_API double fcm_integrator_time(const fcm_integrator *integ);
+FCM_API long long fcm_integrator_step_count(const fcm_integrator *integ);
+/** Borrowed views of the current displacement and velocity (num_dofs entries, valid until
+ * the next call that changes the state). */
+FCM_API const double *fcm_integrator_displacement(const fcm_integrator *integ);
+FCM_API const double *fcm_integrator_velocity(const fcm_integrator *integ);
+/** Number of constrained DOFs (after setup; 0 before). */
+FCM_API fcm_index fcm_integrator_num_constrained(const fcm_integrator *integ);
+
+/** Copy the state out (checkpoint): u, v (num_dofs each, either may be NULL), t, steps
+ * (may be NULL). */
+FCM_API void fcm_integrator_get_state(const fcm_integrator *integ, double *u, double *v,
+                                      double *t, long long *steps);
+
+/** Replace the state (resume, initial conditions): u and v copied (either may be NULL to
+ * keep it), time t and step count. Invalidates cached tangents; for static integrators the
+ * load of the last accepted step becomes f_ext(t) (zero when steps == 0).
+ * @return FCM_OK, FCM_ERR_ARG (non-finite entry: named), errors of the load evaluation. */
+FCM_API fcm_status fcm_integrator_set_state(fcm_integrator *integ, const double *u,
+                                            const double *v, double t, long long steps);
+
+/** Set a rigid initial velocity v = v0 + omega x (X + u - c) at every node (v0, omega, c:
+ * 3 each; NULL means zero). @return FCM_OK, FCM_ERR_ARG (non-finite). */
+FCM_API fcm_status fcm_integrator_set_rigid_velocity(fcm_integrator *integ, const double v0[3],
+                                                     const double omega[3], const double c[3]);
+
+/** Energies of the current state: kinetic 1/2 v^T M v (0 for static), elastic Psi(u) and
+ * external work f_ext(t)^T u; any output may be NULL. After setup. Assembles Psi.
+ * @return FCM_OK, FCM_ERR_ARG (not set up), FCM_ERR_NUMERIC, errors of the assembly. */
+FCM_API fcm_status fcm_integrator_energy(fcm_integrator *integ, double *kinetic, double *elastic,
+                                         double *external_work);
+
+/** Linear momentum p = sum over nodes of (M v)_a and angular momentum about the origin
+ * L = sum (X_a + u_a) x (M v)_a (exact for the interpolated fields with the consistent
+ * mass). Either output may be NULL. After setup. @return FCM_OK, FCM_ERR_ARG. */
+FCM_API fcm_status fcm_integrator_momentum(fcm_integrator *integ, double linear[3],
+                                           double angular[3]);
+
+/** The mass matrix (after setup; borrowed; NULL before). */
+FCM_API const fcm_csr *fcm_integrator_mass(const fcm_integrator *integ);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* FCM_SIM_H */

@@ -1,0 +1,674 @@
+/* sim: the integrator object — options, loads, prescribed motions, state get/set, setup
+ * (mass and load assembly, constrained DOF lists, solver creation), energies, momentum. */
+#include "sim/sim_impl.h"
+
+#include <math.h>
+#include <string.h>
+
+fcm_integrator_options fcm_integrator_options_default(void)
+{
+  fcm_integrator_options o;
+  memset(&o, 0, sizeof o);
+  o.kind = FCM_INTEGRATOR_BACKWARD_EULER;
+  o.dt = 1.0 / 60.0;
+  o.load_steps = 1;
+  o.max_halvings = 4;
+  o.newton_max_iterations = 100;
+  o.tolerance_mode = FCM_NEWTON_TOL_REPRESENTATIVE;
+  o.newton_tolerance = 1e-5;
+  o.newton_atol = 0.0;
+  o.rep_acceleration = 0.0;
+  o.line_search = 1;
+  o.armijo = 1e-4;
+  o.backtrack = 0.5;
+  o.max_backtracks = 20;
+  o.project_psd = 0;
+  o.linear_solver = FCM_LINEAR_DIRECT;
+  o.direct_method = FCM_DIRECT_CHOLMOD;
+  o.preconditioner = FCM_PRECOND_JACOBI;
+  o.krylov_rtol = 1e-8;
+  o.krylov_atol = 0.0;
+  o.krylov_max_iterations = 1000;
+  o.schwarz_theta = 0.5;
+  o.schwarz = fcm_schwarz_options_default();
+  o.assembly = fcm_assembly_options_default();
+  return o;
+}
+
+const char *fcm_step_reason_str(fcm_step_reason reason)
+{
+  switch (reason) {
+  case FCM_STEP_NONE: return "none";
+  case FCM_STEP_CONVERGED: return "converged";
+  case FCM_STEP_MAX_NEWTON: return "max-newton";
+  case FCM_STEP_LINE_SEARCH_FAILED: return "line-search-failed";
+  case FCM_STEP_LINEAR_SOLVER_FAILED: return "linear-solver-failed";
+  case FCM_STEP_NONFINITE: return "nonfinite";
+  }
+  return "unknown";
+}
+
+fcm_motion fcm_motion_default(void)
+{
+  fcm_motion m;
+  memset(&m, 0, sizeof m);
+  m.axis[2] = 1.0;
+  m.end = HUGE_VAL;
+  m.components[0] = m.components[1] = m.components[2] = 1;
+  return m;
+}
+
+void fcm_motion_eval(const fcm_motion *m, const double X[3], double t, double u[3], double v[3])
+{
+  double span = m->end - m->start, tau = t - m->start;
+  if (!(tau > 0.0)) tau = 0.0;
+  if (tau > span) tau = span;
+  double a[3] = {m->axis[0], m->axis[1], m->axis[2]};
+  double an = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+  double r[3], rr[3];
+  for (int i = 0; i < 3; i++) r[i] = X[i] - m->center[i];
+  if (an > 0.0 && m->angular_speed != 0.0) {
+    for (int i = 0; i < 3; i++) a[i] /= an;
+    double phi = m->angular_speed * tau, c = cos(phi), s = sin(phi);
+    double ar = a[0] * r[0] + a[1] * r[1] + a[2] * r[2];
+    double axr[3] = {a[1] * r[2] - a[2] * r[1], a[2] * r[0] - a[0] * r[2], a[0] * r[1] - a[1] * r[0]};
+    for (int i = 0; i < 3; i++) rr[i] = c * r[i] + s * axr[i] + (1.0 - c) * ar * a[i];
+  } else {
+    an = 0.0;
+    memcpy(rr, r, sizeof rr);
+  }
+  /* u = (R r - r) + velocity tau: exactly the translation when there is no rotation. */
+  for (int i = 0; i < 3; i++) u[i] = (rr[i] - r[i]) + m->velocity[i] * tau;
+  if (v) {
+    int moving = t >= m->start && t < m->end;
+    for (int i = 0; i < 3; i++) v[i] = moving ? m->velocity[i] : 0.0;
+    if (moving && an > 0.0) {
+      double w = m->angular_speed;
+      v[0] += w * (a[1] * rr[2] - a[2] * rr[1]);
+      v[1] += w * (a[2] * rr[0] - a[0] * rr[2]);
+      v[2] += w * (a[0] * rr[1] - a[1] * rr[0]);
+    }
+  }
+}
+
+fcm_status fcm_integrator_create(fcm_ctx *ctx, fcm_space *space, const fcm_material *mat,
+                                 const fcm_integrator_options *opts, fcm_integrator **integ)
+{
+  fcm_status st = FCM_OK;
+  fcm_integrator *I = NULL;
+  FCM_CHECK(integ, ctx, FCM_ERR_ARG, "integrator: output pointer is NULL");
+  *integ = NULL;
+  FCM_CHECK(space && mat, ctx, FCM_ERR_ARG, "integrator: NULL space or material");
+  FCM_ALLOC(ctx, 1, I);
+  I->ctx = ctx;
+  I->space = space;
+  I->mat = *mat;
+  I->opts = opts ? *opts : fcm_integrator_options_default();
+  FCM_TRY(ctx, fcm_material_setup(ctx, mat, &I->params));
+  I->params_psd = I->params;
+  I->params_psd.project_psd = 1;
+  I->params.project_psd = I->opts.project_psd ? 1 : 0;
+  I->linear = mat->model == FCM_MATERIAL_LINEAR;
+  I->n = fcm_space_num_dofs(space);
+  FCM_ALLOC(ctx, I->n, I->u);
+  FCM_ALLOC(ctx, I->n, I->v);
+  FCM_ALLOC(ctx, I->n, I->load_prev);
+  *integ = I;
+  I = NULL;
+cleanup:
+  fcm_integrator_destroy(&I);
+  return st;
+}
+
+void fcm_integrator_destroy(fcm_integrator **integ)
+{
+  if (!integ || !*integ) return;
+  fcm_integrator *I = *integ;
+  fcm_ctx *ctx = I->ctx;
+  for (int k = 0; k < I->num_loads; k++) fcm__free(ctx, I->loads[k].f);
+  fcm__free(ctx, I->loads);
+  for (int k = 0; k < I->num_cons; k++) fcm__free(ctx, I->cons[k].nodes);
+  fcm__free(ctx, I->cons);
+  double **vecs[] = {&I->u,   &I->v,    &I->load_prev, &I->act_val, &I->act_inc, &I->Ma,
+                     &I->u_bak, &I->v_bak, &I->lp_bak,  &I->un,      &I->uhat,    &I->fext,
+                     &I->fend,  &I->fint,  &I->g,       &I->d,       &I->b,       &I->ut,
+                     &I->fint_t, &I->g_t,  &I->w1,      &I->w2};
+  for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; k++) FCM_FREE(ctx, *vecs[k]);
+  fcm__free(ctx, I->con_dof);
+  fcm__free(ctx, I->con_node);
+  fcm__free(ctx, I->con_comp);
+  fcm__free(ctx, I->con_id);
+  fcm__free(ctx, I->is_con);
+  fcm__free(ctx, I->con_on);
+  fcm__free(ctx, I->act_dof);
+  fcm__free(ctx, I->schwarz_flag);
+  fcm_csr_destroy(&I->M);
+  fcm_csr_destroy(&I->H);
+  fcm_csr_destroy(&I->D);
+  fcm_csr_destroy(&I->H0);
+  fcm_direct_destroy(&I->chol);
+  fcm_direct_destroy(&I->umf);
+  fcm_krylov_destroy(&I->krylov);
+  fcm_jacobi_destroy(&I->jacobi);
+  fcm_schwarz_destroy(&I->schwarz);
+  fcm__free(ctx, I);
+  *integ = NULL;
+}
+
+static fcm_status add_load(fcm_integrator *I, const sim_load *load)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(!I->is_setup, I->ctx, FCM_ERR_ARG,
+            "integrator: loads must be added before fcm_integrator_setup()");
+  FCM_TRY(I->ctx, fcm__resize(I->ctx, (void **)&I->loads, (size_t)I->num_loads,
+                              (size_t)I->num_loads + 1, sizeof *I->loads));
+  I->loads[I->num_loads++] = *load;
+cleanup:
+  return st;
+}
+
+fcm_status fcm_integrator_add_gravity(fcm_integrator *I, const double accel[3], fcm_time_fn scale,
+                                      void *scale_user)
+{
+  fcm_status st = FCM_OK;
+  sim_load l;
+  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
+  FCM_CHECK(accel, I->ctx, FCM_ERR_ARG, "integrator: gravity is NULL");
+  FCM_CHECK(isfinite(accel[0]) && isfinite(accel[1]) && isfinite(accel[2]), I->ctx, FCM_ERR_ARG,
+            "integrator: gravity (%g, %g, %g) is not finite", accel[0], accel[1], accel[2]);
+  memset(&l, 0, sizeof l);
+  l.kind = SIM_LOAD_GRAVITY;
+  memcpy(l.accel, accel, sizeof l.accel);
+  l.scale = scale;
+  l.scale_user = scale_user;
+  FCM_TRY(I->ctx, add_load(I, &l));
+cleanup:
+  return st;
+}
+
+static fcm_status add_field_load(fcm_integrator *I, sim_load_kind kind, fcm_field_fn field,
+                                 void *user, fcm_time_fn scale, void *scale_user)
+{
+  fcm_status st = FCM_OK;
+  sim_load l;
+  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
+  FCM_CHECK(field, I->ctx, FCM_ERR_ARG, "integrator: %s field is NULL",
+            kind == SIM_LOAD_BODY ? "body force" : "traction");
+  memset(&l, 0, sizeof l);
+  l.kind = kind;
+  l.field = field;
+  l.field_user = user;
+  l.scale = scale;
+  l.scale_user = scale_user;
+  FCM_TRY(I->ctx, add_load(I, &l));
+cleanup:
+  return st;
+}
+
+fcm_status fcm_integrator_add_body_force(fcm_integrator *I, fcm_field_fn field, void *user,
+                                         fcm_time_fn scale, void *scale_user)
+{
+  return add_field_load(I, SIM_LOAD_BODY, field, user, scale, scale_user);
+}
+
+fcm_status fcm_integrator_add_traction(fcm_integrator *I, fcm_field_fn traction, void *user,
+                                       fcm_time_fn scale, void *scale_user)
+{
+  return add_field_load(I, SIM_LOAD_TRACTION, traction, user, scale, scale_user);
+}
+
+static int finite3(const double a[3]) { return isfinite(a[0]) && isfinite(a[1]) && isfinite(a[2]); }
+
+fcm_status fcm_integrator_add_constraint(fcm_integrator *I, fcm_index num_nodes,
+                                         const fcm_index *nodes, const fcm_motion *motion, int *id)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *copy = NULL;
+  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
+  fcm_ctx *ctx = I->ctx;
+  FCM_CHECK(!I->is_setup, ctx, FCM_ERR_ARG,
+            "integrator: constraints must be added before fcm_integrator_setup()");
+  FCM_CHECK(motion && num_nodes >= 0 && (num_nodes == 0 || nodes), ctx, FCM_ERR_ARG,
+            "constraint %d: NULL motion or node list, or num_nodes = %lld < 0", I->num_cons,
+            (long long)num_nodes);
+  FCM_CHECK(finite3(motion->velocity) && finite3(motion->center) && finite3(motion->axis) &&
+                isfinite(motion->angular_speed),
+            ctx, FCM_ERR_ARG, "constraint %d: velocity, center, axis or angular_speed not finite",
+            I->num_cons);
+  FCM_CHECK(isfinite(motion->start) && !isnan(motion->end) && motion->end >= motion->start, ctx,
+            FCM_ERR_ARG, "constraint %d: end = %g must be >= start = %g (start finite)",
+            I->num_cons, motion->end, motion->start);
+  FCM_CHECK(motion->angular_speed == 0.0 || (motion->axis[0] != 0.0 || motion->axis[1] != 0.0 ||
+                                             motion->axis[2] != 0.0),
+            ctx, FCM_ERR_ARG, "constraint %d: rotation with a zero axis", I->num_cons);
+  {
+    fcm_index nn = fcm_mesh_num_nodes(fcm_space_mesh(I->space));
+    for (fcm_index k = 0; k < num_nodes; k++)
+      FCM_CHECK(nodes[k] >= 0 && nodes[k] < nn, ctx, FCM_ERR_ARG,
+                "constraint %d: nodes[%lld] = %lld out of range [0, %lld)", I->num_cons,
+                (long long)k, (long long)nodes[k], (long long)nn);
+  }
+  FCM_ALLOC(ctx, num_nodes, copy);
+  if (num_nodes > 0) memcpy(copy, nodes, sizeof *copy * (size_t)num_nodes);
+  FCM_TRY(ctx, fcm__resize(ctx, (void **)&I->cons, (size_t)I->num_cons, (size_t)I->num_cons + 1,
+                           sizeof *I->cons));
+  {
+    sim_constraint *c = &I->cons[I->num_cons];
+    c->motion = *motion;
+    double an = sqrt(motion->axis[0] * motion->axis[0] + motion->axis[1] * motion->axis[1] +
+                     motion->axis[2] * motion->axis[2]);
+    if (an > 0.0)
+      for (int i = 0; i < 3; i++) c->motion.axis[i] = motion->axis[i] / an;
+    for (int i = 0; i < 3; i++) c->motion.components[i] = motion->components[i] != 0;
+    c->num_nodes = num_nodes;
+    c->nodes = copy;
+    copy = NULL;
+  }
+  if (id) *id = I->num_cons;
+  I->num_cons++;
+cleanup:
+  if (copy) fcm__free(I->ctx, copy);
+  return st;
+}
+
+void fcm__sim_eval_loads(const fcm_integrator *I, double t, double *f)
+{
+  memset(f, 0, sizeof *f * (size_t)I->n);
+  for (int k = 0; k < I->num_loads; k++) {
+    const sim_load *l = &I->loads[k];
+    double s = l->scale ? l->scale(l->scale_user, t) : 1.0;
+    if (s == 0.0) continue; /* an absent load costs nothing; NaN still propagates below */
+    for (fcm_index i = 0; i < I->n; i++) f[i] += s * l->f[i];
+  }
+}
+
+void fcm__sim_eval_constraints(fcm_integrator *I, double t)
+{
+  const double *X = fcm_mesh_coords(fcm_space_mesh(I->space));
+  int changed = 0;
+  for (int k = 0; k < I->num_cons; k++) {
+    const fcm_motion *m = &I->cons[k].motion;
+    unsigned char on = !(m->release && t > m->end);
+    if (on != I->con_on[k]) changed = 1;
+    I->con_on[k] = on;
+  }
+  fcm_index j = 0;
+  for (fcm_index i = 0; i < I->ncon; i++) {
+    if (changed) I->is_con[I->con_dof[i]] = I->con_on[I->con_id[i]];
+    if (!I->con_on[I->con_id[i]]) continue;
+    double u[3];
+    fcm_motion_eval(&I->cons[I->con_id[i]].motion, X + 3 * I->con_node[i], t, u, NULL);
+    I->act_dof[j] = I->con_dof[i];
+    I->act_val[j] = u[I->con_comp[i]];
+    j++;
+  }
+  I->nact = j;
+  if (changed) I->con_version++;
+}
+
+/* Representative acceleration vector (uniform): magnitude and direction per the options. */
+static void rep_acceleration(const fcm_integrator *I, double a[3])
+{
+  const double *grav = NULL;
+  for (int k = 0; k < I->num_loads && !grav; k++)
+    if (I->loads[k].kind == SIM_LOAD_GRAVITY) {
+      const double *g = I->loads[k].accel;
+      if (g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0) grav = g;
+    }
+  double dir[3] = {1.0 / sqrt(3.0), 1.0 / sqrt(3.0), 1.0 / sqrt(3.0)}, mag = 9.81;
+  if (grav) {
+    double gn = sqrt(grav[0] * grav[0] + grav[1] * grav[1] + grav[2] * grav[2]);
+    for (int i = 0; i < 3; i++) dir[i] = grav[i] / gn;
+    mag = gn;
+  }
+  if (I->opts.rep_acceleration > 0.0) mag = I->opts.rep_acceleration;
+  for (int i = 0; i < 3; i++) a[i] = mag * dir[i];
+}
+
+static fcm_status validate_options(fcm_ctx *ctx, const fcm_integrator_options *o)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(o->kind == FCM_INTEGRATOR_STATIC || o->kind == FCM_INTEGRATOR_BACKWARD_EULER, ctx,
+            FCM_ERR_ARG, "integrator: kind = %d must be STATIC (0) or BACKWARD_EULER (1)",
+            (int)o->kind);
+  FCM_CHECK(isfinite(o->dt) && o->dt > 0.0, ctx, FCM_ERR_ARG,
+            "integrator: dt = %g must be positive and finite", o->dt);
+  FCM_CHECK(o->load_steps >= 1, ctx, FCM_ERR_ARG, "integrator: load_steps = %d must be >= 1",
+            o->load_steps);
+  FCM_CHECK(o->load_steps <= (1 << 20), ctx, FCM_ERR_ARG,
+            "integrator: load_steps = %d must be <= 2^20", o->load_steps);
+  FCM_CHECK(o->max_halvings >= 0 && o->max_halvings <= 20, ctx, FCM_ERR_ARG,
+            "integrator: max_halvings = %d outside [0, 20]", o->max_halvings);
+  FCM_CHECK(o->newton_max_iterations >= 1, ctx, FCM_ERR_ARG,
+            "integrator: newton_max_iterations = %d must be >= 1", o->newton_max_iterations);
+  FCM_CHECK(o->tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE ||
+                o->tolerance_mode == FCM_NEWTON_TOL_RELATIVE,
+            ctx, FCM_ERR_ARG, "integrator: tolerance_mode = %d must be 0 or 1",
+            (int)o->tolerance_mode);
+  FCM_CHECK(o->newton_tolerance > 0.0 && o->newton_tolerance < 1.0, ctx, FCM_ERR_ARG,
+            "integrator: newton_tolerance = %g outside (0, 1)", o->newton_tolerance);
+  FCM_CHECK(o->newton_atol >= 0.0 && isfinite(o->newton_atol), ctx, FCM_ERR_ARG,
+            "integrator: newton_atol = %g must be finite and >= 0", o->newton_atol);
+  FCM_CHECK(o->rep_acceleration >= 0.0 && isfinite(o->rep_acceleration), ctx, FCM_ERR_ARG,
+            "integrator: rep_acceleration = %g must be finite and >= 0", o->rep_acceleration);
+  FCM_CHECK(o->armijo > 0.0 && o->armijo < 0.5, ctx, FCM_ERR_ARG,
+            "integrator: armijo = %g outside (0, 0.5)", o->armijo);
+  FCM_CHECK(o->backtrack > 0.0 && o->backtrack < 1.0, ctx, FCM_ERR_ARG,
+            "integrator: backtrack = %g outside (0, 1)", o->backtrack);
+  FCM_CHECK(o->max_backtracks >= 0, ctx, FCM_ERR_ARG, "integrator: max_backtracks = %d must be >= 0",
+            o->max_backtracks);
+  FCM_CHECK(o->linear_solver >= FCM_LINEAR_DIRECT && o->linear_solver <= FCM_LINEAR_MINRES, ctx,
+            FCM_ERR_ARG, "integrator: linear_solver = %d outside [0, 2]", (int)o->linear_solver);
+  FCM_CHECK(o->direct_method == FCM_DIRECT_CHOLMOD || o->direct_method == FCM_DIRECT_UMFPACK, ctx,
+            FCM_ERR_ARG, "integrator: direct_method = %d must be CHOLMOD (0) or UMFPACK (1)",
+            (int)o->direct_method);
+  FCM_CHECK(o->preconditioner >= FCM_PRECOND_NONE && o->preconditioner <= FCM_PRECOND_SCHWARZ, ctx,
+            FCM_ERR_ARG, "integrator: preconditioner = %d outside [0, 3]", (int)o->preconditioner);
+  FCM_CHECK(o->krylov_rtol >= 0.0 && o->krylov_rtol < 1.0, ctx, FCM_ERR_ARG,
+            "integrator: krylov_rtol = %g outside [0, 1)", o->krylov_rtol);
+  FCM_CHECK(o->krylov_atol >= 0.0 && isfinite(o->krylov_atol), ctx, FCM_ERR_ARG,
+            "integrator: krylov_atol = %g must be finite and >= 0", o->krylov_atol);
+  FCM_CHECK(o->krylov_max_iterations >= 1, ctx, FCM_ERR_ARG,
+            "integrator: krylov_max_iterations = %d must be >= 1", o->krylov_max_iterations);
+  FCM_CHECK(o->schwarz_theta > 0.0 && o->schwarz_theta <= 1.0, ctx, FCM_ERR_ARG,
+            "integrator: schwarz_theta = %g outside (0, 1]", o->schwarz_theta);
+  FCM_CHECK(o->rayleigh_mass >= 0.0 && isfinite(o->rayleigh_mass), ctx, FCM_ERR_ARG,
+            "integrator: rayleigh_mass = %g must be finite and >= 0", o->rayleigh_mass);
+  FCM_CHECK(o->rayleigh_stiffness >= 0.0 && isfinite(o->rayleigh_stiffness), ctx, FCM_ERR_ARG,
+            "integrator: rayleigh_stiffness = %g must be finite and >= 0", o->rayleigh_stiffness);
+cleanup:
+  return st;
+}
+
+/* The constrained DOF list: every (node with DOFs, constrained component) of every
+ * constraint; a DOF in two constraints is an error. */
+static fcm_status build_constraints(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  int *owner = NULL;
+  fcm_index count = 0;
+  FCM_ALLOC(ctx, I->n, owner);
+  for (int k = 0; k < I->num_cons; k++) {
+    const sim_constraint *c = &I->cons[k];
+    for (fcm_index a = 0; a < c->num_nodes; a++) {
+      fcm_index d = fcm_space_node_dof(I->space, c->nodes[a]);
+      if (d < 0) continue;
+      for (int i = 0; i < 3; i++) {
+        if (!c->motion.components[i]) continue;
+        FCM_CHECK(owner[d + i] == 0 || owner[d + i] == k + 1, ctx, FCM_ERR_ARG,
+                  "constraint %d: node %lld component %c is already constrained by constraint %d",
+                  k, (long long)c->nodes[a], "xyz"[i], owner[d + i] - 1);
+        if (owner[d + i] == 0) count++;
+        owner[d + i] = k + 1;
+      }
+    }
+  }
+  I->ncon = count;
+  FCM_ALLOC(ctx, count, I->con_dof);
+  FCM_ALLOC(ctx, count, I->con_node);
+  FCM_ALLOC(ctx, count, I->con_comp);
+  FCM_ALLOC(ctx, count, I->con_id);
+  FCM_ALLOC(ctx, count, I->act_dof);
+  FCM_ALLOC(ctx, count, I->act_val);
+  FCM_ALLOC(ctx, count, I->act_inc);
+  FCM_ALLOC(ctx, I->n, I->is_con);
+  FCM_ALLOC(ctx, I->num_cons, I->con_on);
+  count = 0;
+  for (int k = 0; k < I->num_cons; k++) {
+    const sim_constraint *c = &I->cons[k];
+    for (fcm_index a = 0; a < c->num_nodes; a++) {
+      fcm_index d = fcm_space_node_dof(I->space, c->nodes[a]);
+      if (d < 0) continue;
+      for (int i = 0; i < 3; i++) {
+        if (!c->motion.components[i] || owner[d + i] != k + 1) continue;
+        owner[d + i] = -1; /* a node listed twice in one constraint counts once */
+        I->con_dof[count] = d + i;
+        I->con_node[count] = c->nodes[a];
+        I->con_comp[count] = i;
+        I->con_id[count] = k;
+        count++;
+      }
+    }
+  }
+  I->ncon = count;
+  /* Start with every constraint "off" so the first evaluation builds is_con. */
+  I->con_version = 0;
+cleanup:
+  fcm__free(ctx, owner);
+  return st;
+}
+
+fcm_status fcm_integrator_setup(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
+  fcm_ctx *ctx = I->ctx;
+  fcm_index n = I->n;
+  const fcm_integrator_options *o = &I->opts;
+  FCM_CHECK(!I->is_setup, ctx, FCM_ERR_ARG, "integrator: already set up");
+  FCM_TRY(ctx, validate_options(ctx, o));
+  FCM_CHECK(n > 0, ctx, FCM_ERR_ARG, "integrator: the space has no DOFs");
+  FCM_TRY(ctx, build_constraints(I));
+
+  double **vecs[] = {&I->Ma,   &I->u_bak, &I->v_bak, &I->lp_bak, &I->un,     &I->uhat,
+                     &I->fext, &I->fend,  &I->fint,  &I->g,      &I->d,      &I->b,
+                     &I->ut,   &I->fint_t, &I->g_t,  &I->w1,     &I->w2};
+  for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; k++) FCM_ALLOC(ctx, n, *vecs[k]);
+
+  /* Mass (constant) and the loads of scale 1. */
+  FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->M));
+  FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->H));
+  {
+    fcm_elastic el = {I->mat.young, I->mat.poisson, I->mat.density};
+    FCM_TRY(ctx, fcm_assemble_mass(I->space, &el, &o->assembly, I->M));
+    for (int k = 0; k < I->num_loads; k++) {
+      sim_load *l = &I->loads[k];
+      FCM_ALLOC(ctx, n, l->f);
+      if (l->kind == SIM_LOAD_GRAVITY)
+        FCM_TRY(ctx, fcm_assemble_body_force(I->space, &el, l->accel, &o->assembly, l->f));
+      else if (l->kind == SIM_LOAD_BODY)
+        FCM_TRY(ctx, fcm_assemble_body_force_field(I->space, l->field, l->field_user, &o->assembly,
+                                                   l->f));
+      else
+        FCM_TRY(ctx, fcm_assemble_surface_traction(I->space, l->field, l->field_user, l->f));
+    }
+  }
+  {
+    double a[3];
+    rep_acceleration(I, a);
+    for (fcm_index i = 0; i < n; i++) I->w1[i] = a[i % 3];
+    FCM_TRY(ctx, fcm_csr_apply(I->M, 1.0, I->w1, 0.0, I->Ma));
+    double s = 0.0;
+    for (fcm_index i = 0; i < n; i++) s += I->Ma[i] * I->Ma[i];
+    I->rep_norm_full = sqrt(s);
+    FCM_CHECK(o->tolerance_mode != FCM_NEWTON_TOL_REPRESENTATIVE || I->rep_norm_full > 0.0, ctx,
+              FCM_ERR_ARG,
+              "integrator: the representative force ||M a_rep|| is 0 (density %g): set a positive "
+              "density or use FCM_NEWTON_TOL_RELATIVE",
+              I->mat.density);
+  }
+  if (I->linear) FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->H0));
+  if (o->kind == FCM_INTEGRATOR_BACKWARD_EULER &&
+      (o->rayleigh_mass > 0.0 || o->rayleigh_stiffness > 0.0))
+    FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->D));
+
+  /* Solvers: the direct solver is analyzed once here; the UMFPACK fallback on demand. */
+  if (o->linear_solver == FCM_LINEAR_DIRECT) {
+    if (o->direct_method == FCM_DIRECT_CHOLMOD) {
+      FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, I->H, &I->chol));
+      FCM_TRY(ctx, fcm_direct_analyze(I->chol));
+    } else {
+      FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_UMFPACK, I->H, &I->umf));
+      FCM_TRY(ctx, fcm_direct_analyze(I->umf));
+    }
+  } else {
+    FCM_TRY(ctx, fcm_krylov_create(ctx, n, &I->krylov));
+    if (o->preconditioner == FCM_PRECOND_SCHWARZ) {
+      const fcm_mesh *mesh = fcm_space_mesh(I->space);
+      const fcm_cell_rules *rules = fcm_space_cell_rules(I->space);
+      fcm_index nc = fcm_mesh_num_cells(mesh);
+      FCM_ALLOC(ctx, nc, I->schwarz_flag);
+      if (rules)
+        for (fcm_index c = 0; c < nc; c++)
+          I->schwarz_flag[c] = fcm_space_cell_active(I->space, c) &&
+                               fcm_cell_rules_class(rules, c) == FCM_CELL_CUT &&
+                               fcm_cell_rules_volume_fraction(rules, c) < o->schwarz_theta;
+    }
+  }
+
+  I->h_state = SIM_H_INVALID;
+  I->damp_version = 0;
+  for (int k = 0; k < I->num_cons; k++) I->con_on[k] = 0;
+  I->is_setup = 1;
+  fcm__sim_eval_constraints(I, I->t);
+  if (o->kind == FCM_INTEGRATOR_BACKWARD_EULER) {
+    const double *X = fcm_mesh_coords(fcm_space_mesh(I->space));
+    for (fcm_index i = 0; i < I->ncon; i++) {
+      if (!I->con_on[I->con_id[i]]) continue;
+      double uu[3], vv[3];
+      fcm_motion_eval(&I->cons[I->con_id[i]].motion, X + 3 * I->con_node[i], I->t, uu, vv);
+      I->v[I->con_dof[i]] = vv[I->con_comp[i]];
+    }
+  } else if (I->steps > 0) {
+    fcm__sim_eval_loads(I, I->t, I->load_prev);
+  }
+cleanup:
+  return st;
+}
+
+fcm_index fcm_integrator_num_dofs(const fcm_integrator *I) { return I ? I->n : 0; }
+double fcm_integrator_time(const fcm_integrator *I) { return I ? I->t : 0.0; }
+long long fcm_integrator_step_count(const fcm_integrator *I) { return I ? I->steps : 0; }
+const double *fcm_integrator_displacement(const fcm_integrator *I) { return I ? I->u : NULL; }
+const double *fcm_integrator_velocity(const fcm_integrator *I) { return I ? I->v : NULL; }
+fcm_index fcm_integrator_num_constrained(const fcm_integrator *I) { return I ? I->ncon : 0; }
+const fcm_csr *fcm_integrator_mass(const fcm_integrator *I) { return I ? I->M : NULL; }
+
+void fcm_integrator_get_state(const fcm_integrator *I, double *u, double *v, double *t,
+                              long long *steps)
+{
+  if (!I) return;
+  if (u) memcpy(u, I->u, sizeof *u * (size_t)I->n);
+  if (v) memcpy(v, I->v, sizeof *v * (size_t)I->n);
+  if (t) *t = I->t;
+  if (steps) *steps = I->steps;
+}
+
+fcm_status fcm_integrator_set_state(fcm_integrator *I, const double *u, const double *v, double t,
+                                    long long steps)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
+  FCM_CHECK(isfinite(t) && steps >= 0, I->ctx, FCM_ERR_ARG,
+            "integrator: state time %g must be finite and steps %lld >= 0", t, steps);
+  for (fcm_index i = 0; i < I->n; i++) {
+    FCM_CHECK(!u || isfinite(u[i]), I->ctx, FCM_ERR_ARG, "integrator: u[%lld] = %g is not finite",
+              (long long)i, u[i]);
+    FCM_CHECK(!v || isfinite(v[i]), I->ctx, FCM_ERR_ARG, "integrator: v[%lld] = %g is not finite",
+              (long long)i, v[i]);
+  }
+  if (u) memcpy(I->u, u, sizeof *u * (size_t)I->n);
+  if (v) memcpy(I->v, v, sizeof *v * (size_t)I->n);
+  I->t = t;
+  I->steps = steps;
+  if (!I->linear) I->h_state = SIM_H_INVALID; /* a linear system does not depend on u */
+  if (I->is_setup) {
+    if (steps > 0 && I->opts.kind == FCM_INTEGRATOR_STATIC)
+      fcm__sim_eval_loads(I, t, I->load_prev);
+    else
+      memset(I->load_prev, 0, sizeof *I->load_prev * (size_t)I->n);
+    fcm__sim_eval_constraints(I, t);
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm_integrator_set_rigid_velocity(fcm_integrator *I, const double v0[3],
+                                             const double omega[3], const double c[3])
+{
+  fcm_status st = FCM_OK;
+  static const double zero[3] = {0, 0, 0};
+  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
+  if (!v0) v0 = zero;
+  if (!omega) omega = zero;
+  if (!c) c = zero;
+  FCM_CHECK(finite3(v0) && finite3(omega) && finite3(c), I->ctx, FCM_ERR_ARG,
+            "integrator: rigid velocity v0 = (%g, %g, %g), omega = (%g, %g, %g) or centre not "
+            "finite",
+            v0[0], v0[1], v0[2], omega[0], omega[1], omega[2]);
+  {
+    const fcm_mesh *mesh = fcm_space_mesh(I->space);
+    const double *X = fcm_mesh_coords(mesh);
+    fcm_index nn = fcm_mesh_num_nodes(mesh);
+    for (fcm_index a = 0; a < nn; a++) {
+      fcm_index d = fcm_space_node_dof(I->space, a);
+      if (d < 0) continue;
+      double r[3];
+      for (int i = 0; i < 3; i++) r[i] = X[3 * a + i] + I->u[d + i] - c[i];
+      I->v[d + 0] = v0[0] + omega[1] * r[2] - omega[2] * r[1];
+      I->v[d + 1] = v0[1] + omega[2] * r[0] - omega[0] * r[2];
+      I->v[d + 2] = v0[2] + omega[0] * r[1] - omega[1] * r[0];
+    }
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm_integrator_energy(fcm_integrator *I, double *kinetic, double *elastic,
+                                 double *external_work)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
+  FCM_CHECK(I->is_setup, I->ctx, FCM_ERR_ARG, "integrator: energy needs fcm_integrator_setup()");
+  {
+    fcm_index n = I->n;
+    double psi = 0.0, ekin = 0.0, wext = 0.0;
+    FCM_TRY(I->ctx, fcm_assemble_hyperelastic(I->space, &I->params, I->u, &I->opts.assembly, &psi,
+                                              NULL, NULL));
+    if (I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) {
+      FCM_TRY(I->ctx, fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1));
+      for (fcm_index i = 0; i < n; i++) ekin += 0.5 * I->v[i] * I->w1[i];
+      fcm__sim_eval_loads(I, I->t, I->w2);
+    } else {
+      memcpy(I->w2, I->load_prev, sizeof *I->w2 * (size_t)n);
+    }
+    for (fcm_index i = 0; i < n; i++) wext += I->w2[i] * I->u[i];
+    FCM_CHECK(isfinite(ekin) && isfinite(psi) && isfinite(wext), I->ctx, FCM_ERR_NUMERIC,
+              "integrator: energy is not finite (kinetic %g, elastic %g, external work %g)", ekin,
+              psi, wext);
+    if (kinetic) *kinetic = ekin;
+    if (elastic) *elastic = psi;
+    if (external_work) *external_work = wext;
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm_integrator_momentum(fcm_integrator *I, double linear[3], double angular[3])
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
+  FCM_CHECK(I->is_setup, I->ctx, FCM_ERR_ARG, "integrator: momentum needs fcm_integrator_setup()");
+  FCM_TRY(I->ctx, fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1));
+  {
+    const fcm_mesh *mesh = fcm_space_mesh(I->space);
+    const double *X = fcm_mesh_coords(mesh);
+    fcm_index nn = fcm_mesh_num_nodes(mesh);
+    double p[3] = {0, 0, 0}, L[3] = {0, 0, 0};
+    for (fcm_index a = 0; a < nn; a++) {
+      fcm_index d = fcm_space_node_dof(I->space, a);
+      if (d < 0) continue;
+      const double *q = I->w1 + d;
+      double x[3];
+      for (int i = 0; i < 3; i++) x[i] = X[3 * a + i] + I->u[d + i], p[i] += q[i];
+      L[0] += x[1] * q[2] - x[2] * q[1];
+      L[1] += x[2] * q[0] - x[0] * q[2];
+      L[2] += x[0] * q[1] - x[1] * q[0];
+    }
+    if (linear) memcpy(linear, p, sizeof p);
+    if (angular) memcpy(angular, L, sizeof L);
+  }
+cleanup:
+  return st;
+}

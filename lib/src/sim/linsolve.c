@@ -1,0 +1,158 @@
+/* sim: the linear solves of the Newton steps — CHOLMOD with UMFPACK as the fallback when
+ * the matrix is not positive definite (symbolic analyses kept for the whole run), or CG /
+ * MINRES with Jacobi, block Jacobi or additive Schwarz preconditioning (DESIGN §7). */
+#include "sim/sim_impl.h"
+
+#include <math.h>
+#include <string.h>
+
+long long fcm__sim_analyses(const fcm_integrator *I)
+{
+  fcm_direct_info a, b;
+  fcm_direct_get_info(I->chol, &a);
+  fcm_direct_get_info(I->umf, &b);
+  return a.analyses + b.analyses;
+}
+
+/* Map a soft failure of a solver call to a step reason; pass hard errors on. */
+static fcm_status soft(fcm_integrator *I, fcm_status s, fcm_step_reason *reason)
+{
+  if (s == FCM_ERR_NUMERIC || s == FCM_ERR_SINGULAR || s == FCM_ERR_NOT_CONVERGED) {
+    *reason = s == FCM_ERR_NUMERIC ? FCM_STEP_NONFINITE : FCM_STEP_LINEAR_SOLVER_FAILED;
+    fcm_ctx_error_clear(I->ctx);
+    return FCM_OK;
+  }
+  if (s != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
+  return s;
+}
+
+static fcm_status factor_direct(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
+{
+  fcm_status st = FCM_OK, s;
+  fcm_ctx *ctx = I->ctx;
+  const double *vals = fcm_csr_get_values(I->H);
+  I->direct = NULL;
+  if (I->chol) {
+    s = fcm_direct_factor(I->chol, vals);
+    stats->factorizations++;
+    I->total_factorizations++;
+    if (s == FCM_OK) {
+      I->direct = I->chol;
+      return FCM_OK;
+    }
+    if (s != FCM_ERR_SINGULAR) return soft(I, s, reason);
+    /* Not positive definite: LU with partial pivoting on the same matrix. */
+    fcm_ctx_error_clear(ctx);
+    stats->direct_fallbacks++;
+    I->total_fallbacks++;
+  }
+  if (!I->umf) {
+    FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_UMFPACK, I->H, &I->umf));
+    FCM_TRY(ctx, fcm_direct_analyze(I->umf));
+  }
+  s = fcm_direct_factor(I->umf, vals);
+  stats->factorizations++;
+  I->total_factorizations++;
+  if (s == FCM_OK) {
+    I->direct = I->umf;
+    return FCM_OK;
+  }
+  return soft(I, s, reason);
+cleanup:
+  return st;
+}
+
+static fcm_status setup_preconditioner(fcm_integrator *I, fcm_step_reason *reason,
+                                       sim_stats *stats)
+{
+  fcm_status s = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  switch (I->opts.preconditioner) {
+  case FCM_PRECOND_NONE: return FCM_OK;
+  case FCM_PRECOND_JACOBI:
+  case FCM_PRECOND_BLOCK_JACOBI:
+    if (I->jacobi)
+      s = fcm_jacobi_setup(I->jacobi, I->H);
+    else
+      s = fcm_jacobi_create(ctx, I->H,
+                            I->opts.preconditioner == FCM_PRECOND_JACOBI ? FCM_JACOBI_SCALAR
+                                                                         : FCM_JACOBI_BLOCK3,
+                            &I->jacobi);
+    break;
+  case FCM_PRECOND_SCHWARZ:
+    if (I->schwarz)
+      s = fcm_schwarz_setup(I->schwarz, I->H);
+    else
+      s = fcm_schwarz_create_from_space(ctx, I->space, I->H, I->schwarz_flag, &I->opts.schwarz,
+                                        &I->schwarz);
+    break;
+  }
+  stats->factorizations++;
+  I->total_factorizations++;
+  return soft(I, s, reason);
+}
+
+fcm_status fcm__sim_factor(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
+{
+  double t0 = fcm_wtime();
+  fcm_status st = I->opts.linear_solver == FCM_LINEAR_DIRECT ? factor_direct(I, reason, stats)
+                                                             : setup_preconditioner(I, reason, stats);
+  stats->time_factor += fcm_wtime() - t0;
+  return st;
+}
+
+fcm_status fcm__sim_solve(fcm_integrator *I, const double *b, double *d, fcm_step_reason *reason,
+                          int *iterations, sim_stats *stats)
+{
+  fcm_status st = FCM_OK, s;
+  fcm_ctx *ctx = I->ctx;
+  double t0 = fcm_wtime();
+  *iterations = 0;
+  if (I->opts.linear_solver == FCM_LINEAR_DIRECT) {
+    FCM_CHECK(I->direct, ctx, FCM_ERR_INTERNAL, "integrator: no valid factorization to solve with");
+    FCM_TRY(ctx, fcm_direct_solve(I->direct, b, d));
+  } else {
+    fcm_krylov_options ko = fcm_krylov_options_default();
+    fcm_krylov_info ki;
+    fcm_operator_fn S = NULL;
+    void *S_user = NULL;
+    ko.rtol = I->opts.krylov_rtol;
+    ko.atol = I->opts.krylov_atol;
+    ko.max_iterations = I->opts.krylov_max_iterations;
+    if (I->jacobi && (I->opts.preconditioner == FCM_PRECOND_JACOBI ||
+                      I->opts.preconditioner == FCM_PRECOND_BLOCK_JACOBI)) {
+      S = fcm_jacobi_operator;
+      S_user = I->jacobi;
+    } else if (I->schwarz && I->opts.preconditioner == FCM_PRECOND_SCHWARZ) {
+      S = fcm_schwarz_operator;
+      S_user = I->schwarz;
+    }
+    memset(d, 0, sizeof *d * (size_t)I->n);
+    memset(&ki, 0, sizeof ki);
+    if (I->opts.linear_solver == FCM_LINEAR_CG)
+      s = fcm_krylov_cg(I->krylov, fcm_csr_operator, I->H, S, S_user, b, d, &ko, &ki);
+    else
+      s = fcm_krylov_minres(I->krylov, fcm_csr_operator, I->H, S, S_user, b, d, &ko, &ki);
+    *iterations = ki.iterations;
+    stats->linear_iterations += ki.iterations;
+    if (s == FCM_ERR_NOT_CONVERGED) {
+      /* Stopped early (iteration limit, CG breakdown on an indefinite matrix): the iterate
+       * is still usable when it is a finite, non-zero vector; the Newton loop checks that
+       * it descends. */
+      int usable = 1, nonzero = 0;
+      for (fcm_index i = 0; i < I->n; i++) {
+        if (!isfinite(d[i])) usable = 0;
+        if (d[i] != 0.0) nonzero = 1;
+      }
+      if (usable && nonzero) {
+        fcm_ctx_error_clear(ctx);
+        stats->inexact_solves++;
+        s = FCM_OK;
+      }
+    }
+    FCM_TRY(ctx, soft(I, s, reason));
+  }
+cleanup:
+  stats->time_solve += fcm_wtime() - t0;
+  return st;
+}

@@ -1,0 +1,513 @@
+/* sim: one integrator step — substeps with halving on failure, and per substep Newton's
+ * method with a backtracking (Armijo) line search on the incremental potential.
+ *
+ * DESIGN §8 and Longva et al. (2020) §3, §6: backward Euler minimizes
+ * E(u) = 1/2 |u - u^|_M^2 / h^2 + Psi(u) - f^T u (+ 1/(2h) |u - u_n|_D^2); its gradient is
+ * M v' - f_total, and the Newton loop stops when that is below 1e-5 |M a_rep| (the paper's
+ * rule; a_rep = gravity) or below a relative threshold. Prescribed motion enters through
+ * symmetric elimination: while a constrained DOF is off its prescribed value, the Newton
+ * system carries the increment that reaches it (a "predictor" update, taken in full for the
+ * constrained DOFs, snapped exactly); afterwards the constrained increments are zero and
+ * the free DOFs descend the energy with the line search. */
+#include "sim/sim_impl.h"
+
+#include <float.h>
+#include <math.h>
+#include <string.h>
+
+static double dot(fcm_index n, const double *a, const double *b)
+{
+  double s = 0.0;
+  for (fcm_index i = 0; i < n; i++) s += a[i] * b[i];
+  return s;
+}
+
+static double norm_free(const fcm_integrator *I, const double *g)
+{
+  double s = 0.0;
+  for (fcm_index i = 0; i < I->n; i++)
+    if (!I->is_con[i]) s += g[i] * g[i];
+  return sqrt(s);
+}
+
+static int all_finite(fcm_index n, const double *a)
+{
+  for (fcm_index i = 0; i < n; i++)
+    if (!isfinite(a[i])) return 0;
+  return 1;
+}
+
+/* H = M/h^2 + D/h (dynamics) or 0 (static): the part of the Newton matrix the material
+ * tangent is added to. */
+static void set_base(fcm_integrator *I, double h)
+{
+  fcm_index nnz = 0;
+  fcm_csr_get_size(I->H, NULL, NULL, &nnz);
+  double *hv = fcm_csr_get_values(I->H);
+  if (h > 0.0) {
+    const double *mv = fcm_csr_get_values(I->M);
+    double a = 1.0 / (h * h);
+    for (fcm_index e = 0; e < nnz; e++) hv[e] = a * mv[e];
+    if (I->D) {
+      const double *dv = fcm_csr_get_values(I->D);
+      for (fcm_index e = 0; e < nnz; e++) hv[e] += dv[e] / h;
+    }
+  } else {
+    memset(hv, 0, sizeof *hv * (size_t)nnz);
+  }
+}
+
+/* Hyperelastic assembly that turns FCM_ERR_NUMERIC (material NaN/Inf) into *finite = 0. */
+static fcm_status assemble(fcm_integrator *I, const fcm_material_params *p, const double *x,
+                           double *psi, double *fint, fcm_csr *T, int *finite, sim_stats *stats)
+{
+  fcm_status st = FCM_OK;
+  double t0 = fcm_wtime();
+  st = fcm_assemble_hyperelastic(I->space, p, x, &I->opts.assembly, psi, fint, T);
+  stats->time_assembly += fcm_wtime() - t0;
+  if (T) stats->tangent_assemblies++;
+  if (st == FCM_ERR_NUMERIC) {
+    fcm_ctx_error_clear(I->ctx);
+    *finite = 0;
+    return FCM_OK;
+  }
+  if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
+  return st;
+}
+
+/* Tangent at x into H: H = base(h) + K(x), optionally with the PSD-projected material. */
+static fcm_status assemble_tangent(fcm_integrator *I, double h, const double *x, int projected,
+                                   int *finite, sim_stats *stats)
+{
+  set_base(I, h);
+  return assemble(I, projected ? &I->params_psd : &I->params, x, NULL, NULL, I->H, finite, stats);
+}
+
+/* Energy parts at x: E, the internal force fint, the gradient g (n each), the elastic
+ * energy and the magnitude scale of E (sum of the absolute parts). With `tangent`, H =
+ * base + K(x) in the same pass. *finite = 0 when anything is NaN/Inf. */
+typedef struct eval_out {
+  double E, psi, scale;
+  int finite;
+} eval_out;
+
+static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tangent,
+                           double *fint, double *g, eval_out *out, sim_stats *stats)
+{
+  fcm_status st = FCM_OK;
+  fcm_index n = I->n;
+  double psi = 0.0, inertia = 0.0, damp = 0.0, wext;
+  out->finite = 1;
+  memset(fint, 0, sizeof *fint * (size_t)n);
+  if (tangent) set_base(I, h);
+  FCM_TRY(I->ctx, assemble(I, &I->params, x, &psi, fint, tangent ? I->H : NULL, &out->finite,
+                           stats));
+  if (!out->finite) return FCM_OK;
+  {
+    double t0 = fcm_wtime();
+    for (fcm_index i = 0; i < n; i++) g[i] = fint[i] - I->fext[i];
+    if (h > 0.0) {
+      for (fcm_index i = 0; i < n; i++) I->w1[i] = x[i] - I->uhat[i];
+      FCM_TRY(I->ctx, fcm_csr_apply(I->M, 1.0, I->w1, 0.0, I->w2));
+      double a = 1.0 / (h * h);
+      inertia = 0.5 * a * dot(n, I->w1, I->w2);
+      for (fcm_index i = 0; i < n; i++) g[i] += a * I->w2[i];
+      if (I->D) {
+        for (fcm_index i = 0; i < n; i++) I->w1[i] = x[i] - I->un[i];
+        FCM_TRY(I->ctx, fcm_csr_apply(I->D, 1.0, I->w1, 0.0, I->w2));
+        damp = 0.5 / h * dot(n, I->w1, I->w2);
+        for (fcm_index i = 0; i < n; i++) g[i] += I->w2[i] / h;
+      }
+    }
+    wext = dot(n, I->fext, x);
+    out->psi = psi;
+    out->E = inertia + damp + psi - wext;
+    out->scale = fabs(inertia) + fabs(damp) + fabs(psi) + fabs(wext);
+    out->finite = isfinite(out->E) && all_finite(n, g);
+    stats->time_assembly += fcm_wtime() - t0;
+  }
+cleanup:
+  return st;
+}
+
+static int constraints_met(const fcm_integrator *I, const double *x)
+{
+  for (fcm_index j = 0; j < I->nact; j++)
+    if (x[I->act_dof[j]] != I->act_val[j]) return 0;
+  return 1;
+}
+
+/* Threshold of the stopping rule at the current iterate. */
+static double tolerance(const fcm_integrator *I, double rep_free, double r_start)
+{
+  const fcm_integrator_options *o = &I->opts;
+  if (o->tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE) return o->newton_tolerance * rep_free;
+  double R = FCM_MAX(r_start, sqrt(dot(I->n, I->fint, I->fint)));
+  R = FCM_MAX(R, sqrt(dot(I->n, I->fext, I->fext)));
+  return FCM_MAX(o->newton_tolerance * R, o->newton_atol);
+}
+
+static void swap(double **a, double **b)
+{
+  double *t = *a;
+  *a = *b;
+  *b = t;
+}
+
+/* Build the eliminated Newton system for the current iterate and factor it, or reuse the
+ * factor of a constant (linear) system; b = -g with the constrained increments lifted. */
+static fcm_status build_system(fcm_integrator *I, double h, int predictor, int projected,
+                               fcm_step_reason *reason, sim_stats *stats)
+{
+  fcm_status st = FCM_OK;
+  fcm_index n = I->n;
+  for (fcm_index i = 0; i < n; i++) I->b[i] = -I->g[i];
+  int reuse = I->linear && !projected && I->h_state == SIM_H_SYSTEM && I->key_h == h &&
+              I->key_con == I->con_version && I->key_damp == I->damp_version;
+  if (reuse) {
+    /* b_f -= H0_fc inc_c, b_c = H_cc inc_c (as fcm_space_apply_dirichlet would). */
+    if (predictor) {
+      memset(I->w1, 0, sizeof *I->w1 * (size_t)n);
+      for (fcm_index j = 0; j < I->nact; j++) I->w1[I->act_dof[j]] = I->act_inc[j];
+      FCM_TRY(I->ctx, fcm_csr_apply(I->H0, 1.0, I->w1, 0.0, I->w2));
+      for (fcm_index i = 0; i < n; i++)
+        if (!I->is_con[i]) I->b[i] -= I->w2[i];
+    }
+    const double *hv = fcm_csr_get_values(I->H);
+    for (fcm_index j = 0; j < I->nact; j++) {
+      fcm_index d = I->act_dof[j], pos = fcm_csr_get_position(I->H, d, d);
+      I->b[d] = predictor ? hv[pos] * I->act_inc[j] : 0.0;
+    }
+    return FCM_OK;
+  }
+  if (I->h_state != SIM_H_TANGENT || projected) {
+    int finite = 1;
+    FCM_TRY(I->ctx, assemble_tangent(I, h, I->u, projected, &finite, stats));
+    if (!finite) {
+      I->h_state = SIM_H_INVALID;
+      *reason = FCM_STEP_NONFINITE;
+      return FCM_OK;
+    }
+  }
+  if (I->H0) {
+    fcm_index nnz = 0;
+    fcm_csr_get_size(I->H, NULL, NULL, &nnz);
+    memcpy(fcm_csr_get_values(I->H0), fcm_csr_get_values(I->H), sizeof(double) * (size_t)nnz);
+  }
+  FCM_TRY(I->ctx, fcm_space_apply_dirichlet(I->space, I->nact, I->act_dof,
+                                            predictor ? I->act_inc : NULL, I->H, I->b));
+  I->h_state = SIM_H_SYSTEM;
+  I->key_h = h;
+  I->key_con = I->con_version;
+  I->key_damp = I->damp_version;
+  FCM_TRY(I->ctx, fcm__sim_factor(I, reason, stats));
+  if (*reason != FCM_STEP_NONE || projected) I->h_state = SIM_H_INVALID;
+cleanup:
+  if (st != FCM_OK) I->h_state = SIM_H_INVALID;
+  return st;
+}
+
+/* Solve for the direction and pin its constrained entries (Krylov iterates and Schwarz
+ * blocks may leave round-off there). */
+static fcm_status direction(fcm_integrator *I, int predictor, fcm_step_reason *reason, int *its,
+                            sim_stats *stats)
+{
+  fcm_status st = FCM_OK;
+  FCM_TRY(I->ctx, fcm__sim_solve(I, I->b, I->d, reason, its, stats));
+  if (*reason != FCM_STEP_NONE) return FCM_OK;
+  if (!all_finite(I->n, I->d)) {
+    *reason = FCM_STEP_NONFINITE;
+    return FCM_OK;
+  }
+  for (fcm_index j = 0; j < I->nact; j++) I->d[I->act_dof[j]] = predictor ? I->act_inc[j] : 0.0;
+cleanup:
+  return st;
+}
+
+static void monitor(const fcm_integrator *I, double t1, int it, double r, double tol, double E,
+                    double alpha, int its, int met)
+{
+  if (!I->opts.monitor) return;
+  fcm_newton_event ev;
+  ev.time = t1;
+  ev.iteration = it;
+  ev.residual = r;
+  ev.tolerance = tol;
+  ev.energy = E;
+  ev.step_length = alpha;
+  ev.linear_iterations = its;
+  ev.constraints_met = met;
+  I->opts.monitor(I->opts.monitor_user, &ev);
+}
+
+fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reason *reason,
+                           double *residual, double *tol_out, sim_stats *stats)
+{
+  fcm_status st = FCM_OK;
+  const fcm_integrator_options *o = &I->opts;
+  fcm_index n = I->n;
+  eval_out cur, trial;
+  double rep_free = 0.0, r = NAN, r_start = NAN, tol = 0.0;
+  int met = 0;
+  *reason = FCM_STEP_NONE;
+
+  /* Initial guess: u^ = u_n + h v_n on free DOFs (exact for free flight), u_n elsewhere. */
+  if (h > 0.0)
+    for (fcm_index i = 0; i < n; i++) {
+      I->uhat[i] = I->un[i] + h * I->v[i];
+      I->u[i] = I->is_con[i] ? I->un[i] : I->uhat[i];
+    }
+  if (o->tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE) rep_free = norm_free(I, I->Ma);
+
+  FCM_TRY(I->ctx, evaluate(I, h, I->u, !I->linear, I->fint, I->g, &cur, stats));
+  I->h_state = I->linear ? (I->h_state == SIM_H_SYSTEM ? SIM_H_SYSTEM : SIM_H_INVALID)
+                         : (cur.finite ? SIM_H_TANGENT : SIM_H_INVALID);
+  r = cur.finite ? norm_free(I, I->g) : NAN;
+  r_start = r;
+  tol = tolerance(I, rep_free, r_start);
+  met = constraints_met(I, I->u);
+  I->psi = cur.psi;
+  monitor(I, t1, 0, r, tol, cur.E, 0.0, 0, met);
+
+  for (int it = 0;; it++) {
+    if (!cur.finite) {
+      *reason = FCM_STEP_NONFINITE;
+      break;
+    }
+    if (met && r <= tol) {
+      *reason = FCM_STEP_CONVERGED;
+      break;
+    }
+    if (it >= o->newton_max_iterations) {
+      *reason = FCM_STEP_MAX_NEWTON;
+      break;
+    }
+    int predictor = !met, its = 0;
+    for (fcm_index j = 0; j < I->nact; j++) I->act_inc[j] = I->act_val[j] - I->u[I->act_dof[j]];
+    FCM_TRY(I->ctx, build_system(I, h, predictor, 0, reason, stats));
+    if (*reason != FCM_STEP_NONE) break;
+    FCM_TRY(I->ctx, direction(I, predictor, reason, &its, stats));
+    if (*reason != FCM_STEP_NONE) break;
+    double slope = dot(n, I->g, I->d);
+    if (!predictor && !(slope < 0.0)) {
+      /* Not a descent direction (indefinite tangent or inexact solve): retry once with
+       * the PSD-projected tangent, which with M/h^2 (or the constraints) is SPD. */
+      if (!o->project_psd) {
+        stats->projection_fallbacks++;
+        FCM_TRY(I->ctx, build_system(I, h, 0, 1, reason, stats));
+        if (*reason != FCM_STEP_NONE) break;
+        int its2 = 0;
+        FCM_TRY(I->ctx, direction(I, 0, reason, &its2, stats));
+        its += its2;
+        if (*reason != FCM_STEP_NONE) break;
+        slope = dot(n, I->g, I->d);
+      }
+      if (!(slope < 0.0)) {
+        *reason = FCM_STEP_LINE_SEARCH_FAILED;
+        break;
+      }
+    }
+
+    /* Backtracking line search on E (predictor: constrained DOFs land exactly, the free
+     * part backs off only if the energy is not finite there). */
+    double alpha = 1.0;
+    int accepted = 0, speculative = 0;
+    double rt = NAN;
+    for (int bt = 0;; bt++) {
+      for (fcm_index i = 0; i < n; i++) I->ut[i] = I->u[i] + alpha * I->d[i];
+      if (predictor)
+        for (fcm_index j = 0; j < I->nact; j++) I->ut[I->act_dof[j]] = I->act_val[j];
+      /* The tangent of a full step is assembled with it: usually it is accepted and the
+       * next iteration needs that tangent (one pass instead of two). */
+      speculative = !I->linear && bt == 0;
+      FCM_TRY(I->ctx, evaluate(I, h, I->ut, speculative, I->fint_t, I->g_t, &trial, stats));
+      if (trial.finite) {
+        rt = norm_free(I, I->g_t);
+        if (predictor || !o->line_search) {
+          accepted = 1;
+        } else {
+          int armijo = trial.E <= cur.E + o->armijo * alpha * slope;
+          /* Where E no longer resolves the decrease (round-off), ask the residual to drop. */
+          int flat = fabs(trial.E - cur.E) <= 100.0 * DBL_EPSILON * FCM_MAX(cur.scale, trial.scale) &&
+                     rt < r;
+          accepted = armijo || flat;
+        }
+      }
+      if (accepted || bt >= o->max_backtracks) break;
+      alpha *= o->backtrack;
+      stats->backtracks++;
+    }
+    if (!accepted) {
+      I->h_state = SIM_H_INVALID;
+      *reason = trial.finite ? FCM_STEP_LINE_SEARCH_FAILED : FCM_STEP_NONFINITE;
+      break;
+    }
+    swap(&I->u, &I->ut);
+    swap(&I->fint, &I->fint_t);
+    swap(&I->g, &I->g_t);
+    cur = trial;
+    I->psi = cur.psi;
+    if (!I->linear) I->h_state = (speculative && alpha == 1.0) ? SIM_H_TANGENT : SIM_H_INVALID;
+    stats->newton_iterations++;
+    r = rt;
+    met = constraints_met(I, I->u);
+    tol = tolerance(I, rep_free, r_start);
+    monitor(I, t1, it + 1, r, tol, cur.E, alpha, its, met);
+  }
+cleanup:
+  *residual = r;
+  *tol_out = tol;
+  return st;
+}
+
+/* D = alpha_M M + beta_K K+(u_n) (projected tangent at the start of the substep). */
+static fcm_status update_damping(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
+{
+  fcm_status st = FCM_OK;
+  const fcm_integrator_options *o = &I->opts;
+  fcm_index nnz = 0;
+  int finite = 1;
+  fcm_csr_get_size(I->D, NULL, NULL, &nnz);
+  double *dv = fcm_csr_get_values(I->D);
+  const double *mv = fcm_csr_get_values(I->M);
+  fcm_csr_set_zero(I->D);
+  if (o->rayleigh_stiffness > 0.0) {
+    FCM_TRY(I->ctx, assemble(I, &I->params_psd, I->un, NULL, NULL, I->D, &finite, stats));
+    if (!finite) {
+      *reason = FCM_STEP_NONFINITE;
+      return FCM_OK;
+    }
+  }
+  for (fcm_index e = 0; e < nnz; e++) dv[e] = o->rayleigh_stiffness * dv[e] + o->rayleigh_mass * mv[e];
+  I->damp_version++;
+  if (!I->linear) I->h_state = SIM_H_INVALID;
+cleanup:
+  return st;
+}
+
+fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
+{
+  fcm_status st = FCM_OK;
+  fcm_step_info dummy;
+  sim_stats stats;
+  if (!info) info = &dummy;
+  memset(info, 0, sizeof *info);
+  memset(&stats, 0, sizeof stats);
+  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
+  FCM_CHECK(I->is_setup, I->ctx, FCM_ERR_ARG, "integrator: call fcm_integrator_setup() first");
+  {
+    fcm_ctx *ctx = I->ctx;
+    const fcm_integrator_options *o = &I->opts;
+    fcm_index n = I->n;
+    int dyn = o->kind == FCM_INTEGRATOR_BACKWARD_EULER;
+    double t_begin = fcm_wtime(), t0 = I->t, residual = 0.0, tol = 0.0;
+    int H = o->max_halvings, level = 0, done_ok = 0;
+    long long units = (long long)(dyn ? 1 : o->load_steps) << H, done = 0;
+    fcm_step_reason reason = FCM_STEP_NONE;
+    memcpy(I->u_bak, I->u, sizeof(double) * (size_t)n);
+    memcpy(I->v_bak, I->v, sizeof(double) * (size_t)n);
+    memcpy(I->lp_bak, I->load_prev, sizeof(double) * (size_t)n);
+    if (!dyn) fcm__sim_eval_loads(I, t0 + o->dt, I->fend);
+
+    while (done < units) {
+      long long size = 1LL << (H - level);
+      double s1 = (double)(done + size) / (double)units;
+      double t1 = done + size == units ? t0 + o->dt : t0 + s1 * o->dt;
+      double h = dyn ? ldexp(o->dt, -level) : 0.0;
+      if (dyn)
+        fcm__sim_eval_loads(I, t1, I->fext);
+      else
+        for (fcm_index i = 0; i < n; i++)
+          I->fext[i] = I->lp_bak[i] + s1 * (I->fend[i] - I->lp_bak[i]);
+      if (!all_finite(n, I->fext)) {
+        reason = FCM_STEP_NONFINITE;
+        st = fcm__error(ctx, FCM_ERR_NUMERIC, __FILE__, __LINE__, __func__,
+                        "integrator: the external load is not finite at t = %g (a load's "
+                        "time scale or field returned NaN or infinity)",
+                        t1);
+        break;
+      }
+      fcm__sim_eval_constraints(I, t1);
+      memcpy(I->un, I->u, sizeof(double) * (size_t)n);
+      if (dyn && I->D && (!I->linear || I->damp_version == 0)) {
+        st = update_damping(I, &reason, &stats);
+        if (st != FCM_OK) {
+          fcm__trace(ctx, __FILE__, __LINE__, __func__);
+          break;
+        }
+      }
+      if (reason == FCM_STEP_NONE) {
+        st = fcm__sim_newton(I, h, t1, &reason, &residual, &tol, &stats);
+        if (st != FCM_OK) {
+          fcm__trace(ctx, __FILE__, __LINE__, __func__);
+          break;
+        }
+      }
+      info->dt = dyn ? h : o->dt * (double)size / (double)units;
+      if (reason == FCM_STEP_CONVERGED) {
+        if (dyn)
+          for (fcm_index i = 0; i < n; i++) I->v[i] = (I->u[i] - I->un[i]) / h;
+        done += size;
+        info->substeps++;
+        reason = done < units ? FCM_STEP_NONE : reason;
+        continue;
+      }
+      info->failed_attempts++;
+      memcpy(I->u, I->un, sizeof(double) * (size_t)n);
+      if (!I->linear) I->h_state = SIM_H_INVALID;
+      if (level >= H) break;
+      level++;
+      reason = FCM_STEP_NONE;
+    }
+    done_ok = st == FCM_OK && reason == FCM_STEP_CONVERGED;
+    info->reason = reason;
+    info->halvings = level;
+    info->residual = residual;
+    info->tolerance = tol;
+    if (done_ok) {
+      I->t = t0 + o->dt;
+      I->steps++;
+      if (!dyn) memcpy(I->load_prev, I->fext, sizeof(double) * (size_t)n);
+      double ekin = 0.0;
+      if (dyn) {
+        st = fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1);
+        ekin = 0.5 * dot(n, I->v, I->w1);
+      }
+      info->kinetic_energy = ekin;
+      info->elastic_energy = I->psi;
+      info->external_work = dot(n, I->fext, I->u);
+      info->total_energy = ekin + I->psi - info->external_work;
+    } else {
+      memcpy(I->u, I->u_bak, sizeof(double) * (size_t)n);
+      memcpy(I->v, I->v_bak, sizeof(double) * (size_t)n);
+      memcpy(I->load_prev, I->lp_bak, sizeof(double) * (size_t)n);
+      fcm__sim_eval_constraints(I, I->t);
+      if (!I->linear) I->h_state = SIM_H_INVALID;
+      if (st == FCM_OK)
+        st = fcm__error(ctx, reason == FCM_STEP_NONFINITE ? FCM_ERR_NUMERIC : FCM_ERR_NOT_CONVERGED,
+                        __FILE__, __LINE__, __func__,
+                        "integrator: step %lld from t = %g failed after %d halving(s) (last dt = "
+                        "%g): %s, residual %g vs tolerance %g; state left at t = %g",
+                        I->steps + 1, t0, level, info->dt, fcm_step_reason_str(reason), residual,
+                        tol, I->t);
+    }
+    info->time = I->t;
+    info->newton_iterations = stats.newton_iterations;
+    info->line_search_backtracks = stats.backtracks;
+    info->linear_iterations = stats.linear_iterations;
+    info->tangent_assemblies = stats.tangent_assemblies;
+    info->factorizations = stats.factorizations;
+    info->direct_fallbacks = stats.direct_fallbacks;
+    info->projection_fallbacks = stats.projection_fallbacks;
+    info->inexact_solves = stats.inexact_solves;
+    info->total_analyses = fcm__sim_analyses(I);
+    info->total_factorizations = I->total_factorizations;
+    info->total_direct_fallbacks = I->total_fallbacks;
+    info->time_assembly = stats.time_assembly;
+    info->time_factor = stats.time_factor;
+    info->time_solve = stats.time_solve;
+    info->time_total = fcm_wtime() - t_begin;
+  }
+cleanup:
+  return st;
+}

@@ -1,0 +1,127 @@
+/* sim module internals: the integrator object shared by integrator.c (configuration,
+ * state, setup), newton.c (steps) and linsolve.c (direct and Krylov solves). */
+#ifndef FCM_SIM_IMPL_H
+#define FCM_SIM_IMPL_H
+
+#include "core/core_impl.h"
+#include "fcm/sim.h"
+
+typedef enum sim_load_kind { SIM_LOAD_GRAVITY = 0, SIM_LOAD_BODY, SIM_LOAD_TRACTION } sim_load_kind;
+
+typedef struct sim_load {
+  sim_load_kind kind;
+  double accel[3];     /* gravity */
+  fcm_field_fn field;  /* body force or traction */
+  void *field_user;
+  fcm_time_fn scale;   /* NULL: 1 */
+  void *scale_user;
+  double *f;           /* assembled load of scale 1 (n), after setup */
+} sim_load;
+
+typedef struct sim_constraint {
+  fcm_motion motion;   /* axis normalized */
+  fcm_index num_nodes;
+  fcm_index *nodes;
+} sim_constraint;
+
+/* Counters and timers of one step (copied into fcm_step_info). */
+typedef struct sim_stats {
+  int newton_iterations, backtracks, tangent_assemblies, factorizations;
+  int direct_fallbacks, projection_fallbacks, inexact_solves;
+  long long linear_iterations;
+  double time_assembly, time_factor, time_solve;
+} sim_stats;
+
+struct fcm_integrator {
+  fcm_ctx *ctx;
+  fcm_space *space;
+  fcm_material mat;
+  fcm_material_params params;     /* project_psd as the options say */
+  fcm_material_params params_psd; /* project_psd = 1 (fallback, damping) */
+  fcm_integrator_options opts;
+  fcm_index n;
+  int is_setup;
+  int linear;                     /* constant tangent (linear material) */
+
+  /* configuration */
+  sim_load *loads;
+  int num_loads;
+  sim_constraint *cons;
+  int num_cons;
+
+  /* state */
+  double *u, *v;
+  double t;
+  long long steps;
+  double *load_prev; /* static: external load of the last accepted step */
+
+  /* constrained DOFs (setup): per entry its DOF, node, component and constraint */
+  fcm_index ncon;
+  fcm_index *con_dof, *con_node;
+  int *con_comp, *con_id;
+  unsigned char *is_con;    /* n: constrained by an active constraint right now */
+  unsigned char *con_on;    /* num_cons: constraint active right now */
+  long long con_version;    /* bumps whenever the active set changes */
+  fcm_index nact;           /* active constrained DOFs */
+  fcm_index *act_dof;       /* nact DOFs (distinct) */
+  double *act_val;          /* their prescribed displacements at the substep's end */
+  double *act_inc;          /* increments to reach them */
+
+  /* matrices (space pattern) */
+  fcm_csr *M, *H, *D, *H0;  /* mass, Newton matrix, damping (or NULL), pristine copy (linear) */
+  double *Ma;               /* M a_rep (n) */
+  double rep_norm_full;     /* ||M a_rep|| over all DOFs */
+
+  /* work vectors (n each) */
+  double *u_bak, *v_bak, *lp_bak; /* state at the start of the step */
+  double *un;                     /* displacement at the start of the substep */
+  double *uhat, *fext, *fend, *fint, *g, *d, *b, *ut, *fint_t, *g_t, *w1, *w2;
+
+  /* solvers */
+  fcm_direct *chol, *umf, *direct; /* `direct`: the one holding the current factor */
+  fcm_krylov *krylov;
+  fcm_jacobi *jacobi;
+  fcm_schwarz *schwarz;
+  unsigned char *schwarz_flag;     /* num_cells */
+
+  /* Newton matrix cache: H holds base(h) + K(u) (state TANGENT, unmodified) or the
+   * eliminated system with a valid factor / preconditioner (state SYSTEM, key below). */
+  int h_state;
+  double key_h;
+  long long key_con, key_damp;
+  long long damp_version;
+
+  /* cumulative counters */
+  long long total_factorizations, total_fallbacks;
+
+  /* energy parts of the current iterate */
+  double psi;
+};
+
+enum { SIM_H_INVALID = 0, SIM_H_TANGENT = 1, SIM_H_SYSTEM = 2 };
+
+/* Newton solve of one (sub)step of length h (0: static) from the state u = un, v.
+ * Outputs the reason; hard errors are returned as status. (newton.c) */
+fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reason *reason,
+                           double *residual, double *tolerance, sim_stats *stats);
+
+/* Factor (direct) or set up the preconditioner (Krylov) for the eliminated matrix H.
+ * Soft failures set *reason and return FCM_OK. (linsolve.c) */
+fcm_status fcm__sim_factor(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats);
+
+/* Solve H d = b with the current factor or preconditioner. Soft failures set *reason
+ * (d is then unusable) and return FCM_OK. (linsolve.c) */
+fcm_status fcm__sim_solve(fcm_integrator *I, const double *b, double *d, fcm_step_reason *reason,
+                          int *iterations, sim_stats *stats);
+
+/* Symbolic analyses performed so far (CHOLMOD + UMFPACK). (linsolve.c) */
+long long fcm__sim_analyses(const fcm_integrator *I);
+
+/* External load at time t: sum_k scale_k(t) f_k into f (n). (integrator.c) */
+void fcm__sim_eval_loads(const fcm_integrator *I, double t, double *f);
+
+/* Active constraint set and prescribed values at time t (act_dof, act_val; con_version
+ * bumps when the set changes). (integrator.c) */
+void fcm__sim_eval_constraints(fcm_integrator *I, double t);
+
+#endif /* FCM_SIM_IMPL_H */

@@ -1,0 +1,69 @@
+/* Shared helpers of the sim tests: a small beam on a box mesh, node sets on planes, vector
+ * norms and a Newton-residual recorder for the monitor callback. */
+#ifndef FCM_TEST_SIM_UTIL_H
+#define FCM_TEST_SIM_UTIL_H
+
+#include "fcm/fcm.h"
+#include "fcm/sim.h"
+#include "test.h"
+
+/* A beam [0, lx] x [0, 1] x [0, 1] of nx x 1 x 1 cubes (nx cells of `type`, tets split). */
+static inline fcm_status beam_mesh(fcm_ctx *ctx, fcm_element_type type, fcm_index nx, double lx,
+                                   fcm_mesh **mesh)
+{
+  double lo[3] = {0, 0, 0}, hi[3] = {lx, 1, 1};
+  fcm_index n[3] = {nx, 1, 1};
+  return fcm_mesh_create_box(ctx, type, lo, hi, n, mesh);
+}
+
+/* Nodes with coordinate `axis` equal to `value` (tolerance 1e-9); malloc'ed list. */
+static inline fcm_index *plane_nodes(fcm_ctx *ctx, const fcm_mesh *mesh, int axis, double value,
+                                     fcm_index *count)
+{
+  double lo[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, hi[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL};
+  lo[axis] = hi[axis] = value;
+  fcm_index c = 0;
+  if (fcm_mesh_nodes_in_box(ctx, mesh, lo, hi, 1e-9, 0, NULL, &c) != FCM_OK) return NULL;
+  fcm_index *nodes = malloc(sizeof *nodes * (size_t)(c > 0 ? c : 1));
+  if (fcm_mesh_nodes_in_box(ctx, mesh, lo, hi, 1e-9, c, nodes, &c) != FCM_OK) {
+    free(nodes);
+    return NULL;
+  }
+  *count = c;
+  return nodes;
+}
+
+static inline double vec_norm(fcm_index n, const double *a)
+{
+  double s = 0.0;
+  for (fcm_index i = 0; i < n; i++) s += a[i] * a[i];
+  return sqrt(s);
+}
+
+static inline double vec_dist(fcm_index n, const double *a, const double *b)
+{
+  double s = 0.0;
+  for (fcm_index i = 0; i < n; i++) s += (a[i] - b[i]) * (a[i] - b[i]);
+  return sqrt(s);
+}
+
+/* Records the monitor events of the current step. */
+typedef struct newton_log {
+  int count;
+  double residual[256], alpha[256], tolerance[256];
+  int iteration[256];
+} newton_log;
+
+static inline void newton_log_fn(void *user, const fcm_newton_event *ev)
+{
+  newton_log *log = user;
+  if (log->count < 256) {
+    log->residual[log->count] = ev->residual;
+    log->alpha[log->count] = ev->step_length;
+    log->tolerance[log->count] = ev->tolerance;
+    log->iteration[log->count] = ev->iteration;
+    log->count++;
+  }
+}
+
+#endif

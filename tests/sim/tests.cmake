@@ -1,0 +1,6 @@
+foreach(el hex8 tet10)
+  fcm_add_test(sim_static_linear_${el} tests/sim/static_linear.c ARGS ${el})
+endforeach()
+foreach(el hex8 tet10)
+  fcm_add_test(sim_static_snh_${el} tests/sim/static_snh.c ARGS ${el})
+endforeach()
