@@ -11,6 +11,7 @@
 #include "fcm/mesh.h"
 #include "fcm/quad.h"
 #include "fcm/rulegen.h"
+#include "fcm/sim.h"
 #include "fcm/scene.h"
 #include "fcm/solve.h"
 #include "fcm/simplify.h"
