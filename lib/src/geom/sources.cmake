@@ -1,1 +1,2 @@
-list(APPEND FCM_SOURCES)
+list(APPEND FCM_SOURCES lib/src/geom/aabb.c lib/src/geom/clip.c lib/src/geom/geometry.c
+                        lib/src/geom/shapes.c lib/src/geom/tetgen.c)

@@ -1,0 +1,222 @@
+/* AABB tree: a static bounding-volume hierarchy over boxes, built by median splits
+ * along the longest axis of the box centres; box queries for candidate search. */
+#include "geom/geom_impl.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#define LEAF_SIZE 4
+#define MAX_DEPTH 128
+
+/* Centre coordinate of item `id` along `axis` (times 2). */
+static double centre(const double *boxes, fcm_index id, int axis)
+{
+  return boxes[6 * id + axis] + boxes[6 * id + 3 + axis];
+}
+
+static int less(const double *boxes, int axis, fcm_index a, fcm_index b)
+{
+  const double ca = centre(boxes, a, axis), cb = centre(boxes, b, axis);
+  return ca < cb || (ca == cb && a < b);
+}
+
+/* Reorder perm[0..n) so that perm[k] is the k-th smallest (Hoare selection). */
+static void select_kth(const double *boxes, int axis, fcm_index *perm, fcm_index n, fcm_index k)
+{
+  fcm_index lo = 0, hi = n - 1;
+  while (hi > lo) {
+    /* Median of three as pivot, deterministic. */
+    const fcm_index mid = lo + (hi - lo) / 2;
+    fcm_index a = perm[lo], b = perm[mid], c = perm[hi], piv;
+    if (less(boxes, axis, a, b))
+      piv = less(boxes, axis, b, c) ? b : (less(boxes, axis, a, c) ? c : a);
+    else
+      piv = less(boxes, axis, a, c) ? a : (less(boxes, axis, b, c) ? c : b);
+    fcm_index i = lo, j = hi;
+    while (i <= j) {
+      while (less(boxes, axis, perm[i], piv))
+        i++;
+      while (less(boxes, axis, piv, perm[j]))
+        j--;
+      if (i <= j) {
+        const fcm_index t = perm[i];
+        perm[i] = perm[j], perm[j] = t;
+        i++, j--;
+      }
+    }
+    if (k <= j)
+      hi = j;
+    else if (k >= i)
+      lo = i;
+    else
+      return;
+  }
+}
+
+static void node_box(fcm_aabb_tree *t, fcm__aabb_node *nd, fcm_index first, fcm_index count)
+{
+  for (int d = 0; d < 3; d++)
+    nd->lo[d] = HUGE_VAL, nd->hi[d] = -HUGE_VAL;
+  for (fcm_index s = first; s < first + count; s++) {
+    const double *b = t->boxes + 6 * t->perm[s];
+    for (int d = 0; d < 3; d++) {
+      nd->lo[d] = b[d] < nd->lo[d] ? b[d] : nd->lo[d];
+      nd->hi[d] = b[3 + d] > nd->hi[d] ? b[3 + d] : nd->hi[d];
+    }
+  }
+}
+
+static void build(fcm_aabb_tree *t, fcm_index node, fcm_index first, fcm_index count)
+{
+  fcm__aabb_node *nd = t->nodes + node;
+  node_box(t, nd, first, count);
+  if (count <= LEAF_SIZE) {
+    nd->first = first, nd->count = count;
+    return;
+  }
+  double clo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, chi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (fcm_index s = first; s < first + count; s++)
+    for (int d = 0; d < 3; d++) {
+      const double c = centre(t->boxes, t->perm[s], d);
+      clo[d] = c < clo[d] ? c : clo[d];
+      chi[d] = c > chi[d] ? c : chi[d];
+    }
+  int axis = 0;
+  for (int d = 1; d < 3; d++)
+    if (chi[d] - clo[d] > chi[axis] - clo[axis]) axis = d;
+  const fcm_index half = count / 2;
+  select_kth(t->boxes, axis, t->perm + first, count, half);
+  const fcm_index left = t->num_nodes;
+  t->num_nodes += 2;
+  nd->first = left, nd->count = 0;
+  build(t, left, first, half);
+  build(t, left + 1, first + half, count - half);
+}
+
+fcm_status fcm_aabb_tree_create(fcm_ctx *ctx, fcm_index n, const double *boxes,
+                                fcm_aabb_tree **tree)
+{
+  fcm_status st = FCM_OK;
+  fcm_aabb_tree *t = NULL;
+  FCM_CHECK(tree, ctx, FCM_ERR_ARG, "aabb tree: output pointer is NULL");
+  *tree = NULL;
+  FCM_CHECK(ctx, ctx, FCM_ERR_ARG, "aabb tree: ctx is NULL");
+  FCM_CHECK(n >= 0 && (n == 0 || boxes), ctx, FCM_ERR_ARG,
+            "aabb tree: n = %lld must be >= 0 with a non-NULL box array", (long long)n);
+  for (fcm_index i = 0; i < n; i++)
+    for (int d = 0; d < 3; d++)
+      FCM_CHECK(boxes[6 * i + d] <= boxes[6 * i + 3 + d], ctx, FCM_ERR_ARG,
+                "aabb tree: box %lld has lo[%d] = %g > hi[%d] = %g (or NaN)", (long long)i, d,
+                boxes[6 * i + d], d, boxes[6 * i + 3 + d]);
+  FCM_ALLOC(ctx, 1, t);
+  t->ctx = ctx;
+  t->num_items = n;
+  FCM_ALLOC(ctx, 2 * (size_t)n + 1, t->nodes);
+  FCM_ALLOC(ctx, n, t->perm);
+  FCM_ALLOC(ctx, 6 * (size_t)n, t->boxes);
+  for (fcm_index i = 0; i < 6 * n; i++)
+    t->boxes[i] = boxes[i];
+  for (fcm_index i = 0; i < n; i++)
+    t->perm[i] = i;
+  if (n > 0) {
+    t->num_nodes = 1;
+    build(t, 0, 0, n);
+  }
+  *tree = t;
+  t = NULL;
+cleanup:
+  fcm_aabb_tree_destroy(&t);
+  return st;
+}
+
+void fcm_aabb_tree_destroy(fcm_aabb_tree **tree)
+{
+  if (!tree || !*tree) return;
+  fcm_aabb_tree *t = *tree;
+  fcm__free(t->ctx, t->nodes);
+  fcm__free(t->ctx, t->perm);
+  fcm__free(t->ctx, t->boxes);
+  fcm__free(t->ctx, t);
+  *tree = NULL;
+}
+
+static int overlaps(const double *alo, const double *ahi, const double lo[3], const double hi[3])
+{
+  return alo[0] <= hi[0] && lo[0] <= ahi[0] && alo[1] <= hi[1] && lo[1] <= ahi[1] &&
+         alo[2] <= hi[2] && lo[2] <= ahi[2];
+}
+
+static int cmp_index(const void *a, const void *b)
+{
+  const fcm_index x = *(const fcm_index *)a, y = *(const fcm_index *)b;
+  return (x > y) - (x < y);
+}
+
+fcm_status fcm__geom_tree_query(fcm_ctx *ctx, const fcm_aabb_tree *t, const double lo[3],
+                                const double hi[3], fcm__idbuf *buf)
+{
+  fcm_status st = FCM_OK;
+  fcm_index stack[MAX_DEPTH];
+  int top = 0;
+  buf->n = 0;
+  if (t->num_items == 0) goto cleanup;
+  stack[top++] = 0;
+  while (top > 0) {
+    const fcm__aabb_node *nd = t->nodes + stack[--top];
+    if (!overlaps(nd->lo, nd->hi, lo, hi)) continue;
+    if (nd->count == 0) {
+      FCM_CHECK(top + 2 <= MAX_DEPTH, ctx, FCM_ERR_INTERNAL, "aabb tree: depth exceeds %d",
+                MAX_DEPTH);
+      stack[top++] = nd->first + 1;
+      stack[top++] = nd->first;
+      continue;
+    }
+    for (fcm_index s = nd->first; s < nd->first + nd->count; s++) {
+      const fcm_index id = t->perm[s];
+      const double *b = t->boxes + 6 * id;
+      if (!overlaps(b, b + 3, lo, hi)) continue;
+      if (buf->n == buf->cap) {
+        const size_t cap = buf->cap ? 2 * buf->cap : 64;
+        void *grown = buf->ids;
+        FCM_TRY(ctx, fcm__resize(ctx, &grown, buf->cap, cap, sizeof *buf->ids));
+        buf->ids = grown;
+        buf->cap = cap;
+      }
+      buf->ids[buf->n++] = id;
+    }
+  }
+  if (buf->n > 1) qsort(buf->ids, buf->n, sizeof *buf->ids, cmp_index);
+cleanup:
+  return st;
+}
+
+void fcm__geom_idbuf_free(fcm_ctx *ctx, fcm__idbuf *buf)
+{
+  fcm__free(ctx, buf->ids);
+  buf->ids = NULL;
+  buf->n = buf->cap = 0;
+}
+
+fcm_status fcm_aabb_tree_query(const fcm_aabb_tree *tree, const double lo[3], const double hi[3],
+                               fcm_index capacity, fcm_index *ids, fcm_index *count)
+{
+  fcm_status st = FCM_OK;
+  fcm__idbuf buf = {NULL, 0, 0};
+  fcm_ctx *ctx = tree ? tree->ctx : NULL;
+  FCM_CHECK(tree && lo && hi && count, ctx, FCM_ERR_ARG,
+            "aabb tree query: NULL argument (tree, lo, hi and count are required)");
+  FCM_CHECK(capacity >= 0 && (capacity == 0 || ids), ctx, FCM_ERR_ARG,
+            "aabb tree query: capacity = %lld must be >= 0 with a non-NULL ids array",
+            (long long)capacity);
+  for (int d = 0; d < 3; d++)
+    FCM_CHECK(!isnan(lo[d]) && !isnan(hi[d]), ctx, FCM_ERR_ARG,
+              "aabb tree query: box coordinate %d is NaN", d);
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, lo, hi, &buf));
+  *count = (fcm_index)buf.n;
+  if ((fcm_index)buf.n <= capacity)
+    for (size_t i = 0; i < buf.n; i++)
+      ids[i] = buf.ids[i];
+cleanup:
+  fcm__geom_idbuf_free(ctx, &buf);
+  return st;
+}

@@ -1,0 +1,287 @@
+/* Convex polyhedron and polygon clipping by half-spaces with one classification per
+ * vertex and plane, and fan tetrahedralization of the result.
+ *
+ * Longva et al. 2020, Sec. 4.5: the intersection of a convex embedded cell with a
+ * convex background cell is clipped plane by plane; each vertex is classified against
+ * a plane once (with a tolerance relative to the cell size) and that sign decides every
+ * face it belongs to, so neighbouring faces agree on the topology. New vertices are
+ * made only on edges with ends strictly on opposite sides, hence t = s_a / (s_a - s_b)
+ * is well conditioned. The cap face is the convex polygon of the on-plane vertices,
+ * ordered by angle around the plane normal. */
+#include "geom/geom_impl.h"
+
+#include <math.h>
+#include <string.h>
+
+static double dot3(const double a[3], const double b[3])
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void cross3(const double a[3], const double b[3], double c[3])
+{
+  c[0] = a[1] * b[2] - a[2] * b[1];
+  c[1] = a[2] * b[0] - a[0] * b[2];
+  c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+void fcm__geom_poly_from_cell(fcm_element_type type, const double *X, fcm__poly *p)
+{
+  const fcm_element_info *info = fcm_element_get_info(type);
+  p->nv = info->num_corners;
+  for (int a = 0; a < p->nv; a++)
+    for (int d = 0; d < 3; d++)
+      p->x[a][d] = X[3 * a + d];
+  p->nf = info->num_faces;
+  for (int f = 0; f < p->nf; f++) {
+    p->fn[f] = info->face_num_corners[f];
+    for (int k = 0; k < p->fn[f]; k++)
+      p->fv[f][k] = info->face_nodes[f][k];
+  }
+}
+
+int fcm__geom_cell_planes(const fcm_element_info *info, const double *X, fcm__plane *planes)
+{
+  for (int f = 0; f < info->num_faces; f++) {
+    const int nc = info->face_num_corners[f];
+    double n[3] = {0, 0, 0}, c[3] = {0, 0, 0};
+    for (int k = 0; k < nc; k++) {
+      const double *a = X + 3 * info->face_nodes[f][k];
+      const double *b = X + 3 * info->face_nodes[f][(k + 1) % nc];
+      n[0] += (a[1] - b[1]) * (a[2] + b[2]); /* Newell's method */
+      n[1] += (a[2] - b[2]) * (a[0] + b[0]);
+      n[2] += (a[0] - b[0]) * (a[1] + b[1]);
+      for (int d = 0; d < 3; d++)
+        c[d] += a[d] / nc;
+    }
+    const double len = sqrt(dot3(n, n));
+    fcm__plane *pl = planes + f;
+    if (len > 0.0) {
+      for (int d = 0; d < 3; d++)
+        pl->n[d] = n[d] / len;
+      pl->d = dot3(pl->n, c);
+    } else {
+      pl->n[0] = pl->n[1] = pl->n[2] = 0.0;
+      pl->d = 0.0;
+    }
+  }
+  return info->num_faces;
+}
+
+/* Find or make the vertex on edge (a, b) of the input; cache entries are (min, max, id). */
+static int edge_vertex(const fcm__poly *in, const double *s, int a, int b, int (*cache)[3],
+                       int *ncache, fcm__poly *out)
+{
+  const int lo = a < b ? a : b, hi = a < b ? b : a;
+  for (int k = 0; k < *ncache; k++)
+    if (cache[k][0] == lo && cache[k][1] == hi) return cache[k][2];
+  if (out->nv >= FCM__POLY_MAX_VERTS || *ncache >= FCM__POLY_MAX_VERTS) return -1;
+  /* Interpolate from the lower-index end so both faces get the same point. */
+  const double t = s[lo] / (s[lo] - s[hi]);
+  const int id = out->nv++;
+  for (int d = 0; d < 3; d++)
+    out->x[id][d] = in->x[lo][d] + t * (in->x[hi][d] - in->x[lo][d]);
+  cache[*ncache][0] = lo, cache[*ncache][1] = hi, cache[*ncache][2] = id;
+  (*ncache)++;
+  return id;
+}
+
+/* Order the on-plane vertices `ids` (k of them) counter-clockwise around n. */
+static void sort_cap(const fcm__poly *p, const double n[3], int *ids, int k)
+{
+  double c[3] = {0, 0, 0}, u[3], v[3], ang[FCM__POLY_MAX_VERTS];
+  for (int i = 0; i < k; i++)
+    for (int d = 0; d < 3; d++)
+      c[d] += p->x[ids[i]][d] / k;
+  /* u: any unit vector orthogonal to n; v = n x u. */
+  const double ax[3] = {fabs(n[0]) < 0.6 ? 1.0 : 0.0, fabs(n[0]) < 0.6 ? 0.0 : 1.0, 0.0};
+  cross3(n, ax, u);
+  const double lu = sqrt(dot3(u, u));
+  for (int d = 0; d < 3; d++)
+    u[d] /= lu;
+  cross3(n, u, v);
+  for (int i = 0; i < k; i++) {
+    double r[3];
+    for (int d = 0; d < 3; d++)
+      r[d] = p->x[ids[i]][d] - c[d];
+    ang[i] = atan2(dot3(r, v), dot3(r, u));
+  }
+  for (int i = 1; i < k; i++) { /* insertion sort: k is small */
+    const double a = ang[i];
+    const int id = ids[i];
+    int j = i;
+    while (j > 0 && (ang[j - 1] > a || (ang[j - 1] == a && ids[j - 1] > id))) {
+      ang[j] = ang[j - 1], ids[j] = ids[j - 1];
+      j--;
+    }
+    ang[j] = a, ids[j] = id;
+  }
+}
+
+int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__poly *out)
+{
+  double s[FCM__POLY_MAX_VERTS];
+  int sg[FCM__POLY_MAX_VERTS], newid[FCM__POLY_MAX_VERTS], cache[FCM__POLY_MAX_VERTS][3];
+  int ncache = 0, any_in = 0, any_out = 0, cap_face = 0;
+  if (p->nf == 0) return 0;
+  if (pl->n[0] == 0.0 && pl->n[1] == 0.0 && pl->n[2] == 0.0) return 0;
+  for (int i = 0; i < p->nv; i++) {
+    s[i] = dot3(pl->n, p->x[i]) - pl->d;
+    sg[i] = s[i] > tol ? 1 : (s[i] < -tol ? -1 : 0);
+    any_out |= sg[i] > 0;
+    any_in |= sg[i] < 0;
+  }
+  if (!any_out) return 0; /* entirely inside (on-plane vertices kept) */
+  if (!any_in) {          /* outside, or flat on the plane */
+    p->nv = p->nf = 0;
+    return 0;
+  }
+  out->nv = out->nf = 0;
+  for (int i = 0; i < p->nv; i++) {
+    newid[i] = -1;
+    if (sg[i] <= 0) {
+      newid[i] = out->nv++;
+      memcpy(out->x[newid[i]], p->x[i], sizeof out->x[0]);
+    }
+  }
+  for (int f = 0; f < p->nf; f++) {
+    const int fn = p->fn[f];
+    int cyc[FCM__POLY_MAX_FV], nc = 0, all_on = 1;
+    for (int k = 0; k < fn; k++) {
+      const int a = p->fv[f][k], b = p->fv[f][(k + 1) % fn];
+      all_on &= sg[a] == 0;
+      if (sg[a] <= 0) {
+        if (nc >= FCM__POLY_MAX_FV) goto overflow;
+        cyc[nc++] = newid[a];
+      }
+      if (sg[a] * sg[b] < 0) {
+        const int e = edge_vertex(p, s, a, b, cache, &ncache, out);
+        if (e < 0 || nc >= FCM__POLY_MAX_FV) goto overflow;
+        cyc[nc++] = e;
+      }
+    }
+    cap_face |= all_on;
+    if (nc >= 3) {
+      if (out->nf >= FCM__POLY_MAX_FACES) goto overflow;
+      out->fn[out->nf] = nc;
+      memcpy(out->fv[out->nf], cyc, (size_t)nc * sizeof cyc[0]);
+      out->nf++;
+    }
+  }
+  if (!cap_face) {
+    /* Cap: the new edge vertices and the kept on-plane vertices. */
+    int ids[FCM__POLY_MAX_VERTS], k = 0;
+    for (int i = 0; i < p->nv; i++)
+      if (sg[i] == 0) ids[k++] = newid[i];
+    for (int e = 0; e < ncache; e++)
+      ids[k++] = cache[e][2];
+    if (k >= 3) {
+      if (out->nf >= FCM__POLY_MAX_FACES || k > FCM__POLY_MAX_FV) goto overflow;
+      sort_cap(out, pl->n, ids, k);
+      out->fn[out->nf] = k;
+      memcpy(out->fv[out->nf], ids, (size_t)k * sizeof ids[0]);
+      out->nf++;
+    }
+  }
+  if (out->nf < 4) out->nv = out->nf = 0; /* fewer than 4 faces: no volume */
+  memcpy(p, out, sizeof *p);
+  return 0;
+overflow:
+  p->nv = p->nf = 0;
+  return -1;
+}
+
+int fcm__geom_poly_num_tets(const fcm__poly *p)
+{
+  int n = 0;
+  for (int f = 0; f < p->nf; f++)
+    n += p->fn[f] - 2;
+  return n;
+}
+
+int fcm__geom_poly_tets(const fcm__poly *p, double *tets, double *vol)
+{
+  double c[3] = {0, 0, 0};
+  int nt = 0;
+  if (p->nf == 0) return 0;
+  for (int i = 0; i < p->nv; i++)
+    for (int d = 0; d < 3; d++)
+      c[d] += p->x[i][d];
+  for (int d = 0; d < 3; d++)
+    c[d] /= p->nv;
+  for (int f = 0; f < p->nf; f++) {
+    const double *a = p->x[p->fv[f][0]];
+    for (int k = 1; k + 1 < p->fn[f]; k++) {
+      const double *b = p->x[p->fv[f][k]], *e = p->x[p->fv[f][k + 1]];
+      double *t = tets + 12 * nt;
+      double ra[3], rb[3], re[3], cr[3];
+      for (int d = 0; d < 3; d++) {
+        t[d] = c[d], t[3 + d] = a[d], t[6 + d] = b[d], t[9 + d] = e[d];
+        ra[d] = a[d] - c[d], rb[d] = b[d] - c[d], re[d] = e[d] - c[d];
+      }
+      cross3(ra, rb, cr);
+      vol[nt] = dot3(cr, re) / 6.0;
+      nt++;
+    }
+  }
+  return nt;
+}
+
+double fcm__geom_poly_volume(const fcm__poly *p)
+{
+  double c[3] = {0, 0, 0}, v = 0.0;
+  if (p->nf == 0) return 0.0;
+  for (int i = 0; i < p->nv; i++)
+    for (int d = 0; d < 3; d++)
+      c[d] += p->x[i][d] / p->nv;
+  for (int f = 0; f < p->nf; f++) {
+    const double *a = p->x[p->fv[f][0]];
+    for (int k = 1; k + 1 < p->fn[f]; k++) {
+      const double *b = p->x[p->fv[f][k]], *e = p->x[p->fv[f][k + 1]];
+      double ra[3], rb[3], re[3], cr[3];
+      for (int d = 0; d < 3; d++)
+        ra[d] = a[d] - c[d], rb[d] = b[d] - c[d], re[d] = e[d] - c[d];
+      cross3(ra, rb, cr);
+      v += dot3(cr, re) / 6.0;
+    }
+  }
+  return v;
+}
+
+int fcm__geom_polygon_clip(double *x, int n, int cap, const fcm__plane *pl, double tol,
+                           int keep_coplanar, double *work)
+{
+  double s[FCM__POLY_MAX_VERTS];
+  int sg[FCM__POLY_MAX_VERTS], any_in = 0, any_out = 0, m = 0;
+  if (n < 3) return 0;
+  if (n > FCM__POLY_MAX_VERTS) return -1;
+  if (pl->n[0] == 0.0 && pl->n[1] == 0.0 && pl->n[2] == 0.0) return n;
+  for (int i = 0; i < n; i++) {
+    s[i] = dot3(pl->n, x + 3 * i) - pl->d;
+    sg[i] = s[i] > tol ? 1 : (s[i] < -tol ? -1 : 0);
+    any_out |= sg[i] > 0;
+    any_in |= sg[i] < 0;
+  }
+  if (!any_out && !any_in) return keep_coplanar ? n : 0;
+  if (!any_out) return n;
+  if (!any_in) return 0;
+  for (int i = 0; i < n; i++) {
+    const int j = (i + 1) % n;
+    if (sg[i] <= 0) {
+      if (m >= cap) return -1;
+      memcpy(work + 3 * m++, x + 3 * i, 3 * sizeof *x);
+    }
+    if (sg[i] * sg[j] < 0) {
+      /* Interpolate from the lower-index end, as fcm__geom_poly_clip does. */
+      const int lo = i < j ? i : j, hi = i < j ? j : i;
+      const double t = s[lo] / (s[lo] - s[hi]);
+      if (m >= cap) return -1;
+      for (int d = 0; d < 3; d++)
+        work[3 * m + d] = x[3 * lo + d] + t * (x[3 * hi + d] - x[3 * lo + d]);
+      m++;
+    }
+  }
+  if (m < 3) return 0;
+  memcpy(x, work, (size_t)(3 * m) * sizeof *x);
+  return m;
+}

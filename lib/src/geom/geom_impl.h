@@ -1,0 +1,124 @@
+/* fcm geom, internal part: the geometry and AABB-tree structs, and the convex
+ * polyhedron / polygon clipping kernels the embed module runs per background cell. */
+#ifndef FCM_GEOM_IMPL_H
+#define FCM_GEOM_IMPL_H
+
+#include "core/core_impl.h"
+#include "fcm/geom.h"
+
+struct fcm_geometry {
+  fcm_ctx *ctx;
+  fcm_element_type type; /* FCM_ELEMENT_TET4 or FCM_ELEMENT_HEX8 */
+  int npc;               /* nodes per cell: 4 or 8 */
+  fcm_index num_nodes;
+  fcm_index num_cells;
+  double *coords;   /* num_nodes x 3 */
+  fcm_index *cells; /* num_cells x npc */
+  fcm_index num_tris;
+  fcm_index *tris;     /* num_tris x 3 node ids, counter-clockwise seen from outside */
+  fcm_index *tri_cell; /* num_tris: the cell each boundary triangle belongs to */
+  double volume;       /* sum of the cell volumes */
+  double lo[3], hi[3]; /* bounding box of the nodes */
+};
+
+/* Create a geometry that takes ownership of *coords and *cells (allocated with
+ * fcm__calloc on ctx); both are NULL on return, success or failure. Validates ids,
+ * finiteness and (Hex8) convexity; a negatively oriented Tet4 is reoriented, a
+ * negatively oriented Hex8 rejected. With `require_positive` (procedural shapes, which
+ * orient their tets themselves), nothing is reoriented and a cell of zero or negative
+ * volume is an FCM_ERR_INTERNAL. `who` names the caller in messages. Builds the
+ * boundary triangles. */
+fcm_status fcm__geom_create_take(fcm_ctx *ctx, const char *who, fcm_element_type type,
+                                 fcm_index num_nodes, double **coords, fcm_index num_cells,
+                                 fcm_index **cells, int require_positive, fcm_geometry **geom);
+
+/* ---------------------------------------------------------------- AABB tree */
+
+typedef struct fcm__aabb_node {
+  double lo[3], hi[3];
+  fcm_index first; /* leaf: first slot in perm; inner: index of the left child */
+  fcm_index count; /* leaf: number of items (> 0); inner: 0 (right child = left + 1) */
+} fcm__aabb_node;
+
+struct fcm_aabb_tree {
+  fcm_ctx *ctx;
+  fcm_index num_items;
+  fcm_index num_nodes;
+  fcm__aabb_node *nodes; /* node 0 is the root (absent when num_items == 0) */
+  fcm_index *perm;       /* item ids, leaves own contiguous ranges */
+  double *boxes;         /* num_items x 6 copy: lo[3], hi[3] */
+};
+
+/* Growable id buffer for queries from many threads (one buffer per thread). */
+typedef struct fcm__idbuf {
+  fcm_index *ids;
+  size_t n, cap;
+} fcm__idbuf;
+
+/* Ids of the items whose box intersects [lo, hi] (closed boxes), ascending, into
+ * buf (grown through ctx as needed; buf->n is reset first). Thread safe for distinct
+ * buffers. */
+fcm_status fcm__geom_tree_query(fcm_ctx *ctx, const fcm_aabb_tree *tree, const double lo[3],
+                                const double hi[3], fcm__idbuf *buf);
+
+/* Release a buffer's storage. */
+void fcm__geom_idbuf_free(fcm_ctx *ctx, fcm__idbuf *buf);
+
+/* ---------------------------------------------------------------- convex clipping */
+
+#define FCM__POLY_MAX_VERTS 128
+#define FCM__POLY_MAX_FACES 32
+#define FCM__POLY_MAX_FV    64
+
+/* A convex polyhedron: vertex positions and faces as vertex cycles, counter-
+ * clockwise seen from outside. nf == 0 means empty. Plain value type (~25 kB). */
+typedef struct fcm__poly {
+  int nv, nf;
+  double x[FCM__POLY_MAX_VERTS][3];
+  int fn[FCM__POLY_MAX_FACES];
+  int fv[FCM__POLY_MAX_FACES][FCM__POLY_MAX_FV];
+} fcm__poly;
+
+/* A half-space {x : n.x <= d} with unit outward normal n. */
+typedef struct fcm__plane {
+  double n[3];
+  double d;
+} fcm__plane;
+
+/* Polyhedron of a Tet4 (4 nodes) or convex Hex8 (8 nodes, VTK order) cell from its
+ * corner coordinates X (npc x 3), faces from the element's face tables. */
+void fcm__geom_poly_from_cell(fcm_element_type type, const double *X, fcm__poly *p);
+
+/* Outward half-spaces of the planar faces of a convex cell from its corners (Newell
+ * normal, through the face-corner centroid). Returns the number of planes (4 or 6);
+ * a degenerate face (zero normal) gets n = 0, d = 0 (never clips). */
+int fcm__geom_cell_planes(const fcm_element_info *info, const double *X, fcm__plane *planes);
+
+/* Clip p by the half-space `pl` in place. Each vertex is classified once against
+ * the plane: outside when n.x - d > tol, inside when < -tol, on the plane otherwise;
+ * on-plane vertices are kept where they are and new vertices are made only on edges
+ * whose ends are strictly on opposite sides (one per edge, shared by its two faces).
+ * `scratch` is workspace. Returns 0, or -1 when a capacity FCM__POLY_MAX_* would be
+ * exceeded (p is then left empty). */
+int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__poly *scratch);
+
+/* Number of tetrahedra fcm__geom_poly_tets() makes: sum over faces of (fn - 2). */
+int fcm__geom_poly_num_tets(const fcm__poly *p);
+
+/* Tetrahedralize p by a fan from its vertex centroid c over a fan triangulation of
+ * each face: tet k is (c, a, b, e) stored as 12 doubles in tets[12 k ...] and its
+ * signed volume in vol[k] (positive for a convex p with outward faces). Returns the
+ * number of tets written. */
+int fcm__geom_poly_tets(const fcm__poly *p, double *tets, double *vol);
+
+/* Volume of p (sum of the signed fan volumes). */
+double fcm__geom_poly_volume(const fcm__poly *p);
+
+/* Clip the polygon (n vertices x 3, in/out, capacity `cap` vertices) by the half-
+ * space with the same classification rule as fcm__geom_poly_clip; `work` holds cap x 3
+ * doubles. Returns the new vertex count (0: empty), or -1 on overflow. When every
+ * vertex is on the plane the polygon is kept iff keep_coplanar is set. */
+int fcm__geom_polygon_clip(double *x, int n, int cap, const fcm__plane *pl, double tol,
+                           int keep_coplanar, double *work);
+
+#endif /* FCM_GEOM_IMPL_H */

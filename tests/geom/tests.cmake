@@ -1,0 +1,7 @@
+# Embedded geometry: convex clipping, AABB tree, procedural shapes (volumes, convergence,
+# closed outward boundaries), TetGen and Gmsh readers, errors and allocation failures.
+fcm_add_test(geom_clip tests/geom/clip.c)
+fcm_add_test(geom_aabb tests/geom/aabb.c)
+fcm_add_test(geom_shapes tests/geom/shapes.c)
+fcm_add_test(geom_readers tests/geom/readers.c)
+fcm_add_test(geom_errors tests/geom/errors.c)
