@@ -4,7 +4,9 @@
 
 #include "fcm/core.h"
 #include "fcm/element.h"
+#include "fcm/embed.h"
 #include "fcm/fem.h"
+#include "fcm/geom.h"
 #include "fcm/la.h"
 #include "fcm/material.h"
 #include "fcm/io.h"

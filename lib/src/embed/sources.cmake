@@ -1,1 +1,1 @@
-list(APPEND FCM_SOURCES)
+list(APPEND FCM_SOURCES lib/src/embed/cell_rules.c lib/src/embed/intersect.c)

@@ -1,0 +1,151 @@
+/* fcm — embedded (cut-cell) quadrature: per background cell, the embedded geometry is
+ * clipped by the cell's planes, tetrahedralized and integrated with a tet rule mapped into
+ * the cell's reference element (Longva et al. 2020 §4.5, DESIGN §5); cut-cell rules are
+ * simplified (fcm/simplify.h) and stabilized; surface rules on the embedded boundary.
+ *
+ * Rules live in reference coordinates xi of the background cell K. A volume rule's weight
+ * w already contains l_j |J_Q| / |det J_K(xi)|, so the physical integral over K ∩ Ω is
+ * sum_j w_j det J_K(xi_j) f(X(xi_j)). Surface weights are physical area weights. */
+#ifndef FCM_EMBED_H
+#define FCM_EMBED_H
+
+#include "fcm/core.h"
+#include "fcm/element.h"
+#include "fcm/geom.h"
+#include "fcm/mesh.h"
+#include "fcm/simplify.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Class of a background cell by its volume fraction phi = |K ∩ Ω| / |K|. */
+typedef enum fcm_cell_class {
+  FCM_CELL_UNCUT = 0, /**< phi >= uncut_fraction: the catalogue rule of the cell's shape */
+  FCM_CELL_CUT,       /**< min_fraction <= phi < uncut_fraction: an embedded rule */
+  FCM_CELL_DROPPED    /**< phi < min_fraction: no points; the cell leaves the system */
+} fcm_cell_class;
+
+/** The two volume rules each cell carries (DESIGN §3: separate strengths). */
+typedef enum fcm_rule_kind {
+  FCM_RULE_STIFFNESS = 0, /**< stiffness, internal and body forces */
+  FCM_RULE_MASS = 1,      /**< consistent mass */
+  FCM_RULE_KIND_COUNT
+} fcm_rule_kind;
+
+/** Options of fcm_cell_rules_create(); initialize with fcm_cell_rules_options_default(). */
+typedef struct fcm_cell_rules_options {
+  int strength[FCM_RULE_KIND_COUNT]; /**< per kind; -1 (default): the element's default */
+  int surface_strength;  /**< -1 (default): no surface rules; else the triangle rule strength */
+  double min_fraction;   /**< phi below this: dropped; default 1e-4 (0: drop only empty cells) */
+  double uncut_fraction; /**< phi at or above this: uncut; default 1 - 1e-12 */
+  double clip_rtol;      /**< vertex-on-plane tolerance / cell diameter; default 1e-12 */
+  double sliver_rtol;    /**< tets with volume <= this * |K| are dropped; default 1e-14 */
+  double convex_rtol;    /**< tolerance of fcm_mesh_cell_is_convex(); default 1e-10 */
+  int simplify;          /**< 1 (default): simplify cut-cell rules with fcm_simplify() */
+  fcm_simplify_options simplify_options;   /**< default fcm_simplify_options_default() */
+  fcm_stabilization_options stabilization; /**< default mass + stiffness, alpha 1e-6 */
+  int num_threads;                         /**< OpenMP threads; 0 (default): the OpenMP default */
+} fcm_cell_rules_options;
+
+/** Defaults as documented on each member. */
+FCM_API fcm_cell_rules_options fcm_cell_rules_options_default(void);
+
+/** Statistics of fcm_cell_rules_create(). Point counts cover cut cells unless "total".
+ * Times in seconds: wall clock, except intersect and simplify, which are summed over
+ * threads (seconds of one core). */
+typedef struct fcm_cell_rules_stats {
+  fcm_index num_cells, num_uncut, num_cut, num_dropped;
+  fcm_index num_candidates; /**< (background cell, embedded cell) pairs from the tree */
+  fcm_index num_pieces;     /**< non-empty clipped polyhedra */
+  fcm_index num_tets;       /**< tets of the pieces kept (slivers excluded) */
+  fcm_index num_slivers;    /**< tets dropped as slivers */
+  fcm_index points_initial[FCM_RULE_KIND_COUNT];    /**< before simplification */
+  fcm_index points_simplified[FCM_RULE_KIND_COUNT]; /**< after (= initial when off) */
+  fcm_index points_stabilization[FCM_RULE_KIND_COUNT];
+  fcm_index points_total[FCM_RULE_KIND_COUNT];       /**< all stored points, uncut cells included */
+  fcm_index simplify_skipped[FCM_RULE_KIND_COUNT];   /**< cut cells with N <= M */
+  fcm_index simplify_fallbacks[FCM_RULE_KIND_COUNT]; /**< kept unsimplified after failure */
+  double max_residual[FCM_RULE_KIND_COUNT]; /**< largest relative moment residual reported */
+  fcm_index surface_triangles;              /**< clipped boundary triangles kept */
+  fcm_index surface_points;
+  double embedded_volume; /**< sum over all cells of |K ∩ Ω| (dropped cells included) */
+  double dropped_volume;  /**< the part of it in dropped cells */
+  double embedded_area;   /**< sum of the surface weights (non-dropped cells) */
+  double geometry_volume; /**< fcm_geometry_volume() */
+  double time_setup, time_intersect, time_simplify, time_gather, time_total;
+  int num_threads;
+} fcm_cell_rules_stats;
+
+/** Per-cell quadrature of an embedded geometry in a background mesh (opaque). */
+typedef struct fcm_cell_rules fcm_cell_rules;
+
+/** Build the rules of every background cell (DESIGN §5): AABB-tree candidates, convex
+ * clipping by the cell's face planes, fan tetrahedralization, tet rules mapped into the
+ * reference cell (closed-form inverse for affine cells, Newton otherwise), classification;
+ * then per cut cell simplification (if enabled) followed by stabilization points (flag 1).
+ * Parallel over cells (OpenMP); the output does not depend on the thread count.
+ * @param[in] mesh background mesh; every cell must be convex (straight edges, planar faces)
+ * @param[in] geom embedded geometry; both must outlive nothing (data are copied)
+ * @param[in] opts NULL for defaults; @param[out] rules NULL on failure
+ * @return FCM_OK; FCM_ERR_ARG (NULL, strengths outside [0, 20] or thresholds outside
+ *         0 <= min_fraction < uncut_fraction <= 1, tolerances negative); FCM_ERR_GEOMETRY
+ *         (a non-convex background cell, naming it; a degenerate cell); FCM_ERR_NOT_CONVERGED
+ *         (inverse map); FCM_ERR_ALLOC; errors of fcm_simplify(). Allocates. */
+FCM_API fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                         const fcm_geometry *geom,
+                                         const fcm_cell_rules_options *opts,
+                                         fcm_cell_rules **rules);
+
+/** Destroy; accepts NULL and sets `*rules = NULL`. */
+FCM_API void fcm_cell_rules_destroy(fcm_cell_rules **rules);
+
+/** Number of background cells; the element type; the strength of a kind (or of the surface
+ * rules: -1 when none). */
+FCM_API fcm_index fcm_cell_rules_num_cells(const fcm_cell_rules *rules);
+FCM_API fcm_element_type fcm_cell_rules_element_type(const fcm_cell_rules *rules);
+FCM_API int fcm_cell_rules_strength(const fcm_cell_rules *rules, fcm_rule_kind kind);
+FCM_API int fcm_cell_rules_surface_strength(const fcm_cell_rules *rules);
+
+/** Class and volume fraction of `cell` (in [0, num_cells); out of range: DROPPED, 0). */
+FCM_API fcm_cell_class fcm_cell_rules_class(const fcm_cell_rules *rules, fcm_index cell);
+FCM_API double fcm_cell_rules_volume_fraction(const fcm_cell_rules *rules, fcm_index cell);
+
+/** The volume rule of `kind` for `cell`: num_points, reference points (n x 3), weights (n,
+ * including |J_Q|/|J_K|; stabilization points have alpha times the standard weight) and
+ * flags (n; 0 authentic, 1 fictitious stabilization point). Uncut cells share one catalogue
+ * rule; dropped cells have 0 points (pointers then NULL). Any output may be NULL.
+ * Pointers stay valid for the life of `rules`. @return FCM_OK or FCM_ERR_ARG (cell or kind
+ * out of range). No allocation; thread safe. */
+FCM_API fcm_status fcm_cell_rules_get(const fcm_cell_rules *rules, fcm_index cell,
+                                      fcm_rule_kind kind, int *num_points, const double **points,
+                                      const double **weights, const unsigned char **flags);
+
+/** The surface rule of `cell` on the embedded boundary: reference points (n x 3), physical
+ * area weights (the integral of g over the boundary part in K is sum w_j g(X(xi_j))), unit
+ * outward normals (n x 3) and the boundary triangle of each point (index into
+ * fcm_geometry_boundary_triangles()). Dropped cells and rules built without surface
+ * strength have 0 points. Any output may be NULL. @return FCM_OK or FCM_ERR_ARG. */
+FCM_API fcm_status fcm_cell_rules_get_surface(const fcm_cell_rules *rules, fcm_index cell,
+                                              int *num_points, const double **points,
+                                              const double **weights, const double **normals,
+                                              const fcm_index **triangles);
+
+/** The statistics (a pointer into `rules`). */
+FCM_API const fcm_cell_rules_stats *fcm_cell_rules_get_stats(const fcm_cell_rules *rules);
+
+/** Print the statistics (classes, points before/after simplification, fallbacks, residual,
+ * volumes, times) to `stream`. */
+FCM_API void fcm_cell_rules_view(const fcm_cell_rules *rules, FILE *stream);
+
+/** Print every point of `kind` in cell order as "cell xi eta zeta X Y Z w_ref w_phys flag"
+ * (X = map of xi, w_phys = w_ref det J_K(xi)), full precision, one per line, after a
+ * '#' header line. `mesh` must be the mesh the rules were built on.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, kind invalid, cell count differs), FCM_ERR_IO. */
+FCM_API fcm_status fcm_cell_rules_view_points(const fcm_cell_rules *rules, const fcm_mesh *mesh,
+                                              fcm_rule_kind kind, FILE *stream);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* FCM_EMBED_H */

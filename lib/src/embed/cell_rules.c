@@ -1,0 +1,634 @@
+/* Per-background-cell rule storage: the parallel build (intersect, classify, simplify,
+ * stabilize, per cell into private buffers, then gathered in cell order), accessors,
+ * statistics and the point dump. */
+#include "embed/embed_impl.h"
+#include "element/element_impl.h"
+
+#include <math.h>
+#include <omp.h>
+#include <string.h>
+
+fcm_cell_rules_options fcm_cell_rules_options_default(void)
+{
+  fcm_cell_rules_options o;
+  memset(&o, 0, sizeof o);
+  o.strength[FCM_RULE_STIFFNESS] = -1;
+  o.strength[FCM_RULE_MASS] = -1;
+  o.surface_strength = -1;
+  o.min_fraction = 1e-4;
+  o.uncut_fraction = 1.0 - 1e-12;
+  o.clip_rtol = 1e-12;
+  o.sliver_rtol = 1e-14;
+  o.convex_rtol = 1e-10;
+  o.simplify = 1;
+  o.simplify_options = fcm_simplify_options_default();
+  o.stabilization = fcm_stabilization_options_default();
+  o.num_threads = 0;
+  return o;
+}
+
+/* What one cell produced (private to the thread that built it). */
+typedef struct cell_out {
+  int n[FCM_RULE_KIND_COUNT];
+  double *pts[FCM_RULE_KIND_COUNT];
+  double *w[FCM_RULE_KIND_COUNT];
+  unsigned char *flag[FCM_RULE_KIND_COUNT];
+  int ninit[FCM_RULE_KIND_COUNT], nsimp[FCM_RULE_KIND_COUNT], nstab[FCM_RULE_KIND_COUNT];
+  unsigned char skipped[FCM_RULE_KIND_COUNT], fallback[FCM_RULE_KIND_COUNT];
+  double residual[FCM_RULE_KIND_COUNT];
+  int ns;
+  double *spts, *sw, *snrm;
+  fcm_index *stri;
+  double volume;
+} cell_out;
+
+/* Everything the per-cell work reads. */
+typedef struct build {
+  fcm_ctx *ctx;
+  const fcm_mesh *mesh;
+  const fcm_geometry *geom;
+  const fcm_cell_rules_options *o;
+  const fcm_aabb_tree *tree, *tri_tree;
+  const fcm_rule *tet_rule[FCM_RULE_KIND_COUNT];  /* rule mapped onto each tet */
+  const fcm_rule *full_rule[FCM_RULE_KIND_COUNT]; /* catalogue rule of the cell shape */
+  const fcm_rule *tri_rule;                       /* NULL: no surface rules */
+  int stabilize[FCM_RULE_KIND_COUNT];
+} build;
+
+static void cell_out_free(fcm_ctx *ctx, cell_out *o)
+{
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    fcm__free(ctx, o->pts[k]);
+    fcm__free(ctx, o->w[k]);
+    fcm__free(ctx, o->flag[k]);
+    o->pts[k] = o->w[k] = NULL;
+    o->flag[k] = NULL;
+  }
+  fcm__free(ctx, o->spts);
+  fcm__free(ctx, o->sw);
+  fcm__free(ctx, o->snrm);
+  fcm__free(ctx, o->stri);
+  o->spts = o->sw = o->snrm = NULL;
+  o->stri = NULL;
+}
+
+/* The one call into the simplification module: reduce the rule (n points, in place) to
+ * at most M points; record skipped / fallback / residual. */
+static fcm_status simplify_rule(fcm_ctx *ctx, const fcm_simplify_options *opts, int strength,
+                                int *n, double *pts, double *w, cell_out *o, int k)
+{
+  fcm_status st = FCM_OK;
+  fcm_simplify_result res;
+  fcm_simplify_info info;
+  memset(&res, 0, sizeof res);
+  FCM_TRY(ctx, fcm_simplify(ctx, strength, *n, pts, w, opts, &res, &info));
+  FCM_CHECK(res.count >= 1 && res.count <= *n, ctx, FCM_ERR_INTERNAL,
+            "embed: simplification returned %lld of %d points", (long long)res.count, *n);
+  for (fcm_index i = 0; i < res.count; i++) { /* indices ascending: compaction is safe */
+    const fcm_index j = res.indices[i];
+    if (j != i) memmove(pts + 3 * i, pts + 3 * j, 3 * sizeof *pts);
+    w[i] = res.weights[i];
+  }
+  *n = (int)res.count;
+  o->skipped[k] = (unsigned char)info.skipped;
+  o->fallback[k] = (unsigned char)info.fallback;
+  o->residual[k] = info.residual;
+cleanup:
+  fcm_simplify_result_destroy(&res);
+  return st;
+}
+
+static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, fcm__embed_ws *ws,
+                               cell_out *o, fcm_index counts[5], double times[2])
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_cell_rules_options *opt = B->o;
+  fcm__embed_cell cell;
+  double vol = 0.0;
+  const double t0 = fcm_wtime();
+  FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
+  FCM_TRY(ctx,
+          fcm__embed_cell_tets(ctx, B->geom, B->tree, &cell, opt->sliver_rtol, ws, counts, &vol));
+  const double phi = vol / cell.volume;
+  fcm_cell_class cls = FCM_CELL_CUT;
+  if (phi >= opt->uncut_fraction)
+    cls = FCM_CELL_UNCUT;
+  else if (phi < opt->min_fraction || ws->num_tets == 0)
+    cls = FCM_CELL_DROPPED;
+  R->cls[c] = (unsigned char)cls;
+  R->fraction[c] = phi;
+  o->volume = vol;
+  if (cls == FCM_CELL_CUT) {
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+      const size_t n0 = ws->num_tets * (size_t)fcm_rule_num_points(B->tet_rule[k]);
+      const size_t ns = B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0;
+      FCM_CHECK(n0 + ns <= (size_t)1 << 30, ctx, FCM_ERR_UNSUPPORTED,
+                "embed: background cell %lld would get %zu initial points (limit 2^30)",
+                (long long)c, n0 + ns);
+      FCM_ALLOC(ctx, 3 * (n0 + ns), o->pts[k]);
+      FCM_ALLOC(ctx, n0 + ns, o->w[k]);
+      FCM_ALLOC(ctx, n0 + ns, o->flag[k]);
+      FCM_TRY(ctx, fcm__embed_map_tets(ctx, &cell, ws, B->tet_rule[k], o->pts[k], o->w[k]));
+      o->n[k] = o->ninit[k] = o->nsimp[k] = (int)n0;
+    }
+  }
+  if (B->tri_rule && cls != FCM_CELL_DROPPED) {
+    fcm_index ntri = 0;
+    FCM_TRY(ctx, fcm__embed_cell_surface(ctx, B->geom, B->tri_tree, &cell, opt->sliver_rtol,
+                                         B->tri_rule, ws, &ntri));
+    counts[4] += ntri;
+    const size_t ns = ws->num_spts;
+    if (ns > 0) {
+      FCM_ALLOC(ctx, 3 * ns, o->spts);
+      FCM_ALLOC(ctx, ns, o->sw);
+      FCM_ALLOC(ctx, 3 * ns, o->snrm);
+      FCM_ALLOC(ctx, ns, o->stri);
+      for (size_t j = 0; j < ns; j++) {
+        double det;
+        FCM_TRY(ctx, fcm__embed_to_reference(ctx, &cell, ws->spts + 3 * j, o->spts + 3 * j, &det));
+      }
+      memcpy(o->sw, ws->sw, ns * sizeof *o->sw);
+      memcpy(o->snrm, ws->snrm, 3 * ns * sizeof *o->snrm);
+      memcpy(o->stri, ws->stri, ns * sizeof *o->stri);
+      o->ns = (int)ns;
+    }
+  }
+  const double t1 = fcm_wtime();
+  times[0] += t1 - t0;
+  if (cls == FCM_CELL_CUT) {
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+      if (opt->simplify) {
+        FCM_TRY(ctx, simplify_rule(ctx, &opt->simplify_options, R->strength[k], &o->n[k], o->pts[k],
+                                   o->w[k], o, k));
+        o->nsimp[k] = o->n[k];
+      }
+      if (B->stabilize[k]) {
+        fcm_index n = o->n[k];
+        const fcm_index cap = n + fcm_rule_num_points(B->full_rule[k]);
+        FCM_TRY(ctx, fcm_stabilization_append(ctx, &opt->stabilization, B->full_rule[k], cap, &n,
+                                              o->pts[k], o->w[k], o->flag[k]));
+        o->nstab[k] = (int)n - o->n[k];
+        o->n[k] = (int)n;
+      }
+    }
+  }
+  times[1] += fcm_wtime() - t1;
+cleanup:
+  return st;
+}
+
+static fcm_status check_options(fcm_ctx *ctx, const fcm_cell_rules_options *o)
+{
+  fcm_status st = FCM_OK;
+  const int smax = o->simplify ? FCM_SIMPLIFY_MAX_STRENGTH : FCM_RULE_MAX_STRENGTH;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    FCM_CHECK(o->strength[k] >= -1 && o->strength[k] <= smax, ctx, FCM_ERR_ARG,
+              "embed: %s strength = %d outside [0, %d] (-1: element default)",
+              k == FCM_RULE_MASS ? "mass" : "stiffness", o->strength[k], smax);
+  FCM_CHECK(o->surface_strength >= -1 && o->surface_strength <= FCM_RULE_MAX_STRENGTH, ctx,
+            FCM_ERR_ARG, "embed: surface strength = %d outside [0, %d] (-1: none)",
+            o->surface_strength, FCM_RULE_MAX_STRENGTH);
+  FCM_CHECK(o->min_fraction >= 0.0 && o->min_fraction < o->uncut_fraction &&
+                o->uncut_fraction <= 1.0,
+            ctx, FCM_ERR_ARG,
+            "embed: thresholds min_fraction = %g, uncut_fraction = %g must satisfy "
+            "0 <= min_fraction < uncut_fraction <= 1",
+            o->min_fraction, o->uncut_fraction);
+  FCM_CHECK(o->clip_rtol >= 0.0 && o->clip_rtol < 1e-3 && o->sliver_rtol >= 0.0 &&
+                o->sliver_rtol < 1e-3 && o->convex_rtol >= 0.0 && o->convex_rtol < 1e-2,
+            ctx, FCM_ERR_ARG,
+            "embed: tolerances clip_rtol = %g, sliver_rtol = %g (each in [0, 1e-3)), "
+            "convex_rtol = %g (in [0, 1e-2)) out of range",
+            o->clip_rtol, o->sliver_rtol, o->convex_rtol);
+  FCM_CHECK(o->num_threads >= 0, ctx, FCM_ERR_ARG, "embed: num_threads = %d must be >= 0",
+            o->num_threads);
+  FCM_CHECK((int)o->stabilization.mode >= 0 &&
+                o->stabilization.mode < FCM_STABILIZATION_MODE_COUNT &&
+                (o->stabilization.mode == FCM_STABILIZATION_OFF ||
+                 (isfinite(o->stabilization.alpha) && o->stabilization.alpha > 0.0)),
+            ctx, FCM_ERR_ARG, "embed: stabilization mode %d / alpha = %g invalid (alpha > 0)",
+            (int)o->stabilization.mode, o->stabilization.alpha);
+cleanup:
+  return st;
+}
+
+/* Boxes (n x 6) of the embedded cells or of the boundary triangles. */
+static fcm_status geometry_boxes(fcm_ctx *ctx, const fcm_geometry *g, int tris, double **out,
+                                 fcm_index *n)
+{
+  fcm_status st = FCM_OK;
+  const int npv = tris ? 3 : g->npc;
+  const fcm_index *conn = tris ? g->tris : g->cells;
+  const fcm_index m = tris ? g->num_tris : g->num_cells;
+  double *b = NULL;
+  FCM_ALLOC(ctx, 6 * (size_t)m, b);
+  for (fcm_index i = 0; i < m; i++) {
+    double *bi = b + 6 * i;
+    for (int d = 0; d < 3; d++)
+      bi[d] = HUGE_VAL, bi[3 + d] = -HUGE_VAL;
+    for (int a = 0; a < npv; a++)
+      for (int d = 0; d < 3; d++) {
+        const double v = g->coords[3 * conn[(size_t)npv * (size_t)i + a] + d];
+        bi[d] = fmin(bi[d], v);
+        bi[3 + d] = fmax(bi[3 + d], v);
+      }
+  }
+  *out = b;
+  *n = m;
+cleanup:
+  return st;
+}
+
+fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                                 const fcm_cell_rules_options *opts, fcm_cell_rules **rules)
+{
+  fcm_status st = FCM_OK;
+  fcm_cell_rules *R = NULL;
+  fcm_cell_rules_options o = opts ? *opts : fcm_cell_rules_options_default();
+  fcm_aabb_tree *tree = NULL, *tri_tree = NULL;
+  fcm_rule *tet_rule[FCM_RULE_KIND_COUNT] = {NULL, NULL}, *tri_rule = NULL;
+  double *boxes = NULL;
+  cell_out *out = NULL;
+  fcm_index nc = 0, nbox = 0;
+  const double t_start = fcm_wtime();
+  FCM_CHECK(rules, ctx, FCM_ERR_ARG, "embed: output pointer is NULL");
+  *rules = NULL;
+  FCM_CHECK(ctx && mesh && geom, ctx, FCM_ERR_ARG,
+            "embed: NULL argument (ctx, mesh and geometry are required)");
+  FCM_TRY(ctx, check_options(ctx, &o));
+  const fcm_element_info *info = fcm_mesh_element_info(mesh);
+  nc = fcm_mesh_num_cells(mesh);
+  for (fcm_index c = 0; c < nc; c++)
+    FCM_CHECK(fcm_mesh_cell_is_convex(mesh, c, o.convex_rtol), ctx, FCM_ERR_GEOMETRY,
+              "embed: background cell %lld (%s) is not a convex polyhedron with planar faces and "
+              "straight edges (relative tolerance %g); cut-cell quadrature needs convex cells",
+              (long long)c, info->name, o.convex_rtol);
+
+  FCM_ALLOC(ctx, 1, R);
+  R->ctx = ctx;
+  R->num_cells = nc;
+  R->type = info->type;
+  R->strength[FCM_RULE_STIFFNESS] = o.strength[FCM_RULE_STIFFNESS] >= 0
+                                        ? o.strength[FCM_RULE_STIFFNESS]
+                                        : info->stiffness_strength;
+  R->strength[FCM_RULE_MASS] =
+      o.strength[FCM_RULE_MASS] >= 0 ? o.strength[FCM_RULE_MASS] : info->mass_strength;
+  R->surface_strength = o.surface_strength;
+  FCM_ALLOC(ctx, (size_t)nc, R->cls);
+  FCM_ALLOC(ctx, (size_t)nc, R->fraction);
+  FCM_ALLOC(ctx, (size_t)nc + 1, R->soff);
+  build B;
+  memset(&B, 0, sizeof B);
+  B.ctx = ctx, B.mesh = mesh, B.geom = geom, B.o = &o;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TET, R->strength[k], &tet_rule[k]));
+    FCM_TRY(ctx, fcm_rule_create(ctx, info->shape, R->strength[k], &R->uncut[k]));
+    FCM_ALLOC(ctx, (size_t)fcm_rule_num_points(R->uncut[k]), R->uncut_flags[k]);
+    FCM_ALLOC(ctx, (size_t)nc + 1, R->off[k]);
+    B.tet_rule[k] = tet_rule[k];
+    B.full_rule[k] = R->uncut[k];
+  }
+  B.stabilize[FCM_RULE_STIFFNESS] = o.stabilization.mode == FCM_STABILIZATION_MASS_STIFFNESS;
+  B.stabilize[FCM_RULE_MASS] = o.stabilization.mode != FCM_STABILIZATION_OFF;
+  FCM_TRY(ctx, geometry_boxes(ctx, geom, 0, &boxes, &nbox));
+  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &tree));
+  FCM_FREE(ctx, boxes);
+  B.tree = tree;
+  if (o.surface_strength >= 0) {
+    FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TRI, o.surface_strength, &tri_rule));
+    FCM_TRY(ctx, geometry_boxes(ctx, geom, 1, &boxes, &nbox));
+    FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &tri_tree));
+    FCM_FREE(ctx, boxes);
+    B.tri_rule = tri_rule, B.tri_tree = tri_tree;
+  }
+  FCM_ALLOC(ctx, (size_t)nc, out);
+  const double t_setup = fcm_wtime();
+
+  /* Parallel per-cell work into private buffers. */
+  const int nthreads = o.num_threads > 0 ? o.num_threads : omp_get_max_threads();
+  fcm_status first = FCM_OK;
+  int failed = 0;
+  fcm_index counts[5] = {0, 0, 0, 0, 0};
+  double time_intersect = 0.0, time_simplify = 0.0;
+#pragma omp parallel num_threads(nthreads)
+  {
+    fcm__embed_ws *ws = fcm__calloc(ctx, 1, sizeof *ws);
+    fcm_index cnt[5] = {0, 0, 0, 0, 0};
+    double tm[2] = {0.0, 0.0};
+    if (!ws) {
+#pragma omp critical(fcm_embed_fail)
+      {
+        if (!failed) first = FCM_ERR_ALLOC;
+        failed = 1;
+      }
+    }
+#pragma omp for schedule(dynamic, 4)
+    for (fcm_index c = 0; c < nc; c++) {
+      int stop;
+#pragma omp atomic read
+      stop = failed;
+      if (stop || !ws) continue;
+      const fcm_status s = process_cell(&B, R, c, ws, out + c, cnt, tm);
+      if (s != FCM_OK) {
+#pragma omp critical(fcm_embed_fail)
+        {
+          if (!failed) first = s;
+          failed = 1;
+        }
+      }
+    }
+    if (ws) fcm__embed_ws_free(ctx, ws);
+    fcm__free(ctx, ws);
+#pragma omp critical(fcm_embed_sum)
+    {
+      for (int k = 0; k < 5; k++)
+        counts[k] += cnt[k];
+      time_intersect += tm[0];
+      time_simplify += tm[1];
+    }
+  }
+  if (failed) {
+    st = first;
+    fcm__trace(ctx, __FILE__, __LINE__, __func__);
+    goto cleanup;
+  }
+  const double t_loop = fcm_wtime();
+
+  /* Gather in cell order. */
+  fcm_cell_rules_stats *S = &R->stats;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    fcm_index *off = R->off[k];
+    off[0] = 0;
+    for (fcm_index c = 0; c < nc; c++)
+      off[c + 1] = off[c] + out[c].n[k];
+    const size_t tot = (size_t)off[nc];
+    FCM_ALLOC(ctx, 3 * tot, R->points[k]);
+    FCM_ALLOC(ctx, tot, R->weights[k]);
+    FCM_ALLOC(ctx, tot, R->flags[k]);
+    for (fcm_index c = 0; c < nc; c++) {
+      const size_t n = (size_t)out[c].n[k], o0 = (size_t)off[c];
+      if (n) {
+        memcpy(R->points[k] + 3 * o0, out[c].pts[k], 3 * n * sizeof(double));
+        memcpy(R->weights[k] + o0, out[c].w[k], n * sizeof(double));
+        memcpy(R->flags[k] + o0, out[c].flag[k], n);
+      }
+      S->points_initial[k] += out[c].ninit[k];
+      S->points_simplified[k] += out[c].nsimp[k];
+      S->points_stabilization[k] += out[c].nstab[k];
+      S->simplify_skipped[k] += out[c].skipped[k];
+      S->simplify_fallbacks[k] += out[c].fallback[k];
+      S->max_residual[k] = fmax(S->max_residual[k], out[c].residual[k]);
+    }
+  }
+  R->soff[0] = 0;
+  for (fcm_index c = 0; c < nc; c++)
+    R->soff[c + 1] = R->soff[c] + out[c].ns;
+  {
+    const size_t tot = (size_t)R->soff[nc];
+    FCM_ALLOC(ctx, 3 * tot, R->spoints);
+    FCM_ALLOC(ctx, tot, R->sweights);
+    FCM_ALLOC(ctx, 3 * tot, R->snormals);
+    FCM_ALLOC(ctx, tot, R->stris);
+    for (fcm_index c = 0; c < nc; c++) {
+      const size_t n = (size_t)out[c].ns, o0 = (size_t)R->soff[c];
+      if (!n) continue;
+      memcpy(R->spoints + 3 * o0, out[c].spts, 3 * n * sizeof(double));
+      memcpy(R->sweights + o0, out[c].sw, n * sizeof(double));
+      memcpy(R->snormals + 3 * o0, out[c].snrm, 3 * n * sizeof(double));
+      memcpy(R->stris + o0, out[c].stri, n * sizeof(fcm_index));
+      for (size_t j = 0; j < n; j++)
+        S->embedded_area += out[c].sw[j];
+    }
+    S->surface_points = (fcm_index)tot;
+  }
+  S->num_cells = nc;
+  for (fcm_index c = 0; c < nc; c++) {
+    S->embedded_volume += out[c].volume;
+    switch ((fcm_cell_class)R->cls[c]) {
+    case FCM_CELL_UNCUT:
+      S->num_uncut++;
+      break;
+    case FCM_CELL_CUT:
+      S->num_cut++;
+      break;
+    default:
+      S->num_dropped++;
+      S->dropped_volume += out[c].volume;
+      break;
+    }
+  }
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    S->points_total[k] = R->off[k][nc] + S->num_uncut * fcm_rule_num_points(R->uncut[k]);
+  S->num_candidates = counts[0];
+  S->num_pieces = counts[1];
+  S->num_tets = counts[2];
+  S->num_slivers = counts[3];
+  S->surface_triangles = counts[4];
+  S->geometry_volume = fcm_geometry_volume(geom);
+  S->num_threads = nthreads;
+  S->time_setup = t_setup - t_start;
+  S->time_intersect = time_intersect;
+  S->time_simplify = time_simplify;
+  S->time_gather = fcm_wtime() - t_loop;
+  S->time_total = fcm_wtime() - t_start;
+  *rules = R;
+  R = NULL;
+cleanup:
+  if (out)
+    for (fcm_index c = 0; c < nc; c++)
+      cell_out_free(ctx, out + c);
+  fcm__free(ctx, out);
+  fcm__free(ctx, boxes);
+  fcm_aabb_tree_destroy(&tree);
+  fcm_aabb_tree_destroy(&tri_tree);
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    fcm_rule_destroy(&tet_rule[k]);
+  fcm_rule_destroy(&tri_rule);
+  fcm_cell_rules_destroy(&R);
+  return st;
+}
+
+void fcm_cell_rules_destroy(fcm_cell_rules **rules)
+{
+  if (!rules || !*rules) return;
+  fcm_cell_rules *R = *rules;
+  fcm_ctx *ctx = R->ctx;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    fcm__free(ctx, R->off[k]);
+    fcm__free(ctx, R->points[k]);
+    fcm__free(ctx, R->weights[k]);
+    fcm__free(ctx, R->flags[k]);
+    fcm_rule_destroy(&R->uncut[k]);
+    fcm__free(ctx, R->uncut_flags[k]);
+  }
+  fcm__free(ctx, R->cls);
+  fcm__free(ctx, R->fraction);
+  fcm__free(ctx, R->soff);
+  fcm__free(ctx, R->spoints);
+  fcm__free(ctx, R->sweights);
+  fcm__free(ctx, R->snormals);
+  fcm__free(ctx, R->stris);
+  fcm__free(ctx, R);
+  *rules = NULL;
+}
+
+fcm_index fcm_cell_rules_num_cells(const fcm_cell_rules *rules)
+{
+  return rules->num_cells;
+}
+fcm_element_type fcm_cell_rules_element_type(const fcm_cell_rules *rules)
+{
+  return rules->type;
+}
+int fcm_cell_rules_surface_strength(const fcm_cell_rules *rules)
+{
+  return rules->surface_strength;
+}
+
+int fcm_cell_rules_strength(const fcm_cell_rules *rules, fcm_rule_kind kind)
+{
+  return (int)kind >= 0 && kind < FCM_RULE_KIND_COUNT ? rules->strength[kind] : -1;
+}
+
+fcm_cell_class fcm_cell_rules_class(const fcm_cell_rules *rules, fcm_index cell)
+{
+  if (cell < 0 || cell >= rules->num_cells) return FCM_CELL_DROPPED;
+  return (fcm_cell_class)rules->cls[cell];
+}
+
+double fcm_cell_rules_volume_fraction(const fcm_cell_rules *rules, fcm_index cell)
+{
+  if (cell < 0 || cell >= rules->num_cells) return 0.0;
+  return rules->fraction[cell];
+}
+
+fcm_status fcm_cell_rules_get(const fcm_cell_rules *rules, fcm_index cell, fcm_rule_kind kind,
+                              int *num_points, const double **points, const double **weights,
+                              const unsigned char **flags)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = rules ? rules->ctx : NULL;
+  int n = 0;
+  const double *p = NULL, *w = NULL;
+  const unsigned char *f = NULL;
+  FCM_CHECK(rules, ctx, FCM_ERR_ARG, "cell rules: rules is NULL");
+  FCM_CHECK(cell >= 0 && cell < rules->num_cells, ctx, FCM_ERR_ARG,
+            "cell rules: cell %lld out of range [0,%lld)", (long long)cell,
+            (long long)rules->num_cells);
+  FCM_CHECK((int)kind >= 0 && kind < FCM_RULE_KIND_COUNT, ctx, FCM_ERR_ARG,
+            "cell rules: kind %d out of range [0,%d)", (int)kind, (int)FCM_RULE_KIND_COUNT);
+  if (rules->cls[cell] == FCM_CELL_UNCUT) {
+    n = fcm_rule_num_points(rules->uncut[kind]);
+    p = fcm_rule_points(rules->uncut[kind]);
+    w = fcm_rule_weights(rules->uncut[kind]);
+    f = rules->uncut_flags[kind];
+  } else if (rules->cls[cell] == FCM_CELL_CUT) {
+    const fcm_index o0 = rules->off[kind][cell];
+    n = (int)(rules->off[kind][cell + 1] - o0);
+    p = rules->points[kind] + 3 * o0;
+    w = rules->weights[kind] + o0;
+    f = rules->flags[kind] + o0;
+  }
+cleanup:
+  if (num_points) *num_points = n;
+  if (points) *points = p;
+  if (weights) *weights = w;
+  if (flags) *flags = f;
+  return st;
+}
+
+fcm_status fcm_cell_rules_get_surface(const fcm_cell_rules *rules, fcm_index cell, int *num_points,
+                                      const double **points, const double **weights,
+                                      const double **normals, const fcm_index **triangles)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = rules ? rules->ctx : NULL;
+  int n = 0;
+  fcm_index o0 = 0;
+  FCM_CHECK(rules, ctx, FCM_ERR_ARG, "cell rules: rules is NULL");
+  FCM_CHECK(cell >= 0 && cell < rules->num_cells, ctx, FCM_ERR_ARG,
+            "cell rules: cell %lld out of range [0,%lld)", (long long)cell,
+            (long long)rules->num_cells);
+  o0 = rules->soff[cell];
+  n = (int)(rules->soff[cell + 1] - o0);
+cleanup:
+  if (num_points) *num_points = n;
+  if (points) *points = n ? rules->spoints + 3 * o0 : NULL;
+  if (weights) *weights = n ? rules->sweights + o0 : NULL;
+  if (normals) *normals = n ? rules->snormals + 3 * o0 : NULL;
+  if (triangles) *triangles = n ? rules->stris + o0 : NULL;
+  return st;
+}
+
+const fcm_cell_rules_stats *fcm_cell_rules_get_stats(const fcm_cell_rules *rules)
+{
+  return &rules->stats;
+}
+
+void fcm_cell_rules_view(const fcm_cell_rules *rules, FILE *stream)
+{
+  if (!rules || !stream) return;
+  const fcm_cell_rules_stats *S = &rules->stats;
+  static const char *names[FCM_RULE_KIND_COUNT] = {"stiffness", "mass"};
+  fprintf(stream,
+          "cell rules: %s, %lld cells: %lld uncut, %lld cut, %lld dropped (%d threads)\n"
+          "  candidates %lld, pieces %lld, tets %lld, slivers dropped %lld\n"
+          "  embedded volume %.17g (geometry %.17g, in dropped cells %.3g)\n",
+          fcm_element_get_info(rules->type)->name, (long long)S->num_cells, (long long)S->num_uncut,
+          (long long)S->num_cut, (long long)S->num_dropped, S->num_threads,
+          (long long)S->num_candidates, (long long)S->num_pieces, (long long)S->num_tets,
+          (long long)S->num_slivers, S->embedded_volume, S->geometry_volume, S->dropped_volume);
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    fprintf(stream,
+            "  %-9s strength %d: cut-cell points %lld initial -> %lld simplified "
+            "(+%lld stabilization), total %lld; skipped %lld, fallbacks %lld, max residual %.3g\n",
+            names[k], rules->strength[k], (long long)S->points_initial[k],
+            (long long)S->points_simplified[k], (long long)S->points_stabilization[k],
+            (long long)S->points_total[k], (long long)S->simplify_skipped[k],
+            (long long)S->simplify_fallbacks[k], S->max_residual[k]);
+  if (rules->surface_strength >= 0)
+    fprintf(stream, "  surface strength %d: %lld triangles, %lld points, area %.17g\n",
+            rules->surface_strength, (long long)S->surface_triangles, (long long)S->surface_points,
+            S->embedded_area);
+  fprintf(stream,
+          "  time: setup %.3g s, intersect %.3g core-s, simplify %.3g core-s, gather %.3g s, "
+          "total %.3g s\n",
+          S->time_setup, S->time_intersect, S->time_simplify, S->time_gather, S->time_total);
+}
+
+fcm_status fcm_cell_rules_view_points(const fcm_cell_rules *rules, const fcm_mesh *mesh,
+                                      fcm_rule_kind kind, FILE *stream)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = rules ? rules->ctx : NULL;
+  double X[3 * FCM_ELEMENT_MAX_NODES], J[9], x[3];
+  FCM_CHECK(rules && mesh && stream, ctx, FCM_ERR_ARG,
+            "cell rules view: NULL argument (rules, mesh and stream are required)");
+  FCM_CHECK((int)kind >= 0 && kind < FCM_RULE_KIND_COUNT, ctx, FCM_ERR_ARG,
+            "cell rules view: kind %d out of range [0,%d)", (int)kind, (int)FCM_RULE_KIND_COUNT);
+  FCM_CHECK(fcm_mesh_num_cells(mesh) == rules->num_cells &&
+                fcm_mesh_element_type(mesh) == rules->type,
+            ctx, FCM_ERR_ARG, "cell rules view: mesh (%lld cells) is not the rules' mesh (%lld)",
+            (long long)fcm_mesh_num_cells(mesh), (long long)rules->num_cells);
+  FCM_CHECK(fprintf(stream, "# cell xi eta zeta X Y Z w_ref w_phys flag\n") > 0, ctx, FCM_ERR_IO,
+            "cell rules view: write failed");
+  for (fcm_index c = 0; c < rules->num_cells; c++) {
+    int n;
+    const double *p, *w;
+    const unsigned char *f;
+    FCM_TRY(ctx, fcm_cell_rules_get(rules, c, kind, &n, &p, &w, &f));
+    if (!n) continue;
+    fcm_mesh_cell_coords(mesh, c, X);
+    for (int j = 0; j < n; j++) {
+      fcm_element_map(rules->type, X, p + 3 * j, x);
+      const double det = fcm_element_jacobian(rules->type, X, p + 3 * j, J);
+      FCM_CHECK(fprintf(stream, "%lld %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %d\n",
+                        (long long)c, p[3 * j], p[3 * j + 1], p[3 * j + 2], x[0], x[1], x[2], w[j],
+                        w[j] * det, (int)f[j]) > 0,
+                ctx, FCM_ERR_IO, "cell rules view: write failed");
+    }
+  }
+cleanup:
+  return st;
+}

@@ -1,0 +1,275 @@
+/* Per-background-cell kernels of the embedded quadrature: cell planes and map, clipping
+ * of candidate embedded cells into tets, tet rules mapped into the reference cell, and
+ * the same path one dimension lower for the embedded boundary.
+ *
+ * Longva et al. 2020, Sec. 4.5, eq. (11)-(12): a point eta_j of a tet rule with weight
+ * l_j on tet Q goes to X = T_Q(eta_j), then xi = T_K^{-1}(X), with reference weight
+ * l_j |J_Q| / |J_K(xi)|; exact for degree m when T_K is affine. */
+#include "embed/embed_impl.h"
+#include "element/element_impl.h"
+#include "la/mat3.h"
+
+#include <math.h>
+#include <string.h>
+
+void fcm__embed_ws_free(fcm_ctx *ctx, fcm__embed_ws *ws)
+{
+  fcm__geom_idbuf_free(ctx, &ws->cand);
+  fcm__free(ctx, ws->tets);
+  fcm__free(ctx, ws->vol);
+  fcm__free(ctx, ws->spts);
+  fcm__free(ctx, ws->sw);
+  fcm__free(ctx, ws->snrm);
+  fcm__free(ctx, ws->stri);
+  ws->tets = ws->vol = ws->spts = ws->sw = ws->snrm = NULL;
+  ws->stri = NULL;
+  ws->num_tets = ws->tet_cap = ws->num_spts = ws->spt_cap = 0;
+}
+
+fcm_status fcm__embed_cell_setup(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index id, double clip_rtol,
+                                 fcm__embed_cell *cell)
+{
+  fcm_status st = FCM_OK;
+  fcm__poly p;
+  cell->type = fcm_mesh_element_type(mesh);
+  cell->info = fcm_mesh_element_info(mesh);
+  cell->id = id;
+  fcm_mesh_cell_coords(mesh, id, cell->X);
+  const int nc = cell->info->num_corners;
+  cell->num_planes = fcm__geom_cell_planes(cell->info, cell->X, cell->planes);
+  cell->size = fcm__element_cell_size(nc, cell->X);
+  cell->tol = clip_rtol * cell->size;
+  for (int d = 0; d < 3; d++) {
+    cell->lo[d] = HUGE_VAL, cell->hi[d] = -HUGE_VAL;
+    for (int a = 0; a < nc; a++) {
+      cell->lo[d] = fmin(cell->lo[d], cell->X[3 * a + d]);
+      cell->hi[d] = fmax(cell->hi[d], cell->X[3 * a + d]);
+    }
+    cell->lo[d] -= cell->tol, cell->hi[d] += cell->tol;
+  }
+  fcm__geom_poly_from_cell(nc == 4 ? FCM_ELEMENT_TET4 : FCM_ELEMENT_HEX8, cell->X, &p);
+  cell->volume = fcm__geom_poly_volume(&p);
+  FCM_CHECK(cell->volume > 0.0 && isfinite(cell->volume), ctx, FCM_ERR_GEOMETRY,
+            "embed: background cell %lld (%s) has corner-polyhedron volume %g (must be positive)",
+            (long long)id, cell->info->name, cell->volume);
+  cell->affine = fcm_element_is_affine(cell->type, cell->X, 1e-13);
+  if (cell->affine) {
+    fcm__element_corner_affine(cell->type, cell->X, cell->A, cell->xi0);
+    cell->detA = fcm__mat3_inv(cell->A, cell->Ainv);
+    FCM_CHECK(cell->detA > 0.0, ctx, FCM_ERR_GEOMETRY,
+              "embed: background cell %lld (%s) has det J = %g (must be positive)", (long long)id,
+              cell->info->name, cell->detA);
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_to_reference(fcm_ctx *ctx, const fcm__embed_cell *cell, const double x[3],
+                                   double xi[3], double *det)
+{
+  fcm_status st = FCM_OK;
+  if (cell->affine) {
+    const double r[3] = {x[0] - cell->X[0], x[1] - cell->X[1], x[2] - cell->X[2]};
+    double s[3];
+    fcm__mat3_mulv(cell->Ainv, r, s);
+    for (int d = 0; d < 3; d++)
+      xi[d] = cell->xi0[d] + s[d];
+    *det = cell->detA;
+  } else {
+    double J[9];
+    FCM_TRY(ctx, fcm_element_inverse_map(ctx, cell->type, cell->X, x, xi));
+    *det = fcm_element_jacobian(cell->type, cell->X, xi, J);
+    FCM_CHECK(*det > 0.0, ctx, FCM_ERR_GEOMETRY,
+              "embed: background cell %lld (%s) has det J = %g at xi = (%g, %g, %g)",
+              (long long)cell->id, cell->info->name, *det, xi[0], xi[1], xi[2]);
+  }
+cleanup:
+  return st;
+}
+
+static fcm_status grow_tets(fcm_ctx *ctx, fcm__embed_ws *ws, size_t need)
+{
+  fcm_status st = FCM_OK;
+  if (need <= ws->tet_cap) return FCM_OK;
+  size_t cap = ws->tet_cap ? ws->tet_cap : 256;
+  while (cap < need)
+    cap *= 2;
+  void *t = ws->tets, *v = ws->vol;
+  FCM_TRY(ctx, fcm__resize(ctx, &t, 12 * ws->num_tets, 12 * cap, sizeof(double)));
+  ws->tets = t;
+  FCM_TRY(ctx, fcm__resize(ctx, &v, ws->num_tets, cap, sizeof(double)));
+  ws->vol = v;
+  ws->tet_cap = cap;
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_cell_tets(fcm_ctx *ctx, const fcm_geometry *geom, const fcm_aabb_tree *tree,
+                                const fcm__embed_cell *cell, double sliver_rtol, fcm__embed_ws *ws,
+                                fcm_index counts[4], double *volume)
+{
+  fcm_status st = FCM_OK;
+  double X[24], vsum = 0.0;
+  const double vmin = sliver_rtol * cell->volume;
+  fcm_index npieces = 0, nslivers = 0;
+  ws->num_tets = 0;
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, cell->lo, cell->hi, &ws->cand));
+  for (size_t k = 0; k < ws->cand.n; k++) {
+    const fcm_index e = ws->cand.ids[k];
+    const fcm_index *cv = geom->cells + (size_t)geom->npc * (size_t)e;
+    for (int a = 0; a < geom->npc; a++)
+      for (int d = 0; d < 3; d++)
+        X[3 * a + d] = geom->coords[3 * cv[a] + d];
+    fcm__geom_poly_from_cell(geom->type, X, &ws->poly);
+    for (int f = 0; f < cell->num_planes && ws->poly.nf > 0; f++)
+      FCM_CHECK(fcm__geom_poly_clip(&ws->poly, cell->planes + f, cell->tol, &ws->scratch) == 0, ctx,
+                FCM_ERR_INTERNAL,
+                "embed: clipping embedded cell %lld by background cell %lld exceeded the "
+                "polyhedron capacity (%d vertices, %d faces)",
+                (long long)e, (long long)cell->id, FCM__POLY_MAX_VERTS, FCM__POLY_MAX_FACES);
+    if (ws->poly.nf == 0) continue;
+    npieces++;
+    const int nt = fcm__geom_poly_num_tets(&ws->poly);
+    FCM_TRY(ctx, grow_tets(ctx, ws, ws->num_tets + (size_t)nt));
+    double *t = ws->tets + 12 * ws->num_tets, *v = ws->vol + ws->num_tets;
+    const int made = fcm__geom_poly_tets(&ws->poly, t, v);
+    int kept = 0;
+    for (int i = 0; i < made; i++) {
+      if (!(v[i] > vmin)) {
+        nslivers++;
+        continue;
+      }
+      if (kept != i) {
+        memmove(t + 12 * kept, t + 12 * i, 12 * sizeof *t);
+        v[kept] = v[i];
+      }
+      vsum += v[i];
+      kept++;
+    }
+    ws->num_tets += (size_t)kept;
+  }
+  if (counts) {
+    counts[0] += (fcm_index)ws->cand.n;
+    counts[1] += npieces;
+    counts[2] += (fcm_index)ws->num_tets;
+    counts[3] += nslivers;
+  }
+  *volume = vsum;
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_map_tets(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__embed_ws *ws,
+                               const fcm_rule *rule, double *pts, double *w)
+{
+  fcm_status st = FCM_OK;
+  const int nq = fcm_rule_num_points(rule);
+  const double *eta = fcm_rule_points(rule), *l = fcm_rule_weights(rule);
+  size_t k = 0;
+  for (size_t t = 0; t < ws->num_tets; t++) {
+    const double *T = ws->tets + 12 * t;
+    const double jq = 6.0 * ws->vol[t];
+    for (int j = 0; j < nq; j++, k++) {
+      const double *e = eta + 3 * j;
+      double x[3], det;
+      for (int d = 0; d < 3; d++)
+        x[d] =
+            T[d] + e[0] * (T[3 + d] - T[d]) + e[1] * (T[6 + d] - T[d]) + e[2] * (T[9 + d] - T[d]);
+      FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, x, pts + 3 * k, &det));
+      w[k] = l[j] * jq / det;
+    }
+  }
+cleanup:
+  return st;
+}
+
+static fcm_status grow_surface(fcm_ctx *ctx, fcm__embed_ws *ws, size_t need)
+{
+  fcm_status st = FCM_OK;
+  if (need <= ws->spt_cap) return FCM_OK;
+  size_t cap = ws->spt_cap ? ws->spt_cap : 256;
+  while (cap < need)
+    cap *= 2;
+  const size_t n = ws->num_spts;
+  void *p = ws->spts, *w = ws->sw, *q = ws->snrm, *t = ws->stri;
+  FCM_TRY(ctx, fcm__resize(ctx, &p, 3 * n, 3 * cap, sizeof(double)));
+  ws->spts = p;
+  FCM_TRY(ctx, fcm__resize(ctx, &w, n, cap, sizeof(double)));
+  ws->sw = w;
+  FCM_TRY(ctx, fcm__resize(ctx, &q, 3 * n, 3 * cap, sizeof(double)));
+  ws->snrm = q;
+  FCM_TRY(ctx, fcm__resize(ctx, &t, n, cap, sizeof(fcm_index)));
+  ws->stri = t;
+  ws->spt_cap = cap;
+cleanup:
+  return st;
+}
+
+#define POLYGON_CAP 64
+
+fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
+                                   const fcm_aabb_tree *tri_tree, const fcm__embed_cell *cell,
+                                   double sliver_rtol, const fcm_rule *tri_rule, fcm__embed_ws *ws,
+                                   fcm_index *count)
+{
+  fcm_status st = FCM_OK;
+  double poly[3 * POLYGON_CAP], work[3 * POLYGON_CAP];
+  const int nq = fcm_rule_num_points(tri_rule);
+  const double *eta = fcm_rule_points(tri_rule), *l = fcm_rule_weights(tri_rule);
+  const double amin = sliver_rtol * cbrt(cell->volume) * cbrt(cell->volume);
+  ws->num_spts = 0;
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, tri_tree, cell->lo, cell->hi, &ws->cand));
+  for (size_t k = 0; k < ws->cand.n; k++) {
+    const fcm_index tri = ws->cand.ids[k];
+    double nrm[3], u[3], v[3];
+    for (int a = 0; a < 3; a++)
+      for (int d = 0; d < 3; d++)
+        poly[3 * a + d] = geom->coords[3 * geom->tris[3 * tri + a] + d];
+    for (int d = 0; d < 3; d++)
+      u[d] = poly[3 + d] - poly[d], v[d] = poly[6 + d] - poly[d];
+    nrm[0] = u[1] * v[2] - u[2] * v[1];
+    nrm[1] = u[2] * v[0] - u[0] * v[2];
+    nrm[2] = u[0] * v[1] - u[1] * v[0];
+    const double len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    if (!(len > 0.0)) continue;
+    for (int d = 0; d < 3; d++)
+      nrm[d] /= len;
+    int n = 3;
+    for (int f = 0; f < cell->num_planes && n >= 3; f++) {
+      const fcm__plane *pl = cell->planes + f;
+      const int keep = nrm[0] * pl->n[0] + nrm[1] * pl->n[1] + nrm[2] * pl->n[2] > 0.0;
+      n = fcm__geom_polygon_clip(poly, n, POLYGON_CAP, pl, cell->tol, keep, work);
+      FCM_CHECK(n >= 0, ctx, FCM_ERR_INTERNAL,
+                "embed: clipping boundary triangle %lld by background cell %lld exceeded %d "
+                "vertices",
+                (long long)tri, (long long)cell->id, POLYGON_CAP);
+    }
+    if (n < 3) continue;
+    int kept_any = 0;
+    for (int i = 1; i + 1 < n; i++) {
+      const double *a = poly, *b = poly + 3 * i, *c = poly + 3 * (i + 1);
+      double e1[3], e2[3], cr[3];
+      for (int d = 0; d < 3; d++)
+        e1[d] = b[d] - a[d], e2[d] = c[d] - a[d];
+      cr[0] = e1[1] * e2[2] - e1[2] * e2[1];
+      cr[1] = e1[2] * e2[0] - e1[0] * e2[2];
+      cr[2] = e1[0] * e2[1] - e1[1] * e2[0];
+      const double area2 = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+      if (!(0.5 * area2 > amin)) continue;
+      kept_any = 1;
+      FCM_TRY(ctx, grow_surface(ctx, ws, ws->num_spts + (size_t)nq));
+      for (int j = 0; j < nq; j++) {
+        const size_t s = ws->num_spts++;
+        for (int d = 0; d < 3; d++) {
+          ws->spts[3 * s + d] = a[d] + eta[2 * j] * e1[d] + eta[2 * j + 1] * e2[d];
+          ws->snrm[3 * s + d] = nrm[d];
+        }
+        ws->sw[s] = l[j] * area2;
+        ws->stri[s] = tri;
+      }
+    }
+    *count += kept_any;
+  }
+cleanup:
+  return st;
+}
