@@ -15,6 +15,7 @@
 #include "fcm/rulegen.h"
 #include "fcm/sim.h"
 #include "fcm/scene.h"
+#include "fcm/simulation.h"
 #include "fcm/solve.h"
 #include "fcm/simplify.h"
 

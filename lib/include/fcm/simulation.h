@@ -1,0 +1,125 @@
+/* fcm — running a scene (DESIGN §1.2): build the background mesh, the embedded geometry, its
+ * cell rules, the space and an integrator carrying exactly the scene's effects; step it;
+ * write VTU/PVD frames of the background field and of the deformed embedded surface and a
+ * CSV log per step. Counters say what was computed and what was skipped.
+ *
+ * Pipeline derived from the scene: no cell rules without a geometry; surface rules only with
+ * a traction or pressure effect (or an explicit surface strength); one body-force pass per
+ * gravity effect and none without; no inertia (static integrator) for a static scene; no
+ * damping matrix without a damping effect; Schwarz blocks only for cut cells below the
+ * threshold (with none, the Krylov solver falls back to Jacobi and no block is set up). */
+#ifndef FCM_SIMULATION_H
+#define FCM_SIMULATION_H
+
+#include <stdio.h>
+
+#include "fcm/core.h"
+#include "fcm/scene.h"
+#include "fcm/sim.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Options of fcm_simulation_create(); initialize with fcm_simulation_options_default(). */
+typedef struct fcm_simulation_options {
+  fcm_index max_steps; /**< > 0: stop after this many steps (fcm_simulation_done()); 0
+                            (default): the scene's step count */
+} fcm_simulation_options;
+
+/** Defaults as documented on each member. */
+FCM_API fcm_simulation_options fcm_simulation_options_default(void);
+
+/** What the pipeline computed (counts) and which stages it used (flags 0/1). */
+typedef struct fcm_simulation_counters {
+  int cell_rules;            /**< 1: embedded cell rules were built (scene has a geometry) */
+  int surface_rules;         /**< 1: the cell rules carry surface rules */
+  int inertia;               /**< 1: dynamic integrator (inertia term); 0: static */
+  int mass_assemblies;       /**< consistent-mass assemblies (the integrator assembles M once at
+                                  setup; it does so for static runs too, see the report) */
+  int body_force_assemblies; /**< gravity load assemblies (one per gravity effect) */
+  int traction_assemblies;   /**< surface load assemblies (traction and pressure effects) */
+  int damping;               /**< 1: a Rayleigh damping matrix is used */
+  int initial_velocity;      /**< initial-velocity effects applied */
+  int constraints;           /**< constraint sets (fixed and motion effects) */
+  fcm_index constrained_nodes; /**< background nodes named by them (with or without DOFs) */
+  fcm_index constrained_dofs;  /**< constrained DOFs after setup */
+  fcm_index schwarz_blocks;  /**< cut cells given a Schwarz block (0: no Schwarz set up) */
+  int krylov;                /**< 1: Krylov solves; 0: direct */
+  long long steps;           /**< accepted steps */
+  long long newton_iterations, linear_iterations, tangent_assemblies;
+  long long factorizations;  /**< numeric factorizations / preconditioner setups (total) */
+  long long analyses;        /**< symbolic analyses (total) */
+  long long direct_fallbacks;
+  long long frames;          /**< frames written */
+  fcm_index num_dofs;
+  fcm_index surface_points, surface_triangles; /**< embedded surface written per frame */
+  double time_setup, time_steps, time_output;  /**< seconds */
+} fcm_simulation_counters;
+
+/** A running scene (opaque). */
+typedef struct fcm_simulation fcm_simulation;
+
+/** Build everything a scene needs and set the integrator up at t = 0 (initial velocities
+ * applied). No file is created.
+ * @param[in]  ctx   context; must outlive the simulation
+ * @param[in]  scene borrowed; must outlive the simulation
+ * @param[in]  opts  NULL for defaults
+ * @param[out] sim   the new simulation, NULL on failure
+ * @return FCM_OK; FCM_ERR_ARG (a region naming a node out of range, or catching no node:
+ *         "effects[i]: ..."); errors of the mesh, geometry, cell rules, space and integrator
+ *         creation and setup; FCM_ERR_ALLOC. Allocates; not thread safe. */
+FCM_API fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
+                                         const fcm_simulation_options *opts,
+                                         fcm_simulation **sim);
+
+/** Destroy; accepts NULL and `*sim == NULL`, sets `*sim = NULL`. */
+FCM_API void fcm_simulation_destroy(fcm_simulation **sim);
+
+/** Advance one step (fcm_integrator_step()) and record it for the log.
+ * @param[out] info may be NULL
+ * @return as fcm_integrator_step(); FCM_ERR_ARG when the run is done. */
+FCM_API fcm_status fcm_simulation_step(fcm_simulation *sim, fcm_step_info *info);
+
+/** 1 when the steps to take (scene or max_steps) are taken, else 0. */
+FCM_API int fcm_simulation_done(const fcm_simulation *sim);
+/** Steps taken so far and steps to take. */
+FCM_API long long fcm_simulation_step_count(const fcm_simulation *sim);
+FCM_API long long fcm_simulation_num_steps(const fcm_simulation *sim);
+/** Whether this step should be written (frame_interval of the scene; step 0 and the last
+ * step always): 1 or 0. */
+FCM_API int fcm_simulation_frame_due(const fcm_simulation *sim);
+
+/** 1 when the displacement and velocity are finite everywhere, else 0. */
+FCM_API int fcm_simulation_state_finite(const fcm_simulation *sim);
+
+/** Write frame `index` of the current state into the existing directory `dir`:
+ * <dir>/<name>_background_NNNN.vtu (displacement, velocity per node; active flag and volume
+ * fraction per cell) and, with a geometry, <dir>/<name>_surface_NNNN.vtu (the boundary
+ * triangles of the embedded mesh at X + u(X), u interpolated from the background field,
+ * extrapolated from the nearest active cell in dropped cells), as the scene's output section
+ * asks; <dir>/<name>_background.pvd and <dir>/<name>_surface.pvd are rewritten. All writes
+ * are atomic. @return FCM_OK, FCM_ERR_IO (naming the path), FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_simulation_write_frame(fcm_simulation *sim, const char *dir, int index);
+
+/** Write the per-step log as CSV atomically to `path`: header
+ * "step,time,newton_iterations,linear_iterations,residual,energy,wall_time" and one row per
+ * step taken. @return FCM_OK, FCM_ERR_IO, FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_simulation_write_log(fcm_simulation *sim, const char *path);
+
+/** Copy the counters out. */
+FCM_API void fcm_simulation_get_counters(const fcm_simulation *sim,
+                                         fcm_simulation_counters *counters);
+
+/** Borrowed views: the integrator (for energies, momentum, state), the space and the cell
+ * rules (NULL without a geometry). */
+FCM_API fcm_integrator *fcm_simulation_integrator(fcm_simulation *sim);
+FCM_API const fcm_space *fcm_simulation_space(const fcm_simulation *sim);
+
+/** Print what was computed and what was skipped, with the counters, to `stream`. */
+FCM_API void fcm_simulation_summary_view(const fcm_simulation *sim, FILE *stream);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* FCM_SIMULATION_H */

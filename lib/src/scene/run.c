@@ -1,0 +1,699 @@
+/* The scene runner: builds the pipeline a scene asks for (mesh, geometry, cell rules, space,
+ * integrator with exactly its effects), steps it, writes frames and the per-step log. */
+#include "fcm/simulation.h"
+
+#include "core/core_impl.h"
+#include "fcm/embed.h"
+#include "fcm/fem.h"
+#include "fcm/geom.h"
+#include "fcm/io.h"
+#include "fcm/mesh.h"
+#include "io/io_impl.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+typedef struct log_row {
+  double time, residual, energy, wall;
+  long long newton, linear;
+} log_row;
+
+struct fcm_simulation {
+  fcm_ctx *ctx;
+  const fcm_scene *scene;
+  fcm_simulation_options opts;
+  fcm_mesh *mesh;
+  fcm_geometry *geom;
+  fcm_cell_rules *rules;
+  fcm_space *space;
+  fcm_integrator *integ;
+  fcm_simulation_counters c;
+  long long num_steps;
+  /* output scratch */
+  fcm_index nn;      /* background nodes */
+  double *node_u, *node_v;
+  int32_t *cell_active;
+  double *cell_phi;
+  fcm_index ns, nt;  /* surface points and triangles (compacted) */
+  fcm_index *surf_tri, *surf_cell;
+  double *surf_X, *surf_xi, *surf_u, *surf_x;
+  fcm_pvd *pvd_bg, *pvd_surf;
+  /* log */
+  log_row *log;
+  long long log_n, log_cap;
+};
+
+fcm_simulation_options fcm_simulation_options_default(void)
+{
+  fcm_simulation_options o;
+  memset(&o, 0, sizeof o);
+  return o;
+}
+
+/* ---------------------------------------------------------------- effect modules */
+
+static double window_scale(void *user, double t)
+{
+  const fcm_effect *e = user;
+  double s = e->type == FCM_EFFECT_TRACTION ? e->traction.start : e->pressure.start;
+  double f = e->type == FCM_EFFECT_TRACTION ? e->traction.end : e->pressure.end;
+  return (t >= s - 1e-12 && t <= f + 1e-12) ? 1.0 : 0.0;
+}
+
+static void surface_field(void *user, const double x[3], const double normal[3], double value[3])
+{
+  const fcm_effect *e = user;
+  value[0] = value[1] = value[2] = 0.0;
+  if (e->type == FCM_EFFECT_TRACTION) {
+    if (fcm_region_contains(&e->traction.region, x))
+      for (int d = 0; d < 3; d++) value[d] = e->traction.traction[d];
+  } else if (normal && fcm_region_contains(&e->pressure.region, x)) {
+    for (int d = 0; d < 3; d++) value[d] = -e->pressure.pressure * normal[d];
+  }
+}
+
+/* Background nodes of a region: count only (nodes NULL) or fill. */
+static fcm_status region_nodes(fcm_simulation *S, const fcm_region *r, int effect_index,
+                               fcm_index *nodes, fcm_index *count)
+{
+  fcm_status st = FCM_OK;
+  const double *X = fcm_mesh_coords(S->mesh);
+  fcm_index n = 0;
+  if (r->kind == FCM_REGION_NODES) {
+    for (fcm_index k = 0; k < r->num_nodes; k++) {
+      FCM_CHECK(r->nodes[k] >= 0 && r->nodes[k] < S->nn, S->ctx, FCM_ERR_ARG,
+                "scene %s: effects[%d]: node %lld out of range [0, %lld)",
+                fcm_scene_name(S->scene), effect_index, (long long)r->nodes[k],
+                (long long)S->nn);
+      if (nodes) nodes[n] = r->nodes[k];
+      n++;
+    }
+  } else {
+    for (fcm_index a = 0; a < S->nn; a++)
+      if (fcm_region_contains(r, X + 3 * a)) {
+        if (nodes) nodes[n] = a;
+        n++;
+      }
+  }
+  FCM_CHECK(n > 0, S->ctx, FCM_ERR_ARG,
+            "scene %s: effects[%d]: the region contains no background-mesh node",
+            fcm_scene_name(S->scene), effect_index);
+  *count = n;
+cleanup:
+  return st;
+}
+
+static fcm_status add_constraint(fcm_simulation *S, const fcm_effect *e)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *nodes = NULL, n = 0;
+  const fcm_region *r = e->type == FCM_EFFECT_FIXED ? &e->fixed.region : &e->motion.region;
+  fcm_motion m = fcm_motion_default();
+  if (e->type == FCM_EFFECT_FIXED) {
+    for (int d = 0; d < 3; d++) m.components[d] = e->fixed.components[d];
+  } else {
+    const fcm_effect_motion *em = &e->motion;
+    for (int d = 0; d < 3; d++) {
+      m.velocity[d] = em->velocity[d];
+      m.center[d] = em->center[d];
+      m.axis[d] = em->axis[d];
+    }
+    m.angular_speed = em->angular_speed;
+    m.start = em->start;
+    m.end = em->end;
+    m.release = em->release;
+  }
+  FCM_TRY(S->ctx, region_nodes(S, r, e->index, NULL, &n));
+  FCM_ALLOC(S->ctx, n, nodes);
+  FCM_TRY(S->ctx, region_nodes(S, r, e->index, nodes, &n));
+  FCM_TRY(S->ctx, fcm_integrator_add_constraint(S->integ, n, nodes, &m, NULL));
+  S->c.constraints++;
+  S->c.constrained_nodes += n;
+cleanup:
+  fcm__free(S->ctx, nodes);
+  return st;
+}
+
+/* The one table of what each effect contributes before setup (NULL: nothing before setup;
+ * damping goes into the options, initial velocities into the state after setup). */
+typedef fcm_status (*effect_apply_fn)(fcm_simulation *S, const fcm_effect *e);
+
+static fcm_status apply_gravity(fcm_simulation *S, const fcm_effect *e)
+{
+  fcm_status st = FCM_OK;
+  FCM_TRY(S->ctx, fcm_integrator_add_gravity(S->integ, e->gravity.acceleration, NULL, NULL));
+  S->c.body_force_assemblies++;
+cleanup:
+  return st;
+}
+
+static fcm_status apply_surface(fcm_simulation *S, const fcm_effect *e)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(S->c.surface_rules, S->ctx, FCM_ERR_ARG,
+            "scene %s: effects[%d]: %s needs an embedded geometry with surface rules",
+            fcm_scene_name(S->scene), e->index, fcm_effect_type_name(e->type));
+  FCM_TRY(S->ctx, fcm_integrator_add_traction(S->integ, surface_field, (void *)e, window_scale,
+                                              (void *)e));
+  S->c.traction_assemblies++;
+cleanup:
+  return st;
+}
+
+static const effect_apply_fn effect_apply[FCM_EFFECT_TYPE_COUNT] = {
+    [FCM_EFFECT_GRAVITY] = apply_gravity,  [FCM_EFFECT_FIXED] = add_constraint,
+    [FCM_EFFECT_MOTION] = add_constraint,  [FCM_EFFECT_INITIAL_VELOCITY] = NULL,
+    [FCM_EFFECT_DAMPING] = NULL,           [FCM_EFFECT_TRACTION] = apply_surface,
+    [FCM_EFFECT_PRESSURE] = apply_surface,
+};
+
+/* Initial velocities: v = v0 + omega x (X - c) on each region's nodes, c the centre of mass
+ * of the body as the space integrates it (1^T M X / 1^T M 1 per component: exact for the
+ * mass quadrature, embedded or not). */
+static fcm_status apply_initial_velocities(fcm_simulation *S)
+{
+  fcm_status st = FCM_OK;
+  fcm_index n = fcm_integrator_num_dofs(S->integ);
+  double *v = NULL, *x = NULL, *Mx = NULL, com[3] = {0, 0, 0};
+  const double *X = fcm_mesh_coords(S->mesh);
+  FCM_ALLOC(S->ctx, n, v);
+  FCM_ALLOC(S->ctx, n, x);
+  FCM_ALLOC(S->ctx, n, Mx);
+  memcpy(v, fcm_integrator_velocity(S->integ), (size_t)n * sizeof *v);
+  {
+    const fcm_csr *M = fcm_integrator_mass(S->integ);
+    double num[3] = {0, 0, 0}, den[3] = {0, 0, 0};
+    for (fcm_index a = 0; a < S->nn; a++) {
+      fcm_index dof = fcm_space_node_dof(S->space, a);
+      if (dof >= 0)
+        for (int d = 0; d < 3; d++) x[dof + d] = X[3 * a + d];
+    }
+    FCM_TRY(S->ctx, fcm_csr_apply(M, 1.0, x, 0.0, Mx));
+    for (fcm_index i = 0; i < n; i++) num[i % 3] += Mx[i];
+    for (fcm_index i = 0; i < n; i++) x[i] = 1.0;
+    FCM_TRY(S->ctx, fcm_csr_apply(M, 1.0, x, 0.0, Mx));
+    for (fcm_index i = 0; i < n; i++) den[i % 3] += Mx[i];
+    for (int d = 0; d < 3; d++) com[d] = den[d] > 0.0 ? num[d] / den[d] : 0.0;
+  }
+  for (int k = 0; k < fcm_scene_num_effects(S->scene); k++) {
+    const fcm_effect *e = fcm_scene_get_effect(S->scene, k);
+    if (e->type != FCM_EFFECT_INITIAL_VELOCITY) continue;
+    const fcm_region *r = &e->initial_velocity.region;
+    for (fcm_index a = 0; a < S->nn; a++) {
+      fcm_index dof = fcm_space_node_dof(S->space, a);
+      if (dof < 0) continue;
+      int in = 0;
+      if (r->kind == FCM_REGION_NODES) {
+        for (fcm_index j = 0; j < r->num_nodes && !in; j++) in = r->nodes[j] == a;
+      } else {
+        in = fcm_region_contains(r, X + 3 * a);
+      }
+      if (in) fcm_effect_initial_velocity_eval(&e->initial_velocity, X + 3 * a, com, v + dof);
+    }
+    S->c.initial_velocity++;
+  }
+  FCM_TRY(S->ctx, fcm_integrator_set_state(S->integ, NULL, v, fcm_integrator_time(S->integ),
+                                           fcm_integrator_step_count(S->integ)));
+cleanup:
+  fcm__free(S->ctx, v);
+  fcm__free(S->ctx, x);
+  fcm__free(S->ctx, Mx);
+  return st;
+}
+
+/* ---------------------------------------------------------------- building */
+
+static fcm_status build_geometry(fcm_simulation *S, const fcm_scene_geometry *g)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  fcm_geometry *raw = NULL;
+  switch (g->kind) {
+  case FCM_SCENE_GEOMETRY_BOX:
+    FCM_TRY(ctx, fcm_geometry_create_box(ctx, g->min, g->max, g->cells, &raw));
+    break;
+  case FCM_SCENE_GEOMETRY_BALL:
+    FCM_TRY(ctx, fcm_geometry_create_ball(ctx, g->center, g->radius, g->resolution, &raw));
+    break;
+  case FCM_SCENE_GEOMETRY_HEMISPHERE:
+    FCM_TRY(ctx, fcm_geometry_create_hemisphere(ctx, g->center, g->radius, g->resolution, &raw));
+    break;
+  case FCM_SCENE_GEOMETRY_HOLLOW_BALL:
+    FCM_TRY(ctx, fcm_geometry_create_hollow_ball(ctx, g->center, g->inner_radius,
+                                                 g->outer_radius, g->hole_radius, g->resolution,
+                                                 g->layers, &raw));
+    break;
+  case FCM_SCENE_GEOMETRY_TUBE:
+    FCM_TRY(ctx, fcm_geometry_create_tube(ctx, g->center, g->axis, g->inner_radius,
+                                          g->outer_radius, g->length, g->radial_cells,
+                                          g->angular_cells, g->axial_cells, &raw));
+    break;
+  case FCM_SCENE_GEOMETRY_GMSH:
+    FCM_TRY(ctx, fcm_geometry_create_from_gmsh(ctx, g->mesh, &raw));
+    break;
+  case FCM_SCENE_GEOMETRY_TETGEN:
+    FCM_TRY(ctx, fcm_geometry_create_from_tetgen(ctx, g->mesh, g->ele, &raw));
+    break;
+  default:
+    FCM_CHECK(0, ctx, FCM_ERR_ARG, "scene %s: geometry kind %d outside [1, %d)",
+              fcm_scene_name(S->scene), (int)g->kind, (int)FCM_SCENE_GEOMETRY_KIND_COUNT);
+  }
+  if (g->has_transform) {
+    FCM_TRY(ctx, fcm_geometry_create_transformed(ctx, raw, g->transform, g->offset, &S->geom));
+  } else {
+    S->geom = raw;
+    raw = NULL;
+  }
+cleanup:
+  fcm_geometry_destroy(&raw);
+  return st;
+}
+
+static fcm_status build_rules(fcm_simulation *S)
+{
+  fcm_status st = FCM_OK;
+  const fcm_scene_quadrature *q = fcm_scene_get_quadrature(S->scene);
+  const fcm_scene_solver *sv = fcm_scene_get_solver(S->scene);
+  fcm_cell_rules_options ro = fcm_cell_rules_options_default();
+  int nsurf = fcm_scene_count_effects(S->scene, FCM_EFFECT_TRACTION) +
+              fcm_scene_count_effects(S->scene, FCM_EFFECT_PRESSURE);
+  ro.strength[FCM_RULE_STIFFNESS] = q->stiffness_strength;
+  ro.strength[FCM_RULE_MASS] = q->mass_strength;
+  if (q->surface_strength >= 0)
+    ro.surface_strength = q->surface_strength;
+  else if (nsurf > 0)
+    ro.surface_strength = q->stiffness_strength >= 0
+                              ? q->stiffness_strength
+                              : fcm_mesh_element_info(S->mesh)->stiffness_strength;
+  else
+    ro.surface_strength = -1;
+  ro.min_fraction = q->min_fraction;
+  ro.simplify = q->simplify;
+  ro.simplify_options.method = q->simplify_method == FCM_SCENE_SIMPLIFY_LP ? FCM_SIMPLIFY_LP
+                               : q->simplify_method == FCM_SCENE_SIMPLIFY_RECOMBINE
+                                   ? FCM_SIMPLIFY_RECOMBINE
+                                   : FCM_SIMPLIFY_AUTO;
+  ro.stabilization.mode = q->stabilization == FCM_SCENE_STABILIZATION_MASS ? FCM_STABILIZATION_MASS
+                          : q->stabilization == FCM_SCENE_STABILIZATION_OFF
+                              ? FCM_STABILIZATION_OFF
+                              : FCM_STABILIZATION_MASS_STIFFNESS;
+  ro.stabilization.alpha = q->stabilization_alpha;
+  ro.num_threads = sv->threads;
+  FCM_TRY(S->ctx, fcm_cell_rules_create(S->ctx, S->mesh, S->geom, &ro, &S->rules));
+  S->c.cell_rules = 1;
+  S->c.surface_rules = ro.surface_strength >= 0;
+cleanup:
+  return st;
+}
+
+static fcm_integrator_options integrator_options(fcm_simulation *S)
+{
+  const fcm_scene_quadrature *q = fcm_scene_get_quadrature(S->scene);
+  const fcm_scene_solver *sv = fcm_scene_get_solver(S->scene);
+  const fcm_scene_time *tm = fcm_scene_get_time(S->scene);
+  fcm_integrator_options o = fcm_integrator_options_default();
+  o.kind = tm->is_static ? FCM_INTEGRATOR_STATIC : FCM_INTEGRATOR_BACKWARD_EULER;
+  o.dt = tm->dt;
+  o.load_steps = tm->load_steps;
+  o.newton_max_iterations = sv->newton_max_iterations;
+  o.newton_tolerance = sv->newton_rtol;
+  o.rep_acceleration = sv->representative_acceleration;
+  o.line_search = sv->line_search;
+  o.project_psd = sv->project_psd;
+  o.linear_solver = sv->method == FCM_SCENE_SOLVER_DIRECT ? FCM_LINEAR_DIRECT
+                    : sv->method == FCM_SCENE_SOLVER_CG   ? FCM_LINEAR_CG
+                                                          : FCM_LINEAR_MINRES;
+  o.direct_method = sv->direct;
+  o.preconditioner = sv->preconditioner == FCM_SCENE_PRECONDITIONER_NONE ? FCM_PRECOND_NONE
+                     : sv->preconditioner == FCM_SCENE_PRECONDITIONER_JACOBI
+                         ? FCM_PRECOND_JACOBI
+                     : sv->preconditioner == FCM_SCENE_PRECONDITIONER_BLOCK_JACOBI
+                         ? FCM_PRECOND_BLOCK_JACOBI
+                         : FCM_PRECOND_SCHWARZ;
+  o.krylov_rtol = sv->rtol;
+  o.krylov_atol = sv->atol;
+  o.krylov_max_iterations = sv->max_iterations;
+  o.schwarz_theta = sv->schwarz_threshold;
+  o.schwarz.epsilon = sv->schwarz_epsilon;
+  o.schwarz.clamp = sv->schwarz_paper_clamp ? FCM_SCHWARZ_PAPER : FCM_SCHWARZ_CLAMP;
+  o.assembly.stiffness_strength = q->stiffness_strength > 0 ? q->stiffness_strength : 0;
+  o.assembly.mass_strength = q->mass_strength > 0 ? q->mass_strength : 0;
+  for (int k = 0; k < fcm_scene_num_effects(S->scene); k++) {
+    const fcm_effect *e = fcm_scene_get_effect(S->scene, k);
+    if (e->type != FCM_EFFECT_DAMPING || tm->is_static) continue;
+    o.rayleigh_mass += e->damping.mass;
+    o.rayleigh_stiffness += e->damping.stiffness;
+  }
+  return o;
+}
+
+/* Schwarz blocks the integrator would build: active cut cells below the threshold. */
+static fcm_index count_schwarz_blocks(const fcm_simulation *S, double theta)
+{
+  fcm_index n = 0;
+  if (!S->rules) return 0;
+  for (fcm_index c = 0; c < fcm_mesh_num_cells(S->mesh); c++)
+    if (fcm_space_cell_active(S->space, c) && fcm_cell_rules_class(S->rules, c) == FCM_CELL_CUT &&
+        fcm_cell_rules_volume_fraction(S->rules, c) < theta)
+      n++;
+  return n;
+}
+
+/* The embedded surface: the boundary triangles' nodes (compacted), located once. */
+static fcm_status build_surface(fcm_simulation *S)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  fcm_index nv = fcm_geometry_num_nodes(S->geom);
+  fcm_index nt = fcm_geometry_num_boundary_triangles(S->geom);
+  const fcm_index *tri = fcm_geometry_boundary_triangles(S->geom);
+  const double *GX = fcm_geometry_coords(S->geom);
+  fcm_index *map = NULL;
+  FCM_ALLOC(ctx, nv, map);
+  for (fcm_index i = 0; i < nv; i++) map[i] = -1;
+  fcm_index ns = 0;
+  for (fcm_index k = 0; k < 3 * nt; k++)
+    if (map[tri[k]] < 0) map[tri[k]] = ns++;
+  FCM_ALLOC(ctx, 3 * nt, S->surf_tri);
+  FCM_ALLOC(ctx, ns, S->surf_cell);
+  FCM_ALLOC(ctx, 3 * ns, S->surf_X);
+  FCM_ALLOC(ctx, 3 * ns, S->surf_xi);
+  FCM_ALLOC(ctx, 3 * ns, S->surf_u);
+  FCM_ALLOC(ctx, 3 * ns, S->surf_x);
+  for (fcm_index k = 0; k < 3 * nt; k++) S->surf_tri[k] = map[tri[k]];
+  for (fcm_index i = 0; i < nv; i++)
+    if (map[i] >= 0)
+      for (int d = 0; d < 3; d++) S->surf_X[3 * map[i] + d] = GX[3 * i + d];
+  if (ns > 0)
+    FCM_TRY(ctx, fcm_space_locate(S->space, ns, S->surf_X, S->surf_cell, S->surf_xi, NULL));
+  S->ns = ns;
+  S->nt = nt;
+  S->c.surface_points = ns;
+  S->c.surface_triangles = nt;
+cleanup:
+  fcm__free(ctx, map);
+  return st;
+}
+
+fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
+                                 const fcm_simulation_options *opts, fcm_simulation **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_simulation *S = NULL;
+  FCM_CHECK(ctx && scene && out, ctx, FCM_ERR_ARG, "simulation: NULL argument");
+  *out = NULL;
+  double t0 = fcm_wtime();
+  FCM_ALLOC(ctx, 1, S);
+  S->ctx = ctx;
+  S->scene = scene;
+  S->opts = opts ? *opts : fcm_simulation_options_default();
+  FCM_CHECK(S->opts.max_steps >= 0, ctx, FCM_ERR_ARG,
+            "simulation: max_steps = %lld must be >= 0 (0: the scene's)",
+            (long long)S->opts.max_steps);
+  const fcm_scene_time *tm = fcm_scene_get_time(scene);
+  S->num_steps = tm->num_steps;
+  if (S->opts.max_steps > 0 && S->opts.max_steps < S->num_steps) S->num_steps = S->opts.max_steps;
+
+  /* background mesh */
+  const fcm_scene_background *bg = fcm_scene_get_background(scene);
+  if (bg->kind == FCM_SCENE_BACKGROUND_GRID)
+    FCM_TRY(ctx, fcm_mesh_create_box(ctx, bg->element, bg->min, bg->max, bg->cells, &S->mesh));
+  else
+    FCM_TRY(ctx, fcm_mesh_create_from_gmsh(ctx, bg->mesh, &S->mesh));
+  S->nn = fcm_mesh_num_nodes(S->mesh);
+
+  /* geometry and cell rules only when the scene embeds one */
+  const fcm_scene_geometry *g = fcm_scene_get_geometry(scene);
+  if (g->kind != FCM_SCENE_GEOMETRY_NONE) {
+    FCM_TRY(ctx, build_geometry(S, g));
+    FCM_TRY(ctx, build_rules(S));
+    FCM_TRY(ctx, fcm_space_create_embedded(ctx, S->mesh, S->rules, &S->space));
+  } else {
+    FCM_TRY(ctx, fcm_space_create(ctx, S->mesh, NULL, &S->space));
+  }
+  S->c.num_dofs = fcm_space_num_dofs(S->space);
+
+  /* integrator with the scene's effects */
+  fcm_integrator_options io = integrator_options(S);
+  S->c.inertia = io.kind == FCM_INTEGRATOR_BACKWARD_EULER;
+  S->c.damping = io.rayleigh_mass > 0.0 || io.rayleigh_stiffness > 0.0;
+  S->c.krylov = io.linear_solver != FCM_LINEAR_DIRECT;
+  if (S->c.krylov && io.preconditioner == FCM_PRECOND_SCHWARZ) {
+    S->c.schwarz_blocks = count_schwarz_blocks(S, io.schwarz_theta);
+    if (S->c.schwarz_blocks == 0) io.preconditioner = FCM_PRECOND_JACOBI; /* nothing to block */
+  }
+  FCM_TRY(ctx, fcm_integrator_create(ctx, S->space, fcm_scene_get_material(scene), &io,
+                                     &S->integ));
+  for (int k = 0; k < fcm_scene_num_effects(scene); k++) {
+    const fcm_effect *e = fcm_scene_get_effect(scene, k);
+    if (effect_apply[e->type]) FCM_TRY(ctx, effect_apply[e->type](S, e));
+  }
+  FCM_TRY(ctx, fcm_integrator_setup(S->integ));
+  S->c.mass_assemblies = 1; /* fcm_integrator_setup() assembles M once, static or not */
+  S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);
+  if (S->c.inertia && fcm_scene_count_effects(scene, FCM_EFFECT_INITIAL_VELOCITY) > 0)
+    FCM_TRY(ctx, apply_initial_velocities(S));
+
+  /* output scratch */
+  fcm_index nc = fcm_mesh_num_cells(S->mesh);
+  FCM_ALLOC(ctx, 3 * S->nn, S->node_u);
+  FCM_ALLOC(ctx, 3 * S->nn, S->node_v);
+  FCM_ALLOC(ctx, nc, S->cell_active);
+  FCM_ALLOC(ctx, nc, S->cell_phi);
+  for (fcm_index c = 0; c < nc; c++) {
+    S->cell_active[c] = (int32_t)fcm_space_cell_active(S->space, c);
+    S->cell_phi[c] = S->rules ? fcm_cell_rules_volume_fraction(S->rules, c) : 1.0;
+  }
+  if (S->geom && fcm_scene_get_output(scene)->write_surface) FCM_TRY(ctx, build_surface(S));
+  S->c.time_setup = fcm_wtime() - t0;
+  *out = S;
+  S = NULL;
+cleanup:
+  fcm_simulation_destroy(&S);
+  return st;
+}
+
+void fcm_simulation_destroy(fcm_simulation **sim)
+{
+  if (!sim || !*sim) return;
+  fcm_simulation *S = *sim;
+  fcm_ctx *ctx = S->ctx;
+  fcm_pvd_destroy(&S->pvd_bg);
+  fcm_pvd_destroy(&S->pvd_surf);
+  fcm_integrator_destroy(&S->integ);
+  fcm_space_destroy(&S->space);
+  fcm_cell_rules_destroy(&S->rules);
+  fcm_geometry_destroy(&S->geom);
+  fcm_mesh_destroy(&S->mesh);
+  void *arrays[] = {S->node_u,   S->node_v,  S->cell_active, S->cell_phi, S->surf_tri,
+                    S->surf_cell, S->surf_X,  S->surf_xi,     S->surf_u,   S->surf_x,
+                    S->log};
+  for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++) fcm__free(ctx, arrays[k]);
+  fcm__free(ctx, S);
+  *sim = NULL;
+}
+
+/* ---------------------------------------------------------------- stepping */
+
+fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
+{
+  fcm_status st = FCM_OK;
+  fcm_step_info si;
+  memset(&si, 0, sizeof si);
+  FCM_CHECK(S, NULL, FCM_ERR_ARG, "simulation: NULL");
+  FCM_CHECK(!fcm_simulation_done(S), S->ctx, FCM_ERR_ARG,
+            "simulation %s: all %lld steps are taken", fcm_scene_name(S->scene), S->num_steps);
+  double t0 = fcm_wtime();
+  st = fcm_integrator_step(S->integ, &si);
+  double wall = fcm_wtime() - t0;
+  S->c.time_steps += wall;
+  S->c.newton_iterations += si.newton_iterations;
+  S->c.linear_iterations += si.linear_iterations;
+  S->c.tangent_assemblies += si.tangent_assemblies;
+  S->c.factorizations = si.total_factorizations;
+  S->c.analyses = si.total_analyses;
+  S->c.direct_fallbacks = si.total_direct_fallbacks;
+  if (info) *info = si;
+  if (st != FCM_OK) {
+    fcm__trace(S->ctx, __FILE__, __LINE__, __func__);
+    goto cleanup;
+  }
+  S->c.steps++;
+  if (S->log_n == S->log_cap) {
+    long long cap = S->log_cap ? 2 * S->log_cap : 64;
+    FCM_TRY(S->ctx, fcm__resize(S->ctx, (void **)&S->log, (size_t)S->log_cap, (size_t)cap,
+                                sizeof *S->log));
+    S->log_cap = cap;
+  }
+  log_row *r = &S->log[S->log_n++];
+  r->time = si.time;
+  r->newton = si.newton_iterations;
+  r->linear = si.linear_iterations;
+  r->residual = si.residual;
+  r->energy = si.total_energy;
+  r->wall = wall;
+cleanup:
+  return st;
+}
+
+int fcm_simulation_done(const fcm_simulation *S) { return !S || S->c.steps >= S->num_steps; }
+long long fcm_simulation_step_count(const fcm_simulation *S) { return S ? S->c.steps : 0; }
+long long fcm_simulation_num_steps(const fcm_simulation *S) { return S ? S->num_steps : 0; }
+fcm_integrator *fcm_simulation_integrator(fcm_simulation *S) { return S ? S->integ : NULL; }
+const fcm_space *fcm_simulation_space(const fcm_simulation *S) { return S ? S->space : NULL; }
+
+int fcm_simulation_frame_due(const fcm_simulation *S)
+{
+  if (!S) return 0;
+  int every = fcm_scene_get_output(S->scene)->frame_interval;
+  return S->c.steps == 0 || S->c.steps >= S->num_steps || (every > 0 && S->c.steps % every == 0);
+}
+
+int fcm_simulation_state_finite(const fcm_simulation *S)
+{
+  fcm_index n = fcm_integrator_num_dofs(S->integ);
+  const double *u = fcm_integrator_displacement(S->integ), *v = fcm_integrator_velocity(S->integ);
+  for (fcm_index i = 0; i < n; i++)
+    if (!isfinite(u[i]) || !isfinite(v[i])) return 0;
+  return 1;
+}
+
+void fcm_simulation_get_counters(const fcm_simulation *S, fcm_simulation_counters *c)
+{
+  if (S && c) *c = S->c;
+}
+
+/* ---------------------------------------------------------------- output */
+
+fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int index)
+{
+  fcm_status st = FCM_OK;
+  fcm_vtu *vtu = NULL;
+  char path[4096];
+  FCM_CHECK(S && dir && index >= 0, S ? S->ctx : NULL, FCM_ERR_ARG,
+            "simulation: write_frame needs a directory and index >= 0 (got %d)", index);
+  fcm_ctx *ctx = S->ctx;
+  const char *name = fcm_scene_name(S->scene);
+  const fcm_scene_output *out = fcm_scene_get_output(S->scene);
+  double t0 = fcm_wtime(), time = fcm_integrator_time(S->integ);
+  const double *u = fcm_integrator_displacement(S->integ), *v = fcm_integrator_velocity(S->integ);
+  for (fcm_index a = 0; a < S->nn; a++) {
+    fcm_index dof = fcm_space_node_dof(S->space, a);
+    for (int d = 0; d < 3; d++) {
+      S->node_u[3 * a + d] = dof >= 0 ? u[dof + d] : 0.0;
+      S->node_v[3 * a + d] = dof >= 0 ? v[dof + d] : 0.0;
+    }
+  }
+  FCM_TRY(ctx, fcm_vtu_create(ctx, &vtu));
+  if (out->write_background) {
+    fcm_index nc = fcm_mesh_num_cells(S->mesh);
+    FCM_TRY(ctx, fcm_vtu_set_points(vtu, S->nn, fcm_mesh_coords(S->mesh)));
+    FCM_TRY(ctx, fcm_vtu_set_cells(vtu, fcm_mesh_element_info(S->mesh)->vtk_cell_type, nc,
+                                   fcm_mesh_cells(S->mesh)));
+    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "displacement", 3, S->nn, S->node_u));
+    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "velocity", 3, S->nn, S->node_v));
+    FCM_TRY(ctx, fcm_vtu_add_field_int32(vtu, FCM_VTU_CELL_DATA, "active", 1, nc, S->cell_active));
+    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "volume_fraction", 1, nc, S->cell_phi));
+    snprintf(path, sizeof path, "%s/%s_background_%04d.vtu", dir, name, index);
+    FCM_TRY(ctx, fcm_vtu_write(vtu, path, NULL));
+    if (!S->pvd_bg) {
+      char pvd[4096];
+      snprintf(pvd, sizeof pvd, "%s/%s_background.pvd", dir, name);
+      FCM_TRY(ctx, fcm_pvd_create(ctx, pvd, &S->pvd_bg));
+    }
+    FCM_TRY(ctx, fcm_pvd_add(S->pvd_bg, time, path));
+  }
+  if (S->ns > 0) {
+    FCM_TRY(ctx, fcm_space_interpolate(S->space, S->ns, S->surf_cell, S->surf_xi, u, S->surf_u));
+    for (fcm_index i = 0; i < 3 * S->ns; i++) S->surf_x[i] = S->surf_X[i] + S->surf_u[i];
+    fcm_vtu_clear(vtu);
+    FCM_TRY(ctx, fcm_vtu_set_points(vtu, S->ns, S->surf_x));
+    FCM_TRY(ctx, fcm_vtu_set_cells(vtu, FCM_VTK_TRIANGLE, S->nt, S->surf_tri));
+    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "displacement", 3, S->ns, S->surf_u));
+    snprintf(path, sizeof path, "%s/%s_surface_%04d.vtu", dir, name, index);
+    FCM_TRY(ctx, fcm_vtu_write(vtu, path, NULL));
+    if (!S->pvd_surf) {
+      char pvd[4096];
+      snprintf(pvd, sizeof pvd, "%s/%s_surface.pvd", dir, name);
+      FCM_TRY(ctx, fcm_pvd_create(ctx, pvd, &S->pvd_surf));
+    }
+    FCM_TRY(ctx, fcm_pvd_add(S->pvd_surf, time, path));
+  }
+  S->c.frames++;
+  S->c.time_output += fcm_wtime() - t0;
+cleanup:
+  fcm_vtu_destroy(&vtu);
+  return st;
+}
+
+fcm_status fcm_simulation_write_log(fcm_simulation *S, const char *path)
+{
+  fcm_status st = FCM_OK;
+  fcm__atomic_file af;
+  memset(&af, 0, sizeof af);
+  FCM_CHECK(S && path, S ? S->ctx : NULL, FCM_ERR_ARG, "simulation: write_log needs a path");
+  FCM_TRY(S->ctx, fcm__io_atomic_open(S->ctx, path, 0, NULL, &af));
+  FCM_TRY(S->ctx, fcm__io_atomic_printf(
+                      S->ctx, &af,
+                      "step,time,newton_iterations,linear_iterations,residual,energy,wall_time\n"));
+  for (long long k = 0; k < S->log_n; k++) {
+    const log_row *r = &S->log[k];
+    FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, "%lld,%.17g,%lld,%lld,%.17g,%.17g,%.6g\n",
+                                          k + 1, r->time, r->newton, r->linear, r->residual,
+                                          r->energy, r->wall));
+  }
+  FCM_TRY(S->ctx, fcm__io_atomic_commit(S->ctx, &af));
+cleanup:
+  if (st != FCM_OK && S) fcm__io_atomic_abort(S->ctx, &af);
+  return st;
+}
+
+/* ---------------------------------------------------------------- summary */
+
+static void line(FILE *f, int on, const char *what, const char *detail)
+{
+  fprintf(f, "  %-9s %-28s %s\n", on ? "computed" : "skipped", what, detail);
+}
+
+void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
+{
+  if (!S || !f) return;
+  const fcm_simulation_counters *c = &S->c;
+  char b[256];
+  fprintf(f, "simulation %s: %lld of %lld steps, %lld DOFs\n", fcm_scene_name(S->scene),
+          c->steps, S->num_steps, (long long)c->num_dofs);
+  line(f, c->cell_rules, "embedded cell rules", c->cell_rules ? "" : "(no geometry)");
+  line(f, c->surface_rules, "surface rules", c->surface_rules ? "" : "(no traction or pressure)");
+  line(f, c->inertia, "inertia (backward Euler)", c->inertia ? "" : "(static scene)");
+  snprintf(b, sizeof b, "%d%s", c->mass_assemblies,
+           c->inertia ? "" : " (integrator setup; used only by the stopping rule)");
+  line(f, c->mass_assemblies > 0, "mass assemblies", b);
+  snprintf(b, sizeof b, "%d", c->body_force_assemblies);
+  line(f, c->body_force_assemblies > 0, "body-force assemblies",
+       c->body_force_assemblies ? b : "(no gravity)");
+  snprintf(b, sizeof b, "%d", c->traction_assemblies);
+  line(f, c->traction_assemblies > 0, "surface-load assemblies",
+       c->traction_assemblies ? b : "(no traction or pressure)");
+  line(f, c->damping, "Rayleigh damping matrix", c->damping ? "" : "(no damping)");
+  snprintf(b, sizeof b, "%d", c->initial_velocity);
+  line(f, c->initial_velocity > 0, "initial velocities", c->initial_velocity ? b : "(none)");
+  snprintf(b, sizeof b, "%d sets, %lld nodes, %lld DOFs", c->constraints,
+           (long long)c->constrained_nodes, (long long)c->constrained_dofs);
+  line(f, c->constraints > 0, "constraints", c->constraints ? b : "(none)");
+  snprintf(b, sizeof b, "%lld blocks", (long long)c->schwarz_blocks);
+  line(f, c->schwarz_blocks > 0, "Schwarz blocks",
+       c->schwarz_blocks ? b : (c->krylov ? "(no cell below the threshold, or not asked)"
+                                          : "(direct solver)"));
+  snprintf(b, sizeof b, "%lld factorizations, %lld analyses, %lld fallbacks", c->factorizations,
+           c->analyses, c->direct_fallbacks);
+  line(f, 1, c->krylov ? "preconditioner setups" : "direct factorizations", b);
+  snprintf(b, sizeof b, "%lld Newton, %lld linear iterations, %lld tangents",
+           c->newton_iterations, c->linear_iterations, c->tangent_assemblies);
+  line(f, 1, "iterations", b);
+  snprintf(b, sizeof b, "%lld frames, surface %lld points %lld triangles", c->frames,
+           (long long)c->surface_points, (long long)c->surface_triangles);
+  line(f, c->frames > 0, "output", b);
+  fprintf(f, "  time [s]  setup %.3f  steps %.3f  output %.3f\n", c->time_setup, c->time_steps,
+          c->time_output);
+}
