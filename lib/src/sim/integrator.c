@@ -65,25 +65,27 @@ void fcm_motion_eval(const fcm_motion *m, const double X[3], double t, double u[
   if (tau > span) tau = span;
   double a[3] = {m->axis[0], m->axis[1], m->axis[2]};
   double an = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-  double r[3], rr[3];
+  /* Rodrigues: R r = r + s (a x r) + (1 - c) a x (a x r); u = (R r - r) + velocity tau, so a
+   * pure translation is exact and the axial component of a rotation is exactly zero. */
+  double r[3], du[3] = {0, 0, 0};
   for (int i = 0; i < 3; i++) r[i] = X[i] - m->center[i];
   if (an > 0.0 && m->angular_speed != 0.0) {
     for (int i = 0; i < 3; i++) a[i] /= an;
     double phi = m->angular_speed * tau, c = cos(phi), s = sin(phi);
-    double ar = a[0] * r[0] + a[1] * r[1] + a[2] * r[2];
     double axr[3] = {a[1] * r[2] - a[2] * r[1], a[2] * r[0] - a[0] * r[2], a[0] * r[1] - a[1] * r[0]};
-    for (int i = 0; i < 3; i++) rr[i] = c * r[i] + s * axr[i] + (1.0 - c) * ar * a[i];
+    double aaxr[3] = {a[1] * axr[2] - a[2] * axr[1], a[2] * axr[0] - a[0] * axr[2],
+                      a[0] * axr[1] - a[1] * axr[0]};
+    for (int i = 0; i < 3; i++) du[i] = s * axr[i] + (1.0 - c) * aaxr[i];
   } else {
     an = 0.0;
-    memcpy(rr, r, sizeof rr);
   }
-  /* u = (R r - r) + velocity tau: exactly the translation when there is no rotation. */
-  for (int i = 0; i < 3; i++) u[i] = (rr[i] - r[i]) + m->velocity[i] * tau;
+  for (int i = 0; i < 3; i++) u[i] = du[i] + m->velocity[i] * tau;
   if (v) {
     int moving = t >= m->start && t < m->end;
     for (int i = 0; i < 3; i++) v[i] = moving ? m->velocity[i] : 0.0;
     if (moving && an > 0.0) {
-      double w = m->angular_speed;
+      double w = m->angular_speed, rr[3];
+      for (int i = 0; i < 3; i++) rr[i] = r[i] + du[i];
       v[0] += w * (a[1] * rr[2] - a[2] * rr[1]);
       v[1] += w * (a[2] * rr[0] - a[0] * rr[2]);
       v[2] += w * (a[0] * rr[1] - a[1] * rr[0]);
