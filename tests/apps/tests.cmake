@@ -2,3 +2,28 @@
 file(MAKE_DIRECTORY ${PROJECT_BINARY_DIR}/app-tests)
 fcm_add_test(app_quadrature tests/apps/quadrature_app.c LABELS app
              ARGS $<TARGET_FILE:fcm-quadrature> ${PROJECT_BINARY_DIR}/app-tests)
+fcm_add_test(app_condition tests/apps/condition_app.c LABELS app
+             ARGS $<TARGET_FILE:fcm-condition> ${PROJECT_BINARY_DIR}/app-tests)
+fcm_add_test(app_condition_claims tests/apps/condition_claims.c LABELS app
+             ARGS $<TARGET_FILE:fcm-condition> ${PROJECT_BINARY_DIR}/app-tests)
+# fcm-sim: a small scene run (frames, PVDs, CSV log, --steps, -o) and the no-argument demo;
+# invalid scenes exit non-zero with the parser's message and create no output directory;
+# every example scene and the built-in scene run `--check` (the heavy ones labelled slow).
+fcm_add_test(app_sim_run tests/apps/sim_app.c LABELS app
+             ARGS run $<TARGET_FILE:fcm-sim> ${PROJECT_BINARY_DIR}/app-tests)
+add_test(NAME app_sim_errors COMMAND app_sim_run errors $<TARGET_FILE:fcm-sim>
+         ${PROJECT_BINARY_DIR}/app-tests)
+set_tests_properties(app_sim_errors PROPERTIES LABELS app TIMEOUT 300)
+foreach(scene spinning_body slingshot hollow_ball static_beam twisting_cylinder default)
+  if(scene STREQUAL "default")
+    set(arg --default-scene)
+  else()
+    set(arg ${PROJECT_SOURCE_DIR}/apps/scenes/${scene}.json)
+  endif()
+  add_test(NAME app_sim_check_${scene} COMMAND app_sim_run check $<TARGET_FILE:fcm-sim> ${arg})
+  if(scene STREQUAL "spinning_body")
+    set_tests_properties(app_sim_check_${scene} PROPERTIES LABELS app TIMEOUT 300)
+  else()
+    set_tests_properties(app_sim_check_${scene} PROPERTIES LABELS "app;slow" TIMEOUT 1800)
+  endif()
+endforeach()

@@ -6,3 +6,5 @@ fcm_add_test(scene_errors tests/scene/errors.c)
 fcm_add_test(scene_alloc tests/scene/alloc.c)
 fcm_add_test(scene_default tests/scene/default.c)
 fcm_add_test(scene_examples tests/scene/examples.c ARGS ${PROJECT_SOURCE_DIR}/apps/scenes)
+# The scene runner: counters of what a scene computes and skips, frames, log, errors.
+fcm_add_test(scene_run_counters tests/scene/run_counters.c)

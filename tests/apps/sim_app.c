@@ -1,0 +1,181 @@
+/* fcm-sim end to end. Modes:
+ *   sim_app check FCM_SIM SCENE       `fcm-sim SCENE --check` exits 0 and prints the summary
+ *   sim_app run FCM_SIM WORK_DIR      a small scene run with -o and --steps writes the frames,
+ *                                     both PVDs and a CSV log with one row per step; the
+ *                                     no-argument cantilever demo still runs
+ *   sim_app errors FCM_SIM WORK_DIR   invalid scenes and options exit non-zero with the
+ *                                     parser's message and create no output directory */
+#define _POSIX_C_SOURCE 200809L
+#include "fcm/fcm.h"
+#include "test.h"
+
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+static int run(const char *cmd)
+{
+  int st = system(cmd);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static int exists(const char *path)
+{
+  struct stat sb;
+  return stat(path, &sb) == 0;
+}
+
+static void write_file(const char *path, const char *text)
+{
+  FILE *f = fopen(path, "w");
+  TEST_TRUE(f != NULL);
+  if (f) {
+    fputs(text, f);
+    fclose(f);
+  }
+}
+
+/* Whether the file contains `needle`. */
+static int file_has(const char *path, const char *needle)
+{
+  char buf[8192];
+  FILE *f = fopen(path, "r");
+  if (!f) return 0;
+  size_t n = fread(buf, 1, sizeof buf - 1, f);
+  fclose(f);
+  buf[n] = '\0';
+  return strstr(buf, needle) != NULL;
+}
+
+static const char small_scene[] =
+    "{\"version\": 1, \"name\": \"small\","
+    " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0], \"max\": [1.5, 0.5, 0.5]},"
+    "   \"cells\": [3, 1, 1]},"
+    " \"geometry\": {\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [1.2, 0.5, 0.5],"
+    "   \"cells\": [3, 1, 1]},"
+    " \"material\": {\"model\": \"snh\", \"young\": 1e6, \"poisson\": 0.3, \"density\": 1000},"
+    " \"time\": {\"dt\": 0.01, \"steps\": 10},"
+    " \"output\": {\"directory\": \"unused-by-test\", \"frame_interval\": 2},"
+    " \"effects\": [{\"gravity\": {}},"
+    "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, 0, 0]}}}}]}";
+
+static int mode_check(const char *sim, const char *scene)
+{
+  char cmd[8192], out[1024];
+  snprintf(out, sizeof out, "%s.check-%ld.txt", "/tmp/fcm-sim-check", (long)getpid());
+  snprintf(cmd, sizeof cmd, "'%s' '%s' --check > '%s' 2> /dev/null", sim, scene, out);
+  TEST_TRUE(run(cmd) == 0);
+  TEST_TRUE(file_has(out, "steps,") || file_has(out, " steps, "));
+  TEST_TRUE(file_has(out, "computed  inertia") || file_has(out, "skipped   inertia"));
+  remove(out);
+  return TEST_RESULT();
+}
+
+static int mode_run(const char *sim, const char *work)
+{
+  char cmd[8192], scene[1024], dir[1024], path[4096];
+  snprintf(scene, sizeof scene, "%s/small.json", work);
+  snprintf(dir, sizeof dir, "%s/small-out/nested", work);
+  write_file(scene, small_scene);
+  snprintf(cmd, sizeof cmd, "rm -rf '%s/small-out'", work);
+  run(cmd);
+  /* 10 steps in the scene, cut to 4; frames at steps 0, 2, 4 */
+  snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s' --steps 4 --quiet > /dev/null 2>&1", sim, scene,
+           dir);
+  TEST_TRUE(run(cmd) == 0);
+  const char *files[] = {"small_background_0000.vtu", "small_background_0002.vtu",
+                         "small_surface_0000.vtu",    "small_surface_0002.vtu",
+                         "small_background.pvd",      "small_surface.pvd"};
+  for (int k = 0; k < 6; k++) {
+    snprintf(path, sizeof path, "%s/%s", dir, files[k]);
+    TEST_TRUE(exists(path));
+  }
+  snprintf(path, sizeof path, "%s/small_background_0003.vtu", dir);
+  TEST_TRUE(!exists(path));
+  snprintf(path, sizeof path, "%s/small_log.csv", dir);
+  FILE *f = fopen(path, "r");
+  TEST_TRUE(f != NULL);
+  if (f) {
+    char line[512];
+    TEST_TRUE(fgets(line, sizeof line, f) &&
+              !strcmp(line, "step,time,newton_iterations,linear_iterations,residual,energy,"
+                            "wall_time\n"));
+    int rows = 0;
+    long long step, newton, linear;
+    double t, res, energy, wall;
+    while (fscanf(f, "%lld,%lf,%lld,%lld,%lf,%lf,%lf\n", &step, &t, &newton, &linear, &res,
+                  &energy, &wall) == 7) {
+      rows++;
+      TEST_TRUE(step == rows);
+      TEST_NEAR(t, 0.01 * rows, 1e-12, 1e-14);
+      TEST_TRUE(newton >= 1 && linear == 0 && res >= 0 && wall >= 0);
+    }
+    TEST_TRUE(rows == 4);
+    fclose(f);
+  }
+  /* the surface VTU holds triangles */
+  snprintf(path, sizeof path, "%s/small_surface_0002.vtu", dir);
+  TEST_TRUE(file_has(path, "UnstructuredGrid"));
+
+  /* the README demo: no scene, cantilever (small grid) */
+  snprintf(dir, sizeof dir, "%s/demo-out", work);
+  snprintf(cmd, sizeof cmd, "'%s' --cells 4 1 1 -o '%s' -q > /dev/null 2>&1", sim, dir);
+  TEST_TRUE(run(cmd) == 0);
+  snprintf(path, sizeof path, "%s/cantilever.pvd", dir);
+  TEST_TRUE(exists(path));
+  return TEST_RESULT();
+}
+
+static int mode_errors(const char *sim, const char *work)
+{
+  char cmd[8192], scene[1024], dir[1024], err[1024];
+  snprintf(dir, sizeof dir, "%s/must-not-exist", work);
+  snprintf(err, sizeof err, "%s/errors-stderr.txt", work);
+  snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+  run(cmd);
+  struct {
+    const char *json, *message;
+  } bad[] = {
+      {"{\"version\": 1, \"background\": {", ":1:"},                 /* malformed JSON */
+      {"{\"version\": 1, \"bogus\": 3}", "bogus"},                    /* unknown key */
+      {"{\"version\": 1, \"name\": \"x\", \"output\": {\"directory\": \"DIR\"},"
+       " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0],"
+       " \"max\": [1, 1, 1]}, \"cells\": [1, 1, 1]},"
+       " \"material\": {\"model\": \"linear\", \"young\": 1e6, \"poisson\": 0.3},"
+       " \"effects\": [{\"wind\": {}}]}", "wind"}};                   /* unknown effect */
+  for (int k = 0; k < 3; k++) {
+    snprintf(scene, sizeof scene, "%s/bad%d.json", work, k);
+    write_file(scene, bad[k].json);
+    /* with the scene's directory and with -o */
+    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' '%s' 2> '%s' > /dev/null", work, sim, scene, err);
+    int rc = run(cmd);
+    TEST_TRUE(rc != 0);
+    if (!file_has(err, bad[k].message)) TEST_FAIL_("bad%d: stderr lacks '%s'", k, bad[k].message);
+    snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s' 2> /dev/null > /dev/null", sim, scene, dir);
+    TEST_TRUE(run(cmd) != 0);
+    TEST_TRUE(!exists(dir));
+  }
+  snprintf(cmd, sizeof cmd, "cd '%s' && test ! -e DIR", work);
+  TEST_TRUE(run(cmd) == 0);
+  /* a missing file, bad options */
+  snprintf(cmd, sizeof cmd, "'%s' '%s/no-such-scene.json' -o '%s' 2> '%s'", sim, work, dir, err);
+  TEST_TRUE(run(cmd) != 0);
+  TEST_TRUE(file_has(err, "no-such-scene.json"));
+  TEST_TRUE(!exists(dir));
+  snprintf(cmd, sizeof cmd, "'%s' --default-scene --steps 0 -o '%s' 2> /dev/null", sim, dir);
+  TEST_TRUE(run(cmd) == 2);
+  snprintf(cmd, sizeof cmd, "'%s' a.json b.json 2> /dev/null", sim);
+  TEST_TRUE(run(cmd) == 2);
+  TEST_TRUE(!exists(dir));
+  remove(err);
+  return TEST_RESULT();
+}
+
+int main(int argc, char **argv)
+{
+  if (argc != 4) return 2;
+  if (!strcmp(argv[1], "check")) return mode_check(argv[2], argv[3]);
+  if (!strcmp(argv[1], "run")) return mode_run(argv[2], argv[3]);
+  if (!strcmp(argv[1], "errors")) return mode_errors(argv[2], argv[3]);
+  return 2;
+}
