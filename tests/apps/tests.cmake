@@ -2,10 +2,6 @@
 file(MAKE_DIRECTORY ${PROJECT_BINARY_DIR}/app-tests)
 fcm_add_test(app_quadrature tests/apps/quadrature_app.c LABELS app
              ARGS $<TARGET_FILE:fcm-quadrature> ${PROJECT_BINARY_DIR}/app-tests)
-fcm_add_test(app_condition tests/apps/condition_app.c LABELS app
-             ARGS $<TARGET_FILE:fcm-condition> ${PROJECT_BINARY_DIR}/app-tests)
-fcm_add_test(app_condition_claims tests/apps/condition_claims.c LABELS app
-             ARGS $<TARGET_FILE:fcm-condition> ${PROJECT_BINARY_DIR}/app-tests)
 # fcm-sim: a small scene run (frames, PVDs, CSV log, --steps, -o) and the no-argument demo;
 # invalid scenes exit non-zero with the parser's message and create no output directory;
 # every example scene and the built-in scene run `--check` (the heavy ones labelled slow).
