@@ -35,7 +35,8 @@ int main(int argc, char **argv)
     fcm_motion m = fcm_motion_default();
     double X[3] = {1, 2, 3}, u[3], v[3];
     fcm_motion_eval(&m, X, 5.0, u, v);
-    for (int i = 0; i < 3; i++) TEST_TRUE(u[i] == 0.0 && v[i] == 0.0);
+    for (int i = 0; i < 3; i++)
+      TEST_TRUE(u[i] == 0.0 && v[i] == 0.0);
     m.velocity[0] = 2.0, m.start = 1.0, m.end = 3.0;
     fcm_motion_eval(&m, X, 0.5, u, v);
     TEST_TRUE(u[0] == 0.0 && v[0] == 0.0);
@@ -57,7 +58,8 @@ int main(int argc, char **argv)
   TEST_OK(ctx, beam_mesh(ctx, type, 4, 4.0, &mesh));
   TEST_OK(ctx, fcm_space_create(ctx, mesh, NULL, &space));
   fcm_index n = fcm_space_num_dofs(space), nfix = 0, nend = 0;
-  fcm_index *fix = plane_nodes(ctx, mesh, 0, 0.0, &nfix), *end = plane_nodes(ctx, mesh, 0, 4.0, &nend);
+  fcm_index *fix = plane_nodes(ctx, mesh, 0, 0.0, &nfix),
+            *end = plane_nodes(ctx, mesh, 0, 4.0, &nend);
   const double *X = fcm_mesh_coords(mesh);
   fcm_material mat = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 1.0e6, 0.35, 1000.0};
   double *uprev = calloc((size_t)n, sizeof *uprev);
@@ -106,7 +108,8 @@ int main(int argc, char **argv)
         }
       }
       for (fcm_index k = 0; k < nfix; k++)
-        for (int i = 0; i < 3; i++) TEST_TRUE(u[fcm_space_node_dof(space, fix[k]) + i] == 0.0);
+        for (int i = 0; i < 3; i++)
+          TEST_TRUE(u[fcm_space_node_dof(space, fix[k]) + i] == 0.0);
       memcpy(uprev, u, sizeof *uprev * (size_t)n);
     }
     /* The middle of the beam twisted along (rotation transmitted, not just the end). */
@@ -133,11 +136,13 @@ int main(int argc, char **argv)
     TEST_OK(ctx, fcm_integrator_add_constraint(integ, nend, end, &lift, NULL));
     TEST_OK(ctx, fcm_integrator_setup(integ));
     fcm_step_info info;
-    for (int s = 1; s <= 2; s++) TEST_OK(ctx, fcm_integrator_step(integ, &info));
+    for (int s = 1; s <= 2; s++)
+      TEST_OK(ctx, fcm_integrator_step(integ, &info));
     fcm_index d = fcm_space_node_dof(space, end[0]);
     TEST_NEAR(fcm_integrator_displacement(integ)[d + 2], -0.02, 1e-15, 0);
     long long f0 = info.total_factorizations;
-    for (int s = 3; s <= 6; s++) TEST_OK(ctx, fcm_integrator_step(integ, &info));
+    for (int s = 3; s <= 6; s++)
+      TEST_OK(ctx, fcm_integrator_step(integ, &info));
     TEST_TRUE(fcm_integrator_displacement(integ)[d + 2] < -0.02 - 1e-3);
     TEST_TRUE(info.total_factorizations > f0);
     TEST_TRUE(info.total_analyses == 1);

@@ -68,7 +68,7 @@ int main(int argc, char **argv)
   double e_undamped = run(ctx, space, &mat, nfix, fix, 0.0, 0.0, &e0);
   double e_damped = run(ctx, space, &mat, nfix, fix, 0.5, 2e-3, &e0d);
   TEST_TRUE(e0 > 0.0 && e0 == e0d);
-  TEST_TRUE(e_undamped < 0.99 * e0);    /* backward Euler's numerical dissipation */
+  TEST_TRUE(e_undamped < 0.99 * e0);      /* backward Euler's numerical dissipation */
   TEST_TRUE(e_damped < 0.9 * e_undamped); /* Rayleigh damping removes clearly more */
   free(fix);
   fcm_space_destroy(&space);

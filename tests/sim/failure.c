@@ -88,7 +88,8 @@ int main(int argc, char **argv)
     TEST_ERR(ctx, fcm_integrator_step(integ, &info), FCM_ERR_NUMERIC, "not finite");
     TEST_TRUE(info.reason == FCM_STEP_NONFINITE);
     TEST_TRUE(same(integ, &snap));
-    for (fcm_index i = 0; i < n; i++) TEST_TRUE(isfinite(fcm_integrator_displacement(integ)[i]));
+    for (fcm_index i = 0; i < n; i++)
+      TEST_TRUE(isfinite(fcm_integrator_displacement(integ)[i]));
     fcm_integrator_destroy(&integ);
   }
 
@@ -163,7 +164,8 @@ int main(int argc, char **argv)
     m = fixed;
     m.angular_speed = 1.0;
     m.axis[2] = 0.0;
-    TEST_ERR(ctx, fcm_integrator_add_constraint(integ, nfix, fix, &m, NULL), FCM_ERR_ARG, "zero axis");
+    TEST_ERR(ctx, fcm_integrator_add_constraint(integ, nfix, fix, &m, NULL), FCM_ERR_ARG,
+             "zero axis");
     double nan3[3] = {0, NAN, 0};
     TEST_ERR(ctx, fcm_integrator_add_gravity(integ, nan3, NULL, NULL), FCM_ERR_ARG, "not finite");
     TEST_ERR(ctx, fcm_integrator_set_rigid_velocity(integ, nan3, NULL, NULL), FCM_ERR_ARG,

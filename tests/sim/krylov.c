@@ -4,8 +4,8 @@
  * with no, Jacobi, block-Jacobi and Schwarz preconditioning: (A) a clamped beam under
  * gravity on a plain space; (B) an embedded box [0, 1.1]^3 in a 2^3 grid over
  * [0, 4/3]^3 (hexahedra: 7 cut cells with volume fractions 0.27, 0.42 and 0.65, the first
- * two kinds with Schwarz blocks), clamped at x = 0, under gravity and an end traction. Krylov runs report
- * iterations and no symbolic analysis; the direct runs no iterations. */
+ * two kinds with Schwarz blocks), clamped at x = 0, under gravity and an end traction. Krylov runs
+ * report iterations and no symbolic analysis; the direct runs no iterations. */
 #include "sim_util.h"
 
 typedef struct variant {

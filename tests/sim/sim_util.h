@@ -36,14 +36,16 @@ static inline fcm_index *plane_nodes(fcm_ctx *ctx, const fcm_mesh *mesh, int axi
 static inline double vec_norm(fcm_index n, const double *a)
 {
   double s = 0.0;
-  for (fcm_index i = 0; i < n; i++) s += a[i] * a[i];
+  for (fcm_index i = 0; i < n; i++)
+    s += a[i] * a[i];
   return sqrt(s);
 }
 
 static inline double vec_dist(fcm_index n, const double *a, const double *b)
 {
   double s = 0.0;
-  for (fcm_index i = 0; i < n; i++) s += (a[i] - b[i]) * (a[i] - b[i]);
+  for (fcm_index i = 0; i < n; i++)
+    s += (a[i] - b[i]) * (a[i] - b[i]);
   return sqrt(s);
 }
 

@@ -82,7 +82,8 @@ int main(int argc, char **argv)
     double *u0 = calloc((size_t)n, sizeof *u0);
     const double *X = fcm_mesh_coords(cube);
     for (fcm_index a = 0; a < fcm_mesh_num_nodes(cube); a++)
-      for (int i = 0; i < 3; i++) u0[fcm_space_node_dof(cspace, a) + i] = -0.5 * (X[3 * a + i] - 0.5);
+      for (int i = 0; i < 3; i++)
+        u0[fcm_space_node_dof(cspace, a) + i] = -0.5 * (X[3 * a + i] - 0.5);
     fcm_material snh = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 1.0e5, 0.4, 100.0};
     for (int project = 0; project < 2; project++) {
       fcm_integrator_options o = fcm_integrator_options_default();
@@ -97,8 +98,8 @@ int main(int argc, char **argv)
       if (argc > 2)
         printf("project %d: newton %d, backtracks %d, fallbacks %d, projection fallbacks %d, "
                "factorizations %d\n",
-               project, info.newton_iterations, info.line_search_backtracks,
-               info.direct_fallbacks, info.projection_fallbacks, info.factorizations);
+               project, info.newton_iterations, info.line_search_backtracks, info.direct_fallbacks,
+               info.projection_fallbacks, info.factorizations);
       if (project) {
         TEST_TRUE(info.direct_fallbacks == 0);
         TEST_TRUE(info.total_analyses == 1);

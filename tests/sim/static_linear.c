@@ -12,7 +12,8 @@ static const double rho = 1000.0;
 static void rho_g(void *user, const double x[3], const double n[3], double b[3])
 {
   (void)user, (void)x, (void)n;
-  for (int i = 0; i < 3; i++) b[i] = rho * grav[i];
+  for (int i = 0; i < 3; i++)
+    b[i] = rho * grav[i];
 }
 
 /* Reference: K u = f_g with u = 0 on x = 0 and u_z = -w on x = L. */
@@ -30,9 +31,11 @@ static void reference(fcm_ctx *ctx, fcm_space *space, const fcm_material *m, fcm
   TEST_OK(ctx, fcm_assemble_stiffness(space, &el, NULL, K));
   TEST_OK(ctx, fcm_assemble_body_force(space, &el, grav, NULL, f));
   for (fcm_index k = 0; k < nfix; k++)
-    for (int i = 0; i < 3; i++) dofs[nc] = fcm_space_node_dof(space, fix[k]) + i, vals[nc++] = 0.0;
+    for (int i = 0; i < 3; i++)
+      dofs[nc] = fcm_space_node_dof(space, fix[k]) + i, vals[nc++] = 0.0;
   if (w != 0.0)
-    for (fcm_index k = 0; k < nend; k++) dofs[nc] = fcm_space_node_dof(space, end[k]) + 2, vals[nc++] = -w;
+    for (fcm_index k = 0; k < nend; k++)
+      dofs[nc] = fcm_space_node_dof(space, end[k]) + 2, vals[nc++] = -w;
   TEST_OK(ctx, fcm_space_apply_dirichlet(space, nc, dofs, vals, K, f));
   TEST_OK(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, K, &chol));
   TEST_OK(ctx, fcm_direct_analyze(chol));
@@ -55,7 +58,8 @@ int main(int argc, char **argv)
   TEST_OK(ctx, beam_mesh(ctx, type, 4, 4.0, &mesh));
   TEST_OK(ctx, fcm_space_create(ctx, mesh, NULL, &space));
   fcm_index n = fcm_space_num_dofs(space), nfix = 0, nend = 0;
-  fcm_index *fix = plane_nodes(ctx, mesh, 0, 0.0, &nfix), *end = plane_nodes(ctx, mesh, 0, 4.0, &nend);
+  fcm_index *fix = plane_nodes(ctx, mesh, 0, 0.0, &nfix),
+            *end = plane_nodes(ctx, mesh, 0, 4.0, &nend);
   fcm_material mat = {FCM_MATERIAL_LINEAR, 1.0e6, 0.3, rho};
   double *uref = calloc((size_t)n, sizeof *uref), *u = calloc((size_t)n, sizeof *u);
 

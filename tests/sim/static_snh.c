@@ -55,7 +55,8 @@ int main(int argc, char **argv)
   {
     fcm_index nend = 0;
     fcm_index *end = plane_nodes(ctx, mesh, 0, 4.0, &nend);
-    for (fcm_index k = 0; k < nend; k++) tipz += u1[fcm_space_node_dof(space, end[k]) + 2] / (double)nend;
+    for (fcm_index k = 0; k < nend; k++)
+      tipz += u1[fcm_space_node_dof(space, end[k]) + 2] / (double)nend;
     free(end);
   }
   if (verbose) printf("mean tip deflection %.6f\n", tipz);

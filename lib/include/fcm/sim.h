@@ -62,14 +62,14 @@ typedef enum fcm_preconditioner {
 
 /** A Newton iteration as reported to the monitor. */
 typedef struct fcm_newton_event {
-  double time;            /**< end time of the (sub)step being solved */
-  int iteration;          /**< 0: the initial guess; k: after the k-th update */
-  double residual;        /**< ||g|| on the free DOFs */
-  double tolerance;       /**< the threshold of the stopping rule */
-  double energy;          /**< E(u) of the (sub)step */
-  double step_length;     /**< line-search factor of the update (0 at iteration 0) */
-  int linear_iterations;  /**< Krylov iterations of the update (0: direct or iteration 0) */
-  int constraints_met;    /**< 1 when every constrained DOF sits on its prescribed value */
+  double time;           /**< end time of the (sub)step being solved */
+  int iteration;         /**< 0: the initial guess; k: after the k-th update */
+  double residual;       /**< ||g|| on the free DOFs */
+  double tolerance;      /**< the threshold of the stopping rule */
+  double energy;         /**< E(u) of the (sub)step */
+  double step_length;    /**< line-search factor of the update (0 at iteration 0) */
+  int linear_iterations; /**< Krylov iterations of the update (0: direct or iteration 0) */
+  int constraints_met;   /**< 1 when every constrained DOF sits on its prescribed value */
 } fcm_newton_event;
 
 /** Monitor callback, called after every Newton iteration (must not call the integrator). */
@@ -77,37 +77,37 @@ typedef void (*fcm_newton_monitor_fn)(void *user, const fcm_newton_event *event)
 
 /** Options; initialize with fcm_integrator_options_default(). */
 typedef struct fcm_integrator_options {
-  fcm_integrator_kind kind;   /**< default BACKWARD_EULER */
-  double dt;                  /**< step > 0: time step, or the pseudo-time of a static step
-                                   (default 1/60) */
-  int load_steps;             /**< static: increments per step, >= 1 (default 1) */
-  int max_halvings;           /**< retries of a failed (sub)step with half the increment,
-                                   0..20 (default 4) */
-  int newton_max_iterations;  /**< >= 1 (default 100) */
+  fcm_integrator_kind kind;            /**< default BACKWARD_EULER */
+  double dt;                           /**< step > 0: time step, or the pseudo-time of a static step
+                                            (default 1/60) */
+  int load_steps;                      /**< static: increments per step, >= 1 (default 1) */
+  int max_halvings;                    /**< retries of a failed (sub)step with half the increment,
+                                            0..20 (default 4) */
+  int newton_max_iterations;           /**< >= 1 (default 100) */
   fcm_newton_tolerance tolerance_mode; /**< default FCM_NEWTON_TOL_REPRESENTATIVE */
-  double newton_tolerance;    /**< tol in (0, 1) (default 1e-5) */
-  double newton_atol;         /**< RELATIVE mode: absolute floor >= 0 (default 0) */
-  double rep_acceleration;    /**< |a_rep| >= 0 in m/s^2; 0 (default): the magnitude of the
-                                   first gravity load, or 9.81 without gravity. Its direction
-                                   is that gravity's, else (1, 1, 1)/sqrt 3 */
-  int line_search;            /**< 1 (default): backtracking on E; 0: full Newton steps */
-  double armijo;              /**< sufficient decrease c in (0, 0.5) (default 1e-4) */
-  double backtrack;           /**< step factor in (0, 1) (default 0.5) */
-  int max_backtracks;         /**< >= 0 (default 20) */
-  int project_psd;            /**< 1: PSD-projected element tangents (default 0). Without it,
-                                   a non-descent Newton direction is recomputed once with the
-                                   projected tangent (counted as a projection fallback) */
-  fcm_linear_solver linear_solver;  /**< default FCM_LINEAR_DIRECT */
-  fcm_direct_method direct_method;  /**< first direct method (default CHOLMOD; UMFPACK: LU only) */
+  double newton_tolerance;             /**< tol in (0, 1) (default 1e-5) */
+  double newton_atol;                  /**< RELATIVE mode: absolute floor >= 0 (default 0) */
+  double rep_acceleration;             /**< |a_rep| >= 0 in m/s^2; 0 (default): the magnitude of the
+                                            first gravity load, or 9.81 without gravity. Its direction
+                                            is that gravity's, else (1, 1, 1)/sqrt 3 */
+  int line_search;                     /**< 1 (default): backtracking on E; 0: full Newton steps */
+  double armijo;                       /**< sufficient decrease c in (0, 0.5) (default 1e-4) */
+  double backtrack;                    /**< step factor in (0, 1) (default 0.5) */
+  int max_backtracks;                  /**< >= 0 (default 20) */
+  int project_psd;                   /**< 1: PSD-projected element tangents (default 0). Without it,
+                                          a non-descent Newton direction is recomputed once with the
+                                          projected tangent (counted as a projection fallback) */
+  fcm_linear_solver linear_solver;   /**< default FCM_LINEAR_DIRECT */
+  fcm_direct_method direct_method;   /**< first direct method (default CHOLMOD; UMFPACK: LU only) */
   fcm_preconditioner preconditioner; /**< Krylov only (default JACOBI) */
-  double krylov_rtol;         /**< in [0, 1) (default 1e-8) */
-  double krylov_atol;         /**< >= 0 (default 0) */
-  int krylov_max_iterations;  /**< >= 1 (default 1000) */
-  double schwarz_theta;       /**< cut cells with volume fraction below it get a block, (0, 1]
-                                   (default 0.5) */
-  fcm_schwarz_options schwarz; /**< default fcm_schwarz_options_default() */
-  double rayleigh_mass;       /**< alpha_M >= 0 in 1/s (default 0) */
-  double rayleigh_stiffness;  /**< beta_K >= 0 in s (default 0) */
+  double krylov_rtol;                /**< in [0, 1) (default 1e-8) */
+  double krylov_atol;                /**< >= 0 (default 0) */
+  int krylov_max_iterations;         /**< >= 1 (default 1000) */
+  double schwarz_theta;          /**< cut cells with volume fraction below it get a block, (0, 1]
+                                      (default 0.5) */
+  fcm_schwarz_options schwarz;   /**< default fcm_schwarz_options_default() */
+  double rayleigh_mass;          /**< alpha_M >= 0 in 1/s (default 0) */
+  double rayleigh_stiffness;     /**< beta_K >= 0 in s (default 0) */
   fcm_assembly_options assembly; /**< strengths on full cells (default element defaults) */
   fcm_newton_monitor_fn monitor; /**< NULL (default) or a callback */
   void *monitor_user;
@@ -135,34 +135,34 @@ FCM_API const char *fcm_step_reason_str(fcm_step_reason reason);
 /** What one fcm_integrator_step() did. Per-step counts cover every attempt of the step;
  * total_* are cumulative since setup. */
 typedef struct fcm_step_info {
-  fcm_step_reason reason;      /**< CONVERGED on success; else the last failure */
-  int newton_iterations;       /**< Newton updates (all attempts) */
-  int line_search_backtracks;  /**< step-length halvings */
-  long long linear_iterations; /**< Krylov iterations (0 with the direct solver) */
-  double residual;             /**< final ||g|| of the last attempt */
-  double tolerance;            /**< its threshold */
-  double dt;                   /**< length of the last (sub)step: time (dynamics) or
-                                    pseudo-time (static) */
-  int halvings;                /**< halvings needed (0: the step went through at once) */
-  int substeps;                /**< accepted (sub)steps (static: load increments) */
-  int failed_attempts;         /**< (sub)step attempts that were rejected */
-  double time;                 /**< time after the step (unchanged on failure) */
-  double kinetic_energy;       /**< 1/2 v^T M v (0 for static) */
-  double elastic_energy;       /**< Psi(u) */
-  double external_work;        /**< f_ext(t)^T u */
-  double total_energy;         /**< kinetic + elastic - external work */
-  int tangent_assemblies;      /**< tangent assemblies (Newton and damping matrices) */
-  int factorizations;          /**< numeric factorizations or preconditioner setups */
-  int direct_fallbacks;        /**< CHOLMOD "not positive definite" -> UMFPACK */
-  int projection_fallbacks;    /**< non-descent directions recomputed with PSD tangents */
-  int inexact_solves;          /**< Krylov solves stopped early whose iterate was used */
-  long long total_analyses;        /**< symbolic analyses (CHOLMOD and UMFPACK) */
-  long long total_factorizations;  /**< numeric factorizations / preconditioner setups */
+  fcm_step_reason reason;         /**< CONVERGED on success; else the last failure */
+  int newton_iterations;          /**< Newton updates (all attempts) */
+  int line_search_backtracks;     /**< step-length halvings */
+  long long linear_iterations;    /**< Krylov iterations (0 with the direct solver) */
+  double residual;                /**< final ||g|| of the last attempt */
+  double tolerance;               /**< its threshold */
+  double dt;                      /**< length of the last (sub)step: time (dynamics) or
+                                       pseudo-time (static) */
+  int halvings;                   /**< halvings needed (0: the step went through at once) */
+  int substeps;                   /**< accepted (sub)steps (static: load increments) */
+  int failed_attempts;            /**< (sub)step attempts that were rejected */
+  double time;                    /**< time after the step (unchanged on failure) */
+  double kinetic_energy;          /**< 1/2 v^T M v (0 for static) */
+  double elastic_energy;          /**< Psi(u) */
+  double external_work;           /**< f_ext(t)^T u */
+  double total_energy;            /**< kinetic + elastic - external work */
+  int tangent_assemblies;         /**< tangent assemblies (Newton and damping matrices) */
+  int factorizations;             /**< numeric factorizations or preconditioner setups */
+  int direct_fallbacks;           /**< CHOLMOD "not positive definite" -> UMFPACK */
+  int projection_fallbacks;       /**< non-descent directions recomputed with PSD tangents */
+  int inexact_solves;             /**< Krylov solves stopped early whose iterate was used */
+  long long total_analyses;       /**< symbolic analyses (CHOLMOD and UMFPACK) */
+  long long total_factorizations; /**< numeric factorizations / preconditioner setups */
   long long total_direct_fallbacks;
-  double time_assembly;        /**< seconds: energy, force, tangent and damping assembly */
-  double time_factor;          /**< seconds: factorization or preconditioner setup */
-  double time_solve;           /**< seconds: triangular or Krylov solves */
-  double time_total;           /**< seconds of the whole step */
+  double time_assembly; /**< seconds: energy, force, tangent and damping assembly */
+  double time_factor;   /**< seconds: factorization or preconditioner setup */
+  double time_solve;    /**< seconds: triangular or Krylov solves */
+  double time_total;    /**< seconds of the whole step */
 } fcm_step_info;
 
 /** A scalar function of time, e.g. the time scaling of a load. */
@@ -269,15 +269,15 @@ FCM_API fcm_index fcm_integrator_num_constrained(const fcm_integrator *integ);
 
 /** Copy the state out (checkpoint): u, v (num_dofs each, either may be NULL), t, steps
  * (may be NULL). */
-FCM_API void fcm_integrator_get_state(const fcm_integrator *integ, double *u, double *v,
-                                      double *t, long long *steps);
+FCM_API void fcm_integrator_get_state(const fcm_integrator *integ, double *u, double *v, double *t,
+                                      long long *steps);
 
 /** Replace the state (resume, initial conditions): u and v copied (either may be NULL to
  * keep it), time t and step count. Invalidates cached tangents; for static integrators the
  * load of the last accepted step becomes f_ext(t) (zero when steps == 0).
  * @return FCM_OK, FCM_ERR_ARG (non-finite entry: named), errors of the load evaluation. */
-FCM_API fcm_status fcm_integrator_set_state(fcm_integrator *integ, const double *u,
-                                            const double *v, double t, long long steps);
+FCM_API fcm_status fcm_integrator_set_state(fcm_integrator *integ, const double *u, const double *v,
+                                            double t, long long steps);
 
 /** Set a rigid initial velocity v = v0 + omega x (X + u - c) at every node (v0, omega, c:
  * 3 each; NULL means zero). @return FCM_OK, FCM_ERR_ARG (non-finite). */

@@ -38,12 +38,18 @@ fcm_integrator_options fcm_integrator_options_default(void)
 const char *fcm_step_reason_str(fcm_step_reason reason)
 {
   switch (reason) {
-  case FCM_STEP_NONE: return "none";
-  case FCM_STEP_CONVERGED: return "converged";
-  case FCM_STEP_MAX_NEWTON: return "max-newton";
-  case FCM_STEP_LINE_SEARCH_FAILED: return "line-search-failed";
-  case FCM_STEP_LINEAR_SOLVER_FAILED: return "linear-solver-failed";
-  case FCM_STEP_NONFINITE: return "nonfinite";
+  case FCM_STEP_NONE:
+    return "none";
+  case FCM_STEP_CONVERGED:
+    return "converged";
+  case FCM_STEP_MAX_NEWTON:
+    return "max-newton";
+  case FCM_STEP_LINE_SEARCH_FAILED:
+    return "line-search-failed";
+  case FCM_STEP_LINEAR_SOLVER_FAILED:
+    return "linear-solver-failed";
+  case FCM_STEP_NONFINITE:
+    return "nonfinite";
   }
   return "unknown";
 }
@@ -68,24 +74,31 @@ void fcm_motion_eval(const fcm_motion *m, const double X[3], double t, double u[
   /* Rodrigues: R r = r + s (a x r) + (1 - c) a x (a x r); u = (R r - r) + velocity tau, so a
    * pure translation is exact and the axial component of a rotation is exactly zero. */
   double r[3], du[3] = {0, 0, 0};
-  for (int i = 0; i < 3; i++) r[i] = X[i] - m->center[i];
+  for (int i = 0; i < 3; i++)
+    r[i] = X[i] - m->center[i];
   if (an > 0.0 && m->angular_speed != 0.0) {
-    for (int i = 0; i < 3; i++) a[i] /= an;
+    for (int i = 0; i < 3; i++)
+      a[i] /= an;
     double phi = m->angular_speed * tau, c = cos(phi), s = sin(phi);
-    double axr[3] = {a[1] * r[2] - a[2] * r[1], a[2] * r[0] - a[0] * r[2], a[0] * r[1] - a[1] * r[0]};
+    double axr[3] = {a[1] * r[2] - a[2] * r[1], a[2] * r[0] - a[0] * r[2],
+                     a[0] * r[1] - a[1] * r[0]};
     double aaxr[3] = {a[1] * axr[2] - a[2] * axr[1], a[2] * axr[0] - a[0] * axr[2],
                       a[0] * axr[1] - a[1] * axr[0]};
-    for (int i = 0; i < 3; i++) du[i] = s * axr[i] + (1.0 - c) * aaxr[i];
+    for (int i = 0; i < 3; i++)
+      du[i] = s * axr[i] + (1.0 - c) * aaxr[i];
   } else {
     an = 0.0;
   }
-  for (int i = 0; i < 3; i++) u[i] = du[i] + m->velocity[i] * tau;
+  for (int i = 0; i < 3; i++)
+    u[i] = du[i] + m->velocity[i] * tau;
   if (v) {
     int moving = t >= m->start && t < m->end;
-    for (int i = 0; i < 3; i++) v[i] = moving ? m->velocity[i] : 0.0;
+    for (int i = 0; i < 3; i++)
+      v[i] = moving ? m->velocity[i] : 0.0;
     if (moving && an > 0.0) {
       double w = m->angular_speed, rr[3];
-      for (int i = 0; i < 3; i++) rr[i] = r[i] + du[i];
+      for (int i = 0; i < 3; i++)
+        rr[i] = r[i] + du[i];
       v[0] += w * (a[1] * rr[2] - a[2] * rr[1]);
       v[1] += w * (a[2] * rr[0] - a[0] * rr[2]);
       v[2] += w * (a[0] * rr[1] - a[1] * rr[0]);
@@ -127,15 +140,18 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   if (!integ || !*integ) return;
   fcm_integrator *I = *integ;
   fcm_ctx *ctx = I->ctx;
-  for (int k = 0; k < I->num_loads; k++) fcm__free(ctx, I->loads[k].f);
+  for (int k = 0; k < I->num_loads; k++)
+    fcm__free(ctx, I->loads[k].f);
   fcm__free(ctx, I->loads);
-  for (int k = 0; k < I->num_cons; k++) fcm__free(ctx, I->cons[k].nodes);
+  for (int k = 0; k < I->num_cons; k++)
+    fcm__free(ctx, I->cons[k].nodes);
   fcm__free(ctx, I->cons);
-  double **vecs[] = {&I->u,   &I->v,    &I->load_prev, &I->act_val, &I->act_inc, &I->Ma,
-                     &I->u_bak, &I->v_bak, &I->lp_bak,  &I->un,      &I->uhat,    &I->fext,
-                     &I->fend,  &I->fint,  &I->g,       &I->d,       &I->b,       &I->ut,
-                     &I->fint_t, &I->g_t,  &I->w1,      &I->w2};
-  for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; k++) FCM_FREE(ctx, *vecs[k]);
+  double **vecs[] = {&I->u,      &I->v,     &I->load_prev, &I->act_val, &I->act_inc, &I->Ma,
+                     &I->u_bak,  &I->v_bak, &I->lp_bak,    &I->un,      &I->uhat,    &I->fext,
+                     &I->fend,   &I->fint,  &I->g,         &I->d,       &I->b,       &I->ut,
+                     &I->fint_t, &I->g_t,   &I->w1,        &I->w2};
+  for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; k++)
+    FCM_FREE(ctx, *vecs[k]);
   fcm__free(ctx, I->con_dof);
   fcm__free(ctx, I->con_node);
   fcm__free(ctx, I->con_comp);
@@ -219,7 +235,10 @@ fcm_status fcm_integrator_add_traction(fcm_integrator *I, fcm_field_fn traction,
   return add_field_load(I, SIM_LOAD_TRACTION, traction, user, scale, scale_user);
 }
 
-static int finite3(const double a[3]) { return isfinite(a[0]) && isfinite(a[1]) && isfinite(a[2]); }
+static int finite3(const double a[3])
+{
+  return isfinite(a[0]) && isfinite(a[1]) && isfinite(a[2]);
+}
 
 fcm_status fcm_integrator_add_constraint(fcm_integrator *I, fcm_index num_nodes,
                                          const fcm_index *nodes, const fcm_motion *motion, int *id)
@@ -240,8 +259,8 @@ fcm_status fcm_integrator_add_constraint(fcm_integrator *I, fcm_index num_nodes,
   FCM_CHECK(isfinite(motion->start) && !isnan(motion->end) && motion->end >= motion->start, ctx,
             FCM_ERR_ARG, "constraint %d: end = %g must be >= start = %g (start finite)",
             I->num_cons, motion->end, motion->start);
-  FCM_CHECK(motion->angular_speed == 0.0 || (motion->axis[0] != 0.0 || motion->axis[1] != 0.0 ||
-                                             motion->axis[2] != 0.0),
+  FCM_CHECK(motion->angular_speed == 0.0 ||
+                (motion->axis[0] != 0.0 || motion->axis[1] != 0.0 || motion->axis[2] != 0.0),
             ctx, FCM_ERR_ARG, "constraint %d: rotation with a zero axis", I->num_cons);
   {
     fcm_index nn = fcm_mesh_num_nodes(fcm_space_mesh(I->space));
@@ -260,8 +279,10 @@ fcm_status fcm_integrator_add_constraint(fcm_integrator *I, fcm_index num_nodes,
     double an = sqrt(motion->axis[0] * motion->axis[0] + motion->axis[1] * motion->axis[1] +
                      motion->axis[2] * motion->axis[2]);
     if (an > 0.0)
-      for (int i = 0; i < 3; i++) c->motion.axis[i] = motion->axis[i] / an;
-    for (int i = 0; i < 3; i++) c->motion.components[i] = motion->components[i] != 0;
+      for (int i = 0; i < 3; i++)
+        c->motion.axis[i] = motion->axis[i] / an;
+    for (int i = 0; i < 3; i++)
+      c->motion.components[i] = motion->components[i] != 0;
     c->num_nodes = num_nodes;
     c->nodes = copy;
     copy = NULL;
@@ -280,7 +301,8 @@ void fcm__sim_eval_loads(const fcm_integrator *I, double t, double *f)
     const sim_load *l = &I->loads[k];
     double s = l->scale ? l->scale(l->scale_user, t) : 1.0;
     if (s == 0.0) continue; /* an absent load costs nothing; NaN still propagates below */
-    for (fcm_index i = 0; i < I->n; i++) f[i] += s * l->f[i];
+    for (fcm_index i = 0; i < I->n; i++)
+      f[i] += s * l->f[i];
   }
 }
 
@@ -320,11 +342,13 @@ static void rep_acceleration(const fcm_integrator *I, double a[3])
   double dir[3] = {1.0 / sqrt(3.0), 1.0 / sqrt(3.0), 1.0 / sqrt(3.0)}, mag = 9.81;
   if (grav) {
     double gn = sqrt(grav[0] * grav[0] + grav[1] * grav[1] + grav[2] * grav[2]);
-    for (int i = 0; i < 3; i++) dir[i] = grav[i] / gn;
+    for (int i = 0; i < 3; i++)
+      dir[i] = grav[i] / gn;
     mag = gn;
   }
   if (I->opts.rep_acceleration > 0.0) mag = I->opts.rep_acceleration;
-  for (int i = 0; i < 3; i++) a[i] = mag * dir[i];
+  for (int i = 0; i < 3; i++)
+    a[i] = mag * dir[i];
 }
 
 static fcm_status validate_options(fcm_ctx *ctx, const fcm_integrator_options *o)
@@ -357,8 +381,8 @@ static fcm_status validate_options(fcm_ctx *ctx, const fcm_integrator_options *o
             "integrator: armijo = %g outside (0, 0.5)", o->armijo);
   FCM_CHECK(o->backtrack > 0.0 && o->backtrack < 1.0, ctx, FCM_ERR_ARG,
             "integrator: backtrack = %g outside (0, 1)", o->backtrack);
-  FCM_CHECK(o->max_backtracks >= 0, ctx, FCM_ERR_ARG, "integrator: max_backtracks = %d must be >= 0",
-            o->max_backtracks);
+  FCM_CHECK(o->max_backtracks >= 0, ctx, FCM_ERR_ARG,
+            "integrator: max_backtracks = %d must be >= 0", o->max_backtracks);
   FCM_CHECK(o->linear_solver >= FCM_LINEAR_DIRECT && o->linear_solver <= FCM_LINEAR_MINRES, ctx,
             FCM_ERR_ARG, "integrator: linear_solver = %d outside [0, 2]", (int)o->linear_solver);
   FCM_CHECK(o->direct_method == FCM_DIRECT_CHOLMOD || o->direct_method == FCM_DIRECT_UMFPACK, ctx,
@@ -453,10 +477,11 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
   FCM_CHECK(n > 0, ctx, FCM_ERR_ARG, "integrator: the space has no DOFs");
   FCM_TRY(ctx, build_constraints(I));
 
-  double **vecs[] = {&I->Ma,   &I->u_bak, &I->v_bak, &I->lp_bak, &I->un,     &I->uhat,
-                     &I->fext, &I->fend,  &I->fint,  &I->g,      &I->d,      &I->b,
-                     &I->ut,   &I->fint_t, &I->g_t,  &I->w1,     &I->w2};
-  for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; k++) FCM_ALLOC(ctx, n, *vecs[k]);
+  double **vecs[] = {&I->Ma,   &I->u_bak,  &I->v_bak, &I->lp_bak, &I->un, &I->uhat,
+                     &I->fext, &I->fend,   &I->fint,  &I->g,      &I->d,  &I->b,
+                     &I->ut,   &I->fint_t, &I->g_t,   &I->w1,     &I->w2};
+  for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; k++)
+    FCM_ALLOC(ctx, n, *vecs[k]);
 
   /* Mass (constant) and the loads of scale 1. */
   FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->M));
@@ -479,10 +504,12 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
   {
     double a[3];
     rep_acceleration(I, a);
-    for (fcm_index i = 0; i < n; i++) I->w1[i] = a[i % 3];
+    for (fcm_index i = 0; i < n; i++)
+      I->w1[i] = a[i % 3];
     FCM_TRY(ctx, fcm_csr_apply(I->M, 1.0, I->w1, 0.0, I->Ma));
     double s = 0.0;
-    for (fcm_index i = 0; i < n; i++) s += I->Ma[i] * I->Ma[i];
+    for (fcm_index i = 0; i < n; i++)
+      s += I->Ma[i] * I->Ma[i];
     I->rep_norm_full = sqrt(s);
     FCM_CHECK(o->tolerance_mode != FCM_NEWTON_TOL_REPRESENTATIVE || I->rep_norm_full > 0.0, ctx,
               FCM_ERR_ARG,
@@ -521,7 +548,8 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
 
   I->h_state = SIM_H_INVALID;
   I->damp_version = 0;
-  for (int k = 0; k < I->num_cons; k++) I->con_on[k] = 0;
+  for (int k = 0; k < I->num_cons; k++)
+    I->con_on[k] = 0;
   I->is_setup = 1;
   fcm__sim_eval_constraints(I, I->t);
   if (o->kind == FCM_INTEGRATOR_BACKWARD_EULER) {
@@ -539,13 +567,34 @@ cleanup:
   return st;
 }
 
-fcm_index fcm_integrator_num_dofs(const fcm_integrator *I) { return I ? I->n : 0; }
-double fcm_integrator_time(const fcm_integrator *I) { return I ? I->t : 0.0; }
-long long fcm_integrator_step_count(const fcm_integrator *I) { return I ? I->steps : 0; }
-const double *fcm_integrator_displacement(const fcm_integrator *I) { return I ? I->u : NULL; }
-const double *fcm_integrator_velocity(const fcm_integrator *I) { return I ? I->v : NULL; }
-fcm_index fcm_integrator_num_constrained(const fcm_integrator *I) { return I ? I->ncon : 0; }
-const fcm_csr *fcm_integrator_mass(const fcm_integrator *I) { return I ? I->M : NULL; }
+fcm_index fcm_integrator_num_dofs(const fcm_integrator *I)
+{
+  return I ? I->n : 0;
+}
+double fcm_integrator_time(const fcm_integrator *I)
+{
+  return I ? I->t : 0.0;
+}
+long long fcm_integrator_step_count(const fcm_integrator *I)
+{
+  return I ? I->steps : 0;
+}
+const double *fcm_integrator_displacement(const fcm_integrator *I)
+{
+  return I ? I->u : NULL;
+}
+const double *fcm_integrator_velocity(const fcm_integrator *I)
+{
+  return I ? I->v : NULL;
+}
+fcm_index fcm_integrator_num_constrained(const fcm_integrator *I)
+{
+  return I ? I->ncon : 0;
+}
+const fcm_csr *fcm_integrator_mass(const fcm_integrator *I)
+{
+  return I ? I->M : NULL;
+}
 
 void fcm_integrator_get_state(const fcm_integrator *I, double *u, double *v, double *t,
                               long long *steps)
@@ -607,7 +656,8 @@ fcm_status fcm_integrator_set_rigid_velocity(fcm_integrator *I, const double v0[
       fcm_index d = fcm_space_node_dof(I->space, a);
       if (d < 0) continue;
       double r[3];
-      for (int i = 0; i < 3; i++) r[i] = X[3 * a + i] + I->u[d + i] - c[i];
+      for (int i = 0; i < 3; i++)
+        r[i] = X[3 * a + i] + I->u[d + i] - c[i];
       I->v[d + 0] = v0[0] + omega[1] * r[2] - omega[2] * r[1];
       I->v[d + 1] = v0[1] + omega[2] * r[0] - omega[0] * r[2];
       I->v[d + 2] = v0[2] + omega[0] * r[1] - omega[1] * r[0];
@@ -630,12 +680,14 @@ fcm_status fcm_integrator_energy(fcm_integrator *I, double *kinetic, double *ela
                                               NULL, NULL));
     if (I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) {
       FCM_TRY(I->ctx, fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1));
-      for (fcm_index i = 0; i < n; i++) ekin += 0.5 * I->v[i] * I->w1[i];
+      for (fcm_index i = 0; i < n; i++)
+        ekin += 0.5 * I->v[i] * I->w1[i];
       fcm__sim_eval_loads(I, I->t, I->w2);
     } else {
       memcpy(I->w2, I->load_prev, sizeof *I->w2 * (size_t)n);
     }
-    for (fcm_index i = 0; i < n; i++) wext += I->w2[i] * I->u[i];
+    for (fcm_index i = 0; i < n; i++)
+      wext += I->w2[i] * I->u[i];
     FCM_CHECK(isfinite(ekin) && isfinite(psi) && isfinite(wext), I->ctx, FCM_ERR_NUMERIC,
               "integrator: energy is not finite (kinetic %g, elastic %g, external work %g)", ekin,
               psi, wext);
@@ -663,7 +715,8 @@ fcm_status fcm_integrator_momentum(fcm_integrator *I, double linear[3], double a
       if (d < 0) continue;
       const double *q = I->w1 + d;
       double x[3];
-      for (int i = 0; i < 3; i++) x[i] = X[3 * a + i] + I->u[d + i], p[i] += q[i];
+      for (int i = 0; i < 3; i++)
+        x[i] = X[3 * a + i] + I->u[d + i], p[i] += q[i];
       L[0] += x[1] * q[2] - x[2] * q[1];
       L[1] += x[2] * q[0] - x[0] * q[2];
       L[2] += x[0] * q[1] - x[1] * q[0];

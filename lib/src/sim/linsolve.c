@@ -62,13 +62,13 @@ cleanup:
   return st;
 }
 
-static fcm_status setup_preconditioner(fcm_integrator *I, fcm_step_reason *reason,
-                                       sim_stats *stats)
+static fcm_status setup_preconditioner(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
 {
   fcm_status s = FCM_OK;
   fcm_ctx *ctx = I->ctx;
   switch (I->opts.preconditioner) {
-  case FCM_PRECOND_NONE: return FCM_OK;
+  case FCM_PRECOND_NONE:
+    return FCM_OK;
   case FCM_PRECOND_JACOBI:
   case FCM_PRECOND_BLOCK_JACOBI:
     if (I->jacobi)
@@ -95,8 +95,9 @@ static fcm_status setup_preconditioner(fcm_integrator *I, fcm_step_reason *reaso
 fcm_status fcm__sim_factor(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
 {
   double t0 = fcm_wtime();
-  fcm_status st = I->opts.linear_solver == FCM_LINEAR_DIRECT ? factor_direct(I, reason, stats)
-                                                             : setup_preconditioner(I, reason, stats);
+  fcm_status st = I->opts.linear_solver == FCM_LINEAR_DIRECT
+                      ? factor_direct(I, reason, stats)
+                      : setup_preconditioner(I, reason, stats);
   stats->time_factor += fcm_wtime() - t0;
   return st;
 }

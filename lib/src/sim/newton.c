@@ -18,7 +18,8 @@
 static double dot(fcm_index n, const double *a, const double *b)
 {
   double s = 0.0;
-  for (fcm_index i = 0; i < n; i++) s += a[i] * b[i];
+  for (fcm_index i = 0; i < n; i++)
+    s += a[i] * b[i];
   return s;
 }
 
@@ -47,10 +48,12 @@ static void set_base(fcm_integrator *I, double h)
   if (h > 0.0) {
     const double *mv = fcm_csr_get_values(I->M);
     double a = 1.0 / (h * h);
-    for (fcm_index e = 0; e < nnz; e++) hv[e] = a * mv[e];
+    for (fcm_index e = 0; e < nnz; e++)
+      hv[e] = a * mv[e];
     if (I->D) {
       const double *dv = fcm_csr_get_values(I->D);
-      for (fcm_index e = 0; e < nnz; e++) hv[e] += dv[e] / h;
+      for (fcm_index e = 0; e < nnz; e++)
+        hv[e] += dv[e] / h;
     }
   } else {
     memset(hv, 0, sizeof *hv * (size_t)nnz);
@@ -91,8 +94,8 @@ typedef struct eval_out {
   int finite;
 } eval_out;
 
-static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tangent,
-                           double *fint, double *g, eval_out *out, sim_stats *stats)
+static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tangent, double *fint,
+                           double *g, eval_out *out, sim_stats *stats)
 {
   fcm_status st = FCM_OK;
   fcm_index n = I->n;
@@ -100,23 +103,28 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
   out->finite = 1;
   memset(fint, 0, sizeof *fint * (size_t)n);
   if (tangent) set_base(I, h);
-  FCM_TRY(I->ctx, assemble(I, &I->params, x, &psi, fint, tangent ? I->H : NULL, &out->finite,
-                           stats));
+  FCM_TRY(I->ctx,
+          assemble(I, &I->params, x, &psi, fint, tangent ? I->H : NULL, &out->finite, stats));
   if (!out->finite) return FCM_OK;
   {
     double t0 = fcm_wtime();
-    for (fcm_index i = 0; i < n; i++) g[i] = fint[i] - I->fext[i];
+    for (fcm_index i = 0; i < n; i++)
+      g[i] = fint[i] - I->fext[i];
     if (h > 0.0) {
-      for (fcm_index i = 0; i < n; i++) I->w1[i] = x[i] - I->uhat[i];
+      for (fcm_index i = 0; i < n; i++)
+        I->w1[i] = x[i] - I->uhat[i];
       FCM_TRY(I->ctx, fcm_csr_apply(I->M, 1.0, I->w1, 0.0, I->w2));
       double a = 1.0 / (h * h);
       inertia = 0.5 * a * dot(n, I->w1, I->w2);
-      for (fcm_index i = 0; i < n; i++) g[i] += a * I->w2[i];
+      for (fcm_index i = 0; i < n; i++)
+        g[i] += a * I->w2[i];
       if (I->D) {
-        for (fcm_index i = 0; i < n; i++) I->w1[i] = x[i] - I->un[i];
+        for (fcm_index i = 0; i < n; i++)
+          I->w1[i] = x[i] - I->un[i];
         FCM_TRY(I->ctx, fcm_csr_apply(I->D, 1.0, I->w1, 0.0, I->w2));
         damp = 0.5 / h * dot(n, I->w1, I->w2);
-        for (fcm_index i = 0; i < n; i++) g[i] += I->w2[i] / h;
+        for (fcm_index i = 0; i < n; i++)
+          g[i] += I->w2[i] / h;
       }
     }
     wext = dot(n, I->fext, x);
@@ -161,14 +169,16 @@ static fcm_status build_system(fcm_integrator *I, double h, int predictor, int p
 {
   fcm_status st = FCM_OK;
   fcm_index n = I->n;
-  for (fcm_index i = 0; i < n; i++) I->b[i] = -I->g[i];
+  for (fcm_index i = 0; i < n; i++)
+    I->b[i] = -I->g[i];
   int reuse = I->linear && !projected && I->h_state == SIM_H_SYSTEM && I->key_h == h &&
               I->key_con == I->con_version && I->key_damp == I->damp_version;
   if (reuse) {
     /* b_f -= H0_fc inc_c, b_c = H_cc inc_c (as fcm_space_apply_dirichlet would). */
     if (predictor) {
       memset(I->w1, 0, sizeof *I->w1 * (size_t)n);
-      for (fcm_index j = 0; j < I->nact; j++) I->w1[I->act_dof[j]] = I->act_inc[j];
+      for (fcm_index j = 0; j < I->nact; j++)
+        I->w1[I->act_dof[j]] = I->act_inc[j];
       FCM_TRY(I->ctx, fcm_csr_apply(I->H0, 1.0, I->w1, 0.0, I->w2));
       for (fcm_index i = 0; i < n; i++)
         if (!I->is_con[i]) I->b[i] -= I->w2[i];
@@ -219,7 +229,8 @@ static fcm_status direction(fcm_integrator *I, int predictor, fcm_step_reason *r
     *reason = FCM_STEP_NONFINITE;
     return FCM_OK;
   }
-  for (fcm_index j = 0; j < I->nact; j++) I->d[I->act_dof[j]] = predictor ? I->act_inc[j] : 0.0;
+  for (fcm_index j = 0; j < I->nact; j++)
+    I->d[I->act_dof[j]] = predictor ? I->act_inc[j] : 0.0;
 cleanup:
   return st;
 }
@@ -283,7 +294,8 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
       break;
     }
     int predictor = !met, its = 0;
-    for (fcm_index j = 0; j < I->nact; j++) I->act_inc[j] = I->act_val[j] - I->u[I->act_dof[j]];
+    for (fcm_index j = 0; j < I->nact; j++)
+      I->act_inc[j] = I->act_val[j] - I->u[I->act_dof[j]];
     FCM_TRY(I->ctx, build_system(I, h, predictor, 0, reason, stats));
     if (*reason != FCM_STEP_NONE) break;
     FCM_TRY(I->ctx, direction(I, predictor, reason, &its, stats));
@@ -314,9 +326,11 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
     int accepted = 0, speculative = 0;
     double rt = NAN;
     for (int bt = 0;; bt++) {
-      for (fcm_index i = 0; i < n; i++) I->ut[i] = I->u[i] + alpha * I->d[i];
+      for (fcm_index i = 0; i < n; i++)
+        I->ut[i] = I->u[i] + alpha * I->d[i];
       if (predictor)
-        for (fcm_index j = 0; j < I->nact; j++) I->ut[I->act_dof[j]] = I->act_val[j];
+        for (fcm_index j = 0; j < I->nact; j++)
+          I->ut[I->act_dof[j]] = I->act_val[j];
       /* The tangent of a full step is assembled with it: usually it is accepted and the
        * next iteration needs that tangent (one pass instead of two). */
       speculative = !I->linear && bt == 0;
@@ -328,8 +342,9 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
         } else {
           int armijo = trial.E <= cur.E + o->armijo * alpha * slope;
           /* Where E no longer resolves the decrease (round-off), ask the residual to drop. */
-          int flat = fabs(trial.E - cur.E) <= 100.0 * DBL_EPSILON * FCM_MAX(cur.scale, trial.scale) &&
-                     rt < r;
+          int flat =
+              fabs(trial.E - cur.E) <= 100.0 * DBL_EPSILON * FCM_MAX(cur.scale, trial.scale) &&
+              rt < r;
           accepted = armijo || flat;
         }
       }
@@ -378,7 +393,8 @@ static fcm_status update_damping(fcm_integrator *I, fcm_step_reason *reason, sim
       return FCM_OK;
     }
   }
-  for (fcm_index e = 0; e < nnz; e++) dv[e] = o->rayleigh_stiffness * dv[e] + o->rayleigh_mass * mv[e];
+  for (fcm_index e = 0; e < nnz; e++)
+    dv[e] = o->rayleigh_stiffness * dv[e] + o->rayleigh_mass * mv[e];
   I->damp_version++;
   if (!I->linear) I->h_state = SIM_H_INVALID;
 cleanup:
@@ -446,7 +462,8 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
       info->dt = dyn ? h : o->dt * (double)size / (double)units;
       if (reason == FCM_STEP_CONVERGED) {
         if (dyn)
-          for (fcm_index i = 0; i < n; i++) I->v[i] = (I->u[i] - I->un[i]) / h;
+          for (fcm_index i = 0; i < n; i++)
+            I->v[i] = (I->u[i] - I->un[i]) / h;
         done += size;
         info->substeps++;
         reason = done < units ? FCM_STEP_NONE : reason;

@@ -10,16 +10,16 @@ typedef enum sim_load_kind { SIM_LOAD_GRAVITY = 0, SIM_LOAD_BODY, SIM_LOAD_TRACT
 
 typedef struct sim_load {
   sim_load_kind kind;
-  double accel[3];     /* gravity */
-  fcm_field_fn field;  /* body force or traction */
+  double accel[3];    /* gravity */
+  fcm_field_fn field; /* body force or traction */
   void *field_user;
-  fcm_time_fn scale;   /* NULL: 1 */
+  fcm_time_fn scale; /* NULL: 1 */
   void *scale_user;
-  double *f;           /* assembled load of scale 1 (n), after setup */
+  double *f; /* assembled load of scale 1 (n), after setup */
 } sim_load;
 
 typedef struct sim_constraint {
-  fcm_motion motion;   /* axis normalized */
+  fcm_motion motion; /* axis normalized */
   fcm_index num_nodes;
   fcm_index *nodes;
 } sim_constraint;
@@ -41,7 +41,7 @@ struct fcm_integrator {
   fcm_integrator_options opts;
   fcm_index n;
   int is_setup;
-  int linear;                     /* constant tangent (linear material) */
+  int linear; /* constant tangent (linear material) */
 
   /* configuration */
   sim_load *loads;
@@ -59,18 +59,18 @@ struct fcm_integrator {
   fcm_index ncon;
   fcm_index *con_dof, *con_node;
   int *con_comp, *con_id;
-  unsigned char *is_con;    /* n: constrained by an active constraint right now */
-  unsigned char *con_on;    /* num_cons: constraint active right now */
-  long long con_version;    /* bumps whenever the active set changes */
-  fcm_index nact;           /* active constrained DOFs */
-  fcm_index *act_dof;       /* nact DOFs (distinct) */
-  double *act_val;          /* their prescribed displacements at the substep's end */
-  double *act_inc;          /* increments to reach them */
+  unsigned char *is_con; /* n: constrained by an active constraint right now */
+  unsigned char *con_on; /* num_cons: constraint active right now */
+  long long con_version; /* bumps whenever the active set changes */
+  fcm_index nact;        /* active constrained DOFs */
+  fcm_index *act_dof;    /* nact DOFs (distinct) */
+  double *act_val;       /* their prescribed displacements at the substep's end */
+  double *act_inc;       /* increments to reach them */
 
   /* matrices (space pattern) */
-  fcm_csr *M, *H, *D, *H0;  /* mass, Newton matrix, damping (or NULL), pristine copy (linear) */
-  double *Ma;               /* M a_rep (n) */
-  double rep_norm_full;     /* ||M a_rep|| over all DOFs */
+  fcm_csr *M, *H, *D, *H0; /* mass, Newton matrix, damping (or NULL), pristine copy (linear) */
+  double *Ma;              /* M a_rep (n) */
+  double rep_norm_full;    /* ||M a_rep|| over all DOFs */
 
   /* work vectors (n each) */
   double *u_bak, *v_bak, *lp_bak; /* state at the start of the step */
@@ -82,7 +82,7 @@ struct fcm_integrator {
   fcm_krylov *krylov;
   fcm_jacobi *jacobi;
   fcm_schwarz *schwarz;
-  unsigned char *schwarz_flag;     /* num_cells */
+  unsigned char *schwarz_flag; /* num_cells */
 
   /* Newton matrix cache: H holds base(h) + K(u) (state TANGENT, unmodified) or the
    * eliminated system with a valid factor / preconditioner (state SYSTEM, key below). */
