@@ -10,3 +10,9 @@ fcm_add_test(embed_exact_hex_simplified_full tests/embed/exactness.c ARGS hex si
              LABELS slow TIMEOUT 3600)
 fcm_add_test(embed_exact_tet_simplified_full tests/embed/exactness.c ARGS tet simplified-full
              LABELS slow TIMEOUT 3600)
+fcm_add_test(embed_volume tests/embed/volume.c)
+fcm_add_test(embed_degenerate tests/embed/degenerate.c)
+fcm_add_test(embed_surface tests/embed/surface.c)
+fcm_add_test(embed_rules tests/embed/rules.c)
+fcm_add_test(embed_errors tests/embed/errors.c)
+fcm_add_test(embed_bench tests/embed/bench.c LABELS bench TIMEOUT 3600)

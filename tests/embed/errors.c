@@ -1,0 +1,137 @@
+/* Error paths of fcm_cell_rules_create: a non-convex background cell is rejected naming
+ * the cell; bad strengths, thresholds, tolerances, thread counts and stabilization
+ * settings are FCM_ERR_ARG with the value in the message; *rules stays NULL. Then the
+ * allocation-failure loop (fail the k-th allocation, k = 0, 1, ... until success; one
+ * thread): FCM_ERR_ALLOC, NULL output, nothing leaked. */
+#include "fcm/embed.h"
+#include "test.h"
+
+#include <stdlib.h>
+
+typedef struct failing {
+  long count, fail_at;
+} failing;
+
+static void *failing_alloc(void *user, size_t size)
+{
+  failing *f = user;
+  if (f->fail_at >= 0 && f->count++ == f->fail_at) return NULL;
+  return malloc(size);
+}
+
+static void failing_release(void *user, void *ptr)
+{
+  (void)user;
+  free(ptr);
+}
+
+static void arguments(fcm_ctx *ctx)
+{
+  const double lo[3] = {0, 0, 0}, hi[3] = {2, 1, 1}, c0[3] = {1, 0.5, 0.5};
+  const fcm_index n[3] = {2, 1, 1};
+  fcm_mesh *box = NULL, *warped = NULL;
+  fcm_geometry *g = NULL;
+  fcm_cell_rules *r = (fcm_cell_rules *)ctx;
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, n, &box));
+  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c0, 0.4, 1, &g));
+  if (!box || !g) return;
+  /* Lift corner (2,1,1), which only cell 1 uses: its faces are no longer planar. */
+  double x[36];
+  memcpy(x, fcm_mesh_coords(box), sizeof x);
+  x[3 * 11 + 2] += 0.3;
+  TEST_OK(ctx, fcm_mesh_create(ctx, FCM_ELEMENT_HEX8, 12, x, 2, fcm_mesh_cells(box), &warped));
+  if (warped)
+    TEST_ERR(ctx, fcm_cell_rules_create(ctx, warped, g, NULL, &r), FCM_ERR_GEOMETRY,
+             "background cell 1 (hex8) is not a convex polyhedron");
+  TEST_TRUE(r == NULL);
+  fcm_cell_rules_options o = fcm_cell_rules_options_default();
+  o.strength[FCM_RULE_MASS] = 21;
+  TEST_ERR(ctx, fcm_cell_rules_create(ctx, box, g, &o, &r), FCM_ERR_ARG,
+           "mass strength = 21 outside [0, 20]");
+  o.simplify = 0; /* without simplification the catalogue limit applies */
+  o.strength[FCM_RULE_MASS] = FCM_RULE_MAX_STRENGTH + 1;
+  TEST_ERR(ctx, fcm_cell_rules_create(ctx, box, g, &o, &r), FCM_ERR_ARG, "mass strength");
+  o = fcm_cell_rules_options_default();
+  o.strength[FCM_RULE_STIFFNESS] = -2;
+  TEST_ERR(ctx, fcm_cell_rules_create(ctx, box, g, &o, &r), FCM_ERR_ARG, "stiffness strength = -2");
+  o = fcm_cell_rules_options_default();
+  o.min_fraction = 0.5, o.uncut_fraction = 0.4;
+  TEST_ERR(ctx, fcm_cell_rules_create(ctx, box, g, &o, &r), FCM_ERR_ARG,
+           "min_fraction = 0.5, uncut_fraction = 0.4");
+  o = fcm_cell_rules_options_default();
+  o.clip_rtol = -1e-12;
+  TEST_ERR(ctx, fcm_cell_rules_create(ctx, box, g, &o, &r), FCM_ERR_ARG, "clip_rtol = -1e-12");
+  o = fcm_cell_rules_options_default();
+  o.num_threads = -1;
+  TEST_ERR(ctx, fcm_cell_rules_create(ctx, box, g, &o, &r), FCM_ERR_ARG, "num_threads = -1");
+  o = fcm_cell_rules_options_default();
+  o.stabilization.alpha = 0.0;
+  TEST_ERR(ctx, fcm_cell_rules_create(ctx, box, g, &o, &r), FCM_ERR_ARG, "alpha = 0");
+  o = fcm_cell_rules_options_default();
+  o.surface_strength = -3;
+  TEST_ERR(ctx, fcm_cell_rules_create(ctx, box, g, &o, &r), FCM_ERR_ARG, "surface strength = -3");
+  TEST_ERR(ctx, fcm_cell_rules_create(ctx, NULL, g, NULL, &r), FCM_ERR_ARG, "NULL");
+  TEST_ERR(ctx, fcm_cell_rules_create(ctx, box, g, NULL, NULL), FCM_ERR_ARG, "output");
+  TEST_TRUE(r == NULL);
+  fcm_mesh_destroy(&box);
+  fcm_mesh_destroy(&warped);
+  fcm_geometry_destroy(&g);
+}
+
+static void allocation_failures(void)
+{
+  failing f = {0, -1};
+  fcm_ctx_options co = fcm_ctx_options_default();
+  co.allocator.alloc = failing_alloc;
+  co.allocator.release = failing_release;
+  co.allocator.user = &f;
+  fcm_ctx *ctx = NULL;
+  TEST_OK(NULL, fcm_ctx_create(&co, &ctx));
+  if (!ctx) return;
+  const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, c0[3] = {0.1, 0, 0};
+  const fcm_index n[3] = {2, 2, 1};
+  fcm_mesh *mesh = NULL;
+  fcm_geometry *g = NULL;
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, n, &mesh));
+  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c0, 0.9, 1, &g));
+  fcm_cell_rules_options o = fcm_cell_rules_options_default();
+  o.num_threads = 1; /* the failing allocator's counter is not atomic */
+  o.surface_strength = 1;
+  o.strength[FCM_RULE_MASS] = 2;
+  const long long live = fcm_ctx_live_allocations(ctx);
+  int ok = 0, fails = 0;
+  for (long k = 0; k < 100000 && !ok && mesh && g; k++) {
+    fcm_cell_rules *r = (fcm_cell_rules *)&f;
+    f.count = 0, f.fail_at = k;
+    const fcm_status st = fcm_cell_rules_create(ctx, mesh, g, &o, &r);
+    f.fail_at = -1;
+    if (st == FCM_OK) {
+      ok = 1;
+      TEST_TRUE(r != NULL && fcm_cell_rules_get_stats(r)->num_cut > 0);
+      fcm_cell_rules_destroy(&r);
+    } else {
+      fails++;
+      if (!(st == FCM_ERR_ALLOC && r == NULL))
+        TEST_FAIL_("allocation %ld failing: status %s, rules %p", k, fcm_status_str(st), (void *)r);
+    }
+    if (fcm_ctx_live_allocations(ctx) != live)
+      TEST_FAIL_("allocation %ld failing: %lld allocations leaked", k,
+                 fcm_ctx_live_allocations(ctx) - live);
+    fcm_ctx_error_clear(ctx);
+  }
+  TEST_TRUE(ok && fails > 20);
+  fcm_mesh_destroy(&mesh);
+  fcm_geometry_destroy(&g);
+  fcm_ctx_destroy(&ctx);
+}
+
+int main(void)
+{
+  fcm_ctx *ctx = NULL;
+  TEST_OK(NULL, fcm_ctx_create(NULL, &ctx));
+  arguments(ctx);
+  TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
+  fcm_ctx_destroy(&ctx);
+  allocation_failures();
+  return TEST_RESULT();
+}
