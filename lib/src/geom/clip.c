@@ -184,7 +184,13 @@ int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__pol
     }
   }
   if (out->nf < 4) out->nv = out->nf = 0; /* fewer than 4 faces: no volume */
-  memcpy(p, out, sizeof *p);
+  /* Copy back only the used parts (the struct is ~11 kB). */
+  p->nv = out->nv, p->nf = out->nf;
+  memcpy(p->x, out->x, (size_t)out->nv * sizeof out->x[0]);
+  for (int f = 0; f < out->nf; f++) {
+    p->fn[f] = out->fn[f];
+    memcpy(p->fv[f], out->fv[f], (size_t)out->fn[f] * sizeof out->fv[f][0]);
+  }
   return 0;
 overflow:
   p->nv = p->nf = 0;
