@@ -86,10 +86,11 @@ typedef struct fcm_cell_rules fcm_cell_rules;
  * then per cut cell simplification (if enabled) followed by stabilization points (flag 1).
  * Parallel over cells (OpenMP); the output does not depend on the thread count.
  * @param[in] mesh background mesh; every cell must be convex (straight edges, planar faces)
- * @param[in] geom embedded geometry; both must outlive nothing (data are copied)
+ * @param[in] geom embedded geometry; mesh and geom are only read during the call
  * @param[in] opts NULL for defaults; @param[out] rules NULL on failure
- * @return FCM_OK; FCM_ERR_ARG (NULL, strengths outside [0, 20] or thresholds outside
- *         0 <= min_fraction < uncut_fraction <= 1, tolerances negative); FCM_ERR_GEOMETRY
+ * @return FCM_OK; FCM_ERR_ARG (NULL, strengths outside [0, 20] with simplification or
+ *         [0, FCM_RULE_MAX_STRENGTH] without, thresholds outside 0 <= min_fraction <
+ *         uncut_fraction <= 1, tolerances out of range, bad stabilization); FCM_ERR_GEOMETRY
  *         (a non-convex background cell, naming it; a degenerate cell); FCM_ERR_NOT_CONVERGED
  *         (inverse map); FCM_ERR_ALLOC; errors of fcm_simplify(). Allocates. */
 FCM_API fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh,
