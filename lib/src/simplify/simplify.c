@@ -1,0 +1,418 @@
+/* fcm_simplify(): argument checks, weight normalization, the attempts (LP or
+ * recombination, then the other, then a looser rank threshold), least-squares re-fit on
+ * the kept support, verification, and the fallback to the unchanged input rule.
+ *
+ * Longva et al. 2020 §4.4: a basic feasible solution of P w = P w0, w >= 0 has at most
+ * rank P <= M non-zeros, so a subset of the input points (inside the geometry whenever
+ * the input points are) carries positive weights with the input's moments. Unlike the
+ * authors' code every result is checked (weights > 0, count <= M, relative moment
+ * residual <= tolerance) and a failure never aborts: the input rule comes back. */
+#include "la/la_impl.h"
+#include "simplify/simplify_impl.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+/* AUTO uses recombination above this many points per basis function. Measured by
+ * tests/simplify/bench_simplify.c: the plain LP is as fast up to N ~ 8 M, recombination
+ * 1.6-3x faster at 16-32 M, 3-4x at the paper's M = 35, N = 2,900 and 12-23x at
+ * M = 286, N = 110,592. */
+#define AUTO_RECOMBINE_RATIO 12
+
+fcm_simplify_options fcm_simplify_options_default(void)
+{
+  fcm_simplify_options o;
+  memset(&o, 0, sizeof o);
+  o.method = FCM_SIMPLIFY_AUTO;
+  o.rank_tol = 1e-13;
+  o.residual_tol = 1e-12;
+  o.lp_iteration_limit = 0;
+  o.lp_time_limit = 60.0;
+  o.force_lp_failure = 0;
+  return o;
+}
+
+const char *fcm_simplify_method_name(fcm_simplify_method method)
+{
+  switch (method) {
+  case FCM_SIMPLIFY_AUTO:
+    return "auto";
+  case FCM_SIMPLIFY_LP:
+    return "lp";
+  case FCM_SIMPLIFY_RECOMBINE:
+    return "recombine";
+  default:
+    return "unknown";
+  }
+}
+
+const char *fcm_simplify_reason_name(fcm_simplify_reason reason)
+{
+  switch (reason) {
+  case FCM_SIMPLIFY_REASON_NONE:
+    return "none";
+  case FCM_SIMPLIFY_REASON_LP:
+    return "lp";
+  case FCM_SIMPLIFY_REASON_LP_ERROR:
+    return "lp-error";
+  case FCM_SIMPLIFY_REASON_NUMERIC:
+    return "numeric";
+  case FCM_SIMPLIFY_REASON_NOT_POSITIVE:
+    return "not-positive";
+  case FCM_SIMPLIFY_REASON_RESIDUAL:
+    return "residual";
+  case FCM_SIMPLIFY_REASON_COUNT:
+    return "count";
+  case FCM_SIMPLIFY_REASON_NO_PROGRESS:
+    return "no-progress";
+  default:
+    return "unknown";
+  }
+}
+
+void fcm__simplify_fail(fcm__attempt *a, fcm_simplify_reason reason, const char *fmt, ...)
+{
+  va_list ap;
+  a->reason = reason;
+  va_start(ap, fmt);
+  vsnprintf(a->message, sizeof a->message, fmt, ap);
+  va_end(ap);
+}
+
+fcm_status fcm__simplify_soften(fcm__attempt *a, fcm_status st, const char *what)
+{
+  if (st == FCM_OK || st == FCM_ERR_ALLOC) return st;
+  fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_NUMERIC, "%s failed: %s", what, fcm_status_str(st));
+  return FCM_OK;
+}
+
+fcm_status fcm__simplify_row_space(fcm__attempt *a, int rows, int cols, double *g, double *q,
+                                   int *r)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = a->ctx;
+  const int k = FCM_MIN(rows, cols);
+  double *s = NULL;
+  const double t0 = fcm_wtime();
+  *r = 0;
+  FCM_ALLOC(ctx, (size_t)k, s);
+  FCM_TRY(ctx, fcm__simplify_soften(a, fcm__gesvd(ctx, rows, cols, g, rows, s, NULL, 1, q, k),
+                                    "SVD of the moment matrix"));
+  if (a->reason != FCM_SIMPLIFY_REASON_NONE) goto cleanup;
+  if (!(s[0] > 0.0 && isfinite(s[0]))) {
+    fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_NUMERIC, "moment matrix has s_max = %g", s[0]);
+    goto cleanup;
+  }
+  while (*r < k && s[*r] > a->rank_tol * s[0])
+    (*r)++;
+cleanup:
+  a->time_svd += fcm_wtime() - t0;
+  fcm__free(ctx, s);
+  return st;
+}
+
+/* Relative residual max|P_S w - b| / max|b| of weights w on the support (PS is M x count). */
+static double residual_of(int M, int count, const double *PS, const double *w, const double *b)
+{
+  double num = 0.0, den = 0.0;
+  for (int i = 0; i < M; i++) {
+    double s = 0.0;
+    for (int c = 0; c < count; c++)
+      s += PS[i + (size_t)c * (size_t)M] * w[c];
+    num = fmax(num, fabs(s - b[i]));
+    den = fmax(den, fabs(b[i]));
+  }
+  const double res = num / den;
+  return isnan(res) ? INFINITY : res;
+}
+
+/* Re-fit the weights on the support by least squares (P_S w_S = b), then verify; keep
+ * the LP's own weights when the re-fit loses positivity but those verify. */
+static fcm_status refit_verify(fcm__attempt *a, double tol, double *residual)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = a->ctx;
+  const int M = a->box.num_basis, count = a->count;
+  double *PS = NULL, *A = NULL, *B = NULL;
+  *residual = INFINITY;
+  FCM_ALLOC(ctx, (size_t)M * (size_t)count, PS);
+  FCM_ALLOC(ctx, (size_t)M * (size_t)count, A);
+  FCM_ALLOC(ctx, (size_t)FCM_MAX(M, count), B);
+  for (int c = 0; c < count; c++)
+    fcm__simplify_basis_eval(&a->box, a->points + 3 * (size_t)a->support[c],
+                             PS + (size_t)c * (size_t)M);
+  memcpy(A, PS, sizeof *A * (size_t)M * (size_t)count);
+  memcpy(B, a->moments, sizeof *B * (size_t)M);
+
+  const double lp_res = residual_of(M, count, PS, a->w, a->moments);
+  st = fcm__lstsq(ctx, M, count, 1, A, M, B, FCM_MAX(M, count), -1.0, NULL);
+  if (st == FCM_ERR_ALLOC) {
+    fcm__trace(ctx, __FILE__, __LINE__, __func__);
+    goto cleanup;
+  }
+  int refit_ok = st == FCM_OK;
+  st = FCM_OK;
+  for (int c = 0; refit_ok && c < count; c++)
+    refit_ok = B[c] > 0.0 && isfinite(B[c]);
+  const double fit_res = refit_ok ? residual_of(M, count, PS, B, a->moments) : INFINITY;
+
+  if (refit_ok && fit_res <= tol) {
+    memcpy(a->w, B, sizeof *B * (size_t)count);
+    *residual = fit_res;
+  } else if (lp_res <= tol) {
+    *residual = lp_res; /* the LP weights are positive by construction */
+  } else {
+    *residual = fmin(lp_res, fit_res);
+    fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_RESIDUAL,
+                       "relative moment residual %.3g (LP) / %.3g (re-fit%s) above %.3g", lp_res,
+                       fit_res, refit_ok ? "" : ", not positive", tol);
+  }
+  for (int c = 0; a->reason == FCM_SIMPLIFY_REASON_NONE && c < count; c++)
+    if (!(a->w[c] > 0.0) || !isfinite(a->w[c]))
+      fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_NOT_POSITIVE, "weight %d = %g not positive", c,
+                         a->w[c]);
+  if (a->reason == FCM_SIMPLIFY_REASON_NONE && count > M)
+    fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_COUNT, "%d points exceed M = %d", count, M);
+cleanup:
+  fcm__free(ctx, PS);
+  fcm__free(ctx, A);
+  fcm__free(ctx, B);
+  return st;
+}
+
+static fcm_status check_options(fcm_ctx *ctx, const fcm_simplify_options *o)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(o->method >= FCM_SIMPLIFY_AUTO && o->method < FCM_SIMPLIFY_METHOD_COUNT, ctx,
+            FCM_ERR_ARG, "simplify: method = %d out of range [0, %d)", (int)o->method,
+            (int)FCM_SIMPLIFY_METHOD_COUNT);
+  FCM_CHECK(o->rank_tol >= 0.0 && o->rank_tol < 1.0, ctx, FCM_ERR_ARG,
+            "simplify: rank_tol = %g out of range [0, 1)", o->rank_tol);
+  FCM_CHECK(o->residual_tol > 0.0 && o->residual_tol < 1.0, ctx, FCM_ERR_ARG,
+            "simplify: residual_tol = %g out of range (0, 1)", o->residual_tol);
+  FCM_CHECK(o->lp_iteration_limit >= 0, ctx, FCM_ERR_ARG,
+            "simplify: lp_iteration_limit = %d must be >= 0 (0: automatic)", o->lp_iteration_limit);
+  FCM_CHECK(o->lp_time_limit >= 0.0 && isfinite(o->lp_time_limit), ctx, FCM_ERR_ARG,
+            "simplify: lp_time_limit = %g must be finite and >= 0 (0: none)", o->lp_time_limit);
+  FCM_CHECK(o->force_lp_failure >= 0 && o->force_lp_failure <= 2, ctx, FCM_ERR_ARG,
+            "simplify: force_lp_failure = %d out of range [0, 2]", o->force_lp_failure);
+cleanup:
+  return st;
+}
+
+/* The input rule unchanged (N <= M, or every attempt failed). */
+static fcm_status keep_input(fcm_ctx *ctx, int n, const double *weights, fcm_simplify_result *out)
+{
+  fcm_status st = FCM_OK;
+  FCM_ALLOC(ctx, (size_t)n, out->indices);
+  FCM_ALLOC(ctx, (size_t)n, out->weights);
+  for (int j = 0; j < n; j++) {
+    out->indices[j] = j;
+    out->weights[j] = weights[j];
+  }
+  out->count = n;
+cleanup:
+  return st;
+}
+
+static void append_message(fcm_simplify_info *info, int attempt, fcm_simplify_method method,
+                           double tol, const char *msg)
+{
+  const size_t len = strlen(info->message);
+  if (len + 1 < sizeof info->message)
+    snprintf(info->message + len, sizeof info->message - len, "%s[%d %s, rank_tol %.0e] %s",
+             len ? "; " : "", attempt, fcm_simplify_method_name(method), tol, msg);
+}
+
+fcm_status fcm_simplify(fcm_ctx *ctx, int strength, fcm_index n, const double *points,
+                        const double *weights, const fcm_simplify_options *opts,
+                        fcm_simplify_result *out, fcm_simplify_info *info)
+{
+  fcm_status st = FCM_OK;
+  fcm_simplify_info local_info;
+  fcm_simplify_options o = opts ? *opts : fcm_simplify_options_default();
+  fcm__attempt a;
+  double *w0 = NULL, *moments = NULL, *phi = NULL, *packed = NULL, total = 0.0;
+  int *map = NULL, ni = 0, np = 0, success = 0;
+  const double t_start = fcm_wtime();
+
+  memset(&a, 0, sizeof a);
+  if (!info) info = &local_info;
+  memset(info, 0, sizeof *info);
+  if (!ctx) return FCM_ERR_ARG;
+  FCM_CHECK(out, ctx, FCM_ERR_ARG, "simplify: out must not be NULL");
+  memset(out, 0, sizeof *out);
+  out->ctx = ctx;
+  FCM_CHECK(strength >= 0 && strength <= FCM_SIMPLIFY_MAX_STRENGTH, ctx, FCM_ERR_ARG,
+            "simplify: strength = %d out of range [0, %d]", strength, FCM_SIMPLIFY_MAX_STRENGTH);
+  FCM_CHECK(n >= 1, ctx, FCM_ERR_ARG, "simplify: n = %lld points, must be >= 1", (long long)n);
+  FCM_CHECK(points && weights, ctx, FCM_ERR_ARG, "simplify: points and weights must not be NULL");
+  FCM_TRY(ctx, check_options(ctx, &o));
+  FCM_TRY(ctx, fcm__index_to_int(ctx, n, "simplify: number of points", &ni));
+  for (int j = 0; j < ni; j++) {
+    FCM_CHECK(isfinite(points[3 * (size_t)j]) && isfinite(points[3 * (size_t)j + 1]) &&
+                  isfinite(points[3 * (size_t)j + 2]),
+              ctx, FCM_ERR_ARG, "simplify: point %d = (%g, %g, %g) is not finite", j,
+              points[3 * (size_t)j], points[3 * (size_t)j + 1], points[3 * (size_t)j + 2]);
+    FCM_CHECK(weights[j] >= 0.0 && isfinite(weights[j]), ctx, FCM_ERR_ARG,
+              "simplify: weight %d = %g, weights must be finite and >= 0", j, weights[j]);
+    total += weights[j];
+  }
+  FCM_CHECK(total > 0.0 && isfinite(total), ctx, FCM_ERR_ARG,
+            "simplify: total weight %g of %d points must be finite and > 0", total, ni);
+
+  const int M = fcm__simplify_num_basis(strength);
+  info->n = n;
+  info->num_basis = M;
+  info->method_used = FCM_SIMPLIFY_AUTO;
+  if (ni <= M) {
+    info->skipped = 1;
+    FCM_TRY(ctx, keep_input(ctx, ni, weights, out));
+    info->kept = out->count;
+    goto cleanup;
+  }
+
+  /* Points of zero weight take no part: work on the np points of positive weight. */
+  for (int j = 0; j < ni; j++)
+    np += weights[j] > 0.0;
+  FCM_ALLOC(ctx, (size_t)np, map);
+  for (int j = 0, k = 0; j < ni; j++)
+    if (weights[j] > 0.0) map[k++] = j;
+  if (np < ni) {
+    FCM_ALLOC(ctx, 3 * (size_t)np, packed);
+    for (int k = 0; k < np; k++)
+      for (int d = 0; d < 3; d++)
+        packed[3 * (size_t)k + d] = points[3 * (size_t)map[k] + d];
+    points = packed;
+  }
+  if (np <= M) {
+    info->skipped = 1;
+    FCM_ALLOC(ctx, (size_t)np, out->indices);
+    FCM_ALLOC(ctx, (size_t)np, out->weights);
+    for (int k = 0; k < np; k++) {
+      out->indices[k] = map[k];
+      out->weights[k] = weights[map[k]];
+    }
+    info->kept = out->count = np;
+    goto cleanup;
+  }
+
+  /* Mean-1 weights: with tiny weights GLPK reports "optimal" with w = 0 (notes §4). */
+  const double scale = (double)np / total;
+  FCM_CHECK(isfinite(scale), ctx, FCM_ERR_ARG,
+            "simplify: total weight %g of %d points too small to normalize (> %g needed)", total,
+            ni, (double)np / DBL_MAX);
+  FCM_ALLOC(ctx, (size_t)np, w0);
+  for (int k = 0; k < np; k++)
+    w0[k] = weights[map[k]] * scale;
+  FCM_ALLOC(ctx, (size_t)M, moments);
+  FCM_ALLOC(ctx, (size_t)M, phi);
+  FCM_ALLOC(ctx, (size_t)M, a.support);
+  FCM_ALLOC(ctx, (size_t)M, a.w);
+  a.ctx = ctx;
+  a.n = np;
+  a.points = points;
+  a.w0 = w0;
+  a.moments = moments;
+  a.capacity = M;
+  a.lp.it_lim = o.lp_iteration_limit > 0 ? o.lp_iteration_limit : 20 * M + 1000;
+  a.lp.tm_lim = o.lp_time_limit;
+  a.lp.force_failure = o.force_lp_failure;
+  double t0 = fcm_wtime();
+  fcm__simplify_box(strength, np, points, &a.box);
+  for (int j = 0; j < np; j++) {
+    fcm__simplify_basis_eval(&a.box, points + 3 * (size_t)j, phi);
+    for (int i = 0; i < M; i++)
+      moments[i] += w0[j] * phi[i];
+  }
+  a.time_basis += fcm_wtime() - t0;
+
+  /* Attempts: the chosen path, the other path, the chosen path with a looser rank cut. */
+  fcm_simplify_method primary = o.method;
+  if (primary == FCM_SIMPLIFY_AUTO)
+    primary = np > AUTO_RECOMBINE_RATIO * M ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
+  const fcm_simplify_method other =
+      primary == FCM_SIMPLIFY_LP ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
+  const fcm_simplify_method plan[3] = {primary, other, primary};
+  const double tols[3] = {o.rank_tol, o.rank_tol, fmin(1e-3, fmax(100.0 * o.rank_tol, 1e-14))};
+  for (int k = 0; k < 3 && !success; k++) {
+    double residual = INFINITY;
+    a.rank_tol = tols[k];
+    a.count = 0;
+    a.rank = 0;
+    a.reason = FCM_SIMPLIFY_REASON_NONE;
+    a.message[0] = '\0';
+    info->attempts = k + 1;
+    info->method_used = plan[k];
+    if (plan[k] == FCM_SIMPLIFY_LP)
+      FCM_TRY(ctx, fcm__simplify_run_lp(&a));
+    else
+      FCM_TRY(ctx, fcm__simplify_run_recombine(&a));
+    if (a.reason == FCM_SIMPLIFY_REASON_NONE) {
+      t0 = fcm_wtime();
+      st = refit_verify(&a, o.residual_tol, &residual);
+      info->time_refit += fcm_wtime() - t0;
+      if (st != FCM_OK) {
+        fcm__trace(ctx, __FILE__, __LINE__, __func__);
+        goto cleanup;
+      }
+    }
+    info->rank = a.rank;
+    if (a.reason == FCM_SIMPLIFY_REASON_NONE) {
+      success = 1;
+      info->residual = residual;
+    } else {
+      if (info->reason == FCM_SIMPLIFY_REASON_NONE) info->reason = a.reason;
+      append_message(info, k + 1, plan[k], tols[k], a.message);
+    }
+  }
+
+  if (success) {
+    FCM_ALLOC(ctx, (size_t)a.count, out->indices);
+    FCM_ALLOC(ctx, (size_t)a.count, out->weights);
+    for (int c = 0; c < a.count; c++) {
+      out->indices[c] = map[a.support[c]];
+      out->weights[c] = a.w[c] / scale;
+    }
+    out->count = a.count;
+  } else {
+    info->fallback = 1;
+    FCM_TRY(ctx, keep_input(ctx, ni, weights, out));
+  }
+  info->kept = out->count;
+
+cleanup:
+  info->lp_iterations = a.lp_iterations;
+  info->num_lps = a.num_lps;
+  info->rounds = a.rounds;
+  info->time_basis = a.time_basis;
+  info->time_svd = a.time_svd;
+  info->time_lp = a.time_lp;
+  info->time_total = fcm_wtime() - t_start;
+  if (st != FCM_OK && out) {
+    fcm__free(ctx, out->indices);
+    fcm__free(ctx, out->weights);
+    memset(out, 0, sizeof *out);
+  }
+  fcm__free(ctx, map);
+  fcm__free(ctx, packed);
+  fcm__free(ctx, w0);
+  fcm__free(ctx, moments);
+  fcm__free(ctx, phi);
+  fcm__free(ctx, a.support);
+  fcm__free(ctx, a.w);
+  return st;
+}
+
+void fcm_simplify_result_destroy(fcm_simplify_result *res)
+{
+  if (!res) return;
+  if (res->ctx) {
+    fcm__free(res->ctx, res->indices);
+    fcm__free(res->ctx, res->weights);
+  }
+  memset(res, 0, sizeof *res);
+}

@@ -1,0 +1,101 @@
+/* fcm simplify, internal part: the box-scaled Chebyshev basis, the GLPK adapter
+ * interface and the state one simplification attempt (LP or recombination) fills. */
+#ifndef FCM_SIMPLIFY_IMPL_H
+#define FCM_SIMPLIFY_IMPL_H
+
+#include "core/core_impl.h"
+#include "fcm/simplify.h"
+
+/* ---- basis (basis.c) ---- */
+
+/* Tensor Chebyshev basis T_a(x^)T_b(y^)T_c(z^), a+b+c <= m, on the bounding box of a
+ * point set: x^ = scale * x + shift per axis; a degenerate axis (extent at rounding
+ * level) gets scale 0 and shift 1, so every polynomial is constant along it. */
+typedef struct fcm__cheb_box {
+  int m;           /* strength */
+  int num_basis;   /* M = (m+3 choose 3) */
+  double scale[3]; /* per axis */
+  double shift[3];
+} fcm__cheb_box;
+
+/* (m+3 choose 3) for m >= 0. */
+int fcm__simplify_num_basis(int m);
+
+/* Box of the n points (n x 3, row-major) for strength m. */
+void fcm__simplify_box(int m, int n, const double *points, fcm__cheb_box *box);
+
+/* phi[0..M) at the point x[3]; ordered by total degree, then a descending, then b. */
+void fcm__simplify_basis_eval(const fcm__cheb_box *box, const double *x, double *phi);
+
+/* ---- GLPK adapter (glpk_adapter.c, the only file that sees glpk.h) ---- */
+
+typedef struct fcm__lp_params {
+  int it_lim;        /* simplex iteration limit (> 0, or 0 with force_failure 1) */
+  double tm_lim;     /* seconds; 0: none */
+  int force_failure; /* 0, 1 (iteration limit 0), 2 (provoke a GLPK fatal error) */
+} fcm__lp_params;
+
+typedef struct fcm__lp_report {
+  int ok;                     /* 1: x is a vertex reported (primal) feasible */
+  fcm_simplify_reason reason; /* on failure: FCM_SIMPLIFY_REASON_LP or _LP_ERROR */
+  int iterations;             /* simplex iterations */
+  char message[160];          /* on failure: what GLPK said */
+} fcm__lp_report;
+
+/* Find a basic feasible solution of A x = b, x >= 0 (A rows x cols, column-major with
+ * leading dimension lda, rows expected orthonormal) by GLPK's dual simplex with a zero
+ * objective, presolver and scaling off, terminal output swallowed and the error hook
+ * installed. An LP failure is not an error: it returns FCM_OK with rep->ok = 0.
+ * Errors: FCM_ERR_ALLOC (our workspace). x has cols entries. Thread safe (GLPK 5.0
+ * keeps its environment in thread-local storage). */
+fcm_status fcm__simplify_lp_solve(fcm_ctx *ctx, int rows, int cols, const double *a, int lda,
+                                  const double *b, const fcm__lp_params *prm, double *x,
+                                  fcm__lp_report *rep);
+
+/* ---- one attempt (simplify.c drives; lp.c and recombine.c implement) ---- */
+
+typedef struct fcm__attempt {
+  /* input, set by the driver */
+  fcm_ctx *ctx;
+  int n;                 /* points */
+  const double *points;  /* n x 3 */
+  const double *w0;      /* n weights normalized to mean 1 */
+  const double *moments; /* M moments of w0 in the box basis */
+  fcm__cheb_box box;
+  double rank_tol;
+  fcm__lp_params lp;
+  /* output: a support of at most `capacity` points with positive weights (normalized
+   * scale), or reason != NONE with a message; counters and times accumulate */
+  int capacity; /* of support and w */
+  int count;
+  int *support; /* ascending input indices */
+  double *w;
+  int rank;
+  fcm_simplify_reason reason;
+  char message[200];
+  long long lp_iterations;
+  int num_lps, rounds;
+  double time_basis, time_svd, time_lp;
+} fcm__attempt;
+
+/* Record a soft failure of an attempt (the driver retries or falls back). */
+void fcm__simplify_fail(fcm__attempt *a, fcm_simplify_reason reason, const char *fmt, ...)
+    FCM__PRINTF(3, 4);
+
+/* Map a failing status of a dense solver inside an attempt: FCM_ERR_ALLOC stays a hard
+ * error (returned); anything else becomes a soft NUMERIC failure and FCM_OK. */
+fcm_status fcm__simplify_soften(fcm__attempt *a, fcm_status st, const char *what);
+
+/* Rows of the numerical row space: thin SVD of the rows x cols matrix g (destroyed,
+ * column-major, ld rows); q (k x cols, ld k, k = min(rows, cols)) receives V^T, whose
+ * first *r rows (s_i > rank_tol s_0) span the row space; time goes to time_svd. */
+fcm_status fcm__simplify_row_space(fcm__attempt *a, int rows, int cols, double *g, double *q,
+                                   int *r);
+
+/* One full LP on all n points (DESIGN §6): P (M x n), thin SVD, V_r^T w = V_r^T w0. */
+fcm_status fcm__simplify_run_lp(fcm__attempt *a);
+
+/* Hierarchical recombination (notes §2.4): cluster LPs, about log2(n/M) rounds, final LP. */
+fcm_status fcm__simplify_run_recombine(fcm__attempt *a);
+
+#endif /* FCM_SIMPLIFY_IMPL_H */
