@@ -23,3 +23,8 @@ foreach(scene spinning_body slingshot hollow_ball static_beam twisting_cylinder 
     set_tests_properties(app_sim_check_${scene} PROPERTIES LABELS "app;slow" TIMEOUT 1800)
   endif()
 endforeach()
+# fcm-condition: --quick CSV/PNG format and facts; the Fig. 5 claims (Longva et al. 2020)
+fcm_add_test(app_condition tests/apps/condition_app.c LABELS app
+             ARGS $<TARGET_FILE:fcm-condition> ${PROJECT_BINARY_DIR}/app-tests)
+fcm_add_test(app_condition_claims tests/apps/condition_claims.c LABELS app TIMEOUT 1200
+             ARGS $<TARGET_FILE:fcm-condition> ${PROJECT_BINARY_DIR}/app-tests)
