@@ -80,7 +80,7 @@ FCM_API fcm_status fcm_geometry_create_hemisphere(fcm_ctx *ctx, const double cen
  * (36 n^2 layers tets). Holes are approximated by removing every hexahedron (quad x layer,
  * 6 tets) whose vertex centroid lies in a hole: a staircase surface at the grid resolution.
  * @return FCM_OK, FCM_ERR_ARG (0 < r_in < r_out finite, 0 <= hole_radius < r_out,
- *         1 <= n <= 1000, 1 <= layers <= 1000), FCM_ERR_ALLOC. Allocates. */
+ *         1 <= n <= 128, 1 <= layers <= 1000), FCM_ERR_ALLOC. Allocates. */
 FCM_API fcm_status fcm_geometry_create_hollow_ball(fcm_ctx *ctx, const double center[3],
                                                    double r_in, double r_out, double hole_radius,
                                                    int n, int layers, fcm_geometry **geom);

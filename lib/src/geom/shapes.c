@@ -251,7 +251,7 @@ fcm_status fcm_geometry_create_hollow_ball(fcm_ctx *ctx, const double center[3],
             "%s: radii r_in = %g, r_out = %g must satisfy 0 < r_in < r_out", who, r_in, r_out);
   FCM_CHECK(isfinite(hole_radius) && hole_radius >= 0.0 && hole_radius < r_out, ctx, FCM_ERR_ARG,
             "%s: hole radius = %g outside [0, r_out = %g)", who, hole_radius, r_out);
-  FCM_CHECK(n >= 1 && n <= 256, ctx, FCM_ERR_ARG, "%s: resolution n = %d outside [1, 256]", who, n);
+  FCM_CHECK(n >= 1 && n <= 128, ctx, FCM_ERR_ARG, "%s: resolution n = %d outside [1, 128]", who, n);
   FCM_CHECK(layers >= 1 && layers <= 1000, ctx, FCM_ERR_ARG, "%s: layers = %d outside [1, 1000]",
             who, layers);
   {
