@@ -1,0 +1,790 @@
+/* fcm-converge: what accuracy costs in time — convergence rates of FCM (exact embedded
+ * geometry, cut-cell rules) versus staircase FEM, error versus time, a quadrature-strength
+ * sweep, and the payoff of rule simplification (Longva et al. 2020 §6.2, §6.3, §6.6).
+ *
+ * Study: static linear elasticity on a tet-meshed hemisphere (radius 0.9, flat face on
+ * y = 0) in the background box [-1,1] x [0,1] x [-1,1] with h = 1/res, for Tet4, Tet10,
+ * Hex8 and Hex20 grids; a manufactured solution makes the exact error known (see
+ * fcm-converge-study.c), or --reference runs the authors' localized-load problem against a
+ * boundary-conforming Tet10 reference. `payoff` times rule construction and one Newton
+ * iteration (SNH tangent + force, CHOLMOD) with and without simplification. */
+#include "fcm-converge-study.h"
+
+#include <fcm/material.h>
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_LEVELS 32
+#define MAX_SWEEP 24
+
+typedef struct config {
+  cv_setup setup;
+  fcm_element_type elements[FCM_ELEMENT_COUNT];
+  int num_elements;
+  int methods[CV_METHOD_COUNT];
+  int num_methods;
+  int levels[MAX_LEVELS];
+  int num_levels;
+  int fit;
+  int quick;
+  int sweep;
+  fcm_element_type sweep_element;
+  int sweep_res;
+  int sweep_strengths[MAX_SWEEP];
+  int num_sweep;
+  const char *out;
+  const char *csv, *rates_csv, *sweep_csv;
+  int plots;
+  /* payoff */
+  int payoff;
+  fcm_element_type payoff_element;
+  int payoff_res;
+  int repeat;
+  const char *payoff_csv;
+  int levels_given, ref_refine_given, geom_given;
+} config;
+
+static void usage(FILE *f)
+{
+  fprintf(f,
+          "usage: " CV_PROG " [options]           convergence, accuracy vs time, strength sweep\n"
+          "       " CV_PROG " payoff [options]    simplification payoff (Longva et al. 2020 §6.3)\n"
+          "\n"
+          "Static linear elasticity on a hemisphere (tet mesh of radius R, flat face on y = 0)\n"
+          "embedded in the box [-1,1]x[0,1]x[-1,1] meshed with 2res x res x 2res cubes (h = 1/res;\n"
+          "tets: 6 per cube). FCM integrates the exact polyhedron with cut-cell rules; FEM keeps\n"
+          "the cells whose centroid lies inside the polyhedron (point-in-tet test on the geometry\n"
+          "mesh) and integrates them fully - the staircase a plain FEM would use.\n"
+          "Default problem: manufactured u_i = A_i sin(k_i.x + phi_i) (E = 1, nu = 0.3); body\n"
+          "force -div sigma(u); FCM traction sigma(u) n on the embedded boundary (facet normals);\n"
+          "the FEM knows only its staircase boundary and receives the true surface load there\n"
+          "(--fem-traction); body force b(x) on all kept cells; u = u_exact on all nodes on y = 0.\n"
+          "Errors: ||u_h - u||_L2 and |u_h - u|_H1 with strength-8 rules of the polyhedron on the\n"
+          "same grid (FCM: all of Omega, dropped cells extrapolated from a face neighbour; FEM:\n"
+          "Omega inside the kept cells - column 'meas' is that volume / |Omega|).\n"
+          "Rates: least-squares slope of log err vs log h over the finest --fit levels.\n"
+          "\n"
+          "study options:\n"
+          "  --elements LIST        tet4,tet10,hex8,hex20                     (default all)\n"
+          "  --methods LIST         fcm,fem                                   (default both)\n"
+          "  --levels LIST          resolutions res, h = 1/res     (default 2,3,4,6,8)  \n"
+          "  --quick                levels 2,3,4, geometry n 6, sweep res 2 with m = 2..5\n"
+          "  --reference            the authors' problem: E = 5e4, nu = 0, load -5e5 y\n"
+          "                         exp(-1/(1-9r^2)) e_y (3r < 1), u = 0 on y = 0, traction free;\n"
+          "                         errors against boundary-conforming Tet10 on the geometry's\n"
+          "                         tets refined --ref-refine times (default 1; quick 0)\n"
+          "  --radius R             hemisphere radius in (0, 1)               (default 0.9)\n"
+          "  --geom-n N             geometry resolution, 24 N^3 tets          (default 8)\n"
+          "  --strength M           FCM cut-cell stiffness strength           (default element's)\n"
+          "  --surface-strength M   traction rules (FCM and FEM faces)        (default 2p+2)\n"
+          "  --simplify on|off      simplify FCM cut-cell rules               (default on)\n"
+          "  --stabilization A      FCM stabilization alpha, 0 = off          (default 0)\n"
+          "  --min-fraction F       FCM: drop cells with volume fraction < F  (default 0: only\n"
+          "                         empty cells; a dropped cell takes its share of the surface\n"
+          "                         load with it, ~sqrt(F) h^2 each, which stalls convergence)\n"
+          "  --error-strength M     strength of the error rules               (default 8)\n"
+          "  --fem-traction MODE    surface load of the staircase FEM         (default projected)\n"
+          "                         projected: the true load t(y) = sigma(u(y)) n(y) on the\n"
+          "                         polyhedron carried along rays from the centre to the\n"
+          "                         staircase faces (weight |y|^2 (d.n_face) / (|x|^2 (d.n)):\n"
+          "                         the total force is that of the true surface);\n"
+          "                         naive: sigma(u(x)) n_true(x) per staircase face area\n"
+          "                         (n_true: facet met by the ray; the load grows with the\n"
+          "                         staircase's excess area, so this FEM does not converge);\n"
+          "                         face: sigma(u(x)) n_face, the exact data of the staircase\n"
+          "                         domain itself (control: optimal rates, no geometric error)\n"
+          );
+  fprintf(f,
+          "  --fit N                levels in the rate fit                    (default 3)\n"
+          "  --sweep-element E      element of the strength sweep (FCM)       (default hex20)\n"
+          "  --sweep-res R          resolution of the sweep                   (default 4)\n"
+          "  --sweep-strengths LIST strengths m                               (default 1..8)\n"
+          "  --no-sweep             skip the strength sweep\n"
+          "  --out PREFIX           output prefix                             (default fcm-converge)\n"
+          "  --csv FILE             per-level CSV            (default PREFIX-levels.csv)\n"
+          "  --rates-csv FILE       fitted rates CSV         (default PREFIX-rates.csv)\n"
+          "  --sweep-csv FILE       strength sweep CSV       (default PREFIX-sweep.csv)\n"
+          "  --no-plots             no PNG files (else PREFIX-convergence.png, PREFIX-pareto.png,\n"
+          "                         PREFIX-sweep.png through gnuplot; without gnuplot a message\n"
+          "                         is printed and the CSV files are still written)\n"
+          "\n");
+  fprintf(f,
+          "payoff options (Hex20 FCM on the hemisphere with the manufactured displacement):\n"
+          "  --element E            element                                   (default hex20)\n"
+          "  --res R                resolution                                (default 8; quick 4)\n"
+          "  --geom-n N, --strength M, --radius R   as above (default strength: element's)\n"
+          "  --repeat N             timed iterations per variant, minimum kept (default 3)\n"
+          "  --csv FILE             write the two variants as CSV\n"
+          "  --quick                res 4, geometry n 6, repeat 2\n"
+          "\n"
+          "CSV columns. levels: element,method,res,h,dofs,active_cells,cut_cells,points,\n"
+          "  strength,t_rules,t_assembly,t_solve,t_total,err_l2,err_h1,norm_l2,norm_h1,rel_l2,\n"
+          "  rel_h1,measured_volume,domain_volume,failed,note. points: stiffness quadrature\n"
+          "  points of all stored cells (FCM) or kept cells x standard rule (FEM); strength: the\n"
+          "  FCM cut-cell strength or the FEM full-cell rule's; t_rules: FCM cell rules or the FEM\n"
+          "  centroid classification; t_assembly: space, pattern, stiffness, loads, Dirichlet\n"
+          "  elimination; t_solve: CHOLMOD analyze+factor+solve; times are wall-clock seconds;\n"
+          "  err_*: absolute errors, norm_*: the exact (reference) norms over the same domain.\n"
+          "  rates: element,method,norm,rate (method fcm|fem, norm L2|H1).\n"
+          "  sweep: element,method,res,h,strength,points,dofs,t_rules,t_assembly,t_solve,t_total,\n"
+          "  err_l2,err_h1,rel_l2,rel_h1,failed,note.\n"
+          "  payoff: element,res,simplified,points_cut,points_total,t_rules,t_simplify,\n"
+          "  t_assembly,t_factor_solve,t_iteration,break_even_iterations.\n"
+          "Timings are wall-clock with the OpenMP threads of the environment; on a loaded machine\n"
+          "set OMP_WAIT_POLICY=passive (spinning threads inflate small phases).\n"
+          "stdout: tables; stderr: progress. Exit 0 on success, 1 on a computation or output\n"
+          "error, 2 on a usage error.\n");
+}
+
+/* ---------------------------------------------------------------- options */
+
+static int parse_int(const char *opt, const char *s, int lo, int hi, int *out)
+{
+  char *end = NULL;
+  errno = 0;
+  const long v = strtol(s, &end, 10);
+  if (errno || end == s || *end || v < lo || v > hi) {
+    fprintf(stderr, CV_PROG ": %s: '%s' is not an integer in [%d, %d]\n", opt, s, lo, hi);
+    return 0;
+  }
+  *out = (int)v;
+  return 1;
+}
+
+static int parse_double(const char *opt, const char *s, double lo, double hi, double *out)
+{
+  char *end = NULL;
+  errno = 0;
+  const double v = strtod(s, &end);
+  if (errno || end == s || *end || !isfinite(v) || v < lo || v > hi) {
+    fprintf(stderr, CV_PROG ": %s: '%s' is not a number in [%g, %g]\n", opt, s, lo, hi);
+    return 0;
+  }
+  *out = v;
+  return 1;
+}
+
+/* Comma list of integers in [lo, hi]. */
+static int parse_int_list(const char *opt, const char *s, int lo, int hi, int *out, int cap,
+                          int *n)
+{
+  char buf[512];
+  if (strlen(s) >= sizeof buf || !*s) {
+    fprintf(stderr, CV_PROG ": %s: empty or too long list\n", opt);
+    return 0;
+  }
+  strcpy(buf, s);
+  *n = 0;
+  for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+    if (*n >= cap) {
+      fprintf(stderr, CV_PROG ": %s: more than %d items\n", opt, cap);
+      return 0;
+    }
+    if (!parse_int(opt, tok, lo, hi, &out[(*n)++])) return 0;
+  }
+  return *n > 0;
+}
+
+static int parse_elements(const char *opt, const char *s, config *c)
+{
+  char buf[128];
+  if (strlen(s) >= sizeof buf || !*s) {
+    fprintf(stderr, CV_PROG ": %s: empty or too long list\n", opt);
+    return 0;
+  }
+  strcpy(buf, s);
+  c->num_elements = 0;
+  for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+    fcm_element_type t;
+    if (fcm_element_type_from_name(tok, &t) != FCM_OK) {
+      fprintf(stderr, CV_PROG ": %s: unknown element '%s' (tet4, tet10, hex8, hex20)\n", opt, tok);
+      return 0;
+    }
+    for (int k = 0; k < c->num_elements; k++)
+      if (c->elements[k] == t) {
+        fprintf(stderr, CV_PROG ": %s: '%s' given twice\n", opt, tok);
+        return 0;
+      }
+    c->elements[c->num_elements++] = t;
+  }
+  return c->num_elements > 0;
+}
+
+static int parse_methods(const char *s, config *c)
+{
+  char buf[64];
+  if (strlen(s) >= sizeof buf || !*s) {
+    fprintf(stderr, CV_PROG ": --methods: empty or too long list\n");
+    return 0;
+  }
+  strcpy(buf, s);
+  int seen[CV_METHOD_COUNT] = {0, 0};
+  c->num_methods = 0;
+  for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+    int m = !strcmp(tok, "fcm") ? CV_FCM : !strcmp(tok, "fem") ? CV_FEM : -1;
+    if (m < 0 || seen[m]) {
+      fprintf(stderr, CV_PROG ": --methods: '%s' is unknown or repeated (fcm, fem)\n", tok);
+      return 0;
+    }
+    seen[m] = 1;
+    c->methods[c->num_methods++] = m;
+  }
+  return c->num_methods > 0;
+}
+
+static int on_off(const char *opt, const char *s, int *out)
+{
+  if (!strcmp(s, "on") || !strcmp(s, "off")) {
+    *out = !strcmp(s, "on");
+    return 1;
+  }
+  fprintf(stderr, CV_PROG ": %s: expected on or off, got '%s'\n", opt, s);
+  return 0;
+}
+
+static void defaults(config *c)
+{
+  memset(c, 0, sizeof *c);
+  cv_setup *s = &c->setup;
+  s->problem = CV_MANUFACTURED;
+  s->radius = 0.9;
+  s->geom_n = 8;
+  s->young = 1.0;
+  s->poisson = 0.3;
+  s->strength = -1;
+  s->surface_strength = -1;
+  s->simplify = 1;
+  s->stab_alpha = 0.0;
+  s->min_fraction = 0.0;
+  s->error_strength = 8;
+  s->fem_traction = CV_TRACTION_PROJECTED;
+  s->ref_refine = 1;
+  for (int e = 0; e < FCM_ELEMENT_COUNT; e++) c->elements[e] = (fcm_element_type)e;
+  c->num_elements = FCM_ELEMENT_COUNT;
+  c->methods[0] = CV_FCM, c->methods[1] = CV_FEM;
+  c->num_methods = 2;
+  static const int lv[] = {2, 3, 4, 6, 8};
+  c->num_levels = (int)(sizeof lv / sizeof *lv);
+  memcpy(c->levels, lv, sizeof lv);
+  c->fit = 3;
+  c->sweep = 1;
+  c->sweep_element = FCM_ELEMENT_HEX20;
+  c->sweep_res = 4;
+  c->num_sweep = 8;
+  for (int k = 0; k < 8; k++) c->sweep_strengths[k] = k + 1;
+  c->out = CV_PROG;
+  c->plots = 1;
+  c->payoff_element = FCM_ELEMENT_HEX20;
+  c->payoff_res = 8;
+  c->repeat = 3;
+}
+
+static int parse_args(int argc, char **argv, config *c)
+{
+  int i = 1;
+  if (argc > 1 && !strcmp(argv[1], "payoff")) c->payoff = 1, i = 2;
+  int sweep_res_given = 0, sweep_given = 0, res_given = 0, repeat_given = 0;
+  for (; i < argc; i++) {
+    const char *a = argv[i];
+    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+      usage(stdout);
+      exit(0);
+    }
+    /* flags */
+    if (!strcmp(a, "--quick")) {
+      c->quick = 1;
+      continue;
+    }
+    if (!strcmp(a, "--reference")) {
+      c->setup.problem = CV_REFERENCE;
+      continue;
+    }
+    if (!strcmp(a, "--no-sweep")) {
+      c->sweep = 0;
+      continue;
+    }
+    if (!strcmp(a, "--no-plots")) {
+      c->plots = 0;
+      continue;
+    }
+    if (i + 1 >= argc) {
+      fprintf(stderr, CV_PROG ": unknown option or missing value: '%s' (see --help)\n", a);
+      return 0;
+    }
+    const char *v = argv[++i];
+    cv_setup *s = &c->setup;
+    int ok = 1;
+    if (!strcmp(a, "--elements") && !c->payoff)
+      ok = parse_elements(a, v, c);
+    else if (!strcmp(a, "--element") && c->payoff) {
+      if (fcm_element_type_from_name(v, &c->payoff_element) != FCM_OK) {
+        fprintf(stderr, CV_PROG ": --element: unknown element '%s'\n", v);
+        ok = 0;
+      }
+    } else if (!strcmp(a, "--methods") && !c->payoff)
+      ok = parse_methods(v, c);
+    else if (!strcmp(a, "--levels") && !c->payoff)
+      ok = parse_int_list(a, v, 1, 64, c->levels, MAX_LEVELS, &c->num_levels),
+      c->levels_given = 1;
+    else if (!strcmp(a, "--ref-refine") && !c->payoff)
+      ok = parse_int(a, v, 0, 3, &s->ref_refine), c->ref_refine_given = 1;
+    else if (!strcmp(a, "--radius"))
+      ok = parse_double(a, v, 0.05, 0.999, &s->radius);
+    else if (!strcmp(a, "--geom-n"))
+      ok = parse_int(a, v, 1, 64, &s->geom_n), c->geom_given = 1;
+    else if (!strcmp(a, "--strength"))
+      ok = parse_int(a, v, 1, 20, &s->strength);
+    else if (!strcmp(a, "--surface-strength") && !c->payoff)
+      ok = parse_int(a, v, 0, 20, &s->surface_strength);
+    else if (!strcmp(a, "--simplify") && !c->payoff)
+      ok = on_off(a, v, &s->simplify);
+    else if (!strcmp(a, "--stabilization") && !c->payoff)
+      ok = parse_double(a, v, 0.0, 1.0, &s->stab_alpha);
+    else if (!strcmp(a, "--min-fraction") && !c->payoff)
+      ok = parse_double(a, v, 0.0, 0.5, &s->min_fraction);
+    else if (!strcmp(a, "--error-strength") && !c->payoff)
+      ok = parse_int(a, v, 2, 20, &s->error_strength);
+    else if (!strcmp(a, "--fem-traction") && !c->payoff) {
+      if (!strcmp(v, "projected"))
+        s->fem_traction = CV_TRACTION_PROJECTED;
+      else if (!strcmp(v, "naive"))
+        s->fem_traction = CV_TRACTION_NAIVE;
+      else if (!strcmp(v, "face"))
+        s->fem_traction = CV_TRACTION_FACE;
+      else {
+        fprintf(stderr, CV_PROG ": --fem-traction: expected projected, naive or face, got '%s'\n",
+                v);
+        ok = 0;
+      }
+    } else if (!strcmp(a, "--fit") && !c->payoff)
+      ok = parse_int(a, v, 2, MAX_LEVELS, &c->fit);
+    else if (!strcmp(a, "--sweep-element") && !c->payoff) {
+      if (fcm_element_type_from_name(v, &c->sweep_element) != FCM_OK) {
+        fprintf(stderr, CV_PROG ": --sweep-element: unknown element '%s'\n", v);
+        ok = 0;
+      }
+    } else if (!strcmp(a, "--sweep-res") && !c->payoff)
+      ok = parse_int(a, v, 1, 64, &c->sweep_res), sweep_res_given = 1;
+    else if (!strcmp(a, "--sweep-strengths") && !c->payoff)
+      ok = parse_int_list(a, v, 1, 20, c->sweep_strengths, MAX_SWEEP, &c->num_sweep),
+      sweep_given = 1;
+    else if (!strcmp(a, "--out") && !c->payoff)
+      c->out = v;
+    else if (!strcmp(a, "--csv"))
+      c->payoff ? (void)(c->payoff_csv = v) : (void)(c->csv = v);
+    else if (!strcmp(a, "--rates-csv") && !c->payoff)
+      c->rates_csv = v;
+    else if (!strcmp(a, "--sweep-csv") && !c->payoff)
+      c->sweep_csv = v;
+    else if (!strcmp(a, "--res") && c->payoff)
+      ok = parse_int(a, v, 1, 64, &c->payoff_res), res_given = 1;
+    else if (!strcmp(a, "--repeat") && c->payoff)
+      ok = parse_int(a, v, 1, 100, &c->repeat), repeat_given = 1;
+    else {
+      fprintf(stderr, CV_PROG ": unknown option '%s'%s (see --help)\n", a,
+              c->payoff ? " for payoff" : "");
+      ok = 0;
+    }
+    if (!ok) return 0;
+  }
+  if (c->quick) {
+    static const int lv[] = {2, 3, 4};
+    if (!c->levels_given) {
+      c->num_levels = 3;
+      memcpy(c->levels, lv, sizeof lv);
+    }
+    if (!c->geom_given) c->setup.geom_n = 6;
+    if (!c->ref_refine_given) c->setup.ref_refine = 0;
+    if (!sweep_res_given) c->sweep_res = 2;
+    if (!sweep_given) {
+      c->num_sweep = 4;
+      for (int k = 0; k < 4; k++) c->sweep_strengths[k] = k + 2;
+    }
+    if (!res_given) c->payoff_res = 4;
+    if (!repeat_given) c->repeat = 2;
+  }
+  if (c->setup.problem == CV_REFERENCE) {
+    c->setup.young = 5e4;
+    c->setup.poisson = 0.0;
+  }
+  for (int a = 0; a < c->num_levels; a++)
+    for (int b = a + 1; b < c->num_levels; b++)
+      if (c->levels[a] == c->levels[b]) {
+        fprintf(stderr, CV_PROG ": --levels: %d given twice\n", c->levels[a]);
+        return 0;
+      }
+  return 1;
+}
+
+/* ---------------------------------------------------------------- study */
+
+static void progress(const cv_result *r)
+{
+  if (r->failed)
+    fprintf(stderr, CV_PROG ": %-5s %s res %2d: FAILED (%s)\n", fcm_element_get_info(r->element)->name,
+            cv_method_name(r->method), r->res, r->note);
+  else
+    fprintf(stderr,
+            CV_PROG ": %-5s %s res %2d: %7lld dofs, rules %.2f s, assembly %.2f s, solve %.2f s,"
+                    " L2 %.3e, H1 %.3e\n",
+            fcm_element_get_info(r->element)->name, cv_method_name(r->method), r->res,
+            (long long)r->dofs, r->t_rules, r->t_assembly, r->t_solve,
+            r->norm_l2 > 0 ? r->err_l2 / r->norm_l2 : NAN,
+            r->norm_h1 > 0 ? r->err_h1 / r->norm_h1 : NAN);
+}
+
+static fcm_status run_level(cv_study *study, fcm_ctx *ctx, fcm_element_type type, int res,
+                            const int *methods, int nmethods, const cv_run_options *ro,
+                            cv_result *out, int *nout)
+{
+  fcm_mesh *mesh = NULL;
+  fcm_cell_rules *er = NULL;
+  fcm_status st = cv_mesh_create(ctx, type, res, &mesh);
+  const double t0 = fcm_wtime();
+  if (st == FCM_OK) st = cv_error_rules_create(study, mesh, &er);
+  if (st == FCM_OK && study && nmethods > 0)
+    fprintf(stderr, CV_PROG ": %-5s res %2d: error rules %.2f s (%lld points)\n",
+            fcm_element_get_info(type)->name, res, fcm_wtime() - t0,
+            (long long)fcm_cell_rules_get_stats(er)->points_total[FCM_RULE_STIFFNESS]);
+  for (int m = 0; m < nmethods && st == FCM_OK; m++) {
+    cv_result *r = &out[*nout];
+    memset(r, 0, sizeof *r);
+    r->res = res;
+    r->h = 1.0 / res;
+    st = cv_run(study, mesh, er, (cv_method)methods[m], ro, r);
+    if (st == FCM_OK) {
+      progress(r);
+      (*nout)++;
+    }
+  }
+  fcm_cell_rules_destroy(&er);
+  fcm_mesh_destroy(&mesh);
+  return st;
+}
+
+static int output_path(char *buf, size_t cap, const char *given, const char *prefix,
+                       const char *suffix)
+{
+  if (given) return snprintf(buf, cap, "%s", given) < (int)cap;
+  return snprintf(buf, cap, "%s%s", prefix, suffix) < (int)cap;
+}
+
+static int run_study(const config *c, fcm_ctx *ctx)
+{
+  cv_study *study = NULL;
+  cv_result *res = NULL, *sw = NULL;
+  cv_rate rates[2 * CV_METHOD_COUNT * FCM_ELEMENT_COUNT];
+  int nres = 0, nsw = 0, nrates = 0, rc = 0;
+  char path[4096];
+  const double t0 = fcm_wtime();
+  fcm_status st = cv_study_create(ctx, &c->setup, &study);
+  if (st != FCM_OK) goto fail;
+  res = calloc((size_t)(c->num_elements * c->num_levels * CV_METHOD_COUNT), sizeof *res);
+  sw = calloc((size_t)c->num_sweep, sizeof *sw);
+  if (!res || !sw) {
+    st = FCM_ERR_ALLOC;
+    goto fail;
+  }
+  fprintf(stderr,
+          CV_PROG ": %s problem, hemisphere R = %g (%lld tets, volume %.6f), %d element(s) x %d "
+                  "level(s) x %d method(s); simplification %s, stabilization %g\n",
+          c->setup.problem == CV_MANUFACTURED ? "manufactured" : "reference", c->setup.radius,
+          (long long)fcm_geometry_num_cells(cv_study_geometry(study)),
+          fcm_geometry_volume(cv_study_geometry(study)), c->num_elements, c->num_levels,
+          c->num_methods, c->setup.simplify ? "on" : "off", c->setup.stab_alpha);
+  int levels[MAX_LEVELS];
+  memcpy(levels, c->levels, sizeof levels);
+  for (int a = 0; a < c->num_levels; a++) /* coarse to fine */
+    for (int b = a + 1; b < c->num_levels; b++)
+      if (levels[b] < levels[a]) {
+        const int t = levels[a];
+        levels[a] = levels[b], levels[b] = t;
+      }
+  for (int e = 0; e < c->num_elements && st == FCM_OK; e++)
+    for (int l = 0; l < c->num_levels && st == FCM_OK; l++)
+      st = run_level(study, ctx, c->elements[e], levels[l], c->methods, c->num_methods, NULL, res,
+                     &nres);
+  if (st != FCM_OK) goto fail;
+  nrates = cv_rates_compute(res, nres, c->fit, rates);
+
+  if (c->sweep) {
+    const int fcm_only[1] = {CV_FCM};
+    for (int k = 0; k < c->num_sweep && st == FCM_OK; k++) {
+      cv_run_options ro = {c->sweep_strengths[k], -1};
+      st = run_level(study, ctx, c->sweep_element, c->sweep_res, fcm_only, 1, &ro, sw, &nsw);
+    }
+    if (st != FCM_OK) goto fail;
+  }
+  fprintf(stderr, CV_PROG ": done in %.1f s\n", fcm_wtime() - t0);
+
+  if (c->setup.problem == CV_REFERENCE) {
+    fcm_index rd = 0;
+    double rt = 0.0;
+    cv_study_reference_info(study, &rd, &rt);
+    printf("reference: boundary-conforming Tet10, %lld DOFs, %.1f s\n", (long long)rd, rt);
+  }
+  cv_print_levels(stdout, res, nres);
+  cv_print_rates(stdout, rates, nrates);
+  cv_print_pareto(stdout, res, nres);
+  if (c->sweep) cv_print_sweep(stdout, sw, nsw);
+  fflush(stdout);
+
+  const char *what = c->setup.problem == CV_MANUFACTURED ? "manufactured solution"
+                                                         : "localized load vs Tet10 reference";
+  char title[256];
+  snprintf(title, sizeof title, "FCM vs staircase FEM on an embedded hemisphere (%s)", what);
+  if (!output_path(path, sizeof path, c->csv, c->out, "-levels.csv") ||
+      !cv_write_levels_csv(path, res, nres))
+    rc = 1;
+  else
+    fprintf(stderr, CV_PROG ": wrote %s\n", path);
+  if (!output_path(path, sizeof path, c->rates_csv, c->out, "-rates.csv") ||
+      !cv_write_rates_csv(path, rates, nrates))
+    rc = 1;
+  else
+    fprintf(stderr, CV_PROG ": wrote %s\n", path);
+  if (c->sweep) {
+    if (!output_path(path, sizeof path, c->sweep_csv, c->out, "-sweep.csv") ||
+        !cv_write_sweep_csv(path, sw, nsw))
+      rc = 1;
+    else
+      fprintf(stderr, CV_PROG ": wrote %s\n", path);
+  }
+  if (c->plots && cv_have_gnuplot()) {
+    if (!output_path(path, sizeof path, NULL, c->out, "-convergence.png") ||
+        !cv_plot_convergence(path, res, nres, rates, nrates, title))
+      rc = 1;
+    else
+      fprintf(stderr, CV_PROG ": wrote %s\n", path);
+    snprintf(title, sizeof title, "accuracy versus time and DOFs (%s)", what);
+    if (!output_path(path, sizeof path, NULL, c->out, "-pareto.png") ||
+        !cv_plot_pareto(path, res, nres, title))
+      rc = 1;
+    else
+      fprintf(stderr, CV_PROG ": wrote %s\n", path);
+    if (c->sweep) {
+      snprintf(title, sizeof title, "%s FCM, res %d: error and time vs cut-cell strength m (%s)",
+               fcm_element_get_info(c->sweep_element)->name, c->sweep_res, what);
+      if (!output_path(path, sizeof path, NULL, c->out, "-sweep.png") ||
+          !cv_plot_sweep(path, sw, nsw, title))
+        rc = 1;
+      else
+        fprintf(stderr, CV_PROG ": wrote %s\n", path);
+    }
+  }
+  free(res);
+  free(sw);
+  cv_study_destroy(&study);
+  return rc;
+fail:
+  fprintf(stderr, CV_PROG ": failed: %s\n", fcm_status_str(st));
+  fcm_ctx_error_view(ctx, stderr);
+  free(res);
+  free(sw);
+  cv_study_destroy(&study);
+  return 1;
+}
+
+/* ---------------------------------------------------------------- payoff */
+
+typedef struct payoff_result {
+  int simplified;
+  fcm_index points_cut, points_total, points_stab;
+  double t_rules, t_simplify, t_assembly, t_factor_solve, t_iteration;
+} payoff_result;
+
+static int cmp_double(const void *a, const void *b)
+{
+  const double x = *(const double *)a, y = *(const double *)b;
+  return x < y ? -1 : x > y;
+}
+
+/* Build the rules (timed), then time `repeat` Newton iterations: SNH force + tangent at a
+ * fixed displacement, Dirichlet elimination, CHOLMOD factor + solve (symbolic analysis
+ * once, outside the timing: it is reused by every iteration of a simulation). */
+static fcm_status payoff_variant(fcm_ctx *ctx, const config *c, const fcm_mesh *mesh,
+                                 const fcm_geometry *geom, int simplify, payoff_result *p)
+{
+  fcm_status st = FCM_OK;
+  fcm_cell_rules *rules = NULL;
+  fcm_space *space = NULL;
+  fcm_csr *A = NULL;
+  fcm_direct *chol = NULL;
+  double *u = NULL, *g = NULL, *du = NULL, *zero = NULL;
+  fcm_index *con = NULL, ncon = 0, cnt = 0, *nodes = NULL;
+  double ta[100], tf[100], ti[100];
+  fcm_cell_rules_options o = fcm_cell_rules_options_default();
+  o.strength[FCM_RULE_STIFFNESS] = c->setup.strength;
+  o.strength[FCM_RULE_MASS] = 0; /* the Newton iteration timed here uses no mass */
+  o.simplify = simplify;
+  double t0 = fcm_wtime();
+  st = fcm_cell_rules_create(ctx, mesh, geom, &o, &rules);
+  if (st != FCM_OK) return st;
+  p->simplified = simplify;
+  p->t_rules = fcm_wtime() - t0;
+  const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(rules);
+  p->points_cut = rs->points_simplified[FCM_RULE_STIFFNESS];
+  p->points_stab = rs->points_stabilization[FCM_RULE_STIFFNESS];
+  p->points_total = rs->points_total[FCM_RULE_STIFFNESS];
+  p->t_simplify = rs->time_simplify;
+  fprintf(stderr, CV_PROG ": payoff: rules %s simplification: %.3f s, %lld cut-cell points (+%lld "
+                  "stabilization), %lld in all\n",
+          simplify ? "with" : "without", p->t_rules, (long long)p->points_cut,
+          (long long)p->points_stab, (long long)p->points_total);
+
+  fcm_material mat = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 5e4, 0.4, 1000.0};
+  fcm_material_params mp;
+  st = fcm_material_setup(ctx, &mat, &mp);
+  if (st == FCM_OK) st = fcm_space_create_embedded(ctx, mesh, rules, &space);
+  if (st == FCM_OK) st = fcm_space_matrix_create(space, &A);
+  if (st != FCM_OK) goto done;
+  const fcm_index n = fcm_space_num_dofs(space), nn = fcm_mesh_num_nodes(mesh);
+  u = calloc((size_t)n, sizeof *u), g = calloc((size_t)n, sizeof *g);
+  du = calloc((size_t)n, sizeof *du), zero = calloc((size_t)n, sizeof *zero);
+  con = calloc((size_t)n, sizeof *con), nodes = calloc((size_t)nn, sizeof *nodes);
+  if (!u || !g || !du || !zero || !con || !nodes) {
+    st = FCM_ERR_ALLOC;
+    goto done;
+  }
+  const double *X = fcm_mesh_coords(mesh);
+  for (fcm_index a = 0; a < nn; a++) { /* the manufactured field: strains ~ 1e-2 */
+    const fcm_index d = fcm_space_node_dof(space, a);
+    if (d >= 0) cv_exact(X + 3 * a, u + d, NULL);
+  }
+  const double lo[3] = {-HUGE_VAL, 0.0, -HUGE_VAL}, hi[3] = {HUGE_VAL, 0.0, HUGE_VAL};
+  st = fcm_mesh_nodes_in_box(ctx, mesh, lo, hi, 1e-12, nn, nodes, &cnt);
+  for (fcm_index k = 0; k < cnt && st == FCM_OK; k++) {
+    const fcm_index d = fcm_space_node_dof(space, nodes[k]);
+    if (d >= 0)
+      for (int i = 0; i < 3; i++) con[ncon++] = d + i;
+  }
+  if (st == FCM_OK) st = fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, A, &chol);
+  if (st == FCM_OK) st = fcm_direct_analyze(chol);
+  for (int r = 0; r < c->repeat && st == FCM_OK; r++) {
+    t0 = fcm_wtime();
+    fcm_csr_set_zero(A);
+    memset(g, 0, sizeof *g * (size_t)n);
+    st = fcm_assemble_hyperelastic(space, &mp, u, NULL, NULL, g, A);
+    if (st == FCM_OK) st = fcm_space_apply_dirichlet(space, ncon, con, zero, A, g);
+    const double t1 = fcm_wtime();
+    if (st == FCM_OK) st = fcm_direct_factor(chol, fcm_csr_get_values(A));
+    if (st == FCM_OK) st = fcm_direct_solve(chol, g, du);
+    const double t2 = fcm_wtime();
+    ta[r] = t1 - t0, tf[r] = t2 - t1, ti[r] = t2 - t0;
+  }
+  if (st == FCM_OK) {
+    qsort(ta, (size_t)c->repeat, sizeof *ta, cmp_double);
+    qsort(tf, (size_t)c->repeat, sizeof *tf, cmp_double);
+    qsort(ti, (size_t)c->repeat, sizeof *ti, cmp_double);
+    p->t_assembly = ta[0], p->t_factor_solve = tf[0], p->t_iteration = ti[0];
+    fprintf(stderr, CV_PROG ": payoff: %lld DOFs; Newton iteration %.3f s (assembly %.3f s, "
+                    "factor + solve %.3f s), fastest of %d\n",
+            (long long)n, p->t_iteration, p->t_assembly, p->t_factor_solve, c->repeat);
+  }
+done:
+  fcm_direct_destroy(&chol);
+  free(u), free(g), free(du), free(zero), free(con), free(nodes);
+  fcm_csr_destroy(&A);
+  fcm_space_destroy(&space);
+  fcm_cell_rules_destroy(&rules);
+  return st;
+}
+
+static int run_payoff(const config *c, fcm_ctx *ctx)
+{
+  fcm_geometry *geom = NULL;
+  fcm_mesh *mesh = NULL;
+  payoff_result p[2];
+  const double center[3] = {0, 0, 0};
+  int rc = 0;
+  memset(p, 0, sizeof p);
+  fcm_status st = fcm_geometry_create_hemisphere(ctx, center, c->setup.radius, c->setup.geom_n, &geom);
+  if (st == FCM_OK) st = cv_mesh_create(ctx, c->payoff_element, c->payoff_res, &mesh);
+  if (st == FCM_OK)
+    fprintf(stderr, CV_PROG ": payoff: %s res %d (%lld cells), hemisphere %lld tets\n",
+            fcm_element_get_info(c->payoff_element)->name, c->payoff_res,
+            (long long)fcm_mesh_num_cells(mesh), (long long)fcm_geometry_num_cells(geom));
+  if (st == FCM_OK) st = payoff_variant(ctx, c, mesh, geom, 0, &p[0]);
+  if (st == FCM_OK) st = payoff_variant(ctx, c, mesh, geom, 1, &p[1]);
+  if (st != FCM_OK) {
+    fprintf(stderr, CV_PROG ": payoff failed: %s\n", fcm_status_str(st));
+    fcm_ctx_error_view(ctx, stderr);
+    rc = 1;
+    goto done;
+  }
+  const double gain = p[0].t_iteration - p[1].t_iteration;
+  const double cost = p[1].t_rules - p[0].t_rules;
+  const double be = gain > 0.0 ? cost / gain : INFINITY;
+  printf("\nsimplification payoff: %s FCM, res %d (h = %.4f), stiffness strength %d, hemisphere "
+         "%lld tets\n",
+         fcm_element_get_info(c->payoff_element)->name, c->payoff_res, 1.0 / c->payoff_res,
+         c->setup.strength > 0 ? c->setup.strength
+                               : fcm_element_get_info(c->payoff_element)->stiffness_strength,
+         (long long)fcm_geometry_num_cells(geom));
+  printf("%-12s %12s %12s %9s %9s %9s %9s %9s\n", "rules", "cut points", "all points", "t_rules",
+         "t_simpl", "t_asm", "t_fac+sol", "t_iter");
+  for (int k = 0; k < 2; k++)
+    printf("%-12s %12lld %12lld %9.3f %9.3f %9.3f %9.3f %9.3f\n",
+           k ? "simplified" : "plain", (long long)p[k].points_cut, (long long)p[k].points_total,
+           p[k].t_rules, p[k].t_simplify, p[k].t_assembly, p[k].t_factor_solve, p[k].t_iteration);
+  printf("point reduction (cut cells) %.1fx; assembly speed-up %.2fx; iteration speed-up %.2fx\n",
+         p[1].points_cut > 0 ? (double)p[0].points_cut / (double)p[1].points_cut : NAN,
+         p[1].t_assembly > 0 ? p[0].t_assembly / p[1].t_assembly : NAN,
+         p[1].t_iteration > 0 ? p[0].t_iteration / p[1].t_iteration : NAN);
+  if (isfinite(be))
+    printf("break-even: the simplification (%.3f s extra) pays for itself after %.2f Newton "
+           "iteration(s) (%.3f s saved per iteration)\n",
+           cost, be, gain);
+  else
+    printf("break-even: never (an iteration is not faster with the simplified rules)\n");
+  if (c->payoff_csv) {
+    char tmp[4096];
+    FILE *f = NULL;
+    if (snprintf(tmp, sizeof tmp, "%s.tmp", c->payoff_csv) < (int)sizeof tmp)
+      f = fopen(tmp, "w");
+    if (!f) {
+      fprintf(stderr, CV_PROG ": cannot write %s\n", c->payoff_csv);
+      rc = 1;
+      goto done;
+    }
+    fprintf(f, "element,res,simplified,points_cut,points_total,t_rules,t_simplify,t_assembly,"
+               "t_factor_solve,t_iteration,break_even_iterations\n");
+    for (int k = 0; k < 2; k++)
+      fprintf(f, "%s,%d,%d,%lld,%lld,%.6f,%.6f,%.6f,%.6f,%.6f,%.6g\n",
+              fcm_element_get_info(c->payoff_element)->name, c->payoff_res, p[k].simplified,
+              (long long)p[k].points_cut, (long long)p[k].points_total, p[k].t_rules,
+              p[k].t_simplify, p[k].t_assembly, p[k].t_factor_solve, p[k].t_iteration, be);
+    if (ferror(f) | (fclose(f) != 0) || rename(tmp, c->payoff_csv) != 0) {
+      fprintf(stderr, CV_PROG ": cannot write %s: %s\n", c->payoff_csv, strerror(errno));
+      remove(tmp);
+      rc = 1;
+    } else {
+      fprintf(stderr, CV_PROG ": wrote %s\n", c->payoff_csv);
+    }
+  }
+done:
+  fcm_mesh_destroy(&mesh);
+  fcm_geometry_destroy(&geom);
+  return rc;
+}
+
+/* ---------------------------------------------------------------- main */
+
+int main(int argc, char **argv)
+{
+  config c;
+  fcm_ctx *ctx = NULL;
+  defaults(&c);
+  if (!parse_args(argc, argv, &c)) return 2;
+  fcm_status st = fcm_ctx_create(NULL, &ctx);
+  if (st != FCM_OK) {
+    fprintf(stderr, CV_PROG ": cannot create a context: %s\n", fcm_status_str(st));
+    return 1;
+  }
+  const int rc = c.payoff ? run_payoff(&c, ctx) : run_study(&c, ctx);
+  fcm_ctx_destroy(&ctx);
+  return rc;
+}
