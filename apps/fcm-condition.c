@@ -588,7 +588,14 @@ static fcm_status measure(fcm_ctx *ctx, const config *c, const linsys *s, int pr
       TRY(Sop(Suser, e, Sd + (size_t)j * n));
       e[j] = 0.0;
     }
-    if (prec == PREC_JACOBI) { /* diagonal S: scale A symmetrically, no Cholesky needed */
+    int diagonal = 1; /* Jacobi, or Schwarz without blocks */
+    for (fcm_index j = 0; j < n && diagonal; j++)
+      for (fcm_index i = 0; i < n; i++)
+        if (i != j && Sd[i + (size_t)j * n] != 0.0) {
+          diagonal = 0;
+          break;
+        }
+    if (diagonal) { /* diagonal S: scale A symmetrically, no Cholesky needed */
       for (fcm_index j = 0; j < n; j++)
         for (fcm_index i = 0; i < n; i++)
           Bd[i + (size_t)j * n] = sqrt(Sd[i + (size_t)i * n] * Sd[j + (size_t)j * n]) *
@@ -793,8 +800,9 @@ static int write_png(const config *c, const char *path, const result *res, int n
     return 0;
   }
   static const char *const colors[PREC_COUNT] = {"#000000", "#1f77b4", "#d62728", "#2ca02c"};
-  /* one datablock per (stabilization, element, preconditioner) series */
-  int series = 0, ids[2][4][PREC_COUNT];
+  /* one datablock per (stabilization, element, preconditioner) series with finite values;
+   * panels: rows = stabilization settings run, columns = element shapes run */
+  int series = 0, ids[2][4][PREC_COUNT], row_on[2] = {0, 0}, col_on[2] = {0, 0};
   for (int sb = 0; sb < 2; sb++)
     for (int e = 0; e < 4; e++)
       for (int p = 0; p < PREC_COUNT; p++) {
@@ -803,30 +811,39 @@ static int write_png(const config *c, const char *path, const result *res, int n
         for (int k = 0; k < nres; k++) {
           const result *r = &res[k];
           if ((int)r->element != e || r->prec != p || (r->alpha > 0.0) != (sb == 0)) continue;
+          row_on[sb] = col_on[fcm_element_get_info(r->element)->shape == FCM_SHAPE_TET ? 0 : 1] =
+              1;
+          if (!isfinite(r->kappa)) continue;
           if (!any) fprintf(f, "$S%d << EOD\n", series);
           any = 1;
-          if (isfinite(r->kappa)) fprintf(f, "%.6e %.6e\n", r->phi_min, r->kappa);
+          fprintf(f, "%.6e %.6e\n", r->phi_min, r->kappa);
         }
         if (any) {
           fprintf(f, "EOD\n");
           ids[sb][e][p] = series++;
         }
       }
-  fprintf(f, "set terminal png size 1400,1000 font ',11'\nset output '%s'\n", tmp);
+  const int nrows = row_on[0] + row_on[1], ncols = col_on[0] + col_on[1];
+  fprintf(f, "set terminal png size %d,%d font ',11'\nset output '%s'\n", 200 + 600 * ncols,
+          100 + 450 * nrows, tmp);
   fprintf(f, "set logscale xy\nset xrange [*:*] reverse\nset format x '10^{%%L}'\n"
              "set format y '10^{%%L}'\nset grid\nset key top left font ',9'\n"
              "set xlabel 'smallest volume fraction'\nset ylabel 'kappa(SA)'\n");
-  fprintf(f, "set multiplot layout 2,2 title 'kappa(S (M + dt^2 K)), 4x4x4 grid, box [0,1+eps/3]^3"
-             " (Longva et al. 2020, Fig. 5)'\n");
+  fprintf(f, "set multiplot layout %d,%d title 'kappa(S (M + dt^2 K)), 4x4x4 grid, box "
+             "[0,1+eps/3]^3 (Longva et al. 2020, Fig. 5)'\n",
+          nrows, ncols);
   for (int sb = 0; sb < 2; sb++)
     for (int shape = 0; shape < 2; shape++) {
-      /* element types: 0 tet4, 1 tet10, 2 hex8, 3 hex20 in fcm_element_type order */
+      if (!row_on[sb] || !col_on[shape]) continue;
+      /* the linear and the quadratic element of this shape */
       int e0 = -1, e1 = -1;
       for (int e = 0; e < 4; e++) {
         const fcm_element_info *in = fcm_element_get_info((fcm_element_type)e);
         if (!in || (in->shape == FCM_SHAPE_TET) != (shape == 0)) continue;
-        if (in->order == 1) e0 = e;
-        else e1 = e;
+        if (in->order == 1)
+          e0 = e;
+        else
+          e1 = e;
       }
       fprintf(f, "set title '%s, %s'\n", shape == 0 ? "tetrahedra" : "hexahedra",
               sb == 0 ? "with stabilization" : "without stabilization");
@@ -848,7 +865,8 @@ static int write_png(const config *c, const char *path, const result *res, int n
           first = 0;
         }
       }
-      if (first) fprintf(f, "set key off\nplot 1/0 notitle\nset key on");
+      if (first) /* nothing finite to draw: keep the panel, say so */
+        fprintf(f, "plot [1e-12:1] 1 lc rgb '#ffffff' title 'no finite values'");
       fprintf(f, "\n");
     }
   fprintf(f, "unset multiplot\nset output\n");
@@ -873,6 +891,7 @@ static int write_png(const config *c, const char *path, const result *res, int n
 
 int main(int argc, char **argv)
 {
+  fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   config c;
   memset(&c, 0, sizeof c);
   for (int e = 0; e < 4; e++) c.elements[e] = (fcm_element_type)e;

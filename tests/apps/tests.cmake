@@ -28,3 +28,4 @@ fcm_add_test(app_condition tests/apps/condition_app.c LABELS app
              ARGS $<TARGET_FILE:fcm-condition> ${PROJECT_BINARY_DIR}/app-tests)
 fcm_add_test(app_condition_claims tests/apps/condition_claims.c LABELS app TIMEOUT 1200
              ARGS $<TARGET_FILE:fcm-condition> ${PROJECT_BINARY_DIR}/app-tests)
+fcm_add_test(dense_spectrum tests/apps/dense_spectrum.c)
