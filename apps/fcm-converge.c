@@ -775,6 +775,7 @@ done:
 
 int main(int argc, char **argv)
 {
+  fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   config c;
   fcm_ctx *ctx = NULL;
   defaults(&c);

@@ -559,5 +559,6 @@ done:
 
 int main(int argc, char **argv)
 {
+  fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   return is_scene_run(argc, argv) ? scene_main(argc, argv) : demo_main(argc, argv);
 }

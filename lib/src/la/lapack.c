@@ -9,6 +9,17 @@
 
 _Static_assert(sizeof(lapack_int) == sizeof(int), "fcm expects 32-bit LAPACK integers");
 
+/* OpenBLAS extensions (declared here: not every cblas.h carries them). */
+void openblas_set_num_threads(int num_threads);
+int openblas_get_num_threads(void);
+
+int fcm_blas_set_num_threads(int n)
+{
+  int old = openblas_get_num_threads();
+  if (n >= 1) openblas_set_num_threads(n);
+  return old;
+}
+
 static CBLAS_TRANSPOSE cblas_trans(char t) { return (t == 'T' || t == 't') ? CblasTrans : CblasNoTrans; }
 
 void fcm__gemm(char transa, char transb, int m, int n, int k, double alpha, const double *a,
