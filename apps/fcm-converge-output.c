@@ -78,7 +78,7 @@ void cv_print_levels(FILE *f, const cv_result *res, int nres)
             r->t_rules, r->t_assembly, r->t_solve, r->t_total, rel(r->err_l2, r->norm_l2),
             rel(r->err_h1, r->norm_h1),
             r->domain_volume > 0 ? r->measured_volume / r->domain_volume : 0.0,
-            r->failed ? "  FAILED: " : "", r->failed ? r->note : "");
+            r->failed ? "  FAILED: " : r->note[0] ? "  " : "", r->note);
   }
 }
 
@@ -137,8 +137,8 @@ void cv_print_sweep(FILE *f, const cv_result *res, int nres)
     const cv_result *r = &res[k];
     fprintf(f, "%3d %9lld %8.3f %8.3f %8.3f %8.3f %9.3e %9.3e%s%s\n", r->strength,
             (long long)r->points, r->t_rules, r->t_assembly, r->t_solve, r->t_total,
-            rel(r->err_l2, r->norm_l2), rel(r->err_h1, r->norm_h1), r->failed ? "  FAILED: " : "",
-            r->failed ? r->note : "");
+            rel(r->err_l2, r->norm_l2), rel(r->err_h1, r->norm_h1),
+            r->failed ? "  FAILED: " : r->note[0] ? "  " : "", r->note);
   }
 }
 
@@ -256,6 +256,19 @@ static FILE *script_open(const char *path, char *script, char *tmp, size_t cap)
   return f;
 }
 
+/* PNG terminal: cairo when this gnuplot has it (dashed lines), else libgd. */
+static void script_terminal(FILE *f, int w, int h, const char *tmp)
+{
+  fprintf(f,
+          "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) {\n"
+          "  set terminal pngcairo size %d,%d font ',10'\n"
+          "} else {\n"
+          "  set terminal png size %d,%d font ',11'\n"
+          "}\n"
+          "set termoption noenhanced\nset output '%s'\n",
+          w, h, w, h, tmp);
+}
+
 static int script_run(FILE *f, const char *script, const char *tmp, const char *path)
 {
   char cmd[4200];
@@ -315,9 +328,9 @@ static void plot_series(FILE *f, int have[FCM_ELEMENT_COUNT][2], const char *xco
       else
         snprintf(label, sizeof label, "%s %s", ename((fcm_element_type)e),
                  cv_method_name((cv_method)m));
-      fprintf(f, "%s $D%d%d using %s:%s with linespoints lw 2 dt %d pt %d lc rgb '%s' title '%s'",
-              first ? "plot" : ",", e, m, xcol, ycol, m == CV_FCM ? 1 : 2, m == CV_FCM ? 7 : 6,
-              elem_colors[e], label);
+      fprintf(f, "%s $D%d%d using %s:%s with linespoints lw %s dt %d pt %d lc rgb '%s' title '%s'",
+              first ? "plot" : ",", e, m, xcol, ycol, m == CV_FCM ? "2" : "1.5",
+              m == CV_FCM ? 1 : 2, m == CV_FCM ? 7 : 6, elem_colors[e], label);
       first = 0;
     }
   if (first) fprintf(f, "plot 1/0 notitle");
@@ -333,10 +346,9 @@ int cv_plot_convergence(const char *path, const cv_result *res, int nres, const 
   FILE *f = script_open(path, script, tmp, sizeof tmp);
   if (!f) return 0;
   write_blocks(f, res, nres, have);
-  fprintf(f, "set terminal png size 1400,620 font ',11'\nset termoption noenhanced\n"
-             "set output '%s'\nset logscale xy\nset grid\nset key bottom right font ',9'\n"
-             "set format y '%%.0e'\nset xlabel 'h'\n",
-          tmp);
+  script_terminal(f, 1400, 620, tmp);
+  fprintf(f, "set logscale xy\nset grid\nset key bottom right font ',9'\n"
+             "set format y '%%.0e'\nset xlabel 'h'\n");
   fprintf(f, "set multiplot layout 1,2 title '%s'\n", title);
   fprintf(f, "set title 'L2 error (relative)'\nset ylabel '||u_h - u|| / ||u||'\n");
   plot_series(f, have, "1", "4", rates, nrates, 0);
@@ -354,10 +366,8 @@ int cv_plot_pareto(const char *path, const cv_result *res, int nres, const char 
   FILE *f = script_open(path, script, tmp, sizeof tmp);
   if (!f) return 0;
   write_blocks(f, res, nres, have);
-  fprintf(f, "set terminal png size 1400,1100 font ',11'\nset termoption noenhanced\n"
-             "set output '%s'\nset logscale xy\nset grid\nset key top right font ',9'\n"
-             "set format y '%%.0e'\n",
-          tmp);
+  script_terminal(f, 1400, 1100, tmp);
+  fprintf(f, "set logscale xy\nset grid\nset key top right font ',9'\nset format y '%%.0e'\n");
   fprintf(f, "set multiplot layout 2,2 title '%s'\n", title);
   fprintf(f, "set title 'L2 error vs total time'\nset xlabel 'rules + assembly + solve [s]'\n"
              "set ylabel 'relative L2 error'\n");
@@ -388,10 +398,9 @@ int cv_plot_sweep(const char *path, const cv_result *res, int nres, const char *
             fmax(r->t_total, 1e-4), (long long)r->points);
   }
   fprintf(f, "EOD\n");
-  fprintf(f, "set terminal png size 1400,620 font ',11'\nset termoption noenhanced\n"
-             "set output '%s'\nset grid\nset key top right font ',9'\nset xlabel 'strength m'\n"
-             "set logscale y\nset format y '%%.0e'\nset xtics 1\n",
-          tmp);
+  script_terminal(f, 1400, 620, tmp);
+  fprintf(f, "set grid\nset key top right font ',9'\nset xlabel 'strength m'\n"
+             "set logscale y\nset format y '%%.0e'\nset xtics 1\n");
   fprintf(f, "set multiplot layout 1,2 title '%s'\n", title);
   fprintf(f, "set title 'error vs m'\nset ylabel 'relative error'\n"
              "plot $S using 1:2 with linespoints lw 2 pt 7 title 'L2', "

@@ -159,11 +159,17 @@ static fcm_status tet_index_create(fcm_ctx *ctx, const double *coords, const fcm
  * candidate with the largest smallest coordinate, else -1. */
 static fcm_index tet_locate(const tet_index *ti, const double x[3], double l[4])
 {
-  fcm_index ids[64], cnt = 0, best = -1;
+  fcm_index buf[64], *ids = buf, cnt = 0, best = -1;
   double lo[3], hi[3], bl = -HUGE_VAL, lt[4];
   for (int d = 0; d < 3; d++) lo[d] = x[d] - ti->tol, hi[d] = x[d] + ti->tol;
   if (fcm_aabb_tree_query(ti->tree, lo, hi, 64, ids, &cnt) != FCM_OK) return -1;
-  if (cnt > 64) cnt = 64;
+  if (cnt > 64) { /* the buffer's content is unspecified: query again with room for all */
+    ids = malloc(sizeof *ids * (size_t)cnt);
+    if (!ids || fcm_aabb_tree_query(ti->tree, lo, hi, cnt, ids, &cnt) != FCM_OK) {
+      free(ids);
+      return -1;
+    }
+  }
   for (fcm_index k = 0; k < cnt; k++) {
     const fcm_index *c = ti->cells + (size_t)ti->stride * ids[k];
     const double m = tet_bary(ti->coords + 3 * c[0], ti->coords + 3 * c[1], ti->coords + 3 * c[2],
@@ -174,6 +180,7 @@ static fcm_index tet_locate(const tet_index *ti, const double x[3], double l[4])
       if (m >= -1e-10) break;
     }
   }
+  if (ids != buf) free(ids);
   return best;
 }
 
@@ -557,13 +564,20 @@ static fcm_status make_tet10(fcm_ctx *ctx, fcm_index nv, double *X, fcm_index nt
   return st;
 }
 
-static fcm_status direct_solve(fcm_ctx *ctx, fcm_csr *A, const double *b, double *u)
+/* CHOLMOD solve; rcond (may be NULL) gets the factor's crude reciprocal condition. */
+static fcm_status direct_solve(fcm_ctx *ctx, fcm_csr *A, const double *b, double *u,
+                               double *rcond)
 {
   fcm_direct *solver = NULL;
+  fcm_direct_info info;
   fcm_status st = fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, A, &solver);
   if (st == FCM_OK) st = fcm_direct_analyze(solver);
   if (st == FCM_OK) st = fcm_direct_factor(solver, fcm_csr_get_values(A));
   if (st == FCM_OK) st = fcm_direct_solve(solver, b, u);
+  if (st == FCM_OK && rcond) {
+    fcm_direct_get_info(solver, &info);
+    *rcond = info.rcond;
+  }
   fcm_direct_destroy(&solver);
   return st;
 }
@@ -622,7 +636,7 @@ static fcm_status reference_create(cv_study *S)
   S->ref_u = calloc((size_t)n, sizeof *S->ref_u);
   if (!S->ref_u) return FCM_ERR_ALLOC;
   st = assemble_system(S, S->ref_space, 0, NULL, &K, &f);
-  if (st == FCM_OK) st = direct_solve(ctx, K, f, S->ref_u);
+  if (st == FCM_OK) st = direct_solve(ctx, K, f, S->ref_u, NULL);
   fcm_csr_destroy(&K);
   free(f);
   if (st == FCM_OK)
@@ -845,6 +859,7 @@ fcm_status cv_run(cv_study *S, const fcm_mesh *mesh, const fcm_cell_rules *err_r
   fcm_csr *K = NULL;
   double *f = NULL, *u = NULL;
   unsigned char *keep = NULL;
+  double rcond = 1.0;
   const int strength = ro && ro->strength >= -1 ? ro->strength : S->s.strength;
   const int simplify = ro && ro->simplify >= 0 ? ro->simplify : S->s.simplify;
   fcm_index nc = fcm_mesh_num_cells(mesh);
@@ -908,7 +923,7 @@ fcm_status cv_run(cv_study *S, const fcm_mesh *mesh, const fcm_cell_rules *err_r
     goto done;
   }
   t0 = fcm_wtime();
-  st = direct_solve(ctx, K, f, u);
+  st = direct_solve(ctx, K, f, u, &rcond);
   r->t_solve = fcm_wtime() - t0;
   if (st == FCM_ERR_SINGULAR || st == FCM_ERR_NUMERIC) {
     r->failed = 1;
@@ -919,6 +934,8 @@ fcm_status cv_run(cv_study *S, const fcm_mesh *mesh, const fcm_cell_rules *err_r
   }
   if (st != FCM_OK) goto done;
   r->t_total = r->t_rules + r->t_assembly + r->t_solve;
+  if (rcond < 1e-15)
+    snprintf(r->note, sizeof r->note, "near-singular system (CHOLMOD rcond %.1e)", rcond);
   st = errors(S, space, err_rules, method, u, r);
   if (st == FCM_ERR_NOT_CONVERGED) {
     r->failed = 1;

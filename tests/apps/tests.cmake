@@ -29,3 +29,14 @@ fcm_add_test(app_condition tests/apps/condition_app.c LABELS app
 fcm_add_test(app_condition_claims tests/apps/condition_claims.c LABELS app TIMEOUT 1200
              ARGS $<TARGET_FILE:fcm-condition> ${PROJECT_BINARY_DIR}/app-tests)
 fcm_add_test(dense_spectrum tests/apps/dense_spectrum.c)
+# fcm-converge: --quick CSV/PNG format, consistency and error exits, payoff --quick; the
+# convergence rates of the manufactured problem (quick set in the default run, the full
+# assertion set - every element, FCM and staircase FEM - labelled slow)
+fcm_add_test(app_converge tests/apps/converge_app.c LABELS app TIMEOUT 900
+             ARGS $<TARGET_FILE:fcm-converge> ${PROJECT_BINARY_DIR}/app-tests)
+fcm_add_test(app_converge_rates tests/apps/converge_rates.c LABELS app TIMEOUT 900
+             ARGS quick $<TARGET_FILE:fcm-converge> ${PROJECT_BINARY_DIR}/app-tests)
+add_test(NAME app_converge_rates_full COMMAND app_converge_rates full $<TARGET_FILE:fcm-converge>
+         ${PROJECT_BINARY_DIR}/app-tests)
+set_tests_properties(app_converge_rates_full PROPERTIES LABELS "app;slow" TIMEOUT 7200
+                     ENVIRONMENT "OMP_NUM_THREADS=2")

@@ -1,0 +1,156 @@
+/* fcm-converge end to end: `--quick --rates-csv FILE` prints the rates table and writes the
+ * documented CSV files — the rates file holds element,method,norm,rate for every element x
+ * {fcm, fem} x {L2, H1} and equals a refit of the levels file; each level row is consistent
+ * (h = 1/res, t_total = sum of the phases, rel = err / norm, FCM errors measured over all
+ * of Omega, FEM over less); the sweep covers m = 2..5; the PNGs are PNGs (when gnuplot is
+ * installed) and no .tmp file is left. `payoff --quick` reports fewer points with
+ * simplification and one break-even figure. Bad options exit 2 and write nothing.
+ * Usage: app_converge PATH_TO_fcm-converge WORK_DIR */
+#define _POSIX_C_SOURCE 200809L
+#include "converge_csv.h"
+
+static cv_level levels[CV_MAX_ROWS];
+static cv_rate_row rates[CV_MAX_ROWS];
+
+static int is_png(const char *path)
+{
+  unsigned char sig[8] = {0};
+  FILE *f = fopen(path, "rb");
+  const int ok = f && fread(sig, 1, 8, f) == 8 && !memcmp(sig, "\x89PNG\r\n\x1a\n", 8);
+  if (f) fclose(f);
+  return ok;
+}
+
+int main(int argc, char **argv)
+{
+  if (argc != 3) return 2;
+  const char *prog = argv[1], *dir = argv[2];
+  static const char *const elements[4] = {"tet4", "tet10", "hex8", "hex20"};
+  static const char *const methods[2] = {"fcm", "fem"};
+  static const char *const files[] = {"-levels.csv", "-sweep.csv", "-convergence.png",
+                                      "-pareto.png", "-sweep.png"};
+  char cmd[8192], pre[1024], path[1200], rcsv[1024], out[1024];
+  snprintf(pre, sizeof pre, "%s/converge-quick", dir);
+  snprintf(rcsv, sizeof rcsv, "%s/converge-quick-myrates.csv", dir);
+  snprintf(out, sizeof out, "%s/converge-quick.out", dir);
+  for (size_t k = 0; k < sizeof files / sizeof *files; k++) {
+    snprintf(path, sizeof path, "%s%s", pre, files[k]);
+    remove(path);
+  }
+  remove(rcsv);
+
+  snprintf(cmd, sizeof cmd,
+           "OMP_WAIT_POLICY=passive '%s' --quick --rates-csv '%s' --out '%s' > '%s' 2> /dev/null",
+           prog, rcsv, pre, out);
+  TEST_TRUE(cv_run_cmd(cmd) == 0);
+  snprintf(cmd, sizeof cmd, "grep -q '^fitted rates' '%s' && grep -q '^accuracy versus time' '%s'",
+           out, out);
+  TEST_TRUE(cv_run_cmd(cmd) == 0);
+
+  /* rates: 4 elements x 2 methods x 2 norms, once each, finite */
+  const int nr = cv_read_rates(rcsv, rates, CV_MAX_ROWS);
+  TEST_TRUE(nr == 16);
+  snprintf(path, sizeof path, "%s-levels.csv", pre);
+  const int n = cv_read_levels(path, levels, CV_MAX_ROWS);
+  TEST_TRUE(n == 4 * 2 * 3);
+  for (int e = 0; e < 4; e++)
+    for (int m = 0; m < 2; m++) {
+      const cv_level *lv[16];
+      const int cnt = cv_select(levels, n, elements[e], methods[m], lv, 16);
+      TEST_TRUE(cnt == 3);
+      for (int k = 0; k < cnt; k++) {
+        const cv_level *r = lv[k];
+        TEST_TRUE(r->res == 2 + k && r->failed == 0 && r->dofs > 0 && r->points > 0);
+        TEST_NEAR(r->h, 1.0 / r->res, 1e-14, 0.0);
+        TEST_NEAR(r->t_total, r->t_rules + r->t_assembly + r->t_solve, 0.0, 5e-6);
+        TEST_NEAR(r->rel_l2, r->err_l2 / r->norm_l2, 1e-5, 0.0);
+        TEST_NEAR(r->rel_h1, r->err_h1 / r->norm_h1, 1e-5, 0.0);
+        TEST_TRUE(r->err_l2 > 0.0 && r->err_h1 > 0.0 && r->domain > 0.0);
+        if (m == 0) {
+          TEST_NEAR(r->measured, r->domain, 1e-9, 0.0);
+          TEST_TRUE(r->cut > 0 && r->cut <= r->cells);
+        } else {
+          TEST_TRUE(r->measured < r->domain && r->measured > 0.5 * r->domain && r->cut == 0);
+        }
+      }
+      for (int norm = 0; norm < 2; norm++) {
+        const cv_rate_row *rr = cv_find_rate(rates, nr, elements[e], methods[m], norm ? "H1" : "L2");
+        TEST_TRUE(rr != NULL);
+        if (rr && cnt == 3) TEST_NEAR(rr->rate, cv_refit(lv, cnt, 3, norm), 1e-4, 1e-5);
+      }
+    }
+
+  /* sweep: Hex20 FCM at res 2, m = 2..5 */
+  snprintf(path, sizeof path, "%s-sweep.csv", pre);
+  FILE *f = fopen(path, "r");
+  char line[2048];
+  int rows = 0;
+  TEST_TRUE(f && fgets(line, sizeof line, f) &&
+            !strcmp(line, "element,method,res,h,strength,points,dofs,t_rules,t_assembly,t_solve,"
+                          "t_total,err_l2,err_h1,rel_l2,rel_h1,failed,note\n"));
+  while (f && fgets(line, sizeof line, f)) {
+    char el[16], me[8];
+    int res = 0, m = 0;
+    TEST_TRUE(sscanf(line, "%15[^,],%7[^,],%d,%*[^,],%d,", el, me, &res, &m) == 4);
+    TEST_TRUE(!strcmp(el, "hex20") && !strcmp(me, "fcm") && res == 2 && m == 2 + rows);
+    rows++;
+  }
+  if (f) fclose(f);
+  TEST_TRUE(rows == 4);
+
+  /* plots and atomic writes */
+  const int gnuplot = cv_run_cmd("gnuplot --version > /dev/null 2>&1") == 0;
+  for (size_t k = 0; k < sizeof files / sizeof *files; k++) {
+    snprintf(path, sizeof path, "%s%s", pre, files[k]);
+    if (strstr(files[k], ".png")) TEST_TRUE(!gnuplot || is_png(path));
+    snprintf(path, sizeof path, "%s%s.tmp", pre, files[k]);
+    TEST_TRUE(!cv_exists(path));
+  }
+
+  /* payoff: fewer points with simplification, the same break-even on both rows */
+  snprintf(path, sizeof path, "%s/converge-payoff.csv", dir);
+  remove(path);
+  snprintf(cmd, sizeof cmd, "OMP_WAIT_POLICY=passive '%s' payoff --quick --csv '%s' > '%s' 2> /dev/null",
+           prog, path, out);
+  TEST_TRUE(cv_run_cmd(cmd) == 0);
+  f = fopen(path, "r");
+  TEST_TRUE(f && fgets(line, sizeof line, f) &&
+            !strcmp(line, "element,res,simplified,points_cut,points_total,t_rules,t_simplify,"
+                          "t_assembly,t_factor_solve,t_iteration,break_even_iterations\n"));
+  long long pts[2] = {0, 0};
+  double be[2] = {0, 0}, titer[2] = {0, 0};
+  rows = 0;
+  while (f && rows < 2 && fgets(line, sizeof line, f)) {
+    int res = 0, simp = -1;
+    TEST_TRUE(sscanf(line, "hex20,%d,%d,%lld,%*d,%*f,%*f,%*f,%*f,%lf,%lf", &res, &simp,
+                     &pts[rows], &titer[rows], &be[rows]) == 5);
+    TEST_TRUE(res == 4 && simp == rows && titer[rows] > 0.0);
+    rows++;
+  }
+  if (f) fclose(f);
+  TEST_TRUE(rows == 2 && pts[1] > 0 && pts[1] < pts[0]);
+  TEST_TRUE(be[0] == be[1]);
+  snprintf(cmd, sizeof cmd, "grep -q '^break-even' '%s'", out);
+  TEST_TRUE(cv_run_cmd(cmd) == 0);
+
+  /* usage errors: status 2, nothing written */
+  static const char *const bad[] = {"--levels 0",          "--levels 2,2",        "--elements tet5",
+                                    "--methods xfem",      "--simplify maybe",    "--radius 1.5",
+                                    "--fem-traction none", "--strength 0",        "--bogus 1",
+                                    "--fit 1",             "payoff --elements hex8", "--levels"};
+  snprintf(path, sizeof path, "%s/converge-bad-levels.csv", dir);
+  for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
+    remove(path);
+    if (!strncmp(bad[k], "payoff", 6))
+      snprintf(cmd, sizeof cmd, "'%s' %s > /dev/null 2>&1", prog, bad[k]);
+    else
+      snprintf(cmd, sizeof cmd, "'%s' --quick --csv '%s' %s > /dev/null 2>&1", prog, path, bad[k]);
+    const int rc = cv_run_cmd(cmd);
+    if (rc != 2) fprintf(stderr, "'%s' exited with %d\n", bad[k], rc);
+    TEST_TRUE(rc == 2);
+    TEST_TRUE(!cv_exists(path));
+  }
+  snprintf(cmd, sizeof cmd, "'%s' --help | grep -q 'element,method,norm,rate'", prog);
+  TEST_TRUE(cv_run_cmd(cmd) == 0);
+  return TEST_RESULT();
+}
