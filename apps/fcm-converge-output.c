@@ -67,15 +67,15 @@ int cv_rates_compute(const cv_result *res, int nres, int fit, cv_rate *rates)
 
 void cv_print_levels(FILE *f, const cv_result *res, int nres)
 {
-  fprintf(f, "\n%-5s %-4s %4s %7s %8s %7s %6s %9s %3s %8s %8s %8s %8s %9s %9s %6s\n", "elem",
+  fprintf(f, "\n%-5s %-4s %4s %7s %8s %7s %6s %9s %3s %8s %8s %8s %8s %8s %9s %9s %6s\n", "elem",
           "meth", "res", "h", "dofs", "cells", "cut", "points", "m", "t_rules", "t_asm", "t_solve",
-          "t_total", "rel_L2", "rel_H1", "meas");
+          "t_total", "cpu_tot", "rel_L2", "rel_H1", "meas");
   for (int k = 0; k < nres; k++) {
     const cv_result *r = &res[k];
-    fprintf(f, "%-5s %-4s %4d %7.4f %8lld %7lld %6lld %9lld %3d %8.3f %8.3f %8.3f %8.3f %9.3e %9.3e %6.4f%s%s\n",
+    fprintf(f, "%-5s %-4s %4d %7.4f %8lld %7lld %6lld %9lld %3d %8.3f %8.3f %8.3f %8.3f %8.3f %9.3e %9.3e %6.4f%s%s\n",
             ename(r->element), cv_method_name(r->method), r->res, r->h, (long long)r->dofs,
             (long long)r->active_cells, (long long)r->cut_cells, (long long)r->points, r->strength,
-            r->t_rules, r->t_assembly, r->t_solve, r->t_total, rel(r->err_l2, r->norm_l2),
+            r->t_rules, r->t_assembly, r->t_solve, r->t_total, r->c_total, rel(r->err_l2, r->norm_l2),
             rel(r->err_h1, r->norm_h1),
             r->domain_volume > 0 ? r->measured_volume / r->domain_volume : 0.0,
             r->failed ? "  FAILED: " : r->note[0] ? "  " : "", r->note);
@@ -95,12 +95,13 @@ void cv_print_rates(FILE *f, const cv_rate *rates, int nrates)
 }
 
 /* Cheapest run (total time) reaching each relative L2 target, per element x method. */
-void cv_print_pareto(FILE *f, const cv_result *res, int nres)
+void cv_print_pareto(FILE *f, const cv_result *res, int nres, int cpu)
 {
   static const double targets[] = {3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5};
   const int nt = (int)(sizeof targets / sizeof *targets);
-  fprintf(f, "\naccuracy versus time: least total time [s] (rules + assembly + solve) of a run\n"
-             "reaching the relative L2 error in the column head ('-': none reached it)\n");
+  fprintf(f, "\naccuracy versus time: least total %s time [s] (rules + assembly + solve) of a "
+             "run\nreaching the relative L2 error in the column head ('-': none reached it)\n",
+          cpu ? "CPU" : "wall-clock");
   fprintf(f, "%-5s %-4s", "elem", "meth");
   for (int t = 0; t < nt; t++) fprintf(f, " %8.0e", targets[t]);
   fprintf(f, "\n");
@@ -115,7 +116,8 @@ void cv_print_pareto(FILE *f, const cv_result *res, int nres)
         for (int k = 0; k < nres; k++) {
           const cv_result *r = &res[k];
           if ((int)r->element != e || (int)r->method != m || r->failed) continue;
-          if (rel(r->err_l2, r->norm_l2) <= targets[t]) best = fmin(best, r->t_total);
+          if (rel(r->err_l2, r->norm_l2) <= targets[t])
+            best = fmin(best, cpu ? r->c_total : r->t_total);
         }
         if (isfinite(best))
           fprintf(f, " %8.3f", best);
@@ -131,12 +133,12 @@ void cv_print_sweep(FILE *f, const cv_result *res, int nres)
   if (nres == 0) return;
   fprintf(f, "\nquadrature strength sweep: %s FCM, res %d (h = %.4f), cut-cell stiffness strength m\n",
           ename(res[0].element), res[0].res, res[0].h);
-  fprintf(f, "%3s %9s %8s %8s %8s %8s %9s %9s\n", "m", "points", "t_rules", "t_asm", "t_solve",
-          "t_total", "rel_L2", "rel_H1");
+  fprintf(f, "%3s %9s %8s %8s %8s %8s %8s %9s %9s\n", "m", "points", "t_rules", "t_asm",
+          "t_solve", "t_total", "cpu_tot", "rel_L2", "rel_H1");
   for (int k = 0; k < nres; k++) {
     const cv_result *r = &res[k];
-    fprintf(f, "%3d %9lld %8.3f %8.3f %8.3f %8.3f %9.3e %9.3e%s%s\n", r->strength,
-            (long long)r->points, r->t_rules, r->t_assembly, r->t_solve, r->t_total,
+    fprintf(f, "%3d %9lld %8.3f %8.3f %8.3f %8.3f %8.3f %9.3e %9.3e%s%s\n", r->strength,
+            (long long)r->points, r->t_rules, r->t_assembly, r->t_solve, r->t_total, r->c_total,
             rel(r->err_l2, r->norm_l2), rel(r->err_h1, r->norm_h1),
             r->failed ? "  FAILED: " : r->note[0] ? "  " : "", r->note);
   }
@@ -178,7 +180,8 @@ int cv_write_levels_csv(const char *path, const cv_result *res, int nres)
   if (!f) return 0;
   fprintf(f, "element,method,res,h,dofs,active_cells,cut_cells,points,strength,t_rules,"
              "t_assembly,t_solve,t_total,err_l2,err_h1,norm_l2,norm_h1,rel_l2,rel_h1,"
-             "measured_volume,domain_volume,failed,note\n");
+             "measured_volume,domain_volume,failed,note,cpu_rules,cpu_assembly,cpu_solve,"
+             "cpu_total\n");
   for (int k = 0; k < nres; k++) {
     const cv_result *r = &res[k];
     fprintf(f, "%s,%s,%d,%.17g,%lld,%lld,%lld,%lld,%d,%.6f,%.6f,%.6f,%.6f,%.10e,%.10e,%.10e,"
@@ -189,7 +192,7 @@ int cv_write_levels_csv(const char *path, const cv_result *res, int nres)
             r->norm_h1, rel(r->err_l2, r->norm_l2), rel(r->err_h1, r->norm_h1),
             r->measured_volume, r->domain_volume, r->failed);
     csv_note(f, r->note);
-    fputc('\n', f);
+    fprintf(f, ",%.6f,%.6f,%.6f,%.6f\n", r->c_rules, r->c_assembly, r->c_solve, r->c_total);
   }
   return close_rename(f, tmp, path);
 }
@@ -212,7 +215,7 @@ int cv_write_sweep_csv(const char *path, const cv_result *res, int nres)
   FILE *f = open_tmp(path, tmp, sizeof tmp);
   if (!f) return 0;
   fprintf(f, "element,method,res,h,strength,points,dofs,t_rules,t_assembly,t_solve,t_total,"
-             "err_l2,err_h1,rel_l2,rel_h1,failed,note\n");
+             "err_l2,err_h1,rel_l2,rel_h1,failed,note,cpu_rules,cpu_assembly,cpu_solve,cpu_total\n");
   for (int k = 0; k < nres; k++) {
     const cv_result *r = &res[k];
     fprintf(f, "%s,%s,%d,%.17g,%d,%lld,%lld,%.6f,%.6f,%.6f,%.6f,%.10e,%.10e,%.6e,%.6e,%d,",
@@ -221,7 +224,7 @@ int cv_write_sweep_csv(const char *path, const cv_result *res, int nres)
             r->t_total, r->err_l2, r->err_h1, rel(r->err_l2, r->norm_l2),
             rel(r->err_h1, r->norm_h1), r->failed);
     csv_note(f, r->note);
-    fputc('\n', f);
+    fprintf(f, ",%.6f,%.6f,%.6f,%.6f\n", r->c_rules, r->c_assembly, r->c_solve, r->c_total);
   }
   return close_rename(f, tmp, path);
 }
@@ -289,8 +292,10 @@ static int script_run(FILE *f, const char *script, const char *tmp, const char *
 }
 
 /* Datablock $D<e><m> per (element, method) with columns
- * h dofs t_total rel_l2 rel_h1 err_l2 err_h1, coarse to fine; returns the blocks written. */
-static int write_blocks(FILE *f, const cv_result *res, int nres, int have[FCM_ELEMENT_COUNT][2])
+ * h dofs time rel_l2 rel_h1 err_l2 err_h1 (time: total wall or CPU seconds), coarse to
+ * fine; returns the blocks written. */
+static int write_blocks(FILE *f, const cv_result *res, int nres, int cpu,
+                        int have[FCM_ELEMENT_COUNT][2])
 {
   int nb = 0;
   for (int e = 0; e < FCM_ELEMENT_COUNT; e++)
@@ -302,7 +307,8 @@ static int write_blocks(FILE *f, const cv_result *res, int nres, int have[FCM_EL
         if (!have[e][m]) fprintf(f, "$D%d%d << EOD\n", e, m);
         have[e][m] = 1;
         fprintf(f, "%.10e %lld %.6e %.6e %.6e %.6e %.6e\n", r->h, (long long)r->dofs,
-                fmax(r->t_total, 1e-4), rel(r->err_l2, r->norm_l2), rel(r->err_h1, r->norm_h1),
+                fmax(cpu ? r->c_total : r->t_total, 1e-4), rel(r->err_l2, r->norm_l2),
+                rel(r->err_h1, r->norm_h1),
                 r->err_l2, r->err_h1);
       }
       if (have[e][m]) fprintf(f, "EOD\n"), nb++;
@@ -345,7 +351,7 @@ int cv_plot_convergence(const char *path, const cv_result *res, int nres, const 
   if (!cv_have_gnuplot()) return 1;
   FILE *f = script_open(path, script, tmp, sizeof tmp);
   if (!f) return 0;
-  write_blocks(f, res, nres, have);
+  write_blocks(f, res, nres, 0, have);
   script_terminal(f, 1400, 620, tmp);
   fprintf(f, "set logscale xy\nset grid\nset key bottom right font ',9'\n"
              "set format y '%%.0e'\nset xlabel 'h'\n");
@@ -358,24 +364,24 @@ int cv_plot_convergence(const char *path, const cv_result *res, int nres, const 
   return script_run(f, script, tmp, path);
 }
 
-int cv_plot_pareto(const char *path, const cv_result *res, int nres, const char *title)
+int cv_plot_pareto(const char *path, const cv_result *res, int nres, int cpu, const char *title)
 {
   char script[4096], tmp[4096];
   int have[FCM_ELEMENT_COUNT][2];
   if (!cv_have_gnuplot()) return 1;
   FILE *f = script_open(path, script, tmp, sizeof tmp);
   if (!f) return 0;
-  write_blocks(f, res, nres, have);
+  write_blocks(f, res, nres, cpu, have);
   script_terminal(f, 1400, 1100, tmp);
   fprintf(f, "set logscale xy\nset grid\nset key top right font ',9'\nset format y '%%.0e'\n");
   fprintf(f, "set multiplot layout 2,2 title '%s'\n", title);
-  fprintf(f, "set title 'L2 error vs total time'\nset xlabel 'rules + assembly + solve [s]'\n"
-             "set ylabel 'relative L2 error'\n");
+  fprintf(f, "set title 'L2 error vs total %s time'\nset xlabel 'rules + assembly + solve [s]'\n"
+             "set ylabel 'relative L2 error'\n", cpu ? "CPU" : "wall-clock");
   plot_series(f, have, "3", "4", NULL, 0, 0);
   fprintf(f, "set title 'L2 error vs DOFs'\nset xlabel 'DOFs'\n");
   plot_series(f, have, "2", "4", NULL, 0, 0);
-  fprintf(f, "set title 'H1 error vs total time'\nset xlabel 'rules + assembly + solve [s]'\n"
-             "set ylabel 'relative H1 seminorm error'\n");
+  fprintf(f, "set title 'H1 error vs total %s time'\nset xlabel 'rules + assembly + solve [s]'\n"
+             "set ylabel 'relative H1 seminorm error'\n", cpu ? "CPU" : "wall-clock");
   plot_series(f, have, "3", "5", NULL, 0, 0);
   fprintf(f, "set title 'H1 error vs DOFs'\nset xlabel 'DOFs'\n");
   plot_series(f, have, "2", "5", NULL, 0, 0);

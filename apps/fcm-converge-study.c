@@ -16,6 +16,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 /* ---------------------------------------------------------------- manufactured field */
 
@@ -718,6 +719,26 @@ void cv_study_destroy(cv_study **study)
 
 /* ---------------------------------------------------------------- one run */
 
+/* Wall-clock and process CPU seconds (all threads) at one instant. */
+typedef struct stamp {
+  double wall, cpu;
+} stamp;
+
+static stamp stamp_now(void)
+{
+  stamp t = {fcm_wtime(), (double)clock() / CLOCKS_PER_SEC};
+  return t;
+}
+
+/* Seconds since t0 into *wall and *cpu; returns the current stamp. */
+static stamp stamp_lap(stamp t0, double *wall, double *cpu)
+{
+  const stamp t = stamp_now();
+  *wall = t.wall - t0.wall;
+  *cpu = t.cpu - t0.cpu;
+  return t;
+}
+
 fcm_status cv_error_rules_create(cv_study *S, const fcm_mesh *mesh, fcm_cell_rules **rules)
 {
   fcm_cell_rules_options o = fcm_cell_rules_options_default();
@@ -868,7 +889,7 @@ fcm_status cv_run(cv_study *S, const fcm_mesh *mesh, const fcm_cell_rules *err_r
   r->method = method;
   r->failed = 0;
   r->note[0] = '\0';
-  double t0 = fcm_wtime();
+  stamp t0 = stamp_now();
   if (method == CV_FCM) {
     fcm_cell_rules_options o = fcm_cell_rules_options_default();
     o.strength[FCM_RULE_STIFFNESS] = strength;
@@ -883,12 +904,11 @@ fcm_status cv_run(cv_study *S, const fcm_mesh *mesh, const fcm_cell_rules *err_r
       o.stabilization.mode = FCM_STABILIZATION_OFF;
     st = fcm_cell_rules_create(ctx, mesh, S->geom, &o, &rules);
     if (st != FCM_OK) goto done;
-    r->t_rules = fcm_wtime() - t0;
+    t0 = stamp_lap(t0, &r->t_rules, &r->c_rules);
     const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(rules);
     r->cut_cells = rs->num_cut;
     r->points = rs->points_total[FCM_RULE_STIFFNESS];
     r->strength = fcm_cell_rules_strength(rules, FCM_RULE_STIFFNESS);
-    t0 = fcm_wtime();
     st = fcm_space_create_embedded(ctx, mesh, rules, &space);
     if (st == FCM_OK) st = assemble_system(S, space, 1, NULL, &K, &f);
   } else {
@@ -900,7 +920,7 @@ fcm_status cv_run(cv_study *S, const fcm_mesh *mesh, const fcm_cell_rules *err_r
     }
     st = staircase_cells(S, mesh, keep, &nkeep);
     if (st != FCM_OK) goto done;
-    r->t_rules = fcm_wtime() - t0;
+    t0 = stamp_lap(t0, &r->t_rules, &r->c_rules);
     fcm_rule *std_rule = NULL;
     st = fcm_element_standard_rule(ctx, info->type, FCM_INTEGRAND_STIFFNESS, 0, &std_rule);
     if (st != FCM_OK) goto done;
@@ -908,12 +928,12 @@ fcm_status cv_run(cv_study *S, const fcm_mesh *mesh, const fcm_cell_rules *err_r
     r->strength = fcm_rule_strength(std_rule);
     fcm_rule_destroy(&std_rule);
     r->cut_cells = 0;
-    t0 = fcm_wtime();
+    t0 = stamp_now();
     st = fcm_space_create(ctx, mesh, keep, &space);
     if (st == FCM_OK) st = assemble_system(S, space, 0, keep, &K, &f);
   }
   if (st != FCM_OK) goto done;
-  r->t_assembly = fcm_wtime() - t0;
+  stamp_lap(t0, &r->t_assembly, &r->c_assembly);
   r->dofs = fcm_space_num_dofs(space);
   r->active_cells = 0;
   for (fcm_index c = 0; c < nc; c++) r->active_cells += fcm_space_cell_active(space, c);
@@ -922,9 +942,9 @@ fcm_status cv_run(cv_study *S, const fcm_mesh *mesh, const fcm_cell_rules *err_r
     st = FCM_ERR_ALLOC;
     goto done;
   }
-  t0 = fcm_wtime();
+  t0 = stamp_now();
   st = direct_solve(ctx, K, f, u, &rcond);
-  r->t_solve = fcm_wtime() - t0;
+  stamp_lap(t0, &r->t_solve, &r->c_solve);
   if (st == FCM_ERR_SINGULAR || st == FCM_ERR_NUMERIC) {
     r->failed = 1;
     snprintf(r->note, sizeof r->note, "solve failed: %s", fcm_ctx_error_message(ctx));
@@ -934,6 +954,7 @@ fcm_status cv_run(cv_study *S, const fcm_mesh *mesh, const fcm_cell_rules *err_r
   }
   if (st != FCM_OK) goto done;
   r->t_total = r->t_rules + r->t_assembly + r->t_solve;
+  r->c_total = r->c_rules + r->c_assembly + r->c_solve;
   if (rcond < 1e-15)
     snprintf(r->note, sizeof r->note, "near-singular system (CHOLMOD rcond %.1e)", rcond);
   st = errors(S, space, err_rules, method, u, r);

@@ -66,6 +66,7 @@ typedef struct cv_result {
   double t_assembly;    /* space, pattern, stiffness, loads, Dirichlet elimination */
   double t_solve;       /* CHOLMOD analyze + factor + solve */
   double t_total;       /* sum of the three */
+  double c_rules, c_assembly, c_solve, c_total; /* the same in process CPU seconds */
   double err_l2, err_h1;       /* ||u_h - u||_L2, |u_h - u|_H1 over the measured domain */
   double norm_l2, norm_h1;     /* ||u||_L2, |u|_H1 over the same domain */
   double measured_volume;      /* volume the errors were integrated over */
@@ -135,7 +136,8 @@ const char *cv_method_name(cv_method m);
 /** Tables on stdout: levels, rates, accuracy versus time. */
 void cv_print_levels(FILE *f, const cv_result *res, int nres);
 void cv_print_rates(FILE *f, const cv_rate *rates, int nrates);
-void cv_print_pareto(FILE *f, const cv_result *res, int nres);
+/** cpu: 1 ranks by process CPU seconds, 0 by wall-clock seconds. */
+void cv_print_pareto(FILE *f, const cv_result *res, int nres, int cpu);
 /** The m-sweep table. */
 void cv_print_sweep(FILE *f, const cv_result *res, int nres);
 
@@ -150,7 +152,7 @@ int cv_have_gnuplot(void);
 /** PNG plots through gnuplot, atomically; return 1 on success. */
 int cv_plot_convergence(const char *path, const cv_result *res, int nres, const cv_rate *rates,
                         int nrates, const char *title);
-int cv_plot_pareto(const char *path, const cv_result *res, int nres, const char *title);
+int cv_plot_pareto(const char *path, const cv_result *res, int nres, int cpu, const char *title);
 int cv_plot_sweep(const char *path, const cv_result *res, int nres, const char *title);
 
 #endif /* FCM_CONVERGE_STUDY_H */

@@ -16,6 +16,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #define MAX_LEVELS 32
 #define MAX_SWEEP 24
@@ -38,6 +39,7 @@ typedef struct config {
   const char *out;
   const char *csv, *rates_csv, *sweep_csv;
   int plots;
+  int cpu_time; /* accuracy-vs-time table and plot on CPU seconds */
   /* payoff */
   int payoff;
   fcm_element_type payoff_element;
@@ -70,7 +72,7 @@ static void usage(FILE *f)
           "study options:\n"
           "  --elements LIST        tet4,tet10,hex8,hex20                     (default all)\n"
           "  --methods LIST         fcm,fem                                   (default both)\n"
-          "  --levels LIST          resolutions res, h = 1/res     (default 2,3,4,6,8)  \n"
+          "  --levels LIST          resolutions res, h = 1/res     (default 2,3,4,6,8)\n"
           "  --quick                levels 2,3,4, geometry n 6, sweep res 2 with m = 2..5\n"
           "  --reference            the authors' problem: E = 5e4, nu = 0, load -5e5 y\n"
           "                         exp(-1/(1-9r^2)) e_y (3r < 1), u = 0 on y = 0, traction free;\n"
@@ -103,6 +105,9 @@ static void usage(FILE *f)
           "  --sweep-res R          resolution of the sweep                   (default 4)\n"
           "  --sweep-strengths LIST strengths m                               (default 1..8)\n"
           "  --no-sweep             skip the strength sweep\n"
+          "  --time wall|cpu        time base of the accuracy-vs-time table and plot (default\n"
+          "                         wall; cpu = process CPU seconds of all threads, steadier\n"
+          "                         on a shared machine)\n"
           "  --out PREFIX           output prefix                             (default fcm-converge)\n"
           "  --csv FILE             per-level CSV            (default PREFIX-levels.csv)\n"
           "  --rates-csv FILE       fitted rates CSV         (default PREFIX-rates.csv)\n"
@@ -122,17 +127,21 @@ static void usage(FILE *f)
           "\n"
           "CSV columns. levels: element,method,res,h,dofs,active_cells,cut_cells,points,\n"
           "  strength,t_rules,t_assembly,t_solve,t_total,err_l2,err_h1,norm_l2,norm_h1,rel_l2,\n"
-          "  rel_h1,measured_volume,domain_volume,failed,note. points: stiffness quadrature\n"
+          "  rel_h1,measured_volume,domain_volume,failed,note,cpu_rules,cpu_assembly,cpu_solve,\n"
+          "  cpu_total (cpu_*: process CPU seconds of the phases). points: stiffness quadrature\n"
           "  points of all stored cells (FCM) or kept cells x standard rule (FEM); strength: the\n"
-          "  FCM cut-cell strength or the FEM full-cell rule's; t_rules: FCM cell rules or the FEM\n"
-          "  centroid classification; t_assembly: space, pattern, stiffness, loads, Dirichlet\n"
+          "  FCM cut-cell strength or the FEM full-cell rule's; t_rules: FCM cell rules (stiffness\n"
+          "  rules of the cut-cell strength, surface rules, mass rules of strength 0 - a static\n"
+          "  problem assembles no mass) or the FEM centroid classification; t_assembly: space,\n"
+          "  pattern, stiffness, loads, Dirichlet\n"
           "  elimination; t_solve: CHOLMOD analyze+factor+solve; times are wall-clock seconds;\n"
           "  err_*: absolute errors, norm_*: the exact (reference) norms over the same domain.\n"
           "  rates: element,method,norm,rate (method fcm|fem, norm L2|H1).\n"
           "  sweep: element,method,res,h,strength,points,dofs,t_rules,t_assembly,t_solve,t_total,\n"
-          "  err_l2,err_h1,rel_l2,rel_h1,failed,note.\n"
+          "  err_l2,err_h1,rel_l2,rel_h1,failed,note,cpu_rules,cpu_assembly,cpu_solve,cpu_total.\n"
           "  payoff: element,res,simplified,points_cut,points_total,t_rules,t_simplify,\n"
-          "  t_assembly,t_factor_solve,t_iteration,break_even_iterations.\n"
+          "  t_assembly,t_factor_solve,t_iteration,break_even_iterations,cpu_rules,cpu_iteration,\n"
+          "  break_even_cpu.\n"
           "Timings are wall-clock with the OpenMP threads of the environment; on a loaded machine\n"
           "set OMP_WAIT_POLICY=passive (spinning threads inflate small phases).\n"
           "stdout: tables; stderr: progress. Exit 0 on success, 1 on a computation or output\n"
@@ -371,7 +380,14 @@ static int parse_args(int argc, char **argv, config *c)
     else if (!strcmp(a, "--sweep-strengths") && !c->payoff)
       ok = parse_int_list(a, v, 1, 20, c->sweep_strengths, MAX_SWEEP, &c->num_sweep),
       sweep_given = 1;
-    else if (!strcmp(a, "--out") && !c->payoff)
+    else if (!strcmp(a, "--time") && !c->payoff) {
+      if (!strcmp(v, "wall") || !strcmp(v, "cpu"))
+        c->cpu_time = !strcmp(v, "cpu");
+      else {
+        fprintf(stderr, CV_PROG ": --time: expected wall or cpu, got '%s'\n", v);
+        ok = 0;
+      }
+    } else if (!strcmp(a, "--out") && !c->payoff)
       c->out = v;
     else if (!strcmp(a, "--csv"))
       c->payoff ? (void)(c->payoff_csv = v) : (void)(c->csv = v);
@@ -528,7 +544,7 @@ static int run_study(const config *c, fcm_ctx *ctx)
   }
   cv_print_levels(stdout, res, nres);
   cv_print_rates(stdout, rates, nrates);
-  cv_print_pareto(stdout, res, nres);
+  cv_print_pareto(stdout, res, nres, c->cpu_time);
   if (c->sweep) cv_print_sweep(stdout, sw, nsw);
   fflush(stdout);
 
@@ -561,7 +577,7 @@ static int run_study(const config *c, fcm_ctx *ctx)
       fprintf(stderr, CV_PROG ": wrote %s\n", path);
     snprintf(title, sizeof title, "accuracy versus time and DOFs (%s)", what);
     if (!output_path(path, sizeof path, NULL, c->out, "-pareto.png") ||
-        !cv_plot_pareto(path, res, nres, title))
+        !cv_plot_pareto(path, res, nres, c->cpu_time, title))
       rc = 1;
     else
       fprintf(stderr, CV_PROG ": wrote %s\n", path);
@@ -594,6 +610,7 @@ typedef struct payoff_result {
   int simplified;
   fcm_index points_cut, points_total, points_stab;
   double t_rules, t_simplify, t_assembly, t_factor_solve, t_iteration;
+  double c_rules, c_iteration; /* process CPU seconds */
 } payoff_result;
 
 static int cmp_double(const void *a, const void *b)
@@ -615,16 +632,17 @@ static fcm_status payoff_variant(fcm_ctx *ctx, const config *c, const fcm_mesh *
   fcm_direct *chol = NULL;
   double *u = NULL, *g = NULL, *du = NULL, *zero = NULL;
   fcm_index *con = NULL, ncon = 0, cnt = 0, *nodes = NULL;
-  double ta[100], tf[100], ti[100];
+  double ta[100], tf[100], ti[100], ci[100];
   fcm_cell_rules_options o = fcm_cell_rules_options_default();
   o.strength[FCM_RULE_STIFFNESS] = c->setup.strength;
   o.strength[FCM_RULE_MASS] = 0; /* the Newton iteration timed here uses no mass */
   o.simplify = simplify;
-  double t0 = fcm_wtime();
+  double t0 = fcm_wtime(), c0 = (double)clock() / CLOCKS_PER_SEC;
   st = fcm_cell_rules_create(ctx, mesh, geom, &o, &rules);
   if (st != FCM_OK) return st;
   p->simplified = simplify;
   p->t_rules = fcm_wtime() - t0;
+  p->c_rules = (double)clock() / CLOCKS_PER_SEC - c0;
   const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(rules);
   p->points_cut = rs->points_simplified[FCM_RULE_STIFFNESS];
   p->points_stab = rs->points_stabilization[FCM_RULE_STIFFNESS];
@@ -665,6 +683,7 @@ static fcm_status payoff_variant(fcm_ctx *ctx, const config *c, const fcm_mesh *
   if (st == FCM_OK) st = fcm_direct_analyze(chol);
   for (int r = 0; r < c->repeat && st == FCM_OK; r++) {
     t0 = fcm_wtime();
+    c0 = (double)clock() / CLOCKS_PER_SEC;
     fcm_csr_set_zero(A);
     memset(g, 0, sizeof *g * (size_t)n);
     st = fcm_assemble_hyperelastic(space, &mp, u, NULL, NULL, g, A);
@@ -674,12 +693,15 @@ static fcm_status payoff_variant(fcm_ctx *ctx, const config *c, const fcm_mesh *
     if (st == FCM_OK) st = fcm_direct_solve(chol, g, du);
     const double t2 = fcm_wtime();
     ta[r] = t1 - t0, tf[r] = t2 - t1, ti[r] = t2 - t0;
+    ci[r] = (double)clock() / CLOCKS_PER_SEC - c0;
   }
   if (st == FCM_OK) {
     qsort(ta, (size_t)c->repeat, sizeof *ta, cmp_double);
     qsort(tf, (size_t)c->repeat, sizeof *tf, cmp_double);
     qsort(ti, (size_t)c->repeat, sizeof *ti, cmp_double);
+    qsort(ci, (size_t)c->repeat, sizeof *ci, cmp_double);
     p->t_assembly = ta[0], p->t_factor_solve = tf[0], p->t_iteration = ti[0];
+    p->c_iteration = ci[0];
     fprintf(stderr, CV_PROG ": payoff: %lld DOFs; Newton iteration %.3f s (assembly %.3f s, "
                     "factor + solve %.3f s), fastest of %d\n",
             (long long)n, p->t_iteration, p->t_assembly, p->t_factor_solve, c->repeat);
@@ -718,18 +740,23 @@ static int run_payoff(const config *c, fcm_ctx *ctx)
   const double gain = p[0].t_iteration - p[1].t_iteration;
   const double cost = p[1].t_rules - p[0].t_rules;
   const double be = gain > 0.0 ? cost / gain : INFINITY;
+  const double cgain = p[0].c_iteration - p[1].c_iteration, ccost = p[1].c_rules - p[0].c_rules;
+  const double cbe = cgain > 0.0 ? ccost / cgain : INFINITY;
   printf("\nsimplification payoff: %s FCM, res %d (h = %.4f), stiffness strength %d, hemisphere "
          "%lld tets\n",
          fcm_element_get_info(c->payoff_element)->name, c->payoff_res, 1.0 / c->payoff_res,
          c->setup.strength > 0 ? c->setup.strength
                                : fcm_element_get_info(c->payoff_element)->stiffness_strength,
          (long long)fcm_geometry_num_cells(geom));
-  printf("%-12s %12s %12s %9s %9s %9s %9s %9s\n", "rules", "cut points", "all points", "t_rules",
-         "t_simpl", "t_asm", "t_fac+sol", "t_iter");
+  printf("%-12s %12s %12s %9s %9s %9s %9s %9s %9s %9s\n", "rules", "cut points", "all points",
+         "t_rules", "t_simpl", "t_asm", "t_fac+sol", "t_iter", "cpu_rules", "cpu_iter");
   for (int k = 0; k < 2; k++)
-    printf("%-12s %12lld %12lld %9.3f %9.3f %9.3f %9.3f %9.3f\n",
+    printf("%-12s %12lld %12lld %9.3f %9.3f %9.3f %9.3f %9.3f %9.3f %9.3f\n",
            k ? "simplified" : "plain", (long long)p[k].points_cut, (long long)p[k].points_total,
-           p[k].t_rules, p[k].t_simplify, p[k].t_assembly, p[k].t_factor_solve, p[k].t_iteration);
+           p[k].t_rules, p[k].t_simplify, p[k].t_assembly, p[k].t_factor_solve, p[k].t_iteration,
+           p[k].c_rules, p[k].c_iteration);
+  printf("(t_*: wall-clock seconds; t_simpl: simplification summed over threads; cpu_*: process "
+         "CPU seconds)\n");
   printf("point reduction (cut cells) %.1fx; assembly speed-up %.2fx; iteration speed-up %.2fx\n",
          p[1].points_cut > 0 ? (double)p[0].points_cut / (double)p[1].points_cut : NAN,
          p[1].t_assembly > 0 ? p[0].t_assembly / p[1].t_assembly : NAN,
@@ -740,6 +767,8 @@ static int run_payoff(const config *c, fcm_ctx *ctx)
            cost, be, gain);
   else
     printf("break-even: never (an iteration is not faster with the simplified rules)\n");
+  if (isfinite(cbe))
+    printf("break-even in CPU seconds: after %.2f Newton iteration(s)\n", cbe);
   if (c->payoff_csv) {
     char tmp[4096];
     FILE *f = NULL;
@@ -751,12 +780,14 @@ static int run_payoff(const config *c, fcm_ctx *ctx)
       goto done;
     }
     fprintf(f, "element,res,simplified,points_cut,points_total,t_rules,t_simplify,t_assembly,"
-               "t_factor_solve,t_iteration,break_even_iterations\n");
+               "t_factor_solve,t_iteration,break_even_iterations,cpu_rules,cpu_iteration,"
+               "break_even_cpu\n");
     for (int k = 0; k < 2; k++)
-      fprintf(f, "%s,%d,%d,%lld,%lld,%.6f,%.6f,%.6f,%.6f,%.6f,%.6g\n",
+      fprintf(f, "%s,%d,%d,%lld,%lld,%.6f,%.6f,%.6f,%.6f,%.6f,%.6g,%.6f,%.6f,%.6g\n",
               fcm_element_get_info(c->payoff_element)->name, c->payoff_res, p[k].simplified,
               (long long)p[k].points_cut, (long long)p[k].points_total, p[k].t_rules,
-              p[k].t_simplify, p[k].t_assembly, p[k].t_factor_solve, p[k].t_iteration, be);
+              p[k].t_simplify, p[k].t_assembly, p[k].t_factor_solve, p[k].t_iteration, be,
+              p[k].c_rules, p[k].c_iteration, cbe);
     if (ferror(f) | (fclose(f) != 0) || rename(tmp, c->payoff_csv) != 0) {
       fprintf(stderr, CV_PROG ": cannot write %s: %s\n", c->payoff_csv, strerror(errno));
       remove(tmp);

@@ -63,6 +63,8 @@ int main(int argc, char **argv)
         TEST_TRUE(r->res == 2 + k && r->failed == 0 && r->dofs > 0 && r->points > 0);
         TEST_NEAR(r->h, 1.0 / r->res, 1e-14, 0.0);
         TEST_NEAR(r->t_total, r->t_rules + r->t_assembly + r->t_solve, 0.0, 5e-6);
+        TEST_NEAR(r->c_total, r->c_rules + r->c_assembly + r->c_solve, 0.0, 5e-6);
+        TEST_TRUE(r->c_rules >= 0.0 && r->c_assembly >= 0.0 && r->c_solve >= 0.0);
         TEST_NEAR(r->rel_l2, r->err_l2 / r->norm_l2, 1e-5, 0.0);
         TEST_NEAR(r->rel_h1, r->err_h1 / r->norm_h1, 1e-5, 0.0);
         TEST_TRUE(r->err_l2 > 0.0 && r->err_h1 > 0.0 && r->domain > 0.0);
@@ -87,7 +89,8 @@ int main(int argc, char **argv)
   int rows = 0;
   TEST_TRUE(f && fgets(line, sizeof line, f) &&
             !strcmp(line, "element,method,res,h,strength,points,dofs,t_rules,t_assembly,t_solve,"
-                          "t_total,err_l2,err_h1,rel_l2,rel_h1,failed,note\n"));
+                          "t_total,err_l2,err_h1,rel_l2,rel_h1,failed,note,cpu_rules,cpu_assembly,"
+                          "cpu_solve,cpu_total\n"));
   while (f && fgets(line, sizeof line, f)) {
     char el[16], me[8];
     int res = 0, m = 0;
@@ -116,7 +119,8 @@ int main(int argc, char **argv)
   f = fopen(path, "r");
   TEST_TRUE(f && fgets(line, sizeof line, f) &&
             !strcmp(line, "element,res,simplified,points_cut,points_total,t_rules,t_simplify,"
-                          "t_assembly,t_factor_solve,t_iteration,break_even_iterations\n"));
+                          "t_assembly,t_factor_solve,t_iteration,break_even_iterations,cpu_rules,"
+                          "cpu_iteration,break_even_cpu\n"));
   long long pts[2] = {0, 0};
   double be[2] = {0, 0}, titer[2] = {0, 0};
   rows = 0;
@@ -137,7 +141,8 @@ int main(int argc, char **argv)
   static const char *const bad[] = {"--levels 0",          "--levels 2,2",        "--elements tet5",
                                     "--methods xfem",      "--simplify maybe",    "--radius 1.5",
                                     "--fem-traction none", "--strength 0",        "--bogus 1",
-                                    "--fit 1",             "payoff --elements hex8", "--levels"};
+                                    "--fit 1",             "payoff --elements hex8", "--levels",
+                                    "--time gpu"};
   snprintf(path, sizeof path, "%s/converge-bad-levels.csv", dir);
   for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
     remove(path);

@@ -10,14 +10,14 @@
 #define CONVERGE_LEVELS_HEADER                                                                     \
   "element,method,res,h,dofs,active_cells,cut_cells,points,strength,t_rules,t_assembly,t_solve,"  \
   "t_total,err_l2,err_h1,norm_l2,norm_h1,rel_l2,rel_h1,measured_volume,domain_volume,failed,"     \
-  "note\n"
+  "note,cpu_rules,cpu_assembly,cpu_solve,cpu_total\n"
 #define CONVERGE_RATES_HEADER "element,method,norm,rate\n"
 
 typedef struct cv_level {
   char element[16], method[8];
   int res, strength, failed;
   double h, t_rules, t_assembly, t_solve, t_total, err_l2, err_h1, norm_l2, norm_h1, rel_l2,
-      rel_h1, measured, domain;
+      rel_h1, measured, domain, c_rules, c_assembly, c_solve, c_total;
   long long dofs, cells, cut, points;
 } cv_level;
 
@@ -42,7 +42,8 @@ static inline int cv_exists(const char *path)
   return f != NULL;
 }
 
-/* Rows of a levels CSV (header checked); -1 on a missing file, bad header or bad row. */
+/* Rows of a levels CSV (header checked); -1 on a missing file, bad header or bad row. The
+ * note field must be empty (every run of the tests is expected to be clean). */
 static inline int cv_read_levels(const char *path, cv_level *rows, int cap)
 {
   FILE *f = fopen(path, "r");
@@ -58,11 +59,11 @@ static inline int cv_read_levels(const char *path, cv_level *rows, int cap)
     if (n >= cap ||
         sscanf(line,
                "%15[^,],%7[^,],%d,%lf,%lld,%lld,%lld,%lld,%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,"
-               "%lf,%lf,%lf,%d,",
+               "%lf,%lf,%lf,%d,,%lf,%lf,%lf,%lf",
                r.element, r.method, &r.res, &r.h, &r.dofs, &r.cells, &r.cut, &r.points,
                &r.strength, &r.t_rules, &r.t_assembly, &r.t_solve, &r.t_total, &r.err_l2,
                &r.err_h1, &r.norm_l2, &r.norm_h1, &r.rel_l2, &r.rel_h1, &r.measured, &r.domain,
-               &r.failed) != 22) {
+               &r.failed, &r.c_rules, &r.c_assembly, &r.c_solve, &r.c_total) != 26) {
       fclose(f);
       return -1;
     }
