@@ -86,10 +86,10 @@ const fcm_geometry *cv_study_geometry(const cv_study *study);
 /** Reference mode: DOFs and seconds of the reference solve (0 otherwise). */
 void cv_study_reference_info(const cv_study *study, fcm_index *dofs, double *seconds);
 
-/** Per-run overrides (e.g. the m-sweep's strength); NULL fields mean the setup's. */
+/** Per-run overrides (e.g. the m-sweep's strength); a NULL pointer means none. */
 typedef struct cv_run_options {
-  int strength;  /* -2: the setup's */
-  int simplify;  /* -1: the setup's */
+  int strength;  /* FCM cut-cell stiffness strength; -1 the element's default, -2 the setup's */
+  int simplify;  /* 0 or 1; -1: the setup's */
 } cv_run_options;
 
 /** Solve one (element, res, method) problem and measure its errors; the error rules of the
