@@ -3,6 +3,7 @@
 #define FCM_FCM_H
 
 #include "fcm/core.h"
+#include "fcm/dense.h"
 #include "fcm/element.h"
 #include "fcm/embed.h"
 #include "fcm/fem.h"
