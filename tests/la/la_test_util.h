@@ -4,6 +4,7 @@
 #define FCM_LA_TEST_UTIL_H
 
 #include "fcm/core.h"
+#include "test_alloc.h"
 
 #include <float.h>
 #include <math.h>
@@ -11,54 +12,6 @@
 #include <stdlib.h>
 
 #define LA_PI 3.14159265358979323846
-
-/* xorshift64*: uniform doubles in [-1, 1). */
-typedef struct rng {
-  uint64_t s;
-} rng;
-
-static inline double rng_uniform(rng *r)
-{
-  r->s ^= r->s >> 12;
-  r->s ^= r->s << 25;
-  r->s ^= r->s >> 27;
-  uint64_t x = r->s * 2685821657736338717ULL;
-  return (double)(x >> 11) * (2.0 / 9007199254740992.0) - 1.0;
-}
-
-/* Allocator counting its calls and failing call number fail_at (0-based after
- * count was reset); fail_at = -1: never. */
-typedef struct failing {
-  long long count, fail_at;
-} failing;
-
-static inline void *failing_alloc(void *user, size_t size)
-{
-  failing *f = user;
-  long long k = f->count++;
-  if (f->fail_at >= 0 && k == f->fail_at) return NULL;
-  return malloc(size);
-}
-
-static inline void failing_release(void *user, void *p)
-{
-  (void)user;
-  free(p);
-}
-
-/* A context whose allocator is `f` (f->fail_at = -1 until the loop arms it). */
-static inline fcm_ctx *failing_ctx(failing *f)
-{
-  fcm_ctx_options o = fcm_ctx_options_default();
-  o.allocator.alloc = failing_alloc;
-  o.allocator.release = failing_release;
-  o.allocator.user = f;
-  f->count = 0;
-  f->fail_at = -1;
-  fcm_ctx *ctx = NULL;
-  if (fcm_ctx_create(&o, &ctx) != FCM_OK) return NULL;
-  return ctx;
-}
 
 /* Frobenius norm of a 3x3 matrix without under- or overflow. */
 static inline double norm3_safe(const double A[9])

@@ -7,43 +7,11 @@
 #include "fcm/fcm.h"
 #include "la/la_impl.h"
 #include "test.h"
+#include "test_alloc.h"
 
 #include <stdint.h>
 
 #define ST_PI 3.14159265358979323846
-
-/* xorshift64*: uniform doubles in [-1, 1). */
-typedef struct rng {
-  uint64_t s;
-} rng;
-
-static inline double rng_uniform(rng *r)
-{
-  r->s ^= r->s >> 12;
-  r->s ^= r->s << 25;
-  r->s ^= r->s >> 27;
-  uint64_t x = r->s * 2685821657736338717ULL;
-  return (double)(x >> 11) * (2.0 / 9007199254740992.0) - 1.0;
-}
-
-/* Allocator failing call number fail_at (0-based after count was reset); -1: never. */
-typedef struct failing {
-  long long count, fail_at;
-} failing;
-
-static inline void *failing_alloc(void *user, size_t size)
-{
-  failing *f = user;
-  long long k = f->count++;
-  if (f->fail_at >= 0 && k == f->fail_at) return NULL;
-  return malloc(size);
-}
-
-static inline void failing_release(void *user, void *p)
-{
-  (void)user;
-  free(p);
-}
 
 /* 7-point Laplacian (6 on the diagonal, -1 to grid neighbours) on the N^3 interior
  * points of a grid with homogeneous Dirichlet boundary, minus shift * I, with
