@@ -5,6 +5,7 @@
 
 #include "fcm/mesh.h"
 #include "test.h"
+#include "test_alloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -58,38 +59,6 @@ static inline void polygon_area_vector(int n, const double *P, double a[3])
     a[1] += 0.5 * (p[2] * q[0] - p[0] * q[2]);
     a[2] += 0.5 * (p[0] * q[1] - p[1] * q[0]);
   }
-}
-
-/* Allocator failing the fail_at-th allocation after arming (fail_at < 0: never). */
-typedef struct failing {
-  long count;
-  long fail_at;
-} failing;
-
-static inline void *failing_alloc(void *user, size_t size)
-{
-  failing *f = user;
-  if (f->fail_at >= 0 && f->count++ == f->fail_at) return NULL;
-  return malloc(size);
-}
-
-static inline void failing_release(void *user, void *ptr)
-{
-  (void)user;
-  free(ptr);
-}
-
-static inline fcm_ctx *failing_ctx(failing *f)
-{
-  fcm_ctx_options opts = fcm_ctx_options_default();
-  opts.allocator.alloc = failing_alloc;
-  opts.allocator.release = failing_release;
-  opts.allocator.user = f;
-  fcm_ctx *ctx = NULL;
-  f->count = 0;
-  f->fail_at = -1;
-  if (fcm_ctx_create(&opts, &ctx) != FCM_OK) return NULL;
-  return ctx;
 }
 
 /* Write a text file; returns 0 on success. */

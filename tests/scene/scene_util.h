@@ -6,6 +6,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "test.h"
+#include "test_alloc.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -63,38 +64,6 @@ static const char full_scene_json[] =
     "    {\"initial_velocity\": {\"velocity\": [0, 0, -1]}}\n"
     "  ]\n"
     "}\n";
-
-/* Allocator failing the fail_at-th allocation after arming (fail_at < 0: never). */
-typedef struct failing {
-  long count;
-  long fail_at;
-} failing;
-
-static inline void *failing_alloc(void *user, size_t size)
-{
-  failing *f = user;
-  if (f->fail_at >= 0 && f->count++ == f->fail_at) return NULL;
-  return malloc(size);
-}
-
-static inline void failing_release(void *user, void *ptr)
-{
-  (void)user;
-  free(ptr);
-}
-
-static inline fcm_ctx *failing_ctx(failing *f)
-{
-  fcm_ctx_options opts = fcm_ctx_options_default();
-  opts.allocator.alloc = failing_alloc;
-  opts.allocator.release = failing_release;
-  opts.allocator.user = f;
-  fcm_ctx *ctx = NULL;
-  f->count = 0;
-  f->fail_at = -1;
-  if (fcm_ctx_create(&opts, &ctx) != FCM_OK) return NULL;
-  return ctx;
-}
 
 /* Write `n` bytes to a file; returns 0 on success. */
 static inline int write_bytes(const char *path, const char *data, size_t n)
