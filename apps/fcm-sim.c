@@ -1,7 +1,7 @@
-/* fcm-sim: the main program. `fcm-sim scene.json` (or --default-scene) runs a scene file
- * through fcm_simulation; without arguments the built-in demo: a cantilever beam under
- * gravity, clamped at x = 0, solved statically on a quadratic background grid, written
- * for ParaView and compared with Timoshenko beam theory. */
+/* fcm-sim: the main program. `fcm-sim scene.json` runs a scene file through fcm_simulation;
+ * without a file, the built-in default scene (a twisting hollow cylinder). `--cantilever`
+ * runs the beam demo: a cantilever under gravity, clamped at x = 0, solved statically on a
+ * quadratic background grid, written for ParaView and compared with Timoshenko theory. */
 #define _POSIX_C_SOURCE 200809L
 #include <fcm/fcm.h>
 #include <fcm/simulation.h>
@@ -27,27 +27,35 @@ typedef struct options {
 static void usage(FILE *f)
 {
   fprintf(f,
-          "usage: fcm-sim SCENE.json [scene options]\n"
-          "       fcm-sim --default-scene [scene options]\n"
-          "       fcm-sim [demo options]\n"
+          "usage: fcm-sim [SCENE.json] [scene options]\n"
+          "       fcm-sim --cantilever [cantilever options]\n"
           "\n"
-          "A scene file (schema: apps/scenes/README.md) is run with only the effects it names;\n"
-          "frames go to its output directory: <name>_background_NNNN.vtu, <name>_surface_NNNN.vtu,\n"
-          "<name>_background.pvd, <name>_surface.pvd and the per-step log <name>_log.csv.\n"
+          "Runs a scene file (schema: apps/scenes/README.md) with only the effects it names;\n"
+          "without a file, the built-in default scene: a hollow cylinder, one end pushed in and\n"
+          "the other twisted (Longva et al. 2020, 6.2; Hex20 FCM, about 20 s on 2 cores).\n"
+          "Frames go to the scene's output directory: <name>_background_NNNN.vtu,\n"
+          "<name>_surface_NNNN.vtu, <name>_background.pvd, <name>_surface.pvd (open the .pvd\n"
+          "files in ParaView) and the per-step log <name>_log.csv.\n"
           "\n"
           "scene options:\n"
-          "  --default-scene    run the built-in scene (a small twisting hollow cylinder)\n"
-          "  -o, --output DIR   output directory (overrides the scene's)\n"
-          "  --steps N          stop after N steps (N >= 1)\n"
-          "  --check            run at most 3 steps without output, check the state is finite\n"
-          "                     and print the run summary\n"
-          "  -q, --quiet        print only errors\n"
+          "  -o, --output DIR         output directory (overrides the scene's)\n"
+          "  --steps N                stop once N steps in all are taken (N >= 1)\n"
+          "  --check                  run at most 3 steps without output, check the state is\n"
+          "                           finite and print the run summary\n"
+          "  --checkpoint-every K     write <name>_checkpoint_NNNNNN.fcmck every K steps (K >= 1;\n"
+          "                           overrides the scene's output.checkpoint_interval)\n"
+          "  --resume FILE            continue from a checkpoint of the same scene, bit for bit\n"
+          "                           as the uninterrupted run; frames and log go on in the\n"
+          "                           output directory\n"
+          "  --print-scene            print the scene with every default filled in and exit\n"
+          "  -q, --quiet              print only errors\n"
+          "  -h, --help               this text\n"
           "\n"
-          "Without a scene: a steel cantilever beam (8 x 1 x 1 m, clamped at x = 0) under\n"
-          "gravity on a Hex20 grid, solved statically; frames go to fcm-output/ (VTU + PVD)\n"
-          "and the tip deflection is compared with Timoshenko beam theory.\n"
+          "--cantilever: a steel cantilever beam (8 x 1 x 1 m, clamped at x = 0) under gravity\n"
+          "on a Hex20 grid, solved statically; frames go to fcm-output/ (VTU + PVD) and the tip\n"
+          "deflection is compared with Timoshenko beam theory.\n"
           "\n"
-          "demo options:\n"
+          "cantilever options:\n"
           "  --element NAME     tet4 | tet10 | hex8 | hex20            (default hex20)\n"
           "  --cells NX NY NZ   grid cells along the beam, width, height  (default 32 4 4)\n"
           "  --size L W H       beam length, width, height in m           (default 8 1 1)\n"
@@ -56,8 +64,7 @@ static void usage(FILE *f)
           "  --density RHO      density in kg/m^3, >= 0                    (default 7850)\n"
           "  --gravity G        gravitational acceleration in m/s^2        (default 9.81)\n"
           "  -o, --output DIR   output directory                           (default fcm-output)\n"
-          "  -q, --quiet        print only errors\n"
-          "  -h, --help         this text\n");
+          "  -q, --quiet        print only errors\n");
 }
 
 /* Parse a finite double from argv[*i + 1]; a message names the option on failure. */
@@ -127,8 +134,10 @@ static int parse_args(int argc, char **argv, options *o)
       o->outdir = argv[++i];
     } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
       o->quiet = 1;
+    } else if (!strcmp(a, "--cantilever")) {
+      continue;
     } else {
-      fprintf(stderr, "fcm-sim: unknown option '%s' (see --help)\n", a);
+      fprintf(stderr, "fcm-sim: unknown --cantilever option '%s' (see --help)\n", a);
       return 0;
     }
   }
@@ -174,7 +183,8 @@ static void cell_von_mises(const fcm_space *space, const options *o, const doubl
       const double *ua = u + fcm_space_node_dof(space, cn[a]);
       for (int j = 0; j < 3; j++) {
         double g = Ji[j] * dN[3 * a] + Ji[3 + j] * dN[3 * a + 1] + Ji[6 + j] * dN[3 * a + 2];
-        for (int i = 0; i < 3; i++) G[3 * i + j] += ua[i] * g;
+        for (int i = 0; i < 3; i++)
+          G[3 * i + j] += ua[i] * g;
       }
     }
     double s[9], tr = G[0] + G[4] + G[8];
@@ -216,8 +226,8 @@ static int ensure_dir(const char *dir)
 
 static int demo_main(int argc, char **argv)
 {
-  options o = {FCM_ELEMENT_HEX20, {32, 4, 4}, 8.0, 1.0, 1.0, {2.1e11, 0.3, 7850.0}, 9.81,
-               "fcm-output", 0};
+  options o = {FCM_ELEMENT_HEX20,     {32, 4, 4}, 8.0,          1.0, 1.0,
+               {2.1e11, 0.3, 7850.0}, 9.81,       "fcm-output", 0};
   if (!parse_args(argc, argv, &o)) return 2;
 
   int rc = 1;
@@ -276,7 +286,8 @@ static int demo_main(int argc, char **argv)
     if (!nodes || !dofs) goto done;
     CHECK(fcm_mesh_nodes_in_box(ctx, mesh, plo, phi, tol, nfix, nodes, &nfix));
     for (fcm_index k = 0; k < nfix; k++)
-      for (int d = 0; d < 3; d++) dofs[3 * k + d] = fcm_space_node_dof(space, nodes[k]) + d;
+      for (int d = 0; d < 3; d++)
+        dofs[3 * k + d] = fcm_space_node_dof(space, nodes[k]) + d;
     CHECK(fcm_space_apply_dirichlet(space, 3 * nfix, dofs, NULL, K, f));
   }
   t[4] = fcm_wtime();
@@ -294,7 +305,8 @@ static int demo_main(int argc, char **argv)
 
   /* Output: displacement per node, von Mises stress per cell; atomic files. */
   for (fcm_index n = 0; n < nnodes; n++)
-    for (int d = 0; d < 3; d++) upts[3 * n + d] = u[fcm_space_node_dof(space, n) + d];
+    for (int d = 0; d < 3; d++)
+      upts[3 * n + d] = u[fcm_space_node_dof(space, n) + d];
   cell_von_mises(space, &o, u, vm);
   if (!ensure_dir(o.outdir)) goto done;
   snprintf(path, sizeof path, "%s/cantilever.pvd", o.outdir);
@@ -319,7 +331,8 @@ static int demo_main(int argc, char **argv)
     if (!tip) goto done;
     fcm_mesh_nodes_in_box(ctx, mesh, tlo, thi, 1e-9 * o.length, ntip, tip, &ntip);
     double w = 0.0;
-    for (fcm_index k = 0; k < ntip; k++) w += u[fcm_space_node_dof(space, tip[k]) + 2];
+    for (fcm_index k = 0; k < ntip; k++)
+      w += u[fcm_space_node_dof(space, tip[k]) + 2];
     free(tip);
     w = -w / (double)ntip;
     double ref = timoshenko_tip(&o);
@@ -340,8 +353,9 @@ static int demo_main(int argc, char **argv)
              "factor %.3f  solve %.3f  output %.3f\n",
              t[1] - t[0], t[2] - t[1], t[3] - t[2], t[4] - t[3], t[5] - t[4], t[6] - t[5],
              t[7] - t[6]);
-      printf("  output       %s/cantilever.pvd (open in ParaView; Warp By Vector on 'displacement')\n",
-             o.outdir);
+      printf(
+          "  output       %s/cantilever.pvd (open in ParaView; Warp By Vector on 'displacement')\n",
+          o.outdir);
     }
   }
   rc = 0;
@@ -362,55 +376,62 @@ done:
 typedef struct scene_options {
   const char *path; /* NULL: the built-in scene */
   const char *outdir;
+  const char *resume; /* checkpoint to continue from, or NULL */
   long long steps;
-  int check, quiet;
+  int checkpoint_every; /* -1: the scene's */
+  int check, quiet, print_scene;
 } scene_options;
 
-/* Whether the command line asks for a scene run (a .json file, or a scene-only option). */
-static int is_scene_run(int argc, char **argv)
+/* A whole number in [lo, hi] from argv[*i + 1]; a message names the option on failure. */
+static int parse_count(int argc, char **argv, int *i, long long lo, long long hi, long long *out)
 {
-  if (argc > 1 && argv[1][0] != '-') return 1;
-  for (int i = 1; i < argc; i++) {
-    size_t n = strlen(argv[i]);
-    if (!strcmp(argv[i], "--default-scene") || !strcmp(argv[i], "--check") ||
-        !strcmp(argv[i], "--steps") || (n > 5 && !strcmp(argv[i] + n - 5, ".json")))
-      return 1;
+  char *end = NULL;
+  errno = 0;
+  long long v = *i + 1 < argc ? strtoll(argv[*i + 1], &end, 10) : 0;
+  if (*i + 1 >= argc || errno || end == argv[*i + 1] || *end || v < lo || v > hi) {
+    fprintf(stderr, "fcm-sim: %s needs a whole number in [%lld, %lld]\n", argv[*i], lo, hi);
+    return 0;
   }
-  return 0;
+  *out = v;
+  (*i)++;
+  return 1;
 }
 
 static int parse_scene_args(int argc, char **argv, scene_options *o)
 {
-  int builtin = 0;
   for (int i = 1; i < argc; i++) {
     const char *a = argv[i];
+    long long v = 0;
     if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
       usage(stdout);
       exit(0);
-    } else if (!strcmp(a, "--default-scene")) {
-      builtin = 1;
-    } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+    } else if (!strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--resume")) {
       if (i + 1 >= argc || !argv[i + 1][0]) {
-        fprintf(stderr, "fcm-sim: %s needs a directory name\n", a);
+        fprintf(stderr, "fcm-sim: %s needs a %s\n", a,
+                strcmp(a, "--resume") ? "directory name" : "checkpoint file");
         return 0;
       }
-      o->outdir = argv[++i];
+      if (!strcmp(a, "--resume"))
+        o->resume = argv[++i];
+      else
+        o->outdir = argv[++i];
     } else if (!strcmp(a, "--steps")) {
-      char *end = NULL;
-      errno = 0;
-      long long v = i + 1 < argc ? strtoll(argv[i + 1], &end, 10) : 0;
-      if (i + 1 >= argc || errno || end == argv[i + 1] || *end || v < 1) {
-        fprintf(stderr, "fcm-sim: --steps needs a whole number >= 1\n");
-        return 0;
-      }
+      if (!parse_count(argc, argv, &i, 1, 1000000000000LL, &v)) return 0;
       o->steps = v;
-      i++;
+    } else if (!strcmp(a, "--checkpoint-every")) {
+      if (!parse_count(argc, argv, &i, 1, 1000000000, &v)) return 0;
+      o->checkpoint_every = (int)v;
     } else if (!strcmp(a, "--check")) {
       o->check = 1;
+    } else if (!strcmp(a, "--print-scene")) {
+      o->print_scene = 1;
     } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
       o->quiet = 1;
     } else if (a[0] == '-') {
-      fprintf(stderr, "fcm-sim: unknown scene option '%s' (see --help)\n", a);
+      fprintf(stderr,
+              "fcm-sim: unknown option '%s' (see --help; the beam options need "
+              "--cantilever)\n",
+              a);
       return 0;
     } else if (o->path) {
       fprintf(stderr, "fcm-sim: one scene file only ('%s' and '%s')\n", o->path, a);
@@ -419,8 +440,8 @@ static int parse_scene_args(int argc, char **argv, scene_options *o)
       o->path = a;
     }
   }
-  if (builtin == !!o->path) {
-    fprintf(stderr, "fcm-sim: give a scene file or --default-scene (not both)\n");
+  if (o->check && (o->resume || o->checkpoint_every > 0)) {
+    fprintf(stderr, "fcm-sim: --check writes nothing: no --resume or --checkpoint-every\n");
     return 0;
   }
   return 1;
@@ -443,8 +464,7 @@ static int make_dirs(const char *dir)
     struct stat sb;
     if (stat(buf, &sb) != 0) {
       if (mkdir(buf, 0777) != 0 && errno != EEXIST) {
-        fprintf(stderr, "fcm-sim: cannot create output directory '%s': %s\n", buf,
-                strerror(errno));
+        fprintf(stderr, "fcm-sim: cannot create output directory '%s': %s\n", buf, strerror(errno));
         return 0;
       }
     } else if (!S_ISDIR(sb.st_mode)) {
@@ -457,30 +477,48 @@ static int make_dirs(const char *dir)
 }
 
 /* One progress report per step on stderr: a bar with ETA on a terminal, else a line. */
-static void progress(int tty, long long k, long long n, const fcm_step_info *si, double elapsed)
+/* k of n steps of this process done; step `step` of `total` in all. */
+static void progress(int tty, long long k, long long n, long long step, long long total,
+                     const fcm_step_info *si, double elapsed)
 {
   if (tty) {
-    int width = 30, fill = (int)(width * k / (n > 0 ? n : 1));
+    int width = 30, fill = (int)(width * step / (total > 0 ? total : 1));
     double eta = k > 0 ? elapsed / (double)k * (double)(n - k) : 0.0;
     char bar[64];
-    for (int i = 0; i < width; i++) bar[i] = i < fill ? '#' : '.';
+    for (int i = 0; i < width; i++)
+      bar[i] = i < fill ? '#' : '.';
     bar[width] = '\0';
-    fprintf(stderr, "\r[%s] %lld/%lld t=%.4g s newton %d  ETA %.0f s   ", bar, k, n, si->time,
-            si->newton_iterations, eta);
+    fprintf(stderr, "\r[%s] %lld/%lld t=%.4g s newton %d  ETA %.0f s   ", bar, step, total,
+            si->time, si->newton_iterations, eta);
     if (k == n) fputc('\n', stderr);
   } else {
     fprintf(stderr,
-            "fcm-sim: step %lld/%lld t=%.6g s newton %d linear %lld residual %.3e (%.3f s)\n", k,
-            n, si->time, si->newton_iterations, si->linear_iterations, si->residual,
+            "fcm-sim: step %lld/%lld t=%.6g s newton %d linear %lld residual %.3e (%.3f s)\n", step,
+            total, si->time, si->newton_iterations, si->linear_iterations, si->residual,
             si->time_total);
   }
 }
 
+/* Write a checkpoint <dir>/<name>_checkpoint_NNNNNN.fcmck of the current step. */
+static int write_checkpoint(fcm_ctx *ctx, fcm_simulation *sim, const char *dir, const char *name,
+                            int quiet)
+{
+  char path[4096];
+  snprintf(path, sizeof path, "%s/%s_checkpoint_%06lld.fcmck", dir, name,
+           fcm_simulation_step_count(sim));
+  if (fcm_simulation_write_checkpoint(sim, path) != FCM_OK) {
+    fcm_ctx_error_view(ctx, stderr);
+    return 0;
+  }
+  if (!quiet && !isatty(2)) fprintf(stderr, "fcm-sim: checkpoint %s\n", path);
+  return 1;
+}
+
 static int scene_main(int argc, char **argv)
 {
-  scene_options o = {NULL, NULL, 0, 0, 0};
+  scene_options o = {NULL, NULL, NULL, 0, -1, 0, 0, 0};
   if (!parse_scene_args(argc, argv, &o)) return 2;
-  int rc = 1, frame = 0;
+  int rc = 1;
   fcm_ctx *ctx = NULL;
   fcm_scene *scene = NULL;
   fcm_simulation *sim = NULL;
@@ -496,8 +534,14 @@ static int scene_main(int argc, char **argv)
     rc = 2;
     goto done;
   }
+  if (o.print_scene) {
+    fcm_scene_view(scene, stdout);
+    rc = 0;
+    goto done;
+  }
   fcm_simulation_options so = fcm_simulation_options_default();
   so.max_steps = o.check ? (o.steps > 0 && o.steps < 3 ? o.steps : 3) : o.steps;
+  so.checkpoint_interval = o.check ? 0 : o.checkpoint_every;
   const char *name = fcm_scene_name(scene);
   if (!o.quiet)
     fprintf(stderr, "fcm-sim: scene %s (%s): building\n", name, fcm_scene_source(scene));
@@ -505,12 +549,25 @@ static int scene_main(int argc, char **argv)
     fcm_ctx_error_view(ctx, stderr);
     goto done;
   }
+  if (o.resume) {
+    if (fcm_simulation_read_checkpoint(sim, o.resume) != FCM_OK) {
+      fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+      rc = 2;
+      goto done;
+    }
+    if (!o.quiet)
+      fprintf(stderr, "fcm-sim: resumed from %s at step %lld (t = %.9g s)\n", o.resume,
+              fcm_simulation_step_count(sim), fcm_integrator_time(fcm_simulation_integrator(sim)));
+  }
   const char *dir = o.outdir ? o.outdir : fcm_scene_get_output(scene)->directory;
   int write = !o.check;
+  fcm_simulation_counters c;
+  fcm_simulation_get_counters(sim, &c);
+  int frame = (int)c.frames;
   if (write) {
     if (!make_dirs(dir)) goto done;
     snprintf(logpath, sizeof logpath, "%s/%s_log.csv", dir, name);
-    if (fcm_simulation_write_frame(sim, dir, frame++) != FCM_OK ||
+    if ((!o.resume && fcm_simulation_write_frame(sim, dir, frame++) != FCM_OK) ||
         fcm_simulation_write_log(sim, logpath) != FCM_OK) {
       fcm_ctx_error_view(ctx, stderr);
       goto done;
@@ -518,7 +575,7 @@ static int scene_main(int argc, char **argv)
   }
   int tty = !o.quiet && isatty(2);
   double t0 = fcm_wtime();
-  long long n = fcm_simulation_num_steps(sim);
+  long long n = fcm_simulation_num_steps(sim), first = fcm_simulation_step_count(sim);
   while (!fcm_simulation_done(sim)) {
     fcm_step_info si;
     if (fcm_simulation_step(sim, &si) != FCM_OK) {
@@ -532,7 +589,8 @@ static int scene_main(int argc, char **argv)
               fcm_simulation_step_count(sim));
       goto done;
     }
-    if (!o.quiet) progress(tty, fcm_simulation_step_count(sim), n, &si, fcm_wtime() - t0);
+    long long k = fcm_simulation_step_count(sim);
+    if (!o.quiet) progress(tty, k - first, n - first, k, n, &si, fcm_wtime() - t0);
     if (write && fcm_simulation_frame_due(sim)) {
       if (fcm_simulation_write_frame(sim, dir, frame++) != FCM_OK ||
           fcm_simulation_write_log(sim, logpath) != FCM_OK) {
@@ -540,6 +598,9 @@ static int scene_main(int argc, char **argv)
         goto done;
       }
     }
+    if (write && fcm_simulation_checkpoint_due(sim) &&
+        !write_checkpoint(ctx, sim, dir, name, o.quiet))
+      goto done;
   }
   if (write && fcm_simulation_write_log(sim, logpath) != FCM_OK) {
     fcm_ctx_error_view(ctx, stderr);
@@ -560,5 +621,7 @@ done:
 int main(int argc, char **argv)
 {
   fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
-  return is_scene_run(argc, argv) ? scene_main(argc, argv) : demo_main(argc, argv);
+  for (int i = 1; i < argc; i++)
+    if (!strcmp(argv[i], "--cantilever")) return demo_main(argc, argv);
+  return scene_main(argc, argv);
 }

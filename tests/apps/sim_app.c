@@ -1,8 +1,13 @@
 /* fcm-sim end to end. Modes:
  *   sim_app check FCM_SIM SCENE       `fcm-sim SCENE --check` exits 0 and prints the summary
+ *                                     (SCENE "-": the built-in scene, no file)
  *   sim_app run FCM_SIM WORK_DIR      a small scene run with -o and --steps writes the frames,
  *                                     both PVDs and a CSV log with one row per step; the
- *                                     no-argument cantilever demo still runs
+ *                                     --cantilever demo runs
+ *   sim_app resume FCM_SIM WORK_DIR   a run cut short with checkpoints and resumed ends with
+ *                                     frames byte-identical to the uninterrupted run's, the
+ *                                     same log (but wall times) and a complete PVD; bad,
+ *                                     corrupted and foreign checkpoints are refused
  *   sim_app errors FCM_SIM WORK_DIR   invalid scenes and options exit non-zero with the
  *                                     parser's message and create no output directory */
 #define _POSIX_C_SOURCE 200809L
@@ -49,7 +54,8 @@ static int file_has(const char *path, const char *needle)
 
 static const char small_scene[] =
     "{\"version\": 1, \"name\": \"small\","
-    " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0], \"max\": [1.5, 0.5, 0.5]},"
+    " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0], \"max\": [1.5, 0.5, "
+    "0.5]},"
     "   \"cells\": [3, 1, 1]},"
     " \"geometry\": {\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [1.2, 0.5, 0.5],"
     "   \"cells\": [3, 1, 1]},"
@@ -57,13 +63,17 @@ static const char small_scene[] =
     " \"time\": {\"dt\": 0.01, \"steps\": 10},"
     " \"output\": {\"directory\": \"unused-by-test\", \"frame_interval\": 2},"
     " \"effects\": [{\"gravity\": {}},"
-    "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, 0, 0]}}}}]}";
+    "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, 0, "
+    "0]}}}}]}";
 
 static int mode_check(const char *sim, const char *scene)
 {
   char cmd[8192], out[1024];
   snprintf(out, sizeof out, "%s.check-%ld.txt", "/tmp/fcm-sim-check", (long)getpid());
-  snprintf(cmd, sizeof cmd, "'%s' '%s' --check > '%s' 2> /dev/null", sim, scene, out);
+  if (!strcmp(scene, "-"))
+    snprintf(cmd, sizeof cmd, "'%s' --check > '%s' 2> /dev/null", sim, out);
+  else
+    snprintf(cmd, sizeof cmd, "'%s' '%s' --check > '%s' 2> /dev/null", sim, scene, out);
   TEST_TRUE(run(cmd) == 0);
   TEST_TRUE(file_has(out, "steps,") || file_has(out, " steps, "));
   TEST_TRUE(file_has(out, "computed  inertia") || file_has(out, "skipped   inertia"));
@@ -103,8 +113,8 @@ static int mode_run(const char *sim, const char *work)
     int rows = 0;
     long long step, newton, linear;
     double t, res, energy, wall;
-    while (fscanf(f, "%lld,%lf,%lld,%lld,%lf,%lf,%lf\n", &step, &t, &newton, &linear, &res,
-                  &energy, &wall) == 7) {
+    while (fscanf(f, "%lld,%lf,%lld,%lld,%lf,%lf,%lf\n", &step, &t, &newton, &linear, &res, &energy,
+                  &wall) == 7) {
       rows++;
       TEST_TRUE(step == rows);
       TEST_NEAR(t, 0.01 * rows, 1e-12, 1e-14);
@@ -117,9 +127,10 @@ static int mode_run(const char *sim, const char *work)
   snprintf(path, sizeof path, "%s/small_surface_0002.vtu", dir);
   TEST_TRUE(file_has(path, "UnstructuredGrid"));
 
-  /* the README demo: no scene, cantilever (small grid) */
+  /* the cantilever demo (small grid) */
   snprintf(dir, sizeof dir, "%s/demo-out", work);
-  snprintf(cmd, sizeof cmd, "'%s' --cells 4 1 1 -o '%s' -q > /dev/null 2>&1", sim, dir);
+  snprintf(cmd, sizeof cmd, "'%s' --cantilever --cells 4 1 1 -o '%s' -q > /dev/null 2>&1", sim,
+           dir);
   TEST_TRUE(run(cmd) == 0);
   snprintf(path, sizeof path, "%s/cantilever.pvd", dir);
   TEST_TRUE(exists(path));
@@ -135,14 +146,14 @@ static int mode_errors(const char *sim, const char *work)
   run(cmd);
   struct {
     const char *json, *message;
-  } bad[] = {
-      {"{\"version\": 1, \"background\": {", ":1:"},                 /* malformed JSON */
-      {"{\"version\": 1, \"bogus\": 3}", "bogus"},                    /* unknown key */
-      {"{\"version\": 1, \"name\": \"x\", \"output\": {\"directory\": \"DIR\"},"
-       " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0],"
-       " \"max\": [1, 1, 1]}, \"cells\": [1, 1, 1]},"
-       " \"material\": {\"model\": \"linear\", \"young\": 1e6, \"poisson\": 0.3},"
-       " \"effects\": [{\"wind\": {}}]}", "wind"}};                   /* unknown effect */
+  } bad[] = {{"{\"version\": 1, \"background\": {", ":1:"}, /* malformed JSON */
+             {"{\"version\": 1, \"bogus\": 3}", "bogus"},   /* unknown key */
+             {"{\"version\": 1, \"name\": \"x\", \"output\": {\"directory\": \"DIR\"},"
+              " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0],"
+              " \"max\": [1, 1, 1]}, \"cells\": [1, 1, 1]},"
+              " \"material\": {\"model\": \"linear\", \"young\": 1e6, \"poisson\": 0.3},"
+              " \"effects\": [{\"wind\": {}}]}",
+              "wind"}}; /* unknown effect */
   for (int k = 0; k < 3; k++) {
     snprintf(scene, sizeof scene, "%s/bad%d.json", work, k);
     write_file(scene, bad[k].json);
@@ -162,11 +173,158 @@ static int mode_errors(const char *sim, const char *work)
   TEST_TRUE(run(cmd) != 0);
   TEST_TRUE(file_has(err, "no-such-scene.json"));
   TEST_TRUE(!exists(dir));
-  snprintf(cmd, sizeof cmd, "'%s' --default-scene --steps 0 -o '%s' 2> /dev/null", sim, dir);
-  TEST_TRUE(run(cmd) == 2);
+  const char *bad_opts[] = {"--steps 0",     "--checkpoint-every 0", "--check --resume x.fcmck",
+                            "--cells 4 1 1", "--cantilever --bogus", "--resume"};
+  for (int k = 0; k < 6; k++) {
+    snprintf(cmd, sizeof cmd, "'%s' %s -o '%s' 2> /dev/null", sim, bad_opts[k], dir);
+    if (run(cmd) != 2) TEST_FAIL_("'%s' should exit 2", bad_opts[k]);
+  }
   snprintf(cmd, sizeof cmd, "'%s' a.json b.json 2> /dev/null", sim);
   TEST_TRUE(run(cmd) == 2);
   TEST_TRUE(!exists(dir));
+  remove(err);
+  return TEST_RESULT();
+}
+
+/* Whole file into buf (NUL-terminated); its length, or -1. */
+static long slurp(const char *path, char *buf, size_t cap)
+{
+  FILE *f = fopen(path, "rb");
+  if (!f) return -1;
+  size_t n = fread(buf, 1, cap - 1, f);
+  fclose(f);
+  buf[n] = '\0';
+  return (long)n;
+}
+
+/* The CSV log without its last column (wall time), for comparing runs. */
+static void strip_wall(char *csv)
+{
+  char *w = csv;
+  for (char *line = csv; *line;) {
+    char *nl = strchr(line, '\n');
+    size_t len = nl ? (size_t)(nl - line) : strlen(line);
+    char *comma = NULL;
+    for (size_t k = 0; k < len; k++)
+      if (line[k] == ',') comma = line + k;
+    size_t keep = comma ? (size_t)(comma - line) : len;
+    memmove(w, line, keep);
+    w += keep;
+    *w++ = '\n';
+    line += len + (nl ? 1 : 0);
+  }
+  *w = '\0';
+}
+
+static int mode_resume(const char *sim, const char *work)
+{
+  static char a[1 << 20], b[1 << 20];
+  char cmd[8192], scene[1024], full[1024], cut[1024], path[4096], path2[4096], err[1024];
+  snprintf(scene, sizeof scene, "%s/resume.json", work);
+  snprintf(full, sizeof full, "%s/resume-full", work);
+  snprintf(cut, sizeof cut, "%s/resume-cut", work);
+  snprintf(err, sizeof err, "%s/resume-stderr.txt", work);
+  /* a nonlinear embedded body under gravity with damping (YOUNG: the material) */
+#define RESUME_SCENE(young)                                                                        \
+  "{\"version\": 1, \"name\": \"small\","                                                          \
+  " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0],"                         \
+  "   \"max\": [1.5, 0.5, 0.5]}, \"cells\": [3, 1, 1]},"                                           \
+  " \"geometry\": {\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [1.2, 0.5, 0.5],"              \
+  "   \"cells\": [3, 1, 1]},"                                                                      \
+  " \"material\": {\"model\": \"snh\", \"young\": " young                                          \
+  ", \"poisson\": 0.3, \"density\": 1000},"                                                        \
+  " \"time\": {\"dt\": 0.02, \"steps\": 10},"                                                      \
+  " \"output\": {\"frame_interval\": 2},"                                                          \
+  " \"effects\": [{\"gravity\": {}}, {\"damping\": {\"stiffness\": 0.01}},"                        \
+  "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0],"                             \
+  "   \"normal\": [-1, 0, 0]}}}}]}"
+  char json[4096];
+  snprintf(json, sizeof json, "%s", RESUME_SCENE("1e5"));
+  write_file(scene, json);
+  snprintf(cmd, sizeof cmd, "rm -rf '%s' '%s'", full, cut);
+  run(cmd);
+  /* uninterrupted: 10 steps, frames 0..5 */
+  snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s' -q", sim, scene, full);
+  TEST_TRUE(run(cmd) == 0);
+  /* cut at step 4 with a checkpoint every 2 steps, then resumed from step 4 */
+  snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s' -q --steps 4 --checkpoint-every 2", sim, scene, cut);
+  TEST_TRUE(run(cmd) == 0);
+  snprintf(path, sizeof path, "%s/small_checkpoint_000002.fcmck", cut);
+  TEST_TRUE(exists(path));
+  snprintf(path, sizeof path, "%s/small_checkpoint_000004.fcmck", cut);
+  TEST_TRUE(exists(path));
+  snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s' -q --resume '%s/small_checkpoint_000004.fcmck'", sim,
+           scene, cut, cut);
+  TEST_TRUE(run(cmd) == 0);
+  /* every frame identical byte for byte, the log identical but for the wall times */
+  const char *kinds[] = {"background", "surface"};
+  for (int k = 0; k < 2; k++)
+    for (int f = 0; f <= 5; f++) {
+      snprintf(path, sizeof path, "%s/small_%s_%04d.vtu", full, kinds[k], f);
+      snprintf(path2, sizeof path2, "%s/small_%s_%04d.vtu", cut, kinds[k], f);
+      long na = slurp(path, a, sizeof a), nb = slurp(path2, b, sizeof b);
+      if (na <= 0 || na != nb || memcmp(a, b, (size_t)na))
+        TEST_FAIL_("%s differs from the uninterrupted run", path2);
+    }
+  snprintf(path, sizeof path, "%s/small_log.csv", full);
+  snprintf(path2, sizeof path2, "%s/small_log.csv", cut);
+  TEST_TRUE(slurp(path, a, sizeof a) > 0 && slurp(path2, b, sizeof b) > 0);
+  strip_wall(a);
+  strip_wall(b);
+  TEST_TRUE(!strcmp(a, b));
+  /* the PVD index lists all 6 frames with the same times */
+  snprintf(path, sizeof path, "%s/small_background.pvd", full);
+  snprintf(path2, sizeof path2, "%s/small_background.pvd", cut);
+  TEST_TRUE(slurp(path, a, sizeof a) > 0 && slurp(path2, b, sizeof b) > 0);
+  {
+    int ca = 0, cb = 0;
+    for (char *p = a; (p = strstr(p, "<DataSet")); p++)
+      ca++;
+    for (char *p = b; (p = strstr(p, "<DataSet")); p++)
+      cb++;
+    TEST_TRUE(ca == 6 && cb == 6);
+  }
+  /* a corrupted checkpoint: checksum */
+  snprintf(path, sizeof path, "%s/small_checkpoint_000002.fcmck", cut);
+  long n = slurp(path, a, sizeof a);
+  TEST_TRUE(n > 100);
+  if (n > 100) {
+    a[n / 2] ^= 0x20;
+    snprintf(path2, sizeof path2, "%s/corrupt.fcmck", work);
+    FILE *f = fopen(path2, "wb");
+    TEST_TRUE(f && fwrite(a, 1, (size_t)n, f) == (size_t)n);
+    if (f) fclose(f);
+    snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s/x' -q --resume '%s' 2> '%s'", sim, scene, work,
+             path2, err);
+    TEST_TRUE(run(cmd) == 2);
+    TEST_TRUE(file_has(err, "checksum") && file_has(err, "corrupt.fcmck"));
+    /* truncated */
+    f = fopen(path2, "wb");
+    TEST_TRUE(f && fwrite(a, 1, 40, f) == 40);
+    if (f) fclose(f);
+    TEST_TRUE(run(cmd) == 2);
+    TEST_TRUE(file_has(err, "corrupt.fcmck"));
+    /* not a checkpoint at all */
+    TEST_TRUE(run((snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s/x' -q --resume '%s' 2> '%s'", sim,
+                            scene, work, scene, err),
+                   cmd)) == 2);
+    TEST_TRUE(file_has(err, "not an fcm checkpoint"));
+    remove(path2);
+  }
+  /* another scene (stiffer material) refuses the checkpoint */
+  char other[1024];
+  snprintf(other, sizeof other, "%s/resume-other.json", work);
+  {
+    snprintf(json, sizeof json, "%s", RESUME_SCENE("2e5"));
+    write_file(other, json);
+    snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s/x' -q --resume '%s' 2> '%s'", sim, other, work,
+             path, err);
+    TEST_TRUE(run(cmd) == 2);
+    TEST_TRUE(file_has(err, "different scene"));
+    remove(other);
+  }
+  snprintf(path, sizeof path, "%s/x", work);
+  TEST_TRUE(!exists(path)); /* refused resumes write nothing */
   remove(err);
   return TEST_RESULT();
 }
@@ -177,5 +335,6 @@ int main(int argc, char **argv)
   if (!strcmp(argv[1], "check")) return mode_check(argv[2], argv[3]);
   if (!strcmp(argv[1], "run")) return mode_run(argv[2], argv[3]);
   if (!strcmp(argv[1], "errors")) return mode_errors(argv[2], argv[3]);
+  if (!strcmp(argv[1], "resume")) return mode_resume(argv[2], argv[3]);
   return 2;
 }

@@ -139,6 +139,10 @@ static const bad_case cases[] = {
      NULL},
     {"{" BG ", " MAT ", \"output\": {\"directory\": \"\"}}", FCM_ERR_ARG,
      "output.directory: expected a non-empty string, got an empty string", NULL},
+    {"{" BG ", " MAT ", \"output\": {\"checkpoint_interval\": -1}}", FCM_ERR_ARG,
+     "output.checkpoint_interval: expected an integer in [0, 1000000000], got -1", NULL},
+    {"{" BG ", " MAT ", \"solver\": {\"newton\": {\"rule\": \"absolute\"}}}", FCM_ERR_ARG,
+     "solver.newton.rule:", "\"representative\""},
     /* ---- non-finite: 1e999 parses to infinity */
     {"{" BG ", \"material\": {\"young\": 1e999, \"poisson\": 0.3}}", FCM_ERR_ARG,
      "material.young: expected a finite number > 0, got inf", NULL},

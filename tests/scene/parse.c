@@ -79,6 +79,7 @@ static void check_full(fcm_ctx *ctx)
   TEST_TRUE(so->newton_rtol == 1e-4 && so->newton_max_iterations == 17);
   TEST_TRUE(so->line_search == 0 && so->project_psd == 1);
   TEST_TRUE(so->representative_acceleration == 10 && so->threads == 3);
+  TEST_TRUE(so->newton_rule == FCM_SCENE_NEWTON_RELATIVE);
 
   const fcm_scene_time *t = fcm_scene_get_time(s);
   TEST_TRUE(!t->is_static && t->integrator == FCM_SCENE_INTEGRATOR_BACKWARD_EULER);
@@ -87,6 +88,7 @@ static void check_full(fcm_ctx *ctx)
 
   const fcm_scene_output *o = fcm_scene_get_output(s);
   TEST_TRUE(!strcmp(o->directory, "out/full") && o->frame_interval == 4);
+  TEST_TRUE(o->checkpoint_interval == 9);
   TEST_TRUE(o->write_background == 0 && o->write_surface == 0);
 
   TEST_TRUE(fcm_scene_num_effects(s) == 8);
@@ -208,11 +210,13 @@ static void check_defaults(fcm_ctx *ctx)
   TEST_TRUE(so->newton_rtol == 1e-5 && so->newton_max_iterations == 100);
   TEST_TRUE(so->line_search == 1 && so->project_psd == 0);
   TEST_TRUE(so->representative_acceleration == 9.81 && so->threads == 0);
+  TEST_TRUE(so->newton_rule == FCM_SCENE_NEWTON_AUTO);
   const fcm_scene_time *t = fcm_scene_get_time(s);
   TEST_TRUE(!t->is_static && t->dt == 1.0 / 60.0 && t->num_steps == 60 && t->load_steps == 1);
   TEST_NEAR(t->duration, 1.0, 1e-15, 0);
   const fcm_scene_output *o = fcm_scene_get_output(s);
   TEST_TRUE(!strcmp(o->directory, "fcm-output") && o->frame_interval == 1);
+  TEST_TRUE(o->checkpoint_interval == 0);
   TEST_TRUE(o->write_background == 1 && o->write_surface == 1);
   TEST_TRUE(fcm_scene_num_effects(s) == 0);
   for (int k = 0; k < FCM_EFFECT_TYPE_COUNT; k++)

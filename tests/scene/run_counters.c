@@ -47,7 +47,8 @@ static const char dynamic_json[] =
     " \"solver\": {\"method\": \"direct\"},"
     " \"time\": {\"dt\": 0.01, \"steps\": 4},"
     " \"effects\": [{\"gravity\": {\"acceleration\": [0, 0, -9.81]}},"
-    "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, 0, 0]}}}}]}";
+    "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, 0, "
+    "0]}}}}]}";
 
 /* Embedded box in a 3 x 1 x 1 grid over [0, 1.5] x [0, 0.5]^2; MAX sets the cut. */
 static void embedded_json(char *buf, size_t n, double max_x, const char *name)
@@ -81,6 +82,8 @@ int main(void)
   if (sim) {
     fcm_simulation_get_counters(sim, &c);
     TEST_TRUE(c.inertia == 0);
+    TEST_TRUE(c.mass_assemblies == 0 && c.scale_assemblies == 0);
+    TEST_TRUE(fcm_integrator_mass(fcm_simulation_integrator(sim)) == NULL);
     TEST_TRUE(c.body_force_assemblies == 0);
     TEST_TRUE(c.traction_assemblies == 0);
     TEST_TRUE(c.cell_rules == 0 && c.surface_rules == 0);
@@ -108,7 +111,7 @@ int main(void)
   sim = run(ctx, dynamic_json, &scene, 4);
   if (sim) {
     fcm_simulation_get_counters(sim, &c);
-    TEST_TRUE(c.inertia == 1 && c.mass_assemblies == 1);
+    TEST_TRUE(c.inertia == 1 && c.mass_assemblies == 1 && c.scale_assemblies == 0);
     TEST_TRUE(c.body_force_assemblies == 1 && c.traction_assemblies == 0);
     TEST_TRUE(c.steps == 4);
     TEST_TRUE(c.analyses == 1);
@@ -131,14 +134,15 @@ int main(void)
     TEST_TRUE(c.cell_rules == 1 && c.surface_rules == 0 && c.krylov == 1);
     TEST_TRUE(c.schwarz_blocks == 1);
     TEST_TRUE(c.inertia == 0 && c.body_force_assemblies == 1);
+    TEST_TRUE(c.mass_assemblies == 0 && c.scale_assemblies == 0);
     TEST_TRUE(c.surface_triangles > 0 && c.surface_points > 0);
 
     /* frames and log */
     char dir[] = "/tmp/fcm-run-counters-XXXXXX", path[4096];
     if (mkdtemp(dir)) {
       TEST_OK(ctx, fcm_simulation_write_frame(sim, dir, 0));
-      TEST_OK(ctx, fcm_simulation_write_log(sim, (snprintf(path, sizeof path, "%s/log.csv", dir),
-                                                  path)));
+      TEST_OK(ctx, fcm_simulation_write_log(
+                       sim, (snprintf(path, sizeof path, "%s/log.csv", dir), path)));
       const char *files[] = {"cut_background_0000.vtu", "cut_surface_0000.vtu",
                              "cut_background.pvd", "cut_surface.pvd", "log.csv"};
       for (int k = 0; k < 5; k++) {
@@ -188,7 +192,8 @@ int main(void)
     TEST_TRUE(c.initial_velocity == 1 && c.body_force_assemblies == 0 && c.constraints == 0);
     double lin[3], mass = 1000 * 2.0 / 3.0 * 3.14159265358979 * 0.125, scale = mass * 3.7 * 0.5;
     TEST_OK(ctx, fcm_integrator_momentum(fcm_simulation_integrator(sim), lin, NULL));
-    for (int d = 0; d < 3; d++) TEST_NEAR(lin[d], 0.0, 0.0, 1e-10 * scale);
+    for (int d = 0; d < 3; d++)
+      TEST_NEAR(lin[d], 0.0, 0.0, 1e-10 * scale);
   }
   fcm_simulation_destroy(&sim);
   fcm_scene_destroy(&scene);

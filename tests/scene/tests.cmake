@@ -4,7 +4,10 @@
 fcm_add_test(scene_parse tests/scene/parse.c)
 fcm_add_test(scene_errors tests/scene/errors.c)
 fcm_add_test(scene_alloc tests/scene/alloc.c)
-fcm_add_test(scene_default tests/scene/default.c)
+fcm_add_test(scene_default tests/scene/default.c
+             ARGS ${PROJECT_SOURCE_DIR}/apps/scenes/twisting_cylinder.json)
 fcm_add_test(scene_examples tests/scene/examples.c ARGS ${PROJECT_SOURCE_DIR}/apps/scenes)
 # The scene runner: counters of what a scene computes and skips, frames, log, errors.
 fcm_add_test(scene_run_counters tests/scene/run_counters.c)
+# Checkpoints: a restored run continues bit for bit (static, dynamic, free body); errors.
+fcm_add_test(scene_checkpoint tests/scene/checkpoint.c)

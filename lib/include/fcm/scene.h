@@ -114,6 +114,14 @@ typedef enum fcm_scene_preconditioner {
   FCM_SCENE_PRECONDITIONER_SCHWARZ
 } fcm_scene_preconditioner;
 
+/** Newton stopping rules ("solver.newton.rule"; see fcm_newton_tolerance in sim.h). */
+typedef enum fcm_scene_newton_rule {
+  FCM_SCENE_NEWTON_AUTO = 0,           /**< "auto": representative (dynamic), relative (static) */
+  FCM_SCENE_NEWTON_REPRESENTATIVE = 1, /**< "representative": ||M a - f|| <= rtol ||M a_rep|| */
+  FCM_SCENE_NEWTON_RELATIVE = 2        /**< "relative": ||g|| <= rtol max(||g_0||, ||f_int||,
+                                            ||f_ext||) */
+} fcm_scene_newton_rule;
+
 /** Solver settings ("solver"). */
 typedef struct fcm_scene_solver {
   fcm_scene_linear_solver method;          /**< default DIRECT */
@@ -126,7 +134,8 @@ typedef struct fcm_scene_solver {
   double rtol;               /**< Krylov relative tolerance; [0, 1), default 1e-8 */
   double atol;               /**< Krylov absolute tolerance; >= 0, default 0 */
   int max_iterations;        /**< Krylov iterations; >= 1, default 1000 */
-  double newton_rtol;        /**< ||M a - f|| <= newton_rtol ||M a_rep||; (0, 1), default 1e-5 */
+  fcm_scene_newton_rule newton_rule; /**< stopping rule; default AUTO */
+  double newton_rtol;        /**< tolerance of the rule; (0, 1), default 1e-5 */
   int newton_max_iterations; /**< >= 1, default 100 */
   int line_search;           /**< 1 (default): backtracking line search */
   int project_psd;           /**< 1: project element tangents to PSD; default 0 */
@@ -151,6 +160,7 @@ typedef struct fcm_scene_time {
 typedef struct fcm_scene_output {
   const char *directory; /**< default "fcm-output"; relative to the working directory */
   int frame_interval;    /**< write every frame_interval-th step (>= 1, default 1) */
+  int checkpoint_interval; /**< write a checkpoint every n-th step (>= 0; default 0: never) */
   int write_background;  /**< 1 (default): write the deformed background mesh */
   int write_surface;     /**< 1 (default): write the deformed embedded surface */
 } fcm_scene_output;
@@ -308,9 +318,10 @@ FCM_API fcm_status fcm_scene_create_from_file(fcm_ctx *ctx, const char *path, fc
 FCM_API fcm_status fcm_scene_create_from_string(fcm_ctx *ctx, const char *json_text,
                                                 const char *source_name, fcm_scene **scene);
 
-/** The built-in default scene: a small twisting hollow cylinder (Longva et al. 2020 §6.2,
- * scaled down: Hex20 FCM, one end pushed in, the other twisted). Static NUL-terminated
- * JSON text; never NULL. */
+/** The built-in default scene: the example apps/scenes/twisting_cylinder.json, a hollow
+ * cylinder with one end pushed in and the other twisted (Longva et al. 2020 §6.2, on a
+ * coarse Hex20 grid), embedded in the library when it is built. Static NUL-terminated JSON
+ * text; never NULL. */
 FCM_API const char *fcm_scene_default_json(void);
 
 /** fcm_scene_create_from_string(ctx, fcm_scene_default_json(), "<default>", scene). */

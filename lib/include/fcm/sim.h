@@ -4,8 +4,8 @@
  * damping, prescribed motion of node sets, direct (CHOLMOD -> UMFPACK) or Krylov solves.
  *
  * Phases: fcm_integrator_create() -> configure (fcm_integrator_add_*, set_state) ->
- * fcm_integrator_setup() (assembles the mass and the loads, allocates everything, analyzes
- * the matrix) -> fcm_integrator_step() many times -> fcm_integrator_destroy().
+ * fcm_integrator_setup() (assembles the mass — dynamics only — and the loads, allocates
+ * everything, analyzes the matrix) -> fcm_integrator_step() many times -> fcm_integrator_destroy().
  *
  * Backward Euler (unknown u = u_{n+1}, step h, D the damping matrix):
  *   E(u) = 1/2 (u - u^)^T M (u - u^)/h^2 + Psi(u) - f_ext(t_{n+1})^T u
@@ -38,7 +38,8 @@ typedef enum fcm_integrator_kind {
 /** Newton stopping rules (g = gradient of E restricted to the free DOFs, 2-norm). */
 typedef enum fcm_newton_tolerance {
   /** ||g|| <= tol ||M a_rep|| (Longva et al. §6: ||M v' - f_total|| <= 1e-5 ||M a_rep||);
-   * a_rep is a uniform acceleration of magnitude rep_acceleration (M with free rows). */
+   * a_rep is a uniform acceleration of magnitude rep_acceleration (M with free rows).
+   * STATIC runs, which have no M, use the equal body force of rho a_rep instead. */
   FCM_NEWTON_TOL_REPRESENTATIVE = 0,
   /** ||g|| <= max(tol R, atol), R = max(||g|| at the start of the Newton solve,
    * ||f_int||, ||f_ext||) at the current iterate (force scale of the balance). */
@@ -234,8 +235,8 @@ FCM_API fcm_status fcm_integrator_add_constraint(fcm_integrator *integ, fcm_inde
                                                  const fcm_index *nodes, const fcm_motion *motion,
                                                  int *id);
 
-/** Validate the options, build the constrained DOF list, assemble the mass matrix and the
- * loads, allocate every work array and solver, and run the symbolic analysis (direct).
+/** Validate the options, build the constrained DOF list, assemble the mass matrix
+ * (BACKWARD_EULER only) and the loads, allocate every work array and solver, and run the symbolic analysis (direct).
  * Constrained DOFs get their prescribed velocity at the current time.
  * @return FCM_OK, FCM_ERR_ARG (option out of range: named; DOF constrained twice; zero
  * representative force: set the density or use the relative rule), errors of the assembly
@@ -292,12 +293,26 @@ FCM_API fcm_status fcm_integrator_energy(fcm_integrator *integ, double *kinetic,
 
 /** Linear momentum p = sum over nodes of (M v)_a and angular momentum about the origin
  * L = sum (X_a + u_a) x (M v)_a (exact for the interpolated fields with the consistent
- * mass). Either output may be NULL. After setup. @return FCM_OK, FCM_ERR_ARG. */
+ * mass); zero for STATIC integrators. Either output may be NULL. After setup. @return FCM_OK, FCM_ERR_ARG. */
 FCM_API fcm_status fcm_integrator_momentum(fcm_integrator *integ, double linear[3],
                                            double angular[3]);
 
-/** The mass matrix (after setup; borrowed; NULL before). */
+/** The mass matrix (borrowed): after the setup of a BACKWARD_EULER integrator; NULL before
+ * and for STATIC integrators, which never assemble it. */
 FCM_API const fcm_csr *fcm_integrator_mass(const fcm_integrator *integ);
+
+/** What fcm_integrator_setup() assembled (all 0 before the setup). */
+typedef struct fcm_integrator_setup_info {
+  int mass_assemblies;  /**< 1 for BACKWARD_EULER; 0 for STATIC (no inertia, no M) */
+  int load_assemblies;  /**< one per gravity, body-force and traction load */
+  int scale_assemblies; /**< 1 when a STATIC run with the REPRESENTATIVE rule had to assemble
+                             the body force of rho a_rep for its force scale (no gravity load
+                             equal to a_rep to reuse); else 0 */
+} fcm_integrator_setup_info;
+
+/** Copy the setup counts out (zeros for NULL). */
+FCM_API void fcm_integrator_get_setup_info(const fcm_integrator *integ,
+                                           fcm_integrator_setup_info *info);
 
 #ifdef __cplusplus
 }

@@ -25,6 +25,8 @@ extern "C" {
 typedef struct fcm_simulation_options {
   fcm_index max_steps; /**< > 0: stop after this many steps (fcm_simulation_done()); 0
                             (default): the scene's step count */
+  int checkpoint_interval; /**< >= 0: fcm_simulation_checkpoint_due() every n-th step (0:
+                                never); -1 (default): the scene's output.checkpoint_interval */
 } fcm_simulation_options;
 
 /** Defaults as documented on each member. */
@@ -35,9 +37,10 @@ typedef struct fcm_simulation_counters {
   int cell_rules;            /**< 1: embedded cell rules were built (scene has a geometry) */
   int surface_rules;         /**< 1: the cell rules carry surface rules */
   int inertia;               /**< 1: dynamic integrator (inertia term); 0: static */
-  int mass_assemblies;       /**< consistent-mass assemblies (the integrator assembles M once at
-                                  setup; it does so for static runs too, see the report) */
+  int mass_assemblies;       /**< consistent-mass assemblies: 1 for dynamic scenes, 0 static */
   int body_force_assemblies; /**< gravity load assemblies (one per gravity effect) */
+  int scale_assemblies;      /**< 1: a static scene without gravity assembled the body force of
+                                  rho a_rep once for the Newton force scale (see sim.h) */
   int traction_assemblies;   /**< surface load assemblies (traction and pressure effects) */
   int damping;               /**< 1: a Rayleigh damping matrix is used */
   int initial_velocity;      /**< initial-velocity effects applied */
@@ -106,6 +109,41 @@ FCM_API fcm_status fcm_simulation_write_frame(fcm_simulation *sim, const char *d
  * "step,time,newton_iterations,linear_iterations,residual,energy,wall_time" and one row per
  * step taken. @return FCM_OK, FCM_ERR_IO, FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_simulation_write_log(fcm_simulation *sim, const char *path);
+
+/** Save the run: write a checkpoint to `path` atomically (a temporary beside it, synced, then
+ * renamed). It holds the integrator state (displacement, velocity, time, step count) bit for
+ * bit, the per-step log, the times of the frames written, the cumulative Newton, linear and
+ * tangent counts, and a fingerprint of the scene and its discretization; a checksum closes
+ * the file. Host byte order (the header records it). Format: lib/src/scene/checkpoint.c.
+ * @return FCM_OK, FCM_ERR_ARG (NULL), FCM_ERR_IO (naming the path; nothing is left
+ * behind), FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_simulation_write_checkpoint(fcm_simulation *sim, const char *path);
+
+/** Continue a run: restore a checkpoint into a simulation that was just created from the
+ * same scene (only its time span and output section may differ, so a run can be extended)
+ * and has neither stepped nor written a frame. Stepping on then reproduces the states of the
+ * uninterrupted run bit for bit (same build, same thread counts). The frames of the earlier
+ * run count as written: the next frame index is the `frames` counter, and the PVD indexes,
+ * when next written into a directory, first list the earlier frames of that directory
+ * (<name>_background_NNNN.vtu, NNNN = 0 .. frames-1, as fcm-sim numbers them). Solver
+ * counters (factorizations, analyses) count this process only.
+ * @return FCM_OK; FCM_ERR_IO (cannot open or read, naming the path); FCM_ERR_FORMAT (not
+ * a checkpoint, other byte order or version, truncated, checksum mismatch, a count out of
+ * range: named); FCM_ERR_ARG (the simulation has stepped; a different scene or DOF count;
+ * more steps than the simulation takes; a non-finite state); FCM_ERR_ALLOC. On failure the
+ * simulation is unchanged. */
+FCM_API fcm_status fcm_simulation_read_checkpoint(fcm_simulation *sim, const char *path);
+
+/** 1 when a checkpoint is due after the step just taken (every checkpoint_interval-th step,
+ * from the options or the scene), else 0. */
+FCM_API int fcm_simulation_checkpoint_due(const fcm_simulation *sim);
+
+/** Centre of mass of the deformed body, 1^T M x / 1^T M 1 per component with x = X + u at
+ * the nodes (exact for the interpolated field and the mass quadrature, embedded or not).
+ * Dynamic scenes only. fcm_simulation_summary_view() prints its drift for a free body (no
+ * constraint, gravity or surface load), which momentum conservation keeps at zero.
+ * @return FCM_OK, FCM_ERR_ARG (NULL; a static scene has no mass matrix), FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_simulation_center_of_mass(fcm_simulation *sim, double com[3]);
 
 /** Copy the counters out. */
 FCM_API void fcm_simulation_get_counters(const fcm_simulation *sim,

@@ -1,6 +1,6 @@
 /* The scene runner: builds the pipeline a scene asks for (mesh, geometry, cell rules, space,
  * integrator with exactly its effects), steps it, writes frames and the per-step log. */
-#include "fcm/simulation.h"
+#include "scene/run_impl.h"
 
 #include "core/core_impl.h"
 #include "fcm/embed.h"
@@ -14,41 +14,25 @@
 #include <stdio.h>
 #include <string.h>
 
-typedef struct log_row {
-  double time, residual, energy, wall;
-  long long newton, linear;
-} log_row;
-
-struct fcm_simulation {
-  fcm_ctx *ctx;
-  const fcm_scene *scene;
-  fcm_simulation_options opts;
-  fcm_mesh *mesh;
-  fcm_geometry *geom;
-  fcm_cell_rules *rules;
-  fcm_space *space;
-  fcm_integrator *integ;
-  fcm_simulation_counters c;
-  long long num_steps;
-  /* output scratch */
-  fcm_index nn;      /* background nodes */
-  double *node_u, *node_v;
-  int32_t *cell_active;
-  double *cell_phi;
-  fcm_index ns, nt;  /* surface points and triangles (compacted) */
-  fcm_index *surf_tri, *surf_cell;
-  double *surf_X, *surf_xi, *surf_u, *surf_x;
-  fcm_pvd *pvd_bg, *pvd_surf;
-  /* log */
-  log_row *log;
-  long long log_n, log_cap;
-};
-
 fcm_simulation_options fcm_simulation_options_default(void)
 {
   fcm_simulation_options o;
   memset(&o, 0, sizeof o);
+  o.checkpoint_interval = -1;
   return o;
+}
+
+fcm_status fcm__sim_grow(fcm_ctx *ctx, void **array, long long *cap, long long need, size_t size)
+{
+  fcm_status st = FCM_OK;
+  if (need <= *cap) return FCM_OK;
+  long long c = *cap ? *cap : 64;
+  while (c < need)
+    c *= 2;
+  FCM_TRY(ctx, fcm__resize(ctx, array, (size_t)*cap, (size_t)c, size));
+  *cap = c;
+cleanup:
+  return st;
 }
 
 /* ---------------------------------------------------------------- effect modules */
@@ -67,9 +51,11 @@ static void surface_field(void *user, const double x[3], const double normal[3],
   value[0] = value[1] = value[2] = 0.0;
   if (e->type == FCM_EFFECT_TRACTION) {
     if (fcm_region_contains(&e->traction.region, x))
-      for (int d = 0; d < 3; d++) value[d] = e->traction.traction[d];
+      for (int d = 0; d < 3; d++)
+        value[d] = e->traction.traction[d];
   } else if (normal && fcm_region_contains(&e->pressure.region, x)) {
-    for (int d = 0; d < 3; d++) value[d] = -e->pressure.pressure * normal[d];
+    for (int d = 0; d < 3; d++)
+      value[d] = -e->pressure.pressure * normal[d];
   }
 }
 
@@ -83,9 +69,8 @@ static fcm_status region_nodes(fcm_simulation *S, const fcm_region *r, int effec
   if (r->kind == FCM_REGION_NODES) {
     for (fcm_index k = 0; k < r->num_nodes; k++) {
       FCM_CHECK(r->nodes[k] >= 0 && r->nodes[k] < S->nn, S->ctx, FCM_ERR_ARG,
-                "scene %s: effects[%d]: node %lld out of range [0, %lld)",
-                fcm_scene_name(S->scene), effect_index, (long long)r->nodes[k],
-                (long long)S->nn);
+                "scene %s: effects[%d]: node %lld out of range [0, %lld)", fcm_scene_name(S->scene),
+                effect_index, (long long)r->nodes[k], (long long)S->nn);
       if (nodes) nodes[n] = r->nodes[k];
       n++;
     }
@@ -111,7 +96,8 @@ static fcm_status add_constraint(fcm_simulation *S, const fcm_effect *e)
   const fcm_region *r = e->type == FCM_EFFECT_FIXED ? &e->fixed.region : &e->motion.region;
   fcm_motion m = fcm_motion_default();
   if (e->type == FCM_EFFECT_FIXED) {
-    for (int d = 0; d < 3; d++) m.components[d] = e->fixed.components[d];
+    for (int d = 0; d < 3; d++)
+      m.components[d] = e->fixed.components[d];
   } else {
     const fcm_effect_motion *em = &e->motion;
     for (int d = 0; d < 3; d++) {
@@ -154,8 +140,8 @@ static fcm_status apply_surface(fcm_simulation *S, const fcm_effect *e)
   FCM_CHECK(S->c.surface_rules, S->ctx, FCM_ERR_ARG,
             "scene %s: effects[%d]: %s needs an embedded geometry with surface rules",
             fcm_scene_name(S->scene), e->index, fcm_effect_type_name(e->type));
-  FCM_TRY(S->ctx, fcm_integrator_add_traction(S->integ, surface_field, (void *)e, window_scale,
-                                              (void *)e));
+  FCM_TRY(S->ctx,
+          fcm_integrator_add_traction(S->integ, surface_field, (void *)e, window_scale, (void *)e));
   S->c.traction_assemblies++;
 cleanup:
   return st;
@@ -168,34 +154,63 @@ static const effect_apply_fn effect_apply[FCM_EFFECT_TYPE_COUNT] = {
     [FCM_EFFECT_PRESSURE] = apply_surface,
 };
 
+/* Centre of mass of the body at displacement u (NULL: the reference one), as the space
+ * integrates it: 1^T M x / 1^T M 1 per component, x = X + u (exact for the mass quadrature,
+ * embedded or not). Needs the mass matrix (dynamic scenes). */
+static fcm_status center_of_mass(fcm_simulation *S, const double *u, double com[3])
+{
+  fcm_status st = FCM_OK;
+  fcm_index n = fcm_integrator_num_dofs(S->integ);
+  const fcm_csr *M = fcm_integrator_mass(S->integ);
+  const double *X = fcm_mesh_coords(S->mesh);
+  double *x = NULL, *Mx = NULL, num[3] = {0, 0, 0}, den[3] = {0, 0, 0};
+  FCM_CHECK(M, S->ctx, FCM_ERR_ARG,
+            "simulation %s: the centre of mass needs the mass matrix (static scenes have none)",
+            fcm_scene_name(S->scene));
+  FCM_ALLOC(S->ctx, n, x);
+  FCM_ALLOC(S->ctx, n, Mx);
+  for (fcm_index a = 0; a < S->nn; a++) {
+    fcm_index dof = fcm_space_node_dof(S->space, a);
+    if (dof >= 0)
+      for (int d = 0; d < 3; d++)
+        x[dof + d] = X[3 * a + d] + (u ? u[dof + d] : 0.0);
+  }
+  FCM_TRY(S->ctx, fcm_csr_apply(M, 1.0, x, 0.0, Mx));
+  for (fcm_index i = 0; i < n; i++)
+    num[i % 3] += Mx[i];
+  for (fcm_index i = 0; i < n; i++)
+    x[i] = 1.0;
+  FCM_TRY(S->ctx, fcm_csr_apply(M, 1.0, x, 0.0, Mx));
+  for (fcm_index i = 0; i < n; i++)
+    den[i % 3] += Mx[i];
+  for (int d = 0; d < 3; d++)
+    com[d] = den[d] > 0.0 ? num[d] / den[d] : 0.0;
+cleanup:
+  fcm__free(S->ctx, x);
+  fcm__free(S->ctx, Mx);
+  return st;
+}
+
+fcm_status fcm_simulation_center_of_mass(fcm_simulation *S, double com[3])
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(S && com, S ? S->ctx : NULL, FCM_ERR_ARG, "simulation: center_of_mass: NULL");
+  FCM_TRY(S->ctx, center_of_mass(S, fcm_integrator_displacement(S->integ), com));
+cleanup:
+  return st;
+}
+
 /* Initial velocities: v = v0 + omega x (X - c) on each region's nodes, c the centre of mass
- * of the body as the space integrates it (1^T M X / 1^T M 1 per component: exact for the
- * mass quadrature, embedded or not). */
+ * of the body in the reference configuration. */
 static fcm_status apply_initial_velocities(fcm_simulation *S)
 {
   fcm_status st = FCM_OK;
   fcm_index n = fcm_integrator_num_dofs(S->integ);
-  double *v = NULL, *x = NULL, *Mx = NULL, com[3] = {0, 0, 0};
+  double *v = NULL, com[3];
   const double *X = fcm_mesh_coords(S->mesh);
   FCM_ALLOC(S->ctx, n, v);
-  FCM_ALLOC(S->ctx, n, x);
-  FCM_ALLOC(S->ctx, n, Mx);
   memcpy(v, fcm_integrator_velocity(S->integ), (size_t)n * sizeof *v);
-  {
-    const fcm_csr *M = fcm_integrator_mass(S->integ);
-    double num[3] = {0, 0, 0}, den[3] = {0, 0, 0};
-    for (fcm_index a = 0; a < S->nn; a++) {
-      fcm_index dof = fcm_space_node_dof(S->space, a);
-      if (dof >= 0)
-        for (int d = 0; d < 3; d++) x[dof + d] = X[3 * a + d];
-    }
-    FCM_TRY(S->ctx, fcm_csr_apply(M, 1.0, x, 0.0, Mx));
-    for (fcm_index i = 0; i < n; i++) num[i % 3] += Mx[i];
-    for (fcm_index i = 0; i < n; i++) x[i] = 1.0;
-    FCM_TRY(S->ctx, fcm_csr_apply(M, 1.0, x, 0.0, Mx));
-    for (fcm_index i = 0; i < n; i++) den[i % 3] += Mx[i];
-    for (int d = 0; d < 3; d++) com[d] = den[d] > 0.0 ? num[d] / den[d] : 0.0;
-  }
+  FCM_TRY(S->ctx, center_of_mass(S, NULL, com));
   for (int k = 0; k < fcm_scene_num_effects(S->scene); k++) {
     const fcm_effect *e = fcm_scene_get_effect(S->scene, k);
     if (e->type != FCM_EFFECT_INITIAL_VELOCITY) continue;
@@ -205,7 +220,8 @@ static fcm_status apply_initial_velocities(fcm_simulation *S)
       if (dof < 0) continue;
       int in = 0;
       if (r->kind == FCM_REGION_NODES) {
-        for (fcm_index j = 0; j < r->num_nodes && !in; j++) in = r->nodes[j] == a;
+        for (fcm_index j = 0; j < r->num_nodes && !in; j++)
+          in = r->nodes[j] == a;
       } else {
         in = fcm_region_contains(r, X + 3 * a);
       }
@@ -217,8 +233,6 @@ static fcm_status apply_initial_velocities(fcm_simulation *S)
                                            fcm_integrator_step_count(S->integ)));
 cleanup:
   fcm__free(S->ctx, v);
-  fcm__free(S->ctx, x);
-  fcm__free(S->ctx, Mx);
   return st;
 }
 
@@ -240,14 +254,13 @@ static fcm_status build_geometry(fcm_simulation *S, const fcm_scene_geometry *g)
     FCM_TRY(ctx, fcm_geometry_create_hemisphere(ctx, g->center, g->radius, g->resolution, &raw));
     break;
   case FCM_SCENE_GEOMETRY_HOLLOW_BALL:
-    FCM_TRY(ctx, fcm_geometry_create_hollow_ball(ctx, g->center, g->inner_radius,
-                                                 g->outer_radius, g->hole_radius, g->resolution,
-                                                 g->layers, &raw));
+    FCM_TRY(ctx, fcm_geometry_create_hollow_ball(ctx, g->center, g->inner_radius, g->outer_radius,
+                                                 g->hole_radius, g->resolution, g->layers, &raw));
     break;
   case FCM_SCENE_GEOMETRY_TUBE:
-    FCM_TRY(ctx, fcm_geometry_create_tube(ctx, g->center, g->axis, g->inner_radius,
-                                          g->outer_radius, g->length, g->radial_cells,
-                                          g->angular_cells, g->axial_cells, &raw));
+    FCM_TRY(ctx, fcm_geometry_create_tube(ctx, g->center, g->axis, g->inner_radius, g->outer_radius,
+                                          g->length, g->radial_cells, g->angular_cells,
+                                          g->axial_cells, &raw));
     break;
   case FCM_SCENE_GEOMETRY_GMSH:
     FCM_TRY(ctx, fcm_geometry_create_from_gmsh(ctx, g->mesh, &raw));
@@ -318,6 +331,13 @@ static fcm_integrator_options integrator_options(fcm_simulation *S)
   o.load_steps = tm->load_steps;
   o.newton_max_iterations = sv->newton_max_iterations;
   o.newton_tolerance = sv->newton_rtol;
+  /* Static scenes have no mass and no inertia; the force-balance (relative) rule needs
+   * neither, where the representative force would take a body-force pass of its own. */
+  o.tolerance_mode = sv->newton_rule == FCM_SCENE_NEWTON_REPRESENTATIVE
+                         ? FCM_NEWTON_TOL_REPRESENTATIVE
+                     : sv->newton_rule == FCM_SCENE_NEWTON_RELATIVE ? FCM_NEWTON_TOL_RELATIVE
+                     : tm->is_static                                ? FCM_NEWTON_TOL_RELATIVE
+                                                                    : FCM_NEWTON_TOL_REPRESENTATIVE;
   o.rep_acceleration = sv->representative_acceleration;
   o.line_search = sv->line_search;
   o.project_psd = sv->project_psd;
@@ -325,9 +345,8 @@ static fcm_integrator_options integrator_options(fcm_simulation *S)
                     : sv->method == FCM_SCENE_SOLVER_CG   ? FCM_LINEAR_CG
                                                           : FCM_LINEAR_MINRES;
   o.direct_method = sv->direct;
-  o.preconditioner = sv->preconditioner == FCM_SCENE_PRECONDITIONER_NONE ? FCM_PRECOND_NONE
-                     : sv->preconditioner == FCM_SCENE_PRECONDITIONER_JACOBI
-                         ? FCM_PRECOND_JACOBI
+  o.preconditioner = sv->preconditioner == FCM_SCENE_PRECONDITIONER_NONE     ? FCM_PRECOND_NONE
+                     : sv->preconditioner == FCM_SCENE_PRECONDITIONER_JACOBI ? FCM_PRECOND_JACOBI
                      : sv->preconditioner == FCM_SCENE_PRECONDITIONER_BLOCK_JACOBI
                          ? FCM_PRECOND_BLOCK_JACOBI
                          : FCM_PRECOND_SCHWARZ;
@@ -371,7 +390,8 @@ static fcm_status build_surface(fcm_simulation *S)
   const double *GX = fcm_geometry_coords(S->geom);
   fcm_index *map = NULL;
   FCM_ALLOC(ctx, nv, map);
-  for (fcm_index i = 0; i < nv; i++) map[i] = -1;
+  for (fcm_index i = 0; i < nv; i++)
+    map[i] = -1;
   fcm_index ns = 0;
   for (fcm_index k = 0; k < 3 * nt; k++)
     if (map[tri[k]] < 0) map[tri[k]] = ns++;
@@ -381,10 +401,12 @@ static fcm_status build_surface(fcm_simulation *S)
   FCM_ALLOC(ctx, 3 * ns, S->surf_xi);
   FCM_ALLOC(ctx, 3 * ns, S->surf_u);
   FCM_ALLOC(ctx, 3 * ns, S->surf_x);
-  for (fcm_index k = 0; k < 3 * nt; k++) S->surf_tri[k] = map[tri[k]];
+  for (fcm_index k = 0; k < 3 * nt; k++)
+    S->surf_tri[k] = map[tri[k]];
   for (fcm_index i = 0; i < nv; i++)
     if (map[i] >= 0)
-      for (int d = 0; d < 3; d++) S->surf_X[3 * map[i] + d] = GX[3 * i + d];
+      for (int d = 0; d < 3; d++)
+        S->surf_X[3 * map[i] + d] = GX[3 * i + d];
   if (ns > 0)
     FCM_TRY(ctx, fcm_space_locate(S->space, ns, S->surf_X, S->surf_cell, S->surf_xi, NULL));
   S->ns = ns;
@@ -411,6 +433,9 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   FCM_CHECK(S->opts.max_steps >= 0, ctx, FCM_ERR_ARG,
             "simulation: max_steps = %lld must be >= 0 (0: the scene's)",
             (long long)S->opts.max_steps);
+  FCM_CHECK(S->opts.checkpoint_interval >= -1, ctx, FCM_ERR_ARG,
+            "simulation: checkpoint_interval = %d must be >= 0, or -1 for the scene's",
+            S->opts.checkpoint_interval);
   const fcm_scene_time *tm = fcm_scene_get_time(scene);
   S->num_steps = tm->num_steps;
   if (S->opts.max_steps > 0 && S->opts.max_steps < S->num_steps) S->num_steps = S->opts.max_steps;
@@ -443,17 +468,24 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
     S->c.schwarz_blocks = count_schwarz_blocks(S, io.schwarz_theta);
     if (S->c.schwarz_blocks == 0) io.preconditioner = FCM_PRECOND_JACOBI; /* nothing to block */
   }
-  FCM_TRY(ctx, fcm_integrator_create(ctx, S->space, fcm_scene_get_material(scene), &io,
-                                     &S->integ));
+  FCM_TRY(ctx, fcm_integrator_create(ctx, S->space, fcm_scene_get_material(scene), &io, &S->integ));
   for (int k = 0; k < fcm_scene_num_effects(scene); k++) {
     const fcm_effect *e = fcm_scene_get_effect(scene, k);
     if (effect_apply[e->type]) FCM_TRY(ctx, effect_apply[e->type](S, e));
   }
   FCM_TRY(ctx, fcm_integrator_setup(S->integ));
-  S->c.mass_assemblies = 1; /* fcm_integrator_setup() assembles M once, static or not */
+  {
+    fcm_integrator_setup_info si;
+    fcm_integrator_get_setup_info(S->integ, &si);
+    S->c.mass_assemblies = si.mass_assemblies;
+    S->c.scale_assemblies = si.scale_assemblies;
+  }
   S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);
   if (S->c.inertia && fcm_scene_count_effects(scene, FCM_EFFECT_INITIAL_VELOCITY) > 0)
     FCM_TRY(ctx, apply_initial_velocities(S));
+  S->free_body = S->c.inertia && S->c.constraints == 0 && S->c.body_force_assemblies == 0 &&
+                 S->c.traction_assemblies == 0;
+  if (S->free_body) FCM_TRY(ctx, center_of_mass(S, NULL, S->com0));
 
   /* output scratch */
   fcm_index nc = fcm_mesh_num_cells(S->mesh);
@@ -486,10 +518,10 @@ void fcm_simulation_destroy(fcm_simulation **sim)
   fcm_cell_rules_destroy(&S->rules);
   fcm_geometry_destroy(&S->geom);
   fcm_mesh_destroy(&S->mesh);
-  void *arrays[] = {S->node_u,   S->node_v,  S->cell_active, S->cell_phi, S->surf_tri,
-                    S->surf_cell, S->surf_X,  S->surf_xi,     S->surf_u,   S->surf_x,
-                    S->log};
-  for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++) fcm__free(ctx, arrays[k]);
+  void *arrays[] = {S->node_u, S->node_v,  S->cell_active, S->cell_phi, S->surf_tri, S->surf_cell,
+                    S->surf_X, S->surf_xi, S->surf_u,      S->surf_x,   S->log,      S->frame_time};
+  for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
+    fcm__free(ctx, arrays[k]);
   fcm__free(ctx, S);
   *sim = NULL;
 }
@@ -502,8 +534,8 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   fcm_step_info si;
   memset(&si, 0, sizeof si);
   FCM_CHECK(S, NULL, FCM_ERR_ARG, "simulation: NULL");
-  FCM_CHECK(!fcm_simulation_done(S), S->ctx, FCM_ERR_ARG,
-            "simulation %s: all %lld steps are taken", fcm_scene_name(S->scene), S->num_steps);
+  FCM_CHECK(!fcm_simulation_done(S), S->ctx, FCM_ERR_ARG, "simulation %s: all %lld steps are taken",
+            fcm_scene_name(S->scene), S->num_steps);
   double t0 = fcm_wtime();
   st = fcm_integrator_step(S->integ, &si);
   double wall = fcm_wtime() - t0;
@@ -520,13 +552,9 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
     goto cleanup;
   }
   S->c.steps++;
-  if (S->log_n == S->log_cap) {
-    long long cap = S->log_cap ? 2 * S->log_cap : 64;
-    FCM_TRY(S->ctx, fcm__resize(S->ctx, (void **)&S->log, (size_t)S->log_cap, (size_t)cap,
-                                sizeof *S->log));
-    S->log_cap = cap;
-  }
-  log_row *r = &S->log[S->log_n++];
+  FCM_TRY(S->ctx,
+          fcm__sim_grow(S->ctx, (void **)&S->log, &S->log_cap, S->log_n + 1, sizeof *S->log));
+  fcm__log_row *r = &S->log[S->log_n++];
   r->time = si.time;
   r->newton = si.newton_iterations;
   r->linear = si.linear_iterations;
@@ -537,11 +565,26 @@ cleanup:
   return st;
 }
 
-int fcm_simulation_done(const fcm_simulation *S) { return !S || S->c.steps >= S->num_steps; }
-long long fcm_simulation_step_count(const fcm_simulation *S) { return S ? S->c.steps : 0; }
-long long fcm_simulation_num_steps(const fcm_simulation *S) { return S ? S->num_steps : 0; }
-fcm_integrator *fcm_simulation_integrator(fcm_simulation *S) { return S ? S->integ : NULL; }
-const fcm_space *fcm_simulation_space(const fcm_simulation *S) { return S ? S->space : NULL; }
+int fcm_simulation_done(const fcm_simulation *S)
+{
+  return !S || S->c.steps >= S->num_steps;
+}
+long long fcm_simulation_step_count(const fcm_simulation *S)
+{
+  return S ? S->c.steps : 0;
+}
+long long fcm_simulation_num_steps(const fcm_simulation *S)
+{
+  return S ? S->num_steps : 0;
+}
+fcm_integrator *fcm_simulation_integrator(fcm_simulation *S)
+{
+  return S ? S->integ : NULL;
+}
+const fcm_space *fcm_simulation_space(const fcm_simulation *S)
+{
+  return S ? S->space : NULL;
+}
 
 int fcm_simulation_frame_due(const fcm_simulation *S)
 {
@@ -565,6 +608,24 @@ void fcm_simulation_get_counters(const fcm_simulation *S, fcm_simulation_counter
 }
 
 /* ---------------------------------------------------------------- output */
+
+/* Create the PVD index <dir>/<name>_<kind>.pvd; after a restored checkpoint it first lists
+ * the frames the earlier run wrote (<dir>/<name>_<kind>_NNNN.vtu, NNNN = 0, 1, ...). */
+static fcm_status open_pvd(fcm_simulation *S, const char *dir, const char *kind, fcm_pvd **pvd)
+{
+  fcm_status st = FCM_OK;
+  char path[4096];
+  const char *name = fcm_scene_name(S->scene);
+  snprintf(path, sizeof path, "%s/%s_%s.pvd", dir, name, kind);
+  FCM_TRY(S->ctx, fcm_pvd_create(S->ctx, path, pvd));
+  if (S->restored)
+    for (long long k = 0; k < S->c.frames; k++) {
+      snprintf(path, sizeof path, "%s/%s_%s_%04lld.vtu", dir, name, kind, k);
+      FCM_TRY(S->ctx, fcm_pvd_add(*pvd, S->frame_time[k], path));
+    }
+cleanup:
+  return st;
+}
 
 fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int index)
 {
@@ -597,30 +658,25 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "volume_fraction", 1, nc, S->cell_phi));
     snprintf(path, sizeof path, "%s/%s_background_%04d.vtu", dir, name, index);
     FCM_TRY(ctx, fcm_vtu_write(vtu, path, NULL));
-    if (!S->pvd_bg) {
-      char pvd[4096];
-      snprintf(pvd, sizeof pvd, "%s/%s_background.pvd", dir, name);
-      FCM_TRY(ctx, fcm_pvd_create(ctx, pvd, &S->pvd_bg));
-    }
+    if (!S->pvd_bg) FCM_TRY(ctx, open_pvd(S, dir, "background", &S->pvd_bg));
     FCM_TRY(ctx, fcm_pvd_add(S->pvd_bg, time, path));
   }
   if (S->ns > 0) {
     FCM_TRY(ctx, fcm_space_interpolate(S->space, S->ns, S->surf_cell, S->surf_xi, u, S->surf_u));
-    for (fcm_index i = 0; i < 3 * S->ns; i++) S->surf_x[i] = S->surf_X[i] + S->surf_u[i];
+    for (fcm_index i = 0; i < 3 * S->ns; i++)
+      S->surf_x[i] = S->surf_X[i] + S->surf_u[i];
     fcm_vtu_clear(vtu);
     FCM_TRY(ctx, fcm_vtu_set_points(vtu, S->ns, S->surf_x));
     FCM_TRY(ctx, fcm_vtu_set_cells(vtu, FCM_VTK_TRIANGLE, S->nt, S->surf_tri));
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "displacement", 3, S->ns, S->surf_u));
     snprintf(path, sizeof path, "%s/%s_surface_%04d.vtu", dir, name, index);
     FCM_TRY(ctx, fcm_vtu_write(vtu, path, NULL));
-    if (!S->pvd_surf) {
-      char pvd[4096];
-      snprintf(pvd, sizeof pvd, "%s/%s_surface.pvd", dir, name);
-      FCM_TRY(ctx, fcm_pvd_create(ctx, pvd, &S->pvd_surf));
-    }
+    if (!S->pvd_surf) FCM_TRY(ctx, open_pvd(S, dir, "surface", &S->pvd_surf));
     FCM_TRY(ctx, fcm_pvd_add(S->pvd_surf, time, path));
   }
-  S->c.frames++;
+  FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&S->frame_time, &S->frame_cap, S->c.frames + 1,
+                             sizeof *S->frame_time));
+  S->frame_time[S->c.frames++] = time;
   S->c.time_output += fcm_wtime() - t0;
 cleanup:
   fcm_vtu_destroy(&vtu);
@@ -638,10 +694,10 @@ fcm_status fcm_simulation_write_log(fcm_simulation *S, const char *path)
                       S->ctx, &af,
                       "step,time,newton_iterations,linear_iterations,residual,energy,wall_time\n"));
   for (long long k = 0; k < S->log_n; k++) {
-    const log_row *r = &S->log[k];
-    FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, "%lld,%.17g,%lld,%lld,%.17g,%.17g,%.6g\n",
-                                          k + 1, r->time, r->newton, r->linear, r->residual,
-                                          r->energy, r->wall));
+    const fcm__log_row *r = &S->log[k];
+    FCM_TRY(S->ctx,
+            fcm__io_atomic_printf(S->ctx, &af, "%lld,%.17g,%lld,%lld,%.17g,%.17g,%.6g\n", k + 1,
+                                  r->time, r->newton, r->linear, r->residual, r->energy, r->wall));
   }
   FCM_TRY(S->ctx, fcm__io_atomic_commit(S->ctx, &af));
 cleanup:
@@ -661,17 +717,19 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
   if (!S || !f) return;
   const fcm_simulation_counters *c = &S->c;
   char b[256];
-  fprintf(f, "simulation %s: %lld of %lld steps, %lld DOFs\n", fcm_scene_name(S->scene),
-          c->steps, S->num_steps, (long long)c->num_dofs);
+  fprintf(f, "simulation %s: %lld of %lld steps, %lld DOFs\n", fcm_scene_name(S->scene), c->steps,
+          S->num_steps, (long long)c->num_dofs);
   line(f, c->cell_rules, "embedded cell rules", c->cell_rules ? "" : "(no geometry)");
   line(f, c->surface_rules, "surface rules", c->surface_rules ? "" : "(no traction or pressure)");
   line(f, c->inertia, "inertia (backward Euler)", c->inertia ? "" : "(static scene)");
-  snprintf(b, sizeof b, "%d%s", c->mass_assemblies,
-           c->inertia ? "" : " (integrator setup; used only by the stopping rule)");
-  line(f, c->mass_assemblies > 0, "mass assemblies", b);
+  snprintf(b, sizeof b, "%d", c->mass_assemblies);
+  line(f, c->mass_assemblies > 0, "mass assemblies", c->mass_assemblies ? b : "(static scene)");
   snprintf(b, sizeof b, "%d", c->body_force_assemblies);
   line(f, c->body_force_assemblies > 0, "body-force assemblies",
        c->body_force_assemblies ? b : "(no gravity)");
+  if (c->scale_assemblies)
+    line(f, 1, "force-scale assembly",
+         "1 (static, no gravity: body force of rho a_rep for the stopping rule)");
   snprintf(b, sizeof b, "%d", c->traction_assemblies);
   line(f, c->traction_assemblies > 0, "surface-load assemblies",
        c->traction_assemblies ? b : "(no traction or pressure)");
@@ -683,17 +741,26 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
   line(f, c->constraints > 0, "constraints", c->constraints ? b : "(none)");
   snprintf(b, sizeof b, "%lld blocks", (long long)c->schwarz_blocks);
   line(f, c->schwarz_blocks > 0, "Schwarz blocks",
-       c->schwarz_blocks ? b : (c->krylov ? "(no cell below the threshold, or not asked)"
-                                          : "(direct solver)"));
+       c->schwarz_blocks
+           ? b
+           : (c->krylov ? "(no cell below the threshold, or not asked)" : "(direct solver)"));
   snprintf(b, sizeof b, "%lld factorizations, %lld analyses, %lld fallbacks", c->factorizations,
            c->analyses, c->direct_fallbacks);
   line(f, 1, c->krylov ? "preconditioner setups" : "direct factorizations", b);
-  snprintf(b, sizeof b, "%lld Newton, %lld linear iterations, %lld tangents",
-           c->newton_iterations, c->linear_iterations, c->tangent_assemblies);
+  snprintf(b, sizeof b, "%lld Newton, %lld linear iterations, %lld tangents", c->newton_iterations,
+           c->linear_iterations, c->tangent_assemblies);
   line(f, 1, "iterations", b);
   snprintf(b, sizeof b, "%lld frames, surface %lld points %lld triangles", c->frames,
            (long long)c->surface_points, (long long)c->surface_triangles);
   line(f, c->frames > 0, "output", b);
+  if (S->free_body) {
+    double com[3];
+    if (fcm_simulation_center_of_mass((fcm_simulation *)S, com) == FCM_OK) {
+      double d[3] = {com[0] - S->com0[0], com[1] - S->com0[1], com[2] - S->com0[2]};
+      fprintf(f, "  centre of mass (free body) at t = 0: (%.9g, %.9g, %.9g) m; drift now %.3e m\n",
+              S->com0[0], S->com0[1], S->com0[2], sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+    }
+  }
   fprintf(f, "  time [s]  setup %.3f  steps %.3f  output %.3f\n", c->time_setup, c->time_steps,
           c->time_output);
 }

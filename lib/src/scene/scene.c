@@ -60,6 +60,7 @@ static const char *const solver_names[] = {"direct", "minres", "cg"};
 static const char *const direct_names[] = {"cholmod", "umfpack"};
 static const char *const preconditioner_names[] = {"none", "jacobi", "block_jacobi", "schwarz"};
 static const char *const clamp_names[] = {"clamp", "paper"};
+static const char *const newton_rule_names[] = {"auto", "representative", "relative"};
 static const char *const integrator_names[] = {"backward_euler"};
 
 /* Read a choice into an enum of any integer type. */
@@ -380,8 +381,9 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
                                      "schwarz",        "rtol",   "atol",
                                      "max_iterations", "newton", "threads"};
   static const char *const skeys[] = {"threshold", "epsilon", "clamp"};
-  static const char *const nkeys[] = {"rtol", "max_iterations", "line_search", "project_psd",
-                                      "representative_acceleration"};
+  static const char *const nkeys[] = {"rtol",        "max_iterations",
+                                      "line_search", "project_psd",
+                                      "rule",        "representative_acceleration"};
   fcm_scene_solver *s = &p->scene->solver;
   const fcm__json *o = NULL, *sw = NULL, *nw = NULL;
   size_t old = p->path_len;
@@ -427,6 +429,7 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
     READ_INT(p, nw, "max_iterations", 0, 1, 1000000, s->newton_max_iterations);
     FCM_TRY(p->ctx, fcm__scene_read_bool(p, nw, "line_search", 0, &s->line_search));
     FCM_TRY(p->ctx, fcm__scene_read_bool(p, nw, "project_psd", 0, &s->project_psd));
+    READ_CHOICE(p, nw, "rule", 0, newton_rule_names, s->newton_rule);
     FCM_TRY(p->ctx, fcm__scene_read_number(p, nw, "representative_acceleration", 0, FCM__POSITIVE,
                                            &s->representative_acceleration));
     fcm__scene_path_pop(p, here);
@@ -507,7 +510,8 @@ cleanup:
 static fcm_status read_output(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"directory", "frame_interval", "background", "surface"};
+  static const char *const keys[] = {"directory", "frame_interval", "checkpoint_interval",
+                                     "background", "surface"};
   fcm_scene_output *out = &p->scene->output;
   const fcm__json *o = NULL;
   size_t old = p->path_len;
@@ -521,6 +525,7 @@ static fcm_status read_output(fcm__scene_parser *p, const fcm__json *root)
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
   FCM_TRY(p->ctx, fcm__scene_read_string(p, o, "directory", 0, &out->directory));
   READ_INT(p, o, "frame_interval", 0, 1, 1000000000, out->frame_interval);
+  READ_INT(p, o, "checkpoint_interval", 0, 0, 1000000000, out->checkpoint_interval);
   FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "background", 0, &out->write_background));
   FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "surface", 0, &out->write_surface));
 cleanup:
@@ -890,19 +895,23 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
     fprintf(f, ", rtol %g, atol %g, at most %d iterations", so->rtol, so->atol, so->max_iterations);
   }
   fprintf(f,
-          "; Newton rtol %g, at most %d iterations, line search %s, PSD projection %s, "
+          "; Newton %s rule, rtol %g, at most %d iterations, line search %s, PSD projection %s, "
           "|a_rep| %g m/s^2; threads %d\n",
-          so->newton_rtol, so->newton_max_iterations, so->line_search ? "on" : "off",
-          so->project_psd ? "on" : "off", so->representative_acceleration, so->threads);
+          newton_rule_names[so->newton_rule], so->newton_rtol, so->newton_max_iterations,
+          so->line_search ? "on" : "off", so->project_psd ? "on" : "off",
+          so->representative_acceleration, so->threads);
   if (t->is_static)
     fprintf(f, "time: static, %lld step(s) of %g s, %d load step(s) each\n",
             (long long)t->num_steps, t->dt, t->load_steps);
   else
     fprintf(f, "time: %s, %lld steps of dt = %g s, %g s in all\n", integrator_names[t->integrator],
             (long long)t->num_steps, t->dt, t->duration);
-  fprintf(f, "output: %s, every %d step(s), background %s, surface %s\n", s->output.directory,
+  fprintf(f, "output: %s, every %d step(s), background %s, surface %s", s->output.directory,
           s->output.frame_interval, s->output.write_background ? "yes" : "no",
           s->output.write_surface ? "yes" : "no");
+  if (s->output.checkpoint_interval > 0)
+    fprintf(f, ", checkpoint every %d step(s)", s->output.checkpoint_interval);
+  fprintf(f, "\n");
   fprintf(f, "effects: %d\n", s->num_effects);
   for (int i = 0; i < s->num_effects; i++) {
     const fcm__effect_type *type = fcm__scene_effect_type(s->effects[i].type);

@@ -483,12 +483,15 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
   for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; k++)
     FCM_ALLOC(ctx, n, *vecs[k]);
 
-  /* Mass (constant) and the loads of scale 1. */
-  FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->M));
+  /* Mass (constant; dynamics only) and the loads of scale 1. */
   FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->H));
   {
     fcm_elastic el = {I->mat.young, I->mat.poisson, I->mat.density};
-    FCM_TRY(ctx, fcm_assemble_mass(I->space, &el, &o->assembly, I->M));
+    if (o->kind == FCM_INTEGRATOR_BACKWARD_EULER) {
+      FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->M));
+      FCM_TRY(ctx, fcm_assemble_mass(I->space, &el, &o->assembly, I->M));
+      I->setup_info.mass_assemblies = 1;
+    }
     for (int k = 0; k < I->num_loads; k++) {
       sim_load *l = &I->loads[k];
       FCM_ALLOC(ctx, n, l->f);
@@ -499,23 +502,41 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
                                                    l->f));
       else
         FCM_TRY(ctx, fcm_assemble_surface_traction(I->space, l->field, l->field_user, l->f));
+      I->setup_info.load_assemblies++;
     }
-  }
-  {
-    double a[3];
-    rep_acceleration(I, a);
-    for (fcm_index i = 0; i < n; i++)
-      I->w1[i] = a[i % 3];
-    FCM_TRY(ctx, fcm_csr_apply(I->M, 1.0, I->w1, 0.0, I->Ma));
-    double s = 0.0;
-    for (fcm_index i = 0; i < n; i++)
-      s += I->Ma[i] * I->Ma[i];
-    I->rep_norm_full = sqrt(s);
-    FCM_CHECK(o->tolerance_mode != FCM_NEWTON_TOL_REPRESENTATIVE || I->rep_norm_full > 0.0, ctx,
-              FCM_ERR_ARG,
-              "integrator: the representative force ||M a_rep|| is 0 (density %g): set a positive "
-              "density or use FCM_NEWTON_TOL_RELATIVE",
-              I->mat.density);
+    /* The representative force M a_rep. Static runs have no M: by the partition of unity
+     * (sum_b N_b = 1), (M a_rep)_a = int rho N_a a_rep, the body force of rho a_rep, which
+     * is the gravity load itself when a_rep is that gravity (the default). */
+    if (o->tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE) {
+      double a[3];
+      rep_acceleration(I, a);
+      if (I->M) {
+        for (fcm_index i = 0; i < n; i++)
+          I->w1[i] = a[i % 3];
+        FCM_TRY(ctx, fcm_csr_apply(I->M, 1.0, I->w1, 0.0, I->Ma));
+      } else {
+        const sim_load *same = NULL;
+        for (int k = 0; k < I->num_loads && !same; k++)
+          if (I->loads[k].kind == SIM_LOAD_GRAVITY && I->loads[k].accel[0] == a[0] &&
+              I->loads[k].accel[1] == a[1] && I->loads[k].accel[2] == a[2])
+            same = &I->loads[k];
+        if (same) {
+          memcpy(I->Ma, same->f, sizeof *I->Ma * (size_t)n);
+        } else {
+          memset(I->Ma, 0, sizeof *I->Ma * (size_t)n);
+          FCM_TRY(ctx, fcm_assemble_body_force(I->space, &el, a, &o->assembly, I->Ma));
+          I->setup_info.scale_assemblies = 1;
+        }
+      }
+      double s = 0.0;
+      for (fcm_index i = 0; i < n; i++)
+        s += I->Ma[i] * I->Ma[i];
+      I->rep_norm_full = sqrt(s);
+      FCM_CHECK(I->rep_norm_full > 0.0 && isfinite(I->rep_norm_full), ctx, FCM_ERR_ARG,
+                "integrator: the representative force ||M a_rep|| is %g (density %g): set a "
+                "positive density or use FCM_NEWTON_TOL_RELATIVE",
+                I->rep_norm_full, I->mat.density);
+    }
   }
   if (I->linear) FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->H0));
   if (o->kind == FCM_INTEGRATOR_BACKWARD_EULER &&
@@ -594,6 +615,12 @@ fcm_index fcm_integrator_num_constrained(const fcm_integrator *I)
 const fcm_csr *fcm_integrator_mass(const fcm_integrator *I)
 {
   return I ? I->M : NULL;
+}
+void fcm_integrator_get_setup_info(const fcm_integrator *I, fcm_integrator_setup_info *info)
+{
+  if (!info) return;
+  memset(info, 0, sizeof *info);
+  if (I) *info = I->setup_info;
 }
 
 void fcm_integrator_get_state(const fcm_integrator *I, double *u, double *v, double *t,
@@ -704,6 +731,11 @@ fcm_status fcm_integrator_momentum(fcm_integrator *I, double linear[3], double a
   fcm_status st = FCM_OK;
   FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
   FCM_CHECK(I->is_setup, I->ctx, FCM_ERR_ARG, "integrator: momentum needs fcm_integrator_setup()");
+  if (!I->M) { /* static: no inertia, no momentum */
+    if (linear) memset(linear, 0, 3 * sizeof *linear);
+    if (angular) memset(angular, 0, 3 * sizeof *angular);
+    goto cleanup;
+  }
   FCM_TRY(I->ctx, fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1));
   {
     const fcm_mesh *mesh = fcm_space_mesh(I->space);

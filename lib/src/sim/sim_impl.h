@@ -91,6 +91,8 @@ struct fcm_integrator {
   long long key_con, key_damp;
   long long damp_version;
 
+  fcm_integrator_setup_info setup_info; /* what the setup assembled */
+
   /* cumulative counters */
   long long total_factorizations, total_fallbacks;
 

@@ -1,0 +1,316 @@
+/* Checkpoints of a scene run: save the state a run needs to go on (integrator state bit for
+ * bit, per-step log, frame times, cumulative iteration counts) and restore it into a new
+ * simulation of the same scene.
+ *
+ * File layout (host byte order; every integer 8 bytes, doubles IEEE 754 binary64):
+ *   "FCMCKPT\0"  magic
+ *   u64 version (1), u64 byte-order mark 0x0102030405060708
+ *   u64 scene fingerprint (see fingerprint())
+ *   i64 num_dofs, i64 steps, f64 time
+ *   i64 newton_iterations, i64 linear_iterations, i64 tangent_assemblies
+ *   i64 frames, then frames x f64 frame time
+ *   i64 log rows, then rows x (f64 time, residual, energy, wall; i64 newton, linear)
+ *   num_dofs x f64 displacement, num_dofs x f64 velocity
+ *   u64 FNV-1a 64 checksum of every byte before it */
+#define _POSIX_C_SOURCE 200809L
+#include "scene/run_impl.h"
+
+#include "core/core_impl.h"
+#include "io/io_impl.h"
+
+#include <errno.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define CKPT_MAGIC   "FCMCKPT"
+#define CKPT_VERSION 1u
+#define CKPT_BOM     0x0102030405060708ull
+#define FNV_OFFSET   0xcbf29ce484222325ull
+#define FNV_PRIME    0x100000001b3ull
+
+static uint64_t fnv(uint64_t h, const void *data, size_t n)
+{
+  const unsigned char *p = data;
+  for (size_t k = 0; k < n; k++) {
+    h ^= p[k];
+    h *= FNV_PRIME;
+  }
+  return h;
+}
+
+/* A fingerprint of what the state depends on: the scene summary without its name line,
+ * time span and output section (a resumed run may be longer or write elsewhere), plus the
+ * exact bits of the step, the material and the discretization's sizes. It guards against
+ * resuming the wrong scene; it is a hash, not a proof. */
+static uint64_t fingerprint(const fcm_simulation *S)
+{
+  uint64_t h = FNV_OFFSET;
+  char *text = NULL;
+  size_t len = 0;
+  FILE *f = open_memstream(&text, &len);
+  if (f) {
+    fcm_scene_view(S->scene, f);
+    if (fclose(f) == 0 && text) {
+      const char *line = text;
+      while (*line) {
+        const char *nl = strchr(line, '\n');
+        size_t n = nl ? (size_t)(nl - line) + 1 : strlen(line);
+        if (strncmp(line, "scene ", 6) && strncmp(line, "time:", 5) && strncmp(line, "output:", 7))
+          h = fnv(h, line, n);
+        line += n;
+      }
+    }
+    free(text); /* open_memstream's buffer comes from malloc */
+  }
+  const fcm_scene_time *tm = fcm_scene_get_time(S->scene);
+  const fcm_material *mat = fcm_scene_get_material(S->scene);
+  int64_t sizes[5] = {(int64_t)S->c.num_dofs, (int64_t)S->nn, (int64_t)fcm_mesh_num_cells(S->mesh),
+                      (int64_t)S->c.constrained_dofs, (int64_t)tm->load_steps};
+  double reals[4] = {tm->dt, mat->young, mat->poisson, mat->density};
+  int flags[2] = {tm->is_static, (int)mat->model};
+  h = fnv(h, sizes, sizeof sizes);
+  h = fnv(h, reals, sizeof reals);
+  h = fnv(h, flags, sizeof flags);
+  return h;
+}
+
+/* ---------------------------------------------------------------- writing */
+
+typedef struct ckpt_writer {
+  fcm_ctx *ctx;
+  fcm__atomic_file *af;
+  uint64_t hash;
+} ckpt_writer;
+
+static fcm_status put(ckpt_writer *w, const void *data, size_t n)
+{
+  w->hash = fnv(w->hash, data, n);
+  return fcm__io_atomic_write(w->ctx, w->af, data, n);
+}
+
+static fcm_status put_u64(ckpt_writer *w, uint64_t x)
+{
+  return put(w, &x, sizeof x);
+}
+static fcm_status put_i64(ckpt_writer *w, long long x)
+{
+  int64_t v = (int64_t)x;
+  return put(w, &v, sizeof v);
+}
+static fcm_status put_f64(ckpt_writer *w, double x)
+{
+  return put(w, &x, sizeof x);
+}
+
+fcm_status fcm_simulation_write_checkpoint(fcm_simulation *S, const char *path)
+{
+  fcm_status st = FCM_OK;
+  fcm__atomic_file af;
+  memset(&af, 0, sizeof af);
+  FCM_CHECK(S && path && path[0], S ? S->ctx : NULL, FCM_ERR_ARG,
+            "simulation: write_checkpoint needs a simulation and a path");
+  fcm_ctx *ctx = S->ctx;
+  ckpt_writer w = {ctx, &af, FNV_OFFSET};
+  fcm_index n = fcm_integrator_num_dofs(S->integ);
+  double t = 0.0;
+  long long steps = 0;
+  fcm_integrator_get_state(S->integ, NULL, NULL, &t, &steps);
+  FCM_TRY(ctx, fcm__io_atomic_open(ctx, path, 1, NULL, &af));
+  {
+    char magic[8] = CKPT_MAGIC;
+    FCM_TRY(ctx, put(&w, magic, sizeof magic));
+  }
+  FCM_TRY(ctx, put_u64(&w, CKPT_VERSION));
+  FCM_TRY(ctx, put_u64(&w, CKPT_BOM));
+  FCM_TRY(ctx, put_u64(&w, fingerprint(S)));
+  FCM_TRY(ctx, put_i64(&w, (long long)n));
+  FCM_TRY(ctx, put_i64(&w, steps));
+  FCM_TRY(ctx, put_f64(&w, t));
+  FCM_TRY(ctx, put_i64(&w, S->c.newton_iterations));
+  FCM_TRY(ctx, put_i64(&w, S->c.linear_iterations));
+  FCM_TRY(ctx, put_i64(&w, S->c.tangent_assemblies));
+  FCM_TRY(ctx, put_i64(&w, S->c.frames));
+  for (long long k = 0; k < S->c.frames; k++)
+    FCM_TRY(ctx, put_f64(&w, S->frame_time[k]));
+  FCM_TRY(ctx, put_i64(&w, S->log_n));
+  for (long long k = 0; k < S->log_n; k++) {
+    const fcm__log_row *r = &S->log[k];
+    FCM_TRY(ctx, put_f64(&w, r->time));
+    FCM_TRY(ctx, put_f64(&w, r->residual));
+    FCM_TRY(ctx, put_f64(&w, r->energy));
+    FCM_TRY(ctx, put_f64(&w, r->wall));
+    FCM_TRY(ctx, put_i64(&w, r->newton));
+    FCM_TRY(ctx, put_i64(&w, r->linear));
+  }
+  FCM_TRY(ctx, put(&w, fcm_integrator_displacement(S->integ), sizeof(double) * (size_t)n));
+  FCM_TRY(ctx, put(&w, fcm_integrator_velocity(S->integ), sizeof(double) * (size_t)n));
+  {
+    uint64_t sum = w.hash;
+    FCM_TRY(ctx, fcm__io_atomic_write(ctx, &af, &sum, sizeof sum));
+  }
+  FCM_TRY(ctx, fcm__io_atomic_commit(ctx, &af));
+cleanup:
+  if (st != FCM_OK && S) fcm__io_atomic_abort(S->ctx, &af);
+  return st;
+}
+
+/* ---------------------------------------------------------------- reading */
+
+typedef struct ckpt_reader {
+  fcm_ctx *ctx;
+  const char *path;
+  const unsigned char *data;
+  size_t size, pos;
+} ckpt_reader;
+
+static fcm_status get(ckpt_reader *r, void *out, size_t n, const char *what)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(n <= r->size - r->pos, r->ctx, FCM_ERR_FORMAT,
+            "checkpoint %s: truncated (%zu bytes) while reading %s at byte %zu", r->path, r->size,
+            what, r->pos);
+  memcpy(out, r->data + r->pos, n);
+  r->pos += n;
+cleanup:
+  return st;
+}
+
+static fcm_status get_i64(ckpt_reader *r, long long *x, long long lo, long long hi,
+                          const char *what)
+{
+  fcm_status st = FCM_OK;
+  int64_t v = 0;
+  FCM_TRY(r->ctx, get(r, &v, sizeof v, what));
+  FCM_CHECK(v >= lo && v <= hi, r->ctx, FCM_ERR_FORMAT,
+            "checkpoint %s: %s = %lld is outside [%lld, %lld]", r->path, what, (long long)v, lo,
+            hi);
+  *x = (long long)v;
+cleanup:
+  return st;
+}
+
+/* Read a whole file through the ctx allocator. */
+static fcm_status slurp(fcm_ctx *ctx, const char *path, unsigned char **data, size_t *size)
+{
+  fcm_status st = FCM_OK;
+  FILE *f = fopen(path, "rb");
+  long len = -1;
+  FCM_CHECK(f, ctx, FCM_ERR_IO, "checkpoint %s: cannot open: %s", path, strerror(errno));
+  FCM_CHECK(fseek(f, 0, SEEK_END) == 0 && (len = ftell(f)) >= 0 && fseek(f, 0, SEEK_SET) == 0, ctx,
+            FCM_ERR_IO, "checkpoint %s: cannot size the file: %s", path, strerror(errno));
+  FCM_ALLOC(ctx, (size_t)len + 1, *data);
+  FCM_CHECK(fread(*data, 1, (size_t)len, f) == (size_t)len, ctx, FCM_ERR_IO,
+            "checkpoint %s: read error", path);
+  *size = (size_t)len;
+cleanup:
+  if (f) fclose(f);
+  return st;
+}
+
+fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
+{
+  fcm_status st = FCM_OK;
+  unsigned char *data = NULL;
+  double *u = NULL, *v = NULL, *frame_time = NULL;
+  fcm__log_row *log = NULL;
+  long long frame_cap = 0, log_cap = 0;
+  FCM_CHECK(S && path && path[0], S ? S->ctx : NULL, FCM_ERR_ARG,
+            "simulation: read_checkpoint needs a simulation and a path");
+  fcm_ctx *ctx = S->ctx;
+  FCM_CHECK(S->c.steps == 0 && S->c.frames == 0 && !S->restored, ctx, FCM_ERR_ARG,
+            "checkpoint %s: restore into a new simulation (this one has taken %lld steps and "
+            "written %lld frames)",
+            path, S->c.steps, S->c.frames);
+  size_t size = 0;
+  FCM_TRY(ctx, slurp(ctx, path, &data, &size));
+  ckpt_reader r = {ctx, path, data, size, 0};
+  {
+    char magic[8];
+    uint64_t version = 0, bom = 0, fp = 0, sum = 0;
+    FCM_CHECK(size >= sizeof magic + 8 && !memcmp(data, CKPT_MAGIC, sizeof magic), ctx,
+              FCM_ERR_FORMAT, "checkpoint %s: not an fcm checkpoint (no FCMCKPT header)", path);
+    FCM_TRY(ctx, get(&r, magic, sizeof magic, "the header"));
+    FCM_TRY(ctx, get(&r, &version, sizeof version, "the version"));
+    FCM_TRY(ctx, get(&r, &bom, sizeof bom, "the byte-order mark"));
+    FCM_CHECK(bom == CKPT_BOM, ctx, FCM_ERR_FORMAT,
+              "checkpoint %s: written on a machine of the other byte order", path);
+    FCM_CHECK(version == CKPT_VERSION, ctx, FCM_ERR_FORMAT,
+              "checkpoint %s: version %llu; this build reads version %u", path,
+              (unsigned long long)version, CKPT_VERSION);
+    memcpy(&sum, data + size - sizeof sum, sizeof sum);
+    FCM_CHECK(fnv(FNV_OFFSET, data, size - sizeof sum) == sum, ctx, FCM_ERR_FORMAT,
+              "checkpoint %s: checksum mismatch (the file is truncated or corrupted)", path);
+    r.size = size - sizeof sum;
+    FCM_TRY(ctx, get(&r, &fp, sizeof fp, "the fingerprint"));
+    FCM_CHECK(fp == fingerprint(S), ctx, FCM_ERR_ARG,
+              "checkpoint %s: written by a different scene or discretization than scene '%s' "
+              "(only the time span and the output section may change)",
+              path, fcm_scene_name(S->scene));
+  }
+  long long n = 0, steps = 0, frames = 0, rows = 0;
+  long long newton = 0, linear = 0, tangents = 0;
+  double t = 0.0;
+  fcm_index ndof = fcm_integrator_num_dofs(S->integ);
+  FCM_TRY(ctx, get_i64(&r, &n, 0, (long long)ndof, "num_dofs"));
+  FCM_CHECK(n == ndof, ctx, FCM_ERR_ARG, "checkpoint %s: %lld DOFs, the simulation has %lld", path,
+            n, (long long)ndof);
+  FCM_TRY(ctx, get_i64(&r, &steps, 0, S->num_steps, "steps (at most the steps to take)"));
+  FCM_TRY(ctx, get(&r, &t, sizeof t, "time"));
+  FCM_TRY(ctx, get_i64(&r, &newton, 0, INT64_MAX, "newton_iterations"));
+  FCM_TRY(ctx, get_i64(&r, &linear, 0, INT64_MAX, "linear_iterations"));
+  FCM_TRY(ctx, get_i64(&r, &tangents, 0, INT64_MAX, "tangent_assemblies"));
+  FCM_TRY(ctx, get_i64(&r, &frames, 0, steps + 1, "frames"));
+  if (frames > 0) {
+    FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&frame_time, &frame_cap, frames, sizeof *frame_time));
+    FCM_TRY(ctx, get(&r, frame_time, sizeof *frame_time * (size_t)frames, "the frame times"));
+  }
+  FCM_TRY(ctx, get_i64(&r, &rows, 0, steps, "log rows"));
+  if (rows > 0) FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&log, &log_cap, rows, sizeof *log));
+  for (long long k = 0; k < rows; k++) {
+    fcm__log_row *w = &log[k];
+    double d[4];
+    int64_t i[2];
+    FCM_TRY(ctx, get(&r, d, sizeof d, "a log row"));
+    FCM_TRY(ctx, get(&r, i, sizeof i, "a log row"));
+    w->time = d[0], w->residual = d[1], w->energy = d[2], w->wall = d[3];
+    w->newton = (long long)i[0], w->linear = (long long)i[1];
+  }
+  FCM_ALLOC(ctx, n, u);
+  FCM_ALLOC(ctx, n, v);
+  FCM_TRY(ctx, get(&r, u, sizeof *u * (size_t)n, "the displacement"));
+  FCM_TRY(ctx, get(&r, v, sizeof *v * (size_t)n, "the velocity"));
+  FCM_CHECK(r.pos == r.size, ctx, FCM_ERR_FORMAT, "checkpoint %s: %zu unexpected trailing bytes",
+            path, r.size - r.pos);
+  /* Everything read and checked: apply (set_state validates finiteness first). */
+  FCM_TRY(ctx, fcm_integrator_set_state(S->integ, u, v, t, steps));
+  S->c.steps = steps;
+  S->c.newton_iterations = newton;
+  S->c.linear_iterations = linear;
+  S->c.tangent_assemblies = tangents;
+  S->c.frames = frames;
+  fcm__free(ctx, S->frame_time);
+  S->frame_time = frame_time, S->frame_cap = frame_cap, frame_time = NULL;
+  fcm__free(ctx, S->log);
+  S->log = log, S->log_cap = log_cap, S->log_n = rows, log = NULL;
+  S->restored = 1;
+cleanup:
+  if (S) {
+    fcm__free(S->ctx, data);
+    fcm__free(S->ctx, u);
+    fcm__free(S->ctx, v);
+    fcm__free(S->ctx, frame_time);
+    fcm__free(S->ctx, log);
+  }
+  return st;
+}
+
+int fcm_simulation_checkpoint_due(const fcm_simulation *S)
+{
+  if (!S || S->c.steps == 0) return 0;
+  int every = S->opts.checkpoint_interval >= 0
+                  ? S->opts.checkpoint_interval
+                  : fcm_scene_get_output(S->scene)->checkpoint_interval;
+  return every > 0 && S->c.steps % every == 0;
+}

@@ -1,0 +1,261 @@
+/* Checkpoints of scene runs: for a static run with load steps, surface loads and CG with
+ * Schwarz blocks, a dynamic nonlinear run with damping, a released motion and MINRES, and a
+ * free spinning body with the direct solver, running K steps, saving, restoring into a new
+ * simulation and running on gives bit for bit the state, time and per-step log (but wall
+ * times) of the uninterrupted run. Error paths: restoring into a stepped simulation, a
+ * missing file, a checkpoint beyond the steps to take, an unwritable path (nothing left
+ * behind), a simulation of another scene; allocation failures while restoring leave the
+ * simulation usable and leak nothing. */
+#include "scene_util.h"
+
+#include <sys/stat.h>
+
+/* static: embedded box, gravity, traction switched off after t = 2, 2 load steps */
+static const char static_json[] =
+    "{\"version\": 1, \"name\": \"ck_static\","
+    " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0],"
+    "   \"max\": [1.5, 0.5, 0.5]}, \"cells\": [3, 1, 1]},"
+    " \"geometry\": {\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [1.2, 0.5, 0.5],"
+    "   \"cells\": [3, 1, 1]},"
+    " \"material\": {\"model\": \"snh\", \"young\": 1e5, \"poisson\": 0.3, \"density\": 1000},"
+    " \"quadrature\": {\"surface_strength\": 2},"
+    " \"solver\": {\"method\": \"cg\", \"preconditioner\": \"schwarz\", \"rtol\": 1e-10,"
+    "   \"max_iterations\": 2000},"
+    " \"time\": {\"static\": true, \"steps\": 6, \"dt\": 1, \"load_steps\": 2},"
+    " \"effects\": [{\"gravity\": {}},"
+    "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, 0, 0]}}}},"
+    "  {\"traction\": {\"region\": {\"box\": {\"min\": [1.19, -1, -1], \"max\": [2, 1, 1]}},"
+    "    \"value\": [0, 0, -300], \"end\": 2}}]}";
+
+/* dynamic: nonlinear, damping, a pulled patch released at t = 0.06, MINRES + Schwarz */
+static const char dynamic_json[] =
+    "{\"version\": 1, \"name\": \"ck_dynamic\","
+    " \"background\": {\"element\": \"tet10\", \"box\": {\"min\": [0, 0, 0],"
+    "   \"max\": [1.5, 0.5, 0.5]}, \"cells\": [3, 1, 1]},"
+    " \"geometry\": {\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [1.2, 0.5, 0.5],"
+    "   \"cells\": [3, 1, 1]},"
+    " \"material\": {\"model\": \"snh\", \"young\": 1e5, \"poisson\": 0.4, \"density\": 1000},"
+    " \"solver\": {\"method\": \"minres\", \"preconditioner\": \"schwarz\", \"rtol\": 1e-8,"
+    "   \"max_iterations\": 2000},"
+    " \"time\": {\"dt\": 0.02, \"steps\": 6},"
+    " \"effects\": [{\"gravity\": {}}, {\"damping\": {\"stiffness\": 0.01, \"mass\": 0.1}},"
+    "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, 0, 0]}}}},"
+    "  {\"motion\": {\"region\": {\"half_space\": {\"point\": [1.5, 0, 0], \"normal\": [1, 0, 0]}},"
+    "    \"velocity\": [0, 0, 1], \"end\": 0.06, \"release\": true}}]}";
+
+/* a free body spinning in one cell */
+static const char spin_json[] =
+    "{\"version\": 1, \"name\": \"ck_spin\","
+    " \"background\": {\"element\": \"hex20\", \"box\": {\"min\": [-1, -1, -1],"
+    "   \"max\": [1, 1, 1]}, \"cells\": [1, 1, 1]},"
+    " \"geometry\": {\"shape\": \"hemisphere\", \"center\": [0, -0.4, 0], \"radius\": 0.9,"
+    "   \"resolution\": 2},"
+    " \"material\": {\"model\": \"snh\", \"young\": 1e6, \"poisson\": 0.3, \"density\": 1000},"
+    " \"time\": {\"dt\": 0.01, \"steps\": 6},"
+    " \"effects\": [{\"initial_velocity\": {\"angular_velocity\": [0, 0, 3]}}]}";
+
+typedef struct run_state {
+  fcm_index n;
+  double *u, *v, t;
+  long long steps;
+  fcm_simulation_counters c;
+} run_state;
+
+static void capture(fcm_simulation *sim, run_state *r)
+{
+  fcm_integrator *I = fcm_simulation_integrator(sim);
+  r->n = fcm_integrator_num_dofs(I);
+  r->u = calloc((size_t)r->n, sizeof *r->u);
+  r->v = calloc((size_t)r->n, sizeof *r->v);
+  if (r->u && r->v) fcm_integrator_get_state(I, r->u, r->v, &r->t, &r->steps);
+  fcm_simulation_get_counters(sim, &r->c);
+}
+
+static void release(run_state *r)
+{
+  free(r->u);
+  free(r->v);
+  memset(r, 0, sizeof *r);
+}
+
+static void step_to(fcm_ctx *ctx, fcm_simulation *sim, long long k)
+{
+  while (fcm_simulation_step_count(sim) < k && !fcm_simulation_done(sim)) {
+    fcm_step_info si;
+    fcm_status st = fcm_simulation_step(sim, &si);
+    TEST_OK(ctx, st);
+    if (st != FCM_OK) return;
+  }
+}
+
+/* The log file without the wall-time column. */
+static void log_text(fcm_ctx *ctx, fcm_simulation *sim, const char *path, char *buf, size_t cap)
+{
+  buf[0] = '\0';
+  TEST_OK(ctx, fcm_simulation_write_log(sim, path));
+  FILE *f = fopen(path, "r");
+  TEST_TRUE(f != NULL);
+  if (!f) return;
+  char line[512];
+  size_t used = 0;
+  while (fgets(line, sizeof line, f)) {
+    char *comma = strrchr(line, ',');
+    if (comma) *comma = '\0';
+    used += (size_t)snprintf(buf + used, cap - used, "%s\n", line);
+  }
+  fclose(f);
+  remove(path);
+}
+
+static void check_scene(fcm_ctx *ctx, const char *json, const char *dir, long long K)
+{
+  char ck[256], logp[256];
+  static char log_a[1 << 16], log_b[1 << 16];
+  snprintf(ck, sizeof ck, "%s/run.fcmck", dir);
+  snprintf(logp, sizeof logp, "%s/log.csv", dir);
+  fcm_scene *scene = NULL;
+  fcm_simulation *sim = NULL;
+  run_state full = {0};
+  TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "ck.json", &scene));
+  if (!scene) return;
+
+  /* uninterrupted, with a checkpoint written (and ignored) on the way */
+  TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
+  if (!sim) goto done;
+  step_to(ctx, sim, K);
+  TEST_OK(ctx, fcm_simulation_write_checkpoint(sim, ck));
+  step_to(ctx, sim, fcm_simulation_num_steps(sim));
+  TEST_TRUE(fcm_simulation_done(sim));
+  capture(sim, &full);
+  log_text(ctx, sim, logp, log_a, sizeof log_a);
+  /* restoring into a simulation that has stepped is refused */
+  TEST_ERR(ctx, fcm_simulation_read_checkpoint(sim, ck), FCM_ERR_ARG, "new simulation");
+  fcm_simulation_destroy(&sim);
+
+  /* a fresh scene object and simulation, restored at step K and run to the end */
+  fcm_scene_destroy(&scene);
+  TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "ck.json", &scene));
+  TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
+  if (!sim) goto done;
+  TEST_OK(ctx, fcm_simulation_read_checkpoint(sim, ck));
+  TEST_TRUE(fcm_simulation_step_count(sim) == K);
+  step_to(ctx, sim, fcm_simulation_num_steps(sim));
+  run_state res = {0};
+  capture(sim, &res);
+  log_text(ctx, sim, logp, log_b, sizeof log_b);
+  TEST_TRUE(res.n == full.n && res.steps == full.steps);
+  TEST_TRUE(!memcmp(&res.t, &full.t, sizeof res.t));
+  if (res.u && full.u && res.n == full.n) {
+    TEST_TRUE(!memcmp(res.u, full.u, sizeof *res.u * (size_t)res.n));
+    TEST_TRUE(!memcmp(res.v, full.v, sizeof *res.v * (size_t)res.n));
+  }
+  /* the log is complete and equal; the cumulative iteration counts continue */
+  TEST_TRUE(log_a[0] && !strcmp(log_a, log_b));
+  TEST_TRUE(res.c.steps == full.c.steps && res.c.newton_iterations == full.c.newton_iterations &&
+            res.c.linear_iterations == full.c.linear_iterations);
+  /* not a trivial run: the state moved */
+  double umax = 0.0;
+  for (fcm_index i = 0; i < full.n && full.u; i++)
+    umax = fabs(full.u[i]) > umax ? fabs(full.u[i]) : umax;
+  TEST_TRUE(umax > 1e-6);
+  release(&res);
+done:
+  release(&full);
+  fcm_simulation_destroy(&sim);
+  fcm_scene_destroy(&scene);
+  remove(ck);
+}
+
+int main(void)
+{
+  fcm_ctx *ctx = NULL;
+  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  char dir[64];
+  if (!ctx || !make_temp_dir(dir, sizeof dir)) return TEST_RESULT();
+  check_scene(ctx, static_json, dir, 3);
+  check_scene(ctx, dynamic_json, dir, 2);
+  check_scene(ctx, spin_json, dir, 3);
+
+  /* error paths */
+  fcm_scene *scene = NULL, *other = NULL;
+  fcm_simulation *sim = NULL, *sim2 = NULL;
+  char ck[256], path[256];
+  snprintf(ck, sizeof ck, "%s/e.fcmck", dir);
+  TEST_OK(ctx, fcm_scene_create_from_string(ctx, spin_json, "ck.json", &scene));
+  TEST_OK(ctx, fcm_scene_create_from_string(ctx, dynamic_json, "ck.json", &other));
+  if (scene && other) {
+    TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
+    step_to(ctx, sim, 4);
+    TEST_OK(ctx, fcm_simulation_write_checkpoint(sim, ck));
+    /* an unwritable path: FCM_ERR_IO naming it, nothing left behind */
+    snprintf(path, sizeof path, "%s/no-such-dir/e.fcmck", dir);
+    TEST_ERR(ctx, fcm_simulation_write_checkpoint(sim, path), FCM_ERR_IO, "no-such-dir");
+    fcm_simulation_destroy(&sim);
+    /* a missing file */
+    fcm_simulation_options so = fcm_simulation_options_default();
+    TEST_OK(ctx, fcm_simulation_create(ctx, scene, &so, &sim));
+    snprintf(path, sizeof path, "%s/missing.fcmck", dir);
+    TEST_ERR(ctx, fcm_simulation_read_checkpoint(sim, path), FCM_ERR_IO, "missing.fcmck");
+    fcm_simulation_destroy(&sim);
+    /* a run cut to 3 steps cannot take a checkpoint of step 4 */
+    so.max_steps = 3;
+    TEST_OK(ctx, fcm_simulation_create(ctx, scene, &so, &sim));
+    TEST_ERR(ctx, fcm_simulation_read_checkpoint(sim, ck), FCM_ERR_FORMAT, "steps");
+    TEST_TRUE(fcm_simulation_step_count(sim) == 0);
+    fcm_simulation_destroy(&sim);
+    /* another scene */
+    TEST_OK(ctx, fcm_simulation_create(ctx, other, NULL, &sim2));
+    TEST_ERR(ctx, fcm_simulation_read_checkpoint(sim2, ck), FCM_ERR_ARG, "different scene");
+    fcm_simulation_destroy(&sim2);
+    /* checkpoint cadence: the option overrides the scene's (0 there) */
+    so = fcm_simulation_options_default();
+    so.checkpoint_interval = 2;
+    TEST_OK(ctx, fcm_simulation_create(ctx, scene, &so, &sim));
+    TEST_TRUE(!fcm_simulation_checkpoint_due(sim));
+    step_to(ctx, sim, 1);
+    TEST_TRUE(!fcm_simulation_checkpoint_due(sim));
+    step_to(ctx, sim, 2);
+    TEST_TRUE(fcm_simulation_checkpoint_due(sim));
+    fcm_simulation_destroy(&sim);
+    so.checkpoint_interval = -2;
+    TEST_ERR(ctx, fcm_simulation_create(ctx, scene, &so, &sim), FCM_ERR_ARG, "checkpoint_interval");
+  }
+  fcm_scene_destroy(&other);
+
+  /* allocation failures while restoring: FCM_ERR_ALLOC, the simulation still fresh */
+  failing f;
+  fcm_ctx *fctx = failing_ctx(&f);
+  fcm_scene *fs = NULL;
+  if (fctx) TEST_OK(fctx, fcm_scene_create_from_string(fctx, spin_json, "ck.json", &fs));
+  int ok = 0, failures = 0;
+  for (long long k = 0; fs && k < 200 && !ok; k++) {
+    fcm_simulation *s = NULL;
+    f.fail_at = -1;
+    TEST_OK(fctx, fcm_simulation_create(fctx, fs, NULL, &s));
+    if (!s) break;
+    f.count = 0;
+    f.fail_at = k;
+    fcm_status st = fcm_simulation_read_checkpoint(s, ck);
+    f.fail_at = -1;
+    if (st == FCM_OK) {
+      ok = 1;
+      TEST_TRUE(fcm_simulation_step_count(s) == 4);
+    } else {
+      failures++;
+      TEST_TRUE(st == FCM_ERR_ALLOC && fcm_simulation_step_count(s) == 0);
+      TEST_OK(fctx, fcm_simulation_read_checkpoint(s, ck)); /* and then it works */
+    }
+    fcm_simulation_destroy(&s);
+  }
+  TEST_TRUE(ok && failures >= 3);
+  fcm_scene_destroy(&fs);
+  if (fctx) TEST_TRUE(fcm_ctx_live_allocations(fctx) == 0);
+  fcm_ctx_destroy(&fctx);
+
+  remove(ck);
+  fcm_scene_destroy(&scene);
+  TEST_TRUE(rmdir(dir) == 0);
+  TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
+  fcm_ctx_destroy(&ctx);
+  return TEST_RESULT();
+}
