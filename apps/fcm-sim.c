@@ -7,6 +7,7 @@
 #include <fcm/simulation.h>
 
 #include <errno.h>
+#include <omp.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -539,6 +540,8 @@ static int scene_main(int argc, char **argv)
     rc = 0;
     goto done;
   }
+  if (fcm_scene_get_solver(scene)->threads > 0) /* every OpenMP loop of the run */
+    omp_set_num_threads(fcm_scene_get_solver(scene)->threads);
   fcm_simulation_options so = fcm_simulation_options_default();
   so.max_steps = o.check ? (o.steps > 0 && o.steps < 3 ? o.steps : 3) : o.steps;
   so.checkpoint_interval = o.check ? 0 : o.checkpoint_every;

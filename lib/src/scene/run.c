@@ -1,6 +1,7 @@
 /* The scene runner: builds the pipeline a scene asks for (mesh, geometry, cell rules, space,
  * integrator with exactly its effects), steps it, writes frames and the per-step log. */
 #include "scene/run_impl.h"
+#include "scene/scene_impl.h"
 
 #include "core/core_impl.h"
 #include "fcm/embed.h"
@@ -35,7 +36,9 @@ cleanup:
   return st;
 }
 
-/* ---------------------------------------------------------------- effect modules */
+/* ---------------------------------------------------------------- effect hooks
+ * The run-time hooks of the effect modules; the table that names them per effect type is
+ * in effects.c (fcm__effect_type). */
 
 static double window_scale(void *user, double t)
 {
@@ -89,7 +92,7 @@ cleanup:
   return st;
 }
 
-static fcm_status add_constraint(fcm_simulation *S, const fcm_effect *e)
+fcm_status fcm__effect_apply_constraint(fcm_simulation *S, const fcm_effect *e)
 {
   fcm_status st = FCM_OK;
   fcm_index *nodes = NULL, n = 0;
@@ -121,11 +124,7 @@ cleanup:
   return st;
 }
 
-/* The one table of what each effect contributes before setup (NULL: nothing before setup;
- * damping goes into the options, initial velocities into the state after setup). */
-typedef fcm_status (*effect_apply_fn)(fcm_simulation *S, const fcm_effect *e);
-
-static fcm_status apply_gravity(fcm_simulation *S, const fcm_effect *e)
+fcm_status fcm__effect_apply_gravity(fcm_simulation *S, const fcm_effect *e)
 {
   fcm_status st = FCM_OK;
   FCM_TRY(S->ctx, fcm_integrator_add_gravity(S->integ, e->gravity.acceleration, NULL, NULL));
@@ -134,7 +133,7 @@ cleanup:
   return st;
 }
 
-static fcm_status apply_surface(fcm_simulation *S, const fcm_effect *e)
+fcm_status fcm__effect_apply_surface_load(fcm_simulation *S, const fcm_effect *e)
 {
   fcm_status st = FCM_OK;
   FCM_CHECK(S->c.surface_rules, S->ctx, FCM_ERR_ARG,
@@ -147,12 +146,12 @@ cleanup:
   return st;
 }
 
-static const effect_apply_fn effect_apply[FCM_EFFECT_TYPE_COUNT] = {
-    [FCM_EFFECT_GRAVITY] = apply_gravity,  [FCM_EFFECT_FIXED] = add_constraint,
-    [FCM_EFFECT_MOTION] = add_constraint,  [FCM_EFFECT_INITIAL_VELOCITY] = NULL,
-    [FCM_EFFECT_DAMPING] = NULL,           [FCM_EFFECT_TRACTION] = apply_surface,
-    [FCM_EFFECT_PRESSURE] = apply_surface,
-};
+void fcm__effect_configure_damping(const fcm_effect *e, fcm_integrator_options *o)
+{
+  if (o->kind != FCM_INTEGRATOR_BACKWARD_EULER) return; /* (static scenes reject damping) */
+  o->rayleigh_mass += e->damping.mass;
+  o->rayleigh_stiffness += e->damping.stiffness;
+}
 
 /* Centre of mass of the body at displacement u (NULL: the reference one), as the space
  * integrates it: 1^T M x / 1^T M 1 per component, x = X + u (exact for the mass quadrature,
@@ -200,39 +199,52 @@ cleanup:
   return st;
 }
 
-/* Initial velocities: v = v0 + omega x (X - c) on each region's nodes, c the centre of mass
- * of the body in the reference configuration. */
-static fcm_status apply_initial_velocities(fcm_simulation *S)
+/* Initial velocity: v = v0 + omega x (X - c) on the region's nodes, c the centre of mass of
+ * the body in the reference configuration. */
+fcm_status fcm__effect_initialize_velocity(fcm_simulation *S, const fcm_effect *e,
+                                           fcm__effect_init *init)
+{
+  const double *X = fcm_mesh_coords(S->mesh);
+  const fcm_region *r = &e->initial_velocity.region;
+  for (fcm_index a = 0; a < S->nn; a++) {
+    fcm_index dof = fcm_space_node_dof(S->space, a);
+    if (dof < 0) continue;
+    int in = 0;
+    if (r->kind == FCM_REGION_NODES) {
+      for (fcm_index j = 0; j < r->num_nodes && !in; j++)
+        in = r->nodes[j] == a;
+    } else {
+      in = fcm_region_contains(r, X + 3 * a);
+    }
+    if (in)
+      fcm_effect_initial_velocity_eval(&e->initial_velocity, X + 3 * a, init->com, init->v + dof);
+  }
+  S->c.initial_velocity++;
+  return FCM_OK;
+}
+
+/* Run the initialize hooks of the scene's effects into one velocity, set once. */
+static fcm_status initialize_effects(fcm_simulation *S)
 {
   fcm_status st = FCM_OK;
   fcm_index n = fcm_integrator_num_dofs(S->integ);
-  double *v = NULL, com[3];
-  const double *X = fcm_mesh_coords(S->mesh);
-  FCM_ALLOC(S->ctx, n, v);
-  memcpy(v, fcm_integrator_velocity(S->integ), (size_t)n * sizeof *v);
-  FCM_TRY(S->ctx, center_of_mass(S, NULL, com));
+  fcm__effect_init init = {NULL, {0, 0, 0}};
+  int any = 0;
+  for (int k = 0; k < fcm_scene_num_effects(S->scene); k++)
+    any |= fcm__scene_effect_type(fcm_scene_get_effect(S->scene, k)->type)->initialize != NULL;
+  if (!any) return FCM_OK;
+  FCM_ALLOC(S->ctx, n, init.v);
+  memcpy(init.v, fcm_integrator_velocity(S->integ), (size_t)n * sizeof *init.v);
+  FCM_TRY(S->ctx, center_of_mass(S, NULL, init.com));
   for (int k = 0; k < fcm_scene_num_effects(S->scene); k++) {
     const fcm_effect *e = fcm_scene_get_effect(S->scene, k);
-    if (e->type != FCM_EFFECT_INITIAL_VELOCITY) continue;
-    const fcm_region *r = &e->initial_velocity.region;
-    for (fcm_index a = 0; a < S->nn; a++) {
-      fcm_index dof = fcm_space_node_dof(S->space, a);
-      if (dof < 0) continue;
-      int in = 0;
-      if (r->kind == FCM_REGION_NODES) {
-        for (fcm_index j = 0; j < r->num_nodes && !in; j++)
-          in = r->nodes[j] == a;
-      } else {
-        in = fcm_region_contains(r, X + 3 * a);
-      }
-      if (in) fcm_effect_initial_velocity_eval(&e->initial_velocity, X + 3 * a, com, v + dof);
-    }
-    S->c.initial_velocity++;
+    const fcm__effect_type *t = fcm__scene_effect_type(e->type);
+    if (t->initialize) FCM_TRY(S->ctx, t->initialize(S, e, &init));
   }
-  FCM_TRY(S->ctx, fcm_integrator_set_state(S->integ, NULL, v, fcm_integrator_time(S->integ),
+  FCM_TRY(S->ctx, fcm_integrator_set_state(S->integ, NULL, init.v, fcm_integrator_time(S->integ),
                                            fcm_integrator_step_count(S->integ)));
 cleanup:
-  fcm__free(S->ctx, v);
+  fcm__free(S->ctx, init.v);
   return st;
 }
 
@@ -289,8 +301,10 @@ static fcm_status build_rules(fcm_simulation *S)
   const fcm_scene_quadrature *q = fcm_scene_get_quadrature(S->scene);
   const fcm_scene_solver *sv = fcm_scene_get_solver(S->scene);
   fcm_cell_rules_options ro = fcm_cell_rules_options_default();
-  int nsurf = fcm_scene_count_effects(S->scene, FCM_EFFECT_TRACTION) +
-              fcm_scene_count_effects(S->scene, FCM_EFFECT_PRESSURE);
+  int nsurf = 0;
+  for (int k = 0; k < fcm_scene_num_effects(S->scene); k++)
+    nsurf += !!(fcm__scene_effect_type(fcm_scene_get_effect(S->scene, k)->type)->needs &
+                FCM__NEEDS_SURFACE_RULES);
   ro.strength[FCM_RULE_STIFFNESS] = q->stiffness_strength;
   ro.strength[FCM_RULE_MASS] = q->mass_strength;
   if (q->surface_strength >= 0)
@@ -360,9 +374,8 @@ static fcm_integrator_options integrator_options(fcm_simulation *S)
   o.assembly.mass_strength = q->mass_strength > 0 ? q->mass_strength : 0;
   for (int k = 0; k < fcm_scene_num_effects(S->scene); k++) {
     const fcm_effect *e = fcm_scene_get_effect(S->scene, k);
-    if (e->type != FCM_EFFECT_DAMPING || tm->is_static) continue;
-    o.rayleigh_mass += e->damping.mass;
-    o.rayleigh_stiffness += e->damping.stiffness;
+    const fcm__effect_type *t = fcm__scene_effect_type(e->type);
+    if (t->configure) t->configure(e, &o);
   }
   return o;
 }
@@ -471,7 +484,8 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   FCM_TRY(ctx, fcm_integrator_create(ctx, S->space, fcm_scene_get_material(scene), &io, &S->integ));
   for (int k = 0; k < fcm_scene_num_effects(scene); k++) {
     const fcm_effect *e = fcm_scene_get_effect(scene, k);
-    if (effect_apply[e->type]) FCM_TRY(ctx, effect_apply[e->type](S, e));
+    const fcm__effect_type *t = fcm__scene_effect_type(e->type);
+    if (t->apply) FCM_TRY(ctx, t->apply(S, e));
   }
   FCM_TRY(ctx, fcm_integrator_setup(S->integ));
   {
@@ -481,8 +495,7 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
     S->c.scale_assemblies = si.scale_assemblies;
   }
   S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);
-  if (S->c.inertia && fcm_scene_count_effects(scene, FCM_EFFECT_INITIAL_VELOCITY) > 0)
-    FCM_TRY(ctx, apply_initial_velocities(S));
+  if (S->c.inertia) FCM_TRY(ctx, initialize_effects(S));
   S->free_body = S->c.inertia && S->c.constraints == 0 && S->c.body_force_assemblies == 0 &&
                  S->c.traction_assemblies == 0;
   if (S->free_body) FCM_TRY(ctx, center_of_mass(S, NULL, S->com0));

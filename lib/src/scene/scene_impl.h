@@ -5,6 +5,7 @@
 
 #include "core/core_impl.h"
 #include "fcm/scene.h"
+#include "fcm/simulation.h"
 
 #include <math.h>
 
@@ -168,6 +169,19 @@ fcm_status fcm__scene_read_region(fcm__scene_parser *p, const fcm__json *obj, co
  * in "effects[i].<name>"), scene-level rules, and a summary printer. The simulation
  * pipeline attaches its contribution hooks (setup, per-step constraints and forces) to
  * this same table, so that only the effects named in a scene are computed. */
+/* What an effect needs the pipeline to build (flags of fcm__effect_type.needs). */
+enum { FCM__NEEDS_SURFACE_RULES = 1 /* surface rules on the cut cells */ };
+
+/* State the initialize hooks share (run.c): the velocity being built and the body's
+ * centre of mass in the reference configuration. */
+typedef struct fcm__effect_init {
+  double *v;
+  double com[3];
+} fcm__effect_init;
+
+/* An effect module: parsing and printing (effects.c), what it needs from the pipeline,
+ * and the hooks through which the scene runner (run.c) lets it contribute. A NULL hook means
+ * the effect has nothing to do at that stage. */
 typedef struct fcm__effect_type {
   fcm_effect_type type;
   const char *name;
@@ -176,7 +190,22 @@ typedef struct fcm__effect_type {
   int allowed_static;  /* 0: an error in a static scene (needs inertia) */
   fcm_status (*parse)(fcm__scene_parser *p, const fcm__json *params, fcm_effect *effect);
   void (*view)(const fcm_effect *effect, FILE *stream);
+  unsigned needs; /* FCM__NEEDS_* */
+  /* before the integrator exists: adjust its options (e.g. damping coefficients) */
+  void (*configure)(const fcm_effect *effect, fcm_integrator_options *opts);
+  /* before the integrator's setup: add energy/force terms (loads) or constraints */
+  fcm_status (*apply)(fcm_simulation *sim, const fcm_effect *effect);
+  /* after the setup, dynamic scenes: set the initial state */
+  fcm_status (*initialize)(fcm_simulation *sim, const fcm_effect *effect, fcm__effect_init *init);
 } fcm__effect_type;
+
+/* The run-time hooks (run.c). */
+void fcm__effect_configure_damping(const fcm_effect *effect, fcm_integrator_options *opts);
+fcm_status fcm__effect_apply_gravity(fcm_simulation *sim, const fcm_effect *effect);
+fcm_status fcm__effect_apply_constraint(fcm_simulation *sim, const fcm_effect *effect);
+fcm_status fcm__effect_apply_surface_load(fcm_simulation *sim, const fcm_effect *effect);
+fcm_status fcm__effect_initialize_velocity(fcm_simulation *sim, const fcm_effect *effect,
+                                           fcm__effect_init *init);
 
 /* Entry of `type`, or NULL; entry by name, or NULL. */
 const fcm__effect_type *fcm__scene_effect_type(fcm_effect_type type);
