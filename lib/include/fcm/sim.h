@@ -304,7 +304,8 @@ FCM_API const fcm_csr *fcm_integrator_mass(const fcm_integrator *integ);
 /** What fcm_integrator_setup() assembled (all 0 before the setup). */
 typedef struct fcm_integrator_setup_info {
   int mass_assemblies;  /**< 1 for BACKWARD_EULER; 0 for STATIC (no inertia, no M) */
-  int load_assemblies;  /**< one per gravity, body-force and traction load */
+  int body_force_assemblies; /**< one per gravity or body-force load */
+  int traction_assemblies;   /**< one per surface traction load */
   int scale_assemblies; /**< 1 when a STATIC run with the REPRESENTATIVE rule had to assemble
                              the body force of rho a_rep for its force scale (no gravity load
                              equal to a_rep to reuse); else 0 */

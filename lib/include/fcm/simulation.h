@@ -38,10 +38,12 @@ typedef struct fcm_simulation_counters {
   int surface_rules;         /**< 1: the cell rules carry surface rules */
   int inertia;               /**< 1: dynamic integrator (inertia term); 0: static */
   int mass_assemblies;       /**< consistent-mass assemblies: 1 for dynamic scenes, 0 static */
-  int body_force_assemblies; /**< gravity load assemblies (one per gravity effect) */
+  int body_force_assemblies; /**< body-force assemblies the integrator's setup made (one per
+                                  gravity effect) */
   int scale_assemblies;      /**< 1: a static scene without gravity assembled the body force of
                                   rho a_rep once for the Newton force scale (see sim.h) */
-  int traction_assemblies;   /**< surface load assemblies (traction and pressure effects) */
+  int traction_assemblies;   /**< surface load assemblies the setup made (one per traction or
+                                  pressure effect) */
   int damping;               /**< 1: a Rayleigh damping matrix is used */
   int initial_velocity;      /**< initial-velocity effects applied */
   int constraints;           /**< constraint sets (fixed and motion effects) */

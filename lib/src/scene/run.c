@@ -128,7 +128,6 @@ fcm_status fcm__effect_apply_gravity(fcm_simulation *S, const fcm_effect *e)
 {
   fcm_status st = FCM_OK;
   FCM_TRY(S->ctx, fcm_integrator_add_gravity(S->integ, e->gravity.acceleration, NULL, NULL));
-  S->c.body_force_assemblies++;
 cleanup:
   return st;
 }
@@ -141,7 +140,6 @@ fcm_status fcm__effect_apply_surface_load(fcm_simulation *S, const fcm_effect *e
             fcm_scene_name(S->scene), e->index, fcm_effect_type_name(e->type));
   FCM_TRY(S->ctx,
           fcm_integrator_add_traction(S->integ, surface_field, (void *)e, window_scale, (void *)e));
-  S->c.traction_assemblies++;
 cleanup:
   return st;
 }
@@ -492,6 +490,8 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
     fcm_integrator_setup_info si;
     fcm_integrator_get_setup_info(S->integ, &si);
     S->c.mass_assemblies = si.mass_assemblies;
+    S->c.body_force_assemblies = si.body_force_assemblies;
+    S->c.traction_assemblies = si.traction_assemblies;
     S->c.scale_assemblies = si.scale_assemblies;
   }
   S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);

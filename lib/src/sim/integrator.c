@@ -502,7 +502,10 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
                                                    l->f));
       else
         FCM_TRY(ctx, fcm_assemble_surface_traction(I->space, l->field, l->field_user, l->f));
-      I->setup_info.load_assemblies++;
+      if (l->kind == SIM_LOAD_TRACTION)
+        I->setup_info.traction_assemblies++;
+      else
+        I->setup_info.body_force_assemblies++;
     }
     /* The representative force M a_rep. Static runs have no M: by the partition of unity
      * (sum_b N_b = 1), (M a_rep)_a = int rho N_a a_rep, the body force of rho a_rep, which
