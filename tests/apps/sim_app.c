@@ -8,6 +8,9 @@
  *                                     frames byte-identical to the uninterrupted run's, the
  *                                     same log (but wall times) and a complete PVD; bad,
  *                                     corrupted and foreign checkpoints are refused
+ *   sim_app default FCM_SIM WORK_DIR  `fcm-sim` without arguments (the README quick start) runs
+ *                                     the built-in scene to the end and writes its 71 frames
+ *                                     into fcm-output/twisting_cylinder with a 210-row log
  *   sim_app errors FCM_SIM WORK_DIR   invalid scenes and options exit non-zero with the
  *                                     parser's message and create no output directory */
 #define _POSIX_C_SOURCE 200809L
@@ -329,6 +332,37 @@ static int mode_resume(const char *sim, const char *work)
   return TEST_RESULT();
 }
 
+static int mode_default(const char *sim, const char *work)
+{
+  static char buf[1 << 20];
+  char cmd[8192], path[4096];
+  snprintf(cmd, sizeof cmd, "rm -rf '%s/default-run' && mkdir -p '%s/default-run'", work, work);
+  TEST_TRUE(run(cmd) == 0);
+  snprintf(cmd, sizeof cmd, "cd '%s/default-run' && '%s' -q", work, sim);
+  TEST_TRUE(run(cmd) == 0);
+  const char *dir = "default-run/fcm-output/twisting_cylinder";
+  const char *kinds[] = {"background", "surface"};
+  for (int k = 0; k < 2; k++) {
+    snprintf(path, sizeof path, "%s/%s/twisting_cylinder_%s_0070.vtu", work, dir, kinds[k]);
+    TEST_TRUE(exists(path) && file_has(path, "UnstructuredGrid"));
+    snprintf(path, sizeof path, "%s/%s/twisting_cylinder_%s_0071.vtu", work, dir, kinds[k]);
+    TEST_TRUE(!exists(path));
+    snprintf(path, sizeof path, "%s/%s/twisting_cylinder_%s.pvd", work, dir, kinds[k]);
+    int sets = 0;
+    if (slurp(path, buf, sizeof buf) > 0)
+      for (char *p = buf; (p = strstr(p, "<DataSet")); p++)
+        sets++;
+    TEST_TRUE(sets == 71);
+  }
+  snprintf(path, sizeof path, "%s/%s/twisting_cylinder_log.csv", work, dir);
+  int lines = 0;
+  if (slurp(path, buf, sizeof buf) > 0)
+    for (char *p = buf; *p; p++)
+      lines += *p == '\n';
+  TEST_TRUE(lines == 211); /* header + 210 steps */
+  return TEST_RESULT();
+}
+
 int main(int argc, char **argv)
 {
   if (argc != 4) return 2;
@@ -336,5 +370,6 @@ int main(int argc, char **argv)
   if (!strcmp(argv[1], "run")) return mode_run(argv[2], argv[3]);
   if (!strcmp(argv[1], "errors")) return mode_errors(argv[2], argv[3]);
   if (!strcmp(argv[1], "resume")) return mode_resume(argv[2], argv[3]);
+  if (!strcmp(argv[1], "default")) return mode_default(argv[2], argv[3]);
   return 2;
 }

@@ -14,6 +14,10 @@ set_tests_properties(app_sim_errors PROPERTIES LABELS app TIMEOUT 300)
 add_test(NAME app_sim_resume COMMAND app_sim_run resume $<TARGET_FILE:fcm-sim>
          ${PROJECT_BINARY_DIR}/app-tests)
 set_tests_properties(app_sim_resume PROPERTIES LABELS app TIMEOUT 300)
+# The README quick start: `fcm-sim` without arguments, to the end (about 40 s).
+add_test(NAME app_sim_default COMMAND app_sim_run default $<TARGET_FILE:fcm-sim>
+         ${PROJECT_BINARY_DIR}/app-tests)
+set_tests_properties(app_sim_default PROPERTIES LABELS app TIMEOUT 1200)
 # Every example scene and the built-in one ("-", no file) with --check (about 25 s in all
 # on 2 idle cores; the twisting cylinder's cut-cell rules take most of it).
 foreach(scene spinning_body slingshot hollow_ball static_beam twisting_cylinder -)
