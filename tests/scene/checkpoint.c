@@ -200,7 +200,7 @@ int main(void)
     /* a run cut to 3 steps cannot take a checkpoint of step 4 */
     so.max_steps = 3;
     TEST_OK(ctx, fcm_simulation_create(ctx, scene, &so, &sim));
-    TEST_ERR(ctx, fcm_simulation_read_checkpoint(sim, ck), FCM_ERR_FORMAT, "steps");
+    TEST_ERR(ctx, fcm_simulation_read_checkpoint(sim, ck), FCM_ERR_ARG, "beyond the 3 steps");
     TEST_TRUE(fcm_simulation_step_count(sim) == 0);
     fcm_simulation_destroy(&sim);
     /* another scene */

@@ -253,10 +253,14 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
   long long newton = 0, linear = 0, tangents = 0;
   double t = 0.0;
   fcm_index ndof = fcm_integrator_num_dofs(S->integ);
-  FCM_TRY(ctx, get_i64(&r, &n, 0, (long long)ndof, "num_dofs"));
+  FCM_TRY(ctx, get_i64(&r, &n, 0, INT64_MAX, "num_dofs"));
   FCM_CHECK(n == ndof, ctx, FCM_ERR_ARG, "checkpoint %s: %lld DOFs, the simulation has %lld", path,
             n, (long long)ndof);
-  FCM_TRY(ctx, get_i64(&r, &steps, 0, S->num_steps, "steps (at most the steps to take)"));
+  FCM_TRY(ctx, get_i64(&r, &steps, 0, INT64_MAX, "steps"));
+  FCM_CHECK(steps <= S->num_steps, ctx, FCM_ERR_ARG,
+            "checkpoint %s: step %lld is beyond the %lld steps this run takes (extend "
+            "time.duration or --steps)",
+            path, steps, S->num_steps);
   FCM_TRY(ctx, get(&r, &t, sizeof t, "time"));
   FCM_TRY(ctx, get_i64(&r, &newton, 0, INT64_MAX, "newton_iterations"));
   FCM_TRY(ctx, get_i64(&r, &linear, 0, INT64_MAX, "linear_iterations"));
