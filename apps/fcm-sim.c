@@ -33,7 +33,7 @@ static void usage(FILE *f)
           "\n"
           "Runs a scene file (schema: apps/scenes/README.md) with only the effects it names;\n"
           "without a file, the built-in default scene: a hollow cylinder, one end pushed in and\n"
-          "the other twisted (Longva et al. 2020, 6.2; Hex20 FCM, about 20 s on 2 cores).\n"
+          "the other twisted (Longva et al. 2020, 6.2; Hex20 FCM, about 40 s on 2 cores).\n"
           "Frames go to the scene's output directory: <name>_background_NNNN.vtu,\n"
           "<name>_surface_NNNN.vtu, <name>_background.pvd, <name>_surface.pvd (open the .pvd\n"
           "files in ParaView) and the per-step log <name>_log.csv.\n"
@@ -566,7 +566,7 @@ static int scene_main(int argc, char **argv)
   int write = !o.check;
   fcm_simulation_counters c;
   fcm_simulation_get_counters(sim, &c);
-  int frame = (int)c.frames;
+  int frame = (int)c.frames, frames_at_start = frame;
   if (write) {
     if (!make_dirs(dir)) goto done;
     snprintf(logpath, sizeof logpath, "%s/%s_log.csv", dir, name);
@@ -611,7 +611,13 @@ static int scene_main(int argc, char **argv)
   }
   if (!o.quiet) {
     fcm_simulation_summary_view(sim, stdout);
-    if (write) printf("  output    %s/%s_background.pvd, %s/%s_log.csv\n", dir, name, dir, name);
+    if (write) {
+      fcm_simulation_get_counters(sim, &c);
+      if (c.frames > 0 && (int)c.frames > frames_at_start)
+        printf("  output    %s/%s_background.pvd, %s/%s_log.csv\n", dir, name, dir, name);
+      else
+        printf("  output    %s/%s_log.csv (no new frame)\n", dir, name);
+    }
   }
   rc = 0;
 done:

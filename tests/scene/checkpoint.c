@@ -3,14 +3,16 @@
  * free spinning body with the direct solver, running K steps, saving, restoring into a new
  * simulation and running on gives bit for bit the state, time and per-step log (but wall
  * times) of the uninterrupted run. Error paths: restoring into a stepped simulation, a
- * missing file, a checkpoint beyond the steps to take, an unwritable path (nothing left
- * behind), a simulation of another scene; allocation failures while restoring leave the
+ * missing file, a directory, a checkpoint beyond the steps to take, an unwritable path (nothing
+ * left behind), a simulation of another scene; allocation failures while restoring leave the
  * simulation usable and leak nothing. */
 #include "scene_util.h"
 
 #include <sys/stat.h>
 
-/* static: embedded box, gravity, traction switched off after t = 2, 2 load steps */
+/* static: embedded box, gravity, a traction on for 1.5 <= t <= 4.5 and a pressure for
+ * 5.5 <= t <= 7.5, 3 load steps: the load changes into and out of a checkpoint at step 5,
+ * where the last load increment lp + 1 (f - lp) must come out as f itself */
 static const char static_json[] =
     "{\"version\": 1, \"name\": \"ck_static\","
     " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0],"
@@ -21,11 +23,13 @@ static const char static_json[] =
     " \"quadrature\": {\"surface_strength\": 2},"
     " \"solver\": {\"method\": \"cg\", \"preconditioner\": \"schwarz\", \"rtol\": 1e-10,"
     "   \"max_iterations\": 2000},"
-    " \"time\": {\"static\": true, \"steps\": 6, \"dt\": 1, \"load_steps\": 2},"
-    " \"effects\": [{\"gravity\": {}},"
+    " \"time\": {\"static\": true, \"steps\": 8, \"dt\": 1, \"load_steps\": 3},"
+    " \"effects\": [{\"gravity\": {\"acceleration\": [0.013, -0.7, -9.81]}},"
     "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, 0, 0]}}}},"
     "  {\"traction\": {\"region\": {\"box\": {\"min\": [1.19, -1, -1], \"max\": [2, 1, 1]}},"
-    "    \"value\": [0, 0, -300], \"end\": 2}}]}";
+    "    \"value\": [37.3, 11.1, -3000.7], \"start\": 1.5, \"end\": 4.5}},"
+    "  {\"pressure\": {\"region\": {\"half_space\": {\"point\": [0, 0.49, 0],"
+    "    \"normal\": [0, 1, 0]}}, \"value\": 123.456, \"start\": 5.5, \"end\": 7.5}}]}";
 
 /* dynamic: nonlinear, damping, a pulled patch released at t = 0.06, MINRES + Schwarz */
 static const char dynamic_json[] =
@@ -172,7 +176,7 @@ int main(void)
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
   char dir[64];
   if (!ctx || !make_temp_dir(dir, sizeof dir)) return TEST_RESULT();
-  check_scene(ctx, static_json, dir, 3);
+  check_scene(ctx, static_json, dir, 5);
   check_scene(ctx, dynamic_json, dir, 2);
   check_scene(ctx, spin_json, dir, 3);
 
@@ -196,6 +200,8 @@ int main(void)
     TEST_OK(ctx, fcm_simulation_create(ctx, scene, &so, &sim));
     snprintf(path, sizeof path, "%s/missing.fcmck", dir);
     TEST_ERR(ctx, fcm_simulation_read_checkpoint(sim, path), FCM_ERR_IO, "missing.fcmck");
+    /* a directory is not a checkpoint (and must not be sized by seeking) */
+    TEST_ERR(ctx, fcm_simulation_read_checkpoint(sim, dir), FCM_ERR_IO, "not a regular file");
     fcm_simulation_destroy(&sim);
     /* a run cut to 3 steps cannot take a checkpoint of step 4 */
     so.max_steps = 3;

@@ -126,9 +126,9 @@ FCM_API fcm_status fcm_simulation_write_checkpoint(fcm_simulation *sim, const ch
  * and has neither stepped nor written a frame. Stepping on then reproduces the states of the
  * uninterrupted run bit for bit (same build, same thread counts). The frames of the earlier
  * run count as written: the next frame index is the `frames` counter, and the PVD indexes,
- * when next written into a directory, first list the earlier frames of that directory
- * (<name>_background_NNNN.vtu, NNNN = 0 .. frames-1, as fcm-sim numbers them). Solver
- * counters (factorizations, analyses) count this process only.
+ * when next written into a directory, first list those earlier frames found in that
+ * directory (<name>_background_NNNN.vtu, NNNN = 0 .. frames-1, as fcm-sim numbers them).
+ * Solver counters (factorizations, analyses) count this process only.
  * @return FCM_OK; FCM_ERR_IO (cannot open or read, naming the path); FCM_ERR_FORMAT (not
  * a checkpoint, other byte order or version, truncated, checksum mismatch, a count out of
  * range: named); FCM_ERR_ARG (the simulation has stepped; a different scene or DOF count;

@@ -23,6 +23,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #define CKPT_MAGIC   "FCMCKPT"
 #define CKPT_VERSION 1u
@@ -168,7 +169,7 @@ typedef struct ckpt_reader {
 static fcm_status get(ckpt_reader *r, void *out, size_t n, const char *what)
 {
   fcm_status st = FCM_OK;
-  FCM_CHECK(n <= r->size - r->pos, r->ctx, FCM_ERR_FORMAT,
+  FCM_CHECK(r->pos <= r->size && n <= r->size - r->pos, r->ctx, FCM_ERR_FORMAT,
             "checkpoint %s: truncated (%zu bytes) while reading %s at byte %zu", r->path, r->size,
             what, r->pos);
   memcpy(out, r->data + r->pos, n);
@@ -191,19 +192,20 @@ cleanup:
   return st;
 }
 
-/* Read a whole file through the ctx allocator. */
+/* Read a whole regular file through the ctx allocator. */
 static fcm_status slurp(fcm_ctx *ctx, const char *path, unsigned char **data, size_t *size)
 {
   fcm_status st = FCM_OK;
   FILE *f = fopen(path, "rb");
-  long len = -1;
+  struct stat sb;
   FCM_CHECK(f, ctx, FCM_ERR_IO, "checkpoint %s: cannot open: %s", path, strerror(errno));
-  FCM_CHECK(fseek(f, 0, SEEK_END) == 0 && (len = ftell(f)) >= 0 && fseek(f, 0, SEEK_SET) == 0, ctx,
-            FCM_ERR_IO, "checkpoint %s: cannot size the file: %s", path, strerror(errno));
-  FCM_ALLOC(ctx, (size_t)len + 1, *data);
-  FCM_CHECK(fread(*data, 1, (size_t)len, f) == (size_t)len, ctx, FCM_ERR_IO,
-            "checkpoint %s: read error", path);
-  *size = (size_t)len;
+  FCM_CHECK(fstat(fileno(f), &sb) == 0, ctx, FCM_ERR_IO, "checkpoint %s: cannot stat: %s", path,
+            strerror(errno));
+  FCM_CHECK(S_ISREG(sb.st_mode), ctx, FCM_ERR_IO, "checkpoint %s: not a regular file", path);
+  size_t len = (size_t)sb.st_size;
+  FCM_ALLOC(ctx, len + 1, *data);
+  FCM_CHECK(fread(*data, 1, len, f) == len, ctx, FCM_ERR_IO, "checkpoint %s: read error", path);
+  *size = len;
 cleanup:
   if (f) fclose(f);
   return st;
@@ -270,7 +272,7 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
     FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&frame_time, &frame_cap, frames, sizeof *frame_time));
     FCM_TRY(ctx, get(&r, frame_time, sizeof *frame_time * (size_t)frames, "the frame times"));
   }
-  FCM_TRY(ctx, get_i64(&r, &rows, 0, steps, "log rows"));
+  FCM_TRY(ctx, get_i64(&r, &rows, steps, steps, "log rows (one per step)"));
   if (rows > 0) FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&log, &log_cap, rows, sizeof *log));
   for (long long k = 0; k < rows; k++) {
     fcm__log_row *w = &log[k];

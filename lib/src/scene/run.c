@@ -14,6 +14,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 
 fcm_simulation_options fcm_simulation_options_default(void)
 {
@@ -623,7 +624,7 @@ void fcm_simulation_get_counters(const fcm_simulation *S, fcm_simulation_counter
 /* ---------------------------------------------------------------- output */
 
 /* Create the PVD index <dir>/<name>_<kind>.pvd; after a restored checkpoint it first lists
- * the frames the earlier run wrote (<dir>/<name>_<kind>_NNNN.vtu, NNNN = 0, 1, ...). */
+ * the frames of the earlier run found in `dir` (<name>_<kind>_NNNN.vtu, NNNN = 0, 1, ...). */
 static fcm_status open_pvd(fcm_simulation *S, const char *dir, const char *kind, fcm_pvd **pvd)
 {
   fcm_status st = FCM_OK;
@@ -633,8 +634,9 @@ static fcm_status open_pvd(fcm_simulation *S, const char *dir, const char *kind,
   FCM_TRY(S->ctx, fcm_pvd_create(S->ctx, path, pvd));
   if (S->restored)
     for (long long k = 0; k < S->c.frames; k++) {
+      struct stat sb;
       snprintf(path, sizeof path, "%s/%s_%s_%04lld.vtu", dir, name, kind, k);
-      FCM_TRY(S->ctx, fcm_pvd_add(*pvd, S->frame_time[k], path));
+      if (stat(path, &sb) == 0) FCM_TRY(S->ctx, fcm_pvd_add(*pvd, S->frame_time[k], path));
     }
 cleanup:
   return st;

@@ -432,6 +432,8 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
       double h = dyn ? ldexp(o->dt, -level) : 0.0;
       if (dyn)
         fcm__sim_eval_loads(I, t1, I->fext);
+      else if (done + size == units) /* exactly f_ext(t0 + dt): what set_state() restores */
+        memcpy(I->fext, I->fend, sizeof(double) * (size_t)n);
       else
         for (fcm_index i = 0; i < n; i++)
           I->fext[i] = I->lp_bak[i] + s1 * (I->fend[i] - I->lp_bak[i]);
