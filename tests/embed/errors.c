@@ -5,25 +5,9 @@
  * thread): FCM_ERR_ALLOC, NULL output, nothing leaked. */
 #include "fcm/embed.h"
 #include "test.h"
+#include "test_alloc.h"
 
 #include <stdlib.h>
-
-typedef struct failing {
-  long count, fail_at;
-} failing;
-
-static void *failing_alloc(void *user, size_t size)
-{
-  failing *f = user;
-  if (f->fail_at >= 0 && f->count++ == f->fail_at) return NULL;
-  return malloc(size);
-}
-
-static void failing_release(void *user, void *ptr)
-{
-  (void)user;
-  free(ptr);
-}
 
 static void arguments(fcm_ctx *ctx)
 {

@@ -5,23 +5,7 @@
  * constructor: FCM_ERR_ALLOC, *geom NULL, no leak. */
 #include "fcm/geom.h"
 #include "test.h"
-
-typedef struct failing {
-  long count, fail_at;
-} failing;
-
-static void *failing_alloc(void *user, size_t size)
-{
-  failing *f = user;
-  if (f->fail_at >= 0 && f->count++ == f->fail_at) return NULL;
-  return malloc(size);
-}
-
-static void failing_release(void *user, void *ptr)
-{
-  (void)user;
-  free(ptr);
-}
+#include "test_alloc.h"
 
 static void arguments(fcm_ctx *ctx)
 {

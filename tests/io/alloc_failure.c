@@ -3,26 +3,10 @@
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/io.h"
 #include "test.h"
+#include "test_alloc.h"
 #include "vtk_reader.h"
 
 #define DIR "io_alloc_failure.d"
-
-typedef struct failing {
-  long long count, fail_at; /* fail the fail_at-th allocation (0-based), -1: never */
-} failing;
-
-static void *fail_alloc(void *user, size_t size)
-{
-  failing *f = user;
-  if (f->fail_at >= 0 && f->count++ == f->fail_at) return NULL;
-  return malloc(size);
-}
-
-static void fail_release(void *user, void *p)
-{
-  (void)user;
-  free(p);
-}
 
 /* The whole output sequence of one frame: 0 or the failing status. */
 static fcm_status run(fcm_ctx *ctx)
@@ -58,8 +42,8 @@ int main(void)
 {
   failing f = {0, -1};
   fcm_ctx_options o = fcm_ctx_options_default();
-  o.allocator.alloc = fail_alloc;
-  o.allocator.release = fail_release;
+  o.allocator.alloc = failing_alloc;
+  o.allocator.release = failing_release;
   o.allocator.user = &f;
   fcm_ctx *ctx = NULL;
   TEST_OK(ctx, fcm_ctx_create(&o, &ctx));

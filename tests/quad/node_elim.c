@@ -5,6 +5,7 @@
 #include "fcm/rulegen.h"
 #include "moments.h"
 #include "quad/rulegen_impl.h"
+#include "test_alloc.h"
 
 static const fcm_shape all_shapes[] = {FCM_SHAPE_LINE, FCM_SHAPE_TRI, FCM_SHAPE_QUAD,
                                        FCM_SHAPE_TET, FCM_SHAPE_HEX};
@@ -94,23 +95,6 @@ static void count_progress(void *user, const fcm_rulegen_info *info)
 {
   (void)user;
   if (info->num_points > 0) progress_calls++;
-}
-
-typedef struct failing {
-  long count, fail_at;
-} failing;
-
-static void *failing_alloc(void *user, size_t size)
-{
-  failing *f = user;
-  if (f->fail_at >= 0 && f->count++ == f->fail_at) return NULL;
-  return malloc(size);
-}
-
-static void failing_release(void *user, void *ptr)
-{
-  (void)user;
-  free(ptr);
 }
 
 int main(void)

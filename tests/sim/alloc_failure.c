@@ -3,23 +3,7 @@
  * preconditioner created on first use) gives FCM_ERR_ALLOC, leaks nothing, and a failing
  * step leaves the state where it was; eventually the whole sequence succeeds. */
 #include "sim_util.h"
-
-typedef struct failing {
-  long long count, fail_at; /* fail the fail_at-th allocation (0-based), -1: never */
-} failing;
-
-static void *fail_alloc(void *user, size_t size)
-{
-  failing *f = user;
-  if (f->fail_at >= 0 && f->count++ == f->fail_at) return NULL;
-  return malloc(size);
-}
-
-static void fail_release(void *user, void *p)
-{
-  (void)user;
-  free(p);
-}
+#include "test_alloc.h"
 
 static fcm_status run(fcm_ctx *ctx, fcm_space *space, fcm_index nfix, const fcm_index *fix,
                       int krylov, int *state_ok)
@@ -56,8 +40,8 @@ int main(void)
 {
   failing f = {0, -1};
   fcm_ctx_options co = fcm_ctx_options_default();
-  co.allocator.alloc = fail_alloc;
-  co.allocator.release = fail_release;
+  co.allocator.alloc = failing_alloc;
+  co.allocator.release = failing_release;
   co.allocator.user = &f;
   fcm_ctx *ctx = NULL;
   fcm_mesh *mesh = NULL;

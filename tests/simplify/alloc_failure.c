@@ -3,24 +3,7 @@
  * fallback path returns FCM_ERR_ALLOC (never a fallback rule), leaves the result empty
  * and frees everything it allocated. */
 #include "simplify_util.h"
-
-typedef struct failing {
-  long count;   /* allocations so far since arming */
-  long fail_at; /* index of the allocation to fail; < 0: never */
-} failing;
-
-static void *failing_alloc(void *user, size_t size)
-{
-  failing *f = user;
-  if (f->fail_at >= 0 && f->count++ == f->fail_at) return NULL;
-  return malloc(size);
-}
-
-static void failing_release(void *user, void *ptr)
-{
-  (void)user;
-  free(ptr);
-}
+#include "test_alloc.h"
 
 int main(void)
 {
