@@ -1,8 +1,9 @@
 /* Shared helpers of the libFuzzer targets: a context whose allocator refuses single
  * allocations above a cap (so that a header count the reader trusts becomes FCM_ERR_ALLOC
- * instead of an out-of-memory abort of the fuzzer; FCM_FUZZ_ALLOC_CAP_MB, default 256, 0 =
- * no cap), a per-process scratch directory removed at exit, and writing the input to a file
- * in it (the readers take file names). Every call must leave no live allocation behind. */
+ * instead of an out-of-memory abort of the fuzzer; FCM_FUZZ_ALLOC_CAP_MB, default 64, 0 =
+ * no cap), a per-process scratch directory removed at exit (in FCM_FUZZ_DIR, else /dev/shm,
+ * else TMPDIR, else /tmp), and writing the input to a file in it (the readers take file
+ * names). Every input must leave no live allocation behind, and every failure a message. */
 #ifndef FCM_FUZZ_UTIL_H
 #define FCM_FUZZ_UTIL_H
 
@@ -17,7 +18,7 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-static size_t fuzz_cap_bytes_ = (size_t)256 << 20;
+static size_t fuzz_cap_bytes_ = (size_t)64 << 20;
 static char fuzz_dir_[4096];
 
 static inline void *fuzz_alloc_(void *user, size_t size)
@@ -53,7 +54,13 @@ static inline fcm_ctx *fuzz_ctx(void)
   if (ctx) return ctx;
   const char *cap = getenv("FCM_FUZZ_ALLOC_CAP_MB");
   if (cap && *cap) fuzz_cap_bytes_ = (size_t)strtoull(cap, NULL, 10) << 20;
-  const char *tmp = getenv("TMPDIR");
+  /* one thread unless asked otherwise: libFuzzer runs one input at a time */
+  setenv("OMP_NUM_THREADS", "1", 0);
+  setenv("OMP_WAIT_POLICY", "passive", 0);
+  setenv("OPENBLAS_NUM_THREADS", "1", 0);
+  /* scratch in memory when possible: file writes to a disk dominate the run time */
+  const char *tmp = getenv("FCM_FUZZ_DIR");
+  if (!tmp || !*tmp) tmp = access("/dev/shm", W_OK | X_OK) == 0 ? "/dev/shm" : getenv("TMPDIR");
   snprintf(fuzz_dir_, sizeof fuzz_dir_, "%s/fcm-fuzz-XXXXXX", tmp && *tmp ? tmp : "/tmp");
   if (!mkdtemp(fuzz_dir_)) {
     perror("fcm fuzz: mkdtemp");
