@@ -12,6 +12,7 @@
 #include "../io/vtk_reader.h"
 
 #include <dirent.h>
+#include <sys/stat.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -102,9 +103,35 @@ static inline int oc_check_pvd(vr_doc *d, const char *path, char *why, size_t ca
   return ok;
 }
 
+/* Checkpoints already restored once (name, size, modification time): not opened again. */
+typedef struct oc_seen {
+  int n;
+  struct {
+    char name[256];
+    long long size, mtime_ns;
+  } e[256];
+} oc_seen;
+
+static inline int oc_seen_before(oc_seen *seen, const char *name, const struct stat *sb)
+{
+  long long t = (long long)sb->st_mtim.tv_sec * 1000000000LL + sb->st_mtim.tv_nsec;
+  for (int i = 0; seen && i < seen->n; i++)
+    if (!strcmp(seen->e[i].name, name) && seen->e[i].size == (long long)sb->st_size &&
+        seen->e[i].mtime_ns == t)
+      return 1;
+  if (seen && seen->n < 256) {
+    snprintf(seen->e[seen->n].name, sizeof seen->e[0].name, "%s", name);
+    seen->e[seen->n].size = (long long)sb->st_size;
+    seen->e[seen->n++].mtime_ns = t;
+  }
+  return 0;
+}
+
 /* Check every final file of `dir`. `scene` (may be NULL: checkpoints are then not opened)
- * is the scene the checkpoints belong to; `ctx` creates the simulations for them. */
-static inline oc_counts oc_check_dir(const char *dir, fcm_ctx *ctx, const fcm_scene *scene)
+ * is the scene the checkpoints belong to; `ctx` creates the simulations for them; `seen`
+ * (may be NULL) skips the checkpoints restored by an earlier call. */
+static inline oc_counts oc_check_dir_seen(const char *dir, fcm_ctx *ctx, const fcm_scene *scene,
+                                          oc_seen *seen)
 {
   oc_counts c;
   memset(&c, 0, sizeof c);
@@ -132,7 +159,8 @@ static inline oc_counts oc_check_dir(const char *dir, fcm_ctx *ctx, const fcm_sc
       if (!oc_check_csv(path, why, sizeof why)) oc_bad(&c, path, why);
     } else if (oc_ends_with(e->d_name, ".fcmck")) {
       c.checkpoint++;
-      if (scene) {
+      struct stat sb;
+      if (scene && !(stat(path, &sb) == 0 && oc_seen_before(seen, e->d_name, &sb))) {
         fcm_simulation *sim = NULL;
         fcm_status st = fcm_simulation_create(ctx, scene, NULL, &sim);
         if (st == FCM_OK) st = fcm_simulation_read_checkpoint(sim, path);
@@ -145,6 +173,11 @@ static inline oc_counts oc_check_dir(const char *dir, fcm_ctx *ctx, const fcm_sc
   free(d);
   closedir(dp);
   return c;
+}
+
+static inline oc_counts oc_check_dir(const char *dir, fcm_ctx *ctx, const fcm_scene *scene)
+{
+  return oc_check_dir_seen(dir, ctx, scene, NULL);
 }
 
 #endif
