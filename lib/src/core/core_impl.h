@@ -41,6 +41,13 @@ fcm_status fcm__resize(fcm_ctx *ctx, void **ptr, size_t old_n, size_t new_n, siz
 /* Checked narrowing of a global index to int (LAPACK, GLPK, CHOLMOD sizes). */
 fcm_status fcm__index_to_int(fcm_ctx *ctx, fcm_index v, const char *what, int *out);
 
+/* Read the whole regular file `path` into a NUL-terminated buffer of *size + 1 bytes
+ * (released with fcm__free). A directory, device, pipe or socket is refused with
+ * FCM_ERR_IO naming it, before any read (a pipe is not waited on), as is a file larger
+ * than max_bytes. Messages start with `what` (the reader's name). */
+fcm_status fcm__file_read_all(fcm_ctx *ctx, const char *what, const char *path, size_t max_bytes,
+                              char **data, size_t *size);
+
 /* ---- the one error idiom: every function has `fcm_status st` and `cleanup:` ---- */
 
 /* Fail with `code` and a formatted message unless `cond` holds. */
