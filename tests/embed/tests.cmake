@@ -23,3 +23,4 @@ fcm_add_test(embed_cut_catalogue tests/embed/cut_campaign.c ARGS catalogue)
 fcm_add_test(embed_cut_campaign tests/embed/cut_campaign.c ARGS campaign 1000)
 fcm_add_test(embed_cut_campaign_long tests/embed/cut_campaign.c ARGS campaign 60000 7
              LABELS slow TIMEOUT 3600)
+fcm_add_test(embed_limits tests/embed/limits.c)
