@@ -37,8 +37,8 @@ int cli_int(const char *prog, const char *opt, const char *s, long long lo, long
   errno = 0;
   const long long v = s ? strtoll(s, &end, 10) : 0;
   if (!s || end == s || *end || errno == ERANGE || v < lo || v > hi) {
-    fprintf(stderr, "%s: %s: '%s' is not a whole number in [%lld, %lld]\n", prog, opt,
-            s ? s : "", lo, hi);
+    fprintf(stderr, "%s: %s: '%s' is not a whole number in [%lld, %lld]\n", prog, opt, s ? s : "",
+            lo, hi);
     return 0;
   }
   *out = v;
@@ -71,8 +71,7 @@ int cli_list(const char *prog, const char *opt, const char *s, char tok[][CLI_TO
   }
 }
 
-int cli_choice(const char *prog, const char *opt, const char *s, const char *const *names,
-               int *out)
+int cli_choice(const char *prog, const char *opt, const char *s, const char *const *names, int *out)
 {
   for (int k = 0; names[k]; k++)
     if (s && !strcmp(s, names[k])) {
@@ -170,17 +169,17 @@ void cli_print_options(FILE *f, const cli_option *opts)
   char head[128];
   int col = 0;
   for (const cli_option *o = opts; o->name; o++) { /* the help column: longest head + 2 */
-    int n = snprintf(head, sizeof head, "  %s%s%s%s%s", o->alias ? o->alias : "",
-                     o->alias ? ", " : "", o->name, o->metavar ? " " : "",
-                     o->metavar ? o->metavar : "");
+    int n =
+        snprintf(head, sizeof head, "  %s%s%s%s%s", o->alias ? o->alias : "", o->alias ? ", " : "",
+                 o->name, o->metavar ? " " : "", o->metavar ? o->metavar : "");
     if (n > col) col = n;
   }
   if (col < (int)strlen("  -h, --help")) col = (int)strlen("  -h, --help");
   col += 2;
   for (const cli_option *o = opts; o->name; o++) {
-    int n = snprintf(head, sizeof head, "  %s%s%s%s%s", o->alias ? o->alias : "",
-                     o->alias ? ", " : "", o->name, o->metavar ? " " : "",
-                     o->metavar ? o->metavar : "");
+    int n =
+        snprintf(head, sizeof head, "  %s%s%s%s%s", o->alias ? o->alias : "", o->alias ? ", " : "",
+                 o->name, o->metavar ? " " : "", o->metavar ? o->metavar : "");
     fprintf(f, "%s%*s", head, col - n, "");
     for (const char *h = o->help ? o->help : ""; *h;) {
       const char *nl = strchr(h, '\n');

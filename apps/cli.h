@@ -45,15 +45,15 @@ typedef enum cli_kind {
 
 /** One option of a table; the table ends with an entry whose `name` is NULL. */
 typedef struct cli_option {
-  const char *name;    /* "--alpha" */
-  const char *alias;   /* "-a", or NULL */
-  cli_kind kind;       /* how the value is read */
-  void *dest;          /* where it goes (see cli_kind) */
-  const char *metavar; /* the value's name in --help ("A"); NULL for flags */
-  const char *help;    /* help text; '\n' starts a continuation line */
-  double lo, hi;       /* CLI_DOUBLE, CLI_INT, CLI_LLONG: the valid range */
-  unsigned bounds;     /* CLI_DOUBLE: CLI_LO_OPEN | CLI_HI_OPEN */
-  const char *const *choices;                                        /* CLI_CHOICE */
+  const char *name;           /* "--alpha" */
+  const char *alias;          /* "-a", or NULL */
+  cli_kind kind;              /* how the value is read */
+  void *dest;                 /* where it goes (see cli_kind) */
+  const char *metavar;        /* the value's name in --help ("A"); NULL for flags */
+  const char *help;           /* help text; '\n' starts a continuation line */
+  double lo, hi;              /* CLI_DOUBLE, CLI_INT, CLI_LLONG: the valid range */
+  unsigned bounds;            /* CLI_DOUBLE: CLI_LO_OPEN | CLI_HI_OPEN */
+  const char *const *choices; /* CLI_CHOICE */
   int (*parse)(const char *prog, const char *opt, const char *value, void *dest); /* CUSTOM */
   int *seen; /* set to 1 when the option is given; may be NULL */
 } cli_option;

@@ -49,7 +49,8 @@ void condition_print_tables(const config *c, const result *res, int nres)
     printf("\n%s\n", table == 0 ? "condition number kappa(S A)"
                                 : "MINRES iterations to rtol (x0 = 0, b = A 1; * = not converged)");
     printf("%-6s %-14s %-7s", "elem", "precond", "alpha");
-    for (int f = 0; f < c->num_fractions; f++) printf(" %9.0e", c->fractions[f]);
+    for (int f = 0; f < c->num_fractions; f++)
+      printf(" %9.0e", c->fractions[f]);
     printf("\n");
     for (int e = 0; e < c->num_elements; e++)
       for (int sb = 0; sb < 2; sb++) {
@@ -81,8 +82,9 @@ int condition_write_png(const config *c, const char *path, const result *res, in
 {
   char tmp[4096], script[4096], cmd[8400];
   if (system(NULL) == 0 || system("gnuplot --version > /dev/null 2>&1") != 0) {
-    fprintf(stderr, PROG ": gnuplot not found (Debian package gnuplot-nox): %s not written; "
-                    "the CSV is unaffected\n",
+    fprintf(stderr,
+            PROG ": gnuplot not found (Debian package gnuplot-nox): %s not written; "
+                 "the CSV is unaffected\n",
             path);
     return 1;
   }
@@ -108,8 +110,7 @@ int condition_write_png(const config *c, const char *path, const result *res, in
         for (int k = 0; k < nres; k++) {
           const result *r = &res[k];
           if ((int)r->element != e || r->prec != p || (r->alpha > 0.0) != (sb == 0)) continue;
-          row_on[sb] = col_on[fcm_element_get_info(r->element)->shape == FCM_SHAPE_TET ? 0 : 1] =
-              1;
+          row_on[sb] = col_on[fcm_element_get_info(r->element)->shape == FCM_SHAPE_TET ? 0 : 1] = 1;
           if (!isfinite(r->kappa)) continue;
           if (!any) fprintf(f, "$S%d << EOD\n", series);
           any = 1;
@@ -126,8 +127,9 @@ int condition_write_png(const config *c, const char *path, const result *res, in
   fprintf(f, "set logscale xy\nset xrange [*:*] reverse\nset format x '10^{%%L}'\n"
              "set format y '10^{%%L}'\nset grid\nset key top left font ',9'\n"
              "set xlabel 'smallest volume fraction'\nset ylabel 'kappa(SA)'\n");
-  fprintf(f, "set multiplot layout %d,%d title 'kappa(S (M + dt^2 K)), 4x4x4 grid, box "
-             "[0,1+eps/3]^3 (Longva et al. 2020, Fig. 5)'\n",
+  fprintf(f,
+          "set multiplot layout %d,%d title 'kappa(S (M + dt^2 K)), 4x4x4 grid, box "
+          "[0,1+eps/3]^3 (Longva et al. 2020, Fig. 5)'\n",
           nrows, ncols);
   for (int sb = 0; sb < 2; sb++)
     for (int shape = 0; shape < 2; shape++) {
@@ -156,9 +158,9 @@ int condition_write_png(const config *c, const char *path, const result *res, in
           if (id < 0) continue;
           fprintf(f,
                   "%s $S%d using 1:2 with linespoints lw %g dt %d pt %d lc rgb '%s' title '%s %s'",
-                  first ? "plot" : ",", id, p == PREC_SCHWARZ_PAPER ? 5.0 : 2.0,
-                  which == 0 ? 2 : 1, which == 0 ? 6 : 7, colors[p],
-                  fcm_element_get_info((fcm_element_type)e)->name, prec_names[p]);
+                  first ? "plot" : ",", id, p == PREC_SCHWARZ_PAPER ? 5.0 : 2.0, which == 0 ? 2 : 1,
+                  which == 0 ? 6 : 7, colors[p], fcm_element_get_info((fcm_element_type)e)->name,
+                  prec_names[p]);
           first = 0;
         }
       }

@@ -24,8 +24,8 @@ typedef struct linsys {
   fcm_geometry *geom;
   fcm_cell_rules *rules;
   fcm_space *space;
-  fcm_csr *A;   /* full M + dt^2 K */
-  fcm_csr *Af;  /* reduced to the free DOFs */
+  fcm_csr *A;     /* full M + dt^2 K */
+  fcm_csr *Af;    /* reduced to the free DOFs */
   fcm_index *map; /* full DOF -> reduced index, or -1 */
   fcm_index n;    /* reduced size */
   double phi_min;
@@ -129,7 +129,8 @@ static fcm_status system_build(fcm_ctx *ctx, const config *c, fcm_mesh *mesh, do
     goto done;
   }
   TRY(fcm_mesh_nodes_in_box(ctx, mesh, plo, phi_, 1e-12, nfix, fixed, &nfix));
-  for (fcm_index i = 0; i < nd; i++) s->map[i] = 0;
+  for (fcm_index i = 0; i < nd; i++)
+    s->map[i] = 0;
   for (fcm_index k = 0; k < nfix; k++) {
     fcm_index d = fcm_space_node_dof(s->space, fixed[k]);
     if (d >= 0) s->map[d] = s->map[d + 1] = s->map[d + 2] = -1;
@@ -139,8 +140,7 @@ static fcm_status system_build(fcm_ctx *ctx, const config *c, fcm_mesh *mesh, do
     s->map[i] = s->map[i] < 0 ? -1 : s->n++;
   const fcm_index *arp = fcm_csr_get_row_ptr(s->A);
   const int *aci = fcm_csr_get_col_idx(s->A);
-  if (!(rp = malloc(sizeof *rp * (size_t)(s->n + 1))) ||
-      !(ci = malloc(sizeof *ci * (size_t)nnz))) {
+  if (!(rp = malloc(sizeof *rp * (size_t)(s->n + 1))) || !(ci = malloc(sizeof *ci * (size_t)nnz))) {
     st = alloc_fail(ctx);
     goto done;
   }
@@ -228,8 +228,7 @@ static fcm_status measure(fcm_ctx *ctx, const config *c, const linsys *s, int pr
     Sop = fcm_jacobi_operator;
     Suser = J;
   } else if (prec == PREC_SCHWARZ || prec == PREC_SCHWARZ_PAPER) {
-    TRY(schwarz_build(ctx, c, s,
-                      prec == PREC_SCHWARZ ? FCM_SCHWARZ_CLAMP : FCM_SCHWARZ_PAPER, &P));
+    TRY(schwarz_build(ctx, c, s, prec == PREC_SCHWARZ ? FCM_SCHWARZ_CLAMP : FCM_SCHWARZ_PAPER, &P));
     fcm_schwarz_info si;
     fcm_schwarz_get_info(P, &si);
     r->blocks = si.num_blocks;
@@ -261,8 +260,8 @@ static fcm_status measure(fcm_ctx *ctx, const config *c, const linsys *s, int pr
     if (diagonal) { /* diagonal S: scale A symmetrically, no Cholesky needed */
       for (fcm_index j = 0; j < n; j++)
         for (fcm_index i = 0; i < n; i++)
-          Bd[i + (size_t)j * n] = sqrt(Sd[i + (size_t)i * n] * Sd[j + (size_t)j * n]) *
-                                  Ad[i + (size_t)j * n];
+          Bd[i + (size_t)j * n] =
+              sqrt(Sd[i + (size_t)i * n] * Sd[j + (size_t)j * n]) * Ad[i + (size_t)j * n];
       TRY(fcm_dense_spectrum_eval(ctx, ni, Bd, NULL, w, NULL));
     } else {
       for (size_t p = 0; p < nn; p++) /* symmetrize the rounding of the block sums */
@@ -290,9 +289,11 @@ static fcm_status measure(fcm_ctx *ctx, const config *c, const linsys *s, int pr
     st = alloc_fail(ctx);
     goto done;
   }
-  for (fcm_index i = 0; i < n; i++) x[i] = 1.0;
+  for (fcm_index i = 0; i < n; i++)
+    x[i] = 1.0;
   TRY(fcm_csr_apply(s->Af, 1.0, x, 0.0, b));
-  for (fcm_index i = 0; i < n; i++) x[i] = 0.0;
+  for (fcm_index i = 0; i < n; i++)
+    x[i] = 0.0;
   TRY(fcm_krylov_create(ctx, n, &ws));
   fcm_krylov_options ko = fcm_krylov_options_default();
   ko.rtol = c->rtol;
@@ -320,7 +321,7 @@ done:
 
 /* All preconditioners for one (element, fraction, alpha); appends to res. */
 fcm_status condition_run_case(fcm_ctx *ctx, const config *c, fcm_mesh *mesh, double phi,
-                           double alpha, result *res, int *nres)
+                              double alpha, result *res, int *nres)
 {
   fcm_status st = FCM_OK;
   linsys s;
@@ -347,8 +348,7 @@ fcm_status condition_run_case(fcm_ctx *ctx, const config *c, fcm_mesh *mesh, dou
   const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(s.rules);
   fprintf(stderr, "[%s phi=%-7.2g alpha=%-5.2g] %lld dofs, %lld cut cells, rules %.2f s%s", ename,
           phi, alpha, (long long)n, (long long)rs->num_cut, t_rules,
-          rs->simplify_fallbacks[0] + rs->simplify_fallbacks[1] > 0 ? " (simplify fallbacks)"
-                                                                     : "");
+          rs->simplify_fallbacks[0] + rs->simplify_fallbacks[1] > 0 ? " (simplify fallbacks)" : "");
   for (int k = 0; k < c->num_precs; k++) {
     result *r = &res[*nres];
     memset(r, 0, sizeof *r);

@@ -10,7 +10,7 @@
 #include <fcm/mesh.h>
 #include <fcm/solve.h>
 
-#define PROG "fcm-condition"
+#define PROG          "fcm-condition"
 #define MAX_FRACTIONS 64
 
 /** The preconditioners compared. */

@@ -21,53 +21,54 @@
 
 static void usage(FILE *f)
 {
-  fprintf(f,
-          "usage: " PROG " [options]\n"
-          "\n"
-          "Condition numbers kappa(S A) of A = M + dt^2 K(u) for the embedded-box experiment of\n"
-          "Longva et al. 2020, Fig. 5: a 4x4x4 grid on [0,4/3]^3, the box [0,1+eps/3]^3 embedded,\n"
-          "smallest volume fraction phi = eps^3; Stable Neo-Hookean E = 3e6, nu = 0.4,\n"
-          "u(X) = X (1,1,-1), u = 0 on X = 0 (eliminated), dt = 1/60. Dense eigenvalues of\n"
-          "S^(1/2) A S^(1/2); kappa = max|lambda| / min|lambda| (A may be indefinite). Values\n"
-          "above ~1e13 are at the resolution of double precision (rounding-level eigenvalues).\n"
-          "MINRES (x0 = 0, b = A 1, rtol on the preconditioned residual; unpreconditioned for\n"
-          "'none') is run on each system.\n"
-          "\n"
-          "options:\n"
-          "  --elements LIST        comma list of tet4,tet10,hex8,hex20      (default all)\n"
-          "  --fractions SPEC       smallest volume fractions in (0,1]: a comma list\n"
-          "                         (1,1e-4,1e-8) or a log sweep A:B:N       (default 1:1e-12:13)\n"
-          "  --preconditioners LIST none,jacobi,schwarz,schwarz-paper     (default all)\n"
-          "                         schwarz: eigenvalues below eps*lambda_max become\n"
-          "                         1/(eps lambda_max) (authors' code); schwarz-paper:\n"
-          "                         eps/lambda_max (eq. 14 as printed)\n"
-          "  --stabilization LIST   on,off                                   (default on,off)\n"
-          "  --alpha A              stabilization weight factor, > 0         (default 1e-6)\n"
-          "  --stab-mode MODE       mass+stiffness | mass                    (default mass+stiffness)\n"
-          "  --theta T              Schwarz blocks on cut cells with phi < T (default 0.5)\n"
-          "  --epsilon E            Schwarz eigenvalue threshold in (0,1)    (default 1e-13)\n"
-          "  --simplify on|off      simplify cut-cell rules (LP)             (default on)\n"
-          "  --project on|off       PSD-project the material tangent         (default off)\n"
-          "  --density RHO          density in kg/m^3, > 0                   (default 1000)\n"
-          "  --u-scale S            u(X) = S X (1,1,-1); 0: linearization at rest (default 1)\n"
-          "  --rtol R               MINRES relative tolerance                (default 1e-8)\n"
-          "  --minres-max N         MINRES iteration limit                   (default 5000)\n"
-          "  --csv FILE             write the results as CSV (atomically: FILE.tmp, rename)\n"
-          "  --png FILE             plot kappa against phi with gnuplot (2x2 panels: tets /\n"
-          "                         hexes, with / without stabilization); without gnuplot a\n"
-          "                         message is printed and the CSV is still written\n"
-          "  --quick                reduced study: tet4,hex8, phi in {1, 1e-8}, no\n"
-          "                         simplification, MINRES limit 1000 (a few seconds; explicit\n"
-          "                         options override these)\n"
-          "  -h, --help             this text\n"
-          "\n"
-          "CSV columns: element,preconditioner,stabilization,min_volume_fraction,condition_number,\n"
-          "  then nominal_fraction,lambda_min_abs,lambda_max_abs,negative_eigenvalues,dofs,\n"
-          "  schwarz_blocks,clamped_eigenvalues,minres_iterations,minres_reason,\n"
-          "  minres_true_residual,tangent. stabilization is the weight factor alpha (0 = off);\n"
-          "  min_volume_fraction the measured smallest phi of the non-empty cells.\n"
-          "stdout: kappa and MINRES tables; stderr: progress. Exit 0 on success, 1 on a\n"
-          "computation or output error, 2 on a usage error.\n");
+  fprintf(
+      f,
+      "usage: " PROG " [options]\n"
+      "\n"
+      "Condition numbers kappa(S A) of A = M + dt^2 K(u) for the embedded-box experiment of\n"
+      "Longva et al. 2020, Fig. 5: a 4x4x4 grid on [0,4/3]^3, the box [0,1+eps/3]^3 embedded,\n"
+      "smallest volume fraction phi = eps^3; Stable Neo-Hookean E = 3e6, nu = 0.4,\n"
+      "u(X) = X (1,1,-1), u = 0 on X = 0 (eliminated), dt = 1/60. Dense eigenvalues of\n"
+      "S^(1/2) A S^(1/2); kappa = max|lambda| / min|lambda| (A may be indefinite). Values\n"
+      "above ~1e13 are at the resolution of double precision (rounding-level eigenvalues).\n"
+      "MINRES (x0 = 0, b = A 1, rtol on the preconditioned residual; unpreconditioned for\n"
+      "'none') is run on each system.\n"
+      "\n"
+      "options:\n"
+      "  --elements LIST        comma list of tet4,tet10,hex8,hex20      (default all)\n"
+      "  --fractions SPEC       smallest volume fractions in (0,1]: a comma list\n"
+      "                         (1,1e-4,1e-8) or a log sweep A:B:N       (default 1:1e-12:13)\n"
+      "  --preconditioners LIST none,jacobi,schwarz,schwarz-paper     (default all)\n"
+      "                         schwarz: eigenvalues below eps*lambda_max become\n"
+      "                         1/(eps lambda_max) (authors' code); schwarz-paper:\n"
+      "                         eps/lambda_max (eq. 14 as printed)\n"
+      "  --stabilization LIST   on,off                                   (default on,off)\n"
+      "  --alpha A              stabilization weight factor, > 0         (default 1e-6)\n"
+      "  --stab-mode MODE       mass+stiffness | mass                    (default mass+stiffness)\n"
+      "  --theta T              Schwarz blocks on cut cells with phi < T (default 0.5)\n"
+      "  --epsilon E            Schwarz eigenvalue threshold in (0,1)    (default 1e-13)\n"
+      "  --simplify on|off      simplify cut-cell rules (LP)             (default on)\n"
+      "  --project on|off       PSD-project the material tangent         (default off)\n"
+      "  --density RHO          density in kg/m^3, > 0                   (default 1000)\n"
+      "  --u-scale S            u(X) = S X (1,1,-1); 0: linearization at rest (default 1)\n"
+      "  --rtol R               MINRES relative tolerance                (default 1e-8)\n"
+      "  --minres-max N         MINRES iteration limit                   (default 5000)\n"
+      "  --csv FILE             write the results as CSV (atomically: FILE.tmp, rename)\n"
+      "  --png FILE             plot kappa against phi with gnuplot (2x2 panels: tets /\n"
+      "                         hexes, with / without stabilization); without gnuplot a\n"
+      "                         message is printed and the CSV is still written\n"
+      "  --quick                reduced study: tet4,hex8, phi in {1, 1e-8}, no\n"
+      "                         simplification, MINRES limit 1000 (a few seconds; explicit\n"
+      "                         options override these)\n"
+      "  -h, --help             this text\n"
+      "\n"
+      "CSV columns: element,preconditioner,stabilization,min_volume_fraction,condition_number,\n"
+      "  then nominal_fraction,lambda_min_abs,lambda_max_abs,negative_eigenvalues,dofs,\n"
+      "  schwarz_blocks,clamped_eigenvalues,minres_iterations,minres_reason,\n"
+      "  minres_true_residual,tangent. stabilization is the weight factor alpha (0 = off);\n"
+      "  min_volume_fraction the measured smallest phi of the non-empty cells.\n"
+      "stdout: kappa and MINRES tables; stderr: progress. Exit 0 on success, 1 on a\n"
+      "computation or output error, 2 on a usage error.\n");
 }
 
 static int parse_double(const char *opt, const char *s, double *out)
@@ -91,8 +92,9 @@ static int split_list(const char *opt, const char *s, char tok[][32], int cap, i
     const char *c = strchr(s, ',');
     size_t len = c ? (size_t)(c - s) : strlen(s);
     if (len == 0 || len > 31 || *n >= cap) {
-      fprintf(stderr, PROG ": %s: malformed list (empty item, item too long or more than %d items)\n",
-              opt, cap);
+      fprintf(stderr,
+              PROG ": %s: malformed list (empty item, item too long or more than %d items)\n", opt,
+              cap);
       return 0;
     }
     memcpy(tok[*n], s, len);
@@ -196,7 +198,8 @@ static int parse_args(int argc, char **argv, config *c)
       if (!split_list(a, v, tok, PREC_COUNT, &n)) return 0;
       for (int k = 0; k < n; k++) {
         int p = 0;
-        while (p < PREC_COUNT && strcmp(tok[k], prec_names[p])) p++;
+        while (p < PREC_COUNT && strcmp(tok[k], prec_names[p]))
+          p++;
         if (p == PREC_COUNT) {
           fprintf(stderr,
                   PROG ": --preconditioners: unknown '%s' (none, jacobi, schwarz, schwarz-paper)\n",
@@ -309,10 +312,12 @@ int main(int argc, char **argv)
   fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   config c;
   memset(&c, 0, sizeof c);
-  for (int e = 0; e < 4; e++) c.elements[e] = (fcm_element_type)e;
+  for (int e = 0; e < 4; e++)
+    c.elements[e] = (fcm_element_type)e;
   c.num_elements = 4;
   c.num_precs = PREC_COUNT;
-  for (int p = 0; p < PREC_COUNT; p++) c.precs[p] = p;
+  for (int p = 0; p < PREC_COUNT; p++)
+    c.precs[p] = p;
   c.stab_on = c.stab_off = 1;
   c.alpha = 1e-6;
   c.stab_mode = FCM_STABILIZATION_MASS_STIFFNESS;
@@ -361,7 +366,8 @@ int main(int argc, char **argv)
     for (int f = 0; f < c.num_fractions && st == FCM_OK; f++)
       for (int sb = 0; sb < 2 && st == FCM_OK; sb++)
         if (sb == 0 ? c.stab_on : c.stab_off)
-          st = condition_run_case(ctx, &c, mesh, c.fractions[f], sb == 0 ? c.alpha : 0.0, res, &nres);
+          st = condition_run_case(ctx, &c, mesh, c.fractions[f], sb == 0 ? c.alpha : 0.0, res,
+                                  &nres);
     fcm_mesh_destroy(&mesh);
   }
   if (st != FCM_OK) {

@@ -35,8 +35,8 @@ static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS
   const cli_option t[SIM_NUM_OPTIONS] = {
       {"--output", "-o", CLI_STRING, &o->outdir, "DIR", "output directory (overrides the scene's)",
        0, 0, 0, NULL, NULL, NULL},
-      {"--steps", NULL, CLI_LLONG, &o->steps, "N", "stop once N steps in all are taken", 1, 1e12,
-       0, NULL, NULL, NULL},
+      {"--steps", NULL, CLI_LLONG, &o->steps, "N", "stop once N steps in all are taken", 1, 1e12, 0,
+       NULL, NULL, NULL},
       {"--check", NULL, CLI_FLAG, &o->check, NULL,
        "run at most 3 steps without output, check the state is\n"
        "finite and print the run summary",
@@ -62,17 +62,18 @@ static void usage(FILE *f)
   scene_options dummy;
   cli_option opts[SIM_NUM_OPTIONS];
   scene_option_table(&dummy, opts);
-  fprintf(f, "usage: fcm-sim [SCENE.json] [options]\n"
-             "\n"
-             "Runs a scene file (schema: apps/scenes/README.md) with only the effects it names;\n"
-             "without a file, the built-in default scene: a hollow cylinder, one end pushed in and\n"
-             "the other twisted (Longva et al. 2020, 6.2; Hex20 FCM, about 40 s on 2 cores).\n"
-             "Frames go to the scene's output directory: <name>_background_NNNN.vtu,\n"
-             "<name>_surface_NNNN.vtu, <name>_background.pvd, <name>_surface.pvd (open the .pvd\n"
-             "files in ParaView) and the per-step log <name>_log.csv. Example scenes, among them\n"
-             "a steel cantilever under its own weight: apps/scenes/.\n"
-             "\n"
-             "options:\n");
+  fprintf(f,
+          "usage: fcm-sim [SCENE.json] [options]\n"
+          "\n"
+          "Runs a scene file (schema: apps/scenes/README.md) with only the effects it names;\n"
+          "without a file, the built-in default scene: a hollow cylinder, one end pushed in and\n"
+          "the other twisted (Longva et al. 2020, 6.2; Hex20 FCM, about 40 s on 2 cores).\n"
+          "Frames go to the scene's output directory: <name>_background_NNNN.vtu,\n"
+          "<name>_surface_NNNN.vtu, <name>_background.pvd, <name>_surface.pvd (open the .pvd\n"
+          "files in ParaView) and the per-step log <name>_log.csv. Example scenes, among them\n"
+          "a steel cantilever under its own weight: apps/scenes/.\n"
+          "\n"
+          "options:\n");
   cli_print_options(f, opts);
   fprintf(f, "\n"
              "Exit 0 on success, 1 when the run fails, 2 on a usage error, an invalid scene or a\n"

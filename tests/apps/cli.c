@@ -46,7 +46,7 @@ static void numbers(void)
       TEST_FAIL_("'%s' accepted as a number", bad[k]);
   }
   TEST_TRUE(!cli_double("p", "--x", NULL, 0, 1, 0, &x));
-  TEST_TRUE(cli_double("p", "--x", "0", 0, 1, 0, &x));            /* closed ends */
+  TEST_TRUE(cli_double("p", "--x", "0", 0, 1, 0, &x)); /* closed ends */
   TEST_TRUE(cli_double("p", "--x", "1", 0, 1, 0, &x));
   TEST_TRUE(!cli_double("p", "--x", "0", 0, 1, CLI_LO_OPEN, &x)); /* open ends */
   TEST_TRUE(!cli_double("p", "--x", "1", 0, 1, CLI_HI_OPEN, &x));
@@ -71,8 +71,8 @@ static void lists(void)
   TEST_TRUE(cli_list("p", "--l", "tet4,hex20", tok, 4, &n) && n == 2);
   TEST_TRUE(!strcmp(tok[0], "tet4") && !strcmp(tok[1], "hex20"));
   TEST_TRUE(cli_list("p", "--l", "a", tok, 1, &n) && n == 1);
-  const char *bad[] = {"", ",", "a,", ",a", "a,,b", "a,b,c,d,e",
-                       "0123456789012345678901234567890123"};
+  const char *bad[] = {
+      "", ",", "a,", ",a", "a,,b", "a,b,c,d,e", "0123456789012345678901234567890123"};
   for (size_t k = 0; k < sizeof bad / sizeof *bad; k++)
     if (cli_list("p", "--l", bad[k], tok, 4, &n)) TEST_FAIL_("list '%s' accepted", bad[k]);
   const char *const names[] = {"none", "jacobi", "schwarz", NULL};
@@ -96,8 +96,8 @@ static void table(const char *work)
        NULL},
       {"--quick", NULL, CLI_FLAG, &quick, NULL, "reduced run", 0, 0, 0, NULL, NULL, NULL},
       {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
-  char *argv[] = {"p",     "--alpha=0.25", "scene.json", "--steps", "12",     "-o",
-                  "outdir", "--mode",      "mass",       "--quick", "second", NULL};
+  char *argv[] = {"p",      "--alpha=0.25", "scene.json", "--steps", "12",     "-o",
+                  "outdir", "--mode",       "mass",       "--quick", "second", NULL};
   int npos = 0;
   TEST_TRUE(cli_parse("p", opts, 11, argv, pos, 2, &npos) == CLI_OK);
   TEST_TRUE(alpha == 0.25 && seen_alpha && steps == 12 && quick == 1 && mode == 0);

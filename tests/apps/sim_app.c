@@ -172,10 +172,17 @@ static int mode_errors(const char *sim, const char *work)
   TEST_TRUE(run(cmd) != 0);
   TEST_TRUE(file_has(err, "no-such-scene.json"));
   TEST_TRUE(!exists(dir));
-  const char *bad_opts[] = {"--steps 0",       "--checkpoint-every 0", "--check --resume x.fcmck",
-                            "--cells 4 1 1",   "--cantilever",         "--resume",
-                            "--steps 2.5",     "--steps 3x",           "--steps=",
-                            "--check=1",       "-o ''"};
+  const char *bad_opts[] = {"--steps 0",
+                            "--checkpoint-every 0",
+                            "--check --resume x.fcmck",
+                            "--cells 4 1 1",
+                            "--cantilever",
+                            "--resume",
+                            "--steps 2.5",
+                            "--steps 3x",
+                            "--steps=",
+                            "--check=1",
+                            "-o ''"};
   for (int k = 0; k < (int)(sizeof bad_opts / sizeof *bad_opts); k++) {
     snprintf(cmd, sizeof cmd, "'%s' %s -o '%s' 2> /dev/null", sim, bad_opts[k], dir);
     if (run(cmd) != 2) TEST_FAIL_("'%s' should exit 2", bad_opts[k]);
@@ -367,8 +374,7 @@ static int mode_default_quick(const char *sim, const char *work)
   static char buf[1 << 16];
   char cmd[8192], path[4096];
   const double dt = 0.03333333333333333; /* twisting_cylinder.json */
-  snprintf(cmd, sizeof cmd, "rm -rf '%s/default-quick' && mkdir -p '%s/default-quick'", work,
-           work);
+  snprintf(cmd, sizeof cmd, "rm -rf '%s/default-quick' && mkdir -p '%s/default-quick'", work, work);
   TEST_TRUE(run(cmd) == 0);
   snprintf(cmd, sizeof cmd, "cd '%s/default-quick' && '%s' --steps 6 -q", work, sim);
   TEST_TRUE(run(cmd) == 0);
@@ -402,8 +408,8 @@ static int mode_default_quick(const char *sim, const char *work)
     int rows = 0;
     long long step, newton, linear;
     double t, res, energy, wall;
-    while (fscanf(f, "%lld,%lf,%lld,%lld,%lf,%lf,%lf\n", &step, &t, &newton, &linear, &res,
-                  &energy, &wall) == 7) {
+    while (fscanf(f, "%lld,%lf,%lld,%lld,%lf,%lf,%lf\n", &step, &t, &newton, &linear, &res, &energy,
+                  &wall) == 7) {
       rows++;
       TEST_TRUE(step == rows);
       TEST_NEAR(t, dt * rows, 1e-12, 1e-14);
