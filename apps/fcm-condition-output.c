@@ -1,5 +1,6 @@
 /* fcm-condition: the kappa / MINRES tables on stdout, the CSV (written atomically) and the
  * gnuplot PNG of the conditioning study. */
+#include "cli.h"
 #include "fcm-condition-study.h"
 
 #include <errno.h>
@@ -10,16 +11,9 @@
 
 int condition_write_csv(const char *path, const result *res, int nres, int project)
 {
-  char tmp[4096];
-  if (snprintf(tmp, sizeof tmp, "%s.tmp", path) >= (int)sizeof tmp) {
-    fprintf(stderr, PROG ": --csv: path too long\n");
-    return 0;
-  }
-  FILE *f = fopen(tmp, "w");
-  if (!f) {
-    fprintf(stderr, PROG ": cannot write %s: %s\n", tmp, strerror(errno));
-    return 0;
-  }
+  cli_output *out = NULL;
+  FILE *f = cli_output_open(PROG, path, &out);
+  if (!f) return 0;
   fprintf(f, "element,preconditioner,stabilization,min_volume_fraction,condition_number,"
              "nominal_fraction,lambda_min_abs,lambda_max_abs,negative_eigenvalues,dofs,"
              "schwarz_blocks,clamped_eigenvalues,minres_iterations,minres_reason,"
@@ -33,12 +27,7 @@ int condition_write_csv(const char *path, const result *res, int nres, int proje
             fcm_krylov_reason_str(r->reason), r->true_residual,
             project ? "projected" : "unprojected");
   }
-  if (ferror(f) | (fclose(f) != 0) || rename(tmp, path) != 0) {
-    fprintf(stderr, PROG ": cannot write %s: %s\n", path, strerror(errno));
-    remove(tmp);
-    return 0;
-  }
-  return 1;
+  return cli_output_commit(PROG, &out);
 }
 
 /* Tables on stdout: one row per (element, stabilization, preconditioner), one column per
