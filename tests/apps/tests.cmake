@@ -47,3 +47,18 @@ fcm_add_test(app_converge_rates tests/apps/converge_rates.c LABELS app TIMEOUT 9
              ARGS quick $<TARGET_FILE:fcm-converge> ${work})
 fcm_add_test(app_converge_rates_full tests/apps/converge_rates.c LABELS app slow TIMEOUT 7200
              ARGS full $<TARGET_FILE:fcm-converge> ${work})
+# Faults around fcm-sim's output, through an LD_PRELOAD shim (tests/support/fault_shim.c):
+# kill -9 inside file operations and at random moments, then resume (a handful of seeded
+# kills by default, 60 under slow); the disk filling up (the shim's ENOSPC, and a real small
+# tmpfs where an unprivileged mount namespace is allowed); a directory fsync after each
+# rename that puts an output file in place.
+add_library(fcm_fault_shim SHARED tests/support/fault_shim.c)
+target_link_libraries(fcm_fault_shim PRIVATE ${CMAKE_DL_LIBS})
+set_target_properties(fcm_fault_shim PROPERTIES C_VISIBILITY_PRESET default)
+set(fault_args $<TARGET_FILE:fcm-sim> $<TARGET_FILE:fcm_fault_shim> ${work})
+fcm_add_test(app_fault_kill tests/apps/fault_app.c LABELS app ARGS kill ${fault_args})
+fcm_add_test(app_fault_kill_long tests/apps/fault_app.c LABELS app slow TIMEOUT 1800
+             ARGS kill ${fault_args} 60 7)
+fcm_add_test(app_fault_diskfull tests/apps/fault_app.c LABELS app ARGS diskfull ${fault_args})
+fcm_add_test(app_fault_dirsync tests/apps/fault_app.c LABELS app ARGS dirsync ${fault_args})
+add_dependencies(app_fault_kill fcm_fault_shim fcm-sim) # the program of the app_fault_* tests
