@@ -28,6 +28,7 @@ static fcm_status run(fcm_ctx *ctx)
   if ((st = fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "u", 3, 4, u))) goto done;
   if ((st = fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, name, 3, 4, u))) goto done;
   if ((st = fcm_vtu_add_field_int32(vtu, FCM_VTU_CELL_DATA, "class", 1, 1, cls))) goto done;
+  if ((st = fcm_vtu_add_field_int64(vtu, FCM_VTU_CELL_DATA, "id", 1, 1, conn))) goto done;
   if ((st = fcm_vtu_write(vtu, DIR "/a.vtu", NULL))) goto done;
   if ((st = fcm_pvd_create(ctx, DIR "/a.pvd", &pvd))) goto done;
   if ((st = fcm_pvd_add(pvd, 0.0, DIR "/a.vtu"))) goto done;
