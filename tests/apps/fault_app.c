@@ -411,14 +411,19 @@ int main(int argc, char **argv)
   g_sim = argv[2];
   g_shim = argv[3];
   g_work = argv[4];
-  snprintf(g_scene, sizeof g_scene, "%s/fault.json", g_work);
+  /* one scene file per mode: the modes run in parallel under ctest -j */
+  snprintf(g_scene, sizeof g_scene, "%.900s/fault-%.16s.json", g_work, argv[1]);
   FILE *f = fopen(g_scene, "w");
   if (!f) return 2;
   fputs(scene_json, f);
   fclose(f);
+  int rc = 2;
   if (!strcmp(argv[1], "kill"))
-    return mode_kill(argc > 5 ? atoi(argv[5]) : 6, argc > 6 ? strtoull(argv[6], NULL, 10) : 19);
-  if (!strcmp(argv[1], "diskfull")) return mode_diskfull();
-  if (!strcmp(argv[1], "dirsync")) return mode_dirsync();
-  return 2;
+    rc = mode_kill(argc > 5 ? atoi(argv[5]) : 6, argc > 6 ? strtoull(argv[6], NULL, 10) : 19);
+  else if (!strcmp(argv[1], "diskfull"))
+    rc = mode_diskfull();
+  else if (!strcmp(argv[1], "dirsync"))
+    rc = mode_dirsync();
+  remove(g_scene);
+  return rc;
 }
