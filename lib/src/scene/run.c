@@ -103,16 +103,7 @@ fcm_status fcm__effect_apply_constraint(fcm_simulation *S, const fcm_effect *e)
     for (int d = 0; d < 3; d++)
       m.components[d] = e->fixed.components[d];
   } else {
-    const fcm_effect_motion *em = &e->motion;
-    for (int d = 0; d < 3; d++) {
-      m.velocity[d] = em->velocity[d];
-      m.center[d] = em->center[d];
-      m.axis[d] = em->axis[d];
-    }
-    m.angular_speed = em->angular_speed;
-    m.start = em->start;
-    m.end = em->end;
-    m.release = em->release;
+    m = e->motion.motion;
   }
   FCM_TRY(S->ctx, region_nodes(S, r, e->index, NULL, &n));
   FCM_ALLOC(S->ctx, n, nodes);
@@ -316,15 +307,8 @@ static fcm_status build_rules(fcm_simulation *S)
     ro.surface_strength = -1;
   ro.min_fraction = q->min_fraction;
   ro.simplify = q->simplify;
-  ro.simplify_options.method = q->simplify_method == FCM_SCENE_SIMPLIFY_LP ? FCM_SIMPLIFY_LP
-                               : q->simplify_method == FCM_SCENE_SIMPLIFY_RECOMBINE
-                                   ? FCM_SIMPLIFY_RECOMBINE
-                                   : FCM_SIMPLIFY_AUTO;
-  ro.stabilization.mode = q->stabilization == FCM_SCENE_STABILIZATION_MASS ? FCM_STABILIZATION_MASS
-                          : q->stabilization == FCM_SCENE_STABILIZATION_OFF
-                              ? FCM_STABILIZATION_OFF
-                              : FCM_STABILIZATION_MASS_STIFFNESS;
-  ro.stabilization.alpha = q->stabilization_alpha;
+  ro.simplify_options.method = q->simplify_method;
+  ro.stabilization = q->stabilization;
   ro.num_threads = sv->threads;
   FCM_TRY(S->ctx, fcm_cell_rules_create(S->ctx, S->mesh, S->geom, &ro, &S->rules));
   S->c.cell_rules = 1;
@@ -339,36 +323,25 @@ static fcm_integrator_options integrator_options(fcm_simulation *S)
   const fcm_scene_solver *sv = fcm_scene_get_solver(S->scene);
   const fcm_scene_time *tm = fcm_scene_get_time(S->scene);
   fcm_integrator_options o = fcm_integrator_options_default();
-  o.kind = tm->is_static ? FCM_INTEGRATOR_STATIC : FCM_INTEGRATOR_BACKWARD_EULER;
+  o.kind = tm->integrator;
   o.dt = tm->dt;
   o.load_steps = tm->load_steps;
   o.newton_max_iterations = sv->newton_max_iterations;
   o.newton_tolerance = sv->newton_rtol;
-  /* Static scenes have no mass and no inertia; the force-balance (relative) rule needs
+  /* AUTO: static scenes have no mass and no inertia; the force-balance (relative) rule needs
    * neither, where the representative force would take a body-force pass of its own. */
-  o.tolerance_mode = sv->newton_rule == FCM_SCENE_NEWTON_REPRESENTATIVE
-                         ? FCM_NEWTON_TOL_REPRESENTATIVE
-                     : sv->newton_rule == FCM_SCENE_NEWTON_RELATIVE ? FCM_NEWTON_TOL_RELATIVE
-                     : tm->is_static                                ? FCM_NEWTON_TOL_RELATIVE
-                                                                    : FCM_NEWTON_TOL_REPRESENTATIVE;
+  o.tolerance_mode = sv->newton_rule;
   o.rep_acceleration = sv->representative_acceleration;
   o.line_search = sv->line_search;
   o.project_psd = sv->project_psd;
-  o.linear_solver = sv->method == FCM_SCENE_SOLVER_DIRECT ? FCM_LINEAR_DIRECT
-                    : sv->method == FCM_SCENE_SOLVER_CG   ? FCM_LINEAR_CG
-                                                          : FCM_LINEAR_MINRES;
+  o.linear_solver = sv->method;
   o.direct_method = sv->direct;
-  o.preconditioner = sv->preconditioner == FCM_SCENE_PRECONDITIONER_NONE     ? FCM_PRECOND_NONE
-                     : sv->preconditioner == FCM_SCENE_PRECONDITIONER_JACOBI ? FCM_PRECOND_JACOBI
-                     : sv->preconditioner == FCM_SCENE_PRECONDITIONER_BLOCK_JACOBI
-                         ? FCM_PRECOND_BLOCK_JACOBI
-                         : FCM_PRECOND_SCHWARZ;
+  o.preconditioner = sv->preconditioner;
   o.krylov_rtol = sv->rtol;
   o.krylov_atol = sv->atol;
   o.krylov_max_iterations = sv->max_iterations;
   o.schwarz_theta = sv->schwarz_threshold;
-  o.schwarz.epsilon = sv->schwarz_epsilon;
-  o.schwarz.clamp = sv->schwarz_paper_clamp ? FCM_SCHWARZ_PAPER : FCM_SCHWARZ_CLAMP;
+  o.schwarz = sv->schwarz;
   o.assembly.stiffness_strength = q->stiffness_strength > 0 ? q->stiffness_strength : 0;
   o.assembly.mass_strength = q->mass_strength > 0 ? q->mass_strength : 0;
   for (int k = 0; k < fcm_scene_num_effects(S->scene); k++) {
