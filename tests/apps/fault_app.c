@@ -9,7 +9,7 @@
  *       checkpoint) is whole; the run resumes from its last checkpoint (the resumed run may
  *       be killed again, once) or starts over when there is none, and when it ends every
  *       frame is byte for byte the reference's, the log is the reference's but for the wall
- *       times and the PVD indexes list every frame.
+ *       times, the PVD indexes list every frame and no temporary of a killed run is left.
  *   fault_app diskfull FCM_SIM SHIM WORK
  *       the disk fills up (the shim fails writes with ENOSPC after B bytes, B from nothing to
  *       inside the last checkpoint; and, when the machine lets an unprivileged user namespace
@@ -270,6 +270,9 @@ static int mode_kill(int trials, unsigned long long seed)
       check_files(ctx, scene, dir, what);
     }
     TEST_TRUE(rc == 0);
+    /* the temporaries of the killed runs were swept by the runs after them */
+    oc_counts c = oc_check_dir(dir, ctx, NULL);
+    if (c.tmp) TEST_FAIL_("%s: %d temporaries of killed runs are left", what, c.tmp);
     compare_with_reference(ref, dir, what);
   }
   if (getenv("FCM_FAULT_VERBOSE"))

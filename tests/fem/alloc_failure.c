@@ -14,7 +14,7 @@ typedef struct fixture {
   fcm_cell_rules *rules;
   fcm_space *space; /* embedded */
   fcm_csr *K;
-  fcm_elastic mat;
+  fcm_material mat;
   fcm_material_params hyper;
   double *f, *u;
   fcm_index ndof;
@@ -64,7 +64,7 @@ static fcm_status standard_rule(void *u)
 {
   fixture *x = u;
   x->r_out = (fcm_rule *)x;
-  fcm_status st = fcm_element_standard_rule(x->ctx, FCM_ELEMENT_HEX20, FCM_INTEGRAND_MASS, 0,
+  fcm_status st = fcm_element_standard_rule(x->ctx, FCM_ELEMENT_HEX20, FCM_RULE_MASS, 0,
                                             &x->r_out);
   return OUT_CHECK(st, x->r_out);
 }
@@ -141,7 +141,7 @@ int main(void)
   TEST_OK(ctx, fcm_space_create_embedded(ctx, x.mesh, x.rules, &x.space));
   TEST_OK(ctx, fcm_space_matrix_create(x.space, &x.K));
   if (!x.K) return TEST_RESULT();
-  x.mat = (fcm_elastic){1e6, 0.3, 1000};
+  x.mat = (fcm_material){FCM_MATERIAL_LINEAR, 1e6, 0.3, 1000};
   fcm_material m = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 1e6, 0.3, 1000};
   TEST_OK(ctx, fcm_material_setup(ctx, &m, &x.hyper));
   x.ndof = fcm_space_num_dofs(x.space);
