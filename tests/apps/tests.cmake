@@ -50,8 +50,8 @@ fcm_add_test(app_converge_rates_full tests/apps/converge_rates.c LABELS app slow
 # Faults around fcm-sim's output, through an LD_PRELOAD shim (tests/support/fault_shim.c):
 # kill -9 inside file operations and at random moments, then resume (a handful of seeded
 # kills by default, 60 under slow); the disk filling up (the shim's ENOSPC, and a real small
-# tmpfs where an unprivileged mount namespace is allowed); a directory fsync after each
-# rename that puts an output file in place.
+# tmpfs where an unprivileged mount namespace is allowed); power loss: a directory fsync
+# after each durable write (checkpoints: temporary fsynced, then renamed).
 add_library(fcm_fault_shim SHARED tests/support/fault_shim.c)
 target_link_libraries(fcm_fault_shim PRIVATE ${CMAKE_DL_LIBS})
 set_target_properties(fcm_fault_shim PROPERTIES C_VISIBILITY_PRESET default)
