@@ -64,11 +64,32 @@ FCM_API const fcm_mesh *fcm_space_mesh(const fcm_space *space);
  * @return FCM_OK, FCM_ERR_ALLOC. Release with fcm_csr_destroy(). */
 FCM_API fcm_status fcm_space_matrix_create(const fcm_space *space, fcm_csr **A);
 
+/** The material model of the fictitious stabilization points of cut cells (flag 1 in
+ * fcm_cell_rules_get()) in fcm_assemble_hyperelastic(); authentic points always use the
+ * exact model. alpha x an indefinite full-cell tangent does not lift the small blocks of
+ * cut cells, so by default the fictitious points carry a positive semi-definite tangent. */
+typedef enum fcm_fictitious_model {
+  /** Exact energy and force of the material (rotation invariant, so the O(alpha)
+   * stabilization exerts no torque), PSD-projected tangent (Smith et al. 2019): the
+   * tangent differs from the derivative of the force by alpha (K - K_psd) on these
+   * points only (default). */
+  FCM_FICTITIOUS_PROJECTED = 0,
+  /** Linear elasticity about the rest state with the material's (mu, lambda): energy,
+   * force and the constant PSD tangent are consistent (a true Hessian), but not
+   * rotation invariant (an O(alpha) torque under large rotations). */
+  FCM_FICTITIOUS_LINEAR = 1,
+  /** The exact model with its exact (possibly indefinite) tangent: the behaviour before
+   * issue 19. */
+  FCM_FICTITIOUS_EXACT = 2,
+  FCM_FICTITIOUS_MODEL_COUNT
+} fcm_fictitious_model;
+
 /** Quadrature strengths for assembly on full cells; 0 selects the default rule of
  * fcm_element_standard_rule(). */
 typedef struct fcm_assembly_options {
   int stiffness_strength; /**< stiffness and body force */
   int mass_strength;      /**< consistent mass */
+  fcm_fictitious_model fictitious; /**< model at stabilization points (hyperelastic only) */
 } fcm_assembly_options;
 
 /** The rule used on uncut (full) cells of `type` for the integral of `kind`
@@ -88,7 +109,7 @@ FCM_API fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type
                                              fcm_rule_kind kind, int strength,
                                              fcm_rule **rule);
 
-/** Defaults: both strengths 0 (element defaults). */
+/** Defaults: both strengths 0 (element defaults), fictitious FCM_FICTITIOUS_PROJECTED. */
 FCM_API fcm_assembly_options fcm_assembly_options_default(void);
 
 /** Add the linear elastic stiffness K to A (A must come from
@@ -132,7 +153,9 @@ FCM_API fcm_status fcm_assemble_surface_traction(fcm_space *space, fcm_field_fn 
 
 /** Hyperelastic energy, internal force and tangent at the displacement u:
  * E = sum over points of w det J Psi(F), F = I + grad u; force_i = dE/du_i (added
- * to `force`); tangent = d^2E/du^2 (added to `tangent`, space pattern).
+ * to `force`); tangent = d^2E/du^2 (added to `tangent`, space pattern), except at the
+ * fictitious stabilization points of cut cells, whose model is opts->fictitious (default: exact
+ * energy and force, PSD-projected tangent).
  * @param[in]  mat     from fcm_material_setup() (its project_psd is honoured)
  * @param[in]  u       num_dofs displacements
  * @param[out] energy  may be NULL; @param[in,out] force may be NULL; tangent may be NULL

@@ -123,7 +123,14 @@ typedef struct fcm_direct_info {
   double factor_flops;      /**< flops of the last numeric factorization (estimate for CHOLMOD) */
   double rcond;             /**< crude reciprocal condition estimate from the factor's diagonal
                                  (CHOLMOD: (min/max diag L)^2, UMFPACK: min/max |diag U|) */
-  fcm_index failed_column;  /**< column (original numbering) where the last factor failed, or -1 */
+  fcm_index failed_column;  /**< column (original numbering) where the last factor failed
+                                 (not positive definite), or -1 */
+  double min_pivot_ratio;   /**< CHOLMOD: min over columns of pivot / diagonal (L_jj^2 / A_jj, in
+                                 (0, 1]) of the last completed factor; below 1e-10 the factor
+                                 is refused as numerically singular. 0 before any, and for
+                                 UMFPACK. */
+  double backward_error;    /**< ||b - A x|| / (||A|| ||x|| + ||b||) (infinity norms) of the
+                                 last solve; above 1e-8 the solve is refused as singular */
   double time_analyze;      /**< seconds in analyze */
   double time_factor;       /**< seconds in factor */
   double time_solve;        /**< seconds in solve */
@@ -156,14 +163,19 @@ FCM_API fcm_status fcm_direct_analyze(fcm_direct *solver);
  * only). Reuses the symbolic analysis; call fcm_direct_analyze() first.
  * @return FCM_OK, FCM_ERR_ARG (not analyzed), FCM_ERR_NUMERIC (NaN/Inf value),
  * FCM_ERR_SINGULAR (CHOLMOD: not positive definite, UMFPACK: zero pivot; the
- * message and info.failed_column name the column; no factor is kept),
+ * message and info.failed_column name the column; CHOLMOD also refuses a completed factor
+ * whose smallest pivot is below 1e-10 of its diagonal, numerically singular: the message
+ * names the column and the likely causes, info.failed_column stays -1; UMFPACK likewise a
+ * factor with rcond = min/max |diag U| below 1e-13; no factor is kept),
  * FCM_ERR_ALLOC. SuiteSparse allocates the numeric factor. Not thread safe on one solver. */
 FCM_API fcm_status fcm_direct_factor(fcm_direct *solver, const double *values);
 
 /** Solve A x = b (n entries each) with the last successful factorization; `x`
  * may equal `b`. No allocation (CHOLMOD allocates its solve workspace once, on
- * the first solve). @return FCM_OK, FCM_ERR_ARG (no valid factorization, NULL),
- * FCM_ERR_ALLOC (CHOLMOD's first solve). Not thread safe on one solver. */
+ * the first solve). The residual of x is checked: a normwise backward error above 1e-8
+ * (singular system, b outside the range) gives FCM_ERR_SINGULAR with the likely causes and
+ * x is still written. @return FCM_OK, FCM_ERR_ARG (no valid factorization, NULL),
+ * FCM_ERR_ALLOC (CHOLMOD's first solve), FCM_ERR_SINGULAR. Not thread safe on one solver. */
 FCM_API fcm_status fcm_direct_solve(fcm_direct *solver, const double *b, double *x);
 
 /** Copy the counters and statistics into *info. */

@@ -12,7 +12,7 @@
 
 fcm_assembly_options fcm_assembly_options_default(void)
 {
-  fcm_assembly_options o = {0, 0};
+  fcm_assembly_options o = {0, 0, FCM_FICTITIOUS_PROJECTED};
   return o;
 }
 
@@ -43,6 +43,7 @@ typedef struct cell_rule {
   const double *w;  /* nq weights; det J_K(xi) still to be applied */
   const double *N;  /* nq x nn */
   const double *dN; /* nq x nn x 3 reference gradients */
+  const unsigned char *fict; /* nq flags (1: fictitious stabilization point), or NULL */
 } cell_rule;
 
 /* Shape values and reference gradients of the element at the standard rule's points. */
@@ -86,9 +87,9 @@ static cell_rule get_cell_rule(const fcm_space *s, const tabulation *t, fcm_rule
                                fcm_index cell, double *Nbuf, double *dNbuf)
 {
   if (!s->rules || fcm_cell_rules_class(s->rules, cell) == FCM_CELL_UNCUT) return t->r;
-  cell_rule r = {0, NULL, Nbuf, dNbuf};
+  cell_rule r = {0, NULL, Nbuf, dNbuf, NULL};
   const double *pts = NULL;
-  fcm_cell_rules_get(s->rules, cell, kind, &r.nq, &pts, &r.w, NULL);
+  fcm_cell_rules_get(s->rules, cell, kind, &r.nq, &pts, &r.w, &r.fict);
   for (int q = 0; q < r.nq; q++) {
     fcm_element_eval_shape(s->type, pts + 3 * q, Nbuf + (size_t)q * s->nn);
     fcm_element_eval_grad(s->type, pts + 3 * q, dNbuf + (size_t)q * s->nn * 3);
@@ -113,7 +114,33 @@ typedef struct kernel_data {
   const fcm_material_params *mat;
   const double *u; /* displacement per DOF */
   int want_force, want_tangent;
+  fcm_fictitious_model fictitious; /* model at fictitious points (hyperelastic) */
+  fcm_material_params mat_psd;     /* *mat with project_psd = 1 */
 } kernel_data;
+
+/* The material at a fictitious stabilization point (DESIGN §7, issue 19): the exact
+ * model's tangent times alpha is indefinite and does not lift the small blocks of cut
+ * cells, so these points carry a positive semi-definite tangent. PROJECTED keeps the
+ * exact energy and force (rotation invariant) and projects the tangent: the Newton
+ * matrix then differs from the true Hessian by alpha (K - K_psd) on these points only,
+ * the residual and hence the solution stay exact. LINEAR uses linear elasticity at rest
+ * for all three, a consistent energy but an O(alpha) torque under rotations. */
+static void fictitious_eval(const kernel_data *kd, const double F[9], double *psi, double P[9],
+                            double *A)
+{
+  switch (kd->fictitious) {
+  case FCM_FICTITIOUS_LINEAR:
+    fcm__material_linear(kd->mat->mu, kd->mat->lambda, F, psi, P, A);
+    return;
+  case FCM_FICTITIOUS_PROJECTED:
+    fcm__material_eval(kd->mat, F, psi, P, NULL);
+    if (A) fcm__material_eval(&kd->mat_psd, F, NULL, NULL, A);
+    return;
+  default:
+    fcm__material_eval(kd->mat, F, psi, P, A);
+    return;
+  }
+}
 
 /* Jacobian at point q of rule r: physical gradients g (nn x 3); returns det J. */
 static double physical_gradients(const cell_rule *r, int nn, int q, const double *X, double *g)
@@ -215,7 +242,10 @@ static cell_result cell_kernel(const kernel_data *kd, const cell_rule *r, int nn
       for (int a = 0; a < nn; a++)
         for (int i = 0; i < 3; i++)
           for (int j = 0; j < 3; j++) F[3 * i + j] += w->ue[3 * a + i] * g[3 * a + j];
-      fcm__material_eval(kd->mat, F, &psi, P, kd->want_tangent ? A : NULL);
+      if (r->fict && r->fict[q])
+        fictitious_eval(kd, F, &psi, P, kd->want_tangent ? A : NULL);
+      else
+        fcm__material_eval(kd->mat, F, &psi, P, kd->want_tangent ? A : NULL);
       int finite = isfinite(psi);
       for (int k = 0; k < 9; k++) finite &= isfinite(P[k]);
       if (!finite) {
@@ -498,6 +528,14 @@ fcm_status fcm_assemble_hyperelastic(fcm_space *s, const fcm_material_params *ma
   kd.u = u;
   kd.want_force = force != NULL;
   kd.want_tangent = tangent != NULL;
+  FCM_CHECK(o.fictitious >= FCM_FICTITIOUS_PROJECTED && o.fictitious < FCM_FICTITIOUS_MODEL_COUNT,
+            s->ctx, FCM_ERR_ARG,
+            "hyperelastic: assembly option fictitious = %d out of range [0, %d) (0 projected, 1 "
+            "linear, 2 exact)",
+            (int)o.fictitious, (int)FCM_FICTITIOUS_MODEL_COUNT);
+  kd.fictitious = o.fictitious;
+  kd.mat_psd = *mat;
+  kd.mat_psd.project_psd = 1;
   FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, tangent ? fcm_csr_get_values(tangent) : NULL,
                            force, energy));
 cleanup:

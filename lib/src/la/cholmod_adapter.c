@@ -11,6 +11,7 @@
 
 #include <cholmod.h>
 #include <string.h>
+#include <math.h>
 
 _Static_assert(sizeof(SuiteSparse_long) == sizeof(fcm_index),
                "fcm expects SuiteSparse_long to be 64-bit like fcm_index");
@@ -118,6 +119,49 @@ cleanup:
   return st;
 }
 
+/* Rank check of a completed factor (issue 19): CHOLMOD accepts a numerically singular
+ * positive semi-definite matrix whenever rounding leaves its zero pivots positive, and
+ * its rcond ((min/max diag L)^2) is no help because it mixes the scales of all rows. The
+ * pivot of column j of P A P^T relative to that column's diagonal,
+ * r_j = L_jj^2 / A_pp (p = Perm[j]) in (0, 1], is invariant under diagonal scaling and
+ * equals the ratio of the smallest energy of a vector with unit p entry (others
+ * free, among the columns eliminated before j) to A_pp: it is ~ n eps for a direction
+ * that is singular in exact arithmetic (a rigid mode, an hourglass mode of a too weak
+ * rule, a DOF with no quadrature point) and is bounded below for stabilized FCM
+ * systems (the alpha-scaled full-cell rule keeps every cut-cell block definite).
+ * Returns min_j r_j and the original column where it occurs. */
+static double min_pivot_ratio(const chol *h, const double *values, fcm_index *col)
+{
+  const cholmod_factor *L = h->L;
+  const SuiteSparse_long *perm = L->Perm;
+  const double *Lx = L->x;
+  double best = HUGE_VAL;
+  *col = -1;
+  for (fcm_index j = 0, s = 0; j < h->n; j++) {
+    double piv;
+    if (L->is_super) {
+      const SuiteSparse_long *super = L->super, *pi = L->pi, *px = L->px;
+      while (super[s + 1] <= (SuiteSparse_long)j) s++;
+      const SuiteSparse_long k = (SuiteSparse_long)j - super[s], nsrow = pi[s + 1] - pi[s];
+      const double d = Lx[px[s] + k + k * nsrow];
+      piv = d * d;
+    } else {
+      const double d = Lx[((const SuiteSparse_long *)L->p)[j]];
+      piv = L->is_ll ? d * d : d;
+    }
+    const fcm_index p = perm ? (fcm_index)perm[j] : j;
+    double app = 0.0;
+    for (SuiteSparse_long q = h->ap[p]; q < h->ap[p + 1]; q++)
+      if (h->ai[q] == (SuiteSparse_long)p) app = values[q];
+    const double r = app > 0.0 ? piv / app : (piv > 0.0 ? HUGE_VAL : 0.0);
+    if (r < best) {
+      best = r;
+      *col = p;
+    }
+  }
+  return best;
+}
+
 static fcm_status chol_factor(fcm_ctx *ctx, void *impl, const double *values, fcm_direct_info *info)
 {
   fcm_status st = FCM_OK;
@@ -144,6 +188,16 @@ static fcm_status chol_factor(fcm_ctx *ctx, void *impl, const double *values, fc
   info->factor_nnz = h->c.lnz;
   info->factor_flops = h->c.fl;
   info->rcond = cholmod_l_rcond(h->L, &h->c);
+  {
+    fcm_index col = -1;
+    const double r = min_pivot_ratio(h, values, &col);
+    info->min_pivot_ratio = r;
+    FCM_CHECK(!(r < FCM__SINGULAR_PIVOT_RATIO), ctx, FCM_ERR_SINGULAR,
+              "cholmod factor: matrix is numerically singular: the pivot of column %lld is %.3g "
+              "times its diagonal (threshold %.0e, n = %lld); %s",
+              (long long)col, r, FCM__SINGULAR_PIVOT_RATIO, (long long)h->n,
+              FCM__SINGULAR_HINT);
+  }
 cleanup:
   return st;
 }

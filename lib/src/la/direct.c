@@ -3,6 +3,7 @@
 #include "la/la_impl.h"
 
 #include <math.h>
+#include <string.h>
 
 struct fcm_direct {
   fcm_ctx *ctx;
@@ -12,6 +13,9 @@ struct fcm_direct {
   fcm_index n, nnz;
   fcm_index *row_ptr; /* copy of the pattern's rows, to name entries in messages */
   int *col_idx;
+  double *values; /* copy of the factored values, for the residual check */
+  double *b_copy; /* n: b of the solve (x may alias it) */
+  double norm_a;  /* ||A||_inf of the factored values */
   int analyzed, factored;
   fcm_direct_info info;
 };
@@ -57,6 +61,8 @@ fcm_status fcm_direct_create(fcm_ctx *ctx, fcm_direct_method method, const fcm_c
     s->row_ptr[i] = A->row_ptr[i];
   for (fcm_index p = 0; p < s->nnz; p++)
     s->col_idx[p] = A->col_idx[p];
+  FCM_ALLOC(ctx, FCM_MAX(s->nnz, 1), s->values);
+  FCM_ALLOC(ctx, FCM_MAX(s->n, 1), s->b_copy);
   if (s->n > 0) FCM_TRY(ctx, s->ops->create(ctx, A, &s->impl));
   *out = s;
   s = NULL;
@@ -100,6 +106,22 @@ fcm_status fcm_direct_factor(fcm_direct *s, const double *values)
                 values[p]);
   fcm_timer_start(&t);
   if (s->n > 0) FCM_TRY(ctx, s->ops->factor(ctx, s->impl, values, &s->info));
+  /* UMFPACK's rcond is min/max |diag U| of the row-scaled matrix: ~1e-16 or below for the
+   * numerically singular systems of issue 19 (free static body, too weak quadrature) whose
+   * rounding-level pivot CHOLMOD turned into "not positive definite". */
+  FCM_CHECK(s->method != FCM_DIRECT_UMFPACK || s->n == 0 ||
+                !(s->info.rcond < FCM__SINGULAR_UMFPACK_RCOND),
+            ctx, FCM_ERR_SINGULAR,
+            "direct_factor: umfpack pivots span %.3g (min/max |diag U|, threshold %.0e; n = %lld): "
+            "the matrix is numerically singular; %s",
+            s->info.rcond, FCM__SINGULAR_UMFPACK_RCOND, (long long)s->n, FCM__SINGULAR_HINT);
+  s->norm_a = 0.0;
+  for (fcm_index i = 0; i < s->n; i++) {
+    double row = 0.0;
+    for (fcm_index p = s->row_ptr[i]; p < s->row_ptr[i + 1]; p++) row += fabs(values[p]);
+    s->norm_a = fmax(s->norm_a, row);
+  }
+  if (s->nnz > 0) memcpy(s->values, values, sizeof *values * (size_t)s->nnz);
   s->factored = 1;
 cleanup:
   fcm_timer_stop(&t);
@@ -119,8 +141,33 @@ fcm_status fcm_direct_solve(fcm_direct *s, const double *b, double *x)
             s->ops->name);
   FCM_CHECK((b && x) || s->n == 0, ctx, FCM_ERR_ARG, "direct_solve: b or x is NULL");
   fcm_timer_start(&t);
-  if (s->n > 0) FCM_TRY(ctx, s->ops->solve(ctx, s->impl, b, x));
+  if (s->n > 0) {
+    memcpy(s->b_copy, b, sizeof *b * (size_t)s->n);
+    FCM_TRY(ctx, s->ops->solve(ctx, s->impl, b, x));
+  }
   s->info.solves++;
+  if (s->n > 0) {
+    /* Residual check (issue 19): a backward-stable solve of a nonsingular system has a
+     * backward error of a few n eps; far above it the system is singular (b outside the
+     * range, or a null direction blown up by a rounding-level pivot). */
+    double nr = 0.0, nx = 0.0, nb = 0.0;
+    for (fcm_index i = 0; i < s->n; i++) {
+      double r = s->b_copy[i];
+      for (fcm_index p = s->row_ptr[i]; p < s->row_ptr[i + 1]; p++)
+        r -= s->values[p] * x[s->col_idx[p]];
+      nr = fmax(nr, fabs(r));
+      nx = fmax(nx, fabs(x[i]));
+      nb = fmax(nb, fabs(s->b_copy[i]));
+    }
+    const double den = s->norm_a * nx + nb;
+    const double eta = den > 0.0 ? nr / den : (nr > 0.0 ? INFINITY : 0.0);
+    s->info.backward_error = isnan(eta) ? INFINITY : eta;
+    FCM_CHECK(s->info.backward_error <= FCM__SINGULAR_BACKWARD_ERROR, ctx, FCM_ERR_SINGULAR,
+              "direct_solve: %s solution has backward error %.3g (> %.0e; n = %lld): the "
+              "matrix is numerically singular; %s",
+              s->ops->name, s->info.backward_error, FCM__SINGULAR_BACKWARD_ERROR,
+              (long long)s->n, FCM__SINGULAR_HINT);
+  }
 cleanup:
   fcm_timer_stop(&t);
   if (s) s->info.time_solve += t.total;
@@ -146,6 +193,8 @@ void fcm_direct_destroy(fcm_direct **s)
   if ((*s)->impl) (*s)->ops->destroy(ctx, (*s)->impl);
   fcm__free(ctx, (*s)->row_ptr);
   fcm__free(ctx, (*s)->col_idx);
+  fcm__free(ctx, (*s)->values);
+  fcm__free(ctx, (*s)->b_copy);
   fcm__free(ctx, *s);
   *s = NULL;
 }

@@ -2,8 +2,10 @@
  * the matrix is not positive definite (symbolic analyses kept for the whole run), or CG /
  * MINRES with Jacobi, block Jacobi or additive Schwarz preconditioning (DESIGN §7). */
 #include "sim/sim_impl.h"
+#include "la/la_impl.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 long long fcm__sim_analyses(const fcm_integrator *I)
@@ -26,6 +28,28 @@ static fcm_status soft(fcm_integrator *I, fcm_status s, fcm_step_reason *reason)
   return s;
 }
 
+/* A numerically singular system (issue 19: the direct path refuses it instead of returning
+ * garbage) is a hard error, not a step to retry with a shorter time step: re-raise it with
+ * the cause this integrator can name (no active constraint in a static step) before the
+ * direct solver's message. */
+static fcm_status singular(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  char msg[1024];
+  snprintf(msg, sizeof msg, "%s", fcm_ctx_error_message(ctx));
+  fcm_ctx_error_clear(ctx);
+  const int free_static = I->nact == 0 && I->key_h == 0.0;
+  FCM_CHECK(0, ctx, FCM_ERR_SINGULAR, "integrator: the Newton matrix is singular%s: %s%s%s",
+            free_static ? " (static step without any active Dirichlet constraint: the body's "
+                          "rigid-body modes are unconstrained)"
+                        : "",
+            msg, strstr(msg, "likely causes") ? "" : "; ",
+            strstr(msg, "likely causes") ? "" : FCM__SINGULAR_HINT);
+cleanup:
+  return st;
+}
+
 static fcm_status factor_direct(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
 {
   fcm_status st = FCM_OK, s;
@@ -41,6 +65,9 @@ static fcm_status factor_direct(fcm_integrator *I, fcm_step_reason *reason, sim_
       return FCM_OK;
     }
     if (s != FCM_ERR_SINGULAR) return soft(I, s, reason);
+    fcm_direct_info di;
+    fcm_direct_get_info(I->chol, &di);
+    if (di.failed_column < 0) return singular(I); /* factor completed, rank deficient */
     /* Not positive definite: LU with partial pivoting on the same matrix. */
     stats->direct_fallbacks++;
     I->total_fallbacks++;
@@ -61,6 +88,9 @@ static fcm_status factor_direct(fcm_integrator *I, fcm_step_reason *reason, sim_
     I->direct = I->umf;
     return FCM_OK;
   }
+  /* LU with partial pivoting met a zero or rounding-level pivot: no shorter step changes
+   * the rank (mass and constraints stay), so stop with the reason. */
+  if (s == FCM_ERR_SINGULAR) return singular(I);
   return soft(I, s, reason);
 cleanup:
   return st;
@@ -115,7 +145,12 @@ fcm_status fcm__sim_solve(fcm_integrator *I, const double *b, double *d, fcm_ste
   *iterations = 0;
   if (I->opts.linear_solver == FCM_LINEAR_DIRECT) {
     FCM_CHECK(I->direct, ctx, FCM_ERR_INTERNAL, "integrator: no valid factorization to solve with");
-    FCM_TRY(ctx, fcm_direct_solve(I->direct, b, d));
+    s = fcm_direct_solve(I->direct, b, d);
+    if (s == FCM_ERR_SINGULAR) {
+      st = singular(I);
+      goto cleanup;
+    }
+    FCM_TRY(ctx, s);
   } else {
     fcm_krylov_options ko = fcm_krylov_options_default();
     fcm_krylov_info ki;
