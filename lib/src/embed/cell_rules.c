@@ -396,14 +396,15 @@ static fcm_status run_cells(const build *B, fcm_cell_rules *R, int nthreads, cel
 #pragma omp for schedule(dynamic, 4)
     for (fcm_index c = 0; c < nc; c++) {
       if (fcm__loop_skip(&loop, c)) continue;
-      fcm__loop_iter it = fcm__loop_enter(&loop, c);
+      fcm__loop_iter it;
+      fcm__loop_enter(&loop, &it, c);
       fcm_status s = FCM_OK;
       if (!ws) { /* the thread's workspace, made by its first cell */
         ws = fcm__calloc(ctx, 1, sizeof *ws);
         if (!ws) s = FCM_ERR_ALLOC;
       }
       if (s == FCM_OK) s = process_cell(B, R, c, ws, out + c, &mine);
-      fcm__loop_leave(&loop, it, s);
+      fcm__loop_leave(&loop, &it, s);
     }
     if (ws) fcm__embed_ws_free(ctx, ws);
     fcm__free(ctx, ws);

@@ -166,10 +166,11 @@ fcm_status fcm_space_locate(const fcm_space *s, fcm_index n, const double *X, fc
     for (fcm_index i = 0; i < n; i++) {
       int ex = 0;
       if (fcm__loop_skip(&loop, i)) continue;
-      fcm__loop_iter it = fcm__loop_enter(&loop, i);
+      fcm__loop_iter it;
+      fcm__loop_enter(&loop, &it, i);
       fcm_status si = locate_one(s, tree, tree_cell, centroid, reach, i, X + 3 * i, my_ids,
                                  cell + i, xi + 3 * i, &ex);
-      fcm__loop_leave(&loop, it, si);
+      fcm__loop_leave(&loop, &it, si);
       if (si == FCM_OK && extrapolated) extrapolated[i] = ex;
     }
   }
