@@ -70,7 +70,7 @@ static uint64_t fingerprint(const fcm_simulation *S)
   int64_t sizes[5] = {(int64_t)S->c.num_dofs, (int64_t)S->nn, (int64_t)fcm_mesh_num_cells(S->mesh),
                       (int64_t)S->c.constrained_dofs, (int64_t)tm->load_steps};
   double reals[4] = {tm->dt, mat->young, mat->poisson, mat->density};
-  int flags[2] = {tm->is_static, (int)mat->model};
+  int flags[2] = {tm->integrator == FCM_INTEGRATOR_STATIC, (int)mat->model};
   h = fnv(h, sizes, sizeof sizes);
   h = fnv(h, reals, sizeof reals);
   h = fnv(h, flags, sizeof flags);
