@@ -7,10 +7,11 @@
  *   entirely below 1e-13 as "slivers", doubled at 1e-12 across a face);
  * - memory: a cell whose rule building would exceed max_rule_memory is refused before
  *   allocating, FCM_ERR_UNSUPPORTED naming the cell, the estimate and the limit; 0 lifts
- *   the limit;
+ *   the limit; the scene key quadrature.max_rule_memory_gib (default 4, [0, 2^20]) sets it;
  * - errors of the parallel build are reported once and deterministically: when every cell
  *   fails, the lowest-numbered cell is named, for 1, 2 and 4 threads, on every run. */
 #include "fcm/embed.h"
+#include "fcm/scene.h"
 #include "test.h"
 
 #include <omp.h>
@@ -103,7 +104,7 @@ static void crowded(fcm_ctx *ctx)
            "embed: background cell 0 holds ");
   TEST_TRUE(R == NULL);
   TEST_ERR(ctx, fcm_cell_rules_create(ctx, m, g, &o, &R), FCM_ERR_UNSUPPORTED,
-           "above the limit of 0.001 GB (fcm_cell_rules_options.max_rule_memory");
+           "above the limit of 0.000931 GiB (fcm_cell_rules_options.max_rule_memory");
   /* the lowest failing cell, whatever the threads */
   const int threads[3] = {1, 2, 4};
   for (int run = 0; run < 15; run++) {
@@ -120,6 +121,28 @@ static void crowded(fcm_ctx *ctx)
   fcm_mesh_destroy(&m);
 }
 
+/* The scene key: default 4 GiB, read back, range-checked. */
+static void scene_key(fcm_ctx *ctx)
+{
+#define SCENE(q)                                                                                   \
+  "{\"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1]}, "    \
+  "\"cells\": [1, 1, 1]}, \"material\": {\"young\": 1e6, \"poisson\": 0.3}" q "}"
+  fcm_scene *s = NULL;
+  TEST_OK(ctx, fcm_scene_create_from_string(ctx, SCENE(""), "t.json", &s));
+  if (s) TEST_TRUE(fcm_scene_get_quadrature(s)->max_rule_memory_gib == 4.0);
+  fcm_scene_destroy(&s);
+  TEST_OK(ctx, fcm_scene_create_from_string(
+                   ctx, SCENE(", \"quadrature\": {\"max_rule_memory_gib\": 0.5}"), "t.json", &s));
+  if (s) TEST_TRUE(fcm_scene_get_quadrature(s)->max_rule_memory_gib == 0.5);
+  fcm_scene_destroy(&s);
+  TEST_ERR(ctx,
+           fcm_scene_create_from_string(
+               ctx, SCENE(", \"quadrature\": {\"max_rule_memory_gib\": -1}"), "t.json", &s),
+           FCM_ERR_ARG, "max_rule_memory_gib");
+  TEST_TRUE(s == NULL);
+#undef SCENE
+}
+
 int main(void)
 {
   fcm_ctx *ctx = NULL;
@@ -127,6 +150,7 @@ int main(void)
   fractions(ctx);
   thin(ctx);
   crowded(ctx);
+  scene_key(ctx);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();

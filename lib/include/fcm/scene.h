@@ -89,6 +89,8 @@ typedef struct fcm_scene_quadrature {
                                                 default 1e-6 */
   double min_fraction; /**< cells with smaller volume fraction are dropped; [0, 1),
                             default 1e-4 */
+  double max_rule_memory_gib; /**< fcm_cell_rules_options.max_rule_memory in GiB; [0, 2^20],
+                                   default 4; 0: no limit */
 } fcm_scene_quadrature;
 
 /** Solver settings ("solver"), in the library's own types (fcm/sim.h, fcm/solve.h). */

@@ -51,44 +51,51 @@ fcm_status fcm__file_read_all(fcm_ctx *ctx, const char *what, const char *path, 
 /* ---- errors of parallel loops: recorded once, the lowest failing iteration wins ----
  *
  * Inside an iteration bracketed by fcm__loop_enter()/fcm__loop_leave(), errors recorded on
- * the loop's ctx (FCM_CHECK, FCM_ALLOC, fcm__calloc, FCM_TRY frames) go to the loop
- * instead of the ctx, so threads never overwrite each other's message. fcm__loop_end()
- * then records the error of the lowest failing iteration in the ctx and logs it once:
- * the reported error does not depend on the number of threads or on scheduling.
+ * the loop's ctx (FCM_CHECK, FCM_ALLOC, fcm__calloc, FCM_TRY frames) go to the iteration's
+ * own record instead of the ctx, so threads never overwrite each other's message.
+ * fcm__loop_end() then records the error of the lowest failing iteration in the ctx and
+ * logs it once: the reported error does not depend on the thread count or scheduling.
  *
  *   fcm__loop L;
  *   fcm__loop_begin(ctx, &L);
  *   #pragma omp parallel for
  *   for (i = 0; i < n; i++) {
  *     if (fcm__loop_skip(&L, i)) continue;          // a lower iteration already failed
- *     fcm__loop_iter it = fcm__loop_enter(&L, i);
- *     fcm__loop_leave(&L, it, work(i));             // the iteration's status
+ *     fcm__loop_iter it;
+ *     fcm__loop_enter(&L, &it, i);
+ *     fcm__loop_leave(&L, &it, work(i));            // the iteration's status
  *   }
  *   FCM_TRY(ctx, fcm__loop_end(&L, &failed_index)); // FCM_OK or the lowest failure
  *
- * Loops nest (an iteration may run a loop of its own on the same thread). An iteration
- * that returns FCM_OK after an error it handled leaves nothing behind. */
+ * Loops nest (an iteration may run a loop of its own; its error becomes the iteration's).
+ * An iteration that handles an error and returns FCM_OK leaves nothing behind. */
 #define FCM__LOOP_MSG_LEN 1024
 #define FCM__LOOP_FRAMES 32
 
-typedef struct fcm__loop {
-  fcm_ctx *ctx;
-  fcm_index failed;    /* lowest iteration that returned an error; -1: none */
-  fcm_status status;   /* its status */
-  fcm_index recorded;  /* iteration whose message is held below; -1: none */
-  fcm_status rec_code; /* the code of that message */
+/* An error message with its traceback (code FCM_OK: none). */
+typedef struct fcm__error_record {
+  fcm_status code;
   char msg[FCM__LOOP_MSG_LEN];
   struct {
     const char *file, *func;
     int line;
   } frames[FCM__LOOP_FRAMES];
   int nframes, frames_dropped;
+} fcm__error_record;
+
+typedef struct fcm__loop {
+  fcm_ctx *ctx;
+  fcm_index failed;      /* lowest iteration that returned an error; -1: none */
+  fcm_status status;     /* its status */
+  fcm__error_record rec; /* its message (code FCM_OK: it recorded none) */
 } fcm__loop;
 
-/* What fcm__loop_enter() replaced on this thread (restored by fcm__loop_leave()). */
+/* One iteration in progress (on the stack of the thread running it). */
 typedef struct fcm__loop_iter {
-  fcm__loop *prev_loop;
-  fcm_index prev_index;
+  fcm__loop *loop;
+  fcm_index index;
+  struct fcm__loop_iter *prev; /* the iteration this thread was in before (nesting) */
+  fcm__error_record rec;
 } fcm__loop_iter;
 
 /* Start a loop on ctx (no allocation). */
@@ -97,15 +104,15 @@ void fcm__loop_begin(fcm_ctx *ctx, fcm__loop *loop);
 /* Whether iteration i can be skipped: an iteration below i has already failed. */
 int fcm__loop_skip(fcm__loop *loop, fcm_index i);
 
-/* Errors on loop->ctx from this thread now belong to iteration i. */
-fcm__loop_iter fcm__loop_enter(fcm__loop *loop, fcm_index i);
+/* Errors on loop->ctx from this thread now belong to iteration i (recorded in *it). */
+void fcm__loop_enter(fcm__loop *loop, fcm__loop_iter *it, fcm_index i);
 
-/* End the iteration entered with `it`, which returned `st`. */
-void fcm__loop_leave(fcm__loop *loop, fcm__loop_iter it, fcm_status st);
+/* End iteration `it`, which returned `st`. */
+void fcm__loop_leave(fcm__loop *loop, fcm__loop_iter *it, fcm_status st);
 
 /* After the parallel region: FCM_OK, or the status of the lowest failing iteration with
- * its message and traceback recorded in the ctx (or in an enclosing loop). `failed`
- * (may be NULL) receives that iteration, -1 if none. */
+ * its message and traceback recorded in the ctx (or in the enclosing loop's iteration).
+ * `failed` (may be NULL) receives that iteration, -1 if none. */
 fcm_status fcm__loop_end(fcm__loop *loop, fcm_index *failed);
 
 /* ---- the one error idiom: every function has `fcm_status st` and `cleanup:` ---- */

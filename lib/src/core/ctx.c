@@ -144,102 +144,82 @@ static void log_message(const fcm_ctx *ctx, fcm_log_level level, const char *msg
 }
 
 /* The loop iteration this thread is in (fcm__loop_enter), if any. */
-static _Thread_local fcm__loop *tl_loop = NULL;
-static _Thread_local fcm_index tl_index = -1;
+static _Thread_local fcm__loop_iter *tl_iter = NULL;
 
-/* The loop collecting errors of ctx on this thread, or NULL. */
-static fcm__loop *active_loop(const fcm_ctx *ctx)
+/* The iteration collecting errors of ctx on this thread, or NULL. */
+static fcm__loop_iter *active_iter(const fcm_ctx *ctx)
 {
-  return tl_loop && tl_loop->ctx == ctx ? tl_loop : NULL;
+  return tl_iter && tl_iter->loop->ctx == ctx ? tl_iter : NULL;
 }
 
-/* A new error of iteration i in loop L: kept when no lower iteration holds one. */
-static void loop_store(fcm__loop *L, fcm_index i, fcm_status code, const char *msg,
-                       const fcm_frame *frames, int nframes, int dropped)
+static void record_frame(fcm__error_record *r, const char *file, int line, const char *func)
 {
-#pragma omp critical(fcm_error)
-  if (L->recorded < 0 || i <= L->recorded) {
-    L->recorded = i;
-    L->rec_code = code;
-    snprintf(L->msg, sizeof L->msg, "%s", msg);
-    L->nframes = 0;
-    L->frames_dropped = dropped;
-    for (int k = 0; k < nframes; k++) {
-      if (L->nframes < FCM__LOOP_FRAMES) {
-        L->frames[L->nframes].file = frames[k].file;
-        L->frames[L->nframes].func = frames[k].func;
-        L->frames[L->nframes].line = frames[k].line;
-        L->nframes++;
-      } else {
-        L->frames_dropped++;
-      }
-    }
+  if (r->nframes < FCM__LOOP_FRAMES) {
+    r->frames[r->nframes].file = file;
+    r->frames[r->nframes].func = func;
+    r->frames[r->nframes].line = line;
+    r->nframes++;
+  } else {
+    r->frames_dropped++;
   }
 }
 
-/* Record an error with its frames in ctx, or in the loop this thread's iteration belongs to. */
-static void store_error(fcm_ctx *ctx, fcm_status code, const char *msg, const fcm_frame *frames,
-                        int nframes, int dropped)
+/* Record an error (message and frames) in ctx, or in the loop iteration this thread is in. */
+static void store_error(fcm_ctx *ctx, const fcm__error_record *e)
 {
-  fcm__loop *L = active_loop(ctx);
-  if (L) {
-    loop_store(L, tl_index, code, msg, frames, nframes, dropped);
+  fcm__loop_iter *it = active_iter(ctx);
+  if (it) { /* thread-private: no lock */
+    it->rec = *e;
     return;
   }
 #pragma omp critical(fcm_error)
   {
-    ctx->err_status = code;
-    snprintf(ctx->err_msg, sizeof ctx->err_msg, "%s", msg);
+    ctx->err_status = e->code;
+    snprintf(ctx->err_msg, sizeof ctx->err_msg, "%s", e->msg);
     ctx->nframes = 0;
-    ctx->frames_dropped = dropped;
-    for (int k = 0; k < nframes; k++)
-      push_frame(ctx, frames[k].file, frames[k].line, frames[k].func);
+    ctx->frames_dropped = e->frames_dropped;
+    for (int k = 0; k < e->nframes; k++)
+      push_frame(ctx, e->frames[k].file, e->frames[k].line, e->frames[k].func);
   }
-  log_message(ctx, FCM_LOG_ERROR, msg);
+  log_message(ctx, FCM_LOG_ERROR, e->msg);
 }
 
 fcm_status fcm__error(fcm_ctx *ctx, fcm_status code, const char *file, int line, const char *func,
                       const char *fmt, ...)
 {
   if (!ctx) return code;
-  char msg[FCM__MSG_LEN];
+  fcm__error_record e;
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(msg, sizeof msg, fmt, ap);
+  vsnprintf(e.msg, sizeof e.msg, fmt, ap);
   va_end(ap);
-  fcm_frame f = {short_file(file), func, line};
-  store_error(ctx, code, msg, &f, 1, 0);
+  e.code = code;
+  e.nframes = e.frames_dropped = 0;
+  record_frame(&e, short_file(file), line, func);
+  store_error(ctx, &e);
   return code;
 }
 
 void fcm__trace(fcm_ctx *ctx, const char *file, int line, const char *func)
 {
   if (!ctx) return;
-  fcm__loop *L = active_loop(ctx);
-#pragma omp critical(fcm_error)
-  {
-    if (!L) {
-      push_frame(ctx, short_file(file), line, func);
-    } else if (L->recorded == tl_index) { /* frames of a replaced error are dropped */
-      if (L->nframes < FCM__LOOP_FRAMES) {
-        L->frames[L->nframes].file = short_file(file);
-        L->frames[L->nframes].func = func;
-        L->frames[L->nframes].line = line;
-        L->nframes++;
-      } else {
-        L->frames_dropped++;
-      }
-    }
+  fcm__loop_iter *it = active_iter(ctx);
+  if (it) {
+    if (it->rec.code != FCM_OK) record_frame(&it->rec, short_file(file), line, func);
+    return;
   }
+#pragma omp critical(fcm_error)
+  push_frame(ctx, short_file(file), line, func);
 }
 
 void fcm__loop_begin(fcm_ctx *ctx, fcm__loop *loop)
 {
-  memset(loop, 0, sizeof *loop);
   loop->ctx = ctx;
   loop->failed = -1;
-  loop->recorded = -1;
   loop->status = FCM_OK;
+  loop->rec.code = FCM_OK;
+  loop->rec.msg[0] = '\0';
+  loop->rec.nframes = loop->rec.frames_dropped = 0;
 }
 
 int fcm__loop_skip(fcm__loop *loop, fcm_index i)
@@ -250,25 +230,26 @@ int fcm__loop_skip(fcm__loop *loop, fcm_index i)
   return f >= 0 && f < i;
 }
 
-fcm__loop_iter fcm__loop_enter(fcm__loop *loop, fcm_index i)
+void fcm__loop_enter(fcm__loop *loop, fcm__loop_iter *it, fcm_index i)
 {
-  fcm__loop_iter it = {tl_loop, tl_index};
-  tl_loop = loop;
-  tl_index = i;
-  return it;
+  it->loop = loop;
+  it->index = i;
+  it->prev = tl_iter;
+  it->rec.code = FCM_OK;
+  it->rec.nframes = it->rec.frames_dropped = 0;
+  tl_iter = it;
 }
 
-void fcm__loop_leave(fcm__loop *loop, fcm__loop_iter it, fcm_status st)
+void fcm__loop_leave(fcm__loop *loop, fcm__loop_iter *it, fcm_status st)
 {
-  const fcm_index i = tl_index;
-  tl_loop = it.prev_loop;
-  tl_index = it.prev_index;
+  tl_iter = it->prev;
   if (st == FCM_OK) return;
 #pragma omp critical(fcm_error)
-  if (loop->failed < 0 || i < loop->failed) {
+  if (loop->failed < 0 || it->index < loop->failed) {
     loop->status = st;
+    loop->rec = it->rec;
 #pragma omp atomic write
-    loop->failed = i;
+    loop->failed = it->index;
   }
 }
 
@@ -276,23 +257,14 @@ fcm_status fcm__loop_end(fcm__loop *loop, fcm_index *failed)
 {
   if (failed) *failed = loop->failed;
   if (loop->failed < 0) return FCM_OK;
-  fcm_frame frames[FCM__LOOP_FRAMES];
-  char msg[FCM__MSG_LEN];
-  int nframes = 0;
-  if (loop->recorded == loop->failed) {
-    snprintf(msg, sizeof msg, "%s", loop->msg);
-    nframes = loop->nframes;
-    for (int k = 0; k < nframes; k++) {
-      frames[k].file = loop->frames[k].file;
-      frames[k].func = loop->frames[k].func;
-      frames[k].line = loop->frames[k].line;
-    }
-  } else { /* the iteration failed without a message of its own */
-    snprintf(msg, sizeof msg, "iteration %lld of a parallel loop failed: %s",
+  if (loop->rec.code == FCM_OK) { /* the iteration failed without a message of its own */
+    loop->rec.code = loop->status;
+    snprintf(loop->rec.msg, sizeof loop->rec.msg, "iteration %lld of a parallel loop failed: %s",
              (long long)loop->failed, fcm_status_str(loop->status));
+    loop->rec.nframes = loop->rec.frames_dropped = 0;
   }
-  store_error(loop->ctx, loop->status, msg, frames, nframes,
-              loop->recorded == loop->failed ? loop->frames_dropped : 0);
+  loop->rec.code = loop->status;
+  store_error(loop->ctx, &loop->rec);
   return loop->status;
 }
 

@@ -42,8 +42,9 @@ cleanup:
   return st;
 }
 
-/* Locate one point: the lowest-numbered active cell containing it, else the active
- * cell with the nearest centroid among those near it (extrapolated = 1). */
+/* Locate one point: an active cell containing it (the first in the tree's order, the same
+ * on every run), else the active cell with the nearest centroid among those near it
+ * (extrapolated = 1). */
 static fcm_status locate_one(const fcm_space *s, const fcm_aabb_tree *tree,
                              const fcm_index *tree_cell, const double *centroid, double reach,
                              fcm_index i, const double p[3], fcm_index *ids, fcm_index *cell,
@@ -54,23 +55,17 @@ static fcm_status locate_one(const fcm_space *s, const fcm_aabb_tree *tree,
   fcm_index *many = NULL;
   const fcm_index *cand = NULL;
   const fcm_element_info *info = fcm_element_get_info(s->type);
-  fcm_index count = 0, found = -1;
+  fcm_index count = 0;
   FCM_TRY(s->ctx, query_all(s, tree, p, p, ids, &many, &cand, &count));
-  for (fcm_index k = 0; k < count; k++) {
+  for (fcm_index k = 0; k < count; k++) { /* the first containing cell in the tree's order */
     fcm_index c = tree_cell[cand[k]];
-    double xk[3];
-    if (found >= 0 && c >= found) continue;
     fcm_mesh_cell_coords(s->mesh, c, X);
-    if (fcm_element_inverse_map(NULL, s->type, X, p, xk) == FCM_OK &&
-        inside_reference(info->shape, xk, 1e-10)) {
-      found = c;
-      memcpy(xi, xk, sizeof xk);
+    if (fcm_element_inverse_map(NULL, s->type, X, p, xi) == FCM_OK &&
+        inside_reference(info->shape, xi, 1e-10)) {
+      *cell = c;
+      *extrapolated = 0;
+      goto cleanup;
     }
-  }
-  if (found >= 0) {
-    *cell = found;
-    *extrapolated = 0;
-    goto cleanup;
   }
   /* not inside any active cell: the nearest centroid within a growing box */
   for (double r = reach;; r *= 2.0) {
@@ -86,8 +81,7 @@ static fcm_status locate_one(const fcm_space *s, const fcm_aabb_tree *tree,
       const double *cc = centroid + 3 * cand[k];
       double d = (cc[0] - p[0]) * (cc[0] - p[0]) + (cc[1] - p[1]) * (cc[1] - p[1]) +
                  (cc[2] - p[2]) * (cc[2] - p[2]);
-      if (d < best || (d == best && tree_cell[cand[k]] < *cell))
-        best = d, *cell = tree_cell[cand[k]];
+      if (d < best) best = d, *cell = tree_cell[cand[k]];
     }
     break;
   }
@@ -166,10 +160,11 @@ fcm_status fcm_space_locate(const fcm_space *s, fcm_index n, const double *X, fc
     for (fcm_index i = 0; i < n; i++) {
       int ex = 0;
       if (fcm__loop_skip(&loop, i)) continue;
-      fcm__loop_iter it = fcm__loop_enter(&loop, i);
+      fcm__loop_iter it;
+      fcm__loop_enter(&loop, &it, i);
       fcm_status si = locate_one(s, tree, tree_cell, centroid, reach, i, X + 3 * i, my_ids,
                                  cell + i, xi + 3 * i, &ex);
-      fcm__loop_leave(&loop, it, si);
+      fcm__loop_leave(&loop, &it, si);
       if (si == FCM_OK && extrapolated) extrapolated[i] = ex;
     }
   }

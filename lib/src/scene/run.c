@@ -306,6 +306,7 @@ static fcm_status build_rules(fcm_simulation *S)
   else
     ro.surface_strength = -1;
   ro.min_fraction = q->min_fraction;
+  ro.max_rule_memory = q->max_rule_memory_gib * 1024.0 * 1024.0 * 1024.0;
   ro.simplify = q->simplify;
   ro.simplify_options.method = q->simplify_method;
   ro.stabilization = q->stabilization;

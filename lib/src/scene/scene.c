@@ -360,7 +360,7 @@ static fcm_status read_quadrature(fcm__scene_parser *p, const fcm__json *root)
   fcm_status st = FCM_OK;
   static const char *const keys[] = {"stiffness_strength", "mass_strength",   "surface_strength",
                                      "simplify",           "simplify_method", "stabilization",
-                                     "min_fraction"};
+                                     "min_fraction",       "max_rule_memory_gib"};
   static const char *const skeys[] = {"mode", "alpha"};
   fcm_scene_quadrature *q = &p->scene->quadrature;
   const fcm__json *o = NULL, *stab = NULL;
@@ -370,6 +370,7 @@ static fcm_status read_quadrature(fcm__scene_parser *p, const fcm__json *root)
   q->simplify_method = FCM_SIMPLIFY_AUTO;
   q->stabilization = fcm_stabilization_options_default();
   q->min_fraction = 1e-4;
+  q->max_rule_memory_gib = 4.0;
   FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "quadrature", 0, &o));
   if (!o) return FCM_OK;
   ENTER(p, "quadrature");
@@ -391,6 +392,9 @@ static fcm_status read_quadrature(fcm__scene_parser *p, const fcm__json *root)
   }
   FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "min_fraction", 0, (fcm__range){0.0, 1.0, 0, 1},
                                          &q->min_fraction));
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "max_rule_memory_gib", 0,
+                                         (fcm__range){0.0, 1048576.0, 0, 0},
+                                         &q->max_rule_memory_gib));
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
