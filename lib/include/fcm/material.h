@@ -32,6 +32,23 @@ typedef enum fcm_material_model {
   FCM_MATERIAL_COUNT
 } fcm_material_model;
 
+/** Isotropic linear elastic material (what linear assembly takes; plain value type). */
+typedef struct fcm_elastic {
+  double young;   /**< Young's modulus E > 0 */
+  double poisson; /**< Poisson's ratio, -1 < nu < 0.5 */
+  double density; /**< mass density rho >= 0 (mass and body force) */
+} fcm_elastic;
+
+/** Lame parameters of (E, nu): lambda = E nu / ((1 + nu)(1 - 2 nu)), mu = E / (2 (1 + nu)):
+ * the one conversion of the library (fcm_material_setup() uses it).
+ * @param[in]  ctx    context for the error message (may be NULL)
+ * @param[in]  mat    the material; its density is checked too
+ * @param[out] lambda may be NULL; @param[out] mu may be NULL
+ * @return FCM_OK, FCM_ERR_ARG (NULL, E <= 0, nu outside (-1, 0.5), density < 0,
+ * non-finite), message names the range. No allocation; thread safe. */
+FCM_API fcm_status fcm_elastic_lame(fcm_ctx *ctx, const fcm_elastic *mat, double *lambda,
+                                    double *mu);
+
 /** A material as a user or a scene file states it (plain value type). */
 typedef struct fcm_material {
   fcm_material_model model;

@@ -1,13 +1,11 @@
-/* Materials: model names, validation, the parameter setup (Lame parameters and
- * the Stable Neo-Hookean reparametrization) and the public evaluation entry point.
+/* Materials: model names, validation, the Lame conversion, the parameter setup (Lame
+ * parameters and the Stable Neo-Hookean reparametrization) and the public evaluation entry point.
  *
  * Stable Neo-Hookean constants (Smith, Goes & Kim, "Stable Neo-Hookean flesh
  * simulation", ACM TOG 2018, §3.4; DESIGN §8): mu' = 4 mu/3, lambda' = lambda + 5 mu/6
  * make the linearization at F = I equal linear elasticity with (mu, lambda), and
  * alpha = 1 + 3 mu'/(4 lambda') makes the rest state stress free. */
 #include "material/material_impl.h"
-
-#include "fcm/fem.h"
 
 static const char *const model_names[FCM_MATERIAL_COUNT] = {"linear", "stvk", "corotated", "snh"};
 
@@ -33,6 +31,23 @@ fcm_status fcm_material_model_parse(fcm_ctx *ctx, const char *name, fcm_material
             "material: unknown model \"%s\" (valid: linear, stvk, corotated, snh, "
             "stable_neo_hookean)",
             name);
+cleanup:
+  return st;
+}
+
+fcm_status fcm_elastic_lame(fcm_ctx *ctx, const fcm_elastic *m, double *lambda, double *mu)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(m, ctx, FCM_ERR_ARG, "elastic: material is NULL");
+  FCM_CHECK(isfinite(m->young) && m->young > 0.0, ctx, FCM_ERR_ARG,
+            "elastic: Young's modulus E = %g must be positive and finite", m->young);
+  FCM_CHECK(isfinite(m->poisson) && m->poisson > -1.0 && m->poisson < 0.5, ctx, FCM_ERR_ARG,
+            "elastic: Poisson's ratio nu = %g must lie in (-1, 0.5)", m->poisson);
+  FCM_CHECK(isfinite(m->density) && m->density >= 0.0, ctx, FCM_ERR_ARG,
+            "elastic: density = %g must be non-negative and finite", m->density);
+  if (lambda)
+    *lambda = m->young * m->poisson / ((1.0 + m->poisson) * (1.0 - 2.0 * m->poisson));
+  if (mu) *mu = m->young / (2.0 * (1.0 + m->poisson));
 cleanup:
   return st;
 }

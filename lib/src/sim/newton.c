@@ -66,7 +66,7 @@ static fcm_status assemble(fcm_integrator *I, const fcm_material_params *p, cons
 {
   fcm_status st = FCM_OK;
   double t0 = fcm_wtime();
-  st = fcm_assemble_hyperelastic(I->space, p, x, &I->opts.assembly, psi, fint, T);
+  st = fcm_assembly_workspace_hyperelastic(I->aws, p, x, psi, fint, T);
   stats->time_assembly += fcm_wtime() - t0;
   if (T) stats->tangent_assemblies++;
   if (st == FCM_ERR_NUMERIC) {
