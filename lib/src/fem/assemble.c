@@ -649,12 +649,15 @@ cleanup:
 
 /* One linear term through a workspace that lives for this call only. */
 static fcm_status linear_once(const fcm_space *s, const fcm_assembly_options *opts,
-                              const fcm_linear_form *form, fcm_csr *A, double *f)
+                              fcm_linear_term term, const fcm_elastic *elastic,
+                              const double *accel, fcm_field_fn field, void *user, fcm_csr *A,
+                              double *f)
 {
   fcm_status st = FCM_OK;
   fcm_assembly_workspace *ws = NULL;
+  fcm_linear_form form = {term, elastic, accel, field, user};
   FCM_TRY(s->ctx, fcm_assembly_workspace_create(s, opts, &ws));
-  FCM_TRY(s->ctx, fcm_assembly_workspace_linear(ws, form, A, f));
+  FCM_TRY(s->ctx, fcm_assembly_workspace_linear(ws, &form, A, f));
 cleanup:
   fcm_assembly_workspace_destroy(&ws);
   return st;
@@ -663,50 +666,32 @@ cleanup:
 fcm_status fcm_assemble_stiffness(const fcm_space *s, const fcm_elastic *mat,
                                   const fcm_assembly_options *opts, fcm_csr *A)
 {
-  fcm_linear_form form = fcm_linear_form_default();
-  form.term = FCM_LINEAR_STIFFNESS;
-  form.elastic = mat;
-  return linear_once(s, opts, &form, A, NULL);
+  return linear_once(s, opts, FCM_LINEAR_STIFFNESS, mat, NULL, NULL, NULL, A, NULL);
 }
 
 fcm_status fcm_assemble_mass(const fcm_space *s, const fcm_elastic *mat,
                              const fcm_assembly_options *opts, fcm_csr *A)
 {
-  fcm_linear_form form = fcm_linear_form_default();
-  form.term = FCM_LINEAR_MASS;
-  form.elastic = mat;
-  return linear_once(s, opts, &form, A, NULL);
+  return linear_once(s, opts, FCM_LINEAR_MASS, mat, NULL, NULL, NULL, A, NULL);
 }
 
 fcm_status fcm_assemble_body_force(const fcm_space *s, const fcm_elastic *mat,
                                    const double accel[3], const fcm_assembly_options *opts,
                                    double *f)
 {
-  fcm_linear_form form = fcm_linear_form_default();
-  form.term = FCM_LINEAR_BODY_FORCE;
-  form.elastic = mat;
-  form.accel = accel;
-  return linear_once(s, opts, &form, NULL, f);
+  return linear_once(s, opts, FCM_LINEAR_BODY_FORCE, mat, accel, NULL, NULL, NULL, f);
 }
 
 fcm_status fcm_assemble_body_force_field(const fcm_space *s, fcm_field_fn field, void *user,
                                          const fcm_assembly_options *opts, double *f)
 {
-  fcm_linear_form form = fcm_linear_form_default();
-  form.term = FCM_LINEAR_BODY_FORCE_FIELD;
-  form.field = field;
-  form.user = user;
-  return linear_once(s, opts, &form, NULL, f);
+  return linear_once(s, opts, FCM_LINEAR_BODY_FORCE_FIELD, NULL, NULL, field, user, NULL, f);
 }
 
 fcm_status fcm_assemble_surface_traction(const fcm_space *s, fcm_field_fn traction, void *user,
                                          double *f)
 {
-  fcm_linear_form form = fcm_linear_form_default();
-  form.term = FCM_LINEAR_SURFACE_TRACTION;
-  form.field = traction;
-  form.user = user;
-  return linear_once(s, NULL, &form, NULL, f);
+  return linear_once(s, NULL, FCM_LINEAR_SURFACE_TRACTION, NULL, NULL, traction, user, NULL, f);
 }
 
 fcm_status fcm_assemble_hyperelastic(const fcm_space *s, const fcm_material_params *mat,
