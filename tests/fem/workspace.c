@@ -17,13 +17,13 @@ static void gravity_field(void *user, const double x[3], const double normal[3],
 }
 
 /* Every linear term and the hyperelastic energy, force and tangent at u. */
-static void assemble_all(fcm_ctx *ctx, fcm_assembly_workspace *ws, const fcm_elastic *el,
+static void assemble_all(fcm_ctx *ctx, fcm_assembly_workspace *ws, const fcm_material *el,
                          const fcm_material_params *p, const double *u, fcm_csr *K, fcm_csr *M,
                          fcm_csr *T, double *f, double *fint, double *E)
 {
   static const double g[3] = {0.0, 0.0, -9.81};
   fcm_linear_form form = fcm_linear_form_default();
-  form.elastic = el;
+  form.material = el;
   form.term = FCM_LINEAR_STIFFNESS;
   TEST_OK(ctx, fcm_assembly_workspace_linear(ws, &form, K, NULL));
   form.term = FCM_LINEAR_MASS;
@@ -65,7 +65,7 @@ int main(int argc, char **argv)
   fcm_material snh = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 1.0e4, 0.3, 2.0};
   fcm_material_params p;
   TEST_OK(ctx, fcm_material_setup(ctx, &snh, &p));
-  fcm_elastic el = {snh.young, snh.poisson, snh.density};
+  const fcm_material el = snh; /* linear terms use its E, nu and density */
   TEST_OK(ctx, fcm_space_matrix_create(space, &K));
   TEST_OK(ctx, fcm_space_matrix_create(space, &M));
   TEST_OK(ctx, fcm_space_matrix_create(space, &T));
@@ -126,7 +126,7 @@ int main(int argc, char **argv)
   bad.term = (fcm_linear_term)17;
   TEST_ERR(ctx, fcm_assembly_workspace_linear(ws, &bad, K, f), FCM_ERR_ARG, "term = 17");
   TEST_ERR(ctx, fcm_assembly_workspace_linear(ws, NULL, K, f), FCM_ERR_ARG, "NULL");
-  bad.term = FCM_LINEAR_STIFFNESS; /* elastic NULL */
+  bad.term = FCM_LINEAR_STIFFNESS; /* material NULL */
   TEST_ERR(ctx, fcm_assembly_workspace_linear(ws, &bad, K, NULL), FCM_ERR_ARG, "NULL");
   bad.term = FCM_LINEAR_SURFACE_TRACTION; /* a plain space has no surface rules */
   bad.field = gravity_field;

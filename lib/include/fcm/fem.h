@@ -74,13 +74,9 @@ typedef struct fcm_assembly_options {
   int mass_strength;      /**< consistent mass */
 } fcm_assembly_options;
 
-/** Which element integral a standard rule is for. */
-typedef enum fcm_integrand {
-  FCM_INTEGRAND_STIFFNESS = 0, /**< gradients times gradients; also body force */
-  FCM_INTEGRAND_MASS = 1       /**< shape functions times shape functions */
-} fcm_integrand;
-
-/** The rule used on uncut (full) cells of `type` for `integrand`.
+/** The rule used on uncut (full) cells of `type` for the integral of `kind`
+ * (FCM_RULE_STIFFNESS: gradients times gradients, also body force; FCM_RULE_MASS: shape
+ * functions times shape functions).
  * strength <= 0 selects the default: for tetrahedra the catalogue rule
  * (fcm_rule_create) of the element's stiffness_strength or mass_strength; for
  * hexahedra the Gauss-Legendre tensor rule with order+1 points per direction
@@ -89,10 +85,10 @@ typedef enum fcm_integrand {
  * total-degree rules of the element strengths do neither (the Hex20 stiffness
  * integrand has total degree 6 but degree 4 per direction).
  * strength > 0 selects the catalogue rule of that strength for either shape.
- * @return FCM_OK, FCM_ERR_ARG (invalid type, strength > FCM_RULE_MAX_STRENGTH), FCM_ERR_ALLOC.
+ * @return FCM_OK, FCM_ERR_ARG (invalid type or kind, strength > FCM_RULE_MAX_STRENGTH), FCM_ERR_ALLOC.
  * Allocates *rule; release with fcm_rule_destroy(). Thread safe. */
 FCM_API fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type,
-                                             fcm_integrand integrand, int strength,
+                                             fcm_rule_kind kind, int strength,
                                              fcm_rule **rule);
 
 /** Defaults: both strengths 0 (element defaults). */
@@ -120,9 +116,9 @@ FCM_API void fcm_assembly_workspace_destroy(fcm_assembly_workspace **ws);
 
 /** The linear terms of fcm_assembly_workspace_linear(). */
 typedef enum fcm_linear_term {
-  FCM_LINEAR_STIFFNESS = 0,        /**< K into A (elastic) */
-  FCM_LINEAR_MASS = 1,             /**< consistent mass rho N_a N_b I into A (elastic) */
-  FCM_LINEAR_BODY_FORCE = 2,       /**< int rho accel N_a into f (elastic, accel) */
+  FCM_LINEAR_STIFFNESS = 0,        /**< K into A (material) */
+  FCM_LINEAR_MASS = 1,             /**< consistent mass rho N_a N_b I into A (material) */
+  FCM_LINEAR_BODY_FORCE = 2,       /**< int rho accel N_a into f (material, accel) */
   FCM_LINEAR_BODY_FORCE_FIELD = 3, /**< int b(x) N_a into f (field = b, user) */
   FCM_LINEAR_SURFACE_TRACTION = 4  /**< int_{boundary} t(x, n) N_a into f (field = t, user) */
 } fcm_linear_term;
@@ -137,10 +133,11 @@ typedef void (*fcm_field_fn)(void *user, const double x[3], const double normal[
  * the call). Members a term does not use are ignored. */
 typedef struct fcm_linear_form {
   fcm_linear_term term;
-  const fcm_elastic *elastic; /**< STIFFNESS, MASS, BODY_FORCE */
-  const double *accel;        /**< BODY_FORCE: uniform acceleration, 3 entries */
-  fcm_field_fn field;         /**< BODY_FORCE_FIELD, SURFACE_TRACTION */
-  void *user;                 /**< passed to `field` */
+  const fcm_material *material; /**< STIFFNESS, MASS, BODY_FORCE: validated; only E, nu
+                                     and the density are used (linear elasticity) */
+  const double *accel;          /**< BODY_FORCE: uniform acceleration, 3 entries */
+  fcm_field_fn field;           /**< BODY_FORCE_FIELD, SURFACE_TRACTION */
+  void *user;                   /**< passed to `field` */
 } fcm_linear_form;
 
 /** Defaults: FCM_LINEAR_STIFFNESS, every pointer NULL. */
@@ -165,20 +162,22 @@ FCM_API fcm_status fcm_assembly_workspace_hyperelastic(fcm_assembly_workspace *w
 
 /** Add the linear elastic stiffness K to A (A must come from
  * fcm_space_matrix_create() of this space): fcm_assembly_workspace_linear() with
- * FCM_LINEAR_STIFFNESS through a workspace made for this call. Bitwise independent
- * of the number of threads. @return FCM_OK, FCM_ERR_ARG (bad material, wrong matrix),
+ * FCM_LINEAR_STIFFNESS through a workspace made for this call. `mat` is validated
+ * (fcm_material_validate()); its model is not used: the stiffness, mass and body force
+ * here are those of linear elasticity with the material's E, nu and density. Bitwise
+ * independent of the number of threads. @return FCM_OK, FCM_ERR_ARG (bad material, wrong matrix),
  * FCM_ERR_GEOMETRY (det J <= 0 at a quadrature point: the message names the cell),
  * FCM_ERR_ALLOC. Allocates a workspace; for repeated assembly keep one. */
-FCM_API fcm_status fcm_assemble_stiffness(const fcm_space *space, const fcm_elastic *mat,
+FCM_API fcm_status fcm_assemble_stiffness(const fcm_space *space, const fcm_material *mat,
                                           const fcm_assembly_options *opts, fcm_csr *A);
 
 /** Add the consistent mass matrix (rho N_a N_b I) to A. Status codes as above. */
-FCM_API fcm_status fcm_assemble_mass(const fcm_space *space, const fcm_elastic *mat,
+FCM_API fcm_status fcm_assemble_mass(const fcm_space *space, const fcm_material *mat,
                                      const fcm_assembly_options *opts, fcm_csr *A);
 
 /** Add the body force of a uniform acceleration `accel` (e.g. gravity),
  * f_a += integral of rho accel N_a, to f (num_dofs entries). Status codes as above. */
-FCM_API fcm_status fcm_assemble_body_force(const fcm_space *space, const fcm_elastic *mat,
+FCM_API fcm_status fcm_assemble_body_force(const fcm_space *space, const fcm_material *mat,
                                            const double accel[3],
                                            const fcm_assembly_options *opts, double *f);
 

@@ -17,22 +17,22 @@ fcm_assembly_options fcm_assembly_options_default(void)
   return o;
 }
 
-fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type, fcm_integrand integrand,
+fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type, fcm_rule_kind kind,
                                      int strength, fcm_rule **rule)
 {
   fcm_status st = FCM_OK;
   const fcm_element_info *info = fcm_element_get_info(type);
   FCM_CHECK(info, ctx, FCM_ERR_ARG, "standard rule: invalid element type %d", (int)type);
-  FCM_CHECK(integrand == FCM_INTEGRAND_STIFFNESS || integrand == FCM_INTEGRAND_MASS, ctx,
-            FCM_ERR_ARG, "standard rule: invalid integrand %d", (int)integrand);
+  FCM_CHECK(kind == FCM_RULE_STIFFNESS || kind == FCM_RULE_MASS, ctx, FCM_ERR_ARG,
+            "standard rule: invalid rule kind %d", (int)kind);
   if (strength > 0)
     FCM_TRY(ctx, fcm_rule_create(ctx, info->shape, strength, rule));
   else if (info->shape == FCM_SHAPE_HEX) /* order+1 points per direction: strength 2*order+1 */
     FCM_TRY(ctx, fcm_rule_create_computed(ctx, info->shape, 2 * info->order + 1, rule));
   else
     FCM_TRY(ctx, fcm_rule_create(ctx, info->shape,
-                                 integrand == FCM_INTEGRAND_MASS ? info->mass_strength
-                                                                 : info->stiffness_strength,
+                                 kind == FCM_RULE_MASS ? info->mass_strength
+                                                       : info->stiffness_strength,
                                  rule));
 cleanup:
   return st;
@@ -53,12 +53,11 @@ typedef struct tabulation {
   double *N, *dN;
 } tabulation;
 
-static fcm_status tabulate(const fcm_space *s, fcm_integrand integrand, int strength,
-                           tabulation *t)
+static fcm_status tabulate(const fcm_space *s, fcm_rule_kind kind, int strength, tabulation *t)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
-  FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, integrand, strength, &t->rule));
+  FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, kind, strength, &t->rule));
   int nq = fcm_rule_num_points(t->rule);
   const double *pts = fcm_rule_points(t->rule);
   FCM_ALLOC(ctx, (size_t)nq * s->nn, t->N);
@@ -340,7 +339,7 @@ struct fcm_assembly_workspace {
   fcm_ctx *ctx;
   const fcm_space *space;
   fcm_assembly_options opts;
-  tabulation tab[2];   /* by fcm_integrand */
+  tabulation tab[2];   /* standard rules: [0] stiffness, [1] mass */
   int tabulated[2];    /* tab[i] is built */
   int nthreads;        /* threads the scratch serves (omp_get_max_threads() at creation) */
   double *mem;         /* per-thread element buffers */
@@ -383,17 +382,17 @@ void fcm_assembly_workspace_destroy(fcm_assembly_workspace **wsp)
   *wsp = NULL;
 }
 
-/* The tabulated standard rule of `integrand`, built on first use. */
-static fcm_status workspace_tabulation(fcm_assembly_workspace *ws, fcm_integrand integrand,
+/* The tabulated standard rule of `kind` (stiffness or mass), built on first use. */
+static fcm_status workspace_tabulation(fcm_assembly_workspace *ws, fcm_rule_kind kind,
                                        const tabulation **t)
 {
   fcm_status st = FCM_OK;
-  int i = integrand == FCM_INTEGRAND_MASS ? 1 : 0;
+  int i = kind == FCM_RULE_MASS ? 1 : 0;
   if (!ws->tabulated[i]) {
     int strength = i ? ws->opts.mass_strength : ws->opts.stiffness_strength;
     tabulation fresh;
     memset(&fresh, 0, sizeof fresh);
-    st = tabulate(ws->space, integrand, strength, &fresh);
+    st = tabulate(ws->space, kind, strength, &fresh);
     if (st != FCM_OK) {
       tabulation_free(ws->ctx, &fresh);
       FCM_TRY(ws->ctx, st);
@@ -512,12 +511,10 @@ static fcm_status run_volume_pass(fcm_assembly_workspace *ws, const kernel_data 
 {
   fcm_status st = FCM_OK;
   pass ps;
-  int mass = kd->kind == KERNEL_MASS;
   memset(&ps, 0, sizeof ps);
-  FCM_TRY(ws->ctx, workspace_tabulation(ws, mass ? FCM_INTEGRAND_MASS : FCM_INTEGRAND_STIFFNESS,
-                                        &ps.tab));
+  ps.kind = kd->kind == KERNEL_MASS ? FCM_RULE_MASS : FCM_RULE_STIFFNESS;
+  FCM_TRY(ws->ctx, workspace_tabulation(ws, ps.kind, &ps.tab));
   ps.kd = kd;
-  ps.kind = mass ? FCM_RULE_MASS : FCM_RULE_STIFFNESS;
   ps.vals = vals;
   ps.vec = vec;
   ps.cell_energy = cell_energy;
@@ -565,25 +562,25 @@ fcm_status fcm_assembly_workspace_linear(fcm_assembly_workspace *ws, const fcm_l
   switch (form->term) {
   case FCM_LINEAR_STIFFNESS:
     kd.kind = KERNEL_STIFFNESS;
-    FCM_TRY(ctx, fcm_elastic_lame(ctx, form->elastic, &kd.lambda, &kd.mu));
+    FCM_TRY(ctx, fcm_material_lame(ctx, form->material, &kd.lambda, &kd.mu));
     FCM_TRY(ctx, check_matrix(s, A));
     FCM_TRY(ctx, run_volume_pass(ws, &kd, fcm_csr_get_values(A), NULL, NULL));
     break;
   case FCM_LINEAR_MASS:
     kd.kind = KERNEL_MASS;
-    FCM_TRY(ctx, fcm_elastic_lame(ctx, form->elastic, NULL, NULL));
+    FCM_TRY(ctx, fcm_material_lame(ctx, form->material, NULL, NULL));
     FCM_TRY(ctx, check_matrix(s, A));
-    kd.rho = form->elastic->density;
+    kd.rho = form->material->density;
     FCM_TRY(ctx, run_volume_pass(ws, &kd, fcm_csr_get_values(A), NULL, NULL));
     break;
   case FCM_LINEAR_BODY_FORCE: {
     const double *a = form->accel;
     kd.kind = KERNEL_BODY_FORCE;
-    FCM_TRY(ctx, fcm_elastic_lame(ctx, form->elastic, NULL, NULL));
+    FCM_TRY(ctx, fcm_material_lame(ctx, form->material, NULL, NULL));
     FCM_CHECK(f && a, ctx, FCM_ERR_ARG, "body force: NULL vector or acceleration");
     FCM_CHECK(isfinite(a[0]) && isfinite(a[1]) && isfinite(a[2]), ctx, FCM_ERR_ARG,
               "body force: acceleration (%g, %g, %g) is not finite", a[0], a[1], a[2]);
-    kd.rho = form->elastic->density;
+    kd.rho = form->material->density;
     memcpy(kd.accel, a, sizeof kd.accel);
     FCM_TRY(ctx, run_volume_pass(ws, &kd, NULL, f, NULL));
   } break;
@@ -649,13 +646,13 @@ cleanup:
 
 /* One linear term through a workspace that lives for this call only. */
 static fcm_status linear_once(const fcm_space *s, const fcm_assembly_options *opts,
-                              fcm_linear_term term, const fcm_elastic *elastic,
+                              fcm_linear_term term, const fcm_material *material,
                               const double *accel, fcm_field_fn field, void *user, fcm_csr *A,
                               double *f)
 {
   fcm_status st = FCM_OK;
   fcm_assembly_workspace *ws = NULL;
-  fcm_linear_form form = {term, elastic, accel, field, user};
+  fcm_linear_form form = {term, material, accel, field, user};
   FCM_TRY(s->ctx, fcm_assembly_workspace_create(s, opts, &ws));
   FCM_TRY(s->ctx, fcm_assembly_workspace_linear(ws, &form, A, f));
 cleanup:
@@ -663,19 +660,19 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_assemble_stiffness(const fcm_space *s, const fcm_elastic *mat,
+fcm_status fcm_assemble_stiffness(const fcm_space *s, const fcm_material *mat,
                                   const fcm_assembly_options *opts, fcm_csr *A)
 {
   return linear_once(s, opts, FCM_LINEAR_STIFFNESS, mat, NULL, NULL, NULL, A, NULL);
 }
 
-fcm_status fcm_assemble_mass(const fcm_space *s, const fcm_elastic *mat,
+fcm_status fcm_assemble_mass(const fcm_space *s, const fcm_material *mat,
                              const fcm_assembly_options *opts, fcm_csr *A)
 {
   return linear_once(s, opts, FCM_LINEAR_MASS, mat, NULL, NULL, NULL, A, NULL);
 }
 
-fcm_status fcm_assemble_body_force(const fcm_space *s, const fcm_elastic *mat,
+fcm_status fcm_assemble_body_force(const fcm_space *s, const fcm_material *mat,
                                    const double accel[3], const fcm_assembly_options *opts,
                                    double *f)
 {

@@ -1,5 +1,5 @@
-/* Materials: model names, validation, the Lame conversion, the parameter setup (Lame
- * parameters and the Stable Neo-Hookean reparametrization) and the public evaluation entry point.
+/* Materials: model names, validation, the parameter setup (Lame parameters and
+ * the Stable Neo-Hookean reparametrization) and the public evaluation entry point.
  *
  * Stable Neo-Hookean constants (Smith, Goes & Kim, "Stable Neo-Hookean flesh
  * simulation", ACM TOG 2018, §3.4; DESIGN §8): mu' = 4 mu/3, lambda' = lambda + 5 mu/6
@@ -35,33 +35,22 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_elastic_lame(fcm_ctx *ctx, const fcm_elastic *m, double *lambda, double *mu)
-{
-  fcm_status st = FCM_OK;
-  FCM_CHECK(m, ctx, FCM_ERR_ARG, "elastic: material is NULL");
-  FCM_CHECK(isfinite(m->young) && m->young > 0.0, ctx, FCM_ERR_ARG,
-            "elastic: Young's modulus E = %g must be positive and finite", m->young);
-  FCM_CHECK(isfinite(m->poisson) && m->poisson > -1.0 && m->poisson < 0.5, ctx, FCM_ERR_ARG,
-            "elastic: Poisson's ratio nu = %g must lie in (-1, 0.5)", m->poisson);
-  FCM_CHECK(isfinite(m->density) && m->density >= 0.0, ctx, FCM_ERR_ARG,
-            "elastic: density = %g must be non-negative and finite", m->density);
-  if (lambda)
-    *lambda = m->young * m->poisson / ((1.0 + m->poisson) * (1.0 - 2.0 * m->poisson));
-  if (mu) *mu = m->young / (2.0 * (1.0 + m->poisson));
-cleanup:
-  return st;
-}
-
-/* Validate and return the Lame parameters through the one conversion of the
- * library, fcm_elastic_lame(), which also checks E, nu and the density. */
-static fcm_status material_lame(fcm_ctx *ctx, const fcm_material *mat, double *lambda, double *mu)
+/* The one Lame conversion of the library; it validates the model, E, nu and the density. */
+fcm_status fcm_material_lame(fcm_ctx *ctx, const fcm_material *mat, double *lambda, double *mu)
 {
   fcm_status st = FCM_OK;
   FCM_CHECK(mat, ctx, FCM_ERR_ARG, "material: material is NULL");
   FCM_CHECK((int)mat->model >= 0 && mat->model < FCM_MATERIAL_COUNT, ctx, FCM_ERR_ARG,
             "material: model = %d out of range [0, %d)", (int)mat->model, FCM_MATERIAL_COUNT);
-  const fcm_elastic el = {mat->young, mat->poisson, mat->density};
-  FCM_TRY(ctx, fcm_elastic_lame(ctx, &el, lambda, mu));
+  FCM_CHECK(isfinite(mat->young) && mat->young > 0.0, ctx, FCM_ERR_ARG,
+            "material: Young's modulus E = %g must be positive and finite", mat->young);
+  FCM_CHECK(isfinite(mat->poisson) && mat->poisson > -1.0 && mat->poisson < 0.5, ctx, FCM_ERR_ARG,
+            "material: Poisson's ratio nu = %g must lie in (-1, 0.5)", mat->poisson);
+  FCM_CHECK(isfinite(mat->density) && mat->density >= 0.0, ctx, FCM_ERR_ARG,
+            "material: density = %g must be non-negative and finite", mat->density);
+  if (lambda)
+    *lambda = mat->young * mat->poisson / ((1.0 + mat->poisson) * (1.0 - 2.0 * mat->poisson));
+  if (mu) *mu = mat->young / (2.0 * (1.0 + mat->poisson));
 cleanup:
   return st;
 }
@@ -69,7 +58,7 @@ cleanup:
 fcm_status fcm_material_validate(fcm_ctx *ctx, const fcm_material *mat)
 {
   fcm_status st = FCM_OK;
-  FCM_TRY(ctx, material_lame(ctx, mat, NULL, NULL));
+  FCM_TRY(ctx, fcm_material_lame(ctx, mat, NULL, NULL));
 cleanup:
   return st;
 }
@@ -80,7 +69,7 @@ fcm_status fcm_material_setup(fcm_ctx *ctx, const fcm_material *mat, fcm_materia
   fcm_material_params p;
   memset(&p, 0, sizeof p);
   FCM_CHECK(params, ctx, FCM_ERR_ARG, "material: params is NULL");
-  FCM_TRY(ctx, material_lame(ctx, mat, &p.lambda, &p.mu));
+  FCM_TRY(ctx, fcm_material_lame(ctx, mat, &p.lambda, &p.mu));
   p.model = mat->model;
   p.density = mat->density;
   p.project_psd = 0;

@@ -64,6 +64,11 @@ fcm_motion fcm_motion_default(void)
   return m;
 }
 
+int fcm_motion_active(const fcm_motion *m, double t)
+{
+  return !(m->release && t > m->end);
+}
+
 void fcm_motion_eval(const fcm_motion *m, const double X[3], double t, double u[3], double v[3])
 {
   double span = m->end - m->start, tau = t - m->start;
@@ -313,7 +318,7 @@ void fcm__sim_eval_constraints(fcm_integrator *I, double t)
   int changed = 0;
   for (int k = 0; k < I->num_cons; k++) {
     const fcm_motion *m = &I->cons[k].motion;
-    unsigned char on = !(m->release && t > m->end);
+    unsigned char on = (unsigned char)fcm_motion_active(m, t);
     if (on != I->con_on[k]) changed = 1;
     I->con_on[k] = on;
   }
@@ -369,8 +374,10 @@ static fcm_status validate_options(fcm_ctx *ctx, const fcm_integrator_options *o
   FCM_CHECK(o->newton_max_iterations >= 1, ctx, FCM_ERR_ARG,
             "integrator: newton_max_iterations = %d must be >= 1", o->newton_max_iterations);
   FCM_CHECK(o->tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE ||
-                o->tolerance_mode == FCM_NEWTON_TOL_RELATIVE,
-            ctx, FCM_ERR_ARG, "integrator: tolerance_mode = %d must be 0 or 1",
+                o->tolerance_mode == FCM_NEWTON_TOL_RELATIVE ||
+                o->tolerance_mode == FCM_NEWTON_TOL_AUTO,
+            ctx, FCM_ERR_ARG,
+            "integrator: tolerance_mode = %d must be 0 (representative), 1 (relative) or 2 (auto)",
             (int)o->tolerance_mode);
   FCM_CHECK(o->newton_tolerance > 0.0 && o->newton_tolerance < 1.0, ctx, FCM_ERR_ARG,
             "integrator: newton_tolerance = %g outside (0, 1)", o->newton_tolerance);
@@ -487,9 +494,8 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = I->ctx;
-  const fcm_elastic el = {I->mat.young, I->mat.poisson, I->mat.density};
   fcm_linear_form form = fcm_linear_form_default();
-  form.elastic = &el;
+  form.material = &I->mat; /* linear assembly: mass and body forces */
   if (I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) {
     FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->M));
     form.term = FCM_LINEAR_MASS;
@@ -539,10 +545,9 @@ static fcm_status setup_representative_force(fcm_integrator *I)
     if (same) {
       memcpy(I->Ma, same->f, sizeof *I->Ma * (size_t)n);
     } else {
-      const fcm_elastic el = {I->mat.young, I->mat.poisson, I->mat.density};
       fcm_linear_form form = fcm_linear_form_default();
       form.term = FCM_LINEAR_BODY_FORCE;
-      form.elastic = &el;
+      form.material = &I->mat;
       form.accel = a;
       memset(I->Ma, 0, sizeof *I->Ma * (size_t)n);
       FCM_TRY(ctx, fcm_assembly_workspace_linear(I->aws, &form, NULL, I->Ma));
@@ -629,6 +634,9 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
   fcm_ctx *ctx = I->ctx;
   FCM_CHECK(!I->is_setup, ctx, FCM_ERR_ARG, "integrator: already set up");
   FCM_TRY(ctx, validate_options(ctx, &I->opts));
+  if (I->opts.tolerance_mode == FCM_NEWTON_TOL_AUTO)
+    I->opts.tolerance_mode = I->opts.kind == FCM_INTEGRATOR_STATIC ? FCM_NEWTON_TOL_RELATIVE
+                                                                   : FCM_NEWTON_TOL_REPRESENTATIVE;
   FCM_CHECK(I->n > 0, ctx, FCM_ERR_ARG, "integrator: the space has no DOFs");
   FCM_TRY(ctx, build_constraints(I));
   FCM_TRY(ctx, setup_storage(I));
