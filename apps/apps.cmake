@@ -1,5 +1,9 @@
+# The programs' shared command-line helper (apps/cli.h), linked into each program.
+add_library(fcm_apps_cli STATIC apps/cli.c)
+target_link_libraries(fcm_apps_cli PUBLIC fcm::fcm)
+target_compile_options(fcm_apps_cli PRIVATE ${FCM_WARNINGS} ${FCM_SAN_FLAGS})
 fcm_add_app(fcm-sim apps/fcm-sim.c)
 fcm_add_app(fcm-rulegen apps/fcm-rulegen.c)
 fcm_add_app(fcm-quadrature apps/fcm-quadrature.c apps/fcm-quadrature-embed.c)
-fcm_add_app(fcm-condition apps/fcm-condition.c)
+fcm_add_app(fcm-condition apps/fcm-condition.c apps/fcm-condition-study.c apps/fcm-condition-output.c)
 fcm_add_app(fcm-converge apps/fcm-converge.c apps/fcm-converge-study.c apps/fcm-converge-output.c)

@@ -1,5 +1,6 @@
 /* fcm-converge: rate fits, the tables on stdout, the CSV files (written atomically) and
  * the gnuplot PNG plots of the convergence / accuracy-versus-time study. */
+#include "cli.h"
 #include "fcm-converge-study.h"
 
 #include <errno.h>
@@ -146,27 +147,6 @@ void cv_print_sweep(FILE *f, const cv_result *res, int nres)
 
 /* ---------------------------------------------------------------- CSV */
 
-static FILE *open_tmp(const char *path, char *tmp, size_t cap)
-{
-  if (snprintf(tmp, cap, "%s.tmp", path) >= (int)cap) {
-    fprintf(stderr, CV_PROG ": %s: path too long\n", path);
-    return NULL;
-  }
-  FILE *f = fopen(tmp, "w");
-  if (!f) fprintf(stderr, CV_PROG ": cannot write %s: %s\n", tmp, strerror(errno));
-  return f;
-}
-
-static int close_rename(FILE *f, const char *tmp, const char *path)
-{
-  if (ferror(f) | (fclose(f) != 0) || rename(tmp, path) != 0) {
-    fprintf(stderr, CV_PROG ": cannot write %s: %s\n", path, strerror(errno));
-    remove(tmp);
-    return 0;
-  }
-  return 1;
-}
-
 /* The note without commas or quotes (CSV field). */
 static void csv_note(FILE *f, const char *note)
 {
@@ -175,8 +155,8 @@ static void csv_note(FILE *f, const char *note)
 
 int cv_write_levels_csv(const char *path, const cv_result *res, int nres)
 {
-  char tmp[4096];
-  FILE *f = open_tmp(path, tmp, sizeof tmp);
+  cli_output *out = NULL;
+  FILE *f = cli_output_open(CV_PROG, path, &out);
   if (!f) return 0;
   fprintf(f, "element,method,res,h,dofs,active_cells,cut_cells,points,strength,t_rules,"
              "t_assembly,t_solve,t_total,err_l2,err_h1,norm_l2,norm_h1,rel_l2,rel_h1,"
@@ -194,25 +174,25 @@ int cv_write_levels_csv(const char *path, const cv_result *res, int nres)
     csv_note(f, r->note);
     fprintf(f, ",%.6f,%.6f,%.6f,%.6f\n", r->c_rules, r->c_assembly, r->c_solve, r->c_total);
   }
-  return close_rename(f, tmp, path);
+  return cli_output_commit(CV_PROG, &out);
 }
 
 int cv_write_rates_csv(const char *path, const cv_rate *rates, int nrates)
 {
-  char tmp[4096];
-  FILE *f = open_tmp(path, tmp, sizeof tmp);
+  cli_output *out = NULL;
+  FILE *f = cli_output_open(CV_PROG, path, &out);
   if (!f) return 0;
   fprintf(f, "element,method,norm,rate\n");
   for (int k = 0; k < nrates; k++)
     fprintf(f, "%s,%s,%s,%.6f\n", ename(rates[k].element), cv_method_name(rates[k].method),
             rates[k].norm ? "H1" : "L2", rates[k].rate);
-  return close_rename(f, tmp, path);
+  return cli_output_commit(CV_PROG, &out);
 }
 
 int cv_write_sweep_csv(const char *path, const cv_result *res, int nres)
 {
-  char tmp[4096];
-  FILE *f = open_tmp(path, tmp, sizeof tmp);
+  cli_output *out = NULL;
+  FILE *f = cli_output_open(CV_PROG, path, &out);
   if (!f) return 0;
   fprintf(f, "element,method,res,h,strength,points,dofs,t_rules,t_assembly,t_solve,t_total,"
              "err_l2,err_h1,rel_l2,rel_h1,failed,note,cpu_rules,cpu_assembly,cpu_solve,cpu_total\n");
@@ -226,7 +206,7 @@ int cv_write_sweep_csv(const char *path, const cv_result *res, int nres)
     csv_note(f, r->note);
     fprintf(f, ",%.6f,%.6f,%.6f,%.6f\n", r->c_rules, r->c_assembly, r->c_solve, r->c_total);
   }
-  return close_rename(f, tmp, path);
+  return cli_output_commit(CV_PROG, &out);
 }
 
 /* ---------------------------------------------------------------- plots */

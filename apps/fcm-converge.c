@@ -8,6 +8,7 @@
  * fcm-converge-study.c), or --reference runs the authors' localized-load problem against a
  * boundary-conforming Tet10 reference. `payoff` times rule construction and one Newton
  * iteration (SNH tangent + force, CHOLMOD) with and without simplification. */
+#include "cli.h"
 #include "fcm-converge-study.h"
 
 #include <fcm/material.h>
@@ -152,49 +153,26 @@ static void usage(FILE *f)
 
 static int parse_int(const char *opt, const char *s, int lo, int hi, int *out)
 {
-  char *end = NULL;
-  errno = 0;
-  const long v = strtol(s, &end, 10);
-  if (errno || end == s || *end || v < lo || v > hi) {
-    fprintf(stderr, CV_PROG ": %s: '%s' is not an integer in [%d, %d]\n", opt, s, lo, hi);
-    return 0;
-  }
+  long long v = 0;
+  if (!cli_int(CV_PROG, opt, s, lo, hi, &v)) return 0;
   *out = (int)v;
   return 1;
 }
 
 static int parse_double(const char *opt, const char *s, double lo, double hi, double *out)
 {
-  char *end = NULL;
-  errno = 0;
-  const double v = strtod(s, &end);
-  if (errno || end == s || *end || !isfinite(v) || v < lo || v > hi) {
-    fprintf(stderr, CV_PROG ": %s: '%s' is not a number in [%g, %g]\n", opt, s, lo, hi);
-    return 0;
-  }
-  *out = v;
-  return 1;
+  return cli_double(CV_PROG, opt, s, lo, hi, 0, out);
 }
 
-/* Comma list of integers in [lo, hi]. */
+/* Comma list of integers in [lo, hi]; empty items are refused. */
 static int parse_int_list(const char *opt, const char *s, int lo, int hi, int *out, int cap,
                           int *n)
 {
-  char buf[512];
-  if (strlen(s) >= sizeof buf || !*s) {
-    fprintf(stderr, CV_PROG ": %s: empty or too long list\n", opt);
-    return 0;
-  }
-  strcpy(buf, s);
-  *n = 0;
-  for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
-    if (*n >= cap) {
-      fprintf(stderr, CV_PROG ": %s: more than %d items\n", opt, cap);
-      return 0;
-    }
-    if (!parse_int(opt, tok, lo, hi, &out[(*n)++])) return 0;
-  }
-  return *n > 0;
+  char tok[64][CLI_TOKEN];
+  if (!cli_list(CV_PROG, opt, s, tok, cap < 64 ? cap : 64, n)) return 0;
+  for (int k = 0; k < *n; k++)
+    if (!parse_int(opt, tok[k], lo, hi, &out[k])) return 0;
+  return 1;
 }
 
 static int parse_elements(const char *opt, const char *s, config *c)
@@ -770,12 +748,9 @@ static int run_payoff(const config *c, fcm_ctx *ctx)
   if (isfinite(cbe))
     printf("break-even in CPU seconds: after %.2f Newton iteration(s)\n", cbe);
   if (c->payoff_csv) {
-    char tmp[4096];
-    FILE *f = NULL;
-    if (snprintf(tmp, sizeof tmp, "%s.tmp", c->payoff_csv) < (int)sizeof tmp)
-      f = fopen(tmp, "w");
+    cli_output *out = NULL;
+    FILE *f = cli_output_open(CV_PROG, c->payoff_csv, &out);
     if (!f) {
-      fprintf(stderr, CV_PROG ": cannot write %s\n", c->payoff_csv);
       rc = 1;
       goto done;
     }
@@ -788,9 +763,7 @@ static int run_payoff(const config *c, fcm_ctx *ctx)
               (long long)p[k].points_cut, (long long)p[k].points_total, p[k].t_rules,
               p[k].t_simplify, p[k].t_assembly, p[k].t_factor_solve, p[k].t_iteration, be,
               p[k].c_rules, p[k].c_iteration, cbe);
-    if (ferror(f) | (fclose(f) != 0) || rename(tmp, c->payoff_csv) != 0) {
-      fprintf(stderr, CV_PROG ": cannot write %s: %s\n", c->payoff_csv, strerror(errno));
-      remove(tmp);
+    if (!cli_output_commit(CV_PROG, &out)) {
       rc = 1;
     } else {
       fprintf(stderr, CV_PROG ": wrote %s\n", c->payoff_csv);

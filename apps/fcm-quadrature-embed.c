@@ -1,6 +1,7 @@
 /* fcm-quadrature subcommands on embedded rules: `accuracy` (Longva et al. 2020
  * Fig. 4: monomials over a rotated cuboid in [-1,1]^3, initial vs simplified
  * rules) and `embed` (a background grid, an embedded geometry, the statistics). */
+#include "cli.h"
 #include "fcm-quadrature.h"
 
 #include <fcm/fcm.h>
@@ -15,48 +16,14 @@
 
 static int parse_num(const char *opt, const char *s, double lo, double hi, double *out)
 {
-  char *end = NULL;
-  errno = 0;
-  double v = s ? strtod(s, &end) : NAN;
-  if (!s || errno || end == s || *end || !isfinite(v) || v < lo || v > hi) {
-    fprintf(stderr, "fcm-quadrature: %s: '%s' is not a number in [%g, %g]\n", opt, s ? s : "",
-            lo, hi);
-    return 0;
-  }
-  *out = v;
-  return 1;
+  return cli_double("fcm-quadrature", opt, s, lo, hi, 0, out);
 }
 
 static int parse_int(const char *opt, const char *s, int lo, int hi, int *out)
 {
-  double v;
-  if (!parse_num(opt, s, lo, hi, &v)) return 0;
-  if (v != floor(v)) {
-    fprintf(stderr, "fcm-quadrature: %s: '%s' is not a whole number\n", opt, s);
-    return 0;
-  }
+  long long v = 0;
+  if (!cli_int("fcm-quadrature", opt, s, lo, hi, &v)) return 0;
   *out = (int)v;
-  return 1;
-}
-
-/* Open FILE.tmp for writing; fcm_quadrature_commit() renames it over FILE. */
-static FILE *open_tmp(const char *path, char *tmp, size_t cap)
-{
-  snprintf(tmp, cap, "%s.tmp", path);
-  FILE *f = fopen(tmp, "w");
-  if (!f) fprintf(stderr, "fcm-quadrature: cannot write '%s': %s\n", tmp, strerror(errno));
-  return f;
-}
-
-static int commit_tmp(FILE *f, const char *tmp, const char *path)
-{
-  int bad = ferror(f);
-  if (fclose(f) != 0) bad = 1;
-  if (bad || rename(tmp, path) != 0) {
-    fprintf(stderr, "fcm-quadrature: cannot write '%s': %s\n", path, strerror(errno));
-    remove(tmp);
-    return 0;
-  }
   return 1;
 }
 
@@ -152,7 +119,7 @@ int fcm_quadrature_cmd_accuracy(int argc, char **argv)
   fcm_geometry *box = NULL, *cuboid = NULL;
   double *err = NULL;
   FILE *out = NULL;
-  char tmp[4096];
+  cli_output *outf = NULL;
   const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, axis[3] = {1.0, 2.0, 0.5};
   const fcm_index one[3] = {1, 1, 1}, nb[3] = {2, 2, 2};
   double R[9], t[3], c[3];
@@ -178,7 +145,7 @@ int fcm_quadrature_cmd_accuracy(int argc, char **argv)
   }
   err = malloc(sizeof *err * 2000);
   if (!err) goto done;
-  if (csv && !(out = open_tmp(csv, tmp, sizeof tmp))) goto done;
+  if (csv && !(out = cli_output_open("fcm-quadrature", csv, &outf))) goto done;
   if (out) fprintf(out, "strength,rule,points,max_rel_error,median_rel_error\n");
   printf("%8s %10s %7s %7s %14s %14s\n", "strength", "rule", "points", "M", "max_rel_err",
          "median_rel_err");
@@ -211,16 +178,12 @@ int fcm_quadrature_cmd_accuracy(int argc, char **argv)
     }
   }
   if (out) {
-    FILE *f = out;
     out = NULL;
-    if (!commit_tmp(f, tmp, csv)) goto done;
+    if (!cli_output_commit("fcm-quadrature", &outf)) goto done;
   }
   rc = 0;
 done:
-  if (out) {
-    fclose(out);
-    remove(tmp);
-  }
+  cli_output_abort(&outf); /* after a failure: the temporary goes, the target stays */
   free(err);
   fcm_geometry_destroy(&cuboid);
   fcm_geometry_destroy(&box);
@@ -360,7 +323,7 @@ int fcm_quadrature_cmd_embed(int argc, char **argv)
   fcm_geometry *geom = NULL;
   fcm_cell_rules *rules = NULL;
   FILE *out = NULL;
-  char tmp[4096];
+  cli_output *outf = NULL;
   if (fcm_ctx_create(NULL, &ctx) != FCM_OK) return 1;
   const fcm_index n[3] = {cells[0], cells[1], cells[2]};
   if (fcm_mesh_create_box(ctx, type, box, box + 3, n, &mesh) != FCM_OK) {
@@ -394,21 +357,17 @@ int fcm_quadrature_cmd_embed(int argc, char **argv)
   }
   fcm_cell_rules_view(rules, stdout);
   if (dump) {
-    if (!(out = open_tmp(dump, tmp, sizeof tmp))) goto done;
+    if (!(out = cli_output_open("fcm-quadrature", dump, &outf))) goto done;
     if (fcm_cell_rules_view_points(rules, mesh, FCM_RULE_STIFFNESS, out) != FCM_OK) {
       fcm_ctx_error_view(ctx, stderr);
       goto done;
     }
-    FILE *f = out;
     out = NULL;
-    if (!commit_tmp(f, tmp, dump)) goto done;
+    if (!cli_output_commit("fcm-quadrature", &outf)) goto done;
   }
   rc = 0;
 done:
-  if (out) {
-    fclose(out);
-    remove(tmp);
-  }
+  cli_output_abort(&outf); /* after a failure: the temporary goes, the target stays */
   fcm_cell_rules_destroy(&rules);
   fcm_geometry_destroy(&geom);
   fcm_mesh_destroy(&mesh);

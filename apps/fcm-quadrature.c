@@ -1,5 +1,6 @@
 /* fcm-quadrature: quadrature studies and reports. Subcommands are listed in one
  * table; `tables` reports (and with --check re-verifies) the stored rule tables. */
+#include "cli.h"
 #include "fcm-quadrature.h"
 #include <fcm/fcm.h>
 
@@ -149,15 +150,13 @@ static int cmd_tables(int argc, char **argv)
     }
   }
   FILE *csv = NULL;
-  if (csv_path && !(csv = fopen(csv_path, "w"))) {
-    fprintf(stderr, "fcm-quadrature: cannot write %s\n", csv_path);
-    return 1;
-  }
+  cli_output *csv_out = NULL;
+  if (csv_path && !(csv = cli_output_open("fcm-quadrature", csv_path, &csv_out))) return 1;
   if (csv) fprintf(csv, "shape,strength,points,best_published,ratio\n");
   fcm_ctx *ctx = NULL;
   if (fcm_ctx_create(NULL, &ctx) != FCM_OK) {
     fprintf(stderr, "fcm-quadrature: cannot create context\n");
-    if (csv) fclose(csv);
+    cli_output_abort(&csv_out);
     return 1;
   }
   printf("%-5s %3s %7s %-8s %8s %9s %6s %6s%s\n", "shape", "m", "points", "origin", "computed",
@@ -210,10 +209,7 @@ static int cmd_tables(int argc, char **argv)
   if (check) printf("; verification failures: %d", failures);
   printf("\n");
   fcm_ctx_destroy(&ctx);
-  if (csv && fclose(csv) != 0) {
-    fprintf(stderr, "fcm-quadrature: error writing %s\n", csv_path);
-    return 1;
-  }
+  if (csv && !cli_output_commit("fcm-quadrature", &csv_out)) return 1;
   return failures ? 1 : 0;
 }
 

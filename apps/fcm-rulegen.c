@@ -4,6 +4,8 @@
 #include <fcm/fcm.h>
 #include <fcm/rulegen.h>
 
+#include "cli.h"
+
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -138,19 +140,16 @@ static int write_table(const char *path, const fcm_rule *rule, const char *start
                        int start_points, int start_strength, const fcm_rulegen_info *info,
                        double seconds)
 {
-  char tmp[1100], date[32];
+  char date[32];
   time_t now = time(NULL);
   struct tm *tm = gmtime(&now);
   int dim = fcm_shape_dim(fcm_rule_shape(rule)), n = fcm_rule_num_points(rule);
   const double *x = fcm_rule_points(rule), *w = fcm_rule_weights(rule);
   static const char *const axis[3] = {"x", "y", "z"};
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
   if (!tm || !strftime(date, sizeof date, "%Y-%m-%d", tm)) snprintf(date, sizeof date, "unknown");
-  FILE *f = fopen(tmp, "w");
-  if (!f) {
-    fprintf(stderr, "fcm-rulegen: cannot write %s: %s\n", tmp, strerror(errno));
-    return 0;
-  }
+  cli_output *out = NULL;
+  FILE *f = cli_output_open("fcm-rulegen", path, &out);
+  if (!f) return 0;
   fprintf(f, "# fcm quadrature table\n");
   fprintf(f, "# shape: %s\n", fcm_shape_name(fcm_rule_shape(rule)));
   fprintf(f, "# strength: %d\n", fcm_rule_strength(rule));
@@ -169,12 +168,7 @@ static int write_table(const char *path, const fcm_rule *rule, const char *start
     for (int k = 0; k < dim; k++) fprintf(f, "%s%.17g", k ? " " : "", x[dim * i + k]);
     fprintf(f, " %.17g\n", w[i]);
   }
-  if (fclose(f) != 0 || rename(tmp, path) != 0) {
-    fprintf(stderr, "fcm-rulegen: cannot write %s: %s\n", path, strerror(errno));
-    remove(tmp);
-    return 0;
-  }
-  return 1;
+  return cli_output_commit("fcm-rulegen", &out);
 }
 
 typedef struct config {
@@ -261,20 +255,18 @@ static int generate(fcm_ctx *ctx, const config *cfg, fcm_shape shape, int m)
   return ok;
 }
 
-static int parse_int(const char *s, int *v)
+/* An int or a finite double from all of `s` in [lo, hi] (messages name `opt`). */
+static int parse_int(const char *opt, const char *s, long long lo, long long hi, int *v)
 {
-  char *end;
-  long l = strtol(s, &end, 10);
-  if (end == s || *end || l < -1000000 || l > 1000000) return 0;
-  *v = (int)l;
+  long long n = 0;
+  if (!cli_int("fcm-rulegen", opt, s, lo, hi, &n)) return 0;
+  *v = (int)n;
   return 1;
 }
 
-static int parse_double(const char *s, double *v)
+static int parse_double(const char *opt, const char *s, double lo, double hi, double *v)
 {
-  char *end;
-  *v = strtod(s, &end);
-  return end != s && !*end;
+  return cli_double("fcm-rulegen", opt, s, lo, hi, 0, v);
 }
 
 int main(int argc, char **argv)
@@ -312,28 +304,28 @@ int main(int argc, char **argv)
       snprintf(buf, sizeof buf, "%s", v);
       colon = strchr(buf, ':');
       if (colon) *colon = '\0';
-      bad = !parse_int(buf, &mlo) || !parse_int(colon ? colon + 1 : buf, &mhi);
+      bad = !parse_int(a, buf, 1, 40, &mlo) || !parse_int(a, colon ? colon + 1 : buf, 1, 40, &mhi);
       i++;
     } else if (!strcmp(a, "--out")) {
       cfg.out = v;
       i++;
     } else if (!strcmp(a, "--starts")) {
-      bad = !parse_int(v, &cfg.starts) || cfg.starts < 0;
+      bad = !parse_int(a, v, 0, 1000000, &cfg.starts);
       i++;
     } else if (!strcmp(a, "--candidates")) {
-      bad = !parse_int(v, &cfg.opts.max_candidates);
+      bad = !parse_int(a, v, 1, 1000000, &cfg.opts.max_candidates);
       i++;
     } else if (!strcmp(a, "--iterations")) {
-      bad = !parse_int(v, &cfg.opts.max_iterations);
+      bad = !parse_int(a, v, 1, 1000000, &cfg.opts.max_iterations);
       i++;
     } else if (!strcmp(a, "--batch")) {
-      bad = !parse_double(v, &cfg.opts.max_batch);
+      bad = !parse_double(a, v, 0.0, 1.0, &cfg.opts.max_batch);
       i++;
     } else if (!strcmp(a, "--margin")) {
-      bad = !parse_double(v, &cfg.opts.margin);
+      bad = !parse_double(a, v, 0.0, 1.0, &cfg.opts.margin);
       i++;
     } else if (!strcmp(a, "--tol")) {
-      bad = !parse_double(v, &cfg.opts.tol);
+      bad = !parse_double(a, v, 0.0, 1.0, &cfg.opts.tol);
       i++;
     } else {
       bad = 1;

@@ -1,71 +1,64 @@
 # Programs end to end (label app): each test gets the program's path and a scratch directory.
+# Several tests share one program (fcm_add_test builds one executable per source).
 file(MAKE_DIRECTORY ${PROJECT_BINARY_DIR}/app-tests)
+set(work ${PROJECT_BINARY_DIR}/app-tests)
+# The shared command-line helper apps/cli.c: numbers, lists, option tables, atomic output.
+fcm_add_test(app_cli tests/apps/cli.c LABELS app ARGS ${work})
 fcm_add_test(app_quadrature tests/apps/quadrature_app.c LABELS app
-             ARGS $<TARGET_FILE:fcm-quadrature> ${PROJECT_BINARY_DIR}/app-tests)
-# fcm-sim: a small scene run (frames, PVDs, CSV log, --steps, -o) and the cantilever demo;
-# checkpoints and --resume reproduce the uninterrupted run's frames byte for byte;
-# invalid scenes exit non-zero with the parser's message and create no output directory;
-# every example scene and the built-in scene run `--check` (the heavy ones labelled slow).
-fcm_add_test(app_sim_run tests/apps/sim_app.c LABELS app
-             ARGS run $<TARGET_FILE:fcm-sim> ${PROJECT_BINARY_DIR}/app-tests)
-add_test(NAME app_sim_errors COMMAND app_sim_run errors $<TARGET_FILE:fcm-sim>
-         ${PROJECT_BINARY_DIR}/app-tests)
-set_tests_properties(app_sim_errors PROPERTIES LABELS app TIMEOUT 300)
-add_test(NAME app_sim_resume COMMAND app_sim_run resume $<TARGET_FILE:fcm-sim>
-         ${PROJECT_BINARY_DIR}/app-tests)
-set_tests_properties(app_sim_resume PROPERTIES LABELS app TIMEOUT 300)
-# The README quick start: `fcm-sim` without arguments, to the end (about 40 s).
-add_test(NAME app_sim_default COMMAND app_sim_run default $<TARGET_FILE:fcm-sim>
-         ${PROJECT_BINARY_DIR}/app-tests)
-set_tests_properties(app_sim_default PROPERTIES LABELS app TIMEOUT 1200)
-# Every example scene and the built-in one ("-", no file) with --check (about 25 s in all
-# on 2 idle cores; the twisting cylinder's cut-cell rules take most of it).
-foreach(scene spinning_body slingshot hollow_ball static_beam twisting_cylinder -)
-  if(scene STREQUAL "-")
-    set(name builtin)
-    set(arg -)
-  else()
-    set(name ${scene})
-    set(arg ${PROJECT_SOURCE_DIR}/apps/scenes/${scene}.json)
+             ARGS $<TARGET_FILE:fcm-quadrature> ${work})
+# fcm-sim: a small scene run (frames, PVDs, CSV log, --steps, -o); checkpoints and --resume
+# reproduce the uninterrupted run's frames byte for byte; invalid scenes exit non-zero with
+# the parser's message and create no output directory.
+fcm_add_test(app_sim_run tests/apps/sim_app.c LABELS app ARGS run $<TARGET_FILE:fcm-sim> ${work})
+fcm_add_test(app_sim_errors tests/apps/sim_app.c LABELS app
+             ARGS errors $<TARGET_FILE:fcm-sim> ${work})
+fcm_add_test(app_sim_resume tests/apps/sim_app.c LABELS app
+             ARGS resume $<TARGET_FILE:fcm-sim> ${work})
+# The README quick start, `fcm-sim` without arguments: the first 6 steps in the default run
+# (frames, PVD indexes and log rows checked step by step); to the end (71 frames, 210 log
+# rows; about 40 s on 2 idle cores) labelled slow.
+fcm_add_test(app_sim_default_quick tests/apps/sim_app.c LABELS app TIMEOUT 900
+             ARGS default-quick $<TARGET_FILE:fcm-sim> ${work})
+fcm_add_test(app_sim_default tests/apps/sim_app.c LABELS app slow TIMEOUT 1200
+             ARGS default $<TARGET_FILE:fcm-sim> ${work})
+# Every example scene with --check: at most 3 steps, finite state, the run summary. The
+# twisting cylinder is the built-in scene (byte for byte, see scene_default) that
+# app_sim_default_quick already runs, so its --check is labelled slow.
+foreach(scene spinning_body slingshot hollow_ball static_beam cantilever twisting_cylinder)
+  set(labels app)
+  if(scene STREQUAL "twisting_cylinder")
+    set(labels app slow)
   endif()
-  add_test(NAME app_sim_check_${name} COMMAND app_sim_run check $<TARGET_FILE:fcm-sim> ${arg})
-  set_tests_properties(app_sim_check_${name} PROPERTIES LABELS app TIMEOUT 900)
+  fcm_add_test(app_sim_check_${scene} tests/apps/sim_app.c LABELS ${labels} TIMEOUT 900
+               ARGS check $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/${scene}.json)
 endforeach()
 # fcm-condition: --quick CSV/PNG format and facts; the Fig. 5 claims (Longva et al. 2020)
 fcm_add_test(app_condition tests/apps/condition_app.c LABELS app
-             ARGS $<TARGET_FILE:fcm-condition> ${PROJECT_BINARY_DIR}/app-tests)
+             ARGS $<TARGET_FILE:fcm-condition> ${work})
 fcm_add_test(app_condition_claims tests/apps/condition_claims.c LABELS app TIMEOUT 1200
-             ARGS $<TARGET_FILE:fcm-condition> ${PROJECT_BINARY_DIR}/app-tests)
+             ARGS $<TARGET_FILE:fcm-condition> ${work})
 fcm_add_test(dense_spectrum tests/apps/dense_spectrum.c)
 # fcm-converge: --quick CSV/PNG format, consistency and error exits, payoff --quick; the
 # convergence rates of the manufactured problem (quick set in the default run, the full
 # assertion set - every element, FCM and staircase FEM - labelled slow)
 fcm_add_test(app_converge tests/apps/converge_app.c LABELS app TIMEOUT 900
-             ARGS $<TARGET_FILE:fcm-converge> ${PROJECT_BINARY_DIR}/app-tests)
+             ARGS $<TARGET_FILE:fcm-converge> ${work})
 fcm_add_test(app_converge_rates tests/apps/converge_rates.c LABELS app TIMEOUT 900
-             ARGS quick $<TARGET_FILE:fcm-converge> ${PROJECT_BINARY_DIR}/app-tests)
-add_test(NAME app_converge_rates_full COMMAND app_converge_rates full $<TARGET_FILE:fcm-converge>
-         ${PROJECT_BINARY_DIR}/app-tests)
-set_tests_properties(app_converge_rates_full PROPERTIES LABELS "app;slow" TIMEOUT 7200
-                     ENVIRONMENT "OMP_NUM_THREADS=2")
+             ARGS quick $<TARGET_FILE:fcm-converge> ${work})
+fcm_add_test(app_converge_rates_full tests/apps/converge_rates.c LABELS app slow TIMEOUT 7200
+             ARGS full $<TARGET_FILE:fcm-converge> ${work})
 # Faults around fcm-sim's output, through an LD_PRELOAD shim (tests/support/fault_shim.c):
 # kill -9 inside file operations and at random moments, then resume (a handful of seeded
 # kills by default, 60 under slow); the disk filling up (the shim's ENOSPC, and a real small
-# tmpfs where an unprivileged mount namespace is allowed); a directory fsync after each
-# rename that puts an output file in place.
+# tmpfs where an unprivileged mount namespace is allowed); power loss: a directory fsync
+# after each durable write (checkpoints: temporary fsynced, then renamed).
 add_library(fcm_fault_shim SHARED tests/support/fault_shim.c)
 target_link_libraries(fcm_fault_shim PRIVATE ${CMAKE_DL_LIBS})
 set_target_properties(fcm_fault_shim PROPERTIES C_VISIBILITY_PRESET default)
-fcm_add_test(app_fault_kill tests/apps/fault_app.c LABELS app
-             ARGS kill $<TARGET_FILE:fcm-sim> $<TARGET_FILE:fcm_fault_shim>
-                  ${PROJECT_BINARY_DIR}/app-tests)
-add_dependencies(app_fault_kill fcm_fault_shim fcm-sim)
-add_test(NAME app_fault_kill_long COMMAND app_fault_kill kill $<TARGET_FILE:fcm-sim>
-         $<TARGET_FILE:fcm_fault_shim> ${PROJECT_BINARY_DIR}/app-tests 60 7)
-set_tests_properties(app_fault_kill_long PROPERTIES LABELS "app;slow" TIMEOUT 1800)
-add_test(NAME app_fault_diskfull COMMAND app_fault_kill diskfull $<TARGET_FILE:fcm-sim>
-         $<TARGET_FILE:fcm_fault_shim> ${PROJECT_BINARY_DIR}/app-tests)
-set_tests_properties(app_fault_diskfull PROPERTIES LABELS app TIMEOUT 300)
-add_test(NAME app_fault_dirsync COMMAND app_fault_kill dirsync $<TARGET_FILE:fcm-sim>
-         $<TARGET_FILE:fcm_fault_shim> ${PROJECT_BINARY_DIR}/app-tests)
-set_tests_properties(app_fault_dirsync PROPERTIES LABELS app TIMEOUT 300)
+set(fault_args $<TARGET_FILE:fcm-sim> $<TARGET_FILE:fcm_fault_shim> ${work})
+fcm_add_test(app_fault_kill tests/apps/fault_app.c LABELS app ARGS kill ${fault_args})
+fcm_add_test(app_fault_kill_long tests/apps/fault_app.c LABELS app slow TIMEOUT 1800
+             ARGS kill ${fault_args} 60 7)
+fcm_add_test(app_fault_diskfull tests/apps/fault_app.c LABELS app ARGS diskfull ${fault_args})
+fcm_add_test(app_fault_dirsync tests/apps/fault_app.c LABELS app ARGS dirsync ${fault_args})
+add_dependencies(app_fault_kill fcm_fault_shim fcm-sim) # the program of the app_fault_* tests

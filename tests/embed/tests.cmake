@@ -16,4 +16,11 @@ fcm_add_test(embed_surface tests/embed/surface.c)
 fcm_add_test(embed_rules tests/embed/rules.c)
 fcm_add_test(embed_errors tests/embed/errors.c)
 fcm_add_test(embed_bench tests/embed/bench.c LABELS bench TIMEOUT 3600)
+# Degenerate cuts (catalogue) and the random cut campaign: per-cell volume and first moments
+# within 1e-12 h^3 of exact values (2e-12 simplified), positive finite weights, <= M points
+# or a counted fallback; the long campaign (label slow) runs 60x more cases, another seed.
+fcm_add_test(embed_cut_catalogue tests/embed/cut_campaign.c ARGS catalogue)
+fcm_add_test(embed_cut_campaign tests/embed/cut_campaign.c ARGS campaign 1000)
+fcm_add_test(embed_cut_campaign_long tests/embed/cut_campaign.c ARGS campaign 60000 7
+             LABELS slow TIMEOUT 3600)
 fcm_add_test(embed_limits tests/embed/limits.c)

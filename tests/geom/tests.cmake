@@ -6,3 +6,5 @@ fcm_add_test(geom_shapes tests/geom/shapes.c)
 fcm_add_test(geom_readers tests/geom/readers.c)
 fcm_add_test(geom_errors tests/geom/errors.c)
 fcm_add_test(geom_reader_limits tests/geom/reader_limits.c)
+# Allocation failures: geometry from arrays and Gmsh files, AABB tree build and query.
+fcm_add_test(geom_alloc_failure tests/geom/alloc_failure.c)

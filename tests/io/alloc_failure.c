@@ -28,6 +28,7 @@ static fcm_status run(fcm_ctx *ctx)
   if ((st = fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "u", 3, 4, u))) goto done;
   if ((st = fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, name, 3, 4, u))) goto done;
   if ((st = fcm_vtu_add_field_int32(vtu, FCM_VTU_CELL_DATA, "class", 1, 1, cls))) goto done;
+  if ((st = fcm_vtu_add_field_int64(vtu, FCM_VTU_CELL_DATA, "id", 1, 1, conn))) goto done;
   if ((st = fcm_vtu_write(vtu, DIR "/a.vtu", NULL))) goto done;
   if ((st = fcm_pvd_create(ctx, DIR "/a.pvd", &pvd))) goto done;
   if ((st = fcm_pvd_add(pvd, 0.0, DIR "/a.vtu"))) goto done;
@@ -79,6 +80,31 @@ int main(void)
     }
   }
   TEST_TRUE(k >= 15); /* every step allocates: the loop really exercised them */
+
+  /* the public atomic file: open allocates; a failing open leaves NULL and nothing on disk */
+  vr_mkdir(DIR);
+  int opened = 0, failures = 0;
+  for (k = 0; k < 100 && !opened; k++) {
+    fcm_atomic_file *af = (fcm_atomic_file *)&f;
+    f.count = 0;
+    f.fail_at = k;
+    fcm_status st = fcm_atomic_file_open(ctx, DIR "/table.csv", &af);
+    f.fail_at = -1;
+    if (st == FCM_OK) {
+      opened = 1;
+      fputs("a,b\n1,2\n", fcm_atomic_file_stream(af));
+      TEST_OK(ctx, fcm_atomic_file_commit(&af));
+    } else {
+      failures++;
+      if (st != FCM_ERR_ALLOC || af != NULL)
+        TEST_FAIL_("atomic file open, failing allocation %lld: %s", k, fcm_status_str(st));
+      TEST_TRUE(vr_count_entries(DIR, ".tmp.") == 0 && vr_count_entries(DIR, "table") == 0);
+      fcm_ctx_error_clear(ctx);
+    }
+    TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
+  }
+  TEST_TRUE(opened && failures >= 2);
+  TEST_TRUE(vr_count_entries(DIR, "table.csv") == 1 && vr_count_entries(DIR, ".tmp.") == 0);
   fcm_ctx_destroy(&ctx);
   if (!test_failures_) vr_rmdir(DIR);
   return TEST_RESULT();

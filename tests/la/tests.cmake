@@ -8,3 +8,5 @@ fcm_add_test(la_mat3_eig tests/la/mat3_eig.c)
 fcm_add_test(la_mat3_svd tests/la/mat3_svd.c)
 fcm_add_test(la_csr tests/la/csr.c)
 fcm_add_test(la_direct tests/la/direct.c)
+# Allocation failures: fcm_csr_create and fcm_csr_wrap.
+fcm_add_test(la_alloc_failure tests/la/alloc_failure.c)

@@ -2,6 +2,7 @@
  * (k = 0, 1, 2, ... until the call succeeds), every rule constructor returns
  * FCM_ERR_ALLOC, leaves *rule NULL and frees everything it allocated. */
 #include "fcm/quad.h"
+#include "fcm/rulegen.h"
 #include "test.h"
 #include "test_alloc.h"
 
@@ -63,6 +64,34 @@ int main(void)
       TEST_TRUE(succeeded);
       TEST_TRUE(failures >= 3); /* rule struct, points, weights at least */
     }
+  /* fcm_rule_moment_residual allocates its moment workspace */
+  for (int s = 0; s < FCM_SHAPE_COUNT; s++) {
+    fcm_rule *r = NULL;
+    TEST_OK(ctx, fcm_rule_create(ctx, (fcm_shape)s, 4, &r));
+    int succeeded = 0, failures = 0;
+    const long long live = fcm_ctx_live_allocations(ctx); /* the rule's */
+    for (long k = 0; k < 100 && r && !succeeded; k++) {
+      double res = -1.0;
+      f.count = 0;
+      f.fail_at = k;
+      fcm_status st = fcm_rule_moment_residual(ctx, r, 4, &res);
+      f.fail_at = -1;
+      if (st == FCM_OK) {
+        succeeded = 1;
+        TEST_TRUE(res >= 0.0 && res < 1e-12);
+      } else {
+        failures++;
+        if (st != FCM_ERR_ALLOC || fcm_ctx_error_status(ctx) != FCM_ERR_ALLOC)
+          TEST_FAIL_("moment residual, shape %d: failing allocation %ld gave %s", s, k,
+                     fcm_status_str(st));
+        fcm_ctx_error_clear(ctx);
+      }
+      if (fcm_ctx_live_allocations(ctx) != live)
+        TEST_FAIL_("moment residual, shape %d: leak after failing allocation %ld", s, k);
+    }
+    TEST_TRUE(succeeded && failures >= 1);
+    fcm_rule_destroy(&r);
+  }
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
 }

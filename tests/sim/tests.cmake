@@ -20,3 +20,5 @@ foreach(el hex8 tet10)
   fcm_sim_test(sim_krylov_${el} tests/sim/krylov.c ARGS ${el})
 endforeach()
 fcm_sim_test(sim_alloc_failure tests/sim/alloc_failure.c)
+# Allocation failures with a body-force field, a traction, and the energy query.
+fcm_sim_test(sim_alloc_effects tests/sim/alloc_effects.c)

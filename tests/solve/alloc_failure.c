@@ -1,6 +1,7 @@
 /* Allocation failures in the solve module: failing the k-th allocation for k = 0, 1, ...
  * of the workspace (with its history), the Jacobi and the Schwarz builders (from blocks
- * and from a space) gives FCM_ERR_ALLOC and leaks nothing, until everything succeeds. */
+ * and from a space), a second Schwarz setup, MINRES and CG (workspace and one-shot) gives
+ * FCM_ERR_ALLOC and leaks nothing, until everything succeeds. */
 #include "solve_test_util.h"
 
 #include <omp.h>
@@ -9,7 +10,8 @@
 #define NN (N * N * N)
 
 typedef struct fixture {
-  fcm_csr *A; /* shifted Laplacian (indefinite) */
+  fcm_csr *A;   /* shifted Laplacian (indefinite) */
+  fcm_csr *SPD; /* the Laplacian (positive definite), for CG */
   fcm_space *space;
   fcm_csr *K; /* stiffness of the space */
   unsigned char flag[8];
@@ -44,7 +46,22 @@ static fcm_status run(fcm_ctx *ctx, fixture *f)
     goto done;
   o.record_history = 0;
   memset(x, 0, sizeof x);
-  st = fcm_minres_solve(ctx, NN, fcm_csr_operator, f->A, NULL, NULL, f->b, x, &o, &info);
+  if ((st = fcm_minres_solve(ctx, NN, fcm_csr_operator, f->A, NULL, NULL, f->b, x, &o, &info)))
+    goto done;
+  /* a second setup of the same Schwarz preconditioner, then CG (workspace with history,
+   * and one-shot) on the positive definite Laplacian with it */
+  if ((st = fcm_schwarz_setup(P, f->SPD))) goto done;
+  o.record_history = 1;
+  memset(x, 0, sizeof x);
+  if ((st = fcm_krylov_cg(ws, fcm_csr_operator, f->SPD, fcm_schwarz_operator, P, f->b, x, &o,
+                          &info)))
+    goto done;
+  o.record_history = 0;
+  memset(x, 0, sizeof x);
+  st = fcm_cg_solve(ctx, NN, fcm_csr_operator, f->SPD, fcm_jacobi_operator, J, f->b, x, &o, &info);
+  if (st == FCM_OK && info.reason != FCM_KRYLOV_CONVERGED_RTOL &&
+      info.reason != FCM_KRYLOV_CONVERGED_ATOL)
+    st = FCM_ERR_INTERNAL; /* CG converges here */
 done:
   fcm_schwarz_destroy(&Q);
   fcm_schwarz_destroy(&P);
@@ -61,6 +78,7 @@ int main(void)
   static fixture f;
   TEST_OK(ctx0, fcm_ctx_create(NULL, &ctx0));
   TEST_OK(ctx0, laplace3d(ctx0, N, 1.3, NULL, &f.A));
+  TEST_OK(ctx0, laplace3d(ctx0, N, 0.0, NULL, &f.SPD));
   for (int K = 0; K < N; K += 2)
     for (int J = 0; J < N; J += 2)
       for (int I = 0; I < N; I += 2) {
@@ -111,6 +129,7 @@ int main(void)
   fcm_space_destroy(&f.space);
   fcm_mesh_destroy(&mesh);
   fcm_csr_destroy(&f.A);
+  fcm_csr_destroy(&f.SPD);
   TEST_TRUE(fcm_ctx_live_allocations(ctx0) == 0);
   fcm_ctx_destroy(&ctx0);
   return TEST_RESULT();

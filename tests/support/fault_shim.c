@@ -7,9 +7,12 @@
  *                               disk is cut in the middle of a write
  *   FCM_FAULT_ENOSPC_AFTER=B    the disk holds B bytes: an fwrite that would pass B bytes in
  *                               all writes what fits and fails with ENOSPC, as do later ones
- *   FCM_FAULT_REPORT=PATH       at exit, write "ops O renames R synced S dirsyncs D" to PATH:
- *                               S of the R renames were followed by an fsync of a directory
- *                               before the next rename or the exit
+ *   FCM_FAULT_REPORT=PATH       at exit, write "ops O renames R synced S durable U
+ *                               dsynced V dirsyncs D" to PATH: S of the R renames were
+ *                               followed by an fsync of a directory before the next rename
+ *                               or the exit; U renames put a file in place that had been
+ *                               fsynced since the previous rename (durable writes), V of
+ *                               them were followed by a directory fsync
  * Not thread safe beyond what the programs need (they write files from one thread). */
 #define _GNU_SOURCE
 #include <dlfcn.h>
@@ -23,7 +26,8 @@
 #include <unistd.h>
 
 static long long ops, kill_at = -1, enospc_after = -1, written, renames, synced, dirsyncs;
-static int pending_rename, configured;
+static long long durable, dsynced;
+static int pending_rename, pending_durable, file_synced, configured;
 
 static void configure(void)
 {
@@ -57,6 +61,16 @@ static void operation(void)
 {
   configure();
   if (++ops == kill_at) raise(SIGKILL);
+}
+
+static void renamed(int rc)
+{
+  if (rc != 0) return;
+  renames++;
+  pending_rename = 1;
+  pending_durable = file_synced;
+  durable += file_synced;
+  file_synced = 0;
 }
 
 size_t fwrite(const void *p, size_t size, size_t n, FILE *f)
@@ -105,8 +119,10 @@ int fsync(int fd)
   if (fstat(fd, &sb) == 0 && S_ISDIR(sb.st_mode)) {
     dirsyncs++;
     if (pending_rename) synced++, pending_rename = 0;
+    if (pending_durable) dsynced++, pending_durable = 0;
   } else if (watched_fd(fd)) {
     operation();
+    file_synced = 1;
   }
   return real(fd);
 }
@@ -116,7 +132,7 @@ int rename(const char *from, const char *to)
   int (*real)(const char *, const char *) = next("rename");
   operation();
   int rc = real(from, to);
-  if (rc == 0) renames++, pending_rename = 1;
+  renamed(rc);
   return rc;
 }
 
@@ -125,7 +141,7 @@ int renameat(int dfrom, const char *from, int dto, const char *to)
   int (*real)(int, const char *, int, const char *) = next("renameat");
   operation();
   int rc = real(dfrom, from, dto, to);
-  if (rc == 0) renames++, pending_rename = 1;
+  renamed(rc);
   return rc;
 }
 
@@ -134,8 +150,8 @@ __attribute__((destructor)) static void report(void)
   const char *path = getenv("FCM_FAULT_REPORT");
   if (!path || !*path) return;
   char buf[256];
-  int n = snprintf(buf, sizeof buf, "ops %lld renames %lld synced %lld dirsyncs %lld\n", ops,
-                   renames, synced, dirsyncs);
+  int n = snprintf(buf, sizeof buf, "ops %lld renames %lld synced %lld durable %lld dsynced %lld dirsyncs %lld\n", ops,
+                   renames, synced, durable, dsynced, dirsyncs);
   int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0666);
   if (fd < 0) return;
   if (write(fd, buf, (size_t)n) != n) {

@@ -161,6 +161,33 @@ FCM_API fcm_status fcm_pvd_add(fcm_pvd *pvd, double time, const char *file);
 /** Number of entries in the index. */
 FCM_API fcm_index fcm_pvd_num_entries(const fcm_pvd *pvd);
 
+/** An output file replaced atomically, for callers writing their own formats (CSV tables,
+ * plot scripts) with stdio: the data goes to a temporary "<path>.tmp.<pid>.<n>" beside the
+ * target (created exclusively), which replaces `path` only at fcm_atomic_file_commit(). The
+ * library's own writers use the same code. One thread at a time per file. */
+typedef struct fcm_atomic_file fcm_atomic_file;
+
+/** Create the temporary for `path`.
+ * @param[in]  path target file (copied); an existing file is replaced only at commit
+ * @param[out] file the open file, NULL on failure
+ * @return FCM_OK; FCM_ERR_ARG (path NULL or empty); FCM_ERR_IO (the temporary cannot be
+ * created; the message names `path` and the system error); FCM_ERR_ALLOC. Nothing is left
+ * on disk on failure. Allocates; release with fcm_atomic_file_commit() or _abort(). */
+FCM_API fcm_status fcm_atomic_file_open(fcm_ctx *ctx, const char *path, fcm_atomic_file **file);
+
+/** The stream to write to (owned by `file`; do not close it). */
+FCM_API FILE *fcm_atomic_file_stream(fcm_atomic_file *file);
+
+/** Check the stream for earlier write errors, flush, close (each checked) and rename the
+ * temporary over the target; releases the file and sets *file = NULL either way.
+ * @return FCM_OK; FCM_ERR_ARG (file NULL); FCM_ERR_IO (a write, flush, close or rename
+ * failed; the message names the path; the temporary is removed and the target untouched). */
+FCM_API fcm_status fcm_atomic_file_commit(fcm_atomic_file **file);
+
+/** Close and remove the temporary and release the file; accepts NULL and *file == NULL,
+ * sets *file = NULL. Never fails. */
+FCM_API void fcm_atomic_file_abort(fcm_atomic_file **file);
+
 #ifdef __cplusplus
 }
 #endif

@@ -316,3 +316,55 @@ void fcm__io_atomic_abort(fcm_ctx *ctx, fcm__atomic_file *af)
   FCM_FREE(ctx, af->path);
   FCM_FREE(ctx, af->dir);
 }
+
+/* ---------------------------------------------------------------- public wrapper */
+
+struct fcm_atomic_file {
+  fcm_ctx *ctx;
+  fcm__atomic_file af;
+};
+
+fcm_status fcm_atomic_file_open(fcm_ctx *ctx, const char *path, fcm_atomic_file **file)
+{
+  fcm_status st = FCM_OK;
+  fcm_atomic_file *f = NULL;
+  FCM_CHECK(file != NULL, ctx, FCM_ERR_ARG, "io: fcm_atomic_file_open: file is NULL");
+  *file = NULL;
+  FCM_ALLOC(ctx, 1, f);
+  f->ctx = ctx;
+  FCM_TRY(ctx, fcm__io_atomic_open(ctx, path, 0, NULL, &f->af));
+  *file = f;
+  f = NULL;
+cleanup:
+  if (f) fcm__io_atomic_abort(ctx, &f->af);
+  FCM_FREE(ctx, f);
+  return st;
+}
+
+FILE *fcm_atomic_file_stream(fcm_atomic_file *file) { return file ? file->af.fp : NULL; }
+
+fcm_status fcm_atomic_file_commit(fcm_atomic_file **file)
+{
+  if (!file || !*file) return FCM_ERR_ARG;
+  fcm_atomic_file *f = *file;
+  fcm_ctx *ctx = f->ctx;
+  fcm_status st = FCM_OK;
+  *file = NULL;
+  FCM_CHECK(f->af.fp && !ferror(f->af.fp), ctx, FCM_ERR_IO, "io: writing '%s' failed",
+            f->af.path);
+  FCM_TRY(ctx, fcm__io_atomic_commit(ctx, &f->af));
+cleanup:
+  fcm__io_atomic_abort(ctx, &f->af);
+  FCM_FREE(ctx, f);
+  return st;
+}
+
+void fcm_atomic_file_abort(fcm_atomic_file **file)
+{
+  if (!file || !*file) return;
+  fcm_atomic_file *f = *file;
+  fcm_ctx *ctx = f->ctx;
+  *file = NULL;
+  fcm__io_atomic_abort(ctx, &f->af);
+  FCM_FREE(ctx, f);
+}

@@ -1,0 +1,246 @@
+/* apps/cli: shared command-line helpers of the fcm programs (see cli.h). */
+#include "cli.h"
+
+#include <fcm/core.h>
+#include <fcm/io.h>
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+int cli_double(const char *prog, const char *opt, const char *s, double lo, double hi,
+               unsigned bounds, double *out)
+{
+  char *end = NULL;
+  const double v = s ? strtod(s, &end) : NAN;
+  /* overflow gives an infinity (refused); underflow to a subnormal or zero is a number */
+  if (!s || end == s || *end || !isfinite(v)) {
+    fprintf(stderr, "%s: %s: '%s' is not a finite number\n", prog, opt, s ? s : "");
+    return 0;
+  }
+  const int lo_ok = bounds & CLI_LO_OPEN ? v > lo : v >= lo;
+  const int hi_ok = bounds & CLI_HI_OPEN ? v < hi : v <= hi;
+  if (!lo_ok || !hi_ok) {
+    fprintf(stderr, "%s: %s: %s is outside %c%g, %g%c\n", prog, opt, s,
+            bounds & CLI_LO_OPEN ? '(' : '[', lo, hi, bounds & CLI_HI_OPEN ? ')' : ']');
+    return 0;
+  }
+  *out = v;
+  return 1;
+}
+
+int cli_int(const char *prog, const char *opt, const char *s, long long lo, long long hi,
+            long long *out)
+{
+  char *end = NULL;
+  errno = 0;
+  const long long v = s ? strtoll(s, &end, 10) : 0;
+  if (!s || end == s || *end || errno == ERANGE || v < lo || v > hi) {
+    fprintf(stderr, "%s: %s: '%s' is not a whole number in [%lld, %lld]\n", prog, opt, s ? s : "",
+            lo, hi);
+    return 0;
+  }
+  *out = v;
+  return 1;
+}
+
+int cli_list(const char *prog, const char *opt, const char *s, char tok[][CLI_TOKEN], int cap,
+             int *n)
+{
+  *n = 0;
+  if (!s || !*s) {
+    fprintf(stderr, "%s: %s: empty list\n", prog, opt);
+    return 0;
+  }
+  for (;;) {
+    const char *c = strchr(s, ',');
+    const size_t len = c ? (size_t)(c - s) : strlen(s);
+    if (len == 0 || len >= CLI_TOKEN || *n >= cap) {
+      fprintf(stderr,
+              "%s: %s: malformed list (empty item, item longer than %d characters or more than "
+              "%d items)\n",
+              prog, opt, CLI_TOKEN - 1, cap);
+      return 0;
+    }
+    memcpy(tok[*n], s, len);
+    tok[*n][len] = '\0';
+    (*n)++;
+    if (!c) return 1;
+    s = c + 1;
+  }
+}
+
+int cli_choice(const char *prog, const char *opt, const char *s, const char *const *names, int *out)
+{
+  for (int k = 0; names[k]; k++)
+    if (s && !strcmp(s, names[k])) {
+      *out = k;
+      return 1;
+    }
+  fprintf(stderr, "%s: %s: '%s' is not one of", prog, opt, s ? s : "");
+  for (int k = 0; names[k]; k++)
+    fprintf(stderr, "%s %s", k ? "," : "", names[k]);
+  fprintf(stderr, "\n");
+  return 0;
+}
+
+/* ---------------------------------------------------------------- option tables */
+
+static int read_value(const char *prog, const cli_option *o, const char *v)
+{
+  long long n = 0;
+  switch (o->kind) {
+  case CLI_DOUBLE:
+    return cli_double(prog, o->name, v, o->lo, o->hi, o->bounds, (double *)o->dest);
+  case CLI_INT:
+    if (!cli_int(prog, o->name, v, (long long)o->lo, (long long)o->hi, &n)) return 0;
+    *(int *)o->dest = (int)n;
+    return 1;
+  case CLI_LLONG:
+    return cli_int(prog, o->name, v, (long long)o->lo, (long long)o->hi, (long long *)o->dest);
+  case CLI_STRING:
+    if (!*v) {
+      fprintf(stderr, "%s: %s: empty value\n", prog, o->name);
+      return 0;
+    }
+    *(const char **)o->dest = v;
+    return 1;
+  case CLI_CHOICE:
+    return cli_choice(prog, o->name, v, o->choices, (int *)o->dest);
+  case CLI_CUSTOM:
+    return o->parse(prog, o->name, v, o->dest);
+  case CLI_FLAG:
+    break;
+  }
+  return 0;
+}
+
+cli_result cli_parse(const char *prog, const cli_option *opts, int argc, char **argv,
+                     const char **pos, int max_pos, int *npos)
+{
+  int np = 0;
+  if (npos) *npos = 0;
+  for (int i = 1; i < argc; i++) {
+    const char *a = argv[i];
+    if (!strcmp(a, "-h") || !strcmp(a, "--help")) return CLI_HELP;
+    if (a[0] != '-' || !a[1]) { /* positional ("-" alone too: standard input or a default) */
+      if (np >= max_pos) {
+        fprintf(stderr, "%s: unexpected argument '%s' (see --help)\n", prog, a);
+        return CLI_ERROR;
+      }
+      pos[np++] = a;
+      if (npos) *npos = np;
+      continue;
+    }
+    const char *eq = a[1] == '-' ? strchr(a, '=') : NULL;
+    const size_t len = eq ? (size_t)(eq - a) : strlen(a);
+    const cli_option *o = opts;
+    for (; o->name; o++)
+      if ((strlen(o->name) == len && !strncmp(a, o->name, len)) ||
+          (o->alias && strlen(o->alias) == len && !strncmp(a, o->alias, len)))
+        break;
+    if (!o->name) {
+      fprintf(stderr, "%s: unknown option '%.*s' (see --help)\n", prog, (int)len, a);
+      return CLI_ERROR;
+    }
+    if (o->kind == CLI_FLAG) {
+      if (eq) {
+        fprintf(stderr, "%s: %s takes no value\n", prog, o->name);
+        return CLI_ERROR;
+      }
+      *(int *)o->dest = 1;
+    } else {
+      const char *v = eq ? eq + 1 : i + 1 < argc ? argv[++i] : NULL;
+      if (!v) {
+        fprintf(stderr, "%s: %s needs a value %s (see --help)\n", prog, o->name,
+                o->metavar ? o->metavar : "");
+        return CLI_ERROR;
+      }
+      if (!read_value(prog, o, v)) return CLI_ERROR;
+    }
+    if (o->seen) *o->seen = 1;
+  }
+  return CLI_OK;
+}
+
+void cli_print_options(FILE *f, const cli_option *opts)
+{
+  char head[128];
+  int col = 0;
+  for (const cli_option *o = opts; o->name; o++) { /* the help column: longest head + 2 */
+    int n =
+        snprintf(head, sizeof head, "  %s%s%s%s%s", o->alias ? o->alias : "", o->alias ? ", " : "",
+                 o->name, o->metavar ? " " : "", o->metavar ? o->metavar : "");
+    if (n > col) col = n;
+  }
+  if (col < (int)strlen("  -h, --help")) col = (int)strlen("  -h, --help");
+  col += 2;
+  for (const cli_option *o = opts; o->name; o++) {
+    int n =
+        snprintf(head, sizeof head, "  %s%s%s%s%s", o->alias ? o->alias : "", o->alias ? ", " : "",
+                 o->name, o->metavar ? " " : "", o->metavar ? o->metavar : "");
+    fprintf(f, "%s%*s", head, col - n, "");
+    for (const char *h = o->help ? o->help : ""; *h;) {
+      const char *nl = strchr(h, '\n');
+      const int len = nl ? (int)(nl - h) : (int)strlen(h);
+      fprintf(f, "%.*s\n", len, h);
+      if (!nl) break;
+      h = nl + 1;
+      fprintf(f, "%*s", col, "");
+    }
+    if (!o->help || !*o->help) fprintf(f, "\n");
+  }
+  fprintf(f, "  -h, --help%*sthis text\n", col - (int)strlen("  -h, --help"), "");
+}
+
+/* ---------------------------------------------------------------- atomic output */
+
+struct cli_output {
+  fcm_ctx *ctx;
+  fcm_atomic_file *file;
+};
+
+FILE *cli_output_open(const char *prog, const char *path, cli_output **out)
+{
+  cli_output *o = calloc(1, sizeof *o);
+  *out = NULL;
+  if (!o) {
+    fprintf(stderr, "%s: out of memory\n", prog);
+    return NULL;
+  }
+  if (fcm_ctx_create(NULL, &o->ctx) != FCM_OK) {
+    fprintf(stderr, "%s: cannot create an fcm context to write %s\n", prog, path);
+    free(o);
+    return NULL;
+  }
+  if (fcm_atomic_file_open(o->ctx, path, &o->file) != FCM_OK) {
+    fprintf(stderr, "%s: %s\n", prog, fcm_ctx_error_message(o->ctx));
+    fcm_ctx_destroy(&o->ctx);
+    free(o);
+    return NULL;
+  }
+  *out = o;
+  return fcm_atomic_file_stream(o->file);
+}
+
+int cli_output_commit(const char *prog, cli_output **out)
+{
+  if (!out || !*out) return 0;
+  cli_output *o = *out;
+  *out = NULL;
+  const int ok = fcm_atomic_file_commit(&o->file) == FCM_OK;
+  if (!ok) fprintf(stderr, "%s: %s\n", prog, fcm_ctx_error_message(o->ctx));
+  fcm_ctx_destroy(&o->ctx);
+  free(o);
+  return ok;
+}
+
+void cli_output_abort(cli_output **out)
+{
+  if (!out || !*out) return;
+  fcm_atomic_file_abort(&(*out)->file);
+  fcm_ctx_destroy(&(*out)->ctx);
+  free(*out);
+  *out = NULL;
+}

@@ -1,0 +1,90 @@
+/* apps/cli: the command-line helpers every fcm program shares — numbers with range checks
+ * (NaN, infinities and trailing junk refused), comma lists, keyword choices, a table of
+ * options that is both parsed and printed as --help, and atomic output files written
+ * through the library's atomic-file code (fcm_atomic_file in fcm/io.h).
+ *
+ * Every function that rejects its input prints one line "PROG: OPTION: what is wrong" on
+ * stderr and returns 0; success returns 1. The programs exit 2 on a usage error. */
+#ifndef FCM_APPS_CLI_H
+#define FCM_APPS_CLI_H
+
+#include <stdio.h>
+
+/** Longest comma-list item, with its terminating NUL. */
+#define CLI_TOKEN 32
+
+/** Range ends: closed by default; these flags open them. */
+enum { CLI_LO_OPEN = 1, CLI_HI_OPEN = 2 };
+
+/** A finite number in the range [lo, hi] (ends opened by `bounds`) from all of `s`. */
+int cli_double(const char *prog, const char *opt, const char *s, double lo, double hi,
+               unsigned bounds, double *out);
+
+/** A whole number (decimal, no fraction, no exponent) in [lo, hi] from all of `s`. */
+int cli_int(const char *prog, const char *opt, const char *s, long long lo, long long hi,
+            long long *out);
+
+/** Split the comma list `s` into 1..cap non-empty items shorter than CLI_TOKEN. */
+int cli_list(const char *prog, const char *opt, const char *s, char tok[][CLI_TOKEN], int cap,
+             int *n);
+
+/** The index of `s` in the NULL-terminated `names`; the message lists the valid names. */
+int cli_choice(const char *prog, const char *opt, const char *s, const char *const *names,
+               int *out);
+
+/** How an option's value is read into `dest`. */
+typedef enum cli_kind {
+  CLI_FLAG,   /* no value; int *dest = 1 */
+  CLI_DOUBLE, /* double *dest, range lo..hi with `bounds` */
+  CLI_INT,    /* int *dest, whole number in [lo, hi] */
+  CLI_LLONG,  /* long long *dest, whole number in [lo, hi] */
+  CLI_STRING, /* const char **dest = the argument (non-empty) */
+  CLI_CHOICE, /* int *dest = index into `choices` */
+  CLI_CUSTOM  /* parse(prog, name, value, dest) */
+} cli_kind;
+
+/** One option of a table; the table ends with an entry whose `name` is NULL. */
+typedef struct cli_option {
+  const char *name;           /* "--alpha" */
+  const char *alias;          /* "-a", or NULL */
+  cli_kind kind;              /* how the value is read */
+  void *dest;                 /* where it goes (see cli_kind) */
+  const char *metavar;        /* the value's name in --help ("A"); NULL for flags */
+  const char *help;           /* help text; '\n' starts a continuation line */
+  double lo, hi;              /* CLI_DOUBLE, CLI_INT, CLI_LLONG: the valid range */
+  unsigned bounds;            /* CLI_DOUBLE: CLI_LO_OPEN | CLI_HI_OPEN */
+  const char *const *choices; /* CLI_CHOICE */
+  int (*parse)(const char *prog, const char *opt, const char *value, void *dest); /* CUSTOM */
+  int *seen; /* set to 1 when the option is given; may be NULL */
+} cli_option;
+
+/** What cli_parse() found. */
+typedef enum cli_result { CLI_ERROR = 0, CLI_OK = 1, CLI_HELP = 2 } cli_result;
+
+/** Parse argv[1..argc-1] against `opts`. "-h" and "--help" return CLI_HELP (nothing else is
+ *  parsed after them); "--name=value" and "--name value" are both accepted. Arguments not
+ *  starting with '-' are positional: stored in `pos` (at most `max_pos`, count in *npos; `pos`
+ *  may be NULL with max_pos 0). An unknown option, a missing or bad value, or too many
+ *  positional arguments print a message and return CLI_ERROR. */
+cli_result cli_parse(const char *prog, const cli_option *opts, int argc, char **argv,
+                     const char **pos, int max_pos, int *npos);
+
+/** The options of `opts` as help lines: "  -a, --name METAVAR   help", the help column
+ *  aligned, continuation lines indented to it; then "  -h, --help   this text". */
+void cli_print_options(FILE *f, const cli_option *opts);
+
+/** An output file replaced atomically: written to a temporary beside it, renamed over it by
+ *  cli_output_commit(), removed by cli_output_abort() or a failed commit. */
+typedef struct cli_output cli_output;
+
+/** Open the temporary for `path`; returns its stream or NULL (message on stderr). */
+FILE *cli_output_open(const char *prog, const char *path, cli_output **out);
+
+/** Check the stream for write errors, flush, close and rename; releases *out (set to NULL).
+ *  1 on success; 0 with a message naming the path, the target untouched. */
+int cli_output_commit(const char *prog, cli_output **out);
+
+/** Remove the temporary and release *out; accepts NULL and *out == NULL. */
+void cli_output_abort(cli_output **out);
+
+#endif
