@@ -18,3 +18,6 @@ endforeach()
 fcm_add_test(fem_locate_crowded tests/fem/locate_crowded.c)
 # Allocation failures in every allocating fem entry point: FCM_ERR_ALLOC, NULL outputs, no leak.
 fcm_add_test(fem_alloc_failure tests/fem/alloc_failure.c)
+foreach(el tet4 tet10 hex8 hex20)
+  fcm_add_test(fem_workspace_${el} tests/fem/workspace.c ARGS ${el})
+endforeach()

@@ -1,7 +1,10 @@
 /* fcm — finite element spaces on a background mesh and assembly of linear
  * elasticity: DOF map (3 unknowns per active node), the sparse pattern built
  * once with per-cell scatter offsets, parallel deterministic assembly of
- * stiffness, consistent mass and body force, symmetric Dirichlet elimination. */
+ * stiffness, consistent mass and body force, symmetric Dirichlet elimination.
+ * A space is immutable after creation: assembly only reads it and keeps its rules
+ * and scratch in an fcm_assembly_workspace, so any number of workspaces (and
+ * integrators) may share one space. */
 #ifndef FCM_FEM_H
 #define FCM_FEM_H
 
@@ -112,26 +115,34 @@ FCM_API fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type
 /** Defaults: both strengths 0 (element defaults), fictitious FCM_FICTITIOUS_PROJECTED. */
 FCM_API fcm_assembly_options fcm_assembly_options_default(void);
 
-/** Add the linear elastic stiffness K to A (A must come from
- * fcm_space_matrix_create() of this space). `mat` is validated (fcm_material_validate());
- * its model is not used: the stiffness, mass and body force here are those of linear
- * elasticity with the material's E, nu and density. Cells are processed colour by colour,
- * in parallel within a colour, so the result is bitwise independent of the
- * number of threads. @return FCM_OK, FCM_ERR_ARG (bad material, wrong matrix),
- * FCM_ERR_GEOMETRY (det J <= 0 at a quadrature point: the message names the cell),
- * FCM_ERR_ALLOC. Allocates per-thread element buffers. */
-FCM_API fcm_status fcm_assemble_stiffness(fcm_space *space, const fcm_material *mat,
-                                          const fcm_assembly_options *opts, fcm_csr *A);
+/** Everything assembly writes besides its outputs: the standard rules of full cells
+ * with their tabulated shape functions (built on first use, then kept), per-thread
+ * element buffers and per-cell energies. After the first assembly of each integrand,
+ * assembling through a workspace allocates nothing. One workspace serves one
+ * assembly at a time (not thread safe); several workspaces may share a space. */
+typedef struct fcm_assembly_workspace fcm_assembly_workspace;
 
-/** Add the consistent mass matrix (rho N_a N_b I) to A. Status codes as above. */
-FCM_API fcm_status fcm_assemble_mass(fcm_space *space, const fcm_material *mat,
-                                     const fcm_assembly_options *opts, fcm_csr *A);
+/** Create a workspace for assembly on `space` with the rule strengths `opts`.
+ * @param[in]  space borrowed: must outlive the workspace
+ * @param[in]  opts  copied; NULL for fcm_assembly_options_default()
+ * @param[out] ws    the new workspace, NULL on failure
+ * @return FCM_OK, FCM_ERR_ARG (NULL), FCM_ERR_ALLOC. Allocates per-thread buffers for
+ * omp_get_max_threads() threads (assembly uses at most that many) and num_cells doubles. */
+FCM_API fcm_status fcm_assembly_workspace_create(const fcm_space *space,
+                                                 const fcm_assembly_options *opts,
+                                                 fcm_assembly_workspace **ws);
 
-/** Add the body force of a uniform acceleration `accel` (e.g. gravity),
- * f_a += integral of rho accel N_a, to f (num_dofs entries). Status codes as above. */
-FCM_API fcm_status fcm_assemble_body_force(fcm_space *space, const fcm_material *mat,
-                                           const double accel[3],
-                                           const fcm_assembly_options *opts, double *f);
+/** Destroy a workspace; accepts NULL and `*ws == NULL`, sets `*ws = NULL`. */
+FCM_API void fcm_assembly_workspace_destroy(fcm_assembly_workspace **ws);
+
+/** The linear terms of fcm_assembly_workspace_linear(). */
+typedef enum fcm_linear_term {
+  FCM_LINEAR_STIFFNESS = 0,        /**< K into A (material) */
+  FCM_LINEAR_MASS = 1,             /**< consistent mass rho N_a N_b I into A (material) */
+  FCM_LINEAR_BODY_FORCE = 2,       /**< int rho accel N_a into f (material, accel) */
+  FCM_LINEAR_BODY_FORCE_FIELD = 3, /**< int b(x) N_a into f (field = b, user) */
+  FCM_LINEAR_SURFACE_TRACTION = 4  /**< int_{boundary} t(x, n) N_a into f (field = t, user) */
+} fcm_linear_term;
 
 /** A vector field evaluated at a physical point x; `normal` is the unit outward
  * normal for surface fields and NULL for volume fields. Writes value[3]. Called
@@ -139,16 +150,68 @@ FCM_API fcm_status fcm_assemble_body_force(fcm_space *space, const fcm_material 
 typedef void (*fcm_field_fn)(void *user, const double x[3], const double normal[3],
                              double value[3]);
 
+/** One linear term and its data (plain value type; the pointers are borrowed for
+ * the call). Members a term does not use are ignored. */
+typedef struct fcm_linear_form {
+  fcm_linear_term term;
+  const fcm_material *material; /**< STIFFNESS, MASS, BODY_FORCE: validated; only E, nu
+                                     and the density are used (linear elasticity) */
+  const double *accel;          /**< BODY_FORCE: uniform acceleration, 3 entries */
+  fcm_field_fn field;           /**< BODY_FORCE_FIELD, SURFACE_TRACTION */
+  void *user;                   /**< passed to `field` */
+} fcm_linear_form;
+
+/** Defaults: FCM_LINEAR_STIFFNESS, every pointer NULL. */
+FCM_API fcm_linear_form fcm_linear_form_default(void);
+
+/** The one linear assembly: add the term of `form` to A (matrix terms; A from
+ * fcm_space_matrix_create() of the workspace's space) or to f (vector terms,
+ * num_dofs entries). Cells are processed colour by colour, in parallel within a
+ * colour: the result is bitwise independent of the number of threads.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, bad material, wrong matrix, non-finite accel,
+ * traction without surface rules), FCM_ERR_GEOMETRY (det J <= 0 at a quadrature point:
+ * the message names the cell), FCM_ERR_ALLOC (first use of a rule). */
+FCM_API fcm_status fcm_assembly_workspace_linear(fcm_assembly_workspace *ws,
+                                                 const fcm_linear_form *form, fcm_csr *A,
+                                                 double *f);
+
+/** fcm_assemble_hyperelastic() through a workspace (its strengths apply). */
+FCM_API fcm_status fcm_assembly_workspace_hyperelastic(fcm_assembly_workspace *ws,
+                                                       const fcm_material_params *mat,
+                                                       const double *u, double *energy,
+                                                       double *force, fcm_csr *tangent);
+
+/** Add the linear elastic stiffness K to A (A must come from
+ * fcm_space_matrix_create() of this space): fcm_assembly_workspace_linear() with
+ * FCM_LINEAR_STIFFNESS through a workspace made for this call. `mat` is validated
+ * (fcm_material_validate()); its model is not used: the stiffness, mass and body force
+ * here are those of linear elasticity with the material's E, nu and density. Bitwise
+ * independent of the number of threads. @return FCM_OK, FCM_ERR_ARG (bad material, wrong matrix),
+ * FCM_ERR_GEOMETRY (det J <= 0 at a quadrature point: the message names the cell),
+ * FCM_ERR_ALLOC. Allocates a workspace; for repeated assembly keep one. */
+FCM_API fcm_status fcm_assemble_stiffness(const fcm_space *space, const fcm_material *mat,
+                                          const fcm_assembly_options *opts, fcm_csr *A);
+
+/** Add the consistent mass matrix (rho N_a N_b I) to A. Status codes as above. */
+FCM_API fcm_status fcm_assemble_mass(const fcm_space *space, const fcm_material *mat,
+                                     const fcm_assembly_options *opts, fcm_csr *A);
+
+/** Add the body force of a uniform acceleration `accel` (e.g. gravity),
+ * f_a += integral of rho accel N_a, to f (num_dofs entries). Status codes as above. */
+FCM_API fcm_status fcm_assemble_body_force(const fcm_space *space, const fcm_material *mat,
+                                           const double accel[3],
+                                           const fcm_assembly_options *opts, double *f);
+
 /** Add the load of a body force density b(x) (force per volume), f_a += int b N_a.
  * @return as fcm_assemble_body_force(). */
-FCM_API fcm_status fcm_assemble_body_force_field(fcm_space *space, fcm_field_fn field, void *user,
+FCM_API fcm_status fcm_assemble_body_force_field(const fcm_space *space, fcm_field_fn field, void *user,
                                                  const fcm_assembly_options *opts, double *f);
 
 /** Add the load of a surface traction t(x, n) on the embedded boundary,
  * f_a += int_{boundary} t N_a, with the surface rules of the space's cell rules.
  * @return FCM_OK, FCM_ERR_ARG (NULL, no surface rules: build the rules with
  * surface_strength >= 0), FCM_ERR_ALLOC. */
-FCM_API fcm_status fcm_assemble_surface_traction(fcm_space *space, fcm_field_fn traction,
+FCM_API fcm_status fcm_assemble_surface_traction(const fcm_space *space, fcm_field_fn traction,
                                                  void *user, double *f);
 
 /** Hyperelastic energy, internal force and tangent at the displacement u:
@@ -162,7 +225,7 @@ FCM_API fcm_status fcm_assemble_surface_traction(fcm_space *space, fcm_field_fn 
  * @return FCM_OK, FCM_ERR_ARG, FCM_ERR_NUMERIC (the material gave NaN/Inf: the
  * message names the cell), FCM_ERR_GEOMETRY, FCM_ERR_ALLOC. Deterministic for any
  * number of threads (energy summed per cell in cell order). */
-FCM_API fcm_status fcm_assemble_hyperelastic(fcm_space *space, const fcm_material_params *mat,
+FCM_API fcm_status fcm_assemble_hyperelastic(const fcm_space *space, const fcm_material_params *mat,
                                              const double *u, const fcm_assembly_options *opts,
                                              double *energy, double *force, fcm_csr *tangent);
 

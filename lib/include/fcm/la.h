@@ -76,8 +76,11 @@ FCM_API fcm_csr_kind fcm_csr_get_kind(const fcm_csr *A);
 FCM_API const fcm_index *fcm_csr_get_row_ptr(const fcm_csr *A);
 /** Column indices (nnz entries). */
 FCM_API const int *fcm_csr_get_col_idx(const fcm_csr *A);
-/** Values (nnz entries), writable: assembly adds into them. */
+/** Values (nnz entries), writable: assembly adds into them. NULL for a NULL matrix. */
 FCM_API double *fcm_csr_get_values(fcm_csr *A);
+/** Values (nnz entries), read only: what code that holds a `const fcm_csr *` reads
+ * (libCEED's GetArrayRead next to GetArray). NULL for a NULL matrix. Thread safe. */
+FCM_API const double *fcm_csr_get_values_read(const fcm_csr *A);
 
 /** Position of entry (row, col) in the value array (binary search within the
  * row), or -1 when it is not in the pattern or out of range. Thread safe. */

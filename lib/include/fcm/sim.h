@@ -204,13 +204,14 @@ typedef struct fcm_integrator fcm_integrator;
 
 /** Create an integrator with zero displacement and velocity at t = 0.
  * @param[in]  ctx   context; must outlive the integrator
- * @param[in]  space borrowed (plain or embedded); must outlive the integrator. Assembly
- *                   writes per-cell scratch into it: one integrator per space at a time
+ * @param[in]  space borrowed (plain or embedded); must outlive the integrator. Only read:
+ *                   the integrator keeps its own assembly workspace, so several
+ *                   integrators may share a space
  * @param[in]  mat   the material (copied; validated here)
  * @param[in]  opts  copied; NULL for defaults (validated by fcm_integrator_setup())
  * @param[out] integ the new integrator, NULL on failure
  * @return FCM_OK, FCM_ERR_ARG (NULL, invalid material), FCM_ERR_ALLOC. Allocates O(n). */
-FCM_API fcm_status fcm_integrator_create(fcm_ctx *ctx, fcm_space *space, const fcm_material *mat,
+FCM_API fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space, const fcm_material *mat,
                                          const fcm_integrator_options *opts,
                                          fcm_integrator **integ);
 

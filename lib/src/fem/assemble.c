@@ -1,7 +1,8 @@
 /* Assembly on a space: element kernels for linear stiffness, consistent mass,
  * body force, hyperelastic energy/force/tangent and surface traction, on the
  * standard rule of full cells or the per-cell rules of cut cells, scattered
- * colour by colour in parallel (deterministic for any thread count). */
+ * colour by colour in parallel (deterministic for any thread count). The space is
+ * only read; rules, tabulations and scratch live in an fcm_assembly_workspace. */
 #include "fem/fem_impl.h"
 #include "la/mat3.h"
 #include "material/material_impl.h"
@@ -53,7 +54,7 @@ typedef struct tabulation {
   double *N, *dN;
 } tabulation;
 
-static fcm_status tabulate(fcm_space *s, fcm_rule_kind kind, int strength, tabulation *t)
+static fcm_status tabulate(const fcm_space *s, fcm_rule_kind kind, int strength, tabulation *t)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
@@ -359,53 +360,173 @@ cleanup:
   return st;
 }
 
-/* Run the kernel over all active cells colour by colour (parallel within a colour)
- * and scatter into the matrix values `vals` and/or the vector `vec`; the energy
- * (hyperelastic kernel) is summed per cell in cell order. */
-static fcm_status assemble(fcm_space *s, const kernel_data *kd, int strength, double *vals,
-                           double *vec, double *energy)
+/* ------------------------------------------------------------------ workspace */
+
+/* Everything an assembly writes besides its outputs. The standard rule of each
+ * integrand is tabulated on first use and kept; scratch and per-cell energies are
+ * allocated at creation, so repeated assembly allocates nothing. */
+struct fcm_assembly_workspace {
+  fcm_ctx *ctx;
+  const fcm_space *space;
+  fcm_assembly_options opts;
+  tabulation tab[2];   /* standard rules: [0] stiffness, [1] mass */
+  int tabulated[2];    /* tab[i] is built */
+  int nthreads;        /* threads the scratch serves (omp_get_max_threads() at creation) */
+  double *mem;         /* per-thread element buffers */
+  scratch *sc;         /* nthreads views into mem */
+  double *cell_energy; /* num_cells: energy per cell of the last hyperelastic assembly */
+};
+
+fcm_status fcm_assembly_workspace_create(const fcm_space *space, const fcm_assembly_options *opts,
+                                         fcm_assembly_workspace **out)
 {
   fcm_status st = FCM_OK;
-  fcm_ctx *ctx = s->ctx;
-  tabulation t;
-  double *mem = NULL;
-  scratch *sc = NULL;
-  int nn = s->nn, nthreads = omp_get_max_threads();
+  fcm_ctx *ctx = space ? space->ctx : NULL;
+  fcm_assembly_workspace *ws = NULL;
+  FCM_CHECK(out, ctx, FCM_ERR_ARG, "assembly workspace: output pointer is NULL");
+  *out = NULL;
+  FCM_CHECK(space, ctx, FCM_ERR_ARG, "assembly workspace: space is NULL");
+  if (opts)
+    FCM_CHECK(opts->fictitious >= FCM_FICTITIOUS_PROJECTED &&
+                  opts->fictitious < FCM_FICTITIOUS_MODEL_COUNT,
+              ctx, FCM_ERR_ARG,
+              "assembly: option fictitious = %d out of range [0, %d) (0 projected, 1 linear, "
+              "2 exact)",
+              (int)opts->fictitious, (int)FCM_FICTITIOUS_MODEL_COUNT);
+  FCM_ALLOC(ctx, 1, ws);
+  ws->ctx = ctx;
+  ws->space = space;
+  ws->opts = opts ? *opts : fcm_assembly_options_default();
+  ws->nthreads = omp_get_max_threads();
+  FCM_TRY(ctx, scratch_alloc(space, ws->nthreads, &ws->mem, &ws->sc));
+  FCM_ALLOC(ctx, space->num_cells, ws->cell_energy);
+  *out = ws;
+  ws = NULL;
+cleanup:
+  fcm_assembly_workspace_destroy(&ws);
+  return st;
+}
+
+void fcm_assembly_workspace_destroy(fcm_assembly_workspace **wsp)
+{
+  if (!wsp || !*wsp) return;
+  fcm_assembly_workspace *ws = *wsp;
+  for (int i = 0; i < 2; i++) tabulation_free(ws->ctx, &ws->tab[i]);
+  fcm__free(ws->ctx, ws->mem);
+  fcm__free(ws->ctx, ws->sc);
+  fcm__free(ws->ctx, ws->cell_energy);
+  fcm__free(ws->ctx, ws);
+  *wsp = NULL;
+}
+
+/* The tabulated standard rule of `kind` (stiffness or mass), built on first use. */
+static fcm_status workspace_tabulation(fcm_assembly_workspace *ws, fcm_rule_kind kind,
+                                       const tabulation **t)
+{
+  fcm_status st = FCM_OK;
+  int i = kind == FCM_RULE_MASS ? 1 : 0;
+  if (!ws->tabulated[i]) {
+    int strength = i ? ws->opts.mass_strength : ws->opts.stiffness_strength;
+    tabulation fresh;
+    memset(&fresh, 0, sizeof fresh);
+    st = tabulate(ws->space, kind, strength, &fresh);
+    if (st != FCM_OK) {
+      tabulation_free(ws->ctx, &fresh);
+      FCM_TRY(ws->ctx, st);
+    }
+    ws->tab[i] = fresh;
+    ws->tabulated[i] = 1;
+  }
+  *t = &ws->tab[i];
+cleanup:
+  return st;
+}
+
+/* ------------------------------------------------------------------ the parallel pass */
+
+/* What one pass over the cells computes, with the outputs it scatters into. */
+typedef struct pass {
+  const kernel_data *kd;  /* volume kernels */
+  const tabulation *tab;  /* standard rule of the kernel's integrand (volume kernels) */
+  fcm_rule_kind kind;     /* cut-cell rule the kernel integrates with */
+  fcm_field_fn traction;  /* non-NULL: surface traction on the cut cells' surface rules */
+  void *traction_user;
+  double *vals, *vec;     /* matrix values (space pattern) and vector, either may be NULL */
+  double *cell_energy;    /* num_cells, or NULL */
+} pass;
+
+/* Surface traction of one cell into w->fe; returns 0 when the cell has no surface points. */
+static int surface_cell(const fcm_space *s, const pass *ps, fcm_index c, scratch *w)
+{
+  int np = 0, nn = s->nn;
+  const double *pts = NULL, *wts = NULL, *nrm = NULL;
+  fcm_cell_rules_get_surface(s->rules, c, &np, &pts, &wts, &nrm, NULL);
+  if (np == 0) return 0;
+  fcm_mesh_cell_coords(s->mesh, c, w->X);
+  memset(w->fe, 0, sizeof(double) * 3 * (size_t)nn);
+  for (int q = 0; q < np; q++) {
+    double x[3] = {0, 0, 0}, tq[3] = {0, 0, 0};
+    fcm_element_eval_shape(s->type, pts + 3 * q, w->Nb);
+    for (int a = 0; a < nn; a++)
+      for (int i = 0; i < 3; i++) x[i] += w->Nb[a] * w->X[3 * a + i];
+    ps->traction(ps->traction_user, x, nrm + 3 * q, tq);
+    for (int a = 0; a < nn; a++)
+      for (int i = 0; i < 3; i++) w->fe[3 * a + i] += wts[q] * w->Nb[a] * tq[i];
+  }
+  return 1;
+}
+
+/* Volume kernel of one cell into w->Ke / w->fe. */
+static cell_result volume_cell(const fcm_space *s, const pass *ps, fcm_index c, scratch *w)
+{
+  const kernel_data *kd = ps->kd;
+  int nn = s->nn;
+  fcm_mesh_cell_coords(s->mesh, c, w->X);
+  if (kd->u) {
+    const fcm_index *cn = fcm_mesh_cells(s->mesh) + c * nn;
+    for (int a = 0; a < nn; a++)
+      memcpy(w->ue + 3 * a, kd->u + s->node_dof[cn[a]], 3 * sizeof(double));
+  }
+  cell_rule r = get_cell_rule(s, ps->tab, ps->kind, c, w->Nb, w->dNb);
+  return cell_kernel(kd, &r, nn, w);
+}
+
+/* Run the pass over all active cells colour by colour (parallel within a colour)
+ * and scatter each cell's result; a cell with det J <= 0 or a non-finite material
+ * response is not scattered, and the lowest such cell of the colour is reported. */
+static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
+{
+  fcm_status st = FCM_OK;
+  const fcm_space *s = ws->space;
+  fcm_ctx *ctx = ws->ctx;
   fcm_index bad_cell = -1;
   double bad_det = 1.0;
   int bad_numeric = 0;
-  fcm_rule_kind kind = kd->kind == KERNEL_MASS ? FCM_RULE_MASS : FCM_RULE_STIFFNESS;
-  memset(&t, 0, sizeof t);
-  FCM_TRY(ctx, tabulate(s, kind, strength, &t));
-  FCM_TRY(ctx, scratch_alloc(s, nthreads, &mem, &sc));
   for (int color = 0; color < s->num_colors; color++) {
     fcm_index c0 = s->color_ptr[color], c1 = s->color_ptr[color + 1];
-#pragma omp parallel num_threads(nthreads)
+#pragma omp parallel num_threads(ws->nthreads)
     {
-      scratch *w = sc + omp_get_thread_num();
+      scratch *w = ws->sc + omp_get_thread_num();
 #pragma omp for schedule(dynamic, 16)
       for (fcm_index k = c0; k < c1; k++) {
         fcm_index c = s->color_cells[k];
-        fcm_mesh_cell_coords(s->mesh, c, w->X);
-        if (kd->u) {
-          const fcm_index *cn = fcm_mesh_cells(s->mesh) + c * nn;
-          for (int a = 0; a < nn; a++)
-            memcpy(w->ue + 3 * a, kd->u + s->node_dof[cn[a]], 3 * sizeof(double));
-        }
-        cell_rule r = get_cell_rule(s, &t, kind, c, w->Nb, w->dNb);
-        cell_result res = cell_kernel(kd, &r, nn, w);
-        if (!(res.bad_det > 0.0) || res.nonfinite) {
+        if (ps->traction) {
+          if (!surface_cell(s, ps, c, w)) continue;
+        } else {
+          cell_result res = volume_cell(s, ps, c, w);
+          if (!(res.bad_det > 0.0) || res.nonfinite) {
 #pragma omp critical(fcm_assemble_bad)
-          if (bad_cell < 0 || c < bad_cell) {
-            bad_cell = c;
-            bad_det = res.bad_det;
-            bad_numeric = res.nonfinite;
+            if (bad_cell < 0 || c < bad_cell) {
+              bad_cell = c;
+              bad_det = res.bad_det;
+              bad_numeric = res.nonfinite;
+            }
+            continue;
           }
-          continue;
+          if (ps->cell_energy) ps->cell_energy[c] = res.energy;
         }
-        s->cell_energy[c] = res.energy;
-        if (vals) scatter_matrix(s, c, w->Ke, vals);
-        if (vec) scatter_vector(s, c, w->fe, vec);
+        if (ps->vals) scatter_matrix(s, c, w->Ke, ps->vals);
+        if (ps->vec) scatter_vector(s, c, w->fe, ps->vec);
       }
     }
     FCM_CHECK(bad_cell < 0 || !bad_numeric, ctx, FCM_ERR_NUMERIC,
@@ -417,16 +538,25 @@ static fcm_status assemble(fcm_space *s, const kernel_data *kd, int strength, do
               "degenerate %s)",
               (long long)bad_cell, bad_det, fcm_element_get_info(s->type)->name);
   }
-  if (energy) {
-    double e = 0.0;
-    for (fcm_index c = 0; c < s->num_cells; c++)
-      if (s->active[c]) e += s->cell_energy[c];
-    *energy = e;
-  }
 cleanup:
-  tabulation_free(ctx, &t);
-  fcm__free(ctx, mem);
-  fcm__free(ctx, sc);
+  return st;
+}
+
+/* A volume pass of kernel `kd` on the standard rule of its integrand. */
+static fcm_status run_volume_pass(fcm_assembly_workspace *ws, const kernel_data *kd, double *vals,
+                                  double *vec, double *cell_energy)
+{
+  fcm_status st = FCM_OK;
+  pass ps;
+  memset(&ps, 0, sizeof ps);
+  ps.kind = kd->kind == KERNEL_MASS ? FCM_RULE_MASS : FCM_RULE_STIFFNESS;
+  FCM_TRY(ws->ctx, workspace_tabulation(ws, ps.kind, &ps.tab));
+  ps.kd = kd;
+  ps.vals = vals;
+  ps.vec = vec;
+  ps.cell_energy = cell_energy;
+  FCM_TRY(ws->ctx, run_pass(ws, &ps));
+cleanup:
   return st;
 }
 
@@ -447,144 +577,170 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_assemble_stiffness(fcm_space *s, const fcm_material *mat,
-                                  const fcm_assembly_options *opts, fcm_csr *A)
+/* ------------------------------------------------------------------ entry points */
+
+fcm_linear_form fcm_linear_form_default(void)
+{
+  fcm_linear_form f;
+  memset(&f, 0, sizeof f);
+  f.term = FCM_LINEAR_STIFFNESS;
+  return f;
+}
+
+fcm_status fcm_assembly_workspace_linear(fcm_assembly_workspace *ws, const fcm_linear_form *form,
+                                         fcm_csr *A, double *f)
 {
   fcm_status st = FCM_OK;
+  fcm_ctx *ctx = ws ? ws->ctx : NULL;
   kernel_data kd;
-  fcm_assembly_options o = opts ? *opts : fcm_assembly_options_default();
   memset(&kd, 0, sizeof kd);
-  kd.kind = KERNEL_STIFFNESS;
-  FCM_TRY(s->ctx, fcm_material_lame(s->ctx, mat, &kd.lambda, &kd.mu));
-  FCM_TRY(s->ctx, check_matrix(s, A));
-  FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, fcm_csr_get_values(A), NULL, NULL));
+  FCM_CHECK(ws && form, ctx, FCM_ERR_ARG, "linear assembly: NULL workspace or form");
+  const fcm_space *s = ws->space;
+  switch (form->term) {
+  case FCM_LINEAR_STIFFNESS:
+    kd.kind = KERNEL_STIFFNESS;
+    FCM_TRY(ctx, fcm_material_lame(ctx, form->material, &kd.lambda, &kd.mu));
+    FCM_TRY(ctx, check_matrix(s, A));
+    FCM_TRY(ctx, run_volume_pass(ws, &kd, fcm_csr_get_values(A), NULL, NULL));
+    break;
+  case FCM_LINEAR_MASS:
+    kd.kind = KERNEL_MASS;
+    FCM_TRY(ctx, fcm_material_lame(ctx, form->material, NULL, NULL));
+    FCM_TRY(ctx, check_matrix(s, A));
+    kd.rho = form->material->density;
+    FCM_TRY(ctx, run_volume_pass(ws, &kd, fcm_csr_get_values(A), NULL, NULL));
+    break;
+  case FCM_LINEAR_BODY_FORCE: {
+    const double *a = form->accel;
+    kd.kind = KERNEL_BODY_FORCE;
+    FCM_TRY(ctx, fcm_material_lame(ctx, form->material, NULL, NULL));
+    FCM_CHECK(f && a, ctx, FCM_ERR_ARG, "body force: NULL vector or acceleration");
+    FCM_CHECK(isfinite(a[0]) && isfinite(a[1]) && isfinite(a[2]), ctx, FCM_ERR_ARG,
+              "body force: acceleration (%g, %g, %g) is not finite", a[0], a[1], a[2]);
+    kd.rho = form->material->density;
+    memcpy(kd.accel, a, sizeof kd.accel);
+    FCM_TRY(ctx, run_volume_pass(ws, &kd, NULL, f, NULL));
+  } break;
+  case FCM_LINEAR_BODY_FORCE_FIELD:
+    kd.kind = KERNEL_BODY_FORCE;
+    FCM_CHECK(f && form->field, ctx, FCM_ERR_ARG, "body force field: NULL vector or field");
+    kd.field = form->field;
+    kd.field_user = form->user;
+    FCM_TRY(ctx, run_volume_pass(ws, &kd, NULL, f, NULL));
+    break;
+  case FCM_LINEAR_SURFACE_TRACTION: {
+    pass ps;
+    memset(&ps, 0, sizeof ps);
+    FCM_CHECK(f && form->field, ctx, FCM_ERR_ARG, "surface traction: NULL vector or traction");
+    FCM_CHECK(s->rules && fcm_cell_rules_surface_strength(s->rules) >= 0, ctx, FCM_ERR_ARG,
+              "surface traction: the space has no surface rules (build the cell rules with "
+              "surface_strength >= 0)");
+    ps.traction = form->field;
+    ps.traction_user = form->user;
+    ps.vec = f;
+    FCM_TRY(ctx, run_pass(ws, &ps));
+  } break;
+  default:
+    FCM_CHECK(0, ctx, FCM_ERR_ARG,
+              "linear assembly: term = %d outside [FCM_LINEAR_STIFFNESS, "
+              "FCM_LINEAR_SURFACE_TRACTION] = [%d, %d]",
+              (int)form->term, (int)FCM_LINEAR_STIFFNESS, (int)FCM_LINEAR_SURFACE_TRACTION);
+  }
 cleanup:
   return st;
 }
 
-fcm_status fcm_assemble_mass(fcm_space *s, const fcm_material *mat,
-                             const fcm_assembly_options *opts, fcm_csr *A)
+fcm_status fcm_assembly_workspace_hyperelastic(fcm_assembly_workspace *ws,
+                                               const fcm_material_params *mat, const double *u,
+                                               double *energy, double *force, fcm_csr *tangent)
 {
   fcm_status st = FCM_OK;
+  fcm_ctx *ctx = ws ? ws->ctx : NULL;
   kernel_data kd;
-  fcm_assembly_options o = opts ? *opts : fcm_assembly_options_default();
   memset(&kd, 0, sizeof kd);
-  kd.kind = KERNEL_MASS;
-  FCM_TRY(s->ctx, fcm_material_lame(s->ctx, mat, NULL, NULL));
-  FCM_TRY(s->ctx, check_matrix(s, A));
-  kd.rho = mat->density;
-  FCM_TRY(s->ctx, assemble(s, &kd, o.mass_strength, fcm_csr_get_values(A), NULL, NULL));
-cleanup:
-  return st;
-}
-
-fcm_status fcm_assemble_body_force(fcm_space *s, const fcm_material *mat, const double accel[3],
-                                   const fcm_assembly_options *opts, double *f)
-{
-  fcm_status st = FCM_OK;
-  kernel_data kd;
-  fcm_assembly_options o = opts ? *opts : fcm_assembly_options_default();
-  memset(&kd, 0, sizeof kd);
-  kd.kind = KERNEL_BODY_FORCE;
-  FCM_TRY(s->ctx, fcm_material_lame(s->ctx, mat, NULL, NULL));
-  FCM_CHECK(f && accel, s->ctx, FCM_ERR_ARG, "body force: NULL vector or acceleration");
-  FCM_CHECK(isfinite(accel[0]) && isfinite(accel[1]) && isfinite(accel[2]), s->ctx, FCM_ERR_ARG,
-            "body force: acceleration (%g, %g, %g) is not finite", accel[0], accel[1], accel[2]);
-  kd.rho = mat->density;
-  memcpy(kd.accel, accel, sizeof kd.accel);
-  FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, NULL, f, NULL));
-cleanup:
-  return st;
-}
-
-fcm_status fcm_assemble_body_force_field(fcm_space *s, fcm_field_fn field, void *user,
-                                         const fcm_assembly_options *opts, double *f)
-{
-  fcm_status st = FCM_OK;
-  kernel_data kd;
-  fcm_assembly_options o = opts ? *opts : fcm_assembly_options_default();
-  memset(&kd, 0, sizeof kd);
-  kd.kind = KERNEL_BODY_FORCE;
-  FCM_CHECK(f && field, s->ctx, FCM_ERR_ARG, "body force field: NULL vector or field");
-  kd.field = field;
-  kd.field_user = user;
-  FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, NULL, f, NULL));
-cleanup:
-  return st;
-}
-
-fcm_status fcm_assemble_hyperelastic(fcm_space *s, const fcm_material_params *mat, const double *u,
-                                     const fcm_assembly_options *opts, double *energy,
-                                     double *force, fcm_csr *tangent)
-{
-  fcm_status st = FCM_OK;
-  kernel_data kd;
-  fcm_assembly_options o = opts ? *opts : fcm_assembly_options_default();
-  memset(&kd, 0, sizeof kd);
-  FCM_CHECK(mat && u, s->ctx, FCM_ERR_ARG, "hyperelastic: NULL material or displacement");
-  if (tangent) FCM_TRY(s->ctx, check_matrix(s, tangent));
+  FCM_CHECK(ws, ctx, FCM_ERR_ARG, "hyperelastic: workspace is NULL");
+  const fcm_space *s = ws->space;
+  FCM_CHECK(mat && u, ctx, FCM_ERR_ARG, "hyperelastic: NULL material or displacement");
+  if (tangent) FCM_TRY(ctx, check_matrix(s, tangent));
   kd.kind = KERNEL_HYPERELASTIC;
   kd.mat = mat;
   kd.u = u;
   kd.want_force = force != NULL;
   kd.want_tangent = tangent != NULL;
-  FCM_CHECK(o.fictitious >= FCM_FICTITIOUS_PROJECTED && o.fictitious < FCM_FICTITIOUS_MODEL_COUNT,
-            s->ctx, FCM_ERR_ARG,
-            "hyperelastic: assembly option fictitious = %d out of range [0, %d) (0 projected, 1 "
-            "linear, 2 exact)",
-            (int)o.fictitious, (int)FCM_FICTITIOUS_MODEL_COUNT);
-  kd.fictitious = o.fictitious;
+  kd.fictitious = ws->opts.fictitious;
   kd.mat_psd = *mat;
   kd.mat_psd.project_psd = 1;
-  FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, tangent ? fcm_csr_get_values(tangent) : NULL,
-                           force, energy));
+  FCM_TRY(ctx, run_volume_pass(ws, &kd, tangent ? fcm_csr_get_values(tangent) : NULL, force,
+                               ws->cell_energy));
+  if (energy) { /* summed in cell order: independent of the thread count */
+    double e = 0.0;
+    for (fcm_index c = 0; c < s->num_cells; c++)
+      if (s->active[c]) e += ws->cell_energy[c];
+    *energy = e;
+  }
 cleanup:
   return st;
 }
 
-fcm_status fcm_assemble_surface_traction(fcm_space *s, fcm_field_fn traction, void *user,
-                                         double *f)
+/* ------------------------------------------------------------------ one-shot forms */
+
+/* One linear term through a workspace that lives for this call only. */
+static fcm_status linear_once(const fcm_space *s, const fcm_assembly_options *opts,
+                              fcm_linear_term term, const fcm_material *material,
+                              const double *accel, fcm_field_fn field, void *user, fcm_csr *A,
+                              double *f)
 {
   fcm_status st = FCM_OK;
-  fcm_ctx *ctx = s->ctx;
-  double *mem = NULL;
-  scratch *sc = NULL;
-  int nn = s->nn, nthreads = omp_get_max_threads();
-  FCM_CHECK(f && traction, ctx, FCM_ERR_ARG, "surface traction: NULL vector or traction");
-  FCM_CHECK(s->rules && fcm_cell_rules_surface_strength(s->rules) >= 0, ctx, FCM_ERR_ARG,
-            "surface traction: the space has no surface rules (build the cell rules with "
-            "surface_strength >= 0)");
-  FCM_TRY(ctx, scratch_alloc(s, nthreads, &mem, &sc));
-  for (int color = 0; color < s->num_colors; color++) {
-    fcm_index c0 = s->color_ptr[color], c1 = s->color_ptr[color + 1];
-#pragma omp parallel num_threads(nthreads)
-    {
-      scratch *w = sc + omp_get_thread_num();
-#pragma omp for schedule(dynamic, 16)
-      for (fcm_index k = c0; k < c1; k++) {
-        fcm_index c = s->color_cells[k];
-        int np = 0;
-        const double *pts = NULL, *wts = NULL, *nrm = NULL;
-        fcm_cell_rules_get_surface(s->rules, c, &np, &pts, &wts, &nrm, NULL);
-        if (np == 0) continue;
-        fcm_mesh_cell_coords(s->mesh, c, w->X);
-        memset(w->fe, 0, sizeof(double) * 3 * (size_t)nn);
-        for (int q = 0; q < np; q++) {
-          double x[3] = {0, 0, 0}, tq[3] = {0, 0, 0};
-          fcm_element_eval_shape(s->type, pts + 3 * q, w->Nb);
-          for (int a = 0; a < nn; a++)
-            for (int i = 0; i < 3; i++) x[i] += w->Nb[a] * w->X[3 * a + i];
-          traction(user, x, nrm + 3 * q, tq);
-          for (int a = 0; a < nn; a++)
-            for (int i = 0; i < 3; i++) w->fe[3 * a + i] += wts[q] * w->Nb[a] * tq[i];
-        }
-        scatter_vector(s, c, w->fe, f);
-      }
-    }
-  }
+  fcm_assembly_workspace *ws = NULL;
+  fcm_linear_form form = {term, material, accel, field, user};
+  FCM_TRY(s->ctx, fcm_assembly_workspace_create(s, opts, &ws));
+  FCM_TRY(s->ctx, fcm_assembly_workspace_linear(ws, &form, A, f));
 cleanup:
-  fcm__free(ctx, mem);
-  fcm__free(ctx, sc);
+  fcm_assembly_workspace_destroy(&ws);
+  return st;
+}
+
+fcm_status fcm_assemble_stiffness(const fcm_space *s, const fcm_material *mat,
+                                  const fcm_assembly_options *opts, fcm_csr *A)
+{
+  return linear_once(s, opts, FCM_LINEAR_STIFFNESS, mat, NULL, NULL, NULL, A, NULL);
+}
+
+fcm_status fcm_assemble_mass(const fcm_space *s, const fcm_material *mat,
+                             const fcm_assembly_options *opts, fcm_csr *A)
+{
+  return linear_once(s, opts, FCM_LINEAR_MASS, mat, NULL, NULL, NULL, A, NULL);
+}
+
+fcm_status fcm_assemble_body_force(const fcm_space *s, const fcm_material *mat,
+                                   const double accel[3], const fcm_assembly_options *opts,
+                                   double *f)
+{
+  return linear_once(s, opts, FCM_LINEAR_BODY_FORCE, mat, accel, NULL, NULL, NULL, f);
+}
+
+fcm_status fcm_assemble_body_force_field(const fcm_space *s, fcm_field_fn field, void *user,
+                                         const fcm_assembly_options *opts, double *f)
+{
+  return linear_once(s, opts, FCM_LINEAR_BODY_FORCE_FIELD, NULL, NULL, field, user, NULL, f);
+}
+
+fcm_status fcm_assemble_surface_traction(const fcm_space *s, fcm_field_fn traction, void *user,
+                                         double *f)
+{
+  return linear_once(s, NULL, FCM_LINEAR_SURFACE_TRACTION, NULL, NULL, traction, user, NULL, f);
+}
+
+fcm_status fcm_assemble_hyperelastic(const fcm_space *s, const fcm_material_params *mat,
+                                     const double *u, const fcm_assembly_options *opts,
+                                     double *energy, double *force, fcm_csr *tangent)
+{
+  fcm_status st = FCM_OK;
+  fcm_assembly_workspace *ws = NULL;
+  FCM_TRY(s->ctx, fcm_assembly_workspace_create(s, opts, &ws));
+  FCM_TRY(s->ctx, fcm_assembly_workspace_hyperelastic(ws, mat, u, energy, force, tangent));
+cleanup:
+  fcm_assembly_workspace_destroy(&ws);
   return st;
 }
 

@@ -1,4 +1,5 @@
-/* fem module internals: the space layout shared by space.c and assemble.c. */
+/* fem module internals: the space layout shared by space.c, assemble.c and locate.c
+ * (immutable after fcm_space_create). */
 #ifndef FCM_FEM_IMPL_H
 #define FCM_FEM_IMPL_H
 
@@ -29,11 +30,11 @@ struct fcm_space {
   int num_colors;
   fcm_index *color_ptr;
   fcm_index *color_cells;
-  /* Embedded case: per-cell rules of cut cells (borrowed), the most points any cut
-   * cell has in either rule, and the per-cell energies of the last assembly. */
+  /* Embedded case: per-cell rules of cut cells (borrowed) and the most points any cut
+   * cell has in either rule. Nothing here changes after creation: assembly scratch lives
+   * in fcm_assembly_workspace (assemble.c). */
   const fcm_cell_rules *rules;
   int max_cut_points;
-  double *cell_energy; /* num_cells */
 };
 
 #endif /* FCM_FEM_IMPL_H */

@@ -189,7 +189,6 @@ static fcm_status space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigne
   s->num_cells = fcm_mesh_num_cells(mesh);
   s->num_nodes = fcm_mesh_num_nodes(mesh);
   FCM_ALLOC(ctx, s->num_cells, s->active);
-  FCM_ALLOC(ctx, s->num_cells, s->cell_energy);
   for (fcm_index c = 0; c < s->num_cells; c++) {
     s->active[c] = cell_active ? (cell_active[c] != 0) : 1;
     if (rules) {
@@ -264,7 +263,6 @@ void fcm_space_destroy(fcm_space **sp)
   fcm_space *s = *sp;
   fcm_ctx *ctx = s->ctx;
   fcm__free(ctx, s->active);
-  fcm__free(ctx, s->cell_energy);
   fcm__free(ctx, s->node_dof);
   fcm__free(ctx, s->node_ptr);
   fcm__free(ctx, s->node_adj);

@@ -2,7 +2,7 @@
  * taken over), boundary triangles, affine transformation, accessors, view. */
 #include "geom/geom_impl.h"
 #include "element/element_impl.h"
-#include "fcm/mesh.h"
+#include "mesh/mesh_impl.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -54,80 +54,43 @@ static double hex_convexity_defect(const double *X, int *face, int *corner)
   return worst;
 }
 
-typedef struct face_rec {
-  fcm_index key[4]; /* sorted corner ids, key[3] = -1 for triangles */
-  fcm_index cell;
-  int face;
-} face_rec;
-
-static int cmp_face(const void *pa, const void *pb)
-{
-  const face_rec *a = pa, *b = pb;
-  for (int k = 0; k < 4; k++)
-    if (a->key[k] != b->key[k]) return a->key[k] < b->key[k] ? -1 : 1;
-  if (a->cell != b->cell) return a->cell < b->cell ? -1 : 1;
-  return (a->face > b->face) - (a->face < b->face);
-}
-
-static int cmp_cell_face(const void *pa, const void *pb)
-{
-  const face_rec *a = pa, *b = pb;
-  if (a->cell != b->cell) return a->cell < b->cell ? -1 : 1;
-  return (a->face > b->face) - (a->face < b->face);
-}
-
-/* Faces met an odd number of times are boundary faces; emit their triangles. */
+/* Faces met an odd number of times are boundary faces (the first of each such group,
+ * in cell and face order, stands for it); emit their triangles. */
 static fcm_status build_boundary(fcm_geometry *g)
 {
   fcm_status st = FCM_OK;
   const fcm_element_info *info = fcm_element_get_info(g->type);
   const int nf = info->num_faces, tri_per_face = info->face_num_corners[0] - 2;
-  const size_t total = (size_t)g->num_cells * (size_t)nf;
-  face_rec *rec = NULL;
-  size_t nb = 0;
-  FCM_ALLOC(g->ctx, total, rec);
-  for (fcm_index c = 0; c < g->num_cells; c++) {
-    const fcm_index *cell = g->cells + (size_t)g->npc * (size_t)c;
-    for (int f = 0; f < nf; f++) {
-      face_rec *r = rec + (size_t)c * nf + f;
-      const int ncor = info->face_num_corners[f];
-      r->cell = c, r->face = f, r->key[3] = -1;
-      for (int k = 0; k < ncor; k++) {
-        const fcm_index v = cell[info->face_nodes[f][k]];
-        int j = k;
-        while (j > 0 && r->key[j - 1] > v) {
-          r->key[j] = r->key[j - 1];
-          j--;
-        }
-        r->key[j] = v;
-      }
-    }
+  const fcm_index total = g->num_cells * nf;
+  fcm_index *first = NULL, *next = NULL, nb = 0;
+  FCM_ALLOC(g->ctx, total, first);
+  FCM_ALLOC(g->ctx, total, next);
+  FCM_TRY(g->ctx, fcm__mesh_match_faces(g->ctx, info, g->cells, g->num_cells, first, next));
+  for (fcm_index i = 0; i < total; i++) { /* keep the odd groups' first faces, in order */
+    if (first[i] != i) continue;
+    int count = 0;
+    for (fcm_index j = i; j >= 0; j = next[j])
+      count++;
+    if (count % 2 == 1) first[nb++] = i;
   }
-  qsort(rec, total, sizeof *rec, cmp_face);
-  for (size_t i = 0; i < total;) {
-    size_t j = i + 1;
-    while (j < total && memcmp(rec[j].key, rec[i].key, sizeof rec[i].key) == 0)
-      j++;
-    if ((j - i) % 2 == 1) rec[nb++] = rec[i];
-    i = j;
-  }
-  qsort(rec, nb, sizeof *rec, cmp_cell_face);
-  g->num_tris = (fcm_index)(nb * (size_t)tri_per_face);
+  g->num_tris = nb * tri_per_face;
   FCM_ALLOC(g->ctx, 3 * (size_t)g->num_tris, g->tris);
   FCM_ALLOC(g->ctx, (size_t)g->num_tris, g->tri_cell);
-  for (size_t i = 0; i < nb; i++) {
-    const fcm_index *cell = g->cells + (size_t)g->npc * (size_t)rec[i].cell;
-    const int *fv = info->face_nodes[rec[i].face];
+  for (fcm_index i = 0; i < nb; i++) {
+    const fcm_index c = first[i] / nf;
+    const fcm_index *cell = g->cells + (size_t)g->npc * (size_t)c;
+    const int *fv = info->face_nodes[first[i] % nf];
     for (int t = 0; t < tri_per_face; t++) {
-      const size_t k = i * (size_t)tri_per_face + (size_t)t;
+      const size_t k = (size_t)i * (size_t)tri_per_face + (size_t)t;
       g->tris[3 * k] = cell[fv[0]];
       g->tris[3 * k + 1] = cell[fv[t + 1]];
       g->tris[3 * k + 2] = cell[fv[t + 2]];
-      g->tri_cell[k] = rec[i].cell;
+      g->tri_cell[k] = c;
     }
   }
 cleanup:
-  fcm__free(g->ctx, rec);
+  fcm__free(g->ctx, first);
+  fcm__free(g->ctx, next);
   return st;
 }
 

@@ -233,16 +233,27 @@ static double tet_vol6(const double *a, const double *b, const double *c, const 
          u[2] * (v[0] * w[1] - v[1] * w[0]);
 }
 
-fcm_status fcm_geometry_create_hollow_ball(fcm_ctx *ctx, const double center[3], double r_in,
-                                           double r_out, double hole_radius, int n, int layers,
-                                           fcm_geometry **geom)
+/* Most shells of a hollow ball (one drop flag per layer lives on the stack). */
+#define SHELL_MAX_LAYERS 1000
+
+/* The hollow ball as it is built: a cube surface of n x n quads per face projected
+ * equiangularly on the sphere, extruded into `layers` shells between r_in and r_out. */
+typedef struct shell {
+  const double *center;
+  double r_in, r_out, hole_radius;
+  int n, layers;
+  fcm_index ns;     /* surface nodes */
+  fcm_index nq;     /* surface quads: 6 n^2 */
+  fcm_index *sid;   /* (n+1)^3 grid node -> surface id, or -1 inside */
+  double *dir;      /* ns x 3 unit directions */
+  fcm_index *quads; /* nq x 4 surface ids */
+  double *x;        /* (layers + 1) ns x 3: node of layer l, surface node s is l ns + s */
+} shell;
+
+static fcm_status hollow_ball_args(fcm_ctx *ctx, const char *who, const double center[3],
+                                   double r_in, double r_out, double hole_radius, int n, int layers)
 {
   fcm_status st = FCM_OK;
-  const char *who = "geometry hollow ball";
-  fcm_index *sid = NULL, *quads = NULL, *cells = NULL, *used = NULL;
-  double *x = NULL, *dir = NULL, *xs = NULL;
-  FCM_CHECK(geom, ctx, FCM_ERR_ARG, "%s: output pointer is NULL", who);
-  *geom = NULL;
   FCM_CHECK(ctx && center, ctx, FCM_ERR_ARG, "%s: NULL argument (ctx and center are required)",
             who);
   FCM_CHECK(isfinite(center[0]) && isfinite(center[1]) && isfinite(center[2]), ctx, FCM_ERR_ARG,
@@ -252,135 +263,204 @@ fcm_status fcm_geometry_create_hollow_ball(fcm_ctx *ctx, const double center[3],
   FCM_CHECK(isfinite(hole_radius) && hole_radius >= 0.0 && hole_radius < r_out, ctx, FCM_ERR_ARG,
             "%s: hole radius = %g outside [0, r_out = %g)", who, hole_radius, r_out);
   FCM_CHECK(n >= 1 && n <= 128, ctx, FCM_ERR_ARG, "%s: resolution n = %d outside [1, 128]", who, n);
-  FCM_CHECK(layers >= 1 && layers <= 1000, ctx, FCM_ERR_ARG, "%s: layers = %d outside [1, 1000]",
-            who, layers);
-  {
-    const fcm_index n1 = n + 1, ns_total = n1 * n1 * n1;
-    fcm_index ns = 0;
-    FCM_ALLOC(ctx, (size_t)ns_total, sid);
-    for (fcm_index k = 0; k <= n; k++)
-      for (fcm_index j = 0; j <= n; j++)
-        for (fcm_index i = 0; i <= n; i++) {
-          const int surf = i == 0 || i == n || j == 0 || j == n || k == 0 || k == n;
-          sid[i + n1 * (j + n1 * k)] = surf ? ns++ : -1;
-        }
-    /* Equiangular directions of the surface nodes. */
-    FCM_ALLOC(ctx, 3 * (size_t)ns, dir);
-    for (fcm_index k = 0; k <= n; k++)
-      for (fcm_index j = 0; j <= n; j++)
-        for (fcm_index i = 0; i <= n; i++) {
-          const fcm_index s = sid[i + n1 * (j + n1 * k)];
-          if (s < 0) continue;
-          const fcm_index ijk[3] = {i, j, k};
-          double q[3], len = 0.0;
-          for (int d = 0; d < 3; d++) {
-            const double t = 2.0 * (double)ijk[d] / n - 1.0;
-            q[d] = fabs(t) == 1.0 ? t : tan(0.25 * PI * t);
-            len += q[d] * q[d];
-          }
-          len = sqrt(len);
-          for (int d = 0; d < 3; d++)
-            dir[3 * s + d] = q[d] / len;
-        }
-    /* Surface quads: 6 patches of n x n, as 4 surface ids each. */
-    const fcm_index nq = 6 * (fcm_index)n * n;
-    FCM_ALLOC(ctx, 4 * (size_t)nq, quads);
-    fcm_index q = 0;
-    for (int d = 0; d < 3; d++)
-      for (int side = 0; side < 2; side++) {
-        const int d1 = (d + 1) % 3, d2 = (d + 2) % 3;
-        for (fcm_index v = 0; v < n; v++)
-          for (fcm_index u = 0; u < n; u++) {
-            const fcm_index du[4] = {0, 1, 1, 0}, dv[4] = {0, 0, 1, 1};
-            for (int a = 0; a < 4; a++) {
-              fcm_index ijk[3];
-              ijk[d] = side ? n : 0, ijk[d1] = u + du[a], ijk[d2] = v + dv[a];
-              quads[4 * q + a] = sid[ijk[0] + n1 * (ijk[1] + n1 * ijk[2])];
-            }
-            q++;
-          }
+  FCM_CHECK(layers >= 1 && layers <= SHELL_MAX_LAYERS, ctx, FCM_ERR_ARG,
+            "%s: layers = %d outside [1, %d]", who, layers, SHELL_MAX_LAYERS);
+cleanup:
+  return st;
+}
+
+/* Surface ids of the cube grid's boundary nodes and their equiangular directions. */
+static fcm_status shell_surface(fcm_ctx *ctx, shell *sh)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index n = sh->n, n1 = n + 1;
+  FCM_ALLOC(ctx, (size_t)(n1 * n1 * n1), sh->sid);
+  for (fcm_index k = 0; k <= n; k++)
+    for (fcm_index j = 0; j <= n; j++)
+      for (fcm_index i = 0; i <= n; i++) {
+        const int surf = i == 0 || i == n || j == 0 || j == n || k == 0 || k == n;
+        sh->sid[i + n1 * (j + n1 * k)] = surf ? sh->ns++ : -1;
       }
-    /* Nodes: layer l of surface node s is l * ns + s. */
-    const fcm_index nn = (layers + 1) * ns;
-    FCM_ALLOC(ctx, 3 * (size_t)nn, x);
-    for (int l = 0; l <= layers; l++) {
-      const double rho = l == layers ? r_out : r_in + (r_out - r_in) * l / layers;
-      for (fcm_index s = 0; s < ns; s++)
+  FCM_ALLOC(ctx, 3 * (size_t)sh->ns, sh->dir);
+  for (fcm_index k = 0; k <= n; k++)
+    for (fcm_index j = 0; j <= n; j++)
+      for (fcm_index i = 0; i <= n; i++) {
+        const fcm_index s = sh->sid[i + n1 * (j + n1 * k)];
+        if (s < 0) continue;
+        const fcm_index ijk[3] = {i, j, k};
+        double q[3], len = 0.0;
+        for (int d = 0; d < 3; d++) {
+          const double t = 2.0 * (double)ijk[d] / n - 1.0;
+          q[d] = fabs(t) == 1.0 ? t : tan(0.25 * PI * t);
+          len += q[d] * q[d];
+        }
+        len = sqrt(len);
         for (int d = 0; d < 3; d++)
-          x[3 * (l * ns + s) + d] = center[d] + rho * dir[3 * s + d];
-    }
-    /* Prisms (surface triangle x layer), 3 tets each by the sorted-id rule, which
-     * splits every shared quad side the same way from both prisms. */
-    FCM_ALLOC(ctx, 4 * 6 * (size_t)nq * (size_t)layers, cells);
-    fcm_index nc = 0;
-    for (fcm_index qq = 0; qq < nq; qq++) {
-      const fcm_index *qv = quads + 4 * qq;
-      /* Holes: drop the hex (quad x layer) whose vertex centroid lies in a cylinder; the
-       * quads are placed symmetrically, so are the holes. */
-      unsigned char drop[1000];
-      for (int l = 0; l < layers; l++) {
-        const double rho = r_in + (r_out - r_in) * (l + 0.5) / layers;
-        double cen[3] = {0, 0, 0};
-        for (int a = 0; a < 4; a++)
-          for (int d = 0; d < 3; d++)
-            cen[d] += 0.25 * rho * dir[3 * qv[a] + d];
-        drop[l] = 0;
-        for (int d = 0; d < 3 && hole_radius > 0.0; d++) {
-          const double a1 = cen[(d + 1) % 3], a2 = cen[(d + 2) % 3];
-          drop[l] |= a1 * a1 + a2 * a2 < hole_radius * hole_radius;
-        }
+          sh->dir[3 * s + d] = q[d] / len;
       }
-      int m = 0; /* diagonal through the smallest id */
-      for (int a = 1; a < 4; a++)
-        if (qv[a] < qv[m]) m = a;
-      const int base = m % 2;
-      const fcm_index tri[2][3] = {{qv[base], qv[base + 1], qv[(base + 2) % 4]},
-                                   {qv[base], qv[(base + 2) % 4], qv[(base + 3) % 4]}};
-      for (int t = 0; t < 2; t++) {
-        fcm_index v[3] = {tri[t][0], tri[t][1], tri[t][2]};
-        for (int a = 1; a < 3; a++) /* sort ascending */
-          for (int b = a; b > 0 && v[b - 1] > v[b]; b--) {
-            const fcm_index s = v[b];
-            v[b] = v[b - 1], v[b - 1] = s;
+cleanup:
+  return st;
+}
+
+/* Surface quads: for each axis d and side, an n x n patch, as 4 surface ids each. */
+static fcm_status shell_quads(fcm_ctx *ctx, shell *sh)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index n = sh->n, n1 = n + 1;
+  sh->nq = 6 * n * n;
+  FCM_ALLOC(ctx, 4 * (size_t)sh->nq, sh->quads);
+  fcm_index q = 0;
+  for (int d = 0; d < 3; d++)
+    for (int side = 0; side < 2; side++) {
+      const int d1 = (d + 1) % 3, d2 = (d + 2) % 3;
+      for (fcm_index v = 0; v < n; v++)
+        for (fcm_index u = 0; u < n; u++) {
+          const fcm_index du[4] = {0, 1, 1, 0}, dv[4] = {0, 0, 1, 1};
+          for (int a = 0; a < 4; a++) {
+            fcm_index ijk[3];
+            ijk[d] = side ? n : 0, ijk[d1] = u + du[a], ijk[d2] = v + dv[a];
+            sh->quads[4 * q + a] = sh->sid[ijk[0] + n1 * (ijk[1] + n1 * ijk[2])];
           }
-        for (int l = 0; l < layers; l++) {
-          if (drop[l]) continue;
-          const fcm_index b0 = l * ns + v[0], b1 = l * ns + v[1], b2 = l * ns + v[2];
-          const fcm_index t0 = b0 + ns, t1 = b1 + ns, t2 = b2 + ns;
-          const fcm_index tt[3][4] = {{b0, b1, b2, t2}, {b0, b1, t1, t2}, {b0, t0, t1, t2}};
-          for (int e = 0; e < 3; e++) {
-            fcm_index c4[4] = {tt[e][0], tt[e][1], tt[e][2], tt[e][3]};
-            if (tet_vol6(x + 3 * c4[0], x + 3 * c4[1], x + 3 * c4[2], x + 3 * c4[3]) < 0.0) {
-              const fcm_index s = c4[1];
-              c4[1] = c4[2], c4[2] = s;
-            }
-            memcpy(cells + 4 * nc, c4, sizeof c4);
-            nc++;
-          }
+          q++;
         }
-      }
     }
-    /* Drop the nodes of removed tets and renumber. */
-    FCM_ALLOC(ctx, (size_t)nn, used);
-    for (fcm_index c = 0; c < 4 * nc; c++)
-      used[cells[c]] = 1;
-    fcm_index nk = 0;
-    for (fcm_index a = 0; a < nn; a++)
-      used[a] = used[a] ? nk++ : -1;
-    FCM_ALLOC(ctx, 3 * (size_t)nk, xs);
-    for (fcm_index a = 0; a < nn; a++)
-      if (used[a] >= 0) memcpy(xs + 3 * used[a], x + 3 * a, 3 * sizeof *x);
-    for (fcm_index c = 0; c < 4 * nc; c++)
-      cells[c] = used[cells[c]];
-    FCM_TRY(ctx, fcm__geom_create_take(ctx, who, FCM_ELEMENT_TET4, nk, &xs, nc, &cells, 1, geom));
+cleanup:
+  return st;
+}
+
+/* Nodes of every layer: the directions scaled to the layer's radius. */
+static fcm_status shell_nodes(fcm_ctx *ctx, shell *sh)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index ns = sh->ns;
+  FCM_ALLOC(ctx, 3 * (size_t)((sh->layers + 1) * ns), sh->x);
+  for (int l = 0; l <= sh->layers; l++) {
+    const double rho =
+        l == sh->layers ? sh->r_out : sh->r_in + (sh->r_out - sh->r_in) * l / sh->layers;
+    for (fcm_index s = 0; s < ns; s++)
+      for (int d = 0; d < 3; d++)
+        sh->x[3 * (l * ns + s) + d] = sh->center[d] + rho * sh->dir[3 * s + d];
   }
 cleanup:
-  fcm__free(ctx, sid);
-  fcm__free(ctx, quads);
-  fcm__free(ctx, cells);
+  return st;
+}
+
+/* Holes: drop[l] = 1 when the hex (quad qv x layer l) has its vertex centroid in one of
+ * the three axis cylinders of radius hole_radius; the quads are placed symmetrically, so
+ * are the holes. */
+static void shell_holes(const shell *sh, const fcm_index *qv, unsigned char *drop)
+{
+  for (int l = 0; l < sh->layers; l++) {
+    const double rho = sh->r_in + (sh->r_out - sh->r_in) * (l + 0.5) / sh->layers;
+    double cen[3] = {0, 0, 0};
+    for (int a = 0; a < 4; a++)
+      for (int d = 0; d < 3; d++)
+        cen[d] += 0.25 * rho * sh->dir[3 * qv[a] + d];
+    drop[l] = 0;
+    for (int d = 0; d < 3 && sh->hole_radius > 0.0; d++) {
+      const double a1 = cen[(d + 1) % 3], a2 = cen[(d + 2) % 3];
+      drop[l] |= a1 * a1 + a2 * a2 < sh->hole_radius * sh->hole_radius;
+    }
+  }
+}
+
+/* Tets of the column under quad qv: the quad splits into two triangles along the
+ * diagonal through its smallest id; each triangle x layer is a prism of 3 tets by the
+ * sorted-id rule, which splits every shared quad side the same way from both prisms.
+ * Appends to cells (4 ids per tet, positively oriented) and counts in *nc. */
+static void shell_column_tets(const shell *sh, const fcm_index *qv, const unsigned char *drop,
+                              fcm_index *cells, fcm_index *nc)
+{
+  enum { TRIS_PER_QUAD = 2, TETS_PER_PRISM = 3 };
+  const fcm_index ns = sh->ns;
+  int m = 0; /* corner with the smallest id */
+  for (int a = 1; a < 4; a++)
+    if (qv[a] < qv[m]) m = a;
+  const int base = m % 2;
+  const fcm_index tri[TRIS_PER_QUAD][3] = {{qv[base], qv[base + 1], qv[(base + 2) % 4]},
+                                           {qv[base], qv[(base + 2) % 4], qv[(base + 3) % 4]}};
+  for (int t = 0; t < TRIS_PER_QUAD; t++) {
+    fcm_index v[3] = {tri[t][0], tri[t][1], tri[t][2]};
+    for (int a = 1; a < 3; a++) /* sort ascending */
+      for (int b = a; b > 0 && v[b - 1] > v[b]; b--) {
+        const fcm_index s = v[b];
+        v[b] = v[b - 1], v[b - 1] = s;
+      }
+    for (int l = 0; l < sh->layers; l++) {
+      if (drop[l]) continue;
+      const fcm_index b0 = l * ns + v[0], b1 = l * ns + v[1], b2 = l * ns + v[2];
+      const fcm_index t0 = b0 + ns, t1 = b1 + ns, t2 = b2 + ns;
+      const fcm_index tt[TETS_PER_PRISM][4] = {
+          {b0, b1, b2, t2}, {b0, b1, t1, t2}, {b0, t0, t1, t2}};
+      for (int e = 0; e < TETS_PER_PRISM; e++) {
+        fcm_index c4[4] = {tt[e][0], tt[e][1], tt[e][2], tt[e][3]};
+        const double *x = sh->x;
+        if (tet_vol6(x + 3 * c4[0], x + 3 * c4[1], x + 3 * c4[2], x + 3 * c4[3]) < 0.0) {
+          const fcm_index s = c4[1];
+          c4[1] = c4[2], c4[2] = s;
+        }
+        memcpy(cells + 4 * *nc, c4, sizeof c4);
+        (*nc)++;
+      }
+    }
+  }
+}
+
+/* Keep only the nodes the tets use, renumbered in order: *xs (nk x 3) and cells. */
+static fcm_status compact_nodes(fcm_ctx *ctx, fcm_index nn, const double *x, fcm_index nc,
+                                fcm_index *cells, fcm_index *nk, double **xs)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *used = NULL;
+  FCM_ALLOC(ctx, (size_t)nn, used);
+  for (fcm_index c = 0; c < 4 * nc; c++)
+    used[cells[c]] = 1;
+  *nk = 0;
+  for (fcm_index a = 0; a < nn; a++)
+    used[a] = used[a] ? (*nk)++ : -1;
+  FCM_ALLOC(ctx, 3 * (size_t)*nk, *xs);
+  for (fcm_index a = 0; a < nn; a++)
+    if (used[a] >= 0) memcpy(*xs + 3 * used[a], x + 3 * a, 3 * sizeof *x);
+  for (fcm_index c = 0; c < 4 * nc; c++)
+    cells[c] = used[cells[c]];
+cleanup:
   fcm__free(ctx, used);
-  fcm__free(ctx, x);
-  fcm__free(ctx, dir);
+  return st;
+}
+
+fcm_status fcm_geometry_create_hollow_ball(fcm_ctx *ctx, const double center[3], double r_in,
+                                           double r_out, double hole_radius, int n, int layers,
+                                           fcm_geometry **geom)
+{
+  fcm_status st = FCM_OK;
+  const char *who = "geometry hollow ball";
+  shell sh;
+  fcm_index *cells = NULL, nc = 0, nk = 0;
+  double *xs = NULL;
+  memset(&sh, 0, sizeof sh);
+  FCM_CHECK(geom, ctx, FCM_ERR_ARG, "%s: output pointer is NULL", who);
+  *geom = NULL;
+  FCM_TRY(ctx, hollow_ball_args(ctx, who, center, r_in, r_out, hole_radius, n, layers));
+  sh.center = center;
+  sh.r_in = r_in, sh.r_out = r_out, sh.hole_radius = hole_radius;
+  sh.n = n, sh.layers = layers;
+  FCM_TRY(ctx, shell_surface(ctx, &sh));
+  FCM_TRY(ctx, shell_quads(ctx, &sh));
+  FCM_TRY(ctx, shell_nodes(ctx, &sh));
+  FCM_ALLOC(ctx, 4 * 6 * (size_t)sh.nq * (size_t)layers, cells);
+  for (fcm_index q = 0; q < sh.nq; q++) {
+    unsigned char drop[SHELL_MAX_LAYERS];
+    shell_holes(&sh, sh.quads + 4 * q, drop);
+    shell_column_tets(&sh, sh.quads + 4 * q, drop, cells, &nc);
+  }
+  FCM_TRY(ctx, compact_nodes(ctx, (layers + 1) * sh.ns, sh.x, nc, cells, &nk, &xs));
+  FCM_TRY(ctx, fcm__geom_create_take(ctx, who, FCM_ELEMENT_TET4, nk, &xs, nc, &cells, 1, geom));
+cleanup:
+  fcm__free(ctx, sh.sid);
+  fcm__free(ctx, sh.quads);
+  fcm__free(ctx, sh.dir);
+  fcm__free(ctx, sh.x);
+  fcm__free(ctx, cells);
   fcm__free(ctx, xs);
   return st;
 }

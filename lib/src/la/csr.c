@@ -112,11 +112,13 @@ fcm_status fcm_csr_create(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols, const 
             "csr_create: col_idx is NULL with nnz = %lld", (long long)row_ptr[nrows]);
   FCM_TRY(ctx, new_handle(ctx, nrows, ncols, row_ptr[nrows], kind, &A));
   A->owned = 1;
-  FCM_ALLOC(ctx, nrows + 1, A->row_ptr);
-  FCM_ALLOC(ctx, A->nnz, A->col_idx);
+  FCM_ALLOC(ctx, nrows + 1, A->own_row_ptr);
+  FCM_ALLOC(ctx, A->nnz, A->own_col_idx);
   FCM_ALLOC(ctx, A->nnz, A->values);
-  memcpy(A->row_ptr, row_ptr, (size_t)(nrows + 1) * sizeof *row_ptr);
-  if (A->nnz) memcpy(A->col_idx, col_idx, (size_t)A->nnz * sizeof *col_idx);
+  memcpy(A->own_row_ptr, row_ptr, (size_t)(nrows + 1) * sizeof *row_ptr);
+  if (A->nnz) memcpy(A->own_col_idx, col_idx, (size_t)A->nnz * sizeof *col_idx);
+  A->row_ptr = A->own_row_ptr;
+  A->col_idx = A->own_col_idx;
   FCM_TRY(ctx, check_columns(ctx, A));
   *out = A;
   A = NULL;
@@ -137,9 +139,9 @@ fcm_status fcm_csr_wrap(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols, const fc
             "csr_wrap: values is NULL with nnz = %lld", (long long)row_ptr[nrows]);
   FCM_TRY(ctx, new_handle(ctx, nrows, ncols, row_ptr[nrows], kind, &A));
   A->owned = 0;
-  /* Borrowed: the pattern is never written (the casts only drop const for the struct). */
-  A->row_ptr = (fcm_index *)row_ptr;
-  A->col_idx = (int *)col_idx;
+  /* Borrowed: the pattern is only read. */
+  A->row_ptr = row_ptr;
+  A->col_idx = col_idx;
   A->values = values;
   FCM_TRY(ctx, check_columns(ctx, A));
   *out = A;
@@ -236,11 +238,9 @@ void fcm_csr_destroy(fcm_csr **A)
 {
   if (!A || !*A) return;
   fcm_ctx *ctx = (*A)->ctx;
-  if ((*A)->owned) {
-    fcm__free(ctx, (*A)->row_ptr);
-    fcm__free(ctx, (*A)->col_idx);
-    fcm__free(ctx, (*A)->values);
-  }
+  fcm__free(ctx, (*A)->own_row_ptr);
+  fcm__free(ctx, (*A)->own_col_idx);
+  if ((*A)->owned) fcm__free(ctx, (*A)->values);
   fcm__free(ctx, *A);
   *A = NULL;
 }
@@ -268,6 +268,11 @@ const int *fcm_csr_get_col_idx(const fcm_csr *A)
 }
 
 double *fcm_csr_get_values(fcm_csr *A)
+{
+  return A ? A->values : NULL;
+}
+
+const double *fcm_csr_get_values_read(const fcm_csr *A)
 {
   return A ? A->values : NULL;
 }

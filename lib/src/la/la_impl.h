@@ -60,11 +60,15 @@ fcm_status fcm__lstsq(fcm_ctx *ctx, int m, int n, int nrhs, double *a, int lda, 
 struct fcm_csr {
   fcm_ctx *ctx;
   fcm_index nrows, ncols, nnz;
-  fcm_index *row_ptr; /* nrows + 1 */
-  int *col_idx;       /* nnz, sorted and unique per row */
-  double *values;     /* nnz */
+  const fcm_index *row_ptr; /* nrows + 1; never written after creation */
+  const int *col_idx;       /* nnz, sorted and unique per row; never written */
+  double *values;           /* nnz */
   fcm_csr_kind kind;
-  int owned; /* 1: the arrays were allocated through ctx; 0: borrowed (fcm_csr_wrap) */
+  /* Storage allocated through ctx (fcm_csr_create), NULL when borrowed (fcm_csr_wrap):
+   * row_ptr and col_idx point here or at the caller's arrays; values is owned iff owned. */
+  fcm_index *own_row_ptr;
+  int *own_col_idx;
+  int owned;
 };
 
 /* One table per sparse direct-solver adapter (cholmod_adapter.c,

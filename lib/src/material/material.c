@@ -7,8 +7,6 @@
  * alpha = 1 + 3 mu'/(4 lambda') makes the rest state stress free. */
 #include "material/material_impl.h"
 
-#include "fcm/fem.h"
-
 static const char *const model_names[FCM_MATERIAL_COUNT] = {"linear", "stvk", "corotated", "snh"};
 
 const char *fcm_material_model_name(fcm_material_model model)

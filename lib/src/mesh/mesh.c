@@ -20,11 +20,11 @@ cleanup:
 }
 
 /* Sorted corner node ids of local face f of cell c; key[3] = -1 for triangles. */
-static void face_key(const fcm_mesh *m, fcm_index c, int f, fcm_index key[4])
+static void face_key(const fcm_element_info *info, const fcm_index *cells, fcm_index c, int f,
+                     fcm_index key[4])
 {
-  const fcm_element_info *info = m->info;
   int nc = info->face_num_corners[f];
-  const fcm_index *cell = m->cells + (size_t)m->npc * (size_t)c;
+  const fcm_index *cell = cells + (size_t)info->num_nodes * (size_t)c;
   key[3] = -1;
   for (int k = 0; k < nc; k++) {
     fcm_index v = cell[info->face_nodes[f][k]];
@@ -54,58 +54,87 @@ static void format_key(const fcm_index key[4], char *buf, size_t len)
              (long long)key[2], (long long)key[3]);
 }
 
-/* Match faces by their sorted corners in an open-addressing table of face ids
- * (c * num_faces + f) and their key hashes; a stored face's key is recomputed from
- * the connectivity only when the hashes agree. */
+/* Faces are matched by their sorted corners in an open-addressing table holding, per
+ * distinct key, the first face id (c * num_faces + f), the key hash and the group's
+ * last face; a stored face's key is recomputed from the connectivity only when the
+ * hashes agree. */
+fcm_status fcm__mesh_match_faces(fcm_ctx *ctx, const fcm_element_info *info,
+                                 const fcm_index *cells, fcm_index num_cells, fcm_index *first,
+                                 fcm_index *next)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *slots = NULL, *tails = NULL;
+  uint64_t *hashes = NULL;
+  const int nf = info->num_faces;
+  const fcm_index nfaces = num_cells * nf;
+  size_t cap = 0;
+  FCM_TRY(ctx, fcm__mesh_hash_capacity(ctx, nfaces, &cap));
+  FCM_ALLOC(ctx, cap, slots);
+  FCM_ALLOC(ctx, cap, tails);
+  FCM_ALLOC(ctx, cap, hashes);
+  for (size_t i = 0; i < cap; i++)
+    slots[i] = -1;
+  for (fcm_index i = 0; i < nfaces; i++) {
+    fcm_index key[4], other[4];
+    face_key(info, cells, i / nf, (int)(i % nf), key);
+    const uint64_t kh = key_hash(key);
+    size_t h = (size_t)kh & (cap - 1);
+    next[i] = -1;
+    for (;;) {
+      fcm_index s = slots[h];
+      if (s < 0) { /* a new key: i heads its group */
+        slots[h] = tails[h] = first[i] = i;
+        hashes[h] = kh;
+        break;
+      }
+      if (hashes[h] == kh) face_key(info, cells, s / nf, (int)(s % nf), other);
+      if (hashes[h] == kh && memcmp(key, other, sizeof key) == 0) {
+        first[i] = s;
+        next[tails[h]] = i;
+        tails[h] = i;
+        break;
+      }
+      h = (h + 1) & (cap - 1);
+    }
+  }
+cleanup:
+  fcm__free(ctx, slots);
+  fcm__free(ctx, tails);
+  fcm__free(ctx, hashes);
+  return st;
+}
+
+/* Neighbours across faces (a face met twice) and the boundary faces (met once); a face
+ * met a third time is an error naming the three cells. */
 static fcm_status build_adjacency(fcm_mesh *m)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
-  fcm_index *slots = NULL;
-  uint64_t *hashes = NULL;
+  fcm_index *first = NULL, *next = NULL;
   const int nf = m->info->num_faces;
   const fcm_index nfaces = m->num_cells * nf;
-  size_t cap = 0;
 
   FCM_ALLOC(ctx, nfaces, m->neighbors);
+  FCM_ALLOC(ctx, nfaces, first);
+  FCM_ALLOC(ctx, nfaces, next);
+  FCM_TRY(ctx, fcm__mesh_match_faces(ctx, m->info, m->cells, m->num_cells, first, next));
   for (fcm_index i = 0; i < nfaces; i++)
     m->neighbors[i] = -1;
-  FCM_TRY(ctx, fcm__mesh_hash_capacity(ctx, nfaces, &cap));
-  FCM_ALLOC(ctx, cap, slots);
-  FCM_ALLOC(ctx, cap, hashes);
-  for (size_t i = 0; i < cap; i++)
-    slots[i] = -1;
-
-  for (fcm_index c = 0; c < m->num_cells; c++) {
-    for (int f = 0; f < nf; f++) {
-      fcm_index key[4], other[4];
-      face_key(m, c, f, key);
-      const uint64_t kh = key_hash(key);
-      size_t h = (size_t)kh & (cap - 1);
-      for (;;) {
-        fcm_index s = slots[h];
-        if (s < 0) {
-          slots[h] = c * nf + f;
-          hashes[h] = kh;
-          break;
-        }
-        if (hashes[h] == kh) face_key(m, s / nf, (int)(s % nf), other);
-        if (hashes[h] == kh && memcmp(key, other, sizeof key) == 0) {
-          if (m->neighbors[s] >= 0) {
-            char buf[96];
-            format_key(key, buf, sizeof buf);
-            FCM_CHECK(0, ctx, FCM_ERR_GEOMETRY,
-                      "mesh: face with corner nodes (%s) is shared by more than two cells "
-                      "(%lld, %lld, %lld); a conforming mesh has at most two",
-                      buf, (long long)(s / nf), (long long)m->neighbors[s], (long long)c);
-          }
-          m->neighbors[s] = c;
-          m->neighbors[c * nf + f] = s / nf;
-          break;
-        }
-        h = (h + 1) & (cap - 1);
-      }
+  for (fcm_index i = 0; i < nfaces; i++) {
+    const fcm_index s = first[i];
+    if (s == i) continue;
+    if (next[s] != i) { /* the third face of its group */
+      fcm_index key[4];
+      char buf[96];
+      face_key(m->info, m->cells, i / nf, (int)(i % nf), key);
+      format_key(key, buf, sizeof buf);
+      FCM_CHECK(0, ctx, FCM_ERR_GEOMETRY,
+                "mesh: face with corner nodes (%s) is shared by more than two cells "
+                "(%lld, %lld, %lld); a conforming mesh has at most two",
+                buf, (long long)(s / nf), (long long)(next[s] / nf), (long long)(i / nf));
     }
+    m->neighbors[s] = i / nf;
+    m->neighbors[i] = s / nf;
   }
 
   m->num_boundary = 0;
@@ -119,8 +148,8 @@ static fcm_status build_adjacency(fcm_mesh *m)
     b++;
   }
 cleanup:
-  fcm__free(ctx, slots);
-  fcm__free(ctx, hashes);
+  fcm__free(ctx, first);
+  fcm__free(ctx, next);
   return st;
 }
 

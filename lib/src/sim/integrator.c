@@ -111,7 +111,7 @@ void fcm_motion_eval(const fcm_motion *m, const double X[3], double t, double u[
   }
 }
 
-fcm_status fcm_integrator_create(fcm_ctx *ctx, fcm_space *space, const fcm_material *mat,
+fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space, const fcm_material *mat,
                                  const fcm_integrator_options *opts, fcm_integrator **integ)
 {
   fcm_status st = FCM_OK;
@@ -174,6 +174,7 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   fcm_krylov_destroy(&I->krylov);
   fcm_jacobi_destroy(&I->jacobi);
   fcm_schwarz_destroy(&I->schwarz);
+  fcm_assembly_workspace_destroy(&I->aws);
   fcm__free(ctx, I);
   *integ = NULL;
 }
@@ -472,91 +473,111 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_integrator_setup(fcm_integrator *I)
+/* Set-up phase: the work vectors, the Newton matrix H and the assembly workspace. */
+static fcm_status setup_storage(fcm_integrator *I)
 {
   fcm_status st = FCM_OK;
-  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
   fcm_ctx *ctx = I->ctx;
-  fcm_index n = I->n;
-  const fcm_integrator_options *o = &I->opts;
-  FCM_CHECK(!I->is_setup, ctx, FCM_ERR_ARG, "integrator: already set up");
-  FCM_TRY(ctx, validate_options(ctx, o));
-  if (I->opts.tolerance_mode == FCM_NEWTON_TOL_AUTO)
-    I->opts.tolerance_mode = I->opts.kind == FCM_INTEGRATOR_STATIC ? FCM_NEWTON_TOL_RELATIVE
-                                                                   : FCM_NEWTON_TOL_REPRESENTATIVE;
-  FCM_CHECK(n > 0, ctx, FCM_ERR_ARG, "integrator: the space has no DOFs");
-  FCM_TRY(ctx, build_constraints(I));
-
   double **vecs[] = {&I->Ma,   &I->u_bak,  &I->v_bak, &I->lp_bak, &I->un, &I->uhat,
                      &I->fext, &I->fend,   &I->fint,  &I->g,      &I->d,  &I->b,
                      &I->ut,   &I->fint_t, &I->g_t,   &I->w1,     &I->w2};
   for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; k++)
-    FCM_ALLOC(ctx, n, *vecs[k]);
-
-  /* Mass (constant; dynamics only) and the loads of scale 1. */
+    FCM_ALLOC(ctx, I->n, *vecs[k]);
   FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->H));
-  {
-    const fcm_material *el = &I->mat; /* linear assembly: mass and body forces */
-    if (o->kind == FCM_INTEGRATOR_BACKWARD_EULER) {
-      FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->M));
-      FCM_TRY(ctx, fcm_assemble_mass(I->space, el, &o->assembly, I->M));
-      I->setup_info.mass_assemblies = 1;
-    }
-    for (int k = 0; k < I->num_loads; k++) {
-      sim_load *l = &I->loads[k];
-      FCM_ALLOC(ctx, n, l->f);
-      if (l->kind == SIM_LOAD_GRAVITY)
-        FCM_TRY(ctx, fcm_assemble_body_force(I->space, el, l->accel, &o->assembly, l->f));
-      else if (l->kind == SIM_LOAD_BODY)
-        FCM_TRY(ctx, fcm_assemble_body_force_field(I->space, l->field, l->field_user, &o->assembly,
-                                                   l->f));
-      else
-        FCM_TRY(ctx, fcm_assemble_surface_traction(I->space, l->field, l->field_user, l->f));
-      if (l->kind == SIM_LOAD_TRACTION)
-        I->setup_info.traction_assemblies++;
-      else
-        I->setup_info.body_force_assemblies++;
-    }
-    /* The representative force M a_rep. Static runs have no M: by the partition of unity
-     * (sum_b N_b = 1), (M a_rep)_a = int rho N_a a_rep, the body force of rho a_rep, which
-     * is the gravity load itself when a_rep is that gravity (the default). */
-    if (o->tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE) {
-      double a[3];
-      rep_acceleration(I, a);
-      if (I->M) {
-        for (fcm_index i = 0; i < n; i++)
-          I->w1[i] = a[i % 3];
-        FCM_TRY(ctx, fcm_csr_apply(I->M, 1.0, I->w1, 0.0, I->Ma));
-      } else {
-        const sim_load *same = NULL;
-        for (int k = 0; k < I->num_loads && !same; k++)
-          if (I->loads[k].kind == SIM_LOAD_GRAVITY && I->loads[k].accel[0] == a[0] &&
-              I->loads[k].accel[1] == a[1] && I->loads[k].accel[2] == a[2])
-            same = &I->loads[k];
-        if (same) {
-          memcpy(I->Ma, same->f, sizeof *I->Ma * (size_t)n);
-        } else {
-          memset(I->Ma, 0, sizeof *I->Ma * (size_t)n);
-          FCM_TRY(ctx, fcm_assemble_body_force(I->space, el, a, &o->assembly, I->Ma));
-          I->setup_info.scale_assemblies = 1;
-        }
-      }
-      double s = 0.0;
-      for (fcm_index i = 0; i < n; i++)
-        s += I->Ma[i] * I->Ma[i];
-      I->rep_norm_full = sqrt(s);
-      FCM_CHECK(I->rep_norm_full > 0.0 && isfinite(I->rep_norm_full), ctx, FCM_ERR_ARG,
-                "integrator: the representative force ||M a_rep|| is %g (density %g): set a "
-                "positive density or use FCM_NEWTON_TOL_RELATIVE",
-                I->rep_norm_full, I->mat.density);
+  FCM_TRY(ctx, fcm_assembly_workspace_create(I->space, &I->opts.assembly, &I->aws));
+cleanup:
+  return st;
+}
+
+/* Set-up phase: the mass matrix (constant; dynamics only) and each load of scale 1. */
+static fcm_status setup_mass_and_loads(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  fcm_linear_form form = fcm_linear_form_default();
+  form.material = &I->mat; /* linear assembly: mass and body forces */
+  if (I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) {
+    FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->M));
+    form.term = FCM_LINEAR_MASS;
+    FCM_TRY(ctx, fcm_assembly_workspace_linear(I->aws, &form, I->M, NULL));
+    I->setup_info.mass_assemblies = 1;
+  }
+  for (int k = 0; k < I->num_loads; k++) {
+    sim_load *l = &I->loads[k];
+    FCM_ALLOC(ctx, I->n, l->f);
+    form.accel = l->accel;
+    form.field = l->field;
+    form.user = l->field_user;
+    form.term = l->kind == SIM_LOAD_GRAVITY ? FCM_LINEAR_BODY_FORCE
+                : l->kind == SIM_LOAD_BODY  ? FCM_LINEAR_BODY_FORCE_FIELD
+                                            : FCM_LINEAR_SURFACE_TRACTION;
+    FCM_TRY(ctx, fcm_assembly_workspace_linear(I->aws, &form, NULL, l->f));
+    if (l->kind == SIM_LOAD_TRACTION)
+      I->setup_info.traction_assemblies++;
+    else
+      I->setup_info.body_force_assemblies++;
+  }
+cleanup:
+  return st;
+}
+
+/* Set-up phase: the representative force M a_rep of the representative tolerance and
+ * its norm. Static runs have no M: by the partition of unity (sum_b N_b = 1),
+ * (M a_rep)_a = int rho N_a a_rep, the body force of rho a_rep, which is the gravity
+ * load itself when a_rep is that gravity (the default). */
+static fcm_status setup_representative_force(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  fcm_index n = I->n;
+  double a[3];
+  rep_acceleration(I, a);
+  if (I->M) {
+    for (fcm_index i = 0; i < n; i++)
+      I->w1[i] = a[i % 3];
+    FCM_TRY(ctx, fcm_csr_apply(I->M, 1.0, I->w1, 0.0, I->Ma));
+  } else {
+    const sim_load *same = NULL;
+    for (int k = 0; k < I->num_loads && !same; k++)
+      if (I->loads[k].kind == SIM_LOAD_GRAVITY && I->loads[k].accel[0] == a[0] &&
+          I->loads[k].accel[1] == a[1] && I->loads[k].accel[2] == a[2])
+        same = &I->loads[k];
+    if (same) {
+      memcpy(I->Ma, same->f, sizeof *I->Ma * (size_t)n);
+    } else {
+      fcm_linear_form form = fcm_linear_form_default();
+      form.term = FCM_LINEAR_BODY_FORCE;
+      form.material = &I->mat;
+      form.accel = a;
+      memset(I->Ma, 0, sizeof *I->Ma * (size_t)n);
+      FCM_TRY(ctx, fcm_assembly_workspace_linear(I->aws, &form, NULL, I->Ma));
+      I->setup_info.scale_assemblies = 1;
     }
   }
+  double s = 0.0;
+  for (fcm_index i = 0; i < n; i++)
+    s += I->Ma[i] * I->Ma[i];
+  I->rep_norm_full = sqrt(s);
+  FCM_CHECK(I->rep_norm_full > 0.0 && isfinite(I->rep_norm_full), ctx, FCM_ERR_ARG,
+            "integrator: the representative force ||M a_rep|| is %g (density %g): set a "
+            "positive density or use FCM_NEWTON_TOL_RELATIVE",
+            I->rep_norm_full, I->mat.density);
+cleanup:
+  return st;
+}
+
+/* Set-up phase: the pristine copy (linear), the damping matrix, and the solvers: the
+ * direct solver is analyzed once here (the UMFPACK fallback on demand); Schwarz flags
+ * the small cut cells. */
+static fcm_status setup_solvers(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  const fcm_integrator_options *o = &I->opts;
   if (I->linear) FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->H0));
   if (o->kind == FCM_INTEGRATOR_BACKWARD_EULER &&
       (o->rayleigh_mass > 0.0 || o->rayleigh_stiffness > 0.0))
     FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->D));
-
-  /* Solvers: the direct solver is analyzed once here; the UMFPACK fallback on demand. */
   if (o->linear_solver == FCM_LINEAR_DIRECT) {
     if (o->direct_method == FCM_DIRECT_CHOLMOD) {
       FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, I->H, &I->chol));
@@ -566,7 +587,7 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
       FCM_TRY(ctx, fcm_direct_analyze(I->umf));
     }
   } else {
-    FCM_TRY(ctx, fcm_krylov_create(ctx, n, &I->krylov));
+    FCM_TRY(ctx, fcm_krylov_create(ctx, I->n, &I->krylov));
     if (o->preconditioner == FCM_PRECOND_SCHWARZ) {
       const fcm_mesh *mesh = fcm_space_mesh(I->space);
       const fcm_cell_rules *rules = fcm_space_cell_rules(I->space);
@@ -579,14 +600,21 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
                                fcm_cell_rules_volume_fraction(rules, c) < o->schwarz_theta;
     }
   }
+cleanup:
+  return st;
+}
 
+/* Set-up phase: the state at the current time — active constraints, the prescribed
+ * velocities (dynamics) or the external load of the last step (a resumed static run). */
+static void setup_initial_state(fcm_integrator *I)
+{
   I->h_state = SIM_H_INVALID;
   I->damp_version = 0;
   for (int k = 0; k < I->num_cons; k++)
     I->con_on[k] = 0;
   I->is_setup = 1;
   fcm__sim_eval_constraints(I, I->t);
-  if (o->kind == FCM_INTEGRATOR_BACKWARD_EULER) {
+  if (I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) {
     const double *X = fcm_mesh_coords(fcm_space_mesh(I->space));
     for (fcm_index i = 0; i < I->ncon; i++) {
       if (!I->con_on[I->con_id[i]]) continue;
@@ -597,6 +625,26 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
   } else if (I->steps > 0) {
     fcm__sim_eval_loads(I, I->t, I->load_prev);
   }
+}
+
+fcm_status fcm_integrator_setup(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
+  fcm_ctx *ctx = I->ctx;
+  FCM_CHECK(!I->is_setup, ctx, FCM_ERR_ARG, "integrator: already set up");
+  FCM_TRY(ctx, validate_options(ctx, &I->opts));
+  if (I->opts.tolerance_mode == FCM_NEWTON_TOL_AUTO)
+    I->opts.tolerance_mode = I->opts.kind == FCM_INTEGRATOR_STATIC ? FCM_NEWTON_TOL_RELATIVE
+                                                                   : FCM_NEWTON_TOL_REPRESENTATIVE;
+  FCM_CHECK(I->n > 0, ctx, FCM_ERR_ARG, "integrator: the space has no DOFs");
+  FCM_TRY(ctx, build_constraints(I));
+  FCM_TRY(ctx, setup_storage(I));
+  FCM_TRY(ctx, setup_mass_and_loads(I));
+  if (I->opts.tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE)
+    FCM_TRY(ctx, setup_representative_force(I));
+  FCM_TRY(ctx, setup_solvers(I));
+  setup_initial_state(I);
 cleanup:
   return st;
 }
@@ -716,8 +764,7 @@ fcm_status fcm_integrator_energy(fcm_integrator *I, double *kinetic, double *ela
   {
     fcm_index n = I->n;
     double psi = 0.0, ekin = 0.0, wext = 0.0;
-    FCM_TRY(I->ctx, fcm_assemble_hyperelastic(I->space, &I->params, I->u, &I->opts.assembly, &psi,
-                                              NULL, NULL));
+    FCM_TRY(I->ctx, fcm_assembly_workspace_hyperelastic(I->aws, &I->params, I->u, &psi, NULL, NULL));
     if (I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) {
       FCM_TRY(I->ctx, fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1));
       for (fcm_index i = 0; i < n; i++)

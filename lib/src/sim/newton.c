@@ -66,7 +66,7 @@ static fcm_status assemble(fcm_integrator *I, const fcm_material_params *p, cons
 {
   fcm_status st = FCM_OK;
   double t0 = fcm_wtime();
-  st = fcm_assemble_hyperelastic(I->space, p, x, &I->opts.assembly, psi, fint, T);
+  st = fcm_assembly_workspace_hyperelastic(I->aws, p, x, psi, fint, T);
   stats->time_assembly += fcm_wtime() - t0;
   if (T) stats->tangent_assemblies++;
   if (st == FCM_ERR_NUMERIC) {
@@ -251,33 +251,118 @@ static void monitor(const fcm_integrator *I, double t1, int it, double r, double
   I->opts.monitor(I->opts.monitor_user, &ev);
 }
 
+/* Newton set-up phase: the initial guess u^ = u_n + h v_n on free DOFs (exact for
+ * free flight), u_n elsewhere, and its evaluation; the tangent it assembled is kept. */
+static fcm_status newton_start(fcm_integrator *I, double h, eval_out *cur, sim_stats *stats)
+{
+  fcm_status st = FCM_OK;
+  if (h > 0.0)
+    for (fcm_index i = 0; i < I->n; i++) {
+      I->uhat[i] = I->un[i] + h * I->v[i];
+      I->u[i] = I->is_con[i] ? I->un[i] : I->uhat[i];
+    }
+  FCM_TRY(I->ctx, evaluate(I, h, I->u, !I->linear, I->fint, I->g, cur, stats));
+  I->h_state = I->linear ? (I->h_state == SIM_H_SYSTEM ? SIM_H_SYSTEM : SIM_H_INVALID)
+                         : (cur->finite ? SIM_H_TANGENT : SIM_H_INVALID);
+  I->psi = cur->psi;
+cleanup:
+  return st;
+}
+
+/* Newton direction phase: solve for d; a corrector direction that is not a descent
+ * direction (indefinite tangent or inexact solve) is retried once with the PSD-projected
+ * tangent, which with M/h^2 (or the constraints) is SPD. *slope = g.d; *reason is set
+ * when no usable direction exists. */
+static fcm_status newton_direction(fcm_integrator *I, double h, int predictor, double *slope,
+                                   int *its, fcm_step_reason *reason, sim_stats *stats)
+{
+  fcm_status st = FCM_OK;
+  FCM_TRY(I->ctx, build_system(I, h, predictor, 0, reason, stats));
+  if (*reason != FCM_STEP_NONE) goto cleanup;
+  FCM_TRY(I->ctx, direction(I, predictor, reason, its, stats));
+  if (*reason != FCM_STEP_NONE) goto cleanup;
+  *slope = dot(I->n, I->g, I->d);
+  if (predictor || *slope < 0.0) goto cleanup;
+  if (!I->opts.project_psd) {
+    int its2 = 0;
+    stats->projection_fallbacks++;
+    FCM_TRY(I->ctx, build_system(I, h, 0, 1, reason, stats));
+    if (*reason != FCM_STEP_NONE) goto cleanup;
+    FCM_TRY(I->ctx, direction(I, 0, reason, &its2, stats));
+    *its += its2;
+    if (*reason != FCM_STEP_NONE) goto cleanup;
+    *slope = dot(I->n, I->g, I->d);
+  }
+  if (!(*slope < 0.0)) *reason = FCM_STEP_LINE_SEARCH_FAILED;
+cleanup:
+  return st;
+}
+
+/* What the line search found. */
+typedef struct line_result {
+  int accepted;    /* ut = u + alpha d (fint_t, g_t, trial) is the new iterate */
+  int speculative; /* the trial assembled its tangent (the full step) */
+  double alpha, rt; /* step length; free residual norm at the trial */
+} line_result;
+
+/* Newton line-search phase: backtracking on E (predictor: constrained DOFs land exactly,
+ * the free part backs off only if the energy is not finite there). The tangent of a full
+ * step is assembled with it: usually it is accepted and the next iteration needs that
+ * tangent (one pass instead of two). */
+static fcm_status line_search(fcm_integrator *I, double h, int predictor, const eval_out *cur,
+                              double slope, double r, eval_out *trial, line_result *lr,
+                              sim_stats *stats)
+{
+  fcm_status st = FCM_OK;
+  const fcm_integrator_options *o = &I->opts;
+  lr->alpha = 1.0;
+  lr->accepted = lr->speculative = 0;
+  lr->rt = NAN;
+  for (int bt = 0;; bt++) {
+    for (fcm_index i = 0; i < I->n; i++)
+      I->ut[i] = I->u[i] + lr->alpha * I->d[i];
+    if (predictor)
+      for (fcm_index j = 0; j < I->nact; j++)
+        I->ut[I->act_dof[j]] = I->act_val[j];
+    lr->speculative = !I->linear && bt == 0;
+    FCM_TRY(I->ctx, evaluate(I, h, I->ut, lr->speculative, I->fint_t, I->g_t, trial, stats));
+    if (trial->finite) {
+      lr->rt = norm_free(I, I->g_t);
+      if (predictor || !o->line_search) {
+        lr->accepted = 1;
+      } else {
+        int armijo = trial->E <= cur->E + o->armijo * lr->alpha * slope;
+        /* Where E no longer resolves the decrease (round-off), ask the residual to drop. */
+        int flat =
+            fabs(trial->E - cur->E) <= 100.0 * DBL_EPSILON * FCM_MAX(cur->scale, trial->scale) &&
+            lr->rt < r;
+        lr->accepted = armijo || flat;
+      }
+    }
+    if (lr->accepted || bt >= o->max_backtracks) break;
+    lr->alpha *= o->backtrack;
+    stats->backtracks++;
+  }
+cleanup:
+  return st;
+}
+
 fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reason *reason,
                            double *residual, double *tol_out, sim_stats *stats)
 {
   fcm_status st = FCM_OK;
   const fcm_integrator_options *o = &I->opts;
-  fcm_index n = I->n;
   eval_out cur, trial;
   double rep_free = 0.0, r = NAN, r_start = NAN, tol = 0.0;
   int met = 0;
   *reason = FCM_STEP_NONE;
 
-  /* Initial guess: u^ = u_n + h v_n on free DOFs (exact for free flight), u_n elsewhere. */
-  if (h > 0.0)
-    for (fcm_index i = 0; i < n; i++) {
-      I->uhat[i] = I->un[i] + h * I->v[i];
-      I->u[i] = I->is_con[i] ? I->un[i] : I->uhat[i];
-    }
   if (o->tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE) rep_free = norm_free(I, I->Ma);
-
-  FCM_TRY(I->ctx, evaluate(I, h, I->u, !I->linear, I->fint, I->g, &cur, stats));
-  I->h_state = I->linear ? (I->h_state == SIM_H_SYSTEM ? SIM_H_SYSTEM : SIM_H_INVALID)
-                         : (cur.finite ? SIM_H_TANGENT : SIM_H_INVALID);
+  FCM_TRY(I->ctx, newton_start(I, h, &cur, stats));
   r = cur.finite ? norm_free(I, I->g) : NAN;
   r_start = r;
   tol = tolerance(I, rep_free, r_start);
   met = constraints_met(I, I->u);
-  I->psi = cur.psi;
   monitor(I, t1, 0, r, tol, cur.E, 0.0, 0, met);
 
   for (int it = 0;; it++) {
@@ -293,81 +378,33 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
       *reason = FCM_STEP_MAX_NEWTON;
       break;
     }
+    /* A predictor step first moves the constrained DOFs onto their prescribed values. */
     int predictor = !met, its = 0;
+    double slope = 0.0;
+    line_result lr;
     for (fcm_index j = 0; j < I->nact; j++)
       I->act_inc[j] = I->act_val[j] - I->u[I->act_dof[j]];
-    FCM_TRY(I->ctx, build_system(I, h, predictor, 0, reason, stats));
+    FCM_TRY(I->ctx, newton_direction(I, h, predictor, &slope, &its, reason, stats));
     if (*reason != FCM_STEP_NONE) break;
-    FCM_TRY(I->ctx, direction(I, predictor, reason, &its, stats));
-    if (*reason != FCM_STEP_NONE) break;
-    double slope = dot(n, I->g, I->d);
-    if (!predictor && !(slope < 0.0)) {
-      /* Not a descent direction (indefinite tangent or inexact solve): retry once with
-       * the PSD-projected tangent, which with M/h^2 (or the constraints) is SPD. */
-      if (!o->project_psd) {
-        stats->projection_fallbacks++;
-        FCM_TRY(I->ctx, build_system(I, h, 0, 1, reason, stats));
-        if (*reason != FCM_STEP_NONE) break;
-        int its2 = 0;
-        FCM_TRY(I->ctx, direction(I, 0, reason, &its2, stats));
-        its += its2;
-        if (*reason != FCM_STEP_NONE) break;
-        slope = dot(n, I->g, I->d);
-      }
-      if (!(slope < 0.0)) {
-        *reason = FCM_STEP_LINE_SEARCH_FAILED;
-        break;
-      }
-    }
-
-    /* Backtracking line search on E (predictor: constrained DOFs land exactly, the free
-     * part backs off only if the energy is not finite there). */
-    double alpha = 1.0;
-    int accepted = 0, speculative = 0;
-    double rt = NAN;
-    for (int bt = 0;; bt++) {
-      for (fcm_index i = 0; i < n; i++)
-        I->ut[i] = I->u[i] + alpha * I->d[i];
-      if (predictor)
-        for (fcm_index j = 0; j < I->nact; j++)
-          I->ut[I->act_dof[j]] = I->act_val[j];
-      /* The tangent of a full step is assembled with it: usually it is accepted and the
-       * next iteration needs that tangent (one pass instead of two). */
-      speculative = !I->linear && bt == 0;
-      FCM_TRY(I->ctx, evaluate(I, h, I->ut, speculative, I->fint_t, I->g_t, &trial, stats));
-      if (trial.finite) {
-        rt = norm_free(I, I->g_t);
-        if (predictor || !o->line_search) {
-          accepted = 1;
-        } else {
-          int armijo = trial.E <= cur.E + o->armijo * alpha * slope;
-          /* Where E no longer resolves the decrease (round-off), ask the residual to drop. */
-          int flat =
-              fabs(trial.E - cur.E) <= 100.0 * DBL_EPSILON * FCM_MAX(cur.scale, trial.scale) &&
-              rt < r;
-          accepted = armijo || flat;
-        }
-      }
-      if (accepted || bt >= o->max_backtracks) break;
-      alpha *= o->backtrack;
-      stats->backtracks++;
-    }
-    if (!accepted) {
+    FCM_TRY(I->ctx, line_search(I, h, predictor, &cur, slope, r, &trial, &lr, stats));
+    if (!lr.accepted) {
       I->h_state = SIM_H_INVALID;
       *reason = trial.finite ? FCM_STEP_LINE_SEARCH_FAILED : FCM_STEP_NONFINITE;
       break;
     }
+    /* Accept the trial as the new iterate. */
     swap(&I->u, &I->ut);
     swap(&I->fint, &I->fint_t);
     swap(&I->g, &I->g_t);
     cur = trial;
     I->psi = cur.psi;
-    if (!I->linear) I->h_state = (speculative && alpha == 1.0) ? SIM_H_TANGENT : SIM_H_INVALID;
+    if (!I->linear)
+      I->h_state = (lr.speculative && lr.alpha == 1.0) ? SIM_H_TANGENT : SIM_H_INVALID;
     stats->newton_iterations++;
-    r = rt;
+    r = lr.rt;
     met = constraints_met(I, I->u);
     tol = tolerance(I, rep_free, r_start);
-    monitor(I, t1, it + 1, r, tol, cur.E, alpha, its, met);
+    monitor(I, t1, it + 1, r, tol, cur.E, lr.alpha, its, met);
   }
 cleanup:
   *residual = r;
@@ -401,6 +438,104 @@ cleanup:
   return st;
 }
 
+/* Step phase: the external load at the end t1 of a substep, the fraction s1 of the step
+ * (static: interpolated from the last step's load; the last substep ends on exactly
+ * f_ext(t0 + dt), what set_state() restores). Returns 0 when it is not finite. */
+static int substep_load(fcm_integrator *I, int dyn, double t1, double s1, int last)
+{
+  fcm_index n = I->n;
+  if (dyn)
+    fcm__sim_eval_loads(I, t1, I->fext);
+  else if (last)
+    memcpy(I->fext, I->fend, sizeof(double) * (size_t)n);
+  else
+    for (fcm_index i = 0; i < n; i++)
+      I->fext[i] = I->lp_bak[i] + s1 * (I->fend[i] - I->lp_bak[i]);
+  return all_finite(n, I->fext);
+}
+
+/* Step phase: one substep of length h (0: static) ending at t1 from the current state:
+ * constraints at t1, the damping matrix where it must be rebuilt, Newton. */
+static fcm_status run_substep(fcm_integrator *I, int dyn, double h, double t1,
+                              fcm_step_reason *reason, double *residual, double *tol,
+                              sim_stats *stats)
+{
+  fcm_status st = FCM_OK;
+  fcm__sim_eval_constraints(I, t1);
+  memcpy(I->un, I->u, sizeof(double) * (size_t)I->n);
+  if (dyn && I->D && (!I->linear || I->damp_version == 0))
+    FCM_TRY(I->ctx, update_damping(I, reason, stats));
+  if (*reason == FCM_STEP_NONE)
+    FCM_TRY(I->ctx, fcm__sim_newton(I, h, t1, reason, residual, tol, stats));
+cleanup:
+  return st;
+}
+
+/* Gather phase of a converged step: time, the static load, the energies. */
+static fcm_status accept_step(fcm_integrator *I, int dyn, double t0, fcm_step_info *info)
+{
+  fcm_status st = FCM_OK;
+  fcm_index n = I->n;
+  double ekin = 0.0;
+  I->t = t0 + I->opts.dt;
+  I->steps++;
+  if (!dyn) memcpy(I->load_prev, I->fext, sizeof(double) * (size_t)n);
+  if (dyn) {
+    st = fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1);
+    ekin = 0.5 * dot(n, I->v, I->w1);
+  }
+  info->kinetic_energy = ekin;
+  info->elastic_energy = I->psi;
+  info->external_work = dot(n, I->fext, I->u);
+  info->total_energy = ekin + I->psi - info->external_work;
+  return st;
+}
+
+/* Gather phase of a failed step: back to the state at its start; a soft failure
+ * becomes the error that says why (st is a hard error already recorded, or FCM_OK). */
+static fcm_status reject_step(fcm_integrator *I, fcm_status st, fcm_step_reason reason,
+                              double t0, const fcm_step_info *info)
+{
+  fcm_index n = I->n;
+  memcpy(I->u, I->u_bak, sizeof(double) * (size_t)n);
+  memcpy(I->v, I->v_bak, sizeof(double) * (size_t)n);
+  memcpy(I->load_prev, I->lp_bak, sizeof(double) * (size_t)n);
+  fcm__sim_eval_constraints(I, I->t);
+  if (!I->linear) I->h_state = SIM_H_INVALID;
+  if (st == FCM_OK)
+    st = fcm__error(I->ctx, reason == FCM_STEP_NONFINITE ? FCM_ERR_NUMERIC : FCM_ERR_NOT_CONVERGED,
+                    __FILE__, __LINE__, __func__,
+                    "integrator: step %lld from t = %g failed after %d halving(s) (last dt = "
+                    "%g): %s, residual %g vs tolerance %g; state left at t = %g",
+                    I->steps + 1, t0, info->halvings, info->dt, fcm_step_reason_str(reason),
+                    info->residual, info->tolerance, I->t);
+  return st;
+}
+
+/* Statistics phase: the step's counters and times, the cumulative ones. */
+static void record_step_statistics(const fcm_integrator *I, const sim_stats *stats,
+                                   double t_begin, fcm_step_info *info)
+{
+  info->time = I->t;
+  info->newton_iterations = stats->newton_iterations;
+  info->line_search_backtracks = stats->backtracks;
+  info->linear_iterations = stats->linear_iterations;
+  info->tangent_assemblies = stats->tangent_assemblies;
+  info->factorizations = stats->factorizations;
+  info->direct_fallbacks = stats->direct_fallbacks;
+  info->projection_fallbacks = stats->projection_fallbacks;
+  info->inexact_solves = stats->inexact_solves;
+  info->total_analyses = fcm__sim_analyses(I);
+  info->total_factorizations = I->total_factorizations;
+  info->total_direct_fallbacks = I->total_fallbacks;
+  info->time_assembly = stats->time_assembly;
+  info->time_factor = stats->time_factor;
+  info->time_solve = stats->time_solve;
+  info->time_total = fcm_wtime() - t_begin;
+}
+
+/* A step of dt in 2^max_halvings units (static: load_steps x 2^max_halvings): substeps
+ * of the current size; a failed substep is retried at half the size, down to one unit. */
 fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
 {
   fcm_status st = FCM_OK;
@@ -412,12 +547,11 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
   FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
   FCM_CHECK(I->is_setup, I->ctx, FCM_ERR_ARG, "integrator: call fcm_integrator_setup() first");
   {
-    fcm_ctx *ctx = I->ctx;
     const fcm_integrator_options *o = &I->opts;
     fcm_index n = I->n;
     int dyn = o->kind == FCM_INTEGRATOR_BACKWARD_EULER;
     double t_begin = fcm_wtime(), t0 = I->t, residual = 0.0, tol = 0.0;
-    int H = o->max_halvings, level = 0, done_ok = 0;
+    int H = o->max_halvings, level = 0;
     long long units = (long long)(dyn ? 1 : o->load_steps) << H, done = 0;
     fcm_step_reason reason = FCM_STEP_NONE;
     memcpy(I->u_bak, I->u, sizeof(double) * (size_t)n);
@@ -427,39 +561,22 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
 
     while (done < units) {
       long long size = 1LL << (H - level);
+      int last = done + size == units;
       double s1 = (double)(done + size) / (double)units;
-      double t1 = done + size == units ? t0 + o->dt : t0 + s1 * o->dt;
+      double t1 = last ? t0 + o->dt : t0 + s1 * o->dt;
       double h = dyn ? ldexp(o->dt, -level) : 0.0;
-      if (dyn)
-        fcm__sim_eval_loads(I, t1, I->fext);
-      else if (done + size == units) /* exactly f_ext(t0 + dt): what set_state() restores */
-        memcpy(I->fext, I->fend, sizeof(double) * (size_t)n);
-      else
-        for (fcm_index i = 0; i < n; i++)
-          I->fext[i] = I->lp_bak[i] + s1 * (I->fend[i] - I->lp_bak[i]);
-      if (!all_finite(n, I->fext)) {
+      if (!substep_load(I, dyn, t1, s1, last)) {
         reason = FCM_STEP_NONFINITE;
-        st = fcm__error(ctx, FCM_ERR_NUMERIC, __FILE__, __LINE__, __func__,
+        st = fcm__error(I->ctx, FCM_ERR_NUMERIC, __FILE__, __LINE__, __func__,
                         "integrator: the external load is not finite at t = %g (a load's "
                         "time scale or field returned NaN or infinity)",
                         t1);
         break;
       }
-      fcm__sim_eval_constraints(I, t1);
-      memcpy(I->un, I->u, sizeof(double) * (size_t)n);
-      if (dyn && I->D && (!I->linear || I->damp_version == 0)) {
-        st = update_damping(I, &reason, &stats);
-        if (st != FCM_OK) {
-          fcm__trace(ctx, __FILE__, __LINE__, __func__);
-          break;
-        }
-      }
-      if (reason == FCM_STEP_NONE) {
-        st = fcm__sim_newton(I, h, t1, &reason, &residual, &tol, &stats);
-        if (st != FCM_OK) {
-          fcm__trace(ctx, __FILE__, __LINE__, __func__);
-          break;
-        }
+      st = run_substep(I, dyn, h, t1, &reason, &residual, &tol, &stats);
+      if (st != FCM_OK) {
+        fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
+        break;
       }
       info->dt = dyn ? h : o->dt * (double)size / (double)units;
       if (reason == FCM_STEP_CONVERGED) {
@@ -471,61 +588,22 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
         reason = done < units ? FCM_STEP_NONE : reason;
         continue;
       }
-      info->failed_attempts++;
+      info->failed_attempts++; /* retry the substep at half the size */
       memcpy(I->u, I->un, sizeof(double) * (size_t)n);
       if (!I->linear) I->h_state = SIM_H_INVALID;
       if (level >= H) break;
       level++;
       reason = FCM_STEP_NONE;
     }
-    done_ok = st == FCM_OK && reason == FCM_STEP_CONVERGED;
     info->reason = reason;
     info->halvings = level;
     info->residual = residual;
     info->tolerance = tol;
-    if (done_ok) {
-      I->t = t0 + o->dt;
-      I->steps++;
-      if (!dyn) memcpy(I->load_prev, I->fext, sizeof(double) * (size_t)n);
-      double ekin = 0.0;
-      if (dyn) {
-        st = fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1);
-        ekin = 0.5 * dot(n, I->v, I->w1);
-      }
-      info->kinetic_energy = ekin;
-      info->elastic_energy = I->psi;
-      info->external_work = dot(n, I->fext, I->u);
-      info->total_energy = ekin + I->psi - info->external_work;
-    } else {
-      memcpy(I->u, I->u_bak, sizeof(double) * (size_t)n);
-      memcpy(I->v, I->v_bak, sizeof(double) * (size_t)n);
-      memcpy(I->load_prev, I->lp_bak, sizeof(double) * (size_t)n);
-      fcm__sim_eval_constraints(I, I->t);
-      if (!I->linear) I->h_state = SIM_H_INVALID;
-      if (st == FCM_OK)
-        st = fcm__error(ctx, reason == FCM_STEP_NONFINITE ? FCM_ERR_NUMERIC : FCM_ERR_NOT_CONVERGED,
-                        __FILE__, __LINE__, __func__,
-                        "integrator: step %lld from t = %g failed after %d halving(s) (last dt = "
-                        "%g): %s, residual %g vs tolerance %g; state left at t = %g",
-                        I->steps + 1, t0, level, info->dt, fcm_step_reason_str(reason), residual,
-                        tol, I->t);
-    }
-    info->time = I->t;
-    info->newton_iterations = stats.newton_iterations;
-    info->line_search_backtracks = stats.backtracks;
-    info->linear_iterations = stats.linear_iterations;
-    info->tangent_assemblies = stats.tangent_assemblies;
-    info->factorizations = stats.factorizations;
-    info->direct_fallbacks = stats.direct_fallbacks;
-    info->projection_fallbacks = stats.projection_fallbacks;
-    info->inexact_solves = stats.inexact_solves;
-    info->total_analyses = fcm__sim_analyses(I);
-    info->total_factorizations = I->total_factorizations;
-    info->total_direct_fallbacks = I->total_fallbacks;
-    info->time_assembly = stats.time_assembly;
-    info->time_factor = stats.time_factor;
-    info->time_solve = stats.time_solve;
-    info->time_total = fcm_wtime() - t_begin;
+    if (st == FCM_OK && reason == FCM_STEP_CONVERGED)
+      st = accept_step(I, dyn, t0, info);
+    else
+      st = reject_step(I, st, reason, t0, info);
+    record_step_statistics(I, &stats, t_begin, info);
   }
 cleanup:
   return st;

@@ -34,7 +34,8 @@ typedef struct sim_stats {
 
 struct fcm_integrator {
   fcm_ctx *ctx;
-  fcm_space *space;
+  const fcm_space *space;
+  fcm_assembly_workspace *aws; /* assembly rules and scratch (setup) */
   fcm_material mat;
   fcm_material_params params;     /* project_psd as the options say */
   fcm_material_params params_psd; /* project_psd = 1 (fallback, damping) */

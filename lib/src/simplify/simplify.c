@@ -224,6 +224,213 @@ static void append_message(fcm_simplify_info *info, int attempt, fcm_simplify_me
              len ? "; " : "", attempt, fcm_simplify_method_name(method), tol, msg);
 }
 
+/* The attempts in order (DESIGN §6): the chosen path, the other path, the chosen path
+ * with a looser rank cut. */
+enum { ATTEMPT_CHOSEN, ATTEMPT_OTHER, ATTEMPT_LOOSER, ATTEMPT_COUNT };
+
+/* Working state of one fcm_simplify() call: the positive-weight points and the attempt. */
+typedef struct simplify_run {
+  fcm_ctx *ctx;
+  int ni;               /* input points */
+  int np;               /* points of positive weight */
+  int *map;             /* np: input index of each positive-weight point */
+  double *packed;       /* np x 3 copy when some weights are zero, else NULL */
+  const double *points; /* np x 3: the input or `packed` */
+  double scale;         /* np / total weight: the attempts see mean-1 weights */
+  double *w0, *moments, *phi;
+  fcm__attempt a;
+} simplify_run;
+
+/* Set-up phase: arguments, options, finite points and weights; *total is the weight sum. */
+static fcm_status check_input(fcm_ctx *ctx, int strength, fcm_index n, const double *points,
+                              const double *weights, const fcm_simplify_options *o,
+                              int force_lp_failure, int *ni, double *total)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(strength >= 0 && strength <= FCM_SIMPLIFY_MAX_STRENGTH, ctx, FCM_ERR_ARG,
+            "simplify: strength = %d out of range [0, %d]", strength, FCM_SIMPLIFY_MAX_STRENGTH);
+  FCM_CHECK(n >= 1, ctx, FCM_ERR_ARG, "simplify: n = %lld points, must be >= 1", (long long)n);
+  FCM_CHECK(points && weights, ctx, FCM_ERR_ARG, "simplify: points and weights must not be NULL");
+  FCM_TRY(ctx, check_options(ctx, o));
+  FCM_CHECK(force_lp_failure >= 0 && force_lp_failure <= 2, ctx, FCM_ERR_ARG,
+            "simplify: force_lp_failure = %d out of range [0, 2]", force_lp_failure);
+  FCM_TRY(ctx, fcm__index_to_int(ctx, n, "simplify: number of points", ni));
+  *total = 0.0;
+  for (int j = 0; j < *ni; j++) {
+    FCM_CHECK(isfinite(points[3 * (size_t)j]) && isfinite(points[3 * (size_t)j + 1]) &&
+                  isfinite(points[3 * (size_t)j + 2]),
+              ctx, FCM_ERR_ARG, "simplify: point %d = (%g, %g, %g) is not finite", j,
+              points[3 * (size_t)j], points[3 * (size_t)j + 1], points[3 * (size_t)j + 2]);
+    FCM_CHECK(weights[j] >= 0.0 && isfinite(weights[j]), ctx, FCM_ERR_ARG,
+              "simplify: weight %d = %g, weights must be finite and >= 0", j, weights[j]);
+    *total += weights[j];
+  }
+  FCM_CHECK(*total > 0.0 && isfinite(*total), ctx, FCM_ERR_ARG,
+            "simplify: total weight %g of %d points must be finite and > 0", *total, *ni);
+cleanup:
+  return st;
+}
+
+/* Set-up phase: points of zero weight take no part; r->points are the np others. */
+static fcm_status pack_positive(simplify_run *r, const double *points, const double *weights)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = r->ctx;
+  for (int j = 0; j < r->ni; j++)
+    r->np += weights[j] > 0.0;
+  FCM_ALLOC(ctx, (size_t)r->np, r->map);
+  for (int j = 0, k = 0; j < r->ni; j++)
+    if (weights[j] > 0.0) r->map[k++] = j;
+  r->points = points;
+  if (r->np < r->ni) {
+    FCM_ALLOC(ctx, 3 * (size_t)r->np, r->packed);
+    for (int k = 0; k < r->np; k++)
+      for (int d = 0; d < 3; d++)
+        r->packed[3 * (size_t)k + d] = points[3 * (size_t)r->map[k] + d];
+    r->points = r->packed;
+  }
+cleanup:
+  return st;
+}
+
+/* Set-up phase: mean-1 weights (with tiny weights GLPK reports "optimal" with w = 0,
+ * notes §4), the attempt's buffers and parameters, and the moments in the box basis. */
+static fcm_status setup_attempt(simplify_run *r, int strength, const double *weights,
+                                double total, const fcm_simplify_options *o,
+                                int force_lp_failure)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = r->ctx;
+  fcm__attempt *a = &r->a;
+  const int M = fcm__simplify_num_basis(strength), np = r->np;
+  r->scale = (double)np / total;
+  FCM_CHECK(isfinite(r->scale), ctx, FCM_ERR_ARG,
+            "simplify: total weight %g of %d points too small to normalize (> %g needed)", total,
+            r->ni, (double)np / DBL_MAX);
+  FCM_ALLOC(ctx, (size_t)np, r->w0);
+  for (int k = 0; k < np; k++)
+    r->w0[k] = weights[r->map[k]] * r->scale;
+  FCM_ALLOC(ctx, (size_t)M, r->moments);
+  FCM_ALLOC(ctx, (size_t)M, r->phi);
+  FCM_ALLOC(ctx, (size_t)M, a->support);
+  FCM_ALLOC(ctx, (size_t)M, a->w);
+  a->ctx = ctx;
+  a->n = np;
+  a->points = r->points;
+  a->w0 = r->w0;
+  a->moments = r->moments;
+  a->capacity = M;
+  a->lp.it_lim = o->lp_iteration_limit > 0 ? o->lp_iteration_limit : 20 * M + 1000;
+  a->lp.tm_lim = o->lp_time_limit;
+  a->lp.force_failure = force_lp_failure;
+  double t0 = fcm_wtime();
+  fcm__simplify_box(strength, np, r->points, &a->box);
+  for (int j = 0; j < np; j++) {
+    fcm__simplify_basis_eval(&a->box, r->points + 3 * (size_t)j, r->phi);
+    for (int i = 0; i < M; i++)
+      r->moments[i] += r->w0[j] * r->phi[i];
+  }
+  a->time_basis += fcm_wtime() - t0;
+cleanup:
+  return st;
+}
+
+/* Attempt phase: run the attempts until one passes the re-fit and verification;
+ * *success says whether one did. Failed attempts leave their reason and message in info. */
+static fcm_status run_attempts(simplify_run *r, const fcm_simplify_options *o,
+                               fcm_simplify_info *info, int *success)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = r->ctx;
+  fcm__attempt *a = &r->a;
+  fcm_simplify_method chosen = o->method;
+  if (chosen == FCM_SIMPLIFY_AUTO)
+    chosen = r->np > AUTO_RECOMBINE_RATIO * a->capacity ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
+  const fcm_simplify_method other =
+      chosen == FCM_SIMPLIFY_LP ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
+  fcm_simplify_method plan[ATTEMPT_COUNT];
+  double tols[ATTEMPT_COUNT];
+  plan[ATTEMPT_CHOSEN] = chosen, tols[ATTEMPT_CHOSEN] = o->rank_tol;
+  plan[ATTEMPT_OTHER] = other, tols[ATTEMPT_OTHER] = o->rank_tol;
+  plan[ATTEMPT_LOOSER] = chosen;
+  tols[ATTEMPT_LOOSER] = fmin(1e-3, fmax(100.0 * o->rank_tol, 1e-14));
+  *success = 0;
+  for (int k = 0; k < ATTEMPT_COUNT && !*success; k++) {
+    double residual = INFINITY;
+    a->rank_tol = tols[k];
+    a->count = 0;
+    a->rank = 0;
+    a->reason = FCM_SIMPLIFY_REASON_NONE;
+    a->message[0] = '\0';
+    info->attempts = k + 1;
+    info->method_used = plan[k];
+    if (plan[k] == FCM_SIMPLIFY_LP)
+      FCM_TRY(ctx, fcm__simplify_run_lp(a));
+    else
+      FCM_TRY(ctx, fcm__simplify_run_recombine(a));
+    if (a->reason == FCM_SIMPLIFY_REASON_NONE) {
+      double t0 = fcm_wtime();
+      st = refit_verify(a, o->residual_tol, &residual);
+      info->time_refit += fcm_wtime() - t0;
+      FCM_TRY(ctx, st);
+    }
+    info->rank = a->rank;
+    if (a->reason == FCM_SIMPLIFY_REASON_NONE) {
+      *success = 1;
+      info->residual = residual;
+    } else {
+      if (info->reason == FCM_SIMPLIFY_REASON_NONE) info->reason = a->reason;
+      append_message(info, k + 1, plan[k], tols[k], a->message);
+    }
+  }
+cleanup:
+  return st;
+}
+
+/* Gather phase: the support of the successful attempt in input numbering and scale. */
+static fcm_status gather_result(const simplify_run *r, fcm_simplify_result *out)
+{
+  fcm_status st = FCM_OK;
+  const fcm__attempt *a = &r->a;
+  FCM_ALLOC(r->ctx, (size_t)a->count, out->indices);
+  FCM_ALLOC(r->ctx, (size_t)a->count, out->weights);
+  for (int c = 0; c < a->count; c++) {
+    out->indices[c] = r->map[a->support[c]];
+    out->weights[c] = a->w[c] / r->scale;
+  }
+  out->count = a->count;
+cleanup:
+  return st;
+}
+
+/* Gather phase: the positive-weight points unchanged (np <= M). */
+static fcm_status keep_positive(const simplify_run *r, const double *weights,
+                                fcm_simplify_result *out)
+{
+  fcm_status st = FCM_OK;
+  FCM_ALLOC(r->ctx, (size_t)r->np, out->indices);
+  FCM_ALLOC(r->ctx, (size_t)r->np, out->weights);
+  for (int k = 0; k < r->np; k++) {
+    out->indices[k] = r->map[k];
+    out->weights[k] = weights[r->map[k]];
+  }
+  out->count = r->np;
+cleanup:
+  return st;
+}
+
+/* Statistics phase: the attempt's counters and times. */
+static void record_statistics(const fcm__attempt *a, double t_start, fcm_simplify_info *info)
+{
+  info->lp_iterations = a->lp_iterations;
+  info->num_lps = a->num_lps;
+  info->rounds = a->rounds;
+  info->time_basis = a->time_basis;
+  info->time_svd = a->time_svd;
+  info->time_lp = a->time_lp;
+  info->time_total = fcm_wtime() - t_start;
+}
+
 fcm_status fcm_simplify(fcm_ctx *ctx, int strength, fcm_index n, const double *points,
                         const double *weights, const fcm_simplify_options *opts,
                         fcm_simplify_result *out, fcm_simplify_info *info)
@@ -239,182 +446,67 @@ fcm_status fcm__simplify_hooked(fcm_ctx *ctx, int strength, fcm_index n, const d
   fcm_status st = FCM_OK;
   fcm_simplify_info local_info;
   fcm_simplify_options o = opts ? *opts : fcm_simplify_options_default();
-  fcm__attempt a;
-  double *w0 = NULL, *moments = NULL, *phi = NULL, *packed = NULL, total = 0.0;
-  int *map = NULL, ni = 0, np = 0, success = 0;
+  simplify_run r;
+  double total = 0.0;
+  int success = 0;
   const double t_start = fcm_wtime();
 
-  memset(&a, 0, sizeof a);
+  memset(&r, 0, sizeof r);
+  r.ctx = ctx;
   if (!info) info = &local_info;
   memset(info, 0, sizeof *info);
   if (!ctx) return FCM_ERR_ARG;
   FCM_CHECK(out, ctx, FCM_ERR_ARG, "simplify: out must not be NULL");
   memset(out, 0, sizeof *out);
   out->ctx = ctx;
-  FCM_CHECK(strength >= 0 && strength <= FCM_SIMPLIFY_MAX_STRENGTH, ctx, FCM_ERR_ARG,
-            "simplify: strength = %d out of range [0, %d]", strength, FCM_SIMPLIFY_MAX_STRENGTH);
-  FCM_CHECK(n >= 1, ctx, FCM_ERR_ARG, "simplify: n = %lld points, must be >= 1", (long long)n);
-  FCM_CHECK(points && weights, ctx, FCM_ERR_ARG, "simplify: points and weights must not be NULL");
-  FCM_TRY(ctx, check_options(ctx, &o));
-  FCM_CHECK(force_lp_failure >= 0 && force_lp_failure <= 2, ctx, FCM_ERR_ARG,
-            "simplify: force_lp_failure = %d out of range [0, 2]", force_lp_failure);
-  FCM_TRY(ctx, fcm__index_to_int(ctx, n, "simplify: number of points", &ni));
-  for (int j = 0; j < ni; j++) {
-    FCM_CHECK(isfinite(points[3 * (size_t)j]) && isfinite(points[3 * (size_t)j + 1]) &&
-                  isfinite(points[3 * (size_t)j + 2]),
-              ctx, FCM_ERR_ARG, "simplify: point %d = (%g, %g, %g) is not finite", j,
-              points[3 * (size_t)j], points[3 * (size_t)j + 1], points[3 * (size_t)j + 2]);
-    FCM_CHECK(weights[j] >= 0.0 && isfinite(weights[j]), ctx, FCM_ERR_ARG,
-              "simplify: weight %d = %g, weights must be finite and >= 0", j, weights[j]);
-    total += weights[j];
-  }
-  FCM_CHECK(total > 0.0 && isfinite(total), ctx, FCM_ERR_ARG,
-            "simplify: total weight %g of %d points must be finite and > 0", total, ni);
+  FCM_TRY(ctx,
+          check_input(ctx, strength, n, points, weights, &o, force_lp_failure, &r.ni, &total));
 
   const int M = fcm__simplify_num_basis(strength);
   info->n = n;
   info->num_basis = M;
   info->method_used = FCM_SIMPLIFY_AUTO;
-  if (ni <= M) {
+  if (r.ni <= M) { /* nothing to remove */
     info->skipped = 1;
-    FCM_TRY(ctx, keep_input(ctx, ni, weights, out));
+    FCM_TRY(ctx, keep_input(ctx, r.ni, weights, out));
     info->kept = out->count;
     goto cleanup;
   }
-
-  /* Points of zero weight take no part: work on the np points of positive weight. */
-  for (int j = 0; j < ni; j++)
-    np += weights[j] > 0.0;
-  FCM_ALLOC(ctx, (size_t)np, map);
-  for (int j = 0, k = 0; j < ni; j++)
-    if (weights[j] > 0.0) map[k++] = j;
-  if (np < ni) {
-    FCM_ALLOC(ctx, 3 * (size_t)np, packed);
-    for (int k = 0; k < np; k++)
-      for (int d = 0; d < 3; d++)
-        packed[3 * (size_t)k + d] = points[3 * (size_t)map[k] + d];
-    points = packed;
-  }
-  if (np <= M) {
+  FCM_TRY(ctx, pack_positive(&r, points, weights));
+  if (r.np <= M) { /* nothing to remove among the positive weights */
     info->skipped = 1;
-    FCM_ALLOC(ctx, (size_t)np, out->indices);
-    FCM_ALLOC(ctx, (size_t)np, out->weights);
-    for (int k = 0; k < np; k++) {
-      out->indices[k] = map[k];
-      out->weights[k] = weights[map[k]];
-    }
-    info->kept = out->count = np;
+    FCM_TRY(ctx, keep_positive(&r, weights, out));
+    info->kept = out->count;
     goto cleanup;
   }
-
-  /* Mean-1 weights: with tiny weights GLPK reports "optimal" with w = 0 (notes §4). */
-  const double scale = (double)np / total;
-  FCM_CHECK(isfinite(scale), ctx, FCM_ERR_ARG,
-            "simplify: total weight %g of %d points too small to normalize (> %g needed)", total,
-            ni, (double)np / DBL_MAX);
-  FCM_ALLOC(ctx, (size_t)np, w0);
-  for (int k = 0; k < np; k++)
-    w0[k] = weights[map[k]] * scale;
-  FCM_ALLOC(ctx, (size_t)M, moments);
-  FCM_ALLOC(ctx, (size_t)M, phi);
-  FCM_ALLOC(ctx, (size_t)M, a.support);
-  FCM_ALLOC(ctx, (size_t)M, a.w);
-  a.ctx = ctx;
-  a.n = np;
-  a.points = points;
-  a.w0 = w0;
-  a.moments = moments;
-  a.capacity = M;
-  a.lp.it_lim = o.lp_iteration_limit > 0 ? o.lp_iteration_limit : 20 * M + 1000;
-  a.lp.tm_lim = o.lp_time_limit;
-  a.lp.force_failure = force_lp_failure;
-  double t0 = fcm_wtime();
-  fcm__simplify_box(strength, np, points, &a.box);
-  for (int j = 0; j < np; j++) {
-    fcm__simplify_basis_eval(&a.box, points + 3 * (size_t)j, phi);
-    for (int i = 0; i < M; i++)
-      moments[i] += w0[j] * phi[i];
-  }
-  a.time_basis += fcm_wtime() - t0;
-
-  /* Attempts: the chosen path, the other path, the chosen path with a looser rank cut. */
-  fcm_simplify_method primary = o.method;
-  if (primary == FCM_SIMPLIFY_AUTO)
-    primary = np > AUTO_RECOMBINE_RATIO * M ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
-  const fcm_simplify_method other =
-      primary == FCM_SIMPLIFY_LP ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
-  const fcm_simplify_method plan[3] = {primary, other, primary};
-  const double tols[3] = {o.rank_tol, o.rank_tol, fmin(1e-3, fmax(100.0 * o.rank_tol, 1e-14))};
-  for (int k = 0; k < 3 && !success; k++) {
-    double residual = INFINITY;
-    a.rank_tol = tols[k];
-    a.count = 0;
-    a.rank = 0;
-    a.reason = FCM_SIMPLIFY_REASON_NONE;
-    a.message[0] = '\0';
-    info->attempts = k + 1;
-    info->method_used = plan[k];
-    if (plan[k] == FCM_SIMPLIFY_LP)
-      FCM_TRY(ctx, fcm__simplify_run_lp(&a));
-    else
-      FCM_TRY(ctx, fcm__simplify_run_recombine(&a));
-    if (a.reason == FCM_SIMPLIFY_REASON_NONE) {
-      t0 = fcm_wtime();
-      st = refit_verify(&a, o.residual_tol, &residual);
-      info->time_refit += fcm_wtime() - t0;
-      if (st != FCM_OK) {
-        fcm__trace(ctx, __FILE__, __LINE__, __func__);
-        goto cleanup;
-      }
-    }
-    info->rank = a.rank;
-    if (a.reason == FCM_SIMPLIFY_REASON_NONE) {
-      success = 1;
-      info->residual = residual;
-    } else {
-      if (info->reason == FCM_SIMPLIFY_REASON_NONE) info->reason = a.reason;
-      append_message(info, k + 1, plan[k], tols[k], a.message);
-    }
-  }
-
+  FCM_TRY(ctx, setup_attempt(&r, strength, weights, total, &o, force_lp_failure));
+  FCM_TRY(ctx, run_attempts(&r, &o, info, &success));
   if (success) {
-    FCM_ALLOC(ctx, (size_t)a.count, out->indices);
-    FCM_ALLOC(ctx, (size_t)a.count, out->weights);
-    for (int c = 0; c < a.count; c++) {
-      out->indices[c] = map[a.support[c]];
-      out->weights[c] = a.w[c] / scale;
-    }
-    out->count = a.count;
+    FCM_TRY(ctx, gather_result(&r, out));
   } else {
     info->fallback = 1;
     fcm__log(ctx, FCM_LOG_WARNING,
              "simplify: %lld points, strength %d: every attempt failed, the input rule is kept "
              "(%s)",
              (long long)n, strength, info->message);
-    FCM_TRY(ctx, keep_input(ctx, ni, weights, out));
+    FCM_TRY(ctx, keep_input(ctx, r.ni, weights, out));
   }
   info->kept = out->count;
 
 cleanup:
-  info->lp_iterations = a.lp_iterations;
-  info->num_lps = a.num_lps;
-  info->rounds = a.rounds;
-  info->time_basis = a.time_basis;
-  info->time_svd = a.time_svd;
-  info->time_lp = a.time_lp;
-  info->time_total = fcm_wtime() - t_start;
+  record_statistics(&r.a, t_start, info);
   if (st != FCM_OK && out) {
     fcm__free(ctx, out->indices);
     fcm__free(ctx, out->weights);
     memset(out, 0, sizeof *out);
   }
-  fcm__free(ctx, map);
-  fcm__free(ctx, packed);
-  fcm__free(ctx, w0);
-  fcm__free(ctx, moments);
-  fcm__free(ctx, phi);
-  fcm__free(ctx, a.support);
-  fcm__free(ctx, a.w);
+  fcm__free(ctx, r.map);
+  fcm__free(ctx, r.packed);
+  fcm__free(ctx, r.w0);
+  fcm__free(ctx, r.moments);
+  fcm__free(ctx, r.phi);
+  fcm__free(ctx, r.a.support);
+  fcm__free(ctx, r.a.w);
   return st;
 }
 

@@ -64,7 +64,7 @@ fcm_status fcm_jacobi_setup(fcm_jacobi *P, const fcm_csr *A)
             (long long)nr, (long long)nc, (long long)P->n, (long long)P->n);
   P->ready = 0;
   P->fallbacks = 0;
-  const double *vals = fcm_csr_get_values((fcm_csr *)A); /* read only */
+  const double *vals = fcm_csr_get_values_read(A);
   if (P->kind == FCM_JACOBI_SCALAR) {
     for (fcm_index i = 0; i < P->n; i++)
       FCM_TRY(ctx, inverse_diagonal(ctx, i, entry(A, vals, i, i), &P->inv[i], &P->fallbacks));

@@ -192,7 +192,7 @@ fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
             "schwarz_setup: matrix is %lld x %lld, the preconditioner was created for %lld x %lld",
             (long long)nr, (long long)nc, (long long)P->n, (long long)P->n);
   P->ready = 0;
-  const double *vals = fcm_csr_get_values((fcm_csr *)C); /* read only */
+  const double *vals = fcm_csr_get_values_read(C);
   fcm_index fallbacks = 0;
   for (fcm_index i = 0; i < P->n; i++) {
     if (P->inside[i]) {
