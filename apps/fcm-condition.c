@@ -9,6 +9,7 @@
  * which vanishes on the clamped face X_1 = 0; dt = 1/60; K is the unprojected tangent at u
  * (possibly indefinite, then kappa = max|lambda| / min|lambda|). The clamped DOFs are
  * eliminated (removed), and every preconditioner is built on the reduced matrix. */
+#include "app_env.h"
 #include <fcm/core.h>
 #include <fcm/dense.h>
 #include <fcm/element.h>
@@ -891,6 +892,7 @@ static int write_png(const config *c, const char *path, const result *res, int n
 
 int main(int argc, char **argv)
 {
+  app_env_init(argc, argv); /* passive OpenMP waiting unless the user chose */
   fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   config c;
   memset(&c, 0, sizeof c);

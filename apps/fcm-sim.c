@@ -3,6 +3,7 @@
  * runs the beam demo: a cantilever under gravity, clamped at x = 0, solved statically on a
  * quadratic background grid, written for ParaView and compared with Timoshenko theory. */
 #define _POSIX_C_SOURCE 200809L
+#include "app_env.h"
 #include <fcm/fcm.h>
 #include <fcm/simulation.h>
 
@@ -629,6 +630,7 @@ done:
 
 int main(int argc, char **argv)
 {
+  app_env_init(argc, argv); /* passive OpenMP waiting unless the user chose */
   fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   for (int i = 1; i < argc; i++)
     if (!strcmp(argv[i], "--cantilever")) return demo_main(argc, argv);

@@ -48,3 +48,6 @@ add_test(NAME app_converge_rates_full COMMAND app_converge_rates full $<TARGET_F
          ${PROJECT_BINARY_DIR}/app-tests)
 set_tests_properties(app_converge_rates_full PROPERTIES LABELS "app;slow" TIMEOUT 7200
                      ENVIRONMENT "OMP_NUM_THREADS=2")
+# apps/app_env.c: passive OpenMP waiting by default, the user's OMP_WAIT_POLICY / GOMP_SPINCOUNT kept.
+fcm_add_test(app_env tests/apps/app_env.c LABELS app ARGS ${PROJECT_BINARY_DIR}/app-tests)
+target_sources(app_env PRIVATE ${PROJECT_SOURCE_DIR}/apps/app_env.c)
