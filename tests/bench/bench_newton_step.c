@@ -141,7 +141,11 @@ int main(int argc, char **argv)
               fcm_cell_rules_volume_fraction(rules, c) < 0.5;
   stamp t_create = FAR, t_setup = FAR;
   t0 = now();
-  TEST_OK(ctx, fcm_schwarz_create_from_space(ctx, space, A, flag, NULL, &P));
+  fcm_index nb = 0, nd = 0;
+  TEST_OK(ctx, fcm_space_cell_blocks(space, flag, &nb, &nd, NULL, NULL));
+  fcm_index *bptr = calloc((size_t)nb + 1, sizeof *bptr), *bdofs = calloc((size_t)nd + 1, sizeof *bdofs);
+  TEST_OK(ctx, fcm_space_cell_blocks(space, flag, &nb, &nd, bptr, bdofs));
+  TEST_OK(ctx, fcm_schwarz_create(ctx, A, nb, bptr, bdofs, NULL, &P));
   keep_min(&t_create, t0);
   for (int rep = 0; rep < NREP; rep++) {
     t0 = now();
@@ -273,6 +277,8 @@ int main(int argc, char **argv)
   free(nodes);
   free(fix);
   free(flag);
+  free(bptr);
+  free(bdofs);
   fcm_direct_destroy(&chol);
   fcm_krylov_destroy(&ws);
   fcm_schwarz_destroy(&P);
