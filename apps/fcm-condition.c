@@ -445,7 +445,7 @@ static fcm_status system_build(fcm_ctx *ctx, const config *c, fcm_mesh *mesh, do
   fcm_material_params mp;
   TRY(fcm_material_setup(ctx, &m, &mp));
   mp.project_psd = c->project; /* default 0: the unprojected tangent */
-  fcm_elastic el = {c->young, c->poisson, c->density};
+  fcm_material el = {FCM_MATERIAL_LINEAR, c->young, c->poisson, c->density};
   TRY(fcm_space_matrix_create(s->space, &s->A));
   TRY(fcm_space_matrix_create(s->space, &K));
   TRY(fcm_assemble_mass(s->space, &el, NULL, s->A));

@@ -583,7 +583,7 @@ static fcm_status assemble_system(const cv_study *S, fcm_space *space, int embed
                                   const unsigned char *staircase_keep, fcm_csr **K, double **f)
 {
   fcm_status st = FCM_OK;
-  const fcm_elastic mat = {S->s.young, S->s.poisson, 0.0};
+  const fcm_material mat = {FCM_MATERIAL_LINEAR, S->s.young, S->s.poisson, 0.0};
   load_data ld = {S};
   fcm_index ncon = 0, *dofs = NULL;
   double *vals = NULL;
@@ -680,8 +680,8 @@ fcm_status cv_study_create(fcm_ctx *ctx, const cv_setup *setup, cv_study **study
   if (!S) return FCM_ERR_ALLOC;
   S->ctx = ctx;
   S->s = *setup;
-  const fcm_elastic mat = {setup->young, setup->poisson, 0.0};
-  st = fcm_elastic_lame(ctx, &mat, &S->lambda, &S->mu);
+  const fcm_material mat = {FCM_MATERIAL_LINEAR, setup->young, setup->poisson, 0.0};
+  st = fcm_material_lame(ctx, &mat, &S->lambda, &S->mu);
   if (st == FCM_OK) st = fcm_geometry_create_hemisphere(ctx, c, setup->radius, setup->geom_n, &S->geom);
   if (st == FCM_OK)
     st = tet_index_create(ctx, fcm_geometry_coords(S->geom), fcm_geometry_cells(S->geom), 4,
@@ -915,7 +915,7 @@ fcm_status cv_run(cv_study *S, const fcm_mesh *mesh, const fcm_cell_rules *err_r
     if (st != FCM_OK) goto done;
     t0 = stamp_lap(t0, &r->t_rules, &r->c_rules);
     fcm_rule *std_rule = NULL;
-    st = fcm_element_standard_rule(ctx, info->type, FCM_INTEGRAND_STIFFNESS, 0, &std_rule);
+    st = fcm_element_standard_rule(ctx, info->type, FCM_RULE_STIFFNESS, 0, &std_rule);
     if (st != FCM_OK) goto done;
     r->points = nkeep * fcm_rule_num_points(std_rule);
     r->strength = fcm_rule_strength(std_rule);

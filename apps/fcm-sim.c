@@ -20,7 +20,7 @@ typedef struct options {
   fcm_element_type element;
   fcm_index cells[3];
   double length, width, height;
-  fcm_elastic mat;
+  fcm_material mat;
   double gravity;
   const char *outdir;
   int quiet;
@@ -163,7 +163,7 @@ static void cell_von_mises(const fcm_space *space, const options *o, const doubl
   const fcm_mesh *mesh = fcm_space_mesh(space);
   const fcm_element_info *info = fcm_mesh_element_info(mesh);
   double lambda = 0, mu = 0;
-  fcm_elastic_lame(NULL, &o->mat, &lambda, &mu);
+  fcm_material_lame(NULL, &o->mat, &lambda, &mu);
   double xi[3] = {0, 0, 0};
   if (info->shape == FCM_SHAPE_TET) xi[0] = xi[1] = xi[2] = 0.25;
   double dN[3 * FCM_ELEMENT_MAX_NODES];
@@ -229,7 +229,7 @@ static int ensure_dir(const char *dir)
 static int demo_main(int argc, char **argv)
 {
   options o = {FCM_ELEMENT_HEX20,     {32, 4, 4}, 8.0,          1.0, 1.0,
-               {2.1e11, 0.3, 7850.0}, 9.81,       "fcm-output", 0};
+               {FCM_MATERIAL_LINEAR, 2.1e11, 0.3, 7850.0}, 9.81, "fcm-output", 0};
   if (!parse_args(argc, argv, &o)) return 2;
 
   int rc = 1;
@@ -251,7 +251,7 @@ static int demo_main(int argc, char **argv)
   }
   {
     double lam, mu; /* validate the material before any work or output */
-    if (fcm_elastic_lame(ctx, &o.mat, &lam, &mu) != FCM_OK) {
+    if (fcm_material_lame(ctx, &o.mat, &lam, &mu) != FCM_OK) {
       fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
       rc = 2;
       goto done;

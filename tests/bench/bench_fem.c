@@ -15,7 +15,7 @@ int main(int argc, char **argv)
   double scale = argc > 1 ? atof(argv[1]) : 1.0; /* shrink for a quick look: bench_fem 0.5 */
   fcm_ctx *ctx = NULL;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
-  fcm_elastic mat = {1e7, 0.3, 1000};
+  fcm_material mat = {FCM_MATERIAL_LINEAR, 1e7, 0.3, 1000};
   printf("threads: %d\n", omp_get_max_threads());
   printf("%-6s %8s %9s %11s %10s %11s %10s %9s %9s %9s %9s %9s\n", "elem", "cells", "dofs",
          "nnz", "K [s]", "us/cell", "ns/nnz", "M [s]", "analyze", "factor", "GFLOP/s", "solve");

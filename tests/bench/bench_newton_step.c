@@ -213,7 +213,7 @@ int main(int argc, char **argv)
   fcm_material m = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 5e6, 0.48, 1000.0};
   fcm_material_params mp;
   TEST_OK(ctx, fcm_material_setup(ctx, &m, &mp));
-  fcm_elastic el = {5e6, 0.48, 1000.0};
+  fcm_material el = {FCM_MATERIAL_LINEAR, 5e6, 0.48, 1000.0};
   const double dt = 1.0 / 60.0, g[3] = {0, 0, -9.81};
   TEST_OK(ctx, fcm_space_matrix_create(space, &A));
   TEST_OK(ctx, fcm_space_matrix_create(space, &K));

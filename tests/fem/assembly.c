@@ -7,7 +7,7 @@
 
 #include <omp.h>
 
-static fcm_status assemble_K(fcm_space *space, const fcm_elastic *mat, fcm_csr **K)
+static fcm_status assemble_K(fcm_space *space, const fcm_material *mat, fcm_csr **K)
 {
   fcm_status st = fcm_space_matrix_create(space, K);
   if (st == FCM_OK) st = fcm_assemble_stiffness(space, mat, NULL, *K);
@@ -25,7 +25,7 @@ int main(int argc, char **argv)
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
   TEST_OK(ctx, distorted_box(ctx, type, 2, 0.25, &mesh));
   TEST_OK(ctx, fcm_space_create(ctx, mesh, NULL, &space));
-  fcm_elastic mat = {1.0e3, 0.25, 7.5};
+  fcm_material mat = {FCM_MATERIAL_LINEAR, 1.0e3, 0.25, 7.5};
   fcm_index n = fcm_space_num_dofs(space), nnodes = fcm_mesh_num_nodes(mesh);
   const double *X = fcm_mesh_coords(mesh);
   TEST_TRUE(n == 3 * nnodes);
@@ -90,7 +90,7 @@ int main(int argc, char **argv)
   TEST_TRUE(ev[6] > 1e-6 * lmax);
 
   /* Errors: wrong matrix, bad material, Dirichlet index out of range and twice. */
-  fcm_elastic bad = {1.0, 0.5, 1.0};
+  fcm_material bad = {FCM_MATERIAL_LINEAR, 1.0, 0.5, 1.0};
   TEST_ERR(ctx, fcm_assemble_stiffness(space, &bad, NULL, K), FCM_ERR_ARG, "nu = 0.5");
   bad.poisson = 0.3, bad.young = -1;
   TEST_ERR(ctx, fcm_assemble_mass(space, &bad, NULL, M), FCM_ERR_ARG, "E = -1");

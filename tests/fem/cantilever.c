@@ -6,7 +6,7 @@
 /* Timoshenko tip deflection of a cantilever under a uniform load q per length:
  * q L^4 / (8 E I) + q L^2 / (2 kappa G A), rectangular section b x h with
  * Cowper's shear coefficient kappa = 10 (1 + nu) / (12 + 11 nu). */
-static double timoshenko(double L, double b, double h, const fcm_elastic *m, double g)
+static double timoshenko(double L, double b, double h, const fcm_material *m, double g)
 {
   double A = b * h, I = b * h * h * h / 12.0, q = m->density * g * A;
   double G = m->young / (2.0 * (1.0 + m->poisson));
@@ -16,7 +16,7 @@ static double timoshenko(double L, double b, double h, const fcm_elastic *m, dou
 
 /* Deflection (-u_z) at the centre of the tip face, on a mesh of nx x n x n cells. */
 static double tip_deflection(fcm_ctx *ctx, fcm_element_type type, fcm_index nx, fcm_index n,
-                             const fcm_elastic *mat, double g)
+                             const fcm_material *mat, double g)
 {
   double lo[3] = {0, 0, 0}, hi[3] = {8, 1, 1}, accel[3] = {0, 0, -g}, result = NAN;
   fcm_index cells[3] = {nx, n, n}, nfix = 0;
@@ -57,7 +57,7 @@ int main(int argc, char **argv)
   fcm_element_type type;
   if (argc != 2 || fcm_element_type_from_name(argv[1], &type) != FCM_OK) return 2;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
-  fcm_elastic mat = {1.0e7, 0.3, 1000.0};
+  fcm_material mat = {FCM_MATERIAL_LINEAR, 1.0e7, 0.3, 1000.0};
   double ref = timoshenko(8.0, 1.0, 1.0, &mat, 9.81);
   double coarse = tip_deflection(ctx, type, 8, 2, &mat, 9.81);
   double fine = tip_deflection(ctx, type, 16, 4, &mat, 9.81);

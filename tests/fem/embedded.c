@@ -54,7 +54,7 @@ int main(int argc, char **argv)
   /* Stiffness on the stabilized embedded body: six rigid modes, no spurious zero modes
    * (without stabilization tiny cut cells give near-zero eigenvalues, DESIGN §7). */
   TEST_OK(ctx, fcm_space_matrix_create(space, &K));
-  fcm_elastic kmat = {1.0e3, 0.3, 1.0};
+  fcm_material kmat = {FCM_MATERIAL_LINEAR, 1.0e3, 0.3, 1.0};
   TEST_OK(ctx, fcm_assemble_stiffness(space, &kmat, NULL, K));
   int ni = (int)n;
   if (ni <= 1500) {
@@ -82,7 +82,7 @@ int main(int argc, char **argv)
   /* dropped cells lose their (tiny) volume */
   const fcm_cell_rules_stats *stats = fcm_cell_rules_get_stats(rules);
   double Vkept = stats->embedded_volume - stats->dropped_volume;
-  fcm_elastic mat = {1.0e3, 0.3, rho};
+  fcm_material mat = {FCM_MATERIAL_LINEAR, 1.0e3, 0.3, rho};
   TEST_OK(ctx, fcm_space_matrix_create(space, &M));
   TEST_OK(ctx, fcm_assemble_mass(space, &mat, NULL, M));
   TEST_OK(ctx, fcm_csr_apply(M, 1.0, ones, 0.0, y));

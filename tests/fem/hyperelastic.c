@@ -33,7 +33,7 @@ int main(int argc, char **argv)
   fcm_material lin = {FCM_MATERIAL_LINEAR, 1.0e4, 0.3, 1.0};
   fcm_material_params p;
   TEST_OK(ctx, fcm_material_setup(ctx, &lin, &p));
-  fcm_elastic el = {lin.young, lin.poisson, lin.density};
+  fcm_material el = {FCM_MATERIAL_LINEAR, lin.young, lin.poisson, lin.density};
   TEST_OK(ctx, fcm_space_matrix_create(space, &K));
   TEST_OK(ctx, fcm_space_matrix_create(space, &T));
   TEST_OK(ctx, fcm_assemble_stiffness(space, &el, NULL, K));

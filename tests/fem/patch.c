@@ -24,7 +24,7 @@ int main(int argc, char **argv)
   TEST_OK(ctx, distorted_box(ctx, type, 3, 0.25, &mesh));
   TEST_OK(ctx, fcm_space_create(ctx, mesh, NULL, &space));
   TEST_OK(ctx, fcm_space_matrix_create(space, &K));
-  fcm_elastic mat = {2.0e5, 0.3, 1.0};
+  fcm_material mat = {FCM_MATERIAL_LINEAR, 2.0e5, 0.3, 1.0};
   TEST_OK(ctx, fcm_assemble_stiffness(space, &mat, NULL, K));
 
   fcm_index n = fcm_space_num_dofs(space), nnodes = fcm_mesh_num_nodes(mesh), ncon = 0;

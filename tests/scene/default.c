@@ -60,9 +60,9 @@ int main(int argc, char **argv)
     for (int i = 0; i < fcm_scene_num_effects(a); i++) {
       const fcm_effect *e = fcm_scene_get_effect(a, i);
       if (e->type != FCM_EFFECT_MOTION) continue;
-      pushed += e->motion.velocity[1] != 0.0;
-      twisted += e->motion.angular_speed != 0.0 && e->motion.axis[1] == 1.0;
-      TEST_TRUE(e->motion.end < t->duration);
+      pushed += e->motion.motion.velocity[1] != 0.0;
+      twisted += e->motion.motion.angular_speed != 0.0 && e->motion.motion.axis[1] == 1.0;
+      TEST_TRUE(e->motion.motion.end < t->duration);
     }
     TEST_TRUE(pushed == 1 && twisted == 1);
 

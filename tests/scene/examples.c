@@ -165,12 +165,12 @@ static void check_papers(fcm_ctx *ctx, const char *dir)
     for (int i = 0; i < fcm_scene_num_effects(s); i++) {
       const fcm_effect *e = fcm_scene_get_effect(s, i);
       if (e->type != FCM_EFFECT_MOTION) continue;
-      TEST_TRUE(e->motion.end == 4 && !e->motion.release);
-      twisted += e->motion.angular_speed == 0.8 && e->motion.axis[1] == 1.0;
+      TEST_TRUE(e->motion.motion.end == 4 && !e->motion.motion.release);
+      twisted += e->motion.motion.angular_speed == 0.8 && e->motion.motion.axis[1] == 1.0;
       /* Held after the end: the displacement at 7 s equals that at 4 s. */
       double X[3] = {0.9, 8, 0.1}, u4[3], u7[3];
-      fcm_effect_motion_eval(&e->motion, X, 4.0, u4);
-      fcm_effect_motion_eval(&e->motion, X, 7.0, u7);
+      fcm_motion_eval(&e->motion.motion, X, 4.0, u4, NULL);
+      fcm_motion_eval(&e->motion.motion, X, 7.0, u7, NULL);
       for (int d = 0; d < 3; d++)
         TEST_TRUE(u4[d] == u7[d]);
     }
@@ -190,8 +190,8 @@ static void check_papers(fcm_ctx *ctx, const char *dir)
     for (int i = 0; i < fcm_scene_num_effects(s); i++) {
       const fcm_effect *e = fcm_scene_get_effect(s, i);
       if (e->type != FCM_EFFECT_MOTION) continue;
-      compress += e->motion.velocity[2] < 0 && e->motion.region.min[2] > 0;
-      twist += e->motion.angular_speed != 0 && e->motion.axis[2] == 1.0;
+      compress += e->motion.motion.velocity[2] < 0 && e->motion.region.min[2] > 0;
+      twist += e->motion.motion.angular_speed != 0 && e->motion.motion.axis[2] == 1.0;
     }
     TEST_TRUE(compress == 1 && twist == 1);
   }
@@ -206,15 +206,15 @@ static void check_papers(fcm_ctx *ctx, const char *dir)
     TEST_TRUE(fcm_scene_count_effects(s, FCM_EFFECT_FIXED) >= 1);
     for (int i = 0; i < fcm_scene_num_effects(s); i++) {
       const fcm_effect *e = fcm_scene_get_effect(s, i);
-      if (e->type == FCM_EFFECT_MOTION && e->motion.release) {
+      if (e->type == FCM_EFFECT_MOTION && e->motion.motion.release) {
         released++;
-        TEST_TRUE(fcm_effect_motion_active(&e->motion, e->motion.end));
-        TEST_TRUE(!fcm_effect_motion_active(&e->motion, e->motion.end + 0.01));
-        TEST_TRUE(e->motion.end < fcm_scene_get_time(s)->duration);
+        TEST_TRUE(fcm_motion_active(&e->motion.motion, e->motion.motion.end));
+        TEST_TRUE(!fcm_motion_active(&e->motion.motion, e->motion.motion.end + 0.01));
+        TEST_TRUE(e->motion.motion.end < fcm_scene_get_time(s)->duration);
       }
     }
     TEST_TRUE(released == 1);
-    TEST_TRUE(fcm_scene_get_solver(s)->method != FCM_SCENE_SOLVER_DIRECT);
+    TEST_TRUE(fcm_scene_get_solver(s)->method != FCM_LINEAR_DIRECT);
   }
   fcm_scene_destroy(&s);
 

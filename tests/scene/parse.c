@@ -66,23 +66,23 @@ static void check_full(fcm_ctx *ctx)
 
   const fcm_scene_quadrature *q = fcm_scene_get_quadrature(s);
   TEST_TRUE(q->stiffness_strength == 5 && q->mass_strength == 7 && q->surface_strength == 6);
-  TEST_TRUE(q->simplify == 0 && q->simplify_method == FCM_SCENE_SIMPLIFY_RECOMBINE);
-  TEST_TRUE(q->stabilization == FCM_SCENE_STABILIZATION_MASS && q->stabilization_alpha == 1e-8);
+  TEST_TRUE(q->simplify == 0 && q->simplify_method == FCM_SIMPLIFY_RECOMBINE);
+  TEST_TRUE(q->stabilization.mode == FCM_STABILIZATION_MASS && q->stabilization.alpha == 1e-8);
   TEST_TRUE(q->min_fraction == 0.001);
 
   const fcm_scene_solver *so = fcm_scene_get_solver(s);
-  TEST_TRUE(so->method == FCM_SCENE_SOLVER_MINRES && so->direct == FCM_DIRECT_UMFPACK);
-  TEST_TRUE(so->preconditioner == FCM_SCENE_PRECONDITIONER_BLOCK_JACOBI);
-  TEST_TRUE(so->schwarz_threshold == 0.25 && so->schwarz_epsilon == 1e-12 &&
-            so->schwarz_paper_clamp == 1);
+  TEST_TRUE(so->method == FCM_LINEAR_MINRES && so->direct == FCM_DIRECT_UMFPACK);
+  TEST_TRUE(so->preconditioner == FCM_PRECOND_BLOCK_JACOBI);
+  TEST_TRUE(so->schwarz_threshold == 0.25 && so->schwarz.epsilon == 1e-12 &&
+            so->schwarz.clamp == FCM_SCHWARZ_PAPER);
   TEST_TRUE(so->rtol == 1e-6 && so->atol == 1e-12 && so->max_iterations == 321);
   TEST_TRUE(so->newton_rtol == 1e-4 && so->newton_max_iterations == 17);
   TEST_TRUE(so->line_search == 0 && so->project_psd == 1);
   TEST_TRUE(so->representative_acceleration == 10 && so->threads == 3);
-  TEST_TRUE(so->newton_rule == FCM_SCENE_NEWTON_RELATIVE);
+  TEST_TRUE(so->newton_rule == FCM_NEWTON_TOL_RELATIVE);
 
   const fcm_scene_time *t = fcm_scene_get_time(s);
-  TEST_TRUE(!t->is_static && t->integrator == FCM_SCENE_INTEGRATOR_BACKWARD_EULER);
+  TEST_TRUE(t->integrator == FCM_INTEGRATOR_BACKWARD_EULER);
   TEST_TRUE(t->dt == 0.02 && t->num_steps == 75 && t->load_steps == 1);
   TEST_NEAR(t->duration, 1.5, 1e-15, 0);
 
@@ -117,11 +117,11 @@ static void check_full(fcm_ctx *ctx)
   e = fcm_scene_get_effect(s, 2);
   TEST_TRUE(e->type == FCM_EFFECT_MOTION && e->motion.region.kind == FCM_REGION_BOX);
   TEST_TRUE(e->motion.region.tolerance == 0.01);
-  check_vec(e->motion.velocity, 0.1, 0.2, 0.3);
-  check_vec(e->motion.axis, 0, 1, 0);
-  check_vec(e->motion.center, 1, 0, 1);
-  TEST_TRUE(e->motion.angular_speed == -0.5 && e->motion.start == 0.25 && e->motion.end == 1.25 &&
-            e->motion.release == 1);
+  check_vec(e->motion.motion.velocity, 0.1, 0.2, 0.3);
+  check_vec(e->motion.motion.axis, 0, 1, 0);
+  check_vec(e->motion.motion.center, 1, 0, 1);
+  TEST_TRUE(e->motion.motion.angular_speed == -0.5 && e->motion.motion.start == 0.25 && e->motion.motion.end == 1.25 &&
+            e->motion.motion.release == 1);
   const double in_tol[3] = {0, -2.005, 0}, out_tol[3] = {0, -2.02, 0};
   TEST_TRUE(fcm_region_contains(&e->motion.region, in_tol));
   TEST_TRUE(!fcm_region_contains(&e->motion.region, out_tol));
@@ -198,21 +198,21 @@ static void check_defaults(fcm_ctx *ctx)
   TEST_TRUE(m->model == FCM_MATERIAL_STABLE_NEO_HOOKEAN && m->density == 1000);
   const fcm_scene_quadrature *q = fcm_scene_get_quadrature(s);
   TEST_TRUE(q->stiffness_strength == -1 && q->mass_strength == -1 && q->surface_strength == -1);
-  TEST_TRUE(q->simplify == 1 && q->simplify_method == FCM_SCENE_SIMPLIFY_AUTO);
-  TEST_TRUE(q->stabilization == FCM_SCENE_STABILIZATION_MASS_STIFFNESS);
-  TEST_TRUE(q->stabilization_alpha == 1e-6 && q->min_fraction == 1e-4);
+  TEST_TRUE(q->simplify == 1 && q->simplify_method == FCM_SIMPLIFY_AUTO);
+  TEST_TRUE(q->stabilization.mode == FCM_STABILIZATION_MASS_STIFFNESS);
+  TEST_TRUE(q->stabilization.alpha == 1e-6 && q->min_fraction == 1e-4);
   const fcm_scene_solver *so = fcm_scene_get_solver(s);
-  TEST_TRUE(so->method == FCM_SCENE_SOLVER_DIRECT && so->direct == FCM_DIRECT_CHOLMOD);
-  TEST_TRUE(so->preconditioner == FCM_SCENE_PRECONDITIONER_SCHWARZ);
-  TEST_TRUE(so->schwarz_threshold == 0.5 && so->schwarz_epsilon == 1e-13 &&
-            so->schwarz_paper_clamp == 0);
+  TEST_TRUE(so->method == FCM_LINEAR_DIRECT && so->direct == FCM_DIRECT_CHOLMOD);
+  TEST_TRUE(so->preconditioner == FCM_PRECOND_SCHWARZ);
+  TEST_TRUE(so->schwarz_threshold == 0.5 && so->schwarz.epsilon == 1e-13 &&
+            so->schwarz.clamp == FCM_SCHWARZ_CLAMP);
   TEST_TRUE(so->rtol == 1e-8 && so->atol == 0 && so->max_iterations == 1000);
   TEST_TRUE(so->newton_rtol == 1e-5 && so->newton_max_iterations == 100);
   TEST_TRUE(so->line_search == 1 && so->project_psd == 0);
   TEST_TRUE(so->representative_acceleration == 9.81 && so->threads == 0);
-  TEST_TRUE(so->newton_rule == FCM_SCENE_NEWTON_AUTO);
+  TEST_TRUE(so->newton_rule == FCM_NEWTON_TOL_AUTO);
   const fcm_scene_time *t = fcm_scene_get_time(s);
-  TEST_TRUE(!t->is_static && t->dt == 1.0 / 60.0 && t->num_steps == 60 && t->load_steps == 1);
+  TEST_TRUE(t->integrator == FCM_INTEGRATOR_BACKWARD_EULER && t->dt == 1.0 / 60.0 && t->num_steps == 60 && t->load_steps == 1);
   TEST_NEAR(t->duration, 1.0, 1e-15, 0);
   const fcm_scene_output *o = fcm_scene_get_output(s);
   TEST_TRUE(!strcmp(o->directory, "fcm-output") && o->frame_interval == 1);
@@ -237,21 +237,22 @@ static void check_defaults(fcm_ctx *ctx)
                    "s.json", &s));
   if (s) {
     const fcm_scene_time *ts = fcm_scene_get_time(s);
-    TEST_TRUE(ts->is_static && ts->num_steps == 1 && ts->dt == 1.0 / 60.0);
+    TEST_TRUE(ts->integrator == FCM_INTEGRATOR_STATIC && ts->num_steps == 1 && ts->dt == 1.0 / 60.0);
     check_vec(fcm_scene_get_effect(s, 0)->gravity.acceleration, 0, 0, -9.81);
     const fcm_effect_fixed *fx = &fcm_scene_get_effect(s, 1)->fixed;
     TEST_TRUE(fx->components[0] && fx->components[1] && fx->components[2]);
     TEST_TRUE(fx->region.tolerance == 1e-9);
-    const fcm_effect_motion *mo = &fcm_scene_get_effect(s, 2)->motion;
+    const fcm_motion *mo = &fcm_scene_get_effect(s, 2)->motion.motion;
     check_vec(mo->velocity, 0, 0, 0);
     check_vec(mo->axis, 0, 0, 1);
     TEST_TRUE(mo->angular_speed == 0 && mo->start == 0 && mo->end == HUGE_VAL && !mo->release);
+    TEST_TRUE(mo->components[0] && mo->components[1] && mo->components[2]);
     /* A motion with no speeds holds its region in place at all times. */
     double u[3];
     const double X[3] = {0.3, -0.2, 0.9};
-    fcm_effect_motion_eval(mo, X, 5.0, u);
+    fcm_motion_eval(mo, X, 5.0, u, NULL);
     check_vec(u, 0, 0, 0);
-    TEST_TRUE(fcm_effect_motion_active(mo, 1e9));
+    TEST_TRUE(fcm_motion_active(mo, 1e9));
   }
   fcm_scene_destroy(&s);
 }
@@ -283,22 +284,23 @@ static void check_steps(fcm_ctx *ctx)
   }
 }
 
-/* Motion of the full scene's effect 2: rotation about the unit axis a through c by
- * omega tau plus translation v tau, tau clamped to [0, end - start]. */
+/* Motion of the full scene's effect 2, evaluated by fcm_motion_eval() (what the runner
+ * constrains): rotation about the unit axis a through c by omega tau plus translation
+ * v tau, tau clamped to [0, end - start]; velocity v + omega a x (x - c) while moving. */
 static void check_motion(fcm_ctx *ctx)
 {
   fcm_scene *s = NULL;
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, full_scene_json, "full.json", &s));
   if (!s) return;
-  const fcm_effect_motion *m = &fcm_scene_get_effect(s, 2)->motion;
+  const fcm_motion *m = &fcm_scene_get_effect(s, 2)->motion.motion;
   const double Xs[3][3] = {{2, 0.5, -1}, {-0.5, 3, 4}, {1, 7, 1}}; /* the last is on the axis */
   const double times[] = {0.0, 0.25, 0.6, 1.0, 1.25, 3.0};
   for (int i = 0; i < 3; i++) {
     const double *X = Xs[i];
     for (size_t k = 0; k < sizeof times / sizeof *times; k++) {
-      double t = times[k], u[3], y[3], r0[3], r1[3];
+      double t = times[k], u[3], v[3], y[3], r0[3], r1[3];
       double tau = fmin(fmax(t - 0.25, 0.0), 1.0);
-      fcm_effect_motion_eval(m, X, t, u);
+      fcm_motion_eval(m, X, t, u, v);
       for (int d = 0; d < 3; d++) {
         y[d] = X[d] + u[d] - m->velocity[d] * tau; /* undo the translation */
         r0[d] = X[d] - m->center[d];
@@ -318,11 +320,19 @@ static void check_motion(fcm_ctx *ctx)
       TEST_NEAR(dot3(p0, p1), rr * cos(phi), 1e-13, 1e-13);
       TEST_NEAR(dot3(c, m->axis), rr * sin(phi), 1e-13, 1e-13);
       if (t <= 0.25) TEST_TRUE(fabs(u[0]) + fabs(u[1]) + fabs(u[2]) == 0.0);
+      /* Velocity: v + omega a x (x - c) while start <= t < end, else 0. */
+      double w[3], ax[3];
+      cross3(m->axis, r1, ax);
+      int moving = t >= 0.25 && t < 1.25;
+      for (int d = 0; d < 3; d++)
+        w[d] = moving ? m->velocity[d] + m->angular_speed * ax[d] : 0.0;
+      for (int d = 0; d < 3; d++)
+        TEST_NEAR(v[d], w[d], 1e-12, 1e-13);
     }
   }
   /* Released after end: constrained up to end only. */
-  TEST_TRUE(fcm_effect_motion_active(m, 0.0) && fcm_effect_motion_active(m, 1.25));
-  TEST_TRUE(!fcm_effect_motion_active(m, 1.2500001));
+  TEST_TRUE(fcm_motion_active(m, 0.0) && fcm_motion_active(m, 1.25));
+  TEST_TRUE(!fcm_motion_active(m, 1.2500001));
 
   /* Initial velocity: v - v0 = omega x (X - c) is orthogonal to omega and to X - c, with
    * |omega x r|^2 = |omega|^2 |r|^2 - (omega . r)^2. */

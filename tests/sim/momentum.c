@@ -23,7 +23,7 @@ int main(int argc, char **argv)
   TEST_OK(ctx, fcm_space_create(ctx, mesh, NULL, &space));
   fcm_index n = fcm_space_num_dofs(space);
   fcm_material mat = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 1.0e5, 0.35, 800.0};
-  fcm_elastic el = {mat.young, mat.poisson, mat.density};
+  fcm_material el = {FCM_MATERIAL_LINEAR, mat.young, mat.poisson, mat.density};
   TEST_OK(ctx, fcm_space_matrix_create(space, &M));
   TEST_OK(ctx, fcm_assemble_mass(space, &el, NULL, M));
   double *Mv = calloc((size_t)n, sizeof *Mv), *ones = calloc((size_t)n, sizeof *ones);

@@ -5,7 +5,8 @@
  * stays 1 over 20 steps. (3) A uniformly compressed SNH body (F = 0.5 I) with a large
  * step and no tangent projection has an indefinite Newton matrix: CHOLMOD reports "not
  * positive definite", UMFPACK takes over (counted; a second analysis), and the step still
- * converges; with projection on CHOLMOD never fails. */
+ * converges; with projection on CHOLMOD never fails. Every fallback is logged once at
+ * FCM_LOG_WARNING through the ctx's log callback, naming UMFPACK; no fallback, no warning. */
 #include "sim_util.h"
 
 static fcm_status make(fcm_ctx *ctx, fcm_space *space, const fcm_material *mat,
@@ -20,15 +21,24 @@ static fcm_status make(fcm_ctx *ctx, fcm_space *space, const fcm_material *mat,
   return st;
 }
 
+static void count_warnings(void *user, fcm_log_level level, const char *msg)
+{
+  if (level == FCM_LOG_WARNING && strstr(msg, "UMFPACK")) ++*(int *)user;
+}
+
 int main(int argc, char **argv)
 {
+  int warnings = 0;
+  fcm_ctx_options co = fcm_ctx_options_default();
+  co.log = count_warnings;
+  co.log_user = &warnings;
   fcm_ctx *ctx = NULL;
   fcm_mesh *mesh = NULL, *cube = NULL;
   fcm_space *space = NULL, *cspace = NULL;
   fcm_integrator *integ = NULL;
   fcm_element_type type;
   if (argc < 2 || fcm_element_type_from_name(argv[1], &type) != FCM_OK) return 2;
-  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  TEST_OK(ctx, fcm_ctx_create(&co, &ctx));
   TEST_OK(ctx, beam_mesh(ctx, type, 4, 4.0, &mesh));
   TEST_OK(ctx, fcm_space_create(ctx, mesh, NULL, &space));
   fcm_index nfix = 0;
@@ -91,6 +101,7 @@ int main(int argc, char **argv)
       o.project_psd = project;
       o.tolerance_mode = FCM_NEWTON_TOL_RELATIVE;
       o.newton_tolerance = 1e-9;
+      warnings = 0;
       TEST_OK(ctx, make(ctx, cspace, &snh, &o, 0, NULL, NULL, &integ));
       TEST_OK(ctx, fcm_integrator_set_state(integ, u0, NULL, 0.0, 0));
       TEST_OK(ctx, fcm_integrator_step(integ, &info));
@@ -103,10 +114,12 @@ int main(int argc, char **argv)
       if (project) {
         TEST_TRUE(info.direct_fallbacks == 0);
         TEST_TRUE(info.total_analyses == 1);
+        TEST_TRUE(warnings == 0);
       } else {
         TEST_TRUE(info.direct_fallbacks >= 1);
         TEST_TRUE(info.total_direct_fallbacks == info.direct_fallbacks);
         TEST_TRUE(info.total_analyses == 2);
+        TEST_TRUE(warnings == info.direct_fallbacks);
       }
       /* It expanded back towards the reference (J grew from 1/8). */
       const double *u = fcm_integrator_displacement(integ);

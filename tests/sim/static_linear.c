@@ -24,7 +24,7 @@ static void reference(fcm_ctx *ctx, fcm_space *space, const fcm_material *m, fcm
   fcm_index n = fcm_space_num_dofs(space), nc = 0;
   fcm_csr *K = NULL;
   fcm_direct *chol = NULL;
-  fcm_elastic el = {m->young, m->poisson, m->density};
+  fcm_material el = {FCM_MATERIAL_LINEAR, m->young, m->poisson, m->density};
   double *f = calloc((size_t)n, sizeof *f), *vals = calloc((size_t)n, sizeof *vals);
   fcm_index *dofs = calloc((size_t)n, sizeof *dofs);
   TEST_OK(ctx, fcm_space_matrix_create(space, &K));

@@ -2,6 +2,7 @@
  * (k = 0, 1, 2, ... until the call succeeds), fcm_simplify on both paths and on the
  * fallback path returns FCM_ERR_ALLOC (never a fallback rule), leaves the result empty
  * and frees everything it allocated. */
+#include "simplify/simplify_impl.h"
 #include "simplify_util.h"
 #include "test_alloc.h"
 
@@ -24,14 +25,13 @@ int main(void)
   for (int variant = 0; variant < 3; variant++) {
     fcm_simplify_options o = fcm_simplify_options_default();
     o.method = variant == 1 ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
-    o.force_lp_failure = variant == 2;
     int succeeded = 0, failures = 0;
     for (long k = 0; k < 2000 && !succeeded; k++) {
       fcm_simplify_result res;
       fcm_simplify_info info;
       f.count = 0;
       f.fail_at = k;
-      fcm_status st = fcm_simplify(ctx, m, n, pts, w, &o, &res, &info);
+      fcm_status st = fcm__simplify_hooked(ctx, m, n, pts, w, &o, variant == 2, &res, &info);
       f.fail_at = -1;
       if (st == FCM_OK) {
         succeeded = 1;

@@ -1,5 +1,6 @@
 /* Error paths of fcm_simplify and fcm_stabilization_append: each bad argument gives
  * FCM_ERR_ARG with a message naming it, an empty result and no leak. */
+#include "simplify/simplify_impl.h"
 #include "simplify_util.h"
 
 #define EXPECT_ARG(call, substr)                                                                   \
@@ -61,8 +62,7 @@ int main(void)
   o.lp_time_limit = NAN;
   EXPECT_ARG(fcm_simplify(ctx, 2, N, pts, w, &o, &res, NULL), "lp_time_limit = nan");
   o = fcm_simplify_options_default();
-  o.force_lp_failure = 3;
-  EXPECT_ARG(fcm_simplify(ctx, 2, N, pts, w, &o, &res, NULL), "force_lp_failure = 3");
+  EXPECT_ARG(fcm__simplify_hooked(ctx, 2, N, pts, w, &o, 3, &res, NULL), "force_lp_failure = 3");
 
   /* Stabilization. */
   fcm_rule *hex = NULL, *quad = NULL;

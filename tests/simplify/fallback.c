@@ -2,15 +2,37 @@
  * 0, or driven into a fatal error that its error hook turns into a return), fcm_simplify
  * returns FCM_OK, info->fallback = 1 with the reason and GLPK's words, and the rule equal
  * to the input. GLPK prints nothing (stdout goes to a file that must stay empty), the
- * process survives, and the next normal call in the same thread succeeds. */
+ * process survives, and the next normal call in the same thread succeeds. Each fallback is
+ * logged once at FCM_LOG_WARNING through the ctx's log callback; a normal call logs nothing. */
+#include "simplify/simplify_impl.h"
 #include "simplify_util.h"
+
+typedef struct log_count {
+  int warnings, others;
+  char last[512];
+} log_count;
+
+static void count_log(void *user, fcm_log_level level, const char *msg)
+{
+  log_count *c = user;
+  if (level == FCM_LOG_WARNING) {
+    c->warnings++;
+    snprintf(c->last, sizeof c->last, "%s", msg);
+  } else {
+    c->others++;
+  }
+}
 
 int main(void)
 {
   fcm_ctx *ctx = NULL;
+  log_count logged = {0, 0, ""};
+  fcm_ctx_options co = fcm_ctx_options_default();
+  co.log = count_log;
+  co.log_user = &logged;
   const char *capture = "simplify_fallback_stdout.txt";
   if (!freopen(capture, "w", stdout)) return 1;
-  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  TEST_OK(ctx, fcm_ctx_create(&co, &ctx));
   if (!ctx) return TEST_RESULT();
   const int m = 3, M = util_num_basis(m), n = 5 * M;
   const double lo[3] = {-1, -1, -1};
@@ -23,8 +45,10 @@ int main(void)
       fcm_simplify_result res;
       fcm_simplify_info info;
       o.method = (fcm_simplify_method)mi;
-      o.force_lp_failure = force;
-      TEST_OK(ctx, fcm_simplify(ctx, m, n, pts, w, &o, &res, &info));
+      logged.warnings = 0;
+      TEST_OK(ctx, fcm__simplify_hooked(ctx, m, n, pts, w, &o, force, &res, &info));
+      TEST_TRUE(logged.warnings == 1 && logged.others == 0);
+      TEST_TRUE(strstr(logged.last, "simplify:") && strstr(logged.last, "input rule is kept"));
       TEST_TRUE(info.fallback == 1 && info.skipped == 0 && info.attempts == 3);
       TEST_TRUE(info.reason ==
                 (force == 1 ? FCM_SIMPLIFY_REASON_LP : FCM_SIMPLIFY_REASON_LP_ERROR));
@@ -39,9 +63,9 @@ int main(void)
       fcm_simplify_result_destroy(&res);
 
       /* GLPK's environment is usable again. */
-      o.force_lp_failure = 0;
       TEST_OK(ctx, fcm_simplify(ctx, m, n, pts, w, &o, &res, &info));
       TEST_TRUE(info.fallback == 0 && info.attempts == 1);
+      TEST_TRUE(logged.warnings == 1); /* nothing new */
       util_check("after forced failure", m, n, pts, w, &res, M, 1e-12);
       fcm_simplify_result_destroy(&res);
     }

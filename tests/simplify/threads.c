@@ -1,6 +1,7 @@
 /* Concurrency: eight cells simplified at once from OpenMP threads (both paths, one with a
  * forced GLPK fatal error in the middle) give exactly the results of serial calls: GLPK's
  * environment is per thread and fcm keeps no global state. */
+#include "simplify/simplify_impl.h"
 #include "simplify_util.h"
 
 #include <omp.h>
@@ -28,9 +29,9 @@ int main(void)
     for (int c = 0; c < CELLS; c++) {
       fcm_simplify_options o = fcm_simplify_options_default();
       o.method = c % 2 ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
-      o.force_lp_failure = c == 5 ? 2 : 0;
       st[c] =
-          fcm_simplify(ctx, m, n, pts + 3 * (size_t)n * c, w + (size_t)n * c, &o, &out[c], NULL);
+          fcm__simplify_hooked(ctx, m, n, pts + 3 * (size_t)n * c, w + (size_t)n * c, &o,
+                               c == 5 ? 2 : 0, &out[c], NULL);
     }
     for (int c = 0; c < CELLS; c++)
       TEST_TRUE(st[c] == FCM_OK);

@@ -77,7 +77,7 @@ int main(void)
     f.b[i] = rng_uniform(&r);
   const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
   const fcm_index cells[3] = {2, 2, 2};
-  fcm_elastic mat = {1.0, 0.3, 1.0};
+  fcm_material mat = {FCM_MATERIAL_LINEAR, 1.0, 0.3, 1.0};
   TEST_OK(ctx0, fcm_mesh_create_box(ctx0, FCM_ELEMENT_HEX20, lo, hi, cells, &mesh));
   TEST_OK(ctx0, fcm_space_create(ctx0, mesh, NULL, &f.space));
   TEST_OK(ctx0, fcm_space_matrix_create(f.space, &f.K));

@@ -40,7 +40,7 @@ int main(void)
   const int npc = fcm_mesh_nodes_per_cell(mesh);
 
   /* A = M + dt^2 K, clamped at x = 0 */
-  fcm_elastic mat = {3e6, 0.4, 1000.0};
+  fcm_material mat = {FCM_MATERIAL_LINEAR, 3e6, 0.4, 1000.0};
   const double dt = 1.0 / 60.0;
   TEST_OK(ctx, fcm_space_matrix_create(space, &A));
   TEST_OK(ctx, fcm_space_matrix_create(space, &K));

@@ -19,5 +19,6 @@
 #include "fcm/simulation.h"
 #include "fcm/solve.h"
 #include "fcm/simplify.h"
+#include "fcm/version.h"
 
 #endif /* FCM_FCM_H */

@@ -82,18 +82,6 @@ FCM_API fcm_status fcm_space_cell_blocks(const fcm_space *space, const unsigned 
                                          fcm_index *num_blocks, fcm_index *num_dofs,
                                          fcm_index *block_ptr, fcm_index *block_dofs);
 
-/** Isotropic linear elastic material. */
-typedef struct fcm_elastic {
-  double young;   /**< Young's modulus E > 0 */
-  double poisson; /**< Poisson's ratio, -1 < nu < 0.5 */
-  double density; /**< mass density rho >= 0 (mass and body force) */
-} fcm_elastic;
-
-/** Lame parameters of (E, nu): lambda = E nu / ((1 + nu)(1 - 2 nu)), mu = E / (2 (1 + nu)).
- * @return FCM_OK, FCM_ERR_ARG (E <= 0, nu outside (-1, 0.5), non-finite), message names the range. */
-FCM_API fcm_status fcm_elastic_lame(fcm_ctx *ctx, const fcm_elastic *mat, double *lambda,
-                                    double *mu);
-
 /** Quadrature strengths for assembly on full cells; 0 selects the default rule of
  * fcm_element_standard_rule(). */
 typedef struct fcm_assembly_options {
@@ -101,13 +89,9 @@ typedef struct fcm_assembly_options {
   int mass_strength;      /**< consistent mass */
 } fcm_assembly_options;
 
-/** Which element integral a standard rule is for. */
-typedef enum fcm_integrand {
-  FCM_INTEGRAND_STIFFNESS = 0, /**< gradients times gradients; also body force */
-  FCM_INTEGRAND_MASS = 1       /**< shape functions times shape functions */
-} fcm_integrand;
-
-/** The rule used on uncut (full) cells of `type` for `integrand`.
+/** The rule used on uncut (full) cells of `type` for the integral of `kind`
+ * (FCM_RULE_STIFFNESS: gradients times gradients, also body force; FCM_RULE_MASS: shape
+ * functions times shape functions).
  * strength <= 0 selects the default: for tetrahedra the catalogue rule
  * (fcm_rule_create) of the element's stiffness_strength or mass_strength; for
  * hexahedra the Gauss-Legendre tensor rule with order+1 points per direction
@@ -116,31 +100,33 @@ typedef enum fcm_integrand {
  * total-degree rules of the element strengths do neither (the Hex20 stiffness
  * integrand has total degree 6 but degree 4 per direction).
  * strength > 0 selects the catalogue rule of that strength for either shape.
- * @return FCM_OK, FCM_ERR_ARG (invalid type, strength > FCM_RULE_MAX_STRENGTH), FCM_ERR_ALLOC.
+ * @return FCM_OK, FCM_ERR_ARG (invalid type or kind, strength > FCM_RULE_MAX_STRENGTH), FCM_ERR_ALLOC.
  * Allocates *rule; release with fcm_rule_destroy(). Thread safe. */
 FCM_API fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type,
-                                             fcm_integrand integrand, int strength,
+                                             fcm_rule_kind kind, int strength,
                                              fcm_rule **rule);
 
 /** Defaults: both strengths 0 (element defaults). */
 FCM_API fcm_assembly_options fcm_assembly_options_default(void);
 
 /** Add the linear elastic stiffness K to A (A must come from
- * fcm_space_matrix_create() of this space). Cells are processed colour by colour,
+ * fcm_space_matrix_create() of this space). `mat` is validated (fcm_material_validate());
+ * its model is not used: the stiffness, mass and body force here are those of linear
+ * elasticity with the material's E, nu and density. Cells are processed colour by colour,
  * in parallel within a colour, so the result is bitwise independent of the
  * number of threads. @return FCM_OK, FCM_ERR_ARG (bad material, wrong matrix),
  * FCM_ERR_GEOMETRY (det J <= 0 at a quadrature point: the message names the cell),
  * FCM_ERR_ALLOC. Allocates per-thread element buffers. */
-FCM_API fcm_status fcm_assemble_stiffness(fcm_space *space, const fcm_elastic *mat,
+FCM_API fcm_status fcm_assemble_stiffness(fcm_space *space, const fcm_material *mat,
                                           const fcm_assembly_options *opts, fcm_csr *A);
 
 /** Add the consistent mass matrix (rho N_a N_b I) to A. Status codes as above. */
-FCM_API fcm_status fcm_assemble_mass(fcm_space *space, const fcm_elastic *mat,
+FCM_API fcm_status fcm_assemble_mass(fcm_space *space, const fcm_material *mat,
                                      const fcm_assembly_options *opts, fcm_csr *A);
 
 /** Add the body force of a uniform acceleration `accel` (e.g. gravity),
  * f_a += integral of rho accel N_a, to f (num_dofs entries). Status codes as above. */
-FCM_API fcm_status fcm_assemble_body_force(fcm_space *space, const fcm_elastic *mat,
+FCM_API fcm_status fcm_assemble_body_force(fcm_space *space, const fcm_material *mat,
                                            const double accel[3],
                                            const fcm_assembly_options *opts, double *f);
 

@@ -44,7 +44,7 @@ typedef struct fcm_material {
  * All members but project_psd are read-only results of the setup. */
 typedef struct fcm_material_params {
   fcm_material_model model;
-  double mu, lambda; /**< Lame parameters (the conversion of fcm_elastic_lame()) */
+  double mu, lambda; /**< Lame parameters (the conversion of fcm_material_lame()) */
   double snh_mu;     /**< mu' = 4 mu/3 (Stable Neo-Hookean; 0 for the other models) */
   double snh_lambda; /**< lambda' = lambda + 5 mu/6 (Stable Neo-Hookean; else 0) */
   double snh_alpha;  /**< alpha = 1 + 3 mu'/(4 lambda') (Stable Neo-Hookean; else 0) */
@@ -73,6 +73,12 @@ FCM_API fcm_status fcm_material_model_parse(fcm_ctx *ctx, const char *name,
  * @return FCM_OK or FCM_ERR_ARG; the message names the bad value and the valid range.
  * No allocation; thread safe (errors are recorded in ctx, which may be NULL). */
 FCM_API fcm_status fcm_material_validate(fcm_ctx *ctx, const fcm_material *mat);
+
+/** Validate `mat` (fcm_material_validate()) and return its Lame parameters
+ * lambda = E nu / ((1 + nu)(1 - 2 nu)), mu = E / (2 (1 + nu)); either output may be NULL.
+ * @return FCM_OK or FCM_ERR_ARG (as fcm_material_validate()). No allocation; thread safe. */
+FCM_API fcm_status fcm_material_lame(fcm_ctx *ctx, const fcm_material *mat, double *lambda,
+                                     double *mu);
 
 /** Validate `mat` and derive its evaluation parameters (project_psd = 0).
  * @param[in]  ctx    context for the error message (may be NULL)

@@ -14,6 +14,9 @@
 #include "fcm/element.h"
 #include "fcm/la.h"
 #include "fcm/material.h"
+#include "fcm/sim.h"
+#include "fcm/simplify.h"
+#include "fcm/solve.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -71,70 +74,38 @@ typedef struct fcm_scene_geometry {
   double offset[3];    /**< b */
 } fcm_scene_geometry;
 
-/** Rule simplification method (names "auto", "lp", "recombine"; fcm/simplify.h). */
-typedef enum fcm_scene_simplify_method {
-  FCM_SCENE_SIMPLIFY_AUTO = 0,
-  FCM_SCENE_SIMPLIFY_LP,
-  FCM_SCENE_SIMPLIFY_RECOMBINE
-} fcm_scene_simplify_method;
-
-/** Which matrices get cut-cell stabilization ("mass_stiffness", "mass", "off"). */
-typedef enum fcm_scene_stabilization {
-  FCM_SCENE_STABILIZATION_MASS_STIFFNESS = 0,
-  FCM_SCENE_STABILIZATION_MASS,
-  FCM_SCENE_STABILIZATION_OFF
-} fcm_scene_stabilization;
-
-/** Quadrature settings ("quadrature"). */
+/** Quadrature settings ("quadrature"). The enums and option structs are the library's own
+ * (fcm/simplify.h); the strengths use -1 for "automatic". */
 typedef struct fcm_scene_quadrature {
   int stiffness_strength; /**< [0, 20]; -1 (default): the element's default */
   int mass_strength;      /**< [0, 20]; -1 (default): the element's default */
   int surface_strength;   /**< [0, 20]; -1 (default): automatic (the stiffness strength when a
                                traction or pressure effect is present, else no surface rules) */
   int simplify;           /**< 1 (default): simplify cut-cell rules; 0: keep them */
-  fcm_scene_simplify_method simplify_method; /**< default AUTO */
-  fcm_scene_stabilization stabilization;     /**< default MASS_STIFFNESS */
-  double stabilization_alpha;                /**< (0, 1], default 1e-6 */
+  fcm_simplify_method simplify_method;     /**< "simplify_method": "auto" (default), "lp",
+                                                "recombine" */
+  fcm_stabilization_options stabilization; /**< "stabilization": mode "mass_stiffness"
+                                                (default), "mass", "off"; alpha in (0, 1],
+                                                default 1e-6 */
   double min_fraction; /**< cells with smaller volume fraction are dropped; [0, 1),
                             default 1e-4 */
 } fcm_scene_quadrature;
 
-/** Linear solver of the Newton steps ("direct", "minres", "cg"). */
-typedef enum fcm_scene_linear_solver {
-  FCM_SCENE_SOLVER_DIRECT = 0,
-  FCM_SCENE_SOLVER_MINRES,
-  FCM_SCENE_SOLVER_CG
-} fcm_scene_linear_solver;
-
-/** Preconditioner of the Krylov solvers ("none", "jacobi", "block_jacobi", "schwarz"). */
-typedef enum fcm_scene_preconditioner {
-  FCM_SCENE_PRECONDITIONER_NONE = 0,
-  FCM_SCENE_PRECONDITIONER_JACOBI,
-  FCM_SCENE_PRECONDITIONER_BLOCK_JACOBI,
-  FCM_SCENE_PRECONDITIONER_SCHWARZ
-} fcm_scene_preconditioner;
-
-/** Newton stopping rules ("solver.newton.rule"; see fcm_newton_tolerance in sim.h). */
-typedef enum fcm_scene_newton_rule {
-  FCM_SCENE_NEWTON_AUTO = 0,           /**< "auto": representative (dynamic), relative (static) */
-  FCM_SCENE_NEWTON_REPRESENTATIVE = 1, /**< "representative": ||M a - f|| <= rtol ||M a_rep|| */
-  FCM_SCENE_NEWTON_RELATIVE = 2        /**< "relative": ||g|| <= rtol max(||g_0||, ||f_int||,
-                                            ||f_ext||) */
-} fcm_scene_newton_rule;
-
-/** Solver settings ("solver"). */
+/** Solver settings ("solver"), in the library's own types (fcm/sim.h, fcm/solve.h). */
 typedef struct fcm_scene_solver {
-  fcm_scene_linear_solver method;          /**< default DIRECT */
-  fcm_direct_method direct;                /**< default FCM_DIRECT_CHOLMOD */
-  fcm_scene_preconditioner preconditioner; /**< Krylov only; default SCHWARZ */
-  double schwarz_threshold;  /**< cut cells with volume fraction below it get a block; (0, 1],
-                                  default 0.5 */
-  double schwarz_epsilon;    /**< relative eigenvalue threshold; (0, 1), default 1e-13 */
-  int schwarz_paper_clamp;   /**< 0 (default, "clamp"): 1/(eps lambda_max); 1 ("paper") */
-  double rtol;               /**< Krylov relative tolerance; [0, 1), default 1e-8 */
-  double atol;               /**< Krylov absolute tolerance; >= 0, default 0 */
-  int max_iterations;        /**< Krylov iterations; >= 1, default 1000 */
-  fcm_scene_newton_rule newton_rule; /**< stopping rule; default AUTO */
+  fcm_linear_solver method;          /**< "direct" (default), "minres", "cg" */
+  fcm_direct_method direct;          /**< default FCM_DIRECT_CHOLMOD */
+  fcm_preconditioner preconditioner; /**< Krylov only: "none", "jacobi", "block_jacobi",
+                                          "schwarz" (default) */
+  double schwarz_threshold;     /**< cut cells with volume fraction below it get a block; (0, 1],
+                                     default 0.5 (fcm_integrator_options.schwarz_theta) */
+  fcm_schwarz_options schwarz;  /**< epsilon in (0, 1), default 1e-13; clamp "clamp" (default,
+                                     FCM_SCHWARZ_CLAMP) or "paper" (FCM_SCHWARZ_PAPER) */
+  double rtol;                  /**< Krylov relative tolerance; [0, 1), default 1e-8 */
+  double atol;                  /**< Krylov absolute tolerance; >= 0, default 0 */
+  int max_iterations;           /**< Krylov iterations; >= 1, default 1000 */
+  fcm_newton_tolerance newton_rule; /**< "auto" (default, FCM_NEWTON_TOL_AUTO),
+                                         "representative", "relative" */
   double newton_rtol;        /**< tolerance of the rule; (0, 1), default 1e-5 */
   int newton_max_iterations; /**< >= 1, default 100 */
   int line_search;           /**< 1 (default): backtracking line search */
@@ -143,17 +114,16 @@ typedef struct fcm_scene_solver {
   int threads;                        /**< OpenMP threads, >= 0; 0 (default): the OpenMP default */
 } fcm_scene_solver;
 
-/** Time integrators ("backward_euler"). */
-typedef enum fcm_scene_integrator { FCM_SCENE_INTEGRATOR_BACKWARD_EULER = 0 } fcm_scene_integrator;
-
 /** Time stepping ("time"). */
 typedef struct fcm_scene_time {
-  int is_static;                   /**< 1: quasi-static equilibrium at each step (no inertia) */
-  fcm_scene_integrator integrator; /**< default BACKWARD_EULER (dynamic scenes) */
-  double dt;                       /**< step in s, > 0, default 1/60 */
-  fcm_index num_steps;             /**< steps to take (>= 1), from "steps" or "duration" */
-  double duration;                 /**< num_steps * dt: the simulated time in s */
-  int load_steps;                  /**< static: load increments per step, >= 1, default 1 */
+  fcm_integrator_kind integrator; /**< FCM_INTEGRATOR_STATIC ("static": true: quasi-static
+                                       equilibrium at each step, no inertia) or
+                                       FCM_INTEGRATOR_BACKWARD_EULER ("integrator":
+                                       "backward_euler", the default) */
+  double dt;                      /**< step in s, > 0, default 1/60 */
+  fcm_index num_steps;            /**< steps to take (>= 1), from "steps" or "duration" */
+  double duration;                /**< num_steps * dt: the simulated time in s */
+  int load_steps;                 /**< static: load increments per step, >= 1, default 1 */
 } fcm_scene_time;
 
 /** Output settings ("output"). */
@@ -216,19 +186,14 @@ typedef struct fcm_effect_fixed {
   int components[3]; /**< 1: that displacement component is held (default all) */
 } fcm_effect_fixed;
 
-/** Prescribed motion: with tau = clamp(t - start, 0, end - start), every point X of the
- * region is at c + R(axis, angular_speed tau) (X - c) + velocity tau, where R(a, phi) is
- * the right-handed rotation by phi about the unit axis a. Held at tau = 0 before start;
- * after end held at the final position, or released (no constraint) when `release`. */
+/** Prescribed motion of the background nodes in a region: the library's fcm_motion (its
+ * formula, evaluated by fcm_motion_eval() and fcm_motion_active() in fcm/sim.h, is what the
+ * runner constrains). Scene defaults: velocity 0, axis (0, 0, 1) (normalized by the parser),
+ * center 0, angular_speed 0, start 0 (>= 0), end HUGE_VAL (> start), release 0, all three
+ * components constrained. */
 typedef struct fcm_effect_motion {
   fcm_region region;
-  double velocity[3];   /**< m/s, default 0 */
-  double axis[3];       /**< unit axis, default (0, 0, 1) */
-  double center[3];     /**< a point of the axis, default 0 */
-  double angular_speed; /**< rad/s (sign by the right-hand rule), default 0 */
-  double start;         /**< s, >= 0, default 0 */
-  double end;           /**< s, > start; default HUGE_VAL (the whole run) */
-  int release;          /**< 1: no constraint after end; default 0 */
+  fcm_motion motion;
 } fcm_effect_motion;
 
 /** Initial velocity v(X) = velocity + angular_velocity x (X - c) on the region (default
@@ -277,15 +242,6 @@ typedef struct fcm_effect {
     fcm_effect_pressure pressure;
   };
 } fcm_effect;
-
-/** Displacement u = x(t) - X of the point X under a motion effect at time t (formula at
- * fcm_effect_motion). No allocation; thread safe. */
-FCM_API void fcm_effect_motion_eval(const fcm_effect_motion *motion, const double X[3], double t,
-                                    double u[3]);
-
-/** Whether a motion effect constrains its region at time t: 1 unless released and
- * t > end. */
-FCM_API int fcm_effect_motion_active(const fcm_effect_motion *motion, double t);
 
 /** Initial velocity at X: velocity + angular_velocity x (X - c), with c = `com` (the
  * body's centre of mass, computed by the caller) when iv->center_of_mass, else iv->center.

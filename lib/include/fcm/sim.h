@@ -43,7 +43,10 @@ typedef enum fcm_newton_tolerance {
   FCM_NEWTON_TOL_REPRESENTATIVE = 0,
   /** ||g|| <= max(tol R, atol), R = max(||g|| at the start of the Newton solve,
    * ||f_int||, ||f_ext||) at the current iterate (force scale of the balance). */
-  FCM_NEWTON_TOL_RELATIVE = 1
+  FCM_NEWTON_TOL_RELATIVE = 1,
+  /** Chosen by the kind at setup: REPRESENTATIVE for BACKWARD_EULER, RELATIVE for STATIC
+   * (which has no mass; the force-balance rule needs no extra body-force pass). */
+  FCM_NEWTON_TOL_AUTO = 2
 } fcm_newton_tolerance;
 
 /** Linear solver of the Newton systems. */
@@ -192,6 +195,9 @@ FCM_API fcm_motion fcm_motion_default(void);
  * under `motion` at time t (any axis length; a zero axis means no rotation). Pure. */
 FCM_API void fcm_motion_eval(const fcm_motion *motion, const double X[3], double t, double u[3],
                              double v[3]);
+
+/** Whether `motion` constrains its nodes at time t: 1 unless released and t > end. Pure. */
+FCM_API int fcm_motion_active(const fcm_motion *motion, double t);
 
 /** An integrator on a space (opaque). */
 typedef struct fcm_integrator fcm_integrator;

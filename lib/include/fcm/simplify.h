@@ -40,8 +40,6 @@ typedef struct fcm_simplify_options {
   double residual_tol;    /**< accepted relative moment residual; default 1e-12 */
   int lp_iteration_limit; /**< simplex iterations per LP; 0: 20 M + 1000 (default) */
   double lp_time_limit;   /**< seconds per LP; 0: none; default 60 */
-  int force_lp_failure;   /**< test hook: 0 off (default); 1 every LP stops at an iteration
-                               limit of 0; 2 every LP triggers a GLPK fatal error */
 } fcm_simplify_options;
 
 /** The simplified rule: a subset of the input points with new weights. */
@@ -81,7 +79,8 @@ FCM_API fcm_simplify_options fcm_simplify_options_default(void);
  * Every returned rule is verified (weights > 0, count <= M, relative residual <=
  * residual_tol); if all attempts (the chosen path, the other path, the chosen path with a
  * looser rank threshold) fail, the input is returned unchanged with info->fallback = 1 and
- * FCM_OK: the caller decides and counts. N <= M also returns the input (info->skipped).
+ * FCM_OK: the caller decides and counts; the fallback is also logged at FCM_LOG_WARNING
+ * through the ctx's log callback (with the account of info->message). N <= M also returns the input (info->skipped).
  * Points of zero weight are never kept.
  * @param[in] points  n x 3 reference coordinates (row-major); @param[in] weights n, >= 0
  * @param[in] opts NULL for defaults; @param[out] out release with fcm_simplify_result_destroy()

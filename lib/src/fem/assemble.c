@@ -10,45 +10,28 @@
 #include <omp.h>
 #include <string.h>
 
-fcm_status fcm_elastic_lame(fcm_ctx *ctx, const fcm_elastic *m, double *lambda, double *mu)
-{
-  fcm_status st = FCM_OK;
-  FCM_CHECK(m, ctx, FCM_ERR_ARG, "elastic: material is NULL");
-  FCM_CHECK(isfinite(m->young) && m->young > 0.0, ctx, FCM_ERR_ARG,
-            "elastic: Young's modulus E = %g must be positive and finite", m->young);
-  FCM_CHECK(isfinite(m->poisson) && m->poisson > -1.0 && m->poisson < 0.5, ctx, FCM_ERR_ARG,
-            "elastic: Poisson's ratio nu = %g must lie in (-1, 0.5)", m->poisson);
-  FCM_CHECK(isfinite(m->density) && m->density >= 0.0, ctx, FCM_ERR_ARG,
-            "elastic: density = %g must be non-negative and finite", m->density);
-  if (lambda)
-    *lambda = m->young * m->poisson / ((1.0 + m->poisson) * (1.0 - 2.0 * m->poisson));
-  if (mu) *mu = m->young / (2.0 * (1.0 + m->poisson));
-cleanup:
-  return st;
-}
-
 fcm_assembly_options fcm_assembly_options_default(void)
 {
   fcm_assembly_options o = {0, 0};
   return o;
 }
 
-fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type, fcm_integrand integrand,
+fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type, fcm_rule_kind kind,
                                      int strength, fcm_rule **rule)
 {
   fcm_status st = FCM_OK;
   const fcm_element_info *info = fcm_element_get_info(type);
   FCM_CHECK(info, ctx, FCM_ERR_ARG, "standard rule: invalid element type %d", (int)type);
-  FCM_CHECK(integrand == FCM_INTEGRAND_STIFFNESS || integrand == FCM_INTEGRAND_MASS, ctx,
-            FCM_ERR_ARG, "standard rule: invalid integrand %d", (int)integrand);
+  FCM_CHECK(kind == FCM_RULE_STIFFNESS || kind == FCM_RULE_MASS, ctx, FCM_ERR_ARG,
+            "standard rule: invalid rule kind %d", (int)kind);
   if (strength > 0)
     FCM_TRY(ctx, fcm_rule_create(ctx, info->shape, strength, rule));
   else if (info->shape == FCM_SHAPE_HEX) /* order+1 points per direction: strength 2*order+1 */
     FCM_TRY(ctx, fcm_rule_create_computed(ctx, info->shape, 2 * info->order + 1, rule));
   else
     FCM_TRY(ctx, fcm_rule_create(ctx, info->shape,
-                                 integrand == FCM_INTEGRAND_MASS ? info->mass_strength
-                                                                 : info->stiffness_strength,
+                                 kind == FCM_RULE_MASS ? info->mass_strength
+                                                       : info->stiffness_strength,
                                  rule));
 cleanup:
   return st;
@@ -69,11 +52,11 @@ typedef struct tabulation {
   double *N, *dN;
 } tabulation;
 
-static fcm_status tabulate(fcm_space *s, fcm_integrand integrand, int strength, tabulation *t)
+static fcm_status tabulate(fcm_space *s, fcm_rule_kind kind, int strength, tabulation *t)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
-  FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, integrand, strength, &t->rule));
+  FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, kind, strength, &t->rule));
   int nq = fcm_rule_num_points(t->rule);
   const double *pts = fcm_rule_points(t->rule);
   FCM_ALLOC(ctx, (size_t)nq * s->nn, t->N);
@@ -363,8 +346,7 @@ static fcm_status assemble(fcm_space *s, const kernel_data *kd, int strength, do
   int bad_numeric = 0;
   fcm_rule_kind kind = kd->kind == KERNEL_MASS ? FCM_RULE_MASS : FCM_RULE_STIFFNESS;
   memset(&t, 0, sizeof t);
-  FCM_TRY(ctx, tabulate(s, kind == FCM_RULE_MASS ? FCM_INTEGRAND_MASS : FCM_INTEGRAND_STIFFNESS,
-                        strength, &t));
+  FCM_TRY(ctx, tabulate(s, kind, strength, &t));
   FCM_TRY(ctx, scratch_alloc(s, nthreads, &mem, &sc));
   for (int color = 0; color < s->num_colors; color++) {
     fcm_index c0 = s->color_ptr[color], c1 = s->color_ptr[color + 1];
@@ -435,7 +417,7 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_assemble_stiffness(fcm_space *s, const fcm_elastic *mat,
+fcm_status fcm_assemble_stiffness(fcm_space *s, const fcm_material *mat,
                                   const fcm_assembly_options *opts, fcm_csr *A)
 {
   fcm_status st = FCM_OK;
@@ -443,14 +425,14 @@ fcm_status fcm_assemble_stiffness(fcm_space *s, const fcm_elastic *mat,
   fcm_assembly_options o = opts ? *opts : fcm_assembly_options_default();
   memset(&kd, 0, sizeof kd);
   kd.kind = KERNEL_STIFFNESS;
-  FCM_TRY(s->ctx, fcm_elastic_lame(s->ctx, mat, &kd.lambda, &kd.mu));
+  FCM_TRY(s->ctx, fcm_material_lame(s->ctx, mat, &kd.lambda, &kd.mu));
   FCM_TRY(s->ctx, check_matrix(s, A));
   FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, fcm_csr_get_values(A), NULL, NULL));
 cleanup:
   return st;
 }
 
-fcm_status fcm_assemble_mass(fcm_space *s, const fcm_elastic *mat,
+fcm_status fcm_assemble_mass(fcm_space *s, const fcm_material *mat,
                              const fcm_assembly_options *opts, fcm_csr *A)
 {
   fcm_status st = FCM_OK;
@@ -458,7 +440,7 @@ fcm_status fcm_assemble_mass(fcm_space *s, const fcm_elastic *mat,
   fcm_assembly_options o = opts ? *opts : fcm_assembly_options_default();
   memset(&kd, 0, sizeof kd);
   kd.kind = KERNEL_MASS;
-  FCM_TRY(s->ctx, fcm_elastic_lame(s->ctx, mat, NULL, NULL));
+  FCM_TRY(s->ctx, fcm_material_lame(s->ctx, mat, NULL, NULL));
   FCM_TRY(s->ctx, check_matrix(s, A));
   kd.rho = mat->density;
   FCM_TRY(s->ctx, assemble(s, &kd, o.mass_strength, fcm_csr_get_values(A), NULL, NULL));
@@ -466,7 +448,7 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_assemble_body_force(fcm_space *s, const fcm_elastic *mat, const double accel[3],
+fcm_status fcm_assemble_body_force(fcm_space *s, const fcm_material *mat, const double accel[3],
                                    const fcm_assembly_options *opts, double *f)
 {
   fcm_status st = FCM_OK;
@@ -474,7 +456,7 @@ fcm_status fcm_assemble_body_force(fcm_space *s, const fcm_elastic *mat, const d
   fcm_assembly_options o = opts ? *opts : fcm_assembly_options_default();
   memset(&kd, 0, sizeof kd);
   kd.kind = KERNEL_BODY_FORCE;
-  FCM_TRY(s->ctx, fcm_elastic_lame(s->ctx, mat, NULL, NULL));
+  FCM_TRY(s->ctx, fcm_material_lame(s->ctx, mat, NULL, NULL));
   FCM_CHECK(f && accel, s->ctx, FCM_ERR_ARG, "body force: NULL vector or acceleration");
   FCM_CHECK(isfinite(accel[0]) && isfinite(accel[1]) && isfinite(accel[2]), s->ctx, FCM_ERR_ARG,
             "body force: acceleration (%g, %g, %g) is not finite", accel[0], accel[1], accel[2]);

@@ -37,16 +37,22 @@ cleanup:
   return st;
 }
 
-/* Validate and return the Lame parameters through the one conversion of the
- * library, fcm_elastic_lame(), which also checks E, nu and the density. */
-static fcm_status material_lame(fcm_ctx *ctx, const fcm_material *mat, double *lambda, double *mu)
+/* The one Lame conversion of the library; it validates the model, E, nu and the density. */
+fcm_status fcm_material_lame(fcm_ctx *ctx, const fcm_material *mat, double *lambda, double *mu)
 {
   fcm_status st = FCM_OK;
   FCM_CHECK(mat, ctx, FCM_ERR_ARG, "material: material is NULL");
   FCM_CHECK((int)mat->model >= 0 && mat->model < FCM_MATERIAL_COUNT, ctx, FCM_ERR_ARG,
             "material: model = %d out of range [0, %d)", (int)mat->model, FCM_MATERIAL_COUNT);
-  const fcm_elastic el = {mat->young, mat->poisson, mat->density};
-  FCM_TRY(ctx, fcm_elastic_lame(ctx, &el, lambda, mu));
+  FCM_CHECK(isfinite(mat->young) && mat->young > 0.0, ctx, FCM_ERR_ARG,
+            "material: Young's modulus E = %g must be positive and finite", mat->young);
+  FCM_CHECK(isfinite(mat->poisson) && mat->poisson > -1.0 && mat->poisson < 0.5, ctx, FCM_ERR_ARG,
+            "material: Poisson's ratio nu = %g must lie in (-1, 0.5)", mat->poisson);
+  FCM_CHECK(isfinite(mat->density) && mat->density >= 0.0, ctx, FCM_ERR_ARG,
+            "material: density = %g must be non-negative and finite", mat->density);
+  if (lambda)
+    *lambda = mat->young * mat->poisson / ((1.0 + mat->poisson) * (1.0 - 2.0 * mat->poisson));
+  if (mu) *mu = mat->young / (2.0 * (1.0 + mat->poisson));
 cleanup:
   return st;
 }
@@ -54,7 +60,7 @@ cleanup:
 fcm_status fcm_material_validate(fcm_ctx *ctx, const fcm_material *mat)
 {
   fcm_status st = FCM_OK;
-  FCM_TRY(ctx, material_lame(ctx, mat, NULL, NULL));
+  FCM_TRY(ctx, fcm_material_lame(ctx, mat, NULL, NULL));
 cleanup:
   return st;
 }
@@ -65,7 +71,7 @@ fcm_status fcm_material_setup(fcm_ctx *ctx, const fcm_material *mat, fcm_materia
   fcm_material_params p;
   memset(&p, 0, sizeof p);
   FCM_CHECK(params, ctx, FCM_ERR_ARG, "material: params is NULL");
-  FCM_TRY(ctx, material_lame(ctx, mat, &p.lambda, &p.mu));
+  FCM_TRY(ctx, fcm_material_lame(ctx, mat, &p.lambda, &p.mu));
   p.model = mat->model;
   p.density = mat->density;
   p.project_psd = 0;

@@ -1,5 +1,6 @@
 /* The effect table (one entry per effect type: name, parser/validator, scene rules,
- * printer), region parsing, and the closed-form evaluation of motions and velocities. */
+ * printer), region parsing, and the closed-form initial velocity. Motions are the library's
+ * fcm_motion, evaluated by fcm_motion_eval() (fcm/sim.h), the evaluator the runner uses. */
 #include "scene/scene_impl.h"
 
 #include <stdlib.h>
@@ -260,11 +261,11 @@ static fcm_status parse_motion(fcm__scene_parser *p, const fcm__json *o, fcm_eff
   fcm_status st = FCM_OK;
   static const char *const keys[] = {"region", "velocity", "rotation", "start", "end", "release"};
   static const char *const rkeys[] = {"axis", "center", "speed"};
-  fcm_effect_motion *m = &e->motion;
+  fcm_motion *m = &e->motion.motion;
   const fcm__json *rot = NULL;
-  m->axis[2] = 1.0;
+  *m = fcm_motion_default();
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
-  FCM_TRY(p->ctx, fcm__scene_read_region(p, o, "region", 1, 1, &m->region));
+  FCM_TRY(p->ctx, fcm__scene_read_region(p, o, "region", 1, 1, &e->motion.region));
   FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "velocity", 0, FCM__ANY, m->velocity));
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "rotation", 0, &rot));
   if (rot) {
@@ -295,7 +296,7 @@ cleanup:
 
 static void view_motion(const fcm_effect *e, FILE *f)
 {
-  const fcm_effect_motion *m = &e->motion;
+  const fcm_motion *m = &e->motion.motion;
   fprintf(f, "velocity (%g, %g, %g) m/s", m->velocity[0], m->velocity[1], m->velocity[2]);
   if (m->angular_speed != 0.0)
     fprintf(f, ", rotation %g rad/s about (%g, %g, %g) through (%g, %g, %g)", m->angular_speed,
@@ -303,7 +304,7 @@ static void view_motion(const fcm_effect *e, FILE *f)
   view_window(m->start, m->end, f);
   if (m->end < HUGE_VAL) fprintf(f, ", then %s", m->release ? "released" : "held");
   fprintf(f, "; on ");
-  fcm__scene_region_view(&m->region, f);
+  fcm__scene_region_view(&e->motion.region, f);
 }
 
 static fcm_status parse_initial_velocity(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
@@ -521,7 +522,7 @@ fcm_status fcm__scene_read_effects(fcm__scene_parser *p, const fcm__json *root)
     SCENE_CHECK(type->max_count == 0 || counts[type->type] < type->max_count, p, FCM_ERR_ARG,
                 "at most %d %s effect per scene; effects[%d] is one already", type->max_count,
                 type->name, first[type->type]);
-    SCENE_CHECK(type->allowed_static || !s->time.is_static, p, FCM_ERR_ARG,
+    SCENE_CHECK(type->allowed_static || s->time.integrator != FCM_INTEGRATOR_STATIC, p, FCM_ERR_ARG,
                 "not allowed in a static scene (time.static is true)");
     if (counts[type->type]++ == 0) first[type->type] = i;
     s->num_effects = i + 1;
@@ -533,27 +534,6 @@ cleanup:
 }
 
 /* ---------------------------------------------------------------- evaluation */
-
-void fcm_effect_motion_eval(const fcm_effect_motion *m, const double X[3], double t, double u[3])
-{
-  double tau = t - m->start;
-  if (!(tau > 0.0)) tau = 0.0;
-  if (tau > m->end - m->start) tau = m->end - m->start;
-  const double *a = m->axis;
-  double r[3] = {X[0] - m->center[0], X[1] - m->center[1], X[2] - m->center[2]};
-  double phi = m->angular_speed * tau, c = cos(phi), s = sin(phi);
-  double ar = a[0] * r[0] + a[1] * r[1] + a[2] * r[2];
-  double axr[3] = {a[1] * r[2] - a[2] * r[1], a[2] * r[0] - a[0] * r[2], a[0] * r[1] - a[1] * r[0]};
-  for (int d = 0; d < 3; d++) {
-    double Rr = r[d] * c + axr[d] * s + a[d] * ar * (1.0 - c); /* Rodrigues */
-    u[d] = Rr - r[d] + m->velocity[d] * tau;
-  }
-}
-
-int fcm_effect_motion_active(const fcm_effect_motion *m, double t)
-{
-  return !(m->release && t > m->end);
-}
 
 void fcm_effect_initial_velocity_eval(const fcm_effect_initial_velocity *iv, const double X[3],
                                       const double com[3], double v[3])

@@ -103,16 +103,7 @@ fcm_status fcm__effect_apply_constraint(fcm_simulation *S, const fcm_effect *e)
     for (int d = 0; d < 3; d++)
       m.components[d] = e->fixed.components[d];
   } else {
-    const fcm_effect_motion *em = &e->motion;
-    for (int d = 0; d < 3; d++) {
-      m.velocity[d] = em->velocity[d];
-      m.center[d] = em->center[d];
-      m.axis[d] = em->axis[d];
-    }
-    m.angular_speed = em->angular_speed;
-    m.start = em->start;
-    m.end = em->end;
-    m.release = em->release;
+    m = e->motion.motion;
   }
   FCM_TRY(S->ctx, region_nodes(S, r, e->index, NULL, &n));
   FCM_ALLOC(S->ctx, n, nodes);
@@ -316,15 +307,8 @@ static fcm_status build_rules(fcm_simulation *S)
     ro.surface_strength = -1;
   ro.min_fraction = q->min_fraction;
   ro.simplify = q->simplify;
-  ro.simplify_options.method = q->simplify_method == FCM_SCENE_SIMPLIFY_LP ? FCM_SIMPLIFY_LP
-                               : q->simplify_method == FCM_SCENE_SIMPLIFY_RECOMBINE
-                                   ? FCM_SIMPLIFY_RECOMBINE
-                                   : FCM_SIMPLIFY_AUTO;
-  ro.stabilization.mode = q->stabilization == FCM_SCENE_STABILIZATION_MASS ? FCM_STABILIZATION_MASS
-                          : q->stabilization == FCM_SCENE_STABILIZATION_OFF
-                              ? FCM_STABILIZATION_OFF
-                              : FCM_STABILIZATION_MASS_STIFFNESS;
-  ro.stabilization.alpha = q->stabilization_alpha;
+  ro.simplify_options.method = q->simplify_method;
+  ro.stabilization = q->stabilization;
   ro.num_threads = sv->threads;
   FCM_TRY(S->ctx, fcm_cell_rules_create(S->ctx, S->mesh, S->geom, &ro, &S->rules));
   S->c.cell_rules = 1;
@@ -339,36 +323,25 @@ static fcm_integrator_options integrator_options(fcm_simulation *S)
   const fcm_scene_solver *sv = fcm_scene_get_solver(S->scene);
   const fcm_scene_time *tm = fcm_scene_get_time(S->scene);
   fcm_integrator_options o = fcm_integrator_options_default();
-  o.kind = tm->is_static ? FCM_INTEGRATOR_STATIC : FCM_INTEGRATOR_BACKWARD_EULER;
+  o.kind = tm->integrator;
   o.dt = tm->dt;
   o.load_steps = tm->load_steps;
   o.newton_max_iterations = sv->newton_max_iterations;
   o.newton_tolerance = sv->newton_rtol;
-  /* Static scenes have no mass and no inertia; the force-balance (relative) rule needs
+  /* AUTO: static scenes have no mass and no inertia; the force-balance (relative) rule needs
    * neither, where the representative force would take a body-force pass of its own. */
-  o.tolerance_mode = sv->newton_rule == FCM_SCENE_NEWTON_REPRESENTATIVE
-                         ? FCM_NEWTON_TOL_REPRESENTATIVE
-                     : sv->newton_rule == FCM_SCENE_NEWTON_RELATIVE ? FCM_NEWTON_TOL_RELATIVE
-                     : tm->is_static                                ? FCM_NEWTON_TOL_RELATIVE
-                                                                    : FCM_NEWTON_TOL_REPRESENTATIVE;
+  o.tolerance_mode = sv->newton_rule;
   o.rep_acceleration = sv->representative_acceleration;
   o.line_search = sv->line_search;
   o.project_psd = sv->project_psd;
-  o.linear_solver = sv->method == FCM_SCENE_SOLVER_DIRECT ? FCM_LINEAR_DIRECT
-                    : sv->method == FCM_SCENE_SOLVER_CG   ? FCM_LINEAR_CG
-                                                          : FCM_LINEAR_MINRES;
+  o.linear_solver = sv->method;
   o.direct_method = sv->direct;
-  o.preconditioner = sv->preconditioner == FCM_SCENE_PRECONDITIONER_NONE     ? FCM_PRECOND_NONE
-                     : sv->preconditioner == FCM_SCENE_PRECONDITIONER_JACOBI ? FCM_PRECOND_JACOBI
-                     : sv->preconditioner == FCM_SCENE_PRECONDITIONER_BLOCK_JACOBI
-                         ? FCM_PRECOND_BLOCK_JACOBI
-                         : FCM_PRECOND_SCHWARZ;
+  o.preconditioner = sv->preconditioner;
   o.krylov_rtol = sv->rtol;
   o.krylov_atol = sv->atol;
   o.krylov_max_iterations = sv->max_iterations;
   o.schwarz_theta = sv->schwarz_threshold;
-  o.schwarz.epsilon = sv->schwarz_epsilon;
-  o.schwarz.clamp = sv->schwarz_paper_clamp ? FCM_SCHWARZ_PAPER : FCM_SCHWARZ_CLAMP;
+  o.schwarz = sv->schwarz;
   o.assembly.stiffness_strength = q->stiffness_strength > 0 ? q->stiffness_strength : 0;
   o.assembly.mass_strength = q->mass_strength > 0 ? q->mass_strength : 0;
   for (int k = 0; k < fcm_scene_num_effects(S->scene); k++) {
@@ -550,6 +523,9 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   FCM_CHECK(S, NULL, FCM_ERR_ARG, "simulation: NULL");
   FCM_CHECK(!fcm_simulation_done(S), S->ctx, FCM_ERR_ARG, "simulation %s: all %lld steps are taken",
             fcm_scene_name(S->scene), S->num_steps);
+  /* room for the log row first: a step that is taken is also logged */
+  FCM_TRY(S->ctx,
+          fcm__sim_grow(S->ctx, (void **)&S->log, &S->log_cap, S->log_n + 1, sizeof *S->log));
   double t0 = fcm_wtime();
   st = fcm_integrator_step(S->integ, &si);
   double wall = fcm_wtime() - t0;
@@ -566,8 +542,6 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
     goto cleanup;
   }
   S->c.steps++;
-  FCM_TRY(S->ctx,
-          fcm__sim_grow(S->ctx, (void **)&S->log, &S->log_cap, S->log_n + 1, sizeof *S->log));
   fcm__log_row *r = &S->log[S->log_n++];
   r->time = si.time;
   r->newton = si.newton_iterations;
@@ -661,6 +635,9 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
       S->node_v[3 * a + d] = dof >= 0 ? v[dof + d] : 0.0;
     }
   }
+  /* room for the frame time first: a frame that is written is also counted */
+  FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&S->frame_time, &S->frame_cap, S->c.frames + 1,
+                             sizeof *S->frame_time));
   FCM_TRY(ctx, fcm_vtu_create(ctx, &vtu));
   if (out->write_background) {
     fcm_index nc = fcm_mesh_num_cells(S->mesh);
@@ -689,8 +666,6 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
     if (!S->pvd_surf) FCM_TRY(ctx, open_pvd(S, dir, "surface", &S->pvd_surf));
     FCM_TRY(ctx, fcm_pvd_add(S->pvd_surf, time, path));
   }
-  FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&S->frame_time, &S->frame_cap, S->c.frames + 1,
-                             sizeof *S->frame_time));
   S->frame_time[S->c.frames++] = time;
   S->c.time_output += fcm_wtime() - t0;
 cleanup:

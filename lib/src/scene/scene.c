@@ -57,11 +57,16 @@ static const char *const axis_names[] = {"x", "y", "z"};
 static const char *const simplify_names[] = {"auto", "lp", "recombine"};
 static const char *const stabilization_names[] = {"mass_stiffness", "mass", "off"};
 static const char *const solver_names[] = {"direct", "minres", "cg"};
+static const int solver_values[] = {FCM_LINEAR_DIRECT, FCM_LINEAR_MINRES,
+                                                  FCM_LINEAR_CG};
 static const char *const direct_names[] = {"cholmod", "umfpack"};
 static const char *const preconditioner_names[] = {"none", "jacobi", "block_jacobi", "schwarz"};
 static const char *const clamp_names[] = {"clamp", "paper"};
 static const char *const newton_rule_names[] = {"auto", "representative", "relative"};
+static const int newton_rule_values[] = {
+    FCM_NEWTON_TOL_AUTO, FCM_NEWTON_TOL_REPRESENTATIVE, FCM_NEWTON_TOL_RELATIVE};
 static const char *const integrator_names[] = {"backward_euler"};
+static const int integrator_values[] = {FCM_INTEGRATOR_BACKWARD_EULER};
 
 /* Read a choice into an enum of any integer type. */
 #define READ_CHOICE(p, obj, key, required, names, out)                                             \
@@ -71,6 +76,26 @@ static const char *const integrator_names[] = {"backward_euler"};
             fcm__scene_read_choice((p), (obj), (key), (required), (names), COUNT(names), &ch_));   \
     (out) = ch_;                                                                                   \
   } while (0)
+
+/* Read a choice given by names[i] into out = values[i] (the library's enum values, whose
+ * order need not be the names' order). */
+#define READ_CHOICE_AS(p, obj, key, required, names, values, out)                                  \
+  do {                                                                                             \
+    int ch_ = -1;                                                                                  \
+    FCM_TRY((p)->ctx,                                                                              \
+            fcm__scene_read_choice((p), (obj), (key), (required), (names), COUNT(names), &ch_));   \
+    if (ch_ >= 0) (out) = (values)[ch_]; /* an enum of the library */                                                           \
+  } while (0)
+
+/* The name of `value` in a names/values table (for the summary). */
+#define CHOICE_NAME(names, values, value) choice_name((names), (values), COUNT(names), (int)(value))
+
+static const char *choice_name(const char *const *names, const int *values, int n, int value)
+{
+  for (int i = 0; i < n; i++)
+    if (values[i] == value) return names[i];
+  return "?";
+}
 
 /* Read an integer member into an int-like destination. */
 #define READ_INT(p, obj, key, required, lo, hi, out)                                               \
@@ -342,9 +367,8 @@ static fcm_status read_quadrature(fcm__scene_parser *p, const fcm__json *root)
   size_t old = p->path_len;
   q->stiffness_strength = q->mass_strength = q->surface_strength = -1;
   q->simplify = 1;
-  q->simplify_method = FCM_SCENE_SIMPLIFY_AUTO;
-  q->stabilization = FCM_SCENE_STABILIZATION_MASS_STIFFNESS;
-  q->stabilization_alpha = 1e-6;
+  q->simplify_method = FCM_SIMPLIFY_AUTO;
+  q->stabilization = fcm_stabilization_options_default();
   q->min_fraction = 1e-4;
   FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "quadrature", 0, &o));
   if (!o) return FCM_OK;
@@ -360,9 +384,9 @@ static fcm_status read_quadrature(fcm__scene_parser *p, const fcm__json *root)
   if (stab) {
     ENTER(p, "stabilization");
     FCM_TRY(p->ctx, fcm__scene_check_object(p, stab, skeys, COUNT(skeys)));
-    READ_CHOICE(p, stab, "mode", 0, stabilization_names, q->stabilization);
+    READ_CHOICE(p, stab, "mode", 0, stabilization_names, q->stabilization.mode);
     FCM_TRY(p->ctx, fcm__scene_read_number(p, stab, "alpha", 0, (fcm__range){0.0, 1.0, 1, 0},
-                                           &q->stabilization_alpha));
+                                           &q->stabilization.alpha));
     fcm__scene_path_pop(p, here);
   }
   FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "min_fraction", 0, (fcm__range){0.0, 1.0, 0, 1},
@@ -387,11 +411,12 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   fcm_scene_solver *s = &p->scene->solver;
   const fcm__json *o = NULL, *sw = NULL, *nw = NULL;
   size_t old = p->path_len;
-  s->method = FCM_SCENE_SOLVER_DIRECT;
+  s->method = FCM_LINEAR_DIRECT;
   s->direct = FCM_DIRECT_CHOLMOD;
-  s->preconditioner = FCM_SCENE_PRECONDITIONER_SCHWARZ;
+  s->preconditioner = FCM_PRECOND_SCHWARZ;
   s->schwarz_threshold = 0.5;
-  s->schwarz_epsilon = 1e-13;
+  s->schwarz = fcm_schwarz_options_default();
+  s->newton_rule = FCM_NEWTON_TOL_AUTO;
   s->rtol = 1e-8;
   s->max_iterations = 1000;
   s->newton_rtol = 1e-5;
@@ -403,7 +428,7 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   ENTER(p, "solver");
   size_t here = p->path_len;
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
-  READ_CHOICE(p, o, "method", 0, solver_names, s->method);
+  READ_CHOICE_AS(p, o, "method", 0, solver_names, solver_values, s->method);
   READ_CHOICE(p, o, "direct", 0, direct_names, s->direct);
   READ_CHOICE(p, o, "preconditioner", 0, preconditioner_names, s->preconditioner);
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "schwarz", 0, &sw));
@@ -413,8 +438,8 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
     FCM_TRY(p->ctx, fcm__scene_read_number(p, sw, "threshold", 0, (fcm__range){0.0, 1.0, 1, 0},
                                            &s->schwarz_threshold));
     FCM_TRY(p->ctx, fcm__scene_read_number(p, sw, "epsilon", 0, (fcm__range){0.0, 1.0, 1, 1},
-                                           &s->schwarz_epsilon));
-    READ_CHOICE(p, sw, "clamp", 0, clamp_names, s->schwarz_paper_clamp);
+                                           &s->schwarz.epsilon));
+    READ_CHOICE(p, sw, "clamp", 0, clamp_names, s->schwarz.clamp);
     fcm__scene_path_pop(p, here);
   }
   FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "rtol", 0, (fcm__range){0.0, 1.0, 0, 1}, &s->rtol));
@@ -429,7 +454,7 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
     READ_INT(p, nw, "max_iterations", 0, 1, 1000000, s->newton_max_iterations);
     FCM_TRY(p->ctx, fcm__scene_read_bool(p, nw, "line_search", 0, &s->line_search));
     FCM_TRY(p->ctx, fcm__scene_read_bool(p, nw, "project_psd", 0, &s->project_psd));
-    READ_CHOICE(p, nw, "rule", 0, newton_rule_names, s->newton_rule);
+    READ_CHOICE_AS(p, nw, "rule", 0, newton_rule_names, newton_rule_values, s->newton_rule);
     FCM_TRY(p->ctx, fcm__scene_read_number(p, nw, "representative_acceleration", 0, FCM__POSITIVE,
                                            &s->representative_acceleration));
     fcm__scene_path_pop(p, here);
@@ -453,8 +478,8 @@ static fcm_status read_time(fcm__scene_parser *p, const fcm__json *root)
   double duration = 0.0;
   long long steps = 0;
   size_t here = 0;
-  t->is_static = 0;
-  t->integrator = FCM_SCENE_INTEGRATOR_BACKWARD_EULER;
+  int is_static = 0;
+  fcm_integrator_kind dynamic = FCM_INTEGRATOR_BACKWARD_EULER;
   t->dt = 1.0 / 60.0;
   t->load_steps = 1;
   FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "time", 0, &o));
@@ -462,8 +487,8 @@ static fcm_status read_time(fcm__scene_parser *p, const fcm__json *root)
     ENTER(p, "time");
     here = p->path_len;
     FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
-    FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "static", 0, &t->is_static));
-    READ_CHOICE(p, o, "integrator", 0, integrator_names, t->integrator);
+    FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "static", 0, &is_static));
+    READ_CHOICE_AS(p, o, "integrator", 0, integrator_names, integrator_values, dynamic);
     FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "dt", 0, FCM__POSITIVE, &t->dt));
     FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "duration", 0, FCM__POSITIVE, &duration));
     FCM_TRY(p->ctx, fcm__scene_read_int(p, o, "steps", 0, 1, 1000000000, &steps));
@@ -472,17 +497,18 @@ static fcm_status read_time(fcm__scene_parser *p, const fcm__json *root)
                 "expected either \"duration\" or \"steps\", got both");
     if (fcm__json_member(o, "load_steps")) {
       fcm__scene_path_push_key(p, "load_steps");
-      SCENE_CHECK(t->is_static, p, FCM_ERR_ARG, "only for static scenes (\"static\": true)");
+      SCENE_CHECK(is_static, p, FCM_ERR_ARG, "only for static scenes (\"static\": true)");
       fcm__scene_path_pop(p, here);
     }
     if (fcm__json_member(o, "integrator")) {
       fcm__scene_path_push_key(p, "integrator");
-      SCENE_CHECK(!t->is_static, p, FCM_ERR_ARG, "not used by static scenes (\"static\": true)");
+      SCENE_CHECK(!is_static, p, FCM_ERR_ARG, "not used by static scenes (\"static\": true)");
       fcm__scene_path_pop(p, here);
     }
   }
+  t->integrator = is_static ? FCM_INTEGRATOR_STATIC : dynamic;
   if (steps == 0 && !(duration > 0.0)) {
-    if (t->is_static)
+    if (is_static)
       steps = 1;
     else
       duration = 1.0;
@@ -700,46 +726,18 @@ cleanup:
   return st;
 }
 
-/* Thread-safe text of a system error (the XSI strerror_r). */
-static void sys_error(int err, char *buf, size_t len)
-{
-  if (strerror_r(err, buf, len) != 0) snprintf(buf, len, "system error %d", err);
-}
-
 fcm_status fcm_scene_create_from_file(fcm_ctx *ctx, const char *path, fcm_scene **scene)
 {
   fcm_status st = FCM_OK;
-  FILE *f = NULL;
-  char *text = NULL, err[128];
-  size_t cap = 0, len = 0;
+  char *text = NULL;
+  size_t len = 0;
   FCM_CHECK(scene, ctx, FCM_ERR_ARG, "scene: output pointer is NULL");
   *scene = NULL;
   FCM_CHECK(ctx && path, ctx, FCM_ERR_ARG, "scene: %s is NULL", ctx ? "path" : "ctx");
-  f = fopen(path, "rb");
-  if (!f) {
-    sys_error(errno, err, sizeof err);
-    FCM_CHECK(0, ctx, FCM_ERR_IO, "%s: cannot open the scene file: %s", path, err);
-  }
-  for (;;) {
-    if (len + 1 >= cap) {
-      size_t ncap = cap ? 2 * cap : 4096;
-      FCM_CHECK(ncap > cap && ncap <= ((size_t)1 << 30), ctx, FCM_ERR_IO,
-                "%s: scene file larger than 1 GiB", path);
-      FCM_TRY(ctx, fcm__resize(ctx, (void **)&text, cap, ncap, 1));
-      cap = ncap;
-    }
-    size_t got = fread(text + len, 1, cap - 1 - len, f);
-    len += got;
-    if (got == 0) break;
-  }
-  if (ferror(f)) {
-    sys_error(errno, err, sizeof err);
-    FCM_CHECK(0, ctx, FCM_ERR_IO, "%s: cannot read the scene file: %s", path, err);
-  }
-  text[len] = '\0';
+  /* regular files only, up to 1 GiB (a device or pipe is refused, not read) */
+  FCM_TRY(ctx, fcm__file_read_all(ctx, "scene", path, (size_t)1 << 30, &text, &len));
   FCM_TRY(ctx, create(ctx, text, len, path, scene));
 cleanup:
-  if (f) fclose(f);
   fcm__free(ctx, text);
   return st;
 }
@@ -883,28 +881,28 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
     fprintf(f, " surface automatic");
   fprintf(f, "; simplify %s (%s); stabilization %s alpha %g; min fraction %g\n",
           q->simplify ? "on" : "off", simplify_names[q->simplify_method],
-          stabilization_names[q->stabilization], q->stabilization_alpha, q->min_fraction);
-  fprintf(f, "solver: %s", solver_names[so->method]);
-  if (so->method == FCM_SCENE_SOLVER_DIRECT)
+          stabilization_names[q->stabilization.mode], q->stabilization.alpha, q->min_fraction);
+  fprintf(f, "solver: %s", CHOICE_NAME(solver_names, solver_values, so->method));
+  if (so->method == FCM_LINEAR_DIRECT)
     fprintf(f, " (%s)", direct_names[so->direct]);
   else {
     fprintf(f, " preconditioner %s", preconditioner_names[so->preconditioner]);
-    if (so->preconditioner == FCM_SCENE_PRECONDITIONER_SCHWARZ)
-      fprintf(f, " (threshold %g, epsilon %g, %s)", so->schwarz_threshold, so->schwarz_epsilon,
-              clamp_names[so->schwarz_paper_clamp]);
+    if (so->preconditioner == FCM_PRECOND_SCHWARZ)
+      fprintf(f, " (threshold %g, epsilon %g, %s)", so->schwarz_threshold, so->schwarz.epsilon,
+              clamp_names[so->schwarz.clamp]);
     fprintf(f, ", rtol %g, atol %g, at most %d iterations", so->rtol, so->atol, so->max_iterations);
   }
   fprintf(f,
           "; Newton %s rule, rtol %g, at most %d iterations, line search %s, PSD projection %s, "
           "|a_rep| %g m/s^2; threads %d\n",
-          newton_rule_names[so->newton_rule], so->newton_rtol, so->newton_max_iterations,
+          CHOICE_NAME(newton_rule_names, newton_rule_values, so->newton_rule), so->newton_rtol, so->newton_max_iterations,
           so->line_search ? "on" : "off", so->project_psd ? "on" : "off",
           so->representative_acceleration, so->threads);
-  if (t->is_static)
+  if (t->integrator == FCM_INTEGRATOR_STATIC)
     fprintf(f, "time: static, %lld step(s) of %g s, %d load step(s) each\n",
             (long long)t->num_steps, t->dt, t->load_steps);
   else
-    fprintf(f, "time: %s, %lld steps of dt = %g s, %g s in all\n", integrator_names[t->integrator],
+    fprintf(f, "time: %s, %lld steps of dt = %g s, %g s in all\n", CHOICE_NAME(integrator_names, integrator_values, t->integrator),
             (long long)t->num_steps, t->dt, t->duration);
   fprintf(f, "output: %s, every %d step(s), background %s, surface %s", s->output.directory,
           s->output.frame_interval, s->output.write_background ? "yes" : "no",

@@ -64,6 +64,11 @@ fcm_motion fcm_motion_default(void)
   return m;
 }
 
+int fcm_motion_active(const fcm_motion *m, double t)
+{
+  return !(m->release && t > m->end);
+}
+
 void fcm_motion_eval(const fcm_motion *m, const double X[3], double t, double u[3], double v[3])
 {
   double span = m->end - m->start, tau = t - m->start;
@@ -312,7 +317,7 @@ void fcm__sim_eval_constraints(fcm_integrator *I, double t)
   int changed = 0;
   for (int k = 0; k < I->num_cons; k++) {
     const fcm_motion *m = &I->cons[k].motion;
-    unsigned char on = !(m->release && t > m->end);
+    unsigned char on = (unsigned char)fcm_motion_active(m, t);
     if (on != I->con_on[k]) changed = 1;
     I->con_on[k] = on;
   }
@@ -368,8 +373,10 @@ static fcm_status validate_options(fcm_ctx *ctx, const fcm_integrator_options *o
   FCM_CHECK(o->newton_max_iterations >= 1, ctx, FCM_ERR_ARG,
             "integrator: newton_max_iterations = %d must be >= 1", o->newton_max_iterations);
   FCM_CHECK(o->tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE ||
-                o->tolerance_mode == FCM_NEWTON_TOL_RELATIVE,
-            ctx, FCM_ERR_ARG, "integrator: tolerance_mode = %d must be 0 or 1",
+                o->tolerance_mode == FCM_NEWTON_TOL_RELATIVE ||
+                o->tolerance_mode == FCM_NEWTON_TOL_AUTO,
+            ctx, FCM_ERR_ARG,
+            "integrator: tolerance_mode = %d must be 0 (representative), 1 (relative) or 2 (auto)",
             (int)o->tolerance_mode);
   FCM_CHECK(o->newton_tolerance > 0.0 && o->newton_tolerance < 1.0, ctx, FCM_ERR_ARG,
             "integrator: newton_tolerance = %g outside (0, 1)", o->newton_tolerance);
@@ -474,6 +481,9 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
   const fcm_integrator_options *o = &I->opts;
   FCM_CHECK(!I->is_setup, ctx, FCM_ERR_ARG, "integrator: already set up");
   FCM_TRY(ctx, validate_options(ctx, o));
+  if (I->opts.tolerance_mode == FCM_NEWTON_TOL_AUTO)
+    I->opts.tolerance_mode = I->opts.kind == FCM_INTEGRATOR_STATIC ? FCM_NEWTON_TOL_RELATIVE
+                                                                   : FCM_NEWTON_TOL_REPRESENTATIVE;
   FCM_CHECK(n > 0, ctx, FCM_ERR_ARG, "integrator: the space has no DOFs");
   FCM_TRY(ctx, build_constraints(I));
 
@@ -486,17 +496,17 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
   /* Mass (constant; dynamics only) and the loads of scale 1. */
   FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->H));
   {
-    fcm_elastic el = {I->mat.young, I->mat.poisson, I->mat.density};
+    const fcm_material *el = &I->mat; /* linear assembly: mass and body forces */
     if (o->kind == FCM_INTEGRATOR_BACKWARD_EULER) {
       FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->M));
-      FCM_TRY(ctx, fcm_assemble_mass(I->space, &el, &o->assembly, I->M));
+      FCM_TRY(ctx, fcm_assemble_mass(I->space, el, &o->assembly, I->M));
       I->setup_info.mass_assemblies = 1;
     }
     for (int k = 0; k < I->num_loads; k++) {
       sim_load *l = &I->loads[k];
       FCM_ALLOC(ctx, n, l->f);
       if (l->kind == SIM_LOAD_GRAVITY)
-        FCM_TRY(ctx, fcm_assemble_body_force(I->space, &el, l->accel, &o->assembly, l->f));
+        FCM_TRY(ctx, fcm_assemble_body_force(I->space, el, l->accel, &o->assembly, l->f));
       else if (l->kind == SIM_LOAD_BODY)
         FCM_TRY(ctx, fcm_assemble_body_force_field(I->space, l->field, l->field_user, &o->assembly,
                                                    l->f));
@@ -527,7 +537,7 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
           memcpy(I->Ma, same->f, sizeof *I->Ma * (size_t)n);
         } else {
           memset(I->Ma, 0, sizeof *I->Ma * (size_t)n);
-          FCM_TRY(ctx, fcm_assemble_body_force(I->space, &el, a, &o->assembly, I->Ma));
+          FCM_TRY(ctx, fcm_assemble_body_force(I->space, el, a, &o->assembly, I->Ma));
           I->setup_info.scale_assemblies = 1;
         }
       }

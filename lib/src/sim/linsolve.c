@@ -42,9 +42,13 @@ static fcm_status factor_direct(fcm_integrator *I, fcm_step_reason *reason, sim_
     }
     if (s != FCM_ERR_SINGULAR) return soft(I, s, reason);
     /* Not positive definite: LU with partial pivoting on the same matrix. */
-    fcm_ctx_error_clear(ctx);
     stats->direct_fallbacks++;
     I->total_fallbacks++;
+    fcm__log(ctx, FCM_LOG_WARNING,
+             "integrator: t = %g: CHOLMOD failed (%s); factorizing with UMFPACK instead "
+             "(direct fallback %lld)",
+             I->t, fcm_ctx_error_message(ctx), (long long)I->total_fallbacks);
+    fcm_ctx_error_clear(ctx);
   }
   if (!I->umf) {
     FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_UMFPACK, I->H, &I->umf));

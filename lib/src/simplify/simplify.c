@@ -31,7 +31,6 @@ fcm_simplify_options fcm_simplify_options_default(void)
   o.residual_tol = 1e-12;
   o.lp_iteration_limit = 0;
   o.lp_time_limit = 60.0;
-  o.force_lp_failure = 0;
   return o;
 }
 
@@ -197,8 +196,6 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_simplify_options *o)
             "simplify: lp_iteration_limit = %d must be >= 0 (0: automatic)", o->lp_iteration_limit);
   FCM_CHECK(o->lp_time_limit >= 0.0 && isfinite(o->lp_time_limit), ctx, FCM_ERR_ARG,
             "simplify: lp_time_limit = %g must be finite and >= 0 (0: none)", o->lp_time_limit);
-  FCM_CHECK(o->force_lp_failure >= 0 && o->force_lp_failure <= 2, ctx, FCM_ERR_ARG,
-            "simplify: force_lp_failure = %d out of range [0, 2]", o->force_lp_failure);
 cleanup:
   return st;
 }
@@ -231,6 +228,14 @@ fcm_status fcm_simplify(fcm_ctx *ctx, int strength, fcm_index n, const double *p
                         const double *weights, const fcm_simplify_options *opts,
                         fcm_simplify_result *out, fcm_simplify_info *info)
 {
+  return fcm__simplify_hooked(ctx, strength, n, points, weights, opts, 0, out, info);
+}
+
+fcm_status fcm__simplify_hooked(fcm_ctx *ctx, int strength, fcm_index n, const double *points,
+                                const double *weights, const fcm_simplify_options *opts,
+                                int force_lp_failure, fcm_simplify_result *out,
+                                fcm_simplify_info *info)
+{
   fcm_status st = FCM_OK;
   fcm_simplify_info local_info;
   fcm_simplify_options o = opts ? *opts : fcm_simplify_options_default();
@@ -251,6 +256,8 @@ fcm_status fcm_simplify(fcm_ctx *ctx, int strength, fcm_index n, const double *p
   FCM_CHECK(n >= 1, ctx, FCM_ERR_ARG, "simplify: n = %lld points, must be >= 1", (long long)n);
   FCM_CHECK(points && weights, ctx, FCM_ERR_ARG, "simplify: points and weights must not be NULL");
   FCM_TRY(ctx, check_options(ctx, &o));
+  FCM_CHECK(force_lp_failure >= 0 && force_lp_failure <= 2, ctx, FCM_ERR_ARG,
+            "simplify: force_lp_failure = %d out of range [0, 2]", force_lp_failure);
   FCM_TRY(ctx, fcm__index_to_int(ctx, n, "simplify: number of points", &ni));
   for (int j = 0; j < ni; j++) {
     FCM_CHECK(isfinite(points[3 * (size_t)j]) && isfinite(points[3 * (size_t)j + 1]) &&
@@ -320,7 +327,7 @@ fcm_status fcm_simplify(fcm_ctx *ctx, int strength, fcm_index n, const double *p
   a.capacity = M;
   a.lp.it_lim = o.lp_iteration_limit > 0 ? o.lp_iteration_limit : 20 * M + 1000;
   a.lp.tm_lim = o.lp_time_limit;
-  a.lp.force_failure = o.force_lp_failure;
+  a.lp.force_failure = force_lp_failure;
   double t0 = fcm_wtime();
   fcm__simplify_box(strength, np, points, &a.box);
   for (int j = 0; j < np; j++) {
@@ -380,6 +387,10 @@ fcm_status fcm_simplify(fcm_ctx *ctx, int strength, fcm_index n, const double *p
     out->count = a.count;
   } else {
     info->fallback = 1;
+    fcm__log(ctx, FCM_LOG_WARNING,
+             "simplify: %lld points, strength %d: every attempt failed, the input rule is kept "
+             "(%s)",
+             (long long)n, strength, info->message);
     FCM_TRY(ctx, keep_input(ctx, ni, weights, out));
   }
   info->kept = out->count;

@@ -6,6 +6,14 @@
 #include "core/core_impl.h"
 #include "fcm/simplify.h"
 
+/* fcm_simplify() with a test hook that makes every LP fail: force_lp_failure 0 off (what
+ * fcm_simplify() passes), 1 every LP stops at an iteration limit of 0, 2 every LP triggers a
+ * GLPK fatal error (caught). Any other value: FCM_ERR_ARG. */
+fcm_status fcm__simplify_hooked(fcm_ctx *ctx, int strength, fcm_index n, const double *points,
+                                const double *weights, const fcm_simplify_options *opts,
+                                int force_lp_failure, fcm_simplify_result *out,
+                                fcm_simplify_info *info);
+
 /* ---- basis (basis.c) ---- */
 
 /* Tensor Chebyshev basis T_a(x^)T_b(y^)T_c(z^), a+b+c <= m, on the bounding box of a
