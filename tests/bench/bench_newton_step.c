@@ -169,6 +169,7 @@ int main(int argc, char **argv)
 {
   const int shared = argc > 1 && !strcmp(argv[1], "shared");
   const int simplify = !(argc > 1 + shared && !strcmp(argv[1 + shared], "nosimplify"));
+  fcm_blas_set_num_threads(1); /* as the programs: no BLAS threads spinning beside OpenMP's */
   fcm_ctx *ctx = NULL;
   fcm_mesh *mesh = NULL;
   fcm_geometry *tube = NULL;
