@@ -11,6 +11,7 @@
  * eliminated (removed), and every preconditioner is built on the reduced matrix. */
 #include "cli.h"
 #include "fcm-condition-study.h"
+#include "app_env.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -255,6 +256,7 @@ static int parse_args(int argc, char **argv, config *c)
 
 int main(int argc, char **argv)
 {
+  app_env_init(argc, argv); /* passive OpenMP waiting unless the user chose */
   fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   config c;
   memset(&c, 0, sizeof c);

@@ -8,6 +8,7 @@
  * fcm-converge-study.c), or --reference runs the authors' localized-load problem against a
  * boundary-conforming Tet10 reference. `payoff` times rule construction and one Newton
  * iteration (SNH tangent + force, CHOLMOD) with and without simplification. */
+#include "app_env.h"
 #include "cli.h"
 #include "fcm-converge-study.h"
 
@@ -779,6 +780,7 @@ done:
 
 int main(int argc, char **argv)
 {
+  app_env_init(argc, argv); /* passive OpenMP waiting unless the user chose */
   fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   config c;
   fcm_ctx *ctx = NULL;

@@ -1,5 +1,6 @@
 /* fcm-quadrature: quadrature studies and reports. Subcommands are listed in one
  * table; `tables` reports (and with --check re-verifies) the stored rule tables. */
+#include "app_env.h"
 #include "cli.h"
 #include "fcm-quadrature.h"
 #include <fcm/fcm.h>
@@ -238,6 +239,7 @@ static void usage(FILE *f)
 
 int main(int argc, char **argv)
 {
+  app_env_init(argc, argv); /* passive OpenMP waiting unless the user chose */
   fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
     usage(argc < 2 ? stderr : stdout);

@@ -1,6 +1,7 @@
 /* fcm-rulegen: offline generator of the standard-rule tables in quadrature_tables/
  * by node elimination from the computed (tensor / collapsed) rules. */
 #define _POSIX_C_SOURCE 200809L /* mkdir */
+#include "app_env.h"
 #include <fcm/fcm.h>
 #include <fcm/rulegen.h>
 
@@ -271,6 +272,7 @@ static int parse_double(const char *opt, const char *s, double lo, double hi, do
 
 int main(int argc, char **argv)
 {
+  app_env_init(argc, argv); /* passive OpenMP waiting unless the user chose */
   config cfg;
   fcm_shape shapes[16];
   int nshapes = 0, mlo = 1, mhi = 10;

@@ -3,6 +3,7 @@
  * cantilever that used to be a second program here is the example scene
  * apps/scenes/cantilever.json (its Timoshenko comparison: tests/fem/cantilever.c). */
 #define _POSIX_C_SOURCE 200809L
+#include "app_env.h"
 #include <fcm/fcm.h>
 #include <fcm/simulation.h>
 
@@ -284,6 +285,7 @@ done:
 
 int main(int argc, char **argv)
 {
+  app_env_init(argc, argv); /* passive OpenMP waiting unless the user chose */
   fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   return scene_main(argc, argv);
 }

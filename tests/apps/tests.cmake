@@ -62,3 +62,6 @@ fcm_add_test(app_fault_kill_long tests/apps/fault_app.c LABELS app slow TIMEOUT 
 fcm_add_test(app_fault_diskfull tests/apps/fault_app.c LABELS app ARGS diskfull ${fault_args})
 fcm_add_test(app_fault_dirsync tests/apps/fault_app.c LABELS app ARGS dirsync ${fault_args})
 add_dependencies(app_fault_kill fcm_fault_shim fcm-sim) # the program of the app_fault_* tests
+# apps/app_env.c: passive OpenMP waiting by default, the user's OMP_WAIT_POLICY / GOMP_SPINCOUNT kept.
+fcm_add_test(app_env tests/apps/app_env.c LABELS app ARGS ${PROJECT_BINARY_DIR}/app-tests)
+target_sources(app_env PRIVATE ${PROJECT_SOURCE_DIR}/apps/app_env.c)

@@ -10,12 +10,25 @@
  * stiffness, alpha 1e-6) and simplified cut-cell rules. State: a twist u = R(k (y + 8)) X - X
  * about the y axis, k = 0.1 rad per unit length, zero velocity, gravity -9.81 e_z; the ends
  * y = +-8 are held. Step: A = M + dt^2 K(u) (unprojected tangent), b = -dt^2 (f_int(u) - f_ext),
- * Dirichlet rows eliminated. Usage: bench_newton_step [nosimplify] */
+ * Dirichlet rows eliminated. Usage: bench_newton_step [nosimplify]
+ *
+ * bench_newton_step shared [nosimplify]: the same system, then MINRES + Schwarz (rtol 1e-8,
+ * 3 solves a round) alone and beside 3 busy-loop processes per core, in alternating
+ * rounds, and the slowdown loaded / alone (a fair share of the cores makes it 4x on 2
+ * cores: 8 runnable processes instead of the 2 threads). Run it with the wait policy to
+ * measure (the programs use OMP_WAIT_POLICY=passive, apps/app_env.h). Asserts that every
+ * solve converges and that the loaded solves are bitwise equal to the lone ones. */
+#define _GNU_SOURCE /* getloadavg */
 #include "fcm/fcm.h"
 #include "test.h"
 
 #include <omp.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
 #include <time.h>
+#include <unistd.h>
 
 #define NREP 3
 
@@ -43,9 +56,120 @@ static void keep_min(stamp *best, stamp t0)
 
 static const stamp FAR = {1e30, 1e30};
 
+/* ---- shared cores ---- */
+
+#define SHARED_ROUNDS 3
+#define SHARED_SOLVES 3
+#define SPIN_PER_CORE 3
+
+/* Start `count` busy-loop child processes (they die with this process). */
+static int spin_start(int count, pid_t *pids)
+{
+  for (int k = 0; k < count; k++) {
+    pids[k] = fork();
+    if (pids[k] == 0) {
+      prctl(PR_SET_PDEATHSIG, SIGKILL);
+      for (volatile unsigned long i = 0;; i++) {
+      }
+    }
+    if (pids[k] < 0) return 0;
+  }
+  return 1;
+}
+
+static void spin_stop(int count, pid_t *pids)
+{
+  for (int k = 0; k < count; k++)
+    if (pids[k] > 0) {
+      kill(pids[k], SIGKILL);
+      waitpid(pids[k], NULL, 0);
+      pids[k] = 0;
+    }
+}
+
+/* SHARED_SOLVES MINRES solves from x = 0; the time of all, the last iterate in x. */
+static stamp solves(fcm_ctx *ctx, fcm_krylov *ws, fcm_csr *A, fcm_schwarz *P, const double *b,
+                    double *x, fcm_index n, int *iterations)
+{
+  fcm_krylov_options ko = fcm_krylov_options_default();
+  ko.max_iterations = 20000;
+  ko.rtol = 1e-8;
+  fcm_krylov_info ki;
+  stamp t0 = now(), t;
+  for (int k = 0; k < SHARED_SOLVES; k++) {
+    memset(x, 0, sizeof *x * (size_t)n);
+    TEST_OK(ctx, fcm_krylov_minres(ws, fcm_csr_operator, A, fcm_schwarz_operator, P, b, x, &ko,
+                                   &ki));
+    TEST_TRUE(ki.reason == FCM_KRYLOV_CONVERGED_RTOL);
+  }
+  *iterations = ki.iterations;
+  t = now();
+  t.wall -= t0.wall;
+  t.cpu -= t0.cpu;
+  return t;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+  const double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+static void shared_cores(fcm_ctx *ctx, fcm_csr *A, fcm_schwarz *P, const double *b, fcm_index n)
+{
+  const long cores = sysconf(_SC_NPROCESSORS_ONLN);
+  const int nspin = (int)(SPIN_PER_CORE * (cores > 0 ? cores : 1));
+  const char *pol = getenv("OMP_WAIT_POLICY"), *spc = getenv("GOMP_SPINCOUNT");
+  double load[3] = {-1, -1, -1};
+  fcm_krylov *ws = NULL;
+  pid_t *pids = calloc((size_t)nspin, sizeof *pids);
+  double *x0 = calloc((size_t)n, sizeof *x0), *x1 = calloc((size_t)n, sizeof *x1);
+  double ra[SHARED_ROUNDS], rl[SHARED_ROUNDS], ca[SHARED_ROUNDS], cl[SHARED_ROUNDS];
+  int it0 = 0, it1 = 0;
+  TEST_OK(ctx, fcm_krylov_create(ctx, n, &ws));
+  if (getloadavg(load, 3) < 0) load[0] = -1;
+  printf("Shared cores: MINRES + Schwarz (rtol 1e-8) on the twisted-tube Newton system, %lld "
+         "DOFs,\n  %d thread(s), %ld core(s), OMP_WAIT_POLICY=%s GOMP_SPINCOUNT=%s, load average "
+         "%.1f before\n",
+         (long long)n, omp_get_max_threads(), cores, pol ? pol : "(unset)",
+         spc ? spc : "(unset)", load[0]);
+  (void)solves(ctx, ws, A, P, b, x0, n, &it0); /* warm-up */
+  for (int r = 0; r < SHARED_ROUNDS; r++) {
+    stamp t = solves(ctx, ws, A, P, b, x0, n, &it0);
+    ra[r] = t.wall;
+    ca[r] = t.cpu;
+    TEST_TRUE(spin_start(nspin, pids));
+    struct timespec settle = {0, 200000000};
+    nanosleep(&settle, NULL);
+    t = solves(ctx, ws, A, P, b, x1, n, &it1);
+    spin_stop(nspin, pids);
+    rl[r] = t.wall;
+    cl[r] = t.cpu;
+    TEST_TRUE(it1 == it0 && memcmp(x0, x1, sizeof *x0 * (size_t)n) == 0);
+    printf("  round %d: %d solves of %d iterations: alone %.3f s wall (%.3f s CPU), beside %d "
+           "busy loops %.3f s wall (%.3f s CPU): slowdown %.1fx\n",
+           r + 1, SHARED_SOLVES, it0, ra[r], ca[r], nspin, rl[r], cl[r], rl[r] / ra[r]);
+  }
+  qsort(ra, SHARED_ROUNDS, sizeof *ra, cmp_double);
+  qsort(rl, SHARED_ROUNDS, sizeof *rl, cmp_double);
+  const double med_a = ra[SHARED_ROUNDS / 2], med_l = rl[SHARED_ROUNDS / 2];
+  /* fair share: the team of T threads gets T cores / (T + spinners) of the machine */
+  const double T = omp_get_max_threads(), C = cores > 0 ? (double)cores : 1.0;
+  const double fair = (T < C ? T : C) * (T + nspin) / (T * C);
+  printf("  median: alone %.3f s, loaded %.3f s: slowdown %.1fx (fair share %.1fx; target <= "
+         "6x)\n",
+         med_a, med_l, med_l / med_a, fair);
+  fcm_krylov_destroy(&ws);
+  free(pids);
+  free(x0);
+  free(x1);
+}
+
 int main(int argc, char **argv)
 {
-  const int simplify = !(argc > 1 && !strcmp(argv[1], "nosimplify"));
+  const int shared = argc > 1 && !strcmp(argv[1], "shared");
+  const int simplify = !(argc > 1 + shared && !strcmp(argv[1 + shared], "nosimplify"));
+  fcm_blas_set_num_threads(1); /* as the programs: no BLAS threads spinning beside OpenMP's */
   fcm_ctx *ctx = NULL;
   fcm_mesh *mesh = NULL;
   fcm_geometry *tube = NULL;
@@ -99,7 +223,8 @@ int main(int argc, char **argv)
 
   /* assembly: best of NREP */
   stamp tm = FAR, th = FAR;
-  for (int rep = 0; rep < NREP; rep++) {
+  const int nrep = shared ? 1 : NREP;
+  for (int rep = 0; rep < nrep; rep++) {
     fcm_csr_set_zero(A);
     fcm_csr_set_zero(K);
     memset(fint, 0, sizeof *fint * (size_t)n);
@@ -141,15 +266,23 @@ int main(int argc, char **argv)
               fcm_cell_rules_volume_fraction(rules, c) < 0.5;
   stamp t_create = FAR, t_setup = FAR;
   t0 = now();
-  TEST_OK(ctx, fcm_schwarz_create_from_space(ctx, space, A, flag, NULL, &P));
+  fcm_index nb = 0, nd = 0;
+  TEST_OK(ctx, fcm_space_cell_blocks(space, flag, &nb, &nd, NULL, NULL));
+  fcm_index *bptr = calloc((size_t)nb + 1, sizeof *bptr), *bdofs = calloc((size_t)nd + 1, sizeof *bdofs);
+  TEST_OK(ctx, fcm_space_cell_blocks(space, flag, &nb, &nd, bptr, bdofs));
+  TEST_OK(ctx, fcm_schwarz_create(ctx, A, nb, bptr, bdofs, NULL, &P));
   keep_min(&t_create, t0);
-  for (int rep = 0; rep < NREP; rep++) {
+  for (int rep = 0; rep < nrep; rep++) {
     t0 = now();
     TEST_OK(ctx, fcm_schwarz_setup(P, A));
     keep_min(&t_setup, t0);
   }
   fcm_schwarz_info si;
   fcm_schwarz_get_info(P, &si);
+  if (shared) {
+    shared_cores(ctx, A, P, b, n);
+    goto done;
+  }
 
   /* MINRES + Schwarz at the paper's CG tolerance 1e-5 and at rtol 1e-8 */
   TEST_OK(ctx, fcm_krylov_create(ctx, n, &ws));
@@ -262,6 +395,7 @@ int main(int argc, char **argv)
 #undef ROW
   printf("  paper (Table 1, Hex20 res 7): 359 ms per time step on 28 cores, MKL direct solver\n");
   printf("  MINRES (1e-8) vs direct solution: relative difference %.1e\n", diff);
+done:
 
   free(u);
   free(fint);
@@ -273,6 +407,8 @@ int main(int argc, char **argv)
   free(nodes);
   free(fix);
   free(flag);
+  free(bptr);
+  free(bdofs);
   fcm_direct_destroy(&chol);
   fcm_krylov_destroy(&ws);
   fcm_schwarz_destroy(&P);

@@ -1,6 +1,6 @@
 /* Allocation failures in the solve module: failing the k-th allocation for k = 0, 1, ...
- * of the workspace (with its history), the Jacobi and the Schwarz builders (from blocks
- * and from a space), a second Schwarz setup, MINRES and CG (workspace and one-shot) gives
+ * of the workspace (with its history), the Jacobi and the Schwarz builders (from blocks,
+ * and from the cell blocks of a space), a second Schwarz setup, MINRES and CG (workspace and one-shot) gives
  * FCM_ERR_ALLOC and leaks nothing, until everything succeeds. */
 #include "solve_test_util.h"
 
@@ -17,6 +17,7 @@ typedef struct fixture {
   unsigned char flag[8];
   fcm_index bptr[28], bdofs[NN];
   int nb;
+  fcm_index cell_nb, cell_ptr[9], cell_dofs[8 * 60]; /* fcm_space_cell_blocks of flag */
   double b[NN];
 } fixture;
 
@@ -34,7 +35,8 @@ static fcm_status run(fcm_ctx *ctx, fixture *f)
   if ((st = fcm_krylov_create(ctx, NN, &ws))) goto done;
   if ((st = fcm_jacobi_create(ctx, f->A, FCM_JACOBI_BLOCK3, &J))) goto done;
   if ((st = fcm_schwarz_create(ctx, f->A, f->nb, f->bptr, f->bdofs, NULL, &P))) goto done;
-  if ((st = fcm_schwarz_create_from_space(ctx, f->space, f->K, f->flag, NULL, &Q))) goto done;
+  if ((st = fcm_schwarz_create(ctx, f->K, f->cell_nb, f->cell_ptr, f->cell_dofs, NULL, &Q)))
+    goto done;
   memset(x, 0, sizeof x);
   if ((st = fcm_krylov_minres(ws, fcm_csr_operator, f->A, fcm_schwarz_operator, P, f->b, x, &o,
                               &info)))
@@ -100,6 +102,10 @@ int main(void)
   /* stiffness without boundary conditions: singular, but its cell blocks are not zero */
   for (int c = 0; c < 8; c++)
     f.flag[c] = (unsigned char)(c % 2);
+  fcm_index nd = 0;
+  TEST_OK(ctx0, fcm_space_cell_blocks(f.space, f.flag, &f.cell_nb, &nd, NULL, NULL));
+  TEST_TRUE(f.cell_nb == 4 && nd == 4 * 60);
+  TEST_OK(ctx0, fcm_space_cell_blocks(f.space, f.flag, &f.cell_nb, &nd, f.cell_ptr, f.cell_dofs));
 
   failing fl = {0, -1};
   fcm_ctx_options opts = fcm_ctx_options_default();

@@ -87,6 +87,24 @@ typedef enum fcm_fictitious_model {
   FCM_FICTITIOUS_MODEL_COUNT
 } fcm_fictitious_model;
 
+/** DOF blocks of flagged cells, e.g. the blocks of an additive Schwarz preconditioner
+ * (fcm_schwarz_create() of fcm/solve.h; the paper's choice: the cut cells with volume
+ * fraction below theta = 0.5). Block k holds the 3 x nodes_per_cell DOFs of the k-th
+ * flagged cell in ascending cell order: node order of the cell, components x, y, z
+ * (fcm_space_node_dof()). Call once with block_ptr and block_dofs NULL for the counts,
+ * then with buffers of *num_blocks + 1 and *num_dofs entries.
+ * @param[in]  space      the space
+ * @param[in]  cell_flag  num_cells flags (nonzero: a block); flagged cells must be active
+ * @param[out] num_blocks the number of flagged cells
+ * @param[out] num_dofs   the total block size, num_blocks x 3 x nodes_per_cell
+ * @param[out] block_ptr  NULL, or num_blocks + 1 offsets into block_dofs (block_ptr[0] = 0)
+ * @param[out] block_dofs NULL, or num_dofs DOFs (both NULL or both given)
+ * @return FCM_OK, FCM_ERR_ARG (NULL, one buffer only, a flagged inactive cell: named).
+ * No allocation; thread safe. */
+FCM_API fcm_status fcm_space_cell_blocks(const fcm_space *space, const unsigned char *cell_flag,
+                                         fcm_index *num_blocks, fcm_index *num_dofs,
+                                         fcm_index *block_ptr, fcm_index *block_dofs);
+
 /** Quadrature strengths for assembly on full cells; 0 selects the default rule of
  * fcm_element_standard_rule(). */
 typedef struct fcm_assembly_options {

@@ -4,7 +4,6 @@
 #define FCM_SOLVE_H
 
 #include "fcm/core.h"
-#include "fcm/fem.h"
 #include "fcm/la.h"
 
 #ifdef __cplusplus
@@ -205,7 +204,8 @@ typedef struct fcm_schwarz_info {
   fcm_index num_blocks;   /**< blocks K */
   fcm_index block_dofs;   /**< sum of the block sizes */
   int max_block_size;     /**< largest block */
-  int num_colors;         /**< colours of the block graph (blocks of a colour share no DOF) */
+  int num_colors;         /**< colours of a greedy colouring of the block graph (blocks of a
+                               colour share no DOF; a statistic, the apply does not use it) */
   fcm_index outside_dofs; /**< DOFs in no block (Jacobi) */
   fcm_index negative_eigenvalues; /**< reflected eigenvalues lambda < 0 (over all blocks) */
   fcm_index clamped_eigenvalues;  /**< eigenvalues with |lambda| < eps lambda_max */
@@ -230,20 +230,11 @@ typedef struct fcm_schwarz fcm_schwarz;
  * @param[out] P          the new preconditioner, NULL on failure
  * @return FCM_OK, FCM_ERR_ARG (bad block: the message names it and the DOF), and the
  * codes of fcm_schwarz_setup(). Allocates the blocks (sum of squared sizes) and O(n).
- * Builds a greedy colouring of the blocks. Thread safe. */
+ * Blocks of cells of a finite element space: fcm_space_cell_blocks() (fcm/fem.h). Thread
+ * safe. */
 FCM_API fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
                                       const fcm_index *block_ptr, const fcm_index *block_dofs,
                                       const fcm_schwarz_options *opts, fcm_schwarz **P);
-
-/** Create with one block per flagged cell of a space: the 3 x nodes_per_cell DOFs of the
- * cell (fcm_space_node_dof, node order of the cell, components x, y, z). The caller
- * flags the cells, e.g. cut cells with volume fraction below theta (0.5 in the paper).
- * @param[in] space      the space C was assembled on; @param[in] C as fcm_schwarz_create()
- * @param[in] cell_flag  num_cells flags (nonzero: block); flagged cells must be active
- * @return as fcm_schwarz_create(); FCM_ERR_ARG names a flagged inactive cell. */
-FCM_API fcm_status fcm_schwarz_create_from_space(fcm_ctx *ctx, const fcm_space *space,
-                                                 const fcm_csr *C, const unsigned char *cell_flag,
-                                                 const fcm_schwarz_options *opts, fcm_schwarz **P);
 
 /** Recompute the blocks and the diagonal from new values of C (same size): dense block
  * gather, symmetric eigendecomposition (LAPACK dsyevd, lower triangle), eigenvalue
@@ -254,9 +245,10 @@ FCM_API fcm_status fcm_schwarz_create_from_space(fcm_ctx *ctx, const fcm_space *
  * diagonal: named), FCM_ERR_LAPACK, FCM_ERR_ALLOC. Allocates per-thread block buffers. */
 FCM_API fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C);
 
-/** z = S r (n entries each, must not overlap). No allocation. Blocks are applied colour by
- * colour, in parallel within a colour; every z entry receives its contributions in a fixed
- * order, so z is bitwise independent of the thread count.
+/** z = S r (n entries each, must not overlap). No allocation. One parallel loop over the
+ * DOFs (no barrier inside): each z_i is summed by one thread from its diagonal term and
+ * the rows of the blocks holding DOF i in ascending block order, so z is bitwise
+ * independent of the thread count.
  * @return FCM_OK, FCM_ERR_ARG (NULL, not set up). Thread safe for distinct z. */
 FCM_API fcm_status fcm_schwarz_apply(const fcm_schwarz *P, const double *r, double *z);
 

@@ -96,6 +96,23 @@ cleanup:
   return st;
 }
 
+/* Schwarz with one block per flagged cell (cut cells with volume fraction below theta). */
+static fcm_status schwarz_create(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  fcm_index nb = 0, nd = 0, *ptr = NULL, *dofs = NULL;
+  FCM_TRY(ctx, fcm_space_cell_blocks(I->space, I->schwarz_flag, &nb, &nd, NULL, NULL));
+  FCM_ALLOC(ctx, nb + 1, ptr);
+  FCM_ALLOC(ctx, FCM_MAX(nd, 1), dofs);
+  FCM_TRY(ctx, fcm_space_cell_blocks(I->space, I->schwarz_flag, &nb, &nd, ptr, dofs));
+  FCM_TRY(ctx, fcm_schwarz_create(ctx, I->H, nb, ptr, dofs, &I->opts.schwarz, &I->schwarz));
+cleanup:
+  fcm__free(ctx, ptr);
+  fcm__free(ctx, dofs);
+  return st;
+}
+
 static fcm_status setup_preconditioner(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
 {
   fcm_status s = FCM_OK;
@@ -117,8 +134,7 @@ static fcm_status setup_preconditioner(fcm_integrator *I, fcm_step_reason *reaso
     if (I->schwarz)
       s = fcm_schwarz_setup(I->schwarz, I->H);
     else
-      s = fcm_schwarz_create_from_space(ctx, I->space, I->H, I->schwarz_flag, &I->opts.schwarz,
-                                        &I->schwarz);
+      s = schwarz_create(I);
     break;
   }
   stats->factorizations++;

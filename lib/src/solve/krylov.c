@@ -125,26 +125,66 @@ static double dot(const fcm_krylov *ws, const double *x, const double *y)
   return s;
 }
 
+/* ---- team kernels: called by every thread of a parallel region (or by one thread outside
+ * any), with orphaned worksharing, so that one region holds several vector operations.
+ * A team dot product sums the same fixed chunks as dot() into ws->partial, then (after the
+ * loop's barrier) every thread adds the chunk sums in order itself: the value is the same
+ * in all threads and bitwise equal to dot(). At most one team dot per region (the region's
+ * closing barrier keeps the next region's chunk writes from racing with the reads). ---- */
+
+/* Chunk c of the n entries. */
+#define CHUNK_RANGE(c, n, i0, i1)                                                                  \
+  const fcm_index i0 = (c)*DOT_CHUNK, i1 = FCM_MIN(i0 + DOT_CHUNK, (n))
+
+static double team_sum(const fcm_krylov *ws)
+{
+  double s = 0.0;
+  for (fcm_index c = 0; c < ws->num_chunks; c++)
+    s += ws->partial[c];
+  return s;
+}
+
+/* In a team: if c1 != 0, y += c1 r; then return v^T y. */
+static double team_axpy_dot(const fcm_krylov *ws, double c1, const double *r, const double *v,
+                            double *y)
+{
+  const fcm_index n = ws->n;
+#pragma omp for schedule(static)
+  for (fcm_index c = 0; c < ws->num_chunks; c++) {
+    CHUNK_RANGE(c, n, i0, i1);
+    double s = 0.0;
+    if (c1 != 0.0)
+      for (fcm_index i = i0; i < i1; i++)
+        y[i] += c1 * r[i];
+    for (fcm_index i = i0; i < i1; i++)
+      s += v[i] * y[i];
+    ws->partial[c] = s;
+  }
+  return team_sum(ws);
+}
+
+/* In a team: if copy_y, y = r; then return r^T y. */
+static double team_copy_dot(const fcm_krylov *ws, int copy_y, const double *r, double *y)
+{
+  const fcm_index n = ws->n;
+#pragma omp for schedule(static)
+  for (fcm_index c = 0; c < ws->num_chunks; c++) {
+    CHUNK_RANGE(c, n, i0, i1);
+    double s = 0.0;
+    if (copy_y)
+      for (fcm_index i = i0; i < i1; i++)
+        y[i] = r[i];
+    for (fcm_index i = i0; i < i1; i++)
+      s += r[i] * y[i];
+    ws->partial[c] = s;
+  }
+  return team_sum(ws);
+}
+
 /* y = x */
 static void copy(fcm_index n, const double *x, double *y)
 {
   if (n > 0 && x != y) memcpy(y, x, (size_t)n * sizeof *x);
-}
-
-/* y = a x */
-static void scale(fcm_index n, double a, const double *x, double *y)
-{
-#pragma omp parallel for schedule(static) if (n >= VEC_PARALLEL)
-  for (fcm_index i = 0; i < n; i++)
-    y[i] = a * x[i];
-}
-
-/* y += a x */
-static void axpy(fcm_index n, double a, const double *x, double *y)
-{
-#pragma omp parallel for schedule(static) if (n >= VEC_PARALLEL)
-  for (fcm_index i = 0; i < n; i++)
-    y[i] += a * x[i];
 }
 
 /* r = b - r */
@@ -356,6 +396,39 @@ cleanup:
 
 /* ---- MINRES (Paige and Saunders) ---- */
 
+/* The scalars of one MINRES iteration before and after the new Lanczos beta. */
+typedef struct mr_in {
+  double beta, dbar, epsln, cs, sn, phibar, alfa;
+} mr_in;
+typedef struct mr_out {
+  double betasq, beta, dbar, epsln, cs, sn, phibar; /* the new state */
+  double oldeps, delta, gamma, ig, phi, ib;         /* for the vector update */
+  int ok;                                           /* betasq > 0 and gamma > 0 */
+} mr_out;
+
+/* Apply the previous rotation, then the new one that annihilates beta = sqrt(betasq).
+ * A pure function, so that every thread of a team computes the same values. */
+static mr_out mr_rotate(const mr_in *in, double betasq)
+{
+  mr_out o;
+  o.betasq = betasq;
+  o.beta = betasq >= 0.0 ? sqrt(betasq) : 0.0;
+  o.oldeps = in->epsln;
+  o.delta = in->cs * in->dbar + in->sn * in->alfa;
+  const double gbar = in->sn * in->dbar - in->cs * in->alfa;
+  o.epsln = in->sn * o.beta;
+  o.dbar = -in->cs * o.beta;
+  o.gamma = hypot(gbar, o.beta);
+  o.cs = gbar / o.gamma;
+  o.sn = o.beta / o.gamma;
+  o.phi = o.cs * in->phibar;
+  o.phibar = o.sn * in->phibar;
+  o.ig = 1.0 / o.gamma;
+  o.ib = 1.0 / o.beta;
+  o.ok = isfinite(betasq) && betasq > 0.0 && o.gamma > 0.0;
+  return o;
+}
+
 static fcm_status run_minres(solve *sv)
 {
   fcm_status st = FCM_OK;
@@ -371,6 +444,7 @@ static fcm_status run_minres(solve *sv)
   double betasq = 0.0, rr, beta1;
   double oldb = 0.0, beta, dbar = 0.0, epsln = 0.0, phibar, cs = -1.0, sn = 0.0;
   int k = 0;
+  const int par = n >= VEC_PARALLEL;
 
   if (x0_zero) {
     copy(n, b, r1);
@@ -410,62 +484,92 @@ static fcm_status run_minres(solve *sv)
   if (maxit == 0) goto maxed;
 
   beta = phibar = beta1;
-  memset(w, 0, (size_t)n * sizeof *w);
-  memset(w2, 0, (size_t)n * sizeof *w2);
-  copy(n, r1, r2);
+  /* w = w2 = 0, r2 = r1, v = y / beta */
+  {
+    const double ib = 1.0 / beta;
+#pragma omp parallel for schedule(static) if (par)
+    for (fcm_index i = 0; i < n; i++) {
+      w[i] = w2[i] = 0.0;
+      r2[i] = r1[i];
+      v[i] = ib * y[i];
+    }
+  }
+  /* Each iteration: the operator, one parallel region (Lanczos orthogonalization), the
+   * preconditioner, one parallel region (its dot product, the rotations — computed by
+   * every thread alike —, the update of w and x and the next v). */
   for (k = 1; k <= maxit; k++) {
-    /* Lanczos step: v = y / beta, y = A v - (beta/oldb) r1 - (alfa/beta) r2 */
-    scale(n, 1.0 / beta, y, v);
+    /* Lanczos step: y = A v - (beta/oldb) r1 - (alfa/beta) r2 */
     APPLY_A(sv, v, y);
-    if (k >= 2) axpy(n, -beta / oldb, r1, y);
-    double alfa = dot(ws, v, y);
+    double alfa = 0.0;
+    {
+      const double c1 = k >= 2 ? -beta / oldb : 0.0;
+#pragma omp parallel if (par)
+      {
+        const double a = team_axpy_dot(ws, c1, r1, v, y);
+        const double c2 = -a / beta;
+#pragma omp for schedule(static)
+        for (fcm_index i = 0; i < n; i++)
+          y[i] += c2 * r2[i];
+#pragma omp master
+        alfa = a;
+      }
+    }
     if (!isfinite(alfa)) goto nan;
-    axpy(n, -alfa / beta, r2, y);
     tmp = r1;
     r1 = r2;
     r2 = y;
     y = tmp;
-    if (sv->S) {
-      APPLY_S(sv, r2, y);
-      betasq = dot(ws, r2, y);
-    } else {
-      copy(n, r2, y);
-      betasq = dot(ws, r2, r2);
+    if (sv->S) APPLY_S(sv, r2, y);
+    /* w = (v - oldeps w1 - delta w2) / gamma, x += phi w, next v = y / beta (rotated
+     * pointers: w takes the oldest direction's storage) */
+    tmp = w1;
+    w1 = w2;
+    w2 = w;
+    w = tmp;
+    const mr_in in = {beta, dbar, epsln, cs, sn, phibar, alfa};
+    mr_out out;
+    int updated = 0;
+#pragma omp parallel if (par)
+    {
+      const double bsq = team_copy_dot(ws, !sv->S, r2, y);
+      const mr_out o = mr_rotate(&in, bsq);
+      if (o.ok) {
+#pragma omp for schedule(static)
+        for (fcm_index i = 0; i < n; i++) {
+          w[i] = (v[i] - o.oldeps * w1[i] - o.delta * w2[i]) * o.ig;
+          x[i] += o.phi * w[i];
+          v[i] = o.ib * y[i];
+        }
+      }
+#pragma omp master
+      {
+        out = o;
+        updated = o.ok;
+      }
     }
+    betasq = out.betasq;
     if (!isfinite(betasq)) goto nan;
     /* r2^T S r2 < 0, or = 0 for r2 != 0 (r2 = 0: the Krylov space is exhausted) */
     if (!(betasq > 0.0) && (betasq < 0.0 || dot(ws, r2, r2) > 0.0)) goto indefinite;
-    oldb = beta;
-    beta = sqrt(betasq);
-    /* apply the previous rotation, then the new one that annihilates beta */
-    double oldeps = epsln;
-    double delta = cs * dbar + sn * alfa;
-    double gbar = sn * dbar - cs * alfa;
-    epsln = sn * beta;
-    dbar = -cs * beta;
-    double gamma = hypot(gbar, beta);
-    if (!(gamma > 0.0)) {
+    if (!(out.gamma > 0.0)) {
       sv->info.reason = FCM_KRYLOV_BREAKDOWN;
       FCM_CHECK(0, ctx, FCM_ERR_NOT_CONVERGED,
                 "minres: breakdown in iteration %d: the Lanczos tridiagonal is singular "
                 "(b not in the range of A?)",
                 k);
     }
-    cs = gbar / gamma;
-    sn = beta / gamma;
-    double phi = cs * phibar;
-    phibar = sn * phibar;
-    /* w = (v - oldeps w1 - delta w2) / gamma, x += phi w */
-    tmp = w1;
-    w1 = w2;
-    w2 = w;
-    w = tmp;
-    const double ig = 1.0 / gamma;
-#pragma omp parallel for schedule(static) if (n >= VEC_PARALLEL)
-    for (fcm_index i = 0; i < n; i++) {
-      w[i] = (v[i] - oldeps * w1[i] - delta * w2[i]) * ig;
-      x[i] += phi * w[i];
-    }
+    if (!updated) /* betasq = 0 with r2 = 0: the last update (phibar becomes 0) */
+      for (fcm_index i = 0; i < n; i++) {
+        w[i] = (v[i] - out.oldeps * w1[i] - out.delta * w2[i]) * out.ig;
+        x[i] += out.phi * w[i];
+      }
+    oldb = beta;
+    beta = out.beta;
+    dbar = out.dbar;
+    epsln = out.epsln;
+    cs = out.cs;
+    sn = out.sn;
+    phibar = out.phibar;
     sv->info.iterations = k;
     if (!isfinite(phibar)) goto nan;
     if (converged(sv, k, phibar)) goto finish;

@@ -6,8 +6,10 @@
  * S_K = V diag(s_k) V^T from C_K = R_K C R_K^T = V diag(lambda_k) V^T with
  * s_k = 1/|lambda_k| for |lambda_k| >= eps lambda_max and, below, either 1/(eps lambda_max)
  * (clamp, the authors' code) or eps/lambda_max (eq. 14 as printed). The blocks are built in
- * parallel (one block per thread at a time) and applied colour by colour (blocks of one
- * colour share no DOF), so z = S r does not depend on the number of threads. */
+ * parallel (one block per thread at a time). The apply is one parallel loop over the DOFs
+ * without barriers: z_i = r_i / |c_ii| outside the blocks, and inside the sum of the rows
+ * for DOF i of the S_K of the blocks holding i (in ascending block order), each z_i summed
+ * by one thread, so z = S r does not depend on the number of threads. */
 #include "solve/solve_impl.h"
 
 #include <math.h>
@@ -18,6 +20,8 @@
 #define MAX_BLOCK 46340
 /* Apply in parallel from this many stored block entries (multiply-adds) on. */
 #define APPLY_PARALLEL_WORK 65536
+/* DOFs per chunk of the dynamically scheduled apply loop. */
+#define APPLY_CHUNK 64
 
 struct fcm_schwarz {
   fcm_ctx *ctx;
@@ -29,9 +33,10 @@ struct fcm_schwarz {
   size_t *s_off;        /* num_blocks + 1 offsets into S */
   double *S;            /* dense S_K, m x m each (symmetric) */
   int max_m;
-  int num_colors;
-  fcm_index *color_ptr; /* num_colors + 1 */
-  fcm_index *color_blocks;
+  int num_colors; /* of the block graph (statistics only) */
+  fcm_index *inc_ptr;    /* n + 1: DOF i is row inc_row[q] of block inc_blk[q], q in range */
+  fcm_index *inc_blk;    /* block_ptr[num_blocks], ascending blocks per DOF */
+  int *inc_row;          /* block_ptr[num_blocks] */
   unsigned char *inside; /* n: DOF belongs to a block */
   double *dinv;          /* n: 1/|c_ii| outside the blocks, 0 inside */
   fcm_schwarz_info info;
@@ -55,26 +60,31 @@ void fcm_schwarz_destroy(fcm_schwarz **P)
   fcm__free(ctx, p->dofs);
   fcm__free(ctx, p->s_off);
   fcm__free(ctx, p->S);
-  fcm__free(ctx, p->color_ptr);
-  fcm__free(ctx, p->color_blocks);
+  fcm__free(ctx, p->inc_ptr);
+  fcm__free(ctx, p->inc_blk);
+  fcm__free(ctx, p->inc_row);
   fcm__free(ctx, p->inside);
   fcm__free(ctx, p->dinv);
   fcm__free(ctx, p);
   *P = NULL;
 }
 
-/* Greedy colouring in block order: a block takes the smallest colour not used by an
- * earlier block sharing one of its DOFs. */
-static fcm_status color_blocks(fcm_schwarz *P)
+/* The DOF -> (block, row) incidence of the apply (blocks ascending per DOF), and a greedy
+ * colouring in block order for the statistics: a block takes the smallest colour not used
+ * by an earlier block sharing one of its DOFs. */
+static fcm_status incidence_and_colors(fcm_schwarz *P)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P->ctx;
   const fcm_index n = P->n, nb = P->num_blocks;
   fcm_index *inc_ptr = NULL, *inc = NULL, *fill = NULL, *mark = NULL;
   int *color = NULL;
-  FCM_ALLOC(ctx, n + 1, inc_ptr);
-  FCM_ALLOC(ctx, P->block_ptr[nb], inc);
-  FCM_ALLOC(ctx, FCM_MAX(n, nb), fill); /* per DOF, then per colour (<= nb colours) */
+  FCM_ALLOC(ctx, n + 1, P->inc_ptr);
+  FCM_ALLOC(ctx, FCM_MAX(P->block_ptr[nb], 1), P->inc_blk);
+  FCM_ALLOC(ctx, FCM_MAX(P->block_ptr[nb], 1), P->inc_row);
+  inc_ptr = P->inc_ptr;
+  inc = P->inc_blk;
+  FCM_ALLOC(ctx, n, fill); /* per DOF */
   FCM_ALLOC(ctx, nb, color);
   FCM_ALLOC(ctx, nb + 1, mark);
   /* DOF -> blocks containing it (ascending) */
@@ -84,8 +94,9 @@ static fcm_status color_blocks(fcm_schwarz *P)
     inc_ptr[i + 1] += inc_ptr[i];
   for (fcm_index b = 0; b < nb; b++)
     for (fcm_index p = P->block_ptr[b]; p < P->block_ptr[b + 1]; p++) {
-      fcm_index d = P->dofs[p];
-      inc[inc_ptr[d] + fill[d]++] = b;
+      fcm_index d = P->dofs[p], q = inc_ptr[d] + fill[d]++;
+      inc[q] = b;
+      P->inc_row[q] = (int)(p - P->block_ptr[b]);
     }
   int ncol = 0;
   for (fcm_index b = 0; b < nb; b++) {
@@ -101,19 +112,7 @@ static fcm_status color_blocks(fcm_schwarz *P)
     ncol = FCM_MAX(ncol, c + 1);
   }
   P->num_colors = ncol;
-  FCM_ALLOC(ctx, ncol + 1, P->color_ptr);
-  FCM_ALLOC(ctx, FCM_MAX(nb, 1), P->color_blocks);
-  for (fcm_index b = 0; b < nb; b++)
-    P->color_ptr[color[b] + 1]++;
-  for (int c = 0; c < ncol; c++)
-    P->color_ptr[c + 1] += P->color_ptr[c];
-  for (fcm_index c = 0; c < ncol; c++)
-    fill[c] = 0;
-  for (fcm_index b = 0; b < nb; b++)
-    P->color_blocks[P->color_ptr[color[b]] + fill[color[b]]++] = b;
 cleanup:
-  fcm__free(ctx, inc_ptr);
-  fcm__free(ctx, inc);
   fcm__free(ctx, fill);
   fcm__free(ctx, color);
   fcm__free(ctx, mark);
@@ -334,7 +333,7 @@ fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_bloc
     P->inside[block_dofs[p]] = 1;
   }
   FCM_ALLOC(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->S);
-  FCM_TRY(ctx, color_blocks(P));
+  FCM_TRY(ctx, incidence_and_colors(P));
   P->info.num_blocks = num_blocks;
   P->info.block_dofs = total;
   P->info.max_block_size = max_m;
@@ -350,49 +349,6 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_schwarz_create_from_space(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *C,
-                                         const unsigned char *cell_flag,
-                                         const fcm_schwarz_options *opts, fcm_schwarz **out)
-{
-  fcm_status st = FCM_OK;
-  fcm_index *block_ptr = NULL, *dofs = NULL;
-  FCM_CHECK(out, ctx, FCM_ERR_ARG, "schwarz_create_from_space: output pointer is NULL");
-  *out = NULL;
-  FCM_CHECK(space && cell_flag, ctx, FCM_ERR_ARG,
-            "schwarz_create_from_space: space or cell_flag is NULL");
-  const fcm_mesh *mesh = fcm_space_mesh(space);
-  const fcm_index ncell = fcm_mesh_num_cells(mesh);
-  const int npc = fcm_mesh_nodes_per_cell(mesh);
-  const fcm_index *cells = fcm_mesh_cells(mesh);
-  fcm_index nb = 0;
-  for (fcm_index c = 0; c < ncell; c++)
-    nb += cell_flag[c] != 0;
-  FCM_ALLOC(ctx, nb + 1, block_ptr);
-  FCM_ALLOC(ctx, FCM_MAX(nb * 3 * npc, 1), dofs);
-  fcm_index b = 0;
-  for (fcm_index c = 0; c < ncell; c++) {
-    if (!cell_flag[c]) continue;
-    fcm_index *bd = dofs + b * 3 * npc;
-    for (int a = 0; a < npc; a++) {
-      fcm_index node = cells[c * npc + a];
-      fcm_index d = fcm_space_node_dof(space, node);
-      FCM_CHECK(d >= 0, ctx, FCM_ERR_ARG,
-                "schwarz_create_from_space: cell %lld is flagged but inactive (node %lld has no "
-                "DOFs)",
-                (long long)c, (long long)node);
-      for (int i = 0; i < 3; i++)
-        bd[3 * a + i] = d + i;
-    }
-    b++;
-    block_ptr[b] = b * 3 * npc;
-  }
-  FCM_TRY(ctx, fcm_schwarz_create(ctx, C, nb, block_ptr, dofs, opts, out));
-cleanup:
-  fcm__free(ctx, block_ptr);
-  fcm__free(ctx, dofs);
-  return st;
-}
-
 fcm_status fcm_schwarz_apply(const fcm_schwarz *P, const double *r, double *z)
 {
   fcm_status st = FCM_OK;
@@ -404,30 +360,21 @@ fcm_status fcm_schwarz_apply(const fcm_schwarz *P, const double *r, double *z)
   const fcm_index n = P->n;
   const double *dinv = P->dinv;
   const int par = n >= FCM__SOLVE_PARALLEL_MIN || P->s_off[P->num_blocks] >= APPLY_PARALLEL_WORK;
-  /* One team; the implicit barrier after each colour orders the contributions to z. */
-#pragma omp parallel if (par)
-  {
-#pragma omp for schedule(static)
-    for (fcm_index i = 0; i < n; i++)
-      z[i] = dinv[i] * r[i];
-    for (int c = 0; c < P->num_colors; c++) {
-      const fcm_index k0 = P->color_ptr[c], k1 = P->color_ptr[c + 1];
-      /* blocks of one colour touch disjoint entries of z */
-#pragma omp for schedule(static)
-      for (fcm_index k = k0; k < k1; k++) {
-        const fcm_index b = P->color_blocks[k];
-        const fcm_index *d = P->dofs + P->block_ptr[b];
-        const int m = (int)(P->block_ptr[b + 1] - P->block_ptr[b]);
-        const double *S = P->S + P->s_off[b];
-        for (int i = 0; i < m; i++) {
-          const double *row = S + (size_t)i * m;
-          double s = 0.0;
-          for (int j = 0; j < m; j++)
-            s += row[j] * r[d[j]];
-          z[d[i]] += s;
-        }
-      }
+  /* One loop, no barrier inside: z_i is summed by one thread, in ascending block order. */
+#pragma omp parallel for schedule(dynamic, APPLY_CHUNK) if (par)
+  for (fcm_index i = 0; i < n; i++) {
+    double zi = dinv[i] * r[i];
+    for (fcm_index q = P->inc_ptr[i]; q < P->inc_ptr[i + 1]; q++) {
+      const fcm_index b = P->inc_blk[q];
+      const fcm_index *d = P->dofs + P->block_ptr[b];
+      const int m = (int)(P->block_ptr[b + 1] - P->block_ptr[b]);
+      const double *row = P->S + P->s_off[b] + (size_t)P->inc_row[q] * (size_t)m;
+      double s = 0.0;
+      for (int j = 0; j < m; j++)
+        s += row[j] * r[d[j]];
+      zi += s;
     }
+    z[i] = zi;
   }
 cleanup:
   return st;
