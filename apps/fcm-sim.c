@@ -160,7 +160,7 @@ static double timoshenko_tip(const options *o)
 static void cell_von_mises(const fcm_space *space, const options *o, const double *u, double *vm)
 {
   const fcm_mesh *mesh = fcm_space_mesh(space);
-  const fcm_element_info *info = fcm_mesh_element_info(mesh);
+  const fcm_element_info *info = fcm_mesh_get_element_info(mesh);
   double lambda = 0, mu = 0;
   fcm_material_lame(NULL, &o->mat, &lambda, &mu);
   double xi[3] = {0, 0, 0};
@@ -294,7 +294,7 @@ static int demo_main(int argc, char **argv)
   t[4] = fcm_wtime();
   CHECK(fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, K, &solver));
   CHECK(fcm_direct_analyze(solver));
-  CHECK(fcm_direct_factor(solver, fcm_csr_get_values(K)));
+  CHECK(fcm_direct_factor(solver, fcm_csr_values(K)));
   t[5] = fcm_wtime();
   CHECK(fcm_direct_solve(solver, f, u));
   for (fcm_index i = 0; i < ndof; i++)
@@ -314,8 +314,8 @@ static int demo_main(int argc, char **argv)
   CHECK(fcm_pvd_create(ctx, path, &pvd));
   CHECK(fcm_vtu_create(ctx, &vtu));
   CHECK(fcm_vtu_set_points(vtu, nnodes, fcm_mesh_coords(mesh)));
-  CHECK(fcm_vtu_set_cells(vtu, fcm_mesh_element_info(mesh)->vtk_cell_type, fcm_mesh_num_cells(mesh),
-                          fcm_mesh_cells(mesh)));
+  CHECK(fcm_vtu_set_cells(vtu, fcm_mesh_get_element_info(mesh)->vtk_cell_type,
+                          fcm_mesh_num_cells(mesh), fcm_mesh_cells(mesh)));
   CHECK(fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "displacement", 3, nnodes, upts));
   CHECK(fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "von_mises", 1, fcm_mesh_num_cells(mesh), vm));
   snprintf(path, sizeof path, "%s/cantilever_0000.vtu", o.outdir);
@@ -340,7 +340,7 @@ static int demo_main(int argc, char **argv)
     fcm_direct_info di;
     fcm_direct_get_info(solver, &di);
     if (!o.quiet) {
-      const fcm_element_info *info = fcm_mesh_element_info(mesh);
+      const fcm_element_info *info = fcm_mesh_get_element_info(mesh);
       printf("fcm-sim: cantilever %g x %g x %g m, %s, %lld x %lld x %lld cells\n", o.length,
              o.width, o.height, info->name, (long long)o.cells[0], (long long)o.cells[1],
              (long long)o.cells[2]);
@@ -543,7 +543,8 @@ static int scene_main(int argc, char **argv)
   if (fcm_scene_get_solver(scene)->threads > 0) /* every OpenMP loop of the run */
     omp_set_num_threads(fcm_scene_get_solver(scene)->threads);
   fcm_simulation_options so = fcm_simulation_options_default();
-  so.max_steps = o.check ? (o.steps > 0 && o.steps < 3 ? o.steps : 3) : o.steps;
+  so.max_steps = o.check ? (o.steps > 0 && o.steps < 3 ? o.steps : 3)
+                         : (o.steps > 0 ? o.steps : FCM_DEFAULT);
   so.checkpoint_interval = o.check ? 0 : o.checkpoint_every;
   const char *name = fcm_scene_name(scene);
   if (!o.quiet)

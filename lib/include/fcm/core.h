@@ -44,7 +44,17 @@ typedef enum fcm_status { FCM_STATUS_LIST(FCM_STATUS_ENUM_) FCM_STATUS_COUNT_ } 
 /** Static description of a status code ("invalid argument", ...); never NULL. */
 FCM_API const char *fcm_status_str(fcm_status st);
 
-/** Severity of a log message passed to the log callback. */
+/** The one "use the default" value of option members (and of the parameters documented so):
+ * a member set to FCM_DEFAULT takes the default documented on it, which is computed where
+ * it depends on the problem (element strengths, OpenMP threads, gravity, the scene).
+ * fcm_x_options_default() stores FCM_DEFAULT in such members and the fixed number in the
+ * others; 0 always keeps its literal meaning (a strength-0 rule, never, none). */
+#define FCM_DEFAULT (-1)
+
+/** Severity of a log message passed to the log callback: ERROR for every recorded error
+ * (with its message), WARNING for counted fallbacks that change how a result is computed
+ * (a simplification that keeps the input rule, CHOLMOD -> UMFPACK); INFO and DEBUG are not
+ * emitted by the library today. */
 typedef enum fcm_log_level {
   FCM_LOG_ERROR = 0,
   FCM_LOG_WARNING = 1,

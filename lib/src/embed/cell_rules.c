@@ -23,7 +23,7 @@ fcm_cell_rules_options fcm_cell_rules_options_default(void)
   o.simplify = 1;
   o.simplify_options = fcm_simplify_options_default();
   o.stabilization = fcm_stabilization_options_default();
-  o.num_threads = 0;
+  o.num_threads = FCM_DEFAULT;
   return o;
 }
 
@@ -201,8 +201,8 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_cell_rules_options *o)
             "embed: tolerances clip_rtol = %g, sliver_rtol = %g (each in [0, 1e-3)), "
             "convex_rtol = %g (in [0, 1e-2)) out of range",
             o->clip_rtol, o->sliver_rtol, o->convex_rtol);
-  FCM_CHECK(o->num_threads >= 0, ctx, FCM_ERR_ARG, "embed: num_threads = %d must be >= 0",
-            o->num_threads);
+  FCM_CHECK(o->num_threads >= 1 || o->num_threads == FCM_DEFAULT, ctx, FCM_ERR_ARG,
+            "embed: num_threads = %d must be >= 1, or FCM_DEFAULT (-1)", o->num_threads);
   FCM_CHECK((int)o->stabilization.mode >= 0 &&
                 o->stabilization.mode < FCM_STABILIZATION_MODE_COUNT &&
                 (o->stabilization.mode == FCM_STABILIZATION_OFF ||
@@ -257,7 +257,7 @@ fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_g
   FCM_CHECK(ctx && mesh && geom, ctx, FCM_ERR_ARG,
             "embed: NULL argument (ctx, mesh and geometry are required)");
   FCM_TRY(ctx, check_options(ctx, &o));
-  const fcm_element_info *info = fcm_mesh_element_info(mesh);
+  const fcm_element_info *info = fcm_mesh_get_element_info(mesh);
   nc = fcm_mesh_num_cells(mesh);
   for (fcm_index c = 0; c < nc; c++)
     FCM_CHECK(fcm_mesh_cell_is_convex(mesh, c, o.convex_rtol), ctx, FCM_ERR_GEOMETRY,

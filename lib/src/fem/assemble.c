@@ -12,7 +12,7 @@
 
 fcm_assembly_options fcm_assembly_options_default(void)
 {
-  fcm_assembly_options o = {0, 0};
+  fcm_assembly_options o = {FCM_DEFAULT, FCM_DEFAULT};
   return o;
 }
 
@@ -24,7 +24,9 @@ fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type, fcm_ru
   FCM_CHECK(info, ctx, FCM_ERR_ARG, "standard rule: invalid element type %d", (int)type);
   FCM_CHECK(kind == FCM_RULE_STIFFNESS || kind == FCM_RULE_MASS, ctx, FCM_ERR_ARG,
             "standard rule: invalid rule kind %d", (int)kind);
-  if (strength > 0)
+  FCM_CHECK(strength >= 0 || strength == FCM_DEFAULT, ctx, FCM_ERR_ARG,
+            "standard rule: strength = %d must be >= 0, or FCM_DEFAULT (-1)", strength);
+  if (strength >= 0)
     FCM_TRY(ctx, fcm_rule_create(ctx, info->shape, strength, rule));
   else if (info->shape == FCM_SHAPE_HEX) /* order+1 points per direction: strength 2*order+1 */
     FCM_TRY(ctx, fcm_rule_create_computed(ctx, info->shape, 2 * info->order + 1, rule));
@@ -427,7 +429,7 @@ fcm_status fcm_assemble_stiffness(fcm_space *s, const fcm_material *mat,
   kd.kind = KERNEL_STIFFNESS;
   FCM_TRY(s->ctx, fcm_material_lame(s->ctx, mat, &kd.lambda, &kd.mu));
   FCM_TRY(s->ctx, check_matrix(s, A));
-  FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, fcm_csr_get_values(A), NULL, NULL));
+  FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, fcm_csr_values(A), NULL, NULL));
 cleanup:
   return st;
 }
@@ -443,7 +445,7 @@ fcm_status fcm_assemble_mass(fcm_space *s, const fcm_material *mat,
   FCM_TRY(s->ctx, fcm_material_lame(s->ctx, mat, NULL, NULL));
   FCM_TRY(s->ctx, check_matrix(s, A));
   kd.rho = mat->density;
-  FCM_TRY(s->ctx, assemble(s, &kd, o.mass_strength, fcm_csr_get_values(A), NULL, NULL));
+  FCM_TRY(s->ctx, assemble(s, &kd, o.mass_strength, fcm_csr_values(A), NULL, NULL));
 cleanup:
   return st;
 }
@@ -498,7 +500,7 @@ fcm_status fcm_assemble_hyperelastic(fcm_space *s, const fcm_material_params *ma
   kd.u = u;
   kd.want_force = force != NULL;
   kd.want_tangent = tangent != NULL;
-  FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, tangent ? fcm_csr_get_values(tangent) : NULL,
+  FCM_TRY(s->ctx, assemble(s, &kd, o.stiffness_strength, tangent ? fcm_csr_values(tangent) : NULL,
                            force, energy));
 cleanup:
   return st;
