@@ -53,13 +53,11 @@ FCM_API const char *fcm_status_str(fcm_status st);
 
 /** Severity of a log message passed to the log callback: ERROR for every recorded error
  * (with its message), WARNING for counted fallbacks that change how a result is computed
- * (a simplification that keeps the input rule, CHOLMOD -> UMFPACK); INFO and DEBUG are not
- * emitted by the library today. */
+ * (a simplification that keeps the input rule, CHOLMOD -> UMFPACK). The library emits
+ * nothing else, so there are no lower levels. */
 typedef enum fcm_log_level {
   FCM_LOG_ERROR = 0,
-  FCM_LOG_WARNING = 1,
-  FCM_LOG_INFO = 2,
-  FCM_LOG_DEBUG = 3
+  FCM_LOG_WARNING = 1
 } fcm_log_level;
 
 /** Log callback: `msg` is a complete line without the trailing newline. */
@@ -78,7 +76,8 @@ typedef struct fcm_ctx_options {
   fcm_allocator allocator; /**< all-NULL members: malloc/free */
   fcm_log_fn log;          /**< NULL: the library stays silent */
   void *log_user;          /**< passed to `log` */
-  fcm_log_level log_level; /**< messages above this level are not formatted */
+  fcm_log_level log_level; /**< messages above this level are not formatted (default
+                                WARNING: both; ERROR: errors only) */
 } fcm_ctx_options;
 
 /** The root object: allocator, log callback, last error. No global state exists
