@@ -48,3 +48,24 @@ add_test(NAME app_converge_rates_full COMMAND app_converge_rates full $<TARGET_F
          ${PROJECT_BINARY_DIR}/app-tests)
 set_tests_properties(app_converge_rates_full PROPERTIES LABELS "app;slow" TIMEOUT 7200
                      ENVIRONMENT "OMP_NUM_THREADS=2")
+# Faults around fcm-sim's output, through an LD_PRELOAD shim (tests/support/fault_shim.c):
+# kill -9 inside file operations and at random moments, then resume (a handful of seeded
+# kills by default, 60 under slow); the disk filling up (the shim's ENOSPC, and a real small
+# tmpfs where an unprivileged mount namespace is allowed); a directory fsync after each
+# rename that puts an output file in place.
+add_library(fcm_fault_shim SHARED tests/support/fault_shim.c)
+target_link_libraries(fcm_fault_shim PRIVATE ${CMAKE_DL_LIBS})
+set_target_properties(fcm_fault_shim PROPERTIES C_VISIBILITY_PRESET default)
+fcm_add_test(app_fault_kill tests/apps/fault_app.c LABELS app
+             ARGS kill $<TARGET_FILE:fcm-sim> $<TARGET_FILE:fcm_fault_shim>
+                  ${PROJECT_BINARY_DIR}/app-tests)
+add_dependencies(app_fault_kill fcm_fault_shim fcm-sim)
+add_test(NAME app_fault_kill_long COMMAND app_fault_kill kill $<TARGET_FILE:fcm-sim>
+         $<TARGET_FILE:fcm_fault_shim> ${PROJECT_BINARY_DIR}/app-tests 60 7)
+set_tests_properties(app_fault_kill_long PROPERTIES LABELS "app;slow" TIMEOUT 1800)
+add_test(NAME app_fault_diskfull COMMAND app_fault_kill diskfull $<TARGET_FILE:fcm-sim>
+         $<TARGET_FILE:fcm_fault_shim> ${PROJECT_BINARY_DIR}/app-tests)
+set_tests_properties(app_fault_diskfull PROPERTIES LABELS app TIMEOUT 300)
+add_test(NAME app_fault_dirsync COMMAND app_fault_kill dirsync $<TARGET_FILE:fcm-sim>
+         $<TARGET_FILE:fcm_fault_shim> ${PROJECT_BINARY_DIR}/app-tests)
+set_tests_properties(app_fault_dirsync PROPERTIES LABELS app TIMEOUT 300)

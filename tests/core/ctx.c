@@ -61,7 +61,7 @@ int main(void)
   o.allocator.user = &c;
   o.log = log_fn;
   o.log_user = &book;
-  o.log_level = FCM_LOG_WARNING;
+  o.log_level = FCM_LOG_INFO;
   TEST_OK(ctx, fcm_ctx_create(&o, &ctx));
   TEST_TRUE(c.allocs == 1);
   double *a = fcm__calloc(ctx, 10, sizeof *a);
@@ -93,6 +93,10 @@ int main(void)
 
   /* Logging: levels above the threshold are filtered; errors are logged. */
   int before = book.lines;
+  fcm__log(ctx, FCM_LOG_INFO, "shown %d", 1);
+  TEST_TRUE(book.lines == before + 1 && !strcmp(book.text, "shown 1"));
+  TEST_TRUE(book.last == FCM_LOG_INFO);
+  before = book.lines;
   fcm__log(ctx, FCM_LOG_WARNING, "shown %d", 2);
   TEST_TRUE(book.lines == before + 1 && !strcmp(book.text, "shown 2"));
   TEST_TRUE(book.last == FCM_LOG_WARNING);
@@ -104,6 +108,7 @@ int main(void)
     TEST_OK(quiet, fcm_ctx_create(&q, &quiet));
     before = book.lines;
     fcm__log(quiet, FCM_LOG_WARNING, "hidden %d", 1);
+    fcm__log(quiet, FCM_LOG_INFO, "hidden %d", 2);
     TEST_TRUE(book.lines == before);
     fcm__log(quiet, FCM_LOG_ERROR, "shown %d", 3);
     TEST_TRUE(book.lines == before + 1 && !strcmp(book.text, "shown 3"));

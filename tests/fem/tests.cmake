@@ -15,6 +15,7 @@ fcm_add_test(fem_embedded_hex20_simplified tests/fem/embedded.c ARGS hex20 simpl
 foreach(el tet4 tet10 hex8 hex20)
   fcm_add_test(fem_locate_${el} tests/fem/locate.c ARGS ${el} LABELS conformance)
 endforeach()
+fcm_add_test(fem_locate_crowded tests/fem/locate_crowded.c)
 foreach(el tet4 tet10 hex8 hex20)
   fcm_add_test(fem_space_eval_${el} tests/fem/space_eval.c ARGS ${el})
 endforeach()

@@ -76,7 +76,7 @@ static void tetgen_errors(void)
   write_file("geom_rd_idx.ele", "2 4\n1 1 2 3 4\n2 2 3 4 6\n");
   TEST_ERR(ctx, fcm_geometry_create_from_tetgen(ctx, "geom_rd_e.node", "geom_rd_idx.ele", &g),
            FCM_ERR_FORMAT, "geom_rd_idx.ele:3: node index = 6 outside [1, 5]");
-  write_file("geom_rd_short.ele", "3 4\n1 1 2 3 4\n2 2 3 4 5\n");
+  write_file("geom_rd_short.ele", "3 4\n1 1 2 3 4\n2 2 3 4 5\n# the third is missing\n");
   TEST_ERR(ctx, fcm_geometry_create_from_tetgen(ctx, "geom_rd_e.node", "geom_rd_short.ele", &g),
            FCM_ERR_FORMAT, "end of the file");
   write_file("geom_rd_gap.node", "3 3\n1 0 0 0\n3 1 0 0\n4 0 1 0\n");

@@ -37,7 +37,7 @@ static inline int vr_load(vr_doc *d, const char *path)
 {
   memset(d, 0, sizeof *d);
   FILE *f = fopen(path, "rb");
-  if (!f) return snprintf(d->error, sizeof d->error, "cannot open %s", path), 0;
+  if (!f) return snprintf(d->error, sizeof d->error, "cannot open %.200s", path), 0;
   fseek(f, 0, SEEK_END);
   long n = ftell(f);
   fseek(f, 0, SEEK_SET);

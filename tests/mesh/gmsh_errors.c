@@ -51,7 +51,7 @@ int main(void)
 
   /* Missing file. */
   TEST_ERR(ctx, fcm_mesh_create_from_gmsh(ctx, "no/such/dir/mesh.msh", &m), FCM_ERR_IO,
-           "cannot open Gmsh file 'no/such/dir/mesh.msh'");
+           "Gmsh file: cannot open 'no/such/dir/mesh.msh'");
   TEST_TRUE(m == NULL);
   TEST_ERR(ctx, fcm_mesh_create_from_gmsh(ctx, NULL, &m), FCM_ERR_ARG, "must not be NULL");
 

@@ -221,7 +221,7 @@ int main(void)
   {
     fcm_scene *s = NULL;
     TEST_ERR(ctx, fcm_scene_create_from_file(ctx, "no-such-scene.json", &s), FCM_ERR_IO,
-             "no-such-scene.json: cannot open the scene file: No such file");
+             "scene: cannot open 'no-such-scene.json': No such file");
     TEST_TRUE(s == NULL);
     const char nul_text[] = "{\"name\": \"a\"\0}";
     TEST_TRUE(write_bytes("nul.json", nul_text, sizeof nul_text - 1) == 0);

@@ -11,3 +11,11 @@ fcm_add_test(scene_examples tests/scene/examples.c ARGS ${PROJECT_SOURCE_DIR}/ap
 fcm_add_test(scene_run_counters tests/scene/run_counters.c)
 # Checkpoints: a restored run continues bit for bit (static, dynamic, free body); errors.
 fcm_add_test(scene_checkpoint tests/scene/checkpoint.c)
+# Allocation failures in the runner: create, step, frames, log, checkpoints, centre of mass,
+# summary, scene files and the built-in scene: FCM_ERR_ALLOC, no leak, no partial file.
+# The quick set (a directly solved embedded body, a free body) by default; with MINRES and
+# Schwarz and a static scene too under the label slow.
+fcm_add_test(scene_alloc_simulation tests/scene/alloc_simulation.c TIMEOUT 900)
+add_test(NAME scene_alloc_simulation_full COMMAND scene_alloc_simulation full)
+set_tests_properties(scene_alloc_simulation_full PROPERTIES LABELS slow TIMEOUT 3600
+                     ENVIRONMENT "OMP_NUM_THREADS=1;OMP_WAIT_POLICY=passive;OPENBLAS_NUM_THREADS=1")

@@ -53,11 +53,13 @@ FCM_API const char *fcm_status_str(fcm_status st);
 
 /** Severity of a log message passed to the log callback: ERROR for every recorded error
  * (with its message), WARNING for counted fallbacks that change how a result is computed
- * (a simplification that keeps the input rule, CHOLMOD -> UMFPACK). The library emits
- * nothing else, so there are no lower levels. */
+ * (a simplification that keeps the input rule, CHOLMOD -> UMFPACK), INFO for housekeeping
+ * the caller did not ask for (stale temporary files of dead processes removed). The library
+ * emits nothing else, so there is no lower level. */
 typedef enum fcm_log_level {
   FCM_LOG_ERROR = 0,
-  FCM_LOG_WARNING = 1
+  FCM_LOG_WARNING = 1,
+  FCM_LOG_INFO = 2
 } fcm_log_level;
 
 /** Log callback: `msg` is a complete line without the trailing newline. */
@@ -77,7 +79,7 @@ typedef struct fcm_ctx_options {
   fcm_log_fn log;          /**< NULL: the library stays silent */
   void *log_user;          /**< passed to `log` */
   fcm_log_level log_level; /**< messages above this level are not formatted (default
-                                WARNING: both; ERROR: errors only) */
+                                WARNING: errors and warnings) */
 } fcm_ctx_options;
 
 /** The root object: allocator, log callback, last error. No global state exists

@@ -40,11 +40,19 @@ typedef struct fcm_cell_rules_options {
                               strength */
   double min_fraction;   /**< phi below this: dropped; default 1e-4 (0: drop only empty cells) */
   double uncut_fraction; /**< phi at or above this: uncut; default 1 - 1e-12 */
-  double clip_rtol;      /**< vertex-on-plane tolerance / cell diameter; default 1e-12 */
-  double sliver_rtol;    /**< tets with volume <= this * |K| are dropped; default 1e-14 */
+  double clip_rtol;   /**< vertex-on-plane tolerance / the smaller of the cell diameter and the
+                          embedded cell's thickness 6|E|/diam(E)^2; default 1e-12 */
+  double sliver_rtol; /**< tets with volume <= this * min(|K|, |E|) are dropped (|E|: the
+                          embedded cell clipped), so thin geometry keeps its volume; counted
+                          with their volume in the statistics; default 1e-14 */
   double convex_rtol;    /**< tolerance of fcm_mesh_cell_is_convex(); default 1e-10 */
   int simplify;          /**< 1 (default): simplify cut-cell rules with fcm_simplify() */
   fcm_simplify_options simplify_options;   /**< default fcm_simplify_options_default() */
+  double max_rule_memory; /**< bytes the rules of one cut cell may take to build (an estimate
+                               checked before allocating: points of both kinds plus the
+                               simplification's moment matrix and LP); a cell above it fails
+                               with FCM_ERR_UNSUPPORTED naming the cell, the estimate and the
+                               limit; default 4 GiB; 0: no limit */
   fcm_stabilization_options stabilization; /**< default mass + stiffness, alpha 1e-6 */
   int num_threads; /**< OpenMP threads >= 1; FCM_DEFAULT (default): the OpenMP default */
 } fcm_cell_rules_options;
@@ -61,6 +69,7 @@ typedef struct fcm_cell_rules_stats {
   fcm_index num_pieces;     /**< non-empty clipped polyhedra */
   fcm_index num_tets;       /**< tets of the pieces kept (slivers excluded) */
   fcm_index num_slivers;    /**< tets dropped as slivers */
+  double sliver_volume;     /**< their summed volume (not in embedded_volume) */
   fcm_index points_initial[FCM_RULE_KIND_COUNT];    /**< before simplification */
   fcm_index points_simplified[FCM_RULE_KIND_COUNT]; /**< after (= initial when off) */
   fcm_index points_stabilization[FCM_RULE_KIND_COUNT];
@@ -93,7 +102,10 @@ typedef struct fcm_cell_rules fcm_cell_rules;
  *         [0, FCM_RULE_MAX_STRENGTH] without, thresholds outside 0 <= min_fraction <
  *         uncut_fraction <= 1, tolerances out of range, bad stabilization); FCM_ERR_GEOMETRY
  *         (a non-convex background cell, naming it; a degenerate cell); FCM_ERR_NOT_CONVERGED
- *         (inverse map); FCM_ERR_ALLOC; errors of fcm_simplify(). Allocates. */
+ *         (inverse map); FCM_ERR_UNSUPPORTED (a cell whose rules would exceed
+ *         max_rule_memory or 2^30 points); FCM_ERR_ALLOC; errors of fcm_simplify(). When
+ *         several cells fail, the error is that of the lowest-numbered one. Volume fractions
+ *         are clamped to [0, 1]. Allocates. */
 FCM_API fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh,
                                          const fcm_geometry *geom,
                                          const fcm_cell_rules_options *opts,

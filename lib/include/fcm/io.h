@@ -121,8 +121,9 @@ FCM_API fcm_status fcm_vtu_add_field_int64(fcm_vtu *vtu, fcm_vtu_location where,
                                            int num_components, fcm_index num_tuples,
                                            const int64_t *data);
 
-/** Validate and write the file atomically ("<path>.tmp.<pid>.<n>" in the same directory,
- * flushed and closed with checks, then renamed over `path`).
+/** Validate and write the file atomically (the hidden ".<name>.tmp.<pid>.<n>" in the same
+ * directory, flushed and closed with checks, then renamed over `path`; temporaries left there
+ * by dead processes are removed by the first write of a process into the directory).
  * @param[in]  path target file; an existing file is replaced only on success
  * @param[out] info counts of non-finite values and the file size; may be NULL
  * @return FCM_OK; FCM_ERR_ARG (no points set, cell type unknown, connectivity index out of

@@ -41,6 +41,73 @@ fcm_status fcm__resize(fcm_ctx *ctx, void **ptr, size_t old_n, size_t new_n, siz
 /* Checked narrowing of a global index to int (LAPACK, GLPK, CHOLMOD sizes). */
 fcm_status fcm__index_to_int(fcm_ctx *ctx, fcm_index v, const char *what, int *out);
 
+/* Read the whole regular file `path` into a NUL-terminated buffer of *size + 1 bytes
+ * (released with fcm__free). A directory, device, pipe or socket is refused with
+ * FCM_ERR_IO naming it, before any read (a pipe is not waited on), as is a file larger
+ * than max_bytes. Messages start with `what` (the reader's name). */
+fcm_status fcm__file_read_all(fcm_ctx *ctx, const char *what, const char *path, size_t max_bytes,
+                              char **data, size_t *size);
+
+/* ---- errors of parallel loops: recorded once, the lowest failing iteration wins ----
+ *
+ * Inside an iteration bracketed by fcm__loop_enter()/fcm__loop_leave(), errors recorded on
+ * the loop's ctx (FCM_CHECK, FCM_ALLOC, fcm__calloc, FCM_TRY frames) go to the loop
+ * instead of the ctx, so threads never overwrite each other's message. fcm__loop_end()
+ * then records the error of the lowest failing iteration in the ctx and logs it once:
+ * the reported error does not depend on the number of threads or on scheduling.
+ *
+ *   fcm__loop L;
+ *   fcm__loop_begin(ctx, &L);
+ *   #pragma omp parallel for
+ *   for (i = 0; i < n; i++) {
+ *     if (fcm__loop_skip(&L, i)) continue;          // a lower iteration already failed
+ *     fcm__loop_iter it = fcm__loop_enter(&L, i);
+ *     fcm__loop_leave(&L, it, work(i));             // the iteration's status
+ *   }
+ *   FCM_TRY(ctx, fcm__loop_end(&L, &failed_index)); // FCM_OK or the lowest failure
+ *
+ * Loops nest (an iteration may run a loop of its own on the same thread). An iteration
+ * that returns FCM_OK after an error it handled leaves nothing behind. */
+#define FCM__LOOP_MSG_LEN 1024
+#define FCM__LOOP_FRAMES 32
+
+typedef struct fcm__loop {
+  fcm_ctx *ctx;
+  fcm_index failed;    /* lowest iteration that returned an error; -1: none */
+  fcm_status status;   /* its status */
+  fcm_index recorded;  /* iteration whose message is held below; -1: none */
+  fcm_status rec_code; /* the code of that message */
+  char msg[FCM__LOOP_MSG_LEN];
+  struct {
+    const char *file, *func;
+    int line;
+  } frames[FCM__LOOP_FRAMES];
+  int nframes, frames_dropped;
+} fcm__loop;
+
+/* What fcm__loop_enter() replaced on this thread (restored by fcm__loop_leave()). */
+typedef struct fcm__loop_iter {
+  fcm__loop *prev_loop;
+  fcm_index prev_index;
+} fcm__loop_iter;
+
+/* Start a loop on ctx (no allocation). */
+void fcm__loop_begin(fcm_ctx *ctx, fcm__loop *loop);
+
+/* Whether iteration i can be skipped: an iteration below i has already failed. */
+int fcm__loop_skip(fcm__loop *loop, fcm_index i);
+
+/* Errors on loop->ctx from this thread now belong to iteration i. */
+fcm__loop_iter fcm__loop_enter(fcm__loop *loop, fcm_index i);
+
+/* End the iteration entered with `it`, which returned `st`. */
+void fcm__loop_leave(fcm__loop *loop, fcm__loop_iter it, fcm_status st);
+
+/* After the parallel region: FCM_OK, or the status of the lowest failing iteration with
+ * its message and traceback recorded in the ctx (or in an enclosing loop). `failed`
+ * (may be NULL) receives that iteration, -1 if none. */
+fcm_status fcm__loop_end(fcm__loop *loop, fcm_index *failed);
+
 /* ---- the one error idiom: every function has `fcm_status st` and `cleanup:` ---- */
 
 /* Fail with `code` and a formatted message unless `cond` holds. */

@@ -115,7 +115,8 @@ void fcm_ctx_error_view(const fcm_ctx *ctx, FILE *stream)
   if (ctx->frames_dropped) fprintf(stream, "  ... %d more frames\n", ctx->frames_dropped);
 }
 
-/* Keep only the path below lib/ (or the base name) so tracebacks stay short. */
+/* Keep only the path below lib/ (or the base name) so tracebacks stay short; applied
+ * once, when a frame is recorded. */
 static const char *short_file(const char *file)
 {
   const char *p = strstr(file, "lib/src/");
@@ -128,7 +129,7 @@ static void push_frame(fcm_ctx *ctx, const char *file, int line, const char *fun
 {
   if (ctx->nframes < FCM__MAX_FRAMES) {
     fcm_frame *f = &ctx->frames[ctx->nframes++];
-    f->file = short_file(file);
+    f->file = file;
     f->line = line;
     f->func = func;
   } else {
@@ -142,6 +143,61 @@ static void log_message(const fcm_ctx *ctx, fcm_log_level level, const char *msg
     ctx->opts.log(ctx->opts.log_user, level, msg);
 }
 
+/* The loop iteration this thread is in (fcm__loop_enter), if any. */
+static _Thread_local fcm__loop *tl_loop = NULL;
+static _Thread_local fcm_index tl_index = -1;
+
+/* The loop collecting errors of ctx on this thread, or NULL. */
+static fcm__loop *active_loop(const fcm_ctx *ctx)
+{
+  return tl_loop && tl_loop->ctx == ctx ? tl_loop : NULL;
+}
+
+/* A new error of iteration i in loop L: kept when no lower iteration holds one. */
+static void loop_store(fcm__loop *L, fcm_index i, fcm_status code, const char *msg,
+                       const fcm_frame *frames, int nframes, int dropped)
+{
+#pragma omp critical(fcm_error)
+  if (L->recorded < 0 || i <= L->recorded) {
+    L->recorded = i;
+    L->rec_code = code;
+    snprintf(L->msg, sizeof L->msg, "%s", msg);
+    L->nframes = 0;
+    L->frames_dropped = dropped;
+    for (int k = 0; k < nframes; k++) {
+      if (L->nframes < FCM__LOOP_FRAMES) {
+        L->frames[L->nframes].file = frames[k].file;
+        L->frames[L->nframes].func = frames[k].func;
+        L->frames[L->nframes].line = frames[k].line;
+        L->nframes++;
+      } else {
+        L->frames_dropped++;
+      }
+    }
+  }
+}
+
+/* Record an error with its frames in ctx, or in the loop this thread's iteration belongs to. */
+static void store_error(fcm_ctx *ctx, fcm_status code, const char *msg, const fcm_frame *frames,
+                        int nframes, int dropped)
+{
+  fcm__loop *L = active_loop(ctx);
+  if (L) {
+    loop_store(L, tl_index, code, msg, frames, nframes, dropped);
+    return;
+  }
+#pragma omp critical(fcm_error)
+  {
+    ctx->err_status = code;
+    snprintf(ctx->err_msg, sizeof ctx->err_msg, "%s", msg);
+    ctx->nframes = 0;
+    ctx->frames_dropped = dropped;
+    for (int k = 0; k < nframes; k++)
+      push_frame(ctx, frames[k].file, frames[k].line, frames[k].func);
+  }
+  log_message(ctx, FCM_LOG_ERROR, msg);
+}
+
 fcm_status fcm__error(fcm_ctx *ctx, fcm_status code, const char *file, int line, const char *func,
                       const char *fmt, ...)
 {
@@ -151,23 +207,93 @@ fcm_status fcm__error(fcm_ctx *ctx, fcm_status code, const char *file, int line,
   va_start(ap, fmt);
   vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
-#pragma omp critical(fcm_error)
-  {
-    ctx->err_status = code;
-    memcpy(ctx->err_msg, msg, sizeof msg);
-    ctx->nframes = 0;
-    ctx->frames_dropped = 0;
-    push_frame(ctx, file, line, func);
-  }
-  log_message(ctx, FCM_LOG_ERROR, msg);
+  fcm_frame f = {short_file(file), func, line};
+  store_error(ctx, code, msg, &f, 1, 0);
   return code;
 }
 
 void fcm__trace(fcm_ctx *ctx, const char *file, int line, const char *func)
 {
   if (!ctx) return;
+  fcm__loop *L = active_loop(ctx);
 #pragma omp critical(fcm_error)
-  push_frame(ctx, file, line, func);
+  {
+    if (!L) {
+      push_frame(ctx, short_file(file), line, func);
+    } else if (L->recorded == tl_index) { /* frames of a replaced error are dropped */
+      if (L->nframes < FCM__LOOP_FRAMES) {
+        L->frames[L->nframes].file = short_file(file);
+        L->frames[L->nframes].func = func;
+        L->frames[L->nframes].line = line;
+        L->nframes++;
+      } else {
+        L->frames_dropped++;
+      }
+    }
+  }
+}
+
+void fcm__loop_begin(fcm_ctx *ctx, fcm__loop *loop)
+{
+  memset(loop, 0, sizeof *loop);
+  loop->ctx = ctx;
+  loop->failed = -1;
+  loop->recorded = -1;
+  loop->status = FCM_OK;
+}
+
+int fcm__loop_skip(fcm__loop *loop, fcm_index i)
+{
+  fcm_index f;
+#pragma omp atomic read
+  f = loop->failed;
+  return f >= 0 && f < i;
+}
+
+fcm__loop_iter fcm__loop_enter(fcm__loop *loop, fcm_index i)
+{
+  fcm__loop_iter it = {tl_loop, tl_index};
+  tl_loop = loop;
+  tl_index = i;
+  return it;
+}
+
+void fcm__loop_leave(fcm__loop *loop, fcm__loop_iter it, fcm_status st)
+{
+  const fcm_index i = tl_index;
+  tl_loop = it.prev_loop;
+  tl_index = it.prev_index;
+  if (st == FCM_OK) return;
+#pragma omp critical(fcm_error)
+  if (loop->failed < 0 || i < loop->failed) {
+    loop->status = st;
+#pragma omp atomic write
+    loop->failed = i;
+  }
+}
+
+fcm_status fcm__loop_end(fcm__loop *loop, fcm_index *failed)
+{
+  if (failed) *failed = loop->failed;
+  if (loop->failed < 0) return FCM_OK;
+  fcm_frame frames[FCM__LOOP_FRAMES];
+  char msg[FCM__MSG_LEN];
+  int nframes = 0;
+  if (loop->recorded == loop->failed) {
+    snprintf(msg, sizeof msg, "%s", loop->msg);
+    nframes = loop->nframes;
+    for (int k = 0; k < nframes; k++) {
+      frames[k].file = loop->frames[k].file;
+      frames[k].func = loop->frames[k].func;
+      frames[k].line = loop->frames[k].line;
+    }
+  } else { /* the iteration failed without a message of its own */
+    snprintf(msg, sizeof msg, "iteration %lld of a parallel loop failed: %s",
+             (long long)loop->failed, fcm_status_str(loop->status));
+  }
+  store_error(loop->ctx, loop->status, msg, frames, nframes,
+              loop->recorded == loop->failed ? loop->frames_dropped : 0);
+  return loop->status;
 }
 
 void fcm__log(const fcm_ctx *ctx, fcm_log_level level, const char *fmt, ...)

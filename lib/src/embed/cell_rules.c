@@ -23,6 +23,7 @@ fcm_cell_rules_options fcm_cell_rules_options_default(void)
   o.simplify = 1;
   o.simplify_options = fcm_simplify_options_default();
   o.stabilization = fcm_stabilization_options_default();
+  o.max_rule_memory = 4.0 * 1024 * 1024 * 1024;
   o.num_threads = FCM_DEFAULT;
   return o;
 }
@@ -42,18 +43,24 @@ typedef struct cell_out {
   double volume;
 } cell_out;
 
-/* Everything the per-cell work reads. */
+/* Everything the per-cell work reads; the trees and rules are owned (build_release). */
 typedef struct build {
   fcm_ctx *ctx;
   const fcm_mesh *mesh;
   const fcm_geometry *geom;
   const fcm_cell_rules_options *o;
-  const fcm_aabb_tree *tree, *tri_tree;
-  const fcm_rule *tet_rule[FCM_RULE_KIND_COUNT];  /* rule mapped onto each tet */
-  const fcm_rule *full_rule[FCM_RULE_KIND_COUNT]; /* catalogue rule of the cell shape */
-  const fcm_rule *tri_rule;                       /* NULL: no surface rules */
+  fcm_aabb_tree *tree, *tri_tree;
+  fcm_rule *tet_rule[FCM_RULE_KIND_COUNT];        /* rule mapped onto each tet */
+  const fcm_rule *full_rule[FCM_RULE_KIND_COUNT]; /* catalogue rule of the cell shape (in R) */
+  fcm_rule *tri_rule;                             /* NULL: no surface rules */
   int stabilize[FCM_RULE_KIND_COUNT];
 } build;
+
+/* What one thread summed over the cells it built. */
+typedef struct cell_sums {
+  fcm__embed_counts counts;
+  double time_intersect, time_simplify; /* seconds of one core */
+} cell_sums;
 
 static void cell_out_free(fcm_ctx *ctx, cell_out *o)
 {
@@ -98,8 +105,55 @@ cleanup:
   return st;
 }
 
+/* Bytes that building the cut-cell rules of one background cell takes at its peak,
+ * approximately, for n[k] initial points of each kind: the points, weights and flags of
+ * both kinds (33 bytes a point) plus the largest simplification, which holds the M x n
+ * moment matrix, its row space and the LP's constraint matrix (GLPK stores a nonzero in
+ * about 56 bytes): 72 M bytes a point, M = (m+1)(m+2)(m+3)/6 moments of strength m. */
+static double rule_memory_estimate(const size_t n[FCM_RULE_KIND_COUNT],
+                                   const int strength[FCM_RULE_KIND_COUNT], int simplify)
+{
+  double storage = 0.0, simplify_peak = 0.0;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    const double m = strength[k], M = (m + 1) * (m + 2) * (m + 3) / 6;
+    storage += 33.0 * (double)n[k];
+    if (simplify && (double)n[k] > M) simplify_peak = fmax(simplify_peak, 72.0 * M * (double)n[k]);
+  }
+  return storage + simplify_peak;
+}
+
+/* Refuse a cell whose rule building would take more than opt->max_rule_memory bytes,
+ * before anything is allocated for it. */
+static fcm_status check_rule_memory(const build *B, const fcm_cell_rules *R,
+                                    const fcm__embed_cell *cell, const fcm__embed_ws *ws)
+{
+  fcm_status st = FCM_OK;
+  const double limit = B->o->max_rule_memory;
+  size_t n[FCM_RULE_KIND_COUNT];
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    n[k] = ws->num_tets * (size_t)fcm_rule_num_points(B->tet_rule[k]) +
+           (B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0);
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    FCM_CHECK(n[k] <= (size_t)1 << 30, B->ctx, FCM_ERR_UNSUPPORTED,
+              "embed: background cell %lld would get %zu initial %s points (limit 2^30)",
+              (long long)cell->id, n[k], k == FCM_RULE_MASS ? "mass" : "stiffness");
+  const double need = rule_memory_estimate(n, R->strength, B->o->simplify);
+  FCM_CHECK(limit <= 0.0 || need <= limit, B->ctx, FCM_ERR_UNSUPPORTED,
+            "embed: background cell %lld holds %zu embedded tets (%zu stiffness, %zu mass "
+            "points); building its rules needs about %.3g GB, above the limit of %.3g GB "
+            "(fcm_cell_rules_options.max_rule_memory; scene key quadrature.max_rule_memory_gb): "
+            "refine the background mesh there, coarsen the embedded geometry, lower the rule "
+            "strengths or raise the limit",
+            (long long)cell->id, ws->num_tets, n[FCM_RULE_STIFFNESS], n[FCM_RULE_MASS], need / 1e9,
+            limit / 1e9);
+cleanup:
+  return st;
+}
+
+/* Intersect, classify and build the rules of background cell c into o (the thread's own
+ * buffers); R->cls[c] and R->fraction[c] are written here (one writer per cell). */
 static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, fcm__embed_ws *ws,
-                               cell_out *o, fcm_index counts[5], double times[2])
+                               cell_out *o, cell_sums *sums)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
@@ -108,9 +162,12 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   double vol = 0.0;
   const double t0 = fcm_wtime();
   FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
-  FCM_TRY(ctx,
-          fcm__embed_cell_tets(ctx, B->geom, B->tree, &cell, opt->sliver_rtol, ws, counts, &vol));
-  const double phi = vol / cell.volume;
+  FCM_TRY(ctx, fcm__embed_cell_tets(ctx, B->geom, B->tree, &cell, opt->clip_rtol, opt->sliver_rtol,
+                                    ws, &sums->counts, &vol));
+  /* |K ∩ Ω| <= |K|: the clipped volumes can sum to |K| (1 + 1e-12) through rounding. A cut
+   * cell has phi < uncut_fraction <= 1, so its rule needs no rescaling; only the recorded
+   * fraction and volume are clamped. */
+  const double phi = fmin(vol / cell.volume, 1.0);
   fcm_cell_class cls = FCM_CELL_CUT;
   if (phi >= opt->uncut_fraction)
     cls = FCM_CELL_UNCUT;
@@ -118,14 +175,12 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
     cls = FCM_CELL_DROPPED;
   R->cls[c] = (unsigned char)cls;
   R->fraction[c] = phi;
-  o->volume = vol;
+  o->volume = phi * cell.volume;
   if (cls == FCM_CELL_CUT) {
+    FCM_TRY(ctx, check_rule_memory(B, R, &cell, ws));
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
       const size_t n0 = ws->num_tets * (size_t)fcm_rule_num_points(B->tet_rule[k]);
       const size_t ns = B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0;
-      FCM_CHECK(n0 + ns <= (size_t)1 << 30, ctx, FCM_ERR_UNSUPPORTED,
-                "embed: background cell %lld would get %zu initial points (limit 2^30)",
-                (long long)c, n0 + ns);
       FCM_ALLOC(ctx, 3 * (n0 + ns), o->pts[k]);
       FCM_ALLOC(ctx, n0 + ns, o->w[k]);
       FCM_ALLOC(ctx, n0 + ns, o->flag[k]);
@@ -134,10 +189,8 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
     }
   }
   if (B->tri_rule && cls != FCM_CELL_DROPPED) {
-    fcm_index ntri = 0;
     FCM_TRY(ctx, fcm__embed_cell_surface(ctx, B->geom, B->tri_tree, &cell, opt->sliver_rtol,
-                                         B->tri_rule, ws, &ntri));
-    counts[4] += ntri;
+                                         B->tri_rule, ws, &sums->counts));
     const size_t ns = ws->num_spts;
     if (ns > 0) {
       FCM_ALLOC(ctx, 3 * ns, o->spts);
@@ -155,7 +208,7 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
     }
   }
   const double t1 = fcm_wtime();
-  times[0] += t1 - t0;
+  sums->time_intersect += t1 - t0;
   if (cls == FCM_CELL_CUT) {
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
       if (opt->simplify) {
@@ -173,7 +226,7 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
       }
     }
   }
-  times[1] += fcm_wtime() - t1;
+  sums->time_simplify += fcm_wtime() - t1;
 cleanup:
   return st;
 }
@@ -201,6 +254,8 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_cell_rules_options *o)
             "embed: tolerances clip_rtol = %g, sliver_rtol = %g (each in [0, 1e-3)), "
             "convex_rtol = %g (in [0, 1e-2)) out of range",
             o->clip_rtol, o->sliver_rtol, o->convex_rtol);
+  FCM_CHECK(o->max_rule_memory >= 0.0 && !isnan(o->max_rule_memory), ctx, FCM_ERR_ARG,
+            "embed: max_rule_memory = %g bytes must be >= 0 (0: no limit)", o->max_rule_memory);
   FCM_CHECK(o->num_threads >= 1 || o->num_threads == FCM_DEFAULT, ctx, FCM_ERR_ARG,
             "embed: num_threads = %d must be >= 1, or FCM_DEFAULT (-1)", o->num_threads);
   FCM_CHECK((int)o->stabilization.mode >= 0 &&
@@ -240,123 +295,128 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
-                                 const fcm_cell_rules_options *opts, fcm_cell_rules **rules)
+/* Phase 1a: the result object with its per-cell arrays, strengths and catalogue rules. */
+static fcm_status rules_alloc(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_cell_rules_options *o,
+                              fcm_cell_rules **out)
 {
   fcm_status st = FCM_OK;
   fcm_cell_rules *R = NULL;
-  fcm_cell_rules_options o = opts ? *opts : fcm_cell_rules_options_default();
-  fcm_aabb_tree *tree = NULL, *tri_tree = NULL;
-  fcm_rule *tet_rule[FCM_RULE_KIND_COUNT] = {NULL, NULL}, *tri_rule = NULL;
-  double *boxes = NULL;
-  cell_out *out = NULL;
-  fcm_index nc = 0, nbox = 0;
-  const double t_start = fcm_wtime();
-  FCM_CHECK(rules, ctx, FCM_ERR_ARG, "embed: output pointer is NULL");
-  *rules = NULL;
-  FCM_CHECK(ctx && mesh && geom, ctx, FCM_ERR_ARG,
-            "embed: NULL argument (ctx, mesh and geometry are required)");
-  FCM_TRY(ctx, check_options(ctx, &o));
   const fcm_element_info *info = fcm_mesh_get_element_info(mesh);
-  nc = fcm_mesh_num_cells(mesh);
-  for (fcm_index c = 0; c < nc; c++)
-    FCM_CHECK(fcm_mesh_cell_is_convex(mesh, c, o.convex_rtol), ctx, FCM_ERR_GEOMETRY,
-              "embed: background cell %lld (%s) is not a convex polyhedron with planar faces and "
-              "straight edges (relative tolerance %g); cut-cell quadrature needs convex cells",
-              (long long)c, info->name, o.convex_rtol);
-
+  const fcm_index nc = fcm_mesh_num_cells(mesh);
+  const int element_strength[FCM_RULE_KIND_COUNT] = {
+      [FCM_RULE_STIFFNESS] = info->stiffness_strength, [FCM_RULE_MASS] = info->mass_strength};
   FCM_ALLOC(ctx, 1, R);
   R->ctx = ctx;
   R->num_cells = nc;
   R->type = info->type;
-  R->strength[FCM_RULE_STIFFNESS] = o.strength[FCM_RULE_STIFFNESS] >= 0
-                                        ? o.strength[FCM_RULE_STIFFNESS]
-                                        : info->stiffness_strength;
-  R->strength[FCM_RULE_MASS] =
-      o.strength[FCM_RULE_MASS] >= 0 ? o.strength[FCM_RULE_MASS] : info->mass_strength;
-  R->surface_strength = o.surface_strength;
+  R->surface_strength = o->surface_strength;
   FCM_ALLOC(ctx, (size_t)nc, R->cls);
   FCM_ALLOC(ctx, (size_t)nc, R->fraction);
   FCM_ALLOC(ctx, (size_t)nc + 1, R->soff);
-  build B;
-  memset(&B, 0, sizeof B);
-  B.ctx = ctx, B.mesh = mesh, B.geom = geom, B.o = &o;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
-    FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TET, R->strength[k], &tet_rule[k]));
+    R->strength[k] = o->strength[k] >= 0 ? o->strength[k] : element_strength[k];
     FCM_TRY(ctx, fcm_rule_create(ctx, info->shape, R->strength[k], &R->uncut[k]));
     FCM_ALLOC(ctx, (size_t)fcm_rule_num_points(R->uncut[k]), R->uncut_flags[k]);
     FCM_ALLOC(ctx, (size_t)nc + 1, R->off[k]);
-    B.tet_rule[k] = tet_rule[k];
-    B.full_rule[k] = R->uncut[k];
   }
-  B.stabilize[FCM_RULE_STIFFNESS] = o.stabilization.mode == FCM_STABILIZATION_MASS_STIFFNESS;
-  B.stabilize[FCM_RULE_MASS] = o.stabilization.mode != FCM_STABILIZATION_OFF;
-  FCM_TRY(ctx, geometry_boxes(ctx, geom, 0, &boxes, &nbox));
-  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &tree));
-  FCM_FREE(ctx, boxes);
-  B.tree = tree;
-  if (o.surface_strength >= 0) {
-    FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TRI, o.surface_strength, &tri_rule));
-    FCM_TRY(ctx, geometry_boxes(ctx, geom, 1, &boxes, &nbox));
-    FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &tri_tree));
-    FCM_FREE(ctx, boxes);
-    B.tri_rule = tri_rule, B.tri_tree = tri_tree;
-  }
-  FCM_ALLOC(ctx, (size_t)nc, out);
-  const double t_setup = fcm_wtime();
+  *out = R;
+  R = NULL;
+cleanup:
+  fcm_cell_rules_destroy(&R);
+  return st;
+}
 
-  /* Parallel per-cell work into private buffers. */
-  const int nthreads = o.num_threads > 0 ? o.num_threads : omp_get_max_threads();
-  fcm_status first = FCM_OK;
-  int failed = 0;
-  fcm_index counts[5] = {0, 0, 0, 0, 0};
-  double time_intersect = 0.0, time_simplify = 0.0;
+static void build_release(build *B)
+{
+  fcm_aabb_tree_destroy(&B->tree);
+  fcm_aabb_tree_destroy(&B->tri_tree);
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    fcm_rule_destroy(&B->tet_rule[k]);
+  fcm_rule_destroy(&B->tri_rule);
+}
+
+/* Phase 1b: what every cell reads: tet rules, search trees of the embedded cells and
+ * boundary triangles, which kinds get stabilization points. */
+static fcm_status build_setup(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                              const fcm_cell_rules_options *o, const fcm_cell_rules *R, build *B)
+{
+  fcm_status st = FCM_OK;
+  double *boxes = NULL;
+  fcm_index nbox = 0;
+  memset(B, 0, sizeof *B);
+  B->ctx = ctx, B->mesh = mesh, B->geom = geom, B->o = o;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TET, R->strength[k], &B->tet_rule[k]));
+    B->full_rule[k] = R->uncut[k];
+  }
+  B->stabilize[FCM_RULE_STIFFNESS] = o->stabilization.mode == FCM_STABILIZATION_MASS_STIFFNESS;
+  B->stabilize[FCM_RULE_MASS] = o->stabilization.mode != FCM_STABILIZATION_OFF;
+  FCM_TRY(ctx, geometry_boxes(ctx, geom, 0, &boxes, &nbox));
+  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &B->tree));
+  FCM_FREE(ctx, boxes);
+  if (o->surface_strength >= 0) {
+    FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TRI, o->surface_strength, &B->tri_rule));
+    FCM_TRY(ctx, geometry_boxes(ctx, geom, 1, &boxes, &nbox));
+    FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &B->tri_tree));
+  }
+cleanup:
+  fcm__free(ctx, boxes);
+  if (st != FCM_OK) build_release(B);
+  return st;
+}
+
+/* Phase 2: every cell in parallel into its own cell_out; thread sums into *sums. An error
+ * is that of the lowest failing cell, whatever the thread count. */
+static fcm_status run_cells(const build *B, fcm_cell_rules *R, int nthreads, cell_out *out,
+                            cell_sums *sums)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_index nc = R->num_cells;
+  fcm__loop loop;
+  fcm__loop_begin(ctx, &loop);
+  memset(sums, 0, sizeof *sums);
 #pragma omp parallel num_threads(nthreads)
   {
-    fcm__embed_ws *ws = fcm__calloc(ctx, 1, sizeof *ws);
-    fcm_index cnt[5] = {0, 0, 0, 0, 0};
-    double tm[2] = {0.0, 0.0};
-    if (!ws) {
-#pragma omp critical(fcm_embed_fail)
-      {
-        if (!failed) first = FCM_ERR_ALLOC;
-        failed = 1;
-      }
-    }
+    cell_sums mine;
+    memset(&mine, 0, sizeof mine);
+    fcm__embed_ws *ws = NULL;
 #pragma omp for schedule(dynamic, 4)
     for (fcm_index c = 0; c < nc; c++) {
-      int stop;
-#pragma omp atomic read
-      stop = failed;
-      if (stop || !ws) continue;
-      const fcm_status s = process_cell(&B, R, c, ws, out + c, cnt, tm);
-      if (s != FCM_OK) {
-#pragma omp critical(fcm_embed_fail)
-        {
-          if (!failed) first = s;
-          failed = 1;
-        }
+      if (fcm__loop_skip(&loop, c)) continue;
+      fcm__loop_iter it = fcm__loop_enter(&loop, c);
+      fcm_status s = FCM_OK;
+      if (!ws) { /* the thread's workspace, made by its first cell */
+        ws = fcm__calloc(ctx, 1, sizeof *ws);
+        if (!ws) s = FCM_ERR_ALLOC;
       }
+      if (s == FCM_OK) s = process_cell(B, R, c, ws, out + c, &mine);
+      fcm__loop_leave(&loop, it, s);
     }
     if (ws) fcm__embed_ws_free(ctx, ws);
     fcm__free(ctx, ws);
 #pragma omp critical(fcm_embed_sum)
     {
-      for (int k = 0; k < 5; k++)
-        counts[k] += cnt[k];
-      time_intersect += tm[0];
-      time_simplify += tm[1];
+      sums->counts.candidates += mine.counts.candidates;
+      sums->counts.pieces += mine.counts.pieces;
+      sums->counts.tets += mine.counts.tets;
+      sums->counts.slivers += mine.counts.slivers;
+      sums->counts.surface_triangles += mine.counts.surface_triangles;
+      sums->counts.sliver_volume += mine.counts.sliver_volume;
+      sums->time_intersect += mine.time_intersect;
+      sums->time_simplify += mine.time_simplify;
     }
   }
-  if (failed) {
-    st = first;
-    fcm__trace(ctx, __FILE__, __LINE__, __func__);
-    goto cleanup;
-  }
-  const double t_loop = fcm_wtime();
+  FCM_TRY(ctx, fcm__loop_end(&loop, NULL));
+cleanup:
+  return st;
+}
 
-  /* Gather in cell order. */
-  fcm_cell_rules_stats *S = &R->stats;
+/* Phase 3: concatenate the cells' volume and surface rules in cell order. */
+static fcm_status gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_out *out)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index nc = R->num_cells;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     fcm_index *off = R->off[k];
     off[0] = 0;
@@ -368,43 +428,52 @@ fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_g
     FCM_ALLOC(ctx, tot, R->flags[k]);
     for (fcm_index c = 0; c < nc; c++) {
       const size_t n = (size_t)out[c].n[k], o0 = (size_t)off[c];
-      if (n) {
-        memcpy(R->points[k] + 3 * o0, out[c].pts[k], 3 * n * sizeof(double));
-        memcpy(R->weights[k] + o0, out[c].w[k], n * sizeof(double));
-        memcpy(R->flags[k] + o0, out[c].flag[k], n);
-      }
-      S->points_initial[k] += out[c].ninit[k];
-      S->points_simplified[k] += out[c].nsimp[k];
-      S->points_stabilization[k] += out[c].nstab[k];
-      S->simplify_skipped[k] += out[c].skipped[k];
-      S->simplify_fallbacks[k] += out[c].fallback[k];
-      S->max_residual[k] = fmax(S->max_residual[k], out[c].residual[k]);
+      if (!n) continue;
+      memcpy(R->points[k] + 3 * o0, out[c].pts[k], 3 * n * sizeof(double));
+      memcpy(R->weights[k] + o0, out[c].w[k], n * sizeof(double));
+      memcpy(R->flags[k] + o0, out[c].flag[k], n);
     }
   }
   R->soff[0] = 0;
   for (fcm_index c = 0; c < nc; c++)
     R->soff[c + 1] = R->soff[c] + out[c].ns;
-  {
-    const size_t tot = (size_t)R->soff[nc];
-    FCM_ALLOC(ctx, 3 * tot, R->spoints);
-    FCM_ALLOC(ctx, tot, R->sweights);
-    FCM_ALLOC(ctx, 3 * tot, R->snormals);
-    FCM_ALLOC(ctx, tot, R->stris);
-    for (fcm_index c = 0; c < nc; c++) {
-      const size_t n = (size_t)out[c].ns, o0 = (size_t)R->soff[c];
-      if (!n) continue;
-      memcpy(R->spoints + 3 * o0, out[c].spts, 3 * n * sizeof(double));
-      memcpy(R->sweights + o0, out[c].sw, n * sizeof(double));
-      memcpy(R->snormals + 3 * o0, out[c].snrm, 3 * n * sizeof(double));
-      memcpy(R->stris + o0, out[c].stri, n * sizeof(fcm_index));
-      for (size_t j = 0; j < n; j++)
-        S->embedded_area += out[c].sw[j];
-    }
-    S->surface_points = (fcm_index)tot;
+  const size_t tot = (size_t)R->soff[nc];
+  FCM_ALLOC(ctx, 3 * tot, R->spoints);
+  FCM_ALLOC(ctx, tot, R->sweights);
+  FCM_ALLOC(ctx, 3 * tot, R->snormals);
+  FCM_ALLOC(ctx, tot, R->stris);
+  for (fcm_index c = 0; c < nc; c++) {
+    const size_t n = (size_t)out[c].ns, o0 = (size_t)R->soff[c];
+    if (!n) continue;
+    memcpy(R->spoints + 3 * o0, out[c].spts, 3 * n * sizeof(double));
+    memcpy(R->sweights + o0, out[c].sw, n * sizeof(double));
+    memcpy(R->snormals + 3 * o0, out[c].snrm, 3 * n * sizeof(double));
+    memcpy(R->stris + o0, out[c].stri, n * sizeof(fcm_index));
   }
+cleanup:
+  return st;
+}
+
+/* Phase 4: the statistics (times are filled in by the caller). */
+static void gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const cell_out *out,
+                         const cell_sums *sums, int nthreads)
+{
+  fcm_cell_rules_stats *S = &R->stats;
+  const fcm_index nc = R->num_cells;
   S->num_cells = nc;
   for (fcm_index c = 0; c < nc; c++) {
-    S->embedded_volume += out[c].volume;
+    const cell_out *o = out + c;
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+      S->points_initial[k] += o->ninit[k];
+      S->points_simplified[k] += o->nsimp[k];
+      S->points_stabilization[k] += o->nstab[k];
+      S->simplify_skipped[k] += o->skipped[k];
+      S->simplify_fallbacks[k] += o->fallback[k];
+      S->max_residual[k] = fmax(S->max_residual[k], o->residual[k]);
+    }
+    for (int j = 0; j < o->ns; j++)
+      S->embedded_area += o->sw[j];
+    S->embedded_volume += o->volume;
     switch ((fcm_cell_class)R->cls[c]) {
     case FCM_CELL_UNCUT:
       S->num_uncut++;
@@ -414,24 +483,64 @@ fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_g
       break;
     default:
       S->num_dropped++;
-      S->dropped_volume += out[c].volume;
+      S->dropped_volume += o->volume;
       break;
     }
   }
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     S->points_total[k] = R->off[k][nc] + S->num_uncut * fcm_rule_num_points(R->uncut[k]);
-  S->num_candidates = counts[0];
-  S->num_pieces = counts[1];
-  S->num_tets = counts[2];
-  S->num_slivers = counts[3];
-  S->surface_triangles = counts[4];
+  S->surface_points = R->soff[nc];
+  S->num_candidates = sums->counts.candidates;
+  S->num_pieces = sums->counts.pieces;
+  S->num_tets = sums->counts.tets;
+  S->num_slivers = sums->counts.slivers;
+  S->sliver_volume = sums->counts.sliver_volume;
+  S->surface_triangles = sums->counts.surface_triangles;
   S->geometry_volume = fcm_geometry_volume(geom);
   S->num_threads = nthreads;
-  S->time_setup = t_setup - t_start;
-  S->time_intersect = time_intersect;
-  S->time_simplify = time_simplify;
-  S->time_gather = fcm_wtime() - t_loop;
-  S->time_total = fcm_wtime() - t_start;
+  S->time_intersect = sums->time_intersect;
+  S->time_simplify = sums->time_simplify;
+}
+
+fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                                 const fcm_cell_rules_options *opts, fcm_cell_rules **rules)
+{
+  fcm_status st = FCM_OK;
+  fcm_cell_rules *R = NULL;
+  const fcm_cell_rules_options o = opts ? *opts : fcm_cell_rules_options_default();
+  build B;
+  cell_out *out = NULL;
+  cell_sums sums;
+  fcm_index nc = 0;
+  memset(&B, 0, sizeof B);
+  const double t_start = fcm_wtime();
+  FCM_CHECK(rules, ctx, FCM_ERR_ARG, "embed: output pointer is NULL");
+  *rules = NULL;
+  FCM_CHECK(ctx && mesh && geom, ctx, FCM_ERR_ARG,
+            "embed: NULL argument (ctx, mesh and geometry are required)");
+  FCM_TRY(ctx, check_options(ctx, &o));
+  nc = fcm_mesh_num_cells(mesh);
+  for (fcm_index c = 0; c < nc; c++)
+    FCM_CHECK(fcm_mesh_cell_is_convex(mesh, c, o.convex_rtol), ctx, FCM_ERR_GEOMETRY,
+              "embed: background cell %lld (%s) is not a convex polyhedron with planar faces and "
+              "straight edges (relative tolerance %g); cut-cell quadrature needs convex cells",
+              (long long)c, fcm_mesh_get_element_info(mesh)->name, o.convex_rtol);
+
+  /* 1. set-up */
+  FCM_TRY(ctx, rules_alloc(ctx, mesh, &o, &R));
+  FCM_TRY(ctx, build_setup(ctx, mesh, geom, &o, R, &B));
+  FCM_ALLOC(ctx, (size_t)nc, out);
+  const double t_setup = fcm_wtime();
+  /* 2. parallel per-cell work */
+  const int nthreads = o.num_threads > 0 ? o.num_threads : omp_get_max_threads();
+  FCM_TRY(ctx, run_cells(&B, R, nthreads, out, &sums));
+  const double t_loop = fcm_wtime();
+  /* 3. gather, 4. statistics */
+  FCM_TRY(ctx, gather_rules(ctx, R, out));
+  gather_stats(R, geom, out, &sums, nthreads);
+  R->stats.time_setup = t_setup - t_start;
+  R->stats.time_gather = fcm_wtime() - t_loop;
+  R->stats.time_total = fcm_wtime() - t_start;
   *rules = R;
   R = NULL;
 cleanup:
@@ -439,12 +548,7 @@ cleanup:
     for (fcm_index c = 0; c < nc; c++)
       cell_out_free(ctx, out + c);
   fcm__free(ctx, out);
-  fcm__free(ctx, boxes);
-  fcm_aabb_tree_destroy(&tree);
-  fcm_aabb_tree_destroy(&tri_tree);
-  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
-    fcm_rule_destroy(&tet_rule[k]);
-  fcm_rule_destroy(&tri_rule);
+  build_release(&B);
   fcm_cell_rules_destroy(&R);
   return st;
 }
@@ -573,12 +677,12 @@ void fcm_cell_rules_view(const fcm_cell_rules *rules, FILE *stream)
   static const char *names[FCM_RULE_KIND_COUNT] = {"stiffness", "mass"};
   fprintf(stream,
           "cell rules: %s, %lld cells: %lld uncut, %lld cut, %lld dropped (%d threads)\n"
-          "  candidates %lld, pieces %lld, tets %lld, slivers dropped %lld\n"
+          "  candidates %lld, pieces %lld, tets %lld, slivers dropped %lld (volume %.3g)\n"
           "  embedded volume %.17g (geometry %.17g, in dropped cells %.3g)\n",
           fcm_element_get_info(rules->type)->name, (long long)S->num_cells, (long long)S->num_uncut,
           (long long)S->num_cut, (long long)S->num_dropped, S->num_threads,
           (long long)S->num_candidates, (long long)S->num_pieces, (long long)S->num_tets,
-          (long long)S->num_slivers, S->embedded_volume, S->geometry_volume, S->dropped_volume);
+          (long long)S->num_slivers, S->sliver_volume, S->embedded_volume, S->geometry_volume, S->dropped_volume);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     fprintf(stream,
             "  %-9s strength %d: cut-cell points %lld initial -> %lld simplified "

@@ -70,13 +70,25 @@ void fcm__embed_ws_free(fcm_ctx *ctx, fcm__embed_ws *ws);
 fcm_status fcm__embed_cell_setup(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index id, double clip_rtol,
                                  fcm__embed_cell *cell);
 
-/* Clip every candidate embedded cell by the planes of `cell` and tetrahedralize the
- * pieces into ws->tets / ws->vol (tets with volume <= sliver_rtol |K| are dropped).
- * Counters (may be NULL): candidates, pieces, tets kept, slivers; *volume = sum of the
- * kept tets' volumes. */
+/* Counters of the per-cell kernels (summed over cells into the statistics). */
+typedef struct fcm__embed_counts {
+  fcm_index candidates;        /* (background cell, embedded cell) pairs from the tree */
+  fcm_index pieces;            /* non-empty clipped polyhedra */
+  fcm_index tets;              /* tets kept */
+  fcm_index slivers;           /* tets dropped as slivers */
+  fcm_index surface_triangles; /* clipped boundary triangles kept */
+  double sliver_volume;        /* summed volume of the dropped slivers */
+} fcm__embed_counts;
+
+/* Clip every candidate embedded cell E by the planes of `cell` and tetrahedralize the
+ * pieces into ws->tets / ws->vol. Both tolerances follow the smaller of the two scales,
+ * so that geometry much thinner than the background cell keeps its volume: a vertex is
+ * on a plane within min(cell->tol, clip_rtol * t_E), t_E = 6 |E| / diam(E)^2 being E's
+ * thickness, and tets with volume <= sliver_rtol * min(|K|, |E|) are dropped (counted,
+ * with their volume). *volume = sum of the kept tets' volumes. */
 fcm_status fcm__embed_cell_tets(fcm_ctx *ctx, const fcm_geometry *geom, const fcm_aabb_tree *tree,
-                                const fcm__embed_cell *cell, double sliver_rtol, fcm__embed_ws *ws,
-                                fcm_index counts[4], double *volume);
+                                const fcm__embed_cell *cell, double clip_rtol, double sliver_rtol,
+                                fcm__embed_ws *ws, fcm__embed_counts *counts, double *volume);
 
 /* Reference coordinates xi and det J_K(xi) of the physical point x. */
 fcm_status fcm__embed_to_reference(fcm_ctx *ctx, const fcm__embed_cell *cell, const double x[3],
@@ -91,10 +103,10 @@ fcm_status fcm__embed_map_tets(fcm_ctx *ctx, const fcm__embed_cell *cell, const 
  * cell plane is kept only when its outward normal agrees with the plane's) and map the
  * triangle rule onto the fan triangles: physical points, area weights, unit normals and
  * triangle ids into ws->spts, ws->sw, ws->snrm, ws->stri (ws->num_spts of them).
- * counts[0] += clipped triangles kept. */
+ * counts->surface_triangles += clipped triangles kept. */
 fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
                                    const fcm_aabb_tree *tri_tree, const fcm__embed_cell *cell,
                                    double sliver_rtol, const fcm_rule *tri_rule, fcm__embed_ws *ws,
-                                   fcm_index *count);
+                                   fcm__embed_counts *counts);
 
 #endif /* FCM_EMBED_IMPL_H */

@@ -104,13 +104,27 @@ cleanup:
   return st;
 }
 
+/* Thickness scale of an embedded cell with volume `vol` and vertices X (n x 3):
+ * 6 |E| / diam(E)^2 (about the smallest height: a regular tet of edge a gives 0.71 a, a
+ * flat L x L x t slab tet about t / 2). */
+static double cell_thickness(const double *X, int n, double vol)
+{
+  double d2 = 0.0;
+  for (int a = 0; a < n; a++)
+    for (int b = a + 1; b < n; b++) {
+      const double dx = X[3 * a] - X[3 * b], dy = X[3 * a + 1] - X[3 * b + 1],
+                   dz = X[3 * a + 2] - X[3 * b + 2];
+      d2 = fmax(d2, dx * dx + dy * dy + dz * dz);
+    }
+  return d2 > 0.0 ? 6.0 * vol / d2 : 0.0;
+}
+
 fcm_status fcm__embed_cell_tets(fcm_ctx *ctx, const fcm_geometry *geom, const fcm_aabb_tree *tree,
-                                const fcm__embed_cell *cell, double sliver_rtol, fcm__embed_ws *ws,
-                                fcm_index counts[4], double *volume)
+                                const fcm__embed_cell *cell, double clip_rtol, double sliver_rtol,
+                                fcm__embed_ws *ws, fcm__embed_counts *counts, double *volume)
 {
   fcm_status st = FCM_OK;
-  double X[24], vsum = 0.0;
-  const double vmin = sliver_rtol * cell->volume;
+  double X[24], vsum = 0.0, lost = 0.0;
   fcm_index npieces = 0, nslivers = 0;
   ws->num_tets = 0;
   FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, cell->lo, cell->hi, &ws->cand));
@@ -121,8 +135,12 @@ fcm_status fcm__embed_cell_tets(fcm_ctx *ctx, const fcm_geometry *geom, const fc
       for (int d = 0; d < 3; d++)
         X[3 * a + d] = geom->coords[3 * cv[a] + d];
     fcm__geom_poly_from_cell(geom->type, X, &ws->poly);
+    /* the scales of this embedded cell: a thin one gets tolerances of its own size */
+    const double vol_e = fabs(fcm__geom_poly_volume(&ws->poly));
+    const double tol = fmin(cell->tol, clip_rtol * cell_thickness(X, geom->npc, vol_e));
+    const double vmin = sliver_rtol * fmin(cell->volume, vol_e);
     for (int f = 0; f < cell->num_planes && ws->poly.nf > 0; f++)
-      FCM_CHECK(fcm__geom_poly_clip(&ws->poly, cell->planes + f, cell->tol, &ws->scratch) == 0, ctx,
+      FCM_CHECK(fcm__geom_poly_clip(&ws->poly, cell->planes + f, tol, &ws->scratch) == 0, ctx,
                 FCM_ERR_INTERNAL,
                 "embed: clipping embedded cell %lld by background cell %lld exceeded the "
                 "polyhedron capacity (%d vertices, %d faces)",
@@ -137,6 +155,7 @@ fcm_status fcm__embed_cell_tets(fcm_ctx *ctx, const fcm_geometry *geom, const fc
     for (int i = 0; i < made; i++) {
       if (!(v[i] > vmin)) {
         nslivers++;
+        if (v[i] > 0.0) lost += v[i];
         continue;
       }
       if (kept != i) {
@@ -149,10 +168,11 @@ fcm_status fcm__embed_cell_tets(fcm_ctx *ctx, const fcm_geometry *geom, const fc
     ws->num_tets += (size_t)kept;
   }
   if (counts) {
-    counts[0] += (fcm_index)ws->cand.n;
-    counts[1] += npieces;
-    counts[2] += (fcm_index)ws->num_tets;
-    counts[3] += nslivers;
+    counts->candidates += (fcm_index)ws->cand.n;
+    counts->pieces += npieces;
+    counts->tets += (fcm_index)ws->num_tets;
+    counts->slivers += nslivers;
+    counts->sliver_volume += lost;
   }
   *volume = vsum;
 cleanup:
@@ -210,7 +230,7 @@ cleanup:
 fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
                                    const fcm_aabb_tree *tri_tree, const fcm__embed_cell *cell,
                                    double sliver_rtol, const fcm_rule *tri_rule, fcm__embed_ws *ws,
-                                   fcm_index *count)
+                                   fcm__embed_counts *counts)
 {
   fcm_status st = FCM_OK;
   double poly[3 * POLYGON_CAP], work[3 * POLYGON_CAP];
@@ -268,7 +288,7 @@ fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
         ws->stri[s] = tri;
       }
     }
-    *count += kept_any;
+    counts->surface_triangles += kept_any;
   }
 cleanup:
   return st;

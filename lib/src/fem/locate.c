@@ -17,48 +17,77 @@ static int inside_reference(fcm_shape shape, const double xi[3], double tol)
 
 enum { MAX_CANDIDATES = 256 };
 
+/* Boxes of the tree overlapping [lo, hi]: into `ids` (MAX_CANDIDATES entries) when they
+ * fit, else into *many (allocated here, released by the caller) by a second query sized
+ * to the count; *cand points at whichever holds them. */
+static fcm_status query_all(const fcm_space *s, const fcm_aabb_tree *tree, const double lo[3],
+                            const double hi[3], fcm_index *ids, fcm_index **many,
+                            const fcm_index **cand, fcm_index *count)
+{
+  fcm_status st = FCM_OK;
+  *cand = ids;
+  FCM_TRY(s->ctx, fcm_aabb_tree_query(tree, lo, hi, MAX_CANDIDATES, ids, count));
+  if (*count > MAX_CANDIDATES) { /* a crowded box: ids was not written; fetch them all */
+    fcm_index want = *count;
+    fcm__free(s->ctx, *many);
+    *many = NULL;
+    FCM_ALLOC(s->ctx, want, *many);
+    FCM_TRY(s->ctx, fcm_aabb_tree_query(tree, lo, hi, want, *many, count));
+    FCM_CHECK(*count == want, s->ctx, FCM_ERR_INTERNAL,
+              "locate: the box query returned %lld boxes, then %lld", (long long)want,
+              (long long)*count);
+    *cand = *many;
+  }
+cleanup:
+  return st;
+}
+
 /* Locate one point: the lowest-numbered active cell containing it, else the active
  * cell with the nearest centroid among those near it (extrapolated = 1). */
 static fcm_status locate_one(const fcm_space *s, const fcm_aabb_tree *tree,
                              const fcm_index *tree_cell, const double *centroid, double reach,
-                             const double p[3], fcm_index *ids, fcm_index *cell, double xi[3],
-                             int *extrapolated)
+                             fcm_index i, const double p[3], fcm_index *ids, fcm_index *cell,
+                             double xi[3], int *extrapolated)
 {
   fcm_status st = FCM_OK;
   double X[3 * FCM_ELEMENT_MAX_NODES];
   fcm_index *many = NULL;
+  const fcm_index *cand = NULL;
   const fcm_element_info *info = fcm_element_get_info(s->type);
-  fcm_index count = 0;
-  FCM_TRY(s->ctx, fcm_aabb_tree_query(tree, p, p, MAX_CANDIDATES, ids, &count));
-  for (fcm_index k = 0; k < FCM_MIN(count, (fcm_index)MAX_CANDIDATES); k++) {
-    fcm_index c = tree_cell[ids[k]];
+  fcm_index count = 0, found = -1;
+  FCM_TRY(s->ctx, query_all(s, tree, p, p, ids, &many, &cand, &count));
+  for (fcm_index k = 0; k < count; k++) {
+    fcm_index c = tree_cell[cand[k]];
+    double xk[3];
+    if (found >= 0 && c >= found) continue;
     fcm_mesh_cell_coords(s->mesh, c, X);
-    if (fcm_element_inverse_map(NULL, s->type, X, p, xi) == FCM_OK &&
-        inside_reference(info->shape, xi, 1e-10)) {
-      *cell = c;
-      *extrapolated = 0;
-      goto cleanup;
+    if (fcm_element_inverse_map(NULL, s->type, X, p, xk) == FCM_OK &&
+        inside_reference(info->shape, xk, 1e-10)) {
+      found = c;
+      memcpy(xi, xk, sizeof xk);
     }
+  }
+  if (found >= 0) {
+    *cell = found;
+    *extrapolated = 0;
+    goto cleanup;
   }
   /* not inside any active cell: the nearest centroid within a growing box */
   for (double r = reach;; r *= 2.0) {
     double lo[3] = {p[0] - r, p[1] - r, p[2] - r}, hi[3] = {p[0] + r, p[1] + r, p[2] + r};
-    FCM_TRY(s->ctx, fcm_aabb_tree_query(tree, lo, hi, MAX_CANDIDATES, ids, &count));
+    FCM_TRY(s->ctx, query_all(s, tree, lo, hi, ids, &many, &cand, &count));
     if (count == 0 && r < 1e6 * reach) continue;
     FCM_CHECK(count > 0, s->ctx, FCM_ERR_GEOMETRY,
-              "locate: no active cell near the point (%g, %g, %g)", p[0], p[1], p[2]);
-    const fcm_index *cand = ids;
-    if (count > MAX_CANDIDATES) { /* a crowded box: fetch all of them */
-      FCM_ALLOC(s->ctx, count, many);
-      FCM_TRY(s->ctx, fcm_aabb_tree_query(tree, lo, hi, count, many, &count));
-      cand = many;
-    }
+              "locate: point %lld (%g, %g, %g) has no active cell within %g of it", (long long)i,
+              p[0], p[1], p[2], r);
     double best = HUGE_VAL;
+    *cell = -1;
     for (fcm_index k = 0; k < count; k++) {
       const double *cc = centroid + 3 * cand[k];
       double d = (cc[0] - p[0]) * (cc[0] - p[0]) + (cc[1] - p[1]) * (cc[1] - p[1]) +
                  (cc[2] - p[2]) * (cc[2] - p[2]);
-      if (d < best) best = d, *cell = tree_cell[cand[k]];
+      if (d < best || (d == best && tree_cell[cand[k]] < *cell))
+        best = d, *cell = tree_cell[cand[k]];
     }
     break;
   }
@@ -70,14 +99,15 @@ static fcm_status locate_one(const fcm_space *s, const fcm_aabb_tree *tree,
     double c0 = info->shape == FCM_SHAPE_TET ? 0.25 : 0.0, ref[3] = {c0, c0, c0};
     fcm_element_map(s->type, X, ref, xc);
     double det = fcm_element_jacobian(s->type, X, ref, J);
-    FCM_CHECK(det != 0.0, s->ctx, FCM_ERR_GEOMETRY, "locate: degenerate cell %lld",
+    FCM_CHECK(det != 0.0, s->ctx, FCM_ERR_GEOMETRY,
+              "locate: point %lld: the nearest active cell %lld is degenerate", (long long)i,
               (long long)*cell);
     for (int k = 0; k < 3; k++) d[k] = p[k] - xc[k];
     /* Cramer's rule on J dxi = d */
     for (int k = 0; k < 3; k++) {
       double Jk[9];
       memcpy(Jk, J, sizeof Jk);
-      for (int i = 0; i < 3; i++) Jk[3 * i + k] = d[i];
+      for (int r = 0; r < 3; r++) Jk[3 * r + k] = d[r];
       double dk = Jk[0] * (Jk[4] * Jk[8] - Jk[5] * Jk[7]) - Jk[1] * (Jk[3] * Jk[8] - Jk[5] * Jk[6]) +
                   Jk[2] * (Jk[3] * Jk[7] - Jk[4] * Jk[6]);
       xi[k] = ref[k] + dk / det;
@@ -96,7 +126,7 @@ fcm_status fcm_space_locate(const fcm_space *s, fcm_index n, const double *X, fc
   fcm_ctx *ctx = s->ctx;
   fcm_aabb_tree *tree = NULL;
   double *boxes = NULL, *centroid = NULL;
-  fcm_index *tree_cell = NULL, *ids = NULL, nact = 0, failed = -1;
+  fcm_index *tree_cell = NULL, *ids = NULL, nact = 0;
   double reach = 0.0;
   int nthreads = omp_get_max_threads();
   FCM_CHECK(n >= 0 && (n == 0 || (X && cell && xi)), ctx, FCM_ERR_ARG,
@@ -127,23 +157,23 @@ fcm_status fcm_space_locate(const fcm_space *s, fcm_index n, const double *X, fc
     }
   }
   FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nact, boxes, &tree));
+  fcm__loop loop; /* an error is recorded once: the lowest failing point's */
+  fcm__loop_begin(ctx, &loop);
 #pragma omp parallel num_threads(nthreads)
   {
     fcm_index *my_ids = ids + (size_t)MAX_CANDIDATES * omp_get_thread_num();
 #pragma omp for schedule(dynamic, 64)
     for (fcm_index i = 0; i < n; i++) {
       int ex = 0;
-      if (locate_one(s, tree, tree_cell, centroid, reach, X + 3 * i, my_ids, cell + i, xi + 3 * i,
-                     &ex) != FCM_OK) {
-#pragma omp critical(fcm_locate)
-        if (failed < 0 || i < failed) failed = i;
-        continue;
-      }
-      if (extrapolated) extrapolated[i] = ex;
+      if (fcm__loop_skip(&loop, i)) continue;
+      fcm__loop_iter it = fcm__loop_enter(&loop, i);
+      fcm_status si = locate_one(s, tree, tree_cell, centroid, reach, i, X + 3 * i, my_ids,
+                                 cell + i, xi + 3 * i, &ex);
+      fcm__loop_leave(&loop, it, si);
+      if (si == FCM_OK && extrapolated) extrapolated[i] = ex;
     }
   }
-  FCM_CHECK(failed < 0, ctx, FCM_ERR_GEOMETRY, "locate: point %lld (%g, %g, %g) has no cell",
-            (long long)failed, X[3 * failed], X[3 * failed + 1], X[3 * failed + 2]);
+  FCM_TRY(ctx, fcm__loop_end(&loop, NULL));
 cleanup:
   fcm_aabb_tree_destroy(&tree);
   fcm__free(ctx, boxes);

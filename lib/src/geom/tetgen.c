@@ -14,32 +14,36 @@ typedef struct lines {
   const char *path;
   char *buf; /* whole file, NUL-terminated */
   char *pos; /* start of the next line */
+  size_t len; /* bytes in the file */
   long line; /* number of the line last returned */
   char *tok[MAX_TOKENS];
   int ntok; /* tokens of the current line; more than MAX_TOKENS are counted, not kept */
 } lines;
 
+/* Files above this size are refused before reading (4 GiB: ~200 million points). */
+#define TETGEN_MAX_BYTES ((size_t)1 << 32)
+
 static fcm_status read_file(fcm_ctx *ctx, const char *path, lines *L)
 {
   fcm_status st = FCM_OK;
-  FILE *f = NULL;
-  long len = 0;
-  L->path = path, L->buf = NULL, L->line = 0;
+  size_t len = 0;
+  L->path = path, L->buf = NULL, L->line = 0, L->len = 0;
   FCM_CHECK(path, ctx, FCM_ERR_ARG, "tetgen: file name is NULL");
-  f = fopen(path, "rb");
-  FCM_CHECK(f, ctx, FCM_ERR_IO, "tetgen: cannot open %s: %s", path, strerror(errno));
-  FCM_CHECK(fseek(f, 0, SEEK_END) == 0 && (len = ftell(f)) >= 0 && fseek(f, 0, SEEK_SET) == 0, ctx,
-            FCM_ERR_IO, "tetgen: cannot determine the size of %s", path);
-  FCM_ALLOC(ctx, (size_t)len + 1, L->buf);
-  FCM_CHECK(fread(L->buf, 1, (size_t)len, f) == (size_t)len, ctx, FCM_ERR_IO,
-            "tetgen: cannot read %s", path);
-  L->buf[len] = '\0';
-  FCM_CHECK(strlen(L->buf) == (size_t)len, ctx, FCM_ERR_FORMAT,
+  FCM_TRY(ctx, fcm__file_read_all(ctx, "tetgen", path, TETGEN_MAX_BYTES, &L->buf, &len));
+  L->len = len;
+  FCM_CHECK(strlen(L->buf) == len, ctx, FCM_ERR_FORMAT,
             "tetgen: %s contains a NUL byte (binary file?)", path);
   L->pos = L->buf;
 cleanup:
-  if (f) fclose(f);
   return st;
+}
+
+/* Largest count of records of `ntok` tokens the file can hold: each needs at least
+ * ntok one-character tokens, ntok - 1 separators and a line break (except the last),
+ * so counts announced beyond that are malformed and must not size an allocation. */
+static long long max_records(const lines *L, int ntok)
+{
+  return (long long)((L->len + 1) / (size_t)(2 * ntok));
 }
 
 /* Next line with at least one token (comments stripped); 0 at the end of the file. */
@@ -121,7 +125,8 @@ fcm_status fcm_geometry_create_from_tetgen(fcm_ctx *ctx, const char *node_path,
             "%s:%ld: expected the header \"count 3 attributes "
             "markers\", got the end of the file",
             node_path, N.line);
-  FCM_TRY(ctx, token_int(ctx, &N, 0, "number of points", 0, 1LL << 40, &np));
+  FCM_TRY(ctx, token_int(ctx, &N, 0, "number of points (bounded by the file size)", 0,
+                         max_records(&N, 4), &np));
   FCM_TRY(ctx, token_int(ctx, &N, 1, "dimension", 0, 1000, &dim));
   FCM_CHECK(dim == 3, ctx, FCM_ERR_UNSUPPORTED, "%s:%ld: dimension %lld is not supported (need 3)",
             node_path, N.line, dim);
@@ -151,7 +156,8 @@ fcm_status fcm_geometry_create_from_tetgen(fcm_ctx *ctx, const char *node_path,
   FCM_CHECK(next_line(&E), ctx, FCM_ERR_FORMAT,
             "%s:%ld: expected the header \"count 4 attributes\", got the end of the file", ele_path,
             E.line);
-  FCM_TRY(ctx, token_int(ctx, &E, 0, "number of tetrahedra", 0, 1LL << 40, &nt));
+  FCM_TRY(ctx, token_int(ctx, &E, 0, "number of tetrahedra (bounded by the file size)", 0,
+                         max_records(&E, 5), &nt));
   FCM_TRY(ctx, token_int(ctx, &E, 1, "nodes per tetrahedron", 0, 1000, &npe));
   FCM_CHECK(npe != 10, ctx, FCM_ERR_UNSUPPORTED,
             "%s:%ld: 10-node tetrahedra are not supported (embedded cells must be straight "

@@ -15,18 +15,22 @@ typedef struct fcm__io_fault {
   int fail_commit;      /* the commit fails (EIO, as fflush/fsync/fclose could) */
 } fcm__io_fault;
 
-/* An output file being written: the data goes to "<path>.tmp.<pid>.<n>" (created
- * exclusively, mode 0666 minus umask) and replaces `path` only at commit. */
+/* An output file being written: the data goes to the hidden "<dir>/.<name>.tmp.<pid>.<n>"
+ * (created exclusively, mode 0666 minus umask; no glob for outputs such as name_*.vtu or *
+ * matches it) and replaces `path` only at commit. */
 typedef struct fcm__atomic_file {
   FILE *fp;
   char *path;      /* the target (copy) */
   char *tmp_path;  /* the temporary (NULL once renamed or removed) */
+  char *dir;       /* the target's directory */
   long long bytes; /* written so far */
-  int durable;     /* fsync before the rename */
+  int durable;     /* fsync the file before the rename and the directory after it */
   fcm__io_fault fault;
 } fcm__atomic_file;
 
-/* Create the temporary beside `path`. On failure (FCM_ERR_IO naming `path` and the
+/* Create the temporary beside `path`. The first open into a directory in a process also
+ * removes the temporaries there whose writer process no longer exists (left by kill -9 or
+ * a crash; only files named as ours, never a live process's). On failure (FCM_ERR_IO naming `path` and the
  * system error, FCM_ERR_ALLOC) nothing is left behind and `af` needs no abort, though
  * fcm__io_atomic_abort() is harmless. `fault` may be NULL. */
 fcm_status fcm__io_atomic_open(fcm_ctx *ctx, const char *path, int durable,
@@ -42,9 +46,11 @@ fcm_status fcm__io_atomic_printf(fcm_ctx *ctx, fcm__atomic_file *af, const char 
 /* Text with the XML attribute escapes &amp; &lt; &gt; &quot; &apos;. */
 fcm_status fcm__io_atomic_write_xml(fcm_ctx *ctx, fcm__atomic_file *af, const char *text);
 
-/* fflush, optional fsync, fclose (each checked), then rename over the target. On any
- * failure the temporary is removed, the target is untouched and FCM_ERR_IO names the
- * path and the system error. `af` is released either way. */
+/* fflush, optional fsync, fclose (each checked), then rename over the target and, when
+ * durable, fsync the directory. On any failure before the rename the temporary is removed,
+ * the target is untouched and FCM_ERR_IO names the path and the system error (a failing
+ * directory sync is FCM_ERR_IO too, with the new file in place). `af` is released either
+ * way. */
 fcm_status fcm__io_atomic_commit(fcm_ctx *ctx, fcm__atomic_file *af);
 
 /* Close and remove the temporary and release `af`; accepts an unopened or released

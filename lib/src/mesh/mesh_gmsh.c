@@ -63,34 +63,12 @@ static int gmsh_other_volume(long long t)
   return 0;
 }
 
+/* Files above this size are refused before reading (16 GiB). */
+#define GMSH_MAX_BYTES ((size_t)1 << 34)
+
 static fcm_status read_whole_file(fcm_ctx *ctx, const char *path, char **out, size_t *out_len)
 {
-  fcm_status st = FCM_OK;
-  FILE *fp = NULL;
-  char *buf = NULL;
-  size_t cap = 1 << 16, len = 0;
-  fp = fopen(path, "rb");
-  FCM_CHECK(fp, ctx, FCM_ERR_IO,
-            "mesh: cannot open Gmsh file '%s' for reading (missing file or no permission)", path);
-  FCM_ALLOC(ctx, cap, buf);
-  for (;;) {
-    if (cap - len < 2) {
-      FCM_TRY(ctx, fcm__resize(ctx, (void **)&buf, cap, 2 * cap, 1));
-      cap *= 2;
-    }
-    size_t got = fread(buf + len, 1, cap - 1 - len, fp);
-    len += got;
-    if (got == 0) break;
-  }
-  FCM_CHECK(!ferror(fp), ctx, FCM_ERR_IO, "mesh: error reading Gmsh file '%s'", path);
-  buf[len] = '\0';
-  *out = buf;
-  *out_len = len;
-  buf = NULL;
-cleanup:
-  if (fp) fclose(fp);
-  fcm__free(ctx, buf);
-  return st;
+  return fcm__file_read_all(ctx, "mesh: Gmsh file", path, GMSH_MAX_BYTES, out, out_len);
 }
 
 static int is_space(char c)
@@ -239,12 +217,16 @@ cleanup:
   return st;
 }
 
-/* A count announced by the file: every entry needs at least two bytes of text, so a count
- * beyond the file size is malformed (and must not turn into a huge allocation). */
-static fcm_status read_count(reader *r, const char *what, long long *v)
+/* A count announced by the file: every entry needs at least `min_bytes` bytes of text
+ * (two for a one-digit token and a separator; eight for a node "t x y z" in either
+ * version), so a count beyond what the file can hold is malformed and must not turn
+ * into a huge allocation. */
+static fcm_status read_count(reader *r, const char *what, size_t min_bytes, long long *v)
 {
-  return read_int(r, what, 0, (long long)FCM_MIN(r->len / 2, (size_t)1 << 40), v);
+  return read_int(r, what, 0, (long long)FCM_MIN(r->len / min_bytes, (size_t)1 << 40), v);
 }
+
+enum { MIN_ENTRY_BYTES = 2, MIN_NODE_BYTES = 8 };
 
 static fcm_status read_coords(reader *r, double *x)
 {
@@ -260,8 +242,8 @@ static fcm_status read_nodes_v4(reader *r, msh_data *m)
 {
   fcm_status st = FCM_OK;
   long long nblocks, count, mintag, maxtag;
-  FCM_TRY(r->ctx, read_count(r, "number of node blocks", &nblocks));
-  FCM_TRY(r->ctx, read_count(r, "number of nodes", &count));
+  FCM_TRY(r->ctx, read_count(r, "number of node blocks", MIN_ENTRY_BYTES, &nblocks));
+  FCM_TRY(r->ctx, read_count(r, "number of nodes", MIN_NODE_BYTES, &count));
   FCM_TRY(r->ctx, read_int(r, "minimum node tag", 0, INT64_MAX, &mintag));
   FCM_TRY(r->ctx, read_int(r, "maximum node tag", 0, INT64_MAX, &maxtag));
   FCM_TRY(r->ctx, alloc_nodes(r, m, count));
@@ -296,7 +278,7 @@ static fcm_status read_nodes_v2(reader *r, msh_data *m)
 {
   fcm_status st = FCM_OK;
   long long count;
-  FCM_TRY(r->ctx, read_count(r, "number of nodes", &count));
+  FCM_TRY(r->ctx, read_count(r, "number of nodes", MIN_NODE_BYTES, &count));
   FCM_TRY(r->ctx, alloc_nodes(r, m, count));
   for (long long i = 0; i < count; i++) {
     long long tag;
@@ -367,8 +349,8 @@ static fcm_status read_elements_v4(reader *r, msh_data *m)
 {
   fcm_status st = FCM_OK;
   long long nblocks, count, mintag, maxtag, seen = 0;
-  FCM_TRY(r->ctx, read_count(r, "number of element blocks", &nblocks));
-  FCM_TRY(r->ctx, read_count(r, "number of elements", &count));
+  FCM_TRY(r->ctx, read_count(r, "number of element blocks", MIN_ENTRY_BYTES, &nblocks));
+  FCM_TRY(r->ctx, read_count(r, "number of elements", MIN_ENTRY_BYTES, &count));
   FCM_TRY(r->ctx, read_int(r, "minimum element tag", 0, INT64_MAX, &mintag));
   FCM_TRY(r->ctx, read_int(r, "maximum element tag", 0, INT64_MAX, &maxtag));
   for (long long b = 0; b < nblocks; b++) {
@@ -403,7 +385,7 @@ static fcm_status read_elements_v2(reader *r, msh_data *m)
 {
   fcm_status st = FCM_OK;
   long long count;
-  FCM_TRY(r->ctx, read_count(r, "number of elements", &count));
+  FCM_TRY(r->ctx, read_count(r, "number of elements", MIN_ENTRY_BYTES, &count));
   for (long long i = 0; i < count; i++) {
     long long tag, type, ntags, t;
     fcm_element_type et;

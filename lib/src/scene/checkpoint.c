@@ -192,22 +192,20 @@ cleanup:
   return st;
 }
 
-/* Read a whole regular file through the ctx allocator. */
-static fcm_status slurp(fcm_ctx *ctx, const char *path, unsigned char **data, size_t *size)
+/* Checkpoints above this size are refused before reading (1 TiB). */
+#define CKPT_MAX_BYTES ((size_t)1 << 40)
+
+/* `count` records of `each` bytes must fit in what is left of the file before anything is
+ * allocated for them: a count the file cannot hold is a truncated or corrupted file. */
+static fcm_status need(ckpt_reader *r, long long count, size_t each, const char *what)
 {
   fcm_status st = FCM_OK;
-  FILE *f = fopen(path, "rb");
-  struct stat sb;
-  FCM_CHECK(f, ctx, FCM_ERR_IO, "checkpoint %s: cannot open: %s", path, strerror(errno));
-  FCM_CHECK(fstat(fileno(f), &sb) == 0, ctx, FCM_ERR_IO, "checkpoint %s: cannot stat: %s", path,
-            strerror(errno));
-  FCM_CHECK(S_ISREG(sb.st_mode), ctx, FCM_ERR_IO, "checkpoint %s: not a regular file", path);
-  size_t len = (size_t)sb.st_size;
-  FCM_ALLOC(ctx, len + 1, *data);
-  FCM_CHECK(fread(*data, 1, len, f) == len, ctx, FCM_ERR_IO, "checkpoint %s: read error", path);
-  *size = len;
+  size_t left = r->pos <= r->size ? r->size - r->pos : 0;
+  FCM_CHECK(count >= 0 && (unsigned long long)count <= left / each, r->ctx, FCM_ERR_FORMAT,
+            "checkpoint %s: %lld %s of %zu bytes announced at byte %zu, but only %zu bytes are "
+            "left (the file is truncated or corrupted)",
+            r->path, count, what, each, r->pos, left);
 cleanup:
-  if (f) fclose(f);
   return st;
 }
 
@@ -226,7 +224,7 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
             "written %lld frames)",
             path, S->c.steps, S->c.frames);
   size_t size = 0;
-  FCM_TRY(ctx, slurp(ctx, path, &data, &size));
+  FCM_TRY(ctx, fcm__file_read_all(ctx, "checkpoint", path, CKPT_MAX_BYTES, (char **)&data, &size));
   ckpt_reader r = {ctx, path, data, size, 0};
   {
     char magic[8];
@@ -268,11 +266,13 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
   FCM_TRY(ctx, get_i64(&r, &linear, 0, INT64_MAX, "linear_iterations"));
   FCM_TRY(ctx, get_i64(&r, &tangents, 0, INT64_MAX, "tangent_assemblies"));
   FCM_TRY(ctx, get_i64(&r, &frames, 0, steps + 1, "frames"));
+  FCM_TRY(ctx, need(&r, frames, sizeof *frame_time, "frame times"));
   if (frames > 0) {
     FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&frame_time, &frame_cap, frames, sizeof *frame_time));
     FCM_TRY(ctx, get(&r, frame_time, sizeof *frame_time * (size_t)frames, "the frame times"));
   }
   FCM_TRY(ctx, get_i64(&r, &rows, steps, steps, "log rows (one per step)"));
+  FCM_TRY(ctx, need(&r, rows, 4 * sizeof(double) + 2 * sizeof(int64_t), "log rows"));
   if (rows > 0) FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&log, &log_cap, rows, sizeof *log));
   for (long long k = 0; k < rows; k++) {
     fcm__log_row *w = &log[k];
@@ -283,6 +283,7 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
     w->time = d[0], w->residual = d[1], w->energy = d[2], w->wall = d[3];
     w->newton = (long long)i[0], w->linear = (long long)i[1];
   }
+  FCM_TRY(ctx, need(&r, n, 2 * sizeof(double), "displacement and velocity values"));
   FCM_ALLOC(ctx, n, u);
   FCM_ALLOC(ctx, n, v);
   FCM_TRY(ctx, get(&r, u, sizeof *u * (size_t)n, "the displacement"));

@@ -527,6 +527,9 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   FCM_CHECK(S, NULL, FCM_ERR_ARG, "simulation: NULL");
   FCM_CHECK(!fcm_simulation_done(S), S->ctx, FCM_ERR_ARG, "simulation %s: all %lld steps are taken",
             fcm_scene_name(S->scene), S->num_steps);
+  /* room for the log row first: a step that is taken is also logged */
+  FCM_TRY(S->ctx,
+          fcm__sim_grow(S->ctx, (void **)&S->log, &S->log_cap, S->log_n + 1, sizeof *S->log));
   double t0 = fcm_wtime();
   st = fcm_integrator_step(S->integ, &si);
   double wall = fcm_wtime() - t0;
@@ -543,8 +546,6 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
     goto cleanup;
   }
   S->c.steps++;
-  FCM_TRY(S->ctx,
-          fcm__sim_grow(S->ctx, (void **)&S->log, &S->log_cap, S->log_n + 1, sizeof *S->log));
   fcm__log_row *r = &S->log[S->log_n++];
   r->time = si.time;
   r->newton = si.newton_iterations;
@@ -638,6 +639,9 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
       S->node_v[3 * a + d] = dof >= 0 ? v[dof + d] : 0.0;
     }
   }
+  /* room for the frame time first: a frame that is written is also counted */
+  FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&S->frame_time, &S->frame_cap, S->c.frames + 1,
+                             sizeof *S->frame_time));
   FCM_TRY(ctx, fcm_vtu_create(ctx, &vtu));
   if (out->write_background) {
     fcm_index nc = fcm_mesh_num_cells(S->mesh);
@@ -666,8 +670,6 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
     if (!S->pvd_surf) FCM_TRY(ctx, open_pvd(S, dir, "surface", &S->pvd_surf));
     FCM_TRY(ctx, fcm_pvd_add(S->pvd_surf, time, path));
   }
-  FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&S->frame_time, &S->frame_cap, S->c.frames + 1,
-                             sizeof *S->frame_time));
   S->frame_time[S->c.frames++] = time;
   S->c.time_output += fcm_wtime() - t0;
 cleanup:

@@ -728,46 +728,18 @@ cleanup:
   return st;
 }
 
-/* Thread-safe text of a system error (the XSI strerror_r). */
-static void sys_error(int err, char *buf, size_t len)
-{
-  if (strerror_r(err, buf, len) != 0) snprintf(buf, len, "system error %d", err);
-}
-
 fcm_status fcm_scene_create_from_file(fcm_ctx *ctx, const char *path, fcm_scene **scene)
 {
   fcm_status st = FCM_OK;
-  FILE *f = NULL;
-  char *text = NULL, err[128];
-  size_t cap = 0, len = 0;
+  char *text = NULL;
+  size_t len = 0;
   FCM_CHECK(scene, ctx, FCM_ERR_ARG, "scene: output pointer is NULL");
   *scene = NULL;
   FCM_CHECK(ctx && path, ctx, FCM_ERR_ARG, "scene: %s is NULL", ctx ? "path" : "ctx");
-  f = fopen(path, "rb");
-  if (!f) {
-    sys_error(errno, err, sizeof err);
-    FCM_CHECK(0, ctx, FCM_ERR_IO, "%s: cannot open the scene file: %s", path, err);
-  }
-  for (;;) {
-    if (len + 1 >= cap) {
-      size_t ncap = cap ? 2 * cap : 4096;
-      FCM_CHECK(ncap > cap && ncap <= ((size_t)1 << 30), ctx, FCM_ERR_IO,
-                "%s: scene file larger than 1 GiB", path);
-      FCM_TRY(ctx, fcm__resize(ctx, (void **)&text, cap, ncap, 1));
-      cap = ncap;
-    }
-    size_t got = fread(text + len, 1, cap - 1 - len, f);
-    len += got;
-    if (got == 0) break;
-  }
-  if (ferror(f)) {
-    sys_error(errno, err, sizeof err);
-    FCM_CHECK(0, ctx, FCM_ERR_IO, "%s: cannot read the scene file: %s", path, err);
-  }
-  text[len] = '\0';
+  /* regular files only, up to 1 GiB (a device or pipe is refused, not read) */
+  FCM_TRY(ctx, fcm__file_read_all(ctx, "scene", path, (size_t)1 << 30, &text, &len));
   FCM_TRY(ctx, create(ctx, text, len, path, scene));
 cleanup:
-  if (f) fclose(f);
   fcm__free(ctx, text);
   return st;
 }
