@@ -114,8 +114,8 @@ static fcm_status system_build(fcm_ctx *ctx, const config *c, fcm_mesh *mesh, do
   TRY(fcm_assemble_hyperelastic(s->space, &mp, u, NULL, NULL, NULL, K));
   fcm_index nnz;
   fcm_csr_get_size(s->A, NULL, NULL, &nnz);
-  double *av = fcm_csr_get_values(s->A);
-  const double *kv = fcm_csr_get_values(K);
+  double *av = fcm_csr_values(s->A);
+  const double *kv = fcm_csr_values(K);
   for (fcm_index p = 0; p < nnz; p++)
     av[p] += c->dt * c->dt * kv[p];
 
@@ -138,8 +138,8 @@ static fcm_status system_build(fcm_ctx *ctx, const config *c, fcm_mesh *mesh, do
   s->n = 0;
   for (fcm_index i = 0; i < nd; i++)
     s->map[i] = s->map[i] < 0 ? -1 : s->n++;
-  const fcm_index *arp = fcm_csr_get_row_ptr(s->A);
-  const int *aci = fcm_csr_get_col_idx(s->A);
+  const fcm_index *arp = fcm_csr_row_ptr(s->A);
+  const int *aci = fcm_csr_col_idx(s->A);
   if (!(rp = malloc(sizeof *rp * (size_t)(s->n + 1))) || !(ci = malloc(sizeof *ci * (size_t)nnz))) {
     st = alloc_fail(ctx);
     goto done;
@@ -153,7 +153,7 @@ static fcm_status system_build(fcm_ctx *ctx, const config *c, fcm_mesh *mesh, do
     rp[s->map[i] + 1] = q;
   }
   TRY(fcm_csr_create(ctx, s->n, s->n, rp, ci, FCM_CSR_SYMMETRIC, &s->Af));
-  double *fv = fcm_csr_get_values(s->Af);
+  double *fv = fcm_csr_values(s->Af);
   q = 0;
   for (fcm_index i = 0; i < nd; i++) {
     if (s->map[i] < 0) continue;
@@ -338,9 +338,9 @@ fcm_status condition_run_case(fcm_ctx *ctx, const config *c, fcm_mesh *mesh, dou
     goto done;
   }
   {
-    const fcm_index *rp = fcm_csr_get_row_ptr(s.Af);
-    const int *ci = fcm_csr_get_col_idx(s.Af);
-    const double *v = fcm_csr_get_values(s.Af);
+    const fcm_index *rp = fcm_csr_row_ptr(s.Af);
+    const int *ci = fcm_csr_col_idx(s.Af);
+    const double *v = fcm_csr_values(s.Af);
     for (fcm_index i = 0; i < n; i++)
       for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
         Ad[i + (size_t)ci[p] * n] = v[p];

@@ -364,7 +364,7 @@ static fcm_status staircase_traction(const cv_study *S, const fcm_space *space,
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = S->ctx;
   const fcm_mesh *mesh = fcm_space_mesh(space);
-  const fcm_element_info *info = fcm_mesh_element_info(mesh);
+  const fcm_element_info *info = fcm_mesh_get_element_info(mesh);
   const fcm_element_type type = info->type;
   const int nn = info->num_nodes, nf = info->num_faces;
   const fcm_index nc = fcm_mesh_num_cells(mesh), *nb = fcm_mesh_neighbors(mesh);
@@ -571,7 +571,7 @@ static fcm_status direct_solve(fcm_ctx *ctx, fcm_csr *A, const double *b, double
   fcm_direct *solver = NULL;
   fcm_status st = fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, A, &solver);
   if (st == FCM_OK) st = fcm_direct_analyze(solver);
-  if (st == FCM_OK) st = fcm_direct_factor(solver, fcm_csr_get_values(A));
+  if (st == FCM_OK) st = fcm_direct_factor(solver, fcm_csr_values(A));
   if (st == FCM_OK) st = fcm_direct_solve(solver, b, u);
   fcm_direct_destroy(&solver);
   return st;
@@ -749,7 +749,7 @@ fcm_status cv_error_rules_create(cv_study *S, const fcm_mesh *mesh, fcm_cell_rul
 static fcm_status staircase_cells(const cv_study *S, const fcm_mesh *mesh, unsigned char *keep,
                                   fcm_index *nkeep)
 {
-  const fcm_element_info *info = fcm_mesh_element_info(mesh);
+  const fcm_element_info *info = fcm_mesh_get_element_info(mesh);
   const fcm_index nc = fcm_mesh_num_cells(mesh), *cn = fcm_mesh_cells(mesh);
   const double *X = fcm_mesh_coords(mesh);
   const int nn = info->num_nodes, ncorn = info->num_corners;
@@ -772,7 +772,7 @@ static int cell_errors(const cv_study *S, const fcm_space *space, const fcm_cell
                        fcm_index c, fcm_index e, const double *u, double acc[5])
 {
   const fcm_mesh *mesh = fcm_space_mesh(space);
-  const fcm_element_info *info = fcm_mesh_element_info(mesh);
+  const fcm_element_info *info = fcm_mesh_get_element_info(mesh);
   const fcm_element_type type = info->type;
   const int nn = info->num_nodes;
   const fcm_index *cn = fcm_mesh_cells(mesh) + (size_t)nn * e;
@@ -830,7 +830,7 @@ static fcm_status errors(const cv_study *S, const fcm_space *space, const fcm_ce
 {
   const fcm_mesh *mesh = fcm_space_mesh(space);
   const fcm_index nc = fcm_mesh_num_cells(mesh), *nb = fcm_mesh_neighbors(mesh);
-  const int nf = fcm_mesh_element_info(mesh)->num_faces;
+  const int nf = fcm_mesh_get_element_info(mesh)->num_faces;
   double *acc = calloc(5 * (size_t)nc, sizeof *acc);
   int bad = 0;
   if (!acc) return FCM_ERR_ALLOC;
@@ -868,7 +868,7 @@ fcm_status cv_run(cv_study *S, const fcm_mesh *mesh, const fcm_cell_rules *err_r
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = S->ctx;
-  const fcm_element_info *info = fcm_mesh_element_info(mesh);
+  const fcm_element_info *info = fcm_mesh_get_element_info(mesh);
   fcm_cell_rules *rules = NULL;
   fcm_space *space = NULL;
   fcm_csr *K = NULL;
@@ -915,7 +915,7 @@ fcm_status cv_run(cv_study *S, const fcm_mesh *mesh, const fcm_cell_rules *err_r
     if (st != FCM_OK) goto done;
     t0 = stamp_lap(t0, &r->t_rules, &r->c_rules);
     fcm_rule *std_rule = NULL;
-    st = fcm_element_standard_rule(ctx, info->type, FCM_RULE_STIFFNESS, 0, &std_rule);
+    st = fcm_element_standard_rule(ctx, info->type, FCM_RULE_STIFFNESS, FCM_DEFAULT, &std_rule);
     if (st != FCM_OK) goto done;
     r->points = nkeep * fcm_rule_num_points(std_rule);
     r->strength = fcm_rule_strength(std_rule);

@@ -668,7 +668,7 @@ static fcm_status payoff_variant(fcm_ctx *ctx, const config *c, const fcm_mesh *
     st = fcm_assemble_hyperelastic(space, &mp, u, NULL, NULL, g, A);
     if (st == FCM_OK) st = fcm_space_apply_dirichlet(space, ncon, con, zero, A, g);
     const double t1 = fcm_wtime();
-    if (st == FCM_OK) st = fcm_direct_factor(chol, fcm_csr_get_values(A));
+    if (st == FCM_OK) st = fcm_direct_factor(chol, fcm_csr_values(A));
     if (st == FCM_OK) st = fcm_direct_solve(chol, g, du);
     const double t2 = fcm_wtime();
     ta[r] = t1 - t0, tf[r] = t2 - t1, ti[r] = t2 - t0;

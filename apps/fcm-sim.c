@@ -199,7 +199,8 @@ static int scene_main(int argc, char **argv)
   if (fcm_scene_get_solver(scene)->threads > 0) /* every OpenMP loop of the run */
     omp_set_num_threads(fcm_scene_get_solver(scene)->threads);
   fcm_simulation_options so = fcm_simulation_options_default();
-  so.max_steps = o.check ? (o.steps > 0 && o.steps < 3 ? o.steps : 3) : o.steps;
+  so.max_steps = o.check ? (o.steps > 0 && o.steps < 3 ? o.steps : 3)
+                         : (o.steps > 0 ? o.steps : FCM_DEFAULT);
   so.checkpoint_interval = o.check ? 0 : o.checkpoint_every;
   const char *name = fcm_scene_name(scene);
   if (!o.quiet)

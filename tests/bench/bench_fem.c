@@ -62,7 +62,7 @@ int main(int argc, char **argv)
     fcm_direct_info di;
     TEST_OK(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, K, &solver));
     TEST_OK(ctx, fcm_direct_analyze(solver));
-    TEST_OK(ctx, fcm_direct_factor(solver, fcm_csr_get_values(K)));
+    TEST_OK(ctx, fcm_direct_factor(solver, fcm_csr_values(K)));
     TEST_OK(ctx, fcm_direct_solve(solver, f, u));
     fcm_direct_get_info(solver, &di);
     TEST_OK(ctx, fcm_csr_apply(K, 1.0, u, 0.0, r));

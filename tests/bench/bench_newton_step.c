@@ -239,8 +239,8 @@ int main(int argc, char **argv)
   }
   stamp t_bc = FAR;
   t0 = now();
-  double *av = fcm_csr_get_values(A);
-  const double *kv = fcm_csr_get_values(K);
+  double *av = fcm_csr_values(A);
+  const double *kv = fcm_csr_values(K);
   for (fcm_index p = 0; p < nnz; p++) av[p] += dt * dt * kv[p];
   for (fcm_index i = 0; i < n; i++) b[i] = -dt * dt * (fint[i] - fext[i]);
   const double plo[3] = {-HUGE_VAL, -8, -HUGE_VAL}, phi[3] = {HUGE_VAL, -8, HUGE_VAL};

@@ -54,7 +54,7 @@ int main(void)
 
   /* Custom allocator: every allocation goes through it, live count tracks it. */
   counting c = {0, 0, -1};
-  logbook book = {0, FCM_LOG_DEBUG, ""};
+  logbook book = {0, FCM_LOG_WARNING, ""};
   fcm_ctx_options o = fcm_ctx_options_default();
   o.allocator.alloc = count_alloc;
   o.allocator.release = count_release;
@@ -93,11 +93,27 @@ int main(void)
 
   /* Logging: levels above the threshold are filtered; errors are logged. */
   int before = book.lines;
-  fcm__log(ctx, FCM_LOG_DEBUG, "hidden %d", 1);
-  TEST_TRUE(book.lines == before);
-  fcm__log(ctx, FCM_LOG_INFO, "shown %d", 2);
-  TEST_TRUE(book.lines == before + 1 && !strcmp(book.text, "shown 2"));
+  fcm__log(ctx, FCM_LOG_INFO, "shown %d", 1);
+  TEST_TRUE(book.lines == before + 1 && !strcmp(book.text, "shown 1"));
   TEST_TRUE(book.last == FCM_LOG_INFO);
+  before = book.lines;
+  fcm__log(ctx, FCM_LOG_WARNING, "shown %d", 2);
+  TEST_TRUE(book.lines == before + 1 && !strcmp(book.text, "shown 2"));
+  TEST_TRUE(book.last == FCM_LOG_WARNING);
+  {
+    fcm_ctx *quiet = NULL;
+    fcm_ctx_options q = o;
+    q.allocator = fcm_ctx_options_default().allocator;
+    q.log_level = FCM_LOG_ERROR; /* warnings filtered, errors still logged */
+    TEST_OK(quiet, fcm_ctx_create(&q, &quiet));
+    before = book.lines;
+    fcm__log(quiet, FCM_LOG_WARNING, "hidden %d", 1);
+    fcm__log(quiet, FCM_LOG_INFO, "hidden %d", 2);
+    TEST_TRUE(book.lines == before);
+    fcm__log(quiet, FCM_LOG_ERROR, "shown %d", 3);
+    TEST_TRUE(book.lines == before + 1 && !strcmp(book.text, "shown 3"));
+    fcm_ctx_destroy(&quiet);
+  }
 
   /* Index narrowing. */
   int n = -1;

@@ -46,8 +46,10 @@ static void arguments(fcm_ctx *ctx)
   o.clip_rtol = -1e-12;
   TEST_ERR(ctx, fcm_cell_rules_create(ctx, box, g, &o, &r), FCM_ERR_ARG, "clip_rtol = -1e-12");
   o = fcm_cell_rules_options_default();
-  o.num_threads = -1;
-  TEST_ERR(ctx, fcm_cell_rules_create(ctx, box, g, &o, &r), FCM_ERR_ARG, "num_threads = -1");
+  o.num_threads = 0; /* FCM_DEFAULT (-1) is the OpenMP default; 0 threads means nothing */
+  TEST_ERR(ctx, fcm_cell_rules_create(ctx, box, g, &o, &r), FCM_ERR_ARG, "num_threads = 0");
+  o.num_threads = -2;
+  TEST_ERR(ctx, fcm_cell_rules_create(ctx, box, g, &o, &r), FCM_ERR_ARG, "num_threads = -2");
   o = fcm_cell_rules_options_default();
   o.stabilization.alpha = 0.0;
   TEST_ERR(ctx, fcm_cell_rules_create(ctx, box, g, &o, &r), FCM_ERR_ARG, "alpha = 0");

@@ -31,7 +31,7 @@ static void stabilization_and_classes(const fcm_mesh *m, const fcm_geometry *g)
   for (int mode = 0; mode < FCM_STABILIZATION_MODE_COUNT; mode++) {
     /* Simplified in the default mode only (the LPs dominate the time). */
     const int simplified = mode == FCM_STABILIZATION_MASS_STIFFNESS;
-    fcm_cell_rules *r = build(m, g, (fcm_stabilization_mode)mode, simplified, 0);
+    fcm_cell_rules *r = build(m, g, (fcm_stabilization_mode)mode, simplified, FCM_DEFAULT);
     if (!r) return;
     TEST_TRUE(fcm_cell_rules_strength(r, FCM_RULE_STIFFNESS) == info->stiffness_strength);
     TEST_TRUE(fcm_cell_rules_strength(r, FCM_RULE_MASS) == info->mass_strength);
@@ -94,7 +94,7 @@ static void stabilization_and_classes(const fcm_mesh *m, const fcm_geometry *g)
 
 static void dump(const fcm_mesh *m, const fcm_geometry *g)
 {
-  fcm_cell_rules *r = build(m, g, FCM_STABILIZATION_MASS_STIFFNESS, 0, 0);
+  fcm_cell_rules *r = build(m, g, FCM_STABILIZATION_MASS_STIFFNESS, 0, FCM_DEFAULT);
   if (!r) return;
   FILE *f = tmpfile();
   TEST_TRUE(f != NULL);

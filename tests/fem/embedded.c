@@ -59,9 +59,9 @@ int main(int argc, char **argv)
   int ni = (int)n;
   if (ni <= 1500) {
     double *dense = calloc((size_t)ni * ni, sizeof *dense), *ev = calloc((size_t)ni, sizeof *ev);
-    const fcm_index *rp = fcm_csr_get_row_ptr(K);
-    const int *ci = fcm_csr_get_col_idx(K);
-    const double *v = fcm_csr_get_values(K);
+    const fcm_index *rp = fcm_csr_row_ptr(K);
+    const int *ci = fcm_csr_col_idx(K);
+    const double *v = fcm_csr_values(K);
     for (int i = 0; i < ni; i++)
       for (fcm_index e = rp[i]; e < rp[i + 1]; e++) dense[i + (size_t)ci[e] * ni] = v[e];
     TEST_OK(ctx, fcm__syev(ctx, 0, ni, dense, ni, ev));

@@ -28,7 +28,7 @@ static inline fcm_status distorted_box(fcm_ctx *ctx, fcm_element_type type, fcm_
     return st;
   }
   fcm_index nn = fcm_mesh_num_nodes(box), nc = fcm_mesh_num_cells(box);
-  const fcm_element_info *info = fcm_mesh_element_info(box);
+  const fcm_element_info *info = fcm_mesh_get_element_info(box);
   int npc = info->num_nodes;
   double *X = malloc(sizeof *X * 3 * (size_t)nn);
   unsigned char *corner = calloc((size_t)nn, 1);
@@ -66,7 +66,7 @@ static inline fcm_status direct_solve(fcm_ctx *ctx, fcm_csr *A, const double *b,
   fcm_direct *solver = NULL;
   fcm_status st = fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, A, &solver);
   if (st == FCM_OK) st = fcm_direct_analyze(solver);
-  if (st == FCM_OK) st = fcm_direct_factor(solver, fcm_csr_get_values(A));
+  if (st == FCM_OK) st = fcm_direct_factor(solver, fcm_csr_values(A));
   if (st == FCM_OK) st = fcm_direct_solve(solver, b, u);
   fcm_direct_destroy(&solver);
   return st;

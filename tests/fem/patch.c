@@ -59,7 +59,7 @@ int main(int argc, char **argv)
   TEST_NEAR(maxerr, 0.0, 0.0, 1e-12);
 
   /* The displacement gradient is the constant matrix at sample points of every cell. */
-  const fcm_element_info *info = fcm_mesh_element_info(mesh);
+  const fcm_element_info *info = fcm_mesh_get_element_info(mesh);
   double Xc[3 * FCM_ELEMENT_MAX_NODES], dN[3 * FCM_ELEMENT_MAX_NODES];
   double maxgrad = 0.0;
   const double xi[3] = {0.2, 0.15, info->shape == FCM_SHAPE_TET ? 0.3 : -0.4};

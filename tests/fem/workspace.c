@@ -95,9 +95,9 @@ int main(int argc, char **argv)
   TEST_OK(ctx, fcm_assemble_body_force(space, &el, g, NULL, f1));
   TEST_OK(ctx, fcm_assemble_body_force_field(space, gravity_field, NULL, NULL, f1));
   TEST_OK(ctx, fcm_assemble_hyperelastic(space, &p, u, NULL, &E1, fint1, T1));
-  TEST_TRUE(same(fcm_csr_get_values_read(K), fcm_csr_get_values_read(K1), nnz));
-  TEST_TRUE(same(fcm_csr_get_values_read(M), fcm_csr_get_values_read(M1), nnz));
-  TEST_TRUE(same(fcm_csr_get_values_read(T), fcm_csr_get_values_read(T1), nnz));
+  TEST_TRUE(same(fcm_csr_values_read(K), fcm_csr_values_read(K1), nnz));
+  TEST_TRUE(same(fcm_csr_values_read(M), fcm_csr_values_read(M1), nnz));
+  TEST_TRUE(same(fcm_csr_values_read(T), fcm_csr_values_read(T1), nnz));
   TEST_TRUE(same(f, f1, n));
   TEST_TRUE(same(fint, fint1, n));
   TEST_TRUE(E == E1 && E != 0.0);

@@ -8,3 +8,4 @@ fcm_add_test(geom_errors tests/geom/errors.c)
 fcm_add_test(geom_reader_limits tests/geom/reader_limits.c)
 # Allocation failures: geometry from arrays and Gmsh files, AABB tree build and query.
 fcm_add_test(geom_alloc_failure tests/geom/alloc_failure.c)
+fcm_add_test(geom_boundary_cells tests/geom/boundary_cells.c)

@@ -43,24 +43,24 @@ static void test_small(fcm_ctx *ctx, rng *r)
   fcm_csr_get_size(A, &nr, &nc, &nnz);
   TEST_TRUE(nr == M && nc == N && nnz <= T && nnz > 0);
   TEST_TRUE(fcm_csr_get_kind(A) == FCM_CSR_GENERAL);
-  const fcm_index *rp = fcm_csr_get_row_ptr(A);
-  const int *ci = fcm_csr_get_col_idx(A);
-  double *v = fcm_csr_get_values(A);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  double *v = fcm_csr_values(A);
   /* Every stored entry equals the dense sum; every dense non-zero is stored. */
   fcm_index stored = 0;
   for (int i = 0; i < M; i++)
     for (fcm_index p = rp[i]; p < rp[i + 1]; p++) {
       TEST_TRUE(p == rp[i] || ci[p] > ci[p - 1]);
       TEST_NEAR(v[p], dense[i][ci[p]], 0.0, 1e-15);
-      TEST_TRUE(fcm_csr_get_position(A, i, ci[p]) == p);
+      TEST_TRUE(fcm_csr_position(A, i, ci[p]) == p);
       stored++;
     }
   for (int i = 0; i < M; i++)
     for (int j = 0; j < N; j++)
-      if (dense[i][j] != 0.0) TEST_TRUE(fcm_csr_get_position(A, i, j) >= 0);
+      if (dense[i][j] != 0.0) TEST_TRUE(fcm_csr_position(A, i, j) >= 0);
   TEST_TRUE(stored == nnz);
-  TEST_TRUE(fcm_csr_get_position(A, -1, 0) == -1 && fcm_csr_get_position(A, M, 0) == -1);
-  TEST_TRUE(fcm_csr_get_position(A, 0, N) == -1);
+  TEST_TRUE(fcm_csr_position(A, -1, 0) == -1 && fcm_csr_position(A, M, 0) == -1);
+  TEST_TRUE(fcm_csr_position(A, 0, N) == -1);
 
   /* y = 0.5 A x - 2 y, and beta = 0 ignores a NaN-filled y. */
   double x[N], y[M], yref[M];
@@ -87,7 +87,7 @@ static void test_small(fcm_ctx *ctx, rng *r)
   }
   TEST_ERR(ctx, fcm_csr_apply(A, 1.0, NULL, 0.0, y), FCM_ERR_ARG, "x or y is NULL");
   double asym;
-  TEST_ERR(ctx, fcm_csr_get_asymmetry(A, &asym), FCM_ERR_ARG, "9 x 7, not square");
+  TEST_ERR(ctx, fcm_csr_asymmetry(A, &asym), FCM_ERR_ARG, "9 x 7, not square");
 
   /* Same matrix around the caller's arrays (borrowed): same product, values shared. */
   fcm_index rp2[M + 1];
@@ -99,7 +99,7 @@ static void test_small(fcm_ctx *ctx, rng *r)
     ci2[p] = ci[p], v2[p] = v[p];
   fcm_csr *W = NULL;
   TEST_OK(ctx, fcm_csr_wrap(ctx, M, N, rp2, ci2, v2, FCM_CSR_GENERAL, &W));
-  TEST_TRUE(fcm_csr_get_values(W) == v2 && fcm_csr_get_col_idx(W) == ci2);
+  TEST_TRUE(fcm_csr_values(W) == v2 && fcm_csr_col_idx(W) == ci2);
   double yw[M];
   TEST_OK(ctx, fcm_csr_apply(W, 1.0, x, 0.0, yw));
   for (int i = 0; i < M; i++)
@@ -184,15 +184,15 @@ static void test_large(fcm_ctx *ctx, rng *r)
   fcm_csr_get_size(A, NULL, NULL, &nnz);
   TEST_TRUE(nnz == nt && nnz >= 32768);
   double asym = -1.0;
-  TEST_OK(ctx, fcm_csr_get_asymmetry(A, &asym));
+  TEST_OK(ctx, fcm_csr_asymmetry(A, &asym));
   TEST_TRUE(asym == 0.0);
   double *x = malloc((size_t)n * sizeof *x), *y = malloc((size_t)n * sizeof *y);
   double *yref = malloc((size_t)n * sizeof *yref);
   for (fcm_index i = 0; i < n; i++)
     x[i] = rng_uniform(r), y[i] = yref[i] = rng_uniform(r);
-  const fcm_index *rp = fcm_csr_get_row_ptr(A);
-  const int *ci = fcm_csr_get_col_idx(A);
-  const double *v = fcm_csr_get_values(A);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const double *v = fcm_csr_values(A);
   for (fcm_index i = 0; i < n; i++) {
     double s = 0.0;
     for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
@@ -210,11 +210,11 @@ static void test_large(fcm_ctx *ctx, rng *r)
   TEST_OK(ctx, fcm_csr_apply(A, 1.0, x, 0.0, y));
   TEST_TRUE(y[0] == 3.0 && y[15 + g * (15 + g * 15)] == 0.0);
   /* A perturbed mirror entry shows in the asymmetry. */
-  double *vw = fcm_csr_get_values(A);
-  fcm_index p01 = fcm_csr_get_position(A, 0, 1);
+  double *vw = fcm_csr_values(A);
+  fcm_index p01 = fcm_csr_position(A, 0, 1);
   TEST_TRUE(p01 >= 0);
   vw[p01] = -1.5;
-  TEST_OK(ctx, fcm_csr_get_asymmetry(A, &asym));
+  TEST_OK(ctx, fcm_csr_asymmetry(A, &asym));
   TEST_NEAR(asym, 0.5 / 6.0, 1e-15, 0.0);
   fcm_csr_destroy(&A);
   free(ti), free(tj), free(tv), free(x), free(y), free(yref);
@@ -235,7 +235,7 @@ static void test_alloc(void)
     f.fail_at = -1;
     if (st == FCM_OK) {
       ok = 1;
-      TEST_TRUE(fcm_csr_get_values(A)[fcm_csr_get_position(A, 0, 1)] == 5.0);
+      TEST_TRUE(fcm_csr_values(A)[fcm_csr_position(A, 0, 1)] == 5.0);
       fcm_csr_destroy(&A);
     } else {
       failures++;

@@ -67,11 +67,11 @@ static void test_spd(fcm_ctx *ctx, rng *r)
   fcm_direct *s = NULL;
   fcm_direct_info info;
   TEST_OK(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, A, &s));
-  TEST_ERR(ctx, fcm_direct_factor(s, fcm_csr_get_values(A)), FCM_ERR_ARG, "not analyzed");
+  TEST_ERR(ctx, fcm_direct_factor(s, fcm_csr_values(A)), FCM_ERR_ARG, "not analyzed");
   TEST_ERR(ctx, fcm_direct_solve(s, b, x), FCM_ERR_ARG, "no valid factorization");
   TEST_OK(ctx, fcm_direct_analyze(s));
   TEST_OK(ctx, fcm_direct_analyze(s)); /* no-op */
-  TEST_OK(ctx, fcm_direct_factor(s, fcm_csr_get_values(A)));
+  TEST_OK(ctx, fcm_direct_factor(s, fcm_csr_values(A)));
   TEST_OK(ctx, fcm_direct_solve(s, b, x));
   TEST_TRUE(rel_residual(A, x, b) <= 1e-10);
   fcm_direct_get_info(s, &info);
@@ -79,9 +79,9 @@ static void test_spd(fcm_ctx *ctx, rng *r)
   TEST_TRUE(info.rcond > 0.0 && info.rcond <= 1.0);
 
   /* New values, same pattern: A' = 2 A + I. The analysis is reused. */
-  double *v = fcm_csr_get_values(A);
-  const fcm_index *rp = fcm_csr_get_row_ptr(A);
-  const int *ci = fcm_csr_get_col_idx(A);
+  double *v = fcm_csr_values(A);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
   for (fcm_index i = 0; i < n; i++)
     for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
       v[p] = 2.0 * v[p] + (ci[p] == i ? 1.0 : 0.0);
@@ -104,7 +104,7 @@ static void test_spd(fcm_ctx *ctx, rng *r)
 
   /* Indefinite: shift the diagonal by -10.1 (the spectrum of 2A+I lies in (1, 25)). */
   for (fcm_index i = 0; i < n; i++)
-    v[fcm_csr_get_position(A, i, i)] -= 10.1;
+    v[fcm_csr_position(A, i, i)] -= 10.1;
   TEST_ERR(ctx, fcm_direct_factor(s, v), FCM_ERR_SINGULAR,
            "not positive definite (pivot of column");
   fcm_direct_get_info(s, &info);
@@ -123,7 +123,7 @@ static void test_spd(fcm_ctx *ctx, rng *r)
 
   /* CHOLMOD recovers with positive definite values after the failure. */
   for (fcm_index i = 0; i < n; i++)
-    v[fcm_csr_get_position(A, i, i)] += 10.1;
+    v[fcm_csr_position(A, i, i)] += 10.1;
   TEST_OK(ctx, fcm_direct_factor(s, v));
   TEST_OK(ctx, fcm_direct_solve(s, b, x));
   TEST_TRUE(rel_residual(A, x, b) <= 1e-10);
@@ -142,7 +142,7 @@ static void test_unsymmetric(fcm_ctx *ctx, rng *r)
   fcm_index n;
   fcm_csr_get_size(A, &n, NULL, NULL);
   double asym;
-  TEST_OK(ctx, fcm_csr_get_asymmetry(A, &asym));
+  TEST_OK(ctx, fcm_csr_asymmetry(A, &asym));
   TEST_TRUE(asym > 0.1);
   double *b = malloc((size_t)n * sizeof *b), *x = malloc((size_t)n * sizeof *x);
   for (fcm_index i = 0; i < n; i++)
@@ -156,7 +156,7 @@ static void test_unsymmetric(fcm_ctx *ctx, rng *r)
   TEST_OK(ctx, fcm_direct_create(ctx, FCM_DIRECT_UMFPACK, A, &s));
   TEST_OK(ctx, fcm_direct_analyze(s));
   for (int rep = 0; rep < 2; rep++) {
-    TEST_OK(ctx, fcm_direct_factor(s, fcm_csr_get_values(A)));
+    TEST_OK(ctx, fcm_direct_factor(s, fcm_csr_values(A)));
     TEST_OK(ctx, fcm_direct_solve(s, b, x));
     TEST_TRUE(rel_residual(A, x, b) <= 1e-10);
   }
@@ -164,9 +164,9 @@ static void test_unsymmetric(fcm_ctx *ctx, rng *r)
   {
     fcm_index nn = n;
     double *y = malloc((size_t)nn * sizeof *y), d = 0.0;
-    const fcm_index *rp = fcm_csr_get_row_ptr(A);
-    const int *ci = fcm_csr_get_col_idx(A);
-    const double *v = fcm_csr_get_values(A);
+    const fcm_index *rp = fcm_csr_row_ptr(A);
+    const int *ci = fcm_csr_col_idx(A);
+    const double *v = fcm_csr_values(A);
     for (fcm_index i = 0; i < nn; i++)
       y[i] = -b[i];
     for (fcm_index i = 0; i < nn; i++)
@@ -248,7 +248,7 @@ static void test_failed_column(fcm_ctx *ctx)
   TEST_OK(ctx, fcm_csr_create_triplets(ctx, N, N, t, ti, tj, tv, FCM_CSR_SYMMETRIC, &A));
   TEST_OK(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, A, &s));
   TEST_OK(ctx, fcm_direct_analyze(s));
-  TEST_ERR(ctx, fcm_direct_factor(s, fcm_csr_get_values(A)), FCM_ERR_SINGULAR,
+  TEST_ERR(ctx, fcm_direct_factor(s, fcm_csr_values(A)), FCM_ERR_SINGULAR,
            "not positive definite (pivot of column 7, n = 12)");
   fcm_direct_info info;
   fcm_direct_get_info(s, &info);
@@ -283,7 +283,7 @@ static void test_alloc(fcm_direct_method method)
     fcm_direct *s = NULL;
     fcm_status st = fcm_direct_create(ctx, method, A, &s);
     if (st == FCM_OK) st = fcm_direct_analyze(s);
-    if (st == FCM_OK) st = fcm_direct_factor(s, fcm_csr_get_values(A));
+    if (st == FCM_OK) st = fcm_direct_factor(s, fcm_csr_values(A));
     if (st == FCM_OK) st = fcm_direct_solve(s, b, x);
     f.fail_at = -1;
     if (st == FCM_OK) {
@@ -293,7 +293,7 @@ static void test_alloc(fcm_direct_method method)
         TEST_NEAR(x[i], 0.5 * (i + 1) * (N - i), 1e-12, 0.0);
       /* Further factorizations and solves allocate nothing through the ctx. */
       long long before = f.count;
-      TEST_OK(ctx, fcm_direct_factor(s, fcm_csr_get_values(A)));
+      TEST_OK(ctx, fcm_direct_factor(s, fcm_csr_values(A)));
       TEST_OK(ctx, fcm_direct_solve(s, b, x));
       TEST_OK(ctx, fcm_direct_solve(s, x, x));
       TEST_TRUE(f.count == before);

@@ -33,7 +33,7 @@ static void test_two_cubes(fcm_ctx *ctx)
   TEST_TRUE(fcm_mesh_nodes_per_cell(m) == 8);
   TEST_TRUE(fcm_mesh_num_nodes(m) == 12 && fcm_mesh_num_cells(m) == 2);
   TEST_TRUE(fcm_mesh_coords(m)[0] == 0.0 && fcm_mesh_cells(m)[0] == 0);
-  TEST_TRUE(fcm_mesh_element_info(m) == fcm_element_get_info(FCM_ELEMENT_HEX8));
+  TEST_TRUE(fcm_mesh_get_element_info(m) == fcm_element_get_info(FCM_ELEMENT_HEX8));
 
   double X[24];
   fcm_mesh_cell_coords(m, 1, X);
@@ -43,7 +43,7 @@ static void test_two_cubes(fcm_ctx *ctx)
   TEST_NEAR(cell_volume(FCM_ELEMENT_HEX8, X), 1.0, 1e-14, 0);
 
   /* Exactly one face pair is shared: the face of cell 0 at x = 1 and of cell 1 at x = 1. */
-  const fcm_element_info *info = fcm_mesh_element_info(m);
+  const fcm_element_info *info = fcm_mesh_get_element_info(m);
   const fcm_index *nb = fcm_mesh_neighbors(m);
   int shared = 0;
   for (int c = 0; c < 2; c++)

@@ -209,7 +209,7 @@ static void check_defaults(fcm_ctx *ctx)
   TEST_TRUE(so->rtol == 1e-8 && so->atol == 0 && so->max_iterations == 1000);
   TEST_TRUE(so->newton_rtol == 1e-5 && so->newton_max_iterations == 100);
   TEST_TRUE(so->line_search == 1 && so->project_psd == 0);
-  TEST_TRUE(so->representative_acceleration == 9.81 && so->threads == 0);
+  TEST_TRUE(so->representative_acceleration == 9.81 && so->threads == FCM_DEFAULT);
   TEST_TRUE(so->newton_rule == FCM_NEWTON_TOL_AUTO);
   const fcm_scene_time *t = fcm_scene_get_time(s);
   TEST_TRUE(t->integrator == FCM_INTEGRATOR_BACKWARD_EULER && t->dt == 1.0 / 60.0 && t->num_steps == 60 && t->load_steps == 1);

@@ -198,8 +198,8 @@ int main(int argc, char **argv)
     snap.u[0] = NAN;
     TEST_ERR(ctx, fcm_integrator_set_state(integ, snap.u, NULL, 0.0, 0), FCM_ERR_ARG, "u[0]");
     fcm_integrator_destroy(&integ);
-    TEST_TRUE(!strcmp(fcm_step_reason_str(FCM_STEP_LINEAR_SOLVER_FAILED), "linear-solver-failed"));
-    TEST_TRUE(!strcmp(fcm_step_reason_str((fcm_step_reason)99), "unknown"));
+    TEST_TRUE(!strcmp(fcm_step_reason_name(FCM_STEP_LINEAR_SOLVER_FAILED), "linear-solver-failed"));
+    TEST_TRUE(!strcmp(fcm_step_reason_name((fcm_step_reason)99), "unknown"));
   }
 
   free(fix), free(snap.u), free(snap.v);

@@ -135,8 +135,8 @@ static void check_scene(fcm_ctx *ctx, const char *path, const char *file, int st
     TEST_OK(ctx, fcm_simulation_step(m.sim, &im));
     TEST_OK(ctx, fcm_simulation_step(d.sim, &id));
     if (im.reason != FCM_STEP_CONVERGED || id.reason != FCM_STEP_CONVERGED) {
-      TEST_FAIL_("%s step %d: minres %s, direct %s", file, k, fcm_step_reason_str(im.reason),
-                 fcm_step_reason_str(id.reason));
+      TEST_FAIL_("%s step %d: minres %s, direct %s", file, k, fcm_step_reason_name(im.reason),
+                 fcm_step_reason_name(id.reason));
       break;
     }
     if (im.inexact_solves != 0 || im.projection_fallbacks != 0 || im.failed_attempts != 0)

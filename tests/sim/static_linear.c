@@ -39,7 +39,7 @@ static void reference(fcm_ctx *ctx, fcm_space *space, const fcm_material *m, fcm
   TEST_OK(ctx, fcm_space_apply_dirichlet(space, nc, dofs, vals, K, f));
   TEST_OK(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, K, &chol));
   TEST_OK(ctx, fcm_direct_analyze(chol));
-  TEST_OK(ctx, fcm_direct_factor(chol, fcm_csr_get_values(K)));
+  TEST_OK(ctx, fcm_direct_factor(chol, fcm_csr_values(K)));
   TEST_OK(ctx, fcm_direct_solve(chol, f, u));
   fcm_direct_destroy(&chol);
   fcm_csr_destroy(&K);

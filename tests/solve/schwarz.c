@@ -287,7 +287,7 @@ static void check_errors(fcm_ctx *ctx)
   fcm_csr_destroy(&A);
   TEST_OK(ctx, fcm_csr_create_triplets(ctx, 4, 4, 4, ri, ri, d, FCM_CSR_SYMMETRIC, &A));
   TEST_OK(ctx, fcm_schwarz_create(ctx, A, 2, bp2, bd2, NULL, &P));
-  double *vals = fcm_csr_get_values(A), r[4] = {1, 1, 1, 1}, z[4];
+  double *vals = fcm_csr_values(A), r[4] = {1, 1, 1, 1}, z[4];
   vals[1] = NAN;
   TEST_ERR(ctx, fcm_schwarz_setup(P, A), FCM_ERR_NUMERIC,
            "block 0 (2 DOFs, first DOF 0) contains NaN");

@@ -48,8 +48,8 @@ int main(void)
   TEST_OK(ctx, fcm_assemble_stiffness(space, &mat, NULL, K));
   fcm_index nnz;
   fcm_csr_get_size(A, NULL, NULL, &nnz);
-  double *av = fcm_csr_get_values(A);
-  const double *kv = fcm_csr_get_values(K);
+  double *av = fcm_csr_values(A);
+  const double *kv = fcm_csr_values(K);
   for (fcm_index p = 0; p < nnz; p++)
     av[p] += dt * dt * kv[p];
   const double plo[3] = {0, -HUGE_VAL, -HUGE_VAL}, phi[3] = {0, HUGE_VAL, HUGE_VAL};

@@ -44,12 +44,22 @@ typedef enum fcm_status { FCM_STATUS_LIST(FCM_STATUS_ENUM_) FCM_STATUS_COUNT_ } 
 /** Static description of a status code ("invalid argument", ...); never NULL. */
 FCM_API const char *fcm_status_str(fcm_status st);
 
-/** Severity of a log message passed to the log callback. */
+/** The one "use the default" value of option members (and of the parameters documented so):
+ * a member set to FCM_DEFAULT takes the default documented on it, which is computed where
+ * it depends on the problem (element strengths, OpenMP threads, gravity, the scene).
+ * fcm_x_options_default() stores FCM_DEFAULT in such members and the fixed number in the
+ * others; 0 always keeps its literal meaning (a strength-0 rule, never, none). */
+#define FCM_DEFAULT (-1)
+
+/** Severity of a log message passed to the log callback: ERROR for every recorded error
+ * (with its message), WARNING for counted fallbacks that change how a result is computed
+ * (a simplification that keeps the input rule, CHOLMOD -> UMFPACK), INFO for housekeeping
+ * the caller did not ask for (stale temporary files of dead processes removed). The library
+ * emits nothing else, so there is no lower level. */
 typedef enum fcm_log_level {
   FCM_LOG_ERROR = 0,
   FCM_LOG_WARNING = 1,
-  FCM_LOG_INFO = 2,
-  FCM_LOG_DEBUG = 3
+  FCM_LOG_INFO = 2
 } fcm_log_level;
 
 /** Log callback: `msg` is a complete line without the trailing newline. */
@@ -68,7 +78,8 @@ typedef struct fcm_ctx_options {
   fcm_allocator allocator; /**< all-NULL members: malloc/free */
   fcm_log_fn log;          /**< NULL: the library stays silent */
   void *log_user;          /**< passed to `log` */
-  fcm_log_level log_level; /**< messages above this level are not formatted */
+  fcm_log_level log_level; /**< messages above this level are not formatted (default
+                                WARNING: errors and warnings) */
 } fcm_ctx_options;
 
 /** The root object: allocator, log callback, last error. No global state exists

@@ -35,8 +35,9 @@ typedef enum fcm_rule_kind {
 
 /** Options of fcm_cell_rules_create(); initialize with fcm_cell_rules_options_default(). */
 typedef struct fcm_cell_rules_options {
-  int strength[FCM_RULE_KIND_COUNT]; /**< per kind; -1 (default): the element's default */
-  int surface_strength;  /**< -1 (default): no surface rules; else the triangle rule strength */
+  int strength[FCM_RULE_KIND_COUNT]; /**< per kind; FCM_DEFAULT (default): the element's */
+  int surface_strength;  /**< FCM_DEFAULT (default): no surface rules; else the triangle rule
+                              strength */
   double min_fraction;   /**< phi below this: dropped; default 1e-4 (0: drop only empty cells) */
   double uncut_fraction; /**< phi at or above this: uncut; default 1 - 1e-12 */
   double clip_rtol;   /**< vertex-on-plane tolerance / the smaller of the cell diameter and the
@@ -53,7 +54,7 @@ typedef struct fcm_cell_rules_options {
                                with FCM_ERR_UNSUPPORTED naming the cell, the estimate and the
                                limit; default 4 GiB; 0: no limit */
   fcm_stabilization_options stabilization; /**< default mass + stiffness, alpha 1e-6 */
-  int num_threads;                         /**< OpenMP threads; 0 (default): the OpenMP default */
+  int num_threads; /**< OpenMP threads >= 1; FCM_DEFAULT (default): the OpenMP default */
 } fcm_cell_rules_options;
 
 /** Defaults as documented on each member. */

@@ -105,7 +105,7 @@ FCM_API fcm_status fcm_space_cell_blocks(const fcm_space *space, const unsigned 
                                          fcm_index *num_blocks, fcm_index *num_dofs,
                                          fcm_index *block_ptr, fcm_index *block_dofs);
 
-/** Quadrature strengths for assembly on full cells; 0 selects the default rule of
+/** Quadrature strengths for assembly on full cells; FCM_DEFAULT selects the default rule of
  * fcm_element_standard_rule(). */
 typedef struct fcm_assembly_options {
   int stiffness_strength; /**< stiffness and body force */
@@ -116,21 +116,23 @@ typedef struct fcm_assembly_options {
 /** The rule used on uncut (full) cells of `type` for the integral of `kind`
  * (FCM_RULE_STIFFNESS: gradients times gradients, also body force; FCM_RULE_MASS: shape
  * functions times shape functions).
- * strength <= 0 selects the default: for tetrahedra the catalogue rule
+ * strength FCM_DEFAULT selects the default: for tetrahedra the catalogue rule
  * (fcm_rule_create) of the element's stiffness_strength or mass_strength; for
  * hexahedra the Gauss-Legendre tensor rule with order+1 points per direction
  * (2^3 for Hex8, 3^3 for Hex20), which integrates both the stiffness and the mass
  * of an affine cell exactly and keeps the patch test exact on distorted cells —
  * total-degree rules of the element strengths do neither (the Hex20 stiffness
  * integrand has total degree 6 but degree 4 per direction).
- * strength > 0 selects the catalogue rule of that strength for either shape.
- * @return FCM_OK, FCM_ERR_ARG (invalid type or kind, strength > FCM_RULE_MAX_STRENGTH), FCM_ERR_ALLOC.
+ * strength in [0, FCM_RULE_MAX_STRENGTH] selects the catalogue rule of that strength for
+ * either shape.
+ * @return FCM_OK, FCM_ERR_ARG (invalid type or kind, strength outside
+ * [0, FCM_RULE_MAX_STRENGTH] and not FCM_DEFAULT), FCM_ERR_ALLOC.
  * Allocates *rule; release with fcm_rule_destroy(). Thread safe. */
 FCM_API fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type,
                                              fcm_rule_kind kind, int strength,
                                              fcm_rule **rule);
 
-/** Defaults: both strengths 0 (element defaults), fictitious FCM_FICTITIOUS_PROJECTED. */
+/** Defaults: both strengths FCM_DEFAULT (element defaults), fictitious FCM_FICTITIOUS_PROJECTED. */
 FCM_API fcm_assembly_options fcm_assembly_options_default(void);
 
 /** Everything assembly writes besides its outputs: the standard rules of full cells

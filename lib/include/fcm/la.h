@@ -27,7 +27,8 @@ typedef enum fcm_csr_kind {
   FCM_CSR_SYMMETRIC = 1 /**< square, a_ij = a_ji, both triangles stored (pattern symmetric) */
 } fcm_csr_kind;
 
-/** A sparse matrix in CSR form. Opaque; read it with the fcm_csr_get_* functions. */
+/** A sparse matrix in CSR form. Opaque; read it with fcm_csr_get_size(), fcm_csr_get_kind(),
+ * fcm_csr_row_ptr(), fcm_csr_col_idx() and fcm_csr_values(). */
 typedef struct fcm_csr fcm_csr;
 
 /** Create a matrix with the given pattern (copied) and zero values.
@@ -57,7 +58,7 @@ FCM_API fcm_status fcm_csr_create_triplets(fcm_ctx *ctx, fcm_index nrows, fcm_in
 
 /** Wrap caller arrays without copying (borrow: the caller keeps ownership and the
  * arrays must outlive the matrix). fcm never writes the pattern; `values`
- * (row_ptr[nrows] entries) is written only through fcm_csr_get_values() and
+ * (row_ptr[nrows] entries) is written only through fcm_csr_values() and
  * fcm_csr_set_zero(). The pattern is validated as in fcm_csr_create().
  * @return as fcm_csr_create(). Allocates only the small handle. Thread safe. */
 FCM_API fcm_status fcm_csr_wrap(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols,
@@ -73,18 +74,18 @@ FCM_API void fcm_csr_get_size(const fcm_csr *A, fcm_index *nrows, fcm_index *nco
 /** The kind given at creation. */
 FCM_API fcm_csr_kind fcm_csr_get_kind(const fcm_csr *A);
 /** Row pointers (nrows+1 entries), owned by A or the wrapping caller. */
-FCM_API const fcm_index *fcm_csr_get_row_ptr(const fcm_csr *A);
+FCM_API const fcm_index *fcm_csr_row_ptr(const fcm_csr *A);
 /** Column indices (nnz entries). */
-FCM_API const int *fcm_csr_get_col_idx(const fcm_csr *A);
+FCM_API const int *fcm_csr_col_idx(const fcm_csr *A);
 /** Values (nnz entries), writable: assembly adds into them. NULL for a NULL matrix. */
-FCM_API double *fcm_csr_get_values(fcm_csr *A);
+FCM_API double *fcm_csr_values(fcm_csr *A);
 /** Values (nnz entries), read only: what code that holds a `const fcm_csr *` reads
  * (libCEED's GetArrayRead next to GetArray). NULL for a NULL matrix. Thread safe. */
-FCM_API const double *fcm_csr_get_values_read(const fcm_csr *A);
+FCM_API const double *fcm_csr_values_read(const fcm_csr *A);
 
 /** Position of entry (row, col) in the value array (binary search within the
  * row), or -1 when it is not in the pattern or out of range. Thread safe. */
-FCM_API fcm_index fcm_csr_get_position(const fcm_csr *A, fcm_index row, fcm_index col);
+FCM_API fcm_index fcm_csr_position(const fcm_csr *A, fcm_index row, fcm_index col);
 
 /** Set every stored value to zero (keeps the pattern). */
 FCM_API void fcm_csr_set_zero(fcm_csr *A);
@@ -101,7 +102,7 @@ FCM_API fcm_status fcm_csr_apply(const fcm_csr *A, double alpha, const double *x
 /** Largest |a_ij - a_ji| over stored entries (an entry whose mirror is not
  * stored counts against 0), divided by max |a_ij| (0 for a zero matrix).
  * @return FCM_OK, FCM_ERR_ARG (A not square). No allocation. Thread safe. */
-FCM_API fcm_status fcm_csr_get_asymmetry(const fcm_csr *A, double *rel_asymmetry);
+FCM_API fcm_status fcm_csr_asymmetry(const fcm_csr *A, double *rel_asymmetry);
 
 /* ------------------------------------------------------------ direct solvers
  * Phases: create (pattern, copied) -> analyze (symbolic: ordering, elimination
@@ -162,7 +163,7 @@ FCM_API fcm_status fcm_direct_create(fcm_ctx *ctx, fcm_direct_method method, con
 FCM_API fcm_status fcm_direct_analyze(fcm_direct *solver);
 
 /** Numeric factorization of the matrix with the created pattern and `values`
- * (nnz entries in pattern order, e.g. fcm_csr_get_values(); read during the call
+ * (nnz entries in pattern order, e.g. fcm_csr_values(); read during the call
  * only). Reuses the symbolic analysis; call fcm_direct_analyze() first.
  * @return FCM_OK, FCM_ERR_ARG (not analyzed), FCM_ERR_NUMERIC (NaN/Inf value),
  * FCM_ERR_SINGULAR (CHOLMOD: not positive definite, UMFPACK: zero pivot; the

@@ -69,7 +69,7 @@ FCM_API void fcm_mesh_destroy(fcm_mesh **mesh);
 /** Accessors (mesh must not be NULL). Pointers stay valid for the life of the mesh.
  * fcm_mesh_coords: num_nodes x 3; fcm_mesh_cells: num_cells x nodes_per_cell. */
 FCM_API fcm_element_type fcm_mesh_element_type(const fcm_mesh *mesh);
-FCM_API const fcm_element_info *fcm_mesh_element_info(const fcm_mesh *mesh);
+FCM_API const fcm_element_info *fcm_mesh_get_element_info(const fcm_mesh *mesh);
 FCM_API int fcm_mesh_nodes_per_cell(const fcm_mesh *mesh);
 FCM_API fcm_index fcm_mesh_num_nodes(const fcm_mesh *mesh);
 FCM_API fcm_index fcm_mesh_num_cells(const fcm_mesh *mesh);

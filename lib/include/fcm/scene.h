@@ -75,11 +75,11 @@ typedef struct fcm_scene_geometry {
 } fcm_scene_geometry;
 
 /** Quadrature settings ("quadrature"). The enums and option structs are the library's own
- * (fcm/simplify.h); the strengths use -1 for "automatic". */
+ * (fcm/simplify.h); "automatic" strengths are FCM_DEFAULT. */
 typedef struct fcm_scene_quadrature {
-  int stiffness_strength; /**< [0, 20]; -1 (default): the element's default */
-  int mass_strength;      /**< [0, 20]; -1 (default): the element's default */
-  int surface_strength;   /**< [0, 20]; -1 (default): automatic (the stiffness strength when a
+  int stiffness_strength; /**< [0, 20]; FCM_DEFAULT (default): the element's default */
+  int mass_strength;      /**< [0, 20]; FCM_DEFAULT (default): the element's default */
+  int surface_strength;   /**< [0, 20]; FCM_DEFAULT (default): automatic (the stiffness strength when a
                                traction or pressure effect is present, else no surface rules) */
   int simplify;           /**< 1 (default): simplify cut-cell rules; 0: keep them */
   fcm_simplify_method simplify_method;     /**< "simplify_method": "auto" (default), "lp",
@@ -113,7 +113,8 @@ typedef struct fcm_scene_solver {
   int line_search;           /**< 1 (default): backtracking line search */
   int project_psd;           /**< 1: project element tangents to PSD; default 0 */
   double representative_acceleration; /**< |a_rep| in m/s^2, > 0, default 9.81 */
-  int threads;                        /**< OpenMP threads, >= 0; 0 (default): the OpenMP default */
+  int threads; /**< OpenMP threads >= 1; FCM_DEFAULT ("threads": 0, the default): the OpenMP
+                    default */
 } fcm_scene_solver;
 
 /** Time stepping ("time"). */

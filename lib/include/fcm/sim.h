@@ -91,7 +91,7 @@ typedef struct fcm_integrator_options {
   fcm_newton_tolerance tolerance_mode; /**< default FCM_NEWTON_TOL_REPRESENTATIVE */
   double newton_tolerance;             /**< tol in (0, 1) (default 1e-5) */
   double newton_atol;                  /**< RELATIVE mode: absolute floor >= 0 (default 0) */
-  double rep_acceleration;             /**< |a_rep| >= 0 in m/s^2; 0 (default): the magnitude of the
+  double rep_acceleration;             /**< |a_rep| > 0 in m/s^2; FCM_DEFAULT (default): the magnitude of the
                                             first gravity load, or 9.81 without gravity. Its direction
                                             is that gravity's, else (1, 1, 1)/sqrt 3 */
   int line_search;                     /**< 1 (default): backtracking on E; 0: full Newton steps */
@@ -134,7 +134,7 @@ typedef enum fcm_step_reason {
 
 /** Name of a reason ("converged", "max-newton", "line-search-failed",
  * "linear-solver-failed", "nonfinite", "none"), or "unknown". Static string. */
-FCM_API const char *fcm_step_reason_str(fcm_step_reason reason);
+FCM_API const char *fcm_step_reason_name(fcm_step_reason reason);
 
 /** What one fcm_integrator_step() did. Per-step counts cover every attempt of the step;
  * total_* are cumulative since setup. */

@@ -38,7 +38,8 @@ typedef struct fcm_simplify_options {
   fcm_simplify_method method; /**< default FCM_SIMPLIFY_AUTO */
   double rank_tol;        /**< singular values <= rank_tol * s_max count as zero; default 1e-13 */
   double residual_tol;    /**< accepted relative moment residual; default 1e-12 */
-  int lp_iteration_limit; /**< simplex iterations per LP; 0: 20 M + 1000 (default) */
+  int lp_iteration_limit; /**< simplex iterations per LP, >= 1; FCM_DEFAULT (default):
+                               20 M + 1000 */
   double lp_time_limit;   /**< seconds per LP; 0: none; default 60 */
 } fcm_simplify_options;
 

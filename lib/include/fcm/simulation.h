@@ -23,10 +23,11 @@ extern "C" {
 
 /** Options of fcm_simulation_create(); initialize with fcm_simulation_options_default(). */
 typedef struct fcm_simulation_options {
-  fcm_index max_steps; /**< > 0: stop after this many steps (fcm_simulation_done()); 0
-                            (default): the scene's step count */
+  fcm_index max_steps; /**< >= 1: stop after this many steps (fcm_simulation_done());
+                            FCM_DEFAULT (default): the scene's step count */
   int checkpoint_interval; /**< >= 0: fcm_simulation_checkpoint_due() every n-th step (0:
-                                never); -1 (default): the scene's output.checkpoint_interval */
+                                never); FCM_DEFAULT (default): the scene's
+                                output.checkpoint_interval */
 } fcm_simulation_options;
 
 /** Defaults as documented on each member. */

@@ -26,7 +26,7 @@ fcm_cell_rules_options fcm_cell_rules_options_default(void)
   o.simplify_options = fcm_simplify_options_default();
   o.stabilization = fcm_stabilization_options_default();
   o.max_rule_memory = 4.0 * GIB;
-  o.num_threads = 0;
+  o.num_threads = FCM_DEFAULT;
   return o;
 }
 
@@ -268,8 +268,8 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_cell_rules_options *o)
             o->clip_rtol, o->sliver_rtol, o->convex_rtol);
   FCM_CHECK(o->max_rule_memory >= 0.0 && !isnan(o->max_rule_memory), ctx, FCM_ERR_ARG,
             "embed: max_rule_memory = %g bytes must be >= 0 (0: no limit)", o->max_rule_memory);
-  FCM_CHECK(o->num_threads >= 0, ctx, FCM_ERR_ARG, "embed: num_threads = %d must be >= 0",
-            o->num_threads);
+  FCM_CHECK(o->num_threads >= 1 || o->num_threads == FCM_DEFAULT, ctx, FCM_ERR_ARG,
+            "embed: num_threads = %d must be >= 1, or FCM_DEFAULT (-1)", o->num_threads);
   FCM_CHECK((int)o->stabilization.mode >= 0 &&
                 o->stabilization.mode < FCM_STABILIZATION_MODE_COUNT &&
                 (o->stabilization.mode == FCM_STABILIZATION_OFF ||
@@ -313,7 +313,7 @@ static fcm_status rules_alloc(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_cell
 {
   fcm_status st = FCM_OK;
   fcm_cell_rules *R = NULL;
-  const fcm_element_info *info = fcm_mesh_element_info(mesh);
+  const fcm_element_info *info = fcm_mesh_get_element_info(mesh);
   const fcm_index nc = fcm_mesh_num_cells(mesh);
   const int element_strength[FCM_RULE_KIND_COUNT] = {
       [FCM_RULE_STIFFNESS] = info->stiffness_strength, [FCM_RULE_MASS] = info->mass_strength};
@@ -537,7 +537,7 @@ fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_g
     FCM_CHECK(fcm_mesh_cell_is_convex(mesh, c, o.convex_rtol), ctx, FCM_ERR_GEOMETRY,
               "embed: background cell %lld (%s) is not a convex polyhedron with planar faces and "
               "straight edges (relative tolerance %g); cut-cell quadrature needs convex cells",
-              (long long)c, fcm_mesh_element_info(mesh)->name, o.convex_rtol);
+              (long long)c, fcm_mesh_get_element_info(mesh)->name, o.convex_rtol);
 
   /* 1. set-up */
   FCM_TRY(ctx, rules_alloc(ctx, mesh, &o, &R));

@@ -32,7 +32,7 @@ fcm_status fcm__embed_cell_setup(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index i
   fcm_status st = FCM_OK;
   fcm__poly p;
   cell->type = fcm_mesh_element_type(mesh);
-  cell->info = fcm_mesh_element_info(mesh);
+  cell->info = fcm_mesh_get_element_info(mesh);
   cell->id = id;
   fcm_mesh_cell_coords(mesh, id, cell->X);
   const int nc = cell->info->num_corners;

@@ -13,7 +13,7 @@
 
 fcm_assembly_options fcm_assembly_options_default(void)
 {
-  fcm_assembly_options o = {0, 0, FCM_FICTITIOUS_PROJECTED};
+  fcm_assembly_options o = {FCM_DEFAULT, FCM_DEFAULT, FCM_FICTITIOUS_PROJECTED};
   return o;
 }
 
@@ -25,7 +25,9 @@ fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type, fcm_ru
   FCM_CHECK(info, ctx, FCM_ERR_ARG, "standard rule: invalid element type %d", (int)type);
   FCM_CHECK(kind == FCM_RULE_STIFFNESS || kind == FCM_RULE_MASS, ctx, FCM_ERR_ARG,
             "standard rule: invalid rule kind %d", (int)kind);
-  if (strength > 0)
+  FCM_CHECK(strength >= 0 || strength == FCM_DEFAULT, ctx, FCM_ERR_ARG,
+            "standard rule: strength = %d must be >= 0, or FCM_DEFAULT (-1)", strength);
+  if (strength >= 0)
     FCM_TRY(ctx, fcm_rule_create(ctx, info->shape, strength, rule));
   else if (info->shape == FCM_SHAPE_HEX) /* order+1 points per direction: strength 2*order+1 */
     FCM_TRY(ctx, fcm_rule_create_computed(ctx, info->shape, 2 * info->order + 1, rule));
@@ -601,14 +603,14 @@ fcm_status fcm_assembly_workspace_linear(fcm_assembly_workspace *ws, const fcm_l
     kd.kind = KERNEL_STIFFNESS;
     FCM_TRY(ctx, fcm_material_lame(ctx, form->material, &kd.lambda, &kd.mu));
     FCM_TRY(ctx, check_matrix(s, A));
-    FCM_TRY(ctx, run_volume_pass(ws, &kd, fcm_csr_get_values(A), NULL, NULL));
+    FCM_TRY(ctx, run_volume_pass(ws, &kd, fcm_csr_values(A), NULL, NULL));
     break;
   case FCM_LINEAR_MASS:
     kd.kind = KERNEL_MASS;
     FCM_TRY(ctx, fcm_material_lame(ctx, form->material, NULL, NULL));
     FCM_TRY(ctx, check_matrix(s, A));
     kd.rho = form->material->density;
-    FCM_TRY(ctx, run_volume_pass(ws, &kd, fcm_csr_get_values(A), NULL, NULL));
+    FCM_TRY(ctx, run_volume_pass(ws, &kd, fcm_csr_values(A), NULL, NULL));
     break;
   case FCM_LINEAR_BODY_FORCE: {
     const double *a = form->accel;
@@ -670,7 +672,7 @@ fcm_status fcm_assembly_workspace_hyperelastic(fcm_assembly_workspace *ws,
   kd.fictitious = ws->opts.fictitious;
   kd.mat_psd = *mat;
   kd.mat_psd.project_psd = 1;
-  FCM_TRY(ctx, run_volume_pass(ws, &kd, tangent ? fcm_csr_get_values(tangent) : NULL, force,
+  FCM_TRY(ctx, run_volume_pass(ws, &kd, tangent ? fcm_csr_values(tangent) : NULL, force,
                                ws->cell_energy));
   if (energy) { /* summed in cell order: independent of the thread count */
     double e = 0.0;

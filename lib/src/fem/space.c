@@ -324,9 +324,9 @@ fcm_status fcm_space_apply_dirichlet(const fcm_space *s, fcm_index ncon, const f
     g[d] = values ? values[k] : 0.0;
   }
   {
-    const fcm_index *rp = fcm_csr_get_row_ptr(A);
-    const int *ci = fcm_csr_get_col_idx(A);
-    double *v = fcm_csr_get_values(A);
+    const fcm_index *rp = fcm_csr_row_ptr(A);
+    const int *ci = fcm_csr_col_idx(A);
+    double *v = fcm_csr_values(A);
 #pragma omp parallel for schedule(static)
     for (fcm_index i = 0; i < n; i++) {
       if (con[i]) {

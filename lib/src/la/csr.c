@@ -257,27 +257,27 @@ fcm_csr_kind fcm_csr_get_kind(const fcm_csr *A)
   return A ? A->kind : FCM_CSR_GENERAL;
 }
 
-const fcm_index *fcm_csr_get_row_ptr(const fcm_csr *A)
+const fcm_index *fcm_csr_row_ptr(const fcm_csr *A)
 {
   return A ? A->row_ptr : NULL;
 }
 
-const int *fcm_csr_get_col_idx(const fcm_csr *A)
+const int *fcm_csr_col_idx(const fcm_csr *A)
 {
   return A ? A->col_idx : NULL;
 }
 
-double *fcm_csr_get_values(fcm_csr *A)
+double *fcm_csr_values(fcm_csr *A)
 {
   return A ? A->values : NULL;
 }
 
-const double *fcm_csr_get_values_read(const fcm_csr *A)
+const double *fcm_csr_values_read(const fcm_csr *A)
 {
   return A ? A->values : NULL;
 }
 
-fcm_index fcm_csr_get_position(const fcm_csr *A, fcm_index row, fcm_index col)
+fcm_index fcm_csr_position(const fcm_csr *A, fcm_index row, fcm_index col)
 {
   if (!A || row < 0 || row >= A->nrows || col < 0 || col >= A->ncols) return -1;
   return row_find(A, row, (int)col);
@@ -312,7 +312,7 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_csr_get_asymmetry(const fcm_csr *A, double *rel_asymmetry)
+fcm_status fcm_csr_asymmetry(const fcm_csr *A, double *rel_asymmetry)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = A ? A->ctx : NULL;

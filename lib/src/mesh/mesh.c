@@ -265,7 +265,7 @@ fcm_element_type fcm_mesh_element_type(const fcm_mesh *mesh)
 {
   return mesh->type;
 }
-const fcm_element_info *fcm_mesh_element_info(const fcm_mesh *mesh)
+const fcm_element_info *fcm_mesh_get_element_info(const fcm_mesh *mesh)
 {
   return mesh->info;
 }

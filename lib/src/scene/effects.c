@@ -475,10 +475,13 @@ fcm_status fcm__scene_read_effects(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
   fcm_scene *s = p->scene;
-  const fcm__json *arr = fcm__json_member(root, "effects");
+  const fcm__json *arr = NULL;
   char got[96], names[256];
   int counts[FCM_EFFECT_TYPE_COUNT] = {0}, first[FCM_EFFECT_TYPE_COUNT] = {0};
   size_t old = p->path_len;
+  FCM_TRY(p->ctx, fcm__scene_field(p, root, "effects", 0,
+                                   "an array of effects (objects like {\"gravity\": {}})",
+                                   FCM__JSON_ARRAY, -1, &arr));
   if (!arr) return FCM_OK;
   {
     size_t used = 0;
@@ -486,10 +489,6 @@ fcm_status fcm__scene_read_effects(fcm__scene_parser *p, const fcm__json *root)
       used += (size_t)snprintf(names + used, sizeof names - used, "%s\"%s\"", i ? ", " : "",
                                effect_types[i].name);
   }
-  fcm__scene_path_push_key(p, "effects");
-  fcm__scene_describe(arr, got, sizeof got);
-  SCENE_CHECK(fcm__json_get_kind(arr) == FCM__JSON_ARRAY, p, FCM_ERR_ARG,
-              "expected an array of effects (objects like {\"gravity\": {}}), got %s", got);
   int n = fcm__json_size(arr);
   if (n == 0) goto cleanup;
   s->effects = fcm__scene_alloc(s, (size_t)n, sizeof *s->effects);

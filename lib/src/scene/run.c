@@ -20,7 +20,8 @@ fcm_simulation_options fcm_simulation_options_default(void)
 {
   fcm_simulation_options o;
   memset(&o, 0, sizeof o);
-  o.checkpoint_interval = -1;
+  o.max_steps = FCM_DEFAULT;
+  o.checkpoint_interval = FCM_DEFAULT;
   return o;
 }
 
@@ -302,7 +303,7 @@ static fcm_status build_rules(fcm_simulation *S)
   else if (nsurf > 0)
     ro.surface_strength = q->stiffness_strength >= 0
                               ? q->stiffness_strength
-                              : fcm_mesh_element_info(S->mesh)->stiffness_strength;
+                              : fcm_mesh_get_element_info(S->mesh)->stiffness_strength;
   else
     ro.surface_strength = -1;
   ro.min_fraction = q->min_fraction;
@@ -343,8 +344,10 @@ static fcm_integrator_options integrator_options(fcm_simulation *S)
   o.krylov_max_iterations = sv->max_iterations;
   o.schwarz_theta = sv->schwarz_threshold;
   o.schwarz = sv->schwarz;
-  o.assembly.stiffness_strength = q->stiffness_strength > 0 ? q->stiffness_strength : 0;
-  o.assembly.mass_strength = q->mass_strength > 0 ? q->mass_strength : 0;
+  /* Full cells: the scene's strength, except that 0 keeps the element's rule there (as the
+   * scene README documents for strength 0: only cut cells get the strength-0 rule). */
+  o.assembly.stiffness_strength = q->stiffness_strength > 0 ? q->stiffness_strength : FCM_DEFAULT;
+  o.assembly.mass_strength = q->mass_strength > 0 ? q->mass_strength : FCM_DEFAULT;
   for (int k = 0; k < fcm_scene_num_effects(S->scene); k++) {
     const fcm_effect *e = fcm_scene_get_effect(S->scene, k);
     const fcm__effect_type *t = fcm__scene_effect_type(e->type);
@@ -416,11 +419,12 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   S->ctx = ctx;
   S->scene = scene;
   S->opts = opts ? *opts : fcm_simulation_options_default();
-  FCM_CHECK(S->opts.max_steps >= 0, ctx, FCM_ERR_ARG,
-            "simulation: max_steps = %lld must be >= 0 (0: the scene's)",
+  FCM_CHECK(S->opts.max_steps >= 1 || S->opts.max_steps == FCM_DEFAULT, ctx, FCM_ERR_ARG,
+            "simulation: max_steps = %lld must be >= 1, or FCM_DEFAULT (-1: the scene's)",
             (long long)S->opts.max_steps);
-  FCM_CHECK(S->opts.checkpoint_interval >= -1, ctx, FCM_ERR_ARG,
-            "simulation: checkpoint_interval = %d must be >= 0, or -1 for the scene's",
+  FCM_CHECK(S->opts.checkpoint_interval >= 0 || S->opts.checkpoint_interval == FCM_DEFAULT, ctx,
+            FCM_ERR_ARG,
+            "simulation: checkpoint_interval = %d must be >= 0, or FCM_DEFAULT (-1: the scene's)",
             S->opts.checkpoint_interval);
   const fcm_scene_time *tm = fcm_scene_get_time(scene);
   S->num_steps = tm->num_steps;
@@ -643,7 +647,7 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
   if (out->write_background) {
     fcm_index nc = fcm_mesh_num_cells(S->mesh);
     FCM_TRY(ctx, fcm_vtu_set_points(vtu, S->nn, fcm_mesh_coords(S->mesh)));
-    FCM_TRY(ctx, fcm_vtu_set_cells(vtu, fcm_mesh_element_info(S->mesh)->vtk_cell_type, nc,
+    FCM_TRY(ctx, fcm_vtu_set_cells(vtu, fcm_mesh_get_element_info(S->mesh)->vtk_cell_type, nc,
                                    fcm_mesh_cells(S->mesh)));
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "displacement", 3, S->nn, S->node_u));
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "velocity", 3, S->nn, S->node_v));

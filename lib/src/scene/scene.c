@@ -421,6 +421,7 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   s->schwarz_threshold = 0.5;
   s->schwarz = fcm_schwarz_options_default();
   s->newton_rule = FCM_NEWTON_TOL_AUTO;
+  s->threads = FCM_DEFAULT;
   s->rtol = 1e-8;
   s->max_iterations = 1000;
   s->newton_rtol = 1e-5;
@@ -464,6 +465,7 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
     fcm__scene_path_pop(p, here);
   }
   READ_INT(p, o, "threads", 0, 0, 4096, s->threads);
+  if (s->threads == 0) s->threads = FCM_DEFAULT; /* "threads": 0, the OpenMP default */
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
@@ -901,7 +903,7 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
           "|a_rep| %g m/s^2; threads %d\n",
           CHOICE_NAME(newton_rule_names, newton_rule_values, so->newton_rule), so->newton_rtol, so->newton_max_iterations,
           so->line_search ? "on" : "off", so->project_psd ? "on" : "off",
-          so->representative_acceleration, so->threads);
+          so->representative_acceleration, so->threads > 0 ? so->threads : 0);
   if (t->integrator == FCM_INTEGRATOR_STATIC)
     fprintf(f, "time: static, %lld step(s) of %g s, %d load step(s) each\n",
             (long long)t->num_steps, t->dt, t->load_steps);

@@ -118,6 +118,18 @@ typedef struct fcm__range {
 /* "a finite number > 0", "a finite number in (-1, 0.5)", ... */
 void fcm__scene_range_text(fcm__range r, char *buf, size_t len);
 
+/* Any kind: the reader checks the node itself (numbers, with their range in the message). */
+#define FCM__SCENE_ANY_KIND FCM__JSON_INVALID
+
+/* The one field lookup of the typed readers: the member `key` of obj.
+ * Absent: *out = NULL and FCM_OK, or, when required, "missing; expected <want>" at path.key.
+ * Present: the path is extended by key and left so for the caller's further checks (the
+ * caller pops back to the length it saved on entry); unless kind is FCM__SCENE_ANY_KIND the
+ * member must be of that kind, and an array of exactly `len` entries when len >= 0, else
+ * "expected <want>, got <what it is>". On an error *out is NULL. */
+fcm_status fcm__scene_field(fcm__scene_parser *p, const fcm__json *obj, const char *key, int required,
+                           const char *want, fcm__json_kind kind, int len, const fcm__json **out);
+
 /* The typed readers. Each reads member `key` of `obj`: when the member is absent and
  * `required` is 0 the output keeps the value the caller put there (the default); when it
  * is absent and required, or present with the wrong type or out of range, it fails with

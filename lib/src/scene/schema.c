@@ -178,18 +178,26 @@ cleanup:
   return st;
 }
 
-/* Look up a member; absent and required is an error naming the expectation. */
-static fcm_status member(fcm__scene_parser *p, const fcm__json *obj, const char *key, int required,
-                         const char *want, const fcm__json **out)
+fcm_status fcm__scene_field(fcm__scene_parser *p, const fcm__json *obj, const char *key, int required,
+                           const char *want, fcm__json_kind kind, int len, const fcm__json **out)
 {
   fcm_status st = FCM_OK;
-  *out = fcm__json_member(obj, key);
-  if (!*out && required) {
-    size_t old = fcm__scene_path_push_key(p, key);
-    st = fcm__scene_error(p, FCM_ERR_ARG, __FILE__, __LINE__, __func__, "missing; expected %s",
-                          want);
+  char got[DESC_LEN];
+  const fcm__json *v = fcm__json_member(obj, key);
+  size_t old = fcm__scene_path_push_key(p, key);
+  *out = NULL;
+  if (!v) {
+    SCENE_CHECK(!required, p, FCM_ERR_ARG, "missing; expected %s", want);
     fcm__scene_path_pop(p, old);
+    return FCM_OK;
   }
+  if (kind != FCM__SCENE_ANY_KIND) {
+    fcm__scene_describe(v, got, sizeof got);
+    SCENE_CHECK(fcm__json_get_kind(v) == kind && (len < 0 || fcm__json_size(v) == len), p,
+                FCM_ERR_ARG, "expected %s, got %s", want, got);
+  }
+  *out = v;
+cleanup:
   return st;
 }
 
@@ -201,9 +209,8 @@ fcm_status fcm__scene_read_number(fcm__scene_parser *p, const fcm__json *obj, co
   char want[RANGE_LEN];
   size_t old = p->path_len;
   fcm__scene_range_text(range, want, sizeof want);
-  FCM_TRY(p->ctx, member(p, obj, key, required, want, &v));
+  FCM_TRY(p->ctx, fcm__scene_field(p, obj, key, required, want, FCM__SCENE_ANY_KIND, -1, &v));
   if (!v) return FCM_OK;
-  fcm__scene_path_push_key(p, key);
   FCM_TRY(p->ctx, check_number(p, v, range, out));
 cleanup:
   fcm__scene_path_pop(p, old);
@@ -218,9 +225,8 @@ fcm_status fcm__scene_read_int(fcm__scene_parser *p, const fcm__json *obj, const
   char want[RANGE_LEN];
   size_t old = p->path_len;
   snprintf(want, sizeof want, "an integer in [%lld, %lld]", lo, hi);
-  FCM_TRY(p->ctx, member(p, obj, key, required, want, &v));
+  FCM_TRY(p->ctx, fcm__scene_field(p, obj, key, required, want, FCM__SCENE_ANY_KIND, -1, &v));
   if (!v) return FCM_OK;
-  fcm__scene_path_push_key(p, key);
   FCM_TRY(p->ctx, check_int(p, v, lo, hi, out));
 cleanup:
   fcm__scene_path_pop(p, old);
@@ -232,14 +238,9 @@ fcm_status fcm__scene_read_bool(fcm__scene_parser *p, const fcm__json *obj, cons
 {
   fcm_status st = FCM_OK;
   const fcm__json *v = NULL;
-  char got[DESC_LEN];
   size_t old = p->path_len;
-  FCM_TRY(p->ctx, member(p, obj, key, required, "true or false", &v));
+  FCM_TRY(p->ctx, fcm__scene_field(p, obj, key, required, "true or false", FCM__JSON_BOOL, -1, &v));
   if (!v) return FCM_OK;
-  fcm__scene_path_push_key(p, key);
-  fcm__scene_describe(v, got, sizeof got);
-  SCENE_CHECK(fcm__json_get_kind(v) == FCM__JSON_BOOL, p, FCM_ERR_ARG,
-              "expected true or false, got %s", got);
   *out = fcm__json_bool(v);
 cleanup:
   fcm__scene_path_pop(p, old);
@@ -267,15 +268,10 @@ static fcm_status string_node(fcm__scene_parser *p, const fcm__json *obj, const 
 {
   fcm_status st = FCM_OK;
   const fcm__json *v = NULL;
-  char got[DESC_LEN];
   size_t old = p->path_len;
   *raw = NULL;
-  FCM_TRY(p->ctx, member(p, obj, key, required, want, &v));
+  FCM_TRY(p->ctx, fcm__scene_field(p, obj, key, required, want, FCM__JSON_STRING, -1, &v));
   if (!v) return FCM_OK;
-  fcm__scene_path_push_key(p, key);
-  fcm__scene_describe(v, got, sizeof got);
-  SCENE_CHECK(fcm__json_get_kind(v) == FCM__JSON_STRING, p, FCM_ERR_ARG, "expected %s, got %s",
-              want, got);
   const char *s = fcm__json_string(v);
   SCENE_CHECK(s[0] != '\0', p, FCM_ERR_ARG, "expected %s, got an empty string", want);
   for (const char *c = s; *c; c++)
@@ -304,7 +300,7 @@ fcm_status fcm__scene_read_vec3(fcm__scene_parser *p, const fcm__json *obj, cons
 {
   fcm_status st = FCM_OK;
   const fcm__json *v = NULL;
-  char want[RANGE_LEN + 32], got[DESC_LEN];
+  char want[RANGE_LEN + 32];
   size_t old = p->path_len;
   double tmp[3];
   {
@@ -314,12 +310,8 @@ fcm_status fcm__scene_read_vec3(fcm__scene_parser *p, const fcm__json *obj, cons
     const char *tail = strstr(r, "number");
     snprintf(want, sizeof want, "an array of 3 finite numbers%s", tail ? tail + 6 : "");
   }
-  FCM_TRY(p->ctx, member(p, obj, key, required, want, &v));
+  FCM_TRY(p->ctx, fcm__scene_field(p, obj, key, required, want, FCM__JSON_ARRAY, 3, &v));
   if (!v) return FCM_OK;
-  fcm__scene_path_push_key(p, key);
-  fcm__scene_describe(v, got, sizeof got);
-  SCENE_CHECK(fcm__json_get_kind(v) == FCM__JSON_ARRAY && fcm__json_size(v) == 3, p, FCM_ERR_ARG,
-              "expected %s, got %s", want, got);
   int i = 0;
   for (const fcm__json *c = fcm__json_child(v); c; c = fcm__json_next(c), i++) {
     size_t o = fcm__scene_path_push_index(p, i);
@@ -337,16 +329,12 @@ fcm_status fcm__scene_read_ivec3(fcm__scene_parser *p, const fcm__json *obj, con
 {
   fcm_status st = FCM_OK;
   const fcm__json *v = NULL;
-  char want[RANGE_LEN], got[DESC_LEN];
+  char want[RANGE_LEN];
   size_t old = p->path_len;
   long long tmp[3];
   snprintf(want, sizeof want, "an array of 3 integers in [%lld, %lld]", lo, hi);
-  FCM_TRY(p->ctx, member(p, obj, key, required, want, &v));
+  FCM_TRY(p->ctx, fcm__scene_field(p, obj, key, required, want, FCM__JSON_ARRAY, 3, &v));
   if (!v) return FCM_OK;
-  fcm__scene_path_push_key(p, key);
-  fcm__scene_describe(v, got, sizeof got);
-  SCENE_CHECK(fcm__json_get_kind(v) == FCM__JSON_ARRAY && fcm__json_size(v) == 3, p, FCM_ERR_ARG,
-              "expected %s, got %s", want, got);
   int i = 0;
   for (const fcm__json *c = fcm__json_child(v); c; c = fcm__json_next(c), i++) {
     size_t o = fcm__scene_path_push_index(p, i);
@@ -395,17 +383,8 @@ fcm_status fcm__scene_read_object(fcm__scene_parser *p, const fcm__json *obj, co
                                   int required, const fcm__json **out)
 {
   fcm_status st = FCM_OK;
-  const fcm__json *v = NULL;
-  char got[DESC_LEN];
   size_t old = p->path_len;
-  *out = NULL;
-  FCM_TRY(p->ctx, member(p, obj, key, required, "an object", &v));
-  if (!v) return FCM_OK;
-  fcm__scene_path_push_key(p, key);
-  fcm__scene_describe(v, got, sizeof got);
-  SCENE_CHECK(fcm__json_get_kind(v) == FCM__JSON_OBJECT, p, FCM_ERR_ARG,
-              "expected an object, got %s", got);
-  *out = v;
+  FCM_TRY(p->ctx, fcm__scene_field(p, obj, key, required, "an object", FCM__JSON_OBJECT, -1, out));
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;

@@ -17,7 +17,7 @@ fcm_integrator_options fcm_integrator_options_default(void)
   o.tolerance_mode = FCM_NEWTON_TOL_REPRESENTATIVE;
   o.newton_tolerance = 1e-5;
   o.newton_atol = 0.0;
-  o.rep_acceleration = 0.0;
+  o.rep_acceleration = FCM_DEFAULT;
   o.line_search = 1;
   o.armijo = 1e-4;
   o.backtrack = 0.5;
@@ -35,7 +35,7 @@ fcm_integrator_options fcm_integrator_options_default(void)
   return o;
 }
 
-const char *fcm_step_reason_str(fcm_step_reason reason)
+const char *fcm_step_reason_name(fcm_step_reason reason)
 {
   switch (reason) {
   case FCM_STEP_NONE:
@@ -383,8 +383,11 @@ static fcm_status validate_options(fcm_ctx *ctx, const fcm_integrator_options *o
             "integrator: newton_tolerance = %g outside (0, 1)", o->newton_tolerance);
   FCM_CHECK(o->newton_atol >= 0.0 && isfinite(o->newton_atol), ctx, FCM_ERR_ARG,
             "integrator: newton_atol = %g must be finite and >= 0", o->newton_atol);
-  FCM_CHECK(o->rep_acceleration >= 0.0 && isfinite(o->rep_acceleration), ctx, FCM_ERR_ARG,
-            "integrator: rep_acceleration = %g must be finite and >= 0", o->rep_acceleration);
+  FCM_CHECK((o->rep_acceleration > 0.0 && isfinite(o->rep_acceleration)) ||
+                o->rep_acceleration == FCM_DEFAULT,
+            ctx, FCM_ERR_ARG,
+            "integrator: rep_acceleration = %g must be positive and finite, or FCM_DEFAULT (-1)",
+            o->rep_acceleration);
   FCM_CHECK(o->armijo > 0.0 && o->armijo < 0.5, ctx, FCM_ERR_ARG,
             "integrator: armijo = %g outside (0, 0.5)", o->armijo);
   FCM_CHECK(o->backtrack > 0.0 && o->backtrack < 1.0, ctx, FCM_ERR_ARG,

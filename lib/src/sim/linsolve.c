@@ -54,7 +54,7 @@ static fcm_status factor_direct(fcm_integrator *I, fcm_step_reason *reason, sim_
 {
   fcm_status st = FCM_OK, s;
   fcm_ctx *ctx = I->ctx;
-  const double *vals = fcm_csr_get_values(I->H);
+  const double *vals = fcm_csr_values(I->H);
   I->direct = NULL;
   if (I->chol) {
     s = fcm_direct_factor(I->chol, vals);

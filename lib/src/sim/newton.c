@@ -44,14 +44,14 @@ static void set_base(fcm_integrator *I, double h)
 {
   fcm_index nnz = 0;
   fcm_csr_get_size(I->H, NULL, NULL, &nnz);
-  double *hv = fcm_csr_get_values(I->H);
+  double *hv = fcm_csr_values(I->H);
   if (h > 0.0) {
-    const double *mv = fcm_csr_get_values(I->M);
+    const double *mv = fcm_csr_values(I->M);
     double a = 1.0 / (h * h);
     for (fcm_index e = 0; e < nnz; e++)
       hv[e] = a * mv[e];
     if (I->D) {
-      const double *dv = fcm_csr_get_values(I->D);
+      const double *dv = fcm_csr_values(I->D);
       for (fcm_index e = 0; e < nnz; e++)
         hv[e] += dv[e] / h;
     }
@@ -183,9 +183,9 @@ static fcm_status build_system(fcm_integrator *I, double h, int predictor, int p
       for (fcm_index i = 0; i < n; i++)
         if (!I->is_con[i]) I->b[i] -= I->w2[i];
     }
-    const double *hv = fcm_csr_get_values(I->H);
+    const double *hv = fcm_csr_values(I->H);
     for (fcm_index j = 0; j < I->nact; j++) {
-      fcm_index d = I->act_dof[j], pos = fcm_csr_get_position(I->H, d, d);
+      fcm_index d = I->act_dof[j], pos = fcm_csr_position(I->H, d, d);
       I->b[d] = predictor ? hv[pos] * I->act_inc[j] : 0.0;
     }
     return FCM_OK;
@@ -202,7 +202,7 @@ static fcm_status build_system(fcm_integrator *I, double h, int predictor, int p
   if (I->H0) {
     fcm_index nnz = 0;
     fcm_csr_get_size(I->H, NULL, NULL, &nnz);
-    memcpy(fcm_csr_get_values(I->H0), fcm_csr_get_values(I->H), sizeof(double) * (size_t)nnz);
+    memcpy(fcm_csr_values(I->H0), fcm_csr_values(I->H), sizeof(double) * (size_t)nnz);
   }
   FCM_TRY(I->ctx, fcm_space_apply_dirichlet(I->space, I->nact, I->act_dof,
                                             predictor ? I->act_inc : NULL, I->H, I->b));
@@ -420,8 +420,8 @@ static fcm_status update_damping(fcm_integrator *I, fcm_step_reason *reason, sim
   fcm_index nnz = 0;
   int finite = 1;
   fcm_csr_get_size(I->D, NULL, NULL, &nnz);
-  double *dv = fcm_csr_get_values(I->D);
-  const double *mv = fcm_csr_get_values(I->M);
+  double *dv = fcm_csr_values(I->D);
+  const double *mv = fcm_csr_values(I->M);
   fcm_csr_set_zero(I->D);
   if (o->rayleigh_stiffness > 0.0) {
     FCM_TRY(I->ctx, assemble(I, &I->params_psd, I->un, NULL, NULL, I->D, &finite, stats));
@@ -507,7 +507,7 @@ static fcm_status reject_step(fcm_integrator *I, fcm_status st, fcm_step_reason 
                     __FILE__, __LINE__, __func__,
                     "integrator: step %lld from t = %g failed after %d halving(s) (last dt = "
                     "%g): %s, residual %g vs tolerance %g; state left at t = %g",
-                    I->steps + 1, t0, info->halvings, info->dt, fcm_step_reason_str(reason),
+                    I->steps + 1, t0, info->halvings, info->dt, fcm_step_reason_name(reason),
                     info->residual, info->tolerance, I->t);
   return st;
 }

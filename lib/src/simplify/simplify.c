@@ -29,7 +29,7 @@ fcm_simplify_options fcm_simplify_options_default(void)
   o.method = FCM_SIMPLIFY_AUTO;
   o.rank_tol = 1e-13;
   o.residual_tol = 1e-12;
-  o.lp_iteration_limit = 0;
+  o.lp_iteration_limit = FCM_DEFAULT;
   o.lp_time_limit = 60.0;
   return o;
 }
@@ -192,8 +192,9 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_simplify_options *o)
             "simplify: rank_tol = %g out of range [0, 1)", o->rank_tol);
   FCM_CHECK(o->residual_tol > 0.0 && o->residual_tol < 1.0, ctx, FCM_ERR_ARG,
             "simplify: residual_tol = %g out of range (0, 1)", o->residual_tol);
-  FCM_CHECK(o->lp_iteration_limit >= 0, ctx, FCM_ERR_ARG,
-            "simplify: lp_iteration_limit = %d must be >= 0 (0: automatic)", o->lp_iteration_limit);
+  FCM_CHECK(o->lp_iteration_limit >= 1 || o->lp_iteration_limit == FCM_DEFAULT, ctx, FCM_ERR_ARG,
+            "simplify: lp_iteration_limit = %d must be >= 1, or FCM_DEFAULT (-1: automatic)",
+            o->lp_iteration_limit);
   FCM_CHECK(o->lp_time_limit >= 0.0 && isfinite(o->lp_time_limit), ctx, FCM_ERR_ARG,
             "simplify: lp_time_limit = %g must be finite and >= 0 (0: none)", o->lp_time_limit);
 cleanup:

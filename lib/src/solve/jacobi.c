@@ -16,7 +16,7 @@ struct fcm_jacobi {
 
 static double entry(const fcm_csr *A, const double *vals, fcm_index i, fcm_index j)
 {
-  fcm_index p = fcm_csr_get_position(A, i, j);
+  fcm_index p = fcm_csr_position(A, i, j);
   return p >= 0 ? vals[p] : 0.0;
 }
 
@@ -64,7 +64,7 @@ fcm_status fcm_jacobi_setup(fcm_jacobi *P, const fcm_csr *A)
             (long long)nr, (long long)nc, (long long)P->n, (long long)P->n);
   P->ready = 0;
   P->fallbacks = 0;
-  const double *vals = fcm_csr_get_values_read(A);
+  const double *vals = fcm_csr_values_read(A);
   if (P->kind == FCM_JACOBI_SCALAR) {
     for (fcm_index i = 0; i < P->n; i++)
       FCM_TRY(ctx, inverse_diagonal(ctx, i, entry(A, vals, i, i), &P->inv[i], &P->fallbacks));

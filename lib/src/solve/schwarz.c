@@ -137,7 +137,7 @@ static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *va
   double *S = P->S + P->s_off[b];
   for (int j = 0; j < m; j++)
     for (int i = 0; i < m; i++) {
-      fcm_index p = fcm_csr_get_position(C, d[i], d[j]);
+      fcm_index p = fcm_csr_position(C, d[i], d[j]);
       double v = p >= 0 ? vals[p] : 0.0;
       if (!isfinite(v)) {
         *fail = FAIL_NONFINITE;
@@ -191,14 +191,14 @@ fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
             "schwarz_setup: matrix is %lld x %lld, the preconditioner was created for %lld x %lld",
             (long long)nr, (long long)nc, (long long)P->n, (long long)P->n);
   P->ready = 0;
-  const double *vals = fcm_csr_get_values_read(C);
+  const double *vals = fcm_csr_values_read(C);
   fcm_index fallbacks = 0;
   for (fcm_index i = 0; i < P->n; i++) {
     if (P->inside[i]) {
       P->dinv[i] = 0.0;
       continue;
     }
-    fcm_index p = fcm_csr_get_position(C, i, i);
+    fcm_index p = fcm_csr_position(C, i, i);
     double dii = p >= 0 ? vals[p] : 0.0;
     FCM_CHECK(isfinite(dii), ctx, FCM_ERR_NUMERIC,
               "schwarz: diagonal entry of row %lld (outside all blocks) is %g", (long long)i, dii);
