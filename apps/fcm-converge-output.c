@@ -8,11 +8,20 @@
 #include <stdlib.h>
 #include <string.h>
 
-const char *cv_method_name(cv_method m) { return m == CV_FCM ? "fcm" : "fem"; }
+const char *cv_method_name(cv_method m)
+{
+  return m == CV_FCM ? "fcm" : "fem";
+}
 
-static const char *ename(fcm_element_type t) { return fcm_element_get_info(t)->name; }
+static const char *ename(fcm_element_type t)
+{
+  return fcm_element_get_info(t)->name;
+}
 
-static double rel(double err, double norm) { return norm > 0.0 ? err / norm : NAN; }
+static double rel(double err, double norm)
+{
+  return norm > 0.0 ? err / norm : NAN;
+}
 
 /* ---------------------------------------------------------------- rates */
 
@@ -73,13 +82,18 @@ void cv_print_levels(FILE *f, const cv_result *res, int nres)
           "t_total", "cpu_tot", "rel_L2", "rel_H1", "meas");
   for (int k = 0; k < nres; k++) {
     const cv_result *r = &res[k];
-    fprintf(f, "%-5s %-4s %4d %7.4f %8lld %7lld %6lld %9lld %3d %8.3f %8.3f %8.3f %8.3f %8.3f %9.3e %9.3e %6.4f%s%s\n",
+    fprintf(f,
+            "%-5s %-4s %4d %7.4f %8lld %7lld %6lld %9lld %3d %8.3f %8.3f %8.3f %8.3f %8.3f %9.3e "
+            "%9.3e %6.4f%s%s\n",
             ename(r->element), cv_method_name(r->method), r->res, r->h, (long long)r->dofs,
             (long long)r->active_cells, (long long)r->cut_cells, (long long)r->points, r->strength,
-            r->t_rules, r->t_assembly, r->t_solve, r->t_total, r->c_total, rel(r->err_l2, r->norm_l2),
-            rel(r->err_h1, r->norm_h1),
+            r->t_rules, r->t_assembly, r->t_solve, r->t_total, r->c_total,
+            rel(r->err_l2, r->norm_l2), rel(r->err_h1, r->norm_h1),
             r->domain_volume > 0 ? r->measured_volume / r->domain_volume : 0.0,
-            r->failed ? "  FAILED: " : r->note[0] ? "  " : "", r->note);
+            r->failed    ? "  FAILED: "
+            : r->note[0] ? "  "
+                         : "",
+            r->note);
   }
 }
 
@@ -100,16 +114,19 @@ void cv_print_pareto(FILE *f, const cv_result *res, int nres, int cpu)
 {
   static const double targets[] = {3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5};
   const int nt = (int)(sizeof targets / sizeof *targets);
-  fprintf(f, "\naccuracy versus time: least total %s time [s] (rules + assembly + solve) of a "
-             "run\nreaching the relative L2 error in the column head ('-': none reached it)\n",
+  fprintf(f,
+          "\naccuracy versus time: least total %s time [s] (rules + assembly + solve) of a "
+          "run\nreaching the relative L2 error in the column head ('-': none reached it)\n",
           cpu ? "CPU" : "wall-clock");
   fprintf(f, "%-5s %-4s", "elem", "meth");
-  for (int t = 0; t < nt; t++) fprintf(f, " %8.0e", targets[t]);
+  for (int t = 0; t < nt; t++)
+    fprintf(f, " %8.0e", targets[t]);
   fprintf(f, "\n");
   for (int e = 0; e < FCM_ELEMENT_COUNT; e++)
     for (int m = 0; m < CV_METHOD_COUNT; m++) {
       int any = 0;
-      for (int k = 0; k < nres; k++) any |= (int)res[k].element == e && (int)res[k].method == m;
+      for (int k = 0; k < nres; k++)
+        any |= (int)res[k].element == e && (int)res[k].method == m;
       if (!any) continue;
       fprintf(f, "%-5s %-4s", ename((fcm_element_type)e), cv_method_name((cv_method)m));
       for (int t = 0; t < nt; t++) {
@@ -132,16 +149,20 @@ void cv_print_pareto(FILE *f, const cv_result *res, int nres, int cpu)
 void cv_print_sweep(FILE *f, const cv_result *res, int nres)
 {
   if (nres == 0) return;
-  fprintf(f, "\nquadrature strength sweep: %s FCM, res %d (h = %.4f), cut-cell stiffness strength m\n",
+  fprintf(f,
+          "\nquadrature strength sweep: %s FCM, res %d (h = %.4f), cut-cell stiffness strength m\n",
           ename(res[0].element), res[0].res, res[0].h);
-  fprintf(f, "%3s %9s %8s %8s %8s %8s %8s %9s %9s\n", "m", "points", "t_rules", "t_asm",
-          "t_solve", "t_total", "cpu_tot", "rel_L2", "rel_H1");
+  fprintf(f, "%3s %9s %8s %8s %8s %8s %8s %9s %9s\n", "m", "points", "t_rules", "t_asm", "t_solve",
+          "t_total", "cpu_tot", "rel_L2", "rel_H1");
   for (int k = 0; k < nres; k++) {
     const cv_result *r = &res[k];
     fprintf(f, "%3d %9lld %8.3f %8.3f %8.3f %8.3f %8.3f %9.3e %9.3e%s%s\n", r->strength,
             (long long)r->points, r->t_rules, r->t_assembly, r->t_solve, r->t_total, r->c_total,
             rel(r->err_l2, r->norm_l2), rel(r->err_h1, r->norm_h1),
-            r->failed ? "  FAILED: " : r->note[0] ? "  " : "", r->note);
+            r->failed    ? "  FAILED: "
+            : r->note[0] ? "  "
+                         : "",
+            r->note);
   }
 }
 
@@ -150,7 +171,8 @@ void cv_print_sweep(FILE *f, const cv_result *res, int nres)
 /* The note without commas or quotes (CSV field). */
 static void csv_note(FILE *f, const char *note)
 {
-  for (const char *p = note; *p; p++) fputc(*p == ',' || *p == '"' || *p == '\n' ? ';' : *p, f);
+  for (const char *p = note; *p; p++)
+    fputc(*p == ',' || *p == '"' || *p == '\n' ? ';' : *p, f);
 }
 
 int cv_write_levels_csv(const char *path, const cv_result *res, int nres)
@@ -164,13 +186,14 @@ int cv_write_levels_csv(const char *path, const cv_result *res, int nres)
              "cpu_total\n");
   for (int k = 0; k < nres; k++) {
     const cv_result *r = &res[k];
-    fprintf(f, "%s,%s,%d,%.17g,%lld,%lld,%lld,%lld,%d,%.6f,%.6f,%.6f,%.6f,%.10e,%.10e,%.10e,"
-               "%.10e,%.6e,%.6e,%.12g,%.12g,%d,",
+    fprintf(f,
+            "%s,%s,%d,%.17g,%lld,%lld,%lld,%lld,%d,%.6f,%.6f,%.6f,%.6f,%.10e,%.10e,%.10e,"
+            "%.10e,%.6e,%.6e,%.12g,%.12g,%d,",
             ename(r->element), cv_method_name(r->method), r->res, r->h, (long long)r->dofs,
             (long long)r->active_cells, (long long)r->cut_cells, (long long)r->points, r->strength,
             r->t_rules, r->t_assembly, r->t_solve, r->t_total, r->err_l2, r->err_h1, r->norm_l2,
-            r->norm_h1, rel(r->err_l2, r->norm_l2), rel(r->err_h1, r->norm_h1),
-            r->measured_volume, r->domain_volume, r->failed);
+            r->norm_h1, rel(r->err_l2, r->norm_l2), rel(r->err_h1, r->norm_h1), r->measured_volume,
+            r->domain_volume, r->failed);
     csv_note(f, r->note);
     fprintf(f, ",%.6f,%.6f,%.6f,%.6f\n", r->c_rules, r->c_assembly, r->c_solve, r->c_total);
   }
@@ -194,8 +217,9 @@ int cv_write_sweep_csv(const char *path, const cv_result *res, int nres)
   cli_output *out = NULL;
   FILE *f = cli_output_open(CV_PROG, path, &out);
   if (!f) return 0;
-  fprintf(f, "element,method,res,h,strength,points,dofs,t_rules,t_assembly,t_solve,t_total,"
-             "err_l2,err_h1,rel_l2,rel_h1,failed,note,cpu_rules,cpu_assembly,cpu_solve,cpu_total\n");
+  fprintf(f,
+          "element,method,res,h,strength,points,dofs,t_rules,t_assembly,t_solve,t_total,"
+          "err_l2,err_h1,rel_l2,rel_h1,failed,note,cpu_rules,cpu_assembly,cpu_solve,cpu_total\n");
   for (int k = 0; k < nres; k++) {
     const cv_result *r = &res[k];
     fprintf(f, "%s,%s,%d,%.17g,%d,%lld,%lld,%.6f,%.6f,%.6f,%.6f,%.10e,%.10e,%.6e,%.6e,%d,",
@@ -218,7 +242,7 @@ int cv_have_gnuplot(void)
     have = system(NULL) != 0 && system("gnuplot --version > /dev/null 2>&1") == 0;
     if (!have)
       fprintf(stderr, CV_PROG ": gnuplot not found (Debian package gnuplot-nox): no PNG plots "
-                      "are written; the CSV files carry every number\n");
+                              "are written; the CSV files carry every number\n");
   }
   return have;
 }
@@ -288,16 +312,15 @@ static int write_blocks(FILE *f, const cv_result *res, int nres, int cpu,
         have[e][m] = 1;
         fprintf(f, "%.10e %lld %.6e %.6e %.6e %.6e %.6e\n", r->h, (long long)r->dofs,
                 fmax(cpu ? r->c_total : r->t_total, 1e-4), rel(r->err_l2, r->norm_l2),
-                rel(r->err_h1, r->norm_h1),
-                r->err_l2, r->err_h1);
+                rel(r->err_h1, r->norm_h1), r->err_l2, r->err_h1);
       }
       if (have[e][m]) fprintf(f, "EOD\n"), nb++;
     }
   return nb;
 }
 
-static void plot_series(FILE *f, int have[FCM_ELEMENT_COUNT][2], const char *xcol,
-                        const char *ycol, const cv_rate *rates, int nrates, int norm)
+static void plot_series(FILE *f, int have[FCM_ELEMENT_COUNT][2], const char *xcol, const char *ycol,
+                        const cv_rate *rates, int nrates, int norm)
 {
   int first = 1;
   for (int e = 0; e < FCM_ELEMENT_COUNT; e++)
@@ -355,13 +378,17 @@ int cv_plot_pareto(const char *path, const cv_result *res, int nres, int cpu, co
   script_terminal(f, 1400, 1100, tmp);
   fprintf(f, "set logscale xy\nset grid\nset key top right font ',9'\nset format y '%%.0e'\n");
   fprintf(f, "set multiplot layout 2,2 title '%s'\n", title);
-  fprintf(f, "set title 'L2 error vs total %s time'\nset xlabel 'rules + assembly + solve [s]'\n"
-             "set ylabel 'relative L2 error'\n", cpu ? "CPU" : "wall-clock");
+  fprintf(f,
+          "set title 'L2 error vs total %s time'\nset xlabel 'rules + assembly + solve [s]'\n"
+          "set ylabel 'relative L2 error'\n",
+          cpu ? "CPU" : "wall-clock");
   plot_series(f, have, "3", "4", NULL, 0, 0);
   fprintf(f, "set title 'L2 error vs DOFs'\nset xlabel 'DOFs'\n");
   plot_series(f, have, "2", "4", NULL, 0, 0);
-  fprintf(f, "set title 'H1 error vs total %s time'\nset xlabel 'rules + assembly + solve [s]'\n"
-             "set ylabel 'relative H1 seminorm error'\n", cpu ? "CPU" : "wall-clock");
+  fprintf(f,
+          "set title 'H1 error vs total %s time'\nset xlabel 'rules + assembly + solve [s]'\n"
+          "set ylabel 'relative H1 seminorm error'\n",
+          cpu ? "CPU" : "wall-clock");
   plot_series(f, have, "3", "5", NULL, 0, 0);
   fprintf(f, "set title 'H1 error vs DOFs'\nset xlabel 'DOFs'\n");
   plot_series(f, have, "2", "5", NULL, 0, 0);
@@ -391,12 +418,13 @@ int cv_plot_sweep(const char *path, const cv_result *res, int nres, const char *
   fprintf(f, "set title 'error vs m'\nset ylabel 'relative error'\n"
              "plot $S using 1:2 with linespoints lw 2 pt 7 title 'L2', "
              "$S using 1:3 with linespoints lw 2 pt 5 title 'H1 seminorm'\n");
-  fprintf(f, "set title 'time and points vs m'\nset ylabel 'seconds'\nset y2label 'points'\n"
-             "set logscale y2\nset y2tics\nset format y2 '%%.0e'\n"
-             "plot $S using 1:4 with linespoints lw 2 pt 7 title 'rules', "
-             "$S using 1:5 with linespoints lw 2 pt 5 title 'assembly', "
-             "$S using 1:6 with linespoints lw 2 pt 9 title 'total', "
-             "$S using 1:7 axes x1y2 with linespoints lw 2 dt 2 pt 6 title 'points (right axis)'\n");
+  fprintf(f,
+          "set title 'time and points vs m'\nset ylabel 'seconds'\nset y2label 'points'\n"
+          "set logscale y2\nset y2tics\nset format y2 '%%.0e'\n"
+          "plot $S using 1:4 with linespoints lw 2 pt 7 title 'rules', "
+          "$S using 1:5 with linespoints lw 2 pt 5 title 'assembly', "
+          "$S using 1:6 with linespoints lw 2 pt 9 title 'total', "
+          "$S using 1:7 axes x1y2 with linespoints lw 2 dt 2 pt 6 title 'points (right axis)'\n");
   fprintf(f, "unset multiplot\nset output\n");
   return script_run(f, script, tmp, path);
 }

@@ -31,7 +31,8 @@ void cv_exact(const double x[3], double u[3], double G[9])
     const double s = sin(th), c = cos(th);
     if (u) u[i] = MS_A[i] * s;
     if (G)
-      for (int j = 0; j < 3; j++) G[3 * i + j] = MS_A[i] * MS_K[i][j] * c;
+      for (int j = 0; j < 3; j++)
+        G[3 * i + j] = MS_A[i] * MS_K[i][j] * c;
   }
 }
 
@@ -43,7 +44,8 @@ void cv_exact_body_force(double lambda, double mu, const double x[3], double b[3
     sn[i] = sin(MS_K[i][0] * x[0] + MS_K[i][1] * x[1] + MS_K[i][2] * x[2] + MS_PHI[i]);
   for (int j = 0; j < 3; j++) {
     double ddiv = 0.0;
-    for (int i = 0; i < 3; i++) ddiv -= MS_A[i] * MS_K[i][i] * MS_K[i][j] * sn[i];
+    for (int i = 0; i < 3; i++)
+      ddiv -= MS_A[i] * MS_K[i][i] * MS_K[i][j] * sn[i];
     const double k2 = MS_K[j][0] * MS_K[j][0] + MS_K[j][1] * MS_K[j][1] + MS_K[j][2] * MS_K[j][2];
     b[j] = -((lambda + mu) * ddiv - mu * MS_A[j] * k2 * sn[j]);
   }
@@ -58,7 +60,8 @@ static void exact_traction(double lambda, double mu, const double x[3], const do
   const double tr = G[0] + G[4] + G[8];
   for (int i = 0; i < 3; i++) {
     t[i] = lambda * tr * n[i];
-    for (int j = 0; j < 3; j++) t[i] += mu * (G[3 * i + j] + G[3 * j + i]) * n[j];
+    for (int j = 0; j < 3; j++)
+      t[i] += mu * (G[3 * i + j] + G[3 * j + i]) * n[j];
   }
 }
 
@@ -111,14 +114,19 @@ static double tet_bary(const double *a, const double *b, const double *c, const 
                        const double x[3], double l[4])
 {
   double e1[3], e2[3], e3[3], r[3], J[9], Ji[9];
-  for (int k = 0; k < 3; k++) e1[k] = b[k] - a[k], e2[k] = c[k] - a[k], e3[k] = d[k] - a[k];
-  for (int k = 0; k < 3; k++) J[3 * k] = e1[k], J[3 * k + 1] = e2[k], J[3 * k + 2] = e3[k];
+  for (int k = 0; k < 3; k++)
+    e1[k] = b[k] - a[k], e2[k] = c[k] - a[k], e3[k] = d[k] - a[k];
+  for (int k = 0; k < 3; k++)
+    J[3 * k] = e1[k], J[3 * k + 1] = e2[k], J[3 * k + 2] = e3[k];
   if (!(fabs(inv3(J, Ji)) > 0.0)) return -HUGE_VAL;
-  for (int k = 0; k < 3; k++) r[k] = x[k] - a[k];
-  for (int k = 0; k < 3; k++) l[k + 1] = Ji[3 * k] * r[0] + Ji[3 * k + 1] * r[1] + Ji[3 * k + 2] * r[2];
+  for (int k = 0; k < 3; k++)
+    r[k] = x[k] - a[k];
+  for (int k = 0; k < 3; k++)
+    l[k + 1] = Ji[3 * k] * r[0] + Ji[3 * k + 1] * r[1] + Ji[3 * k + 2] * r[2];
   l[0] = 1.0 - l[1] - l[2] - l[3];
   double m = l[0];
-  for (int k = 1; k < 4; k++) m = fmin(m, l[k]);
+  for (int k = 1; k < 4; k++)
+    m = fmin(m, l[k]);
   return m;
 }
 
@@ -142,7 +150,8 @@ static fcm_status tet_index_create(fcm_ctx *ctx, const double *coords, const fcm
   if (!boxes) return FCM_ERR_ALLOC;
   for (fcm_index t = 0; t < n; t++) {
     double *bx = boxes + 6 * t;
-    for (int d = 0; d < 3; d++) bx[d] = HUGE_VAL, bx[3 + d] = -HUGE_VAL;
+    for (int d = 0; d < 3; d++)
+      bx[d] = HUGE_VAL, bx[3 + d] = -HUGE_VAL;
     for (int a = 0; a < 4; a++)
       for (int d = 0; d < 3; d++) {
         const double v = coords[3 * cells[(size_t)stride * t + a] + d];
@@ -162,7 +171,8 @@ static fcm_index tet_locate(const tet_index *ti, const double x[3], double l[4])
 {
   fcm_index buf[64], *ids = buf, cnt = 0, best = -1;
   double lo[3], hi[3], bl = -HUGE_VAL, lt[4];
-  for (int d = 0; d < 3; d++) lo[d] = x[d] - ti->tol, hi[d] = x[d] + ti->tol;
+  for (int d = 0; d < 3; d++)
+    lo[d] = x[d] - ti->tol, hi[d] = x[d] + ti->tol;
   if (fcm_aabb_tree_query(ti->tree, lo, hi, 64, ids, &cnt) != FCM_OK) return -1;
   if (cnt > 64) { /* the buffer's content is unspecified: query again with room for all */
     ids = malloc(sizeof *ids * (size_t)cnt);
@@ -221,13 +231,17 @@ static fcm_status build_facets(cv_study *S)
     double *f = S->facets + FACET_STRIDE * S->nfacets++;
     double e1[3], e2[3], n[3], ax[3] = {0, 0, 0};
     for (int a = 0; a < 3; a++)
-      for (int d = 0; d < 3; d++) f[3 * a + d] = v[a][d], ax[d] += v[a][d] / 3.0;
-    for (int d = 0; d < 3; d++) e1[d] = v[1][d] - v[0][d], e2[d] = v[2][d] - v[0][d];
+      for (int d = 0; d < 3; d++)
+        f[3 * a + d] = v[a][d], ax[d] += v[a][d] / 3.0;
+    for (int d = 0; d < 3; d++)
+      e1[d] = v[1][d] - v[0][d], e2[d] = v[2][d] - v[0][d];
     cross(e1, e2, n);
     const double ln = sqrt(dot(n, n)), la = sqrt(dot(ax, ax));
     double cmin = 1.0;
-    for (int d = 0; d < 3; d++) f[9 + d] = n[d] / ln, f[12 + d] = ax[d] / la;
-    for (int a = 0; a < 3; a++) cmin = fmin(cmin, dot(v[a], f + 12) / sqrt(dot(v[a], v[a])));
+    for (int d = 0; d < 3; d++)
+      f[9 + d] = n[d] / ln, f[12 + d] = ax[d] / la;
+    for (int a = 0; a < 3; a++)
+      cmin = fmin(cmin, dot(v[a], f + 12) / sqrt(dot(v[a], v[a])));
     f[15] = cmin - 1e-9;
   }
   return FCM_OK;
@@ -243,7 +257,8 @@ static int ray_hit(const cv_study *S, const double d[3], double n[3], double *di
     if (dot(d, f + 12) < f[15]) continue;
     /* Moller-Trumbore from the origin */
     double e1[3], e2[3], p[3], q[3], tv[3];
-    for (int c = 0; c < 3; c++) e1[c] = f[3 + c] - f[c], e2[c] = f[6 + c] - f[c], tv[c] = -f[c];
+    for (int c = 0; c < 3; c++)
+      e1[c] = f[3 + c] - f[c], e2[c] = f[6 + c] - f[c], tv[c] = -f[c];
     cross(d, e2, p);
     const double det = dot(e1, p);
     if (fabs(det) < 1e-300) continue;
@@ -276,7 +291,8 @@ static void staircase_load(const cv_study *S, const double x[3], const double nf
     exact_traction(S->lambda, S->mu, x, nf, t);
     return;
   }
-  for (int i = 0; i < 3; i++) d[i] = x[i] / r;
+  for (int i = 0; i < 3; i++)
+    d[i] = x[i] / r;
   ray_hit(S, d, n, &dist);
   if (S->s.fem_traction == CV_TRACTION_NAIVE) {
     exact_traction(S->lambda, S->mu, x, n, t);
@@ -285,10 +301,14 @@ static void staircase_load(const cv_study *S, const double x[3], const double nf
   const double y[3] = {dist * d[0], dist * d[1], dist * d[2]};
   const double J = dist * dist * dot(d, nf) / (r * r * dot(d, n));
   exact_traction(S->lambda, S->mu, y, n, t);
-  for (int i = 0; i < 3; i++) t[i] *= J;
+  for (int i = 0; i < 3; i++)
+    t[i] *= J;
 }
 
-const fcm_geometry *cv_study_geometry(const cv_study *study) { return study->geom; }
+const fcm_geometry *cv_study_geometry(const cv_study *study)
+{
+  return study->geom;
+}
 
 void cv_study_reference_info(const cv_study *study, fcm_index *dofs, double *seconds)
 {
@@ -350,7 +370,8 @@ static fcm_status dirichlet_y0(const cv_study *S, const fcm_space *space, fcm_in
     if (d < 0) continue;
     double u[3] = {0, 0, 0};
     if (S->s.problem == CV_MANUFACTURED) cv_exact(X + 3 * nodes[k], u, NULL);
-    for (int i = 0; i < 3; i++) (*dofs)[*ncon] = d + i, (*vals)[(*ncon)++] = u[i];
+    for (int i = 0; i < 3; i++)
+      (*dofs)[*ncon] = d + i, (*vals)[(*ncon)++] = u[i];
   }
   free(nodes);
   return st;
@@ -389,7 +410,8 @@ static fcm_status staircase_traction(const cv_study *S, const fcm_space *space,
       const int ncorn = info->face_num_corners[fc];
       const int *fn = info->face_nodes[fc];
       int on_y0 = 1;
-      for (int k = 0; k < ncorn; k++) on_y0 &= fabs(X[3 * fn[k] + 1]) < yt;
+      for (int k = 0; k < ncorn; k++)
+        on_y0 &= fabs(X[3 * fn[k] + 1]) < yt;
       if (on_y0) continue;
       memset(fe, 0, sizeof(double) * 3 * (size_t)nn);
       for (int q = 0; q < nq; q++) {
@@ -421,15 +443,18 @@ static fcm_status staircase_traction(const cv_study *S, const fcm_space *space,
         }
         cross(a, b, ab);
         const double dA = qw[q] * sqrt(dot(ab, ab));
-        for (int i = 0; i < 3; i++) n[i] = ab[i] / sqrt(dot(ab, ab));
+        for (int i = 0; i < 3; i++)
+          n[i] = ab[i] / sqrt(dot(ab, ab));
         staircase_load(S, x, n, tr);
         fcm_element_eval_shape(type, xi, N);
         for (int k = 0; k < nn; k++)
-          for (int i = 0; i < 3; i++) fe[3 * k + i] += dA * N[k] * tr[i];
+          for (int i = 0; i < 3; i++)
+            fe[3 * k + i] += dA * N[k] * tr[i];
       }
       for (int k = 0; k < nn; k++) {
         const fcm_index d = fcm_space_node_dof(space, cn[(size_t)nn * c + k]);
-        for (int i = 0; i < 3; i++) f[d + i] += fe[3 * k + i];
+        for (int i = 0; i < 3; i++)
+          f[d + i] += fe[3 * k + i];
       }
     }
   }
@@ -478,7 +503,8 @@ static double tet_volume6(const double *X, const fcm_index *t)
 {
   double J[9];
   for (int k = 0; k < 3; k++)
-    for (int d = 0; d < 3; d++) J[3 * d + k] = X[3 * t[k + 1] + d] - X[3 * t[0] + d];
+    for (int d = 0; d < 3; d++)
+      J[3 * d + k] = X[3 * t[k + 1] + d] - X[3 * t[0] + d];
   return det3(J);
 }
 
@@ -510,10 +536,11 @@ static fcm_status refine_tets(fcm_index *nv, double **X, fcm_index *nt, fcm_inde
     const fcm_index *c = *tets + 4 * t;
     fcm_index m[4][4];
     for (int i = 0; i < 4; i++)
-      for (int j = i + 1; j < 4; j++) m[i][j] = m[j][i] = v0 + edge_id(edges, ne, c[i], c[j]);
+      for (int j = i + 1; j < 4; j++)
+        m[i][j] = m[j][i] = v0 + edge_id(edges, ne, c[i], c[j]);
     const fcm_index sub[8][4] = {
-        {c[0], m[0][1], m[0][2], m[0][3]}, {m[0][1], c[1], m[1][2], m[1][3]},
-        {m[0][2], m[1][2], c[2], m[2][3]}, {m[0][3], m[1][3], m[2][3], c[3]},
+        {c[0], m[0][1], m[0][2], m[0][3]},    {m[0][1], c[1], m[1][2], m[1][3]},
+        {m[0][2], m[1][2], c[2], m[2][3]},    {m[0][3], m[1][3], m[2][3], c[3]},
         {m[0][1], m[0][2], m[0][3], m[1][3]}, {m[0][1], m[0][2], m[1][2], m[1][3]},
         {m[0][2], m[0][3], m[1][3], m[2][3]}, {m[0][2], m[1][2], m[1][3], m[2][3]}};
     for (int k = 0; k < 8; k++) {
@@ -553,7 +580,8 @@ static fcm_status make_tet10(fcm_ctx *ctx, fcm_index nv, double *X, fcm_index nt
   for (fcm_index t = 0; t < nt && st == FCM_OK; t++) {
     const fcm_index *c = tets + 4 * t;
     fcm_index *o = C + 10 * t;
-    for (int a = 0; a < 4; a++) o[a] = c[a];
+    for (int a = 0; a < 4; a++)
+      o[a] = c[a];
     for (int e = 0; e < info->num_edges; e++)
       o[info->edge_nodes[e][2]] =
           nv + edge_id(edges, ne, c[info->edge_nodes[e][0]], c[info->edge_nodes[e][1]]);
@@ -620,7 +648,8 @@ static fcm_status reference_create(cv_study *S)
   }
   memcpy(X, fcm_geometry_coords(S->geom), sizeof *X * 3 * (size_t)nv);
   memcpy(T, fcm_geometry_cells(S->geom), sizeof *T * 4 * (size_t)nt);
-  for (int r = 0; r < S->s.ref_refine && st == FCM_OK; r++) st = refine_tets(&nv, &X, &nt, &T);
+  for (int r = 0; r < S->s.ref_refine && st == FCM_OK; r++)
+    st = refine_tets(&nv, &X, &nt, &T);
   if (st == FCM_OK) st = make_tet10(ctx, nv, X, nt, T, &S->ref_mesh);
   free(X), free(T);
   if (st == FCM_OK) st = fcm_space_create(ctx, S->ref_mesh, NULL, &S->ref_space);
@@ -638,8 +667,7 @@ static fcm_status reference_create(cv_study *S)
     st = tet_index_create(ctx, fcm_mesh_coords(S->ref_mesh), fcm_mesh_cells(S->ref_mesh), 10,
                           fcm_mesh_num_cells(S->ref_mesh), &S->ref_tets);
   S->ref_time = fcm_wtime() - t0;
-  if (st == FCM_OK)
-    fprintf(stderr, CV_PROG ": reference solved in %.1f s\n", S->ref_time);
+  if (st == FCM_OK) fprintf(stderr, CV_PROG ": reference solved in %.1f s\n", S->ref_time);
   return st;
 }
 
@@ -665,7 +693,8 @@ static int reference_eval(const cv_study *S, const double x[3], double u[3], dou
       g[j] = dN[3 * a] * Ji[j] + dN[3 * a + 1] * Ji[3 + j] + dN[3 * a + 2] * Ji[6 + j];
     for (int i = 0; i < 3; i++) {
       u[i] += N[a] * ua[i];
-      for (int j = 0; j < 3; j++) G[3 * i + j] += ua[i] * g[j];
+      for (int j = 0; j < 3; j++)
+        G[3 * i + j] += ua[i] * g[j];
     }
   }
   return 1;
@@ -682,7 +711,8 @@ fcm_status cv_study_create(fcm_ctx *ctx, const cv_setup *setup, cv_study **study
   S->s = *setup;
   const fcm_material mat = {FCM_MATERIAL_LINEAR, setup->young, setup->poisson, 0.0};
   st = fcm_material_lame(ctx, &mat, &S->lambda, &S->mu);
-  if (st == FCM_OK) st = fcm_geometry_create_hemisphere(ctx, c, setup->radius, setup->geom_n, &S->geom);
+  if (st == FCM_OK)
+    st = fcm_geometry_create_hemisphere(ctx, c, setup->radius, setup->geom_n, &S->geom);
   if (st == FCM_OK)
     st = tet_index_create(ctx, fcm_geometry_coords(S->geom), fcm_geometry_cells(S->geom), 4,
                           fcm_geometry_num_cells(S->geom), &S->geo_tets);
@@ -758,7 +788,8 @@ static fcm_status staircase_cells(const cv_study *S, const fcm_mesh *mesh, unsig
   for (fcm_index c = 0; c < nc; c++) {
     double x[3] = {0, 0, 0}, l[4];
     for (int a = 0; a < ncorn; a++)
-      for (int d = 0; d < 3; d++) x[d] += X[3 * cn[(size_t)nn * c + a] + d] / ncorn;
+      for (int d = 0; d < 3; d++)
+        x[d] += X[3 * cn[(size_t)nn * c + a] + d] / ncorn;
     const fcm_index t = tet_locate(&S->geo_tets, x, l);
     keep[c] = t >= 0 && l[0] >= -1e-10 && l[1] >= -1e-10 && l[2] >= -1e-10 && l[3] >= -1e-10;
     cnt += keep[c];
@@ -776,14 +807,16 @@ static int cell_errors(const cv_study *S, const fcm_space *space, const fcm_cell
   const fcm_element_type type = info->type;
   const int nn = info->num_nodes;
   const fcm_index *cn = fcm_mesh_cells(mesh) + (size_t)nn * e;
-  double Xc[3 * FCM_ELEMENT_MAX_NODES], Xe[3 * FCM_ELEMENT_MAX_NODES], ue[3 * FCM_ELEMENT_MAX_NODES];
+  double Xc[3 * FCM_ELEMENT_MAX_NODES], Xe[3 * FCM_ELEMENT_MAX_NODES],
+      ue[3 * FCM_ELEMENT_MAX_NODES];
   int np = 0;
   const double *pts = NULL, *w = NULL;
   const unsigned char *flags = NULL;
   fcm_cell_rules_get(er, c, FCM_RULE_STIFFNESS, &np, &pts, &w, &flags);
   fcm_mesh_cell_coords(mesh, c, Xc);
   if (e != c) fcm_mesh_cell_coords(mesh, e, Xe);
-  for (int a = 0; a < nn; a++) memcpy(ue + 3 * a, u + fcm_space_node_dof(space, cn[a]), 3 * sizeof *u);
+  for (int a = 0; a < nn; a++)
+    memcpy(ue + 3 * a, u + fcm_space_node_dof(space, cn[a]), 3 * sizeof *u);
   for (int q = 0; q < np; q++) {
     if (flags && flags[q]) continue;
     double J[9], Ji[9], x[3], xi[3], N[FCM_ELEMENT_MAX_NODES], dN[3 * FCM_ELEMENT_MAX_NODES];
@@ -802,7 +835,8 @@ static int cell_errors(const cv_study *S, const fcm_space *space, const fcm_cell
         g[j] = dN[3 * a] * Ji[j] + dN[3 * a + 1] * Ji[3 + j] + dN[3 * a + 2] * Ji[6 + j];
       for (int i = 0; i < 3; i++) {
         uh[i] += N[a] * ue[3 * a + i];
-        for (int j = 0; j < 3; j++) Gh[3 * i + j] += ue[3 * a + i] * g[j];
+        for (int j = 0; j < 3; j++)
+          Gh[3 * i + j] += ue[3 * a + i] * g[j];
       }
     }
     if (S->s.problem == CV_MANUFACTURED)
@@ -850,7 +884,8 @@ static fcm_status errors(const cv_study *S, const fcm_space *space, const fcm_ce
   }
   double t[5] = {0, 0, 0, 0, 0};
   for (fcm_index c = 0; c < nc; c++)
-    for (int k = 0; k < 5; k++) t[k] += acc[5 * c + k];
+    for (int k = 0; k < 5; k++)
+      t[k] += acc[5 * c + k];
   free(acc);
   r->err_l2 = sqrt(t[0]), r->err_h1 = sqrt(t[1]);
   r->norm_l2 = sqrt(t[2]), r->norm_h1 = sqrt(t[3]);
@@ -887,8 +922,7 @@ fcm_status cv_run(cv_study *S, const fcm_mesh *mesh, const fcm_cell_rules *err_r
     fcm_cell_rules_options o = fcm_cell_rules_options_default();
     o.strength[FCM_RULE_STIFFNESS] = strength;
     o.strength[FCM_RULE_MASS] = 0; /* static problem: no mass matrix */
-    o.surface_strength =
-        S->s.surface_strength >= 0 ? S->s.surface_strength : 2 * info->order + 2;
+    o.surface_strength = S->s.surface_strength >= 0 ? S->s.surface_strength : 2 * info->order + 2;
     o.simplify = simplify;
     o.min_fraction = S->s.min_fraction;
     if (S->s.stab_alpha > 0.0)
@@ -929,7 +963,8 @@ fcm_status cv_run(cv_study *S, const fcm_mesh *mesh, const fcm_cell_rules *err_r
   stamp_lap(t0, &r->t_assembly, &r->c_assembly);
   r->dofs = fcm_space_num_dofs(space);
   r->active_cells = 0;
-  for (fcm_index c = 0; c < nc; c++) r->active_cells += fcm_space_cell_active(space, c);
+  for (fcm_index c = 0; c < nc; c++)
+    r->active_cells += fcm_space_cell_active(space, c);
   u = calloc((size_t)r->dofs, sizeof *u);
   if (!u) {
     st = FCM_ERR_ALLOC;

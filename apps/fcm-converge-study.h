@@ -38,17 +38,17 @@ typedef enum cv_fem_traction {
 /** Settings shared by every run of a study. */
 typedef struct cv_setup {
   cv_problem problem;
-  double radius;          /* hemisphere radius (centre 0, flat face on y = 0) */
-  int geom_n;             /* fcm_geometry_create_hemisphere resolution (24 n^3 tets) */
-  double young, poisson;  /* linear elastic material */
-  int strength;           /* cut-cell stiffness strength; -1: the element default */
-  int surface_strength;   /* surface rules (FCM traction, FEM staircase faces); -1: default */
-  int simplify;           /* FCM cut-cell rules simplified (1) or not (0) */
-  double stab_alpha;      /* stabilization weight factor; 0: off */
-  double min_fraction;    /* FCM: cells with phi below this are dropped */
-  int error_strength;     /* strength of the error-norm rules */
+  double radius;         /* hemisphere radius (centre 0, flat face on y = 0) */
+  int geom_n;            /* fcm_geometry_create_hemisphere resolution (24 n^3 tets) */
+  double young, poisson; /* linear elastic material */
+  int strength;          /* cut-cell stiffness strength; -1: the element default */
+  int surface_strength;  /* surface rules (FCM traction, FEM staircase faces); -1: default */
+  int simplify;          /* FCM cut-cell rules simplified (1) or not (0) */
+  double stab_alpha;     /* stabilization weight factor; 0: off */
+  double min_fraction;   /* FCM: cells with phi below this are dropped */
+  int error_strength;    /* strength of the error-norm rules */
   cv_fem_traction fem_traction;
-  int ref_refine;         /* reference mode: uniform 8-splits of the geometry tets */
+  int ref_refine; /* reference mode: uniform 8-splits of the geometry tets */
   int verbose;
 } cv_setup;
 
@@ -56,22 +56,22 @@ typedef struct cv_setup {
 typedef struct cv_result {
   fcm_element_type element;
   cv_method method;
-  int res;              /* cells per unit length; h = 1 / res */
+  int res; /* cells per unit length; h = 1 / res */
   double h;
-  int strength;         /* stiffness strength of the cut cells (FCM), of the full cells (FEM) */
+  int strength; /* stiffness strength of the cut cells (FCM), of the full cells (FEM) */
   fcm_index dofs;
   fcm_index active_cells, cut_cells;
-  fcm_index points;     /* stiffness quadrature points stored for the active cells */
-  double t_rules;       /* FCM: cell rules; FEM: centroid classification */
-  double t_assembly;    /* space, pattern, stiffness, loads, Dirichlet elimination */
-  double t_solve;       /* CHOLMOD analyze + factor + solve */
-  double t_total;       /* sum of the three */
+  fcm_index points;  /* stiffness quadrature points stored for the active cells */
+  double t_rules;    /* FCM: cell rules; FEM: centroid classification */
+  double t_assembly; /* space, pattern, stiffness, loads, Dirichlet elimination */
+  double t_solve;    /* CHOLMOD analyze + factor + solve */
+  double t_total;    /* sum of the three */
   double c_rules, c_assembly, c_solve, c_total; /* the same in process CPU seconds */
-  double err_l2, err_h1;       /* ||u_h - u||_L2, |u_h - u|_H1 over the measured domain */
-  double norm_l2, norm_h1;     /* ||u||_L2, |u|_H1 over the same domain */
-  double measured_volume;      /* volume the errors were integrated over */
-  double domain_volume;        /* |Omega| (the polyhedron) */
-  int failed;                  /* 1: the run failed (message in `note`) */
+  double err_l2, err_h1;   /* ||u_h - u||_L2, |u_h - u|_H1 over the measured domain */
+  double norm_l2, norm_h1; /* ||u||_L2, |u|_H1 over the same domain */
+  double measured_volume;  /* volume the errors were integrated over */
+  double domain_volume;    /* |Omega| (the polyhedron) */
+  int failed;              /* 1: the run failed (message in `note`) */
   char note[160];
 } cv_result;
 
@@ -88,8 +88,8 @@ void cv_study_reference_info(const cv_study *study, fcm_index *dofs, double *sec
 
 /** Per-run overrides (e.g. the m-sweep's strength); a NULL pointer means none. */
 typedef struct cv_run_options {
-  int strength;  /* FCM cut-cell stiffness strength; -1 the element's default, -2 the setup's */
-  int simplify;  /* 0 or 1; -1: the setup's */
+  int strength; /* FCM cut-cell stiffness strength; -1 the element's default, -2 the setup's */
+  int simplify; /* 0 or 1; -1: the setup's */
 } cv_run_options;
 
 /** Solve one (element, res, method) problem and measure its errors; the error rules of the
@@ -114,7 +114,8 @@ void cv_exact_body_force(double lambda, double mu, const double x[3], double b[3
 /** Least-squares slope of log(err) against log(h) over n points; NaN when n < 2. */
 double cv_fit_rate(int n, const double *h, const double *err);
 
-/* ---------------------------------------------------------------- output (fcm-converge-output.c) */
+/* ---------------------------------------------------------------- output (fcm-converge-output.c)
+ */
 
 /** A fitted rate: element x method x norm over the finest `levels` successful levels. */
 typedef struct cv_rate {
@@ -122,8 +123,8 @@ typedef struct cv_rate {
   cv_method method;
   int norm; /* 0: L2, 1: H1 */
   double rate;
-  int levels;     /* levels used in the fit */
-  int monotone;   /* 1: the error decreased at every refinement (all levels) */
+  int levels;   /* levels used in the fit */
+  int monotone; /* 1: the error decreased at every refinement (all levels) */
   double h_min, h_max;
 } cv_rate;
 

@@ -21,7 +21,7 @@
 #include <time.h>
 
 #define MAX_LEVELS 32
-#define MAX_SWEEP 24
+#define MAX_SWEEP  24
 
 typedef struct config {
   cv_setup setup;
@@ -53,101 +53,101 @@ typedef struct config {
 
 static void usage(FILE *f)
 {
-  fprintf(f,
-          "usage: " CV_PROG " [options]           convergence, accuracy vs time, strength sweep\n"
-          "       " CV_PROG " payoff [options]    simplification payoff (Longva et al. 2020 §6.3)\n"
-          "\n"
-          "Static linear elasticity on a hemisphere (tet mesh of radius R, flat face on y = 0)\n"
-          "embedded in the box [-1,1]x[0,1]x[-1,1] meshed with 2res x res x 2res cubes (h = 1/res;\n"
-          "tets: 6 per cube). FCM integrates the exact polyhedron with cut-cell rules; FEM keeps\n"
-          "the cells whose centroid lies inside the polyhedron (point-in-tet test on the geometry\n"
-          "mesh) and integrates them fully - the staircase a plain FEM would use.\n"
-          "Default problem: manufactured u_i = A_i sin(k_i.x + phi_i) (E = 1, nu = 0.3); body\n"
-          "force -div sigma(u); FCM traction sigma(u) n on the embedded boundary (facet normals);\n"
-          "the FEM knows only its staircase boundary and receives the true surface load there\n"
-          "(--fem-traction); body force b(x) on all kept cells; u = u_exact on all nodes on y = 0.\n"
-          "Errors: ||u_h - u||_L2 and |u_h - u|_H1 with strength-8 rules of the polyhedron on the\n"
-          "same grid (FCM: all of Omega, dropped cells extrapolated from a face neighbour; FEM:\n"
-          "Omega inside the kept cells - column 'meas' is that volume / |Omega|).\n"
-          "Rates: least-squares slope of log err vs log h over the finest --fit levels.\n"
-          "\n"
-          "study options:\n"
-          "  --elements LIST        tet4,tet10,hex8,hex20                     (default all)\n"
-          "  --methods LIST         fcm,fem                                   (default both)\n"
-          "  --levels LIST          resolutions res, h = 1/res     (default 2,3,4,6,8)\n"
-          "  --quick                levels 2,3,4, geometry n 6, sweep res 2 with m = 2..5\n"
-          "  --reference            the authors' problem: E = 5e4, nu = 0, load -5e5 y\n"
-          "                         exp(-1/(1-9r^2)) e_y (3r < 1), u = 0 on y = 0, traction free;\n"
-          "                         errors against boundary-conforming Tet10 on the geometry's\n"
-          "                         tets refined --ref-refine times (default 1; quick 0)\n"
-          "  --radius R             hemisphere radius in (0, 1)               (default 0.9)\n"
-          "  --geom-n N             geometry resolution, 24 N^3 tets          (default 8)\n"
-          "  --strength M           FCM cut-cell stiffness strength           (default element's)\n"
-          "  --surface-strength M   traction rules (FCM and FEM faces)        (default 2p+2)\n"
-          "  --simplify on|off      simplify FCM cut-cell rules               (default on)\n"
-          "  --stabilization A      FCM stabilization alpha, 0 = off          (default 0)\n"
-          "  --min-fraction F       FCM: drop cells with volume fraction < F  (default 0: only\n"
-          "                         empty cells; a dropped cell takes its share of the surface\n"
-          "                         load with it, ~sqrt(F) h^2 each, which stalls convergence)\n"
-          "  --error-strength M     strength of the error rules               (default 8)\n"
-          "  --fem-traction MODE    surface load of the staircase FEM         (default projected)\n"
-          "                         projected: the true load t(y) = sigma(u(y)) n(y) on the\n"
-          "                         polyhedron carried along rays from the centre to the\n"
-          "                         staircase faces (weight |y|^2 (d.n_face) / (|x|^2 (d.n)):\n"
-          "                         the total force is that of the true surface);\n"
-          "                         naive: sigma(u(x)) n_true(x) per staircase face area\n"
-          "                         (n_true: facet met by the ray; the load grows with the\n"
-          "                         staircase's excess area, so this FEM does not converge);\n"
-          "                         face: sigma(u(x)) n_face, the exact data of the staircase\n"
-          "                         domain itself (control: optimal rates, no geometric error)\n"
-          );
-  fprintf(f,
-          "  --fit N                levels in the rate fit                    (default 3)\n"
-          "  --sweep-element E      element of the strength sweep (FCM)       (default hex20)\n"
-          "  --sweep-res R          resolution of the sweep                   (default 4)\n"
-          "  --sweep-strengths LIST strengths m                               (default 1..8)\n"
-          "  --no-sweep             skip the strength sweep\n"
-          "  --time wall|cpu        time base of the accuracy-vs-time table and plot (default\n"
-          "                         wall; cpu = process CPU seconds of all threads, steadier\n"
-          "                         on a shared machine)\n"
-          "  --out PREFIX           output prefix                             (default fcm-converge)\n"
-          "  --csv FILE             per-level CSV            (default PREFIX-levels.csv)\n"
-          "  --rates-csv FILE       fitted rates CSV         (default PREFIX-rates.csv)\n"
-          "  --sweep-csv FILE       strength sweep CSV       (default PREFIX-sweep.csv)\n"
-          "  --no-plots             no PNG files (else PREFIX-convergence.png, PREFIX-pareto.png,\n"
-          "                         PREFIX-sweep.png through gnuplot; without gnuplot a message\n"
-          "                         is printed and the CSV files are still written)\n"
-          "\n");
-  fprintf(f,
-          "payoff options (Hex20 FCM on the hemisphere with the manufactured displacement):\n"
-          "  --element E            element                                   (default hex20)\n"
-          "  --res R                resolution                                (default 8; quick 4)\n"
-          "  --geom-n N, --strength M, --radius R   as above (default strength: element's)\n"
-          "  --repeat N             timed iterations per variant, minimum kept (default 3)\n"
-          "  --csv FILE             write the two variants as CSV\n"
-          "  --quick                res 4, geometry n 6, repeat 2\n"
-          "\n"
-          "CSV columns. levels: element,method,res,h,dofs,active_cells,cut_cells,points,\n"
-          "  strength,t_rules,t_assembly,t_solve,t_total,err_l2,err_h1,norm_l2,norm_h1,rel_l2,\n"
-          "  rel_h1,measured_volume,domain_volume,failed,note,cpu_rules,cpu_assembly,cpu_solve,\n"
-          "  cpu_total (cpu_*: process CPU seconds of the phases). points: stiffness quadrature\n"
-          "  points of all stored cells (FCM) or kept cells x standard rule (FEM); strength: the\n"
-          "  FCM cut-cell strength or the FEM full-cell rule's; t_rules: FCM cell rules (stiffness\n"
-          "  rules of the cut-cell strength, surface rules, mass rules of strength 0 - a static\n"
-          "  problem assembles no mass) or the FEM centroid classification; t_assembly: space,\n"
-          "  pattern, stiffness, loads, Dirichlet\n"
-          "  elimination; t_solve: CHOLMOD analyze+factor+solve; times are wall-clock seconds;\n"
-          "  err_*: absolute errors, norm_*: the exact (reference) norms over the same domain.\n"
-          "  rates: element,method,norm,rate (method fcm|fem, norm L2|H1).\n"
-          "  sweep: element,method,res,h,strength,points,dofs,t_rules,t_assembly,t_solve,t_total,\n"
-          "  err_l2,err_h1,rel_l2,rel_h1,failed,note,cpu_rules,cpu_assembly,cpu_solve,cpu_total.\n"
-          "  payoff: element,res,simplified,points_cut,points_total,t_rules,t_simplify,\n"
-          "  t_assembly,t_factor_solve,t_iteration,break_even_iterations,cpu_rules,cpu_iteration,\n"
-          "  break_even_cpu.\n"
-          "Timings are wall-clock with the OpenMP threads of the environment; on a loaded machine\n"
-          "set OMP_WAIT_POLICY=passive (spinning threads inflate small phases).\n"
-          "stdout: tables; stderr: progress. Exit 0 on success, 1 on a computation or output\n"
-          "error, 2 on a usage error.\n");
+  fprintf(
+      f, "usage: " CV_PROG " [options]           convergence, accuracy vs time, strength sweep\n"
+         "       " CV_PROG " payoff [options]    simplification payoff (Longva et al. 2020 §6.3)\n"
+         "\n"
+         "Static linear elasticity on a hemisphere (tet mesh of radius R, flat face on y = 0)\n"
+         "embedded in the box [-1,1]x[0,1]x[-1,1] meshed with 2res x res x 2res cubes (h = 1/res;\n"
+         "tets: 6 per cube). FCM integrates the exact polyhedron with cut-cell rules; FEM keeps\n"
+         "the cells whose centroid lies inside the polyhedron (point-in-tet test on the geometry\n"
+         "mesh) and integrates them fully - the staircase a plain FEM would use.\n"
+         "Default problem: manufactured u_i = A_i sin(k_i.x + phi_i) (E = 1, nu = 0.3); body\n"
+         "force -div sigma(u); FCM traction sigma(u) n on the embedded boundary (facet normals);\n"
+         "the FEM knows only its staircase boundary and receives the true surface load there\n"
+         "(--fem-traction); body force b(x) on all kept cells; u = u_exact on all nodes on y = 0.\n"
+         "Errors: ||u_h - u||_L2 and |u_h - u|_H1 with strength-8 rules of the polyhedron on the\n"
+         "same grid (FCM: all of Omega, dropped cells extrapolated from a face neighbour; FEM:\n"
+         "Omega inside the kept cells - column 'meas' is that volume / |Omega|).\n"
+         "Rates: least-squares slope of log err vs log h over the finest --fit levels.\n"
+         "\n"
+         "study options:\n"
+         "  --elements LIST        tet4,tet10,hex8,hex20                     (default all)\n"
+         "  --methods LIST         fcm,fem                                   (default both)\n"
+         "  --levels LIST          resolutions res, h = 1/res     (default 2,3,4,6,8)\n"
+         "  --quick                levels 2,3,4, geometry n 6, sweep res 2 with m = 2..5\n"
+         "  --reference            the authors' problem: E = 5e4, nu = 0, load -5e5 y\n"
+         "                         exp(-1/(1-9r^2)) e_y (3r < 1), u = 0 on y = 0, traction free;\n"
+         "                         errors against boundary-conforming Tet10 on the geometry's\n"
+         "                         tets refined --ref-refine times (default 1; quick 0)\n"
+         "  --radius R             hemisphere radius in (0, 1)               (default 0.9)\n"
+         "  --geom-n N             geometry resolution, 24 N^3 tets          (default 8)\n"
+         "  --strength M           FCM cut-cell stiffness strength           (default element's)\n"
+         "  --surface-strength M   traction rules (FCM and FEM faces)        (default 2p+2)\n"
+         "  --simplify on|off      simplify FCM cut-cell rules               (default on)\n"
+         "  --stabilization A      FCM stabilization alpha, 0 = off          (default 0)\n"
+         "  --min-fraction F       FCM: drop cells with volume fraction < F  (default 0: only\n"
+         "                         empty cells; a dropped cell takes its share of the surface\n"
+         "                         load with it, ~sqrt(F) h^2 each, which stalls convergence)\n"
+         "  --error-strength M     strength of the error rules               (default 8)\n"
+         "  --fem-traction MODE    surface load of the staircase FEM         (default projected)\n"
+         "                         projected: the true load t(y) = sigma(u(y)) n(y) on the\n"
+         "                         polyhedron carried along rays from the centre to the\n"
+         "                         staircase faces (weight |y|^2 (d.n_face) / (|x|^2 (d.n)):\n"
+         "                         the total force is that of the true surface);\n"
+         "                         naive: sigma(u(x)) n_true(x) per staircase face area\n"
+         "                         (n_true: facet met by the ray; the load grows with the\n"
+         "                         staircase's excess area, so this FEM does not converge);\n"
+         "                         face: sigma(u(x)) n_face, the exact data of the staircase\n"
+         "                         domain itself (control: optimal rates, no geometric error)\n");
+  fprintf(
+      f,
+      "  --fit N                levels in the rate fit                    (default 3)\n"
+      "  --sweep-element E      element of the strength sweep (FCM)       (default hex20)\n"
+      "  --sweep-res R          resolution of the sweep                   (default 4)\n"
+      "  --sweep-strengths LIST strengths m                               (default 1..8)\n"
+      "  --no-sweep             skip the strength sweep\n"
+      "  --time wall|cpu        time base of the accuracy-vs-time table and plot (default\n"
+      "                         wall; cpu = process CPU seconds of all threads, steadier\n"
+      "                         on a shared machine)\n"
+      "  --out PREFIX           output prefix                             (default fcm-converge)\n"
+      "  --csv FILE             per-level CSV            (default PREFIX-levels.csv)\n"
+      "  --rates-csv FILE       fitted rates CSV         (default PREFIX-rates.csv)\n"
+      "  --sweep-csv FILE       strength sweep CSV       (default PREFIX-sweep.csv)\n"
+      "  --no-plots             no PNG files (else PREFIX-convergence.png, PREFIX-pareto.png,\n"
+      "                         PREFIX-sweep.png through gnuplot; without gnuplot a message\n"
+      "                         is printed and the CSV files are still written)\n"
+      "\n");
+  fprintf(
+      f, "payoff options (Hex20 FCM on the hemisphere with the manufactured displacement):\n"
+         "  --element E            element                                   (default hex20)\n"
+         "  --res R                resolution                                (default 8; quick 4)\n"
+         "  --geom-n N, --strength M, --radius R   as above (default strength: element's)\n"
+         "  --repeat N             timed iterations per variant, minimum kept (default 3)\n"
+         "  --csv FILE             write the two variants as CSV\n"
+         "  --quick                res 4, geometry n 6, repeat 2\n"
+         "\n"
+         "CSV columns. levels: element,method,res,h,dofs,active_cells,cut_cells,points,\n"
+         "  strength,t_rules,t_assembly,t_solve,t_total,err_l2,err_h1,norm_l2,norm_h1,rel_l2,\n"
+         "  rel_h1,measured_volume,domain_volume,failed,note,cpu_rules,cpu_assembly,cpu_solve,\n"
+         "  cpu_total (cpu_*: process CPU seconds of the phases). points: stiffness quadrature\n"
+         "  points of all stored cells (FCM) or kept cells x standard rule (FEM); strength: the\n"
+         "  FCM cut-cell strength or the FEM full-cell rule's; t_rules: FCM cell rules (stiffness\n"
+         "  rules of the cut-cell strength, surface rules, mass rules of strength 0 - a static\n"
+         "  problem assembles no mass) or the FEM centroid classification; t_assembly: space,\n"
+         "  pattern, stiffness, loads, Dirichlet\n"
+         "  elimination; t_solve: CHOLMOD analyze+factor+solve; times are wall-clock seconds;\n"
+         "  err_*: absolute errors, norm_*: the exact (reference) norms over the same domain.\n"
+         "  rates: element,method,norm,rate (method fcm|fem, norm L2|H1).\n"
+         "  sweep: element,method,res,h,strength,points,dofs,t_rules,t_assembly,t_solve,t_total,\n"
+         "  err_l2,err_h1,rel_l2,rel_h1,failed,note,cpu_rules,cpu_assembly,cpu_solve,cpu_total.\n"
+         "  payoff: element,res,simplified,points_cut,points_total,t_rules,t_simplify,\n"
+         "  t_assembly,t_factor_solve,t_iteration,break_even_iterations,cpu_rules,cpu_iteration,\n"
+         "  break_even_cpu.\n"
+         "Timings are wall-clock with the OpenMP threads of the environment; on a loaded machine\n"
+         "set OMP_WAIT_POLICY=passive (spinning threads inflate small phases).\n"
+         "stdout: tables; stderr: progress. Exit 0 on success, 1 on a computation or output\n"
+         "error, 2 on a usage error.\n");
 }
 
 /* ---------------------------------------------------------------- options */
@@ -166,8 +166,7 @@ static int parse_double(const char *opt, const char *s, double lo, double hi, do
 }
 
 /* Comma list of integers in [lo, hi]; empty items are refused. */
-static int parse_int_list(const char *opt, const char *s, int lo, int hi, int *out, int cap,
-                          int *n)
+static int parse_int_list(const char *opt, const char *s, int lo, int hi, int *out, int cap, int *n)
 {
   char tok[64][CLI_TOKEN];
   if (!cli_list(CV_PROG, opt, s, tok, cap < 64 ? cap : 64, n)) return 0;
@@ -250,7 +249,8 @@ static void defaults(config *c)
   s->error_strength = 8;
   s->fem_traction = CV_TRACTION_PROJECTED;
   s->ref_refine = 1;
-  for (int e = 0; e < FCM_ELEMENT_COUNT; e++) c->elements[e] = (fcm_element_type)e;
+  for (int e = 0; e < FCM_ELEMENT_COUNT; e++)
+    c->elements[e] = (fcm_element_type)e;
   c->num_elements = FCM_ELEMENT_COUNT;
   c->methods[0] = CV_FCM, c->methods[1] = CV_FEM;
   c->num_methods = 2;
@@ -262,7 +262,8 @@ static void defaults(config *c)
   c->sweep_element = FCM_ELEMENT_HEX20;
   c->sweep_res = 4;
   c->num_sweep = 8;
-  for (int k = 0; k < 8; k++) c->sweep_strengths[k] = k + 1;
+  for (int k = 0; k < 8; k++)
+    c->sweep_strengths[k] = k + 1;
   c->out = CV_PROG;
   c->plots = 1;
   c->payoff_element = FCM_ELEMENT_HEX20;
@@ -315,8 +316,7 @@ static int parse_args(int argc, char **argv, config *c)
     } else if (!strcmp(a, "--methods") && !c->payoff)
       ok = parse_methods(v, c);
     else if (!strcmp(a, "--levels") && !c->payoff)
-      ok = parse_int_list(a, v, 1, 64, c->levels, MAX_LEVELS, &c->num_levels),
-      c->levels_given = 1;
+      ok = parse_int_list(a, v, 1, 64, c->levels, MAX_LEVELS, &c->num_levels), c->levels_given = 1;
     else if (!strcmp(a, "--ref-refine") && !c->payoff)
       ok = parse_int(a, v, 0, 3, &s->ref_refine), c->ref_refine_given = 1;
     else if (!strcmp(a, "--radius"))
@@ -396,7 +396,8 @@ static int parse_args(int argc, char **argv, config *c)
     if (!sweep_res_given) c->sweep_res = 2;
     if (!sweep_given) {
       c->num_sweep = 4;
-      for (int k = 0; k < 4; k++) c->sweep_strengths[k] = k + 2;
+      for (int k = 0; k < 4; k++)
+        c->sweep_strengths[k] = k + 2;
     }
     if (!res_given) c->payoff_res = 4;
     if (!repeat_given) c->repeat = 2;
@@ -419,8 +420,8 @@ static int parse_args(int argc, char **argv, config *c)
 static void progress(const cv_result *r)
 {
   if (r->failed)
-    fprintf(stderr, CV_PROG ": %-5s %s res %2d: FAILED (%s)\n", fcm_element_get_info(r->element)->name,
-            cv_method_name(r->method), r->res, r->note);
+    fprintf(stderr, CV_PROG ": %-5s %s res %2d: FAILED (%s)\n",
+            fcm_element_get_info(r->element)->name, cv_method_name(r->method), r->res, r->note);
   else
     fprintf(stderr,
             CV_PROG ": %-5s %s res %2d: %7lld dofs, rules %.2f s, assembly %.2f s, solve %.2f s,"
@@ -627,7 +628,8 @@ static fcm_status payoff_variant(fcm_ctx *ctx, const config *c, const fcm_mesh *
   p->points_stab = rs->points_stabilization[FCM_RULE_STIFFNESS];
   p->points_total = rs->points_total[FCM_RULE_STIFFNESS];
   p->t_simplify = rs->time_simplify;
-  fprintf(stderr, CV_PROG ": payoff: rules %s simplification: %.3f s, %lld cut-cell points (+%lld "
+  fprintf(stderr,
+          CV_PROG ": payoff: rules %s simplification: %.3f s, %lld cut-cell points (+%lld "
                   "stabilization), %lld in all\n",
           simplify ? "with" : "without", p->t_rules, (long long)p->points_cut,
           (long long)p->points_stab, (long long)p->points_total);
@@ -656,7 +658,8 @@ static fcm_status payoff_variant(fcm_ctx *ctx, const config *c, const fcm_mesh *
   for (fcm_index k = 0; k < cnt && st == FCM_OK; k++) {
     const fcm_index d = fcm_space_node_dof(space, nodes[k]);
     if (d >= 0)
-      for (int i = 0; i < 3; i++) con[ncon++] = d + i;
+      for (int i = 0; i < 3; i++)
+        con[ncon++] = d + i;
   }
   if (st == FCM_OK) st = fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, A, &chol);
   if (st == FCM_OK) st = fcm_direct_analyze(chol);
@@ -681,7 +684,8 @@ static fcm_status payoff_variant(fcm_ctx *ctx, const config *c, const fcm_mesh *
     qsort(ci, (size_t)c->repeat, sizeof *ci, cmp_double);
     p->t_assembly = ta[0], p->t_factor_solve = tf[0], p->t_iteration = ti[0];
     p->c_iteration = ci[0];
-    fprintf(stderr, CV_PROG ": payoff: %lld DOFs; Newton iteration %.3f s (assembly %.3f s, "
+    fprintf(stderr,
+            CV_PROG ": payoff: %lld DOFs; Newton iteration %.3f s (assembly %.3f s, "
                     "factor + solve %.3f s), fastest of %d\n",
             (long long)n, p->t_iteration, p->t_assembly, p->t_factor_solve, c->repeat);
   }
@@ -702,7 +706,8 @@ static int run_payoff(const config *c, fcm_ctx *ctx)
   const double center[3] = {0, 0, 0};
   int rc = 0;
   memset(p, 0, sizeof p);
-  fcm_status st = fcm_geometry_create_hemisphere(ctx, center, c->setup.radius, c->setup.geom_n, &geom);
+  fcm_status st =
+      fcm_geometry_create_hemisphere(ctx, center, c->setup.radius, c->setup.geom_n, &geom);
   if (st == FCM_OK) st = cv_mesh_create(ctx, c->payoff_element, c->payoff_res, &mesh);
   if (st == FCM_OK)
     fprintf(stderr, CV_PROG ": payoff: %s res %d (%lld cells), hemisphere %lld tets\n",
@@ -746,8 +751,7 @@ static int run_payoff(const config *c, fcm_ctx *ctx)
            cost, be, gain);
   else
     printf("break-even: never (an iteration is not faster with the simplified rules)\n");
-  if (isfinite(cbe))
-    printf("break-even in CPU seconds: after %.2f Newton iteration(s)\n", cbe);
+  if (isfinite(cbe)) printf("break-even in CPU seconds: after %.2f Newton iteration(s)\n", cbe);
   if (c->payoff_csv) {
     cli_output *out = NULL;
     FILE *f = cli_output_open(CV_PROG, c->payoff_csv, &out);
@@ -780,7 +784,7 @@ done:
 
 int main(int argc, char **argv)
 {
-  app_env_init(argc, argv); /* passive OpenMP waiting unless the user chose */
+  app_env_init(argc, argv);    /* passive OpenMP waiting unless the user chose */
   fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   config c;
   fcm_ctx *ctx = NULL;

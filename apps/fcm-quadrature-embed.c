@@ -45,15 +45,16 @@ static void rotation(const double axis[3], double angle, double R[9])
   double n = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
   double k[3] = {axis[0] / n, axis[1] / n, axis[2] / n}, c = cos(angle), s = sin(angle);
   for (int i = 0; i < 3; i++)
-    for (int j = 0; j < 3; j++) R[3 * i + j] = (1 - c) * k[i] * k[j] + (i == j ? c : 0.0);
+    for (int j = 0; j < 3; j++)
+      R[3 * i + j] = (1 - c) * k[i] * k[j] + (i == j ? c : 0.0);
   R[1] -= s * k[2], R[2] += s * k[1], R[3] += s * k[2];
   R[5] -= s * k[0], R[6] -= s * k[1], R[7] += s * k[0];
 }
 
 /* Relative errors of the rule (cell 0 of `rules`, identity map) on every monomial
  * y^a of total degree <= m in the cuboid frame y = R^T (x - t). */
-static int monomial_errors(const fcm_cell_rules *rules, int m, const double R[9],
-                           const double t[3], double *err, int *npts)
+static int monomial_errors(const fcm_cell_rules *rules, int m, const double R[9], const double t[3],
+                           double *err, int *npts)
 {
   int np = 0, count = 0;
   const double *pts = NULL, *w = NULL;
@@ -68,8 +69,10 @@ static int monomial_errors(const fcm_cell_rules *rules, int m, const double R[9]
           exact *= (pow(cub_hi[d], e[d] + 1) - pow(cub_lo[d], e[d] + 1)) / (e[d] + 1);
         for (int p = 0; p < np; p++) {
           double x[3], y[3];
-          for (int d = 0; d < 3; d++) x[d] = pts[3 * p + d] - t[d];
-          for (int d = 0; d < 3; d++) y[d] = R[d] * x[0] + R[3 + d] * x[1] + R[6 + d] * x[2];
+          for (int d = 0; d < 3; d++)
+            x[d] = pts[3 * p + d] - t[d];
+          for (int d = 0; d < 3; d++)
+            y[d] = R[d] * x[0] + R[3 + d] * x[1] + R[6 + d] * x[2];
           /* reference [-1,1]^3 = physical [-1,1]^3: det J = 1 */
           q += w[p] * pow(y[0], a) * pow(y[1], b) * pow(y[2], c);
         }
@@ -124,9 +127,13 @@ int fcm_quadrature_cmd_accuracy(int argc, char **argv)
   const fcm_index one[3] = {1, 1, 1}, nb[3] = {2, 2, 2};
   double R[9], t[3], c[3];
   rotation(axis, 0.7, R);
-  for (int d = 0; d < 3; d++) c[d] = 0.5 * (cub_lo[d] + cub_hi[d]);
+  for (int d = 0; d < 3; d++)
+    c[d] = 0.5 * (cub_lo[d] + cub_hi[d]);
   for (int d = 0; d < 3; d++) /* the cuboid's centre goes to (0.03, -0.02, 0.05) */
-    t[d] = (d == 0 ? 0.03 : d == 1 ? -0.02 : 0.05) - (R[3 * d] * c[0] + R[3 * d + 1] * c[1] + R[3 * d + 2] * c[2]);
+    t[d] = (d == 0   ? 0.03
+            : d == 1 ? -0.02
+                     : 0.05) -
+           (R[3 * d] * c[0] + R[3 * d + 1] * c[1] + R[3 * d + 2] * c[2]);
   if (fcm_ctx_create(NULL, &ctx) != FCM_OK) return 1;
   if (fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, one, &cell) != FCM_OK ||
       fcm_geometry_create_box(ctx, cub_lo, cub_hi, nb, &box) != FCM_OK ||
@@ -167,12 +174,13 @@ int fcm_quadrature_cmd_accuracy(int argc, char **argv)
       fcm_cell_rules_destroy(&rules);
       if (count <= 0) goto done;
       double mx = 0.0;
-      for (int k = 0; k < count; k++) mx = fmax(mx, err[k]);
+      for (int k = 0; k < count; k++)
+        mx = fmax(mx, err[k]);
       qsort(err, (size_t)count, sizeof *err, cmp_double);
       double med = count % 2 ? err[count / 2] : 0.5 * (err[count / 2 - 1] + err[count / 2]);
       const char *name = simplify ? "simplified" : "initial";
-      printf("%8d %10s %7d %7d %14.3e %14.3e%s\n", m, name, np, (m + 1) * (m + 2) * (m + 3) / 6,
-             mx, med, fallback ? "  (simplification fell back)" : "");
+      printf("%8d %10s %7d %7d %14.3e %14.3e%s\n", m, name, np, (m + 1) * (m + 2) * (m + 3) / 6, mx,
+             med, fallback ? "  (simplification fell back)" : "");
       if (out) fprintf(out, "%d,%s,%d,%.6e,%.6e\n", m, name, np, mx, med);
       fflush(stdout);
     }
@@ -196,28 +204,27 @@ done:
 
 static void embed_usage(FILE *f)
 {
-  fprintf(f,
-          "usage: fcm-quadrature embed --element {tet4,tet10,hex8,hex20}\n"
-          "           --box X0 Y0 Z0 X1 Y1 Z1 --cells NX NY NZ --geometry FILE|SHAPE\n"
-          "           --strength M [--mass-strength M] [--no-simplify] [--stabilization A]\n"
-          "           [--min-fraction PHI] [--dump FILE]\n"
-          "\n"
-          "Builds the background grid, embeds the geometry, builds the cut-cell rules and\n"
-          "prints their statistics (cells per class, points before and after\n"
-          "simplification, fallbacks, residual, volumes, time per phase).\n"
-          "\n"
-          "  --geometry FILE   Gmsh .msh (tetrahedra), or TetGen FILE.node (with FILE.ele)\n"
-          "  --geometry SHAPE  ball:CX,CY,CZ,R,N | hemisphere:CX,CY,CZ,R,N |\n"
-          "                    box:X0,Y0,Z0,X1,Y1,Z1,N\n"
-          "  --strength M      stiffness rule strength 1..20 (mass: --mass-strength,\n"
-          "                    default the element's mass strength)\n"
-          "  --no-simplify     keep the initial (tetrahedralized) rules\n"
-          "  --stabilization A append the full cell's rule x A to cut cells (0: off;\n"
-          "                    default 1e-6)\n"
-          "  --min-fraction P  drop cells with volume fraction below P (default 1e-4)\n"
-          "  --dump FILE       one line per stiffness point:\n"
-          "                    cell xi eta zeta X Y Z w_ref w_phys flag\n"
-          "                    (w_phys = w_ref |J|; flag 0 embedded, 1 stabilization)\n");
+  fprintf(f, "usage: fcm-quadrature embed --element {tet4,tet10,hex8,hex20}\n"
+             "           --box X0 Y0 Z0 X1 Y1 Z1 --cells NX NY NZ --geometry FILE|SHAPE\n"
+             "           --strength M [--mass-strength M] [--no-simplify] [--stabilization A]\n"
+             "           [--min-fraction PHI] [--dump FILE]\n"
+             "\n"
+             "Builds the background grid, embeds the geometry, builds the cut-cell rules and\n"
+             "prints their statistics (cells per class, points before and after\n"
+             "simplification, fallbacks, residual, volumes, time per phase).\n"
+             "\n"
+             "  --geometry FILE   Gmsh .msh (tetrahedra), or TetGen FILE.node (with FILE.ele)\n"
+             "  --geometry SHAPE  ball:CX,CY,CZ,R,N | hemisphere:CX,CY,CZ,R,N |\n"
+             "                    box:X0,Y0,Z0,X1,Y1,Z1,N\n"
+             "  --strength M      stiffness rule strength 1..20 (mass: --mass-strength,\n"
+             "                    default the element's mass strength)\n"
+             "  --no-simplify     keep the initial (tetrahedralized) rules\n"
+             "  --stabilization A append the full cell's rule x A to cut cells (0: off;\n"
+             "                    default 1e-6)\n"
+             "  --min-fraction P  drop cells with volume fraction below P (default 1e-4)\n"
+             "  --dump FILE       one line per stiffness point:\n"
+             "                    cell xi eta zeta X Y Z w_ref w_phys flag\n"
+             "                    (w_phys = w_ref |J|; flag 0 embedded, 1 stabilization)\n");
 }
 
 /* Procedural geometry "name:a,b,c,..." or a file. */
@@ -237,7 +244,8 @@ static fcm_status load_geometry(fcm_ctx *ctx, const char *spec, fcm_geometry **g
       p = *end == ',' ? end + 1 : end;
       if (*end && *end != ',') return FCM_ERR_ARG;
     }
-    if (!strcmp(name, "ball") && n == 5) return fcm_geometry_create_ball(ctx, v, v[3], (int)v[4], g);
+    if (!strcmp(name, "ball") && n == 5)
+      return fcm_geometry_create_ball(ctx, v, v[3], (int)v[4], g);
     if (!strcmp(name, "hemisphere") && n == 5)
       return fcm_geometry_create_hemisphere(ctx, v, v[3], (int)v[4], g);
     if (!strcmp(name, "box") && n == 7) {
@@ -335,8 +343,10 @@ int fcm_quadrature_cmd_embed(int argc, char **argv)
     if (fcm_ctx_error_status(ctx) != FCM_OK)
       fcm_ctx_error_view(ctx, stderr);
     else
-      fprintf(stderr, "fcm-quadrature embed: --geometry '%s': not a readable file or a shape "
-                      "spec (see --help)\n", geometry);
+      fprintf(stderr,
+              "fcm-quadrature embed: --geometry '%s': not a readable file or a shape "
+              "spec (see --help)\n",
+              geometry);
     rc = 2;
     goto done;
   }

@@ -14,8 +14,8 @@
 
 /* Best published counts of positive interior rules (Witherden–Vincent and
  * successors), as given in the rule-tables issue; 0 = not listed. */
-static const int best_tet[21] = {0,  1,  4,   8, 14, 14,  24, 35,  46, 59, 79,
-                                 0, 123, 0, 172, 0, 251, 0, 352, 0, 474};
+static const int best_tet[21] = {0, 1,   4, 8,   14, 14,  24, 35,  46, 59, 79,
+                                 0, 123, 0, 172, 0,  251, 0,  352, 0,  474};
 static const int best_hex_odd[11] = {1, 6, 14, 34, 58, 90, 148, 199, 282, 369, 505};
 static const int best_tri[21] = {0,  1,  3,  6,  6,  7,  12, 15, 16, 19, 25,
                                  28, 33, 37, 42, 49, 55, 60, 67, 73, 79};
@@ -35,11 +35,16 @@ static const shape_range report_shapes[] = {
 static int best_published(fcm_shape shape, int m)
 {
   switch (shape) {
-  case FCM_SHAPE_TET: return m >= 1 && m <= 20 ? best_tet[m] : 0;
-  case FCM_SHAPE_TRI: return m >= 1 && m <= 20 ? best_tri[m] : 0;
-  case FCM_SHAPE_HEX: return m >= 1 && m <= 21 ? best_hex_odd[m / 2] : 0;
-  case FCM_SHAPE_QUAD: return m >= 1 && m <= 21 ? best_quad_odd[m / 2] : 0;
-  default: return 0;
+  case FCM_SHAPE_TET:
+    return m >= 1 && m <= 20 ? best_tet[m] : 0;
+  case FCM_SHAPE_TRI:
+    return m >= 1 && m <= 20 ? best_tri[m] : 0;
+  case FCM_SHAPE_HEX:
+    return m >= 1 && m <= 21 ? best_hex_odd[m / 2] : 0;
+  case FCM_SHAPE_QUAD:
+    return m >= 1 && m <= 21 ? best_quad_odd[m / 2] : 0;
+  default:
+    return 0;
   }
 }
 
@@ -47,14 +52,16 @@ static int best_published(fcm_shape shape, int m)
 static int lower_bound(int dim, int m)
 {
   int k = m / 2, c = 1;
-  for (int i = 1; i <= dim; i++) c = c * (k + i) / i;
+  for (int i = 1; i <= dim; i++)
+    c = c * (k + i) / i;
   return c;
 }
 
 static double factorial(int k)
 {
   double f = 1.0;
-  for (int i = 2; i <= k; i++) f *= i;
+  for (int i = 2; i <= k; i++)
+    f *= i;
   return f;
 }
 
@@ -105,7 +112,8 @@ static int verify_rule(const fcm_rule *rule, int m, double *max_err)
         double sum = 0.0, comp = 0.0, exact, absint;
         for (int i = 0; i < n; i++) {
           double t = w[i];
-          for (int d = 0; d < dim; d++) t *= pow(x[(size_t)i * dim + d], e[d]);
+          for (int d = 0; d < dim; d++)
+            t *= pow(x[(size_t)i * dim + d], e[d]);
           double s1 = sum + t;
           comp += fabs(sum) >= fabs(t) ? (sum - s1) + t : (t - s1) + sum;
           sum = s1;
@@ -119,16 +127,15 @@ static int verify_rule(const fcm_rule *rule, int m, double *max_err)
 
 static void tables_help(FILE *f)
 {
-  fprintf(f,
-          "usage: fcm-quadrature tables [--check] [--csv FILE]\n"
-          "Per shape and strength (tet 1..20, hex 1..21, tri 1..20, quad 1..21): the point\n"
-          "count of the catalogue rule (stored table, else computed), the best published\n"
-          "count of a positive interior rule and the ratio. Hex and quad even strengths are\n"
-          "compared with the published count of the next odd strength; '-' = not listed.\n"
-          "  --check     re-verify every rule: all monomials up to the strength exact to\n"
-          "              1e-13 (|Q - I| / int |f|), weights positive, points strictly inside;\n"
-          "              exit status 1 if any fails\n"
-          "  --csv FILE  also write shape,strength,points,best_published,ratio\n");
+  fprintf(f, "usage: fcm-quadrature tables [--check] [--csv FILE]\n"
+             "Per shape and strength (tet 1..20, hex 1..21, tri 1..20, quad 1..21): the point\n"
+             "count of the catalogue rule (stored table, else computed), the best published\n"
+             "count of a positive interior rule and the ratio. Hex and quad even strengths are\n"
+             "compared with the published count of the next odd strength; '-' = not listed.\n"
+             "  --check     re-verify every rule: all monomials up to the strength exact to\n"
+             "              1e-13 (|Q - I| / int |f|), weights positive, points strictly inside;\n"
+             "              exit status 1 if any fails\n"
+             "  --csv FILE  also write shape,strength,points,best_published,ratio\n");
 }
 
 static int cmd_tables(int argc, char **argv)
@@ -239,7 +246,7 @@ static void usage(FILE *f)
 
 int main(int argc, char **argv)
 {
-  app_env_init(argc, argv); /* passive OpenMP waiting unless the user chose */
+  app_env_init(argc, argv);    /* passive OpenMP waiting unless the user chose */
   fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
     usage(argc < 2 ? stderr : stdout);

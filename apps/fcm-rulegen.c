@@ -115,7 +115,8 @@ static fcm_rule *read_table(fcm_ctx *ctx, const char *path, fcm_shape shape)
     if (k == 0) continue;
     ok = k == dim + 1 && x && rows < n;
     if (!ok) break;
-    for (int d = 0; d < dim; d++) x[rows * dim + d] = v[d];
+    for (int d = 0; d < dim; d++)
+      x[rows * dim + d] = v[d];
     w[rows++] = v[dim];
   }
   fclose(f);
@@ -163,10 +164,12 @@ static int write_table(const char *path, const fcm_rule *rule, const char *start
   fprintf(f, "# generator time: %.2f s\n", seconds);
   fprintf(f, "# date: %s\n", date);
   fprintf(f, "# columns:");
-  for (int k = 0; k < dim; k++) fprintf(f, " %s", axis[k]);
+  for (int k = 0; k < dim; k++)
+    fprintf(f, " %s", axis[k]);
   fprintf(f, " weight\n");
   for (int i = 0; i < n; i++) {
-    for (int k = 0; k < dim; k++) fprintf(f, "%s%.17g", k ? " " : "", x[dim * i + k]);
+    for (int k = 0; k < dim; k++)
+      fprintf(f, "%s%.17g", k ? " " : "", x[dim * i + k]);
     fprintf(f, " %.17g\n", w[i]);
   }
   return cli_output_commit("fcm-rulegen", &out);
@@ -214,9 +217,9 @@ static int generate(fcm_ctx *ctx, const config *cfg, fcm_shape shape, int m)
       fcm_ctx_error_view(ctx, stderr);
       fcm_ctx_error_clear(ctx);
     } else {
-      fprintf(stderr, "  %s %2d: start %s (%d points): %d points, residual %.1e, %.1f s\n",
-              sname, m, start_desc, fcm_rule_num_points(start),
-              fcm_rule_num_points(rule), info.residual, info.seconds);
+      fprintf(stderr, "  %s %2d: start %s (%d points): %d points, residual %.1e, %.1f s\n", sname,
+              m, start_desc, fcm_rule_num_points(start), fcm_rule_num_points(rule), info.residual,
+              info.seconds);
       if (!best || fcm_rule_num_points(rule) < fcm_rule_num_points(best) ||
           (fcm_rule_num_points(rule) == fcm_rule_num_points(best) &&
            info.residual < best_info.residual)) {
@@ -361,7 +364,8 @@ int main(int argc, char **argv)
   int ok = 1;
   double t0 = fcm_wtime();
   for (int m = mlo; m <= mhi && ok; m++)
-    for (int s = 0; s < nshapes && ok; s++) ok = generate(ctx, &cfg, shapes[s], m);
+    for (int s = 0; s < nshapes && ok; s++)
+      ok = generate(ctx, &cfg, shapes[s], m);
   fprintf(stderr, "fcm-rulegen: total %.1f s\n", fcm_wtime() - t0);
   fcm_ctx_destroy(&ctx);
   return ok ? 0 : 1;

@@ -199,8 +199,8 @@ static int scene_main(int argc, char **argv)
   if (fcm_scene_get_solver(scene)->threads > 0) /* every OpenMP loop of the run */
     omp_set_num_threads(fcm_scene_get_solver(scene)->threads);
   fcm_simulation_options so = fcm_simulation_options_default();
-  so.max_steps = o.check ? (o.steps > 0 && o.steps < 3 ? o.steps : 3)
-                         : (o.steps > 0 ? o.steps : FCM_DEFAULT);
+  so.max_steps =
+      o.check ? (o.steps > 0 && o.steps < 3 ? o.steps : 3) : (o.steps > 0 ? o.steps : FCM_DEFAULT);
   so.checkpoint_interval = o.check ? 0 : o.checkpoint_every;
   const char *name = fcm_scene_name(scene);
   if (!o.quiet)
@@ -286,7 +286,7 @@ done:
 
 int main(int argc, char **argv)
 {
-  app_env_init(argc, argv); /* passive OpenMP waiting unless the user chose */
+  app_env_init(argc, argv);    /* passive OpenMP waiting unless the user chose */
   fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   return scene_main(argc, argv);
 }

@@ -31,8 +31,8 @@ static int probe(int argc, char **argv)
 
 /* Run `self probe` with the variables set (NULL: unset), stdout and stderr into files;
  * return the runs count and the runtime's GOMP_SPINCOUNT (-1 when not reported). */
-static void run(const char *self, const char *dir, const char *policy, const char *spin,
-                int *runs, long long *spincount, char env_policy[64])
+static void run(const char *self, const char *dir, const char *policy, const char *spin, int *runs,
+                long long *spincount, char env_policy[64])
 {
   char out[4096], err[4096];
   snprintf(out, sizeof out, "%s/app_env.out", dir);
@@ -42,10 +42,14 @@ static void run(const char *self, const char *dir, const char *policy, const cha
     unsetenv(RUNS_VAR);
     unsetenv("KMP_BLOCKTIME");
     unsetenv("LD_PRELOAD");
-    if (policy) setenv("OMP_WAIT_POLICY", policy, 1);
-    else unsetenv("OMP_WAIT_POLICY");
-    if (spin) setenv("GOMP_SPINCOUNT", spin, 1);
-    else unsetenv("GOMP_SPINCOUNT");
+    if (policy)
+      setenv("OMP_WAIT_POLICY", policy, 1);
+    else
+      unsetenv("OMP_WAIT_POLICY");
+    if (spin)
+      setenv("GOMP_SPINCOUNT", spin, 1);
+    else
+      unsetenv("GOMP_SPINCOUNT");
     if (!freopen(out, "w", stdout) || !freopen(err, "w", stderr)) _exit(127);
     execl(self, self, "probe", (char *)NULL);
     _exit(127);

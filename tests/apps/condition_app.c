@@ -76,15 +76,18 @@ int main(int argc, char **argv)
   }
 
   /* usage errors: status 2, nothing written */
-  static const char *const bad[] = {"--fractions 0",        "--fractions 1,2",
-                                    "--fractions 1:1e-3:1", "--elements tet5",
-                                    "--preconditioners ilu", "--stabilization maybe",
-                                    "--alpha -1",           "--bogus 1",
+  static const char *const bad[] = {"--fractions 0",
+                                    "--fractions 1,2",
+                                    "--fractions 1:1e-3:1",
+                                    "--elements tet5",
+                                    "--preconditioners ilu",
+                                    "--stabilization maybe",
+                                    "--alpha -1",
+                                    "--bogus 1",
                                     "--csv"};
   for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
     remove(csv);
-    snprintf(cmd, sizeof cmd, "'%s' --quick %s --csv '%s' > /dev/null 2>&1", argv[1], bad[k],
-             csv);
+    snprintf(cmd, sizeof cmd, "'%s' --quick %s --csv '%s' > /dev/null 2>&1", argv[1], bad[k], csv);
     if (!strcmp(bad[k], "--csv"))
       snprintf(cmd, sizeof cmd, "'%s' --quick --csv > /dev/null 2>&1", argv[1]);
     int rc = cond_run(cmd);

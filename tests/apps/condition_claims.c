@@ -124,8 +124,8 @@ int main(int argc, char **argv)
     if (!one || !on) continue;
     TEST_TRUE(!strcmp(on->tangent, "unprojected") && on->negative > 0 && on->blocks > 0);
     if (!(on->kappa <= 10.0 * one->kappa))
-      fprintf(stderr, "%s unprojected: stabilized Schwarz kappa %.3e at %g vs %.3e at 1\n",
-              quad[e], on->kappa, at, one->kappa);
+      fprintf(stderr, "%s unprojected: stabilized Schwarz kappa %.3e at %g vs %.3e at 1\n", quad[e],
+              on->kappa, at, one->kappa);
     TEST_TRUE(on->kappa <= 10.0 * one->kappa);
   }
   remove(csv);

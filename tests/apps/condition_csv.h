@@ -8,7 +8,7 @@
 
 #define CONDITION_HEADER                                                                           \
   "element,preconditioner,stabilization,min_volume_fraction,condition_number,nominal_fraction,"    \
-  "lambda_min_abs,lambda_max_abs,negative_eigenvalues,dofs,schwarz_blocks,clamped_eigenvalues,"   \
+  "lambda_min_abs,lambda_max_abs,negative_eigenvalues,dofs,schwarz_blocks,clamped_eigenvalues,"    \
   "minres_iterations,minres_reason,minres_true_residual,tangent\n"
 
 typedef struct cond_row {
@@ -44,9 +44,9 @@ static int cond_read(const char *path, cond_row *rows, int cap)
     if (n >= cap ||
         sscanf(line,
                "%15[^,],%15[^,],%lf,%lf,%lf,%lf,%lf,%lf,%lld,%lld,%lld,%lld,%d,%31[^,],%lf,%15s",
-               r.element, r.prec, &r.alpha, &r.phi_min, &r.kappa, &r.phi_nominal, &r.lmin,
-               &r.lmax, &r.negative, &r.dofs, &r.blocks, &r.clamped, &r.iterations, r.reason,
-               &r.true_res, r.tangent) != 16) {
+               r.element, r.prec, &r.alpha, &r.phi_min, &r.kappa, &r.phi_nominal, &r.lmin, &r.lmax,
+               &r.negative, &r.dofs, &r.blocks, &r.clamped, &r.iterations, r.reason, &r.true_res,
+               r.tangent) != 16) {
       fclose(f);
       return -1;
     }
@@ -57,8 +57,8 @@ static int cond_read(const char *path, cond_row *rows, int cap)
 }
 
 /* The row of (element, preconditioner, stabilized?, nominal fraction), or NULL. */
-static const cond_row *cond_find(const cond_row *rows, int n, const char *element,
-                                 const char *prec, int stabilized, double phi)
+static const cond_row *cond_find(const cond_row *rows, int n, const char *element, const char *prec,
+                                 int stabilized, double phi)
 {
   for (int k = 0; k < n; k++)
     if (!strcmp(rows[k].element, element) && !strcmp(rows[k].prec, prec) &&

@@ -76,7 +76,8 @@ int main(int argc, char **argv)
         }
       }
       for (int norm = 0; norm < 2; norm++) {
-        const cv_rate_row *rr = cv_find_rate(rates, nr, elements[e], methods[m], norm ? "H1" : "L2");
+        const cv_rate_row *rr =
+            cv_find_rate(rates, nr, elements[e], methods[m], norm ? "H1" : "L2");
         TEST_TRUE(rr != NULL);
         if (rr && cnt == 3) TEST_NEAR(rr->rate, cv_refit(lv, cnt, 3, norm), 1e-4, 1e-5);
       }
@@ -113,8 +114,9 @@ int main(int argc, char **argv)
   /* payoff: fewer points with simplification, the same break-even on both rows */
   snprintf(path, sizeof path, "%s/converge-payoff.csv", dir);
   remove(path);
-  snprintf(cmd, sizeof cmd, "OMP_WAIT_POLICY=passive '%s' payoff --quick --csv '%s' > '%s' 2> /dev/null",
-           prog, path, out);
+  snprintf(cmd, sizeof cmd,
+           "OMP_WAIT_POLICY=passive '%s' payoff --quick --csv '%s' > '%s' 2> /dev/null", prog, path,
+           out);
   TEST_TRUE(cv_run_cmd(cmd) == 0);
   f = fopen(path, "r");
   TEST_TRUE(f && fgets(line, sizeof line, f) &&
@@ -126,8 +128,8 @@ int main(int argc, char **argv)
   rows = 0;
   while (f && rows < 2 && fgets(line, sizeof line, f)) {
     int res = 0, simp = -1;
-    TEST_TRUE(sscanf(line, "hex20,%d,%d,%lld,%*d,%*f,%*f,%*f,%*f,%lf,%lf", &res, &simp,
-                     &pts[rows], &titer[rows], &be[rows]) == 5);
+    TEST_TRUE(sscanf(line, "hex20,%d,%d,%lld,%*d,%*f,%*f,%*f,%*f,%lf,%lf", &res, &simp, &pts[rows],
+                     &titer[rows], &be[rows]) == 5);
     TEST_TRUE(res == 4 && simp == rows && titer[rows] > 0.0);
     rows++;
   }
@@ -138,11 +140,11 @@ int main(int argc, char **argv)
   TEST_TRUE(cv_run_cmd(cmd) == 0);
 
   /* usage errors: status 2, nothing written */
-  static const char *const bad[] = {"--levels 0",          "--levels 2,2",        "--elements tet5",
-                                    "--methods xfem",      "--simplify maybe",    "--radius 1.5",
-                                    "--fem-traction none", "--strength 0",        "--bogus 1",
-                                    "--fit 1",             "payoff --elements hex8", "--levels",
-                                    "--time gpu"};
+  static const char *const bad[] = {
+      "--levels 0",       "--levels 2,2", "--elements tet5",        "--methods xfem",
+      "--simplify maybe", "--radius 1.5", "--fem-traction none",    "--strength 0",
+      "--bogus 1",        "--fit 1",      "payoff --elements hex8", "--levels",
+      "--time gpu"};
   snprintf(path, sizeof path, "%s/converge-bad-levels.csv", dir);
   for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
     remove(path);

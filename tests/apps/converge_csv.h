@@ -8,16 +8,16 @@
 #include <sys/wait.h>
 
 #define CONVERGE_LEVELS_HEADER                                                                     \
-  "element,method,res,h,dofs,active_cells,cut_cells,points,strength,t_rules,t_assembly,t_solve,"  \
-  "t_total,err_l2,err_h1,norm_l2,norm_h1,rel_l2,rel_h1,measured_volume,domain_volume,failed,"     \
+  "element,method,res,h,dofs,active_cells,cut_cells,points,strength,t_rules,t_assembly,t_solve,"   \
+  "t_total,err_l2,err_h1,norm_l2,norm_h1,rel_l2,rel_h1,measured_volume,domain_volume,failed,"      \
   "note,cpu_rules,cpu_assembly,cpu_solve,cpu_total\n"
 #define CONVERGE_RATES_HEADER "element,method,norm,rate\n"
 
 typedef struct cv_level {
   char element[16], method[8];
   int res, strength, failed;
-  double h, t_rules, t_assembly, t_solve, t_total, err_l2, err_h1, norm_l2, norm_h1, rel_l2,
-      rel_h1, measured, domain, c_rules, c_assembly, c_solve, c_total;
+  double h, t_rules, t_assembly, t_solve, t_total, err_l2, err_h1, norm_l2, norm_h1, rel_l2, rel_h1,
+      measured, domain, c_rules, c_assembly, c_solve, c_total;
   long long dofs, cells, cut, points;
 } cv_level;
 
@@ -60,10 +60,10 @@ static inline int cv_read_levels(const char *path, cv_level *rows, int cap)
         sscanf(line,
                "%15[^,],%7[^,],%d,%lf,%lld,%lld,%lld,%lld,%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,"
                "%lf,%lf,%lf,%d,,%lf,%lf,%lf,%lf",
-               r.element, r.method, &r.res, &r.h, &r.dofs, &r.cells, &r.cut, &r.points,
-               &r.strength, &r.t_rules, &r.t_assembly, &r.t_solve, &r.t_total, &r.err_l2,
-               &r.err_h1, &r.norm_l2, &r.norm_h1, &r.rel_l2, &r.rel_h1, &r.measured, &r.domain,
-               &r.failed, &r.c_rules, &r.c_assembly, &r.c_solve, &r.c_total) != 26) {
+               r.element, r.method, &r.res, &r.h, &r.dofs, &r.cells, &r.cut, &r.points, &r.strength,
+               &r.t_rules, &r.t_assembly, &r.t_solve, &r.t_total, &r.err_l2, &r.err_h1, &r.norm_l2,
+               &r.norm_h1, &r.rel_l2, &r.rel_h1, &r.measured, &r.domain, &r.failed, &r.c_rules,
+               &r.c_assembly, &r.c_solve, &r.c_total) != 26) {
       fclose(f);
       return -1;
     }
@@ -86,8 +86,8 @@ static inline int cv_read_rates(const char *path, cv_rate_row *rows, int cap)
   }
   while (fgets(line, sizeof line, f)) {
     cv_rate_row r;
-    if (n >= cap || sscanf(line, "%15[^,],%7[^,],%7[^,],%lf", r.element, r.method, r.norm,
-                           &r.rate) != 4) {
+    if (n >= cap ||
+        sscanf(line, "%15[^,],%7[^,],%7[^,],%lf", r.element, r.method, r.norm, &r.rate) != 4) {
       fclose(f);
       return -1;
     }
@@ -98,7 +98,7 @@ static inline int cv_read_rates(const char *path, cv_rate_row *rows, int cap)
 }
 
 static inline const cv_rate_row *cv_find_rate(const cv_rate_row *rows, int n, const char *element,
-                                       const char *method, const char *norm)
+                                              const char *method, const char *norm)
 {
   for (int k = 0; k < n; k++)
     if (!strcmp(rows[k].element, element) && !strcmp(rows[k].method, method) &&
@@ -109,7 +109,7 @@ static inline const cv_rate_row *cv_find_rate(const cv_rate_row *rows, int n, co
 
 /* The levels of (element, method) sorted coarse to fine into out (pointers); their count. */
 static inline int cv_select(const cv_level *rows, int n, const char *element, const char *method,
-                     const cv_level **out, int cap)
+                            const cv_level **out, int cap)
 {
   int m = 0;
   for (int k = 0; k < n; k++)

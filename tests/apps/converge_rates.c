@@ -43,7 +43,7 @@ static int study(const char *prog, const char *dir, const char *name, const char
 
 /* Rate bounds and monotone decrease of one (element, method) series; returns the L2 rate. */
 static double check(int n, int nrates, int fit, const char *element, const char *method,
-                  double l2_lo, double l2_hi, double h1_lo, double h1_hi)
+                    double l2_lo, double l2_hi, double h1_lo, double h1_hi)
 {
   const cv_level *lv[64];
   const int m = cv_select(levels, n, element, method, lv, 64);

@@ -19,7 +19,8 @@ static void householder(rng *r, double *Q)
     vv += v[i] * v[i];
   }
   for (int j = 0; j < N; j++)
-    for (int i = 0; i < N; i++) Q[i + j * N] = (i == j) - 2.0 * v[i] * v[j] / vv;
+    for (int i = 0; i < N; i++)
+      Q[i + j * N] = (i == j) - 2.0 * v[i] * v[j] / vv;
 }
 
 /* M = Q diag(d) Q^T */
@@ -28,7 +29,8 @@ static void compose(const double *Q, const double *d, double *M)
   for (int j = 0; j < N; j++)
     for (int i = 0; i < N; i++) {
       double s = 0.0;
-      for (int k = 0; k < N; k++) s += Q[i + k * N] * d[k] * Q[j + k * N];
+      for (int k = 0; k < N; k++)
+        s += Q[i + k * N] * d[k] * Q[j + k * N];
       M[i + j * N] = s;
     }
 }
@@ -50,11 +52,13 @@ int main(void)
 
   /* L lower triangular with diagonal in [1, 3); Li = L^{-1} by forward substitution */
   for (int j = 0; j < N; j++)
-    for (int i = j; i < N; i++) L[i + j * N] = i == j ? 2.0 + rng_uniform(&r) : rng_uniform(&r);
+    for (int i = j; i < N; i++)
+      L[i + j * N] = i == j ? 2.0 + rng_uniform(&r) : rng_uniform(&r);
   for (int j = 0; j < N; j++)
     for (int i = 0; i < N; i++) {
       double s = i == j ? 1.0 : 0.0;
-      for (int k = 0; k < i; k++) s -= L[i + k * N] * Li[k + j * N];
+      for (int k = 0; k < i; k++)
+        s -= L[i + k * N] * Li[k + j * N];
       Li[i + j * N] = s / L[i + i * N];
     }
   for (int j = 0; j < N; j++)
@@ -74,26 +78,31 @@ int main(void)
     }
   TEST_OK(ctx, fcm_dense_spectrum_eval(ctx, N, A, S, w, &info));
   TEST_TRUE(info.cholesky == 1 && info.s_nonpositive == 0);
-  for (int k = 0; k < N; k++) TEST_NEAR(w[k], dvals[k], 1e-9, 1e-11 * 1e4);
+  for (int k = 0; k < N; k++)
+    TEST_NEAR(w[k], dvals[k], 1e-9, 1e-11 * 1e4);
 
   /* S = NULL: the eigenvalues of A itself */
   householder(&r, Q);
   compose(Q, dvals, A);
   TEST_OK(ctx, fcm_dense_spectrum_eval(ctx, N, A, NULL, w, NULL));
-  for (int k = 0; k < N; k++) TEST_NEAR(w[k], dvals[k], 1e-12, 1e-11);
+  for (int k = 0; k < N; k++)
+    TEST_NEAR(w[k], dvals[k], 1e-12, 1e-11);
 
   /* indefinite S: fallback; with A = I the spectrum is max(s, 0) */
   static const double svals[N] = {-1e-3, 0.1, 0.2, 0.5, 1.0, 2.0, 3.0, 4.0, 5.0};
   compose(Q, svals, S);
   for (int j = 0; j < N; j++)
-    for (int i = 0; i < N; i++) A[i + j * N] = i == j;
+    for (int i = 0; i < N; i++)
+      A[i + j * N] = i == j;
   TEST_OK(ctx, fcm_dense_spectrum_eval(ctx, N, A, S, w, &info));
   TEST_TRUE(info.cholesky == 0 && info.s_nonpositive == 1);
   TEST_NEAR(info.s_min, -1e-3, 1e-9, 0.0);
   TEST_NEAR(info.s_max, 5.0, 1e-12, 0.0);
-  for (int k = 0; k < N; k++) d[k] = fmax(svals[k], 0.0);
+  for (int k = 0; k < N; k++)
+    d[k] = fmax(svals[k], 0.0);
   qsort(d, N, sizeof *d, cmp);
-  for (int k = 0; k < N; k++) TEST_NEAR(w[k], d[k], 1e-12, 1e-13);
+  for (int k = 0; k < N; k++)
+    TEST_NEAR(w[k], d[k], 1e-12, 1e-13);
 
   /* errors */
   TEST_ERR(ctx, fcm_dense_spectrum_eval(ctx, N, NULL, S, w, NULL), FCM_ERR_ARG, "NULL argument");
@@ -119,7 +128,8 @@ int main(void)
     if (st == FCM_OK) {
       done = 1;
       TEST_TRUE(k > 0);
-      for (int i = 0; i < N; i++) TEST_NEAR(w[i], d[i], 1e-12, 1e-13);
+      for (int i = 0; i < N; i++)
+        TEST_NEAR(w[i], d[i], 1e-12, 1e-13);
     } else {
       TEST_TRUE(st == FCM_ERR_ALLOC);
       fcm_ctx_error_clear(ctx);

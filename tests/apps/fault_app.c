@@ -80,7 +80,8 @@ static int run_sim(const char *const *args, const fault_env *e, const char *out)
     unsetenv("FCM_FAULT_KILL_AT");
     unsetenv("FCM_FAULT_ENOSPC_AFTER");
     unsetenv("FCM_FAULT_REPORT");
-    if (e && e->kill_at > 0) snprintf(buf, sizeof buf, "%lld", e->kill_at), setenv("FCM_FAULT_KILL_AT", buf, 1);
+    if (e && e->kill_at > 0)
+      snprintf(buf, sizeof buf, "%lld", e->kill_at), setenv("FCM_FAULT_KILL_AT", buf, 1);
     if (e && e->enospc_after >= 0)
       snprintf(buf, sizeof buf, "%lld", e->enospc_after), setenv("FCM_FAULT_ENOSPC_AFTER", buf, 1);
     if (e && e->report) setenv("FCM_FAULT_REPORT", e->report, 1);

@@ -10,15 +10,20 @@
 int main(int argc, char **argv)
 {
   /* cells per direction giving 35,937 nodes = 107,811 DOFs for every type */
-  static const struct { fcm_element_type type; fcm_index n; } cases[] = {
-      {FCM_ELEMENT_TET4, 32}, {FCM_ELEMENT_TET10, 16}, {FCM_ELEMENT_HEX8, 32}, {FCM_ELEMENT_HEX20, 20}};
+  static const struct {
+    fcm_element_type type;
+    fcm_index n;
+  } cases[] = {{FCM_ELEMENT_TET4, 32},
+               {FCM_ELEMENT_TET10, 16},
+               {FCM_ELEMENT_HEX8, 32},
+               {FCM_ELEMENT_HEX20, 20}};
   double scale = argc > 1 ? atof(argv[1]) : 1.0; /* shrink for a quick look: bench_fem 0.5 */
   fcm_ctx *ctx = NULL;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
   fcm_material mat = {FCM_MATERIAL_LINEAR, 1e7, 0.3, 1000};
   printf("threads: %d\n", omp_get_max_threads());
-  printf("%-6s %8s %9s %11s %10s %11s %10s %9s %9s %9s %9s %9s\n", "elem", "cells", "dofs",
-         "nnz", "K [s]", "us/cell", "ns/nnz", "M [s]", "analyze", "factor", "GFLOP/s", "solve");
+  printf("%-6s %8s %9s %11s %10s %11s %10s %9s %9s %9s %9s %9s\n", "elem", "cells", "dofs", "nnz",
+         "K [s]", "us/cell", "ns/nnz", "M [s]", "analyze", "factor", "GFLOP/s", "solve");
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
     fcm_index n = (fcm_index)(cases[k].n * scale + 0.5);
     if (n < 1) n = 1;
@@ -54,10 +59,12 @@ int main(int argc, char **argv)
     double plo[3] = {-1, -1, 0}, phi[3] = {2, 2, 0};
     fcm_index nfix = 0;
     TEST_OK(ctx, fcm_mesh_nodes_in_box(ctx, mesh, plo, phi, 1e-9, 0, NULL, &nfix));
-    fcm_index *nodes = calloc((size_t)nfix, sizeof *nodes), *dofs = calloc(3 * (size_t)nfix, sizeof *dofs);
+    fcm_index *nodes = calloc((size_t)nfix, sizeof *nodes),
+              *dofs = calloc(3 * (size_t)nfix, sizeof *dofs);
     TEST_OK(ctx, fcm_mesh_nodes_in_box(ctx, mesh, plo, phi, 1e-9, nfix, nodes, &nfix));
     for (fcm_index i = 0; i < nfix; i++)
-      for (int d = 0; d < 3; d++) dofs[3 * i + d] = fcm_space_node_dof(space, nodes[i]) + d;
+      for (int d = 0; d < 3; d++)
+        dofs[3 * i + d] = fcm_space_node_dof(space, nodes[i]) + d;
     TEST_OK(ctx, fcm_space_apply_dirichlet(space, 3 * nfix, dofs, NULL, K, f));
     fcm_direct_info di;
     TEST_OK(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, K, &solver));
@@ -67,13 +74,13 @@ int main(int argc, char **argv)
     fcm_direct_get_info(solver, &di);
     TEST_OK(ctx, fcm_csr_apply(K, 1.0, u, 0.0, r));
     double rn = 0, fn = 0;
-    for (fcm_index i = 0; i < ndof; i++) rn += (r[i] - f[i]) * (r[i] - f[i]), fn += f[i] * f[i];
+    for (fcm_index i = 0; i < ndof; i++)
+      rn += (r[i] - f[i]) * (r[i] - f[i]), fn += f[i] * f[i];
     TEST_TRUE(sqrt(rn) <= 1e-8 * sqrt(fn));
     printf("%-6s %8lld %9lld %11lld %10.3f %11.1f %10.2f %9.3f %9.3f %9.3f %9.2f %9.3f\n",
            fcm_element_get_info(cases[k].type)->name, (long long)ncell, (long long)ndof,
            (long long)nnz, tK, 1e6 * tK / (double)ncell, 1e9 * tK / (double)nnz, tM,
-           di.time_analyze, di.time_factor, di.factor_flops / di.time_factor * 1e-9,
-           di.time_solve);
+           di.time_analyze, di.time_factor, di.factor_flops / di.time_factor * 1e-9, di.time_solve);
     fflush(stdout);
     free(f), free(u), free(r), free(nodes), free(dofs);
     fcm_direct_destroy(&solver);

@@ -98,8 +98,8 @@ static stamp solves(fcm_ctx *ctx, fcm_krylov *ws, fcm_csr *A, fcm_schwarz *P, co
   stamp t0 = now(), t;
   for (int k = 0; k < SHARED_SOLVES; k++) {
     memset(x, 0, sizeof *x * (size_t)n);
-    TEST_OK(ctx, fcm_krylov_minres(ws, fcm_csr_operator, A, fcm_schwarz_operator, P, b, x, &ko,
-                                   &ki));
+    TEST_OK(ctx,
+            fcm_krylov_minres(ws, fcm_csr_operator, A, fcm_schwarz_operator, P, b, x, &ko, &ki));
     TEST_TRUE(ki.reason == FCM_KRYLOV_CONVERGED_RTOL);
   }
   *iterations = ki.iterations;
@@ -131,8 +131,8 @@ static void shared_cores(fcm_ctx *ctx, fcm_csr *A, fcm_schwarz *P, const double 
   printf("Shared cores: MINRES + Schwarz (rtol 1e-8) on the twisted-tube Newton system, %lld "
          "DOFs,\n  %d thread(s), %ld core(s), OMP_WAIT_POLICY=%s GOMP_SPINCOUNT=%s, load average "
          "%.1f before\n",
-         (long long)n, omp_get_max_threads(), cores, pol ? pol : "(unset)",
-         spc ? spc : "(unset)", load[0]);
+         (long long)n, omp_get_max_threads(), cores, pol ? pol : "(unset)", spc ? spc : "(unset)",
+         load[0]);
   (void)solves(ctx, ws, A, P, b, x0, n, &it0); /* warm-up */
   for (int r = 0; r < SHARED_ROUNDS; r++) {
     stamp t = solves(ctx, ws, A, P, b, x0, n, &it0);
@@ -194,7 +194,8 @@ int main(int argc, char **argv)
   const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(rules);
   const fcm_index n = fcm_space_num_dofs(space), nc = fcm_mesh_num_cells(mesh);
   fcm_index active = 0;
-  for (fcm_index c = 0; c < nc; c++) active += fcm_space_cell_active(space, c);
+  for (fcm_index c = 0; c < nc; c++)
+    active += fcm_space_cell_active(space, c);
 
   /* the twisted state */
   const fcm_index nn = fcm_mesh_num_nodes(mesh);
@@ -241,8 +242,10 @@ int main(int argc, char **argv)
   t0 = now();
   double *av = fcm_csr_values(A);
   const double *kv = fcm_csr_values(K);
-  for (fcm_index p = 0; p < nnz; p++) av[p] += dt * dt * kv[p];
-  for (fcm_index i = 0; i < n; i++) b[i] = -dt * dt * (fint[i] - fext[i]);
+  for (fcm_index p = 0; p < nnz; p++)
+    av[p] += dt * dt * kv[p];
+  for (fcm_index i = 0; i < n; i++)
+    b[i] = -dt * dt * (fint[i] - fext[i]);
   const double plo[3] = {-HUGE_VAL, -8, -HUGE_VAL}, phi[3] = {HUGE_VAL, -8, HUGE_VAL};
   const double qlo[3] = {-HUGE_VAL, 8, -HUGE_VAL}, qhi[3] = {HUGE_VAL, 8, HUGE_VAL};
   fcm_index n1 = 0, n2 = 0;
@@ -254,7 +257,8 @@ int main(int argc, char **argv)
   TEST_OK(ctx, fcm_mesh_nodes_in_box(ctx, mesh, qlo, qhi, 1e-9, n2, nodes + n1, &n2));
   for (fcm_index k = 0; k < n1 + n2; k++) {
     fcm_index d = fcm_space_node_dof(space, nodes[k]);
-    for (int i = 0; d >= 0 && i < 3; i++) fix[nfix++] = d + i;
+    for (int i = 0; d >= 0 && i < 3; i++)
+      fix[nfix++] = d + i;
   }
   TEST_OK(ctx, fcm_space_apply_dirichlet(space, nfix, fix, NULL, A, b));
   keep_min(&t_bc, t0);
@@ -268,7 +272,8 @@ int main(int argc, char **argv)
   t0 = now();
   fcm_index nb = 0, nd = 0;
   TEST_OK(ctx, fcm_space_cell_blocks(space, flag, &nb, &nd, NULL, NULL));
-  fcm_index *bptr = calloc((size_t)nb + 1, sizeof *bptr), *bdofs = calloc((size_t)nd + 1, sizeof *bdofs);
+  fcm_index *bptr = calloc((size_t)nb + 1, sizeof *bptr),
+            *bdofs = calloc((size_t)nd + 1, sizeof *bdofs);
   TEST_OK(ctx, fcm_space_cell_blocks(space, flag, &nb, &nd, bptr, bdofs));
   TEST_OK(ctx, fcm_schwarz_create(ctx, A, nb, bptr, bdofs, NULL, &P));
   keep_min(&t_create, t0);
@@ -293,13 +298,13 @@ int main(int argc, char **argv)
   stamp t_m5 = FAR, t_m8 = FAR;
   ko.rtol = 1e-5;
   t0 = now();
-  TEST_OK(ctx, fcm_krylov_minres(ws, fcm_csr_operator, A, fcm_schwarz_operator, P, b, x2, &ko,
-                                 &ki5));
+  TEST_OK(ctx,
+          fcm_krylov_minres(ws, fcm_csr_operator, A, fcm_schwarz_operator, P, b, x2, &ko, &ki5));
   keep_min(&t_m5, t0);
   ko.rtol = 1e-8;
   t0 = now();
-  TEST_OK(ctx, fcm_krylov_minres(ws, fcm_csr_operator, A, fcm_schwarz_operator, P, b, x1, &ko,
-                                 &ki8));
+  TEST_OK(ctx,
+          fcm_krylov_minres(ws, fcm_csr_operator, A, fcm_schwarz_operator, P, b, x1, &ko, &ki8));
   keep_min(&t_m8, t0);
 
   /* CHOLMOD (UMFPACK if A is not positive definite) */
@@ -381,7 +386,8 @@ int main(int argc, char **argv)
       ta);
   printf("\n");
   ROW("  factor", tf);
-  printf("   factor nnz %.3g, %.2f GFLOP/s (wall)\n", di.factor_nnz, di.factor_flops / tf.wall * 1e-9);
+  printf("   factor nnz %.3g, %.2f GFLOP/s (wall)\n", di.factor_nnz,
+         di.factor_flops / tf.wall * 1e-9);
   ROW("  solve", ts);
   printf("\n");
   const stamp step_d = {tm.wall + th.wall + t_bc.wall + tf.wall + ts.wall,

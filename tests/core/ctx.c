@@ -42,7 +42,8 @@ int main(void)
   TEST_TRUE(!strcmp(fcm_status_str(FCM_OK), "success"));
   TEST_TRUE(!strcmp(fcm_status_str(FCM_ERR_ALLOC), "out of memory"));
   TEST_TRUE(!strcmp(fcm_status_str((fcm_status)999), "unknown status"));
-  for (int s = 0; s < FCM_STATUS_COUNT_; s++) TEST_TRUE(strlen(fcm_status_str((fcm_status)s)) > 0);
+  for (int s = 0; s < FCM_STATUS_COUNT_; s++)
+    TEST_TRUE(strlen(fcm_status_str((fcm_status)s)) > 0);
 
   /* Bad arguments to create. */
   TEST_TRUE(fcm_ctx_create(NULL, NULL) == FCM_ERR_ARG);
@@ -67,7 +68,8 @@ int main(void)
   double *a = fcm__calloc(ctx, 10, sizeof *a);
   int *b = fcm__calloc(ctx, 0, sizeof *b);
   TEST_TRUE(a && b);
-  for (int i = 0; i < 10; i++) TEST_TRUE(a[i] == 0.0);
+  for (int i = 0; i < 10; i++)
+    TEST_TRUE(a[i] == 0.0);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 2);
   a[9] = 7.0;
   TEST_OK(ctx, fcm__resize(ctx, (void **)&a, 10, 20, sizeof *a));
@@ -140,7 +142,8 @@ int main(void)
   double w0 = fcm_wtime();
   fcm_timer_start(&t);
   volatile double s = 0;
-  for (int i = 0; i < 100000; i++) s += i;
+  for (int i = 0; i < 100000; i++)
+    s += i;
   fcm_timer_stop(&t);
   fcm_timer_stop(&t); /* no effect */
   TEST_TRUE(t.total >= 0.0 && t.count == 1);

@@ -68,7 +68,8 @@ int main(void)
   TEST_TRUE(fcm_ctx_error_status(ctx) == FCM_OK);
 
   /* Deep recursion beyond the frame limit does not overflow the record. */
-  for (int i = 0; i < 100; i++) fcm__trace(ctx, __FILE__, __LINE__, __func__);
+  for (int i = 0; i < 100; i++)
+    fcm__trace(ctx, __FILE__, __LINE__, __func__);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
 }

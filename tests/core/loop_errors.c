@@ -24,8 +24,7 @@ static fcm_status work(fcm_ctx *ctx, fcm_index i, const fcm_index *fail, int nfa
 {
   fcm_status st = FCM_OK;
   if (i == 100) { /* an error handled inside the iteration */
-    fcm__error(ctx, FCM_ERR_NUMERIC, __FILE__, __LINE__, __func__, "handled at %lld",
-               (long long)i);
+    fcm__error(ctx, FCM_ERR_NUMERIC, __FILE__, __LINE__, __func__, "handled at %lld", (long long)i);
     return FCM_OK;
   }
   for (int k = 0; k < nfail; k++)

@@ -192,8 +192,9 @@ static void check(const fcm_mesh *mesh, const geom_case *gc, int m, int simplify
       for (int j = 0; j < n; j++) {
         const int ok = isfinite(p[3 * j]) && isfinite(p[3 * j + 1]) && isfinite(p[3 * j + 2]) &&
                        isfinite(w[j]) && w[j] > 0.0;
-        if (!ok) TEST_FAIL_("%s m %d cell %lld kind %d point %d: w %g", gc->what, m, (long long)c,
-                            kind, j, w[j]);
+        if (!ok)
+          TEST_FAIL_("%s m %d cell %lld kind %d point %d: w %g", gc->what, m, (long long)c, kind, j,
+                     w[j]);
         if (f[j]) continue; /* stabilization */
         authentic++;
         if (kind != FCM_RULE_STIFFNESS) continue;
@@ -204,8 +205,8 @@ static void check(const fcm_mesh *mesh, const geom_case *gc, int m, int simplify
       if (simplify && cls == FCM_CELL_CUT && authentic > M) {
         over_m[kind]++;
         if (verbose)
-          fprintf(stderr, "%s m %d cell %lld kind %d: %d points > M = %d (fallback)\n", gc->what,
-                  m, (long long)c, kind, authentic, M);
+          fprintf(stderr, "%s m %d cell %lld kind %d: %d points > M = %d (fallback)\n", gc->what, m,
+                  (long long)c, kind, authentic, M);
       }
     }
     /* exact[] is ordered 1, x, y, z (degree ascending) */
@@ -371,16 +372,16 @@ static void catalogue(fcm_mesh *const meshes[2])
   /* slivers crossing the plane z = 0: a flat tet of thickness t straddling it */
   for (int k = 3; k <= 15; k += 2) {
     const double t = pow(10.0, -k);
-    double v[4][3] = {{-0.6, -0.5, -0.3 * t}, {0.7, -0.4, 0.6 * t}, {0.1, 0.8, -0.5 * t},
-                      {0.2, 0.1, 0.7 * t}};
+    double v[4][3] = {
+        {-0.6, -0.5, -0.3 * t}, {0.7, -0.4, 0.6 * t}, {0.1, 0.8, -0.5 * t}, {0.2, 0.1, 0.7 * t}};
     snprintf(names[nn], sizeof names[nn], "sliver of thickness %.0e across z = 0", t);
     tet_case(meshes, v, names[nn++]);
   }
   /* a tiny tet at the central node, edge length 1e-5 .. 1e-2 */
   for (int k = 2; k <= 5; k++) {
     const double h = pow(10.0, -k);
-    double v[4][3] = {{-h, -h, -h}, {h, -0.5 * h, 0.2 * h}, {0.3 * h, h, -0.4 * h},
-                      {0.1 * h, 0.2 * h, h}};
+    double v[4][3] = {
+        {-h, -h, -h}, {h, -0.5 * h, 0.2 * h}, {0.3 * h, h, -0.4 * h}, {0.1 * h, 0.2 * h, h}};
     snprintf(names[nn], sizeof names[nn], "tet of size %.0e at the central node", h);
     tet_case(meshes, v, names[nn++]);
   }

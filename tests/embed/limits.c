@@ -125,7 +125,7 @@ static void crowded(fcm_ctx *ctx)
 static void scene_key(fcm_ctx *ctx)
 {
 #define SCENE(q)                                                                                   \
-  "{\"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1]}, "    \
+  "{\"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1]}, "   \
   "\"cells\": [1, 1, 1]}, \"material\": {\"young\": 1e6, \"poisson\": 0.3}" q "}"
   fcm_scene *s = NULL;
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, SCENE(""), "t.json", &s));

@@ -64,8 +64,7 @@ static fcm_status standard_rule(void *u)
 {
   fixture *x = u;
   x->r_out = (fcm_rule *)x;
-  fcm_status st = fcm_element_standard_rule(x->ctx, FCM_ELEMENT_HEX20, FCM_RULE_MASS, 0,
-                                            &x->r_out);
+  fcm_status st = fcm_element_standard_rule(x->ctx, FCM_ELEMENT_HEX20, FCM_RULE_MASS, 0, &x->r_out);
   return OUT_CHECK(st, x->r_out);
 }
 static void release(void *u)

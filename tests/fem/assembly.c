@@ -44,7 +44,8 @@ int main(int argc, char **argv)
   }
   TEST_OK(ctx, fcm_csr_apply(M, 1.0, ones, 0.0, y));
   double total = 0.0, moment = 0.0;
-  for (fcm_index i = 0; i < n; i++) total += y[i], moment += y[i] * xcoord[i];
+  for (fcm_index i = 0; i < n; i++)
+    total += y[i], moment += y[i] * xcoord[i];
   TEST_NEAR(total, mat.density, 1e-12, 0.0);
   TEST_NEAR(moment, mat.density * 0.5, 1e-12, 0.0);
   double asym = 1.0;
@@ -79,7 +80,8 @@ int main(int argc, char **argv)
   const int *ci = fcm_csr_col_idx(K);
   const double *v = fcm_csr_values(K);
   for (int i = 0; i < ni; i++)
-    for (fcm_index e = rp[i]; e < rp[i + 1]; e++) dense[i + (size_t)ci[e] * ni] = v[e];
+    for (fcm_index e = rp[i]; e < rp[i + 1]; e++)
+      dense[i + (size_t)ci[e] * ni] = v[e];
   TEST_OK(ctx, fcm__syev(ctx, 0, ni, dense, ni, ev));
   double lmax = ev[ni - 1];
   int zeros = 0;

@@ -32,10 +32,12 @@ static double tip_deflection(fcm_ctx *ctx, fcm_element_type type, fcm_index nx, 
   TEST_OK(ctx, fcm_assemble_body_force(space, mat, accel, NULL, f));
   double plo[3] = {0, -1, -1}, phi[3] = {0, 2, 2};
   TEST_OK(ctx, fcm_mesh_nodes_in_box(ctx, mesh, plo, phi, 1e-9, 0, NULL, &nfix));
-  fcm_index *nodes = calloc((size_t)nfix, sizeof *nodes), *dofs = calloc(3 * (size_t)nfix, sizeof *dofs);
+  fcm_index *nodes = calloc((size_t)nfix, sizeof *nodes),
+            *dofs = calloc(3 * (size_t)nfix, sizeof *dofs);
   TEST_OK(ctx, fcm_mesh_nodes_in_box(ctx, mesh, plo, phi, 1e-9, nfix, nodes, &nfix));
   for (fcm_index k = 0; k < nfix; k++)
-    for (int d = 0; d < 3; d++) dofs[3 * k + d] = fcm_space_node_dof(space, nodes[k]) + d;
+    for (int d = 0; d < 3; d++)
+      dofs[3 * k + d] = fcm_space_node_dof(space, nodes[k]) + d;
   TEST_OK(ctx, fcm_space_apply_dirichlet(space, 3 * nfix, dofs, NULL, K, f));
   TEST_OK(ctx, direct_solve(ctx, K, f, u));
   /* the tip-face centre (8, 0.5, 0.5) is a node for even n */

@@ -9,7 +9,8 @@
 static void pressure(void *user, const double x[3], const double n[3], double t[3])
 {
   (void)user, (void)x;
-  for (int i = 0; i < 3; i++) t[i] = -2.5 * n[i];
+  for (int i = 0; i < 3; i++)
+    t[i] = -2.5 * n[i];
 }
 
 static void x_normal(void *user, const double x[3], const double n[3], double t[3])
@@ -63,7 +64,8 @@ int main(int argc, char **argv)
     const int *ci = fcm_csr_col_idx(K);
     const double *v = fcm_csr_values(K);
     for (int i = 0; i < ni; i++)
-      for (fcm_index e = rp[i]; e < rp[i + 1]; e++) dense[i + (size_t)ci[e] * ni] = v[e];
+      for (fcm_index e = rp[i]; e < rp[i + 1]; e++)
+        dense[i + (size_t)ci[e] * ni] = v[e];
     TEST_OK(ctx, fcm__syev(ctx, 0, ni, dense, ni, ev));
     int zeros = 0;
     for (int i = 0; i < ni; i++)
@@ -87,7 +89,8 @@ int main(int argc, char **argv)
   TEST_OK(ctx, fcm_assemble_mass(space, &mat, NULL, M));
   TEST_OK(ctx, fcm_csr_apply(M, 1.0, ones, 0.0, y));
   double total = 0.0, moment = 0.0;
-  for (fcm_index i = 0; i < n; i++) total += y[i], moment += y[i] * xc[i];
+  for (fcm_index i = 0; i < n; i++)
+    total += y[i], moment += y[i] * xc[i];
   TEST_NEAR(total, rho * Vkept, 1e-12, 0.0);
   TEST_NEAR(Vkept, V, 1e-3, 0.0); /* little is dropped at this resolution */
   /* first moment: rho * |ball| * centre_x (the tet mesh of the ball is symmetric about c) */
@@ -96,7 +99,8 @@ int main(int argc, char **argv)
   double g[3] = {0, 0, -9.81};
   TEST_OK(ctx, fcm_assemble_body_force(space, &mat, g, NULL, f));
   double fz = 0.0;
-  for (fcm_index i = 2; i < n; i += 3) fz += f[i];
+  for (fcm_index i = 2; i < n; i += 3)
+    fz += f[i];
   TEST_NEAR(fz, -9.81 * rho * Vkept, 1e-12, 0.0);
 
   /* Surface rules: a closed surface under uniform pressure has zero net force;
@@ -104,13 +108,16 @@ int main(int argc, char **argv)
   memset(f, 0, sizeof *f * (size_t)n);
   TEST_OK(ctx, fcm_assemble_surface_traction(space, pressure, NULL, f));
   double net[3] = {0, 0, 0}, fabs_sum = 0.0;
-  for (fcm_index i = 0; i < n; i++) net[i % 3] += f[i], fabs_sum += fabs(f[i]);
-  for (int d = 0; d < 3; d++) TEST_NEAR(net[d], 0.0, 0.0, 1e-12 * fabs_sum);
+  for (fcm_index i = 0; i < n; i++)
+    net[i % 3] += f[i], fabs_sum += fabs(f[i]);
+  for (int d = 0; d < 3; d++)
+    TEST_NEAR(net[d], 0.0, 0.0, 1e-12 * fabs_sum);
   TEST_TRUE(fabs_sum > 1.0);
   memset(f, 0, sizeof *f * (size_t)n);
   TEST_OK(ctx, fcm_assemble_surface_traction(space, x_normal, NULL, f));
   double div = 0.0;
-  for (fcm_index i = 0; i < n; i += 3) div += f[i];
+  for (fcm_index i = 0; i < n; i += 3)
+    div += f[i];
   TEST_NEAR(div, V, 1e-12, 0.0);
 
   free(ones), free(xc), free(y), free(f);

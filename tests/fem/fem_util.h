@@ -17,7 +17,7 @@ static inline double urand(unsigned long long *s)
  * corner nodes are moved by up to amp * h in each direction and the mid-edge
  * nodes are put back on the midpoints of their (straight) edges. */
 static inline fcm_status distorted_box(fcm_ctx *ctx, fcm_element_type type, fcm_index n, double amp,
-                                fcm_mesh **out)
+                                       fcm_mesh **out)
 {
   double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
   fcm_index cells[3] = {n, n, n};
@@ -35,7 +35,8 @@ static inline fcm_status distorted_box(fcm_ctx *ctx, fcm_element_type type, fcm_
   memcpy(X, fcm_mesh_coords(box), sizeof *X * 3 * (size_t)nn);
   const fcm_index *cn = fcm_mesh_cells(box);
   for (fcm_index c = 0; c < nc; c++)
-    for (int a = 0; a < info->num_corners; a++) corner[cn[c * npc + a]] = 1;
+    for (int a = 0; a < info->num_corners; a++)
+      corner[cn[c * npc + a]] = 1;
   unsigned long long seed = 12345;
   double h = 1.0 / (double)n;
   for (fcm_index i = 0; i < nn; i++) {
@@ -43,7 +44,8 @@ static inline fcm_status distorted_box(fcm_ctx *ctx, fcm_element_type type, fcm_
     for (int d = 0; d < 3; d++)
       if (X[3 * i + d] < 1e-12 || X[3 * i + d] > 1 - 1e-12) interior = 0;
     if (interior && corner[i])
-      for (int d = 0; d < 3; d++) X[3 * i + d] += amp * h * urand(&seed);
+      for (int d = 0; d < 3; d++)
+        X[3 * i + d] += amp * h * urand(&seed);
   }
   if (info->order == 2)
     for (fcm_index c = 0; c < nc; c++)

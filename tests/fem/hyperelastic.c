@@ -7,7 +7,8 @@
 static double dot(fcm_index n, const double *a, const double *b)
 {
   double s = 0.0;
-  for (fcm_index i = 0; i < n; i++) s += a[i] * b[i];
+  for (fcm_index i = 0; i < n; i++)
+    s += a[i] * b[i];
   return s;
 }
 
@@ -27,7 +28,8 @@ int main(int argc, char **argv)
   double *f = calloc((size_t)n, sizeof *f), *fp = calloc((size_t)n, sizeof *fp);
   double *fm = calloc((size_t)n, sizeof *fm), *Ku = calloc((size_t)n, sizeof *Ku);
   unsigned long long seed = 99;
-  for (fcm_index i = 0; i < n; i++) u[i] = 0.05 * urand(&seed), du[i] = urand(&seed);
+  for (fcm_index i = 0; i < n; i++)
+    u[i] = 0.05 * urand(&seed), du[i] = urand(&seed);
 
   /* Linear model == linear stiffness: same matrix, force = K u, energy = u.K u / 2. */
   fcm_material lin = {FCM_MATERIAL_LINEAR, 1.0e4, 0.3, 1.0};
@@ -64,13 +66,16 @@ int main(int argc, char **argv)
     fcm_csr_set_zero(T);
     TEST_OK(ctx, fcm_assemble_hyperelastic(space, &p, u, NULL, &E, f, T));
     double h = 1e-6, Ep = 0, Em = 0;
-    for (fcm_index i = 0; i < n; i++) u[i] += h * du[i];
+    for (fcm_index i = 0; i < n; i++)
+      u[i] += h * du[i];
     memset(fp, 0, sizeof *fp * (size_t)n);
     TEST_OK(ctx, fcm_assemble_hyperelastic(space, &p, u, NULL, &Ep, fp, NULL));
-    for (fcm_index i = 0; i < n; i++) u[i] -= 2 * h * du[i];
+    for (fcm_index i = 0; i < n; i++)
+      u[i] -= 2 * h * du[i];
     memset(fm, 0, sizeof *fm * (size_t)n);
     TEST_OK(ctx, fcm_assemble_hyperelastic(space, &p, u, NULL, &Em, fm, NULL));
-    for (fcm_index i = 0; i < n; i++) u[i] += h * du[i];
+    for (fcm_index i = 0; i < n; i++)
+      u[i] += h * du[i];
     /* dE/du . du */
     TEST_NEAR((Ep - Em) / (2 * h), dot(n, f, du), 1e-6, 0.0);
     /* T du vs (f(u + h du) - f(u - h du)) / 2h */

@@ -43,12 +43,14 @@ int main(int argc, char **argv)
     if (d >= 0) field(Xn + 3 * i, quad, u + d);
   }
   enum { NP = 400 };
-  double *P = malloc(sizeof *P * 3 * NP), *xi = malloc(sizeof *xi * 3 * NP), *val = malloc(sizeof *val * 3 * NP);
+  double *P = malloc(sizeof *P * 3 * NP), *xi = malloc(sizeof *xi * 3 * NP),
+         *val = malloc(sizeof *val * 3 * NP);
   fcm_index *cell = malloc(sizeof *cell * NP);
   int *ex = malloc(sizeof *ex * NP);
   unsigned long long seed = 7;
   for (int i = 0; i < NP; i++)
-    for (int d = 0; d < 3; d++) P[3 * i + d] = 0.5 + 0.499 * urand(&seed);
+    for (int d = 0; d < 3; d++)
+      P[3 * i + d] = 0.5 + 0.499 * urand(&seed);
   P[0] = 1.3, P[1] = -0.2, P[2] = 0.5; /* outside the mesh */
   TEST_OK(ctx, fcm_space_locate(space, NP, P, cell, xi, ex));
   TEST_OK(ctx, fcm_space_interpolate(space, NP, cell, xi, u, val));
@@ -60,16 +62,23 @@ int main(int argc, char **argv)
     fcm_element_map(type, Xc, xi + 3 * i, x);
     /* extrapolation from a curved cell is approximate: check it where the map is affine */
     if (!ex[i] || affine)
-      for (int d = 0; d < 3; d++) TEST_NEAR(x[d], P[3 * i + d], 0.0, 1e-10);
-    for (int d = 0; d < 3; d++) TEST_TRUE(isfinite(val[3 * i + d]));
+      for (int d = 0; d < 3; d++)
+        TEST_NEAR(x[d], P[3 * i + d], 0.0, 1e-10);
+    for (int d = 0; d < 3; d++)
+      TEST_TRUE(isfinite(val[3 * i + d]));
     /* inside: the field of the space is exact; extrapolated: exact for linear fields */
     if (!ex[i] || (affine && !quad)) {
       field(P + 3 * i, quad, ue);
-      for (int d = 0; d < 3; d++) TEST_NEAR(val[3 * i + d], ue[d], 0.0, 1e-10);
+      for (int d = 0; d < 3; d++)
+        TEST_NEAR(val[3 * i + d], ue[d], 0.0, 1e-10);
     }
-    if (ex[i]) outside++; else inside++;
+    if (ex[i])
+      outside++;
+    else
+      inside++;
     int in_inactive_region = 1; /* deep in the deactivated corner */
-    for (int d = 0; d < 3; d++) in_inactive_region &= P[3 * i + d] > 0.7 && P[3 * i + d] < 1.0;
+    for (int d = 0; d < 3; d++)
+      in_inactive_region &= P[3 * i + d] > 0.7 && P[3 * i + d] < 1.0;
     if (in_inactive_region && P[3 * i] > 0.95) TEST_TRUE(ex[i]);
   }
   TEST_TRUE(ex[0] && inside > 100 && outside > 5);

@@ -74,10 +74,12 @@ int main(void)
     fcm_index c = (fcm_index)i * (NFAN / NP);
     const fcm_index *cn = fcm_mesh_cells(mesh) + 4 * c;
     double w[4], sum = 0.0;
-    for (int a = 0; a < 4; a++) sum += (w[a] = 0.1 + 0.5 * (1.0 + urand(&seed)));
+    for (int a = 0; a < 4; a++)
+      sum += (w[a] = 0.1 + 0.5 * (1.0 + urand(&seed)));
     for (int d = 0; d < 3; d++) {
       P[3 * i + d] = 0.0;
-      for (int a = 0; a < 4; a++) P[3 * i + d] += w[a] / sum * Xn[3 * cn[a] + d];
+      for (int a = 0; a < 4; a++)
+        P[3 * i + d] += w[a] / sum * Xn[3 * cn[a] + d];
     }
     home[i] = c;
   }
@@ -89,7 +91,8 @@ int main(void)
     wrong += cell[i] != home[i];
     fcm_mesh_cell_coords(mesh, cell[i], Xc);
     fcm_element_map(FCM_ELEMENT_TET4, Xc, xi + 3 * i, x);
-    for (int d = 0; d < 3; d++) TEST_NEAR(x[d], P[3 * i + d], 0.0, 1e-12);
+    for (int d = 0; d < 3; d++)
+      TEST_NEAR(x[d], P[3 * i + d], 0.0, 1e-12);
   }
   TEST_TRUE(extrapolated == 0);
   TEST_TRUE(wrong == 0);
@@ -117,7 +120,8 @@ int main(void)
       if (k > 100000) break;
     }
     TEST_TRUE(failures > NA && other == 0); /* at least one allocation per point failed */
-    for (int i = 0; i < NA; i++) TEST_TRUE(c2[i] == home[i]);
+    for (int i = 0; i < NA; i++)
+      TEST_TRUE(c2[i] == home[i]);
   }
 
   /* points 5, 9 and 13 far from every cell: the error names point 5, on every run */
@@ -126,7 +130,8 @@ int main(void)
     fcm_index c3[20];
     memcpy(Q, P, sizeof Q);
     const int far[3] = {13, 5, 9};
-    for (int j = 0; j < 3; j++) Q[3 * far[j]] = 1e12 * (j + 1);
+    for (int j = 0; j < 3; j++)
+      Q[3 * far[j]] = 1e12 * (j + 1);
     const int threads[3] = {1, 2, 4};
     for (int run = 0; run < 12; run++) {
       omp_set_num_threads(threads[run % 3]);

@@ -9,7 +9,8 @@ static void linear_field(const double x[3], double u[3])
   static const double A[9] = {1e-3, 2e-3, -1e-3, 0.5e-3, -2e-3, 1.5e-3, 3e-3, 1e-3, 2.5e-3};
   static const double c[3] = {0.1, -0.2, 0.3};
   fcm__mat3_mulv(A, x, u);
-  for (int i = 0; i < 3; i++) u[i] += c[i];
+  for (int i = 0; i < 3; i++)
+    u[i] += c[i];
 }
 
 int main(int argc, char **argv)
@@ -75,7 +76,8 @@ int main(int argc, char **argv)
       double g[3];
       fcm__mat3_tmulv(Ji, dN + 3 * a, g);
       for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) G[3 * i + j] += u[fcm_space_node_dof(space, cn[a]) + i] * g[j];
+        for (int j = 0; j < 3; j++)
+          G[3 * i + j] += u[fcm_space_node_dof(space, cn[a]) + i] * g[j];
     }
     double e1[3] = {1, 0, 0}, e2[3] = {0, 1, 0}, e3[3] = {0, 0, 1}, z[3] = {0, 0, 0}, u0[3];
     double *E[3] = {e1, e2, e3};
@@ -83,7 +85,8 @@ int main(int argc, char **argv)
     for (int j = 0; j < 3; j++) {
       double uj[3];
       linear_field(E[j], uj);
-      for (int i = 0; i < 3; i++) maxgrad = fmax(maxgrad, fabs(G[3 * i + j] - (uj[i] - u0[i])));
+      for (int i = 0; i < 3; i++)
+        maxgrad = fmax(maxgrad, fabs(G[3 * i + j] - (uj[i] - u0[i])));
     }
   }
   /* stresses = lambda tr(eps) I + 2 mu eps: constant to 1e-10 relative to E |grad u| */

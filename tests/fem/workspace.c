@@ -61,7 +61,8 @@ int main(int argc, char **argv)
   double *f = calloc((size_t)n, sizeof *f), *fint = calloc((size_t)n, sizeof *fint);
   double *f1 = calloc((size_t)n, sizeof *f1), *fint1 = calloc((size_t)n, sizeof *fint1);
   unsigned long long seed = 7;
-  for (fcm_index i = 0; i < n; i++) u[i] = 0.05 * urand(&seed), u2[i] = 0.05 * urand(&seed);
+  for (fcm_index i = 0; i < n; i++)
+    u[i] = 0.05 * urand(&seed), u2[i] = 0.05 * urand(&seed);
   fcm_material snh = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 1.0e4, 0.3, 2.0};
   fcm_material_params p;
   TEST_OK(ctx, fcm_material_setup(ctx, &snh, &p));

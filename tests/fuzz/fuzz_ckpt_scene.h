@@ -12,6 +12,7 @@ static const char fuzz_ckpt_scene_json[] =
     " \"material\": {\"model\": \"snh\", \"young\": 1e5, \"poisson\": 0.3, \"density\": 1000},"
     " \"time\": {\"static\": true, \"steps\": 4, \"dt\": 1},"
     " \"effects\": [{\"gravity\": {}},"
-    "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, 0, 0]}}}}]}";
+    "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, 0, "
+    "0]}}}}]}";
 
 #endif

@@ -10,8 +10,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
   const uint8_t *nul = size ? memchr(data, 0, size) : NULL;
   size_t nsize = nul ? (size_t)(nul - data) : size;
   const char *node = fuzz_write_file(0, "in.node", data, nsize);
-  const char *ele = fuzz_write_file(1, "in.ele", nul ? nul + 1 : data + size,
-                                    nul ? size - nsize - 1 : 0);
+  const char *ele =
+      fuzz_write_file(1, "in.ele", nul ? nul + 1 : data + size, nul ? size - nsize - 1 : 0);
   fcm_geometry *geom = NULL;
   fcm_status st = fcm_geometry_create_from_tetgen(ctx, node, ele, &geom);
   fuzz_check_status(ctx, st);

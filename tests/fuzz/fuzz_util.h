@@ -76,7 +76,8 @@ static inline fcm_ctx *fuzz_ctx(void)
 
 /* Write data[0, size) to <scratch>/name; the path is returned in a static buffer per name
  * slot (slot 0 or 1). */
-static inline const char *fuzz_write_file(int slot, const char *name, const uint8_t *data, size_t size)
+static inline const char *fuzz_write_file(int slot, const char *name, const uint8_t *data,
+                                          size_t size)
 {
   static char path[2][sizeof fuzz_dir_ + 16];
   snprintf(path[slot], sizeof path[slot], "%s/%s", fuzz_dir_, name);

@@ -64,9 +64,8 @@ int main(void)
     size_t got = fread(text, 1, sizeof text - 1, f);
     text[got] = '\0';
     fclose(f);
-    snprintf(want, sizeof want, "geometry: %s cells %lld, nodes %lld, volume %.17g,",
-             info->name, (long long)nc, (long long)fcm_geometry_num_nodes(g),
-             fcm_geometry_volume(g));
+    snprintf(want, sizeof want, "geometry: %s cells %lld, nodes %lld, volume %.17g,", info->name,
+             (long long)nc, (long long)fcm_geometry_num_nodes(g), fcm_geometry_volume(g));
     TEST_TRUE(strstr(text, want) != NULL);
     snprintf(want, sizeof want, "boundary triangles %lld", (long long)nt);
     TEST_TRUE(strstr(text, want) != NULL);

@@ -58,19 +58,19 @@ int main(void)
   /* F1: header counts beyond what the file can hold; no allocation above a few KiB. */
   write_file("rl_14.node", "99999999999 3\n"); /* 14 bytes: 2.4 TB of coordinates */
   largest = 0;
-  TEST_ERR(ctx, fcm_geometry_create_from_tetgen(ctx, "rl_14.node", "rl_ok.ele", &g),
-           FCM_ERR_FORMAT, "rl_14.node:1: number of points");
+  TEST_ERR(ctx, fcm_geometry_create_from_tetgen(ctx, "rl_14.node", "rl_ok.ele", &g), FCM_ERR_FORMAT,
+           "rl_14.node:1: number of points");
   TEST_TRUE(largest < 4096 && g == NULL);
   write_file("rl_23.node", "29500000 3\n0 0 0 0\n1 0\n"); /* 23 bytes: 709 MB before */
   largest = 0;
-  TEST_ERR(ctx, fcm_geometry_create_from_tetgen(ctx, "rl_23.node", "rl_ok.ele", &g),
-           FCM_ERR_FORMAT, "outside [0, 3]");
+  TEST_ERR(ctx, fcm_geometry_create_from_tetgen(ctx, "rl_23.node", "rl_ok.ele", &g), FCM_ERR_FORMAT,
+           "outside [0, 3]");
   TEST_TRUE(largest < 4096 && g == NULL);
   write_file("rl_4.node", "4 3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n");
   write_file("rl_big.ele", "9999999999 4\n1 1 2 3 4\n");
   largest = 0;
-  TEST_ERR(ctx, fcm_geometry_create_from_tetgen(ctx, "rl_4.node", "rl_big.ele", &g),
-           FCM_ERR_FORMAT, "rl_big.ele:1: number of tetrahedra");
+  TEST_ERR(ctx, fcm_geometry_create_from_tetgen(ctx, "rl_4.node", "rl_big.ele", &g), FCM_ERR_FORMAT,
+           "rl_big.ele:1: number of tetrahedra");
   TEST_TRUE(largest < 4096 && g == NULL);
   /* the bound admits the smallest valid files */
   write_file("rl_min.node", "4 3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1");
@@ -110,9 +110,10 @@ int main(void)
   TEST_TRUE(have_fifo);
   remove("rl_fifo");
   rmdir("rl_dir");
-  const char *files[] = {"rl_ok.ele", "rl_14.node", "rl_23.node", "rl_4.node", "rl_big.ele",
-                         "rl_min.node", "rl_min.ele", "rl_nodes.msh"};
-  for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) remove(files[k]);
+  const char *files[] = {"rl_ok.ele",  "rl_14.node",  "rl_23.node", "rl_4.node",
+                         "rl_big.ele", "rl_min.node", "rl_min.ele", "rl_nodes.msh"};
+  for (size_t k = 0; k < sizeof files / sizeof files[0]; k++)
+    remove(files[k]);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();

@@ -79,9 +79,9 @@ int main(void)
   touch(name);
   snprintf(name, sizeof name, DIR "/frame_0003.vtu.tmp.%ld.7", dead); /* not hidden */
   touch(name);
-  touch(DIR "/.frame.vtu.tmp.abc.7");                                 /* pid not a number */
+  touch(DIR "/.frame.vtu.tmp.abc.7"); /* pid not a number */
   touch(DIR "/.frame.vtu.tmp.12x.7");
-  snprintf(name, sizeof name, DIR "/.adir.tmp.%ld.7", dead);          /* a directory */
+  snprintf(name, sizeof name, DIR "/.adir.tmp.%ld.7", dead); /* a directory */
   TEST_TRUE(mkdir(name, 0700) == 0);
   TEST_TRUE(vr_count_entries(DIR, ".tmp.") == 7);
 

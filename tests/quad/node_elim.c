@@ -7,8 +7,8 @@
 #include "quad/rulegen_impl.h"
 #include "test_alloc.h"
 
-static const fcm_shape all_shapes[] = {FCM_SHAPE_LINE, FCM_SHAPE_TRI, FCM_SHAPE_QUAD,
-                                       FCM_SHAPE_TET, FCM_SHAPE_HEX};
+static const fcm_shape all_shapes[] = {FCM_SHAPE_LINE, FCM_SHAPE_TRI, FCM_SHAPE_QUAD, FCM_SHAPE_TET,
+                                       FCM_SHAPE_HEX};
 
 /* Gram matrix of the degree-m basis with a rule exact for 2m: identity to 1e-13;
  * for m <= 8 gradients against central differences at some of the rule's points. */
@@ -27,12 +27,14 @@ static void check_basis(fcm_ctx *ctx, fcm_shape shape, int m)
     double wi = fcm_rule_weights(r)[i] / meas;
     fcm__orthobasis_eval(shape, m, x, phi, grad, M);
     for (int a = 0; a < M; a++)
-      for (int b = 0; b < M; b++) gram[(size_t)a * M + b] += wi * phi[a] * phi[b];
+      for (int b = 0; b < M; b++)
+        gram[(size_t)a * M + b] += wi * phi[a] * phi[b];
     if (i % 7 || m > 8) continue; /* differences lose accuracy at high degree */
     for (int k = 0; k < dim; k++) {
       const double h = 1e-6;
       double xp[3] = {0, 0, 0}, xm[3] = {0, 0, 0};
-      for (int d = 0; d < dim; d++) xp[d] = xm[d] = x[d];
+      for (int d = 0; d < dim; d++)
+        xp[d] = xm[d] = x[d];
       xp[k] += h;
       xm[k] -= h;
       fcm__orthobasis_eval(shape, m, xp, pp, NULL, M);
@@ -44,7 +46,8 @@ static void check_basis(fcm_ctx *ctx, fcm_shape shape, int m)
     }
   }
   for (int a = 0; a < M; a++)
-    for (int b = 0; b < M; b++) gerr = fmax(gerr, fabs(gram[(size_t)a * M + b] - (a == b)));
+    for (int b = 0; b < M; b++)
+      gerr = fmax(gerr, fabs(gram[(size_t)a * M + b] - (a == b)));
   if (!(gerr <= 1e-13)) TEST_FAIL_("%s m=%d: |Gram - I| = %.3g", fcm_shape_name(shape), m, gerr);
   if (!(derr <= 1e-6))
     TEST_FAIL_("%s m=%d: gradient vs finite difference %.3g", fcm_shape_name(shape), m, derr);
@@ -60,7 +63,8 @@ done:
 static int binom(int n, int k)
 {
   int c = 1;
-  for (int i = 1; i <= k; i++) c = c * (n - k + i) / i;
+  for (int i = 1; i <= k; i++)
+    c = c * (n - k + i) / i;
   return c;
 }
 
@@ -116,7 +120,8 @@ int main(void)
   TEST_OK(ctx, fcm_rule_create_gauss_jacobi(ctx, 4, 0.0, 0.0, &gauss));
   if (out && gauss && fcm_rule_num_points(out) == 4) {
     double x[4], w[4];
-    for (int i = 0; i < 4; i++) x[i] = fcm_rule_points(out)[i], w[i] = fcm_rule_weights(out)[i];
+    for (int i = 0; i < 4; i++)
+      x[i] = fcm_rule_points(out)[i], w[i] = fcm_rule_weights(out)[i];
     for (int i = 0; i < 4; i++) /* sort ascending like the Gauss nodes */
       for (int j = i + 1; j < 4; j++)
         if (x[j] < x[i]) {

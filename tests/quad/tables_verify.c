@@ -3,8 +3,8 @@
  * fewer points than the computed rule, and the compiled-in copy identical to the file. */
 #include "moments.h"
 
-#define RTOL 1e-13 /* relative error on monomials with non-zero integral */
-#define ZTOL 1e-14 /* |Q| / measure on monomials with zero integral */
+#define RTOL       1e-13 /* relative error on monomials with non-zero integral */
+#define ZTOL       1e-14 /* |Q| / measure on monomials with zero integral */
 #define MAX_POINTS 4096
 
 static const fcm_shape shapes[] = {FCM_SHAPE_TRI, FCM_SHAPE_QUAD, FCM_SHAPE_TET, FCM_SHAPE_HEX};
@@ -42,12 +42,13 @@ static int read_table(const char *path, int dim, table *t)
     }
     if (k == 0) continue; /* blank line */
     if (k != dim + 1 || rows >= MAX_POINTS) {
-      TEST_FAIL_("%s:%d: %d numbers (expected %d) or more than %d rows", path, lineno, k,
-                 dim + 1, MAX_POINTS);
+      TEST_FAIL_("%s:%d: %d numbers (expected %d) or more than %d rows", path, lineno, k, dim + 1,
+                 MAX_POINTS);
       ok = 0;
       break;
     }
-    for (int d = 0; d < dim; d++) t->x[rows * dim + d] = v[d];
+    for (int d = 0; d < dim; d++)
+      t->x[rows * dim + d] = v[d];
     t->w[rows++] = v[dim];
   }
   fclose(f);
@@ -90,14 +91,13 @@ int main(int argc, char **argv)
       found++;
       if (read_table(path, dim, &t)) {
         if (strcmp(t.shape, name) || t.strength != m)
-          TEST_FAIL_("%s: header shape '%s' strength %d, expected %s %d", path, t.shape,
-                     t.strength, name, m);
+          TEST_FAIL_("%s: header shape '%s' strength %d, expected %s %d", path, t.shape, t.strength,
+                     name, m);
         TEST_OK(ctx, fcm_rule_create_from_arrays(ctx, shape, m, t.n, t.x, t.w, &file_rule));
         TEST_OK(ctx, fcm_rule_create_computed(ctx, shape, m, &comp));
       }
       if (file_rule && comp) {
-        if (mom_check_exact(file_rule, m, RTOL, ZTOL, NULL) ||
-            mom_check_inside_positive(file_rule))
+        if (mom_check_exact(file_rule, m, RTOL, ZTOL, NULL) || mom_check_inside_positive(file_rule))
           TEST_FAIL_("%s failed verification", path);
         if (!(t.n <= fcm_rule_num_points(comp)))
           TEST_FAIL_("%s: %d points, more than the computed rule's %d", path, t.n,

@@ -16,7 +16,7 @@
 
 #define DIR "scene_alloc_sim.d"
 
-#define BODY(extra_solver, time, damping)                                                                   \
+#define BODY(extra_solver, time, damping)                                                          \
   "{\"version\": 1, \"name\": \"as\","                                                             \
   " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0],"                         \
   "   \"max\": [1.5, 0.5, 0.5]}, \"cells\": [3, 1, 1]},"                                           \
@@ -26,7 +26,7 @@
   " \"solver\": {\"threads\": 1" extra_solver "},"                                                 \
   " \"time\": " time ","                                                                           \
   " \"output\": {\"frame_interval\": 1, \"checkpoint_interval\": 1},"                              \
-  " \"effects\": [{\"gravity\": {}}," damping                                                   \
+  " \"effects\": [{\"gravity\": {}}," damping                                                      \
   "  {\"traction\": {\"region\": {\"box\": {\"min\": [1.1, -1, -1], \"max\": [1.3, 1, 1]}},"       \
   "   \"value\": [0, 0, -100]}},"                                                                  \
   "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0],"                             \
@@ -155,7 +155,8 @@ static int loop(fcm_ctx *ctx, failing *f, const fcm_scene *scene, int s, int whi
       ok = 1;
     } else {
       failures++;
-      if (st != FCM_ERR_ALLOC || (which != OP_SUMMARY && fcm_ctx_error_status(ctx) != FCM_ERR_ALLOC))
+      if (st != FCM_ERR_ALLOC ||
+          (which != OP_SUMMARY && fcm_ctx_error_status(ctx) != FCM_ERR_ALLOC))
         TEST_FAIL_("scene %d %s, allocation %lld failing: %s (%s)", s, op_names[which], k,
                    fcm_status_str(st), fcm_ctx_error_message(ctx));
     }
@@ -221,7 +222,9 @@ int main(int argc, char **argv)
       if (s == 2 && w == OP_COM) continue; /* static: no mass matrix */
       double t0 = fcm_wtime();
       n[w] = loop(ctx, &f, scene, s, w, w == OP_STEP ? 1 : 2, 1);
-      if (getenv("VERBOSE")) fprintf(stderr, "scene %d %s: %d failing allocations, %.2f s\n", s, op_names[w], n[w], fcm_wtime() - t0);
+      if (getenv("VERBOSE"))
+        fprintf(stderr, "scene %d %s: %d failing allocations, %.2f s\n", s, op_names[w], n[w],
+                fcm_wtime() - t0);
       if (w == OP_CREATE && n[w] < 20) TEST_FAIL_("scene %d: create failed only %d times", s, n[w]);
       if ((w == OP_FRAME || w == OP_CHECKPOINT || w == OP_LOG) && n[w] < 1)
         TEST_FAIL_("scene %d %s: no allocation to fail", s, op_names[w]);

@@ -120,8 +120,8 @@ static void check_full(fcm_ctx *ctx)
   check_vec(e->motion.motion.velocity, 0.1, 0.2, 0.3);
   check_vec(e->motion.motion.axis, 0, 1, 0);
   check_vec(e->motion.motion.center, 1, 0, 1);
-  TEST_TRUE(e->motion.motion.angular_speed == -0.5 && e->motion.motion.start == 0.25 && e->motion.motion.end == 1.25 &&
-            e->motion.motion.release == 1);
+  TEST_TRUE(e->motion.motion.angular_speed == -0.5 && e->motion.motion.start == 0.25 &&
+            e->motion.motion.end == 1.25 && e->motion.motion.release == 1);
   const double in_tol[3] = {0, -2.005, 0}, out_tol[3] = {0, -2.02, 0};
   TEST_TRUE(fcm_region_contains(&e->motion.region, in_tol));
   TEST_TRUE(!fcm_region_contains(&e->motion.region, out_tol));
@@ -212,7 +212,8 @@ static void check_defaults(fcm_ctx *ctx)
   TEST_TRUE(so->representative_acceleration == 9.81 && so->threads == FCM_DEFAULT);
   TEST_TRUE(so->newton_rule == FCM_NEWTON_TOL_AUTO);
   const fcm_scene_time *t = fcm_scene_get_time(s);
-  TEST_TRUE(t->integrator == FCM_INTEGRATOR_BACKWARD_EULER && t->dt == 1.0 / 60.0 && t->num_steps == 60 && t->load_steps == 1);
+  TEST_TRUE(t->integrator == FCM_INTEGRATOR_BACKWARD_EULER && t->dt == 1.0 / 60.0 &&
+            t->num_steps == 60 && t->load_steps == 1);
   TEST_NEAR(t->duration, 1.0, 1e-15, 0);
   const fcm_scene_output *o = fcm_scene_get_output(s);
   TEST_TRUE(!strcmp(o->directory, "fcm-output") && o->frame_interval == 1);
@@ -237,7 +238,8 @@ static void check_defaults(fcm_ctx *ctx)
                    "s.json", &s));
   if (s) {
     const fcm_scene_time *ts = fcm_scene_get_time(s);
-    TEST_TRUE(ts->integrator == FCM_INTEGRATOR_STATIC && ts->num_steps == 1 && ts->dt == 1.0 / 60.0);
+    TEST_TRUE(ts->integrator == FCM_INTEGRATOR_STATIC && ts->num_steps == 1 &&
+              ts->dt == 1.0 / 60.0);
     check_vec(fcm_scene_get_effect(s, 0)->gravity.acceleration, 0, 0, -9.81);
     const fcm_effect_fixed *fx = &fcm_scene_get_effect(s, 1)->fixed;
     TEST_TRUE(fx->components[0] && fx->components[1] && fx->components[2]);

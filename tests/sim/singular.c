@@ -57,19 +57,21 @@ static void test_direct(fcm_ctx *ctx)
 static void beam_json(char *buf, size_t n, const char *element, int fixed, int strength)
 {
   char quad[128] = "";
-  if (strength > 0) snprintf(quad, sizeof quad, " \"quadrature\": {\"stiffness_strength\": %d},", strength);
-  snprintf(buf, n,
-           "{\"version\": 1, \"name\": \"singular\","
-           " \"background\": {\"element\": \"%s\", \"box\": {\"min\": [0, 0, 0], \"max\": [2, 1, 1]},"
-           "   \"cells\": [4, 2, 2]},%s"
-           " \"material\": {\"model\": \"linear\", \"young\": 1e6, \"poisson\": 0.3, \"density\": 1000},"
-           " \"solver\": {\"method\": \"direct\", \"direct\": \"cholmod\"},"
-           " \"time\": {\"static\": true, \"steps\": 1},"
-           " \"effects\": [{\"gravity\": {\"acceleration\": [0, 0, -9.81]}}%s]}",
-           element, quad,
-           fixed ? ", {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0],"
-                   " \"normal\": [-1, 0, 0]}}}}"
-                 : "");
+  if (strength > 0)
+    snprintf(quad, sizeof quad, " \"quadrature\": {\"stiffness_strength\": %d},", strength);
+  snprintf(
+      buf, n,
+      "{\"version\": 1, \"name\": \"singular\","
+      " \"background\": {\"element\": \"%s\", \"box\": {\"min\": [0, 0, 0], \"max\": [2, 1, 1]},"
+      "   \"cells\": [4, 2, 2]},%s"
+      " \"material\": {\"model\": \"linear\", \"young\": 1e6, \"poisson\": 0.3, \"density\": 1000},"
+      " \"solver\": {\"method\": \"direct\", \"direct\": \"cholmod\"},"
+      " \"time\": {\"static\": true, \"steps\": 1},"
+      " \"effects\": [{\"gravity\": {\"acceleration\": [0, 0, -9.81]}}%s]}",
+      element, quad,
+      fixed ? ", {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0],"
+              " \"normal\": [-1, 0, 0]}}}}"
+            : "");
 }
 
 /* Step the scene once: the status and the step's reason. */
@@ -96,8 +98,7 @@ static void test_sim(fcm_ctx *ctx)
   static const char *const elements[2] = {"hex20", "tet10"};
   for (int e = 0; e < 2; e++) {
     beam_json(json, sizeof json, elements[e], 0, 0); /* free body */
-    TEST_ERR(ctx, step(ctx, json, &reason), FCM_ERR_SINGULAR,
-             "rigid-body modes are unconstrained");
+    TEST_ERR(ctx, step(ctx, json, &reason), FCM_ERR_SINGULAR, "rigid-body modes are unconstrained");
     beam_json(json, sizeof json, elements[e], 1, 1); /* one point per cell: hourglass modes */
     TEST_ERR(ctx, step(ctx, json, &reason), FCM_ERR_SINGULAR, "quadrature rule too weak");
     beam_json(json, sizeof json, elements[e], 1, 0); /* well posed */
@@ -115,22 +116,23 @@ static void test_small_cut(fcm_ctx *ctx)
     for (int dyn = 0; dyn < 2; dyn++)
       for (int el = 0; el < 2; el++) {
         char json[4096];
-        snprintf(json, sizeof json,
-                 "{\"version\": 1, \"name\": \"small_cut\","
-                 " \"background\": {\"element\": \"%s\", \"box\": {\"min\": [0, 0, 0],"
-                 "   \"max\": [1.5, 0.5, 0.5]}, \"cells\": [3, 1, 1]},"
-                 " \"geometry\": {\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [%.17g, 0.5, 0.5],"
-                 "   \"cells\": [3, 1, 1]},"
-                 " \"quadrature\": {\"min_fraction\": 0},"
-                 " \"material\": {\"model\": \"snh\", \"young\": 1e6, \"poisson\": 0.45,"
-                 "   \"density\": 1000},"
-                 " \"solver\": {\"method\": \"direct\", \"direct\": \"cholmod\"},"
-                 " \"time\": %s,"
-                 " \"effects\": [{\"gravity\": {\"acceleration\": [0, 0, -9.81]}},"
-                 "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0],"
-                 "    \"normal\": [-1, 0, 0]}}}}]}",
-                 el ? "hex20" : "hex8", 1.0 + 0.5 * fractions[f],
-                 dyn ? "{\"dt\": 0.01, \"steps\": 1}" : "{\"static\": true, \"steps\": 1}");
+        snprintf(
+            json, sizeof json,
+            "{\"version\": 1, \"name\": \"small_cut\","
+            " \"background\": {\"element\": \"%s\", \"box\": {\"min\": [0, 0, 0],"
+            "   \"max\": [1.5, 0.5, 0.5]}, \"cells\": [3, 1, 1]},"
+            " \"geometry\": {\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [%.17g, 0.5, 0.5],"
+            "   \"cells\": [3, 1, 1]},"
+            " \"quadrature\": {\"min_fraction\": 0},"
+            " \"material\": {\"model\": \"snh\", \"young\": 1e6, \"poisson\": 0.45,"
+            "   \"density\": 1000},"
+            " \"solver\": {\"method\": \"direct\", \"direct\": \"cholmod\"},"
+            " \"time\": %s,"
+            " \"effects\": [{\"gravity\": {\"acceleration\": [0, 0, -9.81]}},"
+            "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0],"
+            "    \"normal\": [-1, 0, 0]}}}}]}",
+            el ? "hex20" : "hex8", 1.0 + 0.5 * fractions[f],
+            dyn ? "{\"dt\": 0.01, \"steps\": 1}" : "{\"static\": true, \"steps\": 1}");
         fcm_step_reason reason;
         fcm_status st = step(ctx, json, &reason);
         if (st != FCM_OK || reason != FCM_STEP_CONVERGED)

@@ -29,9 +29,8 @@ int main(void)
     for (int c = 0; c < CELLS; c++) {
       fcm_simplify_options o = fcm_simplify_options_default();
       o.method = c % 2 ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
-      st[c] =
-          fcm__simplify_hooked(ctx, m, n, pts + 3 * (size_t)n * c, w + (size_t)n * c, &o,
-                               c == 5 ? 2 : 0, &out[c], NULL);
+      st[c] = fcm__simplify_hooked(ctx, m, n, pts + 3 * (size_t)n * c, w + (size_t)n * c, &o,
+                                   c == 5 ? 2 : 0, &out[c], NULL);
     }
     for (int c = 0; c < CELLS; c++)
       TEST_TRUE(st[c] == FCM_OK);

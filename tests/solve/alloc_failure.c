@@ -1,7 +1,7 @@
 /* Allocation failures in the solve module: failing the k-th allocation for k = 0, 1, ...
  * of the workspace (with its history), the Jacobi and the Schwarz builders (from blocks,
- * and from the cell blocks of a space), a second Schwarz setup, MINRES and CG (workspace and one-shot) gives
- * FCM_ERR_ALLOC and leaks nothing, until everything succeeds. */
+ * and from the cell blocks of a space), a second Schwarz setup, MINRES and CG (workspace and
+ * one-shot) gives FCM_ERR_ALLOC and leaks nothing, until everything succeeds. */
 #include "solve_test_util.h"
 
 #include <omp.h>

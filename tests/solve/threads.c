@@ -52,10 +52,10 @@ int main(void)
     o.history = h[t];
     o.history_capacity = MAXIT;
     o.rtol = 1e-12; /* not reached: MAXIT iterations each */
-    TEST_ERR(ctx,
-             fcm_minres_solve(ctx, n, fcm_csr_operator, A, fcm_schwarz_operator, P, b, x[t], &o,
-                              &ix[t]),
-             FCM_ERR_NOT_CONVERGED, "max_iterations");
+    TEST_ERR(
+        ctx,
+        fcm_minres_solve(ctx, n, fcm_csr_operator, A, fcm_schwarz_operator, P, b, x[t], &o, &ix[t]),
+        FCM_ERR_NOT_CONVERGED, "max_iterations");
     o.record_history = 0;
     TEST_ERR(ctx, fcm_minres_solve(ctx, n, fcm_csr_operator, A, NULL, NULL, b, y[t], &o, &iy[t]),
              FCM_ERR_NOT_CONVERGED, "max_iterations");

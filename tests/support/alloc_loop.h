@@ -15,8 +15,7 @@ typedef void (*alloc_release)(void *user);
 /* Returns the number of failing rounds (the test fails when none succeeds within
  * max_rounds, or when fewer than min_failures rounds failed). */
 static inline long alloc_loop(fcm_ctx *ctx, failing *f, const char *name, alloc_call call,
-                              alloc_release release, void *user, long min_failures,
-                              long max_rounds)
+                              alloc_release release, void *user, long min_failures, long max_rounds)
 {
   const long long live = fcm_ctx_live_allocations(ctx);
   long failures = 0;
@@ -46,8 +45,7 @@ static inline long alloc_loop(fcm_ctx *ctx, failing *f, const char *name, alloc_
   }
   if (ok == 0) TEST_FAIL_("%s: no success within %ld rounds", name, max_rounds);
   if (ok == 1 && failures < min_failures)
-    TEST_FAIL_("%s: %ld failing allocations, expected at least %ld", name, failures,
-               min_failures);
+    TEST_FAIL_("%s: %ld failing allocations, expected at least %ld", name, failures, min_failures);
   return failures;
 }
 

@@ -150,8 +150,9 @@ __attribute__((destructor)) static void report(void)
   const char *path = getenv("FCM_FAULT_REPORT");
   if (!path || !*path) return;
   char buf[256];
-  int n = snprintf(buf, sizeof buf, "ops %lld renames %lld synced %lld durable %lld dsynced %lld dirsyncs %lld\n", ops,
-                   renames, synced, durable, dsynced, dirsyncs);
+  int n = snprintf(buf, sizeof buf,
+                   "ops %lld renames %lld synced %lld durable %lld dsynced %lld dirsyncs %lld\n",
+                   ops, renames, synced, durable, dsynced, dirsyncs);
   int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0666);
   if (fd < 0) return;
   if (write(fd, buf, (size_t)n) != n) {

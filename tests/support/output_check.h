@@ -89,8 +89,8 @@ static inline int oc_check_pvd(vr_doc *d, const char *path, char *why, size_t ca
         /* relative to the PVD's directory */
         char full[2048];
         const char *slash = strrchr(path, '/');
-        snprintf(full, sizeof full, "%.*s/%s", slash ? (int)(slash - path) : 1,
-                 slash ? path : ".", file);
+        snprintf(full, sizeof full, "%.*s/%s", slash ? (int)(slash - path) : 1, slash ? path : ".",
+                 file);
         f = fopen(full, "rb");
       }
       if (f)

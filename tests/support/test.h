@@ -32,7 +32,7 @@ static int test_failures_ = 0;
   do {                                                                                             \
     double ta_ = (double)(a), tb_ = (double)(b);                                                   \
     if (!(fabs(ta_ - tb_) <= (atol) + (rtol)*fabs(tb_)))                                           \
-      TEST_FAIL_("%s = %.17g, expected %s = %.17g (diff %.3g, rtol %g, atol %g)", #a, ta_, #b,    \
+      TEST_FAIL_("%s = %.17g, expected %s = %.17g (diff %.3g, rtol %g, atol %g)", #a, ta_, #b,     \
                  tb_, fabs(ta_ - tb_), (double)(rtol), (double)(atol));                            \
   } while (0)
 
@@ -53,11 +53,12 @@ static int test_failures_ = 0;
     if (ts_ != (code))                                                                             \
       TEST_FAIL_("%s returned %s, expected %s", #call, fcm_status_str(ts_), #code);                \
     else if (!strstr(fcm_ctx_error_message(ctx), (substr)))                                        \
-      TEST_FAIL_("%s: message \"%s\" lacks \"%s\"", #call, fcm_ctx_error_message(ctx), (substr)); \
+      TEST_FAIL_("%s: message \"%s\" lacks \"%s\"", #call, fcm_ctx_error_message(ctx), (substr));  \
     fcm_ctx_error_clear(ctx);                                                                      \
   } while (0)
 
 /* Exit status of a test's main(). */
-#define TEST_RESULT() (test_failures_ ? (fprintf(stderr, "%d check(s) failed\n", test_failures_), 1) : 0)
+#define TEST_RESULT()                                                                              \
+  (test_failures_ ? (fprintf(stderr, "%d check(s) failed\n", test_failures_), 1) : 0)
 
 #endif

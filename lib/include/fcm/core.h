@@ -21,19 +21,19 @@ extern "C" {
 typedef int64_t fcm_index;
 
 /** One list generates the status enum and the messages of fcm_status_str(). */
-#define FCM_STATUS_LIST(X)                                                     \
-  X(FCM_OK, "success")                                                         \
-  X(FCM_ERR_ARG, "invalid argument")                                           \
-  X(FCM_ERR_ALLOC, "out of memory")                                            \
-  X(FCM_ERR_IO, "input/output error")                                          \
-  X(FCM_ERR_FORMAT, "malformed input")                                         \
-  X(FCM_ERR_LAPACK, "dense linear algebra routine failed")                     \
-  X(FCM_ERR_SINGULAR, "matrix is singular or not positive definite")           \
-  X(FCM_ERR_NOT_CONVERGED, "iteration did not converge")                       \
-  X(FCM_ERR_NUMERIC, "NaN or infinity encountered")                            \
-  X(FCM_ERR_LP, "linear program failed")                                       \
-  X(FCM_ERR_GEOMETRY, "invalid or degenerate geometry")                        \
-  X(FCM_ERR_UNSUPPORTED, "operation not supported")                            \
+#define FCM_STATUS_LIST(X)                                                                         \
+  X(FCM_OK, "success")                                                                             \
+  X(FCM_ERR_ARG, "invalid argument")                                                               \
+  X(FCM_ERR_ALLOC, "out of memory")                                                                \
+  X(FCM_ERR_IO, "input/output error")                                                              \
+  X(FCM_ERR_FORMAT, "malformed input")                                                             \
+  X(FCM_ERR_LAPACK, "dense linear algebra routine failed")                                         \
+  X(FCM_ERR_SINGULAR, "matrix is singular or not positive definite")                               \
+  X(FCM_ERR_NOT_CONVERGED, "iteration did not converge")                                           \
+  X(FCM_ERR_NUMERIC, "NaN or infinity encountered")                                                \
+  X(FCM_ERR_LP, "linear program failed")                                                           \
+  X(FCM_ERR_GEOMETRY, "invalid or degenerate geometry")                                            \
+  X(FCM_ERR_UNSUPPORTED, "operation not supported")                                                \
   X(FCM_ERR_INTERNAL, "internal error")
 
 #define FCM_STATUS_ENUM_(name, msg) name,
@@ -122,8 +122,8 @@ FCM_API double fcm_wtime(void);
 
 /** Accumulating stopwatch: start/stop pairs add to `total`. Plain value type. */
 typedef struct fcm_timer {
-  double total;   /**< accumulated seconds */
-  double started; /**< fcm_wtime() at the last start, negative when stopped */
+  double total;    /**< accumulated seconds */
+  double started;  /**< fcm_wtime() at the last start, negative when stopped */
   long long count; /**< completed start/stop intervals */
 } fcm_timer;
 

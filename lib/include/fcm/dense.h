@@ -12,11 +12,11 @@ extern "C" {
 
 /** How fcm_dense_spectrum_eval() went. */
 typedef struct fcm_dense_spectrum_info {
-  int cholesky;              /**< 1: S = L L^T by Cholesky; 0: by an eigendecomposition of S
-                                  (Cholesky failed, S numerically semi-definite), or S NULL */
-  int s_nonpositive;         /**< eigenvalues of S <= 0 (rounding) used as 0 (fallback only) */
-  double s_min, s_max;       /**< extreme eigenvalues of S (fallback only; else 0) */
-  double time;               /**< wall-clock seconds */
+  int cholesky;        /**< 1: S = L L^T by Cholesky; 0: by an eigendecomposition of S
+                            (Cholesky failed, S numerically semi-definite), or S NULL */
+  int s_nonpositive;   /**< eigenvalues of S <= 0 (rounding) used as 0 (fallback only) */
+  double s_min, s_max; /**< extreme eigenvalues of S (fallback only; else 0) */
+  double time;         /**< wall-clock seconds */
 } fcm_dense_spectrum_info;
 
 /** Eigenvalues of S A for symmetric A and symmetric positive definite S, computed as the

@@ -51,10 +51,10 @@ typedef enum fcm_element_type {
   FCM_ELEMENT_COUNT
 } fcm_element_type;
 
-#define FCM_ELEMENT_MAX_NODES 20
-#define FCM_ELEMENT_MAX_FACES 6
+#define FCM_ELEMENT_MAX_NODES      20
+#define FCM_ELEMENT_MAX_FACES      6
 #define FCM_ELEMENT_MAX_FACE_NODES 8
-#define FCM_ELEMENT_MAX_EDGES 12
+#define FCM_ELEMENT_MAX_EDGES      12
 
 /** Static description of an element type (immutable, shared, thread safe). */
 typedef struct fcm_element_info {

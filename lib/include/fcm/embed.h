@@ -40,14 +40,14 @@ typedef struct fcm_cell_rules_options {
                               strength */
   double min_fraction;   /**< phi below this: dropped; default 1e-4 (0: drop only empty cells) */
   double uncut_fraction; /**< phi at or above this: uncut; default 1 - 1e-12 */
-  double clip_rtol;   /**< vertex-on-plane tolerance / the smaller of the cell diameter and the
-                          embedded cell's thickness 6|E|/diam(E)^2; default 1e-12 */
-  double sliver_rtol; /**< tets with volume <= this * min(|K|, |E|) are dropped (|E|: the
-                          embedded cell clipped), so thin geometry keeps its volume; counted
-                          with their volume in the statistics; default 1e-14 */
+  double clip_rtol;      /**< vertex-on-plane tolerance / the smaller of the cell diameter and the
+                             embedded cell's thickness 6|E|/diam(E)^2; default 1e-12 */
+  double sliver_rtol;    /**< tets with volume <= this * min(|K|, |E|) are dropped (|E|: the
+                             embedded cell clipped), so thin geometry keeps its volume; counted
+                             with their volume in the statistics; default 1e-14 */
   double convex_rtol;    /**< tolerance of fcm_mesh_cell_is_convex(); default 1e-10 */
   int simplify;          /**< 1 (default): simplify cut-cell rules with fcm_simplify() */
-  fcm_simplify_options simplify_options;   /**< default fcm_simplify_options_default() */
+  fcm_simplify_options simplify_options; /**< default fcm_simplify_options_default() */
   double max_rule_memory; /**< bytes the rules of one cut cell may take to build (an estimate
                                checked before allocating: points of both kinds plus the
                                simplification's moment matrix and LP); a cell above it fails

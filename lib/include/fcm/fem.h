@@ -108,8 +108,8 @@ FCM_API fcm_status fcm_space_cell_blocks(const fcm_space *space, const unsigned 
 /** Quadrature strengths for assembly on full cells; FCM_DEFAULT selects the default rule of
  * fcm_element_standard_rule(). */
 typedef struct fcm_assembly_options {
-  int stiffness_strength; /**< stiffness and body force */
-  int mass_strength;      /**< consistent mass */
+  int stiffness_strength;          /**< stiffness and body force */
+  int mass_strength;               /**< consistent mass */
   fcm_fictitious_model fictitious; /**< model at stabilization points (hyperelastic only) */
 } fcm_assembly_options;
 
@@ -129,8 +129,7 @@ typedef struct fcm_assembly_options {
  * [0, FCM_RULE_MAX_STRENGTH] and not FCM_DEFAULT), FCM_ERR_ALLOC.
  * Allocates *rule; release with fcm_rule_destroy(). Thread safe. */
 FCM_API fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type,
-                                             fcm_rule_kind kind, int strength,
-                                             fcm_rule **rule);
+                                             fcm_rule_kind kind, int strength, fcm_rule **rule);
 
 /** Defaults: both strengths FCM_DEFAULT (element defaults), fictitious FCM_FICTITIOUS_PROJECTED. */
 FCM_API fcm_assembly_options fcm_assembly_options_default(void);
@@ -219,13 +218,14 @@ FCM_API fcm_status fcm_assemble_mass(const fcm_space *space, const fcm_material 
 /** Add the body force of a uniform acceleration `accel` (e.g. gravity),
  * f_a += integral of rho accel N_a, to f (num_dofs entries). Status codes as above. */
 FCM_API fcm_status fcm_assemble_body_force(const fcm_space *space, const fcm_material *mat,
-                                           const double accel[3],
-                                           const fcm_assembly_options *opts, double *f);
+                                           const double accel[3], const fcm_assembly_options *opts,
+                                           double *f);
 
 /** Add the load of a body force density b(x) (force per volume), f_a += int b N_a.
  * @return as fcm_assemble_body_force(). */
-FCM_API fcm_status fcm_assemble_body_force_field(const fcm_space *space, fcm_field_fn field, void *user,
-                                                 const fcm_assembly_options *opts, double *f);
+FCM_API fcm_status fcm_assemble_body_force_field(const fcm_space *space, fcm_field_fn field,
+                                                 void *user, const fcm_assembly_options *opts,
+                                                 double *f);
 
 /** Add the load of a surface traction t(x, n) on the embedded boundary,
  * f_a += int_{boundary} t N_a, with the surface rules of the space's cell rules.
@@ -278,9 +278,8 @@ FCM_API fcm_status fcm_space_locate(const fcm_space *space, fcm_index n, const d
 
 /** values[3i..3i+3) = sum_a N_a(xi_i) u_a in cell[i] (from fcm_space_locate()).
  * @return FCM_OK, FCM_ERR_ARG (an inactive or out-of-range cell). No allocation. */
-FCM_API fcm_status fcm_space_interpolate(const fcm_space *space, fcm_index n,
-                                         const fcm_index *cell, const double *xi,
-                                         const double *u, double *values);
+FCM_API fcm_status fcm_space_interpolate(const fcm_space *space, fcm_index n, const fcm_index *cell,
+                                         const double *xi, const double *u, double *values);
 
 #ifdef __cplusplus
 }

@@ -67,7 +67,8 @@ FCM_API int fcm_rule_num_points(const fcm_rule *rule);
 FCM_API const double *fcm_rule_points(const fcm_rule *rule);
 FCM_API const double *fcm_rule_weights(const fcm_rule *rule);
 FCM_API fcm_rule_origin fcm_rule_get_origin(const fcm_rule *rule);
-/** One-line description of how the rule was made ("Gauss-Legendre 3^3", a table header line, ...). */
+/** One-line description of how the rule was made ("Gauss-Legendre 3^3", a table header line, ...).
+ */
 FCM_API const char *fcm_rule_description(const fcm_rule *rule);
 
 /** Print shape, strength, count, origin and (with `full`) every point and weight. */

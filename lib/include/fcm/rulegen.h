@@ -13,15 +13,15 @@ extern "C" {
 
 /** Progress of a running elimination, passed to the progress callback. */
 typedef struct fcm_rulegen_info {
-  int initial_points;     /**< points of the start rule */
-  int num_points;         /**< points of the current (final, on return) rule */
-  int removals;           /**< accepted removal steps (a step may remove several points) */
-  int failed_attempts;    /**< removal attempts whose solve did not converge */
-  long long iterations;   /**< Levenberg–Marquardt iterations, all attempts */
-  double residual;        /**< max_j |sum_i w_i phi_j(x_i) - int phi_j| / int phi_0 (orthonormal phi) */
-  double min_weight;      /**< smallest weight divided by the mean weight */
-  double min_distance;    /**< smallest distance of a point to the boundary of the shape */
-  double seconds;         /**< wall time so far */
+  int initial_points;   /**< points of the start rule */
+  int num_points;       /**< points of the current (final, on return) rule */
+  int removals;         /**< accepted removal steps (a step may remove several points) */
+  int failed_attempts;  /**< removal attempts whose solve did not converge */
+  long long iterations; /**< Levenberg–Marquardt iterations, all attempts */
+  double residual;   /**< max_j |sum_i w_i phi_j(x_i) - int phi_j| / int phi_0 (orthonormal phi) */
+  double min_weight; /**< smallest weight divided by the mean weight */
+  double min_distance; /**< smallest distance of a point to the boundary of the shape */
+  double seconds;      /**< wall time so far */
 } fcm_rulegen_info;
 
 /** Progress callback, called after every accepted removal (from the calling thread). */
@@ -29,13 +29,13 @@ typedef void (*fcm_rulegen_progress_fn)(void *user, const fcm_rulegen_info *info
 
 /** Options of fcm_rule_eliminate_nodes(); initialize with fcm_rulegen_options_default(). */
 typedef struct fcm_rulegen_options {
-  double tol;           /**< accept a removal when the relative moment residual <= tol (1e-14) */
-  int max_iterations;   /**< Levenberg–Marquardt iterations per attempt (60) */
-  int max_candidates;   /**< single points tried, least significant first, before stopping (12) */
-  int target_points;    /**< stop at or below this many points (0: as few as possible) */
-  double max_batch;     /**< while unknowns exceed 1.25 x moments, remove up to this fraction of
-                             the points at once (0.05; 0 removes one point at a time) */
-  double margin;        /**< points keep this distance from the boundary (1e-9) */
+  double tol;         /**< accept a removal when the relative moment residual <= tol (1e-14) */
+  int max_iterations; /**< Levenberg–Marquardt iterations per attempt (60) */
+  int max_candidates; /**< single points tried, least significant first, before stopping (12) */
+  int target_points;  /**< stop at or below this many points (0: as few as possible) */
+  double max_batch;   /**< while unknowns exceed 1.25 x moments, remove up to this fraction of
+                           the points at once (0.05; 0 removes one point at a time) */
+  double margin;      /**< points keep this distance from the boundary (1e-9) */
   fcm_rulegen_progress_fn progress; /**< NULL: none */
   void *progress_user;              /**< passed to `progress` */
 } fcm_rulegen_options;
@@ -57,8 +57,8 @@ FCM_API fcm_rulegen_options fcm_rulegen_options_default(void);
  *         to tol), FCM_ERR_LAPACK, FCM_ERR_ALLOC. Allocates O(M n) memory for M moments
  *         and n points; uses OpenMP and BLAS threads. Thread safe for distinct outputs. */
 FCM_API fcm_status fcm_rule_eliminate_nodes(fcm_ctx *ctx, const fcm_rule *start, int strength,
-                                            const fcm_rulegen_options *opts,
-                                            fcm_rulegen_info *info, fcm_rule **out);
+                                            const fcm_rulegen_options *opts, fcm_rulegen_info *info,
+                                            fcm_rule **out);
 
 /** Relative moment residual of `rule` for `strength` in the orthonormal basis used
  * by fcm_rule_eliminate_nodes() (the number it reports as `residual`).

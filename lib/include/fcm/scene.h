@@ -79,16 +79,16 @@ typedef struct fcm_scene_geometry {
 typedef struct fcm_scene_quadrature {
   int stiffness_strength; /**< [0, 20]; FCM_DEFAULT (default): the element's default */
   int mass_strength;      /**< [0, 20]; FCM_DEFAULT (default): the element's default */
-  int surface_strength;   /**< [0, 20]; FCM_DEFAULT (default): automatic (the stiffness strength when a
-                               traction or pressure effect is present, else no surface rules) */
-  int simplify;           /**< 1 (default): simplify cut-cell rules; 0: keep them */
+  int surface_strength; /**< [0, 20]; FCM_DEFAULT (default): automatic (the stiffness strength when
+                           a traction or pressure effect is present, else no surface rules) */
+  int simplify;         /**< 1 (default): simplify cut-cell rules; 0: keep them */
   fcm_simplify_method simplify_method;     /**< "simplify_method": "auto" (default), "lp",
                                                 "recombine" */
   fcm_stabilization_options stabilization; /**< "stabilization": mode "mass_stiffness"
                                                 (default), "mass", "off"; alpha in (0, 1],
                                                 default 1e-6 */
-  double min_fraction; /**< cells with smaller volume fraction are dropped; [0, 1),
-                            default 1e-4 */
+  double min_fraction;        /**< cells with smaller volume fraction are dropped; [0, 1),
+                                   default 1e-4 */
   double max_rule_memory_gib; /**< fcm_cell_rules_options.max_rule_memory in GiB; [0, 2^20],
                                    default 4; 0: no limit */
 } fcm_scene_quadrature;
@@ -99,19 +99,19 @@ typedef struct fcm_scene_solver {
   fcm_direct_method direct;          /**< default FCM_DIRECT_CHOLMOD */
   fcm_preconditioner preconditioner; /**< Krylov only: "none", "jacobi", "block_jacobi",
                                           "schwarz" (default) */
-  double schwarz_threshold;     /**< cut cells with volume fraction below it get a block; (0, 1],
-                                     default 0.5 (fcm_integrator_options.schwarz_theta) */
-  fcm_schwarz_options schwarz;  /**< epsilon in (0, 1), default 1e-13; clamp "clamp" (default,
-                                     FCM_SCHWARZ_CLAMP) or "paper" (FCM_SCHWARZ_PAPER) */
-  double rtol;                  /**< Krylov relative tolerance; [0, 1), default 1e-8 */
-  double atol;                  /**< Krylov absolute tolerance; >= 0, default 0 */
-  int max_iterations;           /**< Krylov iterations; >= 1, default 1000 */
-  fcm_newton_tolerance newton_rule; /**< "auto" (default, FCM_NEWTON_TOL_AUTO),
-                                         "representative", "relative" */
-  double newton_rtol;        /**< tolerance of the rule; (0, 1), default 1e-5 */
-  int newton_max_iterations; /**< >= 1, default 100 */
-  int line_search;           /**< 1 (default): backtracking line search */
-  int project_psd;           /**< 1: project element tangents to PSD; default 0 */
+  double schwarz_threshold;    /**< cut cells with volume fraction below it get a block; (0, 1],
+                                    default 0.5 (fcm_integrator_options.schwarz_theta) */
+  fcm_schwarz_options schwarz; /**< epsilon in (0, 1), default 1e-13; clamp "clamp" (default,
+                                    FCM_SCHWARZ_CLAMP) or "paper" (FCM_SCHWARZ_PAPER) */
+  double rtol;                 /**< Krylov relative tolerance; [0, 1), default 1e-8 */
+  double atol;                 /**< Krylov absolute tolerance; >= 0, default 0 */
+  int max_iterations;          /**< Krylov iterations; >= 1, default 1000 */
+  fcm_newton_tolerance newton_rule;   /**< "auto" (default, FCM_NEWTON_TOL_AUTO),
+                                           "representative", "relative" */
+  double newton_rtol;                 /**< tolerance of the rule; (0, 1), default 1e-5 */
+  int newton_max_iterations;          /**< >= 1, default 100 */
+  int line_search;                    /**< 1 (default): backtracking line search */
+  int project_psd;                    /**< 1: project element tangents to PSD; default 0 */
   double representative_acceleration; /**< |a_rep| in m/s^2, > 0, default 9.81 */
   int threads; /**< OpenMP threads >= 1; FCM_DEFAULT ("threads": 0, the default): the OpenMP
                     default */
@@ -131,11 +131,11 @@ typedef struct fcm_scene_time {
 
 /** Output settings ("output"). */
 typedef struct fcm_scene_output {
-  const char *directory; /**< default "fcm-output"; relative to the working directory */
-  int frame_interval;    /**< write every frame_interval-th step (>= 1, default 1) */
+  const char *directory;   /**< default "fcm-output"; relative to the working directory */
+  int frame_interval;      /**< write every frame_interval-th step (>= 1, default 1) */
   int checkpoint_interval; /**< write a checkpoint every n-th step (>= 0; default 0: never) */
-  int write_background;  /**< 1 (default): write the deformed background mesh */
-  int write_surface;     /**< 1 (default): write the deformed embedded surface */
+  int write_background;    /**< 1 (default): write the deformed background mesh */
+  int write_surface;       /**< 1 (default): write the deformed embedded surface */
 } fcm_scene_output;
 
 /* ------------------------------------------------------------------- regions */

@@ -91,16 +91,16 @@ typedef struct fcm_integrator_options {
   fcm_newton_tolerance tolerance_mode; /**< default FCM_NEWTON_TOL_REPRESENTATIVE */
   double newton_tolerance;             /**< tol in (0, 1) (default 1e-5) */
   double newton_atol;                  /**< RELATIVE mode: absolute floor >= 0 (default 0) */
-  double rep_acceleration;             /**< |a_rep| > 0 in m/s^2; FCM_DEFAULT (default): the magnitude of the
-                                            first gravity load, or 9.81 without gravity. Its direction
-                                            is that gravity's, else (1, 1, 1)/sqrt 3 */
-  int line_search;                     /**< 1 (default): backtracking on E; 0: full Newton steps */
-  double armijo;                       /**< sufficient decrease c in (0, 0.5) (default 1e-4) */
-  double backtrack;                    /**< step factor in (0, 1) (default 0.5) */
-  int max_backtracks;                  /**< >= 0 (default 20) */
-  int project_psd;                   /**< 1: PSD-projected element tangents (default 0). Without it,
-                                          a non-descent Newton direction is recomputed once with the
-                                          projected tangent (counted as a projection fallback) */
+  double rep_acceleration; /**< |a_rep| > 0 in m/s^2; FCM_DEFAULT (default): the magnitude of the
+                                first gravity load, or 9.81 without gravity. Its direction
+                                is that gravity's, else (1, 1, 1)/sqrt 3 */
+  int line_search;         /**< 1 (default): backtracking on E; 0: full Newton steps */
+  double armijo;           /**< sufficient decrease c in (0, 0.5) (default 1e-4) */
+  double backtrack;        /**< step factor in (0, 1) (default 0.5) */
+  int max_backtracks;      /**< >= 0 (default 20) */
+  int project_psd;         /**< 1: PSD-projected element tangents (default 0). Without it,
+                                a non-descent Newton direction is recomputed once with the
+                                projected tangent (counted as a projection fallback) */
   fcm_linear_solver linear_solver;   /**< default FCM_LINEAR_DIRECT */
   fcm_direct_method direct_method;   /**< first direct method (default CHOLMOD; UMFPACK: LU only) */
   fcm_preconditioner preconditioner; /**< Krylov only (default JACOBI) */
@@ -211,7 +211,8 @@ typedef struct fcm_integrator fcm_integrator;
  * @param[in]  opts  copied; NULL for defaults (validated by fcm_integrator_setup())
  * @param[out] integ the new integrator, NULL on failure
  * @return FCM_OK, FCM_ERR_ARG (NULL, invalid material), FCM_ERR_ALLOC. Allocates O(n). */
-FCM_API fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space, const fcm_material *mat,
+FCM_API fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space,
+                                         const fcm_material *mat,
                                          const fcm_integrator_options *opts,
                                          fcm_integrator **integ);
 
@@ -243,8 +244,8 @@ FCM_API fcm_status fcm_integrator_add_constraint(fcm_integrator *integ, fcm_inde
                                                  int *id);
 
 /** Validate the options, build the constrained DOF list, assemble the mass matrix
- * (BACKWARD_EULER only) and the loads, allocate every work array and solver, and run the symbolic analysis (direct).
- * Constrained DOFs get their prescribed velocity at the current time.
+ * (BACKWARD_EULER only) and the loads, allocate every work array and solver, and run the symbolic
+ * analysis (direct). Constrained DOFs get their prescribed velocity at the current time.
  * @return FCM_OK, FCM_ERR_ARG (option out of range: named; DOF constrained twice; zero
  * representative force: set the density or use the relative rule), errors of the assembly
  * and of the solvers, FCM_ERR_ALLOC. Allocates; a second call is FCM_ERR_ARG. */
@@ -300,7 +301,8 @@ FCM_API fcm_status fcm_integrator_energy(fcm_integrator *integ, double *kinetic,
 
 /** Linear momentum p = sum over nodes of (M v)_a and angular momentum about the origin
  * L = sum (X_a + u_a) x (M v)_a (exact for the interpolated fields with the consistent
- * mass); zero for STATIC integrators. Either output may be NULL. After setup. @return FCM_OK, FCM_ERR_ARG. */
+ * mass); zero for STATIC integrators. Either output may be NULL. After setup. @return FCM_OK,
+ * FCM_ERR_ARG. */
 FCM_API fcm_status fcm_integrator_momentum(fcm_integrator *integ, double linear[3],
                                            double angular[3]);
 
@@ -310,12 +312,12 @@ FCM_API const fcm_csr *fcm_integrator_mass(const fcm_integrator *integ);
 
 /** What fcm_integrator_setup() assembled (all 0 before the setup). */
 typedef struct fcm_integrator_setup_info {
-  int mass_assemblies;  /**< 1 for BACKWARD_EULER; 0 for STATIC (no inertia, no M) */
+  int mass_assemblies;       /**< 1 for BACKWARD_EULER; 0 for STATIC (no inertia, no M) */
   int body_force_assemblies; /**< one per gravity or body-force load */
   int traction_assemblies;   /**< one per surface traction load */
-  int scale_assemblies; /**< 1 when a STATIC run with the REPRESENTATIVE rule had to assemble
-                             the body force of rho a_rep for its force scale (no gravity load
-                             equal to a_rep to reuse); else 0 */
+  int scale_assemblies;      /**< 1 when a STATIC run with the REPRESENTATIVE rule had to assemble
+                                  the body force of rho a_rep for its force scale (no gravity load
+                                  equal to a_rep to reuse); else 0 */
 } fcm_integrator_setup_info;
 
 /** Copy the setup counts out (zeros for NULL). */

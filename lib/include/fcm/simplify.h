@@ -81,8 +81,8 @@ FCM_API fcm_simplify_options fcm_simplify_options_default(void);
  * residual_tol); if all attempts (the chosen path, the other path, the chosen path with a
  * looser rank threshold) fail, the input is returned unchanged with info->fallback = 1 and
  * FCM_OK: the caller decides and counts; the fallback is also logged at FCM_LOG_WARNING
- * through the ctx's log callback (with the account of info->message). N <= M also returns the input (info->skipped).
- * Points of zero weight are never kept.
+ * through the ctx's log callback (with the account of info->message). N <= M also returns the input
+ * (info->skipped). Points of zero weight are never kept.
  * @param[in] points  n x 3 reference coordinates (row-major); @param[in] weights n, >= 0
  * @param[in] opts NULL for defaults; @param[out] out release with fcm_simplify_result_destroy()
  * @param[out] info may be NULL

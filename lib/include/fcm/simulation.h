@@ -23,8 +23,8 @@ extern "C" {
 
 /** Options of fcm_simulation_create(); initialize with fcm_simulation_options_default(). */
 typedef struct fcm_simulation_options {
-  fcm_index max_steps; /**< >= 1: stop after this many steps (fcm_simulation_done());
-                            FCM_DEFAULT (default): the scene's step count */
+  fcm_index max_steps;     /**< >= 1: stop after this many steps (fcm_simulation_done());
+                                FCM_DEFAULT (default): the scene's step count */
   int checkpoint_interval; /**< >= 0: fcm_simulation_checkpoint_due() every n-th step (0:
                                 never); FCM_DEFAULT (default): the scene's
                                 output.checkpoint_interval */
@@ -35,29 +35,29 @@ FCM_API fcm_simulation_options fcm_simulation_options_default(void);
 
 /** What the pipeline computed (counts) and which stages it used (flags 0/1). */
 typedef struct fcm_simulation_counters {
-  int cell_rules;            /**< 1: embedded cell rules were built (scene has a geometry) */
-  int surface_rules;         /**< 1: the cell rules carry surface rules */
-  int inertia;               /**< 1: dynamic integrator (inertia term); 0: static */
-  int mass_assemblies;       /**< consistent-mass assemblies: 1 for dynamic scenes, 0 static */
-  int body_force_assemblies; /**< body-force assemblies the integrator's setup made (one per
-                                  gravity effect) */
-  int scale_assemblies;      /**< 1: a static scene without gravity assembled the body force of
-                                  rho a_rep once for the Newton force scale (see sim.h) */
-  int traction_assemblies;   /**< surface load assemblies the setup made (one per traction or
-                                  pressure effect) */
-  int damping;               /**< 1: a Rayleigh damping matrix is used */
-  int initial_velocity;      /**< initial-velocity effects applied */
-  int constraints;           /**< constraint sets (fixed and motion effects) */
+  int cell_rules;              /**< 1: embedded cell rules were built (scene has a geometry) */
+  int surface_rules;           /**< 1: the cell rules carry surface rules */
+  int inertia;                 /**< 1: dynamic integrator (inertia term); 0: static */
+  int mass_assemblies;         /**< consistent-mass assemblies: 1 for dynamic scenes, 0 static */
+  int body_force_assemblies;   /**< body-force assemblies the integrator's setup made (one per
+                                    gravity effect) */
+  int scale_assemblies;        /**< 1: a static scene without gravity assembled the body force of
+                                    rho a_rep once for the Newton force scale (see sim.h) */
+  int traction_assemblies;     /**< surface load assemblies the setup made (one per traction or
+                                    pressure effect) */
+  int damping;                 /**< 1: a Rayleigh damping matrix is used */
+  int initial_velocity;        /**< initial-velocity effects applied */
+  int constraints;             /**< constraint sets (fixed and motion effects) */
   fcm_index constrained_nodes; /**< background nodes named by them (with or without DOFs) */
   fcm_index constrained_dofs;  /**< constrained DOFs after setup */
-  fcm_index schwarz_blocks;  /**< cut cells given a Schwarz block (0: no Schwarz set up) */
-  int krylov;                /**< 1: Krylov solves; 0: direct */
-  long long steps;           /**< accepted steps */
+  fcm_index schwarz_blocks;    /**< cut cells given a Schwarz block (0: no Schwarz set up) */
+  int krylov;                  /**< 1: Krylov solves; 0: direct */
+  long long steps;             /**< accepted steps */
   long long newton_iterations, linear_iterations, tangent_assemblies;
-  long long factorizations;  /**< numeric factorizations / preconditioner setups (total) */
-  long long analyses;        /**< symbolic analyses (total) */
+  long long factorizations; /**< numeric factorizations / preconditioner setups (total) */
+  long long analyses;       /**< symbolic analyses (total) */
   long long direct_fallbacks;
-  long long frames;          /**< frames written */
+  long long frames; /**< frames written */
   fcm_index num_dofs;
   fcm_index surface_points, surface_triangles; /**< embedded surface written per frame */
   double time_setup, time_steps, time_output;  /**< seconds */
@@ -76,8 +76,7 @@ typedef struct fcm_simulation fcm_simulation;
  *         "effects[i]: ..."); errors of the mesh, geometry, cell rules, space and integrator
  *         creation and setup; FCM_ERR_ALLOC. Allocates; not thread safe. */
 FCM_API fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
-                                         const fcm_simulation_options *opts,
-                                         fcm_simulation **sim);
+                                         const fcm_simulation_options *opts, fcm_simulation **sim);
 
 /** Destroy; accepts NULL and `*sim == NULL`, sets `*sim = NULL`. */
 FCM_API void fcm_simulation_destroy(fcm_simulation **sim);

@@ -201,12 +201,12 @@ FCM_API fcm_schwarz_options fcm_schwarz_options_default(void);
 
 /** Statistics of the last setup. */
 typedef struct fcm_schwarz_info {
-  fcm_index num_blocks;   /**< blocks K */
-  fcm_index block_dofs;   /**< sum of the block sizes */
-  int max_block_size;     /**< largest block */
-  int num_colors;         /**< colours of a greedy colouring of the block graph (blocks of a
-                               colour share no DOF; a statistic, the apply does not use it) */
-  fcm_index outside_dofs; /**< DOFs in no block (Jacobi) */
+  fcm_index num_blocks;           /**< blocks K */
+  fcm_index block_dofs;           /**< sum of the block sizes */
+  int max_block_size;             /**< largest block */
+  int num_colors;                 /**< colours of a greedy colouring of the block graph (blocks of a
+                                       colour share no DOF; a statistic, the apply does not use it) */
+  fcm_index outside_dofs;         /**< DOFs in no block (Jacobi) */
   fcm_index negative_eigenvalues; /**< reflected eigenvalues lambda < 0 (over all blocks) */
   fcm_index clamped_eigenvalues;  /**< eigenvalues with |lambda| < eps lambda_max */
   fcm_index jacobi_fallbacks;     /**< outside DOFs with a negative diagonal (|a_ii| used) */

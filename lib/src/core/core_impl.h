@@ -70,7 +70,7 @@ fcm_status fcm__file_read_all(fcm_ctx *ctx, const char *what, const char *path, 
  * Loops nest (an iteration may run a loop of its own; its error becomes the iteration's).
  * An iteration that handles an error and returns FCM_OK leaves nothing behind. */
 #define FCM__LOOP_MSG_LEN 1024
-#define FCM__LOOP_FRAMES 32
+#define FCM__LOOP_FRAMES  32
 
 /* An error message with its traceback (code FCM_OK: none). */
 typedef struct fcm__error_record {
@@ -121,7 +121,7 @@ fcm_status fcm__loop_end(fcm__loop *loop, fcm_index *failed);
 #define FCM_CHECK(cond, ctx, code, ...)                                                            \
   do {                                                                                             \
     if (!(cond)) {                                                                                 \
-      st = fcm__error((ctx), (code), __FILE__, __LINE__, __func__, __VA_ARGS__);                  \
+      st = fcm__error((ctx), (code), __FILE__, __LINE__, __func__, __VA_ARGS__);                   \
       goto cleanup;                                                                                \
     }                                                                                              \
   } while (0)
@@ -161,7 +161,7 @@ fcm_status fcm__loop_end(fcm__loop *loop, fcm_index *failed);
 #define FCM_ASSERT(cond, ctx)                                                                      \
   do {                                                                                             \
     if (!(cond)) {                                                                                 \
-      st = fcm__error((ctx), FCM_ERR_INTERNAL, __FILE__, __LINE__, __func__,                      \
+      st = fcm__error((ctx), FCM_ERR_INTERNAL, __FILE__, __LINE__, __func__,                       \
                       "assertion failed: %s", #cond);                                              \
       goto cleanup;                                                                                \
     }                                                                                              \

@@ -7,7 +7,7 @@
 #include <string.h>
 
 #define FCM__MAX_FRAMES 32
-#define FCM__MSG_LEN 1024
+#define FCM__MSG_LEN    1024
 
 typedef struct fcm_frame {
   const char *file;
@@ -89,9 +89,15 @@ long long fcm_ctx_live_allocations(const fcm_ctx *ctx)
   return ctx ? atomic_load(&((fcm_ctx *)ctx)->live) : 0;
 }
 
-fcm_status fcm_ctx_error_status(const fcm_ctx *ctx) { return ctx ? ctx->err_status : FCM_OK; }
+fcm_status fcm_ctx_error_status(const fcm_ctx *ctx)
+{
+  return ctx ? ctx->err_status : FCM_OK;
+}
 
-const char *fcm_ctx_error_message(const fcm_ctx *ctx) { return ctx ? ctx->err_msg : ""; }
+const char *fcm_ctx_error_message(const fcm_ctx *ctx)
+{
+  return ctx ? ctx->err_msg : "";
+}
 
 void fcm_ctx_error_clear(fcm_ctx *ctx)
 {
@@ -322,8 +328,8 @@ fcm_status fcm__index_to_int(fcm_ctx *ctx, fcm_index v, const char *what, int *o
 {
   fcm_status st = FCM_OK;
   FCM_CHECK(v >= 0 && v <= INT_MAX, ctx, FCM_ERR_UNSUPPORTED,
-            "%s = %lld does not fit the 32-bit integer range [0, %d] of the solver interface",
-            what, (long long)v, INT_MAX);
+            "%s = %lld does not fit the 32-bit integer range [0, %d] of the solver interface", what,
+            (long long)v, INT_MAX);
   *out = (int)v;
 cleanup:
   return st;

@@ -148,16 +148,16 @@ static fcm_status check_rule_memory(const build *B, const fcm_cell_rules *R,
     FCM_CHECK(n[k] <= (size_t)1 << 30, B->ctx, FCM_ERR_UNSUPPORTED,
               "embed: background cell %lld would get %zu initial %s points (limit 2^30)",
               (long long)cell->id, n[k], k == FCM_RULE_MASS ? "mass" : "stiffness");
-  const double need = rule_memory_estimate(n, R->strength, B->o->simplify,
-                                           B->o->simplify_options.method);
+  const double need =
+      rule_memory_estimate(n, R->strength, B->o->simplify, B->o->simplify_options.method);
   FCM_CHECK(limit <= 0.0 || need <= limit, B->ctx, FCM_ERR_UNSUPPORTED,
             "embed: background cell %lld holds %zu embedded tets (%zu stiffness, %zu mass "
             "points); building its rules needs about %.3g GiB, above the limit of %.3g GiB "
             "(fcm_cell_rules_options.max_rule_memory; scene key quadrature.max_rule_memory_gib): "
             "refine the background mesh there, coarsen the embedded geometry, lower the rule "
             "strengths or raise the limit",
-            (long long)cell->id, ws->num_tets, n[FCM_RULE_STIFFNESS], n[FCM_RULE_MASS],
-            need / GIB, limit / GIB);
+            (long long)cell->id, ws->num_tets, n[FCM_RULE_STIFFNESS], n[FCM_RULE_MASS], need / GIB,
+            limit / GIB);
 cleanup:
   return st;
 }
@@ -695,7 +695,8 @@ void fcm_cell_rules_view(const fcm_cell_rules *rules, FILE *stream)
           fcm_element_get_info(rules->type)->name, (long long)S->num_cells, (long long)S->num_uncut,
           (long long)S->num_cut, (long long)S->num_dropped, S->num_threads,
           (long long)S->num_candidates, (long long)S->num_pieces, (long long)S->num_tets,
-          (long long)S->num_slivers, S->sliver_volume, S->embedded_volume, S->geometry_volume, S->dropped_volume);
+          (long long)S->num_slivers, S->sliver_volume, S->embedded_volume, S->geometry_volume,
+          S->dropped_volume);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     fprintf(stream,
             "  %-9s strength %d: cut-cell points %lld initial -> %lld simplified "

@@ -32,10 +32,9 @@ fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type, fcm_ru
   else if (info->shape == FCM_SHAPE_HEX) /* order+1 points per direction: strength 2*order+1 */
     FCM_TRY(ctx, fcm_rule_create_computed(ctx, info->shape, 2 * info->order + 1, rule));
   else
-    FCM_TRY(ctx, fcm_rule_create(ctx, info->shape,
-                                 kind == FCM_RULE_MASS ? info->mass_strength
-                                                       : info->stiffness_strength,
-                                 rule));
+    FCM_TRY(ctx, fcm_rule_create(
+                     ctx, info->shape,
+                     kind == FCM_RULE_MASS ? info->mass_strength : info->stiffness_strength, rule));
 cleanup:
   return st;
 }
@@ -43,9 +42,9 @@ cleanup:
 /* The points of one cell's rule with the shape functions evaluated there. */
 typedef struct cell_rule {
   int nq;
-  const double *w;  /* nq weights; det J_K(xi) still to be applied */
-  const double *N;  /* nq x nn */
-  const double *dN; /* nq x nn x 3 reference gradients */
+  const double *w;           /* nq weights; det J_K(xi) still to be applied */
+  const double *N;           /* nq x nn */
+  const double *dN;          /* nq x nn x 3 reference gradients */
   const unsigned char *fict; /* nq flags (1: fictitious stabilization point), or NULL */
 } cell_rule;
 
@@ -152,10 +151,12 @@ static double physical_gradients(const cell_rule *r, int nn, int q, const double
   double J[9] = {0}, Ji[9] = {0};
   for (int a = 0; a < nn; a++)
     for (int i = 0; i < 3; i++)
-      for (int j = 0; j < 3; j++) J[3 * i + j] += X[3 * a + i] * dN[3 * a + j];
+      for (int j = 0; j < 3; j++)
+        J[3 * i + j] += X[3 * a + i] * dN[3 * a + j];
   double det = fcm__mat3_inv(J, Ji);
   if (!(det > 0.0)) return det;
-  for (int a = 0; a < nn; a++) fcm__mat3_tmulv(Ji, dN + 3 * a, g + 3 * a);
+  for (int a = 0; a < nn; a++)
+    fcm__mat3_tmulv(Ji, dN + 3 * a, g + 3 * a);
   return det;
 }
 
@@ -219,14 +220,16 @@ static cell_result cell_kernel(const kernel_data *kd, const cell_rule *r, int nn
     case KERNEL_STIFFNESS:
       for (int a = 0; a < ndof; a++) {
         double sa = wd * g[a], *Ha = H + (size_t)a * ndof;
-        for (int b = a; b < ndof; b++) Ha[b] += sa * g[b];
+        for (int b = a; b < ndof; b++)
+          Ha[b] += sa * g[b];
       }
       break;
     case KERNEL_MASS: {
       double rw = wd * kd->rho;
       for (int a = 0; a < nn; a++) {
         double sa = rw * N[a], *Ha = H + (size_t)a * nn;
-        for (int b = a; b < nn; b++) Ha[b] += sa * N[b];
+        for (int b = a; b < nn; b++)
+          Ha[b] += sa * N[b];
       }
     } break;
     case KERNEL_BODY_FORCE: {
@@ -234,23 +237,27 @@ static cell_result cell_kernel(const kernel_data *kd, const cell_rule *r, int nn
       if (kd->field) {
         double x[3] = {0, 0, 0};
         for (int a = 0; a < nn; a++)
-          for (int i = 0; i < 3; i++) x[i] += N[a] * w->X[3 * a + i];
+          for (int i = 0; i < 3; i++)
+            x[i] += N[a] * w->X[3 * a + i];
         kd->field(kd->field_user, x, NULL, b);
       }
       for (int a = 0; a < nn; a++)
-        for (int i = 0; i < 3; i++) fe[3 * a + i] += wd * b[i] * N[a];
+        for (int i = 0; i < 3; i++)
+          fe[3 * a + i] += wd * b[i] * N[a];
     } break;
     case KERNEL_HYPERELASTIC: {
       double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, psi = 0.0, P[9], A[81];
       for (int a = 0; a < nn; a++)
         for (int i = 0; i < 3; i++)
-          for (int j = 0; j < 3; j++) F[3 * i + j] += w->ue[3 * a + i] * g[3 * a + j];
+          for (int j = 0; j < 3; j++)
+            F[3 * i + j] += w->ue[3 * a + i] * g[3 * a + j];
       if (r->fict && r->fict[q])
         fictitious_eval(kd, F, &psi, P, kd->want_tangent ? A : NULL);
       else
         fcm__material_eval(kd->mat, F, &psi, P, kd->want_tangent ? A : NULL);
       int finite = isfinite(psi);
-      for (int k = 0; k < 9; k++) finite &= isfinite(P[k]);
+      for (int k = 0; k < 9; k++)
+        finite &= isfinite(P[k]);
       if (!finite) {
         res.nonfinite = 1;
         return res;
@@ -285,21 +292,24 @@ static cell_result cell_kernel(const kernel_data *kd, const cell_rule *r, int nn
   if (kd->kind == KERNEL_STIFFNESS) {
     double l = kd->lambda, m = kd->mu;
     for (int a = 0; a < ndof; a++) /* complete H from its upper triangle */
-      for (int b = 0; b < a; b++) H[(size_t)a * ndof + b] = H[(size_t)b * ndof + a];
+      for (int b = 0; b < a; b++)
+        H[(size_t)a * ndof + b] = H[(size_t)b * ndof + a];
     for (int a = 0; a < nn; a++)
       for (int b = a; b < nn; b++) {
         const double *Hab = H + (size_t)(3 * a) * ndof + 3 * b; /* block (a, b) of H */
         double tr = m * (Hab[0] + Hab[ndof + 1] + Hab[2 * ndof + 2]);
         for (int i = 0; i < 3; i++) {
           double *row = Ke + (size_t)(3 * a + i) * ndof + 3 * b;
-          for (int j = 0; j < 3; j++) row[j] = l * Hab[i * ndof + j] + m * Hab[j * ndof + i];
+          for (int j = 0; j < 3; j++)
+            row[j] = l * Hab[i * ndof + j] + m * Hab[j * ndof + i];
           row[i] += tr;
         }
       }
   } else if (kd->kind == KERNEL_MASS) {
     for (int a = 0; a < nn; a++)
       for (int b = a; b < nn; b++)
-        for (int i = 0; i < 3; i++) Ke[(size_t)(3 * a + i) * ndof + 3 * b + i] = H[(size_t)a * nn + b];
+        for (int i = 0; i < 3; i++)
+          Ke[(size_t)(3 * a + i) * ndof + 3 * b + i] = H[(size_t)a * nn + b];
   }
   if (matrix) mirror_blocks(nn, Ke);
   return res;
@@ -332,7 +342,8 @@ static void scatter_vector(const fcm_space *s, fcm_index cell, const double *fe,
   const fcm_index *cn = fcm_mesh_cells(s->mesh) + cell * s->nn;
   for (int a = 0; a < s->nn; a++) {
     fcm_index da = s->node_dof[cn[a]];
-    for (int i = 0; i < 3; i++) vec[da + i] += fe[3 * a + i];
+    for (int i = 0; i < 3; i++)
+      vec[da + i] += fe[3 * a + i];
   }
 }
 
@@ -342,8 +353,8 @@ static fcm_status scratch_alloc(const fcm_space *s, int nthreads, double **mem, 
   fcm_status st = FCM_OK;
   int nn = s->nn, ndof = 3 * nn;
   size_t mq = (size_t)FCM_MAX(s->max_cut_points, 1);
-  size_t per = 3 * (size_t)nn + 2 * (size_t)ndof + 3 * (size_t)nn + 2 * (size_t)ndof * ndof +
-               mq * nn * 4;
+  size_t per =
+      3 * (size_t)nn + 2 * (size_t)ndof + 3 * (size_t)nn + 2 * (size_t)ndof * ndof + mq * nn * 4;
   FCM_ALLOC(s->ctx, per * (size_t)nthreads, *mem);
   FCM_ALLOC(s->ctx, nthreads, *sc);
   for (int t = 0; t < nthreads; t++) {
@@ -413,7 +424,8 @@ void fcm_assembly_workspace_destroy(fcm_assembly_workspace **wsp)
 {
   if (!wsp || !*wsp) return;
   fcm_assembly_workspace *ws = *wsp;
-  for (int i = 0; i < 2; i++) tabulation_free(ws->ctx, &ws->tab[i]);
+  for (int i = 0; i < 2; i++)
+    tabulation_free(ws->ctx, &ws->tab[i]);
   fcm__free(ws->ctx, ws->mem);
   fcm__free(ws->ctx, ws->sc);
   fcm__free(ws->ctx, ws->cell_energy);
@@ -448,13 +460,13 @@ cleanup:
 
 /* What one pass over the cells computes, with the outputs it scatters into. */
 typedef struct pass {
-  const kernel_data *kd;  /* volume kernels */
-  const tabulation *tab;  /* standard rule of the kernel's integrand (volume kernels) */
-  fcm_rule_kind kind;     /* cut-cell rule the kernel integrates with */
-  fcm_field_fn traction;  /* non-NULL: surface traction on the cut cells' surface rules */
+  const kernel_data *kd; /* volume kernels */
+  const tabulation *tab; /* standard rule of the kernel's integrand (volume kernels) */
+  fcm_rule_kind kind;    /* cut-cell rule the kernel integrates with */
+  fcm_field_fn traction; /* non-NULL: surface traction on the cut cells' surface rules */
   void *traction_user;
-  double *vals, *vec;     /* matrix values (space pattern) and vector, either may be NULL */
-  double *cell_energy;    /* num_cells, or NULL */
+  double *vals, *vec;  /* matrix values (space pattern) and vector, either may be NULL */
+  double *cell_energy; /* num_cells, or NULL */
 } pass;
 
 /* Surface traction of one cell into w->fe; returns 0 when the cell has no surface points. */
@@ -470,10 +482,12 @@ static int surface_cell(const fcm_space *s, const pass *ps, fcm_index c, scratch
     double x[3] = {0, 0, 0}, tq[3] = {0, 0, 0};
     fcm_element_eval_shape(s->type, pts + 3 * q, w->Nb);
     for (int a = 0; a < nn; a++)
-      for (int i = 0; i < 3; i++) x[i] += w->Nb[a] * w->X[3 * a + i];
+      for (int i = 0; i < 3; i++)
+        x[i] += w->Nb[a] * w->X[3 * a + i];
     ps->traction(ps->traction_user, x, nrm + 3 * q, tq);
     for (int a = 0; a < nn; a++)
-      for (int i = 0; i < 3; i++) w->fe[3 * a + i] += wts[q] * w->Nb[a] * tq[i];
+      for (int i = 0; i < 3; i++)
+        w->fe[3 * a + i] += wts[q] * w->Nb[a] * tq[i];
   }
   return 1;
 }
@@ -760,7 +774,8 @@ fcm_status fcm_space_eval(const fcm_space *s, fcm_index cell, const double xi[3]
     const fcm_index *cn = fcm_mesh_cells(s->mesh) + cell * s->nn;
     for (int a = 0; a < s->nn; a++) {
       fcm_index d = s->node_dof[cn[a]];
-      for (int i = 0; i < 3; i++) value[i] += N[a] * u[d + i];
+      for (int i = 0; i < 3; i++)
+        value[i] += N[a] * u[d + i];
     }
   }
 cleanup:

@@ -10,11 +10,11 @@ struct fcm_space {
   fcm_ctx *ctx;
   const fcm_mesh *mesh;
   fcm_element_type type;
-  int nn;                  /* nodes per cell */
+  int nn; /* nodes per cell */
   fcm_index num_cells;
   fcm_index num_nodes;
-  unsigned char *active;   /* num_cells */
-  fcm_index *node_dof;     /* num_nodes: first DOF or -1 */
+  unsigned char *active; /* num_cells */
+  fcm_index *node_dof;   /* num_nodes: first DOF or -1 */
   fcm_index num_dofs;
   /* Node graph of active nodes (by active rank): node_ptr[k]..node_ptr[k+1] are
    * the ranks of the nodes sharing a cell with node k (itself included), sorted. */

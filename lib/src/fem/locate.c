@@ -96,14 +96,16 @@ static fcm_status locate_one(const fcm_space *s, const fcm_aabb_tree *tree,
     FCM_CHECK(det != 0.0, s->ctx, FCM_ERR_GEOMETRY,
               "locate: point %lld: the nearest active cell %lld is degenerate", (long long)i,
               (long long)*cell);
-    for (int k = 0; k < 3; k++) d[k] = p[k] - xc[k];
+    for (int k = 0; k < 3; k++)
+      d[k] = p[k] - xc[k];
     /* Cramer's rule on J dxi = d */
     for (int k = 0; k < 3; k++) {
       double Jk[9];
       memcpy(Jk, J, sizeof Jk);
-      for (int r = 0; r < 3; r++) Jk[3 * r + k] = d[r];
-      double dk = Jk[0] * (Jk[4] * Jk[8] - Jk[5] * Jk[7]) - Jk[1] * (Jk[3] * Jk[8] - Jk[5] * Jk[6]) +
-                  Jk[2] * (Jk[3] * Jk[7] - Jk[4] * Jk[6]);
+      for (int r = 0; r < 3; r++)
+        Jk[3 * r + k] = d[r];
+      double dk = Jk[0] * (Jk[4] * Jk[8] - Jk[5] * Jk[7]) -
+                  Jk[1] * (Jk[3] * Jk[8] - Jk[5] * Jk[6]) + Jk[2] * (Jk[3] * Jk[7] - Jk[4] * Jk[6]);
       xi[k] = ref[k] + dk / det;
     }
   }
@@ -125,7 +127,8 @@ fcm_status fcm_space_locate(const fcm_space *s, fcm_index n, const double *X, fc
   int nthreads = omp_get_max_threads();
   FCM_CHECK(n >= 0 && (n == 0 || (X && cell && xi)), ctx, FCM_ERR_ARG,
             "locate: n = %lld with NULL arrays", (long long)n);
-  for (fcm_index c = 0; c < s->num_cells; c++) nact += s->active[c];
+  for (fcm_index c = 0; c < s->num_cells; c++)
+    nact += s->active[c];
   FCM_ALLOC(ctx, 6 * nact, boxes);
   FCM_ALLOC(ctx, 3 * nact, centroid);
   FCM_ALLOC(ctx, nact, tree_cell);
@@ -137,7 +140,8 @@ fcm_status fcm_space_locate(const fcm_space *s, fcm_index n, const double *X, fc
       if (!s->active[c]) continue;
       double *b = boxes + 6 * k;
       fcm_mesh_cell_coords(s->mesh, c, Xc);
-      for (int d = 0; d < 3; d++) b[d] = HUGE_VAL, b[3 + d] = -HUGE_VAL;
+      for (int d = 0; d < 3; d++)
+        b[d] = HUGE_VAL, b[3 + d] = -HUGE_VAL;
       for (int a = 0; a < s->nn; a++)
         for (int d = 0; d < 3; d++) {
           b[d] = fmin(b[d], Xc[3 * a + d]);
@@ -198,12 +202,15 @@ fcm_status fcm_space_interpolate(const fcm_space *s, fcm_index n, const fcm_inde
     const fcm_index *cn = fcm_mesh_cells(s->mesh) + c * s->nn;
     for (int a = 0; a < s->nn; a++) {
       const double *ua = u + s->node_dof[cn[a]];
-      for (int d = 0; d < 3; d++) v[d] += N[a] * ua[d];
+      for (int d = 0; d < 3; d++)
+        v[d] += N[a] * ua[d];
     }
     memcpy(values + 3 * i, v, sizeof v);
   }
-  FCM_CHECK(bad < 0, s->ctx, FCM_ERR_ARG, "interpolate: point %lld names cell %lld, which is "
-            "out of range or inactive", (long long)bad, (long long)cell[bad]);
+  FCM_CHECK(bad < 0, s->ctx, FCM_ERR_ARG,
+            "interpolate: point %lld names cell %lld, which is "
+            "out of range or inactive",
+            (long long)bad, (long long)cell[bad]);
 cleanup:
   return st;
 }

@@ -22,8 +22,10 @@ static fcm_status build_incidence(fcm_space *s, fcm_index **inc_ptr, fcm_index *
   FCM_ALLOC(ctx, s->num_nodes + 1, ptr);
   for (fcm_index c = 0; c < s->num_cells; c++)
     if (s->active[c])
-      for (int a = 0; a < s->nn; a++) ptr[cells[c * s->nn + a] + 1]++;
-  for (fcm_index n = 0; n < s->num_nodes; n++) ptr[n + 1] += ptr[n];
+      for (int a = 0; a < s->nn; a++)
+        ptr[cells[c * s->nn + a] + 1]++;
+  for (fcm_index n = 0; n < s->num_nodes; n++)
+    ptr[n + 1] += ptr[n];
   FCM_ALLOC(ctx, ptr[s->num_nodes], list);
   FCM_ALLOC(ctx, s->num_nodes, fill);
   for (fcm_index c = 0; c < s->num_cells; c++)
@@ -51,7 +53,8 @@ static fcm_status build_node_graph(fcm_space *s, const fcm_index *inc_ptr, const
   fcm_index nact = s->num_dofs / 3;
   fcm_index *mark = NULL;
   FCM_ALLOC(ctx, s->num_nodes, mark);
-  for (fcm_index n = 0; n < s->num_nodes; n++) mark[n] = -1;
+  for (fcm_index n = 0; n < s->num_nodes; n++)
+    mark[n] = -1;
   FCM_ALLOC(ctx, nact + 1, s->node_ptr);
   /* Pass 1 counts, pass 2 fills: the mark array avoids duplicates without sorting twice. */
   for (int pass = 0; pass < 2; pass++) {
@@ -76,9 +79,11 @@ static fcm_status build_node_graph(fcm_space *s, const fcm_index *inc_ptr, const
         s->node_ptr[k + 1] = cnt;
     }
     if (!pass) {
-      for (fcm_index k = 0; k < nact; k++) s->node_ptr[k + 1] += s->node_ptr[k];
+      for (fcm_index k = 0; k < nact; k++)
+        s->node_ptr[k + 1] += s->node_ptr[k];
       FCM_ALLOC(ctx, s->node_ptr[nact], s->node_adj);
-      for (fcm_index n = 0; n < s->num_nodes; n++) mark[n] = -1;
+      for (fcm_index n = 0; n < s->num_nodes; n++)
+        mark[n] = -1;
     }
   }
 cleanup:
@@ -96,14 +101,16 @@ static fcm_status build_pattern(fcm_space *s)
   FCM_ALLOC(ctx, s->num_dofs + 1, s->row_ptr);
   for (fcm_index k = 0; k < nact; k++) {
     fcm_index deg = s->node_ptr[k + 1] - s->node_ptr[k];
-    for (int i = 0; i < 3; i++) s->row_ptr[3 * k + i + 1] = s->row_ptr[3 * k + i] + 3 * deg;
+    for (int i = 0; i < 3; i++)
+      s->row_ptr[3 * k + i + 1] = s->row_ptr[3 * k + i] + 3 * deg;
   }
   FCM_ALLOC(ctx, s->row_ptr[s->num_dofs], s->col_idx);
   for (fcm_index k = 0; k < nact; k++)
     for (int i = 0; i < 3; i++) {
       int *cols = s->col_idx + s->row_ptr[3 * k + i];
       for (fcm_index e = s->node_ptr[k]; e < s->node_ptr[k + 1]; e++)
-        for (int j = 0; j < 3; j++) *cols++ = (int)(3 * s->node_adj[e] + j);
+        for (int j = 0; j < 3; j++)
+          *cols++ = (int)(3 * s->node_adj[e] + j);
     }
   FCM_ALLOC(ctx, (size_t)s->num_cells * s->nn * s->nn, s->cell_off);
   for (fcm_index c = 0; c < s->num_cells; c++) {
@@ -137,7 +144,8 @@ static fcm_status build_colors(fcm_space *s, const fcm_index *inc_ptr, const fcm
   enum { MAX_COLORS = 4096 };
   FCM_ALLOC(ctx, s->num_cells, color);
   FCM_ALLOC(ctx, MAX_COLORS, forbid);
-  for (int k = 0; k < MAX_COLORS; k++) forbid[k] = -1;
+  for (int k = 0; k < MAX_COLORS; k++)
+    forbid[k] = -1;
   for (fcm_index c = 0; c < s->num_cells; c++) {
     color[c] = -1;
     if (!s->active[c]) continue;
@@ -147,7 +155,8 @@ static fcm_status build_colors(fcm_space *s, const fcm_index *inc_ptr, const fcm
         if (color[inc[e]] >= 0) forbid[color[inc[e]]] = c;
     }
     int k = 0;
-    while (k < MAX_COLORS && forbid[k] == c) k++;
+    while (k < MAX_COLORS && forbid[k] == c)
+      k++;
     FCM_CHECK(k < MAX_COLORS, ctx, FCM_ERR_UNSUPPORTED,
               "space: cell %lld needs more than %d colours (a node shared by too many cells)",
               (long long)c, MAX_COLORS);
@@ -158,7 +167,8 @@ static fcm_status build_colors(fcm_space *s, const fcm_index *inc_ptr, const fcm
   FCM_ALLOC(ctx, ncol + 1, s->color_ptr);
   for (fcm_index c = 0; c < s->num_cells; c++)
     if (color[c] >= 0) s->color_ptr[color[c] + 1]++;
-  for (int k = 0; k < ncol; k++) s->color_ptr[k + 1] += s->color_ptr[k];
+  for (int k = 0; k < ncol; k++)
+    s->color_ptr[k + 1] += s->color_ptr[k];
   FCM_ALLOC(ctx, s->color_ptr[ncol], s->color_cells);
   FCM_ALLOC(ctx, ncol, fill);
   for (fcm_index c = 0; c < s->num_cells; c++)
@@ -207,10 +217,12 @@ static fcm_status space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigne
   FCM_ALLOC(ctx, s->num_nodes, s->node_dof);
   {
     const fcm_index *cells = fcm_mesh_cells(mesh);
-    for (fcm_index n = 0; n < s->num_nodes; n++) s->node_dof[n] = -1;
+    for (fcm_index n = 0; n < s->num_nodes; n++)
+      s->node_dof[n] = -1;
     for (fcm_index c = 0; c < s->num_cells; c++)
       if (s->active[c])
-        for (int a = 0; a < s->nn; a++) s->node_dof[cells[c * s->nn + a]] = 0;
+        for (int a = 0; a < s->nn; a++)
+          s->node_dof[cells[c * s->nn + a]] = 0;
     for (fcm_index n = 0; n < s->num_nodes; n++)
       if (s->node_dof[n] == 0) s->node_dof[n] = 3 * nact++;
   }
@@ -255,7 +267,10 @@ cleanup:
   return st;
 }
 
-const fcm_cell_rules *fcm_space_cell_rules(const fcm_space *s) { return s->rules; }
+const fcm_cell_rules *fcm_space_cell_rules(const fcm_space *s)
+{
+  return s->rules;
+}
 
 void fcm_space_destroy(fcm_space **sp)
 {
@@ -275,21 +290,30 @@ void fcm_space_destroy(fcm_space **sp)
   *sp = NULL;
 }
 
-fcm_index fcm_space_num_dofs(const fcm_space *s) { return s->num_dofs; }
+fcm_index fcm_space_num_dofs(const fcm_space *s)
+{
+  return s->num_dofs;
+}
 
 fcm_index fcm_space_node_dof(const fcm_space *s, fcm_index node)
 {
   return (node < 0 || node >= s->num_nodes) ? -1 : s->node_dof[node];
 }
 
-int fcm_space_num_colors(const fcm_space *s) { return s->num_colors; }
+int fcm_space_num_colors(const fcm_space *s)
+{
+  return s->num_colors;
+}
 
 int fcm_space_cell_active(const fcm_space *s, fcm_index cell)
 {
   return cell >= 0 && cell < s->num_cells && s->active[cell];
 }
 
-const fcm_mesh *fcm_space_mesh(const fcm_space *s) { return s->mesh; }
+const fcm_mesh *fcm_space_mesh(const fcm_space *s)
+{
+  return s->mesh;
+}
 
 fcm_status fcm_space_matrix_create(const fcm_space *s, fcm_csr **A)
 {
@@ -317,8 +341,9 @@ fcm_status fcm_space_apply_dirichlet(const fcm_space *s, fcm_index ncon, const f
   FCM_ALLOC(ctx, n, g);
   for (fcm_index k = 0; k < ncon; k++) {
     fcm_index d = dofs[k];
-    FCM_CHECK(d >= 0 && d < n, ctx, FCM_ERR_ARG, "dirichlet: dofs[%lld] = %lld out of range [0, %lld)",
-              (long long)k, (long long)d, (long long)n);
+    FCM_CHECK(d >= 0 && d < n, ctx, FCM_ERR_ARG,
+              "dirichlet: dofs[%lld] = %lld out of range [0, %lld)", (long long)k, (long long)d,
+              (long long)n);
     FCM_CHECK(!con[d], ctx, FCM_ERR_ARG, "dirichlet: DOF %lld is constrained twice", (long long)d);
     con[d] = 1;
     g[d] = values ? values[k] : 0.0;

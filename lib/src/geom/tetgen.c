@@ -12,10 +12,10 @@
 
 typedef struct lines {
   const char *path;
-  char *buf; /* whole file, NUL-terminated */
-  char *pos; /* start of the next line */
+  char *buf;  /* whole file, NUL-terminated */
+  char *pos;  /* start of the next line */
   size_t len; /* bytes in the file */
-  long line; /* number of the line last returned */
+  long line;  /* number of the line last returned */
   char *tok[MAX_TOKENS];
   int ntok; /* tokens of the current line; more than MAX_TOKENS are counted, not kept */
 } lines;

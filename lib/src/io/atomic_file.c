@@ -288,7 +288,7 @@ fcm_status fcm__io_atomic_commit(fcm_ctx *ctx, fcm__atomic_file *af)
     FCM_CHECK(0, ctx, FCM_ERR_IO, "io: %s '%s' failed: %s", stage, af->path, msg);
   }
   FCM_FREE(ctx, af->tmp_path); /* renamed: nothing to remove */
-  if (af->dir) { /* the rename itself must survive a power loss */
+  if (af->dir) {               /* the rename itself must survive a power loss */
     int fd = open(af->dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     err = fd < 0 ? errno : fsync(fd) != 0 ? errno : 0;
     if (fd >= 0) close(fd);
@@ -341,7 +341,10 @@ cleanup:
   return st;
 }
 
-FILE *fcm_atomic_file_stream(fcm_atomic_file *file) { return file ? file->af.fp : NULL; }
+FILE *fcm_atomic_file_stream(fcm_atomic_file *file)
+{
+  return file ? file->af.fp : NULL;
+}
 
 fcm_status fcm_atomic_file_commit(fcm_atomic_file **file)
 {
@@ -350,8 +353,7 @@ fcm_status fcm_atomic_file_commit(fcm_atomic_file **file)
   fcm_ctx *ctx = f->ctx;
   fcm_status st = FCM_OK;
   *file = NULL;
-  FCM_CHECK(f->af.fp && !ferror(f->af.fp), ctx, FCM_ERR_IO, "io: writing '%s' failed",
-            f->af.path);
+  FCM_CHECK(f->af.fp && !ferror(f->af.fp), ctx, FCM_ERR_IO, "io: writing '%s' failed", f->af.path);
   FCM_TRY(ctx, fcm__io_atomic_commit(ctx, &f->af));
 cleanup:
   fcm__io_atomic_abort(ctx, &f->af);

@@ -24,14 +24,14 @@ typedef struct fcm__atomic_file {
   char *tmp_path;  /* the temporary (NULL once renamed or removed) */
   char *dir;       /* the target's directory */
   long long bytes; /* written so far */
-  int durable;     /* fsync the file before the rename (the directory is synced after every rename) */
+  int durable; /* fsync the file before the rename (the directory is synced after every rename) */
   fcm__io_fault fault;
 } fcm__atomic_file;
 
 /* Create the temporary beside `path`. The first open into a directory in a process also
  * removes the temporaries there whose writer process no longer exists (left by kill -9 or
- * a crash; only files named as ours, never a live process's). On failure (FCM_ERR_IO naming `path` and the
- * system error, FCM_ERR_ALLOC) nothing is left behind and `af` needs no abort, though
+ * a crash; only files named as ours, never a live process's). On failure (FCM_ERR_IO naming `path`
+ * and the system error, FCM_ERR_ALLOC) nothing is left behind and `af` needs no abort, though
  * fcm__io_atomic_abort() is harmless. `fault` may be NULL. */
 fcm_status fcm__io_atomic_open(fcm_ctx *ctx, const char *path, int durable,
                                const fcm__io_fault *fault, fcm__atomic_file *af);

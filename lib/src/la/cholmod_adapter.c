@@ -141,7 +141,8 @@ static double min_pivot_ratio(const chol *h, const double *values, fcm_index *co
     double piv;
     if (L->is_super) {
       const SuiteSparse_long *super = L->super, *pi = L->pi, *px = L->px;
-      while (super[s + 1] <= (SuiteSparse_long)j) s++;
+      while (super[s + 1] <= (SuiteSparse_long)j)
+        s++;
       const SuiteSparse_long k = (SuiteSparse_long)j - super[s], nsrow = pi[s + 1] - pi[s];
       const double d = Lx[px[s] + k + k * nsrow];
       piv = d * d;
@@ -195,8 +196,7 @@ static fcm_status chol_factor(fcm_ctx *ctx, void *impl, const double *values, fc
     FCM_CHECK(!(r < FCM__SINGULAR_PIVOT_RATIO), ctx, FCM_ERR_SINGULAR,
               "cholmod factor: matrix is numerically singular: the pivot of column %lld is %.3g "
               "times its diagonal (threshold %.0e, n = %lld); %s",
-              (long long)col, r, FCM__SINGULAR_PIVOT_RATIO, (long long)h->n,
-              FCM__SINGULAR_HINT);
+              (long long)col, r, FCM__SINGULAR_PIVOT_RATIO, (long long)h->n, FCM__SINGULAR_HINT);
   }
 cleanup:
   return st;

@@ -19,8 +19,8 @@ static void congruence(int n, const double *A, const double *G, double *T, doubl
     }
 }
 
-fcm_status fcm_dense_spectrum_eval(fcm_ctx *ctx, int n, const double *A, const double *S,
-                                   double *w, fcm_dense_spectrum_info *info)
+fcm_status fcm_dense_spectrum_eval(fcm_ctx *ctx, int n, const double *A, const double *S, double *w,
+                                   fcm_dense_spectrum_info *info)
 {
   fcm_status st = FCM_OK;
   double *B = NULL, *G = NULL, *T = NULL;

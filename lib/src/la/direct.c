@@ -118,7 +118,8 @@ fcm_status fcm_direct_factor(fcm_direct *s, const double *values)
   s->norm_a = 0.0;
   for (fcm_index i = 0; i < s->n; i++) {
     double row = 0.0;
-    for (fcm_index p = s->row_ptr[i]; p < s->row_ptr[i + 1]; p++) row += fabs(values[p]);
+    for (fcm_index p = s->row_ptr[i]; p < s->row_ptr[i + 1]; p++)
+      row += fabs(values[p]);
     s->norm_a = fmax(s->norm_a, row);
   }
   if (s->nnz > 0) memcpy(s->values, values, sizeof *values * (size_t)s->nnz);
@@ -165,8 +166,8 @@ fcm_status fcm_direct_solve(fcm_direct *s, const double *b, double *x)
     FCM_CHECK(s->info.backward_error <= FCM__SINGULAR_BACKWARD_ERROR, ctx, FCM_ERR_SINGULAR,
               "direct_solve: %s solution has backward error %.3g (> %.0e; n = %lld): the "
               "matrix is numerically singular; %s",
-              s->ops->name, s->info.backward_error, FCM__SINGULAR_BACKWARD_ERROR,
-              (long long)s->n, FCM__SINGULAR_HINT);
+              s->ops->name, s->info.backward_error, FCM__SINGULAR_BACKWARD_ERROR, (long long)s->n,
+              FCM__SINGULAR_HINT);
   }
 cleanup:
   fcm_timer_stop(&t);

@@ -29,8 +29,8 @@ fcm_status fcm__stev(fcm_ctx *ctx, int n, double *d, double *e, double *z, int l
 
 /* Thin SVD A = U diag(s) Vt of the m x n matrix A (destroyed), k = min(m, n):
  * s[k] descending, U m x k (ldu), Vt k x n (ldvt); U or Vt may be NULL. */
-fcm_status fcm__gesvd(fcm_ctx *ctx, int m, int n, double *a, int lda, double *s, double *u,
-                      int ldu, double *vt, int ldvt);
+fcm_status fcm__gesvd(fcm_ctx *ctx, int m, int n, double *a, int lda, double *s, double *u, int ldu,
+                      double *vt, int ldvt);
 
 /* LU factorization with partial pivoting in place; FCM_ERR_SINGULAR names the
  * zero pivot. ipiv has n entries. */
@@ -94,13 +94,13 @@ typedef struct fcm__direct_ops {
  * normwise backward error ||b - A x|| / (||A|| ||x|| + ||b||) (infinity norms) exceeds the
  * second value, or an UMFPACK factor whose rcond (min/max |diag U|, row-scaled) is below the
  * third, is refused with FCM_ERR_SINGULAR and the hint below. */
-#define FCM__SINGULAR_PIVOT_RATIO 1e-10
+#define FCM__SINGULAR_PIVOT_RATIO    1e-10
 #define FCM__SINGULAR_BACKWARD_ERROR 1e-8
-#define FCM__SINGULAR_UMFPACK_RCOND 1e-13
-#define FCM__SINGULAR_HINT                                                                       \
-  "likely causes: rigid-body modes left free (a static problem needs Dirichlet constraints "     \
-  "that fix translations and rotations), a quadrature rule too weak for the element "           \
-  "(hourglass modes; raise the quadrature strength), or cells with (nearly) no quadrature "     \
+#define FCM__SINGULAR_UMFPACK_RCOND  1e-13
+#define FCM__SINGULAR_HINT                                                                         \
+  "likely causes: rigid-body modes left free (a static problem needs Dirichlet constraints "       \
+  "that fix translations and rotations), a quadrature rule too weak for the element "              \
+  "(hourglass modes; raise the quadrature strength), or cells with (nearly) no quadrature "        \
   "points (empty or dropped cut cells without stabilization)"
 
 extern const fcm__direct_ops fcm__cholmod_ops;

@@ -20,7 +20,10 @@ int fcm_blas_set_num_threads(int n)
   return old;
 }
 
-static CBLAS_TRANSPOSE cblas_trans(char t) { return (t == 'T' || t == 't') ? CblasTrans : CblasNoTrans; }
+static CBLAS_TRANSPOSE cblas_trans(char t)
+{
+  return (t == 'T' || t == 't') ? CblasTrans : CblasNoTrans;
+}
 
 void fcm__gemm(char transa, char transb, int m, int n, int k, double alpha, const double *a,
                int lda, const double *b, int ldb, double beta, double *c, int ldc)
@@ -86,8 +89,7 @@ fcm_status fcm__syev(fcm_ctx *ctx, int want_vectors, int n, double *a, int lda, 
   info = LAPACKE_dsyevd_work(LAPACK_COL_MAJOR, jobz, 'L', n, a, lda, w, work, (lapack_int)qwork,
                              iwork, qiwork);
   FCM_CHECK(info <= 0, ctx, FCM_ERR_LAPACK,
-            "dsyevd: eigenvalue iteration failed to converge (info = %d) for n = %d", (int)info,
-            n);
+            "dsyevd: eigenvalue iteration failed to converge (info = %d) for n = %d", (int)info, n);
   FCM_TRY(ctx, lapack_info(ctx, "dsyevd", info));
 cleanup:
   fcm__free(ctx, work);
@@ -116,8 +118,8 @@ cleanup:
   return st;
 }
 
-fcm_status fcm__gesvd(fcm_ctx *ctx, int m, int n, double *a, int lda, double *s, double *u,
-                      int ldu, double *vt, int ldvt)
+fcm_status fcm__gesvd(fcm_ctx *ctx, int m, int n, double *a, int lda, double *s, double *u, int ldu,
+                      double *vt, int ldvt)
 {
   fcm_status st = FCM_OK;
   double *work = NULL, qwork, dummy = 0.0;
@@ -126,8 +128,8 @@ fcm_status fcm__gesvd(fcm_ctx *ctx, int m, int n, double *a, int lda, double *s,
   FCM_CHECK(m >= 0 && n >= 0 && lda >= FCM_MAX(1, m), ctx, FCM_ERR_ARG,
             "gesvd: m = %d, n = %d, lda = %d", m, n, lda);
   /* Checked here so that LAPACK's xerbla (which prints) is never reached. */
-  FCM_CHECK(!u || ldu >= FCM_MAX(1, m), ctx, FCM_ERR_ARG, "gesvd: ldu = %d must be >= m = %d",
-            ldu, m);
+  FCM_CHECK(!u || ldu >= FCM_MAX(1, m), ctx, FCM_ERR_ARG, "gesvd: ldu = %d must be >= m = %d", ldu,
+            m);
   FCM_CHECK(!vt || ldvt >= FCM_MAX(1, FCM_MIN(m, n)), ctx, FCM_ERR_ARG,
             "gesvd: ldvt = %d must be >= min(m, n) = %d", ldvt, FCM_MIN(m, n));
   if (m == 0 || n == 0) goto cleanup;
@@ -138,8 +140,8 @@ fcm_status fcm__gesvd(fcm_ctx *ctx, int m, int n, double *a, int lda, double *s,
                              &qwork, -1);
   FCM_TRY(ctx, lapack_info(ctx, "dgesvd (workspace query)", info));
   FCM_ALLOC(ctx, (size_t)qwork + 1, work);
-  info = LAPACKE_dgesvd_work(LAPACK_COL_MAJOR, jobu, jobvt, m, n, a, lda, s, u, ldu, vt, ldvt,
-                             work, (lapack_int)qwork);
+  info = LAPACKE_dgesvd_work(LAPACK_COL_MAJOR, jobu, jobvt, m, n, a, lda, s, u, ldu, vt, ldvt, work,
+                             (lapack_int)qwork);
   FCM_CHECK(info <= 0, ctx, FCM_ERR_LAPACK,
             "dgesvd: %d superdiagonals failed to converge (%d x %d matrix)", (int)info, m, n);
   FCM_TRY(ctx, lapack_info(ctx, "dgesvd", info));
@@ -171,9 +173,9 @@ fcm_status fcm__getrs(fcm_ctx *ctx, int n, int nrhs, const double *lu, int lda, 
   FCM_CHECK(n >= 0 && nrhs >= 0 && lda >= FCM_MAX(1, n) && ldb >= FCM_MAX(1, n), ctx, FCM_ERR_ARG,
             "getrs: n = %d, nrhs = %d, lda = %d, ldb = %d", n, nrhs, lda, ldb);
   if (n == 0 || nrhs == 0) goto cleanup;
-  FCM_TRY(ctx, lapack_info(ctx, "dgetrs",
-                           LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', n, nrhs, lu, lda, ipiv, b,
-                                               ldb)));
+  FCM_TRY(ctx,
+          lapack_info(ctx, "dgetrs",
+                      LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', n, nrhs, lu, lda, ipiv, b, ldb)));
 cleanup:
   return st;
 }
@@ -212,15 +214,16 @@ fcm_status fcm__lstsq(fcm_ctx *ctx, int m, int n, int nrhs, double *a, int lda, 
   fcm_status st = FCM_OK;
   double *s = NULL, *work = NULL, qwork;
   lapack_int *iwork = NULL, qiwork, info, r = 0;
-  FCM_CHECK(m >= 0 && n >= 0 && nrhs >= 0 && lda >= FCM_MAX(1, m) && ldb >= FCM_MAX(1, FCM_MAX(m, n)),
+  FCM_CHECK(m >= 0 && n >= 0 && nrhs >= 0 && lda >= FCM_MAX(1, m) &&
+                ldb >= FCM_MAX(1, FCM_MAX(m, n)),
             ctx, FCM_ERR_ARG, "lstsq: m = %d, n = %d, nrhs = %d, lda = %d, ldb = %d", m, n, nrhs,
             lda, ldb);
   if (m == 0 || n == 0 || nrhs == 0) goto cleanup;
   FCM_TRY(ctx, check_finite(ctx, "dgelsd", m, n, a, lda));
   FCM_TRY(ctx, check_finite(ctx, "dgelsd", m, nrhs, b, ldb));
   FCM_ALLOC(ctx, (size_t)FCM_MIN(m, n), s);
-  info = LAPACKE_dgelsd_work(LAPACK_COL_MAJOR, m, n, nrhs, a, lda, b, ldb, s, rcond, &r, &qwork,
-                             -1, &qiwork);
+  info = LAPACKE_dgelsd_work(LAPACK_COL_MAJOR, m, n, nrhs, a, lda, b, ldb, s, rcond, &r, &qwork, -1,
+                             &qiwork);
   FCM_TRY(ctx, lapack_info(ctx, "dgelsd (workspace query)", info));
   FCM_ALLOC(ctx, (size_t)qwork + 1, work);
   FCM_ALLOC(ctx, (size_t)qiwork + 1, iwork);

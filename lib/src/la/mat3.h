@@ -35,7 +35,8 @@ static inline double fcm__mat3_inv(const double A[9], double Ainv[9])
   if (det == 0.0) return det;
   double s = 1.0 / det;
   for (int i = 0; i < 3; i++)
-    for (int j = 0; j < 3; j++) Ainv[3 * i + j] = s * C[3 * j + i];
+    for (int j = 0; j < 3; j++)
+      Ainv[3 * i + j] = s * C[3 * j + i];
   return det;
 }
 
@@ -69,14 +70,16 @@ static inline void fcm__mat3_mul(const double A[9], const double B[9], double C[
 static inline void fcm__mat3_transpose(const double A[9], double B[9])
 {
   for (int i = 0; i < 3; i++)
-    for (int j = 0; j < 3; j++) B[3 * i + j] = A[3 * j + i];
+    for (int j = 0; j < 3; j++)
+      B[3 * i + j] = A[3 * j + i];
 }
 
 /* Frobenius norm. */
 static inline double fcm__mat3_norm(const double A[9])
 {
   double s = 0.0;
-  for (int i = 0; i < 9; i++) s += A[i] * A[i];
+  for (int i = 0; i < 9; i++)
+    s += A[i] * A[i];
   return sqrt(s);
 }
 

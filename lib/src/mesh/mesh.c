@@ -58,9 +58,8 @@ static void format_key(const fcm_index key[4], char *buf, size_t len)
  * distinct key, the first face id (c * num_faces + f), the key hash and the group's
  * last face; a stored face's key is recomputed from the connectivity only when the
  * hashes agree. */
-fcm_status fcm__mesh_match_faces(fcm_ctx *ctx, const fcm_element_info *info,
-                                 const fcm_index *cells, fcm_index num_cells, fcm_index *first,
-                                 fcm_index *next)
+fcm_status fcm__mesh_match_faces(fcm_ctx *ctx, const fcm_element_info *info, const fcm_index *cells,
+                                 fcm_index num_cells, fcm_index *first, fcm_index *next)
 {
   fcm_status st = FCM_OK;
   fcm_index *slots = NULL, *tails = NULL;

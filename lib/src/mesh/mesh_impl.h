@@ -45,9 +45,8 @@ fcm_status fcm__mesh_add_mid_edge_nodes(fcm_ctx *ctx, fcm_element_type linear_ty
  * first[i] is the lowest face id of its group and next[i] the next higher one, or -1.
  * A face with first[i] == i and next[i] == -1 is met once: a boundary face. `first` and
  * `next` hold num_cells * num_faces entries. Allocates a hash table of O(faces). */
-fcm_status fcm__mesh_match_faces(fcm_ctx *ctx, const fcm_element_info *info,
-                                 const fcm_index *cells, fcm_index num_cells, fcm_index *first,
-                                 fcm_index *next);
+fcm_status fcm__mesh_match_faces(fcm_ctx *ctx, const fcm_element_info *info, const fcm_index *cells,
+                                 fcm_index num_cells, fcm_index *first, fcm_index *next);
 
 /* Smallest power of two >= 2n (at least 16): capacity of an open-addressing table. */
 fcm_status fcm__mesh_hash_capacity(fcm_ctx *ctx, fcm_index n, size_t *cap);

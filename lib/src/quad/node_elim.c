@@ -36,28 +36,41 @@ fcm_rulegen_options fcm_rulegen_options_default(void)
 static double shape_measure(fcm_shape shape)
 {
   switch (shape) {
-  case FCM_SHAPE_LINE: return 2.0;
-  case FCM_SHAPE_TRI: return 0.5;
-  case FCM_SHAPE_QUAD: return 4.0;
-  case FCM_SHAPE_TET: return 1.0 / 6.0;
-  case FCM_SHAPE_HEX: return 8.0;
-  default: return 0.0;
+  case FCM_SHAPE_LINE:
+    return 2.0;
+  case FCM_SHAPE_TRI:
+    return 0.5;
+  case FCM_SHAPE_QUAD:
+    return 4.0;
+  case FCM_SHAPE_TET:
+    return 1.0 / 6.0;
+  case FCM_SHAPE_HEX:
+    return 8.0;
+  default:
+    return 0.0;
   }
 }
 
 static int shape_dim(fcm_shape shape)
 {
   switch (shape) {
-  case FCM_SHAPE_LINE: return 1;
+  case FCM_SHAPE_LINE:
+    return 1;
   case FCM_SHAPE_TRI:
-  case FCM_SHAPE_QUAD: return 2;
+  case FCM_SHAPE_QUAD:
+    return 2;
   case FCM_SHAPE_TET:
-  case FCM_SHAPE_HEX: return 3;
-  default: return 0;
+  case FCM_SHAPE_HEX:
+    return 3;
+  default:
+    return 0;
   }
 }
 
-static int is_simplex(fcm_shape shape) { return shape == FCM_SHAPE_TRI || shape == FCM_SHAPE_TET; }
+static int is_simplex(fcm_shape shape)
+{
+  return shape == FCM_SHAPE_TRI || shape == FCM_SHAPE_TET;
+}
 
 double fcm__rulegen_min_distance(fcm_shape shape, int n, const double *x)
 {
@@ -73,7 +86,8 @@ double fcm__rulegen_min_distance(fcm_shape shape, int n, const double *x)
       }
       dmin = FCM_MIN(dmin, (1.0 - s) / sqrt((double)d));
     } else {
-      for (int k = 0; k < d; k++) dmin = FCM_MIN(dmin, 1.0 - fabs(p[k]));
+      for (int k = 0; k < d; k++)
+        dmin = FCM_MIN(dmin, 1.0 - fabs(p[k]));
     }
   }
   return dmin;
@@ -91,13 +105,13 @@ typedef struct ws {
   fcm_shape shape;
   int m, d, nc, M, cap;
   const fcm_rulegen_options *opts;
-  double *J, *J2;      /* current and trial Jacobian */
-  double *Js;          /* column-scaled Jacobian of the last factorization */
-  double *K, *Kf;      /* Gram matrix and its damped Cholesky factor */
-  double *r, *r2;      /* residuals (M) */
+  double *J, *J2; /* current and trial Jacobian */
+  double *Js;     /* column-scaled Jacobian of the last factorization */
+  double *K, *Kf; /* Gram matrix and its damped Cholesky factor */
+  double *r, *r2; /* residuals (M) */
   double *y, *dlt, *scale;
-  double *x2, *w2;     /* trial state inside the solver */
-  char *frozen;        /* points held fixed in the current step */
+  double *x2, *w2; /* trial state inside the solver */
+  char *frozen;    /* points held fixed in the current step */
   long long iterations;
 } ws;
 
@@ -112,13 +126,15 @@ static void build(const ws *s, int n, const double *x, const double *w, double *
     double *col = J + (size_t)M * nc * i;
     fcm__orthobasis_eval(s->shape, s->m, x + (size_t)d * i, col + (size_t)M * d, col, M);
     for (int k = 0; k < d; k++)
-      for (int j = 0; j < M; j++) col[(size_t)k * M + j] *= w[i];
+      for (int j = 0; j < M; j++)
+        col[(size_t)k * M + j] *= w[i];
   }
   double f2 = 0.0, ri = 0.0;
 #pragma omp parallel for schedule(static) reduction(+ : f2) reduction(max : ri) if (par)
   for (int j = 0; j < M; j++) {
     long double acc = 0.0L;
-    for (int i = 0; i < n; i++) acc += (long double)w[i] * J[(size_t)M * (nc * i + d) + j];
+    for (int i = 0; i < n; i++)
+      acc += (long double)w[i] * J[(size_t)M * (nc * i + d) + j];
     r[j] = (double)(acc - (j == 0 ? 1.0L : 0.0L));
     f2 += r[j] * r[j];
     ri = FCM_MAX(ri, fabs(r[j]));
@@ -177,20 +193,24 @@ static fcm_status solve_step(ws *s, int n, const double *r)
   const int M = s->M, nc = s->nc, nv = n * nc;
   const int under = nv >= M, sz = under ? M : nv;
   if (under) {
-    for (int j = 0; j < M; j++) s->y[j] = -r[j];
+    for (int j = 0; j < M; j++)
+      s->y[j] = -r[j];
     FCM_TRY(s->ctx, fcm__potrs(s->ctx, sz, 1, s->Kf, sz, s->y, sz));
     fcm__gemv('T', M, nv, 1.0, s->Js, M, s->y, 0.0, s->dlt);
     for (int i = 0; i < n; i++)
       if (s->frozen[i])
-        for (int k = 0; k < nc; k++) s->dlt[nc * i + k] = 0.0;
+        for (int k = 0; k < nc; k++)
+          s->dlt[nc * i + k] = 0.0;
   } else {
     fcm__gemv('T', M, nv, -1.0, s->Js, M, r, 0.0, s->dlt);
     for (int i = 0; i < n; i++)
       if (s->frozen[i])
-        for (int k = 0; k < nc; k++) s->dlt[nc * i + k] = 0.0;
+        for (int k = 0; k < nc; k++)
+          s->dlt[nc * i + k] = 0.0;
     FCM_TRY(s->ctx, fcm__potrs(s->ctx, sz, 1, s->Kf, sz, s->dlt, sz));
   }
-  for (int c = 0; c < nv; c++) s->dlt[c] /= s->scale[c];
+  for (int c = 0; c < nv; c++)
+    s->dlt[c] /= s->scale[c];
 cleanup:
   return st;
 }
@@ -261,7 +281,8 @@ static fcm_status lm_solve(ws *s, int n, double *x, double *w, double tol, int m
     for (int c = 0; c < nv; c++) {
       const double *col = s->J + (size_t)M * c;
       double nrm = 0.0;
-      for (int j = 0; j < M; j++) nrm += col[j] * col[j];
+      for (int j = 0; j < M; j++)
+        nrm += col[j] * col[j];
       if (c % nc == d)
         sw += nrm;
       else
@@ -273,21 +294,24 @@ static fcm_status lm_solve(ws *s, int n, double *x, double *w, double tol, int m
       const double *col = s->J + (size_t)M * c;
       double *out = s->Js + (size_t)M * c;
       s->scale[c] = (c % nc == d) ? sw : sx;
-      for (int j = 0; j < M; j++) out[j] = col[j] / s->scale[c];
+      for (int j = 0; j < M; j++)
+        out[j] = col[j] / s->scale[c];
     }
     if (under)
       fcm__gemm('N', 'T', M, M, nv, 1.0, s->Js, M, s->Js, M, 0.0, s->K, sz);
     else
       fcm__gemm('T', 'N', nv, nv, M, 1.0, s->Js, M, s->Js, M, 0.0, s->K, sz);
     double diag = 0.0;
-    for (int k = 0; k < sz; k++) diag += s->K[(size_t)k * sz + k];
+    for (int k = 0; k < sz; k++)
+      diag += s->K[(size_t)k * sz + k];
     diag /= sz;
     int accepted = 0, nfrozen = 0;
     memset(s->frozen, 0, (size_t)n);
     while (!accepted) {
       if (lambda > 1e8) goto cleanup; /* stuck: not converged */
       memcpy(s->Kf, s->K, sizeof(double) * (size_t)sz * sz);
-      for (int k = 0; k < sz; k++) s->Kf[(size_t)k * sz + k] += lambda * diag;
+      for (int k = 0; k < sz; k++)
+        s->Kf[(size_t)k * sz + k] += lambda * diag;
       fcm_status fst = fcm__potrf(s->ctx, sz, s->Kf, sz);
       if (fst == FCM_ERR_SINGULAR) { /* rounding made the damped Gram indefinite */
         fcm_ctx_error_clear(s->ctx);
@@ -308,7 +332,8 @@ static fcm_status lm_solve(ws *s, int n, double *x, double *w, double tol, int m
           fcm__gemm('N', 'T', M, M, nc, -1.0, jb, M, jb, M, 1.0, s->K, sz);
         } else {
           for (int k = nc * block; k < nc * block + nc; k++) {
-            for (int l = 0; l < sz; l++) s->K[(size_t)k * sz + l] = s->K[(size_t)l * sz + k] = 0.0;
+            for (int l = 0; l < sz; l++)
+              s->K[(size_t)k * sz + l] = s->K[(size_t)l * sz + k] = 0.0;
             s->K[(size_t)k * sz + k] = diag;
           }
         }
@@ -357,7 +382,8 @@ static void significance(const ws *s, int n, const double *w, sig_entry *sig)
   for (int i = 0; i < n; i++) {
     const double *phi = s->J + (size_t)s->M * (s->nc * i + s->d);
     double t = 0.0;
-    for (int j = 0; j < s->M; j++) t += phi[j] * phi[j];
+    for (int j = 0; j < s->M; j++)
+      t += phi[j] * phi[j];
     sig[i].s = w[i] * t;
     sig[i].i = i;
   }
@@ -377,11 +403,12 @@ static int copy_without(int d, int n, const double *x, const double *w, const ch
   return k;
 }
 
-static void fill_info(fcm_rulegen_info *info, const ws *s, int n, const double *x,
-                      const double *w, double rinf, double t0)
+static void fill_info(fcm_rulegen_info *info, const ws *s, int n, const double *x, const double *w,
+                      double rinf, double t0)
 {
   double wmin = HUGE_VAL;
-  for (int i = 0; i < n; i++) wmin = FCM_MIN(wmin, w[i]);
+  for (int i = 0; i < n; i++)
+    wmin = FCM_MIN(wmin, w[i]);
   info->num_points = n;
   info->iterations = s->iterations;
   info->residual = rinf;
@@ -438,14 +465,15 @@ fcm_status fcm__rulegen_eliminate(fcm_ctx *ctx, fcm_shape shape, int m, int n0, 
   FCM_ALLOC(ctx, n0, sig);
   FCM_ALLOC(ctx, n0, drop);
   memcpy(x, x0, sizeof(double) * (size_t)n0 * s.d);
-  for (int i = 0; i < n0; i++) w[i] = w0[i] / meas;
+  for (int i = 0; i < n0; i++)
+    w[i] = w0[i] / meas;
   info->initial_points = n0;
 
   /* polish the start rule in the basis of this strength */
   FCM_TRY(ctx, lm_solve(&s, n, x, w, opts->tol, opts->max_iterations, &converged, &rinf));
   FCM_CHECK(converged, ctx, FCM_ERR_NOT_CONVERGED,
-            "node elimination: start rule (%d points) reaches moment residual %.3g, not %.3g",
-            n, rinf, opts->tol);
+            "node elimination: start rule (%d points) reaches moment residual %.3g, not %.3g", n,
+            rinf, opts->tol);
   significance(&s, n, w, sig);
 
   const int nfloor = (int)ceil(1.25 * s.M / s.nc);
@@ -462,7 +490,8 @@ fcm_status fcm__rulegen_eliminate(fcm_ctx *ctx, fcm_shape shape, int m, int n0, 
     int done = 0;
     if (b > 1) {
       memset(drop, 0, (size_t)n);
-      for (int c = 0; c < b; c++) drop[sig[c].i] = 1;
+      for (int c = 0; c < b; c++)
+        drop[sig[c].i] = 1;
       int nt = copy_without(s.d, n, x, w, drop, xt, wt);
       FCM_TRY(ctx, lm_solve(&s, nt, xt, wt, opts->tol, opts->max_iterations, &converged, &rinf));
       if (converged) {
@@ -480,8 +509,7 @@ fcm_status fcm__rulegen_eliminate(fcm_ctx *ctx, fcm_shape shape, int m, int n0, 
         memset(drop, 0, (size_t)n);
         drop[sig[c].i] = 1;
         int nt = copy_without(s.d, n, x, w, drop, xt, wt);
-        FCM_TRY(ctx,
-                lm_solve(&s, nt, xt, wt, opts->tol, opts->max_iterations, &converged, &rinf));
+        FCM_TRY(ctx, lm_solve(&s, nt, xt, wt, opts->tol, opts->max_iterations, &converged, &rinf));
         if (converged) {
           n = nt;
           done = 1;
@@ -516,7 +544,8 @@ fcm_status fcm__rulegen_eliminate(fcm_ctx *ctx, fcm_shape shape, int m, int n0, 
     rinf = r0;
   }
   fill_info(info, &s, n, x, w, rinf, t0);
-  for (int i = 0; i < n; i++) w[i] *= meas;
+  for (int i = 0; i < n; i++)
+    w[i] *= meas;
   *n_out = n;
   *x_out = x;
   *w_out = w;
@@ -558,7 +587,8 @@ double fcm__rulegen_residual(fcm_ctx *ctx, fcm_shape shape, int m, int n, const 
   }
   for (int i = 0; i < n; i++) {
     fcm__orthobasis_eval(shape, m, x + (size_t)d * i, phi, NULL, M);
-    for (int j = 0; j < M; j++) acc[j] += (long double)(w[i] / meas) * phi[j];
+    for (int j = 0; j < M; j++)
+      acc[j] += (long double)(w[i] / meas) * phi[j];
   }
   for (int j = 0; j < M; j++)
     rmax = FCM_MAX(rmax, fabs((double)(acc[j] - (j == 0 ? 1.0L : 0.0L))));
@@ -567,7 +597,10 @@ double fcm__rulegen_residual(fcm_ctx *ctx, fcm_shape shape, int m, int n, const 
   return rmax;
 }
 
-static int shape_supported(fcm_shape shape) { return shape_dim(shape) > 0; }
+static int shape_supported(fcm_shape shape)
+{
+  return shape_dim(shape) > 0;
+}
 
 fcm_status fcm_rule_moment_residual(fcm_ctx *ctx, const fcm_rule *rule, int strength,
                                     double *residual)
@@ -575,13 +608,13 @@ fcm_status fcm_rule_moment_residual(fcm_ctx *ctx, const fcm_rule *rule, int stre
   fcm_status st = FCM_OK;
   FCM_CHECK(rule && residual, ctx, FCM_ERR_ARG, "moment residual: %s is NULL",
             rule ? "residual" : "rule");
-  FCM_CHECK(shape_supported(rule->shape), ctx, FCM_ERR_ARG,
-            "moment residual: shape %d unsupported", (int)rule->shape);
+  FCM_CHECK(shape_supported(rule->shape), ctx, FCM_ERR_ARG, "moment residual: shape %d unsupported",
+            (int)rule->shape);
   FCM_CHECK(strength >= 0 && strength <= FCM__ORTHOBASIS_MAX_DEGREE, ctx, FCM_ERR_ARG,
             "moment residual: strength %d out of range [0, %d]", strength,
             FCM__ORTHOBASIS_MAX_DEGREE);
-  *residual = fcm__rulegen_residual(ctx, rule->shape, strength, rule->n, rule->points,
-                                    rule->weights);
+  *residual =
+      fcm__rulegen_residual(ctx, rule->shape, strength, rule->n, rule->points, rule->weights);
   FCM_CHECK(*residual >= 0.0, ctx, FCM_ERR_ALLOC, "moment residual: out of memory");
 cleanup:
   return st;
@@ -603,17 +636,19 @@ fcm_status fcm_rule_eliminate_nodes(fcm_ctx *ctx, const fcm_rule *start, int str
   FCM_CHECK(start, ctx, FCM_ERR_ARG, "node elimination: start rule is NULL");
   FCM_CHECK(shape_supported(start->shape), ctx, FCM_ERR_ARG,
             "node elimination: shape %d unsupported", (int)start->shape);
-  FCM_CHECK(strength >= 0 && strength <= FCM_MIN(start->strength, FCM__ORTHOBASIS_MAX_DEGREE),
-            ctx, FCM_ERR_ARG, "node elimination: strength %d out of range [0, %d] (start rule "
-            "strength %d)", strength, FCM_MIN(start->strength, FCM__ORTHOBASIS_MAX_DEGREE),
-            start->strength);
+  FCM_CHECK(strength >= 0 && strength <= FCM_MIN(start->strength, FCM__ORTHOBASIS_MAX_DEGREE), ctx,
+            FCM_ERR_ARG,
+            "node elimination: strength %d out of range [0, %d] (start rule "
+            "strength %d)",
+            strength, FCM_MIN(start->strength, FCM__ORTHOBASIS_MAX_DEGREE), start->strength);
   FCM_CHECK(start->n > 0, ctx, FCM_ERR_ARG, "node elimination: start rule has no points");
   FCM_CHECK(o.tol > 0.0 && o.tol < 1.0, ctx, FCM_ERR_ARG,
             "node elimination: tol = %g out of range (0, 1)", o.tol);
   FCM_CHECK(o.max_iterations >= 1 && o.max_candidates >= 1 && o.target_points >= 0, ctx,
-            FCM_ERR_ARG, "node elimination: max_iterations = %d, max_candidates = %d must be "
-            ">= 1 and target_points = %d >= 0", o.max_iterations, o.max_candidates,
-            o.target_points);
+            FCM_ERR_ARG,
+            "node elimination: max_iterations = %d, max_candidates = %d must be "
+            ">= 1 and target_points = %d >= 0",
+            o.max_iterations, o.max_candidates, o.target_points);
   FCM_CHECK(o.max_batch >= 0.0 && o.max_batch <= 0.5, ctx, FCM_ERR_ARG,
             "node elimination: max_batch = %g out of range [0, 0.5]", o.max_batch);
   FCM_CHECK(o.margin >= 0.0 && o.margin <= 0.1, ctx, FCM_ERR_ARG,
@@ -621,14 +656,13 @@ fcm_status fcm_rule_eliminate_nodes(fcm_ctx *ctx, const fcm_rule *start, int str
   for (int i = 0; i < start->n; i++) {
     double di = fcm__rulegen_min_distance(start->shape, 1, start->points + (size_t)start->dim * i);
     FCM_CHECK(start->weights[i] > 0.0, ctx, FCM_ERR_ARG,
-              "node elimination: start rule weight %d = %g is not positive", i,
-              start->weights[i]);
+              "node elimination: start rule weight %d = %g is not positive", i, start->weights[i]);
     FCM_CHECK(di >= o.margin, ctx, FCM_ERR_ARG,
               "node elimination: start rule point %d lies %g from the boundary, margin is %g", i,
               di, o.margin);
   }
-  double res = fcm__rulegen_residual(ctx, start->shape, strength, start->n, start->points,
-                                     start->weights);
+  double res =
+      fcm__rulegen_residual(ctx, start->shape, strength, start->n, start->points, start->weights);
   FCM_CHECK(res >= 0.0, ctx, FCM_ERR_ALLOC, "node elimination: out of memory");
   FCM_CHECK(res <= 1e-8, ctx, FCM_ERR_ARG,
             "node elimination: start rule is not exact for strength %d (moment residual %.3g)",
@@ -639,8 +673,8 @@ fcm_status fcm_rule_eliminate_nodes(fcm_ctx *ctx, const fcm_rule *start, int str
   memcpy(r->points, x, sizeof(double) * (size_t)n * r->dim);
   memcpy(r->weights, w, sizeof(double) * (size_t)n);
   snprintf(r->description, sizeof r->description,
-           "node elimination from %d points (%.60s), residual %.1e", start->n,
-           start->description, inf.residual);
+           "node elimination from %d points (%.60s), residual %.1e", start->n, start->description,
+           inf.residual);
   *out = r;
   r = NULL;
 cleanup:

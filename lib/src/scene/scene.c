@@ -57,14 +57,13 @@ static const char *const axis_names[] = {"x", "y", "z"};
 static const char *const simplify_names[] = {"auto", "lp", "recombine"};
 static const char *const stabilization_names[] = {"mass_stiffness", "mass", "off"};
 static const char *const solver_names[] = {"direct", "minres", "cg"};
-static const int solver_values[] = {FCM_LINEAR_DIRECT, FCM_LINEAR_MINRES,
-                                                  FCM_LINEAR_CG};
+static const int solver_values[] = {FCM_LINEAR_DIRECT, FCM_LINEAR_MINRES, FCM_LINEAR_CG};
 static const char *const direct_names[] = {"cholmod", "umfpack"};
 static const char *const preconditioner_names[] = {"none", "jacobi", "block_jacobi", "schwarz"};
 static const char *const clamp_names[] = {"clamp", "paper"};
 static const char *const newton_rule_names[] = {"auto", "representative", "relative"};
-static const int newton_rule_values[] = {
-    FCM_NEWTON_TOL_AUTO, FCM_NEWTON_TOL_REPRESENTATIVE, FCM_NEWTON_TOL_RELATIVE};
+static const int newton_rule_values[] = {FCM_NEWTON_TOL_AUTO, FCM_NEWTON_TOL_REPRESENTATIVE,
+                                         FCM_NEWTON_TOL_RELATIVE};
 static const char *const integrator_names[] = {"backward_euler"};
 static const int integrator_values[] = {FCM_INTEGRATOR_BACKWARD_EULER};
 
@@ -84,7 +83,7 @@ static const int integrator_values[] = {FCM_INTEGRATOR_BACKWARD_EULER};
     int ch_ = -1;                                                                                  \
     FCM_TRY((p)->ctx,                                                                              \
             fcm__scene_read_choice((p), (obj), (key), (required), (names), COUNT(names), &ch_));   \
-    if (ch_ >= 0) (out) = (values)[ch_]; /* an enum of the library */                                                           \
+    if (ch_ >= 0) (out) = (values)[ch_]; /* an enum of the library */                              \
   } while (0)
 
 /* The name of `value` in a names/values table (for the summary). */
@@ -358,8 +357,8 @@ cleanup:
 static fcm_status read_quadrature(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"stiffness_strength", "mass_strength",   "surface_strength",
-                                     "simplify",           "simplify_method", "stabilization",
+  static const char *const keys[] = {"stiffness_strength", "mass_strength",      "surface_strength",
+                                     "simplify",           "simplify_method",    "stabilization",
                                      "min_fraction",       "max_rule_memory_gib"};
   static const char *const skeys[] = {"mode", "alpha"};
   fcm_scene_quadrature *q = &p->scene->quadrature;
@@ -392,9 +391,9 @@ static fcm_status read_quadrature(fcm__scene_parser *p, const fcm__json *root)
   }
   FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "min_fraction", 0, (fcm__range){0.0, 1.0, 0, 1},
                                          &q->min_fraction));
-  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "max_rule_memory_gib", 0,
-                                         (fcm__range){0.0, 1048576.0, 0, 0},
-                                         &q->max_rule_memory_gib));
+  FCM_TRY(p->ctx,
+          fcm__scene_read_number(p, o, "max_rule_memory_gib", 0, (fcm__range){0.0, 1048576.0, 0, 0},
+                                 &q->max_rule_memory_gib));
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
@@ -901,14 +900,15 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
   fprintf(f,
           "; Newton %s rule, rtol %g, at most %d iterations, line search %s, PSD projection %s, "
           "|a_rep| %g m/s^2; threads %d\n",
-          CHOICE_NAME(newton_rule_names, newton_rule_values, so->newton_rule), so->newton_rtol, so->newton_max_iterations,
-          so->line_search ? "on" : "off", so->project_psd ? "on" : "off",
+          CHOICE_NAME(newton_rule_names, newton_rule_values, so->newton_rule), so->newton_rtol,
+          so->newton_max_iterations, so->line_search ? "on" : "off", so->project_psd ? "on" : "off",
           so->representative_acceleration, so->threads > 0 ? so->threads : 0);
   if (t->integrator == FCM_INTEGRATOR_STATIC)
     fprintf(f, "time: static, %lld step(s) of %g s, %d load step(s) each\n",
             (long long)t->num_steps, t->dt, t->load_steps);
   else
-    fprintf(f, "time: %s, %lld steps of dt = %g s, %g s in all\n", CHOICE_NAME(integrator_names, integrator_values, t->integrator),
+    fprintf(f, "time: %s, %lld steps of dt = %g s, %g s in all\n",
+            CHOICE_NAME(integrator_names, integrator_values, t->integrator),
             (long long)t->num_steps, t->dt, t->duration);
   fprintf(f, "output: %s, every %d step(s), background %s, surface %s", s->output.directory,
           s->output.frame_interval, s->output.write_background ? "yes" : "no",

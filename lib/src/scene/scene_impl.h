@@ -127,8 +127,9 @@ void fcm__scene_range_text(fcm__range r, char *buf, size_t len);
  * caller pops back to the length it saved on entry); unless kind is FCM__SCENE_ANY_KIND the
  * member must be of that kind, and an array of exactly `len` entries when len >= 0, else
  * "expected <want>, got <what it is>". On an error *out is NULL. */
-fcm_status fcm__scene_field(fcm__scene_parser *p, const fcm__json *obj, const char *key, int required,
-                           const char *want, fcm__json_kind kind, int len, const fcm__json **out);
+fcm_status fcm__scene_field(fcm__scene_parser *p, const fcm__json *obj, const char *key,
+                            int required, const char *want, fcm__json_kind kind, int len,
+                            const fcm__json **out);
 
 /* The typed readers. Each reads member `key` of `obj`: when the member is absent and
  * `required` is 0 the output keeps the value the caller put there (the default); when it

@@ -178,8 +178,9 @@ cleanup:
   return st;
 }
 
-fcm_status fcm__scene_field(fcm__scene_parser *p, const fcm__json *obj, const char *key, int required,
-                           const char *want, fcm__json_kind kind, int len, const fcm__json **out)
+fcm_status fcm__scene_field(fcm__scene_parser *p, const fcm__json *obj, const char *key,
+                            int required, const char *want, fcm__json_kind kind, int len,
+                            const fcm__json **out)
 {
   fcm_status st = FCM_OK;
   char got[DESC_LEN];

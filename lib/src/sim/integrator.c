@@ -767,7 +767,8 @@ fcm_status fcm_integrator_energy(fcm_integrator *I, double *kinetic, double *ela
   {
     fcm_index n = I->n;
     double psi = 0.0, ekin = 0.0, wext = 0.0;
-    FCM_TRY(I->ctx, fcm_assembly_workspace_hyperelastic(I->aws, &I->params, I->u, &psi, NULL, NULL));
+    FCM_TRY(I->ctx,
+            fcm_assembly_workspace_hyperelastic(I->aws, &I->params, I->u, &psi, NULL, NULL));
     if (I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) {
       FCM_TRY(I->ctx, fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1));
       for (fcm_index i = 0; i < n; i++)

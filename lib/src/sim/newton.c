@@ -300,8 +300,8 @@ cleanup:
 
 /* What the line search found. */
 typedef struct line_result {
-  int accepted;    /* ut = u + alpha d (fint_t, g_t, trial) is the new iterate */
-  int speculative; /* the trial assembled its tangent (the full step) */
+  int accepted;     /* ut = u + alpha d (fint_t, g_t, trial) is the new iterate */
+  int speculative;  /* the trial assembled its tangent (the full step) */
   double alpha, rt; /* step length; free residual norm at the trial */
 } line_result;
 
@@ -493,8 +493,8 @@ static fcm_status accept_step(fcm_integrator *I, int dyn, double t0, fcm_step_in
 
 /* Gather phase of a failed step: back to the state at its start; a soft failure
  * becomes the error that says why (st is a hard error already recorded, or FCM_OK). */
-static fcm_status reject_step(fcm_integrator *I, fcm_status st, fcm_step_reason reason,
-                              double t0, const fcm_step_info *info)
+static fcm_status reject_step(fcm_integrator *I, fcm_status st, fcm_step_reason reason, double t0,
+                              const fcm_step_info *info)
 {
   fcm_index n = I->n;
   memcpy(I->u, I->u_bak, sizeof(double) * (size_t)n);
@@ -513,8 +513,8 @@ static fcm_status reject_step(fcm_integrator *I, fcm_status st, fcm_step_reason 
 }
 
 /* Statistics phase: the step's counters and times, the cumulative ones. */
-static void record_step_statistics(const fcm_integrator *I, const sim_stats *stats,
-                                   double t_begin, fcm_step_info *info)
+static void record_step_statistics(const fcm_integrator *I, const sim_stats *stats, double t_begin,
+                                   fcm_step_info *info)
 {
   info->time = I->t;
   info->newton_iterations = stats->newton_iterations;

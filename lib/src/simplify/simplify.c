@@ -296,9 +296,8 @@ cleanup:
 
 /* Set-up phase: mean-1 weights (with tiny weights GLPK reports "optimal" with w = 0,
  * notes §4), the attempt's buffers and parameters, and the moments in the box basis. */
-static fcm_status setup_attempt(simplify_run *r, int strength, const double *weights,
-                                double total, const fcm_simplify_options *o,
-                                int force_lp_failure)
+static fcm_status setup_attempt(simplify_run *r, int strength, const double *weights, double total,
+                                const fcm_simplify_options *o, int force_lp_failure)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = r->ctx;
@@ -460,8 +459,7 @@ fcm_status fcm__simplify_hooked(fcm_ctx *ctx, int strength, fcm_index n, const d
   FCM_CHECK(out, ctx, FCM_ERR_ARG, "simplify: out must not be NULL");
   memset(out, 0, sizeof *out);
   out->ctx = ctx;
-  FCM_TRY(ctx,
-          check_input(ctx, strength, n, points, weights, &o, force_lp_failure, &r.ni, &total));
+  FCM_TRY(ctx, check_input(ctx, strength, n, points, weights, &o, force_lp_failure, &r.ni, &total));
 
   const int M = fcm__simplify_num_basis(strength);
   info->n = n;

@@ -33,7 +33,7 @@ struct fcm_schwarz {
   size_t *s_off;        /* num_blocks + 1 offsets into S */
   double *S;            /* dense S_K, m x m each (symmetric) */
   int max_m;
-  int num_colors; /* of the block graph (statistics only) */
+  int num_colors;        /* of the block graph (statistics only) */
   fcm_index *inc_ptr;    /* n + 1: DOF i is row inc_row[q] of block inc_blk[q], q in range */
   fcm_index *inc_blk;    /* block_ptr[num_blocks], ascending blocks per DOF */
   int *inc_row;          /* block_ptr[num_blocks] */
