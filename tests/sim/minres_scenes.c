@@ -8,8 +8,9 @@
  * the displacements agree, max |u_minres - u_direct| <= 1e-6 max |u_direct| (both runs stop
  * Newton at the scene's relative residual tolerance, 1e-5 by default, with MINRES at 1e-8;
  * measured: at most 5e-9). MINRES iterations per Newton step are
- * printed with argv[3] = "-v".
- * Usage: sim_minres_scenes SCENE_DIR STEPS [-v] */
+ * printed with "-v". Further arguments name the scenes to run (default: every scene of the
+ * directory, at least five).
+ * Usage: sim_minres_scenes SCENE_DIR STEPS [-v] [NAME.json ...] */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "test.h"
@@ -174,7 +175,15 @@ static void check_scene(fcm_ctx *ctx, const char *path, const char *file, int st
 int main(int argc, char **argv)
 {
   if (argc < 3) return 2;
-  const int steps = atoi(argv[2]), verbose = argc > 3 && !strcmp(argv[3], "-v");
+  const int steps = atoi(argv[2]);
+  int verbose = 0, nsel = 0;
+  const char *sel[MAX_FILES];
+  for (int a = 3; a < argc; a++) {
+    if (!strcmp(argv[a], "-v"))
+      verbose = 1;
+    else if (nsel < MAX_FILES)
+      sel[nsel++] = argv[a];
+  }
   fcm_ctx *ctx = NULL;
   if (fcm_ctx_create(NULL, &ctx) != FCM_OK) return 1;
   DIR *dir = opendir(argv[1]);
@@ -183,11 +192,14 @@ int main(int argc, char **argv)
   int nf = 0;
   for (struct dirent *e; dir && (e = readdir(dir)) && nf < MAX_FILES;) {
     size_t len = strlen(e->d_name);
-    if (len > 5 && !strcmp(e->d_name + len - 5, ".json")) files[nf++] = strdup(e->d_name);
+    int chosen = nsel == 0;
+    for (int k = 0; k < nsel; k++)
+      if (!strcmp(e->d_name, sel[k])) chosen = 1;
+    if (chosen && len > 5 && !strcmp(e->d_name + len - 5, ".json")) files[nf++] = strdup(e->d_name);
   }
   if (dir) closedir(dir);
   qsort(files, (size_t)nf, sizeof *files, cmp_str);
-  TEST_TRUE(nf >= 5);
+  TEST_TRUE(nsel ? nf == nsel : nf >= 5);
   for (int i = 0; i < nf; i++) {
     char path[2048];
     snprintf(path, sizeof path, "%s/%s", argv[1], files[i]);
