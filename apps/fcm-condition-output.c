@@ -24,7 +24,7 @@ int condition_write_csv(const char *path, const result *res, int nres, int proje
             fcm_element_get_info(r->element)->name, prec_names[r->prec], r->alpha, r->phi_min,
             r->kappa, r->phi_nominal, r->lmin_abs, r->lmax_abs, (long long)r->negative,
             (long long)r->dofs, (long long)r->blocks, (long long)r->clamped, r->iterations,
-            fcm_krylov_reason_str(r->reason), r->true_residual,
+            fcm_krylov_reason_name(r->reason), r->true_residual,
             project ? "projected" : "unprojected");
   }
   return cli_output_commit(PROG, &out);

@@ -290,7 +290,7 @@ int main(int argc, char **argv)
   int nres = 0, rc = 0;
   fcm_status st = fcm_ctx_create(NULL, &ctx);
   if (st != FCM_OK) {
-    fprintf(stderr, PROG ": cannot create a context: %s\n", fcm_status_str(st));
+    fprintf(stderr, PROG ": cannot create a context: %s\n", fcm_status_name(st));
     return 1;
   }
   res = calloc((size_t)(c.num_elements * c.num_fractions * 2 * c.num_precs), sizeof *res);
@@ -319,7 +319,7 @@ int main(int argc, char **argv)
     fcm_mesh_destroy(&mesh);
   }
   if (st != FCM_OK) {
-    fprintf(stderr, PROG ": failed: %s\n", fcm_status_str(st));
+    fprintf(stderr, PROG ": failed: %s\n", fcm_status_name(st));
     fcm_ctx_error_view(ctx, stderr);
     rc = 1;
   } else {

@@ -576,7 +576,7 @@ static int run_study(const config *c, fcm_ctx *ctx)
   cv_study_destroy(&study);
   return rc;
 fail:
-  fprintf(stderr, CV_PROG ": failed: %s\n", fcm_status_str(st));
+  fprintf(stderr, CV_PROG ": failed: %s\n", fcm_status_name(st));
   fcm_ctx_error_view(ctx, stderr);
   free(res);
   free(sw);
@@ -716,7 +716,7 @@ static int run_payoff(const config *c, fcm_ctx *ctx)
   if (st == FCM_OK) st = payoff_variant(ctx, c, mesh, geom, 0, &p[0]);
   if (st == FCM_OK) st = payoff_variant(ctx, c, mesh, geom, 1, &p[1]);
   if (st != FCM_OK) {
-    fprintf(stderr, CV_PROG ": payoff failed: %s\n", fcm_status_str(st));
+    fprintf(stderr, CV_PROG ": payoff failed: %s\n", fcm_status_name(st));
     fcm_ctx_error_view(ctx, stderr);
     rc = 1;
     goto done;
@@ -792,7 +792,7 @@ int main(int argc, char **argv)
   if (!parse_args(argc, argv, &c)) return 2;
   fcm_status st = fcm_ctx_create(NULL, &ctx);
   if (st != FCM_OK) {
-    fprintf(stderr, CV_PROG ": cannot create a context: %s\n", fcm_status_str(st));
+    fprintf(stderr, CV_PROG ": cannot create a context: %s\n", fcm_status_name(st));
     return 1;
   }
   const int rc = c.payoff ? run_payoff(&c, ctx) : run_study(&c, ctx);

@@ -39,11 +39,11 @@ static void log_fn(void *user, fcm_log_level level, const char *msg)
 int main(void)
 {
   /* Status strings: one per code, the out-of-range value is handled. */
-  TEST_TRUE(!strcmp(fcm_status_str(FCM_OK), "success"));
-  TEST_TRUE(!strcmp(fcm_status_str(FCM_ERR_ALLOC), "out of memory"));
-  TEST_TRUE(!strcmp(fcm_status_str((fcm_status)999), "unknown status"));
+  TEST_TRUE(!strcmp(fcm_status_name(FCM_OK), "success"));
+  TEST_TRUE(!strcmp(fcm_status_name(FCM_ERR_ALLOC), "out of memory"));
+  TEST_TRUE(!strcmp(fcm_status_name((fcm_status)999), "unknown status"));
   for (int s = 0; s < FCM_STATUS_COUNT_; s++)
-    TEST_TRUE(strlen(fcm_status_str((fcm_status)s)) > 0);
+    TEST_TRUE(strlen(fcm_status_name((fcm_status)s)) > 0);
 
   /* Bad arguments to create. */
   TEST_TRUE(fcm_ctx_create(NULL, NULL) == FCM_ERR_ARG);

@@ -98,7 +98,8 @@ static void allocation_failures(void)
     } else {
       fails++;
       if (!(st == FCM_ERR_ALLOC && r == NULL))
-        TEST_FAIL_("allocation %ld failing: status %s, rules %p", k, fcm_status_str(st), (void *)r);
+        TEST_FAIL_("allocation %ld failing: status %s, rules %p", k, fcm_status_name(st),
+                   (void *)r);
     }
     if (fcm_ctx_live_allocations(ctx) != live)
       TEST_FAIL_("allocation %ld failing: %lld allocations leaked", k,

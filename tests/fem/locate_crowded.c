@@ -113,7 +113,7 @@ int main(void)
       failures++;
       if (st != FCM_ERR_ALLOC || !strstr(fcm_ctx_error_message(ctx), "out of memory")) {
         if (other++ < 3)
-          fprintf(stderr, "allocation %lld failed: %s \"%s\"\n", k, fcm_status_str(st),
+          fprintf(stderr, "allocation %lld failed: %s \"%s\"\n", k, fcm_status_name(st),
                   fcm_ctx_error_message(ctx));
       }
       fcm_ctx_error_clear(ctx);

@@ -106,10 +106,10 @@ static inline void fuzz_check_no_live(fcm_ctx *ctx, long long before)
 static inline void fuzz_check_status(fcm_ctx *ctx, fcm_status st)
 {
   if (getenv("FCM_FUZZ_VERBOSE"))
-    fprintf(stderr, "fcm fuzz: %s %s\n", fcm_status_str(st), fcm_ctx_error_message(ctx));
+    fprintf(stderr, "fcm fuzz: %s %s\n", fcm_status_name(st), fcm_ctx_error_message(ctx));
   if (st != FCM_OK && (fcm_ctx_error_status(ctx) != st || !fcm_ctx_error_message(ctx)[0])) {
     fprintf(stderr, "fcm fuzz: %s returned without a matching message in the context\n",
-            fcm_status_str(st));
+            fcm_status_name(st));
     abort();
   }
 }

@@ -59,7 +59,7 @@ int main(void)
     TEST_TRUE(vr_count_entries(DIR, ".tmp.") == 0);
     if (st == FCM_OK) break;
     if (st != FCM_ERR_ALLOC) {
-      TEST_FAIL_("failing allocation %lld: %s (%s)", k, fcm_status_str(st),
+      TEST_FAIL_("failing allocation %lld: %s (%s)", k, fcm_status_name(st),
                  fcm_ctx_error_message(ctx));
       break;
     }
@@ -97,7 +97,7 @@ int main(void)
     } else {
       failures++;
       if (st != FCM_ERR_ALLOC || af != NULL)
-        TEST_FAIL_("atomic file open, failing allocation %lld: %s", k, fcm_status_str(st));
+        TEST_FAIL_("atomic file open, failing allocation %lld: %s", k, fcm_status_name(st));
       TEST_TRUE(vr_count_entries(DIR, ".tmp.") == 0 && vr_count_entries(DIR, "table") == 0);
       fcm_ctx_error_clear(ctx);
     }

@@ -76,7 +76,7 @@ int main(void)
     fcm__io_fault fault = {k, k == size_a};
     fcm_status st = fcm__vtu_write_fault(vtu, OUT, &info, &fault);
     if (st != FCM_ERR_IO || !strstr(fcm_ctx_error_message(ctx), "'" OUT "'"))
-      TEST_FAIL_("fault at byte %lld: %s, \"%s\"", k, fcm_status_str(st),
+      TEST_FAIL_("fault at byte %lld: %s, \"%s\"", k, fcm_status_name(st),
                  fcm_ctx_error_message(ctx));
     fcm_ctx_error_clear(ctx);
     if (!same_file(OUT, a, size_a)) TEST_FAIL_("fault at byte %lld changed the file", k);

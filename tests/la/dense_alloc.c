@@ -73,7 +73,7 @@ int main(void)
       } else {
         failures++;
         if (st != FCM_ERR_ALLOC)
-          fprintf(stderr, "%s, k = %lld: status %s\n", names[w], k, fcm_status_str(st));
+          fprintf(stderr, "%s, k = %lld: status %s\n", names[w], k, fcm_status_name(st));
         TEST_TRUE(st == FCM_ERR_ALLOC);
         TEST_TRUE(strstr(fcm_ctx_error_message(ctx), "out of memory") != NULL);
         fcm_ctx_error_clear(ctx);

@@ -18,8 +18,8 @@ static void expect(fcm_ctx *ctx, const char *text, fcm_status code, const char *
   fcm_status st = fcm_mesh_create_from_gmsh(ctx, PATH, &m);
   const char *msg = fcm_ctx_error_message(ctx);
   if (st != code)
-    TEST_FAIL_("status %s, expected %s; message: %s; file:\n%s", fcm_status_str(st),
-               fcm_status_str(code), msg, text);
+    TEST_FAIL_("status %s, expected %s; message: %s; file:\n%s", fcm_status_name(st),
+               fcm_status_name(code), msg, text);
   if (!strstr(msg, substr)) TEST_FAIL_("message \"%s\" lacks \"%s\"", msg, substr);
   if (line > 0) {
     snprintf(where, sizeof where, PATH ":%d: ", line);

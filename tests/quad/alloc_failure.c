@@ -52,7 +52,7 @@ int main(void)
           failures++;
           if (st != FCM_ERR_ALLOC)
             TEST_FAIL_("kind %d shape %d: failing allocation %ld gave %s", kind, s, k,
-                       fcm_status_str(st));
+                       fcm_status_name(st));
           TEST_TRUE(r == NULL);
           TEST_TRUE(fcm_ctx_error_status(ctx) == FCM_ERR_ALLOC);
           fcm_ctx_error_clear(ctx);
@@ -83,7 +83,7 @@ int main(void)
         failures++;
         if (st != FCM_ERR_ALLOC || fcm_ctx_error_status(ctx) != FCM_ERR_ALLOC)
           TEST_FAIL_("moment residual, shape %d: failing allocation %ld gave %s", s, k,
-                     fcm_status_str(st));
+                     fcm_status_name(st));
         fcm_ctx_error_clear(ctx);
       }
       if (fcm_ctx_live_allocations(ctx) != live)

@@ -227,7 +227,7 @@ int main(void)
     if (st == FCM_OK) {
       succeeded = 1;
     } else if (st != FCM_ERR_ALLOC || out != NULL) {
-      TEST_FAIL_("allocation %ld failed: status %s, out %p", k, fcm_status_str(st), (void *)out);
+      TEST_FAIL_("allocation %ld failed: status %s, out %p", k, fcm_status_name(st), (void *)out);
     }
     fcm_rule_destroy(&out);
     fcm_ctx_error_clear(ctx);

@@ -158,7 +158,7 @@ static int loop(fcm_ctx *ctx, failing *f, const fcm_scene *scene, int s, int whi
       if (st != FCM_ERR_ALLOC ||
           (which != OP_SUMMARY && fcm_ctx_error_status(ctx) != FCM_ERR_ALLOC))
         TEST_FAIL_("scene %d %s, allocation %lld failing: %s (%s)", s, op_names[which], k,
-                   fcm_status_str(st), fcm_ctx_error_message(ctx));
+                   fcm_status_name(st), fcm_ctx_error_message(ctx));
     }
     fcm_ctx_error_clear(ctx);
     /* no temporary, and whatever was written is whole */
@@ -206,7 +206,7 @@ int main(int argc, char **argv)
       } else {
         failures++;
         if (st != FCM_ERR_ALLOC || sc != NULL)
-          TEST_FAIL_("scene file %d, allocation %ld failing: %s", s, k, fcm_status_str(st));
+          TEST_FAIL_("scene file %d, allocation %ld failing: %s", s, k, fcm_status_name(st));
       }
       fcm_ctx_error_clear(ctx);
       TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
@@ -251,7 +251,7 @@ int main(int argc, char **argv)
       } else {
         failures++;
         if (st != FCM_ERR_ALLOC || sc != NULL)
-          TEST_FAIL_("default scene, allocation %ld failing: %s", k, fcm_status_str(st));
+          TEST_FAIL_("default scene, allocation %ld failing: %s", k, fcm_status_name(st));
       }
       fcm_ctx_error_clear(ctx);
       TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);

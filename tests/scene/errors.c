@@ -197,8 +197,8 @@ int main(void)
     const char *msg = fcm_ctx_error_message(ctx);
     if (st != c->status || !strstr(msg, c->substr) || (c->substr2 && !strstr(msg, c->substr2)) ||
         strncmp(msg, source_of(c), strlen(source_of(c))))
-      TEST_FAIL_("case %d: got %s \"%s\"; expected %s with \"%s\"%s%s", i, fcm_status_str(st), msg,
-                 fcm_status_str(c->status), c->substr, c->substr2 ? " and " : "",
+      TEST_FAIL_("case %d: got %s \"%s\"; expected %s with \"%s\"%s%s", i, fcm_status_name(st), msg,
+                 fcm_status_name(c->status), c->substr, c->substr2 ? " and " : "",
                  c->substr2 ? c->substr2 : "");
     TEST_TRUE(s == NULL);
     TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);

@@ -137,7 +137,7 @@ static void test_small_cut(fcm_ctx *ctx)
         fcm_status st = step(ctx, json, &reason);
         if (st != FCM_OK || reason != FCM_STEP_CONVERGED)
           TEST_FAIL_("small cut %g %s %s: %s (%s)", fractions[f], el ? "hex20" : "hex8",
-                     dyn ? "dynamic" : "static", fcm_status_str(st), fcm_ctx_error_message(ctx));
+                     dyn ? "dynamic" : "static", fcm_status_name(st), fcm_ctx_error_message(ctx));
         fcm_ctx_error_clear(ctx);
       }
 }

@@ -41,7 +41,7 @@ int main(void)
       } else {
         failures++;
         if (st != FCM_ERR_ALLOC)
-          TEST_FAIL_("variant %d: failing allocation %ld gave %s", variant, k, fcm_status_str(st));
+          TEST_FAIL_("variant %d: failing allocation %ld gave %s", variant, k, fcm_status_name(st));
         TEST_TRUE(res.count == 0 && res.indices == NULL && res.weights == NULL);
         TEST_TRUE(fcm_ctx_error_status(ctx) == FCM_ERR_ALLOC);
         fcm_ctx_error_clear(ctx);

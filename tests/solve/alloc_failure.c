@@ -123,7 +123,7 @@ int main(void)
                  fcm_ctx_live_allocations(ctx));
     if (st == FCM_OK) break;
     if (st != FCM_ERR_ALLOC) {
-      TEST_FAIL_("failing allocation %lld: %s (%s)", k, fcm_status_str(st),
+      TEST_FAIL_("failing allocation %lld: %s (%s)", k, fcm_status_name(st),
                  fcm_ctx_error_message(ctx));
       break;
     }

@@ -40,7 +40,7 @@ static void check_scaling(fcm_ctx *ctx)
     fcm_jacobi_kind kind = k ? FCM_JACOBI_BLOCK3 : FCM_JACOBI_SCALAR;
     TEST_OK(ctx, fcm_jacobi_create(ctx, L, kind, &J[k][0]));
     TEST_OK(ctx, fcm_jacobi_create(ctx, A, kind, &J[k][1]));
-    TEST_TRUE(fcm_jacobi_get_fallbacks(J[k][1]) == 0);
+    TEST_TRUE(fcm_jacobi_num_fallbacks(J[k][1]) == 0);
     it[k][0] = cg_iterations(ctx, L, J[k][0], b, n, 1000, &st);
     TEST_TRUE(st == FCM_OK);
     /* the same problem in scaled coordinates: D L D x = D b has x = D^{-1} y with L y = b,
@@ -60,7 +60,7 @@ static void check_scaling(fcm_ctx *ctx)
   /* plain CG on D L D: many more iterations (or none converged within 20x) */
   int plain = cg_iterations(ctx, A, NULL, b, n, 20 * it[0][1], &st);
   if (!(plain >= 5 * it[0][1]))
-    TEST_FAIL_("plain CG %d iterations (%s) vs Jacobi %d", plain, fcm_status_str(st), it[0][1]);
+    TEST_FAIL_("plain CG %d iterations (%s) vs Jacobi %d", plain, fcm_status_name(st), it[0][1]);
   for (int k = 0; k < 2; k++)
     for (int q = 0; q < 2; q++)
       fcm_jacobi_destroy(&J[k][q]);
@@ -87,9 +87,9 @@ static void check_blocks(fcm_ctx *ctx)
   fcm_jacobi *J = NULL, *Js = NULL;
   TEST_OK(ctx, fcm_csr_create_triplets(ctx, 6, 6, 18, ri, ci, v, FCM_CSR_SYMMETRIC, &A));
   TEST_OK(ctx, fcm_jacobi_create(ctx, A, FCM_JACOBI_BLOCK3, &J));
-  TEST_TRUE(fcm_jacobi_get_fallbacks(J) == 1);
+  TEST_TRUE(fcm_jacobi_num_fallbacks(J) == 1);
   TEST_OK(ctx, fcm_jacobi_create(ctx, A, FCM_JACOBI_SCALAR, &Js));
-  TEST_TRUE(fcm_jacobi_get_fallbacks(Js) == 1); /* the -4 */
+  TEST_TRUE(fcm_jacobi_num_fallbacks(Js) == 1); /* the -4 */
   double rr[6] = {1, -2, 3, 0.5, -1, 2}, z[6], y[3];
   TEST_OK(ctx, fcm_jacobi_apply(J, rr, z));
   for (int i = 0; i < 3; i++) {

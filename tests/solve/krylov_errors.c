@@ -165,8 +165,8 @@ int main(void)
   fcm_krylov *bad = NULL;
   TEST_ERR(ctx, fcm_krylov_create(ctx, -1, &bad), FCM_ERR_ARG, "n = -1");
   TEST_TRUE(bad == NULL);
-  TEST_TRUE(strcmp(fcm_krylov_reason_str(FCM_KRYLOV_MAX_ITERATIONS), "max-iterations") == 0);
-  TEST_TRUE(strcmp(fcm_krylov_reason_str((fcm_krylov_reason)99), "unknown") == 0);
+  TEST_TRUE(strcmp(fcm_krylov_reason_name(FCM_KRYLOV_MAX_ITERATIONS), "max-iterations") == 0);
+  TEST_TRUE(strcmp(fcm_krylov_reason_name((fcm_krylov_reason)99), "unknown") == 0);
 
   /* an empty system */
   fcm_krylov *ws0 = NULL;

@@ -93,8 +93,8 @@ int main(void)
     /* n iterations in exact arithmetic; finite precision may delay (the reflected block
      * inverses spread the spectrum of S A over both signs) */
     if (!(info.reason == FCM_KRYLOV_CONVERGED_RTOL && info.iterations <= 2 * NN))
-      TEST_FAIL_("preconditioner %d: %s after %d iterations", p, fcm_krylov_reason_str(info.reason),
-                 info.iterations);
+      TEST_FAIL_("preconditioner %d: %s after %d iterations", p,
+                 fcm_krylov_reason_name(info.reason), info.iterations);
     /* the recurrence norm is the S-norm of the true residual */
     TEST_NEAR(info.residual_norm, s_norm_residual(A, S[p], Su[p], b, x), 1e-3,
               1e-12 * info.rhs_norm);

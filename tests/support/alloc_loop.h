@@ -30,7 +30,7 @@ static inline long alloc_loop(fcm_ctx *ctx, failing *f, const char *name, alloc_
     } else {
       failures++;
       if (st != FCM_ERR_ALLOC || fcm_ctx_error_status(ctx) != FCM_ERR_ALLOC) {
-        TEST_FAIL_("%s, allocation %ld failing: %s (%s)", name, k, fcm_status_str(st),
+        TEST_FAIL_("%s, allocation %ld failing: %s (%s)", name, k, fcm_status_name(st),
                    fcm_ctx_error_message(ctx));
         ok = -1;
       }

@@ -41,7 +41,7 @@ static int test_failures_ = 0;
   do {                                                                                             \
     fcm_status ts_ = (call);                                                                       \
     if (ts_ != FCM_OK) {                                                                           \
-      TEST_FAIL_("%s returned %s", #call, fcm_status_str(ts_));                                    \
+      TEST_FAIL_("%s returned %s", #call, fcm_status_name(ts_));                                   \
       fcm_ctx_error_view((ctx), stderr);                                                           \
     }                                                                                              \
   } while (0)
@@ -51,7 +51,7 @@ static int test_failures_ = 0;
   do {                                                                                             \
     fcm_status ts_ = (call);                                                                       \
     if (ts_ != (code))                                                                             \
-      TEST_FAIL_("%s returned %s, expected %s", #call, fcm_status_str(ts_), #code);                \
+      TEST_FAIL_("%s returned %s, expected %s", #call, fcm_status_name(ts_), #code);               \
     else if (!strstr(fcm_ctx_error_message(ctx), (substr)))                                        \
       TEST_FAIL_("%s: message \"%s\" lacks \"%s\"", #call, fcm_ctx_error_message(ctx), (substr));  \
     fcm_ctx_error_clear(ctx);                                                                      \

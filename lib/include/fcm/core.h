@@ -20,7 +20,7 @@ extern "C" {
 /** Global (64-bit) index type: nodes, DOFs, non-zeros, points of a mesh. */
 typedef int64_t fcm_index;
 
-/** One list generates the status enum and the messages of fcm_status_str(). */
+/** One list generates the status enum and the messages of fcm_status_name(). */
 #define FCM_STATUS_LIST(X)                                                                         \
   X(FCM_OK, "success")                                                                             \
   X(FCM_ERR_ARG, "invalid argument")                                                               \
@@ -42,7 +42,7 @@ typedef enum fcm_status { FCM_STATUS_LIST(FCM_STATUS_ENUM_) FCM_STATUS_COUNT_ } 
 #undef FCM_STATUS_ENUM_
 
 /** Static description of a status code ("invalid argument", ...); never NULL. */
-FCM_API const char *fcm_status_str(fcm_status st);
+FCM_API const char *fcm_status_name(fcm_status st);
 
 /** The one "use the default" value of option members (and of the parameters documented so):
  * a member set to FCM_DEFAULT takes the default documented on it, which is computed where

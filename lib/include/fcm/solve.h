@@ -38,7 +38,7 @@ typedef enum fcm_krylov_reason {
 } fcm_krylov_reason;
 
 /** Name of a reason ("converged-rtol", "max-iterations", ...), or "unknown". */
-FCM_API const char *fcm_krylov_reason_str(fcm_krylov_reason reason);
+FCM_API const char *fcm_krylov_reason_name(fcm_krylov_reason reason);
 
 /** Which residual norm the stopping test and the history use. */
 typedef enum fcm_krylov_norm {
@@ -174,7 +174,7 @@ FCM_API fcm_status fcm_jacobi_apply(const fcm_jacobi *P, const double *r, double
 FCM_API fcm_status fcm_jacobi_operator(void *user, const double *r, double *z);
 
 /** Number of fallbacks of the last setup (negative diagonals, or non-SPD 3x3 blocks). */
-FCM_API fcm_index fcm_jacobi_get_fallbacks(const fcm_jacobi *P);
+FCM_API fcm_index fcm_jacobi_num_fallbacks(const fcm_jacobi *P);
 
 /** Destroy; accepts NULL and `*P == NULL`, sets `*P = NULL`. */
 FCM_API void fcm_jacobi_destroy(fcm_jacobi **P);

@@ -29,7 +29,7 @@ struct fcm_ctx {
 static const char *const status_msgs[] = {FCM_STATUS_LIST(FCM_STATUS_STR_)};
 #undef FCM_STATUS_STR_
 
-const char *fcm_status_str(fcm_status st)
+const char *fcm_status_name(fcm_status st)
 {
   if ((int)st < 0 || st >= FCM_STATUS_COUNT_) return "unknown status";
   return status_msgs[st];
@@ -114,7 +114,7 @@ void fcm_ctx_error_clear(fcm_ctx *ctx)
 void fcm_ctx_error_view(const fcm_ctx *ctx, FILE *stream)
 {
   if (!ctx || !stream || ctx->err_status == FCM_OK) return;
-  fprintf(stream, "fcm error: %s (%s)\n", ctx->err_msg, fcm_status_str(ctx->err_status));
+  fprintf(stream, "fcm error: %s (%s)\n", ctx->err_msg, fcm_status_name(ctx->err_status));
   for (int i = 0; i < ctx->nframes; i++)
     fprintf(stream, "  [%d] %s() at %s:%d\n", i, ctx->frames[i].func, ctx->frames[i].file,
             ctx->frames[i].line);
@@ -266,7 +266,7 @@ fcm_status fcm__loop_end(fcm__loop *loop, fcm_index *failed)
   if (loop->rec.code == FCM_OK) { /* the iteration failed without a message of its own */
     loop->rec.code = loop->status;
     snprintf(loop->rec.msg, sizeof loop->rec.msg, "iteration %lld of a parallel loop failed: %s",
-             (long long)loop->failed, fcm_status_str(loop->status));
+             (long long)loop->failed, fcm_status_name(loop->status));
     loop->rec.nframes = loop->rec.frames_dropped = 0;
   }
   loop->rec.code = loop->status;

@@ -84,7 +84,7 @@ void fcm__simplify_fail(fcm__attempt *a, fcm_simplify_reason reason, const char 
 fcm_status fcm__simplify_soften(fcm__attempt *a, fcm_status st, const char *what)
 {
   if (st == FCM_OK || st == FCM_ERR_ALLOC) return st;
-  fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_NUMERIC, "%s failed: %s", what, fcm_status_str(st));
+  fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_NUMERIC, "%s failed: %s", what, fcm_status_name(st));
   return FCM_OK;
 }
 

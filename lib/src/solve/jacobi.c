@@ -158,7 +158,7 @@ fcm_status fcm_jacobi_operator(void *user, const double *r, double *z)
   return fcm_jacobi_apply((const fcm_jacobi *)user, r, z);
 }
 
-fcm_index fcm_jacobi_get_fallbacks(const fcm_jacobi *P)
+fcm_index fcm_jacobi_num_fallbacks(const fcm_jacobi *P)
 {
   return P ? P->fallbacks : 0;
 }

@@ -28,7 +28,7 @@ struct fcm_krylov {
   int history_capacity;
 };
 
-const char *fcm_krylov_reason_str(fcm_krylov_reason reason)
+const char *fcm_krylov_reason_name(fcm_krylov_reason reason)
 {
   switch (reason) {
   case FCM_KRYLOV_NONE:

@@ -247,7 +247,7 @@ fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
               (long long)bad, m, (long long)d[0]);
     FCM_CHECK(bad_fail != FAIL_LAPACK, ctx, bad_st,
               "schwarz: eigendecomposition of block %lld (%lld DOFs) failed: %s", (long long)bad, m,
-              fcm_status_str(bad_st));
+              fcm_status_name(bad_st));
     st = bad_st; /* allocation failure inside dsyevd, already recorded */
     fcm__trace(ctx, __FILE__, __LINE__, __func__);
     goto cleanup;
