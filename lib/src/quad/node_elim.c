@@ -33,24 +33,6 @@ fcm_rulegen_options fcm_rulegen_options_default(void)
   return o;
 }
 
-static double shape_measure(fcm_shape shape)
-{
-  switch (shape) {
-  case FCM_SHAPE_LINE:
-    return 2.0;
-  case FCM_SHAPE_TRI:
-    return 0.5;
-  case FCM_SHAPE_QUAD:
-    return 4.0;
-  case FCM_SHAPE_TET:
-    return 1.0 / 6.0;
-  case FCM_SHAPE_HEX:
-    return 8.0;
-  default:
-    return 0.0;
-  }
-}
-
 static int shape_dim(fcm_shape shape)
 {
   switch (shape) {
@@ -427,7 +409,7 @@ fcm_status fcm__rulegen_eliminate(fcm_ctx *ctx, fcm_shape shape, int m, int n0, 
   double *x = NULL, *w = NULL, *xt = NULL, *wt = NULL;
   sig_entry *sig = NULL;
   char *drop = NULL;
-  const double t0 = fcm_wtime(), meas = shape_measure(shape);
+  const double t0 = fcm_wtime(), meas = fcm_shape_measure(shape);
   int n = n0, converged = 0;
   double rinf = 0.0;
   memset(&s, 0, sizeof s);
@@ -577,7 +559,7 @@ double fcm__rulegen_residual(fcm_ctx *ctx, fcm_shape shape, int m, int n, const 
                              const double *w)
 {
   int M = fcm__orthobasis_size(shape, m), d = shape_dim(shape);
-  double meas = shape_measure(shape), rmax = 0.0;
+  double meas = fcm_shape_measure(shape), rmax = 0.0;
   double *phi = fcm__calloc(ctx, (size_t)M, sizeof *phi);
   long double *acc = fcm__calloc(ctx, (size_t)M, sizeof *acc);
   if (!phi || !acc) {
