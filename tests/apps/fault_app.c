@@ -143,25 +143,6 @@ static char *slurp(const char *path, long *n)
   return (char *)vr_slurp(path, n);
 }
 
-/* The CSV log without its last column (wall time). */
-static void strip_wall(char *csv)
-{
-  char *w = csv;
-  for (char *line = csv; *line;) {
-    char *nl = strchr(line, '\n');
-    size_t len = nl ? (size_t)(nl - line) : strlen(line);
-    char *comma = NULL;
-    for (size_t k = 0; k < len; k++)
-      if (line[k] == ',') comma = line + k;
-    size_t keep = comma ? (size_t)(comma - line) : len;
-    memmove(w, line, keep);
-    w += keep;
-    *w++ = '\n';
-    line += len + (nl ? 1 : 0);
-  }
-  *w = '\0';
-}
-
 /* `dir` holds the reference's frames byte for byte, its log and complete PVD indexes. */
 static void compare_with_reference(const char *ref, const char *dir, const char *what)
 {
@@ -191,7 +172,7 @@ static void compare_with_reference(const char *ref, const char *dir, const char 
   snprintf(a, sizeof a, "%.900s/fault_log.csv", ref);
   snprintf(b, sizeof b, "%.900s/fault_log.csv", dir);
   char *x = slurp(a, &na), *y = slurp(b, &nb);
-  if (x && y) strip_wall(x), strip_wall(y);
+  if (x && y) oc_strip_last_column(x), oc_strip_last_column(y);
   if (!x || !y || strcmp(x, y)) TEST_FAIL_("%s: %s differs from the uninterrupted run's", what, b);
   free(x), free(y);
 }

@@ -18,6 +18,7 @@
  *                                     parser's message and create no output directory */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
+#include "output_check.h"
 #include "test.h"
 
 #include <sys/stat.h>
@@ -205,25 +206,6 @@ static long slurp(const char *path, char *buf, size_t cap)
   return (long)n;
 }
 
-/* The CSV log without its last column (wall time), for comparing runs. */
-static void strip_wall(char *csv)
-{
-  char *w = csv;
-  for (char *line = csv; *line;) {
-    char *nl = strchr(line, '\n');
-    size_t len = nl ? (size_t)(nl - line) : strlen(line);
-    char *comma = NULL;
-    for (size_t k = 0; k < len; k++)
-      if (line[k] == ',') comma = line + k;
-    size_t keep = comma ? (size_t)(comma - line) : len;
-    memmove(w, line, keep);
-    w += keep;
-    *w++ = '\n';
-    line += len + (nl ? 1 : 0);
-  }
-  *w = '\0';
-}
-
 static int mode_resume(const char *sim, const char *work)
 {
   static char a[1 << 20], b[1 << 20];
@@ -277,8 +259,8 @@ static int mode_resume(const char *sim, const char *work)
   snprintf(path, sizeof path, "%s/small_log.csv", full);
   snprintf(path2, sizeof path2, "%s/small_log.csv", cut);
   TEST_TRUE(slurp(path, a, sizeof a) > 0 && slurp(path2, b, sizeof b) > 0);
-  strip_wall(a);
-  strip_wall(b);
+  oc_strip_last_column(a);
+  oc_strip_last_column(b);
   TEST_TRUE(!strcmp(a, b));
   /* the PVD index lists all 6 frames with the same times */
   snprintf(path, sizeof path, "%s/small_background.pvd", full);

@@ -21,6 +21,26 @@ typedef struct oc_counts {
   char first_error[512];
 } oc_counts;
 
+/* Drop the last column (the wall time) of every line of a CSV text, in place: what stays is
+ * what a repeated or resumed run must reproduce exactly. */
+static inline void oc_strip_last_column(char *csv)
+{
+  char *w = csv;
+  for (char *line = csv; *line;) {
+    char *nl = strchr(line, '\n');
+    size_t len = nl ? (size_t)(nl - line) : strlen(line);
+    char *comma = NULL;
+    for (size_t k = 0; k < len; k++)
+      if (line[k] == ',') comma = line + k;
+    size_t keep = comma ? (size_t)(comma - line) : len;
+    memmove(w, line, keep);
+    w += keep;
+    *w++ = '\n';
+    line += len + (nl ? 1 : 0);
+  }
+  *w = '\0';
+}
+
 static inline int oc_ends_with(const char *s, const char *suffix)
 {
   size_t n = strlen(s), m = strlen(suffix);
