@@ -26,6 +26,7 @@ typedef struct linsys {
   fcm_space *space;
   fcm_csr *A;     /* full M + dt^2 K */
   fcm_csr *Af;    /* reduced to the free DOFs */
+  fcm_csr *Pf;    /* the preconditioners' matrix M + dt^2 K_pc reduced, NULL: Af */
   fcm_index *map; /* full DOF -> reduced index, or -1 */
   fcm_index n;    /* reduced size */
   double phi_min;
@@ -34,6 +35,7 @@ typedef struct linsys {
 static void system_free(linsys *s)
 {
   fcm_csr_destroy(&s->Af);
+  fcm_csr_destroy(&s->Pf);
   fcm_csr_destroy(&s->A);
   fcm_space_destroy(&s->space);
   fcm_cell_rules_destroy(&s->rules);
@@ -55,15 +57,51 @@ static fcm_status alloc_fail(fcm_ctx *ctx)
   return FCM_ERR_ALLOC;
 }
 
+/* B reduced to the free DOFs of s (s->map, s->n): a new symmetric CSR matrix. */
+static fcm_status reduce(fcm_ctx *ctx, const linsys *s, fcm_csr *B, fcm_csr **Bf)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *rp = NULL, nnz;
+  int *ci = NULL;
+  const fcm_index nd = fcm_space_num_dofs(s->space);
+  fcm_csr_get_size(B, NULL, NULL, &nnz);
+  const fcm_index *arp = fcm_csr_row_ptr(B);
+  const int *aci = fcm_csr_col_idx(B);
+  const double *av = fcm_csr_values(B);
+  if (!(rp = malloc(sizeof *rp * (size_t)(s->n + 1))) || !(ci = malloc(sizeof *ci * (size_t)nnz))) {
+    st = alloc_fail(ctx);
+    goto done;
+  }
+  fcm_index q = 0;
+  rp[0] = 0;
+  for (fcm_index i = 0; i < nd; i++) {
+    if (s->map[i] < 0) continue;
+    for (fcm_index p = arp[i]; p < arp[i + 1]; p++)
+      if (s->map[aci[p]] >= 0) ci[q++] = (int)s->map[aci[p]];
+    rp[s->map[i] + 1] = q;
+  }
+  TRY(fcm_csr_create(ctx, s->n, s->n, rp, ci, FCM_CSR_SYMMETRIC, Bf));
+  double *fv = fcm_csr_values(*Bf);
+  q = 0;
+  for (fcm_index i = 0; i < nd; i++) {
+    if (s->map[i] < 0) continue;
+    for (fcm_index p = arp[i]; p < arp[i + 1]; p++)
+      if (s->map[aci[p]] >= 0) fv[q++] = av[p];
+  }
+done:
+  free(rp);
+  free(ci);
+  return st;
+}
+
 /* Build rules, space, A = M + dt^2 K(u) and the reduced matrix. */
 static fcm_status system_build(fcm_ctx *ctx, const config *c, fcm_mesh *mesh, double phi,
                                double alpha, linsys *s, double *t_rules)
 {
   fcm_status st = FCM_OK;
-  fcm_csr *K = NULL;
+  fcm_csr *K = NULL, *P = NULL;
   double *u = NULL;
-  fcm_index *fixed = NULL, *rp = NULL;
-  int *ci = NULL;
+  fcm_index *fixed = NULL;
   memset(s, 0, sizeof *s);
   s->mesh = mesh;
   const double eps = cbrt(phi);
@@ -111,7 +149,9 @@ static fcm_status system_build(fcm_ctx *ctx, const config *c, fcm_mesh *mesh, do
   TRY(fcm_space_matrix_create(s->space, &s->A));
   TRY(fcm_space_matrix_create(s->space, &K));
   TRY(fcm_assemble_mass(s->space, &el, NULL, s->A));
-  TRY(fcm_assemble_hyperelastic(s->space, &mp, u, NULL, NULL, NULL, K));
+  fcm_assembly_options ao = fcm_assembly_options_default();
+  ao.fictitious = (fcm_fictitious_model)c->fictitious;
+  TRY(fcm_assemble_hyperelastic(s->space, &mp, u, &ao, NULL, NULL, K));
   fcm_index nnz;
   fcm_csr_get_size(s->A, NULL, NULL, &nnz);
   double *av = fcm_csr_values(s->A);
@@ -138,34 +178,30 @@ static fcm_status system_build(fcm_ctx *ctx, const config *c, fcm_mesh *mesh, do
   s->n = 0;
   for (fcm_index i = 0; i < nd; i++)
     s->map[i] = s->map[i] < 0 ? -1 : s->n++;
-  const fcm_index *arp = fcm_csr_row_ptr(s->A);
-  const int *aci = fcm_csr_col_idx(s->A);
-  if (!(rp = malloc(sizeof *rp * (size_t)(s->n + 1))) || !(ci = malloc(sizeof *ci * (size_t)nnz))) {
-    st = alloc_fail(ctx);
-    goto done;
-  }
-  fcm_index q = 0;
-  rp[0] = 0;
-  for (fcm_index i = 0; i < nd; i++) {
-    if (s->map[i] < 0) continue;
-    for (fcm_index p = arp[i]; p < arp[i + 1]; p++)
-      if (s->map[aci[p]] >= 0) ci[q++] = (int)s->map[aci[p]];
-    rp[s->map[i] + 1] = q;
-  }
-  TRY(fcm_csr_create(ctx, s->n, s->n, rp, ci, FCM_CSR_SYMMETRIC, &s->Af));
-  double *fv = fcm_csr_values(s->Af);
-  q = 0;
-  for (fcm_index i = 0; i < nd; i++) {
-    if (s->map[i] < 0) continue;
-    for (fcm_index p = arp[i]; p < arp[i + 1]; p++)
-      if (s->map[aci[p]] >= 0) fv[q++] = av[p];
+  TRY(reduce(ctx, s, s->A, &s->Af));
+  if (c->pc_tangent != FCM_FICTITIOUS_EXACT) { /* the preconditioners' operator */
+    fcm_csr_destroy(&K);
+    TRY(fcm_space_matrix_create(s->space, &P));
+    TRY(fcm_space_matrix_create(s->space, &K));
+    TRY(fcm_assemble_mass(s->space, &el, NULL, P));
+    if (c->pc_tangent == FCM_FICTITIOUS_LINEAR) {
+      TRY(fcm_assemble_stiffness(s->space, &el, NULL, K));
+    } else {
+      fcm_material_params pp = mp;
+      pp.project_psd = 1;
+      TRY(fcm_assemble_hyperelastic(s->space, &pp, u, &ao, NULL, NULL, K));
+    }
+    double *pv = fcm_csr_values(P);
+    const double *k2 = fcm_csr_values(K);
+    for (fcm_index p = 0; p < nnz; p++)
+      pv[p] += c->dt * c->dt * k2[p];
+    TRY(reduce(ctx, s, P, &s->Pf));
   }
 done:
   fcm_csr_destroy(&K);
+  fcm_csr_destroy(&P);
   free(u);
   free(fixed);
-  free(rp);
-  free(ci);
   return st;
 }
 
@@ -201,7 +237,7 @@ static fcm_status schwarz_build(fcm_ctx *ctx, const config *c, const linsys *s,
   fcm_schwarz_options so = fcm_schwarz_options_default();
   so.epsilon = c->epsilon;
   so.clamp = clamp;
-  TRY(fcm_schwarz_create(ctx, s->Af, nb, ptr, dofs, &so, P));
+  TRY(fcm_schwarz_create(ctx, s->Pf ? s->Pf : s->Af, nb, ptr, dofs, &so, P));
 done:
   free(ptr);
   free(dofs);
@@ -224,7 +260,7 @@ static fcm_status measure(fcm_ctx *ctx, const config *c, const linsys *s, int pr
   void *Suser = NULL;
   r->blocks = r->clamped = 0;
   if (prec == PREC_JACOBI) {
-    TRY(fcm_jacobi_create(ctx, s->Af, FCM_JACOBI_SCALAR, &J));
+    TRY(fcm_jacobi_create(ctx, s->Pf ? s->Pf : s->Af, FCM_JACOBI_SCALAR, &J));
     Sop = fcm_jacobi_operator;
     Suser = J;
   } else if (prec == PREC_SCHWARZ || prec == PREC_SCHWARZ_PAPER) {

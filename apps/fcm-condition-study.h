@@ -33,6 +33,8 @@ typedef struct config {
   double epsilon; /* Schwarz eigenvalue threshold */
   int simplify;
   int project; /* 1: PSD-projected material tangent */
+  int fictitious; /* fcm_fictitious_model of the stabilization points */
+  int pc_tangent; /* fcm_fictitious_model: tangent of the preconditioners' matrix */
   double density, young, poisson, dt;
   double u_scale; /* u(X) = u_scale X_1 (1, 1, -1) */
   double rtol;

@@ -122,8 +122,10 @@ typedef struct seen {
 
 static const char *const on_off[] = {"off", "on", NULL};
 static const char *const stab_modes[] = {"mass+stiffness", "mass", NULL};
+/* in the order of fcm_fictitious_model */
+static const char *const tangent_models[] = {"projected", "linear", "exact", NULL};
 
-#define NUM_OPTIONS 20
+#define NUM_OPTIONS 22
 static void option_table(config *c, int *stab_mode, seen *g, cli_option t[NUM_OPTIONS])
 {
   const cli_option o[NUM_OPTIONS] = {
@@ -160,6 +162,14 @@ static void option_table(config *c, int *stab_mode, seen *g, cli_option t[NUM_OP
        &g->simplify},
       {"--project", NULL, CLI_CHOICE, &c->project, "on|off",
        "PSD-project the material tangent               (default off)", 0, 0, 0, on_off, NULL, NULL},
+      {"--fictitious", NULL, CLI_CHOICE, &c->fictitious, "MODEL",
+       "tangent at the stabilization points: projected |\n"
+       "linear | exact                                 (default projected)", 0, 0, 0,
+       tangent_models, NULL, NULL},
+      {"--pc-tangent", NULL, CLI_CHOICE, &c->pc_tangent, "MODEL",
+       "tangent of the preconditioners' matrix: exact |\n"
+       "projected | linear (at rest)                   (default exact)", 0, 0, 0,
+       tangent_models, NULL, NULL},
       {"--density", NULL, CLI_DOUBLE, &c->density, "RHO",
        "density in kg/m^3, > 0                         (default 1000)", 0, HUGE_VAL, CLI_LO_OPEN,
        NULL, NULL, NULL},
@@ -278,6 +288,8 @@ int main(int argc, char **argv)
   c.dt = 1.0 / 60.0;
   c.rtol = 1e-8;
   c.u_scale = 1.0;
+  c.fictitious = FCM_FICTITIOUS_PROJECTED;
+  c.pc_tangent = FCM_FICTITIOUS_EXACT;
   c.minres_max = 5000;
   if (!parse_fractions(PROG, "--fractions", "1:1e-12:13", &c)) return 2;
   if (!parse_args(argc, argv, &c)) return 2;

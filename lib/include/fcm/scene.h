@@ -99,6 +99,10 @@ typedef struct fcm_scene_solver {
   fcm_direct_method direct;          /**< default FCM_DIRECT_CHOLMOD */
   fcm_preconditioner preconditioner; /**< Krylov only: "none", "jacobi", "block_jacobi",
                                           "schwarz" (default) */
+  fcm_fictitious_model preconditioner_tangent; /**< "preconditioner_tangent": the tangent
+                                      the preconditioner is built from, "projected" (default),
+                                      "linear", "exact"
+                                      (fcm_integrator_options.preconditioner_tangent) */
   double schwarz_threshold;    /**< cut cells with volume fraction below it get a block; (0, 1],
                                     default 0.5 (fcm_integrator_options.schwarz_theta) */
   fcm_schwarz_options schwarz; /**< epsilon in (0, 1), default 1e-13; clamp "clamp" (default,

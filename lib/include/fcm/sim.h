@@ -104,6 +104,16 @@ typedef struct fcm_integrator_options {
   fcm_linear_solver linear_solver;   /**< default FCM_LINEAR_DIRECT */
   fcm_direct_method direct_method;   /**< first direct method (default CHOLMOD; UMFPACK: LU only) */
   fcm_preconditioner preconditioner; /**< Krylov only (default JACOBI) */
+  fcm_fictitious_model preconditioner_tangent; /**< Krylov only: the material tangent the
+      preconditioner (Jacobi, block Jacobi, Schwarz) is built from, while the Krylov
+      operator stays the exact Newton matrix base + K(u). The values of fcm_fictitious_model
+      name the tangent models: FCM_FICTITIOUS_PROJECTED (default): base + the PSD-projected
+      tangent at the iterate (one more tangent assembly per preconditioner setup); the
+      Schwarz blocks of small cut cells are then positive definite instead of indefinite or
+      nearly singular, and the preconditioner is SPD as MINRES requires;
+      FCM_FICTITIOUS_LINEAR: base + the linear-elastic stiffness at rest (assembled once);
+      FCM_FICTITIOUS_EXACT: the Newton matrix itself. Without effect when the Newton matrix
+      has a PSD tangent already (project_psd, linear material, projection fallback). */
   double krylov_rtol;                /**< in [0, 1) (default 1e-8) */
   double krylov_atol;                /**< >= 0 (default 0) */
   int krylov_max_iterations;         /**< >= 1 (default 1000) */

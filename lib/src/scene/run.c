@@ -339,6 +339,7 @@ static fcm_integrator_options integrator_options(fcm_simulation *S)
   o.linear_solver = sv->method;
   o.direct_method = sv->direct;
   o.preconditioner = sv->preconditioner;
+  o.preconditioner_tangent = sv->preconditioner_tangent;
   o.krylov_rtol = sv->rtol;
   o.krylov_atol = sv->atol;
   o.krylov_max_iterations = sv->max_iterations;

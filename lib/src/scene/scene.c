@@ -61,6 +61,8 @@ static const int solver_values[] = {FCM_LINEAR_DIRECT, FCM_LINEAR_MINRES, FCM_LI
 static const char *const direct_names[] = {"cholmod", "umfpack"};
 static const char *const preconditioner_names[] = {"none", "jacobi", "block_jacobi", "schwarz"};
 static const char *const clamp_names[] = {"clamp", "paper"};
+/* in the order of fcm_fictitious_model */
+static const char *const tangent_names[] = {"projected", "linear", "exact"};
 static const char *const newton_rule_names[] = {"auto", "representative", "relative"};
 static const int newton_rule_values[] = {FCM_NEWTON_TOL_AUTO, FCM_NEWTON_TOL_REPRESENTATIVE,
                                          FCM_NEWTON_TOL_RELATIVE};
@@ -406,7 +408,8 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   fcm_status st = FCM_OK;
   static const char *const keys[] = {"method",         "direct", "preconditioner",
                                      "schwarz",        "rtol",   "atol",
-                                     "max_iterations", "newton", "threads"};
+                                     "max_iterations", "newton", "threads",
+                                     "preconditioner_tangent"};
   static const char *const skeys[] = {"threshold", "epsilon", "clamp"};
   static const char *const nkeys[] = {"rtol",        "max_iterations",
                                       "line_search", "project_psd",
@@ -417,6 +420,7 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   s->method = FCM_LINEAR_DIRECT;
   s->direct = FCM_DIRECT_CHOLMOD;
   s->preconditioner = FCM_PRECOND_SCHWARZ;
+  s->preconditioner_tangent = FCM_FICTITIOUS_PROJECTED;
   s->schwarz_threshold = 0.5;
   s->schwarz = fcm_schwarz_options_default();
   s->newton_rule = FCM_NEWTON_TOL_AUTO;
@@ -435,6 +439,7 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   READ_CHOICE_AS(p, o, "method", 0, solver_names, solver_values, s->method);
   READ_CHOICE(p, o, "direct", 0, direct_names, s->direct);
   READ_CHOICE(p, o, "preconditioner", 0, preconditioner_names, s->preconditioner);
+  READ_CHOICE(p, o, "preconditioner_tangent", 0, tangent_names, s->preconditioner_tangent);
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "schwarz", 0, &sw));
   if (sw) {
     ENTER(p, "schwarz");
@@ -891,7 +896,8 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
   if (so->method == FCM_LINEAR_DIRECT)
     fprintf(f, " (%s)", direct_names[so->direct]);
   else {
-    fprintf(f, " preconditioner %s", preconditioner_names[so->preconditioner]);
+    fprintf(f, " preconditioner %s (%s tangent)", preconditioner_names[so->preconditioner],
+            tangent_names[so->preconditioner_tangent]);
     if (so->preconditioner == FCM_PRECOND_SCHWARZ)
       fprintf(f, " (threshold %g, epsilon %g, %s)", so->schwarz_threshold, so->schwarz.epsilon,
               clamp_names[so->schwarz.clamp]);

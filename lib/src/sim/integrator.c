@@ -26,6 +26,7 @@ fcm_integrator_options fcm_integrator_options_default(void)
   o.linear_solver = FCM_LINEAR_DIRECT;
   o.direct_method = FCM_DIRECT_CHOLMOD;
   o.preconditioner = FCM_PRECOND_JACOBI;
+  o.preconditioner_tangent = FCM_FICTITIOUS_PROJECTED;
   o.krylov_rtol = 1e-8;
   o.krylov_atol = 0.0;
   o.krylov_max_iterations = 1000;
@@ -169,6 +170,8 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   fcm_csr_destroy(&I->H);
   fcm_csr_destroy(&I->D);
   fcm_csr_destroy(&I->H0);
+  fcm_csr_destroy(&I->Hpc);
+  fcm_csr_destroy(&I->K0);
   fcm_direct_destroy(&I->chol);
   fcm_direct_destroy(&I->umf);
   fcm_krylov_destroy(&I->krylov);
@@ -401,6 +404,10 @@ static fcm_status validate_options(fcm_ctx *ctx, const fcm_integrator_options *o
             (int)o->direct_method);
   FCM_CHECK(o->preconditioner >= FCM_PRECOND_NONE && o->preconditioner <= FCM_PRECOND_SCHWARZ, ctx,
             FCM_ERR_ARG, "integrator: preconditioner = %d outside [0, 3]", (int)o->preconditioner);
+  FCM_CHECK(o->preconditioner_tangent >= 0 && o->preconditioner_tangent < FCM_FICTITIOUS_MODEL_COUNT,
+            ctx, FCM_ERR_ARG,
+            "integrator: preconditioner_tangent = %d outside [0, 2] (projected, linear, exact)",
+            (int)o->preconditioner_tangent);
   FCM_CHECK(o->krylov_rtol >= 0.0 && o->krylov_rtol < 1.0, ctx, FCM_ERR_ARG,
             "integrator: krylov_rtol = %g outside [0, 1)", o->krylov_rtol);
   FCM_CHECK(o->krylov_atol >= 0.0 && isfinite(o->krylov_atol), ctx, FCM_ERR_ARG,

@@ -1,6 +1,7 @@
 /* sim: the linear solves of the Newton steps — CHOLMOD with UMFPACK as the fallback when
  * the matrix is not positive definite (symbolic analyses kept for the whole run), or CG /
- * MINRES with Jacobi, block Jacobi or additive Schwarz preconditioning (DESIGN §7). */
+ * MINRES with Jacobi, block Jacobi or additive Schwarz preconditioning (DESIGN §7), the
+ * preconditioner built from a PSD tangent by default (preconditioner_tangent). */
 #include "sim/sim_impl.h"
 #include "la/la_impl.h"
 
@@ -96,8 +97,65 @@ cleanup:
   return st;
 }
 
+/* The matrix the preconditioner is built from (issue 19): the eliminated Newton matrix H
+ * when its tangent is PSD already or preconditioner_tangent is EXACT; otherwise
+ * Hpc = base(h) + K_pc with the PSD-projected tangent at u (PROJECTED) or the linear-elastic
+ * stiffness at rest (LINEAR, assembled once into K0), eliminated like H. The exact tangent of
+ * the physical points makes the small cut-cell blocks of H indefinite or nearly singular,
+ * and their inverses poor; the PSD blocks of Hpc are positive definite (mass) and the
+ * preconditioner SPD, while MINRES still solves with H. */
+static fcm_status pc_matrix(fcm_integrator *I, fcm_csr **P, fcm_step_reason *reason,
+                            sim_stats *stats)
+{
+  fcm_status st = FCM_OK, s;
+  fcm_ctx *ctx = I->ctx;
+  const fcm_fictitious_model tm = I->opts.preconditioner_tangent;
+  *P = I->H;
+  if (tm == FCM_FICTITIOUS_EXACT || I->h_psd || I->opts.preconditioner == FCM_PRECOND_NONE)
+    return FCM_OK;
+  if (!I->Hpc) FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->Hpc));
+  fcm_index nnz = 0;
+  fcm_csr_get_size(I->Hpc, NULL, NULL, &nnz);
+  double *pv = fcm_csr_values(I->Hpc);
+  const double h = I->key_h;
+  if (h > 0.0) { /* base(h) = M/h^2 + D/h, as newton.c's set_base */
+    const double *mv = fcm_csr_values(I->M), a = 1.0 / (h * h);
+    for (fcm_index e = 0; e < nnz; e++)
+      pv[e] = a * mv[e];
+    if (I->D) {
+      const double *dv = fcm_csr_values(I->D);
+      for (fcm_index e = 0; e < nnz; e++)
+        pv[e] += dv[e] / h;
+    }
+  } else {
+    memset(pv, 0, sizeof *pv * (size_t)nnz);
+  }
+  if (tm == FCM_FICTITIOUS_LINEAR) {
+    if (!I->K0) {
+      fcm_linear_form form = fcm_linear_form_default();
+      form.term = FCM_LINEAR_STIFFNESS;
+      form.material = &I->mat;
+      FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->K0));
+      FCM_TRY(ctx, fcm_assembly_workspace_linear(I->aws, &form, I->K0, NULL));
+    }
+    const double *kv = fcm_csr_values(I->K0);
+    for (fcm_index e = 0; e < nnz; e++)
+      pv[e] += kv[e];
+  } else {
+    s = fcm_assembly_workspace_hyperelastic(I->aws, &I->params_psd, I->u, NULL, NULL, I->Hpc);
+    stats->tangent_assemblies++;
+    if (s != FCM_OK) return soft(I, s, reason);
+  }
+  /* Eliminate the active constraints as H was (zero prescribed values: only the matrix
+   * matters; w2 is scratch here). */
+  FCM_TRY(ctx, fcm_space_apply_dirichlet(I->space, I->nact, I->act_dof, NULL, I->Hpc, I->w2));
+  *P = I->Hpc;
+cleanup:
+  return st;
+}
+
 /* Schwarz with one block per flagged cell (cut cells with volume fraction below theta). */
-static fcm_status schwarz_create(fcm_integrator *I)
+static fcm_status schwarz_create(fcm_integrator *I, const fcm_csr *P)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = I->ctx;
@@ -106,7 +164,7 @@ static fcm_status schwarz_create(fcm_integrator *I)
   FCM_ALLOC(ctx, nb + 1, ptr);
   FCM_ALLOC(ctx, FCM_MAX(nd, 1), dofs);
   FCM_TRY(ctx, fcm_space_cell_blocks(I->space, I->schwarz_flag, &nb, &nd, ptr, dofs));
-  FCM_TRY(ctx, fcm_schwarz_create(ctx, I->H, nb, ptr, dofs, &I->opts.schwarz, &I->schwarz));
+  FCM_TRY(ctx, fcm_schwarz_create(ctx, P, nb, ptr, dofs, &I->opts.schwarz, &I->schwarz));
 cleanup:
   fcm__free(ctx, ptr);
   fcm__free(ctx, dofs);
@@ -117,24 +175,27 @@ static fcm_status setup_preconditioner(fcm_integrator *I, fcm_step_reason *reaso
 {
   fcm_status s = FCM_OK;
   fcm_ctx *ctx = I->ctx;
+  fcm_csr *P = NULL;
+  s = pc_matrix(I, &P, reason, stats);
+  if (s != FCM_OK || *reason != FCM_STEP_NONE) return s;
   switch (I->opts.preconditioner) {
   case FCM_PRECOND_NONE:
     return FCM_OK;
   case FCM_PRECOND_JACOBI:
   case FCM_PRECOND_BLOCK_JACOBI:
     if (I->jacobi)
-      s = fcm_jacobi_setup(I->jacobi, I->H);
+      s = fcm_jacobi_setup(I->jacobi, P);
     else
-      s = fcm_jacobi_create(ctx, I->H,
+      s = fcm_jacobi_create(ctx, P,
                             I->opts.preconditioner == FCM_PRECOND_JACOBI ? FCM_JACOBI_SCALAR
                                                                          : FCM_JACOBI_BLOCK3,
                             &I->jacobi);
     break;
   case FCM_PRECOND_SCHWARZ:
     if (I->schwarz)
-      s = fcm_schwarz_setup(I->schwarz, I->H);
+      s = fcm_schwarz_setup(I->schwarz, P);
     else
-      s = schwarz_create(I);
+      s = schwarz_create(I, P);
     break;
   }
   stats->factorizations++;

@@ -207,6 +207,7 @@ static fcm_status build_system(fcm_integrator *I, double h, int predictor, int p
   FCM_TRY(I->ctx, fcm_space_apply_dirichlet(I->space, I->nact, I->act_dof,
                                             predictor ? I->act_inc : NULL, I->H, I->b));
   I->h_state = SIM_H_SYSTEM;
+  I->h_psd = projected || I->opts.project_psd || I->linear;
   I->key_h = h;
   I->key_con = I->con_version;
   I->key_damp = I->damp_version;
