@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-int condition_write_csv(const char *path, const result *res, int nres, int project)
+int condition_write_csv(const char *path, const config *c, const result *res, int nres)
 {
   cli_output *out = NULL;
   FILE *f = cli_output_open(PROG, path, &out);
@@ -17,15 +17,16 @@ int condition_write_csv(const char *path, const result *res, int nres, int proje
   fprintf(f, "element,preconditioner,stabilization,min_volume_fraction,condition_number,"
              "nominal_fraction,lambda_min_abs,lambda_max_abs,negative_eigenvalues,dofs,"
              "schwarz_blocks,clamped_eigenvalues,minres_iterations,minres_reason,"
-             "minres_true_residual,tangent\n");
+             "minres_true_residual,tangent,fictitious,preconditioner_tangent\n");
   for (int k = 0; k < nres; k++) {
     const result *r = &res[k];
-    fprintf(f, "%s,%s,%g,%.6e,%.6e,%g,%.6e,%.6e,%lld,%lld,%lld,%lld,%d,%s,%.3e,%s\n",
+    fprintf(f, "%s,%s,%g,%.6e,%.6e,%g,%.6e,%.6e,%lld,%lld,%lld,%lld,%d,%s,%.3e,%s,%s,%s\n",
             fcm_element_get_info(r->element)->name, prec_names[r->prec], r->alpha, r->phi_min,
             r->kappa, r->phi_nominal, r->lmin_abs, r->lmax_abs, (long long)r->negative,
             (long long)r->dofs, (long long)r->blocks, (long long)r->clamped, r->iterations,
             fcm_krylov_reason_name(r->reason), r->true_residual,
-            project ? "projected" : "unprojected");
+            c->project ? "projected" : "unprojected", tangent_model_names[c->fictitious],
+            tangent_model_names[c->pc_tangent]);
   }
   return cli_output_commit(PROG, &out);
 }

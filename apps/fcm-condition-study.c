@@ -15,6 +15,8 @@
 #include <string.h>
 
 const char *const prec_names[PREC_COUNT] = {"none", "jacobi", "schwarz", "schwarz-paper"};
+const char *const tangent_model_names[FCM_FICTITIOUS_MODEL_COUNT + 1] = {"projected", "linear",
+                                                                         "exact", NULL};
 
 /* ---------------------------------------------------------------- one system */
 
@@ -179,7 +181,8 @@ static fcm_status system_build(fcm_ctx *ctx, const config *c, fcm_mesh *mesh, do
   for (fcm_index i = 0; i < nd; i++)
     s->map[i] = s->map[i] < 0 ? -1 : s->n++;
   TRY(reduce(ctx, s, s->A, &s->Af));
-  if (c->pc_tangent != FCM_FICTITIOUS_EXACT) { /* the preconditioners' operator */
+  /* the preconditioners' operator, unless A's tangent is PSD already */
+  if (c->pc_tangent != FCM_FICTITIOUS_EXACT && !c->project) {
     fcm_csr_destroy(&K);
     TRY(fcm_space_matrix_create(s->space, &P));
     TRY(fcm_space_matrix_create(s->space, &K));

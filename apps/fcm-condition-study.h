@@ -17,6 +17,9 @@
 enum { PREC_NONE, PREC_JACOBI, PREC_SCHWARZ, PREC_SCHWARZ_PAPER, PREC_COUNT };
 /** Names of the preconditioners, as on the command line and in the CSV. */
 extern const char *const prec_names[PREC_COUNT];
+/** Names of the tangent models in the order of fcm_fictitious_model ("projected", "linear",
+ *  "exact"; NULL-terminated), as on the command line and in the CSV. */
+extern const char *const tangent_model_names[FCM_FICTITIOUS_MODEL_COUNT + 1];
 
 /** The study's settings (fcm-condition.c fills them from the command line). */
 typedef struct config {
@@ -70,7 +73,7 @@ void condition_print_tables(const config *c, const result *res, int nres);
 
 /** The results as CSV at `path`, written atomically; 1 on success, 0 (message on stderr) on
  *  failure. */
-int condition_write_csv(const char *path, const result *res, int nres, int project);
+int condition_write_csv(const char *path, const config *c, const result *res, int nres);
 
 /** kappa against phi plotted with gnuplot into the PNG `path` (atomically); without gnuplot a
  *  message and success. 1 on success, 0 (message on stderr) on failure. */

@@ -8,7 +8,10 @@
  * quantity; eps = phi^(1/3)). Stable Neo-Hookean E = 3e6 Pa, nu = 0.4; u(X) = X_1 (1, 1, -1),
  * which vanishes on the clamped face X_1 = 0; dt = 1/60; K is the unprojected tangent at u
  * (possibly indefinite, then kappa = max|lambda| / min|lambda|). The clamped DOFs are
- * eliminated (removed), and every preconditioner is built on the reduced matrix. */
+ * eliminated (removed), and every preconditioner is built on the reduced matrix
+ * P = M + dt^2 K_pc with K_pc the PSD-projected tangent by default (--pc-tangent, as the
+ * integrator's preconditioner_tangent): the exact tangent's small cut-cell blocks are
+ * indefinite or nearly singular and their Schwarz inverses poor (issue 19). */
 #include "cli.h"
 #include "fcm-condition-study.h"
 #include "app_env.h"
@@ -122,8 +125,6 @@ typedef struct seen {
 
 static const char *const on_off[] = {"off", "on", NULL};
 static const char *const stab_modes[] = {"mass+stiffness", "mass", NULL};
-/* in the order of fcm_fictitious_model */
-static const char *const tangent_models[] = {"projected", "linear", "exact", NULL};
 
 #define NUM_OPTIONS 22
 static void option_table(config *c, int *stab_mode, seen *g, cli_option t[NUM_OPTIONS])
@@ -165,11 +166,13 @@ static void option_table(config *c, int *stab_mode, seen *g, cli_option t[NUM_OP
       {"--fictitious", NULL, CLI_CHOICE, &c->fictitious, "MODEL",
        "tangent at the stabilization points: projected |\n"
        "linear | exact                                 (default projected)", 0, 0, 0,
-       tangent_models, NULL, NULL},
+       tangent_model_names, NULL, NULL},
       {"--pc-tangent", NULL, CLI_CHOICE, &c->pc_tangent, "MODEL",
-       "tangent of the preconditioners' matrix: exact |\n"
-       "projected | linear (at rest)                   (default exact)", 0, 0, 0,
-       tangent_models, NULL, NULL},
+       "tangent the preconditioners are built from:\n"
+       "projected (PSD-projected at u) | linear (linear\n"
+       "elastic at rest) | exact (A itself); without\n"
+       "effect with --project on                       (default projected)", 0, 0, 0,
+       tangent_model_names, NULL, NULL},
       {"--density", NULL, CLI_DOUBLE, &c->density, "RHO",
        "density in kg/m^3, > 0                         (default 1000)", 0, HUGE_VAL, CLI_LO_OPEN,
        NULL, NULL, NULL},
@@ -214,7 +217,9 @@ static void usage(FILE *f)
           "S^(1/2) A S^(1/2); kappa = max|lambda| / min|lambda| (A may be indefinite). Values\n"
           "above ~1e13 are at the resolution of double precision (rounding-level eigenvalues).\n"
           "MINRES (x0 = 0, b = A 1, rtol on the preconditioned residual; unpreconditioned for\n"
-          "'none') is run on each system.\n"
+          "'none') is run on each system. The preconditioners are built from\n"
+          "P = M + dt^2 K_pc (--pc-tangent; the library's default, fcm_integrator_options.\n"
+          "preconditioner_tangent): A stays the Krylov operator.\n"
           "\n"
           "options:\n");
   cli_print_options(f, opts);
@@ -223,7 +228,8 @@ static void usage(FILE *f)
          "CSV columns: element,preconditioner,stabilization,min_volume_fraction,condition_number,\n"
          "  then nominal_fraction,lambda_min_abs,lambda_max_abs,negative_eigenvalues,dofs,\n"
          "  schwarz_blocks,clamped_eigenvalues,minres_iterations,minres_reason,\n"
-         "  minres_true_residual,tangent. stabilization is the weight factor alpha (0 = off);\n"
+         "  minres_true_residual,tangent,fictitious,preconditioner_tangent. stabilization is\n"
+         "  the weight factor alpha (0 = off); tangent projected|unprojected (--project);\n"
          "  min_volume_fraction the measured smallest phi of the non-empty cells.\n"
          "stdout: kappa and MINRES tables; stderr: progress. Exit 0 on success, 1 on a\n"
          "computation or output error, 2 on a usage error.\n");
@@ -289,7 +295,7 @@ int main(int argc, char **argv)
   c.rtol = 1e-8;
   c.u_scale = 1.0;
   c.fictitious = FCM_FICTITIOUS_PROJECTED;
-  c.pc_tangent = FCM_FICTITIOUS_EXACT;
+  c.pc_tangent = FCM_FICTITIOUS_PROJECTED;
   c.minres_max = 5000;
   if (!parse_fractions(PROG, "--fractions", "1:1e-12:13", &c)) return 2;
   if (!parse_args(argc, argv, &c)) return 2;
@@ -337,7 +343,7 @@ int main(int argc, char **argv)
   } else {
     fprintf(stderr, PROG ": %d results in %.1f s\n", nres, fcm_wtime() - t0);
     condition_print_tables(&c, res, nres);
-    if (c.csv && !condition_write_csv(c.csv, res, nres, c.project)) rc = 1;
+    if (c.csv && !condition_write_csv(c.csv, &c, res, nres)) rc = 1;
     if (c.png && !condition_write_png(&c, c.png, res, nres)) rc = 1;
   }
   free(res);

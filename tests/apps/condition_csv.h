@@ -9,10 +9,11 @@
 #define CONDITION_HEADER                                                                           \
   "element,preconditioner,stabilization,min_volume_fraction,condition_number,nominal_fraction,"    \
   "lambda_min_abs,lambda_max_abs,negative_eigenvalues,dofs,schwarz_blocks,clamped_eigenvalues,"    \
-  "minres_iterations,minres_reason,minres_true_residual,tangent\n"
+  "minres_iterations,minres_reason,minres_true_residual,tangent,fictitious,"                       \
+  "preconditioner_tangent\n"
 
 typedef struct cond_row {
-  char element[16], prec[16], reason[32], tangent[16];
+  char element[16], prec[16], reason[32], tangent[16], fictitious[16], pc_tangent[16];
   double alpha, phi_min, kappa, phi_nominal, lmin, lmax, true_res;
   long long negative, dofs, blocks, clamped;
   int iterations;
@@ -43,10 +44,11 @@ static int cond_read(const char *path, cond_row *rows, int cap)
     cond_row r;
     if (n >= cap ||
         sscanf(line,
-               "%15[^,],%15[^,],%lf,%lf,%lf,%lf,%lf,%lf,%lld,%lld,%lld,%lld,%d,%31[^,],%lf,%15s",
+               "%15[^,],%15[^,],%lf,%lf,%lf,%lf,%lf,%lf,%lld,%lld,%lld,%lld,%d,%31[^,],%lf,%15[^,],"
+               "%15[^,],%15s",
                r.element, r.prec, &r.alpha, &r.phi_min, &r.kappa, &r.phi_nominal, &r.lmin, &r.lmax,
                &r.negative, &r.dofs, &r.blocks, &r.clamped, &r.iterations, r.reason, &r.true_res,
-               r.tangent) != 16) {
+               r.tangent, r.fictitious, r.pc_tangent) != 18) {
       fclose(f);
       return -1;
     }

@@ -37,6 +37,9 @@ fcm_add_test(app_condition tests/apps/condition_app.c LABELS app
              ARGS $<TARGET_FILE:fcm-condition> ${work})
 fcm_add_test(app_condition_claims tests/apps/condition_claims.c LABELS app TIMEOUT 1200
              ARGS $<TARGET_FILE:fcm-condition> ${work})
+# the same with claim 5 on every decade 1..1e-12 (13 fractions) instead of every other one
+fcm_add_test(app_condition_claims_long tests/apps/condition_claims.c LABELS slow TIMEOUT 3600
+             ARGS $<TARGET_FILE:fcm-condition> ${work} full)
 fcm_add_test(dense_spectrum tests/apps/dense_spectrum.c)
 # fcm-converge: --quick CSV/PNG format, consistency and error exits, payoff --quick; the
 # convergence rates of the manufactured problem (quick set in the default run, the full

@@ -9,8 +9,11 @@
  * Newton at the scene's relative residual tolerance, 1e-5 by default, with MINRES at 1e-8;
  * measured: at most 5e-9). MINRES iterations per Newton step are
  * printed with "-v". Further arguments name the scenes to run (default: every scene of the
- * directory, at least five).
- * Usage: sim_minres_scenes SCENE_DIR STEPS [-v] [NAME.json ...] */
+ * directory, at least five, and the built-in default scene; "default" names the built-in
+ * one); "tangent=NAME" sets solver.preconditioner_tangent (default: the scene default,
+ * "projected": the Schwarz blocks are built from the PSD-projected tangent while MINRES
+ * solves the exact, unprojected Newton system).
+ * Usage: sim_minres_scenes SCENE_DIR STEPS [-v] [tangent=NAME] [default] [NAME.json ...] */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "test.h"
@@ -119,13 +122,20 @@ static void stop(run *r)
   fcm_scene_destroy(&r->scene);
 }
 
-static void check_scene(fcm_ctx *ctx, const char *path, const char *file, int steps, int verbose)
+static void check_scene(fcm_ctx *ctx, const char *path, const char *file, int steps, int verbose,
+                        const char *tangent)
 {
-  char *json = read_text(path);
+  /* "<default>": the built-in default scene */
+  char *json = strcmp(path, "<default>") ? read_text(path) : strdup(fcm_scene_default_json());
   TEST_TRUE(json != NULL);
   if (!json) return;
-  char *jm = with_solver(json, "\"method\": \"minres\", \"preconditioner\": \"schwarz\", "
-                               "\"rtol\": 1e-8, \"max_iterations\": 5000");
+  char ms[256];
+  snprintf(ms, sizeof ms,
+           "\"method\": \"minres\", \"preconditioner\": \"schwarz\", \"rtol\": 1e-8, "
+           "\"max_iterations\": 5000%s%s%s",
+           tangent ? ", \"preconditioner_tangent\": \"" : "", tangent ? tangent : "",
+           tangent ? "\"" : "");
+  char *jm = with_solver(json, ms);
   char *jd = with_solver(json, "\"method\": \"direct\", \"direct\": \"cholmod\"");
   TEST_TRUE(jm && jd);
   run m = {NULL, NULL}, d = {NULL, NULL};
@@ -176,11 +186,15 @@ int main(int argc, char **argv)
 {
   if (argc < 3) return 2;
   const int steps = atoi(argv[2]);
-  int verbose = 0, nsel = 0;
-  const char *sel[MAX_FILES];
+  int verbose = 0, nsel = 0, with_default = 0;
+  const char *sel[MAX_FILES], *tangent = NULL;
   for (int a = 3; a < argc; a++) {
     if (!strcmp(argv[a], "-v"))
       verbose = 1;
+    else if (!strncmp(argv[a], "tangent=", 8))
+      tangent = argv[a] + 8;
+    else if (!strcmp(argv[a], "default"))
+      with_default = 1;
     else if (nsel < MAX_FILES)
       sel[nsel++] = argv[a];
   }
@@ -200,10 +214,11 @@ int main(int argc, char **argv)
   if (dir) closedir(dir);
   qsort(files, (size_t)nf, sizeof *files, cmp_str);
   TEST_TRUE(nsel ? nf == nsel : nf >= 5);
+  if (with_default || nsel == 0) check_scene(ctx, "<default>", "<default>", steps, verbose, tangent);
   for (int i = 0; i < nf; i++) {
     char path[2048];
     snprintf(path, sizeof path, "%s/%s", argv[1], files[i]);
-    check_scene(ctx, path, files[i], steps, verbose);
+    check_scene(ctx, path, files[i], steps, verbose, tangent);
     free(files[i]);
   }
   fcm_ctx_destroy(&ctx);
