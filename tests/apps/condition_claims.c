@@ -17,7 +17,7 @@
  *    inertia along the sweep (Hex20: 146 negative eigenvalues at 1, 156 at 1e-2, 87 at
  *    1e-12), so eigenvalues cross zero between sweep points, and at a crossing kappa(S A) is
  *    unbounded for every SPD S (Sylvester: S^(1/2) A S^(1/2) keeps the inertia of A).
- *    Measured: Hex20 at 1e-2 has kappa(A) = 6.1e12 (kappa(S A) = 800x its value at 1);
+ *    Measured: Hex20 at 1e-2 has kappa(A) = 6.1e12 (kappa(S A) = 799x its value at 1);
  *    at most one such fraction per element is allowed, and there Schwarz must still divide
  *    kappa(A) by 1e3. Measured on the other fractions: at most 6.3x (Tet10) and 5.8x (Hex20).
  *    kappa(A) (a run without preconditioner) is measured only where the bound fails.
