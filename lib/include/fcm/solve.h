@@ -216,7 +216,11 @@ typedef struct fcm_schwarz_info {
 /** Additive Schwarz preconditioner S = sum_K R_K^T S_K R_K + D^{-1} (Longva et al. 2020,
  * §5.2): S_K is the reflected, clamped pseudo-inverse of the dense block C_K = R_K C R_K^T
  * of the system matrix C on the DOFs of block K; D^{-1} the inverse |diagonal| on the DOFs
- * outside all blocks. Stored as dense S_K, applied matrix-free. */
+ * outside all blocks. Stored as dense S_K, applied matrix-free. C need not be the matrix
+ * the Krylov method solves with: for an indefinite system A (the exact tangent of a large
+ * deformation), building S from a positive definite C close to A (the PSD-projected tangent:
+ * fcm_integrator_options.preconditioner_tangent in fcm/sim.h) gives well-conditioned blocks
+ * where the blocks of A itself are indefinite or nearly singular. */
 typedef struct fcm_schwarz fcm_schwarz;
 
 /** Create from the square matrix C and a list of blocks, and set up (fcm_schwarz_setup()).
