@@ -110,6 +110,7 @@ static fcm_status pc_matrix(fcm_integrator *I, fcm_csr **P, fcm_step_reason *rea
   fcm_status st = FCM_OK, s;
   fcm_ctx *ctx = I->ctx;
   const fcm_fictitious_model tm = I->opts.preconditioner_tangent;
+  fcm_csr *K0 = NULL;
   *P = I->H;
   if (tm == FCM_FICTITIOUS_EXACT || I->h_psd || I->opts.preconditioner == FCM_PRECOND_NONE)
     return FCM_OK;
@@ -131,12 +132,14 @@ static fcm_status pc_matrix(fcm_integrator *I, fcm_csr **P, fcm_step_reason *rea
     memset(pv, 0, sizeof *pv * (size_t)nnz);
   }
   if (tm == FCM_FICTITIOUS_LINEAR) {
-    if (!I->K0) {
+    if (!I->K0) { /* kept only when complete */
       fcm_linear_form form = fcm_linear_form_default();
       form.term = FCM_LINEAR_STIFFNESS;
       form.material = &I->mat;
-      FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->K0));
-      FCM_TRY(ctx, fcm_assembly_workspace_linear(I->aws, &form, I->K0, NULL));
+      FCM_TRY(ctx, fcm_space_matrix_create(I->space, &K0));
+      FCM_TRY(ctx, fcm_assembly_workspace_linear(I->aws, &form, K0, NULL));
+      I->K0 = K0;
+      K0 = NULL;
     }
     const double *kv = fcm_csr_values(I->K0);
     for (fcm_index e = 0; e < nnz; e++)
@@ -151,6 +154,7 @@ static fcm_status pc_matrix(fcm_integrator *I, fcm_csr **P, fcm_step_reason *rea
   FCM_TRY(ctx, fcm_space_apply_dirichlet(I->space, I->nact, I->act_dof, NULL, I->Hpc, I->w2));
   *P = I->Hpc;
 cleanup:
+  fcm_csr_destroy(&K0);
   return st;
 }
 
