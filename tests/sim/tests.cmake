@@ -29,6 +29,9 @@ fcm_sim_test(sim_minres_scenes tests/sim/minres_scenes.c
              ARGS ${PROJECT_SOURCE_DIR}/apps/scenes 1 slingshot.json spinning_body.json)
 fcm_sim_test(sim_minres_scenes_long tests/sim/minres_scenes.c LABELS slow
              ARGS ${PROJECT_SOURCE_DIR}/apps/scenes 10 TIMEOUT 3600)
+# Issue 19: the preconditioner's tangent (projected, linear, exact): each converges to the
+# direct solution on a hard twist of a Hex20 tube; the option is parsed and validated.
+fcm_sim_test(sim_minres_pc_tangent tests/sim/minres_pc_tangent.c)
 # Issue 19: numerically singular systems are refused by the direct path with the cause;
 # stabilized systems with tiny cut cells are not.
 fcm_sim_test(sim_singular tests/sim/singular.c)
