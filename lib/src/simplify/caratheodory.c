@@ -197,6 +197,7 @@ fcm_status fcm__simplify_run_eliminate(fcm__attempt *a)
     fcm__simplify_basis_eval(&a->box, a->points + 3 * (size_t)j, g + (size_t)j * (size_t)M);
     lam[j] = a->w0[j];
   }
+  fcm__simplify_set_moments(a, n, g, lam);
   a->time_basis += fcm_wtime() - t0;
   FCM_TRY(ctx, fcm__simplify_reduce(a, M, n, g, q, lam));
   if (a->reason != FCM_SIMPLIFY_REASON_NONE) goto cleanup;

@@ -79,6 +79,7 @@ fcm_status fcm__simplify_run_recombine(fcm__attempt *a)
       fcm__simplify_moments(&a->box, hi - lo, a->points, idx + lo, cw + lo,
                             g + (size_t)c * (size_t)M, acc);
     }
+    fcm__simplify_set_moments(a, K, g, NULL); /* the first round sees every point */
     a->time_basis += fcm_wtime() - t0;
     FCM_TRY(ctx, cluster_lp(a, M, K, g, q, rhs, lam));
     if (a->reason != FCM_SIMPLIFY_REASON_NONE) goto cleanup;
@@ -108,6 +109,7 @@ fcm_status fcm__simplify_run_recombine(fcm__attempt *a)
     for (int p = 0; p < M; p++)
       gi[p] *= cw[i];
   }
+  fcm__simplify_set_moments(a, nact, g, NULL); /* when no round ran */
   a->time_basis += fcm_wtime() - t0;
   FCM_TRY(ctx, cluster_lp(a, M, nact, g, q, rhs, lam));
   if (a->reason != FCM_SIMPLIFY_REASON_NONE) goto cleanup;

@@ -81,6 +81,18 @@ const char *fcm_simplify_reason_name(fcm_simplify_reason reason)
   }
 }
 
+void fcm__simplify_set_moments(fcm__attempt *a, int ncols, const double *g, const double *lam)
+{
+  const int M = a->box.num_basis;
+  if (a->have_moments) return;
+  for (int i = 0; i < M; i++)
+    a->moments[i] = 0.0;
+  for (int c = 0; c < ncols; c++)
+    for (int i = 0; i < M; i++)
+      a->moments[i] += (lam ? lam[c] : 1.0) * g[i + (size_t)c * (size_t)M];
+  a->have_moments = 1;
+}
+
 void fcm__simplify_fail(fcm__attempt *a, fcm_simplify_reason reason, const char *fmt, ...)
 {
   va_list ap;
@@ -153,6 +165,13 @@ static fcm_status refit_verify(fcm__attempt *a, double tol, double *residual)
   for (int c = 0; c < count; c++)
     fcm__simplify_basis_eval(&a->box, a->points + 3 * (size_t)a->support[c],
                              PS + (size_t)c * (size_t)M);
+  if (!a->have_moments) { /* no path got as far as evaluating the basis on every point */
+    double *scratch = NULL;
+    FCM_ALLOC(ctx, fcm__simplify_moments_scratch(a->box.m), scratch);
+    fcm__simplify_moments(&a->box, a->n, a->points, NULL, a->w0, a->moments, scratch);
+    fcm__free(ctx, scratch);
+    a->have_moments = 1;
+  }
   memcpy(A, PS, sizeof *A * (size_t)M * (size_t)count);
   memcpy(B, a->moments, sizeof *B * (size_t)M);
 
@@ -251,7 +270,7 @@ typedef struct simplify_run {
   double *packed;       /* np x 3 copy when some weights are zero, else NULL */
   const double *points; /* np x 3: the input or `packed` */
   double scale;         /* np / total weight: the attempts see mean-1 weights */
-  double *w0, *moments, *acc;
+  double *w0, *moments;
   fcm__attempt a;
 } simplify_run;
 
@@ -308,7 +327,8 @@ cleanup:
 }
 
 /* Set-up phase: mean-1 weights (with tiny weights GLPK reports "optimal" with w = 0,
- * notes §4), the attempt's buffers and parameters, and the moments in the box basis. */
+ * notes §4), the attempt's buffers and parameters and the box of the basis (the moments
+ * come from the first path that evaluates the basis on every point). */
 static fcm_status setup_attempt(simplify_run *r, int strength, const double *weights, double total,
                                 const fcm_simplify_options *o, int force_lp_failure)
 {
@@ -324,7 +344,6 @@ static fcm_status setup_attempt(simplify_run *r, int strength, const double *wei
   for (int k = 0; k < np; k++)
     r->w0[k] = weights[r->map[k]] * r->scale;
   FCM_ALLOC(ctx, (size_t)M, r->moments);
-  FCM_ALLOC(ctx, fcm__simplify_moments_scratch(strength), r->acc);
   FCM_ALLOC(ctx, (size_t)M, a->support);
   FCM_ALLOC(ctx, (size_t)M, a->w);
   a->ctx = ctx;
@@ -338,7 +357,6 @@ static fcm_status setup_attempt(simplify_run *r, int strength, const double *wei
   a->lp.force_failure = force_lp_failure;
   double t0 = fcm_wtime();
   fcm__simplify_box(strength, np, r->points, &a->box);
-  fcm__simplify_moments(&a->box, np, r->points, NULL, r->w0, r->moments, r->acc);
   a->time_basis += fcm_wtime() - t0;
 cleanup:
   return st;
@@ -519,7 +537,6 @@ cleanup:
   fcm__free(ctx, r.packed);
   fcm__free(ctx, r.w0);
   fcm__free(ctx, r.moments);
-  fcm__free(ctx, r.acc);
   fcm__free(ctx, r.a.support);
   fcm__free(ctx, r.a.w);
   return st;

@@ -84,7 +84,9 @@ typedef struct fcm__attempt {
   int n;                 /* points */
   const double *points;  /* n x 3 */
   const double *w0;      /* n weights normalized to mean 1 */
-  const double *moments; /* M moments of w0 in the box basis */
+  double *moments;       /* M moments of w0 in the box basis, valid once have_moments: the
+                            path that first evaluates the basis on all points sets them */
+  int have_moments;
   fcm__cheb_box box;
   double rank_tol;
   fcm__lp_params lp;
@@ -103,6 +105,10 @@ typedef struct fcm__attempt {
   int num_lps, num_eliminations, rounds;
   double time_basis, time_svd, time_lp;
 } fcm__attempt;
+
+/* Set a->moments (once) to the sum of the ncols columns of g (M rows, ld M) times lam
+ * (NULL: ones). */
+void fcm__simplify_set_moments(fcm__attempt *a, int ncols, const double *g, const double *lam);
 
 /* Record a soft failure of an attempt (the driver retries or falls back). */
 void fcm__simplify_fail(fcm__attempt *a, fcm_simplify_reason reason, const char *fmt, ...)
