@@ -1,5 +1,5 @@
-/* Simplification of positive rules for strengths m = 1..10 with the path given as
- * argv[1] ("lp", "recombine" or "eliminate"): random rules in a box, unions of conical rules on
+/* Simplification of positive rules for strengths m = 1..argv[2] (default 10) with the path
+ * given as argv[1] ("lp", "recombine" or "eliminate"): random rules in a box, unions of conical rules on
  * red-refined sub-tets of the unit tet (whole, and cut by a sphere). Each result has at
  * most M points, is an ascending subset of the input (hence inside the tet), has
  * positive weights and integrates every monomial of degree <= m like the input. */
@@ -48,10 +48,11 @@ int main(int argc, char **argv)
   fcm_simplify_method method = FCM_SIMPLIFY_LP;
   if (argc > 1 && !strcmp(argv[1], "recombine")) method = FCM_SIMPLIFY_RECOMBINE;
   if (argc > 1 && !strcmp(argv[1], "eliminate")) method = FCM_SIMPLIFY_ELIMINATE;
+  const int mmax = argc > 2 ? atoi(argv[2]) : 10;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
   if (!ctx) return TEST_RESULT();
 
-  for (int m = 1; m <= 10; m++) {
+  for (int m = 1; m <= mmax; m++) {
     const int M = util_num_basis(m);
     /* Random rules: the unit box around the origin and a small box far from it. */
     const int n = 4 * M + 7;

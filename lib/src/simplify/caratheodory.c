@@ -64,17 +64,40 @@ static void eliminate(tableau *t)
   }
 }
 
+/* Grow the attempt's scratch to nd doubles and ni ints (kept across rounds and attempts:
+ * one allocation per call of fcm_simplify instead of one per elimination). */
+static fcm_status reserve(fcm__attempt *a, size_t nd, size_t ni)
+{
+  fcm_status st = FCM_OK;
+  if (nd > a->ws_cap) {
+    FCM_FREE(a->ctx, a->ws);
+    a->ws_cap = 0;
+    FCM_ALLOC(a->ctx, nd, a->ws);
+    a->ws_cap = nd;
+  }
+  if (ni > a->iws_cap) {
+    FCM_FREE(a->ctx, a->iws);
+    a->iws_cap = 0;
+    FCM_ALLOC(a->ctx, ni, a->iws);
+    a->iws_cap = ni;
+  }
+cleanup:
+  return st;
+}
+
 fcm_status fcm__simplify_caratheodory(fcm__attempt *a, int rows, int ncols, const double *g,
                                       int ldg, double *lam, int *deficient)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = a->ctx;
   tableau t;
-  int *act = NULL;
   memset(&t, 0, sizeof t);
   *deficient = 0;
 
-  FCM_ALLOC(ctx, (size_t)ncols, act);
+  /* Scratch: act, ipiv, perm, id_b, id_n (ints); the tableau, lam_b, lam_n, f (doubles). */
+  const size_t nc = (size_t)ncols, nr = (size_t)rows;
+  FCM_TRY(ctx, reserve(a, nc * nr + 3 * nc, 4 * nc + 2 * nr));
+  int *act = a->iws;
   int K = 0;
   for (int c = 0; c < ncols; c++)
     if (lam[c] > 0.0) act[K++] = c;
@@ -82,14 +105,14 @@ fcm_status fcm__simplify_caratheodory(fcm__attempt *a, int rows, int ncols, cons
       lam[c] = 0.0;
   if (K <= rows) goto cleanup; /* already at most `rows` positive weights */
   t.rows = rows, t.K = K, t.kn = K - rows;
-  FCM_ALLOC(ctx, (size_t)K * (size_t)rows, t.at);
-  FCM_ALLOC(ctx, (size_t)rows, t.ipiv);
-  FCM_ALLOC(ctx, (size_t)K, t.perm);
-  FCM_ALLOC(ctx, (size_t)rows, t.id_b);
-  FCM_ALLOC(ctx, (size_t)t.kn, t.id_n);
-  FCM_ALLOC(ctx, (size_t)rows, t.lam_b);
-  FCM_ALLOC(ctx, (size_t)t.kn, t.lam_n);
-  FCM_ALLOC(ctx, (size_t)t.kn, t.f);
+  t.at = a->ws;
+  t.lam_b = t.at + (size_t)K * nr;
+  t.lam_n = t.lam_b + nr;
+  t.f = t.lam_n + t.kn;
+  t.ipiv = act + K;
+  t.perm = t.ipiv + rows;
+  t.id_b = t.perm + K;
+  t.id_n = t.id_b + rows;
 
   double t0 = fcm_wtime();
   for (int c = 0; c < K; c++) {
@@ -140,15 +163,6 @@ fcm_status fcm__simplify_caratheodory(fcm__attempt *a, int rows, int ncols, cons
   a->time_lp += fcm_wtime() - t0;
   a->num_eliminations++;
 cleanup:
-  fcm__free(ctx, act);
-  fcm__free(ctx, t.at);
-  fcm__free(ctx, t.ipiv);
-  fcm__free(ctx, t.perm);
-  fcm__free(ctx, t.id_b);
-  fcm__free(ctx, t.id_n);
-  fcm__free(ctx, t.lam_b);
-  fcm__free(ctx, t.lam_n);
-  fcm__free(ctx, t.f);
   return st;
 }
 

@@ -537,6 +537,8 @@ cleanup:
   fcm__free(ctx, r.packed);
   fcm__free(ctx, r.w0);
   fcm__free(ctx, r.moments);
+  fcm__free(ctx, r.a.ws);
+  fcm__free(ctx, r.a.iws);
   fcm__free(ctx, r.a.support);
   fcm__free(ctx, r.a.w);
   return st;

@@ -92,6 +92,9 @@ typedef struct fcm__attempt {
   fcm__lp_params lp;
   double pivot_tol; /* elimination: an LU pivot <= pivot_tol * max pivot means rank-deficient */
   int eliminate;    /* recombination: 1 rounds by Carathéodory elimination, 0 by SVD + GLPK */
+  double *ws;       /* elimination scratch, grown on demand, released by the driver */
+  int *iws;
+  size_t ws_cap, iws_cap;
   /* output: a support of at most `capacity` points with positive weights (normalized
    * scale), or reason != NONE with a message; counters and times accumulate */
   int capacity; /* of support and w */
