@@ -10,7 +10,8 @@
  * and each of the ten steps must converge with at least two Newton iterations (so repeated
  * Newton iterations, line searches and solves are what is counted). Frames, logs and
  * checkpoints are not part of a step and are not written here.
- * Usage: sim_step_alloc SOLVER [ELEMENT]  (ELEMENT: hex8 (default), tet10, hex20) */
+ * With "static" the scene is static instead (two load steps per step, no inertia or damping).
+ * Usage: sim_step_alloc SOLVER [ELEMENT] [static]  (ELEMENT: hex8 (default), tet10, hex20) */
 #include "fcm/fcm.h"
 #include "test.h"
 #include "test_alloc.h"
@@ -41,6 +42,7 @@ int main(int argc, char **argv)
   if (argc < 2) return 2;
   const char *solver = solver_json(argv[1]);
   const char *element = argc > 2 ? argv[2] : "hex8";
+  const int stat = argc > 3 && !strcmp(argv[3], "static");
   if (!solver) {
     fprintf(stderr, "unknown solver '%s'\n", argv[1]);
     return 2;
@@ -57,15 +59,17 @@ int main(int argc, char **argv)
            " \"quadrature\": {\"stiffness_strength\": 3,"
            " \"stabilization\": {\"mode\": \"mass_stiffness\", \"alpha\": 1e-8}},"
            " \"solver\": %s,"
-           " \"time\": {\"dt\": 0.02, \"duration\": 1},"
+           " \"time\": %s,"
            " \"effects\": ["
            "  {\"gravity\": {\"acceleration\": [0, -9.81, 0]}},"
            "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0.06, 0],"
            " \"normal\": [0, -1, 0]}}}},"
            "  {\"motion\": {\"region\": {\"box\": {\"min\": [-0.7, 0.6, -0.7],"
-           " \"max\": [0.7, 1.2, 0.7]}}, \"velocity\": [0, 0, 1.0], \"end\": 1}},"
-           "  {\"damping\": {\"stiffness\": 0.01, \"mass\": 0.1}}]}",
-           element, solver);
+           " \"max\": [0.7, 1.2, 0.7]}}, \"velocity\": [0, 0, 1.0], \"end\": 1}}%s]}",
+           element, solver,
+           stat ? "{\"static\": true, \"steps\": 20, \"load_steps\": 2}"
+                : "{\"dt\": 0.02, \"duration\": 1}",
+           stat ? "" : ", {\"damping\": {\"stiffness\": 0.01, \"mass\": 0.1}}");
 
   failing f;
   fcm_ctx *ctx = failing_ctx(&f);
