@@ -1,7 +1,12 @@
-# Quadrature simplification (both paths), its fallback, errors, allocation failures and
+# Quadrature simplification (every path), its fallback, errors, allocation failures and
 # threads; stabilization points; the benchmark (label bench, not in the default run).
-fcm_add_test(simplify_rules_lp tests/simplify/rules.c ARGS lp)
-fcm_add_test(simplify_rules_recombine tests/simplify/rules.c ARGS recombine)
+# The default path up to strength 10; the GLPK reference paths up to 7 (10 under slow).
+fcm_add_test(simplify_rules_eliminate tests/simplify/rules.c ARGS eliminate)
+fcm_add_test(simplify_rules_lp tests/simplify/rules.c ARGS lp 7)
+fcm_add_test(simplify_rules_recombine tests/simplify/rules.c ARGS recombine 7)
+fcm_add_test(simplify_rules_lp_full tests/simplify/rules.c ARGS lp 10 LABELS slow TIMEOUT 1800)
+fcm_add_test(simplify_rules_recombine_full tests/simplify/rules.c ARGS recombine 10 LABELS slow
+             TIMEOUT 1800)
 fcm_add_test(simplify_special tests/simplify/special.c)
 fcm_add_test(simplify_fallback tests/simplify/fallback.c)
 fcm_add_test(simplify_errors tests/simplify/errors.c)

@@ -83,7 +83,7 @@ typedef struct fcm_scene_quadrature {
                            a traction or pressure effect is present, else no surface rules) */
   int simplify;         /**< 1 (default): simplify cut-cell rules; 0: keep them */
   fcm_simplify_method simplify_method;     /**< "simplify_method": "auto" (default), "lp",
-                                                "recombine" */
+                                                "recombine", "eliminate" */
   fcm_stabilization_options stabilization; /**< "stabilization": mode "mass_stiffness"
                                                 (default), "mass", "off"; alpha in (0, 1],
                                                 default 1e-6 */

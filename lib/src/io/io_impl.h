@@ -24,7 +24,8 @@ typedef struct fcm__atomic_file {
   char *tmp_path;  /* the temporary (NULL once renamed or removed) */
   char *dir;       /* the target's directory */
   long long bytes; /* written so far */
-  int durable; /* fsync the file before the rename (the directory is synced after every rename) */
+  int durable; /* fsync the file before the rename and its directory after it; other files
+                  (frames, logs) are only renamed: whole or absent, not forced to disk */
   fcm__io_fault fault;
 } fcm__atomic_file;
 
@@ -46,8 +47,8 @@ fcm_status fcm__io_atomic_printf(fcm_ctx *ctx, fcm__atomic_file *af, const char 
 /* Text with the XML attribute escapes &amp; &lt; &gt; &quot; &apos;. */
 fcm_status fcm__io_atomic_write_xml(fcm_ctx *ctx, fcm__atomic_file *af, const char *text);
 
-/* fflush, optional fsync, fclose (each checked), then rename over the target and fsync
- * the directory. On any failure before the rename the temporary is removed,
+/* fflush, fsync when durable, fclose (each checked), then rename over the target and,
+ * when durable, fsync the directory. On any failure before the rename the temporary is removed,
  * the target is untouched and FCM_ERR_IO names the path and the system error (a failing
  * directory sync is FCM_ERR_IO too, with the new file in place). `af` is released either
  * way. */
