@@ -265,9 +265,12 @@ FCM_API fcm_status fcm_integrator_setup(fcm_integrator *integ);
  * loads from those of the last accepted step — zero before the first — in load_steps
  * increments). A failed (sub)step is retried from its start with half the increment, at
  * most max_halvings times. On failure the state (u, v, t, step count) stays at the last
- * accepted step. The integrator's own arrays are all allocated by the setup; what still
- * allocates is the fem assembly (per-call scratch), the symmetric elimination (O(n) flags),
- * the first UMFPACK fallback and the Jacobi/Schwarz preconditioner (created on first use).
+ * accepted step. Allocation through the context happens in the setup and on first use only:
+ * the assembly workspace, work vectors and the direct solver's symbolic analysis come from
+ * the setup; the tabulated standard rule of an integrand the setup did not assemble, the
+ * Jacobi/Schwarz preconditioner and the UMFPACK fallback are made the first time they are
+ * needed. Later steps allocate nothing through the context (test sim_step_alloc_*);
+ * CHOLMOD's and UMFPACK's numeric factorizations allocate internally (SuiteSparse's malloc).
  * @param[out] info may be NULL
  * @return FCM_OK; FCM_ERR_NOT_CONVERGED (info->reason says why; the message gives the time,
  * the residual and the tolerance); FCM_ERR_NUMERIC (NaN/Inf in a load, or the last attempt

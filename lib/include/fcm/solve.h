@@ -233,7 +233,9 @@ typedef struct fcm_schwarz fcm_schwarz;
  * @param[in]  opts       options, NULL for defaults
  * @param[out] P          the new preconditioner, NULL on failure
  * @return FCM_OK, FCM_ERR_ARG (bad block: the message names it and the DOF), and the
- * codes of fcm_schwarz_setup(). Allocates the blocks (sum of squared sizes) and O(n).
+ * codes of fcm_schwarz_setup(). Allocates the blocks (sum of squared sizes), O(n), and the
+ * setup scratch of omp_get_max_threads() threads (a largest block, its eigenvalues and
+ * dsyevd workspace each), so that fcm_schwarz_setup() allocates nothing.
  * Blocks of cells of a finite element space: fcm_space_cell_blocks() (fcm/fem.h). Thread
  * safe. */
 FCM_API fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
@@ -242,11 +244,12 @@ FCM_API fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index 
 
 /** Recompute the blocks and the diagonal from new values of C (same size): dense block
  * gather, symmetric eigendecomposition (LAPACK dsyevd, lower triangle), eigenvalue
- * reflection and clamping, S_K = V diag(s) V^T. Parallel over blocks (OpenMP); each block
- * is computed by one thread, so the result does not depend on the thread count.
+ * reflection and clamping, S_K = V diag(s) V^T. Parallel over blocks (OpenMP, at most the
+ * thread count of the creation); each block is computed by one thread, so the result does
+ * not depend on the thread count.
  * @return FCM_OK, FCM_ERR_ARG (size mismatch), FCM_ERR_SINGULAR (a zero block or a zero
  * diagonal outside the blocks: named), FCM_ERR_NUMERIC (NaN/Inf in a block or on the
- * diagonal: named), FCM_ERR_LAPACK, FCM_ERR_ALLOC. Allocates per-thread block buffers. */
+ * diagonal: named), FCM_ERR_LAPACK. No allocation (scratch from fcm_schwarz_create()). */
 FCM_API fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C);
 
 /** z = S r (n entries each, must not overlap). No allocation. One parallel loop over the

@@ -324,6 +324,36 @@ cleanup:
   return st;
 }
 
+void fcm__eliminate_marked(fcm_csr *A, double *b, const unsigned char *con, const double *g)
+{
+  fcm_index n = 0;
+  fcm_csr_get_size(A, &n, NULL, NULL);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  double *v = fcm_csr_values(A);
+#pragma omp parallel for schedule(static)
+  for (fcm_index i = 0; i < n; i++) {
+    if (con[i]) {
+      double diag = 1.0;
+      for (fcm_index e = rp[i]; e < rp[i + 1]; e++) {
+        if (ci[e] == i && v[e] > 0.0) diag = v[e];
+        v[e] = 0.0;
+      }
+      for (fcm_index e = rp[i]; e < rp[i + 1]; e++)
+        if (ci[e] == i) v[e] = diag;
+      b[i] = diag * g[i];
+    } else {
+      double acc = 0.0;
+      for (fcm_index e = rp[i]; e < rp[i + 1]; e++)
+        if (con[ci[e]]) {
+          acc += v[e] * g[ci[e]];
+          v[e] = 0.0;
+        }
+      b[i] -= acc;
+    }
+  }
+}
+
 fcm_status fcm_space_apply_dirichlet(const fcm_space *s, fcm_index ncon, const fcm_index *dofs,
                                      const double *values, fcm_csr *A, double *b)
 {
@@ -348,32 +378,7 @@ fcm_status fcm_space_apply_dirichlet(const fcm_space *s, fcm_index ncon, const f
     con[d] = 1;
     g[d] = values ? values[k] : 0.0;
   }
-  {
-    const fcm_index *rp = fcm_csr_row_ptr(A);
-    const int *ci = fcm_csr_col_idx(A);
-    double *v = fcm_csr_values(A);
-#pragma omp parallel for schedule(static)
-    for (fcm_index i = 0; i < n; i++) {
-      if (con[i]) {
-        double diag = 1.0;
-        for (fcm_index e = rp[i]; e < rp[i + 1]; e++) {
-          if (ci[e] == i && v[e] > 0.0) diag = v[e];
-          v[e] = 0.0;
-        }
-        for (fcm_index e = rp[i]; e < rp[i + 1]; e++)
-          if (ci[e] == i) v[e] = diag;
-        b[i] = diag * g[i];
-      } else {
-        double acc = 0.0;
-        for (fcm_index e = rp[i]; e < rp[i + 1]; e++)
-          if (con[ci[e]]) {
-            acc += v[e] * g[ci[e]];
-            v[e] = 0.0;
-          }
-        b[i] -= acc;
-      }
-    }
-  }
+  fcm__eliminate_marked(A, b, con, g);
 cleanup:
   fcm__free(ctx, con);
   fcm__free(ctx, g);

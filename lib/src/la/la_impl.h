@@ -31,6 +31,16 @@ void fcm__trsm_right_unit_lower(int m, int n, double alpha, const double *a, int
  * converge, FCM_ERR_NUMERIC on NaN/Inf input. */
 fcm_status fcm__syev(fcm_ctx *ctx, int want_vectors, int n, double *a, int lda, double *w);
 
+/* Workspace of fcm__syev_work() for order n: *lwork doubles and *liwork ints (dsyevd's
+ * query, plus one). */
+fcm_status fcm__syev_workspace(fcm_ctx *ctx, int want_vectors, int n, size_t *lwork,
+                               size_t *liwork);
+
+/* fcm__syev() with caller workspace of at least the sizes fcm__syev_workspace() gives for n:
+ * allocates nothing, same result (FCM_ERR_INTERNAL when the workspace is too small). */
+fcm_status fcm__syev_work(fcm_ctx *ctx, int want_vectors, int n, double *a, int lda, double *w,
+                          double *work, size_t lwork, int *iwork, size_t liwork);
+
 /* Eigenvalues (ascending, into d) and optionally eigenvectors (z, n x n, ldz) of
  * the symmetric tridiagonal matrix with diagonal d[0..n) and off-diagonal
  * e[0..n-1) (e is destroyed). z == NULL: eigenvalues only. */

@@ -88,24 +88,71 @@ cleanup:
   return st;
 }
 
-fcm_status fcm__syev(fcm_ctx *ctx, int want_vectors, int n, double *a, int lda, double *w)
+/* dsyevd's workspace query for order n (depends on n and jobz only). */
+static fcm_status syev_query(fcm_ctx *ctx, char jobz, int n, lapack_int *lwork, lapack_int *liwork)
 {
   fcm_status st = FCM_OK;
-  double *work = NULL, qwork;
-  lapack_int *iwork = NULL, qiwork, info;
+  double qwork = 0.0, a = 0.0, w = 0.0;
+  lapack_int qiwork = 0;
+  lapack_int info =
+      LAPACKE_dsyevd_work(LAPACK_COL_MAJOR, jobz, 'L', n, &a, FCM_MAX(1, n), &w, &qwork, -1,
+                          &qiwork, -1);
+  FCM_TRY(ctx, lapack_info(ctx, "dsyevd (workspace query)", info));
+  *lwork = (lapack_int)qwork;
+  *liwork = qiwork;
+cleanup:
+  return st;
+}
+
+fcm_status fcm__syev_workspace(fcm_ctx *ctx, int want_vectors, int n, size_t *lwork,
+                               size_t *liwork)
+{
+  fcm_status st = FCM_OK;
+  lapack_int lw = 0, liw = 0;
+  FCM_CHECK(n >= 0, ctx, FCM_ERR_ARG, "syev workspace: n = %d must be >= 0", n);
+  if (n > 0) FCM_TRY(ctx, syev_query(ctx, want_vectors ? 'V' : 'N', n, &lw, &liw));
+  *lwork = (size_t)lw + 1;
+  *liwork = (size_t)liw + 1;
+cleanup:
+  return st;
+}
+
+fcm_status fcm__syev_work(fcm_ctx *ctx, int want_vectors, int n, double *a, int lda, double *w,
+                          double *work, size_t lwork, int *iwork, size_t liwork)
+{
+  fcm_status st = FCM_OK;
+  lapack_int qwork = 0, qiwork = 0, info;
   char jobz = want_vectors ? 'V' : 'N';
   FCM_CHECK(n >= 0 && lda >= FCM_MAX(1, n), ctx, FCM_ERR_ARG, "syev: n = %d, lda = %d", n, lda);
   if (n == 0) goto cleanup;
   FCM_TRY(ctx, check_finite_part(ctx, "dsyevd", n, n, a, lda, 1));
-  info = LAPACKE_dsyevd_work(LAPACK_COL_MAJOR, jobz, 'L', n, a, lda, w, &qwork, -1, &qiwork, -1);
-  FCM_TRY(ctx, lapack_info(ctx, "dsyevd (workspace query)", info));
-  FCM_ALLOC(ctx, (size_t)qwork + 1, work);
-  FCM_ALLOC(ctx, (size_t)qiwork + 1, iwork);
-  info = LAPACKE_dsyevd_work(LAPACK_COL_MAJOR, jobz, 'L', n, a, lda, w, work, (lapack_int)qwork,
-                             iwork, qiwork);
+  /* exactly the queried sizes, whatever the caller holds: the result does not depend on it */
+  FCM_TRY(ctx, syev_query(ctx, jobz, n, &qwork, &qiwork));
+  FCM_CHECK((size_t)qwork < lwork && (size_t)qiwork < liwork, ctx, FCM_ERR_INTERNAL,
+            "syev: workspace of %zu doubles and %zu integers, n = %d needs %lld and %lld", lwork,
+            liwork, n, (long long)qwork + 1, (long long)qiwork + 1);
+  info = LAPACKE_dsyevd_work(LAPACK_COL_MAJOR, jobz, 'L', n, a, lda, w, work, qwork, iwork,
+                             qiwork);
   FCM_CHECK(info <= 0, ctx, FCM_ERR_LAPACK,
             "dsyevd: eigenvalue iteration failed to converge (info = %d) for n = %d", (int)info, n);
   FCM_TRY(ctx, lapack_info(ctx, "dsyevd", info));
+cleanup:
+  return st;
+}
+
+fcm_status fcm__syev(fcm_ctx *ctx, int want_vectors, int n, double *a, int lda, double *w)
+{
+  fcm_status st = FCM_OK;
+  double *work = NULL;
+  lapack_int *iwork = NULL;
+  size_t lwork = 0, liwork = 0;
+  FCM_CHECK(n >= 0 && lda >= FCM_MAX(1, n), ctx, FCM_ERR_ARG, "syev: n = %d, lda = %d", n, lda);
+  if (n == 0) goto cleanup;
+  FCM_TRY(ctx, check_finite_part(ctx, "dsyevd", n, n, a, lda, 1));
+  FCM_TRY(ctx, fcm__syev_workspace(ctx, want_vectors, n, &lwork, &liwork));
+  FCM_ALLOC(ctx, lwork, work);
+  FCM_ALLOC(ctx, liwork, iwork);
+  FCM_TRY(ctx, fcm__syev_work(ctx, want_vectors, n, a, lda, w, work, lwork, iwork, liwork));
 cleanup:
   fcm__free(ctx, work);
   fcm__free(ctx, iwork);

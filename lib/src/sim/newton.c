@@ -10,6 +10,7 @@
  * constrained DOFs, snapped exactly); afterwards the constrained increments are zero and
  * the free DOFs descend the energy with the line search. */
 #include "sim/sim_impl.h"
+#include "fem/fem_impl.h"
 
 #include <float.h>
 #include <math.h>
@@ -204,8 +205,11 @@ static fcm_status build_system(fcm_integrator *I, double h, int predictor, int p
     fcm_csr_get_size(I->H, NULL, NULL, &nnz);
     memcpy(fcm_csr_values(I->H0), fcm_csr_values(I->H), sizeof(double) * (size_t)nnz);
   }
-  FCM_TRY(I->ctx, fcm_space_apply_dirichlet(I->space, I->nact, I->act_dof,
-                                            predictor ? I->act_inc : NULL, I->H, I->b));
+  /* fcm_space_apply_dirichlet's elimination on the integrator's own marks (is_con is the
+   * active set act_dof; w1 carries the increments there): nothing allocated per iteration. */
+  for (fcm_index j = 0; j < I->nact; j++)
+    I->w1[I->act_dof[j]] = predictor ? I->act_inc[j] : 0.0;
+  fcm__eliminate_marked(I->H, I->b, I->is_con, I->w1);
   I->h_state = SIM_H_SYSTEM;
   I->h_psd = projected || I->opts.project_psd || I->linear;
   I->key_h = h;

@@ -41,6 +41,13 @@ struct fcm_schwarz {
   double *dinv;          /* n: 1/|c_ii| outside the blocks, 0 inside */
   fcm_schwarz_info info;
   int ready;
+  /* Setup scratch, allocated at creation so a setup allocates nothing: per thread (nt of
+   * them) a max_m^2 block, max_m eigenvalues and lwork doubles of eigensolver workspace
+   * (per_thread doubles in all), and liwork ints. */
+  int nt;
+  size_t per_thread, lwork, liwork;
+  double *work;
+  int *iwork;
 };
 
 fcm_schwarz_options fcm_schwarz_options_default(void)
@@ -65,6 +72,8 @@ void fcm_schwarz_destroy(fcm_schwarz **P)
   fcm__free(ctx, p->inc_row);
   fcm__free(ctx, p->inside);
   fcm__free(ctx, p->dinv);
+  fcm__free(ctx, p->work);
+  fcm__free(ctx, p->iwork);
   fcm__free(ctx, p);
   *P = NULL;
 }
@@ -128,7 +137,8 @@ typedef struct block_stats {
 
 /* Gather C_K into a (m x m), eigendecompose, and write S_K. */
 static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *vals, fcm_index b,
-                              double *a, double *w, block_stats *bs, block_fail *fail)
+                              double *a, double *w, double *lw, int *iw, block_stats *bs,
+                              block_fail *fail)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P->ctx;
@@ -145,7 +155,7 @@ static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *va
       }
       a[i + (size_t)j * m] = v;
     }
-  st = fcm__syev(ctx, 1, m, a, m, w);
+  st = fcm__syev_work(ctx, 1, m, a, m, w, lw, P->lwork, iw, P->liwork);
   if (st != FCM_OK) {
     *fail = st == FCM_ERR_ALLOC ? FAIL_NONE : FAIL_LAPACK;
     return st;
@@ -182,7 +192,6 @@ fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P ? P->ctx : NULL;
-  double *work = NULL;
   fcm_index nr = -1, nc = -1;
   double t0 = fcm_wtime();
   FCM_CHECK(P && C, ctx, FCM_ERR_ARG, "schwarz_setup: NULL argument");
@@ -209,21 +218,21 @@ fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
   }
 
   const fcm_index nb = P->num_blocks;
-  const int nt = omp_get_max_threads();
-  const size_t per_thread = (size_t)P->max_m * (size_t)P->max_m + (size_t)P->max_m;
   fcm_index bad = -1, negative = 0, clamped = 0;
   fcm_status bad_st = FCM_OK;
   block_fail bad_fail = FAIL_NONE;
-  if (nb > 0) FCM_ALLOC(ctx, per_thread * (size_t)nt, work);
-#pragma omp parallel num_threads(nt) if (nb > 1) reduction(+ : negative, clamped)
+#pragma omp parallel num_threads(P->nt) if (nb > 1) reduction(+ : negative, clamped)
   if (nb > 0) {
-    double *a = work + per_thread * (size_t)omp_get_thread_num();
+    const int t = omp_get_thread_num();
+    double *a = P->work + P->per_thread * (size_t)t;
     double *w = a + (size_t)P->max_m * (size_t)P->max_m;
+    double *lw = w + P->max_m;
+    int *iw = P->iwork + P->liwork * (size_t)t;
 #pragma omp for schedule(dynamic, 1)
     for (fcm_index b = 0; b < nb; b++) {
       block_stats bs = {0, 0};
       block_fail fail = FAIL_NONE;
-      fcm_status s = build_block(P, C, vals, b, a, w, &bs, &fail);
+      fcm_status s = build_block(P, C, vals, b, a, w, lw, iw, &bs, &fail);
       negative += bs.negative;
       clamped += bs.clamped;
       if (s != FCM_OK) {
@@ -258,7 +267,6 @@ fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
   P->info.setup_time = fcm_wtime() - t0;
   P->ready = 1;
 cleanup:
-  fcm__free(ctx, work);
   return st;
 }
 
@@ -334,6 +342,22 @@ fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_bloc
   }
   FCM_ALLOC(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->S);
   FCM_TRY(ctx, incidence_and_colors(P));
+  /* setup scratch: the eigensolver workspace of the largest need over the block sizes */
+  P->nt = omp_get_max_threads();
+  for (fcm_index b = 0, m_prev = -1; b < num_blocks; b++) {
+    const fcm_index m = block_ptr[b + 1] - block_ptr[b];
+    size_t lw = 0, liw = 0;
+    if (m == m_prev) continue;
+    m_prev = m;
+    FCM_TRY(ctx, fcm__syev_workspace(ctx, 1, (int)m, &lw, &liw));
+    P->lwork = FCM_MAX(P->lwork, lw);
+    P->liwork = FCM_MAX(P->liwork, liw);
+  }
+  P->per_thread = (size_t)max_m * (size_t)max_m + (size_t)max_m + P->lwork;
+  if (num_blocks > 0) {
+    FCM_ALLOC(ctx, P->per_thread * (size_t)P->nt, P->work);
+    FCM_ALLOC(ctx, P->liwork * (size_t)P->nt, P->iwork);
+  }
   P->info.num_blocks = num_blocks;
   P->info.block_dofs = total;
   P->info.max_block_size = max_m;
