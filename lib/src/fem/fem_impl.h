@@ -39,8 +39,8 @@ struct fcm_space {
 
 /* The elimination of fcm_space_apply_dirichlet() on a square A (n x n) with the constrained
  * DOFs already marked: con[i] = 1 for a constrained DOF i (n flags) and g[i] its prescribed
- * value (read only where con[i] = 1). Allocates nothing: the integrator calls it every Newton
- * iteration with its own marks. (space.c) */
+ * value (read only where con[i] = 1); b == NULL: the matrix only (g unused). Allocates
+ * nothing: the integrator calls it every Newton iteration with its own marks. (space.c) */
 void fcm__eliminate_marked(fcm_csr *A, double *b, const unsigned char *con, const double *g);
 
 #endif /* FCM_FEM_IMPL_H */

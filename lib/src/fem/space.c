@@ -341,15 +341,15 @@ void fcm__eliminate_marked(fcm_csr *A, double *b, const unsigned char *con, cons
       }
       for (fcm_index e = rp[i]; e < rp[i + 1]; e++)
         if (ci[e] == i) v[e] = diag;
-      b[i] = diag * g[i];
+      if (b) b[i] = diag * g[i];
     } else {
       double acc = 0.0;
       for (fcm_index e = rp[i]; e < rp[i + 1]; e++)
         if (con[ci[e]]) {
-          acc += v[e] * g[ci[e]];
+          if (b) acc += v[e] * g[ci[e]];
           v[e] = 0.0;
         }
-      b[i] -= acc;
+      if (b) b[i] -= acc;
     }
   }
 }

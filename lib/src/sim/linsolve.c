@@ -3,6 +3,7 @@
  * MINRES with Jacobi, block Jacobi or additive Schwarz preconditioning (DESIGN §7), the
  * preconditioner built from a PSD tangent by default (preconditioner_tangent). */
 #include "sim/sim_impl.h"
+#include "fem/fem_impl.h"
 #include "la/la_impl.h"
 
 #include <math.h>
@@ -149,9 +150,8 @@ static fcm_status pc_matrix(fcm_integrator *I, fcm_csr **P, fcm_step_reason *rea
     stats->tangent_assemblies++;
     if (s != FCM_OK) return soft(I, s, reason);
   }
-  /* Eliminate the active constraints as H was (zero prescribed values: only the matrix
-   * matters; w2 is scratch here). */
-  FCM_TRY(ctx, fcm_space_apply_dirichlet(I->space, I->nact, I->act_dof, NULL, I->Hpc, I->w2));
+  /* Eliminate the active constraints as H was (only the matrix matters; nothing allocated). */
+  fcm__eliminate_marked(I->Hpc, NULL, I->is_con, NULL);
   *P = I->Hpc;
 cleanup:
   fcm_csr_destroy(&K0);
