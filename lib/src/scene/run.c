@@ -737,7 +737,7 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
       const fcm_simplify_decision *d = &rs->decision[k];
       char what[64];
-      snprintf(what, sizeof what, "%s rule simplification", kinds[k]);
+      snprintf(what, sizeof what, "%s simplification", kinds[k]);
       if (q->simplify == FCM_CELL_SIMPLIFY_AUTO)
         snprintf(b, sizeof b,
                  "auto: %s for %g expected assemblies; cost model %.3g core-s per point per "
