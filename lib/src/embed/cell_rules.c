@@ -52,17 +52,16 @@ int fcm_simplify_pays(double assemblies, double point_cost, double points_before
 }
 
 /* Core-seconds per cut-cell point per assembly. Measured with
- *   OMP_NUM_THREADS=1 fcm-converge payoff --csv payoff.csv
+ *   OMP_NUM_THREADS=1 OMP_WAIT_POLICY=passive fcm-converge payoff --csv payoff.csv
  * (column point_cost: the CPU time an assembly saves divided by the points it saves, on the
- * hemisphere at res 8 with the elements' default strengths); re-measure after a change of
- * the assembly kernels. */
+ * hemisphere at res 8, geometry n 8, with the elements' default strengths; 2026-11-23, one
+ * core of the 2-core development machine); re-measure after a change of the assembly
+ * kernels. */
 double fcm_cell_rules_point_cost(fcm_element_type type, fcm_rule_kind kind)
 {
   static const double cost[FCM_ELEMENT_COUNT][FCM_RULE_KIND_COUNT] = {
-      [FCM_ELEMENT_TET4] = {1.0e-6, 1.0e-7},
-      [FCM_ELEMENT_TET10] = {1.0e-6, 1.0e-7},
-      [FCM_ELEMENT_HEX8] = {1.0e-6, 1.0e-7},
-      [FCM_ELEMENT_HEX20] = {1.0e-6, 1.0e-7},
+      [FCM_ELEMENT_TET4] = {4.84e-7, 7.90e-8},  [FCM_ELEMENT_TET10] = {1.24e-6, 1.29e-7},
+      [FCM_ELEMENT_HEX8] = {9.27e-7, 9.98e-8},  [FCM_ELEMENT_HEX20] = {3.55e-6, 2.45e-7},
   };
   if ((int)type < 0 || type >= FCM_ELEMENT_COUNT || (int)kind < 0 || kind >= FCM_RULE_KIND_COUNT)
     return 0.0;
