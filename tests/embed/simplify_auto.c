@@ -78,13 +78,18 @@ static void check_decision(const fcm_cell_rules *r, int expect_simplified, int e
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     const fcm_simplify_decision *d = &S->decision[k];
     TEST_TRUE(d->simplified == expect_simplified);
-    TEST_TRUE(expect_probe ? d->probe_cells == 3 : d->probe_cells == 0);
+    /* the probe stops early only when the estimates differ by more than 4x */
+    TEST_TRUE(expect_probe ? d->probe_cells >= 1 && d->probe_cells <= 3 : d->probe_cells == 0);
+    if (expect_probe && d->probe_cells < 3)
+      TEST_TRUE(d->cost_plain > 4.0 * d->cost_simplified ||
+                d->cost_simplified > 4.0 * d->cost_plain);
     const double n = (double)S->points_initial[k], A = d->expected_assemblies;
     TEST_NEAR(d->cost_plain, n * d->point_cost * A, 1e-14, 0.0);
     if (!expect_probe) continue;
     TEST_TRUE(d->probe_points > d->probe_kept && d->probe_time > 0.0);
     TEST_NEAR(d->estimated_time, d->probe_time * n / (double)d->probe_points, 1e-14, 0.0);
-    TEST_NEAR(d->estimated_kept, (double)d->probe_kept * (double)S->num_cut / 3.0, 1e-14, 0.0);
+    TEST_NEAR(d->estimated_kept, (double)d->probe_kept * (double)S->num_cut / (double)d->probe_cells,
+              1e-14, 0.0);
     TEST_NEAR(d->cost_simplified, d->estimated_time + d->estimated_kept * d->point_cost * A, 1e-14,
               0.0);
     TEST_TRUE(d->simplified == fcm_simplify_pays(A, d->point_cost, n, d->estimated_kept,

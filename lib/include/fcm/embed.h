@@ -81,8 +81,10 @@ typedef struct fcm_cell_rules_options {
                               Newton iterations stiffness, 1 mass (assembled once); default 1 */
   double point_cost[FCM_RULE_KIND_COUNT]; /**< AUTO: core-seconds per point per assembly, > 0;
                               FCM_DEFAULT (default): fcm_cell_rules_point_cost() */
-  int probe_cells;       /**< AUTO: cut cells per kind simplified to measure the simplification
-                              time, >= 1; default 4 */
+  int probe_cells;       /**< AUTO: at most this many cut cells per kind are simplified to
+                              measure the simplification time (in rounds of one per thread,
+                              stopping once the two cost estimates differ by more than 4x),
+                              >= 1; default 4 */
   fcm_simplify_options simplify_options; /**< default fcm_simplify_options_default() */
   double max_rule_memory; /**< bytes the rules of one cut cell may take to build (an estimate
                                checked before allocating: points of both kinds plus the
@@ -102,7 +104,8 @@ typedef struct fcm_simplify_decision {
   int simplified;             /**< 1: the cut-cell rules of this kind were simplified */
   double expected_assemblies; /**< input of the model */
   double point_cost;          /**< input: core-seconds per point per assembly */
-  fcm_index probe_cells;      /**< cut cells simplified to measure the cost */
+  fcm_index probe_cells;      /**< cut cells simplified to measure the cost (0: no probe, when
+                                   no assembly is expected or no cell is cut) */
   fcm_index probe_points;     /**< their points before simplification */
   fcm_index probe_kept;       /**< and after */
   double probe_time;          /**< their simplification time */

@@ -499,6 +499,9 @@ cleanup:
   return st;
 }
 
+/* AUTO stops probing once the two cost estimates differ by more than this factor. */
+#define AUTO_PROBE_MARGIN 4.0
+
 /* What a loop of auto_simplify() does to each cell of its list. */
 typedef enum auto_phase {
   AUTO_PROBE,  /* simplify kind `kind` (timed) */
@@ -550,8 +553,10 @@ cleanup:
 /* Phase 2b of FCM_CELL_SIMPLIFY_AUTO (the cells are intersected and mapped, not yet
  * simplified nor stabilized): per kind, simplify probe_cells cut cells spread over the cell
  * order, extrapolate their time by points and their kept points per cell to all cut cells,
- * decide with fcm_simplify_pays(); a probe whose kind does not pay gets its unsimplified rule
- * back, so the rules are those of OFF or ON for each kind. Then finish every cut cell. */
+ * decide with fcm_simplify_pays() (the probe runs in rounds of one cell per thread and stops
+ * early when the estimates differ by more than AUTO_PROBE_MARGIN); probe cells of a kind that
+ * does not pay get their unsimplified rules back, so the rules are those of OFF or ON for
+ * each kind. Then finish every cut cell. */
 static fcm_status auto_simplify(const build *B, fcm_cell_rules *R, int nthreads, cell_out *out,
                                 cell_sums *sums)
 {
@@ -570,8 +575,12 @@ static fcm_status auto_simplify(const build *B, fcm_cell_rules *R, int nthreads,
     if (R->cls[c] == FCM_CELL_CUT) cut[ncut++] = c;
   const fcm_index np = ncut < opt->probe_cells ? ncut : opt->probe_cells;
   FCM_ALLOC(ctx, (size_t)np + 1, probe);
-  for (fcm_index i = 0; i < np; i++) /* distinct: consecutive indices differ by ncut/np >= 1 */
-    probe[i] = cut[(2 * i + 1) * ncut / (2 * np)];
+  /* Spread over the cell order (distinct: consecutive picks differ by ncut/np >= 1), the
+   * even picks first so that an early stop still samples the whole range. */
+  for (fcm_index i = 0, j = 0; i < np; i++, j += 2) {
+    if (j >= np) j = 1;
+    probe[i] = cut[(2 * j + 1) * ncut / (2 * np)];
+  }
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     fcm_simplify_decision *d = &R->stats.decision[k];
     const fcm_element_type type = fcm_mesh_element_type(B->mesh);
@@ -597,22 +606,33 @@ static fcm_status auto_simplify(const build *B, fcm_cell_rules *R, int nthreads,
       memcpy(saved + 4 * at + 3 * n, o->w[k], n * sizeof *saved);
       at += n;
     }
-    FCM_TRY(ctx, auto_loop(B, R, nthreads, out, probe, np, AUTO_PROBE, k, pays, sums));
-    for (fcm_index i = 0; i < np; i++) {
-      const cell_out *o = out + probe[i];
-      d->probe_points += o->ninit[k];
-      d->probe_kept += o->nsimp[k];
-      d->probe_time += o->tsimp[k];
+    /* Rounds of one cell per thread until every probe cell is done or the estimates differ by
+     * more than AUTO_PROBE_MARGIN either way. */
+    fcm_index q = 0;
+    while (q < np) {
+      const fcm_index m = np - q < nthreads ? np - q : nthreads;
+      FCM_TRY(ctx, auto_loop(B, R, nthreads, out, probe + q, m, AUTO_PROBE, k, pays, sums));
+      for (fcm_index i = q; i < q + m; i++) {
+        const cell_out *o = out + probe[i];
+        d->probe_points += o->ninit[k];
+        d->probe_kept += o->nsimp[k];
+        d->probe_time += o->tsimp[k];
+      }
+      q += m;
+      d->probe_cells = q;
+      d->estimated_time =
+          d->probe_points > 0 ? d->probe_time * ntot / (double)d->probe_points : 0.0;
+      d->estimated_kept = (double)d->probe_kept * (double)ncut / (double)q;
+      d->cost_simplified =
+          d->estimated_time + d->estimated_kept * d->point_cost * d->expected_assemblies;
+      if (d->cost_plain > AUTO_PROBE_MARGIN * d->cost_simplified ||
+          d->cost_simplified > AUTO_PROBE_MARGIN * d->cost_plain)
+        break;
     }
-    d->probe_cells = np;
-    d->estimated_time = d->probe_points > 0 ? d->probe_time * ntot / (double)d->probe_points : 0.0;
-    d->estimated_kept = (double)d->probe_kept * (double)ncut / (double)np;
-    d->cost_simplified =
-        d->estimated_time + d->estimated_kept * d->point_cost * d->expected_assemblies;
     pays[k] = fcm_simplify_pays(d->expected_assemblies, d->point_cost, ntot, d->estimated_kept,
                                 d->estimated_time);
     if (!pays[k]) /* give the probe cells their unsimplified rules back */
-      for (size_t i = 0, at = 0; i < (size_t)np; i++) {
+      for (size_t i = 0, at = 0; i < (size_t)q; i++) {
         cell_out *o = out + probe[i];
         const size_t n = (size_t)o->ninit[k];
         memcpy(o->pts[k], saved + 4 * at, 3 * n * sizeof *saved);
