@@ -10,12 +10,15 @@
  * Cost growth (issue 15, item 4): for a fixed geometry (a ball of radius 0.8 meshed with
  * fcm_geometry_create_ball, resolution 6) in box grids of n^3 Hex8 and Hex20 cells over
  * [-1,1]^3, n = 4, 8, 16, 32, the rules time (one thread, CPU seconds of the call) against the
- * number of cut cells, the time per cut cell and the least-squares exponent p of
+ * number of cut cells (n = 4, 6, 8, 12, 16, 24, 32), the time per cut cell and the
+ * least-squares exponent p of
  * time ~ cut^p; the target is p <= 1.1. Without simplification (the geometric part: clip,
  * tetrahedralize, map) for every n; with simplification while the predicted time (previous
  * grid x 4) stays within GROWTH_SIMPLIFY_BUDGET seconds. Column "p local": the exponent
  * between consecutive grids (the fixed set-up, e.g. the AABB tree of the geometry, weighs
- * on the small grids, so the fit over all grids is lower than the local one at large n).
+ * on the small grids, so the fit over all grids is lower than the local one at large n);
+ * "pts/cut": initial points (both kinds) per cut cell, the size of the simplification
+ * problems, which shrinks as the cells do.
  * Usage: embed_bench [grid resolution per unit length, default 8] [geometry n, default 8]
  *        embed_bench growth [largest n, default 32]   (only the growth sweep) */
 #include "fcm/embed.h"
@@ -27,7 +30,8 @@
 #include <time.h>
 
 #define GROWTH_SIMPLIFY_BUDGET 60.0 /* seconds a simplified grid may take, predicted as the
-                                      previous grid's time x 4 (a step of n: ~4x cut cells) */
+                                      previous grid's time x (n / n_previous)^2 (cut cells grow
+                                      like the surface) */
 
 /* Least-squares slope of log y against log x. */
 static double fit_exponent(int n, const double *x, const double *y)
@@ -46,16 +50,21 @@ static int growth(fcm_ctx *ctx, const fcm_geometry *g, fcm_element_type type, in
                   int nmax, int *failed)
 {
   const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
+  static const int ns[] = {4, 6, 8, 12, 16, 24, 32};
   double cut[8], t[8];
-  int k = 0;
-  printf("%s, simplification %s:\n%6s %8s %8s %10s %12s %8s\n", fcm_element_get_info(type)->name,
-         simplify ? "on" : "off", "n", "cells", "cut", "cpu-s", "ms/cut cell", "p local");
-  for (int n = 4; n <= nmax && k < 8; n *= 2) {
-    if (simplify && k > 0 && 4.0 * t[k - 1] > GROWTH_SIMPLIFY_BUDGET) {
-      printf("%6d  (skipped with simplification: predicted %.0f s > %.0f s)\n", n, 4.0 * t[k - 1],
+  int k = 0, nprev = 0;
+  printf("%s, simplification %s:\n%6s %8s %8s %10s %10s %12s %8s\n",
+         fcm_element_get_info(type)->name, simplify ? "on" : "off", "n", "cells", "cut", "pts/cut",
+         "cpu-s", "ms/cut cell", "p local");
+  for (size_t in = 0; in < sizeof ns / sizeof *ns && ns[in] <= nmax; in++) {
+    const int n = ns[in];
+    const double predicted = k > 0 ? t[k - 1] * (double)(n * n) / (double)(nprev * nprev) : 0.0;
+    if (simplify && predicted > GROWTH_SIMPLIFY_BUDGET) {
+      printf("%6d  (skipped with simplification: predicted %.0f s > %.0f s)\n", n, predicted,
              GROWTH_SIMPLIFY_BUDGET);
       break;
     }
+    nprev = n;
     const fcm_index nn[3] = {n, n, n};
     fcm_mesh *m = NULL;
     fcm_cell_rules *r = NULL;
@@ -79,8 +88,10 @@ static int growth(fcm_ctx *ctx, const fcm_geometry *g, fcm_element_type type, in
     cut[k] = (double)S->num_cut, t[k] = cpu;
     char local[16] = "-";
     if (k > 0) snprintf(local, sizeof local, "%.3f", log(cpu / t[k - 1]) / log(cut[k] / cut[k - 1]));
-    printf("%6d %8lld %8lld %10.3f %12.4f %8s\n", n, (long long)S->num_cells,
-           (long long)S->num_cut, cpu, 1e3 * cpu / (double)S->num_cut, local);
+    printf("%6d %8lld %8lld %10.0f %10.3f %12.4f %8s\n", n, (long long)S->num_cells,
+           (long long)S->num_cut,
+           (double)(S->points_initial[0] + S->points_initial[1]) / (double)S->num_cut, cpu,
+           1e3 * cpu / (double)S->num_cut, local);
     k++;
     fcm_cell_rules_destroy(&r);
     fcm_mesh_destroy(&m);
@@ -104,7 +115,10 @@ static int run_growth(fcm_ctx *ctx, int nmax)
   for (int t = FCM_ELEMENT_HEX8; t <= FCM_ELEMENT_HEX20; t++)
     for (int simp = 0; simp <= 1; simp++)
       linear &= growth(ctx, g, (fcm_element_type)t, simp, nmax, &failed);
-  printf("cost growth: %s\n", linear ? "every fitted exponent <= 1.1" : "an exponent > 1.1");
+  printf("cost growth: %s (CPU time of one thread; with simplification the grids that fit in "
+         "about %.0f s each)\n",
+         linear ? "every fitted exponent <= 1.1" : "an exponent > 1.1 or too few grids",
+         GROWTH_SIMPLIFY_BUDGET);
   fcm_geometry_destroy(&g);
   return failed;
 }
