@@ -1,19 +1,35 @@
-/* Benchmark of the simplification (label "bench"): milliseconds per cell for the plain
- * LP and the hierarchical recombination, side by side with their ratio, for
- *   M = 35  (m = 4),  N ~ 2,900: the paper's Hex20 case, 5.23 s on 28 cores for 2,016
- *                                cells = 73 ms of one core per cell (Longva et al. 2020);
- *   M = 286 (m = 10), N ~ 110,000: the unit tet red-refined three times, conical rules.
- * Inputs are unions of conical rules on sphere-cut sub-tets (the cut-cell situation).
- * Best of `reps` runs per cell (the machine may be shared). Also checks every result. */
+/* Benchmark of the simplification (label "bench"): microseconds per cell on one core for
+ * the default path (Carathéodory elimination) beside the GLPK path the default used before
+ * (the plain LP up to N = 12 M, hierarchical recombination with LPs above), their ratio
+ * and the target of each case:
+ *   M = 20  (m = 3),  N ~ 70:      Tet10-like cut cells,              target 30 us
+ *   M = 35  (m = 4),  N ~ 2,900:   the paper's Hex20 case (73 ms per cell per core in
+ *                                  Longva et al. 2020),                target 0.5 ms
+ *   M = 120 (m = 7),  N ~ 360:                                         target 1.5 ms
+ *   M = 165 (m = 8),  N = 64,000:  a Hex20 mass rule of a finely cut cell, target 40 ms
+ *   M = 286 (m = 10), N = 110,592: the unit tet red-refined three times, target 0.2 s
+ * Inputs are unions of conical rules on (sphere-cut) red-refined sub-tets of the unit tet,
+ * the cut-cell situation. Best of `reps` runs per cell (the machine may be shared); every
+ * result is checked against the monomial moments of its input.
+ * Usage: simplify_bench [--csv FILE] [--quick] (quick: the three small cases only).
+ * The CSV has one row per case and path: M,N,method,us_per_cell,fallbacks,max_residual. */
+#include "fcm/io.h"
 #include "simplify_util.h"
 
 typedef struct stats {
-  double ms;      /* mean over cells of the best time */
-  double part[5]; /* mean ms in basis, SVD, LP, re-fit, total (first run) */
+  double us;      /* mean over cells of the best time */
+  double part[5]; /* mean us in basis, factorizations, LP/elimination, re-fit, total */
   double res;     /* worst residual */
   double kept;    /* mean kept */
   int fallbacks;  /* cells that fell back */
 } stats;
+
+typedef struct bench_case {
+  int m, r;                 /* strength, red refinements of the unit tet */
+  double radius, dradius;   /* sphere cut of cell c: radius + c * dradius (0: whole tet) */
+  int cells, reps;
+  double target_us;
+} bench_case;
 
 static stats run(fcm_ctx *ctx, fcm_simplify_method method, int m, int cells, int *n, double **pts,
                  double **w, int reps)
@@ -37,88 +53,104 @@ static stats run(fcm_ctx *ctx, fcm_simplify_method method, int m, int cells, int
         const double part[5] = {info.time_basis, info.time_svd, info.time_lp, info.time_refit,
                                 info.time_total};
         for (int k = 0; k < 5; k++)
-          s.part[k] += 1e3 * part[k] / cells;
-        util_check(fcm_simplify_method_name(method), m, n[c], pts[c], w[c], &res, util_num_basis(m),
-                   1e-12);
+          s.part[k] += 1e6 * part[k] / cells;
+        util_check(fcm_simplify_method_name(method), m, n[c], pts[c], w[c], &res,
+                   util_num_basis(m), 1e-12);
       }
       fcm_simplify_result_destroy(&res);
     }
-    s.ms += 1e3 * best / cells;
+    s.us += 1e6 * best / cells;
   }
   return s;
 }
 
-int main(void)
+static void csv_row(FILE *csv, int M, double n, const char *method, const stats *s)
 {
+  if (csv)
+    fprintf(csv, "%d,%.0f,%s,%.3f,%d,%.3e\n", M, n, method, s->us, s->fallbacks, s->res);
+}
+
+int main(int argc, char **argv)
+{
+  const char *csv_path = NULL;
+  int quick = 0;
+  for (int i = 1; i < argc; i++) {
+    if (!strcmp(argv[i], "--csv") && i + 1 < argc)
+      csv_path = argv[++i];
+    else if (!strcmp(argv[i], "--quick"))
+      quick = 1;
+    else {
+      fprintf(stderr, "usage: simplify_bench [--csv FILE] [--quick]\n");
+      return 2;
+    }
+  }
   fcm_ctx *ctx = NULL;
+  fcm_atomic_file *af = NULL;
+  FILE *csv = NULL;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
   if (!ctx) return TEST_RESULT();
-  const char *threads = getenv("OMP_NUM_THREADS");
-  printf("fcm_simplify benchmark (single call per cell; BLAS threads: OMP_NUM_THREADS=%s)\n",
+  if (csv_path) {
+    TEST_OK(ctx, fcm_atomic_file_open(ctx, csv_path, &af));
+    if (!af) return TEST_RESULT();
+    csv = fcm_atomic_file_stream(af);
+    fprintf(csv, "M,N,method,us_per_cell,fallbacks,max_residual\n");
+  }
+  const char *threads = getenv("OPENBLAS_NUM_THREADS");
+  printf("fcm_simplify benchmark, one call per cell, best of reps (OPENBLAS_NUM_THREADS=%s)\n",
          threads ? threads : "unset");
-  printf("%-5s %4s %8s %6s %12s %12s %8s %6s %9s %s\n", "m", "M", "N", "cells", "LP ms/cell",
-         "recomb ms", "LP/rec", "kept", "max res", "fallbacks");
+  printf("'before' is the GLPK path the default took before (LP up to N = 12 M, else "
+         "recombination with LPs), measured in this run\n");
+  printf("%4s %7s %5s %12s %12s %8s %10s %4s %6s %9s %s\n", "M", "N", "cells", "default us",
+         "before us", "speedup", "target us", "met", "kept", "max res", "fallbacks");
 
-  /* m = 4: cells cut from the unit tet after 3 refinements (27 points per sub-tet). */
-  enum { CELLS4 = 8 };
-  int n4[CELLS4];
-  double *p4[CELLS4], *w4[CELLS4], nmean = 0;
-  for (int c = 0; c < CELLS4; c++) {
-    n4[c] = util_tet_union(ctx, 4, 3, 0.40 + 0.002 * c, &p4[c], &w4[c]);
-    nmean += (double)n4[c] / CELLS4;
-  }
-  stats a = run(ctx, FCM_SIMPLIFY_LP, 4, CELLS4, n4, p4, w4, 5);
-  stats b = run(ctx, FCM_SIMPLIFY_RECOMBINE, 4, CELLS4, n4, p4, w4, 5);
-  printf("%-5d %4d %8.0f %6d %12.2f %12.2f %8.2f %6.1f %9.2e %d/%d\n", 4, 35, nmean, CELLS4, a.ms,
-         b.ms, a.ms / b.ms, b.kept, fmax(a.res, b.res), a.fallbacks, b.fallbacks);
-  printf("      paper anchor: 73 ms per cell per core (GLOP primal, 28 cores): LP %.1fx, "
-         "recombination %.1fx faster\n",
-         73.0 / a.ms, 73.0 / b.ms);
-  for (int c = 0; c < CELLS4; c++) {
-    free(p4[c]);
-    free(w4[c]);
-  }
-
-  /* m = 10: the whole unit tet after 3 refinements, 512 x 216 = 110,592 points. */
-  int n10;
-  double *p10, *w10;
-  n10 = util_tet_union(ctx, 10, 3, 0.0, &p10, &w10);
-  stats c10 = run(ctx, FCM_SIMPLIFY_LP, 10, 1, &n10, &p10, &w10, 1);
-  stats d10 = run(ctx, FCM_SIMPLIFY_RECOMBINE, 10, 1, &n10, &p10, &w10, 1);
-  printf("%-5d %4d %8d %6d %12.0f %12.0f %8.2f %6.1f %9.2e %d/%d\n", 10, 286, n10, 1, c10.ms,
-         d10.ms, c10.ms / d10.ms, d10.kept, fmax(c10.res, d10.res), c10.fallbacks, d10.fallbacks);
-  free(p10);
-  free(w10);
-  /* Crossover for FCM_SIMPLIFY_AUTO: random rules in a box with N = ratio * M. */
-  printf("\ncrossover (random box rules, best of 3): ms LP / ms recombination\n%-5s %4s", "m", "M");
-  const int ratios[5] = {2, 4, 8, 16, 32};
-  for (int k = 0; k < 5; k++)
-    printf("      N=%dM     ", ratios[k]);
-  printf("\n");
-  for (int m = 2; m <= 10; m += 2) {
-    const int M = util_num_basis(m);
-    printf("%-5d %4d", m, M);
-    for (int k = 0; k < 5; k++) {
-      int n = ratios[k] * M;
-      double *p = malloc(3 * (size_t)n * sizeof *p), *w = malloc((size_t)n * sizeof *w);
-      const double lo[3] = {-1, -1, -1};
-      util_random_box((uint64_t)(m * 10 + k), n, lo, 2.0, 1.0, p, w);
-      stats e = run(ctx, FCM_SIMPLIFY_LP, m, 1, &n, &p, &w, 3);
-      stats f = run(ctx, FCM_SIMPLIFY_RECOMBINE, m, 1, &n, &p, &w, 3);
-      printf(" %7.1f/%-7.1f", e.ms, f.ms);
-      fflush(stdout);
-      free(p);
-      free(w);
+  const bench_case cases[] = {
+      {3, 2, 0.33, 0.002, 16, 20, 30.0},    {4, 3, 0.40, 0.002, 8, 5, 500.0},
+      {7, 1, 0.62, 0.002, 8, 5, 1500.0},    {8, 3, 0.0, 0.0, 1, 1, 40000.0},
+      {10, 3, 0.0, 0.0, 1, 1, 200000.0},
+  };
+  const int ncases = quick ? 3 : (int)(sizeof cases / sizeof cases[0]);
+  stats def[8];
+  int met = 0;
+  for (int k = 0; k < ncases; k++) {
+    const bench_case *bc = &cases[k];
+    const int M = util_num_basis(bc->m);
+    int n[32];
+    double *p[32], *w[32], nmean = 0.0;
+    for (int c = 0; c < bc->cells; c++) {
+      const double radius = bc->radius > 0.0 ? bc->radius + c * bc->dradius : 0.0;
+      n[c] = util_tet_union(ctx, bc->m, bc->r, radius, &p[c], &w[c]);
+      nmean += (double)n[c] / bc->cells;
     }
-    printf("\n");
+    const fcm_simplify_method before =
+        nmean > 12.0 * M ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
+    def[k] = run(ctx, FCM_SIMPLIFY_AUTO, bc->m, bc->cells, n, p, w, bc->reps);
+    const stats old = run(ctx, before, bc->m, bc->cells, n, p, w, bc->reps);
+    const int ok = def[k].us <= bc->target_us && def[k].fallbacks == 0 && def[k].res <= 1e-12;
+    met += ok;
+    printf("%4d %7.0f %5d %12.1f %12.1f %8.1f %10.0f %4s %6.1f %9.2e %d/%d (before: %s)\n", M,
+           nmean, bc->cells, def[k].us, old.us, old.us / def[k].us, bc->target_us,
+           ok ? "yes" : "NO", def[k].kept, fmax(def[k].res, old.res), def[k].fallbacks,
+           old.fallbacks, fcm_simplify_method_name(before));
+    fflush(stdout);
+    csv_row(csv, M, nmean, "eliminate (default)", &def[k]);
+    csv_row(csv, M, nmean, fcm_simplify_method_name(before), &old);
+    for (int c = 0; c < bc->cells; c++) {
+      free(p[c]);
+      free(w[c]);
+    }
   }
-
-  printf("\nbreakdown, ms per cell (first run): basis / SVD / LP / re-fit / total\n");
-  const stats *all[4] = {&a, &b, &c10, &d10};
-  const char *names[4] = {"m=4 lp", "m=4 recombine", "m=10 lp", "m=10 recombine"};
-  for (int k = 0; k < 4; k++)
-    printf("%-15s %10.2f %10.2f %10.2f %10.2f %10.2f\n", names[k], all[k]->part[0], all[k]->part[1],
-           all[k]->part[2], all[k]->part[3], all[k]->part[4]);
+  printf("targets met: %d of %d\n", met, ncases);
+  printf("\ndefault path, us per cell (first run): basis+moments / LU / elimination / re-fit / "
+         "total\n");
+  for (int k = 0; k < ncases; k++)
+    printf("M = %4d %12.1f %12.1f %12.1f %12.1f %12.1f\n", util_num_basis(cases[k].m),
+           def[k].part[0], def[k].part[1], def[k].part[2], def[k].part[3], def[k].part[4]);
+  if (af) {
+    if (TEST_RESULT() == 0)
+      TEST_OK(ctx, fcm_atomic_file_commit(&af));
+    else
+      fcm_atomic_file_abort(&af);
+  }
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
 }

@@ -1,5 +1,6 @@
 /* The fallback path: with every LP forced to fail (GLPK stopped by an iteration limit of
- * 0, or driven into a fatal error that its error hook turns into a return), fcm_simplify
+ * 0, or driven into a fatal error that its error hook turns into a return) and every
+ * elimination finding its LU pivots too small, fcm_simplify
  * returns FCM_OK, info->fallback = 1 with the reason and GLPK's words, and the rule equal
  * to the input. GLPK prints nothing (stdout goes to a file that must stay empty), the
  * process survives, and the next normal call in the same thread succeeds. Each fallback is
@@ -39,7 +40,7 @@ int main(void)
   double *pts = malloc(3 * (size_t)n * sizeof *pts), *w = malloc((size_t)n * sizeof *w);
   util_random_box(3, n, lo, 2.0, 1.0, pts, w);
 
-  for (int mi = FCM_SIMPLIFY_AUTO; mi <= FCM_SIMPLIFY_RECOMBINE; mi++)
+  for (int mi = FCM_SIMPLIFY_AUTO; mi < FCM_SIMPLIFY_METHOD_COUNT; mi++)
     for (int force = 1; force <= 2; force++) {
       fcm_simplify_options o = fcm_simplify_options_default();
       fcm_simplify_result res;
@@ -50,9 +51,14 @@ int main(void)
       TEST_TRUE(logged.warnings == 1 && logged.others == 0);
       TEST_TRUE(strstr(logged.last, "simplify:") && strstr(logged.last, "input rule is kept"));
       TEST_TRUE(info.fallback == 1 && info.skipped == 0 && info.attempts == 3);
-      TEST_TRUE(info.reason ==
-                (force == 1 ? FCM_SIMPLIFY_REASON_LP : FCM_SIMPLIFY_REASON_LP_ERROR));
+      /* AUTO and ELIMINATE: elimination first, a GLPK path second, elimination third. */
+      const int elim_first = mi == FCM_SIMPLIFY_AUTO || mi == FCM_SIMPLIFY_ELIMINATE;
+      const fcm_simplify_reason glpk_reason =
+          force == 1 ? FCM_SIMPLIFY_REASON_LP : FCM_SIMPLIFY_REASON_LP_ERROR;
+      TEST_TRUE(info.reason == (elim_first ? FCM_SIMPLIFY_REASON_NUMERIC : glpk_reason));
       TEST_TRUE(strstr(info.message, force == 1 ? "iteration limit" : "GLPK fatal error") != NULL);
+      if (elim_first)
+        TEST_TRUE(strstr(info.message, "elimination") && strstr(info.message, "[2 "));
       TEST_TRUE(strstr(info.message, "[1 ") && strstr(info.message, "[3 "));
       TEST_TRUE(info.residual == 0.0 && info.kept == n);
       if (getenv("FCM_TEST_VERBOSE")) fprintf(stderr, "%s\n", info.message);

@@ -1,5 +1,5 @@
 /* Names of the simplification methods and failure reasons: every value has its own static
- * name, "auto"/"lp"/"recombine" and "none" as documented, and a value out of range is
+ * name, "auto"/"lp"/"recombine"/"eliminate" and "none" as documented, and a value out of range is
  * "unknown", never NULL. */
 #include "fcm/simplify.h"
 #include "test.h"
@@ -16,6 +16,7 @@ int main(void)
   TEST_TRUE(!strcmp(fcm_simplify_method_name(FCM_SIMPLIFY_AUTO), "auto"));
   TEST_TRUE(!strcmp(fcm_simplify_method_name(FCM_SIMPLIFY_LP), "lp"));
   TEST_TRUE(!strcmp(fcm_simplify_method_name(FCM_SIMPLIFY_RECOMBINE), "recombine"));
+  TEST_TRUE(!strcmp(fcm_simplify_method_name(FCM_SIMPLIFY_ELIMINATE), "eliminate"));
 
   enum { NR = FCM_SIMPLIFY_REASON_NO_PROGRESS + 1 };
   const char *r[NR];

@@ -1,5 +1,5 @@
 /* Simplification of positive rules for strengths m = 1..10 with the path given as
- * argv[1] ("lp" or "recombine"): random rules in a box, unions of conical rules on
+ * argv[1] ("lp", "recombine" or "eliminate"): random rules in a box, unions of conical rules on
  * red-refined sub-tets of the unit tet (whole, and cut by a sphere). Each result has at
  * most M points, is an ascending subset of the input (hence inside the tet), has
  * positive weights and integrates every monomial of degree <= m like the input. */
@@ -25,13 +25,19 @@ static void run(fcm_ctx *ctx, fcm_simplify_method method, const char *what, int 
   TEST_TRUE(info.residual <= 1e-12);
   TEST_TRUE(info.kept == res.count && info.n == n && info.num_basis == util_num_basis(m));
   TEST_TRUE(info.rank >= 1 && info.rank <= info.num_basis && res.count <= info.rank);
-  TEST_TRUE(info.num_lps >= 1 && info.lp_iterations >= 0);
-  TEST_TRUE(method == FCM_SIMPLIFY_RECOMBINE || info.rounds == 0);
+  if (method == FCM_SIMPLIFY_ELIMINATE)
+    TEST_TRUE(info.num_eliminations >= 1 && info.num_lps == 0);
+  else
+    TEST_TRUE(info.num_lps >= 1 && info.lp_iterations >= 0 && info.num_eliminations == 0);
+  TEST_TRUE(method != FCM_SIMPLIFY_LP || info.rounds == 0);
   util_check(label, m, n, pts, w, &res, n, RTOL);
   if (getenv("FCM_TEST_VERBOSE"))
-    fprintf(stderr, "%s: kept %lld rank %d residual %.2e lps %d its %lld rounds %d %.1f ms\n",
+    fprintf(stderr,
+            "%s: kept %lld rank %d residual %.2e lps %d its %lld eliminations %d rounds %d "
+            "%.2f ms\n",
             label, (long long)res.count, info.rank, info.residual, info.num_lps, info.lp_iterations,
-            info.rounds, 1e3 * info.time_total);
+            info.num_eliminations, info.rounds,
+            1e3 * info.time_total);
   fcm_simplify_result_destroy(&res);
   TEST_TRUE(res.indices == NULL && res.weights == NULL && res.count == 0);
 }
@@ -41,6 +47,7 @@ int main(int argc, char **argv)
   fcm_ctx *ctx = NULL;
   fcm_simplify_method method = FCM_SIMPLIFY_LP;
   if (argc > 1 && !strcmp(argv[1], "recombine")) method = FCM_SIMPLIFY_RECOMBINE;
+  if (argc > 1 && !strcmp(argv[1], "eliminate")) method = FCM_SIMPLIFY_ELIMINATE;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
   if (!ctx) return TEST_RESULT();
 

@@ -1,4 +1,4 @@
-/* Special inputs, both paths: N <= M returns the rule unchanged; coplanar points (on an
+/* Special inputs, every path (LP, recombination, elimination): N <= M returns the rule unchanged; coplanar points (on an
  * axis plane: degenerate box axis; on a tilted plane: rank-deficient P) give a valid rule
  * of at most (m+2 choose 2) points; a slab 1e-9 thick (box-scaled, full rank) a valid rule
  * of at most M; weights of scale 1e-14 and 1e+14 (normalized before the LP) valid rules;
@@ -28,7 +28,7 @@ int main(void)
   double *w2 = malloc(NMAX * sizeof *w2);
   char label[96];
 
-  for (int mi = FCM_SIMPLIFY_LP; mi <= FCM_SIMPLIFY_RECOMBINE; mi++) {
+  for (int mi = FCM_SIMPLIFY_LP; mi < FCM_SIMPLIFY_METHOD_COUNT; mi++) {
     const fcm_simplify_method method = (fcm_simplify_method)mi;
     const char *name = fcm_simplify_method_name(method);
     fcm_simplify_result res;

@@ -86,7 +86,7 @@ typedef struct fcm_scene_quadrature {
                                    (OFF) or "auto" (AUTO: per rule kind, where it pays for the
                                    assemblies the run expects; see fcm_simulation_create()) */
   fcm_simplify_method simplify_method;     /**< "simplify_method": "auto" (default), "lp",
-                                                "recombine" */
+                                                "recombine", "eliminate" */
   fcm_stabilization_options stabilization; /**< "stabilization": mode "mass_stiffness"
                                                 (default), "mass", "off"; alpha in (0, 1],
                                                 default 1e-6 */

@@ -18,6 +18,8 @@ typedef enum fcm_simplify_method {
   FCM_SIMPLIFY_AUTO = 0,  /**< the measured default (see fcm_simplify_options_default) */
   FCM_SIMPLIFY_LP,        /**< thin SVD of P, one LP on all N points */
   FCM_SIMPLIFY_RECOMBINE, /**< hierarchical recombination: small LPs on cluster moments */
+  FCM_SIMPLIFY_ELIMINATE, /**< Carathéodory elimination along null vectors of an LU tableau,
+                               on all points or inside recombination rounds (default) */
   FCM_SIMPLIFY_METHOD_COUNT
 } fcm_simplify_method;
 
@@ -61,6 +63,7 @@ typedef struct fcm_simplify_info {
                                         (box-scaled Chebyshev basis); 0 when returned unchanged */
   long long lp_iterations;         /**< simplex iterations over all LPs */
   int num_lps;                     /**< LPs solved */
+  int num_eliminations;            /**< Carathéodory eliminations (one per round or solve) */
   int rounds;                      /**< recombination rounds (not counting the final LP) */
   int attempts;                    /**< attempts made; 1 when the first succeeded */
   fcm_simplify_method method_used; /**< path of the last attempt (AUTO when none ran) */
@@ -69,6 +72,8 @@ typedef struct fcm_simplify_info {
   int fallback;                    /**< 1: every attempt failed, input returned unchanged */
   fcm_simplify_reason reason;      /**< first failure; NONE if none */
   char message[320];               /**< account of the failed attempts ("" if none) */
+  /** Seconds in: the basis and moments; SVDs and LU factorizations; LPs and eliminations;
+   * the least-squares re-fit and verification; the whole call. */
   double time_basis, time_svd, time_lp, time_refit, time_total;
 } fcm_simplify_info;
 

@@ -16,6 +16,15 @@ void fcm__gemm(char transa, char transb, int m, int n, int k, double alpha, cons
 void fcm__gemv(char trans, int m, int n, double alpha, const double *a, int lda, const double *x,
                double beta, double *y);
 
+/* A += alpha x y^T, A m x n (lda), x stride 1, y stride incy (BLAS dger). */
+void fcm__ger(int m, int n, double alpha, const double *x, const double *y, int incy, double *a,
+              int lda);
+
+/* B = alpha B inv(A) with A n x n unit lower triangular (B m x n, ldb): BLAS dtrsm
+ * side right, lower, no transpose, unit diagonal. */
+void fcm__trsm_right_unit_lower(int m, int n, double alpha, const double *a, int lda, double *b,
+                                int ldb);
+
 /* Symmetric eigen-decomposition of the n x n matrix A (lower triangle read).
  * w receives the eigenvalues in ascending order; with want_vectors the columns of
  * A are overwritten by orthonormal eigenvectors. FCM_ERR_LAPACK if it fails to
@@ -35,6 +44,11 @@ fcm_status fcm__gesvd(fcm_ctx *ctx, int m, int n, double *a, int lda, double *s,
 /* LU factorization with partial pivoting in place; FCM_ERR_SINGULAR names the
  * zero pivot. ipiv has n entries. */
 fcm_status fcm__getrf(fcm_ctx *ctx, int n, double *a, int lda, int *ipiv);
+
+/* LU factorization with partial pivoting P A = L U of the m x n matrix A (m >= n) in
+ * place; ipiv has n entries. An exactly zero pivot is not an error here: the caller reads
+ * the diagonal of U. FCM_ERR_NUMERIC on NaN/Inf input. */
+fcm_status fcm__getrf_tall(fcm_ctx *ctx, int m, int n, double *a, int lda, int *ipiv);
 
 /* Solve A X = B with the factors of fcm__getrf; B is n x nrhs (ldb). */
 fcm_status fcm__getrs(fcm_ctx *ctx, int n, int nrhs, const double *lu, int lda, const int *ipiv,

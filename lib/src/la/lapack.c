@@ -40,6 +40,21 @@ void fcm__gemv(char trans, int m, int n, double alpha, const double *a, int lda,
   cblas_dgemv(CblasColMajor, cblas_trans(trans), m, n, alpha, a, lda, x, 1, beta, y, 1);
 }
 
+void fcm__ger(int m, int n, double alpha, const double *x, const double *y, int incy, double *a,
+              int lda)
+{
+  if (m <= 0 || n <= 0) return;
+  cblas_dger(CblasColMajor, m, n, alpha, x, 1, y, incy, a, lda);
+}
+
+void fcm__trsm_right_unit_lower(int m, int n, double alpha, const double *a, int lda, double *b,
+                                int ldb)
+{
+  if (m <= 0 || n <= 0) return;
+  cblas_dtrsm(CblasColMajor, CblasRight, CblasLower, CblasNoTrans, CblasUnit, m, n, alpha, a, lda,
+              b, ldb);
+}
+
 /* FCM_ERR_NUMERIC unless every entry of the m x n matrix (with lower_only, of
  * its lower triangle, the part symmetric routines read) is finite. */
 static fcm_status check_finite_part(fcm_ctx *ctx, const char *routine, int m, int n,
@@ -161,6 +176,21 @@ fcm_status fcm__getrf(fcm_ctx *ctx, int n, double *a, int lda, int *ipiv)
   FCM_CHECK(info <= 0, ctx, FCM_ERR_SINGULAR,
             "dgetrf: matrix is singular, pivot U(%d,%d) is exactly zero (n = %d)", (int)info - 1,
             (int)info - 1, n);
+  FCM_TRY(ctx, lapack_info(ctx, "dgetrf", info));
+cleanup:
+  return st;
+}
+
+fcm_status fcm__getrf_tall(fcm_ctx *ctx, int m, int n, double *a, int lda, int *ipiv)
+{
+  fcm_status st = FCM_OK;
+  lapack_int info;
+  FCM_CHECK(m >= n && n >= 0 && lda >= FCM_MAX(1, m), ctx, FCM_ERR_ARG,
+            "getrf: m = %d, n = %d, lda = %d", m, n, lda);
+  if (n == 0) goto cleanup;
+  FCM_TRY(ctx, check_finite(ctx, "dgetrf", m, n, a, lda));
+  info = LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, m, n, a, lda, ipiv);
+  if (info > 0) info = 0; /* an exact zero pivot: U says so */
   FCM_TRY(ctx, lapack_info(ctx, "dgetrf", info));
 cleanup:
   return st;

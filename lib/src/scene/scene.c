@@ -54,7 +54,7 @@ static const fcm_material_model model_values[] = {
     FCM_MATERIAL_STABLE_NEO_HOOKEAN};
 static const char *const shape_names[] = {"box", "ball", "hemisphere", "hollow_ball", "tube"};
 static const char *const axis_names[] = {"x", "y", "z"};
-static const char *const simplify_names[] = {"auto", "lp", "recombine"};
+static const char *const simplify_names[] = {"auto", "lp", "recombine", "eliminate"};
 static const char *const stabilization_names[] = {"mass_stiffness", "mass", "off"};
 static const char *const solver_names[] = {"direct", "minres", "cg"};
 static const int solver_values[] = {FCM_LINEAR_DIRECT, FCM_LINEAR_MINRES, FCM_LINEAR_CG};

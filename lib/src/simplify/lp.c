@@ -16,6 +16,7 @@ fcm_status fcm__simplify_run_lp(fcm__attempt *a)
   FCM_ALLOC(ctx, (size_t)M * (size_t)n, P);
   for (int j = 0; j < n; j++)
     fcm__simplify_basis_eval(&a->box, a->points + 3 * (size_t)j, P + (size_t)j * (size_t)M);
+  fcm__simplify_set_moments(a, n, P, a->w0);
   a->time_basis += fcm_wtime() - t0;
 
   FCM_ALLOC(ctx, (size_t)k * (size_t)n, vt);

@@ -22,6 +22,11 @@ static fcm_status cluster_lp(fcm__attempt *a, int rows, int cols, double *g, dou
   fcm__lp_report rep;
   const int k = FCM_MIN(rows, cols);
   int r = 0;
+  if (a->eliminate) { /* lam = 1 is feasible: eliminate from there */
+    for (int c = 0; c < cols; c++)
+      lam[c] = 1.0;
+    return fcm__simplify_reduce(a, rows, cols, g, q, lam);
+  }
   FCM_TRY(ctx, fcm__simplify_row_space(a, rows, cols, g, q, &r));
   if (a->reason != FCM_SIMPLIFY_REASON_NONE) goto cleanup;
   a->rank = r;
@@ -51,7 +56,7 @@ fcm_status fcm__simplify_run_recombine(fcm__attempt *a)
   fcm_ctx *ctx = a->ctx;
   const int n = a->n, M = a->box.num_basis, K = 2 * (M + 1);
   int *idx = NULL, nact = 0;
-  double *cw = NULL, *g = NULL, *q = NULL, *rhs = NULL, *lam = NULL, *phi = NULL;
+  double *cw = NULL, *g = NULL, *q = NULL, *rhs = NULL, *lam = NULL, *acc = NULL;
 
   FCM_ALLOC(ctx, (size_t)n, idx);
   FCM_ALLOC(ctx, (size_t)n, cw);
@@ -59,7 +64,7 @@ fcm_status fcm__simplify_run_recombine(fcm__attempt *a)
   FCM_ALLOC(ctx, (size_t)M * (size_t)K, q);
   FCM_ALLOC(ctx, (size_t)M, rhs);
   FCM_ALLOC(ctx, (size_t)K, lam);
-  FCM_ALLOC(ctx, (size_t)M, phi);
+  FCM_ALLOC(ctx, fcm__simplify_moments_scratch(a->box.m), acc);
   for (int j = 0; j < n; j++)
     if (a->w0[j] > 0.0) {
       idx[nact] = j;
@@ -69,17 +74,12 @@ fcm_status fcm__simplify_run_recombine(fcm__attempt *a)
   while (nact > K) {
     a->rounds++;
     double t0 = fcm_wtime();
-    for (size_t i = 0; i < (size_t)M * (size_t)K; i++)
-      g[i] = 0.0;
     for (int c = 0; c < K; c++) {
       const int lo = (int)((long long)c * nact / K), hi = (int)((long long)(c + 1) * nact / K);
-      double *gc = g + (size_t)c * (size_t)M;
-      for (int i = lo; i < hi; i++) {
-        fcm__simplify_basis_eval(&a->box, a->points + 3 * (size_t)idx[i], phi);
-        for (int p = 0; p < M; p++)
-          gc[p] += cw[i] * phi[p];
-      }
+      fcm__simplify_moments(&a->box, hi - lo, a->points, idx + lo, cw + lo,
+                            g + (size_t)c * (size_t)M, acc);
     }
+    fcm__simplify_set_moments(a, K, g, NULL); /* the first round sees every point */
     a->time_basis += fcm_wtime() - t0;
     FCM_TRY(ctx, cluster_lp(a, M, K, g, q, rhs, lam));
     if (a->reason != FCM_SIMPLIFY_REASON_NONE) goto cleanup;
@@ -109,6 +109,7 @@ fcm_status fcm__simplify_run_recombine(fcm__attempt *a)
     for (int p = 0; p < M; p++)
       gi[p] *= cw[i];
   }
+  fcm__simplify_set_moments(a, nact, g, NULL); /* when no round ran */
   a->time_basis += fcm_wtime() - t0;
   FCM_TRY(ctx, cluster_lp(a, M, nact, g, q, rhs, lam));
   if (a->reason != FCM_SIMPLIFY_REASON_NONE) goto cleanup;
@@ -132,6 +133,6 @@ cleanup:
   fcm__free(ctx, q);
   fcm__free(ctx, rhs);
   fcm__free(ctx, lam);
-  fcm__free(ctx, phi);
+  fcm__free(ctx, acc);
   return st;
 }

@@ -1,11 +1,14 @@
-/* fcm_simplify(): argument checks, weight normalization, the attempts (LP or
- * recombination, then the other, then a looser rank threshold), least-squares re-fit on
- * the kept support, verification, and the fallback to the unchanged input rule.
+/* fcm_simplify(): argument checks, weight normalization, the attempts (the chosen path,
+ * then a GLPK path, then the chosen path with a looser rank threshold), verification with
+ * a least-squares re-fit on the kept support when needed, and the fallback to the
+ * unchanged input rule.
  *
  * Longva et al. 2020 §4.4: a basic feasible solution of P w = P w0, w >= 0 has at most
  * rank P <= M non-zeros, so a subset of the input points (inside the geometry whenever
- * the input points are) carries positive weights with the input's moments. Unlike the
- * authors' code every result is checked (weights > 0, count <= M, relative moment
+ * the input points are) carries positive weights with the input's moments. The paper
+ * finds one with an LP; the default here reaches one by Carathéodory elimination (no LP),
+ * which starts from the feasible w0 and keeps every weight >= 0 by construction. Unlike
+ * the authors' code every result is checked (weights > 0, count <= M, relative moment
  * residual <= tolerance) and a failure never aborts: the input rule comes back. */
 #include "la/la_impl.h"
 #include "simplify/simplify_impl.h"
@@ -21,6 +24,10 @@
  * 1.6-3x faster at 16-32 M, 3-4x at the paper's M = 35, N = 2,900 and 12-23x at
  * M = 286, N = 110,592. */
 #define AUTO_RECOMBINE_RATIO 12
+
+/* Elimination: an LU pivot below this times rank_tol of the largest one means the moment
+ * rows are dependent (rank_tol 1e-13 gives 1e-10; LU pivots are not singular values). */
+#define PIVOT_FACTOR 1e3
 
 fcm_simplify_options fcm_simplify_options_default(void)
 {
@@ -43,6 +50,8 @@ const char *fcm_simplify_method_name(fcm_simplify_method method)
     return "lp";
   case FCM_SIMPLIFY_RECOMBINE:
     return "recombine";
+  case FCM_SIMPLIFY_ELIMINATE:
+    return "eliminate";
   default:
     return "unknown";
   }
@@ -70,6 +79,18 @@ const char *fcm_simplify_reason_name(fcm_simplify_reason reason)
   default:
     return "unknown";
   }
+}
+
+void fcm__simplify_set_moments(fcm__attempt *a, int ncols, const double *g, const double *lam)
+{
+  const int M = a->box.num_basis;
+  if (a->have_moments) return;
+  for (int i = 0; i < M; i++)
+    a->moments[i] = 0.0;
+  for (int c = 0; c < ncols; c++)
+    for (int i = 0; i < M; i++)
+      a->moments[i] += (lam ? lam[c] : 1.0) * g[i + (size_t)c * (size_t)M];
+  a->have_moments = 1;
 }
 
 void fcm__simplify_fail(fcm__attempt *a, fcm_simplify_reason reason, const char *fmt, ...)
@@ -128,8 +149,9 @@ static double residual_of(int M, int count, const double *PS, const double *w, c
   return isnan(res) ? INFINITY : res;
 }
 
-/* Re-fit the weights on the support by least squares (P_S w_S = b), then verify; keep
- * the LP's own weights when the re-fit loses positivity but those verify. */
+/* Verify the path's weights (positive by construction); only when their residual is above
+ * the tolerance, re-fit them on the support by least squares (P_S w_S = b) and verify
+ * those. */
 static fcm_status refit_verify(fcm__attempt *a, double tol, double *residual)
 {
   fcm_status st = FCM_OK;
@@ -143,10 +165,21 @@ static fcm_status refit_verify(fcm__attempt *a, double tol, double *residual)
   for (int c = 0; c < count; c++)
     fcm__simplify_basis_eval(&a->box, a->points + 3 * (size_t)a->support[c],
                              PS + (size_t)c * (size_t)M);
+  if (!a->have_moments) { /* no path got as far as evaluating the basis on every point */
+    double *scratch = NULL;
+    FCM_ALLOC(ctx, fcm__simplify_moments_scratch(a->box.m), scratch);
+    fcm__simplify_moments(&a->box, a->n, a->points, NULL, a->w0, a->moments, scratch);
+    fcm__free(ctx, scratch);
+    a->have_moments = 1;
+  }
   memcpy(A, PS, sizeof *A * (size_t)M * (size_t)count);
   memcpy(B, a->moments, sizeof *B * (size_t)M);
 
   const double lp_res = residual_of(M, count, PS, a->w, a->moments);
+  if (lp_res <= tol) { /* the path's own weights verify: no re-fit needed */
+    *residual = lp_res;
+    goto checks;
+  }
   st = fcm__lstsq(ctx, M, count, 1, A, M, B, FCM_MAX(M, count), -1.0, NULL);
   if (st == FCM_ERR_ALLOC) {
     fcm__trace(ctx, __FILE__, __LINE__, __func__);
@@ -161,14 +194,13 @@ static fcm_status refit_verify(fcm__attempt *a, double tol, double *residual)
   if (refit_ok && fit_res <= tol) {
     memcpy(a->w, B, sizeof *B * (size_t)count);
     *residual = fit_res;
-  } else if (lp_res <= tol) {
-    *residual = lp_res; /* the LP weights are positive by construction */
   } else {
     *residual = fmin(lp_res, fit_res);
     fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_RESIDUAL,
-                       "relative moment residual %.3g (LP) / %.3g (re-fit%s) above %.3g", lp_res,
+                       "relative moment residual %.3g (path) / %.3g (re-fit%s) above %.3g", lp_res,
                        fit_res, refit_ok ? "" : ", not positive", tol);
   }
+checks:
   for (int c = 0; a->reason == FCM_SIMPLIFY_REASON_NONE && c < count; c++)
     if (!(a->w[c] > 0.0) || !isfinite(a->w[c]))
       fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_NOT_POSITIVE, "weight %d = %g not positive", c,
@@ -238,7 +270,7 @@ typedef struct simplify_run {
   double *packed;       /* np x 3 copy when some weights are zero, else NULL */
   const double *points; /* np x 3: the input or `packed` */
   double scale;         /* np / total weight: the attempts see mean-1 weights */
-  double *w0, *moments, *phi;
+  double *w0, *moments;
   fcm__attempt a;
 } simplify_run;
 
@@ -295,7 +327,8 @@ cleanup:
 }
 
 /* Set-up phase: mean-1 weights (with tiny weights GLPK reports "optimal" with w = 0,
- * notes §4), the attempt's buffers and parameters, and the moments in the box basis. */
+ * notes §4), the attempt's buffers and parameters and the box of the basis (the moments
+ * come from the first path that evaluates the basis on every point). */
 static fcm_status setup_attempt(simplify_run *r, int strength, const double *weights, double total,
                                 const fcm_simplify_options *o, int force_lp_failure)
 {
@@ -311,7 +344,6 @@ static fcm_status setup_attempt(simplify_run *r, int strength, const double *wei
   for (int k = 0; k < np; k++)
     r->w0[k] = weights[r->map[k]] * r->scale;
   FCM_ALLOC(ctx, (size_t)M, r->moments);
-  FCM_ALLOC(ctx, (size_t)M, r->phi);
   FCM_ALLOC(ctx, (size_t)M, a->support);
   FCM_ALLOC(ctx, (size_t)M, a->w);
   a->ctx = ctx;
@@ -325,11 +357,6 @@ static fcm_status setup_attempt(simplify_run *r, int strength, const double *wei
   a->lp.force_failure = force_lp_failure;
   double t0 = fcm_wtime();
   fcm__simplify_box(strength, np, r->points, &a->box);
-  for (int j = 0; j < np; j++) {
-    fcm__simplify_basis_eval(&a->box, r->points + 3 * (size_t)j, r->phi);
-    for (int i = 0; i < M; i++)
-      r->moments[i] += r->w0[j] * r->phi[i];
-  }
   a->time_basis += fcm_wtime() - t0;
 cleanup:
   return st;
@@ -343,11 +370,13 @@ static fcm_status run_attempts(simplify_run *r, const fcm_simplify_options *o,
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = r->ctx;
   fcm__attempt *a = &r->a;
-  fcm_simplify_method chosen = o->method;
-  if (chosen == FCM_SIMPLIFY_AUTO)
-    chosen = r->np > AUTO_RECOMBINE_RATIO * a->capacity ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
-  const fcm_simplify_method other =
-      chosen == FCM_SIMPLIFY_LP ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
+  /* The GLPK paths: the plain LP up to AUTO_RECOMBINE_RATIO points per basis function. */
+  const fcm_simplify_method glpk =
+      r->np > AUTO_RECOMBINE_RATIO * a->capacity ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
+  const fcm_simplify_method chosen = o->method == FCM_SIMPLIFY_AUTO ? FCM_SIMPLIFY_ELIMINATE : o->method;
+  fcm_simplify_method other = glpk;
+  if (chosen == FCM_SIMPLIFY_LP) other = FCM_SIMPLIFY_RECOMBINE;
+  if (chosen == FCM_SIMPLIFY_RECOMBINE) other = FCM_SIMPLIFY_LP;
   fcm_simplify_method plan[ATTEMPT_COUNT];
   double tols[ATTEMPT_COUNT];
   plan[ATTEMPT_CHOSEN] = chosen, tols[ATTEMPT_CHOSEN] = o->rank_tol;
@@ -358,6 +387,8 @@ static fcm_status run_attempts(simplify_run *r, const fcm_simplify_options *o,
   for (int k = 0; k < ATTEMPT_COUNT && !*success; k++) {
     double residual = INFINITY;
     a->rank_tol = tols[k];
+    a->pivot_tol = a->lp.force_failure ? INFINITY : fmin(1e-3, PIVOT_FACTOR * tols[k]);
+    a->eliminate = 0;
     a->count = 0;
     a->rank = 0;
     a->reason = FCM_SIMPLIFY_REASON_NONE;
@@ -366,8 +397,10 @@ static fcm_status run_attempts(simplify_run *r, const fcm_simplify_options *o,
     info->method_used = plan[k];
     if (plan[k] == FCM_SIMPLIFY_LP)
       FCM_TRY(ctx, fcm__simplify_run_lp(a));
-    else
+    else if (plan[k] == FCM_SIMPLIFY_RECOMBINE)
       FCM_TRY(ctx, fcm__simplify_run_recombine(a));
+    else
+      FCM_TRY(ctx, fcm__simplify_run_eliminate(a));
     if (a->reason == FCM_SIMPLIFY_REASON_NONE) {
       double t0 = fcm_wtime();
       st = refit_verify(a, o->residual_tol, &residual);
@@ -424,6 +457,7 @@ static void record_statistics(const fcm__attempt *a, double t_start, fcm_simplif
 {
   info->lp_iterations = a->lp_iterations;
   info->num_lps = a->num_lps;
+  info->num_eliminations = a->num_eliminations;
   info->rounds = a->rounds;
   info->time_basis = a->time_basis;
   info->time_svd = a->time_svd;
@@ -503,7 +537,8 @@ cleanup:
   fcm__free(ctx, r.packed);
   fcm__free(ctx, r.w0);
   fcm__free(ctx, r.moments);
-  fcm__free(ctx, r.phi);
+  fcm__free(ctx, r.a.ws);
+  fcm__free(ctx, r.a.iws);
   fcm__free(ctx, r.a.support);
   fcm__free(ctx, r.a.w);
   return st;

@@ -6,9 +6,10 @@
 #include "core/core_impl.h"
 #include "fcm/simplify.h"
 
-/* fcm_simplify() with a test hook that makes every LP fail: force_lp_failure 0 off (what
- * fcm_simplify() passes), 1 every LP stops at an iteration limit of 0, 2 every LP triggers a
- * GLPK fatal error (caught). Any other value: FCM_ERR_ARG. */
+/* fcm_simplify() with a test hook that makes every LP and elimination fail: force_lp_failure
+ * 0 off (what fcm_simplify() passes), 1 every LP stops at an iteration limit of 0, 2 every LP
+ * triggers a GLPK fatal error (caught); with 1 and 2 every elimination finds its LU pivots
+ * too small. Any other value: FCM_ERR_ARG. */
 fcm_status fcm__simplify_hooked(fcm_ctx *ctx, int strength, fcm_index n, const double *points,
                                 const double *weights, const fcm_simplify_options *opts,
                                 int force_lp_failure, fcm_simplify_result *out,
@@ -34,6 +35,21 @@ void fcm__simplify_box(int m, int n, const double *points, fcm__cheb_box *box);
 
 /* phi[0..M) at the point x[3]; ordered by total degree, then a descending, then b. */
 void fcm__simplify_basis_eval(const fcm__cheb_box *box, const double *x, double *phi);
+
+/* Points per block of fcm__simplify_moments, and the fewest for which a block goes through
+ * BLAS (measured by tests/simplify/bench_simplify.c). */
+#define FCM__MOMENT_BLOCK 256
+#define FCM__MOMENT_GEMM_MIN 64
+
+/* Doubles of scratch fcm__simplify_moments needs at strength m. */
+size_t fcm__simplify_moments_scratch(int m);
+
+/* mom[0..M) = sum_i w[i] phi(points[idx[i]]) over i < n (idx NULL: points[i]). Uses the
+ * tensor structure of the basis: per block of points, the products T_a(x) T_b(y) and
+ * w T_c(z) and one matrix product (BLAS dgemm) for all (a, b, c). work: scratch of
+ * fcm__simplify_moments_scratch(m) doubles. */
+void fcm__simplify_moments(const fcm__cheb_box *box, int n, const double *points, const int *idx,
+                           const double *w, double *mom, double *work);
 
 /* ---- GLPK adapter (glpk_adapter.c, the only file that sees glpk.h) ---- */
 
@@ -68,10 +84,17 @@ typedef struct fcm__attempt {
   int n;                 /* points */
   const double *points;  /* n x 3 */
   const double *w0;      /* n weights normalized to mean 1 */
-  const double *moments; /* M moments of w0 in the box basis */
+  double *moments;       /* M moments of w0 in the box basis, valid once have_moments: the
+                            path that first evaluates the basis on all points sets them */
+  int have_moments;
   fcm__cheb_box box;
   double rank_tol;
   fcm__lp_params lp;
+  double pivot_tol; /* elimination: an LU pivot <= pivot_tol * max pivot means rank-deficient */
+  int eliminate;    /* recombination: 1 rounds by Carathéodory elimination, 0 by SVD + GLPK */
+  double *ws;       /* elimination scratch, grown on demand, released by the driver */
+  int *iws;
+  size_t ws_cap, iws_cap;
   /* output: a support of at most `capacity` points with positive weights (normalized
    * scale), or reason != NONE with a message; counters and times accumulate */
   int capacity; /* of support and w */
@@ -82,9 +105,13 @@ typedef struct fcm__attempt {
   fcm_simplify_reason reason;
   char message[200];
   long long lp_iterations;
-  int num_lps, rounds;
+  int num_lps, num_eliminations, rounds;
   double time_basis, time_svd, time_lp;
 } fcm__attempt;
+
+/* Set a->moments (once) to the sum of the ncols columns of g (M rows, ld M) times lam
+ * (NULL: ones). */
+void fcm__simplify_set_moments(fcm__attempt *a, int ncols, const double *g, const double *lam);
 
 /* Record a soft failure of an attempt (the driver retries or falls back). */
 void fcm__simplify_fail(fcm__attempt *a, fcm_simplify_reason reason, const char *fmt, ...)
@@ -103,7 +130,26 @@ fcm_status fcm__simplify_row_space(fcm__attempt *a, int rows, int cols, double *
 /* One full LP on all n points (DESIGN §6): P (M x n), thin SVD, V_r^T w = V_r^T w0. */
 fcm_status fcm__simplify_run_lp(fcm__attempt *a);
 
-/* Hierarchical recombination (notes §2.4): cluster LPs, about log2(n/M) rounds, final LP. */
+/* Hierarchical recombination (notes §2.4): about log2(n/M) rounds on cluster moments and a
+ * final step on single points, each an LP (or, with a->eliminate, a Carathéodory
+ * elimination). */
 fcm_status fcm__simplify_run_recombine(fcm__attempt *a);
+
+/* Carathéodory elimination (caratheodory.c) on the rows x ncols matrix g (ld ldg): lam
+ * (ncols, >= 0, entries <= 0 are set to 0) is replaced by weights with the same g lam and at
+ * most `rows` positive entries. *deficient = 1 (lam unchanged) when the LU pivots say the
+ * active columns do not have full row rank. Times go to time_svd (LU) and time_lp.
+ * Errors: FCM_ERR_ALLOC; a failed LU becomes a soft NUMERIC failure. */
+fcm_status fcm__simplify_caratheodory(fcm__attempt *a, int rows, int ncols, const double *g,
+                                      int ldg, double *lam, int *deficient);
+
+/* Elimination with the rank handled: on g (rows x ncols, ld rows, destroyed) directly, or,
+ * when its rows are dependent, on the orthonormal rows of its row space (thin SVD; q is
+ * min(rows, ncols) x ncols scratch). Sets a->rank. */
+fcm_status fcm__simplify_reduce(fcm__attempt *a, int rows, int ncols, double *g, double *q,
+                                double *lam);
+
+/* Elimination on all n points when n <= 4 M, else recombination with elimination rounds. */
+fcm_status fcm__simplify_run_eliminate(fcm__attempt *a);
 
 #endif /* FCM_SIMPLIFY_IMPL_H */

@@ -1,0 +1,236 @@
+/* Carathéodory elimination: from weights lam >= 0 with G lam = b, weights with at most
+ * rank G positive entries and the same G lam, by moving along null vectors of G until one
+ * weight reaches zero (Carathéodory's theorem made constructive; Tchernychova 2016,
+ * Maalouf et al. 2019 use it inside recombination).
+ *
+ * The null vectors come from a simplex tableau: LU with partial pivoting of G^T
+ * (K x rows) picks `rows` basis columns B (the pivot rows) and gives the others as
+ * g_N = G_B D, D^T = L2 inv(L1) (one triangular solve). For each non-basic column j in
+ * turn, lam_j goes down and lam_B up along D[:, j]; the first weight to reach zero is
+ * either lam_j (no pivot: O(rows) work) or a basic one, which then leaves the basis for j
+ * (a rank-1 update of the remaining tableau rows). Cost O(K rows^2) for LU and triangular
+ * solve plus at most O(rows (K - rows)^2) for the pivots, no iteration count to tune, and
+ * the weights stay non-negative by construction. */
+#include "la/la_impl.h"
+#include "simplify/simplify_impl.h"
+
+#include <math.h>
+#include <string.h>
+
+typedef struct tableau {
+  int rows, K, kn; /* basis size, active columns, non-basic columns (K - rows) */
+  double *at;      /* K x rows, ld K: LU of G^T, then D^T in rows rows..K-1 */
+  int *ipiv;       /* rows */
+  int *perm;       /* K: active column of each pivoted row */
+  int *id_b, *id_n;
+  double *lam_b, *lam_n, *f;
+} tableau;
+
+/* Eliminate along the non-basic columns in order (see the file comment). */
+static void eliminate(tableau *t)
+{
+  const int rows = t->rows, kn = t->kn, ld = t->K;
+  double *dt = t->at + rows; /* D^T(j, i) = dt[j + i ld] */
+  for (int j = 0; j < kn; j++) {
+    if (!(t->lam_n[j] > 0.0)) continue;
+    double step = t->lam_n[j];
+    int q = -1;
+    for (int i = 0; i < rows; i++) {
+      const double d = dt[j + (size_t)i * ld];
+      if (d < 0.0 && t->lam_b[i] < step * -d) step = t->lam_b[i] / -d, q = i;
+    }
+    for (int i = 0; i < rows; i++) {
+      const double v = t->lam_b[i] + step * dt[j + (size_t)i * ld];
+      t->lam_b[i] = v > 0.0 ? v : 0.0; /* rounding below zero: a weight at zero */
+    }
+    if (q < 0) {
+      t->lam_n[j] = 0.0;
+      continue;
+    }
+    /* Column j enters the basis at q; the old basic column (weight 0) leaves. */
+    const double dq = dt[j + (size_t)q * ld];
+    const int rest = kn - j - 1;
+    double *colq = dt + (size_t)q * ld + j + 1;
+    for (int r = 0; r < rest; r++)
+      t->f[r] = colq[r] / dq;
+    /* Rows below j: e -= f d^T (column q becomes 0 and is then set to f). */
+    fcm__ger(rest, rows, -1.0, t->f, dt + j, ld, dt + j + 1, ld);
+    memcpy(colq, t->f, sizeof *t->f * (size_t)rest);
+    const int leaving = t->id_b[q];
+    t->id_b[q] = t->id_n[j];
+    t->lam_b[q] = t->lam_n[j] - step;
+    t->id_n[j] = leaving;
+    t->lam_n[j] = 0.0;
+  }
+}
+
+/* Grow the attempt's scratch to nd doubles and ni ints (kept across rounds and attempts:
+ * one allocation per call of fcm_simplify instead of one per elimination). */
+static fcm_status reserve(fcm__attempt *a, size_t nd, size_t ni)
+{
+  fcm_status st = FCM_OK;
+  if (nd > a->ws_cap) {
+    FCM_FREE(a->ctx, a->ws);
+    a->ws_cap = 0;
+    FCM_ALLOC(a->ctx, nd, a->ws);
+    a->ws_cap = nd;
+  }
+  if (ni > a->iws_cap) {
+    FCM_FREE(a->ctx, a->iws);
+    a->iws_cap = 0;
+    FCM_ALLOC(a->ctx, ni, a->iws);
+    a->iws_cap = ni;
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm__simplify_caratheodory(fcm__attempt *a, int rows, int ncols, const double *g,
+                                      int ldg, double *lam, int *deficient)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = a->ctx;
+  tableau t;
+  memset(&t, 0, sizeof t);
+  *deficient = 0;
+
+  /* Scratch: act, ipiv, perm, id_b, id_n (ints); the tableau, lam_b, lam_n, f (doubles). */
+  const size_t nc = (size_t)ncols, nr = (size_t)rows;
+  FCM_TRY(ctx, reserve(a, nc * nr + 3 * nc, 4 * nc + 2 * nr));
+  int *act = a->iws;
+  int K = 0;
+  for (int c = 0; c < ncols; c++)
+    if (lam[c] > 0.0) act[K++] = c;
+    else
+      lam[c] = 0.0;
+  if (K <= rows) goto cleanup; /* already at most `rows` positive weights */
+  t.rows = rows, t.K = K, t.kn = K - rows;
+  t.at = a->ws;
+  t.lam_b = t.at + (size_t)K * nr;
+  t.lam_n = t.lam_b + nr;
+  t.f = t.lam_n + t.kn;
+  t.ipiv = act + K;
+  t.perm = t.ipiv + rows;
+  t.id_b = t.perm + K;
+  t.id_n = t.id_b + rows;
+
+  double t0 = fcm_wtime();
+  for (int c = 0; c < K; c++) {
+    const double *gc = g + (size_t)act[c] * (size_t)ldg;
+    for (int i = 0; i < rows; i++)
+      t.at[c + (size_t)i * K] = gc[i];
+  }
+  st = fcm__getrf_tall(ctx, K, rows, t.at, K, t.ipiv);
+  if (st != FCM_OK) {
+    a->time_svd += fcm_wtime() - t0;
+    FCM_TRY(ctx, fcm__simplify_soften(a, st, "LU of the moment matrix"));
+    goto cleanup;
+  }
+  /* A pivot at rounding level: the basis is not a basis (rank-deficient moments). */
+  double umax = 0.0;
+  for (int i = 0; i < rows; i++)
+    umax = fmax(umax, fabs(t.at[i + (size_t)i * K]));
+  for (int i = 0; i < rows; i++)
+    if (!(fabs(t.at[i + (size_t)i * K]) > a->pivot_tol * umax)) *deficient = 1;
+  if (*deficient) {
+    a->time_svd += fcm_wtime() - t0;
+    goto cleanup;
+  }
+  for (int c = 0; c < K; c++)
+    t.perm[c] = c;
+  for (int i = 0; i < rows; i++) {
+    const int p = t.ipiv[i] - 1, tmp = t.perm[i];
+    t.perm[i] = t.perm[p];
+    t.perm[p] = tmp;
+  }
+  fcm__trsm_right_unit_lower(t.kn, rows, 1.0, t.at, K, t.at + rows, K);
+  a->time_svd += fcm_wtime() - t0;
+
+  t0 = fcm_wtime();
+  for (int i = 0; i < rows; i++) {
+    t.id_b[i] = act[t.perm[i]];
+    t.lam_b[i] = lam[t.id_b[i]];
+  }
+  for (int j = 0; j < t.kn; j++) {
+    t.id_n[j] = act[t.perm[rows + j]];
+    t.lam_n[j] = lam[t.id_n[j]];
+  }
+  eliminate(&t);
+  for (int c = 0; c < K; c++)
+    lam[act[c]] = 0.0;
+  for (int i = 0; i < rows; i++)
+    lam[t.id_b[i]] = t.lam_b[i];
+  a->time_lp += fcm_wtime() - t0;
+  a->num_eliminations++;
+cleanup:
+  return st;
+}
+
+fcm_status fcm__simplify_reduce(fcm__attempt *a, int rows, int ncols, double *g, double *q,
+                                double *lam)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = a->ctx;
+  int deficient = 0, r = 0;
+  FCM_TRY(ctx, fcm__simplify_caratheodory(a, rows, ncols, g, rows, lam, &deficient));
+  a->rank = rows;
+  if (!deficient || a->reason != FCM_SIMPLIFY_REASON_NONE) goto cleanup;
+  /* Dependent rows: the same null space through the orthonormal rows of the row space. */
+  FCM_TRY(ctx, fcm__simplify_row_space(a, rows, ncols, g, q, &r));
+  if (a->reason != FCM_SIMPLIFY_REASON_NONE) goto cleanup;
+  a->rank = r;
+  FCM_TRY(ctx, fcm__simplify_caratheodory(a, r, ncols, q, FCM_MIN(rows, ncols), lam, &deficient));
+  if (deficient && a->reason == FCM_SIMPLIFY_REASON_NONE)
+    fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_NUMERIC,
+                       "elimination: rank %d row space still has a pivot below %.1e of the largest",
+                       r, a->pivot_tol);
+cleanup:
+  return st;
+}
+
+/* Elimination on all points up to this many per basis function (one LU of n x M); above,
+ * recombination rounds (measured: tests/simplify/bench_simplify.c). */
+#define ELIMINATE_ALL_RATIO 4
+
+fcm_status fcm__simplify_run_eliminate(fcm__attempt *a)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = a->ctx;
+  const int n = a->n, M = a->box.num_basis;
+  double *g = NULL, *q = NULL, *lam = NULL;
+  if (n > ELIMINATE_ALL_RATIO * M) {
+    a->eliminate = 1;
+    FCM_TRY(ctx, fcm__simplify_run_recombine(a));
+    goto cleanup;
+  }
+  double t0 = fcm_wtime();
+  FCM_ALLOC(ctx, (size_t)M * (size_t)n, g);
+  FCM_ALLOC(ctx, (size_t)FCM_MIN(M, n) * (size_t)n, q);
+  FCM_ALLOC(ctx, (size_t)n, lam);
+  for (int j = 0; j < n; j++) {
+    fcm__simplify_basis_eval(&a->box, a->points + 3 * (size_t)j, g + (size_t)j * (size_t)M);
+    lam[j] = a->w0[j];
+  }
+  fcm__simplify_set_moments(a, n, g, lam);
+  a->time_basis += fcm_wtime() - t0;
+  FCM_TRY(ctx, fcm__simplify_reduce(a, M, n, g, q, lam));
+  if (a->reason != FCM_SIMPLIFY_REASON_NONE) goto cleanup;
+  a->count = 0;
+  for (int j = 0; j < n; j++)
+    if (lam[j] > 0.0) {
+      if (a->count == a->capacity) {
+        fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_COUNT,
+                           "elimination kept more than M = %d positive weights", a->capacity);
+        goto cleanup;
+      }
+      a->support[a->count] = j;
+      a->w[a->count++] = lam[j];
+    }
+  if (a->count == 0)
+    fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_NOT_POSITIVE, "elimination kept no positive weight");
+cleanup:
+  fcm__free(ctx, g);
+  fcm__free(ctx, q);
+  fcm__free(ctx, lam);
+  return st;
+}
