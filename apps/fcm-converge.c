@@ -6,8 +6,8 @@
  * y = 0) in the background box [-1,1] x [0,1] x [-1,1] with h = 1/res, for Tet4, Tet10,
  * Hex8 and Hex20 grids; a manufactured solution makes the exact error known (see
  * fcm-converge-study.c), or --reference runs the authors' localized-load problem against a
- * boundary-conforming Tet10 reference. `payoff` times rule construction and one Newton
- * iteration (SNH tangent + force, CHOLMOD) with and without simplification. */
+ * boundary-conforming Tet10 reference. `payoff` measures, per element and rule kind, the
+ * simplification time and the assembly time it saves: the break-even number of assemblies. */
 #include "app_env.h"
 #include "cli.h"
 #include "fcm-converge-study.h"
@@ -44,7 +44,6 @@ typedef struct config {
   int cpu_time; /* accuracy-vs-time table and plot on CPU seconds */
   /* payoff */
   int payoff;
-  fcm_element_type payoff_element;
   int payoff_res;
   int repeat;
   const char *payoff_csv;
@@ -119,13 +118,15 @@ static void usage(FILE *f)
       "                         is printed and the CSV files are still written)\n"
       "\n");
   fprintf(
-      f, "payoff options (Hex20 FCM on the hemisphere with the manufactured displacement):\n"
-         "  --element E            element                                   (default hex20)\n"
-         "  --res R                resolution                                (default 8; quick 4)\n"
-         "  --geom-n N, --strength M, --radius R   as above (default strength: element's)\n"
-         "  --repeat N             timed iterations per variant, minimum kept (default 3)\n"
-         "  --csv FILE             write the two variants as CSV\n"
-         "  --quick                res 4, geometry n 6, repeat 2\n"
+      f, "payoff options (FCM on the hemisphere with the manufactured displacement; per element\n"
+         "and rule kind the rules are built without and with simplification and one assembly of\n"
+         "each is timed: the break-even is the number of assemblies at which simplifying pays):\n"
+         "  --elements LIST        tet4,tet10,hex8,hex20 (--element E: one)  (default all)\n"
+         "  --res R                resolution                                (default 8; quick 3)\n"
+         "  --geom-n N, --strength M, --radius R   as above (default strengths: element's)\n"
+         "  --repeat N             timed assemblies per variant, minimum kept (default 3)\n"
+         "  --csv FILE             write the table as CSV\n"
+         "  --quick                res 3, geometry n 6, repeat 2\n"
          "\n"
          "CSV columns. levels: element,method,res,h,dofs,active_cells,cut_cells,points,\n"
          "  strength,t_rules,t_assembly,t_solve,t_total,err_l2,err_h1,norm_l2,norm_h1,rel_l2,\n"
@@ -141,9 +142,12 @@ static void usage(FILE *f)
          "  rates: element,method,norm,rate (method fcm|fem, norm L2|H1).\n"
          "  sweep: element,method,res,h,strength,points,dofs,t_rules,t_assembly,t_solve,t_total,\n"
          "  err_l2,err_h1,rel_l2,rel_h1,failed,note,cpu_rules,cpu_assembly,cpu_solve,cpu_total.\n"
-         "  payoff: element,res,simplified,points_cut,points_total,t_rules,t_simplify,\n"
-         "  t_assembly,t_factor_solve,t_iteration,break_even_iterations,cpu_rules,cpu_iteration,\n"
-         "  break_even_cpu.\n"
+         "  payoff: element,res,kind,strength,cut_cells,points_plain,points_simplified,\n"
+         "  t_simplify,t_assembly_plain,t_assembly_simplified,point_cost,simplify_per_cell,\n"
+         "  break_even_assemblies (kind stiffness|mass; points: cut-cell points before\n"
+         "  stabilization; times in core-seconds: the kind's simplification, one assembly (CPU);\n"
+         "  point_cost = assembly time saved / points saved; break_even = t_simplify / assembly\n"
+         "  time saved, inf when none is saved).\n"
          "Timings are wall-clock with the OpenMP threads of the environment; on a loaded machine\n"
          "set OMP_WAIT_POLICY=passive (spinning threads inflate small phases).\n"
          "stdout: tables; stderr: progress. Exit 0 on success, 1 on a computation or output\n"
@@ -266,7 +270,6 @@ static void defaults(config *c)
     c->sweep_strengths[k] = k + 1;
   c->out = CV_PROG;
   c->plots = 1;
-  c->payoff_element = FCM_ELEMENT_HEX20;
   c->payoff_res = 8;
   c->repeat = 3;
 }
@@ -306,14 +309,9 @@ static int parse_args(int argc, char **argv, config *c)
     const char *v = argv[++i];
     cv_setup *s = &c->setup;
     int ok = 1;
-    if (!strcmp(a, "--elements") && !c->payoff)
+    if (!strcmp(a, "--elements") || (!strcmp(a, "--element") && c->payoff))
       ok = parse_elements(a, v, c);
-    else if (!strcmp(a, "--element") && c->payoff) {
-      if (fcm_element_type_from_name(v, &c->payoff_element) != FCM_OK) {
-        fprintf(stderr, CV_PROG ": --element: unknown element '%s'\n", v);
-        ok = 0;
-      }
-    } else if (!strcmp(a, "--methods") && !c->payoff)
+    else if (!strcmp(a, "--methods") && !c->payoff)
       ok = parse_methods(v, c);
     else if (!strcmp(a, "--levels") && !c->payoff)
       ok = parse_int_list(a, v, 1, 64, c->levels, MAX_LEVELS, &c->num_levels), c->levels_given = 1;
@@ -399,7 +397,7 @@ static int parse_args(int argc, char **argv, config *c)
       for (int k = 0; k < 4; k++)
         c->sweep_strengths[k] = k + 2;
     }
-    if (!res_given) c->payoff_res = 4;
+    if (!res_given) c->payoff_res = 3;
     if (!repeat_given) c->repeat = 2;
   }
   if (c->setup.problem == CV_REFERENCE) {
@@ -586,65 +584,70 @@ fail:
 
 /* ---------------------------------------------------------------- payoff */
 
-typedef struct payoff_result {
-  int simplified;
-  fcm_index points_cut, points_total, points_stab;
-  double t_rules, t_simplify, t_assembly, t_factor_solve, t_iteration;
-  double c_rules, c_iteration; /* process CPU seconds */
-} payoff_result;
+/* One variant (plain or simplified rules) of one element: per rule kind the cut-cell points,
+ * the simplification time and the CPU time of one assembly through a kept workspace. */
+typedef struct payoff_variant_result {
+  fcm_index cut_cells;
+  fcm_index points[FCM_RULE_KIND_COUNT]; /* cut-cell points before stabilization */
+  int strength[FCM_RULE_KIND_COUNT];
+  double t_simplify[FCM_RULE_KIND_COUNT]; /* core-seconds (fcm_simplify's own times) */
+  double t_assembly[FCM_RULE_KIND_COUNT]; /* CPU seconds of one assembly, fastest of repeat */
+  double t_rules;                         /* wall seconds of fcm_cell_rules_create */
+} payoff_variant_result;
 
-static int cmp_double(const void *a, const void *b)
+/* One row of the table: an element and a rule kind. */
+typedef struct payoff_row {
+  fcm_element_type element;
+  fcm_rule_kind kind;
+  int strength;
+  fcm_index cut_cells, points_plain, points_simplified;
+  double t_simplify, t_plain, t_simplified; /* core-seconds */
+  double point_cost;                        /* core-seconds per point per assembly */
+  double per_cell;                          /* simplification core-seconds per cut cell */
+  double break_even;                        /* assemblies; INFINITY when nothing is saved */
+} payoff_row;
+
+static double cpu_seconds(void)
 {
-  const double x = *(const double *)a, y = *(const double *)b;
-  return x < y ? -1 : x > y;
+  return (double)clock() / CLOCKS_PER_SEC;
 }
 
-/* Build the rules (timed), then time `repeat` Newton iterations: SNH force + tangent at a
- * fixed displacement, Dirichlet elimination, CHOLMOD factor + solve (symbolic analysis
- * once, outside the timing: it is reused by every iteration of a simulation). */
+/* Build the rules (OFF or ON), then time `repeat` assemblies of each kind after an untimed
+ * warm-up: stiffness = stable Neo-Hookean force + tangent at the manufactured displacement
+ * (what a Newton iteration assembles), mass = the consistent mass matrix. */
 static fcm_status payoff_variant(fcm_ctx *ctx, const config *c, const fcm_mesh *mesh,
-                                 const fcm_geometry *geom, int simplify, payoff_result *p)
+                                 const fcm_geometry *geom, int simplify, payoff_variant_result *p)
 {
   fcm_status st = FCM_OK;
   fcm_cell_rules *rules = NULL;
   fcm_space *space = NULL;
+  fcm_assembly_workspace *ws = NULL;
   fcm_csr *A = NULL;
-  fcm_direct *chol = NULL;
-  double *u = NULL, *g = NULL, *du = NULL, *zero = NULL;
-  fcm_index *con = NULL, ncon = 0, cnt = 0, *nodes = NULL;
-  double ta[100], tf[100], ti[100], ci[100];
+  double *u = NULL, *g = NULL;
   fcm_cell_rules_options o = fcm_cell_rules_options_default();
   o.strength[FCM_RULE_STIFFNESS] = c->setup.strength;
-  o.strength[FCM_RULE_MASS] = 0; /* the Newton iteration timed here uses no mass */
-  o.simplify = simplify;
-  double t0 = fcm_wtime(), c0 = (double)clock() / CLOCKS_PER_SEC;
+  o.simplify = simplify ? FCM_CELL_SIMPLIFY_ON : FCM_CELL_SIMPLIFY_OFF;
+  double t0 = fcm_wtime();
   st = fcm_cell_rules_create(ctx, mesh, geom, &o, &rules);
   if (st != FCM_OK) return st;
-  p->simplified = simplify;
   p->t_rules = fcm_wtime() - t0;
-  p->c_rules = (double)clock() / CLOCKS_PER_SEC - c0;
   const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(rules);
-  p->points_cut = rs->points_simplified[FCM_RULE_STIFFNESS];
-  p->points_stab = rs->points_stabilization[FCM_RULE_STIFFNESS];
-  p->points_total = rs->points_total[FCM_RULE_STIFFNESS];
-  p->t_simplify = rs->time_simplify;
-  fprintf(stderr,
-          CV_PROG ": payoff: rules %s simplification: %.3f s, %lld cut-cell points (+%lld "
-                  "stabilization), %lld in all\n",
-          simplify ? "with" : "without", p->t_rules, (long long)p->points_cut,
-          (long long)p->points_stab, (long long)p->points_total);
-
+  p->cut_cells = rs->num_cut;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    p->points[k] = rs->points_simplified[k];
+    p->t_simplify[k] = rs->decision[k].time_simplify;
+    p->strength[k] = fcm_cell_rules_strength(rules, (fcm_rule_kind)k);
+  }
   fcm_material mat = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 5e4, 0.4, 1000.0};
   fcm_material_params mp;
   st = fcm_material_setup(ctx, &mat, &mp);
   if (st == FCM_OK) st = fcm_space_create_embedded(ctx, mesh, rules, &space);
   if (st == FCM_OK) st = fcm_space_matrix_create(space, &A);
+  if (st == FCM_OK) st = fcm_assembly_workspace_create(space, NULL, &ws);
   if (st != FCM_OK) goto done;
   const fcm_index n = fcm_space_num_dofs(space), nn = fcm_mesh_num_nodes(mesh);
   u = calloc((size_t)n, sizeof *u), g = calloc((size_t)n, sizeof *g);
-  du = calloc((size_t)n, sizeof *du), zero = calloc((size_t)n, sizeof *zero);
-  con = calloc((size_t)n, sizeof *con), nodes = calloc((size_t)nn, sizeof *nodes);
-  if (!u || !g || !du || !zero || !con || !nodes) {
+  if (!u || !g) {
     st = FCM_ERR_ALLOC;
     goto done;
   }
@@ -653,127 +656,127 @@ static fcm_status payoff_variant(fcm_ctx *ctx, const config *c, const fcm_mesh *
     const fcm_index d = fcm_space_node_dof(space, a);
     if (d >= 0) cv_exact(X + 3 * a, u + d, NULL);
   }
-  const double lo[3] = {-HUGE_VAL, 0.0, -HUGE_VAL}, hi[3] = {HUGE_VAL, 0.0, HUGE_VAL};
-  st = fcm_mesh_nodes_in_box(ctx, mesh, lo, hi, 1e-12, nn, nodes, &cnt);
-  for (fcm_index k = 0; k < cnt && st == FCM_OK; k++) {
-    const fcm_index d = fcm_space_node_dof(space, nodes[k]);
-    if (d >= 0)
-      for (int i = 0; i < 3; i++)
-        con[ncon++] = d + i;
+  fcm_linear_form mass = fcm_linear_form_default();
+  mass.term = FCM_LINEAR_MASS;
+  mass.material = &mat;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT && st == FCM_OK; k++) {
+    p->t_assembly[k] = INFINITY;
+    for (int r = -1; r < c->repeat && st == FCM_OK; r++) { /* r = -1: warm-up */
+      fcm_csr_set_zero(A);
+      memset(g, 0, sizeof *g * (size_t)n);
+      const double c0 = cpu_seconds();
+      st = k == FCM_RULE_STIFFNESS ? fcm_assembly_workspace_hyperelastic(ws, &mp, u, NULL, g, A)
+                                   : fcm_assembly_workspace_linear(ws, &mass, A, NULL);
+      const double dt = cpu_seconds() - c0;
+      if (r >= 0) p->t_assembly[k] = fmin(p->t_assembly[k], dt);
+    }
   }
-  if (st == FCM_OK) st = fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, A, &chol);
-  if (st == FCM_OK) st = fcm_direct_analyze(chol);
-  for (int r = 0; r < c->repeat && st == FCM_OK; r++) {
-    t0 = fcm_wtime();
-    c0 = (double)clock() / CLOCKS_PER_SEC;
-    fcm_csr_set_zero(A);
-    memset(g, 0, sizeof *g * (size_t)n);
-    st = fcm_assemble_hyperelastic(space, &mp, u, NULL, NULL, g, A);
-    if (st == FCM_OK) st = fcm_space_apply_dirichlet(space, ncon, con, zero, A, g);
-    const double t1 = fcm_wtime();
-    if (st == FCM_OK) st = fcm_direct_factor(chol, fcm_csr_values(A));
-    if (st == FCM_OK) st = fcm_direct_solve(chol, g, du);
-    const double t2 = fcm_wtime();
-    ta[r] = t1 - t0, tf[r] = t2 - t1, ti[r] = t2 - t0;
-    ci[r] = (double)clock() / CLOCKS_PER_SEC - c0;
-  }
-  if (st == FCM_OK) {
-    qsort(ta, (size_t)c->repeat, sizeof *ta, cmp_double);
-    qsort(tf, (size_t)c->repeat, sizeof *tf, cmp_double);
-    qsort(ti, (size_t)c->repeat, sizeof *ti, cmp_double);
-    qsort(ci, (size_t)c->repeat, sizeof *ci, cmp_double);
-    p->t_assembly = ta[0], p->t_factor_solve = tf[0], p->t_iteration = ti[0];
-    p->c_iteration = ci[0];
+  if (st == FCM_OK)
     fprintf(stderr,
-            CV_PROG ": payoff: %lld DOFs; Newton iteration %.3f s (assembly %.3f s, "
-                    "factor + solve %.3f s), fastest of %d\n",
-            (long long)n, p->t_iteration, p->t_assembly, p->t_factor_solve, c->repeat);
-  }
+            CV_PROG ": payoff: %s: rules %s simplification %.3f s; %lld + %lld cut-cell points; "
+                    "assembly %.4f + %.4f CPU s (stiffness + mass, fastest of %d)\n",
+            fcm_element_get_info(fcm_mesh_element_type(mesh))->name, simplify ? "with" : "without",
+            p->t_rules, (long long)p->points[0], (long long)p->points[1], p->t_assembly[0],
+            p->t_assembly[1], c->repeat);
 done:
-  fcm_direct_destroy(&chol);
-  free(u), free(g), free(du), free(zero), free(con), free(nodes);
+  free(u), free(g);
+  fcm_assembly_workspace_destroy(&ws);
   fcm_csr_destroy(&A);
   fcm_space_destroy(&space);
   fcm_cell_rules_destroy(&rules);
   return st;
 }
 
+static void payoff_rows(fcm_element_type e, const payoff_variant_result v[2], payoff_row rows[2])
+{
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    payoff_row *r = rows + k;
+    r->element = e;
+    r->kind = (fcm_rule_kind)k;
+    r->strength = v[1].strength[k];
+    r->cut_cells = v[1].cut_cells;
+    r->points_plain = v[0].points[k], r->points_simplified = v[1].points[k];
+    r->t_simplify = v[1].t_simplify[k];
+    r->t_plain = v[0].t_assembly[k], r->t_simplified = v[1].t_assembly[k];
+    const double gain = r->t_plain - r->t_simplified;
+    const double saved = (double)(r->points_plain - r->points_simplified);
+    r->point_cost = saved > 0.0 && gain > 0.0 ? gain / saved : NAN;
+    r->per_cell = r->cut_cells > 0 ? r->t_simplify / (double)r->cut_cells : NAN;
+    r->break_even = gain > 0.0 ? r->t_simplify / gain : INFINITY;
+  }
+}
+
+static int payoff_write_csv(const char *path, const config *c, const payoff_row *rows, int n)
+{
+  cli_output *out = NULL;
+  FILE *f = cli_output_open(CV_PROG, path, &out);
+  if (!f) return 0;
+  fprintf(f, "element,res,kind,strength,cut_cells,points_plain,points_simplified,t_simplify,"
+             "t_assembly_plain,t_assembly_simplified,point_cost,simplify_per_cell,"
+             "break_even_assemblies\n");
+  for (int i = 0; i < n; i++) {
+    const payoff_row *r = rows + i;
+    fprintf(f, "%s,%d,%s,%d,%lld,%lld,%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
+            fcm_element_get_info(r->element)->name, c->payoff_res,
+            r->kind == FCM_RULE_MASS ? "mass" : "stiffness", r->strength, (long long)r->cut_cells,
+            (long long)r->points_plain, (long long)r->points_simplified, r->t_simplify, r->t_plain,
+            r->t_simplified, r->point_cost, r->per_cell, r->break_even);
+  }
+  if (!cli_output_commit(CV_PROG, &out)) return 0;
+  fprintf(stderr, CV_PROG ": wrote %s\n", path);
+  return 1;
+}
+
 static int run_payoff(const config *c, fcm_ctx *ctx)
 {
   fcm_geometry *geom = NULL;
   fcm_mesh *mesh = NULL;
-  payoff_result p[2];
+  payoff_row rows[2 * FCM_ELEMENT_COUNT];
+  int nrows = 0, rc = 0;
   const double center[3] = {0, 0, 0};
-  int rc = 0;
-  memset(p, 0, sizeof p);
   fcm_status st =
       fcm_geometry_create_hemisphere(ctx, center, c->setup.radius, c->setup.geom_n, &geom);
-  if (st == FCM_OK) st = cv_mesh_create(ctx, c->payoff_element, c->payoff_res, &mesh);
-  if (st == FCM_OK)
-    fprintf(stderr, CV_PROG ": payoff: %s res %d (%lld cells), hemisphere %lld tets\n",
-            fcm_element_get_info(c->payoff_element)->name, c->payoff_res,
-            (long long)fcm_mesh_num_cells(mesh), (long long)fcm_geometry_num_cells(geom));
-  if (st == FCM_OK) st = payoff_variant(ctx, c, mesh, geom, 0, &p[0]);
-  if (st == FCM_OK) st = payoff_variant(ctx, c, mesh, geom, 1, &p[1]);
+  for (int e = 0; e < c->num_elements && st == FCM_OK; e++) {
+    payoff_variant_result v[2];
+    memset(v, 0, sizeof v);
+    st = cv_mesh_create(ctx, c->elements[e], c->payoff_res, &mesh);
+    if (st == FCM_OK)
+      fprintf(stderr, CV_PROG ": payoff: %s res %d (%lld cells), hemisphere %lld tets\n",
+              fcm_element_get_info(c->elements[e])->name, c->payoff_res,
+              (long long)fcm_mesh_num_cells(mesh), (long long)fcm_geometry_num_cells(geom));
+    if (st == FCM_OK) st = payoff_variant(ctx, c, mesh, geom, 0, &v[0]);
+    if (st == FCM_OK) st = payoff_variant(ctx, c, mesh, geom, 1, &v[1]);
+    if (st == FCM_OK) payoff_rows(c->elements[e], v, rows + nrows), nrows += 2;
+    fcm_mesh_destroy(&mesh);
+  }
   if (st != FCM_OK) {
     fprintf(stderr, CV_PROG ": payoff failed: %s\n", fcm_status_name(st));
     fcm_ctx_error_view(ctx, stderr);
     rc = 1;
     goto done;
   }
-  const double gain = p[0].t_iteration - p[1].t_iteration;
-  const double cost = p[1].t_rules - p[0].t_rules;
-  const double be = gain > 0.0 ? cost / gain : INFINITY;
-  const double cgain = p[0].c_iteration - p[1].c_iteration, ccost = p[1].c_rules - p[0].c_rules;
-  const double cbe = cgain > 0.0 ? ccost / cgain : INFINITY;
-  printf("\nsimplification payoff: %s FCM, res %d (h = %.4f), stiffness strength %d, hemisphere "
-         "%lld tets\n",
-         fcm_element_get_info(c->payoff_element)->name, c->payoff_res, 1.0 / c->payoff_res,
-         c->setup.strength > 0 ? c->setup.strength
-                               : fcm_element_get_info(c->payoff_element)->stiffness_strength,
-         (long long)fcm_geometry_num_cells(geom));
-  printf("%-12s %12s %12s %9s %9s %9s %9s %9s %9s %9s\n", "rules", "cut points", "all points",
-         "t_rules", "t_simpl", "t_asm", "t_fac+sol", "t_iter", "cpu_rules", "cpu_iter");
-  for (int k = 0; k < 2; k++)
-    printf("%-12s %12lld %12lld %9.3f %9.3f %9.3f %9.3f %9.3f %9.3f %9.3f\n",
-           k ? "simplified" : "plain", (long long)p[k].points_cut, (long long)p[k].points_total,
-           p[k].t_rules, p[k].t_simplify, p[k].t_assembly, p[k].t_factor_solve, p[k].t_iteration,
-           p[k].c_rules, p[k].c_iteration);
-  printf("(t_*: wall-clock seconds; t_simpl: simplification summed over threads; cpu_*: process "
-         "CPU seconds)\n");
-  printf("point reduction (cut cells) %.1fx; assembly speed-up %.2fx; iteration speed-up %.2fx\n",
-         p[1].points_cut > 0 ? (double)p[0].points_cut / (double)p[1].points_cut : NAN,
-         p[1].t_assembly > 0 ? p[0].t_assembly / p[1].t_assembly : NAN,
-         p[1].t_iteration > 0 ? p[0].t_iteration / p[1].t_iteration : NAN);
-  if (isfinite(be))
-    printf("break-even: the simplification (%.3f s extra) pays for itself after %.2f Newton "
-           "iteration(s) (%.3f s saved per iteration)\n",
-           cost, be, gain);
-  else
-    printf("break-even: never (an iteration is not faster with the simplified rules)\n");
-  if (isfinite(cbe)) printf("break-even in CPU seconds: after %.2f Newton iteration(s)\n", cbe);
-  if (c->payoff_csv) {
-    cli_output *out = NULL;
-    FILE *f = cli_output_open(CV_PROG, c->payoff_csv, &out);
-    if (!f) {
-      rc = 1;
-      goto done;
-    }
-    fprintf(f, "element,res,simplified,points_cut,points_total,t_rules,t_simplify,t_assembly,"
-               "t_factor_solve,t_iteration,break_even_iterations,cpu_rules,cpu_iteration,"
-               "break_even_cpu\n");
-    for (int k = 0; k < 2; k++)
-      fprintf(f, "%s,%d,%d,%lld,%lld,%.6f,%.6f,%.6f,%.6f,%.6f,%.6g,%.6f,%.6f,%.6g\n",
-              fcm_element_get_info(c->payoff_element)->name, c->payoff_res, p[k].simplified,
-              (long long)p[k].points_cut, (long long)p[k].points_total, p[k].t_rules,
-              p[k].t_simplify, p[k].t_assembly, p[k].t_factor_solve, p[k].t_iteration, be,
-              p[k].c_rules, p[k].c_iteration, cbe);
-    if (!cli_output_commit(CV_PROG, &out)) {
-      rc = 1;
-    } else {
-      fprintf(stderr, CV_PROG ": wrote %s\n", c->payoff_csv);
-    }
+  printf("\nsimplification payoff: FCM on the hemisphere (R = %g, %lld tets), res %d (h = %.4f), "
+         "manufactured displacement\n",
+         c->setup.radius, (long long)fcm_geometry_num_cells(geom), c->payoff_res,
+         1.0 / c->payoff_res);
+  printf("%-6s %-9s %2s %6s %10s %9s %9s %10s %10s %10s %10s %11s\n", "elem", "kind", "m", "cut",
+         "pts plain", "pts simpl", "t_simpl", "t_asm pl", "t_asm si", "s/point", "s/cell",
+         "break-even");
+  for (int i = 0; i < nrows; i++) {
+    const payoff_row *r = rows + i;
+    printf("%-6s %-9s %2d %6lld %10lld %9lld %9.4f %10.5f %10.5f %10.3g %10.3g %11.4g\n",
+           fcm_element_get_info(r->element)->name, r->kind == FCM_RULE_MASS ? "mass" : "stiffness",
+           r->strength, (long long)r->cut_cells, (long long)r->points_plain,
+           (long long)r->points_simplified, r->t_simplify, r->t_plain, r->t_simplified,
+           r->point_cost, r->per_cell, r->break_even);
   }
+  printf("(core-seconds: t_simpl = simplification of the kind's cut-cell rules; t_asm = one\n"
+         " assembly with plain / simplified rules, CPU time, fastest of %d: stiffness = Neo-Hookean\n"
+         " force + tangent, mass = consistent mass; s/point = (t_asm pl - t_asm si) / (pts plain -\n"
+         " pts simpl); break-even = t_simpl / (t_asm pl - t_asm si): simplification pays for\n"
+         " more assemblies than that)\n",
+         c->repeat);
+  if (c->payoff_csv && !payoff_write_csv(c->payoff_csv, c, rows, nrows)) rc = 1;
 done:
   fcm_mesh_destroy(&mesh);
   fcm_geometry_destroy(&geom);

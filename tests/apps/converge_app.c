@@ -3,8 +3,9 @@
  * {fcm, fem} x {L2, H1} and equals a refit of the levels file; each level row is consistent
  * (h = 1/res, t_total = sum of the phases, rel = err / norm, FCM errors measured over all
  * of Omega, FEM over less); the sweep covers m = 2..5; the PNGs are PNGs (when gnuplot is
- * installed) and no .tmp file is left. `payoff --quick` reports fewer points with
- * simplification and one break-even figure. Bad options exit 2 and write nothing.
+ * installed) and no .tmp file is left. `payoff --quick` (Tet4, Hex8) reports per element and
+ * rule kind fewer points with simplification and a finite positive break-even equal to
+ * its measured columns. Bad options exit 2 and write nothing.
  * Usage: app_converge PATH_TO_fcm-converge WORK_DIR */
 #define _POSIX_C_SOURCE 200809L
 #include "converge_csv.h"
@@ -111,39 +112,53 @@ int main(int argc, char **argv)
     TEST_TRUE(!cv_exists(path));
   }
 
-  /* payoff: fewer points with simplification, the same break-even on both rows */
+  /* payoff: per element and rule kind fewer points with simplification, a positive
+   * simplification time, and a finite positive break-even equal to the measured columns'
+   * t_simplify / (t_assembly_plain - t_assembly_simplified) */
   snprintf(path, sizeof path, "%s/converge-payoff.csv", dir);
   remove(path);
   snprintf(cmd, sizeof cmd,
-           "OMP_WAIT_POLICY=passive '%s' payoff --quick --csv '%s' > '%s' 2> /dev/null", prog, path,
-           out);
+           "OMP_WAIT_POLICY=passive '%s' payoff --quick --geom-n 3 --elements tet4,hex8 --csv '%s' "
+           "> '%s' 2> /dev/null",
+           prog, path, out);
   TEST_TRUE(cv_run_cmd(cmd) == 0);
   f = fopen(path, "r");
   TEST_TRUE(f && fgets(line, sizeof line, f) &&
-            !strcmp(line, "element,res,simplified,points_cut,points_total,t_rules,t_simplify,"
-                          "t_assembly,t_factor_solve,t_iteration,break_even_iterations,cpu_rules,"
-                          "cpu_iteration,break_even_cpu\n"));
-  long long pts[2] = {0, 0};
-  double be[2] = {0, 0}, titer[2] = {0, 0};
+            !strcmp(line, "element,res,kind,strength,cut_cells,points_plain,points_simplified,"
+                          "t_simplify,t_assembly_plain,t_assembly_simplified,point_cost,"
+                          "simplify_per_cell,break_even_assemblies\n"));
+  static const char *const prow[4][2] = {
+      {"tet4", "stiffness"}, {"tet4", "mass"}, {"hex8", "stiffness"}, {"hex8", "mass"}};
   rows = 0;
-  while (f && rows < 2 && fgets(line, sizeof line, f)) {
-    int res = 0, simp = -1;
-    TEST_TRUE(sscanf(line, "hex20,%d,%d,%lld,%*d,%*f,%*f,%*f,%*f,%lf,%lf", &res, &simp, &pts[rows],
-                     &titer[rows], &be[rows]) == 5);
-    TEST_TRUE(res == 4 && simp == rows && titer[rows] > 0.0);
+  while (f && rows < 4 && fgets(line, sizeof line, f)) {
+    char el[16] = "", kind[16] = "";
+    int res = 0, m = 0;
+    long long cut = 0, pp = 0, ps = 0;
+    double ts = 0, tp = 0, tq = 0, pc = 0, pcell = 0, be = 0;
+    TEST_TRUE(sscanf(line, "%15[^,],%d,%15[^,],%d,%lld,%lld,%lld,%lf,%lf,%lf,%lf,%lf,%lf", el, &res,
+                     kind, &m, &cut, &pp, &ps, &ts, &tp, &tq, &pc, &pcell, &be) == 13);
+    TEST_TRUE(!strcmp(el, prow[rows][0]) && !strcmp(kind, prow[rows][1]) && res == 3);
+    TEST_TRUE(m >= 1 && cut > 0 && ps > 0 && ps < pp && ts > 0.0 && tp > 0.0 && tq >= 0.0);
+    TEST_TRUE(tp > tq && isfinite(be) && be > 0.0);
+    if (tp > tq) {
+      TEST_NEAR(be, ts / (tp - tq), 1e-6, 0.0);
+      TEST_NEAR(pc, (tp - tq) / (double)(pp - ps), 1e-6, 0.0);
+      TEST_NEAR(pcell, ts / (double)cut, 1e-6, 0.0);
+    }
     rows++;
   }
   if (f) fclose(f);
-  TEST_TRUE(rows == 2 && pts[1] > 0 && pts[1] < pts[0]);
-  TEST_TRUE(be[0] == be[1]);
-  snprintf(cmd, sizeof cmd, "grep -q '^break-even' '%s'", out);
+  TEST_TRUE(rows == 4);
+  snprintf(cmd, sizeof cmd, "grep -q '^hex8   mass ' '%s' && grep -q 'break-even' '%s'", out, out);
   TEST_TRUE(cv_run_cmd(cmd) == 0);
+  snprintf(path, sizeof path, "%s/converge-payoff.csv.tmp", dir);
+  TEST_TRUE(!cv_exists(path));
 
   /* usage errors: status 2, nothing written */
   static const char *const bad[] = {
       "--levels 0",       "--levels 2,2", "--elements tet5",        "--methods xfem",
       "--simplify maybe", "--radius 1.5", "--fem-traction none",    "--strength 0",
-      "--bogus 1",        "--fit 1",      "payoff --elements hex8", "--levels",
+      "--bogus 1",        "--fit 1",      "payoff --elements hex9", "--levels",
       "--time gpu"};
   snprintf(path, sizeof path, "%s/converge-bad-levels.csv", dir);
   for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {

@@ -15,6 +15,9 @@ fcm_add_test(embed_degenerate tests/embed/degenerate.c)
 fcm_add_test(embed_surface tests/embed/surface.c)
 fcm_add_test(embed_rules tests/embed/rules.c)
 fcm_add_test(embed_errors tests/embed/errors.c)
+# Simplify only where it pays: the cost model on both sides of a break-even, AUTO = ON with
+# many assemblies, = OFF with none or a negligible point cost; its option errors.
+fcm_add_test(embed_simplify_auto tests/embed/simplify_auto.c)
 fcm_add_test(embed_bench tests/embed/bench.c LABELS bench TIMEOUT 3600)
 # Degenerate cuts (catalogue) and the random cut campaign: per-cell volume and first moments
 # within 1e-12 h^3 of exact values (2e-12 simplified), positive finite weights, <= M points

@@ -69,7 +69,9 @@ static const bad_case cases[] = {
      "1]}, \"cells\": [1, 1, 1]}}",
      FCM_ERR_ARG, "background.box.min: expected an array of 3 finite numbers, got 0", NULL},
     {"{" BASE ", \"quadrature\": {\"simplify\": 1}}", FCM_ERR_ARG,
-     "quadrature.simplify: expected true or false, got 1", NULL},
+     "quadrature.simplify: expected true, false or \"auto\", got 1", NULL},
+    {"{" BASE ", \"quadrature\": {\"simplify\": \"sometimes\"}}", FCM_ERR_ARG,
+     "quadrature.simplify: expected true, false or \"auto\", got \"sometimes\"", NULL},
     {"{" BASE ", \"effects\": [" FIX ", " FIX ", {\"motion\": {\"region\": {\"nodes\": [0]}, "
      "\"rotation\": {\"speed\": \"fast\"}}}]}",
      FCM_ERR_ARG, "effects[2].motion.rotation.speed: expected a finite number, got \"fast\"", NULL},

@@ -19,3 +19,5 @@ fcm_add_test(scene_alloc_simulation tests/scene/alloc_simulation.c TIMEOUT 900)
 add_test(NAME scene_alloc_simulation_full COMMAND scene_alloc_simulation full)
 set_tests_properties(scene_alloc_simulation_full PROPERTIES LABELS slow TIMEOUT 3600
                      ENVIRONMENT "OMP_NUM_THREADS=1;OMP_WAIT_POLICY=passive;OPENBLAS_NUM_THREADS=1")
+# quadrature.simplify "auto": parsing, and the choice per rule kind in the run summary.
+fcm_add_test(scene_simplify_auto tests/scene/simplify_auto.c)

@@ -33,6 +33,34 @@ typedef enum fcm_rule_kind {
   FCM_RULE_KIND_COUNT
 } fcm_rule_kind;
 
+/** Whether fcm_cell_rules_create() simplifies the cut-cell rules (fcm_simplify()). */
+typedef enum fcm_cell_simplify {
+  FCM_CELL_SIMPLIFY_OFF = 0, /**< keep every point of the mapped tet rules */
+  FCM_CELL_SIMPLIFY_ON = 1,  /**< simplify the rules of every cut cell (default) */
+  FCM_CELL_SIMPLIFY_AUTO = 2, /**< per rule kind, simplify when it pays for the expected number
+                                   of assemblies: a few cut cells are simplified and timed (the
+                                   probe), the time of all is extrapolated by points and compared
+                                   with the assembly time it saves (fcm_simplify_pays()); the
+                                   choice and its inputs are in fcm_cell_rules_stats.decision */
+  FCM_CELL_SIMPLIFY_COUNT
+} fcm_cell_simplify;
+
+/** Static name of a mode ("off", "on", "auto"; "invalid" outside the enum). */
+FCM_API const char *fcm_cell_simplify_name(fcm_cell_simplify mode);
+
+/** The cost model of FCM_CELL_SIMPLIFY_AUTO: 1 when simplifying pays, i.e. when
+ * (points_before - points_after) * point_cost * assemblies > simplify_time, else 0 (also for
+ * non-finite or negative arguments). point_cost: core-seconds one quadrature point costs in
+ * one assembly; simplify_time: core-seconds of simplifying the rules. No allocation. */
+FCM_API int fcm_simplify_pays(double assemblies, double point_cost, double points_before,
+                              double points_after, double simplify_time);
+
+/** Core-seconds one cut-cell quadrature point of `kind` costs in one assembly of a cell of
+ * element `type`, measured with `fcm-converge payoff` (stiffness: stable Neo-Hookean force +
+ * tangent; mass: the consistent mass) on one core of the development machine; the default
+ * point_cost of FCM_CELL_SIMPLIFY_AUTO. 0 for an invalid type or kind. */
+FCM_API double fcm_cell_rules_point_cost(fcm_element_type type, fcm_rule_kind kind);
+
 /** Options of fcm_cell_rules_create(); initialize with fcm_cell_rules_options_default(). */
 typedef struct fcm_cell_rules_options {
   int strength[FCM_RULE_KIND_COUNT]; /**< per kind; FCM_DEFAULT (default): the element's */
@@ -46,7 +74,17 @@ typedef struct fcm_cell_rules_options {
                              embedded cell clipped), so thin geometry keeps its volume; counted
                              with their volume in the statistics; default 1e-14 */
   double convex_rtol;    /**< tolerance of fcm_mesh_cell_is_convex(); default 1e-10 */
-  int simplify;          /**< 1 (default): simplify cut-cell rules with fcm_simplify() */
+  fcm_cell_simplify simplify; /**< FCM_CELL_SIMPLIFY_ON (default), OFF or AUTO */
+  double expected_assemblies[FCM_RULE_KIND_COUNT]; /**< AUTO: how many times the rules of each
+                              kind will be assembled (>= 0): a static single solve about 1
+                              stiffness (Newton iterations), 0 mass; a dynamic run steps x
+                              Newton iterations stiffness, 1 mass (assembled once); default 1 */
+  double point_cost[FCM_RULE_KIND_COUNT]; /**< AUTO: core-seconds per point per assembly, > 0;
+                              FCM_DEFAULT (default): fcm_cell_rules_point_cost() */
+  int probe_cells;       /**< AUTO: at most this many cut cells per kind are simplified to
+                              measure the simplification time (in rounds of one per thread,
+                              stopping once the two cost estimates differ by more than 4x),
+                              >= 1; default 4 */
   fcm_simplify_options simplify_options; /**< default fcm_simplify_options_default() */
   double max_rule_memory; /**< bytes the rules of one cut cell may take to build (an estimate
                                checked before allocating: points of both kinds plus the
@@ -59,6 +97,27 @@ typedef struct fcm_cell_rules_options {
 
 /** Defaults as documented on each member. */
 FCM_API fcm_cell_rules_options fcm_cell_rules_options_default(void);
+
+/** What FCM_CELL_SIMPLIFY_AUTO decided for one rule kind, and why (times in core-seconds).
+ * With OFF / ON only `simplified` and `time_simplify` are set (the rest 0). */
+typedef struct fcm_simplify_decision {
+  int simplified;             /**< 1: the cut-cell rules of this kind were simplified */
+  double expected_assemblies; /**< input of the model */
+  double point_cost;          /**< input: core-seconds per point per assembly */
+  fcm_index probe_cells;      /**< cut cells simplified to measure the cost (0: no probe, when
+                                   no assembly is expected or no cell is cut) */
+  fcm_index probe_points;     /**< their points before simplification */
+  fcm_index probe_kept;       /**< and after */
+  double probe_time;          /**< their simplification time */
+  double estimated_time;      /**< simplification time of all cut cells, extrapolated by points
+                                   from the probe */
+  double estimated_kept;      /**< points all cut cells keep, extrapolated per cell */
+  double cost_plain;          /**< assembly time of the unsimplified cut-cell points over the
+                                   expected assemblies: points x point_cost x assemblies */
+  double cost_simplified;     /**< estimated_time + estimated_kept x point_cost x assemblies */
+  double time_simplify;       /**< simplification time actually spent on this kind (probe
+                                   included, also when the probe's results were discarded) */
+} fcm_simplify_decision;
 
 /** Statistics of fcm_cell_rules_create(). Point counts cover cut cells unless "total".
  * Times in seconds: wall clock, except intersect and simplify, which are summed over
@@ -85,6 +144,7 @@ typedef struct fcm_cell_rules_stats {
   double geometry_volume; /**< fcm_geometry_volume() */
   double time_setup, time_intersect, time_simplify, time_gather, time_total;
   int num_threads;
+  fcm_simplify_decision decision[FCM_RULE_KIND_COUNT]; /**< per kind (see the mode) */
 } fcm_cell_rules_stats;
 
 /** Per-cell quadrature of an embedded geometry in a background mesh (opaque). */
@@ -94,12 +154,15 @@ typedef struct fcm_cell_rules fcm_cell_rules;
  * clipping by the cell's face planes, fan tetrahedralization, tet rules mapped into the
  * reference cell (closed-form inverse for affine cells, Newton otherwise), classification;
  * then per cut cell simplification (if enabled) followed by stabilization points (flag 1).
- * Parallel over cells (OpenMP); the output does not depend on the thread count.
+ * Parallel over cells (OpenMP); the output does not depend on the thread count. With
+ * FCM_CELL_SIMPLIFY_AUTO the choice per kind depends on measured times; the rules are then
+ * exactly those of OFF or of ON for that kind.
  * @param[in] mesh background mesh; every cell must be convex (straight edges, planar faces)
  * @param[in] geom embedded geometry; mesh and geom are only read during the call
  * @param[in] opts NULL for defaults; @param[out] rules NULL on failure
  * @return FCM_OK; FCM_ERR_ARG (NULL, strengths outside [0, 20] with simplification or
- *         [0, FCM_RULE_MAX_STRENGTH] without, thresholds outside 0 <= min_fraction <
+ *         [0, FCM_RULE_MAX_STRENGTH] without, simplify not a mode, AUTO with expected_assemblies
+ *         < 0, point_cost <= 0 (not FCM_DEFAULT) or probe_cells < 1, thresholds outside 0 <= min_fraction <
  *         uncut_fraction <= 1, tolerances out of range, bad stabilization); FCM_ERR_GEOMETRY
  *         (a non-convex background cell, naming it; a degenerate cell); FCM_ERR_NOT_CONVERGED
  *         (inverse map); FCM_ERR_UNSUPPORTED (a cell whose rules would exceed

@@ -12,6 +12,7 @@
 
 #include "fcm/core.h"
 #include "fcm/element.h"
+#include "fcm/embed.h"
 #include "fcm/la.h"
 #include "fcm/material.h"
 #include "fcm/sim.h"
@@ -81,7 +82,9 @@ typedef struct fcm_scene_quadrature {
   int mass_strength;      /**< [0, 20]; FCM_DEFAULT (default): the element's default */
   int surface_strength; /**< [0, 20]; FCM_DEFAULT (default): automatic (the stiffness strength when
                            a traction or pressure effect is present, else no surface rules) */
-  int simplify;         /**< 1 (default): simplify cut-cell rules; 0: keep them */
+  fcm_cell_simplify simplify; /**< "simplify": true (FCM_CELL_SIMPLIFY_ON, default), false
+                                   (OFF) or "auto" (AUTO: per rule kind, where it pays for the
+                                   assemblies the run expects; see fcm_simulation_create()) */
   fcm_simplify_method simplify_method;     /**< "simplify_method": "auto" (default), "lp",
                                                 "recombine", "eliminate" */
   fcm_stabilization_options stabilization; /**< "stabilization": mode "mass_stiffness"

@@ -22,12 +22,50 @@ fcm_cell_rules_options fcm_cell_rules_options_default(void)
   o.clip_rtol = 1e-12;
   o.sliver_rtol = 1e-14;
   o.convex_rtol = 1e-10;
-  o.simplify = 1;
+  o.simplify = FCM_CELL_SIMPLIFY_ON;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    o.expected_assemblies[k] = 1.0;
+    o.point_cost[k] = FCM_DEFAULT;
+  }
+  o.probe_cells = 4;
   o.simplify_options = fcm_simplify_options_default();
   o.stabilization = fcm_stabilization_options_default();
   o.max_rule_memory = 4.0 * GIB;
   o.num_threads = FCM_DEFAULT;
   return o;
+}
+
+const char *fcm_cell_simplify_name(fcm_cell_simplify mode)
+{
+  static const char *const names[FCM_CELL_SIMPLIFY_COUNT] = {"off", "on", "auto"};
+  return (int)mode >= 0 && mode < FCM_CELL_SIMPLIFY_COUNT ? names[mode] : "invalid";
+}
+
+int fcm_simplify_pays(double assemblies, double point_cost, double points_before,
+                      double points_after, double simplify_time)
+{
+  if (!(isfinite(assemblies) && isfinite(point_cost) && isfinite(points_before) &&
+        isfinite(points_after) && isfinite(simplify_time)) ||
+      assemblies < 0.0 || point_cost < 0.0 || points_after < 0.0 || simplify_time < 0.0)
+    return 0;
+  return (points_before - points_after) * point_cost * assemblies > simplify_time;
+}
+
+/* Core-seconds per cut-cell point per assembly. Measured with
+ *   OMP_NUM_THREADS=1 OMP_WAIT_POLICY=passive fcm-converge payoff --csv payoff.csv
+ * (column point_cost: the CPU time an assembly saves divided by the points it saves, on the
+ * hemisphere at res 8, geometry n 8, with the elements' default strengths; 2026-11-23, one
+ * core of the 2-core development machine); re-measure after a change of the assembly
+ * kernels. */
+double fcm_cell_rules_point_cost(fcm_element_type type, fcm_rule_kind kind)
+{
+  static const double cost[FCM_ELEMENT_COUNT][FCM_RULE_KIND_COUNT] = {
+      [FCM_ELEMENT_TET4] = {4.84e-7, 7.90e-8},  [FCM_ELEMENT_TET10] = {1.24e-6, 1.29e-7},
+      [FCM_ELEMENT_HEX8] = {9.27e-7, 9.98e-8},  [FCM_ELEMENT_HEX20] = {3.55e-6, 2.45e-7},
+  };
+  if ((int)type < 0 || type >= FCM_ELEMENT_COUNT || (int)kind < 0 || kind >= FCM_RULE_KIND_COUNT)
+    return 0.0;
+  return cost[type][kind];
 }
 
 /* What one cell produced (private to the thread that built it). */
@@ -39,6 +77,8 @@ typedef struct cell_out {
   int ninit[FCM_RULE_KIND_COUNT], nsimp[FCM_RULE_KIND_COUNT], nstab[FCM_RULE_KIND_COUNT];
   unsigned char skipped[FCM_RULE_KIND_COUNT], fallback[FCM_RULE_KIND_COUNT];
   double residual[FCM_RULE_KIND_COUNT];
+  double tsimp[FCM_RULE_KIND_COUNT];          /* fcm_simplify's time_total */
+  unsigned char probed[FCM_RULE_KIND_COUNT]; /* AUTO: simplified by the probe */
   int ns;
   double *spts, *sw, *snrm;
   fcm_index *stri;
@@ -102,6 +142,7 @@ static fcm_status simplify_rule(fcm_ctx *ctx, const fcm_simplify_options *opts, 
   o->skipped[k] = (unsigned char)info.skipped;
   o->fallback[k] = (unsigned char)info.fallback;
   o->residual[k] = info.residual;
+  o->tsimp[k] += info.time_total;
 cleanup:
   fcm_simplify_result_destroy(&res);
   return st;
@@ -162,6 +203,35 @@ cleanup:
   return st;
 }
 
+/* The last step of a cut cell: simplify the kinds with simp[k] set, then append the
+ * stabilization points. */
+static fcm_status finish_cell(const build *B, const fcm_cell_rules *R, cell_out *o,
+                              const int simp[FCM_RULE_KIND_COUNT], cell_sums *sums)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_cell_rules_options *opt = B->o;
+  const double t1 = fcm_wtime();
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    if (simp[k]) {
+      FCM_TRY(ctx, simplify_rule(ctx, &opt->simplify_options, R->strength[k], &o->n[k], o->pts[k],
+                                 o->w[k], o, k));
+      o->nsimp[k] = o->n[k];
+    }
+    if (B->stabilize[k]) {
+      fcm_index n = o->n[k];
+      const fcm_index cap = n + fcm_rule_num_points(B->full_rule[k]);
+      FCM_TRY(ctx, fcm_stabilization_append(ctx, &opt->stabilization, B->full_rule[k], cap, &n,
+                                            o->pts[k], o->w[k], o->flag[k]));
+      o->nstab[k] = (int)n - o->n[k];
+      o->n[k] = (int)n;
+    }
+  }
+cleanup:
+  sums->time_simplify += fcm_wtime() - t1;
+  return st;
+}
+
 /* Intersect, classify and build the rules of background cell c into o (the thread's own
  * buffers); R->cls[c] and R->fraction[c] are written here (one writer per cell). */
 static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, fcm__embed_ws *ws,
@@ -219,26 +289,12 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
       o->ns = (int)ns;
     }
   }
-  const double t1 = fcm_wtime();
-  sums->time_intersect += t1 - t0;
-  if (cls == FCM_CELL_CUT) {
-    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
-      if (opt->simplify) {
-        FCM_TRY(ctx, simplify_rule(ctx, &opt->simplify_options, R->strength[k], &o->n[k], o->pts[k],
-                                   o->w[k], o, k));
-        o->nsimp[k] = o->n[k];
-      }
-      if (B->stabilize[k]) {
-        fcm_index n = o->n[k];
-        const fcm_index cap = n + fcm_rule_num_points(B->full_rule[k]);
-        FCM_TRY(ctx, fcm_stabilization_append(ctx, &opt->stabilization, B->full_rule[k], cap, &n,
-                                              o->pts[k], o->w[k], o->flag[k]));
-        o->nstab[k] = (int)n - o->n[k];
-        o->n[k] = (int)n;
-      }
-    }
+  sums->time_intersect += fcm_wtime() - t0;
+  if (cls == FCM_CELL_CUT && opt->simplify != FCM_CELL_SIMPLIFY_AUTO) {
+    const int on = opt->simplify == FCM_CELL_SIMPLIFY_ON;
+    const int simp[FCM_RULE_KIND_COUNT] = {on, on};
+    FCM_TRY(ctx, finish_cell(B, R, o, simp, sums));
   }
-  sums->time_simplify += fcm_wtime() - t1;
 cleanup:
   return st;
 }
@@ -246,6 +302,24 @@ cleanup:
 static fcm_status check_options(fcm_ctx *ctx, const fcm_cell_rules_options *o)
 {
   fcm_status st = FCM_OK;
+  FCM_CHECK((int)o->simplify >= 0 && o->simplify < FCM_CELL_SIMPLIFY_COUNT, ctx, FCM_ERR_ARG,
+            "embed: simplify = %d is not a mode (0 off, 1 on, 2 auto)", (int)o->simplify);
+  if (o->simplify == FCM_CELL_SIMPLIFY_AUTO) {
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+      const char *kn = k == FCM_RULE_MASS ? "mass" : "stiffness";
+      FCM_CHECK(isfinite(o->expected_assemblies[k]) && o->expected_assemblies[k] >= 0.0, ctx,
+                FCM_ERR_ARG, "embed: expected_assemblies[%s] = %g must be finite and >= 0", kn,
+                o->expected_assemblies[k]);
+      FCM_CHECK(o->point_cost[k] == FCM_DEFAULT ||
+                    (isfinite(o->point_cost[k]) && o->point_cost[k] > 0.0),
+                ctx, FCM_ERR_ARG,
+                "embed: point_cost[%s] = %g must be > 0 seconds (FCM_DEFAULT: the measured "
+                "constant of the element)",
+                kn, o->point_cost[k]);
+    }
+    FCM_CHECK(o->probe_cells >= 1, ctx, FCM_ERR_ARG, "embed: probe_cells = %d must be >= 1",
+              o->probe_cells);
+  }
   const int smax = o->simplify ? FCM_SIMPLIFY_MAX_STRENGTH : FCM_RULE_MAX_STRENGTH;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     FCM_CHECK(o->strength[k] >= -1 && o->strength[k] <= smax, ctx, FCM_ERR_ARG,
@@ -425,6 +499,161 @@ cleanup:
   return st;
 }
 
+/* AUTO stops probing once the two cost estimates differ by more than this factor. */
+#define AUTO_PROBE_MARGIN 4.0
+
+/* What a loop of auto_simplify() does to each cell of its list. */
+typedef enum auto_phase {
+  AUTO_PROBE,  /* simplify kind `kind` (timed) */
+  AUTO_FINISH  /* simplify the kinds that pay (not the probed cells again), stabilize */
+} auto_phase;
+
+/* Run `phase` on the cells list[0 .. n) in parallel; the error is the lowest failing one's. */
+static fcm_status auto_loop(const build *B, const fcm_cell_rules *R, int nthreads, cell_out *out,
+                            const fcm_index *list, fcm_index n, auto_phase phase, int kind,
+                            const int pays[FCM_RULE_KIND_COUNT], cell_sums *sums)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  fcm__loop loop;
+  fcm__loop_begin(ctx, &loop);
+#pragma omp parallel num_threads(nthreads)
+  {
+    cell_sums mine;
+    memset(&mine, 0, sizeof mine);
+#pragma omp for schedule(dynamic, 1)
+    for (fcm_index i = 0; i < n; i++) {
+      if (fcm__loop_skip(&loop, i)) continue;
+      fcm__loop_iter it;
+      fcm__loop_enter(&loop, &it, i);
+      cell_out *o = out + list[i];
+      fcm_status s = FCM_OK;
+      if (phase == AUTO_PROBE) {
+        s = simplify_rule(ctx, &B->o->simplify_options, R->strength[kind], &o->n[kind],
+                          o->pts[kind], o->w[kind], o, kind);
+        o->nsimp[kind] = o->n[kind];
+        o->probed[kind] = 1;
+        mine.time_simplify += o->tsimp[kind];
+      } else {
+        int simp[FCM_RULE_KIND_COUNT];
+        for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+          simp[k] = pays[k] && !o->probed[k];
+        s = finish_cell(B, R, o, simp, &mine);
+      }
+      fcm__loop_leave(&loop, &it, s);
+    }
+#pragma omp critical(fcm_embed_auto_sum)
+    sums->time_simplify += mine.time_simplify;
+  }
+  FCM_TRY(ctx, fcm__loop_end(&loop, NULL));
+cleanup:
+  return st;
+}
+
+/* Phase 2b of FCM_CELL_SIMPLIFY_AUTO (the cells are intersected and mapped, not yet
+ * simplified nor stabilized): per kind, simplify probe_cells cut cells spread over the cell
+ * order, extrapolate their time by points and their kept points per cell to all cut cells,
+ * decide with fcm_simplify_pays() (the probe runs in rounds of one cell per thread and stops
+ * early when the estimates differ by more than AUTO_PROBE_MARGIN); probe cells of a kind that
+ * does not pay get their unsimplified rules back, so the rules are those of OFF or ON for
+ * each kind. Then finish every cut cell. */
+static fcm_status auto_simplify(const build *B, fcm_cell_rules *R, int nthreads, cell_out *out,
+                                cell_sums *sums)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_cell_rules_options *opt = B->o;
+  const fcm_index nc = R->num_cells;
+  fcm_index *cut = NULL, *probe = NULL, ncut = 0;
+  double *saved = NULL; /* the probe cells' unsimplified points (x 3) and weights */
+  int pays[FCM_RULE_KIND_COUNT] = {0, 0};
+  for (fcm_index c = 0; c < nc; c++)
+    ncut += R->cls[c] == FCM_CELL_CUT;
+  FCM_ALLOC(ctx, (size_t)ncut + 1, cut);
+  ncut = 0;
+  for (fcm_index c = 0; c < nc; c++)
+    if (R->cls[c] == FCM_CELL_CUT) cut[ncut++] = c;
+  const fcm_index np = ncut < opt->probe_cells ? ncut : opt->probe_cells;
+  FCM_ALLOC(ctx, (size_t)np + 1, probe);
+  /* Spread over the cell order (distinct: consecutive picks differ by ncut/np >= 1), the
+   * even picks first so that an early stop still samples the whole range. */
+  for (fcm_index i = 0, j = 0; i < np; i++, j += 2) {
+    if (j >= np) j = 1;
+    probe[i] = cut[(2 * j + 1) * ncut / (2 * np)];
+  }
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    fcm_simplify_decision *d = &R->stats.decision[k];
+    const fcm_element_type type = fcm_mesh_element_type(B->mesh);
+    d->expected_assemblies = opt->expected_assemblies[k];
+    d->point_cost = opt->point_cost[k] == FCM_DEFAULT ? fcm_cell_rules_point_cost(type, k)
+                                                      : opt->point_cost[k];
+    double ntot = 0.0;
+    for (fcm_index i = 0; i < ncut; i++)
+      ntot += out[cut[i]].ninit[k];
+    d->cost_plain = ntot * d->point_cost * d->expected_assemblies;
+    if (np == 0 || d->expected_assemblies <= 0.0) { /* nothing to gain: no probe */
+      d->cost_simplified = d->cost_plain;
+      continue;
+    }
+    size_t nsave = 0;
+    for (fcm_index i = 0; i < np; i++)
+      nsave += (size_t)out[probe[i]].ninit[k];
+    FCM_ALLOC(ctx, 4 * nsave, saved);
+    for (size_t i = 0, at = 0; i < (size_t)np; i++) {
+      const cell_out *o = out + probe[i];
+      const size_t n = (size_t)o->ninit[k];
+      memcpy(saved + 4 * at, o->pts[k], 3 * n * sizeof *saved);
+      memcpy(saved + 4 * at + 3 * n, o->w[k], n * sizeof *saved);
+      at += n;
+    }
+    /* Rounds of one cell per thread until every probe cell is done or the estimates differ by
+     * more than AUTO_PROBE_MARGIN either way. */
+    fcm_index q = 0;
+    while (q < np) {
+      const fcm_index m = np - q < nthreads ? np - q : nthreads;
+      FCM_TRY(ctx, auto_loop(B, R, nthreads, out, probe + q, m, AUTO_PROBE, k, pays, sums));
+      for (fcm_index i = q; i < q + m; i++) {
+        const cell_out *o = out + probe[i];
+        d->probe_points += o->ninit[k];
+        d->probe_kept += o->nsimp[k];
+        d->probe_time += o->tsimp[k];
+      }
+      q += m;
+      d->probe_cells = q;
+      d->estimated_time =
+          d->probe_points > 0 ? d->probe_time * ntot / (double)d->probe_points : 0.0;
+      d->estimated_kept = (double)d->probe_kept * (double)ncut / (double)q;
+      d->cost_simplified =
+          d->estimated_time + d->estimated_kept * d->point_cost * d->expected_assemblies;
+      if (d->cost_plain > AUTO_PROBE_MARGIN * d->cost_simplified ||
+          d->cost_simplified > AUTO_PROBE_MARGIN * d->cost_plain)
+        break;
+    }
+    pays[k] = fcm_simplify_pays(d->expected_assemblies, d->point_cost, ntot, d->estimated_kept,
+                                d->estimated_time);
+    if (!pays[k]) /* give the probe cells their unsimplified rules back */
+      for (size_t i = 0, at = 0; i < (size_t)q; i++) {
+        cell_out *o = out + probe[i];
+        const size_t n = (size_t)o->ninit[k];
+        memcpy(o->pts[k], saved + 4 * at, 3 * n * sizeof *saved);
+        memcpy(o->w[k], saved + 4 * at + 3 * n, n * sizeof *saved);
+        o->n[k] = o->nsimp[k] = o->ninit[k];
+        o->skipped[k] = o->fallback[k] = 0;
+        o->residual[k] = 0.0;
+        at += n;
+      }
+    FCM_FREE(ctx, saved);
+  }
+  FCM_TRY(ctx, auto_loop(B, R, nthreads, out, cut, ncut, AUTO_FINISH, -1, pays, sums));
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    R->stats.decision[k].simplified = pays[k];
+cleanup:
+  fcm__free(ctx, saved);
+  fcm__free(ctx, cut);
+  fcm__free(ctx, probe);
+  return st;
+}
+
 /* Phase 3: concatenate the cells' volume and surface rules in cell order. */
 static fcm_status gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_out *out)
 {
@@ -483,6 +712,7 @@ static void gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const cell
       S->simplify_skipped[k] += o->skipped[k];
       S->simplify_fallbacks[k] += o->fallback[k];
       S->max_residual[k] = fmax(S->max_residual[k], o->residual[k]);
+      S->decision[k].time_simplify += o->tsimp[k];
     }
     for (int j = 0; j < o->ns; j++)
       S->embedded_area += o->sw[j];
@@ -547,10 +777,14 @@ fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_g
   /* 2. parallel per-cell work */
   const int nthreads = o.num_threads > 0 ? o.num_threads : omp_get_max_threads();
   FCM_TRY(ctx, run_cells(&B, R, nthreads, out, &sums));
+  if (o.simplify == FCM_CELL_SIMPLIFY_AUTO) FCM_TRY(ctx, auto_simplify(&B, R, nthreads, out, &sums));
   const double t_loop = fcm_wtime();
   /* 3. gather, 4. statistics */
   FCM_TRY(ctx, gather_rules(ctx, R, out));
   gather_stats(R, geom, out, &sums, nthreads);
+  if (o.simplify != FCM_CELL_SIMPLIFY_AUTO)
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+      R->stats.decision[k].simplified = o.simplify == FCM_CELL_SIMPLIFY_ON;
   R->stats.time_setup = t_setup - t_start;
   R->stats.time_gather = fcm_wtime() - t_loop;
   R->stats.time_total = fcm_wtime() - t_start;
@@ -705,6 +939,17 @@ void fcm_cell_rules_view(const fcm_cell_rules *rules, FILE *stream)
             (long long)S->points_simplified[k], (long long)S->points_stabilization[k],
             (long long)S->points_total[k], (long long)S->simplify_skipped[k],
             (long long)S->simplify_fallbacks[k], S->max_residual[k]);
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    const fcm_simplify_decision *d = &S->decision[k];
+    if (d->probe_cells > 0 || d->point_cost > 0.0)
+      fprintf(stream,
+              "  %-9s simplify auto: %s for %g assemblies (%.3g core-s per point): probe %lld "
+              "cells %lld -> %lld points in %.3g core-s; estimated assembly %.3g core-s plain vs "
+              "%.3g simplify + assembly\n",
+              names[k], d->simplified ? "on" : "off", d->expected_assemblies, d->point_cost,
+              (long long)d->probe_cells, (long long)d->probe_points, (long long)d->probe_kept,
+              d->probe_time, d->cost_plain, d->cost_simplified);
+  }
   if (rules->surface_strength >= 0)
     fprintf(stream, "  surface strength %d: %lld triangles, %lld points, area %.17g\n",
             rules->surface_strength, (long long)S->surface_triangles, (long long)S->surface_points,

@@ -286,6 +286,11 @@ cleanup:
   return st;
 }
 
+/* Stiffness assemblies per time or load step that FCM_CELL_SIMPLIFY_AUTO assumes: the default
+ * scene takes 508 Newton iterations in 210 steps (2.4 per step), each assembling force and
+ * tangent, plus line-search and predictor force evaluations. */
+#define RUN_ASSEMBLIES_PER_STEP 3.0
+
 static fcm_status build_rules(fcm_simulation *S)
 {
   fcm_status st = FCM_OK;
@@ -309,6 +314,16 @@ static fcm_status build_rules(fcm_simulation *S)
   ro.min_fraction = q->min_fraction;
   ro.max_rule_memory = q->max_rule_memory_gib * 1024.0 * 1024.0 * 1024.0;
   ro.simplify = q->simplify;
+  if (q->simplify == FCM_CELL_SIMPLIFY_AUTO) {
+    /* The assemblies the run expects: stiffness-kind rules (force + tangent, body forces) once
+     * per Newton iteration, about RUN_ASSEMBLIES_PER_STEP per step and load step; mass rules
+     * once (the constant mass matrix of a dynamic run), never in a static one. */
+    const fcm_scene_time *tm = fcm_scene_get_time(S->scene);
+    const int dynamic = tm->integrator != FCM_INTEGRATOR_STATIC;
+    ro.expected_assemblies[FCM_RULE_STIFFNESS] =
+        RUN_ASSEMBLIES_PER_STEP * (double)tm->num_steps * (dynamic ? 1.0 : (double)tm->load_steps);
+    ro.expected_assemblies[FCM_RULE_MASS] = dynamic ? 1.0 : 0.0;
+  }
   ro.simplify_options.method = q->simplify_method;
   ro.stabilization = q->stabilization;
   ro.num_threads = sv->threads;
@@ -712,10 +727,32 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
 {
   if (!S || !f) return;
   const fcm_simulation_counters *c = &S->c;
-  char b[256];
+  char b[512];
   fprintf(f, "simulation %s: %lld of %lld steps, %lld DOFs\n", fcm_scene_name(S->scene), c->steps,
           S->num_steps, (long long)c->num_dofs);
   line(f, c->cell_rules, "embedded cell rules", c->cell_rules ? "" : "(no geometry)");
+  if (S->rules) {
+    const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(S->rules);
+    const fcm_scene_quadrature *q = fcm_scene_get_quadrature(S->scene);
+    static const char *const kinds[FCM_RULE_KIND_COUNT] = {"stiffness", "mass"};
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+      const fcm_simplify_decision *d = &rs->decision[k];
+      char what[64];
+      snprintf(what, sizeof what, "%s simplification", kinds[k]);
+      if (q->simplify == FCM_CELL_SIMPLIFY_AUTO)
+        snprintf(b, sizeof b,
+                 "auto: %s for %g expected assemblies; cost model %.3g core-s per point per "
+                 "assembly; probe %lld cells %lld -> %lld points in %.3g core-s; estimated "
+                 "%.3g core-s assembling plain vs %.3g simplifying + assembling",
+                 d->simplified ? "on" : "off", d->expected_assemblies, d->point_cost,
+                 (long long)d->probe_cells, (long long)d->probe_points, (long long)d->probe_kept,
+                 d->probe_time, d->cost_plain, d->cost_simplified);
+      else
+        snprintf(b, sizeof b, "%s (scene), %.3g core-s", fcm_cell_simplify_name(q->simplify),
+                 d->time_simplify);
+      line(f, d->simplified, what, b);
+    }
+  }
   line(f, c->surface_rules, "surface rules", c->surface_rules ? "" : "(no traction or pressure)");
   line(f, c->inertia, "inertia (backward Euler)", c->inertia ? "" : "(static scene)");
   snprintf(b, sizeof b, "%d", c->mass_assemblies);

@@ -367,7 +367,7 @@ static fcm_status read_quadrature(fcm__scene_parser *p, const fcm__json *root)
   const fcm__json *o = NULL, *stab = NULL;
   size_t old = p->path_len;
   q->stiffness_strength = q->mass_strength = q->surface_strength = -1;
-  q->simplify = 1;
+  q->simplify = FCM_CELL_SIMPLIFY_ON;
   q->simplify_method = FCM_SIMPLIFY_AUTO;
   q->stabilization = fcm_stabilization_options_default();
   q->min_fraction = 1e-4;
@@ -380,7 +380,12 @@ static fcm_status read_quadrature(fcm__scene_parser *p, const fcm__json *root)
   READ_INT(p, o, "stiffness_strength", 0, 0, 20, q->stiffness_strength);
   READ_INT(p, o, "mass_strength", 0, 0, 20, q->mass_strength);
   READ_INT(p, o, "surface_strength", 0, 0, 20, q->surface_strength);
-  FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "simplify", 0, &q->simplify));
+  {
+    int simplify = (int)q->simplify;
+    FCM_TRY(p->ctx, fcm__scene_read_bool_or_word(p, o, "simplify", 0, "auto",
+                                                 FCM_CELL_SIMPLIFY_AUTO, &simplify));
+    q->simplify = (fcm_cell_simplify)simplify;
+  }
   READ_CHOICE(p, o, "simplify_method", 0, simplify_names, q->simplify_method);
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "stabilization", 0, &stab));
   if (stab) {
@@ -890,7 +895,7 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
   else
     fprintf(f, " surface automatic");
   fprintf(f, "; simplify %s (%s); stabilization %s alpha %g; min fraction %g\n",
-          q->simplify ? "on" : "off", simplify_names[q->simplify_method],
+          fcm_cell_simplify_name(q->simplify), simplify_names[q->simplify_method],
           stabilization_names[q->stabilization.mode], q->stabilization.alpha, q->min_fraction);
   fprintf(f, "solver: %s", CHOICE_NAME(solver_names, solver_values, so->method));
   if (so->method == FCM_LINEAR_DIRECT)

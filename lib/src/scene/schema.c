@@ -248,6 +248,30 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__scene_read_bool_or_word(fcm__scene_parser *p, const fcm__json *obj,
+                                        const char *key, int required, const char *word,
+                                        int word_value, int *out)
+{
+  fcm_status st = FCM_OK;
+  const fcm__json *v = NULL;
+  char want[DESC_LEN], got[DESC_LEN];
+  size_t old = p->path_len;
+  snprintf(want, sizeof want, "true, false or \"%s\"", word);
+  FCM_TRY(p->ctx, fcm__scene_field(p, obj, key, required, want, FCM__SCENE_ANY_KIND, -1, &v));
+  if (!v) return FCM_OK;
+  if (fcm__json_get_kind(v) == FCM__JSON_BOOL) {
+    *out = fcm__json_bool(v);
+  } else {
+    fcm__scene_describe(v, got, sizeof got);
+    SCENE_CHECK(fcm__json_get_kind(v) == FCM__JSON_STRING && !strcmp(fcm__json_string(v), word),
+                p, FCM_ERR_ARG, "expected %s, got %s", want, got);
+    *out = word_value;
+  }
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
 fcm_status fcm__scene_strdup(fcm__scene_parser *p, const char *s, const char **out)
 {
   fcm_status st = FCM_OK;
