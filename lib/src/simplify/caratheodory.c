@@ -17,6 +17,9 @@
 #include <math.h>
 #include <string.h>
 
+/* Tableau updates with at least this many entries go through BLAS dger. */
+#define ELIM_GER_MIN 4096
+
 typedef struct tableau {
   int rows, K, kn; /* basis size, active columns, non-basic columns (K - rows) */
   double *at;      /* K x rows, ld K: LU of G^T, then D^T in rows rows..K-1 */
@@ -53,8 +56,20 @@ static void eliminate(tableau *t)
     double *colq = dt + (size_t)q * ld + j + 1;
     for (int r = 0; r < rest; r++)
       t->f[r] = colq[r] / dq;
-    /* Rows below j: e -= f d^T (column q becomes 0 and is then set to f). */
-    fcm__ger(rest, rows, -1.0, t->f, dt + j, ld, dt + j + 1, ld);
+    /* Rows below j: e -= f d^T (column q becomes 0 and is then set to f); BLAS for large
+     * updates, a plain loop below the cost of the call. */
+    if ((long long)rest * rows >= ELIM_GER_MIN) {
+      fcm__ger(rest, rows, -1.0, t->f, dt + j, ld, dt + j + 1, ld);
+    } else {
+      for (int i = 0; i < rows; i++) {
+        const double di = dt[j + (size_t)i * ld];
+        double *restrict col = dt + (size_t)i * ld + j + 1;
+        const double *restrict f = t->f;
+        if (di != 0.0)
+          for (int r = 0; r < rest; r++)
+            col[r] -= f[r] * di;
+      }
+    }
     memcpy(colq, t->f, sizeof *t->f * (size_t)rest);
     const int leaving = t->id_b[q];
     t->id_b[q] = t->id_n[j];
