@@ -230,19 +230,7 @@ fcm_status fcm__simplify_run_eliminate(fcm__attempt *a)
   a->time_basis += fcm_wtime() - t0;
   FCM_TRY(ctx, fcm__simplify_reduce(a, M, n, g, q, lam));
   if (a->reason != FCM_SIMPLIFY_REASON_NONE) goto cleanup;
-  a->count = 0;
-  for (int j = 0; j < n; j++)
-    if (lam[j] > 0.0) {
-      if (a->count == a->capacity) {
-        fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_COUNT,
-                           "elimination kept more than M = %d positive weights", a->capacity);
-        goto cleanup;
-      }
-      a->support[a->count] = j;
-      a->w[a->count++] = lam[j];
-    }
-  if (a->count == 0)
-    fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_NOT_POSITIVE, "elimination kept no positive weight");
+  fcm__simplify_take_support(a, n, NULL, NULL, lam, "elimination");
 cleanup:
   fcm__free(ctx, g);
   fcm__free(ctx, q);

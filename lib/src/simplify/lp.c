@@ -45,19 +45,7 @@ fcm_status fcm__simplify_run_lp(fcm__attempt *a)
   }
 
   /* Keep the positive entries of the vertex (at most r of them are basic). */
-  a->count = 0;
-  for (int j = 0; j < n; j++)
-    if (x[j] > 0.0) {
-      if (a->count == a->capacity) {
-        fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_COUNT,
-                           "LP vertex has more than M = %d positive weights", a->capacity);
-        goto cleanup;
-      }
-      a->support[a->count] = j;
-      a->w[a->count++] = x[j];
-    }
-  if (a->count == 0)
-    fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_NOT_POSITIVE, "LP vertex has no positive weight");
+  fcm__simplify_take_support(a, n, NULL, NULL, x, "LP vertex");
 cleanup:
   fcm__free(ctx, P);
   fcm__free(ctx, vt);

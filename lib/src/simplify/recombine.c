@@ -113,19 +113,7 @@ fcm_status fcm__simplify_run_recombine(fcm__attempt *a)
   a->time_basis += fcm_wtime() - t0;
   FCM_TRY(ctx, cluster_lp(a, M, nact, g, q, rhs, lam));
   if (a->reason != FCM_SIMPLIFY_REASON_NONE) goto cleanup;
-  a->count = 0;
-  for (int i = 0; i < nact; i++)
-    if (lam[i] > 0.0) {
-      if (a->count == a->capacity) {
-        fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_COUNT,
-                           "final LP vertex has more than M = %d positive weights", a->capacity);
-        goto cleanup;
-      }
-      a->support[a->count] = idx[i];
-      a->w[a->count++] = cw[i] * lam[i];
-    }
-  if (a->count == 0)
-    fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_NOT_POSITIVE, "final LP has no positive weight");
+  fcm__simplify_take_support(a, nact, idx, cw, lam, "final step");
 cleanup:
   fcm__free(ctx, idx);
   fcm__free(ctx, cw);

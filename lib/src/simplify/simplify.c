@@ -93,6 +93,24 @@ void fcm__simplify_set_moments(fcm__attempt *a, int ncols, const double *g, cons
   a->have_moments = 1;
 }
 
+void fcm__simplify_take_support(fcm__attempt *a, int n, const int *idx, const double *scale,
+                                const double *x, const char *what)
+{
+  a->count = 0;
+  for (int j = 0; j < n; j++)
+    if (x[j] > 0.0) {
+      if (a->count == a->capacity) {
+        fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_COUNT,
+                           "%s kept more than M = %d positive weights", what, a->capacity);
+        return;
+      }
+      a->support[a->count] = idx ? idx[j] : j;
+      a->w[a->count++] = scale ? scale[j] * x[j] : x[j];
+    }
+  if (a->count == 0)
+    fcm__simplify_fail(a, FCM_SIMPLIFY_REASON_NOT_POSITIVE, "%s kept no positive weight", what);
+}
+
 void fcm__simplify_fail(fcm__attempt *a, fcm_simplify_reason reason, const char *fmt, ...)
 {
   va_list ap;

@@ -113,6 +113,12 @@ typedef struct fcm__attempt {
  * (NULL: ones). */
 void fcm__simplify_set_moments(fcm__attempt *a, int ncols, const double *g, const double *lam);
 
+/* The attempt's support from the positive entries of x (n): point idx[j] (idx NULL: j) with
+ * weight x[j] * scale[j] (scale NULL: x[j]), ascending when idx is; a soft COUNT failure
+ * past a->capacity points, NOT_POSITIVE when none is positive (`what` names the step). */
+void fcm__simplify_take_support(fcm__attempt *a, int n, const int *idx, const double *scale,
+                                const double *x, const char *what);
+
 /* Record a soft failure of an attempt (the driver retries or falls back). */
 void fcm__simplify_fail(fcm__attempt *a, fcm_simplify_reason reason, const char *fmt, ...)
     FCM__PRINTF(3, 4);
