@@ -16,7 +16,7 @@ fcm_add_test(app_sim_resume tests/apps/sim_app.c LABELS app
              ARGS resume $<TARGET_FILE:fcm-sim> ${work})
 # The README quick start, `fcm-sim` without arguments: the first 6 steps in the default run
 # (frames, PVD indexes and log rows checked step by step); to the end (71 frames, 210 log
-# rows; about 85 s on 2 idle cores) labelled slow.
+# rows; about 55 s on 2 idle cores) labelled slow.
 fcm_add_test(app_sim_default_quick tests/apps/sim_app.c LABELS app TIMEOUT 900
              ARGS default-quick $<TARGET_FILE:fcm-sim> ${work})
 fcm_add_test(app_sim_default tests/apps/sim_app.c LABELS app slow TIMEOUT 1200
