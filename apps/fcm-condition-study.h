@@ -35,7 +35,7 @@ typedef struct config {
   double theta;   /* Schwarz: cut cells with phi < theta get a block */
   double epsilon; /* Schwarz eigenvalue threshold */
   int simplify;
-  int project; /* 1: PSD-projected material tangent */
+  int project;    /* 1: PSD-projected material tangent */
   int fictitious; /* fcm_fictitious_model of the stabilization points */
   int pc_tangent; /* fcm_fictitious_model: tangent of the preconditioners' matrix */
   double density, young, poisson, dt;

@@ -165,14 +165,14 @@ static void option_table(config *c, int *stab_mode, seen *g, cli_option t[NUM_OP
        "PSD-project the material tangent               (default off)", 0, 0, 0, on_off, NULL, NULL},
       {"--fictitious", NULL, CLI_CHOICE, &c->fictitious, "MODEL",
        "tangent at the stabilization points: projected |\n"
-       "linear | exact                                 (default projected)", 0, 0, 0,
-       tangent_model_names, NULL, NULL},
+       "linear | exact                                 (default projected)",
+       0, 0, 0, tangent_model_names, NULL, NULL},
       {"--pc-tangent", NULL, CLI_CHOICE, &c->pc_tangent, "MODEL",
        "tangent the preconditioners are built from:\n"
        "projected (PSD-projected at u) | linear (linear\n"
        "elastic at rest) | exact (A itself); without\n"
-       "effect with --project on                       (default projected)", 0, 0, 0,
-       tangent_model_names, NULL, NULL},
+       "effect with --project on                       (default projected)",
+       0, 0, 0, tangent_model_names, NULL, NULL},
       {"--density", NULL, CLI_DOUBLE, &c->density, "RHO",
        "density in kg/m^3, > 0                         (default 1000)", 0, HUGE_VAL, CLI_LO_OPEN,
        NULL, NULL, NULL},

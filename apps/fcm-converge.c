@@ -772,12 +772,13 @@ static int run_payoff(const config *c, fcm_ctx *ctx)
            (long long)r->points_simplified, r->t_simplify, r->t_plain, r->t_simplified,
            r->point_cost, r->per_cell, r->break_even);
   }
-  printf("(core-seconds: t_simpl = simplification of the kind's cut-cell rules; t_asm = one\n"
-         " assembly with plain / simplified rules, CPU time, fastest of %d: stiffness = Neo-Hookean\n"
-         " force + tangent, mass = consistent mass; s/point = (t_asm pl - t_asm si) / (pts plain -\n"
-         " pts simpl); break-even = t_simpl / (t_asm pl - t_asm si): simplification pays for\n"
-         " more assemblies than that)\n",
-         c->repeat);
+  printf(
+      "(core-seconds: t_simpl = simplification of the kind's cut-cell rules; t_asm = one\n"
+      " assembly with plain / simplified rules, CPU time, fastest of %d: stiffness = Neo-Hookean\n"
+      " force + tangent, mass = consistent mass; s/point = (t_asm pl - t_asm si) / (pts plain -\n"
+      " pts simpl); break-even = t_simpl / (t_asm pl - t_asm si): simplification pays for\n"
+      " more assemblies than that)\n",
+      c->repeat);
   if (c->payoff_csv && !payoff_write_csv(c->payoff_csv, c, rows, nrows)) rc = 1;
 done:
   fcm_mesh_destroy(&mesh);

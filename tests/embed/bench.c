@@ -29,9 +29,10 @@
 #include <string.h>
 #include <time.h>
 
-#define GROWTH_SIMPLIFY_BUDGET 60.0 /* seconds a simplified grid may take, predicted as the
-                                      previous grid's time x (n / n_previous)^2 (cut cells grow
-                                      like the surface) */
+#define GROWTH_SIMPLIFY_BUDGET                                                                     \
+  60.0 /* seconds a simplified grid may take, predicted as the                                     \
+         previous grid's time x (n / n_previous)^2 (cut cells grow                                 \
+         like the surface) */
 
 /* Least-squares slope of log y against log x. */
 static double fit_exponent(int n, const double *x, const double *y)
@@ -87,7 +88,8 @@ static int growth(fcm_ctx *ctx, const fcm_geometry *g, fcm_element_type type, in
     const fcm_cell_rules_stats *S = fcm_cell_rules_get_stats(r);
     cut[k] = (double)S->num_cut, t[k] = cpu;
     char local[16] = "-";
-    if (k > 0) snprintf(local, sizeof local, "%.3f", log(cpu / t[k - 1]) / log(cut[k] / cut[k - 1]));
+    if (k > 0)
+      snprintf(local, sizeof local, "%.3f", log(cpu / t[k - 1]) / log(cut[k] / cut[k - 1]));
     printf("%6d %8lld %8lld %10.0f %10.3f %12.4f %8s\n", n, (long long)S->num_cells,
            (long long)S->num_cut,
            (double)(S->points_initial[0] + S->points_initial[1]) / (double)S->num_cut, cpu,
@@ -99,7 +101,9 @@ static int growth(fcm_ctx *ctx, const fcm_geometry *g, fcm_element_type type, in
   const double p = fit_exponent(k, cut, t);
   const int ok = k >= 2 && p <= 1.1;
   printf("fitted exponent of time vs cut cells (%d grids): %.3f  -> %s\n\n", k, p,
-         k < 2 ? "too few grids" : ok ? "linear (<= 1.1)" : "NOT linear (> 1.1)");
+         k < 2 ? "too few grids"
+         : ok  ? "linear (<= 1.1)"
+               : "NOT linear (> 1.1)");
   return ok;
 }
 

@@ -88,12 +88,12 @@ static void check_decision(const fcm_cell_rules *r, int expect_simplified, int e
     if (!expect_probe) continue;
     TEST_TRUE(d->probe_points > d->probe_kept && d->probe_time > 0.0);
     TEST_NEAR(d->estimated_time, d->probe_time * n / (double)d->probe_points, 1e-14, 0.0);
-    TEST_NEAR(d->estimated_kept, (double)d->probe_kept * (double)S->num_cut / (double)d->probe_cells,
-              1e-14, 0.0);
+    TEST_NEAR(d->estimated_kept,
+              (double)d->probe_kept * (double)S->num_cut / (double)d->probe_cells, 1e-14, 0.0);
     TEST_NEAR(d->cost_simplified, d->estimated_time + d->estimated_kept * d->point_cost * A, 1e-14,
               0.0);
-    TEST_TRUE(d->simplified == fcm_simplify_pays(A, d->point_cost, n, d->estimated_kept,
-                                                 d->estimated_time));
+    TEST_TRUE(d->simplified ==
+              fcm_simplify_pays(A, d->point_cost, n, d->estimated_kept, d->estimated_time));
     TEST_TRUE(d->simplified == (d->cost_simplified < d->cost_plain));
     TEST_TRUE(d->time_simplify >= d->probe_time);
     /* simplified: the stored counts are those of ON; else those of OFF */

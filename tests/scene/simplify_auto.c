@@ -63,8 +63,8 @@ static int line_check(const char *text, const char *head, const char *what, int 
     ok = (strstr(line, what) != NULL) == want;
   }
   if (!ok)
-    fprintf(stderr, "the line '%s' %s '%s' in the summary:\n%s", head,
-            want ? "lacks" : "has", what, text ? text : "");
+    fprintf(stderr, "the line '%s' %s '%s' in the summary:\n%s", head, want ? "lacks" : "has", what,
+            text ? text : "");
   return ok;
 }
 
@@ -102,8 +102,8 @@ int main(void)
   /* dynamic, 300 steps: 900 stiffness assemblies pay back; 1 mass assembly expected */
   scene_json(json, sizeof json, "\"auto\"", 1, 300);
   s = summary(ctx, json, FCM_CELL_SIMPLIFY_AUTO);
-  TEST_TRUE(line_has(s, "computed  stiffness simplification",
-                     " auto: on for 900 expected assemblies; "));
+  TEST_TRUE(
+      line_has(s, "computed  stiffness simplification", " auto: on for 900 expected assemblies; "));
   TEST_TRUE(line_has(s, "stiffness simplification", "probe "));
   TEST_TRUE(line_has(s, "mass simplification", " for 1 expected assemblies; "));
   TEST_TRUE(line_check(s, "mass simplification", "probe 0 cells", 0));

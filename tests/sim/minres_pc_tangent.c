@@ -80,7 +80,8 @@ static void run(fcm_ctx *ctx, const char *solver, run_out *out)
     const fcm_integrator *I = fcm_simulation_integrator(sim);
     out->n = fcm_integrator_num_dofs(I);
     TEST_TRUE(out->n > 0 && out->n <= 100000);
-    if (out->n > 100000) out->ok = 0;
+    if (out->n > 100000)
+      out->ok = 0;
     else
       memcpy(out->u, fcm_integrator_displacement(I), sizeof(double) * (size_t)out->n);
   }
@@ -99,8 +100,8 @@ int main(int argc, char **argv)
   fcm_scene *scene = NULL;
   TEST_OK(ctx, fcm_scene_create_from_string(
                    ctx, scene_json(json, sizeof json, "\"method\": \"minres\""), "<t>", &scene));
-  TEST_TRUE(scene && fcm_scene_get_solver(scene)->preconditioner_tangent ==
-                         FCM_FICTITIOUS_PROJECTED);
+  TEST_TRUE(scene &&
+            fcm_scene_get_solver(scene)->preconditioner_tangent == FCM_FICTITIOUS_PROJECTED);
   fcm_scene_destroy(&scene);
   static const char *const names[] = {"projected", "linear", "exact"};
   static const fcm_fictitious_model models[] = {FCM_FICTITIOUS_PROJECTED, FCM_FICTITIOUS_LINEAR,
@@ -113,11 +114,11 @@ int main(int argc, char **argv)
     TEST_TRUE(scene && fcm_scene_get_solver(scene)->preconditioner_tangent == models[k]);
     fcm_scene_destroy(&scene);
   }
-  TEST_ERR(ctx,
-           fcm_scene_create_from_string(
-               ctx, scene_json(json, sizeof json, "\"preconditioner_tangent\": \"psd\""), "<t>",
-               &scene),
-           FCM_ERR_ARG, "preconditioner_tangent");
+  TEST_ERR(
+      ctx,
+      fcm_scene_create_from_string(
+          ctx, scene_json(json, sizeof json, "\"preconditioner_tangent\": \"psd\""), "<t>", &scene),
+      FCM_ERR_ARG, "preconditioner_tangent");
   TEST_TRUE(scene == NULL);
   {
     fcm_scene *s2 = NULL;
@@ -132,8 +133,7 @@ int main(int argc, char **argv)
       TEST_TRUE(o.preconditioner_tangent == FCM_FICTITIOUS_PROJECTED);
       o.preconditioner_tangent = FCM_FICTITIOUS_MODEL_COUNT;
       TEST_OK(ctx, fcm_integrator_create(ctx, fcm_simulation_space(sim), &mat, &o, &I));
-      if (I)
-        TEST_ERR(ctx, fcm_integrator_setup(I), FCM_ERR_ARG, "preconditioner_tangent");
+      if (I) TEST_ERR(ctx, fcm_integrator_setup(I), FCM_ERR_ARG, "preconditioner_tangent");
       fcm_integrator_destroy(&I);
     }
     fcm_simulation_destroy(&sim);

@@ -10,10 +10,10 @@
  * measured: at most 5e-9). MINRES iterations per Newton step are
  * printed with "-v". Further arguments name the scenes to run (default: every scene of the
  * directory, at least five, and the built-in default scene unless it is one of them byte for
- * byte; "default" names the built-in one); "tangent=NAME" sets solver.preconditioner_tangent (default: the scene default,
- * "projected": the Schwarz blocks are built from the PSD-projected tangent while MINRES
- * solves the exact, unprojected Newton system).
- * Usage: sim_minres_scenes SCENE_DIR STEPS [-v] [tangent=NAME] [default] [NAME.json ...] */
+ * byte; "default" names the built-in one); "tangent=NAME" sets solver.preconditioner_tangent
+ * (default: the scene default, "projected": the Schwarz blocks are built from the PSD-projected
+ * tangent while MINRES solves the exact, unprojected Newton system). Usage: sim_minres_scenes
+ * SCENE_DIR STEPS [-v] [tangent=NAME] [default] [NAME.json ...] */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "test.h"

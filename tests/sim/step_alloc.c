@@ -89,8 +89,8 @@ int main(int argc, char **argv)
       f.count = 0;
       TEST_OK(ctx, fcm_simulation_step(sim, &info));
       if (f.count != 0)
-        TEST_FAIL_("%s %s: step %d made %lld allocation(s) through the context", argv[1],
-                   element, k + 2, f.count);
+        TEST_FAIL_("%s %s: step %d made %lld allocation(s) through the context", argv[1], element,
+                   k + 2, f.count);
       total += f.count;
       if (info.reason != FCM_STEP_CONVERGED || info.newton_iterations < 2 ||
           info.failed_attempts != 0)

@@ -25,8 +25,8 @@ typedef struct stats {
 } stats;
 
 typedef struct bench_case {
-  int m, r;                 /* strength, red refinements of the unit tet */
-  double radius, dradius;   /* sphere cut of cell c: radius + c * dradius (0: whole tet) */
+  int m, r;               /* strength, red refinements of the unit tet */
+  double radius, dradius; /* sphere cut of cell c: radius + c * dradius (0: whole tet) */
   int cells, reps;
   double target_us;
 } bench_case;
@@ -54,8 +54,8 @@ static stats run(fcm_ctx *ctx, fcm_simplify_method method, int m, int cells, int
                                 info.time_total};
         for (int k = 0; k < 5; k++)
           s.part[k] += 1e6 * part[k] / cells;
-        util_check(fcm_simplify_method_name(method), m, n[c], pts[c], w[c], &res,
-                   util_num_basis(m), 1e-12);
+        util_check(fcm_simplify_method_name(method), m, n[c], pts[c], w[c], &res, util_num_basis(m),
+                   1e-12);
       }
       fcm_simplify_result_destroy(&res);
     }
@@ -66,8 +66,7 @@ static stats run(fcm_ctx *ctx, fcm_simplify_method method, int m, int cells, int
 
 static void csv_row(FILE *csv, int M, double n, const char *method, const stats *s)
 {
-  if (csv)
-    fprintf(csv, "%d,%.0f,%s,%.3f,%d,%.3e\n", M, n, method, s->us, s->fallbacks, s->res);
+  if (csv) fprintf(csv, "%d,%.0f,%s,%.3f,%d,%.3e\n", M, n, method, s->us, s->fallbacks, s->res);
 }
 
 int main(int argc, char **argv)
@@ -104,8 +103,8 @@ int main(int argc, char **argv)
          "before us", "speedup", "target us", "met", "kept", "max res", "fallbacks");
 
   const bench_case cases[] = {
-      {3, 2, 0.33, 0.002, 16, 20, 30.0},    {4, 3, 0.40, 0.002, 8, 5, 500.0},
-      {7, 1, 0.62, 0.002, 8, 5, 1500.0},    {8, 3, 0.0, 0.0, 1, 1, 40000.0},
+      {3, 2, 0.33, 0.002, 16, 20, 30.0}, {4, 3, 0.40, 0.002, 8, 5, 500.0},
+      {7, 1, 0.62, 0.002, 8, 5, 1500.0}, {8, 3, 0.0, 0.0, 1, 1, 40000.0},
       {10, 3, 0.0, 0.0, 1, 1, 200000.0},
   };
   const int ncases = quick ? 3 : (int)(sizeof cases / sizeof cases[0]);
@@ -121,8 +120,7 @@ int main(int argc, char **argv)
       n[c] = util_tet_union(ctx, bc->m, bc->r, radius, &p[c], &w[c]);
       nmean += (double)n[c] / bc->cells;
     }
-    const fcm_simplify_method before =
-        nmean > 12.0 * M ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
+    const fcm_simplify_method before = nmean > 12.0 * M ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
     def[k] = run(ctx, FCM_SIMPLIFY_AUTO, bc->m, bc->cells, n, p, w, bc->reps);
     const stats old = run(ctx, before, bc->m, bc->cells, n, p, w, bc->reps);
     const int ok = def[k].us <= bc->target_us && def[k].fallbacks == 0 && def[k].res <= 1e-12;

@@ -57,8 +57,7 @@ int main(void)
           force == 1 ? FCM_SIMPLIFY_REASON_LP : FCM_SIMPLIFY_REASON_LP_ERROR;
       TEST_TRUE(info.reason == (elim_first ? FCM_SIMPLIFY_REASON_NUMERIC : glpk_reason));
       TEST_TRUE(strstr(info.message, force == 1 ? "iteration limit" : "GLPK fatal error") != NULL);
-      if (elim_first)
-        TEST_TRUE(strstr(info.message, "elimination") && strstr(info.message, "[2 "));
+      if (elim_first) TEST_TRUE(strstr(info.message, "elimination") && strstr(info.message, "[2 "));
       TEST_TRUE(strstr(info.message, "[1 ") && strstr(info.message, "[3 "));
       TEST_TRUE(info.residual == 0.0 && info.kept == n);
       if (getenv("FCM_TEST_VERBOSE")) fprintf(stderr, "%s\n", info.message);

@@ -1,6 +1,6 @@
 /* Simplification of positive rules for strengths m = 1..argv[2] (default 10) with the path
- * given as argv[1] ("lp", "recombine" or "eliminate"): random rules in a box, unions of conical rules on
- * red-refined sub-tets of the unit tet (whole, and cut by a sphere). Each result has at
+ * given as argv[1] ("lp", "recombine" or "eliminate"): random rules in a box, unions of conical
+ * rules on red-refined sub-tets of the unit tet (whole, and cut by a sphere). Each result has at
  * most M points, is an ascending subset of the input (hence inside the tet), has
  * positive weights and integrates every monomial of degree <= m like the input. */
 #include "simplify_util.h"
@@ -36,8 +36,7 @@ static void run(fcm_ctx *ctx, fcm_simplify_method method, const char *what, int 
             "%s: kept %lld rank %d residual %.2e lps %d its %lld eliminations %d rounds %d "
             "%.2f ms\n",
             label, (long long)res.count, info.rank, info.residual, info.num_lps, info.lp_iterations,
-            info.num_eliminations, info.rounds,
-            1e3 * info.time_total);
+            info.num_eliminations, info.rounds, 1e3 * info.time_total);
   fcm_simplify_result_destroy(&res);
   TEST_TRUE(res.indices == NULL && res.weights == NULL && res.count == 0);
 }

@@ -1,7 +1,7 @@
-/* Special inputs, every path (LP, recombination, elimination): N <= M returns the rule unchanged; coplanar points (on an
- * axis plane: degenerate box axis; on a tilted plane: rank-deficient P) give a valid rule
- * of at most (m+2 choose 2) points; a slab 1e-9 thick (box-scaled, full rank) a valid rule
- * of at most M; weights of scale 1e-14 and 1e+14 (normalized before the LP) valid rules;
+/* Special inputs, every path (LP, recombination, elimination): N <= M returns the rule unchanged;
+ * coplanar points (on an axis plane: degenerate box axis; on a tilted plane: rank-deficient P) give
+ * a valid rule of at most (m+2 choose 2) points; a slab 1e-9 thick (box-scaled, full rank) a valid
+ * rule of at most M; weights of scale 1e-14 and 1e+14 (normalized before the LP) valid rules;
  * points of zero weight are never kept. */
 #include "simplify_util.h"
 

@@ -35,8 +35,8 @@ typedef enum fcm_rule_kind {
 
 /** Whether fcm_cell_rules_create() simplifies the cut-cell rules (fcm_simplify()). */
 typedef enum fcm_cell_simplify {
-  FCM_CELL_SIMPLIFY_OFF = 0, /**< keep every point of the mapped tet rules */
-  FCM_CELL_SIMPLIFY_ON = 1,  /**< simplify the rules of every cut cell (default) */
+  FCM_CELL_SIMPLIFY_OFF = 0,  /**< keep every point of the mapped tet rules */
+  FCM_CELL_SIMPLIFY_ON = 1,   /**< simplify the rules of every cut cell (default) */
   FCM_CELL_SIMPLIFY_AUTO = 2, /**< per rule kind, simplify when it pays for the expected number
                                    of assemblies: a few cut cells are simplified and timed (the
                                    probe), the time of all is extrapolated by points and compared
@@ -81,10 +81,10 @@ typedef struct fcm_cell_rules_options {
                               Newton iterations stiffness, 1 mass (assembled once); default 1 */
   double point_cost[FCM_RULE_KIND_COUNT]; /**< AUTO: core-seconds per point per assembly, > 0;
                               FCM_DEFAULT (default): fcm_cell_rules_point_cost() */
-  int probe_cells;       /**< AUTO: at most this many cut cells per kind are simplified to
-                              measure the simplification time (in rounds of one per thread,
-                              stopping once the two cost estimates differ by more than 4x),
-                              >= 1; default 4 */
+  int probe_cells; /**< AUTO: at most this many cut cells per kind are simplified to
+                        measure the simplification time (in rounds of one per thread,
+                        stopping once the two cost estimates differ by more than 4x),
+                        >= 1; default 4 */
   fcm_simplify_options simplify_options; /**< default fcm_simplify_options_default() */
   double max_rule_memory; /**< bytes the rules of one cut cell may take to build (an estimate
                                checked before allocating: points of both kinds plus the
@@ -162,8 +162,8 @@ typedef struct fcm_cell_rules fcm_cell_rules;
  * @param[in] opts NULL for defaults; @param[out] rules NULL on failure
  * @return FCM_OK; FCM_ERR_ARG (NULL, strengths outside [0, 20] with simplification or
  *         [0, FCM_RULE_MAX_STRENGTH] without, simplify not a mode, AUTO with expected_assemblies
- *         < 0, point_cost <= 0 (not FCM_DEFAULT) or probe_cells < 1, thresholds outside 0 <= min_fraction <
- *         uncut_fraction <= 1, tolerances out of range, bad stabilization); FCM_ERR_GEOMETRY
+ *         < 0, point_cost <= 0 (not FCM_DEFAULT) or probe_cells < 1, thresholds outside 0 <=
+ * min_fraction < uncut_fraction <= 1, tolerances out of range, bad stabilization); FCM_ERR_GEOMETRY
  *         (a non-convex background cell, naming it; a degenerate cell); FCM_ERR_NOT_CONVERGED
  *         (inverse map); FCM_ERR_UNSUPPORTED (a cell whose rules would exceed
  *         max_rule_memory or 2^30 points); FCM_ERR_ALLOC; errors of fcm_simplify(). When

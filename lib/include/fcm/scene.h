@@ -82,11 +82,11 @@ typedef struct fcm_scene_quadrature {
   int mass_strength;      /**< [0, 20]; FCM_DEFAULT (default): the element's default */
   int surface_strength; /**< [0, 20]; FCM_DEFAULT (default): automatic (the stiffness strength when
                            a traction or pressure effect is present, else no surface rules) */
-  fcm_cell_simplify simplify; /**< "simplify": true (FCM_CELL_SIMPLIFY_ON, default), false
-                                   (OFF) or "auto" (AUTO: per rule kind, where it pays for the
-                                   assemblies the run expects; see fcm_simulation_create()) */
-  fcm_simplify_method simplify_method;     /**< "simplify_method": "auto" (default), "lp",
-                                                "recombine", "eliminate" */
+  fcm_cell_simplify simplify;          /**< "simplify": true (FCM_CELL_SIMPLIFY_ON, default), false
+                                            (OFF) or "auto" (AUTO: per rule kind, where it pays for the
+                                            assemblies the run expects; see fcm_simulation_create()) */
+  fcm_simplify_method simplify_method; /**< "simplify_method": "auto" (default), "lp",
+                                            "recombine", "eliminate" */
   fcm_stabilization_options stabilization; /**< "stabilization": mode "mass_stiffness"
                                                 (default), "mass", "off"; alpha in (0, 1],
                                                 default 1e-6 */
@@ -98,10 +98,10 @@ typedef struct fcm_scene_quadrature {
 
 /** Solver settings ("solver"), in the library's own types (fcm/sim.h, fcm/solve.h). */
 typedef struct fcm_scene_solver {
-  fcm_linear_solver method;          /**< "direct" (default), "minres", "cg" */
-  fcm_direct_method direct;          /**< default FCM_DIRECT_CHOLMOD */
-  fcm_preconditioner preconditioner; /**< Krylov only: "none", "jacobi", "block_jacobi",
-                                          "schwarz" (default) */
+  fcm_linear_solver method;                    /**< "direct" (default), "minres", "cg" */
+  fcm_direct_method direct;                    /**< default FCM_DIRECT_CHOLMOD */
+  fcm_preconditioner preconditioner;           /**< Krylov only: "none", "jacobi", "block_jacobi",
+                                                    "schwarz" (default) */
   fcm_fictitious_model preconditioner_tangent; /**< "preconditioner_tangent": the tangent
                                       the preconditioner is built from, "projected" (default),
                                       "linear", "exact"

@@ -114,9 +114,9 @@ typedef struct fcm_integrator_options {
       FCM_FICTITIOUS_LINEAR: base + the linear-elastic stiffness at rest (assembled once);
       FCM_FICTITIOUS_EXACT: the Newton matrix itself. Without effect when the Newton matrix
       has a PSD tangent already (project_psd, linear material, projection fallback). */
-  double krylov_rtol;                /**< in [0, 1) (default 1e-8) */
-  double krylov_atol;                /**< >= 0 (default 0) */
-  int krylov_max_iterations;         /**< >= 1 (default 1000) */
+  double krylov_rtol;                          /**< in [0, 1) (default 1e-8) */
+  double krylov_atol;                          /**< >= 0 (default 0) */
+  int krylov_max_iterations;                   /**< >= 1 (default 1000) */
   double schwarz_theta;          /**< cut cells with volume fraction below it get a block, (0, 1]
                                       (default 0.5) */
   fcm_schwarz_options schwarz;   /**< default fcm_schwarz_options_default() */

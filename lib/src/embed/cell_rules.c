@@ -60,8 +60,10 @@ int fcm_simplify_pays(double assemblies, double point_cost, double points_before
 double fcm_cell_rules_point_cost(fcm_element_type type, fcm_rule_kind kind)
 {
   static const double cost[FCM_ELEMENT_COUNT][FCM_RULE_KIND_COUNT] = {
-      [FCM_ELEMENT_TET4] = {4.84e-7, 7.90e-8},  [FCM_ELEMENT_TET10] = {1.24e-6, 1.29e-7},
-      [FCM_ELEMENT_HEX8] = {9.27e-7, 9.98e-8},  [FCM_ELEMENT_HEX20] = {3.55e-6, 2.45e-7},
+      [FCM_ELEMENT_TET4] = {4.84e-7, 7.90e-8},
+      [FCM_ELEMENT_TET10] = {1.24e-6, 1.29e-7},
+      [FCM_ELEMENT_HEX8] = {9.27e-7, 9.98e-8},
+      [FCM_ELEMENT_HEX20] = {3.55e-6, 2.45e-7},
   };
   if ((int)type < 0 || type >= FCM_ELEMENT_COUNT || (int)kind < 0 || kind >= FCM_RULE_KIND_COUNT)
     return 0.0;
@@ -77,7 +79,7 @@ typedef struct cell_out {
   int ninit[FCM_RULE_KIND_COUNT], nsimp[FCM_RULE_KIND_COUNT], nstab[FCM_RULE_KIND_COUNT];
   unsigned char skipped[FCM_RULE_KIND_COUNT], fallback[FCM_RULE_KIND_COUNT];
   double residual[FCM_RULE_KIND_COUNT];
-  double tsimp[FCM_RULE_KIND_COUNT];          /* fcm_simplify's time_total */
+  double tsimp[FCM_RULE_KIND_COUNT];         /* fcm_simplify's time_total */
   unsigned char probed[FCM_RULE_KIND_COUNT]; /* AUTO: simplified by the probe */
   int ns;
   double *spts, *sw, *snrm;
@@ -504,8 +506,8 @@ cleanup:
 
 /* What a loop of auto_simplify() does to each cell of its list. */
 typedef enum auto_phase {
-  AUTO_PROBE,  /* simplify kind `kind` (timed) */
-  AUTO_FINISH  /* simplify the kinds that pay (not the probed cells again), stabilize */
+  AUTO_PROBE, /* simplify kind `kind` (timed) */
+  AUTO_FINISH /* simplify the kinds that pay (not the probed cells again), stabilize */
 } auto_phase;
 
 /* Run `phase` on the cells list[0 .. n) in parallel; the error is the lowest failing one's. */
@@ -585,8 +587,8 @@ static fcm_status auto_simplify(const build *B, fcm_cell_rules *R, int nthreads,
     fcm_simplify_decision *d = &R->stats.decision[k];
     const fcm_element_type type = fcm_mesh_element_type(B->mesh);
     d->expected_assemblies = opt->expected_assemblies[k];
-    d->point_cost = opt->point_cost[k] == FCM_DEFAULT ? fcm_cell_rules_point_cost(type, k)
-                                                      : opt->point_cost[k];
+    d->point_cost =
+        opt->point_cost[k] == FCM_DEFAULT ? fcm_cell_rules_point_cost(type, k) : opt->point_cost[k];
     double ntot = 0.0;
     for (fcm_index i = 0; i < ncut; i++)
       ntot += out[cut[i]].ninit[k];
@@ -777,7 +779,8 @@ fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_g
   /* 2. parallel per-cell work */
   const int nthreads = o.num_threads > 0 ? o.num_threads : omp_get_max_threads();
   FCM_TRY(ctx, run_cells(&B, R, nthreads, out, &sums));
-  if (o.simplify == FCM_CELL_SIMPLIFY_AUTO) FCM_TRY(ctx, auto_simplify(&B, R, nthreads, out, &sums));
+  if (o.simplify == FCM_CELL_SIMPLIFY_AUTO)
+    FCM_TRY(ctx, auto_simplify(&B, R, nthreads, out, &sums));
   const double t_loop = fcm_wtime();
   /* 3. gather, 4. statistics */
   FCM_TRY(ctx, gather_rules(ctx, R, out));

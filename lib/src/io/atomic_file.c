@@ -287,7 +287,7 @@ fcm_status fcm__io_atomic_commit(fcm_ctx *ctx, fcm__atomic_file *af)
     sys_error(err, msg, sizeof msg);
     FCM_CHECK(0, ctx, FCM_ERR_IO, "io: %s '%s' failed: %s", stage, af->path, msg);
   }
-  FCM_FREE(ctx, af->tmp_path); /* renamed: nothing to remove */
+  FCM_FREE(ctx, af->tmp_path);  /* renamed: nothing to remove */
   if (af->dir && af->durable) { /* the rename itself must survive a power loss */
     int fd = open(af->dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     err = fd < 0 ? errno : fsync(fd) != 0 ? errno : 0;

@@ -24,8 +24,8 @@ typedef struct fcm__atomic_file {
   char *tmp_path;  /* the temporary (NULL once renamed or removed) */
   char *dir;       /* the target's directory */
   long long bytes; /* written so far */
-  int durable; /* fsync the file before the rename and its directory after it; other files
-                  (frames, logs) are only renamed: whole or absent, not forced to disk */
+  int durable;     /* fsync the file before the rename and its directory after it; other files
+                      (frames, logs) are only renamed: whole or absent, not forced to disk */
   fcm__io_fault fault;
 } fcm__atomic_file;
 

@@ -94,9 +94,8 @@ static fcm_status syev_query(fcm_ctx *ctx, char jobz, int n, lapack_int *lwork, 
   fcm_status st = FCM_OK;
   double qwork = 0.0, a = 0.0, w = 0.0;
   lapack_int qiwork = 0;
-  lapack_int info =
-      LAPACKE_dsyevd_work(LAPACK_COL_MAJOR, jobz, 'L', n, &a, FCM_MAX(1, n), &w, &qwork, -1,
-                          &qiwork, -1);
+  lapack_int info = LAPACKE_dsyevd_work(LAPACK_COL_MAJOR, jobz, 'L', n, &a, FCM_MAX(1, n), &w,
+                                        &qwork, -1, &qiwork, -1);
   FCM_TRY(ctx, lapack_info(ctx, "dsyevd (workspace query)", info));
   *lwork = (lapack_int)qwork;
   *liwork = qiwork;
@@ -104,8 +103,7 @@ cleanup:
   return st;
 }
 
-fcm_status fcm__syev_workspace(fcm_ctx *ctx, int want_vectors, int n, size_t *lwork,
-                               size_t *liwork)
+fcm_status fcm__syev_workspace(fcm_ctx *ctx, int want_vectors, int n, size_t *lwork, size_t *liwork)
 {
   fcm_status st = FCM_OK;
   lapack_int lw = 0, liw = 0;
@@ -131,8 +129,7 @@ fcm_status fcm__syev_work(fcm_ctx *ctx, int want_vectors, int n, double *a, int 
   FCM_CHECK((size_t)qwork < lwork && (size_t)qiwork < liwork, ctx, FCM_ERR_INTERNAL,
             "syev: workspace of %zu doubles and %zu integers, n = %d needs %lld and %lld", lwork,
             liwork, n, (long long)qwork + 1, (long long)qiwork + 1);
-  info = LAPACKE_dsyevd_work(LAPACK_COL_MAJOR, jobz, 'L', n, a, lda, w, work, qwork, iwork,
-                             qiwork);
+  info = LAPACKE_dsyevd_work(LAPACK_COL_MAJOR, jobz, 'L', n, a, lda, w, work, qwork, iwork, qiwork);
   FCM_CHECK(info <= 0, ctx, FCM_ERR_LAPACK,
             "dsyevd: eigenvalue iteration failed to converge (info = %d) for n = %d", (int)info, n);
   FCM_TRY(ctx, lapack_info(ctx, "dsyevd", info));

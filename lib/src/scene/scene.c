@@ -411,10 +411,9 @@ cleanup:
 static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"method",         "direct", "preconditioner",
-                                     "schwarz",        "rtol",   "atol",
-                                     "max_iterations", "newton", "threads",
-                                     "preconditioner_tangent"};
+  static const char *const keys[] = {
+      "method", "direct",         "preconditioner", "schwarz", "rtol",
+      "atol",   "max_iterations", "newton",         "threads", "preconditioner_tangent"};
   static const char *const skeys[] = {"threshold", "epsilon", "clamp"};
   static const char *const nkeys[] = {"rtol",        "max_iterations",
                                       "line_search", "project_psd",

@@ -142,9 +142,8 @@ fcm_status fcm__scene_read_int(fcm__scene_parser *p, const fcm__json *obj, const
 fcm_status fcm__scene_read_bool(fcm__scene_parser *p, const fcm__json *obj, const char *key,
                                 int required, int *out);
 /* true (1), false (0) or the string `word` (word_value). */
-fcm_status fcm__scene_read_bool_or_word(fcm__scene_parser *p, const fcm__json *obj,
-                                        const char *key, int required, const char *word,
-                                        int word_value, int *out);
+fcm_status fcm__scene_read_bool_or_word(fcm__scene_parser *p, const fcm__json *obj, const char *key,
+                                        int required, const char *word, int word_value, int *out);
 /* String copied into the scene; non-empty, no control characters. */
 fcm_status fcm__scene_read_string(fcm__scene_parser *p, const fcm__json *obj, const char *key,
                                   int required, const char **out);

@@ -248,9 +248,8 @@ cleanup:
   return st;
 }
 
-fcm_status fcm__scene_read_bool_or_word(fcm__scene_parser *p, const fcm__json *obj,
-                                        const char *key, int required, const char *word,
-                                        int word_value, int *out)
+fcm_status fcm__scene_read_bool_or_word(fcm__scene_parser *p, const fcm__json *obj, const char *key,
+                                        int required, const char *word, int word_value, int *out)
 {
   fcm_status st = FCM_OK;
   const fcm__json *v = NULL;
@@ -263,8 +262,8 @@ fcm_status fcm__scene_read_bool_or_word(fcm__scene_parser *p, const fcm__json *o
     *out = fcm__json_bool(v);
   } else {
     fcm__scene_describe(v, got, sizeof got);
-    SCENE_CHECK(fcm__json_get_kind(v) == FCM__JSON_STRING && !strcmp(fcm__json_string(v), word),
-                p, FCM_ERR_ARG, "expected %s, got %s", want, got);
+    SCENE_CHECK(fcm__json_get_kind(v) == FCM__JSON_STRING && !strcmp(fcm__json_string(v), word), p,
+                FCM_ERR_ARG, "expected %s, got %s", want, got);
     *out = word_value;
   }
 cleanup:

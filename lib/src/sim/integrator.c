@@ -404,7 +404,8 @@ static fcm_status validate_options(fcm_ctx *ctx, const fcm_integrator_options *o
             (int)o->direct_method);
   FCM_CHECK(o->preconditioner >= FCM_PRECOND_NONE && o->preconditioner <= FCM_PRECOND_SCHWARZ, ctx,
             FCM_ERR_ARG, "integrator: preconditioner = %d outside [0, 3]", (int)o->preconditioner);
-  FCM_CHECK(o->preconditioner_tangent >= 0 && o->preconditioner_tangent < FCM_FICTITIOUS_MODEL_COUNT,
+  FCM_CHECK(o->preconditioner_tangent >= 0 &&
+                o->preconditioner_tangent < FCM_FICTITIOUS_MODEL_COUNT,
             ctx, FCM_ERR_ARG,
             "integrator: preconditioner_tangent = %d outside [0, 2] (projected, linear, exact)",
             (int)o->preconditioner_tangent);

@@ -70,10 +70,10 @@ struct fcm_integrator {
 
   /* matrices (space pattern) */
   fcm_csr *M, *H, *D, *H0; /* mass, Newton matrix, damping (or NULL), pristine copy (linear) */
-  fcm_csr *Hpc, *K0; /* preconditioner matrix, linear stiffness at rest (created on first use) */
-  int h_psd;         /* H holds a PSD tangent (set with H by newton.c) */
-  double *Ma;              /* M a_rep (n) */
-  double rep_norm_full;    /* ||M a_rep|| over all DOFs */
+  fcm_csr *Hpc, *K0;    /* preconditioner matrix, linear stiffness at rest (created on first use) */
+  int h_psd;            /* H holds a PSD tangent (set with H by newton.c) */
+  double *Ma;           /* M a_rep (n) */
+  double rep_norm_full; /* ||M a_rep|| over all DOFs */
 
   /* work vectors (n each) */
   double *u_bak, *v_bak, *lp_bak; /* state at the start of the step */

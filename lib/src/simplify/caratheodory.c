@@ -115,7 +115,8 @@ fcm_status fcm__simplify_caratheodory(fcm__attempt *a, int rows, int ncols, cons
   int *act = a->iws;
   int K = 0;
   for (int c = 0; c < ncols; c++)
-    if (lam[c] > 0.0) act[K++] = c;
+    if (lam[c] > 0.0)
+      act[K++] = c;
     else
       lam[c] = 0.0;
   if (K <= rows) goto cleanup; /* already at most `rows` positive weights */

@@ -391,7 +391,8 @@ static fcm_status run_attempts(simplify_run *r, const fcm_simplify_options *o,
   /* The GLPK paths: the plain LP up to AUTO_RECOMBINE_RATIO points per basis function. */
   const fcm_simplify_method glpk =
       r->np > AUTO_RECOMBINE_RATIO * a->capacity ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
-  const fcm_simplify_method chosen = o->method == FCM_SIMPLIFY_AUTO ? FCM_SIMPLIFY_ELIMINATE : o->method;
+  const fcm_simplify_method chosen =
+      o->method == FCM_SIMPLIFY_AUTO ? FCM_SIMPLIFY_ELIMINATE : o->method;
   fcm_simplify_method other = glpk;
   if (chosen == FCM_SIMPLIFY_LP) other = FCM_SIMPLIFY_RECOMBINE;
   if (chosen == FCM_SIMPLIFY_RECOMBINE) other = FCM_SIMPLIFY_LP;

@@ -38,7 +38,7 @@ void fcm__simplify_basis_eval(const fcm__cheb_box *box, const double *x, double 
 
 /* Points per block of fcm__simplify_moments, and the fewest for which a block goes through
  * BLAS (measured by tests/simplify/bench_simplify.c). */
-#define FCM__MOMENT_BLOCK 256
+#define FCM__MOMENT_BLOCK    256
 #define FCM__MOMENT_GEMM_MIN 64
 
 /* Doubles of scratch fcm__simplify_moments needs at strength m. */
@@ -81,11 +81,11 @@ fcm_status fcm__simplify_lp_solve(fcm_ctx *ctx, int rows, int cols, const double
 typedef struct fcm__attempt {
   /* input, set by the driver */
   fcm_ctx *ctx;
-  int n;                 /* points */
-  const double *points;  /* n x 3 */
-  const double *w0;      /* n weights normalized to mean 1 */
-  double *moments;       /* M moments of w0 in the box basis, valid once have_moments: the
-                            path that first evaluates the basis on all points sets them */
+  int n;                /* points */
+  const double *points; /* n x 3 */
+  const double *w0;     /* n weights normalized to mean 1 */
+  double *moments;      /* M moments of w0 in the box basis, valid once have_moments: the
+                           path that first evaluates the basis on all points sets them */
   int have_moments;
   fcm__cheb_box box;
   double rank_tol;
