@@ -145,7 +145,7 @@ FCM_API int fcm_simulation_checkpoint_due(const fcm_simulation *sim);
  * Dynamic scenes only. fcm_simulation_summary_view() prints its drift for a free body (no
  * constraint, gravity or surface load), which momentum conservation keeps at zero.
  * @return FCM_OK, FCM_ERR_ARG (NULL; a static scene has no mass matrix), FCM_ERR_ALLOC. */
-FCM_API fcm_status fcm_simulation_center_of_mass(fcm_simulation *sim, double com[3]);
+FCM_API fcm_status fcm_simulation_center_of_mass(const fcm_simulation *sim, double com[3]);
 
 /** Copy the counters out. */
 FCM_API void fcm_simulation_get_counters(const fcm_simulation *sim,

@@ -131,8 +131,13 @@ fcm_status fcm__effect_apply_surface_load(fcm_simulation *S, const fcm_effect *e
   FCM_CHECK(S->c.surface_rules, S->ctx, FCM_ERR_ARG,
             "scene %s: effects[%d]: %s needs an embedded geometry with surface rules",
             fcm_scene_name(S->scene), e->index, fcm_effect_type_name(e->type));
-  FCM_TRY(S->ctx,
-          fcm_integrator_add_traction(S->integ, surface_field, (void *)e, window_scale, (void *)e));
+  if (!S->loads) FCM_ALLOC(S->ctx, fcm_scene_num_effects(S->scene), S->loads);
+  FCM_CHECK(S->num_loads < fcm_scene_num_effects(S->scene), S->ctx, FCM_ERR_INTERNAL,
+            "scene %s: effects[%d]: surface load applied twice", fcm_scene_name(S->scene),
+            e->index);
+  fcm_effect *copy = &S->loads[S->num_loads++];
+  *copy = *e; /* its region arrays stay the scene's, read only */
+  FCM_TRY(S->ctx, fcm_integrator_add_traction(S->integ, surface_field, copy, window_scale, copy));
 cleanup:
   return st;
 }
@@ -147,7 +152,7 @@ void fcm__effect_configure_damping(const fcm_effect *e, fcm_integrator_options *
 /* Centre of mass of the body at displacement u (NULL: the reference one), as the space
  * integrates it: 1^T M x / 1^T M 1 per component, x = X + u (exact for the mass quadrature,
  * embedded or not). Needs the mass matrix (dynamic scenes). */
-static fcm_status center_of_mass(fcm_simulation *S, const double *u, double com[3])
+static fcm_status center_of_mass(const fcm_simulation *S, const double *u, double com[3])
 {
   fcm_status st = FCM_OK;
   fcm_index n = fcm_integrator_num_dofs(S->integ);
@@ -181,7 +186,7 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_simulation_center_of_mass(fcm_simulation *S, double com[3])
+fcm_status fcm_simulation_center_of_mass(const fcm_simulation *S, double com[3])
 {
   fcm_status st = FCM_OK;
   FCM_CHECK(S && com, S ? S->ctx : NULL, FCM_ERR_ARG, "simulation: center_of_mass: NULL");
@@ -526,8 +531,9 @@ void fcm_simulation_destroy(fcm_simulation **sim)
   fcm_cell_rules_destroy(&S->rules);
   fcm_geometry_destroy(&S->geom);
   fcm_mesh_destroy(&S->mesh);
-  void *arrays[] = {S->node_u, S->node_v,  S->cell_active, S->cell_phi, S->surf_tri, S->surf_cell,
-                    S->surf_X, S->surf_xi, S->surf_u,      S->surf_x,   S->log,      S->frame_time};
+  void *arrays[] = {S->node_u,    S->node_v,     S->cell_active, S->cell_phi, S->surf_tri,
+                    S->surf_cell, S->surf_X,     S->surf_xi,     S->surf_u,   S->surf_x,
+                    S->log,       S->frame_time, S->loads};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(ctx, arrays[k]);
   fcm__free(ctx, S);
@@ -788,7 +794,7 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
   line(f, c->frames > 0, "output", b);
   if (S->free_body) {
     double com[3];
-    if (fcm_simulation_center_of_mass((fcm_simulation *)S, com) == FCM_OK) {
+    if (fcm_simulation_center_of_mass(S, com) == FCM_OK) {
       double d[3] = {com[0] - S->com0[0], com[1] - S->com0[1], com[2] - S->com0[2]};
       fprintf(f, "  centre of mass (free body) at t = 0: (%.9g, %.9g, %.9g) m; drift now %.3e m\n",
               S->com0[0], S->com0[1], S->com0[2], sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));

@@ -45,6 +45,10 @@ struct fcm_simulation {
    * t = 0, for the drift in the summary */
   int free_body;
   double com0[3];
+  /* copies of the surface-load effects: the integrator's callbacks get these as their
+   * (mutable) user pointer, so the scene's const effects are never cast */
+  fcm_effect *loads;
+  int num_loads;
   /* log */
   fcm__log_row *log;
   long long log_n, log_cap;
