@@ -85,20 +85,57 @@ int cli_choice(const char *prog, const char *opt, const char *s, const char *con
   return 0;
 }
 
+int cli_element(const char *prog, const char *opt, const char *s, void *dest)
+{
+  if (s && fcm_element_type_from_name(s, (fcm_element_type *)dest) == FCM_OK) return 1;
+  fprintf(stderr, "%s: %s: unknown element '%s' (tet4, tet10, hex8, hex20)\n", prog, opt,
+          s ? s : "");
+  return 0;
+}
+
+int cli_element_list(const char *prog, const char *opt, const char *s,
+                     fcm_element_type out[FCM_ELEMENT_COUNT], int *n)
+{
+  char tok[FCM_ELEMENT_COUNT][CLI_TOKEN];
+  int count = 0;
+  if (!cli_list(prog, opt, s, tok, FCM_ELEMENT_COUNT, &count)) return 0;
+  for (int k = 0; k < count; k++) {
+    if (!cli_element(prog, opt, tok[k], &out[k])) return 0;
+    for (int j = 0; j < k; j++)
+      if (out[j] == out[k]) {
+        fprintf(stderr, "%s: %s: '%s' given twice\n", prog, opt, tok[k]);
+        return 0;
+      }
+  }
+  *n = count;
+  return 1;
+}
+
 /* ---------------------------------------------------------------- option tables */
 
-static int read_value(const char *prog, const cli_option *o, const char *v)
+/* The number of values `o` takes: the words of a number option's metavar, else 1. */
+static int num_values(const cli_option *o)
+{
+  int n = 1;
+  if ((o->kind == CLI_DOUBLE || o->kind == CLI_INT || o->kind == CLI_LLONG) && o->metavar)
+    for (const char *c = o->metavar; *c; c++)
+      n += *c == ' ' && c[1] && c[1] != ' ';
+  return n;
+}
+
+/* Value `k` of option `o` from `v`. */
+static int read_value(const char *prog, const cli_option *o, int k, const char *v)
 {
   long long n = 0;
   switch (o->kind) {
   case CLI_DOUBLE:
-    return cli_double(prog, o->name, v, o->lo, o->hi, o->bounds, (double *)o->dest);
+    return cli_double(prog, o->name, v, o->lo, o->hi, o->bounds, (double *)o->dest + k);
   case CLI_INT:
     if (!cli_int(prog, o->name, v, (long long)o->lo, (long long)o->hi, &n)) return 0;
-    *(int *)o->dest = (int)n;
+    ((int *)o->dest)[k] = (int)n;
     return 1;
   case CLI_LLONG:
-    return cli_int(prog, o->name, v, (long long)o->lo, (long long)o->hi, (long long *)o->dest);
+    return cli_int(prog, o->name, v, (long long)o->lo, (long long)o->hi, (long long *)o->dest + k);
   case CLI_STRING:
     if (!*v) {
       fprintf(stderr, "%s: %s: empty value\n", prog, o->name);
@@ -151,13 +188,25 @@ cli_result cli_parse(const char *prog, const cli_option *opts, int argc, char **
       }
       *(int *)o->dest = 1;
     } else {
-      const char *v = eq ? eq + 1 : i + 1 < argc ? argv[++i] : NULL;
-      if (!v) {
-        fprintf(stderr, "%s: %s needs a value %s (see --help)\n", prog, o->name,
-                o->metavar ? o->metavar : "");
+      const int nv = num_values(o);
+      if (eq && nv > 1) {
+        fprintf(stderr, "%s: %s takes %d values as separate arguments: %s %s\n", prog, o->name, nv,
+                o->name, o->metavar);
         return CLI_ERROR;
       }
-      if (!read_value(prog, o, v)) return CLI_ERROR;
+      for (int k = 0; k < nv; k++) {
+        const char *v = eq ? eq + 1 : i + 1 < argc ? argv[++i] : NULL;
+        if (!v) {
+          if (nv > 1)
+            fprintf(stderr, "%s: %s needs %d values %s (see --help)\n", prog, o->name, nv,
+                    o->metavar);
+          else
+            fprintf(stderr, "%s: %s needs a value %s (see --help)\n", prog, o->name,
+                    o->metavar ? o->metavar : "");
+          return CLI_ERROR;
+        }
+        if (!read_value(prog, o, k, v)) return CLI_ERROR;
+      }
     }
     if (o->seen) *o->seen = 1;
   }

@@ -1,12 +1,14 @@
 /* apps/cli: the command-line helpers every fcm program shares — numbers with range checks
- * (NaN, infinities and trailing junk refused), comma lists, keyword choices, a table of
- * options that is both parsed and printed as --help, and atomic output files written
- * through the library's atomic-file code (fcm_atomic_file in fcm/io.h).
+ * (NaN, infinities and trailing junk refused), comma lists, keyword choices, element names,
+ * a table of options that is both parsed and printed as --help, and atomic output files
+ * written through the library's atomic-file code (fcm_atomic_file in fcm/io.h).
  *
  * Every function that rejects its input prints one line "PROG: OPTION: what is wrong" on
  * stderr and returns 0; success returns 1. The programs exit 2 on a usage error. */
 #ifndef FCM_APPS_CLI_H
 #define FCM_APPS_CLI_H
+
+#include <fcm/element.h>
 
 #include <stdio.h>
 
@@ -32,16 +34,27 @@ int cli_list(const char *prog, const char *opt, const char *s, char tok[][CLI_TO
 int cli_choice(const char *prog, const char *opt, const char *s, const char *const *names,
                int *out);
 
+/** An element name (tet4, tet10, hex8, hex20; any case) into `*(fcm_element_type *)dest`;
+ *  usable as the `parse` function of a CLI_CUSTOM option. */
+int cli_element(const char *prog, const char *opt, const char *s, void *dest);
+
+/** A comma list of distinct element names into out[0..*n-1] (at most FCM_ELEMENT_COUNT). */
+int cli_element_list(const char *prog, const char *opt, const char *s,
+                     fcm_element_type out[FCM_ELEMENT_COUNT], int *n);
+
 /** How an option's value is read into `dest`. */
 typedef enum cli_kind {
   CLI_FLAG,   /* no value; int *dest = 1 */
-  CLI_DOUBLE, /* double *dest, range lo..hi with `bounds` */
-  CLI_INT,    /* int *dest, whole number in [lo, hi] */
-  CLI_LLONG,  /* long long *dest, whole number in [lo, hi] */
+  CLI_DOUBLE, /* double *dest, range lo..hi with `bounds` (*) */
+  CLI_INT,    /* int *dest, whole number in [lo, hi] (*) */
+  CLI_LLONG,  /* long long *dest, whole number in [lo, hi] (*) */
   CLI_STRING, /* const char **dest = the argument (non-empty) */
   CLI_CHOICE, /* int *dest = index into `choices` */
   CLI_CUSTOM  /* parse(prog, name, value, dest) */
 } cli_kind;
+/* (*) A number option whose `metavar` has k space-separated words ("X0 Y0 Z0") takes k
+ *     values, as k arguments ("--box -1 -1 -1 1 1 1", not "--box=..."), into dest[0..k-1].
+ *     The other kinds take one value. */
 
 /** One option of a table; the table ends with an entry whose `name` is NULL. */
 typedef struct cli_option {

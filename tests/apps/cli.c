@@ -2,8 +2,10 @@
  * overflow, trailing junk and out-of-range values (open and closed ends); whole numbers refuse
  * fractions and exponents; lists refuse empty items; the option table parses "--x v",
  * "--x=v", aliases, flags and positionals, refuses unknown options and missing values, and
- * prints aligned help; output files appear only at commit, and an abort or a write error
- * leaves the previous file untouched and no temporary behind. argv[1]: a scratch directory. */
+ * prints aligned help; a number option takes one value per metavar word; element names and
+ * lists (repeats refused) are read; output files appear only at commit, and an abort or a
+ * write error leaves the previous file untouched and no temporary behind. argv[1]: a scratch
+ * directory. */
 #define _POSIX_C_SOURCE 200809L
 #include "../../apps/cli.c"
 #include "test.h"
@@ -146,6 +148,46 @@ static void table(const char *work)
   TEST_TRUE(lines == 7 && col == (int)strlen("  -o, --output DIR  "));
 }
 
+/* Number options with several values (one per metavar word) and element names. */
+static void several_values(void)
+{
+  double box[6] = {0, 0, 0, 0, 0, 0};
+  int cells[3] = {0, 0, 0}, seen_box = 0;
+  fcm_element_type type = FCM_ELEMENT_COUNT;
+  const cli_option opts[] = {
+      {"--box", NULL, CLI_DOUBLE, box, "X0 Y0 Z0 X1 Y1 Z1", "corners", -10, 10, 0, NULL, NULL,
+       &seen_box},
+      {"--cells", NULL, CLI_INT, cells, "NX NY NZ", "cells", 1, 100, 0, NULL, NULL, NULL},
+      {"--element", NULL, CLI_CUSTOM, &type, "E", "element", 0, 0, 0, NULL, cli_element, NULL},
+      {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
+  char *argv[] = {"p",       "--box", "-1", "-2", "-3",        "1",     "2", "3.5",
+                  "--cells", "2",     "3",  "4",  "--element", "Hex20", NULL};
+  TEST_TRUE(cli_parse("p", opts, 14, argv, NULL, 0, NULL) == CLI_OK);
+  TEST_TRUE(seen_box && box[0] == -1 && box[1] == -2 && box[2] == -3 && box[3] == 1 &&
+            box[4] == 2 && box[5] == 3.5);
+  TEST_TRUE(cells[0] == 2 && cells[1] == 3 && cells[2] == 4 && type == FCM_ELEMENT_HEX20);
+  struct {
+    int argc;
+    char *argv[5];
+  } bad[] = {{4, {"p", "--cells", "2", "3"}},      /* one value missing */
+             {5, {"p", "--cells", "2", "3", "0"}}, /* out of range */
+             {5, {"p", "--cells", "2", "x", "4"}},
+             {4, {"p", "--cells=2", "3", "4"}}, /* several values: no --name= */
+             {3, {"p", "--element", "hex27"}}};
+  for (size_t k = 0; k < sizeof bad / sizeof *bad; k++)
+    if (cli_parse("p", opts, bad[k].argc, bad[k].argv, NULL, 0, NULL) != CLI_ERROR)
+      TEST_FAIL_("bad case %zu accepted", k);
+
+  fcm_element_type list[FCM_ELEMENT_COUNT];
+  int n = 0;
+  TEST_TRUE(cli_element_list("p", "--e", "hex8,tet4", list, &n) && n == 2 &&
+            list[0] == FCM_ELEMENT_HEX8 && list[1] == FCM_ELEMENT_TET4);
+  const char *bad_list[] = {"hex8,hex8", "hex8,,tet4", "", "tet4,hex9"};
+  for (size_t k = 0; k < sizeof bad_list / sizeof *bad_list; k++)
+    if (cli_element_list("p", "--e", bad_list[k], list, &n) || n != 2)
+      TEST_FAIL_("element list '%s' accepted", bad_list[k]);
+}
+
 static void output(const char *work)
 {
   char dir[4096], path[4200];
@@ -197,6 +239,7 @@ int main(int argc, char **argv)
   numbers();
   lists();
   table(argv[1]);
+  several_values();
   output(argv[1]);
   int rc = TEST_RESULT();
   if (rc != 0) {
