@@ -16,30 +16,6 @@
 
 #define RULEGEN_VERSION "0.1"
 
-static void usage(FILE *f)
-{
-  fprintf(f,
-          "usage: fcm-rulegen [options]\n"
-          "Generates small positive interior rules by node elimination (Xiao & Gimbutas 2010)\n"
-          "from the computed rules and writes one table per shape and strength as\n"
-          "DIR/<shape>/<shape>_<mm>.txt. Progress lines go to stderr.\n"
-          "  --shape S        tet, hex, tri, quad, line; repeat or use a comma list (default:\n"
-          "                   tet,hex,tri,quad)\n"
-          "  --strength A[:B] strength or inclusive range (default 1:10)\n"
-          "  --out DIR        output directory (default quadrature_tables)\n"
-          "  --starts K       try K start rules (computed rules of strength m, m+2, ...) and keep\n"
-          "                   the smallest result (default 1)\n"
-          "  --from-next      also start from the table of strength m+1 in DIR, if present\n"
-          "  --candidates N   single points tried per removal before stopping (default 12)\n"
-          "  --iterations N   Levenberg-Marquardt iterations per attempt (default 60)\n"
-          "  --batch F        largest fraction of points removed at once early on (default 0.05)\n"
-          "  --margin D       smallest distance of a point to the boundary (default 1e-9)\n"
-          "  --tol T          moment residual accepted after a removal (default 1e-14)\n"
-          "  --force          overwrite a table even when it has fewer points than the new rule\n"
-          "  --dry-run        do not write files\n"
-          "  --help           this text\n");
-}
-
 typedef struct progress_state {
   const char *shape;
   int strength;
@@ -54,24 +30,6 @@ static void progress(void *user, const fcm_rulegen_info *info)
   fprintf(stderr, "  %s %2d: %d -> %d points, residual %.1e, %lld iterations, %d failed, %.1f s\n",
           p->shape, p->strength, info->initial_points, info->num_points, info->residual,
           info->iterations, info->failed_attempts, info->seconds);
-}
-
-static int parse_shape(const char *s, fcm_shape *out)
-{
-  static const struct {
-    const char *name;
-    fcm_shape shape;
-  } names[] = {{"line", FCM_SHAPE_LINE},
-               {"tri", FCM_SHAPE_TRI},
-               {"quad", FCM_SHAPE_QUAD},
-               {"tet", FCM_SHAPE_TET},
-               {"hex", FCM_SHAPE_HEX}};
-  for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
-    if (!strcmp(s, names[i].name)) {
-      *out = names[i].shape;
-      return 1;
-    }
-  return 0;
 }
 
 /* Number of points of an existing table file, 0 when absent or unreadable. */
@@ -259,103 +217,151 @@ static int generate(fcm_ctx *ctx, const config *cfg, fcm_shape shape, int m)
   return ok;
 }
 
-/* An int or a finite double from all of `s` in [lo, hi] (messages name `opt`). */
-static int parse_int(const char *opt, const char *s, long long lo, long long hi, int *v)
+/* ---------------------------------------------------------------- options */
+
+#define MAX_SHAPES 16
+
+typedef struct shape_list {
+  fcm_shape shape[MAX_SHAPES];
+  int count;
+} shape_list;
+
+/* --shape: a comma list appended to the shapes given so far (the option may repeat). */
+static int parse_shapes(const char *prog, const char *opt, const char *s, void *dest)
 {
-  long long n = 0;
-  if (!cli_int("fcm-rulegen", opt, s, lo, hi, &n)) return 0;
-  *v = (int)n;
+  static const char *const names[] = {"line", "tri", "quad", "tet", "hex", NULL};
+  static const fcm_shape shapes[] = {FCM_SHAPE_LINE, FCM_SHAPE_TRI, FCM_SHAPE_QUAD, FCM_SHAPE_TET,
+                                     FCM_SHAPE_HEX};
+  shape_list *l = dest;
+  char tok[MAX_SHAPES][CLI_TOKEN];
+  int n = 0, which = 0;
+  if (!cli_list(prog, opt, s, tok, MAX_SHAPES, &n)) return 0;
+  if (l->count + n > MAX_SHAPES) {
+    fprintf(stderr, "%s: %s: more than %d shapes in all\n", prog, opt, MAX_SHAPES);
+    return 0;
+  }
+  for (int k = 0; k < n; k++) {
+    if (!cli_choice(prog, opt, tok[k], names, &which)) return 0;
+    l->shape[l->count++] = shapes[which];
+  }
   return 1;
 }
 
-static int parse_double(const char *opt, const char *s, double lo, double hi, double *v)
+/* --strength: A or A:B (inclusive) with 1 <= A <= B <= 40 into int[2]. */
+static int parse_strengths(const char *prog, const char *opt, const char *s, void *dest)
 {
-  return cli_double("fcm-rulegen", opt, s, lo, hi, 0, v);
+  int *m = dest;
+  long long lo = 0, hi = 0;
+  char buf[64];
+  if (snprintf(buf, sizeof buf, "%s", s) >= (int)sizeof buf) {
+    fprintf(stderr, "%s: %s: '%s' is not A or A:B\n", prog, opt, s);
+    return 0;
+  }
+  char *colon = strchr(buf, ':');
+  if (colon) *colon = '\0';
+  if (!cli_int(prog, opt, buf, 1, 40, &lo) ||
+      !cli_int(prog, opt, colon ? colon + 1 : buf, 1, 40, &hi))
+    return 0;
+  if (hi < lo) {
+    fprintf(stderr, "%s: %s: the range %lld:%lld is empty\n", prog, opt, lo, hi);
+    return 0;
+  }
+  m[0] = (int)lo, m[1] = (int)hi;
+  return 1;
+}
+
+#define NUM_OPTIONS 13
+static void option_table(config *c, shape_list *shapes, int strengths[2], cli_option t[NUM_OPTIONS])
+{
+  fcm_rulegen_options *o = &c->opts;
+  const cli_option opts[NUM_OPTIONS] = {
+      {"--shape", NULL, CLI_CUSTOM, shapes, "S",
+       "tet, hex, tri, quad, line; repeat or use a comma list\n(default: tet,hex,tri,quad)", 0, 0,
+       0, NULL, parse_shapes, NULL},
+      {"--strength", NULL, CLI_CUSTOM, strengths, "A[:B]",
+       "strength or inclusive range in [1, 40] (default 1:10)", 0, 0, 0, NULL, parse_strengths,
+       NULL},
+      {"--out", NULL, CLI_STRING, &c->out, "DIR", "output directory (default quadrature_tables)", 0,
+       0, 0, NULL, NULL, NULL},
+      {"--starts", NULL, CLI_INT, &c->starts, "K",
+       "try K start rules (computed rules of strength m, m+2, ...) and keep\n"
+       "the smallest result (default 1; 0 needs --from-next)",
+       0, 1e6, 0, NULL, NULL, NULL},
+      {"--from-next", NULL, CLI_FLAG, &c->from_next, NULL,
+       "also start from the table of strength m+1 in DIR, if present", 0, 0, 0, NULL, NULL, NULL},
+      {"--candidates", NULL, CLI_INT, &o->max_candidates, "N",
+       "single points tried per removal before stopping (default 12)", 1, 1e6, 0, NULL, NULL, NULL},
+      {"--iterations", NULL, CLI_INT, &o->max_iterations, "N",
+       "Levenberg-Marquardt iterations per attempt (default 60)", 1, 1e6, 0, NULL, NULL, NULL},
+      {"--batch", NULL, CLI_DOUBLE, &o->max_batch, "F",
+       "largest fraction of points removed at once early on, in [0, 1]\n(default 0.05)", 0, 1, 0,
+       NULL, NULL, NULL},
+      {"--margin", NULL, CLI_DOUBLE, &o->margin, "D",
+       "smallest distance of a point to the boundary, in [0, 1] (default 1e-9)", 0, 1, 0, NULL,
+       NULL, NULL},
+      {"--tol", NULL, CLI_DOUBLE, &o->tol, "T",
+       "moment residual accepted after a removal, in [0, 1] (default 1e-14)", 0, 1, 0, NULL, NULL,
+       NULL},
+      {"--force", NULL, CLI_FLAG, &c->force, NULL,
+       "overwrite a table even when it has fewer points than the new rule", 0, 0, 0, NULL, NULL,
+       NULL},
+      {"--dry-run", NULL, CLI_FLAG, &c->dry_run, NULL, "do not write files", 0, 0, 0, NULL, NULL,
+       NULL},
+      {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
+  memcpy(t, opts, sizeof opts);
+}
+
+static void usage(FILE *f)
+{
+  config c;
+  shape_list shapes;
+  int strengths[2];
+  cli_option opts[NUM_OPTIONS];
+  option_table(&c, &shapes, strengths, opts);
+  fprintf(f, "usage: fcm-rulegen [options]\n"
+             "Generates small positive interior rules by node elimination (Xiao & Gimbutas 2010)\n"
+             "from the computed rules and writes one table per shape and strength as\n"
+             "DIR/<shape>/<shape>_<mm>.txt. Progress lines go to stderr.\n");
+  cli_print_options(f, opts);
+}
+
+/* Parse the command line into `c`, the shapes and the strength range; 0 on a usage error. */
+static int parse_args(int argc, char **argv, config *c, shape_list *shapes, int strengths[2])
+{
+  cli_option opts[NUM_OPTIONS];
+  option_table(c, shapes, strengths, opts);
+  switch (cli_parse("fcm-rulegen", opts, argc, argv, NULL, 0, NULL)) {
+  case CLI_HELP:
+    usage(stdout);
+    exit(0);
+  case CLI_ERROR:
+    return 0;
+  case CLI_OK:
+    break;
+  }
+  if (shapes->count == 0) {
+    static const fcm_shape def[] = {FCM_SHAPE_TET, FCM_SHAPE_HEX, FCM_SHAPE_TRI, FCM_SHAPE_QUAD};
+    memcpy(shapes->shape, def, sizeof def);
+    shapes->count = 4;
+  }
+  if (c->starts == 0 && !c->from_next) {
+    fprintf(stderr, "fcm-rulegen: --starts 0 needs --from-next\n");
+    return 0;
+  }
+  return 1;
 }
 
 int main(int argc, char **argv)
 {
   app_env_init(argc, argv); /* passive OpenMP waiting unless the user chose */
   config cfg;
-  fcm_shape shapes[16];
-  int nshapes = 0, mlo = 1, mhi = 10;
+  shape_list shapes = {{FCM_SHAPE_LINE}, 0};
+  int strengths[2] = {1, 10};
   memset(&cfg, 0, sizeof cfg);
   cfg.out = "quadrature_tables";
   cfg.starts = 1;
   cfg.opts = fcm_rulegen_options_default();
-  for (int i = 1; i < argc; i++) {
-    const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-    int bad = 0;
-    if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-      usage(stdout);
-      return 0;
-    } else if (!strcmp(a, "--force")) {
-      cfg.force = 1;
-    } else if (!strcmp(a, "--from-next")) {
-      cfg.from_next = 1;
-    } else if (!strcmp(a, "--dry-run")) {
-      cfg.dry_run = 1;
-    } else if (!v) {
-      bad = 1;
-    } else if (!strcmp(a, "--shape")) {
-      char buf[256];
-      snprintf(buf, sizeof buf, "%s", v);
-      for (char *tok = strtok(buf, ","); tok && !bad; tok = strtok(NULL, ",")) {
-        if (nshapes >= 16 || !parse_shape(tok, &shapes[nshapes++])) bad = 1;
-      }
-      i++;
-    } else if (!strcmp(a, "--strength")) {
-      char buf[64], *colon;
-      snprintf(buf, sizeof buf, "%s", v);
-      colon = strchr(buf, ':');
-      if (colon) *colon = '\0';
-      bad = !parse_int(a, buf, 1, 40, &mlo) || !parse_int(a, colon ? colon + 1 : buf, 1, 40, &mhi);
-      i++;
-    } else if (!strcmp(a, "--out")) {
-      cfg.out = v;
-      i++;
-    } else if (!strcmp(a, "--starts")) {
-      bad = !parse_int(a, v, 0, 1000000, &cfg.starts);
-      i++;
-    } else if (!strcmp(a, "--candidates")) {
-      bad = !parse_int(a, v, 1, 1000000, &cfg.opts.max_candidates);
-      i++;
-    } else if (!strcmp(a, "--iterations")) {
-      bad = !parse_int(a, v, 1, 1000000, &cfg.opts.max_iterations);
-      i++;
-    } else if (!strcmp(a, "--batch")) {
-      bad = !parse_double(a, v, 0.0, 1.0, &cfg.opts.max_batch);
-      i++;
-    } else if (!strcmp(a, "--margin")) {
-      bad = !parse_double(a, v, 0.0, 1.0, &cfg.opts.margin);
-      i++;
-    } else if (!strcmp(a, "--tol")) {
-      bad = !parse_double(a, v, 0.0, 1.0, &cfg.opts.tol);
-      i++;
-    } else {
-      bad = 1;
-    }
-    if (bad) {
-      fprintf(stderr, "fcm-rulegen: bad or incomplete argument '%s%s%s'\n", a, v ? " " : "",
-              v ? v : "");
-      usage(stderr);
-      return 2;
-    }
-  }
-  if (nshapes == 0) {
-    shapes[nshapes++] = FCM_SHAPE_TET;
-    shapes[nshapes++] = FCM_SHAPE_HEX;
-    shapes[nshapes++] = FCM_SHAPE_TRI;
-    shapes[nshapes++] = FCM_SHAPE_QUAD;
-  }
-  if (cfg.starts == 0 && !cfg.from_next) {
-    fprintf(stderr, "fcm-rulegen: --starts 0 needs --from-next\n");
-    return 2;
-  }
-  if (mlo < 1 || mhi < mlo || mhi > 40) {
-    fprintf(stderr, "fcm-rulegen: strength range %d:%d outside [1, 40]\n", mlo, mhi);
-    return 2;
-  }
+  if (!parse_args(argc, argv, &cfg, &shapes, strengths)) return 2;
   fcm_ctx *ctx = NULL;
   if (fcm_ctx_create(NULL, &ctx) != FCM_OK) {
     fprintf(stderr, "fcm-rulegen: cannot create context\n");
@@ -363,9 +369,9 @@ int main(int argc, char **argv)
   }
   int ok = 1;
   double t0 = fcm_wtime();
-  for (int m = mlo; m <= mhi && ok; m++)
-    for (int s = 0; s < nshapes && ok; s++)
-      ok = generate(ctx, &cfg, shapes[s], m);
+  for (int m = strengths[0]; m <= strengths[1] && ok; m++)
+    for (int s = 0; s < shapes.count && ok; s++)
+      ok = generate(ctx, &cfg, shapes.shape[s], m);
   fprintf(stderr, "fcm-rulegen: total %.1f s\n", fcm_wtime() - t0);
   fcm_ctx_destroy(&ctx);
   return ok ? 0 : 1;
