@@ -6,26 +6,12 @@
 
 #include <fcm/fcm.h>
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 /* ------------------------------------------------------------------ helpers */
-
-static int parse_num(const char *opt, const char *s, double lo, double hi, double *out)
-{
-  return cli_double("fcm-quadrature", opt, s, lo, hi, 0, out);
-}
-
-static int parse_int(const char *opt, const char *s, int lo, int hi, int *out)
-{
-  long long v = 0;
-  if (!cli_int("fcm-quadrature", opt, s, lo, hi, &v)) return 0;
-  *out = (int)v;
-  return 1;
-}
 
 static int cmp_double(const void *a, const void *b)
 {
@@ -81,7 +67,7 @@ static int monomial_errors(const fcm_cell_rules *rules, int m, const double R[9]
   return count;
 }
 
-static void accuracy_usage(FILE *f)
+static void accuracy_usage(FILE *f, const cli_option *opts)
 {
   fprintf(f, "usage: fcm-quadrature accuracy [--max-strength M] [--csv FILE]\n"
              "\n"
@@ -91,32 +77,22 @@ static void accuracy_usage(FILE *f)
              "vanishes) is integrated with the initial cut-cell rule (tetrahedralized\n"
              "intersection) and the simplified rule (<= (m+3 choose 3) positive points), and\n"
              "compared with its analytic value.\n"
-             "\n"
-             "  --max-strength M   1..20 (default 10)\n"
-             "  --csv FILE         write strength,rule,points,max_rel_error,median_rel_error\n");
+             "\n");
+  cli_print_options(f, opts);
 }
 
 int fcm_quadrature_cmd_accuracy(int argc, char **argv)
 {
   int maxm = 10, rc = 1;
   const char *csv = NULL;
-  for (int i = 0; i < argc; i++) {
-    if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
-      accuracy_usage(stdout);
-      return 0;
-    } else if (!strcmp(argv[i], "--max-strength")) {
-      if (!parse_int("--max-strength", i + 1 < argc ? argv[++i] : NULL, 1, 20, &maxm)) return 2;
-    } else if (!strcmp(argv[i], "--csv")) {
-      if (i + 1 >= argc) {
-        fprintf(stderr, "fcm-quadrature: --csv needs a file name\n");
-        return 2;
-      }
-      csv = argv[++i];
-    } else {
-      fprintf(stderr, "fcm-quadrature accuracy: unknown option '%s' (see --help)\n", argv[i]);
-      return 2;
-    }
-  }
+  const cli_option opts[] = {{"--max-strength", NULL, CLI_INT, &maxm, "M", "1..20 (default 10)", 1,
+                              20, 0, NULL, NULL, NULL},
+                             {"--csv", NULL, CLI_STRING, &csv, "FILE",
+                              "write strength,rule,points,max_rel_error,median_rel_error", 0, 0, 0,
+                              NULL, NULL, NULL},
+                             {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
+  const int prc = fcm_quadrature_parse(opts, argc, argv, accuracy_usage);
+  if (prc >= 0) return prc;
   fcm_ctx *ctx = NULL;
   fcm_mesh *cell = NULL;
   fcm_geometry *box = NULL, *cuboid = NULL;
@@ -202,7 +178,7 @@ done:
 
 /* ----------------------------------------------------------------- embed */
 
-static void embed_usage(FILE *f)
+static void embed_usage(FILE *f, const cli_option *opts)
 {
   fprintf(f, "usage: fcm-quadrature embed --element {tet4,tet10,hex8,hex20}\n"
              "           --box X0 Y0 Z0 X1 Y1 Z1 --cells NX NY NZ --geometry FILE|SHAPE\n"
@@ -212,19 +188,8 @@ static void embed_usage(FILE *f)
              "Builds the background grid, embeds the geometry, builds the cut-cell rules and\n"
              "prints their statistics (cells per class, points before and after\n"
              "simplification, fallbacks, residual, volumes, time per phase).\n"
-             "\n"
-             "  --geometry FILE   Gmsh .msh (tetrahedra), or TetGen FILE.node (with FILE.ele)\n"
-             "  --geometry SHAPE  ball:CX,CY,CZ,R,N | hemisphere:CX,CY,CZ,R,N |\n"
-             "                    box:X0,Y0,Z0,X1,Y1,Z1,N\n"
-             "  --strength M      stiffness rule strength 1..20 (mass: --mass-strength,\n"
-             "                    default the element's mass strength)\n"
-             "  --no-simplify     keep the initial (tetrahedralized) rules\n"
-             "  --stabilization A append the full cell's rule x A to cut cells (0: off;\n"
-             "                    default 1e-6)\n"
-             "  --min-fraction P  drop cells with volume fraction below P (default 1e-4)\n"
-             "  --dump FILE       one line per stiffness point:\n"
-             "                    cell xi eta zeta X Y Z w_ref w_phys flag\n"
-             "                    (w_phys = w_ref |J|; flag 0 embedded, 1 stabilization)\n");
+             "\n");
+  cli_print_options(f, opts);
 }
 
 /* Procedural geometry "name:a,b,c,..." or a file. */
@@ -267,50 +232,42 @@ int fcm_quadrature_cmd_embed(int argc, char **argv)
 {
   fcm_element_type type = FCM_ELEMENT_COUNT;
   double box[6] = {0, 0, 0, 0, 0, 0}, alpha = 1e-6, phimin = 1e-4;
-  int cells[3] = {0, 0, 0}, strength = 0, mstrength = 0, simplify = 1, have_box = 0, rc = 1;
+  int cells[3] = {0, 0, 0}, strength = 0, mstrength = 0, no_simplify = 0, have_box = 0, rc = 1;
   const char *geometry = NULL, *dump = NULL;
-  for (int i = 0; i < argc; i++) {
-    const char *a = argv[i];
-    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-      embed_usage(stdout);
-      return 0;
-    } else if (!strcmp(a, "--element")) {
-      if (i + 1 >= argc || fcm_element_type_from_name(argv[i + 1], &type) != FCM_OK) {
-        fprintf(stderr, "fcm-quadrature: --element needs one of tet4, tet10, hex8, hex20\n");
-        return 2;
-      }
-      i++;
-    } else if (!strcmp(a, "--box")) {
-      for (int d = 0; d < 6; d++)
-        if (!parse_num("--box", i + 1 < argc ? argv[++i] : NULL, -1e12, 1e12, &box[d])) return 2;
-      have_box = 1;
-    } else if (!strcmp(a, "--cells")) {
-      for (int d = 0; d < 3; d++)
-        if (!parse_int("--cells", i + 1 < argc ? argv[++i] : NULL, 1, 100000, &cells[d])) return 2;
-    } else if (!strcmp(a, "--geometry")) {
-      geometry = i + 1 < argc ? argv[++i] : NULL;
-    } else if (!strcmp(a, "--strength")) {
-      if (!parse_int("--strength", i + 1 < argc ? argv[++i] : NULL, 1, 20, &strength)) return 2;
-    } else if (!strcmp(a, "--mass-strength")) {
-      if (!parse_int("--mass-strength", i + 1 < argc ? argv[++i] : NULL, 1, 20, &mstrength))
-        return 2;
-    } else if (!strcmp(a, "--no-simplify")) {
-      simplify = 0;
-    } else if (!strcmp(a, "--stabilization")) {
-      if (!parse_num("--stabilization", i + 1 < argc ? argv[++i] : NULL, 0, 1, &alpha)) return 2;
-    } else if (!strcmp(a, "--min-fraction")) {
-      if (!parse_num("--min-fraction", i + 1 < argc ? argv[++i] : NULL, 0, 1, &phimin)) return 2;
-    } else if (!strcmp(a, "--dump")) {
-      dump = i + 1 < argc ? argv[++i] : NULL;
-      if (!dump) {
-        fprintf(stderr, "fcm-quadrature: --dump needs a file name\n");
-        return 2;
-      }
-    } else {
-      fprintf(stderr, "fcm-quadrature embed: unknown option '%s' (see --help)\n", a);
-      return 2;
-    }
-  }
+  const cli_option opts[] = {
+      {"--element", NULL, CLI_CUSTOM, &type, "E", "background element: tet4, tet10, hex8, hex20", 0,
+       0, 0, NULL, cli_element, NULL},
+      {"--box", NULL, CLI_DOUBLE, box, "X0 Y0 Z0 X1 Y1 Z1", "background box corners", -1e12, 1e12,
+       0, NULL, NULL, &have_box},
+      {"--cells", NULL, CLI_INT, cells, "NX NY NZ", "background cells per direction, 1..100000", 1,
+       100000, 0, NULL, NULL, NULL},
+      {"--geometry", NULL, CLI_STRING, &geometry, "FILE|SHAPE",
+       "Gmsh .msh (tetrahedra), or TetGen FILE.node (with\n"
+       "FILE.ele), or a shape: ball:CX,CY,CZ,R,N |\n"
+       "hemisphere:CX,CY,CZ,R,N | box:X0,Y0,Z0,X1,Y1,Z1,N",
+       0, 0, 0, NULL, NULL, NULL},
+      {"--strength", NULL, CLI_INT, &strength, "M", "stiffness rule strength 1..20", 1, 20, 0, NULL,
+       NULL, NULL},
+      {"--mass-strength", NULL, CLI_INT, &mstrength, "M",
+       "mass rule strength 1..20 (default the element's)", 1, 20, 0, NULL, NULL, NULL},
+      {"--no-simplify", NULL, CLI_FLAG, &no_simplify, NULL,
+       "keep the initial (tetrahedralized) rules", 0, 0, 0, NULL, NULL, NULL},
+      {"--stabilization", NULL, CLI_DOUBLE, &alpha, "A",
+       "append the full cell's rule x A to cut cells,\n"
+       "A in [0, 1] (0: off; default 1e-6)",
+       0, 1, 0, NULL, NULL, NULL},
+      {"--min-fraction", NULL, CLI_DOUBLE, &phimin, "PHI",
+       "drop cells with volume fraction below PHI, in [0, 1]\n(default 1e-4)", 0, 1, 0, NULL, NULL,
+       NULL},
+      {"--dump", NULL, CLI_STRING, &dump, "FILE",
+       "one line per stiffness point:\n"
+       "cell xi eta zeta X Y Z w_ref w_phys flag\n"
+       "(w_phys = w_ref |J|; flag 0 embedded, 1 stabilization)",
+       0, 0, 0, NULL, NULL, NULL},
+      {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
+  const int prc = fcm_quadrature_parse(opts, argc, argv, embed_usage);
+  if (prc >= 0) return prc;
+  const int simplify = !no_simplify;
   const char *missing = type == FCM_ELEMENT_COUNT ? "--element"
                         : !have_box               ? "--box"
                         : !cells[0]               ? "--cells"

@@ -125,17 +125,14 @@ static int verify_rule(const fcm_rule *rule, int m, double *max_err)
   return ok && *max_err <= 1e-13;
 }
 
-static void tables_help(FILE *f)
+static void tables_help(FILE *f, const cli_option *opts)
 {
   fprintf(f, "usage: fcm-quadrature tables [--check] [--csv FILE]\n"
              "Per shape and strength (tet 1..20, hex 1..21, tri 1..20, quad 1..21): the point\n"
              "count of the catalogue rule (stored table, else computed), the best published\n"
              "count of a positive interior rule and the ratio. Hex and quad even strengths are\n"
-             "compared with the published count of the next odd strength; '-' = not listed.\n"
-             "  --check     re-verify every rule: all monomials up to the strength exact to\n"
-             "              1e-13 (|Q - I| / int |f|), weights positive, points strictly inside;\n"
-             "              exit status 1 if any fails\n"
-             "  --csv FILE  also write shape,strength,points,best_published,ratio\n");
+             "compared with the published count of the next odd strength; '-' = not listed.\n");
+  cli_print_options(f, opts);
 }
 
 static int cmd_tables(int argc, char **argv)
@@ -143,20 +140,17 @@ static int cmd_tables(int argc, char **argv)
   int check = 0, failures = 0, missing = 0;
   const char *csv_path = NULL;
   double worst_low = 0.0;
-  for (int i = 0; i < argc; i++) {
-    if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-      tables_help(stdout);
-      return 0;
-    } else if (!strcmp(argv[i], "--check")) {
-      check = 1;
-    } else if (!strcmp(argv[i], "--csv") && i + 1 < argc) {
-      csv_path = argv[++i];
-    } else {
-      fprintf(stderr, "fcm-quadrature tables: bad argument '%s'\n", argv[i]);
-      tables_help(stderr);
-      return 2;
-    }
-  }
+  const cli_option opts[] = {
+      {"--check", NULL, CLI_FLAG, &check, NULL,
+       "re-verify every rule: all monomials up to the strength exact to\n"
+       "1e-13 (|Q - I| / int |f|), weights positive, points strictly inside;\n"
+       "exit status 1 if any fails",
+       0, 0, 0, NULL, NULL, NULL},
+      {"--csv", NULL, CLI_STRING, &csv_path, "FILE",
+       "also write shape,strength,points,best_published,ratio", 0, 0, 0, NULL, NULL, NULL},
+      {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
+  const int rc = fcm_quadrature_parse(opts, argc, argv, tables_help);
+  if (rc >= 0) return rc;
   FILE *csv = NULL;
   cli_output *csv_out = NULL;
   if (csv_path && !(csv = cli_output_open("fcm-quadrature", csv_path, &csv_out))) return 1;
@@ -223,10 +217,27 @@ static int cmd_tables(int argc, char **argv)
 
 /* ---------------------------------------------------------------- driver */
 
+int fcm_quadrature_parse(const cli_option *opts, int argc, char **argv,
+                         void (*help)(FILE *f, const cli_option *opts))
+{
+  char prog[64];
+  snprintf(prog, sizeof prog, "fcm-quadrature %s", argv[0]);
+  switch (cli_parse(prog, opts, argc, argv, NULL, 0, NULL)) {
+  case CLI_HELP:
+    help(stdout, opts);
+    return 0;
+  case CLI_ERROR:
+    return 2;
+  case CLI_OK:
+    break;
+  }
+  return -1;
+}
+
 typedef struct subcommand {
   const char *name;
   const char *summary;
-  int (*run)(int argc, char **argv); /* arguments after the subcommand name */
+  int (*run)(int argc, char **argv); /* argv[0]: the subcommand name */
 } subcommand;
 
 static const subcommand commands[] = {
@@ -253,7 +264,7 @@ int main(int argc, char **argv)
     return argc < 2 ? 2 : 0;
   }
   for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
-    if (!strcmp(argv[1], commands[i].name)) return commands[i].run(argc - 2, argv + 2);
+    if (!strcmp(argv[1], commands[i].name)) return commands[i].run(argc - 1, argv + 1);
   fprintf(stderr, "fcm-quadrature: unknown command '%s'\n", argv[1]);
   usage(stderr);
   return 2;
