@@ -14,7 +14,6 @@
 
 #include <fcm/material.h>
 
-#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -47,11 +46,232 @@ typedef struct config {
   int payoff_res;
   int repeat;
   const char *payoff_csv;
-  int levels_given, ref_refine_given, geom_given;
 } config;
+
+/* ---------------------------------------------------------------- options */
+
+/* A comma list of integers in [lo, hi], at most cap of them, into values[0..*count-1]. */
+typedef struct int_list {
+  int *values, *count;
+  int cap, lo, hi;
+} int_list;
+
+static int parse_int_list(const char *prog, const char *opt, const char *s, void *dest)
+{
+  const int_list *l = dest;
+  char tok[MAX_LEVELS > MAX_SWEEP ? MAX_LEVELS : MAX_SWEEP][CLI_TOKEN];
+  long long v = 0;
+  int n = 0;
+  if (!cli_list(prog, opt, s, tok, l->cap, &n)) return 0;
+  for (int k = 0; k < n; k++) {
+    if (!cli_int(prog, opt, tok[k], l->lo, l->hi, &v)) return 0;
+    l->values[k] = (int)v;
+  }
+  *l->count = n;
+  return 1;
+}
+
+static int parse_elements(const char *prog, const char *opt, const char *s, void *dest)
+{
+  config *c = dest;
+  return cli_element_list(prog, opt, s, c->elements, &c->num_elements);
+}
+
+static int parse_methods(const char *prog, const char *opt, const char *s, void *dest)
+{
+  static const char *const names[CV_METHOD_COUNT + 1] = {"fcm", "fem", NULL};
+  config *c = dest;
+  char tok[CV_METHOD_COUNT][CLI_TOKEN];
+  int n = 0;
+  if (!cli_list(prog, opt, s, tok, CV_METHOD_COUNT, &n)) return 0;
+  for (int k = 0; k < n; k++) {
+    if (!cli_choice(prog, opt, tok[k], names, &c->methods[k])) return 0;
+    for (int j = 0; j < k; j++)
+      if (c->methods[j] == c->methods[k]) {
+        fprintf(stderr, "%s: %s: '%s' given twice\n", prog, opt, tok[k]);
+        return 0;
+      }
+  }
+  c->num_methods = n;
+  return 1;
+}
+
+/* What the option table writes besides the config: flags and choices that map onto it, the
+ * list descriptors, and which options were given (the --quick defaults yield to them). */
+typedef struct parse_state {
+  int reference, no_sweep, no_plots, fem_traction;
+  int_list levels, sweep_strengths;
+  struct {
+    int levels, ref_refine, geom, sweep_res, sweep, error_strength, res, repeat;
+  } given;
+} parse_state;
+
+static const char *const on_off[] = {"off", "on", NULL};
+static const char *const traction_names[] = {"projected", "naive", "face", NULL};
+static const char *const time_names[] = {"wall", "cpu", NULL};
+
+enum { CMD_STUDY = 1, CMD_PAYOFF = 2, CMD_BOTH = 3 };
+
+/* One option and the subcommands (CMD_*) that take it. */
+typedef struct cv_option {
+  unsigned cmds;
+  cli_option o;
+} cv_option;
+
+#define NUM_OPTIONS 32 /* entries of the table below, sentinel included */
+
+/* The options of subcommand `cmd` (CMD_STUDY or CMD_PAYOFF) writing into c and p. */
+static void option_table(unsigned cmd, config *c, parse_state *p, cli_option t[NUM_OPTIONS])
+{
+  cv_setup *s = &c->setup;
+  p->levels = (int_list){c->levels, &c->num_levels, MAX_LEVELS, 1, 64};
+  p->sweep_strengths = (int_list){c->sweep_strengths, &c->num_sweep, MAX_SWEEP, 1, 20};
+  const cv_option all[NUM_OPTIONS] = {
+      {CMD_STUDY,
+       {"--elements", NULL, CLI_CUSTOM, c, "LIST", "tet4,tet10,hex8,hex20 (default all)", 0, 0, 0,
+        NULL, parse_elements, NULL}},
+      {CMD_PAYOFF,
+       {"--elements", "--element", CLI_CUSTOM, c, "LIST",
+        "tet4,tet10,hex8,hex20 (--element E: one)\n"
+        "(default all)",
+        0, 0, 0, NULL, parse_elements, NULL}},
+      {CMD_STUDY,
+       {"--methods", NULL, CLI_CUSTOM, c, "LIST", "fcm,fem (default both)", 0, 0, 0, NULL,
+        parse_methods, NULL}},
+      {CMD_STUDY,
+       {"--levels", NULL, CLI_CUSTOM, &p->levels, "LIST",
+        "resolutions res in [1, 64], h = 1/res (default 2,3,4,6,8)", 0, 0, 0, NULL, parse_int_list,
+        &p->given.levels}},
+      {CMD_STUDY,
+       {"--quick", NULL, CLI_FLAG, &c->quick, NULL,
+        "levels 2,3,4, geometry n 6, sweep res 2 with m = 2..5,\n"
+        "error strength 6 (rates as with 8 to 3 digits),\n"
+        "--ref-refine 0; explicit options override these",
+        0, 0, 0, NULL, NULL, NULL}},
+      {CMD_PAYOFF,
+       {"--quick", NULL, CLI_FLAG, &c->quick, NULL,
+        "res 3, geometry n 6, repeat 2; explicit options\n"
+        "override these",
+        0, 0, 0, NULL, NULL, NULL}},
+      {CMD_STUDY,
+       {"--reference", NULL, CLI_FLAG, &p->reference, NULL,
+        "the authors' problem: E = 5e4, nu = 0, load -5e5 y\n"
+        "exp(-1/(1-9r^2)) e_y (3r < 1), u = 0 on y = 0, traction\n"
+        "free; errors against boundary-conforming Tet10 on the\n"
+        "geometry's tets refined --ref-refine times",
+        0, 0, 0, NULL, NULL, NULL}},
+      {CMD_STUDY,
+       {"--ref-refine", NULL, CLI_INT, &s->ref_refine, "N",
+        "refinements of the reference, 0..3 (default 1; quick 0)", 0, 3, 0, NULL, NULL,
+        &p->given.ref_refine}},
+      {CMD_BOTH,
+       {"--radius", NULL, CLI_DOUBLE, &s->radius, "R",
+        "hemisphere radius in [0.05, 0.999] (default 0.9)", 0.05, 0.999, 0, NULL, NULL, NULL}},
+      {CMD_BOTH,
+       {"--geom-n", NULL, CLI_INT, &s->geom_n, "N",
+        "geometry resolution, 24 N^3 tets, N in [1, 64]\n"
+        "(default 8; quick 6)",
+        1, 64, 0, NULL, NULL, &p->given.geom}},
+      {CMD_BOTH,
+       {"--strength", NULL, CLI_INT, &s->strength, "M",
+        "FCM cut-cell stiffness strength, 1..20 (default element's)", 1, 20, 0, NULL, NULL, NULL}},
+      {CMD_STUDY,
+       {"--surface-strength", NULL, CLI_INT, &s->surface_strength, "M",
+        "traction rules (FCM and FEM faces), 0..20 (default 2p+2)", 0, 20, 0, NULL, NULL, NULL}},
+      {CMD_STUDY,
+       {"--simplify", NULL, CLI_CHOICE, &s->simplify, "on|off",
+        "simplify FCM cut-cell rules (default on)", 0, 0, 0, on_off, NULL, NULL}},
+      {CMD_STUDY,
+       {"--stabilization", NULL, CLI_DOUBLE, &s->stab_alpha, "A",
+        "FCM stabilization alpha in [0, 1], 0 = off (default 0)", 0, 1, 0, NULL, NULL, NULL}},
+      {CMD_STUDY,
+       {"--min-fraction", NULL, CLI_DOUBLE, &s->min_fraction, "F",
+        "FCM: drop cells with volume fraction < F, F in [0, 0.5]\n"
+        "(default 0: only empty cells; a dropped cell takes its\n"
+        "share of the surface load with it, ~sqrt(F) h^2 each,\n"
+        "which stalls convergence)",
+        0, 0.5, 0, NULL, NULL, NULL}},
+      {CMD_STUDY,
+       {"--error-strength", NULL, CLI_INT, &s->error_strength, "M",
+        "strength of the error rules, 2..20 (default 8; quick 6)", 2, 20, 0, NULL, NULL,
+        &p->given.error_strength}},
+      {CMD_STUDY,
+       {"--fem-traction", NULL, CLI_CHOICE, &p->fem_traction, "MODE",
+        "surface load of the staircase FEM (default projected)\n"
+        "projected: the true load t(y) = sigma(u(y)) n(y) on the\n"
+        "polyhedron carried along rays from the centre to the\n"
+        "staircase faces (weight |y|^2 (d.n_face) / (|x|^2 (d.n)):\n"
+        "the total force is that of the true surface);\n"
+        "naive: sigma(u(x)) n_true(x) per staircase face area\n"
+        "(n_true: facet met by the ray; the load grows with the\n"
+        "staircase's excess area, so this FEM does not converge);\n"
+        "face: sigma(u(x)) n_face, the exact data of the staircase\n"
+        "domain itself (control: optimal rates, no geometric error)",
+        0, 0, 0, traction_names, NULL, NULL}},
+      {CMD_STUDY,
+       {"--fit", NULL, CLI_INT, &c->fit, "N", "levels in the rate fit, 2..32 (default 3)", 2,
+        MAX_LEVELS, 0, NULL, NULL, NULL}},
+      {CMD_STUDY,
+       {"--sweep-element", NULL, CLI_CUSTOM, &c->sweep_element, "E",
+        "element of the strength sweep (FCM) (default hex20)", 0, 0, 0, NULL, cli_element, NULL}},
+      {CMD_STUDY,
+       {"--sweep-res", NULL, CLI_INT, &c->sweep_res, "R",
+        "resolution of the sweep, 1..64 (default 4; quick 2)", 1, 64, 0, NULL, NULL,
+        &p->given.sweep_res}},
+      {CMD_STUDY,
+       {"--sweep-strengths", NULL, CLI_CUSTOM, &p->sweep_strengths, "LIST",
+        "strengths m in [1, 20] (default 1..8; quick 2..5)", 0, 0, 0, NULL, parse_int_list,
+        &p->given.sweep}},
+      {CMD_STUDY,
+       {"--no-sweep", NULL, CLI_FLAG, &p->no_sweep, NULL, "skip the strength sweep", 0, 0, 0, NULL,
+        NULL, NULL}},
+      {CMD_STUDY,
+       {"--time", NULL, CLI_CHOICE, &c->cpu_time, "wall|cpu",
+        "time base of the accuracy-vs-time table and plot\n"
+        "(default wall; cpu = process CPU seconds of all threads,\n"
+        "steadier on a shared machine)",
+        0, 0, 0, time_names, NULL, NULL}},
+      {CMD_STUDY,
+       {"--out", NULL, CLI_STRING, &c->out, "PREFIX", "output prefix (default fcm-converge)", 0, 0,
+        0, NULL, NULL, NULL}},
+      {CMD_STUDY,
+       {"--csv", NULL, CLI_STRING, &c->csv, "FILE", "per-level CSV (default PREFIX-levels.csv)", 0,
+        0, 0, NULL, NULL, NULL}},
+      {CMD_STUDY,
+       {"--rates-csv", NULL, CLI_STRING, &c->rates_csv, "FILE",
+        "fitted rates CSV (default PREFIX-rates.csv)", 0, 0, 0, NULL, NULL, NULL}},
+      {CMD_STUDY,
+       {"--sweep-csv", NULL, CLI_STRING, &c->sweep_csv, "FILE",
+        "strength sweep CSV (default PREFIX-sweep.csv)", 0, 0, 0, NULL, NULL, NULL}},
+      {CMD_STUDY,
+       {"--no-plots", NULL, CLI_FLAG, &p->no_plots, NULL,
+        "no PNG files (else PREFIX-convergence.png,\n"
+        "PREFIX-pareto.png, PREFIX-sweep.png through gnuplot;\n"
+        "without gnuplot a message is printed and the CSV files\n"
+        "are still written)",
+        0, 0, 0, NULL, NULL, NULL}},
+      {CMD_PAYOFF,
+       {"--res", NULL, CLI_INT, &c->payoff_res, "R", "resolution, 1..64 (default 8; quick 3)", 1,
+        64, 0, NULL, NULL, &p->given.res}},
+      {CMD_PAYOFF,
+       {"--repeat", NULL, CLI_INT, &c->repeat, "N",
+        "timed assemblies per variant, minimum kept, 1..100\n"
+        "(default 3; quick 2)",
+        1, 100, 0, NULL, NULL, &p->given.repeat}},
+      {CMD_PAYOFF,
+       {"--csv", NULL, CLI_STRING, &c->payoff_csv, "FILE", "write the table as CSV", 0, 0, 0, NULL,
+        NULL, NULL}},
+      {CMD_BOTH, {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}}};
+  int n = 0;
+  for (int k = 0; k < NUM_OPTIONS; k++)
+    if (all[k].cmds & cmd) t[n++] = all[k].o;
+}
 
 static void usage(FILE *f)
 {
+  config c;
+  parse_state p;
+  cli_option opts[NUM_OPTIONS];
   fprintf(
       f, "usage: " CV_PROG " [options]           convergence, accuracy vs time, strength sweep\n"
          "       " CV_PROG " payoff [options]    simplification payoff (Longva et al. 2020 §6.3)\n"
@@ -70,65 +290,18 @@ static void usage(FILE *f)
          "Omega inside the kept cells - column 'meas' is that volume / |Omega|).\n"
          "Rates: least-squares slope of log err vs log h over the finest --fit levels.\n"
          "\n"
-         "study options:\n"
-         "  --elements LIST        tet4,tet10,hex8,hex20                     (default all)\n"
-         "  --methods LIST         fcm,fem                                   (default both)\n"
-         "  --levels LIST          resolutions res, h = 1/res     (default 2,3,4,6,8)\n"
-         "  --quick                levels 2,3,4, geometry n 6, sweep res 2 with m = 2..5,\n"
-         "                         error strength 6 (rates as with 8 to 3 digits)\n"
-         "  --reference            the authors' problem: E = 5e4, nu = 0, load -5e5 y\n"
-         "                         exp(-1/(1-9r^2)) e_y (3r < 1), u = 0 on y = 0, traction free;\n"
-         "                         errors against boundary-conforming Tet10 on the geometry's\n"
-         "                         tets refined --ref-refine times (default 1; quick 0)\n"
-         "  --radius R             hemisphere radius in (0, 1)               (default 0.9)\n"
-         "  --geom-n N             geometry resolution, 24 N^3 tets          (default 8)\n"
-         "  --strength M           FCM cut-cell stiffness strength           (default element's)\n"
-         "  --surface-strength M   traction rules (FCM and FEM faces)        (default 2p+2)\n"
-         "  --simplify on|off      simplify FCM cut-cell rules               (default on)\n"
-         "  --stabilization A      FCM stabilization alpha, 0 = off          (default 0)\n"
-         "  --min-fraction F       FCM: drop cells with volume fraction < F  (default 0: only\n"
-         "                         empty cells; a dropped cell takes its share of the surface\n"
-         "                         load with it, ~sqrt(F) h^2 each, which stalls convergence)\n"
-         "  --error-strength M     strength of the error rules      (default 8; quick 6)\n"
-         "  --fem-traction MODE    surface load of the staircase FEM         (default projected)\n"
-         "                         projected: the true load t(y) = sigma(u(y)) n(y) on the\n"
-         "                         polyhedron carried along rays from the centre to the\n"
-         "                         staircase faces (weight |y|^2 (d.n_face) / (|x|^2 (d.n)):\n"
-         "                         the total force is that of the true surface);\n"
-         "                         naive: sigma(u(x)) n_true(x) per staircase face area\n"
-         "                         (n_true: facet met by the ray; the load grows with the\n"
-         "                         staircase's excess area, so this FEM does not converge);\n"
-         "                         face: sigma(u(x)) n_face, the exact data of the staircase\n"
-         "                         domain itself (control: optimal rates, no geometric error)\n");
+         "study options:\n");
+  option_table(CMD_STUDY, &c, &p, opts);
+  cli_print_options(f, opts);
   fprintf(
-      f,
-      "  --fit N                levels in the rate fit                    (default 3)\n"
-      "  --sweep-element E      element of the strength sweep (FCM)       (default hex20)\n"
-      "  --sweep-res R          resolution of the sweep                   (default 4)\n"
-      "  --sweep-strengths LIST strengths m                               (default 1..8)\n"
-      "  --no-sweep             skip the strength sweep\n"
-      "  --time wall|cpu        time base of the accuracy-vs-time table and plot (default\n"
-      "                         wall; cpu = process CPU seconds of all threads, steadier\n"
-      "                         on a shared machine)\n"
-      "  --out PREFIX           output prefix                             (default fcm-converge)\n"
-      "  --csv FILE             per-level CSV            (default PREFIX-levels.csv)\n"
-      "  --rates-csv FILE       fitted rates CSV         (default PREFIX-rates.csv)\n"
-      "  --sweep-csv FILE       strength sweep CSV       (default PREFIX-sweep.csv)\n"
-      "  --no-plots             no PNG files (else PREFIX-convergence.png, PREFIX-pareto.png,\n"
-      "                         PREFIX-sweep.png through gnuplot; without gnuplot a message\n"
-      "                         is printed and the CSV files are still written)\n"
-      "\n");
-  fprintf(
-      f, "payoff options (FCM on the hemisphere with the manufactured displacement; per element\n"
+      f, "\n"
+         "payoff options (FCM on the hemisphere with the manufactured displacement; per element\n"
          "and rule kind the rules are built without and with simplification and one assembly of\n"
-         "each is timed: the break-even is the number of assemblies at which simplifying pays):\n"
-         "  --elements LIST        tet4,tet10,hex8,hex20 (--element E: one)  (default all)\n"
-         "  --res R                resolution                                (default 8; quick 3)\n"
-         "  --geom-n N, --strength M, --radius R   as above (default strengths: element's)\n"
-         "  --repeat N             timed assemblies per variant, minimum kept (default 3)\n"
-         "  --csv FILE             write the table as CSV\n"
-         "  --quick                res 3, geometry n 6, repeat 2\n"
-         "\n"
+         "each is timed: the break-even is the number of assemblies at which simplifying pays):\n");
+  option_table(CMD_PAYOFF, &c, &p, opts);
+  cli_print_options(f, opts);
+  fprintf(
+      f, "\n"
          "CSV columns. levels: element,method,res,h,dofs,active_cells,cut_cells,points,\n"
          "  strength,t_rules,t_assembly,t_solve,t_total,err_l2,err_h1,norm_l2,norm_h1,rel_l2,\n"
          "  rel_h1,measured_volume,domain_volume,failed,note,cpu_rules,cpu_assembly,cpu_solve,\n"
@@ -153,88 +326,6 @@ static void usage(FILE *f)
          "set OMP_WAIT_POLICY=passive (spinning threads inflate small phases).\n"
          "stdout: tables; stderr: progress. Exit 0 on success, 1 on a computation or output\n"
          "error, 2 on a usage error.\n");
-}
-
-/* ---------------------------------------------------------------- options */
-
-static int parse_int(const char *opt, const char *s, int lo, int hi, int *out)
-{
-  long long v = 0;
-  if (!cli_int(CV_PROG, opt, s, lo, hi, &v)) return 0;
-  *out = (int)v;
-  return 1;
-}
-
-static int parse_double(const char *opt, const char *s, double lo, double hi, double *out)
-{
-  return cli_double(CV_PROG, opt, s, lo, hi, 0, out);
-}
-
-/* Comma list of integers in [lo, hi]; empty items are refused. */
-static int parse_int_list(const char *opt, const char *s, int lo, int hi, int *out, int cap, int *n)
-{
-  char tok[64][CLI_TOKEN];
-  if (!cli_list(CV_PROG, opt, s, tok, cap < 64 ? cap : 64, n)) return 0;
-  for (int k = 0; k < *n; k++)
-    if (!parse_int(opt, tok[k], lo, hi, &out[k])) return 0;
-  return 1;
-}
-
-static int parse_elements(const char *opt, const char *s, config *c)
-{
-  char buf[128];
-  if (strlen(s) >= sizeof buf || !*s) {
-    fprintf(stderr, CV_PROG ": %s: empty or too long list\n", opt);
-    return 0;
-  }
-  strcpy(buf, s);
-  c->num_elements = 0;
-  for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
-    fcm_element_type t;
-    if (fcm_element_type_from_name(tok, &t) != FCM_OK) {
-      fprintf(stderr, CV_PROG ": %s: unknown element '%s' (tet4, tet10, hex8, hex20)\n", opt, tok);
-      return 0;
-    }
-    for (int k = 0; k < c->num_elements; k++)
-      if (c->elements[k] == t) {
-        fprintf(stderr, CV_PROG ": %s: '%s' given twice\n", opt, tok);
-        return 0;
-      }
-    c->elements[c->num_elements++] = t;
-  }
-  return c->num_elements > 0;
-}
-
-static int parse_methods(const char *s, config *c)
-{
-  char buf[64];
-  if (strlen(s) >= sizeof buf || !*s) {
-    fprintf(stderr, CV_PROG ": --methods: empty or too long list\n");
-    return 0;
-  }
-  strcpy(buf, s);
-  int seen[CV_METHOD_COUNT] = {0, 0};
-  c->num_methods = 0;
-  for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
-    int m = !strcmp(tok, "fcm") ? CV_FCM : !strcmp(tok, "fem") ? CV_FEM : -1;
-    if (m < 0 || seen[m]) {
-      fprintf(stderr, CV_PROG ": --methods: '%s' is unknown or repeated (fcm, fem)\n", tok);
-      return 0;
-    }
-    seen[m] = 1;
-    c->methods[c->num_methods++] = m;
-  }
-  return c->num_methods > 0;
-}
-
-static int on_off(const char *opt, const char *s, int *out)
-{
-  if (!strcmp(s, "on") || !strcmp(s, "off")) {
-    *out = !strcmp(s, "on");
-    return 1;
-  }
-  fprintf(stderr, CV_PROG ": %s: expected on or off, got '%s'\n", opt, s);
-  return 0;
 }
 
 static void defaults(config *c)
@@ -275,133 +366,51 @@ static void defaults(config *c)
   c->repeat = 3;
 }
 
+/* The --quick defaults of the options not given. */
+static void quick_defaults(config *c, const parse_state *p)
+{
+  static const int lv[] = {2, 3, 4};
+  if (!p->given.levels) {
+    c->num_levels = 3;
+    memcpy(c->levels, lv, sizeof lv);
+  }
+  if (!p->given.geom) c->setup.geom_n = 6;
+  if (!p->given.ref_refine) c->setup.ref_refine = 0;
+  if (!p->given.sweep_res) c->sweep_res = 2;
+  if (!p->given.error_strength) c->setup.error_strength = 6;
+  if (!p->given.sweep) {
+    c->num_sweep = 4;
+    for (int k = 0; k < 4; k++)
+      c->sweep_strengths[k] = k + 2;
+  }
+  if (!p->given.res) c->payoff_res = 3;
+  if (!p->given.repeat) c->repeat = 2;
+}
+
 static int parse_args(int argc, char **argv, config *c)
 {
-  int i = 1;
-  if (argc > 1 && !strcmp(argv[1], "payoff")) c->payoff = 1, i = 2;
-  int sweep_res_given = 0, sweep_given = 0, res_given = 0, repeat_given = 0, err_given = 0;
-  for (; i < argc; i++) {
-    const char *a = argv[i];
-    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-      usage(stdout);
-      exit(0);
-    }
-    /* flags */
-    if (!strcmp(a, "--quick")) {
-      c->quick = 1;
-      continue;
-    }
-    if (!strcmp(a, "--reference")) {
-      c->setup.problem = CV_REFERENCE;
-      continue;
-    }
-    if (!strcmp(a, "--no-sweep")) {
-      c->sweep = 0;
-      continue;
-    }
-    if (!strcmp(a, "--no-plots")) {
-      c->plots = 0;
-      continue;
-    }
-    if (i + 1 >= argc) {
-      fprintf(stderr, CV_PROG ": unknown option or missing value: '%s' (see --help)\n", a);
-      return 0;
-    }
-    const char *v = argv[++i];
-    cv_setup *s = &c->setup;
-    int ok = 1;
-    if (!strcmp(a, "--elements") || (!strcmp(a, "--element") && c->payoff))
-      ok = parse_elements(a, v, c);
-    else if (!strcmp(a, "--methods") && !c->payoff)
-      ok = parse_methods(v, c);
-    else if (!strcmp(a, "--levels") && !c->payoff)
-      ok = parse_int_list(a, v, 1, 64, c->levels, MAX_LEVELS, &c->num_levels), c->levels_given = 1;
-    else if (!strcmp(a, "--ref-refine") && !c->payoff)
-      ok = parse_int(a, v, 0, 3, &s->ref_refine), c->ref_refine_given = 1;
-    else if (!strcmp(a, "--radius"))
-      ok = parse_double(a, v, 0.05, 0.999, &s->radius);
-    else if (!strcmp(a, "--geom-n"))
-      ok = parse_int(a, v, 1, 64, &s->geom_n), c->geom_given = 1;
-    else if (!strcmp(a, "--strength"))
-      ok = parse_int(a, v, 1, 20, &s->strength);
-    else if (!strcmp(a, "--surface-strength") && !c->payoff)
-      ok = parse_int(a, v, 0, 20, &s->surface_strength);
-    else if (!strcmp(a, "--simplify") && !c->payoff)
-      ok = on_off(a, v, &s->simplify);
-    else if (!strcmp(a, "--stabilization") && !c->payoff)
-      ok = parse_double(a, v, 0.0, 1.0, &s->stab_alpha);
-    else if (!strcmp(a, "--min-fraction") && !c->payoff)
-      ok = parse_double(a, v, 0.0, 0.5, &s->min_fraction);
-    else if (!strcmp(a, "--error-strength") && !c->payoff)
-      ok = parse_int(a, v, 2, 20, &s->error_strength), err_given = 1;
-    else if (!strcmp(a, "--fem-traction") && !c->payoff) {
-      if (!strcmp(v, "projected"))
-        s->fem_traction = CV_TRACTION_PROJECTED;
-      else if (!strcmp(v, "naive"))
-        s->fem_traction = CV_TRACTION_NAIVE;
-      else if (!strcmp(v, "face"))
-        s->fem_traction = CV_TRACTION_FACE;
-      else {
-        fprintf(stderr, CV_PROG ": --fem-traction: expected projected, naive or face, got '%s'\n",
-                v);
-        ok = 0;
-      }
-    } else if (!strcmp(a, "--fit") && !c->payoff)
-      ok = parse_int(a, v, 2, MAX_LEVELS, &c->fit);
-    else if (!strcmp(a, "--sweep-element") && !c->payoff) {
-      if (fcm_element_type_from_name(v, &c->sweep_element) != FCM_OK) {
-        fprintf(stderr, CV_PROG ": --sweep-element: unknown element '%s'\n", v);
-        ok = 0;
-      }
-    } else if (!strcmp(a, "--sweep-res") && !c->payoff)
-      ok = parse_int(a, v, 1, 64, &c->sweep_res), sweep_res_given = 1;
-    else if (!strcmp(a, "--sweep-strengths") && !c->payoff)
-      ok = parse_int_list(a, v, 1, 20, c->sweep_strengths, MAX_SWEEP, &c->num_sweep),
-      sweep_given = 1;
-    else if (!strcmp(a, "--time") && !c->payoff) {
-      if (!strcmp(v, "wall") || !strcmp(v, "cpu"))
-        c->cpu_time = !strcmp(v, "cpu");
-      else {
-        fprintf(stderr, CV_PROG ": --time: expected wall or cpu, got '%s'\n", v);
-        ok = 0;
-      }
-    } else if (!strcmp(a, "--out") && !c->payoff)
-      c->out = v;
-    else if (!strcmp(a, "--csv"))
-      c->payoff ? (void)(c->payoff_csv = v) : (void)(c->csv = v);
-    else if (!strcmp(a, "--rates-csv") && !c->payoff)
-      c->rates_csv = v;
-    else if (!strcmp(a, "--sweep-csv") && !c->payoff)
-      c->sweep_csv = v;
-    else if (!strcmp(a, "--res") && c->payoff)
-      ok = parse_int(a, v, 1, 64, &c->payoff_res), res_given = 1;
-    else if (!strcmp(a, "--repeat") && c->payoff)
-      ok = parse_int(a, v, 1, 100, &c->repeat), repeat_given = 1;
-    else {
-      fprintf(stderr, CV_PROG ": unknown option '%s'%s (see --help)\n", a,
-              c->payoff ? " for payoff" : "");
-      ok = 0;
-    }
-    if (!ok) return 0;
+  parse_state p;
+  cli_option opts[NUM_OPTIONS];
+  memset(&p, 0, sizeof p);
+  p.fem_traction = (int)c->setup.fem_traction;
+  c->payoff = argc > 1 && !strcmp(argv[1], "payoff");
+  option_table(c->payoff ? CMD_PAYOFF : CMD_STUDY, c, &p, opts);
+  /* the payoff options from argv[2] on: cli_parse skips its argv[0] */
+  switch (cli_parse(c->payoff ? CV_PROG " payoff" : CV_PROG, opts, argc - c->payoff,
+                    argv + c->payoff, NULL, 0, NULL)) {
+  case CLI_HELP:
+    usage(stdout);
+    exit(0);
+  case CLI_ERROR:
+    return 0;
+  case CLI_OK:
+    break;
   }
-  if (c->quick) {
-    static const int lv[] = {2, 3, 4};
-    if (!c->levels_given) {
-      c->num_levels = 3;
-      memcpy(c->levels, lv, sizeof lv);
-    }
-    if (!c->geom_given) c->setup.geom_n = 6;
-    if (!c->ref_refine_given) c->setup.ref_refine = 0;
-    if (!sweep_res_given) c->sweep_res = 2;
-    if (!err_given) c->setup.error_strength = 6;
-    if (!sweep_given) {
-      c->num_sweep = 4;
-      for (int k = 0; k < 4; k++)
-        c->sweep_strengths[k] = k + 2;
-    }
-    if (!res_given) c->payoff_res = 3;
-    if (!repeat_given) c->repeat = 2;
-  }
+  if (p.reference) c->setup.problem = CV_REFERENCE;
+  c->setup.fem_traction = (cv_fem_traction)p.fem_traction;
+  c->sweep = !p.no_sweep;
+  c->plots = !p.no_plots;
+  if (c->quick) quick_defaults(c, &p);
   if (c->setup.problem == CV_REFERENCE) {
     c->setup.young = 5e4;
     c->setup.poisson = 0.0;
