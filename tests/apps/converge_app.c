@@ -5,7 +5,8 @@
  * of Omega, FEM over less); the sweep covers m = 2..5; the PNGs are PNGs (when gnuplot is
  * installed) and no .tmp file is left. `payoff --quick` (Tet4, Hex8) reports per element and
  * rule kind fewer points with simplification and a finite positive break-even equal to
- * its measured columns. Bad options exit 2 and write nothing.
+ * its measured columns. Bad options, and options of the other subcommand, exit 2 and write
+ * nothing.
  * Usage: app_converge PATH_TO_fcm-converge WORK_DIR */
 #define _POSIX_C_SOURCE 200809L
 #include "converge_csv.h"
@@ -156,10 +157,12 @@ int main(int argc, char **argv)
 
   /* usage errors: status 2, nothing written */
   static const char *const bad[] = {
-      "--levels 0",       "--levels 2,2", "--elements tet5",        "--methods xfem",
-      "--simplify maybe", "--radius 1.5", "--fem-traction none",    "--strength 0",
-      "--bogus 1",        "--fit 1",      "payoff --elements hex9", "--levels",
-      "--time gpu"};
+      "--levels 0", "--levels 2,2", "--elements tet5", "--methods xfem", "--simplify maybe",
+      "--radius 1.5", "--fem-traction none", "--strength 0", "--bogus 1", "--fit 1",
+      "payoff --elements hex9", "--levels", "--time gpu", "--methods fcm,fcm",
+      "--elements hex8,hex8",
+      /* each subcommand takes only its own options */
+      "--res 3", "--element hex8", "payoff --error-strength 6", "payoff --no-plots", "payof"};
   snprintf(path, sizeof path, "%s/converge-bad-levels.csv", dir);
   for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
     remove(path);

@@ -94,6 +94,15 @@ int main(int argc, char **argv)
   TEST_TRUE(run(cmd) == 2);
   snprintf(cmd, sizeof cmd, "'%s' embed --element hex27 2> /dev/null", argv[1]);
   TEST_TRUE(run(cmd) == 2);
+  remove(dump); /* --box takes six values: five and then an option are refused */
+  snprintf(cmd, sizeof cmd,
+           "'%s' embed --element hex8 --box -1 -1 -1 1 1 --cells 2 2 2 --geometry "
+           "ball:0,0,0,0.5,2 --strength 2 --dump '%s' 2> /dev/null",
+           argv[1], dump);
+  TEST_TRUE(run(cmd) == 2);
+  TEST_TRUE(fopen(dump, "r") == NULL);
+  snprintf(cmd, sizeof cmd, "'%s' tables --check=1 2> /dev/null", argv[1]);
+  TEST_TRUE(run(cmd) == 2);
   TEST_TRUE(fopen(csv, "r") == NULL);
   return TEST_RESULT();
 }

@@ -6,6 +6,10 @@ set(work ${PROJECT_BINARY_DIR}/app-tests)
 fcm_add_test(app_cli tests/apps/cli.c LABELS app ARGS ${work})
 fcm_add_test(app_quadrature tests/apps/quadrature_app.c LABELS app
              ARGS $<TARGET_FILE:fcm-quadrature> ${work})
+# fcm-rulegen: tables written for the shapes and strengths asked for (positive weights adding
+# up to the reference measure); --dry-run and bad options write nothing, bad options exit 2.
+fcm_add_test(app_rulegen tests/apps/rulegen_app.c LABELS app
+             ARGS $<TARGET_FILE:fcm-rulegen> ${work})
 # fcm-sim: a small scene run (frames, PVDs, CSV log, --steps, -o); checkpoints and --resume
 # reproduce the uninterrupted run's frames byte for byte; invalid scenes exit non-zero with
 # the parser's message and create no output directory.
