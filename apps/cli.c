@@ -213,6 +213,22 @@ cli_result cli_parse(const char *prog, const cli_option *opts, int argc, char **
   return CLI_OK;
 }
 
+int cli_parse_args(const char *prog, const cli_option *opts, int argc, char **argv,
+                   const char **pos, int max_pos, int *npos,
+                   void (*help)(FILE *f, const cli_option *opts))
+{
+  switch (cli_parse(prog, opts, argc, argv, pos, max_pos, npos)) {
+  case CLI_HELP:
+    help(stdout, opts);
+    return 0;
+  case CLI_ERROR:
+    return 2;
+  case CLI_OK:
+    break;
+  }
+  return -1;
+}
+
 void cli_print_options(FILE *f, const cli_option *opts)
 {
   char head[128];

@@ -82,6 +82,13 @@ typedef enum cli_result { CLI_ERROR = 0, CLI_OK = 1, CLI_HELP = 2 } cli_result;
 cli_result cli_parse(const char *prog, const cli_option *opts, int argc, char **argv,
                      const char **pos, int max_pos, int *npos);
 
+/** cli_parse() as a program's option parsing uses it: "--help" prints help(stdout, opts) and
+ *  gives the exit code 0, a usage error (its message printed) gives 2, and -1 means the
+ *  arguments are parsed: go on. */
+int cli_parse_args(const char *prog, const cli_option *opts, int argc, char **argv,
+                   const char **pos, int max_pos, int *npos,
+                   void (*help)(FILE *f, const cli_option *opts));
+
 /** The options of `opts` as help lines: "  -a, --name METAVAR   help", the help column
  *  aligned, continuation lines indented to it; then "  -h, --help   this text". */
 void cli_print_options(FILE *f, const cli_option *opts);

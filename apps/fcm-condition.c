@@ -200,13 +200,8 @@ static void option_table(config *c, int *stab_mode, seen *g, cli_option t[NUM_OP
   memcpy(t, o, sizeof o);
 }
 
-static void usage(FILE *f)
+static void usage(FILE *f, const cli_option *opts)
 {
-  config c;
-  int mode;
-  seen g;
-  cli_option opts[NUM_OPTIONS];
-  option_table(&c, &mode, &g, opts);
   fprintf(f,
           "usage: " PROG " [options]\n"
           "\n"
@@ -235,21 +230,15 @@ static void usage(FILE *f)
          "computation or output error, 2 on a usage error.\n");
 }
 
+/* -1 when the arguments are parsed into `c`, else the exit code (0 after --help, 2). */
 static int parse_args(int argc, char **argv, config *c)
 {
   seen g = {0, 0, 0, 0};
   int mode = c->stab_mode == FCM_STABILIZATION_MASS ? 1 : 0;
   cli_option opts[NUM_OPTIONS];
   option_table(c, &mode, &g, opts);
-  switch (cli_parse(PROG, opts, argc, argv, NULL, 0, NULL)) {
-  case CLI_HELP:
-    usage(stdout);
-    exit(0);
-  case CLI_ERROR:
-    return 0;
-  case CLI_OK:
-    break;
-  }
+  const int rc = cli_parse_args(PROG, opts, argc, argv, NULL, 0, NULL, usage);
+  if (rc >= 0) return rc;
   c->stab_mode = mode == 1 ? FCM_STABILIZATION_MASS : FCM_STABILIZATION_MASS_STIFFNESS;
   if (c->quick) {
     if (!g.elements) {
@@ -265,7 +254,7 @@ static int parse_args(int argc, char **argv, config *c)
     if (!g.simplify) c->simplify = 0;
     if (!g.minres) c->minres_max = 1000;
   }
-  return 1;
+  return -1;
 }
 
 /* ---------------------------------------------------------------- main */
@@ -298,7 +287,8 @@ int main(int argc, char **argv)
   c.pc_tangent = FCM_FICTITIOUS_PROJECTED;
   c.minres_max = 5000;
   if (!parse_fractions(PROG, "--fractions", "1:1e-12:13", &c)) return 2;
-  if (!parse_args(argc, argv, &c)) return 2;
+  const int parsed = parse_args(argc, argv, &c);
+  if (parsed >= 0) return parsed;
   for (int e = 0; e < c.num_elements; e++)
     if (!fcm_element_get_info(c.elements[e])) return 2;
 

@@ -267,11 +267,13 @@ static void option_table(unsigned cmd, config *c, parse_state *p, cli_option t[N
     if (all[k].cmds & cmd) t[n++] = all[k].o;
 }
 
-static void usage(FILE *f)
+/* Both subcommands' options (`opts`, the one parsed, is not used). */
+static void usage(FILE *f, const cli_option *opts)
 {
   config c;
   parse_state p;
-  cli_option opts[NUM_OPTIONS];
+  cli_option all[NUM_OPTIONS];
+  (void)opts;
   fprintf(
       f, "usage: " CV_PROG " [options]           convergence, accuracy vs time, strength sweep\n"
          "       " CV_PROG " payoff [options]    simplification payoff (Longva et al. 2020 §6.3)\n"
@@ -291,15 +293,15 @@ static void usage(FILE *f)
          "Rates: least-squares slope of log err vs log h over the finest --fit levels.\n"
          "\n"
          "study options:\n");
-  option_table(CMD_STUDY, &c, &p, opts);
-  cli_print_options(f, opts);
+  option_table(CMD_STUDY, &c, &p, all);
+  cli_print_options(f, all);
   fprintf(
       f, "\n"
          "payoff options (FCM on the hemisphere with the manufactured displacement; per element\n"
          "and rule kind the rules are built without and with simplification and one assembly of\n"
          "each is timed: the break-even is the number of assemblies at which simplifying pays):\n");
-  option_table(CMD_PAYOFF, &c, &p, opts);
-  cli_print_options(f, opts);
+  option_table(CMD_PAYOFF, &c, &p, all);
+  cli_print_options(f, all);
   fprintf(
       f, "\n"
          "CSV columns. levels: element,method,res,h,dofs,active_cells,cut_cells,points,\n"
@@ -387,6 +389,7 @@ static void quick_defaults(config *c, const parse_state *p)
   if (!p->given.repeat) c->repeat = 2;
 }
 
+/* -1 when the arguments are parsed into `c`, else the exit code (0 after --help, 2). */
 static int parse_args(int argc, char **argv, config *c)
 {
   parse_state p;
@@ -396,16 +399,9 @@ static int parse_args(int argc, char **argv, config *c)
   c->payoff = argc > 1 && !strcmp(argv[1], "payoff");
   option_table(c->payoff ? CMD_PAYOFF : CMD_STUDY, c, &p, opts);
   /* the payoff options from argv[2] on: cli_parse skips its argv[0] */
-  switch (cli_parse(c->payoff ? CV_PROG " payoff" : CV_PROG, opts, argc - c->payoff,
-                    argv + c->payoff, NULL, 0, NULL)) {
-  case CLI_HELP:
-    usage(stdout);
-    exit(0);
-  case CLI_ERROR:
-    return 0;
-  case CLI_OK:
-    break;
-  }
+  const int rc = cli_parse_args(c->payoff ? CV_PROG " payoff" : CV_PROG, opts, argc - c->payoff,
+                                argv + c->payoff, NULL, 0, NULL, usage);
+  if (rc >= 0) return rc;
   if (p.reference) c->setup.problem = CV_REFERENCE;
   c->setup.fem_traction = (cv_fem_traction)p.fem_traction;
   c->sweep = !p.no_sweep;
@@ -419,9 +415,9 @@ static int parse_args(int argc, char **argv, config *c)
     for (int b = a + 1; b < c->num_levels; b++)
       if (c->levels[a] == c->levels[b]) {
         fprintf(stderr, CV_PROG ": --levels: %d given twice\n", c->levels[a]);
-        return 0;
+        return 2;
       }
-  return 1;
+  return -1;
 }
 
 /* ---------------------------------------------------------------- study */
@@ -804,7 +800,8 @@ int main(int argc, char **argv)
   config c;
   fcm_ctx *ctx = NULL;
   defaults(&c);
-  if (!parse_args(argc, argv, &c)) return 2;
+  const int parsed = parse_args(argc, argv, &c);
+  if (parsed >= 0) return parsed;
   fcm_status st = fcm_ctx_create(NULL, &ctx);
   if (st != FCM_OK) {
     fprintf(stderr, CV_PROG ": cannot create a context: %s\n", fcm_status_name(st));

@@ -222,16 +222,7 @@ int fcm_quadrature_parse(const cli_option *opts, int argc, char **argv,
 {
   char prog[64];
   snprintf(prog, sizeof prog, "fcm-quadrature %s", argv[0]);
-  switch (cli_parse(prog, opts, argc, argv, NULL, 0, NULL)) {
-  case CLI_HELP:
-    help(stdout, opts);
-    return 0;
-  case CLI_ERROR:
-    return 2;
-  case CLI_OK:
-    break;
-  }
-  return -1;
+  return cli_parse_args(prog, opts, argc, argv, NULL, 0, NULL, help);
 }
 
 typedef struct subcommand {

@@ -311,13 +311,8 @@ static void option_table(config *c, shape_list *shapes, int strengths[2], cli_op
   memcpy(t, opts, sizeof opts);
 }
 
-static void usage(FILE *f)
+static void usage(FILE *f, const cli_option *opts)
 {
-  config c;
-  shape_list shapes;
-  int strengths[2];
-  cli_option opts[NUM_OPTIONS];
-  option_table(&c, &shapes, strengths, opts);
   fprintf(f, "usage: fcm-rulegen [options]\n"
              "Generates small positive interior rules by node elimination (Xiao & Gimbutas 2010)\n"
              "from the computed rules and writes one table per shape and strength as\n"
@@ -325,20 +320,14 @@ static void usage(FILE *f)
   cli_print_options(f, opts);
 }
 
-/* Parse the command line into `c`, the shapes and the strength range; 0 on a usage error. */
+/* Parse the command line into `c`, the shapes and the strength range: -1 to go on, else the
+ * exit code (0 after --help, 2 on a usage error). */
 static int parse_args(int argc, char **argv, config *c, shape_list *shapes, int strengths[2])
 {
   cli_option opts[NUM_OPTIONS];
   option_table(c, shapes, strengths, opts);
-  switch (cli_parse("fcm-rulegen", opts, argc, argv, NULL, 0, NULL)) {
-  case CLI_HELP:
-    usage(stdout);
-    exit(0);
-  case CLI_ERROR:
-    return 0;
-  case CLI_OK:
-    break;
-  }
+  const int rc = cli_parse_args("fcm-rulegen", opts, argc, argv, NULL, 0, NULL, usage);
+  if (rc >= 0) return rc;
   if (shapes->count == 0) {
     static const fcm_shape def[] = {FCM_SHAPE_TET, FCM_SHAPE_HEX, FCM_SHAPE_TRI, FCM_SHAPE_QUAD};
     memcpy(shapes->shape, def, sizeof def);
@@ -346,9 +335,9 @@ static int parse_args(int argc, char **argv, config *c, shape_list *shapes, int 
   }
   if (c->starts == 0 && !c->from_next) {
     fprintf(stderr, "fcm-rulegen: --starts 0 needs --from-next\n");
-    return 0;
+    return 2;
   }
-  return 1;
+  return -1;
 }
 
 int main(int argc, char **argv)
@@ -361,7 +350,8 @@ int main(int argc, char **argv)
   cfg.out = "quadrature_tables";
   cfg.starts = 1;
   cfg.opts = fcm_rulegen_options_default();
-  if (!parse_args(argc, argv, &cfg, &shapes, strengths)) return 2;
+  const int parsed = parse_args(argc, argv, &cfg, &shapes, strengths);
+  if (parsed >= 0) return parsed;
   fcm_ctx *ctx = NULL;
   if (fcm_ctx_create(NULL, &ctx) != FCM_OK) {
     fprintf(stderr, "fcm-rulegen: cannot create context\n");

@@ -58,11 +58,8 @@ static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS
   memcpy(opts, t, sizeof t);
 }
 
-static void usage(FILE *f)
+static void usage(FILE *f, const cli_option *opts)
 {
-  scene_options dummy;
-  cli_option opts[SIM_NUM_OPTIONS];
-  scene_option_table(&dummy, opts);
   fprintf(f,
           "usage: fcm-sim [SCENE.json] [options]\n"
           "\n"
@@ -81,27 +78,21 @@ static void usage(FILE *f)
              "refused checkpoint.\n");
 }
 
+/* -1 when the arguments are parsed into `o`, else the exit code (0 after --help, 2). */
 static int parse_scene_args(int argc, char **argv, scene_options *o)
 {
   cli_option opts[SIM_NUM_OPTIONS];
   const char *pos[1] = {NULL};
   int npos = 0;
   scene_option_table(o, opts);
-  switch (cli_parse("fcm-sim", opts, argc, argv, pos, 1, &npos)) {
-  case CLI_HELP:
-    usage(stdout);
-    exit(0);
-  case CLI_ERROR:
-    return 0;
-  case CLI_OK:
-    break;
-  }
+  const int rc = cli_parse_args("fcm-sim", opts, argc, argv, pos, 1, &npos, usage);
+  if (rc >= 0) return rc;
   o->path = npos ? pos[0] : NULL;
   if (o->check && (o->resume || o->checkpoint_every > 0)) {
     fprintf(stderr, "fcm-sim: --check writes nothing: no --resume or --checkpoint-every\n");
-    return 0;
+    return 2;
   }
-  return 1;
+  return -1;
 }
 
 /* mkdir -p: create `dir` and its missing parents. */
@@ -174,7 +165,8 @@ static int write_checkpoint(fcm_ctx *ctx, fcm_simulation *sim, const char *dir, 
 static int scene_main(int argc, char **argv)
 {
   scene_options o = {NULL, NULL, NULL, 0, -1, 0, 0, 0};
-  if (!parse_scene_args(argc, argv, &o)) return 2;
+  const int parsed = parse_scene_args(argc, argv, &o);
+  if (parsed >= 0) return parsed;
   int rc = 1;
   fcm_ctx *ctx = NULL;
   fcm_scene *scene = NULL;

@@ -2,10 +2,10 @@
  * overflow, trailing junk and out-of-range values (open and closed ends); whole numbers refuse
  * fractions and exponents; lists refuse empty items; the option table parses "--x v",
  * "--x=v", aliases, flags and positionals, refuses unknown options and missing values, and
- * prints aligned help; a number option takes one value per metavar word; element names and
- * lists (repeats refused) are read; output files appear only at commit, and an abort or a
- * write error leaves the previous file untouched and no temporary behind. argv[1]: a scratch
- * directory. */
+ * prints aligned help; cli_parse_args gives the exit codes; a number option takes one value per
+ * metavar word; element names and lists (repeats refused) are read; output files appear only at
+ * commit, and an abort or a write error leaves the previous file untouched and no temporary behind.
+ * argv[1]: a scratch directory. */
 #define _POSIX_C_SOURCE 200809L
 #include "../../apps/cli.c"
 #include "test.h"
@@ -148,6 +148,31 @@ static void table(const char *work)
   TEST_TRUE(lines == 7 && col == (int)strlen("  -o, --output DIR  "));
 }
 
+static int help_calls;
+static const cli_option *help_opts;
+static void count_help(FILE *f, const cli_option *opts)
+{
+  (void)f;
+  help_calls++;
+  help_opts = opts;
+}
+
+/* cli_parse_args: the exit code after --help (0, the help printed once with the table) and
+ * after a usage error (2), -1 when parsing went through. */
+static void parse_args(void)
+{
+  int n = 0;
+  const cli_option opts[] = {{"--n", NULL, CLI_INT, &n, "N", "count", 1, 9, 0, NULL, NULL, NULL},
+                             {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
+  char *ok[] = {"p", "--n", "3", NULL}, *help[] = {"p", "--help", NULL},
+       *bad[] = {"p", "--n", "0", NULL};
+  TEST_TRUE(cli_parse_args("p", opts, 3, ok, NULL, 0, NULL, count_help) == -1 && n == 3);
+  TEST_TRUE(help_calls == 0);
+  TEST_TRUE(cli_parse_args("p", opts, 2, help, NULL, 0, NULL, count_help) == 0);
+  TEST_TRUE(help_calls == 1 && help_opts == opts);
+  TEST_TRUE(cli_parse_args("p", opts, 3, bad, NULL, 0, NULL, count_help) == 2 && help_calls == 1);
+}
+
 /* Number options with several values (one per metavar word) and element names. */
 static void several_values(void)
 {
@@ -240,6 +265,7 @@ int main(int argc, char **argv)
   lists();
   table(argv[1]);
   several_values();
+  parse_args();
   output(argv[1]);
   int rc = TEST_RESULT();
   if (rc != 0) {
