@@ -8,13 +8,6 @@
 #define _POSIX_C_SOURCE 200809L
 #include "condition_csv.h"
 
-static int exists(const char *path)
-{
-  FILE *f = fopen(path, "rb");
-  if (f) fclose(f);
-  return f != NULL;
-}
-
 int main(int argc, char **argv)
 {
   if (argc != 3) return 2;
@@ -29,7 +22,7 @@ int main(int argc, char **argv)
            "OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 '%s' --quick --csv '%s' --png '%s' "
            "> /dev/null 2>&1",
            argv[1], csv, png);
-  TEST_TRUE(cond_run(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   int n = cond_read(csv, rows, COND_MAX_ROWS);
   TEST_TRUE(n == 2 * 2 * 2 * 4); /* tet4, hex8 x {1, 1e-8} x {on, off} x 4 preconditioners */
   for (int k = 0; k < n; k++) {
@@ -65,14 +58,14 @@ int main(int argc, char **argv)
     }
   }
   snprintf(tmp, sizeof tmp, "%s.tmp", csv);
-  TEST_TRUE(!exists(tmp));
-  if (cond_run("gnuplot --version > /dev/null 2>&1") == 0) {
+  TEST_TRUE(!app_exists(tmp));
+  if (app_run("gnuplot --version > /dev/null 2>&1") == 0) {
     FILE *f = fopen(png, "rb");
     unsigned char sig[8] = {0};
     TEST_TRUE(f && fread(sig, 1, 8, f) == 8 && !memcmp(sig, "\x89PNG\r\n\x1a\n", 8));
     if (f) fclose(f);
     snprintf(tmp, sizeof tmp, "%s.tmp", png);
-    TEST_TRUE(!exists(tmp));
+    TEST_TRUE(!app_exists(tmp));
   }
 
   /* usage errors: status 2, nothing written */
@@ -90,12 +83,12 @@ int main(int argc, char **argv)
     snprintf(cmd, sizeof cmd, "'%s' --quick %s --csv '%s' > /dev/null 2>&1", argv[1], bad[k], csv);
     if (!strcmp(bad[k], "--csv"))
       snprintf(cmd, sizeof cmd, "'%s' --quick --csv > /dev/null 2>&1", argv[1]);
-    int rc = cond_run(cmd);
+    int rc = app_run(cmd);
     if (rc != 2) fprintf(stderr, "'%s' exited with %d\n", bad[k], rc);
     TEST_TRUE(rc == 2);
-    TEST_TRUE(!exists(csv));
+    TEST_TRUE(!app_exists(csv));
   }
   snprintf(cmd, sizeof cmd, "'%s' --help | grep -q min_volume_fraction", argv[1]);
-  TEST_TRUE(cond_run(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   return TEST_RESULT();
 }

@@ -45,7 +45,7 @@ static int run_study(const char *exe, const char *csv, const char *args, cond_ro
            "OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 '%s' %s --simplify off --minres-max 1 "
            "--csv '%s' > /dev/null",
            exe, args, csv);
-  int rc = cond_run(cmd);
+  int rc = app_run(cmd);
   if (rc != 0) {
     fprintf(stderr, "'%s' exited with %d\n", cmd, rc);
     return 0;

@@ -4,7 +4,7 @@
 
 #include "test.h"
 
-#include <sys/wait.h>
+#include "app_run.h"
 
 #define CONDITION_HEADER                                                                           \
   "element,preconditioner,stabilization,min_volume_fraction,condition_number,nominal_fraction,"    \
@@ -20,13 +20,6 @@ typedef struct cond_row {
 } cond_row;
 
 enum { COND_MAX_ROWS = 256 };
-
-/* Exit status of a shell command (-1 when it did not exit normally). */
-static int cond_run(const char *cmd)
-{
-  int st = system(cmd);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
 
 /* Read a CSV written by fcm-condition: header checked, rows into `rows`; returns the
  * number of rows, or -1 (missing file, bad header or malformed row). */

@@ -44,10 +44,10 @@ int main(int argc, char **argv)
   snprintf(cmd, sizeof cmd,
            "OMP_WAIT_POLICY=passive '%s' --quick --rates-csv '%s' --out '%s' > '%s' 2> /dev/null",
            prog, rcsv, pre, out);
-  TEST_TRUE(cv_run_cmd(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   snprintf(cmd, sizeof cmd, "grep -q '^fitted rates' '%s' && grep -q '^accuracy versus time' '%s'",
            out, out);
-  TEST_TRUE(cv_run_cmd(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
 
   /* rates: 4 elements x 2 methods x 2 norms, once each, finite */
   const int nr = cv_read_rates(rcsv, rates, CV_MAX_ROWS);
@@ -105,12 +105,12 @@ int main(int argc, char **argv)
   TEST_TRUE(rows == 4);
 
   /* plots and atomic writes */
-  const int gnuplot = cv_run_cmd("gnuplot --version > /dev/null 2>&1") == 0;
+  const int gnuplot = app_run("gnuplot --version > /dev/null 2>&1") == 0;
   for (size_t k = 0; k < sizeof files / sizeof *files; k++) {
     snprintf(path, sizeof path, "%s%s", pre, files[k]);
     if (strstr(files[k], ".png")) TEST_TRUE(!gnuplot || is_png(path));
     snprintf(path, sizeof path, "%s%s.tmp", pre, files[k]);
-    TEST_TRUE(!cv_exists(path));
+    TEST_TRUE(!app_exists(path));
   }
 
   /* payoff: per element and rule kind fewer points with simplification, a positive
@@ -122,7 +122,7 @@ int main(int argc, char **argv)
            "OMP_WAIT_POLICY=passive '%s' payoff --quick --geom-n 3 --elements tet4,hex8 --csv '%s' "
            "> '%s' 2> /dev/null",
            prog, path, out);
-  TEST_TRUE(cv_run_cmd(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   f = fopen(path, "r");
   TEST_TRUE(f && fgets(line, sizeof line, f) &&
             !strcmp(line, "element,res,kind,strength,cut_cells,points_plain,points_simplified,"
@@ -151,9 +151,9 @@ int main(int argc, char **argv)
   if (f) fclose(f);
   TEST_TRUE(rows == 4);
   snprintf(cmd, sizeof cmd, "grep -q '^hex8   mass ' '%s' && grep -q 'break-even' '%s'", out, out);
-  TEST_TRUE(cv_run_cmd(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   snprintf(path, sizeof path, "%s/converge-payoff.csv.tmp", dir);
-  TEST_TRUE(!cv_exists(path));
+  TEST_TRUE(!app_exists(path));
 
   /* usage errors: status 2, nothing written */
   static const char *const bad[] = {
@@ -170,12 +170,12 @@ int main(int argc, char **argv)
       snprintf(cmd, sizeof cmd, "'%s' %s > /dev/null 2>&1", prog, bad[k]);
     else
       snprintf(cmd, sizeof cmd, "'%s' --quick --csv '%s' %s > /dev/null 2>&1", prog, path, bad[k]);
-    const int rc = cv_run_cmd(cmd);
+    const int rc = app_run(cmd);
     if (rc != 2) fprintf(stderr, "'%s' exited with %d\n", bad[k], rc);
     TEST_TRUE(rc == 2);
-    TEST_TRUE(!cv_exists(path));
+    TEST_TRUE(!app_exists(path));
   }
   snprintf(cmd, sizeof cmd, "'%s' --help | grep -q 'element,method,norm,rate'", prog);
-  TEST_TRUE(cv_run_cmd(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   return TEST_RESULT();
 }

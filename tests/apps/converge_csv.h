@@ -5,7 +5,7 @@
 
 #include "test.h"
 
-#include <sys/wait.h>
+#include "app_run.h"
 
 #define CONVERGE_LEVELS_HEADER                                                                     \
   "element,method,res,h,dofs,active_cells,cut_cells,points,strength,t_rules,t_assembly,t_solve,"   \
@@ -27,20 +27,6 @@ typedef struct cv_rate_row {
 } cv_rate_row;
 
 enum { CV_MAX_ROWS = 256 };
-
-/* Exit status of a shell command (-1 when it did not exit normally). */
-static inline int cv_run_cmd(const char *cmd)
-{
-  int st = system(cmd);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-static inline int cv_exists(const char *path)
-{
-  FILE *f = fopen(path, "rb");
-  if (f) fclose(f);
-  return f != NULL;
-}
 
 /* Rows of a levels CSV (header checked); -1 on a missing file, bad header or bad row. The
  * note field must be empty (every run of the tests is expected to be clean). */

@@ -31,7 +31,7 @@ static int study(const char *prog, const char *dir, const char *name, const char
            "OMP_WAIT_POLICY=passive '%s' %s --fit %d --no-sweep --no-plots --out '%s/%s' "
            "> /dev/null 2> '%s/%s.log'",
            prog, args, fit, dir, name, dir, name);
-  const int rc = cv_run_cmd(cmd);
+  const int rc = app_run(cmd);
   if (rc != 0) fprintf(stderr, "%s exited with %d (log %s/%s.log)\n", name, rc, dir, name);
   TEST_TRUE(rc == 0);
   *nrates = cv_read_rates(rcsv, rates, CV_MAX_ROWS);

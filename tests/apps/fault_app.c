@@ -23,6 +23,7 @@
 #include "fcm/fcm.h"
 #include "fcm/simulation.h"
 #include "output_check.h"
+#include "app_run.h"
 #include "test.h"
 #include "test_alloc.h"
 
@@ -113,12 +114,6 @@ static long long read_report(const char *path, const char *key)
   return p ? atoll(p + strlen(key) + 1) : -1;
 }
 
-static int sh(const char *cmd)
-{
-  int st = system(cmd);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
 /* The highest-numbered checkpoint in `dir` (path into `out`), or 0 when there is none. */
 static int last_checkpoint(const char *dir, char *out, size_t cap)
 {
@@ -194,7 +189,7 @@ static int mode_kill(int trials, unsigned long long seed)
   snprintf(dir, sizeof dir, "%s/fault-kill", g_work);
   char cmd[4096];
   snprintf(cmd, sizeof cmd, "rm -rf '%s' '%s'", ref, dir);
-  sh(cmd);
+  app_run(cmd);
   fcm_ctx *ctx = NULL;
   fcm_scene *scene = NULL;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
@@ -216,7 +211,7 @@ static int mode_kill(int trials, unsigned long long seed)
   int killed = 0, resumed = 0, restarted = 0;
   for (int t = 0; t < trials; t++) {
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    sh(cmd);
+    app_run(cmd);
     g_seen.n = 0;
     fault_env k = {-1, -1, NULL, 0};
     if (t % 4 == 1)
@@ -265,7 +260,7 @@ static int mode_kill(int trials, unsigned long long seed)
   fcm_scene_destroy(&scene);
   fcm_ctx_destroy(&ctx);
   snprintf(cmd, sizeof cmd, "rm -rf '%s' '%s' '%s' '%s'", ref, dir, report, out);
-  sh(cmd);
+  app_run(cmd);
   return TEST_RESULT();
 }
 
@@ -302,7 +297,7 @@ static int mode_diskfull(void)
 
   /* the bytes a whole run writes */
   snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-  sh(cmd);
+  app_run(cmd);
   fault_env e = {-1, 1LL << 60, report, 0};
   TEST_TRUE(run_sim(args, &e, out) == 0);
   long long total = 0;
@@ -322,7 +317,7 @@ static int mode_diskfull(void)
   const double at[] = {0.0, 1e-4, 0.2, 0.5, 0.9, 0.99};
   for (int i = 0; i < 6; i++) {
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    sh(cmd);
+    app_run(cmd);
     /* the files are rewritten (PVD, log) along the way: more than `total` is written */
     fault_env f = {-1, (long long)(at[i] * (double)total), NULL, 0};
     int rc = run_sim(args, &f, out);
@@ -340,10 +335,10 @@ static int mode_diskfull(void)
   snprintf(rcfile, sizeof rcfile, "%s/fault-tmpfs-rc.txt", g_work);
   snprintf(cmd, sizeof cmd, "rm -rf '%s' '%s' '%s' && mkdir -p '%s' '%s'", mnt, copy, rcfile, mnt,
            copy);
-  sh(cmd);
+  app_run(cmd);
   snprintf(cmd, sizeof cmd,
            "unshare -rm sh -c \"mount -t tmpfs -o size=48k fcm-fault '%s'\" > /dev/null 2>&1", mnt);
-  if (sh(cmd) != 0) {
+  if (app_run(cmd) != 0) {
     printf("fault_app: no unprivileged tmpfs here; the disk-full case ran with the shim only\n");
   } else {
     snprintf(cmd, sizeof cmd,
@@ -351,7 +346,7 @@ static int mode_diskfull(void)
              " { '%s' '%s' -o '%s/out' -q > '%s' 2>&1; echo \\$? > '%s';"
              " cp -a '%s/out/.' '%s/'; }\"",
              mnt, g_sim, g_scene, mnt, out, rcfile, mnt, copy);
-    TEST_TRUE(sh(cmd) == 0);
+    TEST_TRUE(app_run(cmd) == 0);
     long n = 0;
     char *rc = slurp(rcfile, &n);
     int code = rc ? atoi(rc) : -1;
@@ -362,7 +357,7 @@ static int mode_diskfull(void)
   }
   snprintf(cmd, sizeof cmd, "rm -rf '%s' '%s' '%s' '%s' '%s' '%s'", dir, out, report, mnt, copy,
            rcfile);
-  sh(cmd);
+  app_run(cmd);
   fcm_scene_destroy(&scene);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
@@ -375,7 +370,7 @@ static int mode_dirsync(void)
   snprintf(out, sizeof out, "%s/fault-sync-out.txt", g_work);
   snprintf(report, sizeof report, "%s/fault-sync-report.txt", g_work);
   snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-  sh(cmd);
+  app_run(cmd);
   const char *args[] = {g_scene, "-o", dir, "-q", "--steps", "3", NULL};
   fault_env e = {-1, -1, report, 0};
   TEST_TRUE(run_sim(args, &e, out) == 0);
@@ -389,7 +384,7 @@ static int mode_dirsync(void)
                "the directory",
                durable - dsynced, durable);
   snprintf(cmd, sizeof cmd, "rm -rf '%s' '%s' '%s'", dir, out, report);
-  sh(cmd);
+  app_run(cmd);
   return TEST_RESULT();
 }
 

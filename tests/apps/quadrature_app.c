@@ -7,13 +7,7 @@
 #include "fcm/fcm.h"
 #include "test.h"
 
-#include <sys/wait.h>
-
-static int run(const char *cmd)
-{
-  int st = system(cmd);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
+#include "app_run.h"
 
 int main(int argc, char **argv)
 {
@@ -26,7 +20,7 @@ int main(int argc, char **argv)
 
   /* accuracy: the paper's Fig. 4 experiment up to strength 6 */
   snprintf(cmd, sizeof cmd, "'%s' accuracy --max-strength 6 --csv '%s' > /dev/null", argv[1], csv);
-  TEST_TRUE(run(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   FILE *f = fopen(csv, "r");
   TEST_TRUE(f != NULL);
   if (f) {
@@ -55,7 +49,7 @@ int main(int argc, char **argv)
            "ball:0.05,0,-0.1,0.8,2 --strength 4 --stabilization 0 --min-fraction 0 --dump '%s' "
            "> /dev/null 2>&1",
            argv[1], dump);
-  TEST_TRUE(run(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   fcm_ctx *ctx = NULL;
   fcm_geometry *ball = NULL;
   const double c[3] = {0.05, 0, -0.1};
@@ -91,18 +85,18 @@ int main(int argc, char **argv)
   /* bad input: exit 2, no output file */
   remove(csv);
   snprintf(cmd, sizeof cmd, "'%s' accuracy --max-strength 0 --csv '%s' 2> /dev/null", argv[1], csv);
-  TEST_TRUE(run(cmd) == 2);
+  TEST_TRUE(app_run(cmd) == 2);
   snprintf(cmd, sizeof cmd, "'%s' embed --element hex27 2> /dev/null", argv[1]);
-  TEST_TRUE(run(cmd) == 2);
+  TEST_TRUE(app_run(cmd) == 2);
   remove(dump); /* --box takes six values: five and then an option are refused */
   snprintf(cmd, sizeof cmd,
            "'%s' embed --element hex8 --box -1 -1 -1 1 1 --cells 2 2 2 --geometry "
            "ball:0,0,0,0.5,2 --strength 2 --dump '%s' 2> /dev/null",
            argv[1], dump);
-  TEST_TRUE(run(cmd) == 2);
+  TEST_TRUE(app_run(cmd) == 2);
   TEST_TRUE(fopen(dump, "r") == NULL);
   snprintf(cmd, sizeof cmd, "'%s' tables --check=1 2> /dev/null", argv[1]);
-  TEST_TRUE(run(cmd) == 2);
+  TEST_TRUE(app_run(cmd) == 2);
   TEST_TRUE(fopen(csv, "r") == NULL);
   return TEST_RESULT();
 }

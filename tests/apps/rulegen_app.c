@@ -6,25 +6,13 @@
  * option) exit 2 and write nothing.
  * Usage: app_rulegen PATH_TO_fcm-rulegen WORK_DIR */
 #define _POSIX_C_SOURCE 200809L
+#include "app_run.h"
 #include "test.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
-
-static int run(const char *cmd)
-{
-  int st = system(cmd);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-static int exists(const char *path)
-{
-  struct stat sb;
-  return stat(path, &sb) == 0;
-}
 
 /* Check one table: `dim` coordinates and a weight per row, `points` rows as declared. */
 static void check_table(const char *path, int dim, double measure)
@@ -61,11 +49,11 @@ int main(int argc, char **argv)
   char dir[4096], cmd[12288], path[8192];
   snprintf(dir, sizeof dir, "%s/rulegen", argv[2]);
   snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-  TEST_TRUE(run(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
 
   snprintf(cmd, sizeof cmd,
            "'%s' --shape tri --shape line --strength 2:3 --out '%s' > /dev/null 2>&1", prog, dir);
-  TEST_TRUE(run(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   static const char *const shapes[2] = {"tri", "line"};
   for (int s = 0; s < 2; s++)
     for (int m = 2; m <= 3; m++) {
@@ -73,14 +61,14 @@ int main(int argc, char **argv)
       check_table(path, s == 0 ? 2 : 1, s == 0 ? 0.5 : 2.0);
     }
   snprintf(path, sizeof path, "%s/tri/tri_01.txt", dir); /* only the range asked for */
-  TEST_TRUE(!exists(path));
+  TEST_TRUE(!app_exists(path));
 
   snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-  TEST_TRUE(run(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   snprintf(cmd, sizeof cmd, "'%s' --shape quad --strength 2 --dry-run --out '%s' > /dev/null 2>&1",
            prog, dir);
-  TEST_TRUE(run(cmd) == 0);
-  TEST_TRUE(!exists(dir));
+  TEST_TRUE(app_run(cmd) == 0);
+  TEST_TRUE(!app_exists(dir));
 
   static const char *const bad[] = {"--strength 3:2", "--strength 0", "--strength 41",
                                     "--shape cube",   "--shape tri,", "--batch nan",
@@ -89,10 +77,10 @@ int main(int argc, char **argv)
   for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
     snprintf(cmd, sizeof cmd, "'%s' --shape line --strength 1 --out '%s' %s > /dev/null 2>&1", prog,
              dir, bad[k]);
-    const int rc = run(cmd);
+    const int rc = app_run(cmd);
     if (rc != 2) fprintf(stderr, "'%s' exited with %d\n", bad[k], rc);
     TEST_TRUE(rc == 2);
-    TEST_TRUE(!exists(dir));
+    TEST_TRUE(!app_exists(dir));
   }
   return TEST_RESULT();
 }

@@ -19,23 +19,11 @@
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "output_check.h"
+#include "app_run.h"
 #include "test.h"
 
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
-
-static int run(const char *cmd)
-{
-  int st = system(cmd);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-static int exists(const char *path)
-{
-  struct stat sb;
-  return stat(path, &sb) == 0;
-}
 
 static void write_file(const char *path, const char *text)
 {
@@ -81,7 +69,7 @@ static int mode_check(const char *sim, const char *scene)
     snprintf(cmd, sizeof cmd, "'%s' --check > '%s' 2> /dev/null", sim, out);
   else
     snprintf(cmd, sizeof cmd, "'%s' '%s' --check > '%s' 2> /dev/null", sim, scene, out);
-  TEST_TRUE(run(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   TEST_TRUE(file_has(out, "steps,") || file_has(out, " steps, "));
   TEST_TRUE(file_has(out, "computed  inertia") || file_has(out, "skipped   inertia"));
   remove(out);
@@ -95,20 +83,20 @@ static int mode_run(const char *sim, const char *work)
   snprintf(dir, sizeof dir, "%s/small-out/nested", work);
   write_file(scene, small_scene);
   snprintf(cmd, sizeof cmd, "rm -rf '%s/small-out'", work);
-  run(cmd);
+  app_run(cmd);
   /* 10 steps in the scene, cut to 4; frames at steps 0, 2, 4 */
   snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s' --steps 4 --quiet > /dev/null 2>&1", sim, scene,
            dir);
-  TEST_TRUE(run(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   const char *files[] = {"small_background_0000.vtu", "small_background_0002.vtu",
                          "small_surface_0000.vtu",    "small_surface_0002.vtu",
                          "small_background.pvd",      "small_surface.pvd"};
   for (int k = 0; k < 6; k++) {
     snprintf(path, sizeof path, "%s/%s", dir, files[k]);
-    TEST_TRUE(exists(path));
+    TEST_TRUE(app_exists(path));
   }
   snprintf(path, sizeof path, "%s/small_background_0003.vtu", dir);
-  TEST_TRUE(!exists(path));
+  TEST_TRUE(!app_exists(path));
   snprintf(path, sizeof path, "%s/small_log.csv", dir);
   FILE *f = fopen(path, "r");
   TEST_TRUE(f != NULL);
@@ -143,7 +131,7 @@ static int mode_errors(const char *sim, const char *work)
   snprintf(dir, sizeof dir, "%s/must-not-exist", work);
   snprintf(err, sizeof err, "%s/errors-stderr.txt", work);
   snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-  run(cmd);
+  app_run(cmd);
   struct {
     const char *json, *message;
   } bad[] = {{"{\"version\": 1, \"background\": {", ":1:"}, /* malformed JSON */
@@ -159,20 +147,20 @@ static int mode_errors(const char *sim, const char *work)
     write_file(scene, bad[k].json);
     /* with the scene's directory and with -o */
     snprintf(cmd, sizeof cmd, "cd '%s' && '%s' '%s' 2> '%s' > /dev/null", work, sim, scene, err);
-    int rc = run(cmd);
+    int rc = app_run(cmd);
     TEST_TRUE(rc != 0);
     if (!file_has(err, bad[k].message)) TEST_FAIL_("bad%d: stderr lacks '%s'", k, bad[k].message);
     snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s' 2> /dev/null > /dev/null", sim, scene, dir);
-    TEST_TRUE(run(cmd) != 0);
-    TEST_TRUE(!exists(dir));
+    TEST_TRUE(app_run(cmd) != 0);
+    TEST_TRUE(!app_exists(dir));
   }
   snprintf(cmd, sizeof cmd, "cd '%s' && test ! -e DIR", work);
-  TEST_TRUE(run(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   /* a missing file, bad options */
   snprintf(cmd, sizeof cmd, "'%s' '%s/no-such-scene.json' -o '%s' 2> '%s'", sim, work, dir, err);
-  TEST_TRUE(run(cmd) != 0);
+  TEST_TRUE(app_run(cmd) != 0);
   TEST_TRUE(file_has(err, "no-such-scene.json"));
-  TEST_TRUE(!exists(dir));
+  TEST_TRUE(!app_exists(dir));
   const char *bad_opts[] = {"--steps 0",
                             "--checkpoint-every 0",
                             "--check --resume x.fcmck",
@@ -186,11 +174,11 @@ static int mode_errors(const char *sim, const char *work)
                             "-o ''"};
   for (int k = 0; k < (int)(sizeof bad_opts / sizeof *bad_opts); k++) {
     snprintf(cmd, sizeof cmd, "'%s' %s -o '%s' 2> /dev/null", sim, bad_opts[k], dir);
-    if (run(cmd) != 2) TEST_FAIL_("'%s' should exit 2", bad_opts[k]);
+    if (app_run(cmd) != 2) TEST_FAIL_("'%s' should exit 2", bad_opts[k]);
   }
   snprintf(cmd, sizeof cmd, "'%s' a.json b.json 2> /dev/null", sim);
-  TEST_TRUE(run(cmd) == 2);
-  TEST_TRUE(!exists(dir));
+  TEST_TRUE(app_run(cmd) == 2);
+  TEST_TRUE(!app_exists(dir));
   remove(err);
   return TEST_RESULT();
 }
@@ -232,20 +220,20 @@ static int mode_resume(const char *sim, const char *work)
   snprintf(json, sizeof json, "%s", RESUME_SCENE("1e5"));
   write_file(scene, json);
   snprintf(cmd, sizeof cmd, "rm -rf '%s' '%s'", full, cut);
-  run(cmd);
+  app_run(cmd);
   /* uninterrupted: 10 steps, frames 0..5 */
   snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s' -q", sim, scene, full);
-  TEST_TRUE(run(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   /* cut at step 4 with a checkpoint every 2 steps, then resumed from step 4 */
   snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s' -q --steps 4 --checkpoint-every 2", sim, scene, cut);
-  TEST_TRUE(run(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   snprintf(path, sizeof path, "%s/small_checkpoint_000002.fcmck", cut);
-  TEST_TRUE(exists(path));
+  TEST_TRUE(app_exists(path));
   snprintf(path, sizeof path, "%s/small_checkpoint_000004.fcmck", cut);
-  TEST_TRUE(exists(path));
+  TEST_TRUE(app_exists(path));
   snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s' -q --resume '%s/small_checkpoint_000004.fcmck'", sim,
            scene, cut, cut);
-  TEST_TRUE(run(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   /* every frame identical byte for byte, the log identical but for the wall times */
   const char *kinds[] = {"background", "surface"};
   for (int k = 0; k < 2; k++)
@@ -286,18 +274,18 @@ static int mode_resume(const char *sim, const char *work)
     if (f) fclose(f);
     snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s/x' -q --resume '%s' 2> '%s'", sim, scene, work,
              path2, err);
-    TEST_TRUE(run(cmd) == 2);
+    TEST_TRUE(app_run(cmd) == 2);
     TEST_TRUE(file_has(err, "checksum") && file_has(err, "corrupt.fcmck"));
     /* truncated */
     f = fopen(path2, "wb");
     TEST_TRUE(f && fwrite(a, 1, 40, f) == 40);
     if (f) fclose(f);
-    TEST_TRUE(run(cmd) == 2);
+    TEST_TRUE(app_run(cmd) == 2);
     TEST_TRUE(file_has(err, "corrupt.fcmck"));
     /* not a checkpoint at all */
-    TEST_TRUE(run((snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s/x' -q --resume '%s' 2> '%s'", sim,
-                            scene, work, scene, err),
-                   cmd)) == 2);
+    TEST_TRUE(app_run((snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s/x' -q --resume '%s' 2> '%s'",
+                                sim, scene, work, scene, err),
+                       cmd)) == 2);
     TEST_TRUE(file_has(err, "not an fcm checkpoint"));
     remove(path2);
   }
@@ -309,12 +297,12 @@ static int mode_resume(const char *sim, const char *work)
     write_file(other, json);
     snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s/x' -q --resume '%s' 2> '%s'", sim, other, work,
              path, err);
-    TEST_TRUE(run(cmd) == 2);
+    TEST_TRUE(app_run(cmd) == 2);
     TEST_TRUE(file_has(err, "different scene"));
     remove(other);
   }
   snprintf(path, sizeof path, "%s/x", work);
-  TEST_TRUE(!exists(path)); /* refused resumes write nothing */
+  TEST_TRUE(!app_exists(path)); /* refused resumes write nothing */
   remove(err);
   return TEST_RESULT();
 }
@@ -324,16 +312,16 @@ static int mode_default(const char *sim, const char *work)
   static char buf[1 << 20];
   char cmd[8192], path[4096];
   snprintf(cmd, sizeof cmd, "rm -rf '%s/default-run' && mkdir -p '%s/default-run'", work, work);
-  TEST_TRUE(run(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   snprintf(cmd, sizeof cmd, "cd '%s/default-run' && '%s' -q", work, sim);
-  TEST_TRUE(run(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   const char *dir = "default-run/fcm-output/twisting_cylinder";
   const char *kinds[] = {"background", "surface"};
   for (int k = 0; k < 2; k++) {
     snprintf(path, sizeof path, "%s/%s/twisting_cylinder_%s_0070.vtu", work, dir, kinds[k]);
-    TEST_TRUE(exists(path) && file_has(path, "UnstructuredGrid"));
+    TEST_TRUE(app_exists(path) && file_has(path, "UnstructuredGrid"));
     snprintf(path, sizeof path, "%s/%s/twisting_cylinder_%s_0071.vtu", work, dir, kinds[k]);
-    TEST_TRUE(!exists(path));
+    TEST_TRUE(!app_exists(path));
     snprintf(path, sizeof path, "%s/%s/twisting_cylinder_%s.pvd", work, dir, kinds[k]);
     int sets = 0;
     if (slurp(path, buf, sizeof buf) > 0)
@@ -357,17 +345,17 @@ static int mode_default_quick(const char *sim, const char *work)
   char cmd[8192], path[4096];
   const double dt = 0.03333333333333333; /* twisting_cylinder.json */
   snprintf(cmd, sizeof cmd, "rm -rf '%s/default-quick' && mkdir -p '%s/default-quick'", work, work);
-  TEST_TRUE(run(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   snprintf(cmd, sizeof cmd, "cd '%s/default-quick' && '%s' --steps 6 -q", work, sim);
-  TEST_TRUE(run(cmd) == 0);
+  TEST_TRUE(app_run(cmd) == 0);
   const char *dir = "default-quick/fcm-output/twisting_cylinder";
   const char *kinds[] = {"background", "surface"};
   for (int k = 0; k < 2; k++) {
     for (int f = 0; f <= 3; f++) { /* steps 0, 3, 6: frames 0..2, no frame 3 */
       snprintf(path, sizeof path, "%s/%s/twisting_cylinder_%s_%04d.vtu", work, dir, kinds[k], f);
-      if (f < 3 && !(exists(path) && file_has(path, "UnstructuredGrid")))
+      if (f < 3 && !(app_exists(path) && file_has(path, "UnstructuredGrid")))
         TEST_FAIL_("%s missing or not a VTU", path);
-      if (f == 3 && exists(path)) TEST_FAIL_("%s should not exist", path);
+      if (f == 3 && app_exists(path)) TEST_FAIL_("%s should not exist", path);
     }
     snprintf(path, sizeof path, "%s/%s/twisting_cylinder_%s.pvd", work, dir, kinds[k]);
     int sets = 0;
