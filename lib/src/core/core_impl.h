@@ -31,7 +31,10 @@ void fcm__log(const fcm_ctx *ctx, fcm_log_level level, const char *fmt, ...) FCM
  * n == 0 still returns a valid (1-byte) allocation. */
 void *fcm__calloc(fcm_ctx *ctx, size_t n, size_t size);
 
-/* Release memory from fcm__calloc; accepts NULL. */
+/* As fcm__calloc, without the zero fill: for arrays written in full before they are read. */
+void *fcm__malloc(fcm_ctx *ctx, size_t n, size_t size);
+
+/* Release memory from fcm__calloc or fcm__malloc; accepts NULL. */
 void fcm__free(fcm_ctx *ctx, void *ptr);
 
 /* Grow or shrink an fcm__calloc array, preserving min(old_n, new_n) elements and
@@ -140,6 +143,17 @@ fcm_status fcm__loop_end(fcm__loop *loop, fcm_index *failed);
 #define FCM_ALLOC(ctx, n, p)                                                                       \
   do {                                                                                             \
     (p) = fcm__calloc((ctx), (size_t)(n), sizeof *(p));                                            \
+    if (!(p)) {                                                                                    \
+      st = FCM_ERR_ALLOC;                                                                          \
+      fcm__trace((ctx), __FILE__, __LINE__, __func__);                                             \
+      goto cleanup;                                                                                \
+    }                                                                                              \
+  } while (0)
+
+/* As FCM_ALLOC without the zero fill (fcm__malloc): every element is written before use. */
+#define FCM_ALLOC_RAW(ctx, n, p)                                                                   \
+  do {                                                                                             \
+    (p) = fcm__malloc((ctx), (size_t)(n), sizeof *(p));                                            \
     if (!(p)) {                                                                                    \
       st = FCM_ERR_ALLOC;                                                                          \
       fcm__trace((ctx), __FILE__, __LINE__, __func__);                                             \

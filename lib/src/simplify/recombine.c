@@ -74,7 +74,7 @@ fcm_status fcm__simplify_run_recombine(fcm__attempt *a)
   FCM_ALLOC(ctx, fcm__simplify_moments_scratch(a->box.m), acc);
   if ((size_t)n * (size_t)M <= RECOMBINE_CACHE_MAX) { /* the basis at every point, once */
     double t0 = fcm_wtime();
-    FCM_ALLOC(ctx, (size_t)n * (size_t)M, phi);
+    FCM_ALLOC_RAW(ctx, (size_t)n * (size_t)M, phi);
     fcm__simplify_basis_points(&a->box, n, a->points, phi, acc);
     a->time_basis += fcm_wtime() - t0;
   }
