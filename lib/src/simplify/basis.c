@@ -135,11 +135,14 @@ void fcm__simplify_moments(const fcm__cheb_box *box, int n, const double *points
         for (int k = 0; k <= m - s; k++)
           for (int q = s * (s + 1) / 2; q <= s * (s + 1) / 2 + s; q++) {
             const double *o = txy + (size_t)q * B, *z = tzw + (size_t)k * B;
-            double d = 0.0;
-#pragma omp simd reduction(+ : d)
-            for (int p = 0; p < bn; p++)
-              d += o[p] * z[p];
-            c[q + (size_t)k * (size_t)pairs] += d;
+            double d[4] = {0.0, 0.0, 0.0, 0.0}; /* four partial sums: no serial add chain */
+            int p = 0;
+            for (; p + 4 <= bn; p += 4)
+              for (int l = 0; l < 4; l++)
+                d[l] += o[p + l] * z[p + l];
+            for (; p < bn; p++)
+              d[0] += o[p] * z[p];
+            c[q + (size_t)k * (size_t)pairs] += (d[0] + d[1]) + (d[2] + d[3]);
           }
     }
   }
