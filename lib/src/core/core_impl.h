@@ -139,10 +139,11 @@ fcm_status fcm__loop_end(fcm__loop *loop, fcm_index *failed);
     }                                                                                              \
   } while (0)
 
-/* Allocate `n` zeroed elements of *p's type into p, or fail with FCM_ERR_ALLOC. */
-#define FCM_ALLOC(ctx, n, p)                                                                       \
+/* Allocate `n` elements of *p's type into p through `fn` (fcm__calloc or fcm__malloc), or
+ * fail with FCM_ERR_ALLOC. */
+#define FCM__ALLOC_WITH(fn, ctx, n, p)                                                             \
   do {                                                                                             \
-    (p) = fcm__calloc((ctx), (size_t)(n), sizeof *(p));                                            \
+    (p) = fn((ctx), (size_t)(n), sizeof *(p));                                                     \
     if (!(p)) {                                                                                    \
       st = FCM_ERR_ALLOC;                                                                          \
       fcm__trace((ctx), __FILE__, __LINE__, __func__);                                             \
@@ -150,16 +151,11 @@ fcm_status fcm__loop_end(fcm__loop *loop, fcm_index *failed);
     }                                                                                              \
   } while (0)
 
+/* Allocate `n` zeroed elements of *p's type into p, or fail with FCM_ERR_ALLOC. */
+#define FCM_ALLOC(ctx, n, p) FCM__ALLOC_WITH(fcm__calloc, ctx, n, p)
+
 /* As FCM_ALLOC without the zero fill (fcm__malloc): every element is written before use. */
-#define FCM_ALLOC_RAW(ctx, n, p)                                                                   \
-  do {                                                                                             \
-    (p) = fcm__malloc((ctx), (size_t)(n), sizeof *(p));                                            \
-    if (!(p)) {                                                                                    \
-      st = FCM_ERR_ALLOC;                                                                          \
-      fcm__trace((ctx), __FILE__, __LINE__, __func__);                                             \
-      goto cleanup;                                                                                \
-    }                                                                                              \
-  } while (0)
+#define FCM_ALLOC_RAW(ctx, n, p) FCM__ALLOC_WITH(fcm__malloc, ctx, n, p)
 
 /* Free and reset to NULL. */
 #define FCM_FREE(ctx, p)                                                                           \
