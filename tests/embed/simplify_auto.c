@@ -1,8 +1,10 @@
 /* Simplify only where it pays (FCM_CELL_SIMPLIFY_AUTO): the cost model fcm_simplify_pays()
- * on both sides of a given break-even and on invalid inputs; AUTO with many expected
- * assemblies gives exactly the rules of ON, with none or with a negligible point cost exactly
- * those of OFF (the probe cells get their unsimplified rules back); the reported decision
- * follows from its own reported inputs; bad AUTO options are rejected naming the field. */
+ * on both sides of a given break-even and on invalid inputs; the simplification-time model
+ * fcm_simplify_cost_estimate() (its formula, 0 where nothing is removed or the input is
+ * invalid); AUTO with many expected assemblies gives exactly the rules of ON, with none or
+ * with a negligible point cost exactly those of OFF; the reported decision follows from its
+ * own reported inputs, and is the same with 1 and 2 threads (no timing enters it); bad AUTO
+ * options are rejected naming the field. */
 #include "fcm/embed.h"
 #include "test.h"
 
@@ -35,16 +37,24 @@ static void cost_model(void)
       TEST_TRUE(isfinite(c) && c > 0.0 && c < 1e-3);
     }
   TEST_TRUE(fcm_cell_rules_point_cost(FCM_ELEMENT_COUNT, FCM_RULE_MASS) == 0.0);
+  /* the time model: 2.5e-9 N M + 6.6e-10 M^3 for N > M */
+  TEST_NEAR(fcm_simplify_cost_estimate(4, 2900), 2.5e-9 * 2900 * 35 + 6.6e-10 * 35 * 35 * 35, 1e-14,
+            0.0);
+  TEST_TRUE(fcm_simplify_cost_estimate(4, 35) == 0.0 && fcm_simplify_cost_estimate(4, 36) > 0.0);
+  TEST_TRUE(fcm_simplify_cost_estimate(8, 64000) > fcm_simplify_cost_estimate(8, 32000));
+  TEST_TRUE(fcm_simplify_cost_estimate(-1, 100) == 0.0 &&
+            fcm_simplify_cost_estimate(21, 1e6) == 0.0);
+  TEST_TRUE(fcm_simplify_cost_estimate(4, -5) == 0.0);
 }
 
 static fcm_cell_rules *build(const fcm_mesh *m, const fcm_geometry *g, fcm_cell_simplify mode,
-                             double assemblies, double point_cost)
+                             double assemblies, double point_cost, int threads)
 {
   fcm_cell_rules_options o = fcm_cell_rules_options_default();
   o.strength[FCM_RULE_STIFFNESS] = 2;
   o.strength[FCM_RULE_MASS] = 3;
   o.simplify = mode;
-  o.probe_cells = 3;
+  o.num_threads = threads;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     o.expected_assemblies[k] = assemblies;
     o.point_cost[k] = point_cost;
@@ -72,52 +82,67 @@ static int same_rules(const fcm_cell_rules *a, const fcm_cell_rules *b, fcm_rule
 }
 
 /* The decision is fcm_simplify_pays() of its own reported estimates. */
-static void check_decision(const fcm_cell_rules *r, int expect_simplified, int expect_probe)
+static void check_decision(const fcm_cell_rules *r, int expect_simplified)
 {
   const fcm_cell_rules_stats *S = fcm_cell_rules_get_stats(r);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     const fcm_simplify_decision *d = &S->decision[k];
+    const int m = fcm_cell_rules_strength(r, (fcm_rule_kind)k);
+    const double M = (m + 1) * (m + 2) * (m + 3) / 6.0;
     TEST_TRUE(d->simplified == expect_simplified);
-    /* the probe stops early only when the estimates differ by more than 4x */
-    TEST_TRUE(expect_probe ? d->probe_cells >= 1 && d->probe_cells <= 3 : d->probe_cells == 0);
-    if (expect_probe && d->probe_cells < 3)
-      TEST_TRUE(d->cost_plain > 4.0 * d->cost_simplified ||
-                d->cost_simplified > 4.0 * d->cost_plain);
     const double n = (double)S->points_initial[k], A = d->expected_assemblies;
     TEST_NEAR(d->cost_plain, n * d->point_cost * A, 1e-14, 0.0);
-    if (!expect_probe) continue;
-    TEST_TRUE(d->probe_points > d->probe_kept && d->probe_time > 0.0);
-    TEST_NEAR(d->estimated_time, d->probe_time * n / (double)d->probe_points, 1e-14, 0.0);
-    TEST_NEAR(d->estimated_kept,
-              (double)d->probe_kept * (double)S->num_cut / (double)d->probe_cells, 1e-14, 0.0);
+    /* every cut cell keeps min(N, M) points; the model's time is positive when some cell
+     * has more than M points and at most that of all points in one cell */
+    TEST_TRUE(d->estimated_kept > 0.0 && d->estimated_kept <= (double)S->num_cut * M &&
+              d->estimated_kept < n);
+    TEST_TRUE(d->estimated_time > 0.0 &&
+              d->estimated_time <=
+                  (double)S->num_cut * fcm_simplify_cost_estimate(m, S->points_initial[k]));
     TEST_NEAR(d->cost_simplified, d->estimated_time + d->estimated_kept * d->point_cost * A, 1e-14,
               0.0);
     TEST_TRUE(d->simplified ==
               fcm_simplify_pays(A, d->point_cost, n, d->estimated_kept, d->estimated_time));
-    TEST_TRUE(d->simplified == (d->cost_simplified < d->cost_plain));
-    TEST_TRUE(d->time_simplify >= d->probe_time);
     /* simplified: the stored counts are those of ON; else those of OFF */
     if (d->simplified)
       TEST_TRUE(S->points_simplified[k] < S->points_initial[k]);
     else
-      TEST_TRUE(S->points_simplified[k] == S->points_initial[k] && S->max_residual[k] == 0.0);
+      TEST_TRUE(S->points_simplified[k] == S->points_initial[k] && S->max_residual[k] == 0.0 &&
+                d->time_simplify == 0.0);
+  }
+}
+
+/* Same decision inputs and results (the model has no timing in it). */
+static void same_decision(const fcm_cell_rules *a, const fcm_cell_rules *b)
+{
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    const fcm_simplify_decision *x = &fcm_cell_rules_get_stats(a)->decision[k],
+                                *y = &fcm_cell_rules_get_stats(b)->decision[k];
+    TEST_TRUE(x->simplified == y->simplified && x->estimated_time == y->estimated_time &&
+              x->estimated_kept == y->estimated_kept && x->cost_plain == y->cost_plain &&
+              x->cost_simplified == y->cost_simplified);
+    TEST_TRUE(same_rules(a, b, (fcm_rule_kind)k));
   }
 }
 
 static void auto_mode(const fcm_mesh *m, const fcm_geometry *g)
 {
-  fcm_cell_rules *off = build(m, g, FCM_CELL_SIMPLIFY_OFF, 1, FCM_DEFAULT);
-  fcm_cell_rules *on = build(m, g, FCM_CELL_SIMPLIFY_ON, 1, FCM_DEFAULT);
-  fcm_cell_rules *many = build(m, g, FCM_CELL_SIMPLIFY_AUTO, 1e12, FCM_DEFAULT);
-  fcm_cell_rules *none = build(m, g, FCM_CELL_SIMPLIFY_AUTO, 0, FCM_DEFAULT);
-  fcm_cell_rules *cheap = build(m, g, FCM_CELL_SIMPLIFY_AUTO, 1, 1e-30);
-  if (!off || !on || !many || !none || !cheap) goto done;
+  fcm_cell_rules *off = build(m, g, FCM_CELL_SIMPLIFY_OFF, 1, FCM_DEFAULT, 2);
+  fcm_cell_rules *on = build(m, g, FCM_CELL_SIMPLIFY_ON, 1, FCM_DEFAULT, 2);
+  fcm_cell_rules *many = build(m, g, FCM_CELL_SIMPLIFY_AUTO, 1e12, FCM_DEFAULT, 2);
+  fcm_cell_rules *none = build(m, g, FCM_CELL_SIMPLIFY_AUTO, 0, FCM_DEFAULT, 2);
+  fcm_cell_rules *cheap = build(m, g, FCM_CELL_SIMPLIFY_AUTO, 1, 1e-30, 2);
+  /* near the break-even of this grid (mass, strength 3): the same decision on one thread */
+  fcm_cell_rules *mid2 = build(m, g, FCM_CELL_SIMPLIFY_AUTO, 3, FCM_DEFAULT, 2);
+  fcm_cell_rules *mid1 = build(m, g, FCM_CELL_SIMPLIFY_AUTO, 3, FCM_DEFAULT, 1);
+  if (!off || !on || !many || !none || !cheap || !mid1 || !mid2) goto done;
+  same_decision(mid1, mid2);
   TEST_TRUE(fcm_cell_rules_get_stats(off)->num_cut > 3);
   TEST_TRUE(fcm_cell_rules_get_stats(on)->decision[0].simplified == 1 &&
             fcm_cell_rules_get_stats(off)->decision[0].simplified == 0);
-  check_decision(many, 1, 1);
-  check_decision(none, 0, 0);
-  check_decision(cheap, 0, 1);
+  check_decision(many, 1);
+  check_decision(none, 0);
+  check_decision(cheap, 0);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     TEST_TRUE(same_rules(many, on, (fcm_rule_kind)k));
     TEST_TRUE(same_rules(none, off, (fcm_rule_kind)k));
@@ -131,6 +156,8 @@ done:
   fcm_cell_rules_destroy(&many);
   fcm_cell_rules_destroy(&none);
   fcm_cell_rules_destroy(&cheap);
+  fcm_cell_rules_destroy(&mid1);
+  fcm_cell_rules_destroy(&mid2);
 }
 
 static void errors(const fcm_mesh *m, const fcm_geometry *g)
@@ -150,11 +177,6 @@ static void errors(const fcm_mesh *m, const fcm_geometry *g)
   o.point_cost[FCM_RULE_STIFFNESS] = 0.0;
   TEST_ERR(ctx, fcm_cell_rules_create(ctx, m, g, &o, &r), FCM_ERR_ARG,
            "point_cost[stiffness] = 0 must be > 0");
-  o = fcm_cell_rules_options_default();
-  o.simplify = FCM_CELL_SIMPLIFY_AUTO;
-  o.probe_cells = 0;
-  TEST_ERR(ctx, fcm_cell_rules_create(ctx, m, g, &o, &r), FCM_ERR_ARG,
-           "probe_cells = 0 must be >= 1");
   TEST_TRUE(r == NULL);
 }
 

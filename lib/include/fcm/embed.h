@@ -38,10 +38,11 @@ typedef enum fcm_cell_simplify {
   FCM_CELL_SIMPLIFY_OFF = 0,  /**< keep every point of the mapped tet rules */
   FCM_CELL_SIMPLIFY_ON = 1,   /**< simplify the rules of every cut cell (default) */
   FCM_CELL_SIMPLIFY_AUTO = 2, /**< per rule kind, simplify when it pays for the expected number
-                                   of assemblies: a few cut cells are simplified and timed (the
-                                   probe), the time of all is extrapolated by points and compared
-                                   with the assembly time it saves (fcm_simplify_pays()); the
-                                   choice and its inputs are in fcm_cell_rules_stats.decision */
+                                   of assemblies: the simplification time of every cut cell
+                                   (fcm_simplify_cost_estimate(), a deterministic model) against
+                                   the assembly time it saves (fcm_simplify_pays()), so the
+                                   same inputs always give the same rules; the choice and its
+                                   inputs are in fcm_cell_rules_stats.decision */
   FCM_CELL_SIMPLIFY_COUNT
 } fcm_cell_simplify;
 
@@ -81,11 +82,7 @@ typedef struct fcm_cell_rules_options {
                               Newton iterations stiffness, 1 mass (assembled once); default 1 */
   double point_cost[FCM_RULE_KIND_COUNT]; /**< AUTO: core-seconds per point per assembly, > 0;
                               FCM_DEFAULT (default): fcm_cell_rules_point_cost() */
-  int probe_cells; /**< AUTO: at most this many cut cells per kind are simplified to
-                        measure the simplification time (in rounds of one per thread,
-                        stopping once the two cost estimates differ by more than 4x),
-                        >= 1; default 4 */
-  fcm_simplify_options simplify_options; /**< default fcm_simplify_options_default() */
+  fcm_simplify_options simplify_options;  /**< default fcm_simplify_options_default() */
   double max_rule_memory; /**< bytes the rules of one cut cell may take to build (an estimate
                                checked before allocating: points of both kinds plus the
                                simplification's moment matrix and LP); a cell above it fails
@@ -104,19 +101,13 @@ typedef struct fcm_simplify_decision {
   int simplified;             /**< 1: the cut-cell rules of this kind were simplified */
   double expected_assemblies; /**< input of the model */
   double point_cost;          /**< input: core-seconds per point per assembly */
-  fcm_index probe_cells;      /**< cut cells simplified to measure the cost (0: no probe, when
-                                   no assembly is expected or no cell is cut) */
-  fcm_index probe_points;     /**< their points before simplification */
-  fcm_index probe_kept;       /**< and after */
-  double probe_time;          /**< their simplification time */
-  double estimated_time;      /**< simplification time of all cut cells, extrapolated by points
-                                   from the probe */
-  double estimated_kept;      /**< points all cut cells keep, extrapolated per cell */
+  double estimated_time;      /**< simplification time of all cut cells: the sum of
+                                   fcm_simplify_cost_estimate() over them */
+  double estimated_kept;      /**< points all cut cells keep: min(N, M) per cell */
   double cost_plain;          /**< assembly time of the unsimplified cut-cell points over the
                                    expected assemblies: points x point_cost x assemblies */
   double cost_simplified;     /**< estimated_time + estimated_kept x point_cost x assemblies */
-  double time_simplify;       /**< simplification time actually spent on this kind (probe
-                                   included, also when the probe's results were discarded) */
+  double time_simplify;       /**< simplification time actually spent on this kind */
 } fcm_simplify_decision;
 
 /** Statistics of fcm_cell_rules_create(). Point counts cover cut cells unless "total".
@@ -162,7 +153,7 @@ typedef struct fcm_cell_rules fcm_cell_rules;
  * @param[in] opts NULL for defaults; @param[out] rules NULL on failure
  * @return FCM_OK; FCM_ERR_ARG (NULL, strengths outside [0, 20] with simplification or
  *         [0, FCM_RULE_MAX_STRENGTH] without, simplify not a mode, AUTO with expected_assemblies
- *         < 0, point_cost <= 0 (not FCM_DEFAULT) or probe_cells < 1, thresholds outside 0 <=
+ *         < 0, point_cost <= 0 (not FCM_DEFAULT), thresholds outside 0 <=
  * min_fraction < uncut_fraction <= 1, tolerances out of range, bad stabilization); FCM_ERR_GEOMETRY
  *         (a non-convex background cell, naming it; a degenerate cell); FCM_ERR_NOT_CONVERGED
  *         (inverse map); FCM_ERR_UNSUPPORTED (a cell whose rules would exceed

@@ -101,6 +101,13 @@ FCM_API fcm_status fcm_simplify(fcm_ctx *ctx, int strength, fcm_index n, const d
                                 const double *weights, const fcm_simplify_options *opts,
                                 fcm_simplify_result *out, fcm_simplify_info *info);
 
+/** Model of the core-seconds fcm_simplify()'s default path takes for n points at this
+ * strength: 2.5e-9 N M + 6.6e-10 M^3 for N > M (0 otherwise), M = (strength+3 choose 3),
+ * fitted to simplify_bench on one core of the development machine (M = 20 ... 286,
+ * N = 72 ... 110,592; within a factor 2 of each case). Deterministic, for cost decisions
+ * (FCM_CELL_SIMPLIFY_AUTO); a strength outside [0, 20] or n < 0 gives 0. */
+FCM_API double fcm_simplify_cost_estimate(int strength, fcm_index n);
+
 /** Release the arrays of a result and zero it; accepts NULL and an empty result. */
 FCM_API void fcm_simplify_result_destroy(fcm_simplify_result *res);
 

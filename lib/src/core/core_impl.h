@@ -31,7 +31,10 @@ void fcm__log(const fcm_ctx *ctx, fcm_log_level level, const char *fmt, ...) FCM
  * n == 0 still returns a valid (1-byte) allocation. */
 void *fcm__calloc(fcm_ctx *ctx, size_t n, size_t size);
 
-/* Release memory from fcm__calloc; accepts NULL. */
+/* As fcm__calloc, without the zero fill: for arrays written in full before they are read. */
+void *fcm__malloc(fcm_ctx *ctx, size_t n, size_t size);
+
+/* Release memory from fcm__calloc or fcm__malloc; accepts NULL. */
 void fcm__free(fcm_ctx *ctx, void *ptr);
 
 /* Grow or shrink an fcm__calloc array, preserving min(old_n, new_n) elements and
@@ -136,16 +139,23 @@ fcm_status fcm__loop_end(fcm__loop *loop, fcm_index *failed);
     }                                                                                              \
   } while (0)
 
-/* Allocate `n` zeroed elements of *p's type into p, or fail with FCM_ERR_ALLOC. */
-#define FCM_ALLOC(ctx, n, p)                                                                       \
+/* Allocate `n` elements of *p's type into p through `fn` (fcm__calloc or fcm__malloc), or
+ * fail with FCM_ERR_ALLOC. */
+#define FCM__ALLOC_WITH(fn, ctx, n, p)                                                             \
   do {                                                                                             \
-    (p) = fcm__calloc((ctx), (size_t)(n), sizeof *(p));                                            \
+    (p) = fn((ctx), (size_t)(n), sizeof *(p));                                                     \
     if (!(p)) {                                                                                    \
       st = FCM_ERR_ALLOC;                                                                          \
       fcm__trace((ctx), __FILE__, __LINE__, __func__);                                             \
       goto cleanup;                                                                                \
     }                                                                                              \
   } while (0)
+
+/* Allocate `n` zeroed elements of *p's type into p, or fail with FCM_ERR_ALLOC. */
+#define FCM_ALLOC(ctx, n, p) FCM__ALLOC_WITH(fcm__calloc, ctx, n, p)
+
+/* As FCM_ALLOC without the zero fill (fcm__malloc): every element is written before use. */
+#define FCM_ALLOC_RAW(ctx, n, p) FCM__ALLOC_WITH(fcm__malloc, ctx, n, p)
 
 /* Free and reset to NULL. */
 #define FCM_FREE(ctx, p)                                                                           \

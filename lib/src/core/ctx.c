@@ -287,6 +287,13 @@ void fcm__log(const fcm_ctx *ctx, fcm_log_level level, const char *fmt, ...)
 
 void *fcm__calloc(fcm_ctx *ctx, size_t n, size_t size)
 {
+  void *p = fcm__malloc(ctx, n, size);
+  if (p) memset(p, 0, n * size);
+  return p;
+}
+
+void *fcm__malloc(fcm_ctx *ctx, size_t n, size_t size)
+{
   if (size && n > SIZE_MAX / size) {
     fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
                "allocation of %zu elements of %zu bytes overflows size_t", n, size);
@@ -300,7 +307,6 @@ void *fcm__calloc(fcm_ctx *ctx, size_t n, size_t size)
                "out of memory allocating %zu bytes", bytes);
     return NULL;
   }
-  memset(p, 0, bytes);
   atomic_fetch_add(&ctx->live, 1);
   return p;
 }

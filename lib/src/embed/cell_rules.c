@@ -27,7 +27,6 @@ fcm_cell_rules_options fcm_cell_rules_options_default(void)
     o.expected_assemblies[k] = 1.0;
     o.point_cost[k] = FCM_DEFAULT;
   }
-  o.probe_cells = 4;
   o.simplify_options = fcm_simplify_options_default();
   o.stabilization = fcm_stabilization_options_default();
   o.max_rule_memory = 4.0 * GIB;
@@ -79,8 +78,7 @@ typedef struct cell_out {
   int ninit[FCM_RULE_KIND_COUNT], nsimp[FCM_RULE_KIND_COUNT], nstab[FCM_RULE_KIND_COUNT];
   unsigned char skipped[FCM_RULE_KIND_COUNT], fallback[FCM_RULE_KIND_COUNT];
   double residual[FCM_RULE_KIND_COUNT];
-  double tsimp[FCM_RULE_KIND_COUNT];         /* fcm_simplify's time_total */
-  unsigned char probed[FCM_RULE_KIND_COUNT]; /* AUTO: simplified by the probe */
+  double tsimp[FCM_RULE_KIND_COUNT]; /* fcm_simplify's time_total */
   int ns;
   double *spts, *sw, *snrm;
   fcm_index *stri;
@@ -319,8 +317,6 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_cell_rules_options *o)
                 "constant of the element)",
                 kn, o->point_cost[k]);
     }
-    FCM_CHECK(o->probe_cells >= 1, ctx, FCM_ERR_ARG, "embed: probe_cells = %d must be >= 1",
-              o->probe_cells);
   }
   const int smax = o->simplify ? FCM_SIMPLIFY_MAX_STRENGTH : FCM_RULE_MAX_STRENGTH;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
@@ -501,19 +497,11 @@ cleanup:
   return st;
 }
 
-/* AUTO stops probing once the two cost estimates differ by more than this factor. */
-#define AUTO_PROBE_MARGIN 4.0
-
-/* What a loop of auto_simplify() does to each cell of its list. */
-typedef enum auto_phase {
-  AUTO_PROBE, /* simplify kind `kind` (timed) */
-  AUTO_FINISH /* simplify the kinds that pay (not the probed cells again), stabilize */
-} auto_phase;
-
-/* Run `phase` on the cells list[0 .. n) in parallel; the error is the lowest failing one's. */
-static fcm_status auto_loop(const build *B, const fcm_cell_rules *R, int nthreads, cell_out *out,
-                            const fcm_index *list, fcm_index n, auto_phase phase, int kind,
-                            const int pays[FCM_RULE_KIND_COUNT], cell_sums *sums)
+/* Finish the cut cells list[0 .. n) in parallel (simplify the kinds that pay, stabilize);
+ * the error is the lowest failing one's. */
+static fcm_status auto_finish(const build *B, const fcm_cell_rules *R, int nthreads, cell_out *out,
+                              const fcm_index *list, fcm_index n,
+                              const int pays[FCM_RULE_KIND_COUNT], cell_sums *sums)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
@@ -528,20 +516,10 @@ static fcm_status auto_loop(const build *B, const fcm_cell_rules *R, int nthread
       if (fcm__loop_skip(&loop, i)) continue;
       fcm__loop_iter it;
       fcm__loop_enter(&loop, &it, i);
-      cell_out *o = out + list[i];
-      fcm_status s = FCM_OK;
-      if (phase == AUTO_PROBE) {
-        s = simplify_rule(ctx, &B->o->simplify_options, R->strength[kind], &o->n[kind],
-                          o->pts[kind], o->w[kind], o, kind);
-        o->nsimp[kind] = o->n[kind];
-        o->probed[kind] = 1;
-        mine.time_simplify += o->tsimp[kind];
-      } else {
-        int simp[FCM_RULE_KIND_COUNT];
-        for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
-          simp[k] = pays[k] && !o->probed[k];
-        s = finish_cell(B, R, o, simp, &mine);
-      }
+      int simp[FCM_RULE_KIND_COUNT];
+      for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+        simp[k] = pays[k];
+      fcm_status s = finish_cell(B, R, out + list[i], simp, &mine);
       fcm__loop_leave(&loop, &it, s);
     }
 #pragma omp critical(fcm_embed_auto_sum)
@@ -553,12 +531,12 @@ cleanup:
 }
 
 /* Phase 2b of FCM_CELL_SIMPLIFY_AUTO (the cells are intersected and mapped, not yet
- * simplified nor stabilized): per kind, simplify probe_cells cut cells spread over the cell
- * order, extrapolate their time by points and their kept points per cell to all cut cells,
- * decide with fcm_simplify_pays() (the probe runs in rounds of one cell per thread and stops
- * early when the estimates differ by more than AUTO_PROBE_MARGIN); probe cells of a kind that
- * does not pay get their unsimplified rules back, so the rules are those of OFF or ON for
- * each kind. Then finish every cut cell. */
+ * simplified nor stabilized): per kind, the simplification time of every cut cell from the
+ * deterministic model fcm_simplify_cost_estimate() and the points it would keep (min(N, M)),
+ * against the assembly time of the points it removes over the expected assemblies
+ * (fcm_simplify_pays()). The rules are then those of OFF or ON for each kind, and the same
+ * inputs always give the same decision (no timing: runs, thread counts and resumed runs
+ * agree). Then finish every cut cell. */
 static fcm_status auto_simplify(const build *B, fcm_cell_rules *R, int nthreads, cell_out *out,
                                 cell_sums *sums)
 {
@@ -566,8 +544,7 @@ static fcm_status auto_simplify(const build *B, fcm_cell_rules *R, int nthreads,
   fcm_ctx *ctx = B->ctx;
   const fcm_cell_rules_options *opt = B->o;
   const fcm_index nc = R->num_cells;
-  fcm_index *cut = NULL, *probe = NULL, ncut = 0;
-  double *saved = NULL; /* the probe cells' unsimplified points (x 3) and weights */
+  fcm_index *cut = NULL, ncut = 0;
   int pays[FCM_RULE_KIND_COUNT] = {0, 0};
   for (fcm_index c = 0; c < nc; c++)
     ncut += R->cls[c] == FCM_CELL_CUT;
@@ -575,84 +552,32 @@ static fcm_status auto_simplify(const build *B, fcm_cell_rules *R, int nthreads,
   ncut = 0;
   for (fcm_index c = 0; c < nc; c++)
     if (R->cls[c] == FCM_CELL_CUT) cut[ncut++] = c;
-  const fcm_index np = ncut < opt->probe_cells ? ncut : opt->probe_cells;
-  FCM_ALLOC(ctx, (size_t)np + 1, probe);
-  /* Spread over the cell order (distinct: consecutive picks differ by ncut/np >= 1), the
-   * even picks first so that an early stop still samples the whole range. */
-  for (fcm_index i = 0, j = 0; i < np; i++, j += 2) {
-    if (j >= np) j = 1;
-    probe[i] = cut[(2 * j + 1) * ncut / (2 * np)];
-  }
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     fcm_simplify_decision *d = &R->stats.decision[k];
     const fcm_element_type type = fcm_mesh_element_type(B->mesh);
+    const int m = R->strength[k];
+    const double M = (double)(m + 1) * (m + 2) * (m + 3) / 6.0;
     d->expected_assemblies = opt->expected_assemblies[k];
     d->point_cost =
         opt->point_cost[k] == FCM_DEFAULT ? fcm_cell_rules_point_cost(type, k) : opt->point_cost[k];
     double ntot = 0.0;
-    for (fcm_index i = 0; i < ncut; i++)
-      ntot += out[cut[i]].ninit[k];
+    for (fcm_index i = 0; i < ncut; i++) {
+      const fcm_index n = out[cut[i]].ninit[k];
+      ntot += (double)n;
+      d->estimated_time += fcm_simplify_cost_estimate(m, n);
+      d->estimated_kept += (double)n < M ? (double)n : M;
+    }
     d->cost_plain = ntot * d->point_cost * d->expected_assemblies;
-    if (np == 0 || d->expected_assemblies <= 0.0) { /* nothing to gain: no probe */
-      d->cost_simplified = d->cost_plain;
-      continue;
-    }
-    size_t nsave = 0;
-    for (fcm_index i = 0; i < np; i++)
-      nsave += (size_t)out[probe[i]].ninit[k];
-    FCM_ALLOC(ctx, 4 * nsave, saved);
-    for (size_t i = 0, at = 0; i < (size_t)np; i++) {
-      const cell_out *o = out + probe[i];
-      const size_t n = (size_t)o->ninit[k];
-      memcpy(saved + 4 * at, o->pts[k], 3 * n * sizeof *saved);
-      memcpy(saved + 4 * at + 3 * n, o->w[k], n * sizeof *saved);
-      at += n;
-    }
-    /* Rounds of one cell per thread until every probe cell is done or the estimates differ by
-     * more than AUTO_PROBE_MARGIN either way. */
-    fcm_index q = 0;
-    while (q < np) {
-      const fcm_index m = np - q < nthreads ? np - q : nthreads;
-      FCM_TRY(ctx, auto_loop(B, R, nthreads, out, probe + q, m, AUTO_PROBE, k, pays, sums));
-      for (fcm_index i = q; i < q + m; i++) {
-        const cell_out *o = out + probe[i];
-        d->probe_points += o->ninit[k];
-        d->probe_kept += o->nsimp[k];
-        d->probe_time += o->tsimp[k];
-      }
-      q += m;
-      d->probe_cells = q;
-      d->estimated_time =
-          d->probe_points > 0 ? d->probe_time * ntot / (double)d->probe_points : 0.0;
-      d->estimated_kept = (double)d->probe_kept * (double)ncut / (double)q;
-      d->cost_simplified =
-          d->estimated_time + d->estimated_kept * d->point_cost * d->expected_assemblies;
-      if (d->cost_plain > AUTO_PROBE_MARGIN * d->cost_simplified ||
-          d->cost_simplified > AUTO_PROBE_MARGIN * d->cost_plain)
-        break;
-    }
+    d->cost_simplified =
+        d->estimated_time + d->estimated_kept * d->point_cost * d->expected_assemblies;
     pays[k] = fcm_simplify_pays(d->expected_assemblies, d->point_cost, ntot, d->estimated_kept,
                                 d->estimated_time);
-    if (!pays[k]) /* give the probe cells their unsimplified rules back */
-      for (size_t i = 0, at = 0; i < (size_t)q; i++) {
-        cell_out *o = out + probe[i];
-        const size_t n = (size_t)o->ninit[k];
-        memcpy(o->pts[k], saved + 4 * at, 3 * n * sizeof *saved);
-        memcpy(o->w[k], saved + 4 * at + 3 * n, n * sizeof *saved);
-        o->n[k] = o->nsimp[k] = o->ninit[k];
-        o->skipped[k] = o->fallback[k] = 0;
-        o->residual[k] = 0.0;
-        at += n;
-      }
-    FCM_FREE(ctx, saved);
   }
-  FCM_TRY(ctx, auto_loop(B, R, nthreads, out, cut, ncut, AUTO_FINISH, -1, pays, sums));
+  FCM_TRY(ctx, auto_finish(B, R, nthreads, out, cut, ncut, pays, sums));
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     R->stats.decision[k].simplified = pays[k];
 cleanup:
-  fcm__free(ctx, saved);
   fcm__free(ctx, cut);
-  fcm__free(ctx, probe);
   return st;
 }
 
@@ -944,14 +869,13 @@ void fcm_cell_rules_view(const fcm_cell_rules *rules, FILE *stream)
             (long long)S->simplify_fallbacks[k], S->max_residual[k]);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     const fcm_simplify_decision *d = &S->decision[k];
-    if (d->probe_cells > 0 || d->point_cost > 0.0)
+    if (d->point_cost > 0.0)
       fprintf(stream,
-              "  %-9s simplify auto: %s for %g assemblies (%.3g core-s per point): probe %lld "
-              "cells %lld -> %lld points in %.3g core-s; estimated assembly %.3g core-s plain vs "
-              "%.3g simplify + assembly\n",
+              "  %-9s simplify auto: %s for %g assemblies (%.3g core-s per point): estimated "
+              "%.3g core-s simplifying to %.0f points; assembly %.3g core-s plain vs %.3g "
+              "simplify + assembly\n",
               names[k], d->simplified ? "on" : "off", d->expected_assemblies, d->point_cost,
-              (long long)d->probe_cells, (long long)d->probe_points, (long long)d->probe_kept,
-              d->probe_time, d->cost_plain, d->cost_simplified);
+              d->estimated_time, d->estimated_kept, d->cost_plain, d->cost_simplified);
   }
   if (rules->surface_strength >= 0)
     fprintf(stream, "  surface strength %d: %lld triangles, %lld points, area %.17g\n",

@@ -748,11 +748,10 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
       if (q->simplify == FCM_CELL_SIMPLIFY_AUTO)
         snprintf(b, sizeof b,
                  "auto: %s for %g expected assemblies; cost model %.3g core-s per point per "
-                 "assembly; probe %lld cells %lld -> %lld points in %.3g core-s; estimated "
-                 "%.3g core-s assembling plain vs %.3g simplifying + assembling",
+                 "assembly, %.3g core-s simplifying to %.0f points; estimated %.3g core-s "
+                 "assembling plain vs %.3g simplifying + assembling",
                  d->simplified ? "on" : "off", d->expected_assemblies, d->point_cost,
-                 (long long)d->probe_cells, (long long)d->probe_points, (long long)d->probe_kept,
-                 d->probe_time, d->cost_plain, d->cost_simplified);
+                 d->estimated_time, d->estimated_kept, d->cost_plain, d->cost_simplified);
       else
         snprintf(b, sizeof b, "%s (scene), %.3g core-s", fcm_cell_simplify_name(q->simplify),
                  d->time_simplify);

@@ -52,6 +52,61 @@ void fcm__simplify_basis_eval(const fcm__cheb_box *box, const double *x, double 
         phi[i++] = t[0][a] * t[1][b] * t[2][deg - a - b];
 }
 
+/* One block of bn <= FCM__MOMENT_BLOCK points (idx[j0 + p], or j0 + p): per axis the
+ * Chebyshev values T_k, points innermost, with w (NULL: 1) folded into the z factor, and
+ * the products T_a(x) T_b(y), pair index (a + b)(a + b + 1)/2 + b. */
+static void tabulate_block(const fcm__cheb_box *box, int j0, int bn, const double *points,
+                           const int *idx, const double *w, double *tx, double *ty, double *tzw,
+                           double *txy)
+{
+  enum { B = FCM__MOMENT_BLOCK };
+  const int m = box->m;
+  /* Chebyshev values per axis, points innermost; the weight goes into the z factor. */
+  for (int p = 0; p < bn; p++) {
+    const double *x = points + 3 * (size_t)(idx ? idx[j0 + p] : j0 + p);
+    tx[p] = 1.0;
+    ty[p] = 1.0;
+    tzw[p] = w ? w[j0 + p] : 1.0;
+    if (m >= 1) {
+      tx[B + p] = box->scale[0] * x[0] + box->shift[0];
+      ty[B + p] = box->scale[1] * x[1] + box->shift[1];
+      tzw[B + p] = box->scale[2] * x[2] + box->shift[2]; /* the argument for now */
+    }
+  }
+  for (int k = 2; k <= m; k++) {
+    double *restrict xk = tx + (size_t)k * B, *restrict yk = ty + (size_t)k * B;
+    const double *x1 = tx + (size_t)(k - 1) * B, *x2 = tx + (size_t)(k - 2) * B;
+    const double *y1 = ty + (size_t)(k - 1) * B, *y2 = ty + (size_t)(k - 2) * B;
+    for (int p = 0; p < bn; p++) {
+      xk[p] = 2.0 * tx[B + p] * x1[p] - x2[p];
+      yk[p] = 2.0 * ty[B + p] * y1[p] - y2[p];
+    }
+  }
+  /* z: the recurrence on the unweighted values, then times the weight. */
+  if (m >= 1) {
+    double *restrict z1 = tzw + B;
+    for (int p = 0; p < bn; p++) {
+      const double s = z1[p];
+      double t0 = 1.0, t1 = s;
+      z1[p] = tzw[p] * s;
+      for (int k = 2; k <= m; k++) {
+        const double t2 = 2.0 * s * t1 - t0;
+        tzw[(size_t)k * B + p] = tzw[p] * t2;
+        t0 = t1;
+        t1 = t2;
+      }
+    }
+  }
+  /* T_a(x) T_b(y) for a + b <= m, pair index (a + b)(a + b + 1)/2 + b. */
+  for (int s = 0; s <= m; s++)
+    for (int b = 0; b <= s; b++) {
+      double *restrict o = txy + (size_t)(s * (s + 1) / 2 + b) * B;
+      const double *xa = tx + (size_t)(s - b) * B, *yb = ty + (size_t)b * B;
+      for (int p = 0; p < bn; p++)
+        o[p] = xa[p] * yb[p];
+    }
+}
+
 size_t fcm__simplify_moments_scratch(int m)
 {
   const size_t pairs = (size_t)(m + 1) * (size_t)(m + 2) / 2, nz = (size_t)m + 1;
@@ -69,50 +124,7 @@ void fcm__simplify_moments(const fcm__cheb_box *box, int n, const double *points
     c[i] = 0.0;
   for (int j0 = 0; j0 < n; j0 += B) {
     const int bn = n - j0 < B ? n - j0 : B;
-    /* Chebyshev values per axis, points innermost; the weight goes into the z factor. */
-    for (int p = 0; p < bn; p++) {
-      const double *x = points + 3 * (size_t)(idx ? idx[j0 + p] : j0 + p);
-      tx[p] = 1.0;
-      ty[p] = 1.0;
-      tzw[p] = w[j0 + p];
-      if (m >= 1) {
-        tx[B + p] = box->scale[0] * x[0] + box->shift[0];
-        ty[B + p] = box->scale[1] * x[1] + box->shift[1];
-        tzw[B + p] = box->scale[2] * x[2] + box->shift[2]; /* the argument for now */
-      }
-    }
-    for (int k = 2; k <= m; k++) {
-      double *restrict xk = tx + (size_t)k * B, *restrict yk = ty + (size_t)k * B;
-      const double *x1 = tx + (size_t)(k - 1) * B, *x2 = tx + (size_t)(k - 2) * B;
-      const double *y1 = ty + (size_t)(k - 1) * B, *y2 = ty + (size_t)(k - 2) * B;
-      for (int p = 0; p < bn; p++) {
-        xk[p] = 2.0 * tx[B + p] * x1[p] - x2[p];
-        yk[p] = 2.0 * ty[B + p] * y1[p] - y2[p];
-      }
-    }
-    /* z: the recurrence on the unweighted values, then times the weight. */
-    if (m >= 1) {
-      double *restrict z1 = tzw + B;
-      for (int p = 0; p < bn; p++) {
-        const double s = z1[p];
-        double t0 = 1.0, t1 = s;
-        z1[p] = tzw[p] * s;
-        for (int k = 2; k <= m; k++) {
-          const double t2 = 2.0 * s * t1 - t0;
-          tzw[(size_t)k * B + p] = tzw[p] * t2;
-          t0 = t1;
-          t1 = t2;
-        }
-      }
-    }
-    /* T_a(x) T_b(y) for a + b <= m, pair index (a + b)(a + b + 1)/2 + b. */
-    for (int s = 0; s <= m; s++)
-      for (int b = 0; b <= s; b++) {
-        double *restrict o = txy + (size_t)(s * (s + 1) / 2 + b) * B;
-        const double *xa = tx + (size_t)(s - b) * B, *yb = ty + (size_t)b * B;
-        for (int p = 0; p < bn; p++)
-          o[p] = xa[p] * yb[p];
-      }
+    tabulate_block(box, j0, bn, points, idx, w, tx, ty, tzw, txy);
     /* C(pair, c) += sum_p T_a T_b(p) w T_c(p): one matrix product per block (it also forms the
      * products of degree above m, cheaper there than skipping them); short blocks (small
      * recombination clusters) by dot products, below the cost of a BLAS call. */
@@ -123,11 +135,14 @@ void fcm__simplify_moments(const fcm__cheb_box *box, int n, const double *points
         for (int k = 0; k <= m - s; k++)
           for (int q = s * (s + 1) / 2; q <= s * (s + 1) / 2 + s; q++) {
             const double *o = txy + (size_t)q * B, *z = tzw + (size_t)k * B;
-            double d = 0.0;
-#pragma omp simd reduction(+ : d)
-            for (int p = 0; p < bn; p++)
-              d += o[p] * z[p];
-            c[q + (size_t)k * (size_t)pairs] += d;
+            double d[4] = {0.0, 0.0, 0.0, 0.0}; /* four partial sums: no serial add chain */
+            int p = 0;
+            for (; p + 4 <= bn; p += 4)
+              for (int l = 0; l < 4; l++)
+                d[l] += o[p + l] * z[p + l];
+            for (; p < bn; p++)
+              d[0] += o[p] * z[p];
+            c[q + (size_t)k * (size_t)pairs] += (d[0] + d[1]) + (d[2] + d[3]);
           }
     }
   }
@@ -137,4 +152,27 @@ void fcm__simplify_moments(const fcm__cheb_box *box, int n, const double *points
     for (int a = deg; a >= 0; a--)
       for (int b = deg - a; b >= 0; b--)
         mom[i++] = c[(a + b) * (a + b + 1) / 2 + b + (size_t)(deg - a - b) * (size_t)pairs];
+}
+
+void fcm__simplify_basis_points(const fcm__cheb_box *box, int n, const double *points, double *phi,
+                                double *work)
+{
+  enum { B = FCM__MOMENT_BLOCK };
+  const int m = box->m, M = box->num_basis, pairs = (m + 1) * (m + 2) / 2, nz = m + 1;
+  double *tx = work, *ty = tx + (size_t)nz * B, *txy = ty + (size_t)nz * B;
+  double *tz = txy + (size_t)pairs * B;
+  for (int j0 = 0; j0 < n; j0 += B) {
+    const int bn = n - j0 < B ? n - j0 : B;
+    tabulate_block(box, j0, bn, points, NULL, NULL, tx, ty, tz, txy);
+    int i = 0;
+    for (int deg = 0; deg <= m; deg++)
+      for (int a = deg; a >= 0; a--)
+        for (int b = deg - a; b >= 0; b--, i++) {
+          const double *o = txy + (size_t)((a + b) * (a + b + 1) / 2 + b) * B;
+          const double *z = tz + (size_t)(deg - a - b) * B;
+          double *out = phi + (size_t)j0 * (size_t)M + i;
+          for (int p = 0; p < bn; p++)
+            out[(size_t)p * (size_t)M] = o[p] * z[p];
+        }
+  }
 }

@@ -87,13 +87,13 @@ static fcm_status reserve(fcm__attempt *a, size_t nd, size_t ni)
   if (nd > a->ws_cap) {
     FCM_FREE(a->ctx, a->ws);
     a->ws_cap = 0;
-    FCM_ALLOC(a->ctx, nd, a->ws);
+    FCM_ALLOC_RAW(a->ctx, nd, a->ws);
     a->ws_cap = nd;
   }
   if (ni > a->iws_cap) {
     FCM_FREE(a->ctx, a->iws);
     a->iws_cap = 0;
-    FCM_ALLOC(a->ctx, ni, a->iws);
+    FCM_ALLOC_RAW(a->ctx, ni, a->iws);
     a->iws_cap = ni;
   }
 cleanup:
@@ -213,20 +213,19 @@ fcm_status fcm__simplify_run_eliminate(fcm__attempt *a)
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = a->ctx;
   const int n = a->n, M = a->box.num_basis;
-  double *g = NULL, *q = NULL, *lam = NULL;
+  double *g = NULL, *q = NULL, *lam = NULL, *work = NULL;
   if (n > ELIMINATE_ALL_RATIO * M) {
     a->eliminate = 1;
     FCM_TRY(ctx, fcm__simplify_run_recombine(a));
     goto cleanup;
   }
   double t0 = fcm_wtime();
-  FCM_ALLOC(ctx, (size_t)M * (size_t)n, g);
-  FCM_ALLOC(ctx, (size_t)FCM_MIN(M, n) * (size_t)n, q);
-  FCM_ALLOC(ctx, (size_t)n, lam);
-  for (int j = 0; j < n; j++) {
-    fcm__simplify_basis_eval(&a->box, a->points + 3 * (size_t)j, g + (size_t)j * (size_t)M);
-    lam[j] = a->w0[j];
-  }
+  FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)n, g);
+  FCM_ALLOC_RAW(ctx, (size_t)FCM_MIN(M, n) * (size_t)n, q);
+  FCM_ALLOC_RAW(ctx, (size_t)n, lam);
+  FCM_ALLOC_RAW(ctx, fcm__simplify_moments_scratch(a->box.m), work);
+  fcm__simplify_basis_points(&a->box, n, a->points, g, work);
+  memcpy(lam, a->w0, sizeof *lam * (size_t)n);
   fcm__simplify_set_moments(a, n, g, lam);
   a->time_basis += fcm_wtime() - t0;
   FCM_TRY(ctx, fcm__simplify_reduce(a, M, n, g, q, lam));
@@ -236,5 +235,6 @@ cleanup:
   fcm__free(ctx, g);
   fcm__free(ctx, q);
   fcm__free(ctx, lam);
+  fcm__free(ctx, work);
   return st;
 }

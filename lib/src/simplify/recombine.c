@@ -13,6 +13,13 @@
 #include "la/la_impl.h"
 #include "simplify/simplify_impl.h"
 
+#include <string.h>
+
+/* The basis is evaluated once at every point and kept when it takes at most this many
+ * doubles (8 MiB); above, each round evaluates it again at the active points (measured:
+ * tests/simplify/bench_simplify.c). */
+#define RECOMBINE_CACHE_MAX ((size_t)1 << 20)
+
 /* Solve Q lam = Q 1, lam >= 0 for the rows x cols matrix g (destroyed, ld rows). */
 static fcm_status cluster_lp(fcm__attempt *a, int rows, int cols, double *g, double *q, double *rhs,
                              double *lam)
@@ -56,7 +63,7 @@ fcm_status fcm__simplify_run_recombine(fcm__attempt *a)
   fcm_ctx *ctx = a->ctx;
   const int n = a->n, M = a->box.num_basis, K = 2 * (M + 1);
   int *idx = NULL, nact = 0;
-  double *cw = NULL, *g = NULL, *q = NULL, *rhs = NULL, *lam = NULL, *acc = NULL;
+  double *cw = NULL, *g = NULL, *q = NULL, *rhs = NULL, *lam = NULL, *acc = NULL, *phi = NULL;
 
   FCM_ALLOC(ctx, (size_t)n, idx);
   FCM_ALLOC(ctx, (size_t)n, cw);
@@ -65,6 +72,12 @@ fcm_status fcm__simplify_run_recombine(fcm__attempt *a)
   FCM_ALLOC(ctx, (size_t)M, rhs);
   FCM_ALLOC(ctx, (size_t)K, lam);
   FCM_ALLOC(ctx, fcm__simplify_moments_scratch(a->box.m), acc);
+  if ((size_t)n * (size_t)M <= RECOMBINE_CACHE_MAX) { /* the basis at every point, once */
+    double t0 = fcm_wtime();
+    FCM_ALLOC_RAW(ctx, (size_t)n * (size_t)M, phi);
+    fcm__simplify_basis_points(&a->box, n, a->points, phi, acc);
+    a->time_basis += fcm_wtime() - t0;
+  }
   for (int j = 0; j < n; j++)
     if (a->w0[j] > 0.0) {
       idx[nact] = j;
@@ -76,8 +89,18 @@ fcm_status fcm__simplify_run_recombine(fcm__attempt *a)
     double t0 = fcm_wtime();
     for (int c = 0; c < K; c++) {
       const int lo = (int)((long long)c * nact / K), hi = (int)((long long)(c + 1) * nact / K);
-      fcm__simplify_moments(&a->box, hi - lo, a->points, idx + lo, cw + lo,
-                            g + (size_t)c * (size_t)M, acc);
+      double *gc = g + (size_t)c * (size_t)M;
+      if (phi) {
+        for (int p = 0; p < M; p++)
+          gc[p] = 0.0;
+        for (int i = lo; i < hi; i++) {
+          const double *restrict f = phi + (size_t)idx[i] * (size_t)M, wi = cw[i];
+          for (int p = 0; p < M; p++)
+            gc[p] += wi * f[p];
+        }
+      } else {
+        fcm__simplify_moments(&a->box, hi - lo, a->points, idx + lo, cw + lo, gc, acc);
+      }
     }
     fcm__simplify_set_moments(a, K, g, NULL); /* the first round sees every point */
     a->time_basis += fcm_wtime() - t0;
@@ -105,7 +128,10 @@ fcm_status fcm__simplify_run_recombine(fcm__attempt *a)
   double t0 = fcm_wtime();
   for (int i = 0; i < nact; i++) {
     double *gi = g + (size_t)i * (size_t)M;
-    fcm__simplify_basis_eval(&a->box, a->points + 3 * (size_t)idx[i], gi);
+    if (phi)
+      memcpy(gi, phi + (size_t)idx[i] * (size_t)M, sizeof *gi * (size_t)M);
+    else
+      fcm__simplify_basis_eval(&a->box, a->points + 3 * (size_t)idx[i], gi);
     for (int p = 0; p < M; p++)
       gi[p] *= cw[i];
   }
@@ -122,5 +148,6 @@ cleanup:
   fcm__free(ctx, rhs);
   fcm__free(ctx, lam);
   fcm__free(ctx, acc);
+  fcm__free(ctx, phi);
   return st;
 }

@@ -563,6 +563,13 @@ cleanup:
   return st;
 }
 
+double fcm_simplify_cost_estimate(int strength, fcm_index n)
+{
+  if (strength < 0 || strength > FCM_SIMPLIFY_MAX_STRENGTH || n < 0) return 0.0;
+  const double M = fcm__simplify_num_basis(strength), N = (double)n;
+  return N > M ? 2.5e-9 * N * M + 6.6e-10 * M * M * M : 0.0;
+}
+
 void fcm_simplify_result_destroy(fcm_simplify_result *res)
 {
   if (!res) return;

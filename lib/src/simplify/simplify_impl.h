@@ -44,6 +44,11 @@ void fcm__simplify_basis_eval(const fcm__cheb_box *box, const double *x, double 
 /* Doubles of scratch fcm__simplify_moments needs at strength m. */
 size_t fcm__simplify_moments_scratch(int m);
 
+/* phi (M x n, column j = phi(points[j]), the order of fcm__simplify_basis_eval) by the same
+ * blocked tensor products; work: fcm__simplify_moments_scratch(m) doubles. */
+void fcm__simplify_basis_points(const fcm__cheb_box *box, int n, const double *points, double *phi,
+                                double *work);
+
 /* mom[0..M) = sum_i w[i] phi(points[idx[i]]) over i < n (idx NULL: points[i]). Uses the
  * tensor structure of the basis: per block of points, the products T_a(x) T_b(y) and
  * w T_c(z) and one matrix product (BLAS dgemm) for all (a, b, c). work: scratch of
