@@ -18,6 +18,7 @@
 #include "fcm/scene.h"
 #include "fcm/simulation.h"
 #include "fcm/solve.h"
+#include "fcm/surface.h"
 #include "fcm/simplify.h"
 #include "fcm/version.h"
 
