@@ -9,3 +9,6 @@ fcm_add_test(geom_reader_limits tests/geom/reader_limits.c)
 # Allocation failures: geometry from arrays and Gmsh files, AABB tree build and query.
 fcm_add_test(geom_alloc_failure tests/geom/alloc_failure.c)
 fcm_add_test(geom_boundary_cells tests/geom/boundary_cells.c)
+# Triangle surfaces: the unit cube in OBJ, OFF, STL (ASCII, binary) and PLY (ascii, binary)
+# round trips; malformed files fail naming file and line or byte offset.
+fcm_add_test(geom_surface tests/geom/surface.c)

@@ -39,8 +39,7 @@ FCM_API fcm_status fcm_surface_create(fcm_ctx *ctx, fcm_index num_vertices, cons
  *         message names the file and the line, or the byte offset of binary data, and
  *         what was expected); FCM_ERR_ALLOC. Allocates; release with
  *         fcm_surface_destroy(). Thread safe. */
-FCM_API fcm_status fcm_surface_create_from_file(fcm_ctx *ctx, const char *path,
-                                                fcm_surface **surf);
+FCM_API fcm_status fcm_surface_create_from_file(fcm_ctx *ctx, const char *path, fcm_surface **surf);
 
 /** Release a surface and set *surf to NULL; accepts NULL and *surf == NULL. */
 FCM_API void fcm_surface_destroy(fcm_surface **surf);

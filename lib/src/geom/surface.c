@@ -136,8 +136,8 @@ fcm_status fcm_surface_create(fcm_ctx *ctx, fcm_index num_vertices, const double
   FCM_CHECK(ctx && coords && tris, ctx, FCM_ERR_ARG,
             "surface: NULL argument (ctx, coords and tris are required)");
   FCM_CHECK(num_vertices > 0 && num_triangles > 0, ctx, FCM_ERR_ARG,
-            "surface: %lld vertices and %lld triangles (both must be > 0)",
-            (long long)num_vertices, (long long)num_triangles);
+            "surface: %lld vertices and %lld triangles (both must be > 0)", (long long)num_vertices,
+            (long long)num_triangles);
   for (fcm_index i = 0; i < 3 * num_vertices; i++)
     FCM_CHECK(isfinite(coords[i]), ctx, FCM_ERR_ARG,
               "surface: coordinate %d of vertex %lld is not finite", (int)(i % 3),

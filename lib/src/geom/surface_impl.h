@@ -24,7 +24,7 @@ struct fcm_surface {
 typedef struct fcm__sbuild {
   fcm_ctx *ctx;
   const char *path;
-  double *x; /* nv x 3 */
+  double *x;    /* nv x 3 */
   fcm_index *t; /* nt x 3 */
   size_t nv, nt, capv, capt;
 } fcm__sbuild;

@@ -106,8 +106,8 @@ cleanup:
 static fcm_status text_int(text *T, const char *what, long long lo, long long hi, long long *v)
 {
   fcm_status st = FCM_OK;
-  FCM_CHECK(tok_any(T), T->ctx, FCM_ERR_FORMAT, "surface: %s:%ld: expected %s, got the end of the file",
-            T->path, T->line, what);
+  FCM_CHECK(tok_any(T), T->ctx, FCM_ERR_FORMAT,
+            "surface: %s:%ld: expected %s, got the end of the file", T->path, T->line, what);
   FCM_CHECK(parse_int(T->tok, v), T->ctx, FCM_ERR_FORMAT,
             "surface: %s:%ld: expected %s (an integer), got \"%s\"", T->path, T->line, what,
             T->tok);
@@ -151,8 +151,9 @@ fcm_status fcm__surface_read_obj(fcm__sbuild *B, char *buf, size_t len)
         errno = 0;
         long long v = strtoll(T.tok, &end, 10);
         FCM_CHECK(errno == 0 && end != T.tok && (*end == '\0' || *end == '/'), B->ctx,
-                  FCM_ERR_FORMAT, "surface: %s:%ld: expected a vertex index after \"f\", got \"%s\"",
-                  T.path, T.line, T.tok);
+                  FCM_ERR_FORMAT,
+                  "surface: %s:%ld: expected a vertex index after \"f\", got \"%s\"", T.path,
+                  T.line, T.tok);
         long long nv = (long long)B->nv, id = v > 0 ? v - 1 : nv + v;
         FCM_CHECK(v != 0 && id >= 0 && id < nv, B->ctx, FCM_ERR_FORMAT,
                   "surface: %s:%ld: vertex index %lld outside [1, %lld] (or [-%lld, -1] relative)",
@@ -182,8 +183,8 @@ fcm_status fcm__surface_read_off(fcm__sbuild *B, char *buf, size_t len)
   /* a vertex needs at least "x y z\n" (6 bytes), a face "3 a b c\n" (8 bytes) */
   FCM_TRY(B->ctx, text_int(&T, "the vertex count (bounded by the file size)", 0,
                            (long long)(len / 6), &nv));
-  FCM_TRY(B->ctx, text_int(&T, "the face count (bounded by the file size)", 0,
-                           (long long)(len / 8), &nf));
+  FCM_TRY(B->ctx,
+          text_int(&T, "the face count (bounded by the file size)", 0, (long long)(len / 8), &nf));
   FCM_TRY(B->ctx, text_int(&T, "the edge count", 0, (long long)len, &ne));
   next_line(&T);
   for (long long i = 0; i < nv; i++) {
@@ -195,8 +196,8 @@ fcm_status fcm__surface_read_off(fcm__sbuild *B, char *buf, size_t len)
   }
   for (long long i = 0; i < nf; i++) {
     fcm_index first = -1, prev = -1;
-    FCM_TRY(B->ctx, text_int(&T, "the vertex count of a face (at least 3)", 3,
-                             (long long)(len / 2), &k));
+    FCM_TRY(B->ctx,
+            text_int(&T, "the vertex count of a face (at least 3)", 3, (long long)(len / 2), &k));
     for (long long j = 0; j < k; j++) {
       FCM_TRY(B->ctx, text_int(&T, "a vertex index of a face", 0, nv - 1, &id));
       if (j == 0) first = (fcm_index)id;
@@ -366,13 +367,27 @@ static fcm_status ply_value(fcm__sbuild *B, ply *P, int type, const char *what, 
               "surface: %s: byte %zu: expected %s (%s), got the end of the file", B->path, P->off,
               what, ply_types[type].name);
     switch (type) {
-    case 0: *v = (double)(int8_t)q[0]; break;
-    case 1: *v = (double)q[0]; break;
-    case 2: *v = (double)(int16_t)(uint16_t)(q[0] | q[1] << 8); break;
-    case 3: *v = (double)(uint16_t)(q[0] | q[1] << 8); break;
-    case 4: *v = (double)(int32_t)le32(q); break;
-    case 5: *v = (double)le32(q); break;
-    case 6: *v = (double)lef32(q); break;
+    case 0:
+      *v = (double)(int8_t)q[0];
+      break;
+    case 1:
+      *v = (double)q[0];
+      break;
+    case 2:
+      *v = (double)(int16_t)(uint16_t)(q[0] | q[1] << 8);
+      break;
+    case 3:
+      *v = (double)(uint16_t)(q[0] | q[1] << 8);
+      break;
+    case 4:
+      *v = (double)(int32_t)le32(q);
+      break;
+    case 5:
+      *v = (double)le32(q);
+      break;
+    case 6:
+      *v = (double)lef32(q);
+      break;
     default: {
       uint64_t u = (uint64_t)le32(q) | (uint64_t)le32(q + 4) << 32;
       memcpy(v, &u, sizeof *v);
@@ -431,8 +446,8 @@ static fcm_status ply_header(fcm__sbuild *B, ply *P, plyel *E, int *ne)
                 "surface: %s:%ld: expected the format ascii or binary_little_endian", B->path,
                 T->line);
     } else if (strcmp(T->tok, "element") == 0) {
-      FCM_CHECK(*ne < PLY_MAXE, B->ctx, FCM_ERR_FORMAT,
-                "surface: %s:%ld: more than %d elements", B->path, T->line, PLY_MAXE);
+      FCM_CHECK(*ne < PLY_MAXE, B->ctx, FCM_ERR_FORMAT, "surface: %s:%ld: more than %d elements",
+                B->path, T->line, PLY_MAXE);
       plyel *e = &E[(*ne)++];
       memset(e, 0, sizeof *e);
       FCM_CHECK(tok_line(T), B->ctx, FCM_ERR_FORMAT, "surface: %s:%ld: expected an element name",
@@ -440,11 +455,11 @@ static fcm_status ply_header(fcm__sbuild *B, ply *P, plyel *E, int *ne)
       snprintf(e->name, sizeof e->name, "%.31s", T->tok);
       e->kind = strcmp(T->tok, "vertex") == 0 ? 1 : strcmp(T->tok, "face") == 0 ? 2 : 0;
       FCM_CHECK(tok_line(T) && parse_int(T->tok, &e->count) && e->count >= 0, B->ctx,
-                FCM_ERR_FORMAT, "surface: %s:%ld: expected the count of element %s (>= 0)",
-                B->path, T->line, e->name);
+                FCM_ERR_FORMAT, "surface: %s:%ld: expected the count of element %s (>= 0)", B->path,
+                T->line, e->name);
     } else if (strcmp(T->tok, "property") == 0) {
-      FCM_CHECK(*ne > 0, B->ctx, FCM_ERR_FORMAT,
-                "surface: %s:%ld: property before any element", B->path, T->line);
+      FCM_CHECK(*ne > 0, B->ctx, FCM_ERR_FORMAT, "surface: %s:%ld: property before any element",
+                B->path, T->line);
       plyel *e = &E[*ne - 1];
       FCM_CHECK(e->np < PLY_MAXP, B->ctx, FCM_ERR_FORMAT,
                 "surface: %s:%ld: more than %d properties in element %s", B->path, T->line,
@@ -456,8 +471,8 @@ static fcm_status ply_header(fcm__sbuild *B, ply *P, plyel *E, int *ne)
         got = tok_line(T);
         p->ltype = got ? ply_type(T->tok) : -1;
         FCM_CHECK(p->ltype >= 0 && ply_types[p->ltype].is_int, B->ctx, FCM_ERR_FORMAT,
-                  "surface: %s:%ld: expected an integer list count type (uchar, int, ...)",
-                  B->path, T->line);
+                  "surface: %s:%ld: expected an integer list count type (uchar, int, ...)", B->path,
+                  T->line);
         got = tok_line(T);
       }
       p->type = got ? ply_type(T->tok) : -1;
@@ -467,8 +482,7 @@ static fcm_status ply_header(fcm__sbuild *B, ply *P, plyel *E, int *ne)
                 B->path, T->line);
       FCM_CHECK(tok_line(T), B->ctx, FCM_ERR_FORMAT, "surface: %s:%ld: expected a property name",
                 B->path, T->line);
-      if (e->kind == 1 && p->ltype < 0 && T->tok[1] == '\0' && T->tok[0] >= 'x' &&
-          T->tok[0] <= 'z')
+      if (e->kind == 1 && p->ltype < 0 && T->tok[1] == '\0' && T->tok[0] >= 'x' && T->tok[0] <= 'z')
         p->role = ROLE_X + (T->tok[0] - 'x');
       if (e->kind == 2 && p->ltype >= 0 &&
           (strcmp(T->tok, "vertex_indices") == 0 || strcmp(T->tok, "vertex_index") == 0)) {
@@ -521,8 +535,8 @@ fcm_status fcm__surface_read_ply(fcm__sbuild *B, char *buf, size_t len)
     plyel *e = &E[i];
     size_t rec = 0, left = len - P.off; /* smallest record: lists of 0 items */
     for (int j = 0; j < e->np; j++)
-      rec += P.binary ? (size_t)ply_types[e->p[j].ltype >= 0 ? e->p[j].ltype : e->p[j].type].size
-                      : 2;
+      rec +=
+          P.binary ? (size_t)ply_types[e->p[j].ltype >= 0 ? e->p[j].ltype : e->p[j].type].size : 2;
     ply_where(&P, where, sizeof where);
     FCM_CHECK(rec > 0 && (unsigned long long)e->count <= left / rec, B->ctx, FCM_ERR_FORMAT,
               "surface: %s: %s: element %s declares %lld records of at least %zu bytes, but "
