@@ -1,16 +1,17 @@
 #!/usr/bin/env bash
 # Seed corpora of the fuzz targets: make_corpus.sh BUILD_DIR OUT_DIR writes OUT_DIR/gmsh,
-# tetgen, scene and checkpoint with small valid inputs of each format: MSH 4.1 and 2.2 files
+# tetgen, surface, scene and checkpoint with small valid inputs of each format: MSH 4.1 and 2.2 files
 # of every supported element type with skipped sections and boundary elements, TetGen pairs
 # (0- and 1-based, attributes, markers, comments; .node NUL .ele, as fcm-fuzz-tetgen reads
-# them), the example scenes and the built-in default, and checkpoints of the checkpoint
+# them), surfaces (a format byte, then an OBJ, OFF, STL or PLY file, as fcm-fuzz-surface
+# reads them), the example scenes and the built-in default, and checkpoints of the checkpoint
 # target's scene written by BUILD_DIR/fcm-fuzz-seed-checkpoint (a build with -DFCM_FUZZ=ON).
 set -euo pipefail
-[ $# -eq 2 ] || { sed -n '2,7p' "$0"; exit 2; }
+[ $# -eq 2 ] || { sed -n '2,8p' "$0"; exit 2; }
 build=$1
 out=$2
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
-mkdir -p "$out/gmsh" "$out/tetgen" "$out/scene" "$out/checkpoint"
+mkdir -p "$out/gmsh" "$out/tetgen" "$out/scene" "$out/checkpoint" "$out/surface"
 
 # ---------------------------------------------------------------- Gmsh MSH
 cat > "$out/gmsh/hex8_v22.msh" <<'EOF'
@@ -173,6 +174,22 @@ cat > "$out/scene/small.json" <<'EOF'
   {"initial_velocity": {"angular_velocity": [0, 0, 3]}}]}
 EOF
 echo '{"version": 1}' > "$out/scene/minimal.json"
+
+# ---------------------------------------------------------------- surfaces (format byte + file)
+surface() { # name format-byte(0 obj, 1 off, 2 stl, 3 ply) printf-format [args]
+  local name=$1 fmt=$2
+  shift 2
+  { printf "\\$(printf '%03o' "$fmt")"; printf "$@"; } > "$out/surface/$name"
+}
+surface tet_obj 0 '# tet\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvn 0 0 1\ng a\nf 1 3 2\nf 1/1 2/1 4/1\nf 1//1 4//1 3//1\nf -3 -2 -1\n'
+surface quad_obj 0 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl m\ns 1\nf 1 2 3 4\n'
+surface tet_off 1 'OFF\n# tet\n4 4 6\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n'
+surface quad_off 1 'OFF 4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3 255 0 0\n'
+surface tri_stl 2 'solid t\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 0\n  vertex 0 1 0\n endloop\nendfacet\nfacet normal 0 0 1\n outer loop\n  vertex 1 0 0\n  vertex 1 1 0\n  vertex 0 1 0\n endloop\nendfacet\nendsolid t\n'
+z4='\000\000\000\000' o4='\000\000\200\077' # float 0 and 1, little endian
+surface tri_stl_bin 2 "solid binary%68s\001\000\000\000$z4$z4$o4$z4$z4$z4$o4$z4$z4$z4$o4$z4\000\000" ''
+surface quad_ply 3 'ply\nformat ascii 1.0\ncomment q\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 1\n1 0 0 2\n1 1 0 3\n0 1 0 4\n4 0 1 2 3\n'
+surface tri_ply_bin 3 "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n$z4$z4$z4$o4$z4$z4$z4$o4$z4\003$z4\001\000\000\000\002\000\000\000"
 
 # ---------------------------------------------------------------- checkpoints
 "$build/fcm-fuzz-seed-checkpoint" "$out/checkpoint"
