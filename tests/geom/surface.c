@@ -101,6 +101,8 @@ static void cube_stl_ascii(const char *path)
       n += snprintf(s + n, sizeof s - (size_t)n, "      vertex %g %g %g\n", corner(v[j], 0),
                     corner(v[j], 1), corner(v[j], 2));
     n += snprintf(s + n, sizeof s - (size_t)n, "    endloop\n  endfacet\n");
+    if (t == 5) /* the second half in a second solid */
+      n += snprintf(s + n, sizeof s - (size_t)n, "endsolid cube\n\nsolid second half\n");
   }
   snprintf(s + n, sizeof s - (size_t)n, "endsolid cube\n");
   write_text(path, s);
@@ -150,10 +152,11 @@ static void cube_ply_ascii(const char *path)
   int n = snprintf(s, sizeof s,
                    "ply\nformat ascii 1.0\ncomment unit cube\nelement vertex 8\n"
                    "property float x\nproperty uchar red\nproperty float y\nproperty double z\n"
+                   "property float quality\n"
                    "element face 6\nproperty list uchar int vertex_indices\nproperty int flags\n"
                    "element edge 1\nproperty list int int ids\nproperty float w\nend_header\n");
   for (int i = 0; i < 8; i++)
-    n += snprintf(s + n, sizeof s - (size_t)n, "%g 255 %g %g\n", corner(i, 0), corner(i, 1),
+    n += snprintf(s + n, sizeof s - (size_t)n, "%g 255 %g %g nan\n", corner(i, 0), corner(i, 1),
                   corner(i, 2));
   for (int f = 0; f < 6; f++)
     n += snprintf(s + n, sizeof s - (size_t)n, "4 %d %d %d %d 7\n", quads[f][0], quads[f][1],
@@ -272,7 +275,11 @@ int main(void)
     TEST_TRUE(f && fwrite("xxxxx", 1, 5, f) == 5);
     if (f) fclose(f);
   }
+  cube_stl_binary("sf_trunc_solid.stl", 84 + 50 * 12 - 1, 0); /* header "solid ..." */
   cube_stl_binary("sf_nan.stl", 84 + 50 * 12, NAN);
+  write_text("sf_nan.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+                           "property float y\nproperty float z\nend_header\n0 inf 0\n");
+  write_text("sf_two.stl", "solid a\nendsolid a\nfacet normal 0 0 1\n");
   write_text("sf_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
   write_text("sf_rel.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n");
   write_text("sf_nan.obj", "v 0 0 0\nv nan 0 0\n");
@@ -301,6 +308,10 @@ int main(void)
     const char *msg;
   } bad[] = {
       {"sf_trunc.stl", FCM_ERR_FORMAT, "sf_trunc.stl: byte 80: binary STL declares 12 triangles"},
+      {"sf_trunc_solid.stl", FCM_ERR_FORMAT, "sf_trunc_solid.stl: byte 80: binary STL declares 12"},
+      {"sf_nan.ply", FCM_ERR_FORMAT,
+       "sf_nan.ply:8: expected a vertex coordinate (a finite number), got \"inf\""},
+      {"sf_two.stl", FCM_ERR_FORMAT, "sf_two.stl:3: expected \"solid\" or the end of the file"},
       {"sf_nan.stl", FCM_ERR_FORMAT, "sf_nan.stl: byte 96: expected a finite vertex coordinate"},
       {"sf_index.obj", FCM_ERR_FORMAT, "sf_index.obj:4: vertex index 9 outside [1, 3]"},
       {"sf_rel.obj", FCM_ERR_FORMAT, "sf_rel.obj:4: vertex index -4 outside"},

@@ -236,7 +236,15 @@ static fcm_status stl_ascii(fcm__sbuild *B, char *buf, size_t len)
     FCM_CHECK(tok_any(&T), B->ctx, FCM_ERR_FORMAT,
               "surface: %s:%ld: expected \"facet\" or \"endsolid\", got the end of the file",
               T.path, T.line);
-    if (strcmp(T.tok, "endsolid") == 0) break;
+    if (strcmp(T.tok, "endsolid") == 0) { /* another solid may follow */
+      next_line(&T);
+      if (!tok_any(&T)) break;
+      FCM_CHECK(strcmp(T.tok, "solid") == 0, B->ctx, FCM_ERR_FORMAT,
+                "surface: %s:%ld: expected \"solid\" or the end of the file, got \"%s\"", T.path,
+                T.line, T.tok);
+      next_line(&T);
+      continue;
+    }
     FCM_CHECK(strcmp(T.tok, "facet") == 0, B->ctx, FCM_ERR_FORMAT,
               "surface: %s:%ld: expected \"facet\" or \"endsolid\", got \"%s\"", T.path, T.line,
               T.tok);
@@ -299,7 +307,7 @@ fcm_status fcm__surface_read_stl(fcm__sbuild *B, char *buf, size_t len)
   int solid = len - lead >= 5 && memcmp(buf + lead, "solid", 5) == 0;
   if (len >= 84 && 84 + 50 * (unsigned long long)le32(b + 80) == len) {
     FCM_TRY(B->ctx, stl_binary(B, b, len));
-  } else if (solid) {
+  } else if (solid && (len < 84 || !memchr(buf, '\0', len))) { /* ASCII has no NUL byte */
     FCM_TRY(B->ctx, stl_ascii(B, buf, len));
   } else {
     FCM_CHECK(len >= 84, B->ctx, FCM_ERR_FORMAT,
@@ -357,7 +365,8 @@ static int ply_type(const char *t)
 }
 
 /* One value of `type`; `what` names it in messages. */
-static fcm_status ply_value(fcm__sbuild *B, ply *P, int type, const char *what, double *v)
+static fcm_status ply_value(fcm__sbuild *B, ply *P, int type, int finite, const char *what,
+                            double *v)
 {
   fcm_status st = FCM_OK;
   if (P->binary) {
@@ -393,12 +402,18 @@ static fcm_status ply_value(fcm__sbuild *B, ply *P, int type, const char *what, 
       memcpy(v, &u, sizeof *v);
     }
     }
-    FCM_CHECK(isfinite(*v), B->ctx, FCM_ERR_FORMAT,
+    FCM_CHECK(!finite || isfinite(*v), B->ctx, FCM_ERR_FORMAT,
               "surface: %s: byte %zu: expected %s (a finite %s), got %g", B->path, P->off, what,
               ply_types[type].name, *v);
     P->off += (size_t)sz;
   } else {
-    FCM_TRY(B->ctx, text_num(&P->T, 1, what, v));
+    char *end;
+    FCM_CHECK(tok_any(&P->T), B->ctx, FCM_ERR_FORMAT,
+              "surface: %s:%ld: expected %s, got the end of the file", B->path, P->T.line, what);
+    *v = strtod(P->T.tok, &end);
+    FCM_CHECK(end != P->T.tok && *end == '\0' && (!finite || isfinite(*v)), B->ctx, FCM_ERR_FORMAT,
+              "surface: %s:%ld: expected %s (a %snumber), got \"%s\"", B->path, P->T.line, what,
+              finite ? "finite " : "", P->T.tok);
     FCM_CHECK(!ply_types[type].is_int || *v == floor(*v), B->ctx, FCM_ERR_FORMAT,
               "surface: %s:%ld: expected %s (an integer, %s), got \"%s\"", B->path, P->T.line, what,
               ply_types[type].name, P->T.tok);
@@ -548,20 +563,22 @@ fcm_status fcm__surface_read_ply(fcm__sbuild *B, char *buf, size_t len)
         const plyprop *q = &e->p[j];
         double v;
         if (q->ltype < 0) {
-          FCM_TRY(B->ctx, ply_value(B, &P, q->type, "a property value", &v));
-          if (q->role >= ROLE_X && q->role <= ROLE_Z) p[q->role - ROLE_X] = v;
+          int coord = q->role >= ROLE_X && q->role <= ROLE_Z;
+          FCM_TRY(B->ctx, ply_value(B, &P, q->type, coord,
+                                    coord ? "a vertex coordinate" : "a property value", &v));
+          if (coord) p[q->role - ROLE_X] = v;
           continue;
         }
         double c;
         ply_where(&P, where, sizeof where);
-        FCM_TRY(B->ctx, ply_value(B, &P, q->ltype, "a list count", &c));
+        FCM_TRY(B->ctx, ply_value(B, &P, q->ltype, 1, "a list count", &c));
         FCM_CHECK(c >= 0 && (q->role != ROLE_INDICES || c >= 3), B->ctx, FCM_ERR_FORMAT,
                   "surface: %s: %s: face %lld has %g vertices (expected at least 3)", B->path,
                   where, r, c);
         fcm_index first = -1, prev = -1;
         for (double k = 0; k < c; k++) {
           ply_where(&P, where, sizeof where);
-          FCM_TRY(B->ctx, ply_value(B, &P, q->type, "a list item", &v));
+          FCM_TRY(B->ctx, ply_value(B, &P, q->type, q->role == ROLE_INDICES, "a list item", &v));
           if (q->role != ROLE_INDICES) continue;
           FCM_CHECK(v >= 0 && v < (double)nv, B->ctx, FCM_ERR_FORMAT,
                     "surface: %s: %s: vertex index %g outside [0, %lld)", B->path, where, v, nv);
