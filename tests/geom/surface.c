@@ -73,12 +73,12 @@ static void cube_obj(const char *path)
 static void cube_off(const char *path)
 {
   char s[1024];
-  int n = snprintf(s, sizeof s, "OFF\n# counts\n8 6 12\n");
-  for (int i = 0; i < 8; i++)
-    n += snprintf(s + n, sizeof s - (size_t)n, "%g %g %g\n", corner(i, 0), corner(i, 1),
-                  corner(i, 2));
+  int n = snprintf(s, sizeof s, "COFF\n# counts\n8 6 12\n");
+  for (int i = 0; i < 8; i++) /* with a colour per vertex and per face */
+    n += snprintf(s + n, sizeof s - (size_t)n, "%g %g %g 0.5 0.5 0.5 1\n", corner(i, 0),
+                  corner(i, 1), corner(i, 2));
   for (int f = 0; f < 6; f++)
-    n += snprintf(s + n, sizeof s - (size_t)n, "4 %d %d %d %d\n", quads[f][0], quads[f][1],
+    n += snprintf(s + n, sizeof s - (size_t)n, "4 %d %d %d %d 255 0 0\n", quads[f][0], quads[f][1],
                   quads[f][2], quads[f][3]);
   write_text(path, s);
 }
@@ -286,6 +286,7 @@ int main(void)
   write_text("sf_empty.obj", "# nothing\nv 0 0 0\n");
   write_text("sf_face2.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n");
   write_text("sf_neg.off", "OFF\n-3 1 0\n");
+  write_text("sf_4d.off", "4OFF\n1 1 0\n");
   write_text("sf_huge.off", "OFF\n1000000000000 1 0\n0 0 0\n");
   write_text("sf_index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n");
   write_text("sf_huge.ply", "ply\nformat ascii 1.0\nelement vertex 1000000000000\n"
@@ -318,6 +319,7 @@ int main(void)
       {"sf_nan.obj", FCM_ERR_FORMAT, "sf_nan.obj:2: expected a vertex coordinate after \"v\""},
       {"sf_empty.obj", FCM_ERR_FORMAT, "sf_empty.obj: empty mesh (1 vertices, 0 triangles)"},
       {"sf_face2.obj", FCM_ERR_FORMAT, "sf_face2.obj:3: face with 2 vertices"},
+      {"sf_4d.off", FCM_ERR_FORMAT, "sf_4d.off:1: expected the header \"OFF\""},
       {"sf_neg.off", FCM_ERR_FORMAT, "sf_neg.off:2: the vertex count"},
       {"sf_huge.off", FCM_ERR_FORMAT, "sf_huge.off:2: the vertex count (bounded by the file size)"},
       {"sf_index.off", FCM_ERR_FORMAT,

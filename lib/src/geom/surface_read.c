@@ -179,7 +179,16 @@ fcm_status fcm__surface_read_off(fcm__sbuild *B, char *buf, size_t len)
   text T;
   long long nv = 0, nf = 0, ne = 0, k = 0, id = 0;
   text_init(&T, B, buf, len, '#');
-  FCM_TRY(B->ctx, text_word(&T, "OFF"));
+  int got = tok_any(&T);
+  const char *h = T.tok; /* OFF, with the optional prefixes ST, C and N (per-vertex data
+                            after x y z, skipped) */
+  if (strncmp(h, "ST", 2) == 0) h += 2;
+  if (*h == 'C') h++;
+  if (*h == 'N') h++;
+  FCM_CHECK(
+      got && strcmp(h, "OFF") == 0, B->ctx, FCM_ERR_FORMAT,
+      "surface: %s:%ld: expected the header \"OFF\" (or COFF, NOFF, CNOFF, STOFF), got %s%s%s",
+      T.path, T.line, got ? "\"" : "the end of the file", got ? T.tok : "", got ? "\"" : "");
   /* a vertex needs at least "x y z\n" (6 bytes), a face "3 a b c\n" (8 bytes) */
   FCM_TRY(B->ctx, text_int(&T, "the vertex count (bounded by the file size)", 0,
                            (long long)(len / 6), &nv));
