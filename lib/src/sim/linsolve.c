@@ -120,18 +120,7 @@ static fcm_status pc_matrix(fcm_integrator *I, fcm_csr **P, fcm_step_reason *rea
   fcm_csr_get_size(I->Hpc, NULL, NULL, &nnz);
   double *pv = fcm_csr_values(I->Hpc);
   const double h = I->key_h;
-  if (h > 0.0) { /* base(h) = M/h^2 + D/h, as newton.c's set_base */
-    const double *mv = fcm_csr_values(I->M), a = 1.0 / (h * h);
-    for (fcm_index e = 0; e < nnz; e++)
-      pv[e] = a * mv[e];
-    if (I->D) {
-      const double *dv = fcm_csr_values(I->D);
-      for (fcm_index e = 0; e < nnz; e++)
-        pv[e] += dv[e] / h;
-    }
-  } else {
-    memset(pv, 0, sizeof *pv * (size_t)nnz);
-  }
+  fcm__sim_set_base(I, h, I->Hpc);
   if (tm == FCM_FICTITIOUS_LINEAR) {
     if (!I->K0) { /* kept only when complete */
       fcm_linear_form form = fcm_linear_form_default();

@@ -39,25 +39,22 @@ static int all_finite(fcm_index n, const double *a)
   return 1;
 }
 
-/* H = M/h^2 + D/h (dynamics) or 0 (static): the part of the Newton matrix the material
- * tangent is added to. */
-static void set_base(fcm_integrator *I, double h)
+void fcm__sim_set_base(const fcm_integrator *I, double h, fcm_csr *A)
 {
   fcm_index nnz = 0;
-  fcm_csr_get_size(I->H, NULL, NULL, &nnz);
-  double *hv = fcm_csr_values(I->H);
+  fcm_csr_get_size(A, NULL, NULL, &nnz);
+  double *v = fcm_csr_values(A);
   if (h > 0.0) {
-    const double *mv = fcm_csr_values(I->M);
-    double a = 1.0 / (h * h);
+    const double *mv = fcm_csr_values_read(I->M), a = 1.0 / (h * h);
     for (fcm_index e = 0; e < nnz; e++)
-      hv[e] = a * mv[e];
+      v[e] = a * mv[e];
     if (I->D) {
-      const double *dv = fcm_csr_values(I->D);
+      const double *dv = fcm_csr_values_read(I->D);
       for (fcm_index e = 0; e < nnz; e++)
-        hv[e] += dv[e] / h;
+        v[e] += dv[e] / h;
     }
   } else {
-    memset(hv, 0, sizeof *hv * (size_t)nnz);
+    memset(v, 0, sizeof *v * (size_t)nnz);
   }
 }
 
@@ -83,7 +80,7 @@ static fcm_status assemble(fcm_integrator *I, const fcm_material_params *p, cons
 static fcm_status assemble_tangent(fcm_integrator *I, double h, const double *x, int projected,
                                    int *finite, sim_stats *stats)
 {
-  set_base(I, h);
+  fcm__sim_set_base(I, h, I->H);
   return assemble(I, projected ? &I->params_psd : &I->params, x, NULL, NULL, I->H, finite, stats);
 }
 
@@ -103,7 +100,7 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
   double psi = 0.0, inertia = 0.0, damp = 0.0, wext;
   out->finite = 1;
   memset(fint, 0, sizeof *fint * (size_t)n);
-  if (tangent) set_base(I, h);
+  if (tangent) fcm__sim_set_base(I, h, I->H);
   FCM_TRY(I->ctx,
           assemble(I, &I->params, x, &psi, fint, tangent ? I->H : NULL, &out->finite, stats));
   if (!out->finite) return FCM_OK;

@@ -125,6 +125,11 @@ long long fcm__sim_analyses(const fcm_integrator *I);
 /* External load at time t: sum_k scale_k(t) f_k into f (n). (integrator.c) */
 void fcm__sim_eval_loads(const fcm_integrator *I, double t, double *f);
 
+/* A = M/h^2 + D/h (dynamics, h > 0) or 0 (static): the part of the Newton matrix (and of the
+ * preconditioner's matrix) the material tangent is added to; A has the pattern of M.
+ * (newton.c) */
+void fcm__sim_set_base(const fcm_integrator *I, double h, fcm_csr *A);
+
 /* Active constraint set and prescribed values at time t (act_dof, act_val; con_version
  * bumps when the set changes). (integrator.c) */
 void fcm__sim_eval_constraints(fcm_integrator *I, double t);
