@@ -246,6 +246,7 @@ int main(void)
   fcm_ctx *ctx = NULL;
   if (fcm_ctx_create(&o, &ctx) != FCM_OK) return 1;
   fcm_surface *s = NULL;
+  char bin_index_msg[128];
 
   cube_obj("sf_cube.obj");
   cube_off("sf_cube.OFF"); /* the extension is case-insensitive */
@@ -291,6 +292,27 @@ int main(void)
   write_text("sf_index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n");
   write_text("sf_huge.ply", "ply\nformat ascii 1.0\nelement vertex 1000000000000\n"
                             "property float x\nproperty float y\nproperty float z\nend_header\n");
+  write_text("sf_index.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                             "property float y\nproperty float z\nelement face 1\n"
+                             "property list uchar int vertex_indices\nend_header\n"
+                             "0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n");
+  { /* binary: the third index (7) at byte strlen(header) + 36 + 1 + 8 */
+    const char *h = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+                    "property float y\nproperty float z\nelement face 1\n"
+                    "property list uchar int vertex_indices\nend_header\n";
+    unsigned char b[512] = {0};
+    size_t n = strlen(h);
+    memcpy(b, h, n);
+    b[n + 36] = 3;
+    put32(b + n + 37, 0), put32(b + n + 41, 1), put32(b + n + 45, 7);
+    write_bytes("sf_index_b.ply", b, n + 49);
+    snprintf(bin_index_msg, sizeof bin_index_msg,
+             "sf_index_b.ply: byte %zu: vertex index 7 outside [0, 3)", n + 45);
+  }
+  write_text("sf_face2.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                             "property float y\nproperty float z\nelement face 1\n"
+                             "property list uchar int vertex_indices\nend_header\n"
+                             "0 0 0\n1 0 0\n0 1 0\n2 0 1\n");
   write_text("sf_big.ply", "ply\nformat binary_big_endian 1.0\nend_header\n");
   write_text("sf_noface.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
                               "property float y\nend_header\n0 0\n");
@@ -324,7 +346,11 @@ int main(void)
       {"sf_huge.off", FCM_ERR_FORMAT, "sf_huge.off:2: the vertex count (bounded by the file size)"},
       {"sf_index.off", FCM_ERR_FORMAT,
        "sf_index.off:6: a vertex index of a face = 3 outside [0, 2]"},
-      {"sf_huge.ply", FCM_ERR_FORMAT, "sf_huge.ply: line 8: element vertex declares 1000000000000"},
+      {"sf_huge.ply", FCM_ERR_FORMAT, "sf_huge.ply:8: element vertex declares 1000000000000"},
+      {"sf_index.ply", FCM_ERR_FORMAT, "sf_index.ply:13: vertex index 5 outside [0, 3)"},
+      {"sf_index_b.ply", FCM_ERR_FORMAT, bin_index_msg},
+      {"sf_face2.ply", FCM_ERR_FORMAT,
+       "sf_face2.ply:13: record 0 of element face has a list of 2 items (expected at least 3"},
       {"sf_big.ply", FCM_ERR_UNSUPPORTED, "sf_big.ply:2: binary_big_endian"},
       {"sf_noface.ply", FCM_ERR_FORMAT, "sf_noface.ply: the vertex element lacks"},
       {"sf_short.ply", FCM_ERR_FORMAT, "sf_short.ply: empty mesh"},

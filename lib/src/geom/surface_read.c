@@ -431,13 +431,17 @@ cleanup:
   return st;
 }
 
-/* Where the next value is, for messages: "line N" or "byte N". */
-static void ply_where(const ply *P, char *s, size_t n)
+/* Where the next value is, for messages: "path:line" (ascii) or "path: byte N" (binary). */
+static void ply_where(const fcm__sbuild *B, const ply *P, char *s, size_t n)
 {
   if (P->binary)
-    snprintf(s, n, "byte %zu", P->off);
-  else
-    snprintf(s, n, "line %ld", P->T.line);
+    snprintf(s, n, "%s: byte %zu", B->path, P->off);
+  else { /* the line of the next token */
+    long line = P->T.line;
+    for (const char *c = P->T.p; c < P->T.end && (is_blank(*c) || *c == '\n'); c++)
+      line += *c == '\n';
+    snprintf(s, n, "%s:%ld", B->path, line);
+  }
 }
 
 static fcm_status ply_header(fcm__sbuild *B, ply *P, plyel *E, int *ne)
@@ -535,7 +539,7 @@ fcm_status fcm__surface_read_ply(fcm__sbuild *B, char *buf, size_t len)
   plyel *E = NULL;
   int ne = 0;
   long long nv = -1;
-  char where[64];
+  char where[1100];
   ply P = {.b = (const unsigned char *)buf, .len = len};
   text_init(&P.T, B, buf, len, '\0');
   FCM_ALLOC(B->ctx, PLY_MAXE, E);
@@ -561,11 +565,11 @@ fcm_status fcm__surface_read_ply(fcm__sbuild *B, char *buf, size_t len)
     for (int j = 0; j < e->np; j++)
       rec +=
           P.binary ? (size_t)ply_types[e->p[j].ltype >= 0 ? e->p[j].ltype : e->p[j].type].size : 2;
-    ply_where(&P, where, sizeof where);
+    ply_where(B, &P, where, sizeof where);
     FCM_CHECK(rec > 0 && (unsigned long long)e->count <= left / rec, B->ctx, FCM_ERR_FORMAT,
-              "surface: %s: %s: element %s declares %lld records of at least %zu bytes, but "
+              "surface: %s: element %s declares %lld records of at least %zu bytes, but "
               "%zu bytes are left",
-              B->path, where, e->name, e->count, rec, left);
+              where, e->name, e->count, rec, left);
     for (long long r = 0; r < e->count; r++) {
       double p[3] = {0, 0, 0};
       for (int j = 0; j < e->np; j++) {
@@ -579,18 +583,19 @@ fcm_status fcm__surface_read_ply(fcm__sbuild *B, char *buf, size_t len)
           continue;
         }
         double c;
-        ply_where(&P, where, sizeof where);
+        ply_where(B, &P, where, sizeof where);
         FCM_TRY(B->ctx, ply_value(B, &P, q->ltype, 1, "a list count", &c));
         FCM_CHECK(c >= 0 && (q->role != ROLE_INDICES || c >= 3), B->ctx, FCM_ERR_FORMAT,
-                  "surface: %s: %s: face %lld has %g vertices (expected at least 3)", B->path,
-                  where, r, c);
+                  "surface: %s: record %lld of element %s has a list of %g items (expected %s)",
+                  where, r, e->name, c,
+                  q->role == ROLE_INDICES ? "at least 3 vertex indices" : ">= 0");
         fcm_index first = -1, prev = -1;
         for (double k = 0; k < c; k++) {
-          ply_where(&P, where, sizeof where);
+          ply_where(B, &P, where, sizeof where);
           FCM_TRY(B->ctx, ply_value(B, &P, q->type, q->role == ROLE_INDICES, "a list item", &v));
           if (q->role != ROLE_INDICES) continue;
           FCM_CHECK(v >= 0 && v < (double)nv, B->ctx, FCM_ERR_FORMAT,
-                    "surface: %s: %s: vertex index %g outside [0, %lld)", B->path, where, v, nv);
+                    "surface: %s: vertex index %g outside [0, %lld)", where, v, nv);
           if (k == 0) first = (fcm_index)v;
           if (k >= 2) FCM_TRY(B->ctx, fcm__sbuild_triangle(B, first, prev, (fcm_index)v));
           prev = (fcm_index)v;
