@@ -37,7 +37,7 @@ static inline void fuzz_release_(void *user, void *p)
 static inline void fuzz_remove_dir_(void)
 {
   static const char *const names[] = {"in.msh", "in.node", "in.ele", "in.ckpt",
-                                             "in.obj", "in.off", "in.stl", "in.ply"};
+                                      "in.obj", "in.off",  "in.stl", "in.ply"};
   char path[sizeof fuzz_dir_ + 16];
   for (size_t k = 0; k < sizeof names / sizeof *names; k++) {
     snprintf(path, sizeof path, "%s/%s", fuzz_dir_, names[k]);

@@ -2,7 +2,8 @@
  * m x 3, 0-based) created from arrays or read from OBJ, OFF, STL (ASCII and binary) and
  * PLY (ASCII and binary little endian) files. Polygons are fan-triangulated; STL's
  * per-facet vertices are merged by exact coordinate equality. A surface is immutable
- * after creation; every const accessor is thread safe. */
+ * after creation; every const accessor is thread safe. A surface keeps its context, which
+ * must outlive it. */
 #ifndef FCM_SURFACE_H
 #define FCM_SURFACE_H
 
@@ -28,9 +29,14 @@ FCM_API fcm_status fcm_surface_create(fcm_ctx *ctx, fcm_index num_vertices, cons
                                       fcm_surface **surf);
 
 /** Read a surface from a file, the format chosen by the extension (case-insensitive):
- * .obj (v and f lines, f a, a/b, a//c, a/b/c and negative relative ids; other lines
- * ignored), .off, .stl (ASCII, or binary when the size is 84 + 50 * count) and .ply
- * (ascii or binary_little_endian; vertex x y z float/double, face list vertex_indices).
+ * .obj (v and f lines; f a, a/b, a//c, a/b/c and negative relative ids, each referring to
+ * a vertex defined above it; vt, vn, g, o, s, usemtl, mtllib and other lines ignored),
+ * .off (OFF, COFF, NOFF, CNOFF, STOFF headers; one vertex and one face per line, data
+ * after x y z or after the face's ids skipped), .stl (binary when the size is exactly
+ * 84 + 50 * count, whatever the header says; else ASCII, one or more solids) and .ply
+ * (ascii or binary_little_endian; vertex x y z of any scalar type, face list
+ * vertex_indices or vertex_index; other properties and elements skipped by their types).
+ * Polygons are fan-triangulated; STL vertices with equal coordinates are merged.
  * Counts in a header are bounded by the file size before anything is allocated.
  * @param[out] surf the new surface, NULL on failure
  * @return FCM_OK; FCM_ERR_ARG (NULL pointers); FCM_ERR_UNSUPPORTED (unknown extension,

@@ -280,7 +280,7 @@ cleanup:
   return st;
 }
 
-static fcm_status stl_binary(fcm__sbuild *B, const unsigned char *b, size_t len)
+static fcm_status stl_binary(fcm__sbuild *B, const unsigned char *b)
 {
   fcm_status st = FCM_OK;
   uint32_t n = le32(b + 80);
@@ -301,7 +301,6 @@ static fcm_status stl_binary(fcm__sbuild *B, const unsigned char *b, size_t len)
     fcm_index m = (fcm_index)B->nv;
     FCM_TRY(B->ctx, fcm__sbuild_triangle(B, m - 3, m - 2, m - 1));
   }
-  (void)len;
 cleanup:
   return st;
 }
@@ -315,7 +314,7 @@ fcm_status fcm__surface_read_stl(fcm__sbuild *B, char *buf, size_t len)
     lead++;
   int solid = len - lead >= 5 && memcmp(buf + lead, "solid", 5) == 0;
   if (len >= 84 && 84 + 50 * (unsigned long long)le32(b + 80) == len) {
-    FCM_TRY(B->ctx, stl_binary(B, b, len));
+    FCM_TRY(B->ctx, stl_binary(B, b));
   } else if (solid && (len < 84 || !memchr(buf, '\0', len))) { /* ASCII has no NUL byte */
     FCM_TRY(B->ctx, stl_ascii(B, buf, len));
   } else {
