@@ -15,7 +15,7 @@ extern "C" {
 
 /** Which algorithm selects the kept points. */
 typedef enum fcm_simplify_method {
-  FCM_SIMPLIFY_AUTO = 0,  /**< the measured default (see fcm_simplify_options_default) */
+  FCM_SIMPLIFY_AUTO = 0,  /**< the measured default: FCM_SIMPLIFY_ELIMINATE */
   FCM_SIMPLIFY_LP,        /**< thin SVD of P, one LP on all N points */
   FCM_SIMPLIFY_RECOMBINE, /**< hierarchical recombination: small LPs on cluster moments */
   FCM_SIMPLIFY_ELIMINATE, /**< Carathéodory elimination along null vectors of an LU tableau,
@@ -83,10 +83,11 @@ FCM_API fcm_simplify_options fcm_simplify_options_default(void);
 /** Reduce a positive rule to at most M = (m+3 choose 3) of its own points with positive
  * weights reproducing every moment of total degree <= strength (DESIGN §6).
  * Every returned rule is verified (weights > 0, count <= M, relative residual <=
- * residual_tol); if all attempts (the chosen path, the other path, the chosen path with a
- * looser rank threshold) fail, the input is returned unchanged with info->fallback = 1 and
- * FCM_OK: the caller decides and counts; the fallback is also logged at FCM_LOG_WARNING
- * through the ctx's log callback (with the account of info->message). N <= M also returns the input
+ * residual_tol); if all attempts (the chosen path; a GLPK path: the other GLPK path for LP
+ * or RECOMBINE, for ELIMINATE the LP up to N = 12 M and recombination above; the chosen
+ * path with a looser rank threshold) fail, the input is returned unchanged with info->fallback = 1
+ * and FCM_OK: the caller decides and counts; the fallback is also logged at FCM_LOG_WARNING through
+ * the ctx's log callback (with the account of info->message). N <= M also returns the input
  * (info->skipped). Points of zero weight are never kept.
  * @param[in] points  n x 3 reference coordinates (row-major); @param[in] weights n, >= 0
  * @param[in] opts NULL for defaults; @param[out] out release with fcm_simplify_result_destroy()
