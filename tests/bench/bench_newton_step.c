@@ -3,11 +3,11 @@
  * solver). Times assembly (mass, hyperelastic force + tangent), Schwarz setup, MINRES+Schwarz,
  * and CHOLMOD analyze/factor/solve side by side; asserts only that both solves agree.
  *
- * Setup (HOE cylinder_shell.rs, reference notes §3): background [-1,1]x[-8,8]x[-1,1] with
- * 7x56x7 Hex20 cells (res 7, h = 2/7); embedded tube r in [0.7, 1] around the y axis, length
- * 16 (the radii are our choice: they leave exactly the paper's 2016 active cells); Stable
- * Neo-Hookean E = 5e6, nu = 0.48, rho = 1000; dt = 1/60; default stabilization (mass and
- * stiffness, alpha 1e-6) and simplified cut-cell rules. State: a twist u = R(k (y + 8)) X - X
+ * Setup (the authors' cylinder-shell example, Longva et al. 2020 §6.2): background
+ * [-1,1]x[-8,8]x[-1,1] with 7x56x7 Hex20 cells (res 7, h = 2/7); embedded tube r in [0.7, 1] around
+ * the y axis, length 16 (the radii are our choice: they leave exactly the paper's 2016 active
+ * cells); Stable Neo-Hookean E = 5e6, nu = 0.48, rho = 1000; dt = 1/60; default stabilization (mass
+ * and stiffness, alpha 1e-6) and simplified cut-cell rules. State: a twist u = R(k (y + 8)) X - X
  * about the y axis, k = 0.1 rad per unit length, zero velocity, gravity -9.81 e_z; the ends
  * y = +-8 are held. Step: A = M + dt^2 K(u) (unprojected tangent), b = -dt^2 (f_int(u) - f_ext),
  * Dirichlet rows eliminated. Usage: bench_newton_step [nosimplify]

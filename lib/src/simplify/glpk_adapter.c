@@ -1,7 +1,7 @@
 /* The one file that talks to GLPK: a basic feasible solution of A x = b, x >= 0 with
  * the dual simplex, with GLPK's printing and aborting fenced off.
  *
- * Settings (measured, shared/notes/quadrature-reduction.md §4): GLP_DUALP with a zero
+ * Settings (measured with GLPK 5.0 on the simplification LPs): GLP_DUALP with a zero
  * objective (the all-logical basis is dual feasible, so no phase 1), presolver off and
  * no glp_scale_prob (both returned "optimal" with negative weights), iteration and time
  * limits. The caller supplies orthonormal rows and a right-hand side of mean-1 weights.

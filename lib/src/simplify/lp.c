@@ -8,14 +8,14 @@ fcm_status fcm__simplify_run_lp(fcm__attempt *a)
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = a->ctx;
   const int n = a->n, M = a->box.num_basis, k = FCM_MIN(M, n);
-  double *P = NULL, *vt = NULL, *rhs = NULL, *x = NULL;
+  double *P = NULL, *vt = NULL, *rhs = NULL, *x = NULL, *work = NULL;
   fcm__lp_report rep;
   int r = 0;
 
   double t0 = fcm_wtime();
-  FCM_ALLOC(ctx, (size_t)M * (size_t)n, P);
-  for (int j = 0; j < n; j++)
-    fcm__simplify_basis_eval(&a->box, a->points + 3 * (size_t)j, P + (size_t)j * (size_t)M);
+  FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)n, P);
+  FCM_ALLOC_RAW(ctx, fcm__simplify_moments_scratch(a->box.m), work);
+  fcm__simplify_basis_points(&a->box, n, a->points, P, work);
   fcm__simplify_set_moments(a, n, P, a->w0);
   a->time_basis += fcm_wtime() - t0;
 
@@ -51,5 +51,6 @@ cleanup:
   fcm__free(ctx, vt);
   fcm__free(ctx, rhs);
   fcm__free(ctx, x);
+  fcm__free(ctx, work);
   return st;
 }

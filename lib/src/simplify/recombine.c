@@ -1,5 +1,5 @@
-/* Simplification by hierarchical recombination (shared/notes/quadrature-reduction.md
- * §2.3-2.4; Litterer & Lyons 2012, Maalouf et al. 2019, with an LP as the inner step).
+/* Simplification by hierarchical recombination (Litterer & Lyons 2012, Maalouf et al.
+ * 2019, with an LP or a Carathéodory elimination as the inner step).
  *
  * The active points are cut into K = 2(M+1) contiguous clusters (input order keeps the
  * sub-cells of the initial rule together); each cluster becomes one column g_c =

@@ -344,8 +344,8 @@ cleanup:
   return st;
 }
 
-/* Set-up phase: mean-1 weights (with tiny weights GLPK reports "optimal" with w = 0,
- * notes §4), the attempt's buffers and parameters and the box of the basis (the moments
+/* Set-up phase: mean-1 weights (with tiny weights GLPK reports "optimal" with w = 0, as
+ * measured), the attempt's buffers and parameters and the box of the basis (the moments
  * come from the first path that evaluates the basis on every point). */
 static fcm_status setup_attempt(simplify_run *r, int strength, const double *weights, double total,
                                 const fcm_simplify_options *o, int force_lp_failure)

@@ -141,9 +141,8 @@ fcm_status fcm__simplify_row_space(fcm__attempt *a, int rows, int cols, double *
 /* One full LP on all n points (DESIGN §6): P (M x n), thin SVD, V_r^T w = V_r^T w0. */
 fcm_status fcm__simplify_run_lp(fcm__attempt *a);
 
-/* Hierarchical recombination (notes §2.4): about log2(n/M) rounds on cluster moments and a
- * final step on single points, each an LP (or, with a->eliminate, a Carathéodory
- * elimination). */
+/* Hierarchical recombination (Litterer & Lyons 2012): about log2(n/M) rounds on cluster moments and
+ * a final step on single points, each an LP (or, with a->eliminate, a Carathéodory elimination). */
 fcm_status fcm__simplify_run_recombine(fcm__attempt *a);
 
 /* Carathéodory elimination (caratheodory.c) on the rows x ncols matrix g (ld ldg): lam
