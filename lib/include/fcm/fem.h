@@ -86,6 +86,26 @@ FCM_API int fcm_space_num_colors(const fcm_space *space);
 /** The mesh the space was built on. */
 FCM_API const fcm_mesh *fcm_space_mesh(const fcm_space *space);
 
+/** Carry a field (displacement, velocity: num_dofs of `from`) over a cut: `to` must be the
+ * space of rules that extend the rules of `from` by one cut (fcm_cell_rules_create_cut()).
+ * Every copy of `to` takes the value of the copy of `from` whose support component holds
+ * its own, so the field is unchanged at every point of the body: mass, linear and angular
+ * momentum are preserved up to rounding. @param[out] x_to num_dofs of `to`.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, other mesh, unrelated rules). No allocation. */
+FCM_API fcm_status fcm_space_transfer(const fcm_space *from, const fcm_space *to,
+                                      const double *x_from, double *x_to);
+
+/** Mass, linear momentum and angular momentum (about the origin) of the body, integrated
+ * over the authentic quadrature points of the mass rules (the fictitious stabilization
+ * points are not the body): m = int rho, p = int rho v, L = int rho x cross v with
+ * x = X + u. Exact for the polynomial fields of the space where the mass rules are (cut
+ * cells: rules of the mass strength), so a cut, which leaves the field unchanged, leaves
+ * all three unchanged up to rounding. u and v (num_dofs) may be NULL (zero); outputs may
+ * be NULL. @return FCM_OK, FCM_ERR_ARG (NULL space, density < 0), FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_space_momentum(const fcm_space *space, double density, const double *u,
+                                      const double *v, double *mass, double linear[3],
+                                      double angular[3]);
+
 /** Create a symmetric CSR matrix with the space's pattern and zero values.
  * @return FCM_OK, FCM_ERR_ALLOC. Release with fcm_csr_destroy(). */
 FCM_API fcm_status fcm_space_matrix_create(const fcm_space *space, fcm_csr **A);

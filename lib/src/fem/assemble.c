@@ -794,3 +794,56 @@ fcm_status fcm_space_element_eval(const fcm_space *s, fcm_index elem, const doub
 cleanup:
   return st;
 }
+
+fcm_status fcm_space_momentum(const fcm_space *s, double density, const double *u, const double *v,
+                              double *mass, double linear[3], double angular[3])
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s ? s->ctx : NULL;
+  fcm_rule *full = NULL;
+  double m = 0.0, p[3] = {0, 0, 0}, L[3] = {0, 0, 0};
+  FCM_CHECK(s, ctx, FCM_ERR_ARG, "momentum: space is NULL");
+  FCM_CHECK(isfinite(density) && density >= 0.0, ctx, FCM_ERR_ARG,
+            "momentum: density = %g must be finite and >= 0", density);
+  FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, FCM_RULE_MASS, FCM_DEFAULT, &full));
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    const fcm_index c = s->elem_cell[e];
+    int nq = 0;
+    const double *pts = NULL, *w = NULL;
+    const unsigned char *fl = NULL;
+    if (s->rules && fcm_cell_rules_class(s->rules, c) != FCM_CELL_UNCUT) {
+      FCM_TRY(ctx, fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], FCM_RULE_MASS, &nq, &pts,
+                                            &w, &fl));
+    } else {
+      nq = fcm_rule_num_points(full);
+      pts = fcm_rule_points(full);
+      w = fcm_rule_weights(full);
+    }
+    double X[3 * FCM_ELEMENT_MAX_NODES], J[9], N[FCM_ELEMENT_MAX_NODES];
+    fcm_mesh_cell_coords(s->mesh, c, X);
+    const fcm_index *ed = s->elem_dof + e * s->nn;
+    for (int q = 0; q < nq; q++) {
+      if (fl && fl[q]) continue; /* fictitious stabilization points: not the body */
+      const double wd = density * w[q] * fcm_element_jacobian(s->type, X, pts + 3 * q, J);
+      fcm_element_eval_shape(s->type, pts + 3 * q, N);
+      double x[3] = {0, 0, 0}, vq[3] = {0, 0, 0};
+      for (int a = 0; a < s->nn; a++)
+        for (int i = 0; i < 3; i++) {
+          x[i] += N[a] * (X[3 * a + i] + (u ? u[ed[a] + i] : 0.0));
+          vq[i] += N[a] * (v ? v[ed[a] + i] : 0.0);
+        }
+      m += wd;
+      for (int i = 0; i < 3; i++)
+        p[i] += wd * vq[i];
+      L[0] += wd * (x[1] * vq[2] - x[2] * vq[1]);
+      L[1] += wd * (x[2] * vq[0] - x[0] * vq[2]);
+      L[2] += wd * (x[0] * vq[1] - x[1] * vq[0]);
+    }
+  }
+  if (mass) *mass = m;
+  if (linear) memcpy(linear, p, sizeof p);
+  if (angular) memcpy(angular, L, sizeof L);
+cleanup:
+  fcm_rule_destroy(&full);
+  return st;
+}

@@ -837,3 +837,39 @@ fcm_status fcm_integrator_momentum(fcm_integrator *I, double linear[3], double a
 cleanup:
   return st;
 }
+
+fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space *space,
+                                     fcm_integrator **integ)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = old ? old->ctx : NULL;
+  fcm_integrator *I = NULL;
+  double *u = NULL, *v = NULL;
+  FCM_CHECK(integ, ctx, FCM_ERR_ARG, "integrator cut: output pointer is NULL");
+  *integ = NULL;
+  FCM_CHECK(old && space, ctx, FCM_ERR_ARG, "integrator cut: NULL integrator or space");
+  FCM_CHECK(old->is_setup, ctx, FCM_ERR_ARG,
+            "integrator cut: the integrator must be set up (fcm_integrator_setup())");
+  FCM_TRY(ctx, fcm_integrator_create(ctx, space, &old->mat, &old->opts, &I));
+  for (int k = 0; k < old->num_loads; k++) {
+    sim_load l = old->loads[k];
+    l.f = NULL;
+    FCM_TRY(ctx, add_load(I, &l));
+  }
+  for (int k = 0; k < old->num_cons; k++)
+    FCM_TRY(ctx, fcm_integrator_add_constraint(I, old->cons[k].num_nodes, old->cons[k].nodes,
+                                               &old->cons[k].motion, NULL));
+  FCM_TRY(ctx, fcm_integrator_setup(I));
+  FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, u);
+  FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, v);
+  FCM_TRY(ctx, fcm_space_transfer(old->space, space, old->u, u));
+  FCM_TRY(ctx, fcm_space_transfer(old->space, space, old->v, v));
+  FCM_TRY(ctx, fcm_integrator_set_state(I, u, v, old->t, old->steps));
+  *integ = I;
+  I = NULL;
+cleanup:
+  fcm__free(ctx, u);
+  fcm__free(ctx, v);
+  fcm_integrator_destroy(&I);
+  return st;
+}
