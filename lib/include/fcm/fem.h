@@ -310,6 +310,19 @@ FCM_API fcm_status fcm_space_apply_dirichlet(const fcm_space *space, fcm_index n
 FCM_API fcm_status fcm_space_eval(const fcm_space *space, fcm_index cell, const double xi[3],
                                   const double *u, double value[3]);
 
+/** The element of `cell` that a point at reference coordinates xi belongs to: the cell's
+ * element when it has one; in a cell that cuts split, the piece with the nearest authentic
+ * quadrature point (exact away from the cut faces, a guess within a point spacing of them:
+ * for display, e.g. of surface vertices). -1 for a cell out of range or without elements.
+ * No allocation; thread safe. */
+FCM_API fcm_index fcm_space_point_element(const fcm_space *space, fcm_index cell,
+                                          const double xi[3]);
+
+/** Number of separate bodies: connected components of the elements, two elements being
+ * connected when they share a DOF copy (a node whose support component holds both). One
+ * for an uncut body; -1 when the scratch cannot be allocated. Allocates (and frees). */
+FCM_API fcm_index fcm_space_num_bodies(const fcm_space *space);
+
 /** As fcm_space_eval() on element `elem` (its copies). @return FCM_OK, FCM_ERR_ARG. */
 FCM_API fcm_status fcm_space_element_eval(const fcm_space *space, fcm_index elem,
                                           const double xi[3], const double *u, double value[3]);

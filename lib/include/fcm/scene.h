@@ -181,6 +181,7 @@ typedef enum fcm_effect_type {
   FCM_EFFECT_DAMPING,          /**< "damping": Rayleigh D = mass M + stiffness K */
   FCM_EFFECT_TRACTION,         /**< "traction": force per area on the embedded boundary */
   FCM_EFFECT_PRESSURE,         /**< "pressure": p along the inward normal of the boundary */
+  FCM_EFFECT_CUT,              /**< "cut": a cut surface inserted at a time (XFEM) */
   FCM_EFFECT_TYPE_COUNT
 } fcm_effect_type;
 
@@ -238,6 +239,33 @@ typedef struct fcm_effect_pressure {
   double start, end; /**< s; default 0 and HUGE_VAL */
 } fcm_effect_pressure;
 
+/** The forms of a cut surface (in the reference coordinates of the geometry). */
+typedef enum fcm_cut_kind {
+  FCM_CUT_PLANE = 0, /**< "plane": {"point", "normal"}: clipped to the body's bounding box
+                          enlarged by 10 % (fcm_surface_create_plane()) */
+  FCM_CUT_RECTANGLE, /**< "rectangle": {"center", "normal", "axis", "size": [a, b]} */
+  FCM_CUT_DISC,      /**< "disc": {"center", "normal", "radius", "segments" (default 64)} */
+  FCM_CUT_MESH       /**< "mesh": "FILE" (OBJ, OFF, STL, PLY; fcm_surface_create_from_file()) */
+} fcm_cut_kind;
+
+/** A cut at `time`: before the first step that starts at or after it (time 0: before the
+ * run), the surface is added to the cell rules (fcm_cell_rules_create_cut()) and the run
+ * continues on the enriched space (fcm_integrator_create_cut()). Every form takes an
+ * optional "transform" (scale, rotation, translation) as the geometry does. */
+typedef struct fcm_effect_cut {
+  double time; /**< s, in [0, duration] (default 0) */
+  fcm_cut_kind kind;
+  double point[3];  /**< PLANE: a point; RECTANGLE, DISC: the centre */
+  double normal[3]; /**< unit (normalized by the parser) */
+  double axis[3];   /**< RECTANGLE: the direction of the first side */
+  double size[2];   /**< RECTANGLE: side lengths, > 0 */
+  double radius;    /**< DISC, > 0 */
+  int segments;     /**< DISC: triangles, [3, 256], default 64 */
+  const char *mesh; /**< MESH: resolved path */
+  int has_transform;
+  double transform[9], offset[3]; /**< x -> transform x + offset (identity when none) */
+} fcm_effect_cut;
+
 /** One effect of the scene: a tagged union. */
 typedef struct fcm_effect {
   fcm_effect_type type; /**< selects the member */
@@ -250,6 +278,7 @@ typedef struct fcm_effect {
     fcm_effect_damping damping;
     fcm_effect_traction traction;
     fcm_effect_pressure pressure;
+    fcm_effect_cut cut;
   };
 } fcm_effect;
 

@@ -165,7 +165,8 @@ cleanup:
 
 /* ---------------------------------------------------------------- geometry */
 
-static fcm_status read_transform(fcm__scene_parser *p, const fcm__json *o, fcm_scene_geometry *g)
+fcm_status fcm__scene_read_transform(fcm__scene_parser *p, const fcm__json *o, double A[9],
+                                     double b[3], int *has)
 {
   fcm_status st = FCM_OK;
   static const char *const keys[] = {"scale", "rotation", "translation"};
@@ -208,9 +209,9 @@ static fcm_status read_transform(fcm__scene_parser *p, const fcm__json *o, fcm_s
                  c + a[2] * a[2] * (1 - c)};
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++)
-      g->transform[3 * i + j] = R[3 * i + j] * scale[j];
-  memcpy(g->offset, offset, sizeof offset);
-  g->has_transform = 1;
+      A[3 * i + j] = R[3 * i + j] * scale[j];
+  memcpy(b, offset, sizeof offset);
+  *has = 1;
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
@@ -320,7 +321,7 @@ static fcm_status read_geometry(fcm__scene_parser *p, const fcm__json *root)
       break;
     }
   }
-  FCM_TRY(p->ctx, read_transform(p, o, g));
+  FCM_TRY(p->ctx, fcm__scene_read_transform(p, o, g->transform, g->offset, &g->has_transform));
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
