@@ -157,10 +157,14 @@ typedef struct fcm_surface_fill_info {
 } fcm_surface_fill_info;
 
 /** Close the holes of a surface: the boundary edges are chained into loops (at a vertex
- * with several outgoing boundary edges the first unused one is taken); a loop of 3 edges
- * becomes one triangle, a longer one a fan around a new vertex at the loop's vertex
- * centroid, oriented like the triangles along the loop. Loops larger than the options
- * allow are left open and counted. A closed surface is copied unchanged.
+ * with several outgoing boundary edges the first unused one is taken). Each loop is
+ * triangulated without new vertices by minimum area (dynamic programme of Liepa 2003,
+ * loops up to 400 edges), else by the same with a penalty on folds against the
+ * neighbouring triangles, else by a fan around a new vertex at the loop's centroid: the
+ * first candidate whose triangles meet no other triangle is kept (else the one with the
+ * fewest intersections; fcm_surface_check() then reports them). New triangles run
+ * like those along the loop. Loops larger than the options allow are left open and
+ * counted. A closed surface is copied unchanged.
  * @param[in] opts NULL for defaults; @param[out] info (may be NULL) what was closed
  * @return FCM_OK; FCM_ERR_ARG (NULL, negative option); FCM_ERR_ALLOC. Allocates. */
 FCM_API fcm_status fcm_surface_create_filled(fcm_ctx *ctx, const fcm_surface *src,

@@ -195,7 +195,9 @@ fcm_surface_check_options fcm_surface_check_options_default(void)
   return o;
 }
 
-static fcm_status find_intersections(const fcm_surface *s, fcm_surface_report *r)
+/* Intersecting pairs with at least one triangle >= first (each pair once). */
+static fcm_status find_intersections_from(const fcm_surface *s, fcm_index first,
+                                          fcm_surface_report *r)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
@@ -220,7 +222,7 @@ static fcm_status find_intersections(const fcm_surface *s, fcm_surface_report *r
   FCM_TRY(ctx, fcm_aabb_tree_create(ctx, m, boxes, &tree));
   FCM_ALLOC_RAW(ctx, (size_t)cap, ids);
   r->num_intersections = 0;
-  for (fcm_index t = 0; t < m; t++) {
+  for (fcm_index t = first; t < m; t++) {
     FCM_TRY(ctx, fcm_aabb_tree_query(tree, boxes + 6 * t, boxes + 6 * t + 3, cap, ids, &count));
     if (count > cap) {
       FCM_FREE(ctx, ids);
@@ -230,7 +232,7 @@ static fcm_status find_intersections(const fcm_surface *s, fcm_surface_report *r
     }
     for (fcm_index i = 0; i < count; i++) {
       fcm_index u = ids[i];
-      if (u <= t || !tri_tri(s, t, u)) continue;
+      if (u == t || (u >= first && u < t) || !tri_tri(s, t, u)) continue;
       if (r->num_intersections < FCM_SURFACE_REPORT_MAX)
         r->intersecting[r->num_intersections][0] = t, r->intersecting[r->num_intersections][1] = u;
       r->num_intersections++;
@@ -241,6 +243,11 @@ cleanup:
   FCM_FREE(ctx, ids);
   FCM_FREE(ctx, boxes);
   return st;
+}
+
+static fcm_status find_intersections(const fcm_surface *s, fcm_surface_report *r)
+{
+  return find_intersections_from(s, 0, r);
 }
 
 /* Number of boundary loops: the boundary edges chained (each vertex's outgoing boundary
@@ -319,6 +326,7 @@ typedef struct bloops {
   fcm_index *to;      /* n */
   fcm_index *start;   /* num_vertices + 1: edges leaving each vertex, in order */
   fcm_index *edge;    /* n: edge ids grouped by `from` */
+  fcm_index *tri;     /* n: the triangle the edge borders */
   unsigned char *used;
 } bloops;
 
@@ -328,6 +336,7 @@ static void bloops_free(fcm_ctx *ctx, bloops *L)
   FCM_FREE(ctx, L->to);
   FCM_FREE(ctx, L->start);
   FCM_FREE(ctx, L->edge);
+  FCM_FREE(ctx, L->tri);
   FCM_FREE(ctx, L->used);
 }
 
@@ -348,6 +357,7 @@ static fcm_status bloops_build(fcm_ctx *ctx, const fcm_surface *s, const sedge *
   FCM_ALLOC_RAW(ctx, (size_t)n + 1, L->from);
   FCM_ALLOC_RAW(ctx, (size_t)n + 1, L->to);
   FCM_ALLOC_RAW(ctx, (size_t)n + 1, L->edge);
+  FCM_ALLOC_RAW(ctx, (size_t)n + 1, L->tri);
   FCM_ALLOC(ctx, (size_t)n + 1, L->used);
   FCM_ALLOC(ctx, (size_t)nv + 1, L->start);
   n = 0;
@@ -356,7 +366,7 @@ static fcm_status bloops_build(fcm_ctx *ctx, const fcm_surface *s, const sedge *
     while (j < ne && e[j].lo == e[i].lo && e[j].hi == e[i].hi)
       j++;
     if (j - i == 1 && e[i].lo != e[i].hi) {
-      L->from[n] = e[i].b, L->to[n] = e[i].a;
+      L->from[n] = e[i].b, L->to[n] = e[i].a, L->tri[n] = e[i].t;
       L->start[e[i].b + 1]++;
       n++;
     }
@@ -601,6 +611,85 @@ static double tri_area(const double *a, const double *b, const double *c)
   return 0.5 * sqrt(dot(n, n));
 }
 
+/* Loops up to this size are triangulated by the minimum-area dynamic programme (O(n^3)
+ * time, O(n^2) memory); larger ones by a fan around their centroid. */
+#define FILL_DP_MAX 400
+
+/* Minimum-area triangulation of the polygon v[0..n) (Liepa 2003, "Filling holes in
+ * meshes", with the area weight only): W[i][j] = min_k W[i][k] + W[k][j] + area(i, k, j);
+ * the triangles (v_i, v_k, v_j), i < k < j, run the loop's direction. */
+static void unit_normal(const double *a, const double *b, const double *c, double *n)
+{
+  double u[3], v[3];
+  sub(b, a, u), sub(c, a, v);
+  cross(u, v, n);
+  double l = sqrt(dot(n, n));
+  if (l > 0.0) n[0] /= l, n[1] /= l, n[2] /= l;
+}
+
+/* Weight of the new triangle (v_i, v_k, v_j): its area, times 1 + 10 (1 - cos) for each
+ * side on the loop, cos the cosine of the angle between its normal and that of the surface
+ * triangle across the side (a fold back into the surface costs up to 21 times its area). */
+static double fill_weight(const double *x, const fcm_index *T, const fcm_index *v,
+                          const fcm_index *nb, fcm_index n, fcm_index i, fcm_index k, fcm_index j,
+                          double fold)
+{
+  const double *a = x + 3 * v[i], *b = x + 3 * v[k], *c = x + 3 * v[j];
+  double w = tri_area(a, b, c), nn[3], no[3], f = 1.0;
+  unit_normal(a, b, c, nn);
+  fcm_index sides[3] = {k == i + 1 ? i : -1, j == k + 1 ? k : -1, (i == 0 && j == n - 1) ? j : -1};
+  for (int q = 0; q < 3; q++) {
+    if (sides[q] < 0) continue;
+    const fcm_index *t = T + 3 * nb[sides[q]];
+    unit_normal(x + 3 * t[0], x + 3 * t[1], x + 3 * t[2], no);
+    f += fold * (1.0 - dot(nn, no));
+  }
+  return w * f;
+}
+
+static fcm_status fill_min_area(fcm__sbuild *B, const double *x, const fcm_index *T,
+                                const fcm_index *v, const fcm_index *nb, fcm_index n,
+                                double fold, double *area)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  double *W = NULL;
+  fcm_index *K = NULL, *stack = NULL;
+  size_t nn = (size_t)n * (size_t)n;
+  FCM_ALLOC(ctx, nn, W);
+  FCM_ALLOC(ctx, nn, K);
+  FCM_ALLOC_RAW(ctx, 2 * (size_t)n, stack);
+  for (fcm_index len = 2; len < n; len++)
+    for (fcm_index i = 0; i + len < n; i++) {
+      fcm_index j = i + len, best = -1;
+      double wbest = INFINITY;
+      for (fcm_index k = i + 1; k < j; k++) {
+        double w = W[(size_t)i * (size_t)n + (size_t)k] + W[(size_t)k * (size_t)n + (size_t)j] +
+                   fill_weight(x, T, v, nb, n, i, k, j, fold);
+        if (w < wbest) wbest = w, best = k;
+      }
+      W[(size_t)i * (size_t)n + (size_t)j] = wbest;
+      K[(size_t)i * (size_t)n + (size_t)j] = best;
+    }
+  *area = 0.0;
+  fcm_index top = 0;
+  stack[top++] = 0, stack[top++] = n - 1;
+  while (top > 0) {
+    fcm_index j = stack[--top], i = stack[--top];
+    if (j - i < 2) continue;
+    fcm_index k = K[(size_t)i * (size_t)n + (size_t)j];
+    FCM_TRY(ctx, fcm__sbuild_triangle(B, v[i], v[k], v[j]));
+    *area += tri_area(x + 3 * v[i], x + 3 * v[k], x + 3 * v[j]);
+    stack[top++] = i, stack[top++] = k;
+    stack[top++] = k, stack[top++] = j;
+  }
+cleanup:
+  FCM_FREE(ctx, W);
+  FCM_FREE(ctx, K);
+  FCM_FREE(ctx, stack);
+  return st;
+}
+
 fcm_status fcm_surface_create_filled(fcm_ctx *ctx, const fcm_surface *src,
                                      const fcm_surface_fill_options *opts, fcm_surface **surf,
                                      fcm_surface_fill_info *info)
@@ -608,7 +697,7 @@ fcm_status fcm_surface_create_filled(fcm_ctx *ctx, const fcm_surface *src,
   fcm_status st = FCM_OK;
   sedge *e = NULL;
   bloops L = {0};
-  fcm_index *loop = NULL;
+  fcm_index *loop = NULL, *verts = NULL, *nbtri = NULL;
   fcm__sbuild B = {0};
   fcm_surface_fill_info I;
   memset(&I, 0, sizeof I);
@@ -630,6 +719,8 @@ fcm_status fcm_surface_create_filled(fcm_ctx *ctx, const fcm_surface *src,
   FCM_TRY(ctx, edges_sorted(ctx, src, &e));
   FCM_TRY(ctx, bloops_build(ctx, src, e, 3 * (size_t)src->num_triangles, &L));
   FCM_ALLOC_RAW(ctx, (size_t)L.n + 1, loop);
+  FCM_ALLOC_RAW(ctx, (size_t)L.n + 1, verts);
+  FCM_ALLOC_RAW(ctx, (size_t)L.n + 1, nbtri);
   for (fcm_index k = 0; k < L.n; k++) {
     if (L.used[k]) continue;
     fcm_index len = 0;
@@ -650,23 +741,40 @@ fcm_status fcm_surface_create_filled(fcm_ctx *ctx, const fcm_surface *src,
       if (len > I.largest_left) I.largest_left = len;
       continue;
     }
+    /* candidates: minimum area, area with a fold penalty, fan; the first whose triangles
+     * meet no other triangle is kept, else the one with the fewest intersections */
     double area = 0.0;
-    if (len == 3) {
-      fcm_index a = L.from[loop[0]], b = L.from[loop[1]], cc = L.from[loop[2]];
-      FCM_TRY(ctx, fcm__sbuild_triangle(&B, a, b, cc));
-      area = tri_area(src->coords + 3 * a, src->coords + 3 * b, src->coords + 3 * cc);
-      I.triangles_added++;
-    } else {
-      fcm_index cv = (fcm_index)B.nv;
-      FCM_TRY(ctx, fcm__sbuild_vertex(&B, c));
-      I.vertices_added++;
-      for (fcm_index i = 0; i < len; i++) {
-        fcm_index a = L.from[loop[i]], b = L.to[loop[i]];
-        FCM_TRY(ctx, fcm__sbuild_triangle(&B, a, b, cv));
-        area += tri_area(src->coords + 3 * a, src->coords + 3 * b, c);
-        I.triangles_added++;
+    size_t nv0 = B.nv, nt0 = B.nt;
+    fcm_index best = -1, best_count = -1;
+    for (int pass = 0; pass < 2 && best_count != 0; pass++)
+      for (int method = 0; method < 3; method++) {
+        if (pass == 1 && method != best) continue;
+        if (method < 2 && len > FILL_DP_MAX) continue;
+        B.nv = nv0, B.nt = nt0, area = 0.0;
+        if (method < 2) {
+          for (fcm_index i = 0; i < len; i++)
+            verts[i] = L.from[loop[i]], nbtri[i] = L.tri[loop[i]];
+          FCM_TRY(ctx, fill_min_area(&B, src->coords, src->tris, verts, nbtri, len,
+                                     method == 0 ? 0.0 : 3.0, &area));
+        } else {
+          fcm_index cv = (fcm_index)B.nv;
+          FCM_TRY(ctx, fcm__sbuild_vertex(&B, c));
+          for (fcm_index i = 0; i < len; i++) {
+            fcm_index a = L.from[loop[i]], b = L.to[loop[i]];
+            FCM_TRY(ctx, fcm__sbuild_triangle(&B, a, b, cv));
+            area += tri_area(src->coords + 3 * a, src->coords + 3 * b, c);
+          }
+        }
+        if (pass == 1) break;
+        struct fcm_surface view = {ctx, (fcm_index)B.nv, (fcm_index)B.nt, B.x, B.t, {0}, {0}};
+        fcm_surface_report rep;
+        FCM_TRY(ctx, find_intersections_from(&view, (fcm_index)nt0, &rep));
+        if (best < 0 || rep.num_intersections < best_count)
+          best = method, best_count = rep.num_intersections;
+        if (best_count == 0) break;
       }
-    }
+    I.triangles_added += (fcm_index)(B.nt - nt0);
+    I.vertices_added += (fcm_index)(B.nv - nv0);
     if (I.num_filled < FCM_SURFACE_FILL_MAX_LOOPS)
       I.loop_edges[I.num_filled] = len, I.loop_area[I.num_filled] = area;
     I.num_filled++;
@@ -677,6 +785,8 @@ fcm_status fcm_surface_create_filled(fcm_ctx *ctx, const fcm_surface *src,
 cleanup:
   FCM_FREE(ctx, e);
   FCM_FREE(ctx, loop);
+  FCM_FREE(ctx, verts);
+  FCM_FREE(ctx, nbtri);
   bloops_free(ctx, &L);
   fcm__sbuild_free(&B);
   return st;
