@@ -57,7 +57,7 @@ typedef enum fcm_scene_geometry_kind {
   FCM_SCENE_GEOMETRY_TUBE,        /**< fcm_geometry_create_tube() */
   FCM_SCENE_GEOMETRY_GMSH,        /**< fcm_geometry_create_from_gmsh() */
   FCM_SCENE_GEOMETRY_TETGEN,      /**< fcm_geometry_create_from_tetgen() */
-  FCM_SCENE_GEOMETRY_SURFACE,     /**< a triangle surface file, fcm_geometry_create_from_surface() */
+  FCM_SCENE_GEOMETRY_SURFACE, /**< a triangle surface file, fcm_geometry_create_from_surface() */
   FCM_SCENE_GEOMETRY_KIND_COUNT
 } fcm_scene_geometry_kind;
 

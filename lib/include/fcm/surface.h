@@ -88,16 +88,16 @@ FCM_API fcm_surface_check_options fcm_surface_check_options_default(void);
 /** What fcm_surface_check() found. Edge lists hold vertex ids (a, b), the first
  * min(count, FCM_SURFACE_REPORT_MAX) found. */
 typedef struct fcm_surface_report {
-  fcm_index num_boundary_edges;    /**< edges used by one triangle only (0: closed) */
+  fcm_index num_boundary_edges; /**< edges used by one triangle only (0: closed) */
   fcm_index boundary_edges[FCM_SURFACE_REPORT_MAX][2];
   fcm_index num_boundary_loops;    /**< closed chains of boundary edges (holes) */
   fcm_index num_nonmanifold_edges; /**< edges used by three or more triangles */
   fcm_index nonmanifold_edges[FCM_SURFACE_REPORT_MAX][2];
   fcm_index num_inconsistent_edges; /**< edges both of whose triangles run them the same way */
   fcm_index inconsistent_edges[FCM_SURFACE_REPORT_MAX][2];
-  fcm_index num_degenerate;        /**< degenerate triangles (see degenerate_tol) */
+  fcm_index num_degenerate;                     /**< degenerate triangles (see degenerate_tol) */
   fcm_index degenerate[FCM_SURFACE_REPORT_MAX]; /**< their triangle ids */
-  fcm_index num_intersections;     /**< intersecting triangle pairs (-1: not searched) */
+  fcm_index num_intersections; /**< intersecting triangle pairs (-1: not searched) */
   fcm_index intersecting[FCM_SURFACE_REPORT_MAX][2]; /**< triangle id pairs */
   double signed_volume; /**< sum over triangles of det(a, b, c) / 6 (divergence theorem):
                              the enclosed volume, > 0 when the normals point outward */
@@ -147,13 +147,13 @@ FCM_API fcm_surface_fill_options fcm_surface_fill_options_default(void);
 
 /** What fcm_surface_create_filled() did. */
 typedef struct fcm_surface_fill_info {
-  fcm_index num_loops;        /**< boundary loops found */
-  fcm_index num_filled;       /**< loops closed */
+  fcm_index num_loops;                              /**< boundary loops found */
+  fcm_index num_filled;                             /**< loops closed */
   fcm_index loop_edges[FCM_SURFACE_FILL_MAX_LOOPS]; /**< edges of the first closed loops */
   double loop_area[FCM_SURFACE_FILL_MAX_LOOPS];     /**< area added in each of them */
-  fcm_index largest_left;     /**< edges of the largest loop left open (0: none left) */
+  fcm_index largest_left; /**< edges of the largest loop left open (0: none left) */
   fcm_index triangles_added, vertices_added;
-  double area_added;          /**< total area of the added triangles */
+  double area_added; /**< total area of the added triangles */
 } fcm_surface_fill_info;
 
 /** Close the holes of a surface: the boundary edges are chained into loops (at a vertex

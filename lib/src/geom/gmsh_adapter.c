@@ -45,8 +45,9 @@ static fcm_status gmsh_error(fcm_ctx *ctx, const char *call, int line)
   const char *text = ierr == 0 && msg && msg[0] ? msg : "no message";
   /* the call's function name: up to the '(' */
   size_t n = strcspn(call, "(");
-  fcm_status st = fcm__error(ctx, FCM_ERR_GEOMETRY, __FILE__, line, "fcm_geometry_create_from_surface",
-                             "surface meshing: Gmsh's %.*s failed: %s", (int)n, call, text);
+  fcm_status st =
+      fcm__error(ctx, FCM_ERR_GEOMETRY, __FILE__, line, "fcm_geometry_create_from_surface",
+                 "surface meshing: Gmsh's %.*s failed: %s", (int)n, call, text);
   if (msg) gmshFree(msg);
   return st;
 }
@@ -114,8 +115,8 @@ static fcm_status mesh_locked(fcm_ctx *ctx, const fcm_surface *s, const fcm_surf
               i / 4, gen[i]);
     cells[i] = map[gen[i]];
   }
-  FCM_TRY(ctx, fcm_geometry_create(ctx, FCM_ELEMENT_TET4, (fcm_index)ngn, gc, (fcm_index)nge,
-                                   cells, geom));
+  FCM_TRY(ctx, fcm_geometry_create(ctx, FCM_ELEMENT_TET4, (fcm_index)ngn, gc, (fcm_index)nge, cells,
+                                   geom));
 cleanup:
   if (gn) gmshFree(gn);
   if (gc) gmshFree(gc);
@@ -182,8 +183,7 @@ fcm_status fcm_geometry_create_from_surface(fcm_ctx *ctx, const fcm_surface *sur
   FCM_CHECK(ctx && surf, ctx, FCM_ERR_ARG, "surface meshing: NULL argument (ctx and surf)");
   fcm_surface_mesh_options o = opts ? *opts : fcm_surface_mesh_options_default();
   FCM_CHECK(o.max_volume >= 0.0 && isfinite(o.max_volume), ctx, FCM_ERR_ARG,
-            "surface meshing: max_volume = %g must be finite and >= 0 (0: no limit)",
-            o.max_volume);
+            "surface meshing: max_volume = %g must be finite and >= 0 (0: no limit)", o.max_volume);
   FCM_CHECK(o.size >= 0.0 && isfinite(o.size), ctx, FCM_ERR_ARG,
             "surface meshing: size = %g must be finite and >= 0 (0: from the surface)", o.size);
   FCM_CHECK(o.quality >= 0.0 && o.quality <= 1.0, ctx, FCM_ERR_ARG,

@@ -321,12 +321,12 @@ cleanup:
 /* The boundary edges, each reversed (b -> a for the triangle's a -> b: the direction a
  * filling triangle runs it), with per-vertex adjacency in CSR form. */
 typedef struct bloops {
-  fcm_index n;        /* boundary edges */
-  fcm_index *from;    /* n */
-  fcm_index *to;      /* n */
-  fcm_index *start;   /* num_vertices + 1: edges leaving each vertex, in order */
-  fcm_index *edge;    /* n: edge ids grouped by `from` */
-  fcm_index *tri;     /* n: the triangle the edge borders */
+  fcm_index n;      /* boundary edges */
+  fcm_index *from;  /* n */
+  fcm_index *to;    /* n */
+  fcm_index *start; /* num_vertices + 1: edges leaving each vertex, in order */
+  fcm_index *edge;  /* n: edge ids grouped by `from` */
+  fcm_index *tri;   /* n: the triangle the edge borders */
   unsigned char *used;
 } bloops;
 
@@ -442,7 +442,8 @@ fcm_status fcm_surface_report_check(const fcm_surface *s, const char *what,
   size_t n = 0;
   loc[0] = '\0';
 #define LOC_EDGES(list, count)                                                                     \
-  for (fcm_index i_ = 0; i_ < (count) && i_ < FCM_SURFACE_REPORT_MAX && n < sizeof loc - 1; i_++) { \
+  for (fcm_index i_ = 0; i_ < (count) && i_ < FCM_SURFACE_REPORT_MAX && n < sizeof loc - 1;        \
+       i_++) {                                                                                     \
     fcm_index a_ = (list)[i_][0], b_ = (list)[i_][1];                                              \
     int k_ = snprintf(loc + n, sizeof loc - n, "%s(%lld, %lld) at (%g, %g, %g)-(%g, %g, %g)",      \
                       i_ ? ", " : "", (long long)a_, (long long)b_, x[3 * a_], x[3 * a_ + 1],      \
@@ -648,8 +649,8 @@ static double fill_weight(const double *x, const fcm_index *T, const fcm_index *
 }
 
 static fcm_status fill_min_area(fcm__sbuild *B, const double *x, const fcm_index *T,
-                                const fcm_index *v, const fcm_index *nb, fcm_index n,
-                                double fold, double *area)
+                                const fcm_index *v, const fcm_index *nb, fcm_index n, double fold,
+                                double *area)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
@@ -714,8 +715,8 @@ fcm_status fcm_surface_create_filled(fcm_ctx *ctx, const fcm_surface *src,
   for (fcm_index v = 0; v < src->num_vertices; v++)
     FCM_TRY(ctx, fcm__sbuild_vertex(&B, src->coords + 3 * v));
   for (fcm_index t = 0; t < src->num_triangles; t++)
-    FCM_TRY(ctx, fcm__sbuild_triangle(&B, src->tris[3 * t], src->tris[3 * t + 1],
-                                      src->tris[3 * t + 2]));
+    FCM_TRY(ctx,
+            fcm__sbuild_triangle(&B, src->tris[3 * t], src->tris[3 * t + 1], src->tris[3 * t + 2]));
   FCM_TRY(ctx, edges_sorted(ctx, src, &e));
   FCM_TRY(ctx, bloops_build(ctx, src, e, 3 * (size_t)src->num_triangles, &L));
   FCM_ALLOC_RAW(ctx, (size_t)L.n + 1, loop);

@@ -271,9 +271,8 @@ static fcm_status build_surface_geometry(fcm_simulation *S, const fcm_scene_geom
       fcm__log(ctx, FCM_LOG_WARNING,
                "scene %s: geometry.surface %s: fill_holes closed %lld of %lld hole(s) (edges: "
                "%s), adding %lld triangles of total area %g; largest left open: %lld edges",
-               fcm_scene_name(S->scene), g->mesh, (long long)fi.num_filled,
-               (long long)fi.num_loops, list, (long long)fi.triangles_added, fi.area_added,
-               (long long)fi.largest_left);
+               fcm_scene_name(S->scene), g->mesh, (long long)fi.num_filled, (long long)fi.num_loops,
+               list, (long long)fi.triangles_added, fi.area_added, (long long)fi.largest_left);
     }
     fcm_surface_destroy(&surf);
     surf = filled;
@@ -288,8 +287,8 @@ cleanup:
 
 /* background.fit_background: cubes of the given edge over the geometry's bounding box
  * grown by the margin, the grid centred on the box. */
-static fcm_status fit_background(fcm_simulation *S, const fcm_scene_background *bg,
-                                 double min[3], double max[3], fcm_index cells[3])
+static fcm_status fit_background(fcm_simulation *S, const fcm_scene_background *bg, double min[3],
+                                 double max[3], fcm_index cells[3])
 {
   fcm_status st = FCM_OK;
   double lo[3], hi[3], h = bg->fit_cell_size;

@@ -259,9 +259,9 @@ static fcm_status read_surface_geometry(fcm__scene_parser *p, const fcm__json *o
                                         fcm_scene_geometry *g)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"surface",        "max_volume", "size",
-                                     "quality",        "fill_holes", "max_hole_edges",
-                                     "max_hole_perimeter", "transform"};
+  static const char *const keys[] = {
+      "surface",        "max_volume",         "size",     "quality", "fill_holes",
+      "max_hole_edges", "max_hole_perimeter", "transform"};
   static const char *const exts[] = {".obj", ".off", ".stl", ".ply"};
   size_t old = p->path_len;
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
@@ -286,8 +286,8 @@ static fcm_status read_surface_geometry(fcm__scene_parser *p, const fcm__json *o
   }
   g->surface = fcm_surface_mesh_options_default();
   g->fill = fcm_surface_fill_options_default();
-  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "max_volume", 0, FCM__NONNEGATIVE,
-                                         &g->surface.max_volume));
+  FCM_TRY(p->ctx,
+          fcm__scene_read_number(p, o, "max_volume", 0, FCM__NONNEGATIVE, &g->surface.max_volume));
   FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "size", 0, FCM__NONNEGATIVE, &g->surface.size));
   FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "quality", 0, (fcm__range){0.0, 1.0, 0, 0},
                                          &g->surface.quality));
@@ -313,11 +313,32 @@ cleanup:
 static fcm_status read_geometry(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
-  static const char *const any_keys[] = {
-      "shape",  "mesh",   "tetgen",       "transform",     "min",          "max",         "cells",
-      "center", "radius", "resolution",   "inner_radius",  "outer_radius", "hole_radius", "layers",
-      "axis",   "length", "radial_cells", "angular_cells", "axial_cells", "surface",
-      "max_volume", "size", "quality", "fill_holes", "max_hole_edges", "max_hole_perimeter"};
+  static const char *const any_keys[] = {"shape",
+                                         "mesh",
+                                         "tetgen",
+                                         "transform",
+                                         "min",
+                                         "max",
+                                         "cells",
+                                         "center",
+                                         "radius",
+                                         "resolution",
+                                         "inner_radius",
+                                         "outer_radius",
+                                         "hole_radius",
+                                         "layers",
+                                         "axis",
+                                         "length",
+                                         "radial_cells",
+                                         "angular_cells",
+                                         "axial_cells",
+                                         "surface",
+                                         "max_volume",
+                                         "size",
+                                         "quality",
+                                         "fill_holes",
+                                         "max_hole_edges",
+                                         "max_hole_perimeter"};
   static const char *const box_keys[] = {"shape", "min", "max", "cells", "transform"};
   static const char *const ball_keys[] = {"shape", "center", "radius", "resolution", "transform"};
   static const char *const hollow_keys[] = {"shape",        "center",      "inner_radius",
