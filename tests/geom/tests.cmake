@@ -17,3 +17,5 @@ fcm_add_test(geom_surface tests/geom/surface.c)
 # Gmsh: the tets' volume equals the enclosed volume to 1e-12 (cube, icosphere, filled
 # open cube and holed sphere); without Gmsh the refusal message.
 fcm_add_test(geom_surface_mesh tests/geom/surface_mesh.c)
+# Allocation failures in the surface checks, reorientation, hole filling and meshing.
+fcm_add_test(geom_surface_alloc tests/geom/surface_alloc.c)
