@@ -202,12 +202,15 @@ FCM_API fcm_surface_mesh_options fcm_surface_mesh_options_default(void);
  * @param[in] opts NULL for defaults; @param[out] geom the Tet4 geometry, NULL on failure
  * @return FCM_OK; FCM_ERR_ARG (NULL, bad option); FCM_ERR_GEOMETRY (the surface fails a
  *         check, or Gmsh fails: its message is quoted); FCM_ERR_UNSUPPORTED (fcm built
- *         without Gmsh); FCM_ERR_ALLOC. Allocates. Thread safe (serialized). */
+ *         without Gmsh, or the Gmsh library cannot be loaded: the message says how to get
+ *         it); FCM_ERR_ALLOC. Allocates. Thread safe (serialized). */
 FCM_API fcm_status fcm_geometry_create_from_surface(fcm_ctx *ctx, const fcm_surface *surf,
                                                     const fcm_surface_mesh_options *opts,
                                                     fcm_geometry **geom);
 
-/** 1 when fcm was built with Gmsh (fcm_geometry_create_from_surface() works), else 0. */
+/** 1 when fcm_geometry_create_from_surface() can work: fcm was built with Gmsh's header
+ * and the Gmsh library (loaded on first use, soname libgmsh.so.MAJOR.MINOR of that header)
+ * loads; else 0. Thread safe. */
 FCM_API int fcm_surface_meshing_available(void);
 
 #ifdef __cplusplus

@@ -1,5 +1,6 @@
 /* The one file that talks to Gmsh's C API (gmshc.h, Debian libgmsh-dev; built when
- * FCM_HAVE_GMSH is defined): tetrahedralization of a closed triangle surface. */
+ * FCM_HAVE_GMSH is defined, Gmsh loaded at run time): tetrahedralization of a closed
+ * triangle surface. */
 #include "geom/surface_impl.h"
 
 #include <math.h>
@@ -13,16 +14,98 @@ fcm_surface_mesh_options fcm_surface_mesh_options_default(void)
 
 #ifdef FCM_HAVE_GMSH
 
+#include <dlfcn.h>
 #include <gmshc.h>
 #include <pthread.h>
 #include <stdlib.h>
 
-/* Gmsh keeps one global model and option set: one meshing at a time. */
+/* Gmsh is loaded on first use (dlopen), not linked: programs that never mesh a surface do
+ * not pay its start-up (about 0.13 s of CPU for Gmsh's and OpenCASCADE's initializers), and
+ * a machine without the Gmsh runtime still runs everything else. The functions come from
+ * the library whose header fcm was compiled against (soname libgmsh.so.MAJOR.MINOR). */
+#define GMSH_STR_(x) #x
+#define GMSH_STR(x)  GMSH_STR_(x)
+#define GMSH_SONAME                                                                                \
+  "libgmsh.so." GMSH_STR(GMSH_API_VERSION_MAJOR) "." GMSH_STR(GMSH_API_VERSION_MINOR)
+
+static struct {
+  void (*Free)(void *);
+  void (*Initialize)(int, char **, const int, int *);
+  void (*Finalize)(int *);
+  void (*OptionSetNumber)(const char *, const double, int *);
+  void (*ModelAdd)(const char *, int *);
+  int (*ModelAddDiscreteEntity)(const int, const int, int *, size_t, int *);
+  void (*ModelMeshAddNodes)(const int, const int, size_t *, size_t, double *, size_t, double *,
+                            size_t, int *);
+  void (*ModelMeshAddElementsByType)(const int, const int, size_t *, size_t, size_t *, size_t,
+                                     int *);
+  int (*ModelGeoAddSurfaceLoop)(int *, size_t, const int, int *);
+  int (*ModelGeoAddVolume)(int *, size_t, const int, int *);
+  void (*ModelGeoSynchronize)(int *);
+  void (*ModelMeshGenerate)(const int, int *);
+  void (*ModelMeshGetNodes)(size_t **, size_t *, double **, size_t *, double **, size_t *,
+                            const int, const int, const int, const int, int *);
+  void (*ModelMeshGetElementsByType)(const int, size_t **, size_t *, size_t **, size_t *, const int,
+                                     const size_t, const size_t, int *);
+  void (*LoggerGetLastError)(char **, int *);
+} G;
+
+/* Guards G, the load and Gmsh's global model and options: one meshing at a time. */
 static pthread_mutex_t gmsh_lock = PTHREAD_MUTEX_INITIALIZER;
+static int gmsh_state; /* 0: not tried, 1: loaded, -1: failed */
+static char gmsh_load_error[256];
+
+/* Resolve one symbol into a function pointer (memcpy: ISO C has no object-to-function
+ * pointer conversion). */
+static int sym(void *lib, const char *name, void *fp, size_t size)
+{
+  void *p = dlsym(lib, name);
+  if (!p) {
+    snprintf(gmsh_load_error, sizeof gmsh_load_error, "%s has no symbol %s", GMSH_SONAME, name);
+    return 0;
+  }
+  memcpy(fp, &p, size);
+  return 1;
+}
+
+/* With the lock held: load Gmsh once. */
+static int gmsh_load(void)
+{
+  if (gmsh_state != 0) return gmsh_state > 0;
+  void *lib = dlopen(GMSH_SONAME, RTLD_NOW | RTLD_LOCAL);
+  if (!lib) lib = dlopen("libgmsh.so", RTLD_NOW | RTLD_LOCAL);
+  if (!lib) {
+    const char *e = dlerror();
+    snprintf(gmsh_load_error, sizeof gmsh_load_error, "%s", e ? e : "dlopen failed");
+    gmsh_state = -1;
+    return 0;
+  }
+#define SYM(field, name) sym(lib, name, &G.field, sizeof G.field)
+  int ok = SYM(Free, "gmshFree") && SYM(Initialize, "gmshInitialize") &&
+           SYM(Finalize, "gmshFinalize") && SYM(OptionSetNumber, "gmshOptionSetNumber") &&
+           SYM(ModelAdd, "gmshModelAdd") &&
+           SYM(ModelAddDiscreteEntity, "gmshModelAddDiscreteEntity") &&
+           SYM(ModelMeshAddNodes, "gmshModelMeshAddNodes") &&
+           SYM(ModelMeshAddElementsByType, "gmshModelMeshAddElementsByType") &&
+           SYM(ModelGeoAddSurfaceLoop, "gmshModelGeoAddSurfaceLoop") &&
+           SYM(ModelGeoAddVolume, "gmshModelGeoAddVolume") &&
+           SYM(ModelGeoSynchronize, "gmshModelGeoSynchronize") &&
+           SYM(ModelMeshGenerate, "gmshModelMeshGenerate") &&
+           SYM(ModelMeshGetNodes, "gmshModelMeshGetNodes") &&
+           SYM(ModelMeshGetElementsByType, "gmshModelMeshGetElementsByType") &&
+           SYM(LoggerGetLastError, "gmshLoggerGetLastError");
+#undef SYM
+  if (!ok) dlclose(lib);
+  gmsh_state = ok ? 1 : -1; /* a loaded library stays loaded for the process */
+  return ok;
+}
 
 int fcm_surface_meshing_available(void)
 {
-  return 1;
+  pthread_mutex_lock(&gmsh_lock);
+  int ok = gmsh_load();
+  pthread_mutex_unlock(&gmsh_lock);
+  return ok;
 }
 
 /* Turn a failed Gmsh call into FCM_ERR_GEOMETRY quoting Gmsh's last error. */
@@ -41,14 +124,16 @@ static fcm_status gmsh_error(fcm_ctx *ctx, const char *call, int line)
 {
   char *msg = NULL;
   int ierr = 0;
-  gmshLoggerGetLastError(&msg, &ierr);
+  G.LoggerGetLastError(&msg, &ierr);
   const char *text = ierr == 0 && msg && msg[0] ? msg : "no message";
-  /* the call's function name: up to the '(' */
+  /* the call's function name: "G.Name(..." or "x = G.Name(..." -> gmshName */
+  const char *g = strstr(call, "G.");
+  call = g ? g + 2 : call;
   size_t n = strcspn(call, "(");
   fcm_status st =
       fcm__error(ctx, FCM_ERR_GEOMETRY, __FILE__, line, "fcm_geometry_create_from_surface",
-                 "surface meshing: Gmsh's %.*s failed: %s", (int)n, call, text);
-  if (msg) gmshFree(msg);
+                 "surface meshing: Gmsh's gmsh%.*s failed: %s", (int)n, call, text);
+  if (msg) G.Free(msg);
   return st;
 }
 
@@ -66,14 +151,14 @@ static fcm_status mesh_locked(fcm_ctx *ctx, const fcm_surface *s, const fcm_surf
   if (o->max_volume > 0.0) size = cbrt(6.0 * sqrt(2.0) * o->max_volume);
   if (o->size > 0.0 && (size == 0.0 || o->size < size)) size = o->size;
 
-  GMSH(gmshOptionSetNumber("General.Terminal", 0, IERR));
-  GMSH(gmshOptionSetNumber("General.Verbosity", 0, IERR));
-  GMSH(gmshModelAdd("fcm_surface", IERR));
+  GMSH(G.OptionSetNumber("General.Terminal", 0, IERR));
+  GMSH(G.OptionSetNumber("General.Verbosity", 0, IERR));
+  GMSH(G.ModelAdd("fcm_surface", IERR));
   /* HXT (Delaunay, Marot et al. 2019): keeps the surface mesh and honours MeshSizeMax for
    * a discrete surface (the classic Delaunay, 1, ignores it there) */
-  GMSH(gmshOptionSetNumber("Mesh.Algorithm3D", 10, IERR));
-  GMSH(gmshOptionSetNumber("Mesh.OptimizeThreshold", o->quality, IERR));
-  if (size > 0.0) GMSH(gmshOptionSetNumber("Mesh.MeshSizeMax", size, IERR));
+  GMSH(G.OptionSetNumber("Mesh.Algorithm3D", 10, IERR));
+  GMSH(G.OptionSetNumber("Mesh.OptimizeThreshold", o->quality, IERR));
+  if (size > 0.0) GMSH(G.OptionSetNumber("Mesh.MeshSizeMax", size, IERR));
 
   FCM_ALLOC_RAW(ctx, nv, ntags);
   FCM_ALLOC_RAW(ctx, nt, etags);
@@ -86,16 +171,16 @@ static fcm_status mesh_locked(fcm_ctx *ctx, const fcm_surface *s, const fcm_surf
       enodes[3 * t + (size_t)k] = (size_t)s->tris[3 * t + (size_t)k] + 1;
   }
   int surf = 0, loop = 0;
-  GMSH(surf = gmshModelAddDiscreteEntity(2, -1, NULL, 0, IERR));
-  GMSH(gmshModelMeshAddNodes(2, surf, ntags, nv, s->coords, 3 * nv, NULL, 0, IERR));
-  GMSH(gmshModelMeshAddElementsByType(surf, 2, etags, nt, enodes, 3 * nt, IERR));
-  GMSH(loop = gmshModelGeoAddSurfaceLoop(&surf, 1, -1, IERR));
-  GMSH(gmshModelGeoAddVolume(&loop, 1, -1, IERR));
-  GMSH(gmshModelGeoSynchronize(IERR));
-  GMSH(gmshModelMeshGenerate(3, IERR));
+  GMSH(surf = G.ModelAddDiscreteEntity(2, -1, NULL, 0, IERR));
+  GMSH(G.ModelMeshAddNodes(2, surf, ntags, nv, s->coords, 3 * nv, NULL, 0, IERR));
+  GMSH(G.ModelMeshAddElementsByType(surf, 2, etags, nt, enodes, 3 * nt, IERR));
+  GMSH(loop = G.ModelGeoAddSurfaceLoop(&surf, 1, -1, IERR));
+  GMSH(G.ModelGeoAddVolume(&loop, 1, -1, IERR));
+  GMSH(G.ModelGeoSynchronize(IERR));
+  GMSH(G.ModelMeshGenerate(3, IERR));
 
-  GMSH(gmshModelMeshGetNodes(&gn, &ngn, &gc, &ngc, &gp, &ngp, -1, -1, 0, 0, IERR));
-  GMSH(gmshModelMeshGetElementsByType(4, &ge, &nge, &gen, &ngen, -1, 0, 1, IERR));
+  GMSH(G.ModelMeshGetNodes(&gn, &ngn, &gc, &ngc, &gp, &ngp, -1, -1, 0, 0, IERR));
+  GMSH(G.ModelMeshGetElementsByType(4, &ge, &nge, &gen, &ngen, -1, 0, 1, IERR));
   FCM_CHECK(nge > 0 && ngen == 4 * nge && ngc == 3 * ngn, ctx, FCM_ERR_GEOMETRY,
             "surface meshing: Gmsh returned %zu tetrahedra (%zu node ids) and %zu nodes (%zu "
             "coordinates) for a surface of %zu triangles",
@@ -118,11 +203,11 @@ static fcm_status mesh_locked(fcm_ctx *ctx, const fcm_surface *s, const fcm_surf
   FCM_TRY(ctx, fcm_geometry_create(ctx, FCM_ELEMENT_TET4, (fcm_index)ngn, gc, (fcm_index)nge, cells,
                                    geom));
 cleanup:
-  if (gn) gmshFree(gn);
-  if (gc) gmshFree(gc);
-  if (gp) gmshFree(gp);
-  if (ge) gmshFree(ge);
-  if (gen) gmshFree(gen);
+  if (gn) G.Free(gn);
+  if (gc) G.Free(gc);
+  if (gp) G.Free(gp);
+  if (ge) G.Free(ge);
+  if (gen) G.Free(gen);
   FCM_FREE(ctx, ntags);
   FCM_FREE(ctx, etags);
   FCM_FREE(ctx, enodes);
@@ -137,15 +222,23 @@ static fcm_status tetrahedralize(fcm_ctx *ctx, const fcm_surface *s,
   fcm_status st = FCM_OK;
   int ierr = 0;
   pthread_mutex_lock(&gmsh_lock);
-  gmshInitialize(0, NULL, 0, &ierr);
+  if (!gmsh_load()) {
+    st = fcm__error(ctx, FCM_ERR_UNSUPPORTED, __FILE__, __LINE__, __func__,
+                    "surface meshing: cannot load Gmsh (%s): install it (Debian: apt-get "
+                    "install libgmsh4.8, or libgmsh-dev)",
+                    gmsh_load_error);
+    pthread_mutex_unlock(&gmsh_lock);
+    return st;
+  }
+  G.Initialize(0, NULL, 0, &ierr);
   if (ierr != 0) {
-    st = gmsh_error(ctx, "gmshInitialize(", __LINE__);
+    st = gmsh_error(ctx, "G.Initialize(", __LINE__);
   } else {
     st = mesh_locked(ctx, s, o, geom);
-    gmshFinalize(&ierr);
+    G.Finalize(&ierr);
     if (ierr != 0 && st == FCM_OK) {
       fcm_geometry_destroy(geom);
-      st = gmsh_error(ctx, "gmshFinalize(", __LINE__);
+      st = gmsh_error(ctx, "G.Finalize(", __LINE__);
     }
   }
   pthread_mutex_unlock(&gmsh_lock);
