@@ -278,7 +278,22 @@ static fcm_status build_surface_geometry(fcm_simulation *S, const fcm_scene_geom
     surf = filled;
     filled = NULL;
   }
-  FCM_TRY(ctx, fcm_geometry_create_from_surface(ctx, surf, &g->surface, raw));
+  /* the checks here, so that a failure names the scene and the file */
+  {
+    char what[512];
+    fcm_surface_report rep;
+    fcm_surface_mesh_options mo = g->surface;
+    snprintf(what, sizeof what, "scene %s: geometry.surface %s", fcm_scene_name(S->scene), g->mesh);
+    FCM_TRY(ctx, fcm_surface_create_oriented(ctx, surf, &filled, NULL));
+    fcm_surface_destroy(&surf);
+    surf = filled;
+    filled = NULL;
+    FCM_TRY(ctx, fcm_surface_check(surf, NULL, &rep));
+    FCM_TRY(ctx, fcm_surface_report_check(surf, what, &rep));
+    mo.check_intersections = 0; /* done above */
+    mo.orient = 0;
+    FCM_TRY(ctx, fcm_geometry_create_from_surface(ctx, surf, &mo, raw));
+  }
 cleanup:
   fcm_surface_destroy(&surf);
   fcm_surface_destroy(&filled);
