@@ -229,6 +229,11 @@ int main(void)
     check_volume(ctx, cube, 0.001);
     check_volume(ctx, s, 0.0);
     check_volume(ctx, s, 0.01);
+    /* no size limit after calls with a limit (no option left over): the cube comes back as
+     * its 8 corners */
+    TEST_OK(ctx, fcm_geometry_create_from_surface(ctx, cube, NULL, &g));
+    TEST_TRUE(g && fcm_geometry_num_nodes(g) == 8);
+    fcm_geometry_destroy(&g);
   } else {
     TEST_ERR(ctx, fcm_geometry_create_from_surface(ctx, cube, NULL, &g), FCM_ERR_UNSUPPORTED,
              "apt-get install libgmsh-dev");

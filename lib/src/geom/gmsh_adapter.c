@@ -158,7 +158,8 @@ static fcm_status mesh_locked(fcm_ctx *ctx, const fcm_surface *s, const fcm_surf
    * a discrete surface (the classic Delaunay, 1, ignores it there) */
   GMSH(G.OptionSetNumber("Mesh.Algorithm3D", 10, IERR));
   GMSH(G.OptionSetNumber("Mesh.OptimizeThreshold", o->quality, IERR));
-  if (size > 0.0) GMSH(G.OptionSetNumber("Mesh.MeshSizeMax", size, IERR));
+  /* always set, not left to Gmsh's state between calls (1e22: its default) */
+  GMSH(G.OptionSetNumber("Mesh.MeshSizeMax", size > 0.0 ? size : 1e22, IERR));
 
   FCM_ALLOC_RAW(ctx, nv, ntags);
   FCM_ALLOC_RAW(ctx, nt, etags);
