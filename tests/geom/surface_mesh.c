@@ -215,6 +215,27 @@ int main(void)
     fcm_surface_destroy(&s);
   }
 
+  /* two triangles sharing a vertex: B's far edge through A (x = y = 0.3) or beside it
+   * (x = y = -0.3); sharing an edge: folded onto A (third vertex coplanar, same side) or
+   * continuing it flat (other side) */
+  {
+    static const double cases[4][15] = {{0, 0, 0, 1, 0, 0, 0, 1, 0, 0.3, 0.3, 1, 0.3, 0.3, -1},
+                                        {0, 0, 0, 1, 0, 0, 0, 1, 0, -0.3, -0.3, 1, -0.3, -0.3, -1},
+                                        {0, 0, 0, 1, 0, 0, 0, 1, 0, 0.2, 0.3, 0, 0, 0, 0},
+                                        {0, 0, 0, 1, 0, 0, 0, 1, 0, 0.2, -0.3, 0, 0, 0, 0}};
+    static const fcm_index vertex_t[6] = {0, 1, 2, 0, 3, 4}, edge_t[6] = {0, 1, 2, 1, 0, 3};
+    static const int expect[4] = {1, 0, 1, 0};
+    for (int c = 0; c < 4; c++) {
+      TEST_OK(ctx,
+              fcm_surface_create(ctx, c < 2 ? 5 : 4, cases[c], 2, c < 2 ? vertex_t : edge_t, &s));
+      TEST_OK(ctx, fcm_surface_check(s, NULL, &r));
+      if (r.num_intersections != expect[c])
+        TEST_FAIL_("case %d: %lld intersections, expected %d", c, (long long)r.num_intersections,
+                   expect[c]);
+      fcm_surface_destroy(&s);
+    }
+  }
+
   /* icosphere: closed, no false intersections among neighbours */
   icosphere(&sph, 2); /* 162 vertices, 320 triangles */
   TEST_OK(ctx, fcm_surface_create(ctx, sph.nv, sph.x, sph.nt, sph.t, &s));

@@ -85,16 +85,17 @@ typedef struct fcm_surface_check_options {
 /** Defaults of fcm_surface_check_options. */
 FCM_API fcm_surface_check_options fcm_surface_check_options_default(void);
 
-/** What fcm_surface_check() found. Edge lists hold vertex ids (a, b), the first
- * min(count, FCM_SURFACE_REPORT_MAX) found. */
+/** What fcm_surface_check() found. Edge lists hold vertex ids (a < b) of the first
+ * min(count, FCM_SURFACE_REPORT_MAX) edges found (in vertex order); the intersection
+ * search counts every intersecting pair, with a tolerance, so near-touching pairs count. */
 typedef struct fcm_surface_report {
   fcm_index num_boundary_edges; /**< edges used by one triangle only (0: closed) */
-  fcm_index boundary_edges[FCM_SURFACE_REPORT_MAX][2];
-  fcm_index num_boundary_loops;    /**< closed chains of boundary edges (holes) */
-  fcm_index num_nonmanifold_edges; /**< edges used by three or more triangles */
-  fcm_index nonmanifold_edges[FCM_SURFACE_REPORT_MAX][2];
+  fcm_index boundary_edges[FCM_SURFACE_REPORT_MAX][2]; /**< the first ones, vertex ids */
+  fcm_index num_boundary_loops;                        /**< chains of boundary edges (holes) */
+  fcm_index num_nonmanifold_edges;                     /**< edges used by three or more triangles */
+  fcm_index nonmanifold_edges[FCM_SURFACE_REPORT_MAX][2]; /**< the first ones, vertex ids */
   fcm_index num_inconsistent_edges; /**< edges both of whose triangles run them the same way */
-  fcm_index inconsistent_edges[FCM_SURFACE_REPORT_MAX][2];
+  fcm_index inconsistent_edges[FCM_SURFACE_REPORT_MAX][2]; /**< the first ones, vertex ids */
   fcm_index num_degenerate;                     /**< degenerate triangles (see degenerate_tol) */
   fcm_index degenerate[FCM_SURFACE_REPORT_MAX]; /**< their triangle ids */
   fcm_index num_intersections; /**< intersecting triangle pairs (-1: not searched) */
