@@ -27,3 +27,4 @@ fcm_add_test(embed_cut_campaign tests/embed/cut_campaign.c ARGS campaign 1000)
 fcm_add_test(embed_cut_campaign_long tests/embed/cut_campaign.c ARGS campaign 60000 7
              LABELS slow TIMEOUT 3600)
 fcm_add_test(embed_limits tests/embed/limits.c)
+fcm_add_test(embed_cut tests/embed/cut.c)
