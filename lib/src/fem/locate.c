@@ -192,16 +192,16 @@ fcm_status fcm_space_interpolate(const fcm_space *s, fcm_index n, const fcm_inde
 #pragma omp parallel for schedule(static)
   for (fcm_index i = 0; i < n; i++) {
     fcm_index c = cell[i];
-    if (c < 0 || c >= s->num_cells || !s->active[c]) {
+    if (c < 0 || c >= s->num_cells || !s->active[c] || s->cell_elem[c + 1] - s->cell_elem[c] != 1) {
 #pragma omp critical(fcm_interpolate)
       if (bad < 0 || i < bad) bad = i;
       continue;
     }
     double N[FCM_ELEMENT_MAX_NODES], v[3] = {0, 0, 0};
     fcm_element_eval_shape(s->type, xi + 3 * i, N);
-    const fcm_index *cn = fcm_mesh_cells(s->mesh) + c * s->nn;
+    const fcm_index *ed = s->elem_dof + s->cell_elem[c] * s->nn;
     for (int a = 0; a < s->nn; a++) {
-      const double *ua = u + s->node_dof[cn[a]];
+      const double *ua = u + ed[a];
       for (int d = 0; d < 3; d++)
         v[d] += N[a] * ua[d];
     }
@@ -209,7 +209,7 @@ fcm_status fcm_space_interpolate(const fcm_space *s, fcm_index n, const fcm_inde
   }
   FCM_CHECK(bad < 0, s->ctx, FCM_ERR_ARG,
             "interpolate: point %lld names cell %lld, which is "
-            "out of range or inactive",
+            "out of range, inactive or split into pieces by cuts",
             (long long)bad, (long long)cell[bad]);
 cleanup:
   return st;

@@ -165,8 +165,8 @@ static fcm_status center_of_mass(const fcm_simulation *S, const double *u, doubl
   FCM_ALLOC(S->ctx, n, x);
   FCM_ALLOC(S->ctx, n, Mx);
   for (fcm_index a = 0; a < S->nn; a++) {
-    fcm_index dof = fcm_space_node_dof(S->space, a);
-    if (dof >= 0)
+    const fcm_index d0 = fcm_space_node_dof(S->space, a);
+    for (fcm_index dof = d0; d0 >= 0 && dof < d0 + 3 * fcm_space_node_copies(S->space, a); dof += 3)
       for (int d = 0; d < 3; d++)
         x[dof + d] = X[3 * a + d] + (u ? u[dof + d] : 0.0);
   }
@@ -212,8 +212,9 @@ fcm_status fcm__effect_initialize_velocity(fcm_simulation *S, const fcm_effect *
     } else {
       in = fcm_region_contains(r, X + 3 * a);
     }
-    if (in)
-      fcm_effect_initial_velocity_eval(&e->initial_velocity, X + 3 * a, init->com, init->v + dof);
+    for (fcm_index k = 0; in && k < fcm_space_node_copies(S->space, a); k++)
+      fcm_effect_initial_velocity_eval(&e->initial_velocity, X + 3 * a, init->com,
+                                       init->v + dof + 3 * k);
   }
   S->c.initial_velocity++;
   return FCM_OK;
