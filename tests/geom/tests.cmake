@@ -12,3 +12,10 @@ fcm_add_test(geom_boundary_cells tests/geom/boundary_cells.c)
 # Triangle surfaces: the unit cube in OBJ, OFF, STL (ASCII, binary) and PLY (ascii, binary)
 # round trips; malformed files fail naming file and line or byte offset.
 fcm_add_test(geom_surface tests/geom/surface.c)
+# Surface checks (boundary, non-manifold and inconsistent edges, inward orientation,
+# degenerate triangles, self-intersections), hole filling, and tetrahedralization through
+# Gmsh: the tets' volume equals the enclosed volume to 1e-12 (cube, icosphere, filled
+# open cube and holed sphere); without Gmsh the refusal message.
+fcm_add_test(geom_surface_mesh tests/geom/surface_mesh.c)
+# Allocation failures in the surface checks, reorientation, hole filling and meshing.
+fcm_add_test(geom_surface_alloc tests/geom/surface_alloc.c)

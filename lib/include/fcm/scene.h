@@ -18,6 +18,7 @@
 #include "fcm/sim.h"
 #include "fcm/simplify.h"
 #include "fcm/solve.h"
+#include "fcm/surface.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -39,6 +40,11 @@ typedef struct fcm_scene_background {
   fcm_index cells[3];       /**< GRID: cells per axis, >= 1 */
   const char *mesh;         /**< MESH: the file, resolved against the scene file's directory;
                                  GRID: NULL */
+  int fit;                  /**< GRID with "fit_background": 1, min, max and cells are then
+                                 set when the simulation is built, from the geometry's box */
+  double fit_cell_size;     /**< fit: edge of the (cubic) cells, > 0 */
+  double fit_margin;        /**< fit: gap between the body's box and the grid's, >= 0 (default:
+                                 one cell) */
 } fcm_scene_background;
 
 /** What the embedded geometry is. */
@@ -51,6 +57,7 @@ typedef enum fcm_scene_geometry_kind {
   FCM_SCENE_GEOMETRY_TUBE,        /**< fcm_geometry_create_tube() */
   FCM_SCENE_GEOMETRY_GMSH,        /**< fcm_geometry_create_from_gmsh() */
   FCM_SCENE_GEOMETRY_TETGEN,      /**< fcm_geometry_create_from_tetgen() */
+  FCM_SCENE_GEOMETRY_SURFACE, /**< a triangle surface file, fcm_geometry_create_from_surface() */
   FCM_SCENE_GEOMETRY_KIND_COUNT
 } fcm_scene_geometry_kind;
 
@@ -68,11 +75,15 @@ typedef struct fcm_scene_geometry {
   int resolution; /**< BALL, HEMISPHERE: cubes per radius; HOLLOW_BALL: quads per patch edge */
   int layers;     /**< HOLLOW_BALL: radial layers */
   int radial_cells, angular_cells, axial_cells; /**< TUBE */
-  const char *mesh;    /**< GMSH: the .msh file; TETGEN: the .node file (resolved paths) */
+  const char *mesh;    /**< GMSH: the .msh file; TETGEN: the .node file; SURFACE: the .obj,
+                            .off, .stl or .ply file (resolved paths) */
   const char *ele;     /**< TETGEN: the .ele file */
   int has_transform;   /**< 1: map the created geometry by x -> A x + b */
   double transform[9]; /**< A, row-major: rotation times scale (identity when none) */
   double offset[3];    /**< b */
+  fcm_surface_mesh_options surface; /**< SURFACE: tetrahedralization options */
+  int fill_holes;                   /**< SURFACE: 1: close holes first */
+  fcm_surface_fill_options fill;    /**< SURFACE: which holes fill_holes closes */
 } fcm_scene_geometry;
 
 /** Quadrature settings ("quadrature"). The enums and option structs are the library's own

@@ -247,6 +247,89 @@ cleanup:
 
 /* ---------------------------------------------------------------- building */
 
+/* geometry.surface: read, optionally close holes (logged as a warning with what was
+ * closed), tetrahedralize. */
+static fcm_status build_surface_geometry(fcm_simulation *S, const fcm_scene_geometry *g,
+                                         fcm_geometry **raw)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  fcm_surface *surf = NULL, *filled = NULL;
+  FCM_TRY(ctx, fcm_surface_create_from_file(ctx, g->mesh, &surf));
+  if (g->fill_holes) {
+    fcm_surface_fill_info fi;
+    FCM_TRY(ctx, fcm_surface_create_filled(ctx, surf, &g->fill, &filled, &fi));
+    if (fi.num_loops > 0) {
+      char list[256];
+      size_t n = 0;
+      list[0] = '\0';
+      for (fcm_index i = 0; i < fi.num_filled && i < FCM_SURFACE_FILL_MAX_LOOPS; i++) {
+        int k = snprintf(list + n, sizeof list - n, "%s%lld", i ? ", " : "",
+                         (long long)fi.loop_edges[i]);
+        if (k < 0 || (size_t)k >= sizeof list - n) break;
+        n += (size_t)k;
+      }
+      fcm__log(ctx, FCM_LOG_WARNING,
+               "scene %s: geometry.surface %s: fill_holes closed %lld of %lld hole(s) (edges: "
+               "%s), adding %lld triangles of total area %g; largest left open: %lld edges",
+               fcm_scene_name(S->scene), g->mesh, (long long)fi.num_filled, (long long)fi.num_loops,
+               list, (long long)fi.triangles_added, fi.area_added, (long long)fi.largest_left);
+    }
+    fcm_surface_destroy(&surf);
+    surf = filled;
+    filled = NULL;
+  }
+  /* the checks here, so that a failure names the scene and the file */
+  {
+    char what[512];
+    fcm_surface_report rep;
+    fcm_surface_mesh_options mo = g->surface;
+    snprintf(what, sizeof what, "scene %s: geometry.surface %s", fcm_scene_name(S->scene), g->mesh);
+    FCM_TRY(ctx, fcm_surface_create_oriented(ctx, surf, &filled, NULL));
+    fcm_surface_destroy(&surf);
+    surf = filled;
+    filled = NULL;
+    FCM_TRY(ctx, fcm_surface_check(surf, NULL, &rep));
+    FCM_TRY(ctx, fcm_surface_report_check(surf, what, &rep));
+    mo.check_intersections = 0; /* done above */
+    mo.orient = 0;
+    FCM_TRY(ctx, fcm_geometry_create_from_surface(ctx, surf, &mo, raw));
+  }
+cleanup:
+  fcm_surface_destroy(&surf);
+  fcm_surface_destroy(&filled);
+  return st;
+}
+
+/* background.fit_background: cubes of the given edge over the geometry's bounding box
+ * grown by the margin, the grid centred on the box. */
+static fcm_status fit_background(fcm_simulation *S, const fcm_scene_background *bg, double min[3],
+                                 double max[3], fcm_index cells[3])
+{
+  fcm_status st = FCM_OK;
+  double lo[3], hi[3], h = bg->fit_cell_size;
+  fcm_geometry_bounding_box(S->geom, lo, hi);
+  double total = 1.0;
+  for (int d = 0; d < 3; d++) {
+    FCM_CHECK(lo[d] <= hi[d], S->ctx, FCM_ERR_GEOMETRY,
+              "scene %s: background.fit_background: the geometry is empty",
+              fcm_scene_name(S->scene));
+    double len = hi[d] - lo[d] + 2.0 * bg->fit_margin;
+    double n = ceil(len / h - 1e-9);
+    if (n < 1.0) n = 1.0;
+    total *= n;
+    FCM_CHECK(total <= 1e8, S->ctx, FCM_ERR_ARG,
+              "scene %s: background.fit_background: cell_size %g gives more than 1e8 cells "
+              "around the geometry's box [%g, %g] x [%g, %g] x [%g, %g]; use larger cells",
+              fcm_scene_name(S->scene), h, lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]);
+    double c = 0.5 * (lo[d] + hi[d]);
+    cells[d] = (fcm_index)n;
+    min[d] = c - 0.5 * n * h, max[d] = c + 0.5 * n * h;
+  }
+cleanup:
+  return st;
+}
+
 static fcm_status build_geometry(fcm_simulation *S, const fcm_scene_geometry *g)
 {
   fcm_status st = FCM_OK;
@@ -276,6 +359,9 @@ static fcm_status build_geometry(fcm_simulation *S, const fcm_scene_geometry *g)
     break;
   case FCM_SCENE_GEOMETRY_TETGEN:
     FCM_TRY(ctx, fcm_geometry_create_from_tetgen(ctx, g->mesh, g->ele, &raw));
+    break;
+  case FCM_SCENE_GEOMETRY_SURFACE:
+    FCM_TRY(ctx, build_surface_geometry(S, g, &raw));
     break;
   default:
     FCM_CHECK(0, ctx, FCM_ERR_ARG, "scene %s: geometry kind %d outside [1, %d)",
@@ -454,16 +540,22 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
 
   /* background mesh */
   const fcm_scene_background *bg = fcm_scene_get_background(scene);
-  if (bg->kind == FCM_SCENE_BACKGROUND_GRID)
+  const fcm_scene_geometry *g = fcm_scene_get_geometry(scene);
+  if (bg->kind == FCM_SCENE_BACKGROUND_GRID && bg->fit) {
+    double min[3], max[3];
+    fcm_index cells[3];
+    FCM_TRY(ctx, build_geometry(S, g)); /* the parser ensured there is one */
+    FCM_TRY(ctx, fit_background(S, bg, min, max, cells));
+    FCM_TRY(ctx, fcm_mesh_create_box(ctx, bg->element, min, max, cells, &S->mesh));
+  } else if (bg->kind == FCM_SCENE_BACKGROUND_GRID)
     FCM_TRY(ctx, fcm_mesh_create_box(ctx, bg->element, bg->min, bg->max, bg->cells, &S->mesh));
   else
     FCM_TRY(ctx, fcm_mesh_create_from_gmsh(ctx, bg->mesh, &S->mesh));
   S->nn = fcm_mesh_num_nodes(S->mesh);
 
   /* geometry and cell rules only when the scene embeds one */
-  const fcm_scene_geometry *g = fcm_scene_get_geometry(scene);
   if (g->kind != FCM_SCENE_GEOMETRY_NONE) {
-    FCM_TRY(ctx, build_geometry(S, g));
+    if (!S->geom) FCM_TRY(ctx, build_geometry(S, g));
     FCM_TRY(ctx, build_rules(S));
     FCM_TRY(ctx, fcm_space_create_embedded(ctx, S->mesh, S->rules, &S->space));
   } else {
