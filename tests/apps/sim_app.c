@@ -104,12 +104,13 @@ static int mode_run(const char *sim, const char *work)
     char line[512];
     TEST_TRUE(fgets(line, sizeof line, f) &&
               !strcmp(line, "step,time,newton_iterations,linear_iterations,residual,energy,"
-                            "wall_time\n"));
+                            "pieces,mass,momentum_x,momentum_y,momentum_z,wall_time\n"));
     int rows = 0;
-    long long step, newton, linear;
-    double t, res, energy, wall;
-    while (fscanf(f, "%lld,%lf,%lld,%lld,%lf,%lf,%lf\n", &step, &t, &newton, &linear, &res, &energy,
-                  &wall) == 7) {
+    long long step, newton, linear, pieces;
+    double t, res, energy, wall, mass, p[3];
+    while (fscanf(f, "%lld,%lf,%lld,%lld,%lf,%lf,%lld,%lf,%lf,%lf,%lf,%lf\n", &step, &t, &newton,
+                  &linear, &res, &energy, &pieces, &mass, &p[0], &p[1], &p[2], &wall) == 12) {
+      TEST_TRUE(pieces == 1 && mass > 0.0);
       rows++;
       TEST_TRUE(step == rows);
       TEST_NEAR(t, 0.01 * rows, 1e-12, 1e-14);
@@ -376,10 +377,11 @@ static int mode_default_quick(const char *sim, const char *work)
     char line[512];
     TEST_TRUE(fgets(line, sizeof line, f) && !strncmp(line, "step,time,newton_iterations,", 28));
     int rows = 0;
-    long long step, newton, linear;
-    double t, res, energy, wall;
-    while (fscanf(f, "%lld,%lf,%lld,%lld,%lf,%lf,%lf\n", &step, &t, &newton, &linear, &res, &energy,
-                  &wall) == 7) {
+    long long step, newton, linear, pieces;
+    double t, res, energy, wall, mass, p[3];
+    while (fscanf(f, "%lld,%lf,%lld,%lld,%lf,%lf,%lld,%lf,%lf,%lf,%lf,%lf\n", &step, &t, &newton,
+                  &linear, &res, &energy, &pieces, &mass, &p[0], &p[1], &p[2], &wall) == 12) {
+      TEST_TRUE(pieces == 1 && mass > 0.0);
       rows++;
       TEST_TRUE(step == rows);
       TEST_NEAR(t, dt * rows, 1e-12, 1e-14);

@@ -1,6 +1,7 @@
 /* Checkpoints of scene runs: for a static run with load steps, surface loads and CG with
  * Schwarz blocks, a dynamic nonlinear run with damping, a released motion and MINRES, and a
- * free spinning body with the direct solver, running K steps, saving, restoring into a new
+ * free spinning body with the direct solver, and a spinning body cut in two during the run
+ * (checkpoints before and after the cut), running K steps, saving, restoring into a new
  * simulation and running on gives bit for bit the state, time and per-step log (but wall
  * times) of the uninterrupted run. Error paths: restoring into a stepped simulation, a
  * missing file, a directory, a checkpoint beyond the steps to take, an unwritable path (nothing
@@ -57,6 +58,20 @@ static const char spin_json[] =
     " \"material\": {\"model\": \"snh\", \"young\": 1e6, \"poisson\": 0.3, \"density\": 1000},"
     " \"time\": {\"dt\": 0.01, \"steps\": 6},"
     " \"effects\": [{\"initial_velocity\": {\"angular_velocity\": [0, 0, 3]}}]}";
+
+/* a spinning free body cut in two at t = 0.04 (before step 3): checkpoints before and after
+ * the cut */
+static const char cut_json[] =
+    "{\"version\": 1, \"name\": \"ck_cut\","
+    " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [-0.25, -0.25, -0.25],"
+    "   \"max\": [1.25, 0.75, 0.75]}, \"cells\": [3, 2, 2]},"
+    " \"geometry\": {\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [1, 0.5, 0.5],"
+    "   \"cells\": [2, 1, 1]},"
+    " \"material\": {\"model\": \"snh\", \"young\": 1e5, \"poisson\": 0.3, \"density\": 1000},"
+    " \"time\": {\"dt\": 0.02, \"steps\": 6},"
+    " \"effects\": [{\"initial_velocity\": {\"angular_velocity\": [0, 0, 4]}},"
+    "  {\"cut\": {\"time\": 0.04, \"surface\": {\"plane\": {\"point\": [0.43, 0.25, 0.25],"
+    "    \"normal\": [1, 0.1, 0]}}}}]}";
 
 typedef struct run_state {
   fcm_index n;
@@ -179,6 +194,8 @@ int main(void)
   check_scene(ctx, static_json, dir, 5);
   check_scene(ctx, dynamic_json, dir, 2);
   check_scene(ctx, spin_json, dir, 3);
+  check_scene(ctx, cut_json, dir, 1); /* before the cut */
+  check_scene(ctx, cut_json, dir, 4); /* after it */
 
   /* error paths */
   fcm_scene *scene = NULL, *other = NULL;

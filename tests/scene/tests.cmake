@@ -24,3 +24,5 @@ fcm_add_test(scene_simplify_auto tests/scene/simplify_auto.c)
 # geometry.surface and background.fit_background: parse errors of the new keys; a binary STL
 # cube and an open OBJ cube (refused, then closed with fill_holes) built on a fitted grid.
 fcm_add_test(scene_surface tests/scene/surface_scene.c)
+# The cut effect: bodies and mass in the log across cuts, cuts at t = 0, no-op cuts, errors.
+fcm_add_test(scene_cut tests/scene/cut_scene.c)

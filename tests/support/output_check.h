@@ -52,7 +52,7 @@ static inline void oc_bad(oc_counts *c, const char *path, const char *why)
   if (!c->bad++) snprintf(c->first_error, sizeof c->first_error, "%.250s: %.250s", path, why);
 }
 
-/* A CSV log: the header, then rows "k,<6 more fields>\n" for k = 1, 2, ... */
+/* A CSV log: the header, then rows "k,<11 more fields>\n" for k = 1, 2, ... */
 static inline int oc_check_csv(const char *path, char *why, size_t cap)
 {
   long n = 0;
@@ -62,7 +62,8 @@ static inline int oc_check_csv(const char *path, char *why, size_t cap)
     snprintf(why, cap, "unreadable");
     return 0;
   }
-  const char *hdr = "step,time,newton_iterations,linear_iterations,residual,energy,wall_time\n";
+  const char *hdr = "step,time,newton_iterations,linear_iterations,residual,energy,pieces,mass,"
+                    "momentum_x,momentum_y,momentum_z,wall_time\n";
   const char *p = (const char *)buf, *end = p + n;
   if ((size_t)n < strlen(hdr) || memcmp(p, hdr, strlen(hdr))) {
     snprintf(why, cap, "no header");
@@ -78,7 +79,7 @@ static inline int oc_check_csv(const char *path, char *why, size_t cap)
     int commas = 0;
     for (const char *q = p; q < nl; q++)
       commas += *q == ',';
-    if (commas != 6 || strtoll(p, NULL, 10) != row) {
+    if (commas != 11 || strtoll(p, NULL, 10) != row) {
       snprintf(why, cap, "row %lld malformed", row);
       goto done;
     }

@@ -101,7 +101,7 @@ FCM_API fcm_status fcm_space_transfer(const fcm_space *from, const fcm_space *to
  * x = X + u. Exact for the polynomial fields of the space where the mass rules are (cut
  * cells: rules of the mass strength), so a cut, which leaves the field unchanged, leaves
  * all three unchanged up to rounding. u and v (num_dofs) may be NULL (zero); outputs may
- * be NULL. @return FCM_OK, FCM_ERR_ARG (NULL space, density < 0), FCM_ERR_ALLOC. */
+ * be NULL. @return FCM_OK, FCM_ERR_ARG (NULL space, density < 0). No allocation. */
 FCM_API fcm_status fcm_space_momentum(const fcm_space *space, double density, const double *u,
                                       const double *v, double *mass, double linear[3],
                                       double angular[3]);

@@ -57,8 +57,12 @@ typedef struct fcm_simulation_counters {
   long long factorizations; /**< numeric factorizations / preconditioner setups (total) */
   long long analyses;       /**< symbolic analyses (total) */
   long long direct_fallbacks;
-  long long frames; /**< frames written */
-  fcm_index num_dofs;
+  long long frames;    /**< frames written */
+  fcm_index num_dofs;  /**< DOFs now (cuts add copies) */
+  int cuts;            /**< cut effects applied so far */
+  int cuts_missed;     /**< of them, cuts that missed the body (no cell got a new piece) */
+  fcm_index cut_cells; /**< cells integrated again because a cut reached them (summed) */
+  fcm_index pieces;    /**< separate bodies now (fcm_space_num_bodies()) */
   fcm_index surface_points, surface_triangles; /**< embedded surface written per frame */
   double time_setup, time_steps, time_output;  /**< seconds */
 } fcm_simulation_counters;
@@ -108,7 +112,9 @@ FCM_API int fcm_simulation_state_finite(const fcm_simulation *sim);
 FCM_API fcm_status fcm_simulation_write_frame(fcm_simulation *sim, const char *dir, int index);
 
 /** Write the per-step log as CSV atomically to `path`: header
- * "step,time,newton_iterations,linear_iterations,residual,energy,wall_time" and one row per
+ * "step,time,newton_iterations,linear_iterations,residual,energy,pieces,mass,momentum_x,
+ * momentum_y,momentum_z,wall_time" (pieces: separate bodies, fcm_space_num_bodies(); mass and
+ * linear momentum over the body's own quadrature points, fcm_space_momentum()) and one row per
  * step taken. @return FCM_OK, FCM_ERR_IO, FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_simulation_write_log(fcm_simulation *sim, const char *path);
 

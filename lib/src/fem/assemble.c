@@ -800,12 +800,11 @@ fcm_status fcm_space_momentum(const fcm_space *s, double density, const double *
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s ? s->ctx : NULL;
-  fcm_rule *full = NULL;
   double m = 0.0, p[3] = {0, 0, 0}, L[3] = {0, 0, 0};
   FCM_CHECK(s, ctx, FCM_ERR_ARG, "momentum: space is NULL");
   FCM_CHECK(isfinite(density) && density >= 0.0, ctx, FCM_ERR_ARG,
             "momentum: density = %g must be finite and >= 0", density);
-  FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, FCM_RULE_MASS, FCM_DEFAULT, &full));
+  const fcm_rule *full = s->mass_rule;
   for (fcm_index e = 0; e < s->num_elems; e++) {
     const fcm_index c = s->elem_cell[e];
     int nq = 0;
@@ -844,6 +843,5 @@ fcm_status fcm_space_momentum(const fcm_space *s, double density, const double *
   if (linear) memcpy(linear, p, sizeof p);
   if (angular) memcpy(angular, L, sizeof L);
 cleanup:
-  fcm_rule_destroy(&full);
   return st;
 }

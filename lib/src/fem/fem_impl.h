@@ -45,6 +45,7 @@ struct fcm_space {
    * in fcm_assembly_workspace (assemble.c). */
   const fcm_cell_rules *rules;
   int max_cut_points;
+  fcm_rule *mass_rule; /* the standard mass rule of full cells (fcm_space_momentum()) */
 };
 
 /* The elimination of fcm_space_apply_dirichlet() on a square A (n x n) with the constrained

@@ -356,6 +356,7 @@ static fcm_status space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigne
   FCM_TRY(ctx, build_node_graph(s, inc_ptr, inc));
   FCM_TRY(ctx, build_pattern(s));
   FCM_TRY(ctx, build_colors(s, inc_ptr, inc));
+  FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, FCM_RULE_MASS, FCM_DEFAULT, &s->mass_rule));
   *out = s;
   s = NULL;
 cleanup:
@@ -410,6 +411,7 @@ void fcm_space_destroy(fcm_space **sp)
   fcm__free(ctx, s->row_ptr);
   fcm__free(ctx, s->col_idx);
   fcm__free(ctx, s->elem_off);
+  fcm_rule_destroy(&s->mass_rule);
   fcm__free(ctx, s->color_ptr);
   fcm__free(ctx, s->color_elems);
   fcm__free(ctx, s);

@@ -7,9 +7,11 @@
  *   u64 version (1), u64 byte-order mark 0x0102030405060708
  *   u64 scene fingerprint (see fingerprint())
  *   i64 num_dofs, i64 steps, f64 time
+ *   (version 2) i64 cuts applied (the first k cut effects in time order)
  *   i64 newton_iterations, i64 linear_iterations, i64 tangent_assemblies
  *   i64 frames, then frames x f64 frame time
- *   i64 log rows, then rows x (f64 time, residual, energy, wall; i64 newton, linear)
+ *   i64 log rows, then rows x (f64 time, residual, energy, wall; i64 newton, linear;
+ *   version 2: i64 pieces; f64 mass, momentum x, y, z)
  *   num_dofs x f64 displacement, num_dofs x f64 velocity
  *   u64 FNV-1a 64 checksum of every byte before it */
 #define _POSIX_C_SOURCE 200809L
@@ -26,7 +28,7 @@
 #include <sys/stat.h>
 
 #define CKPT_MAGIC   "FCMCKPT"
-#define CKPT_VERSION 1u
+#define CKPT_VERSION 2u
 #define CKPT_BOM     0x0102030405060708ull
 #define FNV_OFFSET   0xcbf29ce484222325ull
 #define FNV_PRIME    0x100000001b3ull
@@ -67,8 +69,9 @@ static uint64_t fingerprint(const fcm_simulation *S)
   }
   const fcm_scene_time *tm = fcm_scene_get_time(S->scene);
   const fcm_material *mat = fcm_scene_get_material(S->scene);
-  int64_t sizes[5] = {(int64_t)S->c.num_dofs, (int64_t)S->nn, (int64_t)fcm_mesh_num_cells(S->mesh),
-                      (int64_t)S->c.constrained_dofs, (int64_t)tm->load_steps};
+  /* sizes before any cut: a restored run re-applies the cuts the checkpoint had */
+  int64_t sizes[5] = {(int64_t)S->base_dofs, (int64_t)S->nn, (int64_t)fcm_mesh_num_cells(S->mesh),
+                      (int64_t)S->base_constrained, (int64_t)tm->load_steps};
   double reals[4] = {tm->dt, mat->young, mat->poisson, mat->density};
   int flags[2] = {tm->integrator == FCM_INTEGRATOR_STATIC, (int)mat->model};
   h = fnv(h, sizes, sizeof sizes);
@@ -129,6 +132,7 @@ fcm_status fcm_simulation_write_checkpoint(fcm_simulation *S, const char *path)
   FCM_TRY(ctx, put_i64(&w, (long long)n));
   FCM_TRY(ctx, put_i64(&w, steps));
   FCM_TRY(ctx, put_f64(&w, t));
+  FCM_TRY(ctx, put_i64(&w, S->cuts_applied));
   FCM_TRY(ctx, put_i64(&w, S->c.newton_iterations));
   FCM_TRY(ctx, put_i64(&w, S->c.linear_iterations));
   FCM_TRY(ctx, put_i64(&w, S->c.tangent_assemblies));
@@ -144,6 +148,10 @@ fcm_status fcm_simulation_write_checkpoint(fcm_simulation *S, const char *path)
     FCM_TRY(ctx, put_f64(&w, r->wall));
     FCM_TRY(ctx, put_i64(&w, r->newton));
     FCM_TRY(ctx, put_i64(&w, r->linear));
+    FCM_TRY(ctx, put_i64(&w, r->pieces));
+    FCM_TRY(ctx, put_f64(&w, r->mass));
+    for (int d = 0; d < 3; d++)
+      FCM_TRY(ctx, put_f64(&w, r->momentum[d]));
   }
   FCM_TRY(ctx, put(&w, fcm_integrator_displacement(S->integ), sizeof(double) * (size_t)n));
   FCM_TRY(ctx, put(&w, fcm_integrator_velocity(S->integ), sizeof(double) * (size_t)n));
@@ -224,6 +232,7 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
             "written %lld frames)",
             path, S->c.steps, S->c.frames);
   size_t size = 0;
+  uint64_t ver = 0;
   FCM_TRY(ctx, fcm__file_read_all(ctx, "checkpoint", path, CKPT_MAX_BYTES, (char **)&data, &size));
   ckpt_reader r = {ctx, path, data, size, 0};
   {
@@ -236,9 +245,10 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
     FCM_TRY(ctx, get(&r, &bom, sizeof bom, "the byte-order mark"));
     FCM_CHECK(bom == CKPT_BOM, ctx, FCM_ERR_FORMAT,
               "checkpoint %s: written on a machine of the other byte order", path);
-    FCM_CHECK(version == CKPT_VERSION, ctx, FCM_ERR_FORMAT,
-              "checkpoint %s: version %llu; this build reads version %u", path,
+    FCM_CHECK(version == 1 || version == CKPT_VERSION, ctx, FCM_ERR_FORMAT,
+              "checkpoint %s: version %llu; this build reads versions 1 and %u", path,
               (unsigned long long)version, CKPT_VERSION);
+    ver = version;
     memcpy(&sum, data + size - sizeof sum, sizeof sum);
     FCM_CHECK(fnv(FNV_OFFSET, data, size - sizeof sum) == sum, ctx, FCM_ERR_FORMAT,
               "checkpoint %s: checksum mismatch (the file is truncated or corrupted)", path);
@@ -249,19 +259,17 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
               "(only the time span and the output section may change)",
               path, fcm_scene_name(S->scene));
   }
-  long long n = 0, steps = 0, frames = 0, rows = 0;
+  long long n = 0, steps = 0, frames = 0, rows = 0, cuts = 0;
   long long newton = 0, linear = 0, tangents = 0;
   double t = 0.0;
-  fcm_index ndof = fcm_integrator_num_dofs(S->integ);
   FCM_TRY(ctx, get_i64(&r, &n, 0, INT64_MAX, "num_dofs"));
-  FCM_CHECK(n == ndof, ctx, FCM_ERR_ARG, "checkpoint %s: %lld DOFs, the simulation has %lld", path,
-            n, (long long)ndof);
   FCM_TRY(ctx, get_i64(&r, &steps, 0, INT64_MAX, "steps"));
   FCM_CHECK(steps <= S->num_steps, ctx, FCM_ERR_ARG,
             "checkpoint %s: step %lld is beyond the %lld steps this run takes (extend "
             "time.duration or --steps)",
             path, steps, S->num_steps);
   FCM_TRY(ctx, get(&r, &t, sizeof t, "time"));
+  if (ver >= 2) FCM_TRY(ctx, get_i64(&r, &cuts, S->cuts_applied, S->num_cuts, "cuts applied"));
   FCM_TRY(ctx, get_i64(&r, &newton, 0, INT64_MAX, "newton_iterations"));
   FCM_TRY(ctx, get_i64(&r, &linear, 0, INT64_MAX, "linear_iterations"));
   FCM_TRY(ctx, get_i64(&r, &tangents, 0, INT64_MAX, "tangent_assemblies"));
@@ -272,7 +280,9 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
     FCM_TRY(ctx, get(&r, frame_time, sizeof *frame_time * (size_t)frames, "the frame times"));
   }
   FCM_TRY(ctx, get_i64(&r, &rows, steps, steps, "log rows (one per step)"));
-  FCM_TRY(ctx, need(&r, rows, 4 * sizeof(double) + 2 * sizeof(int64_t), "log rows"));
+  const size_t row_bytes = ver >= 2 ? 8 * sizeof(double) + 3 * sizeof(int64_t)
+                                    : 4 * sizeof(double) + 2 * sizeof(int64_t);
+  FCM_TRY(ctx, need(&r, rows, row_bytes, "log rows"));
   if (rows > 0) FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&log, &log_cap, rows, sizeof *log));
   for (long long k = 0; k < rows; k++) {
     fcm__log_row *w = &log[k];
@@ -282,6 +292,14 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
     FCM_TRY(ctx, get(&r, i, sizeof i, "a log row"));
     w->time = d[0], w->residual = d[1], w->energy = d[2], w->wall = d[3];
     w->newton = (long long)i[0], w->linear = (long long)i[1];
+    if (ver >= 2) {
+      int64_t pc;
+      double e[4];
+      FCM_TRY(ctx, get(&r, &pc, sizeof pc, "a log row"));
+      FCM_TRY(ctx, get(&r, e, sizeof e, "a log row"));
+      w->pieces = (long long)pc, w->mass = e[0];
+      memcpy(w->momentum, e + 1, 3 * sizeof *e);
+    }
   }
   FCM_TRY(ctx, need(&r, n, 2 * sizeof(double), "displacement and velocity values"));
   FCM_ALLOC(ctx, n, u);
@@ -290,6 +308,14 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
   FCM_TRY(ctx, get(&r, v, sizeof *v * (size_t)n, "the velocity"));
   FCM_CHECK(r.pos == r.size, ctx, FCM_ERR_FORMAT, "checkpoint %s: %zu unexpected trailing bytes",
             path, r.size - r.pos);
+  /* The file is whole: re-apply the cuts it had (the state lives on the cut space). */
+  while (S->cuts_applied < cuts)
+    FCM_TRY(ctx, fcm__sim_apply_cut(S));
+  {
+    const fcm_index ndof = fcm_integrator_num_dofs(S->integ);
+    FCM_CHECK(n == ndof, ctx, FCM_ERR_ARG, "checkpoint %s: %lld DOFs, the simulation has %lld",
+              path, n, (long long)ndof);
+  }
   /* Everything read and checked: apply (set_state validates finiteness first). */
   FCM_TRY(ctx, fcm_integrator_set_state(S->integ, u, v, t, steps));
   S->c.steps = steps;

@@ -477,6 +477,13 @@ static fcm_index count_schwarz_blocks(const fcm_simulation *S, double theta)
 }
 
 /* The embedded surface: the boundary triangles' nodes (compacted), located once. */
+/* The element each surface vertex moves with (after every cut). */
+static void surface_elements(fcm_simulation *S)
+{
+  for (fcm_index i = 0; S->surf_elem && i < S->ns; i++)
+    S->surf_elem[i] = fcm_space_point_element(S->space, S->surf_cell[i], S->surf_xi + 3 * i);
+}
+
 static fcm_status build_surface(fcm_simulation *S)
 {
   fcm_status st = FCM_OK;
@@ -504,14 +511,131 @@ static fcm_status build_surface(fcm_simulation *S)
     if (map[i] >= 0)
       for (int d = 0; d < 3; d++)
         S->surf_X[3 * map[i] + d] = GX[3 * i + d];
+  FCM_ALLOC(ctx, ns + 1, S->surf_elem);
   if (ns > 0)
     FCM_TRY(ctx, fcm_space_locate(S->space, ns, S->surf_X, S->surf_cell, S->surf_xi, NULL));
   S->ns = ns;
   S->nt = nt;
+  surface_elements(S);
   S->c.surface_points = ns;
   S->c.surface_triangles = nt;
 cleanup:
   fcm__free(ctx, map);
+  return st;
+}
+
+/* The surface of cut effect c: the plane is clipped to the body's bounding box enlarged
+ * by 10 % of its diagonal (before the transform). *surf NULL: a plane that misses the box. */
+static fcm_status cut_surface(fcm_simulation *S, const fcm_effect_cut *c, fcm_surface **surf)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  fcm_surface *raw = NULL;
+  *surf = NULL;
+  switch (c->kind) {
+  case FCM_CUT_PLANE: {
+    double lo[3], hi[3], diag = 0.0;
+    fcm_geometry_bounding_box(S->geom, lo, hi);
+    for (int d = 0; d < 3; d++)
+      diag += (hi[d] - lo[d]) * (hi[d] - lo[d]);
+    diag = sqrt(diag);
+    for (int d = 0; d < 3; d++)
+      lo[d] -= 0.1 * diag, hi[d] += 0.1 * diag;
+    st = fcm_surface_create_plane(ctx, c->point, c->normal, lo, hi, &raw);
+    if (st == FCM_ERR_GEOMETRY) { /* misses the body: a counted no-op */
+      fcm_ctx_error_clear(ctx);
+      st = FCM_OK;
+      goto cleanup;
+    }
+    FCM_TRY(ctx, st);
+  } break;
+  case FCM_CUT_RECTANGLE:
+    FCM_TRY(ctx, fcm_surface_create_rectangle(ctx, c->point, c->normal, c->axis, c->size, &raw));
+    break;
+  case FCM_CUT_DISC:
+    FCM_TRY(ctx, fcm_surface_create_disc(ctx, c->point, c->normal, c->radius, c->segments, &raw));
+    break;
+  case FCM_CUT_MESH:
+    FCM_TRY(ctx, fcm_surface_create_from_file(ctx, c->mesh, &raw));
+    break;
+  }
+  if (c->has_transform) {
+    FCM_TRY(ctx, fcm_surface_create_transformed(ctx, raw, c->transform, c->offset, surf));
+  } else {
+    *surf = raw;
+    raw = NULL;
+  }
+cleanup:
+  fcm_surface_destroy(&raw);
+  return st;
+}
+
+fcm_status fcm__sim_apply_cut(fcm_simulation *S)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  const fcm_effect *e = S->cuts[S->cuts_applied];
+  fcm_surface *surf = NULL;
+  fcm_cell_rules *rules = NULL;
+  fcm_space *space = NULL;
+  fcm_integrator *integ = NULL;
+  FCM_TRY(ctx, cut_surface(S, &e->cut, &surf));
+  S->cuts_applied++;
+  S->c.cuts++;
+  if (!surf) {
+    S->c.cuts_missed++;
+    goto cleanup;
+  }
+  FCM_TRY(ctx, fcm_cell_rules_create_cut(ctx, S->mesh, S->geom, S->rules, surf, &rules));
+  S->c.cut_cells += fcm_cell_rules_get_stats(rules)->num_integrated;
+  FCM_TRY(ctx, fcm_space_create_embedded(ctx, S->mesh, rules, &space));
+  if (fcm_cell_rules_num_pieces(rules) == fcm_cell_rules_num_pieces(S->rules)) S->c.cuts_missed++;
+  FCM_TRY(ctx, fcm_integrator_create_cut(S->integ, space, &integ));
+  /* the new integrator counts from zero: keep the totals so far */
+  S->base_factorizations = S->c.factorizations;
+  S->base_analyses = S->c.analyses;
+  S->base_fallbacks = S->c.direct_fallbacks;
+  fcm_integrator_destroy(&S->integ);
+  fcm_space_destroy(&S->space);
+  fcm_cell_rules_destroy(&S->rules);
+  S->integ = integ, S->space = space, S->rules = rules;
+  integ = NULL, space = NULL, rules = NULL;
+  S->c.num_dofs = fcm_space_num_dofs(S->space);
+  S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);
+  S->pieces = fcm_space_num_bodies(S->space);
+  S->c.pieces = S->pieces;
+  surface_elements(S);
+cleanup:
+  fcm_integrator_destroy(&integ);
+  fcm_space_destroy(&space);
+  fcm_cell_rules_destroy(&rules);
+  fcm_surface_destroy(&surf);
+  return st;
+}
+
+/* The scene's cut effects in time order (stable); they need an embedded geometry. */
+static fcm_status collect_cuts(fcm_simulation *S)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  const int n = fcm_scene_count_effects(S->scene, FCM_EFFECT_CUT);
+  if (n == 0) return FCM_OK;
+  FCM_ALLOC(ctx, (size_t)n, S->cuts);
+  for (int k = 0; k < fcm_scene_num_effects(S->scene); k++) {
+    const fcm_effect *e = fcm_scene_get_effect(S->scene, k);
+    if (e->type != FCM_EFFECT_CUT) continue;
+    FCM_CHECK(S->rules, ctx, FCM_ERR_ARG,
+              "scene %s: effects[%d].cut needs an embedded geometry (\"geometry\"): cuts split "
+              "the embedded body",
+              fcm_scene_name(S->scene), k);
+    int i = S->num_cuts++;
+    while (i > 0 && S->cuts[i - 1]->cut.time > e->cut.time) {
+      S->cuts[i] = S->cuts[i - 1];
+      i--;
+    }
+    S->cuts[i] = e;
+  }
+cleanup:
   return st;
 }
 
@@ -592,6 +716,13 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   S->free_body = S->c.inertia && S->c.constraints == 0 && S->c.body_force_assemblies == 0 &&
                  S->c.traction_assemblies == 0;
   if (S->free_body) FCM_TRY(ctx, center_of_mass(S, NULL, S->com0));
+  S->base_dofs = S->c.num_dofs;
+  S->base_constrained = S->c.constrained_dofs;
+  S->pieces = fcm_space_num_bodies(S->space);
+  S->c.pieces = S->pieces;
+  FCM_TRY(ctx, collect_cuts(S));
+  while (S->cuts_applied < S->num_cuts && S->cuts[S->cuts_applied]->cut.time <= 0.0)
+    FCM_TRY(ctx, fcm__sim_apply_cut(S));
 
   /* output scratch */
   fcm_index nc = fcm_mesh_num_cells(S->mesh);
@@ -626,7 +757,7 @@ void fcm_simulation_destroy(fcm_simulation **sim)
   fcm_mesh_destroy(&S->mesh);
   void *arrays[] = {S->node_u,    S->node_v,     S->cell_active, S->cell_phi, S->surf_tri,
                     S->surf_cell, S->surf_X,     S->surf_xi,     S->surf_u,   S->surf_x,
-                    S->log,       S->frame_time, S->loads};
+                    S->log,       S->frame_time, S->loads,       S->cuts,     S->surf_elem};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(ctx, arrays[k]);
   fcm__free(ctx, S);
@@ -646,6 +777,14 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   /* room for the log row first: a step that is taken is also logged */
   FCM_TRY(S->ctx,
           fcm__sim_grow(S->ctx, (void **)&S->log, &S->log_cap, S->log_n + 1, sizeof *S->log));
+  {
+    const double t = fcm_integrator_time(S->integ), dt = fcm_scene_get_time(S->scene)->dt;
+    while (S->cuts_applied < S->num_cuts && S->cuts[S->cuts_applied]->cut.time <= t + 1e-9 * dt) {
+      const double tc = fcm_wtime();
+      FCM_TRY(S->ctx, fcm__sim_apply_cut(S));
+      S->c.time_steps += fcm_wtime() - tc;
+    }
+  }
   double t0 = fcm_wtime();
   st = fcm_integrator_step(S->integ, &si);
   double wall = fcm_wtime() - t0;
@@ -653,9 +792,9 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   S->c.newton_iterations += si.newton_iterations;
   S->c.linear_iterations += si.linear_iterations;
   S->c.tangent_assemblies += si.tangent_assemblies;
-  S->c.factorizations = si.total_factorizations;
-  S->c.analyses = si.total_analyses;
-  S->c.direct_fallbacks = si.total_direct_fallbacks;
+  S->c.factorizations = S->base_factorizations + si.total_factorizations;
+  S->c.analyses = S->base_analyses + si.total_analyses;
+  S->c.direct_fallbacks = S->base_fallbacks + si.total_direct_fallbacks;
   if (info) *info = si;
   if (st != FCM_OK) {
     fcm__trace(S->ctx, __FILE__, __LINE__, __func__);
@@ -669,6 +808,11 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   r->residual = si.residual;
   r->energy = si.total_energy;
   r->wall = wall;
+  r->pieces = S->pieces;
+  FCM_TRY(S->ctx,
+          fcm_space_momentum(S->space, fcm_scene_get_material(S->scene)->density,
+                             fcm_integrator_displacement(S->integ),
+                             fcm_integrator_velocity(S->integ), &r->mass, r->momentum, NULL));
 cleanup:
   return st;
 }
@@ -774,7 +918,9 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
     FCM_TRY(ctx, fcm_pvd_add(S->pvd_bg, time, path));
   }
   if (S->ns > 0) {
-    FCM_TRY(ctx, fcm_space_interpolate(S->space, S->ns, S->surf_cell, S->surf_xi, u, S->surf_u));
+    for (fcm_index i = 0; i < S->ns; i++)
+      FCM_TRY(ctx, fcm_space_element_eval(S->space, S->surf_elem[i], S->surf_xi + 3 * i, u,
+                                          S->surf_u + 3 * i));
     for (fcm_index i = 0; i < 3 * S->ns; i++)
       S->surf_x[i] = S->surf_X[i] + S->surf_u[i];
     fcm_vtu_clear(vtu);
@@ -802,12 +948,15 @@ fcm_status fcm_simulation_write_log(fcm_simulation *S, const char *path)
   FCM_TRY(S->ctx, fcm__io_atomic_open(S->ctx, path, 0, NULL, &af));
   FCM_TRY(S->ctx, fcm__io_atomic_printf(
                       S->ctx, &af,
-                      "step,time,newton_iterations,linear_iterations,residual,energy,wall_time\n"));
+                      "step,time,newton_iterations,linear_iterations,residual,energy,pieces,mass,"
+                      "momentum_x,momentum_y,momentum_z,wall_time\n"));
   for (long long k = 0; k < S->log_n; k++) {
     const fcm__log_row *r = &S->log[k];
     FCM_TRY(S->ctx,
-            fcm__io_atomic_printf(S->ctx, &af, "%lld,%.17g,%lld,%lld,%.17g,%.17g,%.6g\n", k + 1,
-                                  r->time, r->newton, r->linear, r->residual, r->energy, r->wall));
+            fcm__io_atomic_printf(
+                S->ctx, &af, "%lld,%.17g,%lld,%lld,%.17g,%.17g,%lld,%.17g,%.17g,%.17g,%.17g,%.6g\n",
+                k + 1, r->time, r->newton, r->linear, r->residual, r->energy, r->pieces, r->mass,
+                r->momentum[0], r->momentum[1], r->momentum[2], r->wall));
   }
   FCM_TRY(S->ctx, fcm__io_atomic_commit(S->ctx, &af));
 cleanup:
@@ -875,6 +1024,9 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
        c->schwarz_blocks
            ? b
            : (c->krylov ? "(no cell below the threshold, or not asked)" : "(direct solver)"));
+  snprintf(b, sizeof b, "%d applied (%d missed the body), %lld cells integrated again, %lld bodies",
+           c->cuts, c->cuts_missed, (long long)c->cut_cells, (long long)c->pieces);
+  line(f, c->cuts > 0, "cuts", c->cuts ? b : (S->num_cuts ? "(none due yet)" : "(no cut effect)"));
   snprintf(b, sizeof b, "%lld factorizations, %lld analyses, %lld fallbacks", c->factorizations,
            c->analyses, c->direct_fallbacks);
   line(f, 1, c->krylov ? "preconditioner setups" : "direct factorizations", b);

@@ -9,10 +9,13 @@
 #include "fcm/mesh.h"
 #include "fcm/simulation.h"
 
-/* One row of the per-step log. */
+/* One row of the per-step log: the step, and the body after it (separate bodies, mass and
+ * linear momentum over the body's own quadrature points, fcm_space_momentum()). */
 typedef struct fcm__log_row {
   double time, residual, energy, wall;
   long long newton, linear;
+  long long pieces;
+  double mass, momentum[3];
 } fcm__log_row;
 
 struct fcm_simulation {
@@ -49,6 +52,14 @@ struct fcm_simulation {
    * (mutable) user pointer, so the scene's const effects are never cast */
   fcm_effect *loads;
   int num_loads;
+  /* cuts ("cut" effects) in time order; the first cuts_applied are in the rules */
+  int num_cuts, cuts_applied;
+  const fcm_effect **cuts;
+  fcm_index pieces; /* separate bodies of the current space (fcm_space_num_bodies()) */
+  long long base_factorizations, base_analyses, base_fallbacks; /* of integrators before cuts */
+  fcm_index base_dofs, base_constrained; /* DOFs and constrained DOFs before any cut (the
+                                            checkpoint fingerprint) */
+  fcm_index *surf_elem;                  /* element of each surface vertex (cuts split cells) */
   /* log */
   fcm__log_row *log;
   long long log_n, log_cap;
@@ -56,5 +67,9 @@ struct fcm_simulation {
 
 /* Grow an array of `size`-byte items to hold at least `need` (doubling). */
 fcm_status fcm__sim_grow(fcm_ctx *ctx, void **array, long long *cap, long long need, size_t size);
+
+/* Apply the next cut of the scene (S->cuts[S->cuts_applied]): rules, space, integrator and the
+ * output's element map are replaced; the state carries over (run.c). */
+fcm_status fcm__sim_apply_cut(fcm_simulation *S);
 
 #endif /* FCM_SCENE_RUN_IMPL_H */
