@@ -12,3 +12,7 @@ fcm_add_test(geom_boundary_cells tests/geom/boundary_cells.c)
 # Triangle surfaces: the unit cube in OBJ, OFF, STL (ASCII, binary) and PLY (ascii, binary)
 # round trips; malformed files fail naming file and line or byte offset.
 fcm_add_test(geom_surface tests/geom/surface.c)
+# Voxel images (NRRD, MetaImage): exact volumes, box merging, round trips, header errors.
+fcm_add_test(geom_voxels tests/geom/voxels.c)
+# Level-set bodies: O(h^2) sphere volume error, CSG volumes, implicit-tree errors.
+fcm_add_test(geom_level_set tests/geom/level_set.c)
