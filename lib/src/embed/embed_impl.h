@@ -109,4 +109,11 @@ fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
                                    double sliver_rtol, const fcm_rule *tri_rule, fcm__embed_ws *ws,
                                    fcm__embed_counts *counts);
 
+/* The embedding diagnostics of the statistics S (geometry, embedded and sliver volumes
+ * already set): bounding boxes, volume ratio, the volume outside the mesh and beyond each
+ * face of its bounding box. FCM_ERR_GEOMETRY, with both bounding boxes, when a geometry of
+ * positive volume has none inside the mesh; FCM_ERR_ALLOC. Single-threaded. */
+fcm_status fcm__embed_outside(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                              fcm_cell_rules_stats *S);
+
 #endif /* FCM_EMBED_IMPL_H */
