@@ -16,3 +16,6 @@ fcm_add_test(geom_surface tests/geom/surface.c)
 fcm_add_test(geom_voxels tests/geom/voxels.c)
 # Level-set bodies: O(h^2) sphere volume error, CSG volumes, implicit-tree errors.
 fcm_add_test(geom_level_set tests/geom/level_set.c)
+# The example image apps/scenes/porous_block.nrrd is what its generator writes.
+fcm_add_test(geom_porous_block_image apps/scenes/porous_block.c
+             ARGS --check ${PROJECT_SOURCE_DIR}/apps/scenes/porous_block.nrrd)
