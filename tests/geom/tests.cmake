@@ -19,3 +19,5 @@ fcm_add_test(geom_level_set tests/geom/level_set.c)
 # The example image apps/scenes/porous_block.nrrd is what its generator writes.
 fcm_add_test(geom_porous_block_image apps/scenes/porous_block.c
              ARGS --check ${PROJECT_SOURCE_DIR}/apps/scenes/porous_block.nrrd)
+# Allocation failures of the voxel-image readers, voxel merging and level-set marching.
+fcm_add_test(geom_voxel_alloc_failure tests/geom/voxel_alloc.c)
