@@ -63,8 +63,9 @@ FCM_API int fcm_simplify_pays(double assemblies, double point_cost, double point
 FCM_API double fcm_cell_rules_point_cost(fcm_element_type type, fcm_rule_kind kind);
 
 /** Progress of fcm_cell_rules_create(): `done` of `total` background cells processed (the
- * intersection, simplification and stabilization of each). It must not call back into the
- * library on the rules being built. */
+ * intersection, simplification and stabilization of each; with FCM_CELL_SIMPLIFY_AUTO the
+ * simplification runs after this loop and is not reported). It must not call back into
+ * the library on the rules being built. */
 typedef void (*fcm_cell_rules_progress_fn)(fcm_index done, fcm_index total, void *user);
 
 /** Options of fcm_cell_rules_create(); initialize with fcm_cell_rules_options_default(). */
