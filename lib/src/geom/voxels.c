@@ -602,8 +602,12 @@ static fcm_status read_data(header *H, const char *dpath, const char *data, size
         p++;
       char tok[64];
       size_t k = 0;
-      while (p < end && !(*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r' || *p == ','))
-        tok[k < 63 ? k++ : k] = *p, p++;
+      for (; p < end && !(*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r' || *p == ','); p++)
+        if (k < sizeof tok - 1) tok[k++] = *p;
+        else k = sizeof tok; /* too long: reported below */
+      FCM_CHECK(k < sizeof tok, H->ctx, FCM_ERR_FORMAT,
+                "%s: ascii data: value %zu is longer than %zu characters", dpath, i,
+                sizeof tok - 1);
       tok[k] = '\0';
       FCM_CHECK(k > 0, H->ctx, FCM_ERR_FORMAT,
                 "%s: ascii data: %zu values, expected %zu (sizes %lld x %lld x %lld)", dpath, i,
