@@ -171,7 +171,7 @@ int main(int argc, char **argv)
              fcm_element_get_info((fcm_element_type)t)->name, (long long)S->num_cells,
              (long long)S->num_cut, threads, (long long)S->points_initial[0],
              (long long)S->points_initial[1], S->time_intersect, pts / S->time_intersect,
-             S->time_total, per_cpu, (long long)S->num_pieces);
+             S->time_total, per_cpu, (long long)S->num_parts);
       fcm_cell_rules_destroy(&r);
     }
     if (t == FCM_ELEMENT_HEX20) { /* simplification of the stiffness rules (mass: 1) */

@@ -30,3 +30,4 @@ fcm_add_test(embed_limits tests/embed/limits.c)
 # Embedding diagnostics (volume outside the background by side, ratio, wholly outside is an
 # error with both boxes), the progress callback, voxel and level-set bodies embedded.
 fcm_add_test(embed_diagnostics tests/embed/diagnostics.c)
+fcm_add_test(embed_cut tests/embed/cut.c)

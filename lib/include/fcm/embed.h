@@ -14,6 +14,7 @@
 #include "fcm/geom.h"
 #include "fcm/mesh.h"
 #include "fcm/simplify.h"
+#include "fcm/surface.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -122,13 +123,20 @@ typedef struct fcm_simplify_decision {
   double time_simplify;       /**< simplification time actually spent on this kind */
 } fcm_simplify_decision;
 
-/** Statistics of fcm_cell_rules_create(). Point counts cover cut cells unless "total".
+/** Statistics of fcm_cell_rules_create(). Point counts cover cut cells unless "total"; after
+ * fcm_cell_rules_create_cut() they cover the cells that call integrated.
  * Times in seconds: wall clock, except intersect and simplify, which are summed over
  * threads (seconds of one core). */
 typedef struct fcm_cell_rules_stats {
   fcm_index num_cells, num_uncut, num_cut, num_dropped;
   fcm_index num_candidates; /**< (background cell, embedded cell) pairs from the tree */
-  fcm_index num_pieces;     /**< non-empty clipped polyhedra */
+  fcm_index num_parts;      /**< non-empty clipped polyhedra (convex parts) */
+  fcm_index num_material_pieces; /**< material pieces (fcm_cell_rules_num_pieces()) */
+  fcm_index num_split;      /**< cells that cuts split into two or more pieces */
+  fcm_index num_links;      /**< fcm_cell_rules_num_links() */
+  fcm_index num_integrated; /**< cells whose rules this call built: every cell for
+                                 fcm_cell_rules_create(), the cells the new cut reaches for
+                                 fcm_cell_rules_create_cut() (the others are copied) */
   fcm_index num_tets;       /**< tets of the pieces kept (slivers excluded) */
   fcm_index num_slivers;    /**< tets dropped as slivers */
   double sliver_volume;     /**< their summed volume (not in embedded_volume) */
@@ -202,7 +210,9 @@ FCM_API int fcm_cell_rules_surface_strength(const fcm_cell_rules *rules);
 FCM_API fcm_cell_class fcm_cell_rules_class(const fcm_cell_rules *rules, fcm_index cell);
 FCM_API double fcm_cell_rules_volume_fraction(const fcm_cell_rules *rules, fcm_index cell);
 
-/** The volume rule of `kind` for `cell`: num_points, reference points (n x 3), weights (n,
+/** The volume rule of `kind` for `cell`: for a cell that cuts split into several material
+ * pieces, the concatenation of its pieces' rules (each with its own stabilization points;
+ * fcm_cell_rules_get_piece() gives them one by one). num_points, reference points (n x 3), weights (n,
  * including |J_Q|/|J_K|; stabilization points have alpha times the standard weight) and
  * flags (n; 0 authentic, 1 fictitious stabilization point). Uncut cells share one catalogue
  * rule; dropped cells have 0 points (pointers then NULL). Any output may be NULL.
@@ -221,6 +231,73 @@ FCM_API fcm_status fcm_cell_rules_get_surface(const fcm_cell_rules *rules, fcm_i
                                               int *num_points, const double **points,
                                               const double **weights, const double **normals,
                                               const fcm_index **triangles);
+
+/* ---------------------------------------------------------------- cutting (XFEM) */
+
+/** Extend `prev` by a cut (DESIGN §9): a triangle surface in the reference (material)
+ * coordinates of the geometry. Inside every background cell the cuts reach, the convex parts
+ * of the embedded geometry are split by the plane of each cut triangle that reaches them
+ * and by its three edge planes (perpendicular to the triangle through its edges), so every
+ * new face lies wholly on or wholly off a triangle; two parts sharing a face of positive
+ * area are connected unless that face lies on a cut triangle; the connected components are
+ * the cell's material pieces. Each piece's rules come from the same path as a cut cell
+ * (tetrahedralize, map, simplify with prev's options, stabilize). A cut that ends inside a
+ * cell does not separate it. Only the cells the new cut reaches are integrated again
+ * (stats.num_integrated); the rules of every other cell are copied, so adding cuts one at a
+ * time costs what the cut touches. Triangles without area are ignored; a cut that misses
+ * the body changes nothing but still counts in fcm_cell_rules_num_cuts(). The links between
+ * pieces of neighbouring cells (fcm_cell_rules_links()) are recomputed around every cut.
+ * `prev` is not changed (it may be destroyed afterwards).
+ * @param[in] mesh, geom the mesh and geometry `prev` was built on; @param[in] cut copied
+ * @return FCM_OK; FCM_ERR_ARG (NULL, another mesh); FCM_ERR_INTERNAL (a split exceeding
+ *         the polyhedron capacity); the errors of fcm_cell_rules_create(). Allocates. */
+FCM_API fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                             const fcm_geometry *geom,
+                                             const fcm_cell_rules *prev, const fcm_surface *cut,
+                                             fcm_cell_rules **rules);
+
+/** Number of cuts added so far (fcm_cell_rules_create_cut() calls). */
+FCM_API int fcm_cell_rules_num_cuts(const fcm_cell_rules *rules);
+
+/** Number of material pieces over all cells: one per uncut cell, none for a dropped cell,
+ * one or (when cuts split it) more per cut cell. Pieces are numbered cell by cell. */
+FCM_API fcm_index fcm_cell_rules_num_pieces(const fcm_cell_rules *rules);
+
+/** Number of pieces of `cell` and, in *first (may be NULL), the first one's index (0 and 0
+ * for a cell out of range). */
+FCM_API fcm_index fcm_cell_rules_cell_pieces(const fcm_cell_rules *rules, fcm_index cell,
+                                             fcm_index *first);
+
+/** The cell of `piece` (-1 out of range) and its volume (|piece|, physical). */
+FCM_API fcm_index fcm_cell_rules_piece_cell(const fcm_cell_rules *rules, fcm_index piece);
+FCM_API double fcm_cell_rules_piece_volume(const fcm_cell_rules *rules, fcm_index piece);
+
+/** The volume rule of `kind` for one piece, as fcm_cell_rules_get() (a piece of an uncut
+ * cell has the catalogue rule). @return FCM_OK or FCM_ERR_ARG (piece or kind out of range).
+ * No allocation; thread safe. */
+FCM_API fcm_status fcm_cell_rules_get_piece(const fcm_cell_rules *rules, fcm_index piece,
+                                            fcm_rule_kind kind, int *num_points,
+                                            const double **points, const double **weights,
+                                            const unsigned char **flags);
+
+/** The surface rule of one piece, as fcm_cell_rules_get_surface(). In a cell split into
+ * pieces each surface quadrature point goes to the piece whose part contains it (the
+ * boundary triangles themselves are not split by the cut planes, so a traction integral
+ * over a triangle that a cut crosses is split point by point).
+ * @return FCM_OK or FCM_ERR_ARG. */
+FCM_API fcm_status fcm_cell_rules_get_piece_surface(const fcm_cell_rules *rules, fcm_index piece,
+                                                    int *num_points, const double **points,
+                                                    const double **weights,
+                                                    const double **normals,
+                                                    const fcm_index **triangles);
+
+/** Links between pieces of face-neighbouring cells near the cuts: pairs (p, q), p < q, of
+ * pieces that share a part of the cells' common face with positive area not lying on a
+ * cut triangle; 2 x num_links entries, sorted. Computed for every pair of cells that share a
+ * node with a cell the cuts reach (elsewhere every cell has one piece). The generalized
+ * enrichment of fcm_space_create_embedded() groups each node's pieces along these links. */
+FCM_API fcm_index fcm_cell_rules_num_links(const fcm_cell_rules *rules);
+FCM_API const fcm_index *fcm_cell_rules_links(const fcm_cell_rules *rules);
 
 /** The statistics (a pointer into `rules`). */
 FCM_API const fcm_cell_rules_stats *fcm_cell_rules_get_stats(const fcm_cell_rules *rules);

@@ -66,6 +66,38 @@ FCM_API const fcm_index *fcm_surface_triangles(const fcm_surface *surf);
  * not NULL). */
 FCM_API void fcm_surface_bounding_box(const fcm_surface *surf, double lo[3], double hi[3]);
 
+/** A plane cut clipped to a box: the polygon where the plane through `point` with normal
+ * `normal` meets the box [lo, hi], fan-triangulated from its centroid (3 to 6 triangles).
+ * Give a box somewhat larger than the body so that the polygon's edges lie outside it.
+ * @return FCM_OK; FCM_ERR_ARG (NULL, non-finite, zero normal, lo[d] >= hi[d]);
+ *         FCM_ERR_GEOMETRY (the plane misses the box); FCM_ERR_ALLOC. Allocates. */
+FCM_API fcm_status fcm_surface_create_plane(fcm_ctx *ctx, const double point[3],
+                                            const double normal[3], const double lo[3],
+                                            const double hi[3], fcm_surface **surf);
+
+/** A rectangle (two triangles) centred at `center` in the plane with normal `normal`; its
+ * first side (length size[0]) runs along `axis` projected onto the plane, the second
+ * (size[1]) along normal x axis. A partial cut: it may end inside a body.
+ * @return FCM_OK; FCM_ERR_ARG (NULL, non-finite, sizes <= 0, zero normal, axis parallel to
+ *         the normal); FCM_ERR_ALLOC. Allocates. */
+FCM_API fcm_status fcm_surface_create_rectangle(fcm_ctx *ctx, const double center[3],
+                                                const double normal[3], const double axis[3],
+                                                const double size[2], fcm_surface **surf);
+
+/** A disc of `radius` around `center` with normal `normal`: a fan of `segments` triangles
+ * (in [3, 256]) from the centre to a regular polygon inscribed in the circle.
+ * @return FCM_OK; FCM_ERR_ARG (NULL, non-finite, radius <= 0, segments out of range, zero
+ *         normal); FCM_ERR_ALLOC. Allocates. */
+FCM_API fcm_status fcm_surface_create_disc(fcm_ctx *ctx, const double center[3],
+                                           const double normal[3], double radius, int segments,
+                                           fcm_surface **surf);
+
+/** Copy of `src` with every vertex mapped by x -> A x + b (A row-major 3x3, invertible).
+ * @return FCM_OK; FCM_ERR_ARG (NULL, non-finite, det A = 0); FCM_ERR_ALLOC. Allocates. */
+FCM_API fcm_status fcm_surface_create_transformed(fcm_ctx *ctx, const fcm_surface *src,
+                                                  const double A[9], const double b[3],
+                                                  fcm_surface **surf);
+
 #ifdef __cplusplus
 }
 #endif

@@ -6,6 +6,7 @@
 
 #include <math.h>
 #include <omp.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define GIB (1024.0 * 1024.0 * 1024.0)
@@ -72,8 +73,8 @@ double fcm_cell_rules_point_cost(fcm_element_type type, fcm_rule_kind kind)
   return cost[type][kind];
 }
 
-/* What one cell produced (private to the thread that built it). */
-typedef struct cell_out {
+/* What one material piece of a cell produced (private to the thread that built it). */
+typedef struct piece_out {
   int n[FCM_RULE_KIND_COUNT];
   double *pts[FCM_RULE_KIND_COUNT];
   double *w[FCM_RULE_KIND_COUNT];
@@ -86,6 +87,18 @@ typedef struct cell_out {
   double *spts, *sw, *snrm;
   fcm_index *stri;
   double volume;
+} piece_out;
+
+/* What one cell produced: its pieces (pc == &one for at most one piece), and for cells
+ * next to cuts the polygons of its pieces on its faces (for the links between cells). */
+typedef struct cell_out {
+  int np;
+  piece_out one;
+  piece_out *pc;
+  double volume;
+  int nfp;     /* face polygons: meta (face, piece, vertices) x nfp, coordinates fx */
+  int *fmeta;
+  double *fx;
 } cell_out;
 
 /* Everything the per-cell work reads; the trees and rules are owned (build_release). */
@@ -99,6 +112,13 @@ typedef struct build {
   const fcm_rule *full_rule[FCM_RULE_KIND_COUNT]; /* catalogue rule of the cell shape (in R) */
   fcm_rule *tri_rule;                             /* NULL: no surface rules */
   int stabilize[FCM_RULE_KIND_COUNT];
+  /* Cutting: the tree of R->cut_tris (NULL without cuts); region[c]: cell c shares a node
+   * with a cell the cuts reach (its face polygons are recorded for the links); rebuild[c]:
+   * integrate cell c (NULL: every cell), else copy its rules from prev. */
+  fcm_aabb_tree *cut_tree;
+  const fcm__cut_tri *cut_tris;
+  unsigned char *region, *rebuild;
+  const fcm_cell_rules *prev;
 } build;
 
 /* What one thread summed over the cells it built. */
@@ -107,7 +127,7 @@ typedef struct cell_sums {
   double time_intersect, time_simplify; /* seconds of one core */
 } cell_sums;
 
-static void cell_out_free(fcm_ctx *ctx, cell_out *o)
+static void piece_out_free(fcm_ctx *ctx, piece_out *o)
 {
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     fcm__free(ctx, o->pts[k]);
@@ -124,10 +144,24 @@ static void cell_out_free(fcm_ctx *ctx, cell_out *o)
   o->stri = NULL;
 }
 
+static void cell_out_free(fcm_ctx *ctx, cell_out *o)
+{
+  if (o->pc)
+    for (int i = 0; i < o->np; i++)
+      piece_out_free(ctx, o->pc + i);
+  if (o->pc != &o->one) fcm__free(ctx, o->pc);
+  o->pc = NULL;
+  o->np = 0;
+  fcm__free(ctx, o->fmeta);
+  fcm__free(ctx, o->fx);
+  o->fmeta = NULL;
+  o->fx = NULL;
+}
+
 /* The one call into the simplification module: reduce the rule (n points, in place) to
  * at most M points; record skipped / fallback / residual. */
 static fcm_status simplify_rule(fcm_ctx *ctx, const fcm_simplify_options *opts, int strength,
-                                int *n, double *pts, double *w, cell_out *o, int k)
+                                int *n, double *pts, double *w, piece_out *o, int k)
 {
   fcm_status st = FCM_OK;
   fcm_simplify_result res;
@@ -206,9 +240,9 @@ cleanup:
   return st;
 }
 
-/* The last step of a cut cell: simplify the kinds with simp[k] set, then append the
+/* The last step of a cut cell's piece: simplify the kinds with simp[k] set, then append the
  * stabilization points. */
-static fcm_status finish_cell(const build *B, const fcm_cell_rules *R, cell_out *o,
+static fcm_status finish_cell(const build *B, const fcm_cell_rules *R, piece_out *o,
                               const int simp[FCM_RULE_KIND_COUNT], cell_sums *sums)
 {
   fcm_status st = FCM_OK;
@@ -235,8 +269,148 @@ cleanup:
   return st;
 }
 
+/* Map the tets in ws into piece o's initial rules of both kinds. */
+static fcm_status map_piece(const build *B, const fcm_cell_rules *R, const fcm__embed_cell *cell,
+                            fcm__embed_ws *ws, piece_out *o)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  FCM_TRY(ctx, check_rule_memory(B, R, cell, ws));
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    const size_t n0 = ws->num_tets * (size_t)fcm_rule_num_points(B->tet_rule[k]);
+    const size_t ns = B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0;
+    FCM_ALLOC(ctx, 3 * (n0 + ns), o->pts[k]);
+    FCM_ALLOC(ctx, n0 + ns, o->w[k]);
+    FCM_ALLOC(ctx, n0 + ns, o->flag[k]);
+    FCM_TRY(ctx, fcm__embed_map_tets(ctx, cell, ws, B->tet_rule[k], o->pts[k], o->w[k]));
+    o->n[k] = o->ninit[k] = o->nsimp[k] = (int)n0;
+  }
+cleanup:
+  return st;
+}
+
+/* The surface points in ws (physical) that belong to piece `piece` (all when P is NULL)
+ * into o, mapped to reference coordinates. */
+static fcm_status surface_piece(const build *B, const fcm__embed_cell *cell,
+                                const fcm__embed_ws *ws, const fcm__parts *P, int piece,
+                                piece_out *o)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  size_t ns = 0;
+  for (size_t j = 0; j < ws->num_spts; j++)
+    ns += !P || fcm__embed_point_piece(P, ws->spts + 3 * j) == piece;
+  if (ns == 0) return FCM_OK;
+  FCM_ALLOC(ctx, 3 * ns, o->spts);
+  FCM_ALLOC(ctx, ns, o->sw);
+  FCM_ALLOC(ctx, 3 * ns, o->snrm);
+  FCM_ALLOC(ctx, ns, o->stri);
+  size_t i = 0;
+  for (size_t j = 0; j < ws->num_spts; j++) {
+    if (P && fcm__embed_point_piece(P, ws->spts + 3 * j) != piece) continue;
+    double det;
+    FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, ws->spts + 3 * j, o->spts + 3 * i, &det));
+    o->sw[i] = ws->sw[j];
+    memcpy(o->snrm + 3 * i, ws->snrm + 3 * j, 3 * sizeof *o->snrm);
+    o->stri[i] = ws->stri[j];
+    i++;
+  }
+  o->ns = (int)ns;
+cleanup:
+  return st;
+}
+
+/* Copy the rules of cell c from the previous rules object (a cell no new cut reaches). */
+static fcm_status copy_cell(const build *B, fcm_index c, cell_out *o)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_cell_rules *Q = B->prev;
+  const fcm_index p0 = Q->piece_off[c], np = Q->piece_off[c + 1] - p0;
+  for (fcm_index i = 0; i < np; i++) {
+    piece_out *po = o->pc + i;
+    const fcm_index p = p0 + i;
+    po->volume = Q->piece_volume[p];
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+      const size_t a = (size_t)Q->off[k][p], n = (size_t)Q->off[k][p + 1] - a;
+      if (n) {
+        FCM_ALLOC(ctx, 3 * n, po->pts[k]);
+        FCM_ALLOC(ctx, n, po->w[k]);
+        FCM_ALLOC(ctx, n, po->flag[k]);
+        memcpy(po->pts[k], Q->points[k] + 3 * a, 3 * n * sizeof(double));
+        memcpy(po->w[k], Q->weights[k] + a, n * sizeof(double));
+        memcpy(po->flag[k], Q->flags[k] + a, n);
+      }
+      po->n[k] = po->ninit[k] = po->nsimp[k] = (int)n;
+    }
+    const size_t a = (size_t)Q->soff[p], n = (size_t)Q->soff[p + 1] - a;
+    if (n) {
+      FCM_ALLOC(ctx, 3 * n, po->spts);
+      FCM_ALLOC(ctx, n, po->sw);
+      FCM_ALLOC(ctx, 3 * n, po->snrm);
+      FCM_ALLOC(ctx, n, po->stri);
+      memcpy(po->spts, Q->spoints + 3 * a, 3 * n * sizeof(double));
+      memcpy(po->sw, Q->sweights + a, n * sizeof(double));
+      memcpy(po->snrm, Q->snormals + 3 * a, 3 * n * sizeof(double));
+      memcpy(po->stri, Q->stris + a, n * sizeof(fcm_index));
+    }
+    po->ns = (int)n;
+  }
+cleanup:
+  return st;
+}
+
+/* Room for np pieces in o (inline for one). */
+static fcm_status cell_out_pieces(fcm_ctx *ctx, cell_out *o, int np)
+{
+  fcm_status st = FCM_OK;
+  o->np = np;
+  if (np <= 1) {
+    o->pc = &o->one;
+  } else {
+    FCM_ALLOC(ctx, (size_t)np, o->pc);
+  }
+cleanup:
+  return st;
+}
+
+/* The convex parts and material pieces of a cell that cuts reach (or that lies next to
+ * such a cell): parts, split, grouped; empty pieces (all slivers) are removed. On return
+ * P->piece numbers the pieces with volume, -1 for parts of removed ones; vol[i] is the
+ * volume of piece i (P->num_pieces of them). */
+static fcm_status cell_pieces(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
+                              cell_sums *sums, double **vol)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_cell_rules_options *opt = B->o;
+  fcm__parts *P = ws->parts;
+  FCM_TRY(ctx, fcm__embed_cell_parts(ctx, B->geom, B->tree, cell, opt->clip_rtol, opt->sliver_rtol,
+                                     ws, P, &sums->counts));
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, cell->lo, cell->hi, &P->tcand));
+  if (P->tcand.n > 0) FCM_TRY(ctx, fcm__embed_cell_pieces(ctx, cell, B->cut_tris, P));
+  FCM_ALLOC(ctx, (size_t)P->num_pieces + 1, *vol);
+  int kept = 0;
+  int *renum = NULL;
+  FCM_ALLOC(ctx, (size_t)P->num_pieces + 1, renum);
+  for (int i = 0; i < P->num_pieces; i++) {
+    double v = 0.0;
+    FCM_TRY(ctx, fcm__embed_piece_tets(ctx, P, i, ws, &sums->counts, &v));
+    renum[i] = v > 0.0 ? kept : -1;
+    if (v > 0.0) (*vol)[kept++] = v;
+  }
+  for (size_t j = 0; j < P->n; j++)
+    P->piece[j] = renum[P->piece[j]];
+  P->num_pieces = kept;
+  fcm__free(ctx, renum);
+cleanup:
+  return st;
+}
+
 /* Intersect, classify and build the rules of background cell c into o (the thread's own
- * buffers); R->cls[c] and R->fraction[c] are written here (one writer per cell). */
+ * buffers); R->cls[c] and R->fraction[c] are written here (one writer per cell). Cells the
+ * cuts reach are split into material pieces first (DESIGN §9); each piece then takes the
+ * path of a cut cell. */
 static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, fcm__embed_ws *ws,
                                cell_out *o, cell_sums *sums)
 {
@@ -244,61 +418,81 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   fcm_ctx *ctx = B->ctx;
   const fcm_cell_rules_options *opt = B->o;
   fcm__embed_cell cell;
-  double vol = 0.0;
+  double vol = 0.0, *pvol = NULL;
+  fcm__parts *P = NULL;
+  const int integrate = !B->rebuild || B->rebuild[c];
   const double t0 = fcm_wtime();
   FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
-  FCM_TRY(ctx, fcm__embed_cell_tets(ctx, B->geom, B->tree, &cell, opt->clip_rtol, opt->sliver_rtol,
-                                    ws, &sums->counts, &vol));
+  if (B->cut_tree && B->region[c]) {
+    if (!ws->parts) FCM_ALLOC(ctx, 1, ws->parts);
+    P = ws->parts;
+    FCM_TRY(ctx, cell_pieces(B, &cell, ws, sums, &pvol));
+    for (int i = 0; i < P->num_pieces; i++)
+      vol += pvol[i];
+    FCM_TRY(ctx, fcm__embed_face_polygons(ctx, &cell, P));
+    if (P->nfp > 0) {
+      FCM_ALLOC(ctx, 3 * P->nfp, o->fmeta);
+      FCM_ALLOC(ctx, 3 * P->nfx, o->fx);
+      memcpy(o->fmeta, P->fmeta, 3 * P->nfp * sizeof(int));
+      memcpy(o->fx, P->fx, 3 * P->nfx * sizeof(double));
+      o->nfp = (int)P->nfp;
+    }
+  } else {
+    FCM_TRY(ctx, fcm__embed_cell_tets(ctx, B->geom, B->tree, &cell, opt->clip_rtol,
+                                      opt->sliver_rtol, ws, &sums->counts, &vol));
+  }
+  const int np = P ? P->num_pieces : ws->num_tets > 0;
   /* |K ∩ Ω| <= |K|: the clipped volumes can sum to |K| (1 + 1e-12) through rounding. A cut
    * cell has phi < uncut_fraction <= 1, so its rule needs no rescaling; only the recorded
-   * fraction and volume are clamped. */
+   * fraction and volume are clamped. A cell split into several pieces is cut whatever its
+   * fraction. */
   const double phi = fmin(vol / cell.volume, 1.0);
   fcm_cell_class cls = FCM_CELL_CUT;
-  if (phi >= opt->uncut_fraction)
-    cls = FCM_CELL_UNCUT;
-  else if (phi < opt->min_fraction || ws->num_tets == 0)
+  if (phi < opt->min_fraction || np == 0)
     cls = FCM_CELL_DROPPED;
+  else if (phi >= opt->uncut_fraction && np == 1)
+    cls = FCM_CELL_UNCUT;
   R->cls[c] = (unsigned char)cls;
   R->fraction[c] = phi;
   o->volume = phi * cell.volume;
+  FCM_TRY(ctx, cell_out_pieces(ctx, o, cls == FCM_CELL_DROPPED ? 0 : np));
+  if (o->np == 1) o->pc[0].volume = o->volume;
+  for (int i = 0; P && i < o->np && o->np > 1; i++)
+    o->pc[i].volume = pvol[i];
+  if (!integrate) {
+    FCM_CHECK(B->prev->piece_off[c + 1] - B->prev->piece_off[c] == o->np &&
+                  B->prev->cls[c] == R->cls[c],
+              ctx, FCM_ERR_INTERNAL,
+              "embed: cell %lld, which the new cut does not reach, now has %d pieces (class %d) "
+              "instead of %lld (class %d)",
+              (long long)c, o->np, (int)R->cls[c],
+              (long long)(B->prev->piece_off[c + 1] - B->prev->piece_off[c]),
+              (int)B->prev->cls[c]);
+    FCM_TRY(ctx, copy_cell(B, c, o));
+    goto cleanup;
+  }
   if (cls == FCM_CELL_CUT) {
-    FCM_TRY(ctx, check_rule_memory(B, R, &cell, ws));
-    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
-      const size_t n0 = ws->num_tets * (size_t)fcm_rule_num_points(B->tet_rule[k]);
-      const size_t ns = B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0;
-      FCM_ALLOC(ctx, 3 * (n0 + ns), o->pts[k]);
-      FCM_ALLOC(ctx, n0 + ns, o->w[k]);
-      FCM_ALLOC(ctx, n0 + ns, o->flag[k]);
-      FCM_TRY(ctx, fcm__embed_map_tets(ctx, &cell, ws, B->tet_rule[k], o->pts[k], o->w[k]));
-      o->n[k] = o->ninit[k] = o->nsimp[k] = (int)n0;
+    for (int i = 0; i < o->np; i++) {
+      double v;
+      if (P) FCM_TRY(ctx, fcm__embed_piece_tets(ctx, P, i, ws, NULL, &v));
+      FCM_TRY(ctx, map_piece(B, R, &cell, ws, o->pc + i));
     }
   }
   if (B->tri_rule && cls != FCM_CELL_DROPPED) {
     FCM_TRY(ctx, fcm__embed_cell_surface(ctx, B->geom, B->tri_tree, &cell, opt->sliver_rtol,
                                          B->tri_rule, ws, &sums->counts));
-    const size_t ns = ws->num_spts;
-    if (ns > 0) {
-      FCM_ALLOC(ctx, 3 * ns, o->spts);
-      FCM_ALLOC(ctx, ns, o->sw);
-      FCM_ALLOC(ctx, 3 * ns, o->snrm);
-      FCM_ALLOC(ctx, ns, o->stri);
-      for (size_t j = 0; j < ns; j++) {
-        double det;
-        FCM_TRY(ctx, fcm__embed_to_reference(ctx, &cell, ws->spts + 3 * j, o->spts + 3 * j, &det));
-      }
-      memcpy(o->sw, ws->sw, ns * sizeof *o->sw);
-      memcpy(o->snrm, ws->snrm, 3 * ns * sizeof *o->snrm);
-      memcpy(o->stri, ws->stri, ns * sizeof *o->stri);
-      o->ns = (int)ns;
-    }
+    for (int i = 0; i < o->np; i++)
+      FCM_TRY(ctx, surface_piece(B, &cell, ws, o->np > 1 ? P : NULL, i, o->pc + i));
   }
   sums->time_intersect += fcm_wtime() - t0;
   if (cls == FCM_CELL_CUT && opt->simplify != FCM_CELL_SIMPLIFY_AUTO) {
     const int on = opt->simplify == FCM_CELL_SIMPLIFY_ON;
     const int simp[FCM_RULE_KIND_COUNT] = {on, on};
-    FCM_TRY(ctx, finish_cell(B, R, o, simp, sums));
+    for (int i = 0; i < o->np; i++)
+      FCM_TRY(ctx, finish_cell(B, R, o->pc + i, simp, sums));
   }
 cleanup:
+  fcm__free(ctx, pvol);
   return st;
 }
 
@@ -402,12 +596,12 @@ static fcm_status rules_alloc(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_cell
   R->surface_strength = o->surface_strength;
   FCM_ALLOC(ctx, (size_t)nc, R->cls);
   FCM_ALLOC(ctx, (size_t)nc, R->fraction);
-  FCM_ALLOC(ctx, (size_t)nc + 1, R->soff);
+  FCM_ALLOC(ctx, (size_t)nc + 1, R->piece_off);
+  R->opts = *o;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     R->strength[k] = o->strength[k] >= 0 ? o->strength[k] : element_strength[k];
     FCM_TRY(ctx, fcm_rule_create(ctx, info->shape, R->strength[k], &R->uncut[k]));
     FCM_ALLOC(ctx, (size_t)fcm_rule_num_points(R->uncut[k]), R->uncut_flags[k]);
-    FCM_ALLOC(ctx, (size_t)nc + 1, R->off[k]);
   }
   *out = R;
   R = NULL;
@@ -418,6 +612,12 @@ cleanup:
 
 static void build_release(build *B)
 {
+  fcm_aabb_tree_destroy(&B->cut_tree);
+  if (B->ctx) {
+    fcm__free(B->ctx, B->region);
+    fcm__free(B->ctx, B->rebuild);
+  }
+  B->region = B->rebuild = NULL;
   fcm_aabb_tree_destroy(&B->tree);
   fcm_aabb_tree_destroy(&B->tri_tree);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
@@ -452,6 +652,49 @@ static fcm_status build_setup(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geom
 cleanup:
   fcm__free(ctx, boxes);
   if (st != FCM_OK) build_release(B);
+  return st;
+}
+
+/* Phase 1c (cuts only): the tree of R's cut triangles, the region (cells sharing a node with
+ * a cell the cuts reach) and, when extending `prev` by the triangles from first_new on,
+ * the cells to integrate (those the new triangles reach). */
+static fcm_status cut_setup(build *B, const fcm_cell_rules *R, fcm_index first_new)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_mesh *mesh = B->mesh;
+  const fcm_index nc = fcm_mesh_num_cells(mesh), nn = fcm_mesh_num_nodes(mesh);
+  const int npc = fcm_mesh_nodes_per_cell(mesh);
+  const fcm_index *cells = fcm_mesh_cells(mesh);
+  double *boxes = NULL;
+  unsigned char *node_hit = NULL;
+  fcm__idbuf ids = {NULL, 0, 0};
+  FCM_ALLOC(ctx, 6 * (size_t)R->num_cut_tris + 6, boxes);
+  for (fcm_index t = 0; t < R->num_cut_tris; t++) {
+    memcpy(boxes + 6 * t, R->cut_tris[t].lo, 3 * sizeof(double));
+    memcpy(boxes + 6 * t + 3, R->cut_tris[t].hi, 3 * sizeof(double));
+  }
+  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, R->num_cut_tris, boxes, &B->cut_tree));
+  B->cut_tris = R->cut_tris;
+  FCM_ALLOC(ctx, (size_t)nc + 1, B->region);
+  FCM_ALLOC(ctx, (size_t)nn + 1, node_hit);
+  if (B->prev) FCM_ALLOC(ctx, (size_t)nc + 1, B->rebuild);
+  for (fcm_index c = 0; c < nc; c++) {
+    fcm__embed_cell cell;
+    FCM_TRY(ctx, fcm__embed_cell_setup(ctx, mesh, c, B->o->clip_rtol, &cell));
+    FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, cell.lo, cell.hi, &ids));
+    if (ids.n == 0) continue;
+    for (int a = 0; a < npc; a++)
+      node_hit[cells[(size_t)npc * c + a]] = 1;
+    if (B->rebuild && ids.ids[ids.n - 1] >= first_new) B->rebuild[c] = 1;
+  }
+  for (fcm_index c = 0; c < nc; c++)
+    for (int a = 0; a < npc && !B->region[c]; a++)
+      B->region[c] = node_hit[cells[(size_t)npc * c + a]];
+cleanup:
+  fcm__free(ctx, boxes);
+  fcm__free(ctx, node_hit);
+  fcm__geom_idbuf_free(ctx, &ids);
   return st;
 }
 
@@ -502,7 +745,7 @@ static fcm_status run_cells(const build *B, fcm_cell_rules *R, int nthreads, cel
 #pragma omp critical(fcm_embed_sum)
     {
       sums->counts.candidates += mine.counts.candidates;
-      sums->counts.pieces += mine.counts.pieces;
+      sums->counts.parts += mine.counts.parts;
       sums->counts.tets += mine.counts.tets;
       sums->counts.slivers += mine.counts.slivers;
       sums->counts.surface_triangles += mine.counts.surface_triangles;
@@ -517,10 +760,10 @@ cleanup:
   return st;
 }
 
-/* Finish the cut cells list[0 .. n) in parallel (simplify the kinds that pay, stabilize);
+/* Finish the pieces list[0 .. n) in parallel (simplify the kinds that pay, stabilize);
  * the error is the lowest failing one's. */
-static fcm_status auto_finish(const build *B, const fcm_cell_rules *R, int nthreads, cell_out *out,
-                              const fcm_index *list, fcm_index n,
+static fcm_status auto_finish(const build *B, const fcm_cell_rules *R, int nthreads,
+                              piece_out *const *list, fcm_index n,
                               const int pays[FCM_RULE_KIND_COUNT], cell_sums *sums)
 {
   fcm_status st = FCM_OK;
@@ -539,7 +782,7 @@ static fcm_status auto_finish(const build *B, const fcm_cell_rules *R, int nthre
       int simp[FCM_RULE_KIND_COUNT];
       for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
         simp[k] = pays[k];
-      fcm_status s = finish_cell(B, R, out + list[i], simp, &mine);
+      fcm_status s = finish_cell(B, R, list[i], simp, &mine);
       fcm__loop_leave(&loop, &it, s);
     }
 #pragma omp critical(fcm_embed_auto_sum)
@@ -551,12 +794,12 @@ cleanup:
 }
 
 /* Phase 2b of FCM_CELL_SIMPLIFY_AUTO (the cells are intersected and mapped, not yet
- * simplified nor stabilized): per kind, the simplification time of every cut cell from the
- * deterministic model fcm_simplify_cost_estimate() and the points it would keep (min(N, M)),
- * against the assembly time of the points it removes over the expected assemblies
- * (fcm_simplify_pays()). The rules are then those of OFF or ON for each kind, and the same
- * inputs always give the same decision (no timing: runs, thread counts and resumed runs
- * agree). Then finish every cut cell. */
+ * simplified nor stabilized): per kind, the simplification time of every cut-cell piece
+ * from the deterministic model fcm_simplify_cost_estimate() and the points it would keep
+ * (min(N, M)), against the assembly time of the points it removes over the expected
+ * assemblies (fcm_simplify_pays()). The rules are then those of OFF or ON for each kind,
+ * and the same inputs always give the same decision (no timing: runs, thread counts and
+ * resumed runs agree). Then finish every piece that was integrated here. */
 static fcm_status auto_simplify(const build *B, fcm_cell_rules *R, int nthreads, cell_out *out,
                                 cell_sums *sums)
 {
@@ -564,14 +807,17 @@ static fcm_status auto_simplify(const build *B, fcm_cell_rules *R, int nthreads,
   fcm_ctx *ctx = B->ctx;
   const fcm_cell_rules_options *opt = B->o;
   const fcm_index nc = R->num_cells;
-  fcm_index *cut = NULL, ncut = 0;
+  piece_out **cut = NULL;
+  fcm_index ncut = 0;
   int pays[FCM_RULE_KIND_COUNT] = {0, 0};
   for (fcm_index c = 0; c < nc; c++)
-    ncut += R->cls[c] == FCM_CELL_CUT;
+    if (R->cls[c] == FCM_CELL_CUT && (!B->rebuild || B->rebuild[c])) ncut += out[c].np;
   FCM_ALLOC(ctx, (size_t)ncut + 1, cut);
   ncut = 0;
   for (fcm_index c = 0; c < nc; c++)
-    if (R->cls[c] == FCM_CELL_CUT) cut[ncut++] = c;
+    if (R->cls[c] == FCM_CELL_CUT && (!B->rebuild || B->rebuild[c]))
+      for (int i = 0; i < out[c].np; i++)
+        cut[ncut++] = out[c].pc + i;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     fcm_simplify_decision *d = &R->stats.decision[k];
     const fcm_element_type type = fcm_mesh_element_type(B->mesh);
@@ -582,7 +828,7 @@ static fcm_status auto_simplify(const build *B, fcm_cell_rules *R, int nthreads,
         opt->point_cost[k] == FCM_DEFAULT ? fcm_cell_rules_point_cost(type, k) : opt->point_cost[k];
     double ntot = 0.0;
     for (fcm_index i = 0; i < ncut; i++) {
-      const fcm_index n = out[cut[i]].ninit[k];
+      const fcm_index n = cut[i]->ninit[k];
       ntot += (double)n;
       d->estimated_time += fcm_simplify_cost_estimate(m, n);
       d->estimated_kept += (double)n < M ? (double)n : M;
@@ -592,8 +838,10 @@ static fcm_status auto_simplify(const build *B, fcm_cell_rules *R, int nthreads,
         d->estimated_time + d->estimated_kept * d->point_cost * d->expected_assemblies;
     pays[k] = fcm_simplify_pays(d->expected_assemblies, d->point_cost, ntot, d->estimated_kept,
                                 d->estimated_time);
+    /* A cut added later decides as the rules it extends did: one object, one choice. */
+    if (B->prev) pays[k] = B->prev->stats.decision[k].simplified;
   }
-  FCM_TRY(ctx, auto_finish(B, R, nthreads, out, cut, ncut, pays, sums));
+  FCM_TRY(ctx, auto_finish(B, R, nthreads, cut, ncut, pays, sums));
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     R->stats.decision[k].simplified = pays[k];
 cleanup:
@@ -601,45 +849,153 @@ cleanup:
   return st;
 }
 
-/* Phase 3: concatenate the cells' volume and surface rules in cell order. */
+/* Phase 3: concatenate the pieces' volume and surface rules in cell order. */
 static fcm_status gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_out *out)
 {
   fcm_status st = FCM_OK;
   const fcm_index nc = R->num_cells;
+  fcm_index np = 0;
+  for (fcm_index c = 0; c < nc; c++)
+    np += out[c].np;
+  R->num_pieces = np;
+  FCM_ALLOC(ctx, (size_t)np + 1, R->piece_cell);
+  FCM_ALLOC(ctx, (size_t)np + 1, R->piece_volume);
+  FCM_ALLOC(ctx, (size_t)np + 1, R->soff);
+  R->piece_off[0] = 0;
+  for (fcm_index c = 0; c < nc; c++) {
+    R->piece_off[c + 1] = R->piece_off[c] + out[c].np;
+    for (int i = 0; i < out[c].np; i++) {
+      R->piece_cell[R->piece_off[c] + i] = c;
+      R->piece_volume[R->piece_off[c] + i] = out[c].pc[i].volume;
+    }
+  }
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
-    fcm_index *off = R->off[k];
-    off[0] = 0;
+    fcm_index *off = NULL;
+    FCM_ALLOC(ctx, (size_t)np + 1, R->off[k]);
+    off = R->off[k];
     for (fcm_index c = 0; c < nc; c++)
-      off[c + 1] = off[c] + out[c].n[k];
-    const size_t tot = (size_t)off[nc];
+      for (int i = 0; i < out[c].np; i++) {
+        const fcm_index p = R->piece_off[c] + i;
+        off[p + 1] = off[p] + (R->cls[c] == FCM_CELL_CUT ? out[c].pc[i].n[k] : 0);
+      }
+    const size_t tot = (size_t)off[np];
     FCM_ALLOC(ctx, 3 * tot, R->points[k]);
     FCM_ALLOC(ctx, tot, R->weights[k]);
     FCM_ALLOC(ctx, tot, R->flags[k]);
-    for (fcm_index c = 0; c < nc; c++) {
-      const size_t n = (size_t)out[c].n[k], o0 = (size_t)off[c];
-      if (!n) continue;
-      memcpy(R->points[k] + 3 * o0, out[c].pts[k], 3 * n * sizeof(double));
-      memcpy(R->weights[k] + o0, out[c].w[k], n * sizeof(double));
-      memcpy(R->flags[k] + o0, out[c].flag[k], n);
-    }
+    for (fcm_index c = 0; c < nc; c++)
+      for (int i = 0; i < out[c].np; i++) {
+        const fcm_index p = R->piece_off[c] + i;
+        const size_t n = (size_t)(off[p + 1] - off[p]), o0 = (size_t)off[p];
+        if (!n) continue;
+        memcpy(R->points[k] + 3 * o0, out[c].pc[i].pts[k], 3 * n * sizeof(double));
+        memcpy(R->weights[k] + o0, out[c].pc[i].w[k], n * sizeof(double));
+        memcpy(R->flags[k] + o0, out[c].pc[i].flag[k], n);
+      }
   }
   R->soff[0] = 0;
   for (fcm_index c = 0; c < nc; c++)
-    R->soff[c + 1] = R->soff[c] + out[c].ns;
-  const size_t tot = (size_t)R->soff[nc];
+    for (int i = 0; i < out[c].np; i++) {
+      const fcm_index p = R->piece_off[c] + i;
+      R->soff[p + 1] = R->soff[p] + out[c].pc[i].ns;
+    }
+  const size_t tot = (size_t)R->soff[np];
   FCM_ALLOC(ctx, 3 * tot, R->spoints);
   FCM_ALLOC(ctx, tot, R->sweights);
   FCM_ALLOC(ctx, 3 * tot, R->snormals);
   FCM_ALLOC(ctx, tot, R->stris);
-  for (fcm_index c = 0; c < nc; c++) {
-    const size_t n = (size_t)out[c].ns, o0 = (size_t)R->soff[c];
-    if (!n) continue;
-    memcpy(R->spoints + 3 * o0, out[c].spts, 3 * n * sizeof(double));
-    memcpy(R->sweights + o0, out[c].sw, n * sizeof(double));
-    memcpy(R->snormals + 3 * o0, out[c].snrm, 3 * n * sizeof(double));
-    memcpy(R->stris + o0, out[c].stri, n * sizeof(fcm_index));
-  }
+  for (fcm_index c = 0; c < nc; c++)
+    for (int i = 0; i < out[c].np; i++) {
+      const piece_out *o = out[c].pc + i;
+      const size_t n = (size_t)o->ns, o0 = (size_t)R->soff[R->piece_off[c] + i];
+      if (!n) continue;
+      memcpy(R->spoints + 3 * o0, o->spts, 3 * n * sizeof(double));
+      memcpy(R->sweights + o0, o->sw, n * sizeof(double));
+      memcpy(R->snormals + 3 * o0, o->snrm, 3 * n * sizeof(double));
+      memcpy(R->stris + o0, o->stri, n * sizeof(fcm_index));
+    }
 cleanup:
+  return st;
+}
+
+static int cmp_link(const void *a, const void *b)
+{
+  const fcm_index *x = a, *y = b;
+  if (x[0] != y[0]) return x[0] < y[0] ? -1 : 1;
+  return (x[1] > y[1]) - (x[1] < y[1]);
+}
+
+/* Phase 3b (cuts only): the links between pieces of face-neighbouring region cells: a
+ * polygon of one cell's piece on the shared face overlaps a polygon of the other cell's
+ * piece with positive area, and the overlap does not lie on a cut triangle. */
+static fcm_status gather_links(const build *B, fcm_cell_rules *R, const cell_out *out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_mesh *mesh = B->mesh;
+  const int nf = fcm_mesh_get_element_info(mesh)->num_faces;
+  const fcm_index *nbr = fcm_mesh_neighbors(mesh);
+  fcm_index *links = NULL;
+  size_t nl = 0, cap = 0;
+  fcm__idbuf tc = {NULL, 0, 0};
+  for (fcm_index c = 0; c < R->num_cells; c++) {
+    const cell_out *oa = out + c;
+    if (!B->region[c] || oa->np == 0) continue;
+    fcm__embed_cell cell;
+    FCM_TRY(ctx, fcm__embed_cell_setup(ctx, mesh, c, B->o->clip_rtol, &cell));
+    const double mtol = 1e-9 * cell.size, atol = 1e-12 * cell.size * cell.size;
+    for (int f = 0; f < nf; f++) {
+      const fcm_index c2 = nbr[(size_t)nf * c + f];
+      if (c2 <= c || !B->region[c2] || out[c2].np == 0) continue;
+      int f2 = 0;
+      while (f2 < nf && nbr[(size_t)nf * c2 + f2] != c) f2++;
+      if (f2 == nf) continue;
+      const cell_out *ob = out + c2;
+      const fcm_index pa0 = R->piece_off[c], pb0 = R->piece_off[c2];
+      size_t xa = 0;
+      for (int i = 0; i < oa->nfp; i++) {
+        const int *ma = oa->fmeta + 3 * i;
+        const double *A = oa->fx + 3 * xa;
+        xa += (size_t)ma[2];
+        if (ma[0] != f || ma[1] < 0) continue;
+        size_t xb = 0;
+        for (int j = 0; j < ob->nfp; j++) {
+          const int *mb = ob->fmeta + 3 * j;
+          const double *Bx = ob->fx + 3 * xb;
+          xb += (size_t)mb[2];
+          if (mb[0] != f2 || mb[1] < 0) continue;
+          const fcm_index pa = pa0 + ma[1], pb = pb0 + mb[1];
+          int known = 0;
+          for (size_t l = nl; l-- > 0 && !known;)
+            known = links[2 * l] == pa && links[2 * l + 1] == pb;
+          if (known) continue;
+          double c3[3], lo[3], hi[3];
+          const double *nb = cell.planes[f].n; /* polygon B faces out of c2: normal -n_f */
+          const double nbn[3] = {-nb[0], -nb[1], -nb[2]};
+          if (fcm__embed_overlap(A, ma[2], Bx, mb[2], nbn, mtol, c3) <= atol) continue;
+          for (int d = 0; d < 3; d++)
+            lo[d] = c3[d] - mtol, hi[d] = c3[d] + mtol;
+          FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, lo, hi, &tc));
+          if (fcm__embed_on_cut(B->cut_tris, tc.ids, tc.n, c3, mtol)) continue;
+          if (nl + 1 > cap) {
+            const size_t ncap = cap ? 2 * cap : 256;
+            void *q = links;
+            FCM_TRY(ctx, fcm__resize(ctx, &q, 2 * nl, 2 * ncap, sizeof(fcm_index)));
+            links = q;
+            cap = ncap;
+          }
+          links[2 * nl] = pa, links[2 * nl + 1] = pb;
+          nl++;
+        }
+      }
+    }
+  }
+  if (nl) qsort(links, nl, 2 * sizeof *links, cmp_link);
+  R->links = links;
+  R->num_links = (fcm_index)nl;
+  links = NULL;
+cleanup:
+  fcm__free(ctx, links);
+  fcm__geom_idbuf_free(ctx, &tc);
   return st;
 }
 
@@ -652,17 +1008,21 @@ static void gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const cell
   S->num_cells = nc;
   for (fcm_index c = 0; c < nc; c++) {
     const cell_out *o = out + c;
-    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
-      S->points_initial[k] += o->ninit[k];
-      S->points_simplified[k] += o->nsimp[k];
-      S->points_stabilization[k] += o->nstab[k];
-      S->simplify_skipped[k] += o->skipped[k];
-      S->simplify_fallbacks[k] += o->fallback[k];
-      S->max_residual[k] = fmax(S->max_residual[k], o->residual[k]);
-      S->decision[k].time_simplify += o->tsimp[k];
+    for (int i = 0; i < o->np; i++) {
+      const piece_out *q = o->pc + i;
+      for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+        S->points_initial[k] += q->ninit[k];
+        S->points_simplified[k] += q->nsimp[k];
+        S->points_stabilization[k] += q->nstab[k];
+        S->simplify_skipped[k] += q->skipped[k];
+        S->simplify_fallbacks[k] += q->fallback[k];
+        S->max_residual[k] = fmax(S->max_residual[k], q->residual[k]);
+        S->decision[k].time_simplify += q->tsimp[k];
+      }
+      for (int j = 0; j < q->ns; j++)
+        S->embedded_area += q->sw[j];
     }
-    for (int j = 0; j < o->ns; j++)
-      S->embedded_area += o->sw[j];
+    S->num_split += o->np > 1;
     S->embedded_volume += o->volume;
     switch ((fcm_cell_class)R->cls[c]) {
     case FCM_CELL_UNCUT:
@@ -678,10 +1038,13 @@ static void gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const cell
     }
   }
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
-    S->points_total[k] = R->off[k][nc] + S->num_uncut * fcm_rule_num_points(R->uncut[k]);
-  S->surface_points = R->soff[nc];
+    S->points_total[k] =
+        R->off[k][R->num_pieces] + S->num_uncut * fcm_rule_num_points(R->uncut[k]);
+  S->surface_points = R->soff[R->num_pieces];
+  S->num_material_pieces = R->num_pieces;
+  S->num_links = R->num_links;
   S->num_candidates = sums->counts.candidates;
-  S->num_pieces = sums->counts.pieces;
+  S->num_parts = sums->counts.parts;
   S->num_tets = sums->counts.tets;
   S->num_slivers = sums->counts.slivers;
   S->sliver_volume = sums->counts.sliver_volume;
@@ -692,59 +1055,117 @@ static void gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const cell
   S->time_simplify = sums->time_simplify;
 }
 
-fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
-                                 const fcm_cell_rules_options *opts, fcm_cell_rules **rules)
+/* The build shared by fcm_cell_rules_create() and fcm_cell_rules_create_cut(): R (from
+ * rules_alloc, with its cut triangles set) is filled; `prev` (or NULL) is the object being
+ * extended by the triangles from first_new on. */
+static fcm_status build_rules(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                              const fcm_cell_rules *prev, fcm_index first_new, fcm_cell_rules *R)
 {
   fcm_status st = FCM_OK;
-  fcm_cell_rules *R = NULL;
-  const fcm_cell_rules_options o = opts ? *opts : fcm_cell_rules_options_default();
+  const fcm_cell_rules_options *o = &R->opts;
   build B;
   cell_out *out = NULL;
   cell_sums sums;
-  fcm_index nc = 0;
+  const fcm_index nc = fcm_mesh_num_cells(mesh);
   memset(&B, 0, sizeof B);
   const double t_start = fcm_wtime();
-  FCM_CHECK(rules, ctx, FCM_ERR_ARG, "embed: output pointer is NULL");
-  *rules = NULL;
-  FCM_CHECK(ctx && mesh && geom, ctx, FCM_ERR_ARG,
-            "embed: NULL argument (ctx, mesh and geometry are required)");
-  FCM_TRY(ctx, check_options(ctx, &o));
-  nc = fcm_mesh_num_cells(mesh);
   for (fcm_index c = 0; c < nc; c++)
-    FCM_CHECK(fcm_mesh_cell_is_convex(mesh, c, o.convex_rtol), ctx, FCM_ERR_GEOMETRY,
+    FCM_CHECK(fcm_mesh_cell_is_convex(mesh, c, o->convex_rtol), ctx, FCM_ERR_GEOMETRY,
               "embed: background cell %lld (%s) is not a convex polyhedron with planar faces and "
               "straight edges (relative tolerance %g); cut-cell quadrature needs convex cells",
-              (long long)c, fcm_mesh_get_element_info(mesh)->name, o.convex_rtol);
+              (long long)c, fcm_mesh_get_element_info(mesh)->name, o->convex_rtol);
 
   /* 1. set-up */
-  FCM_TRY(ctx, rules_alloc(ctx, mesh, &o, &R));
-  FCM_TRY(ctx, build_setup(ctx, mesh, geom, &o, R, &B));
+  FCM_TRY(ctx, build_setup(ctx, mesh, geom, o, R, &B));
+  B.prev = prev;
+  if (R->num_cut_tris > 0) FCM_TRY(ctx, cut_setup(&B, R, first_new));
   FCM_ALLOC(ctx, (size_t)nc, out);
   const double t_setup = fcm_wtime();
   /* 2. parallel per-cell work */
-  const int nthreads = o.num_threads > 0 ? o.num_threads : omp_get_max_threads();
-  FCM_TRY(ctx, run_cells(&B, R, nthreads, out, &sums, &o));
-  if (o.simplify == FCM_CELL_SIMPLIFY_AUTO)
+  const int nthreads = o->num_threads > 0 ? o->num_threads : omp_get_max_threads();
+  FCM_TRY(ctx, run_cells(&B, R, nthreads, out, &sums, o));
+  if (o->simplify == FCM_CELL_SIMPLIFY_AUTO)
     FCM_TRY(ctx, auto_simplify(&B, R, nthreads, out, &sums));
   const double t_loop = fcm_wtime();
   /* 3. gather, 4. statistics */
   FCM_TRY(ctx, gather_rules(ctx, R, out));
+  if (B.cut_tree) FCM_TRY(ctx, gather_links(&B, R, out));
   gather_stats(R, geom, out, &sums, nthreads);
   FCM_TRY(ctx, fcm__embed_outside(ctx, mesh, geom, &R->stats));
-  if (o.simplify != FCM_CELL_SIMPLIFY_AUTO)
+  if (o->simplify != FCM_CELL_SIMPLIFY_AUTO)
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
-      R->stats.decision[k].simplified = o.simplify == FCM_CELL_SIMPLIFY_ON;
+      R->stats.decision[k].simplified = o->simplify == FCM_CELL_SIMPLIFY_ON;
+  R->stats.num_integrated = nc;
+  if (B.rebuild) {
+    R->stats.num_integrated = 0;
+    for (fcm_index c = 0; c < nc; c++)
+      R->stats.num_integrated += B.rebuild[c];
+  }
   R->stats.time_setup = t_setup - t_start;
   R->stats.time_gather = fcm_wtime() - t_loop;
   R->stats.time_total = fcm_wtime() - t_start;
-  *rules = R;
-  R = NULL;
 cleanup:
   if (out)
     for (fcm_index c = 0; c < nc; c++)
       cell_out_free(ctx, out + c);
   fcm__free(ctx, out);
   build_release(&B);
+  return st;
+}
+
+fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                                 const fcm_cell_rules_options *opts, fcm_cell_rules **rules)
+{
+  fcm_status st = FCM_OK;
+  fcm_cell_rules *R = NULL;
+  const fcm_cell_rules_options o = opts ? *opts : fcm_cell_rules_options_default();
+  FCM_CHECK(rules, ctx, FCM_ERR_ARG, "embed: output pointer is NULL");
+  *rules = NULL;
+  FCM_CHECK(ctx && mesh && geom, ctx, FCM_ERR_ARG,
+            "embed: NULL argument (ctx, mesh and geometry are required)");
+  FCM_TRY(ctx, check_options(ctx, &o));
+  FCM_TRY(ctx, rules_alloc(ctx, mesh, &o, &R));
+  FCM_TRY(ctx, build_rules(ctx, mesh, geom, NULL, 0, R));
+  *rules = R;
+  R = NULL;
+cleanup:
+  fcm_cell_rules_destroy(&R);
+  return st;
+}
+
+fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                                     const fcm_cell_rules *prev, const fcm_surface *cut,
+                                     fcm_cell_rules **rules)
+{
+  fcm_status st = FCM_OK;
+  fcm_cell_rules *R = NULL;
+  FCM_CHECK(rules, ctx, FCM_ERR_ARG, "embed cut: output pointer is NULL");
+  *rules = NULL;
+  FCM_CHECK(ctx && mesh && geom && prev && cut, ctx, FCM_ERR_ARG,
+            "embed cut: NULL argument (ctx, mesh, geometry, rules and cut are required)");
+  FCM_CHECK(fcm_mesh_num_cells(mesh) == prev->num_cells &&
+                fcm_mesh_element_type(mesh) == prev->type,
+            ctx, FCM_ERR_ARG, "embed cut: the mesh (%lld cells) is not the rules' mesh (%lld)",
+            (long long)fcm_mesh_num_cells(mesh), (long long)prev->num_cells);
+  FCM_CHECK(prev->num_cuts < 1 << 20, ctx, FCM_ERR_UNSUPPORTED,
+            "embed cut: %d cuts already (limit 2^20)", prev->num_cuts);
+  const fcm_index nt = fcm_surface_num_triangles(cut);
+  const double *x = fcm_surface_coords(cut);
+  const fcm_index *tv = fcm_surface_triangles(cut);
+  FCM_TRY(ctx, rules_alloc(ctx, mesh, &prev->opts, &R));
+  FCM_ALLOC(ctx, (size_t)(prev->num_cut_tris + nt), R->cut_tris);
+  if (prev->num_cut_tris)
+    memcpy(R->cut_tris, prev->cut_tris, (size_t)prev->num_cut_tris * sizeof *R->cut_tris);
+  R->num_cut_tris = prev->num_cut_tris;
+  for (fcm_index t = 0; t < nt; t++)
+    R->num_cut_tris +=
+        fcm__embed_cut_tri_setup(x + 3 * tv[3 * t], x + 3 * tv[3 * t + 1], x + 3 * tv[3 * t + 2],
+                                 prev->num_cuts, R->cut_tris + R->num_cut_tris);
+  R->num_cuts = prev->num_cuts + 1;
+  FCM_TRY(ctx, build_rules(ctx, mesh, geom, prev, prev->num_cut_tris, R));
+  *rules = R;
+  R = NULL;
+cleanup:
   fcm_cell_rules_destroy(&R);
   return st;
 }
@@ -764,6 +1185,11 @@ void fcm_cell_rules_destroy(fcm_cell_rules **rules)
   }
   fcm__free(ctx, R->cls);
   fcm__free(ctx, R->fraction);
+  fcm__free(ctx, R->piece_off);
+  fcm__free(ctx, R->piece_cell);
+  fcm__free(ctx, R->piece_volume);
+  fcm__free(ctx, R->cut_tris);
+  fcm__free(ctx, R->links);
   fcm__free(ctx, R->soff);
   fcm__free(ctx, R->spoints);
   fcm__free(ctx, R->sweights);
@@ -824,8 +1250,8 @@ fcm_status fcm_cell_rules_get(const fcm_cell_rules *rules, fcm_index cell, fcm_r
     w = fcm_rule_weights(rules->uncut[kind]);
     f = rules->uncut_flags[kind];
   } else if (rules->cls[cell] == FCM_CELL_CUT) {
-    const fcm_index o0 = rules->off[kind][cell];
-    n = (int)(rules->off[kind][cell + 1] - o0);
+    const fcm_index o0 = rules->off[kind][rules->piece_off[cell]];
+    n = (int)(rules->off[kind][rules->piece_off[cell + 1]] - o0);
     p = rules->points[kind] + 3 * o0;
     w = rules->weights[kind] + o0;
     f = rules->flags[kind] + o0;
@@ -850,8 +1276,8 @@ fcm_status fcm_cell_rules_get_surface(const fcm_cell_rules *rules, fcm_index cel
   FCM_CHECK(cell >= 0 && cell < rules->num_cells, ctx, FCM_ERR_ARG,
             "cell rules: cell %lld out of range [0,%lld)", (long long)cell,
             (long long)rules->num_cells);
-  o0 = rules->soff[cell];
-  n = (int)(rules->soff[cell + 1] - o0);
+  o0 = rules->soff[rules->piece_off[cell]];
+  n = (int)(rules->soff[rules->piece_off[cell + 1]] - o0);
 cleanup:
   if (num_points) *num_points = n;
   if (points) *points = n ? rules->spoints + 3 * o0 : NULL;
@@ -859,6 +1285,107 @@ cleanup:
   if (normals) *normals = n ? rules->snormals + 3 * o0 : NULL;
   if (triangles) *triangles = n ? rules->stris + o0 : NULL;
   return st;
+}
+
+fcm_index fcm_cell_rules_num_pieces(const fcm_cell_rules *rules)
+{
+  return rules ? rules->num_pieces : 0;
+}
+
+fcm_index fcm_cell_rules_cell_pieces(const fcm_cell_rules *rules, fcm_index cell, fcm_index *first)
+{
+  if (!rules || cell < 0 || cell >= rules->num_cells) {
+    if (first) *first = 0;
+    return 0;
+  }
+  if (first) *first = rules->piece_off[cell];
+  return rules->piece_off[cell + 1] - rules->piece_off[cell];
+}
+
+fcm_index fcm_cell_rules_piece_cell(const fcm_cell_rules *rules, fcm_index piece)
+{
+  if (!rules || piece < 0 || piece >= rules->num_pieces) return -1;
+  return rules->piece_cell[piece];
+}
+
+double fcm_cell_rules_piece_volume(const fcm_cell_rules *rules, fcm_index piece)
+{
+  if (!rules || piece < 0 || piece >= rules->num_pieces) return 0.0;
+  return rules->piece_volume[piece];
+}
+
+fcm_status fcm_cell_rules_get_piece(const fcm_cell_rules *rules, fcm_index piece,
+                                    fcm_rule_kind kind, int *num_points, const double **points,
+                                    const double **weights, const unsigned char **flags)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = rules ? rules->ctx : NULL;
+  int n = 0;
+  const double *p = NULL, *w = NULL;
+  const unsigned char *f = NULL;
+  FCM_CHECK(rules, ctx, FCM_ERR_ARG, "cell rules: rules is NULL");
+  FCM_CHECK(piece >= 0 && piece < rules->num_pieces, ctx, FCM_ERR_ARG,
+            "cell rules: piece %lld out of range [0,%lld)", (long long)piece,
+            (long long)rules->num_pieces);
+  FCM_CHECK((int)kind >= 0 && kind < FCM_RULE_KIND_COUNT, ctx, FCM_ERR_ARG,
+            "cell rules: kind %d out of range [0,%d)", (int)kind, (int)FCM_RULE_KIND_COUNT);
+  if (rules->cls[rules->piece_cell[piece]] == FCM_CELL_UNCUT) {
+    n = fcm_rule_num_points(rules->uncut[kind]);
+    p = fcm_rule_points(rules->uncut[kind]);
+    w = fcm_rule_weights(rules->uncut[kind]);
+    f = rules->uncut_flags[kind];
+  } else {
+    const fcm_index o0 = rules->off[kind][piece];
+    n = (int)(rules->off[kind][piece + 1] - o0);
+    p = rules->points[kind] + 3 * o0;
+    w = rules->weights[kind] + o0;
+    f = rules->flags[kind] + o0;
+  }
+cleanup:
+  if (num_points) *num_points = n;
+  if (points) *points = n ? p : NULL;
+  if (weights) *weights = n ? w : NULL;
+  if (flags) *flags = n ? f : NULL;
+  return st;
+}
+
+fcm_status fcm_cell_rules_get_piece_surface(const fcm_cell_rules *rules, fcm_index piece,
+                                            int *num_points, const double **points,
+                                            const double **weights, const double **normals,
+                                            const fcm_index **triangles)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = rules ? rules->ctx : NULL;
+  int n = 0;
+  fcm_index o0 = 0;
+  FCM_CHECK(rules, ctx, FCM_ERR_ARG, "cell rules: rules is NULL");
+  FCM_CHECK(piece >= 0 && piece < rules->num_pieces, ctx, FCM_ERR_ARG,
+            "cell rules: piece %lld out of range [0,%lld)", (long long)piece,
+            (long long)rules->num_pieces);
+  o0 = rules->soff[piece];
+  n = (int)(rules->soff[piece + 1] - o0);
+cleanup:
+  if (num_points) *num_points = n;
+  if (points) *points = n ? rules->spoints + 3 * o0 : NULL;
+  if (weights) *weights = n ? rules->sweights + o0 : NULL;
+  if (normals) *normals = n ? rules->snormals + 3 * o0 : NULL;
+  if (triangles) *triangles = n ? rules->stris + o0 : NULL;
+  return st;
+}
+
+fcm_index fcm_cell_rules_num_links(const fcm_cell_rules *rules)
+{
+  return rules ? rules->num_links : 0;
+}
+
+const fcm_index *fcm_cell_rules_links(const fcm_cell_rules *rules)
+{
+  return rules ? rules->links : NULL;
+}
+
+int fcm_cell_rules_num_cuts(const fcm_cell_rules *rules)
+{
+  return rules ? rules->num_cuts : 0;
 }
 
 const fcm_cell_rules_stats *fcm_cell_rules_get_stats(const fcm_cell_rules *rules)
@@ -873,11 +1400,11 @@ void fcm_cell_rules_view(const fcm_cell_rules *rules, FILE *stream)
   static const char *names[FCM_RULE_KIND_COUNT] = {"stiffness", "mass"};
   fprintf(stream,
           "cell rules: %s, %lld cells: %lld uncut, %lld cut, %lld dropped (%d threads)\n"
-          "  candidates %lld, pieces %lld, tets %lld, slivers dropped %lld (volume %.3g)\n"
+          "  candidates %lld, convex parts %lld, tets %lld, slivers dropped %lld (volume %.3g)\n"
           "  embedded volume %.17g (geometry %.17g, in dropped cells %.3g)\n",
           fcm_element_get_info(rules->type)->name, (long long)S->num_cells, (long long)S->num_uncut,
           (long long)S->num_cut, (long long)S->num_dropped, S->num_threads,
-          (long long)S->num_candidates, (long long)S->num_pieces, (long long)S->num_tets,
+          (long long)S->num_candidates, (long long)S->num_parts, (long long)S->num_tets,
           (long long)S->num_slivers, S->sliver_volume, S->embedded_volume, S->geometry_volume,
           S->dropped_volume);
   fprintf(stream, "  embedded / geometry volume %.6f; outside the background mesh %.3g",

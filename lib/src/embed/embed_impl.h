@@ -8,6 +8,17 @@
 #include "fcm/quad.h"
 #include "geom/geom_impl.h"
 
+/* A cut triangle prepared for splitting (DESIGN §9): its plane (unit normal) and the three
+ * planes through its edges perpendicular to it (outward: the triangle is where all three
+ * are <= 0); lo/hi its bounding box; `cut` the cut surface it came from. */
+typedef struct fcm__cut_tri {
+  double x[3][3];
+  fcm__plane plane;
+  fcm__plane edge[3];
+  double lo[3], hi[3];
+  int cut;
+} fcm__cut_tri;
+
 struct fcm_cell_rules {
   fcm_ctx *ctx;
   fcm_index num_cells;
@@ -16,7 +27,14 @@ struct fcm_cell_rules {
   int surface_strength;
   unsigned char *cls; /* num_cells fcm_cell_class values */
   double *fraction;   /* num_cells volume fractions */
-  /* Cut cells: entries [off[c], off[c+1]) of the concatenated arrays (empty otherwise). */
+  /* Material pieces: cell c has pieces [piece_off[c], piece_off[c+1]) (uncut: one, dropped:
+   * none, cut: one or, when cuts split it, more), each with its cell and volume. */
+  fcm_index num_pieces;
+  fcm_index *piece_off; /* num_cells + 1 */
+  fcm_index *piece_cell;
+  double *piece_volume;
+  /* Pieces of cut cells: entries [off[p], off[p+1]) of the concatenated arrays (empty
+   * otherwise). */
   fcm_index *off[FCM_RULE_KIND_COUNT];
   double *points[FCM_RULE_KIND_COUNT]; /* x 3 */
   double *weights[FCM_RULE_KIND_COUNT];
@@ -24,12 +42,22 @@ struct fcm_cell_rules {
   /* Uncut cells share the catalogue rule of each kind (flags all 0). */
   fcm_rule *uncut[FCM_RULE_KIND_COUNT];
   unsigned char *uncut_flags[FCM_RULE_KIND_COUNT];
-  /* Surface rules of non-dropped cells: entries [soff[c], soff[c+1]). */
+  /* Surface rules of the pieces of non-dropped cells: entries [soff[p], soff[p+1]). */
   fcm_index *soff;
   double *spoints;  /* x 3 */
   double *sweights; /* area weights */
   double *snormals; /* x 3 */
   fcm_index *stris; /* boundary triangle of each point */
+  /* Cutting: the options the rules were built with (fcm_cell_rules_create_cut() reuses
+   * them), the cut triangles of every cut so far, and the links: pairs of pieces of
+   * face-neighbouring cells that share a face of positive area not lying on a cut (only
+   * around cut cells: 2 x num_links piece ids, ascending pairs, sorted). */
+  fcm_cell_rules_options opts;
+  int num_cuts;
+  fcm_index num_cut_tris;
+  fcm__cut_tri *cut_tris;
+  fcm_index num_links;
+  fcm_index *links;
   fcm_cell_rules_stats stats;
 };
 
@@ -61,6 +89,7 @@ typedef struct fcm__embed_ws {
   fcm_index *stri;
   size_t num_spts, spt_cap;
   fcm__poly poly, scratch;
+  struct fcm__parts *parts; /* cells reached by cuts (and their neighbours): NULL until used */
 } fcm__embed_ws;
 
 void fcm__embed_ws_free(fcm_ctx *ctx, fcm__embed_ws *ws);
@@ -73,7 +102,7 @@ fcm_status fcm__embed_cell_setup(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index i
 /* Counters of the per-cell kernels (summed over cells into the statistics). */
 typedef struct fcm__embed_counts {
   fcm_index candidates;        /* (background cell, embedded cell) pairs from the tree */
-  fcm_index pieces;            /* non-empty clipped polyhedra */
+  fcm_index parts;             /* non-empty clipped polyhedra (convex parts) */
   fcm_index tets;              /* tets kept */
   fcm_index slivers;           /* tets dropped as slivers */
   fcm_index surface_triangles; /* clipped boundary triangles kept */
@@ -89,6 +118,17 @@ typedef struct fcm__embed_counts {
 fcm_status fcm__embed_cell_tets(fcm_ctx *ctx, const fcm_geometry *geom, const fcm_aabb_tree *tree,
                                 const fcm__embed_cell *cell, double clip_rtol, double sliver_rtol,
                                 fcm__embed_ws *ws, fcm__embed_counts *counts, double *volume);
+
+/* Clip embedded cell e by the planes of `cell` into ws->poly (empty: nf == 0); *tol and
+ * *vmin are the vertex-on-plane tolerance and the sliver volume for it (see above). */
+fcm_status fcm__embed_clip_cell(fcm_ctx *ctx, const fcm_geometry *geom,
+                                const fcm__embed_cell *cell, fcm_index e, double clip_rtol,
+                                double sliver_rtol, fcm__embed_ws *ws, double *tol, double *vmin);
+
+/* Fan-tetrahedralize p and append the tets with volume > vmin to ws->tets / ws->vol; the
+ * kept volume is added to *vsum, dropped slivers to *lost and *nslivers. */
+fcm_status fcm__embed_append_tets(fcm_ctx *ctx, fcm__embed_ws *ws, const fcm__poly *p, double vmin,
+                                  double *vsum, double *lost, fcm_index *nslivers);
 
 /* Reference coordinates xi and det J_K(xi) of the physical point x. */
 fcm_status fcm__embed_to_reference(fcm_ctx *ctx, const fcm__embed_cell *cell, const double x[3],
@@ -108,6 +148,70 @@ fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
                                    const fcm_aabb_tree *tri_tree, const fcm__embed_cell *cell,
                                    double sliver_rtol, const fcm_rule *tri_rule, fcm__embed_ws *ws,
                                    fcm__embed_counts *counts);
+
+/* ---------------------------------------------------------------- cutting (pieces.c) */
+
+/* Prepare triangle (a, b, c); 0 when it has no area (relative 1e-14 of its longest edge
+ * squared): such a triangle separates nothing and is skipped. */
+int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double c[3], int cut,
+                             fcm__cut_tri *t);
+
+/* Convex parts of the embedded geometry inside one background cell and the material piece
+ * of each: the clipped embedded cells, split by the cut triangles that reach the cell. */
+typedef struct fcm__parts {
+  fcm__poly *poly;
+  double *tol, *vmin; /* per part: clip tolerance and sliver volume of its embedded cell */
+  int *piece;         /* per part: material piece, 0 .. num_pieces-1 (fcm__embed_pieces) */
+  size_t n, cap;
+  int num_pieces;
+  fcm__poly w[3], scratch; /* splitting workspace */
+  fcm__idbuf tcand;        /* cut triangles reaching the cell, ascending */
+  /* Polygons of part faces lying on the cell's faces (fcm__embed_face_polygons): polygon i
+   * is on cell face fmeta[3i], belongs to piece fmeta[3i+1] and has fmeta[3i+2] vertices,
+   * stored consecutively in fx (x 3). */
+  double *fx;
+  int *fmeta;
+  size_t nfx, capfx, nfp, capfp;
+  int *uf; /* union-find scratch, n entries */
+  size_t ufcap;
+} fcm__parts;
+
+void fcm__embed_parts_free(fcm_ctx *ctx, fcm__parts *P);
+
+/* Clip every candidate embedded cell by the cell's planes (as fcm__embed_cell_tets) and keep
+ * the non-empty convex parts in P (P->n of them, every piece 0). counts->parts is added. */
+fcm_status fcm__embed_cell_parts(fcm_ctx *ctx, const fcm_geometry *geom, const fcm_aabb_tree *tree,
+                                 const fcm__embed_cell *cell, double clip_rtol, double sliver_rtol,
+                                 fcm__embed_ws *ws, fcm__parts *P, fcm__embed_counts *counts);
+
+/* Split the parts by the planes and edge planes of the cut triangles tris[P->tcand] that
+ * reach them, then group them into material pieces: two parts connect when they share a
+ * face of positive area that does not lie on a cut triangle; the connected components,
+ * numbered by their first part, are the pieces (P->piece, P->num_pieces). */
+fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
+                                  const fcm__cut_tri *tris, fcm__parts *P);
+
+/* Fan-tetrahedralize the parts of `piece` into ws->tets / ws->vol (slivers dropped and
+ * counted as in fcm__embed_cell_tets); *volume = the kept tets' volume. */
+fcm_status fcm__embed_piece_tets(fcm_ctx *ctx, const fcm__parts *P, int piece, fcm__embed_ws *ws,
+                                 fcm__embed_counts *counts, double *volume);
+
+/* The piece whose parts contain the physical point x (the part with the smallest largest
+ * signed distance to its face planes). */
+int fcm__embed_point_piece(const fcm__parts *P, const double x[3]);
+
+/* Record the polygons of part faces lying on the cell's faces (P->fx, P->fmeta). */
+fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P);
+
+/* Area of the part of polygon a (na vertices) inside the convex polygon b (nb vertices,
+ * counter-clockwise around its unit normal nb_normal), both on one plane; *centroid (may
+ * be NULL) the overlap's vertex centroid. `tol` is the on-edge tolerance. */
+double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
+                          const double nb_normal[3], double tol, double centroid[3]);
+
+/* 1 when the point x lies on one of the cut triangles tris[ids[0 .. n)] within `tol`. */
+int fcm__embed_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n, const double x[3],
+                      double tol);
 
 /* The embedding diagnostics of the statistics S (geometry, embedded and sliver volumes
  * already set): bounding boxes, volume ratio, the volume outside the mesh and beyond each

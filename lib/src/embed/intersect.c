@@ -14,6 +14,9 @@
 
 void fcm__embed_ws_free(fcm_ctx *ctx, fcm__embed_ws *ws)
 {
+  if (ws->parts) fcm__embed_parts_free(ctx, ws->parts);
+  fcm__free(ctx, ws->parts);
+  ws->parts = NULL;
   fcm__geom_idbuf_free(ctx, &ws->cand);
   fcm__free(ctx, ws->tets);
   fcm__free(ctx, ws->vol);
@@ -119,57 +122,78 @@ static double cell_thickness(const double *X, int n, double vol)
   return d2 > 0.0 ? 6.0 * vol / d2 : 0.0;
 }
 
+fcm_status fcm__embed_clip_cell(fcm_ctx *ctx, const fcm_geometry *geom,
+                                const fcm__embed_cell *cell, fcm_index e, double clip_rtol,
+                                double sliver_rtol, fcm__embed_ws *ws, double *tol, double *vmin)
+{
+  fcm_status st = FCM_OK;
+  double X[24];
+  const fcm_index *cv = geom->cells + (size_t)geom->npc * (size_t)e;
+  for (int a = 0; a < geom->npc; a++)
+    for (int d = 0; d < 3; d++)
+      X[3 * a + d] = geom->coords[3 * cv[a] + d];
+  fcm__geom_poly_from_cell(geom->type, X, &ws->poly);
+  /* the scales of this embedded cell: a thin one gets tolerances of its own size */
+  const double vol_e = fabs(fcm__geom_poly_volume(&ws->poly));
+  *tol = fmin(cell->tol, clip_rtol * cell_thickness(X, geom->npc, vol_e));
+  *vmin = sliver_rtol * fmin(cell->volume, vol_e);
+  for (int f = 0; f < cell->num_planes && ws->poly.nf > 0; f++)
+    FCM_CHECK(fcm__geom_poly_clip(&ws->poly, cell->planes + f, *tol, &ws->scratch) == 0, ctx,
+              FCM_ERR_INTERNAL,
+              "embed: clipping embedded cell %lld by background cell %lld exceeded the "
+              "polyhedron capacity (%d vertices, %d faces)",
+              (long long)e, (long long)cell->id, FCM__POLY_MAX_VERTS, FCM__POLY_MAX_FACES);
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_append_tets(fcm_ctx *ctx, fcm__embed_ws *ws, const fcm__poly *p, double vmin,
+                                  double *vsum, double *lost, fcm_index *nslivers)
+{
+  fcm_status st = FCM_OK;
+  const int nt = fcm__geom_poly_num_tets(p);
+  FCM_TRY(ctx, grow_tets(ctx, ws, ws->num_tets + (size_t)nt));
+  double *t = ws->tets + 12 * ws->num_tets, *v = ws->vol + ws->num_tets;
+  const int made = fcm__geom_poly_tets(p, t, v);
+  int kept = 0;
+  for (int i = 0; i < made; i++) {
+    if (!(v[i] > vmin)) {
+      (*nslivers)++;
+      if (v[i] > 0.0) *lost += v[i];
+      continue;
+    }
+    if (kept != i) {
+      memmove(t + 12 * kept, t + 12 * i, 12 * sizeof *t);
+      v[kept] = v[i];
+    }
+    *vsum += v[i];
+    kept++;
+  }
+  ws->num_tets += (size_t)kept;
+cleanup:
+  return st;
+}
+
 fcm_status fcm__embed_cell_tets(fcm_ctx *ctx, const fcm_geometry *geom, const fcm_aabb_tree *tree,
                                 const fcm__embed_cell *cell, double clip_rtol, double sliver_rtol,
                                 fcm__embed_ws *ws, fcm__embed_counts *counts, double *volume)
 {
   fcm_status st = FCM_OK;
-  double X[24], vsum = 0.0, lost = 0.0;
-  fcm_index npieces = 0, nslivers = 0;
+  double vsum = 0.0, lost = 0.0;
+  fcm_index nparts = 0, nslivers = 0;
   ws->num_tets = 0;
   FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, cell->lo, cell->hi, &ws->cand));
   for (size_t k = 0; k < ws->cand.n; k++) {
-    const fcm_index e = ws->cand.ids[k];
-    const fcm_index *cv = geom->cells + (size_t)geom->npc * (size_t)e;
-    for (int a = 0; a < geom->npc; a++)
-      for (int d = 0; d < 3; d++)
-        X[3 * a + d] = geom->coords[3 * cv[a] + d];
-    fcm__geom_poly_from_cell(geom->type, X, &ws->poly);
-    /* the scales of this embedded cell: a thin one gets tolerances of its own size */
-    const double vol_e = fabs(fcm__geom_poly_volume(&ws->poly));
-    const double tol = fmin(cell->tol, clip_rtol * cell_thickness(X, geom->npc, vol_e));
-    const double vmin = sliver_rtol * fmin(cell->volume, vol_e);
-    for (int f = 0; f < cell->num_planes && ws->poly.nf > 0; f++)
-      FCM_CHECK(fcm__geom_poly_clip(&ws->poly, cell->planes + f, tol, &ws->scratch) == 0, ctx,
-                FCM_ERR_INTERNAL,
-                "embed: clipping embedded cell %lld by background cell %lld exceeded the "
-                "polyhedron capacity (%d vertices, %d faces)",
-                (long long)e, (long long)cell->id, FCM__POLY_MAX_VERTS, FCM__POLY_MAX_FACES);
+    double tol, vmin;
+    FCM_TRY(ctx, fcm__embed_clip_cell(ctx, geom, cell, ws->cand.ids[k], clip_rtol, sliver_rtol, ws,
+                                      &tol, &vmin));
     if (ws->poly.nf == 0) continue;
-    npieces++;
-    const int nt = fcm__geom_poly_num_tets(&ws->poly);
-    FCM_TRY(ctx, grow_tets(ctx, ws, ws->num_tets + (size_t)nt));
-    double *t = ws->tets + 12 * ws->num_tets, *v = ws->vol + ws->num_tets;
-    const int made = fcm__geom_poly_tets(&ws->poly, t, v);
-    int kept = 0;
-    for (int i = 0; i < made; i++) {
-      if (!(v[i] > vmin)) {
-        nslivers++;
-        if (v[i] > 0.0) lost += v[i];
-        continue;
-      }
-      if (kept != i) {
-        memmove(t + 12 * kept, t + 12 * i, 12 * sizeof *t);
-        v[kept] = v[i];
-      }
-      vsum += v[i];
-      kept++;
-    }
-    ws->num_tets += (size_t)kept;
+    nparts++;
+    FCM_TRY(ctx, fcm__embed_append_tets(ctx, ws, &ws->poly, vmin, &vsum, &lost, &nslivers));
   }
   if (counts) {
     counts->candidates += (fcm_index)ws->cand.n;
-    counts->pieces += npieces;
+    counts->parts += nparts;
     counts->tets += (fcm_index)ws->num_tets;
     counts->slivers += nslivers;
     counts->sliver_volume += lost;

@@ -1,0 +1,490 @@
+/* Cutting (XFEM) inside one background cell (DESIGN §9): the convex parts of the embedded
+ * geometry are split by the plane of every cut triangle that reaches them and by the
+ * triangle's three edge planes, so that every new face lies wholly on or wholly off the
+ * triangle; parts that share a face of positive area not lying on a cut triangle are
+ * connected; the connected components are the cell's material pieces. Each piece then goes
+ * through the same tetrahedralize -> map -> simplify -> stabilize path as a cut cell.
+ *
+ * Robustness: each part vertex is classified once per plane with the part's tolerance
+ * (fcm__geom_poly_clip), and both halves of a split are made from the same signed
+ * distances, so the two sides of a new face have bitwise equal vertices. A cut through a
+ * node, along an edge or in a face of the background or the embedded mesh needs no special
+ * case: a face lying on a triangle separates, wherever it came from. */
+#include "embed/embed_impl.h"
+
+#include <math.h>
+#include <string.h>
+
+/* Relative tolerances of the connectivity tests: faces match when their planes agree to
+ * MATCH_RTOL x the cell size (normals to 1e-6) and overlap by more than AREA_RTOL x size^2. */
+#define MATCH_RTOL 1e-9
+#define AREA_RTOL  1e-12
+#define NORMAL_TOL 1e-6
+
+static double dot3(const double a[3], const double b[3])
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void cross3(const double a[3], const double b[3], double c[3])
+{
+  c[0] = a[1] * b[2] - a[2] * b[1];
+  c[1] = a[2] * b[0] - a[0] * b[2];
+  c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double c[3], int cut,
+                             fcm__cut_tri *t)
+{
+  double e0[3], e1[3], n[3], l2 = 0.0;
+  memcpy(t->x[0], a, sizeof t->x[0]);
+  memcpy(t->x[1], b, sizeof t->x[1]);
+  memcpy(t->x[2], c, sizeof t->x[2]);
+  for (int k = 0; k < 3; k++) {
+    const double *p = t->x[k], *q = t->x[(k + 1) % 3];
+    double d2 = 0.0;
+    for (int d = 0; d < 3; d++)
+      d2 += (q[d] - p[d]) * (q[d] - p[d]);
+    l2 = fmax(l2, d2);
+  }
+  for (int d = 0; d < 3; d++) {
+    e0[d] = b[d] - a[d];
+    e1[d] = c[d] - a[d];
+    t->lo[d] = fmin(a[d], fmin(b[d], c[d]));
+    t->hi[d] = fmax(a[d], fmax(b[d], c[d]));
+  }
+  cross3(e0, e1, n);
+  const double ln = sqrt(dot3(n, n));
+  if (!(ln > 1e-14 * l2)) return 0;
+  for (int d = 0; d < 3; d++)
+    t->plane.n[d] = n[d] / ln;
+  t->plane.d = dot3(t->plane.n, a);
+  for (int k = 0; k < 3; k++) {
+    const double *p = t->x[k], *q = t->x[(k + 1) % 3];
+    double e[3], m[3];
+    for (int d = 0; d < 3; d++)
+      e[d] = q[d] - p[d];
+    cross3(e, t->plane.n, m); /* counter-clockwise around n: e x n points out of the triangle */
+    const double lm = sqrt(dot3(m, m));
+    for (int d = 0; d < 3; d++)
+      t->edge[k].n[d] = m[d] / lm;
+    t->edge[k].d = dot3(t->edge[k].n, p);
+  }
+  t->cut = cut;
+  return 1;
+}
+
+void fcm__embed_parts_free(fcm_ctx *ctx, fcm__parts *P)
+{
+  fcm__free(ctx, P->poly);
+  fcm__free(ctx, P->tol);
+  fcm__free(ctx, P->vmin);
+  fcm__free(ctx, P->piece);
+  fcm__free(ctx, P->fx);
+  fcm__free(ctx, P->fmeta);
+  fcm__free(ctx, P->uf);
+  fcm__geom_idbuf_free(ctx, &P->tcand);
+  P->poly = NULL;
+  P->tol = P->vmin = P->fx = NULL;
+  P->piece = P->fmeta = P->uf = NULL;
+  P->n = P->cap = P->nfx = P->capfx = P->nfp = P->capfp = P->ufcap = 0;
+}
+
+/* Room for `need` parts. */
+static fcm_status parts_grow(fcm_ctx *ctx, fcm__parts *P, size_t need)
+{
+  fcm_status st = FCM_OK;
+  if (need <= P->cap) return FCM_OK;
+  size_t cap = P->cap ? 2 * P->cap : 16;
+  while (cap < need)
+    cap *= 2;
+  void *p = P->poly, *t = P->tol, *v = P->vmin, *q = P->piece;
+  FCM_TRY(ctx, fcm__resize(ctx, &p, P->n, cap, sizeof(fcm__poly)));
+  P->poly = p;
+  FCM_TRY(ctx, fcm__resize(ctx, &t, P->n, cap, sizeof(double)));
+  P->tol = t;
+  FCM_TRY(ctx, fcm__resize(ctx, &v, P->n, cap, sizeof(double)));
+  P->vmin = v;
+  FCM_TRY(ctx, fcm__resize(ctx, &q, P->n, cap, sizeof(int)));
+  P->piece = q;
+  P->cap = cap;
+cleanup:
+  return st;
+}
+
+/* Copy the used part of a polyhedron (the struct is ~11 kB, mostly unused). */
+static void poly_copy(fcm__poly *dst, const fcm__poly *src)
+{
+  dst->nv = src->nv, dst->nf = src->nf;
+  memcpy(dst->x, src->x, (size_t)src->nv * sizeof src->x[0]);
+  for (int f = 0; f < src->nf; f++) {
+    dst->fn[f] = src->fn[f];
+    memcpy(dst->fv[f], src->fv[f], (size_t)src->fn[f] * sizeof src->fv[f][0]);
+  }
+}
+
+/* Store polyhedron q as part `slot` (slot == P->n appends). */
+static fcm_status parts_put(fcm_ctx *ctx, fcm__parts *P, size_t slot, const fcm__poly *q,
+                            double tol, double vmin)
+{
+  fcm_status st = FCM_OK;
+  if (slot == P->n) {
+    FCM_TRY(ctx, parts_grow(ctx, P, P->n + 1));
+    P->n++;
+  }
+  poly_copy(P->poly + slot, q);
+  P->tol[slot] = tol;
+  P->vmin[slot] = vmin;
+  P->piece[slot] = 0;
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_cell_parts(fcm_ctx *ctx, const fcm_geometry *geom, const fcm_aabb_tree *tree,
+                                 const fcm__embed_cell *cell, double clip_rtol, double sliver_rtol,
+                                 fcm__embed_ws *ws, fcm__parts *P, fcm__embed_counts *counts)
+{
+  fcm_status st = FCM_OK;
+  fcm_index nparts = 0;
+  P->n = 0;
+  P->num_pieces = 0;
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, cell->lo, cell->hi, &ws->cand));
+  for (size_t k = 0; k < ws->cand.n; k++) {
+    double tol, vmin;
+    FCM_TRY(ctx, fcm__embed_clip_cell(ctx, geom, cell, ws->cand.ids[k], clip_rtol, sliver_rtol, ws,
+                                      &tol, &vmin));
+    if (ws->poly.nf == 0) continue;
+    nparts++;
+    FCM_TRY(ctx, parts_put(ctx, P, P->n, &ws->poly, tol, vmin));
+  }
+  if (counts) {
+    counts->candidates += (fcm_index)ws->cand.n;
+    counts->parts += nparts;
+  }
+  P->num_pieces = P->n > 0;
+cleanup:
+  return st;
+}
+
+/* Signed distance range of p's vertices to plane pl. */
+static void plane_range(const fcm__poly *p, const fcm__plane *pl, double *lo, double *hi)
+{
+  *lo = HUGE_VAL, *hi = -HUGE_VAL;
+  for (int i = 0; i < p->nv; i++) {
+    const double s = dot3(pl->n, p->x[i]) - pl->d;
+    *lo = fmin(*lo, s), *hi = fmax(*hi, s);
+  }
+}
+
+static fcm__plane flip(const fcm__plane *pl)
+{
+  fcm__plane q = {{-pl->n[0], -pl->n[1], -pl->n[2]}, -pl->d};
+  return q;
+}
+
+/* Split part i by triangle t into up to 8 parts (both sides of its plane, each side
+ * inside or outside each edge plane); the first stays in slot i, the rest are appended.
+ * A part strictly on one side of the plane or strictly outside an edge plane is left. */
+static fcm_status split_part(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *t,
+                             fcm__parts *P, size_t i)
+{
+  fcm_status st = FCM_OK;
+  const double tol = P->tol[i], vmin = P->vmin[i];
+  double lo, hi;
+  plane_range(P->poly + i, &t->plane, &lo, &hi);
+  if (lo > tol || hi < -tol) return FCM_OK;
+  for (int e = 0; e < 3; e++) {
+    plane_range(P->poly + i, &t->edge[e], &lo, &hi);
+    if (lo > tol) return FCM_OK;
+  }
+  fcm__poly *W = P->w; /* W[0]: the part; W[1]: one side; W[2]: outside an edge */
+  poly_copy(&W[0], P->poly + i);
+  size_t slot = i;
+  int overflow = 0;
+  for (int side = 0; side < 2; side++) {
+    poly_copy(&W[1], &W[0]);
+    const fcm__plane h = side ? flip(&t->plane) : t->plane;
+    overflow |= fcm__geom_poly_clip(&W[1], &h, tol, &P->scratch);
+    for (int e = 0; e < 3 && W[1].nf > 0; e++) {
+      poly_copy(&W[2], &W[1]);
+      const fcm__plane out = flip(&t->edge[e]);
+      overflow |= fcm__geom_poly_clip(&W[2], &out, tol, &P->scratch);
+      overflow |= fcm__geom_poly_clip(&W[1], &t->edge[e], tol, &P->scratch);
+      if (W[2].nf > 0) {
+        FCM_TRY(ctx, parts_put(ctx, P, slot, &W[2], tol, vmin));
+        slot = P->n;
+      }
+    }
+    if (W[1].nf > 0) {
+      FCM_TRY(ctx, parts_put(ctx, P, slot, &W[1], tol, vmin));
+      slot = P->n;
+    }
+  }
+  FCM_CHECK(!overflow, ctx, FCM_ERR_INTERNAL,
+            "embed: splitting a convex part of background cell %lld by a cut triangle exceeded "
+            "the polyhedron capacity (%d vertices, %d faces)",
+            (long long)cell->id, FCM__POLY_MAX_VERTS, FCM__POLY_MAX_FACES);
+  if (slot == i) P->poly[i].nv = P->poly[i].nf = 0; /* nothing left: compacted later */
+cleanup:
+  return st;
+}
+
+/* Unit Newell normal and offset of face f of p; 0 when the face has no area. */
+static int face_plane(const fcm__poly *p, int f, fcm__plane *pl)
+{
+  double n[3] = {0, 0, 0}, c[3] = {0, 0, 0};
+  const int m = p->fn[f];
+  for (int k = 0; k < m; k++) {
+    const double *a = p->x[p->fv[f][k]], *b = p->x[p->fv[f][(k + 1) % m]];
+    n[0] += (a[1] - b[1]) * (a[2] + b[2]);
+    n[1] += (a[2] - b[2]) * (a[0] + b[0]);
+    n[2] += (a[0] - b[0]) * (a[1] + b[1]);
+    for (int d = 0; d < 3; d++)
+      c[d] += a[d] / m;
+  }
+  const double ln = sqrt(dot3(n, n));
+  if (!(ln > 0.0)) return 0;
+  for (int d = 0; d < 3; d++)
+    pl->n[d] = n[d] / ln;
+  pl->d = dot3(pl->n, c);
+  return 1;
+}
+
+/* Gather face f of p into x (fn x 3). */
+static int face_coords(const fcm__poly *p, int f, double *x)
+{
+  for (int k = 0; k < p->fn[f]; k++)
+    memcpy(x + 3 * k, p->x[p->fv[f][k]], 3 * sizeof *x);
+  return p->fn[f];
+}
+
+double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
+                          const double nb_normal[3], double tol, double centroid[3])
+{
+  double x[3 * FCM__POLY_MAX_VERTS], work[3 * FCM__POLY_MAX_VERTS];
+  if (na < 3 || nb < 3 || na > FCM__POLY_MAX_VERTS) return 0.0;
+  memcpy(x, a, 3 * (size_t)na * sizeof *x);
+  int m = na;
+  for (int k = 0; k < nb && m >= 3; k++) {
+    const double *p = b + 3 * k, *q = b + 3 * ((k + 1) % nb);
+    double e[3], mm[3];
+    for (int d = 0; d < 3; d++)
+      e[d] = q[d] - p[d];
+    cross3(e, nb_normal, mm);
+    const double lm = sqrt(dot3(mm, mm));
+    if (!(lm > 0.0)) continue;
+    fcm__plane pl;
+    for (int d = 0; d < 3; d++)
+      pl.n[d] = mm[d] / lm;
+    pl.d = dot3(pl.n, p);
+    m = fcm__geom_polygon_clip(x, m, FCM__POLY_MAX_VERTS, &pl, tol, 1, work);
+  }
+  if (m < 3) return 0.0;
+  double n[3] = {0, 0, 0}, c[3] = {0, 0, 0};
+  for (int k = 0; k < m; k++) {
+    const double *p = x + 3 * k, *q = x + 3 * ((k + 1) % m);
+    n[0] += (p[1] - q[1]) * (p[2] + q[2]);
+    n[1] += (p[2] - q[2]) * (p[0] + q[0]);
+    n[2] += (p[0] - q[0]) * (p[1] + q[1]);
+    for (int d = 0; d < 3; d++)
+      c[d] += p[d] / m;
+  }
+  if (centroid) memcpy(centroid, c, sizeof c);
+  return 0.5 * sqrt(dot3(n, n));
+}
+
+int fcm__embed_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n, const double x[3],
+                      double tol)
+{
+  for (size_t k = 0; k < n; k++) {
+    const fcm__cut_tri *t = tris + ids[k];
+    if (fabs(dot3(t->plane.n, x) - t->plane.d) > tol) continue;
+    int in = 1;
+    for (int e = 0; e < 3 && in; e++)
+      in = dot3(t->edge[e].n, x) - t->edge[e].d <= tol;
+    if (in) return 1;
+  }
+  return 0;
+}
+
+static int uf_find(int *uf, int a)
+{
+  while (uf[a] != a) {
+    uf[a] = uf[uf[a]];
+    a = uf[a];
+  }
+  return a;
+}
+
+static void uf_union(int *uf, int a, int b)
+{
+  a = uf_find(uf, a), b = uf_find(uf, b);
+  if (a < b)
+    uf[b] = a;
+  else if (b < a)
+    uf[a] = b;
+}
+
+/* Whether parts i and j share a face of positive area that does not lie on a cut triangle. */
+static int parts_connected(const fcm__embed_cell *cell, const fcm__cut_tri *tris,
+                           const fcm__parts *P, size_t i, size_t j)
+{
+  const fcm__poly *a = P->poly + i, *b = P->poly + j;
+  const double mtol = MATCH_RTOL * cell->size, atol = AREA_RTOL * cell->size * cell->size;
+  double xa[3 * FCM__POLY_MAX_FV], xb[3 * FCM__POLY_MAX_FV], c[3];
+  for (int fa = 0; fa < a->nf; fa++) {
+    fcm__plane pa, pb;
+    if (!face_plane(a, fa, &pa)) continue;
+    for (int fb = 0; fb < b->nf; fb++) {
+      if (!face_plane(b, fb, &pb)) continue;
+      if (dot3(pa.n, pb.n) > -(1.0 - NORMAL_TOL) || fabs(pa.d + pb.d) > mtol) continue;
+      const int na = face_coords(a, fa, xa), nb = face_coords(b, fb, xb);
+      if (fcm__embed_overlap(xa, na, xb, nb, pb.n, mtol, c) <= atol) continue;
+      if (!fcm__embed_on_cut(tris, P->tcand.ids, P->tcand.n, c, mtol)) return 1;
+    }
+  }
+  return 0;
+}
+
+fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
+                                  const fcm__cut_tri *tris, fcm__parts *P)
+{
+  fcm_status st = FCM_OK;
+  double *box = NULL;
+  for (size_t k = 0; k < P->tcand.n; k++) {
+    const fcm__cut_tri *t = tris + P->tcand.ids[k];
+    const size_t n0 = P->n;
+    for (size_t i = 0; i < n0; i++)
+      FCM_TRY(ctx, split_part(ctx, cell, t, P, i));
+  }
+  size_t kept = 0; /* drop the parts the tolerance emptied */
+  for (size_t i = 0; i < P->n; i++) {
+    if (P->poly[i].nf == 0) continue;
+    if (kept != i) {
+      poly_copy(P->poly + kept, P->poly + i);
+      P->tol[kept] = P->tol[i];
+      P->vmin[kept] = P->vmin[i];
+    }
+    kept++;
+  }
+  P->n = kept;
+  /* Components: union-find over part pairs whose boxes overlap. */
+  if (P->n > P->ufcap) {
+    void *u = P->uf;
+    FCM_TRY(ctx, fcm__resize(ctx, &u, 0, P->n, sizeof(int)));
+    P->uf = u;
+    P->ufcap = P->n;
+  }
+  FCM_ALLOC_RAW(ctx, 6 * P->n + 1, box);
+  const double mtol = MATCH_RTOL * cell->size;
+  for (size_t i = 0; i < P->n; i++) {
+    P->uf[i] = (int)i;
+    double *bi = box + 6 * i;
+    for (int d = 0; d < 3; d++)
+      bi[d] = HUGE_VAL, bi[3 + d] = -HUGE_VAL;
+    for (int v = 0; v < P->poly[i].nv; v++)
+      for (int d = 0; d < 3; d++) {
+        bi[d] = fmin(bi[d], P->poly[i].x[v][d] - mtol);
+        bi[3 + d] = fmax(bi[3 + d], P->poly[i].x[v][d] + mtol);
+      }
+  }
+  for (size_t i = 0; i < P->n; i++)
+    for (size_t j = i + 1; j < P->n; j++) {
+      const double *bi = box + 6 * i, *bj = box + 6 * j;
+      int apart = 0;
+      for (int d = 0; d < 3; d++)
+        apart |= bi[d] > bj[3 + d] || bj[d] > bi[3 + d];
+      if (apart || uf_find(P->uf, (int)i) == uf_find(P->uf, (int)j)) continue;
+      if (parts_connected(cell, tris, P, i, j)) uf_union(P->uf, (int)i, (int)j);
+    }
+  /* Pieces numbered by their first part. */
+  int np = 0;
+  for (size_t i = 0; i < P->n; i++) {
+    const int r = uf_find(P->uf, (int)i);
+    P->piece[i] = r == (int)i ? np++ : P->piece[r];
+  }
+  P->num_pieces = np;
+cleanup:
+  fcm__free(ctx, box);
+  return st;
+}
+
+fcm_status fcm__embed_piece_tets(fcm_ctx *ctx, const fcm__parts *P, int piece, fcm__embed_ws *ws,
+                                 fcm__embed_counts *counts, double *volume)
+{
+  fcm_status st = FCM_OK;
+  double vsum = 0.0, lost = 0.0;
+  fcm_index nslivers = 0;
+  ws->num_tets = 0;
+  for (size_t i = 0; i < P->n; i++)
+    if (P->piece[i] == piece)
+      FCM_TRY(ctx,
+              fcm__embed_append_tets(ctx, ws, P->poly + i, P->vmin[i], &vsum, &lost, &nslivers));
+  if (counts) {
+    counts->tets += (fcm_index)ws->num_tets;
+    counts->slivers += nslivers;
+    counts->sliver_volume += lost;
+  }
+  *volume = vsum;
+cleanup:
+  return st;
+}
+
+int fcm__embed_point_piece(const fcm__parts *P, const double x[3])
+{
+  double best = HUGE_VAL;
+  int piece = 0;
+  for (size_t i = 0; i < P->n; i++) {
+    double worst = -HUGE_VAL;
+    for (int f = 0; f < P->poly[i].nf; f++) {
+      fcm__plane pl;
+      if (face_plane(P->poly + i, f, &pl)) worst = fmax(worst, dot3(pl.n, x) - pl.d);
+    }
+    if (worst < best) best = worst, piece = P->piece[i];
+  }
+  return piece;
+}
+
+fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P)
+{
+  fcm_status st = FCM_OK;
+  const double mtol = MATCH_RTOL * cell->size;
+  P->nfx = P->nfp = 0;
+  for (size_t i = 0; i < P->n; i++) {
+    const fcm__poly *p = P->poly + i;
+    for (int f = 0; f < p->nf; f++) {
+      fcm__plane pl;
+      if (!face_plane(p, f, &pl)) continue;
+      for (int g = 0; g < cell->num_planes; g++) {
+        const fcm__plane *cp = cell->planes + g;
+        if (dot3(pl.n, cp->n) < 1.0 - NORMAL_TOL || fabs(pl.d - cp->d) > mtol) continue;
+        const size_t m = (size_t)p->fn[f];
+        if (P->nfp + 1 > P->capfp) {
+          const size_t cap = P->capfp ? 2 * P->capfp : 64;
+          void *q = P->fmeta;
+          FCM_TRY(ctx, fcm__resize(ctx, &q, 3 * P->nfp, 3 * cap, sizeof(int)));
+          P->fmeta = q;
+          P->capfp = cap;
+        }
+        if (P->nfx + m > P->capfx) {
+          size_t cap = P->capfx ? 2 * P->capfx : 256;
+          while (cap < P->nfx + m)
+            cap *= 2;
+          void *q = P->fx;
+          FCM_TRY(ctx, fcm__resize(ctx, &q, 3 * P->nfx, 3 * cap, sizeof(double)));
+          P->fx = q;
+          P->capfx = cap;
+        }
+        face_coords(p, f, P->fx + 3 * P->nfx);
+        P->fmeta[3 * P->nfp] = g;
+        P->fmeta[3 * P->nfp + 1] = P->piece[i];
+        P->fmeta[3 * P->nfp + 2] = (int)m;
+        P->nfp++;
+        P->nfx += m;
+        break;
+      }
+    }
+  }
+cleanup:
+  return st;
+}

@@ -1,0 +1,266 @@
+/* Cutting (XFEM) on the quadrature path (DESIGN §9): material pieces of cells split by cut
+ * surfaces. Checked facts: the pieces' volumes add up to the geometry's (a cut never loses
+ * or doubles volume), every authentic point of a piece lies on one side of a full planar
+ * cut, a cell a plane crosses has two pieces and the other cells one, a cut that ends
+ * inside the body separates nothing, pieces connected along the links form the expected
+ * number of material components (two halves; the 36 sticks of Ton-That et al. 2024 Fig. 5
+ * for a cube of 5 tets and 2x2x2 hexes diced by 10 planes), a cut along cell faces and
+ * through nodes is handled, and only cells a new cut reaches are integrated again. */
+#include "fcm/embed.h"
+#include "test.h"
+
+static fcm_ctx *ctx;
+
+/* Physical integral of 1 and of x_d over piece p (authentic points). */
+static void piece_moments(const fcm_mesh *mesh, const fcm_cell_rules *r, fcm_index p,
+                          double *vol, double xlo[3], double xhi[3])
+{
+  int n;
+  const double *pts, *w;
+  const unsigned char *fl;
+  double X[3 * 27], J[9], x[3];
+  const fcm_element_type type = fcm_mesh_element_type(mesh);
+  fcm_mesh_cell_coords(mesh, fcm_cell_rules_piece_cell(r, p), X);
+  TEST_OK(ctx, fcm_cell_rules_get_piece(r, p, FCM_RULE_STIFFNESS, &n, &pts, &w, &fl));
+  *vol = 0.0;
+  for (int d = 0; d < 3; d++)
+    xlo[d] = HUGE_VAL, xhi[d] = -HUGE_VAL;
+  for (int j = 0; j < n; j++) {
+    if (fl[j]) continue;
+    fcm_element_map(type, X, pts + 3 * j, x);
+    *vol += w[j] * fcm_element_jacobian(type, X, pts + 3 * j, J);
+    for (int d = 0; d < 3; d++)
+      xlo[d] = fmin(xlo[d], x[d]), xhi[d] = fmax(xhi[d], x[d]);
+  }
+}
+
+static int uf_find(fcm_index *uf, fcm_index a)
+{
+  while (uf[a] != a)
+    a = uf[a] = uf[uf[a]];
+  return (int)a;
+}
+
+/* Connected material components: pieces joined along the links; cells with one piece and
+ * no link partner next to them count as joined with their face neighbours' single pieces. */
+static int components(const fcm_mesh *mesh, const fcm_cell_rules *r)
+{
+  const fcm_index np = fcm_cell_rules_num_pieces(r), nc = fcm_mesh_num_cells(mesh);
+  const int nf = fcm_mesh_get_element_info(mesh)->num_faces;
+  const fcm_index *nbr = fcm_mesh_neighbors(mesh), *L = fcm_cell_rules_links(r);
+  fcm_index *uf = malloc((size_t)np * sizeof *uf);
+  unsigned char *linked = calloc((size_t)np, 1);
+  for (fcm_index p = 0; p < np; p++)
+    uf[p] = p;
+  for (fcm_index l = 0; l < fcm_cell_rules_num_links(r); l++) {
+    linked[L[2 * l]] = linked[L[2 * l + 1]] = 1;
+    uf[uf_find(uf, L[2 * l])] = uf_find(uf, L[2 * l + 1]);
+  }
+  for (fcm_index c = 0; c < nc; c++) { /* away from the cuts: one piece per cell */
+    fcm_index f0, f1;
+    if (fcm_cell_rules_cell_pieces(r, c, &f0) != 1 || linked[f0]) continue;
+    for (int f = 0; f < nf; f++) {
+      const fcm_index c2 = nbr[nf * c + f];
+      if (c2 >= 0 && fcm_cell_rules_cell_pieces(r, c2, &f1) == 1 && !linked[f1])
+        uf[uf_find(uf, f0)] = uf_find(uf, f1);
+    }
+  }
+  int k = 0;
+  for (fcm_index p = 0; p < np; p++)
+    k += uf_find(uf, p) == p;
+  free(uf);
+  free(linked);
+  return k;
+}
+
+static double total_volume(const fcm_cell_rules *r)
+{
+  double v = 0.0;
+  for (fcm_index p = 0; p < fcm_cell_rules_num_pieces(r); p++)
+    v += fcm_cell_rules_piece_volume(r, p);
+  return v;
+}
+
+static fcm_cell_rules_options opts(void)
+{
+  fcm_cell_rules_options o = fcm_cell_rules_options_default();
+  o.min_fraction = 0.0;
+  o.num_threads = 2;
+  return o;
+}
+
+/* A unit box body in a 3x3x3 Hex8 grid over [-0.25, 1.25]^3, cut by the plane x = 0.6:
+ * the 9 cells of the middle layer split in two, each piece on one side. */
+static void plane_cut(fcm_element_type type)
+{
+  const double lo[3] = {-0.25, -0.25, -0.25}, hi[3] = {1.25, 1.25, 1.25};
+  const double glo[3] = {0, 0, 0}, ghi[3] = {1, 1, 1};
+  const fcm_index n[3] = {3, 3, 3}, gn[3] = {3, 3, 3};
+  fcm_mesh *mesh = NULL;
+  fcm_geometry *g = NULL;
+  fcm_cell_rules *r0 = NULL, *r1 = NULL;
+  fcm_surface *cut = NULL;
+  const fcm_cell_rules_options o = opts();
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, n, &mesh));
+  TEST_OK(ctx, fcm_geometry_create_box(ctx, glo, ghi, gn, &g));
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &o, &r0));
+  const double p0[3] = {0.6, 0.5, 0.5}, nx[3] = {1, 0, 0};
+  const double blo[3] = {-0.1, -0.1, -0.1}, bhi[3] = {1.1, 1.1, 1.1};
+  TEST_OK(ctx, fcm_surface_create_plane(ctx, p0, nx, blo, bhi, &cut));
+  TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, r0, cut, &r1));
+  TEST_TRUE(fcm_cell_rules_num_pieces(r0) == fcm_mesh_num_cells(mesh) ||
+            type != FCM_ELEMENT_HEX8);
+  TEST_NEAR(total_volume(r1), 1.0, 1e-12, 0);
+  const fcm_cell_rules_stats *S = fcm_cell_rules_get_stats(r1);
+  TEST_NEAR(S->embedded_volume, 1.0, 1e-12, 0);
+  int split = 0;
+  for (fcm_index c = 0; c < fcm_mesh_num_cells(mesh); c++) {
+    fcm_index first;
+    const fcm_index k = fcm_cell_rules_cell_pieces(r1, c, &first);
+    TEST_TRUE(k <= 2);
+    split += k == 2;
+    for (fcm_index p = first; p < first + k; p++) {
+      double v, xl[3], xh[3];
+      piece_moments(mesh, r1, p, &v, xl, xh);
+      TEST_NEAR(v, fcm_cell_rules_piece_volume(r1, p), 1e-12, 0);
+      if (k == 2) TEST_TRUE(xh[0] < 0.6 || xl[0] > 0.6);
+    }
+    /* split when the uncut material of the cell has points on both sides */
+    fcm_index f0;
+    if (fcm_cell_rules_cell_pieces(r0, c, &f0) == 1) {
+      double v, xl[3], xh[3];
+      piece_moments(mesh, r0, f0, &v, xl, xh);
+      if (fcm_cell_rules_class(r0, c) == FCM_CELL_UNCUT) { /* catalogue points: the cell */
+        double X[3 * 27];
+        fcm_mesh_cell_coords(mesh, c, X);
+        xl[0] = HUGE_VAL, xh[0] = -HUGE_VAL;
+        for (int a = 0; a < fcm_mesh_nodes_per_cell(mesh); a++)
+          xl[0] = fmin(xl[0], X[3 * a]), xh[0] = fmax(xh[0], X[3 * a]);
+      }
+      if (xl[0] < 0.6 && xh[0] > 0.6) TEST_TRUE(k == 2);
+    }
+  }
+  /* the plane crosses 9 Hex8 cells */
+  TEST_TRUE(type != FCM_ELEMENT_HEX8 || split == 9);
+  TEST_TRUE((int)S->num_split == split);
+  TEST_TRUE(components(mesh, r1) == 2);
+  TEST_TRUE(components(mesh, r0) == 1);
+  TEST_TRUE(type != FCM_ELEMENT_HEX8 || S->num_integrated == 9);
+  TEST_TRUE(S->num_integrated < fcm_mesh_num_cells(mesh));
+  fcm_cell_rules_destroy(&r0);
+  fcm_cell_rules_destroy(&r1);
+  fcm_surface_destroy(&cut);
+  fcm_geometry_destroy(&g);
+  fcm_mesh_destroy(&mesh);
+}
+
+/* A rectangle that ends inside the body, and a cut lying in the cell faces x = 0.25 and
+ * through the grid nodes: the first separates nothing, the second separates two parts. */
+static void partial_and_face_cut(void)
+{
+  const double lo[3] = {-0.25, -0.25, -0.25}, hi[3] = {1.25, 1.25, 1.25};
+  const double glo[3] = {0, 0, 0}, ghi[3] = {1, 1, 1};
+  const fcm_index n[3] = {3, 3, 3}, gn[3] = {2, 2, 2};
+  fcm_mesh *mesh = NULL;
+  fcm_geometry *g = NULL;
+  fcm_cell_rules *r0 = NULL, *r1 = NULL, *r2 = NULL;
+  fcm_surface *rect = NULL, *face = NULL;
+  const fcm_cell_rules_options o = opts();
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, n, &mesh));
+  TEST_OK(ctx, fcm_geometry_create_box(ctx, glo, ghi, gn, &g));
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &o, &r0));
+  const double c[3] = {0.6, 0.5, 0.3}, nx[3] = {1, 0, 0}, ay[3] = {0, 1, 0},
+               size[2] = {1.4, 0.8}; /* z from -0.1 to 0.7: ends inside */
+  TEST_OK(ctx, fcm_surface_create_rectangle(ctx, c, nx, ay, size, &rect));
+  TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, r0, rect, &r1));
+  TEST_NEAR(total_volume(r1), 1.0, 1e-12, 0);
+  TEST_TRUE(components(mesh, r1) == 1);
+  /* cells below z = 0.25 in the middle layer are split, the ones the cut ends in are not */
+  TEST_TRUE(fcm_cell_rules_get_stats(r1)->num_split > 0);
+  const double pf[3] = {0.25, 0.5, 0.5}, bl[3] = {-0.1, -0.1, -0.1}, bh[3] = {1.1, 1.1, 1.1};
+  TEST_OK(ctx, fcm_surface_create_plane(ctx, pf, nx, bl, bh, &face));
+  TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, r1, face, &r2));
+  TEST_NEAR(total_volume(r2), 1.0, 1e-12, 0);
+  TEST_TRUE(components(mesh, r2) == 2);
+  TEST_TRUE(fcm_cell_rules_num_cuts(r2) == 2);
+  fcm_cell_rules_destroy(&r0);
+  fcm_cell_rules_destroy(&r1);
+  fcm_cell_rules_destroy(&r2);
+  fcm_surface_destroy(&rect);
+  fcm_surface_destroy(&face);
+  fcm_geometry_destroy(&g);
+  fcm_mesh_destroy(&mesh);
+}
+
+/* Ton-That et al. 2024, Fig. 5: the unit cube as the background (5 tets, or one or 2x2x2
+ * hexes) and as the body, diced by 5 planes normal to x and 5 normal to y: 36 sticks. */
+static void dice(const char *what)
+{
+  static const double cube[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                                    {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  static const fcm_index five[5][4] = {
+      {0, 1, 3, 4}, {1, 2, 3, 6}, {1, 4, 5, 6}, {3, 4, 6, 7}, {1, 3, 4, 6}};
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  const fcm_index one[3] = {1, 1, 1}, two[3] = {2, 2, 2};
+  fcm_mesh *mesh = NULL;
+  fcm_geometry *g = NULL;
+  fcm_cell_rules *r = NULL, *next = NULL;
+  if (!strcmp(what, "tet5")) {
+    fcm_index cells[20];
+    for (int t = 0; t < 5; t++) { /* orient positively */
+      const double *a = cube[five[t][0]], *b = cube[five[t][1]], *c = cube[five[t][2]],
+                   *d = cube[five[t][3]];
+      double u[3], v[3], w[3];
+      for (int k = 0; k < 3; k++)
+        u[k] = b[k] - a[k], v[k] = c[k] - a[k], w[k] = d[k] - a[k];
+      const double det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+                         u[2] * (v[0] * w[1] - v[1] * w[0]);
+      for (int k = 0; k < 4; k++)
+        cells[4 * t + k] = five[t][k];
+      if (det < 0) cells[4 * t + 1] = five[t][2], cells[4 * t + 2] = five[t][1];
+    }
+    TEST_OK(ctx, fcm_mesh_create(ctx, FCM_ELEMENT_TET4, 8, &cube[0][0], 5, cells, &mesh));
+  } else {
+    TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi,
+                                     !strcmp(what, "hex1") ? one : two, &mesh));
+  }
+  TEST_OK(ctx, fcm_geometry_create_box(ctx, lo, hi, two, &g));
+  const fcm_cell_rules_options o = opts();
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &o, &r));
+  static const double at[5] = {0.13, 0.31, 0.5, 0.67, 0.86};
+  const double bl[3] = {-0.1, -0.1, -0.1}, bh[3] = {1.1, 1.1, 1.1};
+  for (int k = 0; k < 10 && r; k++) {
+    double p[3] = {0.5, 0.5, 0.5}, nrm[3] = {0, 0, 0};
+    p[k / 5] = at[k % 5];
+    nrm[k / 5] = 1.0;
+    fcm_surface *s = NULL;
+    TEST_OK(ctx, fcm_surface_create_plane(ctx, p, nrm, bl, bh, &s));
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, r, s, &next));
+    fcm_surface_destroy(&s);
+    fcm_cell_rules_destroy(&r);
+    r = next;
+    next = NULL;
+  }
+  if (r) {
+    TEST_NEAR(total_volume(r), 1.0, 1e-12, 0);
+    const int k = components(mesh, r);
+    if (k != 36) fprintf(stderr, "%s: %d components\n", what, k);
+    TEST_TRUE(k == 36);
+  }
+  fcm_cell_rules_destroy(&r);
+  fcm_geometry_destroy(&g);
+  fcm_mesh_destroy(&mesh);
+}
+
+int main(void)
+{
+  TEST_OK(NULL, fcm_ctx_create(NULL, &ctx));
+  plane_cut(FCM_ELEMENT_HEX8);
+  plane_cut(FCM_ELEMENT_TET4);
+  partial_and_face_cut();
+  dice("tet5");
+  dice("hex1");
+  dice("hex8");
+  fcm_ctx_destroy(&ctx);
+  return TEST_RESULT();
+}
