@@ -27,9 +27,11 @@ typedef struct fcm_level_set_options {
   int estimate_error; /**< 1 (default): also compute the volume at refinement 2r (volume
                            only, nothing stored) for fcm_level_set_info.error_estimate */
   int refine_inside;  /**< 0 (default): cells where every sample is inside become 6 tets of
-                           the whole cell (few cells; their faces next to refined cells do not
-                           conform, see fcm_geometry_create_from_level_set()); 1: refine them
-                           too (conforming, r^3 times more tets there) */
+                           the whole cell, and in cut cells the sub-cubes with every corner
+                           inside are merged into boxes of 6 tets (fewer tets; their faces next
+                           to refined sub-cubes do not conform, see
+                           fcm_geometry_create_from_level_set()); 1: every sub-cube is split
+                           on its own (conforming, more tets) */
 } fcm_level_set_options;
 
 /** Defaults as documented on each member. */
@@ -55,7 +57,8 @@ typedef struct fcm_level_set_info {
  * refine_inside). The parts of the body outside [lo, hi] are cut off. Tets share nodes
  * (lattice points and edge crossings), so the boundary triangles are the surface phi = 0
  * plus the box faces it crosses, plus (refine_inside = 0) the non-conforming faces between
- * whole and refined cells, in opposite pairs.
+ * whole cells or merged boxes and refined sub-cubes, in pairs of opposite orientation (so
+ * surface integrals of continuous fields cancel there).
  * @param[in] phi, user the function and its argument; @param[in] opts NULL for defaults
  * @param[out] geom the geometry; @param[out] info may be NULL
  * @return FCM_OK; FCM_ERR_ARG (NULL, lo >= hi, n outside [1, 10^4], refinement outside

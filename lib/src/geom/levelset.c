@@ -164,10 +164,20 @@ cleanup:
 
 typedef enum { CELL_OUTSIDE, CELL_INSIDE, CELL_CUT } cell_kind;
 
+/* 1 when the 8 corners of sub-cube (cx, cy, cz) of the sample block w (m per axis) are
+ * inside. */
+static int cube_inside(const lvert *w, int m, int cx, int cy, int cz)
+{
+  for (int k = 0; k < 8; k++)
+    if (!(w[(cx + (k & 1)) + m * ((cy + !!(k & 2)) + m * (cz + !!(k & 4)))].phi < 0.0)) return 0;
+  return 1;
+}
+
 /* Sample cell (ix, iy, iz) at refinement r (B->N = n r) into w ((r+1)^3) and march it;
- * `whole`: a cell with every sample inside becomes the 6 tets of the cell. */
+ * `whole`: a cell with every sample inside becomes the 6 tets of the cell, and the inside
+ * sub-cubes of a cut cell are merged into boxes. todo: r^3 bytes of workspace. */
 static fcm_status do_cell(builder *B, const int64_t cell[3], int r, int whole, lvert *w,
-                          cell_kind *kind)
+                          unsigned char *todo, cell_kind *kind)
 {
   fcm_status st = FCM_OK;
   const int m = r + 1;
@@ -193,12 +203,38 @@ static fcm_status do_cell(builder *B, const int64_t cell[3], int r, int whole, l
       c[k] = w + (k & 1 ? r : 0) + m * ((k & 2 ? r : 0) + m * (k & 4 ? r : 0));
     return march_cube(B, c);
   }
+  /* Sub-cubes with every corner inside: with `whole`, merged greedily into boxes (runs
+   * along x, extended along y, then z) that become 6 tets each; the rest is marched. */
+  for (int cz = 0; cz < r; cz++)
+    for (int cy = 0; cy < r; cy++)
+      for (int cx = 0; cx < r; cx++)
+        todo[cx + r * (cy + r * cz)] = (unsigned char)(1 + (whole && cube_inside(w, m, cx, cy, cz)));
   for (int cz = 0; cz < r; cz++)
     for (int cy = 0; cy < r; cy++)
       for (int cx = 0; cx < r; cx++) {
+        const int id = cx + r * (cy + r * cz);
+        if (!todo[id]) continue;
+        int x1 = cx + 1, y1 = cy + 1, z1 = cz + 1;
+        if (todo[id] == 2) {
+#define TODO_IN(a, b, c) (todo[(a) + r * ((b) + r * (c))] == 2)
+          while (x1 < r && TODO_IN(x1, cy, cz))
+            x1++;
+          for (int ok = 1; ok && y1 < r; y1 += ok)
+            for (int a = cx; ok && a < x1; a++)
+              ok = TODO_IN(a, y1, cz);
+          for (int ok = 1; ok && z1 < r; z1 += ok)
+            for (int b = cy; ok && b < y1; b++)
+              for (int a = cx; ok && a < x1; a++)
+                ok = TODO_IN(a, b, z1);
+#undef TODO_IN
+        }
+        for (int c = cz; c < z1; c++)
+          for (int b = cy; b < y1; b++)
+            for (int a = cx; a < x1; a++)
+              todo[a + r * (b + r * c)] = 0;
         const lvert *c[8];
         for (int k = 0; k < 8; k++)
-          c[k] = w + (cx + (k & 1)) + m * ((cy + !!(k & 2)) + m * (cz + !!(k & 4)));
+          c[k] = w + (k & 1 ? x1 : cx) + m * ((k & 2 ? y1 : cy) + m * (k & 4 ? z1 : cz));
         FCM_TRY(B->ctx, march_cube(B, c));
       }
 cleanup:
@@ -225,7 +261,7 @@ fcm_status fcm_geometry_create_from_level_set(fcm_ctx *ctx, fcm_level_set_fn phi
   fcm_status st = FCM_OK;
   builder B = {0};
   lvert *w = NULL;
-  unsigned char *kinds = NULL;
+  unsigned char *kinds = NULL, *todo = NULL;
   keyslot *ks = NULL;
   double *X = NULL;
   fcm_index *cells = NULL;
@@ -257,6 +293,7 @@ fcm_status fcm_geometry_create_from_level_set(fcm_ctx *ctx, fcm_level_set_fn phi
   const size_t ncell = (size_t)n[0] * (size_t)n[1] * (size_t)n[2];
   FCM_ALLOC_RAW(ctx, (size_t)(2 * r + 1) * (size_t)(2 * r + 1) * (size_t)(2 * r + 1), w);
   FCM_ALLOC_RAW(ctx, ncell, kinds);
+  FCM_ALLOC_RAW(ctx, (size_t)(2 * r) * (size_t)(2 * r) * (size_t)(2 * r), todo);
   /* Pass 1: refinement r, stored. */
   B.store = 1;
   for (int d = 0; d < 3; d++)
@@ -267,7 +304,7 @@ fcm_status fcm_geometry_create_from_level_set(fcm_ctx *ctx, fcm_level_set_fn phi
       for (int64_t i = 0; i < n[0]; i++, ci++) {
         const int64_t cell[3] = {i, j, k};
         cell_kind kind;
-        FCM_TRY(ctx, do_cell(&B, cell, r, !o.refine_inside, w, &kind));
+        FCM_TRY(ctx, do_cell(&B, cell, r, !o.refine_inside, w, todo, &kind));
         kinds[ci] = (unsigned char)kind;
         inf.cells_inside += kind == CELL_INSIDE;
         inf.cells_cut += kind == CELL_CUT;
@@ -292,7 +329,7 @@ fcm_status fcm_geometry_create_from_level_set(fcm_ctx *ctx, fcm_level_set_fn phi
           const int64_t cell[3] = {i, j, k};
           cell_kind kind;
           if (kinds[ci] == CELL_CUT)
-            FCM_TRY(ctx, do_cell(&F, cell, 2 * r, 1, w, &kind));
+            FCM_TRY(ctx, do_cell(&F, cell, 2 * r, 1, w, todo, &kind));
           else if (kinds[ci] == CELL_INSIDE)
             v_whole += 1.0;
         }
@@ -326,6 +363,7 @@ cleanup:
   fcm__free(ctx, B.nodes);
   fcm__free(ctx, w);
   fcm__free(ctx, kinds);
+  fcm__free(ctx, todo);
   fcm__free(ctx, ks);
   fcm__free(ctx, X);
   fcm__free(ctx, cells);
