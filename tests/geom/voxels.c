@@ -283,7 +283,15 @@ static void errors(fcm_ctx *ctx)
       {"NRRD0004\ntype: uint16\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n0123",
        "need an 'endian' field", FCM_ERR_FORMAT},
       {"NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n0123",
-       "raw data: 4 bytes after the 0 skipped, expected 8", FCM_ERR_FORMAT},
+       "vox_err.nrrd: 2 x 2 x 2 raw values need at least 8 bytes of data, the file has 4",
+       FCM_ERR_FORMAT},
+      {"NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nbyte skip: 2\n\n"
+       "01234567",
+       "raw data: 6 bytes after the 2 skipped, expected 8", FCM_ERR_FORMAT},
+      /* an announced size far beyond the data fails before anything that large is allocated */
+      {"NRRD0004\ntype: double\ndimension: 3\nsizes: 100000 100000 100\nendian: little\n"
+       "encoding: raw\n\n01234567",
+       "values need at least 8000000000000 bytes", FCM_ERR_FORMAT},
       {"NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nfoo: bar\n\n",
        "vox_err.nrrd:6: 'foo' is not a NRRD field", FCM_ERR_FORMAT},
       {"NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nspace directions: (1,0,0) (2,0,0) "

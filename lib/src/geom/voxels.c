@@ -670,19 +670,28 @@ fcm_status fcm_voxel_image_create_from_file(fcm_ctx *ctx, const char *path, fcm_
   else
     FCM_TRY(ctx, parse_mhd(H, buf, len));
   FCM_TRY(ctx, check_geometry(ctx, path, H->dims, H->axes, H->origin));
+  const char *dpath = path, *data = buf + H->data_offset;
+  size_t dl = len - H->data_offset;
+  if (H->data_file[0]) {
+    FCM_TRY(ctx, fcm__file_read_all(ctx, "voxel image", H->data_file, VOXEL_MAX_FILE, &dbuf,
+                                    &dlen));
+    dpath = H->data_file, data = dbuf, dl = dlen;
+  }
+  /* The announced size must fit in the data before the values are allocated: raw values take
+   * their size each, ascii values at least 2 bytes but the last. */
+  const size_t n = (size_t)H->dims[0] * (size_t)H->dims[1] * (size_t)H->dims[2];
+  const size_t least = H->ascii ? 2 * n - 1 : n * (size_t)type_size[H->type];
+  FCM_CHECK(least <= dl, ctx, FCM_ERR_FORMAT,
+            "%s: %lld x %lld x %lld %s values need at least %zu bytes of data, the file has %zu",
+            dpath, (long long)H->dims[0], (long long)H->dims[1], (long long)H->dims[2],
+            H->ascii ? "ascii" : "raw", least, dl);
   FCM_ALLOC(ctx, 1, m);
   m->ctx = ctx;
   memcpy(m->dims, H->dims, sizeof m->dims);
   memcpy(m->axes, H->axes, sizeof m->axes);
   memcpy(m->origin, H->origin, sizeof m->origin);
-  FCM_ALLOC_RAW(ctx, (size_t)H->dims[0] * (size_t)H->dims[1] * (size_t)H->dims[2], m->values);
-  if (H->data_file[0]) {
-    FCM_TRY(ctx, fcm__file_read_all(ctx, "voxel image", H->data_file, VOXEL_MAX_FILE, &dbuf,
-                                    &dlen));
-    FCM_TRY(ctx, read_data(H, H->data_file, dbuf, dlen, m->values));
-  } else {
-    FCM_TRY(ctx, read_data(H, path, buf + H->data_offset, len - H->data_offset, m->values));
-  }
+  FCM_ALLOC_RAW(ctx, n, m->values);
+  FCM_TRY(ctx, read_data(H, dpath, data, dl, m->values));
   *img = m;
   m = NULL;
 cleanup:
