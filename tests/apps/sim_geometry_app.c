@@ -2,7 +2,8 @@
  * and prints a warning with the lost volume (half the body) and the side (+x); a body
  * wholly outside exits 2 naming the scene section and both bounding boxes, without a
  * traceback unless --debug; a malformed voxel image exits 2 naming geometry.voxels and the
- * file:line of the bad header field; --progress prints the cell-rule progress off a
+ * file:line of the bad header field; a body smaller than min_fraction of every cell exits 2
+ * saying so; --progress prints the cell-rule progress off a
  * terminal and ends at all cells. Usage: sim_geometry_app FCM_SIM WORKDIR */
 #define _POSIX_C_SOURCE 200809L
 #include "app_run.h"
@@ -72,6 +73,13 @@ int main(int argc, char **argv)
   snprintf(cmd, sizeof cmd, "'%s' '%s' --check --debug 2> '%s' > /dev/null", sim, path, err);
   TEST_TRUE(app_run(cmd) == 2);
   TEST_TRUE(file_has(err, "wholly outside") && file_has(err, "cell_rules.c"));
+
+  /* a body too small for every cell: the message says so instead of "no active cell" */
+  scene(path, "{\"shape\": \"box\", \"min\": [0.4, 0.4, 0.4], \"max\": [0.401, 0.401, 0.401]}");
+  snprintf(cmd, sizeof cmd, "'%s' '%s' --check 2> '%s' > /dev/null", sim, path, err);
+  TEST_TRUE(app_run(cmd) == 2);
+  TEST_TRUE(file_has(err, "geometry: every one of the 8 background cells holds less than "
+                          "quadrature.min_fraction = 0.0001"));
 
   /* a voxel image with a bad header line */
   char img[1024];

@@ -130,8 +130,8 @@ int main(void)
   s.kind = FCM_IMPLICIT_SPHERE, s.radius = 0.3, s.center[0] = s.center[1] = s.center[2] = 0.5;
   fcm_implicit_tree t = {1, &s};
   fcm_level_set_info li;
-  TEST_OK(ctx, fcm_geometry_create_from_level_set(ctx, fcm_implicit_eval, &t, lo, hi, n, NULL, &g,
-                                                  &li));
+  TEST_OK(ctx,
+          fcm_geometry_create_from_level_set(ctx, fcm_implicit_eval, &t, lo, hi, n, NULL, &g, &li));
   if (g) {
     TEST_OK(ctx, fcm_cell_rules_create(ctx, m, g, NULL, &r));
     if (r) TEST_NEAR(fcm_cell_rules_get_stats(r)->embedded_volume, li.volume, 1e-12, 0);

@@ -19,8 +19,8 @@ static fcm_geometry *build(fcm_ctx *ctx, const fcm_implicit *nodes, int num, con
   fcm_level_set_options o = fcm_level_set_options_default();
   o.refinement = r;
   TEST_OK(ctx, fcm_implicit_check(ctx, &t));
-  TEST_OK(ctx, fcm_geometry_create_from_level_set(ctx, fcm_implicit_eval, &t, lo, hi, nn, &o, &g,
-                                                  info));
+  TEST_OK(ctx,
+          fcm_geometry_create_from_level_set(ctx, fcm_implicit_eval, &t, lo, hi, nn, &o, &g, info));
   return g;
 }
 
@@ -56,7 +56,8 @@ static void sphere_rate(fcm_ctx *ctx)
   for (int l = 0; l < 4; l++)
     sxx += (log(h[l]) - mx) * (log(h[l]) - mx), sxy += (log(h[l]) - mx) * (log(err[l]) - my);
   const double rate = sxy / sxx;
-  if (!(rate > 1.7 && rate < 2.3)) TEST_FAIL_("sphere volume error rate %g outside [1.7, 2.3]", rate);
+  if (!(rate > 1.7 && rate < 2.3))
+    TEST_FAIL_("sphere volume error rate %g outside [1.7, 2.3]", rate);
 }
 
 static void csg(fcm_ctx *ctx)
@@ -102,7 +103,8 @@ static void csg(fcm_ctx *ctx)
     TEST_NEAR(info.volume_fine, shell, 3e-3, 0);
   }
   fcm_geometry_destroy(&g);
-  if ((g = build(ctx, d, 5, lo, hi, 8, 6, &info))) TEST_NEAR(fcm_geometry_volume(g), shell / 2, 1e-2, 0);
+  if ((g = build(ctx, d, 5, lo, hi, 8, 6, &info)))
+    TEST_NEAR(fcm_geometry_volume(g), shell / 2, 1e-2, 0);
   fcm_geometry_destroy(&g);
   /* torus: 2 pi^2 R r^2 */
   fcm_implicit t = {0};
@@ -116,7 +118,8 @@ static void csg(fcm_ctx *ctx)
   gy.kind = FCM_IMPLICIT_GYROID, gy.period = 1, gy.thickness = 0, gy.sheet = 0;
   const double glo[3] = {0, 0, 0}, ghi[3] = {2, 2, 2};
   memcpy(gy.min, glo, sizeof glo), memcpy(gy.max, ghi, sizeof ghi);
-  if ((g = build(ctx, &gy, 1, glo, ghi, 8, 4, &info))) TEST_NEAR(fcm_geometry_volume(g), 4.0, 3e-2, 0);
+  if ((g = build(ctx, &gy, 1, glo, ghi, 8, 4, &info)))
+    TEST_NEAR(fcm_geometry_volume(g), 4.0, 3e-2, 0);
   fcm_geometry_destroy(&g);
   gy.sheet = 1, gy.thickness = 0.05;
   if ((g = build(ctx, &gy, 1, glo, ghi, 8, 4, &info))) {
@@ -135,8 +138,8 @@ static void csg(fcm_ctx *ctx)
   TEST_OK(ctx, fcm_geometry_create_from_level_set(ctx, fcm_implicit_eval, &tr, clo, chi, n4, &o, &g,
                                                   &info));
   o.refine_inside = 1;
-  TEST_OK(ctx, fcm_geometry_create_from_level_set(ctx, fcm_implicit_eval, &tr, clo, chi, n4, &o, &g2,
-                                                  NULL));
+  TEST_OK(ctx, fcm_geometry_create_from_level_set(ctx, fcm_implicit_eval, &tr, clo, chi, n4, &o,
+                                                  &g2, NULL));
   if (g && g2) {
     TEST_TRUE(info.cells_inside == 8);
     TEST_NEAR(fcm_geometry_volume(g), fcm_geometry_volume(g2), 1e-12, 0);
@@ -175,9 +178,11 @@ static void errors(fcm_ctx *ctx)
   fcm_level_set_options o = fcm_level_set_options_default();
   TEST_ERR(ctx, fcm_geometry_create_from_level_set(ctx, nan_phi, NULL, lo, hi, n, NULL, &g, NULL),
            FCM_ERR_GEOMETRY, "is not finite");
-  TEST_ERR(ctx, fcm_geometry_create_from_level_set(ctx, outside_phi, NULL, lo, hi, n, NULL, &g, NULL),
+  TEST_ERR(ctx,
+           fcm_geometry_create_from_level_set(ctx, outside_phi, NULL, lo, hi, n, NULL, &g, NULL),
            FCM_ERR_GEOMETRY, "has no volume in the box");
-  TEST_ERR(ctx, fcm_geometry_create_from_level_set(ctx, outside_phi, NULL, lo, bad, n, NULL, &g, NULL),
+  TEST_ERR(ctx,
+           fcm_geometry_create_from_level_set(ctx, outside_phi, NULL, lo, bad, n, NULL, &g, NULL),
            FCM_ERR_ARG, "box axis 2");
   o.refinement = 65;
   TEST_ERR(ctx, fcm_geometry_create_from_level_set(ctx, outside_phi, NULL, lo, hi, n, &o, &g, NULL),

@@ -55,9 +55,8 @@ static fcm_status level_set(void *u)
   const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
   const fcm_index n[3] = {3, 3, 3};
   x->g = (fcm_geometry *)x;
-  fcm_status st =
-      fcm_geometry_create_from_level_set(x->ctx, fcm_implicit_eval, &t, lo, hi, n, NULL, &x->g,
-                                         NULL);
+  fcm_status st = fcm_geometry_create_from_level_set(x->ctx, fcm_implicit_eval, &t, lo, hi, n, NULL,
+                                                     &x->g, NULL);
   return st != FCM_OK && x->g ? FCM_ERR_INTERNAL : st;
 }
 static void release(void *u)
@@ -83,10 +82,11 @@ int main(void)
   FILE *mhd = fopen("vox_alloc.mhd", "w");
   TEST_TRUE(fp && raw && mhd);
   if (!fp || !raw || !mhd) return TEST_RESULT();
-  fprintf(fp, "NRRD0004\ntype: uint8\ndimension: 3\nsizes: %d %d %d\nencoding: raw\n\n", N, N,
-          N);
-  fprintf(mhd, "NDims = 3\nDimSize = %d %d %d\nElementType = MET_UCHAR\n"
-               "ElementDataFile = vox_alloc.raw\n", N, N, N);
+  fprintf(fp, "NRRD0004\ntype: uint8\ndimension: 3\nsizes: %d %d %d\nencoding: raw\n\n", N, N, N);
+  fprintf(mhd,
+          "NDims = 3\nDimSize = %d %d %d\nElementType = MET_UCHAR\n"
+          "ElementDataFile = vox_alloc.raw\n",
+          N, N, N);
   for (int i = 0; i < N * N * N; i++)
     fputc((int)x.values[i], fp), fputc((int)x.values[i], raw);
   fclose(fp), fclose(raw), fclose(mhd);
@@ -94,14 +94,12 @@ int main(void)
   alloc_loop(x.ctx, &f, "fcm_voxel_image_create_from_file (nrrd)", image_file, release, &x, 2,
              1000);
   x.path = "vox_alloc.mhd";
-  alloc_loop(x.ctx, &f, "fcm_voxel_image_create_from_file (mhd)", image_file, release, &x, 3,
-             1000);
+  alloc_loop(x.ctx, &f, "fcm_voxel_image_create_from_file (mhd)", image_file, release, &x, 3, 1000);
   TEST_OK(x.ctx, fcm_voxel_image_create_from_file(x.ctx, "vox_alloc.nrrd", &x.src));
   remove("vox_alloc.nrrd"), remove("vox_alloc.raw"), remove("vox_alloc.mhd");
   if (x.src) {
     x.merge = 1;
-    alloc_loop(x.ctx, &f, "fcm_geometry_create_from_voxels (merged)", voxels, release, &x, 4,
-               1000);
+    alloc_loop(x.ctx, &f, "fcm_geometry_create_from_voxels (merged)", voxels, release, &x, 4, 1000);
     x.merge = 0;
     alloc_loop(x.ctx, &f, "fcm_geometry_create_from_voxels (per voxel)", voxels, release, &x, 4,
                1000);

@@ -26,12 +26,24 @@ static void put(FILE *f, double v, int type, int big)
   uint64_t u = 0;
   int n = 1;
   switch (type) {
-  case 0: /* uint8 */ u = (uint8_t)v, n = 1; break;
-  case 1: /* int8 */ u = (uint8_t)(int8_t)(-v), n = 1; break;
-  case 2: /* uint16 */ u = (uint16_t)(1000 * v), n = 2; break;
-  case 3: /* int16 */ u = (uint16_t)(int16_t)(-1000 * v), n = 2; break;
-  case 4: /* uint32 */ u = (uint32_t)(100000 * v), n = 4; break;
-  case 5: /* int32 */ u = (uint32_t)(int32_t)(-100000 * v), n = 4; break;
+  case 0: /* uint8 */
+    u = (uint8_t)v, n = 1;
+    break;
+  case 1: /* int8 */
+    u = (uint8_t)(int8_t)(-v), n = 1;
+    break;
+  case 2: /* uint16 */
+    u = (uint16_t)(1000 * v), n = 2;
+    break;
+  case 3: /* int16 */
+    u = (uint16_t)(int16_t)(-1000 * v), n = 2;
+    break;
+  case 4: /* uint32 */
+    u = (uint32_t)(100000 * v), n = 4;
+    break;
+  case 5: /* int32 */
+    u = (uint32_t)(int32_t)(-100000 * v), n = 4;
+    break;
   case 6: { /* float */
     float x = (float)(0.25 * v);
     uint32_t w;
@@ -80,8 +92,8 @@ static void check_values(const fcm_voxel_image *img, int type, const char *what)
 
 static void round_trips(fcm_ctx *ctx)
 {
-  static const char *const names[8] = {"uint8", "int8",   "uint16", "short",
-                                       "uint",  "int32_t", "float", "double"};
+  static const char *const names[8] = {"uint8", "int8",    "uint16", "short",
+                                       "uint",  "int32_t", "float",  "double"};
   for (int type = 0; type < 8; type++)
     for (int big = 0; big < 2; big++) {
       FILE *f = fopen("vox_rt.nrrd", "wb");
@@ -172,10 +184,12 @@ static void round_trips(fcm_ctx *ctx)
   FILE *g = fopen("vox_rt_ascii.nrrd", "w");
   TEST_TRUE(f && g);
   if (!f || !g) return;
-  fprintf(f, "NDims = 3\nDimSize = %d %d %d\nElementType = MET_DOUBLE\n"
-             "ElementByteOrderMSB = False\nElementDataFile = LOCAL\n", NX, NY, NZ);
-  fprintf(g, "NRRD0001\ntype: double\ndimension: 3\nsizes: %d %d %d\nencoding: ascii\n\n", NX,
-          NY, NZ);
+  fprintf(f,
+          "NDims = 3\nDimSize = %d %d %d\nElementType = MET_DOUBLE\n"
+          "ElementByteOrderMSB = False\nElementDataFile = LOCAL\n",
+          NX, NY, NZ);
+  fprintf(g, "NRRD0001\ntype: double\ndimension: 3\nsizes: %d %d %d\nencoding: ascii\n\n", NX, NY,
+          NZ);
   for (int k = 0; k < NZ; k++)
     for (int j = 0; j < NY; j++) {
       for (int i = 0; i < NX; i++) {

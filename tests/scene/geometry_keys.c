@@ -63,8 +63,8 @@ int main(void)
       fcm_implicit_tree t = {7, q};
       TEST_OK(ctx, fcm_implicit_check(ctx, &t));
       const double centre[3] = {0.5, 0.5, 0.5}, shell[3] = {0.5, 0.5, 0.75};
-      TEST_TRUE(fcm_implicit_eval(centre, &t) > 0);  /* the box is removed */
-      TEST_TRUE(fcm_implicit_eval(shell, &t) < 0);   /* in the sphere */
+      TEST_TRUE(fcm_implicit_eval(centre, &t) > 0); /* the box is removed */
+      TEST_TRUE(fcm_implicit_eval(shell, &t) < 0);  /* in the sphere */
     }
     fcm_scene_destroy(&s);
   }
@@ -104,16 +104,15 @@ int main(void)
         FCM_ERR_ARG, "geometry.level_set.difference[1].sphere.radius");
   parse(ctx, "{\"level_set\": {\"torus\": {\"major_radius\": 1, \"minor_radius\": 2}}}",
         FCM_ERR_ARG, "geometry.level_set.torus.minor_radius");
-  parse(ctx, "{\"level_set\": {\"sphere\": {\"radius\": 1, \"centre\": [0, 0, 0]}}}",
-        FCM_ERR_ARG, "centre");
+  parse(ctx, "{\"level_set\": {\"sphere\": {\"radius\": 1, \"centre\": [0, 0, 0]}}}", FCM_ERR_ARG,
+        "centre");
   parse(ctx,
         "{\"level_set\": {\"gyroid\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1], \"period\": 0.4, "
         "\"thickness\": 0.2}}}",
         FCM_ERR_ARG, "geometry.level_set.gyroid.thickness");
   parse(ctx, "{\"level_set\": {\"sphere\": {\"radius\": 1}}, \"min\": [0, 0, 0]}", FCM_ERR_ARG,
         "needs all of \"min\", \"max\" and \"cells\"");
-  parse(ctx,
-        "{\"level_set\": {\"sphere\": {\"radius\": 1}}, \"transform\": {\"scale\": 2}}",
+  parse(ctx, "{\"level_set\": {\"sphere\": {\"radius\": 1}}, \"transform\": {\"scale\": 2}}",
         FCM_ERR_ARG, "give \"min\", \"max\" and \"cells\"");
   parse(ctx, "{\"level_set\": {\"sphere\": {\"radius\": 1}}, \"refinement\": 0}", FCM_ERR_ARG,
         "geometry.refinement");

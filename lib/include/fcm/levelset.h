@@ -73,34 +73,34 @@ FCM_API fcm_status fcm_geometry_create_from_level_set(fcm_ctx *ctx, fcm_level_se
 
 /** Built-in implicit functions and CSG operations (fcm_implicit.kind). */
 typedef enum fcm_implicit_kind {
-  FCM_IMPLICIT_SPHERE = 0,    /**< |x - center| - radius */
-  FCM_IMPLICIT_TORUS,         /**< torus around `axis` through center: major radius `radius`,
-                                   tube radius `minor_radius` */
-  FCM_IMPLICIT_BOX,           /**< the box [min, max]: max_d (|x_d - c_d| - half_d) */
-  FCM_IMPLICIT_GYROID,        /**< gyroid lattice of cell size `period` inside [min, max]:
-                                   g = sin kx cos ky + sin ky cos kz + sin kz cos kx, k = 2 pi /
-                                   period, scaled by period / (2 pi); sheet: |g| - thickness,
-                                   solid: g - thickness; intersected with the box */
-  FCM_IMPLICIT_UNION,         /**< min(phi_a, phi_b) */
-  FCM_IMPLICIT_INTERSECTION,  /**< max(phi_a, phi_b) */
-  FCM_IMPLICIT_DIFFERENCE,    /**< a minus b: max(phi_a, -phi_b) */
+  FCM_IMPLICIT_SPHERE = 0,   /**< |x - center| - radius */
+  FCM_IMPLICIT_TORUS,        /**< torus around `axis` through center: major radius `radius`,
+                                  tube radius `minor_radius` */
+  FCM_IMPLICIT_BOX,          /**< the box [min, max]: max_d (|x_d - c_d| - half_d) */
+  FCM_IMPLICIT_GYROID,       /**< gyroid lattice of cell size `period` inside [min, max]:
+                                  g = sin kx cos ky + sin ky cos kz + sin kz cos kx, k = 2 pi /
+                                  period, scaled by period / (2 pi); sheet: |g| - thickness,
+                                  solid: g - thickness; intersected with the box */
+  FCM_IMPLICIT_UNION,        /**< min(phi_a, phi_b) */
+  FCM_IMPLICIT_INTERSECTION, /**< max(phi_a, phi_b) */
+  FCM_IMPLICIT_DIFFERENCE,   /**< a minus b: max(phi_a, -phi_b) */
   FCM_IMPLICIT_KIND_COUNT
 } fcm_implicit_kind;
 
 /** One node of an implicit-function tree; members not used by `kind` are ignored. */
 typedef struct fcm_implicit {
   fcm_implicit_kind kind;
-  double center[3];       /**< SPHERE, TORUS */
-  double radius;          /**< SPHERE; TORUS: major radius; > 0 */
-  double minor_radius;    /**< TORUS: in (0, radius] */
-  int axis;               /**< TORUS: symmetry axis 0 (x), 1 (y), 2 (z) */
-  double min[3], max[3];  /**< BOX, GYROID: min[d] < max[d] */
-  double period;          /**< GYROID: lattice cell size > 0 */
-  double thickness;       /**< GYROID: sheet half-thickness (> 0) or solid level, in length
-                               units (|thickness| < period / 4) */
-  int sheet;              /**< GYROID: 1 a sheet (walls), 0 a solid network */
-  int a, b;               /**< UNION, INTERSECTION, DIFFERENCE: operand nodes, indices < this
-                               node's own */
+  double center[3];      /**< SPHERE, TORUS */
+  double radius;         /**< SPHERE; TORUS: major radius; > 0 */
+  double minor_radius;   /**< TORUS: in (0, radius] */
+  int axis;              /**< TORUS: symmetry axis 0 (x), 1 (y), 2 (z) */
+  double min[3], max[3]; /**< BOX, GYROID: min[d] < max[d] */
+  double period;         /**< GYROID: lattice cell size > 0 */
+  double thickness;      /**< GYROID: sheet half-thickness (> 0) or solid level, in length
+                              units (|thickness| < period / 4) */
+  int sheet;             /**< GYROID: 1 a sheet (walls), 0 a solid network */
+  int a, b;              /**< UNION, INTERSECTION, DIFFERENCE: operand nodes, indices < this
+                              node's own */
 } fcm_implicit;
 
 /** Largest number of nodes of an implicit tree. */
@@ -109,8 +109,8 @@ typedef struct fcm_implicit {
 /** A tree of implicit nodes: the root is the last node. Pass its address as the `user` of
  * fcm_implicit_eval(). */
 typedef struct fcm_implicit_tree {
-  int num_nodes;              /**< [1, FCM_IMPLICIT_MAX_NODES] */
-  const fcm_implicit *nodes;  /**< borrowed */
+  int num_nodes;             /**< [1, FCM_IMPLICIT_MAX_NODES] */
+  const fcm_implicit *nodes; /**< borrowed */
 } fcm_implicit_tree;
 
 /** Validate a tree (counts, kinds, parameters in the ranges documented on fcm_implicit,

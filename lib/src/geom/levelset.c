@@ -208,7 +208,8 @@ static fcm_status do_cell(builder *B, const int64_t cell[3], int r, int whole, l
   for (int cz = 0; cz < r; cz++)
     for (int cy = 0; cy < r; cy++)
       for (int cx = 0; cx < r; cx++)
-        todo[cx + r * (cy + r * cz)] = (unsigned char)(1 + (whole && cube_inside(w, m, cx, cy, cz)));
+        todo[cx + r * (cy + r * cz)] =
+            (unsigned char)(1 + (whole && cube_inside(w, m, cx, cy, cz)));
   for (int cz = 0; cz < r; cz++)
     for (int cy = 0; cy < r; cy++)
       for (int cx = 0; cx < r; cx++) {
@@ -400,21 +401,20 @@ fcm_status fcm_implicit_check(fcm_ctx *ctx, const fcm_implicit_tree *tree)
                 "implicit: node %d (%s): radius %g must be positive", i, nm, q->radius);
       for (int d = 0; d < 3; d++)
         FCM_CHECK(isfinite(q->center[d]), ctx, FCM_ERR_ARG,
-                  "implicit: node %d (%s): center[%d] = %g is not finite", i, nm, d,
-                  q->center[d]);
+                  "implicit: node %d (%s): center[%d] = %g is not finite", i, nm, d, q->center[d]);
       break;
     case FCM_IMPLICIT_GYROID:
       FCM_CHECK(q->period > 0 && isfinite(q->period), ctx, FCM_ERR_ARG,
                 "implicit: node %d (gyroid): period %g must be positive", i, q->period);
       FCM_CHECK(fabs(q->thickness) < q->period / 4 && (!q->sheet || q->thickness > 0), ctx,
-                FCM_ERR_ARG, "implicit: node %d (gyroid): thickness %g outside %s", i,
-                q->thickness, q->sheet ? "(0, period / 4)" : "(-period / 4, period / 4)");
+                FCM_ERR_ARG, "implicit: node %d (gyroid): thickness %g outside %s", i, q->thickness,
+                q->sheet ? "(0, period / 4)" : "(-period / 4, period / 4)");
       /* fall through */
     case FCM_IMPLICIT_BOX:
       for (int d = 0; d < 3; d++)
         FCM_CHECK(isfinite(q->min[d]) && isfinite(q->max[d]) && q->min[d] < q->max[d], ctx,
-                  FCM_ERR_ARG, "implicit: node %d (%s): need min[%d] < max[%d], got %g, %g", i,
-                  nm, d, d, q->min[d], q->max[d]);
+                  FCM_ERR_ARG, "implicit: node %d (%s): need min[%d] < max[%d], got %g, %g", i, nm,
+                  d, d, q->min[d], q->max[d]);
       break;
     default:
       FCM_CHECK(q->a >= 0 && q->a < i && q->b >= 0 && q->b < i, ctx, FCM_ERR_ARG,
@@ -459,11 +459,10 @@ double fcm_implicit_eval(const double x[3], void *user)
       break;
     case FCM_IMPLICIT_GYROID: {
       const double k = 2.0 * 3.14159265358979323846 / q->period;
-      const double sx = sin(k * x[0]), cx = cos(k * x[0]), sy = sin(k * x[1]),
-                   cy = cos(k * x[1]), sz = sin(k * x[2]), cz = cos(k * x[2]);
+      const double sx = sin(k * x[0]), cx = cos(k * x[0]), sy = sin(k * x[1]), cy = cos(k * x[1]),
+                   sz = sin(k * x[2]), cz = cos(k * x[2]);
       const double g = (sx * cy + sy * cz + sz * cx) / k;
-      v[i] = fmax(q->sheet ? fabs(g) - q->thickness : g - q->thickness,
-                  box_phi(q->min, q->max, x));
+      v[i] = fmax(q->sheet ? fabs(g) - q->thickness : g - q->thickness, box_phi(q->min, q->max, x));
       break;
     }
     case FCM_IMPLICIT_UNION:

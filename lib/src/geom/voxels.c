@@ -44,8 +44,10 @@ static fcm_status check_geometry(fcm_ctx *ctx, const char *who, const fcm_index 
             "%s: %lld x %lld x %lld voxels exceed the limit of 2^40", who, (long long)dims[0],
             (long long)dims[1], (long long)dims[2]);
   for (int i = 0; i < 9; i++)
-    FCM_CHECK(isfinite(axes[i]), ctx, FCM_ERR_ARG, "%s: axis vector %d component %d = %g is not "
-              "finite", who, i / 3, i % 3, axes[i]);
+    FCM_CHECK(isfinite(axes[i]), ctx, FCM_ERR_ARG,
+              "%s: axis vector %d component %d = %g is not "
+              "finite",
+              who, i / 3, i % 3, axes[i]);
   const double det = det3(axes);
   double scale = 1.0;
   for (int d = 0; d < 3; d++)
@@ -219,8 +221,7 @@ static int word_in(const char *v, const char *const *list, int n)
   return -1;
 }
 
-#define HDR_CHECK(cond, H, line, ...)                                                              \
-  FCM_CHECK(cond, (H)->ctx, FCM_ERR_FORMAT, __VA_ARGS__)
+#define HDR_CHECK(cond, H, line, ...) FCM_CHECK(cond, (H)->ctx, FCM_ERR_FORMAT, __VA_ARGS__)
 
 static fcm_status nrrd_type(header *H, long line, const char *v)
 {
@@ -361,8 +362,8 @@ static fcm_status parse_nrrd(header *H, const char *buf, size_t len)
                   "%s:%ld: encoding: '%s' is not supported (fcm reads raw and ascii; "
                   "decompress first, e.g. unu save -e raw)",
                   H->path, line, value);
-        HDR_CHECK(0, H, line, "%s:%ld: encoding: '%s' is not a NRRD encoding (raw, ascii)",
-                  H->path, line, value);
+        HDR_CHECK(0, H, line, "%s:%ld: encoding: '%s' is not a NRRD encoding (raw, ascii)", H->path,
+                  line, value);
       }
     } else if (strcmp(field, "endian") == 0) {
       HDR_CHECK(strcmp(value, "little") == 0 || strcmp(value, "big") == 0, H, line,
@@ -377,8 +378,7 @@ static fcm_status parse_nrrd(header *H, const char *buf, size_t len)
     } else if (strcmp(field, "spacings") == 0) {
       HDR_CHECK(parse_numbers(value, 3, spacings) && spacings[0] > 0 && spacings[1] > 0 &&
                     spacings[2] > 0,
-                H, line, "%s:%ld: spacings: '%s' is not 3 positive numbers", H->path, line,
-                value);
+                H, line, "%s:%ld: spacings: '%s' is not 3 positive numbers", H->path, line, value);
       have_spacings = 1;
     } else if (strcmp(field, "space origin") == 0) {
       HDR_CHECK(parse_numbers(value, 3, H->origin), H, line,
@@ -393,16 +393,19 @@ static fcm_status parse_nrrd(header *H, const char *buf, size_t len)
       HDR_CHECK(parse_integer(value, 0, LLONG_MAX / 2, &H->line_skip), H, line,
                 "%s:%ld: line skip: '%s' is not an integer >= 0", H->path, line, value);
     } else if (strcmp(field, "data file") == 0 || strcmp(field, "datafile") == 0) {
-      FCM_CHECK(strncmp(value, "LIST", 4) != 0 && !strchr(value, '%'), H->ctx,
-                FCM_ERR_UNSUPPORTED,
+      FCM_CHECK(strncmp(value, "LIST", 4) != 0 && !strchr(value, '%'), H->ctx, FCM_ERR_UNSUPPORTED,
                 "%s:%ld: data file: '%s': multi-file data (LIST or a format) is not supported",
                 H->path, line, value);
       FCM_TRY(H->ctx, join_path(H, line, value));
     } else if (strcmp(field, "space") == 0) {
-      static const char *const spaces[] = {"right-anterior-superior", "RAS",
-                                           "left-anterior-superior",  "LAS",
-                                           "left-posterior-superior", "LPS",
-                                           "scanner-xyz",             "3D-right-handed",
+      static const char *const spaces[] = {"right-anterior-superior",
+                                           "RAS",
+                                           "left-anterior-superior",
+                                           "LAS",
+                                           "left-posterior-superior",
+                                           "LPS",
+                                           "scanner-xyz",
+                                           "3D-right-handed",
                                            "3D-left-handed"};
       HDR_CHECK(word_in(value, spaces, 9) >= 0, H, line,
                 "%s:%ld: space: '%s' is not a 3D space (right-anterior-superior, "
@@ -410,12 +413,30 @@ static fcm_status parse_nrrd(header *H, const char *buf, size_t len)
                 "3D-left-handed)",
                 H->path, line, value);
     } else {
-      static const char *const ignored[] = {
-          "content",     "kinds",    "labels",     "units",          "space units",
-          "centers",     "centerings", "thicknesses", "axis mins",    "axismins",
-          "axis maxs",   "axismaxs", "min",        "max",            "old min",
-          "oldmin",      "old max",  "oldmax",     "measurement frame", "sample units",
-          "sampleunits", "block size", "blocksize", "number"};
+      static const char *const ignored[] = {"content",
+                                            "kinds",
+                                            "labels",
+                                            "units",
+                                            "space units",
+                                            "centers",
+                                            "centerings",
+                                            "thicknesses",
+                                            "axis mins",
+                                            "axismins",
+                                            "axis maxs",
+                                            "axismaxs",
+                                            "min",
+                                            "max",
+                                            "old min",
+                                            "oldmin",
+                                            "old max",
+                                            "oldmax",
+                                            "measurement frame",
+                                            "sample units",
+                                            "sampleunits",
+                                            "block size",
+                                            "blocksize",
+                                            "number"};
       HDR_CHECK(word_in(field, ignored, (int)(sizeof ignored / sizeof ignored[0])) >= 0, H, line,
                 "%s:%ld: '%s' is not a NRRD field", H->path, line, field);
     }
@@ -431,8 +452,7 @@ static fcm_status parse_nrrd(header *H, const char *buf, size_t len)
       H->axes[4 * d] = spacings[d];
   else
     HDR_CHECK(!have_spacings, H, L.line,
-              "%s: both 'space directions' and 'spacings' given; NRRD allows one of them",
-              H->path);
+              "%s: both 'space directions' and 'spacings' given; NRRD allows one of them", H->path);
   H->data_offset = (size_t)(L.p - buf);
 cleanup:
   return st;
@@ -487,12 +507,12 @@ static fcm_status parse_mhd(header *H, const char *buf, size_t len)
       if (strcmp(key, "ElementSpacing") == 0) memcpy(spacing, s, sizeof s);
     } else if (strcmp(key, "Offset") == 0 || strcmp(key, "Origin") == 0 ||
                strcmp(key, "Position") == 0) {
-      HDR_CHECK(parse_numbers(value, 3, H->origin), H, line,
-                "%s:%ld: %s: '%s' is not 3 numbers", H->path, line, key, value);
+      HDR_CHECK(parse_numbers(value, 3, H->origin), H, line, "%s:%ld: %s: '%s' is not 3 numbers",
+                H->path, line, key, value);
     } else if (strcmp(key, "TransformMatrix") == 0 || strcmp(key, "Rotation") == 0 ||
                strcmp(key, "Orientation") == 0) {
-      HDR_CHECK(parse_numbers(value, 9, R), H, line, "%s:%ld: %s: '%s' is not 9 numbers",
-                H->path, line, key, value);
+      HDR_CHECK(parse_numbers(value, 9, R), H, line, "%s:%ld: %s: '%s' is not 9 numbers", H->path,
+                line, key, value);
     } else if (strcmp(key, "ElementByteOrderMSB") == 0 ||
                strcmp(key, "BinaryDataByteOrderMSB") == 0) {
       HDR_CHECK(lower_eq(value, "true") || lower_eq(value, "false"), H, line,
@@ -515,8 +535,8 @@ static fcm_status parse_mhd(header *H, const char *buf, size_t len)
       HDR_CHECK(parse_integer(value, -1, LLONG_MAX / 2, &H->byte_skip), H, line,
                 "%s:%ld: HeaderSize: '%s' is not an integer >= -1", H->path, line, value);
     } else if (strcmp(key, "ObjectType") == 0) {
-      HDR_CHECK(strcmp(value, "Image") == 0, H, line,
-                "%s:%ld: ObjectType: '%s'; expected Image", H->path, line, value);
+      HDR_CHECK(strcmp(value, "Image") == 0, H, line, "%s:%ld: ObjectType: '%s'; expected Image",
+                H->path, line, value);
     } else if (strcmp(key, "ElementDataFile") == 0) {
       FCM_CHECK(strcmp(value, "LIST") != 0 && !strchr(value, '%'), H->ctx, FCM_ERR_UNSUPPORTED,
                 "%s:%ld: ElementDataFile = %s: multi-file data are not supported", H->path, line,
@@ -525,8 +545,8 @@ static fcm_status parse_mhd(header *H, const char *buf, size_t len)
       have_file = 1;
     } /* other keys (Comment, AnatomicalOrientation, CenterOfRotation, ...) are not needed */
   }
-  HDR_CHECK(ndims == 3 && H->have_dims, H, L.line,
-            "%s: the header lacks 'NDims = 3' or 'DimSize'", H->path);
+  HDR_CHECK(ndims == 3 && H->have_dims, H, L.line, "%s: the header lacks 'NDims = 3' or 'DimSize'",
+            H->path);
   HDR_CHECK(H->have_type, H, L.line, "%s: the header lacks 'ElementType'", H->path);
   for (int d = 0; d < 3; d++)
     for (int c = 0; c < 3; c++)
@@ -594,8 +614,8 @@ static fcm_status read_data(header *H, const char *dpath, const char *data, size
     FCM_CHECK(H->byte_skip >= 0, H->ctx, FCM_ERR_FORMAT,
               "%s: byte skip -1 is only valid for raw data", dpath);
     FCM_CHECK((size_t)H->byte_skip <= len - off, H->ctx, FCM_ERR_FORMAT,
-              "%s: byte skip %lld is beyond the end of the data (%zu bytes)", dpath,
-              H->byte_skip, len - off);
+              "%s: byte skip %lld is beyond the end of the data (%zu bytes)", dpath, H->byte_skip,
+              len - off);
     const char *p = data + off + H->byte_skip, *end = data + len;
     for (size_t i = 0; i < n; i++) {
       while (p < end && (*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r' || *p == ','))
@@ -603,27 +623,31 @@ static fcm_status read_data(header *H, const char *dpath, const char *data, size
       char tok[64];
       size_t k = 0;
       for (; p < end && !(*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r' || *p == ','); p++)
-        if (k < sizeof tok - 1) tok[k++] = *p;
-        else k = sizeof tok; /* too long: reported below */
+        if (k < sizeof tok - 1)
+          tok[k++] = *p;
+        else
+          k = sizeof tok; /* too long: reported below */
       FCM_CHECK(k < sizeof tok, H->ctx, FCM_ERR_FORMAT,
                 "%s: ascii data: value %zu is longer than %zu characters", dpath, i,
                 sizeof tok - 1);
       tok[k] = '\0';
       FCM_CHECK(k > 0, H->ctx, FCM_ERR_FORMAT,
-                "%s: ascii data: %zu values, expected %zu (sizes %lld x %lld x %lld)", dpath, i,
-                n, (long long)H->dims[0], (long long)H->dims[1], (long long)H->dims[2]);
+                "%s: ascii data: %zu values, expected %zu (sizes %lld x %lld x %lld)", dpath, i, n,
+                (long long)H->dims[0], (long long)H->dims[1], (long long)H->dims[2]);
       char *e;
       values[i] = strtod(tok, &e);
-      FCM_CHECK(*e == '\0', H->ctx, FCM_ERR_FORMAT, "%s: ascii data: value %zu '%s' is not a "
-                "number", dpath, i, tok);
+      FCM_CHECK(*e == '\0', H->ctx, FCM_ERR_FORMAT,
+                "%s: ascii data: value %zu '%s' is not a "
+                "number",
+                dpath, i, tok);
     }
   } else {
     const size_t need = n * (size_t)type_size[H->type];
     size_t start;
     if (H->byte_skip < 0) {
       FCM_CHECK(len - off >= need, H->ctx, FCM_ERR_FORMAT,
-                "%s: raw data: %zu bytes, expected at least %zu (%zu values of %d bytes)",
-                dpath, len - off, need, n, type_size[H->type]);
+                "%s: raw data: %zu bytes, expected at least %zu (%zu values of %d bytes)", dpath,
+                len - off, need, n, type_size[H->type]);
       start = len - need;
     } else {
       start = off + (size_t)H->byte_skip;
@@ -673,8 +697,8 @@ fcm_status fcm_voxel_image_create_from_file(fcm_ctx *ctx, const char *path, fcm_
   const char *dpath = path, *data = buf + H->data_offset;
   size_t dl = len - H->data_offset;
   if (H->data_file[0]) {
-    FCM_TRY(ctx, fcm__file_read_all(ctx, "voxel image", H->data_file, VOXEL_MAX_FILE, &dbuf,
-                                    &dlen));
+    FCM_TRY(ctx,
+            fcm__file_read_all(ctx, "voxel image", H->data_file, VOXEL_MAX_FILE, &dbuf, &dlen));
     dpath = H->data_file, data = dbuf, dl = dlen;
   }
   /* The announced size must fit in the data before the values are allocated: raw values take
@@ -831,8 +855,8 @@ fcm_status fcm_geometry_create_from_voxels(fcm_ctx *ctx, const fcm_voxel_image *
     const double p[3] = {(double)(key % lx) - 0.5, (double)((key / lx) % ly) - 0.5,
                          (double)(key / (lx * ly)) - 0.5};
     for (int d = 0; d < 3; d++)
-      X[3 * a + (size_t)d] = img->origin[d] + p[0] * img->axes[d] + p[1] * img->axes[3 + d] +
-                             p[2] * img->axes[6 + d];
+      X[3 * a + (size_t)d] =
+          img->origin[d] + p[0] * img->axes[d] + p[1] * img->axes[3 + d] + p[2] * img->axes[6 + d];
   }
   const int flip = det3(img->axes) < 0.0;
   for (size_t b = 0; b < nb; b++) {

@@ -551,6 +551,14 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
     if (st != FCM_OK)
       fcm__error_prefix(ctx, st == FCM_ERR_GEOMETRY ? "geometry" : "quadrature");
     FCM_TRY(ctx, st);
+    const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(S->rules);
+    FCM_CHECK(rs->num_uncut + rs->num_cut > 0, ctx, FCM_ERR_GEOMETRY,
+              "geometry: every one of the %lld background cells holds less than "
+              "quadrature.min_fraction = %g of its volume of the body (embedded volume %g of "
+              "%g m^3): the body is too small or thin for the grid; refine the background or "
+              "lower quadrature.min_fraction",
+              (long long)rs->num_cells, fcm_scene_get_quadrature(scene)->min_fraction,
+              rs->embedded_volume, rs->geometry_volume);
     st = fcm_space_create_embedded(ctx, S->mesh, S->rules, &S->space);
     if (st != FCM_OK) fcm__error_prefix(ctx, "geometry");
     FCM_TRY(ctx, st);
