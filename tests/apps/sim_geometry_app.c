@@ -92,9 +92,15 @@ int main(int argc, char **argv)
 
   /* --progress off a terminal: lines, the last one at all 8 cells */
   scene(path, "{\"level_set\": {\"sphere\": {\"center\": [0.5, 0.5, 0.5], \"radius\": 0.4}}}");
-  snprintf(cmd, sizeof cmd, "'%s' '%s' --check --progress 2> '%s' > /dev/null", sim, path, err);
+  char out[1024];
+  snprintf(out, sizeof out, "%s/geo-stdout.txt", work);
+  snprintf(cmd, sizeof cmd, "'%s' '%s' --check --progress 2> '%s' > '%s'", sim, path, err, out);
   TEST_TRUE(app_run(cmd) == 0);
   TEST_TRUE(file_has(err, "fcm-sim: cell rules 8/8 cells"));
   TEST_TRUE(!file_has(err, "warning"));
+  /* the summary: what the level set built, the cut-cell statistics and the volumes */
+  TEST_TRUE(file_has(out, "geometry  level set: ") && file_has(out, "estimated error"));
+  TEST_TRUE(file_has(out, "cells     8: 0 uncut, 8 cut, 0 dropped; cut-cell points stiffness"));
+  TEST_TRUE(file_has(out, "(ratio 1.000000), outside the background 0"));
   return TEST_RESULT();
 }
