@@ -208,6 +208,91 @@ static void round_trips(fcm_ctx *ctx)
   remove("vox_rt_ascii.nrrd");
 }
 
+/* The volume a closed, outward oriented boundary encloses (divergence theorem: the sum of
+ * det(a, b, c) / 6 over its triangles) and its area. */
+static void enclosed(const fcm_geometry *g, double *volume, double *area)
+{
+  const double *X = fcm_geometry_coords(g);
+  const fcm_index *t = fcm_geometry_boundary_triangles(g);
+  *volume = *area = 0;
+  for (fcm_index k = 0; k < fcm_geometry_num_boundary_triangles(g); k++) {
+    const double *a = X + 3 * t[3 * k], *b = X + 3 * t[3 * k + 1], *c = X + 3 * t[3 * k + 2];
+    *volume += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                a[2] * (b[0] * c[1] - b[1] * c[0])) /
+               6.0;
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                         u[0] * w[1] - u[1] * w[0]};
+    *area += 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  }
+}
+
+/* Area of the exposed voxel faces of the porous block with value >= 0.5 (the exact
+ * boundary) for voxels of size s[0] x s[1] x s[2]. */
+static double exposed_area(const double s[3])
+{
+  const double fa[3] = {s[1] * s[2], s[0] * s[2], s[0] * s[1]};
+  double n = 0;
+  for (int k = 0; k < NZ; k++)
+    for (int j = 0; j < NY; j++)
+      for (int i = 0; i < NX; i++) {
+        if (porous(i, j, k) < 0.5) continue;
+        const int nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k},
+                              {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
+        for (int f = 0; f < 6; f++) {
+          const int *q = nb[f];
+          if (q[0] < 0 || q[0] >= NX || q[1] < 0 || q[1] >= NY || q[2] < 0 || q[2] >= NZ ||
+              porous(q[0], q[1], q[2]) < 0.5)
+            n += fa[f / 2];
+        }
+      }
+  return n;
+}
+
+/* The boundary is the exact voxel surface, closed and outward, merged or not, on a sheared
+ * left-handed lattice and after a mirroring transform; its area on a box lattice. */
+static void boundaries(fcm_ctx *ctx)
+{
+  double v[NX * NY * NZ];
+  for (int k = 0; k < NZ; k++)
+    for (int j = 0; j < NY; j++)
+      for (int i = 0; i < NX; i++)
+        v[i + NX * (j + NY * k)] = porous(i, j, k);
+  const fcm_index dims[3] = {NX, NY, NZ};
+  const double sheared[9] = {0.5, 0, 0, 0.1, 0.25, 0, 0, 0, -2};
+  const double boxed[9] = {0.5, 0, 0, 0, 0.25, 0, 0, 0, 2}, o[3] = {1, 2, 3};
+  for (int lattice = 0; lattice < 2; lattice++)
+    for (int merge = 0; merge < 2; merge++) {
+      fcm_voxel_image *img = NULL;
+      fcm_geometry *g = NULL, *m = NULL;
+      TEST_OK(ctx, fcm_voxel_image_create(ctx, dims, lattice ? boxed : sheared, o, v, &img));
+      fcm_voxel_options vo = fcm_voxel_options_default();
+      vo.merge = merge;
+      if (img) TEST_OK(ctx, fcm_geometry_create_from_voxels(ctx, img, &vo, &g, NULL));
+      if (g) {
+        double vol, area;
+        enclosed(g, &vol, &area);
+        TEST_NEAR(vol, fcm_geometry_volume(g), 1e-12, 0);
+        const double spacing[3] = {0.5, 0.25, 2};
+        if (lattice == 1) TEST_NEAR(area, exposed_area(spacing), 1e-12, 0);
+        const double A[9] = {-1, 0, 0, 0, 1, 0, 0, 0, 1}, b[3] = {0, 0, 0};
+        TEST_OK(ctx, fcm_geometry_create_transformed(ctx, g, A, b, &m));
+        if (m) {
+          double vm, am;
+          enclosed(m, &vm, &am);
+          TEST_NEAR(vm, fcm_geometry_volume(g), 1e-12, 0);
+          TEST_NEAR(am, area, 1e-12, 0);
+          TEST_TRUE(fcm_geometry_num_boundary_triangles(m) ==
+                    fcm_geometry_num_boundary_triangles(g));
+        }
+      }
+      fcm_geometry_destroy(&m);
+      fcm_geometry_destroy(&g);
+      fcm_voxel_image_destroy(&img);
+    }
+}
+
 static void volumes(fcm_ctx *ctx)
 {
   double v[NX * NY * NZ];
@@ -265,6 +350,7 @@ static void volumes(fcm_ctx *ctx)
     double lo[3], hi[3];
     fcm_geometry_bounding_box(g, lo, hi);
     TEST_TRUE(info.num_boxes == 1 && info.num_selected == 72);
+    TEST_TRUE(fcm_geometry_num_boundary_triangles(g) == 12); /* one rectangle per face */
     TEST_TRUE(lo[0] == -0.5 && hi[0] == 5.5 && lo[2] == -0.5 && hi[2] == 2.5);
     TEST_NEAR(fcm_geometry_volume(g), 72.0, 1e-14, 0);
     fcm_geometry_destroy(&g);
@@ -352,6 +438,7 @@ int main(void)
   if (!ctx) return TEST_RESULT();
   round_trips(ctx);
   volumes(ctx);
+  boundaries(ctx);
   errors(ctx);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);

@@ -84,9 +84,10 @@ typedef struct fcm_voxel_info {
 
 /** The selected voxels as a geometry of Hex8 cells (parallelepipeds; boxes when the axes
  * are orthogonal): the volume is num_selected x voxel_volume up to rounding. Cells share
- * the lattice nodes at their corners. Boundary triangles: exact without merging; with
- * merging, faces where two boxes of different extents touch are also listed (in pairs of
- * opposite orientation, so surface integrals of continuous fields cancel there).
+ * the lattice nodes at their corners. The boundary triangles are the exact voxel surface:
+ * the box faces next to an unselected voxel or the image's edge, merged into rectangles
+ * per box (their corners are extra lattice nodes, not used by any cell), two triangles
+ * each, owned by that box, outward; fcm_geometry_create_transformed() keeps them.
  * @param[in] opts NULL for defaults; @param[out] info may be NULL
  * @return FCM_OK; FCM_ERR_ARG (NULL, num_labels outside [0, 256], labels NULL with
  *         num_labels > 0, non-finite threshold or label); FCM_ERR_GEOMETRY (no voxel

@@ -742,6 +742,74 @@ static int cmp_key(const void *a, const void *b)
   return (x > y) - (x < y);
 }
 
+/* The exposed parts of the faces of the boxes box[0 .. nb) (6 lattice indices each): face
+ * cells whose neighbouring voxel across the face is unselected (mask 0) or outside the
+ * image, merged greedily into rectangles (runs along the face's first axis, extended along
+ * the second). Each rectangle: 4 lattice keys (i + (nx+1)(j + (ny+1)k)), counter-clockwise
+ * seen from outside the box in lattice coordinates, and its box. */
+static fcm_status exposed_faces(fcm_ctx *ctx, const unsigned char *mask, const fcm_index dims[3],
+                                const int64_t *box, size_t nb, int64_t **rect, size_t **rbox,
+                                size_t *nr)
+{
+  fcm_status st = FCM_OK;
+  const int64_t n[3] = {dims[0], dims[1], dims[2]}, lx = n[0] + 1, ly = n[1] + 1;
+  unsigned char *flag = NULL;
+  size_t cap = 0;
+  int64_t fmax = 0;
+  for (int d = 0; d < 3; d++)
+    fmax = FCM_MAX(fmax, n[(d + 1) % 3] * n[(d + 2) % 3]);
+  FCM_ALLOC_RAW(ctx, (size_t)fmax, flag);
+  for (size_t b = 0; b < nb; b++) {
+    const int64_t *lo = box + 6 * b, *hi = lo + 3;
+    for (int d = 0; d < 3; d++)
+      for (int side = 0; side < 2; side++) {
+        const int u = (d + 1) % 3, v = (d + 2) % 3;
+        const int64_t plane = side ? hi[d] : lo[d], layer = side ? hi[d] : lo[d] - 1;
+        const int64_t nu = hi[u] - lo[u], nv = hi[v] - lo[v];
+        for (int64_t b2 = 0; b2 < nv; b2++)
+          for (int64_t a = 0; a < nu; a++) {
+            int64_t g[3];
+            g[d] = layer, g[u] = lo[u] + a, g[v] = lo[v] + b2;
+            flag[a + nu * b2] =
+                (unsigned char)(layer < 0 || layer >= n[d] ||
+                                !mask[(size_t)(g[0] + n[0] * (g[1] + n[1] * g[2]))]);
+          }
+        for (int64_t b2 = 0; b2 < nv; b2++)
+          for (int64_t a = 0; a < nu; a++) {
+            if (!flag[a + nu * b2]) continue;
+            int64_t a1 = a + 1, c1 = b2 + 1;
+            while (a1 < nu && flag[a1 + nu * b2])
+              a1++;
+            for (int ok = 1; ok && c1 < nv; c1 += ok)
+              for (int64_t x = a; ok && x < a1; x++)
+                ok = flag[x + nu * c1];
+            for (int64_t y = b2; y < c1; y++)
+              for (int64_t x = a; x < a1; x++)
+                flag[x + nu * y] = 0;
+            if (*nr == cap) {
+              const size_t nc = cap ? 2 * cap : 256;
+              FCM_TRY(ctx, fcm__resize(ctx, (void **)rect, 4 * cap, 4 * nc, sizeof **rect));
+              FCM_TRY(ctx, fcm__resize(ctx, (void **)rbox, cap, nc, sizeof **rbox));
+              cap = nc;
+            }
+            /* (u, v) corners counter-clockwise seen from +e_d (e_u x e_v = e_d); reversed
+             * on the low side */
+            const int64_t cu[4] = {a, a1, a1, a}, cv[4] = {b2, b2, c1, c1};
+            for (int c = 0; c < 4; c++) {
+              const int k = side ? c : (4 - c) % 4;
+              int64_t g[3];
+              g[d] = plane, g[u] = lo[u] + cu[k], g[v] = lo[v] + cv[k];
+              (*rect)[4 * *nr + (size_t)c] = g[0] + lx * (g[1] + ly * g[2]);
+            }
+            (*rbox)[(*nr)++] = b;
+          }
+      }
+  }
+cleanup:
+  fcm__free(ctx, flag);
+  return st;
+}
+
 fcm_status fcm_geometry_create_from_voxels(fcm_ctx *ctx, const fcm_voxel_image *img,
                                            const fcm_voxel_options *opts, fcm_geometry **geom,
                                            fcm_voxel_info *info)
@@ -749,6 +817,9 @@ fcm_status fcm_geometry_create_from_voxels(fcm_ctx *ctx, const fcm_voxel_image *
   fcm_status st = FCM_OK;
   unsigned char *mask = NULL;
   int64_t *box = NULL, *keys = NULL; /* box: 6 per box (i0 j0 k0 i1 j1 k1, half-open) */
+  int64_t *rect = NULL;              /* exposed rectangles: 4 lattice keys each */
+  size_t *rbox = NULL, nr = 0;       /* the box of each rectangle */
+  fcm_index *tris = NULL, *tri_box = NULL;
   double *X = NULL;
   fcm_index *cells = NULL;
   size_t nb = 0, cap = 0;
@@ -830,9 +901,13 @@ fcm_status fcm_geometry_create_from_voxels(fcm_ctx *ctx, const fcm_voxel_image *
         bx[0] = i, bx[1] = j, bx[2] = k, bx[3] = i1, bx[4] = j1, bx[5] = k1;
       }
 #undef AVAIL
-  /* Lattice corner keys, sorted and unique: the nodes. */
-  FCM_ALLOC_RAW(ctx, 8 * nb, keys);
+  /* The exposed faces of each box (next to an unselected voxel or the image's edge) as
+   * rectangles merged greedily on the face: 4 lattice keys each, counter-clockwise seen from
+   * outside in lattice coordinates, and the box they belong to. */
   const int64_t lx = nx + 1, ly = ny + 1;
+  FCM_TRY(ctx, exposed_faces(ctx, mask, img->dims, box, nb, &rect, &rbox, &nr));
+  /* Lattice corner keys of boxes and rectangles, sorted and unique: the nodes. */
+  FCM_ALLOC_RAW(ctx, 8 * nb + 4 * nr, keys);
   static const int corner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
                                    {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
   for (size_t b = 0; b < nb; b++)
@@ -845,9 +920,10 @@ fcm_status fcm_geometry_create_from_voxels(fcm_ctx *ctx, const fcm_voxel_image *
   FCM_ALLOC_RAW(ctx, 8 * nb, cells);
   for (size_t q = 0; q < 8 * nb; q++)
     cells[q] = (fcm_index)keys[q];
-  qsort(keys, 8 * nb, sizeof *keys, cmp_key);
+  memcpy(keys + 8 * nb, rect, 4 * nr * sizeof *keys);
+  qsort(keys, 8 * nb + 4 * nr, sizeof *keys, cmp_key);
   size_t nn = 0;
-  for (size_t q = 0; q < 8 * nb; q++)
+  for (size_t q = 0; q < 8 * nb + 4 * nr; q++)
     if (q == 0 || keys[q] != keys[nn - 1]) keys[nn++] = keys[q];
   FCM_ALLOC_RAW(ctx, 3 * nn, X);
   for (size_t a = 0; a < nn; a++) {
@@ -870,9 +946,27 @@ fcm_status fcm_geometry_create_from_voxels(fcm_ctx *ctx, const fcm_voxel_image *
     for (int c = 0; c < 8; c++)
       cell[c] = tmp[flip ? (c + 4) % 8 : c];
   }
+  /* Boundary triangles: two per rectangle, reversed on a left-handed lattice. */
+  FCM_ALLOC_RAW(ctx, 6 * nr, tris);
+  FCM_ALLOC_RAW(ctx, 2 * nr, tri_box);
+  for (size_t q = 0; q < nr; q++) {
+    fcm_index v[4];
+    for (int c = 0; c < 4; c++) {
+      const int64_t *hit = bsearch(rect + 4 * q + c, keys, nn, sizeof *keys, cmp_key);
+      v[flip ? 3 - c : c] = (fcm_index)(hit - keys);
+    }
+    const fcm_index t[6] = {v[0], v[1], v[2], v[0], v[2], v[3]};
+    memcpy(tris + 6 * q, t, sizeof t);
+    tri_box[2 * q] = tri_box[2 * q + 1] = (fcm_index)rbox[q];
+  }
   const double vv = fabs(det3(img->axes));
   FCM_TRY(ctx, fcm__geom_create_take(ctx, "voxels", FCM_ELEMENT_HEX8, (fcm_index)nn, &X,
                                      (fcm_index)nb, &cells, 1, geom));
+  fcm__free(ctx, (*geom)->tris);
+  fcm__free(ctx, (*geom)->tri_cell);
+  (*geom)->tris = tris, (*geom)->tri_cell = tri_box, (*geom)->num_tris = (fcm_index)(2 * nr);
+  (*geom)->custom_boundary = 1;
+  tris = tri_box = NULL;
   if (info) {
     info->num_voxels = (fcm_index)n;
     info->num_selected = (fcm_index)nsel;
@@ -885,5 +979,9 @@ cleanup:
   fcm__free(ctx, keys);
   fcm__free(ctx, X);
   fcm__free(ctx, cells);
+  fcm__free(ctx, rect);
+  fcm__free(ctx, rbox);
+  fcm__free(ctx, tris);
+  fcm__free(ctx, tri_box);
   return st;
 }
