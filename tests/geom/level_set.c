@@ -1,7 +1,8 @@
 /* Level-set bodies: the volume error of a sphere falls as O(h^2) in the refinement (fitted
- * rate in [1.7, 2.3]) and the reported Richardson estimate tracks the true error; a box
- * aligned with the lattice is exact; CSG: the union of disjoint spheres has the sum of
- * their volumes, a difference removes the inner ball, an intersection with a half space
+ * rate in [1.7, 2.3]) and the reported Richardson estimate tracks the true error; the boundary
+ * triangles (iso-surface and box faces) are closed and outward (they enclose the volume) and lie on
+ * their tets; a box aligned with the lattice is exact; CSG: the union of disjoint spheres has the
+ * sum of their volumes, a difference removes the inner ball, an intersection with a half space
  * halves a ball; the torus and gyroid evaluate sensibly; bad trees and arguments fail. */
 #include "fcm/levelset.h"
 #include "test.h"
@@ -9,6 +10,32 @@
 #include <math.h>
 
 static const double PI = 3.14159265358979323846;
+
+/* The boundary triangles enclose the geometry's volume (divergence theorem: sum of
+ * det(a, b, c) / 6; closed and outward) and each lies on a face of its own tet. */
+static void check_boundary(const fcm_geometry *g, const char *what)
+{
+  const double *X = fcm_geometry_coords(g);
+  const fcm_index *t = fcm_geometry_boundary_triangles(g), *own = fcm_geometry_boundary_cells(g);
+  const fcm_index *cells = fcm_geometry_cells(g);
+  double vol = 0;
+  int foreign = 0;
+  for (fcm_index k = 0; k < fcm_geometry_num_boundary_triangles(g); k++) {
+    const double *a = X + 3 * t[3 * k], *b = X + 3 * t[3 * k + 1], *c = X + 3 * t[3 * k + 2];
+    vol += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+            a[2] * (b[0] * c[1] - b[1] * c[0])) /
+           6.0;
+    int in = 0;
+    for (int j = 0; j < 3; j++)
+      for (int v = 0; v < 4; v++)
+        in += cells[4 * own[k] + v] == t[3 * k + j];
+    foreign += in != 3;
+  }
+  if (!(fabs(vol - fcm_geometry_volume(g)) <= 1e-12 * fcm_geometry_volume(g)))
+    TEST_FAIL_("%s: boundary encloses %.17g, geometry volume %.17g", what, vol,
+               fcm_geometry_volume(g));
+  if (foreign) TEST_FAIL_("%s: %d boundary triangles not on their tet", what, foreign);
+}
 
 static fcm_geometry *build(fcm_ctx *ctx, const fcm_implicit *nodes, int num, const double lo[3],
                            const double hi[3], fcm_index n, int r, fcm_level_set_info *info)
@@ -39,6 +66,7 @@ static void sphere_rate(fcm_ctx *ctx)
     err[l] = fabs(fcm_geometry_volume(g) - exact);
     h[l] = info.h;
     TEST_NEAR(info.volume, fcm_geometry_volume(g), 1e-12, 0);
+    check_boundary(g, "sphere");
     TEST_TRUE(info.cells_inside + info.cells_cut + info.cells_outside == 64);
     TEST_TRUE(info.num_tets == fcm_geometry_num_cells(g));
     TEST_NEAR(h[l], 2.0 / (4.0 * refinement[l]), 1e-15, 0);
@@ -103,8 +131,18 @@ static void csg(fcm_ctx *ctx)
     TEST_NEAR(info.volume_fine, shell, 3e-3, 0);
   }
   fcm_geometry_destroy(&g);
-  if ((g = build(ctx, d, 5, lo, hi, 8, 6, &info)))
+  if ((g = build(ctx, d, 5, lo, hi, 8, 6, &info))) {
     TEST_NEAR(fcm_geometry_volume(g), shell / 2, 1e-2, 0);
+    check_boundary(g, "half shell");
+  }
+  fcm_geometry_destroy(&g);
+  /* a ball half outside the sampling box: cut off flat by the box face */
+  fcm_implicit hb = {0};
+  hb.kind = FCM_IMPLICIT_SPHERE, hb.radius = 0.8, hb.center[0] = 2.0;
+  if ((g = build(ctx, &hb, 1, lo, hi, 8, 4, &info))) {
+    TEST_NEAR(fcm_geometry_volume(g), 2.0 / 3.0 * PI * 0.512, 2e-2, 0);
+    check_boundary(g, "ball cut by the box");
+  }
   fcm_geometry_destroy(&g);
   /* torus: 2 pi^2 R r^2 */
   fcm_implicit t = {0};
@@ -118,8 +156,10 @@ static void csg(fcm_ctx *ctx)
   gy.kind = FCM_IMPLICIT_GYROID, gy.period = 1, gy.thickness = 0, gy.sheet = 0;
   const double glo[3] = {0, 0, 0}, ghi[3] = {2, 2, 2};
   memcpy(gy.min, glo, sizeof glo), memcpy(gy.max, ghi, sizeof ghi);
-  if ((g = build(ctx, &gy, 1, glo, ghi, 8, 4, &info)))
+  if ((g = build(ctx, &gy, 1, glo, ghi, 8, 4, &info))) {
     TEST_NEAR(fcm_geometry_volume(g), 4.0, 3e-2, 0);
+    check_boundary(g, "gyroid solid (box faces)");
+  }
   fcm_geometry_destroy(&g);
   gy.sheet = 1, gy.thickness = 0.05;
   if ((g = build(ctx, &gy, 1, glo, ghi, 8, 4, &info))) {
@@ -144,7 +184,10 @@ static void csg(fcm_ctx *ctx)
     TEST_TRUE(info.cells_inside == 8);
     TEST_NEAR(fcm_geometry_volume(g), fcm_geometry_volume(g2), 1e-12, 0);
     TEST_TRUE(fcm_geometry_num_cells(g2) > fcm_geometry_num_cells(g));
-    TEST_TRUE(fcm_geometry_num_boundary_triangles(g2) < fcm_geometry_num_boundary_triangles(g));
+    check_boundary(g, "ball, whole cells");
+    check_boundary(g2, "ball, refine_inside");
+    /* the same surface either way: the iso-surface only */
+    TEST_TRUE(fcm_geometry_num_boundary_triangles(g2) == fcm_geometry_num_boundary_triangles(g));
   }
   fcm_geometry_destroy(&g);
   fcm_geometry_destroy(&g2);

@@ -28,10 +28,9 @@ typedef struct fcm_level_set_options {
                            only, nothing stored) for fcm_level_set_info.error_estimate */
   int refine_inside;  /**< 0 (default): cells where every sample is inside become 6 tets of
                            the whole cell, and in cut cells the sub-cubes with every corner
-                           inside are merged into boxes of 6 tets (fewer tets; their faces next
-                           to refined sub-cubes do not conform, see
-                           fcm_geometry_create_from_level_set()); 1: every sub-cube is split
-                           on its own (conforming, more tets) */
+                           inside are merged into boxes of 6 tets (fewer tets, which do not
+                           conform to the refined ones next to them; the boundary triangles
+                           are the same); 1: every sub-cube is split on its own */
 } fcm_level_set_options;
 
 /** Defaults as documented on each member. */
@@ -55,10 +54,10 @@ typedef struct fcm_level_set_info {
  * (r + 1)^3 lattice points of every cell; cells with mixed signs are cut by marching
  * tetrahedra on the r^3 sub-cubes; cells entirely inside are 6 tets (unless
  * refine_inside). The parts of the body outside [lo, hi] are cut off. Tets share nodes
- * (lattice points and edge crossings), so the boundary triangles are the surface phi = 0
- * plus the box faces it crosses, plus (refine_inside = 0) the non-conforming faces between
- * whole cells or merged boxes and refined sub-cubes, in pairs of opposite orientation (so
- * surface integrals of continuous fields cancel there).
+ * (lattice points and edge crossings). The boundary triangles are the surface: the
+ * iso-surface pieces of the marched tets (facing along the gradient of the interpolant)
+ * and the tet faces on the faces of [lo, hi], each owned by its tet; closed and outward
+ * (fcm_geometry_create_transformed() keeps them).
  * @param[in] phi, user the function and its argument; @param[in] opts NULL for defaults
  * @param[out] geom the geometry; @param[out] info may be NULL
  * @return FCM_OK; FCM_ERR_ARG (NULL, lo >= hi, n outside [1, 10^4], refinement outside

@@ -28,6 +28,7 @@ typedef struct lvert {
 typedef struct lnode {
   int64_t key;
   double x[3];
+  int plane; /* bit 2d (2d+1): the node lies on the box face x_d = lo_d (hi_d) */
 } lnode;
 
 typedef struct builder {
@@ -39,6 +40,9 @@ typedef struct builder {
   int store;    /* 0: volume only */
   size_t nt, cap;
   lnode *nodes; /* 4 per tet */
+  size_t ntri, tcap;
+  lnode *tri;     /* boundary triangles: 3 nodes each, outward */
+  size_t *towner; /* the tet of each */
   double volume;
 } builder;
 
@@ -54,11 +58,20 @@ static int64_t lattice_id(const builder *B, const int64_t g[3])
   return g[0] + (B->N[0] + 1) * (g[1] + (B->N[1] + 1) * g[2]);
 }
 
+static int lattice_planes(const builder *B, const int64_t g[3])
+{
+  int m = 0;
+  for (int d = 0; d < 3; d++)
+    m |= (g[d] == 0) << (2 * d) | (g[d] == B->N[d]) << (2 * d + 1);
+  return m;
+}
+
 static lnode vertex_node(const builder *B, const lvert *v)
 {
   lnode n;
   n.key = 8 * lattice_id(B, v->g);
   lattice_x(B, v->g, n.x);
+  n.plane = lattice_planes(B, v->g);
   return n;
 }
 
@@ -79,7 +92,70 @@ static lnode edge_node(const builder *B, const lvert *p, const lvert *q)
   const double t = u->phi / (u->phi - w->phi);
   for (int d = 0; d < 3; d++)
     n.x[d] = xu[d] + t * (xw[d] - xu[d]);
+  n.plane = lattice_planes(B, u->g) & lattice_planes(B, w->g);
   return n;
+}
+
+/* Record boundary triangle (a, b, c) of tet `owner`, turned to face away from o (a point of
+ * the tet off the triangle's plane). */
+static fcm_status add_tri(builder *B, lnode a, lnode b, lnode c, const double o[3], size_t owner)
+{
+  fcm_status st = FCM_OK;
+  double e1[3], e2[3], e3[3];
+  for (int k = 0; k < 3; k++)
+    e1[k] = b.x[k] - a.x[k], e2[k] = c.x[k] - a.x[k], e3[k] = o[k] - a.x[k];
+  const double det = e1[0] * (e2[1] * e3[2] - e2[2] * e3[1]) -
+                     e1[1] * (e2[0] * e3[2] - e2[2] * e3[0]) +
+                     e1[2] * (e2[0] * e3[1] - e2[1] * e3[0]);
+  if (B->ntri == B->tcap) {
+    const size_t nc = B->tcap ? 2 * B->tcap : 1024;
+    FCM_TRY(B->ctx, fcm__resize(B->ctx, (void **)&B->tri, 3 * B->tcap, 3 * nc, sizeof(lnode)));
+    FCM_TRY(B->ctx, fcm__resize(B->ctx, (void **)&B->towner, B->tcap, nc, sizeof(size_t)));
+    B->tcap = nc;
+  }
+  lnode *t = B->tri + 3 * B->ntri;
+  t[0] = a, t[1] = det > 0.0 ? c : b, t[2] = det > 0.0 ? b : c;
+  B->towner[B->ntri++] = owner;
+cleanup:
+  return st;
+}
+
+/* The iso-surface triangle (a, b, c) of the tet just emitted, facing along grad, the
+ * gradient of the linear interpolant of phi (robust where a vertex value is tiny). */
+static fcm_status iso_tri(builder *B, lnode a, lnode b, lnode c, const double grad[3])
+{
+  if (!B->store) return FCM_OK;
+  double o[3];
+  for (int k = 0; k < 3; k++)
+    o[k] = a.x[k] - grad[k];
+  return add_tri(B, a, b, c, o, B->nt - 1);
+}
+
+/* Gradient of the linear interpolant of phi on the tet v[0..3]. */
+static void tet_gradient(const builder *B, const lvert *v[4], double grad[3])
+{
+  double x[4][3], J[3][3], r[3];
+  for (int k = 0; k < 4; k++)
+    lattice_x(B, v[k]->g, x[k]);
+  for (int k = 0; k < 3; k++) {
+    for (int d = 0; d < 3; d++)
+      J[k][d] = x[k + 1][d] - x[0][d];
+    r[k] = v[k + 1]->phi - v[0]->phi;
+  }
+  /* J grad = r by Cramer's rule (Kuhn tets are never flat) */
+  const double det = J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1]) -
+                     J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0]) +
+                     J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]);
+  for (int d = 0; d < 3; d++) {
+    double M[3][3];
+    memcpy(M, J, sizeof M);
+    for (int k = 0; k < 3; k++)
+      M[k][d] = r[k];
+    grad[d] = (M[0][0] * (M[1][1] * M[2][2] - M[1][2] * M[2][1]) -
+               M[0][1] * (M[1][0] * M[2][2] - M[1][2] * M[2][0]) +
+               M[0][2] * (M[1][0] * M[2][1] - M[1][1] * M[2][0])) /
+              det;
+  }
 }
 
 static fcm_status emit(builder *B, lnode a, lnode b, lnode c, lnode d)
@@ -100,6 +176,25 @@ static fcm_status emit(builder *B, lnode a, lnode b, lnode c, lnode d)
   }
   lnode *t = B->nodes + 4 * B->nt++;
   t[0] = a, t[1] = b, t[2] = c, t[3] = d;
+  /* faces on a face of the box are boundary, turned outward by the face's normal (the
+   * tet may be flat: a crossing at a lattice vertex); flat faces are left out */
+  for (int f = 0; f < 4; f++) {
+    const lnode *p = t + (f + 1) % 4, *q = t + (f + 2) % 4, *r = t + (f + 3) % 4;
+    const int m = p->plane & q->plane & r->plane;
+    if (!m) continue;
+    int bit = 0;
+    while (!(m >> bit & 1))
+      bit++;
+    const int dd = bit / 2, e1i = (dd + 1) % 3, e2i = (dd + 2) % 3;
+    const double nd = (q->x[e1i] - p->x[e1i]) * (r->x[e2i] - p->x[e2i]) -
+                      (q->x[e2i] - p->x[e2i]) * (r->x[e1i] - p->x[e1i]);
+    if (nd == 0.0) continue;
+    double o[3]; /* a point on the inner side of the face */
+    for (int k = 0; k < 3; k++)
+      o[k] = p->x[k];
+    o[dd] += bit % 2 ? -1.0 : 1.0;
+    FCM_TRY(B->ctx, add_tri(B, *p, *q, *r, o, B->nt - 1));
+  }
 cleanup:
   return st;
 }
@@ -125,24 +220,35 @@ static fcm_status march(builder *B, const lvert *v[4])
     else
       out[no++] = k;
   if (ni == 0) return FCM_OK;
+  double grad[3] = {0, 0, 0};
+  if (ni < 4 && B->store) tet_gradient(B, v, grad);
   if (ni == 4) {
     FCM_TRY(B->ctx, emit(B, vertex_node(B, v[0]), vertex_node(B, v[1]), vertex_node(B, v[2]),
                          vertex_node(B, v[3])));
   } else if (ni == 1) {
     const lvert *a = v[in[0]];
-    FCM_TRY(B->ctx, emit(B, vertex_node(B, a), edge_node(B, a, v[out[0]]),
-                         edge_node(B, a, v[out[1]]), edge_node(B, a, v[out[2]])));
+    const lnode an = vertex_node(B, a), e0 = edge_node(B, a, v[out[0]]),
+                e1 = edge_node(B, a, v[out[1]]), e2 = edge_node(B, a, v[out[2]]);
+    FCM_TRY(B->ctx, emit(B, an, e0, e1, e2));
+    FCM_TRY(B->ctx, iso_tri(B, e0, e1, e2, grad));
   } else if (ni == 3) {
     const lvert *d = v[out[0]];
     lnode p[3], q[3];
     for (int k = 0; k < 3; k++)
       p[k] = vertex_node(B, v[in[k]]), q[k] = edge_node(B, v[in[k]], d);
-    FCM_TRY(B->ctx, emit_prism(B, p, q));
+    FCM_TRY(B->ctx, emit_prism(B, p, q)); /* the last tet (p2, q0, q1, q2) holds q */
+    FCM_TRY(B->ctx, iso_tri(B, q[0], q[1], q[2], grad));
   } else {
     const lvert *a = v[in[0]], *b = v[in[1]], *c = v[out[0]], *d = v[out[1]];
     const lnode p[3] = {vertex_node(B, a), edge_node(B, a, c), edge_node(B, a, d)};
     const lnode q[3] = {vertex_node(B, b), edge_node(B, b, c), edge_node(B, b, d)};
-    FCM_TRY(B->ctx, emit_prism(B, p, q));
+    /* the iso quad (p1, p2, q2, q1) is split by the diagonal p2-q1 of the prism's tets
+     * (p1, p2, q0, q1) and (p2, q0, q1, q2) */
+    FCM_TRY(B->ctx, emit(B, p[0], p[1], p[2], q[0]));
+    FCM_TRY(B->ctx, emit(B, p[1], p[2], q[0], q[1]));
+    FCM_TRY(B->ctx, iso_tri(B, p[1], p[2], q[1], grad));
+    FCM_TRY(B->ctx, emit(B, p[2], q[0], q[1], q[2]));
+    FCM_TRY(B->ctx, iso_tri(B, p[2], q[1], q[2], grad));
   }
 cleanup:
   return st;
@@ -247,6 +353,12 @@ typedef struct keyslot {
   size_t slot;
 } keyslot;
 
+static int cmp_key(const void *a, const void *b)
+{
+  const int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+  return (x > y) - (x < y);
+}
+
 static int cmp_keyslot(const void *a, const void *b)
 {
   const keyslot *x = a, *y = b;
@@ -264,6 +376,8 @@ fcm_status fcm_geometry_create_from_level_set(fcm_ctx *ctx, fcm_level_set_fn phi
   lvert *w = NULL;
   unsigned char *kinds = NULL, *todo = NULL;
   keyslot *ks = NULL;
+  int64_t *ukeys = NULL;
+  fcm_index *tris = NULL, *tri_tet = NULL;
   double *X = NULL;
   fcm_index *cells = NULL;
   fcm_level_set_info inf = {0};
@@ -319,7 +433,7 @@ fcm_status fcm_geometry_create_from_level_set(fcm_ctx *ctx, fcm_level_set_fn phi
   /* Pass 2 (volume only): the cut cells at refinement 2r, the others as they were. */
   if (o.estimate_error) {
     builder F = B;
-    F.store = 0, F.nodes = NULL, F.volume = 0.0;
+    F.store = 0, F.nodes = NULL, F.tri = NULL, F.towner = NULL, F.volume = 0.0;
     for (int d = 0; d < 3; d++)
       F.N[d] = (int64_t)n[d] * 2 * r;
     ci = 0;
@@ -348,20 +462,41 @@ fcm_status fcm_geometry_create_from_level_set(fcm_ctx *ctx, fcm_level_set_fn phi
   qsort(ks, nv, sizeof *ks, cmp_keyslot);
   FCM_ALLOC_RAW(ctx, nv, cells);
   FCM_ALLOC_RAW(ctx, 3 * nv, X);
+  FCM_ALLOC_RAW(ctx, nv, ukeys);
   size_t nn = 0;
   for (size_t s = 0; s < nv; s++) {
     if (s == 0 || ks[s].key != ks[s - 1].key) {
       memcpy(X + 3 * nn, B.nodes[ks[s].slot].x, 3 * sizeof(double));
-      nn++;
+      ukeys[nn++] = ks[s].key;
     }
     cells[ks[s].slot] = (fcm_index)(nn - 1);
   }
+  /* The boundary: the iso-surface and box-face triangles (every node is a tet node). */
+  FCM_ALLOC_RAW(ctx, 3 * B.ntri + 1, tris);
+  FCM_ALLOC_RAW(ctx, B.ntri + 1, tri_tet);
+  for (size_t k = 0; k < 3 * B.ntri; k++) {
+    const int64_t *hit = bsearch(&B.tri[k].key, ukeys, nn, sizeof *ukeys, cmp_key);
+    tris[k] = (fcm_index)(hit - ukeys);
+  }
+  for (size_t k = 0; k < B.ntri; k++)
+    tri_tet[k] = (fcm_index)B.towner[k];
   inf.num_tets = (fcm_index)B.nt;
   FCM_TRY(ctx, fcm__geom_create_take(ctx, "level set", FCM_ELEMENT_TET4, (fcm_index)nn, &X,
                                      (fcm_index)B.nt, &cells, 0, geom));
+  /* Tets were reoriented in place (two nodes swapped): the triangles do not depend on it. */
+  fcm__free(ctx, (*geom)->tris);
+  fcm__free(ctx, (*geom)->tri_cell);
+  (*geom)->tris = tris, (*geom)->tri_cell = tri_tet, (*geom)->num_tris = (fcm_index)B.ntri;
+  (*geom)->custom_boundary = 1;
+  tris = tri_tet = NULL;
   if (info) *info = inf;
 cleanup:
   fcm__free(ctx, B.nodes);
+  fcm__free(ctx, B.tri);
+  fcm__free(ctx, B.towner);
+  fcm__free(ctx, ukeys);
+  fcm__free(ctx, tris);
+  fcm__free(ctx, tri_tet);
   fcm__free(ctx, w);
   fcm__free(ctx, kinds);
   fcm__free(ctx, todo);
