@@ -12,7 +12,7 @@ here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 build=${FCM_BUILD_DIR:-$here/build}
 jobs=${FCM_JOBS:-$(nproc 2>/dev/null || echo 2)}
 packages=(build-essential cmake pkg-config libopenblas-dev liblapacke-dev libglpk-dev
-          libsuitesparse-dev libcjson-dev gnuplot-nox)
+          libsuitesparse-dev libcjson-dev libgmsh-dev gnuplot-nox)
 
 deps() {
   local missing=()

@@ -6,6 +6,7 @@
 
 #include <fcm/fcm.h>
 
+#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -183,7 +184,7 @@ static void embed_usage(FILE *f, const cli_option *opts)
   fprintf(f, "usage: fcm-quadrature embed --element {tet4,tet10,hex8,hex20}\n"
              "           --box X0 Y0 Z0 X1 Y1 Z1 --cells NX NY NZ --geometry FILE|SHAPE\n"
              "           --strength M [--mass-strength M] [--no-simplify] [--stabilization A]\n"
-             "           [--min-fraction PHI] [--dump FILE]\n"
+             "           [--min-fraction PHI] [--dump FILE] [--fill-holes] [--max-volume V]\n"
              "\n"
              "Builds the background grid, embeds the geometry, builds the cut-cell rules and\n"
              "prints their statistics (cells per class, points before and after\n"
@@ -192,8 +193,47 @@ static void embed_usage(FILE *f, const cli_option *opts)
   cli_print_options(f, opts);
 }
 
-/* Procedural geometry "name:a,b,c,..." or a file. */
-static fcm_status load_geometry(fcm_ctx *ctx, const char *spec, fcm_geometry **g)
+static int has_ext(const char *path, const char *ext)
+{
+  size_t n = strlen(path), e = strlen(ext);
+  if (n <= e) return 0;
+  for (size_t i = 0; i < e; i++)
+    if (tolower((unsigned char)path[n - e + i]) != ext[i]) return 0;
+  return 1;
+}
+
+/* A triangle surface file: read, holes closed when asked (reported on stderr),
+ * tetrahedralized. */
+static fcm_status load_surface(fcm_ctx *ctx, const char *path, int fill_holes, double max_volume,
+                               fcm_geometry **g)
+{
+  fcm_surface *s = NULL, *f = NULL;
+  fcm_status st = fcm_surface_create_from_file(ctx, path, &s);
+  if (st == FCM_OK && fill_holes) {
+    fcm_surface_fill_info fi;
+    st = fcm_surface_create_filled(ctx, s, NULL, &f, &fi);
+    if (st == FCM_OK) {
+      fprintf(stderr,
+              "fcm-quadrature embed: %s: fill_holes closed %lld of %lld hole(s), adding %lld "
+              "triangles of total area %g\n",
+              path, (long long)fi.num_filled, (long long)fi.num_loops,
+              (long long)fi.triangles_added, fi.area_added);
+      fcm_surface_destroy(&s);
+      s = f;
+    }
+  }
+  if (st == FCM_OK) {
+    fcm_surface_mesh_options mo = fcm_surface_mesh_options_default();
+    mo.max_volume = max_volume;
+    st = fcm_geometry_create_from_surface(ctx, s, &mo, g);
+  }
+  fcm_surface_destroy(&s);
+  return st;
+}
+
+/* Procedural geometry "name:a,b,c,..." or a file, by its extension. */
+static fcm_status load_geometry(fcm_ctx *ctx, const char *spec, int fill_holes, double max_volume,
+                                fcm_geometry **g)
 {
   double v[8];
   int n = 0;
@@ -220,19 +260,25 @@ static fcm_status load_geometry(fcm_ctx *ctx, const char *spec, fcm_geometry **g
     return FCM_ERR_ARG;
   }
   size_t len = strlen(spec);
-  if (len > 5 && !strcmp(spec + len - 5, ".node")) {
-    char ele[4096];
-    snprintf(ele, sizeof ele, "%.*s.ele", (int)(len - 5), spec);
-    return fcm_geometry_create_from_tetgen(ctx, spec, ele, g);
+  if (has_ext(spec, ".node") || has_ext(spec, ".ele")) { /* TetGen: base.node + base.ele */
+    char node[4096], ele[4096];
+    int base = (int)(len - (has_ext(spec, ".node") ? 5 : 4));
+    snprintf(node, sizeof node, "%.*s.node", base, spec);
+    snprintf(ele, sizeof ele, "%.*s.ele", base, spec);
+    return fcm_geometry_create_from_tetgen(ctx, node, ele, g);
   }
+  if (has_ext(spec, ".obj") || has_ext(spec, ".off") || has_ext(spec, ".stl") ||
+      has_ext(spec, ".ply"))
+    return load_surface(ctx, spec, fill_holes, max_volume, g);
   return fcm_geometry_create_from_gmsh(ctx, spec, g);
 }
 
 int fcm_quadrature_cmd_embed(int argc, char **argv)
 {
   fcm_element_type type = FCM_ELEMENT_COUNT;
-  double box[6] = {0, 0, 0, 0, 0, 0}, alpha = 1e-6, phimin = 1e-4;
+  double box[6] = {0, 0, 0, 0, 0, 0}, alpha = 1e-6, phimin = 1e-4, max_volume = 0.0;
   int cells[3] = {0, 0, 0}, strength = 0, mstrength = 0, no_simplify = 0, have_box = 0, rc = 1;
+  int fill_holes = 0;
   const char *geometry = NULL, *dump = NULL;
   const cli_option opts[] = {
       {"--element", NULL, CLI_CUSTOM, &type, "E", "background element: tet4, tet10, hex8, hex20", 0,
@@ -242,10 +288,17 @@ int fcm_quadrature_cmd_embed(int argc, char **argv)
       {"--cells", NULL, CLI_INT, cells, "NX NY NZ", "background cells per direction, 1..100000", 1,
        100000, 0, NULL, NULL, NULL},
       {"--geometry", NULL, CLI_STRING, &geometry, "FILE|SHAPE",
-       "Gmsh .msh (tetrahedra), or TetGen FILE.node (with\n"
-       "FILE.ele), or a shape: ball:CX,CY,CZ,R,N |\n"
+       "by extension: Gmsh .msh (tetrahedra), TetGen\n"
+       "FILE.node / FILE.ele (both read), a closed triangle\n"
+       "surface .obj, .off, .stl, .ply (tetrahedralized\n"
+       "with Gmsh); or a shape: ball:CX,CY,CZ,R,N |\n"
        "hemisphere:CX,CY,CZ,R,N | box:X0,Y0,Z0,X1,Y1,Z1,N",
        0, 0, 0, NULL, NULL, NULL},
+      {"--fill-holes", NULL, CLI_FLAG, &fill_holes, NULL,
+       "surfaces: close holes before tetrahedralizing", 0, 0, 0, NULL, NULL, NULL},
+      {"--max-volume", NULL, CLI_DOUBLE, &max_volume, "V",
+       "surfaces: largest tet volume wanted (default 0:\nsizes follow the surface)", 0, 1e300, 0,
+       NULL, NULL, NULL},
       {"--strength", NULL, CLI_INT, &strength, "M", "stiffness rule strength 1..20", 1, 20, 0, NULL,
        NULL, NULL},
       {"--mass-strength", NULL, CLI_INT, &mstrength, "M",
@@ -295,7 +348,7 @@ int fcm_quadrature_cmd_embed(int argc, char **argv)
     fcm_ctx_error_view(ctx, stderr);
     goto done;
   }
-  fcm_status st = load_geometry(ctx, geometry, &geom);
+  fcm_status st = load_geometry(ctx, geometry, fill_holes, max_volume, &geom);
   if (st != FCM_OK) {
     if (fcm_ctx_error_status(ctx) != FCM_OK)
       fcm_ctx_error_view(ctx, stderr);

@@ -1,7 +1,8 @@
 /* fcm-quadrature end to end: `accuracy` writes the documented CSV with errors
  * <= 1e-12 and simplified counts <= M for every strength; `embed --dump` writes
- * one line per point whose physical weights add up to the embedded volume;
- * bad options exit with status 2 and write nothing.
+ * one line per point whose physical weights add up to the embedded volume, for a
+ * procedural ball and for an open cube surface (OFF) tetrahedralized with --fill-holes;
+ * bad options and an open surface without --fill-holes exit with status 2 and write nothing.
  * Usage: app_quadrature PATH_TO_fcm-quadrature WORK_DIR */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
@@ -12,7 +13,7 @@
 int main(int argc, char **argv)
 {
   if (argc != 3) return 2;
-  char cmd[8192], csv[4096], dump[4096];
+  char cmd[16384], csv[4096], dump[4096];
   snprintf(csv, sizeof csv, "%s/accuracy.csv", argv[2]);
   snprintf(dump, sizeof dump, "%s/points.txt", argv[2]);
   remove(csv);
@@ -81,6 +82,54 @@ int main(int argc, char **argv)
   }
   fcm_geometry_destroy(&ball);
   fcm_ctx_destroy(&ctx);
+
+  /* embed a triangle surface by extension: the cube [-0.5, 0.5]^3 without its top face as
+   * OFF; refused open (exit 2, no dump), embedded with --fill-holes (weights add up to 1) */
+  {
+    char off[4096];
+    snprintf(off, sizeof off, "%s/open_cube.off", argv[2]);
+    FILE *o = fopen(off, "w");
+    TEST_TRUE(o != NULL);
+    if (o) {
+      fputs("OFF\n8 10 0\n-0.5 -0.5 -0.5\n0.5 -0.5 -0.5\n0.5 0.5 -0.5\n-0.5 0.5 -0.5\n"
+            "-0.5 -0.5 0.5\n0.5 -0.5 0.5\n0.5 0.5 0.5\n-0.5 0.5 0.5\n"
+            "3 0 2 1\n3 0 3 2\n3 0 1 5\n3 0 5 4\n3 3 7 6\n3 3 6 2\n3 0 4 7\n3 0 7 3\n"
+            "3 1 2 6\n3 1 6 5\n",
+            o);
+      fclose(o);
+    }
+    remove(dump);
+    snprintf(cmd, sizeof cmd,
+             "'%s' embed --element hex8 --box -1 -1 -1 1 1 1 --cells 3 3 3 --geometry '%s' "
+             "--strength 2 --stabilization 0 --min-fraction 0 --dump '%s' > /dev/null 2>&1",
+             argv[1], off, dump);
+    TEST_TRUE(app_run(cmd) == 2);
+    TEST_TRUE(fopen(dump, "r") == NULL);
+    if (fcm_surface_meshing_available()) {
+      snprintf(cmd, sizeof cmd,
+               "'%s' embed --element hex8 --box -1 -1 -1 1 1 1 --cells 3 3 3 --geometry '%s' "
+               "--fill-holes --strength 2 --stabilization 0 --min-fraction 0 --dump '%s' "
+               "> /dev/null 2>&1",
+               argv[1], off, dump);
+      TEST_TRUE(app_run(cmd) == 0);
+      f = fopen(dump, "r");
+      TEST_TRUE(f != NULL);
+      double sum = 0.0;
+      char line[1024];
+      while (f && fgets(line, sizeof line, f)) {
+        long cell;
+        double xi[3], X[3], wr, wp;
+        int flag;
+        if (line[0] != '#' && sscanf(line, "%ld %lf %lf %lf %lf %lf %lf %lf %lf %d", &cell, xi,
+                                     xi + 1, xi + 2, X, X + 1, X + 2, &wr, &wp, &flag) == 10)
+          sum += wp;
+      }
+      if (f) fclose(f);
+      TEST_NEAR(sum, 1.0, 1e-12, 0.0);
+    }
+    remove(off);
+    remove(dump);
+  }
 
   /* bad input: exit 2, no output file */
   remove(csv);

@@ -27,9 +27,14 @@ fcm_add_test(app_sim_default tests/apps/sim_app.c LABELS app slow TIMEOUT 1200
              ARGS default $<TARGET_FILE:fcm-sim> ${work})
 # Every example scene with --check: at most 3 steps, finite state, the run summary. The
 # twisting cylinder is the built-in scene (byte for byte, see scene_default) that
-# app_sim_default_quick already runs, so its --check is labelled slow.
-foreach(scene spinning_body slingshot hollow_ball static_beam cantilever twisting_cylinder
-        voxel_block gyroid_lattice)
+# app_sim_default_quick already runs, so its --check is labelled slow. surface_drop embeds an
+# OBJ surface, tetrahedralized with Gmsh: only when fcm was built with it.
+set(fcm_check_scenes spinning_body slingshot hollow_ball static_beam cantilever twisting_cylinder
+    voxel_block gyroid_lattice)
+if(FCM_HAVE_GMSH)
+  list(APPEND fcm_check_scenes surface_drop)
+endif()
+foreach(scene IN LISTS fcm_check_scenes)
   set(labels app)
   if(scene STREQUAL "twisting_cylinder")
     set(labels app slow)

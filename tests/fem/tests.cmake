@@ -24,3 +24,8 @@ endforeach()
 foreach(el tet4 tet10 hex8 hex20)
   fcm_add_test(fem_space_eval_${el} tests/fem/space_eval.c ARGS ${el})
 endforeach()
+# Generalized enrichment after cuts: rigid modes of the separated bodies, mass, gravity.
+foreach(el tet4 tet10 hex8 hex20)
+  fcm_add_test(fem_xfem_${el} tests/fem/xfem.c ARGS ${el})
+endforeach()
+fcm_add_test(fem_xfem_dice tests/fem/xfem.c ARGS dice)

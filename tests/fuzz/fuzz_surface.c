@@ -1,6 +1,7 @@
 /* libFuzzer target: the triangle surface readers (fcm_surface_create_from_file). The first
  * byte of the input picks the format (its value mod 4: obj, off, stl, ply), the rest is the
- * file; a successful read is checked for ids in range and finite coordinates. */
+ * file; a successful read is checked for ids in range and finite coordinates, then run
+ * through the checks (fcm_surface_check), reorientation and hole filling. */
 #include "fuzz_util.h"
 
 #include <math.h>
@@ -24,6 +25,23 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
       if (!isfinite(x[i])) abort();
     for (fcm_index i = 0; i < 3 * nt; i++)
       if (t[i] < 0 || t[i] >= nv) abort();
+    fcm_surface_report r;
+    fcm_surface *o = NULL, *f = NULL;
+    fcm_surface_fill_info fi;
+    st = fcm_surface_check(s, NULL, &r);
+    fuzz_check_status(ctx, st);
+    if (st == FCM_OK && (r.num_boundary_edges < 0 || r.num_degenerate < 0 ||
+                         r.num_boundary_loops > r.num_boundary_edges))
+      abort();
+    st = fcm_surface_create_oriented(ctx, s, &o, NULL);
+    fuzz_check_status(ctx, st);
+    if (st == FCM_OK && fcm_surface_num_triangles(o) != nt) abort();
+    st = fcm_surface_create_filled(ctx, s, NULL, &f, &fi);
+    fuzz_check_status(ctx, st);
+    if (st == FCM_OK && (fi.num_filled > fi.num_loops || fcm_surface_num_triangles(f) < nt))
+      abort();
+    fcm_surface_destroy(&o);
+    fcm_surface_destroy(&f);
   }
   fcm_surface_destroy(&s);
   fuzz_check_no_live(ctx, live);

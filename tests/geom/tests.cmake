@@ -21,3 +21,10 @@ fcm_add_test(geom_porous_block_image apps/scenes/porous_block.c
              ARGS --check ${PROJECT_SOURCE_DIR}/apps/scenes/porous_block.nrrd)
 # Allocation failures of the voxel-image readers, voxel merging and level-set marching.
 fcm_add_test(geom_voxel_alloc_failure tests/geom/voxel_alloc.c)
+# Surface checks (boundary, non-manifold and inconsistent edges, inward orientation,
+# degenerate triangles, self-intersections), hole filling, and tetrahedralization through
+# Gmsh: the tets' volume equals the enclosed volume to 1e-12 (cube, icosphere, filled
+# open cube and holed sphere); without Gmsh the refusal message.
+fcm_add_test(geom_surface_mesh tests/geom/surface_mesh.c)
+# Allocation failures in the surface checks, reorientation, hole filling and meshing.
+fcm_add_test(geom_surface_alloc tests/geom/surface_alloc.c)

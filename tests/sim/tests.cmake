@@ -42,3 +42,7 @@ foreach(solver direct minres-schwarz cg-jacobi cg-block)
 endforeach()
 fcm_sim_test(sim_step_alloc_direct_tet10 tests/sim/step_alloc.c ARGS direct tet10)
 fcm_sim_test(sim_step_alloc_static tests/sim/step_alloc.c ARGS minres-schwarz hex8 static)
+# Cutting between steps (host calls): mass and momenta unchanged at the cut, the halves separate.
+foreach(el tet4 tet10 hex8 hex20)
+  fcm_sim_test(sim_cut_${el} tests/sim/cut.c ARGS ${el})
+endforeach()

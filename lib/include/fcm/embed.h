@@ -129,17 +129,17 @@ typedef struct fcm_simplify_decision {
  * threads (seconds of one core). */
 typedef struct fcm_cell_rules_stats {
   fcm_index num_cells, num_uncut, num_cut, num_dropped;
-  fcm_index num_candidates; /**< (background cell, embedded cell) pairs from the tree */
-  fcm_index num_parts;      /**< non-empty clipped polyhedra (convex parts) */
+  fcm_index num_candidates;      /**< (background cell, embedded cell) pairs from the tree */
+  fcm_index num_parts;           /**< non-empty clipped polyhedra (convex parts) */
   fcm_index num_material_pieces; /**< material pieces (fcm_cell_rules_num_pieces()) */
-  fcm_index num_split;      /**< cells that cuts split into two or more pieces */
-  fcm_index num_links;      /**< fcm_cell_rules_num_links() */
-  fcm_index num_integrated; /**< cells whose rules this call built: every cell for
-                                 fcm_cell_rules_create(), the cells the new cut reaches for
-                                 fcm_cell_rules_create_cut() (the others are copied) */
-  fcm_index num_tets;       /**< tets of the pieces kept (slivers excluded) */
-  fcm_index num_slivers;    /**< tets dropped as slivers */
-  double sliver_volume;     /**< their summed volume (not in embedded_volume) */
+  fcm_index num_split;           /**< cells that cuts split into two or more pieces */
+  fcm_index num_links;           /**< fcm_cell_rules_num_links() */
+  fcm_index num_integrated;      /**< cells whose rules this call built: every cell for
+                                      fcm_cell_rules_create(), the cells the new cut reaches for
+                                      fcm_cell_rules_create_cut() (the others are copied) */
+  fcm_index num_tets;            /**< tets of the pieces kept (slivers excluded) */
+  fcm_index num_slivers;         /**< tets dropped as slivers */
+  double sliver_volume;          /**< their summed volume (not in embedded_volume) */
   fcm_index points_initial[FCM_RULE_KIND_COUNT];    /**< before simplification */
   fcm_index points_simplified[FCM_RULE_KIND_COUNT]; /**< after (= initial when off) */
   fcm_index points_stabilization[FCM_RULE_KIND_COUNT];
@@ -212,12 +212,12 @@ FCM_API double fcm_cell_rules_volume_fraction(const fcm_cell_rules *rules, fcm_i
 
 /** The volume rule of `kind` for `cell`: for a cell that cuts split into several material
  * pieces, the concatenation of its pieces' rules (each with its own stabilization points;
- * fcm_cell_rules_get_piece() gives them one by one). num_points, reference points (n x 3), weights (n,
- * including |J_Q|/|J_K|; stabilization points have alpha times the standard weight) and
- * flags (n; 0 authentic, 1 fictitious stabilization point). Uncut cells share one catalogue
- * rule; dropped cells have 0 points (pointers then NULL). Any output may be NULL.
- * Pointers stay valid for the life of `rules`. @return FCM_OK or FCM_ERR_ARG (cell or kind
- * out of range). No allocation; thread safe. */
+ * fcm_cell_rules_get_piece() gives them one by one). num_points, reference points (n x 3), weights
+ * (n, including |J_Q|/|J_K|; stabilization points have alpha times the standard weight) and flags
+ * (n; 0 authentic, 1 fictitious stabilization point). Uncut cells share one catalogue rule; dropped
+ * cells have 0 points (pointers then NULL). Any output may be NULL. Pointers stay valid for the
+ * life of `rules`. @return FCM_OK or FCM_ERR_ARG (cell or kind out of range). No allocation; thread
+ * safe. */
 FCM_API fcm_status fcm_cell_rules_get(const fcm_cell_rules *rules, fcm_index cell,
                                       fcm_rule_kind kind, int *num_points, const double **points,
                                       const double **weights, const unsigned char **flags);
@@ -252,9 +252,8 @@ FCM_API fcm_status fcm_cell_rules_get_surface(const fcm_cell_rules *rules, fcm_i
  * @return FCM_OK; FCM_ERR_ARG (NULL, another mesh); FCM_ERR_INTERNAL (a split exceeding
  *         the polyhedron capacity); the errors of fcm_cell_rules_create(). Allocates. */
 FCM_API fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh,
-                                             const fcm_geometry *geom,
-                                             const fcm_cell_rules *prev, const fcm_surface *cut,
-                                             fcm_cell_rules **rules);
+                                             const fcm_geometry *geom, const fcm_cell_rules *prev,
+                                             const fcm_surface *cut, fcm_cell_rules **rules);
 
 /** Number of cuts added so far (fcm_cell_rules_create_cut() calls). */
 FCM_API int fcm_cell_rules_num_cuts(const fcm_cell_rules *rules);
@@ -287,9 +286,16 @@ FCM_API fcm_status fcm_cell_rules_get_piece(const fcm_cell_rules *rules, fcm_ind
  * @return FCM_OK or FCM_ERR_ARG. */
 FCM_API fcm_status fcm_cell_rules_get_piece_surface(const fcm_cell_rules *rules, fcm_index piece,
                                                     int *num_points, const double **points,
-                                                    const double **weights,
-                                                    const double **normals,
+                                                    const double **weights, const double **normals,
                                                     const fcm_index **triangles);
+
+/** The piece of the rules this object extended (the `prev` of fcm_cell_rules_create_cut())
+ * that holds `piece` (pieces only ever split: every piece lies in one earlier piece of the
+ * same cell); -1 for rules from fcm_cell_rules_create() or out of range. With
+ * fcm_cell_rules_parent_num_pieces() (0 without a parent) this is what
+ * fcm_space_transfer() maps fields through. */
+FCM_API fcm_index fcm_cell_rules_piece_parent(const fcm_cell_rules *rules, fcm_index piece);
+FCM_API fcm_index fcm_cell_rules_parent_num_pieces(const fcm_cell_rules *rules);
 
 /** Links between pieces of face-neighbouring cells near the cuts: pairs (p, q), p < q, of
  * pieces that share a part of the cells' common face with positive area not lying on a

@@ -21,7 +21,17 @@ extern "C" {
 
 /** A vector-valued (3 components) Lagrange space on the active cells of a mesh.
  * DOF numbering: node n (if active) owns DOFs 3k, 3k+1, 3k+2 with k its rank
- * among the active nodes (ascending node id), components x, y, z. */
+ * among the active nodes (ascending node id), components x, y, z.
+ *
+ * With cuts (fcm_cell_rules_create_cut()), the space is enriched (generalized XFEM, DESIGN
+ * §9; Ton-That et al. 2024): its *elements* are the material pieces of the active cells,
+ * and the pieces incident to a node (its support) are grouped into connected components
+ * along the links of the rules; each component gets its own copy of the node's three DOFs,
+ * i.e. the node's shape function times the component's indicator function. A node whose
+ * support is not separated keeps one copy; a piece that touches no node still moves with
+ * the copies of its cell's nodes. A node's copies have consecutive DOFs, numbered node by
+ * node (ascending node id), components of a node by their first element; without cuts
+ * there is one element per active cell and one copy per active node, as above. */
 typedef struct fcm_space fcm_space;
 
 /** Create the space on `mesh` and build the matrix pattern, the per-cell
@@ -58,10 +68,43 @@ FCM_API void fcm_space_destroy(fcm_space **space);
 FCM_API fcm_index fcm_space_num_dofs(const fcm_space *space);
 /** First DOF of a node (its x component), or -1 for an inactive or out-of-range node. */
 FCM_API fcm_index fcm_space_node_dof(const fcm_space *space, fcm_index node);
+/** Number of copies of `node` (0: inactive or out of range; 1 unless cuts separate its
+ * support); their DOFs start at fcm_space_node_dof() and are consecutive. */
+FCM_API fcm_index fcm_space_node_copies(const fcm_space *space, fcm_index node);
+/** Number of elements: one per active cell, or per material piece where cuts split cells. */
+FCM_API fcm_index fcm_space_num_elements(const fcm_space *space);
+/** Number of elements of `cell` (0 inactive) and, in *first (may be NULL), the first one. */
+FCM_API fcm_index fcm_space_cell_elements(const fcm_space *space, fcm_index cell, fcm_index *first);
+/** The cell of element `elem` (-1 out of range). Element k of a cell integrates with the
+ * rules of the cell's piece k (fcm_cell_rules_get_piece()). */
+FCM_API fcm_index fcm_space_element_cell(const fcm_space *space, fcm_index elem);
+/** The first DOF at each of the element's nodes_per_cell nodes (cell node order): the copy
+ * the element uses; NULL out of range. Pointer into the space. */
+FCM_API const fcm_index *fcm_space_element_dofs(const fcm_space *space, fcm_index elem);
 /** Number of colours of the assembly colouring. */
 FCM_API int fcm_space_num_colors(const fcm_space *space);
 /** The mesh the space was built on. */
 FCM_API const fcm_mesh *fcm_space_mesh(const fcm_space *space);
+
+/** Carry a field (displacement, velocity: num_dofs of `from`) over a cut: `to` must be the
+ * space of rules that extend the rules of `from` by one cut (fcm_cell_rules_create_cut()).
+ * Every copy of `to` takes the value of the copy of `from` whose support component holds
+ * its own, so the field is unchanged at every point of the body: mass, linear and angular
+ * momentum are preserved up to rounding. @param[out] x_to num_dofs of `to`.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, other mesh, unrelated rules). No allocation. */
+FCM_API fcm_status fcm_space_transfer(const fcm_space *from, const fcm_space *to,
+                                      const double *x_from, double *x_to);
+
+/** Mass, linear momentum and angular momentum (about the origin) of the body, integrated
+ * over the authentic quadrature points of the mass rules (the fictitious stabilization
+ * points are not the body): m = int rho, p = int rho v, L = int rho x cross v with
+ * x = X + u. Exact for the polynomial fields of the space where the mass rules are (cut
+ * cells: rules of the mass strength), so a cut, which leaves the field unchanged, leaves
+ * all three unchanged up to rounding. u and v (num_dofs) may be NULL (zero); outputs may
+ * be NULL. @return FCM_OK, FCM_ERR_ARG (NULL space, density < 0), FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_space_momentum(const fcm_space *space, double density, const double *u,
+                                      const double *v, double *mass, double linear[3],
+                                      double angular[3]);
 
 /** Create a symmetric CSR matrix with the space's pattern and zero values.
  * @return FCM_OK, FCM_ERR_ALLOC. Release with fcm_csr_destroy(). */
@@ -90,12 +133,13 @@ typedef enum fcm_fictitious_model {
 /** DOF blocks of flagged cells, e.g. the blocks of an additive Schwarz preconditioner
  * (fcm_schwarz_create() of fcm/solve.h; the paper's choice: the cut cells with volume
  * fraction below theta = 0.5). Block k holds the 3 x nodes_per_cell DOFs of the k-th
- * flagged cell in ascending cell order: node order of the cell, components x, y, z
- * (fcm_space_node_dof()). Call once with block_ptr and block_dofs NULL for the counts,
+ * element of the flagged cells in ascending element order (one per cell, or one per piece
+ * of a cell that cuts split): node order of the cell, components x, y, z
+ * (fcm_space_element_dofs()). Call once with block_ptr and block_dofs NULL for the counts,
  * then with buffers of *num_blocks + 1 and *num_dofs entries.
  * @param[in]  space      the space
  * @param[in]  cell_flag  num_cells flags (nonzero: a block); flagged cells must be active
- * @param[out] num_blocks the number of flagged cells
+ * @param[out] num_blocks the number of elements of the flagged cells
  * @param[out] num_dofs   the total block size, num_blocks x 3 x nodes_per_cell
  * @param[out] block_ptr  NULL, or num_blocks + 1 offsets into block_dofs (block_ptr[0] = 0)
  * @param[out] block_dofs NULL, or num_dofs DOFs (both NULL or both given)
@@ -261,9 +305,27 @@ FCM_API fcm_status fcm_space_apply_dirichlet(const fcm_space *space, fcm_index n
                                              fcm_csr *A, double *b);
 
 /** Interpolate a displacement field given per DOF at reference point `xi` of
- * `cell`: u = sum_a N_a(xi) u_a (inactive cells: FCM_ERR_ARG). No allocation. */
+ * `cell`: u = sum_a N_a(xi) u_a (inactive cells and cells split into several pieces:
+ * FCM_ERR_ARG; use fcm_space_element_eval()). No allocation. */
 FCM_API fcm_status fcm_space_eval(const fcm_space *space, fcm_index cell, const double xi[3],
                                   const double *u, double value[3]);
+
+/** The element of `cell` that a point at reference coordinates xi belongs to: the cell's
+ * element when it has one; in a cell that cuts split, the piece with the nearest authentic
+ * quadrature point (exact away from the cut faces, a guess within a point spacing of them:
+ * for display, e.g. of surface vertices). -1 for a cell out of range or without elements.
+ * No allocation; thread safe. */
+FCM_API fcm_index fcm_space_point_element(const fcm_space *space, fcm_index cell,
+                                          const double xi[3]);
+
+/** Number of separate bodies: connected components of the elements, two elements being
+ * connected when they share a DOF copy (a node whose support component holds both). One
+ * for an uncut body; -1 when the scratch cannot be allocated. Allocates (and frees). */
+FCM_API fcm_index fcm_space_num_bodies(const fcm_space *space);
+
+/** As fcm_space_eval() on element `elem` (its copies). @return FCM_OK, FCM_ERR_ARG. */
+FCM_API fcm_status fcm_space_element_eval(const fcm_space *space, fcm_index elem,
+                                          const double xi[3], const double *u, double value[3]);
 
 /** Locate physical points: for each X[i] the lowest-numbered active cell containing it
  * (tolerance 1e-10 in reference coordinates) and its reference coordinates xi. A point in

@@ -19,6 +19,7 @@
 #include "fcm/sim.h"
 #include "fcm/simplify.h"
 #include "fcm/solve.h"
+#include "fcm/surface.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -40,6 +41,11 @@ typedef struct fcm_scene_background {
   fcm_index cells[3];       /**< GRID: cells per axis, >= 1 */
   const char *mesh;         /**< MESH: the file, resolved against the scene file's directory;
                                  GRID: NULL */
+  int fit;                  /**< GRID with "fit_background": 1, min, max and cells are then
+                                 set when the simulation is built, from the geometry's box */
+  double fit_cell_size;     /**< fit: edge of the (cubic) cells, > 0 */
+  double fit_margin;        /**< fit: gap between the body's box and the grid's, >= 0 (default:
+                                 one cell) */
 } fcm_scene_background;
 
 /** What the embedded geometry is. */
@@ -52,6 +58,7 @@ typedef enum fcm_scene_geometry_kind {
   FCM_SCENE_GEOMETRY_TUBE,        /**< fcm_geometry_create_tube() */
   FCM_SCENE_GEOMETRY_GMSH,        /**< fcm_geometry_create_from_gmsh() */
   FCM_SCENE_GEOMETRY_TETGEN,      /**< fcm_geometry_create_from_tetgen() */
+  FCM_SCENE_GEOMETRY_SURFACE, /**< a triangle surface file, fcm_geometry_create_from_surface() */
   FCM_SCENE_GEOMETRY_VOXELS,      /**< fcm_geometry_create_from_voxels() of an image file */
   FCM_SCENE_GEOMETRY_LEVEL_SET,   /**< fcm_geometry_create_from_level_set() of built-in
                                        implicits (fcm/levelset.h) */
@@ -72,11 +79,15 @@ typedef struct fcm_scene_geometry {
   int resolution; /**< BALL, HEMISPHERE: cubes per radius; HOLLOW_BALL: quads per patch edge */
   int layers;     /**< HOLLOW_BALL: radial layers */
   int radial_cells, angular_cells, axial_cells; /**< TUBE */
-  const char *mesh;    /**< GMSH: the .msh file; TETGEN: the .node file (resolved paths) */
+  const char *mesh;    /**< GMSH: the .msh file; TETGEN: the .node file; SURFACE: the .obj,
+                            .off, .stl or .ply file (resolved paths) */
   const char *ele;     /**< TETGEN: the .ele file */
   int has_transform;   /**< 1: map the created geometry by x -> A x + b */
   double transform[9]; /**< A, row-major: rotation times scale (identity when none) */
   double offset[3];    /**< b */
+  fcm_surface_mesh_options surface; /**< SURFACE: tetrahedralization options */
+  int fill_holes;                   /**< SURFACE: 1: close holes first */
+  fcm_surface_fill_options fill;    /**< SURFACE: which holes fill_holes closes */
   const char *image;    /**< VOXELS: the image file (.nrrd, .nhdr, .mhd, .mha; resolved path) */
   double threshold;     /**< VOXELS: voxels with value >= threshold are the body (default 0.5) */
   const double *labels; /**< VOXELS: label set replacing the threshold (NULL: none) */
@@ -194,6 +205,7 @@ typedef enum fcm_effect_type {
   FCM_EFFECT_DAMPING,          /**< "damping": Rayleigh D = mass M + stiffness K */
   FCM_EFFECT_TRACTION,         /**< "traction": force per area on the embedded boundary */
   FCM_EFFECT_PRESSURE,         /**< "pressure": p along the inward normal of the boundary */
+  FCM_EFFECT_CUT,              /**< "cut": a cut surface inserted at a time (XFEM) */
   FCM_EFFECT_TYPE_COUNT
 } fcm_effect_type;
 
@@ -251,6 +263,33 @@ typedef struct fcm_effect_pressure {
   double start, end; /**< s; default 0 and HUGE_VAL */
 } fcm_effect_pressure;
 
+/** The forms of a cut surface (in the reference coordinates of the geometry). */
+typedef enum fcm_cut_kind {
+  FCM_CUT_PLANE = 0, /**< "plane": {"point", "normal"}: clipped to the body's bounding box
+                          enlarged by 10 % (fcm_surface_create_plane()) */
+  FCM_CUT_RECTANGLE, /**< "rectangle": {"center", "normal", "axis", "size": [a, b]} */
+  FCM_CUT_DISC,      /**< "disc": {"center", "normal", "radius", "segments" (default 64)} */
+  FCM_CUT_MESH       /**< "mesh": "FILE" (OBJ, OFF, STL, PLY; fcm_surface_create_from_file()) */
+} fcm_cut_kind;
+
+/** A cut at `time`: before the first step that starts at or after it (time 0: before the
+ * run), the surface is added to the cell rules (fcm_cell_rules_create_cut()) and the run
+ * continues on the enriched space (fcm_integrator_create_cut()). Every form takes an
+ * optional "transform" (scale, rotation, translation) as the geometry does. */
+typedef struct fcm_effect_cut {
+  double time; /**< s, in [0, duration] (default 0) */
+  fcm_cut_kind kind;
+  double point[3];  /**< PLANE: a point; RECTANGLE, DISC: the centre */
+  double normal[3]; /**< unit (normalized by the parser) */
+  double axis[3];   /**< RECTANGLE: the direction of the first side */
+  double size[2];   /**< RECTANGLE: side lengths, > 0 */
+  double radius;    /**< DISC, > 0 */
+  int segments;     /**< DISC: triangles, [3, 256], default 64 */
+  const char *mesh; /**< MESH: resolved path */
+  int has_transform;
+  double transform[9], offset[3]; /**< x -> transform x + offset (identity when none) */
+} fcm_effect_cut;
+
 /** One effect of the scene: a tagged union. */
 typedef struct fcm_effect {
   fcm_effect_type type; /**< selects the member */
@@ -263,6 +302,7 @@ typedef struct fcm_effect {
     fcm_effect_damping damping;
     fcm_effect_traction traction;
     fcm_effect_pressure pressure;
+    fcm_effect_cut cut;
   };
 } fcm_effect;
 

@@ -227,6 +227,20 @@ FCM_API fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space,
                                          fcm_integrator **integ);
 
 /** Destroy; accepts NULL and `*integ == NULL`, sets `*integ = NULL`. */
+/** Continue a run across a cut (DESIGN §9). `space` is the embedded space of rules that
+ * extend the rules of old's space by one cut (fcm_cell_rules_create_cut(), then
+ * fcm_space_create_embedded()). The new integrator has old's material, options, loads and
+ * constraints (same callbacks and user pointers, node lists copied), is set up (mass and
+ * loads assembled on the new space; the direct solver analyses the new pattern once, at the
+ * first solve), and starts from old's time, step count, displacement and velocity carried
+ * over by fcm_space_transfer(): every new DOF copy inherits its parent copy's values, so
+ * the field, the mass and the linear and angular momentum are unchanged by the cut. A host
+ * simulator calls it between steps and then destroys `old` (and old's space and rules).
+ * @return FCM_OK; FCM_ERR_ARG (NULL, old not set up, unrelated space); the errors of
+ *         fcm_integrator_setup(); FCM_ERR_ALLOC. Allocates. */
+FCM_API fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space *space,
+                                             fcm_integrator **integ);
+
 FCM_API void fcm_integrator_destroy(fcm_integrator **integ);
 
 /** Add gravity: body force rho a, times scale(t) when `scale` is given (else 1). Before

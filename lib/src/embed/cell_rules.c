@@ -83,6 +83,7 @@ typedef struct piece_out {
   unsigned char skipped[FCM_RULE_KIND_COUNT], fallback[FCM_RULE_KIND_COUNT];
   double residual[FCM_RULE_KIND_COUNT];
   double tsimp[FCM_RULE_KIND_COUNT]; /* fcm_simplify's time_total */
+  int parent; /* the piece of the same cell in the rules being extended that holds this one */
   int ns;
   double *spts, *sw, *snrm;
   fcm_index *stri;
@@ -96,7 +97,7 @@ typedef struct cell_out {
   piece_out one;
   piece_out *pc;
   double volume;
-  int nfp;     /* face polygons: meta (face, piece, vertices) x nfp, coordinates fx */
+  int nfp; /* face polygons: meta (face, piece, vertices) x nfp, coordinates fx */
   int *fmeta;
   double *fx;
 } cell_out;
@@ -119,6 +120,7 @@ typedef struct build {
   const fcm__cut_tri *cut_tris;
   unsigned char *region, *rebuild;
   const fcm_cell_rules *prev;
+  fcm_index first_new; /* cut triangles from here on are new (those of the cut being added) */
 } build;
 
 /* What one thread summed over the cells it built. */
@@ -374,10 +376,37 @@ cleanup:
   return st;
 }
 
+/* Renumber the labels (P->piece or P->parent, *count of them) so that labels whose parts
+ * keep no volume (all slivers) are removed: those parts get -1. vol (may be NULL) gets the
+ * volume of each remaining label. */
+static fcm_status drop_empty(const build *B, fcm__embed_ws *ws, int *label, int *count, double *vol,
+                             cell_sums *sums)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  fcm__parts *P = ws->parts;
+  int kept = 0, *renum = NULL;
+  FCM_ALLOC(ctx, (size_t)*count + 1, renum);
+  for (int i = 0; i < *count; i++) {
+    double v = 0.0;
+    FCM_TRY(ctx, fcm__embed_piece_tets(ctx, P, label, i, ws, sums ? &sums->counts : NULL, &v));
+    renum[i] = v > 0.0 ? kept : -1;
+    if (v > 0.0 && vol) vol[kept] = v;
+    if (v > 0.0) kept++;
+  }
+  for (size_t j = 0; j < P->n; j++)
+    label[j] = label[j] >= 0 ? renum[label[j]] : -1;
+  *count = kept;
+cleanup:
+  fcm__free(ctx, renum);
+  return st;
+}
+
 /* The convex parts and material pieces of a cell that cuts reach (or that lies next to
  * such a cell): parts, split, grouped; empty pieces (all slivers) are removed. On return
  * P->piece numbers the pieces with volume, -1 for parts of removed ones; vol[i] is the
- * volume of piece i (P->num_pieces of them). */
+ * volume of piece i (P->num_pieces of them); P->parent likewise numbers the pieces under
+ * the earlier cuts only (the pieces of the rules being extended). */
 static fcm_status cell_pieces(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
                               cell_sums *sums, double **vol)
 {
@@ -388,21 +417,10 @@ static fcm_status cell_pieces(const build *B, const fcm__embed_cell *cell, fcm__
   FCM_TRY(ctx, fcm__embed_cell_parts(ctx, B->geom, B->tree, cell, opt->clip_rtol, opt->sliver_rtol,
                                      ws, P, &sums->counts));
   FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, cell->lo, cell->hi, &P->tcand));
-  if (P->tcand.n > 0) FCM_TRY(ctx, fcm__embed_cell_pieces(ctx, cell, B->cut_tris, P));
+  if (P->tcand.n > 0) FCM_TRY(ctx, fcm__embed_cell_pieces(ctx, cell, B->cut_tris, B->first_new, P));
   FCM_ALLOC(ctx, (size_t)P->num_pieces + 1, *vol);
-  int kept = 0;
-  int *renum = NULL;
-  FCM_ALLOC(ctx, (size_t)P->num_pieces + 1, renum);
-  for (int i = 0; i < P->num_pieces; i++) {
-    double v = 0.0;
-    FCM_TRY(ctx, fcm__embed_piece_tets(ctx, P, i, ws, &sums->counts, &v));
-    renum[i] = v > 0.0 ? kept : -1;
-    if (v > 0.0) (*vol)[kept++] = v;
-  }
-  for (size_t j = 0; j < P->n; j++)
-    P->piece[j] = renum[P->piece[j]];
-  P->num_pieces = kept;
-  fcm__free(ctx, renum);
+  FCM_TRY(ctx, drop_empty(B, ws, P->piece, &P->num_pieces, *vol, sums));
+  if (B->prev) FCM_TRY(ctx, drop_empty(B, ws, P->parent, &P->num_parents, NULL, NULL));
 cleanup:
   return st;
 }
@@ -457,6 +475,20 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   o->volume = phi * cell.volume;
   FCM_TRY(ctx, cell_out_pieces(ctx, o, cls == FCM_CELL_DROPPED ? 0 : np));
   if (o->np == 1) o->pc[0].volume = o->volume;
+  for (int i = 0; i < o->np; i++) { /* the earlier piece that holds each piece */
+    o->pc[i].parent = i;
+    if (P && B->prev && integrate) {
+      size_t j = 0;
+      while (j < P->n && P->piece[j] != i)
+        j++;
+      o->pc[i].parent = j < P->n ? P->parent[j] : -1;
+      const fcm_index had = B->prev->piece_off[c + 1] - B->prev->piece_off[c];
+      FCM_CHECK(o->pc[i].parent >= 0 && o->pc[i].parent < had, ctx, FCM_ERR_INTERNAL,
+                "embed: piece %d of cell %lld lies in no piece of the rules being extended (%lld "
+                "pieces there)",
+                i, (long long)c, (long long)had);
+    }
+  }
   for (int i = 0; P && i < o->np && o->np > 1; i++)
     o->pc[i].volume = pvol[i];
   if (!integrate) {
@@ -466,15 +498,14 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
               "embed: cell %lld, which the new cut does not reach, now has %d pieces (class %d) "
               "instead of %lld (class %d)",
               (long long)c, o->np, (int)R->cls[c],
-              (long long)(B->prev->piece_off[c + 1] - B->prev->piece_off[c]),
-              (int)B->prev->cls[c]);
+              (long long)(B->prev->piece_off[c + 1] - B->prev->piece_off[c]), (int)B->prev->cls[c]);
     FCM_TRY(ctx, copy_cell(B, c, o));
     goto cleanup;
   }
   if (cls == FCM_CELL_CUT) {
     for (int i = 0; i < o->np; i++) {
       double v;
-      if (P) FCM_TRY(ctx, fcm__embed_piece_tets(ctx, P, i, ws, NULL, &v));
+      if (P) FCM_TRY(ctx, fcm__embed_piece_tets(ctx, P, P->piece, i, ws, NULL, &v));
       FCM_TRY(ctx, map_piece(B, R, &cell, ws, o->pc + i));
     }
   }
@@ -850,7 +881,8 @@ cleanup:
 }
 
 /* Phase 3: concatenate the pieces' volume and surface rules in cell order. */
-static fcm_status gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_out *out)
+static fcm_status gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_out *out,
+                               const fcm_cell_rules *prev)
 {
   fcm_status st = FCM_OK;
   const fcm_index nc = R->num_cells;
@@ -860,6 +892,7 @@ static fcm_status gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_out *
   R->num_pieces = np;
   FCM_ALLOC(ctx, (size_t)np + 1, R->piece_cell);
   FCM_ALLOC(ctx, (size_t)np + 1, R->piece_volume);
+  FCM_ALLOC(ctx, (size_t)np + 1, R->piece_parent);
   FCM_ALLOC(ctx, (size_t)np + 1, R->soff);
   R->piece_off[0] = 0;
   for (fcm_index c = 0; c < nc; c++) {
@@ -867,6 +900,7 @@ static fcm_status gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_out *
     for (int i = 0; i < out[c].np; i++) {
       R->piece_cell[R->piece_off[c] + i] = c;
       R->piece_volume[R->piece_off[c] + i] = out[c].pc[i].volume;
+      R->piece_parent[R->piece_off[c] + i] = prev ? prev->piece_off[c] + out[c].pc[i].parent : -1;
     }
   }
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
@@ -947,7 +981,8 @@ static fcm_status gather_links(const build *B, fcm_cell_rules *R, const cell_out
       const fcm_index c2 = nbr[(size_t)nf * c + f];
       if (c2 <= c || !B->region[c2] || out[c2].np == 0) continue;
       int f2 = 0;
-      while (f2 < nf && nbr[(size_t)nf * c2 + f2] != c) f2++;
+      while (f2 < nf && nbr[(size_t)nf * c2 + f2] != c)
+        f2++;
       if (f2 == nf) continue;
       const cell_out *ob = out + c2;
       const fcm_index pa0 = R->piece_off[c], pb0 = R->piece_off[c2];
@@ -1038,8 +1073,7 @@ static void gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const cell
     }
   }
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
-    S->points_total[k] =
-        R->off[k][R->num_pieces] + S->num_uncut * fcm_rule_num_points(R->uncut[k]);
+    S->points_total[k] = R->off[k][R->num_pieces] + S->num_uncut * fcm_rule_num_points(R->uncut[k]);
   S->surface_points = R->soff[R->num_pieces];
   S->num_material_pieces = R->num_pieces;
   S->num_links = R->num_links;
@@ -1078,6 +1112,7 @@ static fcm_status build_rules(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geom
   /* 1. set-up */
   FCM_TRY(ctx, build_setup(ctx, mesh, geom, o, R, &B));
   B.prev = prev;
+  B.first_new = first_new;
   if (R->num_cut_tris > 0) FCM_TRY(ctx, cut_setup(&B, R, first_new));
   FCM_ALLOC(ctx, (size_t)nc, out);
   const double t_setup = fcm_wtime();
@@ -1088,7 +1123,7 @@ static fcm_status build_rules(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geom
     FCM_TRY(ctx, auto_simplify(&B, R, nthreads, out, &sums));
   const double t_loop = fcm_wtime();
   /* 3. gather, 4. statistics */
-  FCM_TRY(ctx, gather_rules(ctx, R, out));
+  FCM_TRY(ctx, gather_rules(ctx, R, out, prev));
   if (B.cut_tree) FCM_TRY(ctx, gather_links(&B, R, out));
   gather_stats(R, geom, out, &sums, nthreads);
   FCM_TRY(ctx, fcm__embed_outside(ctx, mesh, geom, &R->stats));
@@ -1162,6 +1197,7 @@ fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const f
         fcm__embed_cut_tri_setup(x + 3 * tv[3 * t], x + 3 * tv[3 * t + 1], x + 3 * tv[3 * t + 2],
                                  prev->num_cuts, R->cut_tris + R->num_cut_tris);
   R->num_cuts = prev->num_cuts + 1;
+  R->prev_num_pieces = prev->num_pieces;
   FCM_TRY(ctx, build_rules(ctx, mesh, geom, prev, prev->num_cut_tris, R));
   *rules = R;
   R = NULL;
@@ -1188,6 +1224,7 @@ void fcm_cell_rules_destroy(fcm_cell_rules **rules)
   fcm__free(ctx, R->piece_off);
   fcm__free(ctx, R->piece_cell);
   fcm__free(ctx, R->piece_volume);
+  fcm__free(ctx, R->piece_parent);
   fcm__free(ctx, R->cut_tris);
   fcm__free(ctx, R->links);
   fcm__free(ctx, R->soff);
@@ -1371,6 +1408,17 @@ cleanup:
   if (normals) *normals = n ? rules->snormals + 3 * o0 : NULL;
   if (triangles) *triangles = n ? rules->stris + o0 : NULL;
   return st;
+}
+
+fcm_index fcm_cell_rules_piece_parent(const fcm_cell_rules *rules, fcm_index piece)
+{
+  if (!rules || piece < 0 || piece >= rules->num_pieces) return -1;
+  return rules->piece_parent[piece];
+}
+
+fcm_index fcm_cell_rules_parent_num_pieces(const fcm_cell_rules *rules)
+{
+  return rules ? rules->prev_num_pieces : 0;
 }
 
 fcm_index fcm_cell_rules_num_links(const fcm_cell_rules *rules)

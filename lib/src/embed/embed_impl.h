@@ -58,6 +58,10 @@ struct fcm_cell_rules {
   fcm__cut_tri *cut_tris;
   fcm_index num_links;
   fcm_index *links;
+  /* piece_parent[p]: the piece of the rules this object extends that holds piece p (-1
+   * for rules made by fcm_cell_rules_create()); prev_num_pieces: how many that object had */
+  fcm_index *piece_parent;
+  fcm_index prev_num_pieces;
   fcm_cell_rules_stats stats;
 };
 
@@ -121,9 +125,9 @@ fcm_status fcm__embed_cell_tets(fcm_ctx *ctx, const fcm_geometry *geom, const fc
 
 /* Clip embedded cell e by the planes of `cell` into ws->poly (empty: nf == 0); *tol and
  * *vmin are the vertex-on-plane tolerance and the sliver volume for it (see above). */
-fcm_status fcm__embed_clip_cell(fcm_ctx *ctx, const fcm_geometry *geom,
-                                const fcm__embed_cell *cell, fcm_index e, double clip_rtol,
-                                double sliver_rtol, fcm__embed_ws *ws, double *tol, double *vmin);
+fcm_status fcm__embed_clip_cell(fcm_ctx *ctx, const fcm_geometry *geom, const fcm__embed_cell *cell,
+                                fcm_index e, double clip_rtol, double sliver_rtol,
+                                fcm__embed_ws *ws, double *tol, double *vmin);
 
 /* Fan-tetrahedralize p and append the tets with volume > vmin to ws->tets / ws->vol; the
  * kept volume is added to *vsum, dropped slivers to *lost and *nslivers. */
@@ -162,6 +166,8 @@ typedef struct fcm__parts {
   fcm__poly *poly;
   double *tol, *vmin; /* per part: clip tolerance and sliver volume of its embedded cell */
   int *piece;         /* per part: material piece, 0 .. num_pieces-1 (fcm__embed_pieces) */
+  int *parent;        /* per part: its piece under the triangles before first_new only */
+  int num_parents;
   size_t n, cap;
   int num_pieces;
   fcm__poly w[3], scratch; /* splitting workspace */
@@ -187,14 +193,18 @@ fcm_status fcm__embed_cell_parts(fcm_ctx *ctx, const fcm_geometry *geom, const f
 /* Split the parts by the planes and edge planes of the cut triangles tris[P->tcand] that
  * reach them, then group them into material pieces: two parts connect when they share a
  * face of positive area that does not lie on a cut triangle; the connected components,
- * numbered by their first part, are the pieces (P->piece, P->num_pieces). */
+ * numbered by their first part, are the pieces (P->piece, P->num_pieces). The triangles are
+ * taken in ascending order; those below first_new are the earlier cuts: the pieces under
+ * them alone (what the rules being extended had) are P->parent / P->num_parents, one piece
+ * when none of them reaches the cell. */
 fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
-                                  const fcm__cut_tri *tris, fcm__parts *P);
+                                  const fcm__cut_tri *tris, fcm_index first_new, fcm__parts *P);
 
-/* Fan-tetrahedralize the parts of `piece` into ws->tets / ws->vol (slivers dropped and
- * counted as in fcm__embed_cell_tets); *volume = the kept tets' volume. */
-fcm_status fcm__embed_piece_tets(fcm_ctx *ctx, const fcm__parts *P, int piece, fcm__embed_ws *ws,
-                                 fcm__embed_counts *counts, double *volume);
+/* Fan-tetrahedralize the parts i with label[i] == piece (label: P->piece or P->parent)
+ * into ws->tets / ws->vol (slivers dropped and counted as in fcm__embed_cell_tets);
+ * *volume = the kept tets' volume. */
+fcm_status fcm__embed_piece_tets(fcm_ctx *ctx, const fcm__parts *P, const int *label, int piece,
+                                 fcm__embed_ws *ws, fcm__embed_counts *counts, double *volume);
 
 /* The piece whose parts contain the physical point x (the part with the smallest largest
  * signed distance to its face planes). */

@@ -80,13 +80,14 @@ void fcm__embed_parts_free(fcm_ctx *ctx, fcm__parts *P)
   fcm__free(ctx, P->tol);
   fcm__free(ctx, P->vmin);
   fcm__free(ctx, P->piece);
+  fcm__free(ctx, P->parent);
   fcm__free(ctx, P->fx);
   fcm__free(ctx, P->fmeta);
   fcm__free(ctx, P->uf);
   fcm__geom_idbuf_free(ctx, &P->tcand);
   P->poly = NULL;
   P->tol = P->vmin = P->fx = NULL;
-  P->piece = P->fmeta = P->uf = NULL;
+  P->piece = P->parent = P->fmeta = P->uf = NULL;
   P->n = P->cap = P->nfx = P->capfx = P->nfp = P->capfp = P->ufcap = 0;
 }
 
@@ -98,7 +99,7 @@ static fcm_status parts_grow(fcm_ctx *ctx, fcm__parts *P, size_t need)
   size_t cap = P->cap ? 2 * P->cap : 16;
   while (cap < need)
     cap *= 2;
-  void *p = P->poly, *t = P->tol, *v = P->vmin, *q = P->piece;
+  void *p = P->poly, *t = P->tol, *v = P->vmin, *q = P->piece, *r = P->parent;
   FCM_TRY(ctx, fcm__resize(ctx, &p, P->n, cap, sizeof(fcm__poly)));
   P->poly = p;
   FCM_TRY(ctx, fcm__resize(ctx, &t, P->n, cap, sizeof(double)));
@@ -107,6 +108,8 @@ static fcm_status parts_grow(fcm_ctx *ctx, fcm__parts *P, size_t need)
   P->vmin = v;
   FCM_TRY(ctx, fcm__resize(ctx, &q, P->n, cap, sizeof(int)));
   P->piece = q;
+  FCM_TRY(ctx, fcm__resize(ctx, &r, P->n, cap, sizeof(int)));
+  P->parent = r;
   P->cap = cap;
 cleanup:
   return st;
@@ -125,7 +128,7 @@ static void poly_copy(fcm__poly *dst, const fcm__poly *src)
 
 /* Store polyhedron q as part `slot` (slot == P->n appends). */
 static fcm_status parts_put(fcm_ctx *ctx, fcm__parts *P, size_t slot, const fcm__poly *q,
-                            double tol, double vmin)
+                            double tol, double vmin, int parent)
 {
   fcm_status st = FCM_OK;
   if (slot == P->n) {
@@ -136,6 +139,7 @@ static fcm_status parts_put(fcm_ctx *ctx, fcm__parts *P, size_t slot, const fcm_
   P->tol[slot] = tol;
   P->vmin[slot] = vmin;
   P->piece[slot] = 0;
+  P->parent[slot] = parent;
 cleanup:
   return st;
 }
@@ -155,13 +159,13 @@ fcm_status fcm__embed_cell_parts(fcm_ctx *ctx, const fcm_geometry *geom, const f
                                       &tol, &vmin));
     if (ws->poly.nf == 0) continue;
     nparts++;
-    FCM_TRY(ctx, parts_put(ctx, P, P->n, &ws->poly, tol, vmin));
+    FCM_TRY(ctx, parts_put(ctx, P, P->n, &ws->poly, tol, vmin, 0));
   }
   if (counts) {
     counts->candidates += (fcm_index)ws->cand.n;
     counts->parts += nparts;
   }
-  P->num_pieces = P->n > 0;
+  P->num_pieces = P->num_parents = P->n > 0;
 cleanup:
   return st;
 }
@@ -190,6 +194,7 @@ static fcm_status split_part(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
 {
   fcm_status st = FCM_OK;
   const double tol = P->tol[i], vmin = P->vmin[i];
+  const int parent = P->parent[i];
   double lo, hi;
   plane_range(P->poly + i, &t->plane, &lo, &hi);
   if (lo > tol || hi < -tol) return FCM_OK;
@@ -211,12 +216,12 @@ static fcm_status split_part(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
       overflow |= fcm__geom_poly_clip(&W[2], &out, tol, &P->scratch);
       overflow |= fcm__geom_poly_clip(&W[1], &t->edge[e], tol, &P->scratch);
       if (W[2].nf > 0) {
-        FCM_TRY(ctx, parts_put(ctx, P, slot, &W[2], tol, vmin));
+        FCM_TRY(ctx, parts_put(ctx, P, slot, &W[2], tol, vmin, parent));
         slot = P->n;
       }
     }
     if (W[1].nf > 0) {
-      FCM_TRY(ctx, parts_put(ctx, P, slot, &W[1], tol, vmin));
+      FCM_TRY(ctx, parts_put(ctx, P, slot, &W[1], tol, vmin, parent));
       slot = P->n;
     }
   }
@@ -327,7 +332,7 @@ static void uf_union(int *uf, int a, int b)
 
 /* Whether parts i and j share a face of positive area that does not lie on a cut triangle. */
 static int parts_connected(const fcm__embed_cell *cell, const fcm__cut_tri *tris,
-                           const fcm__parts *P, size_t i, size_t j)
+                           const fcm__parts *P, size_t ntri, size_t i, size_t j)
 {
   const fcm__poly *a = P->poly + i, *b = P->poly + j;
   const double mtol = MATCH_RTOL * cell->size, atol = AREA_RTOL * cell->size * cell->size;
@@ -340,35 +345,47 @@ static int parts_connected(const fcm__embed_cell *cell, const fcm__cut_tri *tris
       if (dot3(pa.n, pb.n) > -(1.0 - NORMAL_TOL) || fabs(pa.d + pb.d) > mtol) continue;
       const int na = face_coords(a, fa, xa), nb = face_coords(b, fb, xb);
       if (fcm__embed_overlap(xa, na, xb, nb, pb.n, mtol, c) <= atol) continue;
-      if (!fcm__embed_on_cut(tris, P->tcand.ids, P->tcand.n, c, mtol)) return 1;
+      if (!fcm__embed_on_cut(tris, P->tcand.ids, ntri, c, mtol)) return 1;
     }
   }
   return 0;
 }
 
-fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
-                                  const fcm__cut_tri *tris, fcm__parts *P)
+/* Split every part by the triangles tris[P->tcand.ids[k0 .. k1)], then drop the parts the
+ * tolerance emptied. */
+static fcm_status split_parts(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
+                              size_t k0, size_t k1, fcm__parts *P)
 {
   fcm_status st = FCM_OK;
-  double *box = NULL;
-  for (size_t k = 0; k < P->tcand.n; k++) {
+  for (size_t k = k0; k < k1; k++) {
     const fcm__cut_tri *t = tris + P->tcand.ids[k];
     const size_t n0 = P->n;
     for (size_t i = 0; i < n0; i++)
       FCM_TRY(ctx, split_part(ctx, cell, t, P, i));
   }
-  size_t kept = 0; /* drop the parts the tolerance emptied */
+  size_t kept = 0;
   for (size_t i = 0; i < P->n; i++) {
     if (P->poly[i].nf == 0) continue;
     if (kept != i) {
       poly_copy(P->poly + kept, P->poly + i);
       P->tol[kept] = P->tol[i];
       P->vmin[kept] = P->vmin[i];
+      P->parent[kept] = P->parent[i];
     }
     kept++;
   }
   P->n = kept;
-  /* Components: union-find over part pairs whose boxes overlap. */
+cleanup:
+  return st;
+}
+
+/* Connected components of the parts when the triangles tris[P->tcand.ids[0 .. ntri)]
+ * separate: label[i] numbered by first part; *count of them. */
+static fcm_status components(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
+                             size_t ntri, fcm__parts *P, int *label, int *count)
+{
+  fcm_status st = FCM_OK;
+  double *box = NULL;
   if (P->n > P->ufcap) {
     void *u = P->uf;
     FCM_TRY(ctx, fcm__resize(ctx, &u, 0, P->n, sizeof(int)));
@@ -395,29 +412,49 @@ fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
       for (int d = 0; d < 3; d++)
         apart |= bi[d] > bj[3 + d] || bj[d] > bi[3 + d];
       if (apart || uf_find(P->uf, (int)i) == uf_find(P->uf, (int)j)) continue;
-      if (parts_connected(cell, tris, P, i, j)) uf_union(P->uf, (int)i, (int)j);
+      if (parts_connected(cell, tris, P, ntri, i, j)) uf_union(P->uf, (int)i, (int)j);
     }
-  /* Pieces numbered by their first part. */
   int np = 0;
   for (size_t i = 0; i < P->n; i++) {
     const int r = uf_find(P->uf, (int)i);
-    P->piece[i] = r == (int)i ? np++ : P->piece[r];
+    label[i] = r == (int)i ? np++ : label[r];
   }
-  P->num_pieces = np;
+  *count = np;
 cleanup:
   fcm__free(ctx, box);
   return st;
 }
 
-fcm_status fcm__embed_piece_tets(fcm_ctx *ctx, const fcm__parts *P, int piece, fcm__embed_ws *ws,
-                                 fcm__embed_counts *counts, double *volume)
+fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
+                                  const fcm__cut_tri *tris, fcm_index first_new, fcm__parts *P)
+{
+  fcm_status st = FCM_OK;
+  size_t nold = 0;
+  while (nold < P->tcand.n && P->tcand.ids[nold] < first_new)
+    nold++;
+  FCM_TRY(ctx, split_parts(ctx, cell, tris, 0, nold, P));
+  if (nold > 0) {
+    FCM_TRY(ctx, components(ctx, cell, tris, nold, P, P->parent, &P->num_parents));
+  } else {
+    for (size_t i = 0; i < P->n; i++)
+      P->parent[i] = 0;
+    P->num_parents = P->n > 0;
+  }
+  FCM_TRY(ctx, split_parts(ctx, cell, tris, nold, P->tcand.n, P));
+  FCM_TRY(ctx, components(ctx, cell, tris, P->tcand.n, P, P->piece, &P->num_pieces));
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_piece_tets(fcm_ctx *ctx, const fcm__parts *P, const int *label, int piece,
+                                 fcm__embed_ws *ws, fcm__embed_counts *counts, double *volume)
 {
   fcm_status st = FCM_OK;
   double vsum = 0.0, lost = 0.0;
   fcm_index nslivers = 0;
   ws->num_tets = 0;
   for (size_t i = 0; i < P->n; i++)
-    if (P->piece[i] == piece)
+    if (label[i] == piece)
       FCM_TRY(ctx,
               fcm__embed_append_tets(ctx, ws, P->poly + i, P->vmin[i], &vsum, &lost, &nslivers));
   if (counts) {

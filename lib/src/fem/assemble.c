@@ -83,15 +83,15 @@ static void tabulation_free(fcm_ctx *ctx, tabulation *t)
   fcm_rule_destroy(&t->rule);
 }
 
-/* The rule of `cell`: the tabulated standard rule for full cells, else the cell's own
+/* The rule of element e: the tabulated standard rule for full cells, else its piece's own
  * points from the embedded rules, evaluated into Nbuf/dNbuf (max_cut_points entries). */
 static cell_rule get_cell_rule(const fcm_space *s, const tabulation *t, fcm_rule_kind kind,
-                               fcm_index cell, double *Nbuf, double *dNbuf)
+                               fcm_index e, double *Nbuf, double *dNbuf)
 {
-  if (!s->rules || fcm_cell_rules_class(s->rules, cell) == FCM_CELL_UNCUT) return t->r;
+  if (!s->rules || fcm_cell_rules_class(s->rules, s->elem_cell[e]) == FCM_CELL_UNCUT) return t->r;
   cell_rule r = {0, NULL, Nbuf, dNbuf, NULL};
   const double *pts = NULL;
-  fcm_cell_rules_get(s->rules, cell, kind, &r.nq, &pts, &r.w, &r.fict);
+  fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], kind, &r.nq, &pts, &r.w, &r.fict);
   for (int q = 0; q < r.nq; q++) {
     fcm_element_eval_shape(s->type, pts + 3 * q, Nbuf + (size_t)q * s->nn);
     fcm_element_eval_grad(s->type, pts + 3 * q, dNbuf + (size_t)q * s->nn * 3);
@@ -315,14 +315,14 @@ static cell_result cell_kernel(const kernel_data *kd, const cell_rule *r, int nn
   return res;
 }
 
-/* Add the element matrix of `cell` into the values of the space's pattern. */
-static void scatter_matrix(const fcm_space *s, fcm_index cell, const double *Ke, double *vals)
+/* Add the element matrix of element e into the values of the space's pattern. */
+static void scatter_matrix(const fcm_space *s, fcm_index e, const double *Ke, double *vals)
 {
   int nn = s->nn, ndof = 3 * nn;
-  const fcm_index *cn = fcm_mesh_cells(s->mesh) + cell * nn;
-  const int *off = s->cell_off + (size_t)cell * nn * nn;
+  const fcm_index *ed = s->elem_dof + e * nn;
+  const int *off = s->elem_off + (size_t)e * nn * nn;
   for (int a = 0; a < nn; a++) {
-    fcm_index da = s->node_dof[cn[a]];
+    fcm_index da = ed[a];
     for (int i = 0; i < 3; i++) {
       double *dst = vals + s->row_ptr[da + i];
       const double *src = Ke + (size_t)(3 * a + i) * ndof;
@@ -336,15 +336,13 @@ static void scatter_matrix(const fcm_space *s, fcm_index cell, const double *Ke,
   }
 }
 
-/* Add the element vector of `cell` into the global vector. */
-static void scatter_vector(const fcm_space *s, fcm_index cell, const double *fe, double *vec)
+/* Add the element vector of element e into the global vector. */
+static void scatter_vector(const fcm_space *s, fcm_index e, const double *fe, double *vec)
 {
-  const fcm_index *cn = fcm_mesh_cells(s->mesh) + cell * s->nn;
-  for (int a = 0; a < s->nn; a++) {
-    fcm_index da = s->node_dof[cn[a]];
+  const fcm_index *ed = s->elem_dof + e * s->nn;
+  for (int a = 0; a < s->nn; a++)
     for (int i = 0; i < 3; i++)
-      vec[da + i] += fe[3 * a + i];
-  }
+      vec[ed[a] + i] += fe[3 * a + i];
 }
 
 /* Per-thread scratch for `nthreads` threads. */
@@ -387,7 +385,7 @@ struct fcm_assembly_workspace {
   int nthreads;        /* threads the scratch serves (omp_get_max_threads() at creation) */
   double *mem;         /* per-thread element buffers */
   scratch *sc;         /* nthreads views into mem */
-  double *cell_energy; /* num_cells: energy per cell of the last hyperelastic assembly */
+  double *cell_energy; /* num_elems: energy per element of the last hyperelastic assembly */
 };
 
 fcm_status fcm_assembly_workspace_create(const fcm_space *space, const fcm_assembly_options *opts,
@@ -412,7 +410,7 @@ fcm_status fcm_assembly_workspace_create(const fcm_space *space, const fcm_assem
   ws->opts = opts ? *opts : fcm_assembly_options_default();
   ws->nthreads = omp_get_max_threads();
   FCM_TRY(ctx, scratch_alloc(space, ws->nthreads, &ws->mem, &ws->sc));
-  FCM_ALLOC(ctx, space->num_cells, ws->cell_energy);
+  FCM_ALLOC(ctx, space->num_elems + 1, ws->cell_energy);
   *out = ws;
   ws = NULL;
 cleanup:
@@ -466,17 +464,17 @@ typedef struct pass {
   fcm_field_fn traction; /* non-NULL: surface traction on the cut cells' surface rules */
   void *traction_user;
   double *vals, *vec;  /* matrix values (space pattern) and vector, either may be NULL */
-  double *cell_energy; /* num_cells, or NULL */
+  double *cell_energy; /* num_elems, or NULL */
 } pass;
 
-/* Surface traction of one cell into w->fe; returns 0 when the cell has no surface points. */
-static int surface_cell(const fcm_space *s, const pass *ps, fcm_index c, scratch *w)
+/* Surface traction of element e into w->fe; returns 0 when it has no surface points. */
+static int surface_cell(const fcm_space *s, const pass *ps, fcm_index e, scratch *w)
 {
   int np = 0, nn = s->nn;
   const double *pts = NULL, *wts = NULL, *nrm = NULL;
-  fcm_cell_rules_get_surface(s->rules, c, &np, &pts, &wts, &nrm, NULL);
+  fcm_cell_rules_get_piece_surface(s->rules, s->elem_piece[e], &np, &pts, &wts, &nrm, NULL);
   if (np == 0) return 0;
-  fcm_mesh_cell_coords(s->mesh, c, w->X);
+  fcm_mesh_cell_coords(s->mesh, s->elem_cell[e], w->X);
   memset(w->fe, 0, sizeof(double) * 3 * (size_t)nn);
   for (int q = 0; q < np; q++) {
     double x[3] = {0, 0, 0}, tq[3] = {0, 0, 0};
@@ -492,24 +490,24 @@ static int surface_cell(const fcm_space *s, const pass *ps, fcm_index c, scratch
   return 1;
 }
 
-/* Volume kernel of one cell into w->Ke / w->fe. */
-static cell_result volume_cell(const fcm_space *s, const pass *ps, fcm_index c, scratch *w)
+/* Volume kernel of element e into w->Ke / w->fe. */
+static cell_result volume_cell(const fcm_space *s, const pass *ps, fcm_index e, scratch *w)
 {
   const kernel_data *kd = ps->kd;
   int nn = s->nn;
-  fcm_mesh_cell_coords(s->mesh, c, w->X);
+  fcm_mesh_cell_coords(s->mesh, s->elem_cell[e], w->X);
   if (kd->u) {
-    const fcm_index *cn = fcm_mesh_cells(s->mesh) + c * nn;
+    const fcm_index *ed = s->elem_dof + e * nn;
     for (int a = 0; a < nn; a++)
-      memcpy(w->ue + 3 * a, kd->u + s->node_dof[cn[a]], 3 * sizeof(double));
+      memcpy(w->ue + 3 * a, kd->u + ed[a], 3 * sizeof(double));
   }
-  cell_rule r = get_cell_rule(s, ps->tab, ps->kind, c, w->Nb, w->dNb);
+  cell_rule r = get_cell_rule(s, ps->tab, ps->kind, e, w->Nb, w->dNb);
   return cell_kernel(kd, &r, nn, w);
 }
 
-/* Run the pass over all active cells colour by colour (parallel within a colour)
- * and scatter each cell's result; a cell with det J <= 0 or a non-finite material
- * response is not scattered, and the lowest such cell of the colour is reported. */
+/* Run the pass over all elements colour by colour (parallel within a colour) and scatter
+ * each element's result; an element with det J <= 0 or a non-finite material response is
+ * not scattered, and the cell of the lowest such element of the colour is reported. */
 static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
 {
   fcm_status st = FCM_OK;
@@ -525,7 +523,7 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
       scratch *w = ws->sc + omp_get_thread_num();
 #pragma omp for schedule(dynamic, 16)
       for (fcm_index k = c0; k < c1; k++) {
-        fcm_index c = s->color_cells[k];
+        fcm_index c = s->color_elems[k];
         if (ps->traction) {
           if (!surface_cell(s, ps, c, w)) continue;
         } else {
@@ -548,11 +546,11 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
     FCM_CHECK(bad_cell < 0 || !bad_numeric, ctx, FCM_ERR_NUMERIC,
               "assembly: the material returned NaN or infinity in cell %lld (deformation "
               "gradient not finite or outside the model's domain)",
-              (long long)bad_cell);
+              (long long)s->elem_cell[bad_cell]);
     FCM_CHECK(bad_cell < 0, ctx, FCM_ERR_GEOMETRY,
               "assembly: cell %lld has det J = %g <= 0 at a quadrature point (inverted or "
               "degenerate %s)",
-              (long long)bad_cell, bad_det, fcm_element_get_info(s->type)->name);
+              (long long)s->elem_cell[bad_cell], bad_det, fcm_element_get_info(s->type)->name);
   }
 cleanup:
   return st;
@@ -688,10 +686,10 @@ fcm_status fcm_assembly_workspace_hyperelastic(fcm_assembly_workspace *ws,
   kd.mat_psd.project_psd = 1;
   FCM_TRY(ctx, run_volume_pass(ws, &kd, tangent ? fcm_csr_values(tangent) : NULL, force,
                                ws->cell_energy));
-  if (energy) { /* summed in cell order: independent of the thread count */
+  if (energy) { /* summed in element order: independent of the thread count */
     double e = 0.0;
-    for (fcm_index c = 0; c < s->num_cells; c++)
-      if (s->active[c]) e += ws->cell_energy[c];
+    for (fcm_index el = 0; el < s->num_elems; el++)
+      e += ws->cell_energy[el];
     *energy = e;
   }
 cleanup:
@@ -764,20 +762,88 @@ fcm_status fcm_space_eval(const fcm_space *s, fcm_index cell, const double xi[3]
                           double value[3])
 {
   fcm_status st = FCM_OK;
-  double N[FCM_ELEMENT_MAX_NODES];
   FCM_CHECK(cell >= 0 && cell < s->num_cells && s->active[cell], s->ctx, FCM_ERR_ARG,
             "space eval: cell %lld is out of range [0, %lld) or inactive", (long long)cell,
             (long long)s->num_cells);
+  FCM_CHECK(s->cell_elem[cell + 1] - s->cell_elem[cell] == 1, s->ctx, FCM_ERR_ARG,
+            "space eval: cell %lld is split into %lld pieces by cuts: evaluate per element "
+            "(fcm_space_element_eval())",
+            (long long)cell, (long long)(s->cell_elem[cell + 1] - s->cell_elem[cell]));
+  FCM_TRY(s->ctx, fcm_space_element_eval(s, s->cell_elem[cell], xi, u, value));
+cleanup:
+  return st;
+}
+
+fcm_status fcm_space_element_eval(const fcm_space *s, fcm_index elem, const double xi[3],
+                                  const double *u, double value[3])
+{
+  fcm_status st = FCM_OK;
+  double N[FCM_ELEMENT_MAX_NODES];
+  FCM_CHECK(elem >= 0 && elem < s->num_elems, s->ctx, FCM_ERR_ARG,
+            "space eval: element %lld is out of range [0, %lld)", (long long)elem,
+            (long long)s->num_elems);
   fcm_element_eval_shape(s->type, xi, N);
   value[0] = value[1] = value[2] = 0.0;
   {
-    const fcm_index *cn = fcm_mesh_cells(s->mesh) + cell * s->nn;
     for (int a = 0; a < s->nn; a++) {
-      fcm_index d = s->node_dof[cn[a]];
+      fcm_index d = s->elem_dof[elem * s->nn + a];
       for (int i = 0; i < 3; i++)
         value[i] += N[a] * u[d + i];
     }
   }
 cleanup:
+  return st;
+}
+
+fcm_status fcm_space_momentum(const fcm_space *s, double density, const double *u, const double *v,
+                              double *mass, double linear[3], double angular[3])
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s ? s->ctx : NULL;
+  fcm_rule *full = NULL;
+  double m = 0.0, p[3] = {0, 0, 0}, L[3] = {0, 0, 0};
+  FCM_CHECK(s, ctx, FCM_ERR_ARG, "momentum: space is NULL");
+  FCM_CHECK(isfinite(density) && density >= 0.0, ctx, FCM_ERR_ARG,
+            "momentum: density = %g must be finite and >= 0", density);
+  FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, FCM_RULE_MASS, FCM_DEFAULT, &full));
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    const fcm_index c = s->elem_cell[e];
+    int nq = 0;
+    const double *pts = NULL, *w = NULL;
+    const unsigned char *fl = NULL;
+    if (s->rules && fcm_cell_rules_class(s->rules, c) != FCM_CELL_UNCUT) {
+      FCM_TRY(ctx, fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], FCM_RULE_MASS, &nq, &pts,
+                                            &w, &fl));
+    } else {
+      nq = fcm_rule_num_points(full);
+      pts = fcm_rule_points(full);
+      w = fcm_rule_weights(full);
+    }
+    double X[3 * FCM_ELEMENT_MAX_NODES], J[9], N[FCM_ELEMENT_MAX_NODES];
+    fcm_mesh_cell_coords(s->mesh, c, X);
+    const fcm_index *ed = s->elem_dof + e * s->nn;
+    for (int q = 0; q < nq; q++) {
+      if (fl && fl[q]) continue; /* fictitious stabilization points: not the body */
+      const double wd = density * w[q] * fcm_element_jacobian(s->type, X, pts + 3 * q, J);
+      fcm_element_eval_shape(s->type, pts + 3 * q, N);
+      double x[3] = {0, 0, 0}, vq[3] = {0, 0, 0};
+      for (int a = 0; a < s->nn; a++)
+        for (int i = 0; i < 3; i++) {
+          x[i] += N[a] * (X[3 * a + i] + (u ? u[ed[a] + i] : 0.0));
+          vq[i] += N[a] * (v ? v[ed[a] + i] : 0.0);
+        }
+      m += wd;
+      for (int i = 0; i < 3; i++)
+        p[i] += wd * vq[i];
+      L[0] += wd * (x[1] * vq[2] - x[2] * vq[1]);
+      L[1] += wd * (x[2] * vq[0] - x[0] * vq[2]);
+      L[2] += wd * (x[0] * vq[1] - x[1] * vq[0]);
+    }
+  }
+  if (mass) *mass = m;
+  if (linear) memcpy(linear, p, sizeof p);
+  if (angular) memcpy(angular, L, sizeof L);
+cleanup:
+  fcm_rule_destroy(&full);
   return st;
 }

@@ -12,7 +12,6 @@ fcm_status fcm_space_cell_blocks(const fcm_space *space, const unsigned char *ce
             "space_cell_blocks: space, cell_flag, num_blocks or num_dofs is NULL");
   FCM_CHECK(!block_ptr == !block_dofs, ctx, FCM_ERR_ARG,
             "space_cell_blocks: give both block_ptr and block_dofs, or neither (counts only)");
-  const fcm_index *cells = fcm_mesh_cells(space->mesh);
   const int npc = space->nn;
   fcm_index nb = 0;
   for (fcm_index c = 0; c < space->num_cells; c++) {
@@ -20,16 +19,18 @@ fcm_status fcm_space_cell_blocks(const fcm_space *space, const unsigned char *ce
     FCM_CHECK(space->active[c], ctx, FCM_ERR_ARG,
               "space_cell_blocks: cell %lld is flagged but inactive (it has no DOFs)",
               (long long)c);
-    if (block_ptr) {
-      fcm_index *bd = block_dofs + nb * 3 * npc;
-      block_ptr[nb] = nb * 3 * npc;
-      for (int a = 0; a < npc; a++) {
-        const fcm_index d = space->node_dof[cells[c * npc + a]];
-        for (int i = 0; i < 3; i++)
-          bd[3 * a + i] = d + i;
+    for (fcm_index e = space->cell_elem[c]; e < space->cell_elem[c + 1]; e++) {
+      if (block_ptr) {
+        fcm_index *bd = block_dofs + nb * 3 * npc;
+        block_ptr[nb] = nb * 3 * npc;
+        for (int a = 0; a < npc; a++) {
+          const fcm_index d = space->elem_dof[e * npc + a];
+          for (int i = 0; i < 3; i++)
+            bd[3 * a + i] = d + i;
+        }
       }
+      nb++;
     }
-    nb++;
   }
   if (block_ptr) block_ptr[nb] = nb * 3 * npc;
   *num_blocks = nb;

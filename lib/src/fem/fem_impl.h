@@ -14,22 +14,32 @@ struct fcm_space {
   fcm_index num_cells;
   fcm_index num_nodes;
   unsigned char *active; /* num_cells */
-  fcm_index *node_dof;   /* num_nodes: first DOF or -1 */
-  fcm_index num_dofs;
-  /* Node graph of active nodes (by active rank): node_ptr[k]..node_ptr[k+1] are
-   * the ranks of the nodes sharing a cell with node k (itself included), sorted. */
+  fcm_index *node_dof;   /* num_nodes: first DOF of the node's first copy, or -1 */
+  fcm_index *node_ncopy; /* num_nodes: copies of the node (0 inactive, 1, or more when cuts
+                            separate its support: generalized enrichment, DESIGN §9) */
+  fcm_index num_dofs;    /* 3 x copies; a node's copies have consecutive DOFs */
+  /* Elements: the material pieces of the active cells (one per cell without cuts), in cell
+   * order: element e lies in cell elem_cell[e], integrates with the rules of piece
+   * elem_piece[e] (-1: standard rule) and has the DOFs elem_dof[nn e + a] .. + 2 at its
+   * local node a (the copy of that node whose support component holds the piece). Cell c
+   * has elements [cell_elem[c], cell_elem[c + 1]). */
+  fcm_index num_elems;
+  fcm_index *elem_cell, *elem_piece, *elem_dof, *cell_elem;
+  /* Copy graph (by copy rank k = DOF / 3): node_ptr[k]..node_ptr[k+1] are the ranks of the
+   * copies sharing an element with copy k (itself included), sorted. */
   fcm_index *node_ptr;
   fcm_index *node_adj;
   /* Scalar CSR pattern: the three rows of node k each hold 3 columns per neighbour. */
   fcm_index *row_ptr; /* num_dofs + 1 */
   int *col_idx;
-  /* Per cell, nn x nn offsets: the position of neighbour b in node a's row of the node
+  /* Per element, nn x nn offsets: the position of copy b in copy a's row of the copy
    * graph, so entry (3ka+i, 3kb+j) lives at row_ptr[3ka+i] + 3 off[a][b] + j. */
-  int *cell_off;
-  /* Cells grouped by colour: color_ptr[c]..color_ptr[c+1] index color_cells. */
+  int *elem_off;
+  /* Elements grouped by colour (no two share a copy): color_ptr[c]..color_ptr[c+1] index
+   * color_elems. */
   int num_colors;
   fcm_index *color_ptr;
-  fcm_index *color_cells;
+  fcm_index *color_elems;
   /* Embedded case: per-cell rules of cut cells (borrowed) and the most points any cut
    * cell has in either rule. Nothing here changes after creation: assembly scratch lives
    * in fcm_assembly_workspace (assemble.c). */

@@ -5,6 +5,7 @@
 
 #include <math.h>
 #include <omp.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* Whether xi lies in the reference element, with tolerance tol. */
@@ -192,16 +193,16 @@ fcm_status fcm_space_interpolate(const fcm_space *s, fcm_index n, const fcm_inde
 #pragma omp parallel for schedule(static)
   for (fcm_index i = 0; i < n; i++) {
     fcm_index c = cell[i];
-    if (c < 0 || c >= s->num_cells || !s->active[c]) {
+    if (c < 0 || c >= s->num_cells || !s->active[c] || s->cell_elem[c + 1] - s->cell_elem[c] != 1) {
 #pragma omp critical(fcm_interpolate)
       if (bad < 0 || i < bad) bad = i;
       continue;
     }
     double N[FCM_ELEMENT_MAX_NODES], v[3] = {0, 0, 0};
     fcm_element_eval_shape(s->type, xi + 3 * i, N);
-    const fcm_index *cn = fcm_mesh_cells(s->mesh) + c * s->nn;
+    const fcm_index *ed = s->elem_dof + s->cell_elem[c] * s->nn;
     for (int a = 0; a < s->nn; a++) {
-      const double *ua = u + s->node_dof[cn[a]];
+      const double *ua = u + ed[a];
       for (int d = 0; d < 3; d++)
         v[d] += N[a] * ua[d];
     }
@@ -209,8 +210,69 @@ fcm_status fcm_space_interpolate(const fcm_space *s, fcm_index n, const fcm_inde
   }
   FCM_CHECK(bad < 0, s->ctx, FCM_ERR_ARG,
             "interpolate: point %lld names cell %lld, which is "
-            "out of range or inactive",
+            "out of range, inactive or split into pieces by cuts",
             (long long)bad, (long long)cell[bad]);
 cleanup:
   return st;
+}
+
+fcm_index fcm_space_point_element(const fcm_space *s, fcm_index cell, const double xi[3])
+{
+  if (!s || cell < 0 || cell >= s->num_cells) return -1;
+  const fcm_index e0 = s->cell_elem[cell], ne = s->cell_elem[cell + 1] - e0;
+  if (ne <= 1) return ne == 1 ? e0 : -1;
+  /* the piece with the nearest authentic quadrature point (reference coordinates) */
+  fcm_index best = e0;
+  double dmin = HUGE_VAL;
+  for (fcm_index e = e0; e < e0 + ne; e++) {
+    int nq = 0;
+    const double *pts = NULL;
+    const unsigned char *fl = NULL;
+    if (fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], FCM_RULE_STIFFNESS, &nq, &pts, NULL,
+                                 &fl) != FCM_OK)
+      continue;
+    for (int q = 0; q < nq; q++) {
+      if (fl[q]) continue;
+      const double dx = pts[3 * q] - xi[0], dy = pts[3 * q + 1] - xi[1], dz = pts[3 * q + 2] - xi[2];
+      const double d = dx * dx + dy * dy + dz * dz;
+      if (d < dmin) dmin = d, best = e;
+    }
+  }
+  return best;
+}
+
+fcm_index fcm_space_num_bodies(const fcm_space *s)
+{
+  if (!s || s->num_elems == 0) return 0;
+  const fcm_index ncopy = s->num_dofs / 3;
+  fcm_index *uf = malloc(sizeof *uf * (size_t)s->num_elems), *first = malloc(sizeof *first * (size_t)ncopy);
+  if (!uf || !first) {
+    free(uf);
+    free(first);
+    return -1;
+  }
+  for (fcm_index e = 0; e < s->num_elems; e++)
+    uf[e] = e;
+  for (fcm_index k = 0; k < ncopy; k++)
+    first[k] = -1;
+  for (fcm_index e = 0; e < s->num_elems; e++)
+    for (int a = 0; a < s->nn; a++) {
+      const fcm_index k = s->elem_dof[e * s->nn + a] / 3;
+      if (first[k] < 0) {
+        first[k] = e;
+        continue;
+      }
+      fcm_index x = e, y = first[k];
+      while (uf[x] != x)
+        x = uf[x] = uf[uf[x]];
+      while (uf[y] != y)
+        y = uf[y] = uf[uf[y]];
+      if (x != y) uf[x > y ? x : y] = x < y ? x : y;
+    }
+  fcm_index count = 0;
+  for (fcm_index e = 0; e < s->num_elems; e++)
+    count += uf[e] == e;
+  free(uf);
+  free(first);
+  return count;
 }

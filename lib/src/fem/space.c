@@ -12,7 +12,7 @@ static int cmp_index(const void *a, const void *b)
   return (x > y) - (x < y);
 }
 
-/* Node -> cells incidence (active cells only) as CSR: inc_ptr[num_nodes+1], inc. */
+/* Node -> elements incidence as CSR: inc_ptr[num_nodes+1], inc (ascending elements). */
 static fcm_status build_incidence(fcm_space *s, fcm_index **inc_ptr, fcm_index **inc)
 {
   fcm_status st = FCM_OK;
@@ -20,20 +20,18 @@ static fcm_status build_incidence(fcm_space *s, fcm_index **inc_ptr, fcm_index *
   const fcm_index *cells = fcm_mesh_cells(s->mesh);
   fcm_index *ptr = NULL, *list = NULL, *fill = NULL;
   FCM_ALLOC(ctx, s->num_nodes + 1, ptr);
-  for (fcm_index c = 0; c < s->num_cells; c++)
-    if (s->active[c])
-      for (int a = 0; a < s->nn; a++)
-        ptr[cells[c * s->nn + a] + 1]++;
+  for (fcm_index e = 0; e < s->num_elems; e++)
+    for (int a = 0; a < s->nn; a++)
+      ptr[cells[s->elem_cell[e] * s->nn + a] + 1]++;
   for (fcm_index n = 0; n < s->num_nodes; n++)
     ptr[n + 1] += ptr[n];
   FCM_ALLOC(ctx, ptr[s->num_nodes], list);
   FCM_ALLOC(ctx, s->num_nodes, fill);
-  for (fcm_index c = 0; c < s->num_cells; c++)
-    if (s->active[c])
-      for (int a = 0; a < s->nn; a++) {
-        fcm_index n = cells[c * s->nn + a];
-        list[ptr[n] + fill[n]++] = c;
-      }
+  for (fcm_index e = 0; e < s->num_elems; e++)
+    for (int a = 0; a < s->nn; a++) {
+      fcm_index n = cells[s->elem_cell[e] * s->nn + a];
+      list[ptr[n] + fill[n]++] = e;
+    }
   *inc_ptr = ptr;
   *inc = list;
   ptr = list = NULL;
@@ -44,46 +42,170 @@ cleanup:
   return st;
 }
 
-/* Node graph over active ranks: neighbours through shared active cells, sorted. */
-static fcm_status build_node_graph(fcm_space *s, const fcm_index *inc_ptr, const fcm_index *inc)
+/* The elements: one per piece of every active cell (a space without rules: one per active
+ * cell, with the standard rule). */
+static fcm_status build_elements(fcm_space *s)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  fcm_index ne = 0;
+  FCM_ALLOC(ctx, s->num_cells + 1, s->cell_elem);
+  for (fcm_index c = 0; c < s->num_cells; c++) {
+    fcm_index k = s->active[c];
+    if (s->rules && s->active[c]) k = fcm_cell_rules_cell_pieces(s->rules, c, NULL);
+    s->cell_elem[c + 1] = s->cell_elem[c] + k;
+  }
+  ne = s->num_elems = s->cell_elem[s->num_cells];
+  FCM_ALLOC(ctx, ne + 1, s->elem_cell);
+  FCM_ALLOC(ctx, ne + 1, s->elem_piece);
+  FCM_ALLOC(ctx, (size_t)ne * s->nn + 1, s->elem_dof);
+  for (fcm_index c = 0; c < s->num_cells; c++) {
+    fcm_index first = 0;
+    if (s->rules) fcm_cell_rules_cell_pieces(s->rules, c, &first);
+    for (fcm_index e = s->cell_elem[c]; e < s->cell_elem[c + 1]; e++) {
+      s->elem_cell[e] = c;
+      s->elem_piece[e] = s->rules ? first + (e - s->cell_elem[c]) : -1;
+    }
+  }
+cleanup:
+  return st;
+}
+
+static fcm_index uf_find(fcm_index *uf, fcm_index a)
+{
+  while (uf[a] != a)
+    a = uf[a] = uf[uf[a]];
+  return a;
+}
+
+/* Generalized enrichment (Ton-That et al. 2024, DESIGN §9): the elements incident to a node
+ * (its support) are grouped into connected components along the links of the cell rules
+ * (pieces of face-neighbouring cells that share a face part not lying on a cut); each
+ * component gets its own copy of the node. Where every incident cell has one piece, the
+ * node has one copy. Copies are numbered node by node, components by their first element;
+ * elem_dof gets the copy each element uses. */
+static fcm_status build_copies(fcm_space *s, const fcm_index *inc_ptr, const fcm_index *inc)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
   const fcm_index *cells = fcm_mesh_cells(s->mesh);
-  fcm_index nact = s->num_dofs / 3;
-  fcm_index *mark = NULL;
-  FCM_ALLOC(ctx, s->num_nodes, mark);
+  const fcm_index nl = s->rules ? fcm_cell_rules_num_links(s->rules) : 0;
+  const fcm_index *links = s->rules ? fcm_cell_rules_links(s->rules) : NULL;
+  fcm_index *uf = NULL, *comp = NULL, *pos = NULL, ncopy = 0, maxdeg = 0;
+  FCM_ALLOC(ctx, s->num_nodes, s->node_ncopy);
   for (fcm_index n = 0; n < s->num_nodes; n++)
-    mark[n] = -1;
-  FCM_ALLOC(ctx, nact + 1, s->node_ptr);
-  /* Pass 1 counts, pass 2 fills: the mark array avoids duplicates without sorting twice. */
-  for (int pass = 0; pass < 2; pass++) {
-    for (fcm_index n = 0; n < s->num_nodes; n++) {
-      fcm_index k = s->node_dof[n];
-      if (k < 0) continue;
-      k /= 3;
-      fcm_index cnt = 0, base = pass ? s->node_ptr[k] : 0;
-      for (fcm_index e = inc_ptr[n]; e < inc_ptr[n + 1]; e++) {
-        const fcm_index *cn = cells + inc[e] * s->nn;
-        for (int b = 0; b < s->nn; b++) {
-          fcm_index m = cn[b];
-          if (mark[m] == n) continue;
-          mark[m] = n;
-          if (pass) s->node_adj[base + cnt] = s->node_dof[m] / 3;
-          cnt++;
+    maxdeg = FCM_MAX(maxdeg, inc_ptr[n + 1] - inc_ptr[n]);
+  FCM_ALLOC(ctx, maxdeg + 1, uf);
+  FCM_ALLOC(ctx, maxdeg + 1, comp);
+  FCM_ALLOC(ctx, s->num_elems + 1, pos);
+  for (fcm_index e = 0; e < s->num_elems; e++)
+    pos[e] = -1;
+  for (fcm_index n = 0; n < s->num_nodes; n++) {
+    const fcm_index i0 = inc_ptr[n], deg = inc_ptr[n + 1] - i0;
+    s->node_dof[n] = -1;
+    if (deg == 0) continue;
+    int split = 0;
+    for (fcm_index i = 0; i < deg; i++) {
+      const fcm_index e = inc[i0 + i], c = s->elem_cell[e];
+      split |= s->cell_elem[c + 1] - s->cell_elem[c] > 1;
+      uf[i] = i;
+      pos[e] = i;
+    }
+    fcm_index k = 1;
+    if (split) {
+      for (fcm_index i = 0; i < deg; i++) {
+        /* links (p, q) with p the piece of this element: binary search for the first */
+        const fcm_index p = s->elem_piece[inc[i0 + i]];
+        fcm_index lo = 0, hi = nl;
+        while (lo < hi) {
+          const fcm_index mid = lo + (hi - lo) / 2;
+          if (links[2 * mid] < p)
+            lo = mid + 1;
+          else
+            hi = mid;
+        }
+        for (fcm_index l = lo; l < nl && links[2 * l] == p; l++) {
+          /* the element of piece q: pieces and elements of a cell are in the same order */
+          const fcm_index q = links[2 * l + 1];
+          const fcm_index cq = fcm_cell_rules_piece_cell(s->rules, q);
+          fcm_index fq;
+          fcm_cell_rules_cell_pieces(s->rules, cq, &fq);
+          const fcm_index eq = s->cell_elem[cq] + (q - fq);
+          if (pos[eq] < 0) continue; /* not in this node's support */
+          const fcm_index ra = uf_find(uf, i), rb = uf_find(uf, pos[eq]);
+          if (ra != rb) uf[FCM_MAX(ra, rb)] = FCM_MIN(ra, rb);
         }
       }
-      if (pass)
-        qsort(s->node_adj + base, (size_t)cnt, sizeof *s->node_adj, cmp_index);
-      else
-        s->node_ptr[k + 1] = cnt;
+      k = 0;
+      for (fcm_index i = 0; i < deg; i++) {
+        const fcm_index r = uf_find(uf, i);
+        comp[i] = r == i ? k++ : comp[r];
+      }
+    } else {
+      for (fcm_index i = 0; i < deg; i++)
+        comp[i] = 0;
+    }
+    s->node_ncopy[n] = k;
+    s->node_dof[n] = 3 * ncopy;
+    for (fcm_index i = 0; i < deg; i++) {
+      const fcm_index e = inc[i0 + i];
+      for (int a = 0; a < s->nn; a++)
+        if (cells[s->elem_cell[e] * s->nn + a] == n)
+          s->elem_dof[e * s->nn + a] = 3 * (ncopy + comp[i]);
+      pos[e] = -1;
+    }
+    ncopy += k;
+  }
+  s->num_dofs = 3 * ncopy;
+cleanup:
+  fcm__free(ctx, uf);
+  fcm__free(ctx, comp);
+  fcm__free(ctx, pos);
+  return st;
+}
+
+/* Copy graph: copies sharing an element, sorted. Element e's copies are elem_dof / 3. */
+static fcm_status build_node_graph(fcm_space *s, const fcm_index *inc_ptr, const fcm_index *inc)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ncopy = s->num_dofs / 3, nn = s->nn;
+  fcm_index *mark = NULL;
+  FCM_ALLOC(ctx, ncopy + 1, mark);
+  FCM_ALLOC(ctx, ncopy + 1, s->node_ptr);
+  for (int pass = 0; pass < 2; pass++) {
+    for (fcm_index k = 0; k < ncopy; k++)
+      mark[k] = -1;
+    for (fcm_index n = 0; n < s->num_nodes; n++) {
+      if (s->node_dof[n] < 0) continue;
+      const fcm_index k0 = s->node_dof[n] / 3;
+      for (fcm_index c = 0; c < s->node_ncopy[n]; c++) {
+        const fcm_index k = k0 + c;
+        fcm_index cnt = 0, base = pass ? s->node_ptr[k] : 0;
+        for (fcm_index i = inc_ptr[n]; i < inc_ptr[n + 1]; i++) {
+          const fcm_index e = inc[i];
+          int uses = 0; /* does element e use copy k? */
+          for (int a = 0; a < nn && !uses; a++)
+            uses = s->elem_dof[e * nn + a] / 3 == k;
+          if (!uses) continue;
+          for (int b = 0; b < nn; b++) {
+            const fcm_index m = s->elem_dof[e * nn + b] / 3;
+            if (mark[m] == k) continue;
+            mark[m] = k;
+            if (pass) s->node_adj[base + cnt] = m;
+            cnt++;
+          }
+        }
+        if (pass)
+          qsort(s->node_adj + base, (size_t)cnt, sizeof *s->node_adj, cmp_index);
+        else
+          s->node_ptr[k + 1] = cnt;
+      }
     }
     if (!pass) {
-      for (fcm_index k = 0; k < nact; k++)
+      for (fcm_index k = 0; k < ncopy; k++)
         s->node_ptr[k + 1] += s->node_ptr[k];
-      FCM_ALLOC(ctx, s->node_ptr[nact], s->node_adj);
-      for (fcm_index n = 0; n < s->num_nodes; n++)
-        mark[n] = -1;
+      FCM_ALLOC(ctx, s->node_ptr[ncopy], s->node_adj);
     }
   }
 cleanup:
@@ -91,13 +213,12 @@ cleanup:
   return st;
 }
 
-/* Scalar pattern from the node graph, and the per-cell offsets. */
+/* Scalar pattern from the copy graph, and the per-element offsets. */
 static fcm_status build_pattern(fcm_space *s)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
   fcm_index nact = s->num_dofs / 3;
-  const fcm_index *cells = fcm_mesh_cells(s->mesh);
   FCM_ALLOC(ctx, s->num_dofs + 1, s->row_ptr);
   for (fcm_index k = 0; k < nact; k++) {
     fcm_index deg = s->node_ptr[k + 1] - s->node_ptr[k];
@@ -112,17 +233,16 @@ static fcm_status build_pattern(fcm_space *s)
         for (int j = 0; j < 3; j++)
           *cols++ = (int)(3 * s->node_adj[e] + j);
     }
-  FCM_ALLOC(ctx, (size_t)s->num_cells * s->nn * s->nn, s->cell_off);
-  for (fcm_index c = 0; c < s->num_cells; c++) {
-    if (!s->active[c]) continue;
-    const fcm_index *cn = cells + c * s->nn;
-    int *off = s->cell_off + (size_t)c * s->nn * s->nn;
+  FCM_ALLOC(ctx, (size_t)s->num_elems * s->nn * s->nn + 1, s->elem_off);
+  for (fcm_index el = 0; el < s->num_elems; el++) {
+    const fcm_index *ed = s->elem_dof + el * s->nn;
+    int *off = s->elem_off + (size_t)el * s->nn * s->nn;
     for (int a = 0; a < s->nn; a++) {
-      fcm_index ka = s->node_dof[cn[a]] / 3;
+      fcm_index ka = ed[a] / 3;
       const fcm_index *row = s->node_adj + s->node_ptr[ka];
       size_t len = (size_t)(s->node_ptr[ka + 1] - s->node_ptr[ka]);
       for (int b = 0; b < s->nn; b++) {
-        fcm_index kb = s->node_dof[cn[b]] / 3;
+        fcm_index kb = ed[b] / 3;
         const fcm_index *hit = bsearch(&kb, row, len, sizeof *row, cmp_index);
         FCM_ASSERT(hit != NULL, ctx);
         off[a * s->nn + b] = (int)(hit - row);
@@ -133,7 +253,8 @@ cleanup:
   return st;
 }
 
-/* Greedy colouring: a cell takes the smallest colour not used by a cell sharing a node. */
+/* Greedy colouring: an element takes the smallest colour not used by an element sharing a
+ * copy (elements sharing a node but using different copies of it may share a colour). */
 static fcm_status build_colors(fcm_space *s, const fcm_index *inc_ptr, const fcm_index *inc)
 {
   fcm_status st = FCM_OK;
@@ -142,37 +263,44 @@ static fcm_status build_colors(fcm_space *s, const fcm_index *inc_ptr, const fcm
   int *color = NULL, ncol = 0;
   fcm_index *forbid = NULL, *fill = NULL;
   enum { MAX_COLORS = 4096 };
-  FCM_ALLOC(ctx, s->num_cells, color);
+  FCM_ALLOC(ctx, s->num_elems + 1, color);
   FCM_ALLOC(ctx, MAX_COLORS, forbid);
   for (int k = 0; k < MAX_COLORS; k++)
     forbid[k] = -1;
-  for (fcm_index c = 0; c < s->num_cells; c++) {
-    color[c] = -1;
-    if (!s->active[c]) continue;
+  for (fcm_index e = 0; e < s->num_elems; e++)
+    color[e] = -1;
+  for (fcm_index e = 0; e < s->num_elems; e++) {
     for (int a = 0; a < s->nn; a++) {
-      fcm_index n = cells[c * s->nn + a];
-      for (fcm_index e = inc_ptr[n]; e < inc_ptr[n + 1]; e++)
-        if (color[inc[e]] >= 0) forbid[color[inc[e]]] = c;
+      fcm_index n = cells[s->elem_cell[e] * s->nn + a];
+      for (fcm_index i = inc_ptr[n]; i < inc_ptr[n + 1]; i++) {
+        const fcm_index f = inc[i];
+        if (color[f] < 0) continue;
+        int shares = 0;
+        for (int b = 0; b < s->nn && !shares; b++)
+          shares = cells[s->elem_cell[f] * s->nn + b] == n &&
+                   s->elem_dof[f * s->nn + b] == s->elem_dof[e * s->nn + a];
+        if (shares) forbid[color[f]] = e;
+      }
     }
     int k = 0;
-    while (k < MAX_COLORS && forbid[k] == c)
+    while (k < MAX_COLORS && forbid[k] == e)
       k++;
     FCM_CHECK(k < MAX_COLORS, ctx, FCM_ERR_UNSUPPORTED,
               "space: cell %lld needs more than %d colours (a node shared by too many cells)",
-              (long long)c, MAX_COLORS);
-    color[c] = k;
+              (long long)s->elem_cell[e], MAX_COLORS);
+    color[e] = k;
     ncol = FCM_MAX(ncol, k + 1);
   }
   s->num_colors = ncol;
   FCM_ALLOC(ctx, ncol + 1, s->color_ptr);
-  for (fcm_index c = 0; c < s->num_cells; c++)
-    if (color[c] >= 0) s->color_ptr[color[c] + 1]++;
+  for (fcm_index e = 0; e < s->num_elems; e++)
+    s->color_ptr[color[e] + 1]++;
   for (int k = 0; k < ncol; k++)
     s->color_ptr[k + 1] += s->color_ptr[k];
-  FCM_ALLOC(ctx, s->color_ptr[ncol], s->color_cells);
-  FCM_ALLOC(ctx, ncol, fill);
-  for (fcm_index c = 0; c < s->num_cells; c++)
-    if (color[c] >= 0) s->color_cells[s->color_ptr[color[c]] + fill[color[c]]++] = c;
+  FCM_ALLOC(ctx, s->color_ptr[ncol] + 1, s->color_elems);
+  FCM_ALLOC(ctx, ncol + 1, fill);
+  for (fcm_index e = 0; e < s->num_elems; e++)
+    s->color_elems[s->color_ptr[color[e]] + fill[color[e]]++] = e;
 cleanup:
   fcm__free(ctx, color);
   fcm__free(ctx, forbid);
@@ -186,7 +314,7 @@ static fcm_status space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigne
 {
   fcm_status st = FCM_OK;
   fcm_space *s = NULL;
-  fcm_index *inc_ptr = NULL, *inc = NULL, nact = 0, nactive_cells = 0;
+  fcm_index *inc_ptr = NULL, *inc = NULL, nactive_cells = 0;
   FCM_CHECK(out, ctx, FCM_ERR_ARG, "space: output pointer is NULL");
   *out = NULL;
   FCM_CHECK(mesh, ctx, FCM_ERR_ARG, "space: mesh is NULL");
@@ -204,34 +332,27 @@ static fcm_status space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigne
     if (rules) {
       fcm_cell_class cls = fcm_cell_rules_class(rules, c);
       s->active[c] = cls != FCM_CELL_DROPPED;
-      for (int k = 0; k < FCM_RULE_KIND_COUNT && cls == FCM_CELL_CUT; k++) {
-        int np = 0;
-        FCM_TRY(ctx, fcm_cell_rules_get(rules, c, (fcm_rule_kind)k, &np, NULL, NULL, NULL));
-        s->max_cut_points = FCM_MAX(s->max_cut_points, np);
-      }
+      fcm_index first = 0;
+      const fcm_index np = fcm_cell_rules_cell_pieces(rules, c, &first);
+      for (fcm_index p = first; p < first + np && cls == FCM_CELL_CUT; p++)
+        for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+          int n = 0;
+          FCM_TRY(ctx, fcm_cell_rules_get_piece(rules, p, (fcm_rule_kind)k, &n, NULL, NULL, NULL));
+          s->max_cut_points = FCM_MAX(s->max_cut_points, n);
+        }
     }
     nactive_cells += s->active[c];
   }
   FCM_CHECK(nactive_cells > 0, ctx, FCM_ERR_ARG, "space: none of the %lld cells is active",
             (long long)s->num_cells);
   FCM_ALLOC(ctx, s->num_nodes, s->node_dof);
-  {
-    const fcm_index *cells = fcm_mesh_cells(mesh);
-    for (fcm_index n = 0; n < s->num_nodes; n++)
-      s->node_dof[n] = -1;
-    for (fcm_index c = 0; c < s->num_cells; c++)
-      if (s->active[c])
-        for (int a = 0; a < s->nn; a++)
-          s->node_dof[cells[c * s->nn + a]] = 0;
-    for (fcm_index n = 0; n < s->num_nodes; n++)
-      if (s->node_dof[n] == 0) s->node_dof[n] = 3 * nact++;
-  }
-  s->num_dofs = 3 * nact;
+  FCM_TRY(ctx, build_elements(s));
+  FCM_TRY(ctx, build_incidence(s, &inc_ptr, &inc));
+  FCM_TRY(ctx, build_copies(s, inc_ptr, inc));
   {
     int dummy;
     FCM_TRY(ctx, fcm__index_to_int(ctx, s->num_dofs, "space: number of DOFs", &dummy));
   }
-  FCM_TRY(ctx, build_incidence(s, &inc_ptr, &inc));
   FCM_TRY(ctx, build_node_graph(s, inc_ptr, inc));
   FCM_TRY(ctx, build_pattern(s));
   FCM_TRY(ctx, build_colors(s, inc_ptr, inc));
@@ -279,13 +400,18 @@ void fcm_space_destroy(fcm_space **sp)
   fcm_ctx *ctx = s->ctx;
   fcm__free(ctx, s->active);
   fcm__free(ctx, s->node_dof);
+  fcm__free(ctx, s->node_ncopy);
+  fcm__free(ctx, s->cell_elem);
+  fcm__free(ctx, s->elem_cell);
+  fcm__free(ctx, s->elem_piece);
+  fcm__free(ctx, s->elem_dof);
   fcm__free(ctx, s->node_ptr);
   fcm__free(ctx, s->node_adj);
   fcm__free(ctx, s->row_ptr);
   fcm__free(ctx, s->col_idx);
-  fcm__free(ctx, s->cell_off);
+  fcm__free(ctx, s->elem_off);
   fcm__free(ctx, s->color_ptr);
-  fcm__free(ctx, s->color_cells);
+  fcm__free(ctx, s->color_elems);
   fcm__free(ctx, s);
   *sp = NULL;
 }
@@ -298,6 +424,36 @@ fcm_index fcm_space_num_dofs(const fcm_space *s)
 fcm_index fcm_space_node_dof(const fcm_space *s, fcm_index node)
 {
   return (node < 0 || node >= s->num_nodes) ? -1 : s->node_dof[node];
+}
+
+fcm_index fcm_space_node_copies(const fcm_space *s, fcm_index node)
+{
+  return (node < 0 || node >= s->num_nodes) ? 0 : s->node_ncopy[node];
+}
+
+fcm_index fcm_space_num_elements(const fcm_space *s)
+{
+  return s->num_elems;
+}
+
+fcm_index fcm_space_cell_elements(const fcm_space *s, fcm_index cell, fcm_index *first)
+{
+  if (cell < 0 || cell >= s->num_cells) {
+    if (first) *first = 0;
+    return 0;
+  }
+  if (first) *first = s->cell_elem[cell];
+  return s->cell_elem[cell + 1] - s->cell_elem[cell];
+}
+
+fcm_index fcm_space_element_cell(const fcm_space *s, fcm_index elem)
+{
+  return (elem < 0 || elem >= s->num_elems) ? -1 : s->elem_cell[elem];
+}
+
+const fcm_index *fcm_space_element_dofs(const fcm_space *s, fcm_index elem)
+{
+  return (elem < 0 || elem >= s->num_elems) ? NULL : s->elem_dof + elem * s->nn;
 }
 
 int fcm_space_num_colors(const fcm_space *s)
@@ -382,5 +538,38 @@ fcm_status fcm_space_apply_dirichlet(const fcm_space *s, fcm_index ncon, const f
 cleanup:
   fcm__free(ctx, con);
   fcm__free(ctx, g);
+  return st;
+}
+
+fcm_status fcm_space_transfer(const fcm_space *from, const fcm_space *to, const double *x_from,
+                              double *x_to)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = to ? to->ctx : NULL;
+  FCM_CHECK(from && to && x_from && x_to, ctx, FCM_ERR_ARG, "space transfer: NULL argument");
+  FCM_CHECK(from->mesh == to->mesh && from->rules && to->rules, ctx, FCM_ERR_ARG,
+            "space transfer: both spaces must be embedded spaces on the same mesh");
+  FCM_CHECK(fcm_cell_rules_parent_num_pieces(to->rules) == fcm_cell_rules_num_pieces(from->rules) &&
+                fcm_cell_rules_parent_num_pieces(to->rules) > 0,
+            ctx, FCM_ERR_ARG,
+            "space transfer: the target's cell rules (made from rules with %lld pieces) do not "
+            "extend the source's (%lld pieces) by a cut (fcm_cell_rules_create_cut())",
+            (long long)fcm_cell_rules_parent_num_pieces(to->rules),
+            (long long)fcm_cell_rules_num_pieces(from->rules));
+  for (fcm_index e = 0; e < to->num_elems; e++) {
+    const fcm_index c = to->elem_cell[e],
+                    pp = fcm_cell_rules_piece_parent(to->rules, to->elem_piece[e]);
+    fcm_index first = 0;
+    fcm_cell_rules_cell_pieces(from->rules, c, &first);
+    const fcm_index fe = from->cell_elem[c] + (pp - first);
+    FCM_CHECK(pp >= first && fe < from->cell_elem[c + 1], ctx, FCM_ERR_INTERNAL,
+              "space transfer: element %lld (cell %lld) has parent piece %lld outside the "
+              "cell's pieces in the source",
+              (long long)e, (long long)c, (long long)pp);
+    for (int a = 0; a < to->nn; a++)
+      for (int i = 0; i < 3; i++)
+        x_to[to->elem_dof[e * to->nn + a] + i] = x_from[from->elem_dof[fe * from->nn + a] + i];
+  }
+cleanup:
   return st;
 }

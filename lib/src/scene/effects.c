@@ -397,6 +397,128 @@ static void view_pressure(const fcm_effect *e, FILE *f)
   fcm__scene_region_view(&q->region, f);
 }
 
+/* A unit vector at member `key` (required). */
+static fcm_status read_unit(fcm__scene_parser *p, const fcm__json *o, const char *key, double v[3])
+{
+  fcm_status st = FCM_OK;
+  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, key, 1, FCM__ANY, v));
+  const double n = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  size_t old = fcm__scene_path_push_key(p, key);
+  SCENE_CHECK(n > 0.0 && isfinite(n), p, FCM_ERR_ARG, "expected a non-zero vector, got (%g, %g, %g)",
+              v[0], v[1], v[2]);
+  fcm__scene_path_pop(p, old);
+  for (int d = 0; d < 3; d++)
+    v[d] /= n;
+cleanup:
+  return st;
+}
+
+static fcm_status parse_cut(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"time", "surface"};
+  static const char *const forms[] = {"plane", "rectangle", "disc", "mesh"};
+  static const char *const plane_keys[] = {"point", "normal", "transform"};
+  static const char *const rect_keys[] = {"center", "normal", "axis", "size", "transform"};
+  static const char *const disc_keys[] = {"center", "normal", "radius", "segments", "transform"};
+  fcm_effect_cut *c = &e->cut;
+  const fcm__json *sf = NULL, *f = NULL;
+  const double duration = p->scene->time.duration;
+  memset(c, 0, sizeof *c);
+  for (int i = 0; i < 9; i++)
+    c->transform[i] = (i % 4 == 0);
+  c->segments = 64;
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "time", 0, (fcm__range){0.0, duration, 0, 0},
+                                         &c->time));
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "surface", 1, &sf));
+  size_t old = fcm__scene_path_push_key(p, "surface");
+  SCENE_CHECK(fcm__json_size(sf) == 1, p, FCM_ERR_ARG,
+              "expected an object with one key naming the form (\"plane\", \"rectangle\", "
+              "\"disc\" or \"mesh\"), got %d keys",
+              (int)fcm__json_size(sf));
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, sf, forms, COUNT(forms)));
+  if (fcm__json_member(sf, "mesh")) {
+    c->kind = FCM_CUT_MESH;
+    FCM_TRY(p->ctx, fcm__scene_read_file(p, sf, "mesh", 1, NULL, &c->mesh));
+  } else {
+    const char *name = fcm__json_member(sf, "plane")       ? "plane"
+                       : fcm__json_member(sf, "rectangle") ? "rectangle"
+                                                           : "disc";
+    FCM_TRY(p->ctx, fcm__scene_read_object(p, sf, name, 1, &f));
+    size_t o2 = fcm__scene_path_push_key(p, name);
+    if (!strcmp(name, "plane")) {
+      c->kind = FCM_CUT_PLANE;
+      FCM_TRY(p->ctx, fcm__scene_check_object(p, f, plane_keys, COUNT(plane_keys)));
+      FCM_TRY(p->ctx, fcm__scene_read_vec3(p, f, "point", 1, FCM__ANY, c->point));
+      FCM_TRY(p->ctx, read_unit(p, f, "normal", c->normal));
+    } else if (!strcmp(name, "rectangle")) {
+      c->kind = FCM_CUT_RECTANGLE;
+      FCM_TRY(p->ctx, fcm__scene_check_object(p, f, rect_keys, COUNT(rect_keys)));
+      FCM_TRY(p->ctx, fcm__scene_read_vec3(p, f, "center", 1, FCM__ANY, c->point));
+      FCM_TRY(p->ctx, read_unit(p, f, "normal", c->normal));
+      FCM_TRY(p->ctx, read_unit(p, f, "axis", c->axis));
+      const double dot =
+          c->axis[0] * c->normal[0] + c->axis[1] * c->normal[1] + c->axis[2] * c->normal[2];
+      size_t o3 = fcm__scene_path_push_key(p, "axis");
+      SCENE_CHECK(fabs(dot) < 1.0 - 1e-9, p, FCM_ERR_ARG,
+                  "expected a direction not parallel to the normal, got (%g, %g, %g)",
+                  c->axis[0], c->axis[1], c->axis[2]);
+      fcm__scene_path_pop(p, o3);
+      const fcm__json *sz = NULL;
+      FCM_TRY(p->ctx, fcm__scene_field(p, f, "size", 1, "an array of 2 numbers > 0 [a, b]",
+                                       FCM__JSON_ARRAY, 2, &sz));
+      const fcm__json *v = fcm__json_child(sz);
+      for (int k = 0; k < 2; k++, v = fcm__json_next(v)) {
+        c->size[k] = fcm__json_get_kind(v) == FCM__JSON_NUMBER ? fcm__json_number(v) : -1.0;
+        SCENE_CHECK(isfinite(c->size[k]) && c->size[k] > 0.0, p, FCM_ERR_ARG,
+                    "expected an array of 2 numbers > 0 [a, b]; entry %d is not", k);
+      }
+      fcm__scene_path_pop(p, o3);
+    } else {
+      long long seg = 64;
+      c->kind = FCM_CUT_DISC;
+      FCM_TRY(p->ctx, fcm__scene_check_object(p, f, disc_keys, COUNT(disc_keys)));
+      FCM_TRY(p->ctx, fcm__scene_read_vec3(p, f, "center", 1, FCM__ANY, c->point));
+      FCM_TRY(p->ctx, read_unit(p, f, "normal", c->normal));
+      FCM_TRY(p->ctx, fcm__scene_read_number(p, f, "radius", 1, FCM__POSITIVE, &c->radius));
+      FCM_TRY(p->ctx, fcm__scene_read_int(p, f, "segments", 0, 3, 256, &seg));
+      c->segments = (int)seg;
+    }
+    FCM_TRY(p->ctx, fcm__scene_read_transform(p, f, c->transform, c->offset, &c->has_transform));
+    fcm__scene_path_pop(p, o2);
+  }
+  fcm__scene_path_pop(p, old);
+cleanup:
+  return st;
+}
+
+static void view_cut(const fcm_effect *e, FILE *f)
+{
+  const fcm_effect_cut *c = &e->cut;
+  const double *q = c->point, *n = c->normal;
+  fprintf(f, "at t = %g s: ", c->time);
+  switch (c->kind) {
+  case FCM_CUT_PLANE:
+    fprintf(f, "plane through (%g, %g, %g), normal (%g, %g, %g)", q[0], q[1], q[2], n[0], n[1],
+            n[2]);
+    break;
+  case FCM_CUT_RECTANGLE:
+    fprintf(f, "rectangle %g x %g at (%g, %g, %g), normal (%g, %g, %g), axis (%g, %g, %g)",
+            c->size[0], c->size[1], q[0], q[1], q[2], n[0], n[1], n[2], c->axis[0], c->axis[1],
+            c->axis[2]);
+    break;
+  case FCM_CUT_DISC:
+    fprintf(f, "disc of radius %g (%d segments) at (%g, %g, %g), normal (%g, %g, %g)", c->radius,
+            c->segments, q[0], q[1], q[2], n[0], n[1], n[2]);
+    break;
+  case FCM_CUT_MESH:
+    fprintf(f, "mesh %s", c->mesh);
+    break;
+  }
+  if (c->has_transform) fprintf(f, " (transformed)");
+}
+
 /* The one table of effect modules. Order = enum fcm_effect_type. */
 static const fcm__effect_type effect_types[FCM_EFFECT_TYPE_COUNT] = {
     {.type = FCM_EFFECT_GRAVITY,
@@ -450,6 +572,12 @@ static const fcm__effect_type effect_types[FCM_EFFECT_TYPE_COUNT] = {
      .view = view_pressure,
      .needs = FCM__NEEDS_SURFACE_RULES,
      .apply = fcm__effect_apply_surface_load},
+    {.type = FCM_EFFECT_CUT,
+     .name = "cut",
+     .summary = "a cut surface inserted at a time (XFEM): the body separates along it",
+     .allowed_static = 1,
+     .parse = parse_cut,
+     .view = view_cut},
 };
 
 const fcm__effect_type *fcm__scene_effect_type(fcm_effect_type type)

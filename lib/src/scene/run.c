@@ -168,8 +168,8 @@ static fcm_status center_of_mass(const fcm_simulation *S, const double *u, doubl
   FCM_ALLOC(S->ctx, n, x);
   FCM_ALLOC(S->ctx, n, Mx);
   for (fcm_index a = 0; a < S->nn; a++) {
-    fcm_index dof = fcm_space_node_dof(S->space, a);
-    if (dof >= 0)
+    const fcm_index d0 = fcm_space_node_dof(S->space, a);
+    for (fcm_index dof = d0; d0 >= 0 && dof < d0 + 3 * fcm_space_node_copies(S->space, a); dof += 3)
       for (int d = 0; d < 3; d++)
         x[dof + d] = X[3 * a + d] + (u ? u[dof + d] : 0.0);
   }
@@ -215,8 +215,9 @@ fcm_status fcm__effect_initialize_velocity(fcm_simulation *S, const fcm_effect *
     } else {
       in = fcm_region_contains(r, X + 3 * a);
     }
-    if (in)
-      fcm_effect_initial_velocity_eval(&e->initial_velocity, X + 3 * a, init->com, init->v + dof);
+    for (fcm_index k = 0; in && k < fcm_space_node_copies(S->space, a); k++)
+      fcm_effect_initial_velocity_eval(&e->initial_velocity, X + 3 * a, init->com,
+                                       init->v + dof + 3 * k);
   }
   S->c.initial_velocity++;
   return FCM_OK;
@@ -305,11 +306,103 @@ static const char *geometry_path(fcm_scene_geometry_kind k)
     return "geometry.voxels";
   case FCM_SCENE_GEOMETRY_LEVEL_SET:
     return "geometry.level_set";
+  case FCM_SCENE_GEOMETRY_SURFACE:
+    return "geometry.surface";
   case FCM_SCENE_GEOMETRY_NONE:
     return "geometry";
   default:
     return "geometry.shape";
   }
+}
+
+/* geometry.surface: read, optionally close holes (logged as a warning with what was
+ * closed), tetrahedralize. */
+static fcm_status build_surface_geometry(fcm_simulation *S, const fcm_scene_geometry *g,
+                                         fcm_geometry **raw)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  fcm_surface *surf = NULL, *filled = NULL;
+  FCM_TRY(ctx, fcm_surface_create_from_file(ctx, g->mesh, &surf));
+  if (g->fill_holes) {
+    fcm_surface_fill_info fi;
+    FCM_TRY(ctx, fcm_surface_create_filled(ctx, surf, &g->fill, &filled, &fi));
+    if (fi.num_loops > 0) {
+      char list[256];
+      size_t n = 0;
+      list[0] = '\0';
+      for (fcm_index i = 0; i < fi.num_filled && i < FCM_SURFACE_FILL_MAX_LOOPS; i++) {
+        int k = snprintf(list + n, sizeof list - n, "%s%lld", i ? ", " : "",
+                         (long long)fi.loop_edges[i]);
+        if (k < 0 || (size_t)k >= sizeof list - n) break;
+        n += (size_t)k;
+      }
+      fcm__log(ctx, FCM_LOG_WARNING,
+               "scene %s: geometry.surface %s: fill_holes closed %lld of %lld hole(s) (edges: "
+               "%s), adding %lld triangles of total area %g; largest left open: %lld edges",
+               fcm_scene_name(S->scene), g->mesh, (long long)fi.num_filled, (long long)fi.num_loops,
+               list, (long long)fi.triangles_added, fi.area_added, (long long)fi.largest_left);
+    }
+    fcm_surface_destroy(&surf);
+    surf = filled;
+    filled = NULL;
+  }
+  /* the checks here, so that a failure names the scene and the file */
+  {
+    char what[512];
+    fcm_surface_report rep;
+    fcm_surface_mesh_options mo = g->surface;
+    snprintf(what, sizeof what, "scene %s: geometry.surface %s", fcm_scene_name(S->scene), g->mesh);
+    FCM_TRY(ctx, fcm_surface_create_oriented(ctx, surf, &filled, NULL));
+    fcm_surface_destroy(&surf);
+    surf = filled;
+    filled = NULL;
+    FCM_TRY(ctx, fcm_surface_check(surf, NULL, &rep));
+    FCM_TRY(ctx, fcm_surface_report_check(surf, what, &rep));
+    mo.check_intersections = 0; /* done above */
+    mo.orient = 0;
+    FCM_TRY(ctx, fcm_geometry_create_from_surface(ctx, surf, &mo, raw));
+  }
+cleanup:
+  fcm_surface_destroy(&surf);
+  fcm_surface_destroy(&filled);
+  return st;
+}
+
+/* background.fit_background: cubes of the given edge over the geometry's bounding box
+ * grown by the margin, the grid centred on the box. */
+static fcm_status fit_background(fcm_simulation *S, const fcm_scene_background *bg, double min[3],
+                                 double max[3], fcm_index cells[3])
+{
+  fcm_status st = FCM_OK;
+  double lo[3], hi[3], h = bg->fit_cell_size;
+  fcm_geometry_bounding_box(S->geom, lo, hi);
+  double total = 1.0;
+  for (int d = 0; d < 3; d++) {
+    FCM_CHECK(lo[d] <= hi[d], S->ctx, FCM_ERR_GEOMETRY,
+              "scene %s: background.fit_background: the geometry is empty",
+              fcm_scene_name(S->scene));
+    double len = hi[d] - lo[d] + 2.0 * bg->fit_margin;
+    double n = ceil(len / h - 1e-9);
+    if (n < 1.0) n = 1.0;
+    total *= n;
+    FCM_CHECK(total <= 1e8, S->ctx, FCM_ERR_ARG,
+              "scene %s: background.fit_background: cell_size %g gives more than 1e8 cells "
+              "around the geometry's box [%g, %g] x [%g, %g] x [%g, %g]; use larger cells",
+              fcm_scene_name(S->scene), h, lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]);
+    double c = 0.5 * (lo[d] + hi[d]);
+    cells[d] = (fcm_index)n;
+    min[d] = c - 0.5 * n * h, max[d] = c + 0.5 * n * h;
+  }
+cleanup:
+  return st;
+}
+
+/* Put the scene section `path` before the recorded error's message, unless the message
+ * names it already. */
+static void name_section(fcm_ctx *ctx, const char *path)
+{
+  if (!strstr(fcm_ctx_error_message(ctx), path)) fcm__error_prefix(ctx, path);
 }
 
 static fcm_status build_geometry(fcm_simulation *S, const fcm_scene_geometry *g)
@@ -341,6 +434,9 @@ static fcm_status build_geometry(fcm_simulation *S, const fcm_scene_geometry *g)
     break;
   case FCM_SCENE_GEOMETRY_TETGEN:
     FCM_TRY(ctx, fcm_geometry_create_from_tetgen(ctx, g->mesh, g->ele, &raw));
+    break;
+  case FCM_SCENE_GEOMETRY_SURFACE:
+    FCM_TRY(ctx, build_surface_geometry(S, g, &raw));
     break;
   case FCM_SCENE_GEOMETRY_VOXELS:
     FCM_TRY(ctx, build_voxels(S, g, &raw));
@@ -532,21 +628,33 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
 
   /* background mesh; errors of the inputs name the scene section they come from */
   const fcm_scene_background *bg = fcm_scene_get_background(scene);
-  if (bg->kind == FCM_SCENE_BACKGROUND_GRID)
+  const fcm_scene_geometry *g = fcm_scene_get_geometry(scene);
+  if (bg->kind == FCM_SCENE_BACKGROUND_GRID && bg->fit) {
+    double min[3], max[3];
+    fcm_index cells[3];
+    st = build_geometry(S, g); /* the parser ensured there is one */
+    if (st != FCM_OK) name_section(ctx, geometry_path(g->kind));
+    FCM_TRY(ctx, st);
+    st = fit_background(S, bg, min, max, cells);
+    if (st == FCM_OK) st = fcm_mesh_create_box(ctx, bg->element, min, max, cells, &S->mesh);
+    if (st != FCM_OK) name_section(ctx, "background.fit_background");
+    FCM_TRY(ctx, st);
+  } else if (bg->kind == FCM_SCENE_BACKGROUND_GRID)
     st = fcm_mesh_create_box(ctx, bg->element, bg->min, bg->max, bg->cells, &S->mesh);
   else
     st = fcm_mesh_create_from_gmsh(ctx, bg->mesh, &S->mesh);
   if (st != FCM_OK)
-    fcm__error_prefix(ctx, bg->kind == FCM_SCENE_BACKGROUND_GRID ? "background" : "background.mesh");
+    name_section(ctx, bg->kind == FCM_SCENE_BACKGROUND_GRID ? "background" : "background.mesh");
   FCM_TRY(ctx, st);
   S->nn = fcm_mesh_num_nodes(S->mesh);
 
   /* geometry and cell rules only when the scene embeds one */
-  const fcm_scene_geometry *g = fcm_scene_get_geometry(scene);
   if (g->kind != FCM_SCENE_GEOMETRY_NONE) {
-    st = build_geometry(S, g);
-    if (st != FCM_OK) fcm__error_prefix(ctx, geometry_path(g->kind));
-    FCM_TRY(ctx, st);
+    if (!S->geom) {
+      st = build_geometry(S, g);
+      if (st != FCM_OK) name_section(ctx, geometry_path(g->kind));
+      FCM_TRY(ctx, st);
+    }
     st = build_rules(S);
     if (st != FCM_OK)
       fcm__error_prefix(ctx, st == FCM_ERR_GEOMETRY ? "geometry" : "quadrature");

@@ -111,10 +111,43 @@ static const char *choice_name(const char *const *names, const int *values, int 
 
 /* ---------------------------------------------------------------- background */
 
+/* "fit_background": {"cell_size": h, "margin": m}: a grid of cubes of edge h around the
+ * geometry's bounding box grown by m on every side, placed when the simulation is built. */
+static fcm_status read_fit_background(fcm__scene_parser *p, const fcm__json *o,
+                                      fcm_scene_background *b)
+{
+  fcm_status st = FCM_OK;
+  static const char *const fit_keys[] = {"cell_size", "margin"};
+  static const char *const excluded[] = {"box", "cells", "mesh"};
+  const fcm__json *fit = NULL;
+  size_t old = p->path_len;
+  for (int i = 0; i < COUNT(excluded); i++) {
+    if (!fcm__json_member(o, excluded[i])) continue;
+    fcm__scene_path_push_key(p, excluded[i]);
+    SCENE_CHECK(0, p, FCM_ERR_ARG,
+                "not allowed with \"fit_background\" (which places the grid around the "
+                "geometry: give either \"fit_background\" or \"box\" and \"cells\")");
+  }
+  b->kind = FCM_SCENE_BACKGROUND_GRID;
+  b->fit = 1;
+  READ_CHOICE(p, o, "element", 1, element_names, b->element);
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "fit_background", 1, &fit));
+  ENTER(p, "fit_background");
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, fit, fit_keys, COUNT(fit_keys)));
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, fit, "cell_size", 1, FCM__POSITIVE, &b->fit_cell_size));
+  b->fit_margin = b->fit_cell_size;
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, fit, "margin", 0, FCM__NONNEGATIVE, &b->fit_margin));
+  b->cells[0] = b->cells[1] = b->cells[2] = 1;
+  b->max[0] = b->max[1] = b->max[2] = 1.0;
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
 static fcm_status read_background(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"element", "box", "cells", "mesh"};
+  static const char *const keys[] = {"element", "box", "cells", "mesh", "fit_background"};
   static const char *const box_keys[] = {"min", "max"};
   fcm_scene_background *b = &p->scene->background;
   const fcm__json *o = NULL, *box = NULL;
@@ -122,6 +155,10 @@ static fcm_status read_background(fcm__scene_parser *p, const fcm__json *root)
   FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "background", 1, &o));
   ENTER(p, "background");
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+  if (fcm__json_member(o, "fit_background")) {
+    FCM_TRY(p->ctx, read_fit_background(p, o, b));
+    goto cleanup;
+  }
   if (fcm__json_member(o, "mesh")) {
     for (int i = 0; i < 3; i++) {
       if (!fcm__json_member(o, keys[i])) continue;
@@ -135,7 +172,8 @@ static fcm_status read_background(fcm__scene_parser *p, const fcm__json *root)
     goto cleanup;
   }
   SCENE_CHECK(fcm__json_member(o, "box"), p, FCM_ERR_ARG,
-              "expected either \"box\" (with \"element\" and \"cells\") for a generated grid "
+              "expected either \"box\" (with \"element\" and \"cells\") for a generated grid, "
+              "\"fit_background\" (with \"element\") for a grid around the geometry, "
               "or \"mesh\" (a Gmsh file)");
   b->kind = FCM_SCENE_BACKGROUND_GRID;
   READ_CHOICE(p, o, "element", 1, element_names, b->element);
@@ -165,7 +203,8 @@ cleanup:
 
 /* ---------------------------------------------------------------- geometry */
 
-static fcm_status read_transform(fcm__scene_parser *p, const fcm__json *o, fcm_scene_geometry *g)
+fcm_status fcm__scene_read_transform(fcm__scene_parser *p, const fcm__json *o, double A[9],
+                                     double b[3], int *has)
 {
   fcm_status st = FCM_OK;
   static const char *const keys[] = {"scale", "rotation", "translation"};
@@ -208,9 +247,65 @@ static fcm_status read_transform(fcm__scene_parser *p, const fcm__json *o, fcm_s
                  c + a[2] * a[2] * (1 - c)};
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++)
-      g->transform[3 * i + j] = R[3 * i + j] * scale[j];
-  memcpy(g->offset, offset, sizeof offset);
-  g->has_transform = 1;
+      A[3 * i + j] = R[3 * i + j] * scale[j];
+  memcpy(b, offset, sizeof offset);
+  *has = 1;
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
+/* "surface": a triangle surface file tetrahedralized when the simulation is built. */
+static fcm_status read_surface_geometry(fcm__scene_parser *p, const fcm__json *o,
+                                        fcm_scene_geometry *g)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {
+      "surface",        "max_volume",         "size",     "quality", "fill_holes",
+      "max_hole_edges", "max_hole_perimeter", "transform"};
+  static const char *const exts[] = {".obj", ".off", ".stl", ".ply"};
+  size_t old = p->path_len;
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+  g->kind = FCM_SCENE_GEOMETRY_SURFACE;
+  FCM_TRY(p->ctx, fcm__scene_read_file(p, o, "surface", 1, NULL, &g->mesh));
+  {
+    size_t n = strlen(g->mesh);
+    int known = 0;
+    for (int i = 0; i < COUNT(exts); i++) {
+      size_t e = strlen(exts[i]);
+      int eq = n >= e;
+      for (size_t k = 0; eq && k < e; k++) {
+        char c = g->mesh[n - e + k];
+        eq = (c >= 'A' && c <= 'Z' ? (char)(c - 'A' + 'a') : c) == exts[i][k];
+      }
+      known |= eq;
+    }
+    fcm__scene_path_push_key(p, "surface");
+    SCENE_CHECK(known, p, FCM_ERR_ARG,
+                "expected a file ending in .obj, .off, .stl or .ply, got '%s'", g->mesh);
+    fcm__scene_path_pop(p, old);
+  }
+  g->surface = fcm_surface_mesh_options_default();
+  g->fill = fcm_surface_fill_options_default();
+  FCM_TRY(p->ctx,
+          fcm__scene_read_number(p, o, "max_volume", 0, FCM__NONNEGATIVE, &g->surface.max_volume));
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "size", 0, FCM__NONNEGATIVE, &g->surface.size));
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "quality", 0, (fcm__range){0.0, 1.0, 0, 0},
+                                         &g->surface.quality));
+  FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "fill_holes", 0, &g->fill_holes));
+  long long me = 0;
+  FCM_TRY(p->ctx, fcm__scene_read_int(p, o, "max_hole_edges", 0, 0, 1000000000, &me));
+  g->fill.max_edges = (fcm_index)me;
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "max_hole_perimeter", 0, FCM__NONNEGATIVE,
+                                         &g->fill.max_perimeter));
+  if (!g->fill_holes) {
+    static const char *const fill_keys[] = {"max_hole_edges", "max_hole_perimeter"};
+    for (int i = 0; i < COUNT(fill_keys); i++) {
+      if (!fcm__json_member(o, fill_keys[i])) continue;
+      fcm__scene_path_push_key(p, fill_keys[i]);
+      SCENE_CHECK(0, p, FCM_ERR_ARG, "only used with \"fill_holes\": true");
+    }
+  }
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
@@ -408,10 +503,13 @@ static fcm_status read_geometry(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
   static const char *const any_keys[] = {
-      "shape",  "mesh",   "tetgen",       "transform",     "min",          "max",         "cells",
-      "center", "radius", "resolution",   "inner_radius",  "outer_radius", "hole_radius", "layers",
-      "axis",   "length", "radial_cells", "angular_cells", "axial_cells", "voxels",
-      "threshold", "labels", "merge", "level_set", "refinement"};
+      "shape",          "mesh",         "tetgen",        "transform",          "min",
+      "max",            "cells",        "center",        "radius",             "resolution",
+      "inner_radius",   "outer_radius", "hole_radius",   "layers",             "axis",
+      "length",         "radial_cells", "angular_cells", "axial_cells",        "surface",
+      "max_volume",     "size",         "quality",       "fill_holes",         "max_hole_edges",
+      "max_hole_perimeter", "voxels",   "threshold",     "labels",             "merge",
+      "level_set",      "refinement"};
   static const char *const voxel_keys[] = {"voxels", "threshold", "labels", "merge", "transform"};
   static const char *const level_set_keys[] = {"level_set", "refinement", "min",
                                                "max",       "cells",      "transform"};
@@ -437,14 +535,17 @@ static fcm_status read_geometry(fcm__scene_parser *p, const fcm__json *root)
   /* Typos first (against every geometry key), then the keys of the chosen kind. */
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, any_keys, COUNT(any_keys)));
   int nd = !!fcm__json_member(o, "shape") + !!fcm__json_member(o, "mesh") +
-           !!fcm__json_member(o, "tetgen") + !!fcm__json_member(o, "voxels") +
-           !!fcm__json_member(o, "level_set");
+           !!fcm__json_member(o, "tetgen") + !!fcm__json_member(o, "surface") +
+           !!fcm__json_member(o, "voxels") + !!fcm__json_member(o, "level_set");
   SCENE_CHECK(nd == 1, p, FCM_ERR_ARG,
               "expected exactly one of \"shape\" (a procedural shape), \"mesh\" (a Gmsh file), "
-              "\"tetgen\" (a TetGen base name), \"voxels\" (an image file) or \"level_set\" "
-              "(an implicit body), got %d of them",
+              "\"tetgen\" (a TetGen base name), \"surface\" (an .obj, .off, .stl or .ply "
+              "triangle surface), \"voxels\" (an image file) or \"level_set\" (an implicit "
+              "body), got %d of them",
               nd);
-  if (fcm__json_member(o, "voxels")) {
+  if (fcm__json_member(o, "surface")) {
+    FCM_TRY(p->ctx, read_surface_geometry(p, o, g));
+  } else if (fcm__json_member(o, "voxels")) {
     FCM_TRY(p->ctx, fcm__scene_check_object(p, o, voxel_keys, COUNT(voxel_keys)));
     g->kind = FCM_SCENE_GEOMETRY_VOXELS;
     FCM_TRY(p->ctx, read_voxels(p, o, g));
@@ -522,7 +623,7 @@ static fcm_status read_geometry(fcm__scene_parser *p, const fcm__json *root)
       break;
     }
   }
-  FCM_TRY(p->ctx, read_transform(p, o, g));
+  FCM_TRY(p->ctx, fcm__scene_read_transform(p, o, g->transform, g->offset, &g->has_transform));
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
@@ -836,6 +937,12 @@ static fcm_status parse_root(fcm__scene_parser *p, const fcm__json *root)
   FCM_TRY(p->ctx, fcm__scene_read_string(p, root, "description", 0, &s->description));
   FCM_TRY(p->ctx, read_background(p, root));
   FCM_TRY(p->ctx, read_geometry(p, root));
+  if (s->background.fit && s->geometry.kind == FCM_SCENE_GEOMETRY_NONE) {
+    fcm__scene_path_push_key(p, "background");
+    fcm__scene_path_push_key(p, "fit_background");
+    SCENE_CHECK(0, p, FCM_ERR_ARG,
+                "needs an embedded \"geometry\" to fit the grid around (the scene has none)");
+  }
   FCM_TRY(p->ctx, read_material(p, root));
   FCM_TRY(p->ctx, read_quadrature(p, root));
   FCM_TRY(p->ctx, read_solver(p, root));
@@ -1037,7 +1144,10 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
   const fcm_scene_time *t = &s->time;
   fprintf(f, "scene %s (%s)\n", s->name, s->source);
   if (s->description[0]) fprintf(f, "  %s\n", s->description);
-  if (b->kind == FCM_SCENE_BACKGROUND_GRID)
+  if (b->kind == FCM_SCENE_BACKGROUND_GRID && b->fit)
+    fprintf(f, "background: %s grid of %g m cubes fitted around the geometry, margin %g m\n",
+            element_names[b->element], b->fit_cell_size, b->fit_margin);
+  else if (b->kind == FCM_SCENE_BACKGROUND_GRID)
     fprintf(f, "background: %s grid %lld x %lld x %lld over [%g, %g] x [%g, %g] x [%g, %g] m\n",
             element_names[b->element], (long long)b->cells[0], (long long)b->cells[1],
             (long long)b->cells[2], b->min[0], b->max[0], b->min[1], b->max[1], b->min[2],
@@ -1074,6 +1184,11 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
     break;
   case FCM_SCENE_GEOMETRY_GMSH:
     fprintf(f, "mesh %s", g->mesh);
+    break;
+  case FCM_SCENE_GEOMETRY_SURFACE:
+    fprintf(f, "surface %s, tetrahedralized (max_volume %g, size %g, quality %g), fill_holes %s",
+            g->mesh, g->surface.max_volume, g->surface.size, g->surface.quality,
+            g->fill_holes ? "yes" : "no");
     break;
   case FCM_SCENE_GEOMETRY_VOXELS:
     fprintf(f, "voxels %s, ", g->image);

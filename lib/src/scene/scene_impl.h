@@ -227,6 +227,11 @@ fcm_status fcm__effect_initialize_velocity(fcm_simulation *sim, const fcm_effect
 const fcm__effect_type *fcm__scene_effect_type(fcm_effect_type type);
 const fcm__effect_type *fcm__scene_effect_type_find(const char *name);
 
+/* The optional "transform" member of o (scale, rotation, translation) into x -> A x + b;
+ * *has = 1 when present (A, b untouched otherwise). */
+fcm_status fcm__scene_read_transform(fcm__scene_parser *p, const fcm__json *o, double A[9],
+                                     double b[3], int *has);
+
 /* Parse the "effects" array (absent: no effects) into p->scene. */
 fcm_status fcm__scene_read_effects(fcm__scene_parser *p, const fcm__json *root);
 

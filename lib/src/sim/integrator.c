@@ -437,16 +437,17 @@ static fcm_status build_constraints(fcm_integrator *I)
   for (int k = 0; k < I->num_cons; k++) {
     const sim_constraint *c = &I->cons[k];
     for (fcm_index a = 0; a < c->num_nodes; a++) {
-      fcm_index d = fcm_space_node_dof(I->space, c->nodes[a]);
-      if (d < 0) continue;
-      for (int i = 0; i < 3; i++) {
-        if (!c->motion.components[i]) continue;
-        FCM_CHECK(owner[d + i] == 0 || owner[d + i] == k + 1, ctx, FCM_ERR_ARG,
-                  "constraint %d: node %lld component %c is already constrained by constraint %d",
-                  k, (long long)c->nodes[a], "xyz"[i], owner[d + i] - 1);
-        if (owner[d + i] == 0) count++;
-        owner[d + i] = k + 1;
-      }
+      const fcm_index d0 = fcm_space_node_dof(I->space, c->nodes[a]);
+      const fcm_index ncp = fcm_space_node_copies(I->space, c->nodes[a]);
+      for (fcm_index d = d0; d0 >= 0 && d < d0 + 3 * ncp; d += 3) /* every copy */
+        for (int i = 0; i < 3; i++) {
+          if (!c->motion.components[i]) continue;
+          FCM_CHECK(owner[d + i] == 0 || owner[d + i] == k + 1, ctx, FCM_ERR_ARG,
+                    "constraint %d: node %lld component %c is already constrained by constraint %d",
+                    k, (long long)c->nodes[a], "xyz"[i], owner[d + i] - 1);
+          if (owner[d + i] == 0) count++;
+          owner[d + i] = k + 1;
+        }
     }
   }
   I->ncon = count;
@@ -463,17 +464,18 @@ static fcm_status build_constraints(fcm_integrator *I)
   for (int k = 0; k < I->num_cons; k++) {
     const sim_constraint *c = &I->cons[k];
     for (fcm_index a = 0; a < c->num_nodes; a++) {
-      fcm_index d = fcm_space_node_dof(I->space, c->nodes[a]);
-      if (d < 0) continue;
-      for (int i = 0; i < 3; i++) {
-        if (!c->motion.components[i] || owner[d + i] != k + 1) continue;
-        owner[d + i] = -1; /* a node listed twice in one constraint counts once */
-        I->con_dof[count] = d + i;
-        I->con_node[count] = c->nodes[a];
-        I->con_comp[count] = i;
-        I->con_id[count] = k;
-        count++;
-      }
+      const fcm_index d0 = fcm_space_node_dof(I->space, c->nodes[a]);
+      const fcm_index ncp = fcm_space_node_copies(I->space, c->nodes[a]);
+      for (fcm_index d = d0; d0 >= 0 && d < d0 + 3 * ncp; d += 3) /* every copy */
+        for (int i = 0; i < 3; i++) {
+          if (!c->motion.components[i] || owner[d + i] != k + 1) continue;
+          owner[d + i] = -1; /* a node listed twice in one constraint counts once */
+          I->con_dof[count] = d + i;
+          I->con_node[count] = c->nodes[a];
+          I->con_comp[count] = i;
+          I->con_id[count] = k;
+          count++;
+        }
     }
   }
   I->ncon = count;
@@ -752,14 +754,16 @@ fcm_status fcm_integrator_set_rigid_velocity(fcm_integrator *I, const double v0[
     const double *X = fcm_mesh_coords(mesh);
     fcm_index nn = fcm_mesh_num_nodes(mesh);
     for (fcm_index a = 0; a < nn; a++) {
-      fcm_index d = fcm_space_node_dof(I->space, a);
-      if (d < 0) continue;
-      double r[3];
-      for (int i = 0; i < 3; i++)
-        r[i] = X[3 * a + i] + I->u[d + i] - c[i];
-      I->v[d + 0] = v0[0] + omega[1] * r[2] - omega[2] * r[1];
-      I->v[d + 1] = v0[1] + omega[2] * r[0] - omega[0] * r[2];
-      I->v[d + 2] = v0[2] + omega[0] * r[1] - omega[1] * r[0];
+      const fcm_index d0 = fcm_space_node_dof(I->space, a);
+      const fcm_index ncp = fcm_space_node_copies(I->space, a);
+      for (fcm_index d = d0; d0 >= 0 && d < d0 + 3 * ncp; d += 3) { /* every copy */
+        double r[3];
+        for (int i = 0; i < 3; i++)
+          r[i] = X[3 * a + i] + I->u[d + i] - c[i];
+        I->v[d + 0] = v0[0] + omega[1] * r[2] - omega[2] * r[1];
+        I->v[d + 1] = v0[1] + omega[2] * r[0] - omega[0] * r[2];
+        I->v[d + 2] = v0[2] + omega[0] * r[1] - omega[1] * r[0];
+      }
     }
   }
 cleanup:
@@ -815,19 +819,57 @@ fcm_status fcm_integrator_momentum(fcm_integrator *I, double linear[3], double a
     fcm_index nn = fcm_mesh_num_nodes(mesh);
     double p[3] = {0, 0, 0}, L[3] = {0, 0, 0};
     for (fcm_index a = 0; a < nn; a++) {
-      fcm_index d = fcm_space_node_dof(I->space, a);
-      if (d < 0) continue;
-      const double *q = I->w1 + d;
-      double x[3];
-      for (int i = 0; i < 3; i++)
-        x[i] = X[3 * a + i] + I->u[d + i], p[i] += q[i];
-      L[0] += x[1] * q[2] - x[2] * q[1];
-      L[1] += x[2] * q[0] - x[0] * q[2];
-      L[2] += x[0] * q[1] - x[1] * q[0];
+      const fcm_index d0 = fcm_space_node_dof(I->space, a);
+      const fcm_index ncp = fcm_space_node_copies(I->space, a);
+      for (fcm_index d = d0; d0 >= 0 && d < d0 + 3 * ncp; d += 3) { /* every copy */
+        const double *q = I->w1 + d;
+        double x[3];
+        for (int i = 0; i < 3; i++)
+          x[i] = X[3 * a + i] + I->u[d + i], p[i] += q[i];
+        L[0] += x[1] * q[2] - x[2] * q[1];
+        L[1] += x[2] * q[0] - x[0] * q[2];
+        L[2] += x[0] * q[1] - x[1] * q[0];
+      }
     }
     if (linear) memcpy(linear, p, sizeof p);
     if (angular) memcpy(angular, L, sizeof L);
   }
 cleanup:
+  return st;
+}
+
+fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space *space,
+                                     fcm_integrator **integ)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = old ? old->ctx : NULL;
+  fcm_integrator *I = NULL;
+  double *u = NULL, *v = NULL;
+  FCM_CHECK(integ, ctx, FCM_ERR_ARG, "integrator cut: output pointer is NULL");
+  *integ = NULL;
+  FCM_CHECK(old && space, ctx, FCM_ERR_ARG, "integrator cut: NULL integrator or space");
+  FCM_CHECK(old->is_setup, ctx, FCM_ERR_ARG,
+            "integrator cut: the integrator must be set up (fcm_integrator_setup())");
+  FCM_TRY(ctx, fcm_integrator_create(ctx, space, &old->mat, &old->opts, &I));
+  for (int k = 0; k < old->num_loads; k++) {
+    sim_load l = old->loads[k];
+    l.f = NULL;
+    FCM_TRY(ctx, add_load(I, &l));
+  }
+  for (int k = 0; k < old->num_cons; k++)
+    FCM_TRY(ctx, fcm_integrator_add_constraint(I, old->cons[k].num_nodes, old->cons[k].nodes,
+                                               &old->cons[k].motion, NULL));
+  FCM_TRY(ctx, fcm_integrator_setup(I));
+  FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, u);
+  FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, v);
+  FCM_TRY(ctx, fcm_space_transfer(old->space, space, old->u, u));
+  FCM_TRY(ctx, fcm_space_transfer(old->space, space, old->v, v));
+  FCM_TRY(ctx, fcm_integrator_set_state(I, u, v, old->t, old->steps));
+  *integ = I;
+  I = NULL;
+cleanup:
+  fcm__free(ctx, u);
+  fcm__free(ctx, v);
+  fcm_integrator_destroy(&I);
   return st;
 }
