@@ -91,12 +91,12 @@ static void check_full(fcm_ctx *ctx)
   TEST_TRUE(o->checkpoint_interval == 9);
   TEST_TRUE(o->write_background == 0 && o->write_surface == 0);
 
-  TEST_TRUE(fcm_scene_num_effects(s) == 8);
-  TEST_TRUE(fcm_scene_get_effect(s, 8) == NULL && fcm_scene_get_effect(s, -1) == NULL);
-  const int expect_count[FCM_EFFECT_TYPE_COUNT] = {1, 1, 1, 2, 1, 1, 1};
+  TEST_TRUE(fcm_scene_num_effects(s) == 9);
+  TEST_TRUE(fcm_scene_get_effect(s, 9) == NULL && fcm_scene_get_effect(s, -1) == NULL);
+  const int expect_count[FCM_EFFECT_TYPE_COUNT] = {1, 1, 1, 2, 1, 1, 1, 1};
   for (int k = 0; k < FCM_EFFECT_TYPE_COUNT; k++)
     TEST_TRUE(fcm_scene_count_effects(s, (fcm_effect_type)k) == expect_count[k]);
-  for (int i = 0; i < 8; i++)
+  for (int i = 0; i < 9; i++)
     TEST_TRUE(fcm_scene_get_effect(s, i)->index == i);
 
   const fcm_effect *e = fcm_scene_get_effect(s, 0);
@@ -158,6 +158,14 @@ static void check_full(fcm_ctx *ctx)
   TEST_TRUE(e->initial_velocity.region.kind == FCM_REGION_ALL);
   TEST_TRUE(fcm_region_contains(&e->initial_velocity.region, above));
 
+  e = fcm_scene_get_effect(s, 8);
+  TEST_TRUE(e->type == FCM_EFFECT_CUT && e->cut.kind == FCM_CUT_RECTANGLE && e->cut.time == 0.5);
+  check_vec(e->cut.point, 1, 2, 3);
+  check_vec(e->cut.normal, 0, 0, 1);
+  check_vec(e->cut.axis, sqrt(0.5), 0, sqrt(0.5));
+  TEST_TRUE(e->cut.size[0] == 0.5 && e->cut.size[1] == 0.25 && e->cut.has_transform);
+  check_vec(e->cut.offset, 0, 0, 1);
+
   /* The summary names every section and effect. */
   FILE *f = tmpfile();
   TEST_TRUE(f != NULL);
@@ -169,7 +177,7 @@ static void check_full(fcm_ctx *ctx)
     text[n] = '\0';
     fclose(f);
     const char *words[] = {"full-scene.v1", "tet10",    "tube",     "stvk",      "minres",
-                           "block_jacobi",  "75 steps", "out/full", "effects: 8"};
+                           "block_jacobi",  "75 steps", "out/full", "effects: 9"};
     for (size_t i = 0; i < sizeof words / sizeof *words; i++)
       TEST_TRUE(strstr(text, words[i]));
     for (int k = 0; k < FCM_EFFECT_TYPE_COUNT; k++)

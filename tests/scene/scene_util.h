@@ -63,7 +63,11 @@ static const char full_scene_json[] =
     "    {\"pressure\": {\"region\": {\"half_space\": {\"point\": [0, 4, 0], "
     "\"normal\": [0, 1, 0]}},\n"
     "      \"value\": -250, \"end\": 1}},\n"
-    "    {\"initial_velocity\": {\"velocity\": [0, 0, -1]}}\n"
+    "    {\"initial_velocity\": {\"velocity\": [0, 0, -1]}},\n"
+    "    {\"cut\": {\"time\": 0.5, \"surface\": {\"rectangle\": {\"center\": [1, 2, 3], "
+    "\"normal\": [0, 0, 2],\n"
+    "      \"axis\": [1, 0, 1], \"size\": [0.5, 0.25], \"transform\": {\"translation\": [0, 0, "
+    "1]}}}}}\n"
     "  ]\n"
     "}\n";
 
