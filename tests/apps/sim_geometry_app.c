@@ -56,9 +56,13 @@ int main(int argc, char **argv)
   snprintf(err, sizeof err, "%s/geo-stderr.txt", work);
 
   /* half outside beyond +x: [0.5, 1.5] x [0, 1] x [0, 1] */
+  char out[1024];
+  snprintf(out, sizeof out, "%s/geo-stdout.txt", work);
   scene(path, "{\"shape\": \"box\", \"min\": [0.5, 0, 0], \"max\": [1.5, 1, 1]}");
-  snprintf(cmd, sizeof cmd, "'%s' '%s' --check 2> '%s' > /dev/null", sim, path, err);
+  snprintf(cmd, sizeof cmd, "'%s' '%s' --check 2> '%s' > '%s'", sim, path, err, out);
   TEST_TRUE(app_run(cmd) == 0);
+  TEST_TRUE(file_has(out, "outside the background 0.5,"));
+  TEST_TRUE(file_has(out, "; beyond +x 0.5\n"));
   TEST_TRUE(file_has(err, "fcm-sim: warning: 0.5 m^3 of the body (50% of 1 m^3) lies outside"));
   TEST_TRUE(file_has(err, "(beyond +x: 0.5 m^3)"));
 
@@ -92,8 +96,6 @@ int main(int argc, char **argv)
 
   /* --progress off a terminal: lines, the last one at all 8 cells */
   scene(path, "{\"level_set\": {\"sphere\": {\"center\": [0.5, 0.5, 0.5], \"radius\": 0.4}}}");
-  char out[1024];
-  snprintf(out, sizeof out, "%s/geo-stdout.txt", work);
   snprintf(cmd, sizeof cmd, "'%s' '%s' --check --progress 2> '%s' > '%s'", sim, path, err, out);
   TEST_TRUE(app_run(cmd) == 0);
   TEST_TRUE(file_has(err, "fcm-sim: cell rules 8/8 cells"));

@@ -963,6 +963,18 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
             "dropped cells %.3g\n",
             rs->embedded_volume, rs->geometry_volume, rs->volume_ratio, rs->outside_volume,
             rs->dropped_volume);
+    if (rs->outside_volume > 0.0) {
+      static const char *const sides[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
+      fprintf(f, "  outside   body [%g, %g] x [%g, %g] x [%g, %g], background [%g, %g] x [%g, %g] "
+                 "x [%g, %g]; beyond",
+              rs->geometry_lo[0], rs->geometry_hi[0], rs->geometry_lo[1], rs->geometry_hi[1],
+              rs->geometry_lo[2], rs->geometry_hi[2], rs->mesh_lo[0], rs->mesh_hi[0],
+              rs->mesh_lo[1], rs->mesh_hi[1], rs->mesh_lo[2], rs->mesh_hi[2]);
+      for (int k = 0; k < 6; k++)
+        if (rs->outside_side_volume[k] > 0.0)
+          fprintf(f, " %s %.3g", sides[k], rs->outside_side_volume[k]);
+      fputc('\n', f);
+    }
     const fcm_scene_quadrature *q = fcm_scene_get_quadrature(S->scene);
     static const char *const kinds[FCM_RULE_KIND_COUNT] = {"stiffness", "mass"};
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
