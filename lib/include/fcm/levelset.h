@@ -44,7 +44,8 @@ typedef struct fcm_level_set_info {
   fcm_index num_tets;      /**< tets of the geometry */
   double h;                /**< largest sub-cell edge: max_d (hi - lo)_d / (n_d r) */
   double volume;           /**< volume of the geometry */
-  double volume_fine;      /**< the volume at refinement 2r (0 unless estimate_error) */
+  double volume_fine;      /**< the volume with the cells cut at refinement r sampled at 2r
+                                (the others as at r); 0 unless estimate_error */
   double error_estimate;   /**< 4/3 |volume - volume_fine|: the Richardson estimate of the
                                 volume error for an O(h^2) method (0 unless estimate_error) */
 } fcm_level_set_info;
