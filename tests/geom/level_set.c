@@ -134,6 +134,16 @@ static void csg(fcm_ctx *ctx)
   if ((g = build(ctx, d, 5, lo, hi, 8, 6, &info))) {
     TEST_NEAR(fcm_geometry_volume(g), shell / 2, 1e-2, 0);
     check_boundary(g, "half shell");
+    /* a mirror keeps the surface, turned */
+    const double A[9] = {-1, 0, 0, 0, 2, 0, 0, 0, 1}, off[3] = {1, 2, 3};
+    fcm_geometry *m = NULL;
+    TEST_OK(ctx, fcm_geometry_create_transformed(ctx, g, A, off, &m));
+    if (m) {
+      TEST_TRUE(fcm_geometry_num_boundary_triangles(m) == fcm_geometry_num_boundary_triangles(g));
+      TEST_NEAR(fcm_geometry_volume(m), 2 * fcm_geometry_volume(g), 1e-12, 0);
+      check_boundary(m, "half shell mirrored");
+    }
+    fcm_geometry_destroy(&m);
   }
   fcm_geometry_destroy(&g);
   /* a ball half outside the sampling box: cut off flat by the box face */
