@@ -121,6 +121,27 @@ int main(void)
   parse(ctx, "{\"voxels\": \"missing.nrrd\"}", FCM_ERR_IO, "missing.nrrd");
   parse(ctx, "{\"voxels\": \"v.nrrd\", \"refinement\": 2}", FCM_ERR_ARG, "refinement");
   parse(ctx, "{\"voxels\": \"v.nrrd\", \"level_set\": {}}", FCM_ERR_ARG, "exactly one of");
+  /* with fit_background the level set needs its own sampling box; given one, it builds */
+  {
+#define FIT_HEAD                                                                                   \
+  "{\"background\": {\"element\": \"hex8\", \"fit_background\": {\"cell_size\": 0.25}}, "          \
+  "\"geometry\": {\"level_set\": {\"sphere\": {\"radius\": 0.5}}"
+    TEST_ERR(ctx, fcm_scene_create_from_string(ctx, FIT_HEAD "}, " REST "}", "t.json", &s),
+             FCM_ERR_ARG, "not fit_background");
+    TEST_OK(ctx, fcm_scene_create_from_string(ctx,
+                                              FIT_HEAD ", \"min\": [-1, -1, -1], \"max\": [1, 1, "
+                                                       "1], \"cells\": [4, 4, 4]}, " REST "}",
+                                              "t.json", &s));
+#undef FIT_HEAD
+    fcm_simulation *sim = NULL;
+    if (s) TEST_OK(ctx, fcm_simulation_create(ctx, s, NULL, &sim));
+    if (sim) {
+      const fcm_cell_rules_stats *S = fcm_cell_rules_get_stats(fcm_simulation_cell_rules(sim));
+      TEST_TRUE(S->outside_volume == 0.0 && S->embedded_volume > 0.4);
+    }
+    fcm_simulation_destroy(&sim);
+    fcm_scene_destroy(&s);
+  }
   remove("v.nrrd");
   TEST_TRUE(chdir("/") == 0 && rmdir(dir) == 0);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);

@@ -486,10 +486,12 @@ static fcm_status read_level_set(fcm__scene_parser *p, const fcm__json *o, fcm_s
     FCM_TRY(p->ctx, fcm__scene_read_ivec3(p, o, "cells", 1, 1, 10000, g->cells));
   } else {
     const fcm_scene_background *b = &p->scene->background;
-    SCENE_CHECK(b->kind == FCM_SCENE_BACKGROUND_GRID && !fcm__json_member(o, "transform"), p,
-                FCM_ERR_ARG,
+    SCENE_CHECK(b->kind == FCM_SCENE_BACKGROUND_GRID && !b->fit &&
+                    !fcm__json_member(o, "transform"),
+                p, FCM_ERR_ARG,
                 "a level set is sampled on the background grid only when the background is a "
-                "grid and there is no transform; give \"min\", \"max\" and \"cells\"");
+                "grid with its box given (not fit_background) and there is no transform; give "
+                "\"min\", \"max\" and \"cells\"");
     memcpy(g->min, b->min, sizeof g->min);
     memcpy(g->max, b->max, sizeof g->max);
     memcpy(g->cells, b->cells, sizeof g->cells);
