@@ -17,7 +17,9 @@
 extern "C" {
 #endif
 
-/** A 3D scalar image (opaque): dims[0] x dims[1] x dims[2] values as double, i fastest. */
+/** A 3D scalar image (opaque): dims[0] x dims[1] x dims[2] values as double, i fastest
+ * (8 bytes per voxel whatever the file's type: a 512^3 CT scan takes 1 GiB, plus the file
+ * while it is read and a byte per voxel while it is turned into boxes). */
 typedef struct fcm_voxel_image fcm_voxel_image;
 
 /** Create an image by copying caller values.
