@@ -65,6 +65,18 @@ int main(void)
       if (k != 1) TEST_TRUE(S->outside_side_volume[k] == 0.0);
     TEST_NEAR(S->volume_ratio, 0.5, 1e-12, 0);
     TEST_TRUE(S->mesh_hi[0] == 1 && S->geometry_hi[0] == 1.5 && S->geometry_lo[1] == 0.2);
+    FILE *f = tmpfile();
+    TEST_TRUE(f != NULL);
+    if (f) {
+      char text[4096];
+      fcm_cell_rules_view(r, f);
+      rewind(f);
+      size_t got = fread(text, 1, sizeof text - 1, f);
+      text[got] = '\0';
+      fclose(f);
+      TEST_TRUE(strstr(text, "embedded / geometry volume 0.500000; outside the background mesh "
+                             "0.2, beyond +x 0.2\n") != NULL);
+    }
     fcm_cell_rules_destroy(&r);
   }
   /* beyond the (-x, -y) edge: [-0.5, 0.5] x [-0.25, 0.75] x [0.2, 0.6] */
