@@ -231,6 +231,16 @@ static fcm_status load_surface(fcm_ctx *ctx, const char *path, int fill_holes, d
   return st;
 }
 
+/* A voxel image (NRRD, MetaImage): the voxels >= 0.5 merged into boxes. */
+static fcm_status load_voxels(fcm_ctx *ctx, const char *path, fcm_geometry **g)
+{
+  fcm_voxel_image *img = NULL;
+  fcm_status st = fcm_voxel_image_create_from_file(ctx, path, &img);
+  if (st == FCM_OK) st = fcm_geometry_create_from_voxels(ctx, img, NULL, g, NULL);
+  fcm_voxel_image_destroy(&img);
+  return st;
+}
+
 /* Procedural geometry "name:a,b,c,..." or a file, by its extension. */
 static fcm_status load_geometry(fcm_ctx *ctx, const char *spec, int fill_holes, double max_volume,
                                 fcm_geometry **g)
@@ -270,6 +280,9 @@ static fcm_status load_geometry(fcm_ctx *ctx, const char *spec, int fill_holes, 
   if (has_ext(spec, ".obj") || has_ext(spec, ".off") || has_ext(spec, ".stl") ||
       has_ext(spec, ".ply"))
     return load_surface(ctx, spec, fill_holes, max_volume, g);
+  if (has_ext(spec, ".nrrd") || has_ext(spec, ".nhdr") || has_ext(spec, ".mhd") ||
+      has_ext(spec, ".mha"))
+    return load_voxels(ctx, spec, g);
   return fcm_geometry_create_from_gmsh(ctx, spec, g);
 }
 
@@ -291,7 +304,8 @@ int fcm_quadrature_cmd_embed(int argc, char **argv)
        "by extension: Gmsh .msh (tetrahedra), TetGen\n"
        "FILE.node / FILE.ele (both read), a closed triangle\n"
        "surface .obj, .off, .stl, .ply (tetrahedralized\n"
-       "with Gmsh); or a shape: ball:CX,CY,CZ,R,N |\n"
+       "with Gmsh), a voxel image .nrrd, .nhdr, .mhd, .mha\n"
+       "(voxels >= 0.5, merged into boxes); or a shape: ball:CX,CY,CZ,R,N |\n"
        "hemisphere:CX,CY,CZ,R,N | box:X0,Y0,Z0,X1,Y1,Z1,N",
        0, 0, 0, NULL, NULL, NULL},
       {"--fill-holes", NULL, CLI_FLAG, &fill_holes, NULL,

@@ -27,10 +27,12 @@ typedef struct scene_options {
   long long steps;
   int checkpoint_every; /* -1: the scene's */
   int check, quiet, print_scene;
+  int debug;    /* print the library's traceback with errors */
+  int progress; /* progress of the cell rules also when stderr is not a terminal */
 } scene_options;
 
 /* The option table, writing into `o`. */
-#define SIM_NUM_OPTIONS 8
+#define SIM_NUM_OPTIONS 10
 static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS])
 {
   const cli_option t[SIM_NUM_OPTIONS] = {
@@ -54,6 +56,12 @@ static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS
       {"--print-scene", NULL, CLI_FLAG, &o->print_scene, NULL,
        "print the scene with every default filled in and exit", 0, 0, 0, NULL, NULL, NULL},
       {"--quiet", "-q", CLI_FLAG, &o->quiet, NULL, "print only errors", 0, 0, 0, NULL, NULL, NULL},
+      {"--progress", NULL, CLI_FLAG, &o->progress, NULL,
+       "report the cell-rule build also when stderr is not a\n"
+       "terminal (a line every 2 s; on a terminal: a bar)",
+       0, 0, 0, NULL, NULL, NULL},
+      {"--debug", NULL, CLI_FLAG, &o->debug, NULL,
+       "print the library's traceback with build errors", 0, 0, 0, NULL, NULL, NULL},
       {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
   memcpy(opts, t, sizeof t);
 }
@@ -74,8 +82,10 @@ static void usage(FILE *f, const cli_option *opts)
           "options:\n");
   cli_print_options(f, opts);
   fprintf(f, "\n"
-             "Exit 0 on success, 1 when the run fails, 2 on a usage error, an invalid scene or a\n"
-             "refused checkpoint.\n");
+             "Exit 0 on success, 1 when the run fails, 2 on a usage error, an invalid scene (also\n"
+             "one whose files or geometry fail to build: the message names the scene section,\n"
+             "e.g. geometry.voxels) or a refused checkpoint. A warning is printed when part of\n"
+             "the body lies outside the background mesh (it is cut off).\n");
 }
 
 /* -1 when the arguments are parsed into `o`, else the exit code (0 after --help, 2). */
@@ -147,6 +157,68 @@ static void progress(int tty, long long k, long long n, long long step, long lon
   }
 }
 
+/* Progress of the cell rules: a bar on a terminal, else a line per call. */
+typedef struct rules_progress_state {
+  int tty;
+  double t0;
+} rules_progress_state;
+
+static void rules_progress(fcm_index done, fcm_index total, void *user)
+{
+  const rules_progress_state *ps = user;
+  const double el = fcm_wtime() - ps->t0;
+  if (ps->tty) {
+    const int width = 30, fill = (int)(width * done / (total > 0 ? total : 1));
+    char bar[64];
+    for (int i = 0; i < width; i++)
+      bar[i] = i < fill ? '#' : '.';
+    bar[width] = '\0';
+    const double eta = done > 0 ? el / (double)done * (double)(total - done) : 0.0;
+    fprintf(stderr, "\r[%s] cell rules %lld/%lld  %.0f s  ETA %.0f s   ", bar, (long long)done,
+            (long long)total, el, eta);
+    if (done == total) fputc('\n', stderr);
+  } else {
+    fprintf(stderr, "fcm-sim: cell rules %lld/%lld cells (%.1f s)\n", (long long)done,
+            (long long)total, el);
+  }
+}
+
+/* Exit code of a failed build: 2 for errors of the input (files, geometry, arguments), 1 for
+ * the rest (memory, numerical failures). */
+static int build_exit_code(fcm_status st)
+{
+  return st == FCM_ERR_ARG || st == FCM_ERR_IO || st == FCM_ERR_FORMAT ||
+                 st == FCM_ERR_GEOMETRY || st == FCM_ERR_UNSUPPORTED
+             ? 2
+             : 1;
+}
+
+/* The warning when part of the body lies outside the background mesh. */
+#define SIM_OUTSIDE_RTOL 1e-6
+static void warn_outside(const fcm_simulation *sim)
+{
+  const fcm_cell_rules *r = fcm_simulation_cell_rules(sim);
+  if (!r) return;
+  const fcm_cell_rules_stats *S = fcm_cell_rules_get_stats(r);
+  if (!(S->outside_volume > SIM_OUTSIDE_RTOL * S->geometry_volume)) return;
+  static const char *const sides[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
+  fprintf(stderr,
+          "fcm-sim: warning: %.6g m^3 of the body (%.3g%% of %.6g m^3) lies outside the "
+          "background mesh and is cut off",
+          S->outside_volume, 100.0 * S->outside_volume / S->geometry_volume, S->geometry_volume);
+  const char *sep = " (beyond";
+  for (int k = 0; k < 6; k++)
+    if (S->outside_side_volume[k] > 0.0) {
+      fprintf(stderr, "%s %s: %.3g m^3", sep, sides[k], S->outside_side_volume[k]);
+      sep = ",";
+    }
+  fprintf(stderr, "%s; body [%g, %g] x [%g, %g] x [%g, %g], background [%g, %g] x [%g, %g] x "
+                  "[%g, %g]\n",
+          sep[0] == ',' ? ")" : "", S->geometry_lo[0], S->geometry_hi[0], S->geometry_lo[1],
+          S->geometry_hi[1], S->geometry_lo[2], S->geometry_hi[2], S->mesh_lo[0], S->mesh_hi[0],
+          S->mesh_lo[1], S->mesh_hi[1], S->mesh_lo[2], S->mesh_hi[2]);
+}
+
 /* Write a checkpoint <dir>/<name>_checkpoint_NNNNNN.fcmck of the current step. */
 static int write_checkpoint(fcm_ctx *ctx, fcm_simulation *sim, const char *dir, const char *name,
                             int quiet)
@@ -164,7 +236,7 @@ static int write_checkpoint(fcm_ctx *ctx, fcm_simulation *sim, const char *dir, 
 
 static int scene_main(int argc, char **argv)
 {
-  scene_options o = {NULL, NULL, NULL, 0, -1, 0, 0, 0};
+  scene_options o = {NULL, NULL, NULL, 0, -1, 0, 0, 0, 0, 0};
   const int parsed = parse_scene_args(argc, argv, &o);
   if (parsed >= 0) return parsed;
   int rc = 1;
@@ -194,13 +266,25 @@ static int scene_main(int argc, char **argv)
   so.max_steps =
       o.check ? (o.steps > 0 && o.steps < 3 ? o.steps : 3) : (o.steps > 0 ? o.steps : FCM_DEFAULT);
   so.checkpoint_interval = o.check ? 0 : o.checkpoint_every;
+  rules_progress_state rps = {!o.quiet && isatty(2), fcm_wtime()};
+  if (rps.tty || (o.progress && !o.quiet)) {
+    so.rules_progress = rules_progress;
+    so.rules_progress_user = &rps;
+    so.rules_progress_interval = rps.tty ? 0.2 : 2.0;
+  }
   const char *name = fcm_scene_name(scene);
   if (!o.quiet)
     fprintf(stderr, "fcm-sim: scene %s (%s): building\n", name, fcm_scene_source(scene));
-  if (fcm_simulation_create(ctx, scene, &so, &sim) != FCM_OK) {
-    fcm_ctx_error_view(ctx, stderr);
+  st = fcm_simulation_create(ctx, scene, &so, &sim);
+  if (st != FCM_OK) {
+    if (o.debug)
+      fcm_ctx_error_view(ctx, stderr);
+    else
+      fprintf(stderr, "fcm-sim: scene %s: %s\n", name, fcm_ctx_error_message(ctx));
+    rc = build_exit_code(st);
     goto done;
   }
+  warn_outside(sim);
   if (o.resume) {
     if (fcm_simulation_read_checkpoint(sim, o.resume) != FCM_OK) {
       fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));

@@ -131,6 +131,43 @@ int main(int argc, char **argv)
     remove(dump);
   }
 
+  /* embed a voxel image by extension: 7 of 2 x 2 x 2 voxels of 0.5 m (weights add up to
+   * 7 x 0.125 exactly) */
+  {
+    char img[4096];
+    snprintf(img, sizeof img, "%s/block.nrrd", argv[2]);
+    FILE *o = fopen(img, "w");
+    TEST_TRUE(o != NULL);
+    if (o) {
+      fputs("NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nspacings: 0.5 0.5 0.5\n"
+            "space origin: (-0.25,-0.25,-0.25)\nencoding: ascii\n\n1 1 1 0 1 1 1 1\n",
+            o);
+      fclose(o);
+    }
+    remove(dump);
+    snprintf(cmd, sizeof cmd,
+             "'%s' embed --element hex8 --box -1 -1 -1 1 1 1 --cells 3 3 3 --geometry '%s' "
+             "--strength 2 --stabilization 0 --min-fraction 0 --dump '%s' > /dev/null 2>&1",
+             argv[1], img, dump);
+    TEST_TRUE(app_run(cmd) == 0);
+    f = fopen(dump, "r");
+    TEST_TRUE(f != NULL);
+    double sum = 0.0;
+    char line[1024];
+    while (f && fgets(line, sizeof line, f)) {
+      long cell;
+      double xi[3], X[3], wr, wp;
+      int flag;
+      if (line[0] != '#' && sscanf(line, "%ld %lf %lf %lf %lf %lf %lf %lf %lf %d", &cell, xi,
+                                   xi + 1, xi + 2, X, X + 1, X + 2, &wr, &wp, &flag) == 10)
+        sum += wp;
+    }
+    if (f) fclose(f);
+    TEST_NEAR(sum, 7 * 0.125, 1e-12, 0.0);
+    remove(img);
+    remove(dump);
+  }
+
   /* bad input: exit 2, no output file */
   remove(csv);
   snprintf(cmd, sizeof cmd, "'%s' accuracy --max-strength 0 --csv '%s' 2> /dev/null", argv[1], csv);

@@ -29,7 +29,8 @@ fcm_add_test(app_sim_default tests/apps/sim_app.c LABELS app slow TIMEOUT 1200
 # twisting cylinder is the built-in scene (byte for byte, see scene_default) that
 # app_sim_default_quick already runs, so its --check is labelled slow. surface_drop embeds an
 # OBJ surface, tetrahedralized with Gmsh: only when fcm was built with it.
-set(fcm_check_scenes spinning_body slingshot hollow_ball static_beam cantilever twisting_cylinder)
+set(fcm_check_scenes spinning_body slingshot hollow_ball static_beam cantilever twisting_cylinder
+    voxel_block gyroid_lattice)
 if(FCM_HAVE_GMSH)
   list(APPEND fcm_check_scenes surface_drop)
 endif()
@@ -41,6 +42,11 @@ foreach(scene IN LISTS fcm_check_scenes)
   fcm_add_test(app_sim_check_${scene} tests/apps/sim_app.c LABELS ${labels} TIMEOUT 900
                ARGS check $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/${scene}.json)
 endforeach()
+# fcm-sim and the embedding diagnostics: the outside-volume warning (half a box beyond +x),
+# a body wholly outside and a bad voxel image exit 2 naming the scene section (traceback
+# only with --debug), --progress off a terminal.
+fcm_add_test(app_sim_geometry tests/apps/sim_geometry_app.c LABELS app
+             ARGS $<TARGET_FILE:fcm-sim> ${work})
 # fcm-condition: --quick CSV/PNG format and facts; the Fig. 5 claims (Longva et al. 2020)
 fcm_add_test(app_condition tests/apps/condition_app.c LABELS app
              ARGS $<TARGET_FILE:fcm-condition> ${work})

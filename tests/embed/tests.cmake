@@ -27,4 +27,7 @@ fcm_add_test(embed_cut_campaign tests/embed/cut_campaign.c ARGS campaign 1000)
 fcm_add_test(embed_cut_campaign_long tests/embed/cut_campaign.c ARGS campaign 60000 7
              LABELS slow TIMEOUT 3600)
 fcm_add_test(embed_limits tests/embed/limits.c)
+# Embedding diagnostics (volume outside the background by side, ratio, wholly outside is an
+# error with both boxes), the progress callback, voxel and level-set bodies embedded.
+fcm_add_test(embed_diagnostics tests/embed/diagnostics.c)
 fcm_add_test(embed_cut tests/embed/cut.c)

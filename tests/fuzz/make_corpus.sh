@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Seed corpora of the fuzz targets: make_corpus.sh BUILD_DIR OUT_DIR writes OUT_DIR/gmsh,
-# tetgen, surface, scene and checkpoint with small valid inputs of each format: MSH 4.1 and 2.2 files
+# tetgen, surface, voxels, scene and checkpoint with small valid inputs of each format: MSH 4.1 and 2.2 files
 # of every supported element type with skipped sections and boundary elements, TetGen pairs
 # (0- and 1-based, attributes, markers, comments; .node NUL .ele, as fcm-fuzz-tetgen reads
 # them), surfaces (a format byte, then an OBJ, OFF, STL or PLY file, as fcm-fuzz-surface
@@ -190,6 +190,17 @@ z4='\000\000\000\000' o4='\000\000\200\077' # float 0 and 1, little endian
 surface tri_stl_bin 2 "solid binary%68s\001\000\000\000$z4$z4$o4$z4$z4$z4$o4$z4$z4$z4$o4$z4\000\000" ''
 surface quad_ply 3 'ply\nformat ascii 1.0\ncomment q\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 1\n1 0 0 2\n1 1 0 3\n0 1 0 4\n4 0 1 2 3\n'
 surface tri_ply_bin 3 "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n$z4$z4$z4$o4$z4$z4$z4$o4$z4\003$z4\001\000\000\000\002\000\000\000"
+
+# ---------------------------------------------------------------- voxel images (format byte + file)
+mkdir -p "$out/voxels"
+voxels() { # name format-byte(0 nrrd, 1 mha) printf-format [args]
+  name=$1 fmt=$2
+  shift 2
+  { printf "\\$(printf '%03o' "$fmt")"; printf "$@"; } > "$out/voxels/$name"
+}
+voxels raw_nrrd 0 'NRRD0004\n# c\ntype: uint16\ndimension: 3\nspace: 3D-right-handed\nsizes: 2 2 1\nspace directions: (1,0,0) (0,2,0) (0,0,1)\nspace origin: (0,0,0)\nendian: big\nencoding: raw\n\n\000\001\000\000\001\000\000\002'
+voxels ascii_nrrd 0 'NRRD0001\ntype: float\ndimension: 3\nsizes: 2 2 2\nspacings: 0.5 0.5 0.5\nencoding: ascii\n\n1 0 1 1\n0.5 2 1 1\n'
+voxels local_mha 1 'ObjectType = Image\nNDims = 3\nDimSize = 2 1 2\nElementSpacing = 1 1 2\nOffset = 1 2 3\nTransformMatrix = 0 1 0 1 0 0 0 0 1\nElementType = MET_UCHAR\nElementDataFile = LOCAL\n\001\000\001\001'
 
 # ---------------------------------------------------------------- checkpoints
 "$build/fcm-fuzz-seed-checkpoint" "$out/checkpoint"

@@ -12,6 +12,15 @@ fcm_add_test(geom_boundary_cells tests/geom/boundary_cells.c)
 # Triangle surfaces: the unit cube in OBJ, OFF, STL (ASCII, binary) and PLY (ascii, binary)
 # round trips; malformed files fail naming file and line or byte offset.
 fcm_add_test(geom_surface tests/geom/surface.c)
+# Voxel images (NRRD, MetaImage): exact volumes, box merging, round trips, header errors.
+fcm_add_test(geom_voxels tests/geom/voxels.c)
+# Level-set bodies: O(h^2) sphere volume error, CSG volumes, implicit-tree errors.
+fcm_add_test(geom_level_set tests/geom/level_set.c)
+# The example image apps/scenes/porous_block.nrrd is what its generator writes.
+fcm_add_test(geom_porous_block_image apps/scenes/porous_block.c
+             ARGS --check ${PROJECT_SOURCE_DIR}/apps/scenes/porous_block.nrrd)
+# Allocation failures of the voxel-image readers, voxel merging and level-set marching.
+fcm_add_test(geom_voxel_alloc_failure tests/geom/voxel_alloc.c)
 # Surface checks (boundary, non-manifold and inconsistent edges, inward orientation,
 # degenerate triangles, self-intersections), hole filling, and tetrahedralization through
 # Gmsh: the tets' volume equals the enclosed volume to 1e-12 (cube, icosphere, filled

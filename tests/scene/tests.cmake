@@ -21,6 +21,9 @@ set_tests_properties(scene_alloc_simulation_full PROPERTIES LABELS slow TIMEOUT 
                      ENVIRONMENT "OMP_NUM_THREADS=1;OMP_WAIT_POLICY=passive;OPENBLAS_NUM_THREADS=1")
 # quadrature.simplify "auto": parsing, and the choice per rule kind in the run summary.
 fcm_add_test(scene_simplify_auto tests/scene/simplify_auto.c)
+# The geometry keys "voxels" and "level_set": parsed trees and options, errors with their
+# JSON paths, scenes that build with the embedded volume of the geometry.
+fcm_add_test(scene_geometry_keys tests/scene/geometry_keys.c)
 # geometry.surface and background.fit_background: parse errors of the new keys; a binary STL
 # cube and an open OBJ cube (refused, then closed with fill_holes) built on a fitted grid.
 fcm_add_test(scene_surface tests/scene/surface_scene.c)

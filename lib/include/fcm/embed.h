@@ -63,6 +63,12 @@ FCM_API int fcm_simplify_pays(double assemblies, double point_cost, double point
  * point_cost of FCM_CELL_SIMPLIFY_AUTO. 0 for an invalid type or kind. */
 FCM_API double fcm_cell_rules_point_cost(fcm_element_type type, fcm_rule_kind kind);
 
+/** Progress of fcm_cell_rules_create(): `done` of `total` background cells processed (the
+ * intersection, simplification and stabilization of each; with FCM_CELL_SIMPLIFY_AUTO the
+ * simplification runs after this loop and is not reported). It must not call back into
+ * the library on the rules being built. */
+typedef void (*fcm_cell_rules_progress_fn)(fcm_index done, fcm_index total, void *user);
+
 /** Options of fcm_cell_rules_create(); initialize with fcm_cell_rules_options_default(). */
 typedef struct fcm_cell_rules_options {
   int strength[FCM_RULE_KIND_COUNT]; /**< per kind; FCM_DEFAULT (default): the element's */
@@ -91,6 +97,12 @@ typedef struct fcm_cell_rules_options {
                                limit; default 4 GiB; 0: no limit */
   fcm_stabilization_options stabilization; /**< default mass + stiffness, alpha 1e-6 */
   int num_threads; /**< OpenMP threads >= 1; FCM_DEFAULT (default): the OpenMP default */
+  fcm_cell_rules_progress_fn progress; /**< NULL (default): none; else called with the cells
+                              done so far, at most every progress_interval seconds and once
+                              with done == total at the end of the cell loop, always from the
+                              thread that called fcm_cell_rules_create() */
+  void *progress_user;       /**< passed to progress; default NULL */
+  double progress_interval;  /**< seconds between progress calls, >= 0; default 0.1 */
 } fcm_cell_rules_options;
 
 /** Defaults as documented on each member. */
@@ -141,6 +153,15 @@ typedef struct fcm_cell_rules_stats {
   double dropped_volume;  /**< the part of it in dropped cells */
   double embedded_area;   /**< sum of the surface weights (non-dropped cells) */
   double geometry_volume; /**< fcm_geometry_volume() */
+  double outside_volume;  /**< the body outside the background mesh: geometry_volume -
+                               embedded_volume - sliver_volume, 0 when that is below 1e-12
+                               geometry_volume (rounding) */
+  double outside_side_volume[6]; /**< the body beyond each face plane of the mesh's bounding
+                               box, in the order -x, +x, -y, +y, -z, +z (a part beyond an edge
+                               or a corner counts for each side it is beyond) */
+  double volume_ratio;    /**< embedded_volume / geometry_volume (0 for an empty geometry) */
+  double mesh_lo[3], mesh_hi[3];         /**< bounding box of the background mesh */
+  double geometry_lo[3], geometry_hi[3]; /**< bounding box of the embedded geometry */
   double time_setup, time_intersect, time_simplify, time_gather, time_total;
   int num_threads;
   fcm_simplify_decision decision[FCM_RULE_KIND_COUNT]; /**< per kind (see the mode) */
@@ -162,8 +183,10 @@ typedef struct fcm_cell_rules fcm_cell_rules;
  * @return FCM_OK; FCM_ERR_ARG (NULL, strengths outside [0, 20] with simplification or
  *         [0, FCM_RULE_MAX_STRENGTH] without, simplify not a mode, AUTO with expected_assemblies
  *         < 0, point_cost <= 0 (not FCM_DEFAULT), thresholds outside 0 <=
- * min_fraction < uncut_fraction <= 1, tolerances out of range, bad stabilization); FCM_ERR_GEOMETRY
- *         (a non-convex background cell, naming it; a degenerate cell); FCM_ERR_NOT_CONVERGED
+ *         min_fraction < uncut_fraction <= 1, tolerances out of range, bad stabilization,
+ *         progress_interval < 0); FCM_ERR_GEOMETRY (a non-convex background cell, naming it;
+ *         a degenerate cell; a geometry of positive volume with no part inside any background
+ *         cell, printing both bounding boxes); FCM_ERR_NOT_CONVERGED
  *         (inverse map); FCM_ERR_UNSUPPORTED (a cell whose rules would exceed
  *         max_rule_memory or 2^30 points); FCM_ERR_ALLOC; errors of fcm_simplify(). When
  *         several cells fail, the error is that of the lowest-numbered one. Volume fractions
@@ -286,7 +309,8 @@ FCM_API const fcm_index *fcm_cell_rules_links(const fcm_cell_rules *rules);
 FCM_API const fcm_cell_rules_stats *fcm_cell_rules_get_stats(const fcm_cell_rules *rules);
 
 /** Print the statistics (classes, points before/after simplification, fallbacks, residual,
- * volumes, times) to `stream`. */
+ * volumes with the embedded / geometry ratio and the volume outside the mesh by side, times)
+ * to `stream`. */
 FCM_API void fcm_cell_rules_view(const fcm_cell_rules *rules, FILE *stream);
 
 /** Print every point of `kind` in cell order as "cell xi eta zeta X Y Z w_ref w_phys flag"

@@ -21,5 +21,7 @@
 #include "fcm/surface.h"
 #include "fcm/simplify.h"
 #include "fcm/version.h"
+#include "fcm/voxels.h"
+#include "fcm/levelset.h"
 
 #endif /* FCM_FCM_H */

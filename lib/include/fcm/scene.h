@@ -14,6 +14,7 @@
 #include "fcm/element.h"
 #include "fcm/embed.h"
 #include "fcm/la.h"
+#include "fcm/levelset.h"
 #include "fcm/material.h"
 #include "fcm/sim.h"
 #include "fcm/simplify.h"
@@ -58,14 +59,17 @@ typedef enum fcm_scene_geometry_kind {
   FCM_SCENE_GEOMETRY_GMSH,        /**< fcm_geometry_create_from_gmsh() */
   FCM_SCENE_GEOMETRY_TETGEN,      /**< fcm_geometry_create_from_tetgen() */
   FCM_SCENE_GEOMETRY_SURFACE, /**< a triangle surface file, fcm_geometry_create_from_surface() */
+  FCM_SCENE_GEOMETRY_VOXELS,      /**< fcm_geometry_create_from_voxels() of an image file */
+  FCM_SCENE_GEOMETRY_LEVEL_SET,   /**< fcm_geometry_create_from_level_set() of built-in
+                                       implicits (fcm/levelset.h) */
   FCM_SCENE_GEOMETRY_KIND_COUNT
 } fcm_scene_geometry_kind;
 
 /** The embedded geometry ("geometry"); members not used by `kind` are zero. */
 typedef struct fcm_scene_geometry {
   fcm_scene_geometry_kind kind;
-  double min[3], max[3];             /**< BOX corners, min[d] < max[d] */
-  fcm_index cells[3];                /**< BOX: cubes per axis (6 tets each) */
+  double min[3], max[3];             /**< BOX corners, min[d] < max[d]; LEVEL_SET: sampling box */
+  fcm_index cells[3];                /**< BOX: cubes per axis (6 tets each); LEVEL_SET: sampling cells */
   double center[3];                  /**< BALL, HEMISPHERE, HOLLOW_BALL, TUBE */
   double radius;                     /**< BALL, HEMISPHERE */
   double inner_radius, outer_radius; /**< HOLLOW_BALL, TUBE */
@@ -84,6 +88,15 @@ typedef struct fcm_scene_geometry {
   fcm_surface_mesh_options surface; /**< SURFACE: tetrahedralization options */
   int fill_holes;                   /**< SURFACE: 1: close holes first */
   fcm_surface_fill_options fill;    /**< SURFACE: which holes fill_holes closes */
+  const char *image;    /**< VOXELS: the image file (.nrrd, .nhdr, .mhd, .mha; resolved path) */
+  double threshold;     /**< VOXELS: voxels with value >= threshold are the body (default 0.5) */
+  const double *labels; /**< VOXELS: label set replacing the threshold (NULL: none) */
+  int num_labels;       /**< VOXELS: length of labels, [0, 256] */
+  int merge;            /**< VOXELS: 1 (default): merge voxels into boxes */
+  const fcm_implicit *implicit; /**< LEVEL_SET: the implicit tree, root last */
+  int num_implicit;             /**< LEVEL_SET: nodes, [1, FCM_IMPLICIT_MAX_NODES] */
+  int refinement;               /**< LEVEL_SET: sub-cells per cut cell edge (default 4) */
+  int has_box; /**< LEVEL_SET: 1: sampled on min/max/cells; 0: on the background grid */
 } fcm_scene_geometry;
 
 /** Quadrature settings ("quadrature"). The enums and option structs are the library's own

@@ -28,6 +28,10 @@ typedef struct fcm_simulation_options {
   int checkpoint_interval; /**< >= 0: fcm_simulation_checkpoint_due() every n-th step (0:
                                 never); FCM_DEFAULT (default): the scene's
                                 output.checkpoint_interval */
+  fcm_cell_rules_progress_fn rules_progress; /**< progress of the cell rules build
+                                (fcm_cell_rules_options.progress); NULL (default): none */
+  void *rules_progress_user;   /**< its argument; default NULL */
+  double rules_progress_interval; /**< seconds between calls, >= 0; default 0.1 */
 } fcm_simulation_options;
 
 /** Defaults as documented on each member. */
@@ -71,7 +75,9 @@ typedef struct fcm_simulation_counters {
 typedef struct fcm_simulation fcm_simulation;
 
 /** Build everything a scene needs and set the integrator up at t = 0 (initial velocities
- * applied). No file is created.
+ * applied). No file is created. A failure while building from a scene section has that
+ * section's JSON path before the message ("background.mesh: ...", "geometry.voxels: ...",
+ * "geometry: embed: the geometry lies wholly outside ...").
  * @param[in]  ctx   context; must outlive the simulation
  * @param[in]  scene borrowed; must outlive the simulation
  * @param[in]  opts  NULL for defaults
@@ -84,6 +90,10 @@ FCM_API fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
 
 /** Destroy; accepts NULL and `*sim == NULL`, sets `*sim = NULL`. */
 FCM_API void fcm_simulation_destroy(fcm_simulation **sim);
+
+/** The cell rules of the embedded geometry (statistics: fcm_cell_rules_get_stats()), NULL
+ * for a scene without geometry. Valid for the life of the simulation. */
+FCM_API const fcm_cell_rules *fcm_simulation_cell_rules(const fcm_simulation *sim);
 
 /** Advance one step (fcm_integrator_step()) and record it for the log.
  * @param[out] info may be NULL

@@ -23,6 +23,10 @@ fcm_status fcm__error(fcm_ctx *ctx, fcm_status code, const char *file, int line,
 /* Append a traceback frame to the recorded error. */
 void fcm__trace(fcm_ctx *ctx, const char *file, int line, const char *func);
 
+/* Prepend "prefix: " to the message of the error recorded in ctx (its traceback is kept);
+ * nothing when no error is recorded. Not for use inside a parallel loop iteration. */
+void fcm__error_prefix(fcm_ctx *ctx, const char *prefix);
+
 /* Format a message and pass it to the log callback when level is enabled. */
 void fcm__log(const fcm_ctx *ctx, fcm_log_level level, const char *fmt, ...) FCM__PRINTF(3, 4);
 

@@ -32,6 +32,9 @@ fcm_cell_rules_options fcm_cell_rules_options_default(void)
   o.stabilization = fcm_stabilization_options_default();
   o.max_rule_memory = 4.0 * GIB;
   o.num_threads = FCM_DEFAULT;
+  o.progress = NULL;
+  o.progress_user = NULL;
+  o.progress_interval = 0.1;
   return o;
 }
 
@@ -563,6 +566,9 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_cell_rules_options *o)
             "embed: tolerances clip_rtol = %g, sliver_rtol = %g (each in [0, 1e-3)), "
             "convex_rtol = %g (in [0, 1e-2)) out of range",
             o->clip_rtol, o->sliver_rtol, o->convex_rtol);
+  FCM_CHECK(o->progress_interval >= 0.0 && isfinite(o->progress_interval), ctx, FCM_ERR_ARG,
+            "embed: progress_interval = %g must be finite and >= 0 seconds",
+            o->progress_interval);
   FCM_CHECK(o->max_rule_memory >= 0.0 && !isnan(o->max_rule_memory), ctx, FCM_ERR_ARG,
             "embed: max_rule_memory = %g bytes must be >= 0 (0: no limit)", o->max_rule_memory);
   FCM_CHECK(o->num_threads >= 1 || o->num_threads == FCM_DEFAULT, ctx, FCM_ERR_ARG,
@@ -726,11 +732,13 @@ cleanup:
 /* Phase 2: every cell in parallel into its own cell_out; thread sums into *sums. An error
  * is that of the lowest failing cell, whatever the thread count. */
 static fcm_status run_cells(const build *B, fcm_cell_rules *R, int nthreads, cell_out *out,
-                            cell_sums *sums)
+                            cell_sums *sums, const fcm_cell_rules_options *opt)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
   const fcm_index nc = R->num_cells;
+  fcm_index done = 0;
+  double last = fcm_wtime();
   fcm__loop loop;
   fcm__loop_begin(ctx, &loop);
   memset(sums, 0, sizeof *sums);
@@ -751,6 +759,17 @@ static fcm_status run_cells(const build *B, fcm_cell_rules *R, int nthreads, cel
       }
       if (s == FCM_OK) s = process_cell(B, R, c, ws, out + c, &mine);
       fcm__loop_leave(&loop, &it, s);
+      if (opt->progress) { /* counted by all threads, reported by the calling one */
+#pragma omp atomic
+        done++;
+        if (omp_get_thread_num() == 0 && fcm_wtime() - last >= opt->progress_interval) {
+          fcm_index now;
+#pragma omp atomic read
+          now = done;
+          opt->progress(now, nc, opt->progress_user);
+          last = fcm_wtime();
+        }
+      }
     }
     if (ws) fcm__embed_ws_free(ctx, ws);
     fcm__free(ctx, ws);
@@ -767,6 +786,7 @@ static fcm_status run_cells(const build *B, fcm_cell_rules *R, int nthreads, cel
     }
   }
   FCM_TRY(ctx, fcm__loop_end(&loop, NULL));
+  if (opt->progress) opt->progress(nc, nc, opt->progress_user);
 cleanup:
   return st;
 }
@@ -1098,7 +1118,7 @@ static fcm_status build_rules(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geom
   const double t_setup = fcm_wtime();
   /* 2. parallel per-cell work */
   const int nthreads = o->num_threads > 0 ? o->num_threads : omp_get_max_threads();
-  FCM_TRY(ctx, run_cells(&B, R, nthreads, out, &sums));
+  FCM_TRY(ctx, run_cells(&B, R, nthreads, out, &sums, o));
   if (o->simplify == FCM_CELL_SIMPLIFY_AUTO)
     FCM_TRY(ctx, auto_simplify(&B, R, nthreads, out, &sums));
   const double t_loop = fcm_wtime();
@@ -1106,6 +1126,7 @@ static fcm_status build_rules(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geom
   FCM_TRY(ctx, gather_rules(ctx, R, out, prev));
   if (B.cut_tree) FCM_TRY(ctx, gather_links(&B, R, out));
   gather_stats(R, geom, out, &sums, nthreads);
+  FCM_TRY(ctx, fcm__embed_outside(ctx, mesh, geom, &R->stats));
   if (o->simplify != FCM_CELL_SIMPLIFY_AUTO)
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
       R->stats.decision[k].simplified = o->simplify == FCM_CELL_SIMPLIFY_ON;
@@ -1434,6 +1455,13 @@ void fcm_cell_rules_view(const fcm_cell_rules *rules, FILE *stream)
           (long long)S->num_candidates, (long long)S->num_parts, (long long)S->num_tets,
           (long long)S->num_slivers, S->sliver_volume, S->embedded_volume, S->geometry_volume,
           S->dropped_volume);
+  fprintf(stream, "  embedded / geometry volume %.6f; outside the background mesh %.3g",
+          S->volume_ratio, S->outside_volume);
+  static const char *const sides[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
+  for (int k = 0; k < 6; k++)
+    if (S->outside_side_volume[k] > 0.0)
+      fprintf(stream, ", beyond %s %.3g", sides[k], S->outside_side_volume[k]);
+  fputc('\n', stream);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     fprintf(stream,
             "  %-9s strength %d: cut-cell points %lld initial -> %lld simplified "

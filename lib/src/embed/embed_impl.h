@@ -223,4 +223,11 @@ double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
 int fcm__embed_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n, const double x[3],
                       double tol);
 
+/* The embedding diagnostics of the statistics S (geometry, embedded and sliver volumes
+ * already set): bounding boxes, volume ratio, the volume outside the mesh and beyond each
+ * face of its bounding box. FCM_ERR_GEOMETRY, with both bounding boxes, when a geometry of
+ * positive volume has none inside the mesh; FCM_ERR_ALLOC. Single-threaded. */
+fcm_status fcm__embed_outside(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                              fcm_cell_rules_stats *S);
+
 #endif /* FCM_EMBED_IMPL_H */

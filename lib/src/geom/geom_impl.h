@@ -23,6 +23,8 @@ struct fcm_geometry {
   fcm_index *tris;     /* num_tris x 3 node ids, counter-clockwise seen from outside */
   fcm_index *tri_cell; /* num_tris: the cell each boundary triangle belongs to */
   double volume;       /* sum of the cell volumes */
+  int custom_boundary; /* 1: tris were not derived from the cells (voxel boxes: the exposed
+                          voxel faces); fcm_geometry_create_transformed() keeps them */
   double lo[3], hi[3]; /* bounding box of the nodes */
 };
 

@@ -248,6 +248,28 @@ fcm_status fcm_geometry_create_transformed(fcm_ctx *ctx, const fcm_geometry *src
   /* Tets are reoriented by fcm__geom_create_take. */
   FCM_TRY(ctx, fcm__geom_create_take(ctx, "geometry transform", src->type, src->num_nodes, &x,
                                      src->num_cells, &c, 0, geom));
+  if (src->custom_boundary) { /* keep the source's triangles, mirrored when det A < 0 */
+    fcm_geometry *g = *geom;
+    fcm_index *t = NULL, *tc = NULL;
+    t = fcm__malloc(ctx, 3 * (size_t)src->num_tris + 1, sizeof *t);
+    tc = fcm__malloc(ctx, (size_t)src->num_tris + 1, sizeof *tc);
+    if (!t || !tc) {
+      fcm__free(ctx, t);
+      fcm__free(ctx, tc);
+      fcm_geometry_destroy(geom);
+      FCM_CHECK(0, ctx, FCM_ERR_ALLOC, "geometry transform: out of memory");
+    }
+    memcpy(t, src->tris, 3 * (size_t)src->num_tris * sizeof *t);
+    memcpy(tc, src->tri_cell, (size_t)src->num_tris * sizeof *tc);
+    if (det < 0.0)
+      for (fcm_index k = 0; k < src->num_tris; k++) {
+        const fcm_index s1 = t[3 * k + 1];
+        t[3 * k + 1] = t[3 * k + 2], t[3 * k + 2] = s1;
+      }
+    fcm__free(ctx, g->tris);
+    fcm__free(ctx, g->tri_cell);
+    g->tris = t, g->tri_cell = tc, g->num_tris = src->num_tris, g->custom_boundary = 1;
+  }
 cleanup:
   fcm__free(ctx, x);
   fcm__free(ctx, c);

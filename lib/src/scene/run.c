@@ -8,6 +8,8 @@
 #include "fcm/fem.h"
 #include "fcm/geom.h"
 #include "fcm/io.h"
+#include "fcm/levelset.h"
+#include "fcm/voxels.h"
 #include "fcm/mesh.h"
 #include "io/io_impl.h"
 
@@ -22,6 +24,7 @@ fcm_simulation_options fcm_simulation_options_default(void)
   memset(&o, 0, sizeof o);
   o.max_steps = FCM_DEFAULT;
   o.checkpoint_interval = FCM_DEFAULT;
+  o.rules_progress_interval = 0.1;
   return o;
 }
 
@@ -247,6 +250,71 @@ cleanup:
 
 /* ---------------------------------------------------------------- building */
 
+static fcm_status build_voxels(fcm_simulation *S, const fcm_scene_geometry *g,
+                               fcm_geometry **raw)
+{
+  fcm_status st = FCM_OK;
+  fcm_voxel_image *img = NULL;
+  fcm_voxel_options vo = fcm_voxel_options_default();
+  fcm_voxel_info info;
+  vo.threshold = g->threshold;
+  vo.labels = g->labels;
+  vo.num_labels = g->num_labels;
+  vo.merge = g->merge;
+  FCM_TRY(S->ctx, fcm_voxel_image_create_from_file(S->ctx, g->image, &img));
+  FCM_TRY(S->ctx, fcm_geometry_create_from_voxels(S->ctx, img, &vo, raw, &info));
+  fcm_index d[3];
+  fcm_voxel_image_dims(img, d);
+  snprintf(S->geometry_note, sizeof S->geometry_note,
+           "voxels: %lld of %lld x %lld x %lld selected, merged into %lld boxes",
+           (long long)info.num_selected, (long long)d[0], (long long)d[1], (long long)d[2],
+           (long long)info.num_boxes);
+cleanup:
+  fcm_voxel_image_destroy(&img);
+  return st;
+}
+
+static fcm_status build_level_set(fcm_simulation *S, const fcm_scene_geometry *g,
+                                  fcm_geometry **raw)
+{
+  fcm_status st = FCM_OK;
+  fcm_implicit_tree tree = {g->num_implicit, g->implicit};
+  fcm_level_set_options lo = fcm_level_set_options_default();
+  fcm_level_set_info info;
+  lo.refinement = g->refinement;
+  FCM_TRY(S->ctx, fcm_implicit_check(S->ctx, &tree));
+  FCM_TRY(S->ctx, fcm_geometry_create_from_level_set(S->ctx, fcm_implicit_eval, &tree, g->min,
+                                                     g->max, g->cells, &lo, raw, &info));
+  snprintf(S->geometry_note, sizeof S->geometry_note,
+           "level set: %lld tets, %lld cut cells at refinement %d (h %.3g m), volume %.6g m^3, "
+           "estimated error %.2g m^3 (%.2g%%)",
+           (long long)info.num_tets, (long long)info.cells_cut, g->refinement, info.h,
+           info.volume, info.error_estimate, 100.0 * info.error_estimate / info.volume);
+cleanup:
+  return st;
+}
+
+/* The scene path an error while building the geometry of kind `k` belongs to. */
+static const char *geometry_path(fcm_scene_geometry_kind k)
+{
+  switch (k) {
+  case FCM_SCENE_GEOMETRY_GMSH:
+    return "geometry.mesh";
+  case FCM_SCENE_GEOMETRY_TETGEN:
+    return "geometry.tetgen";
+  case FCM_SCENE_GEOMETRY_VOXELS:
+    return "geometry.voxels";
+  case FCM_SCENE_GEOMETRY_LEVEL_SET:
+    return "geometry.level_set";
+  case FCM_SCENE_GEOMETRY_SURFACE:
+    return "geometry.surface";
+  case FCM_SCENE_GEOMETRY_NONE:
+    return "geometry";
+  default:
+    return "geometry.shape";
+  }
+}
+
 /* geometry.surface: read, optionally close holes (logged as a warning with what was
  * closed), tetrahedralize. */
 static fcm_status build_surface_geometry(fcm_simulation *S, const fcm_scene_geometry *g,
@@ -330,6 +398,13 @@ cleanup:
   return st;
 }
 
+/* Put the scene section `path` before the recorded error's message, unless the message
+ * names it already. */
+static void name_section(fcm_ctx *ctx, const char *path)
+{
+  if (!strstr(fcm_ctx_error_message(ctx), path)) fcm__error_prefix(ctx, path);
+}
+
 static fcm_status build_geometry(fcm_simulation *S, const fcm_scene_geometry *g)
 {
   fcm_status st = FCM_OK;
@@ -362,6 +437,12 @@ static fcm_status build_geometry(fcm_simulation *S, const fcm_scene_geometry *g)
     break;
   case FCM_SCENE_GEOMETRY_SURFACE:
     FCM_TRY(ctx, build_surface_geometry(S, g, &raw));
+    break;
+  case FCM_SCENE_GEOMETRY_VOXELS:
+    FCM_TRY(ctx, build_voxels(S, g, &raw));
+    break;
+  case FCM_SCENE_GEOMETRY_LEVEL_SET:
+    FCM_TRY(ctx, build_level_set(S, g, &raw));
     break;
   default:
     FCM_CHECK(0, ctx, FCM_ERR_ARG, "scene %s: geometry kind %d outside [1, %d)",
@@ -419,6 +500,9 @@ static fcm_status build_rules(fcm_simulation *S)
   ro.simplify_options.method = q->simplify_method;
   ro.stabilization = q->stabilization;
   ro.num_threads = sv->threads;
+  ro.progress = S->opts.rules_progress;
+  ro.progress_user = S->opts.rules_progress_user;
+  ro.progress_interval = S->opts.rules_progress_interval;
   FCM_TRY(S->ctx, fcm_cell_rules_create(S->ctx, S->mesh, S->geom, &ro, &S->rules));
   S->c.cell_rules = 1;
   S->c.surface_rules = ro.surface_strength >= 0;
@@ -662,26 +746,54 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   S->num_steps = tm->num_steps;
   if (S->opts.max_steps > 0 && S->opts.max_steps < S->num_steps) S->num_steps = S->opts.max_steps;
 
-  /* background mesh */
+  FCM_CHECK(S->opts.rules_progress_interval >= 0.0, ctx, FCM_ERR_ARG,
+            "simulation: rules_progress_interval = %g must be >= 0 seconds",
+            S->opts.rules_progress_interval);
+
+  /* background mesh; errors of the inputs name the scene section they come from */
   const fcm_scene_background *bg = fcm_scene_get_background(scene);
   const fcm_scene_geometry *g = fcm_scene_get_geometry(scene);
   if (bg->kind == FCM_SCENE_BACKGROUND_GRID && bg->fit) {
     double min[3], max[3];
     fcm_index cells[3];
-    FCM_TRY(ctx, build_geometry(S, g)); /* the parser ensured there is one */
-    FCM_TRY(ctx, fit_background(S, bg, min, max, cells));
-    FCM_TRY(ctx, fcm_mesh_create_box(ctx, bg->element, min, max, cells, &S->mesh));
+    st = build_geometry(S, g); /* the parser ensured there is one */
+    if (st != FCM_OK) name_section(ctx, geometry_path(g->kind));
+    FCM_TRY(ctx, st);
+    st = fit_background(S, bg, min, max, cells);
+    if (st == FCM_OK) st = fcm_mesh_create_box(ctx, bg->element, min, max, cells, &S->mesh);
+    if (st != FCM_OK) name_section(ctx, "background.fit_background");
+    FCM_TRY(ctx, st);
   } else if (bg->kind == FCM_SCENE_BACKGROUND_GRID)
-    FCM_TRY(ctx, fcm_mesh_create_box(ctx, bg->element, bg->min, bg->max, bg->cells, &S->mesh));
+    st = fcm_mesh_create_box(ctx, bg->element, bg->min, bg->max, bg->cells, &S->mesh);
   else
-    FCM_TRY(ctx, fcm_mesh_create_from_gmsh(ctx, bg->mesh, &S->mesh));
+    st = fcm_mesh_create_from_gmsh(ctx, bg->mesh, &S->mesh);
+  if (st != FCM_OK)
+    name_section(ctx, bg->kind == FCM_SCENE_BACKGROUND_GRID ? "background" : "background.mesh");
+  FCM_TRY(ctx, st);
   S->nn = fcm_mesh_num_nodes(S->mesh);
 
   /* geometry and cell rules only when the scene embeds one */
   if (g->kind != FCM_SCENE_GEOMETRY_NONE) {
-    if (!S->geom) FCM_TRY(ctx, build_geometry(S, g));
-    FCM_TRY(ctx, build_rules(S));
-    FCM_TRY(ctx, fcm_space_create_embedded(ctx, S->mesh, S->rules, &S->space));
+    if (!S->geom) {
+      st = build_geometry(S, g);
+      if (st != FCM_OK) name_section(ctx, geometry_path(g->kind));
+      FCM_TRY(ctx, st);
+    }
+    st = build_rules(S);
+    if (st != FCM_OK)
+      fcm__error_prefix(ctx, st == FCM_ERR_GEOMETRY ? "geometry" : "quadrature");
+    FCM_TRY(ctx, st);
+    const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(S->rules);
+    FCM_CHECK(rs->num_uncut + rs->num_cut > 0, ctx, FCM_ERR_GEOMETRY,
+              "geometry: every one of the %lld background cells holds less than "
+              "quadrature.min_fraction = %g of its volume of the body (embedded volume %g of "
+              "%g m^3): the body is too small or thin for the grid; refine the background or "
+              "lower quadrature.min_fraction",
+              (long long)rs->num_cells, fcm_scene_get_quadrature(scene)->min_fraction,
+              rs->embedded_volume, rs->geometry_volume);
+    st = fcm_space_create_embedded(ctx, S->mesh, S->rules, &S->space);
+    if (st != FCM_OK) fcm__error_prefix(ctx, "geometry");
+    FCM_TRY(ctx, st);
   } else {
     FCM_TRY(ctx, fcm_space_create(ctx, S->mesh, NULL, &S->space));
   }
@@ -741,6 +853,11 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
 cleanup:
   fcm_simulation_destroy(&S);
   return st;
+}
+
+const fcm_cell_rules *fcm_simulation_cell_rules(const fcm_simulation *sim)
+{
+  return sim ? sim->rules : NULL;
 }
 
 void fcm_simulation_destroy(fcm_simulation **sim)
@@ -979,8 +1096,34 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
   fprintf(f, "simulation %s: %lld of %lld steps, %lld DOFs\n", fcm_scene_name(S->scene), c->steps,
           S->num_steps, (long long)c->num_dofs);
   line(f, c->cell_rules, "embedded cell rules", c->cell_rules ? "" : "(no geometry)");
+  if (S->geometry_note[0]) fprintf(f, "  geometry  %s\n", S->geometry_note);
   if (S->rules) {
     const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(S->rules);
+    fprintf(f,
+            "  cells     %lld: %lld uncut, %lld cut, %lld dropped; cut-cell points stiffness "
+            "%lld -> %lld, mass %lld -> %lld (before -> after simplification)\n",
+            (long long)rs->num_cells, (long long)rs->num_uncut, (long long)rs->num_cut,
+            (long long)rs->num_dropped, (long long)rs->points_initial[FCM_RULE_STIFFNESS],
+            (long long)rs->points_simplified[FCM_RULE_STIFFNESS],
+            (long long)rs->points_initial[FCM_RULE_MASS],
+            (long long)rs->points_simplified[FCM_RULE_MASS]);
+    fprintf(f,
+            "  volume    embedded %.6g of %.6g m^3 (ratio %.6f), outside the background %.3g, in "
+            "dropped cells %.3g\n",
+            rs->embedded_volume, rs->geometry_volume, rs->volume_ratio, rs->outside_volume,
+            rs->dropped_volume);
+    if (rs->outside_volume > 0.0) {
+      static const char *const sides[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
+      fprintf(f, "  outside   body [%g, %g] x [%g, %g] x [%g, %g], background [%g, %g] x [%g, %g] "
+                 "x [%g, %g]; beyond",
+              rs->geometry_lo[0], rs->geometry_hi[0], rs->geometry_lo[1], rs->geometry_hi[1],
+              rs->geometry_lo[2], rs->geometry_hi[2], rs->mesh_lo[0], rs->mesh_hi[0],
+              rs->mesh_lo[1], rs->mesh_hi[1], rs->mesh_lo[2], rs->mesh_hi[2]);
+      for (int k = 0; k < 6; k++)
+        if (rs->outside_side_volume[k] > 0.0)
+          fprintf(f, " %s %.3g", sides[k], rs->outside_side_volume[k]);
+      fputc('\n', f);
+    }
     const fcm_scene_quadrature *q = fcm_scene_get_quadrature(S->scene);
     static const char *const kinds[FCM_RULE_KIND_COUNT] = {"stiffness", "mass"};
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {

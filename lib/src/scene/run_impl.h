@@ -63,6 +63,8 @@ struct fcm_simulation {
   /* log */
   fcm__log_row *log;
   long long log_n, log_cap;
+  /* what the voxel or level-set geometry reported ("" for the other kinds) */
+  char geometry_note[256];
 };
 
 /* Grow an array of `size`-byte items to hold at least `need` (doubling). */

@@ -311,35 +311,210 @@ cleanup:
   return st;
 }
 
+static const char *const implicit_names[] = {"sphere", "torus",        "box",       "gyroid",
+                                             "union",  "intersection", "difference"};
+
+/* One implicit (an object with one member named by its kind) at the current path into
+ * nodes[*n ...]; *root is the index of its node. CSG arrays of k >= 2 operands fold left:
+ * ((a op b) op c) ... */
+static fcm_status read_implicit(fcm__scene_parser *p, const fcm__json *node, fcm_implicit *nodes,
+                                int *n, int *root)
+{
+  fcm_status st = FCM_OK;
+  static const char *const sphere_keys[] = {"center", "radius"};
+  static const char *const torus_keys[] = {"center", "axis", "major_radius", "minor_radius"};
+  static const char *const box_keys[] = {"min", "max"};
+  static const char *const gyroid_keys[] = {"min", "max", "period", "thickness", "type"};
+  static const char *const gyroid_types[] = {"sheet", "solid"};
+  size_t old = p->path_len;
+  SCENE_CHECK(fcm__json_get_kind(node) == FCM__JSON_OBJECT && fcm__json_size(node) == 1, p,
+              FCM_ERR_ARG,
+              "expected an object with exactly one member: sphere, torus, box, gyroid, union, "
+              "intersection or difference");
+  const fcm__json *m = fcm__json_child(node);
+  const char *key = fcm__json_key(m);
+  int kind = -1;
+  for (int k = 0; k < COUNT(implicit_names); k++)
+    if (strcmp(key, implicit_names[k]) == 0) kind = k;
+  SCENE_CHECK(kind >= 0, p, FCM_ERR_ARG,
+              "unknown implicit \"%.64s\"; expected sphere, torus, box, gyroid, union, "
+              "intersection or difference",
+              key);
+  ENTER(p, key);
+  fcm_implicit q;
+  memset(&q, 0, sizeof q);
+  q.kind = (fcm_implicit_kind)kind;
+  if (q.kind >= FCM_IMPLICIT_UNION) {
+    SCENE_CHECK(fcm__json_get_kind(m) == FCM__JSON_ARRAY && fcm__json_size(m) >= 2, p,
+                FCM_ERR_ARG, "expected an array of at least 2 implicits");
+    int r = -1, i = 0;
+    for (const fcm__json *c = fcm__json_child(m); c; c = fcm__json_next(c), i++) {
+      size_t o2 = fcm__scene_path_push_index(p, i);
+      int ci = -1;
+      FCM_TRY(p->ctx, read_implicit(p, c, nodes, n, &ci));
+      fcm__scene_path_pop(p, o2);
+      if (r < 0) {
+        r = ci;
+        continue;
+      }
+      SCENE_CHECK(*n < FCM_IMPLICIT_MAX_NODES, p, FCM_ERR_ARG,
+                  "the implicit tree has more than %d nodes", FCM_IMPLICIT_MAX_NODES);
+      q.a = r, q.b = ci;
+      nodes[*n] = q;
+      r = (*n)++;
+    }
+    *root = r;
+  } else {
+    SCENE_CHECK(fcm__json_get_kind(m) == FCM__JSON_OBJECT, p, FCM_ERR_ARG,
+                "expected an object of parameters");
+    SCENE_CHECK(*n < FCM_IMPLICIT_MAX_NODES, p, FCM_ERR_ARG,
+                "the implicit tree has more than %d nodes", FCM_IMPLICIT_MAX_NODES);
+    switch (q.kind) {
+    case FCM_IMPLICIT_SPHERE:
+      FCM_TRY(p->ctx, fcm__scene_check_object(p, m, sphere_keys, COUNT(sphere_keys)));
+      FCM_TRY(p->ctx, fcm__scene_read_vec3(p, m, "center", 0, FCM__ANY, q.center));
+      FCM_TRY(p->ctx, fcm__scene_read_number(p, m, "radius", 1, FCM__POSITIVE, &q.radius));
+      break;
+    case FCM_IMPLICIT_TORUS:
+      FCM_TRY(p->ctx, fcm__scene_check_object(p, m, torus_keys, COUNT(torus_keys)));
+      FCM_TRY(p->ctx, fcm__scene_read_vec3(p, m, "center", 0, FCM__ANY, q.center));
+      q.axis = 2;
+      READ_CHOICE(p, m, "axis", 0, axis_names, q.axis);
+      FCM_TRY(p->ctx, fcm__scene_read_number(p, m, "major_radius", 1, FCM__POSITIVE, &q.radius));
+      FCM_TRY(p->ctx, fcm__scene_read_number(p, m, "minor_radius", 1,
+                                             (fcm__range){0.0, q.radius, 1, 0}, &q.minor_radius));
+      break;
+    case FCM_IMPLICIT_BOX:
+    case FCM_IMPLICIT_GYROID:
+      if (q.kind == FCM_IMPLICIT_BOX)
+        FCM_TRY(p->ctx, fcm__scene_check_object(p, m, box_keys, COUNT(box_keys)));
+      else
+        FCM_TRY(p->ctx, fcm__scene_check_object(p, m, gyroid_keys, COUNT(gyroid_keys)));
+      FCM_TRY(p->ctx, fcm__scene_read_vec3(p, m, "min", 1, FCM__ANY, q.min));
+      FCM_TRY(p->ctx, fcm__scene_read_vec3(p, m, "max", 1, FCM__ANY, q.max));
+      for (int d = 0; d < 3; d++)
+        SCENE_CHECK(q.min[d] < q.max[d], p, FCM_ERR_ARG,
+                    "expected min[%d] < max[%d], got min[%d] = %g >= max[%d] = %g", d, d, d,
+                    q.min[d], d, q.max[d]);
+      if (q.kind == FCM_IMPLICIT_GYROID) {
+        int type = 0;
+        READ_CHOICE(p, m, "type", 0, gyroid_types, type);
+        q.sheet = type == 0;
+        FCM_TRY(p->ctx, fcm__scene_read_number(p, m, "period", 1, FCM__POSITIVE, &q.period));
+        q.thickness = q.sheet ? 0.1 * q.period : 0.0;
+        FCM_TRY(p->ctx, fcm__scene_read_number(
+                            p, m, "thickness", 0,
+                            q.sheet ? (fcm__range){0.0, q.period / 4, 1, 1}
+                                    : (fcm__range){-q.period / 4, q.period / 4, 1, 1},
+                            &q.thickness));
+      }
+      break;
+    default:
+      break;
+    }
+    nodes[*n] = q;
+    *root = (*n)++;
+  }
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
+/* "voxels": the image and its selection. */
+static fcm_status read_voxels(fcm__scene_parser *p, const fcm__json *o, fcm_scene_geometry *g)
+{
+  fcm_status st = FCM_OK;
+  size_t old = p->path_len;
+  const fcm__json *lab = NULL;
+  FCM_TRY(p->ctx, fcm__scene_read_file(p, o, "voxels", 1, NULL, &g->image));
+  g->threshold = 0.5;
+  g->merge = 1;
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "threshold", 0, FCM__ANY, &g->threshold));
+  FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "merge", 0, &g->merge));
+  FCM_TRY(p->ctx, fcm__scene_field(p, o, "labels", 0, "an array of 1 to 256 numbers",
+                                   FCM__JSON_ARRAY, -1, &lab));
+  if (lab) {
+    const int nl = fcm__json_size(lab);
+    SCENE_CHECK(nl >= 1 && nl <= 256, p, FCM_ERR_ARG, "expected 1 to 256 labels, got %d", nl);
+    SCENE_CHECK(!fcm__json_member(o, "threshold"), p, FCM_ERR_ARG,
+                "give either \"labels\" or \"threshold\", not both");
+    double *l = fcm__scene_alloc(p->scene, (size_t)nl, sizeof *l);
+    FCM_CHECK(l, p->ctx, FCM_ERR_ALLOC, "scene: out of memory");
+    int i = 0;
+    for (const fcm__json *c = fcm__json_child(lab); c; c = fcm__json_next(c), i++) {
+      SCENE_CHECK(fcm__json_get_kind(c) == FCM__JSON_NUMBER && isfinite(fcm__json_number(c)), p,
+                  FCM_ERR_ARG, "labels[%d]: expected a finite number", i);
+      l[i] = fcm__json_number(c);
+    }
+    g->labels = l;
+    g->num_labels = nl;
+  }
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
+/* "level_set": the implicit tree, its sampling box (default: the background grid) and the
+ * refinement. */
+static fcm_status read_level_set(fcm__scene_parser *p, const fcm__json *o, fcm_scene_geometry *g)
+{
+  fcm_status st = FCM_OK;
+  size_t old = p->path_len;
+  fcm_implicit *nodes = fcm__scene_alloc(p->scene, FCM_IMPLICIT_MAX_NODES, sizeof *nodes);
+  FCM_CHECK(nodes, p->ctx, FCM_ERR_ALLOC, "scene: out of memory");
+  int n = 0, root = -1;
+  ENTER(p, "level_set");
+  FCM_TRY(p->ctx, read_implicit(p, fcm__json_member(o, "level_set"), nodes, &n, &root));
+  fcm__scene_path_pop(p, old);
+  g->implicit = nodes;
+  g->num_implicit = n;
+  g->refinement = 4;
+  READ_INT(p, o, "refinement", 0, 1, 64, g->refinement);
+  const int nbox = !!fcm__json_member(o, "min") + !!fcm__json_member(o, "max") +
+                   !!fcm__json_member(o, "cells");
+  SCENE_CHECK(nbox == 0 || nbox == 3, p, FCM_ERR_ARG,
+              "the sampling box of a level set needs all of \"min\", \"max\" and \"cells\" "
+              "(or none: the background grid)");
+  if (nbox == 3) {
+    g->has_box = 1;
+    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "min", 1, FCM__ANY, g->min));
+    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "max", 1, FCM__ANY, g->max));
+    for (int d = 0; d < 3; d++)
+      SCENE_CHECK(g->min[d] < g->max[d], p, FCM_ERR_ARG,
+                  "expected min[%d] < max[%d], got min[%d] = %g >= max[%d] = %g", d, d, d,
+                  g->min[d], d, g->max[d]);
+    FCM_TRY(p->ctx, fcm__scene_read_ivec3(p, o, "cells", 1, 1, 10000, g->cells));
+  } else {
+    const fcm_scene_background *b = &p->scene->background;
+    SCENE_CHECK(b->kind == FCM_SCENE_BACKGROUND_GRID && !b->fit &&
+                    !fcm__json_member(o, "transform"),
+                p, FCM_ERR_ARG,
+                "a level set is sampled on the background grid only when the background is a "
+                "grid with its box given (not fit_background) and there is no transform; give "
+                "\"min\", \"max\" and \"cells\"");
+    memcpy(g->min, b->min, sizeof g->min);
+    memcpy(g->max, b->max, sizeof g->max);
+    memcpy(g->cells, b->cells, sizeof g->cells);
+  }
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
 static fcm_status read_geometry(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
-  static const char *const any_keys[] = {"shape",
-                                         "mesh",
-                                         "tetgen",
-                                         "transform",
-                                         "min",
-                                         "max",
-                                         "cells",
-                                         "center",
-                                         "radius",
-                                         "resolution",
-                                         "inner_radius",
-                                         "outer_radius",
-                                         "hole_radius",
-                                         "layers",
-                                         "axis",
-                                         "length",
-                                         "radial_cells",
-                                         "angular_cells",
-                                         "axial_cells",
-                                         "surface",
-                                         "max_volume",
-                                         "size",
-                                         "quality",
-                                         "fill_holes",
-                                         "max_hole_edges",
-                                         "max_hole_perimeter"};
+  static const char *const any_keys[] = {
+      "shape",          "mesh",         "tetgen",        "transform",          "min",
+      "max",            "cells",        "center",        "radius",             "resolution",
+      "inner_radius",   "outer_radius", "hole_radius",   "layers",             "axis",
+      "length",         "radial_cells", "angular_cells", "axial_cells",        "surface",
+      "max_volume",     "size",         "quality",       "fill_holes",         "max_hole_edges",
+      "max_hole_perimeter", "voxels",   "threshold",     "labels",             "merge",
+      "level_set",      "refinement"};
+  static const char *const voxel_keys[] = {"voxels", "threshold", "labels", "merge", "transform"};
+  static const char *const level_set_keys[] = {"level_set", "refinement", "min",
+                                               "max",       "cells",      "transform"};
   static const char *const box_keys[] = {"shape", "min", "max", "cells", "transform"};
   static const char *const ball_keys[] = {"shape", "center", "radius", "resolution", "transform"};
   static const char *const hollow_keys[] = {"shape",        "center",      "inner_radius",
@@ -362,14 +537,24 @@ static fcm_status read_geometry(fcm__scene_parser *p, const fcm__json *root)
   /* Typos first (against every geometry key), then the keys of the chosen kind. */
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, any_keys, COUNT(any_keys)));
   int nd = !!fcm__json_member(o, "shape") + !!fcm__json_member(o, "mesh") +
-           !!fcm__json_member(o, "tetgen") + !!fcm__json_member(o, "surface");
+           !!fcm__json_member(o, "tetgen") + !!fcm__json_member(o, "surface") +
+           !!fcm__json_member(o, "voxels") + !!fcm__json_member(o, "level_set");
   SCENE_CHECK(nd == 1, p, FCM_ERR_ARG,
               "expected exactly one of \"shape\" (a procedural shape), \"mesh\" (a Gmsh file), "
-              "\"tetgen\" (a TetGen base name) or \"surface\" (an .obj, .off, .stl or .ply "
-              "triangle surface), got %d of them",
+              "\"tetgen\" (a TetGen base name), \"surface\" (an .obj, .off, .stl or .ply "
+              "triangle surface), \"voxels\" (an image file) or \"level_set\" (an implicit "
+              "body), got %d of them",
               nd);
   if (fcm__json_member(o, "surface")) {
     FCM_TRY(p->ctx, read_surface_geometry(p, o, g));
+  } else if (fcm__json_member(o, "voxels")) {
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, o, voxel_keys, COUNT(voxel_keys)));
+    g->kind = FCM_SCENE_GEOMETRY_VOXELS;
+    FCM_TRY(p->ctx, read_voxels(p, o, g));
+  } else if (fcm__json_member(o, "level_set")) {
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, o, level_set_keys, COUNT(level_set_keys)));
+    g->kind = FCM_SCENE_GEOMETRY_LEVEL_SET;
+    FCM_TRY(p->ctx, read_level_set(p, o, g));
   } else if (fcm__json_member(o, "mesh")) {
     FCM_TRY(p->ctx, fcm__scene_check_object(p, o, mesh_keys, COUNT(mesh_keys)));
     g->kind = FCM_SCENE_GEOMETRY_GMSH;
@@ -1006,6 +1191,25 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
     fprintf(f, "surface %s, tetrahedralized (max_volume %g, size %g, quality %g), fill_holes %s",
             g->mesh, g->surface.max_volume, g->surface.size, g->surface.quality,
             g->fill_holes ? "yes" : "no");
+    break;
+  case FCM_SCENE_GEOMETRY_VOXELS:
+    fprintf(f, "voxels %s, ", g->image);
+    if (g->num_labels > 0) {
+      fprintf(f, "labels");
+      for (int k = 0; k < g->num_labels; k++)
+        fprintf(f, "%s%g", k ? ", " : " ", g->labels[k]);
+    } else {
+      fprintf(f, "threshold %g", g->threshold);
+    }
+    fprintf(f, ", %s", g->merge ? "merged into boxes" : "one cell per voxel");
+    break;
+  case FCM_SCENE_GEOMETRY_LEVEL_SET:
+    fprintf(f, "level set of %d implicit node%s (root %s), refinement %d, sampled on [%g, %g] x "
+               "[%g, %g] x [%g, %g] in %lld x %lld x %lld cells",
+            g->num_implicit, g->num_implicit == 1 ? "" : "s",
+            implicit_names[g->implicit[g->num_implicit - 1].kind], g->refinement, g->min[0],
+            g->max[0], g->min[1], g->max[1], g->min[2], g->max[2], (long long)g->cells[0],
+            (long long)g->cells[1], (long long)g->cells[2]);
     break;
   default:
     fprintf(f, "tetgen %s, %s", g->mesh, g->ele);

@@ -1,0 +1,66 @@
+/* Embedding diagnostics: how much of the body lies outside the background mesh, beyond which
+ * faces of its bounding box, and the error for a body that misses the mesh entirely. */
+#include "embed/embed_impl.h"
+
+#include <math.h>
+#include <string.h>
+
+fcm_status fcm__embed_outside(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                              fcm_cell_rules_stats *S)
+{
+  fcm_status st = FCM_OK;
+  fcm__poly *p = NULL, *scratch = NULL;
+  fcm_mesh_bounding_box(mesh, S->mesh_lo, S->mesh_hi);
+  fcm_geometry_bounding_box(geom, S->geometry_lo, S->geometry_hi);
+  const double gv = S->geometry_volume;
+  S->volume_ratio = gv > 0.0 ? S->embedded_volume / gv : 0.0;
+  const double out = gv - S->embedded_volume - S->sliver_volume;
+  S->outside_volume = out > 1e-12 * gv ? out : 0.0;
+  memset(S->outside_side_volume, 0, sizeof S->outside_side_volume);
+  const double *glo = S->geometry_lo, *ghi = S->geometry_hi, *mlo = S->mesh_lo, *mhi = S->mesh_hi;
+  FCM_CHECK(!(gv > 0.0) || S->embedded_volume > 1e-12 * gv, ctx, FCM_ERR_GEOMETRY,
+            "embed: the geometry (volume %g) lies wholly outside the background mesh%s: geometry "
+            "bounding box [%g, %g] x [%g, %g] x [%g, %g], background mesh bounding box [%g, %g] x "
+            "[%g, %g] x [%g, %g]; move the body or enlarge the background",
+            gv,
+            glo[0] <= mhi[0] && ghi[0] >= mlo[0] && glo[1] <= mhi[1] && ghi[1] >= mlo[1] &&
+                    glo[2] <= mhi[2] && ghi[2] >= mlo[2]
+                ? " (the boxes overlap, but no geometry cell meets a background cell)"
+                : "",
+            glo[0], ghi[0], glo[1], ghi[1], glo[2], ghi[2], mlo[0], mhi[0], mlo[1], mhi[1], mlo[2],
+            mhi[2]);
+  int beyond = 0;
+  for (int d = 0; d < 3; d++)
+    beyond |= (glo[d] < mlo[d]) << (2 * d) | (ghi[d] > mhi[d]) << (2 * d + 1);
+  if (!beyond) return FCM_OK;
+  const int npc = fcm_geometry_nodes_per_cell(geom);
+  const fcm_element_type type = fcm_geometry_cell_type(geom);
+  const double *GX = fcm_geometry_coords(geom);
+  const fcm_index *cells = fcm_geometry_cells(geom);
+  FCM_ALLOC(ctx, 2, p);
+  scratch = p + 1;
+  for (fcm_index c = 0; c < fcm_geometry_num_cells(geom); c++) {
+    double X[24], lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (int a = 0; a < npc; a++)
+      for (int d = 0; d < 3; d++) {
+        X[3 * a + d] = GX[3 * cells[(size_t)npc * (size_t)c + (size_t)a] + d];
+        lo[d] = fmin(lo[d], X[3 * a + d]), hi[d] = fmax(hi[d], X[3 * a + d]);
+      }
+    for (int side = 0; side < 6; side++) {
+      const int d = side / 2, up = side % 2;
+      if (!(beyond >> side & 1)) continue;
+      const double bound = up ? mhi[d] : mlo[d];
+      if (up ? hi[d] <= bound : lo[d] >= bound) continue; /* nothing beyond this side */
+      fcm__geom_poly_from_cell(type, X, p);
+      if (up ? lo[d] < bound : hi[d] > bound) { /* straddles: keep the part beyond */
+        fcm__plane pl = {{0, 0, 0}, up ? -bound : bound};
+        pl.n[d] = up ? -1.0 : 1.0;
+        if (fcm__geom_poly_clip(p, &pl, 0.0, scratch) != 0) continue;
+      }
+      S->outside_side_volume[side] += fcm__geom_poly_volume(p);
+    }
+  }
+cleanup:
+  fcm__free(ctx, p);
+  return st;
+}
