@@ -1,4 +1,4 @@
-/* Cutting (XFEM) on the quadrature path (DESIGN §9): material pieces of cells split by cut
+/* Cutting (XFEM) on the quadrature path: material pieces of cells split by cut
  * surfaces. Checked facts: the pieces' volumes add up to the geometry's (a cut never loses
  * or doubles volume), every authentic point of a piece lies on one side of a full planar
  * cut, a cell a plane crosses has two pieces and the other cells one, a cut that ends
@@ -12,8 +12,8 @@
 static fcm_ctx *ctx;
 
 /* Physical integral of 1 and of x_d over piece p (authentic points). */
-static void piece_moments(const fcm_mesh *mesh, const fcm_cell_rules *r, fcm_index p,
-                          double *vol, double xlo[3], double xhi[3])
+static void piece_moments(const fcm_mesh *mesh, const fcm_cell_rules *r, fcm_index p, double *vol,
+                          double xlo[3], double xhi[3])
 {
   int n;
   const double *pts, *w;
@@ -108,8 +108,7 @@ static void plane_cut(fcm_element_type type)
   const double blo[3] = {-0.1, -0.1, -0.1}, bhi[3] = {1.1, 1.1, 1.1};
   TEST_OK(ctx, fcm_surface_create_plane(ctx, p0, nx, blo, bhi, &cut));
   TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, r0, cut, &r1));
-  TEST_TRUE(fcm_cell_rules_num_pieces(r0) == fcm_mesh_num_cells(mesh) ||
-            type != FCM_ELEMENT_HEX8);
+  TEST_TRUE(fcm_cell_rules_num_pieces(r0) == fcm_mesh_num_cells(mesh) || type != FCM_ELEMENT_HEX8);
   TEST_NEAR(total_volume(r1), 1.0, 1e-12, 0);
   const fcm_cell_rules_stats *S = fcm_cell_rules_get_stats(r1);
   TEST_NEAR(S->embedded_volume, 1.0, 1e-12, 0);

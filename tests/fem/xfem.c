@@ -1,4 +1,4 @@
-/* Generalized enrichment (DESIGN §9; Ton-That et al. 2024) on all four element types: a body
+/* Generalized enrichment (Ton-That et al. 2024) on all four element types: a body
  * cut through by a plane has exactly 12 rigid-body modes in its stiffness (two free bodies;
  * 6 before the cut), the cube diced by 10 planes into 36 sticks has 216 (Hex8: one cell and
  * a 2x2x2 grid; Tet4: 5 tets), the mass is unchanged by a cut (1^T M 1 = rho V), every node

@@ -1,4 +1,4 @@
-/* Cutting during a run (DESIGN §9) through the host-simulator calls: a spinning, flying
+/* Cutting during a run through the host-simulator calls: a spinning, flying
  * embedded body is stepped, then cut by a plane between two steps
  * (fcm_cell_rules_create_cut -> fcm_space_create_embedded -> fcm_integrator_create_cut).
  * At the cut the new DOF copies inherit their parents' values: the body's mass, linear and

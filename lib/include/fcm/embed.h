@@ -101,8 +101,8 @@ typedef struct fcm_cell_rules_options {
                               done so far, at most every progress_interval seconds and once
                               with done == total at the end of the cell loop, always from the
                               thread that called fcm_cell_rules_create() */
-  void *progress_user;       /**< passed to progress; default NULL */
-  double progress_interval;  /**< seconds between progress calls, >= 0; default 0.1 */
+  void *progress_user;                 /**< passed to progress; default NULL */
+  double progress_interval;            /**< seconds between progress calls, >= 0; default 0.1 */
 } fcm_cell_rules_options;
 
 /** Defaults as documented on each member. */
@@ -149,18 +149,18 @@ typedef struct fcm_cell_rules_stats {
   double max_residual[FCM_RULE_KIND_COUNT]; /**< largest relative moment residual reported */
   fcm_index surface_triangles;              /**< clipped boundary triangles kept */
   fcm_index surface_points;
-  double embedded_volume; /**< sum over all cells of |K ∩ Ω| (dropped cells included) */
-  double dropped_volume;  /**< the part of it in dropped cells */
-  double embedded_area;   /**< sum of the surface weights (non-dropped cells) */
-  double geometry_volume; /**< fcm_geometry_volume() */
-  double outside_volume;  /**< the body outside the background mesh: geometry_volume -
-                               embedded_volume - sliver_volume, 0 when that is below 1e-12
-                               geometry_volume (rounding) */
+  double embedded_volume;        /**< sum over all cells of |K ∩ Ω| (dropped cells included) */
+  double dropped_volume;         /**< the part of it in dropped cells */
+  double embedded_area;          /**< sum of the surface weights (non-dropped cells) */
+  double geometry_volume;        /**< fcm_geometry_volume() */
+  double outside_volume;         /**< the body outside the background mesh: geometry_volume -
+                                      embedded_volume - sliver_volume, 0 when that is below 1e-12
+                                      geometry_volume (rounding) */
   double outside_side_volume[6]; /**< the body beyond each face plane of the mesh's bounding
                                box, in the order -x, +x, -y, +y, -z, +z (a part beyond an edge
                                or a corner counts for each side it is beyond) */
-  double volume_ratio;    /**< embedded_volume / geometry_volume (0 for an empty geometry) */
-  double mesh_lo[3], mesh_hi[3];         /**< bounding box of the background mesh */
+  double volume_ratio;           /**< embedded_volume / geometry_volume (0 for an empty geometry) */
+  double mesh_lo[3], mesh_hi[3]; /**< bounding box of the background mesh */
   double geometry_lo[3], geometry_hi[3]; /**< bounding box of the embedded geometry */
   double time_setup, time_intersect, time_simplify, time_gather, time_total;
   int num_threads;
@@ -234,20 +234,20 @@ FCM_API fcm_status fcm_cell_rules_get_surface(const fcm_cell_rules *rules, fcm_i
 
 /* ---------------------------------------------------------------- cutting (XFEM) */
 
-/** Extend `prev` by a cut (DESIGN §9): a triangle surface in the reference (material)
- * coordinates of the geometry. Inside every background cell the cuts reach, the convex parts
- * of the embedded geometry are split by the plane of each cut triangle that reaches them
- * and by its three edge planes (perpendicular to the triangle through its edges), so every
- * new face lies wholly on or wholly off a triangle; two parts sharing a face of positive
- * area are connected unless that face lies on a cut triangle; the connected components are
- * the cell's material pieces. Each piece's rules come from the same path as a cut cell
- * (tetrahedralize, map, simplify with prev's options, stabilize). A cut that ends inside a
- * cell does not separate it. Only the cells the new cut reaches are integrated again
- * (stats.num_integrated); the rules of every other cell are copied, so adding cuts one at a
- * time costs what the cut touches. Triangles without area are ignored; a cut that misses
- * the body changes nothing but still counts in fcm_cell_rules_num_cuts(). The links between
- * pieces of neighbouring cells (fcm_cell_rules_links()) are recomputed around every cut.
- * `prev` is not changed (it may be destroyed afterwards).
+/** Extend `prev` by a cut (XFEM; Koschier et al. 2017, Ton-That et al. 2024): a triangle surface in
+ * the reference (material) coordinates of the geometry. Inside every background cell the cuts
+ * reach, the convex parts of the embedded geometry are split by the plane of each cut triangle that
+ * reaches them and by its three edge planes (perpendicular to the triangle through its edges), so
+ * every new face lies wholly on or wholly off a triangle; two parts sharing a face of positive area
+ * are connected unless that face lies on a cut triangle; the connected components are the cell's
+ * material pieces. Each piece's rules come from the same path as a cut cell (tetrahedralize, map,
+ * simplify with prev's options, stabilize). A cut that ends inside a cell does not separate it.
+ * Only the cells the new cut reaches are integrated again (stats.num_integrated); the rules of
+ * every other cell are copied, so adding cuts one at a time costs what the cut touches. Triangles
+ * without area are ignored; a cut that misses the body changes nothing but still counts in
+ * fcm_cell_rules_num_cuts(). The links between pieces of neighbouring cells
+ * (fcm_cell_rules_links()) are recomputed around every cut. `prev` is not changed (it may be
+ * destroyed afterwards).
  * @param[in] mesh, geom the mesh and geometry `prev` was built on; @param[in] cut copied
  * @return FCM_OK; FCM_ERR_ARG (NULL, another mesh); FCM_ERR_INTERNAL (a split exceeding
  *         the polyhedron capacity); the errors of fcm_cell_rules_create(). Allocates. */

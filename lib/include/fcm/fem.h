@@ -23,8 +23,8 @@ extern "C" {
  * DOF numbering: node n (if active) owns DOFs 3k, 3k+1, 3k+2 with k its rank
  * among the active nodes (ascending node id), components x, y, z.
  *
- * With cuts (fcm_cell_rules_create_cut()), the space is enriched (generalized XFEM, DESIGN
- * §9; Ton-That et al. 2024): its *elements* are the material pieces of the active cells,
+ * With cuts (fcm_cell_rules_create_cut()), the space is enriched (generalized XFEM,
+ * Ton-That et al. 2024): its *elements* are the material pieces of the active cells,
  * and the pieces incident to a node (its support) are grouped into connected components
  * along the links of the rules; each component gets its own copy of the node's three DOFs,
  * i.e. the node's shape function times the component's indicator function. A node whose

@@ -227,7 +227,7 @@ FCM_API fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space,
                                          fcm_integrator **integ);
 
 /** Destroy; accepts NULL and `*integ == NULL`, sets `*integ = NULL`. */
-/** Continue a run across a cut (DESIGN §9). `space` is the embedded space of rules that
+/** Continue a run across a cut (XFEM). `space` is the embedded space of rules that
  * extend the rules of old's space by one cut (fcm_cell_rules_create_cut(), then
  * fcm_space_create_embedded()). The new integrator has old's material, options, loads and
  * constraints (same callbacks and user pointers, node lists copied), is set up (mass and

@@ -427,7 +427,7 @@ cleanup:
 
 /* Intersect, classify and build the rules of background cell c into o (the thread's own
  * buffers); R->cls[c] and R->fraction[c] are written here (one writer per cell). Cells the
- * cuts reach are split into material pieces first (DESIGN §9); each piece then takes the
+ * cuts reach are split into material pieces first; each piece then takes the
  * path of a cut cell. */
 static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, fcm__embed_ws *ws,
                                cell_out *o, cell_sums *sums)
@@ -567,8 +567,7 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_cell_rules_options *o)
             "convex_rtol = %g (in [0, 1e-2)) out of range",
             o->clip_rtol, o->sliver_rtol, o->convex_rtol);
   FCM_CHECK(o->progress_interval >= 0.0 && isfinite(o->progress_interval), ctx, FCM_ERR_ARG,
-            "embed: progress_interval = %g must be finite and >= 0 seconds",
-            o->progress_interval);
+            "embed: progress_interval = %g must be finite and >= 0 seconds", o->progress_interval);
   FCM_CHECK(o->max_rule_memory >= 0.0 && !isnan(o->max_rule_memory), ctx, FCM_ERR_ARG,
             "embed: max_rule_memory = %g bytes must be >= 0 (0: no limit)", o->max_rule_memory);
   FCM_CHECK(o->num_threads >= 1 || o->num_threads == FCM_DEFAULT, ctx, FCM_ERR_ARG,

@@ -8,7 +8,7 @@
 #include "fcm/quad.h"
 #include "geom/geom_impl.h"
 
-/* A cut triangle prepared for splitting (DESIGN §9): its plane (unit normal) and the three
+/* A cut triangle prepared for splitting: its plane (unit normal) and the three
  * planes through its edges perpendicular to it (outward: the triangle is where all three
  * are <= 0); lo/hi its bounding box; `cut` the cut surface it came from. */
 typedef struct fcm__cut_tri {

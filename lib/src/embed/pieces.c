@@ -1,4 +1,4 @@
-/* Cutting (XFEM) inside one background cell (DESIGN §9): the convex parts of the embedded
+/* Cutting (XFEM) inside one background cell: the convex parts of the embedded
  * geometry are split by the plane of every cut triangle that reaches them and by the
  * triangle's three edge planes, so that every new face lies wholly on or wholly off the
  * triangle; parts that share a face of positive area not lying on a cut triangle are

@@ -16,7 +16,7 @@ struct fcm_space {
   unsigned char *active; /* num_cells */
   fcm_index *node_dof;   /* num_nodes: first DOF of the node's first copy, or -1 */
   fcm_index *node_ncopy; /* num_nodes: copies of the node (0 inactive, 1, or more when cuts
-                            separate its support: generalized enrichment, DESIGN §9) */
+                            separate its support: generalized enrichment, XFEM) */
   fcm_index num_dofs;    /* 3 x copies; a node's copies have consecutive DOFs */
   /* Elements: the material pieces of the active cells (one per cell without cuts), in cell
    * order: element e lies in cell elem_cell[e], integrates with the rules of piece

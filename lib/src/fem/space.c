@@ -78,7 +78,7 @@ static fcm_index uf_find(fcm_index *uf, fcm_index a)
   return a;
 }
 
-/* Generalized enrichment (Ton-That et al. 2024, DESIGN §9): the elements incident to a node
+/* Generalized enrichment (Ton-That et al. 2024, XFEM): the elements incident to a node
  * (its support) are grouped into connected components along the links of the cell rules
  * (pieces of face-neighbouring cells that share a face part not lying on a cut); each
  * component gets its own copy of the node. Where every incident cell has one piece, the

@@ -250,8 +250,7 @@ cleanup:
 
 /* ---------------------------------------------------------------- building */
 
-static fcm_status build_voxels(fcm_simulation *S, const fcm_scene_geometry *g,
-                               fcm_geometry **raw)
+static fcm_status build_voxels(fcm_simulation *S, const fcm_scene_geometry *g, fcm_geometry **raw)
 {
   fcm_status st = FCM_OK;
   fcm_voxel_image *img = NULL;
@@ -288,8 +287,8 @@ static fcm_status build_level_set(fcm_simulation *S, const fcm_scene_geometry *g
   snprintf(S->geometry_note, sizeof S->geometry_note,
            "level set: %lld tets, %lld cut cells at refinement %d (h %.3g m), volume %.6g m^3, "
            "estimated error %.2g m^3 (%.2g%%)",
-           (long long)info.num_tets, (long long)info.cells_cut, g->refinement, info.h,
-           info.volume, info.error_estimate, 100.0 * info.error_estimate / info.volume);
+           (long long)info.num_tets, (long long)info.cells_cut, g->refinement, info.h, info.volume,
+           info.error_estimate, 100.0 * info.error_estimate / info.volume);
 cleanup:
   return st;
 }
@@ -673,7 +672,11 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   FCM_TRY(ctx, fcm_cell_rules_create_cut(ctx, S->mesh, S->geom, S->rules, surf, &rules));
   S->c.cut_cells += fcm_cell_rules_get_stats(rules)->num_integrated;
   FCM_TRY(ctx, fcm_space_create_embedded(ctx, S->mesh, rules, &space));
-  if (fcm_cell_rules_num_pieces(rules) == fcm_cell_rules_num_pieces(S->rules)) S->c.cuts_missed++;
+  /* missed: no cell got a new piece and no node a new copy (a cut along cell faces adds copies
+   * without splitting any cell) */
+  if (fcm_cell_rules_num_pieces(rules) == fcm_cell_rules_num_pieces(S->rules) &&
+      fcm_space_num_dofs(space) == fcm_space_num_dofs(S->space))
+    S->c.cuts_missed++;
   FCM_TRY(ctx, fcm_integrator_create_cut(S->integ, space, &integ));
   /* the new integrator counts from zero: keep the totals so far */
   S->base_factorizations = S->c.factorizations;
@@ -780,8 +783,7 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
       FCM_TRY(ctx, st);
     }
     st = build_rules(S);
-    if (st != FCM_OK)
-      fcm__error_prefix(ctx, st == FCM_ERR_GEOMETRY ? "geometry" : "quadrature");
+    if (st != FCM_OK) fcm__error_prefix(ctx, st == FCM_ERR_GEOMETRY ? "geometry" : "quadrature");
     FCM_TRY(ctx, st);
     const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(S->rules);
     FCM_CHECK(rs->num_uncut + rs->num_cut > 0, ctx, FCM_ERR_GEOMETRY,
@@ -1114,8 +1116,9 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
             rs->dropped_volume);
     if (rs->outside_volume > 0.0) {
       static const char *const sides[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
-      fprintf(f, "  outside   body [%g, %g] x [%g, %g] x [%g, %g], background [%g, %g] x [%g, %g] "
-                 "x [%g, %g]; beyond",
+      fprintf(f,
+              "  outside   body [%g, %g] x [%g, %g] x [%g, %g], background [%g, %g] x [%g, %g] "
+              "x [%g, %g]; beyond",
               rs->geometry_lo[0], rs->geometry_hi[0], rs->geometry_lo[1], rs->geometry_hi[1],
               rs->geometry_lo[2], rs->geometry_hi[2], rs->mesh_lo[0], rs->mesh_hi[0],
               rs->mesh_lo[1], rs->mesh_hi[1], rs->mesh_lo[2], rs->mesh_hi[2]);
