@@ -88,3 +88,18 @@ add_dependencies(app_fault_kill fcm_fault_shim fcm-sim) # the program of the app
 # apps/app_env.c: passive OpenMP waiting by default, the user's OMP_WAIT_POLICY / GOMP_SPINCOUNT kept.
 fcm_add_test(app_env tests/apps/app_env.c LABELS app ARGS ${PROJECT_BINARY_DIR}/app-tests)
 target_sources(app_env PRIVATE ${PROJECT_SOURCE_DIR}/apps/app_env.c)
+# fcm-cut: the cutting experiments check their own claims (exit 1 when one fails): moments of
+# every degree <= m over the pieces of a cut tet and hex within 1e-12 with <= M points, and
+# the 36 sticks of the diced cube with the mass kept. The default run covers strengths 1-4
+# and the Hex8 and Tet4 dice; the full study (strengths 1-8, all four elements) is slow.
+add_test(NAME app_cut_accuracy COMMAND $<TARGET_FILE:fcm-cut> accuracy --max-strength 4
+         --csv ${work}/cut_accuracy.csv)
+add_test(NAME app_cut_dice_hex8 COMMAND $<TARGET_FILE:fcm-cut> dice --element hex8
+         --csv ${work}/cut_dice.csv)
+add_test(NAME app_cut_dice_tet4 COMMAND $<TARGET_FILE:fcm-cut> dice --element tet4)
+add_test(NAME app_cut_accuracy_full COMMAND $<TARGET_FILE:fcm-cut> accuracy)
+add_test(NAME app_cut_dice_full COMMAND $<TARGET_FILE:fcm-cut> dice)
+set_tests_properties(app_cut_accuracy app_cut_dice_hex8 app_cut_dice_tet4 PROPERTIES LABELS app
+                     ENVIRONMENT "OMP_NUM_THREADS=1")
+set_tests_properties(app_cut_accuracy_full app_cut_dice_full PROPERTIES LABELS "app;slow"
+                     TIMEOUT 900)

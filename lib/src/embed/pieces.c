@@ -330,21 +330,23 @@ static void uf_union(int *uf, int a, int b)
     uf[a] = b;
 }
 
-/* Whether parts i and j share a face of positive area that does not lie on a cut triangle. */
+/* Whether parts i and j share a face of positive area that does not lie on a cut triangle;
+ * fp holds every part's face planes (FCM__POLY_MAX_FACES each; zero normal: no area). */
 static int parts_connected(const fcm__embed_cell *cell, const fcm__cut_tri *tris,
-                           const fcm__parts *P, size_t ntri, size_t i, size_t j)
+                           const fcm__parts *P, const fcm__plane *fp, size_t ntri, size_t i,
+                           size_t j)
 {
   const fcm__poly *a = P->poly + i, *b = P->poly + j;
   const double mtol = MATCH_RTOL * cell->size, atol = AREA_RTOL * cell->size * cell->size;
   double xa[3 * FCM__POLY_MAX_FV], xb[3 * FCM__POLY_MAX_FV], c[3];
   for (int fa = 0; fa < a->nf; fa++) {
-    fcm__plane pa, pb;
-    if (!face_plane(a, fa, &pa)) continue;
+    const fcm__plane *pa = fp + i * FCM__POLY_MAX_FACES + fa;
+    if (pa->n[0] == 0.0 && pa->n[1] == 0.0 && pa->n[2] == 0.0) continue;
     for (int fb = 0; fb < b->nf; fb++) {
-      if (!face_plane(b, fb, &pb)) continue;
-      if (dot3(pa.n, pb.n) > -(1.0 - NORMAL_TOL) || fabs(pa.d + pb.d) > mtol) continue;
+      const fcm__plane *pb = fp + j * FCM__POLY_MAX_FACES + fb;
+      if (dot3(pa->n, pb->n) > -(1.0 - NORMAL_TOL) || fabs(pa->d + pb->d) > mtol) continue;
       const int na = face_coords(a, fa, xa), nb = face_coords(b, fb, xb);
-      if (fcm__embed_overlap(xa, na, xb, nb, pb.n, mtol, c) <= atol) continue;
+      if (fcm__embed_overlap(xa, na, xb, nb, pb->n, mtol, c) <= atol) continue;
       if (!fcm__embed_on_cut(tris, P->tcand.ids, ntri, c, mtol)) return 1;
     }
   }
@@ -386,6 +388,7 @@ static fcm_status components(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
 {
   fcm_status st = FCM_OK;
   double *box = NULL;
+  fcm__plane *fp = NULL;
   if (P->n > P->ufcap) {
     void *u = P->uf;
     FCM_TRY(ctx, fcm__resize(ctx, &u, 0, P->n, sizeof(int)));
@@ -393,8 +396,13 @@ static fcm_status components(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
     P->ufcap = P->n;
   }
   FCM_ALLOC_RAW(ctx, 6 * P->n + 1, box);
+  FCM_ALLOC(ctx, FCM__POLY_MAX_FACES * P->n + 1, fp);
   const double mtol = MATCH_RTOL * cell->size;
   for (size_t i = 0; i < P->n; i++) {
+    for (int f = 0; f < P->poly[i].nf; f++) {
+      fcm__plane *pl = fp + i * FCM__POLY_MAX_FACES + f;
+      if (!face_plane(P->poly + i, f, pl)) pl->n[0] = pl->n[1] = pl->n[2] = 0.0;
+    }
     P->uf[i] = (int)i;
     double *bi = box + 6 * i;
     for (int d = 0; d < 3; d++)
@@ -412,7 +420,7 @@ static fcm_status components(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
       for (int d = 0; d < 3; d++)
         apart |= bi[d] > bj[3 + d] || bj[d] > bi[3 + d];
       if (apart || uf_find(P->uf, (int)i) == uf_find(P->uf, (int)j)) continue;
-      if (parts_connected(cell, tris, P, ntri, i, j)) uf_union(P->uf, (int)i, (int)j);
+      if (parts_connected(cell, tris, P, fp, ntri, i, j)) uf_union(P->uf, (int)i, (int)j);
     }
   int np = 0;
   for (size_t i = 0; i < P->n; i++) {
@@ -422,6 +430,7 @@ static fcm_status components(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
   *count = np;
 cleanup:
   fcm__free(ctx, box);
+  fcm__free(ctx, fp);
   return st;
 }
 
