@@ -90,16 +90,21 @@ fcm_add_test(app_env tests/apps/app_env.c LABELS app ARGS ${PROJECT_BINARY_DIR}/
 target_sources(app_env PRIVATE ${PROJECT_SOURCE_DIR}/apps/app_env.c)
 # fcm-cut: the cutting experiments check their own claims (exit 1 when one fails): moments of
 # every degree <= m over the pieces of a cut tet and hex within 1e-12 with <= M points, and
-# the 36 sticks of the diced cube with the mass kept. The default run covers strengths 1-4
+# the 36 sticks of the diced cube with the mass kept, the conditioning of a cut approaching a
+# face (diagonally scaled kappa within 10x with the constraint, raw kappa above 1e8 without
+# constraint and stabilization). The default run covers strengths 1-4
 # and the Hex8 and Tet4 dice; the full study (strengths 1-8, all four elements) is slow.
 add_test(NAME app_cut_accuracy COMMAND $<TARGET_FILE:fcm-cut> accuracy --max-strength 4
          --csv ${work}/cut_accuracy.csv)
 add_test(NAME app_cut_dice_hex8 COMMAND $<TARGET_FILE:fcm-cut> dice --element hex8
          --csv ${work}/cut_dice.csv)
 add_test(NAME app_cut_dice_tet4 COMMAND $<TARGET_FILE:fcm-cut> dice --element tet4)
+add_test(NAME app_cut_condition COMMAND $<TARGET_FILE:fcm-cut> condition
+         --csv ${work}/cut_condition.csv)
 add_test(NAME app_cut_accuracy_full COMMAND $<TARGET_FILE:fcm-cut> accuracy)
 add_test(NAME app_cut_dice_full COMMAND $<TARGET_FILE:fcm-cut> dice)
-set_tests_properties(app_cut_accuracy app_cut_dice_hex8 app_cut_dice_tet4 PROPERTIES LABELS app
+set_tests_properties(app_cut_accuracy app_cut_dice_hex8 app_cut_dice_tet4 app_cut_condition
+                     PROPERTIES LABELS app
                      ENVIRONMENT "OMP_NUM_THREADS=1")
 set_tests_properties(app_cut_accuracy_full app_cut_dice_full PROPERTIES LABELS "app;slow"
                      TIMEOUT 900)

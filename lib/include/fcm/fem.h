@@ -46,7 +46,8 @@ typedef struct fcm_space fcm_space;
 FCM_API fcm_status fcm_space_create(fcm_ctx *ctx, const fcm_mesh *mesh,
                                     const unsigned char *cell_active, fcm_space **space);
 
-/** Create the space of an embedded (FCM) problem: the active cells are those
+/** Create the space of an embedded (FCM) problem (default fcm_space_options): the active cells
+ * are those
  * `rules` does not drop; assembly integrates cut cells with their own rules from
  * `rules` (stiffness rule for stiffness, forces and energy; mass rule for mass;
  * stabilization points included) and full cells with the standard rule.
@@ -54,6 +55,30 @@ FCM_API fcm_status fcm_space_create(fcm_ctx *ctx, const fcm_mesh *mesh,
  * @return as fcm_space_create(), and FCM_ERR_ARG when `rules` belongs to another mesh. */
 FCM_API fcm_status fcm_space_create_embedded(fcm_ctx *ctx, const fcm_mesh *mesh,
                                              const fcm_cell_rules *rules, fcm_space **space);
+
+/** Options of fcm_space_create_embedded_with(). */
+typedef struct fcm_space_options {
+  double constrain_ratio; /**< Koschier et al. 2017, Sec. 6: a DOF copy whose support (the
+                               volume of the pieces that use it) is below this fraction of its
+                               node's (the pieces of all the node's elements) is constrained to
+                               move with its piece: its elements use the DOFs of the largest
+                               copy at another of their nodes instead (exact for translations),
+                               and it leaves the system; in [0, 0.5), default 1e-9; 0: off.
+                               Only copies of enriched nodes (cuts) are affected. */
+} fcm_space_options;
+
+/** Defaults as documented on each member. */
+FCM_API fcm_space_options fcm_space_options_default(void);
+
+/** fcm_space_create_embedded() with options (NULL: defaults).
+ * @return as fcm_space_create_embedded(), and FCM_ERR_ARG for an option out of range. */
+FCM_API fcm_status fcm_space_create_embedded_with(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                                  const fcm_cell_rules *rules,
+                                                  const fcm_space_options *opts,
+                                                  fcm_space **space);
+
+/** Number of DOF copies the options' constraint removed (moved with their piece). */
+FCM_API fcm_index fcm_space_num_constrained_copies(const fcm_space *space);
 
 /** The cell rules of an embedded space, or NULL. */
 FCM_API const fcm_cell_rules *fcm_space_cell_rules(const fcm_space *space);

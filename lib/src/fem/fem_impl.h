@@ -25,6 +25,7 @@ struct fcm_space {
    * has elements [cell_elem[c], cell_elem[c + 1]). */
   fcm_index num_elems;
   fcm_index *elem_cell, *elem_piece, *elem_dof, *cell_elem;
+  fcm_index num_constrained; /* copies constrained to move with their piece (Koschier) */
   /* Copy graph (by copy rank k = DOF / 3): node_ptr[k]..node_ptr[k+1] are the ranks of the
    * copies sharing an element with copy k (itself included), sorted. */
   fcm_index *node_ptr;

@@ -2,6 +2,7 @@
  * CSR pattern built once, per-cell scatter offsets, and the cell colouring. */
 #include "fem/fem_impl.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -164,8 +165,46 @@ cleanup:
   return st;
 }
 
-/* Copy graph: copies sharing an element, sorted. Element e's copies are elem_dof / 3. */
-static fcm_status build_node_graph(fcm_space *s, const fcm_index *inc_ptr, const fcm_index *inc)
+/* Copy -> elements incidence (elements using the copy at any local node, ascending, each
+ * once) as CSR over the num_dofs / 3 copies. */
+static fcm_status build_copy_incidence(fcm_space *s, fcm_index **ptr_out, fcm_index **list_out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ncopy = s->num_dofs / 3, nn = s->nn;
+  fcm_index *ptr = NULL, *list = NULL, *fill = NULL;
+  FCM_ALLOC(ctx, ncopy + 1, ptr);
+  FCM_ALLOC(ctx, ncopy + 1, fill);
+  for (int pass = 0; pass < 2; pass++) {
+    for (fcm_index e = 0; e < s->num_elems; e++)
+      for (int a = 0; a < nn; a++) {
+        const fcm_index k = s->elem_dof[e * nn + a] / 3;
+        int dup = 0; /* an element may use a copy at two local nodes (constrained copies) */
+        for (int b = 0; b < a && !dup; b++)
+          dup = s->elem_dof[e * nn + b] / 3 == k;
+        if (dup) continue;
+        if (pass)
+          list[ptr[k] + fill[k]++] = e;
+        else
+          ptr[k + 1]++;
+      }
+    if (!pass) {
+      for (fcm_index k = 0; k < ncopy; k++)
+        ptr[k + 1] += ptr[k];
+      FCM_ALLOC(ctx, ptr[ncopy] + 1, list);
+    }
+  }
+  *ptr_out = ptr, *list_out = list;
+  ptr = list = NULL;
+cleanup:
+  fcm__free(ctx, ptr);
+  fcm__free(ctx, list);
+  fcm__free(ctx, fill);
+  return st;
+}
+
+/* Copy graph: copies sharing an element, sorted. */
+static fcm_status build_node_graph(fcm_space *s, const fcm_index *cptr, const fcm_index *cinc)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
@@ -176,36 +215,27 @@ static fcm_status build_node_graph(fcm_space *s, const fcm_index *inc_ptr, const
   for (int pass = 0; pass < 2; pass++) {
     for (fcm_index k = 0; k < ncopy; k++)
       mark[k] = -1;
-    for (fcm_index n = 0; n < s->num_nodes; n++) {
-      if (s->node_dof[n] < 0) continue;
-      const fcm_index k0 = s->node_dof[n] / 3;
-      for (fcm_index c = 0; c < s->node_ncopy[n]; c++) {
-        const fcm_index k = k0 + c;
-        fcm_index cnt = 0, base = pass ? s->node_ptr[k] : 0;
-        for (fcm_index i = inc_ptr[n]; i < inc_ptr[n + 1]; i++) {
-          const fcm_index e = inc[i];
-          int uses = 0; /* does element e use copy k? */
-          for (int a = 0; a < nn && !uses; a++)
-            uses = s->elem_dof[e * nn + a] / 3 == k;
-          if (!uses) continue;
-          for (int b = 0; b < nn; b++) {
-            const fcm_index m = s->elem_dof[e * nn + b] / 3;
-            if (mark[m] == k) continue;
-            mark[m] = k;
-            if (pass) s->node_adj[base + cnt] = m;
-            cnt++;
-          }
+    for (fcm_index k = 0; k < ncopy; k++) {
+      fcm_index cnt = 0, base = pass ? s->node_ptr[k] : 0;
+      for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++) {
+        const fcm_index e = cinc[i];
+        for (int b = 0; b < nn; b++) {
+          const fcm_index m = s->elem_dof[e * nn + b] / 3;
+          if (mark[m] == k) continue;
+          mark[m] = k;
+          if (pass) s->node_adj[base + cnt] = m;
+          cnt++;
         }
-        if (pass)
-          qsort(s->node_adj + base, (size_t)cnt, sizeof *s->node_adj, cmp_index);
-        else
-          s->node_ptr[k + 1] = cnt;
       }
+      if (pass)
+        qsort(s->node_adj + base, (size_t)cnt, sizeof *s->node_adj, cmp_index);
+      else
+        s->node_ptr[k + 1] = cnt;
     }
     if (!pass) {
       for (fcm_index k = 0; k < ncopy; k++)
         s->node_ptr[k + 1] += s->node_ptr[k];
-      FCM_ALLOC(ctx, s->node_ptr[ncopy], s->node_adj);
+      FCM_ALLOC(ctx, s->node_ptr[ncopy] + 1, s->node_adj);
     }
   }
 cleanup:
@@ -255,11 +285,10 @@ cleanup:
 
 /* Greedy colouring: an element takes the smallest colour not used by an element sharing a
  * copy (elements sharing a node but using different copies of it may share a colour). */
-static fcm_status build_colors(fcm_space *s, const fcm_index *inc_ptr, const fcm_index *inc)
+static fcm_status build_colors(fcm_space *s, const fcm_index *cptr, const fcm_index *cinc)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
-  const fcm_index *cells = fcm_mesh_cells(s->mesh);
   int *color = NULL, ncol = 0;
   fcm_index *forbid = NULL, *fill = NULL;
   enum { MAX_COLORS = 4096 };
@@ -271,16 +300,9 @@ static fcm_status build_colors(fcm_space *s, const fcm_index *inc_ptr, const fcm
     color[e] = -1;
   for (fcm_index e = 0; e < s->num_elems; e++) {
     for (int a = 0; a < s->nn; a++) {
-      fcm_index n = cells[s->elem_cell[e] * s->nn + a];
-      for (fcm_index i = inc_ptr[n]; i < inc_ptr[n + 1]; i++) {
-        const fcm_index f = inc[i];
-        if (color[f] < 0) continue;
-        int shares = 0;
-        for (int b = 0; b < s->nn && !shares; b++)
-          shares = cells[s->elem_cell[f] * s->nn + b] == n &&
-                   s->elem_dof[f * s->nn + b] == s->elem_dof[e * s->nn + a];
-        if (shares) forbid[color[f]] = e;
-      }
+      const fcm_index k = s->elem_dof[e * s->nn + a] / 3;
+      for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++)
+        if (color[cinc[i]] >= 0) forbid[color[cinc[i]]] = e;
     }
     int k = 0;
     while (k < MAX_COLORS && forbid[k] == e)
@@ -308,13 +330,101 @@ cleanup:
   return st;
 }
 
+/* Koschier et al. 2017, Sec. 6: a copy whose support (the volume of the pieces that use it)
+ * is below `ratio` of its node's (the pieces of all the node's elements) barely contributes
+ * and makes the system (nearly) singular; it is constrained to move with its piece: its
+ * elements use, in its place, the DOFs of the largest-support copy at another node of those
+ * elements, so the fragment follows that copy (exact for translations). Unused copies are then
+ * removed from the numbering. Counts in s->num_constrained. */
+static fcm_status constrain_copies(fcm_space *s, double ratio, const fcm_index *inc_ptr,
+                                   const fcm_index *inc)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index *cells = fcm_mesh_cells(s->mesh);
+  const fcm_index ncopy = s->num_dofs / 3, nn = s->nn;
+  double *venr = NULL;
+  fcm_index *master = NULL, *renum = NULL;
+  FCM_ALLOC(ctx, ncopy + 1, venr);
+  FCM_ALLOC(ctx, ncopy + 1, master);
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    const double v = fcm_cell_rules_piece_volume(s->rules, s->elem_piece[e]);
+    for (int a = 0; a < nn; a++)
+      venr[s->elem_dof[e * nn + a] / 3] += v;
+  }
+  fcm_index count = 0;
+  for (fcm_index k = 0; k < ncopy; k++)
+    master[k] = -1;
+  for (fcm_index n = 0; n < s->num_nodes; n++) {
+    if (s->node_ncopy[n] < 2) continue;
+    double vsupp = 0.0;
+    for (fcm_index i = inc_ptr[n]; i < inc_ptr[n + 1]; i++)
+      vsupp += fcm_cell_rules_piece_volume(s->rules, s->elem_piece[inc[i]]);
+    for (fcm_index c = 0; c < s->node_ncopy[n]; c++) {
+      const fcm_index k = s->node_dof[n] / 3 + c;
+      if (!(venr[k] < ratio * vsupp)) continue;
+      /* the master: the largest-support copy at another node of the copy's elements */
+      fcm_index best = -1;
+      for (fcm_index i = inc_ptr[n]; i < inc_ptr[n + 1]; i++) {
+        const fcm_index e = inc[i];
+        int uses = 0;
+        for (int a = 0; a < nn; a++)
+          uses |= s->elem_dof[e * nn + a] / 3 == k;
+        if (!uses) continue;
+        for (int b = 0; b < nn; b++) {
+          const fcm_index m = s->elem_dof[e * nn + b] / 3;
+          if (cells[s->elem_cell[e] * nn + b] == n || master[m] >= 0 || venr[m] < ratio * vsupp)
+            continue;
+          if (best < 0 || venr[m] > venr[best]) best = m;
+        }
+      }
+      if (best < 0) continue;
+      master[k] = best;
+      count++;
+    }
+  }
+  if (count > 0) {
+    for (fcm_index e = 0; e < s->num_elems; e++)
+      for (int a = 0; a < nn; a++) {
+        const fcm_index k = s->elem_dof[e * nn + a] / 3;
+        if (master[k] >= 0) s->elem_dof[e * nn + a] = 3 * master[k];
+      }
+    /* renumber the copies still in use, node by node */
+    FCM_ALLOC(ctx, ncopy + 1, renum);
+    fcm_index next = 0;
+    for (fcm_index n = 0; n < s->num_nodes; n++) {
+      if (s->node_dof[n] < 0) continue;
+      const fcm_index k0 = s->node_dof[n] / 3, nc = s->node_ncopy[n];
+      fcm_index kept = 0;
+      for (fcm_index c = 0; c < nc; c++) {
+        renum[k0 + c] = master[k0 + c] >= 0 ? -1 : next + kept;
+        kept += master[k0 + c] < 0;
+      }
+      s->node_dof[n] = kept ? 3 * next : -1;
+      s->node_ncopy[n] = kept;
+      next += kept;
+    }
+    for (fcm_index e = 0; e < s->num_elems; e++)
+      for (int a = 0; a < nn; a++)
+        s->elem_dof[e * nn + a] = 3 * renum[s->elem_dof[e * nn + a] / 3];
+    s->num_dofs = 3 * next;
+  }
+  s->num_constrained = count;
+cleanup:
+  fcm__free(ctx, venr);
+  fcm__free(ctx, master);
+  fcm__free(ctx, renum);
+  return st;
+}
+
 /* Shared by fcm_space_create() and fcm_space_create_embedded(). */
 static fcm_status space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigned char *cell_active,
-                               const fcm_cell_rules *rules, fcm_space **out)
+                               const fcm_cell_rules *rules, const fcm_space_options *opts,
+                               fcm_space **out)
 {
   fcm_status st = FCM_OK;
   fcm_space *s = NULL;
-  fcm_index *inc_ptr = NULL, *inc = NULL, nactive_cells = 0;
+  fcm_index *inc_ptr = NULL, *inc = NULL, *cptr = NULL, *cinc = NULL, nactive_cells = 0;
   FCM_CHECK(out, ctx, FCM_ERR_ARG, "space: output pointer is NULL");
   *out = NULL;
   FCM_CHECK(mesh, ctx, FCM_ERR_ARG, "space: mesh is NULL");
@@ -349,19 +459,24 @@ static fcm_status space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigne
   FCM_TRY(ctx, build_elements(s));
   FCM_TRY(ctx, build_incidence(s, &inc_ptr, &inc));
   FCM_TRY(ctx, build_copies(s, inc_ptr, inc));
+  if (rules && opts && opts->constrain_ratio > 0.0)
+    FCM_TRY(ctx, constrain_copies(s, opts->constrain_ratio, inc_ptr, inc));
   {
     int dummy;
     FCM_TRY(ctx, fcm__index_to_int(ctx, s->num_dofs, "space: number of DOFs", &dummy));
   }
-  FCM_TRY(ctx, build_node_graph(s, inc_ptr, inc));
+  FCM_TRY(ctx, build_copy_incidence(s, &cptr, &cinc));
+  FCM_TRY(ctx, build_node_graph(s, cptr, cinc));
   FCM_TRY(ctx, build_pattern(s));
-  FCM_TRY(ctx, build_colors(s, inc_ptr, inc));
+  FCM_TRY(ctx, build_colors(s, cptr, cinc));
   FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, FCM_RULE_MASS, FCM_DEFAULT, &s->mass_rule));
   *out = s;
   s = NULL;
 cleanup:
   fcm__free(ctx, inc_ptr);
   fcm__free(ctx, inc);
+  fcm__free(ctx, cptr);
+  fcm__free(ctx, cinc);
   fcm_space_destroy(&s);
   return st;
 }
@@ -369,11 +484,27 @@ cleanup:
 fcm_status fcm_space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigned char *cell_active,
                             fcm_space **out)
 {
-  return space_create(ctx, mesh, cell_active, NULL, out);
+  return space_create(ctx, mesh, cell_active, NULL, NULL, out);
+}
+
+fcm_space_options fcm_space_options_default(void)
+{
+  fcm_space_options o;
+  memset(&o, 0, sizeof o);
+  o.constrain_ratio = 1e-9;
+  return o;
 }
 
 fcm_status fcm_space_create_embedded(fcm_ctx *ctx, const fcm_mesh *mesh,
                                      const fcm_cell_rules *rules, fcm_space **out)
+{
+  const fcm_space_options o = fcm_space_options_default();
+  return fcm_space_create_embedded_with(ctx, mesh, rules, &o, out);
+}
+
+fcm_status fcm_space_create_embedded_with(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                          const fcm_cell_rules *rules,
+                                          const fcm_space_options *opts, fcm_space **out)
 {
   fcm_status st = FCM_OK;
   FCM_CHECK(out, ctx, FCM_ERR_ARG, "space: output pointer is NULL");
@@ -384,7 +515,11 @@ fcm_status fcm_space_create_embedded(fcm_ctx *ctx, const fcm_mesh *mesh,
             ctx, FCM_ERR_ARG,
             "space: the cell rules (%lld cells) were not built on this mesh (%lld cells)",
             (long long)fcm_cell_rules_num_cells(rules), (long long)fcm_mesh_num_cells(mesh));
-  FCM_TRY(ctx, space_create(ctx, mesh, NULL, rules, out));
+  FCM_CHECK(!opts || (isfinite(opts->constrain_ratio) && opts->constrain_ratio >= 0.0 &&
+                      opts->constrain_ratio < 0.5),
+            ctx, FCM_ERR_ARG, "space: constrain_ratio = %g outside [0, 0.5)",
+            opts ? opts->constrain_ratio : 0.0);
+  FCM_TRY(ctx, space_create(ctx, mesh, NULL, rules, opts, out));
 cleanup:
   return st;
 }
@@ -431,6 +566,11 @@ fcm_index fcm_space_node_dof(const fcm_space *s, fcm_index node)
 fcm_index fcm_space_node_copies(const fcm_space *s, fcm_index node)
 {
   return (node < 0 || node >= s->num_nodes) ? 0 : s->node_ncopy[node];
+}
+
+fcm_index fcm_space_num_constrained_copies(const fcm_space *s)
+{
+  return s->num_constrained;
 }
 
 fcm_index fcm_space_num_elements(const fcm_space *s)
@@ -568,9 +708,14 @@ fcm_status fcm_space_transfer(const fcm_space *from, const fcm_space *to, const 
               "space transfer: element %lld (cell %lld) has parent piece %lld outside the "
               "cell's pieces in the source",
               (long long)e, (long long)c, (long long)pp);
-    for (int a = 0; a < to->nn; a++)
+    const fcm_index *cn = fcm_mesh_cells(to->mesh) + c * to->nn;
+    for (int a = 0; a < to->nn; a++) {
+      const fcm_index d = to->elem_dof[e * to->nn + a], n = cn[a];
+      /* a constrained copy's place holds another node's copy: that node's own elements set it */
+      if (d < to->node_dof[n] || d >= to->node_dof[n] + 3 * to->node_ncopy[n]) continue;
       for (int i = 0; i < 3; i++)
-        x_to[to->elem_dof[e * to->nn + a] + i] = x_from[from->elem_dof[fe * from->nn + a] + i];
+        x_to[d + i] = x_from[from->elem_dof[fe * from->nn + a] + i];
+    }
   }
 cleanup:
   return st;
