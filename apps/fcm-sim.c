@@ -187,8 +187,8 @@ static void rules_progress(fcm_index done, fcm_index total, void *user)
  * the rest (memory, numerical failures). */
 static int build_exit_code(fcm_status st)
 {
-  return st == FCM_ERR_ARG || st == FCM_ERR_IO || st == FCM_ERR_FORMAT ||
-                 st == FCM_ERR_GEOMETRY || st == FCM_ERR_UNSUPPORTED
+  return st == FCM_ERR_ARG || st == FCM_ERR_IO || st == FCM_ERR_FORMAT || st == FCM_ERR_GEOMETRY ||
+                 st == FCM_ERR_UNSUPPORTED
              ? 2
              : 1;
 }
@@ -212,8 +212,9 @@ static void warn_outside(const fcm_simulation *sim)
       fprintf(stderr, "%s %s: %.3g m^3", sep, sides[k], S->outside_side_volume[k]);
       sep = ",";
     }
-  fprintf(stderr, "%s; body [%g, %g] x [%g, %g] x [%g, %g], background [%g, %g] x [%g, %g] x "
-                  "[%g, %g]\n",
+  fprintf(stderr,
+          "%s; body [%g, %g] x [%g, %g] x [%g, %g], background [%g, %g] x [%g, %g] x "
+          "[%g, %g]\n",
           sep[0] == ',' ? ")" : "", S->geometry_lo[0], S->geometry_hi[0], S->geometry_lo[1],
           S->geometry_hi[1], S->geometry_lo[2], S->geometry_hi[2], S->mesh_lo[0], S->mesh_hi[0],
           S->mesh_lo[1], S->mesh_hi[1], S->mesh_lo[2], S->mesh_hi[2]);

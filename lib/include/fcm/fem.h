@@ -74,8 +74,7 @@ FCM_API fcm_space_options fcm_space_options_default(void);
  * @return as fcm_space_create_embedded(), and FCM_ERR_ARG for an option out of range. */
 FCM_API fcm_status fcm_space_create_embedded_with(fcm_ctx *ctx, const fcm_mesh *mesh,
                                                   const fcm_cell_rules *rules,
-                                                  const fcm_space_options *opts,
-                                                  fcm_space **space);
+                                                  const fcm_space_options *opts, fcm_space **space);
 
 /** Number of DOF copies the options' constraint removed (moved with their piece). */
 FCM_API fcm_index fcm_space_num_constrained_copies(const fcm_space *space);

@@ -58,20 +58,20 @@ typedef enum fcm_scene_geometry_kind {
   FCM_SCENE_GEOMETRY_TUBE,        /**< fcm_geometry_create_tube() */
   FCM_SCENE_GEOMETRY_GMSH,        /**< fcm_geometry_create_from_gmsh() */
   FCM_SCENE_GEOMETRY_TETGEN,      /**< fcm_geometry_create_from_tetgen() */
-  FCM_SCENE_GEOMETRY_SURFACE, /**< a triangle surface file, fcm_geometry_create_from_surface() */
-  FCM_SCENE_GEOMETRY_VOXELS,      /**< fcm_geometry_create_from_voxels() of an image file */
-  FCM_SCENE_GEOMETRY_LEVEL_SET,   /**< fcm_geometry_create_from_level_set() of built-in
-                                       implicits (fcm/levelset.h) */
+  FCM_SCENE_GEOMETRY_SURFACE,   /**< a triangle surface file, fcm_geometry_create_from_surface() */
+  FCM_SCENE_GEOMETRY_VOXELS,    /**< fcm_geometry_create_from_voxels() of an image file */
+  FCM_SCENE_GEOMETRY_LEVEL_SET, /**< fcm_geometry_create_from_level_set() of built-in
+                                     implicits (fcm/levelset.h) */
   FCM_SCENE_GEOMETRY_KIND_COUNT
 } fcm_scene_geometry_kind;
 
 /** The embedded geometry ("geometry"); members not used by `kind` are zero. */
 typedef struct fcm_scene_geometry {
   fcm_scene_geometry_kind kind;
-  double min[3], max[3];             /**< BOX corners, min[d] < max[d]; LEVEL_SET: sampling box */
-  fcm_index cells[3];                /**< BOX: cubes per axis (6 tets each); LEVEL_SET: sampling cells */
-  double center[3];                  /**< BALL, HEMISPHERE, HOLLOW_BALL, TUBE */
-  double radius;                     /**< BALL, HEMISPHERE */
+  double min[3], max[3]; /**< BOX corners, min[d] < max[d]; LEVEL_SET: sampling box */
+  fcm_index cells[3];    /**< BOX: cubes per axis (6 tets each); LEVEL_SET: sampling cells */
+  double center[3];      /**< BALL, HEMISPHERE, HOLLOW_BALL, TUBE */
+  double radius;         /**< BALL, HEMISPHERE */
   double inner_radius, outer_radius; /**< HOLLOW_BALL, TUBE */
   double hole_radius;                /**< HOLLOW_BALL (0: no holes) */
   double length;                     /**< TUBE */

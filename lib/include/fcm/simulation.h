@@ -30,8 +30,8 @@ typedef struct fcm_simulation_options {
                                 output.checkpoint_interval */
   fcm_cell_rules_progress_fn rules_progress; /**< progress of the cell rules build
                                 (fcm_cell_rules_options.progress); NULL (default): none */
-  void *rules_progress_user;   /**< its argument; default NULL */
-  double rules_progress_interval; /**< seconds between calls, >= 0; default 0.1 */
+  void *rules_progress_user;                 /**< its argument; default NULL */
+  double rules_progress_interval;            /**< seconds between calls, >= 0; default 0.1 */
 } fcm_simulation_options;
 
 /** Defaults as documented on each member. */

@@ -122,9 +122,9 @@ static double cell_thickness(const double *X, int n, double vol)
   return d2 > 0.0 ? 6.0 * vol / d2 : 0.0;
 }
 
-fcm_status fcm__embed_clip_cell(fcm_ctx *ctx, const fcm_geometry *geom,
-                                const fcm__embed_cell *cell, fcm_index e, double clip_rtol,
-                                double sliver_rtol, fcm__embed_ws *ws, double *tol, double *vmin)
+fcm_status fcm__embed_clip_cell(fcm_ctx *ctx, const fcm_geometry *geom, const fcm__embed_cell *cell,
+                                fcm_index e, double clip_rtol, double sliver_rtol,
+                                fcm__embed_ws *ws, double *tol, double *vmin)
 {
   fcm_status st = FCM_OK;
   double X[24];

@@ -233,7 +233,8 @@ fcm_index fcm_space_point_element(const fcm_space *s, fcm_index cell, const doub
       continue;
     for (int q = 0; q < nq; q++) {
       if (fl[q]) continue;
-      const double dx = pts[3 * q] - xi[0], dy = pts[3 * q + 1] - xi[1], dz = pts[3 * q + 2] - xi[2];
+      const double dx = pts[3 * q] - xi[0], dy = pts[3 * q + 1] - xi[1],
+                   dz = pts[3 * q + 2] - xi[2];
       const double d = dx * dx + dy * dy + dz * dz;
       if (d < dmin) dmin = d, best = e;
     }
@@ -245,7 +246,8 @@ fcm_index fcm_space_num_bodies(const fcm_space *s)
 {
   if (!s || s->num_elems == 0) return 0;
   const fcm_index ncopy = s->num_dofs / 3;
-  fcm_index *uf = malloc(sizeof *uf * (size_t)s->num_elems), *first = malloc(sizeof *first * (size_t)ncopy);
+  fcm_index *uf = malloc(sizeof *uf * (size_t)s->num_elems),
+            *first = malloc(sizeof *first * (size_t)ncopy);
   if (!uf || !first) {
     free(uf);
     free(first);

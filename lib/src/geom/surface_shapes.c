@@ -165,8 +165,7 @@ fcm_status fcm_surface_create_disc(fcm_ctx *ctx, const double center[3], const d
   FCM_CHECK(segments >= 3 && segments <= 256, ctx, FCM_ERR_ARG,
             "disc surface: segments = %d outside [3, 256]", segments);
   FCM_CHECK(plane_frame(normal, NULL, n, u, v), ctx, FCM_ERR_ARG,
-            "disc surface: the normal (%g, %g, %g) has no length", normal[0], normal[1],
-            normal[2]);
+            "disc surface: the normal (%g, %g, %g) has no length", normal[0], normal[1], normal[2]);
   memcpy(x, center, 3 * sizeof *x);
   for (int k = 0; k < segments; k++) {
     const double t = 2.0 * PI * k / segments;

@@ -404,8 +404,8 @@ static fcm_status read_unit(fcm__scene_parser *p, const fcm__json *o, const char
   FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, key, 1, FCM__ANY, v));
   const double n = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
   size_t old = fcm__scene_path_push_key(p, key);
-  SCENE_CHECK(n > 0.0 && isfinite(n), p, FCM_ERR_ARG, "expected a non-zero vector, got (%g, %g, %g)",
-              v[0], v[1], v[2]);
+  SCENE_CHECK(n > 0.0 && isfinite(n), p, FCM_ERR_ARG,
+              "expected a non-zero vector, got (%g, %g, %g)", v[0], v[1], v[2]);
   fcm__scene_path_pop(p, old);
   for (int d = 0; d < 3; d++)
     v[d] /= n;
@@ -429,8 +429,8 @@ static fcm_status parse_cut(fcm__scene_parser *p, const fcm__json *o, fcm_effect
     c->transform[i] = (i % 4 == 0);
   c->segments = 64;
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
-  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "time", 0, (fcm__range){0.0, duration, 0, 0},
-                                         &c->time));
+  FCM_TRY(p->ctx,
+          fcm__scene_read_number(p, o, "time", 0, (fcm__range){0.0, duration, 0, 0}, &c->time));
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "surface", 1, &sf));
   size_t old = fcm__scene_path_push_key(p, "surface");
   SCENE_CHECK(fcm__json_size(sf) == 1, p, FCM_ERR_ARG,
@@ -462,8 +462,8 @@ static fcm_status parse_cut(fcm__scene_parser *p, const fcm__json *o, fcm_effect
           c->axis[0] * c->normal[0] + c->axis[1] * c->normal[1] + c->axis[2] * c->normal[2];
       size_t o3 = fcm__scene_path_push_key(p, "axis");
       SCENE_CHECK(fabs(dot) < 1.0 - 1e-9, p, FCM_ERR_ARG,
-                  "expected a direction not parallel to the normal, got (%g, %g, %g)",
-                  c->axis[0], c->axis[1], c->axis[2]);
+                  "expected a direction not parallel to the normal, got (%g, %g, %g)", c->axis[0],
+                  c->axis[1], c->axis[2]);
       fcm__scene_path_pop(p, o3);
       const fcm__json *sz = NULL;
       FCM_TRY(p->ctx, fcm__scene_field(p, f, "size", 1, "an array of 2 numbers > 0 [a, b]",

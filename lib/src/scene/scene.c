@@ -345,8 +345,8 @@ static fcm_status read_implicit(fcm__scene_parser *p, const fcm__json *node, fcm
   memset(&q, 0, sizeof q);
   q.kind = (fcm_implicit_kind)kind;
   if (q.kind >= FCM_IMPLICIT_UNION) {
-    SCENE_CHECK(fcm__json_get_kind(m) == FCM__JSON_ARRAY && fcm__json_size(m) >= 2, p,
-                FCM_ERR_ARG, "expected an array of at least 2 implicits");
+    SCENE_CHECK(fcm__json_get_kind(m) == FCM__JSON_ARRAY && fcm__json_size(m) >= 2, p, FCM_ERR_ARG,
+                "expected an array of at least 2 implicits");
     int r = -1, i = 0;
     for (const fcm__json *c = fcm__json_child(m); c; c = fcm__json_next(c), i++) {
       size_t o2 = fcm__scene_path_push_index(p, i);
@@ -402,11 +402,11 @@ static fcm_status read_implicit(fcm__scene_parser *p, const fcm__json *node, fcm
         q.sheet = type == 0;
         FCM_TRY(p->ctx, fcm__scene_read_number(p, m, "period", 1, FCM__POSITIVE, &q.period));
         q.thickness = q.sheet ? 0.1 * q.period : 0.0;
-        FCM_TRY(p->ctx, fcm__scene_read_number(
-                            p, m, "thickness", 0,
-                            q.sheet ? (fcm__range){0.0, q.period / 4, 1, 1}
-                                    : (fcm__range){-q.period / 4, q.period / 4, 1, 1},
-                            &q.thickness));
+        FCM_TRY(p->ctx,
+                fcm__scene_read_number(p, m, "thickness", 0,
+                                       q.sheet ? (fcm__range){0.0, q.period / 4, 1, 1}
+                                               : (fcm__range){-q.period / 4, q.period / 4, 1, 1},
+                                       &q.thickness));
       }
       break;
     default:
@@ -470,8 +470,8 @@ static fcm_status read_level_set(fcm__scene_parser *p, const fcm__json *o, fcm_s
   g->num_implicit = n;
   g->refinement = 4;
   READ_INT(p, o, "refinement", 0, 1, 64, g->refinement);
-  const int nbox = !!fcm__json_member(o, "min") + !!fcm__json_member(o, "max") +
-                   !!fcm__json_member(o, "cells");
+  const int nbox =
+      !!fcm__json_member(o, "min") + !!fcm__json_member(o, "max") + !!fcm__json_member(o, "cells");
   SCENE_CHECK(nbox == 0 || nbox == 3, p, FCM_ERR_ARG,
               "the sampling box of a level set needs all of \"min\", \"max\" and \"cells\" "
               "(or none: the background grid)");
@@ -504,14 +504,38 @@ cleanup:
 static fcm_status read_geometry(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
-  static const char *const any_keys[] = {
-      "shape",          "mesh",         "tetgen",        "transform",          "min",
-      "max",            "cells",        "center",        "radius",             "resolution",
-      "inner_radius",   "outer_radius", "hole_radius",   "layers",             "axis",
-      "length",         "radial_cells", "angular_cells", "axial_cells",        "surface",
-      "max_volume",     "size",         "quality",       "fill_holes",         "max_hole_edges",
-      "max_hole_perimeter", "voxels",   "threshold",     "labels",             "merge",
-      "level_set",      "refinement"};
+  static const char *const any_keys[] = {"shape",
+                                         "mesh",
+                                         "tetgen",
+                                         "transform",
+                                         "min",
+                                         "max",
+                                         "cells",
+                                         "center",
+                                         "radius",
+                                         "resolution",
+                                         "inner_radius",
+                                         "outer_radius",
+                                         "hole_radius",
+                                         "layers",
+                                         "axis",
+                                         "length",
+                                         "radial_cells",
+                                         "angular_cells",
+                                         "axial_cells",
+                                         "surface",
+                                         "max_volume",
+                                         "size",
+                                         "quality",
+                                         "fill_holes",
+                                         "max_hole_edges",
+                                         "max_hole_perimeter",
+                                         "voxels",
+                                         "threshold",
+                                         "labels",
+                                         "merge",
+                                         "level_set",
+                                         "refinement"};
   static const char *const voxel_keys[] = {"voxels", "threshold", "labels", "merge", "transform"};
   static const char *const level_set_keys[] = {"level_set", "refinement", "min",
                                                "max",       "cells",      "transform"};
@@ -1204,8 +1228,9 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
     fprintf(f, ", %s", g->merge ? "merged into boxes" : "one cell per voxel");
     break;
   case FCM_SCENE_GEOMETRY_LEVEL_SET:
-    fprintf(f, "level set of %d implicit node%s (root %s), refinement %d, sampled on [%g, %g] x "
-               "[%g, %g] x [%g, %g] in %lld x %lld x %lld cells",
+    fprintf(f,
+            "level set of %d implicit node%s (root %s), refinement %d, sampled on [%g, %g] x "
+            "[%g, %g] x [%g, %g] in %lld x %lld x %lld cells",
             g->num_implicit, g->num_implicit == 1 ? "" : "s",
             implicit_names[g->implicit[g->num_implicit - 1].kind], g->refinement, g->min[0],
             g->max[0], g->min[1], g->max[1], g->min[2], g->max[2], (long long)g->cells[0],
