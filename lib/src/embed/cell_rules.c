@@ -1265,6 +1265,27 @@ double fcm_cell_rules_volume_fraction(const fcm_cell_rules *rules, fcm_index cel
   return rules->fraction[cell];
 }
 
+/* The volume rule of kind k over the pieces [p0, p1) of a cell of class cls: the catalogue
+ * rule for an uncut cell, else the stored points of those pieces (consecutive). */
+static void rule_range(const fcm_cell_rules *R, fcm_cell_class cls, fcm_rule_kind k, fcm_index p0,
+                       fcm_index p1, int *n, const double **p, const double **w,
+                       const unsigned char **f)
+{
+  *n = 0, *p = *w = NULL, *f = NULL;
+  if (cls == FCM_CELL_UNCUT) {
+    *n = fcm_rule_num_points(R->uncut[k]);
+    *p = fcm_rule_points(R->uncut[k]);
+    *w = fcm_rule_weights(R->uncut[k]);
+    *f = R->uncut_flags[k];
+  } else if (cls == FCM_CELL_CUT) {
+    const fcm_index o0 = R->off[k][p0];
+    *n = (int)(R->off[k][p1] - o0);
+    *p = R->points[k] + 3 * o0;
+    *w = R->weights[k] + o0;
+    *f = R->flags[k] + o0;
+  }
+}
+
 fcm_status fcm_cell_rules_get(const fcm_cell_rules *rules, fcm_index cell, fcm_rule_kind kind,
                               int *num_points, const double **points, const double **weights,
                               const unsigned char **flags)
@@ -1280,18 +1301,8 @@ fcm_status fcm_cell_rules_get(const fcm_cell_rules *rules, fcm_index cell, fcm_r
             (long long)rules->num_cells);
   FCM_CHECK((int)kind >= 0 && kind < FCM_RULE_KIND_COUNT, ctx, FCM_ERR_ARG,
             "cell rules: kind %d out of range [0,%d)", (int)kind, (int)FCM_RULE_KIND_COUNT);
-  if (rules->cls[cell] == FCM_CELL_UNCUT) {
-    n = fcm_rule_num_points(rules->uncut[kind]);
-    p = fcm_rule_points(rules->uncut[kind]);
-    w = fcm_rule_weights(rules->uncut[kind]);
-    f = rules->uncut_flags[kind];
-  } else if (rules->cls[cell] == FCM_CELL_CUT) {
-    const fcm_index o0 = rules->off[kind][rules->piece_off[cell]];
-    n = (int)(rules->off[kind][rules->piece_off[cell + 1]] - o0);
-    p = rules->points[kind] + 3 * o0;
-    w = rules->weights[kind] + o0;
-    f = rules->flags[kind] + o0;
-  }
+  rule_range(rules, (fcm_cell_class)rules->cls[cell], kind, rules->piece_off[cell],
+             rules->piece_off[cell + 1], &n, &p, &w, &f);
 cleanup:
   if (num_points) *num_points = n;
   if (points) *points = p;
@@ -1365,18 +1376,8 @@ fcm_status fcm_cell_rules_get_piece(const fcm_cell_rules *rules, fcm_index piece
             (long long)rules->num_pieces);
   FCM_CHECK((int)kind >= 0 && kind < FCM_RULE_KIND_COUNT, ctx, FCM_ERR_ARG,
             "cell rules: kind %d out of range [0,%d)", (int)kind, (int)FCM_RULE_KIND_COUNT);
-  if (rules->cls[rules->piece_cell[piece]] == FCM_CELL_UNCUT) {
-    n = fcm_rule_num_points(rules->uncut[kind]);
-    p = fcm_rule_points(rules->uncut[kind]);
-    w = fcm_rule_weights(rules->uncut[kind]);
-    f = rules->uncut_flags[kind];
-  } else {
-    const fcm_index o0 = rules->off[kind][piece];
-    n = (int)(rules->off[kind][piece + 1] - o0);
-    p = rules->points[kind] + 3 * o0;
-    w = rules->weights[kind] + o0;
-    f = rules->flags[kind] + o0;
-  }
+  rule_range(rules, (fcm_cell_class)rules->cls[rules->piece_cell[piece]], kind, piece, piece + 1,
+             &n, &p, &w, &f);
 cleanup:
   if (num_points) *num_points = n;
   if (points) *points = n ? p : NULL;
