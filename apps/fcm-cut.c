@@ -625,7 +625,80 @@ static void kappas(fcm_ctx *ctx, int n, double *A, double *k_raw, double *k_scal
 /* Koschier et al. 2017, Fig. 14: the cube [-1, 1]^3 of 5 tets (the body fills it), cut by the
  * plane x = 1 - 2 d (d: distance to the face in cell sizes), A = M + dt^2 K with E = 1e6,
  * nu = 0.3, rho = 1000, dt = 1e-3, linear elasticity, no constraint on the body. */
-static int run_condition(fcm_ctx *ctx, const char *csvpath)
+/* The condition study's rows for the picture: [distance exponent 1..12][constraint][stab]. */
+static double cond_raw[13][2][2], cond_scaled[13][2][2];
+
+/* Koschier Fig. 14 as a PNG through gnuplot: kappa against d for the four variants, raw
+ * (solid) and diagonally scaled (dashed). Written to a temporary, then renamed. 1 on success
+ * or when gnuplot is missing (said on stderr; the CSV is unaffected), 0 on an error. */
+static int condition_png(const char *path)
+{
+  char tmp[4096], script[4096], cmd[8400];
+  if (system(NULL) == 0 || system("gnuplot --version > /dev/null 2>&1") != 0) {
+    fprintf(stderr, PROG ": gnuplot not found (Debian package gnuplot-nox): %s not written\n",
+            path);
+    return 1;
+  }
+  if (snprintf(tmp, sizeof tmp, "%s.tmp.png", path) >= (int)sizeof tmp ||
+      snprintf(script, sizeof script, "%s.gp.tmp", path) >= (int)sizeof script) {
+    fprintf(stderr, PROG ": --png: path too long\n");
+    return 0;
+  }
+  FILE *f = fopen(script, "w");
+  if (!f) {
+    fprintf(stderr, PROG ": cannot write %s\n", script);
+    return 0;
+  }
+  for (int con = 0; con < 2; con++)
+    for (int stab = 0; stab < 2; stab++)
+      for (int sc = 0; sc < 2; sc++) {
+        fprintf(f, "$D%d%d%d << EOD\n", con, stab, sc);
+        for (int e = 1; e <= 12; e++) {
+          const double k = sc ? cond_scaled[e][con][stab] : cond_raw[e][con][stab];
+          if (k > 0.0) fprintf(f, "%.3e %.6e\n", pow(10.0, -e), k);
+        }
+        fprintf(f, "EOD\n");
+      }
+  fprintf(f,
+          "set terminal png size 900,600 font ',11'\nset output '%s'\n"
+          "set logscale xy\nset xrange [*:*] reverse\nset format x '10^{%%L}'\n"
+          "set format y '10^{%%L}'\nset grid\nset key outside right font ',9'\n"
+          "set xlabel 'distance of the cut to the face / cell size'\n"
+          "set ylabel 'condition number'\n"
+          "set title 'kappa(M + dt^2 K): cube of 5 tets cut near a face (Koschier et al. 2017, "
+          "Fig. 14)'\n",
+          tmp);
+  static const char *const colors[2][2] = {{"#d62728", "#1f77b4"}, {"#ff7f0e", "#2ca02c"}};
+  fprintf(f, "plot");
+  int first = 1;
+  for (int con = 0; con < 2; con++)
+    for (int stab = 0; stab < 2; stab++)
+      for (int sc = 0; sc < 2; sc++) {
+        fprintf(f,
+                "%s $D%d%d%d with linespoints lw 2 dt %d lc rgb '%s' title '%s, constraint %s, "
+                "stabilization %s'",
+                first ? "" : ",", con, stab, sc, sc ? 2 : 1, colors[con][stab],
+                sc ? "scaled" : "raw", con ? "on" : "off", stab ? "on" : "off");
+        first = 0;
+      }
+  fprintf(f, "\nset output\n");
+  const int werr = ferror(f);
+  if (fclose(f) != 0 || werr) {
+    remove(script);
+    return 0;
+  }
+  snprintf(cmd, sizeof cmd, "gnuplot '%s' 2>/dev/null", script);
+  const int rc = system(cmd);
+  remove(script);
+  if (rc != 0 || rename(tmp, path) != 0) {
+    remove(tmp);
+    fprintf(stderr, PROG ": gnuplot failed; %s not written\n", path);
+    return 0;
+  }
+  return 1;
+}
+
+static int run_condition(fcm_ctx *ctx, const char *csvpath, const char *pngpath)
 {
   cli_output *out = NULL;
   FILE *csv = NULL;
@@ -693,6 +766,7 @@ static int run_condition(fcm_ctx *ctx, const char *csvpath)
                  kr, ks);
           if (csv) fprintf(csv, "tet4,%.0e,%d,%d,%.6e,%.6e\n", d, con, stab, kr, ks);
           if (e == 1) kfar[con][stab] = kr, ksfar[con][stab] = ks;
+          cond_raw[e][con][stab] = kr, cond_scaled[e][con][stab] = ks;
           kmax[con][stab] = kr < 0 ? HUGE_VAL : fmax(kmax[con][stab], kr);
           ksmax[con][stab] = ks < 0 ? HUGE_VAL : fmax(ksmax[con][stab], ks);
         }
@@ -714,6 +788,7 @@ static int run_condition(fcm_ctx *ctx, const char *csvpath)
   fcm_mesh_destroy(&unit);
   if (csv && ok && !cli_output_commit(PROG, &out)) ok = 0;
   cli_output_abort(&out);
+  if (ok && pngpath && !condition_png(pngpath)) ok = 0;
   if (!ok) return 1;
   /* the claims: with the constraint (stabilization off) the scaled system stays within 10x of
    * its value at d = 0.1; with neither, kappa exceeds 1e8 */
@@ -748,13 +823,16 @@ static void usage(FILE *f, const cli_option *opts)
 int main(int argc, char **argv)
 {
   app_env_init(argc, argv);
-  const char *csv = NULL, *pos[1] = {NULL};
+  const char *csv = NULL, *png = NULL, *pos[1] = {NULL};
   int npos = 0, strength = 8;
   fcm_element_type types[FCM_ELEMENT_COUNT] = {FCM_ELEMENT_TET4, FCM_ELEMENT_TET10,
                                                FCM_ELEMENT_HEX8, FCM_ELEMENT_HEX20};
   int ntypes = 4, seen_el = 0;
   const cli_option opts[] = {{"--csv", NULL, CLI_STRING, &csv, "FILE",
                               "write the rows as CSV (atomically)", 0, 0, 0, NULL, NULL, NULL},
+                             {"--png", NULL, CLI_STRING, &png, "FILE",
+                              "condition: the picture of Koschier's Fig. 14 (needs gnuplot)", 0, 0,
+                              0, NULL, NULL, NULL},
                              {"--max-strength", NULL, CLI_INT, &strength, "M",
                               "accuracy: strengths 1..M (default 8)", 1, 8, 0, NULL, NULL, NULL},
                              {"--element", NULL, CLI_CUSTOM, types, "E",
@@ -781,7 +859,7 @@ int main(int argc, char **argv)
   } else if (!strcmp(pos[0], "dice")) {
     rc = run_dice(ctx, csv, types, ntypes);
   } else {
-    rc = run_condition(ctx, csv);
+    rc = run_condition(ctx, csv, png);
   }
   fcm_ctx_destroy(&ctx);
   return rc;

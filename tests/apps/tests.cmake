@@ -100,7 +100,7 @@ add_test(NAME app_cut_dice_hex8 COMMAND $<TARGET_FILE:fcm-cut> dice --element he
          --csv ${work}/cut_dice.csv)
 add_test(NAME app_cut_dice_tet4 COMMAND $<TARGET_FILE:fcm-cut> dice --element tet4)
 add_test(NAME app_cut_condition COMMAND $<TARGET_FILE:fcm-cut> condition
-         --csv ${work}/cut_condition.csv)
+         --csv ${work}/cut_condition.csv --png ${work}/cut_condition.png)
 add_test(NAME app_cut_accuracy_full COMMAND $<TARGET_FILE:fcm-cut> accuracy)
 add_test(NAME app_cut_dice_full COMMAND $<TARGET_FILE:fcm-cut> dice)
 set_tests_properties(app_cut_accuracy app_cut_dice_hex8 app_cut_dice_tet4 app_cut_condition
