@@ -2,7 +2,8 @@
  * the log before the cut and two after, the same mass on every row (1e-12), every DOF count
  * and counter as expected (one cut, only cells near the plane integrated again); a cut at
  * t = 0 (a slab in three slices) gives three bodies from the first step; a plane that
- * misses the body is a counted no-op and a crack that ends inside it separates nothing; bad cuts
+ * misses the body is a counted no-op and a crack that ends inside it separates nothing; a
+ * malformed cut mesh fails when the simulation is built (effect and file:line named); bad cuts
  * are refused with messages naming the key. */
 #include "scene_util.h"
 
@@ -158,6 +159,29 @@ int main(void)
                          ", {\"cut\": {\"surface\": {\"mesh\": \"no-such-cut.obj\"}}}", ""),
                "c.json", &scene),
            FCM_ERR_IO, "no-such-cut.obj");
+  /* a malformed cut mesh fails when the simulation is built, naming the effect and the line */
+  FILE *bad = fopen("scene_cut_bad.obj", "w");
+  TEST_TRUE(bad != NULL);
+  if (bad) {
+    fputs("v 0 0 0\nv 1 0 0\nf 1 2 7\n", bad);
+    fclose(bad);
+    TEST_OK(ctx, fcm_scene_create_from_string(
+                     ctx,
+                     cut_scene(buf, sizeof buf,
+                               ", {\"cut\": {\"time\": 0.02, \"surface\": {\"mesh\": "
+                               "\"scene_cut_bad.obj\"}}}",
+                               ""),
+                     "c.json", &scene));
+    fcm_simulation *sim = NULL;
+    if (scene) {
+      TEST_TRUE(fcm_simulation_create(ctx, scene, NULL, &sim) == FCM_ERR_FORMAT && !sim);
+      TEST_TRUE(strstr(fcm_ctx_error_message(ctx), "effects[1].cut.surface.mesh") &&
+                strstr(fcm_ctx_error_message(ctx), "scene_cut_bad.obj:3"));
+      fcm_ctx_error_clear(ctx);
+    }
+    fcm_scene_destroy(&scene);
+    remove("scene_cut_bad.obj");
+  }
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
 }

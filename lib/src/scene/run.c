@@ -715,6 +715,17 @@ static fcm_status collect_cuts(fcm_simulation *S)
               "scene %s: effects[%d].cut needs an embedded geometry (\"geometry\"): cuts split "
               "the embedded body",
               fcm_scene_name(S->scene), k);
+    if (e->cut.kind == FCM_CUT_MESH) { /* read it now: a bad file fails before the run */
+      fcm_surface *probe = NULL;
+      st = fcm_surface_create_from_file(ctx, e->cut.mesh, &probe);
+      fcm_surface_destroy(&probe);
+      if (st != FCM_OK) {
+        char section[64];
+        snprintf(section, sizeof section, "effects[%d].cut.surface.mesh", k);
+        name_section(ctx, section);
+        goto cleanup;
+      }
+    }
     int i = S->num_cuts++;
     while (i > 0 && S->cuts[i - 1]->cut.time > e->cut.time) {
       S->cuts[i] = S->cuts[i - 1];
