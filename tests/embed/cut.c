@@ -5,7 +5,8 @@
  * inside the body separates nothing, pieces connected along the links form the expected
  * number of material components (two halves; the 36 sticks of Ton-That et al. 2024 Fig. 5
  * for a cube of 5 tets and 2x2x2 hexes diced by 10 planes), a cut along cell faces and
- * through nodes is handled, and only cells a new cut reaches are integrated again. */
+ * through nodes is handled, only cells a new cut reaches are integrated again, and the cut
+ * faces of the pieces cover both sides of the section (area 1 each). */
 #include "fcm/embed.h"
 #include "test.h"
 
@@ -142,6 +143,25 @@ static void plane_cut(fcm_element_type type)
   /* the plane crosses 9 Hex8 cells */
   TEST_TRUE(type != FCM_ELEMENT_HEX8 || split == 9);
   TEST_TRUE((int)S->num_split == split);
+  /* the cut faces: both sides of the section x = 0.6 of the unit box, area 1 each */
+  double area[2] = {0, 0};
+  for (fcm_index p = 0; p < fcm_cell_rules_num_pieces(r1); p++) {
+    const double *xi;
+    const fcm_index nt = fcm_cell_rules_get_piece_cut_faces(r1, p, &xi);
+    double X[3 * 27], v[3][3];
+    fcm_mesh_cell_coords(mesh, fcm_cell_rules_piece_cell(r1, p), X);
+    for (fcm_index t = 0; t < nt; t++) {
+      for (int k = 0; k < 3; k++)
+        fcm_element_map(type, X, xi + 9 * t + 3 * k, v[k]);
+      const double a[3] = {v[1][0] - v[0][0], v[1][1] - v[0][1], v[1][2] - v[0][2]};
+      const double b[3] = {v[2][0] - v[0][0], v[2][1] - v[0][1], v[2][2] - v[0][2]};
+      const double cx = a[1] * b[2] - a[2] * b[1];
+      TEST_NEAR(v[0][0], 0.6, 0, 1e-12); /* on the plane */
+      area[cx > 0.0] += 0.5 * fabs(cx);  /* outward +x: the left side's face */
+    }
+  }
+  TEST_NEAR(area[0], 1.0, 1e-12, 0);
+  TEST_NEAR(area[1], 1.0, 1e-12, 0);
   TEST_TRUE(components(mesh, r1) == 2);
   TEST_TRUE(components(mesh, r0) == 1);
   TEST_TRUE(type != FCM_ELEMENT_HEX8 || S->num_integrated == 9);

@@ -7,6 +7,10 @@
  * are refused with messages naming the key. */
 #include "scene_util.h"
 
+#include <errno.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 static const char *cut_scene(char *buf, size_t cap, const char *cuts, const char *extra)
 {
   snprintf(buf, cap,
@@ -22,6 +26,9 @@ static const char *cut_scene(char *buf, size_t cap, const char *cuts, const char
            extra, cuts);
   return buf;
 }
+
+/* Triangles of the last frame's embedded surface (boundary + cut faces). */
+static long last_surface_cells;
 
 /* Run to the end; return the log's columns pieces and mass per row. */
 static int run(fcm_ctx *ctx, const char *json, long long *pieces, double *mass,
@@ -55,6 +62,26 @@ static int run(fcm_ctx *ctx, const char *json, long long *pieces, double *mass,
     if (f) fclose(f);
     remove(path);
     fcm_simulation_get_counters(sim, c);
+    /* a frame: the embedded surface holds the boundary and, after a cut, the cut faces */
+    TEST_TRUE(mkdir("scene_cut_frames", 0755) == 0 || errno == EEXIST);
+    TEST_OK(ctx, fcm_simulation_write_frame(sim, "scene_cut_frames", 0));
+    FILE *vf = fopen("scene_cut_frames/cut_surface_0000.vtu", "rb");
+    char head[2048] = "";
+    if (vf) {
+      size_t got = fread(head, 1, sizeof head - 1, vf);
+      head[got] = '\0';
+      fclose(vf);
+    }
+    const char *nc = strstr(head, "NumberOfCells=\"");
+    const long cells = nc ? strtol(nc + 15, NULL, 10) : -1;
+    TEST_TRUE(strstr(head, "Name=\"cut_face\"") != NULL);
+    TEST_TRUE(cells >= (long)c->surface_triangles);
+    last_surface_cells = cells;
+    remove("scene_cut_frames/cut_surface_0000.vtu");
+    remove("scene_cut_frames/cut_surface.pvd");
+    remove("scene_cut_frames/cut_background_0000.vtu");
+    remove("scene_cut_frames/cut_background.pvd");
+    rmdir("scene_cut_frames");
     ok = 1;
   }
   fcm_simulation_destroy(&sim);
@@ -87,6 +114,7 @@ int main(void)
     }
     TEST_TRUE(c.cuts == 1 && c.cuts_missed == 0 && c.pieces == 2);
     TEST_TRUE(c.cut_cells > 0 && c.cut_cells < 12);
+    TEST_TRUE(last_surface_cells > (long)c.surface_triangles); /* cut faces written */
   }
   /* two cuts at t = 0 (listed out of order, the later one first): three slices */
   if (run(ctx,

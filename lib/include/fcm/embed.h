@@ -289,6 +289,15 @@ FCM_API fcm_status fcm_cell_rules_get_piece_surface(const fcm_cell_rules *rules,
                                                     const double **weights, const double **normals,
                                                     const fcm_index **triangles);
 
+/** The faces of `piece` that lie on the cuts (its side of them), as triangles for output:
+ * returns their number and, in *xi (may be NULL; NULL when none), 9 reference coordinates
+ * per triangle (3 vertices in the cell's reference element), oriented outward from the
+ * piece. Both sides of a cut face appear, each with its own piece, so moving each with its
+ * piece's DOFs shows the opening. 0 for a piece out of range or of a cell no cut reaches.
+ * No allocation; thread safe. */
+FCM_API fcm_index fcm_cell_rules_get_piece_cut_faces(const fcm_cell_rules *rules, fcm_index piece,
+                                                     const double **xi);
+
 /** The piece of the rules this object extended (the `prev` of fcm_cell_rules_create_cut())
  * that holds `piece` (pieces only ever split: every piece lies in one earlier piece of the
  * same cell); -1 for rules from fcm_cell_rules_create() or out of range. With

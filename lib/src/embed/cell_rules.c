@@ -87,6 +87,8 @@ typedef struct piece_out {
   int ns;
   double *spts, *sw, *snrm;
   fcm_index *stri;
+  int ncf;      /* cut-face triangles */
+  double *cfxi; /* 9 reference coordinates each */
   double volume;
 } piece_out;
 
@@ -142,7 +144,8 @@ static void piece_out_free(fcm_ctx *ctx, piece_out *o)
   fcm__free(ctx, o->sw);
   fcm__free(ctx, o->snrm);
   fcm__free(ctx, o->stri);
-  o->spts = o->sw = o->snrm = NULL;
+  fcm__free(ctx, o->cfxi);
+  o->spts = o->sw = o->snrm = o->cfxi = NULL;
   o->stri = NULL;
 }
 
@@ -357,6 +360,12 @@ static fcm_status copy_cell(const build *B, fcm_index c, cell_out *o)
       memcpy(po->stri, Q->stris + a, n * sizeof(fcm_index));
     }
     po->ns = (int)n;
+    const size_t c0 = (size_t)Q->cfoff[p], nc = (size_t)Q->cfoff[p + 1] - c0;
+    if (nc) {
+      FCM_ALLOC(ctx, 9 * nc, po->cfxi);
+      memcpy(po->cfxi, Q->cfxi + 9 * c0, 9 * nc * sizeof(double));
+    }
+    po->ncf = (int)nc;
   }
 cleanup:
   return st;
@@ -515,6 +524,19 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
     for (int i = 0; i < o->np; i++)
       FCM_TRY(ctx, surface_piece(B, &cell, ws, o->np > 1 ? P : NULL, i, o->pc + i));
   }
+  if (P && P->tcand.n > 0 && cls != FCM_CELL_DROPPED) /* the pieces' sides of the cuts */
+    for (int i = 0; i < o->np; i++) {
+      double *phys = NULL;
+      int nt = 0;
+      FCM_TRY(ctx, fcm__embed_cut_faces(ctx, &cell, B->cut_tris, P, i, &phys, &nt));
+      o->pc[i].cfxi = phys;
+      o->pc[i].ncf = nt;
+      for (int k = 0; k < 3 * nt; k++) {
+        double xi[3], det;
+        FCM_TRY(ctx, fcm__embed_to_reference(ctx, &cell, phys + 3 * k, xi, &det));
+        memcpy(phys + 3 * k, xi, sizeof xi);
+      }
+    }
   sums->time_intersect += fcm_wtime() - t0;
   if (cls == FCM_CELL_CUT && opt->simplify != FCM_CELL_SIMPLIFY_AUTO) {
     const int on = opt->simplify == FCM_CELL_SIMPLIFY_ON;
@@ -925,6 +947,18 @@ static fcm_status gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_out *
         memcpy(R->flags[k] + o0, out[c].pc[i].flag[k], n);
       }
   }
+  FCM_ALLOC(ctx, (size_t)np + 1, R->cfoff);
+  for (fcm_index c = 0; c < nc; c++)
+    for (int i = 0; i < out[c].np; i++) {
+      const fcm_index p = R->piece_off[c] + i;
+      R->cfoff[p + 1] = R->cfoff[p] + out[c].pc[i].ncf;
+    }
+  FCM_ALLOC(ctx, 9 * (size_t)R->cfoff[np] + 1, R->cfxi);
+  for (fcm_index c = 0; c < nc; c++)
+    for (int i = 0; i < out[c].np; i++)
+      if (out[c].pc[i].ncf)
+        memcpy(R->cfxi + 9 * R->cfoff[R->piece_off[c] + i], out[c].pc[i].cfxi,
+               9 * (size_t)out[c].pc[i].ncf * sizeof(double));
   R->soff[0] = 0;
   for (fcm_index c = 0; c < nc; c++)
     for (int i = 0; i < out[c].np; i++) {
@@ -1227,6 +1261,8 @@ void fcm_cell_rules_destroy(fcm_cell_rules **rules)
   fcm__free(ctx, R->cut_tris);
   fcm__free(ctx, R->links);
   fcm__free(ctx, R->soff);
+  fcm__free(ctx, R->cfoff);
+  fcm__free(ctx, R->cfxi);
   fcm__free(ctx, R->spoints);
   fcm__free(ctx, R->sweights);
   fcm__free(ctx, R->snormals);
@@ -1419,6 +1455,18 @@ fcm_index fcm_cell_rules_piece_parent(const fcm_cell_rules *rules, fcm_index pie
 fcm_index fcm_cell_rules_parent_num_pieces(const fcm_cell_rules *rules)
 {
   return rules ? rules->prev_num_pieces : 0;
+}
+
+fcm_index fcm_cell_rules_get_piece_cut_faces(const fcm_cell_rules *rules, fcm_index piece,
+                                             const double **xi)
+{
+  if (!rules || piece < 0 || piece >= rules->num_pieces) {
+    if (xi) *xi = NULL;
+    return 0;
+  }
+  const fcm_index n = rules->cfoff[piece + 1] - rules->cfoff[piece];
+  if (xi) *xi = n ? rules->cfxi + 9 * rules->cfoff[piece] : NULL;
+  return n;
 }
 
 fcm_index fcm_cell_rules_num_links(const fcm_cell_rules *rules)

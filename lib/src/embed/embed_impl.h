@@ -48,6 +48,10 @@ struct fcm_cell_rules {
   double *sweights; /* area weights */
   double *snormals; /* x 3 */
   fcm_index *stris; /* boundary triangle of each point */
+  /* The cut faces of the pieces (their side of the cuts): triangles [cfoff[p], cfoff[p+1]),
+   * 9 reference coordinates each (3 vertices in the cell's reference element). */
+  fcm_index *cfoff;
+  double *cfxi;
   /* Cutting: the options the rules were built with (fcm_cell_rules_create_cut() reuses
    * them), the cut triangles of every cut so far, and the links: pairs of pieces of
    * face-neighbouring cells that share a face of positive area not lying on a cut (only
@@ -209,6 +213,12 @@ fcm_status fcm__embed_piece_tets(fcm_ctx *ctx, const fcm__parts *P, const int *l
 /* The piece whose parts contain the physical point x (the part with the smallest largest
  * signed distance to its face planes). */
 int fcm__embed_point_piece(const fcm__parts *P, const double x[3]);
+
+/* The faces of `piece`'s parts that lie on a cut triangle (the piece's side of the cuts),
+ * fan-triangulated with their outward orientation: *tri (allocated, 9 doubles = 3 physical
+ * vertices per triangle; NULL when none) and *ntri. */
+fcm_status fcm__embed_cut_faces(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
+                                const fcm__parts *P, int piece, double **tri, int *ntri);
 
 /* Record the polygons of part faces lying on the cell's faces (P->fx, P->fmeta). */
 fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P);

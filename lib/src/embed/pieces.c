@@ -534,3 +534,42 @@ fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, f
 cleanup:
   return st;
 }
+
+fcm_status fcm__embed_cut_faces(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
+                                const fcm__parts *P, int piece, double **tri, int *ntri)
+{
+  fcm_status st = FCM_OK;
+  const double mtol = MATCH_RTOL * cell->size;
+  double x[3 * FCM__POLY_MAX_FV];
+  int n = 0, cap = 0;
+  double *t = NULL;
+  for (size_t i = 0; i < P->n; i++) {
+    if (P->piece[i] != piece) continue;
+    const fcm__poly *q = P->poly + i;
+    for (int f = 0; f < q->nf; f++) {
+      const int m = face_coords(q, f, x);
+      double c[3] = {0, 0, 0};
+      for (int k = 0; k < m; k++)
+        for (int d = 0; d < 3; d++)
+          c[d] += x[3 * k + d] / m;
+      if (!fcm__embed_on_cut(tris, P->tcand.ids, P->tcand.n, c, mtol)) continue;
+      if (n + m - 2 > cap) {
+        const int ncap = FCM_MAX(2 * cap, n + m - 2 + 16);
+        void *v = t;
+        FCM_TRY(ctx, fcm__resize(ctx, &v, 9 * (size_t)n, 9 * (size_t)ncap, sizeof(double)));
+        t = v;
+        cap = ncap;
+      }
+      for (int k = 1; k + 1 < m; k++, n++) { /* fan: the face's own orientation (outward) */
+        memcpy(t + 9 * n, x, 3 * sizeof *t);
+        memcpy(t + 9 * n + 3, x + 3 * k, 3 * sizeof *t);
+        memcpy(t + 9 * n + 6, x + 3 * (k + 1), 3 * sizeof *t);
+      }
+    }
+  }
+  *tri = t, *ntri = n;
+  t = NULL;
+cleanup:
+  fcm__free(ctx, t);
+  return st;
+}

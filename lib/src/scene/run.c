@@ -1010,14 +1010,71 @@ cleanup:
   return st;
 }
 
+/* The embedded surface of a frame: the boundary vertices and triangles, then the cut faces
+ * of every piece (its side of the cuts; 3 vertices per triangle, each moved with its piece's
+ * element), so the opening is visible. flag: 1 on cut-face points. */
+typedef struct cut_faces {
+  fcm_index np, nt;
+  double *x, *u;
+  fcm_index *tri;
+  int32_t *flag;
+} cut_faces;
+
+static fcm_status cut_face_output(fcm_simulation *S, const double *u, cut_faces *cf)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  fcm_index ncf = 0;
+  const fcm_index npieces = S->rules ? fcm_cell_rules_num_pieces(S->rules) : 0;
+  for (fcm_index p = 0; p < npieces; p++)
+    ncf += fcm_cell_rules_get_piece_cut_faces(S->rules, p, NULL);
+  cf->np = S->ns + 3 * ncf;
+  cf->nt = S->nt + ncf;
+  FCM_ALLOC_RAW(ctx, 3 * (size_t)cf->np + 1, cf->x);
+  FCM_ALLOC_RAW(ctx, 3 * (size_t)cf->np + 1, cf->u);
+  FCM_ALLOC_RAW(ctx, 3 * (size_t)cf->nt + 1, cf->tri);
+  FCM_ALLOC(ctx, (size_t)cf->np + 1, cf->flag);
+  memcpy(cf->x, S->surf_x, 3 * (size_t)S->ns * sizeof(double));
+  memcpy(cf->u, S->surf_u, 3 * (size_t)S->ns * sizeof(double));
+  memcpy(cf->tri, S->surf_tri, 3 * (size_t)S->nt * sizeof(fcm_index));
+  const fcm_element_type type = fcm_mesh_element_type(S->mesh);
+  double X[3 * FCM_ELEMENT_MAX_NODES];
+  fcm_index v = S->ns, t = S->nt;
+  for (fcm_index p = 0; p < npieces; p++) {
+    const double *xi;
+    const fcm_index n = fcm_cell_rules_get_piece_cut_faces(S->rules, p, &xi);
+    if (!n) continue;
+    const fcm_index c = fcm_cell_rules_piece_cell(S->rules, p);
+    fcm_index first, e0;
+    fcm_cell_rules_cell_pieces(S->rules, c, &first);
+    fcm_space_cell_elements(S->space, c, &e0);
+    fcm_mesh_cell_coords(S->mesh, c, X);
+    for (fcm_index k = 0; k < 3 * n; k++, v++) {
+      double x0[3];
+      fcm_element_map(type, X, xi + 3 * k, x0);
+      FCM_TRY(ctx,
+              fcm_space_element_eval(S->space, e0 + (p - first), xi + 3 * k, u, cf->u + 3 * v));
+      for (int d = 0; d < 3; d++)
+        cf->x[3 * v + d] = x0[d] + cf->u[3 * v + d];
+      cf->flag[v] = 1;
+    }
+    for (fcm_index k = 0; k < n; k++, t++)
+      for (int a = 0; a < 3; a++)
+        cf->tri[3 * t + a] = v - 3 * n + 3 * k + a;
+  }
+cleanup:
+  return st;
+}
+
 fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int index)
 {
+  cut_faces cf = {0, 0, NULL, NULL, NULL, NULL};
   fcm_status st = FCM_OK;
   fcm_vtu *vtu = NULL;
   char path[4096];
-  FCM_CHECK(S && dir && index >= 0, S ? S->ctx : NULL, FCM_ERR_ARG,
+  fcm_ctx *ctx = S ? S->ctx : NULL;
+  FCM_CHECK(S && dir && index >= 0, ctx, FCM_ERR_ARG,
             "simulation: write_frame needs a directory and index >= 0 (got %d)", index);
-  fcm_ctx *ctx = S->ctx;
   const char *name = fcm_scene_name(S->scene);
   const fcm_scene_output *out = fcm_scene_get_output(S->scene);
   double t0 = fcm_wtime(), time = fcm_integrator_time(S->integ);
@@ -1054,9 +1111,11 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
     for (fcm_index i = 0; i < 3 * S->ns; i++)
       S->surf_x[i] = S->surf_X[i] + S->surf_u[i];
     fcm_vtu_clear(vtu);
-    FCM_TRY(ctx, fcm_vtu_set_points(vtu, S->ns, S->surf_x));
-    FCM_TRY(ctx, fcm_vtu_set_cells(vtu, FCM_VTK_TRIANGLE, S->nt, S->surf_tri));
-    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "displacement", 3, S->ns, S->surf_u));
+    FCM_TRY(ctx, cut_face_output(S, u, &cf));
+    FCM_TRY(ctx, fcm_vtu_set_points(vtu, cf.np, cf.x));
+    FCM_TRY(ctx, fcm_vtu_set_cells(vtu, FCM_VTK_TRIANGLE, cf.nt, cf.tri));
+    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "displacement", 3, cf.np, cf.u));
+    FCM_TRY(ctx, fcm_vtu_add_field_int32(vtu, FCM_VTU_POINT_DATA, "cut_face", 1, cf.np, cf.flag));
     snprintf(path, sizeof path, "%s/%s_surface_%04d.vtu", dir, name, index);
     FCM_TRY(ctx, fcm_vtu_write(vtu, path, NULL));
     if (!S->pvd_surf) FCM_TRY(ctx, open_pvd(S, dir, "surface", &S->pvd_surf));
@@ -1065,6 +1124,10 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
   S->frame_time[S->c.frames++] = time;
   S->c.time_output += fcm_wtime() - t0;
 cleanup:
+  fcm__free(ctx, cf.x);
+  fcm__free(ctx, cf.u);
+  fcm__free(ctx, cf.tri);
+  fcm__free(ctx, cf.flag);
   fcm_vtu_destroy(&vtu);
   return st;
 }
