@@ -34,6 +34,10 @@ static void report(fcm_ctx *ctx)
   fprintf(stderr, PROG ": %s\n", fcm_ctx_error_message(ctx));
 }
 
+/* The accuracy study's worst error per (surface, element, strength), and its picture. */
+static double acc_err[3][2][9];
+static int accuracy_png(const char *path, int max_strength);
+
 /* ---------------------------------------------------------------- exact moments */
 
 /* Monomials x^a y^b z^c of degree <= m in graded order; their count. */
@@ -74,8 +78,8 @@ static void tet_moments(const double v[4][3], int m, double *mom)
   int ex[3 * 165];
   mono_exp(m, ex);
   /* a polynomial in lambda of degree `deg` as coefficients poly[a][b][c] of
-   * l0^a l1^b l2^c l3^(deg-a-b-c), degree <= 8 */
-  static double poly[9][9][9], next[9][9][9];
+   * l0^a l1^b l2^c l3^(deg-a-b-c), degree <= 8 (the zeroing reaches deg + 1 <= 9) */
+  static double poly[10][10][10], next[10][10][10];
   for (int k = 0; k < num_mono(m); k++) {
     /* prod_d (sum_i lambda_i v_i[d])^{e_d}, expanded factor by factor */
     poly[0][0][0] = 1.0;
@@ -202,8 +206,8 @@ static void tets_moments(const tets *t, int m, double *mom)
 
 typedef struct cut_case {
   const char *name;
-  int nplanes;          /* the inner piece: the cell intersected with these half-spaces */
-  double planes[80][4]; /* n, d: n.x <= d */
+  int nplanes;           /* the inner piece: the cell intersected with these half-spaces */
+  double planes[256][4]; /* n, d: n.x <= d (the spherical cut has 128) */
 } cut_case;
 
 /* The cut surfaces of the accuracy study, as triangle surfaces, and the half-spaces whose
@@ -288,7 +292,7 @@ static fcm_status make_cut(fcm_ctx *ctx, int which, int hex, fcm_surface **surf,
       nt = n2;
     }
     cc->name = "spherical";
-    cc->nplanes = nt;
+    cc->nplanes = nt;              /* 128 <= 256 planes */
     for (int k = 0; k < nt; k++) { /* outward face planes of the (convex) polyhedron */
       double a[3], b[3], n[3];
       for (int d = 0; d < 3; d++)
@@ -315,7 +319,7 @@ static fcm_status make_cut(fcm_ctx *ctx, int which, int hex, fcm_surface **surf,
 }
 
 typedef struct acc_opts {
-  const char *csv;
+  const char *csv, *png;
   int max_strength;
 } acc_opts;
 
@@ -425,6 +429,7 @@ static int run_accuracy(fcm_ctx *ctx, const acc_opts *ao)
           for (int k = 0; k < nm; k++)
             err = fmax(err, fabs(q[k] - E[k]) / fabs(E[k]));
           worst = fmax(worst, err);
+          acc_err[which][hex][m] = fmax(acc_err[which][hex][m], err);
           over_m += n > nm;
           rows++;
           if (csv)
@@ -444,6 +449,7 @@ static int run_accuracy(fcm_ctx *ctx, const acc_opts *ao)
   }
   if (csv && ok && !cli_output_commit(PROG, &out)) ok = 0;
   cli_output_abort(&out);
+  if (ok && ao->png && !accuracy_png(ao->png, ao->max_strength)) ok = 0;
   if (!ok) return 1;
   const int pass = worst <= 1e-12 && over_m == 0;
   printf("accuracy: %lld pieces x strengths, largest relative moment error %.2e (claim <= 1e-12: "
@@ -625,13 +631,10 @@ static void kappas(fcm_ctx *ctx, int n, double *A, double *k_raw, double *k_scal
 /* Koschier et al. 2017, Fig. 14: the cube [-1, 1]^3 of 5 tets (the body fills it), cut by the
  * plane x = 1 - 2 d (d: distance to the face in cell sizes), A = M + dt^2 K with E = 1e6,
  * nu = 0.3, rho = 1000, dt = 1e-3, linear elasticity, no constraint on the body. */
-/* The condition study's rows for the picture: [distance exponent 1..12][constraint][stab]. */
-static double cond_raw[13][2][2], cond_scaled[13][2][2];
-
-/* Koschier Fig. 14 as a PNG through gnuplot: kappa against d for the four variants, raw
- * (solid) and diagonally scaled (dashed). Written to a temporary, then renamed. 1 on success
- * or when gnuplot is missing (said on stderr; the CSV is unaffected), 0 on an error. */
-static int condition_png(const char *path)
+/* Run the gnuplot script `body` (which draws to the terminal file named by the %s it holds
+ * once) into `path`: the picture goes to a temporary, then is renamed. 1 on success or when
+ * gnuplot is missing (said on stderr), 0 on an error. */
+static int gnuplot_png(const char *path, const char *body)
 {
   char tmp[4096], script[4096], cmd[8400];
   if (system(NULL) == 0 || system("gnuplot --version > /dev/null 2>&1") != 0) {
@@ -649,39 +652,8 @@ static int condition_png(const char *path)
     fprintf(stderr, PROG ": cannot write %s\n", script);
     return 0;
   }
-  for (int con = 0; con < 2; con++)
-    for (int stab = 0; stab < 2; stab++)
-      for (int sc = 0; sc < 2; sc++) {
-        fprintf(f, "$D%d%d%d << EOD\n", con, stab, sc);
-        for (int e = 1; e <= 12; e++) {
-          const double k = sc ? cond_scaled[e][con][stab] : cond_raw[e][con][stab];
-          if (k > 0.0) fprintf(f, "%.3e %.6e\n", pow(10.0, -e), k);
-        }
-        fprintf(f, "EOD\n");
-      }
-  fprintf(f,
-          "set terminal png size 900,600 font ',11'\nset output '%s'\n"
-          "set logscale xy\nset xrange [*:*] reverse\nset format x '10^{%%L}'\n"
-          "set format y '10^{%%L}'\nset grid\nset key outside right font ',9'\n"
-          "set xlabel 'distance of the cut to the face / cell size'\n"
-          "set ylabel 'condition number'\n"
-          "set title 'kappa(M + dt^2 K): cube of 5 tets cut near a face (Koschier et al. 2017, "
-          "Fig. 14)'\n",
-          tmp);
-  static const char *const colors[2][2] = {{"#d62728", "#1f77b4"}, {"#ff7f0e", "#2ca02c"}};
-  fprintf(f, "plot");
-  int first = 1;
-  for (int con = 0; con < 2; con++)
-    for (int stab = 0; stab < 2; stab++)
-      for (int sc = 0; sc < 2; sc++) {
-        fprintf(f,
-                "%s $D%d%d%d with linespoints lw 2 dt %d lc rgb '%s' title '%s, constraint %s, "
-                "stabilization %s'",
-                first ? "" : ",", con, stab, sc, sc ? 2 : 1, colors[con][stab],
-                sc ? "scaled" : "raw", con ? "on" : "off", stab ? "on" : "off");
-        first = 0;
-      }
-  fprintf(f, "\nset output\n");
+  fprintf(f, "set terminal png size 900,600 font ',11'\nset output '%s'\n%s\nset output\n", tmp,
+          body);
   const int werr = ferror(f);
   if (fclose(f) != 0 || werr) {
     remove(script);
@@ -696,6 +668,77 @@ static int condition_png(const char *path)
     return 0;
   }
   return 1;
+}
+
+static int accuracy_png(const char *path, int max_strength)
+{
+  static char body[16384];
+  static const char *const surf[3] = {"planar", "kinked", "spherical"};
+  size_t n = 0;
+  for (int w = 0; w < 3; w++)
+    for (int h = 0; h < 2; h++) {
+      n += (size_t)snprintf(body + n, sizeof body - n, "$A%d%d << EOD\n", w, h);
+      for (int m = 1; m <= max_strength; m++)
+        n += (size_t)snprintf(body + n, sizeof body - n, "%d %.6e\n", m,
+                              fmax(acc_err[w][h][m], 1e-17));
+      n += (size_t)snprintf(body + n, sizeof body - n, "EOD\n");
+    }
+  n += (size_t)snprintf(body + n, sizeof body - n,
+                        "set logscale y\nset format y '10^{%%L}'\nset grid\n"
+                        "set key outside right font ',9'\nset xlabel 'strength m'\n"
+                        "set ylabel 'largest relative moment error over the pieces'\n"
+                        "set yrange [1e-17:1e-10]\nset title 'cut-cell pieces: moments of degree "
+                        "<= m (Koschier et al. 2017, Table 1)'\n"
+                        "plot 1e-12 with lines lc rgb '#888888' dt 2 title 'claim 1e-12'");
+  for (int w = 0; w < 3; w++)
+    for (int h = 0; h < 2; h++)
+      n += (size_t)snprintf(body + n, sizeof body - n,
+                            ", $A%d%d with linespoints lw 2 dt %d title '%s, %s'", w, h, h + 1,
+                            surf[w], h ? "hex8" : "tet4");
+  return gnuplot_png(path, body);
+}
+
+/* The condition study's rows for the picture: [distance exponent 1..12][constraint][stab]. */
+static double cond_raw[13][2][2], cond_scaled[13][2][2];
+
+/* Koschier Fig. 14 as a PNG through gnuplot: kappa against d for the four variants, raw
+ * (solid) and diagonally scaled (dashed). Written to a temporary, then renamed. 1 on success
+ * or when gnuplot is missing (said on stderr; the CSV is unaffected), 0 on an error. */
+static int condition_png(const char *path)
+{
+  static char body[16384];
+  static const char *const colors[2][2] = {{"#d62728", "#1f77b4"}, {"#ff7f0e", "#2ca02c"}};
+  size_t n = 0;
+  for (int con = 0; con < 2; con++)
+    for (int stab = 0; stab < 2; stab++)
+      for (int sc = 0; sc < 2; sc++) {
+        n += (size_t)snprintf(body + n, sizeof body - n, "$D%d%d%d << EOD\n", con, stab, sc);
+        for (int e = 1; e <= 12; e++) {
+          const double k = sc ? cond_scaled[e][con][stab] : cond_raw[e][con][stab];
+          if (k > 0.0)
+            n += (size_t)snprintf(body + n, sizeof body - n, "%.3e %.6e\n", pow(10.0, -e), k);
+        }
+        n += (size_t)snprintf(body + n, sizeof body - n, "EOD\n");
+      }
+  n += (size_t)snprintf(body + n, sizeof body - n,
+                        "set logscale xy\nset xrange [*:*] reverse\nset format x '10^{%%L}'\n"
+                        "set format y '10^{%%L}'\nset grid\nset key outside right font ',9'\n"
+                        "set xlabel 'distance of the cut to the face / cell size'\n"
+                        "set ylabel 'condition number'\n"
+                        "set title 'kappa(M + dt^2 K), cube of 5 tets cut near a face "
+                        "(Koschier et al. 2017, Fig. 14)'\nplot");
+  int first = 1;
+  for (int con = 0; con < 2; con++)
+    for (int stab = 0; stab < 2; stab++)
+      for (int sc = 0; sc < 2; sc++) {
+        n += (size_t)snprintf(body + n, sizeof body - n,
+                              "%s $D%d%d%d with linespoints lw 2 dt %d lc rgb '%s' title '%s, "
+                              "constraint %s, stabilization %s'",
+                              first ? "" : ",", con, stab, sc, sc ? 2 : 1, colors[con][stab],
+                              sc ? "scaled" : "raw", con ? "on" : "off", stab ? "on" : "off");
+        first = 0;
+      }
+  return gnuplot_png(path, body);
 }
 
 static int run_condition(fcm_ctx *ctx, const char *csvpath, const char *pngpath)
@@ -854,7 +897,7 @@ int main(int argc, char **argv)
   }
   int rc;
   if (!strcmp(pos[0], "accuracy")) {
-    const acc_opts ao = {csv, strength};
+    const acc_opts ao = {csv, png, strength};
     rc = run_accuracy(ctx, &ao);
   } else if (!strcmp(pos[0], "dice")) {
     rc = run_dice(ctx, csv, types, ntypes);

@@ -95,7 +95,7 @@ target_sources(app_env PRIVATE ${PROJECT_SOURCE_DIR}/apps/app_env.c)
 # constraint and stabilization). The default run covers strengths 1-4
 # and the Hex8 and Tet4 dice; the full study (strengths 1-8, all four elements) is slow.
 add_test(NAME app_cut_accuracy COMMAND $<TARGET_FILE:fcm-cut> accuracy --max-strength 4
-         --csv ${work}/cut_accuracy.csv)
+         --csv ${work}/cut_accuracy.csv --png ${work}/cut_accuracy.png)
 add_test(NAME app_cut_dice_hex8 COMMAND $<TARGET_FILE:fcm-cut> dice --element hex8
          --csv ${work}/cut_dice.csv)
 add_test(NAME app_cut_dice_tet4 COMMAND $<TARGET_FILE:fcm-cut> dice --element tet4)
