@@ -890,6 +890,7 @@ int main(int argc, char **argv)
     return 2;
   }
   if (seen_el) ntypes = 1;
+  fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   fcm_ctx *ctx = NULL;
   if (fcm_ctx_create(NULL, &ctx) != FCM_OK) {
     fprintf(stderr, PROG ": cannot create a context\n");
