@@ -9,6 +9,7 @@
  * faces of the pieces cover both sides of the section (area 1 each). */
 #include "fcm/embed.h"
 #include "test.h"
+#include "dice.h"
 
 static fcm_ctx *ctx;
 
@@ -215,51 +216,16 @@ static void partial_and_face_cut(void)
  * hexes) and as the body, diced by 5 planes normal to x and 5 normal to y: 36 sticks. */
 static void dice(const char *what)
 {
-  static const double cube[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
-                                    {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
-  static const fcm_index five[5][4] = {
-      {0, 1, 3, 4}, {1, 2, 3, 6}, {1, 4, 5, 6}, {3, 4, 6, 7}, {1, 3, 4, 6}};
   const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
-  const fcm_index one[3] = {1, 1, 1}, two[3] = {2, 2, 2};
+  const fcm_index two[3] = {2, 2, 2};
   fcm_mesh *mesh = NULL;
   fcm_geometry *g = NULL;
-  fcm_cell_rules *r = NULL, *next = NULL;
-  if (!strcmp(what, "tet5")) {
-    fcm_index cells[20];
-    for (int t = 0; t < 5; t++) { /* orient positively */
-      const double *a = cube[five[t][0]], *b = cube[five[t][1]], *c = cube[five[t][2]],
-                   *d = cube[five[t][3]];
-      double u[3], v[3], w[3];
-      for (int k = 0; k < 3; k++)
-        u[k] = b[k] - a[k], v[k] = c[k] - a[k], w[k] = d[k] - a[k];
-      const double det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-                         u[2] * (v[0] * w[1] - v[1] * w[0]);
-      for (int k = 0; k < 4; k++)
-        cells[4 * t + k] = five[t][k];
-      if (det < 0) cells[4 * t + 1] = five[t][2], cells[4 * t + 2] = five[t][1];
-    }
-    TEST_OK(ctx, fcm_mesh_create(ctx, FCM_ELEMENT_TET4, 8, &cube[0][0], 5, cells, &mesh));
-  } else {
-    TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi,
-                                     !strcmp(what, "hex1") ? one : two, &mesh));
-  }
+  fcm_cell_rules *r = NULL;
+  TEST_OK(ctx, dice_mesh(ctx, what, &mesh));
   TEST_OK(ctx, fcm_geometry_create_box(ctx, lo, hi, two, &g));
   const fcm_cell_rules_options o = opts();
   TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &o, &r));
-  static const double at[5] = {0.13, 0.31, 0.5, 0.67, 0.86};
-  const double bl[3] = {-0.1, -0.1, -0.1}, bh[3] = {1.1, 1.1, 1.1};
-  for (int k = 0; k < 10 && r; k++) {
-    double p[3] = {0.5, 0.5, 0.5}, nrm[3] = {0, 0, 0};
-    p[k / 5] = at[k % 5];
-    nrm[k / 5] = 1.0;
-    fcm_surface *s = NULL;
-    TEST_OK(ctx, fcm_surface_create_plane(ctx, p, nrm, bl, bh, &s));
-    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, r, s, &next));
-    fcm_surface_destroy(&s);
-    fcm_cell_rules_destroy(&r);
-    r = next;
-    next = NULL;
-  }
+  if (r) TEST_OK(ctx, dice_cuts(ctx, mesh, g, &r));
   if (r) {
     TEST_NEAR(total_volume(r), 1.0, 1e-12, 0);
     const int k = components(mesh, r);

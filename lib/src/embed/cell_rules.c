@@ -1347,26 +1347,35 @@ cleanup:
   return st;
 }
 
+/* The surface points [s0, s1) into the outputs (each may be NULL; NULL pointers and 0 points
+ * when empty or R is NULL). */
+static void surface_range(const fcm_cell_rules *R, fcm_index s0, fcm_index s1, int *num_points,
+                          const double **points, const double **weights, const double **normals,
+                          const fcm_index **triangles)
+{
+  const int n = R ? (int)(s1 - s0) : 0;
+  if (num_points) *num_points = n;
+  if (points) *points = n ? R->spoints + 3 * s0 : NULL;
+  if (weights) *weights = n ? R->sweights + s0 : NULL;
+  if (normals) *normals = n ? R->snormals + 3 * s0 : NULL;
+  if (triangles) *triangles = n ? R->stris + s0 : NULL;
+}
+
 fcm_status fcm_cell_rules_get_surface(const fcm_cell_rules *rules, fcm_index cell, int *num_points,
                                       const double **points, const double **weights,
                                       const double **normals, const fcm_index **triangles)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = rules ? rules->ctx : NULL;
-  int n = 0;
-  fcm_index o0 = 0;
+  fcm_index s0 = 0, s1 = 0;
   FCM_CHECK(rules, ctx, FCM_ERR_ARG, "cell rules: rules is NULL");
   FCM_CHECK(cell >= 0 && cell < rules->num_cells, ctx, FCM_ERR_ARG,
             "cell rules: cell %lld out of range [0,%lld)", (long long)cell,
             (long long)rules->num_cells);
-  o0 = rules->soff[rules->piece_off[cell]];
-  n = (int)(rules->soff[rules->piece_off[cell + 1]] - o0);
+  s0 = rules->soff[rules->piece_off[cell]];
+  s1 = rules->soff[rules->piece_off[cell + 1]];
 cleanup:
-  if (num_points) *num_points = n;
-  if (points) *points = n ? rules->spoints + 3 * o0 : NULL;
-  if (weights) *weights = n ? rules->sweights + o0 : NULL;
-  if (normals) *normals = n ? rules->snormals + 3 * o0 : NULL;
-  if (triangles) *triangles = n ? rules->stris + o0 : NULL;
+  surface_range(rules, s0, s1, num_points, points, weights, normals, triangles);
   return st;
 }
 
@@ -1429,20 +1438,15 @@ fcm_status fcm_cell_rules_get_piece_surface(const fcm_cell_rules *rules, fcm_ind
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = rules ? rules->ctx : NULL;
-  int n = 0;
-  fcm_index o0 = 0;
+  fcm_index s0 = 0, s1 = 0;
   FCM_CHECK(rules, ctx, FCM_ERR_ARG, "cell rules: rules is NULL");
   FCM_CHECK(piece >= 0 && piece < rules->num_pieces, ctx, FCM_ERR_ARG,
             "cell rules: piece %lld out of range [0,%lld)", (long long)piece,
             (long long)rules->num_pieces);
-  o0 = rules->soff[piece];
-  n = (int)(rules->soff[piece + 1] - o0);
+  s0 = rules->soff[piece];
+  s1 = rules->soff[piece + 1];
 cleanup:
-  if (num_points) *num_points = n;
-  if (points) *points = n ? rules->spoints + 3 * o0 : NULL;
-  if (weights) *weights = n ? rules->sweights + o0 : NULL;
-  if (normals) *normals = n ? rules->snormals + 3 * o0 : NULL;
-  if (triangles) *triangles = n ? rules->stris + o0 : NULL;
+  surface_range(rules, s0, s1, num_points, points, weights, normals, triangles);
   return st;
 }
 
