@@ -67,7 +67,8 @@ typedef struct fcm_simulation_counters {
   int cuts_missed;     /**< of them, cuts that missed the body (no cell got a new piece) */
   fcm_index cut_cells; /**< cells integrated again because a cut reached them (summed) */
   fcm_index pieces;    /**< separate bodies now (fcm_space_num_bodies()) */
-  fcm_index surface_points, surface_triangles; /**< embedded surface written per frame */
+  fcm_index surface_points, surface_triangles; /**< the embedded boundary written per frame
+                                                    (without the cut faces) */
   double time_setup, time_steps, time_output;  /**< seconds */
 } fcm_simulation_counters;
 
