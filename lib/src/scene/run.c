@@ -101,6 +101,7 @@ fcm_status fcm__effect_apply_constraint(fcm_simulation *S, const fcm_effect *e)
 {
   fcm_status st = FCM_OK;
   fcm_index *nodes = NULL, n = 0;
+  int id = -1;
   const fcm_region *r = e->type == FCM_EFFECT_FIXED ? &e->fixed.region : &e->motion.region;
   fcm_motion m = fcm_motion_default();
   if (e->type == FCM_EFFECT_FIXED) {
@@ -112,7 +113,13 @@ fcm_status fcm__effect_apply_constraint(fcm_simulation *S, const fcm_effect *e)
   FCM_TRY(S->ctx, region_nodes(S, r, e->index, NULL, &n));
   FCM_ALLOC(S->ctx, n, nodes);
   FCM_TRY(S->ctx, region_nodes(S, r, e->index, nodes, &n));
-  FCM_TRY(S->ctx, fcm_integrator_add_constraint(S->integ, n, nodes, &m, NULL));
+  if (!S->react_effect) {
+    FCM_ALLOC(S->ctx, fcm_scene_num_effects(S->scene), S->react_effect);
+    FCM_ALLOC(S->ctx, fcm_scene_num_effects(S->scene), S->react_id);
+  }
+  FCM_TRY(S->ctx, fcm_integrator_add_constraint(S->integ, n, nodes, &m, &id));
+  S->react_effect[S->num_react] = e->index;
+  S->react_id[S->num_react++] = id;
   S->c.constraints++;
   S->c.constrained_nodes += n;
 cleanup:
@@ -844,7 +851,8 @@ void fcm_simulation_destroy(fcm_simulation **sim)
   fcm_cell_rules_destroy(&S->rules);
   fcm_geometry_destroy(&S->geom);
   fcm_mesh_destroy(&S->mesh);
-  void *arrays[] = {S->log, S->frame_time, S->loads, S->cuts};
+  void *arrays[] = {S->log,          S->frame_time, S->loads,    S->cuts,
+                    S->react_effect, S->react_id,   S->react_log};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(ctx, arrays[k]);
   fcm__free(ctx, S);
@@ -864,6 +872,9 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   /* room for the log row first: a step that is taken is also logged */
   FCM_TRY(S->ctx,
           fcm__sim_grow(S->ctx, (void **)&S->log, &S->log_cap, S->log_n + 1, sizeof *S->log));
+  if (S->num_react > 0)
+    FCM_TRY(S->ctx, fcm__sim_grow(S->ctx, (void **)&S->react_log, &S->react_cap, S->log_n + 1,
+                                  6 * (size_t)S->num_react * sizeof *S->react_log));
   {
     const double t = fcm_integrator_time(S->integ), dt = fcm_scene_get_time(S->scene)->dt;
     while (S->cuts_applied < S->num_cuts && S->cuts[S->cuts_applied]->cut.time <= t + 1e-9 * dt) {
@@ -888,6 +899,10 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
     goto cleanup;
   }
   S->c.steps++;
+  for (int k = 0; k < S->num_react; k++) {
+    double *q = S->react_log + 6 * ((size_t)S->log_n * (size_t)S->num_react + (size_t)k);
+    FCM_TRY(S->ctx, fcm_integrator_reaction(S->integ, S->react_id[k], q, q + 3));
+  }
   fcm__log_row *r = &S->log[S->log_n++];
   r->time = si.time;
   r->newton = si.newton_iterations;
@@ -1010,14 +1025,27 @@ fcm_status fcm_simulation_write_log(fcm_simulation *S, const char *path)
   FCM_TRY(S->ctx, fcm__io_atomic_printf(
                       S->ctx, &af,
                       "step,time,newton_iterations,linear_iterations,residual,energy,pieces,mass,"
-                      "momentum_x,momentum_y,momentum_z,wall_time\n"));
+                      "momentum_x,momentum_y,momentum_z"));
+  for (int k = 0; k < S->num_react; k++) {
+    const int i = S->react_effect[k];
+    FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af,
+                                          ",reaction_%d_x,reaction_%d_y,reaction_%d_z,moment_%d_x,"
+                                          "moment_%d_y,moment_%d_z",
+                                          i, i, i, i, i, i));
+  }
+  FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, ",wall_time\n"));
   for (long long k = 0; k < S->log_n; k++) {
     const fcm__log_row *r = &S->log[k];
     FCM_TRY(S->ctx,
-            fcm__io_atomic_printf(
-                S->ctx, &af, "%lld,%.17g,%lld,%lld,%.17g,%.17g,%lld,%.17g,%.17g,%.17g,%.17g,%.6g\n",
-                k + 1, r->time, r->newton, r->linear, r->residual, r->energy, r->pieces, r->mass,
-                r->momentum[0], r->momentum[1], r->momentum[2], r->wall));
+            fcm__io_atomic_printf(S->ctx, &af,
+                                  "%lld,%.17g,%lld,%lld,%.17g,%.17g,%lld,%.17g,%.17g,%.17g,%.17g",
+                                  k + 1, r->time, r->newton, r->linear, r->residual, r->energy,
+                                  r->pieces, r->mass, r->momentum[0], r->momentum[1],
+                                  r->momentum[2]));
+    for (int j = 0; j < 6 * S->num_react; j++)
+      FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, ",%.17g",
+                                            S->react_log[(size_t)k * 6 * S->num_react + j]));
+    FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, ",%.6g\n", r->wall));
   }
   FCM_TRY(S->ctx, fcm__io_atomic_commit(S->ctx, &af));
 cleanup:
@@ -1030,6 +1058,41 @@ cleanup:
 static void line(FILE *f, int on, const char *what, const char *detail)
 {
   fprintf(f, "  %-9s %-28s %s\n", on ? "computed" : "skipped", what, detail);
+}
+
+/* The largest displacement of the body: over its quadrature points (authentic points of the
+ * stiffness rules) and the embedded-surface points the frames write; beside it, the largest
+ * over the DOF vector, which includes the fictitious nodes outside the body. */
+static void body_displacement_line(const fcm_simulation *S, FILE *f)
+{
+  const double *u = fcm_integrator_displacement(S->integ);
+  const fcm_index n = fcm_integrator_num_dofs(S->integ);
+  double body = 0.0, dofs = 0.0, *d = NULL;
+  if (fcm_space_max_displacement(S->space, u, &body) != FCM_OK) {
+    fcm_ctx_error_clear(S->ctx);
+    return;
+  }
+  fcm_index np = S->surf ? fcm_embedded_surface_num_points(S->surf) : 0;
+  if (np > 0 && (d = fcm__malloc(S->ctx, 3 * (size_t)np, sizeof *d)) != NULL &&
+      fcm_embedded_surface_eval(S->surf, u, d, NULL) == FCM_OK) {
+    for (fcm_index i = 0; i < np; i++)
+      body = FCM_MAX(body, sqrt(d[3 * i] * d[3 * i] + d[3 * i + 1] * d[3 * i + 1] +
+                                d[3 * i + 2] * d[3 * i + 2]));
+  } else {
+    np = 0;
+    fcm_ctx_error_clear(S->ctx);
+  }
+  fcm__free(S->ctx, d);
+  for (fcm_index i = 0; i + 2 < n; i += 3)
+    dofs = FCM_MAX(dofs, sqrt(u[i] * u[i] + u[i + 1] * u[i + 1] + u[i + 2] * u[i + 2]));
+  if (np > 0)
+    fprintf(f,
+            "  body      max |u| %.6g m over the body (its quadrature points and %lld surface "
+            "points); DOF vector, fictitious nodes included: %.6g m\n",
+            body, (long long)np, dofs);
+  else
+    fprintf(f, "  body      max |u| %.6g m over the body's quadrature points; DOF vector: %.6g m\n",
+            body, dofs);
 }
 
 void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
@@ -1124,6 +1187,7 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
   snprintf(b, sizeof b, "%lld frames, surface %lld points %lld triangles", c->frames,
            (long long)c->surface_points, (long long)c->surface_triangles);
   line(f, c->frames > 0, "output", b);
+  body_displacement_line(S, f);
   if (S->free_body) {
     double com[3];
     if (fcm_simulation_center_of_mass(S, com) == FCM_OK) {

@@ -57,6 +57,13 @@ struct fcm_simulation {
   /* log */
   fcm__log_row *log;
   long long log_n, log_cap;
+  /* reactions in the log: the constraint effects (fixed, motion) in effect order, their effect
+   * index and integrator constraint id; per log row 6 x num_react values (force x, y, z,
+   * moment x, y, z; NaN where unknown, e.g. rows of a version-2 checkpoint) */
+  int num_react;
+  int *react_effect, *react_id;
+  double *react_log;
+  long long react_cap;
   /* what the voxel or level-set geometry reported ("" for the other kinds) */
   char geometry_note[256];
 };
