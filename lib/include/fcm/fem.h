@@ -395,7 +395,8 @@ FCM_API fcm_status fcm_space_node_field(const fcm_space *space, const double *do
  * LINEAR model's small-strain stress P itself), von Mises stress
  * sqrt(3/2 s:s) with s the deviator of sigma, and the strain energy density
  * Psi(F) - Psi(I) per unit reference volume. Where J <= 0 (an inverted point) sigma and
- * von Mises are NaN. Any output may be NULL.
+ * von Mises are NaN. Any output may be NULL. At a physical point X: fcm_space_locate() gives
+ * its cell and xi, fcm_space_point_element() the element (the piece, in a cell cuts split).
  * @param[in] mat validated (fcm_material_validate())
  * @return FCM_OK, FCM_ERR_ARG (NULL space or u, element out of range, bad material). No
  * allocation; thread safe. */
