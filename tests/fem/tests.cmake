@@ -29,6 +29,7 @@ foreach(el tet4 tet10 hex8 hex20)
   fcm_add_test(fem_xfem_${el} tests/fem/xfem.c ARGS ${el})
 endforeach()
 fcm_add_test(fem_xfem_dice tests/fem/xfem.c ARGS dice)
+fcm_add_test(fem_xfem_constraint tests/fem/xfem.c ARGS constraint)
 # Output fields: stress, von Mises, energy density of affine fields (analytic, cut cells
 # included), node and surface fields, VTU files at reference positions, cut faces.
 foreach(el tet4 tet10 hex8 hex20)
