@@ -5,7 +5,7 @@
  * per step minus the weight), the frames' stress arrays (cell averages in the background,
  * point values on the surface), the surface at reference positions (every point on the
  * undeformed box's boundary although the beam sags) and the summary's maximum displacement
- * over the body. */
+ * over the body (without embedding: the largest nodal |u|). */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "test.h"
@@ -213,6 +213,24 @@ static void dynamic_block(fcm_ctx *ctx)
     }
   }
   TEST_TRUE(fabs(rows[0][10]) > 1e-3); /* the block moves: inertia is part of it */
+  /* no embedding: the mesh is the body, max |u| includes the nodes */
+  {
+    const double *u = fcm_integrator_displacement(fcm_simulation_integrator(sim));
+    double umax = 0.0;
+    for (fcm_index i = 0; i < fcm_integrator_num_dofs(fcm_simulation_integrator(sim)); i += 3) {
+      const double m = sqrt(u[i] * u[i] + u[i + 1] * u[i + 1] + u[i + 2] * u[i + 2]);
+      umax = m > umax ? m : umax;
+    }
+    char *text = NULL;
+    size_t len = 0;
+    FILE *mf = open_memstream(&text, &len);
+    fcm_simulation_summary_view(sim, mf);
+    fclose(mf);
+    const char *line = text ? strstr(text, "max |u| ") : NULL;
+    TEST_TRUE(line && strstr(line, "its nodes"));
+    if (line) TEST_NEAR(strtod(line + 8, NULL), umax, 1e-5, 0); /* printed with 6 digits */
+    free(text);
+  }
 done:
   fcm_simulation_destroy(&sim);
   fcm_scene_destroy(&scene);

@@ -1071,7 +1071,8 @@ static void line(FILE *f, int on, const char *what, const char *detail)
 
 /* The largest displacement of the body: over its quadrature points (authentic points of the
  * stiffness rules) and the embedded-surface points the frames write; beside it, the largest
- * over the DOF vector, which includes the fictitious nodes outside the body. */
+ * over the DOF vector, which includes the fictitious nodes outside the body. Without an
+ * embedded geometry the mesh is the body: its nodes count too. */
 static void body_displacement_line(const fcm_simulation *S, FILE *f)
 {
   const double *u = fcm_integrator_displacement(S->integ);
@@ -1094,6 +1095,11 @@ static void body_displacement_line(const fcm_simulation *S, FILE *f)
   fcm__free(S->ctx, d);
   for (fcm_index i = 0; i + 2 < n; i += 3)
     dofs = FCM_MAX(dofs, sqrt(u[i] * u[i] + u[i + 1] * u[i + 1] + u[i + 2] * u[i + 2]));
+  if (!S->rules) { /* no embedding: every node is the body's */
+    fprintf(f, "  body      max |u| %.6g m over the body (its nodes and quadrature points)\n",
+            FCM_MAX(body, dofs));
+    return;
+  }
   if (np > 0)
     fprintf(f,
             "  body      max |u| %.6g m over the body (its quadrature points and %lld surface "
