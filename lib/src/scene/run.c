@@ -110,13 +110,13 @@ fcm_status fcm__effect_apply_constraint(fcm_simulation *S, const fcm_effect *e)
   } else {
     m = e->motion.motion;
   }
-  FCM_TRY(S->ctx, region_nodes(S, r, e->index, NULL, &n));
-  FCM_ALLOC(S->ctx, n, nodes);
-  FCM_TRY(S->ctx, region_nodes(S, r, e->index, nodes, &n));
-  if (!S->react_effect) {
+  if (!S->react_effect) { /* the log's reaction columns: one group per constraint effect */
     FCM_ALLOC(S->ctx, fcm_scene_num_effects(S->scene), S->react_effect);
     FCM_ALLOC(S->ctx, fcm_scene_num_effects(S->scene), S->react_id);
   }
+  FCM_TRY(S->ctx, region_nodes(S, r, e->index, NULL, &n));
+  FCM_ALLOC(S->ctx, n, nodes);
+  FCM_TRY(S->ctx, region_nodes(S, r, e->index, nodes, &n));
   FCM_TRY(S->ctx, fcm_integrator_add_constraint(S->integ, n, nodes, &m, &id));
   S->react_effect[S->num_react] = e->index;
   S->react_id[S->num_react++] = id;
