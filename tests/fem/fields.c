@@ -86,7 +86,8 @@ static void analytic(const fcm_material *m, double sig[6], double *vm, double *s
   sig[0] = c[0], sig[1] = c[4], sig[2] = c[8];
   sig[3] = c[1], sig[4] = c[5], sig[5] = c[2];
   const double a = sig[0] - sig[1], b = sig[1] - sig[2], d = sig[2] - sig[0];
-  *vm = sqrt(0.5 * (a * a + b * b + d * d) + 3 * (sig[3] * sig[3] + sig[4] * sig[4] + sig[5] * sig[5]));
+  *vm = sqrt(0.5 * (a * a + b * b + d * d) +
+             3 * (sig[3] * sig[3] + sig[4] * sig[4] + sig[5] * sig[5]));
   *sed = psi;
 }
 
@@ -100,8 +101,8 @@ static double *affine_field(const fcm_space *space)
     const fcm_index d0 = fcm_space_node_dof(space, a);
     for (fcm_index k = 0; d0 >= 0 && k < fcm_space_node_copies(space, a); k++)
       for (int i = 0; i < 3; i++)
-        u[d0 + 3 * k + i] = T[i] + G[3 * i] * X[3 * a] + G[3 * i + 1] * X[3 * a + 1] +
-                            G[3 * i + 2] * X[3 * a + 2];
+        u[d0 + 3 * k + i] =
+            T[i] + G[3 * i] * X[3 * a] + G[3 * i + 1] * X[3 * a + 1] + G[3 * i + 2] * X[3 * a + 2];
   }
   return u;
 }
@@ -193,7 +194,8 @@ static void plain(fcm_element_type type)
   for (fcm_index a = 0; a < nn; a++)
     for (int i = 0; i < 3; i++)
       TEST_NEAR(nf[3 * a + i],
-                T[i] + G[3 * i] * X[3 * a] + G[3 * i + 1] * X[3 * a + 1] + G[3 * i + 2] * X[3 * a + 2],
+                T[i] + G[3 * i] * X[3 * a] + G[3 * i + 1] * X[3 * a + 1] +
+                    G[3 * i + 2] * X[3 * a + 2],
                 0, 1e-14);
   /* a translation: max |u| = |t| */
   double *tr = malloc(sizeof *tr * (size_t)fcm_space_num_dofs(space)), mx = 0.0;
@@ -258,7 +260,8 @@ static void embedded(fcm_element_type type)
   double *u = affine_field(space);
   stress_checks(space, u, es);
   /* the points are the boundary vertices of the geometry, triangle by triangle */
-  const fcm_index np = fcm_embedded_surface_num_points(es), nt = fcm_embedded_surface_num_triangles(es);
+  const fcm_index np = fcm_embedded_surface_num_points(es),
+                  nt = fcm_embedded_surface_num_triangles(es);
   const double *P = fcm_embedded_surface_points(es), *GX = fcm_geometry_coords(ball);
   const fcm_index *tri = fcm_embedded_surface_triangles(es),
                   *gtri = fcm_geometry_boundary_triangles(ball);
@@ -269,8 +272,8 @@ static void embedded(fcm_element_type type)
   TEST_OK(ctx, fcm_embedded_surface_eval(es, u, d, x));
   for (fcm_index i = 0; i < np; i++)
     for (int k = 0; k < 3; k++) {
-      const double ex = T[k] + G[3 * k] * P[3 * i] + G[3 * k + 1] * P[3 * i + 1] +
-                        G[3 * k + 2] * P[3 * i + 2];
+      const double ex =
+          T[k] + G[3 * k] * P[3 * i] + G[3 * k + 1] * P[3 * i + 1] + G[3 * k + 2] * P[3 * i + 2];
       TEST_NEAR(d[3 * i + k], ex, 0, 1e-13);
       TEST_NEAR(x[3 * i + k], P[3 * i + k] + ex, 0, 1e-13);
     }
@@ -407,8 +410,10 @@ static void cut(fcm_element_type type)
     if (!flag[i]) continue;
     TEST_NEAR(P[3 * i], 0.6, 0, 1e-12);
     TEST_TRUE(fabs(fabs(d[3 * i]) - 1.0) < 1e-12);
-    if (d[3 * i] > 0) left++;
-    else right++;
+    if (d[3 * i] > 0)
+      left++;
+    else
+      right++;
   }
   TEST_TRUE(left > 0 && left == right);
   free(u), free(nf), free(d);

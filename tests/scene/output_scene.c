@@ -132,8 +132,8 @@ static void static_hang(fcm_ctx *ctx)
   size_t cnt = 0;
   int comp = 0;
   const fcm_index nc = fcm_mesh_num_cells(mesh);
-  double *sig = read_array("scene_output_frames/hang_background_0000.vtu", "CellData", "stress",
-                           &cnt, &comp);
+  double *sig =
+      read_array("scene_output_frames/hang_background_0000.vtu", "CellData", "stress", &cnt, &comp);
   TEST_TRUE(sig && comp == 6 && cnt == 6 * (size_t)nc);
   free(sig);
   double *vm = read_array("scene_output_frames/hang_background_0000.vtu", "CellData", "von_mises",
@@ -166,8 +166,8 @@ static void static_hang(fcm_ctx *ctx)
   TEST_TRUE(sum == np);
   TEST_TRUE(umax > 1e-4); /* it does sag: the points are not deformed ones */
   free(pts), free(sd);
-  double *svm = read_array("scene_output_frames/hang_surface_0000.vtu", "PointData", "von_mises",
-                           &cnt, NULL);
+  double *svm =
+      read_array("scene_output_frames/hang_surface_0000.vtu", "PointData", "von_mises", &cnt, NULL);
   TEST_TRUE(svm && cnt == np);
   free(svm);
   vr_rmdir("scene_output_frames");

@@ -272,9 +272,9 @@ struct fcm_embedded_surface {
   fcm_ctx *ctx;
   const fcm_space *space;
   const fcm_mesh *mesh; /* of the space (a replaced space may be gone already) */
-  fcm_index nb, nbt; /* boundary vertices and triangles (fixed) */
-  fcm_index np, nt;  /* all points and triangles (with the cut faces) */
-  double *X, *xi;    /* np x 3: reference positions, reference coordinates in the cell */
+  fcm_index nb, nbt;    /* boundary vertices and triangles (fixed) */
+  fcm_index np, nt;     /* all points and triangles (with the cut faces) */
+  double *X, *xi;       /* np x 3: reference positions, reference coordinates in the cell */
   fcm_index *cell, *elem, *tri;
   int32_t *flag;
   fcm_index cap_p, cap_t;
