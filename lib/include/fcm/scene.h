@@ -194,6 +194,10 @@ typedef struct fcm_region {
  * (membership is by node id). No allocation; thread safe. */
 FCM_API int fcm_region_contains(const fcm_region *region, const double x[3]);
 
+/** fcm_region_contains() as an fcm_boundary_select_fn (fcm/sim.h): `region` is a
+ * const fcm_region *; the normal is ignored. For fcm_integrator_add_boundary_constraint(). */
+FCM_API int fcm_region_select(void *region, const double X[3], const double normal[3]);
+
 /* ------------------------------------------------------------------- effects */
 
 /** Effect types, in the order of the one effect table (see fcm_effect_type_name()). */

@@ -267,6 +267,79 @@ FCM_API fcm_status fcm_integrator_add_constraint(fcm_integrator *integ, fcm_inde
                                                  const fcm_index *nodes, const fcm_motion *motion,
                                                  int *id);
 
+/** How a boundary constraint imposes its motion on the embedded boundary. */
+typedef enum fcm_boundary_method {
+  /** Symmetric Nitsche (consistent, optimal convergence): with r = P_c (u - g) the constrained
+   * components of the gap to the prescribed displacement g and t = P(F) N the first Piola
+   * traction on the reference boundary (outward unit normal N), the energy gains
+   * int_Gamma ( -t . r + gamma/2 |r|^2 ) dA. Its gradient is the weak form
+   * -int t . P_c dv - int (dP/dF[grad dv] N) . r + gamma int r . dv (consistency, adjoint
+   * consistency with the linearized traction, penalty), the Newton matrix its exact Hessian
+   * (the term with the third derivative of Psi times r, by central differences of dP/dF;
+   * zero for LINEAR and where u = g). For linear elasticity this is classical symmetric
+   * Nitsche. gamma per element (cell piece): nitsche_safety times the largest eigenvalue of
+   * T v = lambda K v, T = int_Gamma_K |P_c sigma(v) N|^2 (the boundary traction energy of
+   * the element's selected points), K the element's linear-elastic stiffness at rest with
+   * its stabilization points (so gamma stays bounded, by about 1/alpha, on tiny cut cells);
+   * rigid modes (T = K = 0) are left out. safety > 1 makes the energy's Hessian at rest
+   * positive definite on the free modes (coercivity constant 1 - 1/safety). */
+  FCM_BOUNDARY_NITSCHE = 0,
+  /** Penalty: energy gamma/2 int_Gamma |r|^2 with gamma = penalty E / h_K (h_K the cube root
+   * of the cell's volume). Not consistent: the error is O(h/penalty) in the constraint. */
+  FCM_BOUNDARY_PENALTY = 1,
+  FCM_BOUNDARY_METHOD_COUNT
+} fcm_boundary_method;
+
+/** Static name of a method ("nitsche", "penalty"; "invalid" otherwise). */
+FCM_API const char *fcm_boundary_method_name(fcm_boundary_method method);
+
+/** Options of fcm_integrator_add_boundary_constraint(); fcm_boundary_options_default(). */
+typedef struct fcm_boundary_options {
+  fcm_boundary_method method; /**< default FCM_BOUNDARY_NITSCHE */
+  double nitsche_safety;      /**< NITSCHE: gamma = safety x lambda_max, > 1 (default 2) */
+  double penalty;             /**< PENALTY: gamma = penalty E / h, > 0 (default 1e3) */
+} fcm_boundary_options;
+
+/** The defaults listed on each member. */
+FCM_API fcm_boundary_options fcm_boundary_options_default(void);
+
+/** Selects embedded-boundary points: 1 to constrain the point with reference position X and
+ * unit outward normal `normal`, else 0. Called during fcm_integrator_setup() only (serially).
+ * fcm_region_select() of fcm/scene.h adapts an fcm_region. */
+typedef int (*fcm_boundary_select_fn)(void *user, const double X[3], const double normal[3]);
+
+/** Prescribe `motion` weakly on the embedded-boundary points (the surface rules of the space's
+ * cell rules) that `select` picks (NULL: every point): u(X, t) = the motion's displacement
+ * (fcm_motion_eval()) on its constrained components, by Nitsche's method or a penalty
+ * (`opts`, NULL: defaults; see fcm_boundary_method). No DOF is eliminated: the terms join the
+ * energy, the force and the Newton matrix (which stays symmetric, so the direct solver, CG and
+ * MINRES all apply), for static and dynamic integrators. A point several boundary
+ * constraints select belongs to the first. After `end` the constraint holds (or, with
+ * `release`, is dropped). `user` must outlive the setup. Before setup.
+ * @param[out] id the boundary constraint's index (may be NULL)
+ * @return FCM_OK, FCM_ERR_ARG (NULL integrator or motion, bad motion or option: named, after
+ * setup), FCM_ERR_ALLOC. The setup fails with FCM_ERR_ARG when the space has no surface
+ * rules or the constraint selects no point. */
+FCM_API fcm_status fcm_integrator_add_boundary_constraint(fcm_integrator *integ,
+                                                          fcm_boundary_select_fn select,
+                                                          void *user, const fcm_motion *motion,
+                                                          const fcm_boundary_options *opts,
+                                                          int *id);
+
+/** The penalty gamma (Pa/m) of element `elem` (fcm_space_num_elements()) of the boundary
+ * constraints, after setup; 0 for an element without constrained points or out of range. */
+FCM_API double fcm_integrator_boundary_penalty(const fcm_integrator *integ, fcm_index elem);
+
+/** The boundary constraints' part of the energy alone at displacement u and time t (their
+ * motions evaluated at t; released constraints left out): energy, force (added, num_dofs)
+ * and Newton matrix (added; the space's pattern, fcm_space_matrix_create()), each may be
+ * NULL. The force restricted to a constraint's points is the reaction the constraint
+ * exerts, with opposite sign. After setup. Allocates nothing.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, not set up, wrong matrix), FCM_ERR_NUMERIC (the
+ * material gave NaN/Inf). */
+FCM_API fcm_status fcm_integrator_boundary_eval(fcm_integrator *integ, const double *u, double t,
+                                                double *energy, double *force, fcm_csr *tangent);
+
 /** Validate the options, build the constrained DOF list, assemble the mass matrix
  * (BACKWARD_EULER only) and the loads, allocate every work array and solver, and run the symbolic
  * analysis (direct). Constrained DOFs get their prescribed velocity at the current time.
@@ -345,6 +418,9 @@ typedef struct fcm_integrator_setup_info {
   int scale_assemblies;      /**< 1 when a STATIC run with the REPRESENTATIVE rule had to assemble
                                   the body force of rho a_rep for its force scale (no gravity load
                                   equal to a_rep to reuse); else 0 */
+  fcm_index boundary_points; /**< embedded-boundary points the boundary constraints hold */
+  double boundary_penalty_max; /**< largest gamma h_K / E over the elements (dimensionless;
+                                    0 without boundary constraints) */
 } fcm_integrator_setup_info;
 
 /** Copy the setup counts out (zeros for NULL). */

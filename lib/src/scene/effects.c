@@ -33,6 +33,12 @@ int fcm_region_contains(const fcm_region *r, const double x[3])
   }
 }
 
+int fcm_region_select(void *region, const double X[3], const double normal[3])
+{
+  (void)normal;
+  return fcm_region_contains(region, X);
+}
+
 static int cmp_index(const void *a, const void *b)
 {
   fcm_index x = *(const fcm_index *)a, y = *(const fcm_index *)b;

@@ -41,7 +41,7 @@ static fcm_status singular(fcm_integrator *I)
   char msg[1024];
   snprintf(msg, sizeof msg, "%s", fcm_ctx_error_message(ctx));
   fcm_ctx_error_clear(ctx);
-  const int free_static = I->nact == 0 && I->key_h == 0.0;
+  const int free_static = I->nact == 0 && I->bcon_active == 0 && I->key_h == 0.0;
   FCM_CHECK(0, ctx, FCM_ERR_SINGULAR, "integrator: the Newton matrix is singular%s: %s%s%s",
             free_static ? " (static step without any active Dirichlet constraint: the body's "
                           "rigid-body modes are unconstrained)"
@@ -138,6 +138,14 @@ static fcm_status pc_matrix(fcm_integrator *I, fcm_csr **P, fcm_step_reason *rea
     s = fcm_assembly_workspace_hyperelastic(I->aws, &I->params_psd, I->u, NULL, NULL, I->Hpc);
     stats->tangent_assemblies++;
     if (s != FCM_OK) return soft(I, s, reason);
+  }
+  if (I->bcon_active > 0) { /* boundary constraints: their PSD penalty part */
+    int finite = 1;
+    FCM_TRY(ctx, fcm__sim_boundary_assemble(I, I->u, 1, NULL, NULL, I->Hpc, &finite));
+    if (!finite) {
+      *reason = FCM_STEP_NONFINITE;
+      return FCM_OK;
+    }
   }
   /* Eliminate the active constraints as H was (only the matrix matters; nothing allocated). */
   fcm__eliminate_marked(I->Hpc, NULL, I->is_con, NULL);

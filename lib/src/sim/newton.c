@@ -76,12 +76,32 @@ static fcm_status assemble(fcm_integrator *I, const fcm_material_params *p, cons
   return st;
 }
 
+/* The boundary constraints' terms (nitsche.c) at x: energy, force, tangent (projected: the
+ * PSD penalty part only), timed with the assembly. */
+static fcm_status assemble_boundary(fcm_integrator *I, const double *x, int projected,
+                                    double *energy, double *fint, fcm_csr *T, int *finite,
+                                    sim_stats *stats)
+{
+  if (I->bcon_active == 0) return FCM_OK;
+  double t0 = fcm_wtime();
+  fcm_status st = fcm__sim_boundary_assemble(I, x, projected || I->params.project_psd, energy,
+                                             fint, T, finite);
+  stats->time_assembly += fcm_wtime() - t0;
+  if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
+  return st;
+}
+
 /* Tangent at x into H: H = base(h) + K(x), optionally with the PSD-projected material. */
 static fcm_status assemble_tangent(fcm_integrator *I, double h, const double *x, int projected,
                                    int *finite, sim_stats *stats)
 {
+  fcm_status st = FCM_OK;
   fcm__sim_set_base(I, h, I->H);
-  return assemble(I, projected ? &I->params_psd : &I->params, x, NULL, NULL, I->H, finite, stats);
+  FCM_TRY(I->ctx, assemble(I, projected ? &I->params_psd : &I->params, x, NULL, NULL, I->H,
+                           finite, stats));
+  if (*finite) FCM_TRY(I->ctx, assemble_boundary(I, x, projected, NULL, NULL, I->H, finite, stats));
+cleanup:
+  return st;
 }
 
 /* Energy parts at x: E, the internal force fint, the gradient g (n each), the elastic
@@ -97,12 +117,15 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
 {
   fcm_status st = FCM_OK;
   fcm_index n = I->n;
-  double psi = 0.0, inertia = 0.0, damp = 0.0, wext;
+  double psi = 0.0, inertia = 0.0, damp = 0.0, wext, bnd = 0.0;
   out->finite = 1;
   memset(fint, 0, sizeof *fint * (size_t)n);
   if (tangent) fcm__sim_set_base(I, h, I->H);
   FCM_TRY(I->ctx,
           assemble(I, &I->params, x, &psi, fint, tangent ? I->H : NULL, &out->finite, stats));
+  if (!out->finite) return FCM_OK;
+  FCM_TRY(I->ctx, assemble_boundary(I, x, 0, &bnd, fint, tangent ? I->H : NULL, &out->finite,
+                                    stats));
   if (!out->finite) return FCM_OK;
   {
     double t0 = fcm_wtime();
@@ -127,8 +150,8 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
     }
     wext = dot(n, I->fext, x);
     out->psi = psi;
-    out->E = inertia + damp + psi - wext;
-    out->scale = fabs(inertia) + fabs(damp) + fabs(psi) + fabs(wext);
+    out->E = inertia + damp + psi + bnd - wext;
+    out->scale = fabs(inertia) + fabs(damp) + fabs(psi) + fabs(bnd) + fabs(wext);
     out->finite = isfinite(out->E) && all_finite(n, g);
     stats->time_assembly += fcm_wtime() - t0;
   }
