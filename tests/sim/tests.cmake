@@ -46,3 +46,10 @@ fcm_sim_test(sim_step_alloc_static tests/sim/step_alloc.c ARGS minres-schwarz he
 foreach(el tet4 tet10 hex8 hex20)
   fcm_sim_test(sim_cut_${el} tests/sim/cut.c ARGS ${el})
 endforeach()
+# Issue 18: Dirichlet conditions on the embedded boundary (Nitsche, penalty).
+fcm_sim_test(sim_nitsche_patch_hex8 tests/sim/nitsche.c ARGS patch hex8)
+fcm_sim_test(sim_nitsche_patch_tet4 tests/sim/nitsche.c ARGS patch tet4)
+fcm_sim_test(sim_nitsche_tangent tests/sim/nitsche.c ARGS tangent)
+fcm_sim_test(sim_nitsche_penalty tests/sim/nitsche.c ARGS penalty)
+fcm_sim_test(sim_nitsche_solvers tests/sim/nitsche.c ARGS solvers)
+fcm_sim_test(sim_nitsche_errors tests/sim/nitsche.c ARGS errors)
