@@ -298,6 +298,11 @@ typedef struct fcm_boundary_options {
   fcm_boundary_method method; /**< default FCM_BOUNDARY_NITSCHE */
   double nitsche_safety;      /**< NITSCHE: gamma = safety x lambda_max, > 1 (default 2) */
   double penalty;             /**< PENALTY: gamma = penalty E / h, > 0 (default 1e3) */
+  fcm_field_fn displacement;  /**< NULL (default): the motion's displacement; else the prescribed
+                                   displacement g(X) = displacement(user, X, N) at reference
+                                   position X with outward normal N (not time dependent: the
+                                   motion still gives the components and the active window) */
+  void *displacement_user;    /**< passed to displacement; must outlive the integrator */
 } fcm_boundary_options;
 
 /** The defaults listed on each member. */

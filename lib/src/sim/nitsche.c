@@ -422,7 +422,10 @@ static double point_terms(const fcm_integrator *I, fcm_index p, const double *ue
       for (int j = 0; j < 3; j++)
         F[3 * i + j] += ue[3 * a + i] * G[3 * a + j];
     }
-  fcm_motion_eval(&bc->motion, bp->X + 3 * p, I->bc_time, gv, NULL);
+  if (bc->opts.displacement)
+    bc->opts.displacement(bc->opts.displacement_user, bp->X + 3 * p, nv, gv);
+  else
+    fcm_motion_eval(&bc->motion, bp->X + 3 * p, I->bc_time, gv, NULL);
   for (int i = 0; i < 3; i++)
     r[i] = pc[i] ? u[i] - gv[i] : 0.0;
   double energy = 0.5 * gamma * (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
