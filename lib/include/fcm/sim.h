@@ -1,7 +1,8 @@
 /* fcm — time integration of hyperelastic solids on a space (DESIGN §8): static Newton with
  * load steps and backward Euler on the incremental potential, Newton with a backtracking
  * line search on the energy, the stopping rule of Longva et al. (2020) §6, optional Rayleigh
- * damping, prescribed motion of node sets, direct (CHOLMOD -> UMFPACK) or Krylov solves.
+ * damping, prescribed motion of node sets and, weakly (Nitsche's method or a penalty), of the
+ * embedded-boundary points a selector picks, direct (CHOLMOD -> UMFPACK) or Krylov solves.
  *
  * Phases: fcm_integrator_create() -> configure (fcm_integrator_add_*, set_state) ->
  * fcm_integrator_setup() (assembles the mass — dynamics only — and the loads, allocates
@@ -11,6 +12,8 @@
  *   E(u) = 1/2 (u - u^)^T M (u - u^)/h^2 + Psi(u) - f_ext(t_{n+1})^T u
  *          + 1/(2h) (u - u_n)^T D (u - u_n),     u^ = u_n + h v_n,
  *   v_{n+1} = (u_{n+1} - u_n)/h. Its gradient is M v' - f_total (v' = (v_{n+1} - v_n)/h).
+ * Boundary constraints (fcm_integrator_add_boundary_constraint()) add their energy Pi_B(u)
+ * (fcm_boundary_method) to E(u); it is not part of Psi (fcm_step_info.elastic_energy).
  * Rayleigh damping C = alpha_M M + beta_K K is linearized as D = alpha_M M + beta_K K+(u_n):
  * the tangent at the start of the (sub)step, projected to positive semi-definite and held
  * fixed during the step, so the damping force D v_{n+1} derives from the quadratic term above
