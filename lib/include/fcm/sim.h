@@ -334,8 +334,9 @@ FCM_API fcm_status fcm_integrator_add_boundary_constraint(fcm_integrator *integ,
                                                           const fcm_boundary_options *opts,
                                                           int *id);
 
-/** The penalty gamma (Pa/m) of element `elem` (fcm_space_num_elements()) of the boundary
- * constraints, after setup; 0 for an element without constrained points or out of range. */
+/** The largest penalty gamma (Pa/m) the boundary constraints use in element `elem`
+ * (fcm_space_num_elements()): Nitsche's estimate or penalty E / h, after setup; 0 for an
+ * element without constrained points or out of range. */
 FCM_API double fcm_integrator_boundary_penalty(const fcm_integrator *integ, fcm_index elem);
 
 /** The boundary constraints' part of the energy alone at displacement u and time t (their

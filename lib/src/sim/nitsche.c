@@ -93,6 +93,8 @@ cleanup:
   return st;
 }
 
+static double element_max_penalty(const fcm_integrator *I, fcm_index k);
+
 void fcm__sim_boundary_free(fcm_integrator *I)
 {
   fcm_ctx *ctx = I->ctx;
@@ -100,7 +102,7 @@ void fcm__sim_boundary_free(fcm_integrator *I)
   fcm__free(ctx, bp->elem);
   fcm__free(ctx, bp->ptr);
   fcm__free(ctx, bp->con);
-  double **v[] = {&bp->w, &bp->X, &bp->nrm, &bp->N, &bp->G, &bp->gamma, &bp->scratch};
+  double **v[] = {&bp->w, &bp->X, &bp->nrm, &bp->N, &bp->G, &bp->gamma, &bp->hk, &bp->scratch};
   for (size_t k = 0; k < sizeof v / sizeof v[0]; k++)
     FCM_FREE(ctx, *v[k]);
   fcm__free(ctx, I->bcons);
@@ -150,10 +152,11 @@ static void traction_modes(int nn, const double *g, const double *N, const int *
   }
 }
 
-/* Penalty of element e from its points [p0, p1): Nitsche's eigenvalue estimate (or the
- * plain penalty E/h); *hscale = h_K / E for the dimensionless statistic. */
+/* Penalties of element e from its points [p0, p1): Nitsche's eigenvalue estimate over its
+ * Nitsche points (0 when it has none) into *gamma, and the cell size h_K (the penalty method's
+ * gamma is penalty E / h_K) into *hk. */
 static fcm_status element_penalty(fcm_integrator *I, fcm_index e, fcm_index p0, fcm_index p1,
-                                  const fcm_rule *full, double *gamma, double *hscale)
+                                  const fcm_rule *full, double *gamma, double *hk)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = I->ctx;
@@ -184,13 +187,14 @@ static fcm_status element_penalty(fcm_integrator *I, fcm_index e, fcm_index p0, 
              fcm_element_jacobian(s->type, X, fcm_rule_points(full) + 3 * q, J);
     }
   }
-  const double E = I->mat.young, h = cbrt(fabs(vol));
-  *hscale = h / E;
-  const sim_bcon *b0 = &I->bcons[I->bp.con[p0]];
-  if (b0->opts.method == FCM_BOUNDARY_PENALTY) {
-    *gamma = b0->opts.penalty * E / h;
-    goto cleanup;
+  *hk = cbrt(fabs(vol));
+  *gamma = 0.0;
+  double safety = 0.0; /* the largest safety factor of the element's Nitsche points */
+  for (fcm_index p = p0; p < p1; p++) {
+    const sim_bcon *bc = &I->bcons[I->bp.con[p]];
+    if (bc->opts.method == FCM_BOUNDARY_NITSCHE) safety = FCM_MAX(safety, bc->opts.nitsche_safety);
   }
+  if (safety == 0.0) goto cleanup;
   FCM_ALLOC(ctx, (size_t)nd * nd, K);
   FCM_ALLOC(ctx, (size_t)nd * nd, T);
   FCM_ALLOC(ctx, (size_t)3 * nd, C);
@@ -214,6 +218,7 @@ static fcm_status element_penalty(fcm_integrator *I, fcm_index e, fcm_index p0, 
   }
   for (fcm_index p = p0; p < p1; p++) { /* T = sum w C^T C */
     const sim_bcon *bc = &I->bcons[I->bp.con[p]];
+    if (bc->opts.method != FCM_BOUNDARY_NITSCHE) continue;
     traction_modes(nn, I->bp.G + (size_t)p * nd, I->bp.nrm + 3 * p, bc->motion.components, lambda,
                    mu, C);
     for (int x = 0; x < nd; x++)
@@ -278,7 +283,7 @@ static fcm_status element_penalty(fcm_integrator *I, fcm_index e, fcm_index p0, 
     }
     FCM_TRY(ctx, s2);
   }
-  *gamma = b0->opts.nitsche_safety * FCM_MAX(ev[nd - 1], 0.0);
+  *gamma = safety * FCM_MAX(ev[nd - 1], 0.0);
   FCM_CHECK(isfinite(*gamma), ctx, FCM_ERR_NUMERIC,
             "boundary constraint: the Nitsche penalty of cell %lld is not finite", (long long)cell);
 cleanup:
@@ -306,6 +311,7 @@ fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
   FCM_ALLOC(ctx, I->num_bcons, I->bcon_on);
   FCM_ALLOC(ctx, I->num_bcons, count);
   FCM_ALLOC(ctx, s->num_elems + 1, bp->gamma);
+  FCM_ALLOC(ctx, s->num_elems + 1, bp->hk);
   /* count the selected points per element */
   for (int pass = 0; pass < 2; pass++) {
     fcm_index np = 0, ne = 0;
@@ -376,10 +382,11 @@ fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
                                     I->opts.assembly.stiffness_strength, &full));
   I->setup_info.boundary_points = bp->np;
   for (fcm_index k = 0; k < bp->nelem; k++) {
-    double hs = 0.0, gm = 0.0;
-    FCM_TRY(ctx, element_penalty(I, bp->elem[k], bp->ptr[k], bp->ptr[k + 1], full, &gm, &hs));
-    bp->gamma[bp->elem[k]] = gm;
-    I->setup_info.boundary_penalty_max = FCM_MAX(I->setup_info.boundary_penalty_max, gm * hs);
+    const fcm_index e = bp->elem[k];
+    FCM_TRY(ctx, element_penalty(I, e, bp->ptr[k], bp->ptr[k + 1], full, &bp->gamma[e], &bp->hk[e]));
+    I->setup_info.boundary_penalty_max =
+        FCM_MAX(I->setup_info.boundary_penalty_max,
+                element_max_penalty(I, k) * bp->hk[e] / I->mat.young);
   }
 cleanup:
   fcm__free(ctx, count);
@@ -406,7 +413,7 @@ static void scatter(const fcm_space *s, fcm_index e, const double *Ke, double *v
 /* The terms of one point into fe / Ke (either may be NULL); returns its energy, NaN when the
  * material gives NaN/Inf. */
 static double point_terms(const fcm_integrator *I, fcm_index p, const double *ue, int projected,
-                          double gamma, double *fe, double *Ke, double *Q)
+                          fcm_index e, double *fe, double *Ke, double *Q)
 {
   const sim_bpoints *bp = &I->bp;
   const sim_bcon *bc = &I->bcons[bp->con[p]];
@@ -415,6 +422,7 @@ static double point_terms(const fcm_integrator *I, fcm_index p, const double *ue
   const double *N = bp->N + (size_t)p * nn, *G = bp->G + (size_t)p * nd, *nv = bp->nrm + 3 * p;
   const double w = bp->w[p];
   const int nitsche = bc->opts.method == FCM_BOUNDARY_NITSCHE;
+  const double gamma = nitsche ? bp->gamma[e] : bc->opts.penalty * I->mat.young / bp->hk[e];
   double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, u[3] = {0, 0, 0}, gv[3], r[3], P[9], A[81];
   for (int a = 0; a < nn; a++)
     for (int i = 0; i < 3; i++) {
@@ -536,7 +544,7 @@ fcm_status fcm__sim_boundary_assemble(fcm_integrator *I, const double *x, int pr
       if (!I->bcon_on[bp->con[p]]) continue;
       any = 1;
       double ep =
-          point_terms(I, p, ue, projected, bp->gamma[e], force ? fe : NULL, T ? Ke : NULL, Q);
+          point_terms(I, p, ue, projected, e, force ? fe : NULL, T ? Ke : NULL, Q);
       if (!isfinite(ep)) {
         *finite = 0;
         return FCM_OK;
@@ -571,10 +579,33 @@ int fcm__sim_boundary_time(fcm_integrator *I, double t)
   return changed;
 }
 
+/* The largest gamma of the k-th element with points (Nitsche's, or a penalty point's). */
+static double element_max_penalty(const fcm_integrator *I, fcm_index k)
+{
+  const sim_bpoints *bp = &I->bp;
+  const fcm_index e = bp->elem[k];
+  double g = bp->gamma[e];
+  for (fcm_index p = bp->ptr[k]; p < bp->ptr[k + 1]; p++) {
+    const sim_bcon *bc = &I->bcons[bp->con[p]];
+    if (bc->opts.method == FCM_BOUNDARY_PENALTY)
+      g = FCM_MAX(g, bc->opts.penalty * I->mat.young / bp->hk[e]);
+  }
+  return g;
+}
+
 double fcm_integrator_boundary_penalty(const fcm_integrator *I, fcm_index elem)
 {
-  if (!I || !I->is_setup || !I->bp.gamma || elem < 0 || elem >= I->space->num_elems) return 0.0;
-  return I->bp.gamma[elem];
+  if (!I || !I->bp.gamma || elem < 0 || elem >= I->space->num_elems) return 0.0;
+  const sim_bpoints *bp = &I->bp;
+  fcm_index lo = 0, hi = bp->nelem; /* elements with points are sorted */
+  while (lo < hi) {
+    const fcm_index mid = lo + (hi - lo) / 2;
+    if (bp->elem[mid] < elem)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo < bp->nelem && bp->elem[lo] == elem ? element_max_penalty(I, lo) : 0.0;
 }
 
 fcm_status fcm_integrator_boundary_eval(fcm_integrator *I, const double *u, double t,

@@ -42,7 +42,8 @@ typedef struct sim_bpoints {
   double *w;            /* np: area weights */
   double *X, *nrm;      /* np x 3: reference position and unit outward normal */
   double *N, *G;        /* np x nn shape values, np x nn x 3 physical gradients */
-  double *gamma;        /* num_elems: penalty per element (0: no points) */
+  double *gamma;        /* num_elems: Nitsche penalty per element (0: no Nitsche points) */
+  double *hk;           /* num_elems: cell size h_K (cube root of the volume) */
   double *scratch;      /* element buffers: ue, fe (3nn each), Ke ((3nn)^2), Q (9nn) */
 } sim_bpoints;
 
