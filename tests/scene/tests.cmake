@@ -29,3 +29,5 @@ fcm_add_test(scene_geometry_keys tests/scene/geometry_keys.c)
 fcm_add_test(scene_surface tests/scene/surface_scene.c)
 # The cut effect: bodies and mass in the log across cuts, cuts at t = 0, no-op cuts, errors.
 fcm_add_test(scene_cut tests/scene/cut_scene.c)
+# Issue 18: fixed and motion on the embedded boundary (Nitsche) through the scene runner.
+fcm_add_test(scene_boundary tests/scene/boundary_scene.c)
