@@ -312,6 +312,30 @@ static int solve_ball(fcm_ctx *ctx, const problem *p, fcm_integrator_kind kind,
   fcm_step_info info;
   for (int s = 0; s < 2; s++)
     TEST_OK(ctx, fcm_integrator_step(I, &info));
+  if (kind == FCM_INTEGRATOR_STATIC) { /* the reaction balances the weight (force, moment) */
+    const fcm_index n = fcm_integrator_num_dofs(I);
+    const double *X = fcm_mesh_coords(fcm_space_mesh(p->space)), *u = fcm_integrator_displacement(I);
+    double *f = calloc((size_t)n, sizeof *f), W[3] = {0, 0, 0}, MW[3] = {0, 0, 0}, R[3], MR[3];
+    TEST_OK(ctx, fcm_assemble_body_force(p->space, &mat, grav, NULL, f));
+    for (fcm_index a = 0; a < fcm_mesh_num_nodes(fcm_space_mesh(p->space)); a++) {
+      const fcm_index d = fcm_space_node_dof(p->space, a);
+      if (d < 0) continue;
+      const double x[3] = {X[3 * a] + u[d], X[3 * a + 1] + u[d + 1], X[3 * a + 2] + u[d + 2]};
+      for (int i = 0; i < 3; i++)
+        W[i] += f[d + i];
+      MW[0] += x[1] * f[d + 2] - x[2] * f[d + 1];
+      MW[1] += x[2] * f[d] - x[0] * f[d + 2];
+      MW[2] += x[0] * f[d + 1] - x[1] * f[d];
+    }
+    TEST_OK(ctx, fcm_integrator_boundary_reaction(I, 0, R, MR));
+    for (int i = 0; i < 3; i++)
+      TEST_NEAR(R[i], -W[i], 0.0, 1e-6 * fabs(W[2]));
+    /* the moment of the nodal loads about the origin is that of the weight up to the
+     * deformation's O(|u|) shift of the nodal lever arms */
+    for (int i = 0; i < 3; i++)
+      TEST_NEAR(MR[i], -MW[i], 0.0, 1e-3 * fabs(W[2]));
+    free(f);
+  }
   memcpy(u_out, fcm_integrator_displacement(I), sizeof *u_out * (size_t)fcm_integrator_num_dofs(I));
   fcm_integrator_destroy(&I);
   return 0;

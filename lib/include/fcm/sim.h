@@ -339,6 +339,15 @@ FCM_API fcm_status fcm_integrator_add_boundary_constraint(fcm_integrator *integ,
  * element without constrained points or out of range. */
 FCM_API double fcm_integrator_boundary_penalty(const fcm_integrator *integ, fcm_index elem);
 
+/** Reaction of boundary constraint `id` at the current state: the force and the moment about
+ * the origin that it exerts on the body, force = sum over its points of w (P(F) N - gamma r)
+ * (penalty: -w gamma r) and moment = sum of (X + u) x that, with its motion at the current
+ * time (zeros when released). At equilibrium the reactions balance the loads. Either output
+ * may be NULL. After setup. Allocates nothing.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, not set up, id out of range). */
+FCM_API fcm_status fcm_integrator_boundary_reaction(const fcm_integrator *integ, int id,
+                                                    double force[3], double moment[3]);
+
 /** The boundary constraints' part of the energy alone at displacement u and time t (their
  * motions evaluated at t; released constraints left out): energy, force (added, num_dofs)
  * and Newton matrix (added; the space's pattern, fcm_space_matrix_create()), each may be

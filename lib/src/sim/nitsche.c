@@ -638,3 +638,65 @@ fcm_status fcm_integrator_boundary_eval(fcm_integrator *I, const double *u, doub
 cleanup:
   return st;
 }
+
+fcm_status fcm_integrator_boundary_reaction(const fcm_integrator *I, int id, double force[3],
+                                            double moment[3])
+{
+  fcm_status st = FCM_OK;
+  double Fr[3] = {0, 0, 0}, Mr[3] = {0, 0, 0};
+  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
+  FCM_CHECK(I->is_setup, I->ctx, FCM_ERR_ARG, "boundary reaction: the integrator is not set up");
+  FCM_CHECK(id >= 0 && id < I->num_bcons, I->ctx, FCM_ERR_ARG,
+            "boundary reaction: constraint %d out of range [0, %d)", id, I->num_bcons);
+  {
+    const sim_bpoints *bp = &I->bp;
+    const sim_bcon *bc = &I->bcons[id];
+    const fcm_space *s = I->space;
+    const int nn = s->nn, nd = 3 * nn;
+    const int nitsche = bc->opts.method == FCM_BOUNDARY_NITSCHE;
+    if (!fcm_motion_active(&bc->motion, I->t)) goto cleanup;
+    for (fcm_index k = 0; k < bp->nelem; k++) {
+      const fcm_index e = bp->elem[k];
+      const fcm_index *ed = s->elem_dof + e * nn;
+      for (fcm_index p = bp->ptr[k]; p < bp->ptr[k + 1]; p++) {
+        if (bp->con[p] != id) continue;
+        const double *N = bp->N + (size_t)p * nn, *G = bp->G + (size_t)p * nd;
+        const double *X = bp->X + 3 * p, *nv = bp->nrm + 3 * p;
+        const double gamma =
+            nitsche ? bp->gamma[e] : bc->opts.penalty * I->mat.young / bp->hk[e];
+        double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, u[3] = {0, 0, 0}, gv[3], R[3], P[9];
+        for (int a = 0; a < nn; a++)
+          for (int i = 0; i < 3; i++) {
+            const double ua = I->u[ed[a] + i];
+            u[i] += N[a] * ua;
+            for (int j = 0; j < 3; j++)
+              F[3 * i + j] += ua * G[3 * a + j];
+          }
+        if (bc->opts.displacement)
+          bc->opts.displacement(bc->opts.displacement_user, X, nv, gv);
+        else
+          fcm_motion_eval(&bc->motion, X, I->t, gv, NULL);
+        if (nitsche) fcm__material_eval(&I->params, F, NULL, P, NULL);
+        for (int i = 0; i < 3; i++) {
+          const double r = bc->motion.components[i] ? u[i] - gv[i] : 0.0;
+          const double t =
+              nitsche && bc->motion.components[i]
+                  ? P[3 * i] * nv[0] + P[3 * i + 1] * nv[1] + P[3 * i + 2] * nv[2]
+                  : 0.0;
+          R[i] = bp->w[p] * (t - gamma * r);
+          Fr[i] += R[i];
+        }
+        const double x[3] = {X[0] + u[0], X[1] + u[1], X[2] + u[2]};
+        Mr[0] += x[1] * R[2] - x[2] * R[1];
+        Mr[1] += x[2] * R[0] - x[0] * R[2];
+        Mr[2] += x[0] * R[1] - x[1] * R[0];
+      }
+    }
+  }
+cleanup:
+  if (st == FCM_OK) {
+    if (force) memcpy(force, Fr, sizeof Fr);
+    if (moment) memcpy(moment, Mr, sizeof Mr);
+  }
+  return st;
+}
