@@ -358,12 +358,15 @@ FCM_API fcm_status fcm_integrator_boundary_reaction(const fcm_integrator *integ,
 FCM_API fcm_status fcm_integrator_boundary_eval(fcm_integrator *integ, const double *u, double t,
                                                 double *energy, double *force, fcm_csr *tangent);
 
-/** Validate the options, build the constrained DOF list, assemble the mass matrix
- * (BACKWARD_EULER only) and the loads, allocate every work array and solver, and run the symbolic
- * analysis (direct). Constrained DOFs get their prescribed velocity at the current time.
+/** Validate the options, build the constrained DOF list, gather the boundary constraints'
+ * points and estimate their penalties, assemble the mass matrix (BACKWARD_EULER only) and the
+ * loads, allocate every work array and solver, and run the symbolic analysis (direct).
+ * Constrained DOFs get their prescribed velocity at the current time.
  * @return FCM_OK, FCM_ERR_ARG (option out of range: named; DOF constrained twice; zero
- * representative force: set the density or use the relative rule), errors of the assembly
- * and of the solvers, FCM_ERR_ALLOC. Allocates; a second call is FCM_ERR_ARG. */
+ * representative force: set the density or use the relative rule; a boundary constraint on a
+ * space without surface rules, or selecting no point), FCM_ERR_NUMERIC (a Nitsche penalty that
+ * cannot be estimated: a cell stiffness singular beyond rigid modes, the cell named), errors
+ * of the assembly and of the solvers, FCM_ERR_ALLOC. Allocates; a second call is FCM_ERR_ARG. */
 FCM_API fcm_status fcm_integrator_setup(fcm_integrator *integ);
 
 /** Advance by one step of options.dt (static: solve the equilibrium at t + dt, ramping the
