@@ -17,6 +17,9 @@ typedef struct fcm__cut_tri {
   fcm__plane edge[3];
   double lo[3], hi[3];
   int cut;
+  /* edge k (x[k] -> x[k+1]) is shared with a coplanar triangle of the same cut: the two
+   * cover the plane on both sides of it, so it splits nothing and bounds nothing */
+  unsigned char inner[3];
 } fcm__cut_tri;
 
 struct fcm_cell_rules {
@@ -151,10 +154,14 @@ fcm_status fcm__embed_map_tets(fcm_ctx *ctx, const fcm__embed_cell *cell, const 
  * cell plane is kept only when its outward normal agrees with the plane's) and map the
  * triangle rule onto the fan triangles: physical points, area weights, unit normals and
  * triangle ids into ws->spts, ws->sw, ws->snrm, ws->stri (ws->num_spts of them).
- * counts->surface_triangles += clipped triangles kept. */
+ * With parts P (NULL: the whole cell), only the share of `piece`: each clipped polygon is
+ * clipped further by every part of the piece (fcm__embed_clip_to_part), so a boundary
+ * triangle that a cut crosses is split exactly between the pieces on its two sides.
+ * counts->surface_triangles += clipped triangles kept (per piece when P is given). */
 fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
                                    const fcm_aabb_tree *tri_tree, const fcm__embed_cell *cell,
-                                   double sliver_rtol, const fcm_rule *tri_rule, fcm__embed_ws *ws,
+                                   const struct fcm__parts *P, int piece, double sliver_rtol,
+                                   const fcm_rule *tri_rule, fcm__embed_ws *ws,
                                    fcm__embed_counts *counts);
 
 /* ---------------------------------------------------------------- cutting (pieces.c) */
@@ -162,7 +169,12 @@ fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
 /* Prepare triangle (a, b, c); 0 when it has no area (relative 1e-14 of its longest edge
  * squared): such a triangle separates nothing and is skipped. */
 int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double c[3], int cut,
-                             fcm__cut_tri *t);
+                             const unsigned char inner[3], fcm__cut_tri *t);
+
+/* For each edge of the cut surface's triangles (3 per triangle, edge k from vertex k to
+ * k + 1), whether exactly one other triangle shares it and lies in the same plane (unit
+ * normals parallel to 1e-12, planes within 1e-12 of the longer edge). */
+fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsigned char *inner);
 
 /* Convex parts of the embedded geometry inside one background cell and the material piece
  * of each: the clipped embedded cells, split by the cut triangles that reach the cell. */
@@ -210,9 +222,12 @@ fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
 fcm_status fcm__embed_piece_tets(fcm_ctx *ctx, const fcm__parts *P, const int *label, int piece,
                                  fcm__embed_ws *ws, fcm__embed_counts *counts, double *volume);
 
-/* The piece whose parts contain the physical point x (the part with the smallest largest
- * signed distance to its face planes). */
-int fcm__embed_point_piece(const fcm__parts *P, const double x[3]);
+/* Clip the polygon x (n vertices, capacity cap, work: cap x 3 doubles) lying on the
+ * embedded boundary (outward unit normal nrm) to part i of P: by each of the part's face
+ * planes, a polygon flat on a face kept when the face's outward normal agrees with nrm.
+ * Returns the new vertex count (< 3: nothing of it on the part), -1 on overflow. */
+int fcm__embed_clip_to_part(const fcm__parts *P, size_t i, double *x, int n, int cap,
+                            const double nrm[3], double *work);
 
 /* The faces of `piece`'s parts that lie on a cut triangle (the piece's side of the cuts),
  * fan-triangulated with their outward orientation: *tri (allocated, 9 doubles = 3 physical
@@ -229,9 +244,12 @@ fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, f
 double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
                           const double nb_normal[3], double tol, double centroid[3]);
 
-/* 1 when the point x lies on one of the cut triangles tris[ids[0 .. n)] within `tol`. */
-int fcm__embed_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n, const double x[3],
-                      double tol);
+/* 1 when the polygon x (m vertices; m = 1: a point) lies on the cuts tris[ids[0 .. n)]:
+ * every vertex and the vertex centroid lie on one of the triangles within `tol`. A face
+ * that the splitting (same tolerance) put on a cut passes; a face with one vertex off the
+ * cuts does not, however thin it is. */
+int fcm__embed_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n, const double *x,
+                      int m, double tol);
 
 /* The embedding diagnostics of the statistics S (geometry, embedded and sliver volumes
  * already set): bounding boxes, volume ratio, the volume outside the mesh and beyond each
