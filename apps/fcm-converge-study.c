@@ -4,7 +4,9 @@
  * Manufactured problem (DESIGN §11's advice): on the polyhedral domain Omega (the tet mesh
  * of the hemisphere) the exact field is u_i = A_i sin(k_i . x + phi_i); the body force is
  * b = -div sigma(u), the traction on the curved boundary sigma(u) n with n the facet
- * normal, and u = u_exact at every background node on y = 0 (the flat face lies there).
+ * normal (or, method fcm-nitsche, u = u_exact on the curved boundary imposed weakly by
+ * symmetric Nitsche through the library's boundary constraints), and u = u_exact at every
+ * background node on y = 0 (the flat face lies there).
  * Reference problem (the authors' setup, Longva et al. 2020 §6.6 and the reference
  * implementation notes): body load -5e5 y exp(-1/(1 - 9 r^2)) e_y for 3 r < 1, u = 0 on
  * y = 0, traction free; the reference is boundary-conforming Tet10 on the geometry's own

@@ -5,7 +5,8 @@
  * Study: static linear elasticity on a tet-meshed hemisphere (radius 0.9, flat face on
  * y = 0) in the background box [-1,1] x [0,1] x [-1,1] with h = 1/res, for Tet4, Tet10,
  * Hex8 and Hex20 grids; a manufactured solution makes the exact error known (see
- * fcm-converge-study.c), or --reference runs the authors' localized-load problem against a
+ * fcm-converge-study.c; the curved boundary carries its traction or, with --boundary nitsche,
+ * its displacement imposed by symmetric Nitsche), or --reference runs the authors' localized-load problem against a
  * boundary-conforming Tet10 reference. `payoff` measures, per element and rule kind, the
  * simplification time and the assembly time it saves: the break-even number of assemblies. */
 #include "app_env.h"
@@ -298,6 +299,9 @@ static void usage(FILE *f, const cli_option *opts)
          "force -div sigma(u); FCM traction sigma(u) n on the embedded boundary (facet normals);\n"
          "the FEM knows only its staircase boundary and receives the true surface load there\n"
          "(--fem-traction); body force b(x) on all kept cells; u = u_exact on all nodes on y = 0.\n"
+         "With --boundary nitsche, FCM imposes u = u_exact weakly on the curved boundary instead\n"
+         "of the traction (symmetric Nitsche, fcm_integrator_add_boundary_constraint()); its\n"
+         "rows carry the method name fcm-nitsche.\n"
          "Errors: ||u_h - u||_L2 and |u_h - u|_H1 with strength-8 rules of the polyhedron on the\n"
          "same grid (FCM: all of Omega, dropped cells extrapolated from a face neighbour; FEM:\n"
          "Omega inside the kept cells - column 'meas' is that volume / |Omega|).\n"
