@@ -285,7 +285,11 @@ typedef enum fcm_boundary_method {
    * the element's selected points), K the element's linear-elastic stiffness at rest with
    * its stabilization points (so gamma stays bounded, by about 1/alpha, on tiny cut cells);
    * rigid modes (T = K = 0) are left out. safety > 1 makes the energy's Hessian at rest
-   * positive definite on the free modes (coercivity constant 1 - 1/safety). */
+   * positive definite on the free modes (coercivity constant 1 - 1/safety). Far from rest
+   * (strains of order 1) the estimate at rest may no longer bound the energy from below and
+   * Newton can fail: raise nitsche_safety (10 to 20) or use the penalty. A Newton matrix made
+   * singular there is retried with the penalty part of the boundary terms only, then with
+   * halved steps. */
   FCM_BOUNDARY_NITSCHE = 0,
   /** Penalty: energy gamma/2 int_Gamma |r|^2 with gamma = penalty E / h_K (h_K the cube root
    * of the cell's volume). Not consistent: the error is O(h/penalty) in the constraint. */

@@ -52,6 +52,24 @@ cleanup:
   return st;
 }
 
+/* singular() unless boundary constraints are active on a nonlinear material: far from rest
+ * their energy (penalty estimated at rest) can make the Newton matrix singular, a soft failure
+ * that the Newton loop retries with their PSD penalty part and the step with halving. */
+static fcm_status singular_or_retry(fcm_integrator *I, fcm_step_reason *reason)
+{
+  if (I->bcon_active > 0 && !I->linear) {
+    fcm__log(I->ctx, FCM_LOG_WARNING,
+             "integrator: t = %g: the Newton matrix with boundary constraints is singular (%s); "
+             "retrying (should it persist at large strains: raise nitsche_safety, or use the "
+             "penalty method)",
+             I->t, fcm_ctx_error_message(I->ctx));
+    fcm_ctx_error_clear(I->ctx);
+    *reason = FCM_STEP_LINEAR_SOLVER_FAILED;
+    return FCM_OK;
+  }
+  return singular(I);
+}
+
 static fcm_status factor_direct(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
 {
   fcm_status st = FCM_OK, s;
@@ -69,7 +87,7 @@ static fcm_status factor_direct(fcm_integrator *I, fcm_step_reason *reason, sim_
     if (s != FCM_ERR_SINGULAR) return soft(I, s, reason);
     fcm_direct_info di;
     fcm_direct_get_info(I->chol, &di);
-    if (di.failed_column < 0) return singular(I); /* factor completed, rank deficient */
+    if (di.failed_column < 0) return singular_or_retry(I, reason); /* rank deficient */
     /* Not positive definite: LU with partial pivoting on the same matrix. */
     stats->direct_fallbacks++;
     I->total_fallbacks++;
@@ -92,7 +110,7 @@ static fcm_status factor_direct(fcm_integrator *I, fcm_step_reason *reason, sim_
   }
   /* LU with partial pivoting met a zero or rounding-level pivot: no shorter step changes
    * the rank (mass and constraints stay), so stop with the reason. */
-  if (s == FCM_ERR_SINGULAR) return singular(I);
+  if (s == FCM_ERR_SINGULAR) return singular_or_retry(I, reason);
   return soft(I, s, reason);
 cleanup:
   return st;
@@ -225,7 +243,7 @@ fcm_status fcm__sim_solve(fcm_integrator *I, const double *b, double *d, fcm_ste
     FCM_CHECK(I->direct, ctx, FCM_ERR_INTERNAL, "integrator: no valid factorization to solve with");
     s = fcm_direct_solve(I->direct, b, d);
     if (s == FCM_ERR_SINGULAR) {
-      st = singular(I);
+      st = singular_or_retry(I, reason);
       goto cleanup;
     }
     FCM_TRY(ctx, s);

@@ -84,8 +84,8 @@ static fcm_status assemble_boundary(fcm_integrator *I, const double *x, int proj
 {
   if (I->bcon_active == 0) return FCM_OK;
   double t0 = fcm_wtime();
-  fcm_status st = fcm__sim_boundary_assemble(I, x, projected || I->params.project_psd, energy,
-                                             fint, T, finite);
+  fcm_status st = fcm__sim_boundary_assemble(
+      I, x, projected || I->params.project_psd || (T && I->bc_psd_only), energy, fint, T, finite);
   stats->time_assembly += fcm_wtime() - t0;
   if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
   return st;
@@ -302,13 +302,30 @@ static fcm_status newton_direction(fcm_integrator *I, double h, int predictor, d
                                    int *its, fcm_step_reason *reason, sim_stats *stats)
 {
   fcm_status st = FCM_OK;
+  int projected = 0;
   FCM_TRY(I->ctx, build_system(I, h, predictor, 0, reason, stats));
-  if (*reason != FCM_STEP_NONE) goto cleanup;
-  FCM_TRY(I->ctx, direction(I, predictor, reason, its, stats));
+  if (*reason == FCM_STEP_NONE) FCM_TRY(I->ctx, direction(I, predictor, reason, its, stats));
+  if (*reason == FCM_STEP_LINEAR_SOLVER_FAILED && I->bcon_active > 0 && !I->opts.project_psd) {
+    /* Boundary constraints: far from rest the exact Hessian of the Nitsche terms (penalty
+     * estimated at rest) may make the Newton matrix singular; retry with their PSD penalty
+     * part only (the material's exact tangent kept, as with node constraints). */
+    int its2 = 0;
+    projected = 1;
+    *reason = FCM_STEP_NONE;
+    stats->projection_fallbacks++;
+    I->bc_psd_only = 1;
+    I->h_state = SIM_H_INVALID;
+    st = build_system(I, h, predictor, 0, reason, stats);
+    if (st == FCM_OK && *reason == FCM_STEP_NONE) st = direction(I, predictor, reason, &its2, stats);
+    I->bc_psd_only = 0;
+    I->h_state = SIM_H_INVALID;
+    FCM_TRY(I->ctx, st);
+    *its += its2;
+  }
   if (*reason != FCM_STEP_NONE) goto cleanup;
   *slope = dot(I->n, I->g, I->d);
   if (predictor || *slope < 0.0) goto cleanup;
-  if (!I->opts.project_psd) {
+  if (!I->opts.project_psd && !projected) {
     int its2 = 0;
     stats->projection_fallbacks++;
     FCM_TRY(I->ctx, build_system(I, h, 0, 1, reason, stats));

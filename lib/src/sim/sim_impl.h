@@ -78,6 +78,7 @@ struct fcm_integrator {
   unsigned char *bcon_on; /* num_bcons: active at bc_time */
   int bcon_active;        /* how many are */
   double bc_time;         /* time their motions are evaluated at */
+  int bc_psd_only;        /* 1: their tangent is the PSD penalty part (Newton's retry) */
 
   /* state */
   double *u, *v;
