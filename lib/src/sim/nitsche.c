@@ -472,24 +472,34 @@ static double point_terms(const fcm_integrator *I, fcm_index p, const double *ue
     }
   }
   if (Ke && !projected) {
-    /* Q_i(b,k) = A_iJkL N_J g_bL */
+    /* Q_i(b,k) = B_ikL g_bL with B_ikL = A_iJkL N_J */
+    double B[27];
     for (int i = 0; i < 3; i++)
-      for (int b = 0; b < nn; b++)
+      for (int k = 0; k < 3; k++)
+        for (int L = 0; L < 3; L++)
+          B[9 * i + 3 * k + L] = A[9 * (3 * i) + 3 * k + L] * nv[0] +
+                                 A[9 * (3 * i + 1) + 3 * k + L] * nv[1] +
+                                 A[9 * (3 * i + 2) + 3 * k + L] * nv[2];
+    for (int i = 0; i < 3; i++)
+      for (int b = 0; b < nn; b++) {
+        const double *gb = G + 3 * b;
         for (int k = 0; k < 3; k++) {
-          double q = 0.0;
-          for (int J = 0; J < 3; J++)
-            for (int L = 0; L < 3; L++)
-              q += A[9 * (3 * i + J) + 3 * k + L] * nv[J] * G[3 * b + L];
-          Q[i * nd + 3 * b + k] = q;
+          const double *Bk = B + 9 * i + 3 * k;
+          Q[i * nd + 3 * b + k] = Bk[0] * gb[0] + Bk[1] * gb[1] + Bk[2] * gb[2];
         }
-    for (int x = 0; x < nd; x++) {
-      const int a = x / 3, i = x % 3;
-      for (int y = 0; y < nd; y++) {
-        const int b = y / 3, k = y % 3;
-        Ke[(size_t)x * nd + y] -=
-            w * ((pc[i] ? N[a] * Q[i * nd + y] : 0.0) + (pc[k] ? N[b] * Q[k * nd + x] : 0.0));
       }
-    }
+    /* Ke -= w (V Q + Q^T V^T), V_(a,i),i = p_i N_a */
+    for (int a = 0; a < nn; a++)
+      for (int i = 0; i < 3; i++) {
+        if (!pc[i]) continue;
+        const double c = w * N[a];
+        const double *Qi = Q + i * nd;
+        double *row = Ke + (size_t)(3 * a + i) * nd;
+        for (int y = 0; y < nd; y++) {
+          row[y] -= c * Qi[y];
+          Ke[(size_t)y * nd + 3 * a + i] -= c * Qi[y];
+        }
+      }
     const double rn = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
     if (!I->linear && rn > 0.0) {
       /* dA along D = r (x) N by central differences, step h along D/|D| (|N| = 1) */
@@ -504,20 +514,23 @@ static double point_terms(const fcm_integrator *I, fcm_index p, const double *ue
       fcm__material_eval(&I->params, Fp, NULL, NULL, Ap);
       fcm__material_eval(&I->params, Fm, NULL, NULL, Am);
       const double sc = w * rn / (2.0 * hstep);
-      for (int a = 0; a < nn; a++)
-        for (int b = 0; b < nn; b++) {
-          const double *ga = G + 3 * a, *gb = G + 3 * b;
-          for (int i = 0; i < 3; i++)
-            for (int k = 0; k < 3; k++) {
-              double v = 0.0;
-              for (int J = 0; J < 3; J++)
-                for (int L = 0; L < 3; L++) {
-                  const int m = 9 * (3 * i + J) + 3 * k + L;
-                  v += (Ap[m] - Am[m]) * ga[J] * gb[L];
-                }
-              Ke[(size_t)(3 * a + i) * nd + 3 * b + k] -= sc * v;
-            }
+      for (int m = 0; m < 81; m++)
+        Ap[m] = sc * (Ap[m] - Am[m]);
+      /* C[i][J][k] = dA_iJkL g_bL, then Ke_(a,i)(b,k) -= g_aJ C[i][J][k] */
+      for (int b = 0; b < nn; b++) {
+        const double *gb = G + 3 * b;
+        double C[27];
+        for (int m = 0; m < 27; m++)
+          C[m] = Ap[3 * m] * gb[0] + Ap[3 * m + 1] * gb[1] + Ap[3 * m + 2] * gb[2];
+        for (int a = 0; a < nn; a++) {
+          const double *ga = G + 3 * a;
+          for (int i = 0; i < 3; i++) {
+            double *row = Ke + (size_t)(3 * a + i) * nd + 3 * b;
+            for (int k = 0; k < 3; k++)
+              row[k] -= ga[0] * C[9 * i + k] + ga[1] * C[9 * i + 3 + k] + ga[2] * C[9 * i + 6 + k];
+          }
         }
+      }
     }
   }
   return w * energy;
