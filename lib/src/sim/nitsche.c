@@ -19,6 +19,7 @@
 #include "material/material_impl.h"
 
 #include <math.h>
+#include <omp.h>
 #include <string.h>
 
 const char *fcm_boundary_method_name(fcm_boundary_method method)
@@ -102,7 +103,9 @@ void fcm__sim_boundary_free(fcm_integrator *I)
   fcm__free(ctx, bp->elem);
   fcm__free(ctx, bp->ptr);
   fcm__free(ctx, bp->con);
-  double **v[] = {&bp->w, &bp->X, &bp->nrm, &bp->N, &bp->G, &bp->gamma, &bp->hk, &bp->scratch};
+  fcm__free(ctx, bp->color_ptr);
+  fcm__free(ctx, bp->color_k);
+  double **v[] = {&bp->w, &bp->X, &bp->nrm, &bp->N, &bp->G, &bp->gamma, &bp->hk, &bp->scratch, &bp->eelem};
   for (size_t k = 0; k < sizeof v / sizeof v[0]; k++)
     FCM_FREE(ctx, *v[k]);
   fcm__free(ctx, I->bcons);
@@ -301,7 +304,7 @@ fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
   fcm_ctx *ctx = I->ctx;
   const fcm_space *s = I->space;
   sim_bpoints *bp = &I->bp;
-  fcm_index *count = NULL;
+  fcm_index *count = NULL, *ecol = NULL;
   fcm_rule *full = NULL;
   const int nn = s->nn, nd = 3 * nn;
   if (I->num_bcons == 0) return FCM_OK;
@@ -371,11 +374,30 @@ fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
       FCM_ALLOC(ctx, 3 * (size_t)np, bp->nrm);
       FCM_ALLOC(ctx, (size_t)np * nn, bp->N);
       FCM_ALLOC(ctx, (size_t)np * nd, bp->G);
-      FCM_ALLOC(ctx, (size_t)nd * (nd + 2) + 9 * (size_t)nn, bp->scratch);
+      bp->nthreads = FCM_MAX(omp_get_max_threads(), 1);
+      FCM_ALLOC(ctx, ((size_t)nd * (nd + 2) + 9 * (size_t)nn) * (size_t)bp->nthreads, bp->scratch);
+      FCM_ALLOC(ctx, ne + 1, bp->eelem);
     } else {
       bp->ptr[ne] = np;
     }
   }
+  /* the elements with points grouped by the space's colours (parallel assembly) */
+  FCM_ALLOC(ctx, s->num_elems + 1, ecol);
+  for (int c = 0; c < s->num_colors; c++)
+    for (fcm_index j = s->color_ptr[c]; j < s->color_ptr[c + 1]; j++)
+      ecol[s->color_elems[j]] = c;
+  bp->num_colors = s->num_colors;
+  FCM_ALLOC(ctx, (size_t)s->num_colors + 1, bp->color_ptr);
+  FCM_ALLOC(ctx, (size_t)bp->nelem + 1, bp->color_k);
+  for (fcm_index k = 0; k < bp->nelem; k++)
+    bp->color_ptr[ecol[bp->elem[k]] + 1]++;
+  for (int c = 0; c < s->num_colors; c++)
+    bp->color_ptr[c + 1] += bp->color_ptr[c];
+  for (fcm_index k = 0; k < bp->nelem; k++) /* ascending k within a colour */
+    bp->color_k[bp->color_ptr[ecol[bp->elem[k]]]++] = k;
+  for (int c = s->num_colors; c > 0; c--)
+    bp->color_ptr[c] = bp->color_ptr[c - 1];
+  bp->color_ptr[0] = 0;
   /* penalties */
   FCM_TRY(ctx,
           fcm_element_standard_rule(ctx, s->type, FCM_RULE_STIFFNESS,
@@ -390,6 +412,7 @@ fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
   }
 cleanup:
   fcm__free(ctx, count);
+  fcm__free(ctx, ecol);
   fcm_rule_destroy(&full);
   return st;
 }
@@ -542,35 +565,46 @@ fcm_status fcm__sim_boundary_assemble(fcm_integrator *I, const double *x, int pr
   const fcm_space *s = I->space;
   const sim_bpoints *bp = &I->bp;
   const int nn = s->nn, nd = 3 * nn;
-  double *ue = bp->scratch, *fe = ue + nd, *Ke = fe + nd, *Q = Ke + (size_t)nd * nd;
+  const size_t per = (size_t)nd * (nd + 2) + 9 * (size_t)nn;
   double *vals = T ? fcm_csr_values(T) : NULL, etot = 0.0;
   if (I->bcon_active == 0) return FCM_OK;
-  for (fcm_index k = 0; k < bp->nelem; k++) {
-    const fcm_index e = bp->elem[k];
-    const fcm_index *ed = s->elem_dof + e * nn;
-    for (int a = 0; a < nn; a++)
-      memcpy(ue + 3 * a, x + ed[a], 3 * sizeof(double));
-    if (force) memset(fe, 0, sizeof(double) * (size_t)nd);
-    if (T) memset(Ke, 0, sizeof(double) * (size_t)nd * nd);
-    int any = 0;
-    for (fcm_index p = bp->ptr[k]; p < bp->ptr[k + 1]; p++) {
-      if (!I->bcon_on[bp->con[p]]) continue;
-      any = 1;
-      double ep =
-          point_terms(I, p, ue, projected, e, force ? fe : NULL, T ? Ke : NULL, Q);
-      if (!isfinite(ep)) {
-        *finite = 0;
-        return FCM_OK;
+  /* colour by colour (no two elements of a colour share a DOF copy), in parallel within a
+   * colour; energies summed in element order: the result does not depend on the threads */
+  for (int c = 0; c < bp->num_colors; c++) {
+    const fcm_index j0 = bp->color_ptr[c], j1 = bp->color_ptr[c + 1];
+    if (j0 == j1) continue;
+#pragma omp parallel num_threads(bp->nthreads) if (j1 - j0 > 1)
+    {
+      double *ue = bp->scratch + per * (size_t)omp_get_thread_num(), *fe = ue + nd;
+      double *Ke = fe + nd, *Q = Ke + (size_t)nd * nd;
+#pragma omp for schedule(dynamic, 4)
+      for (fcm_index j = j0; j < j1; j++) {
+        const fcm_index k = bp->color_k[j], e = bp->elem[k];
+        const fcm_index *ed = s->elem_dof + e * nn;
+        double ek = 0.0;
+        int any = 0;
+        for (int a = 0; a < nn; a++)
+          memcpy(ue + 3 * a, x + ed[a], 3 * sizeof(double));
+        if (force) memset(fe, 0, sizeof(double) * (size_t)nd);
+        if (T) memset(Ke, 0, sizeof(double) * (size_t)nd * nd);
+        for (fcm_index p = bp->ptr[k]; p < bp->ptr[k + 1]; p++) {
+          if (!I->bcon_on[bp->con[p]]) continue;
+          any = 1;
+          ek += point_terms(I, p, ue, projected, e, force ? fe : NULL, T ? Ke : NULL, Q);
+        }
+        bp->eelem[k] = ek;
+        if (!any || !isfinite(ek)) continue;
+        if (force)
+          for (int a = 0; a < nn; a++)
+            for (int i = 0; i < 3; i++)
+              force[ed[a] + i] += fe[3 * a + i];
+        if (T) scatter(s, e, Ke, vals);
       }
-      etot += ep;
     }
-    if (!any) continue;
-    if (force)
-      for (int a = 0; a < nn; a++)
-        for (int i = 0; i < 3; i++)
-          force[ed[a] + i] += fe[3 * a + i];
-    if (T) scatter(s, e, Ke, vals);
   }
+  for (fcm_index k = 0; k < bp->nelem; k++)
+    etot += bp->eelem[k];
+  if (!isfinite(etot)) *finite = 0;
   if (energy) *energy += etot;
   if (force)
     for (fcm_index i = 0; i < I->n; i++)
