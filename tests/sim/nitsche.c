@@ -5,7 +5,8 @@
  *   rigid            a finite rigid motion imposed on the whole boundary of a Stable
  *                    Neo-Hookean ball (Nitsche, penalty) is the static solution at every node
  *   tangent          symmetric Newton matrix of the boundary terms, and finite differences
- *                    of energy -> force -> tangent (Stable Neo-Hookean, u != g on the boundary)
+ *                    of energy -> force -> tangent (Stable Neo-Hookean, u != g on the boundary);
+ *                    energy and force bitwise the same with one thread
  *   penalty          the penalty estimate of a cut cell stays bounded as its volume fraction
  *                    goes to 0 with stabilization, and grows like 1/phi without
  *   solvers          a hanging ball clamped on a curved cap: direct, CG and MINRES (Jacobi,
@@ -16,6 +17,7 @@
 #include "test.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -204,6 +206,8 @@ static int tangent(fcm_ctx *ctx)
     u[i] = 0.02 * ((double)rand() / RAND_MAX - 0.5);
     d[i] = (double)rand() / RAND_MAX - 0.5;
   }
+  double *u0 = malloc(sizeof *u0 * (size_t)n); /* the evaluation point, kept bit for bit */
+  memcpy(u0, u, sizeof *u0 * (size_t)n);
   TEST_OK(ctx, fcm_space_matrix_create(p.space, &T));
   double e0 = 0.0, ep = 0.0, em = 0.0, t = 1.0;
   TEST_OK(ctx, fcm_integrator_boundary_eval(I, u, t, &e0, f0, T));
@@ -232,7 +236,28 @@ static int tangent(fcm_ctx *ctx)
   if (!(sqrt(num) <= 1e-6 * sqrt(den)))
     TEST_FAIL_("tangent: |dF/du d - T d| / |T d| = %.3g", sqrt(num / den));
   TEST_TRUE(den > 0.0);
-  free(u), free(d), free(f0), free(fp), free(fm), free(Td);
+  /* the same with one thread: bitwise equal (colour-parallel, energies summed in order) */
+  {
+    fcm_integrator *I1 = NULL;
+    const int threads = omp_get_max_threads();
+    double e1 = 0.0, *f1 = calloc((size_t)n, sizeof *f1);
+    omp_set_num_threads(1);
+    TEST_OK(ctx, fcm_integrator_create(ctx, p.space, &mat, &o, &I1));
+    TEST_OK(ctx, fcm_integrator_add_boundary_constraint(I1, below, &zcut, &m, NULL, NULL));
+    TEST_OK(ctx, fcm_integrator_setup(I1));
+    TEST_OK(ctx, fcm_integrator_boundary_eval(I1, u0, t, &e1, f1, NULL));
+    omp_set_num_threads(threads);
+    TEST_TRUE(e1 == e0);
+    for (fcm_index i = 0; i < n; i++)
+      if (f1[i] != f0[i]) {
+        TEST_FAIL_("force[%lld] %.17g with one thread, %.17g with %d", (long long)i, f1[i], f0[i],
+                   threads);
+        break;
+      }
+    free(f1);
+    fcm_integrator_destroy(&I1);
+  }
+  free(u), free(u0), free(d), free(f0), free(fp), free(fm), free(Td);
   fcm_csr_destroy(&T);
   fcm_integrator_destroy(&I);
   problem_free(&p);
