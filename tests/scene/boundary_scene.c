@@ -13,15 +13,18 @@
 
 static const char bar_json[] =
     "{\"version\": 1, \"name\": \"nitsche_bar\","
-    " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0], \"max\": [2, 0.5, 0.5]},"
+    " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0], \"max\": [2, 0.5, "
+    "0.5]},"
     "   \"cells\": [8, 2, 2]},"
     " \"geometry\": {\"shape\": \"box\", \"min\": [0.07, 0.06, 0.08], \"max\": [1.93, 0.41, 0.44],"
     "   \"cells\": [4, 1, 1]},"
     " \"material\": {\"model\": \"linear\", \"young\": 1e6, \"poisson\": 0.3, \"density\": 1000},"
     " \"time\": {\"static\": true, \"steps\": 1, \"dt\": 1},"
     " \"effects\": ["
-    "  {\"fixed\": {\"boundary\": {\"half_space\": {\"point\": [0.08, 0, 0], \"normal\": [-1, 0, 0]}}}},"
-    "  {\"motion\": {\"boundary\": {\"half_space\": {\"point\": [1.92, 0, 0], \"normal\": [1, 0, 0]}},"
+    "  {\"fixed\": {\"boundary\": {\"half_space\": {\"point\": [0.08, 0, 0], \"normal\": [-1, 0, "
+    "0]}}}},"
+    "  {\"motion\": {\"boundary\": {\"half_space\": {\"point\": [1.92, 0, 0], \"normal\": [1, 0, "
+    "0]}},"
     "    \"velocity\": [0.01, 0, 0]}}]}";
 
 static const char no_geometry_json[] =

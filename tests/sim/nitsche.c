@@ -339,7 +339,8 @@ static int solve_ball(fcm_ctx *ctx, const problem *p, fcm_integrator_kind kind,
     TEST_OK(ctx, fcm_integrator_step(I, &info));
   if (kind == FCM_INTEGRATOR_STATIC) { /* the reaction balances the weight (force, moment) */
     const fcm_index n = fcm_integrator_num_dofs(I);
-    const double *X = fcm_mesh_coords(fcm_space_mesh(p->space)), *u = fcm_integrator_displacement(I);
+    const double *X = fcm_mesh_coords(fcm_space_mesh(p->space)),
+                 *u = fcm_integrator_displacement(I);
     double *f = calloc((size_t)n, sizeof *f), W[3] = {0, 0, 0}, MW[3] = {0, 0, 0}, R[3], MR[3];
     TEST_OK(ctx, fcm_assemble_body_force(p->space, &mat, grav, NULL, f));
     for (fcm_index a = 0; a < fcm_mesh_num_nodes(fcm_space_mesh(p->space)); a++) {

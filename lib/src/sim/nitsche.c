@@ -86,8 +86,8 @@ fcm_status fcm_integrator_add_boundary_constraint(fcm_integrator *I, fcm_boundar
             b.opts.nitsche_safety);
   FCM_CHECK(b.opts.penalty > 0.0 && isfinite(b.opts.penalty), ctx, FCM_ERR_ARG,
             "boundary constraint %d: penalty = %g must be finite and > 0", k, b.opts.penalty);
-  FCM_TRY(ctx, fcm__resize(ctx, (void **)&I->bcons, (size_t)I->num_bcons,
-                           (size_t)I->num_bcons + 1, sizeof *I->bcons));
+  FCM_TRY(ctx, fcm__resize(ctx, (void **)&I->bcons, (size_t)I->num_bcons, (size_t)I->num_bcons + 1,
+                           sizeof *I->bcons));
   I->bcons[I->num_bcons++] = b;
   if (id) *id = k;
 cleanup:
@@ -105,7 +105,8 @@ void fcm__sim_boundary_free(fcm_integrator *I)
   fcm__free(ctx, bp->con);
   fcm__free(ctx, bp->color_ptr);
   fcm__free(ctx, bp->color_k);
-  double **v[] = {&bp->w, &bp->X, &bp->nrm, &bp->N, &bp->G, &bp->gamma, &bp->hk, &bp->scratch, &bp->eelem};
+  double **v[] = {&bp->w,     &bp->X,  &bp->nrm,     &bp->N,    &bp->G,
+                  &bp->gamma, &bp->hk, &bp->scratch, &bp->eelem};
   for (size_t k = 0; k < sizeof v / sizeof v[0]; k++)
     FCM_FREE(ctx, *v[k]);
   fcm__free(ctx, I->bcons);
@@ -174,8 +175,8 @@ static fcm_status element_penalty(fcm_integrator *I, fcm_index e, fcm_index p0, 
   int nq = 0;
   const double *pts = NULL, *wts = NULL;
   if (s->rules && fcm_cell_rules_class(s->rules, cell) != FCM_CELL_UNCUT) {
-    FCM_TRY(ctx, fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], FCM_RULE_STIFFNESS, &nq,
-                                          &pts, &wts, NULL));
+    FCM_TRY(ctx, fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], FCM_RULE_STIFFNESS, &nq, &pts,
+                                          &wts, NULL));
   } else {
     nq = fcm_rule_num_points(full);
     pts = fcm_rule_points(full);
@@ -226,8 +227,8 @@ static fcm_status element_penalty(fcm_integrator *I, fcm_index e, fcm_index p0, 
                    mu, C);
     for (int x = 0; x < nd; x++)
       for (int y = 0; y < nd; y++)
-        T[(size_t)x * nd + y] += I->bp.w[p] * (C[x] * C[y] + C[nd + x] * C[nd + y] +
-                                               C[2 * nd + x] * C[2 * nd + y]);
+        T[(size_t)x * nd + y] +=
+            I->bp.w[p] * (C[x] * C[y] + C[nd + x] * C[nd + y] + C[2 * nd + x] * C[2 * nd + y]);
   }
   /* Rigid modes (translations, rotations about the centroid), orthonormalized; K and T
    * vanish on them, so B = K + s R R^T is positive definite and has the same eigenvalues
@@ -343,8 +344,8 @@ fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
           memcpy(bp->N + (size_t)np * nn, N, sizeof(double) * (size_t)nn);
           double det = gradients(s->type, nn, X, pts + 3 * q, bp->G + (size_t)np * nd);
           FCM_CHECK(det > 0.0, ctx, FCM_ERR_GEOMETRY,
-                    "boundary constraint %d: cell %lld has det J = %g <= 0 at a boundary point",
-                    k, (long long)s->elem_cell[e], det);
+                    "boundary constraint %d: cell %lld has det J = %g <= 0 at a boundary point", k,
+                    (long long)s->elem_cell[e], det);
         } else {
           count[k]++;
         }
@@ -399,16 +400,15 @@ fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
     bp->color_ptr[c] = bp->color_ptr[c - 1];
   bp->color_ptr[0] = 0;
   /* penalties */
-  FCM_TRY(ctx,
-          fcm_element_standard_rule(ctx, s->type, FCM_RULE_STIFFNESS,
-                                    I->opts.assembly.stiffness_strength, &full));
+  FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, FCM_RULE_STIFFNESS,
+                                         I->opts.assembly.stiffness_strength, &full));
   I->setup_info.boundary_points = bp->np;
   for (fcm_index k = 0; k < bp->nelem; k++) {
     const fcm_index e = bp->elem[k];
-    FCM_TRY(ctx, element_penalty(I, e, bp->ptr[k], bp->ptr[k + 1], full, &bp->gamma[e], &bp->hk[e]));
-    I->setup_info.boundary_penalty_max =
-        FCM_MAX(I->setup_info.boundary_penalty_max,
-                element_max_penalty(I, k) * bp->hk[e] / I->mat.young);
+    FCM_TRY(ctx,
+            element_penalty(I, e, bp->ptr[k], bp->ptr[k + 1], full, &bp->gamma[e], &bp->hk[e]));
+    I->setup_info.boundary_penalty_max = FCM_MAX(
+        I->setup_info.boundary_penalty_max, element_max_penalty(I, k) * bp->hk[e] / I->mat.young);
   }
 cleanup:
   fcm__free(ctx, count);
@@ -709,8 +709,7 @@ fcm_status fcm_integrator_boundary_reaction(const fcm_integrator *I, int id, dou
         if (bp->con[p] != id) continue;
         const double *N = bp->N + (size_t)p * nn, *G = bp->G + (size_t)p * nd;
         const double *X = bp->X + 3 * p, *nv = bp->nrm + 3 * p;
-        const double gamma =
-            nitsche ? bp->gamma[e] : bc->opts.penalty * I->mat.young / bp->hk[e];
+        const double gamma = nitsche ? bp->gamma[e] : bc->opts.penalty * I->mat.young / bp->hk[e];
         double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, u[3] = {0, 0, 0}, gv[3], R[3], P[9];
         for (int a = 0; a < nn; a++)
           for (int i = 0; i < 3; i++) {
@@ -726,10 +725,9 @@ fcm_status fcm_integrator_boundary_reaction(const fcm_integrator *I, int id, dou
         if (nitsche) fcm__material_eval(&I->params, F, NULL, P, NULL);
         for (int i = 0; i < 3; i++) {
           const double r = bc->motion.components[i] ? u[i] - gv[i] : 0.0;
-          const double t =
-              nitsche && bc->motion.components[i]
-                  ? P[3 * i] * nv[0] + P[3 * i + 1] * nv[1] + P[3 * i + 2] * nv[2]
-                  : 0.0;
+          const double t = nitsche && bc->motion.components[i]
+                               ? P[3 * i] * nv[0] + P[3 * i + 1] * nv[1] + P[3 * i + 2] * nv[2]
+                               : 0.0;
           R[i] = bp->w[p] * (t - gamma * r);
           Fr[i] += R[i];
         }
