@@ -329,9 +329,9 @@ typedef int (*fcm_boundary_select_fn)(void *user, const double X[3], const doubl
  * constraints select belongs to the first. After `end` the constraint holds (or, with
  * `release`, is dropped). `user` must outlive the setup. Before setup.
  * @param[out] id the boundary constraint's index (may be NULL)
- * @return FCM_OK, FCM_ERR_ARG (NULL integrator or motion, bad motion or option: named, after
- * setup), FCM_ERR_ALLOC. The setup fails with FCM_ERR_ARG when the space has no surface
- * rules or the constraint selects no point. */
+ * @return FCM_OK, FCM_ERR_ARG (NULL integrator or motion; a bad motion or option, named;
+ * called after setup), FCM_ERR_ALLOC. The setup fails with FCM_ERR_ARG when the space has no
+ * surface rules or the constraint selects no point. */
 FCM_API fcm_status fcm_integrator_add_boundary_constraint(fcm_integrator *integ,
                                                           fcm_boundary_select_fn select,
                                                           void *user, const fcm_motion *motion,
@@ -355,8 +355,9 @@ FCM_API fcm_status fcm_integrator_boundary_reaction(const fcm_integrator *integ,
 /** The boundary constraints' part of the energy alone at displacement u and time t (their
  * motions evaluated at t; released constraints left out): energy, force (added, num_dofs)
  * and Newton matrix (added; the space's pattern, fcm_space_matrix_create()), each may be
- * NULL. The force restricted to a constraint's points is the reaction the constraint
- * exerts, with opposite sign. After setup. Allocates nothing.
+ * NULL. Summed over the DOFs of each component the force is minus the total reaction
+ * (fcm_integrator_boundary_reaction(): the partition of unity cancels the gradient terms).
+ * After setup. Allocates nothing.
  * @return FCM_OK, FCM_ERR_ARG (NULL, not set up, wrong matrix), FCM_ERR_NUMERIC (the
  * material gave NaN/Inf). */
 FCM_API fcm_status fcm_integrator_boundary_eval(fcm_integrator *integ, const double *u, double t,
