@@ -1,7 +1,9 @@
 /* Boundary constraints on the embedded boundary (Nitsche, penalty): modes by argument.
  *   patch <element>  an affine displacement imposed by Nitsche on the whole boundary of an
  *                    embedded box is reproduced exactly (linear elasticity, no stabilization:
- *                    its O(alpha) term is not consistent with a non-zero stress)
+ *                    its O(alpha) term is not consistent with a non-zero stress); so is a
+ *                    stretch imposed on the normal component of each face only (rollers:
+ *                    component masks, a prescribed displacement field)
  *   rigid            a finite rigid motion imposed on the whole boundary of a Stable
  *                    Neo-Hookean ball (Nitsche, penalty) is the static solution at every node
  *   tangent          symmetric Newton matrix of the boundary terms, and finite differences
@@ -64,6 +66,24 @@ static fcm_integrator_options static_options(void)
   return o;
 }
 
+/* u = (a x, b y, c z), user = (a, b, c). */
+static void stretch_field(void *user, const double x[3], const double n[3], double u[3])
+{
+  const double *s = user;
+  (void)n;
+  for (int i = 0; i < 3; i++)
+    u[i] = s[i] * x[i];
+}
+
+/* Points whose normal is +-e_d, user = &d. */
+static int facing(void *user, const double X[3], const double n[3])
+{
+  (void)X;
+  return fabs(n[*(const int *)user]) > 0.99;
+}
+
+static const int axes[3] = {0, 1, 2};
+
 static int patch(fcm_ctx *ctx, fcm_element_type type)
 {
   problem p = {ctx, NULL, NULL, NULL, NULL};
@@ -105,6 +125,35 @@ static int patch(fcm_ctx *ctx, fcm_element_type type)
     fcm_integrator_get_setup_info(I, &si);
     TEST_TRUE(si.boundary_points > 0);
     TEST_TRUE(si.boundary_penalty_max > 0.0 && isfinite(si.boundary_penalty_max));
+  }
+  fcm_integrator_destroy(&I);
+  /* rollers: the normal component of the stretch u = (a x, b y, c z) only, on each face
+   * (constraint d holds component d on the faces with normal +-e_d; the stretch's stress is
+   * diagonal, so the free tangential components are traction free): the stretch again */
+  static const double stretch[3] = {0.01, -0.02, 0.015};
+  TEST_OK(ctx, fcm_integrator_create(ctx, p.space, &mat, &o, &I));
+  for (int d = 0; d < 3; d++) {
+    fcm_motion md = fcm_motion_default();
+    fcm_boundary_options bo = fcm_boundary_options_default();
+    md.components[0] = md.components[1] = md.components[2] = 0;
+    md.components[d] = 1;
+    bo.displacement = stretch_field;
+    bo.displacement_user = (void *)stretch;
+    TEST_OK(ctx,
+            fcm_integrator_add_boundary_constraint(I, facing, (void *)&axes[d], &md, &bo, NULL));
+  }
+  TEST_OK(ctx, fcm_integrator_setup(I));
+  TEST_OK(ctx, fcm_integrator_step(I, &info));
+  {
+    const double *u = fcm_integrator_displacement(I), *X = fcm_mesh_coords(p.mesh);
+    double err = 0.0;
+    for (fcm_index a = 0; a < fcm_mesh_num_nodes(p.mesh); a++) {
+      fcm_index d = fcm_space_node_dof(p.space, a);
+      if (d < 0) continue;
+      for (int i = 0; i < 3; i++)
+        err = fmax(err, fabs(u[d + i] - stretch[i] * X[3 * a + i]));
+    }
+    if (!(err <= 1e-10 * 0.02)) TEST_FAIL_("patch, rollers: max nodal error %.3g", err);
   }
   fcm_integrator_destroy(&I);
   problem_free(&p);
