@@ -172,8 +172,9 @@ int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double 
                              const unsigned char inner[3], fcm__cut_tri *t);
 
 /* For each edge of the cut surface's triangles (3 per triangle, edge k from vertex k to
- * k + 1), whether exactly one other triangle shares it and lies in the same plane (unit
- * normals parallel to 1e-12, planes within 1e-12 of the longer edge). */
+ * k + 1), whether exactly one other triangle shares it and lies in the same plane (the
+ * smaller triangle's far vertex within 1e-12 of the longest edge from the larger one's
+ * plane) on the other side of the edge. */
 fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsigned char *inner);
 
 /* Convex parts of the embedded geometry inside one background cell and the material piece

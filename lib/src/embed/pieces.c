@@ -125,23 +125,26 @@ fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsi
     if (i + 2 < 3 * (size_t)nt && E[i + 2].a == E[i].a && E[i + 2].b == E[i].b) continue;
     if (i > 0 && E[i - 1].a == E[i].a && E[i - 1].b == E[i].b) continue;
     const fcm_index s = E[i].slot / 3, r = E[i + 1].slot / 3;
-    double ns[3], nr[3], ds, dr, l2 = 0.0;
-    if (!tri_plane(x, tv, s, ns, &ds) || !tri_plane(x, tv, r, nr, &dr)) continue;
-    for (int k = 0; k < 3; k++)
-      l2 += (x[3 * E[i].a + k] - x[3 * E[i].b + k]) * (x[3 * E[i].a + k] - x[3 * E[i].b + k]);
-    const double c = dot3(ns, nr), sg = c < 0.0 ? -1.0 : 1.0;
-    if (fabs(c) < 1.0 - 1e-12 || fabs(ds - sg * dr) > 1e-12 * sqrt(l2)) continue;
-    /* the two far vertices on opposite sides of the edge (not a fold) */
+    /* coplanar: the other triangle's far vertex on the plane of the larger triangle (whose
+     * normal rounding disturbs least; a sliver's normal may be off by far more than 1e-12),
+     * within 1e-12 of the longest edge; and the two far vertices on opposite sides of the
+     * shared edge (not a fold) */
     const fcm_index fs = tv[3 * s + (E[i].slot % 3 + 2) % 3],
                     fr = tv[3 * r + (E[i + 1].slot % 3 + 2) % 3];
-    double e[3], ps[3], pr[3], cs[3], cr[3];
+    double ns[3], nr[3], ds, dr, e[3], ps[3], pr[3], cs[3], cr[3], lmax = 0.0;
+    if (!tri_plane(x, tv, s, ns, &ds) || !tri_plane(x, tv, r, nr, &dr)) continue;
     for (int k = 0; k < 3; k++) {
       e[k] = x[3 * E[i].b + k] - x[3 * E[i].a + k];
       ps[k] = x[3 * fs + k] - x[3 * E[i].a + k], pr[k] = x[3 * fr + k] - x[3 * E[i].a + k];
     }
     cross3(e, ps, cs);
     cross3(e, pr, cr);
-    if (!(dot3(cs, ns) * dot3(cr, ns) < 0.0)) continue;
+    lmax = fmax(sqrt(dot3(e, e)), fmax(sqrt(dot3(ps, ps)), sqrt(dot3(pr, pr))));
+    const int s_ref = dot3(cs, cs) >= dot3(cr, cr);
+    const double *nref = s_ref ? ns : nr, dref = s_ref ? ds : dr;
+    const double *far = x + 3 * (s_ref ? fr : fs);
+    if (fabs(dot3(nref, far) - dref) > 1e-12 * lmax) continue;
+    if (!(dot3(cs, nref) * dot3(cr, nref) < 0.0)) continue;
     inner[E[i].slot] = inner[E[i + 1].slot] = 1;
   }
 cleanup:
