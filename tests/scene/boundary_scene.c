@@ -2,14 +2,17 @@
  * its left end face and pulled 1 cm at its right end face, both by Nitsche's method on the
  * boundary points in half-spaces, static linear: surface rules are built for them, no node is
  * constrained, and the displacement on the two faces meets the prescribed values (weakly:
- * within 1 % of the pull); a scene without a geometry is refused, naming the effect. */
+ * within 1 % of the pull), and the log's reactions of the two cancel and match E A eps; a
+ * scene without a geometry is refused, naming the effect. */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "test.h"
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static const char bar_json[] =
     "{\"version\": 1, \"name\": \"nitsche_bar\","
@@ -79,6 +82,41 @@ int main(void)
       TEST_NEAR(sum[1][0] / area[1], 0.01, 1e-2, 0.0);
       /* pointwise within 5 % of the pull: the condition is weak, not interpolated */
       TEST_TRUE(worst[0] < 5e-4 && worst[1] < 5e-4);
+    }
+    /* the log's reaction columns of the two boundary constraints: no load, so they cancel;
+     * the pull is about E A eps (A = 0.35 x 0.36, eps = 0.01 / 1.86; clamped ends stiffen it
+     * a little through Poisson's ratio) */
+    char path[] = "/tmp/fcm_boundary_logXXXXXX", line[4096];
+    const int fd = mkstemp(path);
+    TEST_TRUE(fd >= 0);
+    if (fd >= 0) {
+      close(fd);
+      TEST_OK(ctx, fcm_simulation_write_log(sim, path));
+      FILE *f = fopen(path, "r");
+      TEST_TRUE(f != NULL);
+      if (f) {
+        int col[2] = {-1, -1}, k = 0;
+        double rx[2] = {0, 0};
+        if (fgets(line, sizeof line, f))
+          for (char *tok = strtok(line, ",\n"); tok; tok = strtok(NULL, ",\n"), k++) {
+            if (!strcmp(tok, "reaction_0_x")) col[0] = k;
+            if (!strcmp(tok, "reaction_1_x")) col[1] = k;
+          }
+        TEST_TRUE(col[0] >= 0 && col[1] >= 0);
+        if (fgets(line, sizeof line, f)) {
+          k = 0;
+          for (char *tok = strtok(line, ",\n"); tok; tok = strtok(NULL, ",\n"), k++)
+            for (int j = 0; j < 2; j++)
+              if (k == col[j]) rx[j] = atof(tok);
+        }
+        fclose(f);
+        const double pull = 1e6 * 0.35 * 0.36 * 0.01 / 1.86;
+        TEST_NEAR(rx[0] + rx[1], 0.0, 0.0, 1e-6 * pull);
+        if (!(rx[1] > 0.9 * pull && rx[1] < 1.3 * pull))
+          fprintf(stderr, "reactions %g %g, E A eps %g\n", rx[0], rx[1], pull);
+        TEST_TRUE(rx[1] > 0.9 * pull && rx[1] < 1.3 * pull); /* on the body at the pulled end: +x */
+      }
+      remove(path);
     }
   }
   fcm_simulation_destroy(&sim);
