@@ -12,6 +12,7 @@
 #include "fcm/material.h"
 #include "fcm/io.h"
 #include "fcm/mesh.h"
+#include "fcm/mg.h"
 #include "fcm/quad.h"
 #include "fcm/rulegen.h"
 #include "fcm/sim.h"

@@ -1,0 +1,133 @@
+/* fcm — cut-aware geometric multigrid for Hex8 box grids (Dick, Georgii, Westermann 2011):
+ * 2x2x2 blocks of cells are merged, one coarse cell per connected component of the block's
+ * elements, so material that the fine space separates (disjoint bodies, cuts) is never merged;
+ * coarse DOFs are duplicated per component. Trilinear prolongation per component, restriction
+ * its transpose, Galerkin coarse matrices P^T A P, a CHOLMOD solve on the coarsest level,
+ * symmetric Gauss-Seidel or damped Jacobi smoothing. Use it as a solver (fcm_mg_solve()) or as
+ * the preconditioner of fcm_krylov_cg() (fcm_mg_operator()). */
+#ifndef FCM_MG_H
+#define FCM_MG_H
+
+#include "fcm/core.h"
+#include "fcm/fem.h"
+#include "fcm/la.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** The smoother of every level but the coarsest. */
+typedef enum fcm_mg_smoother {
+  /** Symmetric Gauss-Seidel (SSOR with omega): a forward then a backward sweep in row order;
+   * sequential, so bitwise independent of the thread count. */
+  FCM_MG_SMOOTHER_SGS = 0,
+  /** Damped Jacobi x += omega D^{-1} (b - A x); rows in parallel, deterministic. */
+  FCM_MG_SMOOTHER_JACOBI = 1,
+  FCM_MG_SMOOTHER_COUNT
+} fcm_mg_smoother;
+
+/** Options of fcm_mg_create(); initialize with fcm_mg_options_default(). */
+typedef struct fcm_mg_options {
+  fcm_mg_smoother smoother; /**< default FCM_MG_SMOOTHER_SGS */
+  double omega;             /**< relaxation: SGS in (0, 2), Jacobi in (0, 1]; default 1.0 for
+                                 SGS (set 0.6 for Jacobi) */
+  int pre_smooth;           /**< smoothing steps before the coarse correction, >= 0 (default 1;
+                                 one SGS step is a forward and a backward sweep) */
+  int post_smooth;          /**< after it, >= 0 (default 1); pre = post keeps the cycle
+                                 symmetric (needed as a CG preconditioner) */
+  int max_levels;           /**< levels including the finest, >= 1 (default 20) */
+  fcm_index coarse_dofs;    /**< stop coarsening once a level has at most this many DOFs,
+                                 >= 1 (default 2000); that level is solved by CHOLMOD */
+} fcm_mg_options;
+
+/** Defaults as documented on each member. */
+FCM_API fcm_mg_options fcm_mg_options_default(void);
+
+/** A multigrid hierarchy and its operators for one matrix pattern. */
+typedef struct fcm_mg fcm_mg;
+
+/** Build the hierarchy of `space` and the operators of `A`.
+ * The space must live on a structured Hex8 box grid (fcm_mesh_create_box(): every cell an
+ * axis-aligned box of one size at an integer grid position); any cell counts, dropped cells
+ * and cut (XFEM) pieces are allowed. Level 0 is the space itself: its elements (pieces) and
+ * DOF copies. Two elements of face-neighbouring cells are connected when they use the same
+ * copy at a node of the common face and, where cuts reach either cell, the cell rules link
+ * their pieces (fcm_cell_rules_links()); coarse cells are the connected components of the
+ * elements (cells) of each 2x2x2 block, and coarse cells are connected when some of their
+ * fine cells are. A coarse cell has its own copy at each of its 8 corners; two coarse cells
+ * share a corner's copy when a fine copy that interpolates from that corner is used by fine
+ * elements of both, so the coarse space separates exactly what the fine one separates
+ * (two bodies never share a coarse DOF) and the prolongation is single valued.
+ * Rows of A whose off-diagonal entries are all zero (DOFs eliminated by
+ * fcm_space_apply_dirichlet()) are left out of the coarse spaces: their prolongation rows
+ * are zero, and a coarse DOF whose coinciding fine DOFs are all eliminated is dropped.
+ * @param[in]  ctx   context; must outlive the object
+ * @param[in]  space borrowed: must outlive the object
+ * @param[in]  A     symmetric positive definite, the space's pattern (fcm_space_matrix_create());
+ *                   borrowed: must outlive the object, values read by this call and by
+ *                   fcm_mg_setup(), applied in every cycle
+ * @param[in]  opts  copied; NULL for defaults
+ * @param[out] mg    the new object, NULL on failure
+ * @return FCM_OK, FCM_ERR_ARG (NULL, option out of range, A not the space's size),
+ * FCM_ERR_UNSUPPORTED (not a Hex8 box grid: the message names the cell), FCM_ERR_SINGULAR /
+ * FCM_ERR_NUMERIC (the coarsest factorization, a zero diagonal), FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
+                                 const fcm_mg_options *opts, fcm_mg **mg);
+
+/** New values of the same A (same pattern, same eliminated rows): recompute the Galerkin
+ * matrices and the coarsest factorization. @return FCM_OK, FCM_ERR_ARG (NULL, other size, a
+ * different set of eliminated rows), the factorization's errors. No allocation but CHOLMOD's. */
+FCM_API fcm_status fcm_mg_setup(fcm_mg *mg);
+
+/** Destroy; accepts NULL and `*mg == NULL`, sets `*mg = NULL`. */
+FCM_API void fcm_mg_destroy(fcm_mg **mg);
+
+/** One cycle for A x = b from the guess in x (updated in place); b and x have num_dofs
+ * entries and must not overlap. @return FCM_OK, FCM_ERR_ARG, the coarsest solve's errors.
+ * No allocation (CHOLMOD's first solve allocates its workspace). Not thread safe on one
+ * object; bitwise independent of the thread count. */
+FCM_API fcm_status fcm_mg_cycle(fcm_mg *mg, const double *b, double *x);
+
+/** Preconditioner callback (fcm_operator_fn of fcm/solve.h): z = one cycle from z = 0 for
+ * the right-hand side r; `user` is an fcm_mg. Symmetric positive definite when pre_smooth =
+ * post_smooth, so fit for fcm_krylov_cg(). */
+FCM_API fcm_status fcm_mg_operator(void *user, const double *r, double *z);
+
+/** What fcm_mg_solve() did. */
+typedef struct fcm_mg_solve_info {
+  int cycles;                /**< cycles performed */
+  int converged;             /**< 1 when ||b - A x|| <= rtol ||b|| */
+  double relative_residual;  /**< ||b - A x||_2 / ||b||_2 at exit (0 when b = 0) */
+  double convergence_factor; /**< (r_k / r_1)^(1/(k-1)): the mean residual reduction per cycle
+                                  after the first (the first, from an arbitrary guess, is
+                                  not typical); 0 with fewer than 2 cycles */
+} fcm_mg_solve_info;
+
+/** Cycles from the guess in x until ||b - A x||_2 <= rtol ||b||_2 or max_cycles.
+ * @return FCM_OK (converged), FCM_ERR_NOT_CONVERGED, FCM_ERR_NUMERIC (NaN residual),
+ * FCM_ERR_ARG (NULL, rtol < 0, max_cycles < 0). info may be NULL. */
+FCM_API fcm_status fcm_mg_solve(fcm_mg *mg, const double *b, double *x, double rtol,
+                                int max_cycles, fcm_mg_solve_info *info);
+
+/** Number of levels (1: the finest is solved directly). */
+FCM_API int fcm_mg_num_levels(const fcm_mg *mg);
+
+/** Sizes of one level (0 finest). */
+typedef struct fcm_mg_level_info {
+  fcm_index cells;  /**< elements (level 0) or coarse cells */
+  fcm_index copies; /**< node copies (3 DOFs each before dropping) */
+  fcm_index dofs;   /**< rows of the level matrix */
+  fcm_index nnz;    /**< stored entries of the level matrix */
+  fcm_index bodies; /**< connected components of the cells, two cells being connected when
+                         they share a copy */
+  fcm_index grid[3]; /**< cells per axis of the level's grid */
+} fcm_mg_level_info;
+
+/** Sizes of `level`. @return FCM_OK, FCM_ERR_ARG (NULL, level out of range), FCM_ERR_ALLOC
+ * (scratch for the bodies). */
+FCM_API fcm_status fcm_mg_get_level_info(const fcm_mg *mg, int level, fcm_mg_level_info *info);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* FCM_MG_H */

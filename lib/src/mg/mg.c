@@ -1,0 +1,1018 @@
+/* Cut-aware geometric multigrid on Hex8 box grids (Dick, Georgii, Westermann 2011, Sec. 6).
+ *
+ * NOTES (state of issue 13, for whoever continues):
+ * - Done: hierarchy for Hex8 box grids (any cell count, dropped cells, XFEM pieces), per
+ *   component trilinear prolongation, restriction = P^T, Galerkin RAP (sparse, pattern once,
+ *   values again in fcm_mg_setup()), CHOLMOD on the coarsest level, SGS (sequential,
+ *   deterministic) and damped Jacobi smoothers, V-cycle as solver and CG preconditioner.
+ * - Not done: W-cycle; colour-parallel SGS (SGS is sequential now: deterministic but one
+ *   core); Hex20 p-level (Hex20 -> Hex8 on the same grid); scene options
+ *   solver.preconditioner/method "multigrid"; the fcm-scaling app; MINRES use.
+ * - fcm_mg_setup() requires the same set of eliminated (decoupled) rows as at creation.
+ *
+ * Data per level l: cells (level 0: the space's elements) with a grid position and 8 corner
+ * copies (corner bits dx + 2 dy + 4 dz), copies with a node grid position, the connectivity
+ * of the cells (face neighbours), and for l < L-1 the DOF prolongation P_l from level l+1.
+ * DOFs: copy k, component c is row dof[3k + c] of the level matrix, or -1 when dropped
+ * (levels >= 1); level 0 keeps the space's numbering 3k + c. */
+#include "core/core_impl.h"
+#include "fcm/mg.h"
+#include "fcm/solve.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct mg_level {
+  fcm_index grid[3];   /* cells per axis */
+  fcm_index ncell;     /* cells (level 0: elements) */
+  fcm_index *ijk;      /* 3 per cell */
+  fcm_index *corner;   /* 8 copies per cell (corner bits dx + 2 dy + 4 dz) */
+  unsigned char *own;  /* level 0: the element uses the copy at its own node (1 on coarse) */
+  fcm_index *adj_ptr;  /* cell graph (connected face neighbours), CSR */
+  fcm_index *adj;
+  fcm_index ncopy;
+  fcm_index *copy_ijk; /* 3 per copy: node grid position */
+  fcm_index *dof;      /* 3 per copy: row or -1 */
+  unsigned char *inactive; /* per row: eliminated (level 0) */
+  fcm_index n;         /* rows */
+  const fcm_csr *A;    /* level 0: borrowed */
+  fcm_csr *Aown;       /* levels >= 1 */
+  fcm_index *diag;     /* position of a_ii */
+  double *dinv;        /* 1 / a_ii */
+  /* prolongation from level l+1 (n x n_coarse) and its transpose */
+  fcm_index *P_ptr, *R_ptr;
+  int *P_col, *R_col;
+  double *P_val, *R_val;
+  /* A P (n x n_coarse) pattern and values, for the Galerkin product */
+  fcm_index *AP_ptr;
+  int *AP_col;
+  double *AP_val;
+  double *x, *b, *r;   /* work vectors (x, b unused on level 0) */
+} mg_level;
+
+struct fcm_mg {
+  fcm_ctx *ctx;
+  const fcm_space *space;
+  fcm_mg_options opts;
+  int nlev;
+  mg_level lev[32];
+  fcm_direct *direct;
+  double *spa;     /* dense accumulator, max columns */
+  fcm_index *mark; /* positions, max columns */
+};
+
+fcm_mg_options fcm_mg_options_default(void)
+{
+  fcm_mg_options o;
+  o.smoother = FCM_MG_SMOOTHER_SGS;
+  o.omega = 1.0;
+  o.pre_smooth = 1;
+  o.post_smooth = 1;
+  o.max_levels = 20;
+  o.coarse_dofs = 2000;
+  return o;
+}
+
+static fcm_index uf_find(fcm_index *uf, fcm_index a)
+{
+  while (uf[a] != a)
+    a = uf[a] = uf[uf[a]];
+  return a;
+}
+
+static void uf_union(fcm_index *uf, fcm_index a, fcm_index b)
+{
+  a = uf_find(uf, a), b = uf_find(uf, b);
+  if (a != b) uf[FCM_MAX(a, b)] = FCM_MIN(a, b);
+}
+
+static int cmp_index(const void *a, const void *b)
+{
+  const fcm_index x = *(const fcm_index *)a, y = *(const fcm_index *)b;
+  return (x > y) - (x < y);
+}
+
+static int cmp_int(const void *a, const void *b)
+{
+  const int x = *(const int *)a, y = *(const int *)b;
+  return (x > y) - (x < y);
+}
+
+static void level_free(fcm_ctx *ctx, mg_level *L)
+{
+  fcm__free(ctx, L->ijk);
+  fcm__free(ctx, L->corner);
+  fcm__free(ctx, L->own);
+  fcm__free(ctx, L->adj_ptr);
+  fcm__free(ctx, L->adj);
+  fcm__free(ctx, L->copy_ijk);
+  fcm__free(ctx, L->dof);
+  fcm__free(ctx, L->inactive);
+  fcm_csr_destroy(&L->Aown);
+  fcm__free(ctx, L->diag);
+  fcm__free(ctx, L->dinv);
+  fcm__free(ctx, L->P_ptr);
+  fcm__free(ctx, L->P_col);
+  fcm__free(ctx, L->P_val);
+  fcm__free(ctx, L->R_ptr);
+  fcm__free(ctx, L->R_col);
+  fcm__free(ctx, L->R_val);
+  fcm__free(ctx, L->AP_ptr);
+  fcm__free(ctx, L->AP_col);
+  fcm__free(ctx, L->AP_val);
+  fcm__free(ctx, L->x);
+  fcm__free(ctx, L->b);
+  fcm__free(ctx, L->r);
+  memset(L, 0, sizeof *L);
+}
+
+void fcm_mg_destroy(fcm_mg **mg)
+{
+  if (!mg || !*mg) return;
+  fcm_mg *m = *mg;
+  for (int l = 0; l < 32; l++)
+    level_free(m->ctx, &m->lev[l]);
+  fcm_direct_destroy(&m->direct);
+  fcm__free(m->ctx, m->spa);
+  fcm__free(m->ctx, m->mark);
+  fcm__free(m->ctx, m);
+  *mg = NULL;
+}
+
+/* ------------------------------------------------------------------ level 0 */
+
+/* Does piece p link to piece q (p < q or q < p) in the sorted link list? */
+static int linked(const fcm_index *links, fcm_index nl, fcm_index p, fcm_index q)
+{
+  const fcm_index a = FCM_MIN(p, q), b = FCM_MAX(p, q);
+  fcm_index lo = 0, hi = nl;
+  while (lo < hi) {
+    const fcm_index mid = lo + (hi - lo) / 2;
+    if (links[2 * mid] < a || (links[2 * mid] == a && links[2 * mid + 1] < b))
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo < nl && links[2 * lo] == a && links[2 * lo + 1] == b;
+}
+
+/* Build the cell graph CSR from an edge list (pairs, both directions added, deduplicated). */
+static fcm_status graph_from_edges(fcm_ctx *ctx, fcm_index ncell, fcm_index nedge,
+                                   const fcm_index *edges, fcm_index **ptr_out,
+                                   fcm_index **adj_out)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *ptr = NULL, *adj = NULL, *fill = NULL;
+  FCM_ALLOC(ctx, ncell + 1, ptr);
+  FCM_ALLOC(ctx, ncell + 1, fill);
+  for (fcm_index e = 0; e < nedge; e++)
+    ptr[edges[2 * e] + 1]++, ptr[edges[2 * e + 1] + 1]++;
+  for (fcm_index c = 0; c < ncell; c++)
+    ptr[c + 1] += ptr[c];
+  FCM_ALLOC(ctx, ptr[ncell] + 1, adj);
+  for (fcm_index e = 0; e < nedge; e++) {
+    const fcm_index a = edges[2 * e], b = edges[2 * e + 1];
+    adj[ptr[a] + fill[a]++] = b;
+    adj[ptr[b] + fill[b]++] = a;
+  }
+  /* sort and deduplicate each row in place, then compact */
+  fcm_index out = 0;
+  for (fcm_index c = 0; c < ncell; c++) {
+    const fcm_index s = ptr[c], e = ptr[c + 1];
+    qsort(adj + s, (size_t)(e - s), sizeof *adj, cmp_index);
+    ptr[c] = out;
+    for (fcm_index i = s; i < e; i++)
+      if (i == s || adj[i] != adj[i - 1]) adj[out++] = adj[i];
+  }
+  ptr[ncell] = out;
+  *ptr_out = ptr, *adj_out = adj;
+  ptr = adj = NULL;
+cleanup:
+  fcm__free(ctx, ptr);
+  fcm__free(ctx, adj);
+  fcm__free(ctx, fill);
+  return st;
+}
+
+static fcm_status build_level0(fcm_mg *m, const fcm_csr *A)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  const fcm_space *sp = m->space;
+  mg_level *L = &m->lev[0];
+  const fcm_mesh *mesh = fcm_space_mesh(sp);
+  const fcm_index nnode = fcm_mesh_num_nodes(mesh), ncells = fcm_mesh_num_cells(mesh);
+  const fcm_index *cells = fcm_mesh_cells(mesh);
+  const double *X = fcm_mesh_coords(mesh);
+  const fcm_cell_rules *rules = fcm_space_cell_rules(sp);
+  const fcm_index nl = rules ? fcm_cell_rules_num_links(rules) : 0;
+  const fcm_index *links = rules ? fcm_cell_rules_links(rules) : NULL;
+  fcm_index *node_ijk = NULL, *cell_ijk = NULL, *grid = NULL, *edges = NULL;
+  unsigned char *cut = NULL;
+  fcm_index nedge = 0, cap = 0;
+  FCM_CHECK(fcm_mesh_element_type(mesh) == FCM_ELEMENT_HEX8, ctx, FCM_ERR_UNSUPPORTED,
+            "mg: needs a Hex8 box grid (fcm_mesh_create_box), the mesh has element type %d",
+            (int)fcm_mesh_element_type(mesh));
+  FCM_CHECK(ncells > 0, ctx, FCM_ERR_ARG, "mg: the mesh has no cells");
+  /* grid spacing from cell 0, origin from the bounding box */
+  double lo[3], hi[3], h[3];
+  fcm_mesh_bounding_box(mesh, lo, hi);
+  for (int d = 0; d < 3; d++) {
+    double mn = INFINITY, mx = -INFINITY;
+    for (int a = 0; a < 8; a++) {
+      mn = fmin(mn, X[3 * cells[a] + d]);
+      mx = fmax(mx, X[3 * cells[a] + d]);
+    }
+    h[d] = mx - mn;
+    FCM_CHECK(h[d] > 0.0, ctx, FCM_ERR_UNSUPPORTED, "mg: cell 0 has no extent along axis %d", d);
+    L->grid[d] = (fcm_index)llround((hi[d] - lo[d]) / h[d]);
+  }
+  FCM_ALLOC(ctx, 3 * nnode + 1, node_ijk);
+  for (fcm_index n = 0; n < nnode; n++)
+    for (int d = 0; d < 3; d++) {
+      const double t = (X[3 * n + d] - lo[d]) / h[d];
+      const fcm_index r = (fcm_index)llround(t);
+      FCM_CHECK(fabs(t - (double)r) < 1e-6 && r >= 0 && r <= L->grid[d], ctx,
+                FCM_ERR_UNSUPPORTED,
+                "mg: node %lld is not on the grid of spacing %g along axis %d (not a box grid)",
+                (long long)n, h[d], d);
+      node_ijk[3 * n + d] = r;
+    }
+  /* cell positions and the corner bits of each local node */
+  FCM_ALLOC(ctx, 3 * ncells + 1, cell_ijk);
+  const fcm_index gsize = L->grid[0] * L->grid[1] * L->grid[2];
+  FCM_ALLOC(ctx, gsize + 1, grid);
+  for (fcm_index g = 0; g < gsize; g++)
+    grid[g] = -1;
+  unsigned char bits_of[8] = {0};
+  for (fcm_index c = 0; c < ncells; c++) {
+    const fcm_index *cn = cells + 8 * c;
+    for (int d = 0; d < 3; d++) {
+      fcm_index mn = node_ijk[3 * cn[0] + d];
+      for (int a = 1; a < 8; a++)
+        mn = FCM_MIN(mn, node_ijk[3 * cn[a] + d]);
+      cell_ijk[3 * c + d] = mn;
+    }
+    unsigned seen = 0;
+    for (int a = 0; a < 8; a++) {
+      int bits = 0;
+      for (int d = 0; d < 3; d++) {
+        const fcm_index off = node_ijk[3 * cn[a] + d] - cell_ijk[3 * c + d];
+        FCM_CHECK(off == 0 || off == 1, ctx, FCM_ERR_UNSUPPORTED,
+                  "mg: cell %lld is not a grid cube (node %d off by %lld along axis %d)",
+                  (long long)c, a, (long long)off, d);
+        bits |= (int)off << d;
+      }
+      if (c == 0) bits_of[a] = (unsigned char)bits;
+      FCM_CHECK(bits == bits_of[a], ctx, FCM_ERR_UNSUPPORTED,
+                "mg: cell %lld orders its nodes unlike cell 0", (long long)c);
+      seen |= 1u << bits;
+    }
+    FCM_CHECK(seen == 0xffu, ctx, FCM_ERR_UNSUPPORTED, "mg: cell %lld is not a grid cube",
+              (long long)c);
+    const fcm_index g =
+        cell_ijk[3 * c] + L->grid[0] * (cell_ijk[3 * c + 1] + L->grid[1] * cell_ijk[3 * c + 2]);
+    FCM_CHECK(grid[g] < 0, ctx, FCM_ERR_UNSUPPORTED, "mg: cells %lld and %lld overlap",
+              (long long)grid[g], (long long)c);
+    grid[g] = c;
+  }
+  /* copies: node positions */
+  L->ncopy = fcm_space_num_dofs(sp) / 3;
+  FCM_ALLOC(ctx, 3 * L->ncopy + 1, L->copy_ijk);
+  for (fcm_index nd = 0; nd < nnode; nd++) {
+    const fcm_index k0 = fcm_space_node_dof(sp, nd), nc = fcm_space_node_copies(sp, nd);
+    if (k0 < 0) continue;
+    for (fcm_index c = 0; c < nc; c++)
+      for (int d = 0; d < 3; d++)
+        L->copy_ijk[3 * (k0 / 3 + c) + d] = node_ijk[3 * nd + d];
+  }
+  /* elements */
+  L->ncell = fcm_space_num_elements(sp);
+  FCM_ALLOC(ctx, 3 * L->ncell + 1, L->ijk);
+  FCM_ALLOC(ctx, 8 * L->ncell + 1, L->corner);
+  FCM_ALLOC(ctx, 8 * L->ncell + 1, L->own);
+  FCM_ALLOC(ctx, ncells + 1, cut);
+  for (fcm_index e = 0; e < L->ncell; e++) {
+    const fcm_index c = fcm_space_element_cell(sp, e);
+    const fcm_index *ed = fcm_space_element_dofs(sp, e);
+    for (int d = 0; d < 3; d++)
+      L->ijk[3 * e + d] = cell_ijk[3 * c + d];
+    for (int a = 0; a < 8; a++) {
+      const fcm_index k = ed[a] / 3;
+      const int b = bits_of[a];
+      L->corner[8 * e + b] = k;
+      int same = 1;
+      for (int d = 0; d < 3; d++)
+        same &= L->copy_ijk[3 * k + d] == node_ijk[3 * cells[8 * c + a] + d];
+      L->own[8 * e + b] = (unsigned char)same;
+    }
+    fcm_index first = 0;
+    if (fcm_space_cell_elements(sp, c, &first) > 1) cut[c] = 1;
+    if (rules) {
+      fcm_index p0 = 0;
+      fcm_cell_rules_cell_pieces(rules, c, &p0);
+      if (fcm_cell_rules_get_piece_cut_faces(rules, p0 + (e - first), NULL) > 0) cut[c] = 1;
+    }
+  }
+  /* connectivity: face neighbours (+x, +y, +z) */
+  for (fcm_index e = 0; e < L->ncell; e++) {
+    const fcm_index c = fcm_space_element_cell(sp, e);
+    for (int d = 0; d < 3; d++) {
+      fcm_index q[3] = {cell_ijk[3 * c], cell_ijk[3 * c + 1], cell_ijk[3 * c + 2]};
+      q[d]++;
+      if (q[d] >= L->grid[d]) continue;
+      const fcm_index c2 = grid[q[0] + L->grid[0] * (q[1] + L->grid[1] * q[2])];
+      if (c2 < 0) continue;
+      fcm_index f1 = 0, f2 = 0;
+      fcm_space_cell_elements(sp, c, &f1);
+      const fcm_index n2 = fcm_space_cell_elements(sp, c2, &f2);
+      for (fcm_index e2 = f2; e2 < f2 + n2; e2++) {
+        int share = 0;
+        for (int b = 0; b < 8 && !share; b++) {
+          if (!(b >> d & 1)) continue;
+          const int b2 = b & ~(1 << d);
+          share = L->own[8 * e + b] && L->own[8 * e2 + b2] &&
+                  L->corner[8 * e + b] == L->corner[8 * e2 + b2];
+        }
+        if (!share) continue;
+        if ((cut[c] || cut[c2]) && rules) {
+          fcm_index p1 = 0, p2 = 0;
+          fcm_cell_rules_cell_pieces(rules, c, &p1);
+          fcm_cell_rules_cell_pieces(rules, c2, &p2);
+          if (!linked(links, nl, p1 + (e - f1), p2 + (e2 - f2))) continue;
+        }
+        if (nedge == cap) {
+          const fcm_index nc = 2 * cap + 64;
+          void *pe = edges;
+          FCM_TRY(ctx, fcm__resize(ctx, &pe, (size_t)(2 * cap), (size_t)(2 * nc), sizeof *edges));
+          edges = pe, cap = nc;
+        }
+        edges[2 * nedge] = e, edges[2 * nedge + 1] = e2, nedge++;
+      }
+    }
+  }
+  FCM_TRY(ctx, graph_from_edges(ctx, L->ncell, nedge, edges, &L->adj_ptr, &L->adj));
+  /* DOFs: the space's numbering; eliminated rows (no off-diagonal entry) */
+  L->A = A;
+  L->n = 3 * L->ncopy;
+  FCM_ALLOC(ctx, L->n + 1, L->dof);
+  FCM_ALLOC(ctx, L->n + 1, L->inactive);
+  for (fcm_index i = 0; i < L->n; i++)
+    L->dof[i] = i;
+  {
+    const fcm_index *rp = fcm_csr_row_ptr(A);
+    const int *ci = fcm_csr_col_idx(A);
+    const double *v = fcm_csr_values_read(A);
+    for (fcm_index i = 0; i < L->n; i++) {
+      int off = 0;
+      for (fcm_index p = rp[i]; p < rp[i + 1] && !off; p++)
+        off = ci[p] != i && v[p] != 0.0;
+      L->inactive[i] = (unsigned char)!off;
+    }
+  }
+cleanup:
+  fcm__free(ctx, node_ijk);
+  fcm__free(ctx, cell_ijk);
+  fcm__free(ctx, grid);
+  fcm__free(ctx, edges);
+  fcm__free(ctx, cut);
+  return st;
+}
+
+/* ------------------------------------------------------------------ coarsening */
+
+/* Build level l+1's cells, copies, graph and DOFs and the prolongation P_l. */
+static fcm_status coarsen(fcm_mg *m, int l)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  mg_level *F = &m->lev[l], *C = &m->lev[l + 1];
+  fcm_index *uf = NULL, *cid = NULL, *edges = NULL, *cptr = NULL, *cusers = NULL,
+            *cfill = NULL, *scal_ptr = NULL, *scal_col = NULL, *colcnt = NULL, *anc = NULL,
+            *anc_in = NULL;
+  double *scal_w = NULL;
+  const fcm_index nf = F->ncell;
+  for (int d = 0; d < 3; d++)
+    C->grid[d] = (F->grid[d] + 1) / 2;
+  /* 1. coarse cells: components of the graph inside each block */
+  FCM_ALLOC(ctx, nf + 1, uf);
+  FCM_ALLOC(ctx, nf + 1, cid);
+  for (fcm_index c = 0; c < nf; c++)
+    uf[c] = c;
+  for (fcm_index c = 0; c < nf; c++)
+    for (fcm_index i = F->adj_ptr[c]; i < F->adj_ptr[c + 1]; i++) {
+      const fcm_index o = F->adj[i];
+      int same = 1;
+      for (int d = 0; d < 3; d++)
+        same &= F->ijk[3 * c + d] / 2 == F->ijk[3 * o + d] / 2;
+      if (same) uf_union(uf, c, o);
+    }
+  fcm_index nc = 0;
+  for (fcm_index c = 0; c < nf; c++) {
+    const fcm_index r = uf_find(uf, c);
+    cid[c] = r == c ? nc++ : cid[r];
+  }
+  C->ncell = nc;
+  FCM_ALLOC(ctx, 3 * nc + 1, C->ijk);
+  FCM_ALLOC(ctx, 8 * nc + 1, C->corner);
+  FCM_ALLOC(ctx, 8 * nc + 1, C->own);
+  for (fcm_index c = 0; c < nf; c++)
+    for (int d = 0; d < 3; d++)
+      C->ijk[3 * cid[c] + d] = F->ijk[3 * c + d] / 2;
+  for (fcm_index i = 0; i < 8 * nc; i++)
+    C->own[i] = 1;
+  /* 2. coarse graph */
+  fcm_index nedge = 0;
+  FCM_ALLOC(ctx, F->adj_ptr[nf] + 1, edges);
+  for (fcm_index c = 0; c < nf; c++)
+    for (fcm_index i = F->adj_ptr[c]; i < F->adj_ptr[c + 1]; i++) {
+      const fcm_index a = cid[c], b = cid[F->adj[i]];
+      if (a < b) edges[2 * nedge] = a, edges[2 * nedge + 1] = b, nedge++;
+    }
+  FCM_TRY(ctx, graph_from_edges(ctx, nc, nedge, edges, &C->adj_ptr, &C->adj));
+  /* 3. users of each fine copy (at its own node): coarse cells, deduplicated */
+  const fcm_index nk = F->ncopy;
+  FCM_ALLOC(ctx, nk + 1, cptr);
+  FCM_ALLOC(ctx, nk + 1, cfill);
+  for (fcm_index c = 0; c < nf; c++)
+    for (int b = 0; b < 8; b++)
+      if (F->own[8 * c + b]) cptr[F->corner[8 * c + b] + 1]++;
+  for (fcm_index k = 0; k < nk; k++)
+    cptr[k + 1] += cptr[k];
+  FCM_ALLOC(ctx, cptr[nk] + 1, cusers);
+  for (fcm_index c = 0; c < nf; c++)
+    for (int b = 0; b < 8; b++)
+      if (F->own[8 * c + b]) {
+        const fcm_index k = F->corner[8 * c + b];
+        cusers[cptr[k] + cfill[k]++] = cid[c];
+      }
+  /* 4. corner slots of coarse cells, merged through shared fine copies */
+  fcm__free(ctx, uf);
+  uf = NULL;
+  FCM_ALLOC(ctx, 8 * nc + 1, uf);
+  for (fcm_index s = 0; s < 8 * nc; s++)
+    uf[s] = s;
+  for (fcm_index k = 0; k < nk; k++) {
+    if (cptr[k + 1] - cptr[k] < 2) continue;
+    const fcm_index c0 = cusers[cptr[k]];
+    /* the coarse nodes with nonzero weight: corner bits of c0 */
+    for (int b = 0; b < 8; b++) {
+      int ok = 1;
+      for (int d = 0; d < 3 && ok; d++) {
+        const fcm_index p = F->copy_ijk[3 * k + d], q = 2 * (C->ijk[3 * c0 + d] + (b >> d & 1));
+        ok = p == q || p == q - 1 || p == q + 1;
+      }
+      if (!ok) continue;
+      for (fcm_index i = cptr[k] + 1; i < cptr[k + 1]; i++) {
+        const fcm_index c1 = cusers[i];
+        /* the same node as a corner of c1 */
+        int b1 = 0;
+        for (int d = 0; d < 3; d++) {
+          const fcm_index q = C->ijk[3 * c0 + d] + (b >> d & 1), off = q - C->ijk[3 * c1 + d];
+          FCM_CHECK(off == 0 || off == 1, ctx, FCM_ERR_INTERNAL,
+                    "mg: copy %lld used by coarse cells %lld and %lld that share no node",
+                    (long long)k, (long long)c0, (long long)c1);
+          b1 |= (int)off << d;
+        }
+        uf_union(uf, 8 * c0 + b, 8 * c1 + b1);
+      }
+    }
+  }
+  fcm_index ncopy = 0;
+  for (fcm_index s = 0; s < 8 * nc; s++) {
+    const fcm_index r = uf_find(uf, s);
+    C->corner[s] = r == s ? ncopy++ : C->corner[r];
+  }
+  C->ncopy = ncopy;
+  FCM_ALLOC(ctx, 3 * ncopy + 1, C->copy_ijk);
+  for (fcm_index s = 0; s < 8 * nc; s++)
+    for (int d = 0; d < 3; d++)
+      C->copy_ijk[3 * C->corner[s] + d] = C->ijk[3 * (s / 8) + d] + (s % 8 >> d & 1);
+  /* 5. scalar prolongation: row k from the first user's corners */
+  FCM_ALLOC(ctx, nk + 1, scal_ptr);
+  FCM_ALLOC(ctx, 8 * nk + 1, scal_col);
+  FCM_ALLOC(ctx, 8 * nk + 1, scal_w);
+  for (fcm_index k = 0; k < nk; k++) {
+    fcm_index cnt = scal_ptr[k];
+    if (cptr[k + 1] > cptr[k]) {
+      const fcm_index c0 = cusers[cptr[k]];
+      for (int b = 0; b < 8; b++) {
+        double w = 1.0;
+        for (int d = 0; d < 3; d++) {
+          const fcm_index p = F->copy_ijk[3 * k + d], q = 2 * (C->ijk[3 * c0 + d] + (b >> d & 1));
+          w *= p == q ? 1.0 : (p == q - 1 || p == q + 1) ? 0.5 : 0.0;
+        }
+        if (w == 0.0) continue;
+        scal_col[cnt] = C->corner[8 * c0 + b];
+        scal_w[cnt++] = w;
+      }
+    }
+    scal_ptr[k + 1] = cnt;
+  }
+  /* 6. coarse DOFs: dropped when no active fine DOF interpolates from them or all fine DOFs
+   * at the same point are inactive */
+  FCM_ALLOC(ctx, 3 * ncopy + 1, colcnt);
+  FCM_ALLOC(ctx, ncopy + 1, anc);
+  FCM_ALLOC(ctx, 3 * ncopy + 1, anc_in);
+  for (fcm_index k = 0; k < nk; k++)
+    for (fcm_index p = scal_ptr[k]; p < scal_ptr[k + 1]; p++) {
+      const fcm_index K = scal_col[p];
+      if (scal_w[p] == 1.0) anc[K]++;
+      for (int c = 0; c < 3; c++) {
+        const fcm_index f = F->dof[3 * k + c];
+        const int act = f >= 0 && !F->inactive[f];
+        colcnt[3 * K + c] += act;
+        if (scal_w[p] == 1.0) anc_in[3 * K + c] += !act;
+      }
+    }
+  FCM_ALLOC(ctx, 3 * ncopy + 1, C->dof);
+  fcm_index n = 0;
+  for (fcm_index K = 0; K < ncopy; K++)
+    for (int c = 0; c < 3; c++) {
+      const int drop = colcnt[3 * K + c] == 0 || (anc[K] > 0 && anc_in[3 * K + c] == anc[K]);
+      C->dof[3 * K + c] = drop ? -1 : n++;
+    }
+  C->n = n;
+  FCM_ALLOC(ctx, n + 1, C->inactive);
+  /* 7. DOF prolongation (F->n x C->n) and its transpose */
+  FCM_ALLOC(ctx, F->n + 1, F->P_ptr);
+  for (int pass = 0; pass < 2; pass++) {
+    fcm_index cnt = 0;
+    for (fcm_index k = 0; k < nk; k++)
+      for (int c = 0; c < 3; c++) {
+        const fcm_index f = F->dof[3 * k + c];
+        if (f < 0 || F->inactive[f]) continue;
+        for (fcm_index p = scal_ptr[k]; p < scal_ptr[k + 1]; p++) {
+          const fcm_index J = C->dof[3 * scal_col[p] + c];
+          if (J < 0) continue;
+          if (pass) {
+            F->P_col[cnt] = (int)J;
+            F->P_val[cnt] = scal_w[p];
+          } else {
+            F->P_ptr[f + 1]++;
+          }
+          cnt++;
+        }
+      }
+    if (!pass) {
+      for (fcm_index i = 0; i < F->n; i++)
+        F->P_ptr[i + 1] += F->P_ptr[i];
+      FCM_ALLOC(ctx, F->P_ptr[F->n] + 1, F->P_col);
+      FCM_ALLOC(ctx, F->P_ptr[F->n] + 1, F->P_val);
+    }
+  }
+  /* rows of P were filled copy by copy, which is row order for rows f ascending with k:
+   * level 0 rows are 3k + c; coarse rows are numbered copy by copy too */
+  {
+    const fcm_index nnz = F->P_ptr[F->n];
+    FCM_ALLOC(ctx, n + 2, F->R_ptr);
+    FCM_ALLOC(ctx, nnz + 1, F->R_col);
+    FCM_ALLOC(ctx, nnz + 1, F->R_val);
+    for (fcm_index p = 0; p < nnz; p++)
+      F->R_ptr[F->P_col[p] + 1]++;
+    for (fcm_index J = 0; J < n; J++)
+      F->R_ptr[J + 1] += F->R_ptr[J];
+    fcm__free(ctx, cfill);
+    cfill = NULL;
+    FCM_ALLOC(ctx, n + 1, cfill);
+    for (fcm_index i = 0; i < F->n; i++)
+      for (fcm_index p = F->P_ptr[i]; p < F->P_ptr[i + 1]; p++) {
+        const fcm_index J = F->P_col[p];
+        F->R_col[F->R_ptr[J] + cfill[J]] = (int)i;
+        F->R_val[F->R_ptr[J] + cfill[J]++] = F->P_val[p];
+      }
+  }
+cleanup:
+  fcm__free(ctx, uf);
+  fcm__free(ctx, cid);
+  fcm__free(ctx, edges);
+  fcm__free(ctx, cptr);
+  fcm__free(ctx, cusers);
+  fcm__free(ctx, cfill);
+  fcm__free(ctx, scal_ptr);
+  fcm__free(ctx, scal_col);
+  fcm__free(ctx, scal_w);
+  fcm__free(ctx, colcnt);
+  fcm__free(ctx, anc);
+  fcm__free(ctx, anc_in);
+  return st;
+}
+
+/* ------------------------------------------------------------------ Galerkin product */
+
+/* Symbolic C = A B (rows of A, columns of B: ncol), sorted columns. mark: ncol entries. */
+static fcm_status spgemm_symbolic(fcm_ctx *ctx, fcm_index nrow, const fcm_index *Ap,
+                                  const int *Ac, const fcm_index *Bp, const int *Bc,
+                                  fcm_index ncol, fcm_index *mark, fcm_index **Cp_out,
+                                  int **Cc_out)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *Cp = NULL;
+  int *Cc = NULL;
+  FCM_ALLOC(ctx, nrow + 1, Cp);
+  for (fcm_index j = 0; j < ncol; j++)
+    mark[j] = -1;
+  for (int pass = 0; pass < 2; pass++) {
+    for (fcm_index i = 0; i < nrow; i++) {
+      fcm_index cnt = 0, base = pass ? Cp[i] : 0;
+      for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
+        const fcm_index k = Ac[p];
+        for (fcm_index q = Bp[k]; q < Bp[k + 1]; q++) {
+          const fcm_index j = Bc[q];
+          if (mark[j] == i + pass * nrow) continue;
+          mark[j] = i + pass * nrow;
+          if (pass) Cc[base + cnt] = (int)j;
+          cnt++;
+        }
+      }
+      if (pass)
+        qsort(Cc + base, (size_t)cnt, sizeof *Cc, cmp_int);
+      else
+        Cp[i + 1] = cnt;
+    }
+    if (!pass) {
+      for (fcm_index i = 0; i < nrow; i++)
+        Cp[i + 1] += Cp[i];
+      FCM_ALLOC(ctx, Cp[nrow] + 1, Cc);
+    }
+  }
+  *Cp_out = Cp, *Cc_out = Cc;
+  Cp = NULL, Cc = NULL;
+cleanup:
+  fcm__free(ctx, Cp);
+  fcm__free(ctx, Cc);
+  return st;
+}
+
+/* Numeric C = A B on C's pattern; spa: ncol doubles (zero on entry and exit). */
+static void spgemm_numeric(fcm_index nrow, const fcm_index *Ap, const int *Ac, const double *Av,
+                           const fcm_index *Bp, const int *Bc, const double *Bv,
+                           const fcm_index *Cp, const int *Cc, double *Cv, double *spa)
+{
+  for (fcm_index i = 0; i < nrow; i++) {
+    for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
+      const fcm_index k = Ac[p];
+      const double a = Av[p];
+      for (fcm_index q = Bp[k]; q < Bp[k + 1]; q++)
+        spa[Bc[q]] += a * Bv[q];
+    }
+    for (fcm_index p = Cp[i]; p < Cp[i + 1]; p++) {
+      Cv[p] = spa[Cc[p]];
+      spa[Cc[p]] = 0.0;
+    }
+  }
+}
+
+static const fcm_csr *level_matrix(const mg_level *L)
+{
+  return L->A ? L->A : L->Aown;
+}
+
+/* Values of A_{l+1} = R_l A_l P_l (symmetrized), diagonal inverses of level l+1. */
+static fcm_status galerkin_values(fcm_mg *m, int l)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  mg_level *F = &m->lev[l], *C = &m->lev[l + 1];
+  const fcm_csr *A = level_matrix(F);
+  spgemm_numeric(F->n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), fcm_csr_values_read(A), F->P_ptr,
+                 F->P_col, F->P_val, F->AP_ptr, F->AP_col, F->AP_val, m->spa);
+  double *v = fcm_csr_values(C->Aown);
+  const fcm_index *cp = fcm_csr_row_ptr(C->Aown);
+  const int *cc = fcm_csr_col_idx(C->Aown);
+  spgemm_numeric(C->n, F->R_ptr, F->R_col, F->R_val, F->AP_ptr, F->AP_col, F->AP_val, cp, cc, v,
+                 m->spa);
+  for (fcm_index i = 0; i < C->n; i++)
+    for (fcm_index p = cp[i]; p < cp[i + 1]; p++) {
+      const fcm_index j = cc[p];
+      if (j <= i) continue;
+      const fcm_index q = fcm_csr_position(C->Aown, j, i);
+      const double s = 0.5 * (v[p] + v[q]);
+      v[p] = v[q] = s;
+    }
+  for (fcm_index i = 0; i < C->n; i++) {
+    const double d = v[C->diag[i]];
+    FCM_CHECK(isfinite(d) && d > 0.0, ctx, FCM_ERR_NUMERIC,
+              "mg: level %d, row %lld: Galerkin diagonal %g is not positive (is A positive "
+              "definite?)",
+              l + 1, (long long)i, d);
+    C->dinv[i] = 1.0 / d;
+  }
+cleanup:
+  return st;
+}
+
+static fcm_status level_diag(fcm_mg *m, mg_level *L)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  const fcm_csr *A = level_matrix(L);
+  if (!L->diag) FCM_ALLOC(ctx, L->n + 1, L->diag);
+  if (!L->dinv) FCM_ALLOC(ctx, L->n + 1, L->dinv);
+  for (fcm_index i = 0; i < L->n; i++) {
+    L->diag[i] = fcm_csr_position(A, i, i);
+    FCM_CHECK(L->diag[i] >= 0, ctx, FCM_ERR_ARG, "mg: row %lld has no diagonal entry",
+              (long long)i);
+  }
+cleanup:
+  return st;
+}
+
+static fcm_status level0_dinv(fcm_mg *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  mg_level *L = &m->lev[0];
+  const double *v = fcm_csr_values_read(L->A);
+  for (fcm_index i = 0; i < L->n; i++) {
+    const double d = v[L->diag[i]];
+    FCM_CHECK(isfinite(d) && d > 0.0, ctx, FCM_ERR_NUMERIC,
+              "mg: diagonal entry of row %lld is %g (A must be positive definite)", (long long)i,
+              d);
+    L->dinv[i] = 1.0 / d;
+  }
+cleanup:
+  return st;
+}
+
+/* ------------------------------------------------------------------ create / setup */
+
+fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
+                         const fcm_mg_options *opts, fcm_mg **mg)
+{
+  fcm_status st = FCM_OK;
+  fcm_mg *m = NULL;
+  FCM_CHECK(ctx && space && A && mg, ctx, FCM_ERR_ARG, "mg_create: NULL argument");
+  *mg = NULL;
+  fcm_mg_options o = opts ? *opts : fcm_mg_options_default();
+  FCM_CHECK(o.smoother >= 0 && o.smoother < FCM_MG_SMOOTHER_COUNT, ctx, FCM_ERR_ARG,
+            "mg_create: smoother = %d is not a fcm_mg_smoother", (int)o.smoother);
+  FCM_CHECK(isfinite(o.omega) && o.omega > 0.0 &&
+                (o.smoother == FCM_MG_SMOOTHER_SGS ? o.omega < 2.0 : o.omega <= 1.0),
+            ctx, FCM_ERR_ARG, "mg_create: omega = %g outside %s", o.omega,
+            o.smoother == FCM_MG_SMOOTHER_SGS ? "(0, 2) (SGS)" : "(0, 1] (Jacobi)");
+  FCM_CHECK(o.pre_smooth >= 0 && o.post_smooth >= 0, ctx, FCM_ERR_ARG,
+            "mg_create: pre_smooth = %d, post_smooth = %d must be >= 0", o.pre_smooth,
+            o.post_smooth);
+  FCM_CHECK(o.max_levels >= 1 && o.max_levels <= 32, ctx, FCM_ERR_ARG,
+            "mg_create: max_levels = %d outside [1, 32]", o.max_levels);
+  FCM_CHECK(o.coarse_dofs >= 1, ctx, FCM_ERR_ARG, "mg_create: coarse_dofs = %lld must be >= 1",
+            (long long)o.coarse_dofs);
+  fcm_index nr = 0, nc = 0;
+  fcm_csr_get_size(A, &nr, &nc, NULL);
+  FCM_CHECK(nr == fcm_space_num_dofs(space) && nc == nr, ctx, FCM_ERR_ARG,
+            "mg_create: A is %lld x %lld, the space has %lld DOFs", (long long)nr, (long long)nc,
+            (long long)fcm_space_num_dofs(space));
+  FCM_CHECK(fcm_csr_get_kind(A) == FCM_CSR_SYMMETRIC, ctx, FCM_ERR_ARG,
+            "mg_create: A must be an FCM_CSR_SYMMETRIC matrix");
+  m = fcm__calloc(ctx, 1, sizeof *m);
+  FCM_CHECK(m, ctx, FCM_ERR_ALLOC, "mg_create: out of memory");
+  m->ctx = ctx;
+  m->space = space;
+  m->opts = o;
+  FCM_TRY(ctx, build_level0(m, A));
+  FCM_TRY(ctx, level_diag(m, &m->lev[0]));
+  m->nlev = 1;
+  while (m->nlev < o.max_levels && m->lev[m->nlev - 1].n > o.coarse_dofs) {
+    const mg_level *F = &m->lev[m->nlev - 1];
+    if (F->grid[0] <= 1 && F->grid[1] <= 1 && F->grid[2] <= 1) break;
+    FCM_TRY(ctx, coarsen(m, m->nlev - 1));
+    m->nlev++;
+    if (m->lev[m->nlev - 1].n == 0) { /* nothing left to correct: stop above it */
+      m->nlev--;
+      level_free(ctx, &m->lev[m->nlev]);
+      break;
+    }
+  }
+  /* work arrays and Galerkin patterns */
+  fcm_index maxn = 0;
+  for (int l = 0; l < m->nlev; l++)
+    maxn = FCM_MAX(maxn, m->lev[l].n);
+  FCM_ALLOC(ctx, maxn + 1, m->spa);
+  FCM_ALLOC(ctx, maxn + 1, m->mark);
+  for (int l = 0; l < m->nlev; l++) {
+    mg_level *L = &m->lev[l];
+    FCM_ALLOC(ctx, L->n + 1, L->x);
+    FCM_ALLOC(ctx, L->n + 1, L->b);
+    FCM_ALLOC(ctx, L->n + 1, L->r);
+    if (l + 1 < m->nlev) {
+      mg_level *C = &m->lev[l + 1];
+      const fcm_csr *Af = level_matrix(L);
+      FCM_TRY(ctx, spgemm_symbolic(ctx, L->n, fcm_csr_row_ptr(Af), fcm_csr_col_idx(Af), L->P_ptr,
+                                   L->P_col, C->n, m->mark, &L->AP_ptr, &L->AP_col));
+      FCM_ALLOC(ctx, L->AP_ptr[L->n] + 1, L->AP_val);
+      fcm_index *cp = NULL;
+      int *cc = NULL;
+      FCM_TRY(ctx, spgemm_symbolic(ctx, C->n, L->R_ptr, L->R_col, L->AP_ptr, L->AP_col, C->n,
+                                   m->mark, &cp, &cc));
+      st = fcm_csr_create(ctx, C->n, C->n, cp, cc, FCM_CSR_SYMMETRIC, &C->Aown);
+      fcm__free(ctx, cp);
+      fcm__free(ctx, cc);
+      FCM_TRY(ctx, st);
+      FCM_TRY(ctx, level_diag(m, C));
+    }
+  }
+  {
+    mg_level *Lc = &m->lev[m->nlev - 1];
+    FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, level_matrix(Lc), &m->direct));
+    FCM_TRY(ctx, fcm_direct_analyze(m->direct));
+  }
+  FCM_TRY(ctx, fcm_mg_setup(m));
+  *mg = m;
+  m = NULL;
+cleanup:
+  fcm_mg_destroy(&m);
+  return st;
+}
+
+fcm_status fcm_mg_setup(fcm_mg *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m ? m->ctx : NULL;
+  FCM_CHECK(m, ctx, FCM_ERR_ARG, "mg_setup: NULL argument");
+  {
+    mg_level *L = &m->lev[0];
+    const fcm_index *rp = fcm_csr_row_ptr(L->A);
+    const int *ci = fcm_csr_col_idx(L->A);
+    const double *v = fcm_csr_values_read(L->A);
+    for (fcm_index i = 0; i < L->n; i++) {
+      int off = 0;
+      for (fcm_index p = rp[i]; p < rp[i + 1] && !off; p++)
+        off = ci[p] != i && v[p] != 0.0;
+      FCM_CHECK(off == !L->inactive[i], ctx, FCM_ERR_ARG,
+                "mg_setup: row %lld is %s now but was %s at creation (the eliminated rows "
+                "must not change: create the multigrid again)",
+                (long long)i, off ? "coupled" : "eliminated", off ? "eliminated" : "coupled");
+    }
+  }
+  FCM_TRY(ctx, level0_dinv(m));
+  for (int l = 0; l + 1 < m->nlev; l++)
+    FCM_TRY(ctx, galerkin_values(m, l));
+  FCM_TRY(ctx, fcm_direct_factor(m->direct, fcm_csr_values_read(level_matrix(&m->lev[m->nlev - 1]))));
+cleanup:
+  return st;
+}
+
+/* ------------------------------------------------------------------ cycle */
+
+static void smooth(const fcm_mg *m, mg_level *L, const double *b, double *x, int backward)
+{
+  const fcm_csr *A = level_matrix(L);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const double *v = fcm_csr_values_read(A);
+  const double w = m->opts.omega;
+  if (m->opts.smoother == FCM_MG_SMOOTHER_JACOBI) {
+    fcm_csr_apply(A, -1.0, x, 0.0, L->r);
+    const fcm_index n = L->n;
+#pragma omp parallel for schedule(static) if (n > 4096)
+    for (fcm_index i = 0; i < n; i++)
+      x[i] += w * (b[i] + L->r[i]) * L->dinv[i];
+    return;
+  }
+  for (int sweep = 0; sweep < 2; sweep++) {
+    const int back = sweep ^ backward;
+    for (fcm_index t = 0; t < L->n; t++) {
+      const fcm_index i = back ? L->n - 1 - t : t;
+      double s = b[i];
+      for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+        s -= v[p] * x[ci[p]];
+      x[i] += w * s * L->dinv[i];
+    }
+  }
+}
+
+static fcm_status cycle(fcm_mg *m, int l, const double *b, double *x)
+{
+  fcm_status st = FCM_OK;
+  mg_level *L = &m->lev[l];
+  if (l == m->nlev - 1) {
+    return fcm_direct_solve(m->direct, b, x); /* level 0 too when there is one level */
+  }
+  mg_level *C = &m->lev[l + 1];
+  for (int s = 0; s < m->opts.pre_smooth; s++)
+    smooth(m, L, b, x, 0);
+  /* r = b - A x, b_c = R r */
+  fcm_csr_apply(level_matrix(L), -1.0, x, 0.0, L->r);
+  const fcm_index n = L->n;
+  for (fcm_index i = 0; i < n; i++)
+    L->r[i] += b[i];
+  for (fcm_index J = 0; J < C->n; J++) {
+    double s = 0.0;
+    for (fcm_index p = L->R_ptr[J]; p < L->R_ptr[J + 1]; p++)
+      s += L->R_val[p] * L->r[L->R_col[p]];
+    C->b[J] = s;
+    C->x[J] = 0.0;
+  }
+  if ((st = cycle(m, l + 1, C->b, C->x))) return st;
+  for (fcm_index i = 0; i < n; i++) {
+    double s = 0.0;
+    for (fcm_index p = L->P_ptr[i]; p < L->P_ptr[i + 1]; p++)
+      s += L->P_val[p] * C->x[L->P_col[p]];
+    x[i] += s;
+  }
+  for (int s = 0; s < m->opts.post_smooth; s++)
+    smooth(m, L, b, x, 1);
+  return st;
+}
+
+fcm_status fcm_mg_cycle(fcm_mg *m, const double *b, double *x)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m ? m->ctx : NULL;
+  FCM_CHECK(m && b && x && b != x, ctx, FCM_ERR_ARG, "mg_cycle: NULL or overlapping argument");
+  FCM_TRY(ctx, cycle(m, 0, b, x));
+cleanup:
+  return st;
+}
+
+fcm_status fcm_mg_operator(void *user, const double *r, double *z)
+{
+  fcm_mg *m = user;
+  if (m && z) memset(z, 0, sizeof *z * (size_t)m->lev[0].n);
+  return fcm_mg_cycle(m, r, z);
+}
+
+static double norm2(fcm_index n, const double *v)
+{
+  double s = 0.0;
+  for (fcm_index i = 0; i < n; i++)
+    s += v[i] * v[i];
+  return sqrt(s);
+}
+
+fcm_status fcm_mg_solve(fcm_mg *m, const double *b, double *x, double rtol, int max_cycles,
+                        fcm_mg_solve_info *info)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m ? m->ctx : NULL;
+  fcm_mg_solve_info inf = {0, 0, 0.0, 0.0};
+  FCM_CHECK(m && b && x && b != x, ctx, FCM_ERR_ARG, "mg_solve: NULL or overlapping argument");
+  FCM_CHECK(rtol >= 0.0 && max_cycles >= 0, ctx, FCM_ERR_ARG,
+            "mg_solve: rtol = %g must be >= 0 and max_cycles = %d >= 0", rtol, max_cycles);
+  mg_level *L = &m->lev[0];
+  const fcm_index n = L->n;
+  const double bn = norm2(n, b);
+  double r1 = 0.0, rk = 0.0;
+  for (;;) {
+    fcm_csr_apply(L->A, -1.0, x, 0.0, L->b); /* L->b is free on level 0 */
+    for (fcm_index i = 0; i < n; i++)
+      L->b[i] += b[i];
+    rk = norm2(n, L->b);
+    FCM_CHECK(isfinite(rk), ctx, FCM_ERR_NUMERIC, "mg_solve: residual is %g after %d cycles", rk,
+              inf.cycles);
+    inf.relative_residual = bn > 0.0 ? rk / bn : 0.0;
+    if (inf.cycles == 1) r1 = rk;
+    if (rk <= rtol * bn) {
+      inf.converged = 1;
+      break;
+    }
+    if (inf.cycles >= max_cycles) break;
+    FCM_TRY(ctx, cycle(m, 0, b, x));
+    inf.cycles++;
+  }
+  if (inf.cycles >= 2 && r1 > 0.0) inf.convergence_factor = pow(rk / r1, 1.0 / (inf.cycles - 1));
+  FCM_CHECK(inf.converged, ctx, FCM_ERR_NOT_CONVERGED,
+            "mg_solve: relative residual %g after %d cycles, rtol %g", inf.relative_residual,
+            inf.cycles, rtol);
+cleanup:
+  if (info) *info = inf;
+  return st;
+}
+
+int fcm_mg_num_levels(const fcm_mg *m)
+{
+  return m ? m->nlev : 0;
+}
+
+fcm_status fcm_mg_get_level_info(const fcm_mg *m, int level, fcm_mg_level_info *info)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m ? m->ctx : NULL;
+  fcm_index *uf = NULL;
+  FCM_CHECK(m && info && level >= 0 && level < m->nlev, ctx, FCM_ERR_ARG,
+            "mg_get_level_info: NULL argument or level %d outside [0, %d)", level,
+            m ? m->nlev : 0);
+  const mg_level *L = &m->lev[level];
+  info->cells = L->ncell;
+  info->copies = L->ncopy;
+  info->dofs = L->n;
+  fcm_csr_get_size(level_matrix(L), NULL, NULL, &info->nnz);
+  for (int d = 0; d < 3; d++)
+    info->grid[d] = L->grid[d];
+  /* bodies: cells joined through shared copies */
+  FCM_ALLOC(ctx, L->ncell + L->ncopy + 1, uf);
+  for (fcm_index i = 0; i < L->ncell + L->ncopy; i++)
+    uf[i] = i;
+  for (fcm_index c = 0; c < L->ncell; c++)
+    for (int b = 0; b < 8; b++)
+      uf_union(uf, c, L->ncell + L->corner[8 * c + b]);
+  fcm_index nb = 0;
+  for (fcm_index c = 0; c < L->ncell; c++)
+    nb += uf_find(uf, c) == c;
+  info->bodies = nb;
+cleanup:
+  fcm__free(ctx, uf);
+  return st;
+}

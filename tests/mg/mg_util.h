@@ -1,0 +1,146 @@
+/* Problems shared by the multigrid tests: static linear elasticity on Hex8 box grids of an
+ * uncut cube (clamped at x = 0), an embedded hemisphere (clamped on its flat face y = 0, its
+ * curved surface cutting cells; optionally an XFEM plane cut through its upper part) and two
+ * disjoint balls (K + M, no boundary condition). */
+#ifndef FCM_MG_TEST_UTIL_H
+#define FCM_MG_TEST_UTIL_H
+
+#include "fcm/fcm.h"
+#include "test.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct problem {
+  fcm_mesh *mesh;
+  fcm_geometry *geom;
+  fcm_cell_rules *rules, *rules0;
+  fcm_space *space;
+  fcm_csr *A;
+  double *b;
+  fcm_index n;
+} problem;
+
+static inline void problem_free(problem *p)
+{
+  fcm_csr_destroy(&p->A);
+  fcm_space_destroy(&p->space);
+  fcm_cell_rules_destroy(&p->rules);
+  fcm_cell_rules_destroy(&p->rules0);
+  fcm_geometry_destroy(&p->geom);
+  fcm_mesh_destroy(&p->mesh);
+  free(p->b);
+  memset(p, 0, sizeof *p);
+}
+
+/* Clamp every copy of every active node in the box [lo, hi]. */
+static inline void clamp_box(fcm_ctx *ctx, problem *p, const double lo[3], const double hi[3])
+{
+  fcm_index cnt = 0;
+  TEST_OK(ctx, fcm_mesh_nodes_in_box(ctx, p->mesh, lo, hi, 1e-9, 0, NULL, &cnt));
+  fcm_index *nodes = calloc((size_t)cnt + 1, sizeof *nodes);
+  fcm_index *dofs = calloc(3 * (size_t)cnt * 8 + 1, sizeof *dofs), nd = 0;
+  TEST_OK(ctx, fcm_mesh_nodes_in_box(ctx, p->mesh, lo, hi, 1e-9, cnt, nodes, &cnt));
+  for (fcm_index i = 0; i < cnt; i++) {
+    const fcm_index d0 = fcm_space_node_dof(p->space, nodes[i]);
+    const fcm_index nc = fcm_space_node_copies(p->space, nodes[i]);
+    for (fcm_index c = 0; d0 >= 0 && c < nc && c < 8; c++)
+      for (int d = 0; d < 3; d++)
+        dofs[nd++] = d0 + 3 * c + d;
+  }
+  TEST_OK(ctx, fcm_space_apply_dirichlet(p->space, nd, dofs, NULL, p->A, p->b));
+  free(nodes);
+  free(dofs);
+}
+
+static inline void finish_space(fcm_ctx *ctx, problem *p, int with_mass)
+{
+  fcm_material mat = {FCM_MATERIAL_LINEAR, 1.0e5, 0.3, 1000.0};
+  const double g[3] = {0.0, -9.81, 0.0};
+  p->n = fcm_space_num_dofs(p->space);
+  p->b = calloc((size_t)p->n + 1, sizeof *p->b);
+  TEST_OK(ctx, fcm_space_matrix_create(p->space, &p->A));
+  TEST_OK(ctx, fcm_assemble_stiffness(p->space, &mat, NULL, p->A));
+  if (with_mass) {
+    fcm_material m2 = mat;
+    m2.density = 1.0e4; /* a strong mass term: K + M is positive definite */
+    TEST_OK(ctx, fcm_assemble_mass(p->space, &m2, NULL, p->A));
+  }
+  TEST_OK(ctx, fcm_assemble_body_force(p->space, &mat, g, NULL, p->b));
+}
+
+/* Unit cube, n^3 Hex8 cells, clamped at x = 0, gravity. */
+static inline void problem_cube(fcm_ctx *ctx, fcm_index n, problem *p)
+{
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  const fcm_index cells[3] = {n, n, n};
+  memset(p, 0, sizeof *p);
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, cells, &p->mesh));
+  TEST_OK(ctx, fcm_space_create(ctx, p->mesh, NULL, &p->space));
+  finish_space(ctx, p, 0);
+  const double flo[3] = {0, -1, -1}, fhi[3] = {0, 2, 2};
+  clamp_box(ctx, p, flo, fhi);
+}
+
+/* Hemisphere of radius 1 on y = 0 in [-1.1, 1.1] x [0, 1.1] x [-1.1, 1.1] with n x n/2 x n
+ * cells (n even), clamped at y = 0; cut != 0: a vertical plane cut x = 0.05 through the
+ * upper part y > 0.4 (it separates the top into two halves joined below). */
+static inline void problem_hemisphere(fcm_ctx *ctx, fcm_index n, int cut, problem *p)
+{
+  const double lo[3] = {-1.1, 0, -1.1}, hi[3] = {1.1, 1.1, 1.1}, c[3] = {0, 0, 0};
+  const fcm_index cells[3] = {n, n / 2, n};
+  memset(p, 0, sizeof *p);
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, cells, &p->mesh));
+  TEST_OK(ctx, fcm_geometry_create_hemisphere(ctx, c, 1.0, 4, &p->geom));
+  fcm_cell_rules_options ro = fcm_cell_rules_options_default();
+  ro.simplify = FCM_CELL_SIMPLIFY_OFF; /* faster; the solver sees the same kind of matrix */
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, p->mesh, p->geom, &ro, &p->rules0));
+  if (cut) {
+    fcm_surface *s = NULL;
+    const double q[3] = {0.05, 0.0, 0.0}, nx[3] = {1, 0, 0};
+    const double bl[3] = {-0.1, 0.4, -2.0}, bh[3] = {0.2, 2.0, 2.0};
+    TEST_OK(ctx, fcm_surface_create_plane(ctx, q, nx, bl, bh, &s));
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, p->mesh, p->geom, p->rules0, s, &p->rules));
+    fcm_surface_destroy(&s);
+  }
+  TEST_OK(ctx, fcm_space_create_embedded(ctx, p->mesh, p->rules ? p->rules : p->rules0,
+                                         &p->space));
+  finish_space(ctx, p, 0);
+  const double flo[3] = {-2, 0, -2}, fhi[3] = {2, 0, 2};
+  clamp_box(ctx, p, flo, fhi);
+}
+
+/* Two balls of radius 0.3 at (0.5, 0.5, 0.5) and (1.5, 0.5, 0.5) in [0, 2] x [0, 1]^2 with
+ * 2n x n x n cells; A = K + M. */
+static inline void problem_balls(fcm_ctx *ctx, fcm_index n, problem *p)
+{
+  const double lo[3] = {0, 0, 0}, hi[3] = {2, 1, 1};
+  const double c1[3] = {0.5, 0.5, 0.5}, c2[3] = {1.5, 0.5, 0.5};
+  const fcm_index cells[3] = {2 * n, n, n};
+  fcm_geometry *b1 = NULL, *b2 = NULL;
+  memset(p, 0, sizeof *p);
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, cells, &p->mesh));
+  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c1, 0.3, 3, &b1));
+  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c2, 0.3, 3, &b2));
+  const fcm_index n1 = fcm_geometry_num_nodes(b1), n2 = fcm_geometry_num_nodes(b2);
+  const fcm_index e1 = fcm_geometry_num_cells(b1), e2 = fcm_geometry_num_cells(b2);
+  double *X = malloc(sizeof *X * 3 * (size_t)(n1 + n2));
+  fcm_index *T = malloc(sizeof *T * 4 * (size_t)(e1 + e2));
+  memcpy(X, fcm_geometry_coords(b1), sizeof *X * 3 * (size_t)n1);
+  memcpy(X + 3 * n1, fcm_geometry_coords(b2), sizeof *X * 3 * (size_t)n2);
+  memcpy(T, fcm_geometry_cells(b1), sizeof *T * 4 * (size_t)e1);
+  for (fcm_index i = 0; i < 4 * e2; i++)
+    T[4 * e1 + i] = fcm_geometry_cells(b2)[i] + n1;
+  TEST_OK(ctx, fcm_geometry_create(ctx, FCM_ELEMENT_TET4, n1 + n2, X, e1 + e2, T, &p->geom));
+  free(X);
+  free(T);
+  fcm_geometry_destroy(&b1);
+  fcm_geometry_destroy(&b2);
+  fcm_cell_rules_options ro = fcm_cell_rules_options_default();
+  ro.simplify = FCM_CELL_SIMPLIFY_OFF; /* faster; the solver sees the same kind of matrix */
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, p->mesh, p->geom, &ro, &p->rules0));
+  TEST_OK(ctx, fcm_space_create_embedded(ctx, p->mesh, p->rules0, &p->space));
+  finish_space(ctx, p, 1);
+}
+
+#endif /* FCM_MG_TEST_UTIL_H */
