@@ -26,10 +26,17 @@ int main(int argc, char **argv)
   if (kind < 0) return 2;
   const int verbose = getenv("FCM_TEST_VERBOSE") != NULL;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
-  const fcm_index sizes[3] = {4, 8, 16};
-  double factor[3] = {0}, fmin = 1.0, fmax = 0.0;
-  int it_mg[3] = {0}, it_jac[3] = {0};
-  for (int s = 0; s < 3; s++) {
+  /* further arguments: other sizes (even), for measurements */
+  fcm_index sizes[8] = {4, 8, 16};
+  int ns = 3;
+  if (argc > 2) {
+    ns = 0;
+    for (int a = 2; a < argc && ns < 8; a++)
+      sizes[ns++] = atoi(argv[a]);
+  }
+  double factor[8] = {0}, fmin = 1.0, fmax = 0.0;
+  int it_mg[8] = {0}, it_jac[8] = {0};
+  for (int s = 0; s < ns; s++) {
     problem p;
     if (kind == 0)
       problem_cube(ctx, sizes[s], &p);
@@ -93,7 +100,7 @@ int main(int argc, char **argv)
   }
   TEST_TRUE(fmax <= 0.8);
   TEST_TRUE(fmax <= 1.25 * fmin + 0.02);
-  for (int s = 1; s < 3; s++) {
+  for (int s = 1; s < ns; s++) {
     TEST_TRUE(it_mg[s] <= 1.5 * it_mg[0] + 2);
     TEST_TRUE(3 * it_mg[s] < it_jac[s]);
   }

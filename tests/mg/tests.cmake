@@ -1,3 +1,5 @@
 foreach(kind cube hemisphere cut)
   fcm_add_test(mg_convergence_${kind} tests/mg/convergence.c ARGS ${kind})
 endforeach()
+fcm_add_test(mg_bodies tests/mg/bodies.c)
+fcm_add_test(mg_threads tests/mg/threads.c)

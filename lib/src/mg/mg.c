@@ -779,7 +779,8 @@ fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
     if (F->grid[0] <= 1 && F->grid[1] <= 1 && F->grid[2] <= 1) break;
     FCM_TRY(ctx, coarsen(m, m->nlev - 1));
     m->nlev++;
-    if (m->lev[m->nlev - 1].n == 0) { /* nothing left to correct: stop above it */
+    if (m->lev[m->nlev - 1].n == 0 || m->lev[m->nlev - 1].n >= F->n) {
+      /* nothing left to correct, or no reduction (separate cells in one block): stop */
       m->nlev--;
       level_free(ctx, &m->lev[m->nlev]);
       break;
