@@ -3,8 +3,8 @@
  * elements, so material that the fine space separates (disjoint bodies, cuts) is never merged;
  * coarse DOFs are duplicated per component. Trilinear prolongation per component, restriction
  * its transpose, Galerkin coarse matrices P^T A P, a CHOLMOD solve on the coarsest level,
- * symmetric Gauss-Seidel or damped Jacobi smoothing. Use it as a solver (fcm_mg_solve()) or as
- * the preconditioner of fcm_krylov_cg() (fcm_mg_operator()). */
+ * symmetric Gauss-Seidel or damped Jacobi smoothing, V- or W-cycles. Use it as a solver
+ * (fcm_mg_solve()) or as the preconditioner of fcm_krylov_cg() (fcm_mg_operator()). */
 #ifndef FCM_MG_H
 #define FCM_MG_H
 
@@ -35,6 +35,8 @@ typedef struct fcm_mg_options {
                                  one SGS step is a forward and a backward sweep) */
   int post_smooth;          /**< after it, >= 0 (default 1); pre = post keeps the cycle
                                  symmetric (needed as a CG preconditioner) */
+  int cycle_index;          /**< coarse-level corrections per level: 1 V-cycle (default),
+                                 2 W-cycle; in [1, 2] */
   int max_levels;           /**< levels including the finest, >= 1 (default 20) */
   fcm_index coarse_dofs;    /**< stop coarsening once a level has at most this many DOFs,
                                  >= 1 (default 2000); that level is solved by CHOLMOD */

@@ -4,8 +4,9 @@
  * - Done: hierarchy for Hex8 box grids (any cell count, dropped cells, XFEM pieces), per
  *   component trilinear prolongation, restriction = P^T, Galerkin RAP (sparse, pattern once,
  *   values again in fcm_mg_setup()), CHOLMOD on the coarsest level, SGS (sequential,
- *   deterministic) and damped Jacobi smoothers, V-cycle as solver and CG preconditioner.
- * - Not done: W-cycle; colour-parallel SGS (SGS is sequential now: deterministic but one
+ *   deterministic) and damped Jacobi smoothers, V- and W-cycles as solver and CG
+ *   preconditioner.
+ * - Not done: colour-parallel SGS (SGS is sequential now: deterministic but one
  *   core); Hex20 p-level (Hex20 -> Hex8 on the same grid); scene options
  *   solver.preconditioner/method "multigrid"; the fcm-scaling app; MINRES use.
  * - fcm_mg_setup() requires the same set of eliminated (decoupled) rows as at creation.
@@ -17,7 +18,6 @@
  * (levels >= 1); level 0 keeps the space's numbering 3k + c. */
 #include "core/core_impl.h"
 #include "fcm/mg.h"
-#include "fcm/solve.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -69,6 +69,7 @@ fcm_mg_options fcm_mg_options_default(void)
   o.omega = 1.0;
   o.pre_smooth = 1;
   o.post_smooth = 1;
+  o.cycle_index = 1;
   o.max_levels = 20;
   o.coarse_dofs = 2000;
   return o;
@@ -755,6 +756,8 @@ fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
   FCM_CHECK(o.pre_smooth >= 0 && o.post_smooth >= 0, ctx, FCM_ERR_ARG,
             "mg_create: pre_smooth = %d, post_smooth = %d must be >= 0", o.pre_smooth,
             o.post_smooth);
+  FCM_CHECK(o.cycle_index == 1 || o.cycle_index == 2, ctx, FCM_ERR_ARG,
+            "mg_create: cycle_index = %d is neither 1 (V-cycle) nor 2 (W-cycle)", o.cycle_index);
   FCM_CHECK(o.max_levels >= 1 && o.max_levels <= 32, ctx, FCM_ERR_ARG,
             "mg_create: max_levels = %d outside [1, 32]", o.max_levels);
   FCM_CHECK(o.coarse_dofs >= 1, ctx, FCM_ERR_ARG, "mg_create: coarse_dofs = %lld must be >= 1",
@@ -906,7 +909,9 @@ static fcm_status cycle(fcm_mg *m, int l, const double *b, double *x)
     C->b[J] = s;
     C->x[J] = 0.0;
   }
-  if ((st = cycle(m, l + 1, C->b, C->x))) return st;
+  const int gamma = l + 2 == m->nlev ? 1 : m->opts.cycle_index; /* the coarsest is exact */
+  for (int g = 0; g < gamma; g++)
+    if ((st = cycle(m, l + 1, C->b, C->x))) return st;
   for (fcm_index i = 0; i < n; i++) {
     double s = 0.0;
     for (fcm_index p = L->P_ptr[i]; p < L->P_ptr[i + 1]; p++)
