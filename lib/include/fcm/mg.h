@@ -61,8 +61,9 @@ typedef struct fcm_mg fcm_mg;
  * elements of both, so the coarse space separates exactly what the fine one separates
  * (two bodies never share a coarse DOF) and the prolongation is single valued.
  * Rows of A whose off-diagonal entries are all zero (DOFs eliminated by
- * fcm_space_apply_dirichlet()) are left out of the coarse spaces: their prolongation rows
- * are zero, and a coarse DOF whose coinciding fine DOFs are all eliminated is dropped.
+ * fcm_space_apply_dirichlet()) mark the Dirichlet boundary: a coarse DOF whose coinciding
+ * fine DOFs are all eliminated (or dropped) is dropped, so coarse functions vanish there.
+ * The prolongation stays injective, so every coarse matrix is positive definite.
  * @param[in]  ctx   context; must outlive the object
  * @param[in]  space borrowed: must outlive the object
  * @param[in]  A     symmetric positive definite, the space's pattern (fcm_space_matrix_create());

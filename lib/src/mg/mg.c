@@ -511,8 +511,13 @@ static fcm_status coarsen(fcm_mg *m, int l)
     }
     scal_ptr[k + 1] = cnt;
   }
-  /* 6. coarse DOFs: dropped when no active fine DOF interpolates from them or all fine DOFs
-   * at the same point are inactive */
+  /* 6. coarse DOFs: dropped when all fine DOFs at the same point are inactive (eliminated,
+   * or dropped on this level: the coarse node lies on the Dirichlet boundary), or when no
+   * fine DOF interpolates from them. The rows of inactive fine DOFs are kept in P (where a
+   * coarse DOF is not dropped they act as a spring of their diagonal): zeroing them could
+   * make P rank deficient (a coarse cell whose material lies in the fine layer next to the
+   * boundary would see its free fine DOFs on one plane only) and the coarse matrix singular;
+   * dropping columns keeps P injective. */
   FCM_ALLOC(ctx, 3 * ncopy + 1, colcnt);
   FCM_ALLOC(ctx, ncopy + 1, anc);
   FCM_ALLOC(ctx, 3 * ncopy + 1, anc_in);
@@ -523,7 +528,7 @@ static fcm_status coarsen(fcm_mg *m, int l)
       for (int c = 0; c < 3; c++) {
         const fcm_index f = F->dof[3 * k + c];
         const int act = f >= 0 && !F->inactive[f];
-        colcnt[3 * K + c] += act;
+        colcnt[3 * K + c] += f >= 0;
         if (scal_w[p] == 1.0) anc_in[3 * K + c] += !act;
       }
     }
@@ -543,7 +548,7 @@ static fcm_status coarsen(fcm_mg *m, int l)
     for (fcm_index k = 0; k < nk; k++)
       for (int c = 0; c < 3; c++) {
         const fcm_index f = F->dof[3 * k + c];
-        if (f < 0 || F->inactive[f]) continue;
+        if (f < 0) continue;
         for (fcm_index p = scal_ptr[k]; p < scal_ptr[k + 1]; p++) {
           const fcm_index J = C->dof[3 * scal_col[p] + c];
           if (J < 0) continue;
