@@ -47,6 +47,8 @@ int main(int argc, char **argv)
     o.coarse_dofs = 50; /* coarsen as far as the grid allows, for every n */
     if (getenv("FCM_TEST_MG_SMOOTH")) o.pre_smooth = o.post_smooth = atoi(getenv("FCM_TEST_MG_SMOOTH"));
     if (getenv("FCM_TEST_MG_OMEGA")) o.omega = atof(getenv("FCM_TEST_MG_OMEGA"));
+    if (getenv("FCM_TEST_MG_SMOOTHER"))
+      o.smoother = (fcm_mg_smoother)atoi(getenv("FCM_TEST_MG_SMOOTHER"));
     fcm_mg *mg = NULL;
     TEST_OK(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &mg));
     if (!mg) {

@@ -23,14 +23,20 @@ typedef enum fcm_mg_smoother {
   FCM_MG_SMOOTHER_SGS = 0,
   /** Damped Jacobi x += omega D^{-1} (b - A x); rows in parallel, deterministic. */
   FCM_MG_SMOOTHER_JACOBI = 1,
+  /** Symmetric Gauss-Seidel in multicolour order: the rows of each level are coloured
+   * greedily (in row order, no two coupled rows share a colour); a forward sweep runs the
+   * colours in ascending order, the rows of one colour in parallel (they do not read each
+   * other), the backward sweep in descending order. Bitwise independent of the thread
+   * count. */
+  FCM_MG_SMOOTHER_SGS_COLORED = 2,
   FCM_MG_SMOOTHER_COUNT
 } fcm_mg_smoother;
 
 /** Options of fcm_mg_create(); initialize with fcm_mg_options_default(). */
 typedef struct fcm_mg_options {
   fcm_mg_smoother smoother; /**< default FCM_MG_SMOOTHER_SGS */
-  double omega;             /**< relaxation: SGS in (0, 2), Jacobi in (0, 1]; default 1.0 for
-                                 SGS (set 0.6 for Jacobi) */
+  double omega;             /**< relaxation: SGS (both orders) in (0, 2), Jacobi in (0, 1];
+                                 default 1.0 for SGS (set 0.6 for Jacobi) */
   int pre_smooth;           /**< smoothing steps before the coarse correction, >= 0 (default 1;
                                  one SGS step is a forward and a backward sweep) */
   int post_smooth;          /**< after it, >= 0 (default 1); pre = post keeps the cycle
@@ -124,6 +130,8 @@ typedef struct fcm_mg_level_info {
   fcm_index bodies; /**< connected components of the cells, two cells being connected when
                          they share a copy */
   fcm_index grid[3]; /**< cells per axis of the level's grid */
+  int colors;        /**< colours of the rows (FCM_MG_SMOOTHER_SGS_COLORED; 0 otherwise and
+                          on the coarsest level) */
 } fcm_mg_level_info;
 
 /** Sizes of `level`. @return FCM_OK, FCM_ERR_ARG (NULL, level out of range), FCM_ERR_ALLOC

@@ -3,13 +3,20 @@
  * NOTES (state of issue 13, for whoever continues):
  * - Done: hierarchy for Hex8 box grids (any cell count, dropped cells, XFEM pieces), per
  *   component trilinear prolongation, restriction = P^T, Galerkin RAP (sparse, pattern once,
- *   values again in fcm_mg_setup()), CHOLMOD on the coarsest level, SGS (sequential,
- *   deterministic) and damped Jacobi smoothers, V- and W-cycles as solver and CG
- *   preconditioner.
- * - Not done: colour-parallel SGS (SGS is sequential now: deterministic but one
- *   core); Hex20 p-level (Hex20 -> Hex8 on the same grid); scene options
- *   solver.preconditioner/method "multigrid"; the fcm-scaling app; MINRES use.
- * - fcm_mg_setup() requires the same set of eliminated (decoupled) rows as at creation.
+ *   values again in fcm_mg_setup()), CHOLMOD on the coarsest level, smoothers SGS
+ *   (sequential, default), SGS in multicolour order (colour-parallel) and damped Jacobi, all
+ *   deterministic for any thread count; V- and W-cycles as solver (fcm_mg_solve) and as a
+ *   symmetric CG preconditioner (fcm_mg_operator). Tests in tests/mg/.
+ * - Not done (next): Hex20 p-level (Hex20 -> Hex8 on the same grid, then this hierarchy);
+ *   scene options solver.preconditioner / solver.method "multigrid" (sim/linsolve.c);
+ *   MINRES use (an SPD preconditioner of an indefinite tangent: build mg on K_psd); the
+ *   fcm-scaling app (tests/mg/bench.c is its precursor: cholmod, cg-jacobi, cg-mg, mg).
+ * - Known: the cut body's V-cycle factor depends on where the cut lies in the grid (0.2 to
+ *   0.69 measured, not growing with n); coarse cells of blocks holding the cut's end bridge
+ *   the cut there (Dick's "small cuts disappear on coarse levels"). The Galerkin product and
+ *   the hierarchy build are sequential. fcm_mg_setup() needs the same eliminated rows.
+ * - Dirichlet rows (no off-diagonal entry) stay in P (zeroing them made P rank deficient);
+ *   coarse DOFs whose coinciding fine DOFs are all eliminated are dropped.
  *
  * Data per level l: cells (level 0: the space's elements) with a grid position and 8 corner
  * copies (corner bits dx + 2 dy + 4 dz), copies with a node grid position, the connectivity
@@ -49,6 +56,8 @@ typedef struct mg_level {
   int *AP_col;
   double *AP_val;
   double *x, *b, *r;   /* work vectors (x, b unused on level 0) */
+  int ncolor;          /* SGS_COLORED: rows by colour, CSR over colours */
+  fcm_index *color_ptr, *color_rows;
 } mg_level;
 
 struct fcm_mg {
@@ -125,6 +134,8 @@ static void level_free(fcm_ctx *ctx, mg_level *L)
   fcm__free(ctx, L->x);
   fcm__free(ctx, L->b);
   fcm__free(ctx, L->r);
+  fcm__free(ctx, L->color_ptr);
+  fcm__free(ctx, L->color_rows);
   memset(L, 0, sizeof *L);
 }
 
@@ -742,6 +753,48 @@ cleanup:
   return st;
 }
 
+/* Greedy colouring of the rows of the level matrix in row order (a row takes the smallest
+ * colour no coupled row before it has), then the rows grouped by colour, ascending. */
+static fcm_status level_colors(fcm_mg *m, mg_level *L)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  const fcm_csr *A = level_matrix(L);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  int *col = NULL, maxc = 0;
+  fcm_index *seen = NULL, *fill = NULL;
+  FCM_ALLOC(ctx, L->n + 1, col);
+  fcm_index maxdeg = 0;
+  for (fcm_index i = 0; i < L->n; i++)
+    maxdeg = FCM_MAX(maxdeg, rp[i + 1] - rp[i]);
+  FCM_ALLOC(ctx, maxdeg + 2, seen); /* seen[c] == i + 1: colour c taken for row i */
+  for (fcm_index i = 0; i < L->n; i++) {
+    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+      if (ci[p] < i && col[ci[p]] <= maxdeg) seen[col[ci[p]]] = i + 1;
+    int c = 0;
+    while (seen[c] == i + 1)
+      c++;
+    col[i] = c;
+    maxc = FCM_MAX(maxc, c + 1);
+  }
+  L->ncolor = maxc;
+  FCM_ALLOC(ctx, maxc + 1, L->color_ptr);
+  FCM_ALLOC(ctx, L->n + 1, L->color_rows);
+  FCM_ALLOC(ctx, maxc + 1, fill);
+  for (fcm_index i = 0; i < L->n; i++)
+    L->color_ptr[col[i] + 1]++;
+  for (int c = 0; c < maxc; c++)
+    L->color_ptr[c + 1] += L->color_ptr[c];
+  for (fcm_index i = 0; i < L->n; i++)
+    L->color_rows[L->color_ptr[col[i]] + fill[col[i]]++] = i;
+cleanup:
+  fcm__free(ctx, col);
+  fcm__free(ctx, seen);
+  fcm__free(ctx, fill);
+  return st;
+}
+
 /* ------------------------------------------------------------------ create / setup */
 
 fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
@@ -755,9 +808,9 @@ fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
   FCM_CHECK(o.smoother >= 0 && o.smoother < FCM_MG_SMOOTHER_COUNT, ctx, FCM_ERR_ARG,
             "mg_create: smoother = %d is not a fcm_mg_smoother", (int)o.smoother);
   FCM_CHECK(isfinite(o.omega) && o.omega > 0.0 &&
-                (o.smoother == FCM_MG_SMOOTHER_SGS ? o.omega < 2.0 : o.omega <= 1.0),
+                (o.smoother != FCM_MG_SMOOTHER_JACOBI ? o.omega < 2.0 : o.omega <= 1.0),
             ctx, FCM_ERR_ARG, "mg_create: omega = %g outside %s", o.omega,
-            o.smoother == FCM_MG_SMOOTHER_SGS ? "(0, 2) (SGS)" : "(0, 1] (Jacobi)");
+            o.smoother != FCM_MG_SMOOTHER_JACOBI ? "(0, 2) (SGS)" : "(0, 1] (Jacobi)");
   FCM_CHECK(o.pre_smooth >= 0 && o.post_smooth >= 0, ctx, FCM_ERR_ARG,
             "mg_create: pre_smooth = %d, post_smooth = %d must be >= 0", o.pre_smooth,
             o.post_smooth);
@@ -822,6 +875,9 @@ fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
       FCM_TRY(ctx, level_diag(m, C));
     }
   }
+  if (o.smoother == FCM_MG_SMOOTHER_SGS_COLORED)
+    for (int l = 0; l + 1 < m->nlev; l++)
+      if (!m->lev[l].color_ptr) FCM_TRY(ctx, level_colors(m, &m->lev[l]));
   {
     mg_level *Lc = &m->lev[m->nlev - 1];
     FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, level_matrix(Lc), &m->direct));
@@ -865,7 +921,11 @@ cleanup:
 
 /* ------------------------------------------------------------------ cycle */
 
-static void smooth(const fcm_mg *m, mg_level *L, const double *b, double *x, int backward)
+/* One smoothing step. SGS: a forward then a backward sweep, S = (I - B^-1 A)(I - F^-1 A),
+ * which is A-self-adjoint (B = F^T); pre- and post-smoothing both apply S, so the cycle is
+ * symmetric (post-smoothing must be the adjoint of pre-smoothing: backward-then-forward
+ * would not be). */
+static void smooth(const fcm_mg *m, mg_level *L, const double *b, double *x)
 {
   const fcm_csr *A = level_matrix(L);
   const fcm_index *rp = fcm_csr_row_ptr(A);
@@ -880,8 +940,26 @@ static void smooth(const fcm_mg *m, mg_level *L, const double *b, double *x, int
       x[i] += w * (b[i] + L->r[i]) * L->dinv[i];
     return;
   }
+  if (m->opts.smoother == FCM_MG_SMOOTHER_SGS_COLORED) {
+    for (int sweep = 0; sweep < 2; sweep++) {
+      const int back = sweep;
+      for (int t = 0; t < L->ncolor; t++) {
+        const int c = back ? L->ncolor - 1 - t : t;
+        const fcm_index r0 = L->color_ptr[c], r1 = L->color_ptr[c + 1];
+#pragma omp parallel for schedule(static) if (r1 - r0 >= 256)
+        for (fcm_index q = r0; q < r1; q++) {
+          const fcm_index i = L->color_rows[q];
+          double s = b[i];
+          for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+            s -= v[p] * x[ci[p]];
+          x[i] += w * s * L->dinv[i];
+        }
+      }
+    }
+    return;
+  }
   for (int sweep = 0; sweep < 2; sweep++) {
-    const int back = sweep ^ backward;
+    const int back = sweep;
     for (fcm_index t = 0; t < L->n; t++) {
       const fcm_index i = back ? L->n - 1 - t : t;
       double s = b[i];
@@ -901,7 +979,7 @@ static fcm_status cycle(fcm_mg *m, int l, const double *b, double *x)
   }
   mg_level *C = &m->lev[l + 1];
   for (int s = 0; s < m->opts.pre_smooth; s++)
-    smooth(m, L, b, x, 0);
+    smooth(m, L, b, x);
   /* r = b - A x, b_c = R r */
   fcm_csr_apply(level_matrix(L), -1.0, x, 0.0, L->r);
   const fcm_index n = L->n;
@@ -924,7 +1002,7 @@ static fcm_status cycle(fcm_mg *m, int l, const double *b, double *x)
     x[i] += s;
   }
   for (int s = 0; s < m->opts.post_smooth; s++)
-    smooth(m, L, b, x, 1);
+    smooth(m, L, b, x);
   return st;
 }
 
@@ -1009,6 +1087,7 @@ fcm_status fcm_mg_get_level_info(const fcm_mg *m, int level, fcm_mg_level_info *
   info->cells = L->ncell;
   info->copies = L->ncopy;
   info->dofs = L->n;
+  info->colors = L->ncolor;
   fcm_csr_get_size(level_matrix(L), NULL, NULL, &info->nnz);
   for (int d = 0; d < 3; d++)
     info->grid[d] = L->grid[d];
