@@ -1,7 +1,9 @@
-/* Multigrid on Hex8 box grids, static linear elasticity (argument: cube, hemisphere or cut):
- * the V-cycle convergence factor stays below 0.8 for n = 4, 8, 16 cells per axis and, on the
- * cube and the embedded hemisphere, the largest factor is at most 1.25 x the smallest (the
- * cut body's factor varies with the cut's position in the grid), CG preconditioned by one
+/* Multigrid on Hex8 box grids, static linear elasticity (argument: cube, hemisphere, cut:
+ * an XFEM plane cut through the hemisphere's top, split: the plane through the whole body,
+ * two bodies each clamped): the V-cycle convergence factor stays below 0.8 for n = 4, 8, 16
+ * cells per axis and, on the cube and the embedded hemisphere, the largest factor is at most
+ * 1.25 x the smallest (with the XFEM cut it varies with the cut's position in the grid),
+ * CG preconditioned by one
  * V-cycle converges in a number of iterations that does not grow with n (at most 1.5 x
  * the count at the smallest n, plus 2) and far fewer than CG + Jacobi, and its solution
  * equals CHOLMOD's to the tolerance. FCM_TEST_VERBOSE=1 prints the figures. */
@@ -23,6 +25,7 @@ int main(int argc, char **argv)
   if (argc < 2) return 2;
   const int kind = !strcmp(argv[1], "cube") ? 0 : !strcmp(argv[1], "hemisphere") ? 1
                    : !strcmp(argv[1], "cut")                              ? 2
+                   : !strcmp(argv[1], "split")                            ? 3
                                                                           : -1;
   if (kind < 0) return 2;
   const int verbose = getenv("FCM_TEST_VERBOSE") != NULL;
@@ -42,11 +45,12 @@ int main(int argc, char **argv)
     if (kind == 0)
       problem_cube(ctx, sizes[s], &p);
     else
-      problem_hemisphere(ctx, sizes[s], kind == 2, &p);
+      problem_hemisphere(ctx, sizes[s], kind - 1, &p);
     fcm_mg_options o = fcm_mg_options_default();
     o.coarse_dofs = 50; /* coarsen as far as the grid allows, for every n */
     if (getenv("FCM_TEST_MG_SMOOTH")) o.pre_smooth = o.post_smooth = atoi(getenv("FCM_TEST_MG_SMOOTH"));
     if (getenv("FCM_TEST_MG_OMEGA")) o.omega = atof(getenv("FCM_TEST_MG_OMEGA"));
+    if (getenv("FCM_TEST_MG_LEVELS")) o.max_levels = atoi(getenv("FCM_TEST_MG_LEVELS"));
     if (getenv("FCM_TEST_MG_SMOOTHER"))
       o.smoother = (fcm_mg_smoother)atoi(getenv("FCM_TEST_MG_SMOOTHER"));
     fcm_mg *mg = NULL;
@@ -112,10 +116,11 @@ int main(int argc, char **argv)
     problem_free(&p);
   }
   /* Dick et al. Fig. 10: 0.66 uncut, 0.75 cut. The XFEM cut's factor depends on where the
-   * cut meets the grid (measured 0.19 to 0.69 for n = 4 ... 32, not growing with n: the
-   * coarse cells of blocks that hold the cut's end bridge it), so only the bound applies. */
+   * cut meets the grid (measured 0.2 to 0.7 for n = 4 ... 28, not growing with n; the same
+   * for the cut through the whole body, so it is not the cut's end), so only the bound
+   * applies there. */
   TEST_TRUE(fmax <= 0.8);
-  if (kind != 2) TEST_TRUE(fmax <= 1.25 * fmin + 0.02);
+  if (kind < 2) TEST_TRUE(fmax <= 1.25 * fmin + 0.02);
   for (int s = 1; s < ns; s++) {
     TEST_TRUE(it_mg[s] <= 1.5 * it_mg[0] + 2);
     TEST_TRUE(3 * it_mg[s] < it_jac[s]);

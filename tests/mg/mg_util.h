@@ -83,8 +83,9 @@ static inline void problem_cube(fcm_ctx *ctx, fcm_index n, problem *p)
 }
 
 /* Hemisphere of radius 1 on y = 0 in [-1.1, 1.1] x [0, 1.1] x [-1.1, 1.1] with n x n/2 x n
- * cells (n even), clamped at y = 0; cut != 0: a vertical plane cut x = 0.05 through the
- * upper part y > 0.4 (it separates the top into two halves joined below). */
+ * cells (n even), clamped at y = 0; cut = 1: a vertical plane cut x = 0.05 through the
+ * upper part y > 0.4 (it separates the top into two halves joined below); cut = 2: the
+ * same plane through the whole body (two bodies, each clamped). */
 static inline void problem_hemisphere(fcm_ctx *ctx, fcm_index n, int cut, problem *p)
 {
   const double lo[3] = {-1.1, 0, -1.1}, hi[3] = {1.1, 1.1, 1.1}, c[3] = {0, 0, 0};
@@ -98,7 +99,7 @@ static inline void problem_hemisphere(fcm_ctx *ctx, fcm_index n, int cut, proble
   if (cut) {
     fcm_surface *s = NULL;
     const double q[3] = {0.05, 0.0, 0.0}, nx[3] = {1, 0, 0};
-    const double bl[3] = {-0.1, 0.4, -2.0}, bh[3] = {0.2, 2.0, 2.0};
+    const double bl[3] = {-0.1, cut == 2 ? -1.0 : 0.4, -2.0}, bh[3] = {0.2, 2.0, 2.0};
     TEST_OK(ctx, fcm_surface_create_plane(ctx, q, nx, bl, bh, &s));
     TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, p->mesh, p->geom, p->rules0, s, &p->rules));
     fcm_surface_destroy(&s);

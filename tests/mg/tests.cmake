@@ -1,4 +1,4 @@
-foreach(kind cube hemisphere cut)
+foreach(kind cube hemisphere cut split)
   fcm_add_test(mg_convergence_${kind} tests/mg/convergence.c ARGS ${kind})
 endforeach()
 fcm_add_test(mg_bodies tests/mg/bodies.c)

@@ -68,8 +68,9 @@ typedef struct fcm_mg fcm_mg;
  * (two bodies never share a coarse DOF) and the prolongation is single valued.
  * Rows of A whose off-diagonal entries are all zero (DOFs eliminated by
  * fcm_space_apply_dirichlet()) mark the Dirichlet boundary: a coarse DOF whose coinciding
- * fine DOFs are all eliminated (or dropped) is dropped, so coarse functions vanish there.
- * The prolongation stays injective, so every coarse matrix is positive definite.
+ * fine DOFs are all eliminated (or, coarser, constrained) is constrained (decoupled in the
+ * coarse matrix, no correction from it), so coarse corrections vanish there. The
+ * prolongation stays injective, so every coarse matrix is positive definite.
  * @param[in]  ctx   context; must outlive the object
  * @param[in]  space borrowed: must outlive the object
  * @param[in]  A     symmetric positive definite, the space's pattern (fcm_space_matrix_create());

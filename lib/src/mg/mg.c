@@ -15,14 +15,15 @@
  *   0.69 measured, not growing with n); coarse cells of blocks holding the cut's end bridge
  *   the cut there (Dick's "small cuts disappear on coarse levels"). The Galerkin product and
  *   the hierarchy build are sequential. fcm_mg_setup() needs the same eliminated rows.
- * - Dirichlet rows (no off-diagonal entry) stay in P (zeroing them made P rank deficient);
- *   coarse DOFs whose coinciding fine DOFs are all eliminated are dropped.
+ * - Dirichlet: eliminated rows (no off-diagonal entry) and coarse DOFs whose coinciding
+ *   fine DOFs are all inactive stay in P (leaving them out made P rank deficient); coarse
+ *   ones are decoupled in the Galerkin matrix and get no correction.
  *
  * Data per level l: cells (level 0: the space's elements) with a grid position and 8 corner
  * copies (corner bits dx + 2 dy + 4 dz), copies with a node grid position, the connectivity
  * of the cells (face neighbours), and for l < L-1 the DOF prolongation P_l from level l+1.
- * DOFs: copy k, component c is row dof[3k + c] of the level matrix, or -1 when dropped
- * (levels >= 1); level 0 keeps the space's numbering 3k + c. */
+ * DOFs: copy k, component c is row 3k + c of the level matrix on every level (level 0: the
+ * space's numbering); inactive rows are the Dirichlet ones. */
 #include "core/core_impl.h"
 #include "fcm/mg.h"
 
@@ -401,7 +402,7 @@ static fcm_status coarsen(fcm_mg *m, int l)
   fcm_ctx *ctx = m->ctx;
   mg_level *F = &m->lev[l], *C = &m->lev[l + 1];
   fcm_index *uf = NULL, *cid = NULL, *edges = NULL, *cptr = NULL, *cusers = NULL,
-            *cfill = NULL, *scal_ptr = NULL, *scal_col = NULL, *colcnt = NULL, *anc = NULL,
+            *cfill = NULL, *scal_ptr = NULL, *scal_col = NULL, *anc = NULL,
             *anc_in = NULL;
   double *scal_w = NULL;
   const fcm_index nf = F->ncell;
@@ -522,36 +523,34 @@ static fcm_status coarsen(fcm_mg *m, int l)
     }
     scal_ptr[k + 1] = cnt;
   }
-  /* 6. coarse DOFs: dropped when all fine DOFs at the same point are inactive (eliminated,
-   * or dropped on this level: the coarse node lies on the Dirichlet boundary), or when no
-   * fine DOF interpolates from them. The rows of inactive fine DOFs are kept in P (where a
-   * coarse DOF is not dropped they act as a spring of their diagonal): zeroing them could
-   * make P rank deficient (a coarse cell whose material lies in the fine layer next to the
-   * boundary would see its free fine DOFs on one plane only) and the coarse matrix singular;
-   * dropping columns keeps P injective. */
-  FCM_ALLOC(ctx, 3 * ncopy + 1, colcnt);
+  /* 6. coarse DOFs, all 3 per copy; inactive (Dirichlet) when all fine DOFs at the same
+   * point are inactive (eliminated on level 0, inactive on coarser levels): the coarse node
+   * lies on the Dirichlet boundary. Inactive DOFs keep their rows and their columns of P
+   * (as eliminated rows on level 0 do), so P stays injective and every coarse matrix
+   * positive definite; the Galerkin matrix decouples them (off-diagonals zeroed, the
+   * diagonal kept: a spring) and the cycle restricts zero to them and prolongates nothing
+   * from them. Leaving them out instead made P rank deficient next to a clamped face (a
+   * coarse cell whose material lies in the fine layer at the face sees its free fine DOFs
+   * on one plane only) and the coarsest CHOLMOD factor fail. */
   FCM_ALLOC(ctx, ncopy + 1, anc);
   FCM_ALLOC(ctx, 3 * ncopy + 1, anc_in);
   for (fcm_index k = 0; k < nk; k++)
     for (fcm_index p = scal_ptr[k]; p < scal_ptr[k + 1]; p++) {
+      if (scal_w[p] != 1.0) continue;
       const fcm_index K = scal_col[p];
-      if (scal_w[p] == 1.0) anc[K]++;
-      for (int c = 0; c < 3; c++) {
-        const fcm_index f = F->dof[3 * k + c];
-        const int act = f >= 0 && !F->inactive[f];
-        colcnt[3 * K + c] += f >= 0;
-        if (scal_w[p] == 1.0) anc_in[3 * K + c] += !act;
-      }
+      anc[K]++;
+      for (int c = 0; c < 3; c++)
+        anc_in[3 * K + c] += F->inactive[3 * k + c];
     }
-  FCM_ALLOC(ctx, 3 * ncopy + 1, C->dof);
-  fcm_index n = 0;
+  C->n = 3 * ncopy;
+  FCM_ALLOC(ctx, C->n + 1, C->dof);
+  FCM_ALLOC(ctx, C->n + 1, C->inactive);
   for (fcm_index K = 0; K < ncopy; K++)
     for (int c = 0; c < 3; c++) {
-      const int drop = colcnt[3 * K + c] == 0 || (anc[K] > 0 && anc_in[3 * K + c] == anc[K]);
-      C->dof[3 * K + c] = drop ? -1 : n++;
+      C->dof[3 * K + c] = 3 * K + c;
+      C->inactive[3 * K + c] = (unsigned char)(anc[K] > 0 && anc_in[3 * K + c] == anc[K]);
     }
-  C->n = n;
-  FCM_ALLOC(ctx, n + 1, C->inactive);
+  const fcm_index n = C->n;
   /* 7. DOF prolongation (F->n x C->n) and its transpose */
   FCM_ALLOC(ctx, F->n + 1, F->P_ptr);
   for (int pass = 0; pass < 2; pass++) {
@@ -610,7 +609,6 @@ cleanup:
   fcm__free(ctx, scal_ptr);
   fcm__free(ctx, scal_col);
   fcm__free(ctx, scal_w);
-  fcm__free(ctx, colcnt);
   fcm__free(ctx, anc);
   fcm__free(ctx, anc_in);
   return st;
@@ -709,6 +707,16 @@ static fcm_status galerkin_values(fcm_mg *m, int l)
       v[p] = v[q] = s;
     }
   for (fcm_index i = 0; i < C->n; i++) {
+    if (!C->inactive[i]) continue;
+    for (fcm_index p = cp[i]; p < cp[i + 1]; p++) {
+      const fcm_index j = cc[p];
+      if (j == i) continue;
+      v[p] = 0.0;
+      v[fcm_csr_position(C->Aown, j, i)] = 0.0;
+    }
+  }
+  for (fcm_index i = 0; i < C->n; i++) {
+    if (C->inactive[i] && !(v[C->diag[i]] > 0.0)) v[C->diag[i]] = 1.0; /* decoupled anyway */
     const double d = v[C->diag[i]];
     FCM_CHECK(isfinite(d) && d > 0.0, ctx, FCM_ERR_NUMERIC,
               "mg: level %d, row %lld: Galerkin diagonal %g is not positive (is A positive "
@@ -989,12 +997,14 @@ static fcm_status cycle(fcm_mg *m, int l, const double *b, double *x)
     double s = 0.0;
     for (fcm_index p = L->R_ptr[J]; p < L->R_ptr[J + 1]; p++)
       s += L->R_val[p] * L->r[L->R_col[p]];
-    C->b[J] = s;
+    C->b[J] = C->inactive[J] ? 0.0 : s;
     C->x[J] = 0.0;
   }
   const int gamma = l + 2 == m->nlev ? 1 : m->opts.cycle_index; /* the coarsest is exact */
   for (int g = 0; g < gamma; g++)
     if ((st = cycle(m, l + 1, C->b, C->x))) return st;
+  for (fcm_index J = 0; J < C->n; J++)
+    if (C->inactive[J]) C->x[J] = 0.0; /* nothing from the Dirichlet boundary */
   for (fcm_index i = 0; i < n; i++) {
     double s = 0.0;
     for (fcm_index p = L->P_ptr[i]; p < L->P_ptr[i + 1]; p++)
