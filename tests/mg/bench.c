@@ -42,8 +42,8 @@ int main(int argc, char **argv)
     t0 = omp_get_wtime();
     TEST_OK(ctx, fcm_jacobi_create(ctx, p.A, FCM_JACOBI_SCALAR, &J));
     t1 = omp_get_wtime();
-    TEST_OK(ctx, fcm_cg_solve(ctx, p.n, fcm_csr_operator, p.A, fcm_jacobi_operator, J, p.b, x,
-                              &ko, &ki));
+    TEST_OK(ctx, fcm_cg_solve(ctx, p.n, fcm_csr_operator, p.A, fcm_jacobi_operator, J, p.b, x, &ko,
+                              &ki));
     t2 = omp_get_wtime();
     printf("%s,%lld,%lld,cg-jacobi,%d,%.3f,%.3f\n", argv[1], (long long)n, (long long)p.n,
            ki.iterations, t1 - t0, t2 - t1);
@@ -53,8 +53,8 @@ int main(int argc, char **argv)
     TEST_OK(ctx, fcm_mg_create(ctx, p.space, p.A, NULL, &mg));
     t1 = omp_get_wtime();
     memset(x, 0, sizeof *x * (size_t)p.n);
-    TEST_OK(ctx, fcm_cg_solve(ctx, p.n, fcm_csr_operator, p.A, fcm_mg_operator, mg, p.b, x, &ko,
-                              &ki));
+    TEST_OK(ctx,
+            fcm_cg_solve(ctx, p.n, fcm_csr_operator, p.A, fcm_mg_operator, mg, p.b, x, &ko, &ki));
     t2 = omp_get_wtime();
     printf("%s,%lld,%lld,cg-mg,%d,%.3f,%.3f\n", argv[1], (long long)n, (long long)p.n,
            ki.iterations, t1 - t0, t2 - t1);
@@ -67,8 +67,8 @@ int main(int argc, char **argv)
     t1 = omp_get_wtime();
     TEST_OK(ctx, fcm_mg_solve(mg, p.b, x, 1e-8, 1000, &si));
     t2 = omp_get_wtime();
-    printf("%s,%lld,%lld,mg,%d,%.3f,%.3f\n", argv[1], (long long)n, (long long)p.n, si.cycles,
-           0.0, t2 - t1);
+    printf("%s,%lld,%lld,mg,%d,%.3f,%.3f\n", argv[1], (long long)n, (long long)p.n, si.cycles, 0.0,
+           t2 - t1);
     fflush(stdout);
     fcm_mg_destroy(&mg);
     free(x);

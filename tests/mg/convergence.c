@@ -23,10 +23,11 @@ int main(int argc, char **argv)
 {
   fcm_ctx *ctx = NULL;
   if (argc < 2) return 2;
-  const int kind = !strcmp(argv[1], "cube") ? 0 : !strcmp(argv[1], "hemisphere") ? 1
-                   : !strcmp(argv[1], "cut")                              ? 2
-                   : !strcmp(argv[1], "split")                            ? 3
-                                                                          : -1;
+  const int kind = !strcmp(argv[1], "cube")         ? 0
+                   : !strcmp(argv[1], "hemisphere") ? 1
+                   : !strcmp(argv[1], "cut")        ? 2
+                   : !strcmp(argv[1], "split")      ? 3
+                                                    : -1;
   if (kind < 0) return 2;
   const int verbose = getenv("FCM_TEST_VERBOSE") != NULL;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
@@ -48,7 +49,8 @@ int main(int argc, char **argv)
       problem_hemisphere(ctx, sizes[s], kind - 1, &p);
     fcm_mg_options o = fcm_mg_options_default();
     o.coarse_dofs = 50; /* coarsen as far as the grid allows, for every n */
-    if (getenv("FCM_TEST_MG_SMOOTH")) o.pre_smooth = o.post_smooth = atoi(getenv("FCM_TEST_MG_SMOOTH"));
+    if (getenv("FCM_TEST_MG_SMOOTH"))
+      o.pre_smooth = o.post_smooth = atoi(getenv("FCM_TEST_MG_SMOOTH"));
     if (getenv("FCM_TEST_MG_OMEGA")) o.omega = atof(getenv("FCM_TEST_MG_OMEGA"));
     if (getenv("FCM_TEST_MG_LEVELS")) o.max_levels = atoi(getenv("FCM_TEST_MG_LEVELS"));
     if (getenv("FCM_TEST_MG_SMOOTHER"))
@@ -72,8 +74,8 @@ int main(int argc, char **argv)
     ko.max_iterations = 5000;
     fcm_krylov_info ki;
     memset(x, 0, sizeof *x * (size_t)p.n);
-    TEST_OK(ctx, fcm_cg_solve(ctx, p.n, fcm_csr_operator, p.A, fcm_mg_operator, mg, p.b, x, &ko,
-                              &ki));
+    TEST_OK(ctx,
+            fcm_cg_solve(ctx, p.n, fcm_csr_operator, p.A, fcm_mg_operator, mg, p.b, x, &ko, &ki));
     it_mg[s] = ki.iterations;
     double dn = 0.0, xn = 0.0;
     for (fcm_index i = 0; i < p.n; i++)

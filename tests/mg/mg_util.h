@@ -104,8 +104,7 @@ static inline void problem_hemisphere(fcm_ctx *ctx, fcm_index n, int cut, proble
     TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, p->mesh, p->geom, p->rules0, s, &p->rules));
     fcm_surface_destroy(&s);
   }
-  TEST_OK(ctx, fcm_space_create_embedded(ctx, p->mesh, p->rules ? p->rules : p->rules0,
-                                         &p->space));
+  TEST_OK(ctx, fcm_space_create_embedded(ctx, p->mesh, p->rules ? p->rules : p->rules0, &p->space));
   finish_space(ctx, p, 0);
   const double flo[3] = {-2, 0, -2}, fhi[3] = {2, 0, 2};
   clamp_box(ctx, p, flo, fhi);

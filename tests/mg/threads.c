@@ -21,8 +21,8 @@ static double *solve(fcm_ctx *ctx, problem *p, fcm_mg_smoother sm, int threads, 
   fcm_krylov_options ko = fcm_krylov_options_default();
   ko.rtol = 1e-9;
   fcm_krylov_info ki;
-  TEST_OK(ctx, fcm_cg_solve(ctx, p->n, fcm_csr_operator, p->A, fcm_mg_operator, mg, p->b, x, &ko,
-                            &ki));
+  TEST_OK(ctx,
+          fcm_cg_solve(ctx, p->n, fcm_csr_operator, p->A, fcm_mg_operator, mg, p->b, x, &ko, &ki));
   fcm_mg_solve_info si;
   const fcm_status st = fcm_mg_solve(mg, p->b, x, 1e-14, 3, &si); /* 3 more cycles */
   TEST_TRUE(st == FCM_OK || st == FCM_ERR_NOT_CONVERGED);

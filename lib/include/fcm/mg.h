@@ -116,20 +116,20 @@ typedef struct fcm_mg_solve_info {
 /** Cycles from the guess in x until ||b - A x||_2 <= rtol ||b||_2 or max_cycles.
  * @return FCM_OK (converged), FCM_ERR_NOT_CONVERGED, FCM_ERR_NUMERIC (NaN residual),
  * FCM_ERR_ARG (NULL, rtol < 0, max_cycles < 0). info may be NULL. */
-FCM_API fcm_status fcm_mg_solve(fcm_mg *mg, const double *b, double *x, double rtol,
-                                int max_cycles, fcm_mg_solve_info *info);
+FCM_API fcm_status fcm_mg_solve(fcm_mg *mg, const double *b, double *x, double rtol, int max_cycles,
+                                fcm_mg_solve_info *info);
 
 /** Number of levels (1: the finest is solved directly). */
 FCM_API int fcm_mg_num_levels(const fcm_mg *mg);
 
 /** Sizes of one level (0 finest). */
 typedef struct fcm_mg_level_info {
-  fcm_index cells;  /**< elements (level 0) or coarse cells */
-  fcm_index copies; /**< node copies (3 DOFs each before dropping) */
-  fcm_index dofs;   /**< rows of the level matrix */
-  fcm_index nnz;    /**< stored entries of the level matrix */
-  fcm_index bodies; /**< connected components of the cells, two cells being connected when
-                         they share a copy */
+  fcm_index cells;   /**< elements (level 0) or coarse cells */
+  fcm_index copies;  /**< node copies (3 DOFs each before dropping) */
+  fcm_index dofs;    /**< rows of the level matrix */
+  fcm_index nnz;     /**< stored entries of the level matrix */
+  fcm_index bodies;  /**< connected components of the cells, two cells being connected when
+                          they share a copy */
   fcm_index grid[3]; /**< cells per axis of the level's grid */
   int colors;        /**< colours of the rows (FCM_MG_SMOOTHER_SGS_COLORED; 0 otherwise and
                           on the coarsest level) */

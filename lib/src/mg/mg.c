@@ -32,22 +32,22 @@
 #include <string.h>
 
 typedef struct mg_level {
-  fcm_index grid[3];   /* cells per axis */
-  fcm_index ncell;     /* cells (level 0: elements) */
-  fcm_index *ijk;      /* 3 per cell */
-  fcm_index *corner;   /* 8 copies per cell (corner bits dx + 2 dy + 4 dz) */
-  unsigned char *own;  /* level 0: the element uses the copy at its own node (1 on coarse) */
-  fcm_index *adj_ptr;  /* cell graph (connected face neighbours), CSR */
+  fcm_index grid[3];  /* cells per axis */
+  fcm_index ncell;    /* cells (level 0: elements) */
+  fcm_index *ijk;     /* 3 per cell */
+  fcm_index *corner;  /* 8 copies per cell (corner bits dx + 2 dy + 4 dz) */
+  unsigned char *own; /* level 0: the element uses the copy at its own node (1 on coarse) */
+  fcm_index *adj_ptr; /* cell graph (connected face neighbours), CSR */
   fcm_index *adj;
   fcm_index ncopy;
-  fcm_index *copy_ijk; /* 3 per copy: node grid position */
-  fcm_index *dof;      /* 3 per copy: row or -1 */
+  fcm_index *copy_ijk;     /* 3 per copy: node grid position */
+  fcm_index *dof;          /* 3 per copy: row or -1 */
   unsigned char *inactive; /* per row: eliminated (level 0) */
-  fcm_index n;         /* rows */
-  const fcm_csr *A;    /* level 0: borrowed */
-  fcm_csr *Aown;       /* levels >= 1 */
-  fcm_index *diag;     /* position of a_ii */
-  double *dinv;        /* 1 / a_ii */
+  fcm_index n;             /* rows */
+  const fcm_csr *A;        /* level 0: borrowed */
+  fcm_csr *Aown;           /* levels >= 1 */
+  fcm_index *diag;         /* position of a_ii */
+  double *dinv;            /* 1 / a_ii */
   /* prolongation from level l+1 (n x n_coarse) and its transpose */
   fcm_index *P_ptr, *R_ptr;
   int *P_col, *R_col;
@@ -56,8 +56,8 @@ typedef struct mg_level {
   fcm_index *AP_ptr;
   int *AP_col;
   double *AP_val;
-  double *x, *b, *r;   /* work vectors (x, b unused on level 0) */
-  int ncolor;          /* SGS_COLORED: rows by colour, CSR over colours */
+  double *x, *b, *r; /* work vectors (x, b unused on level 0) */
+  int ncolor;        /* SGS_COLORED: rows by colour, CSR over colours */
   fcm_index *color_ptr, *color_rows;
 } mg_level;
 
@@ -172,8 +172,7 @@ static int linked(const fcm_index *links, fcm_index nl, fcm_index p, fcm_index q
 
 /* Build the cell graph CSR from an edge list (pairs, both directions added, deduplicated). */
 static fcm_status graph_from_edges(fcm_ctx *ctx, fcm_index ncell, fcm_index nedge,
-                                   const fcm_index *edges, fcm_index **ptr_out,
-                                   fcm_index **adj_out)
+                                   const fcm_index *edges, fcm_index **ptr_out, fcm_index **adj_out)
 {
   fcm_status st = FCM_OK;
   fcm_index *ptr = NULL, *adj = NULL, *fill = NULL;
@@ -246,8 +245,7 @@ static fcm_status build_level0(fcm_mg *m, const fcm_csr *A)
     for (int d = 0; d < 3; d++) {
       const double t = (X[3 * n + d] - lo[d]) / h[d];
       const fcm_index r = (fcm_index)llround(t);
-      FCM_CHECK(fabs(t - (double)r) < 1e-6 && r >= 0 && r <= L->grid[d], ctx,
-                FCM_ERR_UNSUPPORTED,
+      FCM_CHECK(fabs(t - (double)r) < 1e-6 && r >= 0 && r <= L->grid[d], ctx, FCM_ERR_UNSUPPORTED,
                 "mg: node %lld is not on the grid of spacing %g along axis %d (not a box grid)",
                 (long long)n, h[d], d);
       node_ijk[3 * n + d] = r;
@@ -401,9 +399,8 @@ static fcm_status coarsen(fcm_mg *m, int l)
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
   mg_level *F = &m->lev[l], *C = &m->lev[l + 1];
-  fcm_index *uf = NULL, *cid = NULL, *edges = NULL, *cptr = NULL, *cusers = NULL,
-            *cfill = NULL, *scal_ptr = NULL, *scal_col = NULL, *anc = NULL,
-            *anc_in = NULL;
+  fcm_index *uf = NULL, *cid = NULL, *edges = NULL, *cptr = NULL, *cusers = NULL, *cfill = NULL,
+            *scal_ptr = NULL, *scal_col = NULL, *anc = NULL, *anc_in = NULL;
   double *scal_w = NULL;
   const fcm_index nf = F->ncell;
   for (int d = 0; d < 3; d++)
@@ -617,10 +614,9 @@ cleanup:
 /* ------------------------------------------------------------------ Galerkin product */
 
 /* Symbolic C = A B (rows of A, columns of B: ncol), sorted columns. mark: ncol entries. */
-static fcm_status spgemm_symbolic(fcm_ctx *ctx, fcm_index nrow, const fcm_index *Ap,
-                                  const int *Ac, const fcm_index *Bp, const int *Bc,
-                                  fcm_index ncol, fcm_index *mark, fcm_index **Cp_out,
-                                  int **Cc_out)
+static fcm_status spgemm_symbolic(fcm_ctx *ctx, fcm_index nrow, const fcm_index *Ap, const int *Ac,
+                                  const fcm_index *Bp, const int *Bc, fcm_index ncol,
+                                  fcm_index *mark, fcm_index **Cp_out, int **Cc_out)
 {
   fcm_status st = FCM_OK;
   fcm_index *Cp = NULL;
@@ -922,7 +918,8 @@ fcm_status fcm_mg_setup(fcm_mg *m)
   FCM_TRY(ctx, level0_dinv(m));
   for (int l = 0; l + 1 < m->nlev; l++)
     FCM_TRY(ctx, galerkin_values(m, l));
-  FCM_TRY(ctx, fcm_direct_factor(m->direct, fcm_csr_values_read(level_matrix(&m->lev[m->nlev - 1]))));
+  FCM_TRY(ctx,
+          fcm_direct_factor(m->direct, fcm_csr_values_read(level_matrix(&m->lev[m->nlev - 1]))));
 cleanup:
   return st;
 }
@@ -1091,8 +1088,7 @@ fcm_status fcm_mg_get_level_info(const fcm_mg *m, int level, fcm_mg_level_info *
   fcm_ctx *ctx = m ? m->ctx : NULL;
   fcm_index *uf = NULL;
   FCM_CHECK(m && info && level >= 0 && level < m->nlev, ctx, FCM_ERR_ARG,
-            "mg_get_level_info: NULL argument or level %d outside [0, %d)", level,
-            m ? m->nlev : 0);
+            "mg_get_level_info: NULL argument or level %d outside [0, %d)", level, m ? m->nlev : 0);
   const mg_level *L = &m->lev[level];
   info->cells = L->ncell;
   info->copies = L->ncopy;
