@@ -31,3 +31,7 @@ fcm_add_test(embed_limits tests/embed/limits.c)
 # error with both boxes), the progress callback, voxel and level-set bodies embedded.
 fcm_add_test(embed_diagnostics tests/embed/diagnostics.c)
 fcm_add_test(embed_cut tests/embed/cut.c)
+# Rule kinds asked for (fcm_cell_rules_options.kinds): stiffness alone builds no mass points
+# and gives the same stiffness rules; the kind not built is FCM_ERR_ARG (accessors, mass
+# matrix, momentum); a cut keeps the kinds; bad kind sets rejected.
+fcm_add_test(embed_kinds tests/embed/kinds.c)

@@ -41,6 +41,9 @@ FCM_API fcm_simulation_options fcm_simulation_options_default(void);
 typedef struct fcm_simulation_counters {
   int cell_rules;              /**< 1: embedded cell rules were built (scene has a geometry) */
   int surface_rules;           /**< 1: the cell rules carry surface rules */
+  unsigned rule_kinds;         /**< volume rule kinds built (FCM_RULES_* bits of fcm/embed.h):
+                                    stiffness always, mass only for a dynamic scene; 0 without
+                                    cell rules */
   int inertia;                 /**< 1: dynamic integrator (inertia term); 0: static */
   int mass_assemblies;         /**< consistent-mass assemblies: 1 for dynamic scenes, 0 static */
   int body_force_assemblies;   /**< body-force assemblies the integrator's setup made (one per
