@@ -31,7 +31,8 @@ static void stiffness_only(const fcm_mesh *m, const fcm_geometry *g)
   const fcm_cell_rules_stats *sa = fcm_cell_rules_get_stats(all);
   const fcm_cell_rules_stats *ss = fcm_cell_rules_get_stats(st);
   TEST_TRUE(sa->kinds == FCM_RULES_ALL && ss->kinds == FCM_RULES_STIFFNESS);
-  TEST_TRUE(fcm_cell_rules_has_kind(all, FCM_RULE_MASS) && !fcm_cell_rules_has_kind(st, FCM_RULE_MASS));
+  TEST_TRUE(fcm_cell_rules_has_kind(all, FCM_RULE_MASS) &&
+            !fcm_cell_rules_has_kind(st, FCM_RULE_MASS));
   TEST_TRUE(fcm_cell_rules_has_kind(st, FCM_RULE_STIFFNESS));
   TEST_TRUE(!fcm_cell_rules_has_kind(st, (fcm_rule_kind)7) && !fcm_cell_rules_has_kind(NULL, 0));
   TEST_TRUE(sa->num_cut > 0 && sa->num_uncut > 0); /* both classes are exercised */
@@ -86,8 +87,8 @@ static void stiffness_only(const fcm_mesh *m, const fcm_geometry *g)
     TEST_ERR(ctx, fcm_assemble_mass(sp, &mat, NULL, A), FCM_ERR_ARG,
              "mass matrix needs mass rules");
     double mass = -1.0;
-    TEST_ERR(ctx, fcm_space_momentum(sp, mat.density, NULL, NULL, &mass, NULL, NULL),
-             FCM_ERR_ARG, "without them");
+    TEST_ERR(ctx, fcm_space_momentum(sp, mat.density, NULL, NULL, &mass, NULL, NULL), FCM_ERR_ARG,
+             "without them");
   }
   fcm_csr_destroy(&A);
   fcm_space_destroy(&sp);

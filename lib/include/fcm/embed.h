@@ -1,6 +1,6 @@
 /* fcm — embedded (cut-cell) quadrature: per background cell, the embedded geometry is
  * clipped by the cell's planes, tetrahedralized and integrated with a tet rule mapped into
- * the cell's reference element (Longva et al. 2020 §4.5, DESIGN §5); cut-cell rules are
+ * the cell's reference element (Longva et al. 2020 §4.5, lib/METHOD.md §5); cut-cell rules are
  * simplified (fcm/simplify.h) and stabilized; surface rules on the embedded boundary.
  *
  * Rules live in reference coordinates xi of the background cell K. A volume rule's weight
@@ -27,7 +27,7 @@ typedef enum fcm_cell_class {
   FCM_CELL_DROPPED    /**< phi < min_fraction: no points; the cell leaves the system */
 } fcm_cell_class;
 
-/** The two volume rules each cell carries (DESIGN §3: separate strengths). */
+/** The two volume rules each cell carries (lib/METHOD.md §3: separate strengths). */
 typedef enum fcm_rule_kind {
   FCM_RULE_STIFFNESS = 0, /**< stiffness, internal and body forces */
   FCM_RULE_MASS = 1,      /**< consistent mass */
@@ -40,8 +40,8 @@ typedef enum fcm_rule_kind {
  * from rules without mass rules, ...) is FCM_ERR_ARG naming the missing kind, never an
  * empty rule. Surface rules are requested separately by surface_strength >= 0. */
 #define FCM_RULES_STIFFNESS (1u << FCM_RULE_STIFFNESS) /**< stiffness, internal and body forces */
-#define FCM_RULES_MASS (1u << FCM_RULE_MASS)           /**< consistent mass, momentum */
-#define FCM_RULES_ALL (FCM_RULES_STIFFNESS | FCM_RULES_MASS) /**< both volume kinds (default) */
+#define FCM_RULES_MASS      (1u << FCM_RULE_MASS)      /**< consistent mass, momentum */
+#define FCM_RULES_ALL       (FCM_RULES_STIFFNESS | FCM_RULES_MASS) /**< both volume kinds (default) */
 
 /** Static name of a kind ("stiffness", "mass"; "invalid" outside the enum). */
 FCM_API const char *fcm_rule_kind_name(fcm_rule_kind kind);
@@ -83,12 +83,12 @@ typedef void (*fcm_cell_rules_progress_fn)(fcm_index done, fcm_index total, void
 
 /** Options of fcm_cell_rules_create(); initialize with fcm_cell_rules_options_default(). */
 typedef struct fcm_cell_rules_options {
-  unsigned kinds;        /**< the volume rules to build, a non-empty set of FCM_RULES_* bits;
-                              default FCM_RULES_ALL (what every caller got before the kinds
-                              could be chosen). A static problem needs FCM_RULES_STIFFNESS
-                              only; mass rules serve the mass matrix (dynamics, Rayleigh
-                              damping) and fcm_space_momentum(). The scene runner derives the
-                              set from the scene (fcm/simulation.h). */
+  unsigned kinds; /**< the volume rules to build, a non-empty set of FCM_RULES_* bits;
+                       default FCM_RULES_ALL (what every caller got before the kinds
+                       could be chosen). A static problem needs FCM_RULES_STIFFNESS
+                       only; mass rules serve the mass matrix (dynamics, Rayleigh
+                       damping) and fcm_space_momentum(). The scene runner derives the
+                       set from the scene (fcm/simulation.h). */
   int strength[FCM_RULE_KIND_COUNT]; /**< per kind; FCM_DEFAULT (default): the element's */
   int surface_strength;  /**< FCM_DEFAULT (default): no surface rules; else the triangle rule
                               strength (the explicit request for surface rules) */
@@ -190,7 +190,7 @@ typedef struct fcm_cell_rules_stats {
 /** Per-cell quadrature of an embedded geometry in a background mesh (opaque). */
 typedef struct fcm_cell_rules fcm_cell_rules;
 
-/** Build the rules of every background cell (DESIGN §5): AABB-tree candidates, convex
+/** Build the rules of every background cell (lib/METHOD.md §5): AABB-tree candidates, convex
  * clipping by the cell's face planes, fan tetrahedralization, tet rules mapped into the
  * reference cell (closed-form inverse for affine cells, Newton otherwise), classification;
  * then per cut cell simplification (if enabled) followed by stabilization points (flag 1).

@@ -1,4 +1,4 @@
-/* fcm — running a scene (DESIGN §1.2): build the background mesh, the embedded geometry, its
+/* fcm — running a scene (lib/METHOD.md §1.2): build the background mesh, the embedded geometry, its
  * cell rules, the space and an integrator carrying exactly the scene's effects; step it;
  * write VTU/PVD frames of the background field and of the deformed embedded surface and a
  * CSV log per step. Counters say what was computed and what was skipped.

@@ -235,9 +235,10 @@ static fcm_status check_rule_memory(const build *B, const fcm_cell_rules *R,
   const double limit = B->o->max_rule_memory;
   size_t n[FCM_RULE_KIND_COUNT];
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
-    n[k] = !B->tet_rule[k] ? 0
-                           : ws->num_tets * (size_t)fcm_rule_num_points(B->tet_rule[k]) +
-                                 (B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0);
+    n[k] = !B->tet_rule[k]
+               ? 0
+               : ws->num_tets * (size_t)fcm_rule_num_points(B->tet_rule[k]) +
+                     (B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     FCM_CHECK(n[k] <= (size_t)1 << 30, B->ctx, FCM_ERR_UNSUPPORTED,
               "embed: background cell %lld would get %zu initial %s points (limit 2^30)",
@@ -1563,13 +1564,14 @@ void fcm_cell_rules_view(const fcm_cell_rules *rules, FILE *stream)
     if (!rules->uncut[k])
       fprintf(stream, "  %-9s not built (fcm_cell_rules_options.kinds)\n", names[k]);
     else
-      fprintf(stream,
-            "  %-9s strength %d: cut-cell points %lld initial -> %lld simplified "
-            "(+%lld stabilization), total %lld; skipped %lld, fallbacks %lld, max residual %.3g\n",
-            names[k], rules->strength[k], (long long)S->points_initial[k],
-            (long long)S->points_simplified[k], (long long)S->points_stabilization[k],
-            (long long)S->points_total[k], (long long)S->simplify_skipped[k],
-            (long long)S->simplify_fallbacks[k], S->max_residual[k]);
+      fprintf(
+          stream,
+          "  %-9s strength %d: cut-cell points %lld initial -> %lld simplified "
+          "(+%lld stabilization), total %lld; skipped %lld, fallbacks %lld, max residual %.3g\n",
+          names[k], rules->strength[k], (long long)S->points_initial[k],
+          (long long)S->points_simplified[k], (long long)S->points_stabilization[k],
+          (long long)S->points_total[k], (long long)S->simplify_skipped[k],
+          (long long)S->simplify_fallbacks[k], S->max_residual[k]);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     const fcm_simplify_decision *d = &S->decision[k];
     if (d->point_cost > 0.0)

@@ -916,9 +916,9 @@ static fcm_status log_momentum(fcm_simulation *S, fcm__log_row *r)
     r->momentum[0] = r->momentum[1] = r->momentum[2] = 0.0;
     return FCM_OK;
   }
-  FCM_TRY(S->ctx, fcm_space_momentum(S->space, rho, fcm_integrator_displacement(S->integ),
-                                     fcm_integrator_velocity(S->integ), &r->mass, r->momentum,
-                                     NULL));
+  FCM_TRY(S->ctx,
+          fcm_space_momentum(S->space, rho, fcm_integrator_displacement(S->integ),
+                             fcm_integrator_velocity(S->integ), &r->mass, r->momentum, NULL));
 cleanup:
   return st;
 }
@@ -1247,8 +1247,8 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
   if (S->rules) { /* which rule kinds the scene called for, with their stored points */
     const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(S->rules);
     const int mass = (c->rule_kinds & FCM_RULES_MASS) != 0;
-    snprintf(b, sizeof b, "stiffness (%lld points)%s", (long long)rs->points_total[FCM_RULE_STIFFNESS],
-             mass ? ", mass" : "");
+    snprintf(b, sizeof b, "stiffness (%lld points)%s",
+             (long long)rs->points_total[FCM_RULE_STIFFNESS], mass ? ", mass" : "");
     if (mass)
       snprintf(b + strlen(b), sizeof b - strlen(b), " (%lld points)",
                (long long)rs->points_total[FCM_RULE_MASS]);
