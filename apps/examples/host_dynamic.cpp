@@ -11,7 +11,8 @@
 #include <cstdio>
 #include <vector>
 
-namespace {
+namespace
+{
 
 // Throw-free error handling: print the library's message and report failure.
 bool ok(fcm_ctx *ctx, fcm_status st, const char *what)
@@ -103,12 +104,12 @@ bool run(fcm_ctx *ctx)
       // Cut between steps: new rules, a new space, an integrator continuing the old state.
       Body next;
       double m1 = 0, p1[3];
-      failed = !ok(ctx, fcm_cell_rules_create_cut(ctx, mesh, bar, body.rules, cut, &next.rules),
-                   "cut rules") ||
-               !ok(ctx, fcm_space_create_embedded(ctx, mesh, next.rules, &next.space),
-                   "cut space") ||
-               !ok(ctx, fcm_integrator_create_cut(body.integ, next.space, &next.integ),
-                   "cut integrator");
+      failed =
+          !ok(ctx, fcm_cell_rules_create_cut(ctx, mesh, bar, body.rules, cut, &next.rules),
+              "cut rules") ||
+          !ok(ctx, fcm_space_create_embedded(ctx, mesh, next.rules, &next.space), "cut space") ||
+          !ok(ctx, fcm_integrator_create_cut(body.integ, next.space, &next.integ),
+              "cut integrator");
       if (failed) {
         next.release();
         break;

@@ -2,10 +2,11 @@
  * host program with fcm's C API. Writes the background grid and the embedded surface as VTU,
  * both at reference positions with a `displacement` array (ParaView: Warp By Vector).
  *   cc host_static.c $(pkg-config --cflags --libs fcm) -o host_static && ./host_static [dir]
+ * (shared libfcm: nothing else to link; the .pc's rpath finds the library at run time)
  * Exit status 0 when the run succeeded and the ball sags under its weight. */
 #include <fcm/fcm.h>
 
-#include <math.h>
+#include <math.h> /* HUGE_VAL */
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -68,8 +69,7 @@ int main(int argc, char **argv)
   CHECK(fcm_integrator_setup(integ));
   fcm_step_info si;
   CHECK(fcm_integrator_step(integ, &si));
-  printf("static solve: %d Newton iterations, residual %.3g\n", si.newton_iterations,
-         si.residual);
+  printf("static solve: %d Newton iterations, residual %.3g\n", si.newton_iterations, si.residual);
 
   /* Background VTU: node displacement (first DOF copy; nodes without DOFs stay at 0). */
   const double *u = fcm_integrator_displacement(integ);
@@ -106,15 +106,16 @@ int main(int argc, char **argv)
   CHECK(fcm_vtu_write(vtu, path, NULL));
 
   /* The ball sags: its top moves down, and no point of the body moves up noticeably. */
-  double top = 0.0, umax = 0.0;
+  double top = 0.0, umax2 = 0.0; /* (no libm needed: squared lengths) */
   for (fcm_index v = 0; v < nv; v++) {
     const double *X = fcm_geometry_coords(ball) + 3 * v, *uv = u_surf + 3 * v;
+    const double u2 = uv[0] * uv[0] + uv[1] * uv[1] + uv[2] * uv[2];
     if (X[2] > 0.499) top = uv[2];
-    umax = fmax(umax, sqrt(uv[0] * uv[0] + uv[1] * uv[1] + uv[2] * uv[2]));
+    if (!(u2 <= umax2)) umax2 = u2; /* NaN propagates */
   }
-  printf("top of the ball moves %.4g m; largest surface displacement %.4g m\n", top, umax);
+  printf("top of the ball moves %.4g m; largest surface displacement^2 %.4g m^2\n", top, umax2);
   printf("wrote %s/host_static_{background,surface}.vtu\n", dir);
-  ok = top < 0.0 && umax < 0.5 && isfinite(umax);
+  ok = top < 0.0 && umax2 < 0.25;
 
 done:
   free(clamped);
