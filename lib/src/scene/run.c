@@ -1231,7 +1231,9 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
       const fcm_simplify_decision *d = &rs->decision[k];
       char what[64];
       snprintf(what, sizeof what, "%s simplification", kinds[k]);
-      if (q->simplify == FCM_CELL_SIMPLIFY_AUTO)
+      if (!fcm_cell_rules_has_kind(S->rules, (fcm_rule_kind)k))
+        snprintf(b, sizeof b, "(no %s rules built)", kinds[k]);
+      else if (q->simplify == FCM_CELL_SIMPLIFY_AUTO)
         snprintf(b, sizeof b,
                  "auto: %s for %g expected assemblies; cost model %.3g core-s per point per "
                  "assembly, %.3g core-s simplifying to %.0f points; estimated %.3g core-s "
