@@ -54,6 +54,19 @@ install_check() {
     echo "install check: the exported targets hard-code paths (above)" >&2
     return 1
   fi
+  # a shared libfcm exports the public API (fcm_*) only: no internal fcm__ function, no
+  # symbol of another name (OpenMP's named critical sections aside)
+  local so bad
+  so=$(find "$prefix/fcm" -name 'libfcm.so.*' -type f | head -n 1)
+  if [ -n "$so" ]; then
+    bad=$(nm -D --defined-only "$so" | awk '{print $3}' |
+          grep -vE '^(fcm_[A-Za-z0-9]|\.gomp_critical_user_)' || true)
+    if [ -n "$bad" ]; then
+      echo "install check: libfcm exports symbols outside the public API:" >&2
+      echo "$bad" | head -n 20 >&2
+      return 1
+    fi
+  fi
   pcdir=$(dirname "$(find "$prefix/fcm" -name fcm.pc)")
   ex="$prefix/examples"
   mkdir -p "$ex/out-pc" "$ex/out-cmake"
