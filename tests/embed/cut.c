@@ -5,8 +5,9 @@
  * inside the body separates nothing, pieces connected along the links form the expected
  * number of material components (two halves; the 36 sticks of Ton-That et al. 2024 Fig. 5
  * for a cube of 5 tets and 2x2x2 hexes diced by 10 planes), a cut along cell faces and
- * through nodes is handled, only cells a new cut reaches are integrated again, and the cut
- * faces of the pieces cover both sides of the section (area 1 each). */
+ * through nodes is handled, only cells a new cut reaches are integrated again, the cut
+ * faces of the pieces cover both sides of the section (area 1 each), and the surface rules
+ * of split cells integrate each side's part of the body boundary exactly. */
 #include "fcm/embed.h"
 #include "test.h"
 #include "dice.h"
@@ -102,7 +103,8 @@ static void plane_cut(fcm_element_type type)
   fcm_geometry *g = NULL;
   fcm_cell_rules *r0 = NULL, *r1 = NULL;
   fcm_surface *cut = NULL;
-  const fcm_cell_rules_options o = opts();
+  fcm_cell_rules_options o = opts();
+  o.surface_strength = 2;
   TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, n, &mesh));
   TEST_OK(ctx, fcm_geometry_create_box(ctx, glo, ghi, gn, &g));
   TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &o, &r0));
@@ -163,6 +165,31 @@ static void plane_cut(fcm_element_type type)
   }
   TEST_NEAR(area[0], 1.0, 1e-12, 0);
   TEST_NEAR(area[1], 1.0, 1e-12, 0);
+  /* the boundary of each side: the box's boundary triangles (edges at thirds) that the cut
+   * crosses inside a cell are split exactly between the two pieces, so the surface rules
+   * (strength 2) integrate 1, x and x^2 over each side's part of the box boundary exactly:
+   * x < 0.6: four side faces [0, 0.6] x [0, 1] and the face x = 0; x > 0.6: four side faces
+   * [0.6, 1] x [0, 1] and the face x = 1 */
+  double sm[2][3] = {{0}};
+  for (fcm_index p = 0; p < fcm_cell_rules_num_pieces(r1); p++) {
+    int ns;
+    const double *sp, *sw;
+    double X[3 * 27], x[3], v, xl[3], xh[3];
+    TEST_OK(ctx, fcm_cell_rules_get_piece_surface(r1, p, &ns, &sp, &sw, NULL, NULL));
+    fcm_mesh_cell_coords(mesh, fcm_cell_rules_piece_cell(r1, p), X);
+    piece_moments(mesh, r1, p, &v, xl, xh);
+    const int right = 0.5 * (xl[0] + xh[0]) > 0.6;
+    for (int j = 0; j < ns; j++) {
+      fcm_element_map(type, X, sp + 3 * j, x);
+      sm[right][0] += sw[j], sm[right][1] += sw[j] * x[0], sm[right][2] += sw[j] * x[0] * x[0];
+    }
+  }
+  TEST_NEAR(sm[0][0], 4 * 0.6 + 1, 1e-12, 0);
+  TEST_NEAR(sm[0][1], 4 * 0.18, 1e-12, 0);
+  TEST_NEAR(sm[0][2], 4 * 0.072, 1e-12, 0);
+  TEST_NEAR(sm[1][0], 4 * 0.4 + 1, 1e-12, 0);
+  TEST_NEAR(sm[1][1], 4 * 0.32 + 1, 1e-12, 0);
+  TEST_NEAR(sm[1][2], 4 * 0.784 / 3 + 1, 1e-12, 0);
   TEST_TRUE(components(mesh, r1) == 2);
   TEST_TRUE(components(mesh, r0) == 1);
   TEST_TRUE(type != FCM_ELEMENT_HEX8 || S->num_integrated == 9);

@@ -167,7 +167,8 @@ typedef struct fcm_cell_rules_stats {
   fcm_index simplify_skipped[FCM_RULE_KIND_COUNT];   /**< cut cells with N <= M */
   fcm_index simplify_fallbacks[FCM_RULE_KIND_COUNT]; /**< kept unsimplified after failure */
   double max_residual[FCM_RULE_KIND_COUNT]; /**< largest relative moment residual reported */
-  fcm_index surface_triangles;              /**< clipped boundary triangles kept */
+  fcm_index surface_triangles; /**< clipped boundary triangles kept (per piece in cells that cuts
+                                  split) */
   fcm_index surface_points;
   double embedded_volume;        /**< sum over all cells of |K ∩ Ω| (dropped cells included) */
   double dropped_volume;         /**< the part of it in dropped cells */

@@ -308,25 +308,21 @@ cleanup:
   return st;
 }
 
-/* The surface points in ws (physical) that belong to piece `piece` (all when P is NULL)
- * into o, mapped to reference coordinates. */
+/* The surface points in ws (physical: one piece's, fcm__embed_cell_surface()) into o,
+ * mapped to reference coordinates. */
 static fcm_status surface_piece(const build *B, const fcm__embed_cell *cell,
-                                const fcm__embed_ws *ws, const fcm__parts *P, int piece,
-                                piece_out *o)
+                                const fcm__embed_ws *ws, piece_out *o)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
-  size_t ns = 0;
-  for (size_t j = 0; j < ws->num_spts; j++)
-    ns += !P || fcm__embed_point_piece(P, ws->spts + 3 * j) == piece;
+  const size_t ns = ws->num_spts;
   if (ns == 0) return FCM_OK;
   FCM_ALLOC(ctx, 3 * ns, o->spts);
   FCM_ALLOC(ctx, ns, o->sw);
   FCM_ALLOC(ctx, 3 * ns, o->snrm);
   FCM_ALLOC(ctx, ns, o->stri);
   size_t i = 0;
-  for (size_t j = 0; j < ws->num_spts; j++) {
-    if (P && fcm__embed_point_piece(P, ws->spts + 3 * j) != piece) continue;
+  for (size_t j = 0; j < ns; j++) {
     double det;
     FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, ws->spts + 3 * j, o->spts + 3 * i, &det));
     o->sw[i] = ws->sw[j];
@@ -533,10 +529,12 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
     }
   }
   if (B->tri_rule && cls != FCM_CELL_DROPPED) {
-    FCM_TRY(ctx, fcm__embed_cell_surface(ctx, B->geom, B->tri_tree, &cell, opt->sliver_rtol,
-                                         B->tri_rule, ws, &sums->counts));
-    for (int i = 0; i < o->np; i++)
-      FCM_TRY(ctx, surface_piece(B, &cell, ws, o->np > 1 ? P : NULL, i, o->pc + i));
+    for (int i = 0; i < o->np; i++) { /* split cells: each piece its exact share */
+      if (i == 0 || o->np > 1)
+        FCM_TRY(ctx, fcm__embed_cell_surface(ctx, B->geom, B->tri_tree, &cell, o->np > 1 ? P : NULL,
+                                             i, opt->sliver_rtol, B->tri_rule, ws, &sums->counts));
+      FCM_TRY(ctx, surface_piece(B, &cell, ws, o->pc + i));
+    }
   }
   if (P && P->tcand.n > 0 && cls != FCM_CELL_DROPPED) /* the pieces' sides of the cuts */
     for (int i = 0; i < o->np; i++) {

@@ -151,10 +151,14 @@ fcm_status fcm__embed_map_tets(fcm_ctx *ctx, const fcm__embed_cell *cell, const 
  * cell plane is kept only when its outward normal agrees with the plane's) and map the
  * triangle rule onto the fan triangles: physical points, area weights, unit normals and
  * triangle ids into ws->spts, ws->sw, ws->snrm, ws->stri (ws->num_spts of them).
- * counts->surface_triangles += clipped triangles kept. */
+ * With parts P (NULL: the whole cell), only the share of `piece`: each clipped polygon is
+ * clipped further by every part of the piece (fcm__embed_clip_to_part), so a boundary
+ * triangle that a cut crosses is split exactly between the pieces on its two sides.
+ * counts->surface_triangles += clipped triangles kept (per piece when P is given). */
 fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
                                    const fcm_aabb_tree *tri_tree, const fcm__embed_cell *cell,
-                                   double sliver_rtol, const fcm_rule *tri_rule, fcm__embed_ws *ws,
+                                   const struct fcm__parts *P, int piece, double sliver_rtol,
+                                   const fcm_rule *tri_rule, fcm__embed_ws *ws,
                                    fcm__embed_counts *counts);
 
 /* ---------------------------------------------------------------- cutting (pieces.c) */
@@ -210,9 +214,12 @@ fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
 fcm_status fcm__embed_piece_tets(fcm_ctx *ctx, const fcm__parts *P, const int *label, int piece,
                                  fcm__embed_ws *ws, fcm__embed_counts *counts, double *volume);
 
-/* The piece whose parts contain the physical point x (the part with the smallest largest
- * signed distance to its face planes). */
-int fcm__embed_point_piece(const fcm__parts *P, const double x[3]);
+/* Clip the polygon x (n vertices, capacity cap, work: cap x 3 doubles) lying on the
+ * embedded boundary (outward unit normal nrm) to part i of P: by each of the part's face
+ * planes, a polygon flat on a face kept when the face's outward normal agrees with nrm.
+ * Returns the new vertex count (< 3: nothing of it on the part), -1 on overflow. */
+int fcm__embed_clip_to_part(const fcm__parts *P, size_t i, double *x, int n, int cap,
+                            const double nrm[3], double *work);
 
 /* The faces of `piece`'s parts that lie on a cut triangle (the piece's side of the cuts),
  * fan-triangulated with their outward orientation: *tri (allocated, 9 doubles = 3 physical

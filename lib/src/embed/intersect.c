@@ -253,11 +253,12 @@ cleanup:
 
 fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
                                    const fcm_aabb_tree *tri_tree, const fcm__embed_cell *cell,
-                                   double sliver_rtol, const fcm_rule *tri_rule, fcm__embed_ws *ws,
+                                   const struct fcm__parts *P, int piece, double sliver_rtol,
+                                   const fcm_rule *tri_rule, fcm__embed_ws *ws,
                                    fcm__embed_counts *counts)
 {
   fcm_status st = FCM_OK;
-  double poly[3 * POLYGON_CAP], work[3 * POLYGON_CAP];
+  double cpoly[3 * POLYGON_CAP], poly[3 * POLYGON_CAP], work[3 * POLYGON_CAP];
   const int nq = fcm_rule_num_points(tri_rule);
   const double *eta = fcm_rule_points(tri_rule), *l = fcm_rule_weights(tri_rule);
   const double amin = sliver_rtol * cbrt(cell->volume) * cbrt(cell->volume);
@@ -290,26 +291,41 @@ fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
     }
     if (n < 3) continue;
     int kept_any = 0;
-    for (int i = 1; i + 1 < n; i++) {
-      const double *a = poly, *b = poly + 3 * i, *c = poly + 3 * (i + 1);
-      double e1[3], e2[3], cr[3];
-      for (int d = 0; d < 3; d++)
-        e1[d] = b[d] - a[d], e2[d] = c[d] - a[d];
-      cr[0] = e1[1] * e2[2] - e1[2] * e2[1];
-      cr[1] = e1[2] * e2[0] - e1[0] * e2[2];
-      cr[2] = e1[0] * e2[1] - e1[1] * e2[0];
-      const double area2 = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
-      if (!(0.5 * area2 > amin)) continue;
-      kept_any = 1;
-      FCM_TRY(ctx, grow_surface(ctx, ws, ws->num_spts + (size_t)nq));
-      for (int j = 0; j < nq; j++) {
-        const size_t s = ws->num_spts++;
-        for (int d = 0; d < 3; d++) {
-          ws->spts[3 * s + d] = a[d] + eta[2 * j] * e1[d] + eta[2 * j + 1] * e2[d];
-          ws->snrm[3 * s + d] = nrm[d];
+    /* whole cell: the clipped polygon once; one piece: its share under each of its parts */
+    const size_t nparts = P ? P->n : 1;
+    const int nclip = n;
+    if (P) memcpy(cpoly, poly, 3 * (size_t)nclip * sizeof *poly);
+    for (size_t part = 0; part < nparts; part++) {
+      if (P) {
+        if (P->piece[part] != piece) continue;
+        memcpy(poly, cpoly, 3 * (size_t)nclip * sizeof *poly);
+        n = fcm__embed_clip_to_part(P, part, poly, nclip, POLYGON_CAP, nrm, work);
+        FCM_CHECK(n >= 0, ctx, FCM_ERR_INTERNAL,
+                  "embed: clipping boundary triangle %lld by a piece of background cell %lld "
+                  "exceeded %d vertices",
+                  (long long)tri, (long long)cell->id, POLYGON_CAP);
+      }
+      for (int i = 1; i + 1 < n; i++) {
+        const double *a = poly, *b = poly + 3 * i, *c = poly + 3 * (i + 1);
+        double e1[3], e2[3], cr[3];
+        for (int d = 0; d < 3; d++)
+          e1[d] = b[d] - a[d], e2[d] = c[d] - a[d];
+        cr[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        cr[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        cr[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        const double area2 = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+        if (!(0.5 * area2 > amin)) continue;
+        kept_any = 1;
+        FCM_TRY(ctx, grow_surface(ctx, ws, ws->num_spts + (size_t)nq));
+        for (int j = 0; j < nq; j++) {
+          const size_t s = ws->num_spts++;
+          for (int d = 0; d < 3; d++) {
+            ws->spts[3 * s + d] = a[d] + eta[2 * j] * e1[d] + eta[2 * j + 1] * e2[d];
+            ws->snrm[3 * s + d] = nrm[d];
+          }
+          ws->sw[s] = l[j] * area2;
+          ws->stri[s] = tri;
         }
-        ws->sw[s] = l[j] * area2;
-        ws->stri[s] = tri;
       }
     }
     counts->surface_triangles += kept_any;

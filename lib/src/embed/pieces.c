@@ -476,19 +476,16 @@ cleanup:
   return st;
 }
 
-int fcm__embed_point_piece(const fcm__parts *P, const double x[3])
+int fcm__embed_clip_to_part(const fcm__parts *P, size_t i, double *x, int n, int cap,
+                            const double nrm[3], double *work)
 {
-  double best = HUGE_VAL;
-  int piece = 0;
-  for (size_t i = 0; i < P->n; i++) {
-    double worst = -HUGE_VAL;
-    for (int f = 0; f < P->poly[i].nf; f++) {
-      fcm__plane pl;
-      if (face_plane(P->poly + i, f, &pl)) worst = fmax(worst, dot3(pl.n, x) - pl.d);
-    }
-    if (worst < best) best = worst, piece = P->piece[i];
+  const fcm__poly *p = P->poly + i;
+  for (int f = 0; f < p->nf && n >= 3; f++) {
+    fcm__plane pl;
+    if (!face_plane(p, f, &pl)) continue;
+    n = fcm__geom_polygon_clip(x, n, cap, &pl, P->tol[i], dot3(nrm, pl.n) > 0.0, work);
   }
-  return piece;
+  return n;
 }
 
 fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P)
