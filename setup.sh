@@ -39,12 +39,13 @@ configure_and_build() {
 }
 
 # Install the build into a temporary prefix, move the tree (nothing may hard-code the build
-# machine or the install location), then build the example host programs against it both ways
+# machine or the install location), then build the example host programs installed with it
+# (share/doc/fcm/examples) against it both ways
 # and run them: the C one with `cc ... $(pkg-config --cflags --libs fcm)` (no --static, no
 # other flag), both with find_package(fcm) from apps/examples/CMakeLists.txt. FCM_KEEP_PREFIX=1
 # keeps the prefix (printed) for a look.
 install_check() {
-  local prefix pkgdir pcdir ex
+  local prefix pkgdir pcdir src ex
   prefix=$(mktemp -d)
   [ "${FCM_KEEP_PREFIX:-0}" = 1 ] || trap "rm -rf '$prefix'" RETURN
   cmake --install "$build" --prefix "$prefix/staging" >/dev/null
@@ -68,22 +69,26 @@ install_check() {
     fi
   fi
   pcdir=$(dirname "$(find "$prefix/fcm" -name fcm.pc)")
+  src=$(dirname "$(find "$prefix/fcm" -path '*/examples/host_static.c')")
+  [ -f "$src/host_dynamic.cpp" ] && [ -f "$src/CMakeLists.txt" ]
   ex="$prefix/examples"
   mkdir -p "$ex/out-pc" "$ex/out-cmake"
   # pkg-config, as a user would type it
   # shellcheck disable=SC2046
-  cc -std=c11 "$here/apps/examples/host_static.c" -o "$ex/host_static-pc" \
+  cc -std=c11 "$src/host_static.c" -o "$ex/host_static-pc" \
     $(PKG_CONFIG_PATH="$pcdir" pkg-config --cflags --libs fcm)
   # shellcheck disable=SC2046
-  c++ -std=c++11 "$here/apps/examples/host_dynamic.cpp" -o "$ex/host_dynamic-pc" \
+  c++ -std=c++11 "$src/host_dynamic.cpp" -o "$ex/host_dynamic-pc" \
     $(PKG_CONFIG_PATH="$pcdir" pkg-config --cflags --libs fcm)
   "$ex/host_static-pc" "$ex/out-pc" >/dev/null
   [ -s "$ex/out-pc/host_static_surface.vtu" ] && [ -s "$ex/out-pc/host_static_background.vtu" ]
   # CMake, find_package(fcm)
-  cmake -S "$here/apps/examples" -B "$ex/build" -DCMAKE_PREFIX_PATH="$prefix/fcm" >/dev/null
+  cmake -S "$src" -B "$ex/build" -DCMAKE_PREFIX_PATH="$prefix/fcm" >/dev/null
   cmake --build "$ex/build" >/dev/null
   "$ex/build/host_static" "$ex/out-cmake" >/dev/null
   "$ex/build/host_dynamic" >/dev/null
+  # the installed programs find the moved libfcm through their $ORIGIN rpath
+  if [ -x "$prefix/fcm/bin/fcm-sim" ]; then "$prefix/fcm/bin/fcm-sim" --help >/dev/null; fi
   echo "install check: examples built against the installed package (pkg-config and"\
        "find_package) and run: host_static, host_dynamic"
   [ "${FCM_KEEP_PREFIX:-0}" = 1 ] && echo "install check: prefix kept: $prefix"

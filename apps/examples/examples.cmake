@@ -2,6 +2,11 @@
 # (label app), so an API change that breaks them fails the default test run; CI additionally
 # builds them against the installed package (setup.sh install-check). They use only the
 # public headers and link the library as a host does (fcm::fcm), with fcm's warnings.
+# Their sources and CMake project are installed with the documentation
+# (<prefix>/share/doc/fcm/examples), where the install check builds them.
+install(FILES apps/examples/host_static.c apps/examples/host_dynamic.cpp
+              apps/examples/CMakeLists.txt
+        DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples)
 add_executable(fcm_example_host_static apps/examples/host_static.c)
 target_link_libraries(fcm_example_host_static PRIVATE fcm::fcm)
 target_compile_options(fcm_example_host_static PRIVATE ${FCM_WARNINGS} ${FCM_SAN_FLAGS})
