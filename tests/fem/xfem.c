@@ -180,10 +180,83 @@ static void dice(const char *what)
   fcm_mesh_destroy(&mesh);
 }
 
+/* Koschier's constraint of tiny copies (fcm_space_options.constrain_ratio), and a cut along
+ * cell faces. (a) The cube of 5 tets with the corner (1, 1, 1) cut off 1e-4 deep: the corner
+ * is separated completely and all its copies are tiny (volume ~1e-12 of the supports), so
+ * it follows one anchor copy: the default space has the uncut cube's 24 DOFs and 6 rigid
+ * modes; without the constraint the corner has copies of its own. (b) A 2 x 2 x 1 Hex8 body
+ * cut at x = 1 + 1e-7 with the ratio 1e-6: in the right cells the slice next to x = 1 belongs
+ * to the left body, and its copies at the 6 nodes x = 2 are tiny; they move with the left
+ * body's copies at x = 1, so the space has 18 + 6 copies (the nodes x = 1 have two) and 6
+ * constrained copies; the stiffness has 9 zero modes: the right body's 6 and the left body's
+ * 3 translations (moving with a copy at another node is exact for translations only: a
+ * rotation strains the slice, with an energy of the slice's relative volume, 1e-7). (c) The same
+ * body cut at x = 1 + 1e-13, within the tolerance of the cell faces x = 1: the cut lies in the
+ * faces, splits no cell and still separates two bodies (18 + 6 copies, 12 rigid modes, nothing
+ * constrained). Mass and a = g hold throughout (the constrained elements keep the partition of
+ * unity). */
+static void constraint(void)
+{
+  const double lo[3] = {0, 0, 0}, hi1[3] = {1, 1, 1}, hi2[3] = {2, 2, 1};
+  const double bl[3] = {-1, -1, -1}, bh[3] = {3, 3, 2};
+  const double at[3] = {1.0 - 1e-4 / 3, 1.0 + 1e-7, 1.0 + 1e-13};
+  const fcm_index one[3] = {1, 1, 1}, grid[3] = {2, 2, 1}, constrained[3] = {-1, 6, 0};
+  for (int c = 0; c < 3; c++) {
+    fcm_mesh *mesh = NULL;
+    fcm_geometry *g = NULL;
+    fcm_cell_rules *r0 = NULL, *r1 = NULL;
+    fcm_surface *cut = NULL;
+    fcm_space *s = NULL, *s_off = NULL;
+    fcm_cell_rules_options o = fcm_cell_rules_options_default();
+    o.min_fraction = 0.0;
+    if (c) o.strength[FCM_RULE_STIFFNESS] = 3;
+    const double p[3] = {at[c], c ? 0.5 : at[c], c ? 0.5 : at[c]};
+    const double n[3] = {1, c ? 0 : 1, c ? 0 : 1};
+    if (c == 0)
+      TEST_OK(ctx, dice_mesh(ctx, "tet5", &mesh));
+    else
+      TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi2, grid, &mesh));
+    TEST_OK(ctx, fcm_geometry_create_box(ctx, lo, c ? hi2 : hi1, one, &g));
+    TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &o, &r0));
+    TEST_OK(ctx, fcm_surface_create_plane(ctx, p, n, bl, bh, &cut));
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, r0, cut, &r1));
+    fcm_space_options so = fcm_space_options_default();
+    if (c == 1) so.constrain_ratio = 1e-6;
+    TEST_OK(ctx, fcm_space_create_embedded_with(ctx, mesh, r1, &so, &s));
+    so.constrain_ratio = 0.0;
+    TEST_OK(ctx, fcm_space_create_embedded_with(ctx, mesh, r1, &so, &s_off));
+    if (s && s_off) {
+      const fcm_index nodes = fcm_mesh_num_nodes(mesh), k = fcm_space_num_constrained_copies(s);
+      const int z = rigid_modes(s);
+      const int zero[3] = {6, 9, 12};
+      if (z != zero[c] || (c == 0 ? k == 0 : k != constrained[c]))
+        fprintf(stderr, "constraint case %d: %d rigid modes, %lld constrained copies\n", c, z,
+                (long long)k);
+      TEST_TRUE(fcm_space_num_dofs(s) == 3 * (c ? nodes + 6 : nodes));
+      TEST_TRUE(c == 0 ? k > 0 : k == constrained[c]);
+      TEST_TRUE(z == zero[c]);
+      TEST_TRUE(c == 2 ? fcm_space_num_dofs(s_off) == fcm_space_num_dofs(s)
+                       : fcm_space_num_dofs(s_off) > fcm_space_num_dofs(s));
+      TEST_TRUE(fcm_space_num_constrained_copies(s_off) == 0);
+      mass_and_gravity(s, 1000.0, c ? 4.0 : 1.0);
+      mass_and_gravity(s_off, 1000.0, c ? 4.0 : 1.0);
+    }
+    fcm_space_destroy(&s);
+    fcm_space_destroy(&s_off);
+    fcm_cell_rules_destroy(&r0);
+    fcm_cell_rules_destroy(&r1);
+    fcm_surface_destroy(&cut);
+    fcm_geometry_destroy(&g);
+    fcm_mesh_destroy(&mesh);
+  }
+}
+
 int main(int argc, char **argv)
 {
   TEST_OK(NULL, fcm_ctx_create(NULL, &ctx));
-  if (argc > 1 && !strcmp(argv[1], "dice")) {
+  if (argc > 1 && !strcmp(argv[1], "constraint")) {
+    constraint();
+  } else if (argc > 1 && !strcmp(argv[1], "dice")) {
     dice("tet5");
     dice("hex1");
     dice("hex8");

@@ -63,8 +63,12 @@ typedef struct fcm_space_options {
                                node's (the pieces of all the node's elements) is constrained to
                                move with its piece: its elements use the DOFs of the largest
                                copy at another of their nodes instead (exact for translations),
-                               and it leaves the system; in [0, 0.5), default 1e-9; 0: off.
-                               Only copies of enriched nodes (cuts) are affected. */
+                               and it leaves the system. A fragment the cuts separate
+                               completely, all of whose copies are tiny, has no such copy: it
+                               stays attached at its nodes (their largest copies; Koschier's
+                               "sticking", at most this fraction of the nodes' material).
+                               In [0, 0.5), default 1e-9; 0: off. Only copies of enriched
+                               nodes (cuts) are affected. */
 } fcm_space_options;
 
 /** Defaults as documented on each member. */

@@ -1059,14 +1059,17 @@ static fcm_status gather_links(const build *B, fcm_cell_rules *R, const cell_out
           for (size_t l = nl; l-- > 0 && !known;)
             known = links[2 * l] == pa && links[2 * l + 1] == pb;
           if (known) continue;
-          double c3[3], lo[3], hi[3];
+          double lo[3], hi[3];
           const double *nb = cell.planes[f].n; /* polygon B faces out of c2: normal -n_f */
           const double nbn[3] = {-nb[0], -nb[1], -nb[2]};
-          if (fcm__embed_overlap(A, ma[2], Bx, mb[2], nbn, mtol, c3) <= atol) continue;
-          for (int d = 0; d < 3; d++)
-            lo[d] = c3[d] - mtol, hi[d] = c3[d] + mtol;
+          if (fcm__embed_overlap(A, ma[2], Bx, mb[2], nbn, mtol, NULL) <= atol) continue;
+          for (int d = 0; d < 3; d++) {
+            lo[d] = HUGE_VAL, hi[d] = -HUGE_VAL;
+            for (int k = 0; k < ma[2]; k++)
+              lo[d] = fmin(lo[d], A[3 * k + d] - mtol), hi[d] = fmax(hi[d], A[3 * k + d] + mtol);
+          }
           FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, lo, hi, &tc));
-          if (fcm__embed_on_cut(B->cut_tris, tc.ids, tc.n, c3, mtol)) continue;
+          if (fcm__embed_on_cut(B->cut_tris, tc.ids, tc.n, A, ma[2], mtol)) continue;
           if (nl + 1 > cap) {
             const size_t ncap = cap ? 2 * cap : 256;
             void *q = links;
@@ -1233,6 +1236,7 @@ fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const f
 {
   fcm_status st = FCM_OK;
   fcm_cell_rules *R = NULL;
+  unsigned char *inner = NULL;
   FCM_CHECK(rules, ctx, FCM_ERR_ARG, "embed cut: output pointer is NULL");
   *rules = NULL;
   FCM_CHECK(ctx && mesh && geom && prev && cut, ctx, FCM_ERR_ARG,
@@ -1251,16 +1255,19 @@ fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const f
   if (prev->num_cut_tris)
     memcpy(R->cut_tris, prev->cut_tris, (size_t)prev->num_cut_tris * sizeof *R->cut_tris);
   R->num_cut_tris = prev->num_cut_tris;
+  FCM_ALLOC(ctx, 3 * (size_t)nt + 1, inner);
+  FCM_TRY(ctx, fcm__embed_cut_inner_edges(ctx, cut, inner));
   for (fcm_index t = 0; t < nt; t++)
     R->num_cut_tris +=
         fcm__embed_cut_tri_setup(x + 3 * tv[3 * t], x + 3 * tv[3 * t + 1], x + 3 * tv[3 * t + 2],
-                                 prev->num_cuts, R->cut_tris + R->num_cut_tris);
+                                 prev->num_cuts, inner + 3 * t, R->cut_tris + R->num_cut_tris);
   R->num_cuts = prev->num_cuts + 1;
   R->prev_num_pieces = prev->num_pieces;
   FCM_TRY(ctx, build_rules(ctx, mesh, geom, prev, prev->num_cut_tris, R));
   *rules = R;
   R = NULL;
 cleanup:
+  fcm__free(ctx, inner);
   fcm_cell_rules_destroy(&R);
   return st;
 }

@@ -17,6 +17,9 @@ typedef struct fcm__cut_tri {
   fcm__plane edge[3];
   double lo[3], hi[3];
   int cut;
+  /* edge k (x[k] -> x[k+1]) is shared with a coplanar triangle of the same cut: the two
+   * cover the plane on both sides of it, so it splits nothing and bounds nothing */
+  unsigned char inner[3];
 } fcm__cut_tri;
 
 struct fcm_cell_rules {
@@ -166,7 +169,12 @@ fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
 /* Prepare triangle (a, b, c); 0 when it has no area (relative 1e-14 of its longest edge
  * squared): such a triangle separates nothing and is skipped. */
 int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double c[3], int cut,
-                             fcm__cut_tri *t);
+                             const unsigned char inner[3], fcm__cut_tri *t);
+
+/* For each edge of the cut surface's triangles (3 per triangle, edge k from vertex k to
+ * k + 1), whether exactly one other triangle shares it and lies in the same plane (unit
+ * normals parallel to 1e-12, planes within 1e-12 of the longer edge). */
+fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsigned char *inner);
 
 /* Convex parts of the embedded geometry inside one background cell and the material piece
  * of each: the clipped embedded cells, split by the cut triangles that reach the cell. */
@@ -236,9 +244,12 @@ fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, f
 double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
                           const double nb_normal[3], double tol, double centroid[3]);
 
-/* 1 when the point x lies on one of the cut triangles tris[ids[0 .. n)] within `tol`. */
-int fcm__embed_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n, const double x[3],
-                      double tol);
+/* 1 when the polygon x (m vertices; m = 1: a point) lies on the cuts tris[ids[0 .. n)]:
+ * every vertex and the vertex centroid lie on one of the triangles within `tol`. A face
+ * that the splitting (same tolerance) put on a cut passes; a face with one vertex off the
+ * cuts does not, however thin it is. */
+int fcm__embed_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n, const double *x,
+                      int m, double tol);
 
 /* The embedding diagnostics of the statistics S (geometry, embedded and sliver volumes
  * already set): bounding boxes, volume ratio, the volume outside the mesh and beyond each

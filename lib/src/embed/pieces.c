@@ -13,6 +13,7 @@
 #include "embed/embed_impl.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* Relative tolerances of the connectivity tests: faces match when their planes agree to
@@ -34,8 +35,9 @@ static void cross3(const double a[3], const double b[3], double c[3])
 }
 
 int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double c[3], int cut,
-                             fcm__cut_tri *t)
+                             const unsigned char inner[3], fcm__cut_tri *t)
 {
+  memcpy(t->inner, inner, sizeof t->inner);
   double e0[3], e1[3], n[3], l2 = 0.0;
   memcpy(t->x[0], a, sizeof t->x[0]);
   memcpy(t->x[1], b, sizeof t->x[1]);
@@ -72,6 +74,79 @@ int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double 
   }
   t->cut = cut;
   return 1;
+}
+
+typedef struct edge_key {
+  fcm_index a, b, slot; /* vertex ids (a < b); slot = 3 x triangle + edge */
+} edge_key;
+
+static int edge_cmp(const void *x, const void *y)
+{
+  const edge_key *p = x, *q = y;
+  if (p->a != q->a) return p->a < q->a ? -1 : 1;
+  if (p->b != q->b) return p->b < q->b ? -1 : 1;
+  return (p->slot > q->slot) - (p->slot < q->slot);
+}
+
+/* Unit normal and offset of triangle t of s; 0 when it has no area. */
+static int tri_plane(const double *x, const fcm_index *tv, fcm_index t, double n[3], double *d)
+{
+  const double *a = x + 3 * tv[3 * t], *b = x + 3 * tv[3 * t + 1], *c = x + 3 * tv[3 * t + 2];
+  double u[3], v[3];
+  for (int k = 0; k < 3; k++)
+    u[k] = b[k] - a[k], v[k] = c[k] - a[k];
+  cross3(u, v, n);
+  const double ln = sqrt(dot3(n, n));
+  if (!(ln > 0.0)) return 0;
+  for (int k = 0; k < 3; k++)
+    n[k] /= ln;
+  *d = dot3(n, a);
+  return 1;
+}
+
+fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsigned char *inner)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index nt = fcm_surface_num_triangles(cut);
+  const double *x = fcm_surface_coords(cut);
+  const fcm_index *tv = fcm_surface_triangles(cut);
+  edge_key *E = NULL;
+  memset(inner, 0, 3 * (size_t)nt);
+  if (nt < 2) return FCM_OK;
+  FCM_ALLOC(ctx, 3 * (size_t)nt, E);
+  for (fcm_index t = 0; t < nt; t++)
+    for (int k = 0; k < 3; k++) {
+      const fcm_index p = tv[3 * t + k], q = tv[3 * t + (k + 1) % 3];
+      E[3 * t + k] = (edge_key){FCM_MIN(p, q), FCM_MAX(p, q), 3 * t + k};
+    }
+  qsort(E, 3 * (size_t)nt, sizeof *E, edge_cmp);
+  for (size_t i = 0; i + 1 < 3 * (size_t)nt; i++) {
+    if (E[i].a != E[i + 1].a || E[i].b != E[i + 1].b) continue;
+    if (i + 2 < 3 * (size_t)nt && E[i + 2].a == E[i].a && E[i + 2].b == E[i].b) continue;
+    if (i > 0 && E[i - 1].a == E[i].a && E[i - 1].b == E[i].b) continue;
+    const fcm_index s = E[i].slot / 3, r = E[i + 1].slot / 3;
+    double ns[3], nr[3], ds, dr, l2 = 0.0;
+    if (!tri_plane(x, tv, s, ns, &ds) || !tri_plane(x, tv, r, nr, &dr)) continue;
+    for (int k = 0; k < 3; k++)
+      l2 += (x[3 * E[i].a + k] - x[3 * E[i].b + k]) * (x[3 * E[i].a + k] - x[3 * E[i].b + k]);
+    const double c = dot3(ns, nr), sg = c < 0.0 ? -1.0 : 1.0;
+    if (fabs(c) < 1.0 - 1e-12 || fabs(ds - sg * dr) > 1e-12 * sqrt(l2)) continue;
+    /* the two far vertices on opposite sides of the edge (not a fold) */
+    const fcm_index fs = tv[3 * s + (E[i].slot % 3 + 2) % 3],
+                    fr = tv[3 * r + (E[i + 1].slot % 3 + 2) % 3];
+    double e[3], ps[3], pr[3], cs[3], cr[3];
+    for (int k = 0; k < 3; k++) {
+      e[k] = x[3 * E[i].b + k] - x[3 * E[i].a + k];
+      ps[k] = x[3 * fs + k] - x[3 * E[i].a + k], pr[k] = x[3 * fr + k] - x[3 * E[i].a + k];
+    }
+    cross3(e, ps, cs);
+    cross3(e, pr, cr);
+    if (!(dot3(cs, ns) * dot3(cr, ns) < 0.0)) continue;
+    inner[E[i].slot] = inner[E[i + 1].slot] = 1;
+  }
+cleanup:
+  fcm__free(ctx, E);
+  return st;
 }
 
 void fcm__embed_parts_free(fcm_ctx *ctx, fcm__parts *P)
@@ -193,12 +268,17 @@ static fcm_status split_part(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
                              fcm__parts *P, size_t i)
 {
   fcm_status st = FCM_OK;
-  const double tol = P->tol[i], vmin = P->vmin[i];
+  /* the cut planes classify with the connectivity tests' tolerance (a vertex within
+   * MATCH_RTOL x the cell size is on the plane), so that a face the split treats as lying on
+   * a cut is one the link test treats so too, and a cut passing that close to a vertex or a
+   * face goes through it instead of cutting off a slice thinner than the tolerance */
+  const double tol = fmax(P->tol[i], MATCH_RTOL * cell->size), vmin = P->vmin[i];
   const int parent = P->parent[i];
   double lo, hi;
   plane_range(P->poly + i, &t->plane, &lo, &hi);
   if (lo > tol || hi < -tol) return FCM_OK;
   for (int e = 0; e < 3; e++) {
+    if (t->inner[e]) continue;
     plane_range(P->poly + i, &t->edge[e], &lo, &hi);
     if (lo > tol) return FCM_OK;
   }
@@ -211,17 +291,18 @@ static fcm_status split_part(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
     const fcm__plane h = side ? flip(&t->plane) : t->plane;
     overflow |= fcm__geom_poly_clip(&W[1], &h, tol, &P->scratch);
     for (int e = 0; e < 3 && W[1].nf > 0; e++) {
+      if (t->inner[e]) continue;
       poly_copy(&W[2], &W[1]);
       const fcm__plane out = flip(&t->edge[e]);
       overflow |= fcm__geom_poly_clip(&W[2], &out, tol, &P->scratch);
       overflow |= fcm__geom_poly_clip(&W[1], &t->edge[e], tol, &P->scratch);
       if (W[2].nf > 0) {
-        FCM_TRY(ctx, parts_put(ctx, P, slot, &W[2], tol, vmin, parent));
+        FCM_TRY(ctx, parts_put(ctx, P, slot, &W[2], P->tol[i], vmin, parent));
         slot = P->n;
       }
     }
     if (W[1].nf > 0) {
-      FCM_TRY(ctx, parts_put(ctx, P, slot, &W[1], tol, vmin, parent));
+      FCM_TRY(ctx, parts_put(ctx, P, slot, &W[1], P->tol[i], vmin, parent));
       slot = P->n;
     }
   }
@@ -298,18 +379,32 @@ double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
   return 0.5 * sqrt(dot3(n, n));
 }
 
-int fcm__embed_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n, const double x[3],
-                      double tol)
+/* Whether point x lies on one of the triangles within tol. */
+static int point_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n, const double x[3],
+                        double tol)
 {
   for (size_t k = 0; k < n; k++) {
     const fcm__cut_tri *t = tris + ids[k];
     if (fabs(dot3(t->plane.n, x) - t->plane.d) > tol) continue;
     int in = 1;
     for (int e = 0; e < 3 && in; e++)
-      in = dot3(t->edge[e].n, x) - t->edge[e].d <= tol;
+      in = dot3(t->edge[e].n, x) - t->edge[e].d <= tol; /* inner edges too: a point beyond
+                                                            an outer edge of the patch is off */
     if (in) return 1;
   }
   return 0;
+}
+
+int fcm__embed_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n, const double *x,
+                      int m, double tol)
+{
+  double c[3] = {0, 0, 0};
+  for (int k = 0; k < m; k++) {
+    if (!point_on_cut(tris, ids, n, x + 3 * k, tol)) return 0;
+    for (int d = 0; d < 3; d++)
+      c[d] += x[3 * k + d] / m;
+  }
+  return m > 0 && point_on_cut(tris, ids, n, c, tol);
 }
 
 static int uf_find(int *uf, int a)
@@ -338,7 +433,7 @@ static int parts_connected(const fcm__embed_cell *cell, const fcm__cut_tri *tris
 {
   const fcm__poly *a = P->poly + i, *b = P->poly + j;
   const double mtol = MATCH_RTOL * cell->size, atol = AREA_RTOL * cell->size * cell->size;
-  double xa[3 * FCM__POLY_MAX_FV], xb[3 * FCM__POLY_MAX_FV], c[3];
+  double xa[3 * FCM__POLY_MAX_FV], xb[3 * FCM__POLY_MAX_FV];
   for (int fa = 0; fa < a->nf; fa++) {
     const fcm__plane *pa = fp + i * FCM__POLY_MAX_FACES + fa;
     if (pa->n[0] == 0.0 && pa->n[1] == 0.0 && pa->n[2] == 0.0) continue;
@@ -346,8 +441,8 @@ static int parts_connected(const fcm__embed_cell *cell, const fcm__cut_tri *tris
       const fcm__plane *pb = fp + j * FCM__POLY_MAX_FACES + fb;
       if (dot3(pa->n, pb->n) > -(1.0 - NORMAL_TOL) || fabs(pa->d + pb->d) > mtol) continue;
       const int na = face_coords(a, fa, xa), nb = face_coords(b, fb, xb);
-      if (fcm__embed_overlap(xa, na, xb, nb, pb->n, mtol, c) <= atol) continue;
-      if (!fcm__embed_on_cut(tris, P->tcand.ids, ntri, c, mtol)) return 1;
+      if (fcm__embed_overlap(xa, na, xb, nb, pb->n, mtol, NULL) <= atol) continue;
+      if (!fcm__embed_on_cut(tris, P->tcand.ids, ntri, xa, na, mtol)) return 1;
     }
   }
   return 0;
@@ -545,11 +640,7 @@ fcm_status fcm__embed_cut_faces(fcm_ctx *ctx, const fcm__embed_cell *cell, const
     const fcm__poly *q = P->poly + i;
     for (int f = 0; f < q->nf; f++) {
       const int m = face_coords(q, f, x);
-      double c[3] = {0, 0, 0};
-      for (int k = 0; k < m; k++)
-        for (int d = 0; d < 3; d++)
-          c[d] += x[3 * k + d] / m;
-      if (!fcm__embed_on_cut(tris, P->tcand.ids, P->tcand.n, c, mtol)) continue;
+      if (!fcm__embed_on_cut(tris, P->tcand.ids, P->tcand.n, x, m, mtol)) continue;
       if (n + m - 2 > cap) {
         const int ncap = FCM_MAX(2 * cap, n + m - 2 + 16);
         void *v = t;

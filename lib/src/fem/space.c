@@ -108,7 +108,12 @@ static fcm_status build_copies(fcm_space *s, const fcm_index *inc_ptr, const fcm
     int split = 0;
     for (fcm_index i = 0; i < deg; i++) {
       const fcm_index e = inc[i0 + i], c = s->elem_cell[e];
-      split |= s->cell_elem[c + 1] - s->cell_elem[c] > 1;
+      /* cuts reach the node's support: a cell split into pieces, or a piece with a face on
+       * a cut (a cut along cell faces splits no cell but separates them); the links are
+       * known around every such cell */
+      split |=
+          s->cell_elem[c + 1] - s->cell_elem[c] > 1 ||
+          (s->rules && fcm_cell_rules_get_piece_cut_faces(s->rules, s->elem_piece[e], NULL) > 0);
       uf[i] = i;
       pos[e] = i;
     }
@@ -334,8 +339,12 @@ cleanup:
  * is below `ratio` of its node's (the pieces of all the node's elements) barely contributes
  * and makes the system (nearly) singular; it is constrained to move with its piece: its
  * elements use, in its place, the DOFs of the largest-support copy at another node of those
- * elements, so the fragment follows that copy (exact for translations). Unused copies are then
- * removed from the numbering. Counts in s->num_constrained. */
+ * elements, so the fragment follows that copy (exact for translations). A fragment the cuts
+ * separate completely (every copy its elements use is tiny) has no such copy: all its copies
+ * follow one anchor, the largest copy at any of the fragment's nodes, so the fragment moves
+ * with (translates as) that copy's body — Koschier's "sticking", of material below `ratio`
+ * of its nodes' supports — and never joins two bodies. Unused copies are then removed from
+ * the numbering. Counts in s->num_constrained. */
 static fcm_status constrain_copies(fcm_space *s, double ratio, const fcm_index *inc_ptr,
                                    const fcm_index *inc)
 {
@@ -344,44 +353,77 @@ static fcm_status constrain_copies(fcm_space *s, double ratio, const fcm_index *
   const fcm_index *cells = fcm_mesh_cells(s->mesh);
   const fcm_index ncopy = s->num_dofs / 3, nn = s->nn;
   double *venr = NULL;
-  fcm_index *master = NULL, *renum = NULL;
+  fcm_index *master = NULL, *renum = NULL, *uf = NULL, *node_of = NULL, *anchor = NULL;
+  unsigned char *tiny = NULL;
   FCM_ALLOC(ctx, ncopy + 1, venr);
   FCM_ALLOC(ctx, ncopy + 1, master);
+  FCM_ALLOC(ctx, ncopy + 1, tiny);
+  FCM_ALLOC(ctx, ncopy + 1, uf);
+  FCM_ALLOC(ctx, ncopy + 1, node_of);
+  FCM_ALLOC(ctx, ncopy + 1, anchor);
   for (fcm_index e = 0; e < s->num_elems; e++) {
     const double v = fcm_cell_rules_piece_volume(s->rules, s->elem_piece[e]);
     for (int a = 0; a < nn; a++)
       venr[s->elem_dof[e * nn + a] / 3] += v;
   }
-  fcm_index count = 0;
-  for (fcm_index k = 0; k < ncopy; k++)
-    master[k] = -1;
+  /* which copies are tiny, each against its own node's support */
+  fcm_index ntiny = 0;
   for (fcm_index n = 0; n < s->num_nodes; n++) {
-    if (s->node_ncopy[n] < 2) continue;
     double vsupp = 0.0;
     for (fcm_index i = inc_ptr[n]; i < inc_ptr[n + 1]; i++)
       vsupp += fcm_cell_rules_piece_volume(s->rules, s->elem_piece[inc[i]]);
     for (fcm_index c = 0; c < s->node_ncopy[n]; c++) {
       const fcm_index k = s->node_dof[n] / 3 + c;
-      if (!(venr[k] < ratio * vsupp)) continue;
-      /* the master: the largest-support copy at another node of the copy's elements */
-      fcm_index best = -1;
-      for (fcm_index i = inc_ptr[n]; i < inc_ptr[n + 1]; i++) {
-        const fcm_index e = inc[i];
-        int uses = 0;
-        for (int a = 0; a < nn; a++)
-          uses |= s->elem_dof[e * nn + a] / 3 == k;
-        if (!uses) continue;
-        for (int b = 0; b < nn; b++) {
-          const fcm_index m = s->elem_dof[e * nn + b] / 3;
-          if (cells[s->elem_cell[e] * nn + b] == n || master[m] >= 0 || venr[m] < ratio * vsupp)
-            continue;
-          if (best < 0 || venr[m] > venr[best]) best = m;
-        }
-      }
-      if (best < 0) continue;
-      master[k] = best;
-      count++;
+      node_of[k] = n;
+      tiny[k] = s->node_ncopy[n] > 1 && venr[k] < ratio * vsupp;
+      ntiny += tiny[k];
     }
+  }
+  for (fcm_index k = 0; k < ncopy; k++)
+    master[k] = anchor[k] = -1, uf[k] = k;
+  if (ntiny == 0) goto cleanup;
+  /* rule 1: the largest non-tiny copy at another node of an element that uses the copy;
+   * elements using only tiny copies join them into separated fragments (union-find) */
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    const fcm_index *d = s->elem_dof + e * nn;
+    int all_tiny = 1;
+    for (int a = 0; a < nn; a++)
+      all_tiny &= tiny[d[a] / 3];
+    for (int a = 0; a < nn; a++) {
+      const fcm_index k = d[a] / 3;
+      if (!tiny[k]) continue;
+      if (all_tiny) {
+        const fcm_index ra = uf_find(uf, k), rb = uf_find(uf, d[0] / 3);
+        if (ra != rb) uf[FCM_MAX(ra, rb)] = FCM_MIN(ra, rb);
+        continue;
+      }
+      for (int b = 0; b < nn; b++) {
+        const fcm_index m = d[b] / 3;
+        if (cells[s->elem_cell[e] * nn + b] == node_of[k] || tiny[m]) continue;
+        if (master[k] < 0 || venr[m] > venr[master[k]] ||
+            (venr[m] == venr[master[k]] && m < master[k]))
+          master[k] = m;
+      }
+    }
+  }
+  /* rule 2: a fragment none of whose copies found a master follows its anchor */
+  for (fcm_index k = 0; k < ncopy; k++) /* fragments with a rule-1 master are not separated */
+    if (tiny[k] && master[k] >= 0) anchor[uf_find(uf, k)] = -2;
+  for (fcm_index k = 0; k < ncopy; k++) {
+    if (!tiny[k]) continue;
+    const fcm_index r = uf_find(uf, k), n = node_of[k];
+    if (anchor[r] == -2) continue;
+    for (fcm_index c = 0; c < s->node_ncopy[n]; c++) {
+      const fcm_index m = s->node_dof[n] / 3 + c;
+      if (!tiny[m] && (anchor[r] < 0 || venr[m] > venr[anchor[r]])) anchor[r] = m;
+    }
+  }
+  fcm_index count = 0;
+  for (fcm_index k = 0; k < ncopy; k++) {
+    if (!tiny[k]) continue;
+    const fcm_index r = uf_find(uf, k);
+    if (master[k] < 0 && anchor[r] >= 0) master[k] = anchor[r];
+    count += master[k] >= 0;
   }
   if (count > 0) {
     for (fcm_index e = 0; e < s->num_elems; e++)
@@ -414,6 +456,10 @@ cleanup:
   fcm__free(ctx, venr);
   fcm__free(ctx, master);
   fcm__free(ctx, renum);
+  fcm__free(ctx, tiny);
+  fcm__free(ctx, uf);
+  fcm__free(ctx, node_of);
+  fcm__free(ctx, anchor);
   return st;
 }
 

@@ -116,6 +116,19 @@ static void sort_cap(const fcm__poly *p, const double n[3], int *ids, int k)
     }
     ang[j] = a, ids[j] = id;
   }
+  /* start the cycle at the lexicographically smallest vertex: the two halves of a split
+   * share the cap's vertices bitwise but sort them around opposite normals; starting both
+   * at the same vertex gives both the same fan triangles, so their volumes add up exactly
+   * even where vertices within the tolerance of the plane make the cap slightly non-planar */
+  int first = 0;
+  for (int i = 1; i < k; i++) {
+    const double *a = p->x[ids[i]], *b = p->x[ids[first]];
+    if (a[0] < b[0] || (a[0] == b[0] && (a[1] < b[1] || (a[1] == b[1] && a[2] < b[2])))) first = i;
+  }
+  int rot[FCM__POLY_MAX_VERTS];
+  for (int i = 0; i < k; i++)
+    rot[i] = ids[(first + i) % k];
+  memcpy(ids, rot, (size_t)k * sizeof *ids);
 }
 
 int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__poly *out)
