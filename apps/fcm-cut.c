@@ -508,7 +508,105 @@ static fcm_status dice_mesh(fcm_ctx *ctx, fcm_element_type type, int n, fcm_mesh
   return fcm_mesh_create(ctx, type, nv, x, 5, cells, mesh);
 }
 
-static int run_dice(fcm_ctx *ctx, const char *csvpath, const fcm_element_type *types, int ntypes)
+/* The dice picture: per variant (up to 6), the authentic quadrature points of every piece
+ * at their deformed positions after the drop, seen from above, coloured by stick. */
+#define DICE_PNG_POINTS 12000
+static char *dice_data;
+static size_t dice_len, dice_cap;
+static int dice_panels;
+static char dice_title[6][64];
+
+/* Append the points of space's pieces (displacement u) for the picture; 0 on allocation
+ * failure. The stick of a point: its reference (x, y) between the dicing planes `at`. */
+static int dice_png_add(const fcm_space *space, const double *u, const double at[5],
+                        const char *title)
+{
+  const fcm_cell_rules *r = fcm_space_cell_rules(space);
+  const fcm_mesh *mesh = fcm_space_mesh(space);
+  const fcm_element_type type = fcm_mesh_element_type(mesh);
+  fcm_index total = 0;
+  for (fcm_index e = 0; e < fcm_space_num_elements(space); e++) {
+    int n = 0;
+    const fcm_index c = fcm_space_element_cell(space, e);
+    fcm_index e0, p0;
+    fcm_space_cell_elements(space, c, &e0);
+    fcm_cell_rules_cell_pieces(r, c, &p0);
+    if (fcm_cell_rules_get_piece(r, p0 + e - e0, FCM_RULE_STIFFNESS, &n, NULL, NULL, NULL) ==
+        FCM_OK)
+      total += n;
+  }
+  const fcm_index stride = total / DICE_PNG_POINTS + 1;
+  if (dice_panels >= 6) return 1;
+  snprintf(dice_title[dice_panels], sizeof dice_title[0], "%s", title);
+  fcm_index k = 0;
+  for (fcm_index e = 0; e < fcm_space_num_elements(space); e++) {
+    int n = 0;
+    const double *xi = NULL;
+    const unsigned char *fl = NULL;
+    const fcm_index c = fcm_space_element_cell(space, e);
+    fcm_index e0, p0;
+    double X[3 * 27];
+    fcm_space_cell_elements(space, c, &e0);
+    fcm_cell_rules_cell_pieces(r, c, &p0);
+    fcm_mesh_cell_coords(mesh, c, X);
+    if (fcm_cell_rules_get_piece(r, p0 + e - e0, FCM_RULE_STIFFNESS, &n, &xi, NULL, &fl) != FCM_OK)
+      continue;
+    for (int j = 0; j < n; j++, k++) {
+      double x[3], d[3];
+      if (fl[j] || k % stride) continue;
+      fcm_element_map(type, X, xi + 3 * j, x);
+      if (fcm_space_element_eval(space, e, xi + 3 * j, u, d) != FCM_OK) continue;
+      int ix = 0, iy = 0;
+      while (ix < 5 && x[0] > at[ix])
+        ix++;
+      while (iy < 5 && x[1] > at[iy])
+        iy++;
+      if (dice_len + 96 > dice_cap) {
+        const size_t cap = dice_cap ? 2 * dice_cap : 1 << 16;
+        char *q = realloc(dice_data, cap);
+        if (!q) return 0;
+        dice_data = q, dice_cap = cap;
+      }
+      dice_len += (size_t)snprintf(dice_data + dice_len, dice_cap - dice_len, "%d %.5f %.5f %d\n",
+                                   dice_panels, x[0] + d[0], x[1] + d[1], (ix + 2 * iy) % 6);
+    }
+  }
+  dice_panels++;
+  return 1;
+}
+
+static int gnuplot_png(const char *path, const char *body);
+
+/* Write the picture (gnuplot; 1 when written or gnuplot is missing, 0 on an error). */
+static int dice_png(const char *path)
+{
+  size_t cap = dice_len + 4096, n = 0;
+  char *body = malloc(cap);
+  if (!body) return 0;
+  n += (size_t)snprintf(body + n, cap - n, "$D << EOD\n");
+  if (dice_len) memcpy(body + n, dice_data, dice_len);
+  n += dice_len;
+  n += (size_t)snprintf(
+      body + n, cap - n,
+      "EOD\nset multiplot layout 2,3 title '36 sticks after 5 steps spinning under "
+      "gravity (Ton-That et al. 2024, Fig. 5): quadrature points from above'\n"
+      "unset key\nset size ratio -1\n"
+      "set palette defined (0 '#1f77b4', 1 '#ff7f0e', 2 '#2ca02c', 3 '#d62728', "
+      "4 '#9467bd', 5 '#8c564b')\nunset colorbox\nset xrange [-0.3:1.3]\n"
+      "set yrange [-0.3:1.3]\n");
+  for (int k = 0; k < dice_panels; k++)
+    n += (size_t)snprintf(body + n, cap - n,
+                          "set title '%s'\nplot $D using ($1 == %d ? $2 : 1/0):3:4 "
+                          "with points pt 7 ps 0.3 lc palette\n",
+                          dice_title[k], k);
+  n += (size_t)snprintf(body + n, cap - n, "unset multiplot");
+  const int ok = gnuplot_png(path, body);
+  free(body);
+  return ok;
+}
+
+static int run_dice(fcm_ctx *ctx, const char *csvpath, const char *pngpath,
+                    const fcm_element_type *types, int ntypes)
 {
   cli_output *out = NULL;
   FILE *csv = NULL;
@@ -591,6 +689,14 @@ static int run_dice(fcm_ctx *ctx, const char *csvpath, const fcm_element_type *t
           fprintf(csv, "%s,%lld,10,%lld,%lld,%.3e\n", fcm_element_get_info(type)->name,
                   (long long)fcm_mesh_num_cells(mesh), (long long)pieces,
                   (long long)fcm_space_num_dofs(space), merr);
+        char title[64];
+        snprintf(title, sizeof title, "%s, %lld cell(s): %lld pieces",
+                 fcm_element_get_info(type)->name, (long long)fcm_mesh_num_cells(mesh),
+                 (long long)pieces);
+        if (pngpath && !dice_png_add(space, fcm_integrator_displacement(integ), at, title)) {
+          fprintf(stderr, PROG ": dice: out of memory for the picture\n");
+          ok = 0;
+        }
       }
       fcm_integrator_destroy(&integ);
       fcm_space_destroy(&space);
@@ -600,6 +706,9 @@ static int run_dice(fcm_ctx *ctx, const char *csvpath, const fcm_element_type *t
     }
   if (csv && ok && !cli_output_commit(PROG, &out)) ok = 0;
   cli_output_abort(&out);
+  if (ok && pngpath && !dice_png(pngpath)) ok = 0;
+  free(dice_data);
+  dice_data = NULL;
   if (!ok) return 1;
   printf("dice: 36 pieces for every element: %s; largest mass change %.2e (claim <= 1e-12: %s)\n",
          all36 ? "holds" : "FAILS", worst_mass, worst_mass <= 1e-12 ? "holds" : "FAILS");
@@ -878,17 +987,18 @@ int main(int argc, char **argv)
   fcm_element_type types[FCM_ELEMENT_COUNT] = {FCM_ELEMENT_TET4, FCM_ELEMENT_TET10,
                                                FCM_ELEMENT_HEX8, FCM_ELEMENT_HEX20};
   int ntypes = 4, seen_el = 0;
-  const cli_option opts[] = {{"--csv", NULL, CLI_STRING, &csv, "FILE",
-                              "write the rows as CSV (atomically)", 0, 0, 0, NULL, NULL, NULL},
-                             {"--png", NULL, CLI_STRING, &png, "FILE",
-                              "condition: the picture of Koschier's Fig. 14 (needs gnuplot)", 0, 0,
-                              0, NULL, NULL, NULL},
-                             {"--max-strength", NULL, CLI_INT, &strength, "M",
-                              "accuracy: strengths 1..M (default 8)", 1, 8, 0, NULL, NULL, NULL},
-                             {"--element", NULL, CLI_CUSTOM, types, "E",
-                              "dice: one element type (tet4, tet10, hex8, hex20; default all)", 0,
-                              0, 0, NULL, cli_element, &seen_el},
-                             {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
+  const cli_option opts[] = {
+      {"--csv", NULL, CLI_STRING, &csv, "FILE", "write the rows as CSV (atomically)", 0, 0, 0, NULL,
+       NULL, NULL},
+      {"--png", NULL, CLI_STRING, &png, "FILE",
+       "write the study's picture (accuracy, dice, condition; needs gnuplot)", 0, 0, 0, NULL, NULL,
+       NULL},
+      {"--max-strength", NULL, CLI_INT, &strength, "M", "accuracy: strengths 1..M (default 8)", 1,
+       8, 0, NULL, NULL, NULL},
+      {"--element", NULL, CLI_CUSTOM, types, "E",
+       "dice: one element type (tet4, tet10, hex8, hex20; default all)", 0, 0, 0, NULL, cli_element,
+       &seen_el},
+      {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
   const int code = cli_parse_args(PROG, opts, argc, argv, pos, 1, &npos, usage);
   if (code >= 0) return code;
   if (npos != 1 ||
@@ -908,7 +1018,7 @@ int main(int argc, char **argv)
     const acc_opts ao = {csv, png, strength};
     rc = run_accuracy(ctx, &ao);
   } else if (!strcmp(pos[0], "dice")) {
-    rc = run_dice(ctx, csv, types, ntypes);
+    rc = run_dice(ctx, csv, png, types, ntypes);
   } else {
     rc = run_condition(ctx, csv, png);
   }

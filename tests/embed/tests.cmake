@@ -35,3 +35,9 @@ fcm_add_test(embed_cut tests/embed/cut.c)
 # and gives the same stiffness rules; the kind not built is FCM_ERR_ARG (accessors, mass
 # matrix, momentum); a cut keeps the kinds; bad kind sets rejected.
 fcm_add_test(embed_kinds tests/embed/kinds.c)
+# Random XFEM cuts (planes and V-shaped cuts through nodes, midpoints and quarter points,
+# shifted by 0 .. 1e-6): every cell's volume conserved within 1e-12; the few degenerate
+# ones are shifted by fcm_cell_rules_create_cut() (FCM_TEST_VERBOSE=1 prints how many).
+fcm_add_test(embed_xfem_random tests/embed/cut.c ARGS campaign 300 1)
+fcm_add_test(embed_xfem_random_long tests/embed/cut.c ARGS campaign 20000 11 LABELS slow
+             TIMEOUT 3600)

@@ -1,12 +1,16 @@
 /* Allocation failures in the fem module: failing the k-th allocation (k = 0, 1, ... until
  * success) of fcm_space_create, fcm_space_create_embedded, fcm_space_matrix_create, every
  * assembly (stiffness, mass, body force, body-force field, surface traction, hyperelastic),
- * fcm_space_apply_dirichlet, fcm_space_locate (points inside cells and extrapolated ones)
- * and fcm_element_standard_rule returns FCM_ERR_ALLOC, NULL outputs and leaks nothing. */
+ * fcm_space_apply_dirichlet, fcm_space_locate (points inside cells and extrapolated ones),
+ * fcm_element_standard_rule and the output fields (cell stress, max displacement, VTU of the
+ * space, the embedded surface and its VTU) returns FCM_ERR_ALLOC, NULL outputs and leaks
+ * nothing. */
 #include "fcm/fcm.h"
 #include "alloc_loop.h"
 
 #include <omp.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 typedef struct fixture {
   fcm_ctx *ctx;
@@ -27,6 +31,10 @@ typedef struct fixture {
   fcm_space *s_out;
   fcm_csr *A_out;
   fcm_rule *r_out;
+  fcm_embedded_surface *es_out;
+  fcm_geometry *geom;
+  fcm_embedded_surface *es;
+  double *cell_out; /* 8 x num_cells */
 } fixture;
 
 static void field(void *user, const double x[3], const double normal[3], double value[3])
@@ -67,9 +75,40 @@ static fcm_status standard_rule(void *u)
   fcm_status st = fcm_element_standard_rule(x->ctx, FCM_ELEMENT_HEX20, FCM_RULE_MASS, 0, &x->r_out);
   return OUT_CHECK(st, x->r_out);
 }
+static fcm_status surface_create(void *u)
+{
+  fixture *x = u;
+  x->es_out = (fcm_embedded_surface *)x;
+  fcm_status st = fcm_embedded_surface_create(x->space, x->geom, &x->es_out);
+  return OUT_CHECK(st, x->es_out);
+}
+static fcm_status cell_stress(void *u)
+{
+  fixture *x = u;
+  const fcm_index nc = fcm_mesh_num_cells(x->mesh);
+  return fcm_space_cell_stress(x->space, &x->mat, x->u, x->cell_out, x->cell_out + 6 * nc,
+                               x->cell_out + 7 * nc);
+}
+static fcm_status max_displacement(void *u)
+{
+  fixture *x = u;
+  double m = 0.0;
+  return fcm_space_max_displacement(x->space, x->u, &m);
+}
+static fcm_status space_vtu(void *u)
+{
+  fixture *x = u;
+  return fcm_space_write_vtu(x->space, &x->mat, x->u, x->u, "fem_alloc_out/bg.vtu");
+}
+static fcm_status surface_vtu(void *u)
+{
+  fixture *x = u;
+  return fcm_embedded_surface_write_vtu(x->es, &x->mat, x->u, "fem_alloc_out/s.vtu");
+}
 static void release(void *u)
 {
   fixture *x = u;
+  fcm_embedded_surface_destroy(&x->es_out);
   fcm_space_destroy(&x->s_out);
   fcm_csr_destroy(&x->A_out);
   fcm_rule_destroy(&x->r_out);
@@ -173,6 +212,20 @@ int main(void)
   alloc_loop(ctx, &f, "fcm_space_apply_dirichlet", dirichlet, NULL, &x, 1, 1000);
   alloc_loop(ctx, &f, "fcm_space_locate", locate, NULL, &x, 2, 1000);
   TEST_TRUE(x.ext[0] == 0 && x.ext[3] == 1); /* the last round located both kinds */
+  x.geom = g;
+  x.cell_out = malloc(sizeof *x.cell_out * 8 * (size_t)fcm_mesh_num_cells(x.mesh));
+  TEST_OK(ctx, fcm_embedded_surface_create(x.space, g, &x.es));
+  mkdir("fem_alloc_out", 0755);
+  alloc_loop(ctx, &f, "fcm_embedded_surface_create", surface_create, release, &x, 5, 1000);
+  alloc_loop(ctx, &f, "fcm_space_cell_stress", cell_stress, NULL, &x, 1, 1000);
+  alloc_loop(ctx, &f, "fcm_space_max_displacement", max_displacement, NULL, &x, 1, 1000);
+  alloc_loop(ctx, &f, "fcm_space_write_vtu", space_vtu, NULL, &x, 5, 1000);
+  alloc_loop(ctx, &f, "fcm_embedded_surface_write_vtu", surface_vtu, NULL, &x, 3, 1000);
+  remove("fem_alloc_out/bg.vtu");
+  remove("fem_alloc_out/s.vtu");
+  rmdir("fem_alloc_out");
+  fcm_embedded_surface_destroy(&x.es);
+  free(x.cell_out);
 
   free(x.f), free(x.u);
   fcm_csr_destroy(&x.K);

@@ -30,3 +30,8 @@ foreach(el tet4 tet10 hex8 hex20)
 endforeach()
 fcm_add_test(fem_xfem_dice tests/fem/xfem.c ARGS dice)
 fcm_add_test(fem_xfem_constraint tests/fem/xfem.c ARGS constraint)
+# Output fields: stress, von Mises, energy density of affine fields (analytic, cut cells
+# included), node and surface fields, VTU files at reference positions, cut faces.
+foreach(el tet4 tet10 hex8 hex20)
+  fcm_add_test(fem_fields_${el} tests/fem/fields.c ARGS ${el})
+endforeach()

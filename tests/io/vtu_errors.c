@@ -75,7 +75,7 @@ int main(void)
   TEST_ERR(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, NULL, 3, 5, u), FCM_ERR_ARG,
            "name is NULL");
   TEST_ERR(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "u", 2, 5, u), FCM_ERR_ARG,
-           "field 'u' has 2 components; supported: 1, 3 or 9");
+           "field 'u' has 2 components; supported: 1, 3, 6 or 9");
   TEST_ERR(ctx, fcm_vtu_add_field_int32(vtu, FCM_VTU_CELL_DATA, "k", 1, 2, NULL), FCM_ERR_ARG,
            "field 'k' data is NULL");
   TEST_ERR(ctx, fcm_vtu_add_field_int64(vtu, FCM_VTU_CELL_DATA, "k", 1, -1, NULL), FCM_ERR_ARG,

@@ -32,3 +32,7 @@ fcm_add_test(scene_cut tests/scene/cut_scene.c)
 # Only the rule kinds a scene calls for: a static scene builds no mass rules (statistics,
 # counter, summary line "rules built"), a dynamic one does; the log's mass agrees.
 fcm_add_test(scene_rule_kinds tests/scene/rule_kinds.c)
+# Output for the engineer: the log's reaction columns (minus the weight and its moment in
+# equilibrium; change of momentum minus the weight in dynamics), stress arrays in the frames,
+# the surface at reference positions, the summary's max |u| over the body.
+fcm_add_test(scene_output tests/scene/output_scene.c)

@@ -46,3 +46,9 @@ fcm_sim_test(sim_step_alloc_static tests/sim/step_alloc.c ARGS minres-schwarz he
 foreach(el tet4 tet10 hex8 hex20)
   fcm_sim_test(sim_cut_${el} tests/sim/cut.c ARGS ${el})
 endforeach()
+# Reactions of constraints: minus the assembled weight and its moment in equilibrium (an
+# embedded beam clamped by a half-space of background nodes), change of momentum minus the
+# weight in dynamics; two constraints add up.
+foreach(el hex8 tet4)
+  fcm_sim_test(sim_reaction_${el} tests/sim/reaction.c ARGS ${el})
+endforeach()

@@ -155,6 +155,12 @@ typedef struct fcm_cell_rules_stats {
   fcm_index num_integrated;      /**< cells whose rules this call built: every cell for
                                       fcm_cell_rules_create(), the cells the new cut reaches for
                                       fcm_cell_rules_create_cut() (the others are copied) */
+  fcm_index num_degenerate;      /**< cells whose splitting by the cuts changed their parts'
+                                      volume (0 after a successful fcm_cell_rules_create_cut():
+                                      it shifts the cut until there are none) */
+  double cut_shift[3];           /**< the translation fcm_cell_rules_create_cut() applied to the
+                                      new cut to resolve degenerate cells; 0 when none was needed */
+  int cut_attempts;              /**< times it applied the cut (1: no shift) */
   fcm_index num_tets;            /**< tets of the pieces kept (slivers excluded) */
   fcm_index num_slivers;         /**< tets dropped as slivers */
   double sliver_volume;          /**< their summed volume (not in embedded_volume) */
@@ -274,9 +280,17 @@ FCM_API fcm_status fcm_cell_rules_get_surface(const fcm_cell_rules *rules, fcm_i
  * fcm_cell_rules_num_cuts(). The links between pieces of neighbouring cells
  * (fcm_cell_rules_links()) are recomputed around every cut. `prev` is not changed (it may be
  * destroyed afterwards).
+ * Degenerate cuts: every part vertex is classified once per plane, with the tolerance of the
+ * link test (1e-9 of the cell size): a cut that close to a node, an edge or a face goes
+ * through it (a cut in cell faces separates the cells without splitting them). Where that
+ * cannot resolve a cell (near-coincident vertices classified differently: splitting would
+ * change the cell's volume, stats.num_degenerate), the whole cut is shifted by a small
+ * deterministic translation (1e-7, then 1e-6, 1e-5 of the mean cell size; stats.cut_shift,
+ * stats.cut_attempts) and applied again, so no volume is ever lost or doubled.
  * @param[in] mesh, geom the mesh and geometry `prev` was built on; @param[in] cut copied
- * @return FCM_OK; FCM_ERR_ARG (NULL, another mesh); FCM_ERR_INTERNAL (a split exceeding
- *         the polyhedron capacity); the errors of fcm_cell_rules_create(). Allocates. */
+ * @return FCM_OK; FCM_ERR_ARG (NULL, another mesh); FCM_ERR_GEOMETRY (degenerate cells left
+ *         after the largest shift); FCM_ERR_INTERNAL (a split exceeding the polyhedron
+ *         capacity); the errors of fcm_cell_rules_create(). Allocates. */
 FCM_API fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh,
                                              const fcm_geometry *geom, const fcm_cell_rules *prev,
                                              const fcm_surface *cut, fcm_cell_rules **rules);

@@ -10,6 +10,8 @@
 
 #include "fcm/core.h"
 #include "fcm/embed.h"
+#include "fcm/geom.h"
+#include "fcm/io.h"
 #include "fcm/la.h"
 #include "fcm/material.h"
 #include "fcm/mesh.h"
@@ -373,6 +375,129 @@ FCM_API fcm_status fcm_space_locate(const fcm_space *space, fcm_index n, const d
  * @return FCM_OK, FCM_ERR_ARG (an inactive or out-of-range cell). No allocation. */
 FCM_API fcm_status fcm_space_interpolate(const fcm_space *space, fcm_index n, const fcm_index *cell,
                                          const double *xi, const double *u, double *values);
+
+/* ---------------------------------------------------------------- fields and output
+ * What a host writes out of a solution u (num_dofs): node and surface-point fields, stress,
+ * VTU files. Output convention: every file holds the points at their REFERENCE positions
+ * with a point array `displacement`; ParaView's "Warp By Vector" with it shows the deformed
+ * body. Stresses: 6 components in VTK's symmetric-tensor order xx, yy, zz, xy, yz, xz. */
+
+/** Number of stress components and their order (VTK's symmetric-tensor order, so ParaView
+ * labels the components correctly). */
+enum { FCM_STRESS_XX = 0, FCM_STRESS_YY, FCM_STRESS_ZZ, FCM_STRESS_XY, FCM_STRESS_YZ,
+       FCM_STRESS_XZ, FCM_STRESS_COMPONENTS };
+
+/** A DOF vector (num_dofs, e.g. u or v) as one 3-vector per background node:
+ * node_field[3a .. 3a+3) for node a of the mesh; inactive nodes get 0. A node that cuts
+ * gave several copies gets the copy of the largest support (the volume of the pieces that
+ * use it; ties: the lowest copy), i.e. the part of the body most of its cells hold.
+ * @param[in] dofs num_dofs values; @param[out] node_field 3 x num_nodes of the mesh
+ * @return FCM_OK, FCM_ERR_ARG (NULL), FCM_ERR_ALLOC (only with copies: O(num_dofs) scratch).
+ * Thread safe. */
+FCM_API fcm_status fcm_space_node_field(const fcm_space *space, const double *dofs,
+                                        double *node_field);
+
+/** Stress of the material at reference point xi of element `elem` for the displacement u:
+ * F = I + grad u, Cauchy stress sigma = P F^T / J (P = dPsi/dF of fcm_material_eval(); the
+ * LINEAR model's small-strain stress P itself), von Mises stress
+ * sqrt(3/2 s:s) with s the deviator of sigma, and the strain energy density
+ * Psi(F) - Psi(I) per unit reference volume. Where J <= 0 (an inverted point) sigma and
+ * von Mises are NaN. Any output may be NULL. At a physical point X: fcm_space_locate() gives
+ * its cell and xi, fcm_space_point_element() the element (the piece, in a cell cuts split).
+ * @param[in] mat validated (fcm_material_validate())
+ * @return FCM_OK, FCM_ERR_ARG (NULL space or u, element out of range, bad material). No
+ * allocation; thread safe. */
+FCM_API fcm_status fcm_space_element_stress(const fcm_space *space, const fcm_material *mat,
+                                            fcm_index elem, const double xi[3], const double *u,
+                                            double stress[6], double *von_mises,
+                                            double *energy_density);
+
+/** Per background cell, the volume averages over the body's part of the cell of the
+ * stress, von Mises stress and strain energy density of fcm_space_element_stress():
+ * (integral of f) / (volume) over the authentic points of the stiffness rules of every
+ * element (piece) of the cell (cut cells: their own rules, without stabilization points;
+ * uncut cells: the standard stiffness rule). An affine u gives the exact constant. Inactive
+ * cells get 0. Any output may be NULL.
+ * @param[out] stress 6 x num_cells; von_mises, energy_density num_cells each
+ * @return FCM_OK, FCM_ERR_ARG (NULL, bad material), FCM_ERR_ALLOC (the standard rule).
+ * Parallel over cells (OpenMP); deterministic. */
+FCM_API fcm_status fcm_space_cell_stress(const fcm_space *space, const fcm_material *mat,
+                                         const double *u, double *stress, double *von_mises,
+                                         double *energy_density);
+
+/** The largest |u| over the body's quadrature points (the authentic points of the stiffness
+ * rules of every element; the fictitious part of cut cells and inactive nodes do not count).
+ * @return FCM_OK, FCM_ERR_ARG (NULL), FCM_ERR_ALLOC (the standard rule). */
+FCM_API fcm_status fcm_space_max_displacement(const fcm_space *space, const double *u,
+                                              double *max_norm);
+
+/** Write the background mesh of the space as a VTU file (atomically), points at their
+ * reference positions: point arrays `displacement` (fcm_space_node_field() of u; zero when u
+ * is NULL) and `velocity` (only when v is given); cell arrays `active` (Int32 0/1),
+ * `volume_fraction` (of the embedded rules; 1 without) and, when mat is given, the cell
+ * averages of fcm_space_cell_stress(): `stress` (6), `von_mises`, `strain_energy_density`.
+ * @return FCM_OK, FCM_ERR_ARG, FCM_ERR_IO (naming the path), FCM_ERR_ALLOC. Allocates
+ * scratch for the fields. */
+FCM_API fcm_status fcm_space_write_vtu(const fcm_space *space, const fcm_material *mat,
+                                       const double *u, const double *v, const char *path);
+
+/** The embedded surface of a body located in a space, for output: the boundary triangles of
+ * the geometry (vertices compacted) and, when the space's rules carry cuts, each piece's
+ * side of the cut faces (three points per triangle, flagged, each moving with its piece's
+ * element, so both sides of a cut show the opening). Points are held at their reference
+ * positions X; the element and reference coordinates of each are found once. */
+typedef struct fcm_embedded_surface fcm_embedded_surface;
+
+/** Locate the boundary vertices of `geom` in `space` (fcm_space_locate(): a vertex in no
+ * active cell follows the nearest active cell's extrapolated field).
+ * @param[in] space borrowed: must outlive the object (or be replaced by set_space)
+ * @param[in] geom  read during the call only
+ * @return FCM_OK, FCM_ERR_ARG (NULL, a geometry without boundary triangles), the errors of
+ * fcm_space_locate(), FCM_ERR_ALLOC. Allocates. */
+FCM_API fcm_status fcm_embedded_surface_create(const fcm_space *space, const fcm_geometry *geom,
+                                               fcm_embedded_surface **surface);
+
+/** Destroy; accepts NULL and `*surface == NULL`, sets `*surface = NULL`. */
+FCM_API void fcm_embedded_surface_destroy(fcm_embedded_surface **surface);
+
+/** Move to another space on the same mesh (after a cut: fcm_space_create_embedded() of the
+ * new rules; the old space may be destroyed before): the element of every vertex is chosen
+ * again and the cut faces rebuilt.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, other mesh), FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_embedded_surface_set_space(fcm_embedded_surface *surface,
+                                                  const fcm_space *space);
+
+/** Points (boundary vertices first, then the cut-face points) and triangles; borrowed
+ * views valid until the next set_space or destroy: reference positions (3 x num_points),
+ * triangles (3 x num_triangles point indices, outward), flags (num_points; 1 on a cut face). */
+FCM_API fcm_index fcm_embedded_surface_num_points(const fcm_embedded_surface *surface);
+FCM_API fcm_index fcm_embedded_surface_num_triangles(const fcm_embedded_surface *surface);
+FCM_API const double *fcm_embedded_surface_points(const fcm_embedded_surface *surface);
+FCM_API const fcm_index *fcm_embedded_surface_triangles(const fcm_embedded_surface *surface);
+FCM_API const int32_t *fcm_embedded_surface_cut_flags(const fcm_embedded_surface *surface);
+
+/** The field u (num_dofs of the space) at the points: displacement (3 x num_points) and the
+ * deformed positions X + u (3 x num_points); either output may be NULL.
+ * @return FCM_OK, FCM_ERR_ARG (NULL surface or u). No allocation; thread safe. */
+FCM_API fcm_status fcm_embedded_surface_eval(const fcm_embedded_surface *surface, const double *u,
+                                             double *displacement, double *deformed);
+
+/** fcm_space_element_stress() at every point (outputs 6 x num_points, num_points,
+ * num_points; any may be NULL). @return as fcm_space_element_stress(). No allocation. */
+FCM_API fcm_status fcm_embedded_surface_stress(const fcm_embedded_surface *surface,
+                                               const fcm_material *mat, const double *u,
+                                               double *stress, double *von_mises,
+                                               double *energy_density);
+
+/** Write the surface as a VTU file of triangles (atomically), points at their reference
+ * positions: point arrays `displacement`, `cut_face` (Int32 0/1) and, when mat is given,
+ * `stress` (6), `von_mises`, `strain_energy_density` at the points.
+ * @param[in] u num_dofs; NULL: zero
+ * @return FCM_OK, FCM_ERR_ARG, FCM_ERR_IO (naming the path), FCM_ERR_ALLOC. Allocates
+ * scratch for the fields. */
+FCM_API fcm_status fcm_embedded_surface_write_vtu(const fcm_embedded_surface *surface,
+                                                  const fcm_material *mat, const double *u,
+                                                  const char *path);
 
 #ifdef __cplusplus
 }

@@ -100,7 +100,8 @@ FCM_API fcm_status fcm_vtu_set_cells(fcm_vtu *vtu, int vtk_type, fcm_index num_c
 FCM_API fcm_status fcm_vtu_set_cells_mixed(fcm_vtu *vtu, fcm_index num_cells, const int *vtk_types,
                                            const fcm_index *connectivity);
 
-/** Add a Float64 field of `num_components` (1, 3 or 9) values per tuple.
+/** Add a Float64 field of `num_components` (1, 3, 6 or 9) values per tuple (6: a symmetric
+ * tensor in VTK's order xx, yy, zz, xy, yz, xz; 9: a full tensor, row-major).
  * @param[in] where          point data (one tuple per point) or cell data (one per cell)
  * @param[in] name           non-empty, printable (copied; XML-escaped on output); unique
  *                           among the fields of the same location

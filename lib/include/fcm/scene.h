@@ -165,8 +165,8 @@ typedef struct fcm_scene_output {
   const char *directory;   /**< default "fcm-output"; relative to the working directory */
   int frame_interval;      /**< write every frame_interval-th step (>= 1, default 1) */
   int checkpoint_interval; /**< write a checkpoint every n-th step (>= 0; default 0: never) */
-  int write_background;    /**< 1 (default): write the deformed background mesh */
-  int write_surface;       /**< 1 (default): write the deformed embedded surface */
+  int write_background;    /**< 1 (default): write the background mesh */
+  int write_surface;       /**< 1 (default): write the embedded surface */
 } fcm_scene_output;
 
 /* ------------------------------------------------------------------- regions */

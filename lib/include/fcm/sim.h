@@ -303,6 +303,21 @@ FCM_API const double *fcm_integrator_velocity(const fcm_integrator *integ);
 /** Number of constrained DOFs (after setup; 0 before). */
 FCM_API fcm_index fcm_integrator_num_constrained(const fcm_integrator *integ);
 
+/** Number of constraints added (fcm_integrator_add_constraint() ids are 0 .. n-1). */
+FCM_API int fcm_integrator_num_constraints(const fcm_integrator *integ);
+
+/** Reaction of constraint `id` at the last accepted step: the force the constraint exerts on
+ * the body, i.e. the residual it absorbs, summed over its constrained DOFs (every copy, the
+ * constrained components only): R = f_int(u) - f_ext + M (v_{n+1} - v_n)/h + D v_{n+1}
+ * (the gradient of the step's energy; static: f_int - f_ext). In equilibrium the reactions
+ * of all constraints add up to minus the external load (a body under gravity clamped: minus
+ * its weight). Moment about the origin: sum of (X_a + u_a) x R_a over the constrained nodes
+ * at their current positions. A released constraint reports zeros. Either output may be NULL.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, id out of range, no step accepted since the setup or
+ * the last fcm_integrator_set_state()). No allocation. */
+FCM_API fcm_status fcm_integrator_reaction(const fcm_integrator *integ, int id, double force[3],
+                                           double moment[3]);
+
 /** Copy the state out (checkpoint): u, v (num_dofs each, either may be NULL), t, steps
  * (may be NULL). */
 FCM_API void fcm_integrator_get_state(const fcm_integrator *integ, double *u, double *v, double *t,

@@ -70,7 +70,8 @@ typedef struct fcm_simulation_counters {
   int cuts_missed;     /**< of them, cuts that missed the body (no cell got a new piece) */
   fcm_index cut_cells; /**< cells integrated again because a cut reached them (summed) */
   fcm_index pieces;    /**< separate bodies now (fcm_space_num_bodies()) */
-  fcm_index surface_points, surface_triangles; /**< embedded surface written per frame */
+  fcm_index surface_points, surface_triangles; /**< the embedded boundary written per frame
+                                                    (without the cut faces) */
   double time_setup, time_steps, time_output;  /**< seconds */
 } fcm_simulation_counters;
 
@@ -115,20 +116,27 @@ FCM_API int fcm_simulation_frame_due(const fcm_simulation *sim);
 /** 1 when the displacement and velocity are finite everywhere, else 0. */
 FCM_API int fcm_simulation_state_finite(const fcm_simulation *sim);
 
-/** Write frame `index` of the current state into the existing directory `dir`:
- * <dir>/<name>_background_NNNN.vtu (displacement, velocity per node; active flag and volume
- * fraction per cell) and, with a geometry, <dir>/<name>_surface_NNNN.vtu (the boundary
- * triangles of the embedded mesh at X + u(X), u interpolated from the background field,
- * extrapolated from the nearest active cell in dropped cells), as the scene's output section
- * asks; <dir>/<name>_background.pvd and <dir>/<name>_surface.pvd are rewritten. All writes
- * are atomic. @return FCM_OK, FCM_ERR_IO (naming the path), FCM_ERR_ALLOC. */
+/** Write frame `index` of the current state into the existing directory `dir`, every point at
+ * its reference position with a point array `displacement` (README: ParaView recipe):
+ * <dir>/<name>_background_NNNN.vtu (fcm_space_write_vtu(): displacement and velocity per node;
+ * active flag, volume fraction and the cell averages of stress, von Mises stress and strain
+ * energy density per cell) and, with a geometry, <dir>/<name>_surface_NNNN.vtu
+ * (fcm_embedded_surface_write_vtu(): the boundary triangles of the embedded mesh and both
+ * sides of every cut face with displacement, cut_face and the stresses at the points; u of a
+ * vertex in a dropped cell is extrapolated from the nearest active cell), as the scene's
+ * output section asks; <dir>/<name>_background.pvd and <dir>/<name>_surface.pvd are
+ * rewritten. All writes are atomic. @return FCM_OK, FCM_ERR_IO (naming the path),
+ * FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_simulation_write_frame(fcm_simulation *sim, const char *dir, int index);
 
 /** Write the per-step log as CSV atomically to `path`: header
  * "step,time,newton_iterations,linear_iterations,residual,energy,pieces,mass,momentum_x,
- * momentum_y,momentum_z,wall_time" (pieces: separate bodies, fcm_space_num_bodies(); mass and
- * linear momentum over the body's own quadrature points, fcm_space_momentum()) and one row per
- * step taken. @return FCM_OK, FCM_ERR_IO, FCM_ERR_ALLOC. */
+ * momentum_y,momentum_z", then for every fixed or motion effect i (its index in the scene's
+ * effects) "reaction_<i>_x,reaction_<i>_y,reaction_<i>_z,moment_<i>_x,moment_<i>_y,moment_<i>_z"
+ * (fcm_integrator_reaction(): the force the region exerts on the body, inertia included, and
+ * its moment about the origin), then "wall_time"; one row per step taken (pieces: separate
+ * bodies, fcm_space_num_bodies(); mass and linear momentum over the body's own quadrature
+ * points, fcm_space_momentum()). @return FCM_OK, FCM_ERR_IO, FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_simulation_write_log(fcm_simulation *sim, const char *path);
 
 /** Save the run: write a checkpoint to `path` atomically (a temporary beside it, synced, then
@@ -175,7 +183,9 @@ FCM_API void fcm_simulation_get_counters(const fcm_simulation *sim,
 FCM_API fcm_integrator *fcm_simulation_integrator(fcm_simulation *sim);
 FCM_API const fcm_space *fcm_simulation_space(const fcm_simulation *sim);
 
-/** Print what was computed and what was skipped, with the counters, to `stream`. */
+/** Print what was computed and what was skipped, with the counters, to `stream`; also the
+ * largest displacement of the body (over its quadrature points and the surface points the
+ * frames write) beside the DOF vector's (fictitious nodes included). */
 FCM_API void fcm_simulation_summary_view(const fcm_simulation *sim, FILE *stream);
 
 #ifdef __cplusplus

@@ -136,6 +136,11 @@ typedef struct build {
 } build;
 
 /* What one thread summed over the cells it built. */
+/* A cell whose parts' total volume the cut splitting changes by more than this fraction of
+ * the cell's volume meets the cut in a way the tolerances cannot resolve (near-coincident
+ * vertices classified differently); fcm_cell_rules_create_cut() then shifts the cut. */
+#define DEGENERATE_RTOL 1e-12
+
 typedef struct cell_sums {
   fcm__embed_counts counts;
   double time_intersect, time_simplify; /* seconds of one core */
@@ -436,7 +441,10 @@ static fcm_status cell_pieces(const build *B, const fcm__embed_cell *cell, fcm__
   FCM_TRY(ctx, fcm__embed_cell_parts(ctx, B->geom, B->tree, cell, opt->clip_rtol, opt->sliver_rtol,
                                      ws, P, &sums->counts));
   FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, cell->lo, cell->hi, &P->tcand));
-  if (P->tcand.n > 0) FCM_TRY(ctx, fcm__embed_cell_pieces(ctx, cell, B->cut_tris, B->first_new, P));
+  if (P->tcand.n > 0) {
+    FCM_TRY(ctx, fcm__embed_cell_pieces(ctx, cell, B->cut_tris, B->first_new, P));
+    sums->counts.degenerate += !(P->split_error <= DEGENERATE_RTOL * cell->volume);
+  }
   FCM_ALLOC(ctx, (size_t)P->num_pieces + 1, *vol);
   FCM_TRY(ctx, drop_empty(B, ws, P->piece, &P->num_pieces, *vol, sums));
   if (B->prev) FCM_TRY(ctx, drop_empty(B, ws, P->parent, &P->num_parents, NULL, NULL));
@@ -824,6 +832,7 @@ static fcm_status run_cells(const build *B, fcm_cell_rules *R, int nthreads, cel
       sums->counts.slivers += mine.counts.slivers;
       sums->counts.surface_triangles += mine.counts.surface_triangles;
       sums->counts.sliver_volume += mine.counts.sliver_volume;
+      sums->counts.degenerate += mine.counts.degenerate;
       sums->time_intersect += mine.time_intersect;
       sums->time_simplify += mine.time_simplify;
     }
@@ -1143,6 +1152,7 @@ static void gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const cell
   S->num_tets = sums->counts.tets;
   S->num_slivers = sums->counts.slivers;
   S->sliver_volume = sums->counts.sliver_volume;
+  S->num_degenerate = sums->counts.degenerate;
   S->surface_triangles = sums->counts.surface_triangles;
   S->geometry_volume = fcm_geometry_volume(geom);
   S->num_threads = nthreads;
@@ -1230,6 +1240,23 @@ cleanup:
   return st;
 }
 
+#define CUT_ATTEMPTS 4
+
+/* The mean cell size: the cube root of the mesh's bounding-box volume per cell (its longest
+ * side per cell for a flat box). */
+static double mean_cell_size(const fcm_mesh *mesh)
+{
+  const double *X = fcm_mesh_coords(mesh);
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (fcm_index i = 0; i < fcm_mesh_num_nodes(mesh); i++)
+    for (int d = 0; d < 3; d++)
+      lo[d] = fmin(lo[d], X[3 * i + d]), hi[d] = fmax(hi[d], X[3 * i + d]);
+  const double n = (double)fcm_mesh_num_cells(mesh);
+  const double v = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+  const double side = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+  return v > 0.0 ? cbrt(v / n) : side / n;
+}
+
 fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
                                      const fcm_cell_rules *prev, const fcm_surface *cut,
                                      fcm_cell_rules **rules)
@@ -1237,6 +1264,7 @@ fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const f
   fcm_status st = FCM_OK;
   fcm_cell_rules *R = NULL;
   unsigned char *inner = NULL;
+  fcm_index *ref = NULL;
   FCM_CHECK(rules, ctx, FCM_ERR_ARG, "embed cut: output pointer is NULL");
   *rules = NULL;
   FCM_CHECK(ctx && mesh && geom && prev && cut, ctx, FCM_ERR_ARG,
@@ -1250,24 +1278,54 @@ fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const f
   const fcm_index nt = fcm_surface_num_triangles(cut);
   const double *x = fcm_surface_coords(cut);
   const fcm_index *tv = fcm_surface_triangles(cut);
-  FCM_TRY(ctx, rules_alloc(ctx, mesh, &prev->opts, &R));
-  FCM_ALLOC(ctx, (size_t)(prev->num_cut_tris + nt), R->cut_tris);
-  if (prev->num_cut_tris)
-    memcpy(R->cut_tris, prev->cut_tris, (size_t)prev->num_cut_tris * sizeof *R->cut_tris);
-  R->num_cut_tris = prev->num_cut_tris;
   FCM_ALLOC(ctx, 3 * (size_t)nt + 1, inner);
-  FCM_TRY(ctx, fcm__embed_cut_inner_edges(ctx, cut, inner));
-  for (fcm_index t = 0; t < nt; t++)
-    R->num_cut_tris +=
-        fcm__embed_cut_tri_setup(x + 3 * tv[3 * t], x + 3 * tv[3 * t + 1], x + 3 * tv[3 * t + 2],
-                                 prev->num_cuts, inner + 3 * t, R->cut_tris + R->num_cut_tris);
-  R->num_cuts = prev->num_cuts + 1;
-  R->prev_num_pieces = prev->num_pieces;
-  FCM_TRY(ctx, build_rules(ctx, mesh, geom, prev, prev->num_cut_tris, R));
+  FCM_ALLOC(ctx, (size_t)nt + 1, ref);
+  FCM_TRY(ctx, fcm__embed_cut_inner_edges(ctx, cut, inner, ref));
+  /* A cut that meets the parts of some cell in a way the tolerances cannot resolve (the
+   * splitting changes their volume) is shifted by a small deterministic translation and
+   * applied again: 1e-7, 1e-6, then 1e-5 of the mean cell size, along a fixed direction
+   * with no rational relation to the axes. */
+  const double h = mean_cell_size(mesh);
+  static const double dir[3] = {0.4636476090008061, 0.5880026035475675, 0.6628738660715610};
+  static const double shift[CUT_ATTEMPTS] = {0.0, 1e-7, 1e-6, 1e-5};
+  fcm_index degenerate = 0;
+  for (int attempt = 0; attempt < CUT_ATTEMPTS; attempt++) {
+    fcm_cell_rules_destroy(&R);
+    FCM_TRY(ctx, rules_alloc(ctx, mesh, &prev->opts, &R));
+    FCM_ALLOC(ctx, (size_t)(prev->num_cut_tris + nt), R->cut_tris);
+    if (prev->num_cut_tris)
+      memcpy(R->cut_tris, prev->cut_tris, (size_t)prev->num_cut_tris * sizeof *R->cut_tris);
+    R->num_cut_tris = prev->num_cut_tris;
+    const double d = shift[attempt] * h;
+    for (fcm_index t = 0; t < nt; t++) {
+      double v[3][3], w[3][3];
+      for (int k = 0; k < 3; k++)
+        for (int j = 0; j < 3; j++) {
+          v[k][j] = x[3 * tv[3 * t + k] + j] + d * dir[j];
+          w[k][j] = x[3 * tv[3 * ref[t] + k] + j] + d * dir[j];
+        }
+      R->num_cut_tris += fcm__embed_cut_tri_setup(v[0], v[1], v[2], prev->num_cuts, inner + 3 * t,
+                                                  &w[0][0], R->cut_tris + R->num_cut_tris);
+    }
+    R->num_cuts = prev->num_cuts + 1;
+    R->prev_num_pieces = prev->num_pieces;
+    FCM_TRY(ctx, build_rules(ctx, mesh, geom, prev, prev->num_cut_tris, R));
+    degenerate = R->stats.num_degenerate;
+    for (int j = 0; j < 3; j++)
+      R->stats.cut_shift[j] = d * dir[j];
+    R->stats.cut_attempts = attempt + 1;
+    if (degenerate == 0) break;
+  }
+  FCM_CHECK(degenerate == 0, ctx, FCM_ERR_GEOMETRY,
+            "embed cut: the cut meets %lld cell(s) in a degenerate way that shifts of up to %g "
+            "(1e-5 of the mean cell size %g) did not resolve: splitting them changes their "
+            "volume; move the cut",
+            (long long)degenerate, shift[CUT_ATTEMPTS - 1] * h, h);
   *rules = R;
   R = NULL;
 cleanup:
   fcm__free(ctx, inner);
+  fcm__free(ctx, ref);
   fcm_cell_rules_destroy(&R);
   return st;
 }

@@ -118,6 +118,7 @@ typedef struct fcm__embed_counts {
   fcm_index slivers;           /* tets dropped as slivers */
   fcm_index surface_triangles; /* clipped boundary triangles kept */
   double sliver_volume;        /* summed volume of the dropped slivers */
+  fcm_index degenerate;        /* cells whose cut splitting changed the parts' volume */
 } fcm__embed_counts;
 
 /* Clip every candidate embedded cell E by the planes of `cell` and tetrahedralize the
@@ -166,15 +167,21 @@ fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
 
 /* ---------------------------------------------------------------- cutting (pieces.c) */
 
-/* Prepare triangle (a, b, c); 0 when it has no area (relative 1e-14 of its longest edge
+/* Prepare triangle (a, b, c), with the plane of the triangle ref (9 doubles; NULL: its
+ * own) oriented as its own; 0 when it has no area (relative 1e-14 of its longest edge
  * squared): such a triangle separates nothing and is skipped. */
 int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double c[3], int cut,
-                             const unsigned char inner[3], fcm__cut_tri *t);
+                             const unsigned char inner[3], const double *ref, fcm__cut_tri *t);
 
 /* For each edge of the cut surface's triangles (3 per triangle, edge k from vertex k to
- * k + 1), whether exactly one other triangle shares it and lies in the same plane (unit
- * normals parallel to 1e-12, planes within 1e-12 of the longer edge). */
-fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsigned char *inner);
+ * k + 1), whether exactly one other triangle shares it and lies in the same plane (the
+ * smaller triangle's far vertex within 1e-12 of the longest edge from the larger one's
+ * plane) on the other side of the edge. ref[t]: the largest triangle of t's coplanar patch
+ * (triangles joined through such edges); all of a patch take its plane, so that they
+ * classify every point alike (a sliver's own normal can be off by far more than the
+ * tolerances). */
+fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsigned char *inner,
+                                      fcm_index *ref);
 
 /* Convex parts of the embedded geometry inside one background cell and the material piece
  * of each: the clipped embedded cells, split by the cut triangles that reach the cell. */
@@ -194,7 +201,8 @@ typedef struct fcm__parts {
   double *fx;
   int *fmeta;
   size_t nfx, capfx, nfp, capfp;
-  int *uf; /* union-find scratch, n entries */
+  int *uf;            /* union-find scratch, n entries */
+  double split_error; /* |parts' volume after the splits - before| (fcm__embed_cell_pieces) */
   size_t ufcap;
 } fcm__parts;
 
@@ -212,7 +220,9 @@ fcm_status fcm__embed_cell_parts(fcm_ctx *ctx, const fcm_geometry *geom, const f
  * numbered by their first part, are the pieces (P->piece, P->num_pieces). The triangles are
  * taken in ascending order; those below first_new are the earlier cuts: the pieces under
  * them alone (what the rules being extended had) are P->parent / P->num_parents, one piece
- * when none of them reaches the cell. */
+ * when none of them reaches the cell. P->split_error: how much the splits changed the parts'
+ * total volume (rounding only, unless the cuts meet the parts in a degenerate way the
+ * tolerances cannot resolve).*/
 fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
                                   const fcm__cut_tri *tris, fcm_index first_new, fcm__parts *P);
 

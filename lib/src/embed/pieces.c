@@ -35,7 +35,7 @@ static void cross3(const double a[3], const double b[3], double c[3])
 }
 
 int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double c[3], int cut,
-                             const unsigned char inner[3], fcm__cut_tri *t)
+                             const unsigned char inner[3], const double *ref, fcm__cut_tri *t)
 {
   memcpy(t->inner, inner, sizeof t->inner);
   double e0[3], e1[3], n[3], l2 = 0.0;
@@ -61,6 +61,18 @@ int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double 
   for (int d = 0; d < 3; d++)
     t->plane.n[d] = n[d] / ln;
   t->plane.d = dot3(t->plane.n, a);
+  if (ref) { /* the plane of the reference triangle of a coplanar patch, oriented as this one */
+    double r0[3], r1[3], nr[3];
+    for (int d = 0; d < 3; d++)
+      r0[d] = ref[3 + d] - ref[d], r1[d] = ref[6 + d] - ref[d];
+    cross3(r0, r1, nr);
+    const double lr = sqrt(dot3(nr, nr)), sg = dot3(nr, t->plane.n) < 0.0 ? -1.0 : 1.0;
+    if (lr > 0.0) {
+      for (int d = 0; d < 3; d++)
+        t->plane.n[d] = sg * nr[d] / lr;
+      t->plane.d = dot3(t->plane.n, ref);
+    }
+  }
   for (int k = 0; k < 3; k++) {
     const double *p = t->x[k], *q = t->x[(k + 1) % 3];
     double e[3], m[3];
@@ -104,7 +116,26 @@ static int tri_plane(const double *x, const fcm_index *tv, fcm_index t, double n
   return 1;
 }
 
-fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsigned char *inner)
+static fcm_index tri_find(fcm_index *uf, fcm_index a)
+{
+  while (uf[a] != a)
+    a = uf[a] = uf[uf[a]];
+  return a;
+}
+
+/* Twice the area of triangle t. */
+static double tri_area2(const double *x, const fcm_index *tv, fcm_index t)
+{
+  const double *a = x + 3 * tv[3 * t], *b = x + 3 * tv[3 * t + 1], *c = x + 3 * tv[3 * t + 2];
+  double u[3], v[3], n[3];
+  for (int k = 0; k < 3; k++)
+    u[k] = b[k] - a[k], v[k] = c[k] - a[k];
+  cross3(u, v, n);
+  return sqrt(dot3(n, n));
+}
+
+fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsigned char *inner,
+                                      fcm_index *ref)
 {
   fcm_status st = FCM_OK;
   const fcm_index nt = fcm_surface_num_triangles(cut);
@@ -112,6 +143,8 @@ fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsi
   const fcm_index *tv = fcm_surface_triangles(cut);
   edge_key *E = NULL;
   memset(inner, 0, 3 * (size_t)nt);
+  for (fcm_index t = 0; t < nt; t++)
+    ref[t] = t;
   if (nt < 2) return FCM_OK;
   FCM_ALLOC(ctx, 3 * (size_t)nt, E);
   for (fcm_index t = 0; t < nt; t++)
@@ -125,24 +158,43 @@ fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsi
     if (i + 2 < 3 * (size_t)nt && E[i + 2].a == E[i].a && E[i + 2].b == E[i].b) continue;
     if (i > 0 && E[i - 1].a == E[i].a && E[i - 1].b == E[i].b) continue;
     const fcm_index s = E[i].slot / 3, r = E[i + 1].slot / 3;
-    double ns[3], nr[3], ds, dr, l2 = 0.0;
-    if (!tri_plane(x, tv, s, ns, &ds) || !tri_plane(x, tv, r, nr, &dr)) continue;
-    for (int k = 0; k < 3; k++)
-      l2 += (x[3 * E[i].a + k] - x[3 * E[i].b + k]) * (x[3 * E[i].a + k] - x[3 * E[i].b + k]);
-    const double c = dot3(ns, nr), sg = c < 0.0 ? -1.0 : 1.0;
-    if (fabs(c) < 1.0 - 1e-12 || fabs(ds - sg * dr) > 1e-12 * sqrt(l2)) continue;
-    /* the two far vertices on opposite sides of the edge (not a fold) */
+    /* coplanar: the other triangle's far vertex on the plane of the larger triangle (whose
+     * normal rounding disturbs least; a sliver's normal may be off by far more than 1e-12),
+     * within 1e-12 of the longest edge; and the two far vertices on opposite sides of the
+     * shared edge (not a fold) */
     const fcm_index fs = tv[3 * s + (E[i].slot % 3 + 2) % 3],
                     fr = tv[3 * r + (E[i + 1].slot % 3 + 2) % 3];
-    double e[3], ps[3], pr[3], cs[3], cr[3];
+    double ns[3], nr[3], ds, dr, e[3], ps[3], pr[3], cs[3], cr[3], lmax = 0.0;
+    if (!tri_plane(x, tv, s, ns, &ds) || !tri_plane(x, tv, r, nr, &dr)) continue;
     for (int k = 0; k < 3; k++) {
       e[k] = x[3 * E[i].b + k] - x[3 * E[i].a + k];
       ps[k] = x[3 * fs + k] - x[3 * E[i].a + k], pr[k] = x[3 * fr + k] - x[3 * E[i].a + k];
     }
     cross3(e, ps, cs);
     cross3(e, pr, cr);
-    if (!(dot3(cs, ns) * dot3(cr, ns) < 0.0)) continue;
+    lmax = fmax(sqrt(dot3(e, e)), fmax(sqrt(dot3(ps, ps)), sqrt(dot3(pr, pr))));
+    const int s_ref = dot3(cs, cs) >= dot3(cr, cr);
+    const double *nref = s_ref ? ns : nr, dref = s_ref ? ds : dr;
+    const double *far = x + 3 * (s_ref ? fr : fs);
+    if (fabs(dot3(nref, far) - dref) > 1e-12 * lmax) continue;
+    if (!(dot3(cs, nref) * dot3(cr, nref) < 0.0)) continue;
     inner[E[i].slot] = inner[E[i + 1].slot] = 1;
+    const fcm_index ra = tri_find(ref, s), rb = tri_find(ref, r);
+    if (ra != rb) ref[FCM_MAX(ra, rb)] = FCM_MIN(ra, rb);
+  }
+  /* ref: union-find roots of the coplanar patches -> each patch's largest triangle */
+  for (fcm_index t = 0; t < nt; t++)
+    ref[t] = tri_find(ref, t);
+  {
+    fcm_index *best = (fcm_index *)E; /* 3 nt >= nt entries, no longer needed as keys */
+    for (fcm_index t = 0; t < nt; t++)
+      best[t] = -1;
+    for (fcm_index t = 0; t < nt; t++) {
+      const fcm_index r = ref[t];
+      if (best[r] < 0 || tri_area2(x, tv, t) > tri_area2(x, tv, best[r])) best[r] = t;
+    }
+    for (fcm_index t = 0; t < nt; t++)
+      ref[t] = best[ref[t]];
   }
 cleanup:
   fcm__free(ctx, E);
@@ -534,6 +586,9 @@ fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
 {
   fcm_status st = FCM_OK;
   size_t nold = 0;
+  double before = 0.0, after = 0.0;
+  for (size_t i = 0; i < P->n; i++)
+    before += fcm__geom_poly_volume(P->poly + i);
   while (nold < P->tcand.n && P->tcand.ids[nold] < first_new)
     nold++;
   FCM_TRY(ctx, split_parts(ctx, cell, tris, 0, nold, P));
@@ -545,6 +600,9 @@ fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
     P->num_parents = P->n > 0;
   }
   FCM_TRY(ctx, split_parts(ctx, cell, tris, nold, P->tcand.n, P));
+  for (size_t i = 0; i < P->n; i++)
+    after += fcm__geom_poly_volume(P->poly + i);
+  P->split_error = fabs(after - before);
   FCM_TRY(ctx, components(ctx, cell, tris, P->tcand.n, P, P->piece, &P->num_pieces));
 cleanup:
   return st;

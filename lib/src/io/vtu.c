@@ -176,8 +176,10 @@ static fcm_status add_field(fcm_vtu *vtu, fcm_vtu_location where, const char *na
             "vtu: field location %d is neither point (0) nor cell (1) data", (int)where);
   FCM_CHECK(fcm__io_printable(name), ctx, FCM_ERR_ARG,
             "vtu: field name is NULL, empty or has control characters");
-  FCM_CHECK(num_components == 1 || num_components == 3 || num_components == 9, ctx, FCM_ERR_ARG,
-            "vtu: field '%s' has %d components; supported: 1, 3 or 9", name, num_components);
+  FCM_CHECK(num_components == 1 || num_components == 3 || num_components == 6 ||
+                num_components == 9,
+            ctx, FCM_ERR_ARG, "vtu: field '%s' has %d components; supported: 1, 3, 6 or 9", name,
+            num_components);
   FCM_CHECK(num_tuples >= 0, ctx, FCM_ERR_ARG, "vtu: field '%s' has %lld tuples, must be >= 0",
             name, (long long)num_tuples);
   FCM_CHECK(data || num_tuples == 0, ctx, FCM_ERR_ARG, "vtu: field '%s' data is NULL", name);

@@ -11,7 +11,8 @@
  *   i64 newton_iterations, i64 linear_iterations, i64 tangent_assemblies
  *   i64 frames, then frames x f64 frame time
  *   i64 log rows, then rows x (f64 time, residual, energy, wall; i64 newton, linear;
- *   version 2: i64 pieces; f64 mass, momentum x, y, z)
+ *   version 2: i64 pieces; f64 mass, momentum x, y, z;
+ *   version 3: 6 x f64 per constraint effect: reaction x, y, z, moment x, y, z)
  *   num_dofs x f64 displacement, num_dofs x f64 velocity
  *   u64 FNV-1a 64 checksum of every byte before it */
 #define _POSIX_C_SOURCE 200809L
@@ -21,6 +22,7 @@
 #include "io/io_impl.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,7 +30,7 @@
 #include <sys/stat.h>
 
 #define CKPT_MAGIC   "FCMCKPT"
-#define CKPT_VERSION 2u
+#define CKPT_VERSION 3u
 #define CKPT_BOM     0x0102030405060708ull
 #define FNV_OFFSET   0xcbf29ce484222325ull
 #define FNV_PRIME    0x100000001b3ull
@@ -152,6 +154,9 @@ fcm_status fcm_simulation_write_checkpoint(fcm_simulation *S, const char *path)
     FCM_TRY(ctx, put_f64(&w, r->mass));
     for (int d = 0; d < 3; d++)
       FCM_TRY(ctx, put_f64(&w, r->momentum[d]));
+    if (S->num_react > 0)
+      FCM_TRY(ctx, put(&w, S->react_log + (size_t)k * 6 * (size_t)S->num_react,
+                       6 * (size_t)S->num_react * sizeof(double)));
   }
   FCM_TRY(ctx, put(&w, fcm_integrator_displacement(S->integ), sizeof(double) * (size_t)n));
   FCM_TRY(ctx, put(&w, fcm_integrator_velocity(S->integ), sizeof(double) * (size_t)n));
@@ -223,7 +228,9 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
   unsigned char *data = NULL;
   double *u = NULL, *v = NULL, *frame_time = NULL;
   fcm__log_row *log = NULL;
-  long long frame_cap = 0, log_cap = 0;
+  double *react = NULL;
+  long long frame_cap = 0, log_cap = 0, react_cap = 0;
+  const size_t nreact = S ? 6 * (size_t)S->num_react : 0;
   FCM_CHECK(S && path && path[0], S ? S->ctx : NULL, FCM_ERR_ARG,
             "simulation: read_checkpoint needs a simulation and a path");
   fcm_ctx *ctx = S->ctx;
@@ -245,8 +252,8 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
     FCM_TRY(ctx, get(&r, &bom, sizeof bom, "the byte-order mark"));
     FCM_CHECK(bom == CKPT_BOM, ctx, FCM_ERR_FORMAT,
               "checkpoint %s: written on a machine of the other byte order", path);
-    FCM_CHECK(version == 1 || version == CKPT_VERSION, ctx, FCM_ERR_FORMAT,
-              "checkpoint %s: version %llu; this build reads versions 1 and %u", path,
+    FCM_CHECK(version >= 1 && version <= CKPT_VERSION, ctx, FCM_ERR_FORMAT,
+              "checkpoint %s: version %llu; this build reads versions 1 to %u", path,
               (unsigned long long)version, CKPT_VERSION);
     ver = version;
     memcpy(&sum, data + size - sizeof sum, sizeof sum);
@@ -280,10 +287,13 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
     FCM_TRY(ctx, get(&r, frame_time, sizeof *frame_time * (size_t)frames, "the frame times"));
   }
   FCM_TRY(ctx, get_i64(&r, &rows, steps, steps, "log rows (one per step)"));
-  const size_t row_bytes = ver >= 2 ? 8 * sizeof(double) + 3 * sizeof(int64_t)
+  const size_t row_bytes = ver >= 2 ? (8 + (ver >= 3 ? nreact : 0)) * sizeof(double) +
+                                          3 * sizeof(int64_t)
                                     : 4 * sizeof(double) + 2 * sizeof(int64_t);
   FCM_TRY(ctx, need(&r, rows, row_bytes, "log rows"));
   if (rows > 0) FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&log, &log_cap, rows, sizeof *log));
+  if (rows > 0 && nreact > 0)
+    FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&react, &react_cap, rows, nreact * sizeof *react));
   for (long long k = 0; k < rows; k++) {
     fcm__log_row *w = &log[k];
     double d[4];
@@ -299,6 +309,12 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
       FCM_TRY(ctx, get(&r, e, sizeof e, "a log row"));
       w->pieces = (long long)pc, w->mass = e[0];
       memcpy(w->momentum, e + 1, 3 * sizeof *e);
+    }
+    if (nreact > 0 && ver >= 3) {
+      FCM_TRY(ctx, get(&r, react + (size_t)k * nreact, nreact * sizeof *react, "a log row"));
+    } else {
+      for (size_t j = 0; j < nreact; j++) /* not recorded by that version */
+        react[(size_t)k * nreact + j] = NAN;
     }
   }
   FCM_TRY(ctx, need(&r, n, 2 * sizeof(double), "displacement and velocity values"));
@@ -327,6 +343,8 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
   S->frame_time = frame_time, S->frame_cap = frame_cap, frame_time = NULL;
   fcm__free(ctx, S->log);
   S->log = log, S->log_cap = log_cap, S->log_n = rows, log = NULL;
+  fcm__free(ctx, S->react_log);
+  S->react_log = react, S->react_cap = react_cap, react = NULL;
   S->restored = 1;
 cleanup:
   if (S) {
@@ -335,6 +353,7 @@ cleanup:
     fcm__free(S->ctx, v);
     fcm__free(S->ctx, frame_time);
     fcm__free(S->ctx, log);
+    fcm__free(S->ctx, react);
   }
   return st;
 }

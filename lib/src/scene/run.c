@@ -101,6 +101,7 @@ fcm_status fcm__effect_apply_constraint(fcm_simulation *S, const fcm_effect *e)
 {
   fcm_status st = FCM_OK;
   fcm_index *nodes = NULL, n = 0;
+  int id = -1;
   const fcm_region *r = e->type == FCM_EFFECT_FIXED ? &e->fixed.region : &e->motion.region;
   fcm_motion m = fcm_motion_default();
   if (e->type == FCM_EFFECT_FIXED) {
@@ -109,10 +110,16 @@ fcm_status fcm__effect_apply_constraint(fcm_simulation *S, const fcm_effect *e)
   } else {
     m = e->motion.motion;
   }
+  if (!S->react_effect) { /* the log's reaction columns: one group per constraint effect */
+    FCM_ALLOC(S->ctx, fcm_scene_num_effects(S->scene), S->react_effect);
+    FCM_ALLOC(S->ctx, fcm_scene_num_effects(S->scene), S->react_id);
+  }
   FCM_TRY(S->ctx, region_nodes(S, r, e->index, NULL, &n));
   FCM_ALLOC(S->ctx, n, nodes);
   FCM_TRY(S->ctx, region_nodes(S, r, e->index, nodes, &n));
-  FCM_TRY(S->ctx, fcm_integrator_add_constraint(S->integ, n, nodes, &m, NULL));
+  FCM_TRY(S->ctx, fcm_integrator_add_constraint(S->integ, n, nodes, &m, &id));
+  S->react_effect[S->num_react] = e->index;
+  S->react_id[S->num_react++] = id;
   S->c.constraints++;
   S->c.constrained_nodes += n;
 cleanup:
@@ -564,51 +571,19 @@ static fcm_index count_schwarz_blocks(const fcm_simulation *S, double theta)
   return n;
 }
 
-/* The embedded surface: the boundary triangles' nodes (compacted), located once. */
-/* The element each surface vertex moves with (after every cut). */
-static void surface_elements(fcm_simulation *S)
-{
-  for (fcm_index i = 0; S->surf_elem && i < S->ns; i++)
-    S->surf_elem[i] = fcm_space_point_element(S->space, S->surf_cell[i], S->surf_xi + 3 * i);
-}
-
+/* The embedded surface written per frame: the boundary triangles' vertices located once
+ * (fcm_embedded_surface_create()), the cut faces added after every cut. */
 static fcm_status build_surface(fcm_simulation *S)
 {
   fcm_status st = FCM_OK;
-  fcm_ctx *ctx = S->ctx;
-  fcm_index nv = fcm_geometry_num_nodes(S->geom);
-  fcm_index nt = fcm_geometry_num_boundary_triangles(S->geom);
-  const fcm_index *tri = fcm_geometry_boundary_triangles(S->geom);
-  const double *GX = fcm_geometry_coords(S->geom);
-  fcm_index *map = NULL;
-  FCM_ALLOC(ctx, nv, map);
-  for (fcm_index i = 0; i < nv; i++)
-    map[i] = -1;
-  fcm_index ns = 0;
-  for (fcm_index k = 0; k < 3 * nt; k++)
-    if (map[tri[k]] < 0) map[tri[k]] = ns++;
-  FCM_ALLOC(ctx, 3 * nt, S->surf_tri);
-  FCM_ALLOC(ctx, ns, S->surf_cell);
-  FCM_ALLOC(ctx, 3 * ns, S->surf_X);
-  FCM_ALLOC(ctx, 3 * ns, S->surf_xi);
-  FCM_ALLOC(ctx, 3 * ns, S->surf_u);
-  FCM_ALLOC(ctx, 3 * ns, S->surf_x);
-  for (fcm_index k = 0; k < 3 * nt; k++)
-    S->surf_tri[k] = map[tri[k]];
-  for (fcm_index i = 0; i < nv; i++)
-    if (map[i] >= 0)
-      for (int d = 0; d < 3; d++)
-        S->surf_X[3 * map[i] + d] = GX[3 * i + d];
-  FCM_ALLOC(ctx, ns + 1, S->surf_elem);
-  if (ns > 0)
-    FCM_TRY(ctx, fcm_space_locate(S->space, ns, S->surf_X, S->surf_cell, S->surf_xi, NULL));
-  S->ns = ns;
-  S->nt = nt;
-  surface_elements(S);
-  S->c.surface_points = ns;
-  S->c.surface_triangles = nt;
+  FCM_TRY(S->ctx, fcm_embedded_surface_create(S->space, S->geom, &S->surf));
+  /* the counters name the boundary only (cut faces come and go with the cuts): 3 points per
+   * cut-face triangle */
+  const fcm_index nb = fcm_geometry_num_boundary_triangles(S->geom);
+  S->c.surface_triangles = nb;
+  S->c.surface_points = fcm_embedded_surface_num_points(S->surf) -
+                        3 * (fcm_embedded_surface_num_triangles(S->surf) - nb);
 cleanup:
-  fcm__free(ctx, map);
   return st;
 }
 
@@ -696,7 +671,7 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);
   S->pieces = fcm_space_num_bodies(S->space);
   S->c.pieces = S->pieces;
-  surface_elements(S);
+  if (S->surf) FCM_TRY(ctx, fcm_embedded_surface_set_space(S->surf, S->space));
 cleanup:
   fcm_integrator_destroy(&integ);
   fcm_space_destroy(&space);
@@ -854,16 +829,6 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   while (S->cuts_applied < S->num_cuts && S->cuts[S->cuts_applied]->cut.time <= 0.0)
     FCM_TRY(ctx, fcm__sim_apply_cut(S));
 
-  /* output scratch */
-  fcm_index nc = fcm_mesh_num_cells(S->mesh);
-  FCM_ALLOC(ctx, 3 * S->nn, S->node_u);
-  FCM_ALLOC(ctx, 3 * S->nn, S->node_v);
-  FCM_ALLOC(ctx, nc, S->cell_active);
-  FCM_ALLOC(ctx, nc, S->cell_phi);
-  for (fcm_index c = 0; c < nc; c++) {
-    S->cell_active[c] = (int32_t)fcm_space_cell_active(S->space, c);
-    S->cell_phi[c] = S->rules ? fcm_cell_rules_volume_fraction(S->rules, c) : 1.0;
-  }
   if (S->geom && fcm_scene_get_output(scene)->write_surface) FCM_TRY(ctx, build_surface(S));
   S->c.time_setup = fcm_wtime() - t0;
   *out = S;
@@ -885,14 +850,14 @@ void fcm_simulation_destroy(fcm_simulation **sim)
   fcm_ctx *ctx = S->ctx;
   fcm_pvd_destroy(&S->pvd_bg);
   fcm_pvd_destroy(&S->pvd_surf);
+  fcm_embedded_surface_destroy(&S->surf);
   fcm_integrator_destroy(&S->integ);
   fcm_space_destroy(&S->space);
   fcm_cell_rules_destroy(&S->rules);
   fcm_geometry_destroy(&S->geom);
   fcm_mesh_destroy(&S->mesh);
-  void *arrays[] = {S->node_u,    S->node_v,     S->cell_active, S->cell_phi, S->surf_tri,
-                    S->surf_cell, S->surf_X,     S->surf_xi,     S->surf_u,   S->surf_x,
-                    S->log,       S->frame_time, S->loads,       S->cuts,     S->surf_elem};
+  void *arrays[] = {S->log,          S->frame_time, S->loads,    S->cuts,
+                    S->react_effect, S->react_id,   S->react_log};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(ctx, arrays[k]);
   fcm__free(ctx, S);
@@ -923,6 +888,15 @@ cleanup:
   return st;
 }
 
+/* Force (q[0..3)) and moment about the origin (q[3..6)) of the k-th constraint effect of the
+ * log after the step just taken: node constraints from the integrator's residual
+ * (fcm_integrator_reaction()); a constraint imposed otherwise (weakly, on the embedded
+ * boundary) belongs here too, read through its own call. */
+static fcm_status constraint_reaction(fcm_simulation *S, int k, double q[6])
+{
+  return fcm_integrator_reaction(S->integ, S->react_id[k], q, q + 3);
+}
+
 fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
 {
   fcm_status st = FCM_OK;
@@ -934,6 +908,9 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   /* room for the log row first: a step that is taken is also logged */
   FCM_TRY(S->ctx,
           fcm__sim_grow(S->ctx, (void **)&S->log, &S->log_cap, S->log_n + 1, sizeof *S->log));
+  if (S->num_react > 0)
+    FCM_TRY(S->ctx, fcm__sim_grow(S->ctx, (void **)&S->react_log, &S->react_cap, S->log_n + 1,
+                                  6 * (size_t)S->num_react * sizeof *S->react_log));
   {
     const double t = fcm_integrator_time(S->integ), dt = fcm_scene_get_time(S->scene)->dt;
     while (S->cuts_applied < S->num_cuts && S->cuts[S->cuts_applied]->cut.time <= t + 1e-9 * dt) {
@@ -958,6 +935,10 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
     goto cleanup;
   }
   S->c.steps++;
+  for (int k = 0; k < S->num_react; k++)
+    FCM_TRY(S->ctx, constraint_reaction(S, k,
+                                        S->react_log + 6 * ((size_t)S->log_n * (size_t)S->num_react +
+                                                            (size_t)k)));
   fcm__log_row *r = &S->log[S->log_n++];
   r->time = si.time;
   r->newton = si.newton_iterations;
@@ -1034,125 +1015,36 @@ cleanup:
   return st;
 }
 
-/* The embedded surface of a frame: the boundary vertices and triangles, then the cut faces
- * of every piece (its side of the cuts; 3 vertices per triangle, each moved with its piece's
- * element), so the opening is visible. flag: 1 on cut-face points. */
-typedef struct cut_faces {
-  fcm_index np, nt;
-  double *x, *u;
-  fcm_index *tri;
-  int32_t *flag;
-} cut_faces;
-
-static fcm_status cut_face_output(fcm_simulation *S, const double *u, cut_faces *cf)
-{
-  fcm_status st = FCM_OK;
-  fcm_ctx *ctx = S->ctx;
-  fcm_index ncf = 0;
-  const fcm_index npieces = S->rules ? fcm_cell_rules_num_pieces(S->rules) : 0;
-  for (fcm_index p = 0; p < npieces; p++)
-    ncf += fcm_cell_rules_get_piece_cut_faces(S->rules, p, NULL);
-  cf->np = S->ns + 3 * ncf;
-  cf->nt = S->nt + ncf;
-  FCM_ALLOC_RAW(ctx, 3 * (size_t)cf->np + 1, cf->x);
-  FCM_ALLOC_RAW(ctx, 3 * (size_t)cf->np + 1, cf->u);
-  FCM_ALLOC_RAW(ctx, 3 * (size_t)cf->nt + 1, cf->tri);
-  FCM_ALLOC(ctx, (size_t)cf->np + 1, cf->flag);
-  memcpy(cf->x, S->surf_x, 3 * (size_t)S->ns * sizeof(double));
-  memcpy(cf->u, S->surf_u, 3 * (size_t)S->ns * sizeof(double));
-  memcpy(cf->tri, S->surf_tri, 3 * (size_t)S->nt * sizeof(fcm_index));
-  const fcm_element_type type = fcm_mesh_element_type(S->mesh);
-  double X[3 * FCM_ELEMENT_MAX_NODES];
-  fcm_index v = S->ns, t = S->nt;
-  for (fcm_index p = 0; p < npieces; p++) {
-    const double *xi;
-    const fcm_index n = fcm_cell_rules_get_piece_cut_faces(S->rules, p, &xi);
-    if (!n) continue;
-    const fcm_index c = fcm_cell_rules_piece_cell(S->rules, p);
-    fcm_index first, e0;
-    fcm_cell_rules_cell_pieces(S->rules, c, &first);
-    fcm_space_cell_elements(S->space, c, &e0);
-    fcm_mesh_cell_coords(S->mesh, c, X);
-    for (fcm_index k = 0; k < 3 * n; k++, v++) {
-      double x0[3];
-      fcm_element_map(type, X, xi + 3 * k, x0);
-      FCM_TRY(ctx,
-              fcm_space_element_eval(S->space, e0 + (p - first), xi + 3 * k, u, cf->u + 3 * v));
-      for (int d = 0; d < 3; d++)
-        cf->x[3 * v + d] = x0[d] + cf->u[3 * v + d];
-      cf->flag[v] = 1;
-    }
-    for (fcm_index k = 0; k < n; k++, t++)
-      for (int a = 0; a < 3; a++)
-        cf->tri[3 * t + a] = v - 3 * n + 3 * k + a;
-  }
-cleanup:
-  return st;
-}
-
 fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int index)
 {
-  cut_faces cf = {0, 0, NULL, NULL, NULL, NULL};
   fcm_status st = FCM_OK;
-  fcm_vtu *vtu = NULL;
   char path[4096];
   fcm_ctx *ctx = S ? S->ctx : NULL;
   FCM_CHECK(S && dir && index >= 0, ctx, FCM_ERR_ARG,
             "simulation: write_frame needs a directory and index >= 0 (got %d)", index);
   const char *name = fcm_scene_name(S->scene);
   const fcm_scene_output *out = fcm_scene_get_output(S->scene);
+  const fcm_material *mat = fcm_scene_get_material(S->scene);
   double t0 = fcm_wtime(), time = fcm_integrator_time(S->integ);
   const double *u = fcm_integrator_displacement(S->integ), *v = fcm_integrator_velocity(S->integ);
-  for (fcm_index a = 0; a < S->nn; a++) {
-    fcm_index dof = fcm_space_node_dof(S->space, a);
-    for (int d = 0; d < 3; d++) {
-      S->node_u[3 * a + d] = dof >= 0 ? u[dof + d] : 0.0;
-      S->node_v[3 * a + d] = dof >= 0 ? v[dof + d] : 0.0;
-    }
-  }
   /* room for the frame time first: a frame that is written is also counted */
   FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&S->frame_time, &S->frame_cap, S->c.frames + 1,
                              sizeof *S->frame_time));
-  FCM_TRY(ctx, fcm_vtu_create(ctx, &vtu));
   if (out->write_background) {
-    fcm_index nc = fcm_mesh_num_cells(S->mesh);
-    FCM_TRY(ctx, fcm_vtu_set_points(vtu, S->nn, fcm_mesh_coords(S->mesh)));
-    FCM_TRY(ctx, fcm_vtu_set_cells(vtu, fcm_mesh_get_element_info(S->mesh)->vtk_cell_type, nc,
-                                   fcm_mesh_cells(S->mesh)));
-    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "displacement", 3, S->nn, S->node_u));
-    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "velocity", 3, S->nn, S->node_v));
-    FCM_TRY(ctx, fcm_vtu_add_field_int32(vtu, FCM_VTU_CELL_DATA, "active", 1, nc, S->cell_active));
-    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "volume_fraction", 1, nc, S->cell_phi));
     snprintf(path, sizeof path, "%s/%s_background_%04d.vtu", dir, name, index);
-    FCM_TRY(ctx, fcm_vtu_write(vtu, path, NULL));
+    FCM_TRY(ctx, fcm_space_write_vtu(S->space, mat, u, v, path));
     if (!S->pvd_bg) FCM_TRY(ctx, open_pvd(S, dir, "background", &S->pvd_bg));
     FCM_TRY(ctx, fcm_pvd_add(S->pvd_bg, time, path));
   }
-  if (S->ns > 0) {
-    for (fcm_index i = 0; i < S->ns; i++)
-      FCM_TRY(ctx, fcm_space_element_eval(S->space, S->surf_elem[i], S->surf_xi + 3 * i, u,
-                                          S->surf_u + 3 * i));
-    for (fcm_index i = 0; i < 3 * S->ns; i++)
-      S->surf_x[i] = S->surf_X[i] + S->surf_u[i];
-    fcm_vtu_clear(vtu);
-    FCM_TRY(ctx, cut_face_output(S, u, &cf));
-    FCM_TRY(ctx, fcm_vtu_set_points(vtu, cf.np, cf.x));
-    FCM_TRY(ctx, fcm_vtu_set_cells(vtu, FCM_VTK_TRIANGLE, cf.nt, cf.tri));
-    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "displacement", 3, cf.np, cf.u));
-    FCM_TRY(ctx, fcm_vtu_add_field_int32(vtu, FCM_VTU_POINT_DATA, "cut_face", 1, cf.np, cf.flag));
+  if (S->surf) {
     snprintf(path, sizeof path, "%s/%s_surface_%04d.vtu", dir, name, index);
-    FCM_TRY(ctx, fcm_vtu_write(vtu, path, NULL));
+    FCM_TRY(ctx, fcm_embedded_surface_write_vtu(S->surf, mat, u, path));
     if (!S->pvd_surf) FCM_TRY(ctx, open_pvd(S, dir, "surface", &S->pvd_surf));
     FCM_TRY(ctx, fcm_pvd_add(S->pvd_surf, time, path));
   }
   S->frame_time[S->c.frames++] = time;
   S->c.time_output += fcm_wtime() - t0;
 cleanup:
-  fcm__free(ctx, cf.x);
-  fcm__free(ctx, cf.u);
-  fcm__free(ctx, cf.tri);
-  fcm__free(ctx, cf.flag);
-  fcm_vtu_destroy(&vtu);
   return st;
 }
 
@@ -1166,14 +1058,27 @@ fcm_status fcm_simulation_write_log(fcm_simulation *S, const char *path)
   FCM_TRY(S->ctx, fcm__io_atomic_printf(
                       S->ctx, &af,
                       "step,time,newton_iterations,linear_iterations,residual,energy,pieces,mass,"
-                      "momentum_x,momentum_y,momentum_z,wall_time\n"));
+                      "momentum_x,momentum_y,momentum_z"));
+  for (int k = 0; k < S->num_react; k++) {
+    const int i = S->react_effect[k];
+    FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af,
+                                          ",reaction_%d_x,reaction_%d_y,reaction_%d_z,moment_%d_x,"
+                                          "moment_%d_y,moment_%d_z",
+                                          i, i, i, i, i, i));
+  }
+  FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, ",wall_time\n"));
   for (long long k = 0; k < S->log_n; k++) {
     const fcm__log_row *r = &S->log[k];
     FCM_TRY(S->ctx,
-            fcm__io_atomic_printf(
-                S->ctx, &af, "%lld,%.17g,%lld,%lld,%.17g,%.17g,%lld,%.17g,%.17g,%.17g,%.17g,%.6g\n",
-                k + 1, r->time, r->newton, r->linear, r->residual, r->energy, r->pieces, r->mass,
-                r->momentum[0], r->momentum[1], r->momentum[2], r->wall));
+            fcm__io_atomic_printf(S->ctx, &af,
+                                  "%lld,%.17g,%lld,%lld,%.17g,%.17g,%lld,%.17g,%.17g,%.17g,%.17g",
+                                  k + 1, r->time, r->newton, r->linear, r->residual, r->energy,
+                                  r->pieces, r->mass, r->momentum[0], r->momentum[1],
+                                  r->momentum[2]));
+    for (int j = 0; j < 6 * S->num_react; j++)
+      FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, ",%.17g",
+                                            S->react_log[(size_t)k * 6 * S->num_react + j]));
+    FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, ",%.6g\n", r->wall));
   }
   FCM_TRY(S->ctx, fcm__io_atomic_commit(S->ctx, &af));
 cleanup:
@@ -1186,6 +1091,47 @@ cleanup:
 static void line(FILE *f, int on, const char *what, const char *detail)
 {
   fprintf(f, "  %-9s %-28s %s\n", on ? "computed" : "skipped", what, detail);
+}
+
+/* The largest displacement of the body: over its quadrature points (authentic points of the
+ * stiffness rules) and the embedded-surface points the frames write; beside it, the largest
+ * over the DOF vector, which includes the fictitious nodes outside the body. Without an
+ * embedded geometry the mesh is the body: its nodes count too. */
+static void body_displacement_line(const fcm_simulation *S, FILE *f)
+{
+  const double *u = fcm_integrator_displacement(S->integ);
+  const fcm_index n = fcm_integrator_num_dofs(S->integ);
+  double body = 0.0, dofs = 0.0, *d = NULL;
+  if (fcm_space_max_displacement(S->space, u, &body) != FCM_OK) {
+    fcm_ctx_error_clear(S->ctx);
+    return;
+  }
+  fcm_index np = S->surf ? fcm_embedded_surface_num_points(S->surf) : 0;
+  if (np > 0 && (d = fcm__malloc(S->ctx, 3 * (size_t)np, sizeof *d)) != NULL &&
+      fcm_embedded_surface_eval(S->surf, u, d, NULL) == FCM_OK) {
+    for (fcm_index i = 0; i < np; i++)
+      body = FCM_MAX(body, sqrt(d[3 * i] * d[3 * i] + d[3 * i + 1] * d[3 * i + 1] +
+                                d[3 * i + 2] * d[3 * i + 2]));
+  } else {
+    np = 0;
+    fcm_ctx_error_clear(S->ctx);
+  }
+  fcm__free(S->ctx, d);
+  for (fcm_index i = 0; i + 2 < n; i += 3)
+    dofs = FCM_MAX(dofs, sqrt(u[i] * u[i] + u[i + 1] * u[i + 1] + u[i + 2] * u[i + 2]));
+  if (!S->rules) { /* no embedding: every node is the body's */
+    fprintf(f, "  body      max |u| %.6g m over the body (its nodes and quadrature points)\n",
+            FCM_MAX(body, dofs));
+    return;
+  }
+  if (np > 0)
+    fprintf(f,
+            "  body      max |u| %.6g m over the body (its quadrature points and %lld surface "
+            "points); DOF vector, fictitious nodes included: %.6g m\n",
+            body, (long long)np, dofs);
+  else
+    fprintf(f, "  body      max |u| %.6g m over the body's quadrature points; DOF vector: %.6g m\n",
+            body, dofs);
 }
 
 void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
@@ -1296,6 +1242,7 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
   snprintf(b, sizeof b, "%lld frames, surface %lld points %lld triangles", c->frames,
            (long long)c->surface_points, (long long)c->surface_triangles);
   line(f, c->frames > 0, "output", b);
+  body_displacement_line(S, f);
   if (S->free_body) {
     double com[3];
     if (fcm_simulation_center_of_mass(S, com) == FCM_OK) {

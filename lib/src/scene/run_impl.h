@@ -4,6 +4,7 @@
 #define FCM_SCENE_RUN_IMPL_H
 
 #include "fcm/embed.h"
+#include "fcm/fem.h"
 #include "fcm/geom.h"
 #include "fcm/io.h"
 #include "fcm/mesh.h"
@@ -29,14 +30,8 @@ struct fcm_simulation {
   fcm_integrator *integ;
   fcm_simulation_counters c;
   long long num_steps;
-  /* output scratch */
-  fcm_index nn; /* background nodes */
-  double *node_u, *node_v;
-  int32_t *cell_active;
-  double *cell_phi;
-  fcm_index ns, nt; /* surface points and triangles (compacted) */
-  fcm_index *surf_tri, *surf_cell;
-  double *surf_X, *surf_xi, *surf_u, *surf_x;
+  fcm_index nn;               /* background nodes */
+  fcm_embedded_surface *surf; /* the surface frames write (NULL: none) */
   fcm_pvd *pvd_bg, *pvd_surf;
   /* times of the frames written (frame k at frame_time[k]); c.frames of them */
   double *frame_time;
@@ -59,10 +54,16 @@ struct fcm_simulation {
   long long base_factorizations, base_analyses, base_fallbacks; /* of integrators before cuts */
   fcm_index base_dofs, base_constrained; /* DOFs and constrained DOFs before any cut (the
                                             checkpoint fingerprint) */
-  fcm_index *surf_elem;                  /* element of each surface vertex (cuts split cells) */
   /* log */
   fcm__log_row *log;
   long long log_n, log_cap;
+  /* reactions in the log: the constraint effects (fixed, motion) in effect order, their effect
+   * index and integrator constraint id; per log row 6 x num_react values (force x, y, z,
+   * moment x, y, z; NaN where unknown, e.g. rows of a version-2 checkpoint) */
+  int num_react;
+  int *react_effect, *react_id;
+  double *react_log;
+  long long react_cap;
   /* what the voxel or level-set geometry reported ("" for the other kinds) */
   char geometry_note[256];
 };

@@ -164,6 +164,7 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   fcm__free(ctx, I->con_id);
   fcm__free(ctx, I->is_con);
   fcm__free(ctx, I->con_on);
+  fcm__free(ctx, I->reaction);
   fcm__free(ctx, I->act_dof);
   fcm__free(ctx, I->schwarz_flag);
   fcm_csr_destroy(&I->M);
@@ -460,6 +461,7 @@ static fcm_status build_constraints(fcm_integrator *I)
   FCM_ALLOC(ctx, count, I->act_inc);
   FCM_ALLOC(ctx, I->n, I->is_con);
   FCM_ALLOC(ctx, I->num_cons, I->con_on);
+  FCM_ALLOC(ctx, 6 * (size_t)I->num_cons + 1, I->reaction);
   count = 0;
   for (int k = 0; k < I->num_cons; k++) {
     const sim_constraint *c = &I->cons[k];
@@ -724,6 +726,7 @@ fcm_status fcm_integrator_set_state(fcm_integrator *I, const double *u, const do
   if (v) memcpy(I->v, v, sizeof *v * (size_t)I->n);
   I->t = t;
   I->steps = steps;
+  I->reaction_valid = 0;
   if (!I->linear) I->h_state = SIM_H_INVALID; /* a linear system does not depend on u */
   if (I->is_setup) {
     if (steps > 0 && I->opts.kind == FCM_INTEGRATOR_STATIC)
@@ -836,6 +839,47 @@ fcm_status fcm_integrator_momentum(fcm_integrator *I, double linear[3], double a
   }
 cleanup:
   return st;
+}
+
+void fcm__sim_store_reactions(fcm_integrator *I)
+{
+  const double *X = fcm_mesh_coords(fcm_space_mesh(I->space));
+  memset(I->reaction, 0, 6 * sizeof *I->reaction * (size_t)I->num_cons);
+  for (fcm_index j = 0; j < I->ncon; j++) {
+    const int k = I->con_id[j], i = I->con_comp[j];
+    if (!I->con_on[k]) continue; /* released: it holds nothing */
+    const fcm_index d = I->con_dof[j], base = d - i;
+    double *r = I->reaction + 6 * k, f[3] = {0, 0, 0}, x[3];
+    f[i] = I->g[d];
+    for (int c = 0; c < 3; c++)
+      x[c] = X[3 * I->con_node[j] + c] + I->u[base + c];
+    r[i] += f[i];
+    r[3] += x[1] * f[2] - x[2] * f[1];
+    r[4] += x[2] * f[0] - x[0] * f[2];
+    r[5] += x[0] * f[1] - x[1] * f[0];
+  }
+  I->reaction_valid = 1;
+}
+
+fcm_status fcm_integrator_reaction(const fcm_integrator *I, int id, double force[3],
+                                   double moment[3])
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
+  FCM_CHECK(id >= 0 && id < I->num_cons, I->ctx, FCM_ERR_ARG,
+            "integrator: reaction: constraint %d out of range [0, %d)", id, I->num_cons);
+  FCM_CHECK(I->is_setup && I->reaction_valid, I->ctx, FCM_ERR_ARG,
+            "integrator: reaction: no step accepted since the setup or the last set_state (the "
+            "reaction is that of the last accepted step)");
+  if (force) memcpy(force, I->reaction + 6 * id, 3 * sizeof *force);
+  if (moment) memcpy(moment, I->reaction + 6 * id + 3, 3 * sizeof *moment);
+cleanup:
+  return st;
+}
+
+int fcm_integrator_num_constraints(const fcm_integrator *I)
+{
+  return I ? I->num_cons : 0;
 }
 
 fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space *space,

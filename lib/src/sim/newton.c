@@ -481,6 +481,7 @@ static fcm_status accept_step(fcm_integrator *I, int dyn, double t0, fcm_step_in
   double ekin = 0.0;
   I->t = t0 + I->opts.dt;
   I->steps++;
+  fcm__sim_store_reactions(I);
   if (!dyn) memcpy(I->load_prev, I->fext, sizeof(double) * (size_t)n);
   if (dyn) {
     st = fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1);

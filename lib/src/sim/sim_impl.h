@@ -63,6 +63,9 @@ struct fcm_integrator {
   unsigned char *is_con; /* n: constrained by an active constraint right now */
   unsigned char *con_on; /* num_cons: constraint active right now */
   long long con_version; /* bumps whenever the active set changes */
+  double *reaction;      /* num_cons x 6: force and moment of each constraint at the last
+                            accepted step (fcm_integrator_reaction()) */
+  int reaction_valid;    /* 1 after an accepted step; 0 after setup and set_state */
   fcm_index nact;        /* active constrained DOFs */
   fcm_index *act_dof;    /* nact DOFs (distinct) */
   double *act_val;       /* their prescribed displacements at the substep's end */
@@ -129,6 +132,10 @@ void fcm__sim_eval_loads(const fcm_integrator *I, double t, double *f);
  * preconditioner's matrix) the material tangent is added to; A has the pattern of M.
  * (newton.c) */
 void fcm__sim_set_base(const fcm_integrator *I, double h, fcm_csr *A);
+
+/* Store the reaction of every constraint from the gradient I->g of the accepted iterate
+ * (called when a step is accepted). (integrator.c) */
+void fcm__sim_store_reactions(fcm_integrator *I);
 
 /* Active constraint set and prescribed values at time t (act_dof, act_val; con_version
  * bumps when the set changes). (integrator.c) */

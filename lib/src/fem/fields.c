@@ -1,0 +1,516 @@
+/* Fields of a solution for output: DOF vectors per background node, stress, von Mises stress
+ * and strain energy density at points and as cell averages, the embedded surface, VTU files.
+ * Every file holds reference positions with a `displacement` point array (README: ParaView). */
+#include "fem/fem_impl.h"
+#include "la/mat3.h"
+
+#include <math.h>
+#include <string.h>
+
+/* The material prepared once per call: parameters and Psi(I). */
+typedef struct stress_model {
+  fcm_material_params p;
+  double psi0;
+} stress_model;
+
+static fcm_status stress_model_setup(fcm_ctx *ctx, const fcm_material *mat, stress_model *m)
+{
+  fcm_status st = FCM_OK;
+  static const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  FCM_CHECK(mat, ctx, FCM_ERR_ARG, "stress: material is NULL");
+  FCM_TRY(ctx, fcm_material_setup(ctx, mat, &m->p));
+  fcm_material_eval(&m->p, I, &m->psi0, NULL, NULL);
+cleanup:
+  return st;
+}
+
+/* Stress measures at reference point xi of element e (cell coordinates X given). */
+static void point_stress(const fcm_space *s, const stress_model *m, fcm_index e, const double *X,
+                         const double xi[3], const double *u, double sig[6], double *vm,
+                         double *sed)
+{
+  double dN[3 * FCM_ELEMENT_MAX_NODES], J[9], Ji[9], F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  double P[9], psi = 0.0;
+  fcm_element_eval_grad(s->type, xi, dN);
+  fcm_element_jacobian(s->type, X, xi, J);
+  fcm__mat3_inv(J, Ji);
+  const fcm_index *ed = s->elem_dof + e * s->nn;
+  for (int a = 0; a < s->nn; a++) {
+    double g[3]; /* dN_a/dX_j = sum_k dN_a/dxi_k (J^-1)_kj */
+    for (int j = 0; j < 3; j++)
+      g[j] = dN[3 * a] * Ji[j] + dN[3 * a + 1] * Ji[3 + j] + dN[3 * a + 2] * Ji[6 + j];
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++)
+        F[3 * i + j] += u[ed[a] + i] * g[j];
+  }
+  fcm_material_eval(&m->p, F, &psi, P, NULL);
+  double c[9]; /* Cauchy stress, full */
+  if (m->p.model == FCM_MATERIAL_LINEAR) {
+    memcpy(c, P, sizeof c);
+  } else {
+    const double det = fcm__mat3_det(F);
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++)
+        c[3 * i + j] = det > 0.0 ? (P[3 * i] * F[3 * j] + P[3 * i + 1] * F[3 * j + 1] +
+                                    P[3 * i + 2] * F[3 * j + 2]) /
+                                       det
+                                 : NAN;
+  }
+  sig[FCM_STRESS_XX] = c[0], sig[FCM_STRESS_YY] = c[4], sig[FCM_STRESS_ZZ] = c[8];
+  sig[FCM_STRESS_XY] = 0.5 * (c[1] + c[3]);
+  sig[FCM_STRESS_YZ] = 0.5 * (c[5] + c[7]);
+  sig[FCM_STRESS_XZ] = 0.5 * (c[2] + c[6]);
+  const double dxy = sig[0] - sig[1], dyz = sig[1] - sig[2], dzx = sig[2] - sig[0];
+  *vm = sqrt(0.5 * (dxy * dxy + dyz * dyz + dzx * dzx) +
+             3.0 * (sig[3] * sig[3] + sig[4] * sig[4] + sig[5] * sig[5]));
+  *sed = psi - m->psi0;
+}
+
+fcm_status fcm_space_element_stress(const fcm_space *s, const fcm_material *mat, fcm_index elem,
+                                    const double xi[3], const double *u, double stress[6],
+                                    double *von_mises, double *energy_density)
+{
+  fcm_status st = FCM_OK;
+  stress_model m;
+  double X[3 * FCM_ELEMENT_MAX_NODES], sig[6], vm, sed;
+  FCM_CHECK(s && xi && u, s ? s->ctx : NULL, FCM_ERR_ARG, "stress: NULL space, point or field");
+  FCM_CHECK(elem >= 0 && elem < s->num_elems, s->ctx, FCM_ERR_ARG,
+            "stress: element %lld is out of range [0, %lld)", (long long)elem,
+            (long long)s->num_elems);
+  FCM_TRY(s->ctx, stress_model_setup(s->ctx, mat, &m));
+  fcm_mesh_cell_coords(s->mesh, s->elem_cell[elem], X);
+  point_stress(s, &m, elem, X, xi, u, sig, &vm, &sed);
+  if (stress) memcpy(stress, sig, sizeof sig);
+  if (von_mises) *von_mises = vm;
+  if (energy_density) *energy_density = sed;
+cleanup:
+  return st;
+}
+
+/* The authentic volume points of element e for integration over the body: the piece's own
+ * stiffness rule in a cut cell, else the standard rule `full`. */
+static void element_points(const fcm_space *s, const fcm_rule *full, fcm_index e, int *nq,
+                           const double **pts, const double **w, const unsigned char **fl)
+{
+  if (s->rules && fcm_cell_rules_class(s->rules, s->elem_cell[e]) != FCM_CELL_UNCUT) {
+    if (fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], FCM_RULE_STIFFNESS, nq, pts, w, fl) !=
+        FCM_OK)
+      *nq = 0;
+    return;
+  }
+  *nq = fcm_rule_num_points(full);
+  *pts = fcm_rule_points(full);
+  *w = fcm_rule_weights(full);
+  *fl = NULL;
+}
+
+fcm_status fcm_space_cell_stress(const fcm_space *s, const fcm_material *mat, const double *u,
+                                 double *stress, double *von_mises, double *energy_density)
+{
+  fcm_status st = FCM_OK;
+  fcm_rule *full = NULL;
+  stress_model m;
+  FCM_CHECK(s && u, s ? s->ctx : NULL, FCM_ERR_ARG, "cell stress: NULL space or field");
+  FCM_TRY(s->ctx, stress_model_setup(s->ctx, mat, &m));
+  FCM_TRY(s->ctx,
+          fcm_element_standard_rule(s->ctx, s->type, FCM_RULE_STIFFNESS, FCM_DEFAULT, &full));
+  {
+    const fcm_index nc = s->num_cells;
+#pragma omp parallel for schedule(dynamic, 64)
+    for (fcm_index c = 0; c < nc; c++) {
+      double X[3 * FCM_ELEMENT_MAX_NODES], J[9], acc[8] = {0, 0, 0, 0, 0, 0, 0, 0}, vol = 0.0;
+      fcm_mesh_cell_coords(s->mesh, c, X);
+      for (fcm_index e = s->cell_elem[c]; e < s->cell_elem[c + 1]; e++) {
+        int nq = 0;
+        const double *pts = NULL, *w = NULL;
+        const unsigned char *fl = NULL;
+        element_points(s, full, e, &nq, &pts, &w, &fl);
+        for (int q = 0; q < nq; q++) {
+          if (fl && fl[q]) continue; /* fictitious stabilization points: not the body */
+          double sig[6], vm, sed;
+          const double wd = w[q] * fabs(fcm_element_jacobian(s->type, X, pts + 3 * q, J));
+          point_stress(s, &m, e, X, pts + 3 * q, u, sig, &vm, &sed);
+          for (int k = 0; k < 6; k++)
+            acc[k] += wd * sig[k];
+          acc[6] += wd * vm;
+          acc[7] += wd * sed;
+          vol += wd;
+        }
+      }
+      for (int k = 0; k < 8; k++)
+        acc[k] = vol > 0.0 ? acc[k] / vol : 0.0;
+      if (stress) memcpy(stress + 6 * c, acc, 6 * sizeof *acc);
+      if (von_mises) von_mises[c] = acc[6];
+      if (energy_density) energy_density[c] = acc[7];
+    }
+  }
+cleanup:
+  fcm_rule_destroy(&full);
+  return st;
+}
+
+fcm_status fcm_space_max_displacement(const fcm_space *s, const double *u, double *max_norm)
+{
+  fcm_status st = FCM_OK;
+  fcm_rule *full = NULL;
+  double best = 0.0;
+  FCM_CHECK(s && u && max_norm, s ? s->ctx : NULL, FCM_ERR_ARG,
+            "max displacement: NULL space, field or output");
+  FCM_TRY(s->ctx,
+          fcm_element_standard_rule(s->ctx, s->type, FCM_RULE_STIFFNESS, FCM_DEFAULT, &full));
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    int nq = 0;
+    const double *pts = NULL, *w = NULL;
+    const unsigned char *fl = NULL;
+    element_points(s, full, e, &nq, &pts, &w, &fl);
+    for (int q = 0; q < nq; q++) {
+      double v[3];
+      if (fl && fl[q]) continue;
+      fcm_space_element_eval(s, e, pts + 3 * q, u, v);
+      const double n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+      if (!(n2 <= best)) best = n2; /* NaN propagates */
+    }
+  }
+  *max_norm = sqrt(best);
+cleanup:
+  fcm_rule_destroy(&full);
+  return st;
+}
+
+/* The volume of element e (its piece of the body), which the support of a DOF copy sums;
+ * without rules every element counts 1 (there are no copies then). */
+static double element_volume(const fcm_space *s, fcm_index e)
+{
+  if (!s->rules) return 1.0;
+  fcm_index piece = s->elem_piece[e];
+  if (piece < 0) fcm_cell_rules_cell_pieces(s->rules, s->elem_cell[e], &piece); /* uncut */
+  return fcm_cell_rules_piece_volume(s->rules, piece);
+}
+
+fcm_status fcm_space_node_field(const fcm_space *s, const double *dofs, double *node_field)
+{
+  fcm_status st = FCM_OK;
+  double *support = NULL;
+  int copies = 0;
+  FCM_CHECK(s && dofs && node_field, s ? s->ctx : NULL, FCM_ERR_ARG,
+            "node field: NULL space, DOF vector or output");
+  for (fcm_index a = 0; a < s->num_nodes && !copies; a++)
+    copies = s->node_ncopy[a] > 1;
+  if (copies) {
+    FCM_ALLOC(s->ctx, s->num_dofs / 3 + 1, support);
+    for (fcm_index e = 0; e < s->num_elems; e++) {
+      const double vol = element_volume(s, e);
+      for (int a = 0; a < s->nn; a++)
+        support[s->elem_dof[e * s->nn + a] / 3] += vol;
+    }
+  }
+  for (fcm_index a = 0; a < s->num_nodes; a++) {
+    fcm_index d = s->node_dof[a];
+    if (d >= 0 && support)
+      for (fcm_index k = 1; k < s->node_ncopy[a]; k++)
+        if (support[s->node_dof[a] / 3 + k] > support[d / 3]) d = s->node_dof[a] + 3 * k;
+    for (int i = 0; i < 3; i++)
+      node_field[3 * a + i] = d >= 0 ? dofs[d + i] : 0.0;
+  }
+cleanup:
+  fcm__free(s ? s->ctx : NULL, support);
+  return st;
+}
+
+fcm_status fcm_space_write_vtu(const fcm_space *s, const fcm_material *mat, const double *u,
+                               const double *v, const char *path)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s ? s->ctx : NULL;
+  fcm_vtu *vtu = NULL;
+  double *nu = NULL, *nv = NULL, *phi = NULL, *sig = NULL, *vm = NULL, *sed = NULL, *zero = NULL;
+  int32_t *active = NULL;
+  FCM_CHECK(s && path, ctx, FCM_ERR_ARG, "write vtu: NULL space or path");
+  const fcm_index nn = s->num_nodes, nc = s->num_cells;
+  FCM_ALLOC(ctx, 3 * nn + 1, nu);
+  FCM_ALLOC(ctx, nc + 1, phi);
+  FCM_ALLOC(ctx, nc + 1, active);
+  if (u) FCM_TRY(ctx, fcm_space_node_field(s, u, nu));
+  if (v) {
+    FCM_ALLOC(ctx, 3 * nn + 1, nv);
+    FCM_TRY(ctx, fcm_space_node_field(s, v, nv));
+  }
+  for (fcm_index c = 0; c < nc; c++) {
+    active[c] = s->active[c] ? 1 : 0;
+    phi[c] = s->rules ? fcm_cell_rules_volume_fraction(s->rules, c) : 1.0;
+  }
+  FCM_TRY(ctx, fcm_vtu_create(ctx, &vtu));
+  FCM_TRY(ctx, fcm_vtu_set_points(vtu, nn, fcm_mesh_coords(s->mesh)));
+  FCM_TRY(ctx, fcm_vtu_set_cells(vtu, fcm_mesh_get_element_info(s->mesh)->vtk_cell_type, nc,
+                                 fcm_mesh_cells(s->mesh)));
+  FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "displacement", 3, nn, nu));
+  if (nv) FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "velocity", 3, nn, nv));
+  FCM_TRY(ctx, fcm_vtu_add_field_int32(vtu, FCM_VTU_CELL_DATA, "active", 1, nc, active));
+  FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "volume_fraction", 1, nc, phi));
+  if (mat) {
+    FCM_ALLOC(ctx, 6 * nc + 1, sig);
+    FCM_ALLOC(ctx, nc + 1, vm);
+    FCM_ALLOC(ctx, nc + 1, sed);
+    if (!u) FCM_ALLOC(ctx, s->num_dofs + 1, zero);
+    FCM_TRY(ctx, fcm_space_cell_stress(s, mat, u ? u : zero, sig, vm, sed));
+    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "stress", 6, nc, sig));
+    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "von_mises", 1, nc, vm));
+    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "strain_energy_density", 1, nc, sed));
+  }
+  FCM_TRY(ctx, fcm_vtu_write(vtu, path, NULL));
+cleanup:
+  fcm_vtu_destroy(&vtu);
+  void *arrays[] = {nu, nv, phi, sig, vm, sed, zero, active};
+  for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
+    fcm__free(ctx, arrays[k]);
+  return st;
+}
+
+/* ---------------------------------------------------------------- embedded surface */
+
+struct fcm_embedded_surface {
+  fcm_ctx *ctx;
+  const fcm_space *space;
+  const fcm_mesh *mesh; /* of the space (a replaced space may be gone already) */
+  fcm_index nb, nbt;    /* boundary vertices and triangles (fixed) */
+  fcm_index np, nt;     /* all points and triangles (with the cut faces) */
+  double *X, *xi;       /* np x 3: reference positions, reference coordinates in the cell */
+  fcm_index *cell, *elem, *tri;
+  int32_t *flag;
+  fcm_index cap_p, cap_t;
+};
+
+/* Element of every boundary vertex, and the cut faces of the current space. */
+static fcm_status surface_rebuild(fcm_embedded_surface *es)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = es->ctx;
+  const fcm_space *s = es->space;
+  const fcm_cell_rules *rules = s->rules;
+  const fcm_index npieces = rules ? fcm_cell_rules_num_pieces(rules) : 0;
+  fcm_index ncf = 0;
+  for (fcm_index p = 0; p < npieces; p++)
+    ncf += fcm_cell_rules_get_piece_cut_faces(rules, p, NULL);
+  const fcm_index np = es->nb + 3 * ncf, nt = es->nbt + ncf;
+  if (np > es->cap_p) {
+    const size_t old = (size_t)es->cap_p;
+    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->X, 3 * old, 3 * (size_t)np, sizeof(double)));
+    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->xi, 3 * old, 3 * (size_t)np, sizeof(double)));
+    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->cell, old, (size_t)np, sizeof(fcm_index)));
+    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->elem, old, (size_t)np, sizeof(fcm_index)));
+    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->flag, old, (size_t)np, sizeof(int32_t)));
+    es->cap_p = np;
+  }
+  if (nt > es->cap_t) {
+    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->tri, 3 * (size_t)es->cap_t, 3 * (size_t)nt,
+                             sizeof(fcm_index)));
+    es->cap_t = nt;
+  }
+  for (fcm_index i = 0; i < es->nb; i++) {
+    es->elem[i] = fcm_space_point_element(s, es->cell[i], es->xi + 3 * i);
+    FCM_CHECK(es->elem[i] >= 0, ctx, FCM_ERR_ARG,
+              "embedded surface: vertex %lld lies in cell %lld, which has no element in this "
+              "space (another mesh or active set?)",
+              (long long)i, (long long)es->cell[i]);
+    es->flag[i] = 0;
+  }
+  double Xc[3 * FCM_ELEMENT_MAX_NODES];
+  fcm_index v = es->nb, t = es->nbt;
+  for (fcm_index p = 0; p < npieces; p++) {
+    const double *xi;
+    const fcm_index n = fcm_cell_rules_get_piece_cut_faces(rules, p, &xi);
+    if (!n) continue;
+    const fcm_index c = fcm_cell_rules_piece_cell(rules, p);
+    fcm_index first = 0, e0 = 0;
+    fcm_cell_rules_cell_pieces(rules, c, &first);
+    fcm_space_cell_elements(s, c, &e0);
+    fcm_mesh_cell_coords(s->mesh, c, Xc);
+    for (fcm_index k = 0; k < 3 * n; k++, v++) {
+      fcm_element_map(s->type, Xc, xi + 3 * k, es->X + 3 * v);
+      memcpy(es->xi + 3 * v, xi + 3 * k, 3 * sizeof(double));
+      es->cell[v] = c;
+      es->elem[v] = e0 + (p - first);
+      es->flag[v] = 1;
+    }
+    for (fcm_index k = 0; k < n; k++, t++)
+      for (int a = 0; a < 3; a++)
+        es->tri[3 * t + a] = v - 3 * n + 3 * k + a;
+  }
+  es->np = np;
+  es->nt = nt;
+cleanup:
+  return st;
+}
+
+fcm_status fcm_embedded_surface_create(const fcm_space *s, const fcm_geometry *geom,
+                                       fcm_embedded_surface **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s ? s->ctx : NULL;
+  fcm_embedded_surface *es = NULL;
+  fcm_index *map = NULL;
+  FCM_CHECK(s && geom && out, ctx, FCM_ERR_ARG, "embedded surface: NULL space, geometry or output");
+  *out = NULL;
+  const fcm_index nv = fcm_geometry_num_nodes(geom), nt = fcm_geometry_num_boundary_triangles(geom);
+  const fcm_index *tri = fcm_geometry_boundary_triangles(geom);
+  const double *GX = fcm_geometry_coords(geom);
+  FCM_CHECK(nt > 0, ctx, FCM_ERR_ARG, "embedded surface: the geometry has no boundary triangles");
+  FCM_ALLOC(ctx, 1, es);
+  es->ctx = ctx;
+  es->space = s;
+  es->mesh = s->mesh;
+  FCM_ALLOC(ctx, nv, map);
+  for (fcm_index i = 0; i < nv; i++)
+    map[i] = -1;
+  fcm_index nb = 0;
+  for (fcm_index k = 0; k < 3 * nt; k++)
+    if (map[tri[k]] < 0) map[tri[k]] = nb++;
+  es->cap_p = nb;
+  es->cap_t = nt;
+  FCM_ALLOC(ctx, 3 * nb, es->X);
+  FCM_ALLOC(ctx, 3 * nb, es->xi);
+  FCM_ALLOC(ctx, nb, es->cell);
+  FCM_ALLOC(ctx, nb, es->elem);
+  FCM_ALLOC(ctx, nb, es->flag);
+  FCM_ALLOC(ctx, 3 * nt, es->tri);
+  for (fcm_index k = 0; k < 3 * nt; k++)
+    es->tri[k] = map[tri[k]];
+  for (fcm_index i = 0; i < nv; i++)
+    if (map[i] >= 0) memcpy(es->X + 3 * map[i], GX + 3 * i, 3 * sizeof(double));
+  es->nb = nb;
+  es->nbt = nt;
+  FCM_TRY(ctx, fcm_space_locate(s, nb, es->X, es->cell, es->xi, NULL));
+  FCM_TRY(ctx, surface_rebuild(es));
+  *out = es;
+  es = NULL;
+cleanup:
+  fcm__free(ctx, map);
+  fcm_embedded_surface_destroy(&es);
+  return st;
+}
+
+void fcm_embedded_surface_destroy(fcm_embedded_surface **surface)
+{
+  if (!surface || !*surface) return;
+  fcm_embedded_surface *es = *surface;
+  void *arrays[] = {es->X, es->xi, es->cell, es->elem, es->tri, es->flag};
+  for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
+    fcm__free(es->ctx, arrays[k]);
+  fcm__free(es->ctx, es);
+  *surface = NULL;
+}
+
+fcm_status fcm_embedded_surface_set_space(fcm_embedded_surface *es, const fcm_space *s)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(es && s, es ? es->ctx : NULL, FCM_ERR_ARG, "embedded surface: NULL surface or space");
+  FCM_CHECK(s->mesh == es->mesh, es->ctx, FCM_ERR_ARG,
+            "embedded surface: the new space is on another mesh");
+  es->space = s;
+  FCM_TRY(es->ctx, surface_rebuild(es));
+cleanup:
+  return st;
+}
+
+fcm_index fcm_embedded_surface_num_points(const fcm_embedded_surface *es)
+{
+  return es ? es->np : 0;
+}
+fcm_index fcm_embedded_surface_num_triangles(const fcm_embedded_surface *es)
+{
+  return es ? es->nt : 0;
+}
+const double *fcm_embedded_surface_points(const fcm_embedded_surface *es)
+{
+  return es ? es->X : NULL;
+}
+const fcm_index *fcm_embedded_surface_triangles(const fcm_embedded_surface *es)
+{
+  return es ? es->tri : NULL;
+}
+const int32_t *fcm_embedded_surface_cut_flags(const fcm_embedded_surface *es)
+{
+  return es ? es->flag : NULL;
+}
+
+fcm_status fcm_embedded_surface_eval(const fcm_embedded_surface *es, const double *u,
+                                     double *displacement, double *deformed)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(es && u, es ? es->ctx : NULL, FCM_ERR_ARG, "embedded surface: NULL surface or field");
+  for (fcm_index i = 0; i < es->np; i++) {
+    double d[3];
+    FCM_TRY(es->ctx, fcm_space_element_eval(es->space, es->elem[i], es->xi + 3 * i, u, d));
+    if (displacement) memcpy(displacement + 3 * i, d, sizeof d);
+    if (deformed)
+      for (int k = 0; k < 3; k++)
+        deformed[3 * i + k] = es->X[3 * i + k] + d[k];
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm_embedded_surface_stress(const fcm_embedded_surface *es, const fcm_material *mat,
+                                       const double *u, double *stress, double *von_mises,
+                                       double *energy_density)
+{
+  fcm_status st = FCM_OK;
+  stress_model m;
+  FCM_CHECK(es && u, es ? es->ctx : NULL, FCM_ERR_ARG, "embedded surface: NULL surface or field");
+  FCM_TRY(es->ctx, stress_model_setup(es->ctx, mat, &m));
+  {
+    const fcm_space *s = es->space;
+    double X[3 * FCM_ELEMENT_MAX_NODES];
+    fcm_index last = -1;
+    for (fcm_index i = 0; i < es->np; i++) {
+      double sig[6], vm, sed;
+      const fcm_index c = s->elem_cell[es->elem[i]];
+      if (c != last) fcm_mesh_cell_coords(s->mesh, c, X);
+      last = c;
+      point_stress(s, &m, es->elem[i], X, es->xi + 3 * i, u, sig, &vm, &sed);
+      if (stress) memcpy(stress + 6 * i, sig, sizeof sig);
+      if (von_mises) von_mises[i] = vm;
+      if (energy_density) energy_density[i] = sed;
+    }
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm_embedded_surface_write_vtu(const fcm_embedded_surface *es, const fcm_material *mat,
+                                          const double *u, const char *path)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = es ? es->ctx : NULL;
+  fcm_vtu *vtu = NULL;
+  double *d = NULL, *sig = NULL, *vm = NULL, *sed = NULL, *zero = NULL;
+  FCM_CHECK(es && path, ctx, FCM_ERR_ARG, "embedded surface: write vtu: NULL surface or path");
+  const fcm_index np = es->np;
+  if (!u) {
+    FCM_ALLOC(ctx, es->space->num_dofs + 1, zero);
+    u = zero;
+  }
+  FCM_ALLOC(ctx, 3 * np + 1, d);
+  FCM_TRY(ctx, fcm_embedded_surface_eval(es, u, d, NULL));
+  FCM_TRY(ctx, fcm_vtu_create(ctx, &vtu));
+  FCM_TRY(ctx, fcm_vtu_set_points(vtu, np, es->X));
+  FCM_TRY(ctx, fcm_vtu_set_cells(vtu, FCM_VTK_TRIANGLE, es->nt, es->tri));
+  FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "displacement", 3, np, d));
+  FCM_TRY(ctx, fcm_vtu_add_field_int32(vtu, FCM_VTU_POINT_DATA, "cut_face", 1, np, es->flag));
+  if (mat) {
+    FCM_ALLOC(ctx, 6 * np + 1, sig);
+    FCM_ALLOC(ctx, np + 1, vm);
+    FCM_ALLOC(ctx, np + 1, sed);
+    FCM_TRY(ctx, fcm_embedded_surface_stress(es, mat, u, sig, vm, sed));
+    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "stress", 6, np, sig));
+    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "von_mises", 1, np, vm));
+    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "strain_energy_density", 1, np, sed));
+  }
+  FCM_TRY(ctx, fcm_vtu_write(vtu, path, NULL));
+cleanup:
+  fcm_vtu_destroy(&vtu);
+  void *arrays[] = {d, sig, vm, sed, zero};
+  for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
+    fcm__free(ctx, arrays[k]);
+  return st;
+}
