@@ -86,7 +86,8 @@ install_check() {
   cmake -S "$src" -B "$ex/build" -DCMAKE_PREFIX_PATH="$prefix/fcm" >/dev/null
   cmake --build "$ex/build" >/dev/null
   "$ex/build/host_static" "$ex/out-cmake" >/dev/null
-  "$ex/build/host_dynamic" >/dev/null
+  "$ex/build/host_dynamic" "$ex/out-cmake" >/dev/null
+  [ -s "$ex/out-cmake/host_dynamic_surface.vtu" ]
   # the installed programs find the moved libfcm through their $ORIGIN rpath
   if [ -x "$prefix/fcm/bin/fcm-sim" ]; then "$prefix/fcm/bin/fcm-sim" --help >/dev/null; fi
   echo "install check: examples built against the installed package (pkg-config and"\

@@ -27,7 +27,8 @@ if(CMAKE_CXX_COMPILER)
   list(REMOVE_ITEM cxx_warnings -Wstrict-prototypes -Wmissing-prototypes)
   target_compile_options(fcm_example_host_dynamic PRIVATE ${cxx_warnings} ${FCM_SAN_FLAGS})
   if(BUILD_TESTING)
-    add_test(NAME app_example_host_dynamic COMMAND fcm_example_host_dynamic)
+    add_test(NAME app_example_host_dynamic
+             COMMAND fcm_example_host_dynamic ${PROJECT_BINARY_DIR}/examples-out)
     set_tests_properties(app_example_host_dynamic PROPERTIES LABELS app TIMEOUT 300
                          ENVIRONMENT "OMP_NUM_THREADS=2;OMP_WAIT_POLICY=passive;OPENBLAS_NUM_THREADS=1")
   endif()

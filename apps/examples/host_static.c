@@ -1,6 +1,8 @@
-/* host_static: an embedded ball under gravity, clamped on its lower cap, solved statically by a
- * host program with fcm's C API. Writes the background grid and the embedded surface as VTU,
- * both at reference positions with a `displacement` array (ParaView: Warp By Vector).
+/* host_static: an embedded ball under gravity, clamped at its bottom, solved statically by a
+ * host program with fcm's C API. The clamp holds the background nodes of the bottom layer
+ * (z <= -0.4), which carry the lower cap. Writes the background grid and the embedded surface
+ * as VTU, both at reference positions with a `displacement` array and the stresses (ParaView:
+ * Warp By Vector), and checks the clamp's reaction against the weight.
  *   cc host_static.c $(pkg-config --cflags --libs fcm) -o host_static && ./host_static [dir]
  * (shared libfcm: nothing else to link; the .pc's rpath finds the library at run time)
  * Exit status 0 when the run succeeded and the ball sags under its weight. */
@@ -30,9 +32,9 @@ int main(int argc, char **argv)
   fcm_cell_rules *rules = NULL;
   fcm_space *space = NULL;
   fcm_integrator *integ = NULL;
-  fcm_vtu *vtu = NULL;
-  fcm_index *clamped = NULL, *cell = NULL, ncl = 0;
-  double *u_node = NULL, *xi = NULL, *u_surf = NULL;
+  fcm_embedded_surface *surf = NULL;
+  double *u_surf = NULL;
+  fcm_index *clamped = NULL, ncl = 0;
   if (fcm_ctx_create(NULL, &ctx) != FCM_OK) return 1;
 
   /* Background: 6 x 6 x 6 Hex8 cells over [-0.6, 0.6]^3; body: a ball of radius 0.5. */
@@ -65,65 +67,48 @@ int main(int argc, char **argv)
   if (!clamped) goto done;
   CHECK(fcm_mesh_nodes_in_box(ctx, mesh, blo, bhi, 1e-9, ncl, clamped, &ncl));
   const fcm_motion fixed = fcm_motion_default();
-  CHECK(fcm_integrator_add_constraint(integ, ncl, clamped, &fixed, NULL));
+  int clamp = -1;
+  CHECK(fcm_integrator_add_constraint(integ, ncl, clamped, &fixed, &clamp));
   CHECK(fcm_integrator_setup(integ));
   fcm_step_info si;
   CHECK(fcm_integrator_step(integ, &si));
   printf("static solve: %d Newton iterations, residual %.3g\n", si.newton_iterations, si.residual);
-
-  /* Background VTU: node displacement (first DOF copy; nodes without DOFs stay at 0). */
   const double *u = fcm_integrator_displacement(integ);
-  const fcm_index nn = fcm_mesh_num_nodes(mesh), nc = fcm_mesh_num_cells(mesh);
-  u_node = calloc(3 * (size_t)nn, sizeof *u_node);
-  if (!u_node) goto done;
-  for (fcm_index a = 0; a < nn; a++) {
-    const fcm_index d = fcm_space_node_dof(space, a);
-    for (int k = 0; d >= 0 && k < 3; k++)
-      u_node[3 * a + k] = u[d + k];
-  }
-  CHECK(fcm_vtu_create(ctx, &vtu));
-  CHECK(fcm_vtu_set_points(vtu, nn, fcm_mesh_coords(mesh)));
-  CHECK(fcm_vtu_set_cells(vtu, fcm_mesh_get_element_info(mesh)->vtk_cell_type, nc,
-                          fcm_mesh_cells(mesh)));
-  CHECK(fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "displacement", 3, nn, u_node));
+  double force[3], moment[3], umax = 0.0;
+  CHECK(fcm_integrator_reaction(integ, clamp, force, moment));
+  CHECK(fcm_space_max_displacement(space, u, &umax));
+  printf("reaction of the clamp (%.4g, %.4g, %.4g) N; largest |u| in the body %.4g m\n", force[0],
+         force[1], force[2], umax);
+
+  /* Output: background grid and embedded surface, at reference positions with displacement
+   * and stresses. */
   snprintf(path, sizeof path, "%s/host_static_background.vtu", dir);
-  CHECK(fcm_vtu_write(vtu, path, NULL));
-
-  /* Surface VTU: the ball's boundary triangles, displacement interpolated at the vertices. */
-  const fcm_index nv = fcm_geometry_num_nodes(ball);
-  const fcm_index nt = fcm_geometry_num_boundary_triangles(ball);
-  cell = malloc((size_t)nv * sizeof *cell);
-  xi = malloc(3 * (size_t)nv * sizeof *xi);
-  u_surf = malloc(3 * (size_t)nv * sizeof *u_surf);
-  if (!cell || !xi || !u_surf) goto done;
-  CHECK(fcm_space_locate(space, nv, fcm_geometry_coords(ball), cell, xi, NULL));
-  CHECK(fcm_space_interpolate(space, nv, cell, xi, u, u_surf));
-  fcm_vtu_clear(vtu);
-  CHECK(fcm_vtu_set_points(vtu, nv, fcm_geometry_coords(ball)));
-  CHECK(fcm_vtu_set_cells(vtu, FCM_VTK_TRIANGLE, nt, fcm_geometry_boundary_triangles(ball)));
-  CHECK(fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "displacement", 3, nv, u_surf));
+  CHECK(fcm_space_write_vtu(space, &mat, u, NULL, path));
+  CHECK(fcm_embedded_surface_create(space, ball, &surf));
   snprintf(path, sizeof path, "%s/host_static_surface.vtu", dir);
-  CHECK(fcm_vtu_write(vtu, path, NULL));
-
-  /* The ball sags: its top moves down, and no point of the body moves up noticeably. */
-  double top = 0.0, umax2 = 0.0; /* (no libm needed: squared lengths) */
-  for (fcm_index v = 0; v < nv; v++) {
-    const double *X = fcm_geometry_coords(ball) + 3 * v, *uv = u_surf + 3 * v;
-    const double u2 = uv[0] * uv[0] + uv[1] * uv[1] + uv[2] * uv[2];
-    if (X[2] > 0.499) top = uv[2];
-    if (!(u2 <= umax2)) umax2 = u2; /* NaN propagates */
-  }
-  printf("top of the ball moves %.4g m; largest surface displacement^2 %.4g m^2\n", top, umax2);
+  CHECK(fcm_embedded_surface_write_vtu(surf, &mat, u, path));
   printf("wrote %s/host_static_{background,surface}.vtu\n", dir);
-  ok = top < 0.0 && umax2 < 0.25;
+
+  /* The ball sags (its top moves down), the bottom stays put, the clamp carries the weight. */
+  const fcm_index np = fcm_embedded_surface_num_points(surf);
+  const double *X = fcm_embedded_surface_points(surf);
+  u_surf = malloc(3 * (size_t)np * sizeof *u_surf);
+  if (!u_surf) goto done;
+  CHECK(fcm_embedded_surface_eval(surf, u, u_surf, NULL));
+  double top = 0.0, cap = 0.0;
+  for (fcm_index v = 0; v < np; v++) {
+    if (X[3 * v + 2] > 0.499) top = u_surf[3 * v + 2];
+    if (X[3 * v + 2] < -0.499) cap = u_surf[3 * v + 2];
+  }
+  const double weight = 1100.0 * 9.81 * fcm_cell_rules_get_stats(rules)->embedded_volume;
+  printf("top of the ball moves %.4g m, bottom %.3g m; weight %.4g N\n", top, cap, weight);
+  ok = top < 0.0 && umax < 0.5 && cap * cap < 1e-4 * top * top && force[2] > 0.98 * weight &&
+       force[2] < 1.02 * weight; /* (no libm needed) */
 
 done:
   free(clamped);
-  free(u_node);
-  free(cell);
-  free(xi);
   free(u_surf);
-  fcm_vtu_destroy(&vtu);
+  fcm_embedded_surface_destroy(&surf);
   fcm_integrator_destroy(&integ);
   fcm_space_destroy(&space);
   fcm_cell_rules_destroy(&rules);
