@@ -10,7 +10,7 @@
 
 const char *cv_method_name(cv_method m)
 {
-  return m == CV_FCM ? "fcm" : "fem";
+  return m == CV_FCM ? "fcm" : m == CV_NITSCHE ? "fcm-nitsche" : "fem";
 }
 
 static const char *ename(fcm_element_type t)
@@ -77,13 +77,13 @@ int cv_rates_compute(const cv_result *res, int nres, int fit, cv_rate *rates)
 
 void cv_print_levels(FILE *f, const cv_result *res, int nres)
 {
-  fprintf(f, "\n%-5s %-4s %4s %7s %8s %7s %6s %9s %3s %8s %8s %8s %8s %8s %9s %9s %6s\n", "elem",
+  fprintf(f, "\n%-5s %-11s %4s %7s %8s %7s %6s %9s %3s %8s %8s %8s %8s %8s %9s %9s %6s\n", "elem",
           "meth", "res", "h", "dofs", "cells", "cut", "points", "m", "t_rules", "t_asm", "t_solve",
           "t_total", "cpu_tot", "rel_L2", "rel_H1", "meas");
   for (int k = 0; k < nres; k++) {
     const cv_result *r = &res[k];
     fprintf(f,
-            "%-5s %-4s %4d %7.4f %8lld %7lld %6lld %9lld %3d %8.3f %8.3f %8.3f %8.3f %8.3f %9.3e "
+            "%-5s %-11s %4d %7.4f %8lld %7lld %6lld %9lld %3d %8.3f %8.3f %8.3f %8.3f %8.3f %9.3e "
             "%9.3e %6.4f%s%s\n",
             ename(r->element), cv_method_name(r->method), r->res, r->h, (long long)r->dofs,
             (long long)r->active_cells, (long long)r->cut_cells, (long long)r->points, r->strength,
@@ -100,10 +100,10 @@ void cv_print_levels(FILE *f, const cv_result *res, int nres)
 void cv_print_rates(FILE *f, const cv_rate *rates, int nrates)
 {
   fprintf(f, "\nfitted rates (least squares of log err vs log h over the finest levels)\n");
-  fprintf(f, "%-5s %-4s %8s %8s %9s %14s\n", "elem", "meth", "L2", "H1", "monotone", "h range");
+  fprintf(f, "%-5s %-11s %8s %8s %9s %14s\n", "elem", "meth", "L2", "H1", "monotone", "h range");
   for (int k = 0; k + 1 < nrates; k += 2) {
     const cv_rate *a = &rates[k], *b = &rates[k + 1];
-    fprintf(f, "%-5s %-4s %8.3f %8.3f %4s/%-4s %6.4f-%-6.4f (%d levels)\n", ename(a->element),
+    fprintf(f, "%-5s %-11s %8.3f %8.3f %4s/%-4s %6.4f-%-6.4f (%d levels)\n", ename(a->element),
             cv_method_name(a->method), a->rate, b->rate, a->monotone ? "yes" : "no",
             b->monotone ? "yes" : "no", a->h_min, a->h_max, a->levels);
   }
@@ -118,7 +118,7 @@ void cv_print_pareto(FILE *f, const cv_result *res, int nres, int cpu)
           "\naccuracy versus time: least total %s time [s] (rules + assembly + solve) of a "
           "run\nreaching the relative L2 error in the column head ('-': none reached it)\n",
           cpu ? "CPU" : "wall-clock");
-  fprintf(f, "%-5s %-4s", "elem", "meth");
+  fprintf(f, "%-5s %-11s", "elem", "meth");
   for (int t = 0; t < nt; t++)
     fprintf(f, " %8.0e", targets[t]);
   fprintf(f, "\n");
@@ -128,7 +128,7 @@ void cv_print_pareto(FILE *f, const cv_result *res, int nres, int cpu)
       for (int k = 0; k < nres; k++)
         any |= (int)res[k].element == e && (int)res[k].method == m;
       if (!any) continue;
-      fprintf(f, "%-5s %-4s", ename((fcm_element_type)e), cv_method_name((cv_method)m));
+      fprintf(f, "%-5s %-11s", ename((fcm_element_type)e), cv_method_name((cv_method)m));
       for (int t = 0; t < nt; t++) {
         double best = HUGE_VAL;
         for (int k = 0; k < nres; k++) {
@@ -299,7 +299,7 @@ static int script_run(FILE *f, const char *script, const char *tmp, const char *
  * h dofs time rel_l2 rel_h1 err_l2 err_h1 (time: total wall or CPU seconds), coarse to
  * fine; returns the blocks written. */
 static int write_blocks(FILE *f, const cv_result *res, int nres, int cpu,
-                        int have[FCM_ELEMENT_COUNT][2])
+                        int have[FCM_ELEMENT_COUNT][CV_METHOD_COUNT])
 {
   int nb = 0;
   for (int e = 0; e < FCM_ELEMENT_COUNT; e++)
@@ -319,7 +319,7 @@ static int write_blocks(FILE *f, const cv_result *res, int nres, int cpu,
   return nb;
 }
 
-static void plot_series(FILE *f, int have[FCM_ELEMENT_COUNT][2], const char *xcol, const char *ycol,
+static void plot_series(FILE *f, int have[FCM_ELEMENT_COUNT][CV_METHOD_COUNT], const char *xcol, const char *ycol,
                         const cv_rate *rates, int nrates, int norm)
 {
   int first = 1;
@@ -338,8 +338,8 @@ static void plot_series(FILE *f, int have[FCM_ELEMENT_COUNT][2], const char *xco
         snprintf(label, sizeof label, "%s %s", ename((fcm_element_type)e),
                  cv_method_name((cv_method)m));
       fprintf(f, "%s $D%d%d using %s:%s with linespoints lw %s dt %d pt %d lc rgb '%s' title '%s'",
-              first ? "plot" : ",", e, m, xcol, ycol, m == CV_FCM ? "2" : "1.5",
-              m == CV_FCM ? 1 : 2, m == CV_FCM ? 7 : 6, elem_colors[e], label);
+              first ? "plot" : ",", e, m, xcol, ycol, m != CV_FEM ? "2" : "1.5",
+              m != CV_FEM ? 1 : 2, m != CV_FEM ? 7 : 6, elem_colors[e], label);
       first = 0;
     }
   if (first) fprintf(f, "plot 1/0 notitle");
@@ -350,7 +350,7 @@ int cv_plot_convergence(const char *path, const cv_result *res, int nres, const 
                         int nrates, const char *title)
 {
   char script[4096], tmp[4096];
-  int have[FCM_ELEMENT_COUNT][2];
+  int have[FCM_ELEMENT_COUNT][CV_METHOD_COUNT];
   if (!cv_have_gnuplot()) return 1;
   FILE *f = script_open(path, script, tmp, sizeof tmp);
   if (!f) return 0;
@@ -370,7 +370,7 @@ int cv_plot_convergence(const char *path, const cv_result *res, int nres, const 
 int cv_plot_pareto(const char *path, const cv_result *res, int nres, int cpu, const char *title)
 {
   char script[4096], tmp[4096];
-  int have[FCM_ELEMENT_COUNT][2];
+  int have[FCM_ELEMENT_COUNT][CV_METHOD_COUNT];
   if (!cv_have_gnuplot()) return 1;
   FILE *f = script_open(path, script, tmp, sizeof tmp);
   if (!f) return 0;

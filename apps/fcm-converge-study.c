@@ -4,7 +4,9 @@
  * Manufactured problem (lib/METHOD.md §10): on the polyhedral domain Omega (the tet mesh
  * of the hemisphere) the exact field is u_i = A_i sin(k_i . x + phi_i); the body force is
  * b = -div sigma(u), the traction on the curved boundary sigma(u) n with n the facet
- * normal, and u = u_exact at every background node on y = 0 (the flat face lies there).
+ * normal (or, method fcm-nitsche, u = u_exact on the curved boundary imposed weakly by
+ * symmetric Nitsche through the library's boundary constraints), and u = u_exact at every
+ * background node on y = 0 (the flat face lies there).
  * Reference problem (the authors' setup, Longva et al. 2020 §6.6 and the reference
  * implementation notes): body load -5e5 y exp(-1/(1 - 9 r^2)) e_y for 3 r < 1, u = 0 on
  * y = 0, traction free; the reference is boundary-conforming Tet10 on the geometry's own
@@ -12,6 +14,7 @@
 #include "fcm-converge-study.h"
 
 #include <fcm/quad.h>
+#include <fcm/sim.h>
 
 #include <math.h>
 #include <stdlib.h>
@@ -605,8 +608,55 @@ static fcm_status direct_solve(fcm_ctx *ctx, fcm_csr *A, const double *b, double
   return st;
 }
 
-/* Assemble K u = f (stiffness, body force, optional embedded traction), eliminate the
- * y = 0 nodes; `extra` adds a caller load (the staircase traction) before elimination. */
+/* --boundary nitsche: the exact displacement, prescribed on the curved boundary (the
+ * points whose outward normal is not the flat face's -e_y). */
+static void exact_displacement_cb(void *user, const double x[3], const double n[3], double u[3])
+{
+  (void)user, (void)n;
+  cv_exact(x, u, NULL);
+}
+
+static int curved_cb(void *user, const double X[3], const double n[3])
+{
+  (void)user, (void)X;
+  return n[1] > -0.5;
+}
+
+/* Symmetric Nitsche on the curved boundary (fcm_integrator_add_boundary_constraint, the
+ * library's estimate of the penalty): the linear problem's matrix N and load -grad Pi(0),
+ * from the integrator's boundary terms at u = 0 (Pi is quadratic: K u + N u = f - grad Pi(0)). */
+static fcm_status nitsche_terms(const cv_study *S, fcm_space *space, fcm_csr *K, double *f)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  const fcm_material mat = {FCM_MATERIAL_LINEAR, S->s.young, S->s.poisson, 0.0};
+  fcm_integrator_options io = fcm_integrator_options_default();
+  fcm_boundary_options bo = fcm_boundary_options_default();
+  const fcm_motion m = fcm_motion_default();
+  fcm_integrator *I = NULL;
+  const fcm_index n = fcm_space_num_dofs(space);
+  double *u0 = calloc((size_t)n, sizeof *u0), *g0 = calloc((size_t)n, sizeof *g0);
+  if (!u0 || !g0) st = FCM_ERR_ALLOC;
+  io.kind = FCM_INTEGRATOR_STATIC;
+  io.tolerance_mode = FCM_NEWTON_TOL_RELATIVE;
+  io.linear_solver = FCM_LINEAR_CG; /* no factorization: only the boundary terms are used */
+  bo.displacement = exact_displacement_cb;
+  if (st == FCM_OK) st = fcm_integrator_create(ctx, space, &mat, &io, &I);
+  if (st == FCM_OK) st = fcm_integrator_add_boundary_constraint(I, curved_cb, NULL, &m, &bo, NULL);
+  if (st == FCM_OK) st = fcm_integrator_setup(I);
+  if (st == FCM_OK) st = fcm_integrator_boundary_eval(I, u0, 0.0, NULL, g0, K);
+  if (st == FCM_OK)
+    for (fcm_index i = 0; i < n; i++)
+      f[i] -= g0[i];
+  fcm_integrator_destroy(&I);
+  free(u0);
+  free(g0);
+  return st;
+}
+
+/* Assemble K u = f (stiffness, body force, optional embedded traction or Nitsche terms),
+ * eliminate the y = 0 nodes; `extra` adds a caller load (the staircase traction) before
+ * elimination. */
 static fcm_status assemble_system(const cv_study *S, fcm_space *space, int embedded_traction,
                                   const unsigned char *staircase_keep, fcm_csr **K, double **f)
 {
@@ -622,8 +672,10 @@ static fcm_status assemble_system(const cv_study *S, fcm_space *space, int embed
   st = fcm_space_matrix_create(space, K);
   if (st == FCM_OK) st = fcm_assemble_stiffness(space, &mat, NULL, *K);
   if (st == FCM_OK) st = fcm_assemble_body_force_field(space, body_force_cb, &ld, NULL, *f);
-  if (st == FCM_OK && embedded_traction && S->s.problem == CV_MANUFACTURED)
+  if (st == FCM_OK && embedded_traction == 1 && S->s.problem == CV_MANUFACTURED)
     st = fcm_assemble_surface_traction(space, traction_cb, &ld, *f);
+  if (st == FCM_OK && embedded_traction == 2 && S->s.problem == CV_MANUFACTURED)
+    st = nitsche_terms(S, space, *K, *f);
   if (st == FCM_OK && staircase_keep && S->s.problem == CV_MANUFACTURED)
     st = staircase_traction(S, space, staircase_keep, *f);
   if (st == FCM_OK) st = dirichlet_y0(S, space, &ncon, &dofs, &vals);
@@ -874,7 +926,7 @@ static fcm_status errors(const cv_study *S, const fcm_space *space, const fcm_ce
     fcm_index e = -1;
     if (fcm_space_cell_active(space, c))
       e = c;
-    else if (method == CV_FCM)
+    else if (method != CV_FEM)
       for (int f = 0; f < nf && e < 0; f++) {
         const fcm_index o = nb[(size_t)nf * c + f];
         if (o >= 0 && fcm_space_cell_active(space, o)) e = o;
@@ -918,7 +970,7 @@ fcm_status cv_run(cv_study *S, const fcm_mesh *mesh, const fcm_cell_rules *err_r
   r->failed = 0;
   r->note[0] = '\0';
   stamp t0 = stamp_now();
-  if (method == CV_FCM) {
+  if (method == CV_FCM || method == CV_NITSCHE) {
     fcm_cell_rules_options o = fcm_cell_rules_options_default();
     o.strength[FCM_RULE_STIFFNESS] = strength;
     o.strength[FCM_RULE_MASS] = 0; /* static problem: no mass matrix */
@@ -937,7 +989,7 @@ fcm_status cv_run(cv_study *S, const fcm_mesh *mesh, const fcm_cell_rules *err_r
     r->points = rs->points_total[FCM_RULE_STIFFNESS];
     r->strength = fcm_cell_rules_strength(rules, FCM_RULE_STIFFNESS);
     st = fcm_space_create_embedded(ctx, mesh, rules, &space);
-    if (st == FCM_OK) st = assemble_system(S, space, 1, NULL, &K, &f);
+    if (st == FCM_OK) st = assemble_system(S, space, method == CV_NITSCHE ? 2 : 1, NULL, &K, &f);
   } else {
     fcm_index nkeep = 0;
     keep = malloc((size_t)nc);

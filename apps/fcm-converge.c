@@ -5,7 +5,8 @@
  * Study: static linear elasticity on a tet-meshed hemisphere (radius 0.9, flat face on
  * y = 0) in the background box [-1,1] x [0,1] x [-1,1] with h = 1/res, for Tet4, Tet10,
  * Hex8 and Hex20 grids; a manufactured solution makes the exact error known (see
- * fcm-converge-study.c), or --reference runs the authors' localized-load problem against a
+ * fcm-converge-study.c; the curved boundary carries its traction or, with --boundary nitsche,
+ * its displacement imposed by symmetric Nitsche), or --reference runs the authors' localized-load problem against a
  * boundary-conforming Tet10 reference. `payoff` measures, per element and rule kind, the
  * simplification time and the assembly time it saves: the break-even number of assemblies. */
 #include "app_env.h"
@@ -28,6 +29,7 @@ typedef struct config {
   int num_elements;
   int methods[CV_METHOD_COUNT];
   int num_methods;
+  int nitsche; /* --boundary nitsche */
   int levels[MAX_LEVELS];
   int num_levels;
   int fit;
@@ -79,7 +81,7 @@ static int parse_elements(const char *prog, const char *opt, const char *s, void
 
 static int parse_methods(const char *prog, const char *opt, const char *s, void *dest)
 {
-  static const char *const names[CV_METHOD_COUNT + 1] = {"fcm", "fem", NULL};
+  static const char *const names[CV_METHOD_COUNT + 1] = {"fcm", "fem", "fcm-nitsche", NULL};
   config *c = dest;
   char tok[CV_METHOD_COUNT][CLI_TOKEN];
   int n = 0;
@@ -99,7 +101,7 @@ static int parse_methods(const char *prog, const char *opt, const char *s, void 
 /* What the option table writes besides the config: flags and choices that map onto it, the
  * list descriptors, and which options were given (the --quick defaults yield to them). */
 typedef struct parse_state {
-  int reference, no_sweep, no_plots, fem_traction;
+  int reference, no_sweep, no_plots, fem_traction, boundary;
   int_list levels, sweep_strengths;
   struct {
     int levels, ref_refine, geom, sweep_res, sweep, error_strength, res, repeat;
@@ -108,6 +110,7 @@ typedef struct parse_state {
 
 static const char *const on_off[] = {"off", "on", NULL};
 static const char *const traction_names[] = {"projected", "naive", "face", NULL};
+static const char *const boundary_names[] = {"traction", "nitsche", NULL};
 static const char *const time_names[] = {"wall", "cpu", NULL};
 
 enum { CMD_STUDY = 1, CMD_PAYOFF = 2, CMD_BOTH = 3 };
@@ -118,7 +121,7 @@ typedef struct cv_option {
   cli_option o;
 } cv_option;
 
-#define NUM_OPTIONS 32 /* entries of the table below, sentinel included */
+#define NUM_OPTIONS 33 /* entries of the table below, sentinel included */
 
 /* The options of subcommand `cmd` (CMD_STUDY or CMD_PAYOFF) writing into c and p. */
 static void option_table(unsigned cmd, config *c, parse_state *p, cli_option t[NUM_OPTIONS])
@@ -136,7 +139,7 @@ static void option_table(unsigned cmd, config *c, parse_state *p, cli_option t[N
         "(default all)",
         0, 0, 0, NULL, parse_elements, NULL}},
       {CMD_STUDY,
-       {"--methods", NULL, CLI_CUSTOM, c, "LIST", "fcm,fem (default both)", 0, 0, 0, NULL,
+       {"--methods", NULL, CLI_CUSTOM, c, "LIST", "fcm,fem,fcm-nitsche (default fcm,fem)", 0, 0, 0, NULL,
         parse_methods, NULL}},
       {CMD_STUDY,
        {"--levels", NULL, CLI_CUSTOM, &p->levels, "LIST",
@@ -195,6 +198,15 @@ static void option_table(unsigned cmd, config *c, parse_state *p, cli_option t[N
        {"--error-strength", NULL, CLI_INT, &s->error_strength, "M",
         "strength of the error rules, 2..20 (default 8; quick 6)", 2, 20, 0, NULL, NULL,
         &p->given.error_strength}},
+      {CMD_STUDY,
+       {"--boundary", NULL, CLI_CHOICE, &p->boundary, "MODE",
+        "what FCM imposes on the hemisphere's curved boundary\n"
+        "(manufactured problem; default traction): traction:\n"
+        "sigma(u) n; nitsche: the exact displacement, weakly by\n"
+        "symmetric Nitsche (the library's boundary constraints,\n"
+        "penalty per cell from its eigenvalue estimate); its rows\n"
+        "are method fcm-nitsche",
+        0, 0, 0, boundary_names, NULL, NULL}},
       {CMD_STUDY,
        {"--fem-traction", NULL, CLI_CHOICE, &p->fem_traction, "MODE",
         "surface load of the staircase FEM (default projected)\n"
@@ -287,6 +299,9 @@ static void usage(FILE *f, const cli_option *opts)
          "force -div sigma(u); FCM traction sigma(u) n on the embedded boundary (facet normals);\n"
          "the FEM knows only its staircase boundary and receives the true surface load there\n"
          "(--fem-traction); body force b(x) on all kept cells; u = u_exact on all nodes on y = 0.\n"
+         "With --boundary nitsche, FCM imposes u = u_exact weakly on the curved boundary instead\n"
+         "of the traction (symmetric Nitsche, fcm_integrator_add_boundary_constraint()); its\n"
+         "rows carry the method name fcm-nitsche.\n"
          "Errors: ||u_h - u||_L2 and |u_h - u|_H1 with strength-8 rules of the polyhedron on the\n"
          "same grid (FCM: all of Omega, dropped cells extrapolated from a face neighbour; FEM:\n"
          "Omega inside the kept cells - column 'meas' is that volume / |Omega|).\n"
@@ -315,7 +330,7 @@ static void usage(FILE *f, const cli_option *opts)
          "  pattern, stiffness, loads, Dirichlet\n"
          "  elimination; t_solve: CHOLMOD analyze+factor+solve; times are wall-clock seconds;\n"
          "  err_*: absolute errors, norm_*: the exact (reference) norms over the same domain.\n"
-         "  rates: element,method,norm,rate (method fcm|fem, norm L2|H1).\n"
+         "  rates: element,method,norm,rate (method fcm|fem|fcm-nitsche, norm L2|H1).\n"
          "  sweep: element,method,res,h,strength,points,dofs,t_rules,t_assembly,t_solve,t_total,\n"
          "  err_l2,err_h1,rel_l2,rel_h1,failed,note,cpu_rules,cpu_assembly,cpu_solve,cpu_total.\n"
          "  payoff: element,res,kind,strength,cut_cells,points_plain,points_simplified,\n"
@@ -403,6 +418,23 @@ static int parse_args(int argc, char **argv, config *c)
                                 argv + c->payoff, NULL, 0, NULL, usage);
   if (rc >= 0) return rc;
   if (p.reference) c->setup.problem = CV_REFERENCE;
+  if (p.boundary == 1) {
+    if (p.reference) {
+      fprintf(stderr, CV_PROG ": --boundary nitsche needs the manufactured problem (not "
+                              "--reference)\n");
+      return 2;
+    }
+    int n = 0; /* fcm -> fcm-nitsche, once */
+    for (int k = 0; k < c->num_methods; k++) {
+      const int m = c->methods[k] == CV_FCM ? CV_NITSCHE : c->methods[k];
+      int dup = 0;
+      for (int j = 0; j < n; j++)
+        dup |= c->methods[j] == m;
+      if (!dup) c->methods[n++] = m;
+    }
+    c->num_methods = n;
+  }
+  c->nitsche = p.boundary == 1;
   c->setup.fem_traction = (cv_fem_traction)p.fem_traction;
   c->sweep = !p.no_sweep;
   c->plots = !p.no_plots;
@@ -512,7 +544,7 @@ static int run_study(const config *c, fcm_ctx *ctx)
   nrates = cv_rates_compute(res, nres, c->fit, rates);
 
   if (c->sweep) {
-    const int fcm_only[1] = {CV_FCM};
+    const int fcm_only[1] = {c->nitsche ? CV_NITSCHE : CV_FCM};
     for (int k = 0; k < c->num_sweep && st == FCM_OK; k++) {
       cv_run_options ro = {c->sweep_strengths[k], -1};
       st = run_level(study, ctx, c->sweep_element, c->sweep_res, fcm_only, 1, &ro, sw, &nsw);

@@ -160,7 +160,7 @@ int main(int argc, char **argv)
       "--levels 0", "--levels 2,2", "--elements tet5", "--methods xfem", "--simplify maybe",
       "--radius 1.5", "--fem-traction none", "--strength 0", "--bogus 1", "--fit 1",
       "payoff --elements hex9", "--levels", "--time gpu", "--methods fcm,fcm",
-      "--elements hex8,hex8",
+      "--elements hex8,hex8", "--boundary dirichlet", "--boundary nitsche --reference",
       /* each subcommand takes only its own options */
       "--res 3", "--element hex8", "payoff --error-strength 6", "payoff --no-plots", "payof"};
   snprintf(path, sizeof path, "%s/converge-bad-levels.csv", dir);

@@ -14,7 +14,7 @@
 #define CONVERGE_RATES_HEADER "element,method,norm,rate\n"
 
 typedef struct cv_level {
-  char element[16], method[8];
+  char element[16], method[16];
   int res, strength, failed;
   double h, t_rules, t_assembly, t_solve, t_total, err_l2, err_h1, norm_l2, norm_h1, rel_l2, rel_h1,
       measured, domain, c_rules, c_assembly, c_solve, c_total;
@@ -22,7 +22,7 @@ typedef struct cv_level {
 } cv_level;
 
 typedef struct cv_rate_row {
-  char element[16], method[8], norm[8];
+  char element[16], method[16], norm[8];
   double rate;
 } cv_rate_row;
 
@@ -44,7 +44,7 @@ static inline int cv_read_levels(const char *path, cv_level *rows, int cap)
     cv_level r;
     if (n >= cap ||
         sscanf(line,
-               "%15[^,],%7[^,],%d,%lf,%lld,%lld,%lld,%lld,%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,"
+               "%15[^,],%15[^,],%d,%lf,%lld,%lld,%lld,%lld,%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,"
                "%lf,%lf,%lf,%d,,%lf,%lf,%lf,%lf",
                r.element, r.method, &r.res, &r.h, &r.dofs, &r.cells, &r.cut, &r.points, &r.strength,
                &r.t_rules, &r.t_assembly, &r.t_solve, &r.t_total, &r.err_l2, &r.err_h1, &r.norm_l2,
@@ -73,7 +73,7 @@ static inline int cv_read_rates(const char *path, cv_rate_row *rows, int cap)
   while (fgets(line, sizeof line, f)) {
     cv_rate_row r;
     if (n >= cap ||
-        sscanf(line, "%15[^,],%7[^,],%7[^,],%lf", r.element, r.method, r.norm, &r.rate) != 4) {
+        sscanf(line, "%15[^,],%15[^,],%7[^,],%lf", r.element, r.method, r.norm, &r.rate) != 4) {
       fclose(f);
       return -1;
     }

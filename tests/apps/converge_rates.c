@@ -8,6 +8,9 @@
  * (0.8 to 1.5 over other level choices; 1.10 and 1.22 fitted over res 6, 8, 10, 12, 16)
  * around the asymptotic first order. The rates in the rates CSV must equal a refit of the
  * levels CSV, and every FCM error is measured over all of Omega.
+ * With --boundary nitsche (issue 18: the exact displacement imposed on the curved boundary by
+ * symmetric Nitsche instead of the traction; method fcm-nitsche) the same rates hold, with
+ * tolerances L2 >= 1.8 / 2.7, H1 >= 0.9 / 1.8.
  * Usage: app_converge_rates quick|full PATH_TO_fcm-converge WORK_DIR
  *   quick (default suite): Hex8 and Tet10 FCM on levels 3, 4, 6 (geometry n = 4);
  *   full (label slow): every element: FCM Tet4/Hex8 on res 6, 8, 12, 16, Tet10/Hex20 on
@@ -50,7 +53,7 @@ static double check(int n, int nrates, int fit, const char *element, const char 
   TEST_TRUE(m >= 3);
   for (int k = 0; k < m; k++) {
     TEST_TRUE(lv[k]->failed == 0 && lv[k]->dofs > 0);
-    if (!strcmp(method, "fcm")) TEST_NEAR(lv[k]->measured, lv[k]->domain, 1e-9, 0.0);
+    if (strcmp(method, "fem")) TEST_NEAR(lv[k]->measured, lv[k]->domain, 1e-9, 0.0);
     if (!strcmp(method, "fem")) TEST_TRUE(lv[k]->measured <= lv[k]->domain * (1.0 + 1e-12));
     if (k > 0) {
       if (!(lv[k]->err_l2 < lv[k - 1]->err_l2 && lv[k]->err_h1 < lv[k - 1]->err_h1))
@@ -84,6 +87,14 @@ int main(int argc, char **argv)
               "--elements hex8,tet10 --methods fcm --levels 3,4,6 --geom-n 4", 3, &nr);
     check(n, nr, 3, "hex8", "fcm", 1.9, 2.6, 0.9, 1.6);
     check(n, nr, 3, "tet10", "fcm", 2.8, 3.6, 1.9, 2.6);
+    /* issue 18: the exact displacement imposed weakly on the curved boundary (symmetric
+     * Nitsche, --boundary nitsche): the same optimal rates (measured 2.08 / 1.07 for Hex8,
+     * 2.97 / 1.96 for Tet10 on these levels) */
+    n = study(prog, dir, "converge-rates-nitsche-quick",
+              "--boundary nitsche --elements hex8,tet10 --methods fcm --levels 3,4,6 --geom-n 4", 3,
+              &nr);
+    check(n, nr, 3, "hex8", "fcm-nitsche", 1.8, 2.6, 0.9, 1.6);
+    check(n, nr, 3, "tet10", "fcm-nitsche", 2.7, 3.6, 1.8, 2.6);
   } else if (!strcmp(argv[1], "full")) {
     n = study(prog, dir, "converge-rates-linear",
               "--elements tet4,hex8 --methods fcm --levels 6,8,12,16", 3, &nr);
@@ -97,6 +108,14 @@ int main(int argc, char **argv)
               "--elements tet10,hex20 --methods fem --levels 6,8,12,16", 3, &nr);
     TEST_TRUE(check(n, nr, 3, "tet10", "fem", 0.0, 1.2, 0.0, 0.9) <= t10 - 1.5);
     TEST_TRUE(check(n, nr, 3, "hex20", "fem", 0.0, 1.2, 0.0, 0.9) <= h20 - 1.5);
+    n = study(prog, dir, "converge-rates-nitsche-linear",
+              "--boundary nitsche --elements tet4,hex8 --methods fcm --levels 6,8,12,16", 3, &nr);
+    check(n, nr, 3, "tet4", "fcm-nitsche", 1.8, 2.6, 0.9, 1.6);
+    check(n, nr, 3, "hex8", "fcm-nitsche", 1.8, 2.6, 0.9, 1.6);
+    n = study(prog, dir, "converge-rates-nitsche-quadratic",
+              "--boundary nitsche --elements tet10,hex20 --methods fcm --levels 4,6,8", 3, &nr);
+    check(n, nr, 3, "tet10", "fcm-nitsche", 2.7, 3.6, 1.8, 2.6);
+    check(n, nr, 3, "hex20", "fcm-nitsche", 2.7, 3.6, 1.8, 2.6);
   } else {
     return 2;
   }

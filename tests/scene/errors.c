@@ -123,6 +123,25 @@ static const bad_case cases[] = {
     {"{" BASE ", \"effects\": [{\"fixed\": {\"region\": {\"nodes\": [1]}, \"components\": "
      "\"xw\"}}]}",
      FCM_ERR_ARG, "effects[0].fixed.components: expected distinct letters from \"xyz\"", NULL},
+    /* ---- fixed / motion on the embedded boundary (issue 18) */
+    {"{" BASE ", \"effects\": [{\"fixed\": {\"region\": {\"nodes\": [1]}, \"boundary\": "
+     "\"all\"}}]}",
+     FCM_ERR_ARG, "effects[0].fixed: expected one of \"region\"", "got both"},
+    {"{" BASE ", \"effects\": [{\"fixed\": {\"components\": \"x\"}}]}", FCM_ERR_ARG,
+     "effects[0].fixed: missing \"region\"", "\"boundary\""},
+    {"{" BASE ", \"effects\": [{\"fixed\": {\"boundary\": {\"nodes\": [1]}}}]}", FCM_ERR_ARG,
+     "effects[0].fixed.boundary.nodes: unknown key", "\"box\", \"half_space\""},
+    {"{" BASE ", \"effects\": [{\"fixed\": {\"boundary\": \"everything\"}}]}", FCM_ERR_ARG,
+     "effects[0].fixed.boundary: expected \"all\" or a region object", NULL},
+    {"{" BASE ", \"effects\": [{\"motion\": {\"boundary\": \"all\", \"method\": \"lagrange\"}}]}",
+     FCM_ERR_ARG, "effects[0].motion.method:", "\"nitsche\""},
+    {"{" BASE ", \"effects\": [{\"fixed\": {\"boundary\": \"all\", \"nitsche_safety\": 0.5}}]}",
+     FCM_ERR_ARG, "effects[0].fixed.nitsche_safety: expected a finite number > 1, got 0.5", NULL},
+    {"{" BASE ", \"effects\": [{\"fixed\": {\"boundary\": \"all\", \"penalty\": 0}}]}",
+     FCM_ERR_ARG, "effects[0].fixed.penalty: expected a finite number > 0", NULL},
+    {"{" BASE ", \"effects\": [{\"fixed\": {\"region\": {\"nodes\": [1]}, \"method\": "
+     "\"penalty\"}}]}",
+     FCM_ERR_ARG, "effects[0].fixed.method: allowed only with \"boundary\"", NULL},
     {"{" BASE ", \"quadrature\": {\"stiffness_strength\": 21}}", FCM_ERR_ARG,
      "quadrature.stiffness_strength: expected an integer in [0, 20], got 21", NULL},
     {"{" BASE ", \"geometry\": {\"shape\": \"tube\", \"inner_radius\": 1.2, \"outer_radius\": 1, "

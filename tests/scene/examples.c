@@ -134,9 +134,13 @@ static void check_scene(fcm_ctx *ctx, const char *path, const char *file)
   for (int i = 0; mesh && i < fcm_scene_num_effects(s); i++) {
     const fcm_effect *e = fcm_scene_get_effect(s, i);
     const fcm_region *r = NULL;
-    if (e->type == FCM_EFFECT_FIXED) r = &e->fixed.region;
-    if (e->type == FCM_EFFECT_MOTION) r = &e->motion.region;
-    if (r && nodes_in(mesh, r) == 0) TEST_FAIL_("%s: effects[%d] holds no node", file, i);
+    int boundary = 0;
+    if (e->type == FCM_EFFECT_FIXED) r = &e->fixed.region, boundary = e->fixed.boundary;
+    if (e->type == FCM_EFFECT_MOTION) r = &e->motion.region, boundary = e->motion.boundary;
+    if (r && !boundary && nodes_in(mesh, r) == 0)
+      TEST_FAIL_("%s: effects[%d] holds no node", file, i);
+    if (r && boundary && has_box && !region_meets_box(r, lo, hi))
+      TEST_FAIL_("%s: effects[%d] misses the body's boundary", file, i);
     if (e->type == FCM_EFFECT_TRACTION) r = &e->traction.region;
     if (e->type == FCM_EFFECT_PRESSURE) r = &e->pressure.region;
     if (r && has_box && (e->type == FCM_EFFECT_TRACTION || e->type == FCM_EFFECT_PRESSURE) &&

@@ -294,6 +294,40 @@ static void check_steps(fcm_ctx *ctx)
   }
 }
 
+/* fixed and motion on the embedded boundary (issue 18): "boundary" with a region or "all",
+ * the method keys and their defaults; the region selects points by position. */
+static void check_boundary(fcm_ctx *ctx)
+{
+  const char *json =
+      "{" MIN_BG ", " MIN_MAT ", \"effects\": ["
+      "{\"fixed\": {\"boundary\": \"all\", \"components\": \"z\", \"method\": \"penalty\", "
+      "\"penalty\": 50}},"
+      "{\"motion\": {\"boundary\": {\"half_space\": {\"point\": [0, 0, 1], \"normal\": [0, 0, "
+      "2]}}, \"velocity\": [1, 0, 0], \"nitsche_safety\": 3}},"
+      "{\"fixed\": {\"region\": {\"nodes\": [0]}}}]}";
+  fcm_scene *s = NULL;
+  TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "b.json", &s));
+  if (!s) return;
+  const fcm_effect *e = fcm_scene_get_effect(s, 0);
+  TEST_TRUE(e->type == FCM_EFFECT_FIXED && e->fixed.boundary == 1);
+  TEST_TRUE(e->fixed.region.kind == FCM_REGION_ALL);
+  TEST_TRUE(e->fixed.components[0] == 0 && e->fixed.components[2] == 1);
+  TEST_TRUE(e->fixed.boundary_options.method == FCM_BOUNDARY_PENALTY);
+  TEST_TRUE(e->fixed.boundary_options.penalty == 50.0);
+  TEST_TRUE(e->fixed.boundary_options.nitsche_safety == 2.0);
+  e = fcm_scene_get_effect(s, 1);
+  TEST_TRUE(e->type == FCM_EFFECT_MOTION && e->motion.boundary == 1);
+  TEST_TRUE(e->motion.region.kind == FCM_REGION_HALF_SPACE);
+  TEST_TRUE(e->motion.boundary_options.method == FCM_BOUNDARY_NITSCHE);
+  TEST_TRUE(e->motion.boundary_options.nitsche_safety == 3.0);
+  const double above[3] = {0, 0, 1.5}, below[3] = {0, 0, 0.5}, n[3] = {0, 0, 1};
+  TEST_TRUE(fcm_region_select((void *)&e->motion.region, above, n) == 1);
+  TEST_TRUE(fcm_region_select((void *)&e->motion.region, below, n) == 0);
+  e = fcm_scene_get_effect(s, 2);
+  TEST_TRUE(e->type == FCM_EFFECT_FIXED && e->fixed.boundary == 0);
+  fcm_scene_destroy(&s);
+}
+
 /* Motion of the full scene's effect 2, evaluated by fcm_motion_eval() (what the runner
  * constrains): rotation about the unit axis a through c by omega tau plus translation
  * v tau, tau clamped to [0, end - start]; velocity v + omega a x (x - c) while moving. */
@@ -441,6 +475,7 @@ int main(void)
   check_defaults(ctx);
   check_steps(ctx);
   check_motion(ctx);
+  check_boundary(ctx);
   check_files(ctx);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);

@@ -36,3 +36,5 @@ fcm_add_test(scene_rule_kinds tests/scene/rule_kinds.c)
 # equilibrium; change of momentum minus the weight in dynamics), stress arrays in the frames,
 # the surface at reference positions, the summary's max |u| over the body.
 fcm_add_test(scene_output tests/scene/output_scene.c)
+# Issue 18: fixed and motion on the embedded boundary (Nitsche) through the scene runner.
+fcm_add_test(scene_boundary tests/scene/boundary_scene.c)

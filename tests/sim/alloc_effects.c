@@ -1,6 +1,7 @@
 /* Allocation failures in the integrator entry points alloc_failure.c does not reach: on an
  * embedded beam with surface rules, fcm_integrator_add_body_force (a field),
- * fcm_integrator_add_traction, then setup, a step and fcm_integrator_energy. Failing the
+ * fcm_integrator_add_traction, a Nitsche boundary constraint on the embedded end face
+ * (fcm_integrator_add_boundary_constraint), then setup, a step and fcm_integrator_energy. Failing the
  * k-th allocation (k = 0, 1, ... until the sequence succeeds) gives FCM_ERR_ALLOC and leaks
  * nothing. */
 #include "sim_util.h"
@@ -30,6 +31,13 @@ static double ramp(void *user, double t)
   return t < 1.0 ? t : 1.0;
 }
 
+/* The embedded end face x = 1.7 (Nitsche boundary constraint, issue 18). */
+static int end_face(void *user, const double X[3], const double n[3])
+{
+  (void)user, (void)n;
+  return X[0] > 1.69;
+}
+
 static fcm_status run(void *u)
 {
   fixture *x = u;
@@ -37,12 +45,15 @@ static fcm_status run(void *u)
   fcm_integrator *integ = NULL;
   fcm_material mat = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 1.0e6, 0.3, 1000.0};
   fcm_integrator_options o = fcm_integrator_options_default();
-  fcm_motion fixed = fcm_motion_default();
+  fcm_motion fixed = fcm_motion_default(), pull = fcm_motion_default();
+  pull.velocity[0] = 0.1;
   o.dt = 0.01;
   if ((st = fcm_integrator_create(x->ctx, x->space, &mat, &o, &integ))) goto done;
   if ((st = fcm_integrator_add_body_force(integ, field, NULL, ramp, NULL))) goto done;
   if ((st = fcm_integrator_add_traction(integ, field, NULL, NULL, NULL))) goto done;
   if ((st = fcm_integrator_add_constraint(integ, x->nfix, x->fix, &fixed, NULL))) goto done;
+  if ((st = fcm_integrator_add_boundary_constraint(integ, end_face, NULL, &pull, NULL, NULL)))
+    goto done;
   if ((st = fcm_integrator_setup(integ))) goto done;
   if ((st = fcm_integrator_step(integ, NULL))) goto done;
   st = fcm_integrator_energy(integ, &x->energy[0], &x->energy[1], &x->energy[2]);

@@ -105,7 +105,8 @@ typedef struct fcm_scene_quadrature {
   int stiffness_strength; /**< [0, 20]; FCM_DEFAULT (default): the element's default */
   int mass_strength;      /**< [0, 20]; FCM_DEFAULT (default): the element's default */
   int surface_strength; /**< [0, 20]; FCM_DEFAULT (default): automatic (the stiffness strength when
-                           a traction or pressure effect is present, else no surface rules) */
+                           a traction or pressure effect, or a fixed or motion effect on the
+                           "boundary", is present, else no surface rules) */
   fcm_cell_simplify simplify;          /**< "simplify": true (FCM_CELL_SIMPLIFY_ON, default), false
                                             (OFF) or "auto" (AUTO: per rule kind, where it pays for the
                                             assemblies the run expects; see fcm_simulation_create()) */
@@ -194,6 +195,10 @@ typedef struct fcm_region {
  * (membership is by node id). No allocation; thread safe. */
 FCM_API int fcm_region_contains(const fcm_region *region, const double x[3]);
 
+/** fcm_region_contains() as an fcm_boundary_select_fn (fcm/sim.h): `region` is a
+ * const fcm_region *; the normal is ignored. For fcm_integrator_add_boundary_constraint(). */
+FCM_API int fcm_region_select(void *region, const double X[3], const double normal[3]);
+
 /* ------------------------------------------------------------------- effects */
 
 /** Effect types, in the order of the one effect table (see fcm_effect_type_name()). */
@@ -216,9 +221,15 @@ typedef struct fcm_effect_gravity {
   double acceleration[3]; /**< m/s^2, default (0, 0, -9.81) */
 } fcm_effect_gravity;
 
+/** Where a fixed or motion effect acts: on background nodes ("region") or, weakly, on the
+ * embedded-boundary points in the region ("boundary": fcm_integrator_add_boundary_constraint(),
+ * Nitsche's method by default). */
 typedef struct fcm_effect_fixed {
   fcm_region region;
   int components[3]; /**< 1: that displacement component is held (default all) */
+  int boundary;      /**< 1: "boundary" (BOX, HALF_SPACE or ALL: "boundary": "all"); 0: nodes */
+  fcm_boundary_options boundary_options; /**< "method" ("nitsche", "penalty"), "penalty",
+                                              "nitsche_safety"; boundary only */
 } fcm_effect_fixed;
 
 /** Prescribed motion of the background nodes in a region: the library's fcm_motion (its
@@ -229,6 +240,8 @@ typedef struct fcm_effect_fixed {
 typedef struct fcm_effect_motion {
   fcm_region region;
   fcm_motion motion;
+  int boundary;                          /**< as fcm_effect_fixed */
+  fcm_boundary_options boundary_options; /**< as fcm_effect_fixed */
 } fcm_effect_motion;
 
 /** Initial velocity v(X) = velocity + angular_velocity x (X - c) on the region (default

@@ -1,7 +1,8 @@
 /* fcm — time integration of hyperelastic solids on a space (lib/METHOD.md §8): static Newton with
  * load steps and backward Euler on the incremental potential, Newton with a backtracking
  * line search on the energy, the stopping rule of Longva et al. (2020) §6, optional Rayleigh
- * damping, prescribed motion of node sets, direct (CHOLMOD -> UMFPACK) or Krylov solves.
+ * damping, prescribed motion of node sets and, weakly (Nitsche's method or a penalty), of the
+ * embedded-boundary points a selector picks, direct (CHOLMOD -> UMFPACK) or Krylov solves.
  *
  * Phases: fcm_integrator_create() -> configure (fcm_integrator_add_*, set_state) ->
  * fcm_integrator_setup() (assembles the mass — dynamics only — and the loads, allocates
@@ -11,6 +12,8 @@
  *   E(u) = 1/2 (u - u^)^T M (u - u^)/h^2 + Psi(u) - f_ext(t_{n+1})^T u
  *          + 1/(2h) (u - u_n)^T D (u - u_n),     u^ = u_n + h v_n,
  *   v_{n+1} = (u_{n+1} - u_n)/h. Its gradient is M v' - f_total (v' = (v_{n+1} - v_n)/h).
+ * Boundary constraints (fcm_integrator_add_boundary_constraint()) add their energy Pi_B(u)
+ * (fcm_boundary_method) to E(u); it is not part of Psi (fcm_step_info.elastic_energy).
  * Rayleigh damping C = alpha_M M + beta_K K is linearized as D = alpha_M M + beta_K K+(u_n):
  * the tangent at the start of the (sub)step, projected to positive semi-definite and held
  * fixed during the step, so the damping force D v_{n+1} derives from the quadratic term above
@@ -267,12 +270,108 @@ FCM_API fcm_status fcm_integrator_add_constraint(fcm_integrator *integ, fcm_inde
                                                  const fcm_index *nodes, const fcm_motion *motion,
                                                  int *id);
 
-/** Validate the options, build the constrained DOF list, assemble the mass matrix
- * (BACKWARD_EULER only) and the loads, allocate every work array and solver, and run the symbolic
- * analysis (direct). Constrained DOFs get their prescribed velocity at the current time.
+/** How a boundary constraint imposes its motion on the embedded boundary. */
+typedef enum fcm_boundary_method {
+  /** Symmetric Nitsche (consistent, optimal convergence): with r = P_c (u - g) the constrained
+   * components of the gap to the prescribed displacement g and t = P(F) N the first Piola
+   * traction on the reference boundary (outward unit normal N), the energy gains
+   * int_Gamma ( -t . r + gamma/2 |r|^2 ) dA. Its gradient is the weak form
+   * -int t . P_c dv - int (dP/dF[grad dv] N) . r + gamma int r . dv (consistency, adjoint
+   * consistency with the linearized traction, penalty), the Newton matrix its exact Hessian
+   * (the term with the third derivative of Psi times r, by central differences of dP/dF;
+   * zero for LINEAR and where u = g). For linear elasticity this is classical symmetric
+   * Nitsche. gamma per element (cell piece): nitsche_safety times the largest eigenvalue of
+   * T v = lambda K v, T = int_Gamma_K |P_c sigma(v) N|^2 (the boundary traction energy of
+   * the element's selected points), K the element's linear-elastic stiffness at rest with
+   * its stabilization points (so gamma stays bounded, by about 1/alpha, on tiny cut cells);
+   * rigid modes (T = K = 0) are left out. safety > 1 makes the energy's Hessian at rest
+   * positive definite on the free modes (coercivity constant 1 - 1/safety). Far from rest
+   * (strains of order 1) the estimate at rest may no longer bound the energy from below and
+   * Newton can fail: raise nitsche_safety (10 to 20) or use the penalty. A Newton matrix made
+   * singular there is retried with the penalty part of the boundary terms only, then with
+   * halved steps. */
+  FCM_BOUNDARY_NITSCHE = 0,
+  /** Penalty: energy gamma/2 int_Gamma |r|^2 with gamma = penalty E / h_K (h_K the cube root
+   * of the cell's volume). Not consistent: the error is O(h/penalty) in the constraint. */
+  FCM_BOUNDARY_PENALTY = 1,
+  FCM_BOUNDARY_METHOD_COUNT
+} fcm_boundary_method;
+
+/** Static name of a method ("nitsche", "penalty"; "invalid" otherwise). */
+FCM_API const char *fcm_boundary_method_name(fcm_boundary_method method);
+
+/** Options of fcm_integrator_add_boundary_constraint(); fcm_boundary_options_default(). */
+typedef struct fcm_boundary_options {
+  fcm_boundary_method method; /**< default FCM_BOUNDARY_NITSCHE */
+  double nitsche_safety;      /**< NITSCHE: gamma = safety x lambda_max, > 1 (default 2) */
+  double penalty;             /**< PENALTY: gamma = penalty E / h, > 0 (default 1e3) */
+  fcm_field_fn displacement;  /**< NULL (default): the motion's displacement; else the prescribed
+                                   displacement g(X) = displacement(user, X, N) at reference
+                                   position X with outward normal N (not time dependent: the
+                                   motion still gives the components and the active window) */
+  void *displacement_user;    /**< passed to displacement; must outlive the integrator */
+} fcm_boundary_options;
+
+/** The defaults listed on each member. */
+FCM_API fcm_boundary_options fcm_boundary_options_default(void);
+
+/** Selects embedded-boundary points: 1 to constrain the point with reference position X and
+ * unit outward normal `normal`, else 0. Called during fcm_integrator_setup() only (serially).
+ * fcm_region_select() of fcm/scene.h adapts an fcm_region. */
+typedef int (*fcm_boundary_select_fn)(void *user, const double X[3], const double normal[3]);
+
+/** Prescribe `motion` weakly on the embedded-boundary points (the surface rules of the space's
+ * cell rules) that `select` picks (NULL: every point): u(X, t) = the motion's displacement
+ * (fcm_motion_eval()) on its constrained components, by Nitsche's method or a penalty
+ * (`opts`, NULL: defaults; see fcm_boundary_method). No DOF is eliminated: the terms join the
+ * energy, the force and the Newton matrix (which stays symmetric, so the direct solver, CG and
+ * MINRES all apply), for static and dynamic integrators. A point several boundary
+ * constraints select belongs to the first. After `end` the constraint holds (or, with
+ * `release`, is dropped). `user` must outlive the setup. Before setup.
+ * @param[out] id the boundary constraint's index (may be NULL)
+ * @return FCM_OK, FCM_ERR_ARG (NULL integrator or motion; a bad motion or option, named;
+ * called after setup), FCM_ERR_ALLOC. The setup fails with FCM_ERR_ARG when the space has no
+ * surface rules or the constraint selects no point. */
+FCM_API fcm_status fcm_integrator_add_boundary_constraint(fcm_integrator *integ,
+                                                          fcm_boundary_select_fn select,
+                                                          void *user, const fcm_motion *motion,
+                                                          const fcm_boundary_options *opts,
+                                                          int *id);
+
+/** The largest penalty gamma (Pa/m) the boundary constraints use in element `elem`
+ * (fcm_space_num_elements()): Nitsche's estimate or penalty E / h, after setup; 0 for an
+ * element without constrained points or out of range. */
+FCM_API double fcm_integrator_boundary_penalty(const fcm_integrator *integ, fcm_index elem);
+
+/** Reaction of boundary constraint `id` at the current state: the force and the moment about
+ * the origin that it exerts on the body, force = sum over its points of w (P(F) N - gamma r)
+ * (penalty: -w gamma r) and moment = sum of (X + u) x that, with its motion at the current
+ * time (zeros when released). At equilibrium the reactions balance the loads. Either output
+ * may be NULL. After setup. Allocates nothing.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, not set up, id out of range). */
+FCM_API fcm_status fcm_integrator_boundary_reaction(const fcm_integrator *integ, int id,
+                                                    double force[3], double moment[3]);
+
+/** The boundary constraints' part of the energy alone at displacement u and time t (their
+ * motions evaluated at t; released constraints left out): energy, force (added, num_dofs)
+ * and Newton matrix (added; the space's pattern, fcm_space_matrix_create()), each may be
+ * NULL. Summed over the DOFs of each component the force is minus the total reaction
+ * (fcm_integrator_boundary_reaction(): the partition of unity cancels the gradient terms).
+ * After setup. Allocates nothing.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, not set up, wrong matrix), FCM_ERR_NUMERIC (the
+ * material gave NaN/Inf). */
+FCM_API fcm_status fcm_integrator_boundary_eval(fcm_integrator *integ, const double *u, double t,
+                                                double *energy, double *force, fcm_csr *tangent);
+
+/** Validate the options, build the constrained DOF list, gather the boundary constraints'
+ * points and estimate their penalties, assemble the mass matrix (BACKWARD_EULER only) and the
+ * loads, allocate every work array and solver, and run the symbolic analysis (direct).
+ * Constrained DOFs get their prescribed velocity at the current time.
  * @return FCM_OK, FCM_ERR_ARG (option out of range: named; DOF constrained twice; zero
- * representative force: set the density or use the relative rule), errors of the assembly
- * and of the solvers, FCM_ERR_ALLOC. Allocates; a second call is FCM_ERR_ARG. */
+ * representative force: set the density or use the relative rule; a boundary constraint on a
+ * space without surface rules, or selecting no point), FCM_ERR_NUMERIC (a Nitsche penalty that
+ * cannot be estimated: a cell stiffness singular beyond rigid modes, the cell named), errors
+ * of the assembly and of the solvers, FCM_ERR_ALLOC. Allocates; a second call is FCM_ERR_ARG. */
 FCM_API fcm_status fcm_integrator_setup(fcm_integrator *integ);
 
 /** Advance by one step of options.dt (static: solve the equilibrium at t + dt, ramping the
@@ -360,6 +459,9 @@ typedef struct fcm_integrator_setup_info {
   int scale_assemblies;      /**< 1 when a STATIC run with the REPRESENTATIVE rule had to assemble
                                   the body force of rho a_rep for its force scale (no gravity load
                                   equal to a_rep to reuse); else 0 */
+  fcm_index boundary_points; /**< embedded-boundary points the boundary constraints hold */
+  double boundary_penalty_max; /**< largest gamma h_K / E over the elements (dimensionless;
+                                    0 without boundary constraints) */
 } fcm_integrator_setup_info;
 
 /** Copy the setup counts out (zeros for NULL). */

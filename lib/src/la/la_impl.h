@@ -41,6 +41,12 @@ fcm_status fcm__syev_workspace(fcm_ctx *ctx, int want_vectors, int n, size_t *lw
 fcm_status fcm__syev_work(fcm_ctx *ctx, int want_vectors, int n, double *a, int lda, double *w,
                           double *work, size_t lwork, int *iwork, size_t liwork);
 
+/* Eigenvalues (ascending, into w) of the generalized symmetric-definite problem
+ * A x = lambda B x (LAPACK dsygv, itype 1, no vectors; lower triangles read, A and B
+ * destroyed). FCM_ERR_SINGULAR when B is not positive definite, FCM_ERR_NUMERIC on NaN/Inf,
+ * FCM_ERR_LAPACK when the iteration fails. Allocates a workspace of 3n doubles. */
+fcm_status fcm__sygv(fcm_ctx *ctx, int n, double *a, int lda, double *b, int ldb, double *w);
+
 /* Eigenvalues (ascending, into d) and optionally eigenvectors (z, n x n, ldz) of
  * the symmetric tridiagonal matrix with diagonal d[0..n) and off-diagonal
  * e[0..n-1) (e is destroyed). z == NULL: eigenvalues only. */

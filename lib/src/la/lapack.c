@@ -156,6 +156,29 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__sygv(fcm_ctx *ctx, int n, double *a, int lda, double *b, int ldb, double *w)
+{
+  fcm_status st = FCM_OK;
+  double *work = NULL;
+  lapack_int info;
+  FCM_CHECK(n >= 0 && lda >= FCM_MAX(1, n) && ldb >= FCM_MAX(1, n), ctx, FCM_ERR_ARG,
+            "sygv: n = %d, lda = %d, ldb = %d", n, lda, ldb);
+  if (n == 0) goto cleanup;
+  FCM_TRY(ctx, check_finite_part(ctx, "dsygv", n, n, a, lda, 1));
+  FCM_TRY(ctx, check_finite_part(ctx, "dsygv", n, n, b, ldb, 1));
+  FCM_ALLOC(ctx, 3 * (size_t)n, work);
+  info = LAPACKE_dsygv_work(LAPACK_COL_MAJOR, 1, 'N', 'L', n, a, lda, b, ldb, w, work, 3 * n);
+  FCM_CHECK(info <= n, ctx, FCM_ERR_SINGULAR,
+            "dsygv: B is not positive definite (leading minor of order %d, n = %d)", (int)info - n,
+            n);
+  FCM_CHECK(info <= 0, ctx, FCM_ERR_LAPACK, "dsygv: the eigenvalue iteration failed (info = %d)",
+            (int)info);
+  FCM_TRY(ctx, lapack_info(ctx, "dsygv", info));
+cleanup:
+  fcm__free(ctx, work);
+  return st;
+}
+
 fcm_status fcm__stev(fcm_ctx *ctx, int n, double *d, double *e, double *z, int ldz)
 {
   fcm_status st = FCM_OK;

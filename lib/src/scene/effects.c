@@ -33,6 +33,12 @@ int fcm_region_contains(const fcm_region *r, const double x[3])
   }
 }
 
+int fcm_region_select(void *region, const double X[3], const double normal[3])
+{
+  (void)normal;
+  return fcm_region_contains(region, X);
+}
+
 static int cmp_index(const void *a, const void *b)
 {
   fcm_index x = *(const fcm_index *)a, y = *(const fcm_index *)b;
@@ -221,14 +227,79 @@ static void view_gravity(const fcm_effect *e, FILE *f)
   fprintf(f, "acceleration (%g, %g, %g) m/s^2", a[0], a[1], a[2]);
 }
 
+/* Where a fixed or motion effect acts: "region" (background nodes) or "boundary" (the
+ * embedded-boundary points in a box or half-space region, or "all"), exactly one; with
+ * "boundary" the method keys "method", "penalty", "nitsche_safety". */
+static fcm_status read_target(fcm__scene_parser *p, const fcm__json *o, fcm_region *region,
+                              int *boundary, fcm_boundary_options *bo)
+{
+  fcm_status st = FCM_OK;
+  static const char *const methods[] = {"nitsche", "penalty"};
+  const fcm__json *b = fcm__json_member(o, "boundary");
+  const int has_region = fcm__json_member(o, "region") != NULL;
+  *bo = fcm_boundary_options_default();
+  *boundary = b != NULL;
+  SCENE_CHECK(!(b && has_region), p, FCM_ERR_ARG,
+              "expected one of \"region\" (background nodes) or \"boundary\" (embedded-boundary "
+              "points), got both");
+  if (!b) {
+    SCENE_CHECK(has_region, p, FCM_ERR_ARG,
+                "missing \"region\"; expected a \"region\" (background nodes) or a "
+                "\"boundary\" (embedded-boundary points)");
+    FCM_TRY(p->ctx, fcm__scene_read_region(p, o, "region", 1, 1, region));
+    static const char *const bkeys[] = {"method", "penalty", "nitsche_safety"};
+    for (int k = 0; k < 3; k++) {
+      size_t old = fcm__scene_path_push_key(p, bkeys[k]);
+      SCENE_CHECK(!fcm__json_member(o, bkeys[k]), p, FCM_ERR_ARG,
+                  "allowed only with \"boundary\" (embedded-boundary points), not with "
+                  "\"region\"");
+      fcm__scene_path_pop(p, old);
+    }
+    return FCM_OK;
+  }
+  if (fcm__json_get_kind(b) == FCM__JSON_STRING) {
+    size_t old = fcm__scene_path_push_key(p, "boundary");
+    SCENE_CHECK(!strcmp(fcm__json_string(b), "all"), p, FCM_ERR_ARG,
+                "expected \"all\" or a region object (box or half_space), got \"%.40s\"",
+                fcm__json_string(b));
+    fcm__scene_path_pop(p, old);
+    memset(region, 0, sizeof *region);
+    region->kind = FCM_REGION_ALL;
+    region->tolerance = 1e-9;
+  } else {
+    FCM_TRY(p->ctx, fcm__scene_read_region(p, o, "boundary", 1, 0, region));
+  }
+  int m = 0;
+  FCM_TRY(p->ctx, fcm__scene_read_choice(p, o, "method", 0, methods, 2, &m));
+  bo->method = (fcm_boundary_method)m;
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "penalty", 0, FCM__POSITIVE, &bo->penalty));
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "nitsche_safety", 0,
+                                         (fcm__range){1.0, HUGE_VAL, 1, 1}, &bo->nitsche_safety));
+cleanup:
+  return st;
+}
+
+static void view_target(const fcm_region *r, int boundary, const fcm_boundary_options *bo, FILE *f)
+{
+  if (boundary) {
+    fprintf(f, "the embedded boundary (%s", fcm_boundary_method_name(bo->method));
+    if (bo->method == FCM_BOUNDARY_NITSCHE)
+      fprintf(f, ", safety %g) in ", bo->nitsche_safety);
+    else
+      fprintf(f, " %g E/h) in ", bo->penalty);
+  }
+  fcm__scene_region_view(r, f);
+}
+
 static fcm_status parse_fixed(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"region", "components"};
+  static const char *const keys[] = {"region",  "boundary", "components",
+                                     "method",  "penalty",  "nitsche_safety"};
   fcm_effect_fixed *x = &e->fixed;
   const char *comp = NULL;
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
-  FCM_TRY(p->ctx, fcm__scene_read_region(p, o, "region", 1, 1, &x->region));
+  FCM_TRY(p->ctx, read_target(p, o, &x->region, &x->boundary, &x->boundary_options));
   FCM_TRY(p->ctx, fcm__scene_read_string(p, o, "components", 0, &comp));
   x->components[0] = x->components[1] = x->components[2] = 1;
   if (comp) {
@@ -253,19 +324,21 @@ static void view_fixed(const fcm_effect *e, FILE *f)
 {
   const int *c = e->fixed.components;
   fprintf(f, "components %s%s%s on ", c[0] ? "x" : "", c[1] ? "y" : "", c[2] ? "z" : "");
-  fcm__scene_region_view(&e->fixed.region, f);
+  view_target(&e->fixed.region, e->fixed.boundary, &e->fixed.boundary_options, f);
 }
 
 static fcm_status parse_motion(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"region", "velocity", "rotation", "start", "end", "release"};
+  static const char *const keys[] = {"region",  "boundary", "velocity", "rotation",      "start",
+                                     "end",     "release",  "method",   "nitsche_safety", "penalty"};
   static const char *const rkeys[] = {"axis", "center", "speed"};
   fcm_motion *m = &e->motion.motion;
   const fcm__json *rot = NULL;
   *m = fcm_motion_default();
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
-  FCM_TRY(p->ctx, fcm__scene_read_region(p, o, "region", 1, 1, &e->motion.region));
+  FCM_TRY(p->ctx, read_target(p, o, &e->motion.region, &e->motion.boundary,
+                              &e->motion.boundary_options));
   FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "velocity", 0, FCM__ANY, m->velocity));
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "rotation", 0, &rot));
   if (rot) {
@@ -304,7 +377,7 @@ static void view_motion(const fcm_effect *e, FILE *f)
   view_window(m->start, m->end, f);
   if (m->end < HUGE_VAL) fprintf(f, ", then %s", m->release ? "released" : "held");
   fprintf(f, "; on ");
-  fcm__scene_region_view(&e->motion.region, f);
+  view_target(&e->motion.region, e->motion.boundary, &e->motion.boundary_options, f);
 }
 
 static fcm_status parse_initial_velocity(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)

@@ -114,6 +114,21 @@ fcm_status fcm__effect_apply_constraint(fcm_simulation *S, const fcm_effect *e)
     FCM_ALLOC(S->ctx, fcm_scene_num_effects(S->scene), S->react_effect);
     FCM_ALLOC(S->ctx, fcm_scene_num_effects(S->scene), S->react_id);
   }
+  const int boundary = e->type == FCM_EFFECT_FIXED ? e->fixed.boundary : e->motion.boundary;
+  if (boundary) { /* embedded-boundary points in the region: Nitsche or penalty */
+    FCM_CHECK(S->c.surface_rules, S->ctx, FCM_ERR_ARG,
+              "scene %s: effects[%d]: %s on the \"boundary\" needs an embedded geometry",
+              fcm_scene_name(S->scene), e->index, fcm_effect_type_name(e->type));
+    FCM_TRY(S->ctx, fcm_integrator_add_boundary_constraint(
+                        S->integ, fcm_region_select, (void *)r, &m,
+                        e->type == FCM_EFFECT_FIXED ? &e->fixed.boundary_options
+                                                    : &e->motion.boundary_options,
+                        &id));
+    S->react_effect[S->num_react] = e->index;
+    S->react_id[S->num_react++] = -1 - id; /* negative: a boundary constraint */
+    S->c.constraints++;
+    goto cleanup;
+  }
   FCM_TRY(S->ctx, region_nodes(S, r, e->index, NULL, &n));
   FCM_ALLOC(S->ctx, n, nodes);
   FCM_TRY(S->ctx, region_nodes(S, r, e->index, nodes, &n));
@@ -477,9 +492,12 @@ static fcm_status build_rules(fcm_simulation *S)
   const fcm_scene_solver *sv = fcm_scene_get_solver(S->scene);
   fcm_cell_rules_options ro = fcm_cell_rules_options_default();
   int nsurf = 0;
-  for (int k = 0; k < fcm_scene_num_effects(S->scene); k++)
-    nsurf += !!(fcm__scene_effect_type(fcm_scene_get_effect(S->scene, k)->type)->needs &
-                FCM__NEEDS_SURFACE_RULES);
+  for (int k = 0; k < fcm_scene_num_effects(S->scene); k++) {
+    const fcm_effect *e = fcm_scene_get_effect(S->scene, k);
+    nsurf += !!(fcm__scene_effect_type(e->type)->needs & FCM__NEEDS_SURFACE_RULES);
+    nsurf += (e->type == FCM_EFFECT_FIXED && e->fixed.boundary) ||
+             (e->type == FCM_EFFECT_MOTION && e->motion.boundary); /* Nitsche's points */
+  }
   /* Only the rules the scene calls for: mass rules serve the mass matrix (inertia, Rayleigh
    * damping) and the momentum, so a static scene builds none (the log's mass then comes from
    * the piece volumes, see log_momentum()). */
@@ -894,7 +912,9 @@ cleanup:
  * boundary) belongs here too, read through its own call. */
 static fcm_status constraint_reaction(fcm_simulation *S, int k, double q[6])
 {
-  return fcm_integrator_reaction(S->integ, S->react_id[k], q, q + 3);
+  const int id = S->react_id[k];
+  return id >= 0 ? fcm_integrator_reaction(S->integ, id, q, q + 3)
+                 : fcm_integrator_boundary_reaction(S->integ, -1 - id, q, q + 3);
 }
 
 fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)

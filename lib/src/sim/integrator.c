@@ -152,6 +152,7 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   for (int k = 0; k < I->num_cons; k++)
     fcm__free(ctx, I->cons[k].nodes);
   fcm__free(ctx, I->cons);
+  fcm__sim_boundary_free(I);
   double **vecs[] = {&I->u,      &I->v,     &I->load_prev, &I->act_val, &I->act_inc, &I->Ma,
                      &I->u_bak,  &I->v_bak, &I->lp_bak,    &I->un,      &I->uhat,    &I->fext,
                      &I->fend,   &I->fint,  &I->g,         &I->d,       &I->b,       &I->ut,
@@ -326,6 +327,7 @@ void fcm__sim_eval_constraints(fcm_integrator *I, double t)
     if (on != I->con_on[k]) changed = 1;
     I->con_on[k] = on;
   }
+  if (fcm__sim_boundary_time(I, t)) changed = 1;
   fcm_index j = 0;
   for (fcm_index i = 0; i < I->ncon; i++) {
     if (changed) I->is_con[I->con_dof[i]] = I->con_on[I->con_id[i]];
@@ -655,6 +657,7 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
   FCM_CHECK(I->n > 0, ctx, FCM_ERR_ARG, "integrator: the space has no DOFs");
   FCM_TRY(ctx, build_constraints(I));
   FCM_TRY(ctx, setup_storage(I));
+  FCM_TRY(ctx, fcm__sim_boundary_setup(I));
   FCM_TRY(ctx, setup_mass_and_loads(I));
   if (I->opts.tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE)
     FCM_TRY(ctx, setup_representative_force(I));
@@ -903,6 +906,11 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   for (int k = 0; k < old->num_cons; k++)
     FCM_TRY(ctx, fcm_integrator_add_constraint(I, old->cons[k].num_nodes, old->cons[k].nodes,
                                                &old->cons[k].motion, NULL));
+  for (int k = 0; k < old->num_bcons; k++)
+    FCM_TRY(ctx, fcm_integrator_add_boundary_constraint(I, old->bcons[k].select,
+                                                        old->bcons[k].select_user,
+                                                        &old->bcons[k].motion,
+                                                        &old->bcons[k].opts, NULL));
   FCM_TRY(ctx, fcm_integrator_setup(I));
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, u);
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, v);

@@ -41,7 +41,7 @@ static fcm_status singular(fcm_integrator *I)
   char msg[1024];
   snprintf(msg, sizeof msg, "%s", fcm_ctx_error_message(ctx));
   fcm_ctx_error_clear(ctx);
-  const int free_static = I->nact == 0 && I->key_h == 0.0;
+  const int free_static = I->nact == 0 && I->bcon_active == 0 && I->key_h == 0.0;
   FCM_CHECK(0, ctx, FCM_ERR_SINGULAR, "integrator: the Newton matrix is singular%s: %s%s%s",
             free_static ? " (static step without any active Dirichlet constraint: the body's "
                           "rigid-body modes are unconstrained)"
@@ -50,6 +50,24 @@ static fcm_status singular(fcm_integrator *I)
             strstr(msg, "likely causes") ? "" : FCM__SINGULAR_HINT);
 cleanup:
   return st;
+}
+
+/* singular() unless boundary constraints are active on a nonlinear material: far from rest
+ * their energy (penalty estimated at rest) can make the Newton matrix singular, a soft failure
+ * that the Newton loop retries with their PSD penalty part and the step with halving. */
+static fcm_status singular_or_retry(fcm_integrator *I, fcm_step_reason *reason)
+{
+  if (I->bcon_active > 0 && !I->linear) {
+    fcm__log(I->ctx, FCM_LOG_WARNING,
+             "integrator: t = %g: the Newton matrix with boundary constraints is singular (%s); "
+             "retrying (should it persist at large strains: raise nitsche_safety, or use the "
+             "penalty method)",
+             I->t, fcm_ctx_error_message(I->ctx));
+    fcm_ctx_error_clear(I->ctx);
+    *reason = FCM_STEP_LINEAR_SOLVER_FAILED;
+    return FCM_OK;
+  }
+  return singular(I);
 }
 
 static fcm_status factor_direct(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
@@ -69,7 +87,7 @@ static fcm_status factor_direct(fcm_integrator *I, fcm_step_reason *reason, sim_
     if (s != FCM_ERR_SINGULAR) return soft(I, s, reason);
     fcm_direct_info di;
     fcm_direct_get_info(I->chol, &di);
-    if (di.failed_column < 0) return singular(I); /* factor completed, rank deficient */
+    if (di.failed_column < 0) return singular_or_retry(I, reason); /* rank deficient */
     /* Not positive definite: LU with partial pivoting on the same matrix. */
     stats->direct_fallbacks++;
     I->total_fallbacks++;
@@ -92,7 +110,7 @@ static fcm_status factor_direct(fcm_integrator *I, fcm_step_reason *reason, sim_
   }
   /* LU with partial pivoting met a zero or rounding-level pivot: no shorter step changes
    * the rank (mass and constraints stay), so stop with the reason. */
-  if (s == FCM_ERR_SINGULAR) return singular(I);
+  if (s == FCM_ERR_SINGULAR) return singular_or_retry(I, reason);
   return soft(I, s, reason);
 cleanup:
   return st;
@@ -138,6 +156,14 @@ static fcm_status pc_matrix(fcm_integrator *I, fcm_csr **P, fcm_step_reason *rea
     s = fcm_assembly_workspace_hyperelastic(I->aws, &I->params_psd, I->u, NULL, NULL, I->Hpc);
     stats->tangent_assemblies++;
     if (s != FCM_OK) return soft(I, s, reason);
+  }
+  if (I->bcon_active > 0) { /* boundary constraints: their PSD penalty part */
+    int finite = 1;
+    FCM_TRY(ctx, fcm__sim_boundary_assemble(I, I->u, 1, NULL, NULL, I->Hpc, &finite));
+    if (!finite) {
+      *reason = FCM_STEP_NONFINITE;
+      return FCM_OK;
+    }
   }
   /* Eliminate the active constraints as H was (only the matrix matters; nothing allocated). */
   fcm__eliminate_marked(I->Hpc, NULL, I->is_con, NULL);
@@ -217,7 +243,7 @@ fcm_status fcm__sim_solve(fcm_integrator *I, const double *b, double *d, fcm_ste
     FCM_CHECK(I->direct, ctx, FCM_ERR_INTERNAL, "integrator: no valid factorization to solve with");
     s = fcm_direct_solve(I->direct, b, d);
     if (s == FCM_ERR_SINGULAR) {
-      st = singular(I);
+      st = singular_or_retry(I, reason);
       goto cleanup;
     }
     FCM_TRY(ctx, s);

@@ -76,12 +76,32 @@ static fcm_status assemble(fcm_integrator *I, const fcm_material_params *p, cons
   return st;
 }
 
+/* The boundary constraints' terms (nitsche.c) at x: energy, force, tangent (projected: the
+ * PSD penalty part only), timed with the assembly. */
+static fcm_status assemble_boundary(fcm_integrator *I, const double *x, int projected,
+                                    double *energy, double *fint, fcm_csr *T, int *finite,
+                                    sim_stats *stats)
+{
+  if (I->bcon_active == 0) return FCM_OK;
+  double t0 = fcm_wtime();
+  fcm_status st = fcm__sim_boundary_assemble(
+      I, x, projected || I->params.project_psd || (T && I->bc_psd_only), energy, fint, T, finite);
+  stats->time_assembly += fcm_wtime() - t0;
+  if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
+  return st;
+}
+
 /* Tangent at x into H: H = base(h) + K(x), optionally with the PSD-projected material. */
 static fcm_status assemble_tangent(fcm_integrator *I, double h, const double *x, int projected,
                                    int *finite, sim_stats *stats)
 {
+  fcm_status st = FCM_OK;
   fcm__sim_set_base(I, h, I->H);
-  return assemble(I, projected ? &I->params_psd : &I->params, x, NULL, NULL, I->H, finite, stats);
+  FCM_TRY(I->ctx, assemble(I, projected ? &I->params_psd : &I->params, x, NULL, NULL, I->H,
+                           finite, stats));
+  if (*finite) FCM_TRY(I->ctx, assemble_boundary(I, x, projected, NULL, NULL, I->H, finite, stats));
+cleanup:
+  return st;
 }
 
 /* Energy parts at x: E, the internal force fint, the gradient g (n each), the elastic
@@ -97,12 +117,15 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
 {
   fcm_status st = FCM_OK;
   fcm_index n = I->n;
-  double psi = 0.0, inertia = 0.0, damp = 0.0, wext;
+  double psi = 0.0, inertia = 0.0, damp = 0.0, wext, bnd = 0.0;
   out->finite = 1;
   memset(fint, 0, sizeof *fint * (size_t)n);
   if (tangent) fcm__sim_set_base(I, h, I->H);
   FCM_TRY(I->ctx,
           assemble(I, &I->params, x, &psi, fint, tangent ? I->H : NULL, &out->finite, stats));
+  if (!out->finite) return FCM_OK;
+  FCM_TRY(I->ctx, assemble_boundary(I, x, 0, &bnd, fint, tangent ? I->H : NULL, &out->finite,
+                                    stats));
   if (!out->finite) return FCM_OK;
   {
     double t0 = fcm_wtime();
@@ -127,8 +150,8 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
     }
     wext = dot(n, I->fext, x);
     out->psi = psi;
-    out->E = inertia + damp + psi - wext;
-    out->scale = fabs(inertia) + fabs(damp) + fabs(psi) + fabs(wext);
+    out->E = inertia + damp + psi + bnd - wext;
+    out->scale = fabs(inertia) + fabs(damp) + fabs(psi) + fabs(bnd) + fabs(wext);
     out->finite = isfinite(out->E) && all_finite(n, g);
     stats->time_assembly += fcm_wtime() - t0;
   }
@@ -279,13 +302,30 @@ static fcm_status newton_direction(fcm_integrator *I, double h, int predictor, d
                                    int *its, fcm_step_reason *reason, sim_stats *stats)
 {
   fcm_status st = FCM_OK;
+  int projected = 0;
   FCM_TRY(I->ctx, build_system(I, h, predictor, 0, reason, stats));
-  if (*reason != FCM_STEP_NONE) goto cleanup;
-  FCM_TRY(I->ctx, direction(I, predictor, reason, its, stats));
+  if (*reason == FCM_STEP_NONE) FCM_TRY(I->ctx, direction(I, predictor, reason, its, stats));
+  if (*reason == FCM_STEP_LINEAR_SOLVER_FAILED && I->bcon_active > 0 && !I->opts.project_psd) {
+    /* Boundary constraints: far from rest the exact Hessian of the Nitsche terms (penalty
+     * estimated at rest) may make the Newton matrix singular; retry with their PSD penalty
+     * part only (the material's exact tangent kept, as with node constraints). */
+    int its2 = 0;
+    projected = 1;
+    *reason = FCM_STEP_NONE;
+    stats->projection_fallbacks++;
+    I->bc_psd_only = 1;
+    I->h_state = SIM_H_INVALID;
+    st = build_system(I, h, predictor, 0, reason, stats);
+    if (st == FCM_OK && *reason == FCM_STEP_NONE) st = direction(I, predictor, reason, &its2, stats);
+    I->bc_psd_only = 0;
+    I->h_state = SIM_H_INVALID;
+    FCM_TRY(I->ctx, st);
+    *its += its2;
+  }
   if (*reason != FCM_STEP_NONE) goto cleanup;
   *slope = dot(I->n, I->g, I->d);
   if (predictor || *slope < 0.0) goto cleanup;
-  if (!I->opts.project_psd) {
+  if (!I->opts.project_psd && !projected) {
     int its2 = 0;
     stats->projection_fallbacks++;
     FCM_TRY(I->ctx, build_system(I, h, 0, 1, reason, stats));

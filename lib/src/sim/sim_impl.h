@@ -24,6 +24,34 @@ typedef struct sim_constraint {
   fcm_index *nodes;
 } sim_constraint;
 
+/* A boundary constraint (nitsche.c): motion on selected embedded-boundary points. */
+typedef struct sim_bcon {
+  fcm_boundary_select_fn select; /* NULL: every point */
+  void *select_user;
+  fcm_motion motion; /* axis normalized */
+  fcm_boundary_options opts;
+} sim_bcon;
+
+/* The embedded-boundary points of the boundary constraints (setup), grouped by element in
+ * ascending element order: element elem[k] has points ptr[k] .. ptr[k+1]. */
+typedef struct sim_bpoints {
+  fcm_index nelem;      /* elements with points */
+  fcm_index *elem, *ptr; /* nelem, nelem + 1 */
+  fcm_index np;         /* points */
+  int *con;             /* np: boundary constraint of the point */
+  double *w;            /* np: area weights */
+  double *X, *nrm;      /* np x 3: reference position and unit outward normal */
+  double *N, *G;        /* np x nn shape values, np x nn x 3 physical gradients */
+  double *gamma;        /* num_elems: Nitsche penalty per element (0: no Nitsche points) */
+  double *hk;           /* num_elems: cell size h_K (cube root of the volume) */
+  double *scratch;      /* per thread: ue, fe (3nn each), Ke ((3nn)^2), Q (9nn) */
+  int nthreads;         /* threads the scratch serves (omp_get_max_threads() at setup) */
+  int num_colors;       /* the space's colours: no two elements of one share a DOF copy */
+  fcm_index *color_ptr; /* num_colors + 1 offsets into color_k */
+  fcm_index *color_k;   /* nelem: indices k (into elem) grouped by colour, ascending within */
+  double *eelem;        /* nelem: energy of each element's points (summed in order) */
+} sim_bpoints;
+
 /* Counters and timers of one step (copied into fcm_step_info). */
 typedef struct sim_stats {
   int newton_iterations, backtracks, tangent_assemblies, factorizations;
@@ -49,6 +77,13 @@ struct fcm_integrator {
   int num_loads;
   sim_constraint *cons;
   int num_cons;
+  sim_bcon *bcons; /* boundary constraints (nitsche.c) */
+  int num_bcons;
+  sim_bpoints bp;
+  unsigned char *bcon_on; /* num_bcons: active at bc_time */
+  int bcon_active;        /* how many are */
+  double bc_time;         /* time their motions are evaluated at */
+  int bc_psd_only;        /* 1: their tangent is the PSD penalty part (Newton's retry) */
 
   /* state */
   double *u, *v;
@@ -140,5 +175,17 @@ void fcm__sim_store_reactions(fcm_integrator *I);
 /* Active constraint set and prescribed values at time t (act_dof, act_val; con_version
  * bumps when the set changes). (integrator.c) */
 void fcm__sim_eval_constraints(fcm_integrator *I, double t);
+
+/* Boundary constraints (nitsche.c): points and penalties at setup; free; the energy, force
+ * and tangent at x and time I->bc_time added to *energy, force and T (each may be NULL).
+ * projected: the tangent keeps only the penalty part (PSD; the PSD fallback, project_psd
+ * and the preconditioner). *finite = 0 when the material gives NaN/Inf. */
+fcm_status fcm__sim_boundary_setup(fcm_integrator *I);
+void fcm__sim_boundary_free(fcm_integrator *I);
+/* Evaluate the boundary motions at time t from now on (bc_time, active flags); 1 when the
+ * active set changed. */
+int fcm__sim_boundary_time(fcm_integrator *I, double t);
+fcm_status fcm__sim_boundary_assemble(fcm_integrator *I, const double *x, int projected,
+                                      double *energy, double *force, fcm_csr *T, int *finite);
 
 #endif /* FCM_SIM_IMPL_H */

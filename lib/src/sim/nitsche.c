@@ -1,0 +1,747 @@
+/* sim: Dirichlet conditions on the embedded boundary — symmetric Nitsche (or a penalty) on
+ * the surface quadrature points of the cell rules, with a per-element penalty estimate.
+ *
+ * Energy (fcm/sim.h, fcm_boundary_method): with r = P_c (u - g) and t = P(F) N,
+ *   Pi(u) = sum_points w ( -t . r + gamma/2 |r|^2 )    (Nitsche; penalty: w gamma/2 |r|^2).
+ * Its gradient: f_(a,i) = w ( -S_iL g_aL - p_i t_i N_a + gamma r_i N_a ), S_iL = r_j N_J A_jJiL;
+ * its Hessian: w ( -p_i N_a Q_i(b,k) - p_k N_b Q_k(a,i) + gamma p_i d_ik N_a N_b
+ *   - dA[r (x) N]_iJkL g_aJ g_bL ), Q_i(b,k) = A_iJkL N_J g_bL (the traction of mode (b,k)),
+ * A = dP/dF, dA[D] its derivative along D (central differences; zero for linear elasticity).
+ * For linear elasticity this is symmetric Nitsche (Nitsche 1971; Hansbo 2005). The penalty
+ * of an element: safety x lambda_max of T v = lambda K v (Griebel and Schweitzer 2003; the
+ * eigenvalue estimate of Embar, Dolbow and Harari 2010, with the FCM stabilization points in
+ * K as in de Prenter et al. 2018), T the traction energy of the element's constrained points,
+ * K its linear-elastic stiffness at rest; rigid modes are lifted (B = K + s R R^T). */
+#include "sim/sim_impl.h"
+#include "fem/fem_impl.h"
+#include "la/la_impl.h"
+#include "la/mat3.h"
+#include "material/material_impl.h"
+
+#include <math.h>
+#include <omp.h>
+#include <string.h>
+
+const char *fcm_boundary_method_name(fcm_boundary_method method)
+{
+  switch (method) {
+  case FCM_BOUNDARY_NITSCHE:
+    return "nitsche";
+  case FCM_BOUNDARY_PENALTY:
+    return "penalty";
+  default:
+    return "invalid";
+  }
+}
+
+fcm_boundary_options fcm_boundary_options_default(void)
+{
+  fcm_boundary_options o;
+  memset(&o, 0, sizeof o);
+  o.method = FCM_BOUNDARY_NITSCHE;
+  o.nitsche_safety = 2.0;
+  o.penalty = 1e3;
+  return o;
+}
+
+fcm_status fcm_integrator_add_boundary_constraint(fcm_integrator *I, fcm_boundary_select_fn select,
+                                                  void *user, const fcm_motion *motion,
+                                                  const fcm_boundary_options *opts, int *id)
+{
+  fcm_status st = FCM_OK;
+  sim_bcon b;
+  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
+  fcm_ctx *ctx = I->ctx;
+  const int k = I->num_bcons;
+  FCM_CHECK(!I->is_setup, ctx, FCM_ERR_ARG,
+            "integrator: boundary constraints must be added before fcm_integrator_setup()");
+  FCM_CHECK(motion, ctx, FCM_ERR_ARG, "boundary constraint %d: NULL motion", k);
+  memset(&b, 0, sizeof b);
+  b.select = select;
+  b.select_user = user;
+  b.motion = *motion;
+  b.opts = opts ? *opts : fcm_boundary_options_default();
+  {
+    const fcm_motion *m = motion;
+    int fin = 1;
+    for (int i = 0; i < 3; i++)
+      fin &= isfinite(m->velocity[i]) && isfinite(m->center[i]) && isfinite(m->axis[i]);
+    FCM_CHECK(fin && isfinite(m->angular_speed), ctx, FCM_ERR_ARG,
+              "boundary constraint %d: velocity, center, axis or angular_speed not finite", k);
+    FCM_CHECK(isfinite(m->start) && !isnan(m->end) && m->end >= m->start, ctx, FCM_ERR_ARG,
+              "boundary constraint %d: end = %g must be >= start = %g (start finite)", k, m->end,
+              m->start);
+    double an = sqrt(m->axis[0] * m->axis[0] + m->axis[1] * m->axis[1] + m->axis[2] * m->axis[2]);
+    if (an > 0.0)
+      for (int i = 0; i < 3; i++)
+        b.motion.axis[i] = m->axis[i] / an;
+    FCM_CHECK(m->components[0] || m->components[1] || m->components[2], ctx, FCM_ERR_ARG,
+              "boundary constraint %d: motion.components constrains no component", k);
+  }
+  FCM_CHECK(b.opts.method >= 0 && b.opts.method < FCM_BOUNDARY_METHOD_COUNT, ctx, FCM_ERR_ARG,
+            "boundary constraint %d: method = %d outside [0, 1] (nitsche, penalty)", k,
+            (int)b.opts.method);
+  FCM_CHECK(b.opts.nitsche_safety > 1.0 && isfinite(b.opts.nitsche_safety), ctx, FCM_ERR_ARG,
+            "boundary constraint %d: nitsche_safety = %g must be finite and > 1", k,
+            b.opts.nitsche_safety);
+  FCM_CHECK(b.opts.penalty > 0.0 && isfinite(b.opts.penalty), ctx, FCM_ERR_ARG,
+            "boundary constraint %d: penalty = %g must be finite and > 0", k, b.opts.penalty);
+  FCM_TRY(ctx, fcm__resize(ctx, (void **)&I->bcons, (size_t)I->num_bcons, (size_t)I->num_bcons + 1,
+                           sizeof *I->bcons));
+  I->bcons[I->num_bcons++] = b;
+  if (id) *id = k;
+cleanup:
+  return st;
+}
+
+static double element_max_penalty(const fcm_integrator *I, fcm_index k);
+
+void fcm__sim_boundary_free(fcm_integrator *I)
+{
+  fcm_ctx *ctx = I->ctx;
+  sim_bpoints *bp = &I->bp;
+  fcm__free(ctx, bp->elem);
+  fcm__free(ctx, bp->ptr);
+  fcm__free(ctx, bp->con);
+  fcm__free(ctx, bp->color_ptr);
+  fcm__free(ctx, bp->color_k);
+  double **v[] = {&bp->w,     &bp->X,  &bp->nrm,     &bp->N,    &bp->G,
+                  &bp->gamma, &bp->hk, &bp->scratch, &bp->eelem};
+  for (size_t k = 0; k < sizeof v / sizeof v[0]; k++)
+    FCM_FREE(ctx, *v[k]);
+  fcm__free(ctx, I->bcons);
+  fcm__free(ctx, I->bcon_on);
+  memset(bp, 0, sizeof *bp);
+}
+
+/* Physical gradients g (nn x 3) at reference point xi of a cell with nodes X; det J. */
+static double gradients(fcm_element_type type, int nn, const double *X, const double xi[3],
+                        double *g)
+{
+  double dN[3 * FCM_ELEMENT_MAX_NODES], J[9] = {0}, Ji[9];
+  fcm_element_eval_grad(type, xi, dN);
+  for (int a = 0; a < nn; a++)
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++)
+        J[3 * i + j] += X[3 * a + i] * dN[3 * a + j];
+  double det = fcm__mat3_inv(J, Ji);
+  if (!(det > 0.0)) return det;
+  for (int a = 0; a < nn; a++)
+    fcm__mat3_tmulv(Ji, dN + 3 * a, g + 3 * a);
+  return det;
+}
+
+/* The boundary constraint that holds a point: the first that selects it, or -1. */
+static int point_owner(const fcm_integrator *I, const double X[3], const double n[3])
+{
+  for (int k = 0; k < I->num_bcons; k++) {
+    const sim_bcon *b = &I->bcons[k];
+    if (!b->select || b->select(b->select_user, X, n)) return k;
+  }
+  return -1;
+}
+
+/* Traction of the shape mode (b, k) at a point, linear elasticity at rest: row i of
+ * C (3 x 3nn) = p_i (lambda g_bk N_i + mu (d_ik g_b . N + N_k g_bi)). */
+static void traction_modes(int nn, const double *g, const double *N, const int *pc, double lambda,
+                           double mu, double *C)
+{
+  const int nd = 3 * nn;
+  for (int b = 0; b < nn; b++) {
+    const double *gb = g + 3 * b, gn = gb[0] * N[0] + gb[1] * N[1] + gb[2] * N[2];
+    for (int k = 0; k < 3; k++)
+      for (int i = 0; i < 3; i++)
+        C[i * nd + 3 * b + k] =
+            pc[i] ? lambda * gb[k] * N[i] + mu * ((i == k ? gn : 0.0) + N[k] * gb[i]) : 0.0;
+  }
+}
+
+/* Penalties of element e from its points [p0, p1): Nitsche's eigenvalue estimate over its
+ * Nitsche points (0 when it has none) into *gamma, and the cell size h_K (the penalty method's
+ * gamma is penalty E / h_K) into *hk. */
+static fcm_status element_penalty(fcm_integrator *I, fcm_index e, fcm_index p0, fcm_index p1,
+                                  const fcm_rule *full, double *gamma, double *hk)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  const fcm_space *s = I->space;
+  const int nn = s->nn, nd = 3 * nn;
+  double *K = NULL, *T = NULL, *C = NULL, *R = NULL, *ev = NULL;
+  double X[3 * FCM_ELEMENT_MAX_NODES], g[3 * FCM_ELEMENT_MAX_NODES];
+  const fcm_index cell = s->elem_cell[e];
+  const double lambda = I->params.lambda, mu = I->params.mu;
+  fcm_mesh_cell_coords(s->mesh, cell, X);
+  /* the volume rule the assembly integrates the element with (stabilization included) */
+  int nq = 0;
+  const double *pts = NULL, *wts = NULL;
+  if (s->rules && fcm_cell_rules_class(s->rules, cell) != FCM_CELL_UNCUT) {
+    FCM_TRY(ctx, fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], FCM_RULE_STIFFNESS, &nq, &pts,
+                                          &wts, NULL));
+  } else {
+    nq = fcm_rule_num_points(full);
+    pts = fcm_rule_points(full);
+    wts = fcm_rule_weights(full);
+  }
+  double vol = 0.0; /* |K|: the standard rule integrates 1 exactly */
+  {
+    const int fq = fcm_rule_num_points(full);
+    for (int q = 0; q < fq; q++) {
+      double J[9];
+      vol += fcm_rule_weights(full)[q] *
+             fcm_element_jacobian(s->type, X, fcm_rule_points(full) + 3 * q, J);
+    }
+  }
+  *hk = cbrt(fabs(vol));
+  *gamma = 0.0;
+  double safety = 0.0; /* the largest safety factor of the element's Nitsche points */
+  for (fcm_index p = p0; p < p1; p++) {
+    const sim_bcon *bc = &I->bcons[I->bp.con[p]];
+    if (bc->opts.method == FCM_BOUNDARY_NITSCHE) safety = FCM_MAX(safety, bc->opts.nitsche_safety);
+  }
+  if (safety == 0.0) goto cleanup;
+  FCM_ALLOC(ctx, (size_t)nd * nd, K);
+  FCM_ALLOC(ctx, (size_t)nd * nd, T);
+  FCM_ALLOC(ctx, (size_t)3 * nd, C);
+  FCM_ALLOC(ctx, (size_t)6 * nd, R);
+  FCM_ALLOC(ctx, nd, ev);
+  for (int q = 0; q < nq; q++) { /* K, linear elasticity */
+    double det = gradients(s->type, nn, X, pts + 3 * q, g);
+    FCM_CHECK(det > 0.0, ctx, FCM_ERR_GEOMETRY,
+              "boundary constraint: cell %lld has det J = %g <= 0 at a quadrature point",
+              (long long)cell, det);
+    const double wd = wts[q] * det;
+    for (int a = 0; a < nn; a++)
+      for (int bb = 0; bb < nn; bb++) {
+        const double *ga = g + 3 * a, *gb = g + 3 * bb;
+        const double dd = ga[0] * gb[0] + ga[1] * gb[1] + ga[2] * gb[2];
+        for (int i = 0; i < 3; i++)
+          for (int j = 0; j < 3; j++)
+            K[(size_t)(3 * a + i) * nd + 3 * bb + j] +=
+                wd * (lambda * ga[i] * gb[j] + mu * ga[j] * gb[i] + (i == j ? mu * dd : 0.0));
+      }
+  }
+  for (fcm_index p = p0; p < p1; p++) { /* T = sum w C^T C */
+    const sim_bcon *bc = &I->bcons[I->bp.con[p]];
+    if (bc->opts.method != FCM_BOUNDARY_NITSCHE) continue;
+    traction_modes(nn, I->bp.G + (size_t)p * nd, I->bp.nrm + 3 * p, bc->motion.components, lambda,
+                   mu, C);
+    for (int x = 0; x < nd; x++)
+      for (int y = 0; y < nd; y++)
+        T[(size_t)x * nd + y] +=
+            I->bp.w[p] * (C[x] * C[y] + C[nd + x] * C[nd + y] + C[2 * nd + x] * C[2 * nd + y]);
+  }
+  /* Rigid modes (translations, rotations about the centroid), orthonormalized; K and T
+   * vanish on them, so B = K + s R R^T is positive definite and has the same eigenvalues
+   * on their complement. */
+  {
+    double c[3] = {0, 0, 0}, tr = 0.0;
+    for (int a = 0; a < nn; a++)
+      for (int i = 0; i < 3; i++)
+        c[i] += X[3 * a + i] / nn;
+    for (int a = 0; a < nn; a++) {
+      double r[3] = {X[3 * a] - c[0], X[3 * a + 1] - c[1], X[3 * a + 2] - c[2]};
+      for (int i = 0; i < 3; i++) {
+        R[(size_t)i * nd + 3 * a + i] = 1.0;
+        /* rotation about axis i: e_i x r */
+        double *Ri = R + (size_t)(3 + i) * nd + 3 * a;
+        const int j = (i + 1) % 3, k = (i + 2) % 3;
+        Ri[k] = r[j];
+        Ri[j] = -r[k];
+      }
+    }
+    for (int pass = 0; pass < 2; pass++) /* modified Gram-Schmidt, twice */
+      for (int m = 0; m < 6; m++) {
+        double *rm = R + (size_t)m * nd;
+        for (int l = 0; l < m; l++) {
+          const double *rl = R + (size_t)l * nd;
+          double d = 0.0;
+          for (int x = 0; x < nd; x++)
+            d += rm[x] * rl[x];
+          for (int x = 0; x < nd; x++)
+            rm[x] -= d * rl[x];
+        }
+        double nrm = 0.0;
+        for (int x = 0; x < nd; x++)
+          nrm += rm[x] * rm[x];
+        nrm = sqrt(nrm);
+        for (int x = 0; x < nd; x++)
+          rm[x] /= nrm;
+      }
+    for (int x = 0; x < nd; x++)
+      tr += K[(size_t)x * nd + x];
+    const double sc = tr / nd;
+    for (int m = 0; m < 6; m++)
+      for (int x = 0; x < nd; x++)
+        for (int y = 0; y < nd; y++)
+          K[(size_t)x * nd + y] += sc * R[(size_t)m * nd + x] * R[(size_t)m * nd + y];
+  }
+  {
+    fcm_status s2 = fcm__sygv(ctx, nd, T, nd, K, nd, ev);
+    if (s2 == FCM_ERR_SINGULAR) {
+      fcm_ctx_error_clear(ctx);
+      FCM_CHECK(0, ctx, FCM_ERR_NUMERIC,
+                "boundary constraint: the Nitsche penalty of cell %lld (volume fraction %g) "
+                "cannot be estimated: its stiffness is singular beyond the rigid-body modes "
+                "(enable the stabilization of the cell rules, or raise min_fraction)",
+                (long long)cell, s->rules ? fcm_cell_rules_volume_fraction(s->rules, cell) : 1.0);
+    }
+    FCM_TRY(ctx, s2);
+  }
+  *gamma = safety * FCM_MAX(ev[nd - 1], 0.0);
+  FCM_CHECK(isfinite(*gamma), ctx, FCM_ERR_NUMERIC,
+            "boundary constraint: the Nitsche penalty of cell %lld is not finite", (long long)cell);
+cleanup:
+  fcm__free(ctx, K);
+  fcm__free(ctx, T);
+  fcm__free(ctx, C);
+  fcm__free(ctx, R);
+  fcm__free(ctx, ev);
+  return st;
+}
+
+fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  const fcm_space *s = I->space;
+  sim_bpoints *bp = &I->bp;
+  fcm_index *count = NULL, *ecol = NULL;
+  fcm_rule *full = NULL;
+  const int nn = s->nn, nd = 3 * nn;
+  if (I->num_bcons == 0) return FCM_OK;
+  FCM_CHECK(s->rules && fcm_cell_rules_surface_strength(s->rules) >= 0, ctx, FCM_ERR_ARG,
+            "boundary constraint 0: the space has no surface rules (build the cell rules with "
+            "surface_strength >= 0)");
+  FCM_ALLOC(ctx, I->num_bcons, I->bcon_on);
+  FCM_ALLOC(ctx, I->num_bcons, count);
+  FCM_ALLOC(ctx, s->num_elems + 1, bp->gamma);
+  FCM_ALLOC(ctx, s->num_elems + 1, bp->hk);
+  /* count the selected points per element */
+  for (int pass = 0; pass < 2; pass++) {
+    fcm_index np = 0, ne = 0;
+    for (fcm_index e = 0; e < s->num_elems; e++) {
+      int nsp = 0;
+      const double *pts = NULL, *wts = NULL, *nrm = NULL;
+      double X[3 * FCM_ELEMENT_MAX_NODES], N[FCM_ELEMENT_MAX_NODES];
+      FCM_TRY(ctx, fcm_cell_rules_get_piece_surface(s->rules, s->elem_piece[e], &nsp, &pts, &wts,
+                                                    &nrm, NULL));
+      if (nsp == 0) continue;
+      fcm_mesh_cell_coords(s->mesh, s->elem_cell[e], X);
+      const fcm_index first = np;
+      for (int q = 0; q < nsp; q++) {
+        double x[3] = {0, 0, 0};
+        fcm_element_eval_shape(s->type, pts + 3 * q, N);
+        for (int a = 0; a < nn; a++)
+          for (int i = 0; i < 3; i++)
+            x[i] += N[a] * X[3 * a + i];
+        const int k = point_owner(I, x, nrm + 3 * q);
+        if (k < 0 || !(wts[q] > 0.0)) continue;
+        if (pass == 1) {
+          bp->con[np] = k;
+          bp->w[np] = wts[q];
+          memcpy(bp->X + 3 * np, x, sizeof x);
+          memcpy(bp->nrm + 3 * np, nrm + 3 * q, 3 * sizeof(double));
+          memcpy(bp->N + (size_t)np * nn, N, sizeof(double) * (size_t)nn);
+          double det = gradients(s->type, nn, X, pts + 3 * q, bp->G + (size_t)np * nd);
+          FCM_CHECK(det > 0.0, ctx, FCM_ERR_GEOMETRY,
+                    "boundary constraint %d: cell %lld has det J = %g <= 0 at a boundary point", k,
+                    (long long)s->elem_cell[e], det);
+        } else {
+          count[k]++;
+        }
+        np++;
+      }
+      if (np > first) {
+        if (pass == 1) {
+          bp->elem[ne] = e;
+          bp->ptr[ne] = first;
+        }
+        ne++;
+      }
+    }
+    if (pass == 0) {
+      for (int k = 0; k < I->num_bcons; k++)
+        FCM_CHECK(count[k] > 0, ctx, FCM_ERR_ARG,
+                  "boundary constraint %d selects no embedded-boundary point (check its region "
+                  "against the body's surface)",
+                  k);
+      bp->np = np;
+      bp->nelem = ne;
+      FCM_ALLOC(ctx, ne, bp->elem);
+      FCM_ALLOC(ctx, ne + 1, bp->ptr);
+      FCM_ALLOC(ctx, np, bp->con);
+      FCM_ALLOC(ctx, np, bp->w);
+      FCM_ALLOC(ctx, 3 * (size_t)np, bp->X);
+      FCM_ALLOC(ctx, 3 * (size_t)np, bp->nrm);
+      FCM_ALLOC(ctx, (size_t)np * nn, bp->N);
+      FCM_ALLOC(ctx, (size_t)np * nd, bp->G);
+      bp->nthreads = FCM_MAX(omp_get_max_threads(), 1);
+      FCM_ALLOC(ctx, ((size_t)nd * (nd + 2) + 9 * (size_t)nn) * (size_t)bp->nthreads, bp->scratch);
+      FCM_ALLOC(ctx, ne + 1, bp->eelem);
+    } else {
+      bp->ptr[ne] = np;
+    }
+  }
+  /* the elements with points grouped by the space's colours (parallel assembly) */
+  FCM_ALLOC(ctx, s->num_elems + 1, ecol);
+  for (int c = 0; c < s->num_colors; c++)
+    for (fcm_index j = s->color_ptr[c]; j < s->color_ptr[c + 1]; j++)
+      ecol[s->color_elems[j]] = c;
+  bp->num_colors = s->num_colors;
+  FCM_ALLOC(ctx, (size_t)s->num_colors + 1, bp->color_ptr);
+  FCM_ALLOC(ctx, (size_t)bp->nelem + 1, bp->color_k);
+  for (fcm_index k = 0; k < bp->nelem; k++)
+    bp->color_ptr[ecol[bp->elem[k]] + 1]++;
+  for (int c = 0; c < s->num_colors; c++)
+    bp->color_ptr[c + 1] += bp->color_ptr[c];
+  for (fcm_index k = 0; k < bp->nelem; k++) /* ascending k within a colour */
+    bp->color_k[bp->color_ptr[ecol[bp->elem[k]]]++] = k;
+  for (int c = s->num_colors; c > 0; c--)
+    bp->color_ptr[c] = bp->color_ptr[c - 1];
+  bp->color_ptr[0] = 0;
+  /* penalties */
+  FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, FCM_RULE_STIFFNESS,
+                                         I->opts.assembly.stiffness_strength, &full));
+  I->setup_info.boundary_points = bp->np;
+  for (fcm_index k = 0; k < bp->nelem; k++) {
+    const fcm_index e = bp->elem[k];
+    FCM_TRY(ctx,
+            element_penalty(I, e, bp->ptr[k], bp->ptr[k + 1], full, &bp->gamma[e], &bp->hk[e]));
+    I->setup_info.boundary_penalty_max = FCM_MAX(
+        I->setup_info.boundary_penalty_max, element_max_penalty(I, k) * bp->hk[e] / I->mat.young);
+  }
+cleanup:
+  fcm__free(ctx, count);
+  fcm__free(ctx, ecol);
+  fcm_rule_destroy(&full);
+  return st;
+}
+
+/* Add the element matrix Ke (3nn x 3nn) of element e into the values of the pattern. */
+static void scatter(const fcm_space *s, fcm_index e, const double *Ke, double *vals)
+{
+  const int nn = s->nn, nd = 3 * nn;
+  const fcm_index *ed = s->elem_dof + e * nn;
+  const int *off = s->elem_off + (size_t)e * nn * nn;
+  for (int a = 0; a < nn; a++)
+    for (int i = 0; i < 3; i++) {
+      double *dst = vals + s->row_ptr[ed[a] + i];
+      const double *src = Ke + (size_t)(3 * a + i) * nd;
+      for (int b = 0; b < nn; b++)
+        for (int k = 0; k < 3; k++)
+          dst[3 * off[a * nn + b] + k] += src[3 * b + k];
+    }
+}
+
+/* The terms of one point into fe / Ke (either may be NULL); returns its energy, NaN when the
+ * material gives NaN/Inf. */
+static double point_terms(const fcm_integrator *I, fcm_index p, const double *ue, int projected,
+                          fcm_index e, double *fe, double *Ke, double *Q)
+{
+  const sim_bpoints *bp = &I->bp;
+  const sim_bcon *bc = &I->bcons[bp->con[p]];
+  const int nn = I->space->nn, nd = 3 * nn;
+  const int *pc = bc->motion.components;
+  const double *N = bp->N + (size_t)p * nn, *G = bp->G + (size_t)p * nd, *nv = bp->nrm + 3 * p;
+  const double w = bp->w[p];
+  const int nitsche = bc->opts.method == FCM_BOUNDARY_NITSCHE;
+  const double gamma = nitsche ? bp->gamma[e] : bc->opts.penalty * I->mat.young / bp->hk[e];
+  double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, u[3] = {0, 0, 0}, gv[3], r[3], P[9], A[81];
+  for (int a = 0; a < nn; a++)
+    for (int i = 0; i < 3; i++) {
+      u[i] += N[a] * ue[3 * a + i];
+      for (int j = 0; j < 3; j++)
+        F[3 * i + j] += ue[3 * a + i] * G[3 * a + j];
+    }
+  if (bc->opts.displacement)
+    bc->opts.displacement(bc->opts.displacement_user, bp->X + 3 * p, nv, gv);
+  else
+    fcm_motion_eval(&bc->motion, bp->X + 3 * p, I->bc_time, gv, NULL);
+  for (int i = 0; i < 3; i++)
+    r[i] = pc[i] ? u[i] - gv[i] : 0.0;
+  double energy = 0.5 * gamma * (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+  if (fe)
+    for (int a = 0; a < nn; a++)
+      for (int i = 0; i < 3; i++)
+        fe[3 * a + i] += w * gamma * r[i] * N[a];
+  if (Ke)
+    for (int a = 0; a < nn; a++)
+      for (int b = 0; b < nn; b++)
+        for (int i = 0; i < 3; i++)
+          if (pc[i]) Ke[(size_t)(3 * a + i) * nd + 3 * b + i] += w * gamma * N[a] * N[b];
+  if (!nitsche) return w * energy;
+  const int want_A = fe || (Ke && !projected);
+  fcm__material_eval(&I->params, F, NULL, P, want_A ? A : NULL);
+  double t[3];
+  for (int i = 0; i < 3; i++)
+    t[i] = P[3 * i] * nv[0] + P[3 * i + 1] * nv[1] + P[3 * i + 2] * nv[2];
+  energy -= t[0] * r[0] + t[1] * r[1] + t[2] * r[2];
+  if (!isfinite(energy)) return NAN;
+  if (fe) {
+    double S[9] = {0}; /* S_iL = r_j N_J A_jJiL */
+    for (int j = 0; j < 3; j++)
+      for (int J = 0; J < 3; J++) {
+        const double c = r[j] * nv[J];
+        if (c == 0.0) continue;
+        const double *Ar = A + 9 * (3 * j + J);
+        for (int m = 0; m < 9; m++)
+          S[m] += c * Ar[m];
+      }
+    for (int a = 0; a < nn; a++) {
+      const double *ga = G + 3 * a;
+      for (int i = 0; i < 3; i++)
+        fe[3 * a + i] -= w * (S[3 * i] * ga[0] + S[3 * i + 1] * ga[1] + S[3 * i + 2] * ga[2] +
+                              (pc[i] ? t[i] * N[a] : 0.0));
+    }
+  }
+  if (Ke && !projected) {
+    /* Q_i(b,k) = B_ikL g_bL with B_ikL = A_iJkL N_J */
+    double B[27];
+    for (int i = 0; i < 3; i++)
+      for (int k = 0; k < 3; k++)
+        for (int L = 0; L < 3; L++)
+          B[9 * i + 3 * k + L] = A[9 * (3 * i) + 3 * k + L] * nv[0] +
+                                 A[9 * (3 * i + 1) + 3 * k + L] * nv[1] +
+                                 A[9 * (3 * i + 2) + 3 * k + L] * nv[2];
+    for (int i = 0; i < 3; i++)
+      for (int b = 0; b < nn; b++) {
+        const double *gb = G + 3 * b;
+        for (int k = 0; k < 3; k++) {
+          const double *Bk = B + 9 * i + 3 * k;
+          Q[i * nd + 3 * b + k] = Bk[0] * gb[0] + Bk[1] * gb[1] + Bk[2] * gb[2];
+        }
+      }
+    /* Ke -= w (V Q + Q^T V^T), V_(a,i),i = p_i N_a */
+    for (int a = 0; a < nn; a++)
+      for (int i = 0; i < 3; i++) {
+        if (!pc[i]) continue;
+        const double c = w * N[a];
+        const double *Qi = Q + i * nd;
+        double *row = Ke + (size_t)(3 * a + i) * nd;
+        for (int y = 0; y < nd; y++) {
+          row[y] -= c * Qi[y];
+          Ke[(size_t)y * nd + 3 * a + i] -= c * Qi[y];
+        }
+      }
+    const double rn = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    if (!I->linear && rn > 0.0) {
+      /* dA along D = r (x) N by central differences, step h along D/|D| (|N| = 1) */
+      const double hstep = 1e-5;
+      double Fp[9], Fm[9], Ap[81], Am[81];
+      for (int i = 0; i < 3; i++)
+        for (int J = 0; J < 3; J++) {
+          const double d = hstep * r[i] / rn * nv[J];
+          Fp[3 * i + J] = F[3 * i + J] + d;
+          Fm[3 * i + J] = F[3 * i + J] - d;
+        }
+      fcm__material_eval(&I->params, Fp, NULL, NULL, Ap);
+      fcm__material_eval(&I->params, Fm, NULL, NULL, Am);
+      const double sc = w * rn / (2.0 * hstep);
+      for (int m = 0; m < 81; m++)
+        Ap[m] = sc * (Ap[m] - Am[m]);
+      /* C[i][J][k] = dA_iJkL g_bL, then Ke_(a,i)(b,k) -= g_aJ C[i][J][k] */
+      for (int b = 0; b < nn; b++) {
+        const double *gb = G + 3 * b;
+        double C[27];
+        for (int m = 0; m < 27; m++)
+          C[m] = Ap[3 * m] * gb[0] + Ap[3 * m + 1] * gb[1] + Ap[3 * m + 2] * gb[2];
+        for (int a = 0; a < nn; a++) {
+          const double *ga = G + 3 * a;
+          for (int i = 0; i < 3; i++) {
+            double *row = Ke + (size_t)(3 * a + i) * nd + 3 * b;
+            for (int k = 0; k < 3; k++)
+              row[k] -= ga[0] * C[9 * i + k] + ga[1] * C[9 * i + 3 + k] + ga[2] * C[9 * i + 6 + k];
+          }
+        }
+      }
+    }
+  }
+  return w * energy;
+}
+
+fcm_status fcm__sim_boundary_assemble(fcm_integrator *I, const double *x, int projected,
+                                      double *energy, double *force, fcm_csr *T, int *finite)
+{
+  const fcm_space *s = I->space;
+  const sim_bpoints *bp = &I->bp;
+  const int nn = s->nn, nd = 3 * nn;
+  const size_t per = (size_t)nd * (nd + 2) + 9 * (size_t)nn;
+  double *vals = T ? fcm_csr_values(T) : NULL, etot = 0.0;
+  if (I->bcon_active == 0) return FCM_OK;
+  /* colour by colour (no two elements of a colour share a DOF copy), in parallel within a
+   * colour; energies summed in element order: the result does not depend on the threads */
+  for (int c = 0; c < bp->num_colors; c++) {
+    const fcm_index j0 = bp->color_ptr[c], j1 = bp->color_ptr[c + 1];
+    if (j0 == j1) continue;
+#pragma omp parallel num_threads(bp->nthreads) if (j1 - j0 > 1)
+    {
+      double *ue = bp->scratch + per * (size_t)omp_get_thread_num(), *fe = ue + nd;
+      double *Ke = fe + nd, *Q = Ke + (size_t)nd * nd;
+#pragma omp for schedule(dynamic, 4)
+      for (fcm_index j = j0; j < j1; j++) {
+        const fcm_index k = bp->color_k[j], e = bp->elem[k];
+        const fcm_index *ed = s->elem_dof + e * nn;
+        double ek = 0.0;
+        int any = 0;
+        for (int a = 0; a < nn; a++)
+          memcpy(ue + 3 * a, x + ed[a], 3 * sizeof(double));
+        if (force) memset(fe, 0, sizeof(double) * (size_t)nd);
+        if (T) memset(Ke, 0, sizeof(double) * (size_t)nd * nd);
+        for (fcm_index p = bp->ptr[k]; p < bp->ptr[k + 1]; p++) {
+          if (!I->bcon_on[bp->con[p]]) continue;
+          any = 1;
+          ek += point_terms(I, p, ue, projected, e, force ? fe : NULL, T ? Ke : NULL, Q);
+        }
+        bp->eelem[k] = ek;
+        if (!any || !isfinite(ek)) continue;
+        if (force)
+          for (int a = 0; a < nn; a++)
+            for (int i = 0; i < 3; i++)
+              force[ed[a] + i] += fe[3 * a + i];
+        if (T) scatter(s, e, Ke, vals);
+      }
+    }
+  }
+  for (fcm_index k = 0; k < bp->nelem; k++)
+    etot += bp->eelem[k];
+  if (!isfinite(etot)) *finite = 0;
+  if (energy) *energy += etot;
+  if (force)
+    for (fcm_index i = 0; i < I->n; i++)
+      if (!isfinite(force[i])) *finite = 0;
+  return FCM_OK;
+}
+
+int fcm__sim_boundary_time(fcm_integrator *I, double t)
+{
+  int changed = 0, active = 0;
+  I->bc_time = t;
+  for (int k = 0; k < I->num_bcons; k++) {
+    const unsigned char on = (unsigned char)fcm_motion_active(&I->bcons[k].motion, t);
+    changed |= on != I->bcon_on[k];
+    I->bcon_on[k] = on;
+    active += on;
+  }
+  I->bcon_active = active;
+  return changed;
+}
+
+/* The largest gamma of the k-th element with points (Nitsche's, or a penalty point's). */
+static double element_max_penalty(const fcm_integrator *I, fcm_index k)
+{
+  const sim_bpoints *bp = &I->bp;
+  const fcm_index e = bp->elem[k];
+  double g = bp->gamma[e];
+  for (fcm_index p = bp->ptr[k]; p < bp->ptr[k + 1]; p++) {
+    const sim_bcon *bc = &I->bcons[bp->con[p]];
+    if (bc->opts.method == FCM_BOUNDARY_PENALTY)
+      g = FCM_MAX(g, bc->opts.penalty * I->mat.young / bp->hk[e]);
+  }
+  return g;
+}
+
+double fcm_integrator_boundary_penalty(const fcm_integrator *I, fcm_index elem)
+{
+  if (!I || !I->bp.gamma || elem < 0 || elem >= I->space->num_elems) return 0.0;
+  const sim_bpoints *bp = &I->bp;
+  fcm_index lo = 0, hi = bp->nelem; /* elements with points are sorted */
+  while (lo < hi) {
+    const fcm_index mid = lo + (hi - lo) / 2;
+    if (bp->elem[mid] < elem)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo < bp->nelem && bp->elem[lo] == elem ? element_max_penalty(I, lo) : 0.0;
+}
+
+fcm_status fcm_integrator_boundary_eval(fcm_integrator *I, const double *u, double t,
+                                        double *energy, double *force, fcm_csr *tangent)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
+  fcm_ctx *ctx = I->ctx;
+  FCM_CHECK(I->is_setup && u, ctx, FCM_ERR_ARG,
+            "boundary eval: NULL displacement, or the integrator is not set up");
+  if (tangent) {
+    fcm_index nr = -1, nc = -1, nnz = -1;
+    fcm_csr_get_size(tangent, &nr, &nc, &nnz);
+    FCM_CHECK(nr == I->n && nc == I->n && nnz == I->space->row_ptr[I->n], ctx, FCM_ERR_ARG,
+              "boundary eval: the matrix does not have the space's pattern (use "
+              "fcm_space_matrix_create())");
+  }
+  {
+    const double t_saved = I->bc_time;
+    int finite = 1;
+    double e = 0.0;
+    fcm__sim_boundary_time(I, t);
+    st = fcm__sim_boundary_assemble(I, u, I->params.project_psd, &e, force, tangent, &finite);
+    fcm__sim_boundary_time(I, t_saved);
+    FCM_TRY(ctx, st);
+    FCM_CHECK(finite, ctx, FCM_ERR_NUMERIC,
+              "boundary eval: the material returned NaN or infinity at a boundary point");
+    if (energy) *energy = e;
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm_integrator_boundary_reaction(const fcm_integrator *I, int id, double force[3],
+                                            double moment[3])
+{
+  fcm_status st = FCM_OK;
+  double Fr[3] = {0, 0, 0}, Mr[3] = {0, 0, 0};
+  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
+  FCM_CHECK(I->is_setup, I->ctx, FCM_ERR_ARG, "boundary reaction: the integrator is not set up");
+  FCM_CHECK(id >= 0 && id < I->num_bcons, I->ctx, FCM_ERR_ARG,
+            "boundary reaction: constraint %d out of range [0, %d)", id, I->num_bcons);
+  {
+    const sim_bpoints *bp = &I->bp;
+    const sim_bcon *bc = &I->bcons[id];
+    const fcm_space *s = I->space;
+    const int nn = s->nn, nd = 3 * nn;
+    const int nitsche = bc->opts.method == FCM_BOUNDARY_NITSCHE;
+    if (!fcm_motion_active(&bc->motion, I->t)) goto cleanup;
+    for (fcm_index k = 0; k < bp->nelem; k++) {
+      const fcm_index e = bp->elem[k];
+      const fcm_index *ed = s->elem_dof + e * nn;
+      for (fcm_index p = bp->ptr[k]; p < bp->ptr[k + 1]; p++) {
+        if (bp->con[p] != id) continue;
+        const double *N = bp->N + (size_t)p * nn, *G = bp->G + (size_t)p * nd;
+        const double *X = bp->X + 3 * p, *nv = bp->nrm + 3 * p;
+        const double gamma = nitsche ? bp->gamma[e] : bc->opts.penalty * I->mat.young / bp->hk[e];
+        double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, u[3] = {0, 0, 0}, gv[3], R[3], P[9];
+        for (int a = 0; a < nn; a++)
+          for (int i = 0; i < 3; i++) {
+            const double ua = I->u[ed[a] + i];
+            u[i] += N[a] * ua;
+            for (int j = 0; j < 3; j++)
+              F[3 * i + j] += ua * G[3 * a + j];
+          }
+        if (bc->opts.displacement)
+          bc->opts.displacement(bc->opts.displacement_user, X, nv, gv);
+        else
+          fcm_motion_eval(&bc->motion, X, I->t, gv, NULL);
+        if (nitsche) fcm__material_eval(&I->params, F, NULL, P, NULL);
+        for (int i = 0; i < 3; i++) {
+          const double r = bc->motion.components[i] ? u[i] - gv[i] : 0.0;
+          const double t = nitsche && bc->motion.components[i]
+                               ? P[3 * i] * nv[0] + P[3 * i + 1] * nv[1] + P[3 * i + 2] * nv[2]
+                               : 0.0;
+          R[i] = bp->w[p] * (t - gamma * r);
+          Fr[i] += R[i];
+        }
+        const double x[3] = {X[0] + u[0], X[1] + u[1], X[2] + u[2]};
+        Mr[0] += x[1] * R[2] - x[2] * R[1];
+        Mr[1] += x[2] * R[0] - x[0] * R[2];
+        Mr[2] += x[0] * R[1] - x[1] * R[0];
+      }
+    }
+  }
+cleanup:
+  if (st == FCM_OK) {
+    if (force) memcpy(force, Fr, sizeof Fr);
+    if (moment) memcpy(moment, Mr, sizeof Mr);
+  }
+  return st;
+}
