@@ -145,9 +145,8 @@ static void fictitious_eval(const kernel_data *kd, const double F[9], double *ps
 }
 
 /* Jacobian at point q of rule r: physical gradients g (nn x 3); returns det J. */
-static double physical_gradients(const cell_rule *r, int nn, int q, const double *X, double *g)
+double fcm__fem_gradients(int nn, const double *X, const double *dN, double *g)
 {
-  const double *dN = r->dN + (size_t)q * nn * 3;
   double J[9] = {0}, Ji[9] = {0};
   for (int a = 0; a < nn; a++)
     for (int i = 0; i < 3; i++)
@@ -158,6 +157,11 @@ static double physical_gradients(const cell_rule *r, int nn, int q, const double
   for (int a = 0; a < nn; a++)
     fcm__mat3_tmulv(Ji, dN + 3 * a, g + 3 * a);
   return det;
+}
+
+static double physical_gradients(const cell_rule *r, int nn, int q, const double *X, double *g)
+{
+  return fcm__fem_gradients(nn, X, r->dN + (size_t)q * nn * 3, g);
 }
 
 /* Fill the lower node blocks of a symmetric element matrix from the upper ones. */

@@ -55,4 +55,8 @@ struct fcm_space {
  * nothing: the integrator calls it every Newton iteration with its own marks. (space.c) */
 void fcm__eliminate_marked(fcm_csr *A, double *b, const unsigned char *con, const double *g);
 
+/* Physical shape-function gradients g (nn x 3) at a point from the reference ones dN (nn x 3)
+ * and the nodal coordinates X (nn x 3); returns det J (not positive: g is not written). */
+double fcm__fem_gradients(int nn, const double *X, const double *dN, double *g);
+
 #endif /* FCM_FEM_IMPL_H */

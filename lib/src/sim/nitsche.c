@@ -118,17 +118,9 @@ void fcm__sim_boundary_free(fcm_integrator *I)
 static double gradients(fcm_element_type type, int nn, const double *X, const double xi[3],
                         double *g)
 {
-  double dN[3 * FCM_ELEMENT_MAX_NODES], J[9] = {0}, Ji[9];
+  double dN[3 * FCM_ELEMENT_MAX_NODES];
   fcm_element_eval_grad(type, xi, dN);
-  for (int a = 0; a < nn; a++)
-    for (int i = 0; i < 3; i++)
-      for (int j = 0; j < 3; j++)
-        J[3 * i + j] += X[3 * a + i] * dN[3 * a + j];
-  double det = fcm__mat3_inv(J, Ji);
-  if (!(det > 0.0)) return det;
-  for (int a = 0; a < nn; a++)
-    fcm__mat3_tmulv(Ji, dN + 3 * a, g + 3 * a);
-  return det;
+  return fcm__fem_gradients(nn, X, dN, g);
 }
 
 /* The boundary constraint that holds a point: the first that selects it, or -1. */
