@@ -1,7 +1,7 @@
 /* fcm-converge: the problems of the convergence study and one run of it — FCM on the exact
  * embedded hemisphere or staircase FEM, linear elasticity, CHOLMOD, L2/H1 errors.
  *
- * Manufactured problem (DESIGN §11's advice): on the polyhedral domain Omega (the tet mesh
+ * Manufactured problem (lib/METHOD.md §10): on the polyhedral domain Omega (the tet mesh
  * of the hemisphere) the exact field is u_i = A_i sin(k_i . x + phi_i); the body force is
  * b = -div sigma(u), the traction on the curved boundary sigma(u) n with n the facet
  * normal (or, method fcm-nitsche, u = u_exact on the curved boundary imposed weakly by

@@ -1,4 +1,4 @@
-/* fcm — time integration of hyperelastic solids on a space (DESIGN §8): static Newton with
+/* fcm — time integration of hyperelastic solids on a space (lib/METHOD.md §8): static Newton with
  * load steps and backward Euler on the incremental potential, Newton with a backtracking
  * line search on the energy, the stopping rule of Longva et al. (2020) §6, optional Rayleigh
  * damping, prescribed motion of node sets and, weakly (Nitsche's method or a penalty), of the

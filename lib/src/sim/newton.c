@@ -1,7 +1,7 @@
 /* sim: one integrator step — substeps with halving on failure, and per substep Newton's
  * method with a backtracking (Armijo) line search on the incremental potential.
  *
- * DESIGN §8 and Longva et al. (2020) §3, §6: backward Euler minimizes
+ * lib/METHOD.md §8 and Longva et al. (2020) §3, §6: backward Euler minimizes
  * E(u) = 1/2 |u - u^|_M^2 / h^2 + Psi(u) - f^T u (+ 1/(2h) |u - u_n|_D^2); its gradient is
  * M v' - f_total, and the Newton loop stops when that is below 1e-5 |M a_rep| (the paper's
  * rule; a_rep = gravity) or below a relative threshold. Prescribed motion enters through
