@@ -384,8 +384,15 @@ FCM_API fcm_status fcm_space_interpolate(const fcm_space *space, fcm_index n, co
 
 /** Number of stress components and their order (VTK's symmetric-tensor order, so ParaView
  * labels the components correctly). */
-enum { FCM_STRESS_XX = 0, FCM_STRESS_YY, FCM_STRESS_ZZ, FCM_STRESS_XY, FCM_STRESS_YZ,
-       FCM_STRESS_XZ, FCM_STRESS_COMPONENTS };
+enum {
+  FCM_STRESS_XX = 0,
+  FCM_STRESS_YY,
+  FCM_STRESS_ZZ,
+  FCM_STRESS_XY,
+  FCM_STRESS_YZ,
+  FCM_STRESS_XZ,
+  FCM_STRESS_COMPONENTS
+};
 
 /** A DOF vector (num_dofs, e.g. u or v) as one 3-vector per background node:
  * node_field[3a .. 3a+3) for node a of the mesh; inactive nodes get 0. A node that cuts

@@ -956,9 +956,9 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   }
   S->c.steps++;
   for (int k = 0; k < S->num_react; k++)
-    FCM_TRY(S->ctx, constraint_reaction(S, k,
-                                        S->react_log + 6 * ((size_t)S->log_n * (size_t)S->num_react +
-                                                            (size_t)k)));
+    FCM_TRY(S->ctx,
+            constraint_reaction(
+                S, k, S->react_log + 6 * ((size_t)S->log_n * (size_t)S->num_react + (size_t)k)));
   fcm__log_row *r = &S->log[S->log_n++];
   r->time = si.time;
   r->newton = si.newton_iterations;
@@ -1090,11 +1090,10 @@ fcm_status fcm_simulation_write_log(fcm_simulation *S, const char *path)
   for (long long k = 0; k < S->log_n; k++) {
     const fcm__log_row *r = &S->log[k];
     FCM_TRY(S->ctx,
-            fcm__io_atomic_printf(S->ctx, &af,
-                                  "%lld,%.17g,%lld,%lld,%.17g,%.17g,%lld,%.17g,%.17g,%.17g,%.17g",
-                                  k + 1, r->time, r->newton, r->linear, r->residual, r->energy,
-                                  r->pieces, r->mass, r->momentum[0], r->momentum[1],
-                                  r->momentum[2]));
+            fcm__io_atomic_printf(
+                S->ctx, &af, "%lld,%.17g,%lld,%lld,%.17g,%.17g,%lld,%.17g,%.17g,%.17g,%.17g", k + 1,
+                r->time, r->newton, r->linear, r->residual, r->energy, r->pieces, r->mass,
+                r->momentum[0], r->momentum[1], r->momentum[2]));
     for (int j = 0; j < 6 * S->num_react; j++)
       FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, ",%.17g",
                                             S->react_log[(size_t)k * 6 * S->num_react + j]));

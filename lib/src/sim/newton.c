@@ -97,8 +97,8 @@ static fcm_status assemble_tangent(fcm_integrator *I, double h, const double *x,
 {
   fcm_status st = FCM_OK;
   fcm__sim_set_base(I, h, I->H);
-  FCM_TRY(I->ctx, assemble(I, projected ? &I->params_psd : &I->params, x, NULL, NULL, I->H,
-                           finite, stats));
+  FCM_TRY(I->ctx,
+          assemble(I, projected ? &I->params_psd : &I->params, x, NULL, NULL, I->H, finite, stats));
   if (*finite) FCM_TRY(I->ctx, assemble_boundary(I, x, projected, NULL, NULL, I->H, finite, stats));
 cleanup:
   return st;
@@ -124,8 +124,8 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
   FCM_TRY(I->ctx,
           assemble(I, &I->params, x, &psi, fint, tangent ? I->H : NULL, &out->finite, stats));
   if (!out->finite) return FCM_OK;
-  FCM_TRY(I->ctx, assemble_boundary(I, x, 0, &bnd, fint, tangent ? I->H : NULL, &out->finite,
-                                    stats));
+  FCM_TRY(I->ctx,
+          assemble_boundary(I, x, 0, &bnd, fint, tangent ? I->H : NULL, &out->finite, stats));
   if (!out->finite) return FCM_OK;
   {
     double t0 = fcm_wtime();
@@ -316,7 +316,8 @@ static fcm_status newton_direction(fcm_integrator *I, double h, int predictor, d
     I->bc_psd_only = 1;
     I->h_state = SIM_H_INVALID;
     st = build_system(I, h, predictor, 0, reason, stats);
-    if (st == FCM_OK && *reason == FCM_STEP_NONE) st = direction(I, predictor, reason, &its2, stats);
+    if (st == FCM_OK && *reason == FCM_STEP_NONE)
+      st = direction(I, predictor, reason, &its2, stats);
     I->bc_psd_only = 0;
     I->h_state = SIM_H_INVALID;
     FCM_TRY(I->ctx, st);
