@@ -57,6 +57,7 @@ typedef struct fcm_simulation_counters {
   int constraints;             /**< constraint sets (fixed and motion effects) */
   fcm_index constrained_nodes; /**< background nodes named by them (with or without DOFs) */
   fcm_index constrained_dofs;  /**< constrained DOFs after setup */
+  fcm_index boundary_points;   /**< embedded-boundary points held by `boundary` constraints */
   fcm_index schwarz_blocks;    /**< cut cells given a Schwarz block (0: no Schwarz set up) */
   int krylov;                  /**< 1: Krylov solves; 0: direct */
   long long steps;             /**< accepted steps */

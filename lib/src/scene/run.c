@@ -833,6 +833,7 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
     S->c.body_force_assemblies = si.body_force_assemblies;
     S->c.traction_assemblies = si.traction_assemblies;
     S->c.scale_assemblies = si.scale_assemblies;
+    S->c.boundary_points = si.boundary_points;
   }
   S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);
   if (S->c.inertia) FCM_TRY(ctx, initialize_effects(S));
@@ -1241,8 +1242,9 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
   line(f, c->damping, "Rayleigh damping matrix", c->damping ? "" : "(no damping)");
   snprintf(b, sizeof b, "%d", c->initial_velocity);
   line(f, c->initial_velocity > 0, "initial velocities", c->initial_velocity ? b : "(none)");
-  snprintf(b, sizeof b, "%d sets, %lld nodes, %lld DOFs", c->constraints,
-           (long long)c->constrained_nodes, (long long)c->constrained_dofs);
+  snprintf(b, sizeof b, "%d sets, %lld nodes, %lld DOFs, %lld embedded-boundary points",
+           c->constraints, (long long)c->constrained_nodes, (long long)c->constrained_dofs,
+           (long long)c->boundary_points);
   line(f, c->constraints > 0, "constraints", c->constraints ? b : "(none)");
   snprintf(b, sizeof b, "%lld blocks", (long long)c->schwarz_blocks);
   line(f, c->schwarz_blocks > 0, "Schwarz blocks",
