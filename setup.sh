@@ -4,6 +4,10 @@
 #   bash setup.sh test    install what is missing, build, run the default test suite
 #   bash setup.sh bench   build and run the benchmarks (ctest label "bench")
 #   bash setup.sh deps    only install the Debian packages
+#   bash setup.sh install-check
+#                         build, install into a temporary prefix, move it, and build and run
+#                         the example host programs (apps/examples) against the installed
+#                         package with `pkg-config --cflags --libs fcm` and find_package(fcm)
 # Environment: FCM_BUILD_DIR (default: build), FCM_CMAKE_ARGS (extra CMake arguments),
 #              FCM_JOBS (parallel build jobs, default: number of cores).
 set -euo pipefail
@@ -34,6 +38,64 @@ configure_and_build() {
   cmake --build "$build" -j "$jobs"
 }
 
+# Install the build into a temporary prefix, move the tree (nothing may hard-code the build
+# machine or the install location), then build the example host programs installed with it
+# (share/doc/fcm/examples) against it both ways
+# and run them: the C one with `cc ... $(pkg-config --cflags --libs fcm)` (no --static, no
+# other flag), both with find_package(fcm) from apps/examples/CMakeLists.txt. FCM_KEEP_PREFIX=1
+# keeps the prefix (printed) for a look.
+install_check() {
+  local prefix pkgdir pcdir src ex
+  prefix=$(mktemp -d)
+  [ "${FCM_KEEP_PREFIX:-0}" = 1 ] || trap "rm -rf '$prefix'" RETURN
+  cmake --install "$build" --prefix "$prefix/staging" >/dev/null
+  mv "$prefix/staging" "$prefix/fcm"
+  pkgdir=$(dirname "$(find "$prefix/fcm" -name fcmConfig.cmake)")
+  if grep -nE '(^|[";( :])/[A-Za-z]|staging' "$pkgdir"/fcmTargets*.cmake; then
+    echo "install check: the exported targets hard-code paths (above)" >&2
+    return 1
+  fi
+  # a shared libfcm exports the public API (fcm_*) only: no internal fcm__ function, no
+  # symbol of another name (OpenMP's named critical sections aside)
+  local so bad
+  so=$(find "$prefix/fcm" -name 'libfcm.so.*' -type f | head -n 1)
+  if [ -n "$so" ]; then
+    bad=$(nm -D --defined-only "$so" | awk '{print $3}' |
+          grep -vE '^(fcm_[A-Za-z0-9]|\.gomp_critical_user_)' || true)
+    if [ -n "$bad" ]; then
+      echo "install check: libfcm exports symbols outside the public API:" >&2
+      echo "$bad" | head -n 20 >&2
+      return 1
+    fi
+  fi
+  pcdir=$(dirname "$(find "$prefix/fcm" -name fcm.pc)")
+  src=$(dirname "$(find "$prefix/fcm" -path '*/examples/host_static.c')")
+  [ -f "$src/host_dynamic.cpp" ] && [ -f "$src/CMakeLists.txt" ]
+  ex="$prefix/examples"
+  mkdir -p "$ex/out-pc" "$ex/out-cmake"
+  # pkg-config, as a user would type it
+  # shellcheck disable=SC2046
+  cc -std=c11 "$src/host_static.c" -o "$ex/host_static-pc" \
+    $(PKG_CONFIG_PATH="$pcdir" pkg-config --cflags --libs fcm)
+  # shellcheck disable=SC2046
+  c++ -std=c++11 "$src/host_dynamic.cpp" -o "$ex/host_dynamic-pc" \
+    $(PKG_CONFIG_PATH="$pcdir" pkg-config --cflags --libs fcm)
+  "$ex/host_static-pc" "$ex/out-pc" >/dev/null
+  [ -s "$ex/out-pc/host_static_surface.vtu" ] && [ -s "$ex/out-pc/host_static_background.vtu" ]
+  # CMake, find_package(fcm)
+  cmake -S "$src" -B "$ex/build" -DCMAKE_PREFIX_PATH="$prefix/fcm" >/dev/null
+  cmake --build "$ex/build" >/dev/null
+  "$ex/build/host_static" "$ex/out-cmake" >/dev/null
+  "$ex/build/host_dynamic" "$ex/out-cmake" >/dev/null
+  [ -s "$ex/out-cmake/host_dynamic_surface.vtu" ]
+  # the installed programs find the moved libfcm through their $ORIGIN rpath
+  if [ -x "$prefix/fcm/bin/fcm-sim" ]; then "$prefix/fcm/bin/fcm-sim" --help >/dev/null; fi
+  echo "install check: examples built against the installed package (pkg-config and"\
+       "find_package) and run: host_static, host_dynamic"
+  [ "${FCM_KEEP_PREFIX:-0}" = 1 ] && echo "install check: prefix kept: $prefix"
+  return 0
+}
+
 case "${1:-}" in
   deps) deps ;;
   demo)
@@ -47,13 +109,18 @@ case "${1:-}" in
     configure_and_build
     (cd "$build" && ctest --output-on-failure -j "$jobs" -LE 'bench|slow')
     ;;
+  install-check)
+    deps
+    configure_and_build
+    install_check
+    ;;
   bench)
     deps
     configure_and_build
     (cd "$build" && ctest --output-on-failure -L bench)
     ;;
   *)
-    sed -n '2,9p' "$0"
+    sed -n '2,13p' "$0"
     exit 2
     ;;
 esac

@@ -1,4 +1,4 @@
-/* fcm-condition: the conditioning study of Longva et al. 2020, §5.4 / Fig. 5 (DESIGN §7):
+/* fcm-condition: the conditioning study of Longva et al. 2020, §5.4 / Fig. 5 (lib/METHOD.md §7):
  * kappa(S A) of a backward-Euler step A = M + dt^2 K(u) on a 4x4x4 grid of [0, 4/3]^3 with
  * the box [0, 1 + eps/3]^3 embedded, for S in {none, Jacobi, Schwarz (clamp and as printed)}
  * with and without quadrature stabilization, plus MINRES iteration counts on the same systems.

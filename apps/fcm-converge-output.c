@@ -319,8 +319,8 @@ static int write_blocks(FILE *f, const cv_result *res, int nres, int cpu,
   return nb;
 }
 
-static void plot_series(FILE *f, int have[FCM_ELEMENT_COUNT][CV_METHOD_COUNT], const char *xcol, const char *ycol,
-                        const cv_rate *rates, int nrates, int norm)
+static void plot_series(FILE *f, int have[FCM_ELEMENT_COUNT][CV_METHOD_COUNT], const char *xcol,
+                        const char *ycol, const cv_rate *rates, int nrates, int norm)
 {
   int first = 1;
   for (int e = 0; e < FCM_ELEMENT_COUNT; e++)

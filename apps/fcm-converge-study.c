@@ -1,7 +1,7 @@
 /* fcm-converge: the problems of the convergence study and one run of it — FCM on the exact
  * embedded hemisphere or staircase FEM, linear elasticity, CHOLMOD, L2/H1 errors.
  *
- * Manufactured problem (DESIGN §11's advice): on the polyhedral domain Omega (the tet mesh
+ * Manufactured problem (lib/METHOD.md §10): on the polyhedral domain Omega (the tet mesh
  * of the hemisphere) the exact field is u_i = A_i sin(k_i . x + phi_i); the body force is
  * b = -div sigma(u), the traction on the curved boundary sigma(u) n with n the facet
  * normal (or, method fcm-nitsche, u = u_exact on the curved boundary imposed weakly by
@@ -819,7 +819,7 @@ fcm_status cv_error_rules_create(cv_study *S, const fcm_mesh *mesh, fcm_cell_rul
 {
   fcm_cell_rules_options o = fcm_cell_rules_options_default();
   o.strength[FCM_RULE_STIFFNESS] = S->s.error_strength;
-  o.strength[FCM_RULE_MASS] = 0;
+  o.kinds = FCM_RULES_STIFFNESS; /* errors need no mass rules */
   o.simplify = 0;
   o.stabilization.mode = FCM_STABILIZATION_OFF;
   o.min_fraction = 0.0;
@@ -973,7 +973,7 @@ fcm_status cv_run(cv_study *S, const fcm_mesh *mesh, const fcm_cell_rules *err_r
   if (method == CV_FCM || method == CV_NITSCHE) {
     fcm_cell_rules_options o = fcm_cell_rules_options_default();
     o.strength[FCM_RULE_STIFFNESS] = strength;
-    o.strength[FCM_RULE_MASS] = 0; /* static problem: no mass matrix */
+    o.kinds = FCM_RULES_STIFFNESS; /* static problem: no mass rules */
     o.surface_strength = S->s.surface_strength >= 0 ? S->s.surface_strength : 2 * info->order + 2;
     o.simplify = simplify;
     o.min_fraction = S->s.min_fraction;

@@ -17,8 +17,8 @@
 
 /** The discretizations compared. */
 typedef enum cv_method {
-  CV_FCM = 0, /* exact embedded geometry, cut-cell rules */
-  CV_FEM = 1, /* staircase: cells whose centroid is inside, full standard rules */
+  CV_FCM = 0,     /* exact embedded geometry, cut-cell rules */
+  CV_FEM = 1,     /* staircase: cells whose centroid is inside, full standard rules */
   CV_NITSCHE = 2, /* FCM with the exact displacement imposed weakly (symmetric Nitsche) on the
                      curved boundary instead of the traction ("fcm-nitsche", --boundary nitsche) */
   CV_METHOD_COUNT

@@ -6,9 +6,10 @@
  * y = 0) in the background box [-1,1] x [0,1] x [-1,1] with h = 1/res, for Tet4, Tet10,
  * Hex8 and Hex20 grids; a manufactured solution makes the exact error known (see
  * fcm-converge-study.c; the curved boundary carries its traction or, with --boundary nitsche,
- * its displacement imposed by symmetric Nitsche), or --reference runs the authors' localized-load problem against a
- * boundary-conforming Tet10 reference. `payoff` measures, per element and rule kind, the
- * simplification time and the assembly time it saves: the break-even number of assemblies. */
+ * its displacement imposed by symmetric Nitsche), or --reference runs the authors' localized-load
+ * problem against a boundary-conforming Tet10 reference. `payoff` measures, per element and rule
+ * kind, the simplification time and the assembly time it saves: the break-even number of
+ * assemblies. */
 #include "app_env.h"
 #include "cli.h"
 #include "fcm-converge-study.h"
@@ -139,8 +140,8 @@ static void option_table(unsigned cmd, config *c, parse_state *p, cli_option t[N
         "(default all)",
         0, 0, 0, NULL, parse_elements, NULL}},
       {CMD_STUDY,
-       {"--methods", NULL, CLI_CUSTOM, c, "LIST", "fcm,fem,fcm-nitsche (default fcm,fem)", 0, 0, 0, NULL,
-        parse_methods, NULL}},
+       {"--methods", NULL, CLI_CUSTOM, c, "LIST", "fcm,fem,fcm-nitsche (default fcm,fem)", 0, 0, 0,
+        NULL, parse_methods, NULL}},
       {CMD_STUDY,
        {"--levels", NULL, CLI_CUSTOM, &p->levels, "LIST",
         "resolutions res in [1, 64], h = 1/res (default 2,3,4,6,8)", 0, 0, 0, NULL, parse_int_list,

@@ -1,5 +1,5 @@
 /* Rule storage and its options: uncut cells get the catalogue rule of the element's
- * strengths (DESIGN §3 defaults per kind), cut cells authentic points then stabilization
+ * strengths (lib/METHOD.md §3 defaults per kind), cut cells authentic points then stabilization
  * points (the full cell's rule times alpha, flag 1) per mode (mass + stiffness, mass only,
  * off), simplified counts <= M with the statistics adding up; the point dump lists every
  * point with X = map(xi) and w_phys = w_ref det J; the output is identical for 1, 2 and 3

@@ -31,6 +31,10 @@ fcm_add_test(embed_limits tests/embed/limits.c)
 # error with both boxes), the progress callback, voxel and level-set bodies embedded.
 fcm_add_test(embed_diagnostics tests/embed/diagnostics.c)
 fcm_add_test(embed_cut tests/embed/cut.c)
+# Rule kinds asked for (fcm_cell_rules_options.kinds): stiffness alone builds no mass points
+# and gives the same stiffness rules; the kind not built is FCM_ERR_ARG (accessors, mass
+# matrix, momentum); a cut keeps the kinds; bad kind sets rejected.
+fcm_add_test(embed_kinds tests/embed/kinds.c)
 # Random XFEM cuts (planes and V-shaped cuts through nodes, midpoints and quarter points,
 # shifted by 0 .. 1e-6): every cell's volume conserved within 1e-12; the few degenerate
 # ones are shifted by fcm_cell_rules_create_cut() (FCM_TEST_VERBOSE=1 prints how many).

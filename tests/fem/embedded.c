@@ -53,7 +53,7 @@ int main(int argc, char **argv)
     xc[d] = X[3 * i];
   }
   /* Stiffness on the stabilized embedded body: six rigid modes, no spurious zero modes
-   * (without stabilization tiny cut cells give near-zero eigenvalues, DESIGN §7). */
+   * (without stabilization tiny cut cells give near-zero eigenvalues, lib/METHOD.md §7). */
   TEST_OK(ctx, fcm_space_matrix_create(space, &K));
   fcm_material kmat = {FCM_MATERIAL_LINEAR, 1.0e3, 0.3, 1.0};
   TEST_OK(ctx, fcm_assemble_stiffness(space, &kmat, NULL, K));

@@ -81,7 +81,7 @@ static void check_rest_and_invariance(int model)
   for (int i = 0; i < 9; i++)
     TEST_NEAR(P[i], 0.0, 0.0, 1e-12 * stress_scale);
 
-  /* Energy at rest, from (E, nu) and the DESIGN §8 constants written out here. */
+  /* Energy at rest, from (E, nu) and the lib/METHOD.md §8 constants written out here. */
   double psi_rest = 0.0;
   if (model == FCM_MATERIAL_STABLE_NEO_HOOKEAN) {
     double ms = 4.0 * mu_ref / 3.0, ls = lambda_ref + 5.0 * mu_ref / 6.0;

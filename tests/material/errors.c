@@ -1,6 +1,6 @@
 /* Material error paths and defined behaviour on bad input: invalid parameters give
  * FCM_ERR_ARG with a message naming the value and the range; model names map both
- * ways; the setup derives the textbook Lame parameters and the DESIGN §8 SNH constants;
+ * ways; the setup derives the textbook Lame parameters and the lib/METHOD.md §8 SNH constants;
  * a NaN or infinite F (and an invalid model in the parameters) yields NaN in every
  * requested output for every model, with and without projection, while a finite
  * degenerate F (zero, rank one, -I) gives finite outputs; nothing allocates. */
@@ -53,7 +53,7 @@ int main(void)
   TEST_ERR(ctx, fcm_material_setup(ctx, &m, &p), FCM_ERR_ARG, "nu = 0.7");
   TEST_TRUE(memcmp(&p, &before, sizeof p) == 0);
 
-  /* Setup: textbook Lame parameters, DESIGN §8 SNH constants, projection off. */
+  /* Setup: textbook Lame parameters, lib/METHOD.md §8 SNH constants, projection off. */
   TEST_OK(ctx, fcm_material_setup(ctx, &good, &p));
   double mu, lambda;
   textbook_lame(3e6, 0.4, &mu, &lambda);

@@ -53,7 +53,8 @@ int main(void)
     TEST_OK(ctx, fcm_simulation_step(sim, &si));
     TEST_TRUE(si.reason == FCM_STEP_CONVERGED);
     fcm_simulation_get_counters(sim, &c);
-    TEST_TRUE(c.surface_rules == 1 && c.constraints == 2 && c.constrained_dofs == 0);
+    TEST_TRUE(c.surface_rules == 1 && c.constraints == 2 && c.constrained_dofs == 0 &&
+              c.boundary_points > 0);
     /* the displacement on the end faces, averaged over their surface points */
     const fcm_space *space = fcm_simulation_space(sim);
     const fcm_cell_rules *rules = fcm_simulation_cell_rules(sim);

@@ -137,8 +137,8 @@ static const bad_case cases[] = {
      FCM_ERR_ARG, "effects[0].motion.method:", "\"nitsche\""},
     {"{" BASE ", \"effects\": [{\"fixed\": {\"boundary\": \"all\", \"nitsche_safety\": 0.5}}]}",
      FCM_ERR_ARG, "effects[0].fixed.nitsche_safety: expected a finite number > 1, got 0.5", NULL},
-    {"{" BASE ", \"effects\": [{\"fixed\": {\"boundary\": \"all\", \"penalty\": 0}}]}",
-     FCM_ERR_ARG, "effects[0].fixed.penalty: expected a finite number > 0", NULL},
+    {"{" BASE ", \"effects\": [{\"fixed\": {\"boundary\": \"all\", \"penalty\": 0}}]}", FCM_ERR_ARG,
+     "effects[0].fixed.penalty: expected a finite number > 0", NULL},
     {"{" BASE ", \"effects\": [{\"fixed\": {\"region\": {\"nodes\": [1]}, \"method\": "
      "\"penalty\"}}]}",
      FCM_ERR_ARG, "effects[0].fixed.method: allowed only with \"boundary\"", NULL},

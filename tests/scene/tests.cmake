@@ -29,6 +29,9 @@ fcm_add_test(scene_geometry_keys tests/scene/geometry_keys.c)
 fcm_add_test(scene_surface tests/scene/surface_scene.c)
 # The cut effect: bodies and mass in the log across cuts, cuts at t = 0, no-op cuts, errors.
 fcm_add_test(scene_cut tests/scene/cut_scene.c)
+# Only the rule kinds a scene calls for: a static scene builds no mass rules (statistics,
+# counter, summary line "rules built"), a dynamic one does; the log's mass agrees.
+fcm_add_test(scene_rule_kinds tests/scene/rule_kinds.c)
 # Output for the engineer: the log's reaction columns (minus the weight and its moment in
 # equilibrium; change of momentum minus the weight in dynamics), stress arrays in the frames,
 # the surface at reference positions, the summary's max |u| over the body.

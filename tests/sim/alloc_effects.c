@@ -1,8 +1,8 @@
 /* Allocation failures in the integrator entry points alloc_failure.c does not reach: on an
  * embedded beam with surface rules, fcm_integrator_add_body_force (a field),
  * fcm_integrator_add_traction, a Nitsche boundary constraint on the embedded end face
- * (fcm_integrator_add_boundary_constraint), then setup, a step and fcm_integrator_energy. Failing the
- * k-th allocation (k = 0, 1, ... until the sequence succeeds) gives FCM_ERR_ALLOC and leaks
+ * (fcm_integrator_add_boundary_constraint), then setup, a step and fcm_integrator_energy. Failing
+ * the k-th allocation (k = 0, 1, ... until the sequence succeeds) gives FCM_ERR_ALLOC and leaks
  * nothing. */
 #include "sim_util.h"
 #include "alloc_loop.h"

@@ -67,8 +67,8 @@ static inline int oc_check_csv(const char *path, char *why, size_t cap)
                     "momentum_x,momentum_y,momentum_z,";
   const char *p = (const char *)buf, *end = p + n;
   const char *hnl = memchr(p, '\n', (size_t)n);
-  if ((size_t)n < strlen(hdr) || memcmp(p, hdr, strlen(hdr)) || !hnl ||
-      hnl - p < 10 || memcmp(hnl - 10, ",wall_time", 10)) {
+  if ((size_t)n < strlen(hdr) || memcmp(p, hdr, strlen(hdr)) || !hnl || hnl - p < 10 ||
+      memcmp(hnl - 10, ",wall_time", 10)) {
     snprintf(why, cap, "no header");
     goto done;
   }

@@ -1,6 +1,6 @@
 /* fcm — embedded (cut-cell) quadrature: per background cell, the embedded geometry is
  * clipped by the cell's planes, tetrahedralized and integrated with a tet rule mapped into
- * the cell's reference element (Longva et al. 2020 §4.5, DESIGN §5); cut-cell rules are
+ * the cell's reference element (Longva et al. 2020 §4.5, lib/METHOD.md §5); cut-cell rules are
  * simplified (fcm/simplify.h) and stabilized; surface rules on the embedded boundary.
  *
  * Rules live in reference coordinates xi of the background cell K. A volume rule's weight
@@ -27,12 +27,24 @@ typedef enum fcm_cell_class {
   FCM_CELL_DROPPED    /**< phi < min_fraction: no points; the cell leaves the system */
 } fcm_cell_class;
 
-/** The two volume rules each cell carries (DESIGN §3: separate strengths). */
+/** The two volume rules each cell carries (lib/METHOD.md §3: separate strengths). */
 typedef enum fcm_rule_kind {
   FCM_RULE_STIFFNESS = 0, /**< stiffness, internal and body forces */
   FCM_RULE_MASS = 1,      /**< consistent mass */
   FCM_RULE_KIND_COUNT
 } fcm_rule_kind;
+
+/** Bits of fcm_cell_rules_options.kinds: which volume rules fcm_cell_rules_create() builds.
+ * A kind that is not built costs nothing (no mapping, simplification, stabilization or
+ * storage); asking for its rules afterwards (fcm_cell_rules_get(), assembling a mass matrix
+ * from rules without mass rules, ...) is FCM_ERR_ARG naming the missing kind, never an
+ * empty rule. Surface rules are requested separately by surface_strength >= 0. */
+#define FCM_RULES_STIFFNESS (1u << FCM_RULE_STIFFNESS) /**< stiffness, internal and body forces */
+#define FCM_RULES_MASS      (1u << FCM_RULE_MASS)      /**< consistent mass, momentum */
+#define FCM_RULES_ALL       (FCM_RULES_STIFFNESS | FCM_RULES_MASS) /**< both volume kinds (default) */
+
+/** Static name of a kind ("stiffness", "mass"; "invalid" outside the enum). */
+FCM_API const char *fcm_rule_kind_name(fcm_rule_kind kind);
 
 /** Whether fcm_cell_rules_create() simplifies the cut-cell rules (fcm_simplify()). */
 typedef enum fcm_cell_simplify {
@@ -71,9 +83,15 @@ typedef void (*fcm_cell_rules_progress_fn)(fcm_index done, fcm_index total, void
 
 /** Options of fcm_cell_rules_create(); initialize with fcm_cell_rules_options_default(). */
 typedef struct fcm_cell_rules_options {
+  unsigned kinds; /**< the volume rules to build, a non-empty set of FCM_RULES_* bits;
+                       default FCM_RULES_ALL (what every caller got before the kinds
+                       could be chosen). A static problem needs FCM_RULES_STIFFNESS
+                       only; mass rules serve the mass matrix (dynamics, Rayleigh
+                       damping) and fcm_space_momentum(). The scene runner derives the
+                       set from the scene (fcm/simulation.h). */
   int strength[FCM_RULE_KIND_COUNT]; /**< per kind; FCM_DEFAULT (default): the element's */
   int surface_strength;  /**< FCM_DEFAULT (default): no surface rules; else the triangle rule
-                              strength */
+                              strength (the explicit request for surface rules) */
   double min_fraction;   /**< phi below this: dropped; default 1e-4 (0: drop only empty cells) */
   double uncut_fraction; /**< phi at or above this: uncut; default 1 - 1e-12 */
   double clip_rtol;      /**< vertex-on-plane tolerance / the smaller of the cell diameter and the
@@ -146,6 +164,8 @@ typedef struct fcm_cell_rules_stats {
   fcm_index num_tets;            /**< tets of the pieces kept (slivers excluded) */
   fcm_index num_slivers;         /**< tets dropped as slivers */
   double sliver_volume;          /**< their summed volume (not in embedded_volume) */
+  unsigned kinds;                /**< the volume kinds built (FCM_RULES_* bits); a kind not
+                                      built has 0 points everywhere below */
   fcm_index points_initial[FCM_RULE_KIND_COUNT];    /**< before simplification */
   fcm_index points_simplified[FCM_RULE_KIND_COUNT]; /**< after (= initial when off) */
   fcm_index points_stabilization[FCM_RULE_KIND_COUNT];
@@ -177,7 +197,7 @@ typedef struct fcm_cell_rules_stats {
 /** Per-cell quadrature of an embedded geometry in a background mesh (opaque). */
 typedef struct fcm_cell_rules fcm_cell_rules;
 
-/** Build the rules of every background cell (DESIGN §5): AABB-tree candidates, convex
+/** Build the rules of every background cell (lib/METHOD.md §5): AABB-tree candidates, convex
  * clipping by the cell's face planes, fan tetrahedralization, tet rules mapped into the
  * reference cell (closed-form inverse for affine cells, Newton otherwise), classification;
  * then per cut cell simplification (if enabled) followed by stabilization points (flag 1).
@@ -187,7 +207,8 @@ typedef struct fcm_cell_rules fcm_cell_rules;
  * @param[in] mesh background mesh; every cell must be convex (straight edges, planar faces)
  * @param[in] geom embedded geometry; mesh and geom are only read during the call
  * @param[in] opts NULL for defaults; @param[out] rules NULL on failure
- * @return FCM_OK; FCM_ERR_ARG (NULL, strengths outside [0, 20] with simplification or
+ * @return FCM_OK; FCM_ERR_ARG (NULL, kinds empty or with bits outside FCM_RULES_ALL,
+ *         strengths outside [0, 20] with simplification or
  *         [0, FCM_RULE_MAX_STRENGTH] without, simplify not a mode, AUTO with expected_assemblies
  *         < 0, point_cost <= 0 (not FCM_DEFAULT), thresholds outside 0 <=
  *         min_fraction < uncut_fraction <= 1, tolerances out of range, bad stabilization,
@@ -206,12 +227,16 @@ FCM_API fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh,
 /** Destroy; accepts NULL and sets `*rules = NULL`. */
 FCM_API void fcm_cell_rules_destroy(fcm_cell_rules **rules);
 
-/** Number of background cells; the element type; the strength of a kind (or of the surface
- * rules: -1 when none). */
+/** Number of background cells; the element type; the strength of a kind (-1 for a kind
+ * that was not built) or of the surface rules (-1 when none). */
 FCM_API fcm_index fcm_cell_rules_num_cells(const fcm_cell_rules *rules);
 FCM_API fcm_element_type fcm_cell_rules_element_type(const fcm_cell_rules *rules);
 FCM_API int fcm_cell_rules_strength(const fcm_cell_rules *rules, fcm_rule_kind kind);
 FCM_API int fcm_cell_rules_surface_strength(const fcm_cell_rules *rules);
+
+/** 1 when the rules of `kind` were built (fcm_cell_rules_options.kinds), else 0 (also for
+ * NULL rules or a kind out of range). */
+FCM_API int fcm_cell_rules_has_kind(const fcm_cell_rules *rules, fcm_rule_kind kind);
 
 /** Class and volume fraction of `cell` (in [0, num_cells); out of range: DROPPED, 0). */
 FCM_API fcm_cell_class fcm_cell_rules_class(const fcm_cell_rules *rules, fcm_index cell);
@@ -223,8 +248,8 @@ FCM_API double fcm_cell_rules_volume_fraction(const fcm_cell_rules *rules, fcm_i
  * (n, including |J_Q|/|J_K|; stabilization points have alpha times the standard weight) and flags
  * (n; 0 authentic, 1 fictitious stabilization point). Uncut cells share one catalogue rule; dropped
  * cells have 0 points (pointers then NULL). Any output may be NULL. Pointers stay valid for the
- * life of `rules`. @return FCM_OK or FCM_ERR_ARG (cell or kind out of range). No allocation; thread
- * safe. */
+ * life of `rules`. @return FCM_OK or FCM_ERR_ARG (cell or kind out of range, or a kind that
+ * was not built: fcm_cell_rules_options.kinds). No allocation; thread safe. */
 FCM_API fcm_status fcm_cell_rules_get(const fcm_cell_rules *rules, fcm_index cell,
                                       fcm_rule_kind kind, int *num_points, const double **points,
                                       const double **weights, const unsigned char **flags);
@@ -287,8 +312,8 @@ FCM_API fcm_index fcm_cell_rules_piece_cell(const fcm_cell_rules *rules, fcm_ind
 FCM_API double fcm_cell_rules_piece_volume(const fcm_cell_rules *rules, fcm_index piece);
 
 /** The volume rule of `kind` for one piece, as fcm_cell_rules_get() (a piece of an uncut
- * cell has the catalogue rule). @return FCM_OK or FCM_ERR_ARG (piece or kind out of range).
- * No allocation; thread safe. */
+ * cell has the catalogue rule). @return FCM_OK or FCM_ERR_ARG (piece or kind out of range, or
+ * a kind that was not built). No allocation; thread safe. */
 FCM_API fcm_status fcm_cell_rules_get_piece(const fcm_cell_rules *rules, fcm_index piece,
                                             fcm_rule_kind kind, int *num_points,
                                             const double **points, const double **weights,
@@ -340,7 +365,7 @@ FCM_API void fcm_cell_rules_view(const fcm_cell_rules *rules, FILE *stream);
 /** Print every point of `kind` in cell order as "cell xi eta zeta X Y Z w_ref w_phys flag"
  * (X = map of xi, w_phys = w_ref det J_K(xi)), full precision, one per line, after a
  * '#' header line. `mesh` must be the mesh the rules were built on.
- * @return FCM_OK, FCM_ERR_ARG (NULL, kind invalid, cell count differs), FCM_ERR_IO. */
+ * @return FCM_OK, FCM_ERR_ARG (NULL, kind invalid or not built, cell count differs), FCM_ERR_IO. */
 FCM_API fcm_status fcm_cell_rules_view_points(const fcm_cell_rules *rules, const fcm_mesh *mesh,
                                               fcm_rule_kind kind, FILE *stream);
 

@@ -131,7 +131,8 @@ FCM_API fcm_status fcm_space_transfer(const fcm_space *from, const fcm_space *to
  * x = X + u. Exact for the polynomial fields of the space where the mass rules are (cut
  * cells: rules of the mass strength), so a cut, which leaves the field unchanged, leaves
  * all three unchanged up to rounding. u and v (num_dofs) may be NULL (zero); outputs may
- * be NULL. @return FCM_OK, FCM_ERR_ARG (NULL space, density < 0). No allocation. */
+ * be NULL. @return FCM_OK, FCM_ERR_ARG (NULL space, density < 0, embedded rules built without
+ * mass rules). No allocation. */
 FCM_API fcm_status fcm_space_momentum(const fcm_space *space, double density, const double *u,
                                       const double *v, double *mass, double linear[3],
                                       double angular[3]);
@@ -285,7 +286,9 @@ FCM_API fcm_status fcm_assembly_workspace_hyperelastic(fcm_assembly_workspace *w
 FCM_API fcm_status fcm_assemble_stiffness(const fcm_space *space, const fcm_material *mat,
                                           const fcm_assembly_options *opts, fcm_csr *A);
 
-/** Add the consistent mass matrix (rho N_a N_b I) to A. Status codes as above. */
+/** Add the consistent mass matrix (rho N_a N_b I) to A. Status codes as above; an embedded
+ * space whose cell rules were built without mass rules (fcm_cell_rules_options.kinds) is
+ * FCM_ERR_ARG saying so (likewise the stiffness and force integrals without stiffness rules). */
 FCM_API fcm_status fcm_assemble_mass(const fcm_space *space, const fcm_material *mat,
                                      const fcm_assembly_options *opts, fcm_csr *A);
 
@@ -381,8 +384,15 @@ FCM_API fcm_status fcm_space_interpolate(const fcm_space *space, fcm_index n, co
 
 /** Number of stress components and their order (VTK's symmetric-tensor order, so ParaView
  * labels the components correctly). */
-enum { FCM_STRESS_XX = 0, FCM_STRESS_YY, FCM_STRESS_ZZ, FCM_STRESS_XY, FCM_STRESS_YZ,
-       FCM_STRESS_XZ, FCM_STRESS_COMPONENTS };
+enum {
+  FCM_STRESS_XX = 0,
+  FCM_STRESS_YY,
+  FCM_STRESS_ZZ,
+  FCM_STRESS_XY,
+  FCM_STRESS_YZ,
+  FCM_STRESS_XZ,
+  FCM_STRESS_COMPONENTS
+};
 
 /** A DOF vector (num_dofs, e.g. u or v) as one 3-vector per background node:
  * node_field[3a .. 3a+3) for node a of the mesh; inactive nodes get 0. A node that cuts

@@ -1,4 +1,4 @@
-/* fcm — hyperelastic materials for the mechanics (DESIGN §8): energy density
+/* fcm — hyperelastic materials for the mechanics (lib/METHOD.md §8): energy density
  * Psi(F), first Piola stress P(F) = dPsi/dF and tangent dP/dF of linear
  * elasticity, St. Venant-Kirchhoff, corotated linear and Stable Neo-Hookean,
  * with optional projection of the tangent to positive semi-definite.

@@ -1,4 +1,4 @@
-/* fcm — time integration of hyperelastic solids on a space (DESIGN §8): static Newton with
+/* fcm — time integration of hyperelastic solids on a space (lib/METHOD.md §8): static Newton with
  * load steps and backward Euler on the incremental potential, Newton with a backtracking
  * line search on the energy, the stopping rule of Longva et al. (2020) §6, optional Rayleigh
  * damping, prescribed motion of node sets and, weakly (Nitsche's method or a penalty), of the
@@ -333,8 +333,8 @@ typedef int (*fcm_boundary_select_fn)(void *user, const double X[3], const doubl
  * called after setup), FCM_ERR_ALLOC. The setup fails with FCM_ERR_ARG when the space has no
  * surface rules or the constraint selects no point. */
 FCM_API fcm_status fcm_integrator_add_boundary_constraint(fcm_integrator *integ,
-                                                          fcm_boundary_select_fn select,
-                                                          void *user, const fcm_motion *motion,
+                                                          fcm_boundary_select_fn select, void *user,
+                                                          const fcm_motion *motion,
                                                           const fcm_boundary_options *opts,
                                                           int *id);
 
@@ -453,13 +453,13 @@ FCM_API const fcm_csr *fcm_integrator_mass(const fcm_integrator *integ);
 
 /** What fcm_integrator_setup() assembled (all 0 before the setup). */
 typedef struct fcm_integrator_setup_info {
-  int mass_assemblies;       /**< 1 for BACKWARD_EULER; 0 for STATIC (no inertia, no M) */
-  int body_force_assemblies; /**< one per gravity or body-force load */
-  int traction_assemblies;   /**< one per surface traction load */
-  int scale_assemblies;      /**< 1 when a STATIC run with the REPRESENTATIVE rule had to assemble
-                                  the body force of rho a_rep for its force scale (no gravity load
-                                  equal to a_rep to reuse); else 0 */
-  fcm_index boundary_points; /**< embedded-boundary points the boundary constraints hold */
+  int mass_assemblies;         /**< 1 for BACKWARD_EULER; 0 for STATIC (no inertia, no M) */
+  int body_force_assemblies;   /**< one per gravity or body-force load */
+  int traction_assemblies;     /**< one per surface traction load */
+  int scale_assemblies;        /**< 1 when a STATIC run with the REPRESENTATIVE rule had to assemble
+                                    the body force of rho a_rep for its force scale (no gravity load
+                                    equal to a_rep to reuse); else 0 */
+  fcm_index boundary_points;   /**< embedded-boundary points the boundary constraints hold */
   double boundary_penalty_max; /**< largest gamma h_K / E over the elements (dimensionless;
                                     0 without boundary constraints) */
 } fcm_integrator_setup_info;

@@ -81,7 +81,7 @@ typedef struct fcm_simplify_info {
 FCM_API fcm_simplify_options fcm_simplify_options_default(void);
 
 /** Reduce a positive rule to at most M = (m+3 choose 3) of its own points with positive
- * weights reproducing every moment of total degree <= strength (DESIGN §6).
+ * weights reproducing every moment of total degree <= strength (lib/METHOD.md §6).
  * Every returned rule is verified (weights > 0, count <= M, relative residual <=
  * residual_tol); if all attempts (the chosen path; a GLPK path: the other GLPK path for LP
  * or RECOMBINE, for ELIMINATE the LP up to N = 12 M and recombination above; the chosen
@@ -116,7 +116,7 @@ FCM_API void fcm_simplify_result_destroy(fcm_simplify_result *res);
 FCM_API const char *fcm_simplify_method_name(fcm_simplify_method method);
 FCM_API const char *fcm_simplify_reason_name(fcm_simplify_reason reason);
 
-/* ---- stabilization (DESIGN §7) ---- */
+/* ---- stabilization (lib/METHOD.md §7) ---- */
 
 /** Which matrices receive the fictitious stabilization points of cut cells. */
 typedef enum fcm_stabilization_mode {

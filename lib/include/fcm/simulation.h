@@ -1,4 +1,4 @@
-/* fcm — running a scene (DESIGN §1.2): build the background mesh, the embedded geometry, its
+/* fcm — running a scene (lib/METHOD.md §1.2): build the background mesh, the embedded geometry, its
  * cell rules, the space and an integrator carrying exactly the scene's effects; step it;
  * write VTU/PVD frames of the background field and of the deformed embedded surface and a
  * CSV log per step. Counters say what was computed and what was skipped.
@@ -41,6 +41,9 @@ FCM_API fcm_simulation_options fcm_simulation_options_default(void);
 typedef struct fcm_simulation_counters {
   int cell_rules;              /**< 1: embedded cell rules were built (scene has a geometry) */
   int surface_rules;           /**< 1: the cell rules carry surface rules */
+  unsigned rule_kinds;         /**< volume rule kinds built (FCM_RULES_* bits of fcm/embed.h):
+                                    stiffness always, mass only for a dynamic scene; 0 without
+                                    cell rules */
   int inertia;                 /**< 1: dynamic integrator (inertia term); 0: static */
   int mass_assemblies;         /**< consistent-mass assemblies: 1 for dynamic scenes, 0 static */
   int body_force_assemblies;   /**< body-force assemblies the integrator's setup made (one per
@@ -54,6 +57,7 @@ typedef struct fcm_simulation_counters {
   int constraints;             /**< constraint sets (fixed and motion effects) */
   fcm_index constrained_nodes; /**< background nodes named by them (with or without DOFs) */
   fcm_index constrained_dofs;  /**< constrained DOFs after setup */
+  fcm_index boundary_points;   /**< embedded-boundary points held by `boundary` constraints */
   fcm_index schwarz_blocks;    /**< cut cells given a Schwarz block (0: no Schwarz set up) */
   int krylov;                  /**< 1: Krylov solves; 0: direct */
   long long steps;             /**< accepted steps */

@@ -231,7 +231,11 @@ FCM_API fcm_surface_mesh_options fcm_surface_mesh_options_default(void);
  * (3D Delaunay with the surface mesh kept: no surface vertex is moved or added, so the
  * tets' volume equals the surface's enclosed volume up to rounding). The surface is
  * checked first (fcm_surface_check(), fcm_surface_report_check()) and oriented.
- * Gmsh keeps global state: calls are serialized by a lock, and Gmsh prints nothing.
+ * Gmsh keeps global state: calls are serialized by a lock, and Gmsh prints nothing. The same
+ * surface and options give the same tets in every call (Gmsh's classic Delaunay mesher),
+ * except when the surface is much coarser than the size asked for: that mesher does not
+ * refine inside it (its tets average above 4x the requested volume), and Gmsh's HXT, which
+ * does, is used instead; HXT may return other tets on a later call in the same process.
  * @param[in] opts NULL for defaults; @param[out] geom the Tet4 geometry, NULL on failure
  * @return FCM_OK; FCM_ERR_ARG (NULL, bad option); FCM_ERR_GEOMETRY (the surface fails a
  *         check, or Gmsh fails: its message is quoted); FCM_ERR_UNSUPPORTED (fcm built

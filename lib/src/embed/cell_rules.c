@@ -11,10 +11,20 @@
 
 #define GIB (1024.0 * 1024.0 * 1024.0)
 
+/* Whether the options / rules ask for volume rules of kind k. */
+#define KIND_BUILT(kinds, k) ((((unsigned)(kinds)) >> (unsigned)(k)) & 1u)
+
+const char *fcm_rule_kind_name(fcm_rule_kind kind)
+{
+  static const char *const names[FCM_RULE_KIND_COUNT] = {"stiffness", "mass"};
+  return (int)kind >= 0 && kind < FCM_RULE_KIND_COUNT ? names[kind] : "invalid";
+}
+
 fcm_cell_rules_options fcm_cell_rules_options_default(void)
 {
   fcm_cell_rules_options o;
   memset(&o, 0, sizeof o);
+  o.kinds = FCM_RULES_ALL;
   o.strength[FCM_RULE_STIFFNESS] = -1;
   o.strength[FCM_RULE_MASS] = -1;
   o.surface_strength = -1;
@@ -230,8 +240,10 @@ static fcm_status check_rule_memory(const build *B, const fcm_cell_rules *R,
   const double limit = B->o->max_rule_memory;
   size_t n[FCM_RULE_KIND_COUNT];
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
-    n[k] = ws->num_tets * (size_t)fcm_rule_num_points(B->tet_rule[k]) +
-           (B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0);
+    n[k] = !B->tet_rule[k]
+               ? 0
+               : ws->num_tets * (size_t)fcm_rule_num_points(B->tet_rule[k]) +
+                     (B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     FCM_CHECK(n[k] <= (size_t)1 << 30, B->ctx, FCM_ERR_UNSUPPORTED,
               "embed: background cell %lld would get %zu initial %s points (limit 2^30)",
@@ -260,6 +272,7 @@ static fcm_status finish_cell(const build *B, const fcm_cell_rules *R, piece_out
   const fcm_cell_rules_options *opt = B->o;
   const double t1 = fcm_wtime();
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    if (!B->tet_rule[k]) continue; /* a kind not built */
     if (simp[k]) {
       FCM_TRY(ctx, simplify_rule(ctx, &opt->simplify_options, R->strength[k], &o->n[k], o->pts[k],
                                  o->w[k], o, k));
@@ -287,6 +300,7 @@ static fcm_status map_piece(const build *B, const fcm_cell_rules *R, const fcm__
   fcm_ctx *ctx = B->ctx;
   FCM_TRY(ctx, check_rule_memory(B, R, cell, ws));
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    if (!B->tet_rule[k]) continue; /* a kind not built: no points */
     const size_t n0 = ws->num_tets * (size_t)fcm_rule_num_points(B->tet_rule[k]);
     const size_t ns = B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0;
     FCM_ALLOC(ctx, 3 * (n0 + ns), o->pts[k]);
@@ -558,6 +572,10 @@ cleanup:
 static fcm_status check_options(fcm_ctx *ctx, const fcm_cell_rules_options *o)
 {
   fcm_status st = FCM_OK;
+  FCM_CHECK(o->kinds != 0 && (o->kinds & ~(unsigned)FCM_RULES_ALL) == 0, ctx, FCM_ERR_ARG,
+            "embed: kinds = 0x%x must be a non-empty set of FCM_RULES_STIFFNESS (0x%x) and "
+            "FCM_RULES_MASS (0x%x)",
+            o->kinds, FCM_RULES_STIFFNESS, FCM_RULES_MASS);
   FCM_CHECK((int)o->simplify >= 0 && o->simplify < FCM_CELL_SIMPLIFY_COUNT, ctx, FCM_ERR_ARG,
             "embed: simplify = %d is not a mode (0 off, 1 on, 2 auto)", (int)o->simplify);
   if (o->simplify == FCM_CELL_SIMPLIFY_AUTO) {
@@ -656,7 +674,10 @@ static fcm_status rules_alloc(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_cell
   FCM_ALLOC(ctx, (size_t)nc, R->fraction);
   FCM_ALLOC(ctx, (size_t)nc + 1, R->piece_off);
   R->opts = *o;
+  R->stats.kinds = o->kinds;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    R->strength[k] = -1;
+    if (!KIND_BUILT(o->kinds, k)) continue;
     R->strength[k] = o->strength[k] >= 0 ? o->strength[k] : element_strength[k];
     FCM_TRY(ctx, fcm_rule_create(ctx, info->shape, R->strength[k], &R->uncut[k]));
     FCM_ALLOC(ctx, (size_t)fcm_rule_num_points(R->uncut[k]), R->uncut_flags[k]);
@@ -694,11 +715,14 @@ static fcm_status build_setup(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geom
   memset(B, 0, sizeof *B);
   B->ctx = ctx, B->mesh = mesh, B->geom = geom, B->o = o;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    if (!KIND_BUILT(o->kinds, k)) continue; /* tet_rule[k] NULL marks a kind not built */
     FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TET, R->strength[k], &B->tet_rule[k]));
     B->full_rule[k] = R->uncut[k];
   }
   B->stabilize[FCM_RULE_STIFFNESS] = o->stabilization.mode == FCM_STABILIZATION_MASS_STIFFNESS;
   B->stabilize[FCM_RULE_MASS] = o->stabilization.mode != FCM_STABILIZATION_OFF;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    B->stabilize[k] = B->stabilize[k] && B->tet_rule[k];
   FCM_TRY(ctx, geometry_boxes(ctx, geom, 0, &boxes, &nbox));
   FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &B->tree));
   FCM_FREE(ctx, boxes);
@@ -878,6 +902,7 @@ static fcm_status auto_simplify(const build *B, fcm_cell_rules *R, int nthreads,
       for (int i = 0; i < out[c].np; i++)
         cut[ncut++] = out[c].pc + i;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    if (!B->tet_rule[k]) continue; /* a kind not built: nothing to decide */
     fcm_simplify_decision *d = &R->stats.decision[k];
     const fcm_element_type type = fcm_mesh_element_type(B->mesh);
     const int m = R->strength[k];
@@ -1116,7 +1141,9 @@ static void gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const cell
     }
   }
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
-    S->points_total[k] = R->off[k][R->num_pieces] + S->num_uncut * fcm_rule_num_points(R->uncut[k]);
+    S->points_total[k] =
+        R->uncut[k] ? R->off[k][R->num_pieces] + S->num_uncut * fcm_rule_num_points(R->uncut[k])
+                    : 0;
   S->surface_points = R->soff[R->num_pieces];
   S->num_material_pieces = R->num_pieces;
   S->num_links = R->num_links;
@@ -1173,7 +1200,8 @@ static fcm_status build_rules(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geom
   FCM_TRY(ctx, fcm__embed_outside(ctx, mesh, geom, &R->stats));
   if (o->simplify != FCM_CELL_SIMPLIFY_AUTO)
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
-      R->stats.decision[k].simplified = o->simplify == FCM_CELL_SIMPLIFY_ON;
+      R->stats.decision[k].simplified =
+          o->simplify == FCM_CELL_SIMPLIFY_ON && KIND_BUILT(o->kinds, k);
   R->stats.num_integrated = nc;
   if (B.rebuild) {
     R->stats.num_integrated = 0;
@@ -1347,6 +1375,26 @@ int fcm_cell_rules_surface_strength(const fcm_cell_rules *rules)
   return rules->surface_strength;
 }
 
+int fcm_cell_rules_has_kind(const fcm_cell_rules *rules, fcm_rule_kind kind)
+{
+  return rules && (int)kind >= 0 && kind < FCM_RULE_KIND_COUNT && rules->uncut[kind] != NULL;
+}
+
+/* FCM_ERR_ARG (set on ctx) unless the rules of `kind` were built; `what` names the caller. */
+static fcm_status check_kind(const fcm_cell_rules *R, fcm_rule_kind kind, const char *what)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK((int)kind >= 0 && kind < FCM_RULE_KIND_COUNT, R->ctx, FCM_ERR_ARG,
+            "%s: kind %d out of range [0,%d)", what, (int)kind, (int)FCM_RULE_KIND_COUNT);
+  FCM_CHECK(R->uncut[kind], R->ctx, FCM_ERR_ARG,
+            "%s: no %s rules were built (fcm_cell_rules_options.kinds = 0x%x lacks "
+            "FCM_RULES_%s = 0x%x; request them when creating the rules)",
+            what, fcm_rule_kind_name(kind), R->stats.kinds,
+            kind == FCM_RULE_MASS ? "MASS" : "STIFFNESS", 1u << (unsigned)kind);
+cleanup:
+  return st;
+}
+
 int fcm_cell_rules_strength(const fcm_cell_rules *rules, fcm_rule_kind kind)
 {
   return (int)kind >= 0 && kind < FCM_RULE_KIND_COUNT ? rules->strength[kind] : -1;
@@ -1398,8 +1446,7 @@ fcm_status fcm_cell_rules_get(const fcm_cell_rules *rules, fcm_index cell, fcm_r
   FCM_CHECK(cell >= 0 && cell < rules->num_cells, ctx, FCM_ERR_ARG,
             "cell rules: cell %lld out of range [0,%lld)", (long long)cell,
             (long long)rules->num_cells);
-  FCM_CHECK((int)kind >= 0 && kind < FCM_RULE_KIND_COUNT, ctx, FCM_ERR_ARG,
-            "cell rules: kind %d out of range [0,%d)", (int)kind, (int)FCM_RULE_KIND_COUNT);
+  FCM_TRY(ctx, check_kind(rules, kind, "cell rules"));
   rule_range(rules, (fcm_cell_class)rules->cls[cell], kind, rules->piece_off[cell],
              rules->piece_off[cell + 1], &n, &p, &w, &f);
 cleanup:
@@ -1482,8 +1529,7 @@ fcm_status fcm_cell_rules_get_piece(const fcm_cell_rules *rules, fcm_index piece
   FCM_CHECK(piece >= 0 && piece < rules->num_pieces, ctx, FCM_ERR_ARG,
             "cell rules: piece %lld out of range [0,%lld)", (long long)piece,
             (long long)rules->num_pieces);
-  FCM_CHECK((int)kind >= 0 && kind < FCM_RULE_KIND_COUNT, ctx, FCM_ERR_ARG,
-            "cell rules: kind %d out of range [0,%d)", (int)kind, (int)FCM_RULE_KIND_COUNT);
+  FCM_TRY(ctx, check_kind(rules, kind, "cell rules"));
   rule_range(rules, (fcm_cell_class)rules->cls[rules->piece_cell[piece]], kind, piece, piece + 1,
              &n, &p, &w, &f);
 cleanup:
@@ -1578,13 +1624,17 @@ void fcm_cell_rules_view(const fcm_cell_rules *rules, FILE *stream)
       fprintf(stream, ", beyond %s %.3g", sides[k], S->outside_side_volume[k]);
   fputc('\n', stream);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
-    fprintf(stream,
-            "  %-9s strength %d: cut-cell points %lld initial -> %lld simplified "
-            "(+%lld stabilization), total %lld; skipped %lld, fallbacks %lld, max residual %.3g\n",
-            names[k], rules->strength[k], (long long)S->points_initial[k],
-            (long long)S->points_simplified[k], (long long)S->points_stabilization[k],
-            (long long)S->points_total[k], (long long)S->simplify_skipped[k],
-            (long long)S->simplify_fallbacks[k], S->max_residual[k]);
+    if (!rules->uncut[k])
+      fprintf(stream, "  %-9s not built (fcm_cell_rules_options.kinds)\n", names[k]);
+    else
+      fprintf(
+          stream,
+          "  %-9s strength %d: cut-cell points %lld initial -> %lld simplified "
+          "(+%lld stabilization), total %lld; skipped %lld, fallbacks %lld, max residual %.3g\n",
+          names[k], rules->strength[k], (long long)S->points_initial[k],
+          (long long)S->points_simplified[k], (long long)S->points_stabilization[k],
+          (long long)S->points_total[k], (long long)S->simplify_skipped[k],
+          (long long)S->simplify_fallbacks[k], S->max_residual[k]);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     const fcm_simplify_decision *d = &S->decision[k];
     if (d->point_cost > 0.0)
@@ -1613,8 +1663,7 @@ fcm_status fcm_cell_rules_view_points(const fcm_cell_rules *rules, const fcm_mes
   double X[3 * FCM_ELEMENT_MAX_NODES], J[9], x[3];
   FCM_CHECK(rules && mesh && stream, ctx, FCM_ERR_ARG,
             "cell rules view: NULL argument (rules, mesh and stream are required)");
-  FCM_CHECK((int)kind >= 0 && kind < FCM_RULE_KIND_COUNT, ctx, FCM_ERR_ARG,
-            "cell rules view: kind %d out of range [0,%d)", (int)kind, (int)FCM_RULE_KIND_COUNT);
+  FCM_TRY(ctx, check_kind(rules, kind, "cell rules view"));
   FCM_CHECK(fcm_mesh_num_cells(mesh) == rules->num_cells &&
                 fcm_mesh_element_type(mesh) == rules->type,
             ctx, FCM_ERR_ARG, "cell rules view: mesh (%lld cells) is not the rules' mesh (%lld)",

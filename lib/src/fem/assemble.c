@@ -120,7 +120,7 @@ typedef struct kernel_data {
   fcm_material_params mat_psd;     /* *mat with project_psd = 1 */
 } kernel_data;
 
-/* The material at a fictitious stabilization point (DESIGN §7, issue 19): the exact
+/* The material at a fictitious stabilization point (lib/METHOD.md §7, issue 19): the exact
  * model's tangent times alpha is indefinite and does not lift the small blocks of cut
  * cells, so these points carry a positive semi-definite tangent. PROJECTED keeps the
  * exact energy and force (rotation invariant) and projects the tangent: the Newton
@@ -568,6 +568,12 @@ static fcm_status run_volume_pass(fcm_assembly_workspace *ws, const kernel_data 
   pass ps;
   memset(&ps, 0, sizeof ps);
   ps.kind = kd->kind == KERNEL_MASS ? FCM_RULE_MASS : FCM_RULE_STIFFNESS;
+  FCM_CHECK(!ws->space->rules || fcm_cell_rules_has_kind(ws->space->rules, ps.kind), ws->ctx,
+            FCM_ERR_ARG,
+            "assembly: the %s needs %s rules, but the space's cell rules were built without them "
+            "(add FCM_RULES_%s to fcm_cell_rules_options.kinds)",
+            kd->kind == KERNEL_MASS ? "mass matrix" : "stiffness / force integral",
+            fcm_rule_kind_name(ps.kind), ps.kind == FCM_RULE_MASS ? "MASS" : "STIFFNESS");
   FCM_TRY(ws->ctx, workspace_tabulation(ws, ps.kind, &ps.tab));
   ps.kd = kd;
   ps.vals = vals;
@@ -808,6 +814,9 @@ fcm_status fcm_space_momentum(const fcm_space *s, double density, const double *
   FCM_CHECK(s, ctx, FCM_ERR_ARG, "momentum: space is NULL");
   FCM_CHECK(isfinite(density) && density >= 0.0, ctx, FCM_ERR_ARG,
             "momentum: density = %g must be finite and >= 0", density);
+  FCM_CHECK(!s->rules || fcm_cell_rules_has_kind(s->rules, FCM_RULE_MASS), ctx, FCM_ERR_ARG,
+            "momentum: integrates with the mass rules, but the space's cell rules were built "
+            "without them (add FCM_RULES_MASS to fcm_cell_rules_options.kinds)");
   const fcm_rule *full = s->mass_rule;
   for (fcm_index e = 0; e < s->num_elems; e++) {
     const fcm_index c = s->elem_cell[e];

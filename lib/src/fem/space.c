@@ -493,6 +493,7 @@ static fcm_status space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigne
       for (fcm_index p = first; p < first + np && cls == FCM_CELL_CUT; p++)
         for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
           int n = 0;
+          if (!fcm_cell_rules_has_kind(rules, (fcm_rule_kind)k)) continue; /* not built */
           FCM_TRY(ctx, fcm_cell_rules_get_piece(rules, p, (fcm_rule_kind)k, &n, NULL, NULL, NULL));
           s->max_cut_points = FCM_MAX(s->max_cut_points, n);
         }

@@ -139,7 +139,7 @@ static fcm_status gmsh_error(fcm_ctx *ctx, const char *call, int line)
 
 /* The tetrahedralization itself, with the lock held and Gmsh initialized. */
 static fcm_status mesh_locked(fcm_ctx *ctx, const fcm_surface *s, const fcm_surface_mesh_options *o,
-                              fcm_geometry **geom)
+                              int algorithm, fcm_geometry **geom)
 {
   fcm_status st = FCM_OK;
   size_t nv = (size_t)s->num_vertices, nt = (size_t)s->num_triangles;
@@ -154,12 +154,13 @@ static fcm_status mesh_locked(fcm_ctx *ctx, const fcm_surface *s, const fcm_surf
   GMSH(G.OptionSetNumber("General.Terminal", 0, IERR));
   GMSH(G.OptionSetNumber("General.Verbosity", 0, IERR));
   GMSH(G.ModelAdd("fcm_surface", IERR));
-  /* HXT (Delaunay, Marot et al. 2019): keeps the surface mesh and honours MeshSizeMax for
-   * a discrete surface (the classic Delaunay, 1, ignores it there) */
-  GMSH(G.OptionSetNumber("Mesh.Algorithm3D", 10, IERR));
+  GMSH(G.OptionSetNumber("Mesh.Algorithm3D", algorithm, IERR));
   GMSH(G.OptionSetNumber("Mesh.OptimizeThreshold", o->quality, IERR));
   /* always set, not left to Gmsh's state between calls (1e22: its default) */
   GMSH(G.OptionSetNumber("Mesh.MeshSizeMax", size > 0.0 ? size : 1e22, IERR));
+  GMSH(G.OptionSetNumber("General.NumThreads", 1, IERR));
+  GMSH(G.OptionSetNumber("Mesh.MaxNumThreads3D", 1, IERR));
+  GMSH(G.OptionSetNumber("Mesh.RandomSeed", 1, IERR));
 
   FCM_ALLOC_RAW(ctx, nv, ntags);
   FCM_ALLOC_RAW(ctx, nt, etags);
@@ -231,16 +232,35 @@ static fcm_status tetrahedralize(fcm_ctx *ctx, const fcm_surface *s,
     pthread_mutex_unlock(&gmsh_lock);
     return st;
   }
-  G.Initialize(0, NULL, 0, &ierr);
-  if (ierr != 0) {
-    st = gmsh_error(ctx, "G.Initialize(", __LINE__);
-  } else {
-    st = mesh_locked(ctx, s, o, geom);
+  /* The classic Delaunay mesher (1) keeps the surface mesh and gives the same tetrahedra in
+   * every call; HXT (10, Marot et al. 2019) does not: a second call in one process on the
+   * same surface returned other tetrahedra (68414 vs 67966 for surface_drop's pebble, so two
+   * runs of that scene in one process differed by 3 % on the body). But the classic mesher
+   * does not refine inside a surface much coarser than the size asked for (a 12-triangle
+   * cube stays 12 tets); only then, when its tets average more than 4x the requested
+   * volume, HXT meshes it instead. */
+  int alg = 1;
+  double target = 0.0; /* the volume of a regular tet of the requested edge length */
+  if (o->max_volume > 0.0) target = o->max_volume;
+  if (o->size > 0.0 && (target == 0.0 || o->size * o->size * o->size / (6.0 * sqrt(2.0)) < target))
+    target = o->size * o->size * o->size / (6.0 * sqrt(2.0));
+  for (int attempt = 0; attempt < 2; attempt++) {
+    G.Initialize(0, NULL, 0, &ierr);
+    if (ierr != 0) {
+      st = gmsh_error(ctx, "G.Initialize(", __LINE__);
+      break;
+    }
+    st = mesh_locked(ctx, s, o, alg, geom);
     G.Finalize(&ierr);
     if (ierr != 0 && st == FCM_OK) {
       fcm_geometry_destroy(geom);
       st = gmsh_error(ctx, "G.Finalize(", __LINE__);
     }
+    if (st != FCM_OK || alg == 10 || target <= 0.0 ||
+        fcm_geometry_volume(*geom) <= 4.0 * target * (double)fcm_geometry_num_cells(*geom))
+      break;
+    fcm_geometry_destroy(geom);
+    alg = 10;
   }
   pthread_mutex_unlock(&gmsh_lock);
   return st;

@@ -2,7 +2,7 @@
  * the Stable Neo-Hookean reparametrization) and the public evaluation entry point.
  *
  * Stable Neo-Hookean constants (Smith, Goes & Kim, "Stable Neo-Hookean flesh
- * simulation", ACM TOG 2018, §3.4; DESIGN §8): mu' = 4 mu/3, lambda' = lambda + 5 mu/6
+ * simulation", ACM TOG 2018, §3.4; lib/METHOD.md §8): mu' = 4 mu/3, lambda' = lambda + 5 mu/6
  * make the linearization at F = I equal linear elasticity with (mu, lambda), and
  * alpha = 1 + 3 mu'/(4 lambda') makes the rest state stress free. */
 #include "material/material_impl.h"

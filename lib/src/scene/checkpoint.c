@@ -287,9 +287,9 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
     FCM_TRY(ctx, get(&r, frame_time, sizeof *frame_time * (size_t)frames, "the frame times"));
   }
   FCM_TRY(ctx, get_i64(&r, &rows, steps, steps, "log rows (one per step)"));
-  const size_t row_bytes = ver >= 2 ? (8 + (ver >= 3 ? nreact : 0)) * sizeof(double) +
-                                          3 * sizeof(int64_t)
-                                    : 4 * sizeof(double) + 2 * sizeof(int64_t);
+  const size_t row_bytes =
+      ver >= 2 ? (8 + (ver >= 3 ? nreact : 0)) * sizeof(double) + 3 * sizeof(int64_t)
+               : 4 * sizeof(double) + 2 * sizeof(int64_t);
   FCM_TRY(ctx, need(&r, rows, row_bytes, "log rows"));
   if (rows > 0) FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&log, &log_cap, rows, sizeof *log));
   if (rows > 0 && nreact > 0)

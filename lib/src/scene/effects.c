@@ -294,8 +294,8 @@ static void view_target(const fcm_region *r, int boundary, const fcm_boundary_op
 static fcm_status parse_fixed(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"region",  "boundary", "components",
-                                     "method",  "penalty",  "nitsche_safety"};
+  static const char *const keys[] = {"region", "boundary", "components",
+                                     "method", "penalty",  "nitsche_safety"};
   fcm_effect_fixed *x = &e->fixed;
   const char *comp = NULL;
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
@@ -330,15 +330,15 @@ static void view_fixed(const fcm_effect *e, FILE *f)
 static fcm_status parse_motion(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"region",  "boundary", "velocity", "rotation",      "start",
-                                     "end",     "release",  "method",   "nitsche_safety", "penalty"};
+  static const char *const keys[] = {"region", "boundary", "velocity", "rotation",       "start",
+                                     "end",    "release",  "method",   "nitsche_safety", "penalty"};
   static const char *const rkeys[] = {"axis", "center", "speed"};
   fcm_motion *m = &e->motion.motion;
   const fcm__json *rot = NULL;
   *m = fcm_motion_default();
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
-  FCM_TRY(p->ctx, read_target(p, o, &e->motion.region, &e->motion.boundary,
-                              &e->motion.boundary_options));
+  FCM_TRY(p->ctx,
+          read_target(p, o, &e->motion.region, &e->motion.boundary, &e->motion.boundary_options));
   FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "velocity", 0, FCM__ANY, m->velocity));
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "rotation", 0, &rot));
   if (rot) {

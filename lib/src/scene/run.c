@@ -498,6 +498,11 @@ static fcm_status build_rules(fcm_simulation *S)
     nsurf += (e->type == FCM_EFFECT_FIXED && e->fixed.boundary) ||
              (e->type == FCM_EFFECT_MOTION && e->motion.boundary); /* Nitsche's points */
   }
+  /* Only the rules the scene calls for: mass rules serve the mass matrix (inertia, Rayleigh
+   * damping) and the momentum, so a static scene builds none (the log's mass then comes from
+   * the piece volumes, see log_momentum()). */
+  const int dynamic = fcm_scene_get_time(S->scene)->integrator != FCM_INTEGRATOR_STATIC;
+  ro.kinds = FCM_RULES_STIFFNESS | (dynamic ? FCM_RULES_MASS : 0u);
   ro.strength[FCM_RULE_STIFFNESS] = q->stiffness_strength;
   ro.strength[FCM_RULE_MASS] = q->mass_strength;
   if (q->surface_strength >= 0)
@@ -516,7 +521,6 @@ static fcm_status build_rules(fcm_simulation *S)
      * per Newton iteration, about RUN_ASSEMBLIES_PER_STEP per step and load step; mass rules
      * once (the constant mass matrix of a dynamic run), never in a static one. */
     const fcm_scene_time *tm = fcm_scene_get_time(S->scene);
-    const int dynamic = tm->integrator != FCM_INTEGRATOR_STATIC;
     ro.expected_assemblies[FCM_RULE_STIFFNESS] =
         RUN_ASSEMBLIES_PER_STEP * (double)tm->num_steps * (dynamic ? 1.0 : (double)tm->load_steps);
     ro.expected_assemblies[FCM_RULE_MASS] = dynamic ? 1.0 : 0.0;
@@ -530,6 +534,7 @@ static fcm_status build_rules(fcm_simulation *S)
   FCM_TRY(S->ctx, fcm_cell_rules_create(S->ctx, S->mesh, S->geom, &ro, &S->rules));
   S->c.cell_rules = 1;
   S->c.surface_rules = ro.surface_strength >= 0;
+  S->c.rule_kinds = fcm_cell_rules_get_stats(S->rules)->kinds;
 cleanup:
   return st;
 }
@@ -828,6 +833,7 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
     S->c.body_force_assemblies = si.body_force_assemblies;
     S->c.traction_assemblies = si.traction_assemblies;
     S->c.scale_assemblies = si.scale_assemblies;
+    S->c.boundary_points = si.boundary_points;
   }
   S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);
   if (S->c.inertia) FCM_TRY(ctx, initialize_effects(S));
@@ -879,6 +885,28 @@ void fcm_simulation_destroy(fcm_simulation **sim)
 
 /* ---------------------------------------------------------------- stepping */
 
+/* The log's mass and momentum: integrated with the mass rules when the scene built them; a
+ * static scene built none (build_rules()) and has no velocity: its mass is the density times
+ * the volume of the pieces the space keeps, its momentum zero. */
+static fcm_status log_momentum(fcm_simulation *S, fcm__log_row *r)
+{
+  fcm_status st = FCM_OK;
+  const double rho = fcm_scene_get_material(S->scene)->density;
+  if (S->rules && !fcm_cell_rules_has_kind(S->rules, FCM_RULE_MASS)) {
+    double vol = 0.0;
+    for (fcm_index p = 0; p < fcm_cell_rules_num_pieces(S->rules); p++)
+      vol += fcm_cell_rules_piece_volume(S->rules, p);
+    r->mass = rho * vol;
+    r->momentum[0] = r->momentum[1] = r->momentum[2] = 0.0;
+    return FCM_OK;
+  }
+  FCM_TRY(S->ctx,
+          fcm_space_momentum(S->space, rho, fcm_integrator_displacement(S->integ),
+                             fcm_integrator_velocity(S->integ), &r->mass, r->momentum, NULL));
+cleanup:
+  return st;
+}
+
 /* Force (q[0..3)) and moment about the origin (q[3..6)) of the k-th constraint effect of the
  * log after the step just taken: node constraints from the integrator's residual
  * (fcm_integrator_reaction()); a constraint imposed otherwise (weakly, on the embedded
@@ -929,9 +957,9 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   }
   S->c.steps++;
   for (int k = 0; k < S->num_react; k++)
-    FCM_TRY(S->ctx, constraint_reaction(S, k,
-                                        S->react_log + 6 * ((size_t)S->log_n * (size_t)S->num_react +
-                                                            (size_t)k)));
+    FCM_TRY(S->ctx,
+            constraint_reaction(
+                S, k, S->react_log + 6 * ((size_t)S->log_n * (size_t)S->num_react + (size_t)k)));
   fcm__log_row *r = &S->log[S->log_n++];
   r->time = si.time;
   r->newton = si.newton_iterations;
@@ -940,10 +968,7 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   r->energy = si.total_energy;
   r->wall = wall;
   r->pieces = S->pieces;
-  FCM_TRY(S->ctx,
-          fcm_space_momentum(S->space, fcm_scene_get_material(S->scene)->density,
-                             fcm_integrator_displacement(S->integ),
-                             fcm_integrator_velocity(S->integ), &r->mass, r->momentum, NULL));
+  FCM_TRY(S->ctx, log_momentum(S, r));
 cleanup:
   return st;
 }
@@ -1066,11 +1091,10 @@ fcm_status fcm_simulation_write_log(fcm_simulation *S, const char *path)
   for (long long k = 0; k < S->log_n; k++) {
     const fcm__log_row *r = &S->log[k];
     FCM_TRY(S->ctx,
-            fcm__io_atomic_printf(S->ctx, &af,
-                                  "%lld,%.17g,%lld,%lld,%.17g,%.17g,%lld,%.17g,%.17g,%.17g,%.17g",
-                                  k + 1, r->time, r->newton, r->linear, r->residual, r->energy,
-                                  r->pieces, r->mass, r->momentum[0], r->momentum[1],
-                                  r->momentum[2]));
+            fcm__io_atomic_printf(
+                S->ctx, &af, "%lld,%.17g,%lld,%lld,%.17g,%.17g,%lld,%.17g,%.17g,%.17g,%.17g", k + 1,
+                r->time, r->newton, r->linear, r->residual, r->energy, r->pieces, r->mass,
+                r->momentum[0], r->momentum[1], r->momentum[2]));
     for (int j = 0; j < 6 * S->num_react; j++)
       FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, ",%.17g",
                                             S->react_log[(size_t)k * 6 * S->num_react + j]));
@@ -1173,7 +1197,9 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
       const fcm_simplify_decision *d = &rs->decision[k];
       char what[64];
       snprintf(what, sizeof what, "%s simplification", kinds[k]);
-      if (q->simplify == FCM_CELL_SIMPLIFY_AUTO)
+      if (!fcm_cell_rules_has_kind(S->rules, (fcm_rule_kind)k))
+        snprintf(b, sizeof b, "(no %s rules built)", kinds[k]);
+      else if (q->simplify == FCM_CELL_SIMPLIFY_AUTO)
         snprintf(b, sizeof b,
                  "auto: %s for %g expected assemblies; cost model %.3g core-s per point per "
                  "assembly, %.3g core-s simplifying to %.0f points; estimated %.3g core-s "
@@ -1185,6 +1211,20 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
                  d->time_simplify);
       line(f, d->simplified, what, b);
     }
+  }
+  if (S->rules) { /* which rule kinds the scene called for, with their stored points */
+    const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(S->rules);
+    const int mass = (c->rule_kinds & FCM_RULES_MASS) != 0;
+    snprintf(b, sizeof b, "stiffness (%lld points)%s",
+             (long long)rs->points_total[FCM_RULE_STIFFNESS], mass ? ", mass" : "");
+    if (mass)
+      snprintf(b + strlen(b), sizeof b - strlen(b), " (%lld points)",
+               (long long)rs->points_total[FCM_RULE_MASS]);
+    if (c->surface_rules)
+      snprintf(b + strlen(b), sizeof b - strlen(b), ", surface (%lld points)",
+               (long long)rs->surface_points);
+    if (!mass) snprintf(b + strlen(b), sizeof b - strlen(b), "; mass: not needed (static scene)");
+    line(f, 1, "rules built", b);
   }
   line(f, c->surface_rules, "surface rules", c->surface_rules ? "" : "(no traction or pressure)");
   line(f, c->inertia, "inertia (backward Euler)", c->inertia ? "" : "(static scene)");
@@ -1202,8 +1242,9 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
   line(f, c->damping, "Rayleigh damping matrix", c->damping ? "" : "(no damping)");
   snprintf(b, sizeof b, "%d", c->initial_velocity);
   line(f, c->initial_velocity > 0, "initial velocities", c->initial_velocity ? b : "(none)");
-  snprintf(b, sizeof b, "%d sets, %lld nodes, %lld DOFs", c->constraints,
-           (long long)c->constrained_nodes, (long long)c->constrained_dofs);
+  snprintf(b, sizeof b, "%d sets, %lld nodes, %lld DOFs, %lld embedded-boundary points",
+           c->constraints, (long long)c->constrained_nodes, (long long)c->constrained_dofs,
+           (long long)c->boundary_points);
   line(f, c->constraints > 0, "constraints", c->constraints ? b : "(none)");
   snprintf(b, sizeof b, "%lld blocks", (long long)c->schwarz_blocks);
   line(f, c->schwarz_blocks > 0, "Schwarz blocks",

@@ -907,10 +907,9 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
     FCM_TRY(ctx, fcm_integrator_add_constraint(I, old->cons[k].num_nodes, old->cons[k].nodes,
                                                &old->cons[k].motion, NULL));
   for (int k = 0; k < old->num_bcons; k++)
-    FCM_TRY(ctx, fcm_integrator_add_boundary_constraint(I, old->bcons[k].select,
-                                                        old->bcons[k].select_user,
-                                                        &old->bcons[k].motion,
-                                                        &old->bcons[k].opts, NULL));
+    FCM_TRY(ctx, fcm_integrator_add_boundary_constraint(
+                     I, old->bcons[k].select, old->bcons[k].select_user, &old->bcons[k].motion,
+                     &old->bcons[k].opts, NULL));
   FCM_TRY(ctx, fcm_integrator_setup(I));
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, u);
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, v);

@@ -1,6 +1,6 @@
 /* sim: the linear solves of the Newton steps — CHOLMOD with UMFPACK as the fallback when
  * the matrix is not positive definite (symbolic analyses kept for the whole run), or CG /
- * MINRES with Jacobi, block Jacobi or additive Schwarz preconditioning (DESIGN §7), the
+ * MINRES with Jacobi, block Jacobi or additive Schwarz preconditioning (lib/METHOD.md §7), the
  * preconditioner built from a PSD tangent by default (preconditioner_tangent). */
 #include "sim/sim_impl.h"
 #include "fem/fem_impl.h"

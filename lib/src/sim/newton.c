@@ -1,7 +1,7 @@
 /* sim: one integrator step — substeps with halving on failure, and per substep Newton's
  * method with a backtracking (Armijo) line search on the incremental potential.
  *
- * DESIGN §8 and Longva et al. (2020) §3, §6: backward Euler minimizes
+ * lib/METHOD.md §8 and Longva et al. (2020) §3, §6: backward Euler minimizes
  * E(u) = 1/2 |u - u^|_M^2 / h^2 + Psi(u) - f^T u (+ 1/(2h) |u - u_n|_D^2); its gradient is
  * M v' - f_total, and the Newton loop stops when that is below 1e-5 |M a_rep| (the paper's
  * rule; a_rep = gravity) or below a relative threshold. Prescribed motion enters through
@@ -97,8 +97,8 @@ static fcm_status assemble_tangent(fcm_integrator *I, double h, const double *x,
 {
   fcm_status st = FCM_OK;
   fcm__sim_set_base(I, h, I->H);
-  FCM_TRY(I->ctx, assemble(I, projected ? &I->params_psd : &I->params, x, NULL, NULL, I->H,
-                           finite, stats));
+  FCM_TRY(I->ctx,
+          assemble(I, projected ? &I->params_psd : &I->params, x, NULL, NULL, I->H, finite, stats));
   if (*finite) FCM_TRY(I->ctx, assemble_boundary(I, x, projected, NULL, NULL, I->H, finite, stats));
 cleanup:
   return st;
@@ -124,8 +124,8 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
   FCM_TRY(I->ctx,
           assemble(I, &I->params, x, &psi, fint, tangent ? I->H : NULL, &out->finite, stats));
   if (!out->finite) return FCM_OK;
-  FCM_TRY(I->ctx, assemble_boundary(I, x, 0, &bnd, fint, tangent ? I->H : NULL, &out->finite,
-                                    stats));
+  FCM_TRY(I->ctx,
+          assemble_boundary(I, x, 0, &bnd, fint, tangent ? I->H : NULL, &out->finite, stats));
   if (!out->finite) return FCM_OK;
   {
     double t0 = fcm_wtime();
@@ -316,7 +316,8 @@ static fcm_status newton_direction(fcm_integrator *I, double h, int predictor, d
     I->bc_psd_only = 1;
     I->h_state = SIM_H_INVALID;
     st = build_system(I, h, predictor, 0, reason, stats);
-    if (st == FCM_OK && *reason == FCM_STEP_NONE) st = direction(I, predictor, reason, &its2, stats);
+    if (st == FCM_OK && *reason == FCM_STEP_NONE)
+      st = direction(I, predictor, reason, &its2, stats);
     I->bc_psd_only = 0;
     I->h_state = SIM_H_INVALID;
     FCM_TRY(I->ctx, st);

@@ -35,21 +35,21 @@ typedef struct sim_bcon {
 /* The embedded-boundary points of the boundary constraints (setup), grouped by element in
  * ascending element order: element elem[k] has points ptr[k] .. ptr[k+1]. */
 typedef struct sim_bpoints {
-  fcm_index nelem;      /* elements with points */
+  fcm_index nelem;       /* elements with points */
   fcm_index *elem, *ptr; /* nelem, nelem + 1 */
-  fcm_index np;         /* points */
-  int *con;             /* np: boundary constraint of the point */
-  double *w;            /* np: area weights */
-  double *X, *nrm;      /* np x 3: reference position and unit outward normal */
-  double *N, *G;        /* np x nn shape values, np x nn x 3 physical gradients */
-  double *gamma;        /* num_elems: Nitsche penalty per element (0: no Nitsche points) */
-  double *hk;           /* num_elems: cell size h_K (cube root of the volume) */
-  double *scratch;      /* per thread: ue, fe (3nn each), Ke ((3nn)^2), Q (9nn) */
-  int nthreads;         /* threads the scratch serves (omp_get_max_threads() at setup) */
-  int num_colors;       /* the space's colours: no two elements of one share a DOF copy */
-  fcm_index *color_ptr; /* num_colors + 1 offsets into color_k */
-  fcm_index *color_k;   /* nelem: indices k (into elem) grouped by colour, ascending within */
-  double *eelem;        /* nelem: energy of each element's points (summed in order) */
+  fcm_index np;          /* points */
+  int *con;              /* np: boundary constraint of the point */
+  double *w;             /* np: area weights */
+  double *X, *nrm;       /* np x 3: reference position and unit outward normal */
+  double *N, *G;         /* np x nn shape values, np x nn x 3 physical gradients */
+  double *gamma;         /* num_elems: Nitsche penalty per element (0: no Nitsche points) */
+  double *hk;            /* num_elems: cell size h_K (cube root of the volume) */
+  double *scratch;       /* per thread: ue, fe (3nn each), Ke ((3nn)^2), Q (9nn) */
+  int nthreads;          /* threads the scratch serves (omp_get_max_threads() at setup) */
+  int num_colors;        /* the space's colours: no two elements of one share a DOF copy */
+  fcm_index *color_ptr;  /* num_colors + 1 offsets into color_k */
+  fcm_index *color_k;    /* nelem: indices k (into elem) grouped by colour, ascending within */
+  double *eelem;         /* nelem: energy of each element's points (summed in order) */
 } sim_bpoints;
 
 /* Counters and timers of one step (copied into fcm_step_info). */

@@ -275,7 +275,7 @@ static void append_message(fcm_simplify_info *info, int attempt, fcm_simplify_me
              len ? "; " : "", attempt, fcm_simplify_method_name(method), tol, msg);
 }
 
-/* The attempts in order (DESIGN §6): the chosen path, the other path, the chosen path
+/* The attempts in order (lib/METHOD.md §6): the chosen path, the other path, the chosen path
  * with a looser rank cut. */
 enum { ATTEMPT_CHOSEN, ATTEMPT_OTHER, ATTEMPT_LOOSER, ATTEMPT_COUNT };
 

@@ -138,7 +138,7 @@ fcm_status fcm__simplify_soften(fcm__attempt *a, fcm_status st, const char *what
 fcm_status fcm__simplify_row_space(fcm__attempt *a, int rows, int cols, double *g, double *q,
                                    int *r);
 
-/* One full LP on all n points (DESIGN §6): P (M x n), thin SVD, V_r^T w = V_r^T w0. */
+/* One full LP on all n points (lib/METHOD.md §6): P (M x n), thin SVD, V_r^T w = V_r^T w0. */
 fcm_status fcm__simplify_run_lp(fcm__attempt *a);
 
 /* Hierarchical recombination (Litterer & Lyons 2012): about log2(n/M) rounds on cluster moments and

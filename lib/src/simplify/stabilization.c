@@ -1,4 +1,4 @@
-/* Stabilization of cut cells (DESIGN §7, Longva et al. 2020 §5): the full cell's
+/* Stabilization of cut cells (lib/METHOD.md §7, Longva et al. 2020 §5): the full cell's
  * standard rule with weights x alpha, appended after simplification and flagged. */
 #include "simplify/simplify_impl.h"
 
