@@ -85,8 +85,10 @@ static inline void problem_cube(fcm_ctx *ctx, fcm_index n, problem *p)
 /* Hemisphere of radius 1 on y = 0 in [-1.1, 1.1] x [0, 1.1] x [-1.1, 1.1] with n x n/2 x n
  * cells (n even), clamped at y = 0; cut = 1: a vertical plane cut x = 0.05 through the
  * upper part y > 0.4 (it separates the top into two halves joined below); cut = 2: the
- * same plane through the whole body (two bodies, each clamped). */
-static inline void problem_hemisphere(fcm_ctx *ctx, fcm_index n, int cut, problem *p)
+ * same plane through the whole body (two bodies, each clamped); ratio: the space's
+ * constrain_ratio (copies of smaller support move with their piece). */
+static inline void problem_hemisphere_with(fcm_ctx *ctx, fcm_index n, int cut, double ratio,
+                                           problem *p)
 {
   const double lo[3] = {-1.1, 0, -1.1}, hi[3] = {1.1, 1.1, 1.1}, c[3] = {0, 0, 0};
   const fcm_index cells[3] = {n, n / 2, n};
@@ -104,10 +106,19 @@ static inline void problem_hemisphere(fcm_ctx *ctx, fcm_index n, int cut, proble
     TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, p->mesh, p->geom, p->rules0, s, &p->rules));
     fcm_surface_destroy(&s);
   }
-  TEST_OK(ctx, fcm_space_create_embedded(ctx, p->mesh, p->rules ? p->rules : p->rules0, &p->space));
+  fcm_space_options so = fcm_space_options_default();
+  so.constrain_ratio = ratio;
+  TEST_OK(ctx, fcm_space_create_embedded_with(ctx, p->mesh, p->rules ? p->rules : p->rules0, &so,
+                                              &p->space));
   finish_space(ctx, p, 0);
   const double flo[3] = {-2, 0, -2}, fhi[3] = {2, 0, 2};
   clamp_box(ctx, p, flo, fhi);
+}
+
+/* As problem_hemisphere_with() with the default constrain_ratio (1e-9). */
+static inline void problem_hemisphere(fcm_ctx *ctx, fcm_index n, int cut, problem *p)
+{
+  problem_hemisphere_with(ctx, n, cut, fcm_space_options_default().constrain_ratio, p);
 }
 
 /* Two balls of radius 0.3 at (0.5, 0.5, 0.5) and (1.5, 0.5, 0.5) in [0, 2] x [0, 1]^2 with

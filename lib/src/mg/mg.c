@@ -11,9 +11,13 @@
  *   scene options solver.preconditioner / solver.method "multigrid" (sim/linsolve.c);
  *   MINRES use (an SPD preconditioner of an indefinite tangent: build mg on K_psd); the
  *   fcm-scaling app (tests/mg/bench.c is its precursor: cholmod, cg-jacobi, cg-mg, mg).
- * - Known: the cut body's V-cycle factor depends on where the cut lies in the grid (0.2 to
- *   0.69 measured, not growing with n); coarse cells of blocks holding the cut's end bridge
- *   the cut there (Dick's "small cuts disappear on coarse levels"). The Galerkin product and
+ * - Known: with XFEM cuts the V-cycle factor depends on where the cut lies in the grid
+ *   (0.2 to 0.7 measured for n = 4 ... 28, not growing with n), also for a cut through the
+ *   whole body, so not the cut's end. Diagnosis: small-support copies (pieces holding 0.1 %
+ *   to 10 % of a node's support): split hemisphere n = 20 gives 0.69 with the default
+ *   constrain_ratio 1e-9 and 1e-3, 0.25 with 0.1 (tests/mg/convergence.c, env-free: use
+ *   problem_hemisphere_with). Next: nodal 3x3 block or piece-block (Schwarz) smoothing
+ *   near cut cells, as Longva's Schwarz blocks. The Galerkin product and
  *   the hierarchy build are sequential. fcm_mg_setup() needs the same eliminated rows.
  * - Dirichlet: eliminated rows (no off-diagonal entry) and coarse DOFs whose coinciding
  *   fine DOFs are all inactive stay in P (leaving them out made P rank deficient); coarse
@@ -400,7 +404,7 @@ static fcm_status coarsen(fcm_mg *m, int l)
   fcm_ctx *ctx = m->ctx;
   mg_level *F = &m->lev[l], *C = &m->lev[l + 1];
   fcm_index *uf = NULL, *cid = NULL, *edges = NULL, *cptr = NULL, *cusers = NULL, *cfill = NULL,
-            *scal_ptr = NULL, *scal_col = NULL, *anc = NULL, *anc_in = NULL;
+            *scal_ptr = NULL, *scal_col = NULL, *anc = NULL, *anc_in = NULL, *cused = NULL;
   double *scal_w = NULL;
   const fcm_index nf = F->ncell;
   for (int d = 0; d < 3; d++)
@@ -530,9 +534,11 @@ static fcm_status coarsen(fcm_mg *m, int l)
    * coarse cell whose material lies in the fine layer at the face sees its free fine DOFs
    * on one plane only) and the coarsest CHOLMOD factor fail. */
   FCM_ALLOC(ctx, ncopy + 1, anc);
+  FCM_ALLOC(ctx, ncopy + 1, cused);
   FCM_ALLOC(ctx, 3 * ncopy + 1, anc_in);
   for (fcm_index k = 0; k < nk; k++)
     for (fcm_index p = scal_ptr[k]; p < scal_ptr[k + 1]; p++) {
+      cused[scal_col[p]]++;
       if (scal_w[p] != 1.0) continue;
       const fcm_index K = scal_col[p];
       anc[K]++;
@@ -545,7 +551,10 @@ static fcm_status coarsen(fcm_mg *m, int l)
   for (fcm_index K = 0; K < ncopy; K++)
     for (int c = 0; c < 3; c++) {
       C->dof[3 * K + c] = 3 * K + c;
-      C->inactive[3 * K + c] = (unsigned char)(anc[K] > 0 && anc_in[3 * K + c] == anc[K]);
+      /* a corner no fine copy interpolates from (the elements of its cell use copies of
+       * other nodes in place of tiny ones there) has an empty column: inactive too */
+      C->inactive[3 * K + c] =
+          (unsigned char)(cused[K] == 0 || (anc[K] > 0 && anc_in[3 * K + c] == anc[K]));
     }
   const fcm_index n = C->n;
   /* 7. DOF prolongation (F->n x C->n) and its transpose */
@@ -607,6 +616,7 @@ cleanup:
   fcm__free(ctx, scal_col);
   fcm__free(ctx, scal_w);
   fcm__free(ctx, anc);
+  fcm__free(ctx, cused);
   fcm__free(ctx, anc_in);
   return st;
 }
@@ -653,6 +663,44 @@ static fcm_status spgemm_symbolic(fcm_ctx *ctx, fcm_index nrow, const fcm_index 
 cleanup:
   fcm__free(ctx, Cp);
   fcm__free(ctx, Cc);
+  return st;
+}
+
+/* Insert the missing diagonal entries into a square pattern (rows sorted), in place by
+ * reallocation. */
+static fcm_status add_diagonal(fcm_ctx *ctx, fcm_index n, fcm_index **ptr, int **col)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *p = *ptr, *np = NULL;
+  int *c = *col, *nc = NULL;
+  fcm_index missing = 0;
+  for (fcm_index i = 0; i < n; i++) {
+    int has = 0;
+    for (fcm_index q = p[i]; q < p[i + 1] && !has; q++)
+      has = c[q] == i;
+    missing += !has;
+  }
+  if (missing == 0) goto cleanup;
+  FCM_ALLOC(ctx, n + 1, np);
+  FCM_ALLOC(ctx, p[n] + missing + 1, nc);
+  fcm_index out = 0;
+  for (fcm_index i = 0; i < n; i++) {
+    int done = 0;
+    for (fcm_index q = p[i]; q < p[i + 1]; q++) {
+      if (!done && c[q] > i) nc[out++] = (int)i, done = 1;
+      if (c[q] == i) done = 1;
+      nc[out++] = c[q];
+    }
+    if (!done) nc[out++] = (int)i;
+    np[i + 1] = out;
+  }
+  fcm__free(ctx, p);
+  fcm__free(ctx, c);
+  *ptr = np, *col = nc;
+  np = NULL, nc = NULL;
+cleanup:
+  fcm__free(ctx, np);
+  fcm__free(ctx, nc);
   return st;
 }
 
@@ -872,7 +920,8 @@ fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
       int *cc = NULL;
       FCM_TRY(ctx, spgemm_symbolic(ctx, C->n, L->R_ptr, L->R_col, L->AP_ptr, L->AP_col, C->n,
                                    m->mark, &cp, &cc));
-      st = fcm_csr_create(ctx, C->n, C->n, cp, cc, FCM_CSR_SYMMETRIC, &C->Aown);
+      st = add_diagonal(ctx, C->n, &cp, &cc); /* rows of empty columns */
+      if (st == FCM_OK) st = fcm_csr_create(ctx, C->n, C->n, cp, cc, FCM_CSR_SYMMETRIC, &C->Aown);
       fcm__free(ctx, cp);
       fcm__free(ctx, cc);
       FCM_TRY(ctx, st);
