@@ -59,4 +59,9 @@ void fcm__eliminate_marked(fcm_csr *A, double *b, const unsigned char *con, cons
  * and the nodal coordinates X (nn x 3); returns det J (not positive: g is not written). */
 double fcm__fem_gradients(int nn, const double *X, const double *dN, double *g);
 
+/* The support of every DOF copy (num_dofs / 3 entries): the summed volume of the pieces
+ * (elements) that use it, 1 per element without rules. Used to pick a node's largest copy
+ * and to find the tiny copies Koschier's constraint moves. */
+void fcm__space_copy_support(const fcm_space *s, double *support);
+
 #endif /* FCM_FEM_IMPL_H */

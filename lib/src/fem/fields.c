@@ -177,16 +177,6 @@ cleanup:
   return st;
 }
 
-/* The volume of element e (its piece of the body), which the support of a DOF copy sums;
- * without rules every element counts 1 (there are no copies then). */
-static double element_volume(const fcm_space *s, fcm_index e)
-{
-  if (!s->rules) return 1.0;
-  fcm_index piece = s->elem_piece[e];
-  if (piece < 0) fcm_cell_rules_cell_pieces(s->rules, s->elem_cell[e], &piece); /* uncut */
-  return fcm_cell_rules_piece_volume(s->rules, piece);
-}
-
 fcm_status fcm_space_node_field(const fcm_space *s, const double *dofs, double *node_field)
 {
   fcm_status st = FCM_OK;
@@ -198,11 +188,7 @@ fcm_status fcm_space_node_field(const fcm_space *s, const double *dofs, double *
     copies = s->node_ncopy[a] > 1;
   if (copies) {
     FCM_ALLOC(s->ctx, s->num_dofs / 3 + 1, support);
-    for (fcm_index e = 0; e < s->num_elems; e++) {
-      const double vol = element_volume(s, e);
-      for (int a = 0; a < s->nn; a++)
-        support[s->elem_dof[e * s->nn + a] / 3] += vol;
-    }
+    fcm__space_copy_support(s, support);
   }
   for (fcm_index a = 0; a < s->num_nodes; a++) {
     fcm_index d = s->node_dof[a];

@@ -335,6 +335,17 @@ cleanup:
   return st;
 }
 
+void fcm__space_copy_support(const fcm_space *s, double *support)
+{
+  const fcm_index nn = s->nn;
+  memset(support, 0, sizeof *support * (size_t)(s->num_dofs / 3));
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    const double v = s->rules ? fcm_cell_rules_piece_volume(s->rules, s->elem_piece[e]) : 1.0;
+    for (int a = 0; a < nn; a++)
+      support[s->elem_dof[e * nn + a] / 3] += v;
+  }
+}
+
 /* Koschier et al. 2017, Sec. 6: a copy whose support (the volume of the pieces that use it)
  * is below `ratio` of its node's (the pieces of all the node's elements) barely contributes
  * and makes the system (nearly) singular; it is constrained to move with its piece: its
@@ -361,11 +372,7 @@ static fcm_status constrain_copies(fcm_space *s, double ratio, const fcm_index *
   FCM_ALLOC(ctx, ncopy + 1, uf);
   FCM_ALLOC(ctx, ncopy + 1, node_of);
   FCM_ALLOC(ctx, ncopy + 1, anchor);
-  for (fcm_index e = 0; e < s->num_elems; e++) {
-    const double v = fcm_cell_rules_piece_volume(s->rules, s->elem_piece[e]);
-    for (int a = 0; a < nn; a++)
-      venr[s->elem_dof[e * nn + a] / 3] += v;
-  }
+  fcm__space_copy_support(s, venr);
   /* which copies are tiny, each against its own node's support */
   fcm_index ntiny = 0;
   for (fcm_index n = 0; n < s->num_nodes; n++) {
