@@ -1,0 +1,1101 @@
+/* petsc: the PETSc + MPI adapter (fcm/petsc.h) — distributed linear elasticity, static and
+ * backward Euler, on a partition of the background cells. The only file that sees PETSc.
+ *
+ * NOTES (issue 14, for the next session) ---------------------------------------------------
+ * Done (phase 1):
+ * - build: FCM_WITH_PETSC (AUTO/ON/OFF) in CMakeLists.txt, FCM_HAVE_PETSC in fcm/version.h,
+ *   fcm.pc (variable petsc, Requires mpi-c) and fcmConfig.cmake (FCM_HAVE_PETSC, MPI::MPI_C);
+ *   setup.sh deps --petsc; .ci/run runs the mpi-labelled tests.
+ * - partition: PT-Scotch through MatPartitioning on the face graph of the active cells (Debian's
+ *   PETSc 3.18 has it), Morton-ordered fallback (FCM_PETSC_PARTITION_ORDERED). Equal weights:
+ *   cut cells cost more (their rules) — weight them by their point count next.
+ * - rules: each process builds the rules of its own cells (fcm_cell_rules_options.cell_mask);
+ *   the classification (intersection) runs twice on every process (once for the active set the
+ *   partition needs, once with the mask). Only simplification/stabilization/points are
+ *   distributed.
+ * - DOFs: global numbering, owner = lowest process among the cells using the DOF copy, the
+ *   PETSc index is contiguous per owner; the perm (space DOF -> PETSc index) and the space's
+ *   pattern are REPLICATED (O(DOFs + nnz) integers per process).
+ * - assembly: own elements only (fcm__assembly_element_linear), MatSetValues ADD_VALUES into a
+ *   preallocated MATMPIAIJ (block size 3), VECMPI loads; stiffness, mass, gravity.
+ * - constraints: node sets with fcm_motion (no release), symmetric elimination with
+ *   MatZeroRowsColumns on a copy of the system matrix (diag = mean diagonal), RHS lifted with the
+ *   unmodified matrix every step.
+ * - solver: KSP CG + GAMG + MatNullSpaceCreateRigidBody by default; options string (scene
+ *   solver.petsc_options) then command line; divergence -> FCM_ERR_NOT_CONVERGED with
+ *   KSPConvergedReasons[].
+ * - errors: every local phase ends in agree(): an error on any process is returned on all with
+ *   the lowest failing process's message (tests/petsc: bad input on one rank, no hang).
+ * Not done:
+ * - Newton / hyperelastic materials / the integrator's time stepping on PETSc (a hook in
+ *   lib/src/sim/linsolve.c would replace only the solve; the assembly seam is
+ *   fcm_assembly_workspace_hyperelastic, which needs an element-mask variant): this module is
+ *   the separate static + dynamic LINEAR driver the task allowed.
+ * - Nitsche/penalty boundary constraints, tractions, pressure, body-force fields, damping,
+ *   initial velocities, cuts, checkpoints, pvtu output: fcm-sim --backend petsc refuses them
+ *   with a message naming the feature.
+ * - geometry kept whole on every process (no AABB crop), mesh replicated.
+ * - README projection for 1e8 DOFs (memory and time per DOF are printed by
+ *   tests/petsc/bench: see the report).
+ * ------------------------------------------------------------------------------------------ */
+#include "fcm/petsc.h"
+
+#include "core/core_impl.h"
+#include "embed/embed_impl.h"
+#include "fem/fem_impl.h"
+
+#include <petscksp.h>
+#include <petscmat.h>
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct fcm_petsc_problem {
+  fcm_ctx *ctx;
+  MPI_Comm comm;
+  int size, rank;
+  const fcm_mesh *mesh;
+  fcm_material mat;
+  fcm_petsc_options opts;
+  char *petsc_options; /* copy */
+  fcm_petsc_partition partition;
+  fcm_cell_rules *rules; /* this process's cells carry points */
+  fcm_space *space;      /* replicated topology */
+  fcm_assembly_workspace *aws;
+  fcm_index n;        /* global DOFs */
+  fcm_index ncopy;    /* n / 3 */
+  int *cell_owner;    /* num_cells (-1: inactive) */
+  int *copy_owner;    /* ncopy */
+  PetscInt *perm;     /* ncopy: PETSc block index of each copy */
+  PetscInt nlocal;    /* owned copies */
+  PetscInt first;     /* first owned PETSc block index */
+  fcm_index nelem_own;
+  /* constraints: DOFs (space numbering), motion of each, node of each */
+  fcm_index ncon;
+  fcm_index *con_dof, *con_node;
+  int *con_comp;
+  int *con_motion;
+  fcm_motion *motions;
+  int num_motions;
+  unsigned char *is_con; /* n */
+  double gravity[3];
+  int has_gravity;
+  int is_setup;
+  /* PETSc objects */
+  Mat K, M, S, Se; /* stiffness, mass (dynamic), system, system eliminated */
+  Vec f, u, v, b, x, g, w;
+  KSP ksp;
+  PetscInt *rows; /* owned constrained rows (PETSc indices) */
+  PetscInt nrows;
+  double diag;
+  double t;
+  long long steps, total_iterations;
+  double time_rules, time_assembly, time_setup;
+};
+
+/* ---------------------------------------------------------------- errors */
+
+/* A PETSc call: on failure, record its message as FCM_ERR_INTERNAL. */
+#define PCALL(ctx, call)                                                                           \
+  do {                                                                                             \
+    PetscErrorCode ierr_ = (call);                                                                 \
+    if (ierr_) {                                                                                   \
+      st = petsc_error((ctx), ierr_, #call, __FILE__, __LINE__, __func__);                         \
+      goto cleanup;                                                                                \
+    }                                                                                              \
+  } while (0)
+
+static fcm_status petsc_error(fcm_ctx *ctx, PetscErrorCode ierr, const char *call, const char *file,
+                              int line, const char *func)
+{
+  const char *text = NULL;
+  char *specific = NULL;
+  PetscErrorMessage((int)ierr, &text, &specific);
+  return fcm__error(ctx, FCM_ERR_INTERNAL, file, line, func, "petsc: %s failed: %s%s%s (error %d)",
+                    call, text ? text : "unknown error", specific && *specific ? ": " : "",
+                    specific ? specific : "", (int)ierr);
+}
+
+/* Every process learns whether any failed: on failure somewhere, every process returns the
+ * status and message of the lowest failing process (the others record it as their error). */
+static fcm_status agree(fcm_ctx *ctx, MPI_Comm comm, fcm_status st)
+{
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  int mine = st != FCM_OK ? rank : size, first = size;
+  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm);
+  if (first == size) return FCM_OK;
+  char msg[1024];
+  int code = (int)st;
+  memset(msg, 0, sizeof msg);
+  if (rank == first) snprintf(msg, sizeof msg, "%s", fcm_ctx_error_message(ctx));
+  MPI_Bcast(msg, (int)sizeof msg, MPI_CHAR, first, comm);
+  MPI_Bcast(&code, 1, MPI_INT, first, comm);
+  if (rank == first) {
+    if (size > 1) fcm__error_prefix(ctx, "(on this process)");
+    return st;
+  }
+  return fcm__error(ctx, (fcm_status)code, __FILE__, __LINE__, __func__,
+                    "process %d of %d failed: %s", first, size, msg);
+}
+
+/* ---------------------------------------------------------------- init */
+
+static int fcm_petsc_started_mpi = 0;
+
+fcm_status fcm_petsc_initialize(fcm_ctx *ctx, int *argc, char ***argv)
+{
+  fcm_status st = FCM_OK;
+  int mpi_on = 0;
+  PetscBool on = PETSC_FALSE;
+  MPI_Initialized(&mpi_on);
+  fcm_petsc_started_mpi = !mpi_on;
+  PCALL(ctx, PetscInitialized(&on));
+  if (!on) {
+    PetscErrorCode ierr = PetscInitialize(argc, argv, NULL, NULL);
+    FCM_CHECK(ierr == 0, ctx, FCM_ERR_INTERNAL, "petsc: PetscInitialize failed (error %d)",
+              (int)ierr);
+  }
+cleanup:
+  return st;
+}
+
+void fcm_petsc_finalize(void)
+{
+  PetscBool on = PETSC_FALSE;
+  if (PetscInitialized(&on) == 0 && on) PetscFinalize();
+}
+
+const char *fcm_petsc_partition_name(fcm_petsc_partition p)
+{
+  switch (p) {
+  case FCM_PETSC_PARTITION_AUTO:
+    return "auto";
+  case FCM_PETSC_PARTITION_PTSCOTCH:
+    return "ptscotch";
+  case FCM_PETSC_PARTITION_ORDERED:
+    return "ordered";
+  default:
+    return "invalid";
+  }
+}
+
+fcm_petsc_options fcm_petsc_options_default(void)
+{
+  fcm_petsc_options o;
+  memset(&o, 0, sizeof o);
+  o.kind = FCM_INTEGRATOR_BACKWARD_EULER;
+  o.dt = 1.0 / 60.0;
+  o.partition = FCM_PETSC_PARTITION_AUTO;
+  o.petsc_options = NULL;
+  o.rtol = 1e-10;
+  o.max_iterations = 10000;
+  o.rules = fcm_cell_rules_options_default();
+  o.assembly = fcm_assembly_options_default();
+  return o;
+}
+
+/* ---------------------------------------------------------------- partition */
+
+/* Spread the 21 low bits of x to every third bit. */
+static uint64_t spread3(uint64_t x)
+{
+  x &= 0x1fffff;
+  x = (x | x << 32) & 0x1f00000000ffffULL;
+  x = (x | x << 16) & 0x1f0000ff0000ffULL;
+  x = (x | x << 8) & 0x100f00f00f00f00fULL;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+  x = (x | x << 2) & 0x1249249249249249ULL;
+  return x;
+}
+
+typedef struct keyed {
+  uint64_t key;
+  fcm_index cell;
+} keyed;
+
+static int cmp_keyed(const void *a, const void *b)
+{
+  const keyed *x = a, *y = b;
+  if (x->key != y->key) return x->key < y->key ? -1 : 1;
+  return x->cell < y->cell ? -1 : x->cell > y->cell;
+}
+
+/* ORDERED: active cells along the Morton curve of their centroids, equal contiguous parts. */
+static fcm_status partition_ordered(fcm_petsc_problem *P, const unsigned char *active,
+                                    fcm_index nact)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_index nc = fcm_mesh_num_cells(P->mesh);
+  const int nn = fcm_mesh_nodes_per_cell(P->mesh);
+  keyed *k = NULL;
+  double *X = NULL, lo[3], hi[3];
+  FCM_ALLOC(ctx, nact + 1, k);
+  FCM_ALLOC(ctx, 3 * nn, X);
+  fcm_mesh_bounding_box(P->mesh, lo, hi);
+  fcm_index m = 0;
+  for (fcm_index c = 0; c < nc; c++) {
+    if (!active[c]) continue;
+    double x[3] = {0, 0, 0};
+    fcm_mesh_cell_coords(P->mesh, c, X);
+    for (int a = 0; a < nn; a++)
+      for (int i = 0; i < 3; i++)
+        x[i] += X[3 * a + i] / nn;
+    uint64_t key = 0;
+    for (int i = 0; i < 3; i++) {
+      double s = hi[i] > lo[i] ? (x[i] - lo[i]) / (hi[i] - lo[i]) : 0.0;
+      uint64_t q = (uint64_t)(fmin(fmax(s, 0.0), 1.0) * 2097151.0);
+      key |= spread3(q) << i;
+    }
+    k[m].key = key;
+    k[m].cell = c;
+    m++;
+  }
+  qsort(k, (size_t)m, sizeof *k, cmp_keyed);
+  for (fcm_index i = 0; i < m; i++)
+    P->cell_owner[k[i].cell] = (int)(i * P->size / FCM_MAX(m, 1));
+cleanup:
+  fcm__free(ctx, k);
+  fcm__free(ctx, X);
+  return st;
+}
+
+/* PTSCOTCH: MatPartitioning of the face graph of the active cells; each process hands a
+ * contiguous block of them to PETSc, the result is gathered on every process. */
+static fcm_status partition_graph(fcm_petsc_problem *P, const unsigned char *active,
+                                  fcm_index nact)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_index nc = fcm_mesh_num_cells(P->mesh);
+  const int nf = fcm_mesh_get_element_info(P->mesh)->num_faces;
+  const fcm_index *nb = fcm_mesh_neighbors(P->mesh);
+  fcm_index *act_id = NULL, *act_cell = NULL;
+  PetscInt *ia = NULL, *ja = NULL;
+  Mat adj = NULL;
+  MatPartitioning part = NULL;
+  IS is = NULL, isg = NULL;
+  const PetscInt *own = NULL;
+  FCM_ALLOC(ctx, nc + 1, act_id);
+  FCM_ALLOC(ctx, nact + 1, act_cell);
+  fcm_index m = 0;
+  for (fcm_index c = 0; c < nc; c++) {
+    act_id[c] = active[c] ? m : -1;
+    if (active[c]) act_cell[m++] = c;
+  }
+  const fcm_index lo = nact * P->rank / P->size, hi = nact * (P->rank + 1) / P->size;
+  const PetscInt ml = (PetscInt)(hi - lo);
+  PCALL(ctx, PetscMalloc1(ml + 1, &ia));
+  PCALL(ctx, PetscMalloc1(ml * nf + 1, &ja));
+  ia[0] = 0;
+  for (fcm_index i = lo; i < hi; i++) {
+    PetscInt r = (PetscInt)(i - lo), cnt = ia[r];
+    const fcm_index c = act_cell[i];
+    for (int f = 0; f < nf; f++) {
+      fcm_index o = nb[(size_t)nf * c + f];
+      if (o >= 0 && active[o]) ja[cnt++] = (PetscInt)act_id[o];
+    }
+    /* MatCreateMPIAdj wants sorted columns */
+    for (PetscInt a = ia[r] + 1; a < cnt; a++)
+      for (PetscInt b = a; b > ia[r] && ja[b - 1] > ja[b]; b--) {
+        PetscInt t = ja[b];
+        ja[b] = ja[b - 1];
+        ja[b - 1] = t;
+      }
+    ia[r + 1] = cnt;
+  }
+  PCALL(ctx, MatCreateMPIAdj(P->comm, ml, (PetscInt)nact, ia, ja, NULL, &adj));
+  ia = ja = NULL; /* owned by adj */
+  PCALL(ctx, MatPartitioningCreate(P->comm, &part));
+  PCALL(ctx, MatPartitioningSetAdjacency(part, adj));
+  PCALL(ctx, MatPartitioningSetType(part, MATPARTITIONINGPTSCOTCH));
+  PCALL(ctx, MatPartitioningSetFromOptions(part));
+  PCALL(ctx, MatPartitioningApply(part, &is));
+  PCALL(ctx, ISAllGather(is, &isg));
+  PCALL(ctx, ISGetIndices(isg, &own));
+  for (fcm_index i = 0; i < nact; i++)
+    P->cell_owner[act_cell[i]] = (int)own[i];
+  PCALL(ctx, ISRestoreIndices(isg, &own));
+cleanup:
+  PetscFree(ia);
+  PetscFree(ja);
+  ISDestroy(&is);
+  ISDestroy(&isg);
+  MatPartitioningDestroy(&part);
+  MatDestroy(&adj);
+  fcm__free(ctx, act_id);
+  fcm__free(ctx, act_cell);
+  return st;
+}
+
+/* ---------------------------------------------------------------- create */
+
+static fcm_status check_inputs(fcm_petsc_problem *P, const fcm_petsc_options *o)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  FCM_TRY(ctx, fcm_material_validate(ctx, &P->mat));
+  FCM_CHECK(P->mat.model == FCM_MATERIAL_LINEAR, ctx, FCM_ERR_UNSUPPORTED,
+            "petsc: material model %d: the PETSc backend solves linear elasticity only (model "
+            "linear); use the serial backend for hyperelastic materials",
+            (int)P->mat.model);
+  FCM_CHECK(o->kind == FCM_INTEGRATOR_STATIC || o->kind == FCM_INTEGRATOR_BACKWARD_EULER, ctx,
+            FCM_ERR_ARG, "petsc: kind = %d is neither static (0) nor backward Euler (1)",
+            (int)o->kind);
+  FCM_CHECK(isfinite(o->dt) && o->dt > 0.0, ctx, FCM_ERR_ARG, "petsc: dt = %g must be > 0", o->dt);
+  FCM_CHECK((int)o->partition >= 0 && o->partition < FCM_PETSC_PARTITION_COUNT, ctx, FCM_ERR_ARG,
+            "petsc: partition = %d is not a method (0 auto, 1 ptscotch, 2 ordered)",
+            (int)o->partition);
+  FCM_CHECK(o->rtol > 0.0 && o->rtol < 1.0, ctx, FCM_ERR_ARG,
+            "petsc: rtol = %g outside (0, 1)", o->rtol);
+  FCM_CHECK(o->max_iterations >= 1, ctx, FCM_ERR_ARG, "petsc: max_iterations = %d must be >= 1",
+            o->max_iterations);
+  FCM_CHECK(o->rules.simplify != FCM_CELL_SIMPLIFY_AUTO, ctx, FCM_ERR_UNSUPPORTED,
+            "petsc: rules.simplify = auto is not supported (the choice would differ between "
+            "processes); use on or off");
+cleanup:
+  return st;
+}
+
+/* The rules (geometry) or the plain space, with this process's cells flagged in `mask`
+ * (NULL: classification pass, no cell gets points). */
+static fcm_status build_space(fcm_petsc_problem *P, const fcm_geometry *geom,
+                              const unsigned char *mask, const unsigned char *none)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  fcm_assembly_workspace_destroy(&P->aws);
+  fcm_space_destroy(&P->space);
+  fcm_cell_rules_destroy(&P->rules);
+  if (geom) {
+    fcm_cell_rules_options ro = P->opts.rules;
+    ro.kinds = FCM_RULES_STIFFNESS |
+               (P->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER ? FCM_RULES_MASS : 0u);
+    ro.cell_mask = mask ? mask : none;
+    FCM_TRY(ctx, fcm_cell_rules_create(ctx, P->mesh, geom, &ro, &P->rules));
+    FCM_TRY(ctx, fcm_space_create_embedded(ctx, P->mesh, P->rules, &P->space));
+  } else {
+    FCM_TRY(ctx, fcm_space_create(ctx, P->mesh, NULL, &P->space));
+  }
+cleanup:
+  return st;
+}
+
+/* Ownership of the DOF copies and the PETSc numbering. */
+static fcm_status number_dofs(fcm_petsc_problem *P)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_space *s = P->space;
+  const int nn = s->nn;
+  PetscInt *count = NULL;
+  P->n = s->num_dofs;
+  P->ncopy = P->n / 3;
+  FCM_CHECK(P->n < (fcm_index)INT32_MAX, ctx, FCM_ERR_UNSUPPORTED,
+            "petsc: %lld DOFs exceed PETSc's 32-bit indices (Debian's build); use a PETSc with "
+            "--with-64-bit-indices",
+            (long long)P->n);
+  FCM_ALLOC(ctx, P->ncopy + 1, P->copy_owner);
+  FCM_ALLOC(ctx, P->ncopy + 1, P->perm);
+  FCM_ALLOC(ctx, P->size + 1, count);
+  for (fcm_index k = 0; k < P->ncopy; k++)
+    P->copy_owner[k] = P->size;
+  P->nelem_own = 0;
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    const int r = P->cell_owner[s->elem_cell[e]];
+    if (r == P->rank) P->nelem_own++;
+    for (int a = 0; a < nn; a++) {
+      const fcm_index k = s->elem_dof[e * nn + a] / 3;
+      if (r < P->copy_owner[k]) P->copy_owner[k] = r;
+    }
+  }
+  for (fcm_index k = 0; k < P->ncopy; k++) {
+    FCM_CHECK(P->copy_owner[k] < P->size, ctx, FCM_ERR_INTERNAL,
+              "petsc: DOF copy %lld belongs to no element", (long long)k);
+    count[P->copy_owner[k]]++;
+  }
+  /* exclusive prefix: the first block of each process, then running positions */
+  PetscInt acc = 0;
+  for (int r = 0; r <= P->size; r++) {
+    PetscInt c = count[r];
+    count[r] = acc;
+    acc += c;
+  }
+  P->first = count[P->rank];
+  P->nlocal = count[P->rank + 1] - count[P->rank];
+  for (fcm_index k = 0; k < P->ncopy; k++)
+    P->perm[k] = count[P->copy_owner[k]]++;
+cleanup:
+  fcm__free(ctx, count);
+  return st;
+}
+
+/* A preallocated MATMPIAIJ (block size 3) with the space's pattern on the owned rows. */
+static fcm_status create_matrix(fcm_petsc_problem *P, Mat *A)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_space *s = P->space;
+  PetscInt *dnz = NULL, *onz = NULL;
+  const PetscInt nl = 3 * P->nlocal;
+  FCM_ALLOC(ctx, nl + 1, dnz);
+  FCM_ALLOC(ctx, nl + 1, onz);
+  for (fcm_index k = 0; k < P->ncopy; k++) {
+    if (P->copy_owner[k] != P->rank) continue;
+    PetscInt d = 0, o = 0;
+    for (fcm_index j = s->node_ptr[k]; j < s->node_ptr[k + 1]; j++) {
+      if (P->copy_owner[s->node_adj[j]] == P->rank)
+        d += 3;
+      else
+        o += 3;
+    }
+    const PetscInt row = 3 * (P->perm[k] - P->first);
+    for (int i = 0; i < 3; i++) {
+      dnz[row + i] = d;
+      onz[row + i] = o;
+    }
+  }
+  PCALL(ctx, MatCreate(P->comm, A));
+  PCALL(ctx, MatSetSizes(*A, nl, nl, (PetscInt)P->n, (PetscInt)P->n));
+  PCALL(ctx, MatSetType(*A, MATMPIAIJ));
+  PCALL(ctx, MatSetBlockSize(*A, 3));
+  PCALL(ctx, MatMPIAIJSetPreallocation(*A, 0, dnz, 0, onz));
+  PCALL(ctx, MatSetOption(*A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+  PCALL(ctx, MatSetOption(*A, MAT_SYMMETRIC, PETSC_TRUE));
+cleanup:
+  fcm__free(ctx, dnz);
+  fcm__free(ctx, onz);
+  return st;
+}
+
+static fcm_status create_vectors(fcm_petsc_problem *P)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  PCALL(ctx, VecCreateMPI(P->comm, 3 * P->nlocal, (PetscInt)P->n, &P->f));
+  PCALL(ctx, VecSetBlockSize(P->f, 3));
+  Vec *vs[] = {&P->u, &P->v, &P->b, &P->x, &P->g, &P->w};
+  for (size_t i = 0; i < sizeof vs / sizeof vs[0]; i++) {
+    PCALL(ctx, VecDuplicate(P->f, vs[i]));
+    PCALL(ctx, VecSet(*vs[i], 0.0));
+  }
+  PCALL(ctx, VecSet(P->f, 0.0));
+cleanup:
+  return st;
+}
+
+fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh *mesh,
+                                    const fcm_geometry *geom, const fcm_material *mat,
+                                    const fcm_petsc_options *opts, fcm_petsc_problem **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_petsc_problem *P = NULL;
+  unsigned char *mask = NULL, *none = NULL;
+  const double t0 = fcm_wtime();
+  FCM_CHECK(out, ctx, FCM_ERR_ARG, "petsc: output pointer is NULL");
+  *out = NULL;
+  FCM_CHECK(ctx && mesh && mat, ctx, FCM_ERR_ARG, "petsc: NULL argument (ctx, mesh, material)");
+  FCM_ALLOC(ctx, 1, P);
+  P->ctx = ctx;
+  P->comm = MPI_COMM_NULL;
+  if (MPI_Comm_dup(comm, &P->comm) != MPI_SUCCESS) {
+    P->comm = MPI_COMM_NULL;
+    FCM_CHECK(0, ctx, FCM_ERR_ARG, "petsc: MPI_Comm_dup failed (invalid communicator?)");
+  }
+  MPI_Comm_size(P->comm, &P->size);
+  MPI_Comm_rank(P->comm, &P->rank);
+  P->mesh = mesh;
+  P->mat = *mat;
+  P->opts = opts ? *opts : fcm_petsc_options_default();
+  if (P->opts.petsc_options) {
+    size_t len = strlen(P->opts.petsc_options);
+    P->petsc_options = fcm__calloc(ctx, len + 1, 1);
+    if (P->petsc_options)
+      memcpy(P->petsc_options, P->opts.petsc_options, len);
+    else
+      st = FCM_ERR_ALLOC;
+  }
+  P->opts.petsc_options = NULL;
+  if (st == FCM_OK) st = check_inputs(P, &P->opts);
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+
+  /* 1. the active cells: rules without points (classification) or every cell */
+  const fcm_index nc = fcm_mesh_num_cells(mesh);
+  const double tr = fcm_wtime();
+  none = fcm__calloc(ctx, (size_t)nc + 1, 1);
+  mask = fcm__calloc(ctx, (size_t)nc + 1, 1);
+  P->cell_owner = fcm__calloc(ctx, (size_t)nc + 1, sizeof *P->cell_owner);
+  st = none && mask && P->cell_owner ? FCM_OK : FCM_ERR_ALLOC;
+  if (st == FCM_OK) st = build_space(P, geom, NULL, none);
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  fcm_index nact = 0;
+  for (fcm_index c = 0; c < nc; c++) {
+    P->cell_owner[c] = -1;
+    nact += P->space->active[c] != 0;
+  }
+
+  /* 2. partition the active cells */
+  P->partition = P->opts.partition == FCM_PETSC_PARTITION_AUTO ? FCM_PETSC_PARTITION_PTSCOTCH
+                                                               : P->opts.partition;
+  if (P->size == 1) {
+    for (fcm_index c = 0; c < nc; c++)
+      if (P->space->active[c]) P->cell_owner[c] = 0;
+  } else if (P->partition == FCM_PETSC_PARTITION_PTSCOTCH) {
+    st = partition_graph(P, P->space->active, nact);
+  } else {
+    st = partition_ordered(P, P->space->active, nact);
+  }
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+
+  /* 3. this process's rules; the space must come out the same (it depends on the
+   * classification only) */
+  if (geom) {
+    const fcm_index ndofs0 = P->space->num_dofs, nel0 = P->space->num_elems;
+    for (fcm_index c = 0; c < nc; c++)
+      mask[c] = P->cell_owner[c] == P->rank;
+    st = build_space(P, geom, mask, none);
+    if (st == FCM_OK && (P->space->num_dofs != ndofs0 || P->space->num_elems != nel0))
+      st = fcm__error(ctx, FCM_ERR_INTERNAL, __FILE__, __LINE__, __func__,
+                      "petsc: the space of the masked rules has %lld DOFs / %lld elements, the "
+                      "classification gave %lld / %lld",
+                      (long long)P->space->num_dofs, (long long)P->space->num_elems,
+                      (long long)ndofs0, (long long)nel0);
+    FCM_TRY(ctx, agree(ctx, P->comm, st));
+  }
+  P->time_rules = fcm_wtime() - tr;
+  st = fcm_assembly_workspace_create(P->space, &P->opts.assembly, &P->aws);
+  if (st == FCM_OK) st = number_dofs(P);
+  if (st == FCM_OK) {
+    P->is_con = fcm__calloc(ctx, (size_t)P->n + 1, 1);
+    if (!P->is_con) st = FCM_ERR_ALLOC;
+  }
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+
+  /* 4. matrices and vectors (collective) */
+  st = create_matrix(P, &P->K);
+  if (st == FCM_OK && P->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) st = create_matrix(P, &P->M);
+  if (st == FCM_OK) st = create_vectors(P);
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  P->time_setup = fcm_wtime() - t0;
+  *out = P;
+  P = NULL;
+cleanup:
+  fcm__free(ctx, mask);
+  fcm__free(ctx, none);
+  fcm_petsc_problem_destroy(&P);
+  return st;
+}
+
+void fcm_petsc_problem_destroy(fcm_petsc_problem **problem)
+{
+  if (!problem || !*problem) return;
+  fcm_petsc_problem *P = *problem;
+  fcm_ctx *ctx = P->ctx;
+  KSPDestroy(&P->ksp);
+  Mat *ms[] = {&P->K, &P->M, &P->S, &P->Se};
+  for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++)
+    MatDestroy(ms[i]);
+  Vec *vs[] = {&P->f, &P->u, &P->v, &P->b, &P->x, &P->g, &P->w};
+  for (size_t i = 0; i < sizeof vs / sizeof vs[0]; i++)
+    VecDestroy(vs[i]);
+  PetscFree(P->rows);
+  fcm_assembly_workspace_destroy(&P->aws);
+  fcm_space_destroy(&P->space);
+  fcm_cell_rules_destroy(&P->rules);
+  void *arrays[] = {P->petsc_options, P->cell_owner, P->copy_owner, P->perm,    P->con_dof,
+                    P->con_node,      P->con_comp,   P->con_motion, P->motions, P->is_con};
+  for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
+    fcm__free(ctx, arrays[i]);
+  if (P->comm != MPI_COMM_NULL) MPI_Comm_free(&P->comm);
+  fcm__free(ctx, P);
+  *problem = NULL;
+}
+
+/* ---------------------------------------------------------------- configuration */
+
+fcm_status fcm_petsc_problem_add_gravity(fcm_petsc_problem *P, const double accel[3])
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
+  fcm_ctx *ctx = P->ctx;
+  if (P->is_setup)
+    st = fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                    "petsc: add_gravity after setup");
+  else if (!accel || !isfinite(accel[0]) || !isfinite(accel[1]) || !isfinite(accel[2]))
+    st = fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                    "petsc: gravity acceleration is NULL or not finite");
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  for (int i = 0; i < 3; i++)
+    P->gravity[i] += accel[i];
+  P->has_gravity = 1;
+cleanup:
+  return st;
+}
+
+static int finite3(const double x[3])
+{
+  return isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]);
+}
+
+static fcm_status add_constraint_local(fcm_petsc_problem *P, fcm_index num_nodes,
+                                       const fcm_index *nodes, const fcm_motion *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_space *s = P->space;
+  FCM_CHECK(!P->is_setup, ctx, FCM_ERR_ARG, "petsc: add_constraint after setup");
+  FCM_CHECK(m && num_nodes >= 0 && (num_nodes == 0 || nodes), ctx, FCM_ERR_ARG,
+            "petsc: constraint: NULL motion or nodes, or num_nodes = %lld < 0",
+            (long long)num_nodes);
+  FCM_CHECK(finite3(m->velocity) && finite3(m->center) && finite3(m->axis) &&
+                isfinite(m->angular_speed) && isfinite(m->start) && !isnan(m->end) &&
+                m->end >= m->start,
+            ctx, FCM_ERR_ARG,
+            "petsc: constraint: motion with a non-finite member or end < start");
+  FCM_CHECK(!m->release, ctx, FCM_ERR_UNSUPPORTED,
+            "petsc: constraint: release (a constraint set that changes in time) is not "
+            "supported by the PETSc backend");
+  fcm_index add = 0;
+  for (fcm_index k = 0; k < num_nodes; k++) {
+    FCM_CHECK(nodes[k] >= 0 && nodes[k] < s->num_nodes, ctx, FCM_ERR_ARG,
+              "petsc: constraint: node %lld (entry %lld) outside [0, %lld)", (long long)nodes[k],
+              (long long)k, (long long)s->num_nodes);
+    add += 3 * s->node_ncopy[nodes[k]];
+  }
+  FCM_CHECK(fcm__resize(ctx, (void **)&P->motions, (size_t)P->num_motions,
+                        (size_t)P->num_motions + 1, sizeof *P->motions) == FCM_OK &&
+                fcm__resize(ctx, (void **)&P->con_dof, (size_t)P->ncon, (size_t)(P->ncon + add),
+                            sizeof *P->con_dof) == FCM_OK &&
+                fcm__resize(ctx, (void **)&P->con_node, (size_t)P->ncon, (size_t)(P->ncon + add),
+                            sizeof *P->con_node) == FCM_OK &&
+                fcm__resize(ctx, (void **)&P->con_comp, (size_t)P->ncon, (size_t)(P->ncon + add),
+                            sizeof *P->con_comp) == FCM_OK &&
+                fcm__resize(ctx, (void **)&P->con_motion, (size_t)P->ncon,
+                            (size_t)(P->ncon + add), sizeof *P->con_motion) == FCM_OK,
+            ctx, FCM_ERR_ALLOC, "petsc: constraint: out of memory");
+  P->motions[P->num_motions] = *m;
+  for (fcm_index k = 0; k < num_nodes; k++) {
+    const fcm_index nd = nodes[k];
+    for (fcm_index c = 0; c < s->node_ncopy[nd]; c++)
+      for (int i = 0; i < 3; i++) {
+        if (!m->components[i]) continue;
+        const fcm_index d = s->node_dof[nd] + 3 * c + i;
+        if (P->is_con[d]) continue; /* listed twice in this set; another set: checked below */
+        P->is_con[d] = (unsigned char)(P->num_motions + 1 > 255 ? 255 : P->num_motions + 1);
+        P->con_dof[P->ncon] = d;
+        P->con_node[P->ncon] = nd;
+        P->con_comp[P->ncon] = i;
+        P->con_motion[P->ncon] = P->num_motions;
+        P->ncon++;
+      }
+  }
+  P->num_motions++;
+cleanup:
+  return st;
+}
+
+fcm_status fcm_petsc_problem_add_constraint(fcm_petsc_problem *P, fcm_index num_nodes,
+                                            const fcm_index *nodes, const fcm_motion *motion)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
+  st = add_constraint_local(P, num_nodes, nodes, motion);
+  FCM_TRY(P->ctx, agree(P->ctx, P->comm, st));
+cleanup:
+  return st;
+}
+
+/* ---------------------------------------------------------------- setup */
+
+/* Add this process's elements of `form` into A (matrix terms) or f (vector terms). */
+static fcm_status assemble_local(fcm_petsc_problem *P, const fcm_linear_form *form, Mat A, Vec f)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_space *s = P->space;
+  const int nn = s->nn, nd = 3 * nn;
+  double *Ke = NULL, *fe = NULL;
+  PetscInt *idx = NULL;
+  FCM_ALLOC(ctx, (size_t)nd * nd, Ke);
+  FCM_ALLOC(ctx, nd, fe);
+  FCM_ALLOC(ctx, nd, idx);
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    if (P->cell_owner[s->elem_cell[e]] != P->rank) continue;
+    FCM_TRY(ctx, fcm__assembly_element_linear(P->aws, form, e, A ? Ke : NULL, f ? fe : NULL));
+    for (int a = 0; a < nn; a++) {
+      const fcm_index d = s->elem_dof[e * nn + a];
+      for (int i = 0; i < 3; i++)
+        idx[3 * a + i] = 3 * P->perm[d / 3] + i;
+    }
+    if (A) PCALL(ctx, MatSetValues(A, nd, idx, nd, idx, Ke, ADD_VALUES));
+    if (f) PCALL(ctx, VecSetValues(f, nd, idx, fe, ADD_VALUES));
+  }
+cleanup:
+  fcm__free(ctx, Ke);
+  fcm__free(ctx, fe);
+  fcm__free(ctx, idx);
+  return st;
+}
+
+/* The assembly of all terms of this process: local element loops (errors agreed on before
+ * the collective MatAssembly). */
+static fcm_status assemble_all(fcm_petsc_problem *P)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  fcm_linear_form form = fcm_linear_form_default();
+  form.material = &P->mat;
+  form.term = FCM_LINEAR_STIFFNESS;
+  st = assemble_local(P, &form, P->K, NULL);
+  if (st == FCM_OK && P->M) {
+    form.term = FCM_LINEAR_MASS;
+    st = assemble_local(P, &form, P->M, NULL);
+  }
+  if (st == FCM_OK && P->has_gravity) {
+    form.term = FCM_LINEAR_BODY_FORCE;
+    form.accel = P->gravity;
+    st = assemble_local(P, &form, NULL, P->f);
+  }
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  PCALL(ctx, MatAssemblyBegin(P->K, MAT_FINAL_ASSEMBLY));
+  PCALL(ctx, MatAssemblyEnd(P->K, MAT_FINAL_ASSEMBLY));
+  if (P->M) {
+    PCALL(ctx, MatAssemblyBegin(P->M, MAT_FINAL_ASSEMBLY));
+    PCALL(ctx, MatAssemblyEnd(P->M, MAT_FINAL_ASSEMBLY));
+  }
+  PCALL(ctx, VecAssemblyBegin(P->f));
+  PCALL(ctx, VecAssemblyEnd(P->f));
+cleanup:
+  return st;
+}
+
+/* Coordinates of the owned DOF copies (their node's), block size 3, for the rigid-body modes. */
+static fcm_status near_null_space(fcm_petsc_problem *P, Mat A)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_space *s = P->space;
+  const double *X = fcm_mesh_coords(P->mesh);
+  Vec coords = NULL;
+  MatNullSpace nsp = NULL;
+  PetscScalar *c = NULL;
+  PCALL(ctx, VecDuplicate(P->f, &coords));
+  PCALL(ctx, VecGetArray(coords, &c));
+  for (fcm_index nd = 0; nd < s->num_nodes; nd++)
+    for (fcm_index k = 0; k < s->node_ncopy[nd]; k++) {
+      const fcm_index copy = s->node_dof[nd] / 3 + k;
+      if (P->copy_owner[copy] != P->rank) continue;
+      const PetscInt r = 3 * (P->perm[copy] - P->first);
+      for (int i = 0; i < 3; i++)
+        c[r + i] = X[3 * nd + i];
+    }
+  PCALL(ctx, VecRestoreArray(coords, &c));
+  c = NULL;
+  PCALL(ctx, MatNullSpaceCreateRigidBody(coords, &nsp));
+  PCALL(ctx, MatSetNearNullSpace(A, nsp));
+cleanup:
+  if (c) VecRestoreArray(coords, &c);
+  MatNullSpaceDestroy(&nsp);
+  VecDestroy(&coords);
+  return st;
+}
+
+/* The options database: the problem's string under the command line (re-inserted after it,
+ * so a key both give takes the command line's value). */
+static fcm_status insert_options(fcm_petsc_problem *P)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  if (!P->petsc_options || !*P->petsc_options) return FCM_OK;
+  int argc = 0;
+  char **argv = NULL;
+  PCALL(ctx, PetscOptionsInsertString(NULL, P->petsc_options));
+  PCALL(ctx, PetscGetArgs(&argc, &argv));
+  if (argc > 1) PCALL(ctx, PetscOptionsInsert(NULL, &argc, &argv, NULL));
+cleanup:
+  return st;
+}
+
+fcm_status fcm_petsc_problem_setup(fcm_petsc_problem *P)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
+  fcm_ctx *ctx = P->ctx;
+  const double t0 = fcm_wtime();
+  FCM_TRY(ctx, agree(ctx, P->comm,
+                     P->is_setup ? fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                                              "petsc: setup called twice")
+                                 : FCM_OK));
+  long long ncon_all = 0, ncon = (long long)P->ncon;
+  MPI_Allreduce(&ncon, &ncon_all, 1, MPI_LONG_LONG, MPI_MAX, P->comm);
+  FCM_TRY(ctx, agree(ctx, P->comm,
+                     P->opts.kind == FCM_INTEGRATOR_STATIC && ncon_all == 0
+                         ? fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                                      "petsc: a static problem without any constraint: the "
+                                      "body's rigid-body modes are free (K is singular)")
+                         : FCM_OK));
+  /* 1. assembly */
+  const double ta = fcm_wtime();
+  FCM_TRY(ctx, assemble_all(P));
+  P->time_assembly = fcm_wtime() - ta;
+  /* 2. the system matrix S = K (static) or M/h^2 + K, and its eliminated copy */
+  PCALL(ctx, MatDuplicate(P->K, MAT_COPY_VALUES, &P->S));
+  if (P->M) PCALL(ctx, MatAXPY(P->S, 1.0 / (P->opts.dt * P->opts.dt), P->M, SAME_NONZERO_PATTERN));
+  PCALL(ctx, MatDuplicate(P->S, MAT_COPY_VALUES, &P->Se));
+  {
+    PetscReal dsum = 0.0;
+    PCALL(ctx, MatGetDiagonal(P->S, P->w));
+    PCALL(ctx, VecNorm(P->w, NORM_1, &dsum));
+    P->diag = P->n > 0 ? dsum / (double)P->n : 1.0;
+    if (!(P->diag > 0.0)) P->diag = 1.0;
+  }
+  P->nrows = 0;
+  for (fcm_index k = 0; k < P->ncon; k++)
+    P->nrows += P->copy_owner[P->con_dof[k] / 3] == P->rank;
+  PCALL(ctx, PetscMalloc1(P->nrows + 1, &P->rows));
+  P->nrows = 0;
+  for (fcm_index k = 0; k < P->ncon; k++) {
+    const fcm_index d = P->con_dof[k];
+    if (P->copy_owner[d / 3] == P->rank) P->rows[P->nrows++] = 3 * P->perm[d / 3] + d % 3;
+  }
+  PCALL(ctx, MatZeroRowsColumns(P->Se, P->nrows, P->rows, P->diag, NULL, NULL));
+  PCALL(ctx, MatSetOption(P->Se, MAT_SPD, PETSC_TRUE));
+  FCM_TRY(ctx, near_null_space(P, P->Se));
+  /* 3. the KSP: defaults, then the options database */
+  FCM_TRY(ctx, insert_options(P));
+  PCALL(ctx, KSPCreate(P->comm, &P->ksp));
+  PCALL(ctx, KSPSetOperators(P->ksp, P->Se, P->Se));
+  PCALL(ctx, KSPSetType(P->ksp, KSPCG));
+  {
+    PC pc;
+    PCALL(ctx, KSPGetPC(P->ksp, &pc));
+    PCALL(ctx, PCSetType(pc, PCGAMG));
+  }
+  PCALL(ctx, KSPSetTolerances(P->ksp, P->opts.rtol, PETSC_DEFAULT, PETSC_DEFAULT,
+                              P->opts.max_iterations));
+  PCALL(ctx, KSPSetFromOptions(P->ksp));
+  P->is_setup = 1;
+  P->time_setup += fcm_wtime() - t0;
+cleanup:
+  return st;
+}
+
+/* ---------------------------------------------------------------- steps */
+
+/* g: the prescribed values at time t on the owned constrained DOFs, 0 elsewhere. */
+static fcm_status constraint_values(fcm_petsc_problem *P, double t)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const double *X = fcm_mesh_coords(P->mesh);
+  PCALL(ctx, VecSet(P->g, 0.0));
+  for (fcm_index k = 0; k < P->ncon; k++) {
+    const fcm_index d = P->con_dof[k];
+    if (P->copy_owner[d / 3] != P->rank) continue;
+    double u[3];
+    fcm_motion_eval(&P->motions[P->con_motion[k]], X + 3 * P->con_node[k], t, u, NULL);
+    PCALL(ctx, VecSetValue(P->g, 3 * P->perm[d / 3] + P->con_comp[k], u[P->con_comp[k]],
+                           INSERT_VALUES));
+  }
+  PCALL(ctx, VecAssemblyBegin(P->g));
+  PCALL(ctx, VecAssemblyEnd(P->g));
+cleanup:
+  return st;
+}
+
+static fcm_status energies(fcm_petsc_problem *P, fcm_petsc_step_info *info)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  PetscScalar e = 0.0;
+  PCALL(ctx, MatMult(P->K, P->u, P->w));
+  PCALL(ctx, VecDot(P->u, P->w, &e));
+  info->elastic_energy = 0.5 * e;
+  PCALL(ctx, VecDot(P->f, P->u, &e));
+  info->external_work = e;
+  info->kinetic_energy = 0.0;
+  if (P->M) {
+    PCALL(ctx, MatMult(P->M, P->v, P->w));
+    PCALL(ctx, VecDot(P->v, P->w, &e));
+    info->kinetic_energy = 0.5 * e;
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm_petsc_problem_step(fcm_petsc_problem *P, fcm_petsc_step_info *info)
+{
+  fcm_status st = FCM_OK;
+  fcm_petsc_step_info si;
+  memset(&si, 0, sizeof si);
+  FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
+  fcm_ctx *ctx = P->ctx;
+  FCM_TRY(ctx, agree(ctx, P->comm,
+                     !P->is_setup ? fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                                               "petsc: step before setup")
+                                  : FCM_OK));
+  const double h = P->opts.dt, t1 = P->t + h;
+  double t0 = fcm_wtime();
+  /* b = f (+ M/h^2 (u + h v)) - S g, then b = diag g on the constrained rows */
+  FCM_TRY(ctx, constraint_values(P, t1));
+  PCALL(ctx, VecCopy(P->f, P->b));
+  if (P->M) {
+    PCALL(ctx, VecWAXPY(P->x, h, P->v, P->u));
+    PCALL(ctx, MatMult(P->M, P->x, P->w));
+    PCALL(ctx, VecAXPY(P->b, 1.0 / (h * h), P->w));
+  }
+  PCALL(ctx, MatMult(P->S, P->g, P->w));
+  PCALL(ctx, VecAXPY(P->b, -1.0, P->w));
+  {
+    PetscScalar *bb = NULL;
+    const PetscScalar *gg = NULL;
+    PCALL(ctx, VecGetArray(P->b, &bb));
+    PCALL(ctx, VecGetArrayRead(P->g, &gg));
+    for (PetscInt k = 0; k < P->nrows; k++) {
+      const PetscInt r = P->rows[k] - 3 * P->first;
+      bb[r] = P->diag * gg[r];
+    }
+    PCALL(ctx, VecRestoreArrayRead(P->g, &gg));
+    PCALL(ctx, VecRestoreArray(P->b, &bb));
+  }
+  si.time_rhs = fcm_wtime() - t0;
+  /* solve */
+  t0 = fcm_wtime();
+  KSPConvergedReason reason;
+  PetscInt its = 0;
+  PetscReal rnorm = 0.0;
+  PCALL(ctx, VecCopy(P->u, P->x)); /* initial guess: the current displacement */
+  PCALL(ctx, KSPSetInitialGuessNonzero(P->ksp, PETSC_TRUE));
+  PCALL(ctx, KSPSolve(P->ksp, P->b, P->x));
+  PCALL(ctx, KSPGetConvergedReason(P->ksp, &reason));
+  PCALL(ctx, KSPGetIterationNumber(P->ksp, &its));
+  PCALL(ctx, KSPGetResidualNorm(P->ksp, &rnorm));
+  si.time_solve = fcm_wtime() - t0;
+  si.iterations = (int)its;
+  si.reason = (int)reason;
+  si.residual = rnorm;
+  P->total_iterations += its;
+  if (reason < 0) {
+    KSPType kt = NULL;
+    PC pc;
+    PCType pt = NULL;
+    KSPGetType(P->ksp, &kt);
+    KSPGetPC(P->ksp, &pc);
+    PCGetType(pc, &pt);
+    FCM_CHECK(0, ctx, FCM_ERR_NOT_CONVERGED,
+              "petsc: t = %g: KSP %s with PC %s did not converge: %s (KSPConvergedReason %d) "
+              "after %d iterations, residual norm %g (rtol %g); change the solver with "
+              "-ksp_type / -pc_type or solver.petsc_options",
+              t1, kt ? kt : "?", pt ? pt : "?", KSPConvergedReasons[reason], (int)reason,
+              (int)its, (double)rnorm, P->opts.rtol);
+  }
+  /* accept: v = (u1 - u0)/h (dynamic), u = u1 */
+  if (P->M) {
+    PCALL(ctx, VecWAXPY(P->w, -1.0, P->u, P->x));
+    PCALL(ctx, VecScale(P->w, 1.0 / h));
+    PCALL(ctx, VecCopy(P->w, P->v));
+  }
+  PCALL(ctx, VecCopy(P->x, P->u));
+  P->t = t1;
+  P->steps++;
+  si.time = P->t;
+  FCM_TRY(ctx, energies(P, &si));
+  if (info) *info = si;
+cleanup:
+  return st;
+}
+
+/* ---------------------------------------------------------------- queries */
+
+fcm_index fcm_petsc_problem_num_dofs(const fcm_petsc_problem *P)
+{
+  return P ? P->n : 0;
+}
+
+const fcm_space *fcm_petsc_problem_space(const fcm_petsc_problem *P)
+{
+  return P ? P->space : NULL;
+}
+
+static fcm_status gather(fcm_petsc_problem *P, Vec x, double *out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  VecScatter sc = NULL;
+  Vec all = NULL;
+  const PetscScalar *a = NULL;
+  PCALL(ctx, VecScatterCreateToAll(x, &sc, &all));
+  PCALL(ctx, VecScatterBegin(sc, x, all, INSERT_VALUES, SCATTER_FORWARD));
+  PCALL(ctx, VecScatterEnd(sc, x, all, INSERT_VALUES, SCATTER_FORWARD));
+  PCALL(ctx, VecGetArrayRead(all, &a));
+  for (fcm_index k = 0; k < P->ncopy; k++)
+    for (int i = 0; i < 3; i++)
+      out[3 * k + i] = a[3 * P->perm[k] + i];
+  PCALL(ctx, VecRestoreArrayRead(all, &a));
+cleanup:
+  VecScatterDestroy(&sc);
+  VecDestroy(&all);
+  return st;
+}
+
+fcm_status fcm_petsc_problem_get_state(fcm_petsc_problem *P, double *u, double *v)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
+  if (u) FCM_TRY(P->ctx, gather(P, P->u, u));
+  if (v) FCM_TRY(P->ctx, gather(P, P->v, v));
+cleanup:
+  return st;
+}
+
+fcm_status fcm_petsc_problem_get_info(fcm_petsc_problem *P, fcm_petsc_info *info)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(P && info, NULL, FCM_ERR_ARG, "petsc: NULL problem or info");
+  fcm_ctx *ctx = P->ctx;
+  memset(info, 0, sizeof *info);
+  info->size = P->size;
+  info->rank = P->rank;
+  info->partition = P->size == 1 && P->opts.partition == FCM_PETSC_PARTITION_AUTO
+                        ? FCM_PETSC_PARTITION_PTSCOTCH
+                        : P->partition;
+  info->num_dofs = P->n;
+  info->local_dofs = 3 * (fcm_index)P->nlocal;
+  info->local_elements = P->nelem_own;
+  long long ne = (long long)P->nelem_own, mx = 0, mn = 0;
+  MPI_Allreduce(&ne, &mx, 1, MPI_LONG_LONG, MPI_MAX, P->comm);
+  MPI_Allreduce(&ne, &mn, 1, MPI_LONG_LONG, MPI_MIN, P->comm);
+  info->max_local_elements = (fcm_index)mx;
+  info->min_local_elements = (fcm_index)mn;
+  if (P->M && P->is_setup) { /* 1_x^T M 1_x */
+    PetscScalar *a = NULL, m = 0.0;
+    PCALL(ctx, VecGetArray(P->x, &a));
+    for (PetscInt i = 0; i < 3 * P->nlocal; i++)
+      a[i] = i % 3 == 0 ? 1.0 : 0.0;
+    PCALL(ctx, VecRestoreArray(P->x, &a));
+    PCALL(ctx, MatMult(P->M, P->x, P->w));
+    PCALL(ctx, VecDot(P->x, P->w, &m));
+    info->mass = m;
+  }
+  info->time_rules = P->time_rules;
+  info->time_assembly = P->time_assembly;
+  info->time_setup = P->time_setup;
+  PetscLogDouble mem = 0.0;
+  PCALL(ctx, PetscMemoryGetCurrentUsage(&mem));
+  info->memory_local = mem;
+  MPI_Allreduce(&info->memory_local, &info->memory_total, 1, MPI_DOUBLE, MPI_SUM, P->comm);
+  if (P->Se) {
+    MatInfo mi;
+    PCALL(ctx, MatGetInfo(P->Se, MAT_GLOBAL_SUM, &mi));
+    info->matrix_memory = mi.memory;
+  }
+  info->steps = P->steps;
+  info->total_iterations = P->total_iterations;
+cleanup:
+  return st;
+}
