@@ -969,9 +969,7 @@ fcm_status fcm_petsc_problem_step(fcm_petsc_problem *P, fcm_petsc_step_info *inf
   KSPConvergedReason reason;
   PetscInt its = 0;
   PetscReal rnorm = 0.0;
-  PCALL(ctx, VecCopy(P->u, P->x)); /* initial guess: the current displacement */
-  PCALL(ctx, KSPSetInitialGuessNonzero(P->ksp, PETSC_TRUE));
-  PCALL(ctx, KSPSolve(P->ksp, P->b, P->x));
+  PCALL(ctx, KSPSolve(P->ksp, P->b, P->x)); /* zero initial guess (preonly needs it) */
   PCALL(ctx, KSPGetConvergedReason(P->ksp, &reason));
   PCALL(ctx, KSPGetIterationNumber(P->ksp, &its));
   PCALL(ctx, KSPGetResidualNorm(P->ksp, &rnorm));

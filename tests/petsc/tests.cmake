@@ -1,0 +1,45 @@
+# The PETSc backend's tests (label mpi; only in a build with FCM_HAVE_PETSC): each program runs
+# under mpiexec on 1 and 2 processes. The environment lets OpenMPI run as root (the CI container)
+# and on more processes than cores, and keeps one OpenMP thread per process. They are part of the
+# default run (`ctest -LE 'bench|slow'`) of such a build; `ctest -L mpi` runs them alone.
+set(FCM_MPI_TEST_ENV
+    "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_rmaps_base_oversubscribe=1"
+    "OMPI_MCA_btl_vader_single_copy_mechanism=none;OMP_NUM_THREADS=1;OPENBLAS_NUM_THREADS=1")
+# fcm_add_mpi_test(name source.c NP n [ARGS ...] [TIMEOUT s]): one executable per source.
+function(fcm_add_mpi_test name src)
+  cmake_parse_arguments(T "" "NP;TIMEOUT" "ARGS" ${ARGN})
+  string(MAKE_C_IDENTIFIER "${src}" key)
+  get_property(exe GLOBAL PROPERTY FCM_MPI_TEST_EXE_${key})
+  if(NOT exe)
+    get_filename_component(base ${src} NAME_WE)
+    set(exe petsc_${base})
+    set_property(GLOBAL PROPERTY FCM_MPI_TEST_EXE_${key} ${exe})
+    add_executable(${exe} ${src})
+    target_link_libraries(${exe} PRIVATE fcm_testlib)
+    target_include_directories(${exe} PRIVATE ${PROJECT_SOURCE_DIR}/tests/support)
+    target_compile_options(${exe} PRIVATE ${FCM_WARNINGS} ${FCM_SAN_FLAGS})
+  endif()
+  if(NOT T_TIMEOUT)
+    set(T_TIMEOUT 120)
+  endif()
+  add_test(NAME ${name} COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} ${T_NP}
+                                ${MPIEXEC_PREFLAGS} $<TARGET_FILE:${exe}> ${T_ARGS})
+  set_tests_properties(${name} PROPERTIES LABELS mpi TIMEOUT ${T_TIMEOUT} PROCESSORS ${T_NP}
+                       ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+endfunction()
+
+set(FCM_MUMPS "-ksp_type preonly -pc_type cholesky -pc_factor_mat_solver_type mumps")
+foreach(np 1 2)
+  foreach(el hex8 tet4 hex20 tet10)
+    foreach(kind static dynamic)
+      # the default solver (CG + GAMG, rtol 1e-12) with PT-Scotch
+      fcm_add_mpi_test(petsc_match_${el}_${kind}_np${np} tests/petsc/match.c NP ${np}
+                       ARGS ${el} ${kind} auto)
+    endforeach()
+  endforeach()
+  # the Morton-ordered partition and MUMPS (the direct option)
+  fcm_add_mpi_test(petsc_match_hex8_static_ordered_mumps_np${np} tests/petsc/match.c NP ${np}
+                   ARGS hex8 static ordered ${FCM_MUMPS})
+  fcm_add_mpi_test(petsc_match_tet4_dynamic_ordered_mumps_np${np} tests/petsc/match.c NP ${np}
+                   ARGS tet4 dynamic ordered ${FCM_MUMPS})
+endforeach()
