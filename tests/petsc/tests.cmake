@@ -43,3 +43,7 @@ foreach(np 1 2)
   fcm_add_mpi_test(petsc_match_tet4_dynamic_ordered_mumps_np${np} tests/petsc/match.c NP ${np}
                    ARGS tet4 dynamic ordered ${FCM_MUMPS})
 endforeach()
+# errors on one or all processes end every process with the message, no hang
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_failure_np${np} tests/petsc/failure.c NP ${np} TIMEOUT 60)
+endforeach()

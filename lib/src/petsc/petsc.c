@@ -642,8 +642,9 @@ static int finite3(const double x[3])
   return isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]);
 }
 
-static fcm_status add_constraint_local(fcm_petsc_problem *P, fcm_index num_nodes,
-                                       const fcm_index *nodes, const fcm_motion *m)
+/* Check a constraint (local, no change). */
+static fcm_status check_constraint(fcm_petsc_problem *P, fcm_index num_nodes,
+                                   const fcm_index *nodes, const fcm_motion *m)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P->ctx;
@@ -660,13 +661,33 @@ static fcm_status add_constraint_local(fcm_petsc_problem *P, fcm_index num_nodes
   FCM_CHECK(!m->release, ctx, FCM_ERR_UNSUPPORTED,
             "petsc: constraint: release (a constraint set that changes in time) is not "
             "supported by the PETSc backend");
-  fcm_index add = 0;
   for (fcm_index k = 0; k < num_nodes; k++) {
     FCM_CHECK(nodes[k] >= 0 && nodes[k] < s->num_nodes, ctx, FCM_ERR_ARG,
               "petsc: constraint: node %lld (entry %lld) outside [0, %lld)", (long long)nodes[k],
               (long long)k, (long long)s->num_nodes);
-    add += 3 * s->node_ncopy[nodes[k]];
+    for (fcm_index c = 0; c < s->node_ncopy[nodes[k]]; c++)
+      for (int i = 0; i < 3; i++)
+        FCM_CHECK(!m->components[i] || !P->is_con[s->node_dof[nodes[k]] + 3 * c + i], ctx,
+                  FCM_ERR_ARG,
+                  "petsc: constraint %d: component %d of node %lld is constrained already (by "
+                  "constraint %d); a DOF may belong to one constraint only",
+                  P->num_motions, i, (long long)nodes[k],
+                  (int)P->is_con[s->node_dof[nodes[k]] + 3 * c + i] - 1);
   }
+cleanup:
+  return st;
+}
+
+/* Add a validated constraint (local; only allocation can fail). */
+static fcm_status apply_constraint(fcm_petsc_problem *P, fcm_index num_nodes,
+                                   const fcm_index *nodes, const fcm_motion *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_space *s = P->space;
+  fcm_index add = 0;
+  for (fcm_index k = 0; k < num_nodes; k++)
+    add += 3 * s->node_ncopy[nodes[k]];
   FCM_CHECK(fcm__resize(ctx, (void **)&P->motions, (size_t)P->num_motions,
                         (size_t)P->num_motions + 1, sizeof *P->motions) == FCM_OK &&
                 fcm__resize(ctx, (void **)&P->con_dof, (size_t)P->ncon, (size_t)(P->ncon + add),
@@ -685,7 +706,7 @@ static fcm_status add_constraint_local(fcm_petsc_problem *P, fcm_index num_nodes
       for (int i = 0; i < 3; i++) {
         if (!m->components[i]) continue;
         const fcm_index d = s->node_dof[nd] + 3 * c + i;
-        if (P->is_con[d]) continue; /* listed twice in this set; another set: checked below */
+        if (P->is_con[d]) continue; /* listed twice in this set (others: check_constraint) */
         P->is_con[d] = (unsigned char)(P->num_motions + 1 > 255 ? 255 : P->num_motions + 1);
         P->con_dof[P->ncon] = d;
         P->con_node[P->ncon] = nd;
@@ -704,7 +725,10 @@ fcm_status fcm_petsc_problem_add_constraint(fcm_petsc_problem *P, fcm_index num_
 {
   fcm_status st = FCM_OK;
   FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
-  st = add_constraint_local(P, num_nodes, nodes, motion);
+  /* every process checks its input before any changes its state */
+  st = check_constraint(P, num_nodes, nodes, motion);
+  FCM_TRY(P->ctx, agree(P->ctx, P->comm, st));
+  st = apply_constraint(P, num_nodes, nodes, motion);
   FCM_TRY(P->ctx, agree(P->ctx, P->comm, st));
 cleanup:
   return st;
