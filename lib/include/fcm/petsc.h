@@ -32,6 +32,7 @@
 #include "fcm/geom.h"
 #include "fcm/material.h"
 #include "fcm/mesh.h"
+#include "fcm/scene.h"
 #include "fcm/sim.h"
 
 #ifdef __cplusplus
@@ -103,6 +104,19 @@ FCM_API fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const f
                                             const fcm_geometry *geom, const fcm_material *mat,
                                             const fcm_petsc_options *opts,
                                             fcm_petsc_problem **problem);
+
+/** A problem from a scene (fcm/scene.h), set up and ready to step: the background mesh and the
+ * geometry built as fcm_simulation_create() builds them (on every process), the rules and
+ * assembly options, time kind and step, gravity and the fixed and motion effects on node
+ * regions, solver.rtol / max_iterations and solver.petsc_options. Whatever the backend cannot
+ * run yet — a non-linear material, quadrature.simplify = auto, effects other than gravity,
+ * fixed and motion on node regions (boundary constraints, tractions, pressure, damping,
+ * initial velocities, cuts), a motion with release — is FCM_ERR_UNSUPPORTED naming it, never
+ * run differently. Collective. @return as fcm_petsc_problem_create() and _setup(). */
+FCM_API fcm_status fcm_petsc_problem_create_from_scene(fcm_ctx *ctx, MPI_Comm comm,
+                                                       const fcm_scene *scene,
+                                                       fcm_petsc_partition partition,
+                                                       fcm_petsc_problem **problem);
 
 /** Destroy (collective); accepts NULL and `*problem == NULL`, sets `*problem = NULL`. */
 FCM_API void fcm_petsc_problem_destroy(fcm_petsc_problem **problem);

@@ -147,6 +147,10 @@ typedef struct fcm_scene_solver {
   double representative_acceleration; /**< |a_rep| in m/s^2, > 0, default 9.81 */
   int threads; /**< OpenMP threads >= 1; FCM_DEFAULT ("threads": 0, the default): the OpenMP
                     default */
+  const char *petsc_options; /**< "petsc_options": PETSc options for the PETSc backend
+                                  (fcm/petsc.h, `fcm-sim --backend petsc`), e.g. "-ksp_type
+                                  minres -pc_type jacobi"; the command line wins for a key both
+                                  give. NULL (default): none. The serial backend ignores it */
 } fcm_scene_solver;
 
 /** Time stepping ("time"). */

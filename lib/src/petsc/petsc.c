@@ -43,6 +43,7 @@
 #include "core/core_impl.h"
 #include "embed/embed_impl.h"
 #include "fem/fem_impl.h"
+#include "scene/run_impl.h"
 
 #include <petscksp.h>
 #include <petscmat.h>
@@ -94,6 +95,8 @@ struct fcm_petsc_problem {
   double t;
   long long steps, total_iterations;
   double time_rules, time_assembly, time_setup;
+  fcm_mesh *own_mesh; /* built from a scene (fcm_petsc_problem_create_from_scene) */
+  fcm_geometry *own_geom;
 };
 
 /* ---------------------------------------------------------------- errors */
@@ -612,6 +615,8 @@ void fcm_petsc_problem_destroy(fcm_petsc_problem **problem)
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
     fcm__free(ctx, arrays[i]);
   if (P->comm != MPI_COMM_NULL) MPI_Comm_free(&P->comm);
+  fcm_geometry_destroy(&P->own_geom);
+  fcm_mesh_destroy(&P->own_mesh);
   fcm__free(ctx, P);
   *problem = NULL;
 }
@@ -1119,5 +1124,152 @@ fcm_status fcm_petsc_problem_get_info(fcm_petsc_problem *P, fcm_petsc_info *info
   info->steps = P->steps;
   info->total_iterations = P->total_iterations;
 cleanup:
+  return st;
+}
+
+/* ---------------------------------------------------------------- scenes */
+
+/* What the PETSc backend cannot run of a scene, named (local: every process reads the same). */
+static fcm_status check_scene(fcm_ctx *ctx, const fcm_scene *scene)
+{
+  fcm_status st = FCM_OK;
+  const char *name = fcm_scene_name(scene);
+  FCM_CHECK(fcm_scene_get_material(scene)->model == FCM_MATERIAL_LINEAR, ctx, FCM_ERR_UNSUPPORTED,
+            "scene %s: material.model: the PETSc backend solves linear elasticity only (\"linear\"); "
+            "run this scene with the serial backend",
+            name);
+  FCM_CHECK(fcm_scene_get_quadrature(scene)->simplify != FCM_CELL_SIMPLIFY_AUTO, ctx,
+            FCM_ERR_UNSUPPORTED,
+            "scene %s: quadrature.simplify = \"auto\" is not supported by the PETSc backend (its "
+            "choice would differ between processes); use true or false",
+            name);
+  for (int k = 0; k < fcm_scene_num_effects(scene); k++) {
+    const fcm_effect *e = fcm_scene_get_effect(scene, k);
+    const char *what = NULL;
+    switch (e->type) {
+    case FCM_EFFECT_GRAVITY:
+      break;
+    case FCM_EFFECT_FIXED:
+      if (e->fixed.boundary) what = "a fixed effect on the \"boundary\" (Nitsche / penalty)";
+      break;
+    case FCM_EFFECT_MOTION:
+      if (e->motion.boundary)
+        what = "a motion effect on the \"boundary\" (Nitsche / penalty)";
+      else if (e->motion.motion.release)
+        what = "a motion effect with \"release\"";
+      break;
+    default:
+      what = fcm_effect_type_name(e->type);
+    }
+    FCM_CHECK(!what, ctx, FCM_ERR_UNSUPPORTED,
+              "scene %s: effects[%d]: %s is not supported by the PETSc backend yet (gravity, "
+              "fixed and motion on node regions are); run this scene with the serial backend",
+              name, k, what);
+  }
+cleanup:
+  return st;
+}
+
+/* The background nodes of a region (as the serial runner picks them). */
+static fcm_status scene_region_nodes(fcm_ctx *ctx, const fcm_scene *scene, const fcm_mesh *mesh,
+                                     const fcm_region *r, int k, fcm_index **nodes, fcm_index *n)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index nn = fcm_mesh_num_nodes(mesh);
+  const double *X = fcm_mesh_coords(mesh);
+  fcm_index *out = NULL, m = 0;
+  FCM_ALLOC(ctx, (r->kind == FCM_REGION_NODES ? r->num_nodes : nn) + 1, out);
+  if (r->kind == FCM_REGION_NODES) {
+    for (fcm_index j = 0; j < r->num_nodes; j++) {
+      FCM_CHECK(r->nodes[j] >= 0 && r->nodes[j] < nn, ctx, FCM_ERR_ARG,
+                "scene %s: effects[%d]: node %lld out of range [0, %lld)", fcm_scene_name(scene),
+                k, (long long)r->nodes[j], (long long)nn);
+      out[m++] = r->nodes[j];
+    }
+  } else {
+    for (fcm_index a = 0; a < nn; a++)
+      if (fcm_region_contains(r, X + 3 * a)) out[m++] = a;
+  }
+  FCM_CHECK(m > 0, ctx, FCM_ERR_ARG,
+            "scene %s: effects[%d]: the region contains no background-mesh node",
+            fcm_scene_name(scene), k);
+  *nodes = out;
+  *n = m;
+  out = NULL;
+cleanup:
+  fcm__free(ctx, out);
+  return st;
+}
+
+fcm_status fcm_petsc_problem_create_from_scene(fcm_ctx *ctx, MPI_Comm comm, const fcm_scene *scene,
+                                               fcm_petsc_partition partition,
+                                               fcm_petsc_problem **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_mesh *mesh = NULL;
+  fcm_geometry *geom = NULL;
+  fcm_petsc_problem *P = NULL;
+  fcm_index *nodes = NULL, n = 0;
+  FCM_CHECK(out, ctx, FCM_ERR_ARG, "petsc: output pointer is NULL");
+  *out = NULL;
+  FCM_CHECK(ctx && scene, ctx, FCM_ERR_ARG, "petsc: NULL context or scene");
+  st = check_scene(ctx, scene);
+  if (st == FCM_OK) st = fcm__scene_mesh_geometry(ctx, scene, &mesh, &geom);
+  FCM_TRY(ctx, agree(ctx, comm, st));
+  /* the options as the serial runner derives them (lib/src/scene/run.c) */
+  const fcm_scene_quadrature *q = fcm_scene_get_quadrature(scene);
+  const fcm_scene_solver *sv = fcm_scene_get_solver(scene);
+  const fcm_scene_time *tm = fcm_scene_get_time(scene);
+  fcm_petsc_options o = fcm_petsc_options_default();
+  o.kind = tm->integrator;
+  o.dt = tm->dt;
+  o.partition = partition;
+  o.petsc_options = sv->petsc_options;
+  o.rtol = sv->rtol > 0.0 ? sv->rtol : o.rtol;
+  o.max_iterations = sv->max_iterations;
+  o.rules.strength[FCM_RULE_STIFFNESS] = q->stiffness_strength;
+  o.rules.strength[FCM_RULE_MASS] = q->mass_strength;
+  o.rules.surface_strength = -1;
+  o.rules.min_fraction = q->min_fraction;
+  o.rules.max_rule_memory = q->max_rule_memory_gib * 1024.0 * 1024.0 * 1024.0;
+  o.rules.simplify = q->simplify;
+  o.rules.simplify_options.method = q->simplify_method;
+  o.rules.stabilization = q->stabilization;
+  o.rules.num_threads = sv->threads;
+  o.assembly.stiffness_strength = q->stiffness_strength > 0 ? q->stiffness_strength : FCM_DEFAULT;
+  o.assembly.mass_strength = q->mass_strength > 0 ? q->mass_strength : FCM_DEFAULT;
+  FCM_TRY(ctx, fcm_petsc_problem_create(ctx, comm, mesh, geom, fcm_scene_get_material(scene), &o,
+                                        &P));
+  P->own_mesh = mesh;
+  mesh = NULL;
+  fcm_geometry_destroy(&geom); /* only read while the rules were built */
+  for (int k = 0; k < fcm_scene_num_effects(scene); k++) {
+    const fcm_effect *e = fcm_scene_get_effect(scene, k);
+    if (e->type == FCM_EFFECT_GRAVITY) {
+      FCM_TRY(ctx, fcm_petsc_problem_add_gravity(P, e->gravity.acceleration));
+      continue;
+    }
+    if (e->type != FCM_EFFECT_FIXED && e->type != FCM_EFFECT_MOTION) continue;
+    const fcm_region *r = e->type == FCM_EFFECT_FIXED ? &e->fixed.region : &e->motion.region;
+    fcm_motion m = fcm_motion_default();
+    if (e->type == FCM_EFFECT_FIXED)
+      for (int d = 0; d < 3; d++)
+        m.components[d] = e->fixed.components[d];
+    else
+      m = e->motion.motion;
+    fcm__free(ctx, nodes);
+    nodes = NULL;
+    st = scene_region_nodes(ctx, scene, P->mesh, r, k, &nodes, &n);
+    FCM_TRY(ctx, agree(ctx, P->comm, st));
+    FCM_TRY(ctx, fcm_petsc_problem_add_constraint(P, n, nodes, &m));
+  }
+  FCM_TRY(ctx, fcm_petsc_problem_setup(P));
+  *out = P;
+  P = NULL;
+cleanup:
+  fcm__free(ctx, nodes);
+  fcm_petsc_problem_destroy(&P);
+  fcm_geometry_destroy(&geom);
+  fcm_mesh_destroy(&mesh);
   return st;
 }

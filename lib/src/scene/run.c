@@ -735,6 +735,64 @@ cleanup:
   return st;
 }
 
+/* The background mesh and the embedded geometry (S->mesh, S->nn, S->geom; no geometry for a
+ * scene without one); errors of the inputs name the scene section they come from. */
+static fcm_status build_mesh_geometry(fcm_simulation *S)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  const fcm_scene *scene = S->scene;
+  const fcm_scene_background *bg = fcm_scene_get_background(scene);
+  const fcm_scene_geometry *g = fcm_scene_get_geometry(scene);
+  if (bg->kind == FCM_SCENE_BACKGROUND_GRID && bg->fit) {
+    double min[3], max[3];
+    fcm_index cells[3];
+    st = build_geometry(S, g); /* the parser ensured there is one */
+    if (st != FCM_OK) name_section(ctx, geometry_path(g->kind));
+    FCM_TRY(ctx, st);
+    st = fit_background(S, bg, min, max, cells);
+    if (st == FCM_OK) st = fcm_mesh_create_box(ctx, bg->element, min, max, cells, &S->mesh);
+    if (st != FCM_OK) name_section(ctx, "background.fit_background");
+    FCM_TRY(ctx, st);
+  } else if (bg->kind == FCM_SCENE_BACKGROUND_GRID)
+    st = fcm_mesh_create_box(ctx, bg->element, bg->min, bg->max, bg->cells, &S->mesh);
+  else
+    st = fcm_mesh_create_from_gmsh(ctx, bg->mesh, &S->mesh);
+  if (st != FCM_OK)
+    name_section(ctx, bg->kind == FCM_SCENE_BACKGROUND_GRID ? "background" : "background.mesh");
+  FCM_TRY(ctx, st);
+  S->nn = fcm_mesh_num_nodes(S->mesh);
+
+  if (g->kind != FCM_SCENE_GEOMETRY_NONE && !S->geom) {
+    st = build_geometry(S, g);
+    if (st != FCM_OK) name_section(ctx, geometry_path(g->kind));
+    FCM_TRY(ctx, st);
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm__scene_mesh_geometry(fcm_ctx *ctx, const fcm_scene *scene, fcm_mesh **mesh,
+                                    fcm_geometry **geom)
+{
+  fcm_status st = FCM_OK;
+  fcm_simulation *S = NULL;
+  *mesh = NULL;
+  *geom = NULL;
+  FCM_ALLOC(ctx, 1, S);
+  S->ctx = ctx;
+  S->scene = scene;
+  S->opts = fcm_simulation_options_default();
+  FCM_TRY(ctx, build_mesh_geometry(S));
+  *mesh = S->mesh;
+  *geom = S->geom;
+  S->mesh = NULL;
+  S->geom = NULL;
+cleanup:
+  fcm_simulation_destroy(&S);
+  return st;
+}
+
 fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
                                  const fcm_simulation_options *opts, fcm_simulation **out)
 {
@@ -762,35 +820,11 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
             "simulation: rules_progress_interval = %g must be >= 0 seconds",
             S->opts.rules_progress_interval);
 
-  /* background mesh; errors of the inputs name the scene section they come from */
-  const fcm_scene_background *bg = fcm_scene_get_background(scene);
+  FCM_TRY(ctx, build_mesh_geometry(S));
   const fcm_scene_geometry *g = fcm_scene_get_geometry(scene);
-  if (bg->kind == FCM_SCENE_BACKGROUND_GRID && bg->fit) {
-    double min[3], max[3];
-    fcm_index cells[3];
-    st = build_geometry(S, g); /* the parser ensured there is one */
-    if (st != FCM_OK) name_section(ctx, geometry_path(g->kind));
-    FCM_TRY(ctx, st);
-    st = fit_background(S, bg, min, max, cells);
-    if (st == FCM_OK) st = fcm_mesh_create_box(ctx, bg->element, min, max, cells, &S->mesh);
-    if (st != FCM_OK) name_section(ctx, "background.fit_background");
-    FCM_TRY(ctx, st);
-  } else if (bg->kind == FCM_SCENE_BACKGROUND_GRID)
-    st = fcm_mesh_create_box(ctx, bg->element, bg->min, bg->max, bg->cells, &S->mesh);
-  else
-    st = fcm_mesh_create_from_gmsh(ctx, bg->mesh, &S->mesh);
-  if (st != FCM_OK)
-    name_section(ctx, bg->kind == FCM_SCENE_BACKGROUND_GRID ? "background" : "background.mesh");
-  FCM_TRY(ctx, st);
-  S->nn = fcm_mesh_num_nodes(S->mesh);
 
-  /* geometry and cell rules only when the scene embeds one */
+  /* cell rules only when the scene embeds a geometry */
   if (g->kind != FCM_SCENE_GEOMETRY_NONE) {
-    if (!S->geom) {
-      st = build_geometry(S, g);
-      if (st != FCM_OK) name_section(ctx, geometry_path(g->kind));
-      FCM_TRY(ctx, st);
-    }
     st = build_rules(S);
     if (st != FCM_OK) fcm__error_prefix(ctx, st == FCM_ERR_GEOMETRY ? "geometry" : "quadrature");
     FCM_TRY(ctx, st);

@@ -742,7 +742,8 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   fcm_status st = FCM_OK;
   static const char *const keys[] = {
       "method", "direct",         "preconditioner", "schwarz", "rtol",
-      "atol",   "max_iterations", "newton",         "threads", "preconditioner_tangent"};
+      "atol",   "max_iterations", "newton",         "threads", "preconditioner_tangent",
+      "petsc_options"};
   static const char *const skeys[] = {"threshold", "epsilon", "clamp"};
   static const char *const nkeys[] = {"rtol",        "max_iterations",
                                       "line_search", "project_psd",
@@ -803,6 +804,7 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   }
   READ_INT(p, o, "threads", 0, 0, 4096, s->threads);
   if (s->threads == 0) s->threads = FCM_DEFAULT; /* "threads": 0, the OpenMP default */
+  FCM_TRY(p->ctx, fcm__scene_read_string(p, o, "petsc_options", 0, &s->petsc_options));
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
