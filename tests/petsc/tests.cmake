@@ -47,3 +47,35 @@ endforeach()
 foreach(np 1 2)
   fcm_add_mpi_test(petsc_failure_np${np} tests/petsc/failure.c NP ${np} TIMEOUT 60)
 endforeach()
+# example scenes: the PETSc backend against the serial fcm_simulation
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_scene_cantilever_np${np} tests/petsc/scene.c NP ${np}
+                   ARGS ${PROJECT_SOURCE_DIR}/apps/scenes cantilever.json 1)
+  fcm_add_mpi_test(petsc_scene_vibrating_beam_np${np} tests/petsc/scene.c NP ${np}
+                   ARGS ${PROJECT_SOURCE_DIR}/apps/scenes vibrating_beam.json 10)
+endforeach()
+if(FCM_BUILD_APPS)
+  # mpirun -n 2 fcm-sim SCENE --backend petsc: runs the linear example scenes (--check);
+  # a scene with an effect the backend lacks exits non-zero on every process with the message
+  foreach(scene cantilever vibrating_beam)
+    add_test(NAME petsc_app_sim_${scene}
+             COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
+                     $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/${scene}.json
+                     --backend petsc --check -ksp_rtol 1e-10)
+    set_tests_properties(petsc_app_sim_${scene} PROPERTIES LABELS mpi TIMEOUT 300 PROCESSORS 2
+                         ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+  endforeach()
+  add_test(NAME petsc_app_sim_unsupported
+           COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
+                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/static_beam.json
+                   --backend petsc --check)
+  set_tests_properties(petsc_app_sim_unsupported PROPERTIES LABELS mpi TIMEOUT 120 PROCESSORS 2
+                       WILL_FAIL TRUE ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+  add_test(NAME petsc_app_sim_unsupported_message
+           COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
+                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/static_beam.json
+                   --backend petsc --check)
+  set_tests_properties(petsc_app_sim_unsupported_message PROPERTIES LABELS mpi TIMEOUT 120
+                       PROCESSORS 2 ENVIRONMENT "${FCM_MPI_TEST_ENV}"
+                       PASS_REGULAR_EXPRESSION "effects\\[2\\]: traction is not supported by the PETSc backend")
+endif()
