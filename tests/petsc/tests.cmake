@@ -79,3 +79,8 @@ if(FCM_BUILD_APPS)
                        PROCESSORS 2 ENVIRONMENT "${FCM_MPI_TEST_ENV}"
                        PASS_REGULAR_EXPRESSION "effects\\[2\\]: traction is not supported by the PETSc backend")
 endif()
+# memory and time per DOF on 1 and 2 processes (labels bench, mpi: not in the default run)
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_bench_np${np} tests/petsc/bench.c NP ${np} ARGS hex8 24 TIMEOUT 1800)
+  set_tests_properties(petsc_bench_np${np} PROPERTIES LABELS "bench;mpi")
+endforeach()

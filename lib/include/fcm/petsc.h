@@ -186,8 +186,8 @@ typedef struct fcm_petsc_info {
   double time_setup;               /**< seconds: the whole create + setup */
   double memory_local;             /**< bytes resident on this process (PetscMemoryGetCurrentUsage) */
   double memory_total;             /**< summed over the processes */
-  double matrix_memory;            /**< bytes the system matrix takes over all processes
-                                        (MatGetInfo) */
+  double matrix_memory;            /**< bytes of the system matrix's stored nonzeros over all
+                                        processes (values and column indices, MatGetInfo) */
   long long steps, total_iterations;
 } fcm_petsc_info;
 

@@ -1117,9 +1117,9 @@ fcm_status fcm_petsc_problem_get_info(fcm_petsc_problem *P, fcm_petsc_info *info
   info->memory_local = mem;
   MPI_Allreduce(&info->memory_local, &info->memory_total, 1, MPI_DOUBLE, MPI_SUM, P->comm);
   if (P->Se) {
-    MatInfo mi;
+    MatInfo mi; /* values and column indices of the stored nonzeros (mi.memory is not kept) */
     PCALL(ctx, MatGetInfo(P->Se, MAT_GLOBAL_SUM, &mi));
-    info->matrix_memory = mi.memory;
+    info->matrix_memory = mi.nz_allocated * (double)(sizeof(PetscScalar) + sizeof(PetscInt));
   }
   info->steps = P->steps;
   info->total_iterations = P->total_iterations;
