@@ -46,6 +46,15 @@ typedef struct fcm_mg_options {
   int max_levels;           /**< levels including the finest, >= 1 (default 20) */
   fcm_index coarse_dofs;    /**< stop coarsening once a level has at most this many DOFs,
                                  >= 1 (default 2000); that level is solved by CHOLMOD */
+  int block_smoothing;      /**< 1 (default): on the finest level, the elements of cut cells
+                                 (the geometry's boundary, cut surfaces) are also smoothed as
+                                 blocks: a symmetric block Gauss-Seidel sweep after the
+                                 pre-smoothing and before the post-smoothing, each block
+                                 inverted by the clamped eigen-inverse of the Schwarz
+                                 preconditioner (fcm/solve.h). Small cut fractions make the
+                                 basis functions of a cut cell nearly linearly dependent,
+                                 which pointwise smoothing cannot resolve (Hex20 stalls near
+                                 0.95 without it); 0: pointwise smoothing only */
 } fcm_mg_options;
 
 /** Defaults as documented on each member. */
