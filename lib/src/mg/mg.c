@@ -1,4 +1,5 @@
-/* Cut-aware geometric multigrid on Hex8 box grids (Dick, Georgii, Westermann 2011, Sec. 6).
+/* Cut-aware geometric multigrid on Hex8 and Hex20 box grids (Dick, Georgii, Westermann 2011,
+ * Sec. 6), with a vertex-block smoother at cut cells (de Prenter et al. 2019).
  *
  * NOTES (state of issue 13, for whoever continues):
  * - Done: hierarchy for Hex8 box grids (any cell count, dropped cells, XFEM pieces), per
@@ -6,26 +7,26 @@
  *   values again in fcm_mg_setup()), CHOLMOD on the coarsest level, smoothers SGS
  *   (sequential, default), SGS in multicolour order (colour-parallel) and damped Jacobi, all
  *   deterministic for any thread count; V- and W-cycles as solver (fcm_mg_solve) and as a
- *   symmetric CG preconditioner (fcm_mg_operator). Tests in tests/mg/.
- * - Not done (next): Hex20 p-level (Hex20 -> Hex8 on the same grid, then this hierarchy);
- *   scene options solver.preconditioner / solver.method "multigrid" (sim/linsolve.c);
- *   MINRES use (an SPD preconditioner of an indefinite tangent: build mg on K_psd); the
- *   fcm-scaling app (tests/mg/bench.c is its precursor: cholmod, cg-jacobi, cg-mg, mg).
+ *   symmetric CG preconditioner (fcm_mg_operator). Hex20: a p-level to the Hex8 space of the
+ *   same elements (build_level0). Block smoothing of the DOFs around each vertex of a cut
+ *   cell on level 0 (block_smoother_create, block_smooth): without it the Hex20 embedded
+ *   hemisphere stalled at 0.96 per cycle (two-grid on the p-level alone: 0.955, more
+ *   pointwise sweeps did not help; per-element blocks: 0.64-0.84); with it 0.14-0.29 for
+ *   n = 4 ... 24, and Hex8 0.13-0.15 (was 0.17-0.18). Tests in tests/mg/.
  * - Known: with XFEM cuts the V-cycle factor depends on where the cut lies in the grid
- *   (0.2 to 0.7 measured for n = 4 ... 28, not growing with n), also for a cut through the
- *   whole body, so not the cut's end. Diagnosis: small-support copies (pieces holding 0.1 %
- *   to 10 % of a node's support): split hemisphere n = 20 gives 0.69 with the default
- *   constrain_ratio 1e-9 and 1e-3, 0.25 with 0.1 (tests/mg/convergence.c, env-free: use
- *   problem_hemisphere_with). Next: nodal 3x3 block or piece-block (Schwarz) smoothing
- *   near cut cells, as Longva's Schwarz blocks. The Galerkin product and
- *   the hierarchy build are sequential. fcm_mg_setup() needs the same eliminated rows.
+ *   (0.1 to 0.6 measured for n = 4 ... 32 with block smoothing, not growing with n), also for
+ *   a cut through the whole body, so not the cut's end; Dick et al. report 0.75 cut. The
+ *   Galerkin product, the hierarchy build and the block sweep are sequential.
+ *   fcm_mg_setup() needs the same eliminated rows.
  * - Dirichlet: eliminated rows (no off-diagonal entry) and coarse DOFs whose coinciding
  *   fine DOFs are all inactive stay in P (leaving them out made P rank deficient); coarse
  *   ones are decoupled in the Galerkin matrix and get no correction.
  *
- * Data per level l: cells (level 0: the space's elements) with a grid position and 8 corner
- * copies (corner bits dx + 2 dy + 4 dz), copies with a node grid position, the connectivity
- * of the cells (face neighbours), and for l < L-1 the DOF prolongation P_l from level l+1.
+ * Data per grid level l (level 0 on Hex8, levels >= 1 on Hex20, whose level 0 has only its
+ * DOFs, matrix and prolongation): cells (the first grid level: the space's elements) with a
+ * grid position and 8 corner copies (corner bits dx + 2 dy + 4 dz), copies with a node grid
+ * position, the connectivity of the cells (face neighbours), and for l < L-1 the DOF
+ * prolongation P_l from level l+1.
  * DOFs: copy k, component c is row 3k + c of the level matrix on every level (level 0: the
  * space's numbering); inactive rows are the Dirichlet ones. */
 #include "core/core_impl.h"
