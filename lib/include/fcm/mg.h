@@ -67,26 +67,25 @@ FCM_API fcm_mg_options fcm_mg_options_default(void);
 /** A multigrid hierarchy and its operators for one matrix pattern. */
 typedef struct fcm_mg fcm_mg;
 
-/** Build the hierarchy of `space` and the operators of `A`.
- * The space must live on a structured Hex8 or Hex20 box grid (fcm_mesh_create_box(): every
- * cell an axis-aligned box of one size at an integer grid position); any cell counts,
- * dropped cells and cut (XFEM) pieces are allowed. Level 0 is the space itself: its elements
- * (pieces) and DOF copies. On Hex20, level 1 is the Hex8 space of the same elements with the
- * copies they use at their corners: those copies are injected, a mid-edge copy takes the
- * mean of the corner copies at the ends of its edge (exact for trilinear fields); the
- * 2x2x2 coarsening below starts from level 1. Two elements of face-neighbouring cells are connected when they use the same
- * copy at a node of the common face and, where cuts reach either cell, the cell rules link
- * their pieces (fcm_cell_rules_links()); coarse cells are the connected components of the
- * elements (cells) of each 2x2x2 block, and coarse cells are connected when some of their
- * fine cells are. A coarse cell has its own copy at each of its 8 corners; two coarse cells
- * share a corner's copy when a fine copy that interpolates from that corner is used by fine
- * elements of both, so the coarse space separates exactly what the fine one separates
- * (two bodies never share a coarse DOF) and the prolongation is single valued.
- * Rows of A whose off-diagonal entries are all zero (DOFs eliminated by
- * fcm_space_apply_dirichlet()) mark the Dirichlet boundary: a coarse DOF whose coinciding
- * fine DOFs are all eliminated (or, coarser, constrained) is constrained (decoupled in the
- * coarse matrix, no correction from it), so coarse corrections vanish there. The
- * prolongation stays injective, so every coarse matrix is positive definite.
+/** Build the hierarchy of `space` and the operators of `A`. The space must live on a structured
+ * Hex8 or Hex20 box grid (fcm_mesh_create_box(): every cell an axis-aligned box of one size at an
+ * integer grid position); any cell counts, dropped cells and cut (XFEM) pieces are allowed. Level
+ * 0 is the space itself: its elements (pieces) and DOF copies. On Hex20, level 1 is the Hex8 space
+ * of the same elements with the copies they use at their corners: those copies are injected, a
+ * mid-edge copy takes the mean of the corner copies at the ends of its edge (exact for trilinear
+ * fields); the 2x2x2 coarsening below starts from level 1. Two elements of face-neighbouring cells
+ * are connected when they use the same copy at a node of the common face and, where cuts reach
+ * either cell, the cell rules link their pieces (fcm_cell_rules_links()); coarse cells are the
+ * connected components of the elements (cells) of each 2x2x2 block, and coarse cells are connected
+ * when some of their fine cells are. A coarse cell has its own copy at each of its 8 corners; two
+ * coarse cells share a corner's copy when a fine copy that interpolates from that corner is used
+ * by fine elements of both, so the coarse space separates exactly what the fine one separates (two
+ * bodies never share a coarse DOF) and the prolongation is single valued. Rows of A whose off-
+ * diagonal entries are all zero (DOFs eliminated by fcm_space_apply_dirichlet()) mark the
+ * Dirichlet boundary: a coarse DOF whose coinciding fine DOFs are all eliminated (or, coarser,
+ * constrained) is constrained (decoupled in the coarse matrix, no correction from it), so coarse
+ * corrections vanish there. The prolongation stays injective, so every coarse matrix is positive
+ * definite.
  * @param[in]  ctx   context; must outlive the object
  * @param[in]  space borrowed: must outlive the object
  * @param[in]  A     symmetric positive definite, the space's pattern (fcm_space_matrix_create());
@@ -95,8 +94,9 @@ typedef struct fcm_mg fcm_mg;
  * @param[in]  opts  copied; NULL for defaults
  * @param[out] mg    the new object, NULL on failure
  * @return FCM_OK, FCM_ERR_ARG (NULL, option out of range, A not the space's size),
- * FCM_ERR_UNSUPPORTED (not a Hex8 or Hex20 box grid: the message names the cell), FCM_ERR_SINGULAR /
- * FCM_ERR_NUMERIC (the coarsest factorization, a zero diagonal), FCM_ERR_ALLOC. */
+ * FCM_ERR_UNSUPPORTED (not a Hex8 or Hex20 box grid: the message names the cell),
+ * FCM_ERR_SINGULAR or FCM_ERR_NUMERIC (the coarsest factorization, a zero diagonal),
+ * FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
                                  const fcm_mg_options *opts, fcm_mg **mg);
 
