@@ -51,7 +51,7 @@ typedef struct fcm_mg_options {
                                  vertex of a cut cell (the geometry's boundary, cut surfaces)
                                  are also smoothed as a block: the copies whose support lies
                                  in the vertex's 8 cells (the vertex's own and, on Hex20, those
-                                 of the mid-edge nodes at it; de Prenter et al. 2019). A
+                                 of the mid-edge nodes at it; de Prenter et al. 2020). A
                                  symmetric block Gauss-Seidel sweep (sequential) follows the
                                  pre-smoothing and precedes the post-smoothing, each block
                                  inverted by the clamped eigen-inverse of the Schwarz

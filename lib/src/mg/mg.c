@@ -1,5 +1,5 @@
 /* Cut-aware geometric multigrid on Hex8 and Hex20 box grids (Dick, Georgii, Westermann 2011,
- * Sec. 6), with a vertex-block smoother at cut cells (de Prenter et al. 2019).
+ * Sec. 6), with a vertex-block smoother at cut cells (de Prenter et al. 2020).
  *
  * NOTES (state of issue 13, for whoever continues):
  * - Done: hierarchy for Hex8 box grids (any cell count, dropped cells, XFEM pieces), per
