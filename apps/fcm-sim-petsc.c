@@ -96,8 +96,8 @@ int sim_petsc_run(const char *path, const char *outdir, long long steps, int che
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   const int talk = rank == 0 && !quiet;
   /* every process parses the same file; a failure is the same everywhere */
-  fcm_status st = path ? fcm_scene_create_from_file(ctx, path, &scene)
-                       : fcm_scene_create_default(ctx, &scene);
+  fcm_status st =
+      path ? fcm_scene_create_from_file(ctx, path, &scene) : fcm_scene_create_default(ctx, &scene);
   if (st != FCM_OK) {
     if (rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
     rc = 2;
@@ -108,12 +108,12 @@ int sim_petsc_run(const char *path, const char *outdir, long long steps, int che
     fprintf(stderr, "fcm-sim: scene %s (%s): building on %d process%s (backend petsc)\n", name,
             fcm_scene_source(scene), size, size > 1 ? "es" : "");
   double t0 = fcm_wtime();
-  st = fcm_petsc_problem_create_from_scene(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO,
-                                           &P);
+  st =
+      fcm_petsc_problem_create_from_scene(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO, &P);
   if (st != FCM_OK) { /* every process has the error; process 0 prints it */
     if (rank == 0) fprintf(stderr, "fcm-sim: scene %s: %s\n", name, fcm_ctx_error_message(ctx));
-    rc = st == FCM_ERR_ARG || st == FCM_ERR_IO || st == FCM_ERR_FORMAT ||
-                 st == FCM_ERR_GEOMETRY || st == FCM_ERR_UNSUPPORTED
+    rc = st == FCM_ERR_ARG || st == FCM_ERR_IO || st == FCM_ERR_FORMAT || st == FCM_ERR_GEOMETRY ||
+                 st == FCM_ERR_UNSUPPORTED
              ? 2
              : 1;
     goto done;
@@ -141,8 +141,7 @@ int sim_petsc_run(const char *path, const char *outdir, long long steps, int che
   snprintf(pvdpath, sizeof pvdpath, "%s/%s_background.pvd", dir, name);
   if (write && rank == 0) {
     ok = make_dirs(dir) && fcm_pvd_create(ctx, pvdpath, &pvd) == FCM_OK &&
-         write_frame(ctx, fcm_petsc_problem_space(P), u, v, dir, name, frame++, 0.0, pvd) ==
-             FCM_OK;
+         write_frame(ctx, fcm_petsc_problem_space(P), u, v, dir, name, frame++, 0.0, pvd) == FCM_OK;
     if (!ok && fcm_ctx_error_status(ctx) != FCM_OK)
       fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
   }
@@ -157,8 +156,13 @@ int sim_petsc_run(const char *path, const char *outdir, long long steps, int che
       if (write && rank == 0) write_log(ctx, logpath, rows, k - 1);
       goto done;
     }
-    rows[k - 1] = (run_log){k,          si.time,      si.residual, si.kinetic_energy,
-                            si.elastic_energy, si.external_work, fcm_wtime() - t1,
+    rows[k - 1] = (run_log){k,
+                            si.time,
+                            si.residual,
+                            si.kinetic_energy,
+                            si.elastic_energy,
+                            si.external_work,
+                            fcm_wtime() - t1,
                             si.iterations};
     if (talk)
       fprintf(stderr, "fcm-sim: step %lld/%lld t = %.6g s: KSP %d iterations, residual %.3g\n", k,
@@ -167,8 +171,8 @@ int sim_petsc_run(const char *path, const char *outdir, long long steps, int che
       st = fcm_petsc_problem_get_state(P, u, v); /* collective */
       ok = st == FCM_OK;
       if (ok && rank == 0)
-        ok = write_frame(ctx, fcm_petsc_problem_space(P), u, v, dir, name, frame++, si.time,
-                         pvd) == FCM_OK &&
+        ok = write_frame(ctx, fcm_petsc_problem_space(P), u, v, dir, name, frame++, si.time, pvd) ==
+                 FCM_OK &&
              write_log(ctx, logpath, rows, k) == FCM_OK;
       if (!ok) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
       MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);

@@ -271,8 +271,8 @@ static void split_petsc_args(int *argc, char **argv, int *pargc, char **pargv)
     }
     pargv[m++] = argv[i];
     const char *b = i + 1 < *argc ? argv[i + 1] : NULL;
-    if (b && !(b[0] == '-' && ((b[1] >= 'a' && b[1] <= 'z') || (b[1] >= 'A' && b[1] <= 'Z') ||
-                               b[1] == '-')))
+    if (b && !(b[0] == '-' &&
+               ((b[1] >= 'a' && b[1] <= 'z') || (b[1] >= 'A' && b[1] <= 'Z') || b[1] == '-')))
       pargv[m++] = argv[++i];
   }
   *argc = n;

@@ -33,7 +33,8 @@ int main(void)
   for (fcm_index k = 0; k < nc; k++) {
     TEST_TRUE(fcm_cell_rules_class(full, k) == fcm_cell_rules_class(part, k));
     TEST_TRUE(fcm_cell_rules_volume_fraction(full, k) == fcm_cell_rules_volume_fraction(part, k));
-    TEST_TRUE(fcm_cell_rules_cell_pieces(full, k, NULL) == fcm_cell_rules_cell_pieces(part, k, NULL));
+    TEST_TRUE(fcm_cell_rules_cell_pieces(full, k, NULL) ==
+              fcm_cell_rules_cell_pieces(part, k, NULL));
     if (fcm_cell_rules_class(full, k) != FCM_CELL_CUT) continue;
     for (int kind = 0; kind < FCM_RULE_KIND_COUNT; kind++) {
       int na = 0, nb = 0;

@@ -129,8 +129,8 @@ FCM_API fcm_status fcm_petsc_problem_add_gravity(fcm_petsc_problem *problem, con
  * of `num_nodes` mesh nodes (nodes without DOFs are skipped), as
  * fcm_integrator_add_constraint(). Before setup. Collective.
  * @return FCM_OK, FCM_ERR_ARG (node out of range, DOF constrained twice, bad motion). */
-FCM_API fcm_status fcm_petsc_problem_add_constraint(fcm_petsc_problem *problem,
-                                                    fcm_index num_nodes, const fcm_index *nodes,
+FCM_API fcm_status fcm_petsc_problem_add_constraint(fcm_petsc_problem *problem, fcm_index num_nodes,
+                                                    const fcm_index *nodes,
                                                     const fcm_motion *motion);
 
 /** Assemble K (and M for BACKWARD_EULER) and the loads over this process's elements, eliminate
@@ -172,22 +172,22 @@ FCM_API fcm_status fcm_petsc_problem_get_state(fcm_petsc_problem *problem, doubl
 
 /** Facts about the distribution and the run so far. */
 typedef struct fcm_petsc_info {
-  int size, rank;                  /**< processes and this one */
-  fcm_petsc_partition partition;   /**< the method used (never AUTO) */
-  fcm_index num_dofs;              /**< global DOFs */
-  fcm_index local_dofs;            /**< DOFs (matrix rows) this process owns */
-  fcm_index local_elements;        /**< elements this process integrates */
-  fcm_index max_local_elements;    /**< the largest count over the processes */
-  fcm_index min_local_elements;    /**< the smallest count */
-  double mass;                     /**< 1^T M 1 over the x components (the assembled mass,
-                                        stabilization included; 0 for STATIC) */
-  double time_rules;               /**< seconds (this process): the cut-cell rules */
-  double time_assembly;            /**< seconds (this process): element integration + MatAssembly */
-  double time_setup;               /**< seconds: the whole create + setup */
-  double memory_local;             /**< bytes resident on this process (PetscMemoryGetCurrentUsage) */
-  double memory_total;             /**< summed over the processes */
-  double matrix_memory;            /**< bytes of the system matrix's stored nonzeros over all
-                                        processes (values and column indices, MatGetInfo) */
+  int size, rank;                /**< processes and this one */
+  fcm_petsc_partition partition; /**< the method used (never AUTO) */
+  fcm_index num_dofs;            /**< global DOFs */
+  fcm_index local_dofs;          /**< DOFs (matrix rows) this process owns */
+  fcm_index local_elements;      /**< elements this process integrates */
+  fcm_index max_local_elements;  /**< the largest count over the processes */
+  fcm_index min_local_elements;  /**< the smallest count */
+  double mass;                   /**< 1^T M 1 over the x components (the assembled mass,
+                                      stabilization included; 0 for STATIC) */
+  double time_rules;             /**< seconds (this process): the cut-cell rules */
+  double time_assembly;          /**< seconds (this process): element integration + MatAssembly */
+  double time_setup;             /**< seconds: the whole create + setup */
+  double memory_local;           /**< bytes resident on this process (PetscMemoryGetCurrentUsage) */
+  double memory_total;           /**< summed over the processes */
+  double matrix_memory;          /**< bytes of the system matrix's stored nonzeros over all
+                                      processes (values and column indices, MatGetInfo) */
   long long steps, total_iterations;
 } fcm_petsc_info;
 

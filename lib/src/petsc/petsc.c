@@ -66,13 +66,13 @@ struct fcm_petsc_problem {
   fcm_cell_rules *rules; /* this process's cells carry points */
   fcm_space *space;      /* replicated topology */
   fcm_assembly_workspace *aws;
-  fcm_index n;        /* global DOFs */
-  fcm_index ncopy;    /* n / 3 */
-  int *cell_owner;    /* num_cells (-1: inactive) */
-  int *copy_owner;    /* ncopy */
-  PetscInt *perm;     /* ncopy: PETSc block index of each copy */
-  PetscInt nlocal;    /* owned copies */
-  PetscInt first;     /* first owned PETSc block index */
+  fcm_index n;     /* global DOFs */
+  fcm_index ncopy; /* n / 3 */
+  int *cell_owner; /* num_cells (-1: inactive) */
+  int *copy_owner; /* ncopy */
+  PetscInt *perm;  /* ncopy: PETSc block index of each copy */
+  PetscInt nlocal; /* owned copies */
+  PetscInt first;  /* first owned PETSc block index */
   fcm_index nelem_own;
   /* constraints: DOFs (space numbering), motion of each, node of each */
   fcm_index ncon;
@@ -270,8 +270,7 @@ cleanup:
 
 /* PTSCOTCH: MatPartitioning of the face graph of the active cells; each process hands a
  * contiguous block of them to PETSc, the result is gathered on every process. */
-static fcm_status partition_graph(fcm_petsc_problem *P, const unsigned char *active,
-                                  fcm_index nact)
+static fcm_status partition_graph(fcm_petsc_problem *P, const unsigned char *active, fcm_index nact)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P->ctx;
@@ -354,8 +353,8 @@ static fcm_status check_inputs(fcm_petsc_problem *P, const fcm_petsc_options *o)
   FCM_CHECK((int)o->partition >= 0 && o->partition < FCM_PETSC_PARTITION_COUNT, ctx, FCM_ERR_ARG,
             "petsc: partition = %d is not a method (0 auto, 1 ptscotch, 2 ordered)",
             (int)o->partition);
-  FCM_CHECK(o->rtol > 0.0 && o->rtol < 1.0, ctx, FCM_ERR_ARG,
-            "petsc: rtol = %g outside (0, 1)", o->rtol);
+  FCM_CHECK(o->rtol > 0.0 && o->rtol < 1.0, ctx, FCM_ERR_ARG, "petsc: rtol = %g outside (0, 1)",
+            o->rtol);
   FCM_CHECK(o->max_iterations >= 1, ctx, FCM_ERR_ARG, "petsc: max_iterations = %d must be >= 1",
             o->max_iterations);
   FCM_CHECK(o->rules.simplify != FCM_CELL_SIMPLIFY_AUTO, ctx, FCM_ERR_UNSUPPORTED,
@@ -377,8 +376,8 @@ static fcm_status build_space(fcm_petsc_problem *P, const fcm_geometry *geom,
   fcm_cell_rules_destroy(&P->rules);
   if (geom) {
     fcm_cell_rules_options ro = P->opts.rules;
-    ro.kinds = FCM_RULES_STIFFNESS |
-               (P->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER ? FCM_RULES_MASS : 0u);
+    ro.kinds =
+        FCM_RULES_STIFFNESS | (P->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER ? FCM_RULES_MASS : 0u);
     ro.cell_mask = mask ? mask : none;
     FCM_TRY(ctx, fcm_cell_rules_create(ctx, P->mesh, geom, &ro, &P->rules));
     FCM_TRY(ctx, fcm_space_create_embedded(ctx, P->mesh, P->rules, &P->space));
@@ -661,8 +660,7 @@ static fcm_status check_constraint(fcm_petsc_problem *P, fcm_index num_nodes,
   FCM_CHECK(finite3(m->velocity) && finite3(m->center) && finite3(m->axis) &&
                 isfinite(m->angular_speed) && isfinite(m->start) && !isnan(m->end) &&
                 m->end >= m->start,
-            ctx, FCM_ERR_ARG,
-            "petsc: constraint: motion with a non-finite member or end < start");
+            ctx, FCM_ERR_ARG, "petsc: constraint: motion with a non-finite member or end < start");
   FCM_CHECK(!m->release, ctx, FCM_ERR_UNSUPPORTED,
             "petsc: constraint: release (a constraint set that changes in time) is not "
             "supported by the PETSc backend");
@@ -701,8 +699,8 @@ static fcm_status apply_constraint(fcm_petsc_problem *P, fcm_index num_nodes,
                             sizeof *P->con_node) == FCM_OK &&
                 fcm__resize(ctx, (void **)&P->con_comp, (size_t)P->ncon, (size_t)(P->ncon + add),
                             sizeof *P->con_comp) == FCM_OK &&
-                fcm__resize(ctx, (void **)&P->con_motion, (size_t)P->ncon,
-                            (size_t)(P->ncon + add), sizeof *P->con_motion) == FCM_OK,
+                fcm__resize(ctx, (void **)&P->con_motion, (size_t)P->ncon, (size_t)(P->ncon + add),
+                            sizeof *P->con_motion) == FCM_OK,
             ctx, FCM_ERR_ALLOC, "petsc: constraint: out of memory");
   P->motions[P->num_motions] = *m;
   for (fcm_index k = 0; k < num_nodes; k++) {
@@ -928,8 +926,8 @@ static fcm_status constraint_values(fcm_petsc_problem *P, double t)
     if (P->copy_owner[d / 3] != P->rank) continue;
     double u[3];
     fcm_motion_eval(&P->motions[P->con_motion[k]], X + 3 * P->con_node[k], t, u, NULL);
-    PCALL(ctx, VecSetValue(P->g, 3 * P->perm[d / 3] + P->con_comp[k], u[P->con_comp[k]],
-                           INSERT_VALUES));
+    PCALL(ctx,
+          VecSetValue(P->g, 3 * P->perm[d / 3] + P->con_comp[k], u[P->con_comp[k]], INSERT_VALUES));
   }
   PCALL(ctx, VecAssemblyBegin(P->g));
   PCALL(ctx, VecAssemblyEnd(P->g));
@@ -1018,8 +1016,8 @@ fcm_status fcm_petsc_problem_step(fcm_petsc_problem *P, fcm_petsc_step_info *inf
               "petsc: t = %g: KSP %s with PC %s did not converge: %s (KSPConvergedReason %d) "
               "after %d iterations, residual norm %g (rtol %g); change the solver with "
               "-ksp_type / -pc_type or solver.petsc_options",
-              t1, kt ? kt : "?", pt ? pt : "?", KSPConvergedReasons[reason], (int)reason,
-              (int)its, (double)rnorm, P->opts.rtol);
+              t1, kt ? kt : "?", pt ? pt : "?", KSPConvergedReasons[reason], (int)reason, (int)its,
+              (double)rnorm, P->opts.rtol);
   }
   /* accept: v = (u1 - u0)/h (dynamic), u = u1 */
   if (P->M) {
@@ -1134,10 +1132,11 @@ static fcm_status check_scene(fcm_ctx *ctx, const fcm_scene *scene)
 {
   fcm_status st = FCM_OK;
   const char *name = fcm_scene_name(scene);
-  FCM_CHECK(fcm_scene_get_material(scene)->model == FCM_MATERIAL_LINEAR, ctx, FCM_ERR_UNSUPPORTED,
-            "scene %s: material.model: the PETSc backend solves linear elasticity only (\"linear\"); "
-            "run this scene with the serial backend",
-            name);
+  FCM_CHECK(
+      fcm_scene_get_material(scene)->model == FCM_MATERIAL_LINEAR, ctx, FCM_ERR_UNSUPPORTED,
+      "scene %s: material.model: the PETSc backend solves linear elasticity only (\"linear\"); "
+      "run this scene with the serial backend",
+      name);
   FCM_CHECK(fcm_scene_get_quadrature(scene)->simplify != FCM_CELL_SIMPLIFY_AUTO, ctx,
             FCM_ERR_UNSUPPORTED,
             "scene %s: quadrature.simplify = \"auto\" is not supported by the PETSc backend (its "
@@ -1182,8 +1181,8 @@ static fcm_status scene_region_nodes(fcm_ctx *ctx, const fcm_scene *scene, const
   if (r->kind == FCM_REGION_NODES) {
     for (fcm_index j = 0; j < r->num_nodes; j++) {
       FCM_CHECK(r->nodes[j] >= 0 && r->nodes[j] < nn, ctx, FCM_ERR_ARG,
-                "scene %s: effects[%d]: node %lld out of range [0, %lld)", fcm_scene_name(scene),
-                k, (long long)r->nodes[j], (long long)nn);
+                "scene %s: effects[%d]: node %lld out of range [0, %lld)", fcm_scene_name(scene), k,
+                (long long)r->nodes[j], (long long)nn);
       out[m++] = r->nodes[j];
     }
   } else {
@@ -1238,8 +1237,8 @@ fcm_status fcm_petsc_problem_create_from_scene(fcm_ctx *ctx, MPI_Comm comm, cons
   o.rules.num_threads = sv->threads;
   o.assembly.stiffness_strength = q->stiffness_strength > 0 ? q->stiffness_strength : FCM_DEFAULT;
   o.assembly.mass_strength = q->mass_strength > 0 ? q->mass_strength : FCM_DEFAULT;
-  FCM_TRY(ctx, fcm_petsc_problem_create(ctx, comm, mesh, geom, fcm_scene_get_material(scene), &o,
-                                        &P));
+  FCM_TRY(ctx,
+          fcm_petsc_problem_create(ctx, comm, mesh, geom, fcm_scene_get_material(scene), &o, &P));
   P->own_mesh = mesh;
   mesh = NULL;
   fcm_geometry_destroy(&geom); /* only read while the rules were built */

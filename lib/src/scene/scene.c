@@ -741,8 +741,8 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
   static const char *const keys[] = {
-      "method", "direct",         "preconditioner", "schwarz", "rtol",
-      "atol",   "max_iterations", "newton",         "threads", "preconditioner_tangent",
+      "method",       "direct",         "preconditioner", "schwarz", "rtol",
+      "atol",         "max_iterations", "newton",         "threads", "preconditioner_tangent",
       "petsc_options"};
   static const char *const skeys[] = {"threshold", "epsilon", "clamp"};
   static const char *const nkeys[] = {"rtol",        "max_iterations",
