@@ -1,8 +1,8 @@
 /* fcm-sim --backend petsc (see fcm-sim-petsc.h): every process reads the scene and builds the
  * mesh and the geometry; the problem (fcm_petsc_problem_create_from_scene()) distributes the
- * cells, the cut-cell rules, the assembly and the solves. Process 0 prints, and writes the log
- * <name>_log.csv and the frames (<name>_background_NNNN.vtu with the gathered displacement and
- * velocity, indexed by <name>_background.pvd). */
+ * cells, the cut-cell rules, the assembly and the solves. Process 0 prints and writes the log
+ * <name>_log.csv; each frame is a parallel VTU (<name>_NNNN.pvtu by process 0 naming one piece
+ * <name>_NNNN_<rank>.vtu per process: its own cells), indexed by <name>.pvd. */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm-sim-petsc.h"
 
@@ -58,19 +58,18 @@ static fcm_status write_log(fcm_ctx *ctx, const char *path, const run_log *rows,
   return fcm_atomic_file_commit(&f);
 }
 
-/* Process 0: the frame of the gathered state. */
-static fcm_status write_frame(fcm_ctx *ctx, const fcm_space *space, const double *u,
-                              const double *v, const char *dir, const char *name, int index,
-                              double time, fcm_pvd *pvd)
+/* A frame (collective): the pieces and the .pvtu, indexed in the PVD by process 0. */
+static int write_frame(fcm_ctx *ctx, fcm_petsc_problem *P, const char *dir, const char *name,
+                       int index, double time, fcm_pvd *pvd, int rank)
 {
-  fcm_status st;
-  char file[512], path[4700];
-  snprintf(file, sizeof file, "%s_background_%04d.vtu", name, index);
-  snprintf(path, sizeof path, "%s/%s", dir, file);
-  st = fcm_space_write_vtu(space, NULL, u, v, path);
-  if (st == FCM_OK) st = fcm_pvd_add(pvd, time, file);
-  (void)ctx;
-  return st;
+  char stem[512], file[600];
+  snprintf(stem, sizeof stem, "%s_%04d", name, index);
+  snprintf(file, sizeof file, "%s.pvtu", stem);
+  int ok = fcm_petsc_problem_write_frame(P, dir, stem) == FCM_OK;
+  if (ok && rank == 0) ok = fcm_pvd_add(pvd, time, file) == FCM_OK;
+  if (!ok && rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  return ok;
 }
 
 int sim_petsc_run(const char *path, const char *outdir, long long steps, int check, int quiet,
@@ -138,15 +137,14 @@ int sim_petsc_run(const char *path, const char *outdir, long long steps, int che
     MPI_Abort(MPI_COMM_WORLD, 1); /* a local failure the others cannot learn otherwise */
   }
   snprintf(logpath, sizeof logpath, "%s/%s_log.csv", dir, name);
-  snprintf(pvdpath, sizeof pvdpath, "%s/%s_background.pvd", dir, name);
+  snprintf(pvdpath, sizeof pvdpath, "%s/%s.pvd", dir, name);
   if (write && rank == 0) {
-    ok = make_dirs(dir) && fcm_pvd_create(ctx, pvdpath, &pvd) == FCM_OK &&
-         write_frame(ctx, fcm_petsc_problem_space(P), u, v, dir, name, frame++, 0.0, pvd) == FCM_OK;
+    ok = make_dirs(dir) && fcm_pvd_create(ctx, pvdpath, &pvd) == FCM_OK;
     if (!ok && fcm_ctx_error_status(ctx) != FCM_OK)
       fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
   }
   MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  if (!ok) goto done;
+  if (!ok || (write && !write_frame(ctx, P, dir, name, frame++, 0.0, pvd, rank))) goto done;
   double t1 = fcm_wtime();
   for (long long k = 1; k <= nsteps; k++) {
     fcm_petsc_step_info si;
@@ -168,12 +166,8 @@ int sim_petsc_run(const char *path, const char *outdir, long long steps, int che
       fprintf(stderr, "fcm-sim: step %lld/%lld t = %.6g s: KSP %d iterations, residual %.3g\n", k,
               nsteps, si.time, si.iterations, si.residual);
     if (write && (k % interval == 0 || k == nsteps)) {
-      st = fcm_petsc_problem_get_state(P, u, v); /* collective */
-      ok = st == FCM_OK;
-      if (ok && rank == 0)
-        ok = write_frame(ctx, fcm_petsc_problem_space(P), u, v, dir, name, frame++, si.time, pvd) ==
-                 FCM_OK &&
-             write_log(ctx, logpath, rows, k) == FCM_OK;
+      if (!write_frame(ctx, P, dir, name, frame++, si.time, pvd, rank)) goto done;
+      ok = rank != 0 || write_log(ctx, logpath, rows, k) == FCM_OK;
       if (!ok) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
       MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
       if (!ok) goto done;

@@ -52,9 +52,10 @@ typedef enum fcm_petsc_partition {
   FCM_PETSC_PARTITION_AUTO = 0,     /**< PT-Scotch when PETSc has it, else ORDERED */
   FCM_PETSC_PARTITION_PTSCOTCH = 1, /**< MatPartitioning (type ptscotch, or the option
                                          -mat_partitioning_type) of the face graph of the
-                                         active cells, equal weights */
+                                         active cells; cut cells weigh 4, uncut cells 1 */
   FCM_PETSC_PARTITION_ORDERED = 2,  /**< active cells sorted along a Morton (Z-order) curve
-                                         of their centroids, cut into equal contiguous parts */
+                                         of their centroids, cut into contiguous parts of
+                                         equal weight (as PTSCOTCH) */
   FCM_PETSC_PARTITION_COUNT
 } fcm_petsc_partition;
 
@@ -169,6 +170,15 @@ FCM_API const fcm_space *fcm_petsc_problem_space(const fcm_petsc_problem *proble
 /** Gather the displacement and velocity (either may be NULL) in the space's DOF numbering
  * (num_dofs each) on every process. Collective. @return FCM_OK, FCM_ERR_INTERNAL. */
 FCM_API fcm_status fcm_petsc_problem_get_state(fcm_petsc_problem *problem, double *u, double *v);
+
+/** Write the current state as a parallel VTU: every process writes its piece
+ * <dir>/<stem>_<rank>.vtu (its own cells, their nodes at reference positions; point data
+ * `displacement` and `velocity` — fcm_space_node_field() of the gathered state —, cell data
+ * `process` and `volume_fraction`), process 0 the index <dir>/<stem>.pvtu naming the pieces
+ * (ParaView opens it; a PVD may index it). Files are written atomically; the directory must
+ * exist. Collective. @return FCM_OK, FCM_ERR_ARG, FCM_ERR_IO (naming the path), FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_petsc_problem_write_frame(fcm_petsc_problem *problem, const char *dir,
+                                                 const char *stem);
 
 /** Facts about the distribution and the run so far. */
 typedef struct fcm_petsc_info {

@@ -7,8 +7,8 @@
  *   fcm.pc (variable petsc, Requires mpi-c) and fcmConfig.cmake (FCM_HAVE_PETSC, MPI::MPI_C);
  *   setup.sh deps --petsc; .ci/run runs the mpi-labelled tests.
  * - partition: PT-Scotch through MatPartitioning on the face graph of the active cells (Debian's
- *   PETSc 3.18 has it), Morton-ordered fallback (FCM_PETSC_PARTITION_ORDERED). Equal weights:
- *   cut cells cost more (their rules) — weight them by their point count next.
+ *   PETSc 3.18 has it), Morton-ordered fallback (FCM_PETSC_PARTITION_ORDERED). Weights: cut
+ *   cells 4, uncut 1 (a guess: measure the per-cell rule + assembly cost and weight by it next).
  * - rules: each process builds the rules of its own cells (fcm_cell_rules_options.cell_mask);
  *   the classification (intersection) runs twice on every process (once for the active set the
  *   partition needs, once with the mask). Only simplification/stabilization/points are
@@ -26,17 +26,28 @@
  *   KSPConvergedReasons[].
  * - errors: every local phase ends in agree(): an error on any process is returned on all with
  *   the lowest failing process's message (tests/petsc: bad input on one rank, no hang).
+ * - output: fcm_petsc_problem_write_frame(): a .pvtu (process 0) naming one piece per process
+ *   (its own cells); the node fields come from the gathered (replicated) state.
+ * - scenes: fcm_petsc_problem_create_from_scene() (mesh + geometry through
+ *   fcm__scene_mesh_geometry() of lib/src/scene/run.c) and fcm-sim --backend petsc
+ *   (apps/fcm-sim-petsc.c); the example scene vibrating_beam.json is the dynamic one.
  * Not done:
  * - Newton / hyperelastic materials / the integrator's time stepping on PETSc (a hook in
  *   lib/src/sim/linsolve.c would replace only the solve; the assembly seam is
  *   fcm_assembly_workspace_hyperelastic, which needs an element-mask variant): this module is
  *   the separate static + dynamic LINEAR driver the task allowed.
  * - Nitsche/penalty boundary constraints, tractions, pressure, body-force fields, damping,
- *   initial velocities, cuts, checkpoints, pvtu output: fcm-sim --backend petsc refuses them
+ *   initial velocities, cuts, checkpoints (and --resume): fcm-sim --backend petsc refuses them
  *   with a message naming the feature.
- * - geometry kept whole on every process (no AABB crop), mesh replicated.
+ * - geometry kept whole on every process (no AABB crop), mesh replicated; the classification
+ *   (intersection of EVERY cell) runs twice on every process — on the bench body it costs
+ *   3x the simplification, so distribute it next: intersect own candidate cells only and
+ *   allgather class / fraction / piece volumes (the rules would then take the classification
+ *   of unflagged cells from outside, a new option next to cell_mask).
+ * - the options string goes into the GLOBAL options database (it stays for later problems);
+ *   an options prefix per problem would scope it.
  * - README projection for 1e8 DOFs (memory and time per DOF are printed by
- *   tests/petsc/bench: see the report).
+ *   tests/petsc/bench.c, figures in README "Distributed runs").
  * ------------------------------------------------------------------------------------------ */
 #include "fcm/petsc.h"
 
@@ -228,6 +239,16 @@ static int cmp_keyed(const void *a, const void *b)
   return x->cell < y->cell ? -1 : x->cell > y->cell;
 }
 
+/* Partition weight of an active cell: cut cells carry their own rules (intersection,
+ * simplification, stabilization: several times an uncut cell's work), so they weigh
+ * FCM_PETSC_CUT_WEIGHT, uncut cells 1 (a heuristic: the rule and assembly costs per cell are not
+ * measured per run). */
+#define FCM_PETSC_CUT_WEIGHT 4
+static int cell_weight(const fcm_petsc_problem *P, fcm_index c)
+{
+  return P->rules && fcm_cell_rules_class(P->rules, c) == FCM_CELL_CUT ? FCM_PETSC_CUT_WEIGHT : 1;
+}
+
 /* ORDERED: active cells along the Morton curve of their centroids, equal contiguous parts. */
 static fcm_status partition_ordered(fcm_petsc_problem *P, const unsigned char *active,
                                     fcm_index nact)
@@ -260,8 +281,15 @@ static fcm_status partition_ordered(fcm_petsc_problem *P, const unsigned char *a
     m++;
   }
   qsort(k, (size_t)m, sizeof *k, cmp_keyed);
+  double wsum = 0.0, w = 0.0;
   for (fcm_index i = 0; i < m; i++)
-    P->cell_owner[k[i].cell] = (int)(i * P->size / FCM_MAX(m, 1));
+    wsum += cell_weight(P, k[i].cell);
+  for (fcm_index i = 0; i < m; i++) { /* equal weight per process, cut at the mid-weight */
+    const double wc = cell_weight(P, k[i].cell);
+    const int r = (int)((w + 0.5 * wc) * P->size / wsum);
+    P->cell_owner[k[i].cell] = r < P->size ? r : P->size - 1;
+    w += wc;
+  }
 cleanup:
   fcm__free(ctx, k);
   fcm__free(ctx, X);
@@ -315,6 +343,13 @@ static fcm_status partition_graph(fcm_petsc_problem *P, const unsigned char *act
   ia = ja = NULL; /* owned by adj */
   PCALL(ctx, MatPartitioningCreate(P->comm, &part));
   PCALL(ctx, MatPartitioningSetAdjacency(part, adj));
+  {
+    PetscInt *vw = NULL; /* vertex weights: freed by the partitioning */
+    PCALL(ctx, PetscMalloc1(ml + 1, &vw));
+    for (fcm_index i = lo; i < hi; i++)
+      vw[i - lo] = cell_weight(P, act_cell[i]);
+    PCALL(ctx, MatPartitioningSetVertexWeights(part, vw));
+  }
   PCALL(ctx, MatPartitioningSetType(part, MATPARTITIONINGPTSCOTCH));
   PCALL(ctx, MatPartitioningSetFromOptions(part));
   PCALL(ctx, MatPartitioningApply(part, &is));
@@ -1270,5 +1305,152 @@ cleanup:
   fcm_petsc_problem_destroy(&P);
   fcm_geometry_destroy(&geom);
   fcm_mesh_destroy(&mesh);
+  return st;
+}
+
+/* ---------------------------------------------------------------- output */
+
+/* This process's piece: its active cells with their nodes (renumbered), the node fields of the
+ * gathered state, the owner and the volume fraction per cell. */
+static fcm_status write_piece(fcm_petsc_problem *P, const double *ud, const double *vd,
+                              const char *path)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_mesh *mesh = P->mesh;
+  const fcm_index nc = fcm_mesh_num_cells(mesh), nn = fcm_mesh_num_nodes(mesh);
+  const int npc = fcm_mesh_nodes_per_cell(mesh);
+  const fcm_index *cells = fcm_mesh_cells(mesh);
+  const double *X = fcm_mesh_coords(mesh);
+  fcm_index *map = NULL, *conn = NULL, np = 0, ncl = 0;
+  double *xyz = NULL, *pu = NULL, *pv = NULL, *frac = NULL;
+  int32_t *owner = NULL;
+  fcm_vtu *vtu = NULL;
+  FCM_ALLOC(ctx, nn + 1, map);
+  for (fcm_index a = 0; a < nn; a++)
+    map[a] = -1;
+  for (fcm_index c = 0; c < nc; c++)
+    if (P->cell_owner[c] == P->rank) {
+      ncl++;
+      for (int k = 0; k < npc; k++)
+        if (map[cells[(size_t)npc * c + k]] < 0) map[cells[(size_t)npc * c + k]] = np++;
+    }
+  FCM_ALLOC(ctx, 3 * np + 1, xyz);
+  FCM_ALLOC(ctx, 3 * np + 1, pu);
+  FCM_ALLOC(ctx, 3 * np + 1, pv);
+  FCM_ALLOC(ctx, (size_t)npc * ncl + 1, conn);
+  FCM_ALLOC(ctx, ncl + 1, frac);
+  FCM_ALLOC(ctx, ncl + 1, owner);
+  for (fcm_index a = 0; a < nn; a++)
+    if (map[a] >= 0)
+      for (int i = 0; i < 3; i++) {
+        xyz[3 * map[a] + i] = X[3 * a + i];
+        pu[3 * map[a] + i] = ud[3 * a + i];
+        pv[3 * map[a] + i] = vd[3 * a + i];
+      }
+  fcm_index m = 0;
+  for (fcm_index c = 0; c < nc; c++)
+    if (P->cell_owner[c] == P->rank) {
+      for (int k = 0; k < npc; k++)
+        conn[(size_t)npc * m + k] = map[cells[(size_t)npc * c + k]];
+      frac[m] = P->rules ? fcm_cell_rules_volume_fraction(P->rules, c) : 1.0;
+      owner[m] = P->rank;
+      m++;
+    }
+  FCM_TRY(ctx, fcm_vtu_create(ctx, &vtu));
+  FCM_TRY(ctx, fcm_vtu_set_points(vtu, np, xyz));
+  FCM_TRY(ctx, fcm_vtu_set_cells(vtu, fcm_mesh_get_element_info(mesh)->vtk_cell_type, ncl, conn));
+  FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "displacement", 3, np, pu));
+  FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "velocity", 3, np, pv));
+  FCM_TRY(ctx, fcm_vtu_add_field_int32(vtu, FCM_VTU_CELL_DATA, "process", 1, ncl, owner));
+  FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "volume_fraction", 1, ncl, frac));
+  FCM_TRY(ctx, fcm_vtu_write(vtu, path, NULL));
+cleanup:
+  fcm_vtu_destroy(&vtu);
+  void *arrays[] = {map, conn, xyz, pu, pv, frac, owner};
+  for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
+    fcm__free(ctx, arrays[i]);
+  return st;
+}
+
+/* The host's byte order as VTK names it (the pieces are written in it). */
+static const char *byte_order(void)
+{
+  const uint16_t one = 1;
+  unsigned char first;
+  memcpy(&first, &one, 1);
+  return first ? "LittleEndian" : "BigEndian";
+}
+
+/* Process 0: the .pvtu index of the pieces. */
+static fcm_status write_pvtu(fcm_petsc_problem *P, const char *path, const char *stem)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  fcm_atomic_file *af = NULL;
+  FCM_TRY(ctx, fcm_atomic_file_open(ctx, path, &af));
+  FILE *f = fcm_atomic_file_stream(af);
+  fprintf(f,
+          "<?xml version=\"1.0\"?>\n"
+          "<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"%s\" "
+          "header_type=\"UInt64\">\n"
+          "  <PUnstructuredGrid GhostLevel=\"0\">\n"
+          "    <PPointData>\n"
+          "      <PDataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\"/>\n"
+          "      <PDataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\"/>\n"
+          "    </PPointData>\n"
+          "    <PCellData>\n"
+          "      <PDataArray type=\"Int32\" Name=\"process\" NumberOfComponents=\"1\"/>\n"
+          "      <PDataArray type=\"Float64\" Name=\"volume_fraction\" "
+          "NumberOfComponents=\"1\"/>\n"
+          "    </PCellData>\n"
+          "    <PPoints>\n"
+          "      <PDataArray type=\"Float64\" NumberOfComponents=\"3\"/>\n"
+          "    </PPoints>\n",
+          byte_order());
+  for (int r = 0; r < P->size; r++)
+    fprintf(f, "    <Piece Source=\"%s_%d.vtu\"/>\n", stem, r);
+  fprintf(f, "  </PUnstructuredGrid>\n</VTKFile>\n");
+  FCM_TRY(ctx, fcm_atomic_file_commit(&af));
+cleanup:
+  fcm_atomic_file_abort(&af);
+  return st;
+}
+
+fcm_status fcm_petsc_problem_write_frame(fcm_petsc_problem *P, const char *dir, const char *stem)
+{
+  fcm_status st = FCM_OK;
+  double *u = NULL, *v = NULL, *ud = NULL, *vd = NULL;
+  char path[4096];
+  FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
+  fcm_ctx *ctx = P->ctx;
+  FCM_CHECK(dir && stem && *stem, ctx, FCM_ERR_ARG, "petsc: write_frame: NULL directory or stem");
+  const fcm_index nn = fcm_mesh_num_nodes(P->mesh);
+  u = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *u);
+  v = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *v);
+  ud = fcm__calloc(ctx, 3 * (size_t)nn + 1, sizeof *ud);
+  vd = fcm__calloc(ctx, 3 * (size_t)nn + 1, sizeof *vd);
+  st = u && v && ud && vd ? FCM_OK : FCM_ERR_ALLOC;
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  FCM_TRY(ctx, fcm_petsc_problem_get_state(P, u, v)); /* collective */
+  st = fcm_space_node_field(P->space, u, ud);
+  if (st == FCM_OK) st = fcm_space_node_field(P->space, v, vd);
+  if (st == FCM_OK) {
+    snprintf(path, sizeof path, "%s/%s_%d.vtu", dir, stem, P->rank);
+    st = write_piece(P, ud, vd, path);
+  }
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  if (P->rank == 0) {
+    snprintf(path, sizeof path, "%s/%s.pvtu", dir, stem);
+    st = write_pvtu(P, path, stem);
+  }
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+cleanup:
+  if (P) {
+    fcm__free(P->ctx, u);
+    fcm__free(P->ctx, v);
+    fcm__free(P->ctx, ud);
+    fcm__free(P->ctx, vd);
+  }
   return st;
 }
