@@ -12,6 +12,15 @@
 
 #include <sys/resource.h>
 
+/* CPU seconds of this process (user + system). */
+static double cpu_seconds(void)
+{
+  struct rusage ru;
+  getrusage(RUSAGE_SELF, &ru);
+  return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
+         (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+}
+
 int main(int argc, char **argv)
 {
   fcm_ctx *ctx = NULL;
@@ -35,7 +44,7 @@ int main(int argc, char **argv)
   po.kind = FCM_INTEGRATOR_STATIC;
   po.rtol = 1e-8;
   MPI_Barrier(MPI_COMM_WORLD);
-  double t0 = MPI_Wtime();
+  double t0 = MPI_Wtime(), c0 = cpu_seconds();
   TEST_OK(ctx, fcm_petsc_problem_create(ctx, MPI_COMM_WORLD, mesh, geom, &mat, &po, &P));
   /* clamp the nodes with DOFs in the lowest z layer of cells the ball reaches */
   const fcm_space *space = fcm_petsc_problem_space(P);
@@ -52,13 +61,16 @@ int main(int argc, char **argv)
   TEST_OK(ctx, fcm_petsc_problem_add_constraint(P, nfix, fix, &clamp));
   TEST_OK(ctx, fcm_petsc_problem_setup(P));
   MPI_Barrier(MPI_COMM_WORLD);
-  const double t_setup = MPI_Wtime() - t0;
+  const double t_setup = MPI_Wtime() - t0, c_setup = cpu_seconds() - c0;
   fcm_petsc_step_info si;
   memset(&si, 0, sizeof si);
-  t0 = MPI_Wtime();
+  t0 = MPI_Wtime(), c0 = cpu_seconds();
   TEST_OK(ctx, fcm_petsc_problem_step(P, &si));
   MPI_Barrier(MPI_COMM_WORLD);
-  const double t_solve = MPI_Wtime() - t0;
+  const double t_solve = MPI_Wtime() - t0, c_solve = cpu_seconds() - c0;
+  double cpu[2] = {c_setup, c_solve}, cpu_max[2], cpu_sum[2];
+  MPI_Allreduce(cpu, cpu_max, 2, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Allreduce(cpu, cpu_sum, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
   fcm_petsc_info info;
   TEST_OK(ctx, fcm_petsc_problem_get_info(P, &info));
   struct rusage ru;
@@ -71,6 +83,11 @@ int main(int argc, char **argv)
     printf("petsc_bench np %d: process 0's rules build: intersect %.3g core-s (every cell), "
            "simplify + stabilize %.3g core-s (its own cut cells; %lld cut cells in all)\n",
            size, rs->time_intersect, rs->time_simplify, (long long)rs->num_cut);
+  if (rank == 0)
+    printf("petsc_bench np %d: CPU seconds (user + system; busy MPI waits count) per DOF: setup "
+           "%.3g us max over processes / %.3g us summed, solve %.3g us max / %.3g us summed\n",
+           size, 1e6 * cpu_max[0] / (double)info.num_dofs, 1e6 * cpu_sum[0] / (double)info.num_dofs,
+           1e6 * cpu_max[1] / (double)info.num_dofs, 1e6 * cpu_sum[1] / (double)info.num_dofs);
   if (rank == 0)
     printf("petsc_bench np %d %s N %lld: dofs %lld, setup %.3g us/dof (%.3g s: rules %.3g s, "
            "assembly %.3g s on process 0), solve %.3g us/dof (%.3g s, %d CG+GAMG iterations), "

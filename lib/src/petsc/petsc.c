@@ -10,9 +10,10 @@
  *   PETSc 3.18 has it), Morton-ordered fallback (FCM_PETSC_PARTITION_ORDERED). Weights: cut
  *   cells 4, uncut 1 (a guess: measure the per-cell rule + assembly cost and weight by it next).
  * - rules: each process builds the rules of its own cells (fcm_cell_rules_options.cell_mask);
- *   the classification (intersection) runs twice on every process (once for the active set the
- *   partition needs, once with the mask). Only simplification/stabilization/points are
- *   distributed.
+ *   the partition comes first, on the candidate cells (box meets a geometry cell's box; weight
+ *   4 where it meets a boundary triangle's box too), so one rules build per process; the
+ *   classification (intersection) of every cell runs on every process. Only the points
+ *   (mapping, simplification, stabilization, surface rules) are distributed.
  * - DOFs: global numbering, owner = lowest process among the cells using the DOF copy, the
  *   PETSc index is contiguous per owner; the perm (space DOF -> PETSc index) and the space's
  *   pattern are REPLICATED (O(DOFs + nnz) integers per process).
@@ -40,10 +41,10 @@
  *   initial velocities, cuts, checkpoints (and --resume): fcm-sim --backend petsc refuses them
  *   with a message naming the feature.
  * - geometry kept whole on every process (no AABB crop), mesh replicated; the classification
- *   (intersection of EVERY cell) runs twice on every process — on the bench body it costs
- *   3x the simplification, so distribute it next: intersect own candidate cells only and
- *   allgather class / fraction / piece volumes (the rules would then take the classification
- *   of unflagged cells from outside, a new option next to cell_mask).
+ *   (intersection of EVERY cell) runs on every process — on the bench body it costs 2-3x the
+ *   simplification, so distribute it next: intersect own candidate cells only and allgather
+ *   class / fraction / piece volumes (the rules would then take the classification of
+ *   unflagged cells from outside, a new option next to cell_mask).
  * - the options string goes into the GLOBAL options database (it stays for later problems);
  *   an options prefix per problem would scope it.
  * - README projection for 1e8 DOFs (memory and time per DOF are printed by
@@ -65,6 +66,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define FCM_PETSC_CUT_WEIGHT 4
+
 struct fcm_petsc_problem {
   fcm_ctx *ctx;
   MPI_Comm comm;
@@ -77,13 +80,14 @@ struct fcm_petsc_problem {
   fcm_cell_rules *rules; /* this process's cells carry points */
   fcm_space *space;      /* replicated topology */
   fcm_assembly_workspace *aws;
-  fcm_index n;     /* global DOFs */
-  fcm_index ncopy; /* n / 3 */
-  int *cell_owner; /* num_cells (-1: inactive) */
-  int *copy_owner; /* ncopy */
-  PetscInt *perm;  /* ncopy: PETSc block index of each copy */
-  PetscInt nlocal; /* owned copies */
-  PetscInt first;  /* first owned PETSc block index */
+  fcm_index n;           /* global DOFs */
+  fcm_index ncopy;       /* n / 3 */
+  int *cell_owner;       /* num_cells (-1: inactive) */
+  unsigned char *weight; /* num_cells: partition weight of the candidate cells (0: none) */
+  int *copy_owner;       /* ncopy */
+  PetscInt *perm;        /* ncopy: PETSc block index of each copy */
+  PetscInt nlocal;       /* owned copies */
+  PetscInt first;        /* first owned PETSc block index */
   fcm_index nelem_own;
   /* constraints: DOFs (space numbering), motion of each, node of each */
   fcm_index ncon;
@@ -239,14 +243,13 @@ static int cmp_keyed(const void *a, const void *b)
   return x->cell < y->cell ? -1 : x->cell > y->cell;
 }
 
-/* Partition weight of an active cell: cut cells carry their own rules (intersection,
- * simplification, stabilization: several times an uncut cell's work), so they weigh
- * FCM_PETSC_CUT_WEIGHT, uncut cells 1 (a heuristic: the rule and assembly costs per cell are not
- * measured per run). */
-#define FCM_PETSC_CUT_WEIGHT 4
+/* Partition weight of a candidate cell (candidate_cells()): cut cells carry their own rules
+ * (intersection, simplification, stabilization: several times an uncut cell's work), so cells
+ * that probably are cut weigh FCM_PETSC_CUT_WEIGHT, the others 1 (a heuristic: the rule and
+ * assembly costs per cell are not measured per run). */
 static int cell_weight(const fcm_petsc_problem *P, fcm_index c)
 {
-  return P->rules && fcm_cell_rules_class(P->rules, c) == FCM_CELL_CUT ? FCM_PETSC_CUT_WEIGHT : 1;
+  return P->weight[c];
 }
 
 /* ORDERED: active cells along the Morton curve of their centroids, equal contiguous parts. */
@@ -399,27 +402,88 @@ cleanup:
   return st;
 }
 
-/* The rules (geometry) or the plain space, with this process's cells flagged in `mask`
- * (NULL: classification pass, no cell gets points). */
+/* The rules (geometry: points on the cells flagged in `mask` only) or the plain space. */
 static fcm_status build_space(fcm_petsc_problem *P, const fcm_geometry *geom,
-                              const unsigned char *mask, const unsigned char *none)
+                              const unsigned char *mask)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P->ctx;
-  fcm_assembly_workspace_destroy(&P->aws);
-  fcm_space_destroy(&P->space);
-  fcm_cell_rules_destroy(&P->rules);
   if (geom) {
     fcm_cell_rules_options ro = P->opts.rules;
     ro.kinds =
         FCM_RULES_STIFFNESS | (P->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER ? FCM_RULES_MASS : 0u);
-    ro.cell_mask = mask ? mask : none;
+    ro.cell_mask = mask;
     FCM_TRY(ctx, fcm_cell_rules_create(ctx, P->mesh, geom, &ro, &P->rules));
     FCM_TRY(ctx, fcm_space_create_embedded(ctx, P->mesh, P->rules, &P->space));
   } else {
     FCM_TRY(ctx, fcm_space_create(ctx, P->mesh, NULL, &P->space));
   }
 cleanup:
+  return st;
+}
+
+/* Boxes (lo[3], hi[3]) of the n cells (npc nodes each, connectivity conn) of coordinates X. */
+static fcm_status cell_boxes(fcm_ctx *ctx, fcm_index n, int npc, const fcm_index *conn,
+                             const double *X, double **out)
+{
+  fcm_status st = FCM_OK;
+  double *b = NULL;
+  FCM_ALLOC(ctx, 6 * (size_t)n + 1, b);
+  for (fcm_index i = 0; i < n; i++) {
+    double *bi = b + 6 * i;
+    for (int d = 0; d < 3; d++)
+      bi[d] = HUGE_VAL, bi[3 + d] = -HUGE_VAL;
+    for (int a = 0; a < npc; a++)
+      for (int d = 0; d < 3; d++) {
+        const double v = X[3 * conn[(size_t)npc * i + a] + d];
+        bi[d] = fmin(bi[d], v);
+        bi[3 + d] = fmax(bi[3 + d], v);
+      }
+  }
+  *out = b;
+cleanup:
+  return st;
+}
+
+/* P->weight[c]: 0 no candidate, 1 candidate, FCM_PETSC_CUT_WEIGHT candidate whose box also
+ * meets a boundary triangle's box. Without a geometry every cell weighs 1. */
+static fcm_status candidate_cells(fcm_petsc_problem *P, const fcm_geometry *geom)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_mesh *mesh = P->mesh;
+  const fcm_index nc = fcm_mesh_num_cells(mesh);
+  double *gb = NULL, *tb = NULL, *cb = NULL;
+  fcm_aabb_tree *gt = NULL, *tt = NULL;
+  if (!geom) {
+    for (fcm_index c = 0; c < nc; c++)
+      P->weight[c] = 1;
+    return FCM_OK;
+  }
+  const fcm_index ng = fcm_geometry_num_cells(geom);
+  const fcm_index nt = fcm_geometry_num_boundary_triangles(geom);
+  FCM_TRY(ctx, cell_boxes(ctx, ng, fcm_geometry_nodes_per_cell(geom), fcm_geometry_cells(geom),
+                          fcm_geometry_coords(geom), &gb));
+  FCM_TRY(ctx, cell_boxes(ctx, nt, 3, fcm_geometry_boundary_triangles(geom),
+                          fcm_geometry_coords(geom), &tb));
+  FCM_TRY(ctx, cell_boxes(ctx, nc, fcm_mesh_nodes_per_cell(mesh), fcm_mesh_cells(mesh),
+                          fcm_mesh_coords(mesh), &cb));
+  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, ng, gb, &gt));
+  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nt, tb, &tt));
+  for (fcm_index c = 0; c < nc; c++) {
+    fcm_index hits = 0;
+    FCM_TRY(ctx, fcm_aabb_tree_query(gt, cb + 6 * c, cb + 6 * c + 3, 0, NULL, &hits));
+    P->weight[c] = 0;
+    if (hits == 0) continue;
+    FCM_TRY(ctx, fcm_aabb_tree_query(tt, cb + 6 * c, cb + 6 * c + 3, 0, NULL, &hits));
+    P->weight[c] = hits > 0 ? FCM_PETSC_CUT_WEIGHT : 1;
+  }
+cleanup:
+  fcm_aabb_tree_destroy(&gt);
+  fcm_aabb_tree_destroy(&tt);
+  fcm__free(ctx, gb);
+  fcm__free(ctx, tb);
+  fcm__free(ctx, cb);
   return st;
 }
 
@@ -532,7 +596,7 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
 {
   fcm_status st = FCM_OK;
   fcm_petsc_problem *P = NULL;
-  unsigned char *mask = NULL, *none = NULL;
+  unsigned char *mask = NULL;
   const double t0 = fcm_wtime();
   FCM_CHECK(out, ctx, FCM_ERR_ARG, "petsc: output pointer is NULL");
   *out = NULL;
@@ -561,49 +625,50 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
   if (st == FCM_OK) st = check_inputs(P, &P->opts);
   FCM_TRY(ctx, agree(ctx, P->comm, st));
 
-  /* 1. the active cells: rules without points (classification) or every cell */
+  /* 1. the candidate cells: those whose box meets the box of a geometry cell (every cell
+   * without a geometry), weighted FCM_PETSC_CUT_WEIGHT where it also meets a boundary
+   * triangle's box (likely cut), 1 otherwise; a superset of the active cells, found without
+   * intersecting anything */
   const fcm_index nc = fcm_mesh_num_cells(mesh);
   const double tr = fcm_wtime();
-  none = fcm__calloc(ctx, (size_t)nc + 1, 1);
   mask = fcm__calloc(ctx, (size_t)nc + 1, 1);
   P->cell_owner = fcm__calloc(ctx, (size_t)nc + 1, sizeof *P->cell_owner);
-  st = none && mask && P->cell_owner ? FCM_OK : FCM_ERR_ALLOC;
-  if (st == FCM_OK) st = build_space(P, geom, NULL, none);
+  P->weight = fcm__calloc(ctx, (size_t)nc + 1, 1);
+  st = mask && P->cell_owner && P->weight ? FCM_OK : FCM_ERR_ALLOC;
+  if (st == FCM_OK) st = candidate_cells(P, geom);
   FCM_TRY(ctx, agree(ctx, P->comm, st));
-  fcm_index nact = 0;
+  fcm_index ncand = 0;
   for (fcm_index c = 0; c < nc; c++) {
     P->cell_owner[c] = -1;
-    nact += P->space->active[c] != 0;
+    ncand += P->weight[c] != 0;
   }
 
-  /* 2. partition the active cells */
+  /* 2. partition the candidate cells */
   P->partition = P->opts.partition == FCM_PETSC_PARTITION_AUTO ? FCM_PETSC_PARTITION_PTSCOTCH
                                                                : P->opts.partition;
   if (P->size == 1) {
     for (fcm_index c = 0; c < nc; c++)
-      if (P->space->active[c]) P->cell_owner[c] = 0;
+      if (P->weight[c]) P->cell_owner[c] = 0;
   } else if (P->partition == FCM_PETSC_PARTITION_PTSCOTCH) {
-    st = partition_graph(P, P->space->active, nact);
+    st = partition_graph(P, P->weight, ncand);
   } else {
-    st = partition_ordered(P, P->space->active, nact);
+    st = partition_ordered(P, P->weight, ncand);
   }
   FCM_TRY(ctx, agree(ctx, P->comm, st));
 
-  /* 3. this process's rules; the space must come out the same (it depends on the
-   * classification only) */
-  if (geom) {
-    const fcm_index ndofs0 = P->space->num_dofs, nel0 = P->space->num_elems;
-    for (fcm_index c = 0; c < nc; c++)
-      mask[c] = P->cell_owner[c] == P->rank;
-    st = build_space(P, geom, mask, none);
-    if (st == FCM_OK && (P->space->num_dofs != ndofs0 || P->space->num_elems != nel0))
+  /* 3. the rules, with points on this process's cells only (every process classifies every
+   * cell: the replicated part), and the space; candidates the rules drop own nothing */
+  for (fcm_index c = 0; c < nc; c++)
+    mask[c] = P->cell_owner[c] == P->rank;
+  st = build_space(P, geom, mask);
+  for (fcm_index c = 0; st == FCM_OK && c < nc; c++) {
+    if (P->space->active[c] && P->cell_owner[c] < 0)
       st = fcm__error(ctx, FCM_ERR_INTERNAL, __FILE__, __LINE__, __func__,
-                      "petsc: the space of the masked rules has %lld DOFs / %lld elements, the "
-                      "classification gave %lld / %lld",
-                      (long long)P->space->num_dofs, (long long)P->space->num_elems,
-                      (long long)ndofs0, (long long)nel0);
-    FCM_TRY(ctx, agree(ctx, P->comm, st));
+                      "petsc: active cell %lld is no candidate (its box meets no geometry cell)",
+                      (long long)c);
+    if (!P->space->active[c]) P->cell_owner[c] = -1;
   }
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
   P->time_rules = fcm_wtime() - tr;
   st = fcm_assembly_workspace_create(P->space, &P->opts.assembly, &P->aws);
   if (st == FCM_OK) st = number_dofs(P);
@@ -623,7 +688,6 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
   P = NULL;
 cleanup:
   fcm__free(ctx, mask);
-  fcm__free(ctx, none);
   fcm_petsc_problem_destroy(&P);
   return st;
 }
@@ -644,8 +708,9 @@ void fcm_petsc_problem_destroy(fcm_petsc_problem **problem)
   fcm_assembly_workspace_destroy(&P->aws);
   fcm_space_destroy(&P->space);
   fcm_cell_rules_destroy(&P->rules);
-  void *arrays[] = {P->petsc_options, P->cell_owner, P->copy_owner, P->perm,    P->con_dof,
-                    P->con_node,      P->con_comp,   P->con_motion, P->motions, P->is_con};
+  void *arrays[] = {P->petsc_options, P->weight,  P->cell_owner, P->copy_owner,
+                    P->perm,          P->con_dof, P->con_node,   P->con_comp,
+                    P->con_motion,    P->motions, P->is_con};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
     fcm__free(ctx, arrays[i]);
   if (P->comm != MPI_COMM_NULL) MPI_Comm_free(&P->comm);
