@@ -84,3 +84,7 @@ foreach(np 1 2)
   fcm_add_mpi_test(petsc_bench_np${np} tests/petsc/bench.c NP ${np} ARGS hex8 24 TIMEOUT 1800)
   set_tests_properties(petsc_bench_np${np} PROPERTIES LABELS "bench;mpi")
 endforeach()
+# checkpoints: resume bit for bit on the same processes, to 1e-10 on another count
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_checkpoint_np${np} tests/petsc/checkpoint.c NP ${np})
+endforeach()

@@ -180,6 +180,22 @@ FCM_API fcm_status fcm_petsc_problem_get_state(fcm_petsc_problem *problem, doubl
 FCM_API fcm_status fcm_petsc_problem_write_frame(fcm_petsc_problem *problem, const char *dir,
                                                  const char *stem);
 
+/** Save the run: process 0 writes the gathered displacement and velocity (the space's DOF
+ * numbering), the time, the step count and a fingerprint (DOFs, elements, kind, dt) to `path`
+ * atomically. Collective. @return FCM_OK, FCM_ERR_ARG, FCM_ERR_IO, FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_petsc_problem_write_checkpoint(fcm_petsc_problem *problem, const char *path);
+
+/** Continue a run: every process reads `path` (a shared file system) into a problem set up from
+ * the same inputs; any process count reads it. Resumed on the same process count the steps are
+ * bit for bit those of the uninterrupted run; on another count they agree to the solver's
+ * tolerance (the partition, hence the rounding, differs). Collective.
+ * @return FCM_OK; FCM_ERR_IO (cannot open); FCM_ERR_FORMAT (not a checkpoint, truncated);
+ * FCM_ERR_ARG (before setup, another problem: the fingerprints named). */
+FCM_API fcm_status fcm_petsc_problem_read_checkpoint(fcm_petsc_problem *problem, const char *path);
+
+/** Steps taken (restored by fcm_petsc_problem_read_checkpoint()). */
+FCM_API long long fcm_petsc_problem_step_count(const fcm_petsc_problem *problem);
+
 /** Facts about the distribution and the run so far. */
 typedef struct fcm_petsc_info {
   int size, rank;                /**< processes and this one */

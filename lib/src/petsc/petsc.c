@@ -50,6 +50,7 @@
  * - README projection for 1e8 DOFs (memory and time per DOF are printed by
  *   tests/petsc/bench.c, figures in README "Distributed runs").
  * ------------------------------------------------------------------------------------------ */
+#define _GNU_SOURCE /* RTLD_DEFAULT */
 #include "fcm/petsc.h"
 
 #include "core/core_impl.h"
@@ -60,6 +61,7 @@
 #include <petscksp.h>
 #include <petscmat.h>
 
+#include <dlfcn.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -299,6 +301,18 @@ cleanup:
   return st;
 }
 
+/* PT-Scotch draws from a random generator whose state persists between calls, so a second
+ * problem in the same run would get another partition (and other rounding). Reset it before
+ * each partition when the library PETSc loaded exports SCOTCH_randomReset (looked up at run
+ * time: fcm does not link Scotch itself), so equal inputs give equal partitions. */
+static void scotch_random_reset(void)
+{
+  void (*reset)(void) = NULL;
+  void *sym = dlsym(RTLD_DEFAULT, "SCOTCH_randomReset");
+  memcpy(&reset, &sym, sizeof reset);
+  if (reset) reset();
+}
+
 /* PTSCOTCH: MatPartitioning of the face graph of the active cells; each process hands a
  * contiguous block of them to PETSc, the result is gathered on every process. */
 static fcm_status partition_graph(fcm_petsc_problem *P, const unsigned char *active, fcm_index nact)
@@ -355,6 +369,7 @@ static fcm_status partition_graph(fcm_petsc_problem *P, const unsigned char *act
   }
   PCALL(ctx, MatPartitioningSetType(part, MATPARTITIONINGPTSCOTCH));
   PCALL(ctx, MatPartitioningSetFromOptions(part));
+  scotch_random_reset();
   PCALL(ctx, MatPartitioningApply(part, &is));
   PCALL(ctx, ISAllGather(is, &isg));
   PCALL(ctx, ISGetIndices(isg, &own));
@@ -1518,4 +1533,139 @@ cleanup:
     fcm__free(P->ctx, vd);
   }
   return st;
+}
+
+/* ---------------------------------------------------------------- checkpoints */
+
+/* File layout (host byte order, written by process 0): the magic line, then int64 n, elements,
+ * steps, kind; double t, dt; n doubles u, n doubles v (the space's DOF numbering, so any
+ * process count reads it). */
+static const char ckpt_magic[16] = "fcm-petsc-ck-1\n";
+
+fcm_status fcm_petsc_problem_write_checkpoint(fcm_petsc_problem *P, const char *path)
+{
+  fcm_status st = FCM_OK;
+  double *u = NULL, *v = NULL;
+  fcm_atomic_file *af = NULL;
+  FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
+  fcm_ctx *ctx = P->ctx;
+  st = path ? FCM_OK
+            : fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                         "petsc: checkpoint: NULL path");
+  if (st == FCM_OK) {
+    u = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *u);
+    v = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *v);
+    if (!u || !v) st = FCM_ERR_ALLOC;
+  }
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  FCM_TRY(ctx, fcm_petsc_problem_get_state(P, u, v));
+  if (P->rank == 0) {
+    st = fcm_atomic_file_open(ctx, path, &af);
+    if (st == FCM_OK) {
+      FILE *f = fcm_atomic_file_stream(af);
+      const int64_t head[4] = {(int64_t)P->n, (int64_t)P->space->num_elems, (int64_t)P->steps,
+                               (int64_t)P->opts.kind};
+      const double times[2] = {P->t, P->opts.dt};
+      int ok = fwrite(ckpt_magic, 1, sizeof ckpt_magic, f) == sizeof ckpt_magic &&
+               fwrite(head, sizeof head, 1, f) == 1 && fwrite(times, sizeof times, 1, f) == 1 &&
+               fwrite(u, sizeof *u, (size_t)P->n, f) == (size_t)P->n &&
+               fwrite(v, sizeof *v, (size_t)P->n, f) == (size_t)P->n;
+      if (!ok) {
+        fcm_atomic_file_abort(&af);
+        st = fcm__error(ctx, FCM_ERR_IO, __FILE__, __LINE__, __func__,
+                        "petsc: checkpoint %s: write failed", path);
+      } else {
+        st = fcm_atomic_file_commit(&af);
+      }
+    }
+  }
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+cleanup:
+  fcm_atomic_file_abort(&af);
+  if (P) {
+    fcm__free(P->ctx, u);
+    fcm__free(P->ctx, v);
+  }
+  return st;
+}
+
+/* Read and check a checkpoint into u, v (n each), *t and *steps (every process reads). */
+static fcm_status read_ckpt(fcm_petsc_problem *P, const char *path, double *u, double *v, double *t,
+                            long long *steps)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  FILE *f = NULL;
+  char magic[sizeof ckpt_magic];
+  int64_t head[4];
+  double times[2];
+  FCM_CHECK(path, ctx, FCM_ERR_ARG, "petsc: checkpoint: NULL path");
+  f = fopen(path, "rb");
+  FCM_CHECK(f, ctx, FCM_ERR_IO, "petsc: checkpoint %s: cannot open it", path);
+  FCM_CHECK(fread(magic, 1, sizeof magic, f) == sizeof magic &&
+                memcmp(magic, ckpt_magic, sizeof magic) == 0,
+            ctx, FCM_ERR_FORMAT, "petsc: checkpoint %s: not a PETSc-backend checkpoint of fcm",
+            path);
+  FCM_CHECK(fread(head, sizeof head, 1, f) == 1 && fread(times, sizeof times, 1, f) == 1, ctx,
+            FCM_ERR_FORMAT, "petsc: checkpoint %s: truncated header", path);
+  FCM_CHECK(head[0] == (int64_t)P->n && head[1] == (int64_t)P->space->num_elems &&
+                head[3] == (int64_t)P->opts.kind && times[1] == P->opts.dt && head[2] >= 0,
+            ctx, FCM_ERR_ARG,
+            "petsc: checkpoint %s is of another problem: %lld DOFs, %lld elements, kind %lld, "
+            "dt %g (this one: %lld, %lld, %d, %g)",
+            path, (long long)head[0], (long long)head[1], (long long)head[3], times[1],
+            (long long)P->n, (long long)P->space->num_elems, (int)P->opts.kind, P->opts.dt);
+  FCM_CHECK(fread(u, sizeof *u, (size_t)P->n, f) == (size_t)P->n &&
+                fread(v, sizeof *v, (size_t)P->n, f) == (size_t)P->n && fgetc(f) == EOF,
+            ctx, FCM_ERR_FORMAT, "petsc: checkpoint %s: truncated or with trailing data", path);
+  *t = times[0];
+  *steps = (long long)head[2];
+cleanup:
+  if (f) fclose(f);
+  return st;
+}
+
+fcm_status fcm_petsc_problem_read_checkpoint(fcm_petsc_problem *P, const char *path)
+{
+  fcm_status st = FCM_OK;
+  double *u = NULL, *v = NULL, t = 0.0;
+  long long steps = 0;
+  FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
+  fcm_ctx *ctx = P->ctx;
+  u = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *u);
+  v = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *v);
+  st = u && v ? FCM_OK : FCM_ERR_ALLOC;
+  if (st == FCM_OK)
+    st = P->is_setup ? read_ckpt(P, path, u, v, &t, &steps)
+                     : fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                                  "petsc: read_checkpoint before setup");
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  {
+    PetscScalar *a = NULL, *b = NULL;
+    PCALL(ctx, VecGetArray(P->u, &a));
+    PCALL(ctx, VecGetArray(P->v, &b));
+    for (fcm_index k = 0; k < P->ncopy; k++) {
+      if (P->copy_owner[k] != P->rank) continue;
+      const PetscInt r = 3 * (P->perm[k] - P->first);
+      for (int i = 0; i < 3; i++) {
+        a[r + i] = u[3 * k + i];
+        b[r + i] = v[3 * k + i];
+      }
+    }
+    PCALL(ctx, VecRestoreArray(P->u, &a));
+    PCALL(ctx, VecRestoreArray(P->v, &b));
+  }
+  P->t = t;
+  P->steps = steps;
+cleanup:
+  if (P) {
+    fcm__free(P->ctx, u);
+    fcm__free(P->ctx, v);
+  }
+  return st;
+}
+
+long long fcm_petsc_problem_step_count(const fcm_petsc_problem *P)
+{
+  return P ? P->steps : 0;
 }
