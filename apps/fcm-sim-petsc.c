@@ -72,8 +72,24 @@ static int write_frame(fcm_ctx *ctx, fcm_petsc_problem *P, const char *dir, cons
   return ok;
 }
 
+/* Process 0, resuming: the rows of steps <= first of an existing log (missing ones stay 0). */
+static void read_old_log(const char *path, run_log *rows, long long first)
+{
+  FILE *f = fopen(path, "r");
+  char line[1024];
+  if (!f) return;
+  while (fgets(line, sizeof line, f)) {
+    run_log r;
+    if (sscanf(line, "%lld,%lg,%d,%lg,%lg,%lg,%lg,%lg", &r.step, &r.time, &r.iterations,
+               &r.residual, &r.kinetic, &r.elastic, &r.work, &r.wall) == 8 &&
+        r.step >= 1 && r.step <= first)
+      rows[r.step - 1] = r;
+  }
+  fclose(f);
+}
+
 int sim_petsc_run(const char *path, const char *outdir, long long steps, int check, int quiet,
-                  int petsc_argc, char **petsc_argv)
+                  int checkpoint_every, const char *resume, int petsc_argc, char **petsc_argv)
 {
   int rc = 1, rank = 0, size = 1;
   fcm_ctx *ctx = NULL;
@@ -129,6 +145,19 @@ int sim_petsc_run(const char *path, const char *outdir, long long steps, int che
   const fcm_index n = fcm_petsc_problem_num_dofs(P);
   char logpath[4200], pvdpath[4200];
   int frame = 0, ok = 1;
+  long long first = 0;
+  const int ck_every =
+      checkpoint_every >= 0 ? checkpoint_every : fcm_scene_get_output(scene)->checkpoint_interval;
+  if (resume) { /* every process reads the checkpoint */
+    st = fcm_petsc_problem_read_checkpoint(P, resume);
+    if (st != FCM_OK) {
+      if (rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+      rc = 2;
+      goto done;
+    }
+    first = fcm_petsc_problem_step_count(P);
+    if (talk) fprintf(stderr, "fcm-sim: resumed from %s at step %lld\n", resume, first);
+  }
   u = calloc((size_t)n + 1, sizeof *u);
   v = calloc((size_t)n + 1, sizeof *v);
   rows = calloc((size_t)nsteps + 1, sizeof *rows);
@@ -140,13 +169,24 @@ int sim_petsc_run(const char *path, const char *outdir, long long steps, int che
   snprintf(pvdpath, sizeof pvdpath, "%s/%s.pvd", dir, name);
   if (write && rank == 0) {
     ok = make_dirs(dir) && fcm_pvd_create(ctx, pvdpath, &pvd) == FCM_OK;
+    /* resuming: the earlier frames (0, interval, 2 interval, ... <= first) are indexed again and
+     * the earlier log rows kept */
+    const double dt = fcm_scene_get_time(scene)->dt;
+    for (long long k = 0; ok && resume && k <= first && k <= nsteps; k += interval) {
+      char file[600];
+      snprintf(file, sizeof file, "%s_%04d.pvtu", name, frame++);
+      ok = fcm_pvd_add(pvd, (double)k * dt, file) == FCM_OK;
+    }
+    if (resume && first <= nsteps) read_old_log(logpath, rows, first);
     if (!ok && fcm_ctx_error_status(ctx) != FCM_OK)
       fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
   }
   MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  if (!ok || (write && !write_frame(ctx, P, dir, name, frame++, 0.0, pvd, rank))) goto done;
+  MPI_Bcast(&frame, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (!ok || (write && !resume && !write_frame(ctx, P, dir, name, frame++, 0.0, pvd, rank)))
+    goto done;
   double t1 = fcm_wtime();
-  for (long long k = 1; k <= nsteps; k++) {
+  for (long long k = first + 1; k <= nsteps; k++) {
     fcm_petsc_step_info si;
     st = fcm_petsc_problem_step(P, &si);
     if (st != FCM_OK) {
@@ -171,6 +211,15 @@ int sim_petsc_run(const char *path, const char *outdir, long long steps, int che
       if (!ok) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
       MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
       if (!ok) goto done;
+    }
+    if (write && ck_every > 0 && k % ck_every == 0) {
+      char ck[4300];
+      snprintf(ck, sizeof ck, "%s/%s_checkpoint_%06lld.fcmpk", dir, name, k);
+      if (fcm_petsc_problem_write_checkpoint(P, ck) != FCM_OK) {
+        if (rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+        goto done;
+      }
+      if (talk) fprintf(stderr, "fcm-sim: checkpoint %s\n", ck);
     }
   }
   fcm_petsc_info info;

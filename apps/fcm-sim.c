@@ -292,11 +292,11 @@ static int scene_main(int argc, char **argv)
     int rc = parsed;
     if (parsed < 0) {
 #if FCM_HAVE_PETSC
-      rc = o.resume || o.checkpoint_every > 0 || o.print_scene
-               ? (fprintf(stderr, "fcm-sim: --backend petsc: --resume, --checkpoint-every and "
-                                  "--print-scene are not supported yet\n"),
-                  2)
-               : sim_petsc_run(o.path, o.outdir, o.steps, o.check, o.quiet, pargc, pargv);
+      rc = o.print_scene ? (fprintf(stderr, "fcm-sim: --backend petsc: --print-scene is the "
+                                            "serial backend's (drop --backend)\n"),
+                            2)
+                         : sim_petsc_run(o.path, o.outdir, o.steps, o.check, o.quiet,
+                                         o.check ? 0 : o.checkpoint_every, o.resume, pargc, pargv);
 #else
       fprintf(stderr, "fcm-sim: --backend petsc: this fcm was built without PETSc (CMake option "
                       "FCM_WITH_PETSC; Debian: bash setup.sh deps --petsc, then rebuild)\n");

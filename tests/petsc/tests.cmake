@@ -88,3 +88,12 @@ endforeach()
 foreach(np 1 2)
   fcm_add_mpi_test(petsc_checkpoint_np${np} tests/petsc/checkpoint.c NP ${np})
 endforeach()
+if(FCM_BUILD_APPS)
+  # fcm-sim --backend petsc --checkpoint-every / --resume: byte for byte on 2 processes
+  add_test(NAME petsc_app_sim_resume
+           COMMAND bash ${PROJECT_SOURCE_DIR}/tests/petsc/resume.sh ${MPIEXEC_EXECUTABLE}
+                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/vibrating_beam.json
+                   ${CMAKE_CURRENT_BINARY_DIR}/petsc_app_sim_resume)
+  set_tests_properties(petsc_app_sim_resume PROPERTIES LABELS mpi TIMEOUT 300 PROCESSORS 2
+                       ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+endif()
