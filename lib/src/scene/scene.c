@@ -760,13 +760,16 @@ static fcm_status read_multigrid(fcm__scene_parser *p, const fcm__json *mg, fcm_
   long long coarse = (long long)m->coarse_dofs;
   FCM_TRY(p->ctx, fcm__scene_check_object(p, mg, keys, COUNT(keys)));
   READ_CHOICE_AS(p, mg, "smoother", 0, smoother_names, smoother_values, m->smoother);
-  if (m->smoother == FCM_MG_SMOOTHER_JACOBI) {
+  if (m->smoother == FCM_MG_SMOOTHER_JACOBI)
     m->omega = 0.6; /* the damped Jacobi default (1.0 over-corrects elasticity) */
-    FCM_TRY(p->ctx, fcm__scene_read_number(p, mg, "omega", 0, (fcm__range){0.0, 1.0, 1, 0},
-                                           &m->omega));
-  } else {
-    FCM_TRY(p->ctx, fcm__scene_read_number(p, mg, "omega", 0, (fcm__range){0.0, 2.0, 1, 1},
-                                           &m->omega));
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, mg, "omega", 0, (fcm__range){0.0, 2.0, 1, 1},
+                                         &m->omega));
+  if (m->smoother == FCM_MG_SMOOTHER_JACOBI && m->omega > 1.0) {
+    fcm__scene_path_push_key(p, "omega");
+    SCENE_CHECK(0, p, FCM_ERR_ARG,
+                "expected a finite number in (0, 1] with the \"jacobi\" smoother, got %g "
+                "((0, 2) for the Gauss-Seidel smoothers)",
+                m->omega);
   }
   READ_INT(p, mg, "pre_smooth", 0, 0, 100, m->pre_smooth);
   READ_INT(p, mg, "post_smooth", 0, 0, 100, m->post_smooth);
