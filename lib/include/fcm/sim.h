@@ -2,7 +2,8 @@
  * load steps and backward Euler on the incremental potential, Newton with a backtracking
  * line search on the energy, the stopping rule of Longva et al. (2020) §6, optional Rayleigh
  * damping, prescribed motion of node sets and, weakly (Nitsche's method or a penalty), of the
- * embedded-boundary points a selector picks, direct (CHOLMOD -> UMFPACK) or Krylov solves.
+ * embedded-boundary points a selector picks, direct (CHOLMOD -> UMFPACK), Krylov (CG, MINRES)
+ * or multigrid solves (fcm/mg.h: the Krylov preconditioner, or cycles alone).
  *
  * Phases: fcm_integrator_create() -> configure (fcm_integrator_add_*, set_state) ->
  * fcm_integrator_setup() (assembles the mass — dynamics only — and the loads, allocates

@@ -63,7 +63,8 @@ typedef struct fcm_simulation_counters {
   int multigrid;               /**< 1: multigrid, as the Krylov preconditioner or the solver */
   long long steps;             /**< accepted steps */
   long long newton_iterations, linear_iterations, tangent_assemblies;
-  long long multigrid_cycles; /**< multigrid cycles (fcm_step_info.multigrid_cycles, summed) */
+  long long multigrid_cycles; /**< multigrid cycles (fcm_step_info.multigrid_cycles, summed;
+                                   not in checkpoints: counted from the restore on) */
   long long factorizations; /**< numeric factorizations / preconditioner setups (total) */
   long long analyses;       /**< symbolic analyses (total) */
   long long direct_fallbacks;
