@@ -130,7 +130,7 @@ typedef struct fcm_integrator_options {
   fcm_direct_method direct_method;   /**< first direct method (default CHOLMOD; UMFPACK: LU only) */
   fcm_preconditioner preconditioner; /**< Krylov only (default JACOBI) */
   fcm_fictitious_model preconditioner_tangent; /**< Krylov only: the material tangent the
-      preconditioner (Jacobi, block Jacobi, Schwarz) is built from, while the Krylov
+      preconditioner (Jacobi, block Jacobi, Schwarz, multigrid) is built from, while the Krylov
       operator stays the exact Newton matrix base + K(u). The values of fcm_fictitious_model
       name the tangent models: FCM_FICTITIOUS_PROJECTED (default): base + the PSD-projected
       tangent at the iterate (one more tangent assembly per preconditioner setup); the
