@@ -250,10 +250,10 @@ static fcm_status mg_soft(fcm_integrator *I, fcm_status s, fcm_step_reason *reas
              "integrator: t = %g: multigrid failed (%s); %s", I->t, fcm_ctx_error_message(ctx),
              I->opts.linear_solver == FCM_LINEAR_MULTIGRID
                  ? "the multigrid solver needs a symmetric positive definite Newton matrix "
-                   "(static, or dynamic with a linear material or newton project_psd); "
-                   "retrying with a shorter step"
-                 : "the preconditioner's matrix is not positive definite (use "
-                   "preconditioner_tangent projected); retrying with a shorter step");
+                   "(static, or dynamic with a linear material or project_psd) and enough "
+                   "cycles (krylov_max_iterations); retrying with a shorter step"
+                 : "the multigrid preconditioner needs a symmetric positive definite matrix "
+                   "(preconditioner_tangent projected or linear); retrying with a shorter step");
     fcm_ctx_error_clear(ctx);
     *reason = FCM_STEP_LINEAR_SOLVER_FAILED;
     return FCM_OK;
