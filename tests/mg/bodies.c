@@ -3,7 +3,8 @@
  * to a 2 x 1 x 1 grid (coarsening stops when a level would not shrink), and the V-cycle
  * still converges (factor <= 0.5). Odd cell counts (5 x 7 x 3) coarsen and converge, with
  * the V- and (no worse) the W-cycle. A space with constrained copies (XFEM split
- * hemisphere, constrain_ratio 1e-3) builds and converges. */
+ * hemisphere, constrain_ratio 1e-3) builds and converges. The same on Hex20 grids, whose
+ * first coarse level is the Hex8 p-level on the same grid. */
 #include "mg_util.h"
 
 int main(void)
@@ -36,6 +37,25 @@ int main(void)
   TEST_OK(ctx, fcm_mg_solve(mg, p.b, x, 1e-8, 100, &si));
   TEST_TRUE(si.convergence_factor <= 0.5);
   if (verbose) printf("balls: factor %.3f, %d cycles\n", si.convergence_factor, si.cycles);
+  free(x);
+  fcm_mg_destroy(&mg);
+  problem_free(&p);
+
+  /* Hex20: the p-level keeps the grid (16x8x8, Hex20 then Hex8), then as on Hex8 */
+  problem_balls_of(ctx, FCM_ELEMENT_HEX20, 8, &p);
+  TEST_TRUE(fcm_space_num_bodies(p.space) == 2);
+  TEST_OK(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &mg));
+  TEST_TRUE(fcm_mg_num_levels(mg) == 5); /* 16x8x8 (Hex20), 16x8x8, 8x4x4, 4x2x2, 2x1x1 */
+  for (int l = 0; l < fcm_mg_num_levels(mg); l++) {
+    fcm_mg_level_info li;
+    TEST_OK(ctx, fcm_mg_get_level_info(mg, l, &li));
+    TEST_TRUE(li.bodies == 2);
+    TEST_TRUE(li.grid[0] == (l < 2 ? 16 : 16 >> (l - 1)));
+  }
+  x = calloc((size_t)p.n, sizeof *x);
+  TEST_OK(ctx, fcm_mg_solve(mg, p.b, x, 1e-8, 100, &si));
+  TEST_TRUE(si.convergence_factor <= 0.5);
+  if (verbose) printf("balls Hex20: factor %.3f, %d cycles\n", si.convergence_factor, si.cycles);
   free(x);
   fcm_mg_destroy(&mg);
   problem_free(&p);
@@ -86,6 +106,19 @@ int main(void)
   TEST_TRUE(si.convergence_factor <= 0.8);
   if (verbose)
     printf("split, constrained copies: factor %.3f, %d cycles\n", si.convergence_factor, si.cycles);
+  free(x);
+  fcm_mg_destroy(&mg);
+  problem_free(&p);
+  /* the same on Hex20 (constraint targets may be mid-edge copies: the p-level injects them) */
+  problem_hemisphere_of(ctx, FCM_ELEMENT_HEX20, 12, 2, 1e-2, &p);
+  TEST_TRUE(fcm_space_num_constrained_copies(p.space) > 0);
+  TEST_OK(ctx, fcm_mg_create(ctx, p.space, p.A, NULL, &mg));
+  x = calloc((size_t)p.n, sizeof *x);
+  if (mg) TEST_OK(ctx, fcm_mg_solve(mg, p.b, x, 1e-8, 200, &si));
+  TEST_TRUE(si.convergence_factor <= 0.8);
+  if (verbose)
+    printf("split Hex20, constrained copies: factor %.3f, %d cycles\n", si.convergence_factor,
+           si.cycles);
   free(x);
   fcm_mg_destroy(&mg);
   problem_free(&p);
