@@ -6,7 +6,7 @@
  *               max |u - u_direct| <= 1e-6 max |u_direct| over the DOF vector after the run,
  *               every step converged. Scenes: static linear with a clamped region (eliminated
  *               rows), static linear held by Nitsche on the embedded boundary (no eliminated
- *               row), dynamic stable neo-Hookean (PSD tangent) with a motion released after
+ *               row), the clamped one on a Hex20 grid (the p-level first), dynamic stable neo-Hookean (PSD tangent) with a motion released after
  *               the first step (the eliminated rows change: the hierarchy is built again),
  *               and the same dynamic scene with the exact tangent solved by MINRES+MG (the
  *               multigrid built on the PSD tangent preconditions the indefinite system).
@@ -19,7 +19,7 @@
  *               iterations of CG+Jacobi to the same tolerance, and both agree.
  *   errors      bad multigrid options are refused naming the field and the range: the scene
  *               parser (path solver.multigrid.<key>, solver.method / solver.preconditioner for
- *               the background), the integrator's setup (multigrid.<member>), a Tet4 space
+ *               the background; hex20 and block_smoothing accepted), the integrator's setup (multigrid.<member>), a Tet4 space
  *               (FCM_ERR_UNSUPPORTED at the first step, naming the option), and a singular
  *               system (a static body without constraints) fails the step softly with
  *               "linear-solver-failed" and the state unchanged. */
@@ -29,12 +29,14 @@
 
 /* A 2 x 1 x 1 m embedded box on an nx x ny x nz Hex8 grid over [0, 2.25] x [-0.125, 1.125]^2
  * (cut cells on every side). */
+static const char *grid_element = "hex8"; /* of the background grid in scene_json() */
+
 static void scene_json(char *buf, size_t cap, int n, const char *material, const char *time,
                        const char *solver, const char *effects)
 {
   snprintf(buf, cap,
            "{\"version\": 1, \"name\": \"mg\","
-           " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [-0.03, -0.11, -0.07],"
+           " \"background\": {\"element\": \"%s\", \"box\": {\"min\": [-0.03, -0.11, -0.07],"
            "   \"max\": [2.22, 1.015, 1.055]}, \"cells\": [%d, %d, %d]},"
            " \"geometry\": {\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [2, 0.9, 0.95],"
            "   \"cells\": [4, 2, 2]},"
@@ -43,7 +45,7 @@ static void scene_json(char *buf, size_t cap, int n, const char *material, const
            " \"solver\": %s,"
            " \"output\": {\"background\": false, \"surface\": false},"
            " \"effects\": [%s]}",
-           2 * n, n, n, material, time, solver, effects);
+           grid_element, 2 * n, n, n, material, time, solver, effects);
 }
 
 static const char linear_material[] =
@@ -191,6 +193,9 @@ static void mode_agree(fcm_ctx *ctx)
            "");
   agree(ctx, "static clamped", 4, linear_material, static_time, ref, sv, 4, clamp, 0);
   agree(ctx, "static nitsche", 4, linear_material, static_time, ref, sv, 3, nitsche, 0);
+  grid_element = "hex20"; /* the p-level Hex20 -> Hex8 first */
+  agree(ctx, "static clamped hex20", 2, linear_material, static_time, ref, sv, 3, clamp, 0);
+  grid_element = "hex8";
 
   /* dynamic, stable neo-Hookean with PSD tangents (SPD Newton matrices: MG alone applies); a
    * motion of the far end released after the first step changes the eliminated rows */
@@ -400,7 +405,9 @@ static void mode_errors(fcm_ctx *ctx)
   bad(ctx, "hex8",
       "{\"method\": \"minres\", \"preconditioner\": \"multigrid\", \"multigrid\": {\"pre_smooth\": 3}}",
       "solver.multigrid", "\"minres\"");
-  bad(ctx, "hex20", "{\"method\": \"multigrid\"}", "solver.method", "\"hex8\"");
+  bad(ctx, "tet10", "{\"method\": \"multigrid\"}", "solver.method", "\"hex20\"");
+  bad(ctx, "hex8", "{\"method\": \"multigrid\", \"multigrid\": {\"block_smoothing\": 1}}",
+      "solver.multigrid.block_smoothing", "true");
   bad(ctx, "tet4", "{\"method\": \"minres\", \"preconditioner\": \"multigrid\"}",
       "solver.preconditioner", "\"tet4\"");
   bad(ctx, "hex8", "{\"method\": \"mg\"}", "solver.method", "\"multigrid\"");
@@ -415,6 +422,27 @@ static void mode_errors(fcm_ctx *ctx)
        FCM_MG_SMOOTHER_SGS_COLORED, 1.5);
   good(ctx, "tet4", "{\"method\": \"direct\", \"preconditioner\": \"multigrid\"}",
        FCM_MG_SMOOTHER_SGS, 1.0);
+  good(ctx, "hex20",
+       "{\"method\": \"cg\", \"preconditioner\": \"multigrid\", \"multigrid\": "
+       "{\"block_smoothing\": false, \"smoother\": \"jacobi\", \"omega\": 0.5}}",
+       FCM_MG_SMOOTHER_JACOBI, 0.5);
+
+  {
+    fcm_scene *sc = NULL;
+    const char *j = "{\"version\": 1, \"background\": {\"element\": \"hex20\", \"box\": "
+                    "{\"min\": [0, 0, 0], \"max\": [1, 1, 1]}, \"cells\": [2, 2, 2]},"
+                    " \"material\": {\"model\": \"linear\", \"young\": 1e6, \"poisson\": 0.3},"
+                    " \"solver\": {\"method\": \"multigrid\", \"multigrid\": {\"block_smoothing\":"
+                    " false, \"cycle\": \"w\", \"coarse_dofs\": 77, \"pre_smooth\": 3}},"
+                    " \"time\": {\"static\": true}, \"effects\": []}";
+    TEST_OK(ctx, fcm_scene_create_from_string(ctx, j, "hex20.json", &sc));
+    if (sc) {
+      const fcm_mg_options *m = &fcm_scene_get_solver(sc)->multigrid;
+      TEST_TRUE(m->block_smoothing == 0 && m->cycle_index == 2 && m->coarse_dofs == 77 &&
+                m->pre_smooth == 3 && m->post_smooth == 1);
+    }
+    fcm_scene_destroy(&sc);
+  }
 
   /* integrator setup */
   fcm_step_info info;

@@ -141,9 +141,10 @@ typedef struct fcm_scene_solver {
                                     for Jacobi (default 0.6); pre_smooth, post_smooth in
                                     [0, 100] (default 1 each, at least one step, equal for a
                                     preconditioner); cycle "v" (default, cycle_index 1) or "w"
-                                    (2); coarse_dofs in [1, 1e9] (default 2000). Used by
+                                    (2); coarse_dofs in [1, 1e9] (default 2000);
+                                    block_smoothing true (default) or false. Used by
                                     "method": "multigrid" and "preconditioner": "multigrid",
-                                    which need a hex8 "grid" background */
+                                    which need a hex8 or hex20 "grid" background */
   double rtol;                 /**< Krylov (and multigrid solver) relative tolerance; [0, 1),
                                     default 1e-8 */
   double atol;                 /**< Krylov absolute tolerance; >= 0, default 0 */

@@ -66,8 +66,8 @@ typedef enum fcm_linear_solver {
    * Where it is not SPD the coarsest Cholesky factorization fails, a diagonal is not positive
    * or the cycles do not converge (stalled or diverging): the solve fails softly
    * (FCM_STEP_LINEAR_SOLVER_FAILED, a warning names the cause) and the step is retried with
-   * half the increment, like a failed Krylov solve. Needs a Hex8 box grid (fcm_mg_create()):
-   * on another mesh the first step fails with FCM_ERR_UNSUPPORTED. */
+   * half the increment, like a failed Krylov solve. Needs a Hex8 or Hex20 box grid
+   * (fcm_mg_create()): on another mesh the first step fails with FCM_ERR_UNSUPPORTED. */
   FCM_LINEAR_MULTIGRID = 3
 } fcm_linear_solver;
 
@@ -83,7 +83,7 @@ typedef enum fcm_preconditioner {
    * operator when pre_smooth = post_smooth (checked at setup), as CG and MINRES need. The
    * hierarchy is built at the first setup and again when the active constrained DOFs change
    * (the eliminated rows define the multigrid's Dirichlet boundary); later setups only
-   * recompute the Galerkin matrices (fcm_mg_setup()). Needs a Hex8 box grid
+   * recompute the Galerkin matrices (fcm_mg_setup()). Needs a Hex8 or Hex20 box grid
    * (fcm_mg_create()): on another mesh the first step fails with FCM_ERR_UNSUPPORTED. */
   FCM_PRECOND_MULTIGRID = 4
 } fcm_preconditioner;

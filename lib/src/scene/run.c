@@ -1140,8 +1140,9 @@ static void multigrid_line(const fcm_simulation *S, FILE *f)
     len += snprintf(b + len, sizeof b - (size_t)len, "%s%lld", l ? " > " : " ", (long long)li.dofs);
   }
   if (len > 0 && (size_t)len < sizeof b)
-    snprintf(b + len, sizeof b - (size_t)len, "; %s-cycle, %d+%d smoothing steps",
-             o->cycle_index == 2 ? "W" : "V", o->pre_smooth, o->post_smooth);
+    snprintf(b + len, sizeof b - (size_t)len, "; %s-cycle, %d+%d smoothing steps%s",
+             o->cycle_index == 2 ? "W" : "V", o->pre_smooth, o->post_smooth,
+             o->block_smoothing ? " with vertex blocks" : "");
   line(f, 1, "multigrid levels", b);
 }
 

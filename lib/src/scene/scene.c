@@ -71,7 +71,7 @@ static const int smoother_values[] = {FCM_MG_SMOOTHER_SGS, FCM_MG_SMOOTHER_JACOB
 static const char *const cycle_names[] = {"v", "w"};
 static const int cycle_values[] = {1, 2};
 /* background elements the multigrid supports (fcm_mg_create()) */
-static const fcm_element_type multigrid_elements[] = {FCM_ELEMENT_HEX8};
+static const fcm_element_type multigrid_elements[] = {FCM_ELEMENT_HEX8, FCM_ELEMENT_HEX20};
 static const char *const clamp_names[] = {"clamp", "paper"};
 /* in the order of fcm_fictitious_model */
 static const char *const tangent_names[] = {"projected", "linear", "exact"};
@@ -753,8 +753,8 @@ cleanup:
 static fcm_status read_multigrid(fcm__scene_parser *p, const fcm__json *mg, fcm_scene_solver *s)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"smoother",    "omega", "pre_smooth",
-                                     "post_smooth", "cycle", "coarse_dofs"};
+  static const char *const keys[] = {"smoother", "omega",       "pre_smooth",     "post_smooth",
+                                     "cycle",    "coarse_dofs", "block_smoothing"};
   fcm_mg_options *m = &s->multigrid;
   size_t old = ENTER(p, "multigrid");
   long long coarse = (long long)m->coarse_dofs;
@@ -776,6 +776,7 @@ static fcm_status read_multigrid(fcm__scene_parser *p, const fcm__json *mg, fcm_
   READ_CHOICE_AS(p, mg, "cycle", 0, cycle_names, cycle_values, m->cycle_index);
   FCM_TRY(p->ctx, fcm__scene_read_int(p, mg, "coarse_dofs", 0, 1, 1000000000, &coarse));
   m->coarse_dofs = (fcm_index)coarse;
+  FCM_TRY(p->ctx, fcm__scene_read_bool(p, mg, "block_smoothing", 0, &m->block_smoothing));
   SCENE_CHECK(m->pre_smooth + m->post_smooth >= 1, p, FCM_ERR_ARG,
               "pre_smooth = %d and post_smooth = %d: at least one smoothing step is needed",
               m->pre_smooth, m->post_smooth);
@@ -798,13 +799,13 @@ static fcm_status check_multigrid(fcm__scene_parser *p, const fcm_scene_solver *
   ENTER(p, as_solver ? "method" : "preconditioner");
   SCENE_CHECK(b->kind == FCM_SCENE_BACKGROUND_GRID, p, FCM_ERR_ARG,
               "\"multigrid\" needs a \"background\" grid (\"box\" and \"cells\": a structured "
-              "box grid of hex8 cells); a Gmsh background mesh is not supported");
+              "box grid of hex8 or hex20 cells); a Gmsh background mesh is not supported");
   int supported = 0;
   for (size_t k = 0; k < COUNT(multigrid_elements); k++)
     supported |= b->element == multigrid_elements[k];
   SCENE_CHECK(supported, p, FCM_ERR_ARG,
-              "\"multigrid\" supports \"hex8\" background grids only, the background has "
-              "\"element\": \"%s\"",
+              "\"multigrid\" supports \"hex8\" and \"hex20\" background grids only, the "
+              "background has \"element\": \"%s\"",
               (int)b->element >= 0 && (size_t)b->element < COUNT(element_names)
                   ? element_names[b->element]
                   : "?");
@@ -1246,9 +1247,10 @@ int fcm_scene_count_effects(const fcm_scene *s, fcm_effect_type type)
 /* " (sgs omega 1, 1+1 steps, V-cycle, coarse 2000 DOFs)" */
 static void view_multigrid(FILE *f, const fcm_mg_options *m)
 {
-  fprintf(f, " (%s omega %g, %d+%d steps, %s-cycle, coarse %lld DOFs)",
+  fprintf(f, " (%s omega %g, %d+%d steps%s, %s-cycle, coarse %lld DOFs)",
           CHOICE_NAME(smoother_names, smoother_values, m->smoother), m->omega, m->pre_smooth,
-          m->post_smooth, m->cycle_index == 2 ? "W" : "V", (long long)m->coarse_dofs);
+          m->post_smooth, m->block_smoothing ? " with vertex blocks" : "",
+          m->cycle_index == 2 ? "W" : "V", (long long)m->coarse_dofs);
 }
 
 static void view_strength(FILE *f, const char *what, int m)
