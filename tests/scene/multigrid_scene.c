@@ -6,22 +6,20 @@
  *               max |u - u_direct| <= 1e-6 max |u_direct| over the DOF vector after the run,
  *               every step converged. Scenes: static linear with a clamped region (eliminated
  *               rows), static linear held by Nitsche on the embedded boundary (no eliminated
- *               row), the clamped one on a Hex20 grid (the p-level first), dynamic stable neo-Hookean (PSD tangent) with a motion released after
- *               the first step (the eliminated rows change: the hierarchy is built again),
- *               and the same dynamic scene with the exact tangent solved by MINRES+MG (the
- *               multigrid built on the PSD tangent preconditions the indefinite system).
- *               Also: the hierarchy has at least 2 levels; the cycles are counted (MG alone:
- *               cycles = linear iterations; CG/MINRES: at least one cycle per iteration).
- *   cut         a slab clamped at x = 0 cut by a plane during the run (XFEM on a Hex8
- *               grid: the new space gets a new hierarchy): the same agreement; two bodies
- *               after the cut.
- *   iterations  one static step on a 16 x 8 x 8 grid: CG+MG takes at most a fifth of the
- *               iterations of CG+Jacobi to the same tolerance, and both agree.
+ *               row), the clamped one on a Hex20 grid (the p-level first), dynamic stable
+ * neo-Hookean (PSD tangent) with a motion released after the first step (the eliminated rows
+ * change: the hierarchy is built again), and the same dynamic scene with the exact tangent solved
+ * by MINRES+MG (the multigrid built on the PSD tangent preconditions the indefinite system). Also:
+ * the hierarchy has at least 2 levels; the cycles are counted (MG alone: cycles = linear
+ * iterations; CG/MINRES: at least one cycle per iteration). cut         a slab clamped at x = 0 cut
+ * by a plane during the run (XFEM on a Hex8 grid: the new space gets a new hierarchy): the same
+ * agreement; two bodies after the cut. iterations  one static step on a 16 x 8 x 8 grid: CG+MG
+ * takes at most a fifth of the iterations of CG+Jacobi to the same tolerance, and both agree.
  *   errors      bad multigrid options are refused naming the field and the range: the scene
  *               parser (path solver.multigrid.<key>, solver.method / solver.preconditioner for
- *               the background; hex20 and block_smoothing accepted), the integrator's setup (multigrid.<member>), a Tet4 space
- *               (FCM_ERR_UNSUPPORTED at the first step, naming the option), and a singular
- *               system (a static body without constraints) fails the step softly with
+ *               the background; hex20 and block_smoothing accepted), the integrator's setup
+ * (multigrid.<member>), a Tet4 space (FCM_ERR_UNSUPPORTED at the first step, naming the option),
+ * and a singular system (a static body without constraints) fails the step softly with
  *               "linear-solver-failed" and the state unchanged. */
 #include "scene_util.h"
 
@@ -141,7 +139,8 @@ static void agree(fcm_ctx *ctx, const char *label, int n, const char *material, 
         TEST_FAIL_("%s, solver %s: max |u - u_direct| = %.3g > 1e-6 x %.3g", label, solvers[k], d,
                    scale);
       if (getenv("FCM_TEST_VERBOSE"))
-        fprintf(stderr, "%s %s: diff %.3g of %.3g; %lld Newton, %lld linear, %lld cycles, %d levels\n",
+        fprintf(stderr,
+                "%s %s: diff %.3g of %.3g; %lld Newton, %lld linear, %lld cycles, %d levels\n",
                 label, solvers[k], d, scale, r.newton, r.linear, r.cycles, r.levels);
       TEST_TRUE(r.levels >= 2);
       TEST_TRUE(r.level0_dofs == r.n);
@@ -186,11 +185,12 @@ static void mode_agree(fcm_ctx *ctx)
            "");
   snprintf(s[2], sizeof s[2],
            "{\"method\": \"multigrid\", \"rtol\": 1e-11, " MG_OPTS ", " TIGHT_NEWTON "}", "");
-  snprintf(s[3], sizeof s[3],
-           "{\"method\": \"multigrid\", \"rtol\": 1e-11, \"multigrid\": {\"coarse_dofs\": 100,"
-           " \"smoother\": \"sgs-colored\", \"cycle\": \"w\", \"pre_smooth\": 2, \"post_smooth\": 1},"
-           " " TIGHT_NEWTON "}",
-           "");
+  snprintf(
+      s[3], sizeof s[3],
+      "{\"method\": \"multigrid\", \"rtol\": 1e-11, \"multigrid\": {\"coarse_dofs\": 100,"
+      " \"smoother\": \"sgs-colored\", \"cycle\": \"w\", \"pre_smooth\": 2, \"post_smooth\": 1},"
+      " " TIGHT_NEWTON "}",
+      "");
   agree(ctx, "static clamped", 4, linear_material, static_time, ref, sv, 4, clamp, 0);
   agree(ctx, "static nitsche", 4, linear_material, static_time, ref, sv, 3, nitsche, 0);
   grid_element = "hex20"; /* the p-level Hex20 -> Hex8 first */
@@ -376,13 +376,15 @@ done:
 static void mode_errors(fcm_ctx *ctx)
 {
   /* scene parser */
-  bad(ctx, "hex8", "{\"method\": \"cg\", \"preconditioner\": \"multigrid\","
-                   " \"multigrid\": {\"smoother\": \"gs\"}}",
+  bad(ctx, "hex8",
+      "{\"method\": \"cg\", \"preconditioner\": \"multigrid\","
+      " \"multigrid\": {\"smoother\": \"gs\"}}",
       "solver.multigrid.smoother", "sgs-colored");
   bad(ctx, "hex8", "{\"method\": \"multigrid\", \"multigrid\": {\"omega\": 2}}",
       "solver.multigrid.omega", "(0, 2)");
-  bad(ctx, "hex8", "{\"method\": \"multigrid\", \"multigrid\": {\"smoother\": \"jacobi\","
-                   " \"omega\": 1.2}}",
+  bad(ctx, "hex8",
+      "{\"method\": \"multigrid\", \"multigrid\": {\"smoother\": \"jacobi\","
+      " \"omega\": 1.2}}",
       "solver.multigrid.omega", "(0, 1]");
   bad(ctx, "hex8", "{\"method\": \"multigrid\", \"multigrid\": {\"pre_smooth\": -1}}",
       "solver.multigrid.pre_smooth", "[0, 100]");
@@ -394,16 +396,17 @@ static void mode_errors(fcm_ctx *ctx)
       "solver.multigrid.coarse_dofs", "1");
   bad(ctx, "hex8", "{\"method\": \"multigrid\", \"multigrid\": {\"levels\": 3}}",
       "solver.multigrid", "levels");
-  bad(ctx, "hex8", "{\"method\": \"multigrid\", \"multigrid\": []}", "solver.multigrid",
-      "object");
+  bad(ctx, "hex8", "{\"method\": \"multigrid\", \"multigrid\": []}", "solver.multigrid", "object");
   bad(ctx, "hex8",
       "{\"method\": \"multigrid\", \"multigrid\": {\"pre_smooth\": 0, \"post_smooth\": 0}}",
       "solver.multigrid", "at least one smoothing step");
   bad(ctx, "hex8",
-      "{\"method\": \"cg\", \"preconditioner\": \"multigrid\", \"multigrid\": {\"post_smooth\": 2}}",
+      "{\"method\": \"cg\", \"preconditioner\": \"multigrid\", \"multigrid\": {\"post_smooth\": "
+      "2}}",
       "solver.multigrid", "must be equal");
   bad(ctx, "hex8",
-      "{\"method\": \"minres\", \"preconditioner\": \"multigrid\", \"multigrid\": {\"pre_smooth\": 3}}",
+      "{\"method\": \"minres\", \"preconditioner\": \"multigrid\", \"multigrid\": {\"pre_smooth\": "
+      "3}}",
       "solver.multigrid", "\"minres\"");
   bad(ctx, "tet10", "{\"method\": \"multigrid\"}", "solver.method", "\"hex20\"");
   bad(ctx, "hex8", "{\"method\": \"multigrid\", \"multigrid\": {\"block_smoothing\": 1}}",

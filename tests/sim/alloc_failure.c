@@ -1,8 +1,8 @@
 /* Allocation failures: failing the k-th allocation (k = 0, 1, ...) anywhere in create,
  * configure, setup and two steps (direct with Rayleigh damping, and MINRES with a Jacobi
  * preconditioner created on first use; MINRES with the multigrid preconditioner and the multigrid
- * solver with PSD tangents, the hierarchy built on first use) gives FCM_ERR_ALLOC, leaks nothing, and a failing
- * step leaves the state where it was; eventually the whole sequence succeeds. */
+ * solver with PSD tangents, the hierarchy built on first use) gives FCM_ERR_ALLOC, leaks nothing,
+ * and a failing step leaves the state where it was; eventually the whole sequence succeeds. */
 #include "sim_util.h"
 #include "test_alloc.h"
 

@@ -1295,8 +1295,7 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
        b);
   if (c->multigrid) multigrid_line(S, f);
   snprintf(b, sizeof b, "%lld Newton, %lld linear iterations, %lld multigrid cycles, %lld tangents",
-           c->newton_iterations, c->linear_iterations, c->multigrid_cycles,
-           c->tangent_assemblies);
+           c->newton_iterations, c->linear_iterations, c->multigrid_cycles, c->tangent_assemblies);
   line(f, 1, "iterations", b);
   snprintf(b, sizeof b, "%lld frames, surface %lld points %lld triangles", c->frames,
            (long long)c->surface_points, (long long)c->surface_triangles);

@@ -762,8 +762,8 @@ static fcm_status read_multigrid(fcm__scene_parser *p, const fcm__json *mg, fcm_
   READ_CHOICE_AS(p, mg, "smoother", 0, smoother_names, smoother_values, m->smoother);
   if (m->smoother == FCM_MG_SMOOTHER_JACOBI)
     m->omega = 0.6; /* the damped Jacobi default (1.0 over-corrects elasticity) */
-  FCM_TRY(p->ctx, fcm__scene_read_number(p, mg, "omega", 0, (fcm__range){0.0, 2.0, 1, 1},
-                                         &m->omega));
+  FCM_TRY(p->ctx,
+          fcm__scene_read_number(p, mg, "omega", 0, (fcm__range){0.0, 2.0, 1, 1}, &m->omega));
   if (m->smoother == FCM_MG_SMOOTHER_JACOBI && m->omega > 1.0) {
     fcm__scene_path_push_key(p, "omega");
     SCENE_CHECK(0, p, FCM_ERR_ARG,
@@ -827,9 +827,8 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
   static const char *const keys[] = {
-      "method", "direct",         "preconditioner", "schwarz", "rtol",
-      "atol",   "max_iterations", "newton",         "threads", "preconditioner_tangent",
-      "multigrid"};
+      "method", "direct",  "preconditioner",         "schwarz",  "rtol", "atol", "max_iterations",
+      "newton", "threads", "preconditioner_tangent", "multigrid"};
   static const char *const skeys[] = {"threshold", "epsilon", "clamp"};
   static const char *const nkeys[] = {"rtol",        "max_iterations",
                                       "line_search", "project_psd",

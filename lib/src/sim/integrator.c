@@ -402,8 +402,8 @@ static fcm_status validate_options(fcm_ctx *ctx, const fcm_integrator_options *o
             "integrator: backtrack = %g outside (0, 1)", o->backtrack);
   FCM_CHECK(o->max_backtracks >= 0, ctx, FCM_ERR_ARG,
             "integrator: max_backtracks = %d must be >= 0", o->max_backtracks);
-  FCM_CHECK(o->linear_solver >= FCM_LINEAR_DIRECT && o->linear_solver <= FCM_LINEAR_MULTIGRID,
-            ctx, FCM_ERR_ARG,
+  FCM_CHECK(o->linear_solver >= FCM_LINEAR_DIRECT && o->linear_solver <= FCM_LINEAR_MULTIGRID, ctx,
+            FCM_ERR_ARG,
             "integrator: linear_solver = %d outside [0, 3] (direct, cg, minres, multigrid)",
             (int)o->linear_solver);
   FCM_CHECK(o->direct_method == FCM_DIRECT_CHOLMOD || o->direct_method == FCM_DIRECT_UMFPACK, ctx,

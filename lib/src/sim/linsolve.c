@@ -213,8 +213,8 @@ fcm_status fcm__sim_multigrid_validate(fcm_ctx *ctx, const fcm_integrator_option
     FCM_CHECK(isfinite(m->omega) && m->omega > 0.0 && m->omega < 2.0, ctx, FCM_ERR_ARG,
               "integrator: multigrid.omega = %g outside (0, 2) (the Gauss-Seidel smoothers)",
               m->omega);
-  FCM_CHECK(m->pre_smooth >= 0 && m->post_smooth >= 0 && m->pre_smooth + m->post_smooth >= 1,
-            ctx, FCM_ERR_ARG,
+  FCM_CHECK(m->pre_smooth >= 0 && m->post_smooth >= 0 && m->pre_smooth + m->post_smooth >= 1, ctx,
+            FCM_ERR_ARG,
             "integrator: multigrid.pre_smooth = %d and post_smooth = %d must be >= 0 with at "
             "least one smoothing step",
             m->pre_smooth, m->post_smooth);
@@ -246,8 +246,8 @@ static fcm_status mg_soft(fcm_integrator *I, fcm_status s, fcm_step_reason *reas
 {
   fcm_ctx *ctx = I->ctx;
   if (s == FCM_ERR_NUMERIC || s == FCM_ERR_SINGULAR || s == FCM_ERR_NOT_CONVERGED) {
-    fcm__log(ctx, FCM_LOG_WARNING,
-             "integrator: t = %g: multigrid failed (%s); %s", I->t, fcm_ctx_error_message(ctx),
+    fcm__log(ctx, FCM_LOG_WARNING, "integrator: t = %g: multigrid failed (%s); %s", I->t,
+             fcm_ctx_error_message(ctx),
              I->opts.linear_solver == FCM_LINEAR_MULTIGRID
                  ? "the multigrid solver needs a symmetric positive definite Newton matrix "
                    "(static, or dynamic with a linear material or project_psd) and enough "
