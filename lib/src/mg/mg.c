@@ -1292,9 +1292,12 @@ static fcm_status cycle(fcm_mg *m, int l, const double *b, double *x)
   /* r = b - A x, b_c = R r */
   fcm_csr_apply(level_matrix(L), -1.0, x, 0.0, L->r);
   const fcm_index n = L->n;
+  const fcm_index nc = C->n;
+#pragma omp parallel for schedule(static) if (n > 4096)
   for (fcm_index i = 0; i < n; i++)
     L->r[i] += b[i];
-  for (fcm_index J = 0; J < C->n; J++) {
+#pragma omp parallel for schedule(static) if (nc > 4096)
+  for (fcm_index J = 0; J < nc; J++) {
     double s = 0.0;
     for (fcm_index p = L->R_ptr[J]; p < L->R_ptr[J + 1]; p++)
       s += L->R_val[p] * L->r[L->R_col[p]];
@@ -1304,8 +1307,9 @@ static fcm_status cycle(fcm_mg *m, int l, const double *b, double *x)
   const int gamma = l + 2 == m->nlev ? 1 : m->opts.cycle_index; /* the coarsest is exact */
   for (int g = 0; g < gamma; g++)
     if ((st = cycle(m, l + 1, C->b, C->x))) return st;
-  for (fcm_index J = 0; J < C->n; J++)
+  for (fcm_index J = 0; J < nc; J++)
     if (C->inactive[J]) C->x[J] = 0.0; /* nothing from the Dirichlet boundary */
+#pragma omp parallel for schedule(static) if (n > 4096)
   for (fcm_index i = 0; i < n; i++) {
     double s = 0.0;
     for (fcm_index p = L->P_ptr[i]; p < L->P_ptr[i + 1]; p++)
