@@ -163,9 +163,12 @@ static void progress(int tty, long long k, long long n, long long step, long lon
             si->time, si->newton_iterations, eta);
     if (k == n) fputc('\n', stderr);
   } else {
+    char mg[48] = "";
+    if (si->multigrid_cycles > 0)
+      snprintf(mg, sizeof mg, " multigrid cycles %lld", si->multigrid_cycles);
     fprintf(stderr,
-            "fcm-sim: step %lld/%lld t=%.6g s newton %d linear %lld residual %.3e (%.3f s)\n", step,
-            total, si->time, si->newton_iterations, si->linear_iterations, si->residual,
+            "fcm-sim: step %lld/%lld t=%.6g s newton %d linear %lld%s residual %.3e (%.3f s)\n",
+            step, total, si->time, si->newton_iterations, si->linear_iterations, mg, si->residual,
             si->time_total);
   }
 }
