@@ -34,6 +34,7 @@ int main(int argc, char **argv)
                    : !strcmp(name, "hemisphere") ? 1
                    : !strcmp(name, "cut")        ? 2
                    : !strcmp(name, "split")      ? 3
+                   : !strcmp(name, "hollow")     ? 4
                                                  : -1;
   if (kind < 0) return 2;
   const int verbose = getenv("FCM_TEST_VERBOSE") != NULL;
@@ -52,6 +53,8 @@ int main(int argc, char **argv)
     problem p;
     if (kind == 0)
       problem_cube_of(ctx, type, sizes[s], &p);
+    else if (kind == 4)
+      problem_hollow_of(ctx, type, sizes[s], &p);
     else
       problem_hemisphere_of(ctx, type, sizes[s], kind - 1,
                             fcm_space_options_default().constrain_ratio, &p);
