@@ -63,7 +63,7 @@ typedef struct row {
   fcm_element_type type;
   int body, solver, status;
   fcm_index n, dofs;
-  int iterations;
+  int iterations, levels;     /* levels: of the multigrid hierarchy (cg-mg, mg), else 0 */
   double factor;              /* mean reduction per iteration / cycle; < 0: none (cholmod) */
   double setup_s, solve_s;    /* wall clock */
   double setup_cpu, solve_cpu; /* process CPU seconds (all threads) */
@@ -78,6 +78,7 @@ static int nrows = 0;
 
 typedef struct settings {
   int quick, check, threads, max_iterations, clock;
+  long long coarse_dofs; /* fcm_mg_options.coarse_dofs */
   double rtol, agree, budget, mem_fraction;
   fcm_index sizes[16];
   int nsizes;
@@ -296,7 +297,9 @@ static void run_solver(fcm_ctx *ctx, const settings *o, const problem *p, int s,
   fcm_krylov_options ko = fcm_krylov_options_default();
   fcm_krylov_info ki;
   fcm_mg_solve_info mi;
+  fcm_mg_options mo = fcm_mg_options_default();
   const char *stage = "setup";
+  mo.coarse_dofs = (fcm_index)o->coarse_dofs;
   ko.rtol = o->rtol;
   ko.max_iterations = o->max_iterations;
   memset(x, 0, sizeof *x * (size_t)p->n);
@@ -322,7 +325,7 @@ static void run_solver(fcm_ctx *ctx, const settings *o, const problem *p, int s,
     else if (s == S_MINRES)
       st = schwarz_build(ctx, p, &S);
     else
-      st = fcm_mg_create(ctx, p->space, p->A, NULL, &mg);
+      st = fcm_mg_create(ctx, p->space, p->A, &mo, &mg);
     w1 = omp_get_wtime(), c1 = cpu_now();
     if (st == FCM_OK) {
       stage = "solve";
@@ -340,7 +343,7 @@ static void run_solver(fcm_ctx *ctx, const settings *o, const problem *p, int s,
     }
     break;
   case S_MG:
-    st = fcm_mg_create(ctx, p->space, p->A, NULL, &mg);
+    st = fcm_mg_create(ctx, p->space, p->A, &mo, &mg);
     w1 = omp_get_wtime(), c1 = cpu_now();
     if (st == FCM_OK) {
       stage = "solve";
@@ -352,6 +355,7 @@ static void run_solver(fcm_ctx *ctx, const settings *o, const problem *p, int s,
   default: break;
   }
   const double w2 = omp_get_wtime(), c2 = cpu_now();
+  if (mg) r->levels = fcm_mg_num_levels(mg);
   r->peak_mb = r->base_mb >= 0.0 ? rss_peak() : -1.0;
   r->setup_s = w1 - w0, r->solve_s = w2 - w1;
   r->setup_cpu = c1 - c0, r->solve_cpu = c2 - c1;
@@ -489,12 +493,14 @@ static void write_row(FILE *f, const row *r)
   csv_field_num(f, ran ? r->setup_cpu : -1.0, 4, 0);
   csv_field_num(f, ran ? r->solve_cpu : -1.0, 4, 0);
   csv_field_num(f, ran ? r->base_mb : -1.0, 1, 0);
+  fputc(',', f);
+  if (ran && r->levels > 0) fprintf(f, "%d", r->levels);
   fprintf(f, ",%s\n", r->note);
 }
 
 static const char csv_header[] =
     "element,cells,dofs,solver,iterations,convergence_factor,setup_s,solve_s,peak_rss_mb,"
-    "body,status,relative_residual,diff_cholmod,setup_cpu_s,solve_cpu_s,base_rss_mb,note\n";
+    "body,status,relative_residual,diff_cholmod,setup_cpu_s,solve_cpu_s,base_rss_mb,levels,note\n";
 
 static void print_row(const row *r)
 {
@@ -664,7 +670,7 @@ static int summary(const settings *o)
       if (m == 0) continue;
       printf("  %-5s %-6s", fcm_element_get_info(o->types[ti])->name, body_names[b]);
       for (int i = 0; i < m; i++)
-        printf("  n=%lld: %.3f", (long long)sr[i]->n, sr[i]->factor);
+        printf("  n=%lld: %.3f (%d levels)", (long long)sr[i]->n, sr[i]->factor, sr[i]->levels);
       printf("\n");
     }
   printf("\nclaims of issue 13 (per element; bodies ball and hollow, the V-factor on cut; times "
@@ -708,11 +714,14 @@ static int summary(const settings *o)
       const row *sr[64];
       const int m = series(t, B_CUT, S_MG, sr, 64);
       double worst = 0.0;
+      int k = 0;
       for (int i = 0; i < m; i++)
-        worst = fmax(worst, sr[i]->factor);
-      snprintf(what, sizeof what, "%s cut: V-cycle factor <= 0.8 at every n (worst %.3f)", en,
-               worst);
-      all &= claim(what, worst <= 0.8, m >= 1);
+        if (sr[i]->iterations >= 2 && sr[i]->levels >= 2) /* a factor needs 2 cycles */
+          worst = fmax(worst, sr[i]->factor), k++;
+      snprintf(what, sizeof what,
+               "%s cut: V-cycle factor <= 0.8 at every n with 2+ levels (worst %.3f of %d)", en,
+               worst, k);
+      all &= claim(what, worst <= 0.8, k >= 1);
     }
   }
   return all;
@@ -895,7 +904,8 @@ static void usage(FILE *f, const cli_option *opts)
       "5 to /proc/self/clear_refs and VmHWM read after it), then body,status (ok, skipped,\n"
       "failed),relative_residual (||b - A x||/||b||, computed here),diff_cholmod (||x -\n"
       "x_cholmod||/||x_cholmod||),setup_cpu_s,solve_cpu_s (process CPU, all threads),\n"
-      "base_rss_mb (resident before the row),note (why skipped or failed).\n"
+      "base_rss_mb (resident before the row),levels (multigrid levels),note (why skipped or\n"
+      "failed).\n"
       "Before each size a solver is skipped (and at every larger size) when its time, scaled\n"
       "from the previous sizes, would exceed --budget, or its memory would exceed\n"
       "--mem-fraction of MemAvailable; the problem itself likewise. Rows say what was skipped\n"
@@ -951,6 +961,7 @@ int main(int argc, char **argv)
   memset(&o, 0, sizeof o);
   o.rtol = 1e-8, o.agree = 1e-5, o.budget = -1.0, o.mem_fraction = 0.8;
   o.max_iterations = 20000;
+  o.coarse_dofs = 200;
   const char *sizes = NULL, *elements = NULL, *bodies = NULL, *solvers = NULL;
   int seen_budget = 0;
   const cli_option opts[] = {
@@ -984,6 +995,10 @@ int main(int argc, char **argv)
       {"--mem-fraction", NULL, CLI_DOUBLE, &o.mem_fraction, "F",
        "skip what would need more than F x MemAvailable (default 0.8)", 0, 1, CLI_LO_OPEN, NULL,
        NULL, NULL},
+      {"--coarse-dofs", NULL, CLI_LLONG, &o.coarse_dofs, "N",
+       "multigrid: coarsen until a level has at most N DOFs\n(fcm_mg_options.coarse_dofs; default "
+       "200, so that n = 8 has 2+ levels:\nthe library's 2000 would solve it directly)",
+       1, 1e9, 0, NULL, NULL, NULL},
       {"--threads", NULL, CLI_INT, &o.threads, "T",
        "OpenMP threads (and CHOLMOD's BLAS threads); 0: the\nenvironment's (default)", 0, 1024, 0,
        NULL, NULL, NULL},
