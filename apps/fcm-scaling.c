@@ -729,10 +729,24 @@ static int summary(const settings *o)
 
 /* ------------------------------------------------------------- the study */
 
-static void add_skip(fcm_element_type t, int body, fcm_index n, fcm_index dofs, int s,
+/* The rows so far into --csv (atomically: a temporary renamed over the file); called after
+ * every row, so an interrupted run leaves the rows it finished. 1 on success. */
+static int write_csv(const settings *o)
+{
+  if (!o->csv) return 1;
+  cli_output *out = NULL;
+  FILE *f = cli_output_open(PROG, o->csv, &out);
+  if (!f) return 0;
+  fputs(csv_header, f);
+  for (int i = 0; i < nrows; i++)
+    write_row(f, &rows[i]);
+  return cli_output_commit(PROG, &out);
+}
+
+static int add_skip(const settings *o, fcm_element_type t, int body, fcm_index n, fcm_index dofs, int s,
                      const char *why)
 {
-  if (nrows >= MAX_ROWS) return;
+  if (nrows >= MAX_ROWS) return 1;
   row *r = &rows[nrows++];
   memset(r, 0, sizeof *r);
   r->type = t, r->body = body, r->n = n, r->dofs = dofs, r->solver = s;
@@ -742,6 +756,14 @@ static void add_skip(fcm_element_type t, int body, fcm_index n, fcm_index dofs, 
   fprintf(stderr, PROG ": %s %s n=%lld %s skipped: %s\n", fcm_element_get_info(t)->name,
           body_names[body], (long long)n, solver_names[s], r->note);
   print_row(r);
+  return write_csv(o);
+}
+
+/* print_row() and the CSV so far; 0 when the CSV cannot be written. */
+static int emit(const settings *o, const row *r)
+{
+  print_row(r);
+  return write_csv(o);
 }
 
 static int run_study(fcm_ctx *ctx, const settings *o)
@@ -786,7 +808,7 @@ static int run_study(fcm_ctx *ctx, const settings *o)
                      est_s, o->budget, (long long)est_dofs);
           if (why[0]) {
             for (int s = 0; s < NSOLVER; s++)
-              if (want[s]) add_skip(t, body, n, 0, s, why);
+              if (want[s] && !add_skip(o, t, body, n, 0, s, why)) return 1;
             continue;
           }
         }
@@ -809,7 +831,7 @@ static int run_study(fcm_ctx *ctx, const settings *o)
               char msg[400];
               snprintf(msg, sizeof msg, "problem: %s", fcm_ctx_error_message(ctx));
               set_note(r, msg);
-              print_row(r);
+              if (!emit(o, r)) return 1;
             }
           failed = 1;
           continue;
@@ -833,7 +855,7 @@ static int run_study(fcm_ctx *ctx, const settings *o)
           const int s = o->solvers[si];
           if (!want[s]) continue;
           if (skipped[s][0]) {
-            add_skip(t, body, n, p.n, s, skipped[s]);
+            if (!add_skip(o, t, body, n, p.n, s, skipped[s])) failed = 1;
             continue;
           }
           double est_s = 0.0, est_mb = 0.0;
@@ -850,7 +872,7 @@ static int run_study(fcm_ctx *ctx, const settings *o)
             char w2[200];
             snprintf(w2, sizeof w2, "n=%lld %s", (long long)n, why);
             snprintf(skipped[s], sizeof skipped[s], "%.150s (and larger)", w2);
-            add_skip(t, body, n, p.n, s, why);
+            if (!add_skip(o, t, body, n, p.n, s, why)) failed = 1;
             continue;
           }
           if (nrows >= MAX_ROWS) break;
@@ -864,7 +886,12 @@ static int run_study(fcm_ctx *ctx, const settings *o)
           if (s == S_CHOLMOD && r->status == ROW_OK) have_ref = 1;
           if (r->status == ROW_FAILED) failed = 1;
           if (r->status == ROW_SKIPPED) snprintf(skipped[s], sizeof skipped[s], "%s", r->note);
-          print_row(r);
+          if (!emit(o, r)) {
+            free(x);
+            free(xref);
+            problem_free(&p);
+            return 1;
+          }
         }
         free(x);
         free(xref);
@@ -1057,18 +1084,7 @@ int main(int argc, char **argv)
   const int claims = summary(&o);
   int ok = !failed && (!o.check || claims);
   if (failed) printf("\nsome rows FAILED (see their notes)\n");
-  if (o.csv) {
-    cli_output *out = NULL;
-    FILE *f = cli_output_open(PROG, o.csv, &out);
-    if (!f) {
-      ok = 0;
-    } else {
-      fputs(csv_header, f);
-      for (int i = 0; i < nrows; i++)
-        write_row(f, &rows[i]);
-      if (!cli_output_commit(PROG, &out)) ok = 0;
-    }
-  }
+  if (!write_csv(&o)) ok = 0;
   if (o.png && !write_png(&o)) ok = 0;
   fcm_ctx_destroy(&ctx);
   return ok ? 0 : 1;
