@@ -794,6 +794,14 @@ static int run_study(fcm_ctx *ctx, const settings *o)
           want[s] = 1, nwant++;
         }
         if (!nwant) continue;
+        int all_skipped = 1; /* every solver already stopped at a smaller size: no problem */
+        for (int s = 0; s < NSOLVER; s++)
+          if (want[s] && !skipped[s][0]) all_skipped = 0;
+        if (all_skipped) {
+          for (int s = 0; s < NSOLVER; s++)
+            if (want[s] && !add_skip(o, t, body, n, 0, s, skipped[s])) return 1;
+          continue;
+        }
         /* the problem itself: estimated from the previous size by the cell ratio */
         const double avail = mem_available();
         char why[200];
