@@ -44,8 +44,8 @@
 #define PROG "fcm-scaling"
 
 enum { S_CHOLMOD, S_CGJ, S_MINRES, S_CGMG, S_MG, NSOLVER };
-static const char *const solver_names[] = {"cholmod", "cg-jacobi", "minres-schwarz", "cg-mg", "mg",
-                                           NULL};
+static const char *const solver_names[] = {"cholmod", "cg-jacobi", "minres-schwarz",
+                                           "cg-mg",   "mg",        NULL};
 enum { B_BALL, B_HOLLOW, B_CUBE, B_CUT, NBODY };
 static const char *const body_names[] = {"ball", "hollow", "cube", "cut", NULL};
 enum { CLOCK_WALL, CLOCK_CPU };
@@ -63,12 +63,12 @@ typedef struct row {
   fcm_element_type type;
   int body, solver, status;
   fcm_index n, dofs;
-  int iterations, levels;     /* levels: of the multigrid hierarchy (cg-mg, mg), else 0 */
-  double factor;              /* mean reduction per iteration / cycle; < 0: none (cholmod) */
-  double setup_s, solve_s;    /* wall clock */
+  int iterations, levels;      /* levels: of the multigrid hierarchy (cg-mg, mg), else 0 */
+  double factor;               /* mean reduction per iteration / cycle; < 0: none (cholmod) */
+  double setup_s, solve_s;     /* wall clock */
   double setup_cpu, solve_cpu; /* process CPU seconds (all threads) */
-  double peak_mb, base_mb;    /* VmHWM over setup + solve; VmRSS before it; < 0 unknown */
-  double relres, diff;        /* ||b - Ax|| / ||b||; ||x - x_cholmod|| / ||x_cholmod|| (< 0: none) */
+  double peak_mb, base_mb;     /* VmHWM over setup + solve; VmRSS before it; < 0 unknown */
+  double relres, diff; /* ||b - Ax|| / ||b||; ||x - x_cholmod|| / ||x_cholmod|| (< 0: none) */
   char note[200];
 } row;
 
@@ -78,7 +78,7 @@ static int nrows = 0;
 
 typedef struct settings {
   int quick, check, threads, max_iterations, clock;
-  long long coarse_dofs; /* fcm_mg_options.coarse_dofs */
+  long long coarse_dofs;  /* fcm_mg_options.coarse_dofs */
   double constrain_ratio; /* fcm_space_options.constrain_ratio */
   double rtol, agree, budget, mem_fraction;
   fcm_index sizes[16];
@@ -131,8 +131,14 @@ static double rss_reset(void)
   return proc_kb("/proc/self/status", "VmRSS");
 }
 
-static double rss_peak(void) { return proc_kb("/proc/self/status", "VmHWM"); }
-static double mem_available(void) { return proc_kb("/proc/meminfo", "MemAvailable"); }
+static double rss_peak(void)
+{
+  return proc_kb("/proc/self/status", "VmHWM");
+}
+static double mem_available(void)
+{
+  return proc_kb("/proc/meminfo", "MemAvailable");
+}
 
 /* ------------------------------------------------------------- the problem */
 
@@ -356,7 +362,8 @@ static void run_solver(fcm_ctx *ctx, const settings *o, const problem *p, int s,
       r->factor = mi.convergence_factor;
     }
     break;
-  default: break;
+  default:
+    break;
   }
   const double w2 = omp_get_wtime(), c2 = cpu_now();
   if (mg) r->levels = fcm_mg_num_levels(mg);
@@ -709,7 +716,8 @@ static int summary(const settings *o)
       for (int i = m - 1; i >= 0 && !a; i--)
         for (int j = 0; j < mc; j++)
           if (ch[j]->n == mg[i]->n) a = mg[i], c = ch[j];
-      snprintf(what, sizeof what, "%s %s: cg-mg faster than cholmod at the largest n both ran (%lld: %.3g vs %.3g s)",
+      snprintf(what, sizeof what,
+               "%s %s: cg-mg faster than cholmod at the largest n both ran (%lld: %.3g vs %.3g s)",
                en, body_names[b], a ? (long long)a->n : 0LL, a ? row_time(a, o->clock, 0) : 0.0,
                c ? row_time(c, o->clock, 0) : 0.0);
       all &= claim(what, a && row_time(a, o->clock, 0) < row_time(c, o->clock, 0), a != NULL);
@@ -748,8 +756,8 @@ static int write_csv(const settings *o)
   return cli_output_commit(PROG, &out);
 }
 
-static int add_skip(const settings *o, fcm_element_type t, int body, fcm_index n, fcm_index dofs, int s,
-                     const char *why)
+static int add_skip(const settings *o, fcm_element_type t, int body, fcm_index n, fcm_index dofs,
+                    int s, const char *why)
 {
   if (nrows >= MAX_ROWS) return 1;
   row *r = &rows[nrows++];
@@ -976,8 +984,7 @@ static int parse_sizes(const char *s, settings *o)
   return 1;
 }
 
-static int parse_names(const char *opt, const char *s, const char *const *names, int *out,
-                       int *n)
+static int parse_names(const char *opt, const char *s, const char *const *names, int *out, int *n)
 {
   char tok[8][CLI_TOKEN];
   int m = 0;
@@ -1011,23 +1018,27 @@ int main(int argc, char **argv)
       {"--csv", NULL, CLI_STRING, &o.csv, "FILE", "write the rows as CSV (atomically)", 0, 0, 0,
        NULL, NULL, NULL},
       {"--png", NULL, CLI_STRING, &o.png, "FILE",
-       "plot time (setup + solve) and iterations against DOFs\n(log-log, needs gnuplot)", 0, 0, 0, NULL, NULL,
-       NULL},
-      {"--sizes", NULL, CLI_STRING, &sizes, "N,N,...", "cells per axis, increasing (default "
-       "8,16,32,64)", 0, 0, 0, NULL, NULL, NULL},
+       "plot time (setup + solve) and iterations against DOFs\n(log-log, needs gnuplot)", 0, 0, 0,
+       NULL, NULL, NULL},
+      {"--sizes", NULL, CLI_STRING, &sizes, "N,N,...",
+       "cells per axis, increasing (default "
+       "8,16,32,64)",
+       0, 0, 0, NULL, NULL, NULL},
       {"--elements", NULL, CLI_STRING, &elements, "E,...", "hex8, hex20 (default both)", 0, 0, 0,
        NULL, NULL, NULL},
-      {"--bodies", NULL, CLI_STRING, &bodies, "B,...",
-       "ball, hollow, cube, cut (default all)", 0, 0, 0, NULL, NULL, NULL},
+      {"--bodies", NULL, CLI_STRING, &bodies, "B,...", "ball, hollow, cube, cut (default all)", 0,
+       0, 0, NULL, NULL, NULL},
       {"--solvers", NULL, CLI_STRING, &solvers, "S,...",
        "cholmod, cg-jacobi, minres-schwarz, cg-mg, mg (default all;\ncholmod first gives the "
-       "reference solution)", 0, 0, 0, NULL, NULL, NULL},
+       "reference solution)",
+       0, 0, 0, NULL, NULL, NULL},
       {"--rtol", NULL, CLI_DOUBLE, &o.rtol, "R", "relative residual of every solver (default 1e-8)",
        1e-14, 1e-2, 0, NULL, NULL, NULL},
       {"--agree", NULL, CLI_DOUBLE, &o.agree, "TOL",
-       "largest ||x - x_cholmod||/||x_cholmod|| accepted (default\n1e-4: a residual of rtol allows an "
-       "error of up to kappa x\nrtol; cg-jacobi on Hex20 reaches 1.2e-5 at rtol 1e-8)", 0, 1, CLI_LO_OPEN, NULL,
-       NULL, NULL},
+       "largest ||x - x_cholmod||/||x_cholmod|| accepted (default\n1e-4: a residual of rtol allows "
+       "an "
+       "error of up to kappa x\nrtol; cg-jacobi on Hex20 reaches 1.2e-5 at rtol 1e-8)",
+       0, 1, CLI_LO_OPEN, NULL, NULL, NULL},
       {"--max-iterations", NULL, CLI_INT, &o.max_iterations, "K",
        "iterations / cycles before a solver fails (default 20000)", 1, 1e7, 0, NULL, NULL, NULL},
       {"--budget", NULL, CLI_DOUBLE, &o.budget, "S",
@@ -1049,8 +1060,8 @@ int main(int argc, char **argv)
        "OpenMP threads (and CHOLMOD's BLAS threads); 0: the\nenvironment's (default)", 0, 1024, 0,
        NULL, NULL, NULL},
       {"--clock", NULL, CLI_CHOICE, &o.clock, "C",
-       "wall (default) or cpu: the times the exponents and claims use", 0, 0, 0, clock_names,
-       NULL, NULL},
+       "wall (default) or cpu: the times the exponents and claims use", 0, 0, 0, clock_names, NULL,
+       NULL},
       {"--check", NULL, CLI_FLAG, &o.check, NULL,
        "exit 1 when a claim of issue 13 fails or cannot be measured", 0, 0, 0, NULL, NULL, NULL},
       {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
@@ -1079,8 +1090,7 @@ int main(int argc, char **argv)
       }
   }
   if (bodies && !parse_names("--bodies", bodies, body_names, o.bodies, &o.nbodies)) return 2;
-  if (solvers && !parse_names("--solvers", solvers, solver_names, o.solvers, &o.nsolvers))
-    return 2;
+  if (solvers && !parse_names("--solvers", solvers, solver_names, o.solvers, &o.nsolvers)) return 2;
   /* cholmod first: it gives the reference solution */
   for (int i = 1; i < o.nsolvers; i++)
     if (o.solvers[i] == S_CHOLMOD) {

@@ -170,9 +170,9 @@ int main(int argc, char **argv)
     if (f) fclose(f);
   }
   /* bad options: exit 2, nothing written */
-  static const char *const bad[] = {"--sizes 8,4", "--sizes 1", "--solvers cholmod,foo",
-                                    "--elements tet4", "--bodies ball,ball", "--rtol 0",
-                                    "--clock sun"};
+  static const char *const bad[] = {
+      "--sizes 8,4", "--sizes 1",  "--solvers cholmod,foo", "--elements tet4", "--bodies ball,ball",
+      "--rtol 0",    "--clock sun"};
   for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
     remove(csv);
     snprintf(cmd, sizeof cmd, "'%s' %s --csv '%s' > /dev/null 2>&1", argv[1], bad[k], csv);
