@@ -69,31 +69,37 @@ static inline void finish_space(fcm_ctx *ctx, problem *p, int with_mass)
   TEST_OK(ctx, fcm_assemble_body_force(p->space, &mat, g, NULL, p->b));
 }
 
-/* Unit cube, n^3 Hex8 cells, clamped at x = 0, gravity. */
-static inline void problem_cube(fcm_ctx *ctx, fcm_index n, problem *p)
+/* Unit cube, n^3 cells of `type` (Hex8 or Hex20), clamped at x = 0, gravity. */
+static inline void problem_cube_of(fcm_ctx *ctx, fcm_element_type type, fcm_index n, problem *p)
 {
   const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
   const fcm_index cells[3] = {n, n, n};
   memset(p, 0, sizeof *p);
-  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, cells, &p->mesh));
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, cells, &p->mesh));
   TEST_OK(ctx, fcm_space_create(ctx, p->mesh, NULL, &p->space));
   finish_space(ctx, p, 0);
   const double flo[3] = {0, -1, -1}, fhi[3] = {0, 2, 2};
   clamp_box(ctx, p, flo, fhi);
 }
 
-/* Hemisphere of radius 1 on y = 0 in [-1.1, 1.1] x [0, 1.1] x [-1.1, 1.1] with n x n/2 x n
- * cells (n even), clamped at y = 0; cut = 1: a vertical plane cut x = 0.05 through the
- * upper part y > 0.4 (it separates the top into two halves joined below); cut = 2: the
- * same plane through the whole body (two bodies, each clamped); ratio: the space's
+/* The Hex8 cube. */
+static inline void problem_cube(fcm_ctx *ctx, fcm_index n, problem *p)
+{
+  problem_cube_of(ctx, FCM_ELEMENT_HEX8, n, p);
+}
+
+/* Hemisphere of radius 1 on y = 0 (cells of `type`: Hex8 or Hex20) in [-1.1, 1.1] x [0, 1.1] x
+ * [-1.1, 1.1] with n x n/2 x n cells (n even), clamped at y = 0; cut = 1: a vertical plane cut x =
+ * 0.05 through the upper part y > 0.4 (it separates the top into two halves joined below); cut = 2:
+ * the same plane through the whole body (two bodies, each clamped); ratio: the space's
  * constrain_ratio (copies of smaller support move with their piece). */
-static inline void problem_hemisphere_with(fcm_ctx *ctx, fcm_index n, int cut, double ratio,
-                                           problem *p)
+static inline void problem_hemisphere_of(fcm_ctx *ctx, fcm_element_type type, fcm_index n, int cut,
+                                         double ratio, problem *p)
 {
   const double lo[3] = {-1.1, 0, -1.1}, hi[3] = {1.1, 1.1, 1.1}, c[3] = {0, 0, 0};
   const fcm_index cells[3] = {n, n / 2, n};
   memset(p, 0, sizeof *p);
-  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, cells, &p->mesh));
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, cells, &p->mesh));
   TEST_OK(ctx, fcm_geometry_create_hemisphere(ctx, c, 1.0, 4, &p->geom));
   fcm_cell_rules_options ro = fcm_cell_rules_options_default();
   ro.simplify = FCM_CELL_SIMPLIFY_OFF; /* faster; the solver sees the same kind of matrix */
@@ -115,6 +121,13 @@ static inline void problem_hemisphere_with(fcm_ctx *ctx, fcm_index n, int cut, d
   clamp_box(ctx, p, flo, fhi);
 }
 
+/* The Hex8 grid of problem_hemisphere_of(). */
+static inline void problem_hemisphere_with(fcm_ctx *ctx, fcm_index n, int cut, double ratio,
+                                           problem *p)
+{
+  problem_hemisphere_of(ctx, FCM_ELEMENT_HEX8, n, cut, ratio, p);
+}
+
 /* As problem_hemisphere_with() with the default constrain_ratio (1e-9). */
 static inline void problem_hemisphere(fcm_ctx *ctx, fcm_index n, int cut, problem *p)
 {
@@ -122,15 +135,15 @@ static inline void problem_hemisphere(fcm_ctx *ctx, fcm_index n, int cut, proble
 }
 
 /* Two balls of radius 0.3 at (0.5, 0.5, 0.5) and (1.5, 0.5, 0.5) in [0, 2] x [0, 1]^2 with
- * 2n x n x n cells; A = K + M. */
-static inline void problem_balls(fcm_ctx *ctx, fcm_index n, problem *p)
+ * 2n x n x n cells of `type`; A = K + M. */
+static inline void problem_balls_of(fcm_ctx *ctx, fcm_element_type type, fcm_index n, problem *p)
 {
   const double lo[3] = {0, 0, 0}, hi[3] = {2, 1, 1};
   const double c1[3] = {0.5, 0.5, 0.5}, c2[3] = {1.5, 0.5, 0.5};
   const fcm_index cells[3] = {2 * n, n, n};
   fcm_geometry *b1 = NULL, *b2 = NULL;
   memset(p, 0, sizeof *p);
-  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, cells, &p->mesh));
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, cells, &p->mesh));
   TEST_OK(ctx, fcm_geometry_create_ball(ctx, c1, 0.3, 3, &b1));
   TEST_OK(ctx, fcm_geometry_create_ball(ctx, c2, 0.3, 3, &b2));
   const fcm_index n1 = fcm_geometry_num_nodes(b1), n2 = fcm_geometry_num_nodes(b2);
@@ -152,6 +165,12 @@ static inline void problem_balls(fcm_ctx *ctx, fcm_index n, problem *p)
   TEST_OK(ctx, fcm_cell_rules_create(ctx, p->mesh, p->geom, &ro, &p->rules0));
   TEST_OK(ctx, fcm_space_create_embedded(ctx, p->mesh, p->rules0, &p->space));
   finish_space(ctx, p, 1);
+}
+
+/* The balls on a Hex8 grid. */
+static inline void problem_balls(fcm_ctx *ctx, fcm_index n, problem *p)
+{
+  problem_balls_of(ctx, FCM_ELEMENT_HEX8, n, p);
 }
 
 #endif /* FCM_MG_TEST_UTIL_H */

@@ -106,18 +106,18 @@ int main(void)
       TEST_ERR(ctx, fcm_mg_setup(mg), FCM_ERR_ARG, "eliminated");
       free(b);
       fcm_mg_destroy(&mg);
-      /* a Hex20 grid is refused */
+      /* a tetrahedral grid is refused */
       fcm_mesh *m20 = NULL;
       fcm_space *s20 = NULL;
       fcm_csr *A20 = NULL;
       const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
       const fcm_index c[3] = {2, 2, 2};
       fcm_material mat = {FCM_MATERIAL_LINEAR, 1.0, 0.3, 1.0};
-      TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX20, lo, hi, c, &m20));
+      TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_TET10, lo, hi, c, &m20));
       TEST_OK(ctx, fcm_space_create(ctx, m20, NULL, &s20));
       TEST_OK(ctx, fcm_space_matrix_create(s20, &A20));
       TEST_OK(ctx, fcm_assemble_mass(s20, &mat, NULL, A20));
-      TEST_ERR(ctx, fcm_mg_create(ctx, s20, A20, NULL, &mg), FCM_ERR_UNSUPPORTED, "Hex8");
+      TEST_ERR(ctx, fcm_mg_create(ctx, s20, A20, NULL, &mg), FCM_ERR_UNSUPPORTED, "Hex8 or Hex20");
       fcm_csr_destroy(&A20);
       fcm_space_destroy(&s20);
       fcm_mesh_destroy(&m20);

@@ -1,4 +1,5 @@
-/* fcm — cut-aware geometric multigrid for Hex8 box grids (Dick, Georgii, Westermann 2011):
+/* fcm — cut-aware geometric multigrid for Hex8 and Hex20 box grids (Dick, Georgii,
+ * Westermann 2011): on Hex20 a first p-level Hex20 -> Hex8 on the same grid, then
  * 2x2x2 blocks of cells are merged, one coarse cell per connected component of the block's
  * elements, so material that the fine space separates (disjoint bodies, cuts) is never merged;
  * coarse DOFs are duplicated per component. Trilinear prolongation per component, restriction
@@ -46,6 +47,18 @@ typedef struct fcm_mg_options {
   int max_levels;           /**< levels including the finest, >= 1 (default 20) */
   fcm_index coarse_dofs;    /**< stop coarsening once a level has at most this many DOFs,
                                  >= 1 (default 2000); that level is solved by CHOLMOD */
+  int block_smoothing;      /**< 1 (default): on the finest level, the DOFs around each grid
+                                 vertex of a cut cell (the geometry's boundary, cut surfaces)
+                                 are also smoothed as a block: the copies whose support lies
+                                 in the vertex's 8 cells (the vertex's own and, on Hex20, those
+                                 of the mid-edge nodes at it; de Prenter et al. 2020). A
+                                 symmetric block Gauss-Seidel sweep (sequential) follows the
+                                 pre-smoothing and precedes the post-smoothing, each block
+                                 inverted by the clamped eigen-inverse of the Schwarz
+                                 preconditioner (fcm/solve.h). Small cut fractions make such
+                                 basis functions nearly linearly dependent, which pointwise
+                                 smoothing cannot resolve (the Hex20 V-cycle stalls near 0.95
+                                 without it); 0: pointwise smoothing only */
 } fcm_mg_options;
 
 /** Defaults as documented on each member. */
@@ -54,23 +67,25 @@ FCM_API fcm_mg_options fcm_mg_options_default(void);
 /** A multigrid hierarchy and its operators for one matrix pattern. */
 typedef struct fcm_mg fcm_mg;
 
-/** Build the hierarchy of `space` and the operators of `A`.
- * The space must live on a structured Hex8 box grid (fcm_mesh_create_box(): every cell an
- * axis-aligned box of one size at an integer grid position); any cell counts, dropped cells
- * and cut (XFEM) pieces are allowed. Level 0 is the space itself: its elements (pieces) and
- * DOF copies. Two elements of face-neighbouring cells are connected when they use the same
- * copy at a node of the common face and, where cuts reach either cell, the cell rules link
- * their pieces (fcm_cell_rules_links()); coarse cells are the connected components of the
- * elements (cells) of each 2x2x2 block, and coarse cells are connected when some of their
- * fine cells are. A coarse cell has its own copy at each of its 8 corners; two coarse cells
- * share a corner's copy when a fine copy that interpolates from that corner is used by fine
- * elements of both, so the coarse space separates exactly what the fine one separates
- * (two bodies never share a coarse DOF) and the prolongation is single valued.
- * Rows of A whose off-diagonal entries are all zero (DOFs eliminated by
- * fcm_space_apply_dirichlet()) mark the Dirichlet boundary: a coarse DOF whose coinciding
- * fine DOFs are all eliminated (or, coarser, constrained) is constrained (decoupled in the
- * coarse matrix, no correction from it), so coarse corrections vanish there. The
- * prolongation stays injective, so every coarse matrix is positive definite.
+/** Build the hierarchy of `space` and the operators of `A`. The space must live on a structured
+ * Hex8 or Hex20 box grid (fcm_mesh_create_box(): every cell an axis-aligned box of one size at an
+ * integer grid position); any cell counts, dropped cells and cut (XFEM) pieces are allowed. Level
+ * 0 is the space itself: its elements (pieces) and DOF copies. On Hex20, level 1 is the Hex8 space
+ * of the same elements with the copies they use at their corners: those copies are injected, a
+ * mid-edge copy takes the mean of the corner copies at the ends of its edge (exact for trilinear
+ * fields); the 2x2x2 coarsening below starts from level 1. Two elements of face-neighbouring cells
+ * are connected when they use the same copy at a node of the common face and, where cuts reach
+ * either cell, the cell rules link their pieces (fcm_cell_rules_links()); coarse cells are the
+ * connected components of the elements (cells) of each 2x2x2 block, and coarse cells are connected
+ * when some of their fine cells are. A coarse cell has its own copy at each of its 8 corners; two
+ * coarse cells share a corner's copy when a fine copy that interpolates from that corner is used
+ * by fine elements of both, so the coarse space separates exactly what the fine one separates (two
+ * bodies never share a coarse DOF) and the prolongation is single valued. Rows of A whose off-
+ * diagonal entries are all zero (DOFs eliminated by fcm_space_apply_dirichlet()) mark the
+ * Dirichlet boundary: a coarse DOF whose coinciding fine DOFs are all eliminated (or, coarser,
+ * constrained) is constrained (decoupled in the coarse matrix, no correction from it), so coarse
+ * corrections vanish there. The prolongation stays injective, so every coarse matrix is positive
+ * definite.
  * @param[in]  ctx   context; must outlive the object
  * @param[in]  space borrowed: must outlive the object
  * @param[in]  A     symmetric positive definite, the space's pattern (fcm_space_matrix_create());
@@ -79,8 +94,9 @@ typedef struct fcm_mg fcm_mg;
  * @param[in]  opts  copied; NULL for defaults
  * @param[out] mg    the new object, NULL on failure
  * @return FCM_OK, FCM_ERR_ARG (NULL, option out of range, A not the space's size),
- * FCM_ERR_UNSUPPORTED (not a Hex8 box grid: the message names the cell), FCM_ERR_SINGULAR /
- * FCM_ERR_NUMERIC (the coarsest factorization, a zero diagonal), FCM_ERR_ALLOC. */
+ * FCM_ERR_UNSUPPORTED (not a Hex8 or Hex20 box grid: the message names the cell),
+ * FCM_ERR_SINGULAR or FCM_ERR_NUMERIC (the coarsest factorization, a zero diagonal),
+ * FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
                                  const fcm_mg_options *opts, fcm_mg **mg);
 

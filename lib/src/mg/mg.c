@@ -1,4 +1,5 @@
-/* Cut-aware geometric multigrid on Hex8 box grids (Dick, Georgii, Westermann 2011, Sec. 6).
+/* Cut-aware geometric multigrid on Hex8 and Hex20 box grids (Dick, Georgii, Westermann 2011,
+ * Sec. 6), with a vertex-block smoother at cut cells (de Prenter et al. 2020).
  *
  * NOTES (state of issue 13, for whoever continues):
  * - Done: hierarchy for Hex8 box grids (any cell count, dropped cells, XFEM pieces), per
@@ -6,30 +7,31 @@
  *   values again in fcm_mg_setup()), CHOLMOD on the coarsest level, smoothers SGS
  *   (sequential, default), SGS in multicolour order (colour-parallel) and damped Jacobi, all
  *   deterministic for any thread count; V- and W-cycles as solver (fcm_mg_solve) and as a
- *   symmetric CG preconditioner (fcm_mg_operator). Tests in tests/mg/.
- * - Not done (next): Hex20 p-level (Hex20 -> Hex8 on the same grid, then this hierarchy);
- *   scene options solver.preconditioner / solver.method "multigrid" (sim/linsolve.c);
- *   MINRES use (an SPD preconditioner of an indefinite tangent: build mg on K_psd); the
- *   fcm-scaling app (tests/mg/bench.c is its precursor: cholmod, cg-jacobi, cg-mg, mg).
+ *   symmetric CG preconditioner (fcm_mg_operator). Hex20: a p-level to the Hex8 space of the
+ *   same elements (build_level0). Block smoothing of the DOFs around each vertex of a cut
+ *   cell on level 0 (block_smoother_create, block_smooth): without it the Hex20 embedded
+ *   hemisphere stalled at 0.96 per cycle (two-grid on the p-level alone: 0.955, more
+ *   pointwise sweeps did not help; per-element blocks: 0.64-0.84); with it 0.14-0.29 for
+ *   n = 4 ... 24, and Hex8 0.13-0.15 (was 0.17-0.18). Tests in tests/mg/.
  * - Known: with XFEM cuts the V-cycle factor depends on where the cut lies in the grid
- *   (0.2 to 0.7 measured for n = 4 ... 28, not growing with n), also for a cut through the
- *   whole body, so not the cut's end. Diagnosis: small-support copies (pieces holding 0.1 %
- *   to 10 % of a node's support): split hemisphere n = 20 gives 0.69 with the default
- *   constrain_ratio 1e-9 and 1e-3, 0.25 with 0.1 (tests/mg/convergence.c, env-free: use
- *   problem_hemisphere_with). Next: nodal 3x3 block or piece-block (Schwarz) smoothing
- *   near cut cells, as Longva's Schwarz blocks. The Galerkin product and
- *   the hierarchy build are sequential. fcm_mg_setup() needs the same eliminated rows.
+ *   (0.1 to 0.6 measured for n = 4 ... 32 with block smoothing, not growing with n), also for
+ *   a cut through the whole body, so not the cut's end; Dick et al. report 0.75 cut. The
+ *   Galerkin product, the hierarchy build and the block sweep are sequential.
+ *   fcm_mg_setup() needs the same eliminated rows.
  * - Dirichlet: eliminated rows (no off-diagonal entry) and coarse DOFs whose coinciding
  *   fine DOFs are all inactive stay in P (leaving them out made P rank deficient); coarse
  *   ones are decoupled in the Galerkin matrix and get no correction.
  *
- * Data per level l: cells (level 0: the space's elements) with a grid position and 8 corner
- * copies (corner bits dx + 2 dy + 4 dz), copies with a node grid position, the connectivity
- * of the cells (face neighbours), and for l < L-1 the DOF prolongation P_l from level l+1.
+ * Data per grid level l (level 0 on Hex8, levels >= 1 on Hex20, whose level 0 has only its
+ * DOFs, matrix and prolongation): cells (the first grid level: the space's elements) with a
+ * grid position and 8 corner copies (corner bits dx + 2 dy + 4 dz), copies with a node grid
+ * position, the connectivity of the cells (face neighbours), and for l < L-1 the DOF
+ * prolongation P_l from level l+1.
  * DOFs: copy k, component c is row 3k + c of the level matrix on every level (level 0: the
  * space's numbering); inactive rows are the Dirichlet ones. */
 #include "core/core_impl.h"
 #include "fcm/mg.h"
+#include "solve/solve_impl.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -72,8 +74,12 @@ struct fcm_mg {
   int nlev;
   mg_level lev[32];
   fcm_direct *direct;
-  double *spa;     /* dense accumulator, max columns */
-  fcm_index *mark; /* positions, max columns */
+  double *spa;             /* dense accumulator, max columns */
+  fcm_index *mark;         /* positions, max columns */
+  unsigned char *cut_cell; /* per mesh cell: cut by the geometry or a cut surface, or split */
+  fcm_schwarz *blk;        /* level 0 block smoother: the elements of cut cells */
+  int blk_fresh;           /* blk was set up by its creation, for the current values */
+  double *blk_r, *blk_dx;  /* largest block */
 };
 
 fcm_mg_options fcm_mg_options_default(void)
@@ -86,6 +92,7 @@ fcm_mg_options fcm_mg_options_default(void)
   o.cycle_index = 1;
   o.max_levels = 20;
   o.coarse_dofs = 2000;
+  o.block_smoothing = 1;
   return o;
 }
 
@@ -151,6 +158,10 @@ void fcm_mg_destroy(fcm_mg **mg)
   for (int l = 0; l < 32; l++)
     level_free(m->ctx, &m->lev[l]);
   fcm_direct_destroy(&m->direct);
+  fcm_schwarz_destroy(&m->blk);
+  fcm__free(m->ctx, m->cut_cell);
+  fcm__free(m->ctx, m->blk_r);
+  fcm__free(m->ctx, m->blk_dx);
   fcm__free(m->ctx, m->spa);
   fcm__free(m->ctx, m->mark);
   fcm__free(m->ctx, m);
@@ -211,25 +222,93 @@ cleanup:
   return st;
 }
 
+/* Rows of A whose off-diagonal entries are all zero: the eliminated (Dirichlet) ones. */
+static void eliminated_rows(const fcm_csr *A, fcm_index n, unsigned char *inactive)
+{
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const double *v = fcm_csr_values_read(A);
+  for (fcm_index i = 0; i < n; i++) {
+    int off = 0;
+    for (fcm_index p = rp[i]; p < rp[i + 1] && !off; p++)
+      off = ci[p] != i && v[p] != 0.0;
+    inactive[i] = (unsigned char)!off;
+  }
+}
+
+/* P (F->n x C->n) from per-row lists of (column, weight) pairs, at most `width` per row
+ * (column -1: none), and R = P^T. */
+static fcm_status transfer_from_rows(fcm_ctx *ctx, mg_level *F, fcm_index ncoarse, int width,
+                                     const fcm_index *col, const double *w)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *fill = NULL;
+  FCM_ALLOC(ctx, F->n + 1, F->P_ptr);
+  for (fcm_index i = 0; i < F->n; i++) {
+    fcm_index c = 0;
+    for (int j = 0; j < width; j++)
+      c += col[(fcm_index)width * i + j] >= 0;
+    F->P_ptr[i + 1] = F->P_ptr[i] + c;
+  }
+  const fcm_index nnz = F->P_ptr[F->n];
+  FCM_ALLOC(ctx, nnz + 1, F->P_col);
+  FCM_ALLOC(ctx, nnz + 1, F->P_val);
+  for (fcm_index i = 0, q = 0; i < F->n; i++)
+    for (int j = 0; j < width; j++)
+      if (col[(fcm_index)width * i + j] >= 0) {
+        F->P_col[q] = (int)col[(fcm_index)width * i + j];
+        F->P_val[q++] = w[(fcm_index)width * i + j];
+      }
+  FCM_ALLOC(ctx, ncoarse + 2, F->R_ptr);
+  FCM_ALLOC(ctx, nnz + 1, F->R_col);
+  FCM_ALLOC(ctx, nnz + 1, F->R_val);
+  FCM_ALLOC(ctx, ncoarse + 1, fill);
+  for (fcm_index p = 0; p < nnz; p++)
+    F->R_ptr[F->P_col[p] + 1]++;
+  for (fcm_index J = 0; J < ncoarse; J++)
+    F->R_ptr[J + 1] += F->R_ptr[J];
+  for (fcm_index i = 0; i < F->n; i++)
+    for (fcm_index p = F->P_ptr[i]; p < F->P_ptr[i + 1]; p++) {
+      const fcm_index J = F->P_col[p];
+      F->R_col[F->R_ptr[J] + fill[J]] = (int)i;
+      F->R_val[F->R_ptr[J] + fill[J]++] = F->P_val[p];
+    }
+cleanup:
+  fcm__free(ctx, fill);
+  return st;
+}
+
+/* Level 0 is the space. On Hex8 it is also the first grid level: its cells are the space's
+ * elements, its copies the space's copies. On Hex20 the first grid level is level 1, the
+ * p-coarse Hex8 space on the same grid: the same elements (pieces) with the copies they use
+ * at their 8 corners; a copy that some element uses at a corner is a coarse copy and its
+ * fine DOFs take its value, a mid-edge copy takes the mean of the corner copies at the ends
+ * of its edge in the first element that uses it at its own node (trilinear fields are in
+ * the serendipity space, so this is exact for them). */
 static fcm_status build_level0(fcm_mg *m, const fcm_csr *A)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
   const fcm_space *sp = m->space;
-  mg_level *L = &m->lev[0];
   const fcm_mesh *mesh = fcm_space_mesh(sp);
+  const fcm_element_type type = fcm_mesh_element_type(mesh);
+  const int hex20 = type == FCM_ELEMENT_HEX20;
+  mg_level *L0 = &m->lev[0], *L = hex20 ? &m->lev[1] : L0; /* L: the first grid level */
   const fcm_index nnode = fcm_mesh_num_nodes(mesh), ncells = fcm_mesh_num_cells(mesh);
   const fcm_index *cells = fcm_mesh_cells(mesh);
   const double *X = fcm_mesh_coords(mesh);
   const fcm_cell_rules *rules = fcm_space_cell_rules(sp);
   const fcm_index nl = rules ? fcm_cell_rules_num_links(rules) : 0;
   const fcm_index *links = rules ? fcm_cell_rules_links(rules) : NULL;
-  fcm_index *node_ijk = NULL, *cell_ijk = NULL, *grid = NULL, *edges = NULL;
+  fcm_index *node2 = NULL, *cell_ijk = NULL, *grid = NULL, *edges = NULL, *copy_node = NULL,
+            *cmap = NULL, *pcol = NULL;
+  double *pw = NULL;
   unsigned char *cut = NULL;
   fcm_index nedge = 0, cap = 0;
-  FCM_CHECK(fcm_mesh_element_type(mesh) == FCM_ELEMENT_HEX8, ctx, FCM_ERR_UNSUPPORTED,
-            "mg: needs a Hex8 box grid (fcm_mesh_create_box), the mesh has element type %d",
-            (int)fcm_mesh_element_type(mesh));
+  FCM_CHECK(type == FCM_ELEMENT_HEX8 || hex20, ctx, FCM_ERR_UNSUPPORTED,
+            "mg: needs a Hex8 or Hex20 box grid (fcm_mesh_create_box), the mesh has %s elements",
+            fcm_element_get_info(type) ? fcm_element_get_info(type)->name : "unknown");
+  const int npc = fcm_element_get_info(type)->num_nodes;
   FCM_CHECK(ncells > 0, ctx, FCM_ERR_ARG, "mg: the mesh has no cells");
   /* grid spacing from cell 0, origin from the bounding box */
   double lo[3], hi[3], h[3];
@@ -244,17 +323,20 @@ static fcm_status build_level0(fcm_mg *m, const fcm_csr *A)
     FCM_CHECK(h[d] > 0.0, ctx, FCM_ERR_UNSUPPORTED, "mg: cell 0 has no extent along axis %d", d);
     L->grid[d] = (fcm_index)llround((hi[d] - lo[d]) / h[d]);
   }
-  FCM_ALLOC(ctx, 3 * nnode + 1, node_ijk);
+  if (hex20) L0->grid[0] = L->grid[0], L0->grid[1] = L->grid[1], L0->grid[2] = L->grid[2];
+  /* node positions on the half grid: corners at even, mid-edge nodes at odd coordinates */
+  FCM_ALLOC(ctx, 3 * nnode + 1, node2);
   for (fcm_index n = 0; n < nnode; n++)
     for (int d = 0; d < 3; d++) {
-      const double t = (X[3 * n + d] - lo[d]) / h[d];
+      const double t = 2.0 * (X[3 * n + d] - lo[d]) / h[d];
       const fcm_index r = (fcm_index)llround(t);
-      FCM_CHECK(fabs(t - (double)r) < 1e-6 && r >= 0 && r <= L->grid[d], ctx, FCM_ERR_UNSUPPORTED,
+      FCM_CHECK(fabs(t - (double)r) < 2e-6 && r >= 0 && r <= 2 * L->grid[d], ctx,
+                FCM_ERR_UNSUPPORTED,
                 "mg: node %lld is not on the grid of spacing %g along axis %d (not a box grid)",
                 (long long)n, h[d], d);
-      node_ijk[3 * n + d] = r;
+      node2[3 * n + d] = r;
     }
-  /* cell positions and the corner bits of each local node */
+  /* cell positions and the corner bits of each local corner node */
   FCM_ALLOC(ctx, 3 * ncells + 1, cell_ijk);
   const fcm_index gsize = L->grid[0] * L->grid[1] * L->grid[2];
   FCM_ALLOC(ctx, gsize + 1, grid);
@@ -262,22 +344,24 @@ static fcm_status build_level0(fcm_mg *m, const fcm_csr *A)
     grid[g] = -1;
   unsigned char bits_of[8] = {0};
   for (fcm_index c = 0; c < ncells; c++) {
-    const fcm_index *cn = cells + 8 * c;
+    const fcm_index *cn = cells + (fcm_index)npc * c;
     for (int d = 0; d < 3; d++) {
-      fcm_index mn = node_ijk[3 * cn[0] + d];
+      fcm_index mn = node2[3 * cn[0] + d];
       for (int a = 1; a < 8; a++)
-        mn = FCM_MIN(mn, node_ijk[3 * cn[a] + d]);
-      cell_ijk[3 * c + d] = mn;
+        mn = FCM_MIN(mn, node2[3 * cn[a] + d]);
+      FCM_CHECK(mn % 2 == 0, ctx, FCM_ERR_UNSUPPORTED,
+                "mg: cell %lld does not start at a grid node along axis %d", (long long)c, d);
+      cell_ijk[3 * c + d] = mn / 2;
     }
     unsigned seen = 0;
     for (int a = 0; a < 8; a++) {
       int bits = 0;
       for (int d = 0; d < 3; d++) {
-        const fcm_index off = node_ijk[3 * cn[a] + d] - cell_ijk[3 * c + d];
-        FCM_CHECK(off == 0 || off == 1, ctx, FCM_ERR_UNSUPPORTED,
-                  "mg: cell %lld is not a grid cube (node %d off by %lld along axis %d)",
-                  (long long)c, a, (long long)off, d);
-        bits |= (int)off << d;
+        const fcm_index off = node2[3 * cn[a] + d] - 2 * cell_ijk[3 * c + d];
+        FCM_CHECK(off == 0 || off == 2, ctx, FCM_ERR_UNSUPPORTED,
+                  "mg: cell %lld is not a grid cube (node %d off by %g cells along axis %d)",
+                  (long long)c, a, 0.5 * (double)off, d);
+        bits |= (int)(off / 2) << d;
       }
       if (c == 0) bits_of[a] = (unsigned char)bits;
       FCM_CHECK(bits == bits_of[a], ctx, FCM_ERR_UNSUPPORTED,
@@ -292,18 +376,34 @@ static fcm_status build_level0(fcm_mg *m, const fcm_csr *A)
               (long long)grid[g], (long long)c);
     grid[g] = c;
   }
-  /* copies: node positions */
-  L->ncopy = fcm_space_num_dofs(sp) / 3;
-  FCM_ALLOC(ctx, 3 * L->ncopy + 1, L->copy_ijk);
+  /* the space's copies: their nodes; the grid level's copies (cmap: space copy -> grid
+   * level copy, -1 for copies no element uses at a corner; the identity on Hex8) */
+  const fcm_index nk = fcm_space_num_dofs(sp) / 3;
+  L->ncell = fcm_space_num_elements(sp);
+  FCM_ALLOC(ctx, nk + 1, copy_node);
+  FCM_ALLOC(ctx, nk + 1, cmap);
   for (fcm_index nd = 0; nd < nnode; nd++) {
     const fcm_index k0 = fcm_space_node_dof(sp, nd), nc = fcm_space_node_copies(sp, nd);
-    if (k0 < 0) continue;
-    for (fcm_index c = 0; c < nc; c++)
-      for (int d = 0; d < 3; d++)
-        L->copy_ijk[3 * (k0 / 3 + c) + d] = node_ijk[3 * nd + d];
+    for (fcm_index c = 0; k0 >= 0 && c < nc; c++)
+      copy_node[k0 / 3 + c] = nd;
   }
+  for (fcm_index k = 0; k < nk; k++)
+    cmap[k] = hex20 ? -1 : k;
+  if (hex20) {
+    for (fcm_index e = 0; e < L->ncell; e++)
+      for (int a = 0; a < 8; a++)
+        cmap[fcm_space_element_dofs(sp, e)[a] / 3] = 0;
+    L->ncopy = 0;
+    for (fcm_index k = 0; k < nk; k++)
+      if (cmap[k] == 0) cmap[k] = L->ncopy++;
+  } else {
+    L->ncopy = nk;
+  }
+  FCM_ALLOC(ctx, 3 * L->ncopy + 1, L->copy_ijk);
+  for (fcm_index k = 0; k < nk; k++)
+    for (int d = 0; cmap[k] >= 0 && d < 3; d++) /* mid-edge copies (constraint targets): the */
+      L->copy_ijk[3 * cmap[k] + d] = node2[3 * copy_node[k] + d] / 2; /* grid node below */
   /* elements */
-  L->ncell = fcm_space_num_elements(sp);
   FCM_ALLOC(ctx, 3 * L->ncell + 1, L->ijk);
   FCM_ALLOC(ctx, 8 * L->ncell + 1, L->corner);
   FCM_ALLOC(ctx, 8 * L->ncell + 1, L->own);
@@ -316,11 +416,8 @@ static fcm_status build_level0(fcm_mg *m, const fcm_csr *A)
     for (int a = 0; a < 8; a++) {
       const fcm_index k = ed[a] / 3;
       const int b = bits_of[a];
-      L->corner[8 * e + b] = k;
-      int same = 1;
-      for (int d = 0; d < 3; d++)
-        same &= L->copy_ijk[3 * k + d] == node_ijk[3 * cells[8 * c + a] + d];
-      L->own[8 * e + b] = (unsigned char)same;
+      L->corner[8 * e + b] = cmap[k];
+      L->own[8 * e + b] = (unsigned char)(copy_node[k] == cells[(fcm_index)npc * c + a]);
     }
     fcm_index first = 0;
     if (fcm_space_cell_elements(sp, c, &first) > 1) cut[c] = 1;
@@ -368,30 +465,68 @@ static fcm_status build_level0(fcm_mg *m, const fcm_csr *A)
     }
   }
   FCM_TRY(ctx, graph_from_edges(ctx, L->ncell, nedge, edges, &L->adj_ptr, &L->adj));
-  /* DOFs: the space's numbering; eliminated rows (no off-diagonal entry) */
-  L->A = A;
-  L->n = 3 * L->ncopy;
-  FCM_ALLOC(ctx, L->n + 1, L->dof);
-  FCM_ALLOC(ctx, L->n + 1, L->inactive);
-  for (fcm_index i = 0; i < L->n; i++)
-    L->dof[i] = i;
-  {
-    const fcm_index *rp = fcm_csr_row_ptr(A);
-    const int *ci = fcm_csr_col_idx(A);
-    const double *v = fcm_csr_values_read(A);
-    for (fcm_index i = 0; i < L->n; i++) {
-      int off = 0;
-      for (fcm_index p = rp[i]; p < rp[i + 1] && !off; p++)
-        off = ci[p] != i && v[p] != 0.0;
-      L->inactive[i] = (unsigned char)!off;
+  /* level 0 DOFs: the space's numbering; eliminated rows (no off-diagonal entry) */
+  L0->A = A;
+  L0->n = 3 * nk;
+  L0->ncopy = nk;
+  L0->ncell = L->ncell;
+  FCM_ALLOC(ctx, L0->n + 1, L0->dof);
+  FCM_ALLOC(ctx, L0->n + 1, L0->inactive);
+  for (fcm_index i = 0; i < L0->n; i++)
+    L0->dof[i] = i;
+  eliminated_rows(A, L0->n, L0->inactive);
+  if (hex20) {
+    /* the grid level's DOFs: inactive where the coinciding fine DOF is eliminated */
+    L->n = 3 * L->ncopy;
+    FCM_ALLOC(ctx, L->n + 1, L->dof);
+    FCM_ALLOC(ctx, L->n + 1, L->inactive);
+    for (fcm_index i = 0; i < L->n; i++)
+      L->dof[i] = i;
+    for (fcm_index k = 0; k < nk; k++)
+      for (int c = 0; cmap[k] >= 0 && c < 3; c++)
+        L->inactive[3 * cmap[k] + c] = L0->inactive[3 * k + c];
+    /* prolongation: a corner copy from itself, a mid-edge copy from its edge's ends */
+    const fcm_element_info *info = fcm_element_get_info(type);
+    FCM_ALLOC(ctx, 2 * L0->n + 1, pcol);
+    FCM_ALLOC(ctx, 2 * L0->n + 1, pw);
+    for (fcm_index i = 0; i < 2 * L0->n; i++)
+      pcol[i] = -1;
+    for (fcm_index k = 0; k < nk; k++)
+      for (int c = 0; cmap[k] >= 0 && c < 3; c++)
+        pcol[2 * (3 * k + c)] = 3 * cmap[k] + c, pw[2 * (3 * k + c)] = 1.0;
+    for (fcm_index e = 0; e < L->ncell; e++) {
+      const fcm_index *ed = fcm_space_element_dofs(sp, e);
+      const fcm_index *cn = cells + (fcm_index)npc * fcm_space_element_cell(sp, e);
+      for (int j = 0; j < info->num_edges; j++) {
+        const int a = info->edge_nodes[j][2];
+        const fcm_index k = ed[a] / 3;
+        if (cmap[k] >= 0 || copy_node[k] != cn[a] || pcol[6 * k] >= 0) continue;
+        for (int c = 0; c < 3; c++)
+          for (int t = 0; t < 2; t++) {
+            pcol[2 * (3 * k + c) + t] = 3 * cmap[ed[info->edge_nodes[j][t]] / 3] + c;
+            pw[2 * (3 * k + c) + t] = 0.5;
+          }
+      }
     }
+    FCM_TRY(ctx, transfer_from_rows(ctx, L0, L->n, 2, pcol, pw));
   }
 cleanup:
-  fcm__free(ctx, node_ijk);
+  fcm__free(ctx, node2);
   fcm__free(ctx, cell_ijk);
   fcm__free(ctx, grid);
   fcm__free(ctx, edges);
+  if (st == FCM_OK) {
+    /* cells of the geometry's boundary too: the block smoother's cells */
+    for (fcm_index c = 0; rules && c < ncells; c++)
+      if (fcm_cell_rules_class(rules, c) == FCM_CELL_CUT) cut[c] = 1;
+    m->cut_cell = cut;
+    cut = NULL;
+  }
   fcm__free(ctx, cut);
+  fcm__free(ctx, copy_node);
+  fcm__free(ctx, cmap);
+  fcm__free(ctx, pcol);
+  fcm__free(ctx, pw);
   return st;
 }
 
@@ -849,6 +984,79 @@ cleanup:
 
 /* ------------------------------------------------------------------ create / setup */
 
+/* The level 0 block smoother: one block per grid vertex of the cut cells (de Prenter et
+ * al. 2019): the DOFs of the copies whose support lies in the vertex's patch of 8 cells, the
+ * vertex's own and (Hex20) those of the mid-edge nodes of the edges at the vertex, all
+ * copies together; each block inverted by the clamped eigen-inverse of fcm_schwarz (Longva
+ * et al. 2020, §5.2). */
+static int cmp_pair(const void *a, const void *b)
+{
+  const fcm_index *x = a, *y = b;
+  return x[0] != y[0] ? (x[0] > y[0]) - (x[0] < y[0]) : (x[1] > y[1]) - (x[1] < y[1]);
+}
+
+static fcm_status block_smoother_create(fcm_mg *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  const fcm_space *sp = m->space;
+  const fcm_mesh *mesh = fcm_space_mesh(sp);
+  const fcm_element_info *info = fcm_element_get_info(fcm_mesh_element_type(mesh));
+  const int npc = info->num_nodes, mid = npc > 8;
+  const fcm_index *cells = fcm_mesh_cells(mesh), nnode = fcm_mesh_num_nodes(mesh);
+  const fcm_index ne = fcm_space_num_elements(sp);
+  fcm_index nb = 0, np = 0, *ptr = NULL, *dofs = NULL, *pairs = NULL;
+  unsigned char *mark = NULL;
+  FCM_ALLOC(ctx, nnode + 1, mark);
+  for (fcm_index e = 0; e < ne; e++) {
+    const fcm_index c = fcm_space_element_cell(sp, e);
+    if (!m->cut_cell[c]) continue;
+    for (int a = 0; a < 8; a++)
+      mark[cells[(fcm_index)npc * c + a]] = 1;
+  }
+  FCM_ALLOC(ctx, 2 * (size_t)ne * 8 * (mid ? 4 : 1) + 1, pairs);
+  for (fcm_index e = 0; e < ne; e++) {
+    const fcm_index c = fcm_space_element_cell(sp, e), *ed = fcm_space_element_dofs(sp, e);
+    for (int a = 0; a < 8; a++) {
+      const fcm_index v = cells[(fcm_index)npc * c + a];
+      if (!mark[v]) continue;
+      pairs[2 * np] = v, pairs[2 * np + 1] = ed[a] / 3, np++;
+      for (int j = 0; mid && j < info->num_edges; j++)
+        if (info->edge_nodes[j][0] == a || info->edge_nodes[j][1] == a)
+          pairs[2 * np] = v, pairs[2 * np + 1] = ed[info->edge_nodes[j][2]] / 3, np++;
+    }
+  }
+  if (np == 0) goto cleanup;
+  qsort(pairs, (size_t)np, 2 * sizeof *pairs, cmp_pair);
+  fcm_index nu = 0;
+  for (fcm_index i = 0; i < np; i++)
+    if (i == 0 || pairs[2 * i] != pairs[2 * nu - 2] || pairs[2 * i + 1] != pairs[2 * nu - 1])
+      pairs[2 * nu] = pairs[2 * i], pairs[2 * nu + 1] = pairs[2 * i + 1], nu++;
+  for (fcm_index i = 0; i < nu; i++)
+    nb += i == 0 || pairs[2 * i] != pairs[2 * i - 2];
+  FCM_ALLOC(ctx, nb + 1, ptr);
+  FCM_ALLOC(ctx, 3 * nu + 1, dofs);
+  fcm_index maxm = 0;
+  for (fcm_index i = 0, k = 0; i < nu; i++) {
+    if (i > 0 && pairs[2 * i] != pairs[2 * i - 2]) ptr[++k] = 3 * i;
+    for (int d = 0; d < 3; d++)
+      dofs[3 * i + d] = 3 * pairs[2 * i + 1] + d;
+  }
+  ptr[nb] = 3 * nu;
+  for (fcm_index k = 0; k < nb; k++)
+    maxm = FCM_MAX(maxm, ptr[k + 1] - ptr[k]);
+  FCM_ALLOC(ctx, maxm + 1, m->blk_r);
+  FCM_ALLOC(ctx, maxm + 1, m->blk_dx);
+  FCM_TRY(ctx, fcm_schwarz_create(ctx, m->lev[0].A, nb, ptr, dofs, NULL, &m->blk));
+  m->blk_fresh = 1;
+cleanup:
+  fcm__free(ctx, ptr);
+  fcm__free(ctx, dofs);
+  fcm__free(ctx, pairs);
+  fcm__free(ctx, mark);
+  return st;
+}
+
 fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
                          const fcm_mg_options *opts, fcm_mg **mg)
 {
@@ -887,6 +1095,17 @@ fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
   FCM_TRY(ctx, build_level0(m, A));
   FCM_TRY(ctx, level_diag(m, &m->lev[0]));
   m->nlev = 1;
+  if (m->lev[1].ncell > 0) { /* Hex20: the p-coarse Hex8 level */
+    if (o.max_levels >= 2) {
+      m->nlev = 2;
+    } else { /* the space alone, solved directly */
+      level_free(ctx, &m->lev[1]);
+      mg_level *L0 = &m->lev[0];
+      fcm__free(ctx, L0->P_ptr), fcm__free(ctx, L0->P_col), fcm__free(ctx, L0->P_val);
+      fcm__free(ctx, L0->R_ptr), fcm__free(ctx, L0->R_col), fcm__free(ctx, L0->R_val);
+      L0->P_ptr = L0->R_ptr = NULL, L0->P_col = L0->R_col = NULL, L0->P_val = L0->R_val = NULL;
+    }
+  }
   while (m->nlev < o.max_levels && m->lev[m->nlev - 1].n > o.coarse_dofs) {
     const mg_level *F = &m->lev[m->nlev - 1];
     if (F->grid[0] <= 1 && F->grid[1] <= 1 && F->grid[2] <= 1) break;
@@ -931,6 +1150,7 @@ fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
   if (o.smoother == FCM_MG_SMOOTHER_SGS_COLORED)
     for (int l = 0; l + 1 < m->nlev; l++)
       if (!m->lev[l].color_ptr) FCM_TRY(ctx, level_colors(m, &m->lev[l]));
+  if (o.block_smoothing && m->nlev > 1) FCM_TRY(ctx, block_smoother_create(m));
   {
     mg_level *Lc = &m->lev[m->nlev - 1];
     FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, level_matrix(Lc), &m->direct));
@@ -965,6 +1185,8 @@ fcm_status fcm_mg_setup(fcm_mg *m)
     }
   }
   FCM_TRY(ctx, level0_dinv(m));
+  if (m->blk && !m->blk_fresh) FCM_TRY(ctx, fcm_schwarz_setup(m->blk, m->lev[0].A));
+  m->blk_fresh = 0;
   for (int l = 0; l + 1 < m->nlev; l++)
     FCM_TRY(ctx, galerkin_values(m, l));
   FCM_TRY(ctx,
@@ -1024,6 +1246,38 @@ static void smooth(const fcm_mg *m, mg_level *L, const double *b, double *x)
   }
 }
 
+/* A symmetric block Gauss-Seidel sweep over the level 0 blocks (forward, then backward):
+ * x_K += S_K (b - A x)_K, block after block. */
+static void block_smooth(const fcm_mg *m, const double *b, double *x)
+{
+  const fcm_csr *A = m->lev[0].A;
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const double *v = fcm_csr_values_read(A);
+  const fcm_index nb = fcm__schwarz_num_blocks(m->blk);
+  double *r = m->blk_r, *dx = m->blk_dx;
+  for (fcm_index t = 0; t < 2 * nb; t++) {
+    const fcm_index k = t < nb ? t : 2 * nb - 1 - t;
+    const fcm_index *d = NULL;
+    const double *S = NULL;
+    const int bm = fcm__schwarz_block(m->blk, k, &d, &S);
+    for (int i = 0; i < bm; i++) {
+      double s = b[d[i]];
+      for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++)
+        s -= v[p] * x[ci[p]];
+      r[i] = s;
+    }
+    for (int i = 0; i < bm; i++) {
+      double s = 0.0;
+      for (int j = 0; j < bm; j++)
+        s += S[(size_t)i * (size_t)bm + (size_t)j] * r[j];
+      dx[i] = s;
+    }
+    for (int i = 0; i < bm; i++)
+      x[d[i]] += dx[i];
+  }
+}
+
 static fcm_status cycle(fcm_mg *m, int l, const double *b, double *x)
 {
   fcm_status st = FCM_OK;
@@ -1034,12 +1288,16 @@ static fcm_status cycle(fcm_mg *m, int l, const double *b, double *x)
   mg_level *C = &m->lev[l + 1];
   for (int s = 0; s < m->opts.pre_smooth; s++)
     smooth(m, L, b, x);
+  if (l == 0 && m->blk && m->opts.pre_smooth > 0) block_smooth(m, b, x);
   /* r = b - A x, b_c = R r */
   fcm_csr_apply(level_matrix(L), -1.0, x, 0.0, L->r);
   const fcm_index n = L->n;
+  const fcm_index nc = C->n;
+#pragma omp parallel for schedule(static) if (n > 4096)
   for (fcm_index i = 0; i < n; i++)
     L->r[i] += b[i];
-  for (fcm_index J = 0; J < C->n; J++) {
+#pragma omp parallel for schedule(static) if (nc > 4096)
+  for (fcm_index J = 0; J < nc; J++) {
     double s = 0.0;
     for (fcm_index p = L->R_ptr[J]; p < L->R_ptr[J + 1]; p++)
       s += L->R_val[p] * L->r[L->R_col[p]];
@@ -1049,14 +1307,16 @@ static fcm_status cycle(fcm_mg *m, int l, const double *b, double *x)
   const int gamma = l + 2 == m->nlev ? 1 : m->opts.cycle_index; /* the coarsest is exact */
   for (int g = 0; g < gamma; g++)
     if ((st = cycle(m, l + 1, C->b, C->x))) return st;
-  for (fcm_index J = 0; J < C->n; J++)
+  for (fcm_index J = 0; J < nc; J++)
     if (C->inactive[J]) C->x[J] = 0.0; /* nothing from the Dirichlet boundary */
+#pragma omp parallel for schedule(static) if (n > 4096)
   for (fcm_index i = 0; i < n; i++) {
     double s = 0.0;
     for (fcm_index p = L->P_ptr[i]; p < L->P_ptr[i + 1]; p++)
       s += L->P_val[p] * C->x[L->P_col[p]];
     x[i] += s;
   }
+  if (l == 0 && m->blk && m->opts.post_smooth > 0) block_smooth(m, b, x);
   for (int s = 0; s < m->opts.post_smooth; s++)
     smooth(m, L, b, x);
   return st;
@@ -1146,13 +1406,18 @@ fcm_status fcm_mg_get_level_info(const fcm_mg *m, int level, fcm_mg_level_info *
   fcm_csr_get_size(level_matrix(L), NULL, NULL, &info->nnz);
   for (int d = 0; d < 3; d++)
     info->grid[d] = L->grid[d];
-  /* bodies: cells joined through shared copies */
+  /* bodies: cells joined through shared copies (Hex20 level 0: the space's elements) */
   FCM_ALLOC(ctx, L->ncell + L->ncopy + 1, uf);
   for (fcm_index i = 0; i < L->ncell + L->ncopy; i++)
     uf[i] = i;
+  const int npc = fcm_element_get_info(fcm_mesh_element_type(fcm_space_mesh(m->space)))->num_nodes;
   for (fcm_index c = 0; c < L->ncell; c++)
-    for (int b = 0; b < 8; b++)
-      uf_union(uf, c, L->ncell + L->corner[8 * c + b]);
+    if (L->corner)
+      for (int b = 0; b < 8; b++)
+        uf_union(uf, c, L->ncell + L->corner[8 * c + b]);
+    else
+      for (int a = 0; a < npc; a++)
+        uf_union(uf, c, L->ncell + fcm_space_element_dofs(m->space, c)[a] / 3);
   fcm_index nb = 0;
   for (fcm_index c = 0; c < L->ncell; c++)
     nb += uf_find(uf, c) == c;

@@ -404,6 +404,18 @@ cleanup:
   return st;
 }
 
+fcm_index fcm__schwarz_num_blocks(const fcm_schwarz *P)
+{
+  return P ? P->num_blocks : 0;
+}
+
+int fcm__schwarz_block(const fcm_schwarz *P, fcm_index k, const fcm_index **dofs, const double **S)
+{
+  *dofs = P->dofs + P->block_ptr[k];
+  *S = P->S + P->s_off[k];
+  return (int)(P->block_ptr[k + 1] - P->block_ptr[k]);
+}
+
 fcm_status fcm_schwarz_operator(void *user, const double *r, double *z)
 {
   return fcm_schwarz_apply((const fcm_schwarz *)user, r, z);

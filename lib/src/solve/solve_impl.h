@@ -10,4 +10,10 @@
 /* Rows (or blocks) below this count are processed by one thread. */
 #define FCM__SOLVE_PARALLEL_MIN 4096
 
+/* Blocks of an additive Schwarz preconditioner, for smoothers that sweep them one after the
+ * other (mg): the number of blocks, and block k's size m, its DOFs and its dense m x m
+ * S_K (symmetric, row major), valid after a successful setup. */
+fcm_index fcm__schwarz_num_blocks(const fcm_schwarz *P);
+int fcm__schwarz_block(const fcm_schwarz *P, fcm_index k, const fcm_index **dofs, const double **S);
+
 #endif /* FCM_SOLVE_IMPL_H */
