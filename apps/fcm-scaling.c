@@ -454,6 +454,14 @@ static double series_exponent(fcm_element_type type, int body, int s, int clock,
   return fit_slope(m, x, y);
 }
 
+/* Seconds of a row for the estimates: the smaller of wall and CPU time (on a loaded machine
+ * the wall clock grows with the other load, while the CPU time of a single-threaded phase
+ * is what it costs on an idle core). */
+static double est_time(const row *r)
+{
+  return fmin(r->setup_s + r->solve_s, r->setup_cpu + r->solve_cpu);
+}
+
 /* Estimated wall seconds and extra MB of solver s at `dofs` from its measured rows of the
  * series (the last size scaled by the DOF ratio; the exponent fitted over the last two sizes
  * when both exist, else the default); 0 when nothing is measured yet. */
@@ -468,13 +476,13 @@ static void estimate(fcm_element_type type, int body, int s, fcm_index dofs, dou
   if (m >= 2 && sr[m - 2]->dofs < a->dofs) {
     const row *z = sr[m - 2];
     const double lr = log((double)a->dofs / (double)z->dofs);
-    const double ta = a->setup_s + a->solve_s, tz = z->setup_s + z->solve_s;
+    const double ta = est_time(a), tz = est_time(z);
     const double ma = a->peak_mb - a->base_mb, mz = z->peak_mb - z->base_mb;
     if (ta > 0.05 && tz > 0.05) te = fmin(fmax(log(ta / tz) / lr, 1.0), 3.0);
     if (ma > 20.0 && mz > 20.0) me = fmin(fmax(log(ma / mz) / lr, 1.0), 2.0);
   }
   const double ratio = (double)dofs / (double)a->dofs;
-  *t = (a->setup_s + a->solve_s) * pow(ratio, te);
+  *t = est_time(a) * pow(ratio, te);
   *mb = a->peak_mb >= 0.0 ? (a->peak_mb - a->base_mb) * pow(ratio, me) : 0.0;
 }
 
@@ -954,8 +962,9 @@ static void usage(FILE *f, const cli_option *opts)
       "x_cholmod||/||x_cholmod||),setup_cpu_s,solve_cpu_s (process CPU, all threads),\n"
       "base_rss_mb (resident before the row),levels (multigrid levels),note (why skipped or\n"
       "failed).\n"
-      "Before each size a solver is skipped (and at every larger size) when its time, scaled\n"
-      "from the previous sizes, would exceed --budget, or its memory would exceed\n"
+      "Before each size a solver is skipped (and at every larger size) when its time (the\n"
+      "smaller of wall and CPU seconds: load-independent), scaled from the previous sizes,\n"
+      "would exceed --budget, or its memory would exceed\n"
       "--mem-fraction of MemAvailable; the problem itself likewise. Rows say what was skipped\n"
       "and why. Progress goes to stderr.\n"
       "Default: hex8 and hex20, n = 8,16,32,64, all bodies and solvers. --quick: hex8, n =\n"
