@@ -963,7 +963,7 @@ static void usage(FILE *f, const cli_option *opts)
       "base_rss_mb (resident before the row),levels (multigrid levels),note (why skipped or\n"
       "failed).\n"
       "Before each size a solver is skipped (and at every larger size) when its time (the\n"
-      "smaller of wall and CPU seconds: load-independent), scaled from the previous sizes,\n"
+      "smaller of wall and CPU seconds: less sensitive to load), scaled from the previous sizes,\n"
       "would exceed --budget, or its memory would exceed\n"
       "--mem-fraction of MemAvailable; the problem itself likewise. Rows say what was skipped\n"
       "and why. Progress goes to stderr.\n"
