@@ -601,7 +601,7 @@ static int write_png(const settings *o)
           "the solution (legend: fitted exponents of setup+solve / solve alone)'\n",
           o->clock == CLOCK_CPU ? "CPU" : "wall");
     else
-      ADD("set logscale x\nunset logscale y\nset ylabel 'iterations (cycles)'\nset title "
+      ADD("set logscale xy\nset ylabel 'iterations (cycles)'\nset title "
           "'iterations to rtol %.0e'\nset key top left font ',8'\n",
           o->rtol);
     int first = 1;
