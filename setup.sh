@@ -4,6 +4,11 @@
 #   bash setup.sh test    install what is missing, build, run the default test suite
 #   bash setup.sh bench   build and run the benchmarks (ctest label "bench")
 #   bash setup.sh deps    only install the Debian packages
+#   bash setup.sh deps --petsc
+#                         also the optional PETSc + MPI backend's (petsc-dev, openmpi-bin;
+#                         `test --petsc` etc. likewise): the build then finds PETSc through
+#                         pkg-config (CMake option FCM_WITH_PETSC, default AUTO) and the
+#                         default test run includes the mpi-labelled tests
 #   bash setup.sh install-check
 #                         build, install into a temporary prefix, move it, and build and run
 #                         the example host programs (apps/examples) against the installed
@@ -17,6 +22,11 @@ build=${FCM_BUILD_DIR:-$here/build}
 jobs=${FCM_JOBS:-$(nproc 2>/dev/null || echo 2)}
 packages=(build-essential cmake pkg-config libopenblas-dev liblapacke-dev libglpk-dev
           libsuitesparse-dev libcjson-dev libgmsh-dev gnuplot-nox)
+# --petsc (the argument after the command): the PETSc + MPI backend's packages too
+if [ "${2:-}" = "--petsc" ]; then
+  packages+=(petsc-dev openmpi-bin)
+  set -- "$1" "${@:3}"
+fi
 
 deps() {
   local missing=()
@@ -56,12 +66,14 @@ install_check() {
     return 1
   fi
   # a shared libfcm exports the public API (fcm_*) only: no internal fcm__ function, no
-  # symbol of another name (OpenMP's named critical sections aside)
+  # symbol of another name (OpenMP's named critical sections and the linker's section markers
+  # __bss_start, _edata, _end aside: ld exports those depending on the libraries linked, e.g.
+  # with PETSc and MPI)
   local so bad
   so=$(find "$prefix/fcm" -name 'libfcm.so.*' -type f | head -n 1)
   if [ -n "$so" ]; then
     bad=$(nm -D --defined-only "$so" | awk '{print $3}' |
-          grep -vE '^(fcm_[A-Za-z0-9]|\.gomp_critical_user_)' || true)
+          grep -vE '^(fcm_[A-Za-z0-9]|\.gomp_critical_user_|__bss_start$|_edata$|_end$)' || true)
     if [ -n "$bad" ]; then
       echo "install check: libfcm exports symbols outside the public API:" >&2
       echo "$bad" | head -n 20 >&2
@@ -82,6 +94,22 @@ install_check() {
     $(PKG_CONFIG_PATH="$pcdir" pkg-config --cflags --libs fcm)
   "$ex/host_static-pc" "$ex/out-pc" >/dev/null
   [ -s "$ex/out-pc/host_static_surface.vtu" ] && [ -s "$ex/out-pc/host_static_background.vtu" ]
+  # the package says whether the library has the PETSc backend (pkg-config variable petsc,
+  # FCM_HAVE_PETSC of fcmConfig.cmake and fcm/version.h); with it, fcm/petsc.h (mpi.h through
+  # the .pc file's Requires) compiles and links with the same command
+  local have
+  have=$(PKG_CONFIG_PATH="$pcdir" pkg-config --variable=petsc fcm)
+  grep -q "FCM_HAVE_PETSC $have" "$prefix/fcm/include/fcm/version.h"
+  if [ "$have" = 1 ]; then
+    grep -q "set(FCM_HAVE_PETSC ON)" "$pkgdir/fcmConfig.cmake"
+    printf '%s\n' '#include <fcm/petsc.h>' \
+      'int main(void) { return fcm_petsc_options_default().max_iterations > 0 ? 0 : 1; }' \
+      >"$ex/petsc.c"
+    # shellcheck disable=SC2046
+    cc -std=c11 "$ex/petsc.c" -o "$ex/petsc-pc" \
+      $(PKG_CONFIG_PATH="$pcdir" pkg-config --cflags --libs fcm)
+    "$ex/petsc-pc"
+  fi
   # CMake, find_package(fcm)
   cmake -S "$src" -B "$ex/build" -DCMAKE_PREFIX_PATH="$prefix/fcm" >/dev/null
   cmake --build "$ex/build" >/dev/null
@@ -120,7 +148,7 @@ case "${1:-}" in
     (cd "$build" && ctest --output-on-failure -L bench)
     ;;
   *)
-    sed -n '2,13p' "$0"
+    sed -n '2,17p' "$0"
     exit 2
     ;;
 esac

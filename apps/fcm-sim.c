@@ -8,6 +8,9 @@
 #include <fcm/simulation.h>
 
 #include "cli.h"
+#if FCM_HAVE_PETSC
+#include "fcm-sim-petsc.h"
+#endif
 
 #include <errno.h>
 #include <omp.h>
@@ -29,10 +32,13 @@ typedef struct scene_options {
   int check, quiet, print_scene;
   int debug;    /* print the library's traceback with errors */
   int progress; /* progress of the cell rules also when stderr is not a terminal */
+  int backend;  /* 0 serial, 1 petsc */
 } scene_options;
 
+static const char *const backend_names[] = {"serial", "petsc", NULL};
+
 /* The option table, writing into `o`. */
-#define SIM_NUM_OPTIONS 10
+#define SIM_NUM_OPTIONS 11
 static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS])
 {
   const cli_option t[SIM_NUM_OPTIONS] = {
@@ -62,6 +68,13 @@ static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS
        0, 0, 0, NULL, NULL, NULL},
       {"--debug", NULL, CLI_FLAG, &o->debug, NULL,
        "print the library's traceback with build errors", 0, 0, 0, NULL, NULL, NULL},
+      {"--backend", NULL, CLI_CHOICE, &o->backend, "NAME",
+       "serial (default) or petsc: distributed over the MPI\n"
+       "processes (mpirun -n 2 fcm-sim scene.json --backend petsc;\n"
+       "a build with PETSc). PETSc options (-ksp_type cg ...) may\n"
+       "follow; linear material, gravity, fixed and motion on\n"
+       "node regions only",
+       0, 0, 0, backend_names, NULL, NULL},
       {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
   memcpy(opts, t, sizeof t);
 }
@@ -150,9 +163,12 @@ static void progress(int tty, long long k, long long n, long long step, long lon
             si->time, si->newton_iterations, eta);
     if (k == n) fputc('\n', stderr);
   } else {
+    char mg[48] = "";
+    if (si->multigrid_cycles > 0)
+      snprintf(mg, sizeof mg, " multigrid cycles %lld", si->multigrid_cycles);
     fprintf(stderr,
-            "fcm-sim: step %lld/%lld t=%.6g s newton %d linear %lld residual %.3e (%.3f s)\n", step,
-            total, si->time, si->newton_iterations, si->linear_iterations, si->residual,
+            "fcm-sim: step %lld/%lld t=%.6g s newton %d linear %lld%s residual %.3e (%.3f s)\n",
+            step, total, si->time, si->newton_iterations, si->linear_iterations, mg, si->residual,
             si->time_total);
   }
 }
@@ -235,11 +251,65 @@ static int write_checkpoint(fcm_ctx *ctx, fcm_simulation *sim, const char *dir, 
   return 1;
 }
 
+/* --backend petsc: the PETSc options of the command line (a single dash and a word, "-ksp_type",
+ * with the value after it unless that is an option) are moved from argv into pargv (after the
+ * program name); argv keeps fcm-sim's own. Without --backend petsc nothing moves (an unknown
+ * option stays an error). */
+static void split_petsc_args(int *argc, char **argv, int *pargc, char **pargv)
+{
+  int petsc = 0, n = 1, m = 1;
+  for (int i = 1; i < *argc; i++)
+    if (strcmp(argv[i], "--backend=petsc") == 0 ||
+        (strcmp(argv[i], "--backend") == 0 && i + 1 < *argc && strcmp(argv[i + 1], "petsc") == 0))
+      petsc = 1;
+  pargv[0] = argv[0];
+  *pargc = 1;
+  if (!petsc) return;
+  for (int i = 1; i < *argc; i++) {
+    const char *a = argv[i];
+    const int opt = a[0] == '-' && a[1] != '-' && a[1] != '\0' && a[2] != '\0';
+    if (!opt) {
+      argv[n++] = argv[i];
+      continue;
+    }
+    pargv[m++] = argv[i];
+    const char *b = i + 1 < *argc ? argv[i + 1] : NULL;
+    if (b && !(b[0] == '-' &&
+               ((b[1] >= 'a' && b[1] <= 'z') || (b[1] >= 'A' && b[1] <= 'Z') || b[1] == '-')))
+      pargv[m++] = argv[++i];
+  }
+  *argc = n;
+  *pargc = m;
+  pargv[m] = NULL;
+}
+
 static int scene_main(int argc, char **argv)
 {
-  scene_options o = {NULL, NULL, NULL, 0, -1, 0, 0, 0, 0, 0};
+  scene_options o = {NULL, NULL, NULL, 0, -1, 0, 0, 0, 0, 0, 0};
+  int pargc = 1;
+  char **pargv = calloc((size_t)argc + 1, sizeof *pargv);
+  if (!pargv) return 1;
+  split_petsc_args(&argc, argv, &pargc, pargv);
   const int parsed = parse_scene_args(argc, argv, &o);
-  if (parsed >= 0) return parsed;
+  if (parsed >= 0 || o.backend == 1) {
+    int rc = parsed;
+    if (parsed < 0) {
+#if FCM_HAVE_PETSC
+      rc = o.print_scene ? (fprintf(stderr, "fcm-sim: --backend petsc: --print-scene is the "
+                                            "serial backend's (drop --backend)\n"),
+                            2)
+                         : sim_petsc_run(o.path, o.outdir, o.steps, o.check, o.quiet,
+                                         o.check ? 0 : o.checkpoint_every, o.resume, pargc, pargv);
+#else
+      fprintf(stderr, "fcm-sim: --backend petsc: this fcm was built without PETSc (CMake option "
+                      "FCM_WITH_PETSC; Debian: bash setup.sh deps --petsc, then rebuild)\n");
+      rc = 2;
+#endif
+    }
+    free(pargv);
+    return rc;
+  }
+  free(pargv);
   int rc = 1;
   fcm_ctx *ctx = NULL;
   fcm_scene *scene = NULL;

@@ -30,7 +30,8 @@ fcm_add_test(app_sim_default tests/apps/sim_app.c LABELS app slow TIMEOUT 1200
 # app_sim_default_quick already runs, so its --check is labelled slow. surface_drop embeds an
 # OBJ surface, tetrahedralized with Gmsh: only when fcm was built with it.
 set(fcm_check_scenes spinning_body slingshot hollow_ball static_beam cantilever twisting_cylinder
-    voxel_block gyroid_lattice cut_slab dice cracked_beam clamped_surface)
+    voxel_block gyroid_lattice cut_slab dice cracked_beam clamped_surface hollow_ball_multigrid
+    vibrating_beam)
 if(FCM_HAVE_GMSH)
   list(APPEND fcm_check_scenes surface_drop)
 endif()

@@ -41,3 +41,6 @@ fcm_add_test(embed_kinds tests/embed/kinds.c)
 fcm_add_test(embed_xfem_random tests/embed/cut.c ARGS campaign 300 1)
 fcm_add_test(embed_xfem_random_long tests/embed/cut.c ARGS campaign 20000 11 LABELS slow
              TIMEOUT 3600)
+# cell_mask: unflagged cells classified without points, flagged ones as without a mask (the
+# distributed build of fcm/petsc.h); the one-element assembly sums to the space's.
+fcm_add_test(embed_cell_mask tests/embed/cell_mask.c)

@@ -1,6 +1,7 @@
 /* Checkpoints of scene runs: for a static run with load steps, surface loads and CG with
  * Schwarz blocks, a dynamic nonlinear run with damping, a released motion and MINRES, and a
- * free spinning body with the direct solver, and a spinning body cut in two during the run
+ * free spinning body with the direct solver, the dynamic run on Hex8 with MINRES and the
+ * multigrid preconditioner, and a spinning body cut in two during the run
  * (checkpoints before and after the cut), running K steps, saving, restoring into a new
  * simulation and running on gives bit for bit the state, time and per-step log (but wall
  * times) of the uninterrupted run. Error paths: restoring into a stepped simulation, a
@@ -42,6 +43,24 @@ static const char dynamic_json[] =
     " \"material\": {\"model\": \"snh\", \"young\": 1e5, \"poisson\": 0.4, \"density\": 1000},"
     " \"solver\": {\"method\": \"minres\", \"preconditioner\": \"schwarz\", \"rtol\": 1e-8,"
     "   \"max_iterations\": 2000},"
+    " \"time\": {\"dt\": 0.02, \"steps\": 6},"
+    " \"effects\": [{\"gravity\": {}}, {\"damping\": {\"stiffness\": 0.01, \"mass\": 0.1}},"
+    "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, 0, 0]}}}},"
+    "  {\"motion\": {\"region\": {\"half_space\": {\"point\": [1.5, 0, 0], \"normal\": [1, 0, 0]}},"
+    "    \"velocity\": [0, 0, 1], \"end\": 0.06, \"release\": true}}]}";
+
+/* the dynamic run on a Hex8 grid with MINRES preconditioned by the multigrid (issue 13): the
+ * restored run builds its hierarchy anew at its first step, the uninterrupted one had it since
+ * step 1, the motion's release at t = 0.06 rebuilds it in both */
+static const char mg_json[] =
+    "{\"version\": 1, \"name\": \"ck_multigrid\","
+    " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0],"
+    "   \"max\": [1.5, 0.5, 0.5]}, \"cells\": [6, 2, 2]},"
+    " \"geometry\": {\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [1.2, 0.45, 0.4],"
+    "   \"cells\": [3, 1, 1]},"
+    " \"material\": {\"model\": \"snh\", \"young\": 1e5, \"poisson\": 0.4, \"density\": 1000},"
+    " \"solver\": {\"method\": \"minres\", \"preconditioner\": \"multigrid\", \"rtol\": 1e-8,"
+    "   \"max_iterations\": 2000, \"multigrid\": {\"coarse_dofs\": 30}},"
     " \"time\": {\"dt\": 0.02, \"steps\": 6},"
     " \"effects\": [{\"gravity\": {}}, {\"damping\": {\"stiffness\": 0.01, \"mass\": 0.1}},"
     "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, 0, 0]}}}},"
@@ -193,6 +212,7 @@ int main(void)
   if (!ctx || !make_temp_dir(dir, sizeof dir)) return TEST_RESULT();
   check_scene(ctx, static_json, dir, 5);
   check_scene(ctx, dynamic_json, dir, 2);
+  check_scene(ctx, mg_json, dir, 2);
   check_scene(ctx, spin_json, dir, 3);
   check_scene(ctx, cut_json, dir, 1); /* before the cut */
   check_scene(ctx, cut_json, dir, 4); /* after it */

@@ -1,7 +1,8 @@
 /* Allocation failures: failing the k-th allocation (k = 0, 1, ...) anywhere in create,
  * configure, setup and two steps (direct with Rayleigh damping, and MINRES with a Jacobi
- * preconditioner created on first use) gives FCM_ERR_ALLOC, leaks nothing, and a failing
- * step leaves the state where it was; eventually the whole sequence succeeds. */
+ * preconditioner created on first use; MINRES with the multigrid preconditioner and the multigrid
+ * solver with PSD tangents, the hierarchy built on first use) gives FCM_ERR_ALLOC, leaks nothing,
+ * and a failing step leaves the state where it was; eventually the whole sequence succeeds. */
 #include "sim_util.h"
 #include "test_alloc.h"
 
@@ -17,7 +18,10 @@ static fcm_status run(fcm_ctx *ctx, fcm_space *space, fcm_index nfix, const fcm_
   o.dt = 0.01;
   o.rayleigh_mass = 0.1;
   o.rayleigh_stiffness = 1e-3;
-  if (krylov) o.linear_solver = FCM_LINEAR_MINRES, o.preconditioner = FCM_PRECOND_JACOBI;
+  if (krylov == 1) o.linear_solver = FCM_LINEAR_MINRES, o.preconditioner = FCM_PRECOND_JACOBI;
+  if (krylov == 2) o.linear_solver = FCM_LINEAR_MINRES, o.preconditioner = FCM_PRECOND_MULTIGRID;
+  if (krylov == 3) o.linear_solver = FCM_LINEAR_MULTIGRID, o.project_psd = 1;
+  o.multigrid.coarse_dofs = 12; /* two levels on the 2-cell beam */
   *state_ok = 1;
   if ((st = fcm_integrator_create(ctx, space, &mat, &o, &integ))) goto done;
   if ((st = fcm_integrator_add_gravity(integ, g, NULL, NULL))) goto done;
@@ -52,7 +56,7 @@ int main(void)
   fcm_index nfix = 0;
   fcm_index *fix = plane_nodes(ctx, mesh, 0, 0.0, &nfix);
   long long base = fcm_ctx_live_allocations(ctx);
-  for (int krylov = 0; krylov < 2; krylov++) {
+  for (int krylov = 0; krylov < 4; krylov++) {
     int done = 0;
     for (long long k = 0; k < 20000 && !done; k++) {
       f.count = 0;

@@ -7,6 +7,7 @@
  * for every solver path named by argv[1]:
  *   direct       CHOLMOD (symbolic analysis once: total_analyses stays 1)
  *   minres-schwarz, cg-jacobi, minres-jacobi, cg-block   Krylov paths
+ *   minres-mg, cg-mg, mg   multigrid as the preconditioner or the solver (PSD tangent)
  * and each of the ten steps must converge with at least two Newton iterations (so repeated
  * Newton iterations, line searches and solves are what is counted). Frames, logs and
  * checkpoints are not part of a step and are not written here.
@@ -34,6 +35,18 @@ static const char *solver_json(const char *name)
   if (!strcmp(name, "cg-block"))
     return "{\"method\": \"cg\", \"preconditioner\": \"block_jacobi\", \"rtol\": 1e-8, "
            "\"max_iterations\": 2000}";
+  /* multigrid (issue 13): the hierarchy is built at the first step and kept (the constrained
+   * set does not change); later setups recompute its Galerkin matrices in place */
+  if (!strcmp(name, "minres-mg"))
+    return "{\"method\": \"minres\", \"preconditioner\": \"multigrid\", \"multigrid\": "
+           "{\"coarse_dofs\": 20}, \"rtol\": 1e-8, \"max_iterations\": 2000}";
+  if (!strcmp(name, "cg-mg"))
+    return "{\"method\": \"cg\", \"preconditioner\": \"multigrid\", \"multigrid\": "
+           "{\"coarse_dofs\": 20, \"smoother\": \"sgs-colored\"}, \"rtol\": 1e-8, "
+           "\"max_iterations\": 2000}";
+  if (!strcmp(name, "mg"))
+    return "{\"method\": \"multigrid\", \"multigrid\": {\"coarse_dofs\": 20}, \"rtol\": 1e-8, "
+           "\"max_iterations\": 2000, \"newton\": {\"project_psd\": true}}";
   return NULL;
 }
 

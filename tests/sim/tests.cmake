@@ -37,7 +37,7 @@ fcm_sim_test(sim_minres_pc_tangent tests/sim/minres_pc_tangent.c)
 fcm_sim_test(sim_singular tests/sim/singular.c)
 # Issue 15 item 6: steps after the first allocate nothing through the context (direct
 # CHOLMOD with one symbolic analysis, MINRES + Schwarz, CG + Jacobi, CG + block Jacobi).
-foreach(solver direct minres-schwarz cg-jacobi cg-block)
+foreach(solver direct minres-schwarz cg-jacobi cg-block minres-mg cg-mg mg)
   fcm_sim_test(sim_step_alloc_${solver} tests/sim/step_alloc.c ARGS ${solver})
 endforeach()
 fcm_sim_test(sim_step_alloc_direct_tet10 tests/sim/step_alloc.c ARGS direct tet10)

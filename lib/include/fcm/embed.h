@@ -121,6 +121,14 @@ typedef struct fcm_cell_rules_options {
                               thread that called fcm_cell_rules_create() */
   void *progress_user;                 /**< passed to progress; default NULL */
   double progress_interval;            /**< seconds between progress calls, >= 0; default 0.1 */
+  /** NULL (default): every cell's rules; else num_cells flags (read during the call only):
+   * cells flagged 0 are classified as usual (class, volume fraction, pieces and their volumes,
+   * so a space built on the rules has the same elements and DOFs) but get no quadrature points
+   * (no volume or surface rules, no simplification, no stabilization). For distributed runs,
+   * where each process integrates its own cells only (fcm/petsc.h); the rules must then not be
+   * assembled on unflagged cells. Not with FCM_CELL_SIMPLIFY_AUTO (its choice would depend on
+   * the mask); rules built with a mask cannot be cut (fcm_cell_rules_create_cut()). */
+  const unsigned char *cell_mask;
 } fcm_cell_rules_options;
 
 /** Defaults as documented on each member. */

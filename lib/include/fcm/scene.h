@@ -123,10 +123,11 @@ typedef struct fcm_scene_quadrature {
 
 /** Solver settings ("solver"), in the library's own types (fcm/sim.h, fcm/solve.h). */
 typedef struct fcm_scene_solver {
-  fcm_linear_solver method;                    /**< "direct" (default), "minres", "cg" */
+  fcm_linear_solver method;                    /**< "direct" (default), "minres", "cg",
+                                                    "multigrid" (FCM_LINEAR_MULTIGRID) */
   fcm_direct_method direct;                    /**< default FCM_DIRECT_CHOLMOD */
   fcm_preconditioner preconditioner;           /**< Krylov only: "none", "jacobi", "block_jacobi",
-                                                    "schwarz" (default) */
+                                                    "schwarz" (default), "multigrid" */
   fcm_fictitious_model preconditioner_tangent; /**< "preconditioner_tangent": the tangent
                                       the preconditioner is built from, "projected" (default),
                                       "linear", "exact"
@@ -135,9 +136,20 @@ typedef struct fcm_scene_solver {
                                     default 0.5 (fcm_integrator_options.schwarz_theta) */
   fcm_schwarz_options schwarz; /**< epsilon in (0, 1), default 1e-13; clamp "clamp" (default,
                                     FCM_SCHWARZ_CLAMP) or "paper" (FCM_SCHWARZ_PAPER) */
-  double rtol;                 /**< Krylov relative tolerance; [0, 1), default 1e-8 */
+  fcm_mg_options multigrid;    /**< "multigrid": smoother "sgs" (default), "jacobi",
+                                    "sgs-colored"; omega in (0, 2) for SGS (default 1), (0, 1]
+                                    for Jacobi (default 0.6); pre_smooth, post_smooth in
+                                    [0, 100] (default 1 each, at least one step, equal for a
+                                    preconditioner); cycle "v" (default, cycle_index 1) or "w"
+                                    (2); coarse_dofs in [1, 1e9] (default 2000);
+                                    block_smoothing true (default) or false. Used by
+                                    "method": "multigrid" and "preconditioner": "multigrid",
+                                    which need a hex8 or hex20 "grid" background */
+  double rtol;                 /**< Krylov (and multigrid solver) relative tolerance; [0, 1),
+                                    default 1e-8 */
   double atol;                 /**< Krylov absolute tolerance; >= 0, default 0 */
-  int max_iterations;          /**< Krylov iterations; >= 1, default 1000 */
+  int max_iterations;          /**< Krylov iterations (multigrid solver: cycles) per solve;
+                                    >= 1, default 1000 */
   fcm_newton_tolerance newton_rule;   /**< "auto" (default, FCM_NEWTON_TOL_AUTO),
                                            "representative", "relative" */
   double newton_rtol;                 /**< tolerance of the rule; (0, 1), default 1e-5 */
@@ -147,6 +159,10 @@ typedef struct fcm_scene_solver {
   double representative_acceleration; /**< |a_rep| in m/s^2, > 0, default 9.81 */
   int threads; /**< OpenMP threads >= 1; FCM_DEFAULT ("threads": 0, the default): the OpenMP
                     default */
+  const char *petsc_options; /**< "petsc_options": PETSc options for the PETSc backend
+                                  (fcm/petsc.h, `fcm-sim --backend petsc`), e.g. "-ksp_type
+                                  minres -pc_type jacobi"; the command line wins for a key both
+                                  give. NULL (default): none. The serial backend ignores it */
 } fcm_scene_solver;
 
 /** Time stepping ("time"). */

@@ -2,7 +2,8 @@
  * load steps and backward Euler on the incremental potential, Newton with a backtracking
  * line search on the energy, the stopping rule of Longva et al. (2020) §6, optional Rayleigh
  * damping, prescribed motion of node sets and, weakly (Nitsche's method or a penalty), of the
- * embedded-boundary points a selector picks, direct (CHOLMOD -> UMFPACK) or Krylov solves.
+ * embedded-boundary points a selector picks, direct (CHOLMOD -> UMFPACK), Krylov (CG, MINRES)
+ * or multigrid solves (fcm/mg.h: the Krylov preconditioner, or cycles alone).
  *
  * Phases: fcm_integrator_create() -> configure (fcm_integrator_add_*, set_state) ->
  * fcm_integrator_setup() (assembles the mass — dynamics only — and the loads, allocates
@@ -26,6 +27,7 @@
 #include "fcm/fem.h"
 #include "fcm/la.h"
 #include "fcm/material.h"
+#include "fcm/mg.h"
 #include "fcm/solve.h"
 
 #ifdef __cplusplus
@@ -56,7 +58,17 @@ typedef enum fcm_newton_tolerance {
 typedef enum fcm_linear_solver {
   FCM_LINEAR_DIRECT = 0, /**< CHOLMOD; on "not positive definite" UMFPACK */
   FCM_LINEAR_CG = 1,     /**< preconditioned CG (SPD systems) */
-  FCM_LINEAR_MINRES = 2  /**< preconditioned MINRES (symmetric, possibly indefinite) */
+  FCM_LINEAR_MINRES = 2, /**< preconditioned MINRES (symmetric, possibly indefinite) */
+  /** Cut-aware geometric multigrid cycles as the solver (fcm/mg.h, options `multigrid`):
+   * cycles on the Newton matrix itself from d = 0 until ||b - H d|| <= max(krylov_rtol ||b||,
+   * krylov_atol), at most krylov_max_iterations cycles. Needs an SPD Newton matrix: static
+   * steps, or dynamic ones (M/h^2 + K) with a linear material or a PSD tangent (project_psd).
+   * Where it is not SPD the coarsest Cholesky factorization fails, a diagonal is not positive
+   * or the cycles do not converge (stalled or diverging): the solve fails softly
+   * (FCM_STEP_LINEAR_SOLVER_FAILED, a warning names the cause) and the step is retried with
+   * half the increment, like a failed Krylov solve. Needs a Hex8 or Hex20 box grid
+   * (fcm_mg_create()): on another mesh the first step fails with FCM_ERR_UNSUPPORTED. */
+  FCM_LINEAR_MULTIGRID = 3
 } fcm_linear_solver;
 
 /** Preconditioner of the Krylov solvers. */
@@ -64,7 +76,16 @@ typedef enum fcm_preconditioner {
   FCM_PRECOND_NONE = 0,
   FCM_PRECOND_JACOBI = 1,       /**< inverse |diagonal| */
   FCM_PRECOND_BLOCK_JACOBI = 2, /**< inverse nodal 3x3 blocks */
-  FCM_PRECOND_SCHWARZ = 3       /**< additive Schwarz on cut cells with phi < schwarz_theta */
+  FCM_PRECOND_SCHWARZ = 3,      /**< additive Schwarz on cut cells with phi < schwarz_theta */
+  /** One cycle of the cut-aware geometric multigrid (fcm/mg.h, options `multigrid`) from
+   * z = 0, built on the preconditioner's matrix (preconditioner_tangent: the PSD tangent by
+   * default, so also for MINRES on an indefinite Newton matrix). The cycle is an SPD
+   * operator when pre_smooth = post_smooth (checked at setup), as CG and MINRES need. The
+   * hierarchy is built at the first setup and again when the active constrained DOFs change
+   * (the eliminated rows define the multigrid's Dirichlet boundary); later setups only
+   * recompute the Galerkin matrices (fcm_mg_setup()). Needs a Hex8 or Hex20 box grid
+   * (fcm_mg_create()): on another mesh the first step fails with FCM_ERR_UNSUPPORTED. */
+  FCM_PRECOND_MULTIGRID = 4
 } fcm_preconditioner;
 
 /** A Newton iteration as reported to the monitor. */
@@ -75,7 +96,8 @@ typedef struct fcm_newton_event {
   double tolerance;      /**< the threshold of the stopping rule */
   double energy;         /**< E(u) of the (sub)step */
   double step_length;    /**< line-search factor of the update (0 at iteration 0) */
-  int linear_iterations; /**< Krylov iterations of the update (0: direct or iteration 0) */
+  int linear_iterations; /**< Krylov iterations or multigrid cycles (FCM_LINEAR_MULTIGRID)
+                              of the update (0: direct or iteration 0) */
   int constraints_met;   /**< 1 when every constrained DOF sits on its prescribed value */
 } fcm_newton_event;
 
@@ -108,7 +130,7 @@ typedef struct fcm_integrator_options {
   fcm_direct_method direct_method;   /**< first direct method (default CHOLMOD; UMFPACK: LU only) */
   fcm_preconditioner preconditioner; /**< Krylov only (default JACOBI) */
   fcm_fictitious_model preconditioner_tangent; /**< Krylov only: the material tangent the
-      preconditioner (Jacobi, block Jacobi, Schwarz) is built from, while the Krylov
+      preconditioner (Jacobi, block Jacobi, Schwarz, multigrid) is built from, while the Krylov
       operator stays the exact Newton matrix base + K(u). The values of fcm_fictitious_model
       name the tangent models: FCM_FICTITIOUS_PROJECTED (default): base + the PSD-projected
       tangent at the iterate (one more tangent assembly per preconditioner setup); the
@@ -123,6 +145,11 @@ typedef struct fcm_integrator_options {
   double schwarz_theta;          /**< cut cells with volume fraction below it get a block, (0, 1]
                                       (default 0.5) */
   fcm_schwarz_options schwarz;   /**< default fcm_schwarz_options_default() */
+  fcm_mg_options multigrid;      /**< FCM_PRECOND_MULTIGRID and FCM_LINEAR_MULTIGRID: the
+                                      hierarchy's options (default fcm_mg_options_default(),
+                                      ranges as documented there and checked at setup, plus
+                                      pre_smooth + post_smooth >= 1, and pre_smooth =
+                                      post_smooth for the preconditioner) */
   double rayleigh_mass;          /**< alpha_M >= 0 in 1/s (default 0) */
   double rayleigh_stiffness;     /**< beta_K >= 0 in s (default 0) */
   fcm_assembly_options assembly; /**< strengths on full cells (default element defaults) */
@@ -155,7 +182,11 @@ typedef struct fcm_step_info {
   fcm_step_reason reason;         /**< CONVERGED on success; else the last failure */
   int newton_iterations;          /**< Newton updates (all attempts) */
   int line_search_backtracks;     /**< step-length halvings */
-  long long linear_iterations;    /**< Krylov iterations (0 with the direct solver) */
+  long long linear_iterations;    /**< Krylov iterations, or multigrid cycles with
+                                       FCM_LINEAR_MULTIGRID (0 with the direct solver) */
+  long long multigrid_cycles;     /**< multigrid cycles: the preconditioner applications of
+                                       CG/MINRES with FCM_PRECOND_MULTIGRID, or the cycles of
+                                       FCM_LINEAR_MULTIGRID (0 otherwise) */
   double residual;                /**< final ||g|| of the last attempt */
   double tolerance;               /**< its threshold */
   double dt;                      /**< length of the last (sub)step: time (dynamics) or
@@ -382,7 +413,8 @@ FCM_API fcm_status fcm_integrator_setup(fcm_integrator *integ);
  * the assembly workspace, work vectors and the direct solver's symbolic analysis come from
  * the setup; the tabulated standard rule of an integrand the setup did not assemble, the
  * Jacobi/Schwarz preconditioner and the UMFPACK fallback are made the first time they are
- * needed. Later steps allocate nothing through the context (test sim_step_alloc_*);
+ * needed; the multigrid hierarchy then and again whenever the active constrained DOFs
+ * change. Later steps allocate nothing through the context (test sim_step_alloc_*);
  * CHOLMOD's and UMFPACK's numeric factorizations allocate internally (SuiteSparse's malloc).
  * @param[out] info may be NULL
  * @return FCM_OK; FCM_ERR_NOT_CONVERGED (info->reason says why; the message gives the time,
@@ -450,6 +482,12 @@ FCM_API fcm_status fcm_integrator_momentum(fcm_integrator *integ, double linear[
 /** The mass matrix (borrowed): after the setup of a BACKWARD_EULER integrator; NULL before
  * and for STATIC integrators, which never assemble it. */
 FCM_API const fcm_csr *fcm_integrator_mass(const fcm_integrator *integ);
+
+/** The multigrid hierarchy of FCM_PRECOND_MULTIGRID or FCM_LINEAR_MULTIGRID (borrowed; for
+ * fcm_mg_num_levels() and fcm_mg_get_level_info()): NULL before the first preconditioner
+ * setup or solve and without multigrid. Valid until the next fcm_integrator_step() (which may
+ * build it again) or the integrator's destruction. */
+FCM_API const fcm_mg *fcm_integrator_multigrid(const fcm_integrator *integ);
 
 /** What fcm_integrator_setup() assembled (all 0 before the setup). */
 typedef struct fcm_integrator_setup_info {

@@ -59,9 +59,12 @@ typedef struct fcm_simulation_counters {
   fcm_index constrained_dofs;  /**< constrained DOFs after setup */
   fcm_index boundary_points;   /**< embedded-boundary points held by `boundary` constraints */
   fcm_index schwarz_blocks;    /**< cut cells given a Schwarz block (0: no Schwarz set up) */
-  int krylov;                  /**< 1: Krylov solves; 0: direct */
+  int krylov;                  /**< 1: Krylov solves (CG, MINRES); 0: direct or multigrid */
+  int multigrid;               /**< 1: multigrid, as the Krylov preconditioner or the solver */
   long long steps;             /**< accepted steps */
   long long newton_iterations, linear_iterations, tangent_assemblies;
+  long long multigrid_cycles; /**< multigrid cycles (fcm_step_info.multigrid_cycles, summed;
+                                   not in checkpoints: counted from the restore on) */
   long long factorizations; /**< numeric factorizations / preconditioner setups (total) */
   long long analyses;       /**< symbolic analyses (total) */
   long long direct_fallbacks;

@@ -466,6 +466,7 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   double vol = 0.0, *pvol = NULL;
   fcm__parts *P = NULL;
   const int integrate = !B->rebuild || B->rebuild[c];
+  const int own = !opt->cell_mask || opt->cell_mask[c]; /* 0: classified, no points */
   const double t0 = fcm_wtime();
   FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
   if (B->cut_tree && B->region[c]) {
@@ -527,6 +528,10 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
               (long long)c, o->np, (int)R->cls[c],
               (long long)(B->prev->piece_off[c + 1] - B->prev->piece_off[c]), (int)B->prev->cls[c]);
     FCM_TRY(ctx, copy_cell(B, c, o));
+    goto cleanup;
+  }
+  if (!own) { /* classification and piece volumes only (cell_mask) */
+    sums->time_intersect += fcm_wtime() - t0;
     goto cleanup;
   }
   if (cls == FCM_CELL_CUT) {
@@ -592,6 +597,9 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_cell_rules_options *o)
                 kn, o->point_cost[k]);
     }
   }
+  FCM_CHECK(!o->cell_mask || o->simplify != FCM_CELL_SIMPLIFY_AUTO, ctx, FCM_ERR_ARG,
+            "embed: cell_mask with simplify = auto: the choice would depend on the mask (use on "
+            "or off)");
   const int smax = o->simplify ? FCM_SIMPLIFY_MAX_STRENGTH : FCM_RULE_MAX_STRENGTH;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     FCM_CHECK(o->strength[k] >= -1 && o->strength[k] <= smax, ctx, FCM_ERR_ARG,
@@ -1233,6 +1241,8 @@ fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_g
   FCM_TRY(ctx, check_options(ctx, &o));
   FCM_TRY(ctx, rules_alloc(ctx, mesh, &o, &R));
   FCM_TRY(ctx, build_rules(ctx, mesh, geom, NULL, 0, R));
+  R->masked = o.cell_mask != NULL;
+  R->opts.cell_mask = NULL; /* borrowed for the call only */
   *rules = R;
   R = NULL;
 cleanup:
@@ -1273,6 +1283,9 @@ fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const f
                 fcm_mesh_element_type(mesh) == prev->type,
             ctx, FCM_ERR_ARG, "embed cut: the mesh (%lld cells) is not the rules' mesh (%lld)",
             (long long)fcm_mesh_num_cells(mesh), (long long)prev->num_cells);
+  FCM_CHECK(!prev->masked, ctx, FCM_ERR_UNSUPPORTED,
+            "embed cut: the rules were built with a cell_mask (some cells have no points); cut "
+            "rules built for every cell");
   FCM_CHECK(prev->num_cuts < 1 << 20, ctx, FCM_ERR_UNSUPPORTED,
             "embed cut: %d cuts already (limit 2^20)", prev->num_cuts);
   const fcm_index nt = fcm_surface_num_triangles(cut);

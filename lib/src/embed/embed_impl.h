@@ -59,7 +59,8 @@ struct fcm_cell_rules {
    * them), the cut triangles of every cut so far, and the links: pairs of pieces of
    * face-neighbouring cells that share a face of positive area not lying on a cut (only
    * around cut cells: 2 x num_links piece ids, ascending pairs, sorted). */
-  fcm_cell_rules_options opts;
+  fcm_cell_rules_options opts; /* cell_mask reset to NULL after the build */
+  int masked;                  /* built with a cell_mask: unflagged cells have no points */
   int num_cuts;
   fcm_index num_cut_tris;
   fcm__cut_tri *cut_tris;

@@ -858,3 +858,69 @@ fcm_status fcm_space_momentum(const fcm_space *s, double density, const double *
 cleanup:
   return st;
 }
+
+/* ------------------------------------------------------------------ one element */
+
+fcm_status fcm__assembly_element_linear(fcm_assembly_workspace *ws, const fcm_linear_form *form,
+                                        fcm_index elem, double *Ke, double *fe)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = ws ? ws->ctx : NULL;
+  kernel_data kd;
+  pass ps;
+  memset(&kd, 0, sizeof kd);
+  memset(&ps, 0, sizeof ps);
+  FCM_CHECK(ws && form, ctx, FCM_ERR_ARG, "element assembly: NULL workspace or form");
+  const fcm_space *s = ws->space;
+  FCM_CHECK(elem >= 0 && elem < s->num_elems, ctx, FCM_ERR_ARG,
+            "element assembly: element %lld outside [0, %lld)", (long long)elem,
+            (long long)s->num_elems);
+  switch (form->term) {
+  case FCM_LINEAR_STIFFNESS:
+    kd.kind = KERNEL_STIFFNESS;
+    FCM_TRY(ctx, fcm_material_lame(ctx, form->material, &kd.lambda, &kd.mu));
+    break;
+  case FCM_LINEAR_MASS:
+    kd.kind = KERNEL_MASS;
+    FCM_TRY(ctx, fcm_material_lame(ctx, form->material, NULL, NULL));
+    kd.rho = form->material->density;
+    break;
+  case FCM_LINEAR_BODY_FORCE:
+    kd.kind = KERNEL_BODY_FORCE;
+    FCM_TRY(ctx, fcm_material_lame(ctx, form->material, NULL, NULL));
+    FCM_CHECK(form->accel && isfinite(form->accel[0]) && isfinite(form->accel[1]) &&
+                  isfinite(form->accel[2]),
+              ctx, FCM_ERR_ARG, "element assembly: body force without a finite acceleration");
+    kd.rho = form->material->density;
+    memcpy(kd.accel, form->accel, sizeof kd.accel);
+    break;
+  case FCM_LINEAR_BODY_FORCE_FIELD:
+    kd.kind = KERNEL_BODY_FORCE;
+    FCM_CHECK(form->field, ctx, FCM_ERR_ARG, "element assembly: body force field is NULL");
+    kd.field = form->field;
+    kd.field_user = form->user;
+    break;
+  default:
+    FCM_CHECK(0, ctx, FCM_ERR_UNSUPPORTED,
+              "element assembly: term = %d (stiffness, mass, body force and body force field "
+              "only)",
+              (int)form->term);
+  }
+  ps.kind = kd.kind == KERNEL_MASS ? FCM_RULE_MASS : FCM_RULE_STIFFNESS;
+  FCM_CHECK(!s->rules || fcm_cell_rules_has_kind(s->rules, ps.kind), ctx, FCM_ERR_ARG,
+            "element assembly: the space's cell rules have no %s rules",
+            fcm_rule_kind_name(ps.kind));
+  FCM_TRY(ctx, workspace_tabulation(ws, ps.kind, &ps.tab));
+  ps.kd = &kd;
+  scratch *w = ws->sc;
+  cell_result res = volume_cell(s, &ps, elem, w);
+  FCM_CHECK(res.bad_det > 0.0, ctx, FCM_ERR_GEOMETRY,
+            "assembly: cell %lld has det J = %g <= 0 at a quadrature point (inverted or "
+            "degenerate %s)",
+            (long long)s->elem_cell[elem], res.bad_det, fcm_element_get_info(s->type)->name);
+  const size_t ndof = 3 * (size_t)s->nn;
+  if (Ke && kd.kind != KERNEL_BODY_FORCE) memcpy(Ke, w->Ke, sizeof *Ke * ndof * ndof);
+  if (fe && kd.kind == KERNEL_BODY_FORCE) memcpy(fe, w->fe, sizeof *fe * ndof);
+cleanup:
+  return st;
+}

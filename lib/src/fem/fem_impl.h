@@ -64,4 +64,16 @@ double fcm__fem_gradients(int nn, const double *X, const double *dN, double *g);
  * and to find the tiny copies Koschier's constraint moves. */
 void fcm__space_copy_support(const fcm_space *s, double *support);
 
+/* One element's linear term (stiffness, mass, body force or body-force field of `form`):
+ * the 3nn x 3nn matrix into Ke (row-major, local DOF 3a + i: node a of the cell, component
+ * i) for matrix terms, the 3nn vector into fe for force terms; the other output is not
+ * written (either may be NULL). Serial (the workspace's first scratch); allocates only the
+ * tabulated standard rule on its first use. For the distributed assembly of the PETSc
+ * adapter, which adds the elements of its own cells into a distributed matrix.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, element out of range, bad material, rules without the
+ * kind), FCM_ERR_UNSUPPORTED (another term), FCM_ERR_GEOMETRY (det J <= 0), FCM_ERR_ALLOC.
+ * (assemble.c) */
+fcm_status fcm__assembly_element_linear(fcm_assembly_workspace *ws, const fcm_linear_form *form,
+                                        fcm_index elem, double *Ke, double *fe);
+
 #endif /* FCM_FEM_IMPL_H */

@@ -565,6 +565,7 @@ static fcm_integrator_options integrator_options(fcm_simulation *S)
   o.krylov_max_iterations = sv->max_iterations;
   o.schwarz_theta = sv->schwarz_threshold;
   o.schwarz = sv->schwarz;
+  o.multigrid = sv->multigrid;
   /* Full cells: the scene's strength, except that 0 keeps the element's rule there (as the
    * scene README documents for strength 0: only cut cells get the strength-0 rule). */
   o.assembly.stiffness_strength = q->stiffness_strength > 0 ? q->stiffness_strength : FCM_DEFAULT;
@@ -735,6 +736,64 @@ cleanup:
   return st;
 }
 
+/* The background mesh and the embedded geometry (S->mesh, S->nn, S->geom; no geometry for a
+ * scene without one); errors of the inputs name the scene section they come from. */
+static fcm_status build_mesh_geometry(fcm_simulation *S)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  const fcm_scene *scene = S->scene;
+  const fcm_scene_background *bg = fcm_scene_get_background(scene);
+  const fcm_scene_geometry *g = fcm_scene_get_geometry(scene);
+  if (bg->kind == FCM_SCENE_BACKGROUND_GRID && bg->fit) {
+    double min[3], max[3];
+    fcm_index cells[3];
+    st = build_geometry(S, g); /* the parser ensured there is one */
+    if (st != FCM_OK) name_section(ctx, geometry_path(g->kind));
+    FCM_TRY(ctx, st);
+    st = fit_background(S, bg, min, max, cells);
+    if (st == FCM_OK) st = fcm_mesh_create_box(ctx, bg->element, min, max, cells, &S->mesh);
+    if (st != FCM_OK) name_section(ctx, "background.fit_background");
+    FCM_TRY(ctx, st);
+  } else if (bg->kind == FCM_SCENE_BACKGROUND_GRID)
+    st = fcm_mesh_create_box(ctx, bg->element, bg->min, bg->max, bg->cells, &S->mesh);
+  else
+    st = fcm_mesh_create_from_gmsh(ctx, bg->mesh, &S->mesh);
+  if (st != FCM_OK)
+    name_section(ctx, bg->kind == FCM_SCENE_BACKGROUND_GRID ? "background" : "background.mesh");
+  FCM_TRY(ctx, st);
+  S->nn = fcm_mesh_num_nodes(S->mesh);
+
+  if (g->kind != FCM_SCENE_GEOMETRY_NONE && !S->geom) {
+    st = build_geometry(S, g);
+    if (st != FCM_OK) name_section(ctx, geometry_path(g->kind));
+    FCM_TRY(ctx, st);
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm__scene_mesh_geometry(fcm_ctx *ctx, const fcm_scene *scene, fcm_mesh **mesh,
+                                    fcm_geometry **geom)
+{
+  fcm_status st = FCM_OK;
+  fcm_simulation *S = NULL;
+  *mesh = NULL;
+  *geom = NULL;
+  FCM_ALLOC(ctx, 1, S);
+  S->ctx = ctx;
+  S->scene = scene;
+  S->opts = fcm_simulation_options_default();
+  FCM_TRY(ctx, build_mesh_geometry(S));
+  *mesh = S->mesh;
+  *geom = S->geom;
+  S->mesh = NULL;
+  S->geom = NULL;
+cleanup:
+  fcm_simulation_destroy(&S);
+  return st;
+}
+
 fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
                                  const fcm_simulation_options *opts, fcm_simulation **out)
 {
@@ -762,35 +821,11 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
             "simulation: rules_progress_interval = %g must be >= 0 seconds",
             S->opts.rules_progress_interval);
 
-  /* background mesh; errors of the inputs name the scene section they come from */
-  const fcm_scene_background *bg = fcm_scene_get_background(scene);
+  FCM_TRY(ctx, build_mesh_geometry(S));
   const fcm_scene_geometry *g = fcm_scene_get_geometry(scene);
-  if (bg->kind == FCM_SCENE_BACKGROUND_GRID && bg->fit) {
-    double min[3], max[3];
-    fcm_index cells[3];
-    st = build_geometry(S, g); /* the parser ensured there is one */
-    if (st != FCM_OK) name_section(ctx, geometry_path(g->kind));
-    FCM_TRY(ctx, st);
-    st = fit_background(S, bg, min, max, cells);
-    if (st == FCM_OK) st = fcm_mesh_create_box(ctx, bg->element, min, max, cells, &S->mesh);
-    if (st != FCM_OK) name_section(ctx, "background.fit_background");
-    FCM_TRY(ctx, st);
-  } else if (bg->kind == FCM_SCENE_BACKGROUND_GRID)
-    st = fcm_mesh_create_box(ctx, bg->element, bg->min, bg->max, bg->cells, &S->mesh);
-  else
-    st = fcm_mesh_create_from_gmsh(ctx, bg->mesh, &S->mesh);
-  if (st != FCM_OK)
-    name_section(ctx, bg->kind == FCM_SCENE_BACKGROUND_GRID ? "background" : "background.mesh");
-  FCM_TRY(ctx, st);
-  S->nn = fcm_mesh_num_nodes(S->mesh);
 
-  /* geometry and cell rules only when the scene embeds one */
+  /* cell rules only when the scene embeds a geometry */
   if (g->kind != FCM_SCENE_GEOMETRY_NONE) {
-    if (!S->geom) {
-      st = build_geometry(S, g);
-      if (st != FCM_OK) name_section(ctx, geometry_path(g->kind));
-      FCM_TRY(ctx, st);
-    }
     st = build_rules(S);
     if (st != FCM_OK) fcm__error_prefix(ctx, st == FCM_ERR_GEOMETRY ? "geometry" : "quadrature");
     FCM_TRY(ctx, st);
@@ -814,7 +849,9 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   fcm_integrator_options io = integrator_options(S);
   S->c.inertia = io.kind == FCM_INTEGRATOR_BACKWARD_EULER;
   S->c.damping = io.rayleigh_mass > 0.0 || io.rayleigh_stiffness > 0.0;
-  S->c.krylov = io.linear_solver != FCM_LINEAR_DIRECT;
+  S->c.krylov = io.linear_solver == FCM_LINEAR_CG || io.linear_solver == FCM_LINEAR_MINRES;
+  S->c.multigrid = io.linear_solver == FCM_LINEAR_MULTIGRID ||
+                   (S->c.krylov && io.preconditioner == FCM_PRECOND_MULTIGRID);
   if (S->c.krylov && io.preconditioner == FCM_PRECOND_SCHWARZ) {
     S->c.schwarz_blocks = count_schwarz_blocks(S, io.schwarz_theta);
     if (S->c.schwarz_blocks == 0) io.preconditioner = FCM_PRECOND_JACOBI; /* nothing to block */
@@ -946,6 +983,7 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   S->c.time_steps += wall;
   S->c.newton_iterations += si.newton_iterations;
   S->c.linear_iterations += si.linear_iterations;
+  S->c.multigrid_cycles += si.multigrid_cycles;
   S->c.tangent_assemblies += si.tangent_assemblies;
   S->c.factorizations = S->base_factorizations + si.total_factorizations;
   S->c.analyses = S->base_analyses + si.total_analyses;
@@ -1113,6 +1151,35 @@ static void line(FILE *f, int on, const char *what, const char *detail)
   fprintf(f, "  %-9s %-28s %s\n", on ? "computed" : "skipped", what, detail);
 }
 
+/* The multigrid hierarchy of the current integrator: DOFs per level, finest first (the
+ * coarsest is solved by CHOLMOD), and the cycle. Nothing before the first solve. */
+static void multigrid_line(const fcm_simulation *S, FILE *f)
+{
+  const fcm_mg *mg = fcm_integrator_multigrid(S->integ);
+  const fcm_mg_options *o = &fcm_scene_get_solver(S->scene)->multigrid;
+  char b[512];
+  int len = 0;
+  if (!mg) {
+    line(f, 0, "multigrid levels", "(no solve yet)");
+    return;
+  }
+  const int nl = fcm_mg_num_levels(mg);
+  len = snprintf(b, sizeof b, "%d, DOFs", nl);
+  for (int l = 0; l < nl && len > 0 && (size_t)len < sizeof b; l++) {
+    fcm_mg_level_info li;
+    if (fcm_mg_get_level_info(mg, l, &li) != FCM_OK) {
+      fcm_ctx_error_clear(S->ctx);
+      return;
+    }
+    len += snprintf(b + len, sizeof b - (size_t)len, "%s%lld", l ? " > " : " ", (long long)li.dofs);
+  }
+  if (len > 0 && (size_t)len < sizeof b)
+    snprintf(b + len, sizeof b - (size_t)len, "; %s-cycle, %d+%d smoothing steps%s",
+             o->cycle_index == 2 ? "W" : "V", o->pre_smooth, o->post_smooth,
+             o->block_smoothing ? " with vertex blocks" : "");
+  line(f, 1, "multigrid levels", b);
+}
+
 /* The largest displacement of the body: over its quadrature points (authentic points of the
  * stiffness rules) and the embedded-surface points the frames write; beside it, the largest
  * over the DOF vector, which includes the fictitious nodes outside the body. Without an
@@ -1256,9 +1323,13 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
   line(f, c->cuts > 0, "cuts", c->cuts ? b : (S->num_cuts ? "(none due yet)" : "(no cut effect)"));
   snprintf(b, sizeof b, "%lld factorizations, %lld analyses, %lld fallbacks", c->factorizations,
            c->analyses, c->direct_fallbacks);
-  line(f, 1, c->krylov ? "preconditioner setups" : "direct factorizations", b);
-  snprintf(b, sizeof b, "%lld Newton, %lld linear iterations, %lld tangents", c->newton_iterations,
-           c->linear_iterations, c->tangent_assemblies);
+  line(f, 1,
+       c->krylov ? "preconditioner setups"
+                 : (c->multigrid ? "multigrid setups" : "direct factorizations"),
+       b);
+  if (c->multigrid) multigrid_line(S, f);
+  snprintf(b, sizeof b, "%lld Newton, %lld linear iterations, %lld multigrid cycles, %lld tangents",
+           c->newton_iterations, c->linear_iterations, c->multigrid_cycles, c->tangent_assemblies);
   line(f, 1, "iterations", b);
   snprintf(b, sizeof b, "%lld frames, surface %lld points %lld triangles", c->frames,
            (long long)c->surface_points, (long long)c->surface_triangles);

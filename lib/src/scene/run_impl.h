@@ -75,4 +75,10 @@ fcm_status fcm__sim_grow(fcm_ctx *ctx, void **array, long long *cap, long long n
  * output's element map are replaced; the state carries over (run.c). */
 fcm_status fcm__sim_apply_cut(fcm_simulation *S);
 
+/* The background mesh and the embedded geometry of a scene (NULL when it has none), built as
+ * fcm_simulation_create() builds them, for a driver of its own (the PETSc backend, fcm/petsc.h);
+ * the caller destroys both (run.c). */
+fcm_status fcm__scene_mesh_geometry(fcm_ctx *ctx, const fcm_scene *scene, fcm_mesh **mesh,
+                                    fcm_geometry **geom);
+
 #endif /* FCM_SCENE_RUN_IMPL_H */

@@ -56,10 +56,22 @@ static const char *const shape_names[] = {"box", "ball", "hemisphere", "hollow_b
 static const char *const axis_names[] = {"x", "y", "z"};
 static const char *const simplify_names[] = {"auto", "lp", "recombine", "eliminate"};
 static const char *const stabilization_names[] = {"mass_stiffness", "mass", "off"};
-static const char *const solver_names[] = {"direct", "minres", "cg"};
-static const int solver_values[] = {FCM_LINEAR_DIRECT, FCM_LINEAR_MINRES, FCM_LINEAR_CG};
+static const char *const solver_names[] = {"direct", "minres", "cg", "multigrid"};
+static const int solver_values[] = {FCM_LINEAR_DIRECT, FCM_LINEAR_MINRES, FCM_LINEAR_CG,
+                                    FCM_LINEAR_MULTIGRID};
 static const char *const direct_names[] = {"cholmod", "umfpack"};
-static const char *const preconditioner_names[] = {"none", "jacobi", "block_jacobi", "schwarz"};
+/* in the order of fcm_preconditioner */
+static const char *const preconditioner_names[] = {"none", "jacobi", "block_jacobi", "schwarz",
+                                                   "multigrid"};
+/* solver.multigrid: smoothers ("sgs_colored" also accepted, as the other names are written),
+ * cycles (V: cycle_index 1, W: 2) */
+static const char *const smoother_names[] = {"sgs", "jacobi", "sgs-colored", "sgs_colored"};
+static const int smoother_values[] = {FCM_MG_SMOOTHER_SGS, FCM_MG_SMOOTHER_JACOBI,
+                                      FCM_MG_SMOOTHER_SGS_COLORED, FCM_MG_SMOOTHER_SGS_COLORED};
+static const char *const cycle_names[] = {"v", "w"};
+static const int cycle_values[] = {1, 2};
+/* background elements the multigrid supports (fcm_mg_create()) */
+static const fcm_element_type multigrid_elements[] = {FCM_ELEMENT_HEX8, FCM_ELEMENT_HEX20};
 static const char *const clamp_names[] = {"clamp", "paper"};
 /* in the order of fcm_fictitious_model */
 static const char *const tangent_names[] = {"projected", "linear", "exact"};
@@ -737,20 +749,96 @@ cleanup:
 
 /* ---------------------------------------------------------------- solver */
 
+/* "solver.multigrid": the fcm_mg_options of the multigrid (preconditioner or solver). */
+static fcm_status read_multigrid(fcm__scene_parser *p, const fcm__json *mg, fcm_scene_solver *s)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"smoother", "omega",       "pre_smooth",     "post_smooth",
+                                     "cycle",    "coarse_dofs", "block_smoothing"};
+  fcm_mg_options *m = &s->multigrid;
+  size_t old = ENTER(p, "multigrid");
+  long long coarse = (long long)m->coarse_dofs;
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, mg, keys, COUNT(keys)));
+  READ_CHOICE_AS(p, mg, "smoother", 0, smoother_names, smoother_values, m->smoother);
+  if (m->smoother == FCM_MG_SMOOTHER_JACOBI)
+    m->omega = 0.6; /* the damped Jacobi default (1.0 over-corrects elasticity) */
+  FCM_TRY(p->ctx,
+          fcm__scene_read_number(p, mg, "omega", 0, (fcm__range){0.0, 2.0, 1, 1}, &m->omega));
+  if (m->smoother == FCM_MG_SMOOTHER_JACOBI && m->omega > 1.0) {
+    fcm__scene_path_push_key(p, "omega");
+    SCENE_CHECK(0, p, FCM_ERR_ARG,
+                "expected a finite number in (0, 1] with the \"jacobi\" smoother, got %g "
+                "((0, 2) for the Gauss-Seidel smoothers)",
+                m->omega);
+  }
+  READ_INT(p, mg, "pre_smooth", 0, 0, 100, m->pre_smooth);
+  READ_INT(p, mg, "post_smooth", 0, 0, 100, m->post_smooth);
+  READ_CHOICE_AS(p, mg, "cycle", 0, cycle_names, cycle_values, m->cycle_index);
+  FCM_TRY(p->ctx, fcm__scene_read_int(p, mg, "coarse_dofs", 0, 1, 1000000000, &coarse));
+  m->coarse_dofs = (fcm_index)coarse;
+  FCM_TRY(p->ctx, fcm__scene_read_bool(p, mg, "block_smoothing", 0, &m->block_smoothing));
+  SCENE_CHECK(m->pre_smooth + m->post_smooth >= 1, p, FCM_ERR_ARG,
+              "pre_smooth = %d and post_smooth = %d: at least one smoothing step is needed",
+              m->pre_smooth, m->post_smooth);
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
+/* Cross checks of the multigrid choice: a grid background of a supported element, and a
+ * symmetric cycle when it preconditions CG or MINRES. The path is "solver.<key>". */
+static fcm_status check_multigrid(fcm__scene_parser *p, const fcm_scene_solver *s)
+{
+  fcm_status st = FCM_OK;
+  const int as_solver = s->method == FCM_LINEAR_MULTIGRID;
+  const int as_pc = (s->method == FCM_LINEAR_CG || s->method == FCM_LINEAR_MINRES) &&
+                    s->preconditioner == FCM_PRECOND_MULTIGRID;
+  const fcm_scene_background *b = &p->scene->background;
+  size_t old = p->path_len;
+  if (!as_solver && !as_pc) return FCM_OK;
+  ENTER(p, as_solver ? "method" : "preconditioner");
+  SCENE_CHECK(b->kind == FCM_SCENE_BACKGROUND_GRID, p, FCM_ERR_ARG,
+              "\"multigrid\" needs a \"background\" grid (\"box\" and \"cells\": a structured "
+              "box grid of hex8 or hex20 cells); a Gmsh background mesh is not supported");
+  int supported = 0;
+  for (size_t k = 0; k < COUNT(multigrid_elements); k++)
+    supported |= b->element == multigrid_elements[k];
+  SCENE_CHECK(supported, p, FCM_ERR_ARG,
+              "\"multigrid\" supports \"hex8\" and \"hex20\" background grids only, the "
+              "background has \"element\": \"%s\"",
+              (int)b->element >= 0 && (size_t)b->element < COUNT(element_names)
+                  ? element_names[b->element]
+                  : "?");
+  fcm__scene_path_pop(p, old);
+  if (as_pc) {
+    ENTER(p, "multigrid");
+    SCENE_CHECK(s->multigrid.pre_smooth == s->multigrid.post_smooth, p, FCM_ERR_ARG,
+                "pre_smooth = %d and post_smooth = %d must be equal when the multigrid "
+                "preconditions \"%s\" (the cycle must be symmetric positive definite)",
+                s->multigrid.pre_smooth, s->multigrid.post_smooth,
+                CHOICE_NAME(solver_names, solver_values, s->method));
+  }
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
 static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
   static const char *const keys[] = {
-      "method", "direct",         "preconditioner", "schwarz", "rtol",
-      "atol",   "max_iterations", "newton",         "threads", "preconditioner_tangent"};
+      "method",    "direct",         "preconditioner", "schwarz", "rtol",
+      "atol",      "max_iterations", "newton",         "threads", "preconditioner_tangent",
+      "multigrid", "petsc_options"};
   static const char *const skeys[] = {"threshold", "epsilon", "clamp"};
   static const char *const nkeys[] = {"rtol",        "max_iterations",
                                       "line_search", "project_psd",
                                       "rule",        "representative_acceleration"};
   fcm_scene_solver *s = &p->scene->solver;
-  const fcm__json *o = NULL, *sw = NULL, *nw = NULL;
+  const fcm__json *o = NULL, *sw = NULL, *nw = NULL, *mg = NULL;
   size_t old = p->path_len;
   s->method = FCM_LINEAR_DIRECT;
+  s->multigrid = fcm_mg_options_default();
   s->direct = FCM_DIRECT_CHOLMOD;
   s->preconditioner = FCM_PRECOND_SCHWARZ;
   s->preconditioner_tangent = FCM_FICTITIOUS_PROJECTED;
@@ -803,6 +891,10 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   }
   READ_INT(p, o, "threads", 0, 0, 4096, s->threads);
   if (s->threads == 0) s->threads = FCM_DEFAULT; /* "threads": 0, the OpenMP default */
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "multigrid", 0, &mg));
+  if (mg) FCM_TRY(p->ctx, read_multigrid(p, mg, s));
+  FCM_TRY(p->ctx, check_multigrid(p, s));
+  FCM_TRY(p->ctx, fcm__scene_read_string(p, o, "petsc_options", 0, &s->petsc_options));
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
@@ -1153,6 +1245,15 @@ int fcm_scene_count_effects(const fcm_scene *s, fcm_effect_type type)
 
 /* ---------------------------------------------------------------- view */
 
+/* " (sgs omega 1, 1+1 steps, V-cycle, coarse 2000 DOFs)" */
+static void view_multigrid(FILE *f, const fcm_mg_options *m)
+{
+  fprintf(f, " (%s omega %g, %d+%d steps%s, %s-cycle, coarse %lld DOFs)",
+          CHOICE_NAME(smoother_names, smoother_values, m->smoother), m->omega, m->pre_smooth,
+          m->post_smooth, m->block_smoothing ? " with vertex blocks" : "",
+          m->cycle_index == 2 ? "W" : "V", (long long)m->coarse_dofs);
+}
+
 static void view_strength(FILE *f, const char *what, int m)
 {
   if (m >= 0)
@@ -1262,12 +1363,16 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
   fprintf(f, "solver: %s", CHOICE_NAME(solver_names, solver_values, so->method));
   if (so->method == FCM_LINEAR_DIRECT)
     fprintf(f, " (%s)", direct_names[so->direct]);
-  else {
+  else if (so->method == FCM_LINEAR_MULTIGRID) {
+    view_multigrid(f, &so->multigrid);
+    fprintf(f, ", rtol %g, atol %g, at most %d cycles", so->rtol, so->atol, so->max_iterations);
+  } else {
     fprintf(f, " preconditioner %s (%s tangent)", preconditioner_names[so->preconditioner],
             tangent_names[so->preconditioner_tangent]);
     if (so->preconditioner == FCM_PRECOND_SCHWARZ)
       fprintf(f, " (threshold %g, epsilon %g, %s)", so->schwarz_threshold, so->schwarz.epsilon,
               clamp_names[so->schwarz.clamp]);
+    if (so->preconditioner == FCM_PRECOND_MULTIGRID) view_multigrid(f, &so->multigrid);
     fprintf(f, ", rtol %g, atol %g, at most %d iterations", so->rtol, so->atol, so->max_iterations);
   }
   fprintf(f,

@@ -32,6 +32,7 @@ fcm_integrator_options fcm_integrator_options_default(void)
   o.krylov_max_iterations = 1000;
   o.schwarz_theta = 0.5;
   o.schwarz = fcm_schwarz_options_default();
+  o.multigrid = fcm_mg_options_default();
   o.assembly = fcm_assembly_options_default();
   return o;
 }
@@ -156,7 +157,7 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   double **vecs[] = {&I->u,      &I->v,     &I->load_prev, &I->act_val, &I->act_inc, &I->Ma,
                      &I->u_bak,  &I->v_bak, &I->lp_bak,    &I->un,      &I->uhat,    &I->fext,
                      &I->fend,   &I->fint,  &I->g,         &I->d,       &I->b,       &I->ut,
-                     &I->fint_t, &I->g_t,   &I->w1,        &I->w2};
+                     &I->fint_t, &I->g_t,   &I->w1,        &I->w2,      &I->mg_r};
   for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; k++)
     FCM_FREE(ctx, *vecs[k]);
   fcm__free(ctx, I->con_dof);
@@ -179,6 +180,7 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   fcm_krylov_destroy(&I->krylov);
   fcm_jacobi_destroy(&I->jacobi);
   fcm_schwarz_destroy(&I->schwarz);
+  fcm_mg_destroy(&I->mg);
   fcm_assembly_workspace_destroy(&I->aws);
   fcm__free(ctx, I);
   *integ = NULL;
@@ -400,13 +402,19 @@ static fcm_status validate_options(fcm_ctx *ctx, const fcm_integrator_options *o
             "integrator: backtrack = %g outside (0, 1)", o->backtrack);
   FCM_CHECK(o->max_backtracks >= 0, ctx, FCM_ERR_ARG,
             "integrator: max_backtracks = %d must be >= 0", o->max_backtracks);
-  FCM_CHECK(o->linear_solver >= FCM_LINEAR_DIRECT && o->linear_solver <= FCM_LINEAR_MINRES, ctx,
-            FCM_ERR_ARG, "integrator: linear_solver = %d outside [0, 2]", (int)o->linear_solver);
+  FCM_CHECK(o->linear_solver >= FCM_LINEAR_DIRECT && o->linear_solver <= FCM_LINEAR_MULTIGRID, ctx,
+            FCM_ERR_ARG,
+            "integrator: linear_solver = %d outside [0, 3] (direct, cg, minres, multigrid)",
+            (int)o->linear_solver);
   FCM_CHECK(o->direct_method == FCM_DIRECT_CHOLMOD || o->direct_method == FCM_DIRECT_UMFPACK, ctx,
             FCM_ERR_ARG, "integrator: direct_method = %d must be CHOLMOD (0) or UMFPACK (1)",
             (int)o->direct_method);
-  FCM_CHECK(o->preconditioner >= FCM_PRECOND_NONE && o->preconditioner <= FCM_PRECOND_SCHWARZ, ctx,
-            FCM_ERR_ARG, "integrator: preconditioner = %d outside [0, 3]", (int)o->preconditioner);
+  FCM_CHECK(o->preconditioner >= FCM_PRECOND_NONE && o->preconditioner <= FCM_PRECOND_MULTIGRID,
+            ctx, FCM_ERR_ARG,
+            "integrator: preconditioner = %d outside [0, 4] (none, jacobi, block jacobi, "
+            "schwarz, multigrid)",
+            (int)o->preconditioner);
+  FCM_TRY(ctx, fcm__sim_multigrid_validate(ctx, o));
   FCM_CHECK(o->preconditioner_tangent >= 0 &&
                 o->preconditioner_tangent < FCM_FICTITIOUS_MODEL_COUNT,
             ctx, FCM_ERR_ARG,
@@ -603,6 +611,8 @@ static fcm_status setup_solvers(fcm_integrator *I)
       FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_UMFPACK, I->H, &I->umf));
       FCM_TRY(ctx, fcm_direct_analyze(I->umf));
     }
+  } else if (o->linear_solver == FCM_LINEAR_MULTIGRID) {
+    FCM_ALLOC(ctx, I->n, I->mg_r); /* the hierarchy itself: at the first solve (linsolve.c) */
   } else {
     FCM_TRY(ctx, fcm_krylov_create(ctx, I->n, &I->krylov));
     if (o->preconditioner == FCM_PRECOND_SCHWARZ) {

@@ -1,7 +1,10 @@
 /* sim: the linear solves of the Newton steps — CHOLMOD with UMFPACK as the fallback when
- * the matrix is not positive definite (symbolic analyses kept for the whole run), or CG /
- * MINRES with Jacobi, block Jacobi or additive Schwarz preconditioning (lib/METHOD.md §7), the
- * preconditioner built from a PSD tangent by default (preconditioner_tangent). */
+ * the matrix is not positive definite (symbolic analyses kept for the whole run), CG /
+ * MINRES with Jacobi, block Jacobi, additive Schwarz or multigrid preconditioning
+ * (lib/METHOD.md §7), the preconditioner built from a PSD tangent by default
+ * (preconditioner_tangent), or multigrid cycles as the solver (SPD Newton matrices). One
+ * function per method: factor_direct, setup_preconditioner, mg_factor (set-up) and
+ * solve_direct, solve_krylov, mg_solve (solves). */
 #include "sim/sim_impl.h"
 #include "fem/fem_impl.h"
 #include "la/la_impl.h"
@@ -190,6 +193,193 @@ cleanup:
   return st;
 }
 
+/* ------------------------------------------------------------------ multigrid (fcm/mg.h) */
+
+fcm_status fcm__sim_multigrid_validate(fcm_ctx *ctx, const fcm_integrator_options *o)
+{
+  fcm_status st = FCM_OK;
+  const int as_solver = o->linear_solver == FCM_LINEAR_MULTIGRID;
+  const int as_pc = (o->linear_solver == FCM_LINEAR_CG || o->linear_solver == FCM_LINEAR_MINRES) &&
+                    o->preconditioner == FCM_PRECOND_MULTIGRID;
+  const fcm_mg_options *m = &o->multigrid;
+  if (!as_solver && !as_pc) return FCM_OK;
+  FCM_CHECK(m->smoother >= 0 && m->smoother < FCM_MG_SMOOTHER_COUNT, ctx, FCM_ERR_ARG,
+            "integrator: multigrid.smoother = %d outside [0, %d] (sgs, jacobi, sgs colored)",
+            (int)m->smoother, (int)FCM_MG_SMOOTHER_COUNT - 1);
+  if (m->smoother == FCM_MG_SMOOTHER_JACOBI)
+    FCM_CHECK(isfinite(m->omega) && m->omega > 0.0 && m->omega <= 1.0, ctx, FCM_ERR_ARG,
+              "integrator: multigrid.omega = %g outside (0, 1] (the Jacobi smoother)", m->omega);
+  else
+    FCM_CHECK(isfinite(m->omega) && m->omega > 0.0 && m->omega < 2.0, ctx, FCM_ERR_ARG,
+              "integrator: multigrid.omega = %g outside (0, 2) (the Gauss-Seidel smoothers)",
+              m->omega);
+  FCM_CHECK(m->pre_smooth >= 0 && m->post_smooth >= 0 && m->pre_smooth + m->post_smooth >= 1, ctx,
+            FCM_ERR_ARG,
+            "integrator: multigrid.pre_smooth = %d and post_smooth = %d must be >= 0 with at "
+            "least one smoothing step",
+            m->pre_smooth, m->post_smooth);
+  FCM_CHECK(!as_pc || m->pre_smooth == m->post_smooth, ctx, FCM_ERR_ARG,
+            "integrator: multigrid.pre_smooth = %d and post_smooth = %d must be equal when the "
+            "multigrid preconditions %s (the cycle must be symmetric positive definite)",
+            m->pre_smooth, m->post_smooth, o->linear_solver == FCM_LINEAR_CG ? "CG" : "MINRES");
+  FCM_CHECK(m->cycle_index == 1 || m->cycle_index == 2, ctx, FCM_ERR_ARG,
+            "integrator: multigrid.cycle_index = %d is neither 1 (V-cycle) nor 2 (W-cycle)",
+            m->cycle_index);
+  FCM_CHECK(m->max_levels >= 1 && m->max_levels <= 32, ctx, FCM_ERR_ARG,
+            "integrator: multigrid.max_levels = %d outside [1, 32]", m->max_levels);
+  FCM_CHECK(m->coarse_dofs >= 1, ctx, FCM_ERR_ARG,
+            "integrator: multigrid.coarse_dofs = %lld must be >= 1", (long long)m->coarse_dofs);
+cleanup:
+  return st;
+}
+
+const fcm_mg *fcm_integrator_multigrid(const fcm_integrator *I)
+{
+  return I ? I->mg : NULL;
+}
+
+/* A failure of the multigrid: numerical ones (the coarsest Cholesky factorization or a
+ * diagonal of a matrix that is not positive definite, cycles that do not converge) fail the
+ * solve softly with a warning naming the cause; the others (not a Hex8 box grid, memory)
+ * are hard errors, prefixed with the option. */
+static fcm_status mg_soft(fcm_integrator *I, fcm_status s, fcm_step_reason *reason)
+{
+  fcm_ctx *ctx = I->ctx;
+  if (s == FCM_ERR_NUMERIC || s == FCM_ERR_SINGULAR || s == FCM_ERR_NOT_CONVERGED) {
+    fcm__log(ctx, FCM_LOG_WARNING, "integrator: t = %g: multigrid failed (%s); %s", I->t,
+             fcm_ctx_error_message(ctx),
+             I->opts.linear_solver == FCM_LINEAR_MULTIGRID
+                 ? "the multigrid solver needs a symmetric positive definite Newton matrix "
+                   "(static, or dynamic with a linear material or project_psd) and enough "
+                   "cycles (krylov_max_iterations); retrying with a shorter step"
+                 : "the multigrid preconditioner needs a symmetric positive definite matrix "
+                   "(preconditioner_tangent projected or linear); retrying with a shorter step");
+    fcm_ctx_error_clear(ctx);
+    *reason = FCM_STEP_LINEAR_SOLVER_FAILED;
+    return FCM_OK;
+  }
+  if (s != FCM_OK) {
+    fcm__error_prefix(ctx, I->opts.linear_solver == FCM_LINEAR_MULTIGRID
+                               ? "integrator: linear_solver multigrid"
+                               : "integrator: preconditioner multigrid");
+    fcm__trace(ctx, __FILE__, __LINE__, __func__);
+  }
+  return s;
+}
+
+/* The hierarchy on A with A's current values: fcm_mg_create() at first use and when the
+ * matrix or the active constraints changed (the eliminated rows are the multigrid's Dirichlet
+ * boundary), else fcm_mg_setup() (Galerkin matrices and the coarsest factorization only). A
+ * setup that finds other eliminated rows (a row whose coupling vanished numerically) builds
+ * the hierarchy again. */
+static fcm_status mg_prepare(fcm_integrator *I, const fcm_csr *A, fcm_step_reason *reason)
+{
+  fcm_status s = FCM_OK;
+  if (I->mg && (I->mg_A != A || I->mg_con != I->key_con)) fcm_mg_destroy(&I->mg);
+  if (I->mg) {
+    s = fcm_mg_setup(I->mg);
+    if (s == FCM_ERR_ARG) {
+      fcm_ctx_error_clear(I->ctx);
+      fcm_mg_destroy(&I->mg);
+    }
+  }
+  if (!I->mg) {
+    s = fcm_mg_create(I->ctx, I->space, A, &I->opts.multigrid, &I->mg);
+    I->mg_A = A;
+    I->mg_con = I->key_con;
+  }
+  return mg_soft(I, s, reason);
+}
+
+/* Preconditioner set-up: the hierarchy on the preconditioner's matrix P. Once built on Hpc
+ * it stays there: when P is the Newton matrix itself (a PSD tangent: the projection
+ * fallback), its values are copied into Hpc instead of building the hierarchy again. */
+static fcm_status mg_precond_setup(fcm_integrator *I, fcm_csr *P, fcm_step_reason *reason)
+{
+  if (I->mg && I->mg_A == I->Hpc && P == I->H && I->Hpc && I->mg_con == I->key_con) {
+    fcm_index nnz = 0;
+    fcm_csr_get_size(I->H, NULL, NULL, &nnz);
+    memcpy(fcm_csr_values(I->Hpc), fcm_csr_values_read(I->H), sizeof(double) * (size_t)nnz);
+    P = I->Hpc;
+  }
+  return mg_prepare(I, P, reason);
+}
+
+/* fcm_operator_fn: one cycle from z = 0, counted. */
+static fcm_status mg_precond_apply(void *user, const double *r, double *z)
+{
+  fcm_integrator *I = user;
+  I->mg_applies++;
+  return fcm_mg_operator(I->mg, r, z);
+}
+
+static double norm2(fcm_index n, const double *v)
+{
+  double s = 0.0;
+  for (fcm_index i = 0; i < n; i++)
+    s += v[i] * v[i];
+  return sqrt(s);
+}
+
+/* FCM_LINEAR_MULTIGRID: cycles on H d = b from d = 0 until ||b - H d|| <= max(krylov_rtol
+ * ||b||, krylov_atol). Stops early (soft failure) when the residual grows past 1e3 ||b||
+ * or is not finite (diverging: H is not positive definite) or when 20 cycles reduce it by
+ * less than 5 % (stalled). */
+static fcm_status mg_solve(fcm_integrator *I, const double *b, double *d, fcm_step_reason *reason,
+                           int *iterations, sim_stats *stats)
+{
+  fcm_status st = FCM_OK, s = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  const fcm_index n = I->n;
+  const int max_cycles = I->opts.krylov_max_iterations;
+  FCM_CHECK(I->mg, ctx, FCM_ERR_INTERNAL, "integrator: no multigrid hierarchy to solve with");
+  memset(d, 0, sizeof *d * (size_t)n);
+  const double bn = norm2(n, b);
+  const double target = fmax(I->opts.krylov_rtol * bn, I->opts.krylov_atol);
+  double rk = bn, r1 = bn, r_back = bn;
+  int k = 0;
+  const char *why = NULL;
+  while (!(rk <= target)) {
+    if (k >= max_cycles) {
+      why = "cycle limit (krylov_max_iterations) reached";
+      break;
+    }
+    s = fcm_mg_cycle(I->mg, b, d);
+    if (s != FCM_OK) break;
+    k++;
+    FCM_TRY(ctx, fcm_csr_apply(I->H, -1.0, d, 0.0, I->mg_r));
+    for (fcm_index i = 0; i < n; i++)
+      I->mg_r[i] += b[i];
+    rk = norm2(n, I->mg_r);
+    if (k == 1) r1 = rk;
+    if (!isfinite(rk) || rk > 1e3 * bn) {
+      why = "diverging";
+      break;
+    }
+    if (k % 20 == 0) {
+      if (rk > 0.95 * r_back) {
+        why = "stalled (less than 5 % reduction in 20 cycles)";
+        break;
+      }
+      r_back = rk;
+    }
+  }
+  *iterations = k;
+  stats->linear_iterations += k;
+  stats->mg_cycles += k;
+  if (s == FCM_OK && why) {
+    const double factor = k >= 2 && r1 > 0.0 ? pow(rk / r1, 1.0 / (k - 1)) : 0.0;
+    s = fcm__error(ctx, FCM_ERR_NOT_CONVERGED, __FILE__, __LINE__, __func__,
+                   "multigrid solve %s: relative residual %g after %d cycles (rtol %g, atol %g), "
+                   "mean factor per cycle %.3g",
+                   why, bn > 0.0 ? rk / bn : 0.0, k, I->opts.krylov_rtol, I->opts.krylov_atol,
+                   factor);
+  }
+  st = mg_soft(I, s, reason);
+cleanup:
+  return st;
+}
+
 static fcm_status setup_preconditioner(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
 {
   fcm_status s = FCM_OK;
@@ -216,79 +406,125 @@ static fcm_status setup_preconditioner(fcm_integrator *I, fcm_step_reason *reaso
     else
       s = schwarz_create(I, P);
     break;
+  case FCM_PRECOND_MULTIGRID:
+    stats->factorizations++;
+    I->total_factorizations++;
+    return mg_precond_setup(I, P, reason);
   }
   stats->factorizations++;
   I->total_factorizations++;
   return soft(I, s, reason);
 }
 
+/* FCM_LINEAR_MULTIGRID: the hierarchy on the Newton matrix itself. */
+static fcm_status mg_factor(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
+{
+  stats->factorizations++;
+  I->total_factorizations++;
+  return mg_prepare(I, I->H, reason);
+}
+
 fcm_status fcm__sim_factor(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
 {
   double t0 = fcm_wtime();
-  fcm_status st = I->opts.linear_solver == FCM_LINEAR_DIRECT
-                      ? factor_direct(I, reason, stats)
-                      : setup_preconditioner(I, reason, stats);
+  fcm_status st = FCM_OK;
+  switch (I->opts.linear_solver) {
+  case FCM_LINEAR_DIRECT:
+    st = factor_direct(I, reason, stats);
+    break;
+  case FCM_LINEAR_MULTIGRID:
+    st = mg_factor(I, reason, stats);
+    break;
+  default:
+    st = setup_preconditioner(I, reason, stats);
+  }
   stats->time_factor += fcm_wtime() - t0;
+  return st;
+}
+
+static fcm_status solve_direct(fcm_integrator *I, const double *b, double *d,
+                               fcm_step_reason *reason)
+{
+  fcm_status st = FCM_OK, s;
+  fcm_ctx *ctx = I->ctx;
+  FCM_CHECK(I->direct, ctx, FCM_ERR_INTERNAL, "integrator: no valid factorization to solve with");
+  s = fcm_direct_solve(I->direct, b, d);
+  if (s == FCM_ERR_SINGULAR) return singular_or_retry(I, reason);
+  FCM_TRY(ctx, s);
+cleanup:
+  return st;
+}
+
+static fcm_status solve_krylov(fcm_integrator *I, const double *b, double *d,
+                               fcm_step_reason *reason, int *iterations, sim_stats *stats)
+{
+  fcm_status st = FCM_OK, s;
+  fcm_ctx *ctx = I->ctx;
+  fcm_krylov_options ko = fcm_krylov_options_default();
+  fcm_krylov_info ki;
+  fcm_operator_fn S = NULL;
+  void *S_user = NULL;
+  ko.rtol = I->opts.krylov_rtol;
+  ko.atol = I->opts.krylov_atol;
+  ko.max_iterations = I->opts.krylov_max_iterations;
+  if (I->jacobi && (I->opts.preconditioner == FCM_PRECOND_JACOBI ||
+                    I->opts.preconditioner == FCM_PRECOND_BLOCK_JACOBI)) {
+    S = fcm_jacobi_operator;
+    S_user = I->jacobi;
+  } else if (I->schwarz && I->opts.preconditioner == FCM_PRECOND_SCHWARZ) {
+    S = fcm_schwarz_operator;
+    S_user = I->schwarz;
+  } else if (I->mg && I->opts.preconditioner == FCM_PRECOND_MULTIGRID) {
+    S = mg_precond_apply;
+    S_user = I;
+  }
+  const long long applies0 = I->mg_applies;
+  memset(d, 0, sizeof *d * (size_t)I->n);
+  memset(&ki, 0, sizeof ki);
+  if (I->opts.linear_solver == FCM_LINEAR_CG)
+    s = fcm_krylov_cg(I->krylov, fcm_csr_operator, I->H, S, S_user, b, d, &ko, &ki);
+  else
+    s = fcm_krylov_minres(I->krylov, fcm_csr_operator, I->H, S, S_user, b, d, &ko, &ki);
+  *iterations = ki.iterations;
+  stats->linear_iterations += ki.iterations;
+  stats->mg_cycles += I->mg_applies - applies0;
+  if (s == FCM_ERR_NOT_CONVERGED) {
+    /* Stopped early (iteration limit, CG breakdown on an indefinite matrix): the iterate
+     * is still usable when it is a finite, non-zero vector; the Newton loop checks that
+     * it descends. */
+    int usable = 1, nonzero = 0;
+    for (fcm_index i = 0; i < I->n; i++) {
+      if (!isfinite(d[i])) usable = 0;
+      if (d[i] != 0.0) nonzero = 1;
+    }
+    if (usable && nonzero) {
+      fcm_ctx_error_clear(ctx);
+      stats->inexact_solves++;
+      s = FCM_OK;
+    }
+  }
+  FCM_TRY(ctx, soft(I, s, reason));
+cleanup:
   return st;
 }
 
 fcm_status fcm__sim_solve(fcm_integrator *I, const double *b, double *d, fcm_step_reason *reason,
                           int *iterations, sim_stats *stats)
 {
-  fcm_status st = FCM_OK, s;
-  fcm_ctx *ctx = I->ctx;
+  fcm_status st = FCM_OK;
   double t0 = fcm_wtime();
   *iterations = 0;
-  if (I->opts.linear_solver == FCM_LINEAR_DIRECT) {
-    FCM_CHECK(I->direct, ctx, FCM_ERR_INTERNAL, "integrator: no valid factorization to solve with");
-    s = fcm_direct_solve(I->direct, b, d);
-    if (s == FCM_ERR_SINGULAR) {
-      st = singular_or_retry(I, reason);
-      goto cleanup;
-    }
-    FCM_TRY(ctx, s);
-  } else {
-    fcm_krylov_options ko = fcm_krylov_options_default();
-    fcm_krylov_info ki;
-    fcm_operator_fn S = NULL;
-    void *S_user = NULL;
-    ko.rtol = I->opts.krylov_rtol;
-    ko.atol = I->opts.krylov_atol;
-    ko.max_iterations = I->opts.krylov_max_iterations;
-    if (I->jacobi && (I->opts.preconditioner == FCM_PRECOND_JACOBI ||
-                      I->opts.preconditioner == FCM_PRECOND_BLOCK_JACOBI)) {
-      S = fcm_jacobi_operator;
-      S_user = I->jacobi;
-    } else if (I->schwarz && I->opts.preconditioner == FCM_PRECOND_SCHWARZ) {
-      S = fcm_schwarz_operator;
-      S_user = I->schwarz;
-    }
-    memset(d, 0, sizeof *d * (size_t)I->n);
-    memset(&ki, 0, sizeof ki);
-    if (I->opts.linear_solver == FCM_LINEAR_CG)
-      s = fcm_krylov_cg(I->krylov, fcm_csr_operator, I->H, S, S_user, b, d, &ko, &ki);
-    else
-      s = fcm_krylov_minres(I->krylov, fcm_csr_operator, I->H, S, S_user, b, d, &ko, &ki);
-    *iterations = ki.iterations;
-    stats->linear_iterations += ki.iterations;
-    if (s == FCM_ERR_NOT_CONVERGED) {
-      /* Stopped early (iteration limit, CG breakdown on an indefinite matrix): the iterate
-       * is still usable when it is a finite, non-zero vector; the Newton loop checks that
-       * it descends. */
-      int usable = 1, nonzero = 0;
-      for (fcm_index i = 0; i < I->n; i++) {
-        if (!isfinite(d[i])) usable = 0;
-        if (d[i] != 0.0) nonzero = 1;
-      }
-      if (usable && nonzero) {
-        fcm_ctx_error_clear(ctx);
-        stats->inexact_solves++;
-        s = FCM_OK;
-      }
-    }
-    FCM_TRY(ctx, soft(I, s, reason));
+  switch (I->opts.linear_solver) {
+  case FCM_LINEAR_DIRECT:
+    st = solve_direct(I, b, d, reason);
+    break;
+  case FCM_LINEAR_MULTIGRID:
+    st = mg_solve(I, b, d, reason, iterations, stats);
+    break;
+  default:
+    st = solve_krylov(I, b, d, reason, iterations, stats);
   }
-cleanup:
+  if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
   stats->time_solve += fcm_wtime() - t0;
   return st;
 }

@@ -564,6 +564,7 @@ static void record_step_statistics(const fcm_integrator *I, const sim_stats *sta
   info->newton_iterations = stats->newton_iterations;
   info->line_search_backtracks = stats->backtracks;
   info->linear_iterations = stats->linear_iterations;
+  info->multigrid_cycles = stats->mg_cycles;
   info->tangent_assemblies = stats->tangent_assemblies;
   info->factorizations = stats->factorizations;
   info->direct_fallbacks = stats->direct_fallbacks;

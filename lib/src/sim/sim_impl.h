@@ -56,7 +56,7 @@ typedef struct sim_bpoints {
 typedef struct sim_stats {
   int newton_iterations, backtracks, tangent_assemblies, factorizations;
   int direct_fallbacks, projection_fallbacks, inexact_solves;
-  long long linear_iterations;
+  long long linear_iterations, mg_cycles;
   double time_assembly, time_factor, time_solve;
 } sim_stats;
 
@@ -124,6 +124,14 @@ struct fcm_integrator {
   fcm_jacobi *jacobi;
   fcm_schwarz *schwarz;
   unsigned char *schwarz_flag; /* num_cells */
+  /* multigrid (linsolve.c): built on mg_A (H or Hpc) for the active set key mg_con; mg_r is
+   * the residual of FCM_LINEAR_MULTIGRID's cycles (n, setup); mg_applies counts the cycles
+   * the Krylov solvers ran as preconditioner applications */
+  fcm_mg *mg;
+  const fcm_csr *mg_A;
+  long long mg_con;
+  long long mg_applies;
+  double *mg_r;
 
   /* Newton matrix cache: H holds base(h) + K(u) (state TANGENT, unmodified) or the
    * eliminated system with a valid factor / preconditioner (state SYSTEM, key below). */
@@ -156,6 +164,10 @@ fcm_status fcm__sim_factor(fcm_integrator *I, fcm_step_reason *reason, sim_stats
  * (d is then unusable) and return FCM_OK. (linsolve.c) */
 fcm_status fcm__sim_solve(fcm_integrator *I, const double *b, double *d, fcm_step_reason *reason,
                           int *iterations, sim_stats *stats);
+
+/* Check the multigrid options when FCM_PRECOND_MULTIGRID (with CG or MINRES) or
+ * FCM_LINEAR_MULTIGRID is chosen: FCM_ERR_ARG naming the member and its range. (linsolve.c) */
+fcm_status fcm__sim_multigrid_validate(fcm_ctx *ctx, const fcm_integrator_options *o);
 
 /* Symbolic analyses performed so far (CHOLMOD + UMFPACK). (linsolve.c) */
 long long fcm__sim_analyses(const fcm_integrator *I);

@@ -1,0 +1,270 @@
+/* fcm-sim --backend petsc (see fcm-sim-petsc.h): every process reads the scene and builds the
+ * mesh and the geometry; the problem (fcm_petsc_problem_create_from_scene()) distributes the
+ * cells, the cut-cell rules, the assembly and the solves. Process 0 prints and writes the log
+ * <name>_log.csv; each frame is a parallel VTU (<name>_NNNN.pvtu by process 0 naming one piece
+ * <name>_NNNN_<rank>.vtu per process: its own cells), indexed by <name>.pvd. */
+#define _POSIX_C_SOURCE 200809L
+#include "fcm-sim-petsc.h"
+
+#include <fcm/fcm.h>
+#include <fcm/petsc.h>
+#include <fcm/simulation.h>
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+/* mkdir -p (process 0). */
+static int make_dirs(const char *dir)
+{
+  char buf[4096];
+  size_t n = strlen(dir);
+  if (n == 0 || n >= sizeof buf) return 0;
+  memcpy(buf, dir, n + 1);
+  for (size_t i = 1; i <= n; i++)
+    if (buf[i] == '/' || buf[i] == '\0') {
+      char c = buf[i];
+      buf[i] = '\0';
+      if (mkdir(buf, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "fcm-sim: cannot create directory %s: %s\n", buf, strerror(errno));
+        return 0;
+      }
+      buf[i] = c;
+    }
+  return 1;
+}
+
+typedef struct run_log {
+  long long step;
+  double time, residual, kinetic, elastic, work, wall;
+  int iterations;
+} run_log;
+
+static fcm_status write_log(fcm_ctx *ctx, const char *path, const run_log *rows, long long n)
+{
+  fcm_atomic_file *f = NULL;
+  fcm_status st = fcm_atomic_file_open(ctx, path, &f);
+  if (st != FCM_OK) return st;
+  FILE *s = fcm_atomic_file_stream(f);
+  fprintf(s, "step,time,ksp_iterations,ksp_residual,kinetic_energy,elastic_energy,external_work,"
+             "wall_seconds\n");
+  for (long long k = 0; k < n; k++)
+    fprintf(s, "%lld,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.6g\n", rows[k].step, rows[k].time,
+            rows[k].iterations, rows[k].residual, rows[k].kinetic, rows[k].elastic, rows[k].work,
+            rows[k].wall);
+  return fcm_atomic_file_commit(&f);
+}
+
+/* A frame (collective): the pieces and the .pvtu, indexed in the PVD by process 0. */
+static int write_frame(fcm_ctx *ctx, fcm_petsc_problem *P, const char *dir, const char *name,
+                       int index, double time, fcm_pvd *pvd, int rank)
+{
+  char stem[512], file[600];
+  snprintf(stem, sizeof stem, "%s_%04d", name, index);
+  snprintf(file, sizeof file, "%s.pvtu", stem);
+  int ok = fcm_petsc_problem_write_frame(P, dir, stem) == FCM_OK;
+  if (ok && rank == 0) ok = fcm_pvd_add(pvd, time, file) == FCM_OK;
+  if (!ok && rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  return ok;
+}
+
+/* Process 0, resuming: the rows of steps <= first of an existing log (missing ones stay 0). */
+static void read_old_log(const char *path, run_log *rows, long long first)
+{
+  FILE *f = fopen(path, "r");
+  char line[1024];
+  if (!f) return;
+  while (fgets(line, sizeof line, f)) {
+    run_log r;
+    if (sscanf(line, "%lld,%lg,%d,%lg,%lg,%lg,%lg,%lg", &r.step, &r.time, &r.iterations,
+               &r.residual, &r.kinetic, &r.elastic, &r.work, &r.wall) == 8 &&
+        r.step >= 1 && r.step <= first)
+      rows[r.step - 1] = r;
+  }
+  fclose(f);
+}
+
+int sim_petsc_run(const char *path, const char *outdir, long long steps, int check, int quiet,
+                  int checkpoint_every, const char *resume, int petsc_argc, char **petsc_argv)
+{
+  int rc = 1, rank = 0, size = 1;
+  fcm_ctx *ctx = NULL;
+  fcm_scene *scene = NULL;
+  fcm_petsc_problem *P = NULL;
+  fcm_pvd *pvd = NULL;
+  double *u = NULL, *v = NULL;
+  run_log *rows = NULL;
+  if (fcm_ctx_create(NULL, &ctx) != FCM_OK) {
+    fprintf(stderr, "fcm-sim: cannot create the fcm context\n");
+    return 1;
+  }
+  if (fcm_petsc_initialize(ctx, &petsc_argc, &petsc_argv) != FCM_OK) {
+    fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+    fcm_ctx_destroy(&ctx);
+    return 1;
+  }
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const int talk = rank == 0 && !quiet;
+  /* every process parses the same file; a failure is the same everywhere */
+  fcm_status st =
+      path ? fcm_scene_create_from_file(ctx, path, &scene) : fcm_scene_create_default(ctx, &scene);
+  if (st != FCM_OK) {
+    if (rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+    rc = 2;
+    goto done;
+  }
+  const char *name = fcm_scene_name(scene);
+  if (talk)
+    fprintf(stderr, "fcm-sim: scene %s (%s): building on %d process%s (backend petsc)\n", name,
+            fcm_scene_source(scene), size, size > 1 ? "es" : "");
+  double t0 = fcm_wtime();
+  st =
+      fcm_petsc_problem_create_from_scene(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO, &P);
+  if (st != FCM_OK) { /* every process has the error; process 0 prints it */
+    if (rank == 0) fprintf(stderr, "fcm-sim: scene %s: %s\n", name, fcm_ctx_error_message(ctx));
+    rc = st == FCM_ERR_ARG || st == FCM_ERR_IO || st == FCM_ERR_FORMAT || st == FCM_ERR_GEOMETRY ||
+                 st == FCM_ERR_UNSUPPORTED
+             ? 2
+             : 1;
+    goto done;
+  }
+  const double t_setup = fcm_wtime() - t0;
+  long long nsteps = (long long)fcm_scene_get_time(scene)->num_steps;
+  if (steps > 0 && steps < nsteps) nsteps = steps;
+  if (check && nsteps > 3) nsteps = 3;
+  const int write = !check;
+  const char *dir = outdir ? outdir : fcm_scene_get_output(scene)->directory;
+  const int interval = fcm_scene_get_output(scene)->frame_interval > 0
+                           ? fcm_scene_get_output(scene)->frame_interval
+                           : 1;
+  const fcm_index n = fcm_petsc_problem_num_dofs(P);
+  char logpath[4200], pvdpath[4200];
+  int frame = 0, ok = 1;
+  long long first = 0;
+  const int ck_every =
+      checkpoint_every >= 0 ? checkpoint_every : fcm_scene_get_output(scene)->checkpoint_interval;
+  if (resume) { /* every process reads the checkpoint */
+    st = fcm_petsc_problem_read_checkpoint(P, resume);
+    if (st != FCM_OK) {
+      if (rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+      rc = 2;
+      goto done;
+    }
+    first = fcm_petsc_problem_step_count(P);
+    if (talk) fprintf(stderr, "fcm-sim: resumed from %s at step %lld\n", resume, first);
+  }
+  u = calloc((size_t)n + 1, sizeof *u);
+  v = calloc((size_t)n + 1, sizeof *v);
+  rows = calloc((size_t)nsteps + 1, sizeof *rows);
+  if (!u || !v || !rows) {
+    fprintf(stderr, "fcm-sim: out of memory\n");
+    MPI_Abort(MPI_COMM_WORLD, 1); /* a local failure the others cannot learn otherwise */
+  }
+  snprintf(logpath, sizeof logpath, "%s/%s_log.csv", dir, name);
+  snprintf(pvdpath, sizeof pvdpath, "%s/%s.pvd", dir, name);
+  if (write && rank == 0) {
+    ok = make_dirs(dir) && fcm_pvd_create(ctx, pvdpath, &pvd) == FCM_OK;
+    /* resuming: the earlier frames (0, interval, 2 interval, ... <= first) are indexed again and
+     * the earlier log rows kept */
+    const double dt = fcm_scene_get_time(scene)->dt;
+    for (long long k = 0; ok && resume && k <= first && k <= nsteps; k += interval) {
+      char file[600];
+      snprintf(file, sizeof file, "%s_%04d.pvtu", name, frame++);
+      ok = fcm_pvd_add(pvd, (double)k * dt, file) == FCM_OK;
+    }
+    if (resume && first <= nsteps) read_old_log(logpath, rows, first);
+    if (!ok && fcm_ctx_error_status(ctx) != FCM_OK)
+      fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+  }
+  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  MPI_Bcast(&frame, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (!ok || (write && !resume && !write_frame(ctx, P, dir, name, frame++, 0.0, pvd, rank)))
+    goto done;
+  double t1 = fcm_wtime();
+  for (long long k = first + 1; k <= nsteps; k++) {
+    fcm_petsc_step_info si;
+    st = fcm_petsc_problem_step(P, &si);
+    if (st != FCM_OK) {
+      if (rank == 0) fprintf(stderr, "fcm-sim: step %lld: %s\n", k, fcm_ctx_error_message(ctx));
+      if (write && rank == 0) write_log(ctx, logpath, rows, k - 1);
+      goto done;
+    }
+    rows[k - 1] = (run_log){k,
+                            si.time,
+                            si.residual,
+                            si.kinetic_energy,
+                            si.elastic_energy,
+                            si.external_work,
+                            fcm_wtime() - t1,
+                            si.iterations};
+    if (talk)
+      fprintf(stderr, "fcm-sim: step %lld/%lld t = %.6g s: KSP %d iterations, residual %.3g\n", k,
+              nsteps, si.time, si.iterations, si.residual);
+    if (write && (k % interval == 0 || k == nsteps)) {
+      if (!write_frame(ctx, P, dir, name, frame++, si.time, pvd, rank)) goto done;
+      ok = rank != 0 || write_log(ctx, logpath, rows, k) == FCM_OK;
+      if (!ok) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+      MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+      if (!ok) goto done;
+    }
+    if (write && ck_every > 0 && k % ck_every == 0) {
+      char ck[4300];
+      snprintf(ck, sizeof ck, "%s/%s_checkpoint_%06lld.fcmpk", dir, name, k);
+      if (fcm_petsc_problem_write_checkpoint(P, ck) != FCM_OK) {
+        if (rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+        goto done;
+      }
+      if (talk) fprintf(stderr, "fcm-sim: checkpoint %s\n", ck);
+    }
+  }
+  fcm_petsc_info info;
+  if (fcm_petsc_problem_get_info(P, &info) != FCM_OK) goto done;
+  if (check) {
+    st = fcm_petsc_problem_get_state(P, u, v);
+    int finite = st == FCM_OK;
+    for (fcm_index i = 0; finite && i < n; i++)
+      finite = isfinite(u[i]) && isfinite(v[i]);
+    if (!finite) {
+      if (rank == 0) fprintf(stderr, "fcm-sim: non-finite state after %lld steps\n", nsteps);
+      goto done;
+    }
+  }
+  if (talk) {
+    const double tsteps = fcm_wtime() - t1;
+    printf("scene %s (backend petsc, %d process%s, partition %s)\n", name, size,
+           size > 1 ? "es" : "", fcm_petsc_partition_name(info.partition));
+    printf("  dofs      %lld; elements per process %lld .. %lld\n", (long long)info.num_dofs,
+           (long long)info.min_local_elements, (long long)info.max_local_elements);
+    printf("  steps     %lld, KSP iterations %lld\n", info.steps, info.total_iterations);
+    printf("  time      setup %.3g s (rules %.3g s, assembly %.3g s on process 0), steps %.3g s\n",
+           t_setup, info.time_rules, info.time_assembly, tsteps);
+    printf("  per dof   setup %.3g us, step %.3g us; memory %.0f bytes (all processes), "
+           "matrix %.0f bytes\n",
+           1e6 * t_setup / (double)info.num_dofs,
+           1e6 * tsteps / (double)(info.num_dofs * (info.steps > 0 ? info.steps : 1)),
+           info.memory_total / (double)info.num_dofs, info.matrix_memory / (double)info.num_dofs);
+    if (write) printf("  output    %s, %s\n", pvdpath, logpath);
+  }
+  rc = 0;
+done:
+  /* the exit code every process returns: the largest */
+  {
+    int all = rc;
+    MPI_Allreduce(&rc, &all, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    rc = all;
+  }
+  fcm_pvd_destroy(&pvd);
+  free(u);
+  free(v);
+  free(rows);
+  fcm_petsc_problem_destroy(&P);
+  fcm_scene_destroy(&scene);
+  fcm_ctx_destroy(&ctx);
+  fcm_petsc_finalize();
+  return rc;
+}

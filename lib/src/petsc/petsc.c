@@ -1,0 +1,1671 @@
+/* petsc: the PETSc + MPI adapter (fcm/petsc.h) — distributed linear elasticity, static and
+ * backward Euler, on a partition of the background cells. The only file that sees PETSc.
+ *
+ * NOTES (issue 14, for the next session) ---------------------------------------------------
+ * Done (phase 1):
+ * - build: FCM_WITH_PETSC (AUTO/ON/OFF) in CMakeLists.txt, FCM_HAVE_PETSC in fcm/version.h,
+ *   fcm.pc (variable petsc, Requires mpi-c) and fcmConfig.cmake (FCM_HAVE_PETSC, MPI::MPI_C);
+ *   setup.sh deps --petsc; .ci/run runs the mpi-labelled tests.
+ * - partition: PT-Scotch through MatPartitioning on the face graph of the active cells (Debian's
+ *   PETSc 3.18 has it), Morton-ordered fallback (FCM_PETSC_PARTITION_ORDERED). Weights: cut
+ *   cells 4, uncut 1 (a guess: measure the per-cell rule + assembly cost and weight by it next).
+ * - rules: each process builds the rules of its own cells (fcm_cell_rules_options.cell_mask);
+ *   the partition comes first, on the candidate cells (box meets a geometry cell's box; weight
+ *   4 where it meets a boundary triangle's box too), so one rules build per process; the
+ *   classification (intersection) of every cell runs on every process. Only the points
+ *   (mapping, simplification, stabilization, surface rules) are distributed.
+ * - DOFs: global numbering, owner = lowest process among the cells using the DOF copy, the
+ *   PETSc index is contiguous per owner; the perm (space DOF -> PETSc index) and the space's
+ *   pattern are REPLICATED (O(DOFs + nnz) integers per process).
+ * - assembly: own elements only (fcm__assembly_element_linear), MatSetValues ADD_VALUES into a
+ *   preallocated MATMPIAIJ (block size 3), VECMPI loads; stiffness, mass, gravity.
+ * - constraints: node sets with fcm_motion (no release), symmetric elimination with
+ *   MatZeroRowsColumns on a copy of the system matrix (diag = mean diagonal), RHS lifted with the
+ *   unmodified matrix every step.
+ * - solver: KSP CG + GAMG + MatNullSpaceCreateRigidBody by default; options string (scene
+ *   solver.petsc_options) then command line; divergence -> FCM_ERR_NOT_CONVERGED with
+ *   KSPConvergedReasons[].
+ * - errors: every local phase ends in agree(): an error on any process is returned on all with
+ *   the lowest failing process's message (tests/petsc: bad input on one rank, no hang).
+ * - output: fcm_petsc_problem_write_frame(): a .pvtu (process 0) naming one piece per process
+ *   (its own cells); the node fields come from the gathered (replicated) state.
+ * - scenes: fcm_petsc_problem_create_from_scene() (mesh + geometry through
+ *   fcm__scene_mesh_geometry() of lib/src/scene/run.c) and fcm-sim --backend petsc
+ *   (apps/fcm-sim-petsc.c); the example scene vibrating_beam.json is the dynamic one.
+ * Not done:
+ * - Newton / hyperelastic materials / the integrator's time stepping on PETSc (a hook in
+ *   lib/src/sim/linsolve.c would replace only the solve; the assembly seam is
+ *   fcm_assembly_workspace_hyperelastic, which needs an element-mask variant): this module is
+ *   the separate static + dynamic LINEAR driver the task allowed.
+ * - Nitsche/penalty boundary constraints, tractions, pressure, body-force fields, damping,
+ *   initial velocities, cuts, checkpoints (and --resume): fcm-sim --backend petsc refuses them
+ *   with a message naming the feature.
+ * - geometry kept whole on every process (no AABB crop), mesh replicated; the classification
+ *   (intersection of EVERY cell) runs on every process — on the bench body it costs 2-3x the
+ *   simplification, so distribute it next: intersect own candidate cells only and allgather
+ *   class / fraction / piece volumes (the rules would then take the classification of
+ *   unflagged cells from outside, a new option next to cell_mask).
+ * - the options string goes into the GLOBAL options database (it stays for later problems);
+ *   an options prefix per problem would scope it.
+ * - README projection for 1e8 DOFs (memory and time per DOF are printed by
+ *   tests/petsc/bench.c, figures in README "Distributed runs").
+ * ------------------------------------------------------------------------------------------ */
+#define _GNU_SOURCE /* RTLD_DEFAULT */
+#include "fcm/petsc.h"
+
+#include "core/core_impl.h"
+#include "embed/embed_impl.h"
+#include "fem/fem_impl.h"
+#include "scene/run_impl.h"
+
+#include <petscksp.h>
+#include <petscmat.h>
+
+#include <dlfcn.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define FCM_PETSC_CUT_WEIGHT 4
+
+struct fcm_petsc_problem {
+  fcm_ctx *ctx;
+  MPI_Comm comm;
+  int size, rank;
+  const fcm_mesh *mesh;
+  fcm_material mat;
+  fcm_petsc_options opts;
+  char *petsc_options; /* copy */
+  fcm_petsc_partition partition;
+  fcm_cell_rules *rules; /* this process's cells carry points */
+  fcm_space *space;      /* replicated topology */
+  fcm_assembly_workspace *aws;
+  fcm_index n;           /* global DOFs */
+  fcm_index ncopy;       /* n / 3 */
+  int *cell_owner;       /* num_cells (-1: inactive) */
+  unsigned char *weight; /* num_cells: partition weight of the candidate cells (0: none) */
+  int *copy_owner;       /* ncopy */
+  PetscInt *perm;        /* ncopy: PETSc block index of each copy */
+  PetscInt nlocal;       /* owned copies */
+  PetscInt first;        /* first owned PETSc block index */
+  fcm_index nelem_own;
+  /* constraints: DOFs (space numbering), motion of each, node of each */
+  fcm_index ncon;
+  fcm_index *con_dof, *con_node;
+  int *con_comp;
+  int *con_motion;
+  fcm_motion *motions;
+  int num_motions;
+  unsigned char *is_con; /* n */
+  double gravity[3];
+  int has_gravity;
+  int is_setup;
+  /* PETSc objects */
+  Mat K, M, S, Se; /* stiffness, mass (dynamic), system, system eliminated */
+  Vec f, u, v, b, x, g, w;
+  KSP ksp;
+  PetscInt *rows; /* owned constrained rows (PETSc indices) */
+  PetscInt nrows;
+  double diag;
+  double t;
+  long long steps, total_iterations;
+  double time_rules, time_assembly, time_setup;
+  fcm_mesh *own_mesh; /* built from a scene (fcm_petsc_problem_create_from_scene) */
+  fcm_geometry *own_geom;
+};
+
+/* ---------------------------------------------------------------- errors */
+
+/* A PETSc call: on failure, record its message as FCM_ERR_INTERNAL. */
+#define PCALL(ctx, call)                                                                           \
+  do {                                                                                             \
+    PetscErrorCode ierr_ = (call);                                                                 \
+    if (ierr_) {                                                                                   \
+      st = petsc_error((ctx), ierr_, #call, __FILE__, __LINE__, __func__);                         \
+      goto cleanup;                                                                                \
+    }                                                                                              \
+  } while (0)
+
+static fcm_status petsc_error(fcm_ctx *ctx, PetscErrorCode ierr, const char *call, const char *file,
+                              int line, const char *func)
+{
+  const char *text = NULL;
+  char *specific = NULL;
+  PetscErrorMessage((int)ierr, &text, &specific);
+  return fcm__error(ctx, FCM_ERR_INTERNAL, file, line, func, "petsc: %s failed: %s%s%s (error %d)",
+                    call, text ? text : "unknown error", specific && *specific ? ": " : "",
+                    specific ? specific : "", (int)ierr);
+}
+
+/* Every process learns whether any failed: on failure somewhere, every process returns the
+ * status and message of the lowest failing process (the others record it as their error). */
+static fcm_status agree(fcm_ctx *ctx, MPI_Comm comm, fcm_status st)
+{
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  int mine = st != FCM_OK ? rank : size, first = size;
+  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm);
+  if (first == size) return FCM_OK;
+  char msg[1024];
+  int code = (int)st;
+  memset(msg, 0, sizeof msg);
+  if (rank == first) snprintf(msg, sizeof msg, "%s", fcm_ctx_error_message(ctx));
+  MPI_Bcast(msg, (int)sizeof msg, MPI_CHAR, first, comm);
+  MPI_Bcast(&code, 1, MPI_INT, first, comm);
+  if (rank == first) {
+    if (size > 1) fcm__error_prefix(ctx, "(on this process)");
+    return st;
+  }
+  return fcm__error(ctx, (fcm_status)code, __FILE__, __LINE__, __func__,
+                    "process %d of %d failed: %s", first, size, msg);
+}
+
+/* ---------------------------------------------------------------- init */
+
+static int fcm_petsc_started_mpi = 0;
+
+fcm_status fcm_petsc_initialize(fcm_ctx *ctx, int *argc, char ***argv)
+{
+  fcm_status st = FCM_OK;
+  int mpi_on = 0;
+  PetscBool on = PETSC_FALSE;
+  MPI_Initialized(&mpi_on);
+  fcm_petsc_started_mpi = !mpi_on;
+  PCALL(ctx, PetscInitialized(&on));
+  if (!on) {
+    PetscErrorCode ierr = PetscInitialize(argc, argv, NULL, NULL);
+    FCM_CHECK(ierr == 0, ctx, FCM_ERR_INTERNAL, "petsc: PetscInitialize failed (error %d)",
+              (int)ierr);
+  }
+cleanup:
+  return st;
+}
+
+void fcm_petsc_finalize(void)
+{
+  PetscBool on = PETSC_FALSE;
+  if (PetscInitialized(&on) == 0 && on) PetscFinalize();
+}
+
+const char *fcm_petsc_partition_name(fcm_petsc_partition p)
+{
+  switch (p) {
+  case FCM_PETSC_PARTITION_AUTO:
+    return "auto";
+  case FCM_PETSC_PARTITION_PTSCOTCH:
+    return "ptscotch";
+  case FCM_PETSC_PARTITION_ORDERED:
+    return "ordered";
+  default:
+    return "invalid";
+  }
+}
+
+fcm_petsc_options fcm_petsc_options_default(void)
+{
+  fcm_petsc_options o;
+  memset(&o, 0, sizeof o);
+  o.kind = FCM_INTEGRATOR_BACKWARD_EULER;
+  o.dt = 1.0 / 60.0;
+  o.partition = FCM_PETSC_PARTITION_AUTO;
+  o.petsc_options = NULL;
+  o.rtol = 1e-10;
+  o.max_iterations = 10000;
+  o.rules = fcm_cell_rules_options_default();
+  o.assembly = fcm_assembly_options_default();
+  return o;
+}
+
+/* ---------------------------------------------------------------- partition */
+
+/* Spread the 21 low bits of x to every third bit. */
+static uint64_t spread3(uint64_t x)
+{
+  x &= 0x1fffff;
+  x = (x | x << 32) & 0x1f00000000ffffULL;
+  x = (x | x << 16) & 0x1f0000ff0000ffULL;
+  x = (x | x << 8) & 0x100f00f00f00f00fULL;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+  x = (x | x << 2) & 0x1249249249249249ULL;
+  return x;
+}
+
+typedef struct keyed {
+  uint64_t key;
+  fcm_index cell;
+} keyed;
+
+static int cmp_keyed(const void *a, const void *b)
+{
+  const keyed *x = a, *y = b;
+  if (x->key != y->key) return x->key < y->key ? -1 : 1;
+  return x->cell < y->cell ? -1 : x->cell > y->cell;
+}
+
+/* Partition weight of a candidate cell (candidate_cells()): cut cells carry their own rules
+ * (intersection, simplification, stabilization: several times an uncut cell's work), so cells
+ * that probably are cut weigh FCM_PETSC_CUT_WEIGHT, the others 1 (a heuristic: the rule and
+ * assembly costs per cell are not measured per run). */
+static int cell_weight(const fcm_petsc_problem *P, fcm_index c)
+{
+  return P->weight[c];
+}
+
+/* ORDERED: active cells along the Morton curve of their centroids, equal contiguous parts. */
+static fcm_status partition_ordered(fcm_petsc_problem *P, const unsigned char *active,
+                                    fcm_index nact)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_index nc = fcm_mesh_num_cells(P->mesh);
+  const int nn = fcm_mesh_nodes_per_cell(P->mesh);
+  keyed *k = NULL;
+  double *X = NULL, lo[3], hi[3];
+  FCM_ALLOC(ctx, nact + 1, k);
+  FCM_ALLOC(ctx, 3 * nn, X);
+  fcm_mesh_bounding_box(P->mesh, lo, hi);
+  fcm_index m = 0;
+  for (fcm_index c = 0; c < nc; c++) {
+    if (!active[c]) continue;
+    double x[3] = {0, 0, 0};
+    fcm_mesh_cell_coords(P->mesh, c, X);
+    for (int a = 0; a < nn; a++)
+      for (int i = 0; i < 3; i++)
+        x[i] += X[3 * a + i] / nn;
+    uint64_t key = 0;
+    for (int i = 0; i < 3; i++) {
+      double s = hi[i] > lo[i] ? (x[i] - lo[i]) / (hi[i] - lo[i]) : 0.0;
+      uint64_t q = (uint64_t)(fmin(fmax(s, 0.0), 1.0) * 2097151.0);
+      key |= spread3(q) << i;
+    }
+    k[m].key = key;
+    k[m].cell = c;
+    m++;
+  }
+  qsort(k, (size_t)m, sizeof *k, cmp_keyed);
+  double wsum = 0.0, w = 0.0;
+  for (fcm_index i = 0; i < m; i++)
+    wsum += cell_weight(P, k[i].cell);
+  for (fcm_index i = 0; i < m; i++) { /* equal weight per process, cut at the mid-weight */
+    const double wc = cell_weight(P, k[i].cell);
+    const int r = (int)((w + 0.5 * wc) * P->size / wsum);
+    P->cell_owner[k[i].cell] = r < P->size ? r : P->size - 1;
+    w += wc;
+  }
+cleanup:
+  fcm__free(ctx, k);
+  fcm__free(ctx, X);
+  return st;
+}
+
+/* PT-Scotch draws from a random generator whose state persists between calls, so a second
+ * problem in the same run would get another partition (and other rounding). Reset it before
+ * each partition when the library PETSc loaded exports SCOTCH_randomReset (looked up at run
+ * time: fcm does not link Scotch itself), so equal inputs give equal partitions. */
+static void scotch_random_reset(void)
+{
+  void (*reset)(void) = NULL;
+  void *sym = dlsym(RTLD_DEFAULT, "SCOTCH_randomReset");
+  memcpy(&reset, &sym, sizeof reset);
+  if (reset) reset();
+}
+
+/* PTSCOTCH: MatPartitioning of the face graph of the active cells; each process hands a
+ * contiguous block of them to PETSc, the result is gathered on every process. */
+static fcm_status partition_graph(fcm_petsc_problem *P, const unsigned char *active, fcm_index nact)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_index nc = fcm_mesh_num_cells(P->mesh);
+  const int nf = fcm_mesh_get_element_info(P->mesh)->num_faces;
+  const fcm_index *nb = fcm_mesh_neighbors(P->mesh);
+  fcm_index *act_id = NULL, *act_cell = NULL;
+  PetscInt *ia = NULL, *ja = NULL;
+  Mat adj = NULL;
+  MatPartitioning part = NULL;
+  IS is = NULL, isg = NULL;
+  const PetscInt *own = NULL;
+  FCM_ALLOC(ctx, nc + 1, act_id);
+  FCM_ALLOC(ctx, nact + 1, act_cell);
+  fcm_index m = 0;
+  for (fcm_index c = 0; c < nc; c++) {
+    act_id[c] = active[c] ? m : -1;
+    if (active[c]) act_cell[m++] = c;
+  }
+  const fcm_index lo = nact * P->rank / P->size, hi = nact * (P->rank + 1) / P->size;
+  const PetscInt ml = (PetscInt)(hi - lo);
+  PCALL(ctx, PetscMalloc1(ml + 1, &ia));
+  PCALL(ctx, PetscMalloc1(ml * nf + 1, &ja));
+  ia[0] = 0;
+  for (fcm_index i = lo; i < hi; i++) {
+    PetscInt r = (PetscInt)(i - lo), cnt = ia[r];
+    const fcm_index c = act_cell[i];
+    for (int f = 0; f < nf; f++) {
+      fcm_index o = nb[(size_t)nf * c + f];
+      if (o >= 0 && active[o]) ja[cnt++] = (PetscInt)act_id[o];
+    }
+    /* MatCreateMPIAdj wants sorted columns */
+    for (PetscInt a = ia[r] + 1; a < cnt; a++)
+      for (PetscInt b = a; b > ia[r] && ja[b - 1] > ja[b]; b--) {
+        PetscInt t = ja[b];
+        ja[b] = ja[b - 1];
+        ja[b - 1] = t;
+      }
+    ia[r + 1] = cnt;
+  }
+  PCALL(ctx, MatCreateMPIAdj(P->comm, ml, (PetscInt)nact, ia, ja, NULL, &adj));
+  ia = ja = NULL; /* owned by adj */
+  PCALL(ctx, MatPartitioningCreate(P->comm, &part));
+  PCALL(ctx, MatPartitioningSetAdjacency(part, adj));
+  {
+    PetscInt *vw = NULL; /* vertex weights: freed by the partitioning */
+    PCALL(ctx, PetscMalloc1(ml + 1, &vw));
+    for (fcm_index i = lo; i < hi; i++)
+      vw[i - lo] = cell_weight(P, act_cell[i]);
+    PCALL(ctx, MatPartitioningSetVertexWeights(part, vw));
+  }
+  PCALL(ctx, MatPartitioningSetType(part, MATPARTITIONINGPTSCOTCH));
+  PCALL(ctx, MatPartitioningSetFromOptions(part));
+  scotch_random_reset();
+  PCALL(ctx, MatPartitioningApply(part, &is));
+  PCALL(ctx, ISAllGather(is, &isg));
+  PCALL(ctx, ISGetIndices(isg, &own));
+  for (fcm_index i = 0; i < nact; i++)
+    P->cell_owner[act_cell[i]] = (int)own[i];
+  PCALL(ctx, ISRestoreIndices(isg, &own));
+cleanup:
+  PetscFree(ia);
+  PetscFree(ja);
+  ISDestroy(&is);
+  ISDestroy(&isg);
+  MatPartitioningDestroy(&part);
+  MatDestroy(&adj);
+  fcm__free(ctx, act_id);
+  fcm__free(ctx, act_cell);
+  return st;
+}
+
+/* ---------------------------------------------------------------- create */
+
+static fcm_status check_inputs(fcm_petsc_problem *P, const fcm_petsc_options *o)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  FCM_TRY(ctx, fcm_material_validate(ctx, &P->mat));
+  FCM_CHECK(P->mat.model == FCM_MATERIAL_LINEAR, ctx, FCM_ERR_UNSUPPORTED,
+            "petsc: material model %d: the PETSc backend solves linear elasticity only (model "
+            "linear); use the serial backend for hyperelastic materials",
+            (int)P->mat.model);
+  FCM_CHECK(o->kind == FCM_INTEGRATOR_STATIC || o->kind == FCM_INTEGRATOR_BACKWARD_EULER, ctx,
+            FCM_ERR_ARG, "petsc: kind = %d is neither static (0) nor backward Euler (1)",
+            (int)o->kind);
+  FCM_CHECK(isfinite(o->dt) && o->dt > 0.0, ctx, FCM_ERR_ARG, "petsc: dt = %g must be > 0", o->dt);
+  FCM_CHECK((int)o->partition >= 0 && o->partition < FCM_PETSC_PARTITION_COUNT, ctx, FCM_ERR_ARG,
+            "petsc: partition = %d is not a method (0 auto, 1 ptscotch, 2 ordered)",
+            (int)o->partition);
+  FCM_CHECK(o->rtol > 0.0 && o->rtol < 1.0, ctx, FCM_ERR_ARG, "petsc: rtol = %g outside (0, 1)",
+            o->rtol);
+  FCM_CHECK(o->max_iterations >= 1, ctx, FCM_ERR_ARG, "petsc: max_iterations = %d must be >= 1",
+            o->max_iterations);
+  FCM_CHECK(o->rules.simplify != FCM_CELL_SIMPLIFY_AUTO, ctx, FCM_ERR_UNSUPPORTED,
+            "petsc: rules.simplify = auto is not supported (the choice would differ between "
+            "processes); use on or off");
+cleanup:
+  return st;
+}
+
+/* The rules (geometry: points on the cells flagged in `mask` only) or the plain space. */
+static fcm_status build_space(fcm_petsc_problem *P, const fcm_geometry *geom,
+                              const unsigned char *mask)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  if (geom) {
+    fcm_cell_rules_options ro = P->opts.rules;
+    ro.kinds =
+        FCM_RULES_STIFFNESS | (P->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER ? FCM_RULES_MASS : 0u);
+    ro.cell_mask = mask;
+    FCM_TRY(ctx, fcm_cell_rules_create(ctx, P->mesh, geom, &ro, &P->rules));
+    FCM_TRY(ctx, fcm_space_create_embedded(ctx, P->mesh, P->rules, &P->space));
+  } else {
+    FCM_TRY(ctx, fcm_space_create(ctx, P->mesh, NULL, &P->space));
+  }
+cleanup:
+  return st;
+}
+
+/* Boxes (lo[3], hi[3]) of the n cells (npc nodes each, connectivity conn) of coordinates X. */
+static fcm_status cell_boxes(fcm_ctx *ctx, fcm_index n, int npc, const fcm_index *conn,
+                             const double *X, double **out)
+{
+  fcm_status st = FCM_OK;
+  double *b = NULL;
+  FCM_ALLOC(ctx, 6 * (size_t)n + 1, b);
+  for (fcm_index i = 0; i < n; i++) {
+    double *bi = b + 6 * i;
+    for (int d = 0; d < 3; d++)
+      bi[d] = HUGE_VAL, bi[3 + d] = -HUGE_VAL;
+    for (int a = 0; a < npc; a++)
+      for (int d = 0; d < 3; d++) {
+        const double v = X[3 * conn[(size_t)npc * i + a] + d];
+        bi[d] = fmin(bi[d], v);
+        bi[3 + d] = fmax(bi[3 + d], v);
+      }
+  }
+  *out = b;
+cleanup:
+  return st;
+}
+
+/* P->weight[c]: 0 no candidate, 1 candidate, FCM_PETSC_CUT_WEIGHT candidate whose box also
+ * meets a boundary triangle's box. Without a geometry every cell weighs 1. */
+static fcm_status candidate_cells(fcm_petsc_problem *P, const fcm_geometry *geom)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_mesh *mesh = P->mesh;
+  const fcm_index nc = fcm_mesh_num_cells(mesh);
+  double *gb = NULL, *tb = NULL, *cb = NULL;
+  fcm_aabb_tree *gt = NULL, *tt = NULL;
+  if (!geom) {
+    for (fcm_index c = 0; c < nc; c++)
+      P->weight[c] = 1;
+    return FCM_OK;
+  }
+  const fcm_index ng = fcm_geometry_num_cells(geom);
+  const fcm_index nt = fcm_geometry_num_boundary_triangles(geom);
+  FCM_TRY(ctx, cell_boxes(ctx, ng, fcm_geometry_nodes_per_cell(geom), fcm_geometry_cells(geom),
+                          fcm_geometry_coords(geom), &gb));
+  FCM_TRY(ctx, cell_boxes(ctx, nt, 3, fcm_geometry_boundary_triangles(geom),
+                          fcm_geometry_coords(geom), &tb));
+  FCM_TRY(ctx, cell_boxes(ctx, nc, fcm_mesh_nodes_per_cell(mesh), fcm_mesh_cells(mesh),
+                          fcm_mesh_coords(mesh), &cb));
+  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, ng, gb, &gt));
+  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nt, tb, &tt));
+  for (fcm_index c = 0; c < nc; c++) {
+    fcm_index hits = 0;
+    FCM_TRY(ctx, fcm_aabb_tree_query(gt, cb + 6 * c, cb + 6 * c + 3, 0, NULL, &hits));
+    P->weight[c] = 0;
+    if (hits == 0) continue;
+    FCM_TRY(ctx, fcm_aabb_tree_query(tt, cb + 6 * c, cb + 6 * c + 3, 0, NULL, &hits));
+    P->weight[c] = hits > 0 ? FCM_PETSC_CUT_WEIGHT : 1;
+  }
+cleanup:
+  fcm_aabb_tree_destroy(&gt);
+  fcm_aabb_tree_destroy(&tt);
+  fcm__free(ctx, gb);
+  fcm__free(ctx, tb);
+  fcm__free(ctx, cb);
+  return st;
+}
+
+/* Ownership of the DOF copies and the PETSc numbering. */
+static fcm_status number_dofs(fcm_petsc_problem *P)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_space *s = P->space;
+  const int nn = s->nn;
+  PetscInt *count = NULL;
+  P->n = s->num_dofs;
+  P->ncopy = P->n / 3;
+  FCM_CHECK(P->n < (fcm_index)INT32_MAX, ctx, FCM_ERR_UNSUPPORTED,
+            "petsc: %lld DOFs exceed PETSc's 32-bit indices (Debian's build); use a PETSc with "
+            "--with-64-bit-indices",
+            (long long)P->n);
+  FCM_ALLOC(ctx, P->ncopy + 1, P->copy_owner);
+  FCM_ALLOC(ctx, P->ncopy + 1, P->perm);
+  FCM_ALLOC(ctx, P->size + 1, count);
+  for (fcm_index k = 0; k < P->ncopy; k++)
+    P->copy_owner[k] = P->size;
+  P->nelem_own = 0;
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    const int r = P->cell_owner[s->elem_cell[e]];
+    if (r == P->rank) P->nelem_own++;
+    for (int a = 0; a < nn; a++) {
+      const fcm_index k = s->elem_dof[e * nn + a] / 3;
+      if (r < P->copy_owner[k]) P->copy_owner[k] = r;
+    }
+  }
+  for (fcm_index k = 0; k < P->ncopy; k++) {
+    FCM_CHECK(P->copy_owner[k] < P->size, ctx, FCM_ERR_INTERNAL,
+              "petsc: DOF copy %lld belongs to no element", (long long)k);
+    count[P->copy_owner[k]]++;
+  }
+  /* exclusive prefix: the first block of each process, then running positions */
+  PetscInt acc = 0;
+  for (int r = 0; r <= P->size; r++) {
+    PetscInt c = count[r];
+    count[r] = acc;
+    acc += c;
+  }
+  P->first = count[P->rank];
+  P->nlocal = count[P->rank + 1] - count[P->rank];
+  for (fcm_index k = 0; k < P->ncopy; k++)
+    P->perm[k] = count[P->copy_owner[k]]++;
+cleanup:
+  fcm__free(ctx, count);
+  return st;
+}
+
+/* A preallocated MATMPIAIJ (block size 3) with the space's pattern on the owned rows. */
+static fcm_status create_matrix(fcm_petsc_problem *P, Mat *A)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_space *s = P->space;
+  PetscInt *dnz = NULL, *onz = NULL;
+  const PetscInt nl = 3 * P->nlocal;
+  FCM_ALLOC(ctx, nl + 1, dnz);
+  FCM_ALLOC(ctx, nl + 1, onz);
+  for (fcm_index k = 0; k < P->ncopy; k++) {
+    if (P->copy_owner[k] != P->rank) continue;
+    PetscInt d = 0, o = 0;
+    for (fcm_index j = s->node_ptr[k]; j < s->node_ptr[k + 1]; j++) {
+      if (P->copy_owner[s->node_adj[j]] == P->rank)
+        d += 3;
+      else
+        o += 3;
+    }
+    const PetscInt row = 3 * (P->perm[k] - P->first);
+    for (int i = 0; i < 3; i++) {
+      dnz[row + i] = d;
+      onz[row + i] = o;
+    }
+  }
+  PCALL(ctx, MatCreate(P->comm, A));
+  PCALL(ctx, MatSetSizes(*A, nl, nl, (PetscInt)P->n, (PetscInt)P->n));
+  PCALL(ctx, MatSetType(*A, MATMPIAIJ));
+  PCALL(ctx, MatSetBlockSize(*A, 3));
+  PCALL(ctx, MatMPIAIJSetPreallocation(*A, 0, dnz, 0, onz));
+  PCALL(ctx, MatSetOption(*A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+  PCALL(ctx, MatSetOption(*A, MAT_SYMMETRIC, PETSC_TRUE));
+cleanup:
+  fcm__free(ctx, dnz);
+  fcm__free(ctx, onz);
+  return st;
+}
+
+static fcm_status create_vectors(fcm_petsc_problem *P)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  PCALL(ctx, VecCreateMPI(P->comm, 3 * P->nlocal, (PetscInt)P->n, &P->f));
+  PCALL(ctx, VecSetBlockSize(P->f, 3));
+  Vec *vs[] = {&P->u, &P->v, &P->b, &P->x, &P->g, &P->w};
+  for (size_t i = 0; i < sizeof vs / sizeof vs[0]; i++) {
+    PCALL(ctx, VecDuplicate(P->f, vs[i]));
+    PCALL(ctx, VecSet(*vs[i], 0.0));
+  }
+  PCALL(ctx, VecSet(P->f, 0.0));
+cleanup:
+  return st;
+}
+
+fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh *mesh,
+                                    const fcm_geometry *geom, const fcm_material *mat,
+                                    const fcm_petsc_options *opts, fcm_petsc_problem **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_petsc_problem *P = NULL;
+  unsigned char *mask = NULL;
+  const double t0 = fcm_wtime();
+  FCM_CHECK(out, ctx, FCM_ERR_ARG, "petsc: output pointer is NULL");
+  *out = NULL;
+  FCM_CHECK(ctx && mesh && mat, ctx, FCM_ERR_ARG, "petsc: NULL argument (ctx, mesh, material)");
+  FCM_ALLOC(ctx, 1, P);
+  P->ctx = ctx;
+  P->comm = MPI_COMM_NULL;
+  if (MPI_Comm_dup(comm, &P->comm) != MPI_SUCCESS) {
+    P->comm = MPI_COMM_NULL;
+    FCM_CHECK(0, ctx, FCM_ERR_ARG, "petsc: MPI_Comm_dup failed (invalid communicator?)");
+  }
+  MPI_Comm_size(P->comm, &P->size);
+  MPI_Comm_rank(P->comm, &P->rank);
+  P->mesh = mesh;
+  P->mat = *mat;
+  P->opts = opts ? *opts : fcm_petsc_options_default();
+  if (P->opts.petsc_options) {
+    size_t len = strlen(P->opts.petsc_options);
+    P->petsc_options = fcm__calloc(ctx, len + 1, 1);
+    if (P->petsc_options)
+      memcpy(P->petsc_options, P->opts.petsc_options, len);
+    else
+      st = FCM_ERR_ALLOC;
+  }
+  P->opts.petsc_options = NULL;
+  if (st == FCM_OK) st = check_inputs(P, &P->opts);
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+
+  /* 1. the candidate cells: those whose box meets the box of a geometry cell (every cell
+   * without a geometry), weighted FCM_PETSC_CUT_WEIGHT where it also meets a boundary
+   * triangle's box (likely cut), 1 otherwise; a superset of the active cells, found without
+   * intersecting anything */
+  const fcm_index nc = fcm_mesh_num_cells(mesh);
+  const double tr = fcm_wtime();
+  mask = fcm__calloc(ctx, (size_t)nc + 1, 1);
+  P->cell_owner = fcm__calloc(ctx, (size_t)nc + 1, sizeof *P->cell_owner);
+  P->weight = fcm__calloc(ctx, (size_t)nc + 1, 1);
+  st = mask && P->cell_owner && P->weight ? FCM_OK : FCM_ERR_ALLOC;
+  if (st == FCM_OK) st = candidate_cells(P, geom);
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  fcm_index ncand = 0;
+  for (fcm_index c = 0; c < nc; c++) {
+    P->cell_owner[c] = -1;
+    ncand += P->weight[c] != 0;
+  }
+
+  /* 2. partition the candidate cells */
+  P->partition = P->opts.partition == FCM_PETSC_PARTITION_AUTO ? FCM_PETSC_PARTITION_PTSCOTCH
+                                                               : P->opts.partition;
+  if (P->size == 1) {
+    for (fcm_index c = 0; c < nc; c++)
+      if (P->weight[c]) P->cell_owner[c] = 0;
+  } else if (P->partition == FCM_PETSC_PARTITION_PTSCOTCH) {
+    st = partition_graph(P, P->weight, ncand);
+  } else {
+    st = partition_ordered(P, P->weight, ncand);
+  }
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+
+  /* 3. the rules, with points on this process's cells only (every process classifies every
+   * cell: the replicated part), and the space; candidates the rules drop own nothing */
+  for (fcm_index c = 0; c < nc; c++)
+    mask[c] = P->cell_owner[c] == P->rank;
+  st = build_space(P, geom, mask);
+  for (fcm_index c = 0; st == FCM_OK && c < nc; c++) {
+    if (P->space->active[c] && P->cell_owner[c] < 0)
+      st = fcm__error(ctx, FCM_ERR_INTERNAL, __FILE__, __LINE__, __func__,
+                      "petsc: active cell %lld is no candidate (its box meets no geometry cell)",
+                      (long long)c);
+    if (!P->space->active[c]) P->cell_owner[c] = -1;
+  }
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  P->time_rules = fcm_wtime() - tr;
+  st = fcm_assembly_workspace_create(P->space, &P->opts.assembly, &P->aws);
+  if (st == FCM_OK) st = number_dofs(P);
+  if (st == FCM_OK) {
+    P->is_con = fcm__calloc(ctx, (size_t)P->n + 1, 1);
+    if (!P->is_con) st = FCM_ERR_ALLOC;
+  }
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+
+  /* 4. matrices and vectors (collective) */
+  st = create_matrix(P, &P->K);
+  if (st == FCM_OK && P->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) st = create_matrix(P, &P->M);
+  if (st == FCM_OK) st = create_vectors(P);
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  P->time_setup = fcm_wtime() - t0;
+  *out = P;
+  P = NULL;
+cleanup:
+  fcm__free(ctx, mask);
+  fcm_petsc_problem_destroy(&P);
+  return st;
+}
+
+void fcm_petsc_problem_destroy(fcm_petsc_problem **problem)
+{
+  if (!problem || !*problem) return;
+  fcm_petsc_problem *P = *problem;
+  fcm_ctx *ctx = P->ctx;
+  KSPDestroy(&P->ksp);
+  Mat *ms[] = {&P->K, &P->M, &P->S, &P->Se};
+  for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++)
+    MatDestroy(ms[i]);
+  Vec *vs[] = {&P->f, &P->u, &P->v, &P->b, &P->x, &P->g, &P->w};
+  for (size_t i = 0; i < sizeof vs / sizeof vs[0]; i++)
+    VecDestroy(vs[i]);
+  PetscFree(P->rows);
+  fcm_assembly_workspace_destroy(&P->aws);
+  fcm_space_destroy(&P->space);
+  fcm_cell_rules_destroy(&P->rules);
+  void *arrays[] = {P->petsc_options, P->weight,  P->cell_owner, P->copy_owner,
+                    P->perm,          P->con_dof, P->con_node,   P->con_comp,
+                    P->con_motion,    P->motions, P->is_con};
+  for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
+    fcm__free(ctx, arrays[i]);
+  if (P->comm != MPI_COMM_NULL) MPI_Comm_free(&P->comm);
+  fcm_geometry_destroy(&P->own_geom);
+  fcm_mesh_destroy(&P->own_mesh);
+  fcm__free(ctx, P);
+  *problem = NULL;
+}
+
+/* ---------------------------------------------------------------- configuration */
+
+fcm_status fcm_petsc_problem_add_gravity(fcm_petsc_problem *P, const double accel[3])
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
+  fcm_ctx *ctx = P->ctx;
+  if (P->is_setup)
+    st = fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                    "petsc: add_gravity after setup");
+  else if (!accel || !isfinite(accel[0]) || !isfinite(accel[1]) || !isfinite(accel[2]))
+    st = fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                    "petsc: gravity acceleration is NULL or not finite");
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  for (int i = 0; i < 3; i++)
+    P->gravity[i] += accel[i];
+  P->has_gravity = 1;
+cleanup:
+  return st;
+}
+
+static int finite3(const double x[3])
+{
+  return isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]);
+}
+
+/* Check a constraint (local, no change). */
+static fcm_status check_constraint(fcm_petsc_problem *P, fcm_index num_nodes,
+                                   const fcm_index *nodes, const fcm_motion *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_space *s = P->space;
+  FCM_CHECK(!P->is_setup, ctx, FCM_ERR_ARG, "petsc: add_constraint after setup");
+  FCM_CHECK(m && num_nodes >= 0 && (num_nodes == 0 || nodes), ctx, FCM_ERR_ARG,
+            "petsc: constraint: NULL motion or nodes, or num_nodes = %lld < 0",
+            (long long)num_nodes);
+  FCM_CHECK(finite3(m->velocity) && finite3(m->center) && finite3(m->axis) &&
+                isfinite(m->angular_speed) && isfinite(m->start) && !isnan(m->end) &&
+                m->end >= m->start,
+            ctx, FCM_ERR_ARG, "petsc: constraint: motion with a non-finite member or end < start");
+  FCM_CHECK(!m->release, ctx, FCM_ERR_UNSUPPORTED,
+            "petsc: constraint: release (a constraint set that changes in time) is not "
+            "supported by the PETSc backend");
+  for (fcm_index k = 0; k < num_nodes; k++) {
+    FCM_CHECK(nodes[k] >= 0 && nodes[k] < s->num_nodes, ctx, FCM_ERR_ARG,
+              "petsc: constraint: node %lld (entry %lld) outside [0, %lld)", (long long)nodes[k],
+              (long long)k, (long long)s->num_nodes);
+    for (fcm_index c = 0; c < s->node_ncopy[nodes[k]]; c++)
+      for (int i = 0; i < 3; i++)
+        FCM_CHECK(!m->components[i] || !P->is_con[s->node_dof[nodes[k]] + 3 * c + i], ctx,
+                  FCM_ERR_ARG,
+                  "petsc: constraint %d: component %d of node %lld is constrained already (by "
+                  "constraint %d); a DOF may belong to one constraint only",
+                  P->num_motions, i, (long long)nodes[k],
+                  (int)P->is_con[s->node_dof[nodes[k]] + 3 * c + i] - 1);
+  }
+cleanup:
+  return st;
+}
+
+/* Add a validated constraint (local; only allocation can fail). */
+static fcm_status apply_constraint(fcm_petsc_problem *P, fcm_index num_nodes,
+                                   const fcm_index *nodes, const fcm_motion *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_space *s = P->space;
+  fcm_index add = 0;
+  for (fcm_index k = 0; k < num_nodes; k++)
+    add += 3 * s->node_ncopy[nodes[k]];
+  FCM_CHECK(fcm__resize(ctx, (void **)&P->motions, (size_t)P->num_motions,
+                        (size_t)P->num_motions + 1, sizeof *P->motions) == FCM_OK &&
+                fcm__resize(ctx, (void **)&P->con_dof, (size_t)P->ncon, (size_t)(P->ncon + add),
+                            sizeof *P->con_dof) == FCM_OK &&
+                fcm__resize(ctx, (void **)&P->con_node, (size_t)P->ncon, (size_t)(P->ncon + add),
+                            sizeof *P->con_node) == FCM_OK &&
+                fcm__resize(ctx, (void **)&P->con_comp, (size_t)P->ncon, (size_t)(P->ncon + add),
+                            sizeof *P->con_comp) == FCM_OK &&
+                fcm__resize(ctx, (void **)&P->con_motion, (size_t)P->ncon, (size_t)(P->ncon + add),
+                            sizeof *P->con_motion) == FCM_OK,
+            ctx, FCM_ERR_ALLOC, "petsc: constraint: out of memory");
+  P->motions[P->num_motions] = *m;
+  for (fcm_index k = 0; k < num_nodes; k++) {
+    const fcm_index nd = nodes[k];
+    for (fcm_index c = 0; c < s->node_ncopy[nd]; c++)
+      for (int i = 0; i < 3; i++) {
+        if (!m->components[i]) continue;
+        const fcm_index d = s->node_dof[nd] + 3 * c + i;
+        if (P->is_con[d]) continue; /* listed twice in this set (others: check_constraint) */
+        P->is_con[d] = (unsigned char)(P->num_motions + 1 > 255 ? 255 : P->num_motions + 1);
+        P->con_dof[P->ncon] = d;
+        P->con_node[P->ncon] = nd;
+        P->con_comp[P->ncon] = i;
+        P->con_motion[P->ncon] = P->num_motions;
+        P->ncon++;
+      }
+  }
+  P->num_motions++;
+cleanup:
+  return st;
+}
+
+fcm_status fcm_petsc_problem_add_constraint(fcm_petsc_problem *P, fcm_index num_nodes,
+                                            const fcm_index *nodes, const fcm_motion *motion)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
+  /* every process checks its input before any changes its state */
+  st = check_constraint(P, num_nodes, nodes, motion);
+  FCM_TRY(P->ctx, agree(P->ctx, P->comm, st));
+  st = apply_constraint(P, num_nodes, nodes, motion);
+  FCM_TRY(P->ctx, agree(P->ctx, P->comm, st));
+cleanup:
+  return st;
+}
+
+/* ---------------------------------------------------------------- setup */
+
+/* Add this process's elements of `form` into A (matrix terms) or f (vector terms). */
+static fcm_status assemble_local(fcm_petsc_problem *P, const fcm_linear_form *form, Mat A, Vec f)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_space *s = P->space;
+  const int nn = s->nn, nd = 3 * nn;
+  double *Ke = NULL, *fe = NULL;
+  PetscInt *idx = NULL;
+  FCM_ALLOC(ctx, (size_t)nd * nd, Ke);
+  FCM_ALLOC(ctx, nd, fe);
+  FCM_ALLOC(ctx, nd, idx);
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    if (P->cell_owner[s->elem_cell[e]] != P->rank) continue;
+    FCM_TRY(ctx, fcm__assembly_element_linear(P->aws, form, e, A ? Ke : NULL, f ? fe : NULL));
+    for (int a = 0; a < nn; a++) {
+      const fcm_index d = s->elem_dof[e * nn + a];
+      for (int i = 0; i < 3; i++)
+        idx[3 * a + i] = 3 * P->perm[d / 3] + i;
+    }
+    if (A) PCALL(ctx, MatSetValues(A, nd, idx, nd, idx, Ke, ADD_VALUES));
+    if (f) PCALL(ctx, VecSetValues(f, nd, idx, fe, ADD_VALUES));
+  }
+cleanup:
+  fcm__free(ctx, Ke);
+  fcm__free(ctx, fe);
+  fcm__free(ctx, idx);
+  return st;
+}
+
+/* The assembly of all terms of this process: local element loops (errors agreed on before
+ * the collective MatAssembly). */
+static fcm_status assemble_all(fcm_petsc_problem *P)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  fcm_linear_form form = fcm_linear_form_default();
+  form.material = &P->mat;
+  form.term = FCM_LINEAR_STIFFNESS;
+  st = assemble_local(P, &form, P->K, NULL);
+  if (st == FCM_OK && P->M) {
+    form.term = FCM_LINEAR_MASS;
+    st = assemble_local(P, &form, P->M, NULL);
+  }
+  if (st == FCM_OK && P->has_gravity) {
+    form.term = FCM_LINEAR_BODY_FORCE;
+    form.accel = P->gravity;
+    st = assemble_local(P, &form, NULL, P->f);
+  }
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  PCALL(ctx, MatAssemblyBegin(P->K, MAT_FINAL_ASSEMBLY));
+  PCALL(ctx, MatAssemblyEnd(P->K, MAT_FINAL_ASSEMBLY));
+  if (P->M) {
+    PCALL(ctx, MatAssemblyBegin(P->M, MAT_FINAL_ASSEMBLY));
+    PCALL(ctx, MatAssemblyEnd(P->M, MAT_FINAL_ASSEMBLY));
+  }
+  PCALL(ctx, VecAssemblyBegin(P->f));
+  PCALL(ctx, VecAssemblyEnd(P->f));
+cleanup:
+  return st;
+}
+
+/* Coordinates of the owned DOF copies (their node's), block size 3, for the rigid-body modes. */
+static fcm_status near_null_space(fcm_petsc_problem *P, Mat A)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_space *s = P->space;
+  const double *X = fcm_mesh_coords(P->mesh);
+  Vec coords = NULL;
+  MatNullSpace nsp = NULL;
+  PetscScalar *c = NULL;
+  PCALL(ctx, VecDuplicate(P->f, &coords));
+  PCALL(ctx, VecGetArray(coords, &c));
+  for (fcm_index nd = 0; nd < s->num_nodes; nd++)
+    for (fcm_index k = 0; k < s->node_ncopy[nd]; k++) {
+      const fcm_index copy = s->node_dof[nd] / 3 + k;
+      if (P->copy_owner[copy] != P->rank) continue;
+      const PetscInt r = 3 * (P->perm[copy] - P->first);
+      for (int i = 0; i < 3; i++)
+        c[r + i] = X[3 * nd + i];
+    }
+  PCALL(ctx, VecRestoreArray(coords, &c));
+  c = NULL;
+  PCALL(ctx, MatNullSpaceCreateRigidBody(coords, &nsp));
+  PCALL(ctx, MatSetNearNullSpace(A, nsp));
+cleanup:
+  if (c) VecRestoreArray(coords, &c);
+  MatNullSpaceDestroy(&nsp);
+  VecDestroy(&coords);
+  return st;
+}
+
+/* The options database: the problem's string under the command line (re-inserted after it,
+ * so a key both give takes the command line's value). */
+static fcm_status insert_options(fcm_petsc_problem *P)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  if (!P->petsc_options || !*P->petsc_options) return FCM_OK;
+  int argc = 0;
+  char **argv = NULL;
+  PCALL(ctx, PetscOptionsInsertString(NULL, P->petsc_options));
+  PCALL(ctx, PetscGetArgs(&argc, &argv));
+  if (argc > 1) PCALL(ctx, PetscOptionsInsert(NULL, &argc, &argv, NULL));
+cleanup:
+  return st;
+}
+
+fcm_status fcm_petsc_problem_setup(fcm_petsc_problem *P)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
+  fcm_ctx *ctx = P->ctx;
+  const double t0 = fcm_wtime();
+  FCM_TRY(ctx, agree(ctx, P->comm,
+                     P->is_setup ? fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                                              "petsc: setup called twice")
+                                 : FCM_OK));
+  long long ncon_all = 0, ncon = (long long)P->ncon;
+  MPI_Allreduce(&ncon, &ncon_all, 1, MPI_LONG_LONG, MPI_MAX, P->comm);
+  FCM_TRY(ctx, agree(ctx, P->comm,
+                     P->opts.kind == FCM_INTEGRATOR_STATIC && ncon_all == 0
+                         ? fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                                      "petsc: a static problem without any constraint: the "
+                                      "body's rigid-body modes are free (K is singular)")
+                         : FCM_OK));
+  /* 1. assembly */
+  const double ta = fcm_wtime();
+  FCM_TRY(ctx, assemble_all(P));
+  P->time_assembly = fcm_wtime() - ta;
+  /* 2. the system matrix S = K (static) or M/h^2 + K, and its eliminated copy */
+  PCALL(ctx, MatDuplicate(P->K, MAT_COPY_VALUES, &P->S));
+  if (P->M) PCALL(ctx, MatAXPY(P->S, 1.0 / (P->opts.dt * P->opts.dt), P->M, SAME_NONZERO_PATTERN));
+  PCALL(ctx, MatDuplicate(P->S, MAT_COPY_VALUES, &P->Se));
+  {
+    PetscReal dsum = 0.0;
+    PCALL(ctx, MatGetDiagonal(P->S, P->w));
+    PCALL(ctx, VecNorm(P->w, NORM_1, &dsum));
+    P->diag = P->n > 0 ? dsum / (double)P->n : 1.0;
+    if (!(P->diag > 0.0)) P->diag = 1.0;
+  }
+  P->nrows = 0;
+  for (fcm_index k = 0; k < P->ncon; k++)
+    P->nrows += P->copy_owner[P->con_dof[k] / 3] == P->rank;
+  PCALL(ctx, PetscMalloc1(P->nrows + 1, &P->rows));
+  P->nrows = 0;
+  for (fcm_index k = 0; k < P->ncon; k++) {
+    const fcm_index d = P->con_dof[k];
+    if (P->copy_owner[d / 3] == P->rank) P->rows[P->nrows++] = 3 * P->perm[d / 3] + d % 3;
+  }
+  PCALL(ctx, MatZeroRowsColumns(P->Se, P->nrows, P->rows, P->diag, NULL, NULL));
+  PCALL(ctx, MatSetOption(P->Se, MAT_SPD, PETSC_TRUE));
+  FCM_TRY(ctx, near_null_space(P, P->Se));
+  /* 3. the KSP: defaults, then the options database */
+  FCM_TRY(ctx, insert_options(P));
+  PCALL(ctx, KSPCreate(P->comm, &P->ksp));
+  PCALL(ctx, KSPSetOperators(P->ksp, P->Se, P->Se));
+  PCALL(ctx, KSPSetType(P->ksp, KSPCG));
+  {
+    PC pc;
+    PCALL(ctx, KSPGetPC(P->ksp, &pc));
+    PCALL(ctx, PCSetType(pc, PCGAMG));
+  }
+  PCALL(ctx, KSPSetTolerances(P->ksp, P->opts.rtol, PETSC_DEFAULT, PETSC_DEFAULT,
+                              P->opts.max_iterations));
+  PCALL(ctx, KSPSetFromOptions(P->ksp));
+  P->is_setup = 1;
+  P->time_setup += fcm_wtime() - t0;
+cleanup:
+  return st;
+}
+
+/* ---------------------------------------------------------------- steps */
+
+/* g: the prescribed values at time t on the owned constrained DOFs, 0 elsewhere. */
+static fcm_status constraint_values(fcm_petsc_problem *P, double t)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const double *X = fcm_mesh_coords(P->mesh);
+  PCALL(ctx, VecSet(P->g, 0.0));
+  for (fcm_index k = 0; k < P->ncon; k++) {
+    const fcm_index d = P->con_dof[k];
+    if (P->copy_owner[d / 3] != P->rank) continue;
+    double u[3];
+    fcm_motion_eval(&P->motions[P->con_motion[k]], X + 3 * P->con_node[k], t, u, NULL);
+    PCALL(ctx,
+          VecSetValue(P->g, 3 * P->perm[d / 3] + P->con_comp[k], u[P->con_comp[k]], INSERT_VALUES));
+  }
+  PCALL(ctx, VecAssemblyBegin(P->g));
+  PCALL(ctx, VecAssemblyEnd(P->g));
+cleanup:
+  return st;
+}
+
+static fcm_status energies(fcm_petsc_problem *P, fcm_petsc_step_info *info)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  PetscScalar e = 0.0;
+  PCALL(ctx, MatMult(P->K, P->u, P->w));
+  PCALL(ctx, VecDot(P->u, P->w, &e));
+  info->elastic_energy = 0.5 * e;
+  PCALL(ctx, VecDot(P->f, P->u, &e));
+  info->external_work = e;
+  info->kinetic_energy = 0.0;
+  if (P->M) {
+    PCALL(ctx, MatMult(P->M, P->v, P->w));
+    PCALL(ctx, VecDot(P->v, P->w, &e));
+    info->kinetic_energy = 0.5 * e;
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm_petsc_problem_step(fcm_petsc_problem *P, fcm_petsc_step_info *info)
+{
+  fcm_status st = FCM_OK;
+  fcm_petsc_step_info si;
+  memset(&si, 0, sizeof si);
+  FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
+  fcm_ctx *ctx = P->ctx;
+  FCM_TRY(ctx, agree(ctx, P->comm,
+                     !P->is_setup ? fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                                               "petsc: step before setup")
+                                  : FCM_OK));
+  const double h = P->opts.dt, t1 = P->t + h;
+  double t0 = fcm_wtime();
+  /* b = f (+ M/h^2 (u + h v)) - S g, then b = diag g on the constrained rows */
+  FCM_TRY(ctx, constraint_values(P, t1));
+  PCALL(ctx, VecCopy(P->f, P->b));
+  if (P->M) {
+    PCALL(ctx, VecWAXPY(P->x, h, P->v, P->u));
+    PCALL(ctx, MatMult(P->M, P->x, P->w));
+    PCALL(ctx, VecAXPY(P->b, 1.0 / (h * h), P->w));
+  }
+  PCALL(ctx, MatMult(P->S, P->g, P->w));
+  PCALL(ctx, VecAXPY(P->b, -1.0, P->w));
+  {
+    PetscScalar *bb = NULL;
+    const PetscScalar *gg = NULL;
+    PCALL(ctx, VecGetArray(P->b, &bb));
+    PCALL(ctx, VecGetArrayRead(P->g, &gg));
+    for (PetscInt k = 0; k < P->nrows; k++) {
+      const PetscInt r = P->rows[k] - 3 * P->first;
+      bb[r] = P->diag * gg[r];
+    }
+    PCALL(ctx, VecRestoreArrayRead(P->g, &gg));
+    PCALL(ctx, VecRestoreArray(P->b, &bb));
+  }
+  si.time_rhs = fcm_wtime() - t0;
+  /* solve */
+  t0 = fcm_wtime();
+  KSPConvergedReason reason;
+  PetscInt its = 0;
+  PetscReal rnorm = 0.0;
+  PCALL(ctx, KSPSolve(P->ksp, P->b, P->x)); /* zero initial guess (preonly needs it) */
+  PCALL(ctx, KSPGetConvergedReason(P->ksp, &reason));
+  PCALL(ctx, KSPGetIterationNumber(P->ksp, &its));
+  PCALL(ctx, KSPGetResidualNorm(P->ksp, &rnorm));
+  si.time_solve = fcm_wtime() - t0;
+  si.iterations = (int)its;
+  si.reason = (int)reason;
+  si.residual = rnorm;
+  P->total_iterations += its;
+  if (reason < 0) {
+    KSPType kt = NULL;
+    PC pc;
+    PCType pt = NULL;
+    KSPGetType(P->ksp, &kt);
+    KSPGetPC(P->ksp, &pc);
+    PCGetType(pc, &pt);
+    FCM_CHECK(0, ctx, FCM_ERR_NOT_CONVERGED,
+              "petsc: t = %g: KSP %s with PC %s did not converge: %s (KSPConvergedReason %d) "
+              "after %d iterations, residual norm %g (rtol %g); change the solver with "
+              "-ksp_type / -pc_type or solver.petsc_options",
+              t1, kt ? kt : "?", pt ? pt : "?", KSPConvergedReasons[reason], (int)reason, (int)its,
+              (double)rnorm, P->opts.rtol);
+  }
+  /* accept: v = (u1 - u0)/h (dynamic), u = u1 */
+  if (P->M) {
+    PCALL(ctx, VecWAXPY(P->w, -1.0, P->u, P->x));
+    PCALL(ctx, VecScale(P->w, 1.0 / h));
+    PCALL(ctx, VecCopy(P->w, P->v));
+  }
+  PCALL(ctx, VecCopy(P->x, P->u));
+  P->t = t1;
+  P->steps++;
+  si.time = P->t;
+  FCM_TRY(ctx, energies(P, &si));
+  if (info) *info = si;
+cleanup:
+  return st;
+}
+
+/* ---------------------------------------------------------------- queries */
+
+fcm_index fcm_petsc_problem_num_dofs(const fcm_petsc_problem *P)
+{
+  return P ? P->n : 0;
+}
+
+const fcm_space *fcm_petsc_problem_space(const fcm_petsc_problem *P)
+{
+  return P ? P->space : NULL;
+}
+
+static fcm_status gather(fcm_petsc_problem *P, Vec x, double *out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  VecScatter sc = NULL;
+  Vec all = NULL;
+  const PetscScalar *a = NULL;
+  PCALL(ctx, VecScatterCreateToAll(x, &sc, &all));
+  PCALL(ctx, VecScatterBegin(sc, x, all, INSERT_VALUES, SCATTER_FORWARD));
+  PCALL(ctx, VecScatterEnd(sc, x, all, INSERT_VALUES, SCATTER_FORWARD));
+  PCALL(ctx, VecGetArrayRead(all, &a));
+  for (fcm_index k = 0; k < P->ncopy; k++)
+    for (int i = 0; i < 3; i++)
+      out[3 * k + i] = a[3 * P->perm[k] + i];
+  PCALL(ctx, VecRestoreArrayRead(all, &a));
+cleanup:
+  VecScatterDestroy(&sc);
+  VecDestroy(&all);
+  return st;
+}
+
+fcm_status fcm_petsc_problem_get_state(fcm_petsc_problem *P, double *u, double *v)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
+  if (u) FCM_TRY(P->ctx, gather(P, P->u, u));
+  if (v) FCM_TRY(P->ctx, gather(P, P->v, v));
+cleanup:
+  return st;
+}
+
+fcm_status fcm_petsc_problem_get_info(fcm_petsc_problem *P, fcm_petsc_info *info)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(P && info, NULL, FCM_ERR_ARG, "petsc: NULL problem or info");
+  fcm_ctx *ctx = P->ctx;
+  memset(info, 0, sizeof *info);
+  info->size = P->size;
+  info->rank = P->rank;
+  info->partition = P->size == 1 && P->opts.partition == FCM_PETSC_PARTITION_AUTO
+                        ? FCM_PETSC_PARTITION_PTSCOTCH
+                        : P->partition;
+  info->num_dofs = P->n;
+  info->local_dofs = 3 * (fcm_index)P->nlocal;
+  info->local_elements = P->nelem_own;
+  long long ne = (long long)P->nelem_own, mx = 0, mn = 0;
+  MPI_Allreduce(&ne, &mx, 1, MPI_LONG_LONG, MPI_MAX, P->comm);
+  MPI_Allreduce(&ne, &mn, 1, MPI_LONG_LONG, MPI_MIN, P->comm);
+  info->max_local_elements = (fcm_index)mx;
+  info->min_local_elements = (fcm_index)mn;
+  if (P->M && P->is_setup) { /* 1_x^T M 1_x */
+    PetscScalar *a = NULL, m = 0.0;
+    PCALL(ctx, VecGetArray(P->x, &a));
+    for (PetscInt i = 0; i < 3 * P->nlocal; i++)
+      a[i] = i % 3 == 0 ? 1.0 : 0.0;
+    PCALL(ctx, VecRestoreArray(P->x, &a));
+    PCALL(ctx, MatMult(P->M, P->x, P->w));
+    PCALL(ctx, VecDot(P->x, P->w, &m));
+    info->mass = m;
+  }
+  info->time_rules = P->time_rules;
+  info->time_assembly = P->time_assembly;
+  info->time_setup = P->time_setup;
+  PetscLogDouble mem = 0.0;
+  PCALL(ctx, PetscMemoryGetCurrentUsage(&mem));
+  info->memory_local = mem;
+  MPI_Allreduce(&info->memory_local, &info->memory_total, 1, MPI_DOUBLE, MPI_SUM, P->comm);
+  if (P->Se) {
+    MatInfo mi; /* values and column indices of the stored nonzeros (mi.memory is not kept) */
+    PCALL(ctx, MatGetInfo(P->Se, MAT_GLOBAL_SUM, &mi));
+    info->matrix_memory = mi.nz_allocated * (double)(sizeof(PetscScalar) + sizeof(PetscInt));
+  }
+  info->steps = P->steps;
+  info->total_iterations = P->total_iterations;
+cleanup:
+  return st;
+}
+
+/* ---------------------------------------------------------------- scenes */
+
+/* What the PETSc backend cannot run of a scene, named (local: every process reads the same). */
+static fcm_status check_scene(fcm_ctx *ctx, const fcm_scene *scene)
+{
+  fcm_status st = FCM_OK;
+  const char *name = fcm_scene_name(scene);
+  FCM_CHECK(
+      fcm_scene_get_material(scene)->model == FCM_MATERIAL_LINEAR, ctx, FCM_ERR_UNSUPPORTED,
+      "scene %s: material.model: the PETSc backend solves linear elasticity only (\"linear\"); "
+      "run this scene with the serial backend",
+      name);
+  FCM_CHECK(fcm_scene_get_quadrature(scene)->simplify != FCM_CELL_SIMPLIFY_AUTO, ctx,
+            FCM_ERR_UNSUPPORTED,
+            "scene %s: quadrature.simplify = \"auto\" is not supported by the PETSc backend (its "
+            "choice would differ between processes); use true or false",
+            name);
+  for (int k = 0; k < fcm_scene_num_effects(scene); k++) {
+    const fcm_effect *e = fcm_scene_get_effect(scene, k);
+    const char *what = NULL;
+    switch (e->type) {
+    case FCM_EFFECT_GRAVITY:
+      break;
+    case FCM_EFFECT_FIXED:
+      if (e->fixed.boundary) what = "a fixed effect on the \"boundary\" (Nitsche / penalty)";
+      break;
+    case FCM_EFFECT_MOTION:
+      if (e->motion.boundary)
+        what = "a motion effect on the \"boundary\" (Nitsche / penalty)";
+      else if (e->motion.motion.release)
+        what = "a motion effect with \"release\"";
+      break;
+    default:
+      what = fcm_effect_type_name(e->type);
+    }
+    FCM_CHECK(!what, ctx, FCM_ERR_UNSUPPORTED,
+              "scene %s: effects[%d]: %s is not supported by the PETSc backend yet (gravity, "
+              "fixed and motion on node regions are); run this scene with the serial backend",
+              name, k, what);
+  }
+cleanup:
+  return st;
+}
+
+/* The background nodes of a region (as the serial runner picks them). */
+static fcm_status scene_region_nodes(fcm_ctx *ctx, const fcm_scene *scene, const fcm_mesh *mesh,
+                                     const fcm_region *r, int k, fcm_index **nodes, fcm_index *n)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index nn = fcm_mesh_num_nodes(mesh);
+  const double *X = fcm_mesh_coords(mesh);
+  fcm_index *out = NULL, m = 0;
+  FCM_ALLOC(ctx, (r->kind == FCM_REGION_NODES ? r->num_nodes : nn) + 1, out);
+  if (r->kind == FCM_REGION_NODES) {
+    for (fcm_index j = 0; j < r->num_nodes; j++) {
+      FCM_CHECK(r->nodes[j] >= 0 && r->nodes[j] < nn, ctx, FCM_ERR_ARG,
+                "scene %s: effects[%d]: node %lld out of range [0, %lld)", fcm_scene_name(scene), k,
+                (long long)r->nodes[j], (long long)nn);
+      out[m++] = r->nodes[j];
+    }
+  } else {
+    for (fcm_index a = 0; a < nn; a++)
+      if (fcm_region_contains(r, X + 3 * a)) out[m++] = a;
+  }
+  FCM_CHECK(m > 0, ctx, FCM_ERR_ARG,
+            "scene %s: effects[%d]: the region contains no background-mesh node",
+            fcm_scene_name(scene), k);
+  *nodes = out;
+  *n = m;
+  out = NULL;
+cleanup:
+  fcm__free(ctx, out);
+  return st;
+}
+
+fcm_status fcm_petsc_problem_create_from_scene(fcm_ctx *ctx, MPI_Comm comm, const fcm_scene *scene,
+                                               fcm_petsc_partition partition,
+                                               fcm_petsc_problem **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_mesh *mesh = NULL;
+  fcm_geometry *geom = NULL;
+  fcm_petsc_problem *P = NULL;
+  fcm_index *nodes = NULL, n = 0;
+  FCM_CHECK(out, ctx, FCM_ERR_ARG, "petsc: output pointer is NULL");
+  *out = NULL;
+  FCM_CHECK(ctx && scene, ctx, FCM_ERR_ARG, "petsc: NULL context or scene");
+  st = check_scene(ctx, scene);
+  if (st == FCM_OK) st = fcm__scene_mesh_geometry(ctx, scene, &mesh, &geom);
+  FCM_TRY(ctx, agree(ctx, comm, st));
+  /* the options as the serial runner derives them (lib/src/scene/run.c) */
+  const fcm_scene_quadrature *q = fcm_scene_get_quadrature(scene);
+  const fcm_scene_solver *sv = fcm_scene_get_solver(scene);
+  const fcm_scene_time *tm = fcm_scene_get_time(scene);
+  fcm_petsc_options o = fcm_petsc_options_default();
+  o.kind = tm->integrator;
+  o.dt = tm->dt;
+  o.partition = partition;
+  o.petsc_options = sv->petsc_options;
+  o.rtol = sv->rtol > 0.0 ? sv->rtol : o.rtol;
+  o.max_iterations = sv->max_iterations;
+  o.rules.strength[FCM_RULE_STIFFNESS] = q->stiffness_strength;
+  o.rules.strength[FCM_RULE_MASS] = q->mass_strength;
+  o.rules.surface_strength = -1;
+  o.rules.min_fraction = q->min_fraction;
+  o.rules.max_rule_memory = q->max_rule_memory_gib * 1024.0 * 1024.0 * 1024.0;
+  o.rules.simplify = q->simplify;
+  o.rules.simplify_options.method = q->simplify_method;
+  o.rules.stabilization = q->stabilization;
+  o.rules.num_threads = sv->threads;
+  o.assembly.stiffness_strength = q->stiffness_strength > 0 ? q->stiffness_strength : FCM_DEFAULT;
+  o.assembly.mass_strength = q->mass_strength > 0 ? q->mass_strength : FCM_DEFAULT;
+  FCM_TRY(ctx,
+          fcm_petsc_problem_create(ctx, comm, mesh, geom, fcm_scene_get_material(scene), &o, &P));
+  P->own_mesh = mesh;
+  mesh = NULL;
+  fcm_geometry_destroy(&geom); /* only read while the rules were built */
+  for (int k = 0; k < fcm_scene_num_effects(scene); k++) {
+    const fcm_effect *e = fcm_scene_get_effect(scene, k);
+    if (e->type == FCM_EFFECT_GRAVITY) {
+      FCM_TRY(ctx, fcm_petsc_problem_add_gravity(P, e->gravity.acceleration));
+      continue;
+    }
+    if (e->type != FCM_EFFECT_FIXED && e->type != FCM_EFFECT_MOTION) continue;
+    const fcm_region *r = e->type == FCM_EFFECT_FIXED ? &e->fixed.region : &e->motion.region;
+    fcm_motion m = fcm_motion_default();
+    if (e->type == FCM_EFFECT_FIXED)
+      for (int d = 0; d < 3; d++)
+        m.components[d] = e->fixed.components[d];
+    else
+      m = e->motion.motion;
+    fcm__free(ctx, nodes);
+    nodes = NULL;
+    st = scene_region_nodes(ctx, scene, P->mesh, r, k, &nodes, &n);
+    FCM_TRY(ctx, agree(ctx, P->comm, st));
+    FCM_TRY(ctx, fcm_petsc_problem_add_constraint(P, n, nodes, &m));
+  }
+  FCM_TRY(ctx, fcm_petsc_problem_setup(P));
+  *out = P;
+  P = NULL;
+cleanup:
+  fcm__free(ctx, nodes);
+  fcm_petsc_problem_destroy(&P);
+  fcm_geometry_destroy(&geom);
+  fcm_mesh_destroy(&mesh);
+  return st;
+}
+
+/* ---------------------------------------------------------------- output */
+
+/* This process's piece: its active cells with their nodes (renumbered), the node fields of the
+ * gathered state, the owner and the volume fraction per cell. */
+static fcm_status write_piece(fcm_petsc_problem *P, const double *ud, const double *vd,
+                              const char *path)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_mesh *mesh = P->mesh;
+  const fcm_index nc = fcm_mesh_num_cells(mesh), nn = fcm_mesh_num_nodes(mesh);
+  const int npc = fcm_mesh_nodes_per_cell(mesh);
+  const fcm_index *cells = fcm_mesh_cells(mesh);
+  const double *X = fcm_mesh_coords(mesh);
+  fcm_index *map = NULL, *conn = NULL, np = 0, ncl = 0;
+  double *xyz = NULL, *pu = NULL, *pv = NULL, *frac = NULL;
+  int32_t *owner = NULL;
+  fcm_vtu *vtu = NULL;
+  FCM_ALLOC(ctx, nn + 1, map);
+  for (fcm_index a = 0; a < nn; a++)
+    map[a] = -1;
+  for (fcm_index c = 0; c < nc; c++)
+    if (P->cell_owner[c] == P->rank) {
+      ncl++;
+      for (int k = 0; k < npc; k++)
+        if (map[cells[(size_t)npc * c + k]] < 0) map[cells[(size_t)npc * c + k]] = np++;
+    }
+  FCM_ALLOC(ctx, 3 * np + 1, xyz);
+  FCM_ALLOC(ctx, 3 * np + 1, pu);
+  FCM_ALLOC(ctx, 3 * np + 1, pv);
+  FCM_ALLOC(ctx, (size_t)npc * ncl + 1, conn);
+  FCM_ALLOC(ctx, ncl + 1, frac);
+  FCM_ALLOC(ctx, ncl + 1, owner);
+  for (fcm_index a = 0; a < nn; a++)
+    if (map[a] >= 0)
+      for (int i = 0; i < 3; i++) {
+        xyz[3 * map[a] + i] = X[3 * a + i];
+        pu[3 * map[a] + i] = ud[3 * a + i];
+        pv[3 * map[a] + i] = vd[3 * a + i];
+      }
+  fcm_index m = 0;
+  for (fcm_index c = 0; c < nc; c++)
+    if (P->cell_owner[c] == P->rank) {
+      for (int k = 0; k < npc; k++)
+        conn[(size_t)npc * m + k] = map[cells[(size_t)npc * c + k]];
+      frac[m] = P->rules ? fcm_cell_rules_volume_fraction(P->rules, c) : 1.0;
+      owner[m] = P->rank;
+      m++;
+    }
+  FCM_TRY(ctx, fcm_vtu_create(ctx, &vtu));
+  FCM_TRY(ctx, fcm_vtu_set_points(vtu, np, xyz));
+  FCM_TRY(ctx, fcm_vtu_set_cells(vtu, fcm_mesh_get_element_info(mesh)->vtk_cell_type, ncl, conn));
+  FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "displacement", 3, np, pu));
+  FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "velocity", 3, np, pv));
+  FCM_TRY(ctx, fcm_vtu_add_field_int32(vtu, FCM_VTU_CELL_DATA, "process", 1, ncl, owner));
+  FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "volume_fraction", 1, ncl, frac));
+  FCM_TRY(ctx, fcm_vtu_write(vtu, path, NULL));
+cleanup:
+  fcm_vtu_destroy(&vtu);
+  void *arrays[] = {map, conn, xyz, pu, pv, frac, owner};
+  for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
+    fcm__free(ctx, arrays[i]);
+  return st;
+}
+
+/* The host's byte order as VTK names it (the pieces are written in it). */
+static const char *byte_order(void)
+{
+  const uint16_t one = 1;
+  unsigned char first;
+  memcpy(&first, &one, 1);
+  return first ? "LittleEndian" : "BigEndian";
+}
+
+/* Process 0: the .pvtu index of the pieces. */
+static fcm_status write_pvtu(fcm_petsc_problem *P, const char *path, const char *stem)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  fcm_atomic_file *af = NULL;
+  FCM_TRY(ctx, fcm_atomic_file_open(ctx, path, &af));
+  FILE *f = fcm_atomic_file_stream(af);
+  fprintf(f,
+          "<?xml version=\"1.0\"?>\n"
+          "<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"%s\" "
+          "header_type=\"UInt64\">\n"
+          "  <PUnstructuredGrid GhostLevel=\"0\">\n"
+          "    <PPointData>\n"
+          "      <PDataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\"/>\n"
+          "      <PDataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\"/>\n"
+          "    </PPointData>\n"
+          "    <PCellData>\n"
+          "      <PDataArray type=\"Int32\" Name=\"process\" NumberOfComponents=\"1\"/>\n"
+          "      <PDataArray type=\"Float64\" Name=\"volume_fraction\" "
+          "NumberOfComponents=\"1\"/>\n"
+          "    </PCellData>\n"
+          "    <PPoints>\n"
+          "      <PDataArray type=\"Float64\" NumberOfComponents=\"3\"/>\n"
+          "    </PPoints>\n",
+          byte_order());
+  for (int r = 0; r < P->size; r++)
+    fprintf(f, "    <Piece Source=\"%s_%d.vtu\"/>\n", stem, r);
+  fprintf(f, "  </PUnstructuredGrid>\n</VTKFile>\n");
+  FCM_TRY(ctx, fcm_atomic_file_commit(&af));
+cleanup:
+  fcm_atomic_file_abort(&af);
+  return st;
+}
+
+fcm_status fcm_petsc_problem_write_frame(fcm_petsc_problem *P, const char *dir, const char *stem)
+{
+  fcm_status st = FCM_OK;
+  double *u = NULL, *v = NULL, *ud = NULL, *vd = NULL;
+  char path[4096];
+  FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
+  fcm_ctx *ctx = P->ctx;
+  FCM_CHECK(dir && stem && *stem, ctx, FCM_ERR_ARG, "petsc: write_frame: NULL directory or stem");
+  const fcm_index nn = fcm_mesh_num_nodes(P->mesh);
+  u = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *u);
+  v = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *v);
+  ud = fcm__calloc(ctx, 3 * (size_t)nn + 1, sizeof *ud);
+  vd = fcm__calloc(ctx, 3 * (size_t)nn + 1, sizeof *vd);
+  st = u && v && ud && vd ? FCM_OK : FCM_ERR_ALLOC;
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  FCM_TRY(ctx, fcm_petsc_problem_get_state(P, u, v)); /* collective */
+  st = fcm_space_node_field(P->space, u, ud);
+  if (st == FCM_OK) st = fcm_space_node_field(P->space, v, vd);
+  if (st == FCM_OK) {
+    snprintf(path, sizeof path, "%s/%s_%d.vtu", dir, stem, P->rank);
+    st = write_piece(P, ud, vd, path);
+  }
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  if (P->rank == 0) {
+    snprintf(path, sizeof path, "%s/%s.pvtu", dir, stem);
+    st = write_pvtu(P, path, stem);
+  }
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+cleanup:
+  if (P) {
+    fcm__free(P->ctx, u);
+    fcm__free(P->ctx, v);
+    fcm__free(P->ctx, ud);
+    fcm__free(P->ctx, vd);
+  }
+  return st;
+}
+
+/* ---------------------------------------------------------------- checkpoints */
+
+/* File layout (host byte order, written by process 0): the magic line, then int64 n, elements,
+ * steps, kind; double t, dt; n doubles u, n doubles v (the space's DOF numbering, so any
+ * process count reads it). */
+static const char ckpt_magic[16] = "fcm-petsc-ck-1\n";
+
+fcm_status fcm_petsc_problem_write_checkpoint(fcm_petsc_problem *P, const char *path)
+{
+  fcm_status st = FCM_OK;
+  double *u = NULL, *v = NULL;
+  fcm_atomic_file *af = NULL;
+  FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
+  fcm_ctx *ctx = P->ctx;
+  st = path ? FCM_OK
+            : fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                         "petsc: checkpoint: NULL path");
+  if (st == FCM_OK) {
+    u = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *u);
+    v = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *v);
+    if (!u || !v) st = FCM_ERR_ALLOC;
+  }
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  FCM_TRY(ctx, fcm_petsc_problem_get_state(P, u, v));
+  if (P->rank == 0) {
+    st = fcm_atomic_file_open(ctx, path, &af);
+    if (st == FCM_OK) {
+      FILE *f = fcm_atomic_file_stream(af);
+      const int64_t head[4] = {(int64_t)P->n, (int64_t)P->space->num_elems, (int64_t)P->steps,
+                               (int64_t)P->opts.kind};
+      const double times[2] = {P->t, P->opts.dt};
+      int ok = fwrite(ckpt_magic, 1, sizeof ckpt_magic, f) == sizeof ckpt_magic &&
+               fwrite(head, sizeof head, 1, f) == 1 && fwrite(times, sizeof times, 1, f) == 1 &&
+               fwrite(u, sizeof *u, (size_t)P->n, f) == (size_t)P->n &&
+               fwrite(v, sizeof *v, (size_t)P->n, f) == (size_t)P->n;
+      if (!ok) {
+        fcm_atomic_file_abort(&af);
+        st = fcm__error(ctx, FCM_ERR_IO, __FILE__, __LINE__, __func__,
+                        "petsc: checkpoint %s: write failed", path);
+      } else {
+        st = fcm_atomic_file_commit(&af);
+      }
+    }
+  }
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+cleanup:
+  fcm_atomic_file_abort(&af);
+  if (P) {
+    fcm__free(P->ctx, u);
+    fcm__free(P->ctx, v);
+  }
+  return st;
+}
+
+/* Read and check a checkpoint into u, v (n each), *t and *steps (every process reads). */
+static fcm_status read_ckpt(fcm_petsc_problem *P, const char *path, double *u, double *v, double *t,
+                            long long *steps)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  FILE *f = NULL;
+  char magic[sizeof ckpt_magic];
+  int64_t head[4];
+  double times[2];
+  FCM_CHECK(path, ctx, FCM_ERR_ARG, "petsc: checkpoint: NULL path");
+  f = fopen(path, "rb");
+  FCM_CHECK(f, ctx, FCM_ERR_IO, "petsc: checkpoint %s: cannot open it", path);
+  FCM_CHECK(fread(magic, 1, sizeof magic, f) == sizeof magic &&
+                memcmp(magic, ckpt_magic, sizeof magic) == 0,
+            ctx, FCM_ERR_FORMAT, "petsc: checkpoint %s: not a PETSc-backend checkpoint of fcm",
+            path);
+  FCM_CHECK(fread(head, sizeof head, 1, f) == 1 && fread(times, sizeof times, 1, f) == 1, ctx,
+            FCM_ERR_FORMAT, "petsc: checkpoint %s: truncated header", path);
+  FCM_CHECK(head[0] == (int64_t)P->n && head[1] == (int64_t)P->space->num_elems &&
+                head[3] == (int64_t)P->opts.kind && times[1] == P->opts.dt && head[2] >= 0,
+            ctx, FCM_ERR_ARG,
+            "petsc: checkpoint %s is of another problem: %lld DOFs, %lld elements, kind %lld, "
+            "dt %g (this one: %lld, %lld, %d, %g)",
+            path, (long long)head[0], (long long)head[1], (long long)head[3], times[1],
+            (long long)P->n, (long long)P->space->num_elems, (int)P->opts.kind, P->opts.dt);
+  FCM_CHECK(fread(u, sizeof *u, (size_t)P->n, f) == (size_t)P->n &&
+                fread(v, sizeof *v, (size_t)P->n, f) == (size_t)P->n && fgetc(f) == EOF,
+            ctx, FCM_ERR_FORMAT, "petsc: checkpoint %s: truncated or with trailing data", path);
+  *t = times[0];
+  *steps = (long long)head[2];
+cleanup:
+  if (f) fclose(f);
+  return st;
+}
+
+fcm_status fcm_petsc_problem_read_checkpoint(fcm_petsc_problem *P, const char *path)
+{
+  fcm_status st = FCM_OK;
+  double *u = NULL, *v = NULL, t = 0.0;
+  long long steps = 0;
+  FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
+  fcm_ctx *ctx = P->ctx;
+  u = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *u);
+  v = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *v);
+  st = u && v ? FCM_OK : FCM_ERR_ALLOC;
+  if (st == FCM_OK)
+    st = P->is_setup ? read_ckpt(P, path, u, v, &t, &steps)
+                     : fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                                  "petsc: read_checkpoint before setup");
+  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  {
+    PetscScalar *a = NULL, *b = NULL;
+    PCALL(ctx, VecGetArray(P->u, &a));
+    PCALL(ctx, VecGetArray(P->v, &b));
+    for (fcm_index k = 0; k < P->ncopy; k++) {
+      if (P->copy_owner[k] != P->rank) continue;
+      const PetscInt r = 3 * (P->perm[k] - P->first);
+      for (int i = 0; i < 3; i++) {
+        a[r + i] = u[3 * k + i];
+        b[r + i] = v[3 * k + i];
+      }
+    }
+    PCALL(ctx, VecRestoreArray(P->u, &a));
+    PCALL(ctx, VecRestoreArray(P->v, &b));
+  }
+  P->t = t;
+  P->steps = steps;
+cleanup:
+  if (P) {
+    fcm__free(P->ctx, u);
+    fcm__free(P->ctx, v);
+  }
+  return st;
+}
+
+long long fcm_petsc_problem_step_count(const fcm_petsc_problem *P)
+{
+  return P ? P->steps : 0;
+}

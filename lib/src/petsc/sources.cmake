@@ -1,0 +1,1 @@
+list(APPEND FCM_SOURCES lib/src/petsc/petsc.c)

@@ -1,0 +1,111 @@
+/* Memory and time per DOF of the PETSc backend (labels bench and mpi; not in the default run):
+ * a ball (radius 0.45) embedded in an N^3 grid of the unit cube, clamped on its lowest nodes
+ * layer, under gravity, static; CG + GAMG (the default) to rtol 1e-8. Process 0 prints one
+ * line: processes, element, DOFs, setup seconds (partition + rules + numbering + assembly +
+ * KSP setup) and KSP solve seconds per DOF, peak resident memory summed over the processes per
+ * DOF, the matrix's bytes per DOF (nonzeros x 12 bytes), KSP iterations. Arguments: element,
+ * N. Run: mpirun -n P petsc_bench hex8 24. */
+#define _POSIX_C_SOURCE 200809L
+#include "fcm/fcm.h"
+#include "fcm/petsc.h"
+#include "test.h"
+
+#include <sys/resource.h>
+
+/* CPU seconds of this process (user + system). */
+static double cpu_seconds(void)
+{
+  struct rusage ru;
+  getrusage(RUSAGE_SELF, &ru);
+  return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
+         (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+}
+
+int main(int argc, char **argv)
+{
+  fcm_ctx *ctx = NULL;
+  fcm_mesh *mesh = NULL;
+  fcm_geometry *geom = NULL;
+  fcm_petsc_problem *P = NULL;
+  fcm_element_type type;
+  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  TEST_OK(ctx, fcm_petsc_initialize(ctx, &argc, &argv));
+  if (argc < 3 || fcm_element_type_from_name(argv[1], &type) != FCM_OK) return 2;
+  const fcm_index N = atoi(argv[2]);
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, c[3] = {0.5, 0.5, 0.5};
+  const fcm_index cells[3] = {N, N, N};
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, cells, &mesh));
+  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c, 0.45, 4, &geom));
+  const fcm_material mat = {FCM_MATERIAL_LINEAR, 1e6, 0.3, 1000.0};
+  fcm_petsc_options po = fcm_petsc_options_default();
+  po.kind = FCM_INTEGRATOR_STATIC;
+  po.rtol = 1e-8;
+  MPI_Barrier(MPI_COMM_WORLD);
+  double t0 = MPI_Wtime(), c0 = cpu_seconds();
+  TEST_OK(ctx, fcm_petsc_problem_create(ctx, MPI_COMM_WORLD, mesh, geom, &mat, &po, &P));
+  /* clamp the nodes with DOFs in the lowest z layer of cells the ball reaches */
+  const fcm_space *space = fcm_petsc_problem_space(P);
+  const double *X = fcm_mesh_coords(mesh);
+  fcm_index nn = fcm_mesh_num_nodes(mesh), *fix = calloc((size_t)nn, sizeof *fix), nfix = 0;
+  double zmin = 2.0;
+  for (fcm_index k = 0; k < nn; k++)
+    if (fcm_space_node_dof(space, k) >= 0 && X[3 * k + 2] < zmin) zmin = X[3 * k + 2];
+  for (fcm_index k = 0; k < nn; k++)
+    if (fcm_space_node_dof(space, k) >= 0 && X[3 * k + 2] <= zmin + 1e-12) fix[nfix++] = k;
+  const double g[3] = {0, 0, -9.81};
+  const fcm_motion clamp = fcm_motion_default();
+  TEST_OK(ctx, fcm_petsc_problem_add_gravity(P, g));
+  TEST_OK(ctx, fcm_petsc_problem_add_constraint(P, nfix, fix, &clamp));
+  TEST_OK(ctx, fcm_petsc_problem_setup(P));
+  MPI_Barrier(MPI_COMM_WORLD);
+  const double t_setup = MPI_Wtime() - t0, c_setup = cpu_seconds() - c0;
+  fcm_petsc_step_info si;
+  memset(&si, 0, sizeof si);
+  t0 = MPI_Wtime(), c0 = cpu_seconds();
+  TEST_OK(ctx, fcm_petsc_problem_step(P, &si));
+  MPI_Barrier(MPI_COMM_WORLD);
+  const double t_solve = MPI_Wtime() - t0, c_solve = cpu_seconds() - c0;
+  double cpu[2] = {c_setup, c_solve}, cpu_max[2], cpu_sum[2];
+  MPI_Allreduce(cpu, cpu_max, 2, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Allreduce(cpu, cpu_sum, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  fcm_petsc_info info;
+  TEST_OK(ctx, fcm_petsc_problem_get_info(P, &info));
+  struct rusage ru;
+  getrusage(RUSAGE_SELF, &ru);
+  double peak_local = 1024.0 * (double)ru.ru_maxrss, peak_all = 0.0; /* Linux: kilobytes */
+  MPI_Allreduce(&peak_local, &peak_all, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  const double n = (double)info.num_dofs;
+  const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(fcm_space_cell_rules(space));
+  if (rank == 0)
+    printf("petsc_bench np %d: process 0's rules build: intersect %.3g core-s (every cell), "
+           "simplify + stabilize %.3g core-s (its own cut cells; %lld cut cells in all)\n",
+           size, rs->time_intersect, rs->time_simplify, (long long)rs->num_cut);
+  if (rank == 0)
+    printf("petsc_bench np %d: CPU seconds (user + system; busy MPI waits count) per DOF: setup "
+           "%.3g us max over processes / %.3g us summed, solve %.3g us max / %.3g us summed\n",
+           size, 1e6 * cpu_max[0] / (double)info.num_dofs, 1e6 * cpu_sum[0] / (double)info.num_dofs,
+           1e6 * cpu_max[1] / (double)info.num_dofs, 1e6 * cpu_sum[1] / (double)info.num_dofs);
+  if (rank == 0)
+    printf("petsc_bench np %d %s N %lld: dofs %lld, setup %.3g us/dof (%.3g s: rules %.3g s, "
+           "assembly %.3g s on process 0), solve %.3g us/dof (%.3g s, %d CG+GAMG iterations), "
+           "memory %.0f B/dof resident now / %.0f peak (all processes), matrix %.0f B/dof, "
+           "elements per process %lld..%lld, partition %s\n",
+           size, argv[1], (long long)N, (long long)info.num_dofs, 1e6 * t_setup / n, t_setup,
+           info.time_rules, info.time_assembly, 1e6 * t_solve / n, t_solve, si.iterations,
+           info.memory_total / n, peak_all / n, info.matrix_memory / n,
+           (long long)info.min_local_elements, (long long)info.max_local_elements,
+           fcm_petsc_partition_name(info.partition));
+  TEST_TRUE(si.reason > 0);
+  free(fix);
+  fcm_petsc_problem_destroy(&P);
+  fcm_geometry_destroy(&geom);
+  fcm_mesh_destroy(&mesh);
+  fcm_ctx_destroy(&ctx);
+  int mine = test_failures_, all = 0;
+  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  fcm_petsc_finalize();
+  return all ? TEST_RESULT() + 1 : 0;
+}

@@ -1,0 +1,99 @@
+# The PETSc backend's tests (label mpi; only in a build with FCM_HAVE_PETSC): each program runs
+# under mpiexec on 1 and 2 processes. The environment lets OpenMPI run as root (the CI container)
+# and on more processes than cores, and keeps one OpenMP thread per process. They are part of the
+# default run (`ctest -LE 'bench|slow'`) of such a build; `ctest -L mpi` runs them alone.
+set(FCM_MPI_TEST_ENV
+    "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_rmaps_base_oversubscribe=1"
+    "OMPI_MCA_btl_vader_single_copy_mechanism=none;OMP_NUM_THREADS=1;OPENBLAS_NUM_THREADS=1")
+# fcm_add_mpi_test(name source.c NP n [ARGS ...] [TIMEOUT s]): one executable per source.
+function(fcm_add_mpi_test name src)
+  cmake_parse_arguments(T "" "NP;TIMEOUT" "ARGS" ${ARGN})
+  string(MAKE_C_IDENTIFIER "${src}" key)
+  get_property(exe GLOBAL PROPERTY FCM_MPI_TEST_EXE_${key})
+  if(NOT exe)
+    get_filename_component(base ${src} NAME_WE)
+    set(exe petsc_${base})
+    set_property(GLOBAL PROPERTY FCM_MPI_TEST_EXE_${key} ${exe})
+    add_executable(${exe} ${src})
+    target_link_libraries(${exe} PRIVATE fcm_testlib)
+    target_include_directories(${exe} PRIVATE ${PROJECT_SOURCE_DIR}/tests/support)
+    target_compile_options(${exe} PRIVATE ${FCM_WARNINGS} ${FCM_SAN_FLAGS})
+  endif()
+  if(NOT T_TIMEOUT)
+    set(T_TIMEOUT 120)
+  endif()
+  add_test(NAME ${name} COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} ${T_NP}
+                                ${MPIEXEC_PREFLAGS} $<TARGET_FILE:${exe}> ${T_ARGS})
+  set_tests_properties(${name} PROPERTIES LABELS mpi TIMEOUT ${T_TIMEOUT} PROCESSORS ${T_NP}
+                       ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+endfunction()
+
+set(FCM_MUMPS "-ksp_type preonly -pc_type cholesky -pc_factor_mat_solver_type mumps")
+foreach(np 1 2)
+  foreach(el hex8 tet4 hex20 tet10)
+    foreach(kind static dynamic)
+      # the default solver (CG + GAMG, rtol 1e-12) with PT-Scotch
+      fcm_add_mpi_test(petsc_match_${el}_${kind}_np${np} tests/petsc/match.c NP ${np}
+                       ARGS ${el} ${kind} auto)
+    endforeach()
+  endforeach()
+  # the Morton-ordered partition and MUMPS (the direct option)
+  fcm_add_mpi_test(petsc_match_hex8_static_ordered_mumps_np${np} tests/petsc/match.c NP ${np}
+                   ARGS hex8 static ordered ${FCM_MUMPS})
+  fcm_add_mpi_test(petsc_match_tet4_dynamic_ordered_mumps_np${np} tests/petsc/match.c NP ${np}
+                   ARGS tet4 dynamic ordered ${FCM_MUMPS})
+endforeach()
+# errors on one or all processes end every process with the message, no hang
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_failure_np${np} tests/petsc/failure.c NP ${np} TIMEOUT 60)
+endforeach()
+# example scenes: the PETSc backend against the serial fcm_simulation
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_scene_cantilever_np${np} tests/petsc/scene.c NP ${np}
+                   ARGS ${PROJECT_SOURCE_DIR}/apps/scenes cantilever.json 1)
+  fcm_add_mpi_test(petsc_scene_vibrating_beam_np${np} tests/petsc/scene.c NP ${np}
+                   ARGS ${PROJECT_SOURCE_DIR}/apps/scenes vibrating_beam.json 10)
+endforeach()
+if(FCM_BUILD_APPS)
+  # mpirun -n 2 fcm-sim SCENE --backend petsc: runs the linear example scenes (--check);
+  # a scene with an effect the backend lacks exits non-zero on every process with the message
+  foreach(scene cantilever vibrating_beam)
+    add_test(NAME petsc_app_sim_${scene}
+             COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
+                     $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/${scene}.json
+                     --backend petsc --check -ksp_rtol 1e-10)
+    set_tests_properties(petsc_app_sim_${scene} PROPERTIES LABELS mpi TIMEOUT 300 PROCESSORS 2
+                         ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+  endforeach()
+  add_test(NAME petsc_app_sim_unsupported
+           COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
+                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/static_beam.json
+                   --backend petsc --check)
+  set_tests_properties(petsc_app_sim_unsupported PROPERTIES LABELS mpi TIMEOUT 120 PROCESSORS 2
+                       WILL_FAIL TRUE ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+  add_test(NAME petsc_app_sim_unsupported_message
+           COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
+                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/static_beam.json
+                   --backend petsc --check)
+  set_tests_properties(petsc_app_sim_unsupported_message PROPERTIES LABELS mpi TIMEOUT 120
+                       PROCESSORS 2 ENVIRONMENT "${FCM_MPI_TEST_ENV}"
+                       PASS_REGULAR_EXPRESSION "effects\\[2\\]: traction is not supported by the PETSc backend")
+endif()
+# memory and time per DOF on 1 and 2 processes (labels bench, mpi: not in the default run)
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_bench_np${np} tests/petsc/bench.c NP ${np} ARGS hex8 24 TIMEOUT 1800)
+  set_tests_properties(petsc_bench_np${np} PROPERTIES LABELS "bench;mpi")
+endforeach()
+# checkpoints: resume bit for bit on the same processes, to 1e-10 on another count
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_checkpoint_np${np} tests/petsc/checkpoint.c NP ${np})
+endforeach()
+if(FCM_BUILD_APPS)
+  # fcm-sim --backend petsc --checkpoint-every / --resume: byte for byte on 2 processes
+  add_test(NAME petsc_app_sim_resume
+           COMMAND bash ${PROJECT_SOURCE_DIR}/tests/petsc/resume.sh ${MPIEXEC_EXECUTABLE}
+                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/vibrating_beam.json
+                   ${CMAKE_CURRENT_BINARY_DIR}/petsc_app_sim_resume)
+  set_tests_properties(petsc_app_sim_resume PROPERTIES LABELS mpi TIMEOUT 300 PROCESSORS 2
+                       ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+endif()
