@@ -91,7 +91,7 @@ fcm_mg_options fcm_mg_options_default(void)
   o.omega = 1.0;
   o.pre_smooth = 1;
   o.post_smooth = 1;
-  o.cycle_index = 1;
+  o.cycle_index = 2;
   o.max_levels = 20;
   o.coarse_dofs = 2000;
   o.block_smoothing = 1;
