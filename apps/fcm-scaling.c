@@ -685,8 +685,8 @@ static int summary(const settings *o)
       }
       printf("\n");
     }
-  printf("\nV-cycle convergence factor (mg rows; Dick et al. 2011 Fig. 10: 0.66 uncut, 0.75 "
-         "cut)\n");
+  printf("\nmultigrid convergence factor per cycle (mg rows: V-cycles on cube and cut, W-cycles, "
+         "the default, on ball and hollow; Dick et al. 2011 Fig. 10, V: 0.66 uncut, 0.75 cut)\n");
   for (int ti = 0; ti < o->ntypes; ti++)
     for (int b = 0; b < NBODY; b++) {
       const row *sr[64];
