@@ -7,16 +7,20 @@
  *   values again in fcm_mg_setup()), CHOLMOD on the coarsest level, smoothers SGS
  *   (sequential, default), SGS in multicolour order (colour-parallel) and damped Jacobi, all
  *   deterministic for any thread count; V- and W-cycles as solver (fcm_mg_solve) and as a
- *   symmetric CG preconditioner (fcm_mg_operator). Hex20: a p-level to the Hex8 space of the
- *   same elements (build_level0). Block smoothing of the DOFs around each vertex of a cut
- *   cell on level 0 (block_smoother_create, block_smooth): without it the Hex20 embedded
- *   hemisphere stalled at 0.96 per cycle (two-grid on the p-level alone: 0.955, more
- *   pointwise sweeps did not help; per-element blocks: 0.64-0.84); with it 0.14-0.29 for
- *   n = 4 ... 24, and Hex8 0.13-0.15 (was 0.17-0.18). Tests in tests/mg/.
+ *   symmetric CG preconditioner (fcm_mg_operator); the W-cycle is the default. Hex20: a
+ *   p-level to the Hex8 space of the same elements (build_level0). Block smoothing
+ *   (block_smoothers_create, block_smooth): level 0 vertex blocks (de Prenter) plus the
+ *   element blocks of cut cells, coarser levels the corner DOFs of cells that are not all
+ *   material. Measured: Hex20 embedded hemisphere 0.96 per V-cycle without blocks (two-grid on
+ *   the p-level alone 0.955, more pointwise sweeps did not help, element blocks alone
+ *   0.64-0.84), 0.14-0.29 with vertex blocks; hollow ball with holes (Hex8) 0.40-0.85 growing
+ *   with n with level 0 blocks only, V 0.20-0.42 with coarse blocks, W 0.15-0.21 flat (n = 8
+ *   ... 64). Used by the scenes (sim/linsolve.c) and apps/fcm-scaling.c. Tests in tests/mg/.
  * - Known: with XFEM cuts the V-cycle factor depends on where the cut lies in the grid
- *   (0.1 to 0.6 measured for n = 4 ... 32 with block smoothing, not growing with n), also for
- *   a cut through the whole body, so not the cut's end; Dick et al. report 0.75 cut. The
- *   Galerkin product, the hierarchy build and the block sweep are sequential.
+ *   (0.1 to 0.45 measured for n = 4 ... 64 with block smoothing, not growing with n), also
+ *   for a cut through the whole body, so not the cut's end; Dick et al. report 0.75 cut. The
+ *   Galerkin product, the hierarchy build and the block sweeps are sequential (the W-cycle
+ *   with blocks runs on about one core: CPU seconds ~ wall seconds on 2 threads).
  *   fcm_mg_setup() needs the same eliminated rows.
  * - Dirichlet: eliminated rows (no off-diagonal entry) and coarse DOFs whose coinciding
  *   fine DOFs are all inactive stay in P (leaving them out made P rank deficient); coarse
