@@ -240,6 +240,27 @@ static void constraint(void)
       TEST_TRUE(fcm_space_num_constrained_copies(s_off) == 0);
       mass_and_gravity(s, 1000.0, c ? 4.0 : 1.0);
       mass_and_gravity(s_off, 1000.0, c ? 4.0 : 1.0);
+      /* the Schwarz blocks of every cell list each DOF once although elements use
+       * constrained copies of other nodes (a block listing one twice is refused) */
+      unsigned char *flag = calloc((size_t)fcm_mesh_num_cells(mesh), 1);
+      for (fcm_index q = 0; q < fcm_mesh_num_cells(mesh); q++)
+        flag[q] = fcm_space_cell_elements(s, q, NULL) > 0;
+      fcm_index nb = 0, nd = 0;
+      TEST_OK(ctx, fcm_space_cell_blocks(s, flag, &nb, &nd, NULL, NULL));
+      fcm_index *bp = calloc((size_t)nb + 1, sizeof *bp), *bd = calloc((size_t)nd + 1, sizeof *bd);
+      TEST_OK(ctx, fcm_space_cell_blocks(s, flag, &nb, &nd, bp, bd));
+      TEST_TRUE(k == 0 || nd < 3 * nb * fcm_mesh_nodes_per_cell(mesh));
+      fcm_csr *A = NULL;
+      fcm_schwarz *S = NULL;
+      const fcm_material mat = {FCM_MATERIAL_LINEAR, 1.0e5, 0.3, 1000.0};
+      TEST_OK(ctx, fcm_space_matrix_create(s, &A));
+      TEST_OK(ctx, fcm_assemble_mass(s, &mat, NULL, A));
+      TEST_OK(ctx, fcm_schwarz_create(ctx, A, nb, bp, bd, NULL, &S));
+      fcm_schwarz_destroy(&S);
+      fcm_csr_destroy(&A);
+      free(flag);
+      free(bp);
+      free(bd);
     }
     fcm_space_destroy(&s);
     fcm_space_destroy(&s_off);

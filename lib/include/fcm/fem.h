@@ -163,15 +163,16 @@ typedef enum fcm_fictitious_model {
 
 /** DOF blocks of flagged cells, e.g. the blocks of an additive Schwarz preconditioner
  * (fcm_schwarz_create() of fcm/solve.h; the paper's choice: the cut cells with volume
- * fraction below theta = 0.5). Block k holds the 3 x nodes_per_cell DOFs of the k-th
- * element of the flagged cells in ascending element order (one per cell, or one per piece
- * of a cell that cuts split): node order of the cell, components x, y, z
- * (fcm_space_element_dofs()). Call once with block_ptr and block_dofs NULL for the counts,
- * then with buffers of *num_blocks + 1 and *num_dofs entries.
+ * fraction below theta = 0.5). Block k holds the DOFs of the k-th element of the flagged
+ * cells in ascending element order (one per cell, or one per piece of a cell that cuts
+ * split): node order of the cell, components x, y, z (fcm_space_element_dofs()), each copy
+ * once (an element that uses one copy at two nodes, a tiny copy constrained to another
+ * node's, lists it at the first), so the DOFs of a block are distinct. Call once with block_ptr and
+ * block_dofs NULL for the counts, then with buffers of *num_blocks + 1 and *num_dofs entries.
  * @param[in]  space      the space
  * @param[in]  cell_flag  num_cells flags (nonzero: a block); flagged cells must be active
  * @param[out] num_blocks the number of elements of the flagged cells
- * @param[out] num_dofs   the total block size, num_blocks x 3 x nodes_per_cell
+ * @param[out] num_dofs   the total block size, at most num_blocks x 3 x nodes_per_cell
  * @param[out] block_ptr  NULL, or num_blocks + 1 offsets into block_dofs (block_ptr[0] = 0)
  * @param[out] block_dofs NULL, or num_dofs DOFs (both NULL or both given)
  * @return FCM_OK, FCM_ERR_ARG (NULL, one buffer only, a flagged inactive cell: named).

@@ -1068,20 +1068,8 @@ static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_ou
   }
   ptr[nb] = 3 * nu;
   FCM_TRY(ctx, fcm_space_cell_blocks(sp, m->cut_cell, &neb, &ned, ptr + nb, dofs + 3 * nu));
-  /* offsets after the vertex blocks; an element that uses one copy at two nodes (a tiny
-   * copy constrained to another node's) lists its DOFs twice: keep the first */
-  fcm_index out = 3 * nu;
-  for (fcm_index k = nb; k < nb + neb; k++) {
-    const fcm_index s0 = 3 * nu + ptr[k], s1 = 3 * nu + ptr[k + 1];
-    ptr[k] = out;
-    for (fcm_index i = s0; i < s1; i++) {
-      int dup = 0;
-      for (fcm_index t = ptr[k]; t < out && !dup; t++)
-        dup = dofs[t] == dofs[i];
-      if (!dup) dofs[out++] = dofs[i];
-    }
-  }
-  ptr[nb + neb] = out;
+  for (fcm_index k = nb; k <= nb + neb; k++) /* offsets after the vertex blocks */
+    ptr[k] += 3 * nu;
   *nb_out = nb + neb, *ptr_out = ptr, *dofs_out = dofs;
   ptr = dofs = NULL;
 cleanup:
