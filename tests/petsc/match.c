@@ -70,8 +70,9 @@ int main(int argc, char **argv)
   po.kind = dynamic ? FCM_INTEGRATOR_BACKWARD_EULER : FCM_INTEGRATOR_STATIC;
   po.dt = 0.01;
   po.rtol = 1e-12;
-  po.partition =
-      strcmp(argv[3], "ordered") == 0 ? FCM_PETSC_PARTITION_ORDERED : FCM_PETSC_PARTITION_AUTO;
+  po.partition = strcmp(argv[3], "ordered") == 0    ? FCM_PETSC_PARTITION_ORDERED
+                 : strcmp(argv[3], "ptscotch") == 0 ? FCM_PETSC_PARTITION_PTSCOTCH
+                                                    : FCM_PETSC_PARTITION_AUTO;
   po.petsc_options = argc > 4 ? argv[4] : NULL;
   TEST_OK(ctx, fcm_petsc_problem_create(ctx, MPI_COMM_WORLD, mesh, geom, &mat, &po, &P));
   TEST_OK(ctx, fcm_petsc_problem_add_gravity(P, grav));

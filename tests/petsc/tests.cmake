@@ -34,7 +34,7 @@ foreach(np 1 2)
     foreach(kind static dynamic)
       # the default solver (CG + GAMG, rtol 1e-12) with PT-Scotch
       fcm_add_mpi_test(petsc_match_${el}_${kind}_np${np} tests/petsc/match.c NP ${np}
-                       ARGS ${el} ${kind} auto)
+                       ARGS ${el} ${kind} ptscotch)
     endforeach()
   endforeach()
   # the Morton-ordered partition and MUMPS (the direct option)

@@ -49,7 +49,10 @@ FCM_API void fcm_petsc_finalize(void);
 
 /** How the background cells are distributed over the processes. */
 typedef enum fcm_petsc_partition {
-  FCM_PETSC_PARTITION_AUTO = 0,     /**< PT-Scotch when PETSc has it, else ORDERED */
+  FCM_PETSC_PARTITION_AUTO = 0,     /**< ORDERED: deterministic, so a resumed run on the
+                                         same process count is bit-identical (PT-Scotch's
+                                         partitions vary between runs on a loaded machine,
+                                         and with them the sums' round-off) */
   FCM_PETSC_PARTITION_PTSCOTCH = 1, /**< MatPartitioning (type ptscotch, or the option
                                          -mat_partitioning_type) of the face graph of the
                                          active cells; cut cells weigh 4, uncut cells 1 */

@@ -7,7 +7,9 @@
  *   fcm.pc (variable petsc, Requires mpi-c) and fcmConfig.cmake (FCM_HAVE_PETSC, MPI::MPI_C);
  *   setup.sh deps --petsc; .ci/run runs the mpi-labelled tests.
  * - partition: PT-Scotch through MatPartitioning on the face graph of the active cells (Debian's
- *   PETSc 3.18 has it), Morton-ordered fallback (FCM_PETSC_PARTITION_ORDERED). Weights: cut
+ *   PETSc 3.18 has it), or Morton-ordered (FCM_PETSC_PARTITION_ORDERED, the default since
+ *   PT-Scotch's partitions were seen to vary between runs on 2 processes under load, which
+ *   broke the bit-identical resume: petsc_checkpoint_np2 failed 2 in 12 runs). Weights: cut
  *   cells 4, uncut 1 (a guess: measure the per-cell rule + assembly cost and weight by it next).
  * - rules: each process builds the rules of its own cells (fcm_cell_rules_options.cell_mask);
  *   the partition comes first, on the candidate cells (box meets a geometry cell's box; weight
@@ -659,7 +661,7 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
   }
 
   /* 2. partition the candidate cells */
-  P->partition = P->opts.partition == FCM_PETSC_PARTITION_AUTO ? FCM_PETSC_PARTITION_PTSCOTCH
+  P->partition = P->opts.partition == FCM_PETSC_PARTITION_AUTO ? FCM_PETSC_PARTITION_ORDERED
                                                                : P->opts.partition;
   if (P->size == 1) {
     for (fcm_index c = 0; c < nc; c++)
@@ -1202,7 +1204,7 @@ fcm_status fcm_petsc_problem_get_info(fcm_petsc_problem *P, fcm_petsc_info *info
   info->size = P->size;
   info->rank = P->rank;
   info->partition = P->size == 1 && P->opts.partition == FCM_PETSC_PARTITION_AUTO
-                        ? FCM_PETSC_PARTITION_PTSCOTCH
+                        ? FCM_PETSC_PARTITION_ORDERED
                         : P->partition;
   info->num_dofs = P->n;
   info->local_dofs = 3 * (fcm_index)P->nlocal;
