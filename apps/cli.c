@@ -309,3 +309,38 @@ void cli_output_abort(cli_output **out)
   free(*out);
   *out = NULL;
 }
+
+int cli_gnuplot_png(const char *prog, const char *size, const char *path, const char *body)
+{
+  char tmp[4096], script[4096], cmd[8400];
+  if (system(NULL) == 0 || system("gnuplot --version > /dev/null 2>&1") != 0) {
+    fprintf(stderr, "%s: gnuplot not found (Debian package gnuplot-nox): %s not written\n", prog,
+            path);
+    return 1;
+  }
+  if (snprintf(tmp, sizeof tmp, "%s.tmp.png", path) >= (int)sizeof tmp ||
+      snprintf(script, sizeof script, "%s.gp.tmp", path) >= (int)sizeof script) {
+    fprintf(stderr, "%s: --png: path too long\n", prog);
+    return 0;
+  }
+  FILE *f = fopen(script, "w");
+  if (!f) {
+    fprintf(stderr, "%s: cannot write %s\n", prog, script);
+    return 0;
+  }
+  fprintf(f, "set terminal png size %s\nset output '%s'\n%s\nset output\n", size, tmp, body);
+  const int werr = ferror(f);
+  if (fclose(f) != 0 || werr) {
+    remove(script);
+    return 0;
+  }
+  snprintf(cmd, sizeof cmd, "gnuplot '%s' 2>/dev/null", script);
+  const int rc = system(cmd);
+  remove(script);
+  if (rc != 0 || rename(tmp, path) != 0) {
+    remove(tmp);
+    fprintf(stderr, "%s: gnuplot failed; %s not written\n", prog, path);
+    return 0;
+  }
+  return 1;
+}

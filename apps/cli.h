@@ -38,6 +38,11 @@ int cli_choice(const char *prog, const char *opt, const char *s, const char *con
  *  usable as the `parse` function of a CLI_CUSTOM option. */
 int cli_element(const char *prog, const char *opt, const char *s, void *dest);
 
+/** Run the gnuplot script `body` (drawing to the PNG terminal of `size`, e.g. "900,600 font
+ * ',11'") into `path`: the picture goes to a temporary, then is renamed. 1 on success or when
+ * gnuplot is missing (said on stderr, naming the Debian package), 0 on an error. */
+int cli_gnuplot_png(const char *prog, const char *size, const char *path, const char *body);
+
 /** A comma list of distinct element names into out[0..*n-1] (at most FCM_ELEMENT_COUNT). */
 int cli_element_list(const char *prog, const char *opt, const char *s,
                      fcm_element_type out[FCM_ELEMENT_COUNT], int *n);

@@ -575,8 +575,6 @@ static int dice_png_add(const fcm_space *space, const double *u, const double at
   return 1;
 }
 
-static int gnuplot_png(const char *path, const char *body);
-
 /* Write the picture (gnuplot; 1 when written or gnuplot is missing, 0 on an error). */
 static int dice_png(const char *path)
 {
@@ -600,7 +598,7 @@ static int dice_png(const char *path)
                           "with points pt 7 ps 0.3 lc palette\n",
                           dice_title[k], k);
   n += (size_t)snprintf(body + n, cap - n, "unset multiplot");
-  const int ok = gnuplot_png(path, body);
+  const int ok = cli_gnuplot_png(PROG, "900,600 font ',11'", path, body);
   free(body);
   return ok;
 }
@@ -740,44 +738,6 @@ static void kappas(fcm_ctx *ctx, int n, double *A, double *k_raw, double *k_scal
 /* Koschier et al. 2017, Fig. 14: the cube [-1, 1]^3 of 5 tets (the body fills it), cut by the
  * plane x = 1 - 2 d (d: distance to the face in cell sizes), A = M + dt^2 K with E = 1e6,
  * nu = 0.3, rho = 1000, dt = 1e-3, linear elasticity, no constraint on the body. */
-/* Run the gnuplot script `body` (which draws to the terminal file named by the %s it holds
- * once) into `path`: the picture goes to a temporary, then is renamed. 1 on success or when
- * gnuplot is missing (said on stderr), 0 on an error. */
-static int gnuplot_png(const char *path, const char *body)
-{
-  char tmp[4096], script[4096], cmd[8400];
-  if (system(NULL) == 0 || system("gnuplot --version > /dev/null 2>&1") != 0) {
-    fprintf(stderr, PROG ": gnuplot not found (Debian package gnuplot-nox): %s not written\n",
-            path);
-    return 1;
-  }
-  if (snprintf(tmp, sizeof tmp, "%s.tmp.png", path) >= (int)sizeof tmp ||
-      snprintf(script, sizeof script, "%s.gp.tmp", path) >= (int)sizeof script) {
-    fprintf(stderr, PROG ": --png: path too long\n");
-    return 0;
-  }
-  FILE *f = fopen(script, "w");
-  if (!f) {
-    fprintf(stderr, PROG ": cannot write %s\n", script);
-    return 0;
-  }
-  fprintf(f, "set terminal png size 900,600 font ',11'\nset output '%s'\n%s\nset output\n", tmp,
-          body);
-  const int werr = ferror(f);
-  if (fclose(f) != 0 || werr) {
-    remove(script);
-    return 0;
-  }
-  snprintf(cmd, sizeof cmd, "gnuplot '%s' 2>/dev/null", script);
-  const int rc = system(cmd);
-  remove(script);
-  if (rc != 0 || rename(tmp, path) != 0) {
-    remove(tmp);
-    fprintf(stderr, PROG ": gnuplot failed; %s not written\n", path);
-    return 0;
-  }
-  return 1;
-}
 
 static int accuracy_png(const char *path, int max_strength)
 {
@@ -804,7 +764,7 @@ static int accuracy_png(const char *path, int max_strength)
       n += (size_t)snprintf(body + n, sizeof body - n,
                             ", $A%d%d with linespoints lw 2 dt %d title '%s, %s'", w, h, h + 1,
                             surf[w], h ? "hex8" : "tet4");
-  return gnuplot_png(path, body);
+  return cli_gnuplot_png(PROG, "900,600 font ',11'", path, body);
 }
 
 /* The condition study's rows for the picture: [distance exponent 1..12][constraint][stab]. */
@@ -847,7 +807,7 @@ static int condition_png(const char *path)
                               sc ? "scaled" : "raw", con ? "on" : "off", stab ? "on" : "off");
         first = 0;
       }
-  return gnuplot_png(path, body);
+  return cli_gnuplot_png(PROG, "900,600 font ',11'", path, body);
 }
 
 static int run_condition(fcm_ctx *ctx, const char *csvpath, const char *pngpath)

@@ -541,44 +541,6 @@ static void print_row(const row *r)
   fflush(stdout);
 }
 
-/* Run the gnuplot script `body` into `path` (through a temporary, renamed). 1 on success or
- * when gnuplot is missing (said on stderr), 0 on an error. */
-static int gnuplot_png(const char *path, const char *body)
-{
-  char tmp[4096], script[4096], cmd[8400];
-  if (system(NULL) == 0 || system("gnuplot --version > /dev/null 2>&1") != 0) {
-    fprintf(stderr, PROG ": gnuplot not found (Debian package gnuplot-nox): %s not written\n",
-            path);
-    return 1;
-  }
-  if (snprintf(tmp, sizeof tmp, "%s.tmp.png", path) >= (int)sizeof tmp ||
-      snprintf(script, sizeof script, "%s.gp.tmp", path) >= (int)sizeof script) {
-    fprintf(stderr, PROG ": --png: path too long\n");
-    return 0;
-  }
-  FILE *f = fopen(script, "w");
-  if (!f) {
-    fprintf(stderr, PROG ": cannot write %s\n", script);
-    return 0;
-  }
-  fprintf(f, "set terminal png size 1400,650 font ',10'\nset output '%s'\n%s\nset output\n", tmp,
-          body);
-  const int werr = ferror(f);
-  if (fclose(f) != 0 || werr) {
-    remove(script);
-    return 0;
-  }
-  snprintf(cmd, sizeof cmd, "gnuplot '%s' 2>/dev/null", script);
-  const int rc = system(cmd);
-  remove(script);
-  if (rc != 0 || rename(tmp, path) != 0) {
-    remove(tmp);
-    fprintf(stderr, PROG ": gnuplot failed; %s not written\n", path);
-    return 0;
-  }
-  return 1;
-}
-
 /* Two panels: setup + solve time against DOFs (log-log, the fitted exponents in the legend) and
  * iterations against DOFs, one line per (element, body, solver) of the bodies ball and
  * hollow. The data go inline into the script. */
@@ -651,7 +613,7 @@ static int write_png(const settings *o)
   }
   ADD("unset multiplot\n");
 #undef ADD
-  ok = gnuplot_png(o->png, body);
+  ok = cli_gnuplot_png(PROG, "1400,650 font ',10'", o->png, body);
 out:
   if (!ok) fprintf(stderr, PROG ": --png: the plot script grew too large\n");
   free(body);
