@@ -97,3 +97,9 @@ if(FCM_BUILD_APPS)
   set_tests_properties(petsc_app_sim_resume PROPERTIES LABELS mpi TIMEOUT 300 PROCESSORS 2
                        ENVIRONMENT "${FCM_MPI_TEST_ENV}")
 endif()
+# phase 2: scenes through the integrator (Newton) on PETSc, against the serial run: state,
+# energies and the log (mass, momentum, reactions) to 1e-8 relative
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_newton_clamped_surface_np${np} tests/petsc/newton.c NP ${np}
+                   ARGS ${PROJECT_SOURCE_DIR}/apps/scenes clamped_surface.json 3)
+endforeach()
