@@ -122,6 +122,8 @@ struct fcm_petsc_problem {
   int refs;
   int agreed_fail;
   int ksp_type_set;  /* -ksp_type in the options database: keep it (else CG / MINRES) */
+  int pc_type_set;   /* -pc_type in the options database: keep it */
+  int direct;        /* the scene asks for a direct solver: MUMPS (Cholesky / LU) */
   long long factors; /* matrices given to the KSP */
   VecScatter to_all;
   Vec all;
@@ -1482,7 +1484,13 @@ static fcm_status newton_factor(void *user, const fcm_csr *H, int psd, int *fail
   PCALL(ctx, MatAssemblyBegin(P->S, MAT_FINAL_ASSEMBLY));
   PCALL(ctx, MatAssemblyEnd(P->S, MAT_FINAL_ASSEMBLY));
   PCALL(ctx, MatSetOption(P->S, MAT_SPD, psd ? PETSC_TRUE : PETSC_FALSE));
-  if (!P->ksp_type_set) PCALL(ctx, KSPSetType(P->ksp, psd ? KSPCG : KSPMINRES));
+  if (P->direct && !P->pc_type_set) {
+    PC pc;
+    PCALL(ctx, KSPGetPC(P->ksp, &pc));
+    PCALL(ctx, PCSetType(pc, psd ? PCCHOLESKY : PCLU));
+  } else if (!P->direct && !P->ksp_type_set) {
+    PCALL(ctx, KSPSetType(P->ksp, psd ? KSPCG : KSPMINRES));
+  }
   PCALL(ctx, KSPSetOperators(P->ksp, P->S, P->S));
   PCALL(ctx, KSPSetUp(P->ksp));
   P->factors++;
@@ -1560,14 +1568,22 @@ static fcm_status newton_attach(void *user, fcm_integrator *integ, const fcm_spa
     PetscBool has = PETSC_FALSE;
     PC pc;
     PCALL(ctx, KSPCreate(P->comm, &P->ksp));
-    PCALL(ctx, KSPSetType(P->ksp, KSPCG));
     PCALL(ctx, KSPGetPC(P->ksp, &pc));
-    PCALL(ctx, PCSetType(pc, PCGAMG));
+    if (P->direct) { /* the scene's "direct": MUMPS, the PETSc backend's direct option */
+      PCALL(ctx, KSPSetType(P->ksp, KSPPREONLY));
+      PCALL(ctx, PCSetType(pc, PCCHOLESKY));
+      PCALL(ctx, PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+    } else {
+      PCALL(ctx, KSPSetType(P->ksp, KSPCG));
+      PCALL(ctx, PCSetType(pc, PCGAMG));
+    }
     PCALL(ctx, KSPSetTolerances(P->ksp, P->opts.rtol, PETSC_DEFAULT, PETSC_DEFAULT,
                                 P->opts.max_iterations));
     PCALL(ctx, KSPSetFromOptions(P->ksp));
     PCALL(ctx, PetscOptionsHasName(NULL, NULL, "-ksp_type", &has));
     P->ksp_type_set = has == PETSC_TRUE;
+    PCALL(ctx, PetscOptionsHasName(NULL, NULL, "-pc_type", &has));
+    P->pc_type_set = has == PETSC_TRUE;
   }
 cleanup:
   st = newton_agree(P, st);
@@ -1635,6 +1651,7 @@ fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_sc
   {
     const fcm_scene_solver *sv = fcm_scene_get_solver(scene);
     P->opts.partition = partition;
+    P->direct = sv->method == FCM_LINEAR_DIRECT;
     P->opts.rtol = sv->rtol > 0.0 ? sv->rtol : P->opts.rtol;
     P->opts.max_iterations = sv->max_iterations > 0 ? sv->max_iterations : P->opts.max_iterations;
     if (sv->petsc_options) {
