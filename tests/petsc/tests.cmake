@@ -97,9 +97,28 @@ if(FCM_BUILD_APPS)
   set_tests_properties(petsc_app_sim_resume PROPERTIES LABELS mpi TIMEOUT 300 PROCESSORS 2
                        ENVIRONMENT "${FCM_MPI_TEST_ENV}")
 endif()
-# phase 2: scenes through the integrator (Newton) on PETSc, against the serial run: state,
-# energies and the log (mass, momentum, reactions) to 1e-8 relative
+# phase 2: scenes through the integrator (Newton) on PETSc (fcm_petsc_simulation_create())
+# against the serial fcm_simulation: state, energies and the log (mass, momentum, reactions)
+# to 1e-8 relative, the state bit for bit the same on every process (tests/petsc/newton.c)
+set(FCM_SCENES ${PROJECT_SOURCE_DIR}/apps/scenes)
 foreach(np 1 2)
+  # static Stable Neo-Hookean, penalty boundary constraint, traction, 3 load steps (MUMPS)
+  fcm_add_mpi_test(petsc_newton_static_snh_np${np} tests/petsc/newton.c NP ${np}
+                   ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json 1)
+  # the same with CG + GAMG on the Newton systems
+  fcm_add_mpi_test(petsc_newton_static_snh_gamg_np${np} tests/petsc/newton.c NP ${np}
+                   ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json 1 1e-8
+                        -ksp_type cg -pc_type gamg)
+  # dynamic SNH, Nitsche on the embedded boundary (fixed and rotating caps), gravity, damping
   fcm_add_mpi_test(petsc_newton_clamped_surface_np${np} tests/petsc/newton.c NP ${np}
-                   ARGS ${PROJECT_SOURCE_DIR}/apps/scenes clamped_surface.json 3)
+                   ARGS ${FCM_SCENES} clamped_surface.json 3)
+  # linear material through Newton: traction and pressure, load steps, CG + GAMG
+  fcm_add_mpi_test(petsc_newton_static_beam_np${np} tests/petsc/newton.c NP ${np}
+                   ARGS ${FCM_SCENES} static_beam.json 1)
 endforeach()
+# initial velocity (Hex20, free body: momentum), and a MINRES scene with release and damping
+# (the serial run solves with MINRES to rtol 1e-5 there: compared to 1e-6)
+fcm_add_mpi_test(petsc_newton_spinning_body_np2 tests/petsc/newton.c NP 2
+                 ARGS ${FCM_SCENES} spinning_body.json 3)
+fcm_add_mpi_test(petsc_newton_slingshot_np2 tests/petsc/newton.c NP 2
+                 ARGS ${FCM_SCENES} slingshot.json 2 1e-6)
