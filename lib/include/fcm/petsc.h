@@ -221,6 +221,11 @@ typedef struct fcm_petsc_info {
 /** Fill `info` (collective: the sums and extremes are reduced). */
 FCM_API fcm_status fcm_petsc_problem_get_info(fcm_petsc_problem *problem, fcm_petsc_info *info);
 
+/** 1 when fcm_petsc_problem_create_from_scene() runs `scene` (linear material, the effects it
+ * lists), 0 otherwise (then fcm_petsc_simulation_create() is the way; also 0 for NULL).
+ * Local, no error recorded in ctx. */
+FCM_API int fcm_petsc_problem_supports_scene(fcm_ctx *ctx, const fcm_scene *scene);
+
 /** A scene's ordinary simulation (fcm/simulation.h) on the processes of comm, for every
  * material and effect the serial runner has except cuts (phase 2: Newton on PETSc). Every
  * process runs the scene's fcm_integrator — Newton, line search, time stepping, constraints

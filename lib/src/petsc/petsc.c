@@ -1299,6 +1299,16 @@ cleanup:
   return st;
 }
 
+int fcm_petsc_problem_supports_scene(fcm_ctx *ctx, const fcm_scene *scene)
+{
+  if (!ctx || !scene) return 0;
+  fcm_ctx *tmp = NULL; /* the check's message must not replace the caller's error */
+  if (fcm_ctx_create(NULL, &tmp) != FCM_OK) return 0;
+  const int ok = check_scene(tmp, scene) == FCM_OK;
+  fcm_ctx_destroy(&tmp);
+  return ok;
+}
+
 /* The background nodes of a region (as the serial runner picks them). */
 static fcm_status scene_region_nodes(fcm_ctx *ctx, const fcm_scene *scene, const fcm_mesh *mesh,
                                      const fcm_region *r, int k, fcm_index **nodes, fcm_index *n)
