@@ -1,5 +1,7 @@
 /* petsc: the PETSc + MPI adapter (fcm/petsc.h) — distributed linear elasticity, static and
- * backward Euler, on a partition of the background cells. The only file that sees PETSc.
+ * backward Euler, on a partition of the background cells (phase 1), and the integrator's
+ * backend for every other scene (phase 2, fcm_petsc_simulation_create()). The only file that
+ * sees PETSc.
  *
  * NOTES (issue 14, for the next session) ---------------------------------------------------
  * Done (phase 1):
@@ -32,14 +34,46 @@
  * - scenes: fcm_petsc_problem_create_from_scene() (mesh + geometry through
  *   fcm__scene_mesh_geometry() of lib/src/scene/run.c) and fcm-sim --backend petsc
  *   (apps/fcm-sim-petsc.c); the example scene vibrating_beam.json is the dynamic one.
+ * Done (phase 2, the integrator on PETSc):
+ * - fcm_petsc_simulation_create(): the scene's own fcm_simulation on every process with the
+ *   rules masked to the process's cells (the partition as above) and an internal backend set
+ *   in the integrator (lib/src/sim/sim_backend.h: reduce / factor / solve / destroy, set by
+ *   fcm__integrator_set_backend() from the attach callback of
+ *   fcm__simulation_create_distributed(), lib/src/scene/run.c). This problem object P is the
+ *   backend (borrowed space, refcount: creator + integrator).
+ * - masked rules now also give OTHER processes' UNCUT cells no points in the assembly and in
+ *   fcm_space_momentum() (fcm__cell_rules_owns(), embed_impl.h; lib/src/fem/assemble.c): before,
+ *   only cut cells were masked (the linear driver never noticed: it loops over own elements).
+ * - the integrator sums after each assembly: mass matrix and loads (setup, so M and fext are
+ *   global), energy + force + tangent in evaluate() and assemble_tangent() (the base
+ *   M/h^2 + D/h is added on the root only), the damping tangent, the representative force,
+ *   fcm_integrator_energy(), the boundary reactions, the boundary point counts (nitsche.c),
+ *   and the log's mass and momentum (run.c). A non-finite value on any process counts as one
+ *   everywhere; every reduce starts with agree(), so a process that fails outside a reduce ends
+ *   with one agree() and meets the others wherever they wait (no hang).
+ * - sums: MPI_Reduce to process 0 + MPI_Bcast (the same bits everywhere for any count).
+ * - solve: owned rows of the (already eliminated, summed) Newton matrix into a MATMPIAIJ with
+ *   INSERT_VALUES, KSP: MUMPS Cholesky/LU when the scene says "direct", else CG/MINRES + GAMG
+ *   (psd flag of the integrator); -ksp_type / -pc_type keep the user's choice. KSP divergence
+ *   is a soft failure (the integrator halves the step). Direction gathered with a cached
+ *   VecScatterCreateToAll.
+ * - fcm-sim --backend petsc routes scenes fcm_petsc_problem_supports_scene() rejects to it
+ *   (apps/fcm-sim-petsc.c run_newton(); process 0 writes the serial frames and log).
  * Not done:
- * - Newton / hyperelastic materials / the integrator's time stepping on PETSc (a hook in
- *   lib/src/sim/linsolve.c would replace only the solve; the assembly seam is
- *   fcm_assembly_workspace_hyperelastic, which needs an element-mask variant): this module is
- *   the separate static + dynamic LINEAR driver the task allowed.
- * - Nitsche/penalty boundary constraints, tractions, pressure, body-force fields, damping,
- *   initial velocities, cuts, checkpoints (and --resume): fcm-sim --backend petsc refuses them
- *   with a message naming the feature.
+ * - scalability of phase 2: the sums are dense (n doubles per force, nnz doubles per tangent,
+ *   per process); next: add each process's partial tangent into the MATMPIAIJ with ADD_VALUES
+ *   (own elements only; the eliminated rows' diagonal by the owner), sum the force only on
+ *   owned rows (VecScatter of ghosts), keep the line search's scalars as Allreduce.
+ * - cuts (the cut rules extend whole rules: refused), quadrature.simplify = auto (its decision
+ *   sums every cut cell's point counts: would need a reduce inside the rules build),
+ *   checkpoints on the phase-2 path (fcm-sim refuses --checkpoint-every / --resume there; the
+ *   replicated state makes process 0's fcm_simulation_write_checkpoint() the natural start),
+ *   cell fields (stresses) of other processes' cut cells in process 0's frames, the summary's
+ *   point counts and max |u| (process 0's cells only).
+ * - the linear driver (phase 1) could now be replaced by the phase-2 path for the scenes both
+ *   run (they agree to the KSP tolerance); it is kept: it assembles straight into PETSc and
+ *   scales further (no dense sums), and its tests and checkpoints stay.
+ * Not done (phase 1):
  * - geometry kept whole on every process (no AABB crop), mesh replicated; the classification
  *   (intersection of EVERY cell) runs on every process — on the bench body it costs 2-3x the
  *   simplification, so distribute it next: intersect own candidate cells only and allgather
