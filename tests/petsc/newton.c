@@ -179,6 +179,8 @@ int main(int argc, char **argv)
   const double *us = fcm_integrator_displacement(is), *vs = fcm_integrator_velocity(is);
   const double *up = fcm_integrator_displacement(ip), *vp = fcm_integrator_velocity(ip);
   const double un = norm(n, us), vn = norm(n, vs);
+  if (rank == 0 && getenv("FCM_TEST_VERBOSE"))
+    fprintf(stderr, "|u| serial %.17g, petsc %.17g\n", un, norm(n, up));
   TEST_TRUE(un > 0.0);
   const double du = dist(n, up, us) / un;
   if (!(du <= tol)) fprintf(stderr, "rank %d: |u - u_serial| / |u_serial| = %g\n", rank, du);

@@ -60,6 +60,10 @@
  * - fcm-sim --backend petsc routes scenes fcm_petsc_problem_supports_scene() rejects to it
  *   (apps/fcm-sim-petsc.c run_newton(); process 0 writes the serial frames and log).
  * Not done:
+ * - PT-Scotch's partition of the same scene on 2 processes differs between runs now and then
+ *   (slingshot: 131/133 or 132/132 own elements, although scotch_random_reset() runs before
+ *   it), so phase-2 results agree between runs only to round-off (and KSP iteration counts
+ *   vary); FCM_PETSC_PARTITION_ORDERED is deterministic. Not investigated further.
  * - scalability of phase 2: the sums are dense (n doubles per force, nnz doubles per tangent,
  *   per process); next: add each process's partial tangent into the MATMPIAIJ with ADD_VALUES
  *   (own elements only; the eliminated rows' diagonal by the owner), sum the force only on
