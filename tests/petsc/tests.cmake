@@ -125,3 +125,8 @@ fcm_add_mpi_test(petsc_newton_spinning_body_np2 tests/petsc/newton.c NP 2
                  ARGS ${FCM_SCENES} spinning_body.json 3)
 fcm_add_mpi_test(petsc_newton_slingshot_np2 tests/petsc/newton.c NP 2
                  ARGS ${FCM_SCENES} slingshot.json 2 1e-6 -ksp_max_it 5000)
+# the integrator on PETSc: a failure on one process, in the setup's sums, in the KSP (after the
+# step's halvings) and a refused cut end every process with the message, no hang
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_newton_failure_np${np} tests/petsc/newton_failure.c NP ${np} TIMEOUT 120)
+endforeach()
