@@ -1535,7 +1535,16 @@ static fcm_status newton_factor(void *user, const fcm_csr *H, int psd, int *fail
   if (P->direct && !P->pc_type_set) {
     PC pc;
     PCALL(ctx, KSPGetPC(P->ksp, &pc));
-    PCALL(ctx, PCSetType(pc, psd ? PCCHOLESKY : PCLU));
+    PCType cur = NULL;
+    PCALL(ctx, PCGetType(pc, &cur));
+    const PCType want = psd ? PCCHOLESKY : PCLU;
+    if (!cur || strcmp(cur, want) != 0) { /* a new factor PC: MUMPS again, unless the user chose */
+      PetscBool has = PETSC_FALSE;
+      PCALL(ctx, PCSetType(pc, want));
+      PCALL(ctx, PetscOptionsHasName(NULL, NULL, "-pc_factor_mat_solver_type", &has));
+      if (!has) PCALL(ctx, PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+      PCALL(ctx, PCSetFromOptions(pc));
+    }
   } else if (!P->direct && !P->ksp_type_set) {
     PCALL(ctx, KSPSetType(P->ksp, psd ? KSPCG : KSPMINRES));
   }
