@@ -109,3 +109,12 @@ set_tests_properties(app_cut_accuracy app_cut_dice_hex8 app_cut_dice_tet4 app_cu
                      ENVIRONMENT "OMP_NUM_THREADS=1")
 set_tests_properties(app_cut_accuracy_full app_cut_dice_full PROPERTIES LABELS "app;slow"
                      TIMEOUT 900)
+# fcm-scaling (issue 13): small sizes end to end in the default run (CSV facts: every solver
+# converges and agrees with CHOLMOD, cg-mg iterations flat, mg factor < 1, bad options exit 2);
+# the --quick and full studies with --check (the claims of issue 13) under bench / slow.
+fcm_add_test(app_scaling tests/apps/scaling_app.c LABELS app TIMEOUT 120
+             ARGS small $<TARGET_FILE:fcm-scaling> ${work})
+fcm_add_test(app_scaling_quick tests/apps/scaling_app.c LABELS bench TIMEOUT 900
+             ARGS quick $<TARGET_FILE:fcm-scaling> ${work})
+fcm_add_test(app_scaling_full tests/apps/scaling_app.c LABELS slow TIMEOUT 36000
+             ARGS full $<TARGET_FILE:fcm-scaling> ${work})

@@ -1,10 +1,10 @@
 /* Multigrid on Hex8 and Hex20 box grids, static linear elasticity (argument: cube, hemisphere, cut:
  * an XFEM plane cut through the hemisphere's top, split: the plane through the whole body,
- * two bodies each clamped; with the suffix -hex20 on Hex20 grids, where the first coarse
- * level is the p-level Hex20 -> Hex8 on the same grid; then the cell counts n, default 4 8
- * 16): the V-cycle and the two-grid convergence factors stay below 0.8 for every n and, on
- * the cube and the embedded hemisphere, the factor at the largest n is at most 1.25 x the
- * one at the next (with the XFEM cut it varies with the cut's position in the grid), CG
+ * two bodies each clamped, hollow: a hollow ball with three holes; with the suffix -hex20 on Hex20
+ * grids, where the first coarse level is the p-level Hex20 -> Hex8 on the same grid; then the cell
+ * counts n, default 4 8 16): the V-cycle and the two-grid convergence factors stay below 0.8 for
+ * every n and, on the cube and the embedded hemisphere, the factor at the largest n is at most 1.25
+ * x the one at the next (with the XFEM cut it varies with the cut's position in the grid), CG
  * preconditioned by one V-cycle converges in a number of iterations that does not grow with n (at
  * most 1.5 x the count at the smallest n, plus 2) and far fewer than CG + Jacobi, and its solution
  * equals CHOLMOD's to the tolerance. FCM_TEST_VERBOSE=1 prints the figures. */
@@ -34,6 +34,7 @@ int main(int argc, char **argv)
                    : !strcmp(name, "hemisphere") ? 1
                    : !strcmp(name, "cut")        ? 2
                    : !strcmp(name, "split")      ? 3
+                   : !strcmp(name, "hollow")     ? 4
                                                  : -1;
   if (kind < 0) return 2;
   const int verbose = getenv("FCM_TEST_VERBOSE") != NULL;
@@ -52,14 +53,18 @@ int main(int argc, char **argv)
     problem p;
     if (kind == 0)
       problem_cube_of(ctx, type, sizes[s], &p);
+    else if (kind == 4)
+      problem_hollow_of(ctx, type, sizes[s], &p);
     else
       problem_hemisphere_of(ctx, type, sizes[s], kind - 1,
                             fcm_space_options_default().constrain_ratio, &p);
     fcm_mg_options o = fcm_mg_options_default();
     o.coarse_dofs = 50; /* coarsen as far as the grid allows, for every n */
+    o.cycle_index = 1;  /* the V-cycle (the default is the W-cycle) */
     if (getenv("FCM_TEST_MG_SMOOTH"))
       o.pre_smooth = o.post_smooth = atoi(getenv("FCM_TEST_MG_SMOOTH"));
     if (getenv("FCM_TEST_MG_OMEGA")) o.omega = atof(getenv("FCM_TEST_MG_OMEGA"));
+    if (getenv("FCM_TEST_MG_CYCLE")) o.cycle_index = atoi(getenv("FCM_TEST_MG_CYCLE"));
     if (getenv("FCM_TEST_MG_LEVELS")) o.max_levels = atoi(getenv("FCM_TEST_MG_LEVELS"));
     if (getenv("FCM_TEST_MG_SMOOTHER"))
       o.smoother = (fcm_mg_smoother)atoi(getenv("FCM_TEST_MG_SMOOTHER"));

@@ -173,4 +173,23 @@ static inline void problem_balls(fcm_ctx *ctx, fcm_index n, problem *p)
   problem_balls_of(ctx, FCM_ELEMENT_HEX8, n, p);
 }
 
+/* Hollow ball (radii 0.5 and 0.9, three holes of radius 0.25 along the axes) in [-1, 1]^3
+ * with n^3 cells of `type`, clamped where y <= -0.5 (its bottom cap), gravity. */
+static inline void problem_hollow_of(fcm_ctx *ctx, fcm_element_type type, fcm_index n, problem *p)
+{
+  const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, c[3] = {0, 0, 0};
+  const fcm_index cells[3] = {n, n, n};
+  memset(p, 0, sizeof *p);
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, cells, &p->mesh));
+  TEST_OK(ctx, fcm_geometry_create_hollow_ball(ctx, c, 0.5, 0.9, 0.25, 16, 3, &p->geom));
+  fcm_cell_rules_options ro = fcm_cell_rules_options_default();
+  ro.simplify = FCM_CELL_SIMPLIFY_OFF;
+  ro.kinds = FCM_RULES_STIFFNESS;
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, p->mesh, p->geom, &ro, &p->rules0));
+  TEST_OK(ctx, fcm_space_create_embedded(ctx, p->mesh, p->rules0, &p->space));
+  finish_space(ctx, p, 0);
+  const double flo[3] = {-2, -2, -2}, fhi[3] = {2, -0.5, 2};
+  clamp_box(ctx, p, flo, fhi);
+}
+
 #endif /* FCM_MG_TEST_UTIL_H */

@@ -65,8 +65,8 @@ typedef struct fcm_simulation_counters {
   long long newton_iterations, linear_iterations, tangent_assemblies;
   long long multigrid_cycles; /**< multigrid cycles (fcm_step_info.multigrid_cycles, summed;
                                    not in checkpoints: counted from the restore on) */
-  long long factorizations; /**< numeric factorizations / preconditioner setups (total) */
-  long long analyses;       /**< symbolic analyses (total) */
+  long long factorizations;   /**< numeric factorizations / preconditioner setups (total) */
+  long long analyses;         /**< symbolic analyses (total) */
   long long direct_fallbacks;
   long long frames;    /**< frames written */
   fcm_index num_dofs;  /**< DOFs now (cuts add copies) */

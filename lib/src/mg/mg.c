@@ -7,16 +7,20 @@
  *   values again in fcm_mg_setup()), CHOLMOD on the coarsest level, smoothers SGS
  *   (sequential, default), SGS in multicolour order (colour-parallel) and damped Jacobi, all
  *   deterministic for any thread count; V- and W-cycles as solver (fcm_mg_solve) and as a
- *   symmetric CG preconditioner (fcm_mg_operator). Hex20: a p-level to the Hex8 space of the
- *   same elements (build_level0). Block smoothing of the DOFs around each vertex of a cut
- *   cell on level 0 (block_smoother_create, block_smooth): without it the Hex20 embedded
- *   hemisphere stalled at 0.96 per cycle (two-grid on the p-level alone: 0.955, more
- *   pointwise sweeps did not help; per-element blocks: 0.64-0.84); with it 0.14-0.29 for
- *   n = 4 ... 24, and Hex8 0.13-0.15 (was 0.17-0.18). Tests in tests/mg/.
+ *   symmetric CG preconditioner (fcm_mg_operator); the W-cycle is the default. Hex20: a
+ *   p-level to the Hex8 space of the same elements (build_level0). Block smoothing
+ *   (block_smoothers_create, block_smooth): level 0 vertex blocks (de Prenter) plus the
+ *   element blocks of cut cells, coarser levels the corner DOFs of cells that are not all
+ *   material. Measured: Hex20 embedded hemisphere 0.96 per V-cycle without blocks (two-grid on
+ *   the p-level alone 0.955, more pointwise sweeps did not help, element blocks alone
+ *   0.64-0.84), 0.14-0.29 with vertex blocks; hollow ball with holes (Hex8) 0.40-0.85 growing
+ *   with n with level 0 blocks only, V 0.20-0.42 with coarse blocks, W 0.15-0.21 flat (n = 8
+ *   ... 64). Used by the scenes (sim/linsolve.c) and apps/fcm-scaling.c. Tests in tests/mg/.
  * - Known: with XFEM cuts the V-cycle factor depends on where the cut lies in the grid
- *   (0.1 to 0.6 measured for n = 4 ... 32 with block smoothing, not growing with n), also for
- *   a cut through the whole body, so not the cut's end; Dick et al. report 0.75 cut. The
- *   Galerkin product, the hierarchy build and the block sweep are sequential.
+ *   (0.1 to 0.45 measured for n = 4 ... 64 with block smoothing, not growing with n), also
+ *   for a cut through the whole body, so not the cut's end; Dick et al. report 0.75 cut. The
+ *   Galerkin product, the hierarchy build and the block sweeps are sequential (the W-cycle
+ *   with blocks runs on about one core: CPU seconds ~ wall seconds on 2 threads).
  *   fcm_mg_setup() needs the same eliminated rows.
  * - Dirichlet: eliminated rows (no off-diagonal entry) and coarse DOFs whose coinciding
  *   fine DOFs are all inactive stay in P (leaving them out made P rank deficient); coarse
@@ -65,6 +69,9 @@ typedef struct mg_level {
   double *x, *b, *r; /* work vectors (x, b unused on level 0) */
   int ncolor;        /* SGS_COLORED: rows by colour, CSR over colours */
   fcm_index *color_ptr, *color_rows;
+  unsigned char *full; /* grid levels: per cell, 1 when it is all material (uncut, and on
+                          coarse levels made of 8 such cells) */
+  fcm_schwarz *blk;    /* block smoother (block_smoothing): the level's blocks */
 } mg_level;
 
 struct fcm_mg {
@@ -77,9 +84,8 @@ struct fcm_mg {
   double *spa;             /* dense accumulator, max columns */
   fcm_index *mark;         /* positions, max columns */
   unsigned char *cut_cell; /* per mesh cell: cut by the geometry or a cut surface, or split */
-  fcm_schwarz *blk;        /* level 0 block smoother: the elements of cut cells */
-  int blk_fresh;           /* blk was set up by its creation, for the current values */
-  double *blk_r, *blk_dx;  /* largest block */
+  fcm_index blk_max;       /* largest block of the block smoothers */
+  double *blk_r, *blk_dx;  /* blk_max entries each */
 };
 
 fcm_mg_options fcm_mg_options_default(void)
@@ -89,7 +95,7 @@ fcm_mg_options fcm_mg_options_default(void)
   o.omega = 1.0;
   o.pre_smooth = 1;
   o.post_smooth = 1;
-  o.cycle_index = 1;
+  o.cycle_index = 2;
   o.max_levels = 20;
   o.coarse_dofs = 2000;
   o.block_smoothing = 1;
@@ -148,6 +154,8 @@ static void level_free(fcm_ctx *ctx, mg_level *L)
   fcm__free(ctx, L->r);
   fcm__free(ctx, L->color_ptr);
   fcm__free(ctx, L->color_rows);
+  fcm__free(ctx, L->full);
+  fcm_schwarz_destroy(&L->blk);
   memset(L, 0, sizeof *L);
 }
 
@@ -158,7 +166,6 @@ void fcm_mg_destroy(fcm_mg **mg)
   for (int l = 0; l < 32; l++)
     level_free(m->ctx, &m->lev[l]);
   fcm_direct_destroy(&m->direct);
-  fcm_schwarz_destroy(&m->blk);
   fcm__free(m->ctx, m->cut_cell);
   fcm__free(m->ctx, m->blk_r);
   fcm__free(m->ctx, m->blk_dx);
@@ -510,18 +517,19 @@ static fcm_status build_level0(fcm_mg *m, const fcm_csr *A)
     }
     FCM_TRY(ctx, transfer_from_rows(ctx, L0, L->n, 2, pcol, pw));
   }
+  /* cells of the geometry's boundary too are not full: the block smoother's cells */
+  for (fcm_index c = 0; rules && c < ncells; c++)
+    if (fcm_cell_rules_class(rules, c) == FCM_CELL_CUT) cut[c] = 1;
+  FCM_ALLOC(ctx, L->ncell + 1, L->full);
+  for (fcm_index e = 0; e < L->ncell; e++)
+    L->full[e] = (unsigned char)!cut[fcm_space_element_cell(sp, e)];
+  m->cut_cell = cut;
+  cut = NULL;
 cleanup:
   fcm__free(ctx, node2);
   fcm__free(ctx, cell_ijk);
   fcm__free(ctx, grid);
   fcm__free(ctx, edges);
-  if (st == FCM_OK) {
-    /* cells of the geometry's boundary too: the block smoother's cells */
-    for (fcm_index c = 0; rules && c < ncells; c++)
-      if (fcm_cell_rules_class(rules, c) == FCM_CELL_CUT) cut[c] = 1;
-    m->cut_cell = cut;
-    cut = NULL;
-  }
   fcm__free(ctx, cut);
   fcm__free(ctx, copy_node);
   fcm__free(ctx, cmap);
@@ -571,6 +579,17 @@ static fcm_status coarsen(fcm_mg *m, int l)
       C->ijk[3 * cid[c] + d] = F->ijk[3 * c + d] / 2;
   for (fcm_index i = 0; i < 8 * nc; i++)
     C->own[i] = 1;
+  /* full: 8 full fine cells */
+  FCM_ALLOC(ctx, nc + 1, C->full);
+  {
+    fcm_index *cnt = NULL;
+    FCM_ALLOC(ctx, nc + 1, cnt);
+    for (fcm_index c = 0; c < nf; c++)
+      cnt[cid[c]] += F->full[c] ? 1 : 9; /* any partial child: > 8 */
+    for (fcm_index c = 0; c < nc; c++)
+      C->full[c] = (unsigned char)(cnt[c] == 8);
+    fcm__free(ctx, cnt);
+  }
   /* 2. coarse graph */
   fcm_index nedge = 0;
   FCM_ALLOC(ctx, F->adj_ptr[nf] + 1, edges);
@@ -984,18 +1003,25 @@ cleanup:
 
 /* ------------------------------------------------------------------ create / setup */
 
-/* The level 0 block smoother: one block per grid vertex of the cut cells (de Prenter et
- * al. 2019): the DOFs of the copies whose support lies in the vertex's patch of 8 cells, the
- * vertex's own and (Hex20) those of the mid-edge nodes of the edges at the vertex, all
- * copies together; each block inverted by the clamped eigen-inverse of fcm_schwarz (Longva
- * et al. 2020, §5.2). */
+/* Block smoothers (block_smoothing). Level 0: one block per grid vertex of the cut cells
+ * (de Prenter et al. 2020): the DOFs of the copies whose support lies in the vertex's patch
+ * of 8 cells, the vertex's own and (Hex20) those of the mid-edge nodes of the edges at the
+ * vertex, all copies together; then one block per element of a cut cell (all its DOFs).
+ * Coarser levels: one block per coarse cell that is not all material (its 8 corner copies).
+ * Each block is inverted by the clamped eigen-inverse of fcm_schwarz (Longva et al. 2020,
+ * §5.2). Vertex blocks resolve the nearly dependent functions of one vertex's patch (Hex20:
+ * 0.96 -> 0.2-0.3 per V-cycle), element blocks those of the corners of a sliver cell (Hex8
+ * hollow ball), coarse blocks the same on the Galerkin levels, where thin walls become
+ * cells with little material (the hollow ball's V-cycle grew with n without them). */
 static int cmp_pair(const void *a, const void *b)
 {
   const fcm_index *x = a, *y = b;
   return x[0] != y[0] ? (x[0] > y[0]) - (x[0] < y[0]) : (x[1] > y[1]) - (x[1] < y[1]);
 }
 
-static fcm_status block_smoother_create(fcm_mg *m)
+/* Level 0: the vertex blocks, then the element blocks of the cut cells. */
+static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_out,
+                                fcm_index **dofs_out)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
@@ -1005,7 +1031,7 @@ static fcm_status block_smoother_create(fcm_mg *m)
   const int npc = info->num_nodes, mid = npc > 8;
   const fcm_index *cells = fcm_mesh_cells(mesh), nnode = fcm_mesh_num_nodes(mesh);
   const fcm_index ne = fcm_space_num_elements(sp);
-  fcm_index nb = 0, np = 0, *ptr = NULL, *dofs = NULL, *pairs = NULL;
+  fcm_index nb = 0, np = 0, nu = 0, neb = 0, ned = 0, *ptr = NULL, *dofs = NULL, *pairs = NULL;
   unsigned char *mark = NULL;
   FCM_ALLOC(ctx, nnode + 1, mark);
   for (fcm_index e = 0; e < ne; e++) {
@@ -1026,34 +1052,103 @@ static fcm_status block_smoother_create(fcm_mg *m)
           pairs[2 * np] = v, pairs[2 * np + 1] = ed[info->edge_nodes[j][2]] / 3, np++;
     }
   }
-  if (np == 0) goto cleanup;
-  qsort(pairs, (size_t)np, 2 * sizeof *pairs, cmp_pair);
-  fcm_index nu = 0;
+  if (np > 0) qsort(pairs, (size_t)np, 2 * sizeof *pairs, cmp_pair);
   for (fcm_index i = 0; i < np; i++)
     if (i == 0 || pairs[2 * i] != pairs[2 * nu - 2] || pairs[2 * i + 1] != pairs[2 * nu - 1])
       pairs[2 * nu] = pairs[2 * i], pairs[2 * nu + 1] = pairs[2 * i + 1], nu++;
   for (fcm_index i = 0; i < nu; i++)
     nb += i == 0 || pairs[2 * i] != pairs[2 * i - 2];
-  FCM_ALLOC(ctx, nb + 1, ptr);
-  FCM_ALLOC(ctx, 3 * nu + 1, dofs);
-  fcm_index maxm = 0;
+  FCM_TRY(ctx, fcm_space_cell_blocks(sp, m->cut_cell, &neb, &ned, NULL, NULL));
+  FCM_ALLOC(ctx, nb + neb + 1, ptr);
+  FCM_ALLOC(ctx, 3 * nu + ned + 1, dofs);
   for (fcm_index i = 0, k = 0; i < nu; i++) {
     if (i > 0 && pairs[2 * i] != pairs[2 * i - 2]) ptr[++k] = 3 * i;
     for (int d = 0; d < 3; d++)
       dofs[3 * i + d] = 3 * pairs[2 * i + 1] + d;
   }
   ptr[nb] = 3 * nu;
-  for (fcm_index k = 0; k < nb; k++)
-    maxm = FCM_MAX(maxm, ptr[k + 1] - ptr[k]);
-  FCM_ALLOC(ctx, maxm + 1, m->blk_r);
-  FCM_ALLOC(ctx, maxm + 1, m->blk_dx);
-  FCM_TRY(ctx, fcm_schwarz_create(ctx, m->lev[0].A, nb, ptr, dofs, NULL, &m->blk));
-  m->blk_fresh = 1;
+  FCM_TRY(ctx, fcm_space_cell_blocks(sp, m->cut_cell, &neb, &ned, ptr + nb, dofs + 3 * nu));
+  /* offsets after the vertex blocks; an element that uses one copy at two nodes (a tiny
+   * copy constrained to another node's) lists its DOFs twice: keep the first */
+  fcm_index out = 3 * nu;
+  for (fcm_index k = nb; k < nb + neb; k++) {
+    const fcm_index s0 = 3 * nu + ptr[k], s1 = 3 * nu + ptr[k + 1];
+    ptr[k] = out;
+    for (fcm_index i = s0; i < s1; i++) {
+      int dup = 0;
+      for (fcm_index t = ptr[k]; t < out && !dup; t++)
+        dup = dofs[t] == dofs[i];
+      if (!dup) dofs[out++] = dofs[i];
+    }
+  }
+  ptr[nb + neb] = out;
+  *nb_out = nb + neb, *ptr_out = ptr, *dofs_out = dofs;
+  ptr = dofs = NULL;
 cleanup:
   fcm__free(ctx, ptr);
   fcm__free(ctx, dofs);
   fcm__free(ctx, pairs);
   fcm__free(ctx, mark);
+  return st;
+}
+
+/* A coarse level: the cells that are not all material, their distinct corner copies. */
+static fcm_status blocks_coarse(fcm_mg *m, const mg_level *L, fcm_index *nb_out,
+                                fcm_index **ptr_out, fcm_index **dofs_out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  fcm_index nb = 0, *ptr = NULL, *dofs = NULL;
+  for (fcm_index c = 0; c < L->ncell; c++)
+    nb += !L->full[c];
+  FCM_ALLOC(ctx, nb + 1, ptr);
+  FCM_ALLOC(ctx, 24 * nb + 1, dofs);
+  fcm_index k = 0, q = 0;
+  for (fcm_index c = 0; c < L->ncell; c++) {
+    if (L->full[c]) continue;
+    const fcm_index q0 = q;
+    for (int b = 0; b < 8; b++) {
+      const fcm_index K = L->corner[8 * c + b];
+      int dup = 0;
+      for (fcm_index t = q0; t < q && !dup; t += 3)
+        dup = dofs[t] == 3 * K;
+      for (int d = 0; !dup && d < 3; d++)
+        dofs[q++] = 3 * K + d;
+    }
+    ptr[++k] = q;
+  }
+  *nb_out = nb, *ptr_out = ptr, *dofs_out = dofs;
+  ptr = dofs = NULL;
+cleanup:
+  fcm__free(ctx, ptr);
+  fcm__free(ctx, dofs);
+  return st;
+}
+
+/* The block smoothers of every level but the coarsest, from the current level matrices. */
+static fcm_status block_smoothers_create(fcm_mg *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  fcm_index nb = 0, *ptr = NULL, *dofs = NULL;
+  for (int l = 0; l + 1 < m->nlev; l++) {
+    mg_level *L = &m->lev[l];
+    if (l == 0)
+      FCM_TRY(ctx, blocks_level0(m, &nb, &ptr, &dofs));
+    else
+      FCM_TRY(ctx, blocks_coarse(m, L, &nb, &ptr, &dofs));
+    for (fcm_index k = 0; k < nb; k++)
+      m->blk_max = FCM_MAX(m->blk_max, ptr[k + 1] - ptr[k]);
+    if (nb > 0)
+      FCM_TRY(ctx, fcm_schwarz_create(ctx, level_matrix(L), nb, ptr, dofs, NULL, &L->blk));
+    FCM_FREE(ctx, ptr);
+    FCM_FREE(ctx, dofs);
+  }
+  FCM_ALLOC(ctx, m->blk_max + 1, m->blk_r);
+  FCM_ALLOC(ctx, m->blk_max + 1, m->blk_dx);
+cleanup:
+  fcm__free(ctx, ptr);
+  fcm__free(ctx, dofs);
   return st;
 }
 
@@ -1150,13 +1245,13 @@ fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
   if (o.smoother == FCM_MG_SMOOTHER_SGS_COLORED)
     for (int l = 0; l + 1 < m->nlev; l++)
       if (!m->lev[l].color_ptr) FCM_TRY(ctx, level_colors(m, &m->lev[l]));
-  if (o.block_smoothing && m->nlev > 1) FCM_TRY(ctx, block_smoother_create(m));
   {
     mg_level *Lc = &m->lev[m->nlev - 1];
     FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, level_matrix(Lc), &m->direct));
     FCM_TRY(ctx, fcm_direct_analyze(m->direct));
   }
   FCM_TRY(ctx, fcm_mg_setup(m));
+  if (o.block_smoothing) FCM_TRY(ctx, block_smoothers_create(m)); /* set up as created */
   *mg = m;
   m = NULL;
 cleanup:
@@ -1185,10 +1280,10 @@ fcm_status fcm_mg_setup(fcm_mg *m)
     }
   }
   FCM_TRY(ctx, level0_dinv(m));
-  if (m->blk && !m->blk_fresh) FCM_TRY(ctx, fcm_schwarz_setup(m->blk, m->lev[0].A));
-  m->blk_fresh = 0;
-  for (int l = 0; l + 1 < m->nlev; l++)
+  for (int l = 0; l + 1 < m->nlev; l++) {
+    if (m->lev[l].blk) FCM_TRY(ctx, fcm_schwarz_setup(m->lev[l].blk, level_matrix(&m->lev[l])));
     FCM_TRY(ctx, galerkin_values(m, l));
+  }
   FCM_TRY(ctx,
           fcm_direct_factor(m->direct, fcm_csr_values_read(level_matrix(&m->lev[m->nlev - 1]))));
 cleanup:
@@ -1246,21 +1341,21 @@ static void smooth(const fcm_mg *m, mg_level *L, const double *b, double *x)
   }
 }
 
-/* A symmetric block Gauss-Seidel sweep over the level 0 blocks (forward, then backward):
+/* A symmetric block Gauss-Seidel sweep over the level's blocks (forward, then backward):
  * x_K += S_K (b - A x)_K, block after block. */
-static void block_smooth(const fcm_mg *m, const double *b, double *x)
+static void block_smooth(const fcm_mg *m, const mg_level *L, const double *b, double *x)
 {
-  const fcm_csr *A = m->lev[0].A;
+  const fcm_csr *A = level_matrix(L);
   const fcm_index *rp = fcm_csr_row_ptr(A);
   const int *ci = fcm_csr_col_idx(A);
   const double *v = fcm_csr_values_read(A);
-  const fcm_index nb = fcm__schwarz_num_blocks(m->blk);
+  const fcm_index nb = fcm__schwarz_num_blocks(L->blk);
   double *r = m->blk_r, *dx = m->blk_dx;
   for (fcm_index t = 0; t < 2 * nb; t++) {
     const fcm_index k = t < nb ? t : 2 * nb - 1 - t;
     const fcm_index *d = NULL;
     const double *S = NULL;
-    const int bm = fcm__schwarz_block(m->blk, k, &d, &S);
+    const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
     for (int i = 0; i < bm; i++) {
       double s = b[d[i]];
       for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++)
@@ -1288,7 +1383,7 @@ static fcm_status cycle(fcm_mg *m, int l, const double *b, double *x)
   mg_level *C = &m->lev[l + 1];
   for (int s = 0; s < m->opts.pre_smooth; s++)
     smooth(m, L, b, x);
-  if (l == 0 && m->blk && m->opts.pre_smooth > 0) block_smooth(m, b, x);
+  if (L->blk && m->opts.pre_smooth > 0) block_smooth(m, L, b, x);
   /* r = b - A x, b_c = R r */
   fcm_csr_apply(level_matrix(L), -1.0, x, 0.0, L->r);
   const fcm_index n = L->n;
@@ -1316,7 +1411,7 @@ static fcm_status cycle(fcm_mg *m, int l, const double *b, double *x)
       s += L->P_val[p] * C->x[L->P_col[p]];
     x[i] += s;
   }
-  if (l == 0 && m->blk && m->opts.post_smooth > 0) block_smooth(m, b, x);
+  if (L->blk && m->opts.post_smooth > 0) block_smooth(m, L, b, x);
   for (int s = 0; s < m->opts.post_smooth; s++)
     smooth(m, L, b, x);
   return st;
