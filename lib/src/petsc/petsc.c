@@ -63,8 +63,11 @@
  * - PT-Scotch's partition of the same scene on 2 processes differs between runs now and then
  *   (slingshot: 131/133 or 132/132 own elements, although scotch_random_reset() runs before
  *   it), so phase-2 results agree between runs only to round-off and KSP iteration counts
- *   vary; the phase-1 test petsc_checkpoint_np2 (bit for bit) fails about 1 run in 5 under
- *   load, very likely for the same reason. SCOTCH_PTHREAD_NUMBER=1 (Scotch 7's threads) did
+ *   vary. OPEN REGRESSION: the phase-1 test petsc_checkpoint_np2 (bit for bit) fails
+ *   intermittently on this branch — 10 standalone runs of petsc_checkpoint on 2 processes:
+ *   base 9a6a137 0 failed, branch before the merge of main (7adc39a) 1, after it (358576f) 4 —
+ *   cause not found (suspects: the partition, or the masked-rules change in assemble.c /
+ *   cell_rules.c touching the problem built twice in that test). SCOTCH_PTHREAD_NUMBER=1 (Scotch 7's threads) did
  *   not cure it reliably (1 failure in 6 ctest runs with it). FCM_PETSC_PARTITION_ORDERED is
  *   deterministic; next: find PT-Scotch's source of randomness or gather the graph on one
  *   process and partition it there.
