@@ -1,6 +1,9 @@
 /* fcm-sim --backend petsc (see fcm-sim-petsc.h): every process reads the scene and builds the
- * mesh and the geometry; the problem (fcm_petsc_problem_create_from_scene()) distributes the
- * cells, the cut-cell rules, the assembly and the solves. Process 0 prints and writes the log
+ * mesh and the geometry. A scene the linear driver runs (fcm_petsc_problem_supports_scene():
+ * linear material, gravity, fixed and motion on node regions) goes through it
+ * (fcm_petsc_problem_create_from_scene() distributes the cells, the cut-cell rules, the
+ * assembly and the solves); every other scene except cuts goes through the integrator on
+ * PETSc (run_newton(), fcm_petsc_simulation_create()). Process 0 prints and writes the log
  * <name>_log.csv; each frame is a parallel VTU (<name>_NNNN.pvtu by process 0 naming one piece
  * <name>_NNNN_<rank>.vtu per process: its own cells), indexed by <name>.pvd. */
 #define _POSIX_C_SOURCE 200809L
@@ -88,6 +91,109 @@ static void read_old_log(const char *path, run_log *rows, long long first)
   fclose(f);
 }
 
+/* A scene the linear driver does not run (non-linear material, boundary constraints, loads on
+ * the boundary, damping, initial velocities, release): the scene's own simulation with the
+ * integrator on PETSc (fcm_petsc_simulation_create()). Every process holds the same state and
+ * log, so process 0 writes the frames (the serial <name>_background.pvd and VTUs) and the log
+ * <name>_log.csv with the serial writers. Returns the exit code (the same on every process). */
+static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, long long steps,
+                      int check, int quiet, int checkpoint_every, const char *resume, int rank,
+                      int size)
+{
+  const char *name = fcm_scene_name(scene);
+  const int talk = rank == 0 && !quiet;
+  fcm_simulation *sim = NULL;
+  int rc = 1, ok = 1;
+  if (resume || checkpoint_every > 0) {
+    if (rank == 0)
+      fprintf(stderr, "fcm-sim: scene %s: --backend petsc: checkpoints (--checkpoint-every, "
+                      "--resume) are not supported yet for scenes through the integrator "
+                      "(non-linear material or effects beyond the linear driver's); run without "
+                      "them or with the serial backend\n",
+              name);
+    return 2;
+  }
+  if (talk && !check && checkpoint_every < 0 &&
+      fcm_scene_get_output(scene)->checkpoint_interval > 0)
+    fprintf(stderr, "fcm-sim: note: the scene's checkpoints (output.checkpoint_interval) are not "
+                    "written on this path yet\n");
+  fcm_simulation_options so = fcm_simulation_options_default();
+  so.max_steps = check ? (steps > 0 && steps < 3 ? steps : 3) : (steps > 0 ? steps : FCM_DEFAULT);
+  so.checkpoint_interval = 0;
+  if (talk)
+    fprintf(stderr, "fcm-sim: scene %s: through the integrator (Newton) on PETSc\n", name);
+  fcm_status st = fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene,
+                                              FCM_PETSC_PARTITION_AUTO, &so, &sim);
+  if (st != FCM_OK) { /* every process has the error; process 0 prints it */
+    if (rank == 0) fprintf(stderr, "fcm-sim: scene %s: %s\n", name, fcm_ctx_error_message(ctx));
+    return st == FCM_ERR_ARG || st == FCM_ERR_IO || st == FCM_ERR_FORMAT ||
+                   st == FCM_ERR_GEOMETRY || st == FCM_ERR_UNSUPPORTED
+               ? 2
+               : 1;
+  }
+  const char *dir = outdir ? outdir : fcm_scene_get_output(scene)->directory;
+  const int write = !check;
+  char logpath[4200];
+  int frame = 0;
+  snprintf(logpath, sizeof logpath, "%s/%s_log.csv", dir, name);
+  if (write && rank == 0) {
+    ok = make_dirs(dir) && fcm_simulation_write_frame(sim, dir, frame++) == FCM_OK &&
+         fcm_simulation_write_log(sim, logpath) == FCM_OK;
+    if (!ok && fcm_ctx_error_status(ctx) != FCM_OK)
+      fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+  }
+  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (!ok) goto done;
+  const double t0 = fcm_wtime();
+  const long long n = fcm_simulation_num_steps(sim);
+  while (!fcm_simulation_done(sim)) {
+    fcm_step_info si;
+    st = fcm_simulation_step(sim, &si); /* collective; a failure is the same everywhere */
+    const long long k = fcm_simulation_step_count(sim);
+    if (st != FCM_OK) {
+      if (rank == 0) {
+        fprintf(stderr, "fcm-sim: step %lld: %s\n", k + 1, fcm_ctx_error_message(ctx));
+        if (write) fcm_simulation_write_log(sim, logpath);
+      }
+      goto done;
+    }
+    if (!fcm_simulation_state_finite(sim)) {
+      if (rank == 0) fprintf(stderr, "fcm-sim: non-finite state after step %lld\n", k);
+      goto done;
+    }
+    if (talk)
+      fprintf(stderr,
+              "fcm-sim: step %lld/%lld t = %.6g s: Newton %d, KSP %lld iterations, residual "
+              "%.3g\n",
+              k, n, si.time, si.newton_iterations, si.linear_iterations, si.residual);
+    if (write && fcm_simulation_frame_due(sim)) {
+      if (rank == 0) {
+        ok = fcm_simulation_write_frame(sim, dir, frame++) == FCM_OK &&
+             fcm_simulation_write_log(sim, logpath) == FCM_OK;
+        if (!ok) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+      }
+      MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+      if (!ok) goto done;
+    }
+  }
+  if (write && rank == 0) {
+    ok = fcm_simulation_write_log(sim, logpath) == FCM_OK;
+    if (!ok) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+  }
+  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (!ok) goto done;
+  if (talk) {
+    fcm_simulation_summary_view(sim, stdout);
+    printf("  backend   petsc, %d process%s (Newton on PETSc), steps %.3g s\n", size,
+           size > 1 ? "es" : "", fcm_wtime() - t0);
+    if (write) printf("  output    %s/%s_background.pvd, %s\n", dir, name, logpath);
+  }
+  rc = 0;
+done:
+  fcm_simulation_destroy(&sim);
+  return rc;
+}
+
 int sim_petsc_run(const char *path, const char *outdir, long long steps, int check, int quiet,
                   int checkpoint_every, const char *resume, int petsc_argc, char **petsc_argv)
 {
@@ -122,6 +228,10 @@ int sim_petsc_run(const char *path, const char *outdir, long long steps, int che
   if (talk)
     fprintf(stderr, "fcm-sim: scene %s (%s): building on %d process%s (backend petsc)\n", name,
             fcm_scene_source(scene), size, size > 1 ? "es" : "");
+  if (!fcm_petsc_problem_supports_scene(ctx, scene)) {
+    rc = run_newton(ctx, scene, outdir, steps, check, quiet, checkpoint_every, resume, rank, size);
+    goto done;
+  }
   double t0 = fcm_wtime();
   st =
       fcm_petsc_problem_create_from_scene(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO, &P);

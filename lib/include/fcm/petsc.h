@@ -28,6 +28,7 @@
 
 #include "fcm/core.h"
 #include "fcm/embed.h"
+#include "fcm/simulation.h"
 #include "fcm/fem.h"
 #include "fcm/geom.h"
 #include "fcm/material.h"
@@ -222,6 +223,43 @@ typedef struct fcm_petsc_info {
 
 /** Fill `info` (collective: the sums and extremes are reduced). */
 FCM_API fcm_status fcm_petsc_problem_get_info(fcm_petsc_problem *problem, fcm_petsc_info *info);
+
+/** 1 when fcm_petsc_problem_create_from_scene() runs `scene` (linear material, the effects it
+ * lists), 0 otherwise (then fcm_petsc_simulation_create() is the way; also 0 for NULL).
+ * Local, no error recorded in ctx. */
+FCM_API int fcm_petsc_problem_supports_scene(fcm_ctx *ctx, const fcm_scene *scene);
+
+/** A scene's ordinary simulation (fcm/simulation.h) on the processes of comm, for every
+ * material and effect the serial runner has except cuts (phase 2: Newton on PETSc). Every
+ * process runs the scene's fcm_integrator — Newton, line search, time stepping, constraints
+ * on nodes and on the embedded boundary (Nitsche / penalty), gravity, tractions, pressure,
+ * damping, initial velocities — on the same DOF numbering, but the cut-cell rules carry points
+ * on the process's own cells only (the cells are partitioned as fcm_petsc_problem_create()
+ * partitions them), so each assembly is a partial sum; the integrator sums them over the
+ * processes after every assembly (so every process takes the same decisions and holds the
+ * same state), and each Newton system goes to a PETSc KSP on a MATMPIAIJ of the owned rows
+ * (defaults: CG, or MINRES when the tangent may be indefinite, with GAMG and the rigid-body
+ * near-null space; solver.rtol / max_iterations; solver.petsc_options, then the command line,
+ * override them). A KSP that does not converge is the integrator's linear-solver failure
+ * (the step is retried as in the serial runner).
+ *
+ * The simulation is used as any other: fcm_simulation_step() is collective; the state, the
+ * log rows (energies, mass, momentum, reactions) and the counters are the same on every
+ * process, so one process (rank 0) writes the frames and the log with the serial writers.
+ * Not supported (FCM_ERR_UNSUPPORTED naming it, on every process): "cut" effects,
+ * quadrature.simplify = auto. Stated plainly: the sums are of replicated dense vectors and of
+ * the Newton matrix's values (O(DOFs + nonzeros) per process and assembly), the direction is
+ * gathered on every process; the rules, the element integration and the solve are what is
+ * distributed. Collective.
+ * @param[in] partition the cell partition method (AUTO: PT-Scotch)
+ * @param[in] opts      simulation options (NULL: defaults)
+ * @return FCM_OK; FCM_ERR_UNSUPPORTED; the errors of fcm_simulation_create(); FCM_ERR_INTERNAL
+ * (PETSc or MPI failed: its message). On every process when any failed. */
+FCM_API fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm,
+                                               const fcm_scene *scene,
+                                               fcm_petsc_partition partition,
+                                               const fcm_simulation_options *opts,
+                                               fcm_simulation **out);
 
 #ifdef __cplusplus
 }

@@ -1242,6 +1242,11 @@ fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_g
   FCM_TRY(ctx, rules_alloc(ctx, mesh, &o, &R));
   FCM_TRY(ctx, build_rules(ctx, mesh, geom, NULL, 0, R));
   R->masked = o.cell_mask != NULL;
+  if (R->masked) {
+    const fcm_index nc = fcm_mesh_num_cells(mesh);
+    FCM_ALLOC(ctx, (size_t)nc + 1, R->own);
+    memcpy(R->own, o.cell_mask, (size_t)nc);
+  }
   R->opts.cell_mask = NULL; /* borrowed for the call only */
   *rules = R;
   R = NULL;
@@ -1357,6 +1362,7 @@ void fcm_cell_rules_destroy(fcm_cell_rules **rules)
     fcm__free(ctx, R->uncut_flags[k]);
   }
   fcm__free(ctx, R->cls);
+  fcm__free(ctx, R->own);
   fcm__free(ctx, R->fraction);
   fcm__free(ctx, R->piece_off);
   fcm__free(ctx, R->piece_cell);

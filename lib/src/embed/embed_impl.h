@@ -61,6 +61,9 @@ struct fcm_cell_rules {
    * around cut cells: 2 x num_links piece ids, ascending pairs, sorted). */
   fcm_cell_rules_options opts; /* cell_mask reset to NULL after the build */
   int masked;                  /* built with a cell_mask: unflagged cells have no points */
+  unsigned char *own;          /* masked: copy of the cell_mask (num cells), else NULL; the
+                                  assembly gives unflagged uncut cells no points either
+                                  (fcm__cell_rules_owns()) */
   int num_cuts;
   fcm_index num_cut_tris;
   fcm__cut_tri *cut_tris;
@@ -268,5 +271,12 @@ int fcm__embed_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n, 
  * positive volume has none inside the mesh; FCM_ERR_ALLOC. Single-threaded. */
 fcm_status fcm__embed_outside(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
                               fcm_cell_rules_stats *S);
+
+/* 0 when the rules were built with a cell_mask that does not flag `cell` (the cell belongs to
+ * another process: no points, uncut or not); 1 otherwise. */
+static inline int fcm__cell_rules_owns(const fcm_cell_rules *R, fcm_index cell)
+{
+  return !R || !R->own || R->own[cell];
+}
 
 #endif /* FCM_EMBED_IMPL_H */

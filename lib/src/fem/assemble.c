@@ -3,6 +3,7 @@
  * standard rule of full cells or the per-cell rules of cut cells, scattered
  * colour by colour in parallel (deterministic for any thread count). The space is
  * only read; rules, tabulations and scratch live in an fcm_assembly_workspace. */
+#include "embed/embed_impl.h"
 #include "fem/fem_impl.h"
 #include "la/mat3.h"
 #include "material/material_impl.h"
@@ -88,8 +89,9 @@ static void tabulation_free(fcm_ctx *ctx, tabulation *t)
 static cell_rule get_cell_rule(const fcm_space *s, const tabulation *t, fcm_rule_kind kind,
                                fcm_index e, double *Nbuf, double *dNbuf)
 {
-  if (!s->rules || fcm_cell_rules_class(s->rules, s->elem_cell[e]) == FCM_CELL_UNCUT) return t->r;
   cell_rule r = {0, NULL, Nbuf, dNbuf, NULL};
+  if (!fcm__cell_rules_owns(s->rules, s->elem_cell[e])) return r; /* another process's cell */
+  if (!s->rules || fcm_cell_rules_class(s->rules, s->elem_cell[e]) == FCM_CELL_UNCUT) return t->r;
   const double *pts = NULL;
   fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], kind, &r.nq, &pts, &r.w, &r.fict);
   for (int q = 0; q < r.nq; q++) {
@@ -823,6 +825,7 @@ fcm_status fcm_space_momentum(const fcm_space *s, double density, const double *
     int nq = 0;
     const double *pts = NULL, *w = NULL;
     const unsigned char *fl = NULL;
+    if (!fcm__cell_rules_owns(s->rules, c)) continue; /* another process's cell (cell_mask) */
     if (s->rules && fcm_cell_rules_class(s->rules, c) != FCM_CELL_UNCUT) {
       FCM_TRY(ctx, fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], FCM_RULE_MASS, &nq, &pts,
                                             &w, &fl));

@@ -4,6 +4,7 @@
 #include "scene/scene_impl.h"
 
 #include "core/core_impl.h"
+#include "sim/sim_backend.h"
 #include "fcm/embed.h"
 #include "fcm/fem.h"
 #include "fcm/geom.h"
@@ -531,6 +532,7 @@ static fcm_status build_rules(fcm_simulation *S)
   ro.progress = S->opts.rules_progress;
   ro.progress_user = S->opts.rules_progress_user;
   ro.progress_interval = S->opts.rules_progress_interval;
+  ro.cell_mask = S->cell_mask;
   FCM_TRY(S->ctx, fcm_cell_rules_create(S->ctx, S->mesh, S->geom, &ro, &S->rules));
   S->c.cell_rules = 1;
   S->c.surface_rules = ro.surface_strength >= 0;
@@ -794,8 +796,32 @@ cleanup:
   return st;
 }
 
+static fcm_status simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
+                                    const fcm_simulation_options *opts,
+                                    const unsigned char *cell_mask,
+                                    fcm__simulation_attach_fn attach, void *attach_user,
+                                    fcm_simulation **out);
+
 fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
                                  const fcm_simulation_options *opts, fcm_simulation **out)
+{
+  return simulation_create(ctx, scene, opts, NULL, NULL, NULL, out);
+}
+
+fcm_status fcm__simulation_create_distributed(fcm_ctx *ctx, const fcm_scene *scene,
+                                              const fcm_simulation_options *opts,
+                                              const unsigned char *cell_mask,
+                                              fcm__simulation_attach_fn attach, void *attach_user,
+                                              fcm_simulation **out)
+{
+  return simulation_create(ctx, scene, opts, cell_mask, attach, attach_user, out);
+}
+
+static fcm_status simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
+                                    const fcm_simulation_options *opts,
+                                    const unsigned char *cell_mask,
+                                    fcm__simulation_attach_fn attach, void *attach_user,
+                                    fcm_simulation **out)
 {
   fcm_status st = FCM_OK;
   fcm_simulation *S = NULL;
@@ -804,6 +830,7 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   double t0 = fcm_wtime();
   FCM_ALLOC(ctx, 1, S);
   S->ctx = ctx;
+  S->cell_mask = cell_mask;
   S->scene = scene;
   S->opts = opts ? *opts : fcm_simulation_options_default();
   FCM_CHECK(S->opts.max_steps >= 1 || S->opts.max_steps == FCM_DEFAULT, ctx, FCM_ERR_ARG,
@@ -862,6 +889,7 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
     const fcm__effect_type *t = fcm__scene_effect_type(e->type);
     if (t->apply) FCM_TRY(ctx, t->apply(S, e));
   }
+  if (attach) FCM_TRY(ctx, attach(attach_user, S->integ, S->space));
   FCM_TRY(ctx, fcm_integrator_setup(S->integ));
   {
     fcm_integrator_setup_info si;
@@ -887,6 +915,7 @@ fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
 
   if (S->geom && fcm_scene_get_output(scene)->write_surface) FCM_TRY(ctx, build_surface(S));
   S->c.time_setup = fcm_wtime() - t0;
+  S->cell_mask = NULL; /* borrowed for the create only */
   *out = S;
   S = NULL;
 cleanup:
@@ -940,6 +969,13 @@ static fcm_status log_momentum(fcm_simulation *S, fcm__log_row *r)
   FCM_TRY(S->ctx,
           fcm_space_momentum(S->space, rho, fcm_integrator_displacement(S->integ),
                              fcm_integrator_velocity(S->integ), &r->mass, r->momentum, NULL));
+  { /* a distributed run: this process's cells only, summed over the processes */
+    double q[4] = {r->mass, r->momentum[0], r->momentum[1], r->momentum[2]};
+    FCM_TRY(S->ctx, fcm__integrator_reduce(S->integ, q, 4));
+    r->mass = q[0];
+    for (int d = 0; d < 3; d++)
+      r->momentum[d] = q[1 + d];
+  }
 cleanup:
   return st;
 }

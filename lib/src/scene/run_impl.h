@@ -64,6 +64,9 @@ struct fcm_simulation {
   int *react_effect, *react_id;
   double *react_log;
   long long react_cap;
+  /* distributed runs (fcm__simulation_create_distributed()): points on these cells only
+   * (borrowed during the create; NULL afterwards and in serial runs) */
+  const unsigned char *cell_mask;
   /* what the voxel or level-set geometry reported ("" for the other kinds) */
   char geometry_note[256];
 };
@@ -80,5 +83,21 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S);
  * the caller destroys both (run.c). */
 fcm_status fcm__scene_mesh_geometry(fcm_ctx *ctx, const fcm_scene *scene, fcm_mesh **mesh,
                                     fcm_geometry **geom);
+
+/* Called by fcm__simulation_create_distributed() with the integrator, created with the scene's
+ * effects but not set up yet: it sets the integrator's backend (lib/src/sim/sim_backend.h). */
+typedef fcm_status (*fcm__simulation_attach_fn)(void *user, fcm_integrator *integ,
+                                                const fcm_space *space);
+
+/* fcm_simulation_create() for a distributed backend (the PETSc adapter, fcm/petsc.h): the cell
+ * rules carry points on the cells flagged in cell_mask only (every cell is still classified,
+ * so the space and its DOF numbering are those of the serial run), and `attach` sets the
+ * integrator's backend before its setup; the log's partial quantities (mass, momentum) are
+ * summed through it. Collective over the backend's processes. (run.c) */
+fcm_status fcm__simulation_create_distributed(fcm_ctx *ctx, const fcm_scene *scene,
+                                              const fcm_simulation_options *opts,
+                                              const unsigned char *cell_mask,
+                                              fcm__simulation_attach_fn attach, void *attach_user,
+                                              fcm_simulation **out);
 
 #endif /* FCM_SCENE_RUN_IMPL_H */

@@ -182,6 +182,7 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   fcm_schwarz_destroy(&I->schwarz);
   fcm_mg_destroy(&I->mg);
   fcm_assembly_workspace_destroy(&I->aws);
+  if (I->has_backend && I->backend.destroy) I->backend.destroy(I->backend.user);
   fcm__free(ctx, I);
   *integ = NULL;
 }
@@ -524,7 +525,8 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
   if (I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) {
     FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->M));
     form.term = FCM_LINEAR_MASS;
-    FCM_TRY(ctx, fcm_assembly_workspace_linear(I->aws, &form, I->M, NULL));
+    st = fcm_assembly_workspace_linear(I->aws, &form, I->M, NULL);
+    FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, NULL, I->M));
     I->setup_info.mass_assemblies = 1;
   }
   for (int k = 0; k < I->num_loads; k++) {
@@ -536,7 +538,8 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
     form.term = l->kind == SIM_LOAD_GRAVITY ? FCM_LINEAR_BODY_FORCE
                 : l->kind == SIM_LOAD_BODY  ? FCM_LINEAR_BODY_FORCE_FIELD
                                             : FCM_LINEAR_SURFACE_TRACTION;
-    FCM_TRY(ctx, fcm_assembly_workspace_linear(I->aws, &form, NULL, l->f));
+    st = fcm_assembly_workspace_linear(I->aws, &form, NULL, l->f);
+    FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, l->f, NULL));
     if (l->kind == SIM_LOAD_TRACTION)
       I->setup_info.traction_assemblies++;
     else
@@ -575,7 +578,8 @@ static fcm_status setup_representative_force(fcm_integrator *I)
       form.material = &I->mat;
       form.accel = a;
       memset(I->Ma, 0, sizeof *I->Ma * (size_t)n);
-      FCM_TRY(ctx, fcm_assembly_workspace_linear(I->aws, &form, NULL, I->Ma));
+      st = fcm_assembly_workspace_linear(I->aws, &form, NULL, I->Ma);
+      FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, I->Ma, NULL));
       I->setup_info.scale_assemblies = 1;
     }
   }
@@ -603,7 +607,9 @@ static fcm_status setup_solvers(fcm_integrator *I)
   if (o->kind == FCM_INTEGRATOR_BACKWARD_EULER &&
       (o->rayleigh_mass > 0.0 || o->rayleigh_stiffness > 0.0))
     FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->D));
-  if (o->linear_solver == FCM_LINEAR_DIRECT) {
+  if (I->has_backend) {
+    /* the backend solves: no serial solver */
+  } else if (o->linear_solver == FCM_LINEAR_DIRECT) {
     if (o->direct_method == FCM_DIRECT_CHOLMOD) {
       FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, I->H, &I->chol));
       FCM_TRY(ctx, fcm_direct_analyze(I->chol));
@@ -674,6 +680,49 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
   FCM_TRY(ctx, setup_solvers(I));
   setup_initial_state(I);
 cleanup:
+  return st;
+}
+
+fcm_status fcm__integrator_set_backend(fcm_integrator *I, const fcm__sim_backend *b)
+{
+  fcm_status st = FCM_OK;
+  if (!I || !b) {
+    if (b && b->destroy) b->destroy(b->user);
+    FCM_CHECK(0, I ? I->ctx : NULL, FCM_ERR_ARG, "integrator: NULL integrator or backend");
+  }
+  if (I->is_setup || I->has_backend || !b->reduce || !b->factor || !b->solve) {
+    if (b->destroy) b->destroy(b->user);
+    FCM_CHECK(0, I->ctx, FCM_ERR_ARG,
+              "integrator: a backend needs reduce, factor and solve, and is set once, before "
+              "fcm_integrator_setup()");
+  }
+  I->backend = *b;
+  I->has_backend = 1;
+cleanup:
+  return st;
+}
+
+fcm_status fcm__integrator_reduce(fcm_integrator *I, double *values, fcm_index count)
+{
+  if (!I || !I->has_backend) return FCM_OK;
+  fcm_status st = I->backend.reduce(I->backend.user, FCM_OK, values, count);
+  if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
+  return st;
+}
+
+fcm_status fcm__sim_reduce(fcm_integrator *I, fcm_status st, double *scalars, int ns, double *vec,
+                           fcm_csr *T)
+{
+  if (!I->has_backend) return st;
+  const fcm__sim_backend *b = &I->backend;
+  st = b->reduce(b->user, st, scalars, ns);
+  if (st == FCM_OK && vec) st = b->reduce(b->user, FCM_OK, vec, I->n);
+  if (st == FCM_OK && T) {
+    fcm_index nnz = 0;
+    fcm_csr_get_size(T, NULL, NULL, &nnz);
+    st = b->reduce(b->user, FCM_OK, fcm_csr_values(T), nnz);
+  }
+  if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
   return st;
 }
 
@@ -795,8 +844,8 @@ fcm_status fcm_integrator_energy(fcm_integrator *I, double *kinetic, double *ela
   {
     fcm_index n = I->n;
     double psi = 0.0, ekin = 0.0, wext = 0.0;
-    FCM_TRY(I->ctx,
-            fcm_assembly_workspace_hyperelastic(I->aws, &I->params, I->u, &psi, NULL, NULL));
+    st = fcm_assembly_workspace_hyperelastic(I->aws, &I->params, I->u, &psi, NULL, NULL);
+    FCM_TRY(I->ctx, fcm__sim_reduce(I, st, &psi, 1, NULL, NULL));
     if (I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) {
       FCM_TRY(I->ctx, fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1));
       for (fcm_index i = 0; i < n; i++)

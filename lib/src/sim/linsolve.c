@@ -428,6 +428,16 @@ fcm_status fcm__sim_factor(fcm_integrator *I, fcm_step_reason *reason, sim_stats
 {
   double t0 = fcm_wtime();
   fcm_status st = FCM_OK;
+  if (I->has_backend) { /* sim_backend.h */
+    int failed = 0;
+    st = I->backend.factor(I->backend.user, I->H, I->h_psd, &failed);
+    stats->factorizations++;
+    I->total_factorizations++;
+    if (st == FCM_OK && failed) *reason = FCM_STEP_LINEAR_SOLVER_FAILED;
+    stats->time_factor += fcm_wtime() - t0;
+    if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
+    return st;
+  }
   switch (I->opts.linear_solver) {
   case FCM_LINEAR_DIRECT:
     st = factor_direct(I, reason, stats);
@@ -514,6 +524,12 @@ fcm_status fcm__sim_solve(fcm_integrator *I, const double *b, double *d, fcm_ste
   fcm_status st = FCM_OK;
   double t0 = fcm_wtime();
   *iterations = 0;
+  if (I->has_backend) { /* sim_backend.h */
+    int failed = 0;
+    st = I->backend.solve(I->backend.user, b, d, iterations, &failed);
+    stats->linear_iterations += *iterations;
+    if (st == FCM_OK && failed) *reason = FCM_STEP_LINEAR_SOLVER_FAILED;
+  } else {
   switch (I->opts.linear_solver) {
   case FCM_LINEAR_DIRECT:
     st = solve_direct(I, b, d, reason);
@@ -523,6 +539,7 @@ fcm_status fcm__sim_solve(fcm_integrator *I, const double *b, double *d, fcm_ste
     break;
   default:
     st = solve_krylov(I, b, d, reason, iterations, stats);
+  }
   }
   if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
   stats->time_solve += fcm_wtime() - t0;

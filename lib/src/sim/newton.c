@@ -91,15 +91,47 @@ static fcm_status assemble_boundary(fcm_integrator *I, const double *x, int proj
   return st;
 }
 
+/* The base of the Newton matrix into H before the tangent is added: with a backend
+ * (sim_backend.h) the root process only (H is summed over the processes after the assembly). */
+static void tangent_base(fcm_integrator *I, double h)
+{
+  if (I->has_backend && !I->backend.root)
+    fcm_csr_set_zero(I->H);
+  else
+    fcm__sim_set_base(I, h, I->H);
+}
+
+/* With a backend: agree on st and on *finite, and sum the scalars, fint and T over the
+ * processes (every process then holds the same global values). */
+static fcm_status reduce_eval(fcm_integrator *I, fcm_status st, double *scalars, int ns,
+                              double *fint, fcm_csr *T, int *finite, sim_stats *stats)
+{
+  if (!I->has_backend) return st;
+  double s[4] = {0, 0, 0, 0}; /* up to 3 scalars, then the count of non-finite processes */
+  for (int k = 0; k < ns; k++)
+    s[k] = scalars[k];
+  s[ns] = *finite ? 0.0 : 1.0;
+  double t0 = fcm_wtime();
+  st = fcm__sim_reduce(I, st, s, ns + 1, NULL, NULL);
+  if (st == FCM_OK && s[ns] == 0.0) st = fcm__sim_reduce(I, FCM_OK, NULL, 0, fint, T);
+  stats->time_assembly += fcm_wtime() - t0;
+  if (st != FCM_OK) return st;
+  *finite = s[ns] == 0.0;
+  for (int k = 0; k < ns; k++)
+    scalars[k] = s[k];
+  return FCM_OK;
+}
+
 /* Tangent at x into H: H = base(h) + K(x), optionally with the PSD-projected material. */
 static fcm_status assemble_tangent(fcm_integrator *I, double h, const double *x, int projected,
                                    int *finite, sim_stats *stats)
 {
   fcm_status st = FCM_OK;
-  fcm__sim_set_base(I, h, I->H);
-  FCM_TRY(I->ctx,
-          assemble(I, projected ? &I->params_psd : &I->params, x, NULL, NULL, I->H, finite, stats));
-  if (*finite) FCM_TRY(I->ctx, assemble_boundary(I, x, projected, NULL, NULL, I->H, finite, stats));
+  tangent_base(I, h);
+  st = assemble(I, projected ? &I->params_psd : &I->params, x, NULL, NULL, I->H, finite, stats);
+  if (st == FCM_OK && *finite)
+    st = assemble_boundary(I, x, projected, NULL, NULL, I->H, finite, stats);
+  FCM_TRY(I->ctx, reduce_eval(I, st, NULL, 0, NULL, I->H, finite, stats));
 cleanup:
   return st;
 }
@@ -120,12 +152,17 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
   double psi = 0.0, inertia = 0.0, damp = 0.0, wext, bnd = 0.0;
   out->finite = 1;
   memset(fint, 0, sizeof *fint * (size_t)n);
-  if (tangent) fcm__sim_set_base(I, h, I->H);
-  FCM_TRY(I->ctx,
-          assemble(I, &I->params, x, &psi, fint, tangent ? I->H : NULL, &out->finite, stats));
-  if (!out->finite) return FCM_OK;
-  FCM_TRY(I->ctx,
-          assemble_boundary(I, x, 0, &bnd, fint, tangent ? I->H : NULL, &out->finite, stats));
+  if (tangent) tangent_base(I, h);
+  st = assemble(I, &I->params, x, &psi, fint, tangent ? I->H : NULL, &out->finite, stats);
+  if (st == FCM_OK && out->finite)
+    st = assemble_boundary(I, x, 0, &bnd, fint, tangent ? I->H : NULL, &out->finite, stats);
+  {
+    double parts[2] = {psi, bnd};
+    FCM_TRY(I->ctx,
+            reduce_eval(I, st, parts, 2, fint, tangent ? I->H : NULL, &out->finite, stats));
+    psi = parts[0];
+    bnd = parts[1];
+  }
   if (!out->finite) return FCM_OK;
   {
     double t0 = fcm_wtime();
@@ -467,7 +504,8 @@ static fcm_status update_damping(fcm_integrator *I, fcm_step_reason *reason, sim
   const double *mv = fcm_csr_values(I->M);
   fcm_csr_set_zero(I->D);
   if (o->rayleigh_stiffness > 0.0) {
-    FCM_TRY(I->ctx, assemble(I, &I->params_psd, I->un, NULL, NULL, I->D, &finite, stats));
+    st = assemble(I, &I->params_psd, I->un, NULL, NULL, I->D, &finite, stats);
+    FCM_TRY(I->ctx, reduce_eval(I, st, NULL, 0, NULL, I->D, &finite, stats));
     if (!finite) {
       *reason = FCM_STEP_NONFINITE;
       return FCM_OK;

@@ -352,6 +352,17 @@ fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
       }
     }
     if (pass == 0) {
+      if (I->has_backend) { /* the points of this process's cells: count them all */
+        double c[64];
+        for (int k0 = 0; k0 < I->num_bcons; k0 += 64) {
+          const int m = I->num_bcons - k0 < 64 ? I->num_bcons - k0 : 64;
+          for (int k = 0; k < m; k++)
+            c[k] = (double)count[k0 + k];
+          FCM_TRY(ctx, I->backend.reduce(I->backend.user, FCM_OK, c, m));
+          for (int k = 0; k < m; k++)
+            count[k0 + k] = (fcm_index)c[k];
+        }
+      }
       for (int k = 0; k < I->num_bcons; k++)
         FCM_CHECK(count[k] > 0, ctx, FCM_ERR_ARG,
                   "boundary constraint %d selects no embedded-boundary point (check its region "
@@ -731,6 +742,12 @@ fcm_status fcm_integrator_boundary_reaction(const fcm_integrator *I, int id, dou
     }
   }
 cleanup:
+  if (st == FCM_OK && I->has_backend) { /* partial sums over own cells' points: sum them */
+    double q[6] = {Fr[0], Fr[1], Fr[2], Mr[0], Mr[1], Mr[2]};
+    st = I->backend.reduce(I->backend.user, FCM_OK, q, 6);
+    for (int i = 0; i < 3; i++)
+      Fr[i] = q[i], Mr[i] = q[3 + i];
+  }
   if (st == FCM_OK) {
     if (force) memcpy(force, Fr, sizeof Fr);
     if (moment) memcpy(moment, Mr, sizeof Mr);

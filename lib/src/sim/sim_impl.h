@@ -5,6 +5,7 @@
 
 #include "core/core_impl.h"
 #include "fcm/sim.h"
+#include "sim/sim_backend.h"
 
 typedef enum sim_load_kind { SIM_LOAD_GRAVITY = 0, SIM_LOAD_BODY, SIM_LOAD_TRACTION } sim_load_kind;
 
@@ -147,6 +148,10 @@ struct fcm_integrator {
 
   /* energy parts of the current iterate */
   double psi;
+
+  /* distributed backend (sim_backend.h); has_backend = 0: serial */
+  fcm__sim_backend backend;
+  int has_backend;
 };
 
 enum { SIM_H_INVALID = 0, SIM_H_TANGENT = 1, SIM_H_SYSTEM = 2 };
@@ -199,5 +204,11 @@ void fcm__sim_boundary_free(fcm_integrator *I);
 int fcm__sim_boundary_time(fcm_integrator *I, double t);
 fcm_status fcm__sim_boundary_assemble(fcm_integrator *I, const double *x, int projected,
                                       double *energy, double *force, fcm_csr *T, int *finite);
+
+/* With a backend (sim_backend.h): agree on st and sum the partial quantities over the
+ * processes: the ns scalars, the vector vec (n; may be NULL) and the values of T (may be
+ * NULL). Without one: returns st. (integrator.c) */
+fcm_status fcm__sim_reduce(fcm_integrator *I, fcm_status st, double *scalars, int ns, double *vec,
+                           fcm_csr *T);
 
 #endif /* FCM_SIM_IMPL_H */

@@ -1,0 +1,46 @@
+/* sim module: the integrator's distributed backend (internal; the PETSc adapter of
+ * lib/src/petsc sets it, no public API). Every process runs the same integrator on the same
+ * replicated DOF numbering, but its space's cell rules carry points on the process's own
+ * cells only, so every assembly (mass, loads, energy, force, tangent, boundary terms) is the
+ * process's partial sum. With a backend set, the integrator sums those partial quantities
+ * over the processes right after each assembly (reduce), so the Newton loop, line search,
+ * stopping rules, reactions and energies see the global values and every process takes the
+ * same decisions; and the eliminated Newton system goes to the backend's solver
+ * (factor / solve) instead of the serial ones. */
+#ifndef FCM_SIM_BACKEND_H
+#define FCM_SIM_BACKEND_H
+
+#include "fcm/la.h"
+#include "fcm/sim.h"
+
+typedef struct fcm__sim_backend {
+  void *user;
+  /* 1 on exactly one process: the terms that are no partial sums (the base M/h^2 + D/h of the
+   * Newton matrix, from the already summed M and D) are added there only */
+  int root;
+  /* Agree on st over the processes (on a failure anywhere every process returns the status
+   * and message of the first failing one), then sum values[0 .. count) over the processes in
+   * place (the same result, bit for bit, on every process). Collective. */
+  fcm_status (*reduce)(void *user, fcm_status st, double *values, fcm_index count);
+  /* Prepare the solves with the eliminated Newton matrix H (summed: the same on every
+   * process); psd: H is positive definite (CG) or may be indefinite (MINRES). *failed = 1: a
+   * soft failure (the step is retried). Collective. */
+  fcm_status (*factor)(void *user, const fcm_csr *H, int psd, int *failed);
+  /* Solve H x = b (b the same on every process; x returned on every process). *failed = 1: no
+   * usable solution (soft). Collective. */
+  fcm_status (*solve)(void *user, const double *b, double *x, int *iterations, int *failed);
+  /* Release `user` (called by fcm_integrator_destroy()); may be NULL. */
+  void (*destroy)(void *user);
+} fcm__sim_backend;
+
+/* Set the backend of an integrator that is not set up yet (before fcm_integrator_setup():
+ * the setup sums the mass matrix and the loads). The integrator owns b->user from now on
+ * (b->destroy at fcm_integrator_destroy()), also when this fails. FCM_ERR_ARG after setup. */
+fcm_status fcm__integrator_set_backend(fcm_integrator *I, const fcm__sim_backend *b);
+
+/* Sum values[0 .. count) over the processes of the integrator's backend, in place (a partial
+ * quantity of the space, e.g. the log's mass and momentum); FCM_OK without a backend.
+ * Collective with a backend. */
+fcm_status fcm__integrator_reduce(fcm_integrator *I, double *values, fcm_index count);
+
+#endif /* FCM_SIM_BACKEND_H */

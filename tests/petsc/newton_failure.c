@@ -1,0 +1,121 @@
+/* Errors of the integrator on PETSc (fcm_petsc_simulation_create()) end every process together
+ * with the message (label mpi, 1 and 2 processes, under a timeout: a process left waiting in a
+ * collective call would hang the test until the timeout fails it):
+ * - the cut-cell rules fail on ONE process only (the last one's scene caps the rule memory at
+ *   a few bytes): create fails on every process, the others' message names the failing
+ *   process and carries its message;
+ * - a boundary constraint that selects no embedded-boundary point (known only after the
+ *   processes' point counts are summed, inside the integrator's setup): FCM_ERR_ARG
+ *   everywhere;
+ * - a KSP that cannot converge (CG without preconditioner, 2 iterations): the integrator
+ *   halves the step, then fails with FCM_ERR_NOT_CONVERGED (linear-solver-failed) on every
+ *   process;
+ * - a scene with a cut: FCM_ERR_UNSUPPORTED naming the effect. */
+#include "fcm/fcm.h"
+#include "fcm/petsc.h"
+#include "fcm/simulation.h"
+#include "test.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+
+static const char *scene_text(char *buf, size_t size, const char *extra_quadrature,
+                              const char *effects, const char *solver)
+{
+  snprintf(buf, size,
+           "{\"version\": 1, \"name\": \"fail\","
+           " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [-0.6, -0.6, -0.6],"
+           " \"max\": [0.6, 0.6, 0.6]}, \"cells\": [4, 4, 4]},"
+           " \"geometry\": {\"shape\": \"ball\", \"center\": [0, 0, 0], \"radius\": 0.5,"
+           " \"resolution\": 3},"
+           " \"material\": {\"model\": \"snh\", \"young\": 1e5, \"poisson\": 0.3,"
+           " \"density\": 1000},"
+           " \"quadrature\": {%s}, \"solver\": {%s},"
+           " \"time\": {\"dt\": 0.01, \"duration\": 0.05},"
+           " \"effects\": [{\"gravity\": {}}%s]}",
+           extra_quadrature, solver, effects);
+  return buf;
+}
+
+int main(int argc, char **argv)
+{
+  fcm_ctx *ctx = NULL;
+  fcm_scene *scene = NULL;
+  fcm_simulation *sim = NULL;
+  char text[4096];
+  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  TEST_OK(ctx, fcm_petsc_initialize(ctx, &argc, &argv));
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const char *fix = ", {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0.3],"
+                    " \"normal\": [0, 0, 1]}}}}";
+
+  /* 1. the rules fail on the last process only */
+  TEST_OK(ctx, fcm_scene_create_from_string(
+                   ctx,
+                   scene_text(text, sizeof text,
+                              rank == size - 1 ? "\"max_rule_memory_gib\": 1e-9" : "", fix, ""),
+                   NULL, &scene));
+  fcm_status s = fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene,
+                                             FCM_PETSC_PARTITION_AUTO, NULL, &sim);
+  TEST_TRUE(s != FCM_OK && sim == NULL);
+  if (size > 1 && rank != size - 1) {
+    char want[64];
+    snprintf(want, sizeof want, "process %d of %d failed", size - 1, size);
+    TEST_TRUE(strstr(fcm_ctx_error_message(ctx), want) != NULL);
+  }
+  if (getenv("FCM_TEST_VERBOSE"))
+    fprintf(stderr, "rank %d: case 1: %s\n", rank, fcm_ctx_error_message(ctx));
+  fcm_ctx_error_clear(ctx);
+  fcm_scene_destroy(&scene);
+
+  /* 2. a boundary constraint without points (summed over the processes) */
+  TEST_OK(ctx, fcm_scene_create_from_string(
+                   ctx,
+                   scene_text(text, sizeof text, "",
+                              ", {\"fixed\": {\"boundary\": {\"half_space\": {\"point\": [0, 0, "
+                              "0.9], \"normal\": [0, 0, 1]}}}}",
+                              ""),
+                   NULL, &scene));
+  TEST_ERR(ctx,
+           fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO,
+                                       NULL, &sim),
+           FCM_ERR_ARG, "selects no embedded-boundary point");
+  fcm_scene_destroy(&scene);
+
+  /* 3. a KSP that cannot converge: the step fails everywhere after its halvings */
+  TEST_OK(ctx, fcm_scene_create_from_string(
+                   ctx,
+                   scene_text(text, sizeof text, "", fix,
+                              "\"method\": \"cg\", \"petsc_options\": \"-ksp_type cg -pc_type "
+                              "none -ksp_max_it 2\""),
+                   NULL, &scene));
+  TEST_OK(ctx, fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO,
+                                           NULL, &sim));
+  fcm_step_info si;
+  TEST_ERR(ctx, fcm_simulation_step(sim, &si), FCM_ERR_NOT_CONVERGED, "linear-solver-failed");
+  fcm_simulation_destroy(&sim);
+  fcm_scene_destroy(&scene);
+
+  /* 4. a cut */
+  TEST_OK(ctx, fcm_scene_create_from_string(
+                   ctx,
+                   scene_text(text, sizeof text, "",
+                              ", {\"cut\": {\"surface\": {\"plane\": {\"point\": [0, 0, 0],"
+                              " \"normal\": [1, 0, 0]}}}}",
+                              ""),
+                   NULL, &scene));
+  TEST_ERR(ctx,
+           fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO,
+                                       NULL, &sim),
+           FCM_ERR_UNSUPPORTED, "cut is not supported by the PETSc backend");
+  fcm_scene_destroy(&scene);
+
+  TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
+  fcm_ctx_destroy(&ctx);
+  int mine = test_failures_, all = 0;
+  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  fcm_petsc_finalize();
+  return all ? TEST_RESULT() + 1 : 0;
+}
