@@ -133,6 +133,8 @@ typedef struct build {
   unsigned char *region, *rebuild;
   const fcm_cell_rules *prev;
   fcm_index first_new; /* cut triangles from here on are new (those of the cut being added) */
+  const unsigned char *remote; /* distributed classification: cells another process classifies
+                                  (skipped here), NULL: none */
 } build;
 
 /* What one thread summed over the cells it built. */
@@ -816,7 +818,8 @@ static fcm_status run_cells(const build *B, fcm_cell_rules *R, int nthreads, cel
         ws = fcm__calloc(ctx, 1, sizeof *ws);
         if (!ws) s = FCM_ERR_ALLOC;
       }
-      if (s == FCM_OK) s = process_cell(B, R, c, ws, out + c, &mine);
+      const int remote = B->remote && B->remote[c]; /* classified by another process */
+      if (s == FCM_OK && !remote) s = process_cell(B, R, c, ws, out + c, &mine);
       fcm__loop_leave(&loop, &it, s);
       if (opt->progress) { /* counted by all threads, reported by the calling one */
 #pragma omp atomic
@@ -1171,8 +1174,49 @@ static void gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const cell
 /* The build shared by fcm_cell_rules_create() and fcm_cell_rules_create_cut(): R (from
  * rules_alloc, with its cut triangles set) is filled; `prev` (or NULL) is the object being
  * extended by the triangles from first_new on. */
-static fcm_status build_rules(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
-                              const fcm_cell_rules *prev, fcm_index first_new, fcm_cell_rules *R)
+/* The remote cells' class, fraction and volume from the exchange (x) into R and out; *exchanged
+ * is set once the exchange ran (whatever its outcome). */
+static fcm_status exchange_classes(const build *B, fcm_cell_rules *R, const fcm__rules_exchange *x,
+                                   cell_out *out, cell_sums *sums, int *exchanged)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_index nc = R->num_cells;
+  double *volume = fcm__calloc(ctx, (size_t)nc + 1, sizeof *volume);
+  st = volume ? FCM_OK : FCM_ERR_ALLOC;
+  if (st != FCM_OK) fcm__error(ctx, st, __FILE__, __LINE__, __func__, "embed: out of memory");
+  for (fcm_index c = 0; volume && c < nc; c++)
+    if (!x->remote[c]) volume[c] = out[c].volume;
+  *exchanged = 1;
+  st = x->exchange(x->user, st, st == FCM_OK ? R->cls : NULL, st == FCM_OK ? R->fraction : NULL,
+                   st == FCM_OK ? volume : NULL, st == FCM_OK ? &sums->counts : NULL);
+  FCM_TRY(ctx, st);
+  for (fcm_index c = 0; c < nc; c++) {
+    if (!x->remote[c]) continue;
+    const int cls = R->cls[c];
+    const double phi = R->fraction[c], v = volume[c];
+    FCM_CHECK((cls == FCM_CELL_UNCUT || cls == FCM_CELL_CUT || cls == FCM_CELL_DROPPED) &&
+                  phi >= 0.0 && phi <= 1.0 && v >= 0.0 && isfinite(v),
+              ctx, FCM_ERR_INTERNAL,
+              "embed: the classification handed over for cell %lld is invalid (class %d, "
+              "fraction %g, volume %g)",
+              (long long)c, cls, phi, v);
+    /* as process_cell() leaves an unflagged cell: at most one piece (no cuts), no points */
+    out[c].volume = v;
+    FCM_TRY(ctx, cell_out_pieces(ctx, out + c, cls == FCM_CELL_DROPPED ? 0 : 1));
+    if (out[c].np == 1) {
+      out[c].pc[0].volume = v;
+      out[c].pc[0].parent = 0;
+    }
+  }
+cleanup:
+  fcm__free(ctx, volume);
+  return st;
+}
+
+static fcm_status build_rules_x(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                                const fcm_cell_rules *prev, fcm_index first_new, fcm_cell_rules *R,
+                                const fcm__rules_exchange *x, int *exchanged)
 {
   fcm_status st = FCM_OK;
   const fcm_cell_rules_options *o = &R->opts;
@@ -1192,12 +1236,14 @@ static fcm_status build_rules(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geom
   FCM_TRY(ctx, build_setup(ctx, mesh, geom, o, R, &B));
   B.prev = prev;
   B.first_new = first_new;
+  B.remote = x ? x->remote : NULL;
   if (R->num_cut_tris > 0) FCM_TRY(ctx, cut_setup(&B, R, first_new));
   FCM_ALLOC(ctx, (size_t)nc, out);
   const double t_setup = fcm_wtime();
   /* 2. parallel per-cell work */
   const int nthreads = o->num_threads > 0 ? o->num_threads : omp_get_max_threads();
   FCM_TRY(ctx, run_cells(&B, R, nthreads, out, &sums, o));
+  if (x) FCM_TRY(ctx, exchange_classes(&B, R, x, out, &sums, exchanged));
   if (o->simplify == FCM_CELL_SIMPLIFY_AUTO)
     FCM_TRY(ctx, auto_simplify(&B, R, nthreads, out, &sums));
   const double t_loop = fcm_wtime();
@@ -1228,19 +1274,33 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
-                                 const fcm_cell_rules_options *opts, fcm_cell_rules **rules)
+static fcm_status build_rules(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                              const fcm_cell_rules *prev, fcm_index first_new, fcm_cell_rules *R)
+{
+  int exchanged = 0;
+  return build_rules_x(ctx, mesh, geom, prev, first_new, R, NULL, &exchanged);
+}
+
+static fcm_status create_rules(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                               const fcm_cell_rules_options *opts, const fcm__rules_exchange *x,
+                               fcm_cell_rules **rules)
 {
   fcm_status st = FCM_OK;
   fcm_cell_rules *R = NULL;
+  int exchanged = 0;
   const fcm_cell_rules_options o = opts ? *opts : fcm_cell_rules_options_default();
   FCM_CHECK(rules, ctx, FCM_ERR_ARG, "embed: output pointer is NULL");
   *rules = NULL;
   FCM_CHECK(ctx && mesh && geom, ctx, FCM_ERR_ARG,
             "embed: NULL argument (ctx, mesh and geometry are required)");
   FCM_TRY(ctx, check_options(ctx, &o));
+  FCM_CHECK(!x || (x->remote && x->exchange), ctx, FCM_ERR_ARG,
+            "embed: distributed classification without a remote mask or exchange function");
+  FCM_CHECK(!x || o.simplify != FCM_CELL_SIMPLIFY_AUTO, ctx, FCM_ERR_ARG,
+            "embed: distributed classification with simplify = auto: the choice would depend on "
+            "the distribution (use on or off)");
   FCM_TRY(ctx, rules_alloc(ctx, mesh, &o, &R));
-  FCM_TRY(ctx, build_rules(ctx, mesh, geom, NULL, 0, R));
+  FCM_TRY(ctx, build_rules_x(ctx, mesh, geom, NULL, 0, R, x, &exchanged));
   R->masked = o.cell_mask != NULL;
   if (R->masked) {
     const fcm_index nc = fcm_mesh_num_cells(mesh);
@@ -1251,8 +1311,24 @@ fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_g
   *rules = R;
   R = NULL;
 cleanup:
+  if (x && !exchanged) /* failed before the exchange: the other processes wait in theirs */
+    st = x->exchange(x->user, st != FCM_OK ? st : FCM_ERR_INTERNAL, NULL, NULL, NULL, NULL);
   fcm_cell_rules_destroy(&R);
   return st;
+}
+
+fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                                 const fcm_cell_rules_options *opts, fcm_cell_rules **rules)
+{
+  return create_rules(ctx, mesh, geom, opts, NULL, rules);
+}
+
+fcm_status fcm__cell_rules_create_distributed(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                              const fcm_geometry *geom,
+                                              const fcm_cell_rules_options *opts,
+                                              const fcm__rules_exchange *x, fcm_cell_rules **rules)
+{
+  return create_rules(ctx, mesh, geom, opts, x, rules);
 }
 
 #define CUT_ATTEMPTS 4

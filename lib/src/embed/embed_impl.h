@@ -125,6 +125,39 @@ typedef struct fcm__embed_counts {
   fcm_index degenerate;        /* cells whose cut splitting changed the parts' volume */
 } fcm__embed_counts;
 
+/* ---------------------------------------------------------------- distributed classification */
+
+/* A rules build whose classification is shared among processes (the PETSc adapter, with a
+ * cell_mask): this process intersects only the cells NOT flagged in `remote`; the class, volume
+ * fraction and embedded volume of the flagged ones are classified by another process and
+ * handed over by `exchange`, so no cell is intersected twice. The rules of the cells this
+ * process does intersect are those of fcm_cell_rules_create() bit for bit (the per-cell work
+ * reads nothing of other cells), and so are the class, fraction and pieces of every cell when
+ * the exchange hands over the other processes' results unchanged.
+ *
+ * `exchange` is called exactly once per build (collectively, so it may communicate), with this
+ * process's status so far. On FCM_OK, cls / fraction / volume (num cells each) hold the results
+ * of this process's cells (those of the remote cells undefined) and `counts` this process's
+ * counters: it fills in the remote cells' entries and may sum the counters over the processes
+ * (the statistics then describe the whole build). On a failure the arrays are NULL and it only
+ * lets the other processes know. It returns the status every process agrees on (FCM_OK only when
+ * every process is fine), with the message set. */
+typedef struct fcm__rules_exchange {
+  const unsigned char *remote; /* num cells; 1: classified by another process */
+  fcm_status (*exchange)(void *user, fcm_status st, unsigned char *cls, double *fraction,
+                         double *volume, fcm__embed_counts *counts);
+  void *user;
+} fcm__rules_exchange;
+
+/* fcm_cell_rules_create() with the classification of the cells flagged in x->remote taken from
+ * x->exchange (see above; x NULL: fcm_cell_rules_create()). opts->simplify must not be AUTO
+ * (its choice sums every cut cell's points). The statistics' counters are this process's
+ * unless the exchange sums them; time_intersect covers this process's cells. */
+fcm_status fcm__cell_rules_create_distributed(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                              const fcm_geometry *geom,
+                                              const fcm_cell_rules_options *opts,
+                                              const fcm__rules_exchange *x, fcm_cell_rules **rules);
+
 /* Clip every candidate embedded cell E by the planes of `cell` and tetrahedralize the
  * pieces into ws->tets / ws->vol. Both tolerances follow the smaller of the two scales,
  * so that geometry much thinner than the background cell keeps its volume: a vertex is

@@ -134,6 +134,13 @@ struct fcm_petsc_problem {
   fcm_index ncopy;       /* n / 3 */
   int *cell_owner;       /* num_cells (-1: inactive) */
   unsigned char *weight; /* num_cells: partition weight of the candidate cells (0: none) */
+  /* distributed classification (the rules build, rules_exchange()): the process that
+   * intersects each cell (its owner; the cells no process owns round robin) and whether that
+   * is another one; both freed after the build */
+  int *classifier;
+  unsigned char *remote;
+  fcm_index num_classified; /* cells of the mesh partitioned (the length of both) */
+  double time_classify; /* seconds of this process in the rules build's exchange (waits) */
   int *copy_owner;       /* ncopy */
   PetscInt *perm;        /* ncopy: PETSc block index of each copy */
   PetscInt nlocal;       /* owned copies */
@@ -221,6 +228,15 @@ static fcm_status agree(fcm_ctx *ctx, MPI_Comm comm, fcm_status st)
   }
   return fcm__error(ctx, (fcm_status)code, __FILE__, __LINE__, __func__,
                     "process %d of %d failed: %s", first, size, msg);
+}
+
+/* agree() on P's communicator; a failure is remembered (P->agreed_fail), so that a process
+ * that learnt of it here does not start another agree() the others never meet. */
+static fcm_status problem_agree(fcm_petsc_problem *P, fcm_status st)
+{
+  st = agree(P->ctx, P->comm, st);
+  if (st != FCM_OK) P->agreed_fail = 1;
+  return st;
 }
 
 /* ---------------------------------------------------------------- init */
@@ -477,7 +493,11 @@ cleanup:
   return st;
 }
 
-/* The rules (geometry: points on the cells flagged in `mask` only) or the plain space. */
+static fcm_status rules_exchange(void *user, fcm_status st, unsigned char *cls, double *fraction,
+                                 double *volume, fcm__embed_counts *counts);
+
+/* The rules (geometry: points on the cells flagged in `mask` only, each cell classified by one
+ * process: P->remote, rules_exchange()) or the plain space. */
 static fcm_status build_space(fcm_petsc_problem *P, const fcm_geometry *geom,
                               const unsigned char *mask)
 {
@@ -488,7 +508,8 @@ static fcm_status build_space(fcm_petsc_problem *P, const fcm_geometry *geom,
     ro.kinds =
         FCM_RULES_STIFFNESS | (P->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER ? FCM_RULES_MASS : 0u);
     ro.cell_mask = mask;
-    FCM_TRY(ctx, fcm_cell_rules_create(ctx, P->mesh, geom, &ro, &P->rules));
+    const fcm__rules_exchange x = {P->remote, rules_exchange, P};
+    FCM_TRY(ctx, fcm__cell_rules_create_distributed(ctx, P->mesh, geom, &ro, &x, &P->rules));
     FCM_TRY(ctx, fcm_space_create_embedded(ctx, P->mesh, P->rules, &P->space));
   } else {
     FCM_TRY(ctx, fcm_space_create(ctx, P->mesh, NULL, &P->space));
@@ -559,6 +580,141 @@ cleanup:
   fcm__free(ctx, gb);
   fcm__free(ctx, tb);
   fcm__free(ctx, cb);
+  return st;
+}
+
+/* The candidate cells (candidate_cells(): those whose box meets the box of a geometry cell,
+ * every cell without a geometry, weighted FCM_PETSC_CUT_WEIGHT where the box also meets a
+ * boundary triangle's box: likely cut; a superset of the active cells, found without
+ * intersecting anything) and their partition: P->cell_owner (-1: no candidate), *mask (this
+ * process's cells, allocated), and who classifies each cell in the rules build: its owner, the
+ * cells no process owns (which the rules drop, unless the box test missed a cell) round robin
+ * (P->classifier, P->remote). Collective; a failure is agreed on (problem_agree()). */
+static fcm_status partition_cells(fcm_petsc_problem *P, const fcm_geometry *geom,
+                                  unsigned char **mask)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_index nc = fcm_mesh_num_cells(P->mesh);
+  *mask = fcm__calloc(ctx, (size_t)nc + 1, 1);
+  P->cell_owner = fcm__calloc(ctx, (size_t)nc + 1, sizeof *P->cell_owner);
+  P->weight = fcm__calloc(ctx, (size_t)nc + 1, 1);
+  P->classifier = fcm__calloc(ctx, (size_t)nc + 1, sizeof *P->classifier);
+  P->remote = fcm__calloc(ctx, (size_t)nc + 1, 1);
+  st = *mask && P->cell_owner && P->weight && P->classifier && P->remote ? FCM_OK : FCM_ERR_ALLOC;
+  if (st == FCM_OK) st = candidate_cells(P, geom);
+  FCM_TRY(ctx, problem_agree(P, st));
+  fcm_index ncand = 0;
+  for (fcm_index c = 0; c < nc; c++) {
+    P->cell_owner[c] = -1;
+    ncand += P->weight[c] != 0;
+  }
+  P->partition = P->opts.partition == FCM_PETSC_PARTITION_AUTO ? FCM_PETSC_PARTITION_ORDERED
+                                                               : P->opts.partition;
+  if (P->size == 1) {
+    for (fcm_index c = 0; c < nc; c++)
+      if (P->weight[c]) P->cell_owner[c] = 0;
+  } else if (P->partition == FCM_PETSC_PARTITION_PTSCOTCH) {
+    st = partition_graph(P, P->weight, ncand);
+  } else {
+    st = partition_ordered(P, P->weight, ncand);
+  }
+  FCM_TRY(ctx, problem_agree(P, st));
+  P->num_classified = nc;
+  for (fcm_index c = 0; c < nc; c++) {
+    (*mask)[c] = P->cell_owner[c] == P->rank;
+    P->classifier[c] = P->cell_owner[c] >= 0 ? P->cell_owner[c] : (int)(c % P->size);
+    P->remote[c] = P->classifier[c] != P->rank;
+  }
+cleanup:
+  return st;
+}
+
+/* The exchange of the distributed classification (fcm__rules_exchange, embed_impl.h): after
+ * an agreement on the status, each process sends (class, volume fraction, embedded volume) of
+ * the cells it classified, in cell order, as 3 doubles each (MPI_Allgatherv; every process
+ * knows P->classifier, so no cell ids travel), and the counters are summed in process order
+ * (the same bits everywhere). */
+static fcm_status rules_exchange(void *user, fcm_status st, unsigned char *cls, double *fraction,
+                                 double *volume, fcm__embed_counts *counts)
+{
+  fcm_petsc_problem *P = user;
+  fcm_ctx *ctx = P->ctx;
+  const double t0 = fcm_wtime();
+  const fcm_index nc = P->num_classified;
+  enum { NCOUNT = 7 };
+  int *cnt = NULL, *displ = NULL;
+  double *send = NULL, *recv = NULL, *all = NULL;
+  fcm_index mine = 0;
+  if (st == FCM_OK)
+    FCM_CHECK(3 * nc < (fcm_index)INT32_MAX, ctx, FCM_ERR_UNSUPPORTED,
+              "petsc: %lld background cells: the classification exchange (3 doubles a cell, "
+              "MPI's int counts) is limited to %d cells",
+              (long long)nc, (int)(INT32_MAX / 3));
+  if (st == FCM_OK) {
+    for (fcm_index c = 0; c < nc; c++)
+      mine += P->classifier[c] == P->rank;
+    cnt = fcm__calloc(ctx, (size_t)P->size + 1, sizeof *cnt);
+    displ = fcm__calloc(ctx, (size_t)P->size + 1, sizeof *displ);
+    send = fcm__malloc(ctx, 3 * (size_t)mine + 1, sizeof *send);
+    recv = fcm__malloc(ctx, 3 * (size_t)nc + 1, sizeof *recv);
+    all = fcm__calloc(ctx, (size_t)NCOUNT * (size_t)P->size + 1, sizeof *all);
+    if (!cnt || !displ || !send || !recv || !all) st = FCM_ERR_ALLOC;
+  }
+cleanup:
+  st = problem_agree(P, st); /* every process arrives here, failed or not */
+  if (st != FCM_OK) goto done;
+  for (fcm_index c = 0; c < nc; c++)
+    cnt[P->classifier[c]] += 3;
+  for (int r = 1; r <= P->size; r++)
+    displ[r] = displ[r - 1] + cnt[r - 1];
+  fcm_index k = 0;
+  for (fcm_index c = 0; c < nc; c++)
+    if (P->classifier[c] == P->rank) {
+      send[k++] = (double)cls[c];
+      send[k++] = fraction[c];
+      send[k++] = volume[c];
+    }
+  int rc = MPI_Allgatherv(send, cnt[P->rank], MPI_DOUBLE, recv, cnt, displ, MPI_DOUBLE, P->comm);
+  if (rc == MPI_SUCCESS) {
+    for (fcm_index c = 0; c < nc; c++) {
+      const int r = P->classifier[c];
+      const double *q = recv + displ[r];
+      displ[r] += 3;
+      if (r == P->rank) continue;
+      cls[c] = (unsigned char)q[0];
+      fraction[c] = q[1];
+      volume[c] = q[2];
+    }
+    const double local[NCOUNT] = {
+        (double)counts->candidates, (double)counts->parts,      (double)counts->tets,
+        (double)counts->slivers,    (double)counts->surface_triangles,
+        (double)counts->degenerate, counts->sliver_volume};
+    rc = MPI_Allgather(local, NCOUNT, MPI_DOUBLE, all, NCOUNT, MPI_DOUBLE, P->comm);
+  }
+  if (rc != MPI_SUCCESS) { /* MPI's default handler aborts first; with another one, give up */
+    st = fcm__error(ctx, FCM_ERR_INTERNAL, __FILE__, __LINE__, __func__,
+                    "petsc: the classification exchange failed (MPI error %d)", rc);
+    goto done;
+  }
+  double sum[NCOUNT] = {0};
+  for (int r = 0; r < P->size; r++)
+    for (int i = 0; i < NCOUNT; i++)
+      sum[i] += all[NCOUNT * r + i];
+  counts->candidates = (fcm_index)sum[0];
+  counts->parts = (fcm_index)sum[1];
+  counts->tets = (fcm_index)sum[2];
+  counts->slivers = (fcm_index)sum[3];
+  counts->surface_triangles = (fcm_index)sum[4];
+  counts->degenerate = (fcm_index)sum[5];
+  counts->sliver_volume = sum[6];
+done:
+  P->time_classify = fcm_wtime() - t0;
+  fcm__free(ctx, cnt);
+  fcm__free(ctx, displ);
+  fcm__free(ctx, send);
+  fcm__free(ctx, recv);
+  fcm__free(ctx, all);
   return st;
 }
 
@@ -700,41 +856,14 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
   if (st == FCM_OK) st = check_inputs(P, &P->opts);
   FCM_TRY(ctx, agree(ctx, P->comm, st));
 
-  /* 1. the candidate cells: those whose box meets the box of a geometry cell (every cell
-   * without a geometry), weighted FCM_PETSC_CUT_WEIGHT where it also meets a boundary
-   * triangle's box (likely cut), 1 otherwise; a superset of the active cells, found without
-   * intersecting anything */
+  /* 1., 2. the candidate cells and their partition */
   const fcm_index nc = fcm_mesh_num_cells(mesh);
   const double tr = fcm_wtime();
-  mask = fcm__calloc(ctx, (size_t)nc + 1, 1);
-  P->cell_owner = fcm__calloc(ctx, (size_t)nc + 1, sizeof *P->cell_owner);
-  P->weight = fcm__calloc(ctx, (size_t)nc + 1, 1);
-  st = mask && P->cell_owner && P->weight ? FCM_OK : FCM_ERR_ALLOC;
-  if (st == FCM_OK) st = candidate_cells(P, geom);
-  FCM_TRY(ctx, agree(ctx, P->comm, st));
-  fcm_index ncand = 0;
-  for (fcm_index c = 0; c < nc; c++) {
-    P->cell_owner[c] = -1;
-    ncand += P->weight[c] != 0;
-  }
+  FCM_TRY(ctx, partition_cells(P, geom, &mask));
 
-  /* 2. partition the candidate cells */
-  P->partition = P->opts.partition == FCM_PETSC_PARTITION_AUTO ? FCM_PETSC_PARTITION_ORDERED
-                                                               : P->opts.partition;
-  if (P->size == 1) {
-    for (fcm_index c = 0; c < nc; c++)
-      if (P->weight[c]) P->cell_owner[c] = 0;
-  } else if (P->partition == FCM_PETSC_PARTITION_PTSCOTCH) {
-    st = partition_graph(P, P->weight, ncand);
-  } else {
-    st = partition_ordered(P, P->weight, ncand);
-  }
-  FCM_TRY(ctx, agree(ctx, P->comm, st));
-
-  /* 3. the rules, with points on this process's cells only (every process classifies every
-   * cell: the replicated part), and the space; candidates the rules drop own nothing */
-  for (fcm_index c = 0; c < nc; c++)
-    mask[c] = P->cell_owner[c] == P->rank;
+  /* 3. the rules, with points on this process's cells only (each cell is classified by one
+   * process, the classes gathered on every process), and the space; candidates the rules drop
+   * own nothing */
   st = build_space(P, geom, mask);
   for (fcm_index c = 0; st == FCM_OK && c < nc; c++) {
     if (P->space->active[c] && P->cell_owner[c] < 0)
@@ -743,7 +872,9 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
                       (long long)c);
     if (!P->space->active[c]) P->cell_owner[c] = -1;
   }
-  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  FCM_TRY(ctx, P->agreed_fail ? st : problem_agree(P, st)); /* the exchange agreed on a failure */
+  FCM_FREE(ctx, P->classifier);
+  FCM_FREE(ctx, P->remote);
   P->time_rules = fcm_wtime() - tr;
   st = fcm_assembly_workspace_create(P->space, &P->opts.assembly, &P->aws);
   if (st == FCM_OK) st = number_dofs(P);
@@ -785,9 +916,10 @@ void fcm_petsc_problem_destroy(fcm_petsc_problem **problem)
   fcm_assembly_workspace_destroy(&P->aws);
   if (!P->borrowed_space) fcm_space_destroy(&P->space);
   fcm_cell_rules_destroy(&P->rules);
-  void *arrays[] = {P->petsc_options, P->weight,  P->cell_owner, P->copy_owner,
-                    P->perm,          P->con_dof, P->con_node,   P->con_comp,
-                    P->con_motion,    P->motions, P->is_con};
+  void *arrays[] = {P->petsc_options, P->weight,     P->cell_owner, P->copy_owner,
+                    P->perm,          P->con_dof,    P->con_node,   P->con_comp,
+                    P->con_motion,    P->motions,    P->is_con,     P->classifier,
+                    P->remote};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
     fcm__free(ctx, arrays[i]);
   if (P->comm != MPI_COMM_NULL) MPI_Comm_free(&P->comm);
@@ -1478,9 +1610,7 @@ static void newton_release(void *user)
 /* agree(), remembering a failure it reported (every process then knows it). */
 static fcm_status newton_agree(fcm_petsc_problem *P, fcm_status st)
 {
-  st = agree(P->ctx, P->comm, st);
-  if (st != FCM_OK) P->agreed_fail = 1;
-  return st;
+  return problem_agree(P, st);
 }
 
 /* Sum over the processes: reduced on process 0 and broadcast, so every process holds the same
@@ -1735,39 +1865,22 @@ fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_sc
   FCM_TRY(ctx, newton_agree(P, st));
   /* the partition of the candidate cells, as fcm_petsc_problem_create() makes it */
   P->mesh = mesh;
-  const fcm_index nc = fcm_mesh_num_cells(mesh);
-  mask = fcm__calloc(ctx, (size_t)nc + 1, 1);
-  P->cell_owner = fcm__calloc(ctx, (size_t)nc + 1, sizeof *P->cell_owner);
-  P->weight = fcm__calloc(ctx, (size_t)nc + 1, 1);
-  st = mask && P->cell_owner && P->weight ? FCM_OK : FCM_ERR_ALLOC;
-  if (st == FCM_OK) st = candidate_cells(P, geom);
-  FCM_TRY(ctx, newton_agree(P, st));
-  fcm_index ncand = 0;
-  for (fcm_index c = 0; c < nc; c++) {
-    P->cell_owner[c] = -1;
-    ncand += P->weight[c] != 0;
-  }
-  P->partition =
-      partition == FCM_PETSC_PARTITION_AUTO ? FCM_PETSC_PARTITION_ORDERED : partition;
-  if (P->size == 1) {
-    for (fcm_index c = 0; c < nc; c++)
-      if (P->weight[c]) P->cell_owner[c] = 0;
-  } else if (P->partition == FCM_PETSC_PARTITION_PTSCOTCH) {
-    st = partition_graph(P, P->weight, ncand);
-  } else {
-    st = partition_ordered(P, P->weight, ncand);
-  }
-  FCM_TRY(ctx, newton_agree(P, st));
-  for (fcm_index c = 0; c < nc; c++)
-    mask[c] = P->cell_owner[c] == P->rank;
+  FCM_TRY(ctx, partition_cells(P, geom, &mask));
   P->mesh = NULL;
   fcm_geometry_destroy(&geom);
   fcm_mesh_destroy(&mesh);
-  /* the simulation: collective from newton_attach() on; a process that fails outside an
+  /* the simulation (its mesh is built again from the scene, the same cells): collective from
+   * the rules build's classification exchange on (each process classifies the cells of
+   * P->classifier: rules_exchange()) and newton_attach(); a process that fails outside an
    * agree() ends with one, which meets the agree() the others wait in */
-  st = fcm__simulation_create_distributed(ctx, scene, opts, mask, newton_attach, P, &S);
+  {
+    const fcm__rules_exchange x = {P->remote, rules_exchange, P};
+    st = fcm__simulation_create_distributed(ctx, scene, opts, mask, &x, newton_attach, P, &S);
+  }
   if (!P->agreed_fail) st = newton_agree(P, st);
   FCM_TRY(ctx, st);
+  FCM_FREE(ctx, P->classifier);
+  FCM_FREE(ctx, P->remote);
   *out = S;
   S = NULL;
 cleanup:

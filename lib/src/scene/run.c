@@ -4,6 +4,7 @@
 #include "scene/scene_impl.h"
 
 #include "core/core_impl.h"
+#include "embed/embed_impl.h"
 #include "sim/sim_backend.h"
 #include "fcm/embed.h"
 #include "fcm/fem.h"
@@ -533,7 +534,11 @@ static fcm_status build_rules(fcm_simulation *S)
   ro.progress_user = S->opts.rules_progress_user;
   ro.progress_interval = S->opts.rules_progress_interval;
   ro.cell_mask = S->cell_mask;
-  FCM_TRY(S->ctx, fcm_cell_rules_create(S->ctx, S->mesh, S->geom, &ro, &S->rules));
+  if (S->rules_exchange) /* distributed: each process classifies its share of the cells */
+    FCM_TRY(S->ctx, fcm__cell_rules_create_distributed(S->ctx, S->mesh, S->geom, &ro,
+                                                       S->rules_exchange, &S->rules));
+  else
+    FCM_TRY(S->ctx, fcm_cell_rules_create(S->ctx, S->mesh, S->geom, &ro, &S->rules));
   S->c.cell_rules = 1;
   S->c.surface_rules = ro.surface_strength >= 0;
   S->c.rule_kinds = fcm_cell_rules_get_stats(S->rules)->kinds;
@@ -799,27 +804,30 @@ cleanup:
 static fcm_status simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
                                     const fcm_simulation_options *opts,
                                     const unsigned char *cell_mask,
+                                    const fcm__rules_exchange *exchange,
                                     fcm__simulation_attach_fn attach, void *attach_user,
                                     fcm_simulation **out);
 
 fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
                                  const fcm_simulation_options *opts, fcm_simulation **out)
 {
-  return simulation_create(ctx, scene, opts, NULL, NULL, NULL, out);
+  return simulation_create(ctx, scene, opts, NULL, NULL, NULL, NULL, out);
 }
 
 fcm_status fcm__simulation_create_distributed(fcm_ctx *ctx, const fcm_scene *scene,
                                               const fcm_simulation_options *opts,
                                               const unsigned char *cell_mask,
+                                              const fcm__rules_exchange *exchange,
                                               fcm__simulation_attach_fn attach, void *attach_user,
                                               fcm_simulation **out)
 {
-  return simulation_create(ctx, scene, opts, cell_mask, attach, attach_user, out);
+  return simulation_create(ctx, scene, opts, cell_mask, exchange, attach, attach_user, out);
 }
 
 static fcm_status simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
                                     const fcm_simulation_options *opts,
                                     const unsigned char *cell_mask,
+                                    const fcm__rules_exchange *exchange,
                                     fcm__simulation_attach_fn attach, void *attach_user,
                                     fcm_simulation **out)
 {
@@ -831,6 +839,7 @@ static fcm_status simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   FCM_ALLOC(ctx, 1, S);
   S->ctx = ctx;
   S->cell_mask = cell_mask;
+  S->rules_exchange = exchange;
   S->scene = scene;
   S->opts = opts ? *opts : fcm_simulation_options_default();
   FCM_CHECK(S->opts.max_steps >= 1 || S->opts.max_steps == FCM_DEFAULT, ctx, FCM_ERR_ARG,
@@ -916,6 +925,7 @@ static fcm_status simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   if (S->geom && fcm_scene_get_output(scene)->write_surface) FCM_TRY(ctx, build_surface(S));
   S->c.time_setup = fcm_wtime() - t0;
   S->cell_mask = NULL; /* borrowed for the create only */
+  S->rules_exchange = NULL;
   *out = S;
   S = NULL;
 cleanup:

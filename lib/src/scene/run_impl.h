@@ -67,6 +67,8 @@ struct fcm_simulation {
   /* distributed runs (fcm__simulation_create_distributed()): points on these cells only
    * (borrowed during the create; NULL afterwards and in serial runs) */
   const unsigned char *cell_mask;
+  const struct fcm__rules_exchange *rules_exchange; /* and the classification shared: NULL or as
+                                                       cell_mask (embed/embed_impl.h) */
   /* what the voxel or level-set geometry reported ("" for the other kinds) */
   char geometry_note[256];
 };
@@ -91,12 +93,15 @@ typedef fcm_status (*fcm__simulation_attach_fn)(void *user, fcm_integrator *inte
 
 /* fcm_simulation_create() for a distributed backend (the PETSc adapter, fcm/petsc.h): the cell
  * rules carry points on the cells flagged in cell_mask only (every cell is still classified,
- * so the space and its DOF numbering are those of the serial run), and `attach` sets the
+ * so the space and its DOF numbering are those of the serial run; with `exchange` (may be
+ * NULL) each process intersects its share of the cells and the exchange hands over the others'
+ * classes: fcm__cell_rules_create_distributed(), embed/embed_impl.h), and `attach` sets the
  * integrator's backend before its setup; the log's partial quantities (mass, momentum) are
  * summed through it. Collective over the backend's processes. (run.c) */
 fcm_status fcm__simulation_create_distributed(fcm_ctx *ctx, const fcm_scene *scene,
                                               const fcm_simulation_options *opts,
                                               const unsigned char *cell_mask,
+                                              const struct fcm__rules_exchange *exchange,
                                               fcm__simulation_attach_fn attach, void *attach_user,
                                               fcm_simulation **out);
 
