@@ -43,6 +43,21 @@ foreach(np 1 2)
   fcm_add_mpi_test(petsc_match_tet4_dynamic_ordered_mumps_np${np} tests/petsc/match.c NP ${np}
                    ARGS tet4 dynamic ordered ${FCM_MUMPS})
 endforeach()
+# the distributed classification (each process intersects its share of the cells, the classes
+# are gathered) equals the serial build bit for bit: classes, fractions, pieces, DOF numbering,
+# own cells' volume and surface rules; phase 1 for each element and, on Hex8, phase 2 (a scene)
+foreach(np 1 2)
+  foreach(el hex8 tet4 hex20 tet10)
+    set(scene_args)
+    if(el STREQUAL "hex8")
+      set(scene_args ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json)
+    endif()
+    fcm_add_mpi_test(petsc_classify_${el}_np${np} tests/petsc/classify.c NP ${np}
+                     ARGS ${el} ordered ${scene_args})
+  endforeach()
+  fcm_add_mpi_test(petsc_classify_tet4_ptscotch_np${np} tests/petsc/classify.c NP ${np}
+                   ARGS tet4 ptscotch)
+endforeach()
 # errors on one or all processes end every process with the message, no hang
 foreach(np 1 2)
   fcm_add_mpi_test(petsc_failure_np${np} tests/petsc/failure.c NP ${np} TIMEOUT 60)
