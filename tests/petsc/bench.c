@@ -79,10 +79,18 @@ int main(int argc, char **argv)
   MPI_Allreduce(&peak_local, &peak_all, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
   const double n = (double)info.num_dofs;
   const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(fcm_space_cell_rules(space));
+  /* the rules build per process: intersection (the classification of the cells it classifies,
+   * with the mapping and surface rules of its own cut cells) and simplification; resident memory
+   * per process */
+  double rt[3] = {rs->time_intersect, rs->time_simplify, peak_local}, rt_max[3], rt_min[3];
+  MPI_Allreduce(rt, rt_max, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Allreduce(rt, rt_min, 3, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
   if (rank == 0)
-    printf("petsc_bench np %d: process 0's rules build: intersect %.3g core-s (every cell), "
-           "simplify + stabilize %.3g core-s (its own cut cells; %lld cut cells in all)\n",
-           size, rs->time_intersect, rs->time_simplify, (long long)rs->num_cut);
+    printf("petsc_bench np %d: rules build per process: intersect %.3g..%.3g core-s, simplify + "
+           "stabilize %.3g..%.3g core-s (%lld cut cells in all); peak resident %.1f..%.1f MB per "
+           "process\n",
+           size, rt_min[0], rt_max[0], rt_min[1], rt_max[1], (long long)rs->num_cut,
+           rt_min[2] / 1e6, rt_max[2] / 1e6);
   if (rank == 0)
     printf("petsc_bench np %d: CPU seconds (user + system; busy MPI waits count) per DOF: setup "
            "%.3g us max over processes / %.3g us summed, solve %.3g us max / %.3g us summed\n",

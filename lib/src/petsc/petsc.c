@@ -15,9 +15,22 @@
  *   cells 4, uncut 1 (a guess: measure the per-cell rule + assembly cost and weight by it next).
  * - rules: each process builds the rules of its own cells (fcm_cell_rules_options.cell_mask);
  *   the partition comes first, on the candidate cells (box meets a geometry cell's box; weight
- *   4 where it meets a boundary triangle's box too), so one rules build per process; the
- *   classification (intersection) of every cell runs on every process. Only the points
- *   (mapping, simplification, stabilization, surface rules) are distributed.
+ *   4 where it meets a boundary triangle's box too), so one rules build per process.
+ * - classification (issue 14 item 2, first half): distributed too. Each cell is intersected by
+ *   ONE process (partition_cells(): its owner; the non-candidates, which the rules drop, round
+ *   robin), inside the same rules build that maps its own cells' points
+ *   (fcm__cell_rules_create_distributed(), embed_impl.h: the cells of P->remote are skipped);
+ *   after the per-cell loop the build calls rules_exchange() once: agree(), then
+ *   MPI_Allgatherv of (class, volume fraction, embedded volume) as 3 doubles per classified
+ *   cell in cell order (no ids: P->classifier is replicated), and the counters (candidates,
+ *   tets, slivers, ...) summed in process order, so the statistics are the serial ones. The
+ *   remote cells get what the unflagged cells of a cell_mask got before (one piece unless
+ *   dropped, no points), so classes, fractions, pieces, DOF numbering and the own cells' rules
+ *   are the serial build's bit for bit (tests/petsc/classify.c, 1 and 2 processes, four
+ *   elements, both partitions, phases 1 and 2). Phase 2 hands the exchange through
+ *   fcm__simulation_create_distributed() (run.c build_rules()). A process failing before its
+ *   exchange still calls it (fcm__cell_rules_create_distributed() does, on every error path),
+ *   and a phase-2 process that fails before the rules build meets it with its final agree().
  * - DOFs: global numbering, owner = lowest process among the cells using the DOF copy, the
  *   PETSc index is contiguous per owner; the perm (space DOF -> PETSc index) and the space's
  *   pattern are REPLICATED (O(DOFs + nnz) integers per process).
@@ -87,11 +100,23 @@
  *   run (they agree to the KSP tolerance); it is kept: it assembles straight into PETSc and
  *   scales further (no dense sums), and its tests and checkpoints stay.
  * Not done (phase 1):
- * - geometry kept whole on every process (no AABB crop), mesh replicated; the classification
- *   (intersection of EVERY cell) runs on every process — on the bench body it costs 2-3x the
- *   simplification, so distribute it next: intersect own candidate cells only and allgather
- *   class / fraction / piece volumes (the rules would then take the classification of
- *   unflagged cells from outside, a new option next to cell_mask).
+ * - geometry kept whole on every process (no AABB crop), mesh replicated; still replicated per
+ *   cell: class, fraction, pieces (O(cells) bytes: what the DOF numbering needs).
+ *   The crop is NOT bit-identical as the kernels stand: the candidates of a cell come out of
+ *   the AABB tree (fcm__geom_tree_query, geom/aabb.c) in traversal order, and the tree is built
+ *   from ALL the geometry's boxes, so a cropped geometry gives the same candidates in another
+ *   order: other tet order, other point order, other rounding of the volume sums (fractions)
+ *   and simplifications. What the crop needs: (1) sort the candidate ids in
+ *   fcm__embed_cell_tets() and fcm__embed_cell_surface() (changes every serial rule's point
+ *   order and last bits once); (2) a cropped fcm_geometry that keeps the cells and boundary
+ *   triangles (not rebuilt from the kept cells: custom_boundary) whose boxes meet the own
+ *   cells' boxes enlarged by one cell, in their original order (so sorted cropped ids = sorted
+ *   original ids), with volume / bounding box of the whole geometry; (3) the surface points'
+ *   triangle ids mapped back to the original numbering (a map in fcm__rules_exchange);
+ *   (4) the candidate test here widened to the clipping box (fcm__embed_cell_setup's lo/hi,
+ *   clip_rtol) so that non-candidates classified round robin provably meet nothing;
+ *   (5) fcm__embed_outside()'s per-side outside volumes from the whole geometry (or summed);
+ *   phase 2 keeps the whole geometry (effects select boundary triangles of it).
  * - the options string goes into the GLOBAL options database (it stays for later problems);
  *   an options prefix per problem would scope it.
  * - README projection for 1e8 DOFs (memory and time per DOF are printed by
