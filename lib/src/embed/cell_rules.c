@@ -1171,9 +1171,6 @@ static void gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const cell
   S->time_simplify = sums->time_simplify;
 }
 
-/* The build shared by fcm_cell_rules_create() and fcm_cell_rules_create_cut(): R (from
- * rules_alloc, with its cut triangles set) is filled; `prev` (or NULL) is the object being
- * extended by the triangles from first_new on. */
 /* The remote cells' class, fraction and volume from the exchange (x) into R and out; *exchanged
  * is set once the exchange ran (whatever its outcome). */
 static fcm_status exchange_classes(const build *B, fcm_cell_rules *R, const fcm__rules_exchange *x,
@@ -1214,6 +1211,10 @@ cleanup:
   return st;
 }
 
+/* The build shared by fcm_cell_rules_create() and fcm_cell_rules_create_cut(): R (from
+ * rules_alloc, with its cut triangles set) is filled; `prev` (or NULL) is the object being
+ * extended by the triangles from first_new on. With x (distributed classification, no cuts):
+ * the cells of x->remote are skipped and their classes taken from x->exchange. */
 static fcm_status build_rules_x(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
                                 const fcm_cell_rules *prev, fcm_index first_new, fcm_cell_rules *R,
                                 const fcm__rules_exchange *x, int *exchanged)
@@ -1299,6 +1300,11 @@ static fcm_status create_rules(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geo
   FCM_CHECK(!x || o.simplify != FCM_CELL_SIMPLIFY_AUTO, ctx, FCM_ERR_ARG,
             "embed: distributed classification with simplify = auto: the choice would depend on "
             "the distribution (use on or off)");
+  for (fcm_index c = 0; x && o.cell_mask && c < fcm_mesh_num_cells(mesh); c++)
+    FCM_CHECK(!(o.cell_mask[c] && x->remote[c]), ctx, FCM_ERR_ARG,
+              "embed: cell %lld is flagged in the cell_mask (this process integrates it) and as "
+              "classified by another process",
+              (long long)c);
   FCM_TRY(ctx, rules_alloc(ctx, mesh, &o, &R));
   FCM_TRY(ctx, build_rules_x(ctx, mesh, geom, NULL, 0, R, x, &exchanged));
   R->masked = o.cell_mask != NULL;
