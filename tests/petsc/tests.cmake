@@ -58,6 +58,12 @@ foreach(np 1 2)
   fcm_add_mpi_test(petsc_classify_tet4_ptscotch_np${np} tests/petsc/classify.c NP ${np}
                    ARGS tet4 ptscotch)
 endforeach()
+# a process failing before its rules build (phase 2) or inside it before the per-cell loop
+# (phase 1) ends every process at the classification exchange with the message, no hang
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_classify_failure_np${np} tests/petsc/classify_failure.c NP ${np}
+                   TIMEOUT 60)
+endforeach()
 # errors on one or all processes end every process with the message, no hang
 foreach(np 1 2)
   fcm_add_mpi_test(petsc_failure_np${np} tests/petsc/failure.c NP ${np} TIMEOUT 60)
