@@ -91,11 +91,50 @@ static void read_old_log(const char *path, run_log *rows, long long first)
   fclose(f);
 }
 
+/* Process 0 writes the checkpoint <dir>/<name>_checkpoint_NNNNNN.fcmck of the current step
+ * (the serial format, fcm_simulation_write_checkpoint(): the state is the same on every
+ * process, so any process count, and the serial fcm-sim, can resume from it). Collective:
+ * returns whether it was written, on every process. */
+static int write_checkpoint(fcm_ctx *ctx, fcm_simulation *sim, const char *dir, const char *name,
+                            int talk, int rank)
+{
+  char path[4300];
+  int ok = 1;
+  snprintf(path, sizeof path, "%s/%s_checkpoint_%06lld.fcmck", dir, name,
+           fcm_simulation_step_count(sim));
+  if (rank == 0) {
+    ok = fcm_simulation_write_checkpoint(sim, path) == FCM_OK;
+    if (!ok)
+      fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+    else if (talk)
+      fprintf(stderr, "fcm-sim: checkpoint %s\n", path);
+  }
+  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  return ok;
+}
+
+/* Every process restores the checkpoint `path` into its new simulation (the same bytes give
+ * the same state and the same errors everywhere; a file that one process cannot read is
+ * reported by the lowest such process). Collective: 1 when every process restored it. */
+static int resume_checkpoint(fcm_ctx *ctx, fcm_simulation *sim, const char *path, int rank)
+{
+  const int mine = fcm_simulation_read_checkpoint(sim, path) == FCM_OK ? -1 : rank;
+  int bad = -1, first = mine < 0 ? 1 << 30 : mine;
+  MPI_Allreduce(&mine, &bad, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  if (bad < 0) return 1;
+  int lowest = first;
+  MPI_Allreduce(&first, &lowest, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (rank == lowest) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+  return 0;
+}
+
 /* A scene the linear driver does not run (non-linear material, boundary constraints, loads on
  * the boundary, damping, initial velocities, release): the scene's own simulation with the
  * integrator on PETSc (fcm_petsc_simulation_create()). Every process holds the same state and
- * log, so process 0 writes the frames (the serial <name>_background.pvd and VTUs) and the log
- * <name>_log.csv with the serial writers. Returns the exit code (the same on every process). */
+ * log, so process 0 writes the frames (the serial <name>_background.pvd and VTUs), the log
+ * <name>_log.csv and the checkpoints (<name>_checkpoint_NNNNNN.fcmck, --checkpoint-every or
+ * the scene's output.checkpoint_interval) with the serial writers; --resume: every process
+ * reads the checkpoint. Returns the exit code (the same on every process). */
 static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, long long steps,
                       int check, int quiet, int checkpoint_every, const char *resume, int rank,
                       int size)
@@ -104,22 +143,9 @@ static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
   const int talk = rank == 0 && !quiet;
   fcm_simulation *sim = NULL;
   int rc = 1, ok = 1;
-  if (resume || checkpoint_every > 0) {
-    if (rank == 0)
-      fprintf(stderr, "fcm-sim: scene %s: --backend petsc: checkpoints (--checkpoint-every, "
-                      "--resume) are not supported yet for scenes through the integrator "
-                      "(non-linear material or effects beyond the linear driver's); run without "
-                      "them or with the serial backend\n",
-              name);
-    return 2;
-  }
-  if (talk && !check && checkpoint_every < 0 &&
-      fcm_scene_get_output(scene)->checkpoint_interval > 0)
-    fprintf(stderr, "fcm-sim: note: the scene's checkpoints (output.checkpoint_interval) are not "
-                    "written on this path yet\n");
   fcm_simulation_options so = fcm_simulation_options_default();
   so.max_steps = check ? (steps > 0 && steps < 3 ? steps : 3) : (steps > 0 ? steps : FCM_DEFAULT);
-  so.checkpoint_interval = 0;
+  so.checkpoint_interval = check ? 0 : checkpoint_every; /* -1: the scene's */
   if (talk)
     fprintf(stderr, "fcm-sim: scene %s: through the integrator (Newton) on PETSc\n", name);
   fcm_status st = fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene,
@@ -131,13 +157,25 @@ static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
                ? 2
                : 1;
   }
+  if (resume) {
+    if (!resume_checkpoint(ctx, sim, resume, rank)) {
+      rc = 2;
+      goto done;
+    }
+    if (talk)
+      fprintf(stderr, "fcm-sim: resumed from %s at step %lld (t = %.9g s)\n", resume,
+              fcm_simulation_step_count(sim),
+              fcm_integrator_time(fcm_simulation_integrator(sim)));
+  }
   const char *dir = outdir ? outdir : fcm_scene_get_output(scene)->directory;
   const int write = !check;
   char logpath[4200];
-  int frame = 0;
+  fcm_simulation_counters c;
+  fcm_simulation_get_counters(sim, &c);
+  int frame = (int)c.frames; /* resumed: the frames the checkpoint had */
   snprintf(logpath, sizeof logpath, "%s/%s_log.csv", dir, name);
   if (write && rank == 0) {
-    ok = make_dirs(dir) && fcm_simulation_write_frame(sim, dir, frame++) == FCM_OK &&
+    ok = make_dirs(dir) && (resume || fcm_simulation_write_frame(sim, dir, frame++) == FCM_OK) &&
          fcm_simulation_write_log(sim, logpath) == FCM_OK;
     if (!ok && fcm_ctx_error_status(ctx) != FCM_OK)
       fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
@@ -175,6 +213,10 @@ static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
       MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
       if (!ok) goto done;
     }
+    /* after the frame, as the serial fcm-sim: the checkpoint counts it */
+    if (write && fcm_simulation_checkpoint_due(sim) &&
+        !write_checkpoint(ctx, sim, dir, name, talk, rank))
+      goto done;
   }
   if (write && rank == 0) {
     ok = fcm_simulation_write_log(sim, logpath) == FCM_OK;

@@ -1588,6 +1588,9 @@ static fcm_status newton_solve(void *user, const double *b, double *x, int *iter
   }
   PCALL(ctx, VecRestoreArray(P->b, &bb));
   bb = NULL;
+  /* a zero initial guess also under -ksp_initial_guess_nonzero: the last direction is no state
+   * of the run (a checkpoint does not hold it), so a resumed run takes the same iterations */
+  PCALL(ctx, VecZeroEntries(P->x));
   PCALL(ctx, KSPSolve(P->ksp, P->b, P->x));
   PCALL(ctx, KSPGetConvergedReason(P->ksp, &reason));
   PCALL(ctx, KSPGetIterationNumber(P->ksp, &its));
