@@ -130,3 +130,74 @@ fcm_add_mpi_test(petsc_newton_slingshot_np2 tests/petsc/newton.c NP 2
 foreach(np 1 2)
   fcm_add_mpi_test(petsc_newton_failure_np${np} tests/petsc/newton_failure.c NP ${np} TIMEOUT 120)
 endforeach()
+if(FCM_BUILD_APPS)
+  # the state of two checkpoints (fcm-sim's .fcmck or the linear driver's .fcmpk) to a relative
+  # tolerance: a tool of the shell tests below (no MPI)
+  add_executable(petsc_state_diff tests/petsc/state_diff.c)
+  target_link_libraries(petsc_state_diff PRIVATE m)
+  target_compile_options(petsc_state_diff PRIVATE ${FCM_WARNINGS} ${FCM_SAN_FLAGS})
+  target_link_options(petsc_state_diff PRIVATE ${FCM_SAN_FLAGS})
+endif()
+if(FCM_BUILD_APPS)
+  # EVERY example scene of apps/scenes on 2 processes through fcm-sim --backend petsc
+  # (tests/petsc/scene_app.sh): the state after the first steps equals the serial fcm-sim's to
+  # the tolerance, or the scene is refused with the message. One table; a scene of apps/scenes
+  # in neither list fails petsc_app_scene_listed.
+  # name        steps  relative tolerance of the state (1e-8; slingshot: the serial run
+  #                    solves with MINRES to the scene's rtol 1e-5)
+  set(FCM_PETSC_SCENES_RUN
+      cantilever            2 1e-8
+      clamped_surface       2 1e-8
+      gyroid_lattice        2 1e-8
+      hollow_ball           2 1e-8
+      hollow_ball_multigrid 1 1e-8
+      slingshot             1 1e-6
+      spinning_body         2 1e-8
+      static_beam           2 1e-8
+      surface_drop          2 1e-8
+      vibrating_beam        2 1e-8
+      voxel_block           2 1e-8)
+  # name               the message (grep -E) of the refusal; branch i14-cut makes these run
+  set(FCM_PETSC_SCENES_REFUSED
+      cracked_beam      "effects\\[[0-9]+\\]: cut is not supported by the PETSc backend"
+      cut_slab          "effects\\[[0-9]+\\]: cut is not supported by the PETSc backend"
+      dice              "effects\\[[0-9]+\\]: cut is not supported by the PETSc backend"
+      twisting_cylinder "quadrature.simplify = .auto. is not supported by the PETSc backend")
+  set(listed "")
+  set(run ${FCM_PETSC_SCENES_RUN})
+  while(run)
+    list(POP_FRONT run name steps rtol)
+    list(APPEND listed ${name})
+    add_test(NAME petsc_app_scene_${name}
+             COMMAND bash ${PROJECT_SOURCE_DIR}/tests/petsc/scene_app.sh run ${MPIEXEC_EXECUTABLE}
+                     $<TARGET_FILE:fcm-sim> $<TARGET_FILE:petsc_state_diff>
+                     ${FCM_SCENES}/${name}.json ${steps} ${rtol}
+                     ${CMAKE_CURRENT_BINARY_DIR}/petsc_app_scene_${name})
+    set_tests_properties(petsc_app_scene_${name} PROPERTIES LABELS mpi TIMEOUT 300 PROCESSORS 2
+                         ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+  endwhile()
+  set(refused ${FCM_PETSC_SCENES_REFUSED})
+  while(refused)
+    list(POP_FRONT refused name regex)
+    list(APPEND listed ${name})
+    add_test(NAME petsc_app_scene_${name}
+             COMMAND bash ${PROJECT_SOURCE_DIR}/tests/petsc/scene_app.sh refused
+                     ${MPIEXEC_EXECUTABLE} $<TARGET_FILE:fcm-sim> - ${FCM_SCENES}/${name}.json -
+                     "${regex}" ${CMAKE_CURRENT_BINARY_DIR}/petsc_app_scene_${name})
+    set_tests_properties(petsc_app_scene_${name} PROPERTIES LABELS mpi TIMEOUT 120 PROCESSORS 2
+                         ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+  endwhile()
+  file(GLOB scene_files RELATIVE ${FCM_SCENES} CONFIGURE_DEPENDS ${FCM_SCENES}/*.json)
+  set(unlisted "")
+  foreach(f ${scene_files})
+    string(REGEX REPLACE "\\.json$" "" name ${f})
+    if(NOT name IN_LIST listed)
+      list(APPEND unlisted ${name})
+    endif()
+  endforeach()
+  # every example scene is in one of the two lists (a new scene is added to one of them)
+  add_test(NAME petsc_app_scene_listed
+           COMMAND ${CMAKE_COMMAND} -E echo "example scenes in neither list: ${unlisted}")
+  set_tests_properties(petsc_app_scene_listed PROPERTIES LABELS mpi
+                       FAIL_REGULAR_EXPRESSION "neither list: [a-z]")
+endif()
