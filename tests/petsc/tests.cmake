@@ -201,3 +201,14 @@ if(FCM_BUILD_APPS)
   set_tests_properties(petsc_app_scene_listed PROPERTIES LABELS mpi
                        FAIL_REGULAR_EXPRESSION "neither list: [a-z]")
 endif()
+if(FCM_BUILD_APPS)
+  # fcm-sim --backend petsc on the integrator path: checkpoints (the scene's interval,
+  # --checkpoint-every), --resume byte for byte on 2 processes, to 1e-10 on 1 and serially
+  add_test(NAME petsc_app_newton_resume
+           COMMAND bash ${PROJECT_SOURCE_DIR}/tests/petsc/newton_resume.sh ${MPIEXEC_EXECUTABLE}
+                   $<TARGET_FILE:fcm-sim> $<TARGET_FILE:petsc_state_diff>
+                   ${FCM_SCENES}/clamped_surface.json
+                   ${CMAKE_CURRENT_BINARY_DIR}/petsc_app_newton_resume)
+  set_tests_properties(petsc_app_newton_resume PROPERTIES LABELS mpi TIMEOUT 300 PROCESSORS 2
+                       ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+endif()

@@ -1653,6 +1653,12 @@ static fcm_status newton_attach(void *user, fcm_integrator *integ, const fcm_spa
     P->ksp_type_set = has == PETSC_TRUE;
     PCALL(ctx, PetscOptionsHasName(NULL, NULL, "-pc_type", &has));
     P->pc_type_set = has == PETSC_TRUE;
+    /* GAMG (PETSc 3.18) reuses the previous tangent's interpolation by default: the solves
+     * would then depend on the run's history, and a resumed run (a fresh KSP) would differ
+     * from the uninterrupted one at round-off. A new hierarchy for each tangent, as the serial
+     * solvers do, unless -pc_gamg_reuse_interpolation says otherwise (no effect on other PCs). */
+    PCALL(ctx, PetscOptionsHasName(NULL, NULL, "-pc_gamg_reuse_interpolation", &has));
+    if (!has) PCALL(ctx, PCGAMGSetReuseInterpolation(pc, PETSC_FALSE));
   }
 cleanup:
   st = newton_agree(P, st);
