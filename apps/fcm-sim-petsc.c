@@ -113,6 +113,18 @@ static int write_checkpoint(fcm_ctx *ctx, fcm_simulation *sim, const char *dir, 
   return ok;
 }
 
+/* A frame of the integrator path (collective: every process sums its cells' fields, process 0
+ * writes the serial background and surface VTUs and PVDs); whether it was written, on every
+ * process. */
+static int write_frame_newton(fcm_ctx *ctx, fcm_simulation *sim, const char *dir, int index,
+                              int rank)
+{
+  int ok = fcm_simulation_write_frame(sim, dir, index) == FCM_OK;
+  if (!ok && rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD); /* a failure of the sums is everywhere */
+  return ok;
+}
+
 /* Every process restores the checkpoint `path` into its new simulation (the same bytes give
  * the same state and the same errors everywhere; a file that one process cannot read is
  * reported by the lowest such process). Collective: 1 when every process restored it. */
@@ -174,14 +186,18 @@ static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
   fcm_simulation_get_counters(sim, &c);
   int frame = (int)c.frames; /* resumed: the frames the checkpoint had */
   snprintf(logpath, sizeof logpath, "%s/%s_log.csv", dir, name);
-  if (write && rank == 0) {
-    ok = make_dirs(dir) && (resume || fcm_simulation_write_frame(sim, dir, frame++) == FCM_OK) &&
-         fcm_simulation_write_log(sim, logpath) == FCM_OK;
-    if (!ok && fcm_ctx_error_status(ctx) != FCM_OK)
-      fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+  if (write) {
+    if (rank == 0) ok = make_dirs(dir);
+    MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (!ok) goto done;
+    if (!resume && !write_frame_newton(ctx, sim, dir, frame++, rank)) goto done;
+    if (rank == 0) {
+      ok = fcm_simulation_write_log(sim, logpath) == FCM_OK;
+      if (!ok) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+    }
+    MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (!ok) goto done;
   }
-  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  if (!ok) goto done;
   const double t0 = fcm_wtime();
   const long long n = fcm_simulation_num_steps(sim);
   while (!fcm_simulation_done(sim)) {
@@ -205,9 +221,9 @@ static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
               "%.3g\n",
               k, n, si.time, si.newton_iterations, si.linear_iterations, si.residual);
     if (write && fcm_simulation_frame_due(sim)) {
+      if (!write_frame_newton(ctx, sim, dir, frame++, rank)) goto done;
       if (rank == 0) {
-        ok = fcm_simulation_write_frame(sim, dir, frame++) == FCM_OK &&
-             fcm_simulation_write_log(sim, logpath) == FCM_OK;
+        ok = fcm_simulation_write_log(sim, logpath) == FCM_OK;
         if (!ok) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
       }
       MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);

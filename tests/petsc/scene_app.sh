@@ -4,7 +4,10 @@
 #   scene_app.sh run MPIEXEC FCM_SIM STATE_DIFF SCENE STEPS RTOL WORK
 #     both take STEPS steps (--steps) with a checkpoint every step; the state of the last
 #     checkpoint (displacement and velocity, fcm-sim's .fcmck or the linear driver's .fcmpk)
-#     agrees to RTOL relative (petsc_state_diff); the KSP runs to -ksp_rtol 1e-12.
+#     agrees to RTOL relative (petsc_state_diff); the KSP runs to -ksp_rtol 1e-12. On the
+#     integrator path (serial frames <name>_background_NNNN.vtu) the last frame's displacement,
+#     velocity and cell fields (stress, von Mises, strain energy density: every process's
+#     cells) agree to RTOL too.
 #   scene_app.sh refused MPIEXEC FCM_SIM - SCENE - REGEX WORK
 #     the backend refuses the scene: exit 2 on every process, the message matches REGEX
 #     (grep -E), nothing is stepped.
@@ -31,4 +34,8 @@ a=$(last "$work/p") b=$(last "$work/s")
 # the same step on both (the serial's last checkpoint names the step)
 [ "${a%.*}" = "$work/p/$(basename "${b%.*}")" ] || { echo "last checkpoints $a, $b" >&2; exit 1; }
 "$diff" "$a" "$b" "$arg"
+if ls "$work/p/${name}"_background_*.vtu >/dev/null 2>&1; then
+  f=$(ls "$work/p/${name}"_background_*.vtu | sort | tail -n 1)
+  "$diff" --vtu "$f" "$work/s/$(basename "$f")" "$arg"
+fi
 rm -rf "$work"

@@ -4,7 +4,12 @@
  * doubles before the 8-byte checksum) or of the PETSc backend's linear driver (.fcmpk:
  * "fcm-petsc-ck-1", n at byte 16, u and v from byte 64); both hold the state in the space's
  * DOF numbering, which is the same for every backend and process count. Used by the shell
- * tests of tests/petsc; prints the norms, exits 1 when they differ by more. */
+ * tests of tests/petsc; prints the norms, exits 1 when they differ by more.
+ * petsc_state_diff --vtu A.vtu B.vtu RTOL: the same for the background frames of fcm-sim
+ * (fcm_space_write_vtu()): each of the point arrays displacement, velocity and the cell arrays
+ * stress, von_mises, strain_energy_density (those in B must be in A). */
+#include "../io/vtk_reader.h"
+
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -70,8 +75,61 @@ static int within(const char *what, long long n, const double *a, const double *
   return d <= rtol * nb;
 }
 
+/* Float64 array `name` of `parent` in a VTU file (malloc'ed) and its count; NULL if absent. */
+static double *read_array(const char *path, const char *parent, const char *name, long long *count)
+{
+  vr_doc d;
+  double *out = NULL;
+  *count = 0;
+  if (!vr_load(&d, path)) return NULL;
+  if (vr_parse_vtu(&d)) {
+    const vr_tag *t = vr_data_array(&d, parent, name);
+    if (t) {
+      uint64_t bytes = 0;
+      const unsigned char *p = vr_array(&d, t, &bytes);
+      out = malloc(bytes + 1);
+      if (out) memcpy(out, p, bytes);
+      *count = (long long)(bytes / sizeof(double));
+    }
+  }
+  vr_free(&d);
+  return out;
+}
+
+static int vtu_main(const char *a, const char *b, double rtol)
+{
+  static const char *const arrays[5][2] = {{"PointData", "displacement"},
+                                           {"PointData", "velocity"},
+                                           {"CellData", "stress"},
+                                           {"CellData", "von_mises"},
+                                           {"CellData", "strain_energy_density"}};
+  int ok = 1, found = 0;
+  for (int k = 0; k < 5; k++) {
+    long long na = 0, nb = 0;
+    double *x = read_array(a, arrays[k][0], arrays[k][1], &na);
+    double *y = read_array(b, arrays[k][0], arrays[k][1], &nb);
+    if (y) {
+      found++;
+      if (!x || na != nb) {
+        fprintf(stderr, "petsc_state_diff: %s: %s has %lld values, %s %lld\n", arrays[k][1], a,
+                na, b, nb);
+        ok = 0;
+      } else {
+        ok = within(arrays[k][1], na, x, y, rtol) && ok;
+      }
+    }
+    free(x), free(y);
+  }
+  if (found < 3) {
+    fprintf(stderr, "petsc_state_diff: %s: no displacement or cell fields\n", b);
+    ok = 0;
+  }
+  return ok ? 0 : 1;
+}
+
 int main(int argc, char **argv)
 {
+  if (argc == 5 && strcmp(argv[1], "--vtu") == 0) return vtu_main(argv[2], argv[3], atof(argv[4]));
   state a = {0, NULL, NULL}, b = {0, NULL, NULL};
   if (argc != 4) {
     fprintf(stderr, "usage: petsc_state_diff A B RTOL\n");

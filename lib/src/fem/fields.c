@@ -206,6 +206,12 @@ cleanup:
 fcm_status fcm_space_write_vtu(const fcm_space *s, const fcm_material *mat, const double *u,
                                const double *v, const char *path)
 {
+  return fcm__space_write_vtu_cells(s, mat, u, v, NULL, path);
+}
+
+fcm_status fcm__space_write_vtu_cells(const fcm_space *s, const fcm_material *mat, const double *u,
+                                      const double *v, const double *cells, const char *path)
+{
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s ? s->ctx : NULL;
   fcm_vtu *vtu = NULL;
@@ -237,8 +243,16 @@ fcm_status fcm_space_write_vtu(const fcm_space *s, const fcm_material *mat, cons
     FCM_ALLOC(ctx, 6 * nc + 1, sig);
     FCM_ALLOC(ctx, nc + 1, vm);
     FCM_ALLOC(ctx, nc + 1, sed);
-    if (!u) FCM_ALLOC(ctx, s->num_dofs + 1, zero);
-    FCM_TRY(ctx, fcm_space_cell_stress(s, mat, u ? u : zero, sig, vm, sed));
+    if (cells) { /* given: 8 per cell, stress (6), von Mises, strain energy density */
+      for (fcm_index c = 0; c < nc; c++) {
+        memcpy(sig + 6 * c, cells + 8 * c, 6 * sizeof *sig);
+        vm[c] = cells[8 * c + 6];
+        sed[c] = cells[8 * c + 7];
+      }
+    } else {
+      if (!u) FCM_ALLOC(ctx, s->num_dofs + 1, zero);
+      FCM_TRY(ctx, fcm_space_cell_stress(s, mat, u ? u : zero, sig, vm, sed));
+    }
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "stress", 6, nc, sig));
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "von_mises", 1, nc, vm));
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "strain_energy_density", 1, nc, sed));

@@ -4,6 +4,8 @@
 #include "scene/scene_impl.h"
 
 #include "core/core_impl.h"
+#include "embed/embed_impl.h"
+#include "fem/fem_impl.h"
 #include "sim/sim_backend.h"
 #include "fcm/embed.h"
 #include "fcm/fem.h"
@@ -1110,11 +1112,50 @@ cleanup:
   return st;
 }
 
+/* A distributed run: the cell fields (stress, von Mises, strain energy density: 8 per cell)
+ * of the whole body on every process — each process averages its own cells (the others' cut
+ * cells have no points here) and the sum over the processes collects them. Collective. */
+static fcm_status distributed_cell_fields(fcm_simulation *S, const fcm_material *mat,
+                                          const double *u, double **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  const fcm_space *s = S->space;
+  const fcm_cell_rules *R = fcm_space_cell_rules(s);
+  const fcm_index nc = fcm_mesh_num_cells(S->mesh);
+  double *f = NULL, *sig = NULL, *vm = NULL, *sed = NULL;
+  f = fcm__calloc(ctx, 8 * (size_t)nc + 1, sizeof *f);
+  sig = fcm__calloc(ctx, 6 * (size_t)nc + 1, sizeof *sig);
+  vm = fcm__calloc(ctx, (size_t)nc + 1, sizeof *vm);
+  sed = fcm__calloc(ctx, (size_t)nc + 1, sizeof *sed);
+  st = f && sig && vm && sed ? FCM_OK
+                             : fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
+                                          "simulation: out of memory (cell fields of %lld cells)",
+                                          (long long)nc);
+  if (st == FCM_OK) st = fcm_space_cell_stress(s, mat, u, sig, vm, sed);
+  for (fcm_index c = 0; st == FCM_OK && c < nc; c++) {
+    if (!fcm__cell_rules_owns(R, c)) continue; /* another process's cell: its values */
+    memcpy(f + 8 * c, sig + 6 * c, 6 * sizeof *f);
+    f[8 * c + 6] = vm[c];
+    f[8 * c + 7] = sed[c];
+  }
+  FCM_TRY(ctx, fcm__integrator_reduce_status(S->integ, st, f, 8 * nc)); /* agrees on st first */
+  *out = f;
+  f = NULL;
+cleanup:
+  fcm__free(ctx, f);
+  fcm__free(ctx, sig);
+  fcm__free(ctx, vm);
+  fcm__free(ctx, sed);
+  return st;
+}
+
 fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int index)
 {
   fcm_status st = FCM_OK;
   char path[4096];
   fcm_ctx *ctx = S ? S->ctx : NULL;
+  double *cells = NULL;
   FCM_CHECK(S && dir && index >= 0, ctx, FCM_ERR_ARG,
             "simulation: write_frame needs a directory and index >= 0 (got %d)", index);
   const char *name = fcm_scene_name(S->scene);
@@ -1122,16 +1163,20 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
   const fcm_material *mat = fcm_scene_get_material(S->scene);
   double t0 = fcm_wtime(), time = fcm_integrator_time(S->integ);
   const double *u = fcm_integrator_displacement(S->integ), *v = fcm_integrator_velocity(S->integ);
+  int root = 1;
+  const int dist = fcm__integrator_distributed(S->integ, &root);
   /* room for the frame time first: a frame that is written is also counted */
   FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&S->frame_time, &S->frame_cap, S->c.frames + 1,
                              sizeof *S->frame_time));
-  if (out->write_background) {
+  /* distributed: every process takes part in the cell fields, the root writes */
+  if (dist && out->write_background) FCM_TRY(ctx, distributed_cell_fields(S, mat, u, &cells));
+  if (out->write_background && root) {
     snprintf(path, sizeof path, "%s/%s_background_%04d.vtu", dir, name, index);
-    FCM_TRY(ctx, fcm_space_write_vtu(S->space, mat, u, v, path));
+    FCM_TRY(ctx, fcm__space_write_vtu_cells(S->space, mat, u, v, cells, path));
     if (!S->pvd_bg) FCM_TRY(ctx, open_pvd(S, dir, "background", &S->pvd_bg));
     FCM_TRY(ctx, fcm_pvd_add(S->pvd_bg, time, path));
   }
-  if (S->surf) {
+  if (S->surf && root) { /* the surface's fields come from u alone: whole on every process */
     snprintf(path, sizeof path, "%s/%s_surface_%04d.vtu", dir, name, index);
     FCM_TRY(ctx, fcm_embedded_surface_write_vtu(S->surf, mat, u, path));
     if (!S->pvd_surf) FCM_TRY(ctx, open_pvd(S, dir, "surface", &S->pvd_surf));
@@ -1140,6 +1185,7 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
   S->frame_time[S->c.frames++] = time;
   S->c.time_output += fcm_wtime() - t0;
 cleanup:
+  if (S) fcm__free(ctx, cells);
   return st;
 }
 

@@ -702,10 +702,23 @@ cleanup:
   return st;
 }
 
+int fcm__integrator_distributed(const fcm_integrator *I, int *root)
+{
+  const int dist = I && I->has_backend;
+  if (root) *root = dist ? I->backend.root : 1;
+  return dist;
+}
+
 fcm_status fcm__integrator_reduce(fcm_integrator *I, double *values, fcm_index count)
 {
-  if (!I || !I->has_backend) return FCM_OK;
-  fcm_status st = I->backend.reduce(I->backend.user, FCM_OK, values, count);
+  return fcm__integrator_reduce_status(I, FCM_OK, values, count);
+}
+
+fcm_status fcm__integrator_reduce_status(fcm_integrator *I, fcm_status st, double *values,
+                                         fcm_index count)
+{
+  if (!I || !I->has_backend) return st;
+  st = I->backend.reduce(I->backend.user, st, values, count);
   if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
   return st;
 }

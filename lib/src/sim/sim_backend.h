@@ -42,5 +42,13 @@ fcm_status fcm__integrator_set_backend(fcm_integrator *I, const fcm__sim_backend
  * quantity of the space, e.g. the log's mass and momentum); FCM_OK without a backend.
  * Collective with a backend. */
 fcm_status fcm__integrator_reduce(fcm_integrator *I, double *values, fcm_index count);
+/* The same after a local phase that ended with st: the processes agree on it first (a failure
+ * anywhere is returned everywhere, values untouched and may then be NULL). Collective with a
+ * backend; st itself without one. */
+fcm_status fcm__integrator_reduce_status(fcm_integrator *I, fcm_status st, double *values,
+                                         fcm_index count);
 
+/* Whether the integrator runs on a distributed backend (0: serial); *root (may be NULL): 1 on
+ * the backend's root process, and 1 without a backend. */
+int fcm__integrator_distributed(const fcm_integrator *I, int *root);
 #endif /* FCM_SIM_BACKEND_H */
