@@ -240,8 +240,11 @@ static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
   }
   MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
   if (!ok) goto done;
+  if (fcm_petsc_simulation_summary_view(sim, talk ? stdout : NULL) != FCM_OK) {
+    if (rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+    goto done;
+  }
   if (talk) {
-    fcm_simulation_summary_view(sim, stdout);
     printf("  backend   petsc, %d process%s (Newton on PETSc), steps %.3g s\n", size,
            size > 1 ? "es" : "", fcm_wtime() - t0);
     if (write) printf("  output    %s/%s_background.pvd, %s\n", dir, name, logpath);

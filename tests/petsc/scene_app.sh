@@ -8,6 +8,11 @@
 #     integrator path (serial frames <name>_background_NNNN.vtu) the last frame's displacement,
 #     velocity and cell fields (stress, von Mises, strain energy density: every process's
 #     cells) agree to RTOL too.
+#   scene_app.sh summary MPIEXEC FCM_SIM - SCENE - - WORK
+#     the run summaries (--check, 3 steps) agree on the whole body's figures: the cells and
+#     their cut-cell point counts, the volume, the rules built (stored points), the
+#     constraints (embedded-boundary points) and the body's max |u| — the same lines; the
+#     PETSc run's come from every process's cells (fcm_petsc_simulation_summary_view()).
 #   scene_app.sh refused MPIEXEC FCM_SIM - SCENE - REGEX WORK
 #     the backend refuses the scene: exit 2 on every process, the message matches REGEX
 #     (grep -E), nothing is stepped.
@@ -15,6 +20,15 @@ set -euo pipefail
 mode=$1 mpiexec=$2 sim=$3 diff=$4 scene=$5 steps=$6 arg=$7 work=$8
 name=$(basename "$scene" .json)
 rm -rf "$work" && mkdir -p "$work"
+if [ "$mode" = summary ]; then
+  "$mpiexec" -n 2 "$sim" "$scene" --backend petsc --check -ksp_rtol 1e-12 >"$work/p.txt"
+  "$sim" "$scene" --check >"$work/s.txt"
+  pick() { grep -E '^  (cells|volume|body) |^  computed  (rules built|constraints) ' "$1"; }
+  [ "$(pick "$work/s.txt" | wc -l)" -ge 4 ] || { echo "summary lines missing" >&2; exit 1; }
+  diff <(pick "$work/s.txt") <(pick "$work/p.txt")
+  rm -rf "$work"
+  exit 0
+fi
 if [ "$mode" = refused ]; then
   set +e
   "$mpiexec" -n 2 "$sim" "$scene" --backend petsc -o "$work/p" -q --steps 1 2>"$work/err"

@@ -195,6 +195,16 @@ if(FCM_BUILD_APPS)
       list(APPEND unlisted ${name})
     endif()
   endforeach()
+  # the run summary on 2 processes counts every process's cells (points, boundary points,
+  # max |u|): the same lines as the serial fcm-sim's
+  foreach(name clamped_surface spinning_body)
+    add_test(NAME petsc_app_summary_${name}
+             COMMAND bash ${PROJECT_SOURCE_DIR}/tests/petsc/scene_app.sh summary
+                     ${MPIEXEC_EXECUTABLE} $<TARGET_FILE:fcm-sim> - ${FCM_SCENES}/${name}.json - -
+                     ${CMAKE_CURRENT_BINARY_DIR}/petsc_app_summary_${name})
+    set_tests_properties(petsc_app_summary_${name} PROPERTIES LABELS mpi TIMEOUT 120
+                         PROCESSORS 2 ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+  endforeach()
   # every example scene is in one of the two lists (a new scene is added to one of them)
   add_test(NAME petsc_app_scene_listed
            COMMAND ${CMAKE_COMMAND} -E echo "example scenes in neither list: ${unlisted}")

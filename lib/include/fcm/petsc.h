@@ -245,7 +245,15 @@ FCM_API int fcm_petsc_problem_supports_scene(fcm_ctx *ctx, const fcm_scene *scen
  *
  * The simulation is used as any other: fcm_simulation_step() is collective; the state, the
  * log rows (energies, mass, momentum, reactions) and the counters are the same on every
- * process, so one process (rank 0) writes the frames and the log with the serial writers.
+ * process, so one process (rank 0) writes the log and the checkpoints with the serial
+ * writers (fcm_simulation_write_checkpoint(); every process of any count, and the serial
+ * runner, resumes from it with fcm_simulation_read_checkpoint()); fcm_simulation_write_frame()
+ * is collective (the cell fields are summed over the processes' cells, rank 0 writes), and
+ * fcm_petsc_simulation_summary_view() is the summary over every process's cells. A resumed run
+ * on the same process count repeats the uninterrupted one bit for bit when the KSP does (CG /
+ * MINRES with GAMG, Jacobi, ...: the initial guess is always zero and GAMG builds a new
+ * hierarchy per tangent); MUMPS on more than one process is not bitwise reproducible between
+ * runs (its parallel factorization), on one process it is.
  * Not supported (FCM_ERR_UNSUPPORTED naming it, on every process): "cut" effects,
  * quadrature.simplify = auto. Stated plainly: the sums are of replicated dense vectors and of
  * the Newton matrix's values (O(DOFs + nonzeros) per process and assembly), the direction is
@@ -260,6 +268,16 @@ FCM_API fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm,
                                                fcm_petsc_partition partition,
                                                const fcm_simulation_options *opts,
                                                fcm_simulation **out);
+
+/** fcm_simulation_summary_view() of a simulation of fcm_petsc_simulation_create(), over the
+ * whole body: the cut-cell point counts (before / after simplification, stored, surface) are
+ * summed over the processes and the largest |u| over the body's quadrature points is taken
+ * over every process's cells (each process's rules carry its own cells' points only, so the
+ * plain summary on one process counts that process's cells). Collective; prints to f on the
+ * processes where f is not NULL (typically rank 0 only).
+ * @return FCM_OK; FCM_ERR_ARG (NULL simulation, or not a distributed one); FCM_ERR_ALLOC;
+ * FCM_ERR_INTERNAL (MPI). On every process when any failed. */
+FCM_API fcm_status fcm_petsc_simulation_summary_view(fcm_simulation *sim, FILE *f);
 
 #ifdef __cplusplus
 }

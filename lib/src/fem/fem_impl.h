@@ -82,4 +82,8 @@ fcm_status fcm__assembly_element_linear(fcm_assembly_workspace *ws, const fcm_li
 fcm_status fcm__space_write_vtu_cells(const fcm_space *s, const fcm_material *mat, const double *u,
                                       const double *v, const double *cells, const char *path);
 
+/* fcm_space_max_displacement() per cell: the largest |u| over each cell's authentic points
+ * (0 for a cell without points). */
+fcm_status fcm__space_cell_max_displacement(const fcm_space *s, const double *u, double *cell_max);
+
 #endif /* FCM_FEM_IMPL_H */

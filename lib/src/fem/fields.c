@@ -177,6 +177,34 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__space_cell_max_displacement(const fcm_space *s, const double *u, double *cell_max)
+{
+  fcm_status st = FCM_OK;
+  fcm_rule *full = NULL;
+  FCM_TRY(s->ctx,
+          fcm_element_standard_rule(s->ctx, s->type, FCM_RULE_STIFFNESS, FCM_DEFAULT, &full));
+  for (fcm_index c = 0; c < s->num_cells; c++) {
+    double best = 0.0;
+    for (fcm_index e = s->cell_elem[c]; e < s->cell_elem[c + 1]; e++) {
+      int nq = 0;
+      const double *pts = NULL, *w = NULL;
+      const unsigned char *fl = NULL;
+      element_points(s, full, e, &nq, &pts, &w, &fl);
+      for (int q = 0; q < nq; q++) {
+        double v[3];
+        if (fl && fl[q]) continue;
+        fcm_space_element_eval(s, e, pts + 3 * q, u, v);
+        const double n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        if (!(n2 <= best)) best = n2; /* NaN propagates */
+      }
+    }
+    cell_max[c] = sqrt(best);
+  }
+cleanup:
+  fcm_rule_destroy(&full);
+  return st;
+}
+
 fcm_status fcm_space_node_field(const fcm_space *s, const double *dofs, double *node_field)
 {
   fcm_status st = FCM_OK;

@@ -1788,6 +1788,17 @@ cleanup:
   return st;
 }
 
+fcm_status fcm_petsc_simulation_summary_view(fcm_simulation *sim, FILE *f)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(sim, NULL, FCM_ERR_ARG, "petsc: summary_view: NULL simulation");
+  FCM_CHECK(fcm__integrator_distributed(sim->integ, NULL), sim->ctx, FCM_ERR_ARG,
+            "petsc: summary_view: the simulation is not one of fcm_petsc_simulation_create()");
+  FCM_TRY(sim->ctx, fcm__simulation_summary_view_distributed(sim, f));
+cleanup:
+  return st;
+}
+
 /* ---------------------------------------------------------------- output */
 
 /* This process's piece: its active cells with their nodes (renumbered), the node fields of the

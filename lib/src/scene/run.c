@@ -1133,8 +1133,10 @@ static fcm_status distributed_cell_fields(fcm_simulation *S, const fcm_material 
                                           "simulation: out of memory (cell fields of %lld cells)",
                                           (long long)nc);
   if (st == FCM_OK) st = fcm_space_cell_stress(s, mat, u, sig, vm, sed);
+  int root = 1;
+  fcm__integrator_distributed(S->integ, &root);
   for (fcm_index c = 0; st == FCM_OK && c < nc; c++) {
-    if (!fcm__cell_rules_owns(R, c)) continue; /* another process's cell: its values */
+    if (!fcm__cell_rules_owns(R, c) || (!R && !root)) continue; /* another process's values */
     memcpy(f + 8 * c, sig + 6 * c, 6 * sizeof *f);
     f[8 * c + 6] = vm[c];
     f[8 * c + 7] = sed[c];
@@ -1266,12 +1268,12 @@ static void multigrid_line(const fcm_simulation *S, FILE *f)
  * stiffness rules) and the embedded-surface points the frames write; beside it, the largest
  * over the DOF vector, which includes the fictitious nodes outside the body. Without an
  * embedded geometry the mesh is the body: its nodes count too. */
-static void body_displacement_line(const fcm_simulation *S, FILE *f)
+static void body_displacement_line(const fcm_simulation *S, FILE *f, double body_points)
 {
   const double *u = fcm_integrator_displacement(S->integ);
   const fcm_index n = fcm_integrator_num_dofs(S->integ);
-  double body = 0.0, dofs = 0.0, *d = NULL;
-  if (fcm_space_max_displacement(S->space, u, &body) != FCM_OK) {
+  double body = body_points, dofs = 0.0, *d = NULL;
+  if (body_points < 0.0 && fcm_space_max_displacement(S->space, u, &body) != FCM_OK) {
     fcm_ctx_error_clear(S->ctx);
     return;
   }
@@ -1303,17 +1305,20 @@ static void body_displacement_line(const fcm_simulation *S, FILE *f)
             body, dofs);
 }
 
-void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
+/* The summary with the rules' statistics `gs` and the body's largest |u| over its quadrature
+ * points `body` given (a distributed run: summed over the processes), or taken from this
+ * process (gs NULL, body < 0). */
+static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_stats *gs,
+                         const fcm_simulation_counters *gc, double body)
 {
-  if (!S || !f) return;
-  const fcm_simulation_counters *c = &S->c;
+  const fcm_simulation_counters *c = gc ? gc : &S->c;
   char b[512];
   fprintf(f, "simulation %s: %lld of %lld steps, %lld DOFs\n", fcm_scene_name(S->scene), c->steps,
           S->num_steps, (long long)c->num_dofs);
   line(f, c->cell_rules, "embedded cell rules", c->cell_rules ? "" : "(no geometry)");
   if (S->geometry_note[0]) fprintf(f, "  geometry  %s\n", S->geometry_note);
   if (S->rules) {
-    const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(S->rules);
+    const fcm_cell_rules_stats *rs = gs ? gs : fcm_cell_rules_get_stats(S->rules);
     fprintf(f,
             "  cells     %lld: %lld uncut, %lld cut, %lld dropped; cut-cell points stiffness "
             "%lld -> %lld, mass %lld -> %lld (before -> after simplification)\n",
@@ -1362,7 +1367,7 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
     }
   }
   if (S->rules) { /* which rule kinds the scene called for, with their stored points */
-    const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(S->rules);
+    const fcm_cell_rules_stats *rs = gs ? gs : fcm_cell_rules_get_stats(S->rules);
     const int mass = (c->rule_kinds & FCM_RULES_MASS) != 0;
     snprintf(b, sizeof b, "stiffness (%lld points)%s",
              (long long)rs->points_total[FCM_RULE_STIFFNESS], mass ? ", mass" : "");
@@ -1416,7 +1421,7 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
   snprintf(b, sizeof b, "%lld frames, surface %lld points %lld triangles", c->frames,
            (long long)c->surface_points, (long long)c->surface_triangles);
   line(f, c->frames > 0, "output", b);
-  body_displacement_line(S, f);
+  body_displacement_line(S, f, body);
   if (S->free_body) {
     double com[3];
     if (fcm_simulation_center_of_mass(S, com) == FCM_OK) {
@@ -1427,4 +1432,77 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
   }
   fprintf(f, "  time [s]  setup %.3f  steps %.3f  output %.3f\n", c->time_setup, c->time_steps,
           c->time_output);
+}
+
+void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
+{
+  if (!S || !f) return;
+  summary_view(S, f, NULL, NULL, -1.0);
+}
+
+fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  const fcm_index nc = fcm_mesh_num_cells(S->mesh);
+  const int K = FCM_RULE_KIND_COUNT, nv = 6 * FCM_RULE_KIND_COUNT + 5;
+  fcm_cell_rules_stats gs;
+  fcm_simulation_counters gc = S->c;
+  double *q = NULL, body = 0.0;
+  int root = 1;
+  fcm__integrator_distributed(S->integ, &root);
+  memset(&gs, 0, sizeof gs);
+  /* per kind: points before / after simplification, stabilization, stored, skipped, kept
+   * unsimplified; then surface triangles and points, tets, slivers; then each own cell's
+   * largest |u| (every process's cells: the point counts are its own cells' only) */
+  q = fcm__calloc(ctx, (size_t)nv + (size_t)nc + 1, sizeof *q);
+  st = q ? FCM_OK
+         : fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
+                      "simulation: out of memory (summary of %lld cells)", (long long)nc);
+  if (st == FCM_OK && S->rules) {
+    gs = *fcm_cell_rules_get_stats(S->rules);
+    for (int k = 0; k < K; k++) {
+      q[6 * k + 0] = (double)gs.points_initial[k];
+      q[6 * k + 1] = (double)gs.points_simplified[k];
+      q[6 * k + 2] = (double)gs.points_stabilization[k];
+      /* stored points: the cut cells' own ones, plus the uncut cells' (every process counts
+       * all of those: the classification is replicated) on the root only */
+      q[6 * k + 3] = (double)(root ? gs.points_total[k]
+                                   : gs.points_simplified[k] + gs.points_stabilization[k]);
+      q[6 * k + 4] = (double)gs.simplify_skipped[k];
+      q[6 * k + 5] = (double)gs.simplify_fallbacks[k];
+    }
+    q[6 * K + 0] = (double)gs.surface_triangles;
+    q[6 * K + 1] = (double)gs.surface_points;
+    q[6 * K + 2] = (double)gs.num_tets;
+    q[6 * K + 3] = (double)gs.num_slivers;
+  }
+  if (q) q[6 * K + 4] = (double)S->c.boundary_points; /* Nitsche's: own cells' */
+  if (st == FCM_OK)
+    st = fcm__space_cell_max_displacement(S->space, fcm_integrator_displacement(S->integ), q + nv);
+  if (st == FCM_OK) {
+    const fcm_cell_rules *R = fcm_space_cell_rules(S->space);
+    for (fcm_index c = 0; c < nc; c++) /* another process's cell: its value (no rules: root's) */
+      if (!fcm__cell_rules_owns(R, c) || (!R && !root)) q[nv + c] = 0.0;
+  }
+  FCM_TRY(ctx, fcm__integrator_reduce_status(S->integ, st, q, (fcm_index)nv + nc));
+  for (int k = 0; k < K; k++) {
+    gs.points_initial[k] = (fcm_index)q[6 * k + 0];
+    gs.points_simplified[k] = (fcm_index)q[6 * k + 1];
+    gs.points_stabilization[k] = (fcm_index)q[6 * k + 2];
+    gs.points_total[k] = (fcm_index)q[6 * k + 3];
+    gs.simplify_skipped[k] = (fcm_index)q[6 * k + 4];
+    gs.simplify_fallbacks[k] = (fcm_index)q[6 * k + 5];
+  }
+  gs.surface_triangles = (fcm_index)q[6 * K + 0];
+  gs.surface_points = (fcm_index)q[6 * K + 1];
+  gs.num_tets = (fcm_index)q[6 * K + 2];
+  gs.num_slivers = (fcm_index)q[6 * K + 3];
+  gc.boundary_points = (fcm_index)q[6 * K + 4];
+  for (fcm_index c = 0; c < nc; c++)
+    if (!(q[nv + c] <= body)) body = q[nv + c]; /* NaN propagates */
+  if (f) summary_view(S, f, S->rules ? &gs : NULL, &gc, body);
+cleanup:
+  fcm__free(ctx, q);
+  return st;
 }

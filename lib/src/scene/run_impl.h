@@ -100,4 +100,9 @@ fcm_status fcm__simulation_create_distributed(fcm_ctx *ctx, const fcm_scene *sce
                                               fcm__simulation_attach_fn attach, void *attach_user,
                                               fcm_simulation **out);
 
+/* A distributed run's fcm_simulation_summary_view() (collective; f may be NULL on all but one
+ * process): the rules' point counts and the body's largest |u| summed / maximized over the
+ * processes' own cells first (each process's rules carry its own cells' points only). */
+fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f);
+
 #endif /* FCM_SCENE_RUN_IMPL_H */
