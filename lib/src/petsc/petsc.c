@@ -60,7 +60,8 @@
  *   is a soft failure (the integrator halves the step). Direction gathered with a cached
  *   VecScatterCreateToAll.
  * - fcm-sim --backend petsc routes scenes fcm_petsc_problem_supports_scene() rejects to it
- *   (apps/fcm-sim-petsc.c run_newton(); process 0 writes the serial frames and log).
+ *   (apps/fcm-sim-petsc.c run_newton(); process 0 writes the serial frames, log and
+ *   checkpoints).
  * Not done:
  * - bit-identical resume: PT-Scotch's partition of the same scene on 2 processes differs
  *   between runs now and then (131/133 or 132/132 own elements of slingshot, although
@@ -76,10 +77,14 @@
  *   owned rows (VecScatter of ghosts), keep the line search's scalars as Allreduce.
  * - cuts (the cut rules extend whole rules: refused), quadrature.simplify = auto (its decision
  *   sums every cut cell's point counts: would need a reduce inside the rules build),
- *   checkpoints on the phase-2 path (fcm-sim refuses --checkpoint-every / --resume there; the
- *   replicated state makes process 0's fcm_simulation_write_checkpoint() the natural start),
- *   cell fields (stresses) of other processes' cut cells in process 0's frames, the summary's
- *   point counts and max |u| (process 0's cells only).
+ *   (done since: checkpoints on the phase-2 path — fcm-sim run_newton(): process 0 writes the
+ *   serial .fcmck, every process reads it; frames with every process's cell fields —
+ *   fcm_simulation_write_frame() collective in a distributed run; the summary over every
+ *   process's cells — fcm_petsc_simulation_summary_view(). Bit-identical resume on the same
+ *   count needed a zero initial guess in newton_solve() and PCGAMGSetReuseInterpolation(FALSE)
+ *   in newton_attach(): 3.18's GAMG reused the previous tangent's interpolation, so a resumed
+ *   run (fresh KSP) differed at ~1e-16 on 1 and 2 processes. Tests: petsc_app_newton_resume,
+ *   petsc_app_scene_*, petsc_app_summary_*.)
  * - the linear driver (phase 1) could now be replaced by the phase-2 path for the scenes both
  *   run (they agree to the KSP tolerance); it is kept: it assembles straight into PETSc and
  *   scales further (no dense sums), and its tests and checkpoints stay.
