@@ -130,3 +130,14 @@ fcm_add_mpi_test(petsc_newton_slingshot_np2 tests/petsc/newton.c NP 2
 foreach(np 1 2)
   fcm_add_mpi_test(petsc_newton_failure_np${np} tests/petsc/newton_failure.c NP ${np} TIMEOUT 120)
 endforeach()
+# each problem reads its PETSc options under its own prefix (tests/petsc/options.c): strings
+# of earlier problems do not leak into later ones; the command line wins (unprefixed: every
+# problem; -fcm2_...: the second problem alone)
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_options_np${np} tests/petsc/options.c NP ${np}
+                   ARGS minres cg gmres jacobi gamg gamg)
+  fcm_add_mpi_test(petsc_options_cmdline_np${np} tests/petsc/options.c NP ${np}
+                   ARGS bcgs bcgs bcgs jacobi gamg gamg -ksp_type bcgs)
+  fcm_add_mpi_test(petsc_options_prefixed_np${np} tests/petsc/options.c NP ${np}
+                   ARGS minres cg gmres jacobi jacobi gamg -fcm2_pc_type jacobi)
+endforeach()
