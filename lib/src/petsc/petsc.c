@@ -63,8 +63,10 @@
  *   (apps/fcm-sim-petsc.c run_newton(); process 0 writes the serial frames and log).
  * Done (issue 14 follow-up): options prefix per problem ("fcm<k>_", k counting the problems
  *   this process made; fcm_petsc_info.options_prefix): insert_options() puts the problem's
- *   string and then the command line under it (PetscOptionsPrefixPush), then the command line
- *   again unprefixed; the KSP carries the prefix (both drivers). The prefixed entries stay in
+ *   string and then a copy of the database's other options (PetscOptionsGetAll: command line,
+ *   files, values the program set; not those of other problems' prefixes) under it
+ *   (PetscOptionsPrefixPush), then restores the options that name this prefix; the KSP
+ *   carries the prefix (both drivers). The prefixed entries stay in
  *   the database after the problem (harmless: no later problem has that prefix; PETSc's
  *   -options_left would list the unused ones). tests/petsc/options.c.
  * Not done:
@@ -1026,29 +1028,63 @@ cleanup:
   return st;
 }
 
-/* The options database, scoped to this problem: its string, then the command line again (PETSc
- * re-reads its sources: option files, PETSC_OPTIONS, the arguments), both under the problem's
- * prefix P->prefix, which the KSP (and through it the PC and its inner solvers) carries; so a
- * key both give takes the command line's value, and another problem's string never reaches
- * this one's solver. Last the command line once more as it is (no prefix), so that an option
- * naming this problem's prefix on it ("-fcm2_ksp_type") wins over the string too. */
+/* 1 when the option name carries a problem's prefix ("-fcm12_ksp_type"). */
+static int has_problem_prefix(const char *name)
+{
+  if (strncmp(name, "-fcm", 4) != 0 || !(name[4] >= '0' && name[4] <= '9')) return 0;
+  const char *q = name + 4;
+  while (*q >= '0' && *q <= '9')
+    q++;
+  return *q == '_';
+}
+
+/* The options database, scoped to this problem (the KSP carries the prefix P->prefix, and
+ * through it the PC and its inner solvers): the problem's string under the prefix, then every
+ * option the database held before (the command line, option files, PETSC_OPTIONS, values set
+ * by the program) copied under the prefix, so a key both give takes the database's value; last
+ * the options that name this problem's prefix themselves ("-fcm2_ksp_type") as they were, so
+ * they win over both. Options of other problems' prefixes are not copied: one problem's string
+ * never reaches another problem's solver. (Values are split at spaces, as PETSc lists them.) */
 static fcm_status insert_options(fcm_petsc_problem *P)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P->ctx;
-  int argc = 0, pushed = 0;
-  char **argv = NULL;
+  char *all = NULL, **name = NULL, **value = NULL;
+  int pushed = 0;
+  size_t count = 0;
+  PCALL(ctx, PetscOptionsGetAll(NULL, &all));
+  {
+    const size_t len = strlen(all);
+    name = fcm__calloc(ctx, len / 2 + 1, sizeof *name);
+    value = fcm__calloc(ctx, len / 2 + 1, sizeof *value);
+    FCM_CHECK(name && value, ctx, FCM_ERR_ALLOC, "petsc: out of memory (options)");
+    char *save = NULL;
+    for (char *tok = strtok_r(all, " \t\n", &save); tok; tok = strtok_r(NULL, " \t\n", &save)) {
+      const int is_name = tok[0] == '-' && ((tok[1] >= 'a' && tok[1] <= 'z') ||
+                                            (tok[1] >= 'A' && tok[1] <= 'Z') || tok[1] == '_');
+      if (is_name)
+        name[count++] = tok;
+      else if (count > 0 && !value[count - 1])
+        value[count - 1] = tok;
+    }
+  }
   PCALL(ctx, PetscOptionsPrefixPush(NULL, P->prefix));
   pushed = 1;
   if (P->petsc_options && *P->petsc_options)
     PCALL(ctx, PetscOptionsInsertString(NULL, P->petsc_options));
-  PCALL(ctx, PetscGetArgs(&argc, &argv));
-  if (argc > 1) PCALL(ctx, PetscOptionsInsert(NULL, &argc, &argv, NULL));
+  for (size_t k = 0; k < count; k++)
+    if (!has_problem_prefix(name[k])) PCALL(ctx, PetscOptionsSetValue(NULL, name[k], value[k]));
   pushed = 0;
   PCALL(ctx, PetscOptionsPrefixPop(NULL));
-  if (argc > 1) PCALL(ctx, PetscOptionsInsert(NULL, &argc, &argv, NULL));
+  const size_t plen = strlen(P->prefix);
+  for (size_t k = 0; k < count; k++)
+    if (strncmp(name[k] + 1, P->prefix, plen) == 0)
+      PCALL(ctx, PetscOptionsSetValue(NULL, name[k], value[k]));
 cleanup:
   if (pushed) PetscOptionsPrefixPop(NULL);
+  fcm__free(ctx, name);
+  fcm__free(ctx, value);
+  PetscFree(all);
   return st;
 }
 
