@@ -22,6 +22,13 @@
  * fcm_mg_operator()) and mg (fcm_mg_solve()), with the library's multigrid defaults (W-cycle).
  * The bodies cube and cut run mg only, with V-cycles: their rows give the V-cycle convergence
  * factor (Dick et al. 2011, Fig. 10).
+ * --backend petsc (issue 14; a build with PETSc, under mpirun -n P): the same problems of the
+ * bodies ball and hollow also through the PETSc adapter (fcm/petsc.h, the linear static
+ * driver: partition, rules of the own cells, MATMPIAIJ assembly, KSP) on every process, solved
+ * by petsc-gamg (CG + GAMG with the rigid-body near-null space, stopping on the true residual)
+ * and petsc-mumps (MUMPS Cholesky); process 0 also runs the serial solvers (the others wait
+ * sleeping) and compares the PETSc solution with CHOLMOD's (else cg-mg's); it alone prints
+ * and writes.
  * Writes CSV (--csv FILE, atomically) and a plot (--png FILE, gnuplot), prints the fitted
  * exponents of time against DOFs and the claims of issue 13; exit 0 when every row ran or was
  * skipped (and, with --check, every claim holds), 1 when a computation failed or a solution
@@ -1226,8 +1233,22 @@ static void usage(FILE *f, const cli_option *opts)
       "5 to /proc/self/clear_refs and VmHWM read after it), then body,status (ok, skipped,\n"
       "failed),relative_residual (||b - A x||/||b||, computed here),diff_cholmod (||x -\n"
       "x_cholmod||/||x_cholmod||),setup_cpu_s,solve_cpu_s (process CPU, all threads),\n"
-      "base_rss_mb (resident before the row),levels (multigrid levels),note (why skipped or\n"
-      "failed).\n"
+      "base_rss_mb (resident before the row),levels (multigrid levels),processes (MPI\n"
+      "processes of the row: 1 for the serial solvers),note (why skipped or failed; for a\n"
+      "PETSc row that ran: its KSP + PC).\n"
+      "--backend petsc (mpirun -n P " PROG " --backend petsc): rows of\n"
+      "  petsc-gamg      CG + GAMG, rigid-body near-null space, on the true residual\n"
+      "  petsc-mumps     MUMPS sparse Cholesky (preonly)\n"
+      "on every process through the PETSc adapter (fcm/petsc.h), bodies ball and hollow;\n"
+      "default solvers cholmod,cg-mg,petsc-gamg,petsc-mumps (the serial ones on process 0 give\n"
+      "the reference: diff_cholmod is against CHOLMOD's solution, else cg-mg's). PETSc rows:\n"
+      "setup_s is the whole distributed problem (partition, rules, space, assembly,\n"
+      "elimination), solve_s the KSP solve with GAMG's set-up or MUMPS's factorization;\n"
+      "setup_cpu_s, solve_cpu_s, peak_rss_mb and base_rss_mb are summed over the processes\n"
+      "(process 0 also holds the serial problem: peak - base is the PETSc run's own);\n"
+      "relative_residual is computed with the serial matrix. PETSc options on the command\n"
+      "line (-ksp_type ...) apply to every PETSc row. --check then claims: every PETSc row\n"
+      "agrees with the serial solution within --agree and reports its iterations.\n"
       "Before each size a solver is skipped (and at every larger size) when its time (the\n"
       "smaller of wall and CPU seconds: less sensitive to load), scaled from the previous sizes,\n"
       "would exceed --budget, or its memory would exceed\n"
