@@ -70,17 +70,14 @@
  *   the database after the problem (harmless: no later problem has that prefix; PETSc's
  *   -options_left would list the unused ones). tests/petsc/options.c.
  * Not done:
- * - PT-Scotch's partition of the same scene on 2 processes differs between runs now and then
- *   (slingshot: 131/133 or 132/132 own elements, although scotch_random_reset() runs before
- *   it), so phase-2 results agree between runs only to round-off and KSP iteration counts
- *   vary. OPEN REGRESSION: the phase-1 test petsc_checkpoint_np2 (bit for bit) fails
- *   intermittently on this branch — 10 standalone runs of petsc_checkpoint on 2 processes:
- *   base 9a6a137 0 failed, branch before the merge of main (7adc39a) 1, after it (358576f) 4 —
- *   cause not found (suspects: the partition, or the masked-rules change in assemble.c /
- *   cell_rules.c touching the problem built twice in that test). SCOTCH_PTHREAD_NUMBER=1 (Scotch 7's threads) did
- *   not cure it reliably (1 failure in 6 ctest runs with it). FCM_PETSC_PARTITION_ORDERED is
- *   deterministic; next: find PT-Scotch's source of randomness or gather the graph on one
- *   process and partition it there.
+ * - bit-identical resume: PT-Scotch's partition of the same scene on 2 processes differs
+ *   between runs now and then (131/133 or 132/132 own elements of slingshot, although
+ *   scotch_random_reset() runs before it), hence the Morton default. The round-off differences
+ *   of petsc_checkpoint_np2 came from MUMPS, not from fcm: on 2 processes MUMPS adds the
+ *   contribution blocks of a front in the order their messages arrive, so two factorizations of
+ *   the same matrix differ at ~1e-16 (12 of 12 runs bitwise with CG + GAMG, CG + Jacobi and
+ *   -pc_type redundant; 10 of 12 differing with MUMPS Cholesky or LU, with or without
+ *   OMP/OpenBLAS threads). The test holds the default solver to bit for bit, MUMPS to 1e-12.
  * - scalability of phase 2: the sums are dense (n doubles per force, nnz doubles per tangent,
  *   per process); next: add each process's partial tangent into the MATMPIAIJ with ADD_VALUES
  *   (own elements only; the eliminated rows' diagonal by the owner), sum the force only on
