@@ -1254,7 +1254,7 @@ static void usage(FILE *f, const cli_option *opts)
       "would exceed --budget, or its memory would exceed\n"
       "--mem-fraction of MemAvailable; the problem itself likewise. Rows say what was skipped\n"
       "and why. Progress goes to stderr.\n"
-      "Default: hex8 and hex20, n = 8,16,32,64, all bodies and solvers. --quick: hex8, n =\n"
+      "Default: hex8 and hex20, n = 8,16,32,64, all bodies and serial solvers. --quick: hex8, n =\n"
       "8,16,32 (the same facts on fewer sizes; budget 120 s). Prints the fitted exponents of\n"
       "time (setup+solve and solve alone) against DOFs and the claims of issue 13; --check\n"
       "makes a failed claim exit 1.\n"
@@ -1372,8 +1372,9 @@ static int scaling_main(int argc, char **argv, int pargc, char **pargv)
       {"--bodies", NULL, CLI_STRING, &bodies, "B,...", "ball, hollow, cube, cut (default all)", 0,
        0, 0, NULL, NULL, NULL},
       {"--solvers", NULL, CLI_STRING, &solvers, "S,...",
-       "cholmod, cg-jacobi, minres-schwarz, cg-mg, mg (default all;\ncholmod first gives the "
-       "reference solution)",
+       "cholmod, cg-jacobi, minres-schwarz, cg-mg, mg (default all);\n--backend petsc also "
+       "petsc-gamg, petsc-mumps (default\ncholmod,cg-mg,petsc-gamg,petsc-mumps); cholmod first "
+       "gives\nthe reference solution",
        0, 0, 0, NULL, NULL, NULL},
       {"--rtol", NULL, CLI_DOUBLE, &o.rtol, "R", "relative residual of every solver (default 1e-8)",
        1e-14, 1e-2, 0, NULL, NULL, NULL},
