@@ -222,3 +222,14 @@ if(FCM_BUILD_APPS)
   set_tests_properties(petsc_app_newton_resume PROPERTIES LABELS mpi TIMEOUT 300 PROCESSORS 2
                        ENVIRONMENT "${FCM_MPI_TEST_ENV}")
 endif()
+# each problem reads its PETSc options under its own prefix (tests/petsc/options.c): strings
+# of earlier problems do not leak into later ones; the command line wins (unprefixed: every
+# problem; -fcm2_...: the second problem alone)
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_options_np${np} tests/petsc/options.c NP ${np}
+                   ARGS minres cg gmres jacobi gamg gamg)
+  fcm_add_mpi_test(petsc_options_cmdline_np${np} tests/petsc/options.c NP ${np}
+                   ARGS bcgs bcgs bcgs jacobi gamg gamg -ksp_type bcgs)
+  fcm_add_mpi_test(petsc_options_prefixed_np${np} tests/petsc/options.c NP ${np}
+                   ARGS minres cg gmres jacobi jacobi gamg -fcm2_pc_type jacobi)
+endforeach()
