@@ -130,3 +130,24 @@ fcm_add_mpi_test(petsc_newton_slingshot_np2 tests/petsc/newton.c NP 2
 foreach(np 1 2)
   fcm_add_mpi_test(petsc_newton_failure_np${np} tests/petsc/newton_failure.c NP ${np} TIMEOUT 120)
 endforeach()
+# phase 2 with cuts and quadrature.simplify = "auto" (tests/petsc/newton_cut.c): the example
+# scenes' cuts at t = 0 (dice: 10 planes into 36 sticks; cut_slab: 2 planes; cracked_beam: a
+# partial crack, static), a test scene cut between steps (after solves) plus a cut that misses,
+# and twisting_cylinder's "auto" (Hex20): against the serial run step by step, with the cut
+# bookkeeping and the simplification choice equal to the serial ones
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_newton_cut_dice_np${np} tests/petsc/newton_cut.c NP ${np}
+                   ARGS ${FCM_SCENES} dice.json 3)
+  fcm_add_mpi_test(petsc_newton_cut_slab_np${np} tests/petsc/newton_cut.c NP ${np}
+                   ARGS ${FCM_SCENES} cut_slab.json 3)
+  fcm_add_mpi_test(petsc_newton_cut_cracked_beam_np${np} tests/petsc/newton_cut.c NP ${np}
+                   ARGS ${FCM_SCENES} cracked_beam.json 1)
+  fcm_add_mpi_test(petsc_newton_cut_late_np${np} tests/petsc/newton_cut.c NP ${np}
+                   ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6)
+  fcm_add_mpi_test(petsc_newton_auto_twisting_cylinder_np${np} tests/petsc/newton_cut.c NP ${np}
+                   ARGS ${FCM_SCENES} twisting_cylinder.json 1 TIMEOUT 300)
+endforeach()
+# the late cut with CG + GAMG on the rebuilt KSP
+fcm_add_mpi_test(petsc_newton_cut_late_gamg_np2 tests/petsc/newton_cut.c NP 2
+                 ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6 1e-8
+                      -ksp_type cg -pc_type gamg)
