@@ -55,10 +55,11 @@ foreach(np 1 2)
                    ARGS ${PROJECT_SOURCE_DIR}/apps/scenes vibrating_beam.json 10)
 endforeach()
 if(FCM_BUILD_APPS)
-  # mpirun -n 2 fcm-sim SCENE --backend petsc: runs the example scenes (--check);
-  # a scene with an effect the backend lacks exits non-zero on every process with the message
-  # (the linear driver runs cantilever and vibrating_beam; the others go through the integrator)
-  foreach(scene cantilever vibrating_beam clamped_surface static_beam spinning_body voxel_block)
+  # mpirun -n 2 fcm-sim SCENE --backend petsc: runs the example scenes (--check: 3 steps);
+  # the linear driver runs cantilever and vibrating_beam; the others go through the integrator,
+  # the cut scenes (cracked_beam, cut_slab, dice) and twisting_cylinder (simplify "auto") too
+  foreach(scene cantilever vibrating_beam clamped_surface static_beam spinning_body voxel_block
+          cracked_beam cut_slab dice twisting_cylinder)
     add_test(NAME petsc_app_sim_${scene}
              COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
                      $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/${scene}.json
@@ -66,19 +67,21 @@ if(FCM_BUILD_APPS)
     set_tests_properties(petsc_app_sim_${scene} PROPERTIES LABELS mpi TIMEOUT 300 PROCESSORS 2
                          ENVIRONMENT "${FCM_MPI_TEST_ENV}")
   endforeach()
-  add_test(NAME petsc_app_sim_unsupported
+  # a scene that fails while the simulation is built (its cut's surface file holds no surface):
+  # every process exits non-zero, with the message
+  add_test(NAME petsc_app_sim_bad_cut
            COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
-                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/dice.json
+                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/bad_cut.json
                    --backend petsc --check)
-  set_tests_properties(petsc_app_sim_unsupported PROPERTIES LABELS mpi TIMEOUT 120 PROCESSORS 2
+  set_tests_properties(petsc_app_sim_bad_cut PROPERTIES LABELS mpi TIMEOUT 120 PROCESSORS 2
                        WILL_FAIL TRUE ENVIRONMENT "${FCM_MPI_TEST_ENV}")
-  add_test(NAME petsc_app_sim_unsupported_message
+  add_test(NAME petsc_app_sim_bad_cut_message
            COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
-                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/dice.json
+                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/bad_cut.json
                    --backend petsc --check)
-  set_tests_properties(petsc_app_sim_unsupported_message PROPERTIES LABELS mpi TIMEOUT 120
+  set_tests_properties(petsc_app_sim_bad_cut_message PROPERTIES LABELS mpi TIMEOUT 120
                        PROCESSORS 2 ENVIRONMENT "${FCM_MPI_TEST_ENV}"
-                       PASS_REGULAR_EXPRESSION "effects\\[2\\]: cut is not supported by the PETSc backend")
+                       PASS_REGULAR_EXPRESSION "effects\\[2\\]\\.cut\\.surface\\.mesh: surface: .*empty mesh")
 endif()
 # memory and time per DOF on 1 and 2 processes (labels bench, mpi: not in the default run)
 foreach(np 1 2)
@@ -126,7 +129,8 @@ fcm_add_mpi_test(petsc_newton_spinning_body_np2 tests/petsc/newton.c NP 2
 fcm_add_mpi_test(petsc_newton_slingshot_np2 tests/petsc/newton.c NP 2
                  ARGS ${FCM_SCENES} slingshot.json 2 1e-6 -ksp_max_it 5000)
 # the integrator on PETSc: a failure on one process, in the setup's sums, in the KSP (after the
-# step's halvings) and a refused cut end every process with the message, no hang
+# step's halvings) and in a cut between steps on one process end every process with the
+# message, no hang
 foreach(np 1 2)
   fcm_add_mpi_test(petsc_newton_failure_np${np} tests/petsc/newton_failure.c NP ${np} TIMEOUT 120)
 endforeach()
