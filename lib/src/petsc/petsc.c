@@ -61,6 +61,31 @@
  *   VecScatterCreateToAll.
  * - fcm-sim --backend petsc routes scenes fcm_petsc_problem_supports_scene() rejects to it
  *   (apps/fcm-sim-petsc.c run_newton(); process 0 writes the serial frames and log).
+ * - cuts (issue 14, i14-cut): fcm_cell_rules_create_cut() of masked rules keeps the mask (the
+ *   same cells get points); every cell, masked or not, is classified, split into pieces and
+ *   gets its cut faces (cell_rules.c computes the cut faces before the mask check: the space's
+ *   DOF copies depend on them, a cut along cell faces separates cells without splitting any).
+ *   fcm_integrator_create_cut() asks the old integrator's backend for a new one
+ *   (fcm__sim_backend.cut = newton_cut(): agree, newton_unbuild(), newton_build() for the new
+ *   space — numbering, ownership, MATMPIAIJ, vectors, KSP, the scatter made at the first
+ *   solve — and one more reference to the same P), before the new integrator's setup (its
+ *   mass and load sums). newton_build() checks the replicated topology (DOF and element
+ *   counts, a hash of the elements' cells, pieces and DOFs: min = max over the processes,
+ *   else FCM_ERR_INTERNAL on every process). The old integrator keeps its reference until
+ *   fcm__sim_apply_cut() destroys it; its factor / solve would refuse the rebuilt objects
+ *   (size check, P->factored). fcm__sim_apply_cut() ends with fcm__integrator_finish()
+ *   (newton_finish(): agree unless a failure was agreed already), so a process that fails in
+ *   the local part of a cut meets the others in the hook's agree (tests/petsc/newton_failure.c
+ *   case 4). The "cut missed" counters, pieces, DOFs and the rules' classification equal the
+ *   serial run's (tests/petsc/newton_cut.c).
+ * - quadrature.simplify = "auto": the choice's inputs (per kind: cut-cell points, the modelled
+ *   simplification time, points kept; from this process's own cut cells with a mask) are summed
+ *   over the processes inside the rules build (fcm__cell_rules_create_reduced(), embed_impl.h:
+ *   a reduce callback, here newton_reduce() passed through fcm__simulation_create_distributed()
+ *   before the integrator exists; called exactly once per process, also on a failure before
+ *   the choice), so every process takes the serial run's choice. The modelled time is summed
+ *   in another order than the serial run's (round-off only: a choice exactly at the threshold
+ *   could differ). A cut inherits the choice of the rules it extends (no sum needed).
  * Not done:
  * - PT-Scotch's partition of the same scene on 2 processes differs between runs now and then
  *   (slingshot: 131/133 or 132/132 own elements, although scotch_random_reset() runs before
@@ -77,12 +102,14 @@
  *   per process); next: add each process's partial tangent into the MATMPIAIJ with ADD_VALUES
  *   (own elements only; the eliminated rows' diagonal by the owner), sum the force only on
  *   owned rows (VecScatter of ghosts), keep the line search's scalars as Allreduce.
- * - cuts (the cut rules extend whole rules: refused), quadrature.simplify = auto (its decision
- *   sums every cut cell's point counts: would need a reduce inside the rules build),
- *   checkpoints on the phase-2 path (fcm-sim refuses --checkpoint-every / --resume there; the
+ * - checkpoints on the phase-2 path (fcm-sim refuses --checkpoint-every / --resume there; the
  *   replicated state makes process 0's fcm_simulation_write_checkpoint() the natural start),
  *   cell fields (stresses) of other processes' cut cells in process 0's frames, the summary's
  *   point counts and max |u| (process 0's cells only).
+ * - cuts keep the partition made at the start (the pieces of a split cell belong to its
+ *   owner; cut-heavy regions are not rebalanced) and the cut's classification of every cell
+ *   runs on every process (replicated, as the first build's); the cut-cell weight 4 of the
+ *   partition is not updated for cells a later cut reaches.
  * - the linear driver (phase 1) could now be replaced by the phase-2 path for the scenes both
  *   run (they agree to the KSP tolerance); it is kept: it assembles straight into PETSc and
  *   scales further (no dense sums), and its tests and checkpoints stay.
