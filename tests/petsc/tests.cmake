@@ -155,3 +155,14 @@ endforeach()
 fcm_add_mpi_test(petsc_newton_cut_late_gamg_np2 tests/petsc/newton_cut.c NP 2
                  ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6 1e-8
                       -ksp_type cg -pc_type gamg)
+# each problem reads its PETSc options under its own prefix (tests/petsc/options.c): strings
+# of earlier problems do not leak into later ones; the command line wins (unprefixed: every
+# problem; -fcm2_...: the second problem alone)
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_options_np${np} tests/petsc/options.c NP ${np}
+                   ARGS minres cg gmres jacobi gamg gamg)
+  fcm_add_mpi_test(petsc_options_cmdline_np${np} tests/petsc/options.c NP ${np}
+                   ARGS bcgs bcgs bcgs jacobi gamg gamg -ksp_type bcgs)
+  fcm_add_mpi_test(petsc_options_prefixed_np${np} tests/petsc/options.c NP ${np}
+                   ARGS minres cg gmres jacobi jacobi gamg -fcm2_pc_type jacobi)
+endforeach()

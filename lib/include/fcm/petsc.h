@@ -13,7 +13,10 @@
  * - each linear solve is a PETSc KSP configured from the options database: defaults CG with
  *   GAMG and the rigid-body near-null space, overridden by the options string of the options
  *   (a scene's solver.petsc_options) and then by the command line (-ksp_type, -pc_type, ...:
- *   the command line wins, the ecosystem's convention).
+ *   the command line wins, the ecosystem's convention). Each problem reads them under its own
+ *   options prefix (fcm_petsc_info.options_prefix), so one problem's string never reaches
+ *   another problem's solver; the command line reaches every problem ("-fcm2_ksp_type ..."
+ *   the second one alone).
  *
  * Phase 1 (stated plainly): the mesh, the geometry and the space's topology (DOF numbering
  * and pattern, O(DOFs + nonzeros) integers) are replicated on every process; the heavy part
@@ -74,9 +77,9 @@ typedef struct fcm_petsc_options {
   double dt;                     /**< time step h > 0 (default 1/60) */
   fcm_petsc_partition partition; /**< default AUTO */
   const char *petsc_options;     /**< NULL (default) or PETSc options ("-ksp_type minres
-                                      -pc_type jacobi"), added to the options database at setup
-                                      under the command line (which wins for a key both set);
-                                      copied */
+                                      -pc_type jacobi"), read at setup by this problem's
+                                      solver only (under its options prefix) and under the
+                                      command line (which wins for a key both set); copied */
   double rtol;                   /**< KSP relative tolerance in (0, 1) (default 1e-10; the
                                       option -ksp_rtol overrides it) */
   int max_iterations;            /**< KSP iteration limit >= 1 (default 10000) */
@@ -219,6 +222,14 @@ typedef struct fcm_petsc_info {
   double matrix_memory;          /**< bytes of the system matrix's stored nonzeros over all
                                       processes (values and column indices, MatGetInfo) */
   long long steps, total_iterations;
+  char options_prefix[32];       /**< this problem's PETSc options prefix ("fcm1_", "fcm2_",
+                                      ...: one per problem, numbered in the order this process
+                                      made them); "-fcm2_ksp_type gmres" on the command line
+                                      reaches that problem's solver only */
+  char ksp_type[32];             /**< the KSP's type ("cg", "minres", ...; "" before setup) */
+  char pc_type[32];              /**< its PC's type ("gamg", "cholesky", ...; "" before setup) */
+  char factor_package[32];       /**< the package of an LU / Cholesky PC ("mumps", "petsc",
+                                      ...), else "" */
 } fcm_petsc_info;
 
 /** Fill `info` (collective: the sums and extremes are reduced). */
