@@ -2,8 +2,8 @@
  * mesh and the geometry. A scene the linear driver runs (fcm_petsc_problem_supports_scene():
  * linear material, gravity, fixed and motion on node regions) goes through it
  * (fcm_petsc_problem_create_from_scene() distributes the cells, the cut-cell rules, the
- * assembly and the solves); every other scene except cuts goes through the integrator on
- * PETSc (run_newton(), fcm_petsc_simulation_create()). Process 0 prints and writes the log
+ * assembly and the solves); every other scene (cuts and simplify auto included) goes through
+ * the integrator on PETSc (run_newton(), fcm_petsc_simulation_create()). Process 0 prints and writes the log
  * <name>_log.csv; on the linear driver each frame is a parallel VTU (<name>_NNNN.pvtu by
  * process 0 naming one piece <name>_NNNN_<rank>.vtu per process: its own cells), indexed by
  * <name>.pvd, and checkpoints are <name>_checkpoint_NNNNNN.fcmpk; on the integrator the
@@ -160,10 +160,9 @@ static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
   fcm_simulation_options so = fcm_simulation_options_default();
   so.max_steps = check ? (steps > 0 && steps < 3 ? steps : 3) : (steps > 0 ? steps : FCM_DEFAULT);
   so.checkpoint_interval = check ? 0 : checkpoint_every; /* -1: the scene's */
-  if (talk)
-    fprintf(stderr, "fcm-sim: scene %s: through the integrator (Newton) on PETSc\n", name);
-  fcm_status st = fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene,
-                                              FCM_PETSC_PARTITION_AUTO, &so, &sim);
+  if (talk) fprintf(stderr, "fcm-sim: scene %s: through the integrator (Newton) on PETSc\n", name);
+  fcm_status st =
+      fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO, &so, &sim);
   if (st != FCM_OK) { /* every process has the error; process 0 prints it */
     if (rank == 0) fprintf(stderr, "fcm-sim: scene %s: %s\n", name, fcm_ctx_error_message(ctx));
     return st == FCM_ERR_ARG || st == FCM_ERR_IO || st == FCM_ERR_FORMAT ||
@@ -178,8 +177,7 @@ static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
     }
     if (talk)
       fprintf(stderr, "fcm-sim: resumed from %s at step %lld (t = %.9g s)\n", resume,
-              fcm_simulation_step_count(sim),
-              fcm_integrator_time(fcm_simulation_integrator(sim)));
+              fcm_simulation_step_count(sim), fcm_integrator_time(fcm_simulation_integrator(sim)));
   }
   const char *dir = outdir ? outdir : fcm_scene_get_output(scene)->directory;
   const int write = !check;

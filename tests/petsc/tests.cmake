@@ -55,30 +55,22 @@ foreach(np 1 2)
                    ARGS ${PROJECT_SOURCE_DIR}/apps/scenes vibrating_beam.json 10)
 endforeach()
 if(FCM_BUILD_APPS)
-  # mpirun -n 2 fcm-sim SCENE --backend petsc: runs the example scenes (--check);
-  # a scene with an effect the backend lacks exits non-zero on every process with the message
-  # (the linear driver runs cantilever and vibrating_beam; the others go through the integrator)
-  foreach(scene cantilever vibrating_beam clamped_surface static_beam spinning_body voxel_block)
-    add_test(NAME petsc_app_sim_${scene}
-             COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
-                     $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/${scene}.json
-                     --backend petsc --check -ksp_rtol 1e-10)
-    set_tests_properties(petsc_app_sim_${scene} PROPERTIES LABELS mpi TIMEOUT 300 PROCESSORS 2
-                         ENVIRONMENT "${FCM_MPI_TEST_ENV}")
-  endforeach()
-  add_test(NAME petsc_app_sim_unsupported
+  # every example scene on 2 processes against the serial fcm-sim: petsc_app_scene_* below
+  # a scene that fails while the simulation is built (its cut's surface file holds no surface):
+  # every process exits non-zero, with the message
+  add_test(NAME petsc_app_sim_bad_cut
            COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
-                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/dice.json
+                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/bad_cut.json
                    --backend petsc --check)
-  set_tests_properties(petsc_app_sim_unsupported PROPERTIES LABELS mpi TIMEOUT 120 PROCESSORS 2
+  set_tests_properties(petsc_app_sim_bad_cut PROPERTIES LABELS mpi TIMEOUT 120 PROCESSORS 2
                        WILL_FAIL TRUE ENVIRONMENT "${FCM_MPI_TEST_ENV}")
-  add_test(NAME petsc_app_sim_unsupported_message
+  add_test(NAME petsc_app_sim_bad_cut_message
            COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
-                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/dice.json
+                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/bad_cut.json
                    --backend petsc --check)
-  set_tests_properties(petsc_app_sim_unsupported_message PROPERTIES LABELS mpi TIMEOUT 120
+  set_tests_properties(petsc_app_sim_bad_cut_message PROPERTIES LABELS mpi TIMEOUT 120
                        PROCESSORS 2 ENVIRONMENT "${FCM_MPI_TEST_ENV}"
-                       PASS_REGULAR_EXPRESSION "effects\\[2\\]: cut is not supported by the PETSc backend")
+                       PASS_REGULAR_EXPRESSION "effects\\[2\\]\\.cut\\.surface\\.mesh: surface: .*empty mesh")
 endif()
 # memory and time per DOF on 1 and 2 processes (labels bench, mpi: not in the default run)
 foreach(np 1 2)
@@ -126,7 +118,8 @@ fcm_add_mpi_test(petsc_newton_spinning_body_np2 tests/petsc/newton.c NP 2
 fcm_add_mpi_test(petsc_newton_slingshot_np2 tests/petsc/newton.c NP 2
                  ARGS ${FCM_SCENES} slingshot.json 2 1e-6 -ksp_max_it 5000)
 # the integrator on PETSc: a failure on one process, in the setup's sums, in the KSP (after the
-# step's halvings) and a refused cut end every process with the message, no hang
+# step's halvings) and in a cut between steps on one process end every process with the
+# message, no hang
 foreach(np 1 2)
   fcm_add_mpi_test(petsc_newton_failure_np${np} tests/petsc/newton_failure.c NP ${np} TIMEOUT 120)
 endforeach()
@@ -156,13 +149,13 @@ if(FCM_BUILD_APPS)
       static_beam           2 1e-8
       surface_drop          2 1e-8
       vibrating_beam        2 1e-8
-      voxel_block           2 1e-8)
-  # name               the message (grep -E) of the refusal; branch i14-cut makes these run
-  set(FCM_PETSC_SCENES_REFUSED
-      cracked_beam      "effects\\[[0-9]+\\]: cut is not supported by the PETSc backend"
-      cut_slab          "effects\\[[0-9]+\\]: cut is not supported by the PETSc backend"
-      dice              "effects\\[[0-9]+\\]: cut is not supported by the PETSc backend"
-      twisting_cylinder "quadrature.simplify = .auto. is not supported by the PETSc backend")
+      voxel_block           2 1e-8
+      cracked_beam          1 1e-8
+      cut_slab              2 1e-8
+      dice                  2 1e-8
+      twisting_cylinder     1 1e-8)
+  # name               the message (grep -E) of the refusal (none: every example scene runs)
+  set(FCM_PETSC_SCENES_REFUSED)
   set(listed "")
   set(run ${FCM_PETSC_SCENES_RUN})
   while(run)
@@ -222,6 +215,28 @@ if(FCM_BUILD_APPS)
   set_tests_properties(petsc_app_newton_resume PROPERTIES LABELS mpi TIMEOUT 300 PROCESSORS 2
                        ENVIRONMENT "${FCM_MPI_TEST_ENV}")
 endif()
+# phase 2 with cuts and quadrature.simplify = "auto" (tests/petsc/newton_cut.c): the example
+# scenes' cuts at t = 0 (dice: 10 planes into 36 sticks; cut_slab: 2 planes; cracked_beam: a
+# partial crack, static), a test scene cut between steps (after solves) plus a cut that misses,
+# and twisting_cylinder's "auto" (Hex20): against the serial run step by step, with the cut
+# bookkeeping and the simplification choice equal to the serial ones
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_newton_cut_dice_np${np} tests/petsc/newton_cut.c NP ${np}
+                   ARGS ${FCM_SCENES} dice.json 3)
+  fcm_add_mpi_test(petsc_newton_cut_slab_np${np} tests/petsc/newton_cut.c NP ${np}
+                   ARGS ${FCM_SCENES} cut_slab.json 3)
+  fcm_add_mpi_test(petsc_newton_cut_cracked_beam_np${np} tests/petsc/newton_cut.c NP ${np}
+                   ARGS ${FCM_SCENES} cracked_beam.json 1)
+  fcm_add_mpi_test(petsc_newton_cut_late_np${np} tests/petsc/newton_cut.c NP ${np}
+                   ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6)
+endforeach()
+# (2 processes: the choice's inputs are summed; on 1 the serial rules build decides)
+fcm_add_mpi_test(petsc_newton_auto_twisting_cylinder_np2 tests/petsc/newton_cut.c NP 2
+                 ARGS ${FCM_SCENES} twisting_cylinder.json 1 TIMEOUT 300)
+# the late cut with CG + GAMG on the rebuilt KSP
+fcm_add_mpi_test(petsc_newton_cut_late_gamg_np2 tests/petsc/newton_cut.c NP 2
+                 ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6 1e-8
+                      -ksp_type cg -pc_type gamg)
 # each problem reads its PETSc options under its own prefix (tests/petsc/options.c): strings
 # of earlier problems do not leak into later ones; the command line wins (unprefixed: every
 # problem; -fcm2_...: the second problem alone)

@@ -241,7 +241,7 @@ FCM_API fcm_status fcm_petsc_problem_get_info(fcm_petsc_problem *problem, fcm_pe
 FCM_API int fcm_petsc_problem_supports_scene(fcm_ctx *ctx, const fcm_scene *scene);
 
 /** A scene's ordinary simulation (fcm/simulation.h) on the processes of comm, for every
- * material and effect the serial runner has except cuts (phase 2: Newton on PETSc). Every
+ * material and effect the serial runner has, cuts included (phase 2: Newton on PETSc). Every
  * process runs the scene's fcm_integrator — Newton, line search, time stepping, constraints
  * on nodes and on the embedded boundary (Nitsche / penalty), gravity, tractions, pressure,
  * damping, initial velocities — on the same DOF numbering, but the cut-cell rules carry points
@@ -265,8 +265,11 @@ FCM_API int fcm_petsc_problem_supports_scene(fcm_ctx *ctx, const fcm_scene *scen
  * MINRES with GAMG, Jacobi, ...: the initial guess is always zero and GAMG builds a new
  * hierarchy per tangent); MUMPS on more than one process is not bitwise reproducible between
  * runs (its parallel factorization), on one process it is.
- * Not supported (FCM_ERR_UNSUPPORTED naming it, on every process): "cut" effects,
- * quadrature.simplify = auto. Stated plainly: the sums are of replicated dense vectors and of
+ * Cuts: every process splits every cell the cut reaches (the same pieces and DOF copies
+ * everywhere, checked: FCM_ERR_INTERNAL on every process if the topologies differ), builds its
+ * own cells' points, and the new integrator gets the backend again, rebuilt for the new DOF
+ * count. quadrature.simplify = auto: the choice's inputs are summed over the processes, so it
+ * is the serial run's. Stated plainly: the sums are of replicated dense vectors and of
  * the Newton matrix's values (O(DOFs + nonzeros) per process and assembly), the direction is
  * gathered on every process; the rules, the element integration and the solve are what is
  * distributed. Collective.

@@ -535,7 +535,13 @@ static fcm_status build_rules(fcm_simulation *S)
   ro.progress_user = S->opts.rules_progress_user;
   ro.progress_interval = S->opts.rules_progress_interval;
   ro.cell_mask = S->cell_mask;
-  FCM_TRY(S->ctx, fcm_cell_rules_create(S->ctx, S->mesh, S->geom, &ro, &S->rules));
+  if (S->reduce) { /* distributed: the auto choice's inputs summed over the processes */
+    fcm__rules_reduce red = {S->reduce, S->reduce_user, 0};
+    FCM_TRY(S->ctx,
+            fcm__cell_rules_create_reduced(S->ctx, S->mesh, S->geom, &ro, &red, &S->rules));
+  } else {
+    FCM_TRY(S->ctx, fcm_cell_rules_create(S->ctx, S->mesh, S->geom, &ro, &S->rules));
+  }
   S->c.cell_rules = 1;
   S->c.surface_rules = ro.surface_strength >= 0;
   S->c.rule_kinds = fcm_cell_rules_get_stats(S->rules)->kinds;
@@ -665,6 +671,10 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   fcm_cell_rules *rules = NULL;
   fcm_space *space = NULL;
   fcm_integrator *integ = NULL;
+  /* A distributed run (the integrator has a backend, sim_backend.h): the rules keep the
+   * process's cell mask, the new integrator gets the backend again (its cut hook, which
+   * agrees first), and fcm__integrator_finish() at the end agrees on the outcome, so a
+   * process that fails in the local work meets the others wherever they wait. */
   FCM_TRY(ctx, cut_surface(S, &e->cut, &surf));
   S->cuts_applied++;
   S->c.cuts++;
@@ -696,6 +706,7 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   S->c.pieces = S->pieces;
   if (S->surf) FCM_TRY(ctx, fcm_embedded_surface_set_space(S->surf, S->space));
 cleanup:
+  st = fcm__integrator_finish(S->integ, st);
   fcm_integrator_destroy(&integ);
   fcm_space_destroy(&space);
   fcm_cell_rules_destroy(&rules);
@@ -801,27 +812,30 @@ cleanup:
 static fcm_status simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
                                     const fcm_simulation_options *opts,
                                     const unsigned char *cell_mask,
+                                    fcm__simulation_reduce_fn reduce,
                                     fcm__simulation_attach_fn attach, void *attach_user,
                                     fcm_simulation **out);
 
 fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
                                  const fcm_simulation_options *opts, fcm_simulation **out)
 {
-  return simulation_create(ctx, scene, opts, NULL, NULL, NULL, out);
+  return simulation_create(ctx, scene, opts, NULL, NULL, NULL, NULL, out);
 }
 
 fcm_status fcm__simulation_create_distributed(fcm_ctx *ctx, const fcm_scene *scene,
                                               const fcm_simulation_options *opts,
                                               const unsigned char *cell_mask,
+                                              fcm__simulation_reduce_fn reduce,
                                               fcm__simulation_attach_fn attach, void *attach_user,
                                               fcm_simulation **out)
 {
-  return simulation_create(ctx, scene, opts, cell_mask, attach, attach_user, out);
+  return simulation_create(ctx, scene, opts, cell_mask, reduce, attach, attach_user, out);
 }
 
 static fcm_status simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
                                     const fcm_simulation_options *opts,
                                     const unsigned char *cell_mask,
+                                    fcm__simulation_reduce_fn reduce,
                                     fcm__simulation_attach_fn attach, void *attach_user,
                                     fcm_simulation **out)
 {
@@ -833,6 +847,8 @@ static fcm_status simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   FCM_ALLOC(ctx, 1, S);
   S->ctx = ctx;
   S->cell_mask = cell_mask;
+  S->reduce = reduce;
+  S->reduce_user = attach_user;
   S->scene = scene;
   S->opts = opts ? *opts : fcm_simulation_options_default();
   FCM_CHECK(S->opts.max_steps >= 1 || S->opts.max_steps == FCM_DEFAULT, ctx, FCM_ERR_ARG,
@@ -918,6 +934,8 @@ static fcm_status simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   if (S->geom && fcm_scene_get_output(scene)->write_surface) FCM_TRY(ctx, build_surface(S));
   S->c.time_setup = fcm_wtime() - t0;
   S->cell_mask = NULL; /* borrowed for the create only */
+  S->reduce = NULL;
+  S->reduce_user = NULL;
   *out = S;
   S = NULL;
 cleanup:

@@ -10,6 +10,12 @@
 #include "fcm/mesh.h"
 #include "fcm/simulation.h"
 
+/* A sum over the backend's processes before the integrator exists (the cell rules' choice of
+ * quadrature.simplify = "auto"): agree on st, then sum values[0 .. count) in place, the same
+ * bits on every process (as fcm__sim_backend.reduce). Collective. */
+typedef fcm_status (*fcm__simulation_reduce_fn)(void *user, fcm_status st, double *values,
+                                                fcm_index count);
+
 /* One row of the per-step log: the step, and the body after it (separate bodies, mass and
  * linear momentum over the body's own quadrature points, fcm_space_momentum()). */
 typedef struct fcm__log_row {
@@ -67,6 +73,8 @@ struct fcm_simulation {
   /* distributed runs (fcm__simulation_create_distributed()): points on these cells only
    * (borrowed during the create; NULL afterwards and in serial runs) */
   const unsigned char *cell_mask;
+  fcm__simulation_reduce_fn reduce; /* with reduce_user: during the create only (NULL after) */
+  void *reduce_user;
   /* what the voxel or level-set geometry reported ("" for the other kinds) */
   char geometry_note[256];
 };
@@ -91,12 +99,15 @@ typedef fcm_status (*fcm__simulation_attach_fn)(void *user, fcm_integrator *inte
 
 /* fcm_simulation_create() for a distributed backend (the PETSc adapter, fcm/petsc.h): the cell
  * rules carry points on the cells flagged in cell_mask only (every cell is still classified,
- * so the space and its DOF numbering are those of the serial run), and `attach` sets the
- * integrator's backend before its setup; the log's partial quantities (mass, momentum) are
- * summed through it. Collective over the backend's processes. (run.c) */
+ * so the space and its DOF numbering are those of the serial run), `reduce` (with
+ * attach_user) sums the inputs of the rules' simplify = "auto" choice over the processes, and
+ * `attach` sets the integrator's backend before its setup; the log's partial quantities (mass,
+ * momentum) are summed through it, and cuts hand it on to each new integrator
+ * (fcm__sim_backend.cut). Collective over the backend's processes. (run.c) */
 fcm_status fcm__simulation_create_distributed(fcm_ctx *ctx, const fcm_scene *scene,
                                               const fcm_simulation_options *opts,
                                               const unsigned char *cell_mask,
+                                              fcm__simulation_reduce_fn reduce,
                                               fcm__simulation_attach_fn attach, void *attach_user,
                                               fcm_simulation **out);
 
