@@ -22,6 +22,13 @@
  * fcm_mg_operator()) and mg (fcm_mg_solve()), with the library's multigrid defaults (W-cycle).
  * The bodies cube and cut run mg only, with V-cycles: their rows give the V-cycle convergence
  * factor (Dick et al. 2011, Fig. 10).
+ * --backend petsc (issue 14; a build with PETSc, under mpirun -n P): the same problems of the
+ * bodies ball and hollow also through the PETSc adapter (fcm/petsc.h, the linear static
+ * driver: partition, rules of the own cells, MATMPIAIJ assembly, KSP) on every process, solved
+ * by petsc-gamg (CG + GAMG with the rigid-body near-null space, stopping on the true residual)
+ * and petsc-mumps (MUMPS Cholesky); process 0 also runs the serial solvers (the others wait
+ * sleeping) and compares the PETSc solution with CHOLMOD's (else cg-mg's); it alone prints
+ * and writes.
  * Writes CSV (--csv FILE, atomically) and a plot (--png FILE, gnuplot), prints the fitted
  * exponents of time against DOFs and the claims of issue 13; exit 0 when every row ran or was
  * skipped (and, with --check, every claim holds), 1 when a computation failed or a solution
@@ -31,6 +38,9 @@
 #include "cli.h"
 
 #include <fcm/fcm.h>
+#if FCM_HAVE_PETSC
+#include <fcm/petsc.h>
+#endif
 
 #include <math.h>
 #include <omp.h>
@@ -44,9 +54,13 @@
 
 #define PROG "fcm-scaling"
 
-enum { S_CHOLMOD, S_CGJ, S_MINRES, S_CGMG, S_MG, NSOLVER };
-static const char *const solver_names[] = {"cholmod", "cg-jacobi", "minres-schwarz",
-                                           "cg-mg",   "mg",        NULL};
+/* S_PGAMG, S_PMUMPS: the PETSc backend (--backend petsc, fcm/petsc.h), on every MPI process */
+enum { S_CHOLMOD, S_CGJ, S_MINRES, S_CGMG, S_MG, S_PGAMG, S_PMUMPS, NSOLVER };
+static const char *const solver_names[] = {"cholmod", "cg-jacobi",  "minres-schwarz", "cg-mg",
+                                           "mg",      "petsc-gamg", "petsc-mumps",    NULL};
+#define IS_PETSC(s) ((s) == S_PGAMG || (s) == S_PMUMPS)
+enum { BACKEND_SERIAL, BACKEND_PETSC };
+static const char *const backend_names[] = {"serial", "petsc", NULL};
 enum { B_BALL, B_HOLLOW, B_CUBE, B_CUT, NBODY };
 static const char *const body_names[] = {"ball", "hollow", "cube", "cut", NULL};
 enum { CLOCK_WALL, CLOCK_CPU };
@@ -54,8 +68,8 @@ static const char *const clock_names[] = {"wall", "cpu", NULL};
 
 /* Exponents the estimates use before two sizes of a solver are measured: time ~ dofs^t,
  * extra memory ~ dofs^m (CHOLMOD: ~N^2 flops and ~N^(4/3) fill for 3D nested dissection). */
-static const double default_time_exp[NSOLVER] = {2.0, 1.4, 1.4, 1.15, 1.15};
-static const double default_mem_exp[NSOLVER] = {1.4, 1.0, 1.0, 1.0, 1.0};
+static const double default_time_exp[NSOLVER] = {2.0, 1.4, 1.4, 1.15, 1.15, 1.15, 2.0};
+static const double default_mem_exp[NSOLVER] = {1.4, 1.0, 1.0, 1.0, 1.0, 1.0, 1.4};
 
 enum { ROW_OK, ROW_SKIPPED, ROW_FAILED };
 static const char *const status_names[] = {"ok", "skipped", "failed"};
@@ -70,6 +84,7 @@ typedef struct row {
   double setup_cpu, solve_cpu; /* process CPU seconds (all threads) */
   double peak_mb, base_mb;     /* VmHWM over setup + solve; VmRSS before it; < 0 unknown */
   double relres, diff; /* ||b - Ax|| / ||b||; ||x - x_cholmod|| / ||x_cholmod|| (< 0: none) */
+  int processes;       /* MPI processes of the row (serial solvers: 1) */
   char note[200];
 } row;
 
@@ -89,6 +104,8 @@ typedef struct settings {
   int bodies[NBODY], nbodies;
   int solvers[NSOLVER], nsolvers;
   const char *csv, *png;
+  int backend;    /* BACKEND_SERIAL or BACKEND_PETSC */
+  int rank, size; /* MPI (petsc backend; else 0 and 1): process 0 prints and writes */
 } settings;
 
 /* ------------------------------------------------------------- measurement */
@@ -518,12 +535,13 @@ static void write_row(FILE *f, const row *r)
   csv_field_num(f, ran ? r->base_mb : -1.0, 1, 0);
   fputc(',', f);
   if (ran && r->levels > 0) fprintf(f, "%d", r->levels);
-  fprintf(f, ",%s\n", r->note);
+  fprintf(f, ",%d,%s\n", r->processes > 0 ? r->processes : 1, r->note);
 }
 
 static const char csv_header[] =
     "element,cells,dofs,solver,iterations,convergence_factor,setup_s,solve_s,peak_rss_mb,"
-    "body,status,relative_residual,diff_cholmod,setup_cpu_s,solve_cpu_s,base_rss_mb,levels,note\n";
+    "body,status,relative_residual,diff_cholmod,setup_cpu_s,solve_cpu_s,base_rss_mb,levels,"
+    "processes,note\n";
 
 static void print_row(const row *r)
 {
@@ -559,7 +577,8 @@ static int write_png(const settings *o)
     }                                                                                              \
     len += (size_t)k_;                                                                             \
   } while (0)
-  const char *colors[NSOLVER] = {"#000000", "#1f77b4", "#2ca02c", "#d62728", "#ff7f0e"};
+  const char *colors[NSOLVER] = {"#000000", "#1f77b4", "#2ca02c", "#d62728",
+                                 "#ff7f0e", "#9467bd", "#8c564b"};
   for (int panel = 0; panel < 2; panel++) {
     if (panel == 0)
       ADD("set multiplot layout 1,2\nset logscale xy\nset xlabel 'DOFs'\nset ylabel '%s seconds, "
@@ -714,13 +733,62 @@ static int summary(const settings *o)
   return all;
 }
 
-/* ------------------------------------------------------------- the study */
+/* --backend petsc: the issue-13 summary (printed, not claimed), the PETSc rows' cost per DOF,
+ * and their claims: every PETSc row that ran agrees with the serial solution (CHOLMOD's, else
+ * cg-mg's) within --agree and reports its iterations. 1 when every claim holds. */
+static int summary_petsc(const settings *o)
+{
+  (void)summary(o);
+  printf("(with --backend petsc the claims of issue 13 above are printed, not checked)\n");
+  printf("\nPETSc rows on %d process%s (peak - base RSS summed over the processes; CPU seconds "
+         "summed; per DOF)\n",
+         o->size, o->size == 1 ? "" : "es");
+  for (int i = 0; i < nrows; i++) {
+    const row *r = &rows[i];
+    if (!IS_PETSC(r->solver) || r->status != ROW_OK || r->dofs <= 0) continue;
+    const double d = (double)r->dofs;
+    printf("  %-5s %-6s n=%-3lld %-12s %9lld dofs: %7.0f bytes/dof, setup %.2e s/dof, solve "
+           "%.2e s/dof (wall), %.2e s/dof (CPU); %s\n",
+           fcm_element_get_info(r->type)->name, body_names[r->body], (long long)r->n,
+           solver_names[r->solver], (long long)r->dofs,
+           r->peak_mb >= 0.0 ? (r->peak_mb - r->base_mb) * 1048576.0 / d : 0.0, r->setup_s / d,
+           r->solve_s / d, (r->setup_cpu + r->solve_cpu) / d, r->note);
+  }
+  printf("\nclaims of the PETSc rows (issue 14)\n");
+  int all = 1;
+  for (int ti = 0; ti < o->ntypes; ti++)
+    for (int si = 0; si < o->nsolvers; si++) {
+      const int s = o->solvers[si];
+      if (!IS_PETSC(s)) continue;
+      const fcm_element_type t = o->types[ti];
+      int ran = 0, agree = 0, with_ref = 0, its = 0;
+      double worst = 0.0;
+      for (int i = 0; i < nrows; i++) {
+        const row *r = &rows[i];
+        if (r->type != t || r->solver != s || r->status == ROW_SKIPPED) continue;
+        ran++;
+        its += r->iterations >= 1;
+        if (r->diff >= 0.0) with_ref++, agree += r->diff <= o->agree, worst = fmax(worst, r->diff);
+      }
+      char what[200];
+      snprintf(what, sizeof what,
+               "%s %s: agrees with the serial solution within %.0e (%d of %d rows, worst %.2e)",
+               fcm_element_get_info(t)->name, solver_names[s], o->agree, agree, ran, worst);
+      all &= claim(what, agree == ran, ran > 0 && with_ref == ran);
+      snprintf(what, sizeof what, "%s %s: iterations reported (%d of %d rows)",
+               fcm_element_get_info(t)->name, solver_names[s], its, ran);
+      all &= claim(what, its == ran, ran > 0);
+    }
+  return all;
+}
+
+/* ------------------------------------------------------------- rows out */
 
 /* The rows so far into --csv (atomically: a temporary renamed over the file); called after
  * every row, so an interrupted run leaves the rows it finished. 1 on success. */
 static int write_csv(const settings *o)
 {
-  if (!o->csv) return 1;
+  if (!o->csv || o->rank != 0) return 1;
   cli_output *out = NULL;
   FILE *f = cli_output_open(PROG, o->csv, &out);
   if (!f) return 0;
@@ -739,6 +807,7 @@ static int add_skip(const settings *o, fcm_element_type t, int body, fcm_index n
   r->type = t, r->body = body, r->n = n, r->dofs = dofs, r->solver = s;
   r->status = ROW_SKIPPED;
   r->factor = r->relres = r->diff = r->peak_mb = r->base_mb = -1.0;
+  r->processes = IS_PETSC(s) ? o->size : 1;
   set_note(r, why);
   fprintf(stderr, PROG ": %s %s n=%lld %s skipped: %s\n", fcm_element_get_info(t)->name,
           body_names[body], (long long)n, solver_names[s], r->note);
@@ -753,13 +822,193 @@ static int emit(const settings *o, const row *r)
   return write_csv(o);
 }
 
+/* ------------------------------------------------------------- the PETSc rows */
+
+/* Every process waits here for the others (process 0 comes last, after its serial solvers),
+ * sleeping between polls: a blocking MPI wait spins, and the spinning processes would take
+ * the cores of the serial solvers being timed. Then process 0's `*fatal` reaches every one. */
+static void sync_processes(const settings *o, int *fatal)
+{
+#if FCM_HAVE_PETSC
+  if (o->size <= 1) return;
+  MPI_Request req;
+  int done = 0;
+  MPI_Ibarrier(MPI_COMM_WORLD, &req);
+  while (MPI_Test(&req, &done, MPI_STATUS_IGNORE) == MPI_SUCCESS && !done) {
+    const struct timespec ts = {0, 2000000};
+    nanosleep(&ts, NULL);
+  }
+  MPI_Bcast(fatal, 1, MPI_INT, 0, MPI_COMM_WORLD);
+#else
+  (void)o;
+  (void)fatal;
+#endif
+}
+
+#if FCM_HAVE_PETSC
+/* The PETSc solvers' options strings (the command line's PETSc options override them: the
+ * backend reads the command line after them). CG stops on the true residual ||b - A x||_2, as
+ * the serial solvers do. */
+static const char *petsc_solver_options(int s)
+{
+  return s == S_PGAMG ? "-ksp_type cg -pc_type gamg -ksp_norm_type unpreconditioned"
+                      : "-ksp_type preonly -pc_type cholesky -pc_factor_mat_solver_type mumps";
+}
+
+/* One PETSc row (collective: every process calls it with the same arguments but p and xref,
+ * which only process 0 has: the serial problem (NULL when it was not built) and the reference
+ * solution (NULL: none)). The same problem as problem_build() through the PETSc adapter: mesh
+ * and geometry on every process, fcm_petsc_problem_create() (static; partition, rules of the
+ * own cells, space, DOF numbering), gravity, every copy of every node with y <= -0.5 clamped,
+ * setup (assembly, elimination, KSP), one step (the solve; GAMG's set-up or MUMPS's
+ * factorization included). Times: process 0's wall clock, CPU summed over the processes; RSS
+ * peak and base summed. The row is filled on process 0. */
+static void run_petsc(fcm_ctx *ctx, const settings *o, fcm_element_type type, int body,
+                      fcm_index n, int s, const problem *p, const double *xref, row *r)
+{
+  fcm_status st = FCM_OK;
+  fcm_mesh *mesh = NULL;
+  fcm_geometry *geom = NULL;
+  fcm_petsc_problem *P = NULL;
+  fcm_index *nodes = NULL;
+  double *u = NULL;
+  const char *stage = "problem";
+  const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, c[3] = {0, 0, 0};
+  const fcm_index cells[3] = {n, n, n};
+  const fcm_material mat = {FCM_MATERIAL_LINEAR, 1.0e5, 0.3, 1000.0};
+  const double g[3] = {0.0, -9.81, 0.0};
+  fcm_petsc_step_info si;
+  fcm_petsc_info info;
+  memset(&si, 0, sizeof si);
+  memset(&info, 0, sizeof info);
+  r->processes = o->size;
+  MPI_Barrier(MPI_COMM_WORLD);
+  double base = rss_reset();
+  const double w0 = omp_get_wtime(), c0 = cpu_now();
+  double w1 = w0, c1 = c0;
+  TRY(fcm_mesh_create_box(ctx, type, lo, hi, cells, &mesh));
+  if (body == B_HOLLOW)
+    TRY(fcm_geometry_create_hollow_ball(ctx, c, 0.5, 0.9, 0.25, 16, 3, &geom));
+  else
+    TRY(fcm_geometry_create_ball(ctx, c, 0.9, 6, &geom));
+  fcm_petsc_options po = fcm_petsc_options_default();
+  po.kind = FCM_INTEGRATOR_STATIC;
+  po.rtol = o->rtol;
+  po.max_iterations = o->max_iterations;
+  po.petsc_options = petsc_solver_options(s);
+  TRY(fcm_petsc_problem_create(ctx, MPI_COMM_WORLD, mesh, geom, &mat, &po, &P));
+  {
+    const double blo[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, bhi[3] = {HUGE_VAL, -0.5, HUGE_VAL};
+    fcm_index cnt = 0;
+    TRY(fcm_mesh_nodes_in_box(ctx, mesh, blo, bhi, 1e-9, 0, NULL, &cnt));
+    nodes = malloc(sizeof *nodes * ((size_t)cnt + 1));
+    if (!nodes) {
+      st = FCM_ERR_ALLOC;
+      goto done;
+    }
+    TRY(fcm_mesh_nodes_in_box(ctx, mesh, blo, bhi, 1e-9, cnt, nodes, &cnt));
+    const fcm_motion clamp = fcm_motion_default();
+    TRY(fcm_petsc_problem_add_gravity(P, g));
+    TRY(fcm_petsc_problem_add_constraint(P, cnt, nodes, &clamp));
+  }
+  stage = "setup";
+  TRY(fcm_petsc_problem_setup(P));
+  w1 = omp_get_wtime(), c1 = cpu_now();
+  stage = "solve";
+  st = fcm_petsc_problem_step(P, &si);
+  const double w2 = omp_get_wtime(), c2 = cpu_now();
+  double peak = base >= 0.0 ? rss_peak() : -1.0;
+  r->setup_s = w1 - w0, r->solve_s = w2 - w1;
+  double cpu[2] = {c1 - c0, c2 - c1}, mem[2] = {peak, base}, sum[2];
+  int known = peak >= 0.0, all_known = 0;
+  MPI_Allreduce(cpu, sum, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  r->setup_cpu = sum[0], r->solve_cpu = sum[1];
+  MPI_Allreduce(mem, sum, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  MPI_Allreduce(&known, &all_known, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  r->peak_mb = all_known ? sum[0] : -1.0, r->base_mb = all_known ? sum[1] : -1.0;
+  r->iterations = si.iterations;
+  if (st != FCM_OK) goto done;
+  stage = "result";
+  TRY(fcm_petsc_problem_get_info(P, &info));
+  r->dofs = info.num_dofs;
+  u = malloc(sizeof *u * ((size_t)info.num_dofs + 1));
+  const int have_u = u != NULL;
+  int all_u = 0;
+  MPI_Allreduce(&have_u, &all_u, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (!all_u) {
+    st = FCM_ERR_ALLOC;
+    goto done;
+  }
+  TRY(fcm_petsc_problem_get_state(P, u, NULL));
+  {
+    char what[160];
+    snprintf(what, sizeof what, "%s + %s%s%s%s", info.ksp_type, info.pc_type,
+             info.factor_package[0] ? " (" : "", info.factor_package,
+             info.factor_package[0] ? ")" : "");
+    set_note(r, what);
+  }
+done:
+  if (o->rank == 0 && st != FCM_OK) {
+    r->status = ROW_FAILED;
+    char msg[400];
+    snprintf(msg, sizeof msg, "%s: %s", stage, fcm_ctx_error_message(ctx));
+    set_note(r, msg);
+  } else if (o->rank == 0 && p) {
+    if (p->n != r->dofs) {
+      r->status = ROW_FAILED;
+      char msg[200];
+      snprintf(msg, sizeof msg, "%lld dofs but the serial problem has %lld", (long long)r->dofs,
+               (long long)p->n);
+      set_note(r, msg);
+    } else {
+      double *ax = malloc(sizeof *ax * ((size_t)p->n + 1));
+      if (ax && fcm_csr_apply(p->A, 1.0, u, 0.0, ax) == FCM_OK) {
+        for (fcm_index i = 0; i < p->n; i++)
+          ax[i] = p->b[i] - ax[i];
+        const double bn = norm2(p->n, p->b);
+        r->relres = bn > 0.0 ? norm2(p->n, ax) / bn : 0.0;
+        r->factor = s == S_PMUMPS            ? -1.0
+                    : r->iterations > 0 && r->relres > 0.0 ? pow(r->relres, 1.0 / r->iterations)
+                                                         : 0.0;
+      }
+      free(ax);
+      if (xref) {
+        double dn = 0.0;
+        for (fcm_index i = 0; i < p->n; i++)
+          dn += (u[i] - xref[i]) * (u[i] - xref[i]);
+        const double xn = norm2(p->n, xref);
+        r->diff = xn > 0.0 ? sqrt(dn) / xn : sqrt(dn);
+        if (!(r->diff <= o->agree)) {
+          r->status = ROW_FAILED;
+          char msg[200];
+          snprintf(msg, sizeof msg, "differs from the serial solution by %.3e > --agree %.1e",
+                   r->diff, o->agree);
+          set_note(r, msg);
+        }
+      }
+    }
+  }
+  free(u);
+  free(nodes);
+  fcm_petsc_problem_destroy(&P);
+  fcm_geometry_destroy(&geom);
+  fcm_mesh_destroy(&mesh);
+}
+#endif
+
+/* ------------------------------------------------------------- the study */
+
+/* Process 0 runs the serial solvers of one size and decides what runs; the PETSc solvers run
+ * on every process (--backend petsc), each other process waiting in sync_processes() while
+ * process 0 works alone. */
 static int run_study(fcm_ctx *ctx, const settings *o)
 {
-  int failed = 0;
+  int failed = 0, fatal = 0;
+  const int root = o->rank == 0;
   printf("%-5s %-6s %3s %9s %-14s %6s %7s %9s %9s %8s %9s %9s\n", "elem", "body", "n", "dofs",
          "solver", "its", "factor", "setup_s", "solve_s", "peak_MB", "relres", "diff");
-  for (int ti = 0; ti < o->ntypes; ti++)
-    for (int bi = 0; bi < o->nbodies; bi++) {
+  for (int ti = 0; ti < o->ntypes && !fatal; ti++)
+    for (int bi = 0; bi < o->nbodies && !fatal; bi++) {
       const fcm_element_type t = o->types[ti];
       const int body = o->bodies[bi];
       const char *en = fcm_element_get_info(t)->name;
@@ -767,26 +1016,36 @@ static int run_study(fcm_ctx *ctx, const settings *o)
       memset(skipped, 0, sizeof skipped);
       fcm_index last_n = 0, last_dofs = 0;
       double last_prob_mb = 0.0, last_prob_s = 0.0;
-      for (int ni = 0; ni < o->nsizes; ni++) {
+      for (int ni = 0; ni < o->nsizes && !fatal; ni++) {
         const fcm_index n = o->sizes[ni];
-        int want[NSOLVER] = {0}, nwant = 0;
+        int want[NSOLVER] = {0}, nserial = 0, npetsc = 0;
         for (int si = 0; si < o->nsolvers; si++) {
           const int s = o->solvers[si];
           if ((body == B_CUBE || body == B_CUT) && s != S_MG) continue;
-          want[s] = 1, nwant++;
+          want[s] = 1;
+          if (IS_PETSC(s))
+            npetsc++;
+          else
+            nserial++;
         }
-        if (!nwant) continue;
+        if (!nserial && !npetsc) continue;
+        problem p;
+        memset(&p, 0, sizeof p);
+        int have_p = 0, have_ref = 0, have_mgref = 0;
+        double *x = NULL, *xref = NULL;
+        char why[200];
+        if (!root || !nserial) goto serial_done;
         int all_skipped = 1; /* every solver already stopped at a smaller size: no problem */
         for (int s = 0; s < NSOLVER; s++)
-          if (want[s] && !skipped[s][0]) all_skipped = 0;
+          if (want[s] && !IS_PETSC(s) && !skipped[s][0]) all_skipped = 0;
         if (all_skipped) {
           for (int s = 0; s < NSOLVER; s++)
-            if (want[s] && !add_skip(o, t, body, n, 0, s, skipped[s])) return 1;
-          continue;
+            if (want[s] && !IS_PETSC(s) && !add_skip(o, t, body, n, 0, s, skipped[s]))
+              fatal = 1;
+          goto serial_done;
         }
         /* the problem itself: estimated from the previous size by the cell ratio */
         const double avail = mem_available();
-        char why[200];
         if (last_n > 0) {
           const double ratio = pow((double)n / (double)last_n, 3.0);
           const double est_mb = last_prob_mb * ratio, est_s = last_prob_s * ratio;
@@ -803,13 +1062,12 @@ static int run_study(fcm_ctx *ctx, const settings *o)
                      est_s, o->budget, (long long)est_dofs);
           if (why[0]) {
             for (int s = 0; s < NSOLVER; s++)
-              if (want[s] && !add_skip(o, t, body, n, 0, s, why)) return 1;
-            continue;
+              if (want[s] && !IS_PETSC(s) && !add_skip(o, t, body, n, 0, s, why)) fatal = 1;
+            goto serial_done;
           }
         }
         fprintf(stderr, PROG ": %s %s n=%lld: building the problem\n", en, body_names[body],
                 (long long)n);
-        problem p;
         const double base = rss_reset();
         const double w0 = omp_get_wtime();
         fcm_status st = problem_build(ctx, o, t, body, n, &p);
@@ -818,37 +1076,36 @@ static int run_study(fcm_ctx *ctx, const settings *o)
           fprintf(stderr, PROG ": %s %s n=%lld: building the problem failed: %s\n", en,
                   body_names[body], (long long)n, fcm_ctx_error_message(ctx));
           for (int s = 0; s < NSOLVER; s++)
-            if (want[s] && nrows < MAX_ROWS) {
+            if (want[s] && !IS_PETSC(s) && nrows < MAX_ROWS) {
               row *r = &rows[nrows++];
               memset(r, 0, sizeof *r);
               r->type = t, r->body = body, r->n = n, r->solver = s, r->status = ROW_FAILED;
               r->factor = r->relres = r->diff = r->peak_mb = r->base_mb = -1.0;
+              r->processes = 1;
               char msg[400];
               snprintf(msg, sizeof msg, "problem: %s", fcm_ctx_error_message(ctx));
               set_note(r, msg);
-              if (!emit(o, r)) return 1;
+              if (!emit(o, r)) fatal = 1;
             }
           failed = 1;
-          continue;
+          goto serial_done;
         }
+        have_p = 1;
         const double peak = base >= 0.0 ? rss_peak() : -1.0;
         last_prob_mb = peak >= 0.0 ? fmax(peak - base, 1.0) : 0.0;
         last_prob_s = build_s, last_n = n, last_dofs = p.n;
         fprintf(stderr, PROG ": %s %s n=%lld: %lld dofs, built in %.1f s (%.0f MB)\n", en,
                 body_names[body], (long long)n, (long long)p.n, build_s, last_prob_mb);
-        double *x = malloc(sizeof *x * ((size_t)p.n + 1));
-        double *xref = want[S_CHOLMOD] ? malloc(sizeof *xref * ((size_t)p.n + 1)) : NULL;
-        int have_ref = 0;
-        if (!x || (want[S_CHOLMOD] && !xref)) {
+        x = malloc(sizeof *x * ((size_t)p.n + 1));
+        xref = malloc(sizeof *xref * ((size_t)p.n + 1));
+        if (!x || !xref) {
           fprintf(stderr, PROG ": out of memory for the solution vectors\n");
-          free(x);
-          free(xref);
-          problem_free(&p);
-          return 1;
+          fatal = 1;
+          goto serial_done;
         }
-        for (int si = 0; si < o->nsolvers; si++) {
+        for (int si = 0; si < o->nsolvers && !fatal; si++) {
           const int s = o->solvers[si];
-          if (!want[s]) continue;
+          if (!want[s] || IS_PETSC(s)) continue;
           if (skipped[s][0]) {
             if (!add_skip(o, t, body, n, p.n, s, skipped[s])) failed = 1;
             continue;
@@ -875,25 +1132,74 @@ static int run_study(fcm_ctx *ctx, const settings *o)
           memset(r, 0, sizeof *r);
           r->type = t, r->body = body, r->n = n, r->dofs = p.n, r->solver = s;
           r->factor = r->relres = r->diff = -1.0;
+          r->processes = 1;
           fprintf(stderr, PROG ": %s %s n=%lld %s ...\n", en, body_names[body], (long long)n,
                   solver_names[s]);
           run_solver(ctx, o, &p, s, s == S_CHOLMOD ? xref : x, have_ref ? xref : NULL, r);
           if (s == S_CHOLMOD && r->status == ROW_OK) have_ref = 1;
+          /* the PETSc rows' reference when CHOLMOD's is missing: cg-mg's solution */
+          if (s == S_CGMG && r->status == ROW_OK && !have_ref && !have_mgref) {
+            memcpy(xref, x, sizeof *x * (size_t)p.n);
+            have_mgref = 1;
+          }
           if (r->status == ROW_FAILED) failed = 1;
           if (r->status == ROW_SKIPPED) snprintf(skipped[s], sizeof skipped[s], "%s", r->note);
-          if (!emit(o, r)) {
-            free(x);
-            free(xref);
-            problem_free(&p);
-            return 1;
-          }
+          if (!emit(o, r)) fatal = 1;
         }
+      serial_done:
+        sync_processes(o, &fatal);
+#if FCM_HAVE_PETSC
+        for (int si = 0; si < o->nsolvers && npetsc && !fatal; si++) {
+          const int s = o->solvers[si];
+          if (!want[s] || !IS_PETSC(s)) continue;
+          int go = 0;
+          if (root) {
+            const fcm_index dofs = have_p ? p.n : 0;
+            double est_s = 0.0, est_mb = 0.0;
+            estimate(t, body, s, dofs > 0 ? dofs : last_dofs, &est_s, &est_mb);
+            const double now_avail = mem_available();
+            why[0] = 0;
+            if (skipped[s][0])
+              snprintf(why, sizeof why, "%s", skipped[s]);
+            else if (now_avail > 0.0 && est_mb > o->mem_fraction * now_avail)
+              snprintf(why, sizeof why, "would need about %.0f MB more (%.0f MB available)",
+                       est_mb, now_avail);
+            else if (est_s > o->budget)
+              snprintf(why, sizeof why, "would take about %.0f s > --budget %.0f s", est_s,
+                       o->budget);
+            if (why[0] && !skipped[s][0])
+              snprintf(skipped[s], sizeof skipped[s], "n=%lld %.150s (and larger)", (long long)n,
+                       why);
+            if (why[0]) {
+              if (!add_skip(o, t, body, n, dofs, s, why)) fatal = 1;
+            } else {
+              go = nrows < MAX_ROWS;
+            }
+          }
+          MPI_Bcast(&go, 1, MPI_INT, 0, MPI_COMM_WORLD);
+          if (!go) continue;
+          row scratch, *r = root ? &rows[nrows++] : &scratch;
+          memset(r, 0, sizeof *r);
+          r->type = t, r->body = body, r->n = n, r->solver = s;
+          r->factor = r->relres = r->diff = -1.0;
+          if (root)
+            fprintf(stderr, PROG ": %s %s n=%lld %s on %d processes ...\n", en, body_names[body],
+                    (long long)n, solver_names[s], o->size);
+          run_petsc(ctx, o, t, body, n, s, have_p ? &p : NULL,
+                    have_ref || have_mgref ? xref : NULL, r);
+          if (root) {
+            if (r->status == ROW_FAILED) failed = 1;
+            if (!emit(o, r)) fatal = 1;
+          }
+          MPI_Bcast(&fatal, 1, MPI_INT, 0, MPI_COMM_WORLD);
+        }
+#endif
         free(x);
         free(xref);
-        problem_free(&p);
+        if (have_p) problem_free(&p);
       }
     }
-  return failed;
+  return failed || fatal;
 }
 
 /* ------------------------------------------------------------- main */
@@ -927,14 +1233,28 @@ static void usage(FILE *f, const cli_option *opts)
       "5 to /proc/self/clear_refs and VmHWM read after it), then body,status (ok, skipped,\n"
       "failed),relative_residual (||b - A x||/||b||, computed here),diff_cholmod (||x -\n"
       "x_cholmod||/||x_cholmod||),setup_cpu_s,solve_cpu_s (process CPU, all threads),\n"
-      "base_rss_mb (resident before the row),levels (multigrid levels),note (why skipped or\n"
-      "failed).\n"
+      "base_rss_mb (resident before the row),levels (multigrid levels),processes (MPI\n"
+      "processes of the row: 1 for the serial solvers),note (why skipped or failed; for a\n"
+      "PETSc row that ran: its KSP + PC).\n"
+      "--backend petsc (mpirun -n P " PROG " --backend petsc): rows of\n"
+      "  petsc-gamg      CG + GAMG, rigid-body near-null space, on the true residual\n"
+      "  petsc-mumps     MUMPS sparse Cholesky (preonly)\n"
+      "on every process through the PETSc adapter (fcm/petsc.h), bodies ball and hollow;\n"
+      "default solvers cholmod,cg-mg,petsc-gamg,petsc-mumps (the serial ones on process 0 give\n"
+      "the reference: diff_cholmod is against CHOLMOD's solution, else cg-mg's). PETSc rows:\n"
+      "setup_s is the whole distributed problem (partition, rules, space, assembly,\n"
+      "elimination), solve_s the KSP solve with GAMG's set-up or MUMPS's factorization;\n"
+      "setup_cpu_s, solve_cpu_s, peak_rss_mb and base_rss_mb are summed over the processes\n"
+      "(process 0 also holds the serial problem: peak - base is the PETSc run's own);\n"
+      "relative_residual is computed with the serial matrix. PETSc options on the command\n"
+      "line (-ksp_type ...) apply to every PETSc row. --check then claims: every PETSc row\n"
+      "agrees with the serial solution within --agree and reports its iterations.\n"
       "Before each size a solver is skipped (and at every larger size) when its time (the\n"
       "smaller of wall and CPU seconds: less sensitive to load), scaled from the previous sizes,\n"
       "would exceed --budget, or its memory would exceed\n"
       "--mem-fraction of MemAvailable; the problem itself likewise. Rows say what was skipped\n"
       "and why. Progress goes to stderr.\n"
-      "Default: hex8 and hex20, n = 8,16,32,64, all bodies and solvers. --quick: hex8, n =\n"
+      "Default: hex8 and hex20, n = 8,16,32,64, all bodies and serial solvers. --quick: hex8, n =\n"
       "8,16,32 (the same facts on fewer sizes; budget 120 s). Prints the fitted exponents of\n"
       "time (setup+solve and solve alone) against DOFs and the claims of issue 13; --check\n"
       "makes a failed claim exit 1.\n"
@@ -977,9 +1297,55 @@ static int parse_names(const char *opt, const char *s, const char *const *names,
   return 1;
 }
 
+/* --backend petsc: the PETSc options of the command line (a single dash and a word,
+ * "-ksp_type", with the value after it unless that is an option) are moved from argv into pargv
+ * (after the program name); argv keeps fcm-scaling's own. Without --backend petsc nothing
+ * moves (an unknown option stays an error). As fcm-sim's. */
+static void split_petsc_args(int *argc, char **argv, int *pargc, char **pargv)
+{
+  int petsc = 0, n = 1, m = 1;
+  for (int i = 1; i < *argc; i++)
+    if (strcmp(argv[i], "--backend=petsc") == 0 ||
+        (strcmp(argv[i], "--backend") == 0 && i + 1 < *argc && strcmp(argv[i + 1], "petsc") == 0))
+      petsc = 1;
+  pargv[0] = argv[0];
+  *pargc = 1;
+  pargv[1] = NULL;
+  if (!petsc) return;
+  for (int i = 1; i < *argc; i++) {
+    const char *a = argv[i];
+    const int opt = a[0] == '-' && a[1] != '-' && a[1] != '\0' && a[2] != '\0';
+    if (!opt) {
+      argv[n++] = argv[i];
+      continue;
+    }
+    pargv[m++] = argv[i];
+    const char *b = i + 1 < *argc ? argv[i + 1] : NULL;
+    if (b && !(b[0] == '-' &&
+               ((b[1] >= 'a' && b[1] <= 'z') || (b[1] >= 'A' && b[1] <= 'Z') || b[1] == '-')))
+      pargv[m++] = argv[++i];
+  }
+  *argc = n;
+  *pargc = m;
+  pargv[m] = NULL;
+}
+
+static int scaling_main(int argc, char **argv, int pargc, char **pargv);
+
 int main(int argc, char **argv)
 {
   app_env_init(argc, argv);
+  char **pargv = calloc((size_t)argc + 2, sizeof *pargv);
+  if (!pargv) return 1;
+  int pargc = 1;
+  split_petsc_args(&argc, argv, &pargc, pargv);
+  const int rc = scaling_main(argc, argv, pargc, pargv);
+  free(pargv);
+  return rc;
+}
+
+static int scaling_main(int argc, char **argv, int pargc, char **pargv)
+{
   settings o;
   memset(&o, 0, sizeof o);
   o.rtol = 1e-8, o.agree = 1e-4, o.budget = -1.0, o.mem_fraction = 0.8;
@@ -1006,8 +1372,9 @@ int main(int argc, char **argv)
       {"--bodies", NULL, CLI_STRING, &bodies, "B,...", "ball, hollow, cube, cut (default all)", 0,
        0, 0, NULL, NULL, NULL},
       {"--solvers", NULL, CLI_STRING, &solvers, "S,...",
-       "cholmod, cg-jacobi, minres-schwarz, cg-mg, mg (default all;\ncholmod first gives the "
-       "reference solution)",
+       "cholmod, cg-jacobi, minres-schwarz, cg-mg, mg (default all);\n--backend petsc also "
+       "petsc-gamg, petsc-mumps (default\ncholmod,cg-mg,petsc-gamg,petsc-mumps); cholmod first "
+       "gives\nthe reference solution",
        0, 0, 0, NULL, NULL, NULL},
       {"--rtol", NULL, CLI_DOUBLE, &o.rtol, "R", "relative residual of every solver (default 1e-8)",
        1e-14, 1e-2, 0, NULL, NULL, NULL},
@@ -1041,10 +1408,27 @@ int main(int argc, char **argv)
        "other load) or wall: the\ntimes the exponents, claims and plot use",
        0, 0, 0, clock_names, NULL, NULL},
       {"--check", NULL, CLI_FLAG, &o.check, NULL,
-       "exit 1 when a claim of issue 13 fails or cannot be measured", 0, 0, 0, NULL, NULL, NULL},
+       "exit 1 when a claim of issue 13 fails or cannot be measured\n(--backend petsc: the "
+       "claims on the PETSc rows)",
+       0, 0, 0, NULL, NULL, NULL},
+      {"--backend", NULL, CLI_CHOICE, &o.backend, "NAME",
+       "serial (default) or petsc: add the rows of the PETSc\nsolvers petsc-gamg and "
+       "petsc-mumps on every MPI process\n(mpirun -n 2 " PROG " --backend petsc; PETSc "
+       "options such as\n-ksp_type go to them; needs a build with PETSc)",
+       0, 0, 0, backend_names, NULL, NULL},
       {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
   const int code = cli_parse_args(PROG, opts, argc, argv, NULL, 0, NULL, usage);
   if (code >= 0) return code;
+  const int petsc = o.backend == BACKEND_PETSC;
+#if !FCM_HAVE_PETSC
+  (void)pargc;
+  (void)pargv;
+  if (petsc) {
+    fprintf(stderr, PROG ": --backend petsc: this fcm was built without PETSc (CMake option "
+                    "FCM_WITH_PETSC; Debian: bash setup.sh deps --petsc, then rebuild)\n");
+    return 2;
+  }
+#endif
   const fcm_index def_sizes[4] = {8, 16, 32, 64};
   o.nsizes = o.quick ? 3 : 4;
   memcpy(o.sizes, def_sizes, sizeof def_sizes);
@@ -1067,8 +1451,27 @@ int main(int argc, char **argv)
         return 2;
       }
   }
+  if (petsc) { /* default: the embedded bodies; the references and the PETSc solvers */
+    o.bodies[0] = B_BALL, o.bodies[1] = B_HOLLOW, o.nbodies = 2;
+    o.solvers[0] = S_CHOLMOD, o.solvers[1] = S_CGMG, o.solvers[2] = S_PGAMG;
+    o.solvers[3] = S_PMUMPS, o.nsolvers = 4;
+  } else {
+    o.nsolvers = NSOLVER - 2; /* the serial ones */
+  }
   if (bodies && !parse_names("--bodies", bodies, body_names, o.bodies, &o.nbodies)) return 2;
   if (solvers && !parse_names("--solvers", solvers, solver_names, o.solvers, &o.nsolvers)) return 2;
+  for (int i = 0; i < o.nsolvers && !petsc; i++)
+    if (IS_PETSC(o.solvers[i])) {
+      fprintf(stderr, PROG ": --solvers: %s runs with --backend petsc only\n",
+              solver_names[o.solvers[i]]);
+      return 2;
+    }
+  if (petsc && o.constrain_ratio != fcm_space_options_default().constrain_ratio) {
+    fprintf(stderr, PROG ": --constrain-ratio: the PETSc backend builds its space with the "
+                    "library's default (%g); drop the option with --backend petsc\n",
+            fcm_space_options_default().constrain_ratio);
+    return 2;
+  }
   /* cholmod first: it gives the reference solution */
   for (int i = 1; i < o.nsolvers; i++)
     if (o.solvers[i] == S_CHOLMOD) {
@@ -1082,17 +1485,45 @@ int main(int argc, char **argv)
     fprintf(stderr, PROG ": cannot create a context\n");
     return 1;
   }
-  printf("fcm-scaling: %s; rtol %.1e, %d OpenMP threads, budget %.0f s per row%s\n",
+  o.rank = 0, o.size = 1;
+#if FCM_HAVE_PETSC
+  if (petsc) {
+    if (fcm_petsc_initialize(ctx, &pargc, &pargv) != FCM_OK) {
+      fprintf(stderr, PROG ": %s\n", fcm_ctx_error_message(ctx));
+      fcm_ctx_destroy(&ctx);
+      return 1;
+    }
+    MPI_Comm_rank(MPI_COMM_WORLD, &o.rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &o.size);
+    if (o.rank != 0) { /* process 0 prints and writes */
+      if (!freopen("/dev/null", "w", stdout) || !freopen("/dev/null", "w", stderr)) {
+        fcm_petsc_finalize();
+        fcm_ctx_destroy(&ctx);
+        return 1;
+      }
+      o.png = NULL;
+    }
+  }
+#endif
+  char procs[64] = "";
+  if (petsc) snprintf(procs, sizeof procs, "; PETSc rows on %d MPI process(es)", o.size);
+  printf("fcm-scaling: %s; rtol %.1e, %d OpenMP threads, budget %.0f s per row%s%s\n",
          o.quick ? "--quick: hex8 on n = 8, 16, 32 only (the full run adds hex20 and n = 64)"
                  : "study",
-         o.rtol, omp_get_max_threads(), o.budget,
+         o.rtol, omp_get_max_threads(), o.budget, procs,
          rss_reset() < 0.0 ? "; peak memory not measured (no /proc/self/clear_refs)" : "");
   const int failed = run_study(ctx, &o);
-  const int claims = summary(&o);
+  const int claims = petsc ? summary_petsc(&o) : summary(&o);
   int ok = !failed && (!o.check || claims);
   if (failed) printf("\nsome rows FAILED (see their notes)\n");
   if (!write_csv(&o)) ok = 0;
   if (o.png && !write_png(&o)) ok = 0;
+#if FCM_HAVE_PETSC
+  if (petsc) { /* process 0 decided */
+    MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    fcm_petsc_finalize();
+  }
+#endif
   fcm_ctx_destroy(&ctx);
   return ok ? 0 : 1;
 }

@@ -2,10 +2,12 @@
  * mesh and the geometry. A scene the linear driver runs (fcm_petsc_problem_supports_scene():
  * linear material, gravity, fixed and motion on node regions) goes through it
  * (fcm_petsc_problem_create_from_scene() distributes the cells, the cut-cell rules, the
- * assembly and the solves); every other scene except cuts goes through the integrator on
- * PETSc (run_newton(), fcm_petsc_simulation_create()). Process 0 prints and writes the log
- * <name>_log.csv; each frame is a parallel VTU (<name>_NNNN.pvtu by process 0 naming one piece
- * <name>_NNNN_<rank>.vtu per process: its own cells), indexed by <name>.pvd. */
+ * assembly and the solves); every other scene (cuts and simplify auto included) goes through
+ * the integrator on PETSc (run_newton(), fcm_petsc_simulation_create()). Process 0 prints and writes the log
+ * <name>_log.csv; on the linear driver each frame is a parallel VTU (<name>_NNNN.pvtu by
+ * process 0 naming one piece <name>_NNNN_<rank>.vtu per process: its own cells), indexed by
+ * <name>.pvd, and checkpoints are <name>_checkpoint_NNNNNN.fcmpk; on the integrator the
+ * serial frames and checkpoints (.fcmck) are written by process 0 (run_newton()). */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm-sim-petsc.h"
 
@@ -91,11 +93,62 @@ static void read_old_log(const char *path, run_log *rows, long long first)
   fclose(f);
 }
 
+/* Process 0 writes the checkpoint <dir>/<name>_checkpoint_NNNNNN.fcmck of the current step
+ * (the serial format, fcm_simulation_write_checkpoint(): the state is the same on every
+ * process, so any process count, and the serial fcm-sim, can resume from it). Collective:
+ * returns whether it was written, on every process. */
+static int write_checkpoint(fcm_ctx *ctx, fcm_simulation *sim, const char *dir, const char *name,
+                            int talk, int rank)
+{
+  char path[4300];
+  int ok = 1;
+  snprintf(path, sizeof path, "%s/%s_checkpoint_%06lld.fcmck", dir, name,
+           fcm_simulation_step_count(sim));
+  if (rank == 0) {
+    ok = fcm_simulation_write_checkpoint(sim, path) == FCM_OK;
+    if (!ok)
+      fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+    else if (talk)
+      fprintf(stderr, "fcm-sim: checkpoint %s\n", path);
+  }
+  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  return ok;
+}
+
+/* A frame of the integrator path (collective: every process sums its cells' fields, process 0
+ * writes the serial background and surface VTUs and PVDs); whether it was written, on every
+ * process. */
+static int write_frame_newton(fcm_ctx *ctx, fcm_simulation *sim, const char *dir, int index,
+                              int rank)
+{
+  int ok = fcm_simulation_write_frame(sim, dir, index) == FCM_OK;
+  if (!ok && rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD); /* a failure of the sums is everywhere */
+  return ok;
+}
+
+/* Every process restores the checkpoint `path` into its new simulation (the same bytes give
+ * the same state and the same errors everywhere; a file that one process cannot read is
+ * reported by the lowest such process). Collective: 1 when every process restored it. */
+static int resume_checkpoint(fcm_ctx *ctx, fcm_simulation *sim, const char *path, int rank)
+{
+  const int mine = fcm_simulation_read_checkpoint(sim, path) == FCM_OK ? -1 : rank;
+  int bad = -1, first = mine < 0 ? 1 << 30 : mine;
+  MPI_Allreduce(&mine, &bad, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  if (bad < 0) return 1;
+  int lowest = first;
+  MPI_Allreduce(&first, &lowest, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (rank == lowest) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+  return 0;
+}
+
 /* A scene the linear driver does not run (non-linear material, boundary constraints, loads on
  * the boundary, damping, initial velocities, release): the scene's own simulation with the
  * integrator on PETSc (fcm_petsc_simulation_create()). Every process holds the same state and
- * log, so process 0 writes the frames (the serial <name>_background.pvd and VTUs) and the log
- * <name>_log.csv with the serial writers. Returns the exit code (the same on every process). */
+ * log, so process 0 writes the frames (the serial <name>_background.pvd and VTUs), the log
+ * <name>_log.csv and the checkpoints (<name>_checkpoint_NNNNNN.fcmck, --checkpoint-every or
+ * the scene's output.checkpoint_interval) with the serial writers; --resume: every process
+ * reads the checkpoint. Returns the exit code (the same on every process). */
 static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, long long steps,
                       int check, int quiet, int checkpoint_every, const char *resume, int rank,
                       int size)
@@ -104,26 +157,12 @@ static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
   const int talk = rank == 0 && !quiet;
   fcm_simulation *sim = NULL;
   int rc = 1, ok = 1;
-  if (resume || checkpoint_every > 0) {
-    if (rank == 0)
-      fprintf(stderr, "fcm-sim: scene %s: --backend petsc: checkpoints (--checkpoint-every, "
-                      "--resume) are not supported yet for scenes through the integrator "
-                      "(non-linear material or effects beyond the linear driver's); run without "
-                      "them or with the serial backend\n",
-              name);
-    return 2;
-  }
-  if (talk && !check && checkpoint_every < 0 &&
-      fcm_scene_get_output(scene)->checkpoint_interval > 0)
-    fprintf(stderr, "fcm-sim: note: the scene's checkpoints (output.checkpoint_interval) are not "
-                    "written on this path yet\n");
   fcm_simulation_options so = fcm_simulation_options_default();
   so.max_steps = check ? (steps > 0 && steps < 3 ? steps : 3) : (steps > 0 ? steps : FCM_DEFAULT);
-  so.checkpoint_interval = 0;
-  if (talk)
-    fprintf(stderr, "fcm-sim: scene %s: through the integrator (Newton) on PETSc\n", name);
-  fcm_status st = fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene,
-                                              FCM_PETSC_PARTITION_AUTO, &so, &sim);
+  so.checkpoint_interval = check ? 0 : checkpoint_every; /* -1: the scene's */
+  if (talk) fprintf(stderr, "fcm-sim: scene %s: through the integrator (Newton) on PETSc\n", name);
+  fcm_status st =
+      fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO, &so, &sim);
   if (st != FCM_OK) { /* every process has the error; process 0 prints it */
     if (rank == 0) fprintf(stderr, "fcm-sim: scene %s: %s\n", name, fcm_ctx_error_message(ctx));
     return st == FCM_ERR_ARG || st == FCM_ERR_IO || st == FCM_ERR_FORMAT ||
@@ -131,19 +170,34 @@ static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
                ? 2
                : 1;
   }
+  if (resume) {
+    if (!resume_checkpoint(ctx, sim, resume, rank)) {
+      rc = 2;
+      goto done;
+    }
+    if (talk)
+      fprintf(stderr, "fcm-sim: resumed from %s at step %lld (t = %.9g s)\n", resume,
+              fcm_simulation_step_count(sim), fcm_integrator_time(fcm_simulation_integrator(sim)));
+  }
   const char *dir = outdir ? outdir : fcm_scene_get_output(scene)->directory;
   const int write = !check;
   char logpath[4200];
-  int frame = 0;
+  fcm_simulation_counters c;
+  fcm_simulation_get_counters(sim, &c);
+  int frame = (int)c.frames; /* resumed: the frames the checkpoint had */
   snprintf(logpath, sizeof logpath, "%s/%s_log.csv", dir, name);
-  if (write && rank == 0) {
-    ok = make_dirs(dir) && fcm_simulation_write_frame(sim, dir, frame++) == FCM_OK &&
-         fcm_simulation_write_log(sim, logpath) == FCM_OK;
-    if (!ok && fcm_ctx_error_status(ctx) != FCM_OK)
-      fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+  if (write) {
+    if (rank == 0) ok = make_dirs(dir);
+    MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (!ok) goto done;
+    if (!resume && !write_frame_newton(ctx, sim, dir, frame++, rank)) goto done;
+    if (rank == 0) {
+      ok = fcm_simulation_write_log(sim, logpath) == FCM_OK;
+      if (!ok) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+    }
+    MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (!ok) goto done;
   }
-  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  if (!ok) goto done;
   const double t0 = fcm_wtime();
   const long long n = fcm_simulation_num_steps(sim);
   while (!fcm_simulation_done(sim)) {
@@ -167,14 +221,18 @@ static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
               "%.3g\n",
               k, n, si.time, si.newton_iterations, si.linear_iterations, si.residual);
     if (write && fcm_simulation_frame_due(sim)) {
+      if (!write_frame_newton(ctx, sim, dir, frame++, rank)) goto done;
       if (rank == 0) {
-        ok = fcm_simulation_write_frame(sim, dir, frame++) == FCM_OK &&
-             fcm_simulation_write_log(sim, logpath) == FCM_OK;
+        ok = fcm_simulation_write_log(sim, logpath) == FCM_OK;
         if (!ok) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
       }
       MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
       if (!ok) goto done;
     }
+    /* after the frame, as the serial fcm-sim: the checkpoint counts it */
+    if (write && fcm_simulation_checkpoint_due(sim) &&
+        !write_checkpoint(ctx, sim, dir, name, talk, rank))
+      goto done;
   }
   if (write && rank == 0) {
     ok = fcm_simulation_write_log(sim, logpath) == FCM_OK;
@@ -182,8 +240,11 @@ static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
   }
   MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
   if (!ok) goto done;
+  if (fcm_petsc_simulation_summary_view(sim, talk ? stdout : NULL) != FCM_OK) {
+    if (rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+    goto done;
+  }
   if (talk) {
-    fcm_simulation_summary_view(sim, stdout);
     printf("  backend   petsc, %d process%s (Newton on PETSc), steps %.3g s\n", size,
            size > 1 ? "es" : "", fcm_wtime() - t0);
     if (write) printf("  output    %s/%s_background.pvd, %s\n", dir, name, logpath);

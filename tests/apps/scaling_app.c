@@ -10,9 +10,17 @@
  * PNG (when gnuplot is installed); bad options exit 2 and write no CSV.
  * Mode quick / full (labels bench, slow): `--quick --check` / `--check` (the full study),
  * which must exit 0: the claims of issue 13 hold (see fcm-scaling --help), and write a CSV.
- * Usage: app_scaling small|quick|full PATH_TO_fcm-scaling WORK_DIR */
+ * Mode petsc (label mpi, a build with PETSc): `MPIEXEC -n NP fcm-scaling --backend petsc` on
+ * n = 4, 8 of the ball (Hex8) with --check exits 0 and writes the rows cholmod, cg-mg,
+ * petsc-gamg, petsc-mumps per size; the PETSc rows have status ok, processes NP, the serial
+ * rows' DOFs, iterations >= 1, a relative residual (computed with the serial matrix) of at
+ * most 2e-8 (GAMG: CG on the true residual to rtol 1e-8) / 1e-12 (MUMPS), and agree with
+ * CHOLMOD's solution to 1e-5 (GAMG) / 1e-10 (MUMPS); options the PETSc backend refuses exit 2
+ * on every process, with no CSV.
+ * Usage: app_scaling small|quick|full PATH_TO_fcm-scaling WORK_DIR [MPIEXEC NP] */
 #define _POSIX_C_SOURCE 200809L
 #include "app_run.h"
+#include "fcm/version.h"
 #include "test.h"
 
 #include <math.h>
@@ -22,12 +30,13 @@
 
 #define HEADER                                                                                     \
   "element,cells,dofs,solver,iterations,convergence_factor,setup_s,solve_s,peak_rss_mb,body,"      \
-  "status,relative_residual,diff_cholmod,setup_cpu_s,solve_cpu_s,base_rss_mb,levels,note\n"
+  "status,relative_residual,diff_cholmod,setup_cpu_s,solve_cpu_s,base_rss_mb,levels,processes,"  \
+  "note\n"
 
 typedef struct srow {
   char element[16], solver[32], body[16], status[16];
   long long n, dofs;
-  int iterations, levels;
+  int iterations, levels, processes;
   double factor, setup, solve, peak, relres, diff;
 } srow;
 
@@ -78,6 +87,7 @@ static int read_rows(const char *path, srow *rows, int cap)
     r->relres = num(line, 11);
     r->diff = num(line, 12);
     r->levels = (int)num(line, 16);
+    r->processes = (int)num(line, 17);
   }
   fclose(f);
   return n;
@@ -92,11 +102,59 @@ static const srow *find(const srow *rows, int n, const char *body, long long cel
   return NULL;
 }
 
+/* mode petsc: argv = PATH_TO_fcm-scaling WORK_DIR MPIEXEC NP (after the mode) */
+static int petsc_mode(char **argv)
+{
+  char cmd[8192], csv[1024];
+  static srow rows[64];
+  const int np = atoi(argv[4]);
+  snprintf(csv, sizeof csv, "%s/scaling-petsc-np%d.csv", argv[2], np);
+  remove(csv);
+  snprintf(cmd, sizeof cmd,
+           "OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 '%s' -n %d '%s' --backend petsc --sizes 4,8 "
+           "--elements hex8 --bodies ball --coarse-dofs 100 --check --csv '%s' > /dev/null 2>&1",
+           argv[3], np, argv[1], csv);
+  TEST_TRUE(app_run(cmd) == 0);
+  const int n = read_rows(csv, rows, 64);
+  TEST_TRUE(n == 2 * 4);
+  static const char *const solvers[4] = {"cholmod", "cg-mg", "petsc-gamg", "petsc-mumps"};
+  for (long long c = 4; c <= 8; c *= 2) {
+    const srow *ch = find(rows, n, "ball", c, "cholmod");
+    TEST_TRUE(ch != NULL && ch->processes == 1 && !strcmp(ch->status, "ok"));
+    for (int s = 1; s < 4 && ch; s++) {
+      const srow *r = find(rows, n, "ball", c, solvers[s]);
+      TEST_TRUE(r != NULL);
+      if (!r) continue;
+      TEST_TRUE(!strcmp(r->status, "ok") && r->dofs == ch->dofs && r->iterations >= 1);
+      TEST_TRUE(r->setup >= 0.0 && r->solve >= 0.0 && r->peak > 0.0);
+      if (s == 1) continue;
+      TEST_TRUE(r->processes == np);
+      const int mumps = s == 3;
+      if (!(r->relres >= 0.0 && r->relres <= (mumps ? 1e-12 : 2e-8) && r->diff >= 0.0 &&
+            r->diff <= (mumps ? 1e-10 : 1e-5)))
+        fprintf(stderr, "n=%lld %s: relres %g diff %g\n", c, solvers[s], r->relres, r->diff);
+      TEST_TRUE(r->relres >= 0.0 && r->relres <= (mumps ? 1e-12 : 2e-8));
+      TEST_TRUE(r->diff >= 0.0 && r->diff <= (mumps ? 1e-10 : 1e-5));
+    }
+  }
+  /* refused: exit non-zero (2 on every process), no CSV */
+  static const char *const bad[] = {"--constrain-ratio 0.1", "--solvers petsc-cg", "--backend mpi"};
+  for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
+    remove(csv);
+    snprintf(cmd, sizeof cmd, "'%s' -n %d '%s' --backend petsc %s --csv '%s' > /dev/null 2>&1",
+             argv[3], np, argv[1], bad[k], csv);
+    TEST_TRUE(app_run(cmd) != 0);
+    TEST_TRUE(!app_exists(csv));
+  }
+  return TEST_RESULT();
+}
+
 int main(int argc, char **argv)
 {
-  if (argc != 4) return 2;
+  if (argc != 4 && !(argc == 6 && !strcmp(argv[1], "petsc"))) return 2;
   const char *mode = argv[1];
   argv++;
+  if (!strcmp(mode, "petsc")) return petsc_mode(argv);
   char cmd[8192], csv[1024], png[1024];
   static srow rows[64];
   if (strcmp(mode, "small")) {
@@ -172,7 +230,13 @@ int main(int argc, char **argv)
   /* bad options: exit 2, nothing written */
   static const char *const bad[] = {
       "--sizes 8,4", "--sizes 1",  "--solvers cholmod,foo", "--elements tet4", "--bodies ball,ball",
-      "--rtol 0",    "--clock sun"};
+      "--rtol 0",    "--clock sun",
+      "--solvers cholmod,petsc-gamg", /* the PETSc solvers need --backend petsc */
+      "--backend mpi",
+#if !FCM_HAVE_PETSC
+      "--backend petsc", /* not in this build */
+#endif
+  };
   for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
     remove(csv);
     snprintf(cmd, sizeof cmd, "'%s' %s --csv '%s' > /dev/null 2>&1", argv[1], bad[k], csv);

@@ -118,3 +118,14 @@ fcm_add_test(app_scaling_quick tests/apps/scaling_app.c LABELS bench TIMEOUT 900
              ARGS quick $<TARGET_FILE:fcm-scaling> ${work})
 fcm_add_test(app_scaling_full tests/apps/scaling_app.c LABELS slow TIMEOUT 36000
              ARGS full $<TARGET_FILE:fcm-scaling> ${work})
+# fcm-scaling --backend petsc (issue 14) on 1 and 2 MPI processes: the PETSc rows agree with
+# CHOLMOD's solution, report iterations and the process count; refused options exit non-zero
+if(FCM_HAVE_PETSC)
+  foreach(np 1 2)
+    add_test(NAME app_scaling_petsc_np${np}
+             COMMAND $<TARGET_FILE:app_scaling> petsc $<TARGET_FILE:fcm-scaling> ${work}
+                     ${MPIEXEC_EXECUTABLE} ${np})
+    set_tests_properties(app_scaling_petsc_np${np} PROPERTIES LABELS "app;mpi" TIMEOUT 300
+                         PROCESSORS ${np} ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+  endforeach()
+endif()

@@ -10,7 +10,9 @@
  * - a KSP that cannot converge (CG without preconditioner, 2 iterations): the integrator
  *   halves the step, then fails with FCM_ERR_NOT_CONVERGED (linear-solver-failed) on every
  *   process;
- * - a scene with a cut: FCM_ERR_UNSUPPORTED naming the effect. */
+ * - a cut between steps that fails on one process only (its cut surface file broken after the
+ *   create): the step of the cut fails on every process, the others naming the failing one. */
+#define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
 #include "fcm/simulation.h"
@@ -18,6 +20,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <unistd.h>
 
 static const char *scene_text(char *buf, size_t size, const char *extra_quadrature,
                               const char *effects, const char *solver)
@@ -98,19 +101,44 @@ int main(int argc, char **argv)
   fcm_simulation_destroy(&sim);
   fcm_scene_destroy(&scene);
 
-  /* 4. a cut */
-  TEST_OK(ctx, fcm_scene_create_from_string(
-                   ctx,
-                   scene_text(text, sizeof text, "",
-                              ", {\"cut\": {\"surface\": {\"plane\": {\"point\": [0, 0, 0],"
-                              " \"normal\": [1, 0, 0]}}}}",
-                              ""),
-                   NULL, &scene));
-  TEST_ERR(ctx,
-           fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO,
-                                       NULL, &sim),
-           FCM_ERR_UNSUPPORTED, "cut is not supported by the PETSc backend");
+  /* 4. a cut between steps that fails on the last process only (its cut surface file is
+   * read at the create, then broken before the cut): every process returns the error at the
+   * step of the cut, the others naming the failing process; no hang */
+  char obj[128];
+  snprintf(obj, sizeof obj, "/tmp/fcm-petsc-newton-failure-%ld-%d.obj", (long)getpid(), rank);
+  FILE *f = fopen(obj, "w");
+  TEST_TRUE(f != NULL);
+  if (f) {
+    fputs("v 0.05 -1 -1\nv 0.05 1 -1\nv 0.05 1 1\nv 0.05 -1 1\nf 1 2 3\nf 1 3 4\n", f);
+    fclose(f);
+  }
+  char cut[256];
+  snprintf(cut, sizeof cut, ", {\"cut\": {\"time\": 0.01, \"surface\": {\"mesh\": \"%s\"}}}",
+           obj);
+  TEST_OK(ctx, fcm_scene_create_from_string(ctx, scene_text(text, sizeof text, "", cut, ""), NULL,
+                                            &scene));
+  TEST_OK(ctx, fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO,
+                                           NULL, &sim));
+  if (rank == size - 1 && (f = fopen(obj, "w")) != NULL) {
+    fputs("this is not a surface\n", f);
+    fclose(f);
+  }
+  if (sim) {
+    TEST_OK(ctx, fcm_simulation_step(sim, &si)); /* to t = 0.01: no cut yet */
+    s = fcm_simulation_step(sim, &si);           /* the cut at t = 0.01 first */
+    TEST_TRUE(s != FCM_OK);
+    if (size > 1 && rank != size - 1) {
+      char want[64];
+      snprintf(want, sizeof want, "process %d of %d failed", size - 1, size);
+      TEST_TRUE(strstr(fcm_ctx_error_message(ctx), want) != NULL);
+    }
+    if (getenv("FCM_TEST_VERBOSE"))
+      fprintf(stderr, "rank %d: case 4: %s\n", rank, fcm_ctx_error_message(ctx));
+    fcm_ctx_error_clear(ctx);
+  }
+  fcm_simulation_destroy(&sim);
   fcm_scene_destroy(&scene);
+  remove(obj);
 
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);

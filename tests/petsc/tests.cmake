@@ -76,30 +76,22 @@ foreach(np 1 2)
                    ARGS ${PROJECT_SOURCE_DIR}/apps/scenes vibrating_beam.json 10)
 endforeach()
 if(FCM_BUILD_APPS)
-  # mpirun -n 2 fcm-sim SCENE --backend petsc: runs the example scenes (--check);
-  # a scene with an effect the backend lacks exits non-zero on every process with the message
-  # (the linear driver runs cantilever and vibrating_beam; the others go through the integrator)
-  foreach(scene cantilever vibrating_beam clamped_surface static_beam spinning_body voxel_block)
-    add_test(NAME petsc_app_sim_${scene}
-             COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
-                     $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/${scene}.json
-                     --backend petsc --check -ksp_rtol 1e-10)
-    set_tests_properties(petsc_app_sim_${scene} PROPERTIES LABELS mpi TIMEOUT 300 PROCESSORS 2
-                         ENVIRONMENT "${FCM_MPI_TEST_ENV}")
-  endforeach()
-  add_test(NAME petsc_app_sim_unsupported
+  # every example scene on 2 processes against the serial fcm-sim: petsc_app_scene_* below
+  # a scene that fails while the simulation is built (its cut's surface file holds no surface):
+  # every process exits non-zero, with the message
+  add_test(NAME petsc_app_sim_bad_cut
            COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
-                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/dice.json
+                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/bad_cut.json
                    --backend petsc --check)
-  set_tests_properties(petsc_app_sim_unsupported PROPERTIES LABELS mpi TIMEOUT 120 PROCESSORS 2
+  set_tests_properties(petsc_app_sim_bad_cut PROPERTIES LABELS mpi TIMEOUT 120 PROCESSORS 2
                        WILL_FAIL TRUE ENVIRONMENT "${FCM_MPI_TEST_ENV}")
-  add_test(NAME petsc_app_sim_unsupported_message
+  add_test(NAME petsc_app_sim_bad_cut_message
            COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
-                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/dice.json
+                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/bad_cut.json
                    --backend petsc --check)
-  set_tests_properties(petsc_app_sim_unsupported_message PROPERTIES LABELS mpi TIMEOUT 120
+  set_tests_properties(petsc_app_sim_bad_cut_message PROPERTIES LABELS mpi TIMEOUT 120
                        PROCESSORS 2 ENVIRONMENT "${FCM_MPI_TEST_ENV}"
-                       PASS_REGULAR_EXPRESSION "effects\\[2\\]: cut is not supported by the PETSc backend")
+                       PASS_REGULAR_EXPRESSION "effects\\[2\\]\\.cut\\.surface\\.mesh: surface: .*empty mesh")
 endif()
 # memory and time per DOF on 1 and 2 processes (labels bench, mpi: not in the default run)
 foreach(np 1 2)
@@ -147,7 +139,133 @@ fcm_add_mpi_test(petsc_newton_spinning_body_np2 tests/petsc/newton.c NP 2
 fcm_add_mpi_test(petsc_newton_slingshot_np2 tests/petsc/newton.c NP 2
                  ARGS ${FCM_SCENES} slingshot.json 2 1e-6 -ksp_max_it 5000)
 # the integrator on PETSc: a failure on one process, in the setup's sums, in the KSP (after the
-# step's halvings) and a refused cut end every process with the message, no hang
+# step's halvings) and in a cut between steps on one process end every process with the
+# message, no hang
 foreach(np 1 2)
   fcm_add_mpi_test(petsc_newton_failure_np${np} tests/petsc/newton_failure.c NP ${np} TIMEOUT 120)
+endforeach()
+if(FCM_BUILD_APPS)
+  # the state of two checkpoints (fcm-sim's .fcmck or the linear driver's .fcmpk) to a relative
+  # tolerance: a tool of the shell tests below (no MPI)
+  add_executable(petsc_state_diff tests/petsc/state_diff.c)
+  target_link_libraries(petsc_state_diff PRIVATE m)
+  target_compile_options(petsc_state_diff PRIVATE ${FCM_WARNINGS} ${FCM_SAN_FLAGS})
+  target_link_options(petsc_state_diff PRIVATE ${FCM_SAN_FLAGS})
+endif()
+if(FCM_BUILD_APPS)
+  # EVERY example scene of apps/scenes on 2 processes through fcm-sim --backend petsc
+  # (tests/petsc/scene_app.sh): the state after the first steps equals the serial fcm-sim's to
+  # the tolerance, or the scene is refused with the message. One table; a scene of apps/scenes
+  # in neither list fails petsc_app_scene_listed.
+  # name        steps  relative tolerance of the state (1e-8; slingshot: the serial run
+  #                    solves with MINRES to the scene's rtol 1e-5)
+  set(FCM_PETSC_SCENES_RUN
+      cantilever            2 1e-8
+      clamped_surface       2 1e-8
+      gyroid_lattice        2 1e-8
+      hollow_ball           2 1e-8
+      hollow_ball_multigrid 1 1e-8
+      slingshot             1 1e-6
+      spinning_body         2 1e-8
+      static_beam           2 1e-8
+      surface_drop          2 1e-8
+      vibrating_beam        2 1e-8
+      voxel_block           2 1e-8
+      cracked_beam          1 1e-8
+      cut_slab              2 1e-8
+      dice                  2 1e-8
+      twisting_cylinder     1 1e-8)
+  # name               the message (grep -E) of the refusal (none: every example scene runs)
+  set(FCM_PETSC_SCENES_REFUSED)
+  set(listed "")
+  set(run ${FCM_PETSC_SCENES_RUN})
+  while(run)
+    list(POP_FRONT run name steps rtol)
+    list(APPEND listed ${name})
+    add_test(NAME petsc_app_scene_${name}
+             COMMAND bash ${PROJECT_SOURCE_DIR}/tests/petsc/scene_app.sh run ${MPIEXEC_EXECUTABLE}
+                     $<TARGET_FILE:fcm-sim> $<TARGET_FILE:petsc_state_diff>
+                     ${FCM_SCENES}/${name}.json ${steps} ${rtol}
+                     ${CMAKE_CURRENT_BINARY_DIR}/petsc_app_scene_${name})
+    set_tests_properties(petsc_app_scene_${name} PROPERTIES LABELS mpi TIMEOUT 300 PROCESSORS 2
+                         ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+  endwhile()
+  set(refused ${FCM_PETSC_SCENES_REFUSED})
+  while(refused)
+    list(POP_FRONT refused name regex)
+    list(APPEND listed ${name})
+    add_test(NAME petsc_app_scene_${name}
+             COMMAND bash ${PROJECT_SOURCE_DIR}/tests/petsc/scene_app.sh refused
+                     ${MPIEXEC_EXECUTABLE} $<TARGET_FILE:fcm-sim> - ${FCM_SCENES}/${name}.json -
+                     "${regex}" ${CMAKE_CURRENT_BINARY_DIR}/petsc_app_scene_${name})
+    set_tests_properties(petsc_app_scene_${name} PROPERTIES LABELS mpi TIMEOUT 120 PROCESSORS 2
+                         ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+  endwhile()
+  file(GLOB scene_files RELATIVE ${FCM_SCENES} CONFIGURE_DEPENDS ${FCM_SCENES}/*.json)
+  set(unlisted "")
+  foreach(f ${scene_files})
+    string(REGEX REPLACE "\\.json$" "" name ${f})
+    if(NOT name IN_LIST listed)
+      list(APPEND unlisted ${name})
+    endif()
+  endforeach()
+  # the run summary on 2 processes counts every process's cells (points, boundary points,
+  # max |u|): the same lines as the serial fcm-sim's
+  foreach(name clamped_surface spinning_body)
+    add_test(NAME petsc_app_summary_${name}
+             COMMAND bash ${PROJECT_SOURCE_DIR}/tests/petsc/scene_app.sh summary
+                     ${MPIEXEC_EXECUTABLE} $<TARGET_FILE:fcm-sim> - ${FCM_SCENES}/${name}.json - -
+                     ${CMAKE_CURRENT_BINARY_DIR}/petsc_app_summary_${name})
+    set_tests_properties(petsc_app_summary_${name} PROPERTIES LABELS mpi TIMEOUT 120
+                         PROCESSORS 2 ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+  endforeach()
+  # every example scene is in one of the two lists (a new scene is added to one of them)
+  add_test(NAME petsc_app_scene_listed
+           COMMAND ${CMAKE_COMMAND} -E echo "example scenes in neither list: ${unlisted}")
+  set_tests_properties(petsc_app_scene_listed PROPERTIES LABELS mpi
+                       FAIL_REGULAR_EXPRESSION "neither list: [a-z]")
+endif()
+if(FCM_BUILD_APPS)
+  # fcm-sim --backend petsc on the integrator path: checkpoints (the scene's interval,
+  # --checkpoint-every), --resume byte for byte on 2 processes, to 1e-10 on 1 and serially
+  add_test(NAME petsc_app_newton_resume
+           COMMAND bash ${PROJECT_SOURCE_DIR}/tests/petsc/newton_resume.sh ${MPIEXEC_EXECUTABLE}
+                   $<TARGET_FILE:fcm-sim> $<TARGET_FILE:petsc_state_diff>
+                   ${FCM_SCENES}/clamped_surface.json
+                   ${CMAKE_CURRENT_BINARY_DIR}/petsc_app_newton_resume)
+  set_tests_properties(petsc_app_newton_resume PROPERTIES LABELS mpi TIMEOUT 300 PROCESSORS 2
+                       ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+endif()
+# phase 2 with cuts and quadrature.simplify = "auto" (tests/petsc/newton_cut.c): the example
+# scenes' cuts at t = 0 (dice: 10 planes into 36 sticks; cut_slab: 2 planes; cracked_beam: a
+# partial crack, static), a test scene cut between steps (after solves) plus a cut that misses,
+# and twisting_cylinder's "auto" (Hex20): against the serial run step by step, with the cut
+# bookkeeping and the simplification choice equal to the serial ones
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_newton_cut_dice_np${np} tests/petsc/newton_cut.c NP ${np}
+                   ARGS ${FCM_SCENES} dice.json 3)
+  fcm_add_mpi_test(petsc_newton_cut_slab_np${np} tests/petsc/newton_cut.c NP ${np}
+                   ARGS ${FCM_SCENES} cut_slab.json 3)
+  fcm_add_mpi_test(petsc_newton_cut_cracked_beam_np${np} tests/petsc/newton_cut.c NP ${np}
+                   ARGS ${FCM_SCENES} cracked_beam.json 1)
+  fcm_add_mpi_test(petsc_newton_cut_late_np${np} tests/petsc/newton_cut.c NP ${np}
+                   ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6)
+endforeach()
+# (2 processes: the choice's inputs are summed; on 1 the serial rules build decides)
+fcm_add_mpi_test(petsc_newton_auto_twisting_cylinder_np2 tests/petsc/newton_cut.c NP 2
+                 ARGS ${FCM_SCENES} twisting_cylinder.json 1 TIMEOUT 300)
+# the late cut with CG + GAMG on the rebuilt KSP
+fcm_add_mpi_test(petsc_newton_cut_late_gamg_np2 tests/petsc/newton_cut.c NP 2
+                 ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6 1e-8
+                      -ksp_type cg -pc_type gamg)
+# each problem reads its PETSc options under its own prefix (tests/petsc/options.c): strings
+# of earlier problems do not leak into later ones; the command line wins (unprefixed: every
+# problem; -fcm2_...: the second problem alone)
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_options_np${np} tests/petsc/options.c NP ${np}
+                   ARGS minres cg gmres jacobi gamg gamg)
+  fcm_add_mpi_test(petsc_options_cmdline_np${np} tests/petsc/options.c NP ${np}
+                   ARGS bcgs bcgs bcgs jacobi gamg gamg -ksp_type bcgs)
+  fcm_add_mpi_test(petsc_options_prefixed_np${np} tests/petsc/options.c NP ${np}
+                   ARGS minres cg gmres jacobi jacobi gamg -fcm2_pc_type jacobi)
 endforeach()

@@ -127,7 +127,9 @@ typedef struct fcm_cell_rules_options {
    * (no volume or surface rules, no simplification, no stabilization). For distributed runs,
    * where each process integrates its own cells only (fcm/petsc.h); the rules must then not be
    * assembled on unflagged cells. Not with FCM_CELL_SIMPLIFY_AUTO (its choice would depend on
-   * the mask); rules built with a mask cannot be cut (fcm_cell_rules_create_cut()). */
+   * the mask; the PETSc backend sums the choice's inputs over its processes internally).
+   * fcm_cell_rules_create_cut() of rules built with a mask keeps the mask: the same cells
+   * get points, every cell is split and gets its cut faces. */
   const unsigned char *cell_mask;
 } fcm_cell_rules_options;
 

@@ -13,7 +13,10 @@
  * - each linear solve is a PETSc KSP configured from the options database: defaults CG with
  *   GAMG and the rigid-body near-null space, overridden by the options string of the options
  *   (a scene's solver.petsc_options) and then by the command line (-ksp_type, -pc_type, ...:
- *   the command line wins, the ecosystem's convention).
+ *   the command line wins, the ecosystem's convention). Each problem reads them under its own
+ *   options prefix (fcm_petsc_info.options_prefix), so one problem's string never reaches
+ *   another problem's solver; the command line reaches every problem ("-fcm2_ksp_type ..."
+ *   the second one alone).
  *
  * Phase 1 (stated plainly): the mesh, the geometry and the space's topology (DOF numbering
  * and pattern, O(DOFs + nonzeros) integers) are replicated on every process; the heavy part
@@ -74,9 +77,9 @@ typedef struct fcm_petsc_options {
   double dt;                     /**< time step h > 0 (default 1/60) */
   fcm_petsc_partition partition; /**< default AUTO */
   const char *petsc_options;     /**< NULL (default) or PETSc options ("-ksp_type minres
-                                      -pc_type jacobi"), added to the options database at setup
-                                      under the command line (which wins for a key both set);
-                                      copied */
+                                      -pc_type jacobi"), read at setup by this problem's
+                                      solver only (under its options prefix) and under the
+                                      command line (which wins for a key both set); copied */
   double rtol;                   /**< KSP relative tolerance in (0, 1) (default 1e-10; the
                                       option -ksp_rtol overrides it) */
   int max_iterations;            /**< KSP iteration limit >= 1 (default 10000) */
@@ -219,6 +222,14 @@ typedef struct fcm_petsc_info {
   double matrix_memory;          /**< bytes of the system matrix's stored nonzeros over all
                                       processes (values and column indices, MatGetInfo) */
   long long steps, total_iterations;
+  char options_prefix[32];       /**< this problem's PETSc options prefix ("fcm1_", "fcm2_",
+                                      ...: one per problem, numbered in the order this process
+                                      made them); "-fcm2_ksp_type gmres" on the command line
+                                      reaches that problem's solver only */
+  char ksp_type[32];             /**< the KSP's type ("cg", "minres", ...; "" before setup) */
+  char pc_type[32];              /**< its PC's type ("gamg", "cholesky", ...; "" before setup) */
+  char factor_package[32];       /**< the package of an LU / Cholesky PC ("mumps", "petsc",
+                                      ...), else "" */
 } fcm_petsc_info;
 
 /** Fill `info` (collective: the sums and extremes are reduced). */
@@ -230,7 +241,7 @@ FCM_API fcm_status fcm_petsc_problem_get_info(fcm_petsc_problem *problem, fcm_pe
 FCM_API int fcm_petsc_problem_supports_scene(fcm_ctx *ctx, const fcm_scene *scene);
 
 /** A scene's ordinary simulation (fcm/simulation.h) on the processes of comm, for every
- * material and effect the serial runner has except cuts (phase 2: Newton on PETSc). Every
+ * material and effect the serial runner has, cuts included (phase 2: Newton on PETSc). Every
  * process runs the scene's fcm_integrator — Newton, line search, time stepping, constraints
  * on nodes and on the embedded boundary (Nitsche / penalty), gravity, tractions, pressure,
  * damping, initial velocities — on the same DOF numbering, but the cut-cell rules carry points
@@ -245,9 +256,20 @@ FCM_API int fcm_petsc_problem_supports_scene(fcm_ctx *ctx, const fcm_scene *scen
  *
  * The simulation is used as any other: fcm_simulation_step() is collective; the state, the
  * log rows (energies, mass, momentum, reactions) and the counters are the same on every
- * process, so one process (rank 0) writes the frames and the log with the serial writers.
- * Not supported (FCM_ERR_UNSUPPORTED naming it, on every process): "cut" effects,
- * quadrature.simplify = auto. Stated plainly: the sums are of replicated dense vectors and of
+ * process, so one process (rank 0) writes the log and the checkpoints with the serial
+ * writers (fcm_simulation_write_checkpoint(); every process of any count, and the serial
+ * runner, resumes from it with fcm_simulation_read_checkpoint()); fcm_simulation_write_frame()
+ * is collective (the cell fields are summed over the processes' cells, rank 0 writes), and
+ * fcm_petsc_simulation_summary_view() is the summary over every process's cells. A resumed run
+ * on the same process count repeats the uninterrupted one bit for bit when the KSP does (CG /
+ * MINRES with GAMG, Jacobi, ...: the initial guess is always zero and GAMG builds a new
+ * hierarchy per tangent); MUMPS on more than one process is not bitwise reproducible between
+ * runs (its parallel factorization), on one process it is.
+ * Cuts: every process splits every cell the cut reaches (the same pieces and DOF copies
+ * everywhere, checked: FCM_ERR_INTERNAL on every process if the topologies differ), builds its
+ * own cells' points, and the new integrator gets the backend again, rebuilt for the new DOF
+ * count. quadrature.simplify = auto: the choice's inputs are summed over the processes, so it
+ * is the serial run's. Stated plainly: the sums are of replicated dense vectors and of
  * the Newton matrix's values (O(DOFs + nonzeros) per process and assembly), the direction is
  * gathered on every process; the rules, the element integration and the solve are what is
  * distributed. Collective.
@@ -260,6 +282,16 @@ FCM_API fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm,
                                                fcm_petsc_partition partition,
                                                const fcm_simulation_options *opts,
                                                fcm_simulation **out);
+
+/** fcm_simulation_summary_view() of a simulation of fcm_petsc_simulation_create(), over the
+ * whole body: the cut-cell point counts (before / after simplification, stored, surface) are
+ * summed over the processes and the largest |u| over the body's quadrature points is taken
+ * over every process's cells (each process's rules carry its own cells' points only, so the
+ * plain summary on one process counts that process's cells). Collective; prints to f on the
+ * processes where f is not NULL (typically rank 0 only).
+ * @return FCM_OK; FCM_ERR_ARG (NULL simulation, or not a distributed one); FCM_ERR_ALLOC;
+ * FCM_ERR_INTERNAL (MPI). On every process when any failed. */
+FCM_API fcm_status fcm_petsc_simulation_summary_view(fcm_simulation *sim, FILE *f);
 
 #ifdef __cplusplus
 }

@@ -129,8 +129,10 @@ FCM_API int fcm_simulation_state_finite(const fcm_simulation *sim);
  * sides of every cut face with displacement, cut_face and the stresses at the points; u of a
  * vertex in a dropped cell is extrapolated from the nearest active cell), as the scene's
  * output section asks; <dir>/<name>_background.pvd and <dir>/<name>_surface.pvd are
- * rewritten. All writes are atomic. @return FCM_OK, FCM_ERR_IO (naming the path),
- * FCM_ERR_ALLOC. */
+ * rewritten. All writes are atomic. A simulation of fcm_petsc_simulation_create() (fcm/petsc.h):
+ * collective — every process calls it (the cell averages are summed over the processes'
+ * cells), process 0 writes the files, every process counts the frame. @return FCM_OK,
+ * FCM_ERR_IO (naming the path), FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_simulation_write_frame(fcm_simulation *sim, const char *dir, int index);
 
 /** Write the per-step log as CSV atomically to `path`: header

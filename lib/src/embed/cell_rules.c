@@ -133,6 +133,7 @@ typedef struct build {
   unsigned char *region, *rebuild;
   const fcm_cell_rules *prev;
   fcm_index first_new; /* cut triangles from here on are new (those of the cut being added) */
+  fcm__rules_reduce *red; /* distributed AUTO: sums the choice's inputs (NULL: none) */
   const unsigned char *remote; /* distributed classification: cells another process classifies
                                   (skipped here), NULL: none */
 } build;
@@ -532,7 +533,22 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
     FCM_TRY(ctx, copy_cell(B, c, o));
     goto cleanup;
   }
-  if (!own) { /* classification and piece volumes only (cell_mask) */
+  /* the pieces' sides of the cuts: on every cell, masked or not (the space's DOF copies
+   * depend on them: a cut along cell faces separates cells without splitting any) */
+  if (P && P->tcand.n > 0 && cls != FCM_CELL_DROPPED)
+    for (int i = 0; i < o->np; i++) {
+      double *phys = NULL;
+      int nt = 0;
+      FCM_TRY(ctx, fcm__embed_cut_faces(ctx, &cell, B->cut_tris, P, i, &phys, &nt));
+      o->pc[i].cfxi = phys;
+      o->pc[i].ncf = nt;
+      for (int k = 0; k < 3 * nt; k++) {
+        double xi[3], det;
+        FCM_TRY(ctx, fcm__embed_to_reference(ctx, &cell, phys + 3 * k, xi, &det));
+        memcpy(phys + 3 * k, xi, sizeof xi);
+      }
+    }
+  if (!own) { /* classification, piece volumes and cut faces only (cell_mask) */
     sums->time_intersect += fcm_wtime() - t0;
     goto cleanup;
   }
@@ -551,19 +567,6 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
       FCM_TRY(ctx, surface_piece(B, &cell, ws, o->pc + i));
     }
   }
-  if (P && P->tcand.n > 0 && cls != FCM_CELL_DROPPED) /* the pieces' sides of the cuts */
-    for (int i = 0; i < o->np; i++) {
-      double *phys = NULL;
-      int nt = 0;
-      FCM_TRY(ctx, fcm__embed_cut_faces(ctx, &cell, B->cut_tris, P, i, &phys, &nt));
-      o->pc[i].cfxi = phys;
-      o->pc[i].ncf = nt;
-      for (int k = 0; k < 3 * nt; k++) {
-        double xi[3], det;
-        FCM_TRY(ctx, fcm__embed_to_reference(ctx, &cell, phys + 3 * k, xi, &det));
-        memcpy(phys + 3 * k, xi, sizeof xi);
-      }
-    }
   sums->time_intersect += fcm_wtime() - t0;
   if (cls == FCM_CELL_CUT && opt->simplify != FCM_CELL_SIMPLIFY_AUTO) {
     const int on = opt->simplify == FCM_CELL_SIMPLIFY_ON;
@@ -576,7 +579,7 @@ cleanup:
   return st;
 }
 
-static fcm_status check_options(fcm_ctx *ctx, const fcm_cell_rules_options *o)
+static fcm_status check_options(fcm_ctx *ctx, const fcm_cell_rules_options *o, int reduced)
 {
   fcm_status st = FCM_OK;
   FCM_CHECK(o->kinds != 0 && (o->kinds & ~(unsigned)FCM_RULES_ALL) == 0, ctx, FCM_ERR_ARG,
@@ -599,7 +602,7 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_cell_rules_options *o)
                 kn, o->point_cost[k]);
     }
   }
-  FCM_CHECK(!o->cell_mask || o->simplify != FCM_CELL_SIMPLIFY_AUTO, ctx, FCM_ERR_ARG,
+  FCM_CHECK(!o->cell_mask || reduced || o->simplify != FCM_CELL_SIMPLIFY_AUTO, ctx, FCM_ERR_ARG,
             "embed: cell_mask with simplify = auto: the choice would depend on the mask (use on "
             "or off)");
   const int smax = o->simplify ? FCM_SIMPLIFY_MAX_STRENGTH : FCM_RULE_MAX_STRENGTH;
@@ -904,30 +907,48 @@ static fcm_status auto_simplify(const build *B, fcm_cell_rules *R, int nthreads,
   piece_out **cut = NULL;
   fcm_index ncut = 0;
   int pays[FCM_RULE_KIND_COUNT] = {0, 0};
+  /* the cut cells integrated here (with a cell_mask: this process's only; the others have
+   * no points) */
+#define AUTO_CELL(c)                                                                               \
+  (R->cls[c] == FCM_CELL_CUT && (!B->rebuild || B->rebuild[c]) &&                                  \
+   (!opt->cell_mask || opt->cell_mask[c]))
   for (fcm_index c = 0; c < nc; c++)
-    if (R->cls[c] == FCM_CELL_CUT && (!B->rebuild || B->rebuild[c])) ncut += out[c].np;
+    if (AUTO_CELL(c)) ncut += out[c].np;
   FCM_ALLOC(ctx, (size_t)ncut + 1, cut);
   ncut = 0;
   for (fcm_index c = 0; c < nc; c++)
-    if (R->cls[c] == FCM_CELL_CUT && (!B->rebuild || B->rebuild[c]))
+    if (AUTO_CELL(c))
       for (int i = 0; i < out[c].np; i++)
         cut[ncut++] = out[c].pc + i;
+#undef AUTO_CELL
+  /* the choice's inputs per kind: points, modelled simplification time, points kept */
+  double in[3 * FCM_RULE_KIND_COUNT];
+  memset(in, 0, sizeof in);
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    if (!B->tet_rule[k]) continue;
+    const int m = R->strength[k];
+    const double M = (double)(m + 1) * (m + 2) * (m + 3) / 6.0;
+    for (fcm_index i = 0; i < ncut; i++) {
+      const fcm_index n = cut[i]->ninit[k];
+      in[3 * k] += (double)n;
+      in[3 * k + 1] += fcm_simplify_cost_estimate(m, n);
+      in[3 * k + 2] += (double)n < M ? (double)n : M;
+    }
+  }
+  if (B->red && !B->prev) { /* distributed, masked: every process's cut cells */
+    B->red->called = 1;
+    FCM_TRY(ctx, B->red->fn(B->red->user, FCM_OK, in, 3 * FCM_RULE_KIND_COUNT));
+  }
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     if (!B->tet_rule[k]) continue; /* a kind not built: nothing to decide */
     fcm_simplify_decision *d = &R->stats.decision[k];
     const fcm_element_type type = fcm_mesh_element_type(B->mesh);
-    const int m = R->strength[k];
-    const double M = (double)(m + 1) * (m + 2) * (m + 3) / 6.0;
     d->expected_assemblies = opt->expected_assemblies[k];
     d->point_cost =
         opt->point_cost[k] == FCM_DEFAULT ? fcm_cell_rules_point_cost(type, k) : opt->point_cost[k];
-    double ntot = 0.0;
-    for (fcm_index i = 0; i < ncut; i++) {
-      const fcm_index n = cut[i]->ninit[k];
-      ntot += (double)n;
-      d->estimated_time += fcm_simplify_cost_estimate(m, n);
-      d->estimated_kept += (double)n < M ? (double)n : M;
-    }
+    const double ntot = in[3 * k];
+    d->estimated_time = in[3 * k + 1];
+    d->estimated_kept = in[3 * k + 2];
     d->cost_plain = ntot * d->point_cost * d->expected_assemblies;
     d->cost_simplified =
         d->estimated_time + d->estimated_kept * d->point_cost * d->expected_assemblies;
@@ -1214,9 +1235,11 @@ cleanup:
 /* The build shared by fcm_cell_rules_create() and fcm_cell_rules_create_cut(): R (from
  * rules_alloc, with its cut triangles set) is filled; `prev` (or NULL) is the object being
  * extended by the triangles from first_new on. With x (distributed classification, no cuts):
- * the cells of x->remote are skipped and their classes taken from x->exchange. */
+ * the cells of x->remote are skipped and their classes taken from x->exchange, before the
+ * AUTO choice (red). */
 static fcm_status build_rules_x(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
-                                const fcm_cell_rules *prev, fcm_index first_new, fcm_cell_rules *R,
+                                const fcm_cell_rules *prev, fcm_index first_new,
+                                fcm__rules_reduce *red, fcm_cell_rules *R,
                                 const fcm__rules_exchange *x, int *exchanged)
 {
   fcm_status st = FCM_OK;
@@ -1237,6 +1260,7 @@ static fcm_status build_rules_x(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_ge
   FCM_TRY(ctx, build_setup(ctx, mesh, geom, o, R, &B));
   B.prev = prev;
   B.first_new = first_new;
+  B.red = red;
   B.remote = x ? x->remote : NULL;
   if (R->num_cut_tris > 0) FCM_TRY(ctx, cut_setup(&B, R, first_new));
   FCM_ALLOC(ctx, (size_t)nc, out);
@@ -1276,37 +1300,44 @@ cleanup:
 }
 
 static fcm_status build_rules(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
-                              const fcm_cell_rules *prev, fcm_index first_new, fcm_cell_rules *R)
+                              const fcm_cell_rules *prev, fcm_index first_new,
+                              fcm__rules_reduce *red, fcm_cell_rules *R)
 {
   int exchanged = 0;
-  return build_rules_x(ctx, mesh, geom, prev, first_new, R, NULL, &exchanged);
+  return build_rules_x(ctx, mesh, geom, prev, first_new, red, R, NULL, &exchanged);
 }
 
+/* fcm_cell_rules_create() with the AUTO choice's reduce (red) and the distributed
+ * classification (x), each NULL when not used. */
 static fcm_status create_rules(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
-                               const fcm_cell_rules_options *opts, const fcm__rules_exchange *x,
-                               fcm_cell_rules **rules)
+                               const fcm_cell_rules_options *opts, fcm__rules_reduce *red,
+                               const fcm__rules_exchange *x, fcm_cell_rules **rules)
 {
   fcm_status st = FCM_OK;
   fcm_cell_rules *R = NULL;
   int exchanged = 0;
   const fcm_cell_rules_options o = opts ? *opts : fcm_cell_rules_options_default();
+  if (red) red->called = 0;
   FCM_CHECK(rules, ctx, FCM_ERR_ARG, "embed: output pointer is NULL");
   *rules = NULL;
   FCM_CHECK(ctx && mesh && geom, ctx, FCM_ERR_ARG,
             "embed: NULL argument (ctx, mesh and geometry are required)");
-  FCM_TRY(ctx, check_options(ctx, &o));
+  FCM_CHECK(!red || red->fn, ctx, FCM_ERR_ARG, "embed: a reduce without a function");
+  FCM_TRY(ctx, check_options(ctx, &o, red != NULL));
   FCM_CHECK(!x || (x->remote && x->exchange), ctx, FCM_ERR_ARG,
             "embed: distributed classification without a remote mask or exchange function");
-  FCM_CHECK(!x || o.simplify != FCM_CELL_SIMPLIFY_AUTO, ctx, FCM_ERR_ARG,
-            "embed: distributed classification with simplify = auto: the choice would depend on "
-            "the distribution (use on or off)");
+  FCM_CHECK(!x || red || o.simplify != FCM_CELL_SIMPLIFY_AUTO, ctx, FCM_ERR_ARG,
+            "embed: distributed classification with simplify = auto and no reduce: the choice "
+            "would depend on the distribution (use on or off)");
   for (fcm_index c = 0; x && o.cell_mask && c < fcm_mesh_num_cells(mesh); c++)
     FCM_CHECK(!(o.cell_mask[c] && x->remote[c]), ctx, FCM_ERR_ARG,
               "embed: cell %lld is flagged in the cell_mask (this process integrates it) and as "
               "classified by another process",
               (long long)c);
   FCM_TRY(ctx, rules_alloc(ctx, mesh, &o, &R));
-  FCM_TRY(ctx, build_rules_x(ctx, mesh, geom, NULL, 0, R, x, &exchanged));
+  FCM_TRY(ctx, build_rules_x(ctx, mesh, geom, NULL, 0,
+                             o.simplify == FCM_CELL_SIMPLIFY_AUTO ? red : NULL, R, x,
+                             &exchanged));
   R->masked = o.cell_mask != NULL;
   if (R->masked) {
     const fcm_index nc = fcm_mesh_num_cells(mesh);
@@ -1317,24 +1348,40 @@ static fcm_status create_rules(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geo
   *rules = R;
   R = NULL;
 cleanup:
-  if (x && !exchanged) /* failed before the exchange: the other processes wait in theirs */
+  /* failed before the exchange or the choice: meet the other processes there, in the order
+   * they call them (the exchange first) */
+  if (x && !exchanged)
     st = x->exchange(x->user, st != FCM_OK ? st : FCM_ERR_INTERNAL, NULL, NULL, NULL, NULL);
+  if (red && red->fn && !red->called && o.simplify == FCM_CELL_SIMPLIFY_AUTO) {
+    red->called = 1;
+    st = red->fn(red->user, st, NULL, 0);
+  }
   fcm_cell_rules_destroy(&R);
+  if (st != FCM_OK && rules) fcm_cell_rules_destroy(rules);
   return st;
 }
 
 fcm_status fcm_cell_rules_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
                                  const fcm_cell_rules_options *opts, fcm_cell_rules **rules)
 {
-  return create_rules(ctx, mesh, geom, opts, NULL, rules);
+  return create_rules(ctx, mesh, geom, opts, NULL, NULL, rules);
+}
+
+fcm_status fcm__cell_rules_create_reduced(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                          const fcm_geometry *geom,
+                                          const fcm_cell_rules_options *opts,
+                                          fcm__rules_reduce *red, fcm_cell_rules **rules)
+{
+  return create_rules(ctx, mesh, geom, opts, red, NULL, rules);
 }
 
 fcm_status fcm__cell_rules_create_distributed(fcm_ctx *ctx, const fcm_mesh *mesh,
                                               const fcm_geometry *geom,
                                               const fcm_cell_rules_options *opts,
+                                              fcm__rules_reduce *red,
                                               const fcm__rules_exchange *x, fcm_cell_rules **rules)
 {
-  return create_rules(ctx, mesh, geom, opts, x, rules);
+  return create_rules(ctx, mesh, geom, opts, red, x, rules);
 }
 
 #define CUT_ATTEMPTS 4
@@ -1370,9 +1417,6 @@ fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const f
                 fcm_mesh_element_type(mesh) == prev->type,
             ctx, FCM_ERR_ARG, "embed cut: the mesh (%lld cells) is not the rules' mesh (%lld)",
             (long long)fcm_mesh_num_cells(mesh), (long long)prev->num_cells);
-  FCM_CHECK(!prev->masked, ctx, FCM_ERR_UNSUPPORTED,
-            "embed cut: the rules were built with a cell_mask (some cells have no points); cut "
-            "rules built for every cell");
   FCM_CHECK(prev->num_cuts < 1 << 20, ctx, FCM_ERR_UNSUPPORTED,
             "embed cut: %d cuts already (limit 2^20)", prev->num_cuts);
   const fcm_index nt = fcm_surface_num_triangles(cut);
@@ -1409,12 +1453,22 @@ fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const f
     }
     R->num_cuts = prev->num_cuts + 1;
     R->prev_num_pieces = prev->num_pieces;
-    FCM_TRY(ctx, build_rules(ctx, mesh, geom, prev, prev->num_cut_tris, R));
+    /* rules built with a cell_mask: the same cells get points (the others are classified,
+     * split and get their cut faces: the same pieces and DOF copies on every process) */
+    R->opts.cell_mask = prev->own;
+    st = build_rules(ctx, mesh, geom, prev, prev->num_cut_tris, NULL, R);
+    R->opts.cell_mask = NULL;
+    FCM_TRY(ctx, st);
     degenerate = R->stats.num_degenerate;
     for (int j = 0; j < 3; j++)
       R->stats.cut_shift[j] = d * dir[j];
     R->stats.cut_attempts = attempt + 1;
     if (degenerate == 0) break;
+  }
+  if (prev->masked) {
+    R->masked = 1;
+    FCM_ALLOC(ctx, (size_t)prev->num_cells + 1, R->own);
+    memcpy(R->own, prev->own, (size_t)prev->num_cells);
   }
   FCM_CHECK(degenerate == 0, ctx, FCM_ERR_GEOMETRY,
             "embed cut: the cut meets %lld cell(s) in a degenerate way that shifts of up to %g "

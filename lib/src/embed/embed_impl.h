@@ -149,15 +149,6 @@ typedef struct fcm__rules_exchange {
   void *user;
 } fcm__rules_exchange;
 
-/* fcm_cell_rules_create() with the classification of the cells flagged in x->remote taken from
- * x->exchange (see above; x NULL: fcm_cell_rules_create()). opts->simplify must not be AUTO
- * (its choice sums every cut cell's points). The statistics' counters are this process's
- * unless the exchange sums them; time_intersect covers this process's cells. */
-fcm_status fcm__cell_rules_create_distributed(fcm_ctx *ctx, const fcm_mesh *mesh,
-                                              const fcm_geometry *geom,
-                                              const fcm_cell_rules_options *opts,
-                                              const fcm__rules_exchange *x, fcm_cell_rules **rules);
-
 /* Clip every candidate embedded cell E by the planes of `cell` and tetrahedralize the
  * pieces into ws->tets / ws->vol. Both tolerances follow the smaller of the two scales,
  * so that geometry much thinner than the background cell keeps its volume: a vertex is
@@ -311,5 +302,38 @@ static inline int fcm__cell_rules_owns(const fcm_cell_rules *R, fcm_index cell)
 {
   return !R || !R->own || R->own[cell];
 }
+
+/* A sum over the processes of a distributed run (the PETSc backend's reduce): agree on st
+ * (on a failure anywhere every process returns it), then sum values[0 .. count) in place, the
+ * same bits on every process. Collective. */
+typedef struct fcm__rules_reduce {
+  fcm_status (*fn)(void *user, fcm_status st, double *values, fcm_index count);
+  void *user;
+  int called; /* set once fn was called (every process calls it exactly once) */
+} fcm__rules_reduce;
+
+/* fcm_cell_rules_create() for a distributed run with a cell_mask and simplify = AUTO: the
+ * choice's inputs (each kind's cut-cell point counts and the modelled simplification time,
+ * which the mask limits to this process's cells) are summed through red->fn, so every
+ * process takes the choice the unmasked (serial) build takes. red->fn is called exactly once
+ * by every process when simplify is AUTO, with the status reached so far (also on a failure
+ * before the choice, so no process waits for another). red NULL: fcm_cell_rules_create().
+ * Collective when red is given and simplify is AUTO. */
+fcm_status fcm__cell_rules_create_reduced(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                          const fcm_geometry *geom,
+                                          const fcm_cell_rules_options *opts,
+                                          fcm__rules_reduce *red, fcm_cell_rules **rules);
+
+/* fcm__cell_rules_create_reduced() with the classification of the cells flagged in x->remote
+ * taken from x->exchange (fcm__rules_exchange above; x NULL: fcm__cell_rules_create_reduced()).
+ * The exchange runs before the AUTO choice's reduce; on a failure before either, both are
+ * still called, in that order. simplify = AUTO needs red. The statistics' counters are this
+ * process's unless the exchange sums them; time_intersect covers this process's cells.
+ * Collective. */
+fcm_status fcm__cell_rules_create_distributed(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                              const fcm_geometry *geom,
+                                              const fcm_cell_rules_options *opts,
+                                              fcm__rules_reduce *red,
+                                              const fcm__rules_exchange *x, fcm_cell_rules **rules);
 
 #endif /* FCM_EMBED_IMPL_H */

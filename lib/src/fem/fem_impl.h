@@ -76,4 +76,14 @@ void fcm__space_copy_support(const fcm_space *s, double *support);
 fcm_status fcm__assembly_element_linear(fcm_assembly_workspace *ws, const fcm_linear_form *form,
                                         fcm_index elem, double *Ke, double *fe);
 
+/* fcm_space_write_vtu() with the cell fields given (cells: 8 per cell, the stress (6), the von
+ * Mises stress and the strain energy density, as fcm_space_cell_stress() averages them), or
+ * computed when cells is NULL (a distributed run sums them over the processes first). */
+fcm_status fcm__space_write_vtu_cells(const fcm_space *s, const fcm_material *mat, const double *u,
+                                      const double *v, const double *cells, const char *path);
+
+/* fcm_space_max_displacement() per cell: the largest |u| over each cell's authentic points
+ * (0 for a cell without points). */
+fcm_status fcm__space_cell_max_displacement(const fcm_space *s, const double *u, double *cell_max);
+
 #endif /* FCM_FEM_IMPL_H */

@@ -177,6 +177,34 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__space_cell_max_displacement(const fcm_space *s, const double *u, double *cell_max)
+{
+  fcm_status st = FCM_OK;
+  fcm_rule *full = NULL;
+  FCM_TRY(s->ctx,
+          fcm_element_standard_rule(s->ctx, s->type, FCM_RULE_STIFFNESS, FCM_DEFAULT, &full));
+  for (fcm_index c = 0; c < s->num_cells; c++) {
+    double best = 0.0;
+    for (fcm_index e = s->cell_elem[c]; e < s->cell_elem[c + 1]; e++) {
+      int nq = 0;
+      const double *pts = NULL, *w = NULL;
+      const unsigned char *fl = NULL;
+      element_points(s, full, e, &nq, &pts, &w, &fl);
+      for (int q = 0; q < nq; q++) {
+        double v[3];
+        if (fl && fl[q]) continue;
+        fcm_space_element_eval(s, e, pts + 3 * q, u, v);
+        const double n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        if (!(n2 <= best)) best = n2; /* NaN propagates */
+      }
+    }
+    cell_max[c] = sqrt(best);
+  }
+cleanup:
+  fcm_rule_destroy(&full);
+  return st;
+}
+
 fcm_status fcm_space_node_field(const fcm_space *s, const double *dofs, double *node_field)
 {
   fcm_status st = FCM_OK;
@@ -205,6 +233,12 @@ cleanup:
 
 fcm_status fcm_space_write_vtu(const fcm_space *s, const fcm_material *mat, const double *u,
                                const double *v, const char *path)
+{
+  return fcm__space_write_vtu_cells(s, mat, u, v, NULL, path);
+}
+
+fcm_status fcm__space_write_vtu_cells(const fcm_space *s, const fcm_material *mat, const double *u,
+                                      const double *v, const double *cells, const char *path)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s ? s->ctx : NULL;
@@ -237,8 +271,16 @@ fcm_status fcm_space_write_vtu(const fcm_space *s, const fcm_material *mat, cons
     FCM_ALLOC(ctx, 6 * nc + 1, sig);
     FCM_ALLOC(ctx, nc + 1, vm);
     FCM_ALLOC(ctx, nc + 1, sed);
-    if (!u) FCM_ALLOC(ctx, s->num_dofs + 1, zero);
-    FCM_TRY(ctx, fcm_space_cell_stress(s, mat, u ? u : zero, sig, vm, sed));
+    if (cells) { /* given: 8 per cell, stress (6), von Mises, strain energy density */
+      for (fcm_index c = 0; c < nc; c++) {
+        memcpy(sig + 6 * c, cells + 8 * c, 6 * sizeof *sig);
+        vm[c] = cells[8 * c + 6];
+        sed[c] = cells[8 * c + 7];
+      }
+    } else {
+      if (!u) FCM_ALLOC(ctx, s->num_dofs + 1, zero);
+      FCM_TRY(ctx, fcm_space_cell_stress(s, mat, u ? u : zero, sig, vm, sed));
+    }
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "stress", 6, nc, sig));
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "von_mises", 1, nc, vm));
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "strain_energy_density", 1, nc, sed));

@@ -73,7 +73,49 @@
  *   is a soft failure (the integrator halves the step). Direction gathered with a cached
  *   VecScatterCreateToAll.
  * - fcm-sim --backend petsc routes scenes fcm_petsc_problem_supports_scene() rejects to it
- *   (apps/fcm-sim-petsc.c run_newton(); process 0 writes the serial frames and log).
+ *   (apps/fcm-sim-petsc.c run_newton(); process 0 writes the serial frames, log and
+ *   checkpoints).
+ * - checkpoints on the phase-2 path: fcm-sim run_newton(): process 0 writes the serial .fcmck,
+ *   every process reads it; frames with every process's cell fields
+ *   (fcm_simulation_write_frame() collective in a distributed run); the summary over every
+ *   process's cells (fcm_petsc_simulation_summary_view()). Bit-identical resume on the same
+ *   count needed a zero initial guess in newton_solve() and PCGAMGSetReuseInterpolation(FALSE):
+ *   3.18's GAMG reused the previous tangent's interpolation, so a resumed run (fresh KSP)
+ *   differed at ~1e-16 on 1 and 2 processes. Tests: petsc_app_newton_resume,
+ *   petsc_app_scene_*, petsc_app_summary_*.
+ * - cuts: fcm_cell_rules_create_cut() of masked rules keeps the mask (the
+ *   same cells get points); every cell, masked or not, is classified, split into pieces and
+ *   gets its cut faces (cell_rules.c computes the cut faces before the mask check: the space's
+ *   DOF copies depend on them, a cut along cell faces separates cells without splitting any).
+ *   fcm_integrator_create_cut() asks the old integrator's backend for a new one
+ *   (fcm__sim_backend.cut = newton_cut(): agree, newton_unbuild(), newton_build() for the new
+ *   space — numbering, ownership, MATMPIAIJ, vectors, KSP, the scatter made at the first
+ *   solve — and one more reference to the same P), before the new integrator's setup (its
+ *   mass and load sums). newton_build() checks the replicated topology (DOF and element
+ *   counts, a hash of the elements' cells, pieces and DOFs: min = max over the processes,
+ *   else FCM_ERR_INTERNAL on every process). The old integrator keeps its reference until
+ *   fcm__sim_apply_cut() destroys it; its factor / solve would refuse the rebuilt objects
+ *   (size check, P->factored). fcm__sim_apply_cut() ends with fcm__integrator_finish()
+ *   (newton_finish(): agree unless a failure was agreed already), so a process that fails in
+ *   the local part of a cut meets the others in the hook's agree (tests/petsc/newton_failure.c
+ *   case 4). The "cut missed" counters, pieces, DOFs and the rules' classification equal the
+ *   serial run's (tests/petsc/newton_cut.c).
+ * - quadrature.simplify = "auto": the choice's inputs (per kind: cut-cell points, the modelled
+ *   simplification time, points kept; from this process's own cut cells with a mask) are summed
+ *   over the processes inside the rules build (fcm__cell_rules_create_reduced(), embed_impl.h:
+ *   a reduce callback, here newton_reduce() passed through fcm__simulation_create_distributed()
+ *   before the integrator exists; called exactly once per process, also on a failure before
+ *   the choice), so every process takes the serial run's choice. The modelled time is summed
+ *   in another order than the serial run's (round-off only: a choice exactly at the threshold
+ *   could differ). A cut inherits the choice of the rules it extends (no sum needed).
+ * - options prefix per problem ("fcm<k>_", k counting the problems
+ *   this process made; fcm_petsc_info.options_prefix): insert_options() puts the problem's
+ *   string and then a copy of the database's other options (PetscOptionsGetAll: command line,
+ *   files, values the program set; not those of other problems' prefixes) under it
+ *   (PetscOptionsPrefixPush), then restores the options that name this prefix; the KSP
+ *   carries the prefix (both drivers). The prefixed entries stay in
+ *   the database after the problem (harmless: no later problem has that prefix; PETSc's
+ *   -options_left would list the unused ones). tests/petsc/options.c.
  * Not done:
  * - bit-identical resume: PT-Scotch's partition of the same scene on 2 processes differs
  *   between runs now and then (131/133 or 132/132 own elements of slingshot, although
@@ -87,12 +129,10 @@
  *   per process); next: add each process's partial tangent into the MATMPIAIJ with ADD_VALUES
  *   (own elements only; the eliminated rows' diagonal by the owner), sum the force only on
  *   owned rows (VecScatter of ghosts), keep the line search's scalars as Allreduce.
- * - cuts (the cut rules extend whole rules: refused), quadrature.simplify = auto (its decision
- *   sums every cut cell's point counts: would need a reduce inside the rules build),
- *   checkpoints on the phase-2 path (fcm-sim refuses --checkpoint-every / --resume there; the
- *   replicated state makes process 0's fcm_simulation_write_checkpoint() the natural start),
- *   cell fields (stresses) of other processes' cut cells in process 0's frames, the summary's
- *   point counts and max |u| (process 0's cells only).
+ * - cuts keep the partition made at the start (the pieces of a split cell belong to its
+ *   owner; cut-heavy regions are not rebalanced) and the cut's classification of every cell
+ *   runs on every process (replicated; the first build's is distributed, see above); the cut-cell weight 4 of the
+ *   partition is not updated for cells a later cut reaches.
  * - the linear driver (phase 1) could now be replaced by the phase-2 path for the scenes both
  *   run (they agree to the KSP tolerance); it is kept: it assembles straight into PETSc and
  *   scales further (no dense sums), and its tests and checkpoints stay.
@@ -148,6 +188,7 @@ struct fcm_petsc_problem {
   fcm_material mat;
   fcm_petsc_options opts;
   char *petsc_options; /* copy */
+  char prefix[32];     /* the KSP's options prefix, unique per problem ("fcm1_", ...) */
   fcm_petsc_partition partition;
   fcm_cell_rules *rules; /* this process's cells carry points */
   fcm_space *space;      /* replicated topology */
@@ -201,6 +242,7 @@ struct fcm_petsc_problem {
   int pc_type_set;   /* -pc_type in the options database: keep it */
   int direct;        /* the scene asks for a direct solver: MUMPS (Cholesky / LU) */
   long long factors; /* matrices given to the KSP */
+  int factored;      /* a matrix was given to the KSP since the last (re)build (cuts) */
   VecScatter to_all;
   Vec all;
 };
@@ -262,6 +304,17 @@ static fcm_status problem_agree(fcm_petsc_problem *P, fcm_status st)
 }
 
 /* ---------------------------------------------------------------- init */
+
+/* Problems made so far by this process (every process makes them in the same order: the
+ * creators are collective), for the options prefixes. */
+static unsigned long fcm_petsc_num_problems = 0;
+
+/* A new problem's options prefix "fcm<k>_" (k = 1, 2, ...). */
+static void set_prefix(fcm_petsc_problem *P)
+{
+  snprintf(P->prefix, sizeof P->prefix, "fcm%lu_", ++fcm_petsc_num_problems);
+}
+
 
 static int fcm_petsc_started_mpi = 0;
 
@@ -531,7 +584,7 @@ static fcm_status build_space(fcm_petsc_problem *P, const fcm_geometry *geom,
         FCM_RULES_STIFFNESS | (P->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER ? FCM_RULES_MASS : 0u);
     ro.cell_mask = mask;
     const fcm__rules_exchange x = {P->remote, rules_exchange, P};
-    FCM_TRY(ctx, fcm__cell_rules_create_distributed(ctx, P->mesh, geom, &ro, &x, &P->rules));
+    FCM_TRY(ctx, fcm__cell_rules_create_distributed(ctx, P->mesh, geom, &ro, NULL, &x, &P->rules));
     FCM_TRY(ctx, fcm_space_create_embedded(ctx, P->mesh, P->rules, &P->space));
   } else {
     FCM_TRY(ctx, fcm_space_create(ctx, P->mesh, NULL, &P->space));
@@ -875,6 +928,7 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
       st = FCM_ERR_ALLOC;
   }
   P->opts.petsc_options = NULL;
+  set_prefix(P);
   if (st == FCM_OK) st = check_inputs(P, &P->opts);
   FCM_TRY(ctx, agree(ctx, P->comm, st));
 
@@ -1163,19 +1217,63 @@ cleanup:
   return st;
 }
 
-/* The options database: the problem's string under the command line (re-inserted after it,
- * so a key both give takes the command line's value). */
+/* 1 when the option name carries a problem's prefix ("-fcm12_ksp_type"). */
+static int has_problem_prefix(const char *name)
+{
+  if (strncmp(name, "-fcm", 4) != 0 || !(name[4] >= '0' && name[4] <= '9')) return 0;
+  const char *q = name + 4;
+  while (*q >= '0' && *q <= '9')
+    q++;
+  return *q == '_';
+}
+
+/* The options database, scoped to this problem (the KSP carries the prefix P->prefix, and
+ * through it the PC and its inner solvers): the problem's string under the prefix, then every
+ * option the database held before (the command line, option files, PETSC_OPTIONS, values set
+ * by the program) copied under the prefix, so a key both give takes the database's value; last
+ * the options that name this problem's prefix themselves ("-fcm2_ksp_type") as they were, so
+ * they win over both. Options of other problems' prefixes are not copied: one problem's string
+ * never reaches another problem's solver. (Values are split at spaces, as PETSc lists them.) */
 static fcm_status insert_options(fcm_petsc_problem *P)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P->ctx;
-  if (!P->petsc_options || !*P->petsc_options) return FCM_OK;
-  int argc = 0;
-  char **argv = NULL;
-  PCALL(ctx, PetscOptionsInsertString(NULL, P->petsc_options));
-  PCALL(ctx, PetscGetArgs(&argc, &argv));
-  if (argc > 1) PCALL(ctx, PetscOptionsInsert(NULL, &argc, &argv, NULL));
+  char *all = NULL, **name = NULL, **value = NULL;
+  int pushed = 0;
+  size_t count = 0;
+  PCALL(ctx, PetscOptionsGetAll(NULL, &all));
+  {
+    const size_t len = strlen(all);
+    name = fcm__calloc(ctx, len / 2 + 1, sizeof *name);
+    value = fcm__calloc(ctx, len / 2 + 1, sizeof *value);
+    FCM_CHECK(name && value, ctx, FCM_ERR_ALLOC, "petsc: out of memory (options)");
+    char *save = NULL;
+    for (char *tok = strtok_r(all, " \t\n", &save); tok; tok = strtok_r(NULL, " \t\n", &save)) {
+      const int is_name = tok[0] == '-' && ((tok[1] >= 'a' && tok[1] <= 'z') ||
+                                            (tok[1] >= 'A' && tok[1] <= 'Z') || tok[1] == '_');
+      if (is_name)
+        name[count++] = tok;
+      else if (count > 0 && !value[count - 1])
+        value[count - 1] = tok;
+    }
+  }
+  PCALL(ctx, PetscOptionsPrefixPush(NULL, P->prefix));
+  pushed = 1;
+  if (P->petsc_options && *P->petsc_options)
+    PCALL(ctx, PetscOptionsInsertString(NULL, P->petsc_options));
+  for (size_t k = 0; k < count; k++)
+    if (!has_problem_prefix(name[k])) PCALL(ctx, PetscOptionsSetValue(NULL, name[k], value[k]));
+  pushed = 0;
+  PCALL(ctx, PetscOptionsPrefixPop(NULL));
+  const size_t plen = strlen(P->prefix);
+  for (size_t k = 0; k < count; k++)
+    if (strncmp(name[k] + 1, P->prefix, plen) == 0)
+      PCALL(ctx, PetscOptionsSetValue(NULL, name[k], value[k]));
 cleanup:
+  if (pushed) PetscOptionsPrefixPop(NULL);
+  fcm__free(ctx, name);
+  fcm__free(ctx, value);
+  PetscFree(all);
   return st;
 }
 
@@ -1227,6 +1325,7 @@ fcm_status fcm_petsc_problem_setup(fcm_petsc_problem *P)
   /* 3. the KSP: defaults, then the options database */
   FCM_TRY(ctx, insert_options(P));
   PCALL(ctx, KSPCreate(P->comm, &P->ksp));
+  PCALL(ctx, KSPSetOptionsPrefix(P->ksp, P->prefix));
   PCALL(ctx, KSPSetOperators(P->ksp, P->Se, P->Se));
   PCALL(ctx, KSPSetType(P->ksp, KSPCG));
   {
@@ -1452,6 +1551,22 @@ fcm_status fcm_petsc_problem_get_info(fcm_petsc_problem *P, fcm_petsc_info *info
   }
   info->steps = P->steps;
   info->total_iterations = P->total_iterations;
+  snprintf(info->options_prefix, sizeof info->options_prefix, "%s", P->prefix);
+  if (P->ksp) {
+    KSPType kt = NULL;
+    PCType pt = NULL;
+    PC pc;
+    PCALL(ctx, KSPGetType(P->ksp, &kt));
+    PCALL(ctx, KSPGetPC(P->ksp, &pc));
+    PCALL(ctx, PCGetType(pc, &pt));
+    snprintf(info->ksp_type, sizeof info->ksp_type, "%s", kt ? kt : "");
+    snprintf(info->pc_type, sizeof info->pc_type, "%s", pt ? pt : "");
+    if (pt && (!strcmp(pt, PCLU) || !strcmp(pt, PCCHOLESKY))) {
+      MatSolverType mst = NULL;
+      PCALL(ctx, PCFactorGetMatSolverType(pc, &mst));
+      snprintf(info->factor_package, sizeof info->factor_package, "%s", mst ? mst : "");
+    }
+  }
 cleanup:
   return st;
 }
@@ -1669,6 +1784,14 @@ static fcm_status newton_factor(void *user, const fcm_csr *H, int psd, int *fail
   PetscInt *cols = NULL;
   fcm_index maxrow = 0;
   *failed = 0;
+  {
+    fcm_index rows = 0;
+    fcm_csr_get_size(H, &rows, NULL, NULL);
+    FCM_CHECK(rows == P->n, ctx, FCM_ERR_INTERNAL,
+              "petsc: a Newton matrix of %lld rows for a backend of %lld DOFs (an integrator "
+              "used after a cut replaced it)",
+              (long long)rows, (long long)P->n);
+  }
   for (fcm_index i = 0; i < P->n; i++)
     maxrow = FCM_MAX(maxrow, rp[i + 1] - rp[i]);
   cols = fcm__calloc(ctx, (size_t)maxrow + 1, sizeof *cols);
@@ -1702,7 +1825,7 @@ static fcm_status newton_factor(void *user, const fcm_csr *H, int psd, int *fail
     if (!cur || strcmp(cur, want) != 0) { /* a new factor PC: MUMPS again, unless the user chose */
       PetscBool has = PETSC_FALSE;
       PCALL(ctx, PCSetType(pc, want));
-      PCALL(ctx, PetscOptionsHasName(NULL, NULL, "-pc_factor_mat_solver_type", &has));
+      PCALL(ctx, PetscOptionsHasName(NULL, P->prefix, "-pc_factor_mat_solver_type", &has));
       if (!has) PCALL(ctx, PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
       PCALL(ctx, PCSetFromOptions(pc));
     }
@@ -1712,6 +1835,7 @@ static fcm_status newton_factor(void *user, const fcm_csr *H, int psd, int *fail
   PCALL(ctx, KSPSetOperators(P->ksp, P->S, P->S));
   PCALL(ctx, KSPSetUp(P->ksp));
   P->factors++;
+  P->factored = 1;
 cleanup:
   fcm__free(ctx, cols);
   return st;
@@ -1731,6 +1855,9 @@ static fcm_status newton_solve(void *user, const double *b, double *x, int *iter
   PetscInt its = 0;
   *failed = 0;
   *iterations = 0;
+  FCM_CHECK(P->factored, ctx, FCM_ERR_INTERNAL,
+            "petsc: a solve without a Newton matrix given since the backend was (re)built (an "
+            "integrator used after a cut replaced it)");
   PCALL(ctx, VecGetArray(P->b, &bb));
   for (fcm_index k = 0; k < P->ncopy; k++) {
     if (P->copy_owner[k] != P->rank) continue;
@@ -1740,6 +1867,9 @@ static fcm_status newton_solve(void *user, const double *b, double *x, int *iter
   }
   PCALL(ctx, VecRestoreArray(P->b, &bb));
   bb = NULL;
+  /* a zero initial guess also under -ksp_initial_guess_nonzero: the last direction is no state
+   * of the run (a checkpoint does not hold it), so a resumed run takes the same iterations */
+  PCALL(ctx, VecZeroEntries(P->x));
   PCALL(ctx, KSPSolve(P->ksp, P->b, P->x));
   PCALL(ctx, KSPGetConvergedReason(P->ksp, &reason));
   PCALL(ctx, KSPGetIterationNumber(P->ksp, &its));
@@ -1763,21 +1893,61 @@ cleanup:
   return st;
 }
 
-/* fcm__simulation_attach_fn: the simulation's space is built (every process reached here
- * unless one failed: agree first); number the DOFs, create the matrix, vectors and KSP, and
- * hand the backend to the integrator. */
-static fcm_status newton_attach(void *user, fcm_integrator *integ, const fcm_space *space)
+/* A 64-bit FNV-1a hash of n bytes, continuing h. */
+static uint64_t fnv1a(uint64_t h, const void *data, size_t n)
 {
-  fcm_petsc_problem *P = user;
-  fcm_status st = FCM_OK;
+  const unsigned char *b = data;
+  for (size_t i = 0; i < n; i++)
+    h = (h ^ b[i]) * 0x100000001b3ULL;
+  return h;
+}
+
+/* The space's topology (DOF count, elements, their cells, pieces and DOFs) is replicated: it
+ * must be the same on every process (a cut's pieces and DOF copies come from the
+ * classification, which every process makes for every cell). FCM_ERR_INTERNAL on every
+ * process, naming the counts, when it is not. Collective. */
+static fcm_status check_topology(fcm_petsc_problem *P)
+{
+  const fcm_space *s = P->space;
+  uint64_t h = 0xcbf29ce484222325ULL;
+  const long long counts[2] = {(long long)s->num_dofs, (long long)s->num_elems};
+  h = fnv1a(h, counts, sizeof counts);
+  h = fnv1a(h, s->elem_cell, sizeof *s->elem_cell * (size_t)s->num_elems);
+  h = fnv1a(h, s->elem_piece, sizeof *s->elem_piece * (size_t)s->num_elems);
+  h = fnv1a(h, s->elem_dof, sizeof *s->elem_dof * (size_t)s->num_elems * (size_t)s->nn);
+  /* min and max over the processes of (DOFs, elements, hash): min of x and of -x */
+  long long mine[6] = {counts[0], counts[1], (long long)(h >> 1), -counts[0], -counts[1],
+                       -(long long)(h >> 1)};
+  long long all[6];
+  if (MPI_Allreduce(mine, all, 6, MPI_LONG_LONG, MPI_MIN, P->comm) != MPI_SUCCESS)
+    return fcm__error(P->ctx, FCM_ERR_INTERNAL, __FILE__, __LINE__, __func__,
+                      "petsc: MPI_Allreduce of the topology check failed");
+  if (all[0] != -all[3] || all[1] != -all[4] || all[2] != -all[5])
+    return fcm__error(P->ctx, FCM_ERR_INTERNAL, __FILE__, __LINE__, __func__,
+                      "petsc: the space's DOF numbering differs between the processes (DOFs "
+                      "%lld to %lld, elements %lld to %lld, topology hashes %s; this process: "
+                      "%lld DOFs): the replicated classification of the cells (and of a cut's "
+                      "pieces) must agree on every process",
+                      all[0], -all[3], all[1], -all[4], all[2] != -all[5] ? "differ" : "agree",
+                      counts[0]);
+  return FCM_OK;
+}
+
+/* The backend's PETSc objects and numbering for P->space: number the DOFs, check that every
+ * process has the same topology, create the matrix, vectors and KSP. Agrees on st first and
+ * on the result last. Collective. */
+static fcm_status newton_build(fcm_petsc_problem *P, fcm_status st, const fcm_space *space)
+{
   fcm_ctx *ctx = P->ctx;
-  if (newton_agree(P, FCM_OK) != FCM_OK) return FCM_ERR_ARG; /* another process failed */
+  st = newton_agree(P, st);
+  if (st != FCM_OK) return st; /* another process failed */
   P->space = (fcm_space *)space; /* borrowed: P->borrowed_space */
   P->mesh = fcm_space_mesh(space);
   st = number_dofs(P);
   for (fcm_index c = 0; st == FCM_OK && c < fcm_mesh_num_cells(P->mesh); c++)
     if (!space->active[c]) P->cell_owner[c] = -1;
   FCM_TRY(ctx, newton_agree(P, st));
+  FCM_TRY(ctx, newton_agree(P, check_topology(P)));
   st = create_matrix(P, &P->S);
   if (st == FCM_OK) st = create_vectors(P);
   if (st == FCM_OK) st = near_null_space(P, P->S);
@@ -1786,6 +1956,7 @@ static fcm_status newton_attach(void *user, fcm_integrator *integ, const fcm_spa
     PetscBool has = PETSC_FALSE;
     PC pc;
     PCALL(ctx, KSPCreate(P->comm, &P->ksp));
+    PCALL(ctx, KSPSetOptionsPrefix(P->ksp, P->prefix));
     PCALL(ctx, KSPGetPC(P->ksp, &pc));
     if (P->direct) { /* the scene's "direct": MUMPS, the PETSc backend's direct option */
       PCALL(ctx, KSPSetType(P->ksp, KSPPREONLY));
@@ -1798,44 +1969,99 @@ static fcm_status newton_attach(void *user, fcm_integrator *integ, const fcm_spa
     PCALL(ctx, KSPSetTolerances(P->ksp, P->opts.rtol, PETSC_DEFAULT, PETSC_DEFAULT,
                                 P->opts.max_iterations));
     PCALL(ctx, KSPSetFromOptions(P->ksp));
-    PCALL(ctx, PetscOptionsHasName(NULL, NULL, "-ksp_type", &has));
+    PCALL(ctx, PetscOptionsHasName(NULL, P->prefix, "-ksp_type", &has));
     P->ksp_type_set = has == PETSC_TRUE;
-    PCALL(ctx, PetscOptionsHasName(NULL, NULL, "-pc_type", &has));
+    PCALL(ctx, PetscOptionsHasName(NULL, P->prefix, "-pc_type", &has));
     P->pc_type_set = has == PETSC_TRUE;
+    /* GAMG (PETSc 3.18) reuses the previous tangent's interpolation by default: the solves
+     * would then depend on the run's history, and a resumed run (a fresh KSP) would differ
+     * from the uninterrupted one at round-off. A new hierarchy for each tangent, as the serial
+     * solvers do, unless -pc_gamg_reuse_interpolation says otherwise (no effect on other PCs). */
+    PCALL(ctx, PetscOptionsHasName(NULL, P->prefix, "-pc_gamg_reuse_interpolation", &has));
+    if (!has) PCALL(ctx, PCGAMGSetReuseInterpolation(pc, PETSC_FALSE));
   }
 cleanup:
+  if (P->agreed_fail) return st; /* failed in an agreement above: every process knows */
+  return newton_agree(P, st);
+}
+
+/* Release what newton_build() made (a cut rebuilds it for the new space). */
+static void newton_unbuild(fcm_petsc_problem *P)
+{
+  fcm_ctx *ctx = P->ctx;
+  KSPDestroy(&P->ksp);
+  MatDestroy(&P->S);
+  Vec *vs[] = {&P->f, &P->u, &P->v, &P->b, &P->x, &P->g, &P->w, &P->all};
+  for (size_t i = 0; i < sizeof vs / sizeof vs[0]; i++)
+    VecDestroy(vs[i]);
+  VecScatterDestroy(&P->to_all);
+  fcm__free(ctx, P->copy_owner);
+  fcm__free(ctx, P->perm);
+  P->copy_owner = NULL;
+  P->perm = NULL;
+  P->n = P->ncopy = 0;
+  P->nlocal = P->first = 0;
+}
+
+static fcm_status newton_cut(void *user, fcm_status st, const fcm_space *space,
+                             fcm__sim_backend *out);
+static fcm_status newton_finish(void *user, fcm_status st);
+
+/* The backend handed to an integrator: P itself, one more reference. */
+static void newton_backend(fcm_petsc_problem *P, fcm__sim_backend *b)
+{
+  memset(b, 0, sizeof *b);
+  b->user = P;
+  b->root = P->rank == 0;
+  b->reduce = newton_reduce;
+  b->factor = newton_factor;
+  b->solve = newton_solve;
+  b->destroy = newton_release;
+  b->cut = newton_cut;
+  b->finish = newton_finish;
+  P->refs++;
+}
+
+/* fcm__sim_backend.cut: the integrator of a cut's new space gets this backend again, rebuilt
+ * for the new DOF numbering (ownership, PETSc numbering, matrix, vectors, KSP, scatter); the
+ * old integrator keeps its reference until it is destroyed, and its factor / solve refuse to
+ * run on the rebuilt objects (newton_factor() checks the matrix size, newton_solve() that a
+ * matrix was given since). */
+static fcm_status newton_cut(void *user, fcm_status st, const fcm_space *space,
+                             fcm__sim_backend *out)
+{
+  fcm_petsc_problem *P = user;
   st = newton_agree(P, st);
   if (st != FCM_OK) return st;
+  newton_unbuild(P);
+  P->factored = 0;
+  st = newton_build(P, FCM_OK, space);
+  if (st != FCM_OK) return st;
+  newton_backend(P, out);
+  return FCM_OK;
+}
+
+/* fcm__sim_backend.finish: agree unless a failure was agreed already (on every process). */
+static fcm_status newton_finish(void *user, fcm_status st)
+{
+  fcm_petsc_problem *P = user;
+  if (P->agreed_fail) return st;
+  return newton_agree(P, st);
+}
+
+/* fcm__simulation_attach_fn: the simulation's space is built (every process reached here
+ * unless one failed: newton_build() agrees first); number the DOFs, create the matrix, vectors
+ * and KSP, and hand the backend to the integrator. */
+static fcm_status newton_attach(void *user, fcm_integrator *integ, const fcm_space *space)
+{
+  fcm_petsc_problem *P = user;
+  fcm_status st = newton_build(P, FCM_OK, space);
+  if (st != FCM_OK) return st;
   fcm__sim_backend b;
-  memset(&b, 0, sizeof b);
-  b.user = P;
-  b.root = P->rank == 0;
-  b.reduce = newton_reduce;
-  b.factor = newton_factor;
-  b.solve = newton_solve;
-  b.destroy = newton_release;
-  P->refs++;
+  newton_backend(P, &b);
   return fcm__integrator_set_backend(integ, &b);
 }
 
-/* What this path cannot run (FCM_ERR_UNSUPPORTED naming it; the same on every process). */
-static fcm_status check_scene_newton(fcm_ctx *ctx, const fcm_scene *scene)
-{
-  fcm_status st = FCM_OK;
-  const char *name = fcm_scene_name(scene);
-  FCM_CHECK(fcm_scene_get_quadrature(scene)->simplify != FCM_CELL_SIMPLIFY_AUTO, ctx,
-            FCM_ERR_UNSUPPORTED,
-            "scene %s: quadrature.simplify = \"auto\" is not supported by the PETSc backend (its "
-            "choice would differ between processes); use true or false",
-            name);
-  for (int k = 0; k < fcm_scene_num_effects(scene); k++)
-    FCM_CHECK(fcm_scene_get_effect(scene, k)->type != FCM_EFFECT_CUT, ctx, FCM_ERR_UNSUPPORTED,
-              "scene %s: effects[%d]: cut is not supported by the PETSc backend yet (the cut "
-              "rules are rebuilt from the whole rules); run this scene with the serial backend",
-              name, k);
-cleanup:
-  return st;
-}
 
 fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_scene *scene,
                                        fcm_petsc_partition partition,
@@ -1866,6 +2092,7 @@ fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_sc
   MPI_Comm_size(P->comm, &P->size);
   MPI_Comm_rank(P->comm, &P->rank);
   P->opts = fcm_petsc_options_default();
+  set_prefix(P);
   {
     const fcm_scene_solver *sv = fcm_scene_get_solver(scene);
     P->opts.partition = partition;
@@ -1882,7 +2109,6 @@ fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_sc
     }
   }
   P->mat = *fcm_scene_get_material(scene);
-  if (st == FCM_OK) st = check_scene_newton(ctx, scene);
   if (st == FCM_OK) st = fcm__scene_mesh_geometry(ctx, scene, &mesh, &geom);
   FCM_TRY(ctx, newton_agree(P, st));
   /* the partition of the candidate cells, as fcm_petsc_problem_create() makes it */
@@ -1897,7 +2123,8 @@ fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_sc
    * agree() ends with one, which meets the agree() the others wait in */
   {
     const fcm__rules_exchange x = {P->remote, rules_exchange, P};
-    st = fcm__simulation_create_distributed(ctx, scene, opts, mask, &x, newton_attach, P, &S);
+    st = fcm__simulation_create_distributed(ctx, scene, opts, mask, newton_reduce, &x,
+                                            newton_attach, P, &S);
   }
   if (!P->agreed_fail) st = newton_agree(P, st);
   FCM_TRY(ctx, st);
@@ -1911,6 +2138,17 @@ cleanup:
   fcm_geometry_destroy(&geom);
   fcm_mesh_destroy(&mesh);
   newton_release(P);
+  return st;
+}
+
+fcm_status fcm_petsc_simulation_summary_view(fcm_simulation *sim, FILE *f)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(sim, NULL, FCM_ERR_ARG, "petsc: summary_view: NULL simulation");
+  FCM_CHECK(fcm__integrator_distributed(sim->integ, NULL), sim->ctx, FCM_ERR_ARG,
+            "petsc: summary_view: the simulation is not one of fcm_petsc_simulation_create()");
+  FCM_TRY(sim->ctx, fcm__simulation_summary_view_distributed(sim, f));
+cleanup:
   return st;
 }
 

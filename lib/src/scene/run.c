@@ -5,6 +5,7 @@
 
 #include "core/core_impl.h"
 #include "embed/embed_impl.h"
+#include "fem/fem_impl.h"
 #include "sim/sim_backend.h"
 #include "fcm/embed.h"
 #include "fcm/fem.h"
@@ -534,9 +535,14 @@ static fcm_status build_rules(fcm_simulation *S)
   ro.progress_user = S->opts.rules_progress_user;
   ro.progress_interval = S->opts.rules_progress_interval;
   ro.cell_mask = S->cell_mask;
+  fcm__rules_reduce red = {S->reduce, S->reduce_user, 0};
   if (S->rules_exchange) /* distributed: each process classifies its share of the cells */
     FCM_TRY(S->ctx, fcm__cell_rules_create_distributed(S->ctx, S->mesh, S->geom, &ro,
+                                                       S->reduce ? &red : NULL,
                                                        S->rules_exchange, &S->rules));
+  else if (S->reduce) /* distributed: the auto choice's inputs summed over the processes */
+    FCM_TRY(S->ctx,
+            fcm__cell_rules_create_reduced(S->ctx, S->mesh, S->geom, &ro, &red, &S->rules));
   else
     FCM_TRY(S->ctx, fcm_cell_rules_create(S->ctx, S->mesh, S->geom, &ro, &S->rules));
   S->c.cell_rules = 1;
@@ -668,6 +674,10 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   fcm_cell_rules *rules = NULL;
   fcm_space *space = NULL;
   fcm_integrator *integ = NULL;
+  /* A distributed run (the integrator has a backend, sim_backend.h): the rules keep the
+   * process's cell mask, the new integrator gets the backend again (its cut hook, which
+   * agrees first), and fcm__integrator_finish() at the end agrees on the outcome, so a
+   * process that fails in the local work meets the others wherever they wait. */
   FCM_TRY(ctx, cut_surface(S, &e->cut, &surf));
   S->cuts_applied++;
   S->c.cuts++;
@@ -699,6 +709,7 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   S->c.pieces = S->pieces;
   if (S->surf) FCM_TRY(ctx, fcm_embedded_surface_set_space(S->surf, S->space));
 cleanup:
+  st = fcm__integrator_finish(S->integ, st);
   fcm_integrator_destroy(&integ);
   fcm_space_destroy(&space);
   fcm_cell_rules_destroy(&rules);
@@ -804,6 +815,7 @@ cleanup:
 static fcm_status simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
                                     const fcm_simulation_options *opts,
                                     const unsigned char *cell_mask,
+                                    fcm__simulation_reduce_fn reduce,
                                     const fcm__rules_exchange *exchange,
                                     fcm__simulation_attach_fn attach, void *attach_user,
                                     fcm_simulation **out);
@@ -811,22 +823,25 @@ static fcm_status simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
 fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
                                  const fcm_simulation_options *opts, fcm_simulation **out)
 {
-  return simulation_create(ctx, scene, opts, NULL, NULL, NULL, NULL, out);
+  return simulation_create(ctx, scene, opts, NULL, NULL, NULL, NULL, NULL, out);
 }
 
 fcm_status fcm__simulation_create_distributed(fcm_ctx *ctx, const fcm_scene *scene,
                                               const fcm_simulation_options *opts,
                                               const unsigned char *cell_mask,
+                                              fcm__simulation_reduce_fn reduce,
                                               const fcm__rules_exchange *exchange,
                                               fcm__simulation_attach_fn attach, void *attach_user,
                                               fcm_simulation **out)
 {
-  return simulation_create(ctx, scene, opts, cell_mask, exchange, attach, attach_user, out);
+  return simulation_create(ctx, scene, opts, cell_mask, reduce, exchange, attach, attach_user,
+                           out);
 }
 
 static fcm_status simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
                                     const fcm_simulation_options *opts,
                                     const unsigned char *cell_mask,
+                                    fcm__simulation_reduce_fn reduce,
                                     const fcm__rules_exchange *exchange,
                                     fcm__simulation_attach_fn attach, void *attach_user,
                                     fcm_simulation **out)
@@ -839,6 +854,8 @@ static fcm_status simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   FCM_ALLOC(ctx, 1, S);
   S->ctx = ctx;
   S->cell_mask = cell_mask;
+  S->reduce = reduce;
+  S->reduce_user = attach_user;
   S->rules_exchange = exchange;
   S->scene = scene;
   S->opts = opts ? *opts : fcm_simulation_options_default();
@@ -925,6 +942,8 @@ static fcm_status simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   if (S->geom && fcm_scene_get_output(scene)->write_surface) FCM_TRY(ctx, build_surface(S));
   S->c.time_setup = fcm_wtime() - t0;
   S->cell_mask = NULL; /* borrowed for the create only */
+  S->reduce = NULL;
+  S->reduce_user = NULL;
   S->rules_exchange = NULL;
   *out = S;
   S = NULL;
@@ -1120,11 +1139,52 @@ cleanup:
   return st;
 }
 
+/* A distributed run: the cell fields (stress, von Mises, strain energy density: 8 per cell)
+ * of the whole body on every process — each process averages its own cells (the others' cut
+ * cells have no points here) and the sum over the processes collects them. Collective. */
+static fcm_status distributed_cell_fields(fcm_simulation *S, const fcm_material *mat,
+                                          const double *u, double **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  const fcm_space *s = S->space;
+  const fcm_cell_rules *R = fcm_space_cell_rules(s);
+  const fcm_index nc = fcm_mesh_num_cells(S->mesh);
+  double *f = NULL, *sig = NULL, *vm = NULL, *sed = NULL;
+  f = fcm__calloc(ctx, 8 * (size_t)nc + 1, sizeof *f);
+  sig = fcm__calloc(ctx, 6 * (size_t)nc + 1, sizeof *sig);
+  vm = fcm__calloc(ctx, (size_t)nc + 1, sizeof *vm);
+  sed = fcm__calloc(ctx, (size_t)nc + 1, sizeof *sed);
+  st = f && sig && vm && sed ? FCM_OK
+                             : fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
+                                          "simulation: out of memory (cell fields of %lld cells)",
+                                          (long long)nc);
+  if (st == FCM_OK) st = fcm_space_cell_stress(s, mat, u, sig, vm, sed);
+  int root = 1;
+  fcm__integrator_distributed(S->integ, &root);
+  for (fcm_index c = 0; st == FCM_OK && c < nc; c++) {
+    if (!fcm__cell_rules_owns(R, c) || (!R && !root)) continue; /* another process's values */
+    memcpy(f + 8 * c, sig + 6 * c, 6 * sizeof *f);
+    f[8 * c + 6] = vm[c];
+    f[8 * c + 7] = sed[c];
+  }
+  FCM_TRY(ctx, fcm__integrator_reduce_status(S->integ, st, f, 8 * nc)); /* agrees on st first */
+  *out = f;
+  f = NULL;
+cleanup:
+  fcm__free(ctx, f);
+  fcm__free(ctx, sig);
+  fcm__free(ctx, vm);
+  fcm__free(ctx, sed);
+  return st;
+}
+
 fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int index)
 {
   fcm_status st = FCM_OK;
   char path[4096];
   fcm_ctx *ctx = S ? S->ctx : NULL;
+  double *cells = NULL;
   FCM_CHECK(S && dir && index >= 0, ctx, FCM_ERR_ARG,
             "simulation: write_frame needs a directory and index >= 0 (got %d)", index);
   const char *name = fcm_scene_name(S->scene);
@@ -1132,16 +1192,20 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
   const fcm_material *mat = fcm_scene_get_material(S->scene);
   double t0 = fcm_wtime(), time = fcm_integrator_time(S->integ);
   const double *u = fcm_integrator_displacement(S->integ), *v = fcm_integrator_velocity(S->integ);
+  int root = 1;
+  const int dist = fcm__integrator_distributed(S->integ, &root);
   /* room for the frame time first: a frame that is written is also counted */
   FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&S->frame_time, &S->frame_cap, S->c.frames + 1,
                              sizeof *S->frame_time));
-  if (out->write_background) {
+  /* distributed: every process takes part in the cell fields, the root writes */
+  if (dist && out->write_background) FCM_TRY(ctx, distributed_cell_fields(S, mat, u, &cells));
+  if (out->write_background && root) {
     snprintf(path, sizeof path, "%s/%s_background_%04d.vtu", dir, name, index);
-    FCM_TRY(ctx, fcm_space_write_vtu(S->space, mat, u, v, path));
+    FCM_TRY(ctx, fcm__space_write_vtu_cells(S->space, mat, u, v, cells, path));
     if (!S->pvd_bg) FCM_TRY(ctx, open_pvd(S, dir, "background", &S->pvd_bg));
     FCM_TRY(ctx, fcm_pvd_add(S->pvd_bg, time, path));
   }
-  if (S->surf) {
+  if (S->surf && root) { /* the surface's fields come from u alone: whole on every process */
     snprintf(path, sizeof path, "%s/%s_surface_%04d.vtu", dir, name, index);
     FCM_TRY(ctx, fcm_embedded_surface_write_vtu(S->surf, mat, u, path));
     if (!S->pvd_surf) FCM_TRY(ctx, open_pvd(S, dir, "surface", &S->pvd_surf));
@@ -1150,6 +1214,7 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
   S->frame_time[S->c.frames++] = time;
   S->c.time_output += fcm_wtime() - t0;
 cleanup:
+  if (S) fcm__free(ctx, cells);
   return st;
 }
 
@@ -1230,12 +1295,12 @@ static void multigrid_line(const fcm_simulation *S, FILE *f)
  * stiffness rules) and the embedded-surface points the frames write; beside it, the largest
  * over the DOF vector, which includes the fictitious nodes outside the body. Without an
  * embedded geometry the mesh is the body: its nodes count too. */
-static void body_displacement_line(const fcm_simulation *S, FILE *f)
+static void body_displacement_line(const fcm_simulation *S, FILE *f, double body_points)
 {
   const double *u = fcm_integrator_displacement(S->integ);
   const fcm_index n = fcm_integrator_num_dofs(S->integ);
-  double body = 0.0, dofs = 0.0, *d = NULL;
-  if (fcm_space_max_displacement(S->space, u, &body) != FCM_OK) {
+  double body = body_points, dofs = 0.0, *d = NULL;
+  if (body_points < 0.0 && fcm_space_max_displacement(S->space, u, &body) != FCM_OK) {
     fcm_ctx_error_clear(S->ctx);
     return;
   }
@@ -1267,17 +1332,20 @@ static void body_displacement_line(const fcm_simulation *S, FILE *f)
             body, dofs);
 }
 
-void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
+/* The summary with the rules' statistics `gs` and the body's largest |u| over its quadrature
+ * points `body` given (a distributed run: summed over the processes), or taken from this
+ * process (gs NULL, body < 0). */
+static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_stats *gs,
+                         const fcm_simulation_counters *gc, double body)
 {
-  if (!S || !f) return;
-  const fcm_simulation_counters *c = &S->c;
+  const fcm_simulation_counters *c = gc ? gc : &S->c;
   char b[512];
   fprintf(f, "simulation %s: %lld of %lld steps, %lld DOFs\n", fcm_scene_name(S->scene), c->steps,
           S->num_steps, (long long)c->num_dofs);
   line(f, c->cell_rules, "embedded cell rules", c->cell_rules ? "" : "(no geometry)");
   if (S->geometry_note[0]) fprintf(f, "  geometry  %s\n", S->geometry_note);
   if (S->rules) {
-    const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(S->rules);
+    const fcm_cell_rules_stats *rs = gs ? gs : fcm_cell_rules_get_stats(S->rules);
     fprintf(f,
             "  cells     %lld: %lld uncut, %lld cut, %lld dropped; cut-cell points stiffness "
             "%lld -> %lld, mass %lld -> %lld (before -> after simplification)\n",
@@ -1326,7 +1394,7 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
     }
   }
   if (S->rules) { /* which rule kinds the scene called for, with their stored points */
-    const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(S->rules);
+    const fcm_cell_rules_stats *rs = gs ? gs : fcm_cell_rules_get_stats(S->rules);
     const int mass = (c->rule_kinds & FCM_RULES_MASS) != 0;
     snprintf(b, sizeof b, "stiffness (%lld points)%s",
              (long long)rs->points_total[FCM_RULE_STIFFNESS], mass ? ", mass" : "");
@@ -1380,7 +1448,7 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
   snprintf(b, sizeof b, "%lld frames, surface %lld points %lld triangles", c->frames,
            (long long)c->surface_points, (long long)c->surface_triangles);
   line(f, c->frames > 0, "output", b);
-  body_displacement_line(S, f);
+  body_displacement_line(S, f, body);
   if (S->free_body) {
     double com[3];
     if (fcm_simulation_center_of_mass(S, com) == FCM_OK) {
@@ -1391,4 +1459,77 @@ void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
   }
   fprintf(f, "  time [s]  setup %.3f  steps %.3f  output %.3f\n", c->time_setup, c->time_steps,
           c->time_output);
+}
+
+void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
+{
+  if (!S || !f) return;
+  summary_view(S, f, NULL, NULL, -1.0);
+}
+
+fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  const fcm_index nc = fcm_mesh_num_cells(S->mesh);
+  const int K = FCM_RULE_KIND_COUNT, nv = 6 * FCM_RULE_KIND_COUNT + 5;
+  fcm_cell_rules_stats gs;
+  fcm_simulation_counters gc = S->c;
+  double *q = NULL, body = 0.0;
+  int root = 1;
+  fcm__integrator_distributed(S->integ, &root);
+  memset(&gs, 0, sizeof gs);
+  /* per kind: points before / after simplification, stabilization, stored, skipped, kept
+   * unsimplified; then surface triangles and points, tets, slivers; then each own cell's
+   * largest |u| (every process's cells: the point counts are its own cells' only) */
+  q = fcm__calloc(ctx, (size_t)nv + (size_t)nc + 1, sizeof *q);
+  st = q ? FCM_OK
+         : fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
+                      "simulation: out of memory (summary of %lld cells)", (long long)nc);
+  if (st == FCM_OK && S->rules) {
+    gs = *fcm_cell_rules_get_stats(S->rules);
+    for (int k = 0; k < K; k++) {
+      q[6 * k + 0] = (double)gs.points_initial[k];
+      q[6 * k + 1] = (double)gs.points_simplified[k];
+      q[6 * k + 2] = (double)gs.points_stabilization[k];
+      /* stored points: the cut cells' own ones, plus the uncut cells' (every process counts
+       * all of those: the classification is replicated) on the root only */
+      q[6 * k + 3] = (double)(root ? gs.points_total[k]
+                                   : gs.points_simplified[k] + gs.points_stabilization[k]);
+      q[6 * k + 4] = (double)gs.simplify_skipped[k];
+      q[6 * k + 5] = (double)gs.simplify_fallbacks[k];
+    }
+    q[6 * K + 0] = (double)gs.surface_triangles;
+    q[6 * K + 1] = (double)gs.surface_points;
+    q[6 * K + 2] = (double)gs.num_tets;
+    q[6 * K + 3] = (double)gs.num_slivers;
+  }
+  if (q) q[6 * K + 4] = (double)S->c.boundary_points; /* Nitsche's: own cells' */
+  if (st == FCM_OK)
+    st = fcm__space_cell_max_displacement(S->space, fcm_integrator_displacement(S->integ), q + nv);
+  if (st == FCM_OK) {
+    const fcm_cell_rules *R = fcm_space_cell_rules(S->space);
+    for (fcm_index c = 0; c < nc; c++) /* another process's cell: its value (no rules: root's) */
+      if (!fcm__cell_rules_owns(R, c) || (!R && !root)) q[nv + c] = 0.0;
+  }
+  FCM_TRY(ctx, fcm__integrator_reduce_status(S->integ, st, q, (fcm_index)nv + nc));
+  for (int k = 0; k < K; k++) {
+    gs.points_initial[k] = (fcm_index)q[6 * k + 0];
+    gs.points_simplified[k] = (fcm_index)q[6 * k + 1];
+    gs.points_stabilization[k] = (fcm_index)q[6 * k + 2];
+    gs.points_total[k] = (fcm_index)q[6 * k + 3];
+    gs.simplify_skipped[k] = (fcm_index)q[6 * k + 4];
+    gs.simplify_fallbacks[k] = (fcm_index)q[6 * k + 5];
+  }
+  gs.surface_triangles = (fcm_index)q[6 * K + 0];
+  gs.surface_points = (fcm_index)q[6 * K + 1];
+  gs.num_tets = (fcm_index)q[6 * K + 2];
+  gs.num_slivers = (fcm_index)q[6 * K + 3];
+  gc.boundary_points = (fcm_index)q[6 * K + 4];
+  for (fcm_index c = 0; c < nc; c++)
+    if (!(q[nv + c] <= body)) body = q[nv + c]; /* NaN propagates */
+  if (f) summary_view(S, f, S->rules ? &gs : NULL, &gc, body);
+cleanup:
+  fcm__free(ctx, q);
+  return st;
 }

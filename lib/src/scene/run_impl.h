@@ -10,6 +10,12 @@
 #include "fcm/mesh.h"
 #include "fcm/simulation.h"
 
+/* A sum over the backend's processes before the integrator exists (the cell rules' choice of
+ * quadrature.simplify = "auto"): agree on st, then sum values[0 .. count) in place, the same
+ * bits on every process (as fcm__sim_backend.reduce). Collective. */
+typedef fcm_status (*fcm__simulation_reduce_fn)(void *user, fcm_status st, double *values,
+                                                fcm_index count);
+
 /* One row of the per-step log: the step, and the body after it (separate bodies, mass and
  * linear momentum over the body's own quadrature points, fcm_space_momentum()). */
 typedef struct fcm__log_row {
@@ -67,6 +73,8 @@ struct fcm_simulation {
   /* distributed runs (fcm__simulation_create_distributed()): points on these cells only
    * (borrowed during the create; NULL afterwards and in serial runs) */
   const unsigned char *cell_mask;
+  fcm__simulation_reduce_fn reduce; /* with reduce_user: during the create only (NULL after) */
+  void *reduce_user;
   const struct fcm__rules_exchange *rules_exchange; /* and the classification shared: NULL or as
                                                        cell_mask (embed/embed_impl.h) */
   /* what the voxel or level-set geometry reported ("" for the other kinds) */
@@ -95,14 +103,22 @@ typedef fcm_status (*fcm__simulation_attach_fn)(void *user, fcm_integrator *inte
  * rules carry points on the cells flagged in cell_mask only (every cell is still classified,
  * so the space and its DOF numbering are those of the serial run; with `exchange` (may be
  * NULL) each process intersects its share of the cells and the exchange hands over the others'
- * classes: fcm__cell_rules_create_distributed(), embed/embed_impl.h), and `attach` sets the
- * integrator's backend before its setup; the log's partial quantities (mass, momentum) are
- * summed through it. Collective over the backend's processes. (run.c) */
+ * classes: fcm__cell_rules_create_distributed(), embed/embed_impl.h), `reduce` (with
+ * attach_user) sums the inputs of the rules' simplify = "auto" choice over the processes, and
+ * `attach` sets the integrator's backend before its setup; the log's partial quantities (mass,
+ * momentum) are summed through it, and cuts hand it on to each new integrator
+ * (fcm__sim_backend.cut). Collective over the backend's processes. (run.c) */
 fcm_status fcm__simulation_create_distributed(fcm_ctx *ctx, const fcm_scene *scene,
                                               const fcm_simulation_options *opts,
                                               const unsigned char *cell_mask,
+                                              fcm__simulation_reduce_fn reduce,
                                               const struct fcm__rules_exchange *exchange,
                                               fcm__simulation_attach_fn attach, void *attach_user,
                                               fcm_simulation **out);
+
+/* A distributed run's fcm_simulation_summary_view() (collective; f may be NULL on all but one
+ * process): the rules' point counts and the body's largest |u| summed / maximized over the
+ * processes' own cells first (each process's rules carry its own cells' points only). */
+fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f);
 
 #endif /* FCM_SCENE_RUN_IMPL_H */

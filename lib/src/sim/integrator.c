@@ -702,10 +702,31 @@ cleanup:
   return st;
 }
 
+int fcm__integrator_distributed(const fcm_integrator *I, int *root)
+{
+  const int dist = I && I->has_backend;
+  if (root) *root = dist ? I->backend.root : 1;
+  return dist;
+}
+
 fcm_status fcm__integrator_reduce(fcm_integrator *I, double *values, fcm_index count)
 {
-  if (!I || !I->has_backend) return FCM_OK;
-  fcm_status st = I->backend.reduce(I->backend.user, FCM_OK, values, count);
+  return fcm__integrator_reduce_status(I, FCM_OK, values, count);
+}
+
+fcm_status fcm__integrator_reduce_status(fcm_integrator *I, fcm_status st, double *values,
+                                         fcm_index count)
+{
+  if (!I || !I->has_backend) return st;
+  st = I->backend.reduce(I->backend.user, st, values, count);
+  if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
+  return st;
+}
+
+fcm_status fcm__integrator_finish(fcm_integrator *I, fcm_status st)
+{
+  if (!I || !I->has_backend || !I->backend.finish) return st;
+  st = I->backend.finish(I->backend.user, st);
   if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
   return st;
 }
@@ -956,19 +977,28 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   FCM_CHECK(old && space, ctx, FCM_ERR_ARG, "integrator cut: NULL integrator or space");
   FCM_CHECK(old->is_setup, ctx, FCM_ERR_ARG,
             "integrator cut: the integrator must be set up (fcm_integrator_setup())");
-  FCM_TRY(ctx, fcm_integrator_create(ctx, space, &old->mat, &old->opts, &I));
-  for (int k = 0; k < old->num_loads; k++) {
+  /* with a backend (sim_backend.h) a local failure goes into its cut hook, which agrees */
+  st = fcm_integrator_create(ctx, space, &old->mat, &old->opts, &I);
+  for (int k = 0; st == FCM_OK && k < old->num_loads; k++) {
     sim_load l = old->loads[k];
     l.f = NULL;
-    FCM_TRY(ctx, add_load(I, &l));
+    st = add_load(I, &l);
   }
-  for (int k = 0; k < old->num_cons; k++)
-    FCM_TRY(ctx, fcm_integrator_add_constraint(I, old->cons[k].num_nodes, old->cons[k].nodes,
-                                               &old->cons[k].motion, NULL));
-  for (int k = 0; k < old->num_bcons; k++)
-    FCM_TRY(ctx, fcm_integrator_add_boundary_constraint(
-                     I, old->bcons[k].select, old->bcons[k].select_user, &old->bcons[k].motion,
-                     &old->bcons[k].opts, NULL));
+  for (int k = 0; st == FCM_OK && k < old->num_cons; k++)
+    st = fcm_integrator_add_constraint(I, old->cons[k].num_nodes, old->cons[k].nodes,
+                                       &old->cons[k].motion, NULL);
+  for (int k = 0; st == FCM_OK && k < old->num_bcons; k++)
+    st = fcm_integrator_add_boundary_constraint(I, old->bcons[k].select, old->bcons[k].select_user,
+                                                &old->bcons[k].motion, &old->bcons[k].opts, NULL);
+  if (old->has_backend) {
+    fcm__sim_backend b;
+    memset(&b, 0, sizeof b);
+    FCM_CHECK(old->backend.cut, ctx, FCM_ERR_UNSUPPORTED,
+              "integrator cut: the integrator's distributed backend cannot be cut");
+    FCM_TRY(ctx, old->backend.cut(old->backend.user, st, space, &b));
+    FCM_TRY(ctx, fcm__integrator_set_backend(I, &b));
+  }
+  FCM_TRY(ctx, st);
   FCM_TRY(ctx, fcm_integrator_setup(I));
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, u);
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, v);

@@ -13,7 +13,8 @@
 #include "fcm/la.h"
 #include "fcm/sim.h"
 
-typedef struct fcm__sim_backend {
+typedef struct fcm__sim_backend fcm__sim_backend;
+struct fcm__sim_backend {
   void *user;
   /* 1 on exactly one process: the terms that are no partial sums (the base M/h^2 + D/h of the
    * Newton matrix, from the already summed M and D) are added there only */
@@ -31,7 +32,18 @@ typedef struct fcm__sim_backend {
   fcm_status (*solve)(void *user, const double *b, double *x, int *iterations, int *failed);
   /* Release `user` (called by fcm_integrator_destroy()); may be NULL. */
   void (*destroy)(void *user);
-} fcm__sim_backend;
+  /* The backend of the integrator fcm_integrator_create_cut() makes on a cut's new `space`
+   * (its DOF numbering differs): agree on st first (the status of the new integrator's
+   * creation so far on this process; on a failure anywhere every process returns it), then
+   * fill *out (its own reference: out->destroy releases it). Collective. NULL: an integrator
+   * with this backend cannot be cut (FCM_ERR_UNSUPPORTED). */
+  fcm_status (*cut)(void *user, fcm_status st, const fcm_space *space, fcm__sim_backend *out);
+  /* End a phase with local work between collective calls (a cut): agree on st unless an
+   * earlier agreement of this backend already reported a failure (then return st without
+   * communicating), so a process that failed outside the collective calls meets the others
+   * wherever they wait. NULL: st is returned. Collective. */
+  fcm_status (*finish)(void *user, fcm_status st);
+};
 
 /* Set the backend of an integrator that is not set up yet (before fcm_integrator_setup():
  * the setup sums the mass matrix and the loads). The integrator owns b->user from now on
@@ -42,5 +54,18 @@ fcm_status fcm__integrator_set_backend(fcm_integrator *I, const fcm__sim_backend
  * quantity of the space, e.g. the log's mass and momentum); FCM_OK without a backend.
  * Collective with a backend. */
 fcm_status fcm__integrator_reduce(fcm_integrator *I, double *values, fcm_index count);
+/* The same after a local phase that ended with st: the processes agree on it first (a failure
+ * anywhere is returned everywhere, values untouched and may then be NULL). Collective with a
+ * backend; st itself without one. */
+fcm_status fcm__integrator_reduce_status(fcm_integrator *I, fcm_status st, double *values,
+                                         fcm_index count);
+
+/* Whether the integrator runs on a distributed backend (0: serial); *root (may be NULL): 1 on
+ * the backend's root process, and 1 without a backend. */
+int fcm__integrator_distributed(const fcm_integrator *I, int *root);
+
+/* The backend's finish (see fcm__sim_backend.finish) on st; st without a backend. Collective
+ * with a backend. */
+fcm_status fcm__integrator_finish(fcm_integrator *I, fcm_status st);
 
 #endif /* FCM_SIM_BACKEND_H */
