@@ -11,7 +11,9 @@
  * - the statistics the classification sums: cell counts, embedded volume (bits), candidates,
  *   parts, tets, slivers, surface triangles (the per-process counters are summed).
  * Phase 1 (fcm_petsc_problem_create(): a ball in a box, the element and partition given) and,
- * when a scene is given, phase 2 (fcm_petsc_simulation_create() against fcm_simulation_create()).
+ * when a scene is given, phase 2 (fcm_petsc_simulation_create() against fcm_simulation_create():
+ * the rules after the create, so with a scene cut at t = 0 those the cut extended, and with
+ * quadrature.simplify = "auto" those of the choice summed over the processes).
  * Arguments: element type, partition (ordered|ptscotch), [scenes directory, scene file]. */
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"

@@ -57,6 +57,11 @@ foreach(np 1 2)
   endforeach()
   fcm_add_mpi_test(petsc_classify_tet4_ptscotch_np${np} tests/petsc/classify.c NP ${np}
                    ARGS tet4 ptscotch)
+  # phase 2 with simplify = auto (the exchange, then the choice's reduce; Hex20) and with a cut
+  fcm_add_mpi_test(petsc_classify_auto_np${np} tests/petsc/classify.c NP ${np}
+                   ARGS tet4 ordered ${PROJECT_SOURCE_DIR}/apps/scenes twisting_cylinder.json)
+  fcm_add_mpi_test(petsc_classify_cut_np${np} tests/petsc/classify.c NP ${np}
+                   ARGS tet4 ordered ${PROJECT_SOURCE_DIR}/apps/scenes cut_slab.json)
 endforeach()
 # a process failing before its rules build (phase 2) or inside it before the per-cell loop
 # (phase 1) ends every process at the classification exchange with the message, no hang
