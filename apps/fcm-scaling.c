@@ -863,8 +863,8 @@ static const char *petsc_solver_options(int s)
  * setup (assembly, elimination, KSP), one step (the solve; GAMG's set-up or MUMPS's
  * factorization included). Times: process 0's wall clock, CPU summed over the processes; RSS
  * peak and base summed. The row is filled on process 0. */
-static void run_petsc(fcm_ctx *ctx, const settings *o, fcm_element_type type, int body,
-                      fcm_index n, int s, const problem *p, const double *xref, row *r)
+static void run_petsc(fcm_ctx *ctx, const settings *o, fcm_element_type type, int body, fcm_index n,
+                      int s, const problem *p, const double *xref, row *r)
 {
   fcm_status st = FCM_OK;
   fcm_mesh *mesh = NULL;
@@ -967,9 +967,9 @@ done:
           ax[i] = p->b[i] - ax[i];
         const double bn = norm2(p->n, p->b);
         r->relres = bn > 0.0 ? norm2(p->n, ax) / bn : 0.0;
-        r->factor = s == S_PMUMPS            ? -1.0
+        r->factor = s == S_PMUMPS                          ? -1.0
                     : r->iterations > 0 && r->relres > 0.0 ? pow(r->relres, 1.0 / r->iterations)
-                                                         : 0.0;
+                                                           : 0.0;
       }
       free(ax);
       if (xref) {
@@ -1040,8 +1040,7 @@ static int run_study(fcm_ctx *ctx, const settings *o)
           if (want[s] && !IS_PETSC(s) && !skipped[s][0]) all_skipped = 0;
         if (all_skipped) {
           for (int s = 0; s < NSOLVER; s++)
-            if (want[s] && !IS_PETSC(s) && !add_skip(o, t, body, n, 0, s, skipped[s]))
-              fatal = 1;
+            if (want[s] && !IS_PETSC(s) && !add_skip(o, t, body, n, 0, s, skipped[s])) fatal = 1;
           goto serial_done;
         }
         /* the problem itself: estimated from the previous size by the cell ratio */
@@ -1162,8 +1161,8 @@ static int run_study(fcm_ctx *ctx, const settings *o)
             if (skipped[s][0])
               snprintf(why, sizeof why, "%s", skipped[s]);
             else if (now_avail > 0.0 && est_mb > o->mem_fraction * now_avail)
-              snprintf(why, sizeof why, "would need about %.0f MB more (%.0f MB available)",
-                       est_mb, now_avail);
+              snprintf(why, sizeof why, "would need about %.0f MB more (%.0f MB available)", est_mb,
+                       now_avail);
             else if (est_s > o->budget)
               snprintf(why, sizeof why, "would take about %.0f s > --budget %.0f s", est_s,
                        o->budget);
@@ -1185,8 +1184,8 @@ static int run_study(fcm_ctx *ctx, const settings *o)
           if (root)
             fprintf(stderr, PROG ": %s %s n=%lld %s on %d processes ...\n", en, body_names[body],
                     (long long)n, solver_names[s], o->size);
-          run_petsc(ctx, o, t, body, n, s, have_p ? &p : NULL,
-                    have_ref || have_mgref ? xref : NULL, r);
+          run_petsc(ctx, o, t, body, n, s, have_p ? &p : NULL, have_ref || have_mgref ? xref : NULL,
+                    r);
           if (root) {
             if (r->status == ROW_FAILED) failed = 1;
             if (!emit(o, r)) fatal = 1;
@@ -1425,7 +1424,7 @@ static int scaling_main(int argc, char **argv, int pargc, char **pargv)
   (void)pargv;
   if (petsc) {
     fprintf(stderr, PROG ": --backend petsc: this fcm was built without PETSc (CMake option "
-                    "FCM_WITH_PETSC; Debian: bash setup.sh deps --petsc, then rebuild)\n");
+                         "FCM_WITH_PETSC; Debian: bash setup.sh deps --petsc, then rebuild)\n");
     return 2;
   }
 #endif
@@ -1467,8 +1466,9 @@ static int scaling_main(int argc, char **argv, int pargc, char **pargv)
       return 2;
     }
   if (petsc && o.constrain_ratio != fcm_space_options_default().constrain_ratio) {
-    fprintf(stderr, PROG ": --constrain-ratio: the PETSc backend builds its space with the "
-                    "library's default (%g); drop the option with --backend petsc\n",
+    fprintf(stderr,
+            PROG ": --constrain-ratio: the PETSc backend builds its space with the "
+                 "library's default (%g); drop the option with --backend petsc\n",
             fcm_space_options_default().constrain_ratio);
     return 2;
   }

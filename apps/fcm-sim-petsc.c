@@ -3,11 +3,11 @@
  * linear material, gravity, fixed and motion on node regions) goes through it
  * (fcm_petsc_problem_create_from_scene() distributes the cells, the cut-cell rules, the
  * assembly and the solves); every other scene (cuts and simplify auto included) goes through
- * the integrator on PETSc (run_newton(), fcm_petsc_simulation_create()). Process 0 prints and writes the log
- * <name>_log.csv; on the linear driver each frame is a parallel VTU (<name>_NNNN.pvtu by
- * process 0 naming one piece <name>_NNNN_<rank>.vtu per process: its own cells), indexed by
- * <name>.pvd, and checkpoints are <name>_checkpoint_NNNNNN.fcmpk; on the integrator the
- * serial frames and checkpoints (.fcmck) are written by process 0 (run_newton()). */
+ * the integrator on PETSc (run_newton(), fcm_petsc_simulation_create()). Process 0 prints and
+ * writes the log <name>_log.csv; on the linear driver each frame is a parallel VTU
+ * (<name>_NNNN.pvtu by process 0 naming one piece <name>_NNNN_<rank>.vtu per process: its own
+ * cells), indexed by <name>.pvd, and checkpoints are <name>_checkpoint_NNNNNN.fcmpk; on the
+ * integrator the serial frames and checkpoints (.fcmck) are written by process 0 (run_newton()). */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm-sim-petsc.h"
 

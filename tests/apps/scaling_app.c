@@ -30,7 +30,7 @@
 
 #define HEADER                                                                                     \
   "element,cells,dofs,solver,iterations,convergence_factor,setup_s,solve_s,peak_rss_mb,body,"      \
-  "status,relative_residual,diff_cholmod,setup_cpu_s,solve_cpu_s,base_rss_mb,levels,processes,"  \
+  "status,relative_residual,diff_cholmod,setup_cpu_s,solve_cpu_s,base_rss_mb,levels,processes,"    \
   "note\n"
 
 typedef struct srow {
@@ -229,12 +229,17 @@ int main(int argc, char **argv)
   }
   /* bad options: exit 2, nothing written */
   static const char *const bad[] = {
-      "--sizes 8,4", "--sizes 1",  "--solvers cholmod,foo", "--elements tet4", "--bodies ball,ball",
-      "--rtol 0",    "--clock sun",
-      "--solvers cholmod,petsc-gamg", /* the PETSc solvers need --backend petsc */
-      "--backend mpi",
+    "--sizes 8,4",
+    "--sizes 1",
+    "--solvers cholmod,foo",
+    "--elements tet4",
+    "--bodies ball,ball",
+    "--rtol 0",
+    "--clock sun",
+    "--solvers cholmod,petsc-gamg", /* the PETSc solvers need --backend petsc */
+    "--backend mpi",
 #if !FCM_HAVE_PETSC
-      "--backend petsc", /* not in this build */
+    "--backend petsc", /* not in this build */
 #endif
   };
   for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {

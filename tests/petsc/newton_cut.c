@@ -230,8 +230,8 @@ int main(int argc, char **argv)
     TEST_TRUE(fabs(a.total_energy - b.total_energy) <= tol * scale);
     TEST_TRUE(compare_counters(ser, par, s + 1, rank) == 0);
     if (rank == 0 && getenv("FCM_TEST_VERBOSE"))
-      fprintf(stderr, "step %d: newton %d / %d, linear %lld, DOFs %lld, E %.12g / %.12g\n",
-              s + 1, a.newton_iterations, b.newton_iterations, b.linear_iterations,
+      fprintf(stderr, "step %d: newton %d / %d, linear %lld, DOFs %lld, E %.12g / %.12g\n", s + 1,
+              a.newton_iterations, b.newton_iterations, b.linear_iterations,
               (long long)fcm_integrator_num_dofs(fcm_simulation_integrator(par)), a.total_energy,
               b.total_energy);
     linear += b.linear_iterations;

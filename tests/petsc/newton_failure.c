@@ -60,8 +60,8 @@ int main(int argc, char **argv)
                    scene_text(text, sizeof text,
                               rank == size - 1 ? "\"max_rule_memory_gib\": 1e-9" : "", fix, ""),
                    NULL, &scene));
-  fcm_status s = fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene,
-                                             FCM_PETSC_PARTITION_AUTO, NULL, &sim);
+  fcm_status s =
+      fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO, NULL, &sim);
   TEST_TRUE(s != FCM_OK && sim == NULL);
   if (size > 1 && rank != size - 1) {
     char want[64];
@@ -81,10 +81,10 @@ int main(int argc, char **argv)
                               "0.9], \"normal\": [0, 0, 1]}}}}",
                               ""),
                    NULL, &scene));
-  TEST_ERR(ctx,
-           fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO,
-                                       NULL, &sim),
-           FCM_ERR_ARG, "selects no embedded-boundary point");
+  TEST_ERR(
+      ctx,
+      fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO, NULL, &sim),
+      FCM_ERR_ARG, "selects no embedded-boundary point");
   fcm_scene_destroy(&scene);
 
   /* 3. a KSP that cannot converge: the step fails everywhere after its halvings */
@@ -113,8 +113,7 @@ int main(int argc, char **argv)
     fclose(f);
   }
   char cut[256];
-  snprintf(cut, sizeof cut, ", {\"cut\": {\"time\": 0.01, \"surface\": {\"mesh\": \"%s\"}}}",
-           obj);
+  snprintf(cut, sizeof cut, ", {\"cut\": {\"time\": 0.01, \"surface\": {\"mesh\": \"%s\"}}}", obj);
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, scene_text(text, sizeof text, "", cut, ""), NULL,
                                             &scene));
   TEST_OK(ctx, fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO,

@@ -30,7 +30,8 @@ static const char scene_fmt[] =
     " \"time\": {\"static\": true, \"steps\": 1},"
     " \"solver\": {\"method\": \"cg\"%s},"
     " \"effects\": [{\"gravity\": {\"acceleration\": [0, -9.81, 0]}},"
-    "   {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, 0, 0]}}}}]}";
+    "   {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, 0, "
+    "0]}}}}]}";
 
 int main(int argc, char **argv)
 {
@@ -105,8 +106,8 @@ int main(int argc, char **argv)
     fcm_scene *scene = NULL;
     fcm_simulation *sim = NULL;
     TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "options.json", &scene));
-    TEST_OK(ctx, fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene,
-                                             FCM_PETSC_PARTITION_AUTO, NULL, &sim));
+    TEST_OK(ctx, fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO,
+                                             NULL, &sim));
     fcm_step_info si;
     const fcm_status s = fcm_simulation_step(sim, &si);
     if (k == 0) {

@@ -111,8 +111,8 @@ static int vtu_main(const char *a, const char *b, double rtol)
     if (y) {
       found++;
       if (!x || na != nb) {
-        fprintf(stderr, "petsc_state_diff: %s: %s has %lld values, %s %lld\n", arrays[k][1], a,
-                na, b, nb);
+        fprintf(stderr, "petsc_state_diff: %s: %s has %lld values, %s %lld\n", arrays[k][1], a, na,
+                b, nb);
         ok = 0;
       } else {
         ok = within(arrays[k][1], na, x, y, rtol) && ok;

@@ -222,14 +222,14 @@ typedef struct fcm_petsc_info {
   double matrix_memory;          /**< bytes of the system matrix's stored nonzeros over all
                                       processes (values and column indices, MatGetInfo) */
   long long steps, total_iterations;
-  char options_prefix[32];       /**< this problem's PETSc options prefix ("fcm1_", "fcm2_",
-                                      ...: one per problem, numbered in the order this process
-                                      made them); "-fcm2_ksp_type gmres" on the command line
-                                      reaches that problem's solver only */
-  char ksp_type[32];             /**< the KSP's type ("cg", "minres", ...; "" before setup) */
-  char pc_type[32];              /**< its PC's type ("gamg", "cholesky", ...; "" before setup) */
-  char factor_package[32];       /**< the package of an LU / Cholesky PC ("mumps", "petsc",
-                                      ...), else "" */
+  char options_prefix[32]; /**< this problem's PETSc options prefix ("fcm1_", "fcm2_",
+                                ...: one per problem, numbered in the order this process
+                                made them); "-fcm2_ksp_type gmres" on the command line
+                                reaches that problem's solver only */
+  char ksp_type[32];       /**< the KSP's type ("cg", "minres", ...; "" before setup) */
+  char pc_type[32];        /**< its PC's type ("gamg", "cholesky", ...; "" before setup) */
+  char factor_package[32]; /**< the package of an LU / Cholesky PC ("mumps", "petsc",
+                                ...), else "" */
 } fcm_petsc_info;
 
 /** Fill `info` (collective: the sums and extremes are reduced). */
@@ -277,8 +277,7 @@ FCM_API int fcm_petsc_problem_supports_scene(fcm_ctx *ctx, const fcm_scene *scen
  * @param[in] opts      simulation options (NULL: defaults)
  * @return FCM_OK; FCM_ERR_UNSUPPORTED; the errors of fcm_simulation_create(); FCM_ERR_INTERNAL
  * (PETSc or MPI failed: its message). On every process when any failed. */
-FCM_API fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm,
-                                               const fcm_scene *scene,
+FCM_API fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_scene *scene,
                                                fcm_petsc_partition partition,
                                                const fcm_simulation_options *opts,
                                                fcm_simulation **out);

@@ -132,7 +132,7 @@ typedef struct build {
   const fcm__cut_tri *cut_tris;
   unsigned char *region, *rebuild;
   const fcm_cell_rules *prev;
-  fcm_index first_new; /* cut triangles from here on are new (those of the cut being added) */
+  fcm_index first_new;    /* cut triangles from here on are new (those of the cut being added) */
   fcm__rules_reduce *red; /* distributed AUTO: sums the choice's inputs (NULL: none) */
   const unsigned char *remote; /* distributed classification: cells another process classifies
                                   (skipped here), NULL: none */
@@ -1336,8 +1336,7 @@ static fcm_status create_rules(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geo
               (long long)c);
   FCM_TRY(ctx, rules_alloc(ctx, mesh, &o, &R));
   FCM_TRY(ctx, build_rules_x(ctx, mesh, geom, NULL, 0,
-                             o.simplify == FCM_CELL_SIMPLIFY_AUTO ? red : NULL, R, x,
-                             &exchanged));
+                             o.simplify == FCM_CELL_SIMPLIFY_AUTO ? red : NULL, R, x, &exchanged));
   R->masked = o.cell_mask != NULL;
   if (R->masked) {
     const fcm_index nc = fcm_mesh_num_cells(mesh);
@@ -1378,8 +1377,8 @@ fcm_status fcm__cell_rules_create_reduced(fcm_ctx *ctx, const fcm_mesh *mesh,
 fcm_status fcm__cell_rules_create_distributed(fcm_ctx *ctx, const fcm_mesh *mesh,
                                               const fcm_geometry *geom,
                                               const fcm_cell_rules_options *opts,
-                                              fcm__rules_reduce *red,
-                                              const fcm__rules_exchange *x, fcm_cell_rules **rules)
+                                              fcm__rules_reduce *red, const fcm__rules_exchange *x,
+                                              fcm_cell_rules **rules)
 {
   return create_rules(ctx, mesh, geom, opts, red, x, rules);
 }

@@ -333,7 +333,7 @@ fcm_status fcm__cell_rules_create_reduced(fcm_ctx *ctx, const fcm_mesh *mesh,
 fcm_status fcm__cell_rules_create_distributed(fcm_ctx *ctx, const fcm_mesh *mesh,
                                               const fcm_geometry *geom,
                                               const fcm_cell_rules_options *opts,
-                                              fcm__rules_reduce *red,
-                                              const fcm__rules_exchange *x, fcm_cell_rules **rules);
+                                              fcm__rules_reduce *red, const fcm__rules_exchange *x,
+                                              fcm_cell_rules **rules);
 
 #endif /* FCM_EMBED_IMPL_H */

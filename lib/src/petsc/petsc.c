@@ -131,8 +131,8 @@
  *   owned rows (VecScatter of ghosts), keep the line search's scalars as Allreduce.
  * - cuts keep the partition made at the start (the pieces of a split cell belong to its
  *   owner; cut-heavy regions are not rebalanced) and the cut's classification of every cell
- *   runs on every process (replicated; the first build's is distributed, see above); the cut-cell weight 4 of the
- *   partition is not updated for cells a later cut reaches.
+ *   runs on every process (replicated; the first build's is distributed, see above); the cut-cell
+ * weight 4 of the partition is not updated for cells a later cut reaches.
  * - the linear driver (phase 1) could now be replaced by the phase-2 path for the scenes both
  *   run (they agree to the KSP tolerance); it is kept: it assembles straight into PETSc and
  *   scales further (no dense sums), and its tests and checkpoints stay.
@@ -203,11 +203,11 @@ struct fcm_petsc_problem {
   int *classifier;
   unsigned char *remote;
   fcm_index num_classified; /* cells of the mesh partitioned (the length of both) */
-  double time_classify; /* seconds of this process in the rules build's exchange (waits) */
-  int *copy_owner;       /* ncopy */
-  PetscInt *perm;        /* ncopy: PETSc block index of each copy */
-  PetscInt nlocal;       /* owned copies */
-  PetscInt first;        /* first owned PETSc block index */
+  double time_classify;     /* seconds of this process in the rules build's exchange (waits) */
+  int *copy_owner;          /* ncopy */
+  PetscInt *perm;           /* ncopy: PETSc block index of each copy */
+  PetscInt nlocal;          /* owned copies */
+  PetscInt first;           /* first owned PETSc block index */
   fcm_index nelem_own;
   /* constraints: DOFs (space numbering), motion of each, node of each */
   fcm_index ncon;
@@ -314,7 +314,6 @@ static void set_prefix(fcm_petsc_problem *P)
 {
   snprintf(P->prefix, sizeof P->prefix, "fcm%lu_", ++fcm_petsc_num_problems);
 }
-
 
 static int fcm_petsc_started_mpi = 0;
 
@@ -761,10 +760,13 @@ cleanup:
       fraction[c] = q[1];
       volume[c] = q[2];
     }
-    const double local[NCOUNT] = {
-        (double)counts->candidates, (double)counts->parts,      (double)counts->tets,
-        (double)counts->slivers,    (double)counts->surface_triangles,
-        (double)counts->degenerate, counts->sliver_volume};
+    const double local[NCOUNT] = {(double)counts->candidates,
+                                  (double)counts->parts,
+                                  (double)counts->tets,
+                                  (double)counts->slivers,
+                                  (double)counts->surface_triangles,
+                                  (double)counts->degenerate,
+                                  counts->sliver_volume};
     rc = MPI_Allgather(local, NCOUNT, MPI_DOUBLE, all, NCOUNT, MPI_DOUBLE, P->comm);
   }
   if (rc != MPI_SUCCESS) { /* MPI's default handler aborts first; with another one, give up */
@@ -992,10 +994,9 @@ void fcm_petsc_problem_destroy(fcm_petsc_problem **problem)
   fcm_assembly_workspace_destroy(&P->aws);
   if (!P->borrowed_space) fcm_space_destroy(&P->space);
   fcm_cell_rules_destroy(&P->rules);
-  void *arrays[] = {P->petsc_options, P->weight,     P->cell_owner, P->copy_owner,
-                    P->perm,          P->con_dof,    P->con_node,   P->con_comp,
-                    P->con_motion,    P->motions,    P->is_con,     P->classifier,
-                    P->remote};
+  void *arrays[] = {P->petsc_options, P->weight,     P->cell_owner, P->copy_owner, P->perm,
+                    P->con_dof,       P->con_node,   P->con_comp,   P->con_motion, P->motions,
+                    P->is_con,        P->classifier, P->remote};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
     fcm__free(ctx, arrays[i]);
   if (P->comm != MPI_COMM_NULL) MPI_Comm_free(&P->comm);
@@ -1843,8 +1844,7 @@ cleanup:
 
 /* Solve H x = b with the KSP of newton_factor() (zero initial guess); x gathered on every
  * process. A KSP that does not converge is a soft failure (the integrator retries). */
-static fcm_status newton_solve(void *user, const double *b, double *x, int *iterations,
-                               int *failed)
+static fcm_status newton_solve(void *user, const double *b, double *x, int *iterations, int *failed)
 {
   fcm_petsc_problem *P = user;
   fcm_status st = FCM_OK;
@@ -1916,8 +1916,8 @@ static fcm_status check_topology(fcm_petsc_problem *P)
   h = fnv1a(h, s->elem_piece, sizeof *s->elem_piece * (size_t)s->num_elems);
   h = fnv1a(h, s->elem_dof, sizeof *s->elem_dof * (size_t)s->num_elems * (size_t)s->nn);
   /* min and max over the processes of (DOFs, elements, hash): min of x and of -x */
-  long long mine[6] = {counts[0], counts[1], (long long)(h >> 1), -counts[0], -counts[1],
-                       -(long long)(h >> 1)};
+  long long mine[6] = {counts[0],  counts[1],  (long long)(h >> 1),
+                       -counts[0], -counts[1], -(long long)(h >> 1)};
   long long all[6];
   if (MPI_Allreduce(mine, all, 6, MPI_LONG_LONG, MPI_MIN, P->comm) != MPI_SUCCESS)
     return fcm__error(P->ctx, FCM_ERR_INTERNAL, __FILE__, __LINE__, __func__,
@@ -1940,7 +1940,7 @@ static fcm_status newton_build(fcm_petsc_problem *P, fcm_status st, const fcm_sp
 {
   fcm_ctx *ctx = P->ctx;
   st = newton_agree(P, st);
-  if (st != FCM_OK) return st; /* another process failed */
+  if (st != FCM_OK) return st;   /* another process failed */
   P->space = (fcm_space *)space; /* borrowed: P->borrowed_space */
   P->mesh = fcm_space_mesh(space);
   st = number_dofs(P);
@@ -2061,7 +2061,6 @@ static fcm_status newton_attach(void *user, fcm_integrator *integ, const fcm_spa
   newton_backend(P, &b);
   return fcm__integrator_set_backend(integ, &b);
 }
-
 
 fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_scene *scene,
                                        fcm_petsc_partition partition,

@@ -538,11 +538,10 @@ static fcm_status build_rules(fcm_simulation *S)
   fcm__rules_reduce red = {S->reduce, S->reduce_user, 0};
   if (S->rules_exchange) /* distributed: each process classifies its share of the cells */
     FCM_TRY(S->ctx, fcm__cell_rules_create_distributed(S->ctx, S->mesh, S->geom, &ro,
-                                                       S->reduce ? &red : NULL,
-                                                       S->rules_exchange, &S->rules));
+                                                       S->reduce ? &red : NULL, S->rules_exchange,
+                                                       &S->rules));
   else if (S->reduce) /* distributed: the auto choice's inputs summed over the processes */
-    FCM_TRY(S->ctx,
-            fcm__cell_rules_create_reduced(S->ctx, S->mesh, S->geom, &ro, &red, &S->rules));
+    FCM_TRY(S->ctx, fcm__cell_rules_create_reduced(S->ctx, S->mesh, S->geom, &ro, &red, &S->rules));
   else
     FCM_TRY(S->ctx, fcm_cell_rules_create(S->ctx, S->mesh, S->geom, &ro, &S->rules));
   S->c.cell_rules = 1;
@@ -812,13 +811,11 @@ cleanup:
   return st;
 }
 
-static fcm_status simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
-                                    const fcm_simulation_options *opts,
-                                    const unsigned char *cell_mask,
-                                    fcm__simulation_reduce_fn reduce,
-                                    const fcm__rules_exchange *exchange,
-                                    fcm__simulation_attach_fn attach, void *attach_user,
-                                    fcm_simulation **out);
+static fcm_status
+simulation_create(fcm_ctx *ctx, const fcm_scene *scene, const fcm_simulation_options *opts,
+                  const unsigned char *cell_mask, fcm__simulation_reduce_fn reduce,
+                  const fcm__rules_exchange *exchange, fcm__simulation_attach_fn attach,
+                  void *attach_user, fcm_simulation **out);
 
 fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
                                  const fcm_simulation_options *opts, fcm_simulation **out)
@@ -834,17 +831,14 @@ fcm_status fcm__simulation_create_distributed(fcm_ctx *ctx, const fcm_scene *sce
                                               fcm__simulation_attach_fn attach, void *attach_user,
                                               fcm_simulation **out)
 {
-  return simulation_create(ctx, scene, opts, cell_mask, reduce, exchange, attach, attach_user,
-                           out);
+  return simulation_create(ctx, scene, opts, cell_mask, reduce, exchange, attach, attach_user, out);
 }
 
-static fcm_status simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
-                                    const fcm_simulation_options *opts,
-                                    const unsigned char *cell_mask,
-                                    fcm__simulation_reduce_fn reduce,
-                                    const fcm__rules_exchange *exchange,
-                                    fcm__simulation_attach_fn attach, void *attach_user,
-                                    fcm_simulation **out)
+static fcm_status
+simulation_create(fcm_ctx *ctx, const fcm_scene *scene, const fcm_simulation_options *opts,
+                  const unsigned char *cell_mask, fcm__simulation_reduce_fn reduce,
+                  const fcm__rules_exchange *exchange, fcm__simulation_attach_fn attach,
+                  void *attach_user, fcm_simulation **out)
 {
   fcm_status st = FCM_OK;
   fcm_simulation *S = NULL;
@@ -1155,10 +1149,10 @@ static fcm_status distributed_cell_fields(fcm_simulation *S, const fcm_material 
   sig = fcm__calloc(ctx, 6 * (size_t)nc + 1, sizeof *sig);
   vm = fcm__calloc(ctx, (size_t)nc + 1, sizeof *vm);
   sed = fcm__calloc(ctx, (size_t)nc + 1, sizeof *sed);
-  st = f && sig && vm && sed ? FCM_OK
-                             : fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
-                                          "simulation: out of memory (cell fields of %lld cells)",
-                                          (long long)nc);
+  st = f && sig && vm && sed
+           ? FCM_OK
+           : fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
+                        "simulation: out of memory (cell fields of %lld cells)", (long long)nc);
   if (st == FCM_OK) st = fcm_space_cell_stress(s, mat, u, sig, vm, sed);
   int root = 1;
   fcm__integrator_distributed(S->integ, &root);

@@ -530,16 +530,16 @@ fcm_status fcm__sim_solve(fcm_integrator *I, const double *b, double *d, fcm_ste
     stats->linear_iterations += *iterations;
     if (st == FCM_OK && failed) *reason = FCM_STEP_LINEAR_SOLVER_FAILED;
   } else {
-  switch (I->opts.linear_solver) {
-  case FCM_LINEAR_DIRECT:
-    st = solve_direct(I, b, d, reason);
-    break;
-  case FCM_LINEAR_MULTIGRID:
-    st = mg_solve(I, b, d, reason, iterations, stats);
-    break;
-  default:
-    st = solve_krylov(I, b, d, reason, iterations, stats);
-  }
+    switch (I->opts.linear_solver) {
+    case FCM_LINEAR_DIRECT:
+      st = solve_direct(I, b, d, reason);
+      break;
+    case FCM_LINEAR_MULTIGRID:
+      st = mg_solve(I, b, d, reason, iterations, stats);
+      break;
+    default:
+      st = solve_krylov(I, b, d, reason, iterations, stats);
+    }
   }
   if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
   stats->time_solve += fcm_wtime() - t0;

@@ -158,8 +158,7 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
     st = assemble_boundary(I, x, 0, &bnd, fint, tangent ? I->H : NULL, &out->finite, stats);
   {
     double parts[2] = {psi, bnd};
-    FCM_TRY(I->ctx,
-            reduce_eval(I, st, parts, 2, fint, tangent ? I->H : NULL, &out->finite, stats));
+    FCM_TRY(I->ctx, reduce_eval(I, st, parts, 2, fint, tangent ? I->H : NULL, &out->finite, stats));
     psi = parts[0];
     bnd = parts[1];
   }
