@@ -344,3 +344,32 @@ int cli_gnuplot_png(const char *prog, const char *size, const char *path, const 
   }
   return 1;
 }
+
+void cli_split_petsc_args(int *argc, char **argv, int *pargc, char **pargv)
+{
+  int petsc = 0, n = 1, m = 1;
+  for (int i = 1; i < *argc; i++)
+    if (strcmp(argv[i], "--backend=petsc") == 0 ||
+        (strcmp(argv[i], "--backend") == 0 && i + 1 < *argc && strcmp(argv[i + 1], "petsc") == 0))
+      petsc = 1;
+  pargv[0] = argv[0];
+  *pargc = 1;
+  pargv[1] = NULL;
+  if (!petsc) return;
+  for (int i = 1; i < *argc; i++) {
+    const char *a = argv[i];
+    const int opt = a[0] == '-' && a[1] != '-' && a[1] != '\0' && a[2] != '\0';
+    if (!opt) {
+      argv[n++] = argv[i];
+      continue;
+    }
+    pargv[m++] = argv[i];
+    const char *b = i + 1 < *argc ? argv[i + 1] : NULL;
+    if (b && !(b[0] == '-' &&
+               ((b[1] >= 'a' && b[1] <= 'z') || (b[1] >= 'A' && b[1] <= 'Z') || b[1] == '-')))
+      pargv[m++] = argv[++i];
+  }
+  *argc = n;
+  *pargc = m;
+  pargv[m] = NULL;
+}

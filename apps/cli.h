@@ -43,6 +43,13 @@ int cli_element(const char *prog, const char *opt, const char *s, void *dest);
  * gnuplot is missing (said on stderr, naming the Debian package), 0 on an error. */
 int cli_gnuplot_png(const char *prog, const char *size, const char *path, const char *body);
 
+/** --backend petsc (or --backend=petsc) among the arguments: the PETSc options of the command
+ * line (a single dash and a word, "-ksp_type", with the value after it unless that is an
+ * option) are moved from argv into pargv (after the program name argv[0]; pargv has room for
+ * *argc + 1 entries and ends with NULL); argv keeps the program's own options. Without
+ * --backend petsc nothing moves (an unknown option stays an error for the program's parser). */
+void cli_split_petsc_args(int *argc, char **argv, int *pargc, char **pargv);
+
 /** A comma list of distinct element names into out[0..*n-1] (at most FCM_ELEMENT_COUNT). */
 int cli_element_list(const char *prog, const char *opt, const char *s,
                      fcm_element_type out[FCM_ELEMENT_COUNT], int *n);

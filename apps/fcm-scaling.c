@@ -1296,39 +1296,6 @@ static int parse_names(const char *opt, const char *s, const char *const *names,
   return 1;
 }
 
-/* --backend petsc: the PETSc options of the command line (a single dash and a word,
- * "-ksp_type", with the value after it unless that is an option) are moved from argv into pargv
- * (after the program name); argv keeps fcm-scaling's own. Without --backend petsc nothing
- * moves (an unknown option stays an error). As fcm-sim's. */
-static void split_petsc_args(int *argc, char **argv, int *pargc, char **pargv)
-{
-  int petsc = 0, n = 1, m = 1;
-  for (int i = 1; i < *argc; i++)
-    if (strcmp(argv[i], "--backend=petsc") == 0 ||
-        (strcmp(argv[i], "--backend") == 0 && i + 1 < *argc && strcmp(argv[i + 1], "petsc") == 0))
-      petsc = 1;
-  pargv[0] = argv[0];
-  *pargc = 1;
-  pargv[1] = NULL;
-  if (!petsc) return;
-  for (int i = 1; i < *argc; i++) {
-    const char *a = argv[i];
-    const int opt = a[0] == '-' && a[1] != '-' && a[1] != '\0' && a[2] != '\0';
-    if (!opt) {
-      argv[n++] = argv[i];
-      continue;
-    }
-    pargv[m++] = argv[i];
-    const char *b = i + 1 < *argc ? argv[i + 1] : NULL;
-    if (b && !(b[0] == '-' &&
-               ((b[1] >= 'a' && b[1] <= 'z') || (b[1] >= 'A' && b[1] <= 'Z') || b[1] == '-')))
-      pargv[m++] = argv[++i];
-  }
-  *argc = n;
-  *pargc = m;
-  pargv[m] = NULL;
-}
-
 static int scaling_main(int argc, char **argv, int pargc, char **pargv);
 
 int main(int argc, char **argv)
@@ -1337,7 +1304,7 @@ int main(int argc, char **argv)
   char **pargv = calloc((size_t)argc + 2, sizeof *pargv);
   if (!pargv) return 1;
   int pargc = 1;
-  split_petsc_args(&argc, argv, &pargc, pargv);
+  cli_split_petsc_args(&argc, argv, &pargc, pargv);
   const int rc = scaling_main(argc, argv, pargc, pargv);
   free(pargv);
   return rc;

@@ -252,45 +252,13 @@ static int write_checkpoint(fcm_ctx *ctx, fcm_simulation *sim, const char *dir, 
   return 1;
 }
 
-/* --backend petsc: the PETSc options of the command line (a single dash and a word, "-ksp_type",
- * with the value after it unless that is an option) are moved from argv into pargv (after the
- * program name); argv keeps fcm-sim's own. Without --backend petsc nothing moves (an unknown
- * option stays an error). */
-static void split_petsc_args(int *argc, char **argv, int *pargc, char **pargv)
-{
-  int petsc = 0, n = 1, m = 1;
-  for (int i = 1; i < *argc; i++)
-    if (strcmp(argv[i], "--backend=petsc") == 0 ||
-        (strcmp(argv[i], "--backend") == 0 && i + 1 < *argc && strcmp(argv[i + 1], "petsc") == 0))
-      petsc = 1;
-  pargv[0] = argv[0];
-  *pargc = 1;
-  if (!petsc) return;
-  for (int i = 1; i < *argc; i++) {
-    const char *a = argv[i];
-    const int opt = a[0] == '-' && a[1] != '-' && a[1] != '\0' && a[2] != '\0';
-    if (!opt) {
-      argv[n++] = argv[i];
-      continue;
-    }
-    pargv[m++] = argv[i];
-    const char *b = i + 1 < *argc ? argv[i + 1] : NULL;
-    if (b && !(b[0] == '-' &&
-               ((b[1] >= 'a' && b[1] <= 'z') || (b[1] >= 'A' && b[1] <= 'Z') || b[1] == '-')))
-      pargv[m++] = argv[++i];
-  }
-  *argc = n;
-  *pargc = m;
-  pargv[m] = NULL;
-}
-
 static int scene_main(int argc, char **argv)
 {
   scene_options o = {NULL, NULL, NULL, 0, -1, 0, 0, 0, 0, 0, 0};
   int pargc = 1;
   char **pargv = calloc((size_t)argc + 1, sizeof *pargv);
   if (!pargv) return 1;
-  split_petsc_args(&argc, argv, &pargc, pargv);
+  cli_split_petsc_args(&argc, argv, &pargc, pargv);
   const int parsed = parse_scene_args(argc, argv, &o);
   if (parsed >= 0 || o.backend == 1) {
     int rc = parsed;

@@ -149,6 +149,24 @@ cleanup:
   return st;
 }
 
+/* The largest |u|^2 at element e's points and `best` (a NaN, once met, stays). */
+static double element_max2(const fcm_space *s, const fcm_rule *full, fcm_index e, const double *u,
+                           double best)
+{
+  int nq = 0;
+  const double *pts = NULL, *w = NULL;
+  const unsigned char *fl = NULL;
+  element_points(s, full, e, &nq, &pts, &w, &fl);
+  for (int q = 0; q < nq; q++) {
+    double v[3];
+    if (fl && fl[q]) continue;
+    fcm_space_element_eval(s, e, pts + 3 * q, u, v);
+    const double n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    if (!(n2 <= best) && best == best) best = n2;
+  }
+  return best;
+}
+
 fcm_status fcm_space_max_displacement(const fcm_space *s, const double *u, double *max_norm)
 {
   fcm_status st = FCM_OK;
@@ -158,19 +176,8 @@ fcm_status fcm_space_max_displacement(const fcm_space *s, const double *u, doubl
             "max displacement: NULL space, field or output");
   FCM_TRY(s->ctx,
           fcm_element_standard_rule(s->ctx, s->type, FCM_RULE_STIFFNESS, FCM_DEFAULT, &full));
-  for (fcm_index e = 0; e < s->num_elems; e++) {
-    int nq = 0;
-    const double *pts = NULL, *w = NULL;
-    const unsigned char *fl = NULL;
-    element_points(s, full, e, &nq, &pts, &w, &fl);
-    for (int q = 0; q < nq; q++) {
-      double v[3];
-      if (fl && fl[q]) continue;
-      fcm_space_element_eval(s, e, pts + 3 * q, u, v);
-      const double n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-      if (!(n2 <= best)) best = n2; /* NaN propagates */
-    }
-  }
+  for (fcm_index e = 0; e < s->num_elems; e++)
+    best = element_max2(s, full, e, u, best);
   *max_norm = sqrt(best);
 cleanup:
   fcm_rule_destroy(&full);
@@ -185,19 +192,8 @@ fcm_status fcm__space_cell_max_displacement(const fcm_space *s, const double *u,
           fcm_element_standard_rule(s->ctx, s->type, FCM_RULE_STIFFNESS, FCM_DEFAULT, &full));
   for (fcm_index c = 0; c < s->num_cells; c++) {
     double best = 0.0;
-    for (fcm_index e = s->cell_elem[c]; e < s->cell_elem[c + 1]; e++) {
-      int nq = 0;
-      const double *pts = NULL, *w = NULL;
-      const unsigned char *fl = NULL;
-      element_points(s, full, e, &nq, &pts, &w, &fl);
-      for (int q = 0; q < nq; q++) {
-        double v[3];
-        if (fl && fl[q]) continue;
-        fcm_space_element_eval(s, e, pts + 3 * q, u, v);
-        const double n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-        if (!(n2 <= best)) best = n2; /* NaN propagates */
-      }
-    }
+    for (fcm_index e = s->cell_elem[c]; e < s->cell_elem[c + 1]; e++)
+      best = element_max2(s, full, e, u, best);
     cell_max[c] = sqrt(best);
   }
 cleanup:
