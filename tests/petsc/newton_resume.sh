@@ -2,8 +2,11 @@
 # Checkpoints of fcm-sim --backend petsc on the integrator path (label mpi): clamped_surface.json
 # (Stable Neo-Hookean, Nitsche on the embedded boundary, gravity, damping; CG + GAMG to rtol
 # 1e-12) with the scene's output.checkpoint_interval = 3, 6 steps on 2 processes; then
+#  - the background frames are parallel (<name>_background_NNNN.pvtu + one piece per process,
+#    indexed by the PVD);
 #  - resumed from step 3 on 2 processes: the log (all but the wall-time column), both PVDs,
-#    every frame and the step-6 checkpoint's state equal the uninterrupted run's byte for byte;
+#    every frame (.pvtu, pieces, surface .vtu) and the step-6 checkpoint's state equal the
+#    uninterrupted run's byte for byte;
 #  - resumed on 1 process, and by the serial fcm-sim (the same .fcmck format): the step-6 state
 #    equal to 1e-10 relative;
 #  - --checkpoint-every 2 overrides the scene's interval; a checkpoint of another scene exits 2
@@ -20,16 +23,20 @@ run() { "$mpiexec" -n "$1" "$sim" "$work/scene.json" --backend petsc -q --steps 
 run 2 -o "$work/a"
 [ -f "$work/a/${name}_checkpoint_000003.fcmck" ] && [ -f "$work/a/${name}_checkpoint_000006.fcmck" ]
 [ ! -e "$work/a/${name}_checkpoint_000002.fcmck" ]
+# the background frames are parallel: a .pvtu naming one piece per process, in the PVD
+[ -f "$work/a/${name}_background_0003.pvtu" ] && [ -f "$work/a/${name}_background_0003_1.vtu" ]
+grep -q "${name}_background_0003.pvtu" "$work/a/${name}_background.pvd"
 ck3=${name}_checkpoint_000003.fcmck ck6=${name}_checkpoint_000006.fcmck
 # the same process count: byte for byte (frames at steps 0, 2, 4, 6; the checkpoint has 0, 2)
 for d in b c; do
   cp -r "$work/a" "$work/$d"
-  rm "$work/$d"/${name}_*_000[23].vtu "$work/$d/$ck6"
+  rm "$work/$d"/${name}_*_000[23].vtu "$work/$d"/${name}_*_000[23].pvtu \
+    "$work/$d"/${name}_*_000[23]_*.vtu "$work/$d/$ck6"
 done
 run 2 -o "$work/b" --resume "$work/b/$ck3"
 strip() { sed 's/,[^,]*$//' "$1"; }
 diff <(strip "$work/a/${name}_log.csv") <(strip "$work/b/${name}_log.csv")
-for f in "$work"/a/*.pvd "$work"/a/*.vtu; do cmp "$f" "$work/b/$(basename "$f")"; done
+for f in "$work"/a/*.pvd "$work"/a/*.pvtu "$work"/a/*.vtu; do cmp "$f" "$work/b/$(basename "$f")"; done
 "$diff" "$work/a/$ck6" "$work/b/$ck6" 0
 # another process count, and the serial fcm-sim, from the same checkpoint: to 1e-10
 run 1 -o "$work/c" --resume "$work/c/$ck3"

@@ -5,9 +5,10 @@
 #     both take STEPS steps (--steps) with a checkpoint every step; the state of the last
 #     checkpoint (displacement and velocity, fcm-sim's .fcmck or the linear driver's .fcmpk)
 #     agrees to RTOL relative (petsc_state_diff); the KSP runs to -ksp_rtol 1e-12. On the
-#     integrator path (serial frames <name>_background_NNNN.vtu) the last frame's displacement,
-#     velocity and cell fields (stress, von Mises, strain energy density: every process's
-#     cells) agree to RTOL too.
+#     integrator path (parallel frames <name>_background_NNNN.pvtu, one piece
+#     <name>_background_NNNN_<rank>.vtu per process, indexed by the PVD) the last frame's
+#     pieces' displacement and velocity (placed by node_index) and cell fields (stress, von
+#     Mises, strain energy density, placed by cell_index) agree to RTOL with the serial frame.
 #   scene_app.sh summary MPIEXEC FCM_SIM - SCENE - - WORK
 #     the run summaries (--check, 3 steps) agree on the whole body's figures: the cells and
 #     their cut-cell point counts, the volume, the rules built (stored points), the
@@ -48,8 +49,14 @@ a=$(last "$work/p") b=$(last "$work/s")
 # the same step on both (the serial's last checkpoint names the step)
 [ "${a%.*}" = "$work/p/$(basename "${b%.*}")" ] || { echo "last checkpoints $a, $b" >&2; exit 1; }
 "$diff" "$a" "$b" "$arg"
-if ls "$work/p/${name}"_background_*.vtu >/dev/null 2>&1; then
-  f=$(ls "$work/p/${name}"_background_*.vtu | sort | tail -n 1)
-  "$diff" --vtu "$f" "$work/s/$(basename "$f")" "$arg"
+if ls "$work/p/${name}"_background_*.pvtu >/dev/null 2>&1; then
+  f=$(ls "$work/p/${name}"_background_*.pvtu | sort | tail -n 1)
+  # one piece per process, and the PVD indexes the .pvtu frames
+  for r in 0 1; do [ -f "${f%.pvtu}_$r.vtu" ] || { echo "piece ${f%.pvtu}_$r.vtu missing" >&2; exit 1; }; done
+  grep -q "$(basename "$f")" "$work/p/${name}_background.pvd" || { echo "PVD lacks $f" >&2; exit 1; }
+  if ls "$work/p/${name}"_background_????.vtu >/dev/null 2>&1; then
+    echo "serial background frames next to the .pvtu" >&2; exit 1
+  fi
+  "$diff" --vtu "$f" "$work/s/$(basename "${f%.pvtu}").vtu" "$arg"
 fi
 rm -rf "$work"

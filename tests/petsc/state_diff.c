@@ -7,7 +7,11 @@
  * tests of tests/petsc; prints the norms, exits 1 when they differ by more.
  * petsc_state_diff --vtu A.vtu B.vtu RTOL: the same for the background frames of fcm-sim
  * (fcm_space_write_vtu()): each of the point arrays displacement, velocity and the cell arrays
- * stress, von_mises, strain_energy_density (those in B must be in A). */
+ * stress, von_mises, strain_energy_density (those in B must be in A). A may be a parallel
+ * frame (.pvtu: a distributed run's pieces, fcm__space_write_vtu_piece()): its pieces' values
+ * are placed by their node_index / cell_index (the mesh's node and cell) into the whole mesh's
+ * arrays first; every cell in at most one piece, every node with the same values in each piece
+ * that holds it, and a cell or node in no piece compares as 0 (an inactive cell has none). */
 #include "../io/vtk_reader.h"
 
 #include <math.h>
@@ -96,8 +100,90 @@ static double *read_array(const char *path, const char *parent, const char *name
   return out;
 }
 
+/* Int32 array `name` of `parent` in a VTU file (malloc'ed) and its count; NULL if absent. */
+static int32_t *read_int32(const char *path, const char *parent, const char *name,
+                           long long *count)
+{
+  vr_doc d;
+  int32_t *out = NULL;
+  *count = 0;
+  if (!vr_load(&d, path)) return NULL;
+  if (vr_parse_vtu(&d)) {
+    const vr_tag *t = vr_data_array(&d, parent, name);
+    if (t) {
+      uint64_t bytes = 0;
+      const unsigned char *p = vr_array(&d, t, &bytes);
+      out = malloc(bytes + 1);
+      if (out) memcpy(out, p, bytes);
+      *count = (long long)(bytes / sizeof(int32_t));
+    }
+  }
+  vr_free(&d);
+  return out;
+}
+
+/* The whole mesh's array (nb values, ncomp per entity) of a .pvtu's pieces: NULL when a piece
+ * lacks it, an index is out of range, a cell is in two pieces or a node differs between
+ * pieces. */
+static double *read_pvtu_array(const char *pvtu, const char *parent, const char *name,
+                               long long nb, int ncomp)
+{
+  vr_doc d;
+  double *out = NULL;
+  char dir[4096], src[1024], path[8192];
+  if (!vr_load(&d, pvtu)) return NULL;
+  if (!vr_parse_xml(&d)) {
+    fprintf(stderr, "petsc_state_diff: %s: %s\n", pvtu, d.error);
+    vr_free(&d);
+    return NULL;
+  }
+  snprintf(dir, sizeof dir, "%s", pvtu);
+  char *slash = strrchr(dir, '/');
+  if (slash) *slash = 0;
+  else snprintf(dir, sizeof dir, ".");
+  const int cell = strcmp(parent, "CellData") == 0;
+  out = calloc((size_t)nb + 1, sizeof *out);
+  char *seen = calloc((size_t)(nb / ncomp) + 1, 1);
+  int ok = out && seen, pieces = 0;
+  for (int i = 0; ok; i++) {
+    const vr_tag *t = vr_find(&d, "Piece", "PUnstructuredGrid", i);
+    if (!t) break;
+    pieces++;
+    ok = vr_attr(t, "Source", src, sizeof src);
+    snprintf(path, sizeof path, "%s/%s", dir, src);
+    long long nv = 0, ni = 0;
+    double *x = ok ? read_array(path, parent, name, &nv) : NULL;
+    int32_t *id = ok ? read_int32(path, parent, cell ? "cell_index" : "node_index", &ni) : NULL;
+    ok = x && id && nv == ni * ncomp;
+    for (long long k = 0; ok && k < ni; k++) {
+      ok = id[k] >= 0 && (long long)id[k] * ncomp < nb;
+      if (!ok) break;
+      double *y = out + (size_t)id[k] * (size_t)ncomp;
+      if (seen[id[k]]) {
+        ok = !cell; /* a node shared by pieces: the same (replicated) values */
+        for (int c = 0; ok && c < ncomp; c++)
+          ok = y[c] == x[k * ncomp + c];
+      }
+      seen[id[k]] = 1;
+      for (int c = 0; ok && c < ncomp; c++)
+        y[c] = x[k * ncomp + c];
+    }
+    if (!ok)
+      fprintf(stderr, "petsc_state_diff: %s: piece %s: %s missing, out of range or repeated\n",
+              pvtu, path, name);
+    free(x), free(id);
+  }
+  ok = ok && pieces > 0;
+  vr_free(&d);
+  free(seen);
+  if (!ok) free(out), out = NULL;
+  return out;
+}
+
 static int vtu_main(const char *a, const char *b, double rtol)
 {
+  const size_t la = strlen(a);
+  const int parallel = la > 5 && strcmp(a + la - 5, ".pvtu") == 0;
   static const char *const arrays[5][2] = {{"PointData", "displacement"},
                                            {"PointData", "velocity"},
                                            {"CellData", "stress"},
@@ -105,9 +191,12 @@ static int vtu_main(const char *a, const char *b, double rtol)
                                            {"CellData", "strain_energy_density"}};
   int ok = 1, found = 0;
   for (int k = 0; k < 5; k++) {
+    static const int ncomp[5] = {3, 3, 6, 1, 1};
     long long na = 0, nb = 0;
-    double *x = read_array(a, arrays[k][0], arrays[k][1], &na);
     double *y = read_array(b, arrays[k][0], arrays[k][1], &nb);
+    double *x = NULL;
+    if (!parallel) x = read_array(a, arrays[k][0], arrays[k][1], &na);
+    else if (y && (x = read_pvtu_array(a, arrays[k][0], arrays[k][1], nb, ncomp[k]))) na = nb;
     if (y) {
       found++;
       if (!x || na != nb) {

@@ -76,11 +76,20 @@ void fcm__space_copy_support(const fcm_space *s, double *support);
 fcm_status fcm__assembly_element_linear(fcm_assembly_workspace *ws, const fcm_linear_form *form,
                                         fcm_index elem, double *Ke, double *fe);
 
-/* fcm_space_write_vtu() with the cell fields given (cells: 8 per cell, the stress (6), the von
- * Mises stress and the strain energy density, as fcm_space_cell_stress() averages them), or
- * computed when cells is NULL (a distributed run sums them over the processes first). */
-fcm_status fcm__space_write_vtu_cells(const fcm_space *s, const fcm_material *mat, const double *u,
-                                      const double *v, const double *cells, const char *path);
+/* One process's piece of a parallel frame (.pvtu + one .vtu per process, written atomically):
+ * the cells c with keep[c] != 0 (keep NULL: all) with their nodes renumbered, the point fields
+ * displacement, velocity (v may be NULL) of the DOF vectors u, v (replicated) and node_index
+ * (the mesh's node), the cell fields process (= rank), cell_index (the mesh's cell), active,
+ * volume_fraction and, with mat, stress, von_mises, strain_energy_density (computed here:
+ * the kept cells must have their points on this process). Not collective. (fields.c) */
+fcm_status fcm__space_write_vtu_piece(const fcm_space *s, const fcm_material *mat, const double *u,
+                                      const double *v, const unsigned char *keep, int rank,
+                                      const char *path);
+
+/* The .pvtu index (written atomically) of the pieces <stem>_0.vtu .. <stem>_<nprocs-1>.vtu that
+ * fcm__space_write_vtu_piece() wrote with the same velocity / mat choice. (fields.c) */
+fcm_status fcm__write_pvtu(fcm_ctx *ctx, const char *path, const char *stem, int nprocs,
+                           int with_velocity, int with_stress);
 
 /* fcm_space_max_displacement() per cell: the largest |u| over each cell's authentic points
  * (0 for a cell without points). */

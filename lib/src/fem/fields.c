@@ -5,6 +5,8 @@
 #include "la/mat3.h"
 
 #include <math.h>
+#include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 
 /* The material prepared once per call: parameters and Psi(I). */
@@ -230,12 +232,6 @@ cleanup:
 fcm_status fcm_space_write_vtu(const fcm_space *s, const fcm_material *mat, const double *u,
                                const double *v, const char *path)
 {
-  return fcm__space_write_vtu_cells(s, mat, u, v, NULL, path);
-}
-
-fcm_status fcm__space_write_vtu_cells(const fcm_space *s, const fcm_material *mat, const double *u,
-                                      const double *v, const double *cells, const char *path)
-{
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s ? s->ctx : NULL;
   fcm_vtu *vtu = NULL;
@@ -267,16 +263,8 @@ fcm_status fcm__space_write_vtu_cells(const fcm_space *s, const fcm_material *ma
     FCM_ALLOC(ctx, 6 * nc + 1, sig);
     FCM_ALLOC(ctx, nc + 1, vm);
     FCM_ALLOC(ctx, nc + 1, sed);
-    if (cells) { /* given: 8 per cell, stress (6), von Mises, strain energy density */
-      for (fcm_index c = 0; c < nc; c++) {
-        memcpy(sig + 6 * c, cells + 8 * c, 6 * sizeof *sig);
-        vm[c] = cells[8 * c + 6];
-        sed[c] = cells[8 * c + 7];
-      }
-    } else {
-      if (!u) FCM_ALLOC(ctx, s->num_dofs + 1, zero);
-      FCM_TRY(ctx, fcm_space_cell_stress(s, mat, u ? u : zero, sig, vm, sed));
-    }
+    if (!u) FCM_ALLOC(ctx, s->num_dofs + 1, zero);
+    FCM_TRY(ctx, fcm_space_cell_stress(s, mat, u ? u : zero, sig, vm, sed));
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "stress", 6, nc, sig));
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "von_mises", 1, nc, vm));
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "strain_energy_density", 1, nc, sed));
@@ -287,6 +275,165 @@ cleanup:
   void *arrays[] = {nu, nv, phi, sig, vm, sed, zero, active};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(ctx, arrays[k]);
+  return st;
+}
+
+fcm_status fcm__space_write_vtu_piece(const fcm_space *s, const fcm_material *mat, const double *u,
+                                      const double *v, const unsigned char *keep, int rank,
+                                      const char *path)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s ? s->ctx : NULL;
+  fcm_vtu *vtu = NULL;
+  fcm_index *map = NULL, *conn = NULL, np = 0, ncl = 0;
+  double *nu = NULL, *nv = NULL, *xyz = NULL, *pu = NULL, *pv = NULL, *phi = NULL;
+  double *sig = NULL, *vm = NULL, *sed = NULL, *csig = NULL, *cvm = NULL, *csed = NULL;
+  double *zero = NULL;
+  int32_t *owner = NULL, *cid = NULL, *nid = NULL, *active = NULL;
+  FCM_CHECK(s && path, ctx, FCM_ERR_ARG, "write vtu piece: NULL space or path");
+  const fcm_index nn = s->num_nodes, nc = s->num_cells;
+  FCM_CHECK(nn < INT32_MAX && nc < INT32_MAX, ctx, FCM_ERR_ARG,
+            "write vtu piece: %lld nodes, %lld cells: the indices must fit Int32", (long long)nn,
+            (long long)nc);
+  const int npc = fcm_mesh_nodes_per_cell(s->mesh);
+  const fcm_index *cells = fcm_mesh_cells(s->mesh);
+  const double *X = fcm_mesh_coords(s->mesh);
+  FCM_ALLOC(ctx, nn + 1, map);
+  FCM_ALLOC(ctx, 3 * nn + 1, nu);
+  if (u) FCM_TRY(ctx, fcm_space_node_field(s, u, nu));
+  if (v) {
+    FCM_ALLOC(ctx, 3 * nn + 1, nv);
+    FCM_TRY(ctx, fcm_space_node_field(s, v, nv));
+  }
+  for (fcm_index a = 0; a < nn; a++)
+    map[a] = -1;
+  for (fcm_index c = 0; c < nc; c++)
+    if (!keep || keep[c]) {
+      ncl++;
+      for (int k = 0; k < npc; k++)
+        if (map[cells[(size_t)npc * c + k]] < 0) map[cells[(size_t)npc * c + k]] = np++;
+    }
+  FCM_ALLOC(ctx, 3 * np + 1, xyz);
+  FCM_ALLOC(ctx, 3 * np + 1, pu);
+  FCM_ALLOC(ctx, 3 * np + 1, pv);
+  FCM_ALLOC(ctx, np + 1, nid);
+  FCM_ALLOC(ctx, (size_t)npc * ncl + 1, conn);
+  FCM_ALLOC(ctx, ncl + 1, phi);
+  FCM_ALLOC(ctx, ncl + 1, owner);
+  FCM_ALLOC(ctx, ncl + 1, cid);
+  FCM_ALLOC(ctx, ncl + 1, active);
+  for (fcm_index a = 0; a < nn; a++)
+    if (map[a] >= 0) {
+      nid[map[a]] = (int32_t)a;
+      for (int i = 0; i < 3; i++) {
+        xyz[3 * map[a] + i] = X[3 * a + i];
+        pu[3 * map[a] + i] = nu[3 * a + i];
+        pv[3 * map[a] + i] = nv ? nv[3 * a + i] : 0.0;
+      }
+    }
+  if (mat) {
+    FCM_ALLOC(ctx, 6 * nc + 1, sig);
+    FCM_ALLOC(ctx, nc + 1, vm);
+    FCM_ALLOC(ctx, nc + 1, sed);
+    FCM_ALLOC(ctx, 6 * ncl + 1, csig);
+    FCM_ALLOC(ctx, ncl + 1, cvm);
+    FCM_ALLOC(ctx, ncl + 1, csed);
+    if (!u) FCM_ALLOC(ctx, s->num_dofs + 1, zero);
+    FCM_TRY(ctx, fcm_space_cell_stress(s, mat, u ? u : zero, sig, vm, sed));
+  }
+  fcm_index m = 0;
+  for (fcm_index c = 0; c < nc; c++)
+    if (!keep || keep[c]) {
+      for (int k = 0; k < npc; k++)
+        conn[(size_t)npc * m + k] = map[cells[(size_t)npc * c + k]];
+      phi[m] = s->rules ? fcm_cell_rules_volume_fraction(s->rules, c) : 1.0;
+      owner[m] = rank;
+      cid[m] = (int32_t)c;
+      active[m] = s->active[c] ? 1 : 0;
+      if (mat) {
+        memcpy(csig + 6 * m, sig + 6 * c, 6 * sizeof *csig);
+        cvm[m] = vm[c];
+        csed[m] = sed[c];
+      }
+      m++;
+    }
+  FCM_TRY(ctx, fcm_vtu_create(ctx, &vtu));
+  FCM_TRY(ctx, fcm_vtu_set_points(vtu, np, xyz));
+  FCM_TRY(ctx,
+          fcm_vtu_set_cells(vtu, fcm_mesh_get_element_info(s->mesh)->vtk_cell_type, ncl, conn));
+  FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "displacement", 3, np, pu));
+  if (nv) FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "velocity", 3, np, pv));
+  FCM_TRY(ctx, fcm_vtu_add_field_int32(vtu, FCM_VTU_POINT_DATA, "node_index", 1, np, nid));
+  FCM_TRY(ctx, fcm_vtu_add_field_int32(vtu, FCM_VTU_CELL_DATA, "process", 1, ncl, owner));
+  FCM_TRY(ctx, fcm_vtu_add_field_int32(vtu, FCM_VTU_CELL_DATA, "cell_index", 1, ncl, cid));
+  FCM_TRY(ctx, fcm_vtu_add_field_int32(vtu, FCM_VTU_CELL_DATA, "active", 1, ncl, active));
+  FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "volume_fraction", 1, ncl, phi));
+  if (mat) {
+    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "stress", 6, ncl, csig));
+    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "von_mises", 1, ncl, cvm));
+    FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "strain_energy_density", 1, ncl, csed));
+  }
+  FCM_TRY(ctx, fcm_vtu_write(vtu, path, NULL));
+cleanup:
+  fcm_vtu_destroy(&vtu);
+  void *arrays[] = {map, conn, nu,  nv,   xyz, pu,   pv,    phi, sig,    vm,
+                    sed, csig, cvm, csed, zero, owner, cid, nid, active};
+  for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
+    fcm__free(ctx, arrays[k]);
+  return st;
+}
+
+/* The host's byte order as VTK names it (the pieces are written in it). */
+static const char *byte_order(void)
+{
+  const uint16_t one = 1;
+  unsigned char first;
+  memcpy(&first, &one, 1);
+  return first ? "LittleEndian" : "BigEndian";
+}
+
+fcm_status fcm__write_pvtu(fcm_ctx *ctx, const char *path, const char *stem, int nprocs,
+                           int with_velocity, int with_stress)
+{
+  fcm_status st = FCM_OK;
+  fcm_atomic_file *af = NULL;
+  FCM_CHECK(path && stem && nprocs >= 1, ctx, FCM_ERR_ARG,
+            "write pvtu: NULL path or stem, or %d processes (must be >= 1)", nprocs);
+  FCM_TRY(ctx, fcm_atomic_file_open(ctx, path, &af));
+  FILE *f = fcm_atomic_file_stream(af);
+  fprintf(f,
+          "<?xml version=\"1.0\"?>\n"
+          "<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"%s\" "
+          "header_type=\"UInt64\">\n"
+          "  <PUnstructuredGrid GhostLevel=\"0\">\n"
+          "    <PPointData>\n"
+          "      <PDataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\"/>\n",
+          byte_order());
+  if (with_velocity)
+    fprintf(f, "      <PDataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\"/>\n");
+  fprintf(f, "      <PDataArray type=\"Int32\" Name=\"node_index\" NumberOfComponents=\"1\"/>\n"
+             "    </PPointData>\n"
+             "    <PCellData>\n"
+             "      <PDataArray type=\"Int32\" Name=\"process\" NumberOfComponents=\"1\"/>\n"
+             "      <PDataArray type=\"Int32\" Name=\"cell_index\" NumberOfComponents=\"1\"/>\n"
+             "      <PDataArray type=\"Int32\" Name=\"active\" NumberOfComponents=\"1\"/>\n"
+             "      <PDataArray type=\"Float64\" Name=\"volume_fraction\" "
+             "NumberOfComponents=\"1\"/>\n");
+  if (with_stress)
+    fprintf(f, "      <PDataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"6\"/>\n"
+               "      <PDataArray type=\"Float64\" Name=\"von_mises\" NumberOfComponents=\"1\"/>\n"
+               "      <PDataArray type=\"Float64\" Name=\"strain_energy_density\" "
+               "NumberOfComponents=\"1\"/>\n");
+  fprintf(f, "    </PCellData>\n"
+             "    <PPoints>\n"
+             "      <PDataArray type=\"Float64\" NumberOfComponents=\"3\"/>\n"
+             "    </PPoints>\n");
+  for (int r = 0; r < nprocs; r++)
+    fprintf(f, "    <Piece Source=\"%s_%d.vtu\"/>\n", stem, r);
+  fprintf(f, "  </PUnstructuredGrid>\n</VTKFile>\n");
+  FCM_TRY(ctx, fcm_atomic_file_commit(&af));
+cleanup:
+  fcm_atomic_file_abort(&af);
   return st;
 }
 

@@ -45,7 +45,9 @@
  * - errors: every local phase ends in agree(): an error on any process is returned on all with
  *   the lowest failing process's message (tests/petsc: bad input on one rank, no hang).
  * - output: fcm_petsc_problem_write_frame(): a .pvtu (process 0) naming one piece per process
- *   (its own cells); the node fields come from the gathered (replicated) state.
+ *   (its own cells); the node fields come from the gathered (replicated) state. The integrator
+ *   path's background frames are the same (fcm__space_write_vtu_piece() / fcm__write_pvtu(),
+ *   fields.c, from fcm_simulation_write_frame()); its surface frames stay serial (process 0).
  * - scenes: fcm_petsc_problem_create_from_scene() (mesh + geometry through
  *   fcm__scene_mesh_geometry() of lib/src/scene/run.c) and fcm-sim --backend petsc
  *   (apps/fcm-sim-petsc.c); the example scene vibrating_beam.json is the dynamic one.
@@ -2013,6 +2015,8 @@ static void newton_backend(fcm_petsc_problem *P, fcm__sim_backend *b)
   memset(b, 0, sizeof *b);
   b->user = P;
   b->root = P->rank == 0;
+  b->rank = P->rank;
+  b->nprocs = P->size;
   b->reduce = newton_reduce;
   b->factor = newton_factor;
   b->solve = newton_solve;
@@ -2153,147 +2157,40 @@ cleanup:
 
 /* ---------------------------------------------------------------- output */
 
-/* This process's piece: its active cells with their nodes (renumbered), the node fields of the
- * gathered state, the owner and the volume fraction per cell. */
-static fcm_status write_piece(fcm_petsc_problem *P, const double *ud, const double *vd,
-                              const char *path)
-{
-  fcm_status st = FCM_OK;
-  fcm_ctx *ctx = P->ctx;
-  const fcm_mesh *mesh = P->mesh;
-  const fcm_index nc = fcm_mesh_num_cells(mesh), nn = fcm_mesh_num_nodes(mesh);
-  const int npc = fcm_mesh_nodes_per_cell(mesh);
-  const fcm_index *cells = fcm_mesh_cells(mesh);
-  const double *X = fcm_mesh_coords(mesh);
-  fcm_index *map = NULL, *conn = NULL, np = 0, ncl = 0;
-  double *xyz = NULL, *pu = NULL, *pv = NULL, *frac = NULL;
-  int32_t *owner = NULL;
-  fcm_vtu *vtu = NULL;
-  FCM_ALLOC(ctx, nn + 1, map);
-  for (fcm_index a = 0; a < nn; a++)
-    map[a] = -1;
-  for (fcm_index c = 0; c < nc; c++)
-    if (P->cell_owner[c] == P->rank) {
-      ncl++;
-      for (int k = 0; k < npc; k++)
-        if (map[cells[(size_t)npc * c + k]] < 0) map[cells[(size_t)npc * c + k]] = np++;
-    }
-  FCM_ALLOC(ctx, 3 * np + 1, xyz);
-  FCM_ALLOC(ctx, 3 * np + 1, pu);
-  FCM_ALLOC(ctx, 3 * np + 1, pv);
-  FCM_ALLOC(ctx, (size_t)npc * ncl + 1, conn);
-  FCM_ALLOC(ctx, ncl + 1, frac);
-  FCM_ALLOC(ctx, ncl + 1, owner);
-  for (fcm_index a = 0; a < nn; a++)
-    if (map[a] >= 0)
-      for (int i = 0; i < 3; i++) {
-        xyz[3 * map[a] + i] = X[3 * a + i];
-        pu[3 * map[a] + i] = ud[3 * a + i];
-        pv[3 * map[a] + i] = vd[3 * a + i];
-      }
-  fcm_index m = 0;
-  for (fcm_index c = 0; c < nc; c++)
-    if (P->cell_owner[c] == P->rank) {
-      for (int k = 0; k < npc; k++)
-        conn[(size_t)npc * m + k] = map[cells[(size_t)npc * c + k]];
-      frac[m] = P->rules ? fcm_cell_rules_volume_fraction(P->rules, c) : 1.0;
-      owner[m] = P->rank;
-      m++;
-    }
-  FCM_TRY(ctx, fcm_vtu_create(ctx, &vtu));
-  FCM_TRY(ctx, fcm_vtu_set_points(vtu, np, xyz));
-  FCM_TRY(ctx, fcm_vtu_set_cells(vtu, fcm_mesh_get_element_info(mesh)->vtk_cell_type, ncl, conn));
-  FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "displacement", 3, np, pu));
-  FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "velocity", 3, np, pv));
-  FCM_TRY(ctx, fcm_vtu_add_field_int32(vtu, FCM_VTU_CELL_DATA, "process", 1, ncl, owner));
-  FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "volume_fraction", 1, ncl, frac));
-  FCM_TRY(ctx, fcm_vtu_write(vtu, path, NULL));
-cleanup:
-  fcm_vtu_destroy(&vtu);
-  void *arrays[] = {map, conn, xyz, pu, pv, frac, owner};
-  for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
-    fcm__free(ctx, arrays[i]);
-  return st;
-}
-
-/* The host's byte order as VTK names it (the pieces are written in it). */
-static const char *byte_order(void)
-{
-  const uint16_t one = 1;
-  unsigned char first;
-  memcpy(&first, &one, 1);
-  return first ? "LittleEndian" : "BigEndian";
-}
-
-/* Process 0: the .pvtu index of the pieces. */
-static fcm_status write_pvtu(fcm_petsc_problem *P, const char *path, const char *stem)
-{
-  fcm_status st = FCM_OK;
-  fcm_ctx *ctx = P->ctx;
-  fcm_atomic_file *af = NULL;
-  FCM_TRY(ctx, fcm_atomic_file_open(ctx, path, &af));
-  FILE *f = fcm_atomic_file_stream(af);
-  fprintf(f,
-          "<?xml version=\"1.0\"?>\n"
-          "<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"%s\" "
-          "header_type=\"UInt64\">\n"
-          "  <PUnstructuredGrid GhostLevel=\"0\">\n"
-          "    <PPointData>\n"
-          "      <PDataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\"/>\n"
-          "      <PDataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\"/>\n"
-          "    </PPointData>\n"
-          "    <PCellData>\n"
-          "      <PDataArray type=\"Int32\" Name=\"process\" NumberOfComponents=\"1\"/>\n"
-          "      <PDataArray type=\"Float64\" Name=\"volume_fraction\" "
-          "NumberOfComponents=\"1\"/>\n"
-          "    </PCellData>\n"
-          "    <PPoints>\n"
-          "      <PDataArray type=\"Float64\" NumberOfComponents=\"3\"/>\n"
-          "    </PPoints>\n",
-          byte_order());
-  for (int r = 0; r < P->size; r++)
-    fprintf(f, "    <Piece Source=\"%s_%d.vtu\"/>\n", stem, r);
-  fprintf(f, "  </PUnstructuredGrid>\n</VTKFile>\n");
-  FCM_TRY(ctx, fcm_atomic_file_commit(&af));
-cleanup:
-  fcm_atomic_file_abort(&af);
-  return st;
-}
-
 fcm_status fcm_petsc_problem_write_frame(fcm_petsc_problem *P, const char *dir, const char *stem)
 {
   fcm_status st = FCM_OK;
-  double *u = NULL, *v = NULL, *ud = NULL, *vd = NULL;
+  double *u = NULL, *v = NULL;
+  unsigned char *keep = NULL;
   char path[4096];
   FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
   fcm_ctx *ctx = P->ctx;
   FCM_CHECK(dir && stem && *stem, ctx, FCM_ERR_ARG, "petsc: write_frame: NULL directory or stem");
-  const fcm_index nn = fcm_mesh_num_nodes(P->mesh);
   u = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *u);
   v = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *v);
-  ud = fcm__calloc(ctx, 3 * (size_t)nn + 1, sizeof *ud);
-  vd = fcm__calloc(ctx, 3 * (size_t)nn + 1, sizeof *vd);
-  st = u && v && ud && vd ? FCM_OK : FCM_ERR_ALLOC;
+  st = u && v ? FCM_OK : FCM_ERR_ALLOC;
   FCM_TRY(ctx, agree(ctx, P->comm, st));
   FCM_TRY(ctx, fcm_petsc_problem_get_state(P, u, v)); /* collective */
-  st = fcm_space_node_field(P->space, u, ud);
-  if (st == FCM_OK) st = fcm_space_node_field(P->space, v, vd);
-  if (st == FCM_OK) {
+  { /* this process's piece: its own cells (fcm__space_write_vtu_piece(), fields.c) */
+    const fcm_index nc = fcm_mesh_num_cells(P->mesh);
+    keep = fcm__calloc(ctx, (size_t)nc + 1, 1);
+    st = keep ? FCM_OK : FCM_ERR_ALLOC;
+    for (fcm_index c = 0; keep && c < nc; c++)
+      keep[c] = P->cell_owner[c] == P->rank;
     snprintf(path, sizeof path, "%s/%s_%d.vtu", dir, stem, P->rank);
-    st = write_piece(P, ud, vd, path);
+    if (st == FCM_OK) st = fcm__space_write_vtu_piece(P->space, NULL, u, v, keep, P->rank, path);
   }
   FCM_TRY(ctx, agree(ctx, P->comm, st));
   if (P->rank == 0) {
     snprintf(path, sizeof path, "%s/%s.pvtu", dir, stem);
-    st = write_pvtu(P, path, stem);
+    st = fcm__write_pvtu(ctx, path, stem, P->size, 1, 0);
   }
   FCM_TRY(ctx, agree(ctx, P->comm, st));
 cleanup:
   if (P) {
     fcm__free(P->ctx, u);
     fcm__free(P->ctx, v);
-    fcm__free(P->ctx, ud);
-    fcm__free(P->ctx, vd);
+    fcm__free(P->ctx, keep);
   }
   return st;
 }

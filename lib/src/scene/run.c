@@ -1115,7 +1115,8 @@ void fcm_simulation_get_counters(const fcm_simulation *S, fcm_simulation_counter
 /* ---------------------------------------------------------------- output */
 
 /* Create the PVD index <dir>/<name>_<kind>.pvd; after a restored checkpoint it first lists
- * the frames of the earlier run found in `dir` (<name>_<kind>_NNNN.vtu, NNNN = 0, 1, ...). */
+ * the frames of the earlier run found in `dir` (<name>_<kind>_NNNN.vtu, NNNN = 0, 1, ...; .pvtu
+ * for a distributed run's background). */
 static fcm_status open_pvd(fcm_simulation *S, const char *dir, const char *kind, fcm_pvd **pvd)
 {
   fcm_status st = FCM_OK;
@@ -1126,50 +1127,52 @@ static fcm_status open_pvd(fcm_simulation *S, const char *dir, const char *kind,
   if (S->restored)
     for (long long k = 0; k < S->c.frames; k++) {
       struct stat sb;
-      snprintf(path, sizeof path, "%s/%s_%s_%04lld.vtu", dir, name, kind, k);
+      snprintf(path, sizeof path, "%s/%s_%s_%04lld.%s", dir, name, kind, k,
+               /* a distributed run's background frames are .pvtu */
+               fcm__integrator_distributed(S->integ, NULL) && strcmp(kind, "background") == 0
+                   ? "pvtu"
+                   : "vtu");
       if (stat(path, &sb) == 0) FCM_TRY(S->ctx, fcm_pvd_add(*pvd, S->frame_time[k], path));
     }
 cleanup:
   return st;
 }
 
-/* A distributed run: the cell fields (stress, von Mises, strain energy density: 8 per cell)
- * of the whole body on every process — each process averages its own cells (the others' cut
- * cells have no points here) and the sum over the processes collects them. Collective. */
-static fcm_status distributed_cell_fields(fcm_simulation *S, const fcm_material *mat,
-                                          const double *u, double **out)
+/* A distributed run: this process's piece <name>_background_NNNN_<rank>.vtu of the background
+ * frame (its own cells: the rules' cell mask, all cells on the root without rules; the node
+ * fields from the replicated state, the stresses of its own cells computed here), then the
+ * root's <name>_background_NNNN.pvtu naming the pieces (path). Collective. */
+static fcm_status write_background_pieces(fcm_simulation *S, const char *dir, int index,
+                                          const double *u, const double *v, int root,
+                                          char *path, size_t path_size)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = S->ctx;
-  const fcm_space *s = S->space;
-  const fcm_cell_rules *R = fcm_space_cell_rules(s);
+  const fcm_cell_rules *R = fcm_space_cell_rules(S->space);
   const fcm_index nc = fcm_mesh_num_cells(S->mesh);
-  double *f = NULL, *sig = NULL, *vm = NULL, *sed = NULL;
-  f = fcm__calloc(ctx, 8 * (size_t)nc + 1, sizeof *f);
-  sig = fcm__calloc(ctx, 6 * (size_t)nc + 1, sizeof *sig);
-  vm = fcm__calloc(ctx, (size_t)nc + 1, sizeof *vm);
-  sed = fcm__calloc(ctx, (size_t)nc + 1, sizeof *sed);
-  st = f && sig && vm && sed
-           ? FCM_OK
-           : fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
-                        "simulation: out of memory (cell fields of %lld cells)", (long long)nc);
-  if (st == FCM_OK) st = fcm_space_cell_stress(s, mat, u, sig, vm, sed);
-  int root = 1;
-  fcm__integrator_distributed(S->integ, &root);
-  for (fcm_index c = 0; st == FCM_OK && c < nc; c++) {
-    if (!fcm__cell_rules_owns(R, c) || (!R && !root)) continue; /* another process's values */
-    memcpy(f + 8 * c, sig + 6 * c, 6 * sizeof *f);
-    f[8 * c + 6] = vm[c];
-    f[8 * c + 7] = sed[c];
-  }
-  FCM_TRY(ctx, fcm__integrator_reduce_status(S->integ, st, f, 8 * nc)); /* agrees on st first */
-  *out = f;
-  f = NULL;
+  const char *name = fcm_scene_name(S->scene);
+  char stem[1024];
+  int rank = 0, nprocs = 1;
+  fcm__integrator_processes(S->integ, &rank, &nprocs);
+  const int ns = snprintf(stem, sizeof stem, "%s_background_%04d", name, index);
+  FCM_CHECK(ns > 0 && (size_t)ns < sizeof stem && strlen(dir) + (size_t)ns + 32 < path_size, ctx,
+            FCM_ERR_ARG, "simulation: write_frame: the output directory or scene name is too long "
+            "(%zu + %d characters)", strlen(dir), ns);
+  unsigned char *keep = fcm__calloc(ctx, (size_t)nc + 1, 1);
+  st = keep ? FCM_OK
+            : fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
+                         "simulation: out of memory (cell mask of %lld cells)", (long long)nc);
+  for (fcm_index c = 0; keep && c < nc; c++)
+    keep[c] = fcm__cell_rules_owns(R, c) && (R || root);
+  snprintf(path, path_size, "%s/%.1023s_%d.vtu", dir, stem, rank);
+  if (st == FCM_OK)
+    st = fcm__space_write_vtu_piece(S->space, fcm_scene_get_material(S->scene), u, v, keep, rank,
+                                    path);
+  fcm__free(ctx, keep);
+  FCM_TRY(ctx, fcm__integrator_reduce_status(S->integ, st, NULL, 0)); /* agree on st */
+  snprintf(path, path_size, "%s/%.1023s.pvtu", dir, stem);
+  if (root) FCM_TRY(ctx, fcm__write_pvtu(ctx, path, stem, nprocs, 1, 1));
 cleanup:
-  fcm__free(ctx, f);
-  fcm__free(ctx, sig);
-  fcm__free(ctx, vm);
-  fcm__free(ctx, sed);
   return st;
 }
 
@@ -1178,7 +1181,6 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
   fcm_status st = FCM_OK;
   char path[4096];
   fcm_ctx *ctx = S ? S->ctx : NULL;
-  double *cells = NULL;
   FCM_CHECK(S && dir && index >= 0, ctx, FCM_ERR_ARG,
             "simulation: write_frame needs a directory and index >= 0 (got %d)", index);
   const char *name = fcm_scene_name(S->scene);
@@ -1191,11 +1193,14 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
   /* room for the frame time first: a frame that is written is also counted */
   FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&S->frame_time, &S->frame_cap, S->c.frames + 1,
                              sizeof *S->frame_time));
-  /* distributed: every process takes part in the cell fields, the root writes */
-  if (dist && out->write_background) FCM_TRY(ctx, distributed_cell_fields(S, mat, u, &cells));
-  if (out->write_background && root) {
+  /* distributed: every process writes its piece, the root the .pvtu and the PVD */
+  if (dist && out->write_background)
+    FCM_TRY(ctx, write_background_pieces(S, dir, index, u, v, root, path, sizeof path));
+  else if (out->write_background) {
     snprintf(path, sizeof path, "%s/%s_background_%04d.vtu", dir, name, index);
-    FCM_TRY(ctx, fcm__space_write_vtu_cells(S->space, mat, u, v, cells, path));
+    FCM_TRY(ctx, fcm_space_write_vtu(S->space, mat, u, v, path));
+  }
+  if (out->write_background && root) {
     if (!S->pvd_bg) FCM_TRY(ctx, open_pvd(S, dir, "background", &S->pvd_bg));
     FCM_TRY(ctx, fcm_pvd_add(S->pvd_bg, time, path));
   }
@@ -1208,7 +1213,6 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
   S->frame_time[S->c.frames++] = time;
   S->c.time_output += fcm_wtime() - t0;
 cleanup:
-  if (S) fcm__free(ctx, cells);
   return st;
 }
 

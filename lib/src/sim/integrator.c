@@ -709,6 +709,13 @@ int fcm__integrator_distributed(const fcm_integrator *I, int *root)
   return dist;
 }
 
+void fcm__integrator_processes(const fcm_integrator *I, int *rank, int *nprocs)
+{
+  const int dist = I && I->has_backend;
+  *rank = dist ? I->backend.rank : 0;
+  *nprocs = dist ? I->backend.nprocs : 1;
+}
+
 fcm_status fcm__integrator_reduce(fcm_integrator *I, double *values, fcm_index count)
 {
   return fcm__integrator_reduce_status(I, FCM_OK, values, count);

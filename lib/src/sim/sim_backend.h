@@ -19,6 +19,9 @@ struct fcm__sim_backend {
   /* 1 on exactly one process: the terms that are no partial sums (the base M/h^2 + D/h of the
    * Newton matrix, from the already summed M and D) are added there only */
   int root;
+  /* This process's number (0 .. nprocs-1) and the process count: the pieces of a parallel
+   * frame (fcm_simulation_write_frame()) are named by them. */
+  int rank, nprocs;
   /* Agree on st over the processes (on a failure anywhere every process returns the status
    * and message of the first failing one), then sum values[0 .. count) over the processes in
    * place (the same result, bit for bit, on every process). Collective. */
@@ -63,6 +66,9 @@ fcm_status fcm__integrator_reduce_status(fcm_integrator *I, fcm_status st, doubl
 /* Whether the integrator runs on a distributed backend (0: serial); *root (may be NULL): 1 on
  * the backend's root process, and 1 without a backend. */
 int fcm__integrator_distributed(const fcm_integrator *I, int *root);
+
+/* The backend's rank and process count (0 and 1 without a backend). */
+void fcm__integrator_processes(const fcm_integrator *I, int *rank, int *nprocs);
 
 /* The backend's finish (see fcm__sim_backend.finish) on st; st without a backend. Collective
  * with a backend. */
