@@ -7,7 +7,9 @@
  * writes the log <name>_log.csv; on the linear driver each frame is a parallel VTU
  * (<name>_NNNN.pvtu by process 0 naming one piece <name>_NNNN_<rank>.vtu per process: its own
  * cells), indexed by <name>.pvd, and checkpoints are <name>_checkpoint_NNNNNN.fcmpk; on the
- * integrator the serial frames and checkpoints (.fcmck) are written by process 0 (run_newton()). */
+ * integrator the background frames are parallel VTUs too (<name>_background_NNNN.pvtu + one
+ * piece per process, indexed by <name>_background.pvd), the surface frames and checkpoints
+ * (.fcmck) are written by process 0 (run_newton()). */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm-sim-petsc.h"
 
@@ -115,15 +117,15 @@ static int write_checkpoint(fcm_ctx *ctx, fcm_simulation *sim, const char *dir, 
   return ok;
 }
 
-/* A frame of the integrator path (collective: every process sums its cells' fields, process 0
- * writes the serial background and surface VTUs and PVDs); whether it was written, on every
- * process. */
+/* A frame of the integrator path (collective: every process writes the background piece of its
+ * own cells, process 0 the .pvtu, the surface VTU and the PVDs); whether it was written, on
+ * every process. */
 static int write_frame_newton(fcm_ctx *ctx, fcm_simulation *sim, const char *dir, int index,
                               int rank)
 {
   int ok = fcm_simulation_write_frame(sim, dir, index) == FCM_OK;
   if (!ok && rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
-  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD); /* a failure of the sums is everywhere */
+  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD); /* a failure of a piece is everywhere */
   return ok;
 }
 
@@ -145,7 +147,8 @@ static int resume_checkpoint(fcm_ctx *ctx, fcm_simulation *sim, const char *path
 /* A scene the linear driver does not run (non-linear material, boundary constraints, loads on
  * the boundary, damping, initial velocities, release): the scene's own simulation with the
  * integrator on PETSc (fcm_petsc_simulation_create()). Every process holds the same state and
- * log, so process 0 writes the frames (the serial <name>_background.pvd and VTUs), the log
+ * log; each process writes its background piece, process 0 the rest of the frames
+ * (<name>_background.pvd naming the .pvtu frames, the surface VTUs and PVD), the log
  * <name>_log.csv and the checkpoints (<name>_checkpoint_NNNNNN.fcmck, --checkpoint-every or
  * the scene's output.checkpoint_interval) with the serial writers; --resume: every process
  * reads the checkpoint. Returns the exit code (the same on every process). */
