@@ -101,8 +101,7 @@ static double *read_array(const char *path, const char *parent, const char *name
 }
 
 /* Int32 array `name` of `parent` in a VTU file (malloc'ed) and its count; NULL if absent. */
-static int32_t *read_int32(const char *path, const char *parent, const char *name,
-                           long long *count)
+static int32_t *read_int32(const char *path, const char *parent, const char *name, long long *count)
 {
   vr_doc d;
   int32_t *out = NULL;
@@ -125,8 +124,8 @@ static int32_t *read_int32(const char *path, const char *parent, const char *nam
 /* The whole mesh's array (nb values, ncomp per entity) of a .pvtu's pieces: NULL when a piece
  * lacks it, an index is out of range, a cell is in two pieces or a node differs between
  * pieces. */
-static double *read_pvtu_array(const char *pvtu, const char *parent, const char *name,
-                               long long nb, int ncomp)
+static double *read_pvtu_array(const char *pvtu, const char *parent, const char *name, long long nb,
+                               int ncomp)
 {
   vr_doc d;
   double *out = NULL;
@@ -139,8 +138,10 @@ static double *read_pvtu_array(const char *pvtu, const char *parent, const char 
   }
   snprintf(dir, sizeof dir, "%s", pvtu);
   char *slash = strrchr(dir, '/');
-  if (slash) *slash = 0;
-  else snprintf(dir, sizeof dir, ".");
+  if (slash)
+    *slash = 0;
+  else
+    snprintf(dir, sizeof dir, ".");
   const int cell = strcmp(parent, "CellData") == 0;
   out = calloc((size_t)nb + 1, sizeof *out);
   char *seen = calloc((size_t)(nb / ncomp) + 1, 1);
@@ -195,8 +196,10 @@ static int vtu_main(const char *a, const char *b, double rtol)
     long long na = 0, nb = 0;
     double *y = read_array(b, arrays[k][0], arrays[k][1], &nb);
     double *x = NULL;
-    if (!parallel) x = read_array(a, arrays[k][0], arrays[k][1], &na);
-    else if (y && (x = read_pvtu_array(a, arrays[k][0], arrays[k][1], nb, ncomp[k]))) na = nb;
+    if (!parallel)
+      x = read_array(a, arrays[k][0], arrays[k][1], &na);
+    else if (y && (x = read_pvtu_array(a, arrays[k][0], arrays[k][1], nb, ncomp[k])))
+      na = nb;
     if (y) {
       found++;
       if (!x || na != nb) {

@@ -376,7 +376,7 @@ fcm_status fcm__space_write_vtu_piece(const fcm_space *s, const fcm_material *ma
   FCM_TRY(ctx, fcm_vtu_write(vtu, path, NULL));
 cleanup:
   fcm_vtu_destroy(&vtu);
-  void *arrays[] = {map, conn, nu,  nv,   xyz, pu,   pv,    phi, sig,    vm,
+  void *arrays[] = {map, conn, nu,  nv,   xyz,  pu,    pv,  phi, sig,   vm,
                     sed, csig, cvm, csed, zero, owner, cid, nid, active};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(ctx, arrays[k]);

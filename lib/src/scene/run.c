@@ -1143,8 +1143,8 @@ cleanup:
  * fields from the replicated state, the stresses of its own cells computed here), then the
  * root's <name>_background_NNNN.pvtu naming the pieces (path). Collective. */
 static fcm_status write_background_pieces(fcm_simulation *S, const char *dir, int index,
-                                          const double *u, const double *v, int root,
-                                          char *path, size_t path_size)
+                                          const double *u, const double *v, int root, char *path,
+                                          size_t path_size)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = S->ctx;
@@ -1156,8 +1156,10 @@ static fcm_status write_background_pieces(fcm_simulation *S, const char *dir, in
   fcm__integrator_processes(S->integ, &rank, &nprocs);
   const int ns = snprintf(stem, sizeof stem, "%s_background_%04d", name, index);
   FCM_CHECK(ns > 0 && (size_t)ns < sizeof stem && strlen(dir) + (size_t)ns + 32 < path_size, ctx,
-            FCM_ERR_ARG, "simulation: write_frame: the output directory or scene name is too long "
-            "(%zu + %d characters)", strlen(dir), ns);
+            FCM_ERR_ARG,
+            "simulation: write_frame: the output directory or scene name is too long "
+            "(%zu + %d characters)",
+            strlen(dir), ns);
   unsigned char *keep = fcm__calloc(ctx, (size_t)nc + 1, 1);
   st = keep ? FCM_OK
             : fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
