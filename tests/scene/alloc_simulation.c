@@ -13,6 +13,7 @@
 
 #include <omp.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #define DIR "scene_alloc_sim.d"
 
@@ -182,6 +183,13 @@ int main(int argc, char **argv)
 {
   /* quick (default): the direct embedded scene and the free body; full: all four */
   const int full = argc > 1 && !strcmp(argv[1], "full");
+  /* the quick and the full test run in parallel: each in a working directory of its own */
+  const char *wd = full ? "scene_alloc_sim_full.wd" : "scene_alloc_sim_quick.wd";
+  mkdir(wd, 0755);
+  if (chdir(wd) != 0) {
+    TEST_FAIL_("cannot enter the working directory %s", wd);
+    return TEST_RESULT();
+  }
   omp_set_num_threads(1); /* the failing allocator counts calls in order */
   failing f;
   fcm_ctx *ctx = failing_ctx(&f);
@@ -260,5 +268,6 @@ int main(int argc, char **argv)
   }
   vr_rmdir(DIR);
   fcm_ctx_destroy(&ctx);
+  if (chdir("..") == 0) rmdir(wd);
   return TEST_RESULT();
 }

@@ -259,7 +259,7 @@ FCM_API int fcm_petsc_problem_supports_scene(fcm_ctx *ctx, const fcm_scene *scen
  * process, so one process (rank 0) writes the log and the checkpoints with the serial
  * writers (fcm_simulation_write_checkpoint(); every process of any count, and the serial
  * runner, resumes from it with fcm_simulation_read_checkpoint()); fcm_simulation_write_frame()
- * is collective (the cell fields are summed over the processes' cells, rank 0 writes), and
+ * is collective (each process writes the piece of its own cells, rank 0 the .pvtu), and
  * fcm_petsc_simulation_summary_view() is the summary over every process's cells. A resumed run
  * on the same process count repeats the uninterrupted one bit for bit when the KSP does (CG /
  * MINRES with GAMG, Jacobi, ...: the initial guess is always zero and GAMG builds a new
@@ -273,9 +273,10 @@ FCM_API int fcm_petsc_problem_supports_scene(fcm_ctx *ctx, const fcm_scene *scen
  * the Newton matrix's values (O(DOFs + nonzeros) per process and assembly), the direction is
  * gathered on every process; the rules, the element integration and the solve are what is
  * distributed. Collective.
- * @param[in] partition the cell partition method (AUTO: PT-Scotch)
+ * @param[in] partition the cell partition method (AUTO: Morton-ordered)
  * @param[in] opts      simulation options (NULL: defaults)
- * @return FCM_OK; FCM_ERR_UNSUPPORTED; the errors of fcm_simulation_create(); FCM_ERR_INTERNAL
+ * @return FCM_OK; FCM_ERR_UNSUPPORTED (a scene without an embedded geometry: its cell rules
+ * carry each process's share); the errors of fcm_simulation_create(); FCM_ERR_INTERNAL
  * (PETSc or MPI failed: its message). On every process when any failed. */
 FCM_API fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_scene *scene,
                                                fcm_petsc_partition partition,

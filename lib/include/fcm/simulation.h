@@ -130,8 +130,10 @@ FCM_API int fcm_simulation_state_finite(const fcm_simulation *sim);
  * vertex in a dropped cell is extrapolated from the nearest active cell), as the scene's
  * output section asks; <dir>/<name>_background.pvd and <dir>/<name>_surface.pvd are
  * rewritten. All writes are atomic. A simulation of fcm_petsc_simulation_create() (fcm/petsc.h):
- * collective — every process calls it (the cell averages are summed over the processes'
- * cells), process 0 writes the files, every process counts the frame. @return FCM_OK,
+ * collective — every process calls it and writes the piece of its own cells,
+ * <dir>/<name>_background_NNNN_<rank>.vtu; process 0 writes <dir>/<name>_background_NNNN.pvtu
+ * naming the pieces (the PVD indexes it) and the surface frame; every process counts the
+ * frame. @return FCM_OK,
  * FCM_ERR_IO (naming the path), FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_simulation_write_frame(fcm_simulation *sim, const char *dir, int index);
 

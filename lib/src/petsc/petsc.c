@@ -900,6 +900,22 @@ cleanup:
   return st;
 }
 
+/* Every active cell of P->space has an owner (a candidate of the partition), inactive ones
+ * none: FCM_ERR_INTERNAL naming the first active cell without one (local). */
+static fcm_status own_active_cells(fcm_petsc_problem *P)
+{
+  const fcm_index nc = fcm_mesh_num_cells(fcm_space_mesh(P->space));
+  for (fcm_index c = 0; c < nc; c++) {
+    if (P->space->active[c] && P->cell_owner[c] < 0)
+      return fcm__error(P->ctx, FCM_ERR_INTERNAL, __FILE__, __LINE__, __func__,
+                        "petsc: active cell %lld is no candidate (its box meets no geometry "
+                        "cell)",
+                        (long long)c);
+    if (!P->space->active[c]) P->cell_owner[c] = -1;
+  }
+  return FCM_OK;
+}
+
 fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh *mesh,
                                     const fcm_geometry *geom, const fcm_material *mat,
                                     const fcm_petsc_options *opts, fcm_petsc_problem **out)
@@ -937,7 +953,6 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
   FCM_TRY(ctx, agree(ctx, P->comm, st));
 
   /* 1., 2. the candidate cells and their partition */
-  const fcm_index nc = fcm_mesh_num_cells(mesh);
   const double tr = fcm_wtime();
   FCM_TRY(ctx, partition_cells(P, geom, &mask));
 
@@ -945,13 +960,7 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
    * process, the classes gathered on every process), and the space; candidates the rules drop
    * own nothing */
   st = build_space(P, geom, mask);
-  for (fcm_index c = 0; st == FCM_OK && c < nc; c++) {
-    if (P->space->active[c] && P->cell_owner[c] < 0)
-      st = fcm__error(ctx, FCM_ERR_INTERNAL, __FILE__, __LINE__, __func__,
-                      "petsc: active cell %lld is no candidate (its box meets no geometry cell)",
-                      (long long)c);
-    if (!P->space->active[c]) P->cell_owner[c] = -1;
-  }
+  if (st == FCM_OK) st = own_active_cells(P);
   FCM_TRY(ctx, P->agreed_fail ? st : problem_agree(P, st)); /* the exchange agreed on a failure */
   FCM_FREE(ctx, P->classifier);
   FCM_FREE(ctx, P->remote);
@@ -1945,9 +1954,8 @@ static fcm_status newton_build(fcm_petsc_problem *P, fcm_status st, const fcm_sp
   if (st != FCM_OK) return st;   /* another process failed */
   P->space = (fcm_space *)space; /* borrowed: P->borrowed_space */
   P->mesh = fcm_space_mesh(space);
-  st = number_dofs(P);
-  for (fcm_index c = 0; st == FCM_OK && c < fcm_mesh_num_cells(P->mesh); c++)
-    if (!space->active[c]) P->cell_owner[c] = -1;
+  st = own_active_cells(P);
+  if (st == FCM_OK) st = number_dofs(P);
   FCM_TRY(ctx, newton_agree(P, st));
   FCM_TRY(ctx, newton_agree(P, check_topology(P)));
   st = create_matrix(P, &P->S);
@@ -2113,6 +2121,12 @@ fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_sc
   }
   P->mat = *fcm_scene_get_material(scene);
   if (st == FCM_OK) st = fcm__scene_mesh_geometry(ctx, scene, &mesh, &geom);
+  if (st == FCM_OK && !geom)
+    st = fcm__error(ctx, FCM_ERR_UNSUPPORTED, __FILE__, __LINE__, __func__,
+                    "scene %s: the PETSc backend's integrator path needs an embedded geometry "
+                    "(\"geometry\"): its cell rules carry each process's share of the "
+                    "assembly; run this scene with the serial backend",
+                    fcm_scene_name(scene));
   FCM_TRY(ctx, newton_agree(P, st));
   /* the partition of the candidate cells, as fcm_petsc_problem_create() makes it */
   P->mesh = mesh;

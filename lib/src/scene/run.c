@@ -1067,6 +1067,9 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   r->pieces = S->pieces;
   FCM_TRY(S->ctx, log_momentum(S, r));
 cleanup:
+  /* distributed: a failure on one process only (outside the integrator's reduces) meets the
+   * others here or in their next reduce (FCM_OK without a backend) */
+  if (S) st = fcm__integrator_finish(S->integ, st);
   return st;
 }
 
@@ -1183,15 +1186,16 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
   fcm_status st = FCM_OK;
   char path[4096];
   fcm_ctx *ctx = S ? S->ctx : NULL;
+  int root = 1, dist = 0;
+  double t0 = fcm_wtime(), time = 0.0;
   FCM_CHECK(S && dir && index >= 0, ctx, FCM_ERR_ARG,
             "simulation: write_frame needs a directory and index >= 0 (got %d)", index);
   const char *name = fcm_scene_name(S->scene);
   const fcm_scene_output *out = fcm_scene_get_output(S->scene);
   const fcm_material *mat = fcm_scene_get_material(S->scene);
-  double t0 = fcm_wtime(), time = fcm_integrator_time(S->integ);
+  time = fcm_integrator_time(S->integ);
   const double *u = fcm_integrator_displacement(S->integ), *v = fcm_integrator_velocity(S->integ);
-  int root = 1;
-  const int dist = fcm__integrator_distributed(S->integ, &root);
+  dist = fcm__integrator_distributed(S->integ, &root);
   /* room for the frame time first: a frame that is written is also counted */
   FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&S->frame_time, &S->frame_cap, S->c.frames + 1,
                              sizeof *S->frame_time));
@@ -1212,9 +1216,14 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
     if (!S->pvd_surf) FCM_TRY(ctx, open_pvd(S, dir, "surface", &S->pvd_surf));
     FCM_TRY(ctx, fcm_pvd_add(S->pvd_surf, time, path));
   }
-  S->frame_time[S->c.frames++] = time;
-  S->c.time_output += fcm_wtime() - t0;
 cleanup:
+  /* distributed: a failure on any process (the root's files included) is returned on every
+   * process, and no process counts the frame then */
+  if (dist) st = fcm__integrator_finish(S->integ, st);
+  if (st == FCM_OK) {
+    S->frame_time[S->c.frames++] = time;
+    S->c.time_output += fcm_wtime() - t0;
+  }
   return st;
 }
 
@@ -1521,13 +1530,12 @@ fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f)
     gs.simplify_skipped[k] = (fcm_index)q[6 * k + 4];
     gs.simplify_fallbacks[k] = (fcm_index)q[6 * k + 5];
   }
-  gs.surface_triangles = (fcm_index)q[6 * K + 0];
+  /* surface_triangles, num_tets and num_slivers: the classification exchange summed them
+   * already (every process's stats hold the totals) */
   gs.surface_points = (fcm_index)q[6 * K + 1];
-  gs.num_tets = (fcm_index)q[6 * K + 2];
-  gs.num_slivers = (fcm_index)q[6 * K + 3];
   gc.boundary_points = (fcm_index)q[6 * K + 4];
   for (fcm_index c = 0; c < nc; c++)
-    if (!(q[nv + c] <= body)) body = q[nv + c]; /* NaN propagates */
+    if (!(q[nv + c] <= body) && body == body) body = q[nv + c]; /* a NaN stays */
   if (f) summary_view(S, f, S->rules ? &gs : NULL, &gc, body);
 cleanup:
   fcm__free(ctx, q);
