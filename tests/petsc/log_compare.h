@@ -1,5 +1,5 @@
 /* Shared by the tests that run a scene through the integrator on PETSc against the serial
- * fcm_simulation (newton.c, newton_cut.c): vector norms, the comparison of two CSV logs
+ * fcm_simulation (newton.c, newton_cut.c): the comparison of two CSV logs
  * written by fcm_simulation_write_log(), and of two runs after their steps (compare_runs()). */
 #ifndef FCM_TESTS_PETSC_LOG_COMPARE_H
 #define FCM_TESTS_PETSC_LOG_COMPARE_H
@@ -7,6 +7,7 @@
 #include "fcm/fcm.h"
 #include "fcm/simulation.h"
 #include "test.h"
+#include "../sim/sim_util.h" /* vec_norm(), vec_dist() */
 
 #include <mpi.h>
 #include <unistd.h>
@@ -15,22 +16,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static inline double norm(fcm_index n, const double *a)
-{
-  double s = 0.0;
-  for (fcm_index i = 0; i < n; i++)
-    s += a[i] * a[i];
-  return sqrt(s);
-}
-
-static inline double dist(fcm_index n, const double *a, const double *b)
-{
-  double s = 0.0;
-  for (fcm_index i = 0; i < n; i++)
-    s += (a[i] - b[i]) * (a[i] - b[i]);
-  return sqrt(s);
-}
 
 #define MAXCOL 128
 #define MAXROW 4096
@@ -128,14 +113,14 @@ static inline void compare_runs(fcm_ctx *ctx, fcm_simulation *ser, fcm_simulatio
   const fcm_index n = fcm_integrator_num_dofs(is);
   const double *us = fcm_integrator_displacement(is), *vs = fcm_integrator_velocity(is);
   const double *up = fcm_integrator_displacement(ip), *vp = fcm_integrator_velocity(ip);
-  const double un = norm(n, us), vn = norm(n, vs);
+  const double un = vec_norm(n, us), vn = vec_norm(n, vs);
   if (rank == 0 && getenv("FCM_TEST_VERBOSE"))
-    fprintf(stderr, "|u| serial %.17g, petsc %.17g\n", un, norm(n, up));
+    fprintf(stderr, "|u| serial %.17g, petsc %.17g\n", un, vec_norm(n, up));
   TEST_TRUE(un > 0.0);
-  const double du = dist(n, up, us) / un;
+  const double du = vec_dist(n, up, us) / un;
   if (!(du <= tol)) fprintf(stderr, "rank %d: |u - u_serial| / |u_serial| = %g\n", rank, du);
   TEST_TRUE(du <= tol);
-  if (vn > 0.0) TEST_TRUE(dist(n, vp, vs) <= tol * vn);
+  if (vn > 0.0) TEST_TRUE(vec_dist(n, vp, vs) <= tol * vn);
   /* the same state, bit for bit, on every process */
   double *u0 = malloc(sizeof *u0 * (size_t)(2 * n));
   TEST_TRUE(u0 != NULL);

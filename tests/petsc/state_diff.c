@@ -79,11 +79,13 @@ static int within(const char *what, long long n, const double *a, const double *
   return d <= rtol * nb;
 }
 
-/* Float64 array `name` of `parent` in a VTU file (malloc'ed) and its count; NULL if absent. */
-static double *read_array(const char *path, const char *parent, const char *name, long long *count)
+/* The raw values of array `name` of `parent` in a VTU file (malloc'ed) and their count, of
+ * `size` bytes each; NULL if absent. */
+static void *read_raw(const char *path, const char *parent, const char *name, size_t size,
+                      long long *count)
 {
   vr_doc d;
-  double *out = NULL;
+  unsigned char *out = NULL;
   *count = 0;
   if (!vr_load(&d, path)) return NULL;
   if (vr_parse_vtu(&d)) {
@@ -93,32 +95,23 @@ static double *read_array(const char *path, const char *parent, const char *name
       const unsigned char *p = vr_array(&d, t, &bytes);
       out = malloc(bytes + 1);
       if (out) memcpy(out, p, bytes);
-      *count = (long long)(bytes / sizeof(double));
+      *count = (long long)(bytes / size);
     }
   }
   vr_free(&d);
   return out;
 }
 
+/* Float64 array `name` of `parent` in a VTU file (malloc'ed) and its count; NULL if absent. */
+static double *read_array(const char *path, const char *parent, const char *name, long long *count)
+{
+  return read_raw(path, parent, name, sizeof(double), count);
+}
+
 /* Int32 array `name` of `parent` in a VTU file (malloc'ed) and its count; NULL if absent. */
 static int32_t *read_int32(const char *path, const char *parent, const char *name, long long *count)
 {
-  vr_doc d;
-  int32_t *out = NULL;
-  *count = 0;
-  if (!vr_load(&d, path)) return NULL;
-  if (vr_parse_vtu(&d)) {
-    const vr_tag *t = vr_data_array(&d, parent, name);
-    if (t) {
-      uint64_t bytes = 0;
-      const unsigned char *p = vr_array(&d, t, &bytes);
-      out = malloc(bytes + 1);
-      if (out) memcpy(out, p, bytes);
-      *count = (long long)(bytes / sizeof(int32_t));
-    }
-  }
-  vr_free(&d);
-  return out;
+  return read_raw(path, parent, name, sizeof(int32_t), count);
 }
 
 /* The whole mesh's array (nb values, ncomp per entity) of a .pvtu's pieces: NULL when a piece
