@@ -20,7 +20,7 @@
  *   ONE process (partition_cells(): its owner; the non-candidates, which the rules drop, round
  *   robin), inside the same rules build that maps its own cells' points
  *   (fcm__cell_rules_create_distributed(), embed_impl.h: the cells of P->remote are skipped);
- *   after the per-cell loop the build calls rules_exchange() once: agree(), then
+ *   after the per-cell loop the build calls rules_exchange() once: fcm__petsc_agree(), then
  *   MPI_Allgatherv of (class, volume fraction, embedded volume) as 3 doubles per classified
  *   cell in cell order (no ids: P->classifier is replicated), and the counters (candidates,
  *   tets, slivers, ...) summed in process order, so the statistics are the serial ones. The
@@ -30,7 +30,8 @@
  *   elements, both partitions, phases 1 and 2). Phase 2 hands the exchange through
  *   fcm__simulation_create_distributed() (run.c build_rules()). A process failing before its
  *   exchange still calls it (fcm__cell_rules_create_distributed() does, on every error path),
- *   and a phase-2 process that fails before the rules build meets it with its final agree().
+ *   and a phase-2 process that fails before the rules build meets it with its final
+ * fcm__petsc_agree().
  * - DOFs: global numbering, owner = lowest process among the cells using the DOF copy, the
  *   PETSc index is contiguous per owner; the perm (space DOF -> PETSc index) and the space's
  *   pattern are REPLICATED (O(DOFs + nnz) integers per process).
@@ -42,8 +43,8 @@
  * - solver: KSP CG + GAMG + MatNullSpaceCreateRigidBody by default; options string (scene
  *   solver.petsc_options) then command line; divergence -> FCM_ERR_NOT_CONVERGED with
  *   KSPConvergedReasons[].
- * - errors: every local phase ends in agree(): an error on any process is returned on all with
- *   the lowest failing process's message (tests/petsc: bad input on one rank, no hang).
+ * - errors: every local phase ends in fcm__petsc_agree(): an error on any process is returned on
+ * all with the lowest failing process's message (tests/petsc: bad input on one rank, no hang).
  * - output: fcm_petsc_problem_write_frame(): a .pvtu (process 0) naming one piece per process
  *   (its own cells); the node fields come from the gathered (replicated) state. The integrator
  *   path's background frames are the same (fcm__space_write_vtu_piece() / fcm__write_pvtu(),
@@ -66,8 +67,8 @@
  *   M/h^2 + D/h is added on the root only), the damping tangent, the representative force,
  *   fcm_integrator_energy(), the boundary reactions, the boundary point counts (nitsche.c),
  *   and the log's mass and momentum (run.c). A non-finite value on any process counts as one
- *   everywhere; every reduce starts with agree(), so a process that fails outside a reduce ends
- *   with one agree() and meets the others wherever they wait (no hang).
+ *   everywhere; every reduce starts with fcm__petsc_agree(), so a process that fails outside a
+ * reduce ends with one fcm__petsc_agree() and meets the others wherever they wait (no hang).
  * - sums: MPI_Reduce to process 0 + MPI_Bcast (the same bits everywhere for any count).
  * - solve: owned rows of the (already eliminated, summed) Newton matrix into a MATMPIAIJ with
  *   INSERT_VALUES, KSP: MUMPS Cholesky/LU when the scene says "direct", else CG/MINRES + GAMG
@@ -166,16 +167,12 @@
  *   tests/petsc/bench.c, figures in README "Distributed runs").
  * ------------------------------------------------------------------------------------------ */
 #define _GNU_SOURCE /* RTLD_DEFAULT */
-#include "fcm/petsc.h"
-
-#include "core/core_impl.h"
-#include "embed/embed_impl.h"
-#include "fem/fem_impl.h"
+/* before PETSc's headers: they include complex.h, whose macro I clashes with the integrator
+ * parameters these declare */
 #include "scene/run_impl.h"
 #include "sim/sim_backend.h"
 
-#include <petscksp.h>
-#include <petscmat.h>
+#include "petsc/petsc_impl.h"
 
 #include <dlfcn.h>
 #include <math.h>
@@ -184,89 +181,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define FCM_PETSC_CUT_WEIGHT 4
-
-struct fcm_petsc_problem {
-  fcm_ctx *ctx;
-  MPI_Comm comm;
-  int size, rank;
-  const fcm_mesh *mesh;
-  fcm_material mat;
-  fcm_petsc_options opts;
-  char *petsc_options; /* copy */
-  char prefix[32];     /* the KSP's options prefix, unique per problem ("fcm1_", ...) */
-  fcm_petsc_partition partition;
-  fcm_cell_rules *rules; /* this process's cells carry points */
-  fcm_space *space;      /* replicated topology */
-  fcm_assembly_workspace *aws;
-  fcm_index n;           /* global DOFs */
-  fcm_index ncopy;       /* n / 3 */
-  int *cell_owner;       /* num_cells (-1: inactive) */
-  unsigned char *weight; /* num_cells: partition weight of the candidate cells (0: none) */
-  /* distributed classification (the rules build, rules_exchange()): the process that
-   * intersects each cell (its owner; the cells no process owns round robin) and whether that
-   * is another one; both freed after the build */
-  int *classifier;
-  unsigned char *remote;
-  fcm_index num_classified; /* cells of the mesh partitioned (the length of both) */
-  double time_classify;     /* seconds of this process in the rules build's exchange (waits) */
-  int *copy_owner;          /* ncopy */
-  PetscInt *perm;           /* ncopy: PETSc block index of each copy */
-  PetscInt nlocal;          /* owned copies */
-  PetscInt first;           /* first owned PETSc block index */
-  fcm_index nelem_own;
-  /* constraints: DOFs (space numbering), motion of each, node of each */
-  fcm_index ncon;
-  fcm_index *con_dof, *con_node;
-  int *con_comp;
-  int *con_motion;
-  fcm_motion *motions;
-  int num_motions;
-  unsigned char *is_con; /* n */
-  double gravity[3];
-  int has_gravity;
-  int is_setup;
-  /* PETSc objects */
-  Mat K, M, S, Se; /* stiffness, mass (dynamic), system, system eliminated */
-  Vec f, u, v, b, x, g, w;
-  KSP ksp;
-  PetscInt *rows; /* owned constrained rows (PETSc indices) */
-  PetscInt nrows;
-  double diag;
-  double t;
-  long long steps, total_iterations;
-  double time_rules, time_assembly, time_setup;
-  fcm_mesh *own_mesh; /* built from a scene (fcm_petsc_problem_create_from_scene) */
-  fcm_geometry *own_geom;
-  /* the integrator's backend (fcm_petsc_simulation_create()): the space is the simulation's
-   * (borrowed, not destroyed); refs: the creator and the integrator; agreed_fail: an agree()
-   * of this backend reported a failure (so this process must not start another one) */
-  int borrowed_space;
-  int refs;
-  int agreed_fail;
-  int ksp_type_set;  /* -ksp_type in the options database: keep it (else CG / MINRES) */
-  int pc_type_set;   /* -pc_type in the options database: keep it */
-  int direct;        /* the scene asks for a direct solver: MUMPS (Cholesky / LU) */
-  long long factors; /* matrices given to the KSP */
-  int factored;      /* a matrix was given to the KSP since the last (re)build (cuts) */
-  VecScatter to_all;
-  Vec all;
-};
-
 /* ---------------------------------------------------------------- errors */
 
-/* A PETSc call: on failure, record its message as FCM_ERR_INTERNAL. */
-#define PCALL(ctx, call)                                                                           \
-  do {                                                                                             \
-    PetscErrorCode ierr_ = (call);                                                                 \
-    if (ierr_) {                                                                                   \
-      st = petsc_error((ctx), ierr_, #call, __FILE__, __LINE__, __func__);                         \
-      goto cleanup;                                                                                \
-    }                                                                                              \
-  } while (0)
-
-static fcm_status petsc_error(fcm_ctx *ctx, PetscErrorCode ierr, const char *call, const char *file,
-                              int line, const char *func)
+fcm_status fcm__petsc_error(fcm_ctx *ctx, PetscErrorCode ierr, const char *call, const char *file,
+                            int line, const char *func)
 {
   const char *text = NULL;
   char *specific = NULL;
@@ -278,7 +196,7 @@ static fcm_status petsc_error(fcm_ctx *ctx, PetscErrorCode ierr, const char *cal
 
 /* Every process learns whether any failed: on failure somewhere, every process returns the
  * status and message of the lowest failing process (the others record it as their error). */
-static fcm_status agree(fcm_ctx *ctx, MPI_Comm comm, fcm_status st)
+fcm_status fcm__petsc_agree(fcm_ctx *ctx, MPI_Comm comm, fcm_status st)
 {
   int rank = 0, size = 1;
   MPI_Comm_rank(comm, &rank);
@@ -300,11 +218,12 @@ static fcm_status agree(fcm_ctx *ctx, MPI_Comm comm, fcm_status st)
                     "process %d of %d failed: %s", first, size, msg);
 }
 
-/* agree() on P's communicator; a failure is remembered (P->agreed_fail), so that a process
- * that learnt of it here does not start another agree() the others never meet. */
-static fcm_status problem_agree(fcm_petsc_problem *P, fcm_status st)
+/* fcm__petsc_agree() on P's communicator; a failure is remembered (P->agreed_fail), so that a
+ * process that learnt of it here does not start another fcm__petsc_agree() the others never meet.
+ */
+fcm_status fcm__petsc_problem_agree(fcm_petsc_problem *P, fcm_status st)
 {
-  st = agree(P->ctx, P->comm, st);
+  st = fcm__petsc_agree(P->ctx, P->comm, st);
   if (st != FCM_OK) P->agreed_fail = 1;
   return st;
 }
@@ -669,7 +588,7 @@ cleanup:
  * intersecting anything) and their partition: P->cell_owner (-1: no candidate), *mask (this
  * process's cells, allocated), and who classifies each cell in the rules build: its owner, the
  * cells no process owns (which the rules drop, unless the box test missed a cell) round robin
- * (P->classifier, P->remote). Collective; a failure is agreed on (problem_agree()). */
+ * (P->classifier, P->remote). Collective; a failure is agreed on (fcm__petsc_problem_agree()). */
 static fcm_status partition_cells(fcm_petsc_problem *P, const fcm_geometry *geom,
                                   unsigned char **mask)
 {
@@ -683,7 +602,7 @@ static fcm_status partition_cells(fcm_petsc_problem *P, const fcm_geometry *geom
   P->remote = fcm__calloc(ctx, (size_t)nc + 1, 1);
   st = *mask && P->cell_owner && P->weight && P->classifier && P->remote ? FCM_OK : FCM_ERR_ALLOC;
   if (st == FCM_OK) st = candidate_cells(P, geom);
-  FCM_TRY(ctx, problem_agree(P, st));
+  FCM_TRY(ctx, fcm__petsc_problem_agree(P, st));
   fcm_index ncand = 0;
   for (fcm_index c = 0; c < nc; c++) {
     P->cell_owner[c] = -1;
@@ -699,7 +618,7 @@ static fcm_status partition_cells(fcm_petsc_problem *P, const fcm_geometry *geom
   } else {
     st = partition_ordered(P, P->weight, ncand);
   }
-  FCM_TRY(ctx, problem_agree(P, st));
+  FCM_TRY(ctx, fcm__petsc_problem_agree(P, st));
   P->num_classified = nc;
   for (fcm_index c = 0; c < nc; c++) {
     (*mask)[c] = P->cell_owner[c] == P->rank;
@@ -742,7 +661,7 @@ static fcm_status rules_exchange(void *user, fcm_status st, unsigned char *cls, 
     if (!cnt || !displ || !send || !recv || !all) st = FCM_ERR_ALLOC;
   }
 cleanup:
-  st = problem_agree(P, st); /* every process arrives here, failed or not */
+  st = fcm__petsc_problem_agree(P, st); /* every process arrives here, failed or not */
   if (st != FCM_OK) goto done;
   for (fcm_index c = 0; c < nc; c++)
     cnt[P->classifier[c]] += 3;
@@ -954,7 +873,7 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
   P->opts.petsc_options = NULL;
   set_prefix(P);
   if (st == FCM_OK) st = check_inputs(P, &P->opts);
-  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
 
   /* 1., 2. the candidate cells and their partition */
   const double tr = fcm_wtime();
@@ -965,7 +884,9 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
    * own nothing */
   st = build_space(P, geom, mask);
   if (st == FCM_OK) st = own_active_cells(P);
-  FCM_TRY(ctx, P->agreed_fail ? st : problem_agree(P, st)); /* the exchange agreed on a failure */
+  FCM_TRY(ctx, P->agreed_fail
+                   ? st
+                   : fcm__petsc_problem_agree(P, st)); /* the exchange agreed on a failure */
   FCM_FREE(ctx, P->classifier);
   FCM_FREE(ctx, P->remote);
   P->time_rules = fcm_wtime() - tr;
@@ -975,13 +896,13 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
     P->is_con = fcm__calloc(ctx, (size_t)P->n + 1, 1);
     if (!P->is_con) st = FCM_ERR_ALLOC;
   }
-  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
 
   /* 4. matrices and vectors (collective) */
   st = create_matrix(P, &P->K);
   if (st == FCM_OK && P->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) st = create_matrix(P, &P->M);
   if (st == FCM_OK) st = create_vectors(P);
-  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
   P->time_setup = fcm_wtime() - t0;
   *out = P;
   P = NULL;
@@ -1034,7 +955,7 @@ fcm_status fcm_petsc_problem_add_gravity(fcm_petsc_problem *P, const double acce
   else if (!accel || !isfinite(accel[0]) || !isfinite(accel[1]) || !isfinite(accel[2]))
     st = fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
                     "petsc: gravity acceleration is NULL or not finite");
-  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
   for (int i = 0; i < 3; i++)
     P->gravity[i] += accel[i];
   P->has_gravity = 1;
@@ -1131,9 +1052,9 @@ fcm_status fcm_petsc_problem_add_constraint(fcm_petsc_problem *P, fcm_index num_
   FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
   /* every process checks its input before any changes its state */
   st = check_constraint(P, num_nodes, nodes, motion);
-  FCM_TRY(P->ctx, agree(P->ctx, P->comm, st));
+  FCM_TRY(P->ctx, fcm__petsc_agree(P->ctx, P->comm, st));
   st = apply_constraint(P, num_nodes, nodes, motion);
-  FCM_TRY(P->ctx, agree(P->ctx, P->comm, st));
+  FCM_TRY(P->ctx, fcm__petsc_agree(P->ctx, P->comm, st));
 cleanup:
   return st;
 }
@@ -1189,7 +1110,7 @@ static fcm_status assemble_all(fcm_petsc_problem *P)
     form.accel = P->gravity;
     st = assemble_local(P, &form, NULL, P->f);
   }
-  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
   PCALL(ctx, MatAssemblyBegin(P->K, MAT_FINAL_ASSEMBLY));
   PCALL(ctx, MatAssemblyEnd(P->K, MAT_FINAL_ASSEMBLY));
   if (P->M) {
@@ -1299,18 +1220,19 @@ fcm_status fcm_petsc_problem_setup(fcm_petsc_problem *P)
   FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
   fcm_ctx *ctx = P->ctx;
   const double t0 = fcm_wtime();
-  FCM_TRY(ctx, agree(ctx, P->comm,
-                     P->is_setup ? fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
-                                              "petsc: setup called twice")
-                                 : FCM_OK));
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm,
+                                P->is_setup ? fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__,
+                                                         __func__, "petsc: setup called twice")
+                                            : FCM_OK));
   long long ncon_all = 0, ncon = (long long)P->ncon;
   MPI_Allreduce(&ncon, &ncon_all, 1, MPI_LONG_LONG, MPI_MAX, P->comm);
-  FCM_TRY(ctx, agree(ctx, P->comm,
-                     P->opts.kind == FCM_INTEGRATOR_STATIC && ncon_all == 0
-                         ? fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
-                                      "petsc: a static problem without any constraint: the "
-                                      "body's rigid-body modes are free (K is singular)")
-                         : FCM_OK));
+  FCM_TRY(ctx,
+          fcm__petsc_agree(ctx, P->comm,
+                           P->opts.kind == FCM_INTEGRATOR_STATIC && ncon_all == 0
+                               ? fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                                            "petsc: a static problem without any constraint: the "
+                                            "body's rigid-body modes are free (K is singular)")
+                               : FCM_OK));
   /* 1. assembly */
   const double ta = fcm_wtime();
   FCM_TRY(ctx, assemble_all(P));
@@ -1408,10 +1330,10 @@ fcm_status fcm_petsc_problem_step(fcm_petsc_problem *P, fcm_petsc_step_info *inf
   memset(&si, 0, sizeof si);
   FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
   fcm_ctx *ctx = P->ctx;
-  FCM_TRY(ctx, agree(ctx, P->comm,
-                     !P->is_setup ? fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
-                                               "petsc: step before setup")
-                                  : FCM_OK));
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm,
+                                !P->is_setup ? fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__,
+                                                          __func__, "petsc: step before setup")
+                                             : FCM_OK));
   const double h = P->opts.dt, t1 = P->t + h;
   double t0 = fcm_wtime();
   /* b = f (+ M/h^2 (u + h v)) - S g, then b = diag g on the constrained rows */
@@ -1686,7 +1608,7 @@ fcm_status fcm_petsc_problem_create_from_scene(fcm_ctx *ctx, MPI_Comm comm, cons
   FCM_CHECK(ctx && scene, ctx, FCM_ERR_ARG, "petsc: NULL context or scene");
   st = check_scene(ctx, scene);
   if (st == FCM_OK) st = fcm__scene_mesh_geometry(ctx, scene, &mesh, &geom);
-  FCM_TRY(ctx, agree(ctx, comm, st));
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, comm, st));
   /* the options as the serial runner derives them (lib/src/scene/run.c) */
   const fcm_scene_quadrature *q = fcm_scene_get_quadrature(scene);
   const fcm_scene_solver *sv = fcm_scene_get_solver(scene);
@@ -1731,7 +1653,7 @@ fcm_status fcm_petsc_problem_create_from_scene(fcm_ctx *ctx, MPI_Comm comm, cons
     fcm__free(ctx, nodes);
     nodes = NULL;
     st = scene_region_nodes(ctx, scene, P->mesh, r, k, &nodes, &n);
-    FCM_TRY(ctx, agree(ctx, P->comm, st));
+    FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
     FCM_TRY(ctx, fcm_petsc_problem_add_constraint(P, n, nodes, &m));
   }
   FCM_TRY(ctx, fcm_petsc_problem_setup(P));
@@ -1760,10 +1682,10 @@ static void newton_release(void *user)
   if (P && --P->refs == 0) fcm_petsc_problem_destroy(&P);
 }
 
-/* agree(), remembering a failure it reported (every process then knows it). */
+/* fcm__petsc_agree(), remembering a failure it reported (every process then knows it). */
 static fcm_status newton_agree(fcm_petsc_problem *P, fcm_status st)
 {
-  return problem_agree(P, st);
+  return fcm__petsc_problem_agree(P, st);
 }
 
 /* Sum over the processes: reduced on process 0 and broadcast, so every process holds the same
@@ -1825,7 +1747,7 @@ static fcm_status newton_factor(void *user, const fcm_csr *H, int psd, int *fail
         cols[j] = 3 * P->perm[c / 3] + c % 3;
       }
       PetscErrorCode ierr = MatSetValues(P->S, 1, &row, len, cols, hv + rp[r], INSERT_VALUES);
-      if (ierr) st = petsc_error(ctx, ierr, "MatSetValues", __FILE__, __LINE__, __func__);
+      if (ierr) st = fcm__petsc_error(ctx, ierr, "MatSetValues", __FILE__, __LINE__, __func__);
     }
   }
   FCM_TRY(ctx, newton_agree(P, st));
@@ -2141,7 +2063,7 @@ fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_sc
   /* the simulation (its mesh is built again from the scene, the same cells): collective from
    * the rules build's classification exchange on (each process classifies the cells of
    * P->classifier: rules_exchange()) and newton_attach(); a process that fails outside an
-   * agree() ends with one, which meets the agree() the others wait in */
+   * fcm__petsc_agree() ends with one, which meets the fcm__petsc_agree() the others wait in */
   {
     const fcm__rules_exchange x = {P->remote, rules_exchange, P};
     st = fcm__simulation_create_distributed(ctx, scene, opts, mask, newton_reduce, &x,
@@ -2187,7 +2109,7 @@ fcm_status fcm_petsc_problem_write_frame(fcm_petsc_problem *P, const char *dir, 
   u = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *u);
   v = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *v);
   st = u && v ? FCM_OK : FCM_ERR_ALLOC;
-  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
   FCM_TRY(ctx, fcm_petsc_problem_get_state(P, u, v)); /* collective */
   { /* this process's piece: its own cells (fcm__space_write_vtu_piece(), fields.c) */
     const fcm_index nc = fcm_mesh_num_cells(P->mesh);
@@ -2198,12 +2120,12 @@ fcm_status fcm_petsc_problem_write_frame(fcm_petsc_problem *P, const char *dir, 
     snprintf(path, sizeof path, "%s/%s_%d.vtu", dir, stem, P->rank);
     if (st == FCM_OK) st = fcm__space_write_vtu_piece(P->space, NULL, u, v, keep, P->rank, path);
   }
-  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
   if (P->rank == 0) {
     snprintf(path, sizeof path, "%s/%s.pvtu", dir, stem);
     st = fcm__write_pvtu(ctx, path, stem, P->size, 1, 0);
   }
-  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
 cleanup:
   if (P) {
     fcm__free(P->ctx, u);
@@ -2235,7 +2157,7 @@ fcm_status fcm_petsc_problem_write_checkpoint(fcm_petsc_problem *P, const char *
     v = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *v);
     if (!u || !v) st = FCM_ERR_ALLOC;
   }
-  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
   FCM_TRY(ctx, fcm_petsc_problem_get_state(P, u, v));
   if (P->rank == 0) {
     st = fcm_atomic_file_open(ctx, path, &af);
@@ -2257,7 +2179,7 @@ fcm_status fcm_petsc_problem_write_checkpoint(fcm_petsc_problem *P, const char *
       }
     }
   }
-  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
 cleanup:
   fcm_atomic_file_abort(&af);
   if (P) {
@@ -2317,7 +2239,7 @@ fcm_status fcm_petsc_problem_read_checkpoint(fcm_petsc_problem *P, const char *p
     st = P->is_setup ? read_ckpt(P, path, u, v, &t, &steps)
                      : fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
                                   "petsc: read_checkpoint before setup");
-  FCM_TRY(ctx, agree(ctx, P->comm, st));
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
   {
     PetscScalar *a = NULL, *b = NULL;
     PCALL(ctx, VecGetArray(P->u, &a));

@@ -1,0 +1,108 @@
+/* petsc module (internal): the problem object both drivers share, the PETSc call macro and
+ * the cross-process agreement. Only lib/src/petsc/ includes this (PETSc is touched in this
+ * module only). */
+#ifndef FCM_PETSC_IMPL_H
+#define FCM_PETSC_IMPL_H
+
+#include "fcm/petsc.h"
+
+#include "core/core_impl.h"
+#include "embed/embed_impl.h"
+#include "fem/fem_impl.h"
+
+#include <petscksp.h>
+#include <petscmat.h>
+
+#define FCM_PETSC_CUT_WEIGHT 4
+
+struct fcm_petsc_problem {
+  fcm_ctx *ctx;
+  MPI_Comm comm;
+  int size, rank;
+  const fcm_mesh *mesh;
+  fcm_material mat;
+  fcm_petsc_options opts;
+  char *petsc_options; /* copy */
+  char prefix[32];     /* the KSP's options prefix, unique per problem ("fcm1_", ...) */
+  fcm_petsc_partition partition;
+  fcm_cell_rules *rules; /* this process's cells carry points */
+  fcm_space *space;      /* replicated topology */
+  fcm_assembly_workspace *aws;
+  fcm_index n;           /* global DOFs */
+  fcm_index ncopy;       /* n / 3 */
+  int *cell_owner;       /* num_cells (-1: inactive) */
+  unsigned char *weight; /* num_cells: partition weight of the candidate cells (0: none) */
+  /* distributed classification (the rules build, rules_exchange()): the process that
+   * intersects each cell (its owner; the cells no process owns round robin) and whether that
+   * is another one; both freed after the build */
+  int *classifier;
+  unsigned char *remote;
+  fcm_index num_classified; /* cells of the mesh partitioned (the length of both) */
+  double time_classify;     /* seconds of this process in the rules build's exchange (waits) */
+  int *copy_owner;          /* ncopy */
+  PetscInt *perm;           /* ncopy: PETSc block index of each copy */
+  PetscInt nlocal;          /* owned copies */
+  PetscInt first;           /* first owned PETSc block index */
+  fcm_index nelem_own;
+  /* constraints: DOFs (space numbering), motion of each, node of each */
+  fcm_index ncon;
+  fcm_index *con_dof, *con_node;
+  int *con_comp;
+  int *con_motion;
+  fcm_motion *motions;
+  int num_motions;
+  unsigned char *is_con; /* n */
+  double gravity[3];
+  int has_gravity;
+  int is_setup;
+  /* PETSc objects */
+  Mat K, M, S, Se; /* stiffness, mass (dynamic), system, system eliminated */
+  Vec f, u, v, b, x, g, w;
+  KSP ksp;
+  PetscInt *rows; /* owned constrained rows (PETSc indices) */
+  PetscInt nrows;
+  double diag;
+  double t;
+  long long steps, total_iterations;
+  double time_rules, time_assembly, time_setup;
+  fcm_mesh *own_mesh; /* built from a scene (fcm_petsc_problem_create_from_scene) */
+  fcm_geometry *own_geom;
+  /* the integrator's backend (fcm_petsc_simulation_create()): the space is the simulation's
+   * (borrowed, not destroyed); refs: the creator and the integrator; agreed_fail: an agree()
+   * of this backend reported a failure (so this process must not start another one) */
+  int borrowed_space;
+  int refs;
+  int agreed_fail;
+  int ksp_type_set;  /* -ksp_type in the options database: keep it (else CG / MINRES) */
+  int pc_type_set;   /* -pc_type in the options database: keep it */
+  int direct;        /* the scene asks for a direct solver: MUMPS (Cholesky / LU) */
+  long long factors; /* matrices given to the KSP */
+  int factored;      /* a matrix was given to the KSP since the last (re)build (cuts) */
+  VecScatter to_all;
+  Vec all;
+};
+
+/* A PETSc call: on failure, record its message as FCM_ERR_INTERNAL. */
+#define PCALL(ctx, call)                                                                           \
+  do {                                                                                             \
+    PetscErrorCode ierr_ = (call);                                                                 \
+    if (ierr_) {                                                                                   \
+      st = fcm__petsc_error((ctx), ierr_, #call, __FILE__, __LINE__, __func__);                    \
+      goto cleanup;                                                                                \
+    }                                                                                              \
+  } while (0)
+
+/* The message of a failed PETSc call as FCM_ERR_INTERNAL (PCALL). */
+fcm_status fcm__petsc_error(fcm_ctx *ctx, PetscErrorCode ierr, const char *call, const char *file,
+                            int line, const char *func);
+
+/* Every process learns whether any failed: on failure somewhere, every process returns the
+ * status and message of the lowest failing process (the others record it as their error).
+ * Collective on comm. */
+fcm_status fcm__petsc_agree(fcm_ctx *ctx, MPI_Comm comm, fcm_status st);
+
+/* fcm__petsc_agree() on P's communicator; a failure is remembered (P->agreed_fail), so that a
+ * process that learnt of it there does not start another agreement the others never meet. */
+fcm_status fcm__petsc_problem_agree(fcm_petsc_problem *P, fcm_status st);
+
+#endif /* FCM_PETSC_IMPL_H */
