@@ -35,6 +35,7 @@
  * space's numbering); inactive rows are the Dirichlet ones. */
 #include "core/core_impl.h"
 #include "fcm/mg.h"
+#include "mg/mg_impl.h"
 #include "solve/solve_impl.h"
 
 #include <math.h>
@@ -292,7 +293,7 @@ cleanup:
  * fine DOFs take its value, a mid-edge copy takes the mean of the corner copies at the ends
  * of its edge in the first element that uses it at its own node (trilinear fields are in
  * the serendipity space, so this is exact for them). */
-static fcm_status build_level0(fcm_mg *m, const fcm_csr *A)
+static fcm_status build_level0(fcm_mg *m, const fcm_csr *A, const unsigned char *inactive0)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
@@ -481,7 +482,10 @@ static fcm_status build_level0(fcm_mg *m, const fcm_csr *A)
   FCM_ALLOC(ctx, L0->n + 1, L0->inactive);
   for (fcm_index i = 0; i < L0->n; i++)
     L0->dof[i] = i;
-  eliminated_rows(A, L0->n, L0->inactive);
+  if (inactive0)
+    memcpy(L0->inactive, inactive0, (size_t)L0->n);
+  else
+    eliminated_rows(A, L0->n, L0->inactive);
   if (hex20) {
     /* the grid level's DOFs: inactive where the coinciding fine DOF is eliminated */
     L->n = 3 * L->ncopy;
@@ -1114,6 +1118,14 @@ cleanup:
 }
 
 /* The block smoothers of every level but the coarsest, from the current level matrices. */
+/* The blocks of level l (< nlev - 1) in its DOF numbering: level 0's vertex and cut element
+ * blocks, a coarser level's corner blocks. */
+static fcm_status level_blocks(fcm_mg *m, int l, fcm_index *nb, fcm_index **ptr,
+                               fcm_index **dofs)
+{
+  return l == 0 ? blocks_level0(m, nb, ptr, dofs) : blocks_coarse(m, &m->lev[l], nb, ptr, dofs);
+}
+
 static fcm_status block_smoothers_create(fcm_mg *m)
 {
   fcm_status st = FCM_OK;
@@ -1121,10 +1133,7 @@ static fcm_status block_smoothers_create(fcm_mg *m)
   fcm_index nb = 0, *ptr = NULL, *dofs = NULL;
   for (int l = 0; l + 1 < m->nlev; l++) {
     mg_level *L = &m->lev[l];
-    if (l == 0)
-      FCM_TRY(ctx, blocks_level0(m, &nb, &ptr, &dofs));
-    else
-      FCM_TRY(ctx, blocks_coarse(m, L, &nb, &ptr, &dofs));
+    FCM_TRY(ctx, level_blocks(m, l, &nb, &ptr, &dofs));
     for (fcm_index k = 0; k < nb; k++)
       m->blk_max = FCM_MAX(m->blk_max, ptr[k + 1] - ptr[k]);
     if (nb > 0)
@@ -1137,6 +1146,45 @@ static fcm_status block_smoothers_create(fcm_mg *m)
 cleanup:
   fcm__free(ctx, ptr);
   fcm__free(ctx, dofs);
+  return st;
+}
+
+/* The levels of m (m->ctx, space, opts set): cells, copies, DOFs, inactive rows and the
+ * prolongations. Level 0's inactive rows are `inactive0` (n bytes, the space's numbering) or,
+ * when it is NULL, the eliminated rows of A; A (NULL with inactive0) is level 0's matrix. No
+ * matrix is read beyond that: the prolongations depend on the space and the inactive rows. */
+static fcm_status build_hierarchy(fcm_mg *m, const fcm_csr *A, const unsigned char *inactive0)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  const fcm_mg_options o = m->opts;
+  FCM_TRY(ctx, build_level0(m, A, inactive0));
+  if (A) FCM_TRY(ctx, level_diag(m, &m->lev[0]));
+  m->nlev = 1;
+  if (m->lev[1].ncell > 0) { /* Hex20: the p-coarse Hex8 level */
+    if (o.max_levels >= 2) {
+      m->nlev = 2;
+    } else { /* the space alone, solved directly */
+      level_free(ctx, &m->lev[1]);
+      mg_level *L0 = &m->lev[0];
+      fcm__free(ctx, L0->P_ptr), fcm__free(ctx, L0->P_col), fcm__free(ctx, L0->P_val);
+      fcm__free(ctx, L0->R_ptr), fcm__free(ctx, L0->R_col), fcm__free(ctx, L0->R_val);
+      L0->P_ptr = L0->R_ptr = NULL, L0->P_col = L0->R_col = NULL, L0->P_val = L0->R_val = NULL;
+    }
+  }
+  while (m->nlev < o.max_levels && m->lev[m->nlev - 1].n > o.coarse_dofs) {
+    const mg_level *F = &m->lev[m->nlev - 1];
+    if (F->grid[0] <= 1 && F->grid[1] <= 1 && F->grid[2] <= 1) break;
+    FCM_TRY(ctx, coarsen(m, m->nlev - 1));
+    m->nlev++;
+    if (m->lev[m->nlev - 1].n == 0 || m->lev[m->nlev - 1].n >= F->n) {
+      /* nothing left to correct, or no reduction (separate cells in one block): stop */
+      m->nlev--;
+      level_free(ctx, &m->lev[m->nlev]);
+      break;
+    }
+  }
+cleanup:
   return st;
 }
 
@@ -1175,32 +1223,7 @@ fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
   m->ctx = ctx;
   m->space = space;
   m->opts = o;
-  FCM_TRY(ctx, build_level0(m, A));
-  FCM_TRY(ctx, level_diag(m, &m->lev[0]));
-  m->nlev = 1;
-  if (m->lev[1].ncell > 0) { /* Hex20: the p-coarse Hex8 level */
-    if (o.max_levels >= 2) {
-      m->nlev = 2;
-    } else { /* the space alone, solved directly */
-      level_free(ctx, &m->lev[1]);
-      mg_level *L0 = &m->lev[0];
-      fcm__free(ctx, L0->P_ptr), fcm__free(ctx, L0->P_col), fcm__free(ctx, L0->P_val);
-      fcm__free(ctx, L0->R_ptr), fcm__free(ctx, L0->R_col), fcm__free(ctx, L0->R_val);
-      L0->P_ptr = L0->R_ptr = NULL, L0->P_col = L0->R_col = NULL, L0->P_val = L0->R_val = NULL;
-    }
-  }
-  while (m->nlev < o.max_levels && m->lev[m->nlev - 1].n > o.coarse_dofs) {
-    const mg_level *F = &m->lev[m->nlev - 1];
-    if (F->grid[0] <= 1 && F->grid[1] <= 1 && F->grid[2] <= 1) break;
-    FCM_TRY(ctx, coarsen(m, m->nlev - 1));
-    m->nlev++;
-    if (m->lev[m->nlev - 1].n == 0 || m->lev[m->nlev - 1].n >= F->n) {
-      /* nothing left to correct, or no reduction (separate cells in one block): stop */
-      m->nlev--;
-      level_free(ctx, &m->lev[m->nlev]);
-      break;
-    }
-  }
+  FCM_TRY(ctx, build_hierarchy(m, A, NULL));
   /* work arrays and Galerkin patterns */
   fcm_index maxn = 0;
   for (int l = 0; l < m->nlev; l++)
@@ -1507,5 +1530,95 @@ fcm_status fcm_mg_get_level_info(const fcm_mg *m, int level, fcm_mg_level_info *
   info->bodies = nb;
 cleanup:
   fcm__free(ctx, uf);
+  return st;
+}
+
+/* ------------------------------------------------------------------ transfers only */
+
+void fcm__mg_transfers_destroy(fcm_ctx *ctx, fcm__mg_transfers **tp)
+{
+  if (!tp || !*tp) return;
+  fcm__mg_transfers *t = *tp;
+  for (int l = 0; l < t->num_levels; l++) {
+    if (t->inactive) fcm__free(ctx, t->inactive[l]);
+    if (l + 1 < t->num_levels && t->P_ptr && t->P_col && t->P_val) {
+      fcm__free(ctx, t->P_ptr[l]);
+      fcm__free(ctx, t->P_col[l]);
+      fcm__free(ctx, t->P_val[l]);
+    }
+  }
+  for (int l = 0; l < t->num_levels && t->block_ptr && t->block_dofs; l++) {
+    fcm__free(ctx, t->block_ptr[l]);
+    fcm__free(ctx, t->block_dofs[l]);
+  }
+  fcm__free(ctx, t->num_blocks);
+  fcm__free(ctx, t->block_ptr);
+  fcm__free(ctx, t->block_dofs);
+  fcm__free(ctx, t->n);
+  fcm__free(ctx, t->P_ptr);
+  fcm__free(ctx, t->P_col);
+  fcm__free(ctx, t->P_val);
+  fcm__free(ctx, t->inactive);
+  fcm__free(ctx, t);
+  *tp = NULL;
+}
+
+fcm_status fcm__mg_transfers_create(fcm_ctx *ctx, const fcm_space *space,
+                                    const unsigned char *constrained, int max_levels,
+                                    fcm_index coarse_dofs, fcm__mg_transfers **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_mg *m = NULL;
+  fcm__mg_transfers *t = NULL;
+  unsigned char *none = NULL;
+  FCM_CHECK(ctx && space && out, ctx, FCM_ERR_ARG, "mg_transfers: NULL argument");
+  *out = NULL;
+  FCM_CHECK(max_levels >= 1 && max_levels <= 32, ctx, FCM_ERR_ARG,
+            "mg_transfers: max_levels = %d outside [1, 32]", max_levels);
+  FCM_CHECK(coarse_dofs >= 1, ctx, FCM_ERR_ARG, "mg_transfers: coarse_dofs = %lld must be >= 1",
+            (long long)coarse_dofs);
+  const fcm_index n0 = fcm_space_num_dofs(space);
+  if (!constrained) {
+    none = fcm__calloc(ctx, (size_t)n0 + 1, 1);
+    FCM_CHECK(none, ctx, FCM_ERR_ALLOC, "mg_transfers: out of memory");
+  }
+  m = fcm__calloc(ctx, 1, sizeof *m);
+  FCM_CHECK(m, ctx, FCM_ERR_ALLOC, "mg_transfers: out of memory");
+  m->ctx = ctx;
+  m->space = space;
+  m->opts = fcm_mg_options_default();
+  m->opts.max_levels = max_levels;
+  m->opts.coarse_dofs = coarse_dofs;
+  FCM_TRY(ctx, build_hierarchy(m, NULL, constrained ? constrained : none));
+  t = fcm__calloc(ctx, 1, sizeof *t);
+  FCM_CHECK(t, ctx, FCM_ERR_ALLOC, "mg_transfers: out of memory");
+  const int L = m->nlev;
+  t->num_levels = L;
+  FCM_ALLOC(ctx, L, t->n);
+  FCM_ALLOC(ctx, L, t->P_ptr);
+  FCM_ALLOC(ctx, L, t->P_col);
+  FCM_ALLOC(ctx, L, t->P_val);
+  FCM_ALLOC(ctx, L, t->inactive);
+  FCM_ALLOC(ctx, L, t->num_blocks);
+  FCM_ALLOC(ctx, L, t->block_ptr);
+  FCM_ALLOC(ctx, L, t->block_dofs);
+  for (int l = 0; l + 1 < L; l++)
+    FCM_TRY(ctx, level_blocks(m, l, &t->num_blocks[l], &t->block_ptr[l], &t->block_dofs[l]));
+  for (int l = 0; l < L; l++) { /* move the arrays: m keeps NULL */
+    mg_level *V = &m->lev[l];
+    t->n[l] = V->n;
+    t->inactive[l] = V->inactive, V->inactive = NULL;
+    if (l + 1 < L) {
+      t->P_ptr[l] = V->P_ptr, V->P_ptr = NULL;
+      t->P_col[l] = V->P_col, V->P_col = NULL;
+      t->P_val[l] = V->P_val, V->P_val = NULL;
+    }
+  }
+  *out = t;
+  t = NULL;
+cleanup:
+  fcm__mg_transfers_destroy(ctx, &t);
+  fcm_mg_destroy(&m);
+  fcm__free(ctx, none);
   return st;
 }

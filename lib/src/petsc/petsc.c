@@ -1274,6 +1274,13 @@ fcm_status fcm_petsc_problem_setup(fcm_petsc_problem *P)
   PCALL(ctx, KSPSetTolerances(P->ksp, P->opts.rtol, PETSC_DEFAULT, PETSC_DEFAULT,
                               P->opts.max_iterations));
   PCALL(ctx, KSPSetFromOptions(P->ksp));
+  {
+    PC pc;
+    PetscBool mg = PETSC_FALSE;
+    PCALL(ctx, KSPGetPC(P->ksp, &pc));
+    PCALL(ctx, PetscObjectTypeCompare((PetscObject)pc, PCMG, &mg));
+    if (mg) FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, fcm__petsc_pcmg_setup(P, pc, P->is_con, NULL)));
+  }
   P->is_setup = 1;
   P->time_setup += fcm_wtime() - t0;
 cleanup:

@@ -105,4 +105,20 @@ fcm_status fcm__petsc_agree(fcm_ctx *ctx, MPI_Comm comm, fcm_status st);
  * process that learnt of it there does not start another agreement the others never meet. */
 fcm_status fcm__petsc_problem_agree(fcm_petsc_problem *P, fcm_status st);
 
+/* 1 when fcm's geometric multigrid may apply to the space: Hex8 or Hex20 elements (whether the
+ * mesh is a box grid is found by fcm__petsc_pcmg_setup()). pcmg.c. */
+int fcm__petsc_pcmg_grid(const fcm_space *space);
+
+/* pc (of P's KSP, type PCMG) gets fcm's multigrid hierarchy (lib/src/mg) as its levels: the
+ * prolongations as MATMPIAIJ (block size 3) in P's numbering, Galerkin coarse operators, and
+ * defaults the options database overrides (Chebyshev + point-block Jacobi smoothers, redundant
+ * Cholesky on the coarsest level); then PCSetFromOptions. constrained: P->n bytes in the space's
+ * numbering (nonzero: an eliminated row), or NULL. num_levels (may be NULL): the levels made.
+ * @return FCM_OK, FCM_ERR_UNSUPPORTED (not a Hex8 / Hex20 box grid: named), FCM_ERR_ARG
+ * (-pc_mg_levels that the hierarchy cannot give), FCM_ERR_ALLOC, FCM_ERR_INTERNAL (PETSc). The
+ * same on every process (the hierarchy is built from the replicated space); not agreed here.
+ * pcmg.c. */
+fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned char *constrained,
+                                 int *num_levels);
+
 #endif /* FCM_PETSC_IMPL_H */

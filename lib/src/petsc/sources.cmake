@@ -1,1 +1,1 @@
-list(APPEND FCM_SOURCES lib/src/petsc/petsc.c)
+list(APPEND FCM_SOURCES lib/src/petsc/petsc.c lib/src/petsc/pcmg.c)

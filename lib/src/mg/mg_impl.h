@@ -1,0 +1,42 @@
+/* mg module (internal): the hierarchy's prolongations without a matrix, for other solvers'
+ * multigrid (lib/src/petsc/pcmg.c). */
+#ifndef FCM_MG_IMPL_H
+#define FCM_MG_IMPL_H
+
+#include "fcm/mg.h"
+
+/* The prolongations of the hierarchy fcm_mg_create() builds, without a matrix. Level 0 is the
+ * space (its DOF numbering); level l + 1 is coarser; P[l] is n[l] x n[l + 1], rows sorted by
+ * column, the weights fcm_mg_create() prolongates with. inactive[l] (n[l] bytes) marks the
+ * Dirichlet DOFs of each level: level 0 the constrained ones given, coarser ones as
+ * fcm_mg_create() derives them (every coinciding finer DOF inactive, or no finer DOF
+ * interpolating from it); P keeps their rows and columns (it is injective). */
+typedef struct fcm__mg_transfers {
+  int num_levels;           /* >= 1 */
+  fcm_index *n;             /* num_levels: DOFs (rows) of each level */
+  fcm_index **P_ptr;        /* num_levels - 1 CSR prolongations */
+  int **P_col;
+  double **P_val;
+  unsigned char **inactive; /* num_levels */
+  /* the blocks of fcm_mg_options.block_smoothing on levels 0 .. num_levels - 2, in the level's
+   * numbering (level 0: vertex blocks and the DOFs of each cut element; coarser: the corner
+   * DOFs of each coarse cell that is not all material); CSR over blocks, they may overlap */
+  fcm_index *num_blocks;
+  fcm_index **block_ptr;
+  fcm_index **block_dofs;
+} fcm__mg_transfers;
+
+/* The transfers of `space` (a Hex8 or Hex20 box grid, as fcm_mg_create() needs) with the
+ * constrained DOFs `constrained` (fcm_space_num_dofs() bytes, nonzero: constrained; NULL:
+ * none); max_levels and coarse_dofs as in fcm_mg_options (validated). The levels, copies and
+ * prolongations are those fcm_mg_create() builds (the same code) for a matrix whose eliminated
+ * rows are the constrained ones. @return FCM_OK, FCM_ERR_ARG, FCM_ERR_UNSUPPORTED (not a box
+ * grid: named), FCM_ERR_ALLOC. */
+fcm_status fcm__mg_transfers_create(fcm_ctx *ctx, const fcm_space *space,
+                                    const unsigned char *constrained, int max_levels,
+                                    fcm_index coarse_dofs, fcm__mg_transfers **out);
+
+/* Destroy; accepts NULL and *t == NULL, sets *t = NULL. */
+void fcm__mg_transfers_destroy(fcm_ctx *ctx, fcm__mg_transfers **t);
+
+#endif /* FCM_MG_IMPL_H */

@@ -1,0 +1,369 @@
+/* petsc/pcmg: fcm's geometric multigrid hierarchy (lib/src/mg, cut-aware 2x2x2 coarsening of
+ * Hex8 / Hex20 box grids, Hex20 first to the Hex8 space of the same elements) as the levels of
+ * PETSc's PCMG.
+ *
+ * Every process builds the whole hierarchy's prolongations (fcm__mg_transfers_create(): the
+ * topology is replicated, as the space and the DOF numbering are) and inserts the rows it owns
+ * into one MATMPIAIJ per level (block size 3). Numbering and ownership:
+ * - level 0 (the finest) is the problem's PETSc numbering (3 perm[copy] + component, rows
+ *   owned by the copy's owner);
+ * - a coarse copy is owned by the owner of the finer copy with the lowest global index among
+ *   the finer copies it interpolates to (weight != 0); the coarse copies are numbered owner by
+ *   owner (contiguous per process), by fcm's coarse copy index within one owner;
+ * - a coarse copy no finer copy interpolates to is left out (its Galerkin row would be zero).
+ * The fine constrained rows (eliminated symmetrically, diagonal kept) stay in P, so P stays
+ * injective (as in fcm_mg_create()) and every Galerkin matrix P^T A P is positive definite;
+ * the coarse levels then see the Dirichlet rows as springs of the eliminated diagonal rather
+ * than decoupling them as fcm_mg does.
+ * PETSc numbers its levels from the coarsest (0) to the finest; fcm from the finest. */
+#include "mg/mg_impl.h"
+#include "petsc/petsc_impl.h"
+
+#include <stdio.h>
+#include <string.h>
+
+/* Set `-<prefix><name> value` unless the database has the key already. */
+static fcm_status default_option(fcm_ctx *ctx, const char *prefix, const char *name,
+                                 const char *value)
+{
+  fcm_status st = FCM_OK;
+  char key[128];
+  PetscBool has = PETSC_FALSE;
+  snprintf(key, sizeof key, "-%s%s", prefix, name);
+  PCALL(ctx, PetscOptionsHasName(NULL, NULL, key, &has));
+  if (!has) PCALL(ctx, PetscOptionsSetValue(NULL, key, value));
+cleanup:
+  return st;
+}
+
+/* ---------------------------------------------------------------- block smoother */
+
+/* The default smoother's PC on a level: fcm's additive Schwarz (fcm_schwarz, clamped
+ * eigen-inverses of dense blocks, the inverse diagonal elsewhere) on the owned rows, with the
+ * blocks of fcm_mg's block smoothing restricted to this process's rows (a block's DOFs owned by
+ * other processes are left out). Built from the diagonal block (owned rows and columns) of the
+ * level's operator at each PC setup. */
+typedef struct block_pc {
+  fcm_ctx *ctx;
+  fcm_index n; /* owned rows */
+  fcm_index nb;
+  fcm_index *ptr, *dofs; /* local blocks */
+  fcm_schwarz *S;
+} block_pc;
+
+static PetscErrorCode block_pc_error(const block_pc *b)
+{
+  SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "fcm block smoother: %s",
+          fcm_ctx_error_message(b->ctx));
+}
+
+static PetscErrorCode block_pc_setup(PC pc)
+{
+  block_pc *b = NULL;
+  Mat A = NULL, Ad = NULL;
+  const PetscInt *ia = NULL, *ja = NULL;
+  const PetscScalar *v = NULL;
+  PetscInt n = 0;
+  PetscBool done = PETSC_FALSE;
+  fcm_index *rp = NULL;
+  int *ci = NULL;
+  fcm_csr *C = NULL;
+  fcm_status st = FCM_OK;
+  PetscCall(PCShellGetContext(pc, &b));
+  PetscCall(PCGetOperators(pc, NULL, &A));
+  PetscCall(MatGetDiagonalBlock(A, &Ad));
+  PetscCall(MatGetRowIJ(Ad, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
+  PetscCheck(done && n == b->n, PETSC_COMM_SELF, PETSC_ERR_LIB,
+             "fcm block smoother: the level has %d owned rows, the blocks were made for %lld",
+             (int)n, (long long)b->n);
+  fcm_ctx *ctx = b->ctx;
+  FCM_ALLOC(ctx, n + 1, rp);
+  FCM_ALLOC(ctx, ia[n] + 1, ci);
+  for (PetscInt i = 0; i <= n; i++)
+    rp[i] = ia[i];
+  for (PetscInt p = 0; p < ia[n]; p++)
+    ci[p] = (int)ja[p];
+  FCM_TRY(ctx, fcm_csr_create(ctx, n, n, rp, ci, FCM_CSR_GENERAL, &C));
+  {
+    const PetscErrorCode e = MatSeqAIJGetArrayRead(Ad, &v);
+    if (e) {
+      st = fcm__petsc_error(ctx, e, "MatSeqAIJGetArrayRead", __FILE__, __LINE__, __func__);
+      goto cleanup;
+    }
+  }
+  memcpy(fcm_csr_values(C), v, sizeof *v * (size_t)ia[n]);
+  MatSeqAIJRestoreArrayRead(Ad, &v);
+  fcm_schwarz_destroy(&b->S);
+  FCM_TRY(ctx, fcm_schwarz_create(ctx, C, b->nb, b->ptr, b->dofs, NULL, &b->S));
+cleanup:
+  MatRestoreRowIJ(Ad, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done);
+  fcm_csr_destroy(&C);
+  fcm__free(b->ctx, rp);
+  fcm__free(b->ctx, ci);
+  if (st) return block_pc_error(b);
+  return 0;
+}
+
+static PetscErrorCode block_pc_apply(PC pc, Vec x, Vec y)
+{
+  block_pc *b = NULL;
+  const PetscScalar *xa = NULL;
+  PetscScalar *ya = NULL;
+  PetscCall(PCShellGetContext(pc, &b));
+  PetscCall(VecGetArrayRead(x, &xa));
+  PetscCall(VecGetArray(y, &ya));
+  const fcm_status st = fcm_schwarz_apply(b->S, xa, ya);
+  PetscCall(VecRestoreArray(y, &ya));
+  PetscCall(VecRestoreArrayRead(x, &xa));
+  if (st) return block_pc_error(b);
+  return 0;
+}
+
+static PetscErrorCode block_pc_destroy(PC pc)
+{
+  block_pc *b = NULL;
+  PetscCall(PCShellGetContext(pc, &b));
+  if (!b) return 0;
+  fcm_schwarz_destroy(&b->S);
+  fcm__free(b->ctx, b->ptr);
+  fcm__free(b->ctx, b->dofs);
+  fcm__free(b->ctx, b);
+  return 0;
+}
+
+/* The level's smoother PC becomes the block smoother of the level's blocks (T, level l, in
+ * fcm's level numbering) on the owned rows: gidx / owner of the level's copies, first its first
+ * owned block row, nloc the owned copies. */
+static fcm_status block_pc_set(fcm_petsc_problem *P, PC spc, const fcm__mg_transfers *T, int l,
+                               const PetscInt *gidx, const int *owner, PetscInt first,
+                               PetscInt nloc)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  block_pc *b = fcm__calloc(ctx, 1, sizeof *b);
+  FCM_CHECK(b, ctx, FCM_ERR_ALLOC, "petsc: out of memory (block smoother)");
+  b->ctx = ctx;
+  b->n = 3 * (fcm_index)nloc;
+  const fcm_index nb = T->num_blocks[l], *bp = T->block_ptr[l], *bd = T->block_dofs[l];
+  FCM_ALLOC(ctx, nb + 1, b->ptr);
+  FCM_ALLOC(ctx, bp[nb] + 1, b->dofs);
+  fcm_index q = 0;
+  for (fcm_index k = 0; k < nb; k++) {
+    const fcm_index q0 = q;
+    for (fcm_index p = bp[k]; p < bp[k + 1]; p++) {
+      const fcm_index K = bd[p] / 3;
+      if (gidx[K] < 0 || owner[K] != P->rank) continue;
+      b->dofs[q++] = 3 * (gidx[K] - first) + bd[p] % 3;
+    }
+    if (q > q0) b->ptr[++b->nb] = q;
+  }
+  PCALL(ctx, PCSetType(spc, PCSHELL));
+  PCALL(ctx, PCShellSetContext(spc, b));
+  PCALL(ctx, PCShellSetName(spc, "fcm vertex/cell block Schwarz (fcm_schwarz)"));
+  PCALL(ctx, PCShellSetSetUp(spc, block_pc_setup));
+  PCALL(ctx, PCShellSetApply(spc, block_pc_apply));
+  PCALL(ctx, PCShellSetDestroy(spc, block_pc_destroy));
+  b = NULL;
+cleanup:
+  if (b) {
+    fcm__free(ctx, b->ptr);
+    fcm__free(ctx, b->dofs);
+    fcm__free(ctx, b);
+  }
+  return st;
+}
+
+int fcm__petsc_pcmg_grid(const fcm_space *space)
+{
+  const fcm_element_type t = fcm_mesh_element_type(fcm_space_mesh(space));
+  return t == FCM_ELEMENT_HEX8 || t == FCM_ELEMENT_HEX20;
+}
+
+fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned char *constrained,
+                                 int *num_levels)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  fcm__mg_transfers *T = NULL;
+  PetscInt *gidx = NULL, *gidx_c = NULL, *dnz = NULL, *onz = NULL, *cols = NULL;
+  int *owner = NULL, *owner_c = NULL;
+  fcm_index *minf = NULL;
+  PetscInt *count = NULL;
+  PetscScalar *vals = NULL;
+  Mat Pm = NULL;
+  int max_levels = 20;
+  const char *prefix = P->prefix;
+  if (num_levels) *num_levels = 0;
+  {
+    PetscInt lv = 0;
+    PetscBool has = PETSC_FALSE;
+    char key[64];
+    snprintf(key, sizeof key, "-%spc_mg_levels", prefix);
+    PCALL(ctx, PetscOptionsGetInt(NULL, NULL, key, &lv, &has));
+    if (has) {
+      FCM_CHECK(lv >= 1 && lv <= 32, ctx, FCM_ERR_ARG,
+                "petsc: -pc_mg_levels %d outside [1, 32] (fcm's multigrid levels)", (int)lv);
+      max_levels = (int)lv;
+    }
+  }
+  if (!fcm__petsc_pcmg_grid(P->space)) {
+    const fcm_element_type t = fcm_mesh_element_type(fcm_space_mesh(P->space));
+    const fcm_element_info *info = fcm_element_get_info(t);
+    st = fcm__error(ctx, FCM_ERR_UNSUPPORTED, __FILE__, __LINE__, __func__,
+                    "petsc: -pc_type mg uses fcm's geometric multigrid, which needs a Hex8 or "
+                    "Hex20 box grid; the mesh has %s elements (use -pc_type gamg)",
+                    info ? info->name : "unknown");
+    goto cleanup;
+  }
+  st = fcm__mg_transfers_create(ctx, P->space, constrained, max_levels, 2000, &T);
+  if (st == FCM_ERR_UNSUPPORTED) {
+    char why[256];
+    snprintf(why, sizeof why, "%s", fcm_ctx_error_message(ctx));
+    st = fcm__error(ctx, st, __FILE__, __LINE__, __func__,
+                    "petsc: -pc_type mg uses fcm's geometric multigrid, which needs a Hex8 or "
+                    "Hex20 box grid (fcm_mesh_create_box()): %s (use -pc_type gamg)",
+                    why);
+  }
+  if (st) goto cleanup;
+  const int L = T->num_levels;
+  FCM_CHECK(L >= 2, ctx, FCM_ERR_ARG,
+            "petsc: fcm's multigrid has a single level here (%lld DOFs, max_levels %d): use a "
+            "direct solver or more levels",
+            (long long)T->n[0], max_levels);
+  /* level 0: the problem's numbering */
+  FCM_ALLOC(ctx, P->ncopy + 1, gidx);
+  FCM_ALLOC(ctx, P->ncopy + 1, owner);
+  for (fcm_index k = 0; k < P->ncopy; k++)
+    gidx[k] = P->perm[k], owner[k] = P->copy_owner[k];
+  PetscInt nloc = P->nlocal, first = P->first;
+  FCM_ALLOC(ctx, P->size + 1, count);
+  PCALL(ctx, PCMGSetLevels(pc, L, NULL));
+  int blocks = 1; /* the default smoother's PC unless the options name one */
+  {
+    char key[64];
+    PetscBool has = PETSC_FALSE;
+    snprintf(key, sizeof key, "-%smg_levels_pc_type", prefix);
+    PCALL(ctx, PetscOptionsHasName(NULL, NULL, key, &has));
+    blocks = !has;
+  }
+  for (int l = 0; l + 1 < L; l++) {
+    const fcm_index nf = T->n[l] / 3, nc = T->n[l + 1] / 3;
+    const fcm_index *pp = T->P_ptr[l];
+    const int *pc_ = T->P_col[l];
+    const double *pv = T->P_val[l];
+    /* owners and numbering of the coarse copies */
+    FCM_ALLOC(ctx, nc + 1, minf);
+    FCM_ALLOC(ctx, nc + 1, owner_c);
+    FCM_ALLOC(ctx, nc + 1, gidx_c);
+    for (fcm_index K = 0; K < nc; K++)
+      minf[K] = -1, owner_c[K] = -1;
+    for (fcm_index k = 0; k < nf; k++) {
+      if (gidx[k] < 0) continue;
+      for (fcm_index p = pp[3 * k]; p < pp[3 * k + 1]; p++) {
+        const fcm_index K = pc_[p] / 3;
+        if (pv[p] == 0.0) continue;
+        if (minf[K] < 0 || gidx[k] < gidx[minf[K]]) minf[K] = k;
+      }
+    }
+    memset(count, 0, sizeof *count * (size_t)(P->size + 1));
+    for (fcm_index K = 0; K < nc; K++)
+      if (minf[K] >= 0) owner_c[K] = owner[minf[K]], count[owner_c[K] + 1]++;
+    for (int r = 0; r < P->size; r++)
+      count[r + 1] += count[r];
+    const PetscInt nloc_c = count[P->rank + 1] - count[P->rank], first_c = count[P->rank];
+    for (fcm_index K = 0; K < nc; K++)
+      gidx_c[K] = minf[K] >= 0 ? count[owner_c[K]]++ : -1;
+    /* the matrix: owned rows */
+    FCM_ALLOC(ctx, 3 * nloc + 1, dnz);
+    FCM_ALLOC(ctx, 3 * nloc + 1, onz);
+    int width = 0;
+    for (fcm_index k = 0; k < nf; k++) {
+      if (gidx[k] < 0 || owner[k] != P->rank) continue;
+      for (int c = 0; c < 3; c++) {
+        const PetscInt r = 3 * (gidx[k] - first) + c;
+        for (fcm_index p = pp[3 * k + c]; p < pp[3 * k + c + 1]; p++) {
+          const PetscInt J = gidx_c[pc_[p] / 3];
+          if (J < 0) continue;
+          if (J >= first_c && J < first_c + nloc_c)
+            dnz[r]++;
+          else
+            onz[r]++;
+        }
+        width = FCM_MAX(width, (int)(pp[3 * k + c + 1] - pp[3 * k + c]));
+      }
+    }
+    FCM_ALLOC(ctx, width + 1, cols);
+    FCM_ALLOC(ctx, width + 1, vals);
+    PCALL(ctx, MatCreate(P->comm, &Pm));
+    PCALL(ctx, MatSetSizes(Pm, 3 * nloc, 3 * nloc_c, PETSC_DETERMINE, PETSC_DETERMINE));
+    PCALL(ctx, MatSetType(Pm, MATMPIAIJ));
+    PCALL(ctx, MatSetBlockSizes(Pm, 3, 3));
+    PCALL(ctx, MatMPIAIJSetPreallocation(Pm, 0, dnz, 0, onz));
+    for (fcm_index k = 0; k < nf; k++) {
+      if (gidx[k] < 0 || owner[k] != P->rank) continue;
+      for (int c = 0; c < 3; c++) {
+        const PetscInt row = 3 * gidx[k] + c;
+        PetscInt m = 0;
+        for (fcm_index p = pp[3 * k + c]; p < pp[3 * k + c + 1]; p++) {
+          const PetscInt J = gidx_c[pc_[p] / 3];
+          if (J < 0) continue;
+          cols[m] = 3 * J + pc_[p] % 3;
+          vals[m++] = pv[p];
+        }
+        PCALL(ctx, MatSetValues(Pm, 1, &row, m, cols, vals, INSERT_VALUES));
+      }
+    }
+    PCALL(ctx, MatAssemblyBegin(Pm, MAT_FINAL_ASSEMBLY));
+    PCALL(ctx, MatAssemblyEnd(Pm, MAT_FINAL_ASSEMBLY));
+    PCALL(ctx, PCMGSetInterpolation(pc, L - 1 - l, Pm)); /* PETSc's level: from the coarsest */
+    if (blocks) {
+      KSP sk;
+      PC spc;
+      PCALL(ctx, PCMGGetSmoother(pc, L - 1 - l, &sk));
+      PCALL(ctx, KSPGetPC(sk, &spc));
+      FCM_TRY(ctx, block_pc_set(P, spc, T, l, gidx, owner, first, nloc));
+    }
+    MatDestroy(&Pm);
+    /* the coarse level becomes the fine one */
+    FCM_FREE(ctx, gidx);
+    FCM_FREE(ctx, owner);
+    gidx = gidx_c, owner = owner_c, gidx_c = NULL, owner_c = NULL;
+    nloc = nloc_c, first = first_c;
+    FCM_FREE(ctx, minf);
+    FCM_FREE(ctx, dnz);
+    FCM_FREE(ctx, onz);
+    FCM_FREE(ctx, cols);
+    FCM_FREE(ctx, vals);
+  }
+  PCALL(ctx, PCMGSetGalerkin(pc, PC_MG_GALERKIN_BOTH));
+  /* defaults the options database overrides (read at the PC's setup): Chebyshev with fcm's block
+   * Schwarz (block_pc) on every level, a redundant Cholesky on the coarsest */
+  FCM_TRY(ctx, default_option(ctx, prefix, "mg_levels_ksp_type", "chebyshev"));
+  FCM_TRY(ctx, default_option(ctx, prefix, "mg_coarse_ksp_type", "preonly"));
+  FCM_TRY(ctx, default_option(ctx, prefix, "mg_coarse_pc_type", "redundant"));
+  FCM_TRY(ctx, default_option(ctx, prefix, "mg_coarse_redundant_pc_type", "cholesky"));
+  /* the rest of the user's -pc_mg_* options (cycle type, ...) on the new levels */
+  PCALL(ctx, PCSetFromOptions(pc));
+  {
+    PetscInt nl = 0;
+    PCALL(ctx, PCMGGetLevels(pc, &nl));
+    FCM_CHECK(nl == L, ctx, FCM_ERR_ARG,
+              "petsc: -pc_mg_levels asks for %d levels, fcm's multigrid hierarchy has %d here",
+              (int)nl, L);
+  }
+  if (num_levels) *num_levels = L;
+cleanup:
+  MatDestroy(&Pm);
+  fcm__mg_transfers_destroy(ctx, &T);
+  fcm__free(ctx, gidx);
+  fcm__free(ctx, gidx_c);
+  fcm__free(ctx, owner);
+  fcm__free(ctx, owner_c);
+  fcm__free(ctx, minf);
+  fcm__free(ctx, dnz);
+  fcm__free(ctx, onz);
+  fcm__free(ctx, cols);
+  fcm__free(ctx, vals);
+  fcm__free(ctx, count);
+  return st;
+}
