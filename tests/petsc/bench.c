@@ -1,6 +1,7 @@
 /* Memory and time per DOF of the PETSc backend (labels bench and mpi; not in the default run):
  * a ball (radius 0.45) embedded in an N^3 grid of the unit cube, clamped on its lowest nodes
- * layer, under gravity, static; CG + GAMG (the default) to rtol 1e-8. Process 0 prints one
+ * layer, under gravity, static; the default solver (CG + GAMG; on Hex20 CG + fcm's multigrid as
+ * PCMG) to rtol 1e-8. Process 0 prints one
  * line: processes, element, DOFs, setup seconds (partition + rules + numbering + assembly +
  * KSP setup) and KSP solve seconds per DOF, peak resident memory summed over the processes per
  * DOF, the matrix's bytes per DOF (nonzeros x 12 bytes), KSP iterations. Arguments: element,
@@ -98,11 +99,12 @@ int main(int argc, char **argv)
            1e6 * cpu_max[1] / (double)info.num_dofs, 1e6 * cpu_sum[1] / (double)info.num_dofs);
   if (rank == 0)
     printf("petsc_bench np %d %s N %lld: dofs %lld, setup %.3g us/dof (%.3g s: rules %.3g s, "
-           "assembly %.3g s on process 0), solve %.3g us/dof (%.3g s, %d CG+GAMG iterations), "
+           "assembly %.3g s on process 0), solve %.3g us/dof (%.3g s, %d %s+%s iterations), "
            "memory %.0f B/dof resident now / %.0f peak (all processes), matrix %.0f B/dof, "
            "elements per process %lld..%lld, partition %s\n",
            size, argv[1], (long long)N, (long long)info.num_dofs, 1e6 * t_setup / n, t_setup,
            info.time_rules, info.time_assembly, 1e6 * t_solve / n, t_solve, si.iterations,
+           info.ksp_type, info.pc_type,
            info.memory_total / n, peak_all / n, info.matrix_memory / n,
            (long long)info.min_local_elements, (long long)info.max_local_elements,
            fcm_petsc_partition_name(info.partition));

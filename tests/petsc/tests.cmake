@@ -274,3 +274,9 @@ foreach(np 1 2)
   fcm_add_mpi_test(petsc_options_prefixed_np${np} tests/petsc/options.c NP ${np}
                    ARGS minres cg gmres jacobi jacobi gamg -fcm2_pc_type jacobi)
 endforeach()
+# fcm's geometric multigrid as PCMG (-pc_type mg): the CHOLMOD solution to 1e-8, CG iterations
+# at rtol 1e-10 bounded, fewer than GAMG's by a factor; a clear error on non-box meshes
+foreach(np 1 2)
+  fcm_add_mpi_test(petsc_pcmg_hex8_np${np} tests/petsc/pcmg.c NP ${np} ARGS hex8 12 32 0)
+  fcm_add_mpi_test(petsc_pcmg_hex20_np${np} tests/petsc/pcmg.c NP ${np} ARGS hex20 6 60 5)
+endforeach()

@@ -180,7 +180,7 @@ int fcm__petsc_pcmg_grid(const fcm_space *space)
 }
 
 fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned char *constrained,
-                                 int *num_levels)
+                                 int optional, int *num_levels)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P->ctx;
@@ -206,6 +206,7 @@ fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned cha
       max_levels = (int)lv;
     }
   }
+  if (optional && !fcm__petsc_pcmg_grid(P->space)) goto cleanup;
   if (!fcm__petsc_pcmg_grid(P->space)) {
     const fcm_element_type t = fcm_mesh_element_type(fcm_space_mesh(P->space));
     const fcm_element_info *info = fcm_element_get_info(t);
@@ -216,6 +217,11 @@ fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned cha
     goto cleanup;
   }
   st = fcm__mg_transfers_create(ctx, P->space, constrained, max_levels, 2000, &T);
+  if (optional && st == FCM_ERR_UNSUPPORTED) { /* not a box grid: the caller keeps its PC */
+    fcm_ctx_error_clear(ctx);
+    st = FCM_OK;
+    goto cleanup;
+  }
   if (st == FCM_ERR_UNSUPPORTED) {
     char why[256];
     snprintf(why, sizeof why, "%s", fcm_ctx_error_message(ctx));
@@ -226,6 +232,7 @@ fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned cha
   }
   if (st) goto cleanup;
   const int L = T->num_levels;
+  if (optional && L < 2) goto cleanup;
   FCM_CHECK(L >= 2, ctx, FCM_ERR_ARG,
             "petsc: fcm's multigrid has a single level here (%lld DOFs, max_levels %d): use a "
             "direct solver or more levels",

@@ -1214,6 +1214,16 @@ cleanup:
   return st;
 }
 
+/* 1 when the options database names this problem's PC type (-<prefix>pc_type: the problem's
+ * string and the command line are under the prefix after insert_options()). */
+static int pc_type_given(const fcm_petsc_problem *P)
+{
+  char key[64];
+  PetscBool has = PETSC_FALSE;
+  snprintf(key, sizeof key, "-%spc_type", P->prefix);
+  return PetscOptionsHasName(NULL, NULL, key, &has) == 0 && has;
+}
+
 fcm_status fcm_petsc_problem_setup(fcm_petsc_problem *P)
 {
   fcm_status st = FCM_OK;
@@ -1279,7 +1289,20 @@ fcm_status fcm_petsc_problem_setup(fcm_petsc_problem *P)
     PetscBool mg = PETSC_FALSE;
     PCALL(ctx, KSPGetPC(P->ksp, &pc));
     PCALL(ctx, PetscObjectTypeCompare((PetscObject)pc, PCMG, &mg));
-    if (mg) FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, fcm__petsc_pcmg_setup(P, pc, P->is_con, NULL)));
+    /* the default on Hex20 box grids: fcm's geometric multigrid as PCMG (pcmg.c; CG + GAMG
+     * needs hundreds of iterations there), GAMG when the mesh is no box grid */
+    const int by_default = !mg && !pc_type_given(P) &&
+                           fcm_mesh_element_type(P->mesh) == FCM_ELEMENT_HEX20;
+    if (mg || by_default) {
+      int levels = 0;
+      if (by_default) PCALL(ctx, PCSetType(pc, PCMG));
+      FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm,
+                                    fcm__petsc_pcmg_setup(P, pc, P->is_con, by_default, &levels)));
+      if (levels == 0) { /* not a box grid: GAMG */
+        PCALL(ctx, PCSetType(pc, PCGAMG));
+        PCALL(ctx, PCSetFromOptions(pc));
+      }
+    }
   }
   P->is_setup = 1;
   P->time_setup += fcm_wtime() - t0;

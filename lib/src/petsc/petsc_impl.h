@@ -113,12 +113,14 @@ int fcm__petsc_pcmg_grid(const fcm_space *space);
  * prolongations as MATMPIAIJ (block size 3) in P's numbering, Galerkin coarse operators, and
  * defaults the options database overrides (Chebyshev + point-block Jacobi smoothers, redundant
  * Cholesky on the coarsest level); then PCSetFromOptions. constrained: P->n bytes in the space's
- * numbering (nonzero: an eliminated row), or NULL. num_levels (may be NULL): the levels made.
+ * numbering (nonzero: an eliminated row), or NULL. optional: a space the hierarchy cannot be
+ * built for (not a Hex8 / Hex20 box grid, a single level) is FCM_OK with *num_levels = 0 and pc
+ * untouched (the caller's default applies). num_levels (may be NULL): the levels made.
  * @return FCM_OK, FCM_ERR_UNSUPPORTED (not a Hex8 / Hex20 box grid: named), FCM_ERR_ARG
  * (-pc_mg_levels that the hierarchy cannot give), FCM_ERR_ALLOC, FCM_ERR_INTERNAL (PETSc). The
  * same on every process (the hierarchy is built from the replicated space); not agreed here.
  * pcmg.c. */
 fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned char *constrained,
-                                 int *num_levels);
+                                 int optional, int *num_levels);
 
 #endif /* FCM_PETSC_IMPL_H */
