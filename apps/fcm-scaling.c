@@ -26,7 +26,8 @@
  * bodies ball and hollow also through the PETSc adapter (fcm/petsc.h, the linear static
  * driver: partition, rules of the own cells, MATMPIAIJ assembly, KSP) on every process, solved
  * by petsc-gamg (CG + GAMG with the rigid-body near-null space, stopping on the true residual)
- * and petsc-mumps (MUMPS Cholesky); process 0 also runs the serial solvers (the others wait
+ * petsc-mumps (MUMPS Cholesky) and petsc-mg (CG + fcm's multigrid hierarchy as PETSc's PCMG,
+ * lib/src/petsc/pcmg.c); process 0 also runs the serial solvers (the others wait
  * sleeping) and compares the PETSc solution with CHOLMOD's (else cg-mg's); it alone prints
  * and writes.
  * Writes CSV (--csv FILE, atomically) and a plot (--png FILE, gnuplot), prints the fitted
@@ -54,11 +55,12 @@
 
 #define PROG "fcm-scaling"
 
-/* S_PGAMG, S_PMUMPS: the PETSc backend (--backend petsc, fcm/petsc.h), on every MPI process */
-enum { S_CHOLMOD, S_CGJ, S_MINRES, S_CGMG, S_MG, S_PGAMG, S_PMUMPS, NSOLVER };
-static const char *const solver_names[] = {"cholmod", "cg-jacobi",  "minres-schwarz", "cg-mg",
-                                           "mg",      "petsc-gamg", "petsc-mumps",    NULL};
-#define IS_PETSC(s) ((s) == S_PGAMG || (s) == S_PMUMPS)
+/* S_PGAMG, S_PMUMPS, S_PMG: the PETSc backend (--backend petsc, fcm/petsc.h), on every MPI process */
+enum { S_CHOLMOD, S_CGJ, S_MINRES, S_CGMG, S_MG, S_PGAMG, S_PMUMPS, S_PMG, NSOLVER };
+static const char *const solver_names[] = {"cholmod",     "cg-jacobi",  "minres-schwarz",
+                                           "cg-mg",       "mg",         "petsc-gamg",
+                                           "petsc-mumps", "petsc-mg",   NULL};
+#define IS_PETSC(s) ((s) == S_PGAMG || (s) == S_PMUMPS || (s) == S_PMG)
 enum { BACKEND_SERIAL, BACKEND_PETSC };
 static const char *const backend_names[] = {"serial", "petsc", NULL};
 enum { B_BALL, B_HOLLOW, B_CUBE, B_CUT, NBODY };
@@ -68,8 +70,8 @@ static const char *const clock_names[] = {"wall", "cpu", NULL};
 
 /* Exponents the estimates use before two sizes of a solver are measured: time ~ dofs^t,
  * extra memory ~ dofs^m (CHOLMOD: ~N^2 flops and ~N^(4/3) fill for 3D nested dissection). */
-static const double default_time_exp[NSOLVER] = {2.0, 1.4, 1.4, 1.15, 1.15, 1.15, 2.0};
-static const double default_mem_exp[NSOLVER] = {1.4, 1.0, 1.0, 1.0, 1.0, 1.0, 1.4};
+static const double default_time_exp[NSOLVER] = {2.0, 1.4, 1.4, 1.15, 1.15, 1.15, 2.0, 1.15};
+static const double default_mem_exp[NSOLVER] = {1.4, 1.0, 1.0, 1.0, 1.0, 1.0, 1.4, 1.0};
 
 enum { ROW_OK, ROW_SKIPPED, ROW_FAILED };
 static const char *const status_names[] = {"ok", "skipped", "failed"};
@@ -578,7 +580,7 @@ static int write_png(const settings *o)
     len += (size_t)k_;                                                                             \
   } while (0)
   const char *colors[NSOLVER] = {"#000000", "#1f77b4", "#2ca02c", "#d62728",
-                                 "#ff7f0e", "#9467bd", "#8c564b"};
+                                 "#ff7f0e", "#9467bd", "#8c564b", "#e377c2"};
   for (int panel = 0; panel < 2; panel++) {
     if (panel == 0)
       ADD("set multiplot layout 1,2\nset logscale xy\nset xlabel 'DOFs'\nset ylabel '%s seconds, "
@@ -852,6 +854,7 @@ static void sync_processes(const settings *o, int *fatal)
 static const char *petsc_solver_options(int s)
 {
   return s == S_PGAMG ? "-ksp_type cg -pc_type gamg -ksp_norm_type unpreconditioned"
+         : s == S_PMG ? "-ksp_type cg -pc_type mg -ksp_norm_type unpreconditioned"
                       : "-ksp_type preonly -pc_type cholesky -pc_factor_mat_solver_type mumps";
 }
 
@@ -1238,11 +1241,14 @@ static void usage(FILE *f, const cli_option *opts)
       "--backend petsc (mpirun -n P " PROG " --backend petsc): rows of\n"
       "  petsc-gamg      CG + GAMG, rigid-body near-null space, on the true residual\n"
       "  petsc-mumps     MUMPS sparse Cholesky (preonly)\n"
+      "  petsc-mg        CG + fcm's geometric multigrid as PCMG (-pc_type mg), on the true residual\n"
       "on every process through the PETSc adapter (fcm/petsc.h), bodies ball and hollow;\n"
-      "default solvers cholmod,cg-mg,petsc-gamg,petsc-mumps (the serial ones on process 0 give\n"
+      "default solvers cholmod,cg-mg,petsc-gamg,petsc-mumps,petsc-mg (the serial ones on\n"
+      "process 0 give\n"
       "the reference: diff_cholmod is against CHOLMOD's solution, else cg-mg's). PETSc rows:\n"
       "setup_s is the whole distributed problem (partition, rules, space, assembly,\n"
-      "elimination), solve_s the KSP solve with GAMG's set-up or MUMPS's factorization;\n"
+      "elimination), solve_s the KSP solve with GAMG's or PCMG's set-up or MUMPS's\n"
+      "factorization;\n"
       "setup_cpu_s, solve_cpu_s, peak_rss_mb and base_rss_mb are summed over the processes\n"
       "(process 0 also holds the serial problem: peak - base is the PETSc run's own);\n"
       "relative_residual is computed with the serial matrix. PETSc options on the command\n"
@@ -1339,7 +1345,8 @@ static int scaling_main(int argc, char **argv, int pargc, char **pargv)
        0, 0, NULL, NULL, NULL},
       {"--solvers", NULL, CLI_STRING, &solvers, "S,...",
        "cholmod, cg-jacobi, minres-schwarz, cg-mg, mg (default all);\n--backend petsc also "
-       "petsc-gamg, petsc-mumps (default\ncholmod,cg-mg,petsc-gamg,petsc-mumps); cholmod first "
+       "petsc-gamg, petsc-mumps, petsc-mg (default\ncholmod,cg-mg,petsc-gamg,petsc-mumps,petsc-mg); "
+       "cholmod first "
        "gives\nthe reference solution",
        0, 0, 0, NULL, NULL, NULL},
       {"--rtol", NULL, CLI_DOUBLE, &o.rtol, "R", "relative residual of every solver (default 1e-8)",
@@ -1378,8 +1385,8 @@ static int scaling_main(int argc, char **argv, int pargc, char **pargv)
        "claims on the PETSc rows)",
        0, 0, 0, NULL, NULL, NULL},
       {"--backend", NULL, CLI_CHOICE, &o.backend, "NAME",
-       "serial (default) or petsc: add the rows of the PETSc\nsolvers petsc-gamg and "
-       "petsc-mumps on every MPI process\n(mpirun -n 2 " PROG " --backend petsc; PETSc "
+       "serial (default) or petsc: add the rows of the PETSc\nsolvers petsc-gamg, petsc-mumps "
+       "and petsc-mg on every MPI process\n(mpirun -n 2 " PROG " --backend petsc; PETSc "
        "options such as\n-ksp_type go to them; needs a build with PETSc)",
        0, 0, 0, backend_names, NULL, NULL},
       {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
@@ -1420,9 +1427,9 @@ static int scaling_main(int argc, char **argv, int pargc, char **pargv)
   if (petsc) { /* default: the embedded bodies; the references and the PETSc solvers */
     o.bodies[0] = B_BALL, o.bodies[1] = B_HOLLOW, o.nbodies = 2;
     o.solvers[0] = S_CHOLMOD, o.solvers[1] = S_CGMG, o.solvers[2] = S_PGAMG;
-    o.solvers[3] = S_PMUMPS, o.nsolvers = 4;
+    o.solvers[3] = S_PMUMPS, o.solvers[4] = S_PMG, o.nsolvers = 5;
   } else {
-    o.nsolvers = NSOLVER - 2; /* the serial ones */
+    o.nsolvers = NSOLVER - 3; /* the serial ones */
   }
   if (bodies && !parse_names("--bodies", bodies, body_names, o.bodies, &o.nbodies)) return 2;
   if (solvers && !parse_names("--solvers", solvers, solver_names, o.solvers, &o.nsolvers)) return 2;
