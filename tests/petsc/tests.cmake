@@ -128,6 +128,10 @@ foreach(np 1 2)
   fcm_add_mpi_test(petsc_newton_static_snh_gamg_np${np} tests/petsc/newton.c NP ${np}
                    ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json 1 1e-8
                         -ksp_type cg -pc_type gamg)
+  # the same with CG + fcm's multigrid as PCMG (pcmg.c) on the Newton systems
+  fcm_add_mpi_test(petsc_newton_static_snh_mg_np${np} tests/petsc/newton.c NP ${np}
+                   ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json 1 1e-8
+                        -ksp_type cg -pc_type mg)
   # dynamic SNH, Nitsche on the embedded boundary (fixed and rotating caps), gravity, damping
   fcm_add_mpi_test(petsc_newton_clamped_surface_np${np} tests/petsc/newton.c NP ${np}
                    ARGS ${FCM_SCENES} clamped_surface.json 3)

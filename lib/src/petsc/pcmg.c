@@ -216,7 +216,11 @@ fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned cha
                     info ? info->name : "unknown");
     goto cleanup;
   }
-  st = fcm__mg_transfers_create(ctx, P->space, constrained, max_levels, 2000, &T);
+  /* the coarsest level: at most 2000 DOFs (a redundant Cholesky on every process), and an
+   * eighth of the space's at most, so that a small space gets two levels too */
+  const fcm_index n0 = fcm_space_num_dofs(P->space);
+  const fcm_index coarse = FCM_MIN(2000, FCM_MAX(1, n0 / 8));
+  st = fcm__mg_transfers_create(ctx, P->space, constrained, max_levels, coarse, &T);
   if (optional && st == FCM_ERR_UNSUPPORTED) { /* not a box grid: the caller keeps its PC */
     fcm_ctx_error_clear(ctx);
     st = FCM_OK;

@@ -1801,6 +1801,17 @@ static fcm_status newton_factor(void *user, const fcm_csr *H, int psd, int *fail
   } else if (!P->direct && !P->ksp_type_set) {
     PCALL(ctx, KSPSetType(P->ksp, psd ? KSPCG : KSPMINRES));
   }
+  {
+    /* -pc_type mg: fcm's multigrid levels (pcmg.c), once per KSP (a cut makes a new one); they
+     * depend on the space only, not on the constraints or on H */
+    PC pc;
+    PetscBool mg = PETSC_FALSE;
+    PetscInt nl = 0;
+    PCALL(ctx, KSPGetPC(P->ksp, &pc));
+    PCALL(ctx, PetscObjectTypeCompare((PetscObject)pc, PCMG, &mg));
+    if (mg) PCALL(ctx, PCMGGetLevels(pc, &nl));
+    if (mg && nl < 2) FCM_TRY(ctx, newton_agree(P, fcm__petsc_pcmg_setup(P, pc, NULL, 0, NULL)));
+  }
   PCALL(ctx, KSPSetOperators(P->ksp, P->S, P->S));
   PCALL(ctx, KSPSetUp(P->ksp));
   P->factors++;
