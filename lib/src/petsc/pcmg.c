@@ -20,6 +20,7 @@
 #include "petsc/petsc_impl.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* Set `-<prefix><name> value` unless the database has the key already. */
@@ -38,16 +39,22 @@ cleanup:
 
 /* ---------------------------------------------------------------- block smoother */
 
-/* The default smoother's PC on a level: fcm's additive Schwarz (fcm_schwarz, clamped
- * eigen-inverses of dense blocks, the inverse diagonal elsewhere) on the owned rows, with the
- * blocks of fcm_mg's block smoothing restricted to this process's rows (a block's DOFs owned by
- * other processes are left out). Built from the diagonal block (owned rows and columns) of the
- * level's operator at each PC setup. */
+/* The default smoother's PC on a level: fcm's additive Schwarz (fcm_schwarz: clamped
+ * eigen-inverses of dense blocks, the inverse diagonal elsewhere) with the blocks of fcm_mg's
+ * block smoothing. Each block goes to one process, the owner of its lowest-numbered DOF, whole:
+ * the process works on its owned rows and the other processes' rows of its blocks (the
+ * subdomain `is`, sorted global indices), whose matrix it extracts at each setup
+ * (MatCreateSubMatrices); apply: gather r on the subdomain, z_sub = S r_sub, add z_sub back into
+ * z (ASM's "basic" form, so the smoother is symmetric). */
 typedef struct block_pc {
   fcm_ctx *ctx;
-  fcm_index n; /* owned rows */
+  PetscInt n;            /* subdomain size */
+  IS is;                 /* the subdomain's global rows, sorted */
   fcm_index nb;
-  fcm_index *ptr, *dofs; /* local blocks */
+  fcm_index *ptr, *dofs; /* blocks in subdomain numbering */
+  Mat *sub;              /* the subdomain matrix (1) */
+  Vec xs, ys;            /* subdomain vectors (sequential) */
+  VecScatter sc;         /* level vector -> subdomain */
   fcm_schwarz *S;
 } block_pc;
 
@@ -71,11 +78,21 @@ static PetscErrorCode block_pc_setup(PC pc)
   fcm_status st = FCM_OK;
   PetscCall(PCShellGetContext(pc, &b));
   PetscCall(PCGetOperators(pc, NULL, &A));
-  PetscCall(MatGetDiagonalBlock(A, &Ad));
+  PetscCall(MatCreateSubMatrices(A, 1, &b->is, &b->is, b->sub ? MAT_REUSE_MATRIX : MAT_INITIAL_MATRIX,
+                                 &b->sub));
+  Ad = b->sub[0];
+  if (!b->sc) {
+    Vec x = NULL;
+    PetscCall(MatCreateVecs(A, &x, NULL));
+    PetscCall(VecCreateSeq(PETSC_COMM_SELF, b->n, &b->xs));
+    PetscCall(VecDuplicate(b->xs, &b->ys));
+    PetscCall(VecScatterCreate(x, b->is, b->xs, NULL, &b->sc));
+    PetscCall(VecDestroy(&x));
+  }
   PetscCall(MatGetRowIJ(Ad, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
   PetscCheck(done && n == b->n, PETSC_COMM_SELF, PETSC_ERR_LIB,
-             "fcm block smoother: the level has %d owned rows, the blocks were made for %lld",
-             (int)n, (long long)b->n);
+             "fcm block smoother: the subdomain matrix has %d rows, the subdomain %d", (int)n,
+             (int)b->n);
   fcm_ctx *ctx = b->ctx;
   FCM_ALLOC(ctx, n + 1, rp);
   FCM_ALLOC(ctx, ia[n] + 1, ci);
@@ -110,53 +127,111 @@ static PetscErrorCode block_pc_apply(PC pc, Vec x, Vec y)
   const PetscScalar *xa = NULL;
   PetscScalar *ya = NULL;
   PetscCall(PCShellGetContext(pc, &b));
-  PetscCall(VecGetArrayRead(x, &xa));
-  PetscCall(VecGetArray(y, &ya));
+  PetscCall(VecScatterBegin(b->sc, x, b->xs, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterEnd(b->sc, x, b->xs, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecGetArrayRead(b->xs, &xa));
+  PetscCall(VecGetArray(b->ys, &ya));
   const fcm_status st = fcm_schwarz_apply(b->S, xa, ya);
-  PetscCall(VecRestoreArray(y, &ya));
-  PetscCall(VecRestoreArrayRead(x, &xa));
+  PetscCall(VecRestoreArray(b->ys, &ya));
+  PetscCall(VecRestoreArrayRead(b->xs, &xa));
   if (st) return block_pc_error(b);
+  PetscCall(VecSet(y, 0.0));
+  PetscCall(VecScatterBegin(b->sc, b->ys, y, ADD_VALUES, SCATTER_REVERSE));
+  PetscCall(VecScatterEnd(b->sc, b->ys, y, ADD_VALUES, SCATTER_REVERSE));
   return 0;
+}
+
+static void block_pc_free(block_pc *b)
+{
+  if (!b) return;
+  fcm_schwarz_destroy(&b->S);
+  if (b->sub) MatDestroySubMatrices(1, &b->sub);
+  VecDestroy(&b->xs);
+  VecDestroy(&b->ys);
+  VecScatterDestroy(&b->sc);
+  ISDestroy(&b->is);
+  fcm__free(b->ctx, b->ptr);
+  fcm__free(b->ctx, b->dofs);
+  fcm__free(b->ctx, b);
 }
 
 static PetscErrorCode block_pc_destroy(PC pc)
 {
   block_pc *b = NULL;
   PetscCall(PCShellGetContext(pc, &b));
-  if (!b) return 0;
-  fcm_schwarz_destroy(&b->S);
-  fcm__free(b->ctx, b->ptr);
-  fcm__free(b->ctx, b->dofs);
-  fcm__free(b->ctx, b);
+  block_pc_free(b);
   return 0;
 }
 
+static int cmp_petscint(const void *a, const void *b)
+{
+  const PetscInt x = *(const PetscInt *)a, y = *(const PetscInt *)b;
+  return (x > y) - (x < y);
+}
+
+/* Position of g in the sorted a[0..n). */
+static PetscInt find_sorted(const PetscInt *a, PetscInt n, PetscInt g)
+{
+  PetscInt lo = 0, hi = n;
+  while (lo < hi) {
+    const PetscInt mid = lo + (hi - lo) / 2;
+    if (a[mid] < g)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
 /* The level's smoother PC becomes the block smoother of the level's blocks (T, level l, in
- * fcm's level numbering) on the owned rows: gidx / owner of the level's copies, first its first
- * owned block row, nloc the owned copies. */
+ * fcm's level numbering): gidx / owner of the level's copies, first its first owned block row,
+ * nloc the owned copies. */
 static fcm_status block_pc_set(fcm_petsc_problem *P, PC spc, const fcm__mg_transfers *T, int l,
                                const PetscInt *gidx, const int *owner, PetscInt first,
                                PetscInt nloc)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P->ctx;
+  PetscInt *rows = NULL;
   block_pc *b = fcm__calloc(ctx, 1, sizeof *b);
   FCM_CHECK(b, ctx, FCM_ERR_ALLOC, "petsc: out of memory (block smoother)");
   b->ctx = ctx;
-  b->n = 3 * (fcm_index)nloc;
   const fcm_index nb = T->num_blocks[l], *bp = T->block_ptr[l], *bd = T->block_dofs[l];
+  /* this process's blocks: those whose lowest global DOF it owns */
   FCM_ALLOC(ctx, nb + 1, b->ptr);
   FCM_ALLOC(ctx, bp[nb] + 1, b->dofs);
+  FCM_ALLOC(ctx, 3 * nloc + bp[nb] + 1, rows);
+  PetscInt nr = 0;
+  for (PetscInt i = 0; i < 3 * nloc; i++)
+    rows[nr++] = 3 * first + i;
   fcm_index q = 0;
   for (fcm_index k = 0; k < nb; k++) {
-    const fcm_index q0 = q;
+    PetscInt low = -1;
+    int who = -1;
     for (fcm_index p = bp[k]; p < bp[k + 1]; p++) {
       const fcm_index K = bd[p] / 3;
-      if (gidx[K] < 0 || owner[K] != P->rank) continue;
-      b->dofs[q++] = 3 * (gidx[K] - first) + bd[p] % 3;
+      if (gidx[K] < 0) continue;
+      const PetscInt g = 3 * gidx[K] + bd[p] % 3;
+      if (low < 0 || g < low) low = g, who = owner[K];
     }
-    if (q > q0) b->ptr[++b->nb] = q;
+    if (who != P->rank) continue;
+    for (fcm_index p = bp[k]; p < bp[k + 1]; p++) {
+      const fcm_index K = bd[p] / 3;
+      if (gidx[K] < 0) continue;
+      const PetscInt g = 3 * gidx[K] + bd[p] % 3;
+      b->dofs[q++] = g; /* global for now */
+      if (owner[K] != P->rank) rows[nr++] = g;
+    }
+    b->ptr[++b->nb] = q;
   }
+  qsort(rows, (size_t)nr, sizeof *rows, cmp_petscint);
+  PetscInt nu = 0;
+  for (PetscInt i = 0; i < nr; i++)
+    if (i == 0 || rows[i] != rows[nu - 1]) rows[nu++] = rows[i];
+  b->n = nu;
+  for (fcm_index p = 0; p < q; p++)
+    b->dofs[p] = find_sorted(rows, nu, (PetscInt)b->dofs[p]);
+  PCALL(ctx, ISCreateGeneral(PETSC_COMM_SELF, nu, rows, PETSC_COPY_VALUES, &b->is));
   PCALL(ctx, PCSetType(spc, PCSHELL));
   PCALL(ctx, PCShellSetContext(spc, b));
   PCALL(ctx, PCShellSetName(spc, "fcm vertex/cell block Schwarz (fcm_schwarz)"));
@@ -165,11 +240,8 @@ static fcm_status block_pc_set(fcm_petsc_problem *P, PC spc, const fcm__mg_trans
   PCALL(ctx, PCShellSetDestroy(spc, block_pc_destroy));
   b = NULL;
 cleanup:
-  if (b) {
-    fcm__free(ctx, b->ptr);
-    fcm__free(ctx, b->dofs);
-    fcm__free(ctx, b);
-  }
+  block_pc_free(b);
+  fcm__free(ctx, rows);
   return st;
 }
 
