@@ -282,5 +282,5 @@ endforeach()
 # at rtol 1e-10 bounded, fewer than GAMG's by a factor; a clear error on non-box meshes
 foreach(np 1 2)
   fcm_add_mpi_test(petsc_pcmg_hex8_np${np} tests/petsc/pcmg.c NP ${np} ARGS hex8 12 32 0)
-  fcm_add_mpi_test(petsc_pcmg_hex20_np${np} tests/petsc/pcmg.c NP ${np} ARGS hex20 6 60 5)
+  fcm_add_mpi_test(petsc_pcmg_hex20_np${np} tests/petsc/pcmg.c NP ${np} ARGS hex20 6 40 5)
 endforeach()

@@ -16,6 +16,9 @@
  *   0.64-0.84), 0.14-0.29 with vertex blocks; hollow ball with holes (Hex8) 0.40-0.85 growing
  *   with n with level 0 blocks only, V 0.20-0.42 with coarse blocks, W 0.15-0.21 flat (n = 8
  *   ... 64). Used by the scenes (sim/linsolve.c) and apps/fcm-scaling.c. Tests in tests/mg/.
+ * - fcm__mg_transfers_create() (mg_impl.h): the hierarchy's prolongations and block lists
+ *   without a matrix (build_hierarchy(), the code fcm_mg_create() runs), for PETSc's PCMG
+ *   (lib/src/petsc/pcmg.c).
  * - Known: with XFEM cuts the V-cycle factor depends on where the cut lies in the grid
  *   (0.1 to 0.45 measured for n = 4 ... 64 with block smoothing, not growing with n), also
  *   for a cut through the whole body, so not the cut's end; Dick et al. report 0.75 cut. The

@@ -40,7 +40,8 @@
  * - constraints: node sets with fcm_motion (no release), symmetric elimination with
  *   MatZeroRowsColumns on a copy of the system matrix (diag = mean diagonal), RHS lifted with the
  *   unmodified matrix every step.
- * - solver: KSP CG + GAMG + MatNullSpaceCreateRigidBody by default; options string (scene
+ * - solver: KSP CG + GAMG + MatNullSpaceCreateRigidBody by default (on Hex20 box grids CG + fcm's
+ *   multigrid as PCMG, below); options string (scene
  *   solver.petsc_options) then command line; divergence -> FCM_ERR_NOT_CONVERGED with
  *   KSPConvergedReasons[].
  * - errors: every local phase ends in fcm__petsc_agree(): an error on any process is returned on
@@ -124,6 +125,34 @@
  *   (fcm__integrator_reduce_status()) before the cut replay, which is collective; before
  *   (session 6) a file one process could not read left the others waiting in the replay's
  *   newton_cut() (tests/petsc/newton_failure.c case 5).
+ * Done (fcm's geometric multigrid as PCMG, pcmg.c):
+ * - fcm__petsc_pcmg_setup(): the hierarchy of lib/src/mg (fcm__mg_transfers_create(), the code
+ *   fcm_mg_create() runs, without a matrix; the transfers do not depend on the constrained
+ *   DOFs) built on every process from the replicated space; one MATMPIAIJ prolongation per level
+ *   (bs 3; level 0 rows in P->perm numbering; a coarse copy owned by the owner of the lowest
+ *   global finer copy it interpolates to, numbered contiguously per owner; coarse copies no
+ *   finer copy interpolates to left out), PCMGSetGalerkin(BOTH), levels Chebyshev (2 steps,
+ *   PETSc's eigenvalue estimate) on a PCSHELL applying fcm_schwarz with fcm_mg's block lists
+ *   (each block whole on the owner of its lowest DOF: subdomain = owned rows + the blocks' other
+ *   rows, MatCreateSubMatrices at each setup, scatter in / add back, i.e. ASM basic), coarsest
+ *   level redundant Cholesky (at most min(2000, n/8) DOFs). Options override all of it
+ *   (-mg_levels_pc_type replaces the shell; -pc_mg_levels caps the levels, an error if the
+ *   hierarchy cannot give them).
+ * - phase 1: -pc_type mg, and the default when no -pc_type is given on Hex20 meshes whose
+ *   hierarchy builds (box grids; GAMG otherwise, silently). Measured (petsc_bench hex20 12,
+ *   rtol 1e-8): 53 iterations on 1 and on 2 processes against GAMG's 691 / 673, solve CPU 149 /
+ *   354 us/DOF summed against 658 / 701; pointwise smoothing (-mg_levels_pc_type pbjacobi) 188
+ *   iterations; blocks cut at process boundaries (before the subdomains) 80 on 2 processes.
+ *   Hex8 (hex8 24): 15 against 24-25 at the same CPU, so GAMG stays the Hex8 default.
+ * - phase 2: -pc_type mg in the options: newton_factor() sets the levels once per KSP (PCMG's
+ *   level count < 2 means not yet; a cut makes a new KSP); not a default there (GAMG), and not
+ *   fit for MINRES on an indefinite tangent (Chebyshev needs SPD).
+ * - tests: tests/petsc/pcmg.c (petsc_pcmg_*), petsc_newton_static_snh_mg_*.
+ * - not done: the hierarchy and the block lists are replicated (O(DOFs) per process, like the
+ *   numbering); its build is sequential on every process; the coarsest Cholesky is redundant
+ *   (every process factors <= 2000 DOFs); the Schwarz blocks are dense (memory 15.6 kB/DOF on
+ *   Hex20 against 12.0 with GAMG); the iterations still depend on where the cuts lie (20 on the
+ *   fcm-scaling ball n = 16, 53 on the bench's n = 12).
  * Not done:
  * - bit-identical resume: PT-Scotch's partition of the same scene on 2 processes differs
  *   between runs now and then (131/133 or 132/132 own elements of slingshot, although
