@@ -55,11 +55,12 @@
 
 #define PROG "fcm-scaling"
 
-/* S_PGAMG, S_PMUMPS, S_PMG: the PETSc backend (--backend petsc, fcm/petsc.h), on every MPI process */
+/* S_PGAMG, S_PMUMPS, S_PMG: the PETSc backend (--backend petsc, fcm/petsc.h), on every MPI process
+ */
 enum { S_CHOLMOD, S_CGJ, S_MINRES, S_CGMG, S_MG, S_PGAMG, S_PMUMPS, S_PMG, NSOLVER };
-static const char *const solver_names[] = {"cholmod",     "cg-jacobi",  "minres-schwarz",
-                                           "cg-mg",       "mg",         "petsc-gamg",
-                                           "petsc-mumps", "petsc-mg",   NULL};
+static const char *const solver_names[] = {"cholmod",     "cg-jacobi", "minres-schwarz",
+                                           "cg-mg",       "mg",        "petsc-gamg",
+                                           "petsc-mumps", "petsc-mg",  NULL};
 #define IS_PETSC(s) ((s) == S_PGAMG || (s) == S_PMUMPS || (s) == S_PMG)
 enum { BACKEND_SERIAL, BACKEND_PETSC };
 static const char *const backend_names[] = {"serial", "petsc", NULL};
@@ -1241,7 +1242,8 @@ static void usage(FILE *f, const cli_option *opts)
       "--backend petsc (mpirun -n P " PROG " --backend petsc): rows of\n"
       "  petsc-gamg      CG + GAMG, rigid-body near-null space, on the true residual\n"
       "  petsc-mumps     MUMPS sparse Cholesky (preonly)\n"
-      "  petsc-mg        CG + fcm's geometric multigrid as PCMG (-pc_type mg), on the true residual\n"
+      "  petsc-mg        CG + fcm's geometric multigrid as PCMG (-pc_type mg), on the true "
+      "residual\n"
       "on every process through the PETSc adapter (fcm/petsc.h), bodies ball and hollow;\n"
       "default solvers cholmod,cg-mg,petsc-gamg,petsc-mumps,petsc-mg (the serial ones on\n"
       "process 0 give\n"
@@ -1345,7 +1347,8 @@ static int scaling_main(int argc, char **argv, int pargc, char **pargv)
        0, 0, NULL, NULL, NULL},
       {"--solvers", NULL, CLI_STRING, &solvers, "S,...",
        "cholmod, cg-jacobi, minres-schwarz, cg-mg, mg (default all);\n--backend petsc also "
-       "petsc-gamg, petsc-mumps, petsc-mg (default\ncholmod,cg-mg,petsc-gamg,petsc-mumps,petsc-mg); "
+       "petsc-gamg, petsc-mumps, petsc-mg "
+       "(default\ncholmod,cg-mg,petsc-gamg,petsc-mumps,petsc-mg); "
        "cholmod first "
        "gives\nthe reference solution",
        0, 0, 0, NULL, NULL, NULL},

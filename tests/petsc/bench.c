@@ -104,8 +104,7 @@ int main(int argc, char **argv)
            "elements per process %lld..%lld, partition %s\n",
            size, argv[1], (long long)N, (long long)info.num_dofs, 1e6 * t_setup / n, t_setup,
            info.time_rules, info.time_assembly, 1e6 * t_solve / n, t_solve, si.iterations,
-           info.ksp_type, info.pc_type,
-           info.memory_total / n, peak_all / n, info.matrix_memory / n,
+           info.ksp_type, info.pc_type, info.memory_total / n, peak_all / n, info.matrix_memory / n,
            (long long)info.min_local_elements, (long long)info.max_local_elements,
            fcm_petsc_partition_name(info.partition));
   TEST_TRUE(si.reason > 0);

@@ -129,8 +129,8 @@ int main(int argc, char **argv)
     nx += x[i] * x[i];
   const double rel = dist(n, u, x) / sqrt(nx);
   if (rank == 0)
-    printf("pcmg %s N %lld: %lld DOFs, PCMG %d iterations, |u - u_cholmod| / |u| = %.3g\n",
-           argv[1], (long long)N, (long long)n, its_mg, rel);
+    printf("pcmg %s N %lld: %lld DOFs, PCMG %d iterations, |u - u_cholmod| / |u| = %.3g\n", argv[1],
+           (long long)N, (long long)n, its_mg, rel);
   TEST_TRUE(rel <= 1e-8);
   TEST_TRUE(its_mg >= 1 && its_mg <= max_its);
   if (gamg_ratio > 0.0) {

@@ -1123,8 +1123,7 @@ cleanup:
 /* The block smoothers of every level but the coarsest, from the current level matrices. */
 /* The blocks of level l (< nlev - 1) in its DOF numbering: level 0's vertex and cut element
  * blocks, a coarser level's corner blocks. */
-static fcm_status level_blocks(fcm_mg *m, int l, fcm_index *nb, fcm_index **ptr,
-                               fcm_index **dofs)
+static fcm_status level_blocks(fcm_mg *m, int l, fcm_index *nb, fcm_index **ptr, fcm_index **dofs)
 {
   return l == 0 ? blocks_level0(m, nb, ptr, dofs) : blocks_coarse(m, &m->lev[l], nb, ptr, dofs);
 }

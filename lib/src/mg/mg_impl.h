@@ -12,9 +12,9 @@
  * fcm_mg_create() derives them (every coinciding finer DOF inactive, or no finer DOF
  * interpolating from it); P keeps their rows and columns (it is injective). */
 typedef struct fcm__mg_transfers {
-  int num_levels;           /* >= 1 */
-  fcm_index *n;             /* num_levels: DOFs (rows) of each level */
-  fcm_index **P_ptr;        /* num_levels - 1 CSR prolongations */
+  int num_levels;    /* >= 1 */
+  fcm_index *n;      /* num_levels: DOFs (rows) of each level */
+  fcm_index **P_ptr; /* num_levels - 1 CSR prolongations */
   int **P_col;
   double **P_val;
   unsigned char **inactive; /* num_levels */

@@ -48,8 +48,8 @@ cleanup:
  * z (ASM's "basic" form, so the smoother is symmetric). */
 typedef struct block_pc {
   fcm_ctx *ctx;
-  PetscInt n;            /* subdomain size */
-  IS is;                 /* the subdomain's global rows, sorted */
+  PetscInt n; /* subdomain size */
+  IS is;      /* the subdomain's global rows, sorted */
   fcm_index nb;
   fcm_index *ptr, *dofs; /* blocks in subdomain numbering */
   Mat *sub;              /* the subdomain matrix (1) */
@@ -60,8 +60,7 @@ typedef struct block_pc {
 
 static PetscErrorCode block_pc_error(const block_pc *b)
 {
-  SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "fcm block smoother: %s",
-          fcm_ctx_error_message(b->ctx));
+  SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "fcm block smoother: %s", fcm_ctx_error_message(b->ctx));
 }
 
 static PetscErrorCode block_pc_setup(PC pc)
@@ -78,8 +77,8 @@ static PetscErrorCode block_pc_setup(PC pc)
   fcm_status st = FCM_OK;
   PetscCall(PCShellGetContext(pc, &b));
   PetscCall(PCGetOperators(pc, NULL, &A));
-  PetscCall(MatCreateSubMatrices(A, 1, &b->is, &b->is, b->sub ? MAT_REUSE_MATRIX : MAT_INITIAL_MATRIX,
-                                 &b->sub));
+  PetscCall(MatCreateSubMatrices(A, 1, &b->is, &b->is,
+                                 b->sub ? MAT_REUSE_MATRIX : MAT_INITIAL_MATRIX, &b->sub));
   Ad = b->sub[0];
   if (!b->sc) {
     Vec x = NULL;

@@ -1321,8 +1321,8 @@ fcm_status fcm_petsc_problem_setup(fcm_petsc_problem *P)
     PCALL(ctx, PetscObjectTypeCompare((PetscObject)pc, PCMG, &mg));
     /* the default on Hex20 box grids: fcm's geometric multigrid as PCMG (pcmg.c; CG + GAMG
      * needs hundreds of iterations there), GAMG when the mesh is no box grid */
-    const int by_default = !mg && !pc_type_given(P) &&
-                           fcm_mesh_element_type(P->mesh) == FCM_ELEMENT_HEX20;
+    const int by_default =
+        !mg && !pc_type_given(P) && fcm_mesh_element_type(P->mesh) == FCM_ELEMENT_HEX20;
     if (mg || by_default) {
       int levels = 0;
       if (by_default) PCALL(ctx, PCSetType(pc, PCMG));
