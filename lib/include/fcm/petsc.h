@@ -11,7 +11,10 @@
  *   lowest process among the cells that use it (ghosts: the other processes add into its
  *   rows through MatSetValues);
  * - each linear solve is a PETSc KSP configured from the options database: defaults CG with
- *   GAMG and the rigid-body near-null space, overridden by the options string of the options
+ *   GAMG and the rigid-body near-null space (the linear driver on a Hex20 box grid: CG with
+ *   fcm's geometric multigrid of fcm/mg.h as PCMG; -pc_type mg selects it on Hex8 box grids
+ *   and on the integrator path too, and is FCM_ERR_UNSUPPORTED on other meshes),
+ *   overridden by the options string of the options
  *   (a scene's solver.petsc_options) and then by the command line (-ksp_type, -pc_type, ...:
  *   the command line wins, the ecosystem's convention). Each problem reads them under its own
  *   options prefix (fcm_petsc_info.options_prefix), so one problem's string never reaches
