@@ -152,7 +152,11 @@
  *   numbering); its build is sequential on every process; the coarsest Cholesky is redundant
  *   (every process factors <= 2000 DOFs); the Schwarz blocks are dense (memory 15.6 kB/DOF on
  *   Hex20 against 12.0 with GAMG); the iterations still depend on where the cuts lie (20 on the
- *   fcm-scaling ball n = 16, 53 on the bench's n = 12).
+ *   fcm-scaling ball n = 16, 53 on the bench's n = 12). Reproducibility: the Chebyshev
+ *   estimates use PETSc's deterministic "noisy" vector and fcm_schwarz is deterministic, but
+ *   the smoother's reverse scatter adds the subdomains' corrections; with 3 or more processes a
+ *   row may receive several remote contributions, whose order PETSc does not promise (not
+ *   checked; 1 and 2 processes are exact: at most two addends).
  * Not done:
  * - bit-identical resume: PT-Scotch's partition of the same scene on 2 processes differs
  *   between runs now and then (131/133 or 132/132 own elements of slingshot, although
