@@ -12,10 +12,10 @@
  * which must exit 0: the claims of issue 13 hold (see fcm-scaling --help), and write a CSV.
  * Mode petsc (label mpi, a build with PETSc): `MPIEXEC -n NP fcm-scaling --backend petsc` on
  * n = 4, 8 of the ball (Hex8) with --check exits 0 and writes the rows cholmod, cg-mg,
- * petsc-gamg, petsc-mumps per size; the PETSc rows have status ok, processes NP, the serial
- * rows' DOFs, iterations >= 1, a relative residual (computed with the serial matrix) of at
- * most 2e-8 (GAMG: CG on the true residual to rtol 1e-8) / 1e-12 (MUMPS), and agree with
- * CHOLMOD's solution to 1e-5 (GAMG) / 1e-10 (MUMPS); options the PETSc backend refuses exit 2
+ * petsc-gamg, petsc-mumps, petsc-mg per size; the PETSc rows have status ok, processes NP, the
+ * serial rows' DOFs, iterations >= 1, a relative residual (computed with the serial matrix) of at
+ * most 2e-8 (GAMG, PCMG: CG on the true residual to rtol 1e-8) / 1e-12 (MUMPS), and agree with
+ * CHOLMOD's solution to 1e-5 (GAMG, PCMG) / 1e-10 (MUMPS); options the PETSc backend refuses exit 2
  * on every process, with no CSV.
  * Usage: app_scaling small|quick|full PATH_TO_fcm-scaling WORK_DIR [MPIEXEC NP] */
 #define _POSIX_C_SOURCE 200809L
@@ -116,12 +116,13 @@ static int petsc_mode(char **argv)
            argv[3], np, argv[1], csv);
   TEST_TRUE(app_run(cmd) == 0);
   const int n = read_rows(csv, rows, 64);
-  TEST_TRUE(n == 2 * 4);
-  static const char *const solvers[4] = {"cholmod", "cg-mg", "petsc-gamg", "petsc-mumps"};
+  TEST_TRUE(n == 2 * 5);
+  static const char *const solvers[5] = {"cholmod", "cg-mg", "petsc-gamg", "petsc-mumps",
+                                         "petsc-mg"};
   for (long long c = 4; c <= 8; c *= 2) {
     const srow *ch = find(rows, n, "ball", c, "cholmod");
     TEST_TRUE(ch != NULL && ch->processes == 1 && !strcmp(ch->status, "ok"));
-    for (int s = 1; s < 4 && ch; s++) {
+    for (int s = 1; s < 5 && ch; s++) {
       const srow *r = find(rows, n, "ball", c, solvers[s]);
       TEST_TRUE(r != NULL);
       if (!r) continue;
