@@ -336,12 +336,14 @@ fcm_status fcm__geom_create_subset(fcm_ctx *ctx, const fcm_geometry *g,
   FCM_ALLOC(ctx, (size_t)s->num_tris + 1, s->tri_cell);
   FCM_ALLOC(ctx, (size_t)s->num_tris + 1, s->tri_orig);
   for (fcm_index k = 0; k < g->num_nodes; k++)
-    if (node_new[k] >= 0) memcpy(s->coords + 3 * node_new[k], g->coords + 3 * k, 3 * sizeof(double));
+    if (node_new[k] >= 0)
+      memcpy(s->coords + 3 * node_new[k], g->coords + 3 * k, 3 * sizeof(double));
   for (fcm_index c = 0; c < g->num_cells; c++) {
     if (cell_new[c] < 0) continue;
     const size_t i = (size_t)cell_new[c];
     for (int a = 0; a < npc; a++)
-      s->cells[(size_t)npc * i + (size_t)a] = node_new[g->cells[(size_t)npc * (size_t)c + (size_t)a]];
+      s->cells[(size_t)npc * i + (size_t)a] =
+          node_new[g->cells[(size_t)npc * (size_t)c + (size_t)a]];
     s->cell_orig[i] = g->cell_orig ? g->cell_orig[c] : c;
   }
   fcm_index i = 0;
