@@ -143,24 +143,31 @@
  * - the linear driver (phase 1) could now be replaced by the phase-2 path for the scenes both
  *   run (they agree to the KSP tolerance); it is kept: it assembles straight into PETSc and
  *   scales further (no dense sums), and its tests and checkpoints stay.
+ * Done (phase 1, the crop): crop_geometry() after the partition: each process's rules build
+ *   reads fcm__embed_crop_geometry() (embed/cell_rules.c): the geometry cells whose boxes meet
+ *   the kernels' query box (fcm__embed_cell_setup()'s lo/hi, widened by the clipping
+ *   tolerance) of every cell it classifies (!P->remote: its own and its round-robin
+ *   non-candidates), and the boundary triangles meeting those of its own cells (mask), found
+ *   with the same trees as the build, so every candidate is kept; fcm__geom_create_subset()
+ *   (geom/geometry.c) keeps them in original order with their original ids (cell_orig,
+ *   tri_orig; surface points carry the original triangle ids, intersect.c), the whole
+ *   geometry's volume and box, and the whole geometry's outside volume per side of the mesh
+ *   box (fcm__embed_outside() takes them from the crop). Bit for bit: the candidates were
+ *   already sorted (fcm__geom_tree_query() sorts its ids ascending since the geometry module
+ *   was written, so the earlier note's step (1) was not needed and no serial rule changed);
+ *   sorted crop ids map to sorted original ids. Not on one process (no gain). The crop is
+ *   freed after the rules build; fcm_petsc_info.geometry_* and
+ *   fcm_petsc_problem_geometry_kept() report it (tests/petsc/classify.c check_crop(),
+ *   tests/embed/crop.c). Measured: mpirun -n 2 petsc_bench hex8 24 24 (663,552 tets): 345,600
+ *   cells (15.3 of 24.9 MB) per process, peak RSS 344 vs 384 MB per process without the crop.
  * Not done (phase 1):
- * - geometry kept whole on every process (no AABB crop), mesh replicated; still replicated per
- *   cell: class, fraction, pieces (O(cells) bytes: what the DOF numbering needs).
- *   The crop is NOT bit-identical as the kernels stand: the candidates of a cell come out of
- *   the AABB tree (fcm__geom_tree_query, geom/aabb.c) in traversal order, and the tree is built
- *   from ALL the geometry's boxes, so a cropped geometry gives the same candidates in another
- *   order: other tet order, other point order, other rounding of the volume sums (fractions)
- *   and simplifications. What the crop needs: (1) sort the candidate ids in
- *   fcm__embed_cell_tets() and fcm__embed_cell_surface() (changes every serial rule's point
- *   order and last bits once); (2) a cropped fcm_geometry that keeps the cells and boundary
- *   triangles (not rebuilt from the kept cells: custom_boundary) whose boxes meet the own
- *   cells' boxes enlarged by one cell, in their original order (so sorted cropped ids = sorted
- *   original ids), with volume / bounding box of the whole geometry; (3) the surface points'
- *   triangle ids mapped back to the original numbering (a map in fcm__rules_exchange);
- *   (4) the candidate test here widened to the clipping box (fcm__embed_cell_setup's lo/hi,
- *   clip_rtol) so that non-candidates classified round robin provably meet nothing;
- *   (5) fcm__embed_outside()'s per-side outside volumes from the whole geometry (or summed);
- *   phase 2 keeps the whole geometry (effects select boundary triangles of it).
+ * - every process still reads / generates the WHOLE geometry first (peak memory includes it;
+ *   a reader that streams and keeps only the needed part would remove that); the mesh is
+ *   replicated; still replicated per cell: class, fraction, pieces (O(cells) bytes: what the
+ *   DOF numbering needs).
+ * - phase 2 keeps the whole geometry (effects select boundary triangles of it; cuts classify
+ *   every cell on every process and need every geometry cell); cropping only its first rules
+ *   build would shrink that build's trees, not the geometry (run.c build_rules(), not done).
  * - the options string goes into the GLOBAL options database (it stays for later problems);
  *   an options prefix per problem would scope it.
  * - README projection for 1e8 DOFs (memory and time per DOF are printed by
