@@ -5,7 +5,8 @@
  * - with -pc_type mg the displacement equals the serial CHOLMOD solution (every cell's rules,
  *   symmetric elimination) to 1e-8 relative, and CG needs at most `max_its` iterations (a
  *   wrong prolongation or level numbering cannot reach 1e-10 that fast; the bound is the
- *   argument, about 1.5x what was measured);
+ *   argument: Hex8 32, Hex20 40 in tests.cmake, measured 22 / 26 and 27 / 34 on 1 / 2
+ *   processes);
  * - CG + GAMG (the option -pc_type gamg) needs more than `gamg_ratio` times as many
  *   iterations on the same problem (the reason for the multigrid: argument, 0 to skip);
  * - -pc_type mg on a Tet4 mesh of the same box and on a Hex8 mesh with one node moved off the
