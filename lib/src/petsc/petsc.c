@@ -33,8 +33,17 @@
  *   and a phase-2 process that fails before the rules build meets it with its final
  * fcm__petsc_agree().
  * - DOFs: global numbering, owner = lowest process among the cells using the DOF copy, the
- *   PETSc index is contiguous per owner; the perm (space DOF -> PETSc index) and the space's
- *   pattern are REPLICATED (O(DOFs + nnz) integers per process).
+ *   PETSc index is contiguous per owner; the numbering (fem_impl.h: node_dof, node_ncopy,
+ *   elem_*, cell_elem) and the perm / copy_owner (space DOF -> PETSc index, owner) are
+ *   REPLICATED: O(nodes + elements nn), measured 22 B/DOF (Hex20) / 39 B/DOF (Hex8, most of a
+ *   24^3 grid outside the ball) plus 4-7 B/DOF of the adapter's arrays (petsc_bench).
+ * - topology (phase 1): a local space (fcm__space_create_local(), fem_impl.h), the serial
+ *   numbering bit for bit with the copy graph, pattern, offsets and colours of the own cells
+ *   and their ghosts only (localize_space(): cells with an element using an owned copy; the
+ *   comment there proves every owned row complete; tests/petsc/ghost.c). Measured
+ *   (petsc_bench, fcm__space_memory()): full space 435 (Hex8) / 827 (Hex20) B/DOF on every
+ *   process before; local 224-252 / 424-523 B/DOF per process on 2 processes. create_matrix()
+ *   preallocates from the owned local rows (exact: nz_allocated = nz_used, ghost.c).
  * - assembly: own elements only (fcm__assembly_element_linear), MatSetValues ADD_VALUES into a
  *   preallocated MATMPIAIJ (block size 3), VECMPI loads; stiffness, mass, gravity.
  * - constraints: node sets with fcm_motion (no release), symmetric elimination with
@@ -46,7 +55,13 @@
  * - errors: every local phase ends in fcm__petsc_agree(): an error on any process is returned on
  * all with the lowest failing process's message (tests/petsc: bad input on one rank, no hang).
  * - output: fcm_petsc_problem_write_frame(): a .pvtu (process 0) naming one piece per process
- *   (its own cells); the node fields come from the gathered (replicated) state. The integrator
+ *   (its own cells); the node fields come from a VecScatter of the piece's node values (the
+ *   DOF copy fcm_space_node_field() shows at each node of an own cell, made at the first
+ *   frame: frame_nodes(), frame_scatter()), byte for byte the file written from the gathered
+ *   state (ghost.c). Energies are MatMult / VecDot on the distributed vectors (no gather).
+ *   Still O(n) per process: fcm_petsc_problem_get_state() (every process: the user asks for
+ *   the whole state) and the checkpoint (gathered on process 0 only; read whole by every
+ *   process). The integrator
  *   path's background frames are the same (fcm__space_write_vtu_piece() / fcm__write_pvtu(),
  *   fields.c, from fcm_simulation_write_frame()); its surface frames stay serial (process 0).
  * - scenes: fcm_petsc_problem_create_from_scene() (mesh + geometry through
@@ -165,6 +180,14 @@
  *   an options prefix per problem would scope it.
  * - README projection for 1e8 DOFs (memory and time per DOF are printed by
  *   tests/petsc/bench.c, figures in README "Distributed runs").
+ * - replicated still (phase 1): the numbering and the adapter's per-copy arrays (perm,
+ *   copy_owner, is_con), the mesh, the geometry: about 5 GB per process at 1e8 Hex20 DOFs
+ *   (README projection). Next: number each process's own copies locally and exchange the
+ *   ghosts' numbers (PetscSF), with the mesh cropped to own + ghost cells.
+ * - phase 2 keeps the simulation's full space (fcm_space_create_embedded(): its dense sums and
+ *   nitsche.c's coloured assembly need the whole pattern). What it would need to use a local
+ *   space: see fcm__space_create_local() in fem_impl.h (own-element assembly into local rows,
+ *   ADD_VALUES into the MATMPIAIJ).
  * ------------------------------------------------------------------------------------------ */
 #define _GNU_SOURCE /* RTLD_DEFAULT */
 /* before PETSc's headers: they include complex.h, whose macro I clashes with the integrator
