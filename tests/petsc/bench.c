@@ -132,8 +132,7 @@ int main(int argc, char **argv)
              "(replicated) + adapter %.1f (replicated); copy graph + pattern + offsets + "
              "colours: full space %.1f (before: on every process), local space %.1f..%.1f "
              "(own + ghost cells)\n",
-             size, argv[1], (long long)N, num / n, adapter / n, whole / n, -ext[1] / n,
-             ext[0] / n);
+             size, argv[1], (long long)N, num / n, adapter / n, whole / n, -ext[1] / n, ext[0] / n);
   }
   TEST_TRUE(si.reason > 0);
   free(fix);

@@ -44,15 +44,15 @@ static int cmp_idx(const void *a, const void *b)
 static fcm_index local_pos(const fcm_space *s, fcm_index k)
 {
   if (!s->local_copy) return k;
-  const fcm_index *hit =
-      bsearch(&k, s->local_copy, (size_t)s->num_local_copies, sizeof k, cmp_idx);
+  const fcm_index *hit = bsearch(&k, s->local_copy, (size_t)s->num_local_copies, sizeof k, cmp_idx);
   return hit ? hit - s->local_copy : -1;
 }
 
 /* Whether local row lk of l is full row k of f (graph and the three pattern rows). */
 static int row_equal(const fcm_space *l, fcm_index lk, const fcm_space *f, fcm_index k)
 {
-  const fcm_index dl = l->node_ptr[lk + 1] - l->node_ptr[lk], df = f->node_ptr[k + 1] - f->node_ptr[k];
+  const fcm_index dl = l->node_ptr[lk + 1] - l->node_ptr[lk],
+                  df = f->node_ptr[k + 1] - f->node_ptr[k];
   if (dl != df || !same(l->node_adj + l->node_ptr[lk], f->node_adj + f->node_ptr[k],
                         sizeof(fcm_index) * (size_t)dl))
     return 0;
@@ -184,9 +184,9 @@ static unsigned char *slurp(const char *path, size_t *len)
 
 /* Without PETSc: a cut (fcm_cell_rules_create_cut(): pieces, several copies per node, the
  * constrained copies of fcm_space_create_embedded()) on the same cube, local spaces for the
- * cells of each third of the cell numbering (slabs), against the full space: numbering, topology, and complete rows
- * exactly for the local copies all of whose elements are local; a mask of every cell gives
- * the full space's topology array for array. */
+ * cells of each third of the cell numbering (slabs), against the full space: numbering, topology,
+ * and complete rows exactly for the local copies all of whose elements are local; a mask of every
+ * cell gives the full space's topology array for array. */
 static void cut_check(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom)
 {
   fcm_cell_rules *r0 = NULL, *r1 = NULL;
@@ -329,8 +329,8 @@ int main(int argc, char **argv)
   /* without the ghosts some owned row is incomplete (with several processes) */
   {
     const fcm_space_options so = fcm_space_options_default();
-    TEST_OK(ctx, fcm__space_create_local(ctx, mesh, NULL, P->rules, P->rules ? &so : NULL,
-                                         own_mask, &own));
+    TEST_OK(ctx, fcm__space_create_local(ctx, mesh, NULL, P->rules, P->rules ? &so : NULL, own_mask,
+                                         &own));
     long long bad = own ? (long long)incomplete_rows(P, own, full) : -1, bad_all = 0;
     long long ghosts = (long long)nghost, ghosts_all = 0;
     MPI_Allreduce(&bad, &bad_all, 1, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);

@@ -167,9 +167,8 @@ fcm_status fcm__space_node_field_dofs(const fcm_space *s, fcm_index n, const fcm
  * fcm__space_write_vtu_piece() with mat NULL and those values, without any DOF vector.
  * (fields.c) */
 fcm_status fcm__space_write_vtu_piece_values(const fcm_space *s, const unsigned char *keep,
-                                             fcm_index np, const fcm_index *nodes,
-                                             const double *nu, const double *nv, int rank,
-                                             const char *path);
+                                             fcm_index np, const fcm_index *nodes, const double *nu,
+                                             const double *nv, int rank, const char *path);
 
 /* The .pvtu index (written atomically) of the pieces <stem>_0.vtu .. <stem>_<nprocs-1>.vtu that
  * fcm__space_write_vtu_piece() wrote with the same velocity / mat choice. (fields.c) */

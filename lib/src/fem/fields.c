@@ -374,8 +374,8 @@ static fcm_status write_piece(const fcm_space *s, const fcm_material *mat, const
     if (!keep || keep[c]) {
       ncl++;
       for (int k = 0; k < npc; k++) {
-        const fcm_index *hit = bsearch(cells + (size_t)npc * c + k, nodes, (size_t)np,
-                                       sizeof *nodes, cmp_node);
+        const fcm_index *hit =
+            bsearch(cells + (size_t)npc * c + k, nodes, (size_t)np, sizeof *nodes, cmp_node);
         FCM_CHECK(hit, ctx, FCM_ERR_INTERNAL, "write vtu piece: node %lld of cell %lld unlisted",
                   (long long)cells[(size_t)npc * c + k], (long long)c);
         if (pid[hit - nodes] < 0) pid[hit - nodes] = next++;
@@ -416,8 +416,8 @@ static fcm_status write_piece(const fcm_space *s, const fcm_material *mat, const
   for (fcm_index c = 0; c < nc; c++)
     if (!keep || keep[c]) {
       for (int k = 0; k < npc; k++) {
-        const fcm_index *hit = bsearch(cells + (size_t)npc * c + k, nodes, (size_t)np,
-                                       sizeof *nodes, cmp_node);
+        const fcm_index *hit =
+            bsearch(cells + (size_t)npc * c + k, nodes, (size_t)np, sizeof *nodes, cmp_node);
         conn[(size_t)npc * m + k] = pid[hit - nodes];
       }
       phi[m] = s->rules ? fcm_cell_rules_volume_fraction(s->rules, c) : 1.0;
@@ -450,8 +450,8 @@ static fcm_status write_piece(const fcm_space *s, const fcm_material *mat, const
   FCM_TRY(ctx, fcm_vtu_write(vtu, path, NULL));
 cleanup:
   fcm_vtu_destroy(&vtu);
-  void *arrays[] = {pid, conn, xyz,  pu,   pv,    phi, sig, vm,    sed,
-                    csig, cvm, csed, zero, owner, cid, nid, active};
+  void *arrays[] = {pid,  conn, xyz,  pu,   pv,    phi, sig, vm,    sed,
+                    csig, cvm,  csed, zero, owner, cid, nid, active};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(ctx, arrays[k]);
   return st;
@@ -486,9 +486,8 @@ cleanup:
 }
 
 fcm_status fcm__space_write_vtu_piece_values(const fcm_space *s, const unsigned char *keep,
-                                             fcm_index np, const fcm_index *nodes,
-                                             const double *nu, const double *nv, int rank,
-                                             const char *path)
+                                             fcm_index np, const fcm_index *nodes, const double *nu,
+                                             const double *nv, int rank, const char *path)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s ? s->ctx : NULL;

@@ -356,7 +356,7 @@ cleanup:
 static void free_topology(fcm_space *s)
 {
   fcm_ctx *ctx = s->ctx;
-  void *arrays[] = {s->node_ptr, s->node_adj,    s->row_ptr,    s->col_idx,    s->elem_off,
+  void *arrays[] = {s->node_ptr,  s->node_adj,    s->row_ptr,    s->col_idx,    s->elem_off,
                     s->color_ptr, s->color_elems, s->local_copy, s->local_elem, s->cell_local};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
     fcm__free(ctx, arrays[i]);
@@ -794,7 +794,7 @@ fcm_status fcm__space_check_full(const fcm_space *s, const char *what)
 {
   if (!s->is_local) return FCM_OK;
   fcm_index nl = 0;
-  for (fcm_index c = 0; c < s->num_cells; c++)
+  for (fcm_index c = 0; s->cell_local && c < s->num_cells; c++)
     nl += s->cell_local[c] != 0;
   return fcm__error(s->ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
                     "%s: the space is a local space (its pattern covers the elements of %lld of "
@@ -809,13 +809,14 @@ void fcm__space_memory(const fcm_space *s, double *numbering, double *topology)
   const double I = (double)sizeof(fcm_index), nn = (double)s->nn;
   const double ne = (double)s->num_elems, nc = (double)s->num_cells, np = (double)s->num_nodes;
   const double nl = (double)s->num_local_copies, nle = (double)s->num_local_elems;
-  const double nadj = (double)s->node_ptr[s->num_local_copies];
+  const double nadj = s->node_ptr ? (double)s->node_ptr[s->num_local_copies] : 0.0;
   if (numbering) /* active, node_dof, node_ncopy, cell_elem, elem_cell, elem_piece, elem_dof */
     *numbering = nc + 2.0 * I * np + I * (nc + 1.0) + 2.0 * I * ne + I * nn * ne;
   if (topology) /* node_ptr, node_adj, row_ptr, col_idx (9 per graph entry), elem_off, colours,
                    local lists */
-    *topology = I * (nl + 1.0) + I * nadj + I * (3.0 * nl + 1.0) + (double)sizeof(int) * 9.0 * nadj +
-                (double)sizeof(int) * nn * nn * nle + I * ((double)s->num_colors + 1.0) + I * nle +
+    *topology = I * (nl + 1.0) + I * nadj + I * (3.0 * nl + 1.0) +
+                (double)sizeof(int) * 9.0 * nadj + (double)sizeof(int) * nn * nn * nle +
+                I * ((double)s->num_colors + 1.0) + I * nle +
                 (s->is_local ? I * (nl + nle) + nc : 0.0);
 }
 

@@ -2205,8 +2205,8 @@ static fcm_status frame_scatter(fcm_petsc_problem *P, const PetscInt *blocks)
   fcm_ctx *ctx = P->ctx;
   IS from = NULL;
   VecDestroy(&P->frame_vec); /* a failed first frame's */
-  PCALL(ctx, ISCreateBlock(PETSC_COMM_SELF, 3, (PetscInt)P->frame_np, blocks, PETSC_COPY_VALUES,
-                           &from));
+  PCALL(ctx,
+        ISCreateBlock(PETSC_COMM_SELF, 3, (PetscInt)P->frame_np, blocks, PETSC_COPY_VALUES, &from));
   PCALL(ctx, VecCreateSeq(PETSC_COMM_SELF, 3 * (PetscInt)P->frame_np, &P->frame_vec));
   PCALL(ctx, VecScatterCreate(P->u, from, P->frame_vec, NULL, &P->frame_sc));
 cleanup:
@@ -2260,8 +2260,8 @@ fcm_status fcm_petsc_problem_write_frame(fcm_petsc_problem *P, const char *dir, 
   FCM_TRY(ctx, frame_values(P, P->u, u)); /* collective */
   FCM_TRY(ctx, frame_values(P, P->v, v));
   snprintf(path, sizeof path, "%s/%s_%d.vtu", dir, stem, P->rank);
-  st = fcm__space_write_vtu_piece_values(P->space, keep, P->frame_np, P->frame_nodes, u, v,
-                                         P->rank, path);
+  st = fcm__space_write_vtu_piece_values(P->space, keep, P->frame_np, P->frame_nodes, u, v, P->rank,
+                                         path);
   FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
   if (P->rank == 0) {
     snprintf(path, sizeof path, "%s/%s.pvtu", dir, stem);
