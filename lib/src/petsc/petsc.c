@@ -142,15 +142,16 @@
  *   newton_cut() (tests/petsc/newton_failure.c case 5).
  * Done (fcm's geometric multigrid as PCMG, pcmg.c):
  * - fcm__petsc_pcmg_setup(): the hierarchy of lib/src/mg (fcm__mg_transfers_create(), the code
- *   fcm_mg_create() runs, without a matrix; the transfers do not depend on the constrained
- *   DOFs) built on every process from the replicated space; one MATMPIAIJ prolongation per level
- *   (bs 3; level 0 rows in P->perm numbering; a coarse copy owned by the owner of the lowest
- *   global finer copy it interpolates to, numbered contiguously per owner; coarse copies no
- *   finer copy interpolates to left out), PCMGSetGalerkin(BOTH), levels Chebyshev (2 steps,
- *   PETSc's eigenvalue estimate) on a PCSHELL applying fcm_schwarz with fcm_mg's block lists
- *   (each block whole on the owner of its lowest DOF: subdomain = owned rows + the blocks' other
- *   rows, MatCreateSubMatrices at each setup, scatter in / add back, i.e. ASM basic), coarsest
- *   level redundant Cholesky (at most min(2000, n/8) DOFs). Options override all of it
+ *   fcm_mg_create() runs, without a matrix; the transfers do not depend on the constrained DOFs)
+ *   built on every process from the space (replicated numbering; a local space answers the element
+ *   queries for every element, so the hierarchy is the same everywhere); one MATMPIAIJ prolongation
+ *   per level (bs 3; level 0 rows in P->perm numbering; a coarse copy owned by the owner of the
+ *   lowest global finer copy it interpolates to, numbered contiguously per owner; coarse copies no
+ *   finer copy interpolates to left out), PCMGSetGalerkin(BOTH), levels Chebyshev (2 steps, PETSc's
+ *   eigenvalue estimate) on a PCSHELL applying fcm_schwarz with fcm_mg's block lists (each block
+ *   whole on the owner of its lowest DOF: subdomain = owned rows + the blocks' other rows,
+ *   MatCreateSubMatrices at each setup, scatter in / add back, i.e. ASM basic), coarsest level
+ *   redundant Cholesky (at most min(2000, n/8) DOFs). Options override all of it
  *   (-mg_levels_pc_type replaces the shell; -pc_mg_levels caps the levels, an error if the
  *   hierarchy cannot give them).
  * - phase 1: -pc_type mg, and the default when no -pc_type is given on Hex20 meshes whose

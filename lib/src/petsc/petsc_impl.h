@@ -131,8 +131,8 @@ int fcm__petsc_pcmg_grid(const fcm_space *space);
  * untouched (the caller's default applies). num_levels (may be NULL): the levels made.
  * @return FCM_OK, FCM_ERR_UNSUPPORTED (not a Hex8 / Hex20 box grid: named), FCM_ERR_ARG
  * (-pc_mg_levels that the hierarchy cannot give), FCM_ERR_ALLOC, FCM_ERR_INTERNAL (PETSc). The
- * same on every process (the hierarchy is built from the replicated space); not agreed here.
- * pcmg.c. */
+ * same on every process (the hierarchy is built from the space's replicated numbering and element
+ * queries); not agreed here. pcmg.c. */
 fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned char *constrained,
                                  int optional, int *num_levels);
 
