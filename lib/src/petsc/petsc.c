@@ -180,6 +180,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 /* ---------------------------------------------------------------- errors */
 
@@ -1693,8 +1694,13 @@ static fcm_status newton_agree(fcm_petsc_problem *P, fcm_status st)
 static fcm_status newton_reduce(void *user, fcm_status st, double *values, fcm_index count)
 {
   fcm_petsc_problem *P = user;
+  const double t0 = MPI_Wtime();
+  const clock_t c0 = clock();
   st = newton_agree(P, st);
   if (st != FCM_OK) return st;
+  P->traffic.reduces++;
+  P->traffic.reduce_values += (long long)count;
+  P->traffic.reduce_bytes += (long long)count * (long long)sizeof(double);
   for (fcm_index k = 0; k < count;) {
     const int m = count - k > (1 << 26) ? (1 << 26) : (int)(count - k);
     int rc = MPI_Reduce(P->rank == 0 ? MPI_IN_PLACE : values + k, values + k, m, MPI_DOUBLE,
@@ -1705,6 +1711,8 @@ static fcm_status newton_reduce(void *user, fcm_status st, double *values, fcm_i
                         "petsc: MPI_Reduce / MPI_Bcast of %d values failed (error %d)", m, rc);
     k += m;
   }
+  P->traffic.time_reduce += MPI_Wtime() - t0;
+  P->traffic.cpu_reduce += (double)(clock() - c0) / CLOCKS_PER_SEC;
   return FCM_OK;
 }
 
@@ -1730,6 +1738,8 @@ static fcm_status newton_factor(void *user, const fcm_csr *H, int psd, int *fail
               "used after a cut replaced it)",
               (long long)rows, (long long)P->n);
   }
+  const double t0 = MPI_Wtime();
+  const clock_t c0 = clock();
   for (fcm_index i = 0; i < P->n; i++)
     maxrow = FCM_MAX(maxrow, rp[i + 1] - rp[i]);
   cols = fcm__calloc(ctx, (size_t)maxrow + 1, sizeof *cols);
@@ -1753,6 +1763,9 @@ static fcm_status newton_factor(void *user, const fcm_csr *H, int psd, int *fail
   FCM_TRY(ctx, newton_agree(P, st));
   PCALL(ctx, MatAssemblyBegin(P->S, MAT_FINAL_ASSEMBLY));
   PCALL(ctx, MatAssemblyEnd(P->S, MAT_FINAL_ASSEMBLY));
+  P->traffic.matrices++;
+  P->traffic.time_matrix += MPI_Wtime() - t0;
+  P->traffic.cpu_matrix += (double)(clock() - c0) / CLOCKS_PER_SEC;
   PCALL(ctx, MatSetOption(P->S, MAT_SPD, psd ? PETSC_TRUE : PETSC_FALSE));
   if (P->direct && !P->pc_type_set) {
     PC pc;
@@ -2090,7 +2103,40 @@ fcm_status fcm_petsc_simulation_summary_view(fcm_simulation *sim, FILE *f)
   FCM_CHECK(sim, NULL, FCM_ERR_ARG, "petsc: summary_view: NULL simulation");
   FCM_CHECK(fcm__integrator_distributed(sim->integ, NULL), sim->ctx, FCM_ERR_ARG,
             "petsc: summary_view: the simulation is not one of fcm_petsc_simulation_create()");
-  FCM_TRY(sim->ctx, fcm__simulation_summary_view_distributed(sim, f));
+  {
+    /* the backend's traffic so far (before the summary's own sums), per Newton matrix; the
+     * largest over the processes */
+    fcm_petsc_traffic t;
+    FCM_TRY(sim->ctx, fcm_petsc_simulation_traffic(sim, &t));
+    FCM_TRY(sim->ctx, fcm__simulation_summary_view_distributed(sim, f));
+    const fcm__sim_backend *b = fcm__integrator_backend(sim->integ);
+    fcm_petsc_problem *P = b->user;
+    double mine[4] = {(double)t.reduce_bytes, (double)t.matrix_bytes_sent, t.cpu_reduce,
+                      t.cpu_matrix},
+           all[4];
+    int rc = MPI_Allreduce(mine, all, 4, MPI_DOUBLE, MPI_MAX, P->comm);
+    FCM_CHECK(rc == MPI_SUCCESS, sim->ctx, FCM_ERR_INTERNAL,
+              "petsc: MPI_Allreduce of the traffic counters failed (error %d)", rc);
+    const double per = t.matrices > 0 ? 1.0 / (double)t.matrices : 0.0;
+    if (f)
+      fprintf(f,
+              "  comm      per process (largest): dense sums %.4g MB (%.3g s CPU), matrix stash "
+              "%.4g MB (%.3g s CPU); per Newton matrix (%lld): %.4g + %.4g kB\n",
+              all[0] / 1e6, all[2], all[1] / 1e6, all[3], t.matrices, all[0] * per / 1e3,
+              all[1] * per / 1e3);
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm_petsc_simulation_traffic(const fcm_simulation *sim, fcm_petsc_traffic *out)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(sim && out, sim ? sim->ctx : NULL, FCM_ERR_ARG, "petsc: traffic: NULL argument");
+  const fcm__sim_backend *b = fcm__integrator_backend(sim->integ);
+  FCM_CHECK(b && b->reduce == newton_reduce, sim->ctx, FCM_ERR_ARG,
+            "petsc: traffic: the simulation is not one of fcm_petsc_simulation_create()");
+  *out = ((const fcm_petsc_problem *)b->user)->traffic;
 cleanup:
   return st;
 }

@@ -80,6 +80,8 @@ struct fcm_petsc_problem {
   int factored;      /* a matrix was given to the KSP since the last (re)build (cuts) */
   VecScatter to_all;
   Vec all;
+  fcm_petsc_traffic traffic; /* the integrator's backend (fcm_petsc_simulation_traffic()) */
+  unsigned char *owned_dof;  /* n: 1 on the DOFs whose rows this process owns (newton_build) */
 };
 
 /* A PETSc call: on failure, record its message as FCM_ERR_INTERNAL. */

@@ -702,6 +702,11 @@ cleanup:
   return st;
 }
 
+const fcm__sim_backend *fcm__integrator_backend(const fcm_integrator *I)
+{
+  return I && I->has_backend ? &I->backend : NULL;
+}
+
 int fcm__integrator_distributed(const fcm_integrator *I, int *root)
 {
   const int dist = I && I->has_backend;

@@ -63,6 +63,9 @@ fcm_status fcm__integrator_reduce(fcm_integrator *I, double *values, fcm_index c
 fcm_status fcm__integrator_reduce_status(fcm_integrator *I, fcm_status st, double *values,
                                          fcm_index count);
 
+/* The integrator's backend (NULL without one). */
+const fcm__sim_backend *fcm__integrator_backend(const fcm_integrator *I);
+
 /* Whether the integrator runs on a distributed backend (0: serial); *root (may be NULL): 1 on
  * the backend's root process, and 1 without a backend. */
 int fcm__integrator_distributed(const fcm_integrator *I, int *root);
