@@ -933,7 +933,7 @@ void fcm_petsc_problem_destroy(fcm_petsc_problem **problem)
   fcm_cell_rules_destroy(&P->rules);
   void *arrays[] = {P->petsc_options, P->weight,     P->cell_owner, P->copy_owner, P->perm,
                     P->con_dof,       P->con_node,   P->con_comp,   P->con_motion, P->motions,
-                    P->is_con,        P->classifier, P->remote};
+                    P->is_con,        P->classifier, P->remote,     P->owned_dof};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
     fcm__free(ctx, arrays[i]);
   if (P->comm != MPI_COMM_NULL) MPI_Comm_free(&P->comm);
@@ -1716,10 +1716,19 @@ static fcm_status newton_reduce(void *user, fcm_status st, double *values, fcm_i
   return FCM_OK;
 }
 
-/* The eliminated Newton matrix H (the same on every process) into the MATMPIAIJ: each process
- * inserts its owned rows; the KSP (CG, or MINRES for a possibly indefinite H, unless
- * -ksp_type says otherwise) is set up on it. */
-static fcm_status newton_factor(void *user, const fcm_csr *H, int psd, int *failed)
+/* The eliminated Newton matrix into the MATMPIAIJ: each process adds its PARTIAL eliminated
+ * matrix H (sim_backend.h) with ADD_VALUES, row by row, skipping the all-zero rows (so a process
+ * sends only the rows its cells touch, plus the base on its own rows); the entries of rows
+ * another process owns go through PETSc's stash at the assembly. The constrained rows are
+ * checked against the contract (zero but for the owner's diagonal). The KSP (CG, or MINRES for a
+ * possibly indefinite matrix, unless -ksp_type says otherwise) is set up on the sum.
+ * Order of the additions: an entry's own contribution first, then the received ones in the
+ * order the stash's messages are processed (MatStashScatterGetMesg_BTS, PETSc 3.18: by
+ * MPI_Waitsome, i.e. arrival). With 2 processes every entry has at most one sender, so the
+ * sums are the same bits in every run; with 3 or more, an entry that two other processes both
+ * touch may be summed in another order from run to run (round-off). */
+static fcm_status newton_factor(void *user, const fcm_csr *H, const unsigned char *is_con, int psd,
+                                int *failed)
 {
   fcm_petsc_problem *P = user;
   fcm_status st = FCM_OK;
@@ -1746,18 +1755,43 @@ static fcm_status newton_factor(void *user, const fcm_csr *H, int psd, int *fail
   st = cols ? FCM_OK
             : fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
                          "petsc: out of memory (a row of %lld entries)", (long long)maxrow);
+  if (st == FCM_OK) {
+    PetscErrorCode ierr = MatZeroEntries(P->S);
+    if (ierr) st = fcm__petsc_error(ctx, ierr, "MatZeroEntries", __FILE__, __LINE__, __func__);
+  }
   for (fcm_index k = 0; st == FCM_OK && k < P->ncopy; k++) {
-    if (P->copy_owner[k] != P->rank) continue;
+    const int own = P->copy_owner[k] == P->rank;
     for (int i = 0; i < 3 && st == FCM_OK; i++) {
       const fcm_index r = 3 * k + i;
       const PetscInt row = 3 * P->perm[k] + i;
       const PetscInt len = (PetscInt)(rp[r + 1] - rp[r]);
+      const double *v = hv + rp[r];
+      int nonzero = 0;
       for (PetscInt j = 0; j < len; j++) {
         const int c = ci[rp[r] + j];
+        if (v[j] != 0.0) {
+          nonzero = 1;
+          if (is_con[r] && (c != r || !own)) {
+            st = fcm__error(ctx, FCM_ERR_INTERNAL, __FILE__, __LINE__, __func__,
+                            "petsc: the partial Newton matrix has %g at (%lld, %lld) of the "
+                            "constrained DOF %lld (only its owner's diagonal may be non-zero)",
+                            v[j], (long long)r, (long long)c, (long long)r);
+            break;
+          }
+        }
         cols[j] = 3 * P->perm[c / 3] + c % 3;
       }
-      PetscErrorCode ierr = MatSetValues(P->S, 1, &row, len, cols, hv + rp[r], INSERT_VALUES);
+      if (st != FCM_OK || !nonzero) continue;
+      PetscErrorCode ierr = MatSetValues(P->S, 1, &row, len, cols, v, ADD_VALUES);
       if (ierr) st = fcm__petsc_error(ctx, ierr, "MatSetValues", __FILE__, __LINE__, __func__);
+      if (own) {
+        P->traffic.matrix_values_local += len;
+      } else {
+        P->traffic.matrix_values_sent += len;
+        P->traffic.matrix_rows_sent++;
+        P->traffic.matrix_bytes_sent +=
+            (long long)len * (long long)(2 * sizeof(PetscInt) + sizeof(PetscScalar));
+      }
     }
   }
   FCM_TRY(ctx, newton_agree(P, st));
@@ -1895,6 +1929,14 @@ static fcm_status newton_build(fcm_petsc_problem *P, fcm_status st, const fcm_sp
   P->mesh = fcm_space_mesh(space);
   st = own_active_cells(P);
   if (st == FCM_OK) st = number_dofs(P);
+  if (st == FCM_OK) { /* the integrator's copy of the ownership (fcm__sim_backend.owned) */
+    P->owned_dof = fcm__calloc(ctx, (size_t)P->n + 1, 1);
+    if (!P->owned_dof)
+      st = fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
+                      "petsc: out of memory (%lld owned flags)", (long long)P->n);
+    for (fcm_index d = 0; st == FCM_OK && d < P->n; d++)
+      P->owned_dof[d] = P->copy_owner[d / 3] == P->rank;
+  }
   FCM_TRY(ctx, newton_agree(P, st));
   FCM_TRY(ctx, newton_agree(P, check_topology(P)));
   st = create_matrix(P, &P->S);
@@ -1946,8 +1988,10 @@ static void newton_unbuild(fcm_petsc_problem *P)
   VecScatterDestroy(&P->to_all);
   fcm__free(ctx, P->copy_owner);
   fcm__free(ctx, P->perm);
+  fcm__free(ctx, P->owned_dof);
   P->copy_owner = NULL;
   P->perm = NULL;
+  P->owned_dof = NULL;
   P->n = P->ncopy = 0;
   P->nlocal = P->first = 0;
 }
@@ -1964,6 +2008,7 @@ static void newton_backend(fcm_petsc_problem *P, fcm__sim_backend *b)
   b->root = P->rank == 0;
   b->rank = P->rank;
   b->nprocs = P->size;
+  b->owned = P->owned_dof;
   b->reduce = newton_reduce;
   b->factor = newton_factor;
   b->solve = newton_solve;
