@@ -307,6 +307,8 @@ typedef struct fcm_petsc_traffic {
   long long reduces;            /**< dense sums */
   long long reduce_values;      /**< doubles this process handed to them */
   long long reduce_bytes;       /**< 8 per value (sent to the reduce; as many come back) */
+  long long reduce_large;       /**< sums of more values than the space has DOFs (a matrix:
+                                     the mass matrix at setup; none in the steps) */
   long long matrices;           /**< Newton matrices given to the backend (factorizations) */
   long long matrix_values_local; /**< entries added to rows this process owns */
   long long matrix_values_sent;  /**< entries added to other processes' rows (stash) */

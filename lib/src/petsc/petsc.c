@@ -62,17 +62,36 @@
  * - masked rules now also give OTHER processes' UNCUT cells no points in the assembly and in
  *   fcm_space_momentum() (fcm__cell_rules_owns(), embed_impl.h; lib/src/fem/assemble.c): before,
  *   only cut cells were masked (the linear driver never noticed: it loops over own elements).
- * - the integrator sums after each assembly: mass matrix and loads (setup, so M and fext are
- *   global), energy + force + tangent in evaluate() and assemble_tangent() (the base
- *   M/h^2 + D/h is added on the root only), the damping tangent, the representative force,
+ * - the integrator sums after each assembly (dense, newton_reduce()): the mass matrix (nnz
+ *   doubles, once at setup) and the loads (so M and fext are global), energy + force in
+ *   evaluate(), the damping matrix's product D (x - u_n) there, the representative force,
  *   fcm_integrator_energy(), the boundary reactions, the boundary point counts (nitsche.c),
- *   and the log's mass and momentum (run.c). A non-finite value on any process counts as one
- *   everywhere; every reduce starts with fcm__petsc_agree(), so a process that fails outside a
- * reduce ends with one fcm__petsc_agree() and meets the others wherever they wait (no hang).
+ *   and the log's mass and momentum (run.c); n doubles per sum at most in the steps. A
+ *   non-finite value on any process counts as one everywhere; every reduce starts with
+ *   fcm__petsc_agree(), so a process that fails outside a reduce ends with one
+ *   fcm__petsc_agree() and meets the others wherever they wait (no hang).
  * - sums: MPI_Reduce to process 0 + MPI_Bcast (the same bits everywhere for any count).
- * - solve: owned rows of the (already eliminated, summed) Newton matrix into a MATMPIAIJ with
- *   INSERT_VALUES, KSP: MUMPS Cholesky/LU when the scene says "direct", else CG/MINRES + GAMG
- *   (psd flag of the integrator); -ksp_type / -pc_type keep the user's choice. KSP divergence
+ * - the Newton matrix is NOT summed densely (since session 7, task i14-sparse): each process
+ *   keeps its PARTIAL matrix (its cells' tangent and boundary terms; the base M/h^2 on the
+ *   rows it owns, fcm__sim_backend.owned; D/h of its partial damping matrix D, whose
+ *   alpha_M M part is on its owned rows too), eliminates the active constraints in it
+ *   (newton.c eliminate_partial(): rows and columns zeroed; the lift H_fc inc_c and the
+ *   constrained diagonal summed as vectors, n doubles with a predictor, nact without; the
+ *   diagonal, the summed one or 1 as fcm__eliminate_marked() takes it, on the owner's row;
+ *   the linear reuse path sums H0 inc as an n-vector), and newton_factor() adds it into the
+ *   MATMPIAIJ (MatZeroEntries, then MatSetValues ADD_VALUES per CSR row, all-zero rows
+ *   skipped, off-process rows through PETSc's stash, MatAssembly). Nothing there needs the
+ *   same pattern on every process (each process's matrix needs the entries its cells touch and
+ *   the diagonal of its owned DOFs). Determinism: the owner's value comes first, then the
+ *   stash's in the order its messages are processed (MatStashScatterGetMesg_BTS: MPI_Waitsome,
+ *   arrival order); on 2 processes an entry has at most one sender (same bits every run, the
+ *   resume tests hold), on 3+ an entry touched by two other processes may be summed in
+ *   another order between runs (round-off; not tested: the machine has 2 cores). Traffic
+ *   counters: fcm_petsc_simulation_traffic() (also a "comm" line of the summary);
+ *   tests/petsc/newton.c asserts that no sum in the steps is longer than n and that fewer
+ *   values than nnz are summed per Newton matrix.
+ * - solve: KSP: MUMPS Cholesky/LU when the scene says "direct", else CG/MINRES + GAMG (psd
+ *   flag of the integrator); -ksp_type / -pc_type keep the user's choice. KSP divergence
  *   is a soft failure (the integrator halves the step). Direction gathered with a cached
  *   VecScatterCreateToAll.
  * - fcm-sim --backend petsc routes scenes fcm_petsc_problem_supports_scene() rejects to it
@@ -132,10 +151,13 @@
  *   the same matrix differ at ~1e-16 (12 of 12 runs bitwise with CG + GAMG, CG + Jacobi and
  *   -pc_type redundant; 10 of 12 differing with MUMPS Cholesky or LU, with or without
  *   OMP/OpenBLAS threads). The test holds the default solver to bit for bit, MUMPS to 1e-12.
- * - scalability of phase 2: the sums are dense (n doubles per force, nnz doubles per tangent,
- *   per process); next: add each process's partial tangent into the MATMPIAIJ with ADD_VALUES
- *   (own elements only; the eliminated rows' diagonal by the owner), sum the force only on
- *   owned rows (VecScatter of ghosts), keep the line search's scalars as Allreduce.
+ * - scalability of phase 2: the tangent goes through ADD_VALUES now (above), but the vectors
+ *   are still dense sums of n doubles per process (the force per evaluation, D (x - u_n), the
+ *   elimination's lift per predictor, the loads), the mass matrix is summed densely once at
+ *   setup (nnz doubles), the state is replicated and newton_solve() gathers the direction on
+ *   every process (VecScatterCreateToAll, n doubles), and newton_factor() scans the whole
+ *   replicated pattern (O(nnz) local work per matrix, no communication). Next: sum the force
+ *   on owned rows only (ghost scatter), with the local + ghost space of i14-ghost.
  * - cuts keep the partition made at the start (the pieces of a split cell belong to its
  *   owner; cut-heavy regions are not rebalanced) and the cut's classification of every cell
  *   runs on every process (replicated; the first build's is distributed, see above); the cut-cell
@@ -1701,6 +1723,7 @@ static fcm_status newton_reduce(void *user, fcm_status st, double *values, fcm_i
   P->traffic.reduces++;
   P->traffic.reduce_values += (long long)count;
   P->traffic.reduce_bytes += (long long)count * (long long)sizeof(double);
+  P->traffic.reduce_large += P->n > 0 && count > P->n; /* the rules build: no space yet */
   for (fcm_index k = 0; k < count;) {
     const int m = count - k > (1 << 26) ? (1 << 26) : (int)(count - k);
     int rc = MPI_Reduce(P->rank == 0 ? MPI_IN_PLACE : values + k, values + k, m, MPI_DOUBLE,

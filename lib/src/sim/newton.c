@@ -91,24 +91,30 @@ static fcm_status assemble_boundary(fcm_integrator *I, const double *x, int proj
   return st;
 }
 
-/* The base of the Newton matrix into H before the tangent is added: with a backend
- * (sim_backend.h) on the rows this process owns only (H stays this process's partial matrix;
- * the backend adds the processes' matrices). */
+/* The base of the Newton matrix into H before the tangent is added. With a backend
+ * (sim_backend.h) H stays this process's partial matrix (the backend adds the processes'
+ * matrices): M/h^2 (M is summed) on the rows this process owns, and D/h everywhere (D is this
+ * process's partial damping matrix, update_damping()). */
 static void tangent_base(fcm_integrator *I, double h)
 {
-  fcm__sim_set_base(I, h, I->H);
-  if (!I->has_backend || h == 0.0) return;
+  if (!I->has_backend || h == 0.0) {
+    fcm__sim_set_base(I, h, I->H);
+    return;
+  }
   const fcm_index *rp = fcm_csr_row_ptr(I->H);
   double *v = fcm_csr_values(I->H);
+  const double *mv = fcm_csr_values_read(I->M), *dv = I->D ? fcm_csr_values_read(I->D) : NULL;
+  const double a = 1.0 / (h * h);
   for (fcm_index i = 0; i < I->n; i++)
-    if (!I->owned[i]) memset(v + rp[i], 0, sizeof *v * (size_t)(rp[i + 1] - rp[i]));
+    for (fcm_index e = rp[i]; e < rp[i + 1]; e++)
+      v[e] = (I->owned[i] ? a * mv[e] : 0.0) + (dv ? dv[e] / h : 0.0);
 }
 
-/* With a backend: agree on st and on *finite, and sum the scalars, fint and T over the
- * processes (every process then holds the same global values). T: the damping matrix only
- * (the Newton matrix stays partial, sim_backend.h). */
+/* With a backend: agree on st and on *finite, and sum the scalars and fint over the processes
+ * (every process then holds the same global values); the matrices stay partial
+ * (sim_backend.h). */
 static fcm_status reduce_eval(fcm_integrator *I, fcm_status st, double *scalars, int ns,
-                              double *fint, fcm_csr *T, int *finite, sim_stats *stats)
+                              double *fint, int *finite, sim_stats *stats)
 {
   if (!I->has_backend) return st;
   double s[4] = {0, 0, 0, 0}; /* up to 3 scalars, then the count of non-finite processes */
@@ -117,7 +123,7 @@ static fcm_status reduce_eval(fcm_integrator *I, fcm_status st, double *scalars,
   s[ns] = *finite ? 0.0 : 1.0;
   double t0 = fcm_wtime();
   st = fcm__sim_reduce(I, st, s, ns + 1, NULL, NULL);
-  if (st == FCM_OK && s[ns] == 0.0) st = fcm__sim_reduce(I, FCM_OK, NULL, 0, fint, T);
+  if (st == FCM_OK && s[ns] == 0.0 && fint) st = fcm__sim_reduce(I, FCM_OK, NULL, 0, fint, NULL);
   stats->time_assembly += fcm_wtime() - t0;
   if (st != FCM_OK) return st;
   *finite = s[ns] == 0.0;
@@ -135,7 +141,7 @@ static fcm_status assemble_tangent(fcm_integrator *I, double h, const double *x,
   st = assemble(I, projected ? &I->params_psd : &I->params, x, NULL, NULL, I->H, finite, stats);
   if (st == FCM_OK && *finite)
     st = assemble_boundary(I, x, projected, NULL, NULL, I->H, finite, stats);
-  FCM_TRY(I->ctx, reduce_eval(I, st, NULL, 0, NULL, NULL, finite, stats));
+  FCM_TRY(I->ctx, reduce_eval(I, st, NULL, 0, NULL, finite, stats));
 cleanup:
   return st;
 }
@@ -162,7 +168,7 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
     st = assemble_boundary(I, x, 0, &bnd, fint, tangent ? I->H : NULL, &out->finite, stats);
   {
     double parts[2] = {psi, bnd};
-    FCM_TRY(I->ctx, reduce_eval(I, st, parts, 2, fint, NULL, &out->finite, stats));
+    FCM_TRY(I->ctx, reduce_eval(I, st, parts, 2, fint, &out->finite, stats));
     psi = parts[0];
     bnd = parts[1];
   }
@@ -183,6 +189,8 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
         for (fcm_index i = 0; i < n; i++)
           I->w1[i] = x[i] - I->un[i];
         FCM_TRY(I->ctx, fcm_csr_apply(I->D, 1.0, I->w1, 0.0, I->w2));
+        /* with a backend D is this process's partial matrix: sum the product (n doubles) */
+        FCM_TRY(I->ctx, fcm__integrator_reduce(I, I->w2, n));
         damp = 0.5 / h * dot(n, I->w1, I->w2);
         for (fcm_index i = 0; i < n; i++)
           g[i] += I->w2[i] / h;
@@ -563,7 +571,10 @@ cleanup:
   return st;
 }
 
-/* D = alpha_M M + beta_K K+(u_n) (projected tangent at the start of the substep). */
+/* D = alpha_M M + beta_K K+(u_n) (projected tangent at the start of the substep). With a
+ * backend (sim_backend.h) D is this process's PARTIAL damping matrix, not summed: its cells'
+ * K+ and alpha_M M (M is summed) on the rows it owns; the processes' D sum to the serial one
+ * (evaluate() sums its products, the Newton matrix's base adds it partially). */
 static fcm_status update_damping(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
 {
   fcm_status st = FCM_OK;
@@ -576,14 +587,23 @@ static fcm_status update_damping(fcm_integrator *I, fcm_step_reason *reason, sim
   fcm_csr_set_zero(I->D);
   if (o->rayleigh_stiffness > 0.0) {
     st = assemble(I, &I->params_psd, I->un, NULL, NULL, I->D, &finite, stats);
-    FCM_TRY(I->ctx, reduce_eval(I, st, NULL, 0, NULL, I->D, &finite, stats));
+    FCM_TRY(I->ctx, reduce_eval(I, st, NULL, 0, NULL, &finite, stats));
     if (!finite) {
       *reason = FCM_STEP_NONFINITE;
       return FCM_OK;
     }
   }
-  for (fcm_index e = 0; e < nnz; e++)
-    dv[e] = o->rayleigh_stiffness * dv[e] + o->rayleigh_mass * mv[e];
+  if (I->has_backend) {
+    const fcm_index *rp = fcm_csr_row_ptr(I->D);
+    for (fcm_index i = 0; i < I->n; i++) {
+      const double am = I->owned[i] ? o->rayleigh_mass : 0.0;
+      for (fcm_index e = rp[i]; e < rp[i + 1]; e++)
+        dv[e] = o->rayleigh_stiffness * dv[e] + am * mv[e];
+    }
+  } else {
+    for (fcm_index e = 0; e < nnz; e++)
+      dv[e] = o->rayleigh_stiffness * dv[e] + o->rayleigh_mass * mv[e];
+  }
   I->damp_version++;
   if (!I->linear) I->h_state = SIM_H_INVALID;
 cleanup:
