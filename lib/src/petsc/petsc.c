@@ -89,7 +89,11 @@
  *   another order between runs (round-off; not tested: the machine has 2 cores). Traffic
  *   counters: fcm_petsc_simulation_traffic() (also a "comm" line of the summary);
  *   tests/petsc/newton.c asserts that no sum in the steps is longer than n and that fewer
- *   values than nnz are summed per Newton matrix.
+ *   values than nnz are summed per Newton matrix. Measured (clamped_surface at 16^3 cells,
+ *   6597 DOFs, 2 processes, --steps 3 minus --steps 1 = 4 Newton matrices): dense sums per
+ *   Newton matrix and process 7.2 MB before, 0.16 MB after (3 n-vectors), plus 0.67 MB stash
+ *   from process 1 (process 0 sends none: it owns the shared DOFs); CPU in the sums ~0.036 s
+ *   per matrix both ways (waiting in the agreement dominates at this size).
  * - solve: KSP: MUMPS Cholesky/LU when the scene says "direct", else CG/MINRES + GAMG (psd
  *   flag of the integrator); -ksp_type / -pc_type keep the user's choice. KSP divergence
  *   is a soft failure (the integrator halves the step). Direction gathered with a cached
