@@ -4,12 +4,14 @@
  * cells only, so every assembly (mass, loads, energy, force, tangent, boundary terms) is the
  * process's partial sum. With a backend set:
  * - the integrator sums the partial scalars and vectors over the processes right after each
- *   assembly (reduce: energies, the internal force, the loads; n doubles at most, plus the
- *   mass matrix once at setup and the damping matrix once per substep), so the Newton loop,
+ *   assembly (reduce: energies, the internal force, the loads, the damping matrix's product;
+ *   n doubles at most, plus the mass matrix once at setup), so the Newton loop,
  *   line search, stopping rules, reactions and energies see the global values and every
  *   process takes the same decisions;
  * - the Newton matrix is NOT summed: each process keeps its PARTIAL matrix (its cells'
- *   tangent, plus the base M/h^2 + D/h on the rows it owns), eliminates the constrained DOFs
+ *   tangent and partial damping matrix D/h, plus M/h^2 on the rows it owns: its share of the
+ *   base M/h^2 + D/h; D = alpha_M M + beta_K K+ is partial the same way, alpha_M M on the
+ *   owned rows), eliminates the constrained DOFs
  *   in it (their rows and columns zeroed; the diagonal, from the summed tangent's diagonal,
  *   on the owned rows only; the right-hand side's lift H_fc inc_c summed as an n-vector) and
  *   hands it to the backend (factor), which adds the partial matrices of all processes into
@@ -26,16 +28,17 @@
 typedef struct fcm__sim_backend fcm__sim_backend;
 struct fcm__sim_backend {
   void *user;
-  /* 1 on exactly one process: the terms that are no partial sums (the base M/h^2 + D/h of the
-   * Newton matrix, from the already summed M and D) are added there only */
+  /* 1 on exactly one process: the replicated terms of a summed quantity that every process
+   * would otherwise count (fcm__integrator_distributed(); e.g. the run summary's uncut-cell
+   * points) are counted there only */
   int root;
   /* This process's number (0 .. nprocs-1) and the process count: the pieces of a parallel
    * frame (fcm_simulation_write_frame()) are named by them. */
   int rank, nprocs;
   /* n (the space's DOFs): 1 on the DOFs whose rows of the distributed Newton matrix this
    * process owns (every DOF on exactly one process): the terms of the Newton matrix that are
-   * no partial sums (the base M/h^2 + D/h from the summed M and D, the eliminated rows'
-   * diagonal) are put on those rows only. Required; fcm__integrator_set_backend() copies it. */
+   * no partial sums (the base M/h^2 from the summed M, the damping matrix's alpha_M M, the
+   * eliminated rows' diagonal) are put on those rows only. Required; fcm__integrator_set_backend() copies it. */
   const unsigned char *owned;
   /* Agree on st over the processes (on a failure anywhere every process returns the status
    * and message of the first failing one), then sum values[0 .. count) over the processes in
