@@ -11,7 +11,10 @@
  *   halves the step, then fails with FCM_ERR_NOT_CONVERGED (linear-solver-failed) on every
  *   process;
  * - a cut between steps that fails on one process only (its cut surface file broken after the
- *   create): the step of the cut fails on every process, the others naming the failing one. */
+ *   create): the step of the cut fails on every process, the others naming the failing one;
+ * - resuming a run with a cut from a checkpoint the last process cannot read (truncated), and
+ *   from checkpoints that differ in their cuts between the processes: every process fails
+ *   before the cut replay (collective), no hang. */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
@@ -154,6 +157,57 @@ int main(int argc, char **argv)
   }
   fcm_simulation_destroy(&sim);
   fcm_scene_destroy(&scene);
+
+  /* 5. resume a run with a cut: checkpoints before (step 1) and after the cut (step 2) */
+  char ck0[128], ck1[128];
+  snprintf(ck0, sizeof ck0, "/tmp/fcm-petsc-newton-failure-%ld-%d-0.fcmck", (long)getpid(), rank);
+  snprintf(ck1, sizeof ck1, "/tmp/fcm-petsc-newton-failure-%ld-%d-1.fcmck", (long)getpid(), rank);
+  if ((f = fopen(obj, "w")) != NULL) { /* case 4 broke it on the last process */
+    fputs("v 0.05 -1 -1\nv 0.05 1 -1\nv 0.05 1 1\nv 0.05 -1 1\nf 1 2 3\nf 1 3 4\n", f);
+    fclose(f);
+  }
+  TEST_OK(ctx, fcm_scene_create_from_string(ctx, scene_text(text, sizeof text, "", cut, ""), NULL,
+                                            &scene));
+  TEST_OK(ctx, fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO,
+                                           NULL, &sim));
+  TEST_OK(ctx, fcm_simulation_step(sim, &si));
+  TEST_OK(ctx, fcm_simulation_write_checkpoint(sim, ck0));
+  TEST_OK(ctx, fcm_simulation_step(sim, &si)); /* the cut, then the step */
+  TEST_OK(ctx, fcm_simulation_write_checkpoint(sim, ck1));
+  fcm_simulation_destroy(&sim);
+  /* 5a. the whole file resumes on every process (the cut replayed) */
+  TEST_OK(ctx, fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO,
+                                           NULL, &sim));
+  TEST_OK(ctx, fcm_simulation_read_checkpoint(sim, ck1));
+  TEST_OK(ctx, fcm_simulation_step(sim, &si));
+  fcm_simulation_destroy(&sim);
+  /* 5b. the last process's file is truncated; 5c. it is the one from before the cut */
+  for (int c = 0; c < 2; c++) {
+    if (rank == size - 1) {
+      if (c == 0 && truncate(ck1, 64) != 0) TEST_TRUE(0);
+      if (c == 1) TEST_TRUE(rename(ck0, ck1) == 0);
+    }
+    MPI_Barrier(MPI_COMM_WORLD);
+    TEST_OK(ctx, fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO,
+                                             NULL, &sim));
+    s = fcm_simulation_read_checkpoint(sim, ck1);
+    TEST_TRUE(s != FCM_OK || size == 1);
+    if (size > 1 && c == 0 && rank != size - 1) {
+      char want[64];
+      snprintf(want, sizeof want, "process %d of %d failed", size - 1, size);
+      TEST_TRUE(strstr(fcm_ctx_error_message(ctx), want) != NULL);
+    }
+    if (size > 1 && c == 1)
+      TEST_TRUE(strstr(fcm_ctx_error_message(ctx), "different numbers of cuts") != NULL);
+    if (size == 1 && c == 0) TEST_TRUE(s == FCM_ERR_FORMAT);
+    if (getenv("FCM_TEST_VERBOSE"))
+      fprintf(stderr, "rank %d: case 5%c: %s\n", rank, 'b' + c, fcm_ctx_error_message(ctx));
+    fcm_ctx_error_clear(ctx);
+    fcm_simulation_destroy(&sim);
+  }
+  fcm_scene_destroy(&scene);
+  remove(ck0);
+  remove(ck1);
   remove(obj);
 
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);

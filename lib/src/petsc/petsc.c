@@ -142,11 +142,12 @@
  *   carries the prefix (both drivers). The prefixed entries stay in
  *   the database after the problem (harmless: no later problem has that prefix; PETSc's
  *   -options_left would list the unused ones). tests/petsc/options.c.
+ * - resuming a run with cuts: fcm_simulation_read_checkpoint() (scene/checkpoint.c) reads the
+ *   file, then the processes agree on the read and on the number of cuts
+ *   (fcm__integrator_reduce_status()) before the cut replay, which is collective; before
+ *   (session 6) a file one process could not read left the others waiting in the replay's
+ *   newton_cut() (tests/petsc/newton_failure.c case 5).
  * Not done:
- * - resuming a run with cuts from a checkpoint one process cannot read may hang:
- *   fcm_simulation_read_checkpoint() (scene/checkpoint.c) replays the cuts (collective:
- *   newton_cut() agrees) before any agreement on the read; next: agree on the read's status
- *   with fcm__integrator_reduce_status() before the replay (found by review, session 6).
  * - bit-identical resume: PT-Scotch's partition of the same scene on 2 processes differs
  *   between runs now and then (131/133 or 132/132 own elements of slingshot, although
  *   scotch_random_reset() runs before it), hence the Morton default. The round-off differences

@@ -20,6 +20,7 @@
 
 #include "core/core_impl.h"
 #include "io/io_impl.h"
+#include "sim/sim_backend.h"
 
 #include <errno.h>
 #include <math.h>
@@ -222,22 +223,31 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
+/* What a checkpoint file holds, read and checked against the simulation (not applied yet). */
+typedef struct ckpt_data {
+  long long n, steps, frames, rows, cuts, newton, linear, tangents;
+  double t;
+  double *u, *v, *frame_time, *react;
+  fcm__log_row *log;
+  long long frame_cap, log_cap, react_cap;
+} ckpt_data;
+
+static void ckpt_data_free(fcm_ctx *ctx, ckpt_data *d)
+{
+  fcm__free(ctx, d->u);
+  fcm__free(ctx, d->v);
+  fcm__free(ctx, d->frame_time);
+  fcm__free(ctx, d->log);
+  fcm__free(ctx, d->react);
+}
+
+/* Read and check the whole file `path` into *d (local: no process talks to another). */
+static fcm_status read_file(fcm_simulation *S, const char *path, ckpt_data *d)
 {
   fcm_status st = FCM_OK;
-  unsigned char *data = NULL;
-  double *u = NULL, *v = NULL, *frame_time = NULL;
-  fcm__log_row *log = NULL;
-  double *react = NULL;
-  long long frame_cap = 0, log_cap = 0, react_cap = 0;
-  const size_t nreact = S ? 6 * (size_t)S->num_react : 0;
-  FCM_CHECK(S && path && path[0], S ? S->ctx : NULL, FCM_ERR_ARG,
-            "simulation: read_checkpoint needs a simulation and a path");
   fcm_ctx *ctx = S->ctx;
-  FCM_CHECK(S->c.steps == 0 && S->c.frames == 0 && !S->restored, ctx, FCM_ERR_ARG,
-            "checkpoint %s: restore into a new simulation (this one has taken %lld steps and "
-            "written %lld frames)",
-            path, S->c.steps, S->c.frames);
+  unsigned char *data = NULL;
+  const size_t nreact = 6 * (size_t)S->num_react;
   size_t size = 0;
   uint64_t ver = 0;
   FCM_TRY(ctx, fcm__file_read_all(ctx, "checkpoint", path, CKPT_MAX_BYTES, (char **)&data, &size));
@@ -266,41 +276,42 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
               "(only the time span and the output section may change)",
               path, fcm_scene_name(S->scene));
   }
-  long long n = 0, steps = 0, frames = 0, rows = 0, cuts = 0;
-  long long newton = 0, linear = 0, tangents = 0;
-  double t = 0.0;
-  FCM_TRY(ctx, get_i64(&r, &n, 0, INT64_MAX, "num_dofs"));
-  FCM_TRY(ctx, get_i64(&r, &steps, 0, INT64_MAX, "steps"));
-  FCM_CHECK(steps <= S->num_steps, ctx, FCM_ERR_ARG,
+  FCM_TRY(ctx, get_i64(&r, &d->n, 0, INT64_MAX, "num_dofs"));
+  FCM_TRY(ctx, get_i64(&r, &d->steps, 0, INT64_MAX, "steps"));
+  FCM_CHECK(d->steps <= S->num_steps, ctx, FCM_ERR_ARG,
             "checkpoint %s: step %lld is beyond the %lld steps this run takes (extend "
             "time.duration or --steps)",
-            path, steps, S->num_steps);
-  FCM_TRY(ctx, get(&r, &t, sizeof t, "time"));
-  if (ver >= 2) FCM_TRY(ctx, get_i64(&r, &cuts, S->cuts_applied, S->num_cuts, "cuts applied"));
-  FCM_TRY(ctx, get_i64(&r, &newton, 0, INT64_MAX, "newton_iterations"));
-  FCM_TRY(ctx, get_i64(&r, &linear, 0, INT64_MAX, "linear_iterations"));
-  FCM_TRY(ctx, get_i64(&r, &tangents, 0, INT64_MAX, "tangent_assemblies"));
-  FCM_TRY(ctx, get_i64(&r, &frames, 0, steps + 1, "frames"));
-  FCM_TRY(ctx, need(&r, frames, sizeof *frame_time, "frame times"));
-  if (frames > 0) {
-    FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&frame_time, &frame_cap, frames, sizeof *frame_time));
-    FCM_TRY(ctx, get(&r, frame_time, sizeof *frame_time * (size_t)frames, "the frame times"));
+            path, d->steps, S->num_steps);
+  FCM_TRY(ctx, get(&r, &d->t, sizeof d->t, "time"));
+  if (ver >= 2) FCM_TRY(ctx, get_i64(&r, &d->cuts, S->cuts_applied, S->num_cuts, "cuts applied"));
+  FCM_TRY(ctx, get_i64(&r, &d->newton, 0, INT64_MAX, "newton_iterations"));
+  FCM_TRY(ctx, get_i64(&r, &d->linear, 0, INT64_MAX, "linear_iterations"));
+  FCM_TRY(ctx, get_i64(&r, &d->tangents, 0, INT64_MAX, "tangent_assemblies"));
+  FCM_TRY(ctx, get_i64(&r, &d->frames, 0, d->steps + 1, "frames"));
+  FCM_TRY(ctx, need(&r, d->frames, sizeof *d->frame_time, "frame times"));
+  if (d->frames > 0) {
+    FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&d->frame_time, &d->frame_cap, d->frames,
+                               sizeof *d->frame_time));
+    FCM_TRY(ctx,
+            get(&r, d->frame_time, sizeof *d->frame_time * (size_t)d->frames, "the frame times"));
   }
-  FCM_TRY(ctx, get_i64(&r, &rows, steps, steps, "log rows (one per step)"));
+  FCM_TRY(ctx, get_i64(&r, &d->rows, d->steps, d->steps, "log rows (one per step)"));
   const size_t row_bytes =
       ver >= 2 ? (8 + (ver >= 3 ? nreact : 0)) * sizeof(double) + 3 * sizeof(int64_t)
                : 4 * sizeof(double) + 2 * sizeof(int64_t);
-  FCM_TRY(ctx, need(&r, rows, row_bytes, "log rows"));
-  if (rows > 0) FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&log, &log_cap, rows, sizeof *log));
-  if (rows > 0 && nreact > 0)
-    FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&react, &react_cap, rows, nreact * sizeof *react));
-  for (long long k = 0; k < rows; k++) {
-    fcm__log_row *w = &log[k];
-    double d[4];
+  FCM_TRY(ctx, need(&r, d->rows, row_bytes, "log rows"));
+  if (d->rows > 0)
+    FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&d->log, &d->log_cap, d->rows, sizeof *d->log));
+  if (d->rows > 0 && nreact > 0)
+    FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&d->react, &d->react_cap, d->rows,
+                               nreact * sizeof *d->react));
+  for (long long k = 0; k < d->rows; k++) {
+    fcm__log_row *w = &d->log[k];
+    double x[4];
     int64_t i[2];
-    FCM_TRY(ctx, get(&r, d, sizeof d, "a log row"));
+    FCM_TRY(ctx, get(&r, x, sizeof x, "a log row"));
     FCM_TRY(ctx, get(&r, i, sizeof i, "a log row"));
-    w->time = d[0], w->residual = d[1], w->energy = d[2], w->wall = d[3];
+    w->time = x[0], w->residual = x[1], w->energy = x[2], w->wall = x[3];
     w->newton = (long long)i[0], w->linear = (long long)i[1];
     if (ver >= 2) {
       int64_t pc;
@@ -311,50 +322,76 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
       memcpy(w->momentum, e + 1, 3 * sizeof *e);
     }
     if (nreact > 0 && ver >= 3) {
-      FCM_TRY(ctx, get(&r, react + (size_t)k * nreact, nreact * sizeof *react, "a log row"));
+      FCM_TRY(ctx, get(&r, d->react + (size_t)k * nreact, nreact * sizeof *d->react, "a log row"));
     } else {
       for (size_t j = 0; j < nreact; j++) /* not recorded by that version */
-        react[(size_t)k * nreact + j] = NAN;
+        d->react[(size_t)k * nreact + j] = NAN;
     }
   }
-  FCM_TRY(ctx, need(&r, n, 2 * sizeof(double), "displacement and velocity values"));
-  FCM_ALLOC(ctx, n, u);
-  FCM_ALLOC(ctx, n, v);
-  FCM_TRY(ctx, get(&r, u, sizeof *u * (size_t)n, "the displacement"));
-  FCM_TRY(ctx, get(&r, v, sizeof *v * (size_t)n, "the velocity"));
+  FCM_TRY(ctx, need(&r, d->n, 2 * sizeof(double), "displacement and velocity values"));
+  FCM_ALLOC(ctx, d->n, d->u);
+  FCM_ALLOC(ctx, d->n, d->v);
+  FCM_TRY(ctx, get(&r, d->u, sizeof *d->u * (size_t)d->n, "the displacement"));
+  FCM_TRY(ctx, get(&r, d->v, sizeof *d->v * (size_t)d->n, "the velocity"));
   FCM_CHECK(r.pos == r.size, ctx, FCM_ERR_FORMAT, "checkpoint %s: %zu unexpected trailing bytes",
             path, r.size - r.pos);
+cleanup:
+  fcm__free(ctx, data);
+  return st;
+}
+
+fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
+{
+  fcm_status st = FCM_OK;
+  ckpt_data d;
+  memset(&d, 0, sizeof d);
+  FCM_CHECK(S && path && path[0], S ? S->ctx : NULL, FCM_ERR_ARG,
+            "simulation: read_checkpoint needs a simulation and a path");
+  fcm_ctx *ctx = S->ctx;
+  FCM_CHECK(S->c.steps == 0 && S->c.frames == 0 && !S->restored, ctx, FCM_ERR_ARG,
+            "checkpoint %s: restore into a new simulation (this one has taken %lld steps and "
+            "written %lld frames)",
+            path, S->c.steps, S->c.frames);
+  st = read_file(S, path, &d);
+  /* On a distributed backend (sim_backend.h) the cut replay below is collective: the
+   * processes agree on the read first (a file one process cannot read fails every process
+   * with its message, no process waits in a cut the others never start) and on the number
+   * of cuts to replay (files that differ between the processes are refused). */
+  if (fcm__integrator_distributed(S->integ, NULL)) {
+    int rank = 0, nprocs = 1;
+    fcm__integrator_processes(S->integ, &rank, &nprocs);
+    double c[2] = {(double)d.cuts, 1.0};
+    FCM_TRY(ctx, fcm__integrator_reduce_status(S->integ, st, c, 2));
+    FCM_CHECK(c[0] == (double)d.cuts * c[1], ctx, FCM_ERR_ARG,
+              "checkpoint %s: the processes read different numbers of cuts (this one %lld, "
+              "%g in all over %d processes): every process must read the same file",
+              path, d.cuts, c[0], nprocs);
+  }
+  FCM_TRY(ctx, st);
   /* The file is whole: re-apply the cuts it had (the state lives on the cut space). */
-  while (S->cuts_applied < cuts)
+  while (S->cuts_applied < d.cuts)
     FCM_TRY(ctx, fcm__sim_apply_cut(S));
   {
     const fcm_index ndof = fcm_integrator_num_dofs(S->integ);
-    FCM_CHECK(n == ndof, ctx, FCM_ERR_ARG, "checkpoint %s: %lld DOFs, the simulation has %lld",
-              path, n, (long long)ndof);
+    FCM_CHECK(d.n == ndof, ctx, FCM_ERR_ARG, "checkpoint %s: %lld DOFs, the simulation has %lld",
+              path, d.n, (long long)ndof);
   }
   /* Everything read and checked: apply (set_state validates finiteness first). */
-  FCM_TRY(ctx, fcm_integrator_set_state(S->integ, u, v, t, steps));
-  S->c.steps = steps;
-  S->c.newton_iterations = newton;
-  S->c.linear_iterations = linear;
-  S->c.tangent_assemblies = tangents;
-  S->c.frames = frames;
+  FCM_TRY(ctx, fcm_integrator_set_state(S->integ, d.u, d.v, d.t, d.steps));
+  S->c.steps = d.steps;
+  S->c.newton_iterations = d.newton;
+  S->c.linear_iterations = d.linear;
+  S->c.tangent_assemblies = d.tangents;
+  S->c.frames = d.frames;
   fcm__free(ctx, S->frame_time);
-  S->frame_time = frame_time, S->frame_cap = frame_cap, frame_time = NULL;
+  S->frame_time = d.frame_time, S->frame_cap = d.frame_cap, d.frame_time = NULL;
   fcm__free(ctx, S->log);
-  S->log = log, S->log_cap = log_cap, S->log_n = rows, log = NULL;
+  S->log = d.log, S->log_cap = d.log_cap, S->log_n = d.rows, d.log = NULL;
   fcm__free(ctx, S->react_log);
-  S->react_log = react, S->react_cap = react_cap, react = NULL;
+  S->react_log = d.react, S->react_cap = d.react_cap, d.react = NULL;
   S->restored = 1;
 cleanup:
-  if (S) {
-    fcm__free(S->ctx, data);
-    fcm__free(S->ctx, u);
-    fcm__free(S->ctx, v);
-    fcm__free(S->ctx, frame_time);
-    fcm__free(S->ctx, log);
-    fcm__free(S->ctx, react);
-  }
+  if (S) ckpt_data_free(S->ctx, &d);
   return st;
 }
 
