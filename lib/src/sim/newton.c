@@ -188,9 +188,9 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
       if (I->D) {
         for (fcm_index i = 0; i < n; i++)
           I->w1[i] = x[i] - I->un[i];
-        FCM_TRY(I->ctx, fcm_csr_apply(I->D, 1.0, I->w1, 0.0, I->w2));
         /* with a backend D is this process's partial matrix: sum the product (n doubles) */
-        FCM_TRY(I->ctx, fcm__integrator_reduce(I, I->w2, n));
+        st = fcm_csr_apply(I->D, 1.0, I->w1, 0.0, I->w2);
+        FCM_TRY(I->ctx, fcm__integrator_reduce_status(I, st, I->w2, n));
         damp = 0.5 / h * dot(n, I->w1, I->w2);
         for (fcm_index i = 0; i < n; i++)
           g[i] += I->w2[i] / h;
@@ -310,9 +310,9 @@ static fcm_status build_system(fcm_integrator *I, double h, int predictor, int p
       memset(I->w1, 0, sizeof *I->w1 * (size_t)n);
       for (fcm_index j = 0; j < I->nact; j++)
         I->w1[I->act_dof[j]] = I->act_inc[j];
-      FCM_TRY(I->ctx, fcm_csr_apply(I->H0, 1.0, I->w1, 0.0, I->w2));
       /* with a backend H0 is this process's partial matrix: sum the product */
-      FCM_TRY(I->ctx, fcm__integrator_reduce(I, I->w2, n));
+      st = fcm_csr_apply(I->H0, 1.0, I->w1, 0.0, I->w2);
+      FCM_TRY(I->ctx, fcm__integrator_reduce_status(I, st, I->w2, n));
       for (fcm_index i = 0; i < n; i++)
         if (!I->is_con[i]) I->b[i] -= I->w2[i];
     }
