@@ -86,7 +86,12 @@
  *   stash's in the order its messages are processed (MatStashScatterGetMesg_BTS: MPI_Waitsome,
  *   arrival order); on 2 processes an entry has at most one sender (same bits every run, the
  *   resume tests hold), on 3+ an entry touched by two other processes may be summed in
- *   another order between runs (round-off; not tested: the machine has 2 cores). Traffic
+ *   another order between runs (round-off). Measured on 3 processes (oversubscribed,
+ *   petsc_newton clamped_surface 3 steps, -ksp_type cg -pc_type gamg, 4 runs each): the
+ *   final |u| differed between runs in the last 2 digits both with this change and with the
+ *   old dense sums (then the matrix was the same bits every run: the KSP / GAMG on 3
+ *   processes varies by itself), so bitwise repetition on 3+ processes was not there before
+ *   either; on 2 processes 4 of 4 runs were the same bits. Traffic
  *   counters: fcm_petsc_simulation_traffic() (also a "comm" line of the summary);
  *   tests/petsc/newton.c asserts that no sum in the steps is longer than n and that fewer
  *   values than nnz are summed per Newton matrix. Measured (clamped_surface at 16^3 cells,
