@@ -44,3 +44,7 @@ fcm_add_test(embed_xfem_random_long tests/embed/cut.c ARGS campaign 20000 11 LAB
 # cell_mask: unflagged cells classified without points, flagged ones as without a mask (the
 # distributed build of fcm/petsc.h); the one-element assembly sums to the space's.
 fcm_add_test(embed_cell_mask tests/embed/cell_mask.c)
+# the crop of the geometry to what a distributed build reads (fcm__embed_crop_geometry()): a
+# build on it with the other cells' classes handed over equals the build on the whole geometry
+# bit for bit (classes, fractions, pieces, own rules, surface triangle ids, outside volumes)
+fcm_add_test(embed_crop tests/embed/crop.c)

@@ -3,8 +3,10 @@
  * layer, under gravity, static; CG + GAMG (the default) to rtol 1e-8. Process 0 prints one
  * line: processes, element, DOFs, setup seconds (partition + rules + numbering + assembly +
  * KSP setup) and KSP solve seconds per DOF, peak resident memory summed over the processes per
- * DOF, the matrix's bytes per DOF (nonzeros x 12 bytes), KSP iterations. Arguments: element,
- * N. Run: mpirun -n P petsc_bench hex8 24. */
+ * DOF, the matrix's bytes per DOF (nonzeros x 12 bytes), KSP iterations; and the geometry
+ * each process's rules build read (the crop: cells, boundary triangles, bytes, against the
+ * whole). Arguments: element, N, [ball resolution, default 4]. Run: mpirun -n P petsc_bench
+ * hex8 24 [8]. */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
@@ -38,7 +40,8 @@ int main(int argc, char **argv)
   const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, c[3] = {0.5, 0.5, 0.5};
   const fcm_index cells[3] = {N, N, N};
   TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, cells, &mesh));
-  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c, 0.45, 4, &geom));
+  const int res = argc > 3 ? atoi(argv[3]) : 4;
+  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c, 0.45, res, &geom));
   const fcm_material mat = {FCM_MATERIAL_LINEAR, 1e6, 0.3, 1000.0};
   fcm_petsc_options po = fcm_petsc_options_default();
   po.kind = FCM_INTEGRATOR_STATIC;
@@ -91,6 +94,19 @@ int main(int argc, char **argv)
            "process\n",
            size, rt_min[0], rt_max[0], rt_min[1], rt_max[1], (long long)rs->num_cut,
            rt_min[2] / 1e6, rt_max[2] / 1e6);
+  /* the geometry read per process (kept) against the whole (every process reads it here) */
+  double gk[3] = {(double)info.geometry_cells_kept, (double)info.geometry_triangles_kept,
+                  info.geometry_bytes_kept},
+         gk_max[3], gk_min[3];
+  MPI_Allreduce(gk, gk_max, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  MPI_Allreduce(gk, gk_min, 3, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+  if (rank == 0)
+    printf("petsc_bench np %d: geometry (ball resolution %d) read by the rules build per "
+           "process: cells %.0f..%.0f of %lld, boundary triangles %.0f..%.0f of %lld, %.3g..%.3g "
+           "MB of %.3g MB (%.1f..%.1f B/dof of %.1f)\n",
+           size, res, gk_min[0], gk_max[0], (long long)info.geometry_cells, gk_min[1], gk_max[1],
+           (long long)info.geometry_triangles, gk_min[2] / 1e6, gk_max[2] / 1e6,
+           info.geometry_bytes / 1e6, gk_min[2] / n, gk_max[2] / n, info.geometry_bytes / n);
   if (rank == 0)
     printf("petsc_bench np %d: CPU seconds (user + system; busy MPI waits count) per DOF: setup "
            "%.3g us max over processes / %.3g us summed, solve %.3g us max / %.3g us summed\n",

@@ -174,6 +174,15 @@ FCM_API fcm_index fcm_petsc_problem_num_dofs(const fcm_petsc_problem *problem);
  * carry quadrature points, so do not assemble on it). */
 FCM_API const fcm_space *fcm_petsc_problem_space(const fcm_petsc_problem *problem);
 
+/** The original ids (ascending) of the geometry cells and boundary triangles this process's
+ * rules build read (the crop, see fcm_petsc_info.geometry_cells_kept): borrowed arrays valid
+ * as long as the problem; counts 0 and NULL arrays when nothing was cropped (one process, no
+ * geometry: the whole geometry was read). Local. */
+FCM_API fcm_status fcm_petsc_problem_geometry_kept(const fcm_petsc_problem *problem,
+                                                   fcm_index *num_cells, const fcm_index **cells,
+                                                   fcm_index *num_triangles,
+                                                   const fcm_index **triangles);
+
 /** Gather the displacement and velocity (either may be NULL) in the space's DOF numbering
  * (num_dofs each) on every process. Collective. @return FCM_OK, FCM_ERR_INTERNAL. */
 FCM_API fcm_status fcm_petsc_problem_get_state(fcm_petsc_problem *problem, double *u, double *v);
@@ -221,6 +230,18 @@ typedef struct fcm_petsc_info {
   double memory_total;           /**< summed over the processes */
   double matrix_memory;          /**< bytes of the system matrix's stored nonzeros over all
                                       processes (values and column indices, MatGetInfo) */
+  /* The embedded geometry (fcm_petsc_problem_create(); 0 without one): with more than one
+   * process each reads only the part its rules build needs (the crop: the geometry cells whose
+   * boxes meet the clipping boxes of the background cells it classifies, the boundary
+   * triangles meeting those of the cells it owns), so the kept counts are this process's; on
+   * one process the whole geometry is read (kept = whole). */
+  fcm_index geometry_cells;          /**< cells of the whole geometry */
+  fcm_index geometry_triangles;      /**< boundary triangles of the whole geometry */
+  fcm_index geometry_cells_kept;     /**< geometry cells this process's rules build read */
+  fcm_index geometry_triangles_kept; /**< boundary triangles it read */
+  double geometry_bytes;             /**< bytes of the whole geometry's arrays */
+  double geometry_bytes_kept;        /**< bytes of the part kept (this process) */
+  double max_geometry_bytes_kept;    /**< the largest geometry_bytes_kept over the processes */
   long long steps, total_iterations;
   char options_prefix[32]; /**< this problem's PETSc options prefix ("fcm1_", "fcm2_",
                                 ...: one per problem, numbered in the order this process

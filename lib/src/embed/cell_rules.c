@@ -668,6 +668,78 @@ cleanup:
   return st;
 }
 
+/* FCM_ERR_GEOMETRY when background cell c is not convex (the rules build's first check). */
+static fcm_status check_convex(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index c,
+                               const fcm_cell_rules_options *o)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(fcm_mesh_cell_is_convex(mesh, c, o->convex_rtol), ctx, FCM_ERR_GEOMETRY,
+            "embed: background cell %lld (%s) is not a convex polyhedron with planar faces and "
+            "straight edges (relative tolerance %g); cut-cell quadrature needs convex cells",
+            (long long)c, fcm_mesh_get_element_info(mesh)->name, o->convex_rtol);
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_crop_geometry(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                                    const fcm_cell_rules_options *opts,
+                                    const unsigned char *classify, const unsigned char *surface,
+                                    fcm_geometry **out)
+{
+  fcm_status st = FCM_OK;
+  double *boxes = NULL;
+  fcm_index nbox = 0;
+  fcm_aabb_tree *tree = NULL, *tri_tree = NULL;
+  unsigned char *keep_cell = NULL, *keep_tri = NULL;
+  fcm__idbuf ids = {NULL, 0, 0};
+  FCM_CHECK(out, ctx, FCM_ERR_ARG, "embed crop: output pointer is NULL");
+  *out = NULL;
+  FCM_CHECK(ctx && mesh && geom && opts && classify, ctx, FCM_ERR_ARG,
+            "embed crop: NULL argument (ctx, mesh, geometry, options, classify)");
+  FCM_TRY(ctx, check_options(ctx, opts, 1));
+  const fcm_index nc = fcm_mesh_num_cells(mesh);
+  FCM_TRY(ctx, geometry_boxes(ctx, geom, 0, &boxes, &nbox));
+  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &tree));
+  FCM_FREE(ctx, boxes);
+  FCM_TRY(ctx, geometry_boxes(ctx, geom, 1, &boxes, &nbox));
+  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &tri_tree));
+  FCM_ALLOC(ctx, (size_t)geom->num_cells + 1, keep_cell);
+  FCM_ALLOC(ctx, (size_t)geom->num_tris + 1, keep_tri);
+  for (fcm_index c = 0; c < nc; c++) {
+    const int cls = classify[c] != 0, srf = surface && surface[c] && opts->surface_strength >= 0;
+    if (!cls && !srf) continue;
+    fcm__embed_cell cell; /* the box the kernels query: the corners' widened by cell.tol */
+    FCM_TRY(ctx, check_convex(ctx, mesh, c, opts));
+    FCM_TRY(ctx, fcm__embed_cell_setup(ctx, mesh, c, opts->clip_rtol, &cell));
+    if (cls) {
+      FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, cell.lo, cell.hi, &ids));
+      for (size_t k = 0; k < ids.n; k++)
+        keep_cell[ids.ids[k]] = 1;
+    }
+    if (srf) {
+      FCM_TRY(ctx, fcm__geom_tree_query(ctx, tri_tree, cell.lo, cell.hi, &ids));
+      for (size_t k = 0; k < ids.n; k++)
+        keep_tri[ids.ids[k]] = 1;
+    }
+  }
+  FCM_TRY(ctx, fcm__geom_create_subset(ctx, geom, keep_cell, keep_tri, out));
+  /* the whole geometry's volume beyond each side of the mesh box (fcm__embed_outside()) */
+  fcm_geometry *g = *out;
+  fcm_mesh_bounding_box(mesh, g->outside_mesh_lo, g->outside_mesh_hi);
+  FCM_TRY(ctx, fcm__embed_outside_sides(ctx, g->outside_mesh_lo, g->outside_mesh_hi, geom,
+                                        g->outside_side));
+  g->has_outside = 1;
+cleanup:
+  if (st != FCM_OK) fcm_geometry_destroy(out);
+  fcm__free(ctx, boxes);
+  fcm__free(ctx, keep_cell);
+  fcm__free(ctx, keep_tri);
+  fcm__geom_idbuf_free(ctx, &ids);
+  fcm_aabb_tree_destroy(&tree);
+  fcm_aabb_tree_destroy(&tri_tree);
+  return st;
+}
+
 /* Phase 1a: the result object with its per-cell arrays, strengths and catalogue rules. */
 static fcm_status rules_alloc(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_cell_rules_options *o,
                               fcm_cell_rules **out)
@@ -1251,10 +1323,7 @@ static fcm_status build_rules_x(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_ge
   memset(&B, 0, sizeof B);
   const double t_start = fcm_wtime();
   for (fcm_index c = 0; c < nc; c++)
-    FCM_CHECK(fcm_mesh_cell_is_convex(mesh, c, o->convex_rtol), ctx, FCM_ERR_GEOMETRY,
-              "embed: background cell %lld (%s) is not a convex polyhedron with planar faces and "
-              "straight edges (relative tolerance %g); cut-cell quadrature needs convex cells",
-              (long long)c, fcm_mesh_get_element_info(mesh)->name, o->convex_rtol);
+    FCM_TRY(ctx, check_convex(ctx, mesh, c, o));
 
   /* 1. set-up */
   FCM_TRY(ctx, build_setup(ctx, mesh, geom, o, R, &B));

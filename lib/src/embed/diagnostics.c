@@ -9,7 +9,6 @@ fcm_status fcm__embed_outside(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geom
                               fcm_cell_rules_stats *S)
 {
   fcm_status st = FCM_OK;
-  fcm__poly *p = NULL, *scratch = NULL;
   fcm_mesh_bounding_box(mesh, S->mesh_lo, S->mesh_hi);
   fcm_geometry_bounding_box(geom, S->geometry_lo, S->geometry_hi);
   const double gv = S->geometry_volume;
@@ -29,6 +28,26 @@ fcm_status fcm__embed_outside(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geom
                 : "",
             glo[0], ghi[0], glo[1], ghi[1], glo[2], ghi[2], mlo[0], mhi[0], mlo[1], mhi[1], mlo[2],
             mhi[2]);
+  if (geom->has_outside) { /* a crop: the whole geometry's, for this mesh box */
+    FCM_CHECK(memcmp(geom->outside_mesh_lo, mlo, 3 * sizeof *mlo) == 0 &&
+                  memcmp(geom->outside_mesh_hi, mhi, 3 * sizeof *mhi) == 0,
+              ctx, FCM_ERR_INTERNAL,
+              "embed: a cropped geometry used with another background mesh than its crop's");
+    memcpy(S->outside_side_volume, geom->outside_side, sizeof S->outside_side_volume);
+    return FCM_OK;
+  }
+  FCM_TRY(ctx, fcm__embed_outside_sides(ctx, mlo, mhi, geom, S->outside_side_volume));
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_outside_sides(fcm_ctx *ctx, const double mlo[3], const double mhi[3],
+                                    const fcm_geometry *geom, double side_volume[6])
+{
+  fcm_status st = FCM_OK;
+  fcm__poly *p = NULL, *scratch = NULL;
+  const double *glo = geom->lo, *ghi = geom->hi;
+  memset(side_volume, 0, 6 * sizeof *side_volume);
   int beyond = 0;
   for (int d = 0; d < 3; d++)
     beyond |= (glo[d] < mlo[d]) << (2 * d) | (ghi[d] > mhi[d]) << (2 * d + 1);
@@ -57,7 +76,7 @@ fcm_status fcm__embed_outside(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geom
         pl.n[d] = up ? -1.0 : 1.0;
         if (fcm__geom_poly_clip(p, &pl, 0.0, scratch) != 0) continue;
       }
-      S->outside_side_volume[side] += fcm__geom_poly_volume(p);
+      side_volume[side] += fcm__geom_poly_volume(p);
     }
   }
 cleanup:

@@ -296,6 +296,28 @@ int fcm__embed_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n, 
 fcm_status fcm__embed_outside(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
                               fcm_cell_rules_stats *S);
 
+/* The volume of geom beyond each side of the box [mlo, mhi] (sides -x, +x, -y, +y, -z, +z),
+ * summed over the geometry's cells in order (the clipped part of a straddling cell). */
+fcm_status fcm__embed_outside_sides(fcm_ctx *ctx, const double mlo[3], const double mhi[3],
+                                    const fcm_geometry *geom, double side[6]);
+
+/* The part of geom a rules build on mesh needs when it classifies (intersects) the cells
+ * flagged in `classify` and builds surface rules on those flagged in `surface` (NULL: none;
+ * ignored when opts->surface_strength < 0): the geometry cells, and boundary triangles, whose
+ * boxes meet the box the kernels query for such a cell (its corners' box widened by the
+ * clipping tolerance, fcm__embed_cell_setup()), found with the same trees, so every candidate
+ * of those cells is kept (fcm__geom_create_subset(): original order, original ids in
+ * cell_orig / tri_orig, the whole geometry's volume and bounding box). The whole geometry's
+ * outside volumes per side of the mesh box are stored for fcm__embed_outside(). A rules
+ * build with the crop gives those cells the classes, fractions and rules of a build with
+ * geom bit for bit (candidates are taken in ascending id order; the surface points carry the
+ * original triangle ids). The options are checked as the rules build checks them (with a
+ * reduce), and every flagged cell for convexity, with the build's messages. */
+fcm_status fcm__embed_crop_geometry(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                                    const fcm_cell_rules_options *opts,
+                                    const unsigned char *classify, const unsigned char *surface,
+                                    fcm_geometry **out);
+
 /* 0 when the rules were built with a cell_mask that does not flag `cell` (the cell belongs to
  * another process: no points, uncut or not); 1 otherwise. */
 static inline int fcm__cell_rules_owns(const fcm_cell_rules *R, fcm_index cell)

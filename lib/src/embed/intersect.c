@@ -142,7 +142,8 @@ fcm_status fcm__embed_clip_cell(fcm_ctx *ctx, const fcm_geometry *geom, const fc
               FCM_ERR_INTERNAL,
               "embed: clipping embedded cell %lld by background cell %lld exceeded the "
               "polyhedron capacity (%d vertices, %d faces)",
-              (long long)e, (long long)cell->id, FCM__POLY_MAX_VERTS, FCM__POLY_MAX_FACES);
+              (long long)(geom->cell_orig ? geom->cell_orig[e] : e), (long long)cell->id,
+              FCM__POLY_MAX_VERTS, FCM__POLY_MAX_FACES);
 cleanup:
   return st;
 }
@@ -266,6 +267,7 @@ fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
   FCM_TRY(ctx, fcm__geom_tree_query(ctx, tri_tree, cell->lo, cell->hi, &ws->cand));
   for (size_t k = 0; k < ws->cand.n; k++) {
     const fcm_index tri = ws->cand.ids[k];
+    const fcm_index tri_id = geom->tri_orig ? geom->tri_orig[tri] : tri; /* a crop's: original */
     double nrm[3], u[3], v[3];
     for (int a = 0; a < 3; a++)
       for (int d = 0; d < 3; d++)
@@ -287,7 +289,7 @@ fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
       FCM_CHECK(n >= 0, ctx, FCM_ERR_INTERNAL,
                 "embed: clipping boundary triangle %lld by background cell %lld exceeded %d "
                 "vertices",
-                (long long)tri, (long long)cell->id, POLYGON_CAP);
+                (long long)tri_id, (long long)cell->id, POLYGON_CAP);
     }
     if (n < 3) continue;
     int kept_any = 0;
@@ -303,7 +305,7 @@ fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
         FCM_CHECK(n >= 0, ctx, FCM_ERR_INTERNAL,
                   "embed: clipping boundary triangle %lld by a piece of background cell %lld "
                   "exceeded %d vertices",
-                  (long long)tri, (long long)cell->id, POLYGON_CAP);
+                  (long long)tri_id, (long long)cell->id, POLYGON_CAP);
       }
       for (int i = 1; i + 1 < n; i++) {
         const double *a = poly, *b = poly + 3 * i, *c = poly + 3 * (i + 1);
@@ -324,7 +326,7 @@ fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
             ws->snrm[3 * s + d] = nrm[d];
           }
           ws->sw[s] = l[j] * area2;
-          ws->stri[s] = tri;
+          ws->stri[s] = tri_id;
         }
       }
     }

@@ -26,6 +26,15 @@ struct fcm_geometry {
   int custom_boundary; /* 1: tris were not derived from the cells (voxel boxes: the exposed
                           voxel faces); fcm_geometry_create_transformed() keeps them */
   double lo[3], hi[3]; /* bounding box of the nodes */
+  /* A subset (fcm__geom_create_subset()): the original id of each kept cell and boundary
+   * triangle (NULL: not a subset), the original counts; volume and lo/hi stay those of the
+   * original geometry, tri_cell is the kept cell's id or -1 when that cell was not kept.
+   * outside_*: set by the embed module's crop (fcm__embed_crop_geometry()): the volume of the
+   * ORIGINAL geometry beyond each side of the background mesh box outside_mesh_lo/hi. */
+  fcm_index *cell_orig, *tri_orig;
+  fcm_index orig_cells, orig_tris;
+  int has_outside;
+  double outside_mesh_lo[3], outside_mesh_hi[3], outside_side[6];
 };
 
 /* Create a geometry that takes ownership of *coords and *cells (allocated with
@@ -38,6 +47,18 @@ struct fcm_geometry {
 fcm_status fcm__geom_create_take(fcm_ctx *ctx, const char *who, fcm_element_type type,
                                  fcm_index num_nodes, double **coords, fcm_index num_cells,
                                  fcm_index **cells, int require_positive, fcm_geometry **geom);
+
+/* A subset of g: the cells with keep_cell[c] and the boundary triangles with keep_tri[t] (not
+ * rebuilt from the kept cells), both in their original order, and the nodes they use in
+ * theirs (coordinates copied bit for bit); volume and bounding box those of g. Original ids
+ * in cell_orig / tri_orig (composed when g is a subset itself). For the embedding's kernels
+ * (fcm__embed_crop_geometry()): sorted candidate ids of the subset map to sorted ids of g. */
+fcm_status fcm__geom_create_subset(fcm_ctx *ctx, const fcm_geometry *g,
+                                   const unsigned char *keep_cell, const unsigned char *keep_tri,
+                                   fcm_geometry **out);
+
+/* Bytes of the geometry's arrays (coordinates, cells, triangles, maps) and struct. */
+double fcm__geom_bytes(const fcm_geometry *g);
 
 /* ---------------------------------------------------------------- AABB tree */
 

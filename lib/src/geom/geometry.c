@@ -284,8 +284,95 @@ void fcm_geometry_destroy(fcm_geometry **geom)
   fcm__free(g->ctx, g->cells);
   fcm__free(g->ctx, g->tris);
   fcm__free(g->ctx, g->tri_cell);
+  fcm__free(g->ctx, g->cell_orig);
+  fcm__free(g->ctx, g->tri_orig);
   fcm__free(g->ctx, g);
   *geom = NULL;
+}
+
+fcm_status fcm__geom_create_subset(fcm_ctx *ctx, const fcm_geometry *g,
+                                   const unsigned char *keep_cell, const unsigned char *keep_tri,
+                                   fcm_geometry **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_geometry *s = NULL;
+  fcm_index *node_new = NULL, *cell_new = NULL;
+  FCM_CHECK(g && keep_cell && keep_tri && out, ctx, FCM_ERR_ARG,
+            "geometry subset: NULL argument (geometry, keep_cell, keep_tri, out)");
+  *out = NULL;
+  const int npc = g->npc;
+  FCM_ALLOC(ctx, (size_t)g->num_nodes + 1, node_new);
+  FCM_ALLOC(ctx, (size_t)g->num_cells + 1, cell_new);
+  FCM_ALLOC(ctx, 1, s);
+  s->ctx = ctx;
+  s->type = g->type;
+  s->npc = npc;
+  s->volume = g->volume;
+  s->custom_boundary = 1;
+  memcpy(s->lo, g->lo, sizeof s->lo);
+  memcpy(s->hi, g->hi, sizeof s->hi);
+  s->orig_cells = g->cell_orig ? g->orig_cells : g->num_cells;
+  s->orig_tris = g->tri_orig ? g->orig_tris : g->num_tris;
+  /* mark the nodes used, then number them in their original order */
+  for (fcm_index c = 0; c < g->num_cells; c++) {
+    cell_new[c] = -1;
+    if (!keep_cell[c]) continue;
+    cell_new[c] = s->num_cells++;
+    for (int a = 0; a < npc; a++)
+      node_new[g->cells[(size_t)npc * (size_t)c + (size_t)a]] = 1;
+  }
+  for (fcm_index t = 0; t < g->num_tris; t++) {
+    if (!keep_tri[t]) continue;
+    s->num_tris++;
+    for (int a = 0; a < 3; a++)
+      node_new[g->tris[3 * (size_t)t + (size_t)a]] = 1;
+  }
+  for (fcm_index k = 0; k < g->num_nodes; k++)
+    node_new[k] = node_new[k] ? s->num_nodes++ : -1;
+  FCM_ALLOC(ctx, 3 * (size_t)s->num_nodes + 1, s->coords);
+  FCM_ALLOC(ctx, (size_t)npc * (size_t)s->num_cells + 1, s->cells);
+  FCM_ALLOC(ctx, (size_t)s->num_cells + 1, s->cell_orig);
+  FCM_ALLOC(ctx, 3 * (size_t)s->num_tris + 1, s->tris);
+  FCM_ALLOC(ctx, (size_t)s->num_tris + 1, s->tri_cell);
+  FCM_ALLOC(ctx, (size_t)s->num_tris + 1, s->tri_orig);
+  for (fcm_index k = 0; k < g->num_nodes; k++)
+    if (node_new[k] >= 0)
+      memcpy(s->coords + 3 * node_new[k], g->coords + 3 * k, 3 * sizeof(double));
+  for (fcm_index c = 0; c < g->num_cells; c++) {
+    if (cell_new[c] < 0) continue;
+    const size_t i = (size_t)cell_new[c];
+    for (int a = 0; a < npc; a++)
+      s->cells[(size_t)npc * i + (size_t)a] =
+          node_new[g->cells[(size_t)npc * (size_t)c + (size_t)a]];
+    s->cell_orig[i] = g->cell_orig ? g->cell_orig[c] : c;
+  }
+  fcm_index i = 0;
+  for (fcm_index t = 0; t < g->num_tris; t++) {
+    if (!keep_tri[t]) continue;
+    for (int a = 0; a < 3; a++)
+      s->tris[3 * i + a] = node_new[g->tris[3 * (size_t)t + (size_t)a]];
+    const fcm_index tc = g->tri_cell ? g->tri_cell[t] : -1;
+    s->tri_cell[i] = tc >= 0 ? cell_new[tc] : -1;
+    s->tri_orig[i] = g->tri_orig ? g->tri_orig[t] : t;
+    i++;
+  }
+  *out = s;
+  s = NULL;
+cleanup:
+  fcm__free(ctx, node_new);
+  fcm__free(ctx, cell_new);
+  fcm_geometry_destroy(&s);
+  return st;
+}
+
+double fcm__geom_bytes(const fcm_geometry *g)
+{
+  if (!g) return 0.0;
+  const double idx = (double)sizeof(fcm_index);
+  return (double)sizeof *g + 3.0 * sizeof(double) * (double)g->num_nodes +
+         idx * (double)g->npc * (double)g->num_cells + idx * 4.0 * (double)g->num_tris +
+         (g->cell_orig ? idx * (double)g->num_cells : 0.0) +
+         (g->tri_orig ? idx * (double)g->num_tris : 0.0);
 }
 
 fcm_element_type fcm_geometry_cell_type(const fcm_geometry *geom)

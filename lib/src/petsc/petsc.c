@@ -175,24 +175,31 @@
  * - the linear driver (phase 1) could now be replaced by the phase-2 path for the scenes both
  *   run (they agree to the KSP tolerance); it is kept: it assembles straight into PETSc and
  *   scales further (no dense sums), and its tests and checkpoints stay.
+ * Done (phase 1, the crop): crop_geometry() after the partition: each process's rules build
+ *   reads fcm__embed_crop_geometry() (embed/cell_rules.c): the geometry cells whose boxes meet
+ *   the kernels' query box (fcm__embed_cell_setup()'s lo/hi, widened by the clipping
+ *   tolerance) of every cell it classifies (!P->remote: its own and its round-robin
+ *   non-candidates), and the boundary triangles meeting those of its own cells (mask), found
+ *   with the same trees as the build, so every candidate is kept; fcm__geom_create_subset()
+ *   (geom/geometry.c) keeps them in original order with their original ids (cell_orig,
+ *   tri_orig; surface points carry the original triangle ids, intersect.c), the whole
+ *   geometry's volume and box, and the whole geometry's outside volume per side of the mesh
+ *   box (fcm__embed_outside() takes them from the crop). Bit for bit: the candidates were
+ *   already sorted (fcm__geom_tree_query() sorts its ids ascending since the geometry module
+ *   was written, so the earlier note's step (1) was not needed and no serial rule changed);
+ *   sorted crop ids map to sorted original ids. Not on one process (no gain). The crop is
+ *   freed after the rules build; fcm_petsc_info.geometry_* and
+ *   fcm_petsc_problem_geometry_kept() report it (tests/petsc/classify.c check_crop(),
+ *   tests/embed/crop.c). Measured: mpirun -n 2 petsc_bench hex8 24 24 (663,552 tets): 345,600
+ *   cells (15.3 of 24.9 MB) per process, peak RSS 344 vs 384 MB per process without the crop.
  * Not done (phase 1):
- * - geometry kept whole on every process (no AABB crop), mesh replicated; still replicated per
- *   cell: class, fraction, pieces (O(cells) bytes: what the DOF numbering needs).
- *   The crop is NOT bit-identical as the kernels stand: the candidates of a cell come out of
- *   the AABB tree (fcm__geom_tree_query, geom/aabb.c) in traversal order, and the tree is built
- *   from ALL the geometry's boxes, so a cropped geometry gives the same candidates in another
- *   order: other tet order, other point order, other rounding of the volume sums (fractions)
- *   and simplifications. What the crop needs: (1) sort the candidate ids in
- *   fcm__embed_cell_tets() and fcm__embed_cell_surface() (changes every serial rule's point
- *   order and last bits once); (2) a cropped fcm_geometry that keeps the cells and boundary
- *   triangles (not rebuilt from the kept cells: custom_boundary) whose boxes meet the own
- *   cells' boxes enlarged by one cell, in their original order (so sorted cropped ids = sorted
- *   original ids), with volume / bounding box of the whole geometry; (3) the surface points'
- *   triangle ids mapped back to the original numbering (a map in fcm__rules_exchange);
- *   (4) the candidate test here widened to the clipping box (fcm__embed_cell_setup's lo/hi,
- *   clip_rtol) so that non-candidates classified round robin provably meet nothing;
- *   (5) fcm__embed_outside()'s per-side outside volumes from the whole geometry (or summed);
- *   phase 2 keeps the whole geometry (effects select boundary triangles of it).
+ * - every process still reads / generates the WHOLE geometry first (peak memory includes it;
+ *   a reader that streams and keeps only the needed part would remove that); the mesh is
+ *   replicated; still replicated per cell: class, fraction, pieces (O(cells) bytes: what the
+ *   DOF numbering needs).
+ * - phase 2 keeps the whole geometry (effects select boundary triangles of it; cuts classify
+ *   every cell on every process and need every geometry cell); cropping only its first rules
+ *   build would shrink that build's trees, not the geometry (run.c build_rules(), not done).
  * - the options string goes into the GLOBAL options database (it stays for later problems);
  *   an options prefix per problem would scope it.
  * - README projection for 1e8 DOFs (memory and time per DOF are printed by
@@ -530,16 +537,23 @@ static fcm_status rules_exchange(void *user, fcm_status st, unsigned char *cls, 
 
 /* The rules (geometry: points on the cells flagged in `mask` only, each cell classified by one
  * process: P->remote, rules_exchange()) or the plain space. */
+/* The options of phase 1's rules build: points on the cells flagged in mask. */
+static fcm_cell_rules_options rules_options(const fcm_petsc_problem *P, const unsigned char *mask)
+{
+  fcm_cell_rules_options ro = P->opts.rules;
+  ro.kinds =
+      FCM_RULES_STIFFNESS | (P->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER ? FCM_RULES_MASS : 0u);
+  ro.cell_mask = mask;
+  return ro;
+}
+
 static fcm_status build_space(fcm_petsc_problem *P, const fcm_geometry *geom,
                               const unsigned char *mask)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P->ctx;
   if (geom) {
-    fcm_cell_rules_options ro = P->opts.rules;
-    ro.kinds =
-        FCM_RULES_STIFFNESS | (P->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER ? FCM_RULES_MASS : 0u);
-    ro.cell_mask = mask;
+    const fcm_cell_rules_options ro = rules_options(P, mask);
     const fcm__rules_exchange x = {P->remote, rules_exchange, P};
     FCM_TRY(ctx, fcm__cell_rules_create_distributed(ctx, P->mesh, geom, &ro, NULL, &x, &P->rules));
     FCM_TRY(ctx, fcm_space_create_embedded(ctx, P->mesh, P->rules, &P->space));
@@ -872,6 +886,42 @@ static fcm_status own_active_cells(fcm_petsc_problem *P)
   return FCM_OK;
 }
 
+/* The part of geom this process's rules build reads (fcm__embed_crop_geometry(): the geometry
+ * cells meeting the query boxes of the cells it classifies, !P->remote, the boundary triangles
+ * meeting those of its own cells, mask), into *crop; the counts, bytes and kept ids go to P.
+ * On one process no crop (*crop NULL): the whole geometry is read. Local. */
+static fcm_status crop_geometry(fcm_petsc_problem *P, const fcm_geometry *geom,
+                                const unsigned char *mask, fcm_geometry **crop)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  unsigned char *classify = NULL;
+  *crop = NULL;
+  if (!geom) return FCM_OK;
+  P->geom_cells = P->geom_cells_kept = fcm_geometry_num_cells(geom);
+  P->geom_tris = P->geom_tris_kept = fcm_geometry_num_boundary_triangles(geom);
+  P->geom_bytes = P->geom_bytes_kept = fcm__geom_bytes(geom);
+  if (P->size == 1) return FCM_OK;
+  const fcm_index nc = fcm_mesh_num_cells(P->mesh);
+  const fcm_cell_rules_options ro = rules_options(P, mask);
+  FCM_ALLOC(ctx, (size_t)nc + 1, classify);
+  for (fcm_index c = 0; c < nc; c++)
+    classify[c] = !P->remote[c];
+  FCM_TRY(ctx, fcm__embed_crop_geometry(ctx, P->mesh, geom, &ro, classify, mask, crop));
+  const fcm_geometry *g = *crop;
+  P->geom_cells_kept = g->num_cells;
+  P->geom_tris_kept = g->num_tris;
+  P->geom_bytes_kept = fcm__geom_bytes(g);
+  FCM_ALLOC(ctx, (size_t)g->num_cells + 1, P->kept_cells);
+  FCM_ALLOC(ctx, (size_t)g->num_tris + 1, P->kept_tris);
+  memcpy(P->kept_cells, g->cell_orig, (size_t)g->num_cells * sizeof *P->kept_cells);
+  memcpy(P->kept_tris, g->tri_orig, (size_t)g->num_tris * sizeof *P->kept_tris);
+cleanup:
+  fcm__free(ctx, classify);
+  if (st != FCM_OK) fcm_geometry_destroy(crop);
+  return st;
+}
+
 fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh *mesh,
                                     const fcm_geometry *geom, const fcm_material *mat,
                                     const fcm_petsc_options *opts, fcm_petsc_problem **out)
@@ -879,6 +929,7 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
   fcm_status st = FCM_OK;
   fcm_petsc_problem *P = NULL;
   unsigned char *mask = NULL;
+  fcm_geometry *crop = NULL;
   const double t0 = fcm_wtime();
   FCM_CHECK(out, ctx, FCM_ERR_ARG, "petsc: output pointer is NULL");
   *out = NULL;
@@ -913,9 +964,11 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
   FCM_TRY(ctx, partition_cells(P, geom, &mask));
 
   /* 3. the rules, with points on this process's cells only (each cell is classified by one
-   * process, the classes gathered on every process), and the space; candidates the rules drop
-   * own nothing */
-  st = build_space(P, geom, mask);
+   * process, the classes gathered on every process), from the part of the geometry they read
+   * (the crop), and the space; candidates the rules drop own nothing */
+  FCM_TRY(ctx, fcm__petsc_problem_agree(P, crop_geometry(P, geom, mask, &crop)));
+  st = build_space(P, crop ? crop : geom, mask);
+  fcm_geometry_destroy(&crop);
   if (st == FCM_OK) st = own_active_cells(P);
   FCM_TRY(ctx, P->agreed_fail
                    ? st
@@ -941,6 +994,7 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
   P = NULL;
 cleanup:
   fcm__free(ctx, mask);
+  fcm_geometry_destroy(&crop);
   fcm_petsc_problem_destroy(&P);
   return st;
 }
@@ -965,7 +1019,8 @@ void fcm_petsc_problem_destroy(fcm_petsc_problem **problem)
   fcm_cell_rules_destroy(&P->rules);
   void *arrays[] = {P->petsc_options, P->weight,     P->cell_owner, P->copy_owner, P->perm,
                     P->con_dof,       P->con_node,   P->con_comp,   P->con_motion, P->motions,
-                    P->is_con,        P->classifier, P->remote,     P->owned_dof};
+                    P->is_con,        P->classifier, P->remote,     P->kept_cells, P->kept_tris,
+                    P->owned_dof};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
     fcm__free(ctx, arrays[i]);
   if (P->comm != MPI_COMM_NULL) MPI_Comm_free(&P->comm);
@@ -1448,6 +1503,21 @@ const fcm_space *fcm_petsc_problem_space(const fcm_petsc_problem *P)
   return P ? P->space : NULL;
 }
 
+fcm_status fcm_petsc_problem_geometry_kept(const fcm_petsc_problem *P, fcm_index *num_cells,
+                                           const fcm_index **cells, fcm_index *num_triangles,
+                                           const fcm_index **triangles)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(P && num_cells && cells && num_triangles && triangles, P ? P->ctx : NULL, FCM_ERR_ARG,
+            "petsc: NULL argument (problem, num_cells, cells, num_triangles, triangles)");
+  *num_cells = P->kept_cells ? P->geom_cells_kept : 0;
+  *num_triangles = P->kept_tris ? P->geom_tris_kept : 0;
+  *cells = P->kept_cells;
+  *triangles = P->kept_tris;
+cleanup:
+  return st;
+}
+
 static fcm_status gather(fcm_petsc_problem *P, Vec x, double *out)
 {
   fcm_status st = FCM_OK;
@@ -1520,6 +1590,14 @@ fcm_status fcm_petsc_problem_get_info(fcm_petsc_problem *P, fcm_petsc_info *info
     PCALL(ctx, MatGetInfo(P->Se, MAT_GLOBAL_SUM, &mi));
     info->matrix_memory = mi.nz_allocated * (double)(sizeof(PetscScalar) + sizeof(PetscInt));
   }
+  info->geometry_cells = P->geom_cells;
+  info->geometry_triangles = P->geom_tris;
+  info->geometry_cells_kept = P->geom_cells_kept;
+  info->geometry_triangles_kept = P->geom_tris_kept;
+  info->geometry_bytes = P->geom_bytes;
+  info->geometry_bytes_kept = P->geom_bytes_kept;
+  MPI_Allreduce(&info->geometry_bytes_kept, &info->max_geometry_bytes_kept, 1, MPI_DOUBLE, MPI_MAX,
+                P->comm);
   info->steps = P->steps;
   info->total_iterations = P->total_iterations;
   snprintf(info->options_prefix, sizeof info->options_prefix, "%s", P->prefix);

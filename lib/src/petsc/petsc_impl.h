@@ -65,6 +65,12 @@ struct fcm_petsc_problem {
   double t;
   long long steps, total_iterations;
   double time_rules, time_assembly, time_setup;
+  /* the geometry the rules build read (phase 1 on several processes: the crop,
+   * crop_geometry()): whole and kept counts, bytes; the kept cells' and triangles' original
+   * ids (fcm_petsc_problem_geometry_kept(); NULL without a crop) */
+  fcm_index geom_cells, geom_tris, geom_cells_kept, geom_tris_kept;
+  double geom_bytes, geom_bytes_kept;
+  fcm_index *kept_cells, *kept_tris;
   fcm_mesh *own_mesh; /* built from a scene (fcm_petsc_problem_create_from_scene) */
   fcm_geometry *own_geom;
   /* the integrator's backend (fcm_petsc_simulation_create()): the space is the simulation's
