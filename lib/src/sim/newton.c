@@ -342,9 +342,11 @@ static fcm_status build_system(fcm_integrator *I, double h, int predictor, int p
    * active set act_dof; w1 carries the increments there): nothing allocated per iteration. */
   for (fcm_index j = 0; j < I->nact; j++)
     I->w1[I->act_dof[j]] = predictor ? I->act_inc[j] : 0.0;
-  if (I->has_backend)
-    FCM_TRY(I->ctx, eliminate_partial(I, predictor));
-  else
+  if (I->has_backend) {
+    /* a local failure there meets the others in the backend's factor (its agreement) */
+    st = eliminate_partial(I, predictor);
+    if (st != FCM_OK) FCM_TRY(I->ctx, fcm__integrator_finish(I, st));
+  } else
     fcm__eliminate_marked(I->H, I->b, I->is_con, I->w1);
   I->h_state = SIM_H_SYSTEM;
   I->h_psd = projected || I->opts.project_psd || I->linear;
