@@ -3,13 +3,16 @@
  * layer, under gravity, static; CG + GAMG (the default) to rtol 1e-8. Process 0 prints one
  * line: processes, element, DOFs, setup seconds (partition + rules + numbering + assembly +
  * KSP setup) and KSP solve seconds per DOF, peak resident memory summed over the processes per
- * DOF, the matrix's bytes per DOF (nonzeros x 12 bytes), KSP iterations; and the geometry
- * each process's rules build read (the crop: cells, boundary triangles, bytes, against the
- * whole). Arguments: element, N, [ball resolution, default 4]. Run: mpirun -n P petsc_bench
- * hex8 24 [8]. */
+ * DOF, the matrix's bytes per DOF (nonzeros x 12 bytes), KSP iterations; the geometry each
+ * process's rules build read (the crop: cells, boundary triangles, bytes, against the whole);
+ * and the topology's bytes per DOF on each process (fcm__space_memory(): the replicated
+ * numbering, the local space's copy graph + pattern + offsets + colours against the full
+ * space's, which every process held before the local space). Arguments: element, N, [ball
+ * resolution, default 4]. Run: mpirun -n P petsc_bench hex8 24 [8]. */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
+#include "petsc/petsc_impl.h" /* the problem's space and arrays: topology bytes */
 #include "test.h"
 
 #include <sys/resource.h>
@@ -122,6 +125,30 @@ int main(int argc, char **argv)
            info.memory_total / n, peak_all / n, info.matrix_memory / n,
            (long long)info.min_local_elements, (long long)info.max_local_elements,
            fcm_petsc_partition_name(info.partition));
+  { /* topology bytes per DOF (this process; max and min over the processes) */
+    fcm_space *full = NULL;
+    double num = 0.0, loc = 0.0, whole = 0.0;
+    fcm__space_memory(P->space, &num, &loc);
+    if (P->rules)
+      TEST_OK(ctx, fcm_space_create_embedded(ctx, mesh, P->rules, &full));
+    else
+      TEST_OK(ctx, fcm_space_create(ctx, mesh, NULL, &full));
+    if (full) fcm__space_memory(full, NULL, &whole);
+    fcm_space_destroy(&full);
+    /* the adapter's replicated arrays: perm, copy_owner per copy, is_con per DOF, cell_owner
+     * and weight per cell */
+    const double nc = (double)fcm_mesh_num_cells(mesh);
+    const double adapter = (double)(sizeof(PetscInt) + sizeof(int)) * (double)P->ncopy +
+                           (double)P->n + (sizeof(int) + 1.0) * nc;
+    double mine[2] = {loc, -loc}, ext[2];
+    MPI_Allreduce(mine, ext, 2, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    if (rank == 0)
+      printf("petsc_bench np %d %s N %lld: topology bytes/DOF per process: numbering %.1f "
+             "(replicated) + adapter %.1f (replicated); copy graph + pattern + offsets + "
+             "colours: full space %.1f (before: on every process), local space %.1f..%.1f "
+             "(own + ghost cells)\n",
+             size, argv[1], (long long)N, num / n, adapter / n, whole / n, -ext[1] / n, ext[0] / n);
+  }
   TEST_TRUE(si.reason > 0);
   free(fix);
   fcm_petsc_problem_destroy(&P);

@@ -69,6 +69,21 @@ foreach(np 1 2)
   fcm_add_mpi_test(petsc_classify_failure_np${np} tests/petsc/classify_failure.c NP ${np}
                    TIMEOUT 60)
 endforeach()
+# the local topology of phase 1 (own + ghost cells): the serial numbering bit for bit, every
+# owned row's pattern the full one (and incomplete without the ghosts), exact preallocation,
+# the whole-pattern functions refusing it, frames from the piece's values alone byte for byte
+foreach(np 1 2 3)
+  foreach(case "hex8;ball" "tet4;ball" "hex20;ball" "tet10;ball" "hex8;none")
+    list(GET case 0 el)
+    list(GET case 1 shape)
+    fcm_add_mpi_test(petsc_ghost_${el}_${shape}_np${np} tests/petsc/ghost.c NP ${np}
+                     ARGS ${el} ${shape} petsc_ghost_${el}_${shape}_np${np} TIMEOUT 120)
+  endforeach()
+endforeach()
+# the local space of a cut body (several DOF copies per node, constrained copies), serial
+foreach(el hex8 tet4 hex20 tet10)
+  fcm_add_mpi_test(petsc_ghost_${el}_cut tests/petsc/ghost.c NP 1 ARGS ${el} cut unused)
+endforeach()
 # errors on one or all processes end every process with the message, no hang
 foreach(np 1 2)
   fcm_add_mpi_test(petsc_failure_np${np} tests/petsc/failure.c NP ${np} TIMEOUT 60)

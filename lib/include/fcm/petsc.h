@@ -18,10 +18,10 @@
  *   another problem's solver; the command line reaches every problem ("-fcm2_ksp_type ..."
  *   the second one alone).
  *
- * Phase 1 (stated plainly): the mesh, the geometry and the space's topology (DOF numbering
- * and pattern, O(DOFs + nonzeros) integers) are replicated on every process; the heavy part
- * — simplification and stabilization of the cut-cell rules, element integration, matrix and
- * vector rows, the solve — is distributed. Every function is collective over the
+ * Phase 1 (stated plainly): the mesh, the geometry and the DOF numbering (O(nodes + elements)
+ * integers) are replicated on every process; the sparsity pattern is held per process for its
+ * own and ghost cells only; the heavy part — simplification and stabilization of the
+ * cut-cell rules, element integration, matrix and vector rows, the solve — is distributed. Every function is collective over the
  * communicator; an error on any process (bad input on one of them included) is returned on
  * every process, with the failing process's message, so that all of them stop together. */
 #ifndef FCM_PETSC_H
@@ -170,8 +170,10 @@ FCM_API fcm_status fcm_petsc_problem_step(fcm_petsc_problem *problem, fcm_petsc_
 /** Number of DOFs (the serial space's, fcm_space_num_dofs()). */
 FCM_API fcm_index fcm_petsc_problem_num_dofs(const fcm_petsc_problem *problem);
 
-/** The replicated space (DOF numbering of the serial library; only this process's cut cells
- * carry quadrature points, so do not assemble on it). */
+/** The problem's space: the DOF numbering of the serial library (every accessor of
+ * fcm/fem.h that reads DOFs and elements works on it), but its sparsity pattern covers only
+ * this process's own and ghost cells, so fcm_space_matrix_create() and the fcm_assemble_*()
+ * functions refuse it (FCM_ERR_ARG); only this process's cut cells carry quadrature points. */
 FCM_API const fcm_space *fcm_petsc_problem_space(const fcm_petsc_problem *problem);
 
 /** The original ids (ascending) of the geometry cells and boundary triangles this process's

@@ -622,6 +622,7 @@ fcm_status fcm_assembly_workspace_linear(fcm_assembly_workspace *ws, const fcm_l
   memset(&kd, 0, sizeof kd);
   FCM_CHECK(ws && form, ctx, FCM_ERR_ARG, "linear assembly: NULL workspace or form");
   const fcm_space *s = ws->space;
+  FCM_TRY(ctx, fcm__space_check_full(s, "linear assembly")); /* colours of local elements only */
   switch (form->term) {
   case FCM_LINEAR_STIFFNESS:
     kd.kind = KERNEL_STIFFNESS;
@@ -686,6 +687,7 @@ fcm_status fcm_assembly_workspace_hyperelastic(fcm_assembly_workspace *ws,
   memset(&kd, 0, sizeof kd);
   FCM_CHECK(ws, ctx, FCM_ERR_ARG, "hyperelastic: workspace is NULL");
   const fcm_space *s = ws->space;
+  FCM_TRY(ctx, fcm__space_check_full(s, "hyperelastic assembly"));
   FCM_CHECK(mat && u, ctx, FCM_ERR_ARG, "hyperelastic: NULL material or displacement");
   if (tangent) FCM_TRY(ctx, check_matrix(s, tangent));
   kd.kind = KERNEL_HYPERELASTIC;

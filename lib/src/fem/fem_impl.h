@@ -26,18 +26,34 @@ struct fcm_space {
   fcm_index num_elems;
   fcm_index *elem_cell, *elem_piece, *elem_dof, *cell_elem;
   fcm_index num_constrained; /* copies constrained to move with their piece (Koschier) */
-  /* Copy graph (by copy rank k = DOF / 3): node_ptr[k]..node_ptr[k+1] are the ranks of the
-   * copies sharing an element with copy k (itself included), sorted. */
-  fcm_index *node_ptr;
+  /* Everything above is the numbering: O(nodes + elements x nn), the same on every process of
+   * a distributed run. The topology below covers the LOCAL elements and copies. A full space
+   * (fcm_space_create*(), is_local = 0): every element and copy, local position = element id /
+   * copy rank (local_elem, local_copy, cell_local NULL). A local space
+   * (fcm__space_create_local()): the elements of the flagged cells (cell_local[c] != 0),
+   * local_elem[le] their ids and local_copy[lk] the ranks of the copies they use, both
+   * ascending; a copy's graph row lists the copies sharing a LOCAL element with it, so it is
+   * the full row exactly when every element using the copy is local. */
+  int is_local;
+  unsigned char *cell_local;  /* num_cells (local space), NULL (full space) */
+  fcm_index num_local_elems;  /* full space: num_elems */
+  fcm_index *local_elem;      /* num_local_elems, NULL (full space) */
+  fcm_index num_local_copies; /* full space: num_dofs / 3 */
+  fcm_index *local_copy;      /* num_local_copies, NULL (full space) */
+  /* Copy graph (by local copy position k): node_ptr[k]..node_ptr[k+1] are the ranks (global)
+   * of the copies sharing a local element with copy k (itself included), sorted. */
+  fcm_index *node_ptr; /* num_local_copies + 1 */
   fcm_index *node_adj;
-  /* Scalar CSR pattern: the three rows of node k each hold 3 columns per neighbour. */
-  fcm_index *row_ptr; /* num_dofs + 1 */
+  /* Scalar CSR pattern: the three rows 3k..3k+2 of local copy k each hold 3 columns (global
+   * DOFs) per neighbour. A full space's is the n x n pattern. */
+  fcm_index *row_ptr; /* 3 num_local_copies + 1 */
   int *col_idx;
-  /* Per element, nn x nn offsets: the position of copy b in copy a's row of the copy
-   * graph, so entry (3ka+i, 3kb+j) lives at row_ptr[3ka+i] + 3 off[a][b] + j. */
-  int *elem_off;
-  /* Elements grouped by colour (no two share a copy): color_ptr[c]..color_ptr[c+1] index
-   * color_elems. */
+  /* Per local element le, nn x nn offsets: the position of copy b in copy a's row of the copy
+   * graph, so entry (3ka+i, 3kb+j) lives at row_ptr[3ka+i] + 3 off[a][b] + j (ka the local
+   * position of copy a). */
+  int *elem_off; /* num_local_elems x nn x nn */
+  /* Local elements grouped by colour (no two share a copy): color_ptr[c]..color_ptr[c+1]
+   * index color_elems (element ids). */
   int num_colors;
   fcm_index *color_ptr;
   fcm_index *color_elems;
@@ -48,6 +64,53 @@ struct fcm_space {
   int max_cut_points;
   fcm_rule *mass_rule; /* the standard mass rule of full cells (fcm_space_momentum()) */
 };
+
+/* A space whose numbering (node_dof, node_ncopy, elements, cell_elem, num_dofs, constrained
+ * copies: every array above the topology in struct fcm_space) is fcm_space_create()'s
+ * (rules NULL; cell_active as there) or fcm_space_create_embedded_with()'s (rules given,
+ * cell_active NULL; opts NULL: no constrained copies, as there) bit for bit, but whose copy
+ * graph, pattern, offsets and colours cover only the elements of the active cells flagged in
+ * cell_mask (num_cells flags; NULL: none, the numbering alone). For a distributed run: each
+ * process flags its own cells and their ghosts (cells sharing a DOF copy with a copy it owns),
+ * which makes the graph row of every owned copy the full space's row; the topology then costs
+ * O(local elements + their copies' nonzeros) instead of O(DOFs + nonzeros). The numbering's
+ * build allocates O(nodes + elements x nn) scratch, as fcm_space_create() does.
+ *
+ * What a local space does: every accessor and every function that reads only the numbering
+ * (fcm_space_node_dof / _node_copies / _element_dofs / _cell_elements / _transfer /
+ * _cell_blocks / _node_field / _cell_stress / _max_displacement / _momentum / _locate /
+ * _interpolate / _eval / _num_bodies / _write_vtu, fcm__space_write_vtu_piece(),
+ * fcm__assembly_element_linear(), fcm_assembly_workspace_create()) works on every element as
+ * on the full space (the element's points come from the rules, which a cell_mask of the rules
+ * restricts independently); fcm_space_num_colors() counts the colours of the local elements.
+ * Whatever needs the whole pattern refuses it with FCM_ERR_ARG (fcm__space_check_full()):
+ * fcm_space_matrix_create(), fcm_assembly_workspace_linear() / _hyperelastic() and so every
+ * fcm_assemble_*(), and so the integrator (its setup creates matrices; nitsche.c reads the
+ * colours and offsets only after that). The integrator path (phase 2 of the PETSc backend)
+ * would need, to use it: its per-process assembly over own elements only (not the local
+ * colours, which include ghosts: an element filter or a second mask), a matrix over the local
+ * rows (3 num_local_copies rows, global columns: row_ptr / col_idx as they are, values added
+ * into the MATMPIAIJ with ADD_VALUES) instead of fcm_space_matrix_create(), and force / energy
+ * vectors over the local copies.
+ * @return FCM_OK, FCM_ERR_ARG (as fcm_space_create*(); rules and cell_active both given),
+ * FCM_ERR_ALLOC, FCM_ERR_UNSUPPORTED (colours). (space.c) */
+fcm_status fcm__space_create_local(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                   const unsigned char *cell_active, const fcm_cell_rules *rules,
+                                   const fcm_space_options *opts, const unsigned char *cell_mask,
+                                   fcm_space **out);
+
+/* Rebuild the topology of a local space for the cells flagged in cell_mask (NULL: none); the
+ * numbering is unchanged. On failure the space has no local elements (and the error). FCM_ERR_ARG
+ * for a full space. (space.c) */
+fcm_status fcm__space_set_local_cells(fcm_space *s, const unsigned char *cell_mask);
+
+/* FCM_OK for a full space; for a local one FCM_ERR_ARG with "<what>: the space is a local
+ * space ..." recorded. (space.c) */
+fcm_status fcm__space_check_full(const fcm_space *s, const char *what);
+
+/* Bytes of the space's arrays: the numbering (replicated in a distributed run) and the
+ * topology (copy graph, pattern, offsets, colours, local lists). Either may be NULL. */
+void fcm__space_memory(const fcm_space *s, double *numbering, double *topology);
 
 /* The elimination of fcm_space_apply_dirichlet() on a square A (n x n) with the constrained
  * DOFs already marked: con[i] = 1 for a constrained DOF i (n flags) and g[i] its prescribed
@@ -85,6 +148,27 @@ fcm_status fcm__assembly_element_linear(fcm_assembly_workspace *ws, const fcm_li
 fcm_status fcm__space_write_vtu_piece(const fcm_space *s, const fcm_material *mat, const double *u,
                                       const double *v, const unsigned char *keep, int rank,
                                       const char *path);
+
+/* The mesh nodes of the cells with keep[c] != 0 (keep NULL: all), ascending, each once, in
+ * *nodes (allocated with the space's context; free with fcm__free()), their count in *num.
+ * O(kept cells) memory. (fields.c) */
+fcm_status fcm__space_piece_nodes(const fcm_space *s, const unsigned char *keep, fcm_index *num,
+                                  fcm_index **nodes);
+
+/* dofs[i]: the first DOF fcm_space_node_field() reads at node nodes[i] (-1: an inactive node),
+ * for n nodes: the copy of the largest support when a node has several. Allocates the copies'
+ * supports (O(DOFs) doubles) when some node has two copies. (fields.c) */
+fcm_status fcm__space_node_field_dofs(const fcm_space *s, fcm_index n, const fcm_index *nodes,
+                                      fcm_index *dofs);
+
+/* fcm__space_write_vtu_piece() without stress, from the node values of the piece only: nodes
+ * as fcm__space_piece_nodes() lists them for keep, nu / nv 3 values per listed node (the
+ * values fcm_space_node_field() would give there; nv NULL: no velocity). The same file as
+ * fcm__space_write_vtu_piece() with mat NULL and those values, without any DOF vector.
+ * (fields.c) */
+fcm_status fcm__space_write_vtu_piece_values(const fcm_space *s, const unsigned char *keep,
+                                             fcm_index np, const fcm_index *nodes, const double *nu,
+                                             const double *nv, int rank, const char *path);
 
 /* The .pvtu index (written atomically) of the pieces <stem>_0.vtu .. <stem>_<nprocs-1>.vtu that
  * fcm__space_write_vtu_piece() wrote with the same velocity / mat choice. (fields.c) */

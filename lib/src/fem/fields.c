@@ -7,6 +7,7 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* The material prepared once per call: parameters and Psi(I). */
@@ -203,29 +204,95 @@ cleanup:
   return st;
 }
 
+/* The DOF fcm_space_node_field() reads at node a (-1: inactive): its first copy, or with the
+ * supports of the copies (NULL when no node has two) the first of the largest support. */
+static fcm_index node_field_dof(const fcm_space *s, const double *support, fcm_index a)
+{
+  fcm_index d = s->node_dof[a];
+  if (d >= 0 && support)
+    for (fcm_index k = 1; k < s->node_ncopy[a]; k++)
+      if (support[s->node_dof[a] / 3 + k] > support[d / 3]) d = s->node_dof[a] + 3 * k;
+  return d;
+}
+
+/* The copies' supports when some node has two copies (*support NULL otherwise). */
+static fcm_status node_field_support(const fcm_space *s, double **support)
+{
+  fcm_status st = FCM_OK;
+  int copies = 0;
+  *support = NULL;
+  for (fcm_index a = 0; a < s->num_nodes && !copies; a++)
+    copies = s->node_ncopy[a] > 1;
+  if (copies) {
+    FCM_ALLOC(s->ctx, s->num_dofs / 3 + 1, *support);
+    fcm__space_copy_support(s, *support);
+  }
+cleanup:
+  return st;
+}
+
 fcm_status fcm_space_node_field(const fcm_space *s, const double *dofs, double *node_field)
 {
   fcm_status st = FCM_OK;
   double *support = NULL;
-  int copies = 0;
   FCM_CHECK(s && dofs && node_field, s ? s->ctx : NULL, FCM_ERR_ARG,
             "node field: NULL space, DOF vector or output");
-  for (fcm_index a = 0; a < s->num_nodes && !copies; a++)
-    copies = s->node_ncopy[a] > 1;
-  if (copies) {
-    FCM_ALLOC(s->ctx, s->num_dofs / 3 + 1, support);
-    fcm__space_copy_support(s, support);
-  }
+  FCM_TRY(s->ctx, node_field_support(s, &support));
   for (fcm_index a = 0; a < s->num_nodes; a++) {
-    fcm_index d = s->node_dof[a];
-    if (d >= 0 && support)
-      for (fcm_index k = 1; k < s->node_ncopy[a]; k++)
-        if (support[s->node_dof[a] / 3 + k] > support[d / 3]) d = s->node_dof[a] + 3 * k;
+    const fcm_index d = node_field_dof(s, support, a);
     for (int i = 0; i < 3; i++)
       node_field[3 * a + i] = d >= 0 ? dofs[d + i] : 0.0;
   }
 cleanup:
   fcm__free(s ? s->ctx : NULL, support);
+  return st;
+}
+
+fcm_status fcm__space_node_field_dofs(const fcm_space *s, fcm_index n, const fcm_index *nodes,
+                                      fcm_index *dofs)
+{
+  fcm_status st = FCM_OK;
+  double *support = NULL;
+  FCM_TRY(s->ctx, node_field_support(s, &support));
+  for (fcm_index i = 0; i < n; i++)
+    dofs[i] = node_field_dof(s, support, nodes[i]);
+cleanup:
+  fcm__free(s->ctx, support);
+  return st;
+}
+
+static int cmp_node(const void *a, const void *b)
+{
+  const fcm_index x = *(const fcm_index *)a, y = *(const fcm_index *)b;
+  return (x > y) - (x < y);
+}
+
+fcm_status fcm__space_piece_nodes(const fcm_space *s, const unsigned char *keep, fcm_index *num,
+                                  fcm_index **nodes)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const int npc = fcm_mesh_nodes_per_cell(s->mesh);
+  const fcm_index *cells = fcm_mesh_cells(s->mesh);
+  fcm_index *list = NULL, len = 0, m = 0;
+  *num = 0;
+  *nodes = NULL;
+  for (fcm_index c = 0; c < s->num_cells; c++)
+    len += (!keep || keep[c]) ? npc : 0;
+  FCM_ALLOC(ctx, len + 1, list);
+  for (fcm_index c = 0; c < s->num_cells; c++)
+    if (!keep || keep[c])
+      for (int k = 0; k < npc; k++)
+        list[m++] = cells[(size_t)npc * c + k];
+  qsort(list, (size_t)len, sizeof *list, cmp_node);
+  m = 0;
+  for (fcm_index i = 0; i < len; i++)
+    if (i == 0 || list[i] != list[i - 1]) list[m++] = list[i];
+  *num = m;
+  *nodes = list;
+  list = NULL;
+cleanup:
+  fcm__free(ctx, list);
   return st;
 }
 
@@ -278,19 +345,21 @@ cleanup:
   return st;
 }
 
-fcm_status fcm__space_write_vtu_piece(const fcm_space *s, const fcm_material *mat, const double *u,
-                                      const double *v, const unsigned char *keep, int rank,
-                                      const char *path)
+/* A piece of the kept cells: np points, the mesh nodes listed ascending in `nodes` (every node
+ * of a kept cell), numbered in the order the kept cells first use them; nu, nv: 3 values per
+ * listed node (nv NULL: no velocity); with mat, the cells' stress of the full DOF vector u. */
+static fcm_status write_piece(const fcm_space *s, const fcm_material *mat, const double *u,
+                              const unsigned char *keep, fcm_index np, const fcm_index *nodes,
+                              const double *nu, const double *nv, int rank, const char *path)
 {
   fcm_status st = FCM_OK;
-  fcm_ctx *ctx = s ? s->ctx : NULL;
+  fcm_ctx *ctx = s->ctx;
   fcm_vtu *vtu = NULL;
-  fcm_index *map = NULL, *conn = NULL, np = 0, ncl = 0;
-  double *nu = NULL, *nv = NULL, *xyz = NULL, *pu = NULL, *pv = NULL, *phi = NULL;
+  fcm_index *pid = NULL, *conn = NULL, ncl = 0, next = 0;
+  double *xyz = NULL, *pu = NULL, *pv = NULL, *phi = NULL;
   double *sig = NULL, *vm = NULL, *sed = NULL, *csig = NULL, *cvm = NULL, *csed = NULL;
   double *zero = NULL;
   int32_t *owner = NULL, *cid = NULL, *nid = NULL, *active = NULL;
-  FCM_CHECK(s && path, ctx, FCM_ERR_ARG, "write vtu piece: NULL space or path");
   const fcm_index nn = s->num_nodes, nc = s->num_cells;
   FCM_CHECK(nn < INT32_MAX && nc < INT32_MAX, ctx, FCM_ERR_ARG,
             "write vtu piece: %lld nodes, %lld cells: the indices must fit Int32", (long long)nn,
@@ -298,21 +367,23 @@ fcm_status fcm__space_write_vtu_piece(const fcm_space *s, const fcm_material *ma
   const int npc = fcm_mesh_nodes_per_cell(s->mesh);
   const fcm_index *cells = fcm_mesh_cells(s->mesh);
   const double *X = fcm_mesh_coords(s->mesh);
-  FCM_ALLOC(ctx, nn + 1, map);
-  FCM_ALLOC(ctx, 3 * nn + 1, nu);
-  if (u) FCM_TRY(ctx, fcm_space_node_field(s, u, nu));
-  if (v) {
-    FCM_ALLOC(ctx, 3 * nn + 1, nv);
-    FCM_TRY(ctx, fcm_space_node_field(s, v, nv));
-  }
-  for (fcm_index a = 0; a < nn; a++)
-    map[a] = -1;
+  FCM_ALLOC(ctx, np + 1, pid);
+  for (fcm_index i = 0; i < np; i++)
+    pid[i] = -1;
   for (fcm_index c = 0; c < nc; c++)
     if (!keep || keep[c]) {
       ncl++;
-      for (int k = 0; k < npc; k++)
-        if (map[cells[(size_t)npc * c + k]] < 0) map[cells[(size_t)npc * c + k]] = np++;
+      for (int k = 0; k < npc; k++) {
+        const fcm_index *hit =
+            bsearch(cells + (size_t)npc * c + k, nodes, (size_t)np, sizeof *nodes, cmp_node);
+        FCM_CHECK(hit, ctx, FCM_ERR_INTERNAL, "write vtu piece: node %lld of cell %lld unlisted",
+                  (long long)cells[(size_t)npc * c + k], (long long)c);
+        if (pid[hit - nodes] < 0) pid[hit - nodes] = next++;
+      }
     }
+  FCM_CHECK(next == np, ctx, FCM_ERR_INTERNAL,
+            "write vtu piece: %lld listed nodes, the kept cells use %lld", (long long)np,
+            (long long)next);
   FCM_ALLOC(ctx, 3 * np + 1, xyz);
   FCM_ALLOC(ctx, 3 * np + 1, pu);
   FCM_ALLOC(ctx, 3 * np + 1, pv);
@@ -322,15 +393,15 @@ fcm_status fcm__space_write_vtu_piece(const fcm_space *s, const fcm_material *ma
   FCM_ALLOC(ctx, ncl + 1, owner);
   FCM_ALLOC(ctx, ncl + 1, cid);
   FCM_ALLOC(ctx, ncl + 1, active);
-  for (fcm_index a = 0; a < nn; a++)
-    if (map[a] >= 0) {
-      nid[map[a]] = (int32_t)a;
-      for (int i = 0; i < 3; i++) {
-        xyz[3 * map[a] + i] = X[3 * a + i];
-        pu[3 * map[a] + i] = nu[3 * a + i];
-        pv[3 * map[a] + i] = nv ? nv[3 * a + i] : 0.0;
-      }
+  for (fcm_index i = 0; i < np; i++) {
+    const fcm_index a = nodes[i], p = pid[i];
+    nid[p] = (int32_t)a;
+    for (int j = 0; j < 3; j++) {
+      xyz[3 * p + j] = X[3 * a + j];
+      pu[3 * p + j] = nu[3 * i + j];
+      pv[3 * p + j] = nv ? nv[3 * i + j] : 0.0;
     }
+  }
   if (mat) {
     FCM_ALLOC(ctx, 6 * nc + 1, sig);
     FCM_ALLOC(ctx, nc + 1, vm);
@@ -344,8 +415,11 @@ fcm_status fcm__space_write_vtu_piece(const fcm_space *s, const fcm_material *ma
   fcm_index m = 0;
   for (fcm_index c = 0; c < nc; c++)
     if (!keep || keep[c]) {
-      for (int k = 0; k < npc; k++)
-        conn[(size_t)npc * m + k] = map[cells[(size_t)npc * c + k]];
+      for (int k = 0; k < npc; k++) {
+        const fcm_index *hit =
+            bsearch(cells + (size_t)npc * c + k, nodes, (size_t)np, sizeof *nodes, cmp_node);
+        conn[(size_t)npc * m + k] = pid[hit - nodes];
+      }
       phi[m] = s->rules ? fcm_cell_rules_volume_fraction(s->rules, c) : 1.0;
       owner[m] = rank;
       cid[m] = (int32_t)c;
@@ -376,10 +450,51 @@ fcm_status fcm__space_write_vtu_piece(const fcm_space *s, const fcm_material *ma
   FCM_TRY(ctx, fcm_vtu_write(vtu, path, NULL));
 cleanup:
   fcm_vtu_destroy(&vtu);
-  void *arrays[] = {map, conn, nu,  nv,   xyz,  pu,    pv,  phi, sig,   vm,
-                    sed, csig, cvm, csed, zero, owner, cid, nid, active};
+  void *arrays[] = {pid,  conn, xyz,  pu,   pv,    phi, sig, vm,    sed,
+                    csig, cvm,  csed, zero, owner, cid, nid, active};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(ctx, arrays[k]);
+  return st;
+}
+
+fcm_status fcm__space_write_vtu_piece(const fcm_space *s, const fcm_material *mat, const double *u,
+                                      const double *v, const unsigned char *keep, int rank,
+                                      const char *path)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s ? s->ctx : NULL;
+  fcm_index np = 0, *nodes = NULL, *dofs = NULL;
+  double *nu = NULL, *nv = NULL;
+  FCM_CHECK(s && path, ctx, FCM_ERR_ARG, "write vtu piece: NULL space or path");
+  FCM_TRY(ctx, fcm__space_piece_nodes(s, keep, &np, &nodes));
+  FCM_ALLOC(ctx, np + 1, dofs);
+  FCM_ALLOC(ctx, 3 * np + 1, nu);
+  if (v) FCM_ALLOC(ctx, 3 * np + 1, nv);
+  FCM_TRY(ctx, fcm__space_node_field_dofs(s, np, nodes, dofs));
+  for (fcm_index i = 0; i < np; i++)
+    for (int j = 0; j < 3; j++) {
+      nu[3 * i + j] = u && dofs[i] >= 0 ? u[dofs[i] + j] : 0.0;
+      if (nv) nv[3 * i + j] = dofs[i] >= 0 ? v[dofs[i] + j] : 0.0;
+    }
+  FCM_TRY(ctx, write_piece(s, mat, u, keep, np, nodes, nu, nv, rank, path));
+cleanup:
+  fcm__free(ctx, nodes);
+  fcm__free(ctx, dofs);
+  fcm__free(ctx, nu);
+  fcm__free(ctx, nv);
+  return st;
+}
+
+fcm_status fcm__space_write_vtu_piece_values(const fcm_space *s, const unsigned char *keep,
+                                             fcm_index np, const fcm_index *nodes, const double *nu,
+                                             const double *nv, int rank, const char *path)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s ? s->ctx : NULL;
+  FCM_CHECK(s && path && (np == 0 || (nodes && nu)), ctx, FCM_ERR_ARG,
+            "write vtu piece: NULL space, path, nodes or values");
+  FCM_TRY(ctx, write_piece(s, NULL, NULL, keep, np, nodes, nu, nv, rank, path));
+cleanup:
   return st;
 }
 

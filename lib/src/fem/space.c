@@ -170,29 +170,39 @@ cleanup:
   return st;
 }
 
-/* Copy -> elements incidence (elements using the copy at any local node, ascending, each
- * once) as CSR over the num_dofs / 3 copies. */
-static fcm_status build_copy_incidence(fcm_space *s, fcm_index **ptr_out, fcm_index **list_out)
+/* The element at local position le (a full space: le itself). */
+static fcm_index local_elem(const fcm_space *s, fcm_index le)
+{
+  return s->local_elem ? s->local_elem[le] : le;
+}
+
+/* Copy -> elements incidence over the local topology: for each of the num_local_copies copies,
+ * the local positions of the local elements using it at any local node (ascending, each once),
+ * as CSR. g2l maps a copy rank to its local position (NULL: the identity, a full space). */
+static fcm_status build_copy_incidence(fcm_space *s, const fcm_index *g2l, fcm_index **ptr_out,
+                                       fcm_index **list_out)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
-  const fcm_index ncopy = s->num_dofs / 3, nn = s->nn;
+  const fcm_index ncopy = s->num_local_copies, nn = s->nn;
   fcm_index *ptr = NULL, *list = NULL, *fill = NULL;
   FCM_ALLOC(ctx, ncopy + 1, ptr);
   FCM_ALLOC(ctx, ncopy + 1, fill);
   for (int pass = 0; pass < 2; pass++) {
-    for (fcm_index e = 0; e < s->num_elems; e++)
+    for (fcm_index le = 0; le < s->num_local_elems; le++) {
+      const fcm_index *ed = s->elem_dof + local_elem(s, le) * nn;
       for (int a = 0; a < nn; a++) {
-        const fcm_index k = s->elem_dof[e * nn + a] / 3;
+        const fcm_index k = g2l ? g2l[ed[a] / 3] : ed[a] / 3;
         int dup = 0; /* an element may use a copy at two local nodes (constrained copies) */
         for (int b = 0; b < a && !dup; b++)
-          dup = s->elem_dof[e * nn + b] / 3 == k;
+          dup = ed[b] / 3 == ed[a] / 3;
         if (dup) continue;
         if (pass)
-          list[ptr[k] + fill[k]++] = e;
+          list[ptr[k] + fill[k]++] = le;
         else
           ptr[k + 1]++;
       }
+    }
     if (!pass) {
       for (fcm_index k = 0; k < ncopy; k++)
         ptr[k + 1] += ptr[k];
@@ -208,12 +218,14 @@ cleanup:
   return st;
 }
 
-/* Copy graph: copies sharing an element, sorted. */
-static fcm_status build_node_graph(fcm_space *s, const fcm_index *cptr, const fcm_index *cinc)
+/* Copy graph over the local topology: for each local copy, the ranks (global) of the copies
+ * sharing a local element with it, sorted. */
+static fcm_status build_node_graph(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
+                                   const fcm_index *cinc)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
-  const fcm_index ncopy = s->num_dofs / 3, nn = s->nn;
+  const fcm_index ncopy = s->num_local_copies, nn = s->nn;
   fcm_index *mark = NULL;
   FCM_ALLOC(ctx, ncopy + 1, mark);
   FCM_ALLOC(ctx, ncopy + 1, s->node_ptr);
@@ -223,11 +235,11 @@ static fcm_status build_node_graph(fcm_space *s, const fcm_index *cptr, const fc
     for (fcm_index k = 0; k < ncopy; k++) {
       fcm_index cnt = 0, base = pass ? s->node_ptr[k] : 0;
       for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++) {
-        const fcm_index e = cinc[i];
+        const fcm_index e = local_elem(s, cinc[i]);
         for (int b = 0; b < nn; b++) {
-          const fcm_index m = s->elem_dof[e * nn + b] / 3;
-          if (mark[m] == k) continue;
-          mark[m] = k;
+          const fcm_index m = s->elem_dof[e * nn + b] / 3, lm = g2l ? g2l[m] : m;
+          if (mark[lm] == k) continue;
+          mark[lm] = k;
           if (pass) s->node_adj[base + cnt] = m;
           cnt++;
         }
@@ -248,19 +260,20 @@ cleanup:
   return st;
 }
 
-/* Scalar pattern from the copy graph, and the per-element offsets. */
-static fcm_status build_pattern(fcm_space *s)
+/* Scalar pattern from the copy graph (the three rows of each local copy; global columns), and
+ * the offsets of the local elements. */
+static fcm_status build_pattern(fcm_space *s, const fcm_index *g2l)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
-  fcm_index nact = s->num_dofs / 3;
-  FCM_ALLOC(ctx, s->num_dofs + 1, s->row_ptr);
+  const fcm_index nact = s->num_local_copies, nrow = 3 * nact;
+  FCM_ALLOC(ctx, nrow + 1, s->row_ptr);
   for (fcm_index k = 0; k < nact; k++) {
     fcm_index deg = s->node_ptr[k + 1] - s->node_ptr[k];
     for (int i = 0; i < 3; i++)
       s->row_ptr[3 * k + i + 1] = s->row_ptr[3 * k + i] + 3 * deg;
   }
-  FCM_ALLOC(ctx, s->row_ptr[s->num_dofs], s->col_idx);
+  FCM_ALLOC(ctx, s->row_ptr[nrow], s->col_idx);
   for (fcm_index k = 0; k < nact; k++)
     for (int i = 0; i < 3; i++) {
       int *cols = s->col_idx + s->row_ptr[3 * k + i];
@@ -268,12 +281,12 @@ static fcm_status build_pattern(fcm_space *s)
         for (int j = 0; j < 3; j++)
           *cols++ = (int)(3 * s->node_adj[e] + j);
     }
-  FCM_ALLOC(ctx, (size_t)s->num_elems * s->nn * s->nn + 1, s->elem_off);
-  for (fcm_index el = 0; el < s->num_elems; el++) {
-    const fcm_index *ed = s->elem_dof + el * s->nn;
+  FCM_ALLOC(ctx, (size_t)s->num_local_elems * s->nn * s->nn + 1, s->elem_off);
+  for (fcm_index el = 0; el < s->num_local_elems; el++) {
+    const fcm_index *ed = s->elem_dof + local_elem(s, el) * s->nn;
     int *off = s->elem_off + (size_t)el * s->nn * s->nn;
     for (int a = 0; a < s->nn; a++) {
-      fcm_index ka = ed[a] / 3;
+      fcm_index ka = g2l ? g2l[ed[a] / 3] : ed[a] / 3;
       const fcm_index *row = s->node_adj + s->node_ptr[ka];
       size_t len = (size_t)(s->node_ptr[ka + 1] - s->node_ptr[ka]);
       for (int b = 0; b < s->nn; b++) {
@@ -288,24 +301,28 @@ cleanup:
   return st;
 }
 
-/* Greedy colouring: an element takes the smallest colour not used by an element sharing a
- * copy (elements sharing a node but using different copies of it may share a colour). */
-static fcm_status build_colors(fcm_space *s, const fcm_index *cptr, const fcm_index *cinc)
+/* Greedy colouring of the local elements: an element takes the smallest colour not used by an
+ * element sharing a copy (elements sharing a node but using different copies of it may share a
+ * colour). color_elems holds element ids. */
+static fcm_status build_colors(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
+                               const fcm_index *cinc)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
+  const fcm_index ne = s->num_local_elems;
   int *color = NULL, ncol = 0;
   fcm_index *forbid = NULL, *fill = NULL;
   enum { MAX_COLORS = 4096 };
-  FCM_ALLOC(ctx, s->num_elems + 1, color);
+  FCM_ALLOC(ctx, ne + 1, color);
   FCM_ALLOC(ctx, MAX_COLORS, forbid);
   for (int k = 0; k < MAX_COLORS; k++)
     forbid[k] = -1;
-  for (fcm_index e = 0; e < s->num_elems; e++)
+  for (fcm_index e = 0; e < ne; e++)
     color[e] = -1;
-  for (fcm_index e = 0; e < s->num_elems; e++) {
+  for (fcm_index e = 0; e < ne; e++) {
+    const fcm_index *ed = s->elem_dof + local_elem(s, e) * s->nn;
     for (int a = 0; a < s->nn; a++) {
-      const fcm_index k = s->elem_dof[e * s->nn + a] / 3;
+      const fcm_index k = g2l ? g2l[ed[a] / 3] : ed[a] / 3;
       for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++)
         if (color[cinc[i]] >= 0) forbid[color[cinc[i]]] = e;
     }
@@ -314,24 +331,94 @@ static fcm_status build_colors(fcm_space *s, const fcm_index *cptr, const fcm_in
       k++;
     FCM_CHECK(k < MAX_COLORS, ctx, FCM_ERR_UNSUPPORTED,
               "space: cell %lld needs more than %d colours (a node shared by too many cells)",
-              (long long)s->elem_cell[e], MAX_COLORS);
+              (long long)s->elem_cell[local_elem(s, e)], MAX_COLORS);
     color[e] = k;
     ncol = FCM_MAX(ncol, k + 1);
   }
   s->num_colors = ncol;
   FCM_ALLOC(ctx, ncol + 1, s->color_ptr);
-  for (fcm_index e = 0; e < s->num_elems; e++)
+  for (fcm_index e = 0; e < ne; e++)
     s->color_ptr[color[e] + 1]++;
   for (int k = 0; k < ncol; k++)
     s->color_ptr[k + 1] += s->color_ptr[k];
   FCM_ALLOC(ctx, s->color_ptr[ncol] + 1, s->color_elems);
   FCM_ALLOC(ctx, ncol + 1, fill);
-  for (fcm_index e = 0; e < s->num_elems; e++)
-    s->color_elems[s->color_ptr[color[e]] + fill[color[e]]++] = e;
+  for (fcm_index e = 0; e < ne; e++)
+    s->color_elems[s->color_ptr[color[e]] + fill[color[e]]++] = local_elem(s, e);
 cleanup:
   fcm__free(ctx, color);
   fcm__free(ctx, forbid);
   fcm__free(ctx, fill);
+  return st;
+}
+
+/* Release the topology (copy graph, pattern, offsets, colours, local lists). */
+static void free_topology(fcm_space *s)
+{
+  fcm_ctx *ctx = s->ctx;
+  void *arrays[] = {s->node_ptr,  s->node_adj,    s->row_ptr,    s->col_idx,    s->elem_off,
+                    s->color_ptr, s->color_elems, s->local_copy, s->local_elem, s->cell_local};
+  for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
+    fcm__free(ctx, arrays[i]);
+  s->node_ptr = s->node_adj = s->row_ptr = s->local_copy = s->local_elem = NULL;
+  s->color_ptr = s->color_elems = NULL;
+  s->col_idx = s->elem_off = NULL;
+  s->cell_local = NULL;
+  s->num_colors = 0;
+  s->num_local_copies = s->num_local_elems = 0;
+}
+
+/* The topology of the elements of the cells flagged in cell_mask (local; cell_mask NULL: none)
+ * or of every element (!local, the full space's): their copies, the copy graph, the pattern,
+ * the offsets and the colours. The local copies and elements are listed in ascending order,
+ * so a mask of every active cell gives the full space's arrays. */
+static fcm_status build_topology(fcm_space *s, int local, const unsigned char *cell_mask)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ncopy = s->num_dofs / 3;
+  fcm_index *g2l = NULL, *cptr = NULL, *cinc = NULL;
+  free_topology(s);
+  if (local) {
+    fcm_index ne = 0, nl = 0;
+    FCM_ALLOC(ctx, s->num_cells + 1, s->cell_local);
+    for (fcm_index c = 0; c < s->num_cells; c++) {
+      s->cell_local[c] = cell_mask && cell_mask[c] != 0 && s->active[c];
+      if (s->cell_local[c]) ne += s->cell_elem[c + 1] - s->cell_elem[c];
+    }
+    FCM_ALLOC(ctx, ne + 1, s->local_elem);
+    FCM_ALLOC(ctx, ncopy + 1, g2l); /* transient O(copies): the numbering's size */
+    for (fcm_index k = 0; k < ncopy; k++)
+      g2l[k] = -1;
+    for (fcm_index c = 0; c < s->num_cells; c++) {
+      if (!s->cell_local[c]) continue;
+      for (fcm_index e = s->cell_elem[c]; e < s->cell_elem[c + 1]; e++) {
+        s->local_elem[s->num_local_elems++] = e;
+        for (int a = 0; a < s->nn; a++)
+          g2l[s->elem_dof[e * s->nn + a] / 3] = 0;
+      }
+    }
+    for (fcm_index k = 0; k < ncopy; k++)
+      nl += g2l[k] == 0;
+    FCM_ALLOC(ctx, nl + 1, s->local_copy);
+    for (fcm_index k = 0; k < ncopy; k++)
+      if (g2l[k] == 0) {
+        s->local_copy[s->num_local_copies] = k;
+        g2l[k] = s->num_local_copies++;
+      }
+  } else {
+    s->num_local_elems = s->num_elems;
+    s->num_local_copies = ncopy;
+  }
+  FCM_TRY(ctx, build_copy_incidence(s, g2l, &cptr, &cinc));
+  FCM_TRY(ctx, build_node_graph(s, g2l, cptr, cinc));
+  FCM_TRY(ctx, build_pattern(s, g2l));
+  FCM_TRY(ctx, build_colors(s, g2l, cptr, cinc));
+cleanup:
+  if (st != FCM_OK) free_topology(s);
+  fcm__free(ctx, g2l);
+  fcm__free(ctx, cptr);
+  fcm__free(ctx, cinc);
   return st;
 }
 
@@ -470,14 +557,15 @@ cleanup:
   return st;
 }
 
-/* Shared by fcm_space_create() and fcm_space_create_embedded(). */
+/* Shared by fcm_space_create(), fcm_space_create_embedded() and fcm__space_create_local()
+ * (local != 0: the topology of the cells flagged in cell_mask only). */
 static fcm_status space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigned char *cell_active,
                                const fcm_cell_rules *rules, const fcm_space_options *opts,
-                               fcm_space **out)
+                               int local, const unsigned char *cell_mask, fcm_space **out)
 {
   fcm_status st = FCM_OK;
   fcm_space *s = NULL;
-  fcm_index *inc_ptr = NULL, *inc = NULL, *cptr = NULL, *cinc = NULL, nactive_cells = 0;
+  fcm_index *inc_ptr = NULL, *inc = NULL, nactive_cells = 0;
   FCM_CHECK(out, ctx, FCM_ERR_ARG, "space: output pointer is NULL");
   *out = NULL;
   FCM_CHECK(mesh, ctx, FCM_ERR_ARG, "space: mesh is NULL");
@@ -519,18 +607,17 @@ static fcm_status space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigne
     int dummy;
     FCM_TRY(ctx, fcm__index_to_int(ctx, s->num_dofs, "space: number of DOFs", &dummy));
   }
-  FCM_TRY(ctx, build_copy_incidence(s, &cptr, &cinc));
-  FCM_TRY(ctx, build_node_graph(s, cptr, cinc));
-  FCM_TRY(ctx, build_pattern(s));
-  FCM_TRY(ctx, build_colors(s, cptr, cinc));
+  /* the numbering's incidence is not needed any more: free it before the topology's peak */
+  FCM_FREE(ctx, inc_ptr);
+  FCM_FREE(ctx, inc);
+  s->is_local = local;
+  FCM_TRY(ctx, build_topology(s, local, cell_mask));
   FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, FCM_RULE_MASS, FCM_DEFAULT, &s->mass_rule));
   *out = s;
   s = NULL;
 cleanup:
   fcm__free(ctx, inc_ptr);
   fcm__free(ctx, inc);
-  fcm__free(ctx, cptr);
-  fcm__free(ctx, cinc);
   fcm_space_destroy(&s);
   return st;
 }
@@ -538,7 +625,7 @@ cleanup:
 fcm_status fcm_space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigned char *cell_active,
                             fcm_space **out)
 {
-  return space_create(ctx, mesh, cell_active, NULL, NULL, out);
+  return space_create(ctx, mesh, cell_active, NULL, NULL, 0, NULL, out);
 }
 
 fcm_space_options fcm_space_options_default(void)
@@ -556,13 +643,11 @@ fcm_status fcm_space_create_embedded(fcm_ctx *ctx, const fcm_mesh *mesh,
   return fcm_space_create_embedded_with(ctx, mesh, rules, &o, out);
 }
 
-fcm_status fcm_space_create_embedded_with(fcm_ctx *ctx, const fcm_mesh *mesh,
-                                          const fcm_cell_rules *rules,
-                                          const fcm_space_options *opts, fcm_space **out)
+/* The arguments of an embedded space (rules built on this mesh, constrain_ratio in range). */
+static fcm_status check_embedded(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_cell_rules *rules,
+                                 const fcm_space_options *opts)
 {
   fcm_status st = FCM_OK;
-  FCM_CHECK(out, ctx, FCM_ERR_ARG, "space: output pointer is NULL");
-  *out = NULL;
   FCM_CHECK(mesh && rules, ctx, FCM_ERR_ARG, "space: mesh or cell rules is NULL");
   FCM_CHECK(fcm_cell_rules_num_cells(rules) == fcm_mesh_num_cells(mesh) &&
                 fcm_cell_rules_element_type(rules) == fcm_mesh_element_type(mesh),
@@ -573,7 +658,51 @@ fcm_status fcm_space_create_embedded_with(fcm_ctx *ctx, const fcm_mesh *mesh,
                       opts->constrain_ratio < 0.5),
             ctx, FCM_ERR_ARG, "space: constrain_ratio = %g outside [0, 0.5)",
             opts ? opts->constrain_ratio : 0.0);
-  FCM_TRY(ctx, space_create(ctx, mesh, NULL, rules, opts, out));
+cleanup:
+  return st;
+}
+
+fcm_status fcm_space_create_embedded_with(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                          const fcm_cell_rules *rules,
+                                          const fcm_space_options *opts, fcm_space **out)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(out, ctx, FCM_ERR_ARG, "space: output pointer is NULL");
+  *out = NULL;
+  FCM_TRY(ctx, check_embedded(ctx, mesh, rules, opts));
+  FCM_TRY(ctx, space_create(ctx, mesh, NULL, rules, opts, 0, NULL, out));
+cleanup:
+  return st;
+}
+
+fcm_status fcm__space_create_local(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                   const unsigned char *cell_active, const fcm_cell_rules *rules,
+                                   const fcm_space_options *opts, const unsigned char *cell_mask,
+                                   fcm_space **out)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(out, ctx, FCM_ERR_ARG, "space: output pointer is NULL");
+  *out = NULL;
+  if (rules) {
+    FCM_CHECK(!cell_active, ctx, FCM_ERR_ARG,
+              "local space: give the cell rules or cell_active, not both (the rules decide "
+              "which cells are active)");
+    FCM_TRY(ctx, check_embedded(ctx, mesh, rules, opts));
+  }
+  FCM_TRY(ctx, space_create(ctx, mesh, cell_active, rules, rules ? opts : NULL, 1, cell_mask, out));
+cleanup:
+  return st;
+}
+
+fcm_status fcm__space_set_local_cells(fcm_space *s, const unsigned char *cell_mask)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s ? s->ctx : NULL;
+  FCM_CHECK(s, ctx, FCM_ERR_ARG, "local space: NULL space");
+  FCM_CHECK(s->is_local, ctx, FCM_ERR_ARG,
+            "local space: the space is a full space (fcm_space_create*()); only a space of "
+            "fcm__space_create_local() takes a cell mask");
+  FCM_TRY(ctx, build_topology(s, 1, cell_mask));
 cleanup:
   return st;
 }
@@ -595,14 +724,8 @@ void fcm_space_destroy(fcm_space **sp)
   fcm__free(ctx, s->elem_cell);
   fcm__free(ctx, s->elem_piece);
   fcm__free(ctx, s->elem_dof);
-  fcm__free(ctx, s->node_ptr);
-  fcm__free(ctx, s->node_adj);
-  fcm__free(ctx, s->row_ptr);
-  fcm__free(ctx, s->col_idx);
-  fcm__free(ctx, s->elem_off);
+  free_topology(s);
   fcm_rule_destroy(&s->mass_rule);
-  fcm__free(ctx, s->color_ptr);
-  fcm__free(ctx, s->color_elems);
   fcm__free(ctx, s);
   *sp = NULL;
 }
@@ -667,9 +790,40 @@ const fcm_mesh *fcm_space_mesh(const fcm_space *s)
   return s->mesh;
 }
 
+fcm_status fcm__space_check_full(const fcm_space *s, const char *what)
+{
+  if (!s->is_local) return FCM_OK;
+  fcm_index nl = 0;
+  for (fcm_index c = 0; s->cell_local && c < s->num_cells; c++)
+    nl += s->cell_local[c] != 0;
+  return fcm__error(s->ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                    "%s: the space is a local space (its pattern covers the elements of %lld of "
+                    "its %lld cells: a distributed run's own and ghost cells); this needs the "
+                    "whole pattern: build the space with fcm_space_create() or "
+                    "fcm_space_create_embedded()",
+                    what, (long long)nl, (long long)s->num_cells);
+}
+
+void fcm__space_memory(const fcm_space *s, double *numbering, double *topology)
+{
+  const double I = (double)sizeof(fcm_index), nn = (double)s->nn;
+  const double ne = (double)s->num_elems, nc = (double)s->num_cells, np = (double)s->num_nodes;
+  const double nl = (double)s->num_local_copies, nle = (double)s->num_local_elems;
+  const double nadj = s->node_ptr ? (double)s->node_ptr[s->num_local_copies] : 0.0;
+  if (numbering) /* active, node_dof, node_ncopy, cell_elem, elem_cell, elem_piece, elem_dof */
+    *numbering = nc + 2.0 * I * np + I * (nc + 1.0) + 2.0 * I * ne + I * nn * ne;
+  if (topology) /* node_ptr, node_adj, row_ptr, col_idx (9 per graph entry), elem_off, colours,
+                   local lists */
+    *topology = I * (nl + 1.0) + I * nadj + I * (3.0 * nl + 1.0) +
+                (double)sizeof(int) * 9.0 * nadj + (double)sizeof(int) * nn * nn * nle +
+                I * ((double)s->num_colors + 1.0) + I * nle +
+                (s->is_local ? I * (nl + nle) + nc : 0.0);
+}
+
 fcm_status fcm_space_matrix_create(const fcm_space *s, fcm_csr **A)
 {
   fcm_status st = FCM_OK;
+  FCM_TRY(s->ctx, fcm__space_check_full(s, "space matrix"));
   FCM_TRY(s->ctx, fcm_csr_create(s->ctx, s->num_dofs, s->num_dofs, s->row_ptr, s->col_idx,
                                  FCM_CSR_SYMMETRIC, A));
 cleanup:

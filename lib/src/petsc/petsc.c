@@ -33,8 +33,17 @@
  *   and a phase-2 process that fails before the rules build meets it with its final
  * fcm__petsc_agree().
  * - DOFs: global numbering, owner = lowest process among the cells using the DOF copy, the
- *   PETSc index is contiguous per owner; the perm (space DOF -> PETSc index) and the space's
- *   pattern are REPLICATED (O(DOFs + nnz) integers per process).
+ *   PETSc index is contiguous per owner; the numbering (fem_impl.h: node_dof, node_ncopy,
+ *   elem_*, cell_elem) and the perm / copy_owner (space DOF -> PETSc index, owner) are
+ *   REPLICATED: O(nodes + elements nn), measured 22 B/DOF (Hex20) / 39 B/DOF (Hex8, most of a
+ *   24^3 grid outside the ball) plus 4-7 B/DOF of the adapter's arrays (petsc_bench).
+ * - topology (phase 1): a local space (fcm__space_create_local(), fem_impl.h), the serial
+ *   numbering bit for bit with the copy graph, pattern, offsets and colours of the own cells
+ *   and their ghosts only (localize_space(): cells with an element using an owned copy; the
+ *   comment there proves every owned row complete; tests/petsc/ghost.c). Measured
+ *   (petsc_bench, fcm__space_memory()): full space 435 (Hex8) / 827 (Hex20) B/DOF on every
+ *   process before; local 224-252 / 424-523 B/DOF per process on 2 processes. create_matrix()
+ *   preallocates from the owned local rows (exact: nz_allocated = nz_used, ghost.c).
  * - assembly: own elements only (fcm__assembly_element_linear), MatSetValues ADD_VALUES into a
  *   preallocated MATMPIAIJ (block size 3), VECMPI loads; stiffness, mass, gravity.
  * - constraints: node sets with fcm_motion (no release), symmetric elimination with
@@ -46,7 +55,13 @@
  * - errors: every local phase ends in fcm__petsc_agree(): an error on any process is returned on
  * all with the lowest failing process's message (tests/petsc: bad input on one rank, no hang).
  * - output: fcm_petsc_problem_write_frame(): a .pvtu (process 0) naming one piece per process
- *   (its own cells); the node fields come from the gathered (replicated) state. The integrator
+ *   (its own cells); the node fields come from a VecScatter of the piece's node values (the
+ *   DOF copy fcm_space_node_field() shows at each node of an own cell, made at the first
+ *   frame: frame_nodes(), frame_scatter()), byte for byte the file written from the gathered
+ *   state (ghost.c). Energies are MatMult / VecDot on the distributed vectors (no gather).
+ *   Still O(n) per process: fcm_petsc_problem_get_state() (every process: the user asks for
+ *   the whole state) and the checkpoint (gathered on process 0 only; read whole by every
+ *   process). The integrator
  *   path's background frames are the same (fcm__space_write_vtu_piece() / fcm__write_pvtu(),
  *   fields.c, from fcm_simulation_write_frame()); its surface frames stay serial (process 0).
  * - scenes: fcm_petsc_problem_create_from_scene() (mesh + geometry through
@@ -204,6 +219,14 @@
  *   an options prefix per problem would scope it.
  * - README projection for 1e8 DOFs (memory and time per DOF are printed by
  *   tests/petsc/bench.c, figures in README "Distributed runs").
+ * - replicated still (phase 1): the numbering and the adapter's per-copy arrays (perm,
+ *   copy_owner, is_con), the mesh (and the whole geometry until the cropped rules build):
+ *   about 5 GB per process at 1e8 Hex20 DOFs (README projection). Next: number each process's own copies locally and exchange the
+ *   ghosts' numbers (PetscSF), with the mesh cropped to own + ghost cells.
+ * - phase 2 keeps the simulation's full space (fcm_space_create_embedded(): its dense sums and
+ *   nitsche.c's coloured assembly need the whole pattern). What it would need to use a local
+ *   space: see fcm__space_create_local() in fem_impl.h (own-element assembly into local rows,
+ *   ADD_VALUES into the MATMPIAIJ).
  * ------------------------------------------------------------------------------------------ */
 #define _GNU_SOURCE /* RTLD_DEFAULT */
 /* before PETSc's headers: they include complex.h, whose macro I clashes with the integrator
@@ -535,8 +558,6 @@ cleanup:
 static fcm_status rules_exchange(void *user, fcm_status st, unsigned char *cls, double *fraction,
                                  double *volume, fcm__embed_counts *counts);
 
-/* The rules (geometry: points on the cells flagged in `mask` only, each cell classified by one
- * process: P->remote, rules_exchange()) or the plain space. */
 /* The options of phase 1's rules build: points on the cells flagged in mask. */
 static fcm_cell_rules_options rules_options(const fcm_petsc_problem *P, const unsigned char *mask)
 {
@@ -547,6 +568,10 @@ static fcm_cell_rules_options rules_options(const fcm_petsc_problem *P, const un
   return ro;
 }
 
+/* The rules (geometry: points on the cells flagged in `mask` only, each cell classified by one
+ * process: P->remote, rules_exchange()) and the space's numbering (fcm__space_create_local(),
+ * the serial space's numbering bit for bit; its topology comes after the DOFs' ownership,
+ * localize_space()). */
 static fcm_status build_space(fcm_petsc_problem *P, const fcm_geometry *geom,
                               const unsigned char *mask)
 {
@@ -556,9 +581,10 @@ static fcm_status build_space(fcm_petsc_problem *P, const fcm_geometry *geom,
     const fcm_cell_rules_options ro = rules_options(P, mask);
     const fcm__rules_exchange x = {P->remote, rules_exchange, P};
     FCM_TRY(ctx, fcm__cell_rules_create_distributed(ctx, P->mesh, geom, &ro, NULL, &x, &P->rules));
-    FCM_TRY(ctx, fcm_space_create_embedded(ctx, P->mesh, P->rules, &P->space));
+    const fcm_space_options so = fcm_space_options_default(); /* fcm_space_create_embedded()'s */
+    FCM_TRY(ctx, fcm__space_create_local(ctx, P->mesh, NULL, P->rules, &so, NULL, &P->space));
   } else {
-    FCM_TRY(ctx, fcm_space_create(ctx, P->mesh, NULL, &P->space));
+    FCM_TRY(ctx, fcm__space_create_local(ctx, P->mesh, NULL, NULL, NULL, NULL, &P->space));
   }
 cleanup:
   return st;
@@ -816,20 +842,54 @@ cleanup:
   return st;
 }
 
-/* A preallocated MATMPIAIJ (block size 3) with the space's pattern on the owned rows. */
+/* Phase 1: the space's topology for this process's own cells and their ghosts, the cells with
+ * an element that uses a DOF copy this process owns (fcm__space_set_local_cells()).
+ * Why the graph row of every owned copy k is then the full space's row: the full row lists
+ * the copies of the elements that use k. Each of those elements uses a copy this process owns
+ * (k), so its cell is flagged, and the local row of k (the copies of the LOCAL elements that
+ * use k) is the same set. And k is local: its owner is the lowest process among the cells
+ * using it, so one of this process's own cells uses it. Hence create_matrix() preallocates
+ * the owned rows exactly as from the full pattern (tests/petsc/ghost.c asserts the rows, and
+ * that the own cells alone would miss some). */
+static fcm_status localize_space(fcm_petsc_problem *P)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  fcm_space *s = P->space;
+  const int nn = s->nn;
+  unsigned char *mask = NULL;
+  FCM_ALLOC(ctx, s->num_cells + 1, mask);
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    const fcm_index c = s->elem_cell[e];
+    int mine = P->cell_owner[c] == P->rank;
+    for (int a = 0; a < nn && !mine; a++)
+      mine = P->copy_owner[s->elem_dof[e * nn + a] / 3] == P->rank;
+    if (mine) mask[c] = 1;
+  }
+  FCM_TRY(ctx, fcm__space_set_local_cells(s, mask));
+cleanup:
+  fcm__free(ctx, mask);
+  return st;
+}
+
+/* A preallocated MATMPIAIJ (block size 3) with the space's pattern on the owned rows (every
+ * owned copy is one of the space's local copies: localize_space(); the integrator's full
+ * space has every copy). */
 static fcm_status create_matrix(fcm_petsc_problem *P, Mat *A)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P->ctx;
   const fcm_space *s = P->space;
-  PetscInt *dnz = NULL, *onz = NULL;
+  PetscInt *dnz = NULL, *onz = NULL, rows = 0;
   const PetscInt nl = 3 * P->nlocal;
   FCM_ALLOC(ctx, nl + 1, dnz);
   FCM_ALLOC(ctx, nl + 1, onz);
-  for (fcm_index k = 0; k < P->ncopy; k++) {
+  for (fcm_index lk = 0; lk < s->num_local_copies; lk++) {
+    const fcm_index k = s->local_copy ? s->local_copy[lk] : lk;
     if (P->copy_owner[k] != P->rank) continue;
+    rows++;
     PetscInt d = 0, o = 0;
-    for (fcm_index j = s->node_ptr[k]; j < s->node_ptr[k + 1]; j++) {
+    for (fcm_index j = s->node_ptr[lk]; j < s->node_ptr[lk + 1]; j++) {
       if (P->copy_owner[s->node_adj[j]] == P->rank)
         d += 3;
       else
@@ -841,6 +901,9 @@ static fcm_status create_matrix(fcm_petsc_problem *P, Mat *A)
       onz[row + i] = o;
     }
   }
+  FCM_CHECK(rows == P->nlocal, ctx, FCM_ERR_INTERNAL,
+            "petsc: the space's topology has %lld of the %lld DOF copies this process owns",
+            (long long)rows, (long long)P->nlocal);
   PCALL(ctx, MatCreate(P->comm, A));
   PCALL(ctx, MatSetSizes(*A, nl, nl, (PetscInt)P->n, (PetscInt)P->n));
   PCALL(ctx, MatSetType(*A, MATMPIAIJ));
@@ -978,6 +1041,7 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
   P->time_rules = fcm_wtime() - tr;
   st = fcm_assembly_workspace_create(P->space, &P->opts.assembly, &P->aws);
   if (st == FCM_OK) st = number_dofs(P);
+  if (st == FCM_OK) st = localize_space(P);
   if (st == FCM_OK) {
     P->is_con = fcm__calloc(ctx, (size_t)P->n + 1, 1);
     if (!P->is_con) st = FCM_ERR_ALLOC;
@@ -1014,6 +1078,9 @@ void fcm_petsc_problem_destroy(fcm_petsc_problem **problem)
   PetscFree(P->rows);
   VecScatterDestroy(&P->to_all);
   VecDestroy(&P->all);
+  VecScatterDestroy(&P->frame_sc);
+  VecDestroy(&P->frame_vec);
+  fcm__free(ctx, P->frame_nodes);
   fcm_assembly_workspace_destroy(&P->aws);
   if (!P->borrowed_space) fcm_space_destroy(&P->space);
   fcm_cell_rules_destroy(&P->rules);
@@ -1518,16 +1585,24 @@ cleanup:
   return st;
 }
 
-static fcm_status gather(fcm_petsc_problem *P, Vec x, double *out)
+/* The whole vector x in the space's numbering into out (n values) on every process (to_zero:
+ * on process 0 only; out is not read elsewhere). O(n) memory and traffic per receiving
+ * process: for fcm_petsc_problem_get_state() (every process) and the checkpoint (process 0);
+ * frames and energies do without it. Collective. */
+static fcm_status gather(fcm_petsc_problem *P, Vec x, double *out, int to_zero)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P->ctx;
   VecScatter sc = NULL;
   Vec all = NULL;
   const PetscScalar *a = NULL;
-  PCALL(ctx, VecScatterCreateToAll(x, &sc, &all));
+  if (to_zero)
+    PCALL(ctx, VecScatterCreateToZero(x, &sc, &all));
+  else
+    PCALL(ctx, VecScatterCreateToAll(x, &sc, &all));
   PCALL(ctx, VecScatterBegin(sc, x, all, INSERT_VALUES, SCATTER_FORWARD));
   PCALL(ctx, VecScatterEnd(sc, x, all, INSERT_VALUES, SCATTER_FORWARD));
+  if (to_zero && P->rank != 0) goto cleanup;
   PCALL(ctx, VecGetArrayRead(all, &a));
   for (fcm_index k = 0; k < P->ncopy; k++)
     for (int i = 0; i < 3; i++)
@@ -1543,8 +1618,8 @@ fcm_status fcm_petsc_problem_get_state(fcm_petsc_problem *P, double *u, double *
 {
   fcm_status st = FCM_OK;
   FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
-  if (u) FCM_TRY(P->ctx, gather(P, P->u, u));
-  if (v) FCM_TRY(P->ctx, gather(P, P->v, v));
+  if (u) FCM_TRY(P->ctx, gather(P, P->u, u, 0));
+  if (v) FCM_TRY(P->ctx, gather(P, P->v, v, 0));
 cleanup:
   return st;
 }
@@ -2299,29 +2374,95 @@ cleanup:
 
 /* ---------------------------------------------------------------- output */
 
+/* The frames' nodes (local part of the first frame's setup): the nodes of the own cells and,
+ * per node, the PETSc block of the DOF copy fcm_space_node_field() shows there
+ * (fcm__space_node_field_dofs(): the largest support among the node's copies, which may be a
+ * copy no own or ghost cell uses: the scatter fetches it from its owner like any other). */
+static fcm_status frame_nodes(fcm_petsc_problem *P, const unsigned char *keep, PetscInt **blocks)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  fcm_index *dofs = NULL;
+  FCM_FREE(ctx, P->frame_nodes); /* a failed first frame's */
+  FCM_TRY(ctx, fcm__space_piece_nodes(P->space, keep, &P->frame_np, &P->frame_nodes));
+  FCM_ALLOC(ctx, P->frame_np + 1, dofs);
+  FCM_ALLOC(ctx, P->frame_np + 1, *blocks);
+  FCM_TRY(ctx, fcm__space_node_field_dofs(P->space, P->frame_np, P->frame_nodes, dofs));
+  for (fcm_index i = 0; i < P->frame_np; i++) {
+    FCM_CHECK(dofs[i] >= 0, ctx, FCM_ERR_INTERNAL, "petsc: node %lld of an own cell has no DOF",
+              (long long)P->frame_nodes[i]);
+    (*blocks)[i] = P->perm[dofs[i] / 3];
+  }
+cleanup:
+  fcm__free(ctx, dofs);
+  return st;
+}
+
+/* The frames' scatter from the global vectors to frame_vec (3 values per frame node).
+ * Collective (VecScatterCreate). */
+static fcm_status frame_scatter(fcm_petsc_problem *P, const PetscInt *blocks)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  IS from = NULL;
+  VecDestroy(&P->frame_vec); /* a failed first frame's */
+  PCALL(ctx,
+        ISCreateBlock(PETSC_COMM_SELF, 3, (PetscInt)P->frame_np, blocks, PETSC_COPY_VALUES, &from));
+  PCALL(ctx, VecCreateSeq(PETSC_COMM_SELF, 3 * (PetscInt)P->frame_np, &P->frame_vec));
+  PCALL(ctx, VecScatterCreate(P->u, from, P->frame_vec, NULL, &P->frame_sc));
+cleanup:
+  ISDestroy(&from);
+  return st;
+}
+
+/* The frame values of x (3 per frame node) into out. Collective. */
+static fcm_status frame_values(fcm_petsc_problem *P, Vec x, double *out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const PetscScalar *a = NULL;
+  PCALL(ctx, VecScatterBegin(P->frame_sc, x, P->frame_vec, INSERT_VALUES, SCATTER_FORWARD));
+  PCALL(ctx, VecScatterEnd(P->frame_sc, x, P->frame_vec, INSERT_VALUES, SCATTER_FORWARD));
+  PCALL(ctx, VecGetArrayRead(P->frame_vec, &a));
+  for (fcm_index i = 0; i < 3 * P->frame_np; i++)
+    out[i] = a[i];
+  PCALL(ctx, VecRestoreArrayRead(P->frame_vec, &a));
+cleanup:
+  return st;
+}
+
+/* Each process writes the piece of its own cells from the values of the nodes of those cells
+ * alone (frame_setup(): a scatter of O(piece) values, not the whole state). */
 fcm_status fcm_petsc_problem_write_frame(fcm_petsc_problem *P, const char *dir, const char *stem)
 {
   fcm_status st = FCM_OK;
   double *u = NULL, *v = NULL;
   unsigned char *keep = NULL;
+  PetscInt *blocks = NULL;
   char path[4096];
   FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
   fcm_ctx *ctx = P->ctx;
   FCM_CHECK(dir && stem && *stem, ctx, FCM_ERR_ARG, "petsc: write_frame: NULL directory or stem");
-  u = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *u);
-  v = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *v);
-  st = u && v ? FCM_OK : FCM_ERR_ALLOC;
+  const fcm_index nc = fcm_mesh_num_cells(P->mesh);
+  const int first = !P->frame_sc; /* the same on every process: every frame is collective */
+  keep = fcm__calloc(ctx, (size_t)nc + 1, 1);
+  st = keep ? FCM_OK : FCM_ERR_ALLOC;
+  for (fcm_index c = 0; keep && c < nc; c++)
+    keep[c] = P->cell_owner[c] == P->rank;
+  if (st == FCM_OK && first) st = frame_nodes(P, keep, &blocks);
   FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
-  FCM_TRY(ctx, fcm_petsc_problem_get_state(P, u, v)); /* collective */
-  { /* this process's piece: its own cells (fcm__space_write_vtu_piece(), fields.c) */
-    const fcm_index nc = fcm_mesh_num_cells(P->mesh);
-    keep = fcm__calloc(ctx, (size_t)nc + 1, 1);
-    st = keep ? FCM_OK : FCM_ERR_ALLOC;
-    for (fcm_index c = 0; keep && c < nc; c++)
-      keep[c] = P->cell_owner[c] == P->rank;
-    snprintf(path, sizeof path, "%s/%s_%d.vtu", dir, stem, P->rank);
-    if (st == FCM_OK) st = fcm__space_write_vtu_piece(P->space, NULL, u, v, keep, P->rank, path);
+  if (first) FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, frame_scatter(P, blocks)));
+  if (st == FCM_OK) {
+    u = fcm__calloc(ctx, 3 * (size_t)P->frame_np + 1, sizeof *u);
+    v = fcm__calloc(ctx, 3 * (size_t)P->frame_np + 1, sizeof *v);
+    if (!u || !v) st = FCM_ERR_ALLOC;
   }
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
+  FCM_TRY(ctx, frame_values(P, P->u, u)); /* collective */
+  FCM_TRY(ctx, frame_values(P, P->v, v));
+  snprintf(path, sizeof path, "%s/%s_%d.vtu", dir, stem, P->rank);
+  st = fcm__space_write_vtu_piece_values(P->space, keep, P->frame_np, P->frame_nodes, u, v, P->rank,
+                                         path);
   FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
   if (P->rank == 0) {
     snprintf(path, sizeof path, "%s/%s.pvtu", dir, stem);
@@ -2333,6 +2474,7 @@ cleanup:
     fcm__free(P->ctx, u);
     fcm__free(P->ctx, v);
     fcm__free(P->ctx, keep);
+    fcm__free(P->ctx, blocks);
   }
   return st;
 }
@@ -2354,13 +2496,15 @@ fcm_status fcm_petsc_problem_write_checkpoint(fcm_petsc_problem *P, const char *
   st = path ? FCM_OK
             : fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
                          "petsc: checkpoint: NULL path");
-  if (st == FCM_OK) {
-    u = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *u);
-    v = fcm__calloc(ctx, (size_t)P->n + 1, sizeof *v);
+  if (st == FCM_OK) { /* the state is gathered on process 0 only (O(n) there) */
+    const size_t len = P->rank == 0 ? (size_t)P->n + 1 : 1;
+    u = fcm__calloc(ctx, len, sizeof *u);
+    v = fcm__calloc(ctx, len, sizeof *v);
     if (!u || !v) st = FCM_ERR_ALLOC;
   }
   FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
-  FCM_TRY(ctx, fcm_petsc_problem_get_state(P, u, v));
+  FCM_TRY(ctx, gather(P, P->u, u, 1));
+  FCM_TRY(ctx, gather(P, P->v, v, 1));
   if (P->rank == 0) {
     st = fcm_atomic_file_open(ctx, path, &af);
     if (st == FCM_OK) {

@@ -26,7 +26,8 @@ struct fcm_petsc_problem {
   char prefix[32];     /* the KSP's options prefix, unique per problem ("fcm1_", ...) */
   fcm_petsc_partition partition;
   fcm_cell_rules *rules; /* this process's cells carry points */
-  fcm_space *space;      /* replicated topology */
+  fcm_space *space;      /* phase 1: a local space (numbering replicated, topology of own +
+                            ghost cells: localize_space()); phase 2: the simulation's (full) */
   fcm_assembly_workspace *aws;
   fcm_index n;           /* global DOFs */
   fcm_index ncopy;       /* n / 3 */
@@ -88,6 +89,12 @@ struct fcm_petsc_problem {
   Vec all;
   fcm_petsc_traffic traffic; /* the integrator's backend (fcm_petsc_simulation_traffic()) */
   unsigned char *owned_dof;  /* n: 1 on the DOFs whose rows this process owns (newton_build) */
+  /* phase-1 frames (fcm_petsc_problem_write_frame(), made at the first): the piece's nodes
+   * (of the own cells, ascending) and a scatter of their node-field DOFs into frame_vec */
+  fcm_index frame_np;
+  fcm_index *frame_nodes;
+  VecScatter frame_sc;
+  Vec frame_vec;
 };
 
 /* A PETSc call: on failure, record its message as FCM_ERR_INTERNAL. */
