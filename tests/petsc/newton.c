@@ -10,7 +10,12 @@
  *   relative to the largest value of the column (reactions, moments, momentum: of all
  *   columns of the kind; momentum at least the mass times the largest speed);
  * - the distributed run's linear solves went through PETSc (iterations counted) while the
- *   serial one's matrices were never factored by PETSc (nothing more to check there).
+ *   serial one's matrices were never factored by PETSc (nothing more to check there);
+ * - the Newton matrices were not summed densely (fcm_petsc_simulation_traffic()): during the
+ *   steps no dense sum carried more values than the space has DOFs, fewer values per Newton
+ *   matrix were summed than the matrix has nonzeros (one dense tangent sum alone would be
+ *   that many), entries were added into the distributed matrix and, on 2 processes
+ *   that both have cells, entries of rows another process owns went through PETSc's stash.
  * Arguments: scenes directory, scene file, steps, [tol (default 1e-8)], then PETSc options.
  * The KSP runs to rtol 1e-12 (-ksp_rtol, as a user would set it). */
 #define _POSIX_C_SOURCE 200809L
@@ -58,6 +63,8 @@ int main(int argc, char **argv)
   const fcm_index n = fcm_integrator_num_dofs(is);
   TEST_TRUE(fcm_integrator_num_dofs(ip) == n);
   long long linear = 0;
+  fcm_petsc_traffic t0, t1;
+  TEST_OK(ctx, fcm_petsc_simulation_traffic(par, &t0));
   for (int s = 0; s < steps && !test_failures_; s++) {
     fcm_step_info a, b;
     TEST_OK(ctx, fcm_simulation_step(ser, &a));
@@ -76,6 +83,39 @@ int main(int argc, char **argv)
     linear += b.linear_iterations;
   }
   TEST_TRUE(linear > 0); /* the solves went through the KSP */
+  TEST_OK(ctx, fcm_petsc_simulation_traffic(par, &t1));
+  {
+    fcm_csr *A = NULL;
+    fcm_index nnz = 0;
+    TEST_OK(ctx, fcm_space_matrix_create(fcm_simulation_space(par), &A));
+    fcm_csr_get_size(A, NULL, NULL, &nnz);
+    fcm_csr_destroy(&A);
+    const long long matrices = t1.matrices - t0.matrices;
+    const long long values = t1.reduce_values - t0.reduce_values;
+    /* [0]: stash values of all processes; [1]: processes that added no entry at all; [2]:
+     * entries added to own rows in the steps, all processes */
+    long long mine2[3] = {t1.matrix_values_sent,
+                          t1.matrix_values_local + t1.matrix_values_sent == 0,
+                          t1.matrix_values_local - t0.matrix_values_local},
+              all2[3] = {0, 0, 0};
+    MPI_Allreduce(mine2, all2, 3, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
+    const long long all_sent = all2[0];
+    if (rank == 0 && getenv("FCM_TEST_VERBOSE"))
+      fprintf(stderr,
+              "traffic: %lld DOFs, %lld nonzeros; steps: %lld matrices, %lld sums of %lld "
+              "values (%.1f per matrix), stash %lld values (all processes)\n",
+              (long long)n, (long long)nnz, matrices, t1.reduces - t0.reduces, values,
+              matrices ? (double)values / (double)matrices : 0.0, all_sent);
+    TEST_TRUE(nnz > n);
+    TEST_TRUE(matrices > 0);
+    TEST_TRUE(t1.reduce_large == t0.reduce_large); /* no matrix summed in the steps */
+    TEST_TRUE(values < matrices * (long long)nnz);
+    /* the entries went through the distributed matrix: onto owned rows and, when every
+     * process has cells of the (connected) body, across processes through the stash */
+    TEST_TRUE(all2[2] > 0);
+    if (size > 1 && all2[1] == 0) TEST_TRUE(all_sent > 0);
+    if (size == 1) TEST_TRUE(t1.matrix_values_sent == 0);
+  }
   compare_runs(ctx, ser, par, steps, tol, rank);
 
   fcm_simulation_destroy(&ser);

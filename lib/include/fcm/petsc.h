@@ -319,6 +319,36 @@ FCM_API fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, cons
  * FCM_ERR_INTERNAL (MPI). On every process when any failed. */
 FCM_API fcm_status fcm_petsc_simulation_summary_view(fcm_simulation *sim, FILE *f);
 
+/** What the integrator's backend of a simulation of fcm_petsc_simulation_create() has
+ * communicated on THIS process so far (over every cut's rebuilt backend). Two channels:
+ * - the dense sums (MPI_Reduce to process 0 + MPI_Bcast) of the partial quantities every
+ *   process holds in full: scalars (energies, the agreement on finiteness), the internal force
+ *   and the elimination's lift (n doubles each), the mass matrix and the loads at setup;
+ * - the Newton matrices: each process adds its own partial matrix (its cells' tangent, the
+ *   base M/h^2 + D/h on the rows it owns) into the distributed MATMPIAIJ with ADD_VALUES;
+ *   entries of rows other processes own travel through PETSc's stash (row and column index and
+ *   value per entry: matrix_bytes_sent counts 2 sizeof(PetscInt) + sizeof(PetscScalar) each).
+ * Times are this process's: wall seconds (waits included) and CPU seconds (clock()). */
+typedef struct fcm_petsc_traffic {
+  long long reduces;            /**< dense sums */
+  long long reduce_values;      /**< doubles this process handed to them */
+  long long reduce_bytes;       /**< 8 per value (sent to the reduce; as many come back) */
+  long long reduce_large;       /**< sums of more values than the space has DOFs (a matrix:
+                                     the mass matrix at setup; none in the steps) */
+  long long matrices;           /**< Newton matrices given to the backend (factorizations) */
+  long long matrix_values_local; /**< entries added to rows this process owns */
+  long long matrix_values_sent;  /**< entries added to other processes' rows (stash) */
+  long long matrix_rows_sent;    /**< rows of those (all-zero rows are not sent) */
+  long long matrix_bytes_sent;   /**< stash payload of those entries (see above) */
+  double time_reduce, cpu_reduce; /**< seconds in the dense sums */
+  double time_matrix, cpu_matrix; /**< seconds adding the matrices (MatSetValues, assembly) */
+} fcm_petsc_traffic;
+
+/** This process's communication counters of the integrator's backend (fcm_petsc_traffic).
+ * Local. @return FCM_OK; FCM_ERR_ARG (NULL argument, or not a simulation of
+ * fcm_petsc_simulation_create()). */
+FCM_API fcm_status fcm_petsc_simulation_traffic(const fcm_simulation *sim, fcm_petsc_traffic *out);
+
 #ifdef __cplusplus
 }
 #endif

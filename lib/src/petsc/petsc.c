@@ -78,17 +78,45 @@
  * - masked rules now also give OTHER processes' UNCUT cells no points in the assembly and in
  *   fcm_space_momentum() (fcm__cell_rules_owns(), embed_impl.h; lib/src/fem/assemble.c): before,
  *   only cut cells were masked (the linear driver never noticed: it loops over own elements).
- * - the integrator sums after each assembly: mass matrix and loads (setup, so M and fext are
- *   global), energy + force + tangent in evaluate() and assemble_tangent() (the base
- *   M/h^2 + D/h is added on the root only), the damping tangent, the representative force,
+ * - the integrator sums after each assembly (dense, newton_reduce()): the mass matrix (nnz
+ *   doubles, once at setup) and the loads (so M and fext are global), energy + force in
+ *   evaluate(), the damping matrix's product D (x - u_n) there, the representative force,
  *   fcm_integrator_energy(), the boundary reactions, the boundary point counts (nitsche.c),
- *   and the log's mass and momentum (run.c). A non-finite value on any process counts as one
- *   everywhere; every reduce starts with fcm__petsc_agree(), so a process that fails outside a
- * reduce ends with one fcm__petsc_agree() and meets the others wherever they wait (no hang).
+ *   and the log's mass and momentum (run.c); n doubles per sum at most in the steps. A
+ *   non-finite value on any process counts as one everywhere; every reduce starts with
+ *   fcm__petsc_agree(), so a process that fails outside a reduce ends with one
+ *   fcm__petsc_agree() and meets the others wherever they wait (no hang).
  * - sums: MPI_Reduce to process 0 + MPI_Bcast (the same bits everywhere for any count).
- * - solve: owned rows of the (already eliminated, summed) Newton matrix into a MATMPIAIJ with
- *   INSERT_VALUES, KSP: MUMPS Cholesky/LU when the scene says "direct", else CG/MINRES + GAMG
- *   (psd flag of the integrator); -ksp_type / -pc_type keep the user's choice. KSP divergence
+ * - the Newton matrix is NOT summed densely (since session 7, task i14-sparse): each process
+ *   keeps its PARTIAL matrix (its cells' tangent and boundary terms; the base M/h^2 on the
+ *   rows it owns, fcm__sim_backend.owned; D/h of its partial damping matrix D, whose
+ *   alpha_M M part is on its owned rows too), eliminates the active constraints in it
+ *   (newton.c eliminate_partial(): rows and columns zeroed; the lift H_fc inc_c and the
+ *   constrained diagonal summed as vectors, n doubles with a predictor, nact without; the
+ *   diagonal, the summed one or 1 as fcm__eliminate_marked() takes it, on the owner's row;
+ *   the linear reuse path sums H0 inc as an n-vector), and newton_factor() adds it into the
+ *   MATMPIAIJ (MatZeroEntries, then MatSetValues ADD_VALUES per CSR row, all-zero rows
+ *   skipped, off-process rows through PETSc's stash, MatAssembly). Nothing there needs the
+ *   same pattern on every process (each process's matrix needs the entries its cells touch and
+ *   the diagonal of its owned DOFs). Determinism: the owner's value comes first, then the
+ *   stash's in the order its messages are processed (MatStashScatterGetMesg_BTS: MPI_Waitsome,
+ *   arrival order); on 2 processes an entry has at most one sender (same bits every run, the
+ *   resume tests hold), on 3+ an entry touched by two other processes may be summed in
+ *   another order between runs (round-off). Measured on 3 processes (oversubscribed,
+ *   petsc_newton clamped_surface 3 steps, -ksp_type cg -pc_type gamg, 4 runs each): the
+ *   final |u| differed between runs in the last 2 digits both with this change and with the
+ *   old dense sums (then the matrix was the same bits every run: the KSP / GAMG on 3
+ *   processes varies by itself), so bitwise repetition on 3+ processes was not there before
+ *   either; on 2 processes 4 of 4 runs were the same bits. Traffic
+ *   counters: fcm_petsc_simulation_traffic() (also a "comm" line of the summary);
+ *   tests/petsc/newton.c asserts that no sum in the steps is longer than n and that fewer
+ *   values than nnz are summed per Newton matrix. Measured (clamped_surface at 16^3 cells,
+ *   6597 DOFs, 2 processes, --steps 3 minus --steps 1 = 4 Newton matrices): dense sums per
+ *   Newton matrix and process 7.2 MB before, 0.16 MB after (3 n-vectors), plus 0.67 MB stash
+ *   from process 1 (process 0 sends none: it owns the shared DOFs); CPU in the sums ~0.036 s
+ *   per matrix both ways (waiting in the agreement dominates at this size).
+ * - solve: KSP: MUMPS Cholesky/LU when the scene says "direct", else CG/MINRES + GAMG (psd
+ *   flag of the integrator); -ksp_type / -pc_type keep the user's choice. KSP divergence
  *   is a soft failure (the integrator halves the step). Direction gathered with a cached
  *   VecScatterCreateToAll.
  * - fcm-sim --backend petsc routes scenes fcm_petsc_problem_supports_scene() rejects to it
@@ -182,10 +210,13 @@
  *   the same matrix differ at ~1e-16 (12 of 12 runs bitwise with CG + GAMG, CG + Jacobi and
  *   -pc_type redundant; 10 of 12 differing with MUMPS Cholesky or LU, with or without
  *   OMP/OpenBLAS threads). The test holds the default solver to bit for bit, MUMPS to 1e-12.
- * - scalability of phase 2: the sums are dense (n doubles per force, nnz doubles per tangent,
- *   per process); next: add each process's partial tangent into the MATMPIAIJ with ADD_VALUES
- *   (own elements only; the eliminated rows' diagonal by the owner), sum the force only on
- *   owned rows (VecScatter of ghosts), keep the line search's scalars as Allreduce.
+ * - scalability of phase 2: the tangent goes through ADD_VALUES now (above), but the vectors
+ *   are still dense sums of n doubles per process (the force per evaluation, D (x - u_n), the
+ *   elimination's lift per predictor, the loads), the mass matrix is summed densely once at
+ *   setup (nnz doubles), the state is replicated and newton_solve() gathers the direction on
+ *   every process (VecScatterCreateToAll, n doubles), and newton_factor() scans the whole
+ *   replicated pattern (O(nnz) local work per matrix, no communication). Next: sum the force
+ *   on owned rows only (ghost scatter), with the local + ghost space of i14-ghost.
  * - cuts keep the partition made at the start (the pieces of a split cell belong to its
  *   owner; cut-heavy regions are not rebalanced) and the cut's classification of every cell
  *   runs on every process (replicated; the first build's is distributed, see above); the cut-cell
@@ -245,6 +276,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 /* ---------------------------------------------------------------- errors */
 
@@ -1088,7 +1120,8 @@ void fcm_petsc_problem_destroy(fcm_petsc_problem **problem)
   fcm_cell_rules_destroy(&P->rules);
   void *arrays[] = {P->petsc_options, P->weight,     P->cell_owner, P->copy_owner, P->perm,
                     P->con_dof,       P->con_node,   P->con_comp,   P->con_motion, P->motions,
-                    P->is_con,        P->classifier, P->remote,     P->kept_cells, P->kept_tris};
+                    P->is_con,        P->classifier, P->remote,     P->kept_cells, P->kept_tris,
+                    P->owned_dof};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
     fcm__free(ctx, arrays[i]);
   if (P->comm != MPI_COMM_NULL) MPI_Comm_free(&P->comm);
@@ -1910,8 +1943,14 @@ static fcm_status newton_agree(fcm_petsc_problem *P, fcm_status st)
 static fcm_status newton_reduce(void *user, fcm_status st, double *values, fcm_index count)
 {
   fcm_petsc_problem *P = user;
+  const double t0 = MPI_Wtime();
+  const clock_t c0 = clock();
   st = newton_agree(P, st);
   if (st != FCM_OK) return st;
+  P->traffic.reduces++;
+  P->traffic.reduce_values += (long long)count;
+  P->traffic.reduce_bytes += (long long)count * (long long)sizeof(double);
+  P->traffic.reduce_large += P->n > 0 && count > P->n; /* the rules build: no space yet */
   for (fcm_index k = 0; k < count;) {
     const int m = count - k > (1 << 26) ? (1 << 26) : (int)(count - k);
     int rc = MPI_Reduce(P->rank == 0 ? MPI_IN_PLACE : values + k, values + k, m, MPI_DOUBLE,
@@ -1922,13 +1961,24 @@ static fcm_status newton_reduce(void *user, fcm_status st, double *values, fcm_i
                         "petsc: MPI_Reduce / MPI_Bcast of %d values failed (error %d)", m, rc);
     k += m;
   }
+  P->traffic.time_reduce += MPI_Wtime() - t0;
+  P->traffic.cpu_reduce += (double)(clock() - c0) / CLOCKS_PER_SEC;
   return FCM_OK;
 }
 
-/* The eliminated Newton matrix H (the same on every process) into the MATMPIAIJ: each process
- * inserts its owned rows; the KSP (CG, or MINRES for a possibly indefinite H, unless
- * -ksp_type says otherwise) is set up on it. */
-static fcm_status newton_factor(void *user, const fcm_csr *H, int psd, int *failed)
+/* The eliminated Newton matrix into the MATMPIAIJ: each process adds its PARTIAL eliminated
+ * matrix H (sim_backend.h) with ADD_VALUES, row by row, skipping the all-zero rows (so a process
+ * sends only the rows its cells touch, plus the base on its own rows); the entries of rows
+ * another process owns go through PETSc's stash at the assembly. The constrained rows are
+ * checked against the contract (zero but for the owner's diagonal). The KSP (CG, or MINRES for a
+ * possibly indefinite matrix, unless -ksp_type says otherwise) is set up on the sum.
+ * Order of the additions: an entry's own contribution first, then the received ones in the
+ * order the stash's messages are processed (MatStashScatterGetMesg_BTS, PETSc 3.18: by
+ * MPI_Waitsome, i.e. arrival). With 2 processes every entry has at most one sender, so the
+ * sums are the same bits in every run; with 3 or more, an entry that two other processes both
+ * touch may be summed in another order from run to run (round-off). */
+static fcm_status newton_factor(void *user, const fcm_csr *H, const unsigned char *is_con, int psd,
+                                int *failed)
 {
   fcm_petsc_problem *P = user;
   fcm_status st = FCM_OK;
@@ -1947,29 +1997,59 @@ static fcm_status newton_factor(void *user, const fcm_csr *H, int psd, int *fail
               "used after a cut replaced it)",
               (long long)rows, (long long)P->n);
   }
+  const double t0 = MPI_Wtime();
+  const clock_t c0 = clock();
   for (fcm_index i = 0; i < P->n; i++)
     maxrow = FCM_MAX(maxrow, rp[i + 1] - rp[i]);
   cols = fcm__calloc(ctx, (size_t)maxrow + 1, sizeof *cols);
   st = cols ? FCM_OK
             : fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
                          "petsc: out of memory (a row of %lld entries)", (long long)maxrow);
+  if (st == FCM_OK) {
+    PetscErrorCode ierr = MatZeroEntries(P->S);
+    if (ierr) st = fcm__petsc_error(ctx, ierr, "MatZeroEntries", __FILE__, __LINE__, __func__);
+  }
   for (fcm_index k = 0; st == FCM_OK && k < P->ncopy; k++) {
-    if (P->copy_owner[k] != P->rank) continue;
+    const int own = P->copy_owner[k] == P->rank;
     for (int i = 0; i < 3 && st == FCM_OK; i++) {
       const fcm_index r = 3 * k + i;
       const PetscInt row = 3 * P->perm[k] + i;
       const PetscInt len = (PetscInt)(rp[r + 1] - rp[r]);
+      const double *v = hv + rp[r];
+      int nonzero = 0;
       for (PetscInt j = 0; j < len; j++) {
         const int c = ci[rp[r] + j];
+        if (v[j] != 0.0) {
+          nonzero = 1;
+          if (is_con[r] && (c != r || !own)) {
+            st = fcm__error(ctx, FCM_ERR_INTERNAL, __FILE__, __LINE__, __func__,
+                            "petsc: the partial Newton matrix has %g at (%lld, %lld) of the "
+                            "constrained DOF %lld (only its owner's diagonal may be non-zero)",
+                            v[j], (long long)r, (long long)c, (long long)r);
+            break;
+          }
+        }
         cols[j] = 3 * P->perm[c / 3] + c % 3;
       }
-      PetscErrorCode ierr = MatSetValues(P->S, 1, &row, len, cols, hv + rp[r], INSERT_VALUES);
+      if (st != FCM_OK || !nonzero) continue;
+      PetscErrorCode ierr = MatSetValues(P->S, 1, &row, len, cols, v, ADD_VALUES);
       if (ierr) st = fcm__petsc_error(ctx, ierr, "MatSetValues", __FILE__, __LINE__, __func__);
+      if (own) {
+        P->traffic.matrix_values_local += len;
+      } else {
+        P->traffic.matrix_values_sent += len;
+        P->traffic.matrix_rows_sent++;
+        P->traffic.matrix_bytes_sent +=
+            (long long)len * (long long)(2 * sizeof(PetscInt) + sizeof(PetscScalar));
+      }
     }
   }
   FCM_TRY(ctx, newton_agree(P, st));
   PCALL(ctx, MatAssemblyBegin(P->S, MAT_FINAL_ASSEMBLY));
   PCALL(ctx, MatAssemblyEnd(P->S, MAT_FINAL_ASSEMBLY));
+  P->traffic.matrices++;
+  P->traffic.time_matrix += MPI_Wtime() - t0;
+  P->traffic.cpu_matrix += (double)(clock() - c0) / CLOCKS_PER_SEC;
   PCALL(ctx, MatSetOption(P->S, MAT_SPD, psd ? PETSC_TRUE : PETSC_FALSE));
   if (P->direct && !P->pc_type_set) {
     PC pc;
@@ -2110,6 +2190,14 @@ static fcm_status newton_build(fcm_petsc_problem *P, fcm_status st, const fcm_sp
   P->mesh = fcm_space_mesh(space);
   st = own_active_cells(P);
   if (st == FCM_OK) st = number_dofs(P);
+  if (st == FCM_OK) { /* the integrator's copy of the ownership (fcm__sim_backend.owned) */
+    P->owned_dof = fcm__calloc(ctx, (size_t)P->n + 1, 1);
+    if (!P->owned_dof)
+      st = fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
+                      "petsc: out of memory (%lld owned flags)", (long long)P->n);
+    for (fcm_index d = 0; st == FCM_OK && d < P->n; d++)
+      P->owned_dof[d] = P->copy_owner[d / 3] == P->rank;
+  }
   FCM_TRY(ctx, newton_agree(P, st));
   FCM_TRY(ctx, newton_agree(P, check_topology(P)));
   st = create_matrix(P, &P->S);
@@ -2161,8 +2249,10 @@ static void newton_unbuild(fcm_petsc_problem *P)
   VecScatterDestroy(&P->to_all);
   fcm__free(ctx, P->copy_owner);
   fcm__free(ctx, P->perm);
+  fcm__free(ctx, P->owned_dof);
   P->copy_owner = NULL;
   P->perm = NULL;
+  P->owned_dof = NULL;
   P->n = P->ncopy = 0;
   P->nlocal = P->first = 0;
 }
@@ -2179,6 +2269,7 @@ static void newton_backend(fcm_petsc_problem *P, fcm__sim_backend *b)
   b->root = P->rank == 0;
   b->rank = P->rank;
   b->nprocs = P->size;
+  b->owned = P->owned_dof;
   b->reduce = newton_reduce;
   b->factor = newton_factor;
   b->solve = newton_solve;
@@ -2318,7 +2409,40 @@ fcm_status fcm_petsc_simulation_summary_view(fcm_simulation *sim, FILE *f)
   FCM_CHECK(sim, NULL, FCM_ERR_ARG, "petsc: summary_view: NULL simulation");
   FCM_CHECK(fcm__integrator_distributed(sim->integ, NULL), sim->ctx, FCM_ERR_ARG,
             "petsc: summary_view: the simulation is not one of fcm_petsc_simulation_create()");
-  FCM_TRY(sim->ctx, fcm__simulation_summary_view_distributed(sim, f));
+  {
+    /* the backend's traffic so far (before the summary's own sums), per Newton matrix; the
+     * largest over the processes */
+    fcm_petsc_traffic t;
+    FCM_TRY(sim->ctx, fcm_petsc_simulation_traffic(sim, &t));
+    FCM_TRY(sim->ctx, fcm__simulation_summary_view_distributed(sim, f));
+    const fcm__sim_backend *b = fcm__integrator_backend(sim->integ);
+    fcm_petsc_problem *P = b->user;
+    double mine[4] = {(double)t.reduce_bytes, (double)t.matrix_bytes_sent, t.cpu_reduce,
+                      t.cpu_matrix},
+           all[4];
+    int rc = MPI_Allreduce(mine, all, 4, MPI_DOUBLE, MPI_MAX, P->comm);
+    FCM_CHECK(rc == MPI_SUCCESS, sim->ctx, FCM_ERR_INTERNAL,
+              "petsc: MPI_Allreduce of the traffic counters failed (error %d)", rc);
+    const double per = t.matrices > 0 ? 1.0 / (double)t.matrices : 0.0;
+    if (f)
+      fprintf(f,
+              "  comm      per process (largest): dense sums %.4g MB (%.3g s CPU), matrix stash "
+              "%.4g MB (%.3g s CPU); per Newton matrix (%lld): %.4g + %.4g kB\n",
+              all[0] / 1e6, all[2], all[1] / 1e6, all[3], t.matrices, all[0] * per / 1e3,
+              all[1] * per / 1e3);
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm_petsc_simulation_traffic(const fcm_simulation *sim, fcm_petsc_traffic *out)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(sim && out, sim ? sim->ctx : NULL, FCM_ERR_ARG, "petsc: traffic: NULL argument");
+  const fcm__sim_backend *b = fcm__integrator_backend(sim->integ);
+  FCM_CHECK(b && b->reduce == newton_reduce, sim->ctx, FCM_ERR_ARG,
+            "petsc: traffic: the simulation is not one of fcm_petsc_simulation_create()");
+  *out = ((const fcm_petsc_problem *)b->user)->traffic;
 cleanup:
   return st;
 }

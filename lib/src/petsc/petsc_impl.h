@@ -87,6 +87,8 @@ struct fcm_petsc_problem {
   int factored;      /* a matrix was given to the KSP since the last (re)build (cuts) */
   VecScatter to_all;
   Vec all;
+  fcm_petsc_traffic traffic; /* the integrator's backend (fcm_petsc_simulation_traffic()) */
+  unsigned char *owned_dof;  /* n: 1 on the DOFs whose rows this process owns (newton_build) */
   /* phase-1 frames (fcm_petsc_problem_write_frame(), made at the first): the piece's nodes
    * (of the own cells, ascending) and a scatter of their node-field DOFs into frame_vec */
   fcm_index frame_np;

@@ -155,6 +155,7 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   fcm__free(ctx, I->cons);
   fcm__sim_boundary_free(I);
   double **vecs[] = {&I->u,      &I->v,     &I->load_prev, &I->act_val, &I->act_inc, &I->Ma,
+                     &I->act_diag,
                      &I->u_bak,  &I->v_bak, &I->lp_bak,    &I->un,      &I->uhat,    &I->fext,
                      &I->fend,   &I->fint,  &I->g,         &I->d,       &I->b,       &I->ut,
                      &I->fint_t, &I->g_t,   &I->w1,        &I->w2,      &I->mg_r};
@@ -169,6 +170,7 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   fcm__free(ctx, I->reaction);
   fcm__free(ctx, I->act_dof);
   fcm__free(ctx, I->schwarz_flag);
+  fcm__free(ctx, I->owned);
   fcm_csr_destroy(&I->M);
   fcm_csr_destroy(&I->H);
   fcm_csr_destroy(&I->D);
@@ -470,6 +472,7 @@ static fcm_status build_constraints(fcm_integrator *I)
   FCM_ALLOC(ctx, count, I->act_dof);
   FCM_ALLOC(ctx, count, I->act_val);
   FCM_ALLOC(ctx, count, I->act_inc);
+  FCM_ALLOC(ctx, count, I->act_diag);
   FCM_ALLOC(ctx, I->n, I->is_con);
   FCM_ALLOC(ctx, I->num_cons, I->con_on);
   FCM_ALLOC(ctx, 6 * (size_t)I->num_cons + 1, I->reaction);
@@ -690,16 +693,29 @@ fcm_status fcm__integrator_set_backend(fcm_integrator *I, const fcm__sim_backend
     if (b && b->destroy) b->destroy(b->user);
     FCM_CHECK(0, I ? I->ctx : NULL, FCM_ERR_ARG, "integrator: NULL integrator or backend");
   }
-  if (I->is_setup || I->has_backend || !b->reduce || !b->factor || !b->solve) {
+  if (I->is_setup || I->has_backend || !b->reduce || !b->factor || !b->solve || !b->owned) {
     if (b->destroy) b->destroy(b->user);
     FCM_CHECK(0, I->ctx, FCM_ERR_ARG,
-              "integrator: a backend needs reduce, factor and solve, and is set once, before "
-              "fcm_integrator_setup()");
+              "integrator: a backend needs reduce, factor, solve and the owned DOFs, and is set "
+              "once, before fcm_integrator_setup()");
   }
+  I->owned = fcm__calloc(I->ctx, (size_t)I->n + 1, 1);
+  if (!I->owned) {
+    if (b->destroy) b->destroy(b->user);
+    FCM_CHECK(0, I->ctx, FCM_ERR_ALLOC, "integrator: out of memory (%lld owned flags)",
+              (long long)I->n);
+  }
+  memcpy(I->owned, b->owned, (size_t)I->n);
   I->backend = *b;
+  I->backend.owned = I->owned;
   I->has_backend = 1;
 cleanup:
   return st;
+}
+
+const fcm__sim_backend *fcm__integrator_backend(const fcm_integrator *I)
+{
+  return I && I->has_backend ? &I->backend : NULL;
 }
 
 int fcm__integrator_distributed(const fcm_integrator *I, int *root)

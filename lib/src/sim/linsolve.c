@@ -430,7 +430,7 @@ fcm_status fcm__sim_factor(fcm_integrator *I, fcm_step_reason *reason, sim_stats
   fcm_status st = FCM_OK;
   if (I->has_backend) { /* sim_backend.h */
     int failed = 0;
-    st = I->backend.factor(I->backend.user, I->H, I->h_psd, &failed);
+    st = I->backend.factor(I->backend.user, I->H, I->is_con, I->h_psd, &failed);
     stats->factorizations++;
     I->total_factorizations++;
     if (st == FCM_OK && failed) *reason = FCM_STEP_LINEAR_SOLVER_FAILED;

@@ -91,20 +91,30 @@ static fcm_status assemble_boundary(fcm_integrator *I, const double *x, int proj
   return st;
 }
 
-/* The base of the Newton matrix into H before the tangent is added: with a backend
- * (sim_backend.h) the root process only (H is summed over the processes after the assembly). */
+/* The base of the Newton matrix into H before the tangent is added. With a backend
+ * (sim_backend.h) H stays this process's partial matrix (the backend adds the processes'
+ * matrices): M/h^2 (M is summed) on the rows this process owns, and D/h everywhere (D is this
+ * process's partial damping matrix, update_damping()). */
 static void tangent_base(fcm_integrator *I, double h)
 {
-  if (I->has_backend && !I->backend.root)
-    fcm_csr_set_zero(I->H);
-  else
+  if (!I->has_backend || h == 0.0) {
     fcm__sim_set_base(I, h, I->H);
+    return;
+  }
+  const fcm_index *rp = fcm_csr_row_ptr(I->H);
+  double *v = fcm_csr_values(I->H);
+  const double *mv = fcm_csr_values_read(I->M), *dv = I->D ? fcm_csr_values_read(I->D) : NULL;
+  const double a = 1.0 / (h * h);
+  for (fcm_index i = 0; i < I->n; i++)
+    for (fcm_index e = rp[i]; e < rp[i + 1]; e++)
+      v[e] = (I->owned[i] ? a * mv[e] : 0.0) + (dv ? dv[e] / h : 0.0);
 }
 
-/* With a backend: agree on st and on *finite, and sum the scalars, fint and T over the
- * processes (every process then holds the same global values). */
+/* With a backend: agree on st and on *finite, and sum the scalars and fint over the processes
+ * (every process then holds the same global values); the matrices stay partial
+ * (sim_backend.h). */
 static fcm_status reduce_eval(fcm_integrator *I, fcm_status st, double *scalars, int ns,
-                              double *fint, fcm_csr *T, int *finite, sim_stats *stats)
+                              double *fint, int *finite, sim_stats *stats)
 {
   if (!I->has_backend) return st;
   double s[4] = {0, 0, 0, 0}; /* up to 3 scalars, then the count of non-finite processes */
@@ -113,7 +123,7 @@ static fcm_status reduce_eval(fcm_integrator *I, fcm_status st, double *scalars,
   s[ns] = *finite ? 0.0 : 1.0;
   double t0 = fcm_wtime();
   st = fcm__sim_reduce(I, st, s, ns + 1, NULL, NULL);
-  if (st == FCM_OK && s[ns] == 0.0) st = fcm__sim_reduce(I, FCM_OK, NULL, 0, fint, T);
+  if (st == FCM_OK && s[ns] == 0.0 && fint) st = fcm__sim_reduce(I, FCM_OK, NULL, 0, fint, NULL);
   stats->time_assembly += fcm_wtime() - t0;
   if (st != FCM_OK) return st;
   *finite = s[ns] == 0.0;
@@ -131,7 +141,7 @@ static fcm_status assemble_tangent(fcm_integrator *I, double h, const double *x,
   st = assemble(I, projected ? &I->params_psd : &I->params, x, NULL, NULL, I->H, finite, stats);
   if (st == FCM_OK && *finite)
     st = assemble_boundary(I, x, projected, NULL, NULL, I->H, finite, stats);
-  FCM_TRY(I->ctx, reduce_eval(I, st, NULL, 0, NULL, I->H, finite, stats));
+  FCM_TRY(I->ctx, reduce_eval(I, st, NULL, 0, NULL, finite, stats));
 cleanup:
   return st;
 }
@@ -158,7 +168,7 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
     st = assemble_boundary(I, x, 0, &bnd, fint, tangent ? I->H : NULL, &out->finite, stats);
   {
     double parts[2] = {psi, bnd};
-    FCM_TRY(I->ctx, reduce_eval(I, st, parts, 2, fint, tangent ? I->H : NULL, &out->finite, stats));
+    FCM_TRY(I->ctx, reduce_eval(I, st, parts, 2, fint, &out->finite, stats));
     psi = parts[0];
     bnd = parts[1];
   }
@@ -178,7 +188,9 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
       if (I->D) {
         for (fcm_index i = 0; i < n; i++)
           I->w1[i] = x[i] - I->un[i];
-        FCM_TRY(I->ctx, fcm_csr_apply(I->D, 1.0, I->w1, 0.0, I->w2));
+        /* with a backend D is this process's partial matrix: sum the product (n doubles) */
+        st = fcm_csr_apply(I->D, 1.0, I->w1, 0.0, I->w2);
+        FCM_TRY(I->ctx, fcm__integrator_reduce_status(I, st, I->w2, n));
         damp = 0.5 / h * dot(n, I->w1, I->w2);
         for (fcm_index i = 0; i < n; i++)
           g[i] += I->w2[i] / h;
@@ -219,6 +231,68 @@ static void swap(double **a, double **b)
   *b = t;
 }
 
+/* With a backend (sim_backend.h): fcm__eliminate_marked()'s symmetric elimination on this
+ * process's partial H, with the increments w1 at the constrained DOFs. Every process zeroes the
+ * constrained rows and columns of its matrix; the parts that need the summed matrix — the lift
+ * H_fc inc_c of the free right-hand side (predictor) and the constrained diagonal (the summed
+ * tangent's, 1 where that is not positive, as the serial rule) — are summed over the processes
+ * as vectors: n doubles with a predictor, nact without (the lift is zero then). The diagonal
+ * goes on the rows this process owns (act_diag keeps it for the reuse path); b (the same on
+ * every process) gets the summed lift and diag * inc on the constrained rows. Collective. */
+static fcm_status eliminate_partial(fcm_integrator *I, int predictor)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index n = I->n, nact = I->nact;
+  const fcm_index *rp = fcm_csr_row_ptr(I->H);
+  const int *ci = fcm_csr_col_idx(I->H);
+  double *v = fcm_csr_values(I->H), *l = I->w2;
+  const unsigned char *con = I->is_con;
+  const double *inc = I->w1;
+  if (nact == 0) return FCM_OK;
+  for (fcm_index i = 0; i < n; i++) {
+    double acc = 0.0;
+    if (con[i]) {
+      for (fcm_index e = rp[i]; e < rp[i + 1]; e++) {
+        if (ci[e] == i) acc = v[e];
+        v[e] = 0.0;
+      }
+    } else {
+      for (fcm_index e = rp[i]; e < rp[i + 1]; e++)
+        if (con[ci[e]]) {
+          acc += v[e] * inc[ci[e]];
+          v[e] = 0.0;
+        }
+    }
+    l[i] = acc;
+  }
+  if (predictor) {
+    FCM_TRY(I->ctx, fcm__integrator_reduce(I, l, n));
+    for (fcm_index j = 0; j < nact; j++)
+      I->act_diag[j] = l[I->act_dof[j]];
+  } else {
+    for (fcm_index j = 0; j < nact; j++)
+      I->act_diag[j] = l[I->act_dof[j]];
+    FCM_TRY(I->ctx, fcm__integrator_reduce(I, I->act_diag, nact));
+  }
+  if (predictor)
+    for (fcm_index i = 0; i < n; i++)
+      if (!con[i]) I->b[i] -= l[i];
+  for (fcm_index j = 0; j < nact; j++) {
+    const fcm_index d = I->act_dof[j];
+    if (!(I->act_diag[j] > 0.0)) I->act_diag[j] = 1.0;
+    I->b[d] = I->act_diag[j] * inc[d];
+    if (!I->owned[d]) continue;
+    const fcm_index pos = fcm_csr_position(I->H, d, d);
+    FCM_CHECK(pos >= 0, I->ctx, FCM_ERR_INTERNAL,
+              "integrator: the Newton matrix's pattern has no diagonal entry at DOF %lld (a "
+              "DOF this process owns)",
+              (long long)d);
+    v[pos] = I->act_diag[j];
+  }
+cleanup:
+  return st;
+}
+
 /* Build the eliminated Newton system for the current iterate and factor it, or reuse the
  * factor of a constant (linear) system; b = -g with the constrained increments lifted. */
 static fcm_status build_system(fcm_integrator *I, double h, int predictor, int projected,
@@ -236,14 +310,17 @@ static fcm_status build_system(fcm_integrator *I, double h, int predictor, int p
       memset(I->w1, 0, sizeof *I->w1 * (size_t)n);
       for (fcm_index j = 0; j < I->nact; j++)
         I->w1[I->act_dof[j]] = I->act_inc[j];
-      FCM_TRY(I->ctx, fcm_csr_apply(I->H0, 1.0, I->w1, 0.0, I->w2));
+      /* with a backend H0 is this process's partial matrix: sum the product */
+      st = fcm_csr_apply(I->H0, 1.0, I->w1, 0.0, I->w2);
+      FCM_TRY(I->ctx, fcm__integrator_reduce_status(I, st, I->w2, n));
       for (fcm_index i = 0; i < n; i++)
         if (!I->is_con[i]) I->b[i] -= I->w2[i];
     }
     const double *hv = fcm_csr_values(I->H);
     for (fcm_index j = 0; j < I->nact; j++) {
-      fcm_index d = I->act_dof[j], pos = fcm_csr_position(I->H, d, d);
-      I->b[d] = predictor ? hv[pos] * I->act_inc[j] : 0.0;
+      fcm_index d = I->act_dof[j];
+      const double diag = I->has_backend ? I->act_diag[j] : hv[fcm_csr_position(I->H, d, d)];
+      I->b[d] = predictor ? diag * I->act_inc[j] : 0.0;
     }
     return FCM_OK;
   }
@@ -265,7 +342,12 @@ static fcm_status build_system(fcm_integrator *I, double h, int predictor, int p
    * active set act_dof; w1 carries the increments there): nothing allocated per iteration. */
   for (fcm_index j = 0; j < I->nact; j++)
     I->w1[I->act_dof[j]] = predictor ? I->act_inc[j] : 0.0;
-  fcm__eliminate_marked(I->H, I->b, I->is_con, I->w1);
+  if (I->has_backend) {
+    /* a local failure there meets the others in the backend's factor (its agreement) */
+    st = eliminate_partial(I, predictor);
+    if (st != FCM_OK) FCM_TRY(I->ctx, fcm__integrator_finish(I, st));
+  } else
+    fcm__eliminate_marked(I->H, I->b, I->is_con, I->w1);
   I->h_state = SIM_H_SYSTEM;
   I->h_psd = projected || I->opts.project_psd || I->linear;
   I->key_h = h;
@@ -491,7 +573,10 @@ cleanup:
   return st;
 }
 
-/* D = alpha_M M + beta_K K+(u_n) (projected tangent at the start of the substep). */
+/* D = alpha_M M + beta_K K+(u_n) (projected tangent at the start of the substep). With a
+ * backend (sim_backend.h) D is this process's PARTIAL damping matrix, not summed: its cells'
+ * K+ and alpha_M M (M is summed) on the rows it owns; the processes' D sum to the serial one
+ * (evaluate() sums its products, the Newton matrix's base adds it partially). */
 static fcm_status update_damping(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
 {
   fcm_status st = FCM_OK;
@@ -504,14 +589,23 @@ static fcm_status update_damping(fcm_integrator *I, fcm_step_reason *reason, sim
   fcm_csr_set_zero(I->D);
   if (o->rayleigh_stiffness > 0.0) {
     st = assemble(I, &I->params_psd, I->un, NULL, NULL, I->D, &finite, stats);
-    FCM_TRY(I->ctx, reduce_eval(I, st, NULL, 0, NULL, I->D, &finite, stats));
+    FCM_TRY(I->ctx, reduce_eval(I, st, NULL, 0, NULL, &finite, stats));
     if (!finite) {
       *reason = FCM_STEP_NONFINITE;
       return FCM_OK;
     }
   }
-  for (fcm_index e = 0; e < nnz; e++)
-    dv[e] = o->rayleigh_stiffness * dv[e] + o->rayleigh_mass * mv[e];
+  if (I->has_backend) {
+    const fcm_index *rp = fcm_csr_row_ptr(I->D);
+    for (fcm_index i = 0; i < I->n; i++) {
+      const double am = I->owned[i] ? o->rayleigh_mass : 0.0;
+      for (fcm_index e = rp[i]; e < rp[i + 1]; e++)
+        dv[e] = o->rayleigh_stiffness * dv[e] + am * mv[e];
+    }
+  } else {
+    for (fcm_index e = 0; e < nnz; e++)
+      dv[e] = o->rayleigh_stiffness * dv[e] + o->rayleigh_mass * mv[e];
+  }
   I->damp_version++;
   if (!I->linear) I->h_state = SIM_H_INVALID;
 cleanup:

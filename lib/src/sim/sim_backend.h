@@ -2,11 +2,23 @@
  * lib/src/petsc sets it, no public API). Every process runs the same integrator on the same
  * replicated DOF numbering, but its space's cell rules carry points on the process's own
  * cells only, so every assembly (mass, loads, energy, force, tangent, boundary terms) is the
- * process's partial sum. With a backend set, the integrator sums those partial quantities
- * over the processes right after each assembly (reduce), so the Newton loop, line search,
- * stopping rules, reactions and energies see the global values and every process takes the
- * same decisions; and the eliminated Newton system goes to the backend's solver
- * (factor / solve) instead of the serial ones. */
+ * process's partial sum. With a backend set:
+ * - the integrator sums the partial scalars and vectors over the processes right after each
+ *   assembly (reduce: energies, the internal force, the loads, the damping matrix's product;
+ *   n doubles at most, plus the mass matrix once at setup), so the Newton loop,
+ *   line search, stopping rules, reactions and energies see the global values and every
+ *   process takes the same decisions;
+ * - the Newton matrix is NOT summed: each process keeps its PARTIAL matrix (its cells'
+ *   tangent and partial damping matrix D/h, plus M/h^2 on the rows it owns: its share of the
+ *   base M/h^2 + D/h; D = alpha_M M + beta_K K+ is partial the same way, alpha_M M on the
+ *   owned rows), eliminates the constrained DOFs
+ *   in it (their rows and columns zeroed; the diagonal, from the summed tangent's diagonal,
+ *   on the owned rows only; the right-hand side's lift H_fc inc_c summed as an n-vector) and
+ *   hands it to the backend (factor), which adds the partial matrices of all processes into
+ *   its distributed matrix; the partial matrices sum to the serial run's eliminated matrix
+ *   (up to the order of the additions). Nothing in this path needs every process to have the
+ *   same matrix pattern: each process's matrix needs only the entries its cells touch and
+ *   the diagonal of the DOFs it owns. */
 #ifndef FCM_SIM_BACKEND_H
 #define FCM_SIM_BACKEND_H
 
@@ -16,20 +28,29 @@
 typedef struct fcm__sim_backend fcm__sim_backend;
 struct fcm__sim_backend {
   void *user;
-  /* 1 on exactly one process: the terms that are no partial sums (the base M/h^2 + D/h of the
-   * Newton matrix, from the already summed M and D) are added there only */
+  /* 1 on exactly one process: the replicated terms of a summed quantity that every process
+   * would otherwise count (fcm__integrator_distributed(); e.g. the run summary's uncut-cell
+   * points) are counted there only */
   int root;
   /* This process's number (0 .. nprocs-1) and the process count: the pieces of a parallel
    * frame (fcm_simulation_write_frame()) are named by them. */
   int rank, nprocs;
+  /* n (the space's DOFs): 1 on the DOFs whose rows of the distributed Newton matrix this
+   * process owns (every DOF on exactly one process): the terms of the Newton matrix that are
+   * no partial sums (the base M/h^2 from the summed M, the damping matrix's alpha_M M, the
+   * eliminated rows' diagonal) are put on those rows only. Required; fcm__integrator_set_backend() copies it. */
+  const unsigned char *owned;
   /* Agree on st over the processes (on a failure anywhere every process returns the status
    * and message of the first failing one), then sum values[0 .. count) over the processes in
    * place (the same result, bit for bit, on every process). Collective. */
   fcm_status (*reduce)(void *user, fcm_status st, double *values, fcm_index count);
-  /* Prepare the solves with the eliminated Newton matrix H (summed: the same on every
-   * process); psd: H is positive definite (CG) or may be indefinite (MINRES). *failed = 1: a
-   * soft failure (the step is retried). Collective. */
-  fcm_status (*factor)(void *user, const fcm_csr *H, int psd, int *failed);
+  /* Prepare the solves with the eliminated Newton matrix: the sum over the processes of each
+   * process's PARTIAL eliminated matrix H (see above; the backend adds them); is_con (n): the
+   * constrained DOFs, whose rows and columns of H are zero except the diagonal on the owning
+   * process; psd: the sum is positive definite (CG) or may be indefinite (MINRES).
+   * *failed = 1: a soft failure (the step is retried). Collective. */
+  fcm_status (*factor)(void *user, const fcm_csr *H, const unsigned char *is_con, int psd,
+                       int *failed);
   /* Solve H x = b (b the same on every process; x returned on every process). *failed = 1: no
    * usable solution (soft). Collective. */
   fcm_status (*solve)(void *user, const double *b, double *x, int *iterations, int *failed);
@@ -62,6 +83,9 @@ fcm_status fcm__integrator_reduce(fcm_integrator *I, double *values, fcm_index c
  * backend; st itself without one. */
 fcm_status fcm__integrator_reduce_status(fcm_integrator *I, fcm_status st, double *values,
                                          fcm_index count);
+
+/* The integrator's backend (NULL without one). */
+const fcm__sim_backend *fcm__integrator_backend(const fcm_integrator *I);
 
 /* Whether the integrator runs on a distributed backend (0: serial); *root (may be NULL): 1 on
  * the backend's root process, and 1 without a backend. */

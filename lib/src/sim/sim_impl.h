@@ -106,6 +106,9 @@ struct fcm_integrator {
   fcm_index *act_dof;    /* nact DOFs (distinct) */
   double *act_val;       /* their prescribed displacements at the substep's end */
   double *act_inc;       /* increments to reach them */
+  double *act_diag;      /* with a backend: the eliminated matrix's diagonal there (the summed
+                            tangent's, or 1 where that is not positive: fcm__eliminate_marked's
+                            rule), from the last elimination */
 
   /* matrices (space pattern) */
   fcm_csr *M, *H, *D, *H0; /* mass, Newton matrix, damping (or NULL), pristine copy (linear) */
@@ -152,6 +155,7 @@ struct fcm_integrator {
   /* distributed backend (sim_backend.h); has_backend = 0: serial */
   fcm__sim_backend backend;
   int has_backend;
+  unsigned char *owned; /* n: the backend's owned DOFs (a copy of backend.owned) */
 };
 
 enum { SIM_H_INVALID = 0, SIM_H_TANGENT = 1, SIM_H_SYSTEM = 2 };
@@ -207,7 +211,8 @@ fcm_status fcm__sim_boundary_assemble(fcm_integrator *I, const double *x, int pr
 
 /* With a backend (sim_backend.h): agree on st and sum the partial quantities over the
  * processes: the ns scalars, the vector vec (n; may be NULL) and the values of T (may be
- * NULL). Without one: returns st. (integrator.c) */
+ * NULL: a dense sum of nnz doubles, for the mass matrix at setup and the damping matrix once
+ * per substep, never for the Newton matrix). Without one: returns st. (integrator.c) */
 fcm_status fcm__sim_reduce(fcm_integrator *I, fcm_status st, double *scalars, int ns, double *vec,
                            fcm_csr *T);
 
