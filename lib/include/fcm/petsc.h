@@ -24,9 +24,10 @@
  * Phase 1 (stated plainly): the mesh, the geometry and the DOF numbering (O(nodes + elements)
  * integers) are replicated on every process; the sparsity pattern is held per process for its
  * own and ghost cells only; the heavy part — simplification and stabilization of the
- * cut-cell rules, element integration, matrix and vector rows, the solve — is distributed. Every function is collective over the
- * communicator; an error on any process (bad input on one of them included) is returned on
- * every process, with the failing process's message, so that all of them stop together. */
+ * cut-cell rules, element integration, matrix and vector rows, the solve — is distributed. Every
+ * function is collective over the communicator; an error on any process (bad input on one of them
+ * included) is returned on every process, with the failing process's message, so that all of them
+ * stop together. */
 #ifndef FCM_PETSC_H
 #define FCM_PETSC_H
 
@@ -330,16 +331,16 @@ FCM_API fcm_status fcm_petsc_simulation_summary_view(fcm_simulation *sim, FILE *
  *   value per entry: matrix_bytes_sent counts 2 sizeof(PetscInt) + sizeof(PetscScalar) each).
  * Times are this process's: wall seconds (waits included) and CPU seconds (clock()). */
 typedef struct fcm_petsc_traffic {
-  long long reduces;            /**< dense sums */
-  long long reduce_values;      /**< doubles this process handed to them */
-  long long reduce_bytes;       /**< 8 per value (sent to the reduce; as many come back) */
-  long long reduce_large;       /**< sums of more values than the space has DOFs (a matrix:
-                                     the mass matrix at setup; none in the steps) */
-  long long matrices;           /**< Newton matrices given to the backend (factorizations) */
-  long long matrix_values_local; /**< entries added to rows this process owns */
-  long long matrix_values_sent;  /**< entries added to other processes' rows (stash) */
-  long long matrix_rows_sent;    /**< rows of those (all-zero rows are not sent) */
-  long long matrix_bytes_sent;   /**< stash payload of those entries (see above) */
+  long long reduces;              /**< dense sums */
+  long long reduce_values;        /**< doubles this process handed to them */
+  long long reduce_bytes;         /**< 8 per value (sent to the reduce; as many come back) */
+  long long reduce_large;         /**< sums of more values than the space has DOFs (a matrix:
+                                       the mass matrix at setup; none in the steps) */
+  long long matrices;             /**< Newton matrices given to the backend (factorizations) */
+  long long matrix_values_local;  /**< entries added to rows this process owns */
+  long long matrix_values_sent;   /**< entries added to other processes' rows (stash) */
+  long long matrix_rows_sent;     /**< rows of those (all-zero rows are not sent) */
+  long long matrix_bytes_sent;    /**< stash payload of those entries (see above) */
   double time_reduce, cpu_reduce; /**< seconds in the dense sums */
   double time_matrix, cpu_matrix; /**< seconds adding the matrices (MatSetValues, assembly) */
 } fcm_petsc_traffic;

@@ -255,8 +255,9 @@
  *   tests/petsc/bench.c, figures in README "Distributed runs").
  * - replicated still (phase 1): the numbering and the adapter's per-copy arrays (perm,
  *   copy_owner, is_con), the mesh (and the whole geometry until the cropped rules build):
- *   about 5 GB per process at 1e8 Hex20 DOFs (README projection). Next: number each process's own copies locally and exchange the
- *   ghosts' numbers (PetscSF), with the mesh cropped to own + ghost cells.
+ *   about 5 GB per process at 1e8 Hex20 DOFs (README projection). Next: number each process's own
+ * copies locally and exchange the ghosts' numbers (PetscSF), with the mesh cropped to own + ghost
+ * cells.
  * - phase 2 keeps the simulation's full space (fcm_space_create_embedded(): its dense sums and
  *   nitsche.c's coloured assembly need the whole pattern). What it would need to use a local
  *   space: see fcm__space_create_local() in fem_impl.h (own-element assembly into local rows,
@@ -1118,10 +1119,10 @@ void fcm_petsc_problem_destroy(fcm_petsc_problem **problem)
   fcm_assembly_workspace_destroy(&P->aws);
   if (!P->borrowed_space) fcm_space_destroy(&P->space);
   fcm_cell_rules_destroy(&P->rules);
-  void *arrays[] = {P->petsc_options, P->weight,     P->cell_owner, P->copy_owner, P->perm,
-                    P->con_dof,       P->con_node,   P->con_comp,   P->con_motion, P->motions,
-                    P->is_con,        P->classifier, P->remote,     P->kept_cells, P->kept_tris,
-                    P->owned_dof};
+  void *arrays[] = {P->petsc_options, P->weight,     P->cell_owner, P->copy_owner,
+                    P->perm,          P->con_dof,    P->con_node,   P->con_comp,
+                    P->con_motion,    P->motions,    P->is_con,     P->classifier,
+                    P->remote,        P->kept_cells, P->kept_tris,  P->owned_dof};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
     fcm__free(ctx, arrays[i]);
   if (P->comm != MPI_COMM_NULL) MPI_Comm_free(&P->comm);

@@ -154,11 +154,10 @@ void fcm_integrator_destroy(fcm_integrator **integ)
     fcm__free(ctx, I->cons[k].nodes);
   fcm__free(ctx, I->cons);
   fcm__sim_boundary_free(I);
-  double **vecs[] = {&I->u,      &I->v,     &I->load_prev, &I->act_val, &I->act_inc, &I->Ma,
-                     &I->act_diag,
-                     &I->u_bak,  &I->v_bak, &I->lp_bak,    &I->un,      &I->uhat,    &I->fext,
-                     &I->fend,   &I->fint,  &I->g,         &I->d,       &I->b,       &I->ut,
-                     &I->fint_t, &I->g_t,   &I->w1,        &I->w2,      &I->mg_r};
+  double **vecs[] = {&I->u,        &I->v,      &I->load_prev, &I->act_val, &I->act_inc, &I->Ma,
+                     &I->act_diag, &I->u_bak,  &I->v_bak,     &I->lp_bak,  &I->un,      &I->uhat,
+                     &I->fext,     &I->fend,   &I->fint,      &I->g,       &I->d,       &I->b,
+                     &I->ut,       &I->fint_t, &I->g_t,       &I->w1,      &I->w2,      &I->mg_r};
   for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; k++)
     FCM_FREE(ctx, *vecs[k]);
   fcm__free(ctx, I->con_dof);

@@ -38,7 +38,8 @@ struct fcm__sim_backend {
   /* n (the space's DOFs): 1 on the DOFs whose rows of the distributed Newton matrix this
    * process owns (every DOF on exactly one process): the terms of the Newton matrix that are
    * no partial sums (the base M/h^2 from the summed M, the damping matrix's alpha_M M, the
-   * eliminated rows' diagonal) are put on those rows only. Required; fcm__integrator_set_backend() copies it. */
+   * eliminated rows' diagonal) are put on those rows only. Required; fcm__integrator_set_backend()
+   * copies it. */
   const unsigned char *owned;
   /* Agree on st over the processes (on a failure anywhere every process returns the status
    * and message of the first failing one), then sum values[0 .. count) over the processes in
