@@ -12,9 +12,9 @@
  *   process;
  * - a cut between steps that fails on one process only (its cut surface file broken after the
  *   create): the step of the cut fails on every process, the others naming the failing one;
- * - resuming a run with a cut from a checkpoint the last process cannot read (truncated), and
- *   from checkpoints that differ in their cuts between the processes: every process fails
- *   before the cut replay (collective), no hang. */
+ * - resuming a run with cuts from checkpoints that differ in their cuts between the processes
+ *   (on 3 processes 0, 1 and 2 cuts), and from a checkpoint the last process cannot read
+ *   (truncated): every process fails before the cut replay (collective), no hang. */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
@@ -158,57 +158,69 @@ int main(int argc, char **argv)
   fcm_simulation_destroy(&sim);
   fcm_scene_destroy(&scene);
 
-  /* 5. resume a run with a cut: checkpoints before (step 1) and after the cut (step 2) */
-  char ck0[128], ck1[128];
-  snprintf(ck0, sizeof ck0, "/tmp/fcm-petsc-newton-failure-%ld-%d-0.fcmck", (long)getpid(), rank);
-  snprintf(ck1, sizeof ck1, "/tmp/fcm-petsc-newton-failure-%ld-%d-1.fcmck", (long)getpid(), rank);
+  /* 5. resume a run with two cuts (t = 0.01, 0.02): checkpoints ck[k] with k cuts (steps 1 to
+   * 3) */
+  char ck[3][128], obj2[128], cuts2[512];
+  for (int k = 0; k < 3; k++)
+    snprintf(ck[k], sizeof ck[k], "/tmp/fcm-petsc-newton-failure-%ld-%d-%d.fcmck", (long)getpid(),
+             rank, k);
+  snprintf(obj2, sizeof obj2, "/tmp/fcm-petsc-newton-failure-%ld-%d-b.obj", (long)getpid(), rank);
   if ((f = fopen(obj, "w")) != NULL) { /* case 4 broke it on the last process */
     fputs("v 0.05 -1 -1\nv 0.05 1 -1\nv 0.05 1 1\nv 0.05 -1 1\nf 1 2 3\nf 1 3 4\n", f);
     fclose(f);
   }
-  TEST_OK(ctx, fcm_scene_create_from_string(ctx, scene_text(text, sizeof text, "", cut, ""), NULL,
+  if ((f = fopen(obj2, "w")) != NULL) {
+    fputs("v -0.25 -1 -1\nv -0.25 1 -1\nv -0.25 1 1\nv -0.25 -1 1\nf 1 2 3\nf 1 3 4\n", f);
+    fclose(f);
+  }
+  snprintf(cuts2, sizeof cuts2, "%s, {\"cut\": {\"time\": 0.02, \"surface\": {\"mesh\": \"%s\"}}}",
+           cut, obj2);
+  TEST_OK(ctx, fcm_scene_create_from_string(ctx, scene_text(text, sizeof text, "", cuts2, ""), NULL,
                                             &scene));
   TEST_OK(ctx, fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO,
                                            NULL, &sim));
-  TEST_OK(ctx, fcm_simulation_step(sim, &si));
-  TEST_OK(ctx, fcm_simulation_write_checkpoint(sim, ck0));
-  TEST_OK(ctx, fcm_simulation_step(sim, &si)); /* the cut, then the step */
-  TEST_OK(ctx, fcm_simulation_write_checkpoint(sim, ck1));
+  for (int k = 0; k < 3 && sim; k++) { /* steps 2 and 3 apply a cut first */
+    TEST_OK(ctx, fcm_simulation_step(sim, &si));
+    TEST_OK(ctx, fcm_simulation_write_checkpoint(sim, ck[k]));
+  }
   fcm_simulation_destroy(&sim);
-  /* 5a. the whole file resumes on every process (the cut replayed) */
+  /* 5a. the whole file resumes on every process (both cuts replayed) */
   TEST_OK(ctx, fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO,
                                            NULL, &sim));
-  TEST_OK(ctx, fcm_simulation_read_checkpoint(sim, ck1));
+  TEST_OK(ctx, fcm_simulation_read_checkpoint(sim, ck[2]));
   TEST_OK(ctx, fcm_simulation_step(sim, &si));
   fcm_simulation_destroy(&sim);
-  /* 5b. the last process's file is truncated; 5c. it is the one from before the cut */
+  /* 5b. process r reads ck[r mod 3] (0, 1 and 2 cuts on 3 processes: the mean equals one
+   * process's count); 5c. the last process's ck[2] is truncated, every process reads ck[2] */
   for (int c = 0; c < 2; c++) {
-    if (rank == size - 1) {
-      if (c == 0 && truncate(ck1, 64) != 0) TEST_TRUE(0);
-      if (c == 1) TEST_TRUE(rename(ck0, ck1) == 0);
-    }
+    if (c == 1 && rank == size - 1 && truncate(ck[2], 64) != 0) TEST_TRUE(0);
     MPI_Barrier(MPI_COMM_WORLD);
     TEST_OK(ctx, fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO,
                                              NULL, &sim));
-    s = fcm_simulation_read_checkpoint(sim, ck1);
-    TEST_TRUE(s != FCM_OK || size == 1);
-    if (size > 1 && c == 0 && rank != size - 1) {
-      char want[64];
-      snprintf(want, sizeof want, "process %d of %d failed", size - 1, size);
-      TEST_TRUE(strstr(fcm_ctx_error_message(ctx), want) != NULL);
+    s = fcm_simulation_read_checkpoint(sim, c == 0 ? ck[rank % 3] : ck[2]);
+    if (c == 0) {
+      TEST_TRUE(s != FCM_OK || size == 1);
+      if (size > 1)
+        TEST_TRUE(strstr(fcm_ctx_error_message(ctx), "different numbers of cuts") != NULL);
+    } else {
+      TEST_TRUE(s != FCM_OK);
+      if (size == 1) TEST_TRUE(s == FCM_ERR_FORMAT);
+      if (size > 1 && rank != size - 1) {
+        char want[64];
+        snprintf(want, sizeof want, "process %d of %d failed", size - 1, size);
+        TEST_TRUE(strstr(fcm_ctx_error_message(ctx), want) != NULL);
+      }
     }
-    if (size > 1 && c == 1)
-      TEST_TRUE(strstr(fcm_ctx_error_message(ctx), "different numbers of cuts") != NULL);
-    if (size == 1 && c == 0) TEST_TRUE(s == FCM_ERR_FORMAT);
     if (getenv("FCM_TEST_VERBOSE"))
       fprintf(stderr, "rank %d: case 5%c: %s\n", rank, 'b' + c, fcm_ctx_error_message(ctx));
     fcm_ctx_error_clear(ctx);
     fcm_simulation_destroy(&sim);
   }
   fcm_scene_destroy(&scene);
-  remove(ck0);
-  remove(ck1);
+  for (int k = 0; k < 3; k++)
+    remove(ck[k]);
   remove(obj);
+  remove(obj2);
 
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);

@@ -165,9 +165,16 @@ fcm_add_mpi_test(petsc_newton_slingshot_np2 tests/petsc/newton.c NP 2
 # the integrator on PETSc: a failure on one process, in the setup's sums, in the KSP (after the
 # step's halvings) and in a cut between steps on one process end every process with the
 # message, no hang
-foreach(np 1 2)
-  fcm_add_mpi_test(petsc_newton_failure_np${np} tests/petsc/newton_failure.c NP ${np} TIMEOUT 120)
+# (3 processes too: checkpoints with 0, 1 and 2 cuts, whose mean equals one process's count)
+foreach(np 1 2 3)
+  fcm_add_mpi_test(petsc_newton_failure_np${np} tests/petsc/newton_failure.c NP ${np} TIMEOUT 180)
 endforeach()
+# 3 processes: a DOF's partial Newton rows reach its owner from more than one other process
+# through PETSc's stash (on 2 there is one sender), as do the cut's rebuilt backends
+fcm_add_mpi_test(petsc_newton_clamped_surface_np3 tests/petsc/newton.c NP 3
+                 ARGS ${FCM_SCENES} clamped_surface.json 3)
+fcm_add_mpi_test(petsc_newton_cut_late_np3 tests/petsc/newton_cut.c NP 3
+                 ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6)
 if(FCM_BUILD_APPS)
   # the state of two checkpoints (fcm-sim's .fcmck or the linear driver's .fcmpk) to a relative
   # tolerance: a tool of the shell tests below (no MPI)

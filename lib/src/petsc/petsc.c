@@ -2045,7 +2045,13 @@ static fcm_status newton_factor(void *user, const fcm_csr *H, const unsigned cha
       }
     }
   }
-  FCM_TRY(ctx, newton_agree(P, st));
+  st = newton_agree(P, st);
+  if (st != FCM_OK) {
+    /* every process is here (the failure is agreed): flush the rows already handed to PETSc's
+     * stash, which MatZeroEntries would not clear, so no later matrix receives them */
+    if (!MatAssemblyBegin(P->S, MAT_FINAL_ASSEMBLY)) MatAssemblyEnd(P->S, MAT_FINAL_ASSEMBLY);
+    goto cleanup;
+  }
   PCALL(ctx, MatAssemblyBegin(P->S, MAT_FINAL_ASSEMBLY));
   PCALL(ctx, MatAssemblyEnd(P->S, MAT_FINAL_ASSEMBLY));
   P->traffic.matrices++;
@@ -2482,9 +2488,16 @@ static fcm_status frame_scatter(fcm_petsc_problem *P, const PetscInt *blocks)
   fcm_ctx *ctx = P->ctx;
   IS from = NULL;
   VecDestroy(&P->frame_vec); /* a failed first frame's */
-  PCALL(ctx,
-        ISCreateBlock(PETSC_COMM_SELF, 3, (PetscInt)P->frame_np, blocks, PETSC_COPY_VALUES, &from));
-  PCALL(ctx, VecCreateSeq(PETSC_COMM_SELF, 3 * (PetscInt)P->frame_np, &P->frame_vec));
+  /* the local objects first, agreed, so that no process fails before the collective scatter
+   * the others wait in */
+  PetscErrorCode ierr =
+      ISCreateBlock(PETSC_COMM_SELF, 3, (PetscInt)P->frame_np, blocks, PETSC_COPY_VALUES, &from);
+  if (ierr) st = fcm__petsc_error(ctx, ierr, "ISCreateBlock", __FILE__, __LINE__, __func__);
+  if (st == FCM_OK) {
+    ierr = VecCreateSeq(PETSC_COMM_SELF, 3 * (PetscInt)P->frame_np, &P->frame_vec);
+    if (ierr) st = fcm__petsc_error(ctx, ierr, "VecCreateSeq", __FILE__, __LINE__, __func__);
+  }
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
   PCALL(ctx, VecScatterCreate(P->u, from, P->frame_vec, NULL, &P->frame_sc));
 cleanup:
   ISDestroy(&from);

@@ -356,13 +356,15 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
   /* On a distributed backend (sim_backend.h) the cut replay below is collective: the
    * processes agree on the read first (a file one process cannot read fails every process
    * with its message, no process waits in a cut the others never start) and on the number
-   * of cuts to replay (files that differ between the processes are refused). */
+   * of cuts to replay (files that differ between the processes are refused). The counts c_p
+   * are equal iff N sum c_p^2 = (sum c_p)^2 (Cauchy-Schwarz): every process tests the same
+   * sums (exact: small integers), so every process takes the same decision. */
   if (fcm__integrator_distributed(S->integ, NULL)) {
     int rank = 0, nprocs = 1;
     fcm__integrator_processes(S->integ, &rank, &nprocs);
-    double c[2] = {(double)d.cuts, 1.0};
-    FCM_TRY(ctx, fcm__integrator_reduce_status(S->integ, st, c, 2));
-    FCM_CHECK(c[0] == (double)d.cuts * c[1], ctx, FCM_ERR_ARG,
+    double c[3] = {(double)d.cuts, (double)d.cuts * (double)d.cuts, 1.0};
+    FCM_TRY(ctx, fcm__integrator_reduce_status(S->integ, st, c, 3));
+    FCM_CHECK(c[2] * c[1] == c[0] * c[0], ctx, FCM_ERR_ARG,
               "checkpoint %s: the processes read different numbers of cuts (this one %lld, "
               "%g in all over %d processes): every process must read the same file",
               path, d.cuts, c[0], nprocs);
