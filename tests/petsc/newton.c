@@ -15,7 +15,11 @@
  *   steps no dense sum carried more values than the space has DOFs, fewer values per Newton
  *   matrix were summed than the matrix has nonzeros (one dense tangent sum alone would be
  *   that many), entries were added into the distributed matrix and, on 2 processes
- *   that both have cells, entries of rows another process owns went through PETSc's stash.
+ *   that both have cells, entries of rows another process owns went through PETSc's stash;
+ * - no matrix was summed densely in the whole run, setup included: no dense sum carried more
+ *   values than the space has DOFs (the mass matrix stays partial, its products are summed),
+ *   and the setup (rules, mass, loads, representative force) summed fewer values in all than
+ *   the matrix has nonzeros (one dense mass matrix sum alone would be that many).
  * Arguments: scenes directory, scene file, steps, [tol (default 1e-8)], then PETSc options.
  * The KSP runs to rtol 1e-12 (-ksp_rtol, as a user would set it). */
 #define _POSIX_C_SOURCE 200809L
@@ -102,19 +106,69 @@ int main(int argc, char **argv)
     const long long all_sent = all2[0];
     if (rank == 0 && getenv("FCM_TEST_VERBOSE"))
       fprintf(stderr,
-              "traffic: %lld DOFs, %lld nonzeros; steps: %lld matrices, %lld sums of %lld "
-              "values (%.1f per matrix), stash %lld values (all processes)\n",
-              (long long)n, (long long)nnz, matrices, t1.reduces - t0.reduces, values,
+              "traffic: %lld DOFs, %lld nonzeros; setup: %lld sums of %lld values; steps: %lld "
+              "matrices, %lld sums of %lld values (%.1f per matrix), stash %lld values (all "
+              "processes)\n",
+              (long long)n, (long long)nnz, t0.reduces, t0.reduce_values, matrices,
+              t1.reduces - t0.reduces, values,
               matrices ? (double)values / (double)matrices : 0.0, all_sent);
     TEST_TRUE(nnz > n);
     TEST_TRUE(matrices > 0);
     TEST_TRUE(t1.reduce_large == t0.reduce_large); /* no matrix summed in the steps */
+    TEST_TRUE(t1.reduce_large == 0);               /* nor at setup (the mass matrix) */
+    TEST_TRUE(t0.reduce_values < (long long)nnz);
     TEST_TRUE(values < matrices * (long long)nnz);
     /* the entries went through the distributed matrix: onto owned rows and, when every
      * process has cells of the (connected) body, across processes through the stash */
     TEST_TRUE(all2[2] > 0);
     if (size > 1 && all2[1] == 0) TEST_TRUE(all_sent > 0);
     if (size == 1) TEST_TRUE(t1.matrix_values_sent == 0);
+  }
+  if (fcm_integrator_mass(is)) {
+    /* the uses of the (partial, in the distributed run) mass matrix outside the steps, at the
+     * final state: momentum, centre of mass and kinetic energy equal the serial ones */
+    double ps[3], ls[3], pp[3], lp[3], cs[3], cp[3], es[3], ep[3];
+    TEST_OK(ctx, fcm_integrator_momentum(is, ps, ls));
+    TEST_OK(ctx, fcm_integrator_momentum(ip, pp, lp));
+    TEST_OK(ctx, fcm_simulation_center_of_mass(ser, cs));
+    TEST_OK(ctx, fcm_simulation_center_of_mass(par, cp));
+    TEST_OK(ctx, fcm_integrator_energy(is, &es[0], &es[1], &es[2]));
+    TEST_OK(ctx, fcm_integrator_energy(ip, &ep[0], &ep[1], &ep[2]));
+    /* scales: sum |(M v)_i| bounds |p|; times 2 R (R: the largest |X| coordinate plus the
+     * largest |u|) bounds |L|; R bounds the centre of mass */
+    const fcm_space *sp = fcm_simulation_space(ser);
+    const fcm_mesh *mesh = fcm_space_mesh(sp);
+    const double *X = fcm_mesh_coords(mesh), *u = fcm_integrator_displacement(is);
+    double *w = calloc((size_t)n + 1, sizeof *w), sw = 0.0, R = 0.0;
+    TEST_TRUE(w != NULL);
+    if (w) {
+      TEST_OK(ctx, fcm_csr_apply(fcm_integrator_mass(is), 1.0, fcm_integrator_velocity(is), 0.0,
+                                 w));
+      for (fcm_index i = 0; i < n; i++)
+        sw += fabs(w[i]);
+    }
+    free(w);
+    for (fcm_index a = 0; a < fcm_mesh_num_nodes(mesh); a++)
+      for (int d = 0; d < 3; d++)
+        R = fmax(R, fabs(X[3 * a + d]));
+    double umax = 0.0;
+    for (fcm_index i = 0; i < n; i++)
+      umax = fmax(umax, fabs(u[i]));
+    R += umax;
+    TEST_TRUE(sw > 0.0 && R > 0.0);
+    for (int d = 0; d < 3; d++) {
+      TEST_TRUE(fabs(pp[d] - ps[d]) <= tol * sw);
+      TEST_TRUE(fabs(lp[d] - ls[d]) <= tol * sw * 2.0 * R);
+      TEST_TRUE(fabs(cp[d] - cs[d]) <= tol * R);
+    }
+    const double escale = fabs(es[0]) + fabs(es[1]) + fabs(es[2]) + 1e-300;
+    TEST_TRUE(es[0] > 0.0);
+    for (int k = 0; k < 3; k++)
+      TEST_TRUE(fabs(ep[k] - es[k]) <= tol * escale);
+    if (rank == 0 && getenv("FCM_TEST_VERBOSE"))
+      fprintf(stderr,
+              "final: p (%g %g %g) / (%g %g %g), kinetic %.12g / %.12g, com x %.12g / %.12g\n",
+              ps[0], ps[1], ps[2], pp[0], pp[1], pp[2], es[0], ep[0], cs[0], cp[0]);
   }
   compare_runs(ctx, ser, par, steps, tol, rank);
 

@@ -324,9 +324,10 @@ FCM_API fcm_status fcm_petsc_simulation_summary_view(fcm_simulation *sim, FILE *
  * communicated on THIS process so far (over every cut's rebuilt backend). Two channels:
  * - the dense sums (MPI_Reduce to process 0 + MPI_Bcast) of the partial quantities every
  *   process holds in full: scalars (energies, the agreement on finiteness), the internal force
- *   and the elimination's lift (n doubles each), the mass matrix and the loads at setup;
- * - the Newton matrices: each process adds its own partial matrix (its cells' tangent, the
- *   base M/h^2 + D/h on the rows it owns) into the distributed MATMPIAIJ with ADD_VALUES;
+ *   and the elimination's lift, the mass and damping matrices' products (n doubles each),
+ *   the loads and M a_rep at setup (the mass matrix stays partial: no matrix is summed);
+ * - the Newton matrices: each process adds its own partial matrix (its cells' tangent and
+ *   base M/h^2 + D/h) into the distributed MATMPIAIJ with ADD_VALUES;
  *   entries of rows other processes own travel through PETSc's stash (row and column index and
  *   value per entry: matrix_bytes_sent counts 2 sizeof(PetscInt) + sizeof(PetscScalar) each).
  * Times are this process's: wall seconds (waits included) and CPU seconds (clock()). */
@@ -334,8 +335,8 @@ typedef struct fcm_petsc_traffic {
   long long reduces;              /**< dense sums */
   long long reduce_values;        /**< doubles this process handed to them */
   long long reduce_bytes;         /**< 8 per value (sent to the reduce; as many come back) */
-  long long reduce_large;         /**< sums of more values than the space has DOFs (a matrix:
-                                       the mass matrix at setup; none in the steps) */
+  long long reduce_large;         /**< sums of more values than the space has DOFs (a
+                                       matrix; none since the mass matrix stays partial) */
   long long matrices;             /**< Newton matrices given to the backend (factorizations) */
   long long matrix_values_local;  /**< entries added to rows this process owns */
   long long matrix_values_sent;   /**< entries added to other processes' rows (stash) */

@@ -474,13 +474,16 @@ FCM_API fcm_status fcm_integrator_energy(fcm_integrator *integ, double *kinetic,
 
 /** Linear momentum p = sum over nodes of (M v)_a and angular momentum about the origin
  * L = sum (X_a + u_a) x (M v)_a (exact for the interpolated fields with the consistent
- * mass); zero for STATIC integrators. Either output may be NULL. After setup. @return FCM_OK,
+ * mass); zero for STATIC integrators. Either output may be NULL. After setup. Collective in a
+ * distributed run (the partial mass matrix's parts are summed). @return FCM_OK,
  * FCM_ERR_ARG. */
 FCM_API fcm_status fcm_integrator_momentum(fcm_integrator *integ, double linear[3],
                                            double angular[3]);
 
 /** The mass matrix (borrowed): after the setup of a BACKWARD_EULER integrator; NULL before
- * and for STATIC integrators, which never assemble it. */
+ * and for STATIC integrators, which never assemble it. In a distributed run
+ * (fcm_petsc_simulation_create()) this process's partial mass matrix (its cells' part; the
+ * processes' matrices sum to the serial one). */
 FCM_API const fcm_csr *fcm_integrator_mass(const fcm_integrator *integ);
 
 /** The multigrid hierarchy of FCM_PRECOND_MULTIGRID or FCM_LINEAR_MULTIGRID (borrowed; for

@@ -178,7 +178,8 @@ FCM_API int fcm_simulation_checkpoint_due(const fcm_simulation *sim);
 /** Centre of mass of the deformed body, 1^T M x / 1^T M 1 per component with x = X + u at
  * the nodes (exact for the interpolated field and the mass quadrature, embedded or not).
  * Dynamic scenes only. fcm_simulation_summary_view() prints its drift for a free body (no
- * constraint, gravity or surface load), which momentum conservation keeps at zero.
+ * constraint, gravity or surface load), which momentum conservation keeps at zero. Collective
+ * in a distributed run (fcm_petsc_simulation_create(): the partial mass matrix's sums).
  * @return FCM_OK, FCM_ERR_ARG (NULL; a static scene has no mass matrix), FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_simulation_center_of_mass(const fcm_simulation *sim, double com[3]);
 

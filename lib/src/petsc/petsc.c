@@ -78,19 +78,23 @@
  * - masked rules now also give OTHER processes' UNCUT cells no points in the assembly and in
  *   fcm_space_momentum() (fcm__cell_rules_owns(), embed_impl.h; lib/src/fem/assemble.c): before,
  *   only cut cells were masked (the linear driver never noticed: it loops over own elements).
- * - the integrator sums after each assembly (dense, newton_reduce()): the mass matrix (nnz
- *   doubles, once at setup) and the loads (so M and fext are global), energy + force in
- *   evaluate(), the damping matrix's product D (x - u_n) there, the representative force,
+ * - the integrator sums after each assembly (dense, newton_reduce()): the loads (so fext is
+ *   global), energy + force in evaluate(), the mass and damping matrices' products
+ *   M (x - u^) and D (x - u_n) there, the representative force M a_rep,
  *   fcm_integrator_energy(), the boundary reactions, the boundary point counts (nitsche.c),
- *   and the log's mass and momentum (run.c); n doubles per sum at most in the steps. A
+ *   and the log's mass and momentum (run.c); n doubles per sum at most, setup included. The
+ *   mass matrix is NOT summed (since session 8, task i14-local2; before: nnz doubles once at
+ *   setup): each process keeps its cells' part, and every other use of M sums a product as
+ *   scalars (kinetic energy, fcm_integrator_momentum(), the centre of mass of run.c, collective
+ *   now: the distributed summary computes it on every process). tests/petsc/newton.c asserts
+ *   no sum longer than n in the whole run (fcm_petsc_traffic.reduce_large = 0). A
  *   non-finite value on any process counts as one everywhere; every reduce starts with
  *   fcm__petsc_agree(), so a process that fails outside a reduce ends with one
  *   fcm__petsc_agree() and meets the others wherever they wait (no hang).
  * - sums: MPI_Reduce to process 0 + MPI_Bcast (the same bits everywhere for any count).
  * - the Newton matrix is NOT summed densely (since session 7, task i14-sparse): each process
- *   keeps its PARTIAL matrix (its cells' tangent and boundary terms; the base M/h^2 on the
- *   rows it owns, fcm__sim_backend.owned; D/h of its partial damping matrix D, whose
- *   alpha_M M part is on its owned rows too), eliminates the active constraints in it
+ *   keeps its PARTIAL matrix (its cells' tangent and boundary terms; the base M/h^2 + D/h of
+ *   its partial mass and damping matrices), eliminates the active constraints in it
  *   (newton.c eliminate_partial(): rows and columns zeroed; the lift H_fc inc_c and the
  *   constrained diagonal summed as vectors, n doubles with a predictor, nact without; the
  *   diagonal, the summed one or 1 as fcm__eliminate_marked() takes it, on the owner's row;

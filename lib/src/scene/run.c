@@ -179,33 +179,46 @@ void fcm__effect_configure_damping(const fcm_effect *e, fcm_integrator_options *
 
 /* Centre of mass of the body at displacement u (NULL: the reference one), as the space
  * integrates it: 1^T M x / 1^T M 1 per component, x = X + u (exact for the mass quadrature,
- * embedded or not). Needs the mass matrix (dynamic scenes). */
+ * embedded or not). Needs the mass matrix (dynamic scenes). In a distributed run M is this
+ * process's partial mass matrix (sim_backend.h): the sums are its parts, summed over the
+ * processes (collective; a local failure meets the others in that sum). */
 static fcm_status center_of_mass(const fcm_simulation *S, const double *u, double com[3])
 {
   fcm_status st = FCM_OK;
   fcm_index n = fcm_integrator_num_dofs(S->integ);
   const fcm_csr *M = fcm_integrator_mass(S->integ);
   const double *X = fcm_mesh_coords(S->mesh);
-  double *x = NULL, *Mx = NULL, num[3] = {0, 0, 0}, den[3] = {0, 0, 0};
+  double *x = NULL, *Mx = NULL, q[6] = {0, 0, 0, 0, 0, 0}, *num = q, *den = q + 3;
   FCM_CHECK(M, S->ctx, FCM_ERR_ARG,
             "simulation %s: the centre of mass needs the mass matrix (static scenes have none)",
             fcm_scene_name(S->scene));
-  FCM_ALLOC(S->ctx, n, x);
-  FCM_ALLOC(S->ctx, n, Mx);
-  for (fcm_index a = 0; a < S->nn; a++) {
-    const fcm_index d0 = fcm_space_node_dof(S->space, a);
-    for (fcm_index dof = d0; d0 >= 0 && dof < d0 + 3 * fcm_space_node_copies(S->space, a); dof += 3)
-      for (int d = 0; d < 3; d++)
-        x[dof + d] = X[3 * a + d] + (u ? u[dof + d] : 0.0);
+  x = fcm__calloc(S->ctx, (size_t)n + 1, sizeof *x);
+  Mx = fcm__calloc(S->ctx, (size_t)n + 1, sizeof *Mx);
+  if (!x || !Mx) { /* fcm__calloc() recorded the message */
+    st = FCM_ERR_ALLOC;
+    fcm__trace(S->ctx, __FILE__, __LINE__, __func__);
   }
-  FCM_TRY(S->ctx, fcm_csr_apply(M, 1.0, x, 0.0, Mx));
-  for (fcm_index i = 0; i < n; i++)
-    num[i % 3] += Mx[i];
-  for (fcm_index i = 0; i < n; i++)
-    x[i] = 1.0;
-  FCM_TRY(S->ctx, fcm_csr_apply(M, 1.0, x, 0.0, Mx));
-  for (fcm_index i = 0; i < n; i++)
-    den[i % 3] += Mx[i];
+  if (st == FCM_OK) {
+    for (fcm_index a = 0; a < S->nn; a++) {
+      const fcm_index d0 = fcm_space_node_dof(S->space, a);
+      for (fcm_index dof = d0; d0 >= 0 && dof < d0 + 3 * fcm_space_node_copies(S->space, a);
+           dof += 3)
+        for (int d = 0; d < 3; d++)
+          x[dof + d] = X[3 * a + d] + (u ? u[dof + d] : 0.0);
+    }
+    st = fcm_csr_apply(M, 1.0, x, 0.0, Mx);
+  }
+  if (st == FCM_OK) {
+    for (fcm_index i = 0; i < n; i++)
+      num[i % 3] += Mx[i];
+    for (fcm_index i = 0; i < n; i++)
+      x[i] = 1.0;
+    st = fcm_csr_apply(M, 1.0, x, 0.0, Mx);
+  }
+  if (st == FCM_OK)
+    for (fcm_index i = 0; i < n; i++)
+      den[i % 3] += Mx[i];
+  FCM_TRY(S->ctx, fcm__integrator_reduce_status(S->integ, st, q, 6));
   for (int d = 0; d < 3; d++)
     com[d] = den[d] > 0.0 ? num[d] / den[d] : 0.0;
 cleanup:
@@ -1341,11 +1354,12 @@ static void body_displacement_line(const fcm_simulation *S, FILE *f, double body
             body, dofs);
 }
 
-/* The summary with the rules' statistics `gs` and the body's largest |u| over its quadrature
- * points `body` given (a distributed run: summed over the processes), or taken from this
- * process (gs NULL, body < 0). */
+/* The summary with the rules' statistics `gs`, the counters `gc`, the body's largest |u| over
+ * its quadrature points `body` and the free body's centre of mass `com_now` (NULL: not
+ * available) given (a distributed run, gc not NULL: summed over the processes), or taken from
+ * this process (gs and gc NULL, body < 0). */
 static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_stats *gs,
-                         const fcm_simulation_counters *gc, double body)
+                         const fcm_simulation_counters *gc, double body, const double *com_now)
 {
   const fcm_simulation_counters *c = gc ? gc : &S->c;
   char b[512];
@@ -1459,8 +1473,12 @@ static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_
   line(f, c->frames > 0, "output", b);
   body_displacement_line(S, f, body);
   if (S->free_body) {
+    /* com_now: the centre of mass computed by every process (a distributed run: collective,
+     * NULL when it failed); else computed here */
     double com[3];
-    if (fcm_simulation_center_of_mass(S, com) == FCM_OK) {
+    const int have = gc ? com_now != NULL : fcm_simulation_center_of_mass(S, com) == FCM_OK;
+    if (have && gc) memcpy(com, com_now, sizeof com);
+    if (have) {
       double d[3] = {com[0] - S->com0[0], com[1] - S->com0[1], com[2] - S->com0[2]};
       fprintf(f, "  centre of mass (free body) at t = 0: (%.9g, %.9g, %.9g) m; drift now %.3e m\n",
               S->com0[0], S->com0[1], S->com0[2], sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
@@ -1473,7 +1491,7 @@ static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_
 void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
 {
   if (!S || !f) return;
-  summary_view(S, f, NULL, NULL, -1.0);
+  summary_view(S, f, NULL, NULL, -1.0, NULL);
 }
 
 fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f)
@@ -1484,8 +1502,8 @@ fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f)
   const int K = FCM_RULE_KIND_COUNT, nv = 6 * FCM_RULE_KIND_COUNT + 5;
   fcm_cell_rules_stats gs;
   fcm_simulation_counters gc = S->c;
-  double *q = NULL, body = 0.0;
-  int root = 1;
+  double *q = NULL, body = 0.0, com[3] = {0, 0, 0};
+  int root = 1, com_ok = 0;
   fcm__integrator_distributed(S->integ, &root);
   memset(&gs, 0, sizeof gs);
   /* per kind: points before / after simplification, stabilization, stored, skipped, kept
@@ -1522,6 +1540,11 @@ fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f)
       if (!fcm__cell_rules_owns(R, c) || (!R && !root)) q[nv + c] = 0.0;
   }
   FCM_TRY(ctx, fcm__integrator_reduce_status(S->integ, st, q, (fcm_index)nv + nc));
+  /* the free body's centre of mass: collective (the partial mass matrix), on every process */
+  if (S->free_body) {
+    com_ok = center_of_mass(S, fcm_integrator_displacement(S->integ), com) == FCM_OK;
+    if (!com_ok) fcm_ctx_error_clear(ctx);
+  }
   for (int k = 0; k < K; k++) {
     gs.points_initial[k] = (fcm_index)q[6 * k + 0];
     gs.points_simplified[k] = (fcm_index)q[6 * k + 1];
@@ -1536,7 +1559,7 @@ fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f)
   gc.boundary_points = (fcm_index)q[6 * K + 4];
   for (fcm_index c = 0; c < nc; c++)
     if (!(q[nv + c] <= body) && body == body) body = q[nv + c]; /* a NaN stays */
-  if (f) summary_view(S, f, S->rules ? &gs : NULL, &gc, body);
+  if (f) summary_view(S, f, S->rules ? &gs : NULL, &gc, body, com_ok ? com : NULL);
 cleanup:
   fcm__free(ctx, q);
   return st;

@@ -528,7 +528,9 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
     FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->M));
     form.term = FCM_LINEAR_MASS;
     st = fcm_assembly_workspace_linear(I->aws, &form, I->M, NULL);
-    FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, NULL, I->M));
+    /* with a backend M stays this process's partial mass matrix (its cells' part; never
+     * summed: every use sums a product, sim_backend.h); agree on the status only */
+    FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, NULL));
     I->setup_info.mass_assemblies = 1;
   }
   for (int k = 0; k < I->num_loads; k++) {
@@ -541,7 +543,7 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
                 : l->kind == SIM_LOAD_BODY  ? FCM_LINEAR_BODY_FORCE_FIELD
                                             : FCM_LINEAR_SURFACE_TRACTION;
     st = fcm_assembly_workspace_linear(I->aws, &form, NULL, l->f);
-    FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, l->f, NULL));
+    FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, l->f));
     if (l->kind == SIM_LOAD_TRACTION)
       I->setup_info.traction_assemblies++;
     else
@@ -565,7 +567,9 @@ static fcm_status setup_representative_force(fcm_integrator *I)
   if (I->M) {
     for (fcm_index i = 0; i < n; i++)
       I->w1[i] = a[i % 3];
-    FCM_TRY(ctx, fcm_csr_apply(I->M, 1.0, I->w1, 0.0, I->Ma));
+    /* with a backend: the partial product, summed (n doubles) */
+    st = fcm_csr_apply(I->M, 1.0, I->w1, 0.0, I->Ma);
+    FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, I->Ma));
   } else {
     const sim_load *same = NULL;
     for (int k = 0; k < I->num_loads && !same; k++)
@@ -581,7 +585,7 @@ static fcm_status setup_representative_force(fcm_integrator *I)
       form.accel = a;
       memset(I->Ma, 0, sizeof *I->Ma * (size_t)n);
       st = fcm_assembly_workspace_linear(I->aws, &form, NULL, I->Ma);
-      FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, I->Ma, NULL));
+      FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, I->Ma));
       I->setup_info.scale_assemblies = 1;
     }
   }
@@ -753,18 +757,12 @@ fcm_status fcm__integrator_finish(fcm_integrator *I, fcm_status st)
   return st;
 }
 
-fcm_status fcm__sim_reduce(fcm_integrator *I, fcm_status st, double *scalars, int ns, double *vec,
-                           fcm_csr *T)
+fcm_status fcm__sim_reduce(fcm_integrator *I, fcm_status st, double *scalars, int ns, double *vec)
 {
   if (!I->has_backend) return st;
   const fcm__sim_backend *b = &I->backend;
   st = b->reduce(b->user, st, scalars, ns);
   if (st == FCM_OK && vec) st = b->reduce(b->user, FCM_OK, vec, I->n);
-  if (st == FCM_OK && T) {
-    fcm_index nnz = 0;
-    fcm_csr_get_size(T, NULL, NULL, &nnz);
-    st = b->reduce(b->user, FCM_OK, fcm_csr_values(T), nnz);
-  }
   if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
   return st;
 }
@@ -793,6 +791,7 @@ fcm_index fcm_integrator_num_constrained(const fcm_integrator *I)
 {
   return I ? I->ncon : 0;
 }
+/* With a distributed backend: this process's partial mass matrix (sim_backend.h). */
 const fcm_csr *fcm_integrator_mass(const fcm_integrator *I)
 {
   return I ? I->M : NULL;
@@ -887,12 +886,20 @@ fcm_status fcm_integrator_energy(fcm_integrator *I, double *kinetic, double *ela
   {
     fcm_index n = I->n;
     double psi = 0.0, ekin = 0.0, wext = 0.0;
+    const int dyn = I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER;
     st = fcm_assembly_workspace_hyperelastic(I->aws, &I->params, I->u, &psi, NULL, NULL);
-    FCM_TRY(I->ctx, fcm__sim_reduce(I, st, &psi, 1, NULL, NULL));
-    if (I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) {
-      FCM_TRY(I->ctx, fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1));
-      for (fcm_index i = 0; i < n; i++)
+    if (st == FCM_OK && dyn) {
+      st = fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1);
+      for (fcm_index i = 0; st == FCM_OK && i < n; i++)
         ekin += 0.5 * I->v[i] * I->w1[i];
+    }
+    { /* with a backend psi and v^T M v are this process's parts (M is partial): summed */
+      double parts[2] = {psi, ekin};
+      FCM_TRY(I->ctx, fcm__sim_reduce(I, st, parts, 2, NULL));
+      psi = parts[0];
+      ekin = parts[1];
+    }
+    if (dyn) {
       fcm__sim_eval_loads(I, I->t, I->w2);
     } else {
       memcpy(I->w2, I->load_prev, sizeof *I->w2 * (size_t)n);
@@ -920,12 +927,12 @@ fcm_status fcm_integrator_momentum(fcm_integrator *I, double linear[3], double a
     if (angular) memset(angular, 0, 3 * sizeof *angular);
     goto cleanup;
   }
-  FCM_TRY(I->ctx, fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1));
+  st = fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1);
   {
     const fcm_mesh *mesh = fcm_space_mesh(I->space);
     const double *X = fcm_mesh_coords(mesh);
-    fcm_index nn = fcm_mesh_num_nodes(mesh);
-    double p[3] = {0, 0, 0}, L[3] = {0, 0, 0};
+    fcm_index nn = st == FCM_OK ? fcm_mesh_num_nodes(mesh) : 0;
+    double pl[6] = {0, 0, 0, 0, 0, 0}, *p = pl, *L = pl + 3;
     for (fcm_index a = 0; a < nn; a++) {
       const fcm_index d0 = fcm_space_node_dof(I->space, a);
       const fcm_index ncp = fcm_space_node_copies(I->space, a);
@@ -939,8 +946,11 @@ fcm_status fcm_integrator_momentum(fcm_integrator *I, double linear[3], double a
         L[2] += x[0] * q[1] - x[1] * q[0];
       }
     }
-    if (linear) memcpy(linear, p, sizeof p);
-    if (angular) memcpy(angular, L, sizeof L);
+    /* with a backend M is this process's partial mass matrix: p and L (linear in M v) are
+     * its parts, summed (6 doubles) */
+    FCM_TRY(I->ctx, fcm__sim_reduce(I, st, pl, 6, NULL));
+    if (linear) memcpy(linear, p, 3 * sizeof *p);
+    if (angular) memcpy(angular, L, 3 * sizeof *L);
   }
 cleanup:
   return st;

@@ -93,21 +93,10 @@ static fcm_status assemble_boundary(fcm_integrator *I, const double *x, int proj
 
 /* The base of the Newton matrix into H before the tangent is added. With a backend
  * (sim_backend.h) H stays this process's partial matrix (the backend adds the processes'
- * matrices): M/h^2 (M is summed) on the rows this process owns, and D/h everywhere (D is this
- * process's partial damping matrix, update_damping()). */
+ * matrices): M/h^2 + D/h of its partial M and D, the serial formula. */
 static void tangent_base(fcm_integrator *I, double h)
 {
-  if (!I->has_backend || h == 0.0) {
-    fcm__sim_set_base(I, h, I->H);
-    return;
-  }
-  const fcm_index *rp = fcm_csr_row_ptr(I->H);
-  double *v = fcm_csr_values(I->H);
-  const double *mv = fcm_csr_values_read(I->M), *dv = I->D ? fcm_csr_values_read(I->D) : NULL;
-  const double a = 1.0 / (h * h);
-  for (fcm_index i = 0; i < I->n; i++)
-    for (fcm_index e = rp[i]; e < rp[i + 1]; e++)
-      v[e] = (I->owned[i] ? a * mv[e] : 0.0) + (dv ? dv[e] / h : 0.0);
+  fcm__sim_set_base(I, h, I->H);
 }
 
 /* With a backend: agree on st and on *finite, and sum the scalars and fint over the processes
@@ -122,8 +111,8 @@ static fcm_status reduce_eval(fcm_integrator *I, fcm_status st, double *scalars,
     s[k] = scalars[k];
   s[ns] = *finite ? 0.0 : 1.0;
   double t0 = fcm_wtime();
-  st = fcm__sim_reduce(I, st, s, ns + 1, NULL, NULL);
-  if (st == FCM_OK && s[ns] == 0.0 && fint) st = fcm__sim_reduce(I, FCM_OK, NULL, 0, fint, NULL);
+  st = fcm__sim_reduce(I, st, s, ns + 1, NULL);
+  if (st == FCM_OK && s[ns] == 0.0 && fint) st = fcm__sim_reduce(I, FCM_OK, NULL, 0, fint);
   stats->time_assembly += fcm_wtime() - t0;
   if (st != FCM_OK) return st;
   *finite = s[ns] == 0.0;
@@ -180,7 +169,9 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
     if (h > 0.0) {
       for (fcm_index i = 0; i < n; i++)
         I->w1[i] = x[i] - I->uhat[i];
-      FCM_TRY(I->ctx, fcm_csr_apply(I->M, 1.0, I->w1, 0.0, I->w2));
+      /* with a backend M is this process's partial matrix: sum the product (n doubles) */
+      st = fcm_csr_apply(I->M, 1.0, I->w1, 0.0, I->w2);
+      FCM_TRY(I->ctx, fcm__integrator_reduce_status(I, st, I->w2, n));
       double a = 1.0 / (h * h);
       inertia = 0.5 * a * dot(n, I->w1, I->w2);
       for (fcm_index i = 0; i < n; i++)
@@ -575,8 +566,8 @@ cleanup:
 
 /* D = alpha_M M + beta_K K+(u_n) (projected tangent at the start of the substep). With a
  * backend (sim_backend.h) D is this process's PARTIAL damping matrix, not summed: its cells'
- * K+ and alpha_M M (M is summed) on the rows it owns; the processes' D sum to the serial one
- * (evaluate() sums its products, the Newton matrix's base adds it partially). */
+ * K+ and alpha_M M of its partial M; the processes' D sum to the serial one (evaluate() sums
+ * its products, the Newton matrix's base adds it partially). */
 static fcm_status update_damping(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
 {
   fcm_status st = FCM_OK;
@@ -595,17 +586,8 @@ static fcm_status update_damping(fcm_integrator *I, fcm_step_reason *reason, sim
       return FCM_OK;
     }
   }
-  if (I->has_backend) {
-    const fcm_index *rp = fcm_csr_row_ptr(I->D);
-    for (fcm_index i = 0; i < I->n; i++) {
-      const double am = I->owned[i] ? o->rayleigh_mass : 0.0;
-      for (fcm_index e = rp[i]; e < rp[i + 1]; e++)
-        dv[e] = o->rayleigh_stiffness * dv[e] + am * mv[e];
-    }
-  } else {
-    for (fcm_index e = 0; e < nnz; e++)
-      dv[e] = o->rayleigh_stiffness * dv[e] + o->rayleigh_mass * mv[e];
-  }
+  for (fcm_index e = 0; e < nnz; e++)
+    dv[e] = o->rayleigh_stiffness * dv[e] + o->rayleigh_mass * mv[e];
   I->damp_version++;
   if (!I->linear) I->h_state = SIM_H_INVALID;
 cleanup:
@@ -658,6 +640,8 @@ static fcm_status accept_step(fcm_integrator *I, int dyn, double t0, fcm_step_in
   if (dyn) {
     st = fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1);
     ekin = 0.5 * dot(n, I->v, I->w1);
+    /* with a backend: this process's part (M is partial), summed */
+    st = fcm__sim_reduce(I, st, &ekin, 1, NULL);
   }
   info->kinetic_energy = ekin;
   info->elastic_energy = I->psi;

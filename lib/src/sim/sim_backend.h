@@ -4,14 +4,15 @@
  * cells only, so every assembly (mass, loads, energy, force, tangent, boundary terms) is the
  * process's partial sum. With a backend set:
  * - the integrator sums the partial scalars and vectors over the processes right after each
- *   assembly (reduce: energies, the internal force, the loads, the damping matrix's product;
- *   n doubles at most, plus the mass matrix once at setup), so the Newton loop,
- *   line search, stopping rules, reactions and energies see the global values and every
- *   process takes the same decisions;
- * - the Newton matrix is NOT summed: each process keeps its PARTIAL matrix (its cells'
- *   tangent and partial damping matrix D/h, plus M/h^2 on the rows it owns: its share of the
- *   base M/h^2 + D/h; D = alpha_M M + beta_K K+ is partial the same way, alpha_M M on the
- *   owned rows), eliminates the constrained DOFs
+ *   assembly (reduce: energies, the internal force, the loads, the mass and damping matrices'
+ *   products; n doubles at most), so the Newton loop, line search, stopping rules, reactions
+ *   and energies see the global values and every process takes the same decisions;
+ * - no matrix is summed: the mass matrix M stays this process's PARTIAL one (its cells'
+ *   part, fcm_integrator_mass()); every use sums a product (M (x - u^) in the energy and
+ *   gradient, M a_rep, the kinetic energy, momentum and centre of mass as scalars);
+ * - the Newton matrix is NOT summed either: each process keeps its PARTIAL matrix (its cells'
+ *   tangent and the base M/h^2 + D/h of its partial M and D; D = alpha_M M + beta_K K+ is
+ *   partial the same way), eliminates the constrained DOFs
  *   in it (their rows and columns zeroed; the diagonal, from the summed tangent's diagonal,
  *   on the owned rows only; the right-hand side's lift H_fc inc_c summed as an n-vector) and
  *   hands it to the backend (factor), which adds the partial matrices of all processes into
@@ -37,9 +38,8 @@ struct fcm__sim_backend {
   int rank, nprocs;
   /* n (the space's DOFs): 1 on the DOFs whose rows of the distributed Newton matrix this
    * process owns (every DOF on exactly one process): the terms of the Newton matrix that are
-   * no partial sums (the base M/h^2 from the summed M, the damping matrix's alpha_M M, the
-   * eliminated rows' diagonal) are put on those rows only. Required; fcm__integrator_set_backend()
-   * copies it. */
+   * no partial sums (the eliminated rows' diagonal, from the summed tangent diagonal) are put
+   * on those rows only. Required; fcm__integrator_set_backend() copies it. */
   const unsigned char *owned;
   /* Agree on st over the processes (on a failure anywhere every process returns the status
    * and message of the first failing one), then sum values[0 .. count) over the processes in
@@ -71,7 +71,7 @@ struct fcm__sim_backend {
 };
 
 /* Set the backend of an integrator that is not set up yet (before fcm_integrator_setup():
- * the setup sums the mass matrix and the loads). The integrator owns b->user from now on
+ * the setup sums the loads and M a_rep; the mass matrix stays partial). The integrator owns b->user from now on
  * (b->destroy at fcm_integrator_destroy()), also when this fails. FCM_ERR_ARG after setup. */
 fcm_status fcm__integrator_set_backend(fcm_integrator *I, const fcm__sim_backend *b);
 

@@ -111,7 +111,8 @@ struct fcm_integrator {
                             rule), from the last elimination */
 
   /* matrices (space pattern) */
-  fcm_csr *M, *H, *D, *H0; /* mass, Newton matrix, damping (or NULL), pristine copy (linear) */
+  fcm_csr *M, *H, *D, *H0; /* mass, Newton matrix, damping (or NULL), pristine copy (linear);
+                              with a backend M, D, H and H0 are this process's partial ones */
   fcm_csr *Hpc, *K0;    /* preconditioner matrix, linear stiffness at rest (created on first use) */
   int h_psd;            /* H holds a PSD tangent (set with H by newton.c) */
   double *Ma;           /* M a_rep (n) */
@@ -210,10 +211,9 @@ fcm_status fcm__sim_boundary_assemble(fcm_integrator *I, const double *x, int pr
                                       double *energy, double *force, fcm_csr *T, int *finite);
 
 /* With a backend (sim_backend.h): agree on st and sum the partial quantities over the
- * processes: the ns scalars, the vector vec (n; may be NULL) and the values of T (may be
- * NULL: a dense sum of nnz doubles, for the mass matrix at setup and the damping matrix once
- * per substep, never for the Newton matrix). Without one: returns st. (integrator.c) */
-fcm_status fcm__sim_reduce(fcm_integrator *I, fcm_status st, double *scalars, int ns, double *vec,
-                           fcm_csr *T);
+ * processes: the ns scalars and the vector vec (n; may be NULL). No matrix is ever summed
+ * (the mass, damping and Newton matrices stay partial). Without one: returns st.
+ * (integrator.c) */
+fcm_status fcm__sim_reduce(fcm_integrator *I, fcm_status st, double *scalars, int ns, double *vec);
 
 #endif /* FCM_SIM_IMPL_H */
