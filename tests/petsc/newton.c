@@ -26,7 +26,9 @@
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
 #include "fcm/simulation.h"
+#include "fem/fem_impl.h" /* fcm__space_memory(): the topology's bytes (FCM_TEST_VERBOSE) */
 #include "log_compare.h"
+#include "sim/sim_impl.h" /* the integrator's matrices and vectors (FCM_TEST_VERBOSE) */
 #include "test.h"
 
 #include <petscsys.h>
@@ -169,6 +171,31 @@ int main(int argc, char **argv)
       fprintf(stderr,
               "final: p (%g %g %g) / (%g %g %g), kinetic %.12g / %.12g, com x %.12g / %.12g\n",
               ps[0], ps[1], ps[2], pp[0], pp[1], pp[2], es[0], ep[0], cs[0], cp[0]);
+  }
+  if (getenv("FCM_TEST_VERBOSE")) {
+    /* the integrator path's memory per process in bytes per DOF (largest over the processes):
+     * the space's numbering and topology (fcm__space_memory()), the integrator's matrices
+     * (each a CSR of its own over the whole pattern: 12 per nonzero + 8 per row), its
+     * n-vectors (u, v, load_prev, the 17 work vectors of setup_storage(), one per load) */
+    const fcm_integrator *ig = ip; /* (I: complex.h's) */
+    fcm_index nnzp = 0;
+    fcm_csr_get_size(ig->H, NULL, NULL, &nnzp);
+    const fcm_csr *mats[] = {ig->M, ig->H, ig->D, ig->H0, ig->Hpc, ig->K0};
+    int nmat = 0;
+    for (size_t k = 0; k < sizeof mats / sizeof mats[0]; k++)
+      nmat += mats[k] != NULL;
+    double num = 0.0, top = 0.0, mine[4], all[4];
+    fcm__space_memory(fcm_simulation_space(par), &num, &top);
+    mine[0] = num / (double)n;
+    mine[1] = top / (double)n;
+    mine[2] = (double)nmat * (12.0 * (double)nnzp + 8.0 * ((double)n + 1.0)) / (double)n;
+    mine[3] = 8.0 * (20.0 + (double)ig->num_loads);
+    MPI_Allreduce(mine, all, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    if (rank == 0)
+      fprintf(stderr,
+              "memory per process (largest), B/DOF: numbering %.0f, topology %.0f, %d "
+              "matrices %.0f (%.0f each), vectors %.0f\n",
+              all[0], all[1], nmat, all[2], nmat ? all[2] / nmat : 0.0, all[3]);
   }
   compare_runs(ctx, ser, par, steps, tol, rank);
 
