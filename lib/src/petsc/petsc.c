@@ -253,19 +253,19 @@
  * - phase 2 keeps the whole geometry (effects select boundary triangles of it; cuts classify
  *   every cell on every process and need every geometry cell); cropping only its first rules
  *   build would shrink that build's trees, not the geometry (run.c build_rules(), not done).
- * - the options string goes into the GLOBAL options database (it stays for later problems);
- *   an options prefix per problem would scope it.
- * - README projection for 1e8 DOFs (memory and time per DOF are printed by
- *   tests/petsc/bench.c, figures in README "Distributed runs").
  * - replicated still (phase 1): the numbering and the adapter's per-copy arrays (perm,
  *   copy_owner, is_con), the mesh (and the whole geometry until the cropped rules build):
  *   about 5 GB per process at 1e8 Hex20 DOFs (README projection). Next: number each process's own
  * copies locally and exchange the ghosts' numbers (PetscSF), with the mesh cropped to own + ghost
  * cells.
- * - phase 2 keeps the simulation's full space (fcm_space_create_embedded(): its dense sums and
- *   nitsche.c's coloured assembly need the whole pattern). What it would need to use a local
- *   space: see fcm__space_create_local() in fem_impl.h (own-element assembly into local rows,
- *   ADD_VALUES into the MATMPIAIJ).
+ * - phase 2 keeps the simulation's full space (fcm_space_create_embedded(): the mass matrix's
+ *   dense sum at setup and nitsche.c's coloured assembly need the whole pattern), its matrices
+ *   (M, H, D, H0) allocated over the whole pattern and ~20 replicated DOF vectors: 3-6 kB/DOF
+ *   on every process (README projection), so it does not grow beyond one node. What it would
+ *   need to use a local space: see fcm__space_create_local() in fem_impl.h (own-element
+ *   assembly into local rows, ADD_VALUES into the MATMPIAIJ), a partial mass matrix (its
+ *   products summed as DOF vectors, as D's), and the cuts' spaces local too (branch
+ *   i14-local2 started this, session 7).
  * ------------------------------------------------------------------------------------------ */
 #define _GNU_SOURCE /* RTLD_DEFAULT */
 /* before PETSc's headers: they include complex.h, whose macro I clashes with the integrator
