@@ -258,14 +258,14 @@
  *   about 5 GB per process at 1e8 Hex20 DOFs (README projection). Next: number each process's own
  * copies locally and exchange the ghosts' numbers (PetscSF), with the mesh cropped to own + ghost
  * cells.
- * - phase 2 keeps the simulation's full space (fcm_space_create_embedded(): the mass matrix's
- *   dense sum at setup and nitsche.c's coloured assembly need the whole pattern), its matrices
- *   (M, H, D, H0) allocated over the whole pattern and ~20 replicated DOF vectors: 3-6 kB/DOF
- *   on every process (README projection), so it does not grow beyond one node. What it would
- *   need to use a local space: see fcm__space_create_local() in fem_impl.h (own-element
- *   assembly into local rows, ADD_VALUES into the MATMPIAIJ), a partial mass matrix (its
- *   products summed as DOF vectors, as D's), and the cuts' spaces local too (branch
- *   i14-local2 started this, session 7).
+ * - phase 2 keeps the simulation's full space (fcm_space_create_embedded(): nitsche.c's
+ *   coloured assembly and the integrator's matrix creation need the whole pattern), its
+ *   matrices (M, H, D, H0) allocated over the whole pattern and ~20 replicated DOF vectors:
+ *   3-6 kB/DOF on every process (README projection), so it does not grow beyond one node.
+ *   The mass matrix is partial since session 8 (i14-local2: no matrix is summed any more, so
+ *   nothing in phase 2 needs the whole pattern's VALUES on one process). What it still needs
+ *   to use a local space: see fcm__space_create_local() in fem_impl.h (own-element assembly
+ *   into local rows, ADD_VALUES into the MATMPIAIJ) and the cuts' spaces local too.
  * ------------------------------------------------------------------------------------------ */
 #define _GNU_SOURCE /* RTLD_DEFAULT */
 /* before PETSc's headers: they include complex.h, whose macro I clashes with the integrator
