@@ -112,8 +112,8 @@ int main(int argc, char **argv)
               "matrices, %lld sums of %lld values (%.1f per matrix), stash %lld values (all "
               "processes)\n",
               (long long)n, (long long)nnz, t0.reduces, t0.reduce_values, matrices,
-              t1.reduces - t0.reduces, values,
-              matrices ? (double)values / (double)matrices : 0.0, all_sent);
+              t1.reduces - t0.reduces, values, matrices ? (double)values / (double)matrices : 0.0,
+              all_sent);
     TEST_TRUE(nnz > n);
     TEST_TRUE(matrices > 0);
     TEST_TRUE(t1.reduce_large == t0.reduce_large); /* no matrix summed in the steps */
@@ -144,8 +144,8 @@ int main(int argc, char **argv)
     double *w = calloc((size_t)n + 1, sizeof *w), sw = 0.0, R = 0.0;
     TEST_TRUE(w != NULL);
     if (w) {
-      TEST_OK(ctx, fcm_csr_apply(fcm_integrator_mass(is), 1.0, fcm_integrator_velocity(is), 0.0,
-                                 w));
+      TEST_OK(ctx,
+              fcm_csr_apply(fcm_integrator_mass(is), 1.0, fcm_integrator_velocity(is), 0.0, w));
       for (fcm_index i = 0; i < n; i++)
         sw += fabs(w[i]);
     }

@@ -71,8 +71,9 @@ struct fcm__sim_backend {
 };
 
 /* Set the backend of an integrator that is not set up yet (before fcm_integrator_setup():
- * the setup sums the loads and M a_rep; the mass matrix stays partial). The integrator owns b->user from now on
- * (b->destroy at fcm_integrator_destroy()), also when this fails. FCM_ERR_ARG after setup. */
+ * the setup sums the loads and M a_rep; the mass matrix stays partial). The integrator owns b->user
+ * from now on (b->destroy at fcm_integrator_destroy()), also when this fails. FCM_ERR_ARG after
+ * setup. */
 fcm_status fcm__integrator_set_backend(fcm_integrator *I, const fcm__sim_backend *b);
 
 /* Sum values[0 .. count) over the processes of the integrator's backend, in place (a partial
