@@ -83,7 +83,7 @@
  *   M (x - u^) and D (x - u_n) there, the representative force M a_rep,
  *   fcm_integrator_energy(), the boundary reactions, the boundary point counts (nitsche.c),
  *   and the log's mass and momentum (run.c); n doubles per sum at most, setup included. The
- *   mass matrix is NOT summed (since session 8, task i14-local2; before: nnz doubles once at
+ *   mass matrix is NOT summed (since session 7, task i14-local2; before: nnz doubles once at
  *   setup): each process keeps its cells' part, and every other use of M sums a product as
  *   scalars (kinetic energy, fcm_integrator_momentum(), the centre of mass of run.c, collective
  *   now: the distributed summary computes it on every process). tests/petsc/newton.c asserts
@@ -216,8 +216,8 @@
  *   OMP/OpenBLAS threads). The test holds the default solver to bit for bit, MUMPS to 1e-12.
  * - scalability of phase 2: the tangent goes through ADD_VALUES now (above), but the vectors
  *   are still dense sums of n doubles per process (the force per evaluation, D (x - u_n), the
- *   elimination's lift per predictor, the loads), the mass matrix is summed densely once at
- *   setup (nnz doubles), the state is replicated and newton_solve() gathers the direction on
+ *   elimination's lift per predictor, the loads, the mass matrix's products: no matrix is
+ *   summed any more), the state is replicated and newton_solve() gathers the direction on
  *   every process (VecScatterCreateToAll, n doubles), and newton_factor() scans the whole
  *   replicated pattern (O(nnz) local work per matrix, no communication). Next: sum the force
  *   on owned rows only (ghost scatter), with the local + ghost space of i14-ghost.
@@ -262,7 +262,7 @@
  *   coloured assembly and the integrator's matrix creation need the whole pattern), its
  *   matrices (M, H, D, H0) allocated over the whole pattern and ~20 replicated DOF vectors:
  *   3-6 kB/DOF on every process (README projection), so it does not grow beyond one node.
- *   The mass matrix is partial since session 8 (i14-local2: no matrix is summed any more, so
+ *   The mass matrix is partial since session 7 (i14-local2: no matrix is summed any more, so
  *   nothing in phase 2 needs the whole pattern's VALUES on one process). What it still needs
  *   to use a local space: see fcm__space_create_local() in fem_impl.h (own-element assembly
  *   into local rows, ADD_VALUES into the MATMPIAIJ) and the cuts' spaces local too.
