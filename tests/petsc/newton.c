@@ -93,7 +93,7 @@ int main(int argc, char **argv)
   {
     fcm_csr *A = NULL;
     fcm_index nnz = 0;
-    TEST_OK(ctx, fcm_space_matrix_create(fcm_simulation_space(par), &A));
+    TEST_OK(ctx, fcm_space_matrix_create(fcm_simulation_space(ser), &A));
     fcm_csr_get_size(A, NULL, NULL, &nnz);
     fcm_csr_destroy(&A);
     const long long matrices = t1.matrices - t0.matrices;
@@ -125,6 +125,44 @@ int main(int argc, char **argv)
     TEST_TRUE(all2[2] > 0);
     if (size > 1 && all2[1] == 0) TEST_TRUE(all_sent > 0);
     if (size == 1) TEST_TRUE(t1.matrix_values_sent == 0);
+  }
+  {
+    /* the distributed integrator's space is local (its own cells and a layer of ghosts): its
+     * matrices hold the rows of the local copies only; on 2+ processes with a body spread
+     * over them, each process holds fewer rows and entries than the whole pattern, and the
+     * processes' rows cover every DOF */
+    const fcm_space *sp = fcm_simulation_space(par), *ss = fcm_simulation_space(ser);
+    const fcm_integrator *ig = ip;
+    fcm_index rows = -1, cols = -1, nnzp = 0, nnzs = 0;
+    TEST_TRUE(sp->is_local && !ss->is_local);
+    fcm_csr_get_size(ig->H, &rows, &cols, &nnzp);
+    fcm_csr_get_size(is->H, NULL, NULL, &nnzs);
+    TEST_TRUE(rows == fcm__space_num_rows(sp) && cols == n);
+    TEST_TRUE(rows <= n && nnzp <= nnzs);
+    unsigned char *has = calloc((size_t)n + 1, 1);
+    TEST_TRUE(has != NULL);
+    for (fcm_index r = 0; has && r < rows; r++)
+      has[fcm__space_row_dof(sp, r)] = 1;
+    if (has) MPI_Allreduce(MPI_IN_PLACE, has, (int)n, MPI_UNSIGNED_CHAR, MPI_MAX, MPI_COMM_WORLD);
+    fcm_index covered = 0;
+    for (fcm_index i = 0; has && i < n; i++)
+      covered += has[i];
+    free(has);
+    TEST_TRUE(covered == n);
+    if (getenv("FCM_TEST_VERBOSE"))
+      fprintf(stderr, "process %d: %lld of %lld rows, %lld of %lld entries, %lld of %lld cells\n",
+              rank, (long long)rows, (long long)n, (long long)nnzp, (long long)nnzs,
+              (long long)sp->num_local_elems, (long long)ss->num_elems);
+    /* the rows and entries summed over the processes fall short of every process holding
+     * the whole pattern (on small grids one process's own and ghost cells may still cover
+     * all cells; the others then hold less) */
+    long long mine3[3] = {rows, nnzp, rows > 0}, all3[3];
+    MPI_Allreduce(mine3, all3, 3, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
+    if (size > 1 && all3[2] == size) {
+      TEST_TRUE(all3[0] < (long long)size * n);
+      TEST_TRUE(all3[1] < (long long)size * nnzs);
+    }
+    if (size == 1) TEST_TRUE(rows == n && nnzp == nnzs);
   }
   if (fcm_integrator_mass(is)) {
     /* the uses of the (partial, in the distributed run) mass matrix outside the steps, at the
@@ -175,11 +213,11 @@ int main(int argc, char **argv)
   if (getenv("FCM_TEST_VERBOSE")) {
     /* the integrator path's memory per process in bytes per DOF (largest over the processes):
      * the space's numbering and topology (fcm__space_memory()), the integrator's matrices
-     * (each a CSR of its own over the whole pattern: 12 per nonzero + 8 per row), its
+     * (each a CSR of its own over the local rows: 12 per nonzero + 8 per row), its
      * n-vectors (u, v, load_prev, the 17 work vectors of setup_storage(), one per load) */
     const fcm_integrator *ig = ip; /* (I: complex.h's) */
-    fcm_index nnzp = 0;
-    fcm_csr_get_size(ig->H, NULL, NULL, &nnzp);
+    fcm_index nnzp = 0, rows = 0;
+    fcm_csr_get_size(ig->H, &rows, NULL, &nnzp);
     const fcm_csr *mats[] = {ig->M, ig->H, ig->D, ig->H0, ig->Hpc, ig->K0};
     int nmat = 0;
     for (size_t k = 0; k < sizeof mats / sizeof mats[0]; k++)
@@ -188,7 +226,7 @@ int main(int argc, char **argv)
     fcm__space_memory(fcm_simulation_space(par), &num, &top);
     mine[0] = num / (double)n;
     mine[1] = top / (double)n;
-    mine[2] = (double)nmat * (12.0 * (double)nnzp + 8.0 * ((double)n + 1.0)) / (double)n;
+    mine[2] = (double)nmat * (12.0 * (double)nnzp + 8.0 * ((double)rows + 1.0)) / (double)n;
     mine[3] = 8.0 * (20.0 + (double)ig->num_loads);
     MPI_Allreduce(mine, all, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
     if (rank == 0)

@@ -1992,19 +1992,19 @@ static fcm_status newton_factor(void *user, const fcm_csr *H, const unsigned cha
   const int *ci = fcm_csr_col_idx(H);
   const double *hv = fcm_csr_values_read(H);
   PetscInt *cols = NULL;
-  fcm_index maxrow = 0;
+  fcm_index maxrow = 0, nrows = 0, ncols = 0;
   *failed = 0;
-  {
-    fcm_index rows = 0;
-    fcm_csr_get_size(H, &rows, NULL, NULL);
-    FCM_CHECK(rows == P->n, ctx, FCM_ERR_INTERNAL,
-              "petsc: a Newton matrix of %lld rows for a backend of %lld DOFs (an integrator "
-              "used after a cut replaced it)",
-              (long long)rows, (long long)P->n);
-  }
+  /* H has the rows of the space's local copies (a local space: own and ghost cells'; a full
+   * space: every DOF), global columns */
+  fcm_csr_get_size(H, &nrows, &ncols, NULL);
+  FCM_CHECK(ncols == P->n && nrows == fcm__space_num_rows(P->space), ctx, FCM_ERR_INTERNAL,
+            "petsc: a Newton matrix of %lld x %lld for a backend of %lld DOFs and %lld rows (an "
+            "integrator used after a cut replaced it)",
+            (long long)nrows, (long long)ncols, (long long)P->n,
+            (long long)fcm__space_num_rows(P->space));
   const double t0 = MPI_Wtime();
   const clock_t c0 = clock();
-  for (fcm_index i = 0; i < P->n; i++)
+  for (fcm_index i = 0; i < nrows; i++)
     maxrow = FCM_MAX(maxrow, rp[i + 1] - rp[i]);
   cols = fcm__calloc(ctx, (size_t)maxrow + 1, sizeof *cols);
   st = cols ? FCM_OK
@@ -2014,39 +2014,37 @@ static fcm_status newton_factor(void *user, const fcm_csr *H, const unsigned cha
     PetscErrorCode ierr = MatZeroEntries(P->S);
     if (ierr) st = fcm__petsc_error(ctx, ierr, "MatZeroEntries", __FILE__, __LINE__, __func__);
   }
-  for (fcm_index k = 0; st == FCM_OK && k < P->ncopy; k++) {
+  for (fcm_index r = 0; st == FCM_OK && r < nrows; r++) {
+    const fcm_index d = fcm__space_row_dof(P->space, r), k = d / 3;
     const int own = P->copy_owner[k] == P->rank;
-    for (int i = 0; i < 3 && st == FCM_OK; i++) {
-      const fcm_index r = 3 * k + i;
-      const PetscInt row = 3 * P->perm[k] + i;
-      const PetscInt len = (PetscInt)(rp[r + 1] - rp[r]);
-      const double *v = hv + rp[r];
-      int nonzero = 0;
-      for (PetscInt j = 0; j < len; j++) {
-        const int c = ci[rp[r] + j];
-        if (v[j] != 0.0) {
-          nonzero = 1;
-          if (is_con[r] && (c != r || !own)) {
-            st = fcm__error(ctx, FCM_ERR_INTERNAL, __FILE__, __LINE__, __func__,
-                            "petsc: the partial Newton matrix has %g at (%lld, %lld) of the "
-                            "constrained DOF %lld (only its owner's diagonal may be non-zero)",
-                            v[j], (long long)r, (long long)c, (long long)r);
-            break;
-          }
+    const PetscInt row = 3 * P->perm[k] + d % 3;
+    const PetscInt len = (PetscInt)(rp[r + 1] - rp[r]);
+    const double *v = hv + rp[r];
+    int nonzero = 0;
+    for (PetscInt j = 0; j < len; j++) {
+      const int c = ci[rp[r] + j];
+      if (v[j] != 0.0) {
+        nonzero = 1;
+        if (is_con[d] && (c != d || !own)) {
+          st = fcm__error(ctx, FCM_ERR_INTERNAL, __FILE__, __LINE__, __func__,
+                          "petsc: the partial Newton matrix has %g at (%lld, %lld) of the "
+                          "constrained DOF %lld (only its owner's diagonal may be non-zero)",
+                          v[j], (long long)d, (long long)c, (long long)d);
+          break;
         }
-        cols[j] = 3 * P->perm[c / 3] + c % 3;
       }
-      if (st != FCM_OK || !nonzero) continue;
-      PetscErrorCode ierr = MatSetValues(P->S, 1, &row, len, cols, v, ADD_VALUES);
-      if (ierr) st = fcm__petsc_error(ctx, ierr, "MatSetValues", __FILE__, __LINE__, __func__);
-      if (own) {
-        P->traffic.matrix_values_local += len;
-      } else {
-        P->traffic.matrix_values_sent += len;
-        P->traffic.matrix_rows_sent++;
-        P->traffic.matrix_bytes_sent +=
-            (long long)len * (long long)(2 * sizeof(PetscInt) + sizeof(PetscScalar));
-      }
+      cols[j] = 3 * P->perm[c / 3] + c % 3;
+    }
+    if (st != FCM_OK || !nonzero) continue;
+    PetscErrorCode ierr = MatSetValues(P->S, 1, &row, len, cols, v, ADD_VALUES);
+    if (ierr) st = fcm__petsc_error(ctx, ierr, "MatSetValues", __FILE__, __LINE__, __func__);
+    if (own) {
+      P->traffic.matrix_values_local += len;
+    } else {
+      P->traffic.matrix_values_sent += len;
+      P->traffic.matrix_rows_sent++;
+      P->traffic.matrix_bytes_sent +=
+          (long long)len * (long long)(2 * sizeof(PetscInt) + sizeof(PetscScalar));
     }
   }
   st = newton_agree(P, st);

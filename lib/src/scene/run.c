@@ -206,14 +206,14 @@ static fcm_status center_of_mass(const fcm_simulation *S, const double *u, doubl
         for (int d = 0; d < 3; d++)
           x[dof + d] = X[3 * a + d] + (u ? u[dof + d] : 0.0);
     }
-    st = fcm_csr_apply(M, 1.0, x, 0.0, Mx);
+    st = fcm__space_matrix_apply(S->space, M, x, Mx);
   }
   if (st == FCM_OK) {
     for (fcm_index i = 0; i < n; i++)
       num[i % 3] += Mx[i];
     for (fcm_index i = 0; i < n; i++)
       x[i] = 1.0;
-    st = fcm_csr_apply(M, 1.0, x, 0.0, Mx);
+    st = fcm__space_matrix_apply(S->space, M, x, Mx);
   }
   if (st == FCM_OK)
     for (fcm_index i = 0; i < n; i++)
@@ -677,6 +677,23 @@ cleanup:
   return st;
 }
 
+/* The space of the rules: a full embedded space; in a distributed run (the rules carry this
+ * process's cell mask) a local one, the topology of the process's own cells and one layer of
+ * ghosts around them (fcm__space_localize(): every copy an own cell uses has its full row, as
+ * the backend's matrix preallocation needs), the numbering the full space's bit for bit. */
+static fcm_status create_space(fcm_simulation *S, const fcm_cell_rules *rules, int distributed,
+                               fcm_space **out)
+{
+  fcm_status st = FCM_OK;
+  const fcm_space_options o = fcm_space_options_default();
+  if (!distributed || !rules->own) return fcm_space_create_embedded(S->ctx, S->mesh, rules, out);
+  FCM_TRY(S->ctx, fcm__space_create_local(S->ctx, S->mesh, NULL, rules, &o, NULL, out));
+  FCM_TRY(S->ctx, fcm__space_localize(*out, rules->own));
+cleanup:
+  if (st != FCM_OK) fcm_space_destroy(out);
+  return st;
+}
+
 fcm_status fcm__sim_apply_cut(fcm_simulation *S)
 {
   fcm_status st = FCM_OK;
@@ -699,7 +716,7 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   }
   FCM_TRY(ctx, fcm_cell_rules_create_cut(ctx, S->mesh, S->geom, S->rules, surf, &rules));
   S->c.cut_cells += fcm_cell_rules_get_stats(rules)->num_integrated;
-  FCM_TRY(ctx, fcm_space_create_embedded(ctx, S->mesh, rules, &space));
+  FCM_TRY(ctx, create_space(S, rules, fcm__integrator_distributed(S->integ, NULL), &space));
   /* missed: no cell got a new piece and no node a new copy (a cut along cell faces adds copies
    * without splitting any cell) */
   if (fcm_cell_rules_num_pieces(rules) == fcm_cell_rules_num_pieces(S->rules) &&
@@ -897,7 +914,7 @@ simulation_create(fcm_ctx *ctx, const fcm_scene *scene, const fcm_simulation_opt
               "lower quadrature.min_fraction",
               (long long)rs->num_cells, fcm_scene_get_quadrature(scene)->min_fraction,
               rs->embedded_volume, rs->geometry_volume);
-    st = fcm_space_create_embedded(ctx, S->mesh, S->rules, &S->space);
+    st = create_space(S, S->rules, S->cell_mask != NULL, &S->space);
     if (st != FCM_OK) fcm__error_prefix(ctx, "geometry");
     FCM_TRY(ctx, st);
   } else {

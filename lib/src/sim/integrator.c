@@ -1,6 +1,7 @@
 /* sim: the integrator object — options, loads, prescribed motions, state get/set, setup
  * (mass and load assembly, constrained DOF lists, solver creation), energies, momentum. */
 #include "sim/sim_impl.h"
+#include "fem/fem_impl.h"
 
 #include <math.h>
 #include <string.h>
@@ -511,7 +512,7 @@ static fcm_status setup_storage(fcm_integrator *I)
                      &I->ut,   &I->fint_t, &I->g_t,   &I->w1,     &I->w2};
   for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; k++)
     FCM_ALLOC(ctx, I->n, *vecs[k]);
-  FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->H));
+  FCM_TRY(ctx, fcm__space_matrix_create_rows(I->space, &I->H));
   FCM_TRY(ctx, fcm_assembly_workspace_create(I->space, &I->opts.assembly, &I->aws));
 cleanup:
   return st;
@@ -525,7 +526,7 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
   fcm_linear_form form = fcm_linear_form_default();
   form.material = &I->mat; /* linear assembly: mass and body forces */
   if (I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) {
-    FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->M));
+    FCM_TRY(ctx, fcm__space_matrix_create_rows(I->space, &I->M));
     form.term = FCM_LINEAR_MASS;
     st = fcm_assembly_workspace_linear(I->aws, &form, I->M, NULL);
     /* with a backend M stays this process's partial mass matrix (its cells' part; never
@@ -568,7 +569,7 @@ static fcm_status setup_representative_force(fcm_integrator *I)
     for (fcm_index i = 0; i < n; i++)
       I->w1[i] = a[i % 3];
     /* with a backend: the partial product, summed (n doubles) */
-    st = fcm_csr_apply(I->M, 1.0, I->w1, 0.0, I->Ma);
+    st = fcm__space_matrix_apply(I->space, I->M, I->w1, I->Ma);
     FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, I->Ma));
   } else {
     const sim_load *same = NULL;
@@ -609,10 +610,10 @@ static fcm_status setup_solvers(fcm_integrator *I)
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = I->ctx;
   const fcm_integrator_options *o = &I->opts;
-  if (I->linear) FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->H0));
+  if (I->linear) FCM_TRY(ctx, fcm__space_matrix_create_rows(I->space, &I->H0));
   if (o->kind == FCM_INTEGRATOR_BACKWARD_EULER &&
       (o->rayleigh_mass > 0.0 || o->rayleigh_stiffness > 0.0))
-    FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->D));
+    FCM_TRY(ctx, fcm__space_matrix_create_rows(I->space, &I->D));
   if (I->has_backend) {
     /* the backend solves: no serial solver */
   } else if (o->linear_solver == FCM_LINEAR_DIRECT) {
@@ -677,6 +678,12 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
     I->opts.tolerance_mode = I->opts.kind == FCM_INTEGRATOR_STATIC ? FCM_NEWTON_TOL_RELATIVE
                                                                    : FCM_NEWTON_TOL_REPRESENTATIVE;
   FCM_CHECK(I->n > 0, ctx, FCM_ERR_ARG, "integrator: the space has no DOFs");
+  /* a local space (a distributed run's own and ghost cells) gives partial sums only: the
+   * backend sums them; without one the results would silently miss the other cells */
+  FCM_CHECK(!I->space->is_local || I->has_backend, ctx, FCM_ERR_ARG,
+            "integrator: the space is a local space (a distributed run's cells only) but the "
+            "integrator has no distributed backend; build the space with fcm_space_create() "
+            "or fcm_space_create_embedded()");
   FCM_TRY(ctx, build_constraints(I));
   FCM_TRY(ctx, setup_storage(I));
   FCM_TRY(ctx, fcm__sim_boundary_setup(I));
@@ -889,7 +896,7 @@ fcm_status fcm_integrator_energy(fcm_integrator *I, double *kinetic, double *ela
     const int dyn = I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER;
     st = fcm_assembly_workspace_hyperelastic(I->aws, &I->params, I->u, &psi, NULL, NULL);
     if (st == FCM_OK && dyn) {
-      st = fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1);
+      st = fcm__space_matrix_apply(I->space, I->M, I->v, I->w1);
       for (fcm_index i = 0; st == FCM_OK && i < n; i++)
         ekin += 0.5 * I->v[i] * I->w1[i];
     }
@@ -927,7 +934,7 @@ fcm_status fcm_integrator_momentum(fcm_integrator *I, double linear[3], double a
     if (angular) memset(angular, 0, 3 * sizeof *angular);
     goto cleanup;
   }
-  st = fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1);
+  st = fcm__space_matrix_apply(I->space, I->M, I->v, I->w1);
   {
     const fcm_mesh *mesh = fcm_space_mesh(I->space);
     const double *X = fcm_mesh_coords(mesh);

@@ -170,7 +170,7 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
       for (fcm_index i = 0; i < n; i++)
         I->w1[i] = x[i] - I->uhat[i];
       /* with a backend M is this process's partial matrix: sum the product (n doubles) */
-      st = fcm_csr_apply(I->M, 1.0, I->w1, 0.0, I->w2);
+      st = fcm__space_matrix_apply(I->space, I->M, I->w1, I->w2);
       FCM_TRY(I->ctx, fcm__integrator_reduce_status(I, st, I->w2, n));
       double a = 1.0 / (h * h);
       inertia = 0.5 * a * dot(n, I->w1, I->w2);
@@ -180,7 +180,7 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
         for (fcm_index i = 0; i < n; i++)
           I->w1[i] = x[i] - I->un[i];
         /* with a backend D is this process's partial matrix: sum the product (n doubles) */
-        st = fcm_csr_apply(I->D, 1.0, I->w1, 0.0, I->w2);
+        st = fcm__space_matrix_apply(I->space, I->D, I->w1, I->w2);
         FCM_TRY(I->ctx, fcm__integrator_reduce_status(I, st, I->w2, n));
         damp = 0.5 / h * dot(n, I->w1, I->w2);
         for (fcm_index i = 0; i < n; i++)
@@ -233,22 +233,28 @@ static void swap(double **a, double **b)
 static fcm_status eliminate_partial(fcm_integrator *I, int predictor)
 {
   fcm_status st = FCM_OK;
-  const fcm_index n = I->n, nact = I->nact;
+  const fcm_space *s = I->space;
+  const fcm_index n = I->n, nact = I->nact, nrows = fcm__space_num_rows(s);
   const fcm_index *rp = fcm_csr_row_ptr(I->H);
   const int *ci = fcm_csr_col_idx(I->H);
   double *v = fcm_csr_values(I->H), *l = I->w2;
   const unsigned char *con = I->is_con;
   const double *inc = I->w1;
+  fcm_index placed = 0, owned_con = 0;
   if (nact == 0) return FCM_OK;
-  for (fcm_index i = 0; i < n; i++) {
+  /* the matrix has the rows of the space's local copies (all of them on a full space): l is
+   * zero on the DOFs without a row (no term of this process there) */
+  memset(l, 0, sizeof *l * (size_t)n);
+  for (fcm_index r = 0; r < nrows; r++) {
+    const fcm_index i = fcm__space_row_dof(s, r);
     double acc = 0.0;
     if (con[i]) {
-      for (fcm_index e = rp[i]; e < rp[i + 1]; e++) {
+      for (fcm_index e = rp[r]; e < rp[r + 1]; e++) {
         if (ci[e] == i) acc = v[e];
         v[e] = 0.0;
       }
     } else {
-      for (fcm_index e = rp[i]; e < rp[i + 1]; e++)
+      for (fcm_index e = rp[r]; e < rp[r + 1]; e++)
         if (con[ci[e]]) {
           acc += v[e] * inc[ci[e]];
           v[e] = 0.0;
@@ -268,18 +274,29 @@ static fcm_status eliminate_partial(fcm_integrator *I, int predictor)
   if (predictor)
     for (fcm_index i = 0; i < n; i++)
       if (!con[i]) I->b[i] -= l[i];
+  /* l (done with) carries each constrained DOF's diagonal to its row below */
   for (fcm_index j = 0; j < nact; j++) {
     const fcm_index d = I->act_dof[j];
     if (!(I->act_diag[j] > 0.0)) I->act_diag[j] = 1.0;
     I->b[d] = I->act_diag[j] * inc[d];
-    if (!I->owned[d]) continue;
-    const fcm_index pos = fcm_csr_position(I->H, d, d);
+    l[d] = I->act_diag[j];
+    owned_con += I->owned[d] != 0;
+  }
+  for (fcm_index r = 0; r < nrows; r++) {
+    const fcm_index d = fcm__space_row_dof(s, r);
+    if (!con[d] || !I->owned[d]) continue;
+    const fcm_index pos = fcm_csr_position(I->H, r, d);
     FCM_CHECK(pos >= 0, I->ctx, FCM_ERR_INTERNAL,
               "integrator: the Newton matrix's pattern has no diagonal entry at DOF %lld (a "
               "DOF this process owns)",
               (long long)d);
-    v[pos] = I->act_diag[j];
+    v[pos] = l[d];
+    placed++;
   }
+  FCM_CHECK(placed == owned_con, I->ctx, FCM_ERR_INTERNAL,
+            "integrator: %lld of the %lld constrained DOFs this process owns have a row in its "
+            "Newton matrix (the space's local cells must cover every copy the process owns)",
+            (long long)placed, (long long)owned_con);
 cleanup:
   return st;
 }
@@ -302,7 +319,7 @@ static fcm_status build_system(fcm_integrator *I, double h, int predictor, int p
       for (fcm_index j = 0; j < I->nact; j++)
         I->w1[I->act_dof[j]] = I->act_inc[j];
       /* with a backend H0 is this process's partial matrix: sum the product */
-      st = fcm_csr_apply(I->H0, 1.0, I->w1, 0.0, I->w2);
+      st = fcm__space_matrix_apply(I->space, I->H0, I->w1, I->w2);
       FCM_TRY(I->ctx, fcm__integrator_reduce_status(I, st, I->w2, n));
       for (fcm_index i = 0; i < n; i++)
         if (!I->is_con[i]) I->b[i] -= I->w2[i];
@@ -638,7 +655,7 @@ static fcm_status accept_step(fcm_integrator *I, int dyn, double t0, fcm_step_in
   fcm__sim_store_reactions(I);
   if (!dyn) memcpy(I->load_prev, I->fext, sizeof(double) * (size_t)n);
   if (dyn) {
-    st = fcm_csr_apply(I->M, 1.0, I->v, 0.0, I->w1);
+    st = fcm__space_matrix_apply(I->space, I->M, I->v, I->w1);
     ekin = 0.5 * dot(n, I->v, I->w1);
     /* with a backend: this process's part (M is partial), summed */
     st = fcm__sim_reduce(I, st, &ekin, 1, NULL);

@@ -101,6 +101,7 @@ void fcm__sim_boundary_free(fcm_integrator *I)
   fcm_ctx *ctx = I->ctx;
   sim_bpoints *bp = &I->bp;
   fcm__free(ctx, bp->elem);
+  fcm__free(ctx, bp->lelem);
   fcm__free(ctx, bp->ptr);
   fcm__free(ctx, bp->con);
   fcm__free(ctx, bp->color_ptr);
@@ -371,6 +372,7 @@ fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
       bp->np = np;
       bp->nelem = ne;
       FCM_ALLOC(ctx, ne, bp->elem);
+      FCM_ALLOC(ctx, ne + 1, bp->lelem);
       FCM_ALLOC(ctx, ne + 1, bp->ptr);
       FCM_ALLOC(ctx, np, bp->con);
       FCM_ALLOC(ctx, np, bp->w);
@@ -385,8 +387,17 @@ fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
       bp->ptr[ne] = np;
     }
   }
-  /* the elements with points grouped by the space's colours (parallel assembly) */
-  FCM_ALLOC(ctx, s->num_elems + 1, ecol);
+  /* the elements with points grouped by the space's colours (parallel assembly); a local
+   * space's colours list local positions (fem_impl.h), and its elements with points (those of
+   * the process's own cells) are local */
+  for (fcm_index k = 0; k < bp->nelem; k++) {
+    bp->lelem[k] = fcm__space_elem_local(s, bp->elem[k]);
+    FCM_CHECK(bp->lelem[k] >= 0, ctx, FCM_ERR_INTERNAL,
+              "boundary constraint: cell %lld has boundary points but is no local cell of the "
+              "space",
+              (long long)s->elem_cell[bp->elem[k]]);
+  }
+  FCM_ALLOC(ctx, s->num_local_elems + 1, ecol);
   for (int c = 0; c < s->num_colors; c++)
     for (fcm_index j = s->color_ptr[c]; j < s->color_ptr[c + 1]; j++)
       ecol[s->color_elems[j]] = c;
@@ -394,11 +405,11 @@ fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
   FCM_ALLOC(ctx, (size_t)s->num_colors + 1, bp->color_ptr);
   FCM_ALLOC(ctx, (size_t)bp->nelem + 1, bp->color_k);
   for (fcm_index k = 0; k < bp->nelem; k++)
-    bp->color_ptr[ecol[bp->elem[k]] + 1]++;
+    bp->color_ptr[ecol[bp->lelem[k]] + 1]++;
   for (int c = 0; c < s->num_colors; c++)
     bp->color_ptr[c + 1] += bp->color_ptr[c];
   for (fcm_index k = 0; k < bp->nelem; k++) /* ascending k within a colour */
-    bp->color_k[bp->color_ptr[ecol[bp->elem[k]]]++] = k;
+    bp->color_k[bp->color_ptr[ecol[bp->lelem[k]]]++] = k;
   for (int c = s->num_colors; c > 0; c--)
     bp->color_ptr[c] = bp->color_ptr[c - 1];
   bp->color_ptr[0] = 0;
@@ -420,15 +431,15 @@ cleanup:
   return st;
 }
 
-/* Add the element matrix Ke (3nn x 3nn) of element e into the values of the pattern. */
-static void scatter(const fcm_space *s, fcm_index e, const double *Ke, double *vals)
+/* Add the element matrix Ke (3nn x 3nn) of the element at local position le into the values
+ * of the pattern (a matrix over the space's rows, fcm__space_matrix_create_rows()). */
+static void scatter(const fcm_space *s, fcm_index le, const double *Ke, double *vals)
 {
   const int nn = s->nn, nd = 3 * nn;
-  const fcm_index *ed = s->elem_dof + e * nn;
-  const int *off = s->elem_off + (size_t)e * nn * nn;
+  const int *off = s->elem_off + (size_t)le * nn * nn;
   for (int a = 0; a < nn; a++)
     for (int i = 0; i < 3; i++) {
-      double *dst = vals + s->row_ptr[ed[a] + i];
+      double *dst = vals + s->row_ptr[fcm__space_elem_row(s, le, a) + i];
       const double *src = Ke + (size_t)(3 * a + i) * nd;
       for (int b = 0; b < nn; b++)
         for (int k = 0; k < 3; k++)
@@ -601,7 +612,7 @@ fcm_status fcm__sim_boundary_assemble(fcm_integrator *I, const double *x, int pr
           for (int a = 0; a < nn; a++)
             for (int i = 0; i < 3; i++)
               force[ed[a] + i] += fe[3 * a + i];
-        if (T) scatter(s, e, Ke, vals);
+        if (T) scatter(s, bp->lelem[k], Ke, vals);
       }
     }
   }
@@ -669,7 +680,8 @@ fcm_status fcm_integrator_boundary_eval(fcm_integrator *I, const double *u, doub
   if (tangent) {
     fcm_index nr = -1, nc = -1, nnz = -1;
     fcm_csr_get_size(tangent, &nr, &nc, &nnz);
-    FCM_CHECK(nr == I->n && nc == I->n && nnz == I->space->row_ptr[I->n], ctx, FCM_ERR_ARG,
+    const fcm_index nrow = fcm__space_num_rows(I->space);
+    FCM_CHECK(nr == nrow && nc == I->n && nnz == I->space->row_ptr[nrow], ctx, FCM_ERR_ARG,
               "boundary eval: the matrix does not have the space's pattern (use "
               "fcm_space_matrix_create())");
   }

@@ -38,6 +38,8 @@ typedef struct sim_bcon {
 typedef struct sim_bpoints {
   fcm_index nelem;       /* elements with points */
   fcm_index *elem, *ptr; /* nelem, nelem + 1 */
+  fcm_index *lelem;      /* nelem: local position of elem[k] in the space (fem_impl.h; a full
+                            space: elem[k]) */
   fcm_index np;          /* points */
   int *con;              /* np: boundary constraint of the point */
   double *w;             /* np: area weights */
