@@ -87,16 +87,18 @@ struct fcm_space {
  * _interpolate / _eval / _num_bodies / _write_vtu, fcm__space_write_vtu_piece(),
  * fcm__assembly_element_linear(), fcm_assembly_workspace_create()) works on every element as
  * on the full space (the element's points come from the rules, which a cell_mask of the rules
- * restricts independently); fcm_space_num_colors() counts the colours of the local elements.
- * Whatever needs the whole pattern refuses it with FCM_ERR_ARG (fcm__space_check_full()):
- * fcm_space_matrix_create(), fcm_assembly_workspace_linear() / _hyperelastic() and so every
- * fcm_assemble_*(), and so the integrator (its setup creates matrices; nitsche.c reads the
- * colours and offsets only after that). The integrator path (phase 2 of the PETSc backend)
- * would need, to use it: its per-process assembly over own elements only (not the local
- * colours, which include ghosts: an element filter or a second mask), a matrix over the local
- * rows (3 num_local_copies rows, global columns: row_ptr / col_idx as they are, values added
- * into the MATMPIAIJ with ADD_VALUES) instead of fcm_space_matrix_create(), and force / energy
- * vectors over the local copies.
+ * restricts independently); fcm_space_num_colors() counts the colours of the local elements,
+ * and the colour lists hold local element positions. Whatever needs the whole pattern refuses
+ * it with FCM_ERR_ARG (fcm__space_check_full()): fcm_space_matrix_create() and so the serial
+ * integrator's setup. Assembly over the local rows: fcm__space_matrix_create_rows() (3
+ * num_local_copies rows, global columns: row_ptr / col_idx as they are), filled by
+ * fcm_assembly_workspace_linear() / _hyperelastic() (and the one-shot fcm_assemble_*() given
+ * such a matrix) when fcm__space_check_assemble() passes: the rules' cell_mask gives points to
+ * local cells only (the own cells; ghosts get none), so each process adds its own elements'
+ * terms (PARTIAL rows: summed over the processes they are the full rows); vectors stay
+ * num_dofs long (global DOFs), energies per element id. fcm__space_localize() picks the own
+ * cells and their ghosts. The values of a matrix over the rows go into a MATMPIAIJ with
+ * ADD_VALUES (fcm__space_row_dof() names each row's DOF); fcm__space_matrix_apply() multiplies.
  * @return FCM_OK, FCM_ERR_ARG (as fcm_space_create*(); rules and cell_active both given),
  * FCM_ERR_ALLOC, FCM_ERR_UNSUPPORTED (colours). (space.c) */
 fcm_status fcm__space_create_local(fcm_ctx *ctx, const fcm_mesh *mesh,
@@ -172,8 +174,9 @@ fcm_status fcm__space_localize(fcm_space *s, const unsigned char *own);
 /* FCM_OK when assembling on s gives right (partial) results: a full space, or a local space
  * whose rules were built with a cell mask (fcm__cell_rules_owns()) that flags no active cell
  * outside the local cells (so every element with points is a local element and scatters
- * into rows it has). Else FCM_ERR_ARG "<what>: ..." naming the first such cell / the missing
- * mask (a local space without rules or with unmasked rules). (space.c) */
+ * into rows it has; rules without a mask, or no rules, flag every cell: such a local space
+ * passes only when all its active cells are local). Else FCM_ERR_ARG "<what>: ..." naming the
+ * first such cell and, without a mask, that the mask is missing. (space.c) */
 fcm_status fcm__space_check_assemble(const fcm_space *s, const char *what);
 
 /* Bytes of the space's arrays: the numbering (replicated in a distributed run) and the
