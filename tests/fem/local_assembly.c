@@ -395,8 +395,16 @@ int main(int argc, char **argv)
   {
     const fcm_space_options so = fcm_space_options_default();
     TEST_OK(ctx, fcm__space_create_local(ctx, mesh, NULL, rall, &so, NULL, &bad));
+    /* own: the first active cell only (its ghosts do not cover the grid) */
+    memset(mask[0], 0, (size_t)nc);
+    for (fcm_index c = 0; c < nc; c++)
+      if (full->active[c]) {
+        mask[0][c] = 1;
+        break;
+      }
     if (bad) {
       TEST_OK(ctx, fcm__space_localize(bad, mask[0]));
+      TEST_TRUE(bad->num_local_elems < bad->num_elems);
       TEST_ERR(ctx, fcm__space_check_assemble(bad, "probe"), FCM_ERR_ARG, "probe: ");
       TEST_ERR(ctx, fcm__space_check_assemble(bad, "probe"), FCM_ERR_ARG, "cell_mask");
       fcm_assembly_workspace *ws = NULL;
@@ -418,7 +426,7 @@ int main(int argc, char **argv)
     /* unmasked rules: every cell has points */
     TEST_OK(ctx, fcm__space_create_local(ctx, mesh, NULL, rfull, &so, NULL, &bad));
     if (bad) {
-      TEST_OK(ctx, fcm__space_localize(bad, mask[1]));
+      TEST_OK(ctx, fcm__space_localize(bad, mask[0]));
       TEST_ERR(ctx, fcm__space_check_assemble(bad, "probe"), FCM_ERR_ARG, "without a cell_mask");
     }
   }
