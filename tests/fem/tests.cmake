@@ -35,3 +35,8 @@ fcm_add_test(fem_xfem_constraint tests/fem/xfem.c ARGS constraint)
 foreach(el tet4 tet10 hex8 hex20)
   fcm_add_test(fem_fields_${el} tests/fem/fields.c ARGS ${el})
 endforeach()
+# Assembly over a local space's rows (the distributed integrator's partial assembly): two
+# halves' rows summed equal the full space's matrices, vectors and energy.
+fcm_add_test(fem_local_assembly_hex8 tests/fem/local_assembly.c ARGS hex8 6 LABELS unit)
+fcm_add_test(fem_local_assembly_hex8_cut tests/fem/local_assembly.c ARGS hex8 6 cut LABELS unit)
+fcm_add_test(fem_local_assembly_hex20 tests/fem/local_assembly.c ARGS hex20 6 LABELS unit)

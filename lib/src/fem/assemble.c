@@ -321,14 +321,14 @@ static cell_result cell_kernel(const kernel_data *kd, const cell_rule *r, int nn
   return res;
 }
 
-/* Add the element matrix of element e into the values of the space's pattern. */
-static void scatter_matrix(const fcm_space *s, fcm_index e, const double *Ke, double *vals)
+/* Add the element matrix of local element le into the values of the space's pattern (its
+ * rows: a full space's DOFs, a local space's local copies). */
+static void scatter_matrix(const fcm_space *s, fcm_index le, const double *Ke, double *vals)
 {
   int nn = s->nn, ndof = 3 * nn;
-  const fcm_index *ed = s->elem_dof + e * nn;
-  const int *off = s->elem_off + (size_t)e * nn * nn;
+  const int *off = s->elem_off + (size_t)le * nn * nn;
   for (int a = 0; a < nn; a++) {
-    fcm_index da = ed[a];
+    fcm_index da = fcm__space_elem_row(s, le, a);
     for (int i = 0; i < 3; i++) {
       double *dst = vals + s->row_ptr[da + i];
       const double *src = Ke + (size_t)(3 * a + i) * ndof;
@@ -511,9 +511,11 @@ static cell_result volume_cell(const fcm_space *s, const pass *ps, fcm_index e, 
   return cell_kernel(kd, &r, nn, w);
 }
 
-/* Run the pass over all elements colour by colour (parallel within a colour) and scatter
- * each element's result; an element with det J <= 0 or a non-finite material response is
- * not scattered, and the cell of the lowest such element of the colour is reported. */
+/* Run the pass over the local elements (a full space: all) colour by colour (parallel within
+ * a colour) and scatter each element's result (matrix: into the space's rows, vector: at the
+ * element's DOFs, energy: at its element id); an element with det J <= 0 or a non-finite
+ * material response is not scattered, and the cell of the lowest such element of the colour
+ * is reported. */
 static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
 {
   fcm_status st = FCM_OK;
@@ -529,7 +531,7 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
       scratch *w = ws->sc + omp_get_thread_num();
 #pragma omp for schedule(dynamic, 16)
       for (fcm_index k = c0; k < c1; k++) {
-        fcm_index c = s->color_elems[k];
+        const fcm_index le = s->color_elems[k], c = fcm__space_local_elem(s, le);
         if (ps->traction) {
           if (!surface_cell(s, ps, c, w)) continue;
         } else {
@@ -545,7 +547,7 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
           }
           if (ps->cell_energy) ps->cell_energy[c] = res.energy;
         }
-        if (ps->vals) scatter_matrix(s, c, w->Ke, ps->vals);
+        if (ps->vals) scatter_matrix(s, le, w->Ke, ps->vals);
         if (ps->vec) scatter_vector(s, c, w->fe, ps->vec);
       }
     }
@@ -586,19 +588,20 @@ cleanup:
   return st;
 }
 
-/* The matrix must carry this space's pattern. */
+/* The matrix must carry this space's pattern over its rows. */
 static fcm_status check_matrix(const fcm_space *s, const fcm_csr *A)
 {
   fcm_status st = FCM_OK;
   fcm_index nr = -1, nc = -1, nnz = -1;
+  const fcm_index rows = fcm__space_num_rows(s);
   FCM_CHECK(A, s->ctx, FCM_ERR_ARG, "assembly: matrix is NULL");
   fcm_csr_get_size(A, &nr, &nc, &nnz);
-  FCM_CHECK(nr == s->num_dofs && nc == s->num_dofs && nnz == s->row_ptr[s->num_dofs], s->ctx,
-            FCM_ERR_ARG,
+  FCM_CHECK(nr == rows && nc == s->num_dofs && nnz == s->row_ptr[rows], s->ctx, FCM_ERR_ARG,
             "assembly: matrix is %lld x %lld with %lld entries; the space needs %lld x %lld with "
-            "%lld (create it with fcm_space_matrix_create)",
-            (long long)nr, (long long)nc, (long long)nnz, (long long)s->num_dofs,
-            (long long)s->num_dofs, (long long)s->row_ptr[s->num_dofs]);
+            "%lld (create it with %s)",
+            (long long)nr, (long long)nc, (long long)nnz, (long long)rows, (long long)s->num_dofs,
+            (long long)s->row_ptr[rows],
+            s->is_local ? "fcm__space_matrix_create_rows" : "fcm_space_matrix_create");
 cleanup:
   return st;
 }
@@ -622,7 +625,7 @@ fcm_status fcm_assembly_workspace_linear(fcm_assembly_workspace *ws, const fcm_l
   memset(&kd, 0, sizeof kd);
   FCM_CHECK(ws && form, ctx, FCM_ERR_ARG, "linear assembly: NULL workspace or form");
   const fcm_space *s = ws->space;
-  FCM_TRY(ctx, fcm__space_check_full(s, "linear assembly")); /* colours of local elements only */
+  FCM_TRY(ctx, fcm__space_check_assemble(s, "linear assembly")); /* partial on a local space */
   switch (form->term) {
   case FCM_LINEAR_STIFFNESS:
     kd.kind = KERNEL_STIFFNESS;
@@ -687,7 +690,7 @@ fcm_status fcm_assembly_workspace_hyperelastic(fcm_assembly_workspace *ws,
   memset(&kd, 0, sizeof kd);
   FCM_CHECK(ws, ctx, FCM_ERR_ARG, "hyperelastic: workspace is NULL");
   const fcm_space *s = ws->space;
-  FCM_TRY(ctx, fcm__space_check_full(s, "hyperelastic assembly"));
+  FCM_TRY(ctx, fcm__space_check_assemble(s, "hyperelastic assembly"));
   FCM_CHECK(mat && u, ctx, FCM_ERR_ARG, "hyperelastic: NULL material or displacement");
   if (tangent) FCM_TRY(ctx, check_matrix(s, tangent));
   kd.kind = KERNEL_HYPERELASTIC;
@@ -702,8 +705,8 @@ fcm_status fcm_assembly_workspace_hyperelastic(fcm_assembly_workspace *ws,
                                ws->cell_energy));
   if (energy) { /* summed in element order: independent of the thread count */
     double e = 0.0;
-    for (fcm_index el = 0; el < s->num_elems; el++)
-      e += ws->cell_energy[el];
+    for (fcm_index le = 0; le < s->num_local_elems; le++) /* ascending ids; full space: all */
+      e += ws->cell_energy[fcm__space_local_elem(s, le)];
     *energy = e;
   }
 cleanup:

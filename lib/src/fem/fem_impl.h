@@ -52,8 +52,13 @@ struct fcm_space {
    * graph, so entry (3ka+i, 3kb+j) lives at row_ptr[3ka+i] + 3 off[a][b] + j (ka the local
    * position of copy a). */
   int *elem_off; /* num_local_elems x nn x nn */
+  /* Per local element le of a LOCAL space, the local positions ka of the copies it uses at its
+   * nn nodes (fcm__space_elem_row() = 3 ka); NULL for a full space (ka = elem_dof / 3). */
+  int *elem_lcopy; /* num_local_elems x nn (local space), NULL (full space) */
   /* Local elements grouped by colour (no two share a copy): color_ptr[c]..color_ptr[c+1]
-   * index color_elems (element ids). */
+   * index color_elems, which holds LOCAL element positions le (element local_elem[le]); for a
+   * full space le is the element id. Readers outside fem (sim/nitsche.c) read a full space's
+   * colours only; a local space's colours need fcm__space_local_elem(). */
   int num_colors;
   fcm_index *color_ptr;
   fcm_index *color_elems;
@@ -82,16 +87,18 @@ struct fcm_space {
  * _interpolate / _eval / _num_bodies / _write_vtu, fcm__space_write_vtu_piece(),
  * fcm__assembly_element_linear(), fcm_assembly_workspace_create()) works on every element as
  * on the full space (the element's points come from the rules, which a cell_mask of the rules
- * restricts independently); fcm_space_num_colors() counts the colours of the local elements.
- * Whatever needs the whole pattern refuses it with FCM_ERR_ARG (fcm__space_check_full()):
- * fcm_space_matrix_create(), fcm_assembly_workspace_linear() / _hyperelastic() and so every
- * fcm_assemble_*(), and so the integrator (its setup creates matrices; nitsche.c reads the
- * colours and offsets only after that). The integrator path (phase 2 of the PETSc backend)
- * would need, to use it: its per-process assembly over own elements only (not the local
- * colours, which include ghosts: an element filter or a second mask), a matrix over the local
- * rows (3 num_local_copies rows, global columns: row_ptr / col_idx as they are, values added
- * into the MATMPIAIJ with ADD_VALUES) instead of fcm_space_matrix_create(), and force / energy
- * vectors over the local copies.
+ * restricts independently); fcm_space_num_colors() counts the colours of the local elements,
+ * and the colour lists hold local element positions. Whatever needs the whole pattern refuses
+ * it with FCM_ERR_ARG (fcm__space_check_full()): fcm_space_matrix_create() and so the serial
+ * integrator's setup. Assembly over the local rows: fcm__space_matrix_create_rows() (3
+ * num_local_copies rows, global columns: row_ptr / col_idx as they are), filled by
+ * fcm_assembly_workspace_linear() / _hyperelastic() (and the one-shot fcm_assemble_*() given
+ * such a matrix) when fcm__space_check_assemble() passes: the rules' cell_mask gives points to
+ * local cells only (the own cells; ghosts get none), so each process adds its own elements'
+ * terms (PARTIAL rows: summed over the processes they are the full rows); vectors stay
+ * num_dofs long (global DOFs), energies per element id. fcm__space_localize() picks the own
+ * cells and their ghosts. The values of a matrix over the rows go into a MATMPIAIJ with
+ * ADD_VALUES (fcm__space_row_dof() names each row's DOF); fcm__space_matrix_apply() multiplies.
  * @return FCM_OK, FCM_ERR_ARG (as fcm_space_create*(); rules and cell_active both given),
  * FCM_ERR_ALLOC, FCM_ERR_UNSUPPORTED (colours). (space.c) */
 fcm_status fcm__space_create_local(fcm_ctx *ctx, const fcm_mesh *mesh,
@@ -107,6 +114,70 @@ fcm_status fcm__space_set_local_cells(fcm_space *s, const unsigned char *cell_ma
 /* FCM_OK for a full space; for a local one FCM_ERR_ARG with "<what>: the space is a local
  * space ..." recorded. (space.c) */
 fcm_status fcm__space_check_full(const fcm_space *s, const char *what);
+
+/* ---- Matrices over a space's rows (a local space: its local copies' rows, global columns).
+ * A full space: rows are DOFs, local element positions are element ids, every function below
+ * is the full space's own (same arrays, same bits). */
+
+/* Rows of the space's matrices: 3 num_local_copies (a full space: num_dofs). */
+static inline fcm_index fcm__space_num_rows(const fcm_space *s)
+{
+  return 3 * s->num_local_copies;
+}
+
+/* The DOF of row r of a matrix over the space's rows (a full space: r). */
+static inline fcm_index fcm__space_row_dof(const fcm_space *s, fcm_index r)
+{
+  return s->local_copy ? 3 * s->local_copy[r / 3] + r % 3 : r;
+}
+
+/* The element id of local element position le (a full space: le). */
+static inline fcm_index fcm__space_local_elem(const fcm_space *s, fcm_index le)
+{
+  return s->local_elem ? s->local_elem[le] : le;
+}
+
+/* The local position of element e, -1 when e is not a local element (binary search of the
+ * ascending local_elem; a full space: e, -1 outside [0, num_elems)). (space.c) */
+fcm_index fcm__space_elem_local(const fcm_space *s, fcm_index e);
+
+/* The first row (3 x local copy position) of the copy that local element le uses at node a
+ * (a full space: elem_dof[le nn + a]). Rows r..r+2 are its three components. */
+static inline fcm_index fcm__space_elem_row(const fcm_space *s, fcm_index le, int a)
+{
+  return s->elem_lcopy ? 3 * (fcm_index)s->elem_lcopy[(size_t)le * s->nn + a]
+                       : s->elem_dof[le * s->nn + a];
+}
+
+/* A matrix over the space's rows: fcm__space_num_rows(s) x num_dofs with the space's pattern
+ * (row_ptr / col_idx as they are: global columns, copied), FCM_CSR_GENERAL for a local space;
+ * a full space: exactly fcm_space_matrix_create()'s (square, FCM_CSR_SYMMETRIC). Assembly
+ * (fcm_assembly_workspace_linear() / _hyperelastic()) adds into it.
+ * @return FCM_OK, FCM_ERR_ARG (NULL), FCM_ERR_ALLOC. (space.c) */
+fcm_status fcm__space_matrix_create_rows(const fcm_space *s, fcm_csr **A);
+
+/* y (num_dofs) = A x for A of fcm__space_matrix_create_rows() (x: num_dofs); y is zero on the
+ * DOFs with no row. A full space: fcm_csr_apply(A, 1, x, 0, y) exactly (same bits). Each row is
+ * summed serially (threads over rows): independent of the thread count. No allocation.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, x == y, A not of the space's rows). (space.c) */
+fcm_status fcm__space_matrix_apply(const fcm_space *s, const fcm_csr *A, const double *x,
+                                   double *y);
+
+/* Make a local space's topology that of the cells flagged in `own` (num_cells flags; only
+ * active cells count) and of every active cell with an element sharing a DOF copy with an
+ * element of a flagged cell (one layer of ghosts, found through the copies: every row of a copy
+ * used by an own cell is then the full space's row). FCM_ERR_ARG for a full space or NULL
+ * arguments. Calls fcm__space_set_local_cells() (on its failure the space has no local
+ * elements). Allocates O(num_cells + num_dofs/3) flags while it runs. (space.c) */
+fcm_status fcm__space_localize(fcm_space *s, const unsigned char *own);
+
+/* FCM_OK when assembling on s gives right (partial) results: a full space, or a local space
+ * whose rules were built with a cell mask (fcm__cell_rules_owns()) that flags no active cell
+ * outside the local cells (so every element with points is a local element and scatters
+ * into rows it has; rules without a mask, or no rules, flag every cell: such a local space
+ * passes only when all its active cells are local). Else FCM_ERR_ARG "<what>: ..." naming the
+ * first such cell and, without a mask, that the mask is missing. (space.c) */
+fcm_status fcm__space_check_assemble(const fcm_space *s, const char *what);
 
 /* Bytes of the space's arrays: the numbering (replicated in a distributed run) and the
  * topology (copy graph, pattern, offsets, colours, local lists). Either may be NULL. */

@@ -1,5 +1,6 @@
 /* Finite element space: active nodes, DOF numbering, the node graph and scalar
  * CSR pattern built once, per-cell scatter offsets, and the cell colouring. */
+#include "embed/embed_impl.h"
 #include "fem/fem_impl.h"
 
 #include <math.h>
@@ -261,7 +262,7 @@ cleanup:
 }
 
 /* Scalar pattern from the copy graph (the three rows of each local copy; global columns), and
- * the offsets of the local elements. */
+ * the offsets of the local elements (and, for a local space, their copies' local positions). */
 static fcm_status build_pattern(fcm_space *s, const fcm_index *g2l)
 {
   fcm_status st = FCM_OK;
@@ -282,11 +283,13 @@ static fcm_status build_pattern(fcm_space *s, const fcm_index *g2l)
           *cols++ = (int)(3 * s->node_adj[e] + j);
     }
   FCM_ALLOC(ctx, (size_t)s->num_local_elems * s->nn * s->nn + 1, s->elem_off);
+  if (g2l) FCM_ALLOC(ctx, (size_t)s->num_local_elems * s->nn + 1, s->elem_lcopy);
   for (fcm_index el = 0; el < s->num_local_elems; el++) {
     const fcm_index *ed = s->elem_dof + local_elem(s, el) * s->nn;
     int *off = s->elem_off + (size_t)el * s->nn * s->nn;
     for (int a = 0; a < s->nn; a++) {
       fcm_index ka = g2l ? g2l[ed[a] / 3] : ed[a] / 3;
+      if (g2l) s->elem_lcopy[(size_t)el * s->nn + a] = (int)ka;
       const fcm_index *row = s->node_adj + s->node_ptr[ka];
       size_t len = (size_t)(s->node_ptr[ka + 1] - s->node_ptr[ka]);
       for (int b = 0; b < s->nn; b++) {
@@ -303,7 +306,7 @@ cleanup:
 
 /* Greedy colouring of the local elements: an element takes the smallest colour not used by an
  * element sharing a copy (elements sharing a node but using different copies of it may share a
- * colour). color_elems holds element ids. */
+ * colour). color_elems holds local element positions (a full space: element ids). */
 static fcm_status build_colors(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
                                const fcm_index *cinc)
 {
@@ -344,7 +347,7 @@ static fcm_status build_colors(fcm_space *s, const fcm_index *g2l, const fcm_ind
   FCM_ALLOC(ctx, s->color_ptr[ncol] + 1, s->color_elems);
   FCM_ALLOC(ctx, ncol + 1, fill);
   for (fcm_index e = 0; e < ne; e++)
-    s->color_elems[s->color_ptr[color[e]] + fill[color[e]]++] = local_elem(s, e);
+    s->color_elems[s->color_ptr[color[e]] + fill[color[e]]++] = e;
 cleanup:
   fcm__free(ctx, color);
   fcm__free(ctx, forbid);
@@ -356,13 +359,14 @@ cleanup:
 static void free_topology(fcm_space *s)
 {
   fcm_ctx *ctx = s->ctx;
-  void *arrays[] = {s->node_ptr,  s->node_adj,    s->row_ptr,    s->col_idx,    s->elem_off,
-                    s->color_ptr, s->color_elems, s->local_copy, s->local_elem, s->cell_local};
+  void *arrays[] = {s->node_ptr,    s->node_adj,   s->row_ptr,    s->col_idx,
+                    s->elem_off,    s->elem_lcopy, s->color_ptr,  s->color_elems,
+                    s->local_copy,  s->local_elem, s->cell_local};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
     fcm__free(ctx, arrays[i]);
   s->node_ptr = s->node_adj = s->row_ptr = s->local_copy = s->local_elem = NULL;
   s->color_ptr = s->color_elems = NULL;
-  s->col_idx = s->elem_off = NULL;
+  s->col_idx = s->elem_off = s->elem_lcopy = NULL;
   s->cell_local = NULL;
   s->num_colors = 0;
   s->num_local_copies = s->num_local_elems = 0;
@@ -813,11 +817,11 @@ void fcm__space_memory(const fcm_space *s, double *numbering, double *topology)
   if (numbering) /* active, node_dof, node_ncopy, cell_elem, elem_cell, elem_piece, elem_dof */
     *numbering = nc + 2.0 * I * np + I * (nc + 1.0) + 2.0 * I * ne + I * nn * ne;
   if (topology) /* node_ptr, node_adj, row_ptr, col_idx (9 per graph entry), elem_off, colours,
-                   local lists */
+                   local lists, elem_lcopy */
     *topology = I * (nl + 1.0) + I * nadj + I * (3.0 * nl + 1.0) +
                 (double)sizeof(int) * 9.0 * nadj + (double)sizeof(int) * nn * nn * nle +
                 I * ((double)s->num_colors + 1.0) + I * nle +
-                (s->is_local ? I * (nl + nle) + nc : 0.0);
+                (s->is_local ? I * (nl + nle) + nc + (double)sizeof(int) * nn * nle : 0.0);
 }
 
 fcm_status fcm_space_matrix_create(const fcm_space *s, fcm_csr **A)
@@ -828,6 +832,136 @@ fcm_status fcm_space_matrix_create(const fcm_space *s, fcm_csr **A)
                                  FCM_CSR_SYMMETRIC, A));
 cleanup:
   return st;
+}
+
+fcm_index fcm__space_elem_local(const fcm_space *s, fcm_index e)
+{
+  if (e < 0 || e >= s->num_elems) return -1;
+  if (!s->local_elem) return s->is_local ? -1 : e; /* a local space without local elements */
+  fcm_index lo = 0, hi = s->num_local_elems;
+  while (lo < hi) {
+    const fcm_index mid = lo + (hi - lo) / 2;
+    if (s->local_elem[mid] < e)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return (lo < s->num_local_elems && s->local_elem[lo] == e) ? lo : -1;
+}
+
+fcm_status fcm__space_matrix_create_rows(const fcm_space *s, fcm_csr **A)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s ? s->ctx : NULL;
+  FCM_CHECK(s && A, ctx, FCM_ERR_ARG, "space matrix (rows): NULL space or output pointer");
+  *A = NULL;
+  if (!s->is_local) {
+    FCM_TRY(ctx, fcm_space_matrix_create(s, A));
+  } else {
+    FCM_CHECK(s->row_ptr, ctx, FCM_ERR_ARG,
+              "space matrix (rows): the local space has no topology (a failed rebuild)");
+    FCM_TRY(ctx, fcm_csr_create(ctx, fcm__space_num_rows(s), s->num_dofs, s->row_ptr, s->col_idx,
+                                FCM_CSR_GENERAL, A));
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm__space_matrix_apply(const fcm_space *s, const fcm_csr *A, const double *x,
+                                   double *y)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s ? s->ctx : NULL;
+  fcm_index nr = -1, nc = -1, nnz = -1;
+  FCM_CHECK(s && A, ctx, FCM_ERR_ARG, "space matrix apply: NULL space or matrix");
+  if (!s->is_local) {
+    FCM_TRY(ctx, fcm_csr_apply(A, 1.0, x, 0.0, y));
+    goto cleanup;
+  }
+  const fcm_index nrow = fcm__space_num_rows(s);
+  fcm_csr_get_size(A, &nr, &nc, &nnz);
+  FCM_CHECK(nr == nrow && nc == s->num_dofs && s->row_ptr && nnz == s->row_ptr[nrow], ctx,
+            FCM_ERR_ARG,
+            "space matrix apply: matrix is %lld x %lld with %lld entries; the local space's "
+            "rows need %lld x %lld (create it with fcm__space_matrix_create_rows)",
+            (long long)nr, (long long)nc, (long long)nnz, (long long)nrow,
+            (long long)s->num_dofs);
+  FCM_CHECK((x && y) || s->num_dofs == 0, ctx, FCM_ERR_ARG, "space matrix apply: x or y is NULL");
+  FCM_CHECK(!x || x != y, ctx, FCM_ERR_ARG,
+            "space matrix apply: x and y must not be the same array");
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const double *v = fcm_csr_values_read(A);
+  for (fcm_index i = 0; i < s->num_dofs; i++)
+    y[i] = 0.0;
+#pragma omp parallel for schedule(static) if (nnz >= 20000)
+  for (fcm_index r = 0; r < nrow; r++) { /* distinct rows write distinct DOFs */
+    double sum = 0.0;
+    for (fcm_index p = rp[r]; p < rp[r + 1]; p++)
+      sum += v[p] * x[ci[p]];
+    y[fcm__space_row_dof(s, r)] = 1.0 * sum; /* as fcm_csr_apply(A, 1, x, 0, y) */
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm__space_localize(fcm_space *s, const unsigned char *own)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s ? s->ctx : NULL;
+  unsigned char *mark = NULL, *mask = NULL;
+  FCM_CHECK(s && own, ctx, FCM_ERR_ARG, "localize: NULL space or own-cell flags");
+  FCM_CHECK(s->is_local, ctx, FCM_ERR_ARG,
+            "localize: the space is a full space (fcm_space_create*()); only a space of "
+            "fcm__space_create_local() takes local cells");
+  const fcm_index ncopy = s->num_dofs / 3, nn = s->nn;
+  FCM_ALLOC(ctx, ncopy + 1, mark);
+  FCM_ALLOC(ctx, s->num_cells + 1, mask);
+  for (fcm_index c = 0; c < s->num_cells; c++) /* the copies of the own cells' elements */
+    if (own[c] && s->active[c])
+      for (fcm_index e = s->cell_elem[c]; e < s->cell_elem[c + 1]; e++)
+        for (int a = 0; a < nn; a++)
+          mark[s->elem_dof[e * nn + a] / 3] = 1;
+  for (fcm_index c = 0; c < s->num_cells; c++) { /* own cells and their ghosts */
+    if (!s->active[c]) continue;
+    int hit = own[c] != 0;
+    for (fcm_index e = s->cell_elem[c]; e < s->cell_elem[c + 1] && !hit; e++)
+      for (int a = 0; a < nn && !hit; a++)
+        hit = mark[s->elem_dof[e * nn + a] / 3];
+    mask[c] = (unsigned char)hit;
+  }
+  FCM_TRY(ctx, fcm__space_set_local_cells(s, mask));
+cleanup:
+  if (s) {
+    fcm__free(ctx, mark);
+    fcm__free(ctx, mask);
+  }
+  return st;
+}
+
+fcm_status fcm__space_check_assemble(const fcm_space *s, const char *what)
+{
+  if (!s) return FCM_ERR_ARG;
+  if (!s->is_local) return FCM_OK;
+  /* the rules give points to the cells fcm__cell_rules_owns() flags (all, without a mask):
+   * each active one must be local, or its elements would scatter into rows the space lacks */
+  for (fcm_index c = 0; c < s->num_cells; c++) {
+    if (!s->active[c] || !fcm__cell_rules_owns(s->rules, c) || (s->cell_local && s->cell_local[c]))
+      continue;
+    if (!s->rules || !s->rules->own)
+      return fcm__error(s->ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                        "%s: the space is a local space, but its cell rules %s: every active "
+                        "cell gets points, and active cell %lld is not a local cell (build the "
+                        "rules with fcm_cell_rules_options.cell_mask flagging the own cells)",
+                        what, s->rules ? "were built without a cell_mask" : "are missing (no "
+                        "embedded rules)", (long long)c);
+    return fcm__error(s->ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                      "%s: the space's cell rules flag active cell %lld in their cell_mask (it "
+                      "gets points), but the local space does not cover it (localize the space "
+                      "on the cells the rules flag: fcm__space_localize())",
+                      what, (long long)c);
+  }
+  return FCM_OK;
 }
 
 void fcm__eliminate_marked(fcm_csr *A, double *b, const unsigned char *con, const double *g)
