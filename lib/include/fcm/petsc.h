@@ -296,13 +296,15 @@ FCM_API int fcm_petsc_problem_supports_scene(fcm_ctx *ctx, const fcm_scene *scen
  * everywhere, checked: FCM_ERR_INTERNAL on every process if the topologies differ), builds its
  * own cells' points, and the new integrator gets the backend again, rebuilt for the new DOF
  * count. quadrature.simplify = auto: the choice's inputs are summed over the processes, so it
- * is the serial run's. Stated plainly: every process holds the whole space's topology, the
- * mass, Newton and damping matrices over the whole pattern (values of its own cells only) and
- * the replicated state vectors, a few kB per DOF on every process, so this path does not grow
- * beyond one process's memory (the linear driver, fcm_petsc_problem_create(), does); the sums
- * are of DOF vectors and scalars (no matrix is summed: each process adds its partial Newton
- * matrix into the MATMPIAIJ), the direction is gathered on every process; the rules, the
- * element integration and the solve are what is distributed. Collective.
+ * is the serial run's. Memory, stated plainly: each process holds the space's topology and the
+ * mass, Newton and damping matrices of its own cells and one layer of ghost cells only (they
+ * shrink as processes are added), but the DOF numbering, the state and about twenty work
+ * vectors are replicated: about 0.2 kB per DOF of the whole body on every process, which
+ * bounds this path at a few times 1e7 DOFs per process (the linear driver,
+ * fcm_petsc_problem_create(), replicates about 0.05 kB/DOF). The sums are of DOF vectors and
+ * scalars (no matrix is summed: each process adds its partial Newton matrix into the
+ * MATMPIAIJ), the direction is gathered on every process; the rules, the element integration,
+ * the matrices and the solve are what is distributed. Collective.
  * @param[in] partition the cell partition method (AUTO: Morton-ordered)
  * @param[in] opts      simulation options (NULL: defaults)
  * @return FCM_OK; FCM_ERR_UNSUPPORTED (a scene without an embedded geometry: its cell rules

@@ -214,13 +214,28 @@
  *   the same matrix differ at ~1e-16 (12 of 12 runs bitwise with CG + GAMG, CG + Jacobi and
  *   -pc_type redundant; 10 of 12 differing with MUMPS Cholesky or LU, with or without
  *   OMP/OpenBLAS threads). The test holds the default solver to bit for bit, MUMPS to 1e-12.
- * - scalability of phase 2: the tangent goes through ADD_VALUES now (above), but the vectors
- *   are still dense sums of n doubles per process (the force per evaluation, D (x - u_n), the
- *   elimination's lift per predictor, the loads, the mass matrix's products: no matrix is
- *   summed any more), the state is replicated and newton_solve() gathers the direction on
- *   every process (VecScatterCreateToAll, n doubles), and newton_factor() scans the whole
- *   replicated pattern (O(nnz) local work per matrix, no communication). Next: sum the force
- *   on owned rows only (ghost scatter), with the local + ghost space of i14-ghost.
+ * - scalability of phase 2: the matrices and the topology are local since session 8 (next
+ *   item), but the vectors are still dense sums of n doubles per process (the force per
+ *   evaluation, D (x - u_n), the elimination's lift per predictor, the loads, the mass
+ *   matrix's products), the state and ~20 work vectors are replicated (168 B/DOF), and
+ *   newton_solve() gathers the direction on every process (VecScatterCreateToAll, n doubles).
+ *   Next: the integrator's vectors over the space's rows (the local copies: the same index as
+ *   the local matrices' rows and as fcm__space_elem_row()), the sums as ghost exchanges (a
+ *   VecScatter from the local rows to the MATMPIAIJ's layout, ADD then INSERT back), the dot
+ *   products and norms over owned rows then summed, the constraints' lists per process; the
+ *   frames, checkpoints, log and the cut's state transfer gather what they need.
+ * - phase 2 on a LOCAL space (session 8): run.c creates the simulation's space and every cut's
+ *   space with fcm__space_create_local() + fcm__space_localize() (own cells and a ghost layer
+ *   on both sides), newton_build() narrows it as phase 1 does (localize_space(): own cells and
+ *   the cells using a copy this process owns). M, H, D, H0 are fcm__space_matrix_create_rows()
+ *   matrices over the local copies' rows (global columns); assembly, Nitsche's scatter,
+ *   eliminate_partial() and newton_factor() go by row (fcm__space_row_dof()); every product
+ *   with M / D / H0 is fcm__space_matrix_apply() (an n-vector, zero off the local rows) summed
+ *   as before. Measured (FCM_TEST_VERBOSE=1 mpiexec -n P build/petsc_newton /tmp/scenes
+ *   SCENE 1, the clamped ball at 16^3 Hex8 cells, 6,597 DOFs; bytes per global DOF, largest
+ *   process): P = 1: topology 421, 3 matrices 2,454; P = 2: 256 / 1,499; P = 3: 202 / 1,184
+ *   (the ghost share is large on this small grid: 996 and 832 of 1,664 cells on 2 processes).
+ *   Still replicated: numbering 38 B/DOF, vectors 168 B/DOF, the adapter's per-copy arrays.
  * - cuts keep the partition made at the start (the pieces of a split cell belong to its
  *   owner; cut-heavy regions are not rebalanced) and the cut's classification of every cell
  *   runs on every process (replicated; the first build's is distributed, see above); the cut-cell
@@ -258,14 +273,6 @@
  *   about 5 GB per process at 1e8 Hex20 DOFs (README projection). Next: number each process's own
  * copies locally and exchange the ghosts' numbers (PetscSF), with the mesh cropped to own + ghost
  * cells.
- * - phase 2 keeps the simulation's full space (fcm_space_create_embedded(): nitsche.c's
- *   coloured assembly and the integrator's matrix creation need the whole pattern), its
- *   matrices (M, H, D, H0) allocated over the whole pattern and ~20 replicated DOF vectors:
- *   3-6 kB/DOF on every process (README projection), so it does not grow beyond one node.
- *   The mass matrix is partial since session 7 (i14-local2: no matrix is summed any more, so
- *   nothing in phase 2 needs the whole pattern's VALUES on one process). What it still needs
- *   to use a local space: see fcm__space_create_local() in fem_impl.h (own-element assembly
- *   into local rows, ADD_VALUES into the MATMPIAIJ) and the cuts' spaces local too.
  * ------------------------------------------------------------------------------------------ */
 #define _GNU_SOURCE /* RTLD_DEFAULT */
 /* before PETSc's headers: they include complex.h, whose macro I clashes with the integrator
@@ -2199,6 +2206,11 @@ static fcm_status newton_build(fcm_petsc_problem *P, fcm_status st, const fcm_sp
   P->mesh = fcm_space_mesh(space);
   st = own_active_cells(P);
   if (st == FCM_OK) st = number_dofs(P);
+  /* the simulation's local space (run.c: own cells and a ghost layer on both sides of the
+   * interface) narrowed to what this process needs, as phase 1's: its own cells and the cells
+   * using a copy it owns (every owned row complete for create_matrix(), every row its own
+   * cells' assembly touches present) */
+  if (st == FCM_OK && P->space->is_local) st = localize_space(P);
   if (st == FCM_OK) { /* the integrator's copy of the ownership (fcm__sim_backend.owned) */
     P->owned_dof = fcm__calloc(ctx, (size_t)P->n + 1, 1);
     if (!P->owned_dof)
