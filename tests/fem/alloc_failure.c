@@ -3,10 +3,12 @@
  * assembly (stiffness, mass, body force, body-force field, surface traction, hyperelastic),
  * fcm_space_apply_dirichlet, fcm_space_locate (points inside cells and extrapolated ones),
  * fcm_element_standard_rule and the output fields (cell stress, max displacement, VTU of the
- * space, the embedded surface and its VTU) returns FCM_ERR_ALLOC, NULL outputs and leaks
- * nothing. */
+ * space, the embedded surface and its VTU), a local space localized on some cells
+ * (fcm__space_create_local() + fcm__space_localize()) and its matrix over the local rows
+ * (fcm__space_matrix_create_rows()) returns FCM_ERR_ALLOC, NULL outputs and leaks nothing. */
 #include "fcm/fcm.h"
 #include "alloc_loop.h"
+#include "fem/fem_impl.h"
 
 #include <omp.h>
 #include <sys/stat.h>
@@ -151,6 +153,27 @@ static fcm_status dirichlet(void *u)
   const double vals[6] = {0, 0, 0, 1e-3, 0, 0};
   return fcm_space_apply_dirichlet(x->space, x->ncon, x->con, vals, x->K, x->f);
 }
+static unsigned char own_cells[4] = {1, 0, 0, 0};
+static fcm_status local_space(void *u)
+{
+  fixture *x = u;
+  x->s_out = (fcm_space *)x;
+  fcm_status st = fcm__space_create_local(x->ctx, x->mesh, NULL, x->rules, NULL, NULL, &x->s_out);
+  if (st != FCM_OK) return OUT_CHECK(st, x->s_out);
+  return fcm__space_localize(x->s_out, own_cells); /* released: the space */
+}
+static fcm_status rows_matrix(void *u)
+{
+  fixture *x = u;
+  x->A_out = (fcm_csr *)x;
+  fcm_status st = fcm__space_matrix_create_rows(x->s_out, &x->A_out);
+  return OUT_CHECK(st, x->A_out);
+}
+static void release_matrix(void *u)
+{
+  fixture *x = u;
+  fcm_csr_destroy(&x->A_out);
+}
 static fcm_status locate(void *u)
 {
   fixture *x = u;
@@ -212,6 +235,11 @@ int main(void)
   alloc_loop(ctx, &f, "fcm_space_apply_dirichlet", dirichlet, NULL, &x, 1, 1000);
   alloc_loop(ctx, &f, "fcm_space_locate", locate, NULL, &x, 2, 1000);
   TEST_TRUE(x.ext[0] == 0 && x.ext[3] == 1); /* the last round located both kinds */
+  alloc_loop(ctx, &f, "fcm__space_create_local + fcm__space_localize", local_space, release, &x, 5,
+             1000);
+  TEST_OK(ctx, local_space(&x));
+  alloc_loop(ctx, &f, "fcm__space_matrix_create_rows", rows_matrix, release_matrix, &x, 2, 1000);
+  release(&x);
   x.geom = g;
   x.cell_out = malloc(sizeof *x.cell_out * 8 * (size_t)fcm_mesh_num_cells(x.mesh));
   TEST_OK(ctx, fcm_embedded_surface_create(x.space, g, &x.es));

@@ -1,26 +1,25 @@
 /* Assembly over a LOCAL space's rows (the PETSc backend's integrator path, fem_impl.h): a ball
  * embedded in a box grid (optionally cut by a crack plane: pieces, nodes with several copies),
- * its cells split in two halves (slabs of the cell numbering, then a checkerboard of the grid's octants). For each
- * half: cell rules built with the half as cell_mask, a local space (fcm__space_create_local())
- * localized on the half (fcm__space_localize(): own cells and one layer of ghosts), matrices
- * over its rows (fcm__space_matrix_create_rows()), and the workspace assembly of the stiffness,
- * the mass, body force, surface traction and the hyperelastic energy / force / tangent at a
- * random displacement. Asserted against the full space (unmasked rules, fcm_space_matrix_create()):
- * (1) every local row placed at its DOF (fcm__space_row_dof()), summed over the halves, is the
- *     full matrix to 1e-12 relative (of each full row's largest entry); the local patterns are
- *     subsets of the full one; the vectors sum likewise, the energies to 1e-12 relative;
- * (2) each row of a copy used by an own cell has exactly the full row's columns;
- * (3) fcm__space_matrix_apply() of each half's mass, summed, is the full M x (1e-12 of |M||x|);
- * (4) the accessors: fcm__space_local_elem / _elem_local / _elem_row / _row_dof agree with the
- *     numbering, the colours hold each local element position once;
- * (5) fcm__space_check_assemble() (and so the assembly) refuses a local space whose rules give
- *     points outside its local cells (rules masked with every cell, space localized on a half;
- *     unmasked rules) and the matrix of a full space, a full space passes;
- *     fcm__space_localize() refuses a full space;
- * (6) on the full space fcm__space_matrix_create_rows() is fcm_space_matrix_create() (size,
- *     kind, pattern) and fcm__space_matrix_apply() is fcm_csr_apply() bit for bit.
- * With FCM_TEST_VERBOSE set: the topology bytes (fcm__space_memory()) and matrix entries of
- * each half against the full space. Arguments: element type, grid cells per side, [cut]. */
+ * its cells split in two halves (slabs of the cell numbering, then a checkerboard of the grid's
+ * octants). For each half: cell rules built with the half as cell_mask, a local space
+ * (fcm__space_create_local()) localized on the half (fcm__space_localize(): own cells and one layer
+ * of ghosts), matrices over its rows (fcm__space_matrix_create_rows()), and the workspace assembly
+ * of the stiffness, the mass, body force, surface traction and the hyperelastic energy / force /
+ * tangent at a random displacement. Asserted against the full space (unmasked rules,
+ * fcm_space_matrix_create()): (1) every local row placed at its DOF (fcm__space_row_dof()), summed
+ * over the halves, is the full matrix to 1e-12 relative (of each full row's largest entry); the
+ * local patterns are subsets of the full one; the vectors sum likewise, the energies to 1e-12
+ * relative; (2) each row of a copy used by an own cell has exactly the full row's columns; (3)
+ * fcm__space_matrix_apply() of each half's mass, summed, is the full M x (1e-12 of |M||x|); (4) the
+ * accessors: fcm__space_local_elem / _elem_local / _elem_row / _row_dof agree with the numbering,
+ * the colours hold each local element position once; (5) fcm__space_check_assemble() (and so the
+ * assembly) refuses a local space whose rules give points outside its local cells (rules masked
+ * with every cell, space localized on a half; unmasked rules) and the matrix of a full space, a
+ * full space passes; fcm__space_localize() refuses a full space; (6) on the full space
+ * fcm__space_matrix_create_rows() is fcm_space_matrix_create() (size, kind, pattern) and
+ * fcm__space_matrix_apply() is fcm_csr_apply() bit for bit. With FCM_TEST_VERBOSE set: the topology
+ * bytes (fcm__space_memory()) and matrix entries of each half against the full space. Arguments:
+ * element type, grid cells per side, [cut]. */
 #include "fem/fem_impl.h"
 #include "fem_util.h"
 
@@ -164,8 +163,7 @@ static void outputs_free(outputs *o)
 
 /* Every assembly of the test on space s into o (matrices over its rows). */
 static void assemble_all(fcm_ctx *ctx, const fcm_space *s, const fcm_material *mat,
-                         const fcm_material_params *p, const double *u, const double *x,
-                         outputs *o)
+                         const fcm_material_params *p, const double *u, const double *x, outputs *o)
 {
   fcm_assembly_workspace *ws = NULL;
   const fcm_index n = fcm_space_num_dofs(s);
@@ -288,7 +286,8 @@ int main(int argc, char **argv)
     fcm_csr_get_size(A, &r1, &c1, &z1);
     fcm_csr_get_size(F.M, &r2, &c2, &z2);
     TEST_TRUE(r1 == r2 && c1 == c2 && z1 == z2 && fcm_csr_get_kind(F.M) == FCM_CSR_SYMMETRIC &&
-              memcmp(fcm_csr_row_ptr(A), fcm_csr_row_ptr(F.M), sizeof(fcm_index) * (size_t)(nd + 1)) == 0 &&
+              memcmp(fcm_csr_row_ptr(A), fcm_csr_row_ptr(F.M),
+                     sizeof(fcm_index) * (size_t)(nd + 1)) == 0 &&
               memcmp(fcm_csr_col_idx(A), fcm_csr_col_idx(F.M), sizeof(int) * (size_t)z1) == 0);
     double *y = calloc((size_t)nd + 1, sizeof *y);
     TEST_OK(ctx, fcm_csr_apply(F.M, 1.0, x, 0.0, y));
@@ -301,7 +300,8 @@ int main(int argc, char **argv)
   double topo_full = 0.0;
   fcm__space_memory(full, NULL, &topo_full);
   if (verbose)
-    fprintf(stderr, "%s n=%lld%s: %lld DOFs, %lld elements; full space: topology %.0f bytes, "
+    fprintf(stderr,
+            "%s n=%lld%s: %lld DOFs, %lld elements; full space: topology %.0f bytes, "
             "%lld matrix entries\n",
             argv[1], (long long)n, cut ? " cut" : "", (long long)nd, (long long)full->num_elems,
             topo_full, (long long)full->row_ptr[nd]);

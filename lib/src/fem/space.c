@@ -359,9 +359,9 @@ cleanup:
 static void free_topology(fcm_space *s)
 {
   fcm_ctx *ctx = s->ctx;
-  void *arrays[] = {s->node_ptr,    s->node_adj,   s->row_ptr,    s->col_idx,
-                    s->elem_off,    s->elem_lcopy, s->color_ptr,  s->color_elems,
-                    s->local_copy,  s->local_elem, s->cell_local};
+  void *arrays[] = {s->node_ptr,   s->node_adj,   s->row_ptr,   s->col_idx,
+                    s->elem_off,   s->elem_lcopy, s->color_ptr, s->color_elems,
+                    s->local_copy, s->local_elem, s->cell_local};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
     fcm__free(ctx, arrays[i]);
   s->node_ptr = s->node_adj = s->row_ptr = s->local_copy = s->local_elem = NULL;
@@ -867,8 +867,7 @@ cleanup:
   return st;
 }
 
-fcm_status fcm__space_matrix_apply(const fcm_space *s, const fcm_csr *A, const double *x,
-                                   double *y)
+fcm_status fcm__space_matrix_apply(const fcm_space *s, const fcm_csr *A, const double *x, double *y)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s ? s->ctx : NULL;
@@ -884,8 +883,7 @@ fcm_status fcm__space_matrix_apply(const fcm_space *s, const fcm_csr *A, const d
             FCM_ERR_ARG,
             "space matrix apply: matrix is %lld x %lld with %lld entries; the local space's "
             "rows need %lld x %lld (create it with fcm__space_matrix_create_rows)",
-            (long long)nr, (long long)nc, (long long)nnz, (long long)nrow,
-            (long long)s->num_dofs);
+            (long long)nr, (long long)nc, (long long)nnz, (long long)nrow, (long long)s->num_dofs);
   FCM_CHECK((x && y) || s->num_dofs == 0, ctx, FCM_ERR_ARG, "space matrix apply: x or y is NULL");
   FCM_CHECK(!x || x != y, ctx, FCM_ERR_ARG,
             "space matrix apply: x and y must not be the same array");
@@ -953,8 +951,11 @@ fcm_status fcm__space_check_assemble(const fcm_space *s, const char *what)
                         "%s: the space is a local space, but its cell rules %s: every active "
                         "cell gets points, and active cell %lld is not a local cell (build the "
                         "rules with fcm_cell_rules_options.cell_mask flagging the own cells)",
-                        what, s->rules ? "were built without a cell_mask" : "are missing (no "
-                        "embedded rules)", (long long)c);
+                        what,
+                        s->rules ? "were built without a cell_mask"
+                                 : "are missing (no "
+                                   "embedded rules)",
+                        (long long)c);
     return fcm__error(s->ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
                       "%s: the space's cell rules flag active cell %lld in their cell_mask (it "
                       "gets points), but the local space does not cover it (localize the space "
