@@ -57,8 +57,8 @@ struct fcm_space {
   int *elem_lcopy; /* num_local_elems x nn (local space), NULL (full space) */
   /* Local elements grouped by colour (no two share a copy): color_ptr[c]..color_ptr[c+1]
    * index color_elems, which holds LOCAL element positions le (element local_elem[le]); for a
-   * full space le is the element id. Readers outside fem (sim/nitsche.c) read a full space's
-   * colours only; a local space's colours need fcm__space_local_elem(). */
+   * full space le is the element id (sim/nitsche.c groups its boundary elements by them
+   * through fcm__space_elem_local()). */
   int num_colors;
   fcm_index *color_ptr;
   fcm_index *color_elems;
