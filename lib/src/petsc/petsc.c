@@ -1490,8 +1490,7 @@ fcm_status fcm_petsc_problem_setup(fcm_petsc_problem *P)
     if (mg || by_default) {
       int levels = 0;
       if (by_default) PCALL(ctx, PCSetType(pc, PCMG));
-      FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm,
-                                    fcm__petsc_pcmg_setup(P, pc, P->is_con, by_default, &levels)));
+      FCM_TRY(ctx, fcm__petsc_pcmg_setup(P, pc, P->is_con, by_default, &levels)); /* agreed */
       if (levels == 0) { /* not a box grid: GAMG */
         PCALL(ctx, PCSetType(pc, PCGAMG));
         PCALL(ctx, PCSetFromOptions(pc));
@@ -2087,7 +2086,7 @@ static fcm_status newton_factor(void *user, const fcm_csr *H, const unsigned cha
     PCALL(ctx, KSPGetPC(P->ksp, &pc));
     PCALL(ctx, PetscObjectTypeCompare((PetscObject)pc, PCMG, &mg));
     if (mg) PCALL(ctx, PCMGGetLevels(pc, &nl));
-    if (mg && nl < 2) FCM_TRY(ctx, newton_agree(P, fcm__petsc_pcmg_setup(P, pc, NULL, 0, NULL)));
+    if (mg && nl < 2) FCM_TRY(ctx, fcm__petsc_pcmg_setup(P, pc, NULL, 0, NULL)); /* agreed */
   }
   PCALL(ctx, KSPSetOperators(P->ksp, P->S, P->S));
   PCALL(ctx, KSPSetUp(P->ksp));
