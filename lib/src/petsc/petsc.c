@@ -1465,7 +1465,8 @@ fcm_status fcm_petsc_problem_setup(fcm_petsc_problem *P)
   PCALL(ctx, MatSetOption(P->Se, MAT_SPD, PETSC_TRUE));
   FCM_TRY(ctx, near_null_space(P, P->Se));
   /* 3. the KSP: defaults, then the options database */
-  FCM_TRY(ctx, insert_options(P));
+  /* local (fcm allocations): agreed before the collective KSPCreate and PCMG setup below */
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, insert_options(P)));
   PCALL(ctx, KSPCreate(P->comm, &P->ksp));
   PCALL(ctx, KSPSetOptionsPrefix(P->ksp, P->prefix));
   PCALL(ctx, KSPSetOperators(P->ksp, P->Se, P->Se));
