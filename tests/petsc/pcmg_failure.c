@@ -16,13 +16,22 @@
  * round over the stride (every allocation was failed once with stride 1); the successful
  * round's displacement is the same bits as that of a run with no failing allocator armed (1e-8
  * relative on 3 processes, where PETSc's sums may vary between runs).
+ * The same for the integrator on PETSc (phase 2: fcm_petsc_simulation_create(), -ksp_type cg
+ * -pc_type mg): allocation k of the first step (assembly, Newton matrices, newton_factor():
+ * fcm__petsc_pcmg_setup() at the first, the block smoothers' setup at every one) failing on
+ * process 1: the step fails on every process with the message (the others naming process 1),
+ * no leak; the successful round's energy is the unarmed run's.
  * Arguments: element (hex8|hex20), N (cells per side of the unit cube, a ball of radius 0.45
- * embedded), [stride: k = 0, stride, 2 stride, ... (default 1)]. */
+ * embedded), [stride: k = 0, stride, 2 stride, ... (default 1)]; or: scene <scene file>
+ * [stride]. */
 #define _POSIX_C_SOURCE 200809L /* open_memstream */
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
+#include "fcm/simulation.h"
 #include "test.h"
 #include "test_alloc.h"
+
+#include <petscsys.h>
 
 #include <string.h>
 
@@ -79,6 +88,84 @@ done:
   return st;
 }
 
+/* Phase 2 (the integrator on PETSc, -ksp_type cg -pc_type mg: newton_factor() sets the levels
+ * up at the first Newton matrix): the simulation of `scene` made with no failure, then its
+ * first step with allocation `fail_at` failing (-1: none); this process's allocations in the
+ * step into *count, its energy into *energy. */
+static fcm_status round_scene(fcm_ctx *ctx, failing *f, long long fail_at, const fcm_scene *scene,
+                              long long *count, double *energy)
+{
+  fcm_simulation *sim = NULL;
+  fcm_simulation_options so = fcm_simulation_options_default();
+  so.max_steps = 1;
+  fcm_step_info si;
+  fcm_status st = fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene,
+                                              FCM_PETSC_PARTITION_ORDERED, &so, &sim);
+  if (st) goto done;
+  f->count = 0;
+  f->fail_at = fail_at;
+  st = fcm_simulation_step(sim, &si);
+  f->fail_at = -1;
+  *count = f->count;
+  if (!st) *energy = si.total_energy;
+done:
+  f->fail_at = -1;
+  fcm_simulation_destroy(&sim);
+  return st;
+}
+
+static int scene_main(fcm_ctx *ctx, failing *f, const char *path, long long stride)
+{
+  fcm_scene *scene = NULL;
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const int bad = size > 1 ? 1 : 0;
+  if (PetscOptionsSetValue(NULL, "-ksp_type", "cg") || PetscOptionsSetValue(NULL, "-pc_type", "mg"))
+    return 1;
+  TEST_OK(ctx, fcm_scene_create_from_file(ctx, path, &scene));
+  long long count = 0, failures = 0, count_ok = -1, in_smoother = 0;
+  double e0 = 0.0, e = 0.0;
+  TEST_OK(ctx, round_scene(ctx, f, -1, scene, &count, &e0));
+  if (getenv("FCM_TEST_VERBOSE") && rank == bad)
+    fprintf(stderr, "scene: %lld allocations in the step on process %d\n", count, bad);
+  const long long live = fcm_ctx_live_allocations(ctx);
+  for (long long k = 0; k < 1000000 && !test_failures_; k += stride) {
+    const fcm_status st = round_scene(ctx, f, rank == bad ? k : -1, scene, &count, &e);
+    int mine[2] = {st == FCM_OK, st != FCM_OK}, all[2] = {0, 0};
+    MPI_Allreduce(mine, all, 2, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+    if (all[0] == size) {
+      count_ok = count;
+      TEST_TRUE(e == e0);
+      break;
+    }
+    failures++;
+    const char *msg = fcm_ctx_error_message(ctx);
+    if (getenv("FCM_TEST_VERBOSE") && rank == 0) fprintf(stderr, "%lld: %s\n", k, msg);
+    if (all[1] != size) TEST_FAIL_("scene: allocation %lld failing on process %d: %d of %d "
+                                   "processes failed; this one: %s", k, bad, all[1], size, msg);
+    if (!strstr(msg, "out of memory") || (rank != bad && !strstr(msg, "process 1 of")))
+      TEST_FAIL_("scene: allocation %lld failing on process %d: message on process %d: %s", k,
+                 bad, rank, msg);
+    in_smoother += strstr(msg, "fcm block smoother") != NULL;
+    fcm_ctx_error_clear(ctx);
+    if (fcm_ctx_live_allocations(ctx) != live)
+      TEST_FAIL_("scene: allocation %lld failing: %lld allocations leaked", k,
+                 fcm_ctx_live_allocations(ctx) - live);
+  }
+  long long cnt = rank == bad ? count_ok : 0, cnt_all = 0;
+  MPI_Allreduce(&cnt, &cnt_all, 1, MPI_LONG_LONG, MPI_MAX, MPI_COMM_WORLD);
+  if (rank == 0)
+    printf("pcmg_failure scene on %d processes: %lld failing rounds (%lld in the block smoothers' "
+           "setup), %lld allocations in the step on process %d\n",
+           size, failures, in_smoother, cnt_all, bad);
+  TEST_TRUE(cnt_all > 0);
+  TEST_TRUE(failures == (cnt_all + stride - 1) / stride);
+  TEST_TRUE(in_smoother > 0);
+  fcm_scene_destroy(&scene);
+  return 0;
+}
+
 int main(int argc, char **argv)
 {
   failing f;
@@ -88,6 +175,14 @@ int main(int argc, char **argv)
   fcm_element_type type;
   if (!ctx) return 1;
   TEST_OK(ctx, fcm_petsc_initialize(ctx, &argc, &argv));
+  if (argc >= 3 && strcmp(argv[1], "scene") == 0) {
+    scene_main(ctx, &f, argv[2], argc > 3 ? atoll(argv[3]) : 1);
+    fcm_ctx_destroy(&ctx);
+    int mine = test_failures_, all = 0;
+    MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+    fcm_petsc_finalize();
+    return all ? TEST_RESULT() + 1 : 0;
+  }
   if (argc < 3 || fcm_element_type_from_name(argv[1], &type) != FCM_OK) return 2;
   const fcm_index N = atoi(argv[2]);
   const long long stride = argc > 3 ? atoll(argv[3]) : 1;

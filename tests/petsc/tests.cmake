@@ -317,3 +317,6 @@ fcm_add_mpi_test(petsc_pcmg_failure_hex8_np3 tests/petsc/pcmg_failure.c NP 3 TIM
                  ARGS hex8 4 3)
 fcm_add_mpi_test(petsc_pcmg_failure_hex20_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 90
                  ARGS hex20 3 5)
+# phase 2 (the integrator, -pc_type mg): every 37th allocation of the first step
+fcm_add_mpi_test(petsc_pcmg_failure_newton_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 120
+                 ARGS scene ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 37)

@@ -275,6 +275,32 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__petsc_pcmg_smoothers_setup(fcm_petsc_problem *P)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  PC pc = NULL;
+  PetscBool mg = PETSC_FALSE;
+  PetscInt nl = 0;
+  PCALL(ctx, KSPGetPC(P->ksp, &pc));
+  PCALL(ctx, PetscObjectTypeCompare((PetscObject)pc, PCMG, &mg));
+  if (!mg) goto cleanup;
+  PCALL(ctx, PCMGGetLevels(pc, &nl));
+  for (PetscInt l = 1; l < nl; l++) { /* PETSc's level 0 is the coarsest (no smoother) */
+    KSP sk = NULL;
+    PC spc = NULL;
+    PetscBool shell = PETSC_FALSE;
+    PCALL(ctx, PCMGGetSmoother(pc, l, &sk));
+    PCALL(ctx, KSPGetPC(sk, &spc));
+    PCALL(ctx, PetscObjectTypeCompare((PetscObject)spc, PCSHELL, &shell));
+    /* a no-op when the level's matrix did not change since the last setup; else
+     * block_pc_setup(), agreed (the same on every process: the levels are) */
+    if (shell) PCALL(ctx, PCSetUp(spc));
+  }
+cleanup:
+  return st;
+}
+
 int fcm__petsc_pcmg_grid(const fcm_space *space)
 {
   const fcm_element_type t = fcm_mesh_element_type(fcm_space_mesh(space));

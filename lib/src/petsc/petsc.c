@@ -2091,6 +2091,7 @@ static fcm_status newton_factor(void *user, const fcm_csr *H, const unsigned cha
   }
   PCALL(ctx, KSPSetOperators(P->ksp, P->S, P->S));
   PCALL(ctx, KSPSetUp(P->ksp));
+  FCM_TRY(ctx, fcm__petsc_pcmg_smoothers_setup(P)); /* pcmg.c: PCMG's block smoothers, now */
   P->factors++;
   P->factored = 1;
 cleanup:

@@ -141,4 +141,12 @@ int fcm__petsc_pcmg_grid(const fcm_space *space);
 fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned char *constrained,
                                  int optional, int *num_levels);
 
+/* After KSPSetUp of P->ksp (PCMG with fcm's block smoothers; a no-op for any other PC): the
+ * levels' block smoothers set up now (PCSetUp), each whose Galerkin matrix changed. PCSetUp_MG
+ * sets a level's PC up at the first setup only; after that PETSc sets it up lazily inside
+ * the next cycle, in a smoother's nested KSPSolve, which a failure there (agreed, on every
+ * process) leaves inconsistent (seen: a crash in KSPDestroy). Collective; the same status on
+ * every process. pcmg.c. */
+fcm_status fcm__petsc_pcmg_smoothers_setup(fcm_petsc_problem *P);
+
 #endif /* FCM_PETSC_IMPL_H */
