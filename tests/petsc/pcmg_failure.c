@@ -128,7 +128,8 @@ static int scene_main(fcm_ctx *ctx, failing *f, const char *path, long long stri
   double e0 = 0.0, e = 0.0;
   TEST_OK(ctx, round_scene(ctx, f, -1, scene, &count, &e0));
   if (getenv("FCM_TEST_VERBOSE") && rank == bad)
-    fprintf(stderr, "scene: %lld allocations in the step on process %d\n", count, bad);
+    fprintf(stderr, "scene: %lld allocations in the step on process %d, energy %a\n", count, bad,
+            e0);
   const long long live = fcm_ctx_live_allocations(ctx);
   for (long long k = 0; k < 1000000 && !test_failures_; k += stride) {
     const fcm_status st = round_scene(ctx, f, rank == bad ? k : -1, scene, &count, &e);
@@ -142,11 +143,13 @@ static int scene_main(fcm_ctx *ctx, failing *f, const char *path, long long stri
     failures++;
     const char *msg = fcm_ctx_error_message(ctx);
     if (getenv("FCM_TEST_VERBOSE") && rank == 0) fprintf(stderr, "%lld: %s\n", k, msg);
-    if (all[1] != size) TEST_FAIL_("scene: allocation %lld failing on process %d: %d of %d "
-                                   "processes failed; this one: %s", k, bad, all[1], size, msg);
+    if (all[1] != size)
+      TEST_FAIL_("scene: allocation %lld failing on process %d: %d of %d "
+                 "processes failed; this one: %s",
+                 k, bad, all[1], size, msg);
     if (!strstr(msg, "out of memory") || (rank != bad && !strstr(msg, "process 1 of")))
-      TEST_FAIL_("scene: allocation %lld failing on process %d: message on process %d: %s", k,
-                 bad, rank, msg);
+      TEST_FAIL_("scene: allocation %lld failing on process %d: message on process %d: %s", k, bad,
+                 rank, msg);
     in_smoother += strstr(msg, "fcm block smoother") != NULL;
     fcm_ctx_error_clear(ctx);
     if (fcm_ctx_live_allocations(ctx) != live)
@@ -240,11 +243,13 @@ int main(int argc, char **argv)
     }
     failures++;
     const char *msg = fcm_ctx_error_message(ctx);
-    if (all[1] != size) TEST_FAIL_("allocation %lld failing on process %d: %d of %d processes "
-                                   "failed; this one: %s", k, bad, all[1], size, msg);
+    if (all[1] != size)
+      TEST_FAIL_("allocation %lld failing on process %d: %d of %d processes "
+                 "failed; this one: %s",
+                 k, bad, all[1], size, msg);
     if (!strstr(msg, "out of memory") || (rank != bad && !strstr(msg, other)))
-      TEST_FAIL_("allocation %lld failing on process %d: message on process %d: %s", k, bad,
-                 rank, msg);
+      TEST_FAIL_("allocation %lld failing on process %d: message on process %d: %s", k, bad, rank,
+                 msg);
     if (getenv("FCM_TEST_VERBOSE") && rank == 0) fprintf(stderr, "%lld: %s\n", k, msg);
     if (rank == bad) { /* where it failed: the message, the traceback */
       char *view = NULL;

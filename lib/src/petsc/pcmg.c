@@ -49,8 +49,8 @@ cleanup:
 typedef struct block_pc {
   fcm_ctx *ctx;
   int *agreed_fail; /* the problem's (P->agreed_fail): set when a setup agreed on a failure */
-  PetscInt n; /* subdomain size */
-  IS is;      /* the subdomain's global rows, sorted */
+  PetscInt n;       /* subdomain size */
+  IS is;            /* the subdomain's global rows, sorted */
   fcm_index nb;
   fcm_index *ptr, *dofs; /* blocks in subdomain numbering */
   Mat *sub;              /* the subdomain matrix (1) */
@@ -94,8 +94,8 @@ static fcm_status block_pc_factor(block_pc *b, Mat Ad)
   fcm_schwarz_destroy(&b->S); /* no stale smoother if this setup fails */
   PCALL(ctx, MatGetRowIJ(Ad, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
   FCM_CHECK(done && n == b->n, ctx, FCM_ERR_INTERNAL,
-            "petsc: fcm block smoother: the subdomain matrix has %d rows, the subdomain %d",
-            (int)n, (int)b->n);
+            "petsc: fcm block smoother: the subdomain matrix has %d rows, the subdomain %d", (int)n,
+            (int)b->n);
   FCM_ALLOC(ctx, n + 1, rp);
   FCM_ALLOC(ctx, ia[n] + 1, ci);
   for (PetscInt i = 0; i <= n; i++)
@@ -475,7 +475,7 @@ fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned cha
     PCALL(ctx, MatAssemblyBegin(Pm, MAT_FINAL_ASSEMBLY));
     PCALL(ctx, MatAssemblyEnd(Pm, MAT_FINAL_ASSEMBLY));
     PCALL(ctx, PCMGSetInterpolation(pc, L - 1 - l, Pm)); /* PETSc's level: from the coarsest */
-    MatDestroy(&Pm);                                      /* PCMG holds it */
+    MatDestroy(&Pm);                                     /* PCMG holds it */
     if (blocks) {
       KSP sk;
       PC spc;
