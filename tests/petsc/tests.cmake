@@ -306,3 +306,17 @@ foreach(np 1 2)
   fcm_add_mpi_test(petsc_pcmg_hex8_np${np} tests/petsc/pcmg.c NP ${np} ARGS hex8 12 32 0)
   fcm_add_mpi_test(petsc_pcmg_hex20_np${np} tests/petsc/pcmg.c NP ${np} ARGS hex20 6 40 5)
 endforeach()
+# a local failure on ONE process in PCMG's setup (tests/petsc/pcmg_failure.c): every allocation
+# of the setup and first step failed in turn on process 1; every process fails with the
+# message, none hangs (the timeout is the guard)
+# every allocation on 2 processes, every third on 3 (oversubscribed: slower); Hex20 (its
+# first level is the Hex8 space of the same elements) every fifth on 2
+fcm_add_mpi_test(petsc_pcmg_failure_hex8_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 90
+                 ARGS hex8 4 1)
+fcm_add_mpi_test(petsc_pcmg_failure_hex8_np3 tests/petsc/pcmg_failure.c NP 3 TIMEOUT 90
+                 ARGS hex8 4 3)
+fcm_add_mpi_test(petsc_pcmg_failure_hex20_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 90
+                 ARGS hex20 3 5)
+# phase 2 (the integrator, -pc_type mg): every 37th allocation of the first step
+fcm_add_mpi_test(petsc_pcmg_failure_newton_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 120
+                 ARGS scene ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 37)

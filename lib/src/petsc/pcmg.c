@@ -48,8 +48,9 @@ cleanup:
  * z (ASM's "basic" form, so the smoother is symmetric). */
 typedef struct block_pc {
   fcm_ctx *ctx;
-  PetscInt n; /* subdomain size */
-  IS is;      /* the subdomain's global rows, sorted */
+  int *agreed_fail; /* the problem's (P->agreed_fail): set when a setup agreed on a failure */
+  PetscInt n;       /* subdomain size */
+  IS is;            /* the subdomain's global rows, sorted */
   fcm_index nb;
   fcm_index *ptr, *dofs; /* blocks in subdomain numbering */
   Mat *sub;              /* the subdomain matrix (1) */
@@ -63,10 +64,26 @@ static PetscErrorCode block_pc_error(const block_pc *b)
   SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "fcm block smoother: %s", fcm_ctx_error_message(b->ctx));
 }
 
-static PetscErrorCode block_pc_setup(PC pc)
+/* The local part of the first setup: the subdomain vectors (sequential). */
+static fcm_status block_pc_vectors(block_pc *b)
 {
-  block_pc *b = NULL;
-  Mat A = NULL, Ad = NULL;
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = b->ctx;
+  PCALL(ctx, VecCreateSeq(PETSC_COMM_SELF, b->n, &b->xs));
+  PCALL(ctx, VecDuplicate(b->xs, &b->ys));
+cleanup:
+  if (st) {
+    VecDestroy(&b->xs);
+    VecDestroy(&b->ys);
+  }
+  return st;
+}
+
+/* The local part of every setup: fcm_schwarz on the subdomain matrix Ad (sequential). */
+static fcm_status block_pc_factor(block_pc *b, Mat Ad)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = b->ctx;
   const PetscInt *ia = NULL, *ja = NULL;
   const PetscScalar *v = NULL;
   PetscInt n = 0;
@@ -74,25 +91,11 @@ static PetscErrorCode block_pc_setup(PC pc)
   fcm_index *rp = NULL;
   int *ci = NULL;
   fcm_csr *C = NULL;
-  fcm_status st = FCM_OK;
-  PetscCall(PCShellGetContext(pc, &b));
-  PetscCall(PCGetOperators(pc, NULL, &A));
-  PetscCall(MatCreateSubMatrices(A, 1, &b->is, &b->is,
-                                 b->sub ? MAT_REUSE_MATRIX : MAT_INITIAL_MATRIX, &b->sub));
-  Ad = b->sub[0];
-  if (!b->sc) {
-    Vec x = NULL;
-    PetscCall(MatCreateVecs(A, &x, NULL));
-    PetscCall(VecCreateSeq(PETSC_COMM_SELF, b->n, &b->xs));
-    PetscCall(VecDuplicate(b->xs, &b->ys));
-    PetscCall(VecScatterCreate(x, b->is, b->xs, NULL, &b->sc));
-    PetscCall(VecDestroy(&x));
-  }
-  PetscCall(MatGetRowIJ(Ad, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
-  PetscCheck(done && n == b->n, PETSC_COMM_SELF, PETSC_ERR_LIB,
-             "fcm block smoother: the subdomain matrix has %d rows, the subdomain %d", (int)n,
-             (int)b->n);
-  fcm_ctx *ctx = b->ctx;
+  fcm_schwarz_destroy(&b->S); /* no stale smoother if this setup fails */
+  PCALL(ctx, MatGetRowIJ(Ad, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done));
+  FCM_CHECK(done && n == b->n, ctx, FCM_ERR_INTERNAL,
+            "petsc: fcm block smoother: the subdomain matrix has %d rows, the subdomain %d", (int)n,
+            (int)b->n);
   FCM_ALLOC(ctx, n + 1, rp);
   FCM_ALLOC(ctx, ia[n] + 1, ci);
   for (PetscInt i = 0; i <= n; i++)
@@ -100,23 +103,50 @@ static PetscErrorCode block_pc_setup(PC pc)
   for (PetscInt p = 0; p < ia[n]; p++)
     ci[p] = (int)ja[p];
   FCM_TRY(ctx, fcm_csr_create(ctx, n, n, rp, ci, FCM_CSR_GENERAL, &C));
-  {
-    const PetscErrorCode e = MatSeqAIJGetArrayRead(Ad, &v);
-    if (e) {
-      st = fcm__petsc_error(ctx, e, "MatSeqAIJGetArrayRead", __FILE__, __LINE__, __func__);
-      goto cleanup;
-    }
-  }
+  PCALL(ctx, MatSeqAIJGetArrayRead(Ad, &v));
   memcpy(fcm_csr_values(C), v, sizeof *v * (size_t)ia[n]);
   MatSeqAIJRestoreArrayRead(Ad, &v);
-  fcm_schwarz_destroy(&b->S);
   FCM_TRY(ctx, fcm_schwarz_create(ctx, C, b->nb, b->ptr, b->dofs, NULL, &b->S));
 cleanup:
-  MatRestoreRowIJ(Ad, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done);
+  if (done) MatRestoreRowIJ(Ad, 0, PETSC_FALSE, PETSC_FALSE, &n, &ia, &ja, &done);
   fcm_csr_destroy(&C);
-  fcm__free(b->ctx, rp);
-  fcm__free(b->ctx, ci);
-  if (st) return block_pc_error(b);
+  fcm__free(ctx, rp);
+  fcm__free(ctx, ci);
+  return st;
+}
+
+/* PCSetUp of the shell (inside KSPSetUp / PCSetUp of PCMG: collective). Its collective calls
+ * (MatCreateSubMatrices, VecScatterCreate) are met by every process: each local part before
+ * one ends in fcm__petsc_agree(), so a failure on one process only (an allocation, ...) is
+ * returned as a PETSc error on every process, with the failing process's message (the others
+ * name it), and no process waits in a collective call the failing one never makes. The apply
+ * fails only on arguments (the setup was agreed): no agreement there. */
+static PetscErrorCode block_pc_setup(PC pc)
+{
+  block_pc *b = NULL;
+  Mat A = NULL;
+  PetscCall(PCShellGetContext(pc, &b));
+  PetscCall(PCGetOperators(pc, NULL, &A));
+  const MPI_Comm comm = PetscObjectComm((PetscObject)pc);
+  fcm_status st = FCM_OK;
+  PetscCall(MatCreateSubMatrices(A, 1, &b->is, &b->is,
+                                 b->sub ? MAT_REUSE_MATRIX : MAT_INITIAL_MATRIX, &b->sub));
+  if (!b->sc) {
+    st = fcm__petsc_agree(b->ctx, comm, b->xs ? FCM_OK : block_pc_vectors(b));
+    if (st) {
+      *b->agreed_fail = 1;
+      return block_pc_error(b);
+    }
+    Vec x = NULL;
+    PetscCall(MatCreateVecs(A, &x, NULL));
+    PetscCall(VecScatterCreate(x, b->is, b->xs, NULL, &b->sc));
+    PetscCall(VecDestroy(&x));
+  }
+  st = fcm__petsc_agree(b->ctx, comm, block_pc_factor(b, b->sub[0]));
+  if (st) {
+    *b->agreed_fail = 1;
+    return block_pc_error(b);
+  }
   return 0;
 }
 
@@ -195,6 +225,7 @@ static fcm_status block_pc_set(fcm_petsc_problem *P, PC spc, const fcm__mg_trans
   block_pc *b = fcm__calloc(ctx, 1, sizeof *b);
   FCM_CHECK(b, ctx, FCM_ERR_ALLOC, "petsc: out of memory (block smoother)");
   b->ctx = ctx;
+  b->agreed_fail = &P->agreed_fail;
   const fcm_index nb = T->num_blocks[l], *bp = T->block_ptr[l], *bd = T->block_dofs[l];
   /* this process's blocks: those whose lowest global DOF it owns */
   FCM_ALLOC(ctx, nb + 1, b->ptr);
@@ -244,16 +275,60 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__petsc_pcmg_smoothers_setup(fcm_petsc_problem *P)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  PC pc = NULL;
+  PetscBool mg = PETSC_FALSE;
+  PetscInt nl = 0;
+  PCALL(ctx, KSPGetPC(P->ksp, &pc));
+  PCALL(ctx, PetscObjectTypeCompare((PetscObject)pc, PCMG, &mg));
+  if (!mg) goto cleanup;
+  PCALL(ctx, PCMGGetLevels(pc, &nl));
+  for (PetscInt l = 1; l < nl; l++) { /* PETSc's level 0 is the coarsest (no smoother) */
+    KSP sk = NULL;
+    PC spc = NULL;
+    PetscBool shell = PETSC_FALSE;
+    PCALL(ctx, PCMGGetSmoother(pc, l, &sk));
+    PCALL(ctx, KSPGetPC(sk, &spc));
+    PCALL(ctx, PetscObjectTypeCompare((PetscObject)spc, PCSHELL, &shell));
+    /* a no-op when the level's matrix did not change since the last setup; else
+     * block_pc_setup(), agreed (the same on every process: the levels are) */
+    if (shell) PCALL(ctx, PCSetUp(spc));
+  }
+cleanup:
+  return st;
+}
+
 int fcm__petsc_pcmg_grid(const fcm_space *space)
 {
   const fcm_element_type t = fcm_mesh_element_type(fcm_space_mesh(space));
   return t == FCM_ELEMENT_HEX8 || t == FCM_ELEMENT_HEX20;
 }
 
+/* Distributed failures (issue 14): every call here that communicates (PCMGSetLevels, the
+ * prolongations' MatCreate .. MatAssemblyEnd, PCSetFromOptions) is preceded by an agreement
+ * (AGREE: fcm__petsc_problem_agree()) ending the local work before it, and every exit passes
+ * through one agreement (cleanup) unless a failure was agreed already. A process failing in a
+ * local part (an allocation, a local PETSc call) jumps to cleanup, whose agreement meets the
+ * one the others wait in before their next collective call: every process returns the failing
+ * process's status and message, none is left in a collective call. The collective calls are
+ * made by every process in the same order (the hierarchy is the same everywhere). */
+#define AGREE()                                                                                    \
+  do {                                                                                             \
+    st = fcm__petsc_problem_agree(P, st);                                                          \
+    if (st) {                                                                                      \
+      agreed = 1;                                                                                  \
+      goto cleanup;                                                                                \
+    }                                                                                              \
+  } while (0)
+
 fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned char *constrained,
                                  int optional, int *num_levels)
 {
   fcm_status st = FCM_OK;
+  int agreed = 0; /* a failure was agreed (every process knows it) */
   fcm_ctx *ctx = P->ctx;
   fcm__mg_transfers *T = NULL;
   PetscInt *gidx = NULL, *gidx_c = NULL, *dnz = NULL, *onz = NULL, *cols = NULL;
@@ -319,6 +394,7 @@ fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned cha
     gidx[k] = P->perm[k], owner[k] = P->copy_owner[k];
   PetscInt nloc = P->nlocal, first = P->first;
   FCM_ALLOC(ctx, P->size + 1, count);
+  AGREE();
   PCALL(ctx, PCMGSetLevels(pc, L, NULL));
   int blocks = 1; /* the default smoother's PC unless the options name one */
   {
@@ -376,6 +452,7 @@ fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned cha
     }
     FCM_ALLOC(ctx, width + 1, cols);
     FCM_ALLOC(ctx, width + 1, vals);
+    AGREE(); /* the level's local part (and the finer level's smoother) */
     PCALL(ctx, MatCreate(P->comm, &Pm));
     PCALL(ctx, MatSetSizes(Pm, 3 * nloc, 3 * nloc_c, PETSC_DETERMINE, PETSC_DETERMINE));
     PCALL(ctx, MatSetType(Pm, MATMPIAIJ));
@@ -398,6 +475,7 @@ fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned cha
     PCALL(ctx, MatAssemblyBegin(Pm, MAT_FINAL_ASSEMBLY));
     PCALL(ctx, MatAssemblyEnd(Pm, MAT_FINAL_ASSEMBLY));
     PCALL(ctx, PCMGSetInterpolation(pc, L - 1 - l, Pm)); /* PETSc's level: from the coarsest */
+    MatDestroy(&Pm);                                     /* PCMG holds it */
     if (blocks) {
       KSP sk;
       PC spc;
@@ -405,7 +483,6 @@ fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned cha
       PCALL(ctx, KSPGetPC(sk, &spc));
       FCM_TRY(ctx, block_pc_set(P, spc, T, l, gidx, owner, first, nloc));
     }
-    MatDestroy(&Pm);
     /* the coarse level becomes the fine one */
     FCM_FREE(ctx, gidx);
     FCM_FREE(ctx, owner);
@@ -424,7 +501,9 @@ fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned cha
   FCM_TRY(ctx, default_option(ctx, prefix, "mg_coarse_ksp_type", "preonly"));
   FCM_TRY(ctx, default_option(ctx, prefix, "mg_coarse_pc_type", "redundant"));
   FCM_TRY(ctx, default_option(ctx, prefix, "mg_coarse_redundant_pc_type", "cholesky"));
-  /* the rest of the user's -pc_mg_* options (cycle type, ...) on the new levels */
+  /* the rest of the user's -pc_mg_* options (cycle type, ...) on the new levels (collective:
+   * -pc_mg_levels makes new levels) */
+  AGREE();
   PCALL(ctx, PCSetFromOptions(pc));
   {
     PetscInt nl = 0;
@@ -435,6 +514,8 @@ fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned cha
   }
   if (num_levels) *num_levels = L;
 cleanup:
+  if (!agreed) st = fcm__petsc_problem_agree(P, st); /* meets the others' next agreement */
+  if (st && num_levels) *num_levels = 0;
   MatDestroy(&Pm);
   fcm__mg_transfers_destroy(ctx, &T);
   fcm__free(ctx, gidx);
@@ -449,3 +530,5 @@ cleanup:
   fcm__free(ctx, count);
   return st;
 }
+
+#undef AGREE

@@ -1472,7 +1472,8 @@ fcm_status fcm_petsc_problem_setup(fcm_petsc_problem *P)
   PCALL(ctx, MatSetOption(P->Se, MAT_SPD, PETSC_TRUE));
   FCM_TRY(ctx, near_null_space(P, P->Se));
   /* 3. the KSP: defaults, then the options database */
-  FCM_TRY(ctx, insert_options(P));
+  /* local (fcm allocations): agreed before the collective KSPCreate and PCMG setup below */
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, insert_options(P)));
   PCALL(ctx, KSPCreate(P->comm, &P->ksp));
   PCALL(ctx, KSPSetOptionsPrefix(P->ksp, P->prefix));
   PCALL(ctx, KSPSetOperators(P->ksp, P->Se, P->Se));
@@ -1497,8 +1498,7 @@ fcm_status fcm_petsc_problem_setup(fcm_petsc_problem *P)
     if (mg || by_default) {
       int levels = 0;
       if (by_default) PCALL(ctx, PCSetType(pc, PCMG));
-      FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm,
-                                    fcm__petsc_pcmg_setup(P, pc, P->is_con, by_default, &levels)));
+      FCM_TRY(ctx, fcm__petsc_pcmg_setup(P, pc, P->is_con, by_default, &levels)); /* agreed */
       if (levels == 0) { /* not a box grid: GAMG */
         PCALL(ctx, PCSetType(pc, PCGAMG));
         PCALL(ctx, PCSetFromOptions(pc));
@@ -2092,10 +2092,11 @@ static fcm_status newton_factor(void *user, const fcm_csr *H, const unsigned cha
     PCALL(ctx, KSPGetPC(P->ksp, &pc));
     PCALL(ctx, PetscObjectTypeCompare((PetscObject)pc, PCMG, &mg));
     if (mg) PCALL(ctx, PCMGGetLevels(pc, &nl));
-    if (mg && nl < 2) FCM_TRY(ctx, newton_agree(P, fcm__petsc_pcmg_setup(P, pc, NULL, 0, NULL)));
+    if (mg && nl < 2) FCM_TRY(ctx, fcm__petsc_pcmg_setup(P, pc, NULL, 0, NULL)); /* agreed */
   }
   PCALL(ctx, KSPSetOperators(P->ksp, P->S, P->S));
   PCALL(ctx, KSPSetUp(P->ksp));
+  FCM_TRY(ctx, fcm__petsc_pcmg_smoothers_setup(P)); /* pcmg.c: PCMG's block smoothers, now */
   P->factors++;
   P->factored = 1;
 cleanup:

@@ -132,10 +132,21 @@ int fcm__petsc_pcmg_grid(const fcm_space *space);
  * built for (not a Hex8 / Hex20 box grid, a single level) is FCM_OK with *num_levels = 0 and pc
  * untouched (the caller's default applies). num_levels (may be NULL): the levels made.
  * @return FCM_OK, FCM_ERR_UNSUPPORTED (not a Hex8 / Hex20 box grid: named), FCM_ERR_ARG
- * (-pc_mg_levels that the hierarchy cannot give), FCM_ERR_ALLOC, FCM_ERR_INTERNAL (PETSc). The
- * same on every process (the hierarchy is built from the space's replicated numbering and element
- * queries); not agreed here. pcmg.c. */
+ * (-pc_mg_levels that the hierarchy cannot give), FCM_ERR_ALLOC, FCM_ERR_INTERNAL (PETSc).
+ * Collective on P->comm and agreed here (fcm__petsc_problem_agree()): a failure on one process
+ * only (an allocation, ...) is returned on every process with its message, none waits in a
+ * collective call. The levels' block smoothers (PCSHELL) agree in their setup (inside
+ * KSPSetUp / PCSetUp, collective): a local failure there is a PETSc error on every process,
+ * whose message carries the failing process's (P->agreed_fail set). pcmg.c. */
 fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned char *constrained,
                                  int optional, int *num_levels);
+
+/* After KSPSetUp of P->ksp (PCMG with fcm's block smoothers; a no-op for any other PC): the
+ * levels' block smoothers set up now (PCSetUp), each whose Galerkin matrix changed. PCSetUp_MG
+ * sets a level's PC up at the first setup only; after that PETSc sets it up lazily inside
+ * the next cycle, in a smoother's nested KSPSolve, which a failure there (agreed, on every
+ * process) leaves inconsistent (seen: a crash in KSPDestroy). Collective; the same status on
+ * every process. pcmg.c. */
+fcm_status fcm__petsc_pcmg_smoothers_setup(fcm_petsc_problem *P);
 
 #endif /* FCM_PETSC_IMPL_H */
