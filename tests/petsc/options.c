@@ -12,13 +12,21 @@
  * - the integrator's path (fcm_petsc_simulation_create()): a scene whose solver.petsc_options
  *   make every linear solve fail (Richardson without preconditioner, one iteration) fails
  *   its step, and the same scene without options made after it in the same process steps
- *   (before the prefixes, the first scene's options stayed in the global database). */
+ *   (before the prefixes, the first scene's options stayed in the global database);
+ * - a PETSc error (an unknown PC type in a problem's options) is an fcm error naming the type,
+ *   and nothing is printed on stderr meanwhile (fcm_petsc_initialize() replaced PETSc's
+ *   traceback handler). */
+#define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
 #include "fcm/simulation.h"
 #include "test.h"
 
+#include <fcntl.h>
 #include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 static const char scene_fmt[] =
     "{\"version\": 1, \"name\": \"options_%d\","
@@ -119,6 +127,40 @@ int main(int argc, char **argv)
     }
     fcm_simulation_destroy(&sim);
     fcm_scene_destroy(&scene);
+  }
+
+  /* 3. a PETSc error: an fcm error with PETSc's message, nothing on stderr */
+  {
+    fcm_petsc_problem *P = NULL;
+    fcm_petsc_options po = fcm_petsc_options_default();
+    po.kind = FCM_INTEGRATOR_STATIC;
+    po.petsc_options = "-pc_type no_such_pc";
+    TEST_OK(ctx, fcm_petsc_problem_create(ctx, MPI_COMM_WORLD, mesh, NULL, &mat, &po, &P));
+    TEST_OK(ctx, fcm_petsc_problem_add_gravity(P, g));
+    TEST_OK(ctx, fcm_petsc_problem_add_constraint(P, nfix, fix, &clamp));
+    char path[] = "/tmp/fcm_petsc_stderr_XXXXXX";
+    const int fd = mkstemp(path);
+    TEST_TRUE(fd >= 0);
+    fflush(stderr);
+    const int saved = dup(2);
+    TEST_TRUE(saved >= 0);
+    if (fd >= 0 && saved >= 0) dup2(fd, 2);
+    const fcm_status s = fcm_petsc_problem_setup(P);
+    fflush(stderr);
+    if (fd >= 0 && saved >= 0) dup2(saved, 2);
+    struct stat sb;
+    TEST_TRUE(fd >= 0 && fstat(fd, &sb) == 0 && sb.st_size == 0);
+    if (fd >= 0) {
+      close(fd);
+      unlink(path);
+    }
+    if (saved >= 0) close(saved);
+    TEST_TRUE(s == FCM_ERR_INTERNAL);
+    if (s != FCM_OK && !strstr(fcm_ctx_error_message(ctx), "no_such_pc"))
+      fprintf(stderr, "message: %s\n", fcm_ctx_error_message(ctx));
+    TEST_TRUE(s != FCM_OK && strstr(fcm_ctx_error_message(ctx), "no_such_pc") != NULL);
+    fcm_ctx_error_clear(ctx);
+    fcm_petsc_problem_destroy(&P);
   }
 
   fcm_mesh_destroy(&mesh);

@@ -48,7 +48,11 @@ extern "C" {
 #endif
 
 /** Initialize PETSc (and MPI when not initialized yet) with the program's arguments, which
- * go into the options database (PetscInitialize). Call once before anything else here.
+ * go into the options database (PetscInitialize). Call once before anything else here. When
+ * this call initializes PETSc, it also replaces PETSc's error handler, which prints a
+ * traceback on stderr at every error, by one that prints nothing (PetscReturnErrorHandler):
+ * a failed PETSc call is an fcm error carrying PETSc's message. A program that initialized
+ * PETSc itself keeps its own handler.
  * @return FCM_OK, FCM_ERR_INTERNAL (PETSc failed: the message says so; ctx may be NULL). */
 FCM_API fcm_status fcm_petsc_initialize(fcm_ctx *ctx, int *argc, char ***argv);
 
@@ -300,8 +304,8 @@ FCM_API int fcm_petsc_problem_supports_scene(fcm_ctx *ctx, const fcm_scene *scen
  * mass, Newton and damping matrices of its own cells and one layer of ghost cells only (they
  * shrink as processes are added), but the DOF numbering, the state and about twenty work
  * vectors are replicated: about 0.2 kB per DOF of the whole body on every process, which
- * bounds this path at a few times 1e7 DOFs per process (the linear driver,
- * fcm_petsc_problem_create(), replicates about 0.05 kB/DOF). The sums are of DOF vectors and
+ * bounds the body at a few times 1e7 DOFs on nodes of 18 GB, whatever the process count
+ * (the linear driver, fcm_petsc_problem_create(), replicates about 0.05 kB/DOF). The sums are of DOF vectors and
  * scalars (no matrix is summed: each process adds its partial Newton matrix into the
  * MATMPIAIJ), the direction is gathered on every process; the rules, the element integration,
  * the matrices and the solve are what is distributed. Collective.

@@ -195,7 +195,17 @@
  * - phase 2: -pc_type mg in the options: newton_factor() sets the levels once per KSP (PCMG's
  *   level count < 2 means not yet; a cut makes a new KSP); not a default there (GAMG), and not
  *   fit for MINRES on an indefinite tangent (Chebyshev needs SPD).
- * - tests: tests/petsc/pcmg.c (petsc_pcmg_*), petsc_newton_static_snh_mg_*.
+ * - failures (session 8): fcm__petsc_pcmg_setup() agrees before each collective call
+ *   (PCMGSetLevels, each level's MatCreate .. MatAssemblyEnd, PCSetFromOptions) and at the
+ *   end; the block smoother's PCSetUp agrees on its local vectors and on its factor and then
+ *   fails with a PETSc error carrying the agreed message on every process;
+ *   fcm__petsc_pcmg_smoothers_setup() sets the smoothers up right after KSPSetUp (PETSc would
+ *   do it lazily inside the cycle, where an agreed failure left the KSP inconsistent);
+ *   fcm_petsc_problem_setup() agrees on insert_options() before KSPCreate. Not covered: a
+ *   failure inside a PETSc collective call on one process only (PETSc's own allocations).
+ * - tests: tests/petsc/pcmg.c (petsc_pcmg_*), petsc_newton_static_snh_mg_*,
+ *   tests/petsc/pcmg_failure.c (petsc_pcmg_failure_*: allocation k fails on process 1 only,
+ *   swept over the setup and first step; every process fails with the message, none hangs).
  * - not done: the hierarchy and the block lists are replicated (O(DOFs) per process, like the
  *   numbering); its build is sequential on every process; the coarsest Cholesky is redundant
  *   (every process factors <= 2000 DOFs); the Schwarz blocks are dense (memory 15.6 kB/DOF on
@@ -350,6 +360,7 @@ static void set_prefix(fcm_petsc_problem *P)
 }
 
 static int fcm_petsc_started_mpi = 0;
+static int fcm_petsc_pushed_handler = 0; /* fcm_petsc_initialize() pushed PETSc's error handler */
 
 fcm_status fcm_petsc_initialize(fcm_ctx *ctx, int *argc, char ***argv)
 {
@@ -363,6 +374,14 @@ fcm_status fcm_petsc_initialize(fcm_ctx *ctx, int *argc, char ***argv)
     PetscErrorCode ierr = PetscInitialize(argc, argv, NULL, NULL);
     FCM_CHECK(ierr == 0, ctx, FCM_ERR_INTERNAL, "petsc: PetscInitialize failed (error %d)",
               (int)ierr);
+    /* PETSc's default handler prints a traceback on stderr at every error; a library prints
+     * nothing unasked: the error comes back as the fcm error of the failed call, with PETSc's
+     * message (fcm__petsc_error()). A program that initialized PETSc itself keeps its own
+     * handler. */
+    ierr = PetscPushErrorHandler(PetscReturnErrorHandler, NULL);
+    FCM_CHECK(ierr == 0, ctx, FCM_ERR_INTERNAL,
+              "petsc: PetscPushErrorHandler failed (error %d)", (int)ierr);
+    fcm_petsc_pushed_handler = 1;
   }
 cleanup:
   return st;
@@ -371,7 +390,11 @@ cleanup:
 void fcm_petsc_finalize(void)
 {
   PetscBool on = PETSC_FALSE;
-  if (PetscInitialized(&on) == 0 && on) PetscFinalize();
+  if (PetscInitialized(&on) == 0 && on) {
+    if (fcm_petsc_pushed_handler) PetscPopErrorHandler();
+    fcm_petsc_pushed_handler = 0;
+    PetscFinalize();
+  }
 }
 
 const char *fcm_petsc_partition_name(fcm_petsc_partition p)
