@@ -15,6 +15,7 @@
  * Arguments: element (hex8|hex20), N, max_its, gamg_ratio. */
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
+#include "clamp_util.h"
 #include "test.h"
 
 static const double grav[3] = {0.0, 0.0, -9.81};
@@ -26,21 +27,6 @@ static double dist(fcm_index n, const double *a, const double *b)
   for (fcm_index i = 0; i < n; i++)
     s += (a[i] - b[i]) * (a[i] - b[i]);
   return sqrt(s);
-}
-
-/* Nodes with DOFs on the lowest z with DOFs. */
-static fcm_index *clamped(const fcm_mesh *mesh, const fcm_space *space, fcm_index *nfix)
-{
-  const double *X = fcm_mesh_coords(mesh);
-  const fcm_index nn = fcm_mesh_num_nodes(mesh);
-  fcm_index *fix = calloc((size_t)nn + 1, sizeof *fix);
-  double zmin = 2.0;
-  *nfix = 0;
-  for (fcm_index k = 0; k < nn; k++)
-    if (fcm_space_node_dof(space, k) >= 0 && X[3 * k + 2] < zmin) zmin = X[3 * k + 2];
-  for (fcm_index k = 0; k < nn; k++)
-    if (fcm_space_node_dof(space, k) >= 0 && X[3 * k + 2] <= zmin + 1e-12) fix[(*nfix)++] = k;
-  return fix;
 }
 
 /* Set up and solve with `options`; the displacement into u, the iterations returned

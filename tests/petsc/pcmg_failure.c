@@ -28,6 +28,7 @@
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
 #include "fcm/simulation.h"
+#include "clamp_util.h"
 #include "test.h"
 #include "test_alloc.h"
 
@@ -37,21 +38,6 @@
 
 static const double grav[3] = {0.0, 0.0, -9.81};
 static const fcm_material mat = {FCM_MATERIAL_LINEAR, 1e6, 0.3, 1000.0};
-
-/* Nodes with DOFs on the lowest z with DOFs. */
-static fcm_index *clamped(const fcm_mesh *mesh, const fcm_space *space, fcm_index *nfix)
-{
-  const double *X = fcm_mesh_coords(mesh);
-  const fcm_index nn = fcm_mesh_num_nodes(mesh);
-  fcm_index *fix = calloc((size_t)nn + 1, sizeof *fix);
-  double zmin = 2.0;
-  *nfix = 0;
-  for (fcm_index k = 0; k < nn; k++)
-    if (fcm_space_node_dof(space, k) >= 0 && X[3 * k + 2] < zmin) zmin = X[3 * k + 2];
-  for (fcm_index k = 0; k < nn; k++)
-    if (fcm_space_node_dof(space, k) >= 0 && X[3 * k + 2] <= zmin + 1e-12) fix[(*nfix)++] = k;
-  return fix;
-}
 
 /* One round: the problem made with no failure, then setup and one step with allocation
  * `fail_at` (of this process's context, counted from the setup on) failing (-1: none). The
