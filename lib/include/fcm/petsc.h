@@ -305,9 +305,9 @@ FCM_API int fcm_petsc_problem_supports_scene(fcm_ctx *ctx, const fcm_scene *scen
  * shrink as processes are added), but the DOF numbering, the state and about twenty work
  * vectors are replicated: about 0.2 kB per DOF of the whole body on every process, which
  * bounds the body at a few times 1e7 DOFs on nodes of 18 GB, whatever the process count
- * (the linear driver, fcm_petsc_problem_create(), replicates about 0.05 kB/DOF). The sums are of DOF vectors and
- * scalars (no matrix is summed: each process adds its partial Newton matrix into the
- * MATMPIAIJ), the direction is gathered on every process; the rules, the element integration,
+ * (the linear driver, fcm_petsc_problem_create(), replicates about 0.05 kB/DOF). The sums are of
+ * DOF vectors and scalars (no matrix is summed: each process adds its partial Newton matrix into
+ * the MATMPIAIJ), the direction is gathered on every process; the rules, the element integration,
  * the matrices and the solve are what is distributed. Collective.
  * @param[in] partition the cell partition method (AUTO: Morton-ordered)
  * @param[in] opts      simulation options (NULL: defaults)

@@ -379,8 +379,8 @@ fcm_status fcm_petsc_initialize(fcm_ctx *ctx, int *argc, char ***argv)
      * message (fcm__petsc_error()). A program that initialized PETSc itself keeps its own
      * handler. */
     ierr = PetscPushErrorHandler(PetscReturnErrorHandler, NULL);
-    FCM_CHECK(ierr == 0, ctx, FCM_ERR_INTERNAL,
-              "petsc: PetscPushErrorHandler failed (error %d)", (int)ierr);
+    FCM_CHECK(ierr == 0, ctx, FCM_ERR_INTERNAL, "petsc: PetscPushErrorHandler failed (error %d)",
+              (int)ierr);
     fcm_petsc_pushed_handler = 1;
   }
 cleanup:
