@@ -21,9 +21,16 @@
  * fcm__petsc_pcmg_setup() at the first, the block smoothers' setup at every one) failing on
  * process 1: the step fails on every process with the message (the others naming process 1),
  * no leak; the successful round's energy is the unarmed run's.
+ * And the creation of the integrator on PETSc itself (mode "create": the arguments and the
+ * first allocation, the rules build, the local space, newton_build()'s numbering, matrix
+ * preallocation and options): allocation k of fcm_petsc_simulation_create() failing on
+ * process 1 fails the creation on every process with the message, none hangs, nothing leaks;
+ * the round that succeeds counts process 1's allocations exactly (stride 1: every one failed
+ * once). Before the agreements in create_matrix() and before MPI_Comm_dup, allocations there
+ * hung the other process in MatCreate / MPI_Comm_dup.
  * Arguments: element (hex8|hex20), N (cells per side of the unit cube, a ball of radius 0.45
  * embedded), [stride: k = 0, stride, 2 stride, ... (default 1)]; or: scene <scene file>
- * [stride]. */
+ * [stride]; or: create <scene file> [stride]. */
 #define _POSIX_C_SOURCE 200809L /* open_memstream */
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
@@ -155,6 +162,58 @@ static int scene_main(fcm_ctx *ctx, failing *f, const char *path, long long stri
   return 0;
 }
 
+/* Mode "create": allocation k of fcm_petsc_simulation_create() failing on process 1. */
+static int create_main(fcm_ctx *ctx, failing *f, const char *path, long long stride)
+{
+  fcm_scene *scene = NULL;
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const int bad = size > 1 ? 1 : 0;
+  TEST_OK(ctx, fcm_scene_create_from_file(ctx, path, &scene));
+  const long long live = fcm_ctx_live_allocations(ctx);
+  long long failures = 0, count_ok = -1;
+  for (long long k = 0; k < 10000000 && !test_failures_; k += stride) {
+    fcm_simulation *sim = NULL;
+    f->count = 0;
+    f->fail_at = rank == bad ? k : -1;
+    const fcm_status st = fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene,
+                                                      FCM_PETSC_PARTITION_ORDERED, NULL, &sim);
+    f->fail_at = -1;
+    const long long count = f->count;
+    fcm_simulation_destroy(&sim);
+    int mine[2] = {st == FCM_OK, st != FCM_OK}, all[2] = {0, 0};
+    MPI_Allreduce(mine, all, 2, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+    if (all[0] == size) {
+      count_ok = count;
+      break;
+    }
+    failures++;
+    const char *msg = fcm_ctx_error_message(ctx);
+    if (all[1] != size)
+      TEST_FAIL_("create: allocation %lld failing on process %d: %d of %d processes failed; "
+                 "this one: %s",
+                 k, bad, all[1], size, msg);
+    if (!strstr(msg, "out of memory") || (rank != bad && !strstr(msg, "process 1 of")))
+      TEST_FAIL_("create: allocation %lld failing on process %d: message on process %d: %s", k, bad,
+                 rank, msg);
+    fcm_ctx_error_clear(ctx);
+    if (fcm_ctx_live_allocations(ctx) != live)
+      TEST_FAIL_("create: allocation %lld failing: %lld allocations leaked", k,
+                 fcm_ctx_live_allocations(ctx) - live);
+  }
+  long long cnt = rank == bad ? count_ok : 0, cnt_all = 0;
+  MPI_Allreduce(&cnt, &cnt_all, 1, MPI_LONG_LONG, MPI_MAX, MPI_COMM_WORLD);
+  if (rank == 0)
+    printf("pcmg_failure create on %d processes: %lld failing rounds, %lld allocations in the "
+           "creation on process %d\n",
+           size, failures, cnt_all, bad);
+  TEST_TRUE(cnt_all > 0);
+  TEST_TRUE(failures == (cnt_all + stride - 1) / stride);
+  fcm_scene_destroy(&scene);
+  return 0;
+}
+
 int main(int argc, char **argv)
 {
   failing f;
@@ -164,8 +223,11 @@ int main(int argc, char **argv)
   fcm_element_type type;
   if (!ctx) return 1;
   TEST_OK(ctx, fcm_petsc_initialize(ctx, &argc, &argv));
-  if (argc >= 3 && strcmp(argv[1], "scene") == 0) {
-    scene_main(ctx, &f, argv[2], argc > 3 ? atoll(argv[3]) : 1);
+  if (argc >= 3 && (strcmp(argv[1], "scene") == 0 || strcmp(argv[1], "create") == 0)) {
+    if (argv[1][0] == 's')
+      scene_main(ctx, &f, argv[2], argc > 3 ? atoll(argv[3]) : 1);
+    else
+      create_main(ctx, &f, argv[2], argc > 3 ? atoll(argv[3]) : 1);
     fcm_ctx_destroy(&ctx);
     int mine = test_failures_, all = 0;
     MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);

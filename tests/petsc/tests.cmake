@@ -317,6 +317,12 @@ fcm_add_mpi_test(petsc_pcmg_failure_hex8_np3 tests/petsc/pcmg_failure.c NP 3 TIM
                  ARGS hex8 4 3)
 fcm_add_mpi_test(petsc_pcmg_failure_hex20_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 90
                  ARGS hex20 3 5)
+# the integrator on PETSc's creation (rules, local space, numbering, matrix preallocation,
+# options): every allocation on 2 processes, every third on 3
+fcm_add_mpi_test(petsc_newton_create_failure_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 120
+                 ARGS create ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 1)
+fcm_add_mpi_test(petsc_newton_create_failure_np3 tests/petsc/pcmg_failure.c NP 3 TIMEOUT 120
+                 ARGS create ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 3)
 # phase 2 (the integrator, -pc_type mg): every 37th allocation of the first step
 fcm_add_mpi_test(petsc_pcmg_failure_newton_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 120
                  ARGS scene ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 37)

@@ -385,7 +385,8 @@ FCM_API fcm_status fcm_integrator_boundary_reaction(const fcm_integrator *integ,
 
 /** The boundary constraints' part of the energy alone at displacement u and time t (their
  * motions evaluated at t; released constraints left out): energy, force (added, num_dofs)
- * and Newton matrix (added; the space's pattern, fcm_space_matrix_create()), each may be
+ * and Newton matrix (added; the space's pattern, fcm_space_matrix_create(); in a distributed
+ * run the integrator's local rows, as fcm_integrator_mass() has them), each may be
  * NULL. Summed over the DOFs of each component the force is minus the total reaction
  * (fcm_integrator_boundary_reaction(): the partition of unity cancels the gradient terms).
  * After setup. Allocates nothing.
@@ -482,8 +483,11 @@ FCM_API fcm_status fcm_integrator_momentum(fcm_integrator *integ, double linear[
 
 /** The mass matrix (borrowed): after the setup of a BACKWARD_EULER integrator; NULL before
  * and for STATIC integrators, which never assemble it. In a distributed run
- * (fcm_petsc_simulation_create()) this process's partial mass matrix (its cells' part; the
- * processes' matrices sum to the serial one). */
+ * (fcm_petsc_simulation_create()) this process's partial mass matrix over its local rows
+ * only: (3 x the DOF copies of its own and ghost cells) rows by num_dofs columns, its own
+ * cells' part, whose rows are no DOF numbers (the row-to-DOF map is internal); use
+ * fcm_integrator_momentum() / fcm_integrator_energy() / fcm_simulation_center_of_mass() for
+ * its products there. */
 FCM_API const fcm_csr *fcm_integrator_mass(const fcm_integrator *integ);
 
 /** The multigrid hierarchy of FCM_PRECOND_MULTIGRID or FCM_LINEAR_MULTIGRID (borrowed; for

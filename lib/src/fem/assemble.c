@@ -595,6 +595,8 @@ static fcm_status check_matrix(const fcm_space *s, const fcm_csr *A)
   fcm_index nr = -1, nc = -1, nnz = -1;
   const fcm_index rows = fcm__space_num_rows(s);
   FCM_CHECK(A, s->ctx, FCM_ERR_ARG, "assembly: matrix is NULL");
+  FCM_CHECK(s->row_ptr, s->ctx, FCM_ERR_ARG,
+            "assembly: the local space has no topology (a failed rebuild)");
   fcm_csr_get_size(A, &nr, &nc, &nnz);
   FCM_CHECK(nr == rows && nc == s->num_dofs && nnz == s->row_ptr[rows], s->ctx, FCM_ERR_ARG,
             "assembly: matrix is %lld x %lld with %lld entries; the space needs %lld x %lld with "

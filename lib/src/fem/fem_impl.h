@@ -89,14 +89,14 @@ struct fcm_space {
  * on the full space (the element's points come from the rules, which a cell_mask of the rules
  * restricts independently); fcm_space_num_colors() counts the colours of the local elements,
  * and the colour lists hold local element positions. Whatever needs the whole pattern refuses
- * it with FCM_ERR_ARG (fcm__space_check_full()): fcm_space_matrix_create() and so the serial
- * integrator's setup. Assembly over the local rows: fcm__space_matrix_create_rows() (3
- * num_local_copies rows, global columns: row_ptr / col_idx as they are), filled by
- * fcm_assembly_workspace_linear() / _hyperelastic() (and the one-shot fcm_assemble_*() given
- * such a matrix) when fcm__space_check_assemble() passes: the rules' cell_mask gives points to
- * local cells only (the own cells; ghosts get none), so each process adds its own elements'
- * terms (PARTIAL rows: summed over the processes they are the full rows); vectors stay
- * num_dofs long (global DOFs), energies per element id. fcm__space_localize() picks the own
+ * it with FCM_ERR_ARG (fcm__space_check_full()): fcm_space_matrix_create(); the integrator's
+ * setup refuses a local space without a distributed backend (integrator.c). Assembly over the local
+ * rows: fcm__space_matrix_create_rows() (3 num_local_copies rows, global columns: row_ptr / col_idx
+ * as they are), filled by fcm_assembly_workspace_linear() / _hyperelastic() (and the one-shot
+ * fcm_assemble_*() given such a matrix) when fcm__space_check_assemble() passes: the rules'
+ * cell_mask gives points to local cells only (the own cells; ghosts get none), so each process adds
+ * its own elements' terms (PARTIAL rows: summed over the processes they are the full rows); vectors
+ * stay num_dofs long (global DOFs), energies per element id. fcm__space_localize() picks the own
  * cells and their ghosts. The values of a matrix over the rows go into a MATMPIAIJ with
  * ADD_VALUES (fcm__space_row_dof() names each row's DOF); fcm__space_matrix_apply() multiplies.
  * @return FCM_OK, FCM_ERR_ARG (as fcm_space_create*(); rules and cell_active both given),

@@ -941,10 +941,9 @@ cleanup:
   return st;
 }
 
-/* A preallocated MATMPIAIJ (block size 3) with the space's pattern on the owned rows (every
- * owned copy is one of the space's local copies: localize_space(); the integrator's full
- * space has every copy). */
-static fcm_status create_matrix(fcm_petsc_problem *P, Mat *A)
+/* The preallocation of create_matrix(): the diagonal- and off-block entries of each owned
+ * row (dnz, onz: 3 nlocal each, allocated here). Local. */
+static fcm_status preallocation(fcm_petsc_problem *P, PetscInt **dnz_out, PetscInt **onz_out)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P->ctx;
@@ -973,6 +972,26 @@ static fcm_status create_matrix(fcm_petsc_problem *P, Mat *A)
   FCM_CHECK(rows == P->nlocal, ctx, FCM_ERR_INTERNAL,
             "petsc: the space's topology has %lld of the %lld DOF copies this process owns",
             (long long)rows, (long long)P->nlocal);
+  *dnz_out = dnz;
+  *onz_out = onz;
+  dnz = onz = NULL;
+cleanup:
+  fcm__free(ctx, dnz);
+  fcm__free(ctx, onz);
+  return st;
+}
+
+/* A preallocated MATMPIAIJ (block size 3) with the space's pattern on the owned rows (every
+ * owned copy is one of the space's local copies: localize_space()). The processes agree on
+ * the local preallocation before the collective calls (a failure there is agreed: every
+ * process returns it, P->agreed_fail). Collective. */
+static fcm_status create_matrix(fcm_petsc_problem *P, Mat *A)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  PetscInt *dnz = NULL, *onz = NULL;
+  const PetscInt nl = 3 * P->nlocal;
+  FCM_TRY(ctx, fcm__petsc_problem_agree(P, preallocation(P, &dnz, &onz)));
   PCALL(ctx, MatCreate(P->comm, A));
   PCALL(ctx, MatSetSizes(*A, nl, nl, (PetscInt)P->n, (PetscInt)P->n));
   PCALL(ctx, MatSetType(*A, MATMPIAIJ));
@@ -1063,12 +1082,26 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
   unsigned char *mask = NULL;
   fcm_geometry *crop = NULL;
   const double t0 = fcm_wtime();
-  FCM_CHECK(out, ctx, FCM_ERR_ARG, "petsc: output pointer is NULL");
-  *out = NULL;
-  FCM_CHECK(ctx && mesh && mat, ctx, FCM_ERR_ARG, "petsc: NULL argument (ctx, mesh, material)");
-  FCM_ALLOC(ctx, 1, P);
-  P->ctx = ctx;
-  P->comm = MPI_COMM_NULL;
+  /* agreed before the first collective call (MPI_Comm_dup), as in
+   * fcm_petsc_simulation_create() */
+  if (!out)
+    st =
+        fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__, "petsc: output pointer is NULL");
+  else
+    *out = NULL;
+  if (st == FCM_OK && !(ctx && mesh && mat))
+    st = fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                    "petsc: NULL argument (ctx, mesh, material)");
+  if (st == FCM_OK) {
+    P = fcm__calloc(ctx, 1, sizeof *P);
+    if (!P)
+      st = fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__, "petsc: out of memory");
+  }
+  if (P) { /* what fcm_petsc_problem_destroy() needs, also when another process failed */
+    P->ctx = ctx;
+    P->comm = MPI_COMM_NULL;
+  }
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, comm, st));
   if (MPI_Comm_dup(comm, &P->comm) != MPI_SUCCESS) {
     P->comm = MPI_COMM_NULL;
     FCM_CHECK(0, ctx, FCM_ERR_ARG, "petsc: MPI_Comm_dup failed (invalid communicator?)");
@@ -1121,7 +1154,7 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
   st = create_matrix(P, &P->K);
   if (st == FCM_OK && P->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) st = create_matrix(P, &P->M);
   if (st == FCM_OK) st = create_vectors(P);
-  FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
+  FCM_TRY(ctx, P->agreed_fail ? st : fcm__petsc_problem_agree(P, st)); /* agreed already */
   P->time_setup = fcm_wtime() - t0;
   *out = P;
   P = NULL;
@@ -2245,10 +2278,11 @@ static fcm_status newton_build(fcm_petsc_problem *P, fcm_status st, const fcm_sp
   }
   FCM_TRY(ctx, newton_agree(P, st));
   FCM_TRY(ctx, newton_agree(P, check_topology(P)));
-  st = create_matrix(P, &P->S);
+  st = create_matrix(P, &P->S); /* agrees on its local part */
   if (st == FCM_OK) st = create_vectors(P);
   if (st == FCM_OK) st = near_null_space(P, P->S);
-  if (st == FCM_OK) st = insert_options(P);
+  /* local (the options database), then KSPCreate: agreed between */
+  if (st == FCM_OK) st = newton_agree(P, insert_options(P));
   if (st == FCM_OK) {
     PetscBool has = PETSC_FALSE;
     PC pc;
@@ -2374,18 +2408,31 @@ fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_sc
   fcm_petsc_problem *P = NULL;
   fcm_simulation *S = NULL;
   unsigned char *mask = NULL;
-  FCM_CHECK(out, ctx, FCM_ERR_ARG, "petsc: output pointer is NULL");
-  *out = NULL;
-  FCM_CHECK(ctx && scene, ctx, FCM_ERR_ARG, "petsc: NULL context or scene");
-  FCM_CHECK((int)partition >= 0 && partition < FCM_PETSC_PARTITION_COUNT, ctx, FCM_ERR_ARG,
-            "petsc: partition = %d is not a method (0 auto, 1 ptscotch, 2 ordered)",
-            (int)partition);
-  P = fcm__calloc(ctx, 1, sizeof *P);
-  FCM_CHECK(P, ctx, FCM_ERR_ALLOC, "petsc: out of memory");
-  P->ctx = ctx;
-  P->comm = MPI_COMM_NULL;
-  P->refs = 1;
-  P->borrowed_space = 1;
+  /* the arguments and the allocation are local: the processes agree on them before the
+   * first collective call (MPI_Comm_dup), so bad input on one process ends them all */
+  if (!out)
+    st =
+        fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__, "petsc: output pointer is NULL");
+  else
+    *out = NULL;
+  if (st == FCM_OK && !(ctx && scene))
+    st = fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__, "petsc: NULL context or scene");
+  if (st == FCM_OK && !((int)partition >= 0 && partition < FCM_PETSC_PARTITION_COUNT))
+    st = fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                    "petsc: partition = %d is not a method (0 auto, 1 ptscotch, 2 ordered)",
+                    (int)partition);
+  if (st == FCM_OK) {
+    P = fcm__calloc(ctx, 1, sizeof *P);
+    if (!P)
+      st = fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__, "petsc: out of memory");
+  }
+  if (P) { /* what newton_release() needs, also when another process failed */
+    P->ctx = ctx;
+    P->comm = MPI_COMM_NULL;
+    P->refs = 1;
+    P->borrowed_space = 1;
+  }
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, comm, st));
   if (MPI_Comm_dup(comm, &P->comm) != MPI_SUCCESS) {
     P->comm = MPI_COMM_NULL;
     FCM_CHECK(0, ctx, FCM_ERR_ARG, "petsc: MPI_Comm_dup failed (invalid communicator?)");

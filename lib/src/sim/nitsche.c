@@ -681,9 +681,10 @@ fcm_status fcm_integrator_boundary_eval(fcm_integrator *I, const double *u, doub
     fcm_index nr = -1, nc = -1, nnz = -1;
     fcm_csr_get_size(tangent, &nr, &nc, &nnz);
     const fcm_index nrow = fcm__space_num_rows(I->space);
-    FCM_CHECK(nr == nrow && nc == I->n && nnz == I->space->row_ptr[nrow], ctx, FCM_ERR_ARG,
+    FCM_CHECK(I->space->row_ptr && nr == nrow && nc == I->n && nnz == I->space->row_ptr[nrow], ctx,
+              FCM_ERR_ARG,
               "boundary eval: the matrix does not have the space's pattern (use "
-              "fcm_space_matrix_create())");
+              "fcm_space_matrix_create(); a distributed run: the integrator's local rows)");
   }
   {
     const double t_saved = I->bc_time;

@@ -46,9 +46,12 @@ struct fcm__sim_backend {
    * place (the same result, bit for bit, on every process). Collective. */
   fcm_status (*reduce)(void *user, fcm_status st, double *values, fcm_index count);
   /* Prepare the solves with the eliminated Newton matrix: the sum over the processes of each
-   * process's PARTIAL eliminated matrix H (see above; the backend adds them); is_con (n): the
-   * constrained DOFs, whose rows and columns of H are zero except the diagonal on the owning
-   * process; psd: the sum is positive definite (CG) or may be indefinite (MINRES).
+   * process's PARTIAL eliminated matrix H (see above; the backend adds them). H has the rows
+   * of the integrator's space (fcm__space_num_rows(): a distributed run's local space has the
+   * rows of its local copies only, row r being DOF fcm__space_row_dof(space, r)) and a column
+   * per DOF. is_con (n, by DOF): the constrained DOFs, whose rows and columns of H are zero
+   * except the diagonal on the owning process; psd: the sum is positive definite (CG) or may
+   * be indefinite (MINRES).
    * *failed = 1: a soft failure (the step is retried). Collective. */
   fcm_status (*factor)(void *user, const fcm_csr *H, const unsigned char *is_con, int psd,
                        int *failed);
