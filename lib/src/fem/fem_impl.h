@@ -150,9 +150,10 @@ static inline fcm_index fcm__space_elem_row(const fcm_space *s, fcm_index le, in
 }
 
 /* A matrix over the space's rows: fcm__space_num_rows(s) x num_dofs with the space's pattern
- * (row_ptr / col_idx as they are: global columns, copied), FCM_CSR_GENERAL for a local space;
- * a full space: exactly fcm_space_matrix_create()'s (square, FCM_CSR_SYMMETRIC). Assembly
- * (fcm_assembly_workspace_linear() / _hyperelastic()) adds into it.
+ * (row_ptr / col_idx as they are: global columns; SHARED with the space, not copied: the
+ * space must outlive the matrix; values of its own), FCM_CSR_GENERAL for a local space; a
+ * full space: fcm_space_matrix_create()'s size, kind and pattern (square, FCM_CSR_SYMMETRIC).
+ * Assembly (fcm_assembly_workspace_linear() / _hyperelastic()) adds into it.
  * @return FCM_OK, FCM_ERR_ARG (NULL), FCM_ERR_ALLOC. (space.c) */
 fcm_status fcm__space_matrix_create_rows(const fcm_space *s, fcm_csr **A);
 

@@ -2,6 +2,7 @@
  * CSR pattern built once, per-cell scatter offsets, and the cell colouring. */
 #include "embed/embed_impl.h"
 #include "fem/fem_impl.h"
+#include "la/la_impl.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -855,14 +856,12 @@ fcm_status fcm__space_matrix_create_rows(const fcm_space *s, fcm_csr **A)
   fcm_ctx *ctx = s ? s->ctx : NULL;
   FCM_CHECK(s && A, ctx, FCM_ERR_ARG, "space matrix (rows): NULL space or output pointer");
   *A = NULL;
-  if (!s->is_local) {
-    FCM_TRY(ctx, fcm_space_matrix_create(s, A));
-  } else {
-    FCM_CHECK(s->row_ptr, ctx, FCM_ERR_ARG,
-              "space matrix (rows): the local space has no topology (a failed rebuild)");
-    FCM_TRY(ctx, fcm_csr_create(ctx, fcm__space_num_rows(s), s->num_dofs, s->row_ptr, s->col_idx,
-                                FCM_CSR_GENERAL, A));
-  }
+  FCM_CHECK(s->row_ptr, ctx, FCM_ERR_ARG,
+            "space matrix (rows): the local space has no topology (a failed rebuild)");
+  /* the space's pattern, shared (borrowed: the space outlives the matrices made on it) */
+  FCM_TRY(ctx,
+          fcm__csr_share_pattern(ctx, fcm__space_num_rows(s), s->num_dofs, s->row_ptr, s->col_idx,
+                                 s->is_local ? FCM_CSR_GENERAL : FCM_CSR_SYMMETRIC, A));
 cleanup:
   return st;
 }

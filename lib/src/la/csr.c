@@ -127,6 +127,29 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__csr_share_pattern(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols,
+                                  const fcm_index *row_ptr, const int *col_idx, fcm_csr_kind kind,
+                                  fcm_csr **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_csr *A = NULL;
+  FCM_CHECK(out, ctx, FCM_ERR_ARG, "csr_share_pattern: output pointer is NULL");
+  *out = NULL;
+  FCM_TRY(ctx, check_header(ctx, nrows, ncols, row_ptr, kind));
+  FCM_CHECK(col_idx || row_ptr[nrows] == 0, ctx, FCM_ERR_ARG,
+            "csr_share_pattern: col_idx is NULL with nnz = %lld", (long long)row_ptr[nrows]);
+  FCM_TRY(ctx, new_handle(ctx, nrows, ncols, row_ptr[nrows], kind, &A));
+  A->owned = 1; /* the values; the pattern is borrowed (own_row_ptr / own_col_idx NULL) */
+  FCM_ALLOC(ctx, A->nnz, A->values);
+  A->row_ptr = row_ptr;
+  A->col_idx = col_idx;
+  *out = A;
+  A = NULL;
+cleanup:
+  fcm_csr_destroy(&A);
+  return st;
+}
+
 fcm_status fcm_csr_wrap(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols, const fcm_index *row_ptr,
                         const int *col_idx, double *values, fcm_csr_kind kind, fcm_csr **out)
 {

@@ -245,6 +245,8 @@
  *   SCENE 1, the clamped ball at 16^3 Hex8 cells, 6,597 DOFs; bytes per global DOF, largest
  *   process): P = 1: topology 421, 3 matrices 2,454; P = 2: 256 / 1,499; P = 3: 202 / 1,184
  *   (the ghost share is large on this small grid: 996 and 832 of 1,664 cells on 2 processes).
+ *   The matrices share the space's pattern since (fcm__csr_share_pattern(), la_impl.h: values
+ *   only, 8 B per entry instead of 12): 3 matrices 989 B/DOF on 2 processes there.
  *   Still replicated: numbering 38 B/DOF, vectors 168 B/DOF, the adapter's per-copy arrays.
  * - cuts keep the partition made at the start (the pieces of a split cell belong to its
  *   owner; cut-heavy regions are not rebalanced) and the cut's classification of every cell
