@@ -81,6 +81,33 @@ done:
   return st;
 }
 
+/* The checks of a round in which allocation k failed on process 1 (process 0 on one
+ * process), `what` naming the sweep: every process failed (all_failed of them), the message
+ * carries the allocation's failure and, on the other processes, names the failing one; once
+ * the error is cleared, no allocation beyond `live` is left. Read the message before. */
+static void check_failed_round(fcm_ctx *ctx, const char *what, long long k, int all_failed,
+                               long long live)
+{
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const int bad = size > 1 ? 1 : 0;
+  char other[64];
+  snprintf(other, sizeof other, "process %d of %d failed", bad, size);
+  const char *msg = fcm_ctx_error_message(ctx);
+  if (all_failed != size)
+    TEST_FAIL_("%s: allocation %lld failing on process %d: %d of %d processes failed; this one: "
+               "%s",
+               what, k, bad, all_failed, size, msg);
+  if (!strstr(msg, "out of memory") || (rank != bad && !strstr(msg, other)))
+    TEST_FAIL_("%s: allocation %lld failing on process %d: message on process %d: %s", what, k, bad,
+               rank, msg);
+  fcm_ctx_error_clear(ctx);
+  if (fcm_ctx_live_allocations(ctx) != live)
+    TEST_FAIL_("%s: allocation %lld failing on process %d: %lld allocations leaked", what, k, bad,
+               fcm_ctx_live_allocations(ctx) - live);
+}
+
 /* Phase 2 (the integrator on PETSc, -ksp_type cg -pc_type mg: newton_factor() sets the levels
  * up at the first Newton matrix): the simulation of `scene` made with no failure, then its
  * first step with allocation `fail_at` failing (-1: none); this process's allocations in the
@@ -136,18 +163,8 @@ static int scene_main(fcm_ctx *ctx, failing *f, const char *path, long long stri
     failures++;
     const char *msg = fcm_ctx_error_message(ctx);
     if (getenv("FCM_TEST_VERBOSE") && rank == 0) fprintf(stderr, "%lld: %s\n", k, msg);
-    if (all[1] != size)
-      TEST_FAIL_("scene: allocation %lld failing on process %d: %d of %d "
-                 "processes failed; this one: %s",
-                 k, bad, all[1], size, msg);
-    if (!strstr(msg, "out of memory") || (rank != bad && !strstr(msg, "process 1 of")))
-      TEST_FAIL_("scene: allocation %lld failing on process %d: message on process %d: %s", k, bad,
-                 rank, msg);
     in_smoother += strstr(msg, "fcm block smoother") != NULL;
-    fcm_ctx_error_clear(ctx);
-    if (fcm_ctx_live_allocations(ctx) != live)
-      TEST_FAIL_("scene: allocation %lld failing: %lld allocations leaked", k,
-                 fcm_ctx_live_allocations(ctx) - live);
+    check_failed_round(ctx, "scene", k, all[1], live);
   }
   long long cnt = rank == bad ? count_ok : 0, cnt_all = 0;
   MPI_Allreduce(&cnt, &cnt_all, 1, MPI_LONG_LONG, MPI_MAX, MPI_COMM_WORLD);
@@ -189,18 +206,7 @@ static int create_main(fcm_ctx *ctx, failing *f, const char *path, long long str
       break;
     }
     failures++;
-    const char *msg = fcm_ctx_error_message(ctx);
-    if (all[1] != size)
-      TEST_FAIL_("create: allocation %lld failing on process %d: %d of %d processes failed; "
-                 "this one: %s",
-                 k, bad, all[1], size, msg);
-    if (!strstr(msg, "out of memory") || (rank != bad && !strstr(msg, "process 1 of")))
-      TEST_FAIL_("create: allocation %lld failing on process %d: message on process %d: %s", k, bad,
-                 rank, msg);
-    fcm_ctx_error_clear(ctx);
-    if (fcm_ctx_live_allocations(ctx) != live)
-      TEST_FAIL_("create: allocation %lld failing: %lld allocations leaked", k,
-                 fcm_ctx_live_allocations(ctx) - live);
+    check_failed_round(ctx, "create", k, all[1], live);
   }
   long long cnt = rank == bad ? count_ok : 0, cnt_all = 0;
   MPI_Allreduce(&cnt, &cnt_all, 1, MPI_LONG_LONG, MPI_MAX, MPI_COMM_WORLD);
@@ -270,7 +276,6 @@ int main(int argc, char **argv)
   }
 
   const long long live = fcm_ctx_live_allocations(ctx);
-  const char *other = size == 3 ? "process 1 of 3 failed" : "process 1 of 2 failed";
   long long failures = 0, in_smoother = 0, before_smoother = 0, count_ok = -1;
   for (long long k = 0; k < 100000 && !test_failures_; k += stride) {
     const fcm_status st = round_(ctx, &f, rank == bad ? k : -1, mesh, geom, u, &count);
@@ -291,13 +296,6 @@ int main(int argc, char **argv)
     }
     failures++;
     const char *msg = fcm_ctx_error_message(ctx);
-    if (all[1] != size)
-      TEST_FAIL_("allocation %lld failing on process %d: %d of %d processes "
-                 "failed; this one: %s",
-                 k, bad, all[1], size, msg);
-    if (!strstr(msg, "out of memory") || (rank != bad && !strstr(msg, other)))
-      TEST_FAIL_("allocation %lld failing on process %d: message on process %d: %s", k, bad, rank,
-                 msg);
     if (getenv("FCM_TEST_VERBOSE") && rank == 0) fprintf(stderr, "%lld: %s\n", k, msg);
     if (rank == bad) { /* where it failed: the message, the traceback */
       char *view = NULL;
@@ -313,10 +311,7 @@ int main(int argc, char **argv)
         before_smoother++;
       free(view);
     }
-    fcm_ctx_error_clear(ctx);
-    if (fcm_ctx_live_allocations(ctx) != live)
-      TEST_FAIL_("allocation %lld failing on process %d: %lld allocations leaked", k, bad,
-                 fcm_ctx_live_allocations(ctx) - live);
+    check_failed_round(ctx, "setup", k, all[1], live);
   }
   /* the successful round's allocation count on the failing process: every one failed once */
   long long cnt[3] = {rank == bad ? count_ok : 0, in_smoother, before_smoother}, cnt_all[3];

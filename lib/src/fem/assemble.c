@@ -532,6 +532,8 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
 #pragma omp for schedule(dynamic, 16)
       for (fcm_index k = c0; k < c1; k++) {
         const fcm_index le = s->color_elems[k], c = fcm__space_local_elem(s, le);
+        /* another process's element (a distributed run's ghost): no points, nothing to add */
+        if (!fcm__cell_rules_owns(s->rules, s->elem_cell[c])) continue;
         if (ps->traction) {
           if (!surface_cell(s, ps, c, w)) continue;
         } else {

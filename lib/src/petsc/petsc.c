@@ -1075,6 +1075,35 @@ cleanup:
   return st;
 }
 
+/* The start of both creators: after their local argument checks (st), allocate the problem
+ * (*out, also when the processes then fail: its ctx, comm and single reference set for the
+ * destroy), agree on st and the allocation before the first collective call, so bad input or
+ * a failed allocation on one process ends them all, then duplicate comm. Collective. */
+static fcm_status new_problem(fcm_ctx *ctx, MPI_Comm comm, fcm_status st, fcm_petsc_problem **out)
+{
+  fcm_petsc_problem *P = NULL;
+  if (st == FCM_OK) {
+    P = fcm__calloc(ctx, 1, sizeof *P);
+    if (!P)
+      st = fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__, "petsc: out of memory");
+  }
+  if (P) {
+    P->ctx = ctx;
+    P->comm = MPI_COMM_NULL;
+    P->refs = 1;
+  }
+  *out = P;
+  FCM_TRY(ctx, fcm__petsc_agree(ctx, comm, st));
+  if (MPI_Comm_dup(comm, &P->comm) != MPI_SUCCESS) {
+    P->comm = MPI_COMM_NULL;
+    FCM_CHECK(0, ctx, FCM_ERR_ARG, "petsc: MPI_Comm_dup failed (invalid communicator?)");
+  }
+  MPI_Comm_size(P->comm, &P->size);
+  MPI_Comm_rank(P->comm, &P->rank);
+cleanup:
+  return st;
+}
+
 fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh *mesh,
                                     const fcm_geometry *geom, const fcm_material *mat,
                                     const fcm_petsc_options *opts, fcm_petsc_problem **out)
@@ -1084,8 +1113,7 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
   unsigned char *mask = NULL;
   fcm_geometry *crop = NULL;
   const double t0 = fcm_wtime();
-  /* agreed before the first collective call (MPI_Comm_dup), as in
-   * fcm_petsc_simulation_create() */
+  /* local checks, agreed in new_problem() before the first collective call */
   if (!out)
     st =
         fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__, "petsc: output pointer is NULL");
@@ -1094,22 +1122,7 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
   if (st == FCM_OK && !(ctx && mesh && mat))
     st = fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
                     "petsc: NULL argument (ctx, mesh, material)");
-  if (st == FCM_OK) {
-    P = fcm__calloc(ctx, 1, sizeof *P);
-    if (!P)
-      st = fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__, "petsc: out of memory");
-  }
-  if (P) { /* what fcm_petsc_problem_destroy() needs, also when another process failed */
-    P->ctx = ctx;
-    P->comm = MPI_COMM_NULL;
-  }
-  FCM_TRY(ctx, fcm__petsc_agree(ctx, comm, st));
-  if (MPI_Comm_dup(comm, &P->comm) != MPI_SUCCESS) {
-    P->comm = MPI_COMM_NULL;
-    FCM_CHECK(0, ctx, FCM_ERR_ARG, "petsc: MPI_Comm_dup failed (invalid communicator?)");
-  }
-  MPI_Comm_size(P->comm, &P->size);
-  MPI_Comm_rank(P->comm, &P->rank);
+  FCM_TRY(ctx, new_problem(ctx, comm, st, &P));
   P->mesh = mesh;
   P->mat = *mat;
   P->opts = opts ? *opts : fcm_petsc_options_default();
@@ -2410,8 +2423,7 @@ fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_sc
   fcm_petsc_problem *P = NULL;
   fcm_simulation *S = NULL;
   unsigned char *mask = NULL;
-  /* the arguments and the allocation are local: the processes agree on them before the
-   * first collective call (MPI_Comm_dup), so bad input on one process ends them all */
+  /* local checks, agreed in new_problem() before the first collective call */
   if (!out)
     st =
         fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__, "petsc: output pointer is NULL");
@@ -2423,24 +2435,9 @@ fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_sc
     st = fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
                     "petsc: partition = %d is not a method (0 auto, 1 ptscotch, 2 ordered)",
                     (int)partition);
-  if (st == FCM_OK) {
-    P = fcm__calloc(ctx, 1, sizeof *P);
-    if (!P)
-      st = fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__, "petsc: out of memory");
-  }
-  if (P) { /* what newton_release() needs, also when another process failed */
-    P->ctx = ctx;
-    P->comm = MPI_COMM_NULL;
-    P->refs = 1;
-    P->borrowed_space = 1;
-  }
-  FCM_TRY(ctx, fcm__petsc_agree(ctx, comm, st));
-  if (MPI_Comm_dup(comm, &P->comm) != MPI_SUCCESS) {
-    P->comm = MPI_COMM_NULL;
-    FCM_CHECK(0, ctx, FCM_ERR_ARG, "petsc: MPI_Comm_dup failed (invalid communicator?)");
-  }
-  MPI_Comm_size(P->comm, &P->size);
-  MPI_Comm_rank(P->comm, &P->rank);
+  st = new_problem(ctx, comm, st, &P);
+  if (P) P->borrowed_space = 1;
+  FCM_TRY(ctx, st);
   P->opts = fcm_petsc_options_default();
   set_prefix(P);
   {
