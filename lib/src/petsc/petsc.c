@@ -241,13 +241,14 @@
  *   matrices over the local copies' rows (global columns); assembly, Nitsche's scatter,
  *   eliminate_partial() and newton_factor() go by row (fcm__space_row_dof()); every product
  *   with M / D / H0 is fcm__space_matrix_apply() (an n-vector, zero off the local rows) summed
- *   as before. Measured (FCM_TEST_VERBOSE=1 mpiexec -n P build/petsc_newton /tmp/scenes
- *   SCENE 1, the clamped ball at 16^3 Hex8 cells, 6,597 DOFs; bytes per global DOF, largest
- *   process): P = 1: topology 421, 3 matrices 2,454; P = 2: 256 / 1,499; P = 3: 202 / 1,184
- *   (the ghost share is large on this small grid: 996 and 832 of 1,664 cells on 2 processes).
- *   The matrices share the space's pattern since (fcm__csr_share_pattern(), la_impl.h: values
- *   only, 8 B per entry instead of 12): 3 matrices 989 B/DOF on 2 processes there.
- *   Still replicated: numbering 38 B/DOF, vectors 168 B/DOF, the adapter's per-copy arrays.
+ *   as before. Measured (FCM_TEST_VERBOSE=1 mpiexec -n P build/petsc_newton DIR SCENE 1 on
+ *   apps/scenes/clamped_surface.json with background.cells [16, 16, 16] and
+ *   geometry.resolution 24: 6,597 DOFs; bytes per global DOF, largest process): P = 1:
+ *   topology 421, 3 matrices 2,454; P = 2: 256 / 1,499; P = 3: 202 / 1,184 (the ghost share
+ *   is large on this small grid: 996 and 832 of 1,664 cells on 2 processes). The matrices
+ *   share the space's pattern since (fcm__csr_share_pattern(), la_impl.h: values only, 8 B
+ *   per entry instead of 12): 3 matrices 989 B/DOF on 2 processes there. Still replicated:
+ *   numbering 38 B/DOF, vectors 168 B/DOF, the adapter's per-copy arrays.
  * - cuts keep the partition made at the start (the pieces of a split cell belong to its
  *   owner; cut-heavy regions are not rebalanced) and the cut's classification of every cell
  *   runs on every process (replicated; the first build's is distributed, see above); the cut-cell
