@@ -109,7 +109,8 @@ typedef struct cell_out {
   piece_out one;
   piece_out *pc;
   double volume;
-  int nfp; /* face polygons: meta (face, piece, vertices) x nfp, coordinates fx */
+  int nfp; /* face polygons: meta (face, piece, vertices, part vertices) x nfp, coordinates fx
+              (the polygon's, then its part's) */
   int *fmeta;
   double *fx;
 } cell_out;
@@ -480,9 +481,9 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
       vol += pvol[i];
     FCM_TRY(ctx, fcm__embed_face_polygons(ctx, &cell, P));
     if (P->nfp > 0) {
-      FCM_ALLOC(ctx, 3 * P->nfp, o->fmeta);
+      FCM_ALLOC(ctx, 4 * P->nfp, o->fmeta);
       FCM_ALLOC(ctx, 3 * P->nfx, o->fx);
-      memcpy(o->fmeta, P->fmeta, 3 * P->nfp * sizeof(int));
+      memcpy(o->fmeta, P->fmeta, 4 * P->nfp * sizeof(int));
       memcpy(o->fx, P->fx, 3 * P->nfx * sizeof(double));
       o->nfp = (int)P->nfp;
     }
@@ -1157,15 +1158,15 @@ static fcm_status gather_links(const build *B, fcm_cell_rules *R, const cell_out
       const fcm_index pa0 = R->piece_off[c], pb0 = R->piece_off[c2];
       size_t xa = 0;
       for (int i = 0; i < oa->nfp; i++) {
-        const int *ma = oa->fmeta + 3 * i;
+        const int *ma = oa->fmeta + 4 * i;
         const double *A = oa->fx + 3 * xa;
-        xa += (size_t)ma[2];
+        xa += (size_t)(ma[2] + ma[3]);
         if (ma[0] != f || ma[1] < 0) continue;
         size_t xb = 0;
         for (int j = 0; j < ob->nfp; j++) {
-          const int *mb = ob->fmeta + 3 * j;
+          const int *mb = ob->fmeta + 4 * j;
           const double *Bx = ob->fx + 3 * xb;
-          xb += (size_t)mb[2];
+          xb += (size_t)(mb[2] + mb[3]);
           if (mb[0] != f2 || mb[1] < 0) continue;
           const fcm_index pa = pa0 + ma[1], pb = pb0 + mb[1];
           int known = 0;
@@ -1175,14 +1176,15 @@ static fcm_status gather_links(const build *B, fcm_cell_rules *R, const cell_out
           double lo[3], hi[3];
           const double *nb = cell.planes[f].n; /* polygon B faces out of c2: normal -n_f */
           const double nbn[3] = {-nb[0], -nb[1], -nb[2]};
-          if (fcm__embed_overlap(A, ma[2], Bx, mb[2], nbn, mtol, NULL) <= atol) continue;
           for (int d = 0; d < 3; d++) {
             lo[d] = HUGE_VAL, hi[d] = -HUGE_VAL;
             for (int k = 0; k < ma[2]; k++)
               lo[d] = fmin(lo[d], A[3 * k + d] - mtol), hi[d] = fmax(hi[d], A[3 * k + d] + mtol);
           }
           FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, lo, hi, &tc));
-          if (fcm__embed_on_cut(B->cut_tris, tc.ids, tc.n, A, ma[2], mtol)) continue;
+          if (!fcm__embed_linked(A, ma[2], A + 3 * ma[2], ma[3], Bx, mb[2], Bx + 3 * mb[2], mb[3],
+                                 nbn, mtol, atol, B->cut_tris, tc.ids, tc.n))
+            continue;
           if (nl + 1 > cap) {
             const size_t ncap = cap ? 2 * cap : 256;
             void *q = links;

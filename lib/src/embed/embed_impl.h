@@ -224,8 +224,8 @@ typedef struct fcm__parts {
   fcm__poly w[3], scratch; /* splitting workspace */
   fcm__idbuf tcand;        /* cut triangles reaching the cell, ascending */
   /* Polygons of part faces lying on the cell's faces (fcm__embed_face_polygons): polygon i
-   * is on cell face fmeta[3i], belongs to piece fmeta[3i+1] and has fmeta[3i+2] vertices,
-   * stored consecutively in fx (x 3). */
+   * is on cell face fmeta[4i], belongs to piece fmeta[4i+1], has fmeta[4i+2] vertices and its
+   * part fmeta[4i+3]: stored consecutively in fx (x 3), the polygon's then its part's. */
   double *fx;
   int *fmeta;
   size_t nfx, capfx, nfp, capfp;
@@ -277,10 +277,26 @@ fcm_status fcm__embed_cut_faces(fcm_ctx *ctx, const fcm__embed_cell *cell, const
 fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P);
 
 /* Area of the part of polygon a (na vertices) inside the convex polygon b (nb vertices,
- * counter-clockwise around its unit normal nb_normal), both on one plane; *centroid (may
- * be NULL) the overlap's vertex centroid. `tol` is the on-edge tolerance. */
+ * counter-clockwise around its unit normal nb_normal), both on one plane; `tol` is the
+ * on-edge tolerance. overlap (may be NULL; room for 3 x FCM__POLY_MAX_VERTS) gets that part,
+ * *num_overlap (may be NULL) its vertex count (0 when empty). */
 double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
-                          const double nb_normal[3], double tol, double centroid[3]);
+                          const double nb_normal[3], double tol, double *overlap, int *num_overlap);
+
+/* Whether two faces on one plane join their convex parts (vertices va, nva and vb, nvb): face
+ * a (na vertices) and the convex face b (nb vertices, counter-clockwise around nb_normal)
+ * overlap by more than `atol` in area, and unless the overlap lies on the cuts
+ * tris[ids[0 .. n)] (fcm__embed_on_cut(), twice the tolerance `tol`), in which case the
+ * parts join only when they do not lie on opposite sides of the cut triangle under the
+ * overlap's centroid (a part within tol of the plane, or crossing it, lies on no side).
+ * Deciding by the parts' sides rather than by where each cell placed the cut: the crossing of
+ * a plane almost parallel to a face is ill-conditioned, so two cells can place it a little
+ * apart on their shared face, and the pieces on the two sides of the cut then overlap in a
+ * strip along it, which must not join them; a sliver cut off between the face and the cut
+ * joins the material on its own side. */
+int fcm__embed_linked(const double *a, int na, const double *va, int nva, const double *b, int nb,
+                      const double *vb, int nvb, const double nb_normal[3], double tol, double atol,
+                      const fcm__cut_tri *tris, const fcm_index *ids, size_t n);
 
 /* 1 when the polygon x (m vertices; m = 1: a point) lies on the cuts tris[ids[0 .. n)]:
  * every vertex and the vertex centroid lie on one of the triangles within `tol`. A face

@@ -21,6 +21,10 @@
 #define MATCH_RTOL 1e-9
 #define AREA_RTOL  1e-12
 #define NORMAL_TOL 1e-6
+/* The overlap of two faces is on a cut when its vertices lie within this many times the
+ * matching tolerance of a cut triangle: clipping one face by the other's edges places new
+ * vertices on segments between points within the tolerance, up to rounding. */
+#define ON_CUT_FACTOR 2.0
 
 static double dot3(const double a[3], const double b[3])
 {
@@ -242,7 +246,7 @@ cleanup:
   return st;
 }
 
-/* Copy the used part of a polyhedron (the struct is ~11 kB, mostly unused). */
+/* Copy the used part of a polyhedron (the struct is ~26 kB, mostly unused). */
 static void poly_copy(fcm__poly *dst, const fcm__poly *src)
 {
   dst->nv = src->nv, dst->nf = src->nf;
@@ -251,6 +255,7 @@ static void poly_copy(fcm__poly *dst, const fcm__poly *src)
     dst->fn[f] = src->fn[f];
     memcpy(dst->fv[f], src->fv[f], (size_t)src->fn[f] * sizeof src->fv[f][0]);
   }
+  memcpy(dst->fp, src->fp, (size_t)src->nf * sizeof src->fp[0]);
 }
 
 /* Store polyhedron q as part `slot` (slot == P->n appends). */
@@ -367,24 +372,21 @@ cleanup:
   return st;
 }
 
-/* Unit Newell normal and offset of face f of p; 0 when the face has no area. */
+/* The plane face f of p lies on (the one it carries); 0 when the face has no area. */
 static int face_plane(const fcm__poly *p, int f, fcm__plane *pl)
 {
-  double n[3] = {0, 0, 0}, c[3] = {0, 0, 0};
+  double n[3] = {0, 0, 0};
   const int m = p->fn[f];
   for (int k = 0; k < m; k++) {
     const double *a = p->x[p->fv[f][k]], *b = p->x[p->fv[f][(k + 1) % m]];
     n[0] += (a[1] - b[1]) * (a[2] + b[2]);
     n[1] += (a[2] - b[2]) * (a[0] + b[0]);
     n[2] += (a[0] - b[0]) * (a[1] + b[1]);
-    for (int d = 0; d < 3; d++)
-      c[d] += a[d] / m;
   }
-  const double ln = sqrt(dot3(n, n));
-  if (!(ln > 0.0)) return 0;
-  for (int d = 0; d < 3; d++)
-    pl->n[d] = n[d] / ln;
-  pl->d = dot3(pl->n, c);
+  if (!(dot3(n, n) > 0.0)) return 0;
+  const fcm__plane *q = p->fp + f;
+  if (q->n[0] == 0.0 && q->n[1] == 0.0 && q->n[2] == 0.0) return 0;
+  *pl = *q;
   return 1;
 }
 
@@ -397,9 +399,10 @@ static int face_coords(const fcm__poly *p, int f, double *x)
 }
 
 double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
-                          const double nb_normal[3], double tol, double centroid[3])
+                          const double nb_normal[3], double tol, double *overlap, int *num_overlap)
 {
   double x[3 * FCM__POLY_MAX_VERTS], work[3 * FCM__POLY_MAX_VERTS];
+  if (num_overlap) *num_overlap = 0;
   if (na < 3 || nb < 3 || na > FCM__POLY_MAX_VERTS) return 0.0;
   memcpy(x, a, 3 * (size_t)na * sizeof *x);
   int m = na;
@@ -418,16 +421,15 @@ double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
     m = fcm__geom_polygon_clip(x, m, FCM__POLY_MAX_VERTS, &pl, tol, 1, work);
   }
   if (m < 3) return 0.0;
-  double n[3] = {0, 0, 0}, c[3] = {0, 0, 0};
+  double n[3] = {0, 0, 0};
   for (int k = 0; k < m; k++) {
     const double *p = x + 3 * k, *q = x + 3 * ((k + 1) % m);
     n[0] += (p[1] - q[1]) * (p[2] + q[2]);
     n[1] += (p[2] - q[2]) * (p[0] + q[0]);
     n[2] += (p[0] - q[0]) * (p[1] + q[1]);
-    for (int d = 0; d < 3; d++)
-      c[d] += p[d] / m;
   }
-  if (centroid) memcpy(centroid, c, sizeof c);
+  if (overlap) memcpy(overlap, x, 3 * (size_t)m * sizeof *x);
+  if (num_overlap) *num_overlap = m;
   return 0.5 * sqrt(dot3(n, n));
 }
 
@@ -457,6 +459,42 @@ int fcm__embed_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n, 
       c[d] += x[3 * k + d] / m;
   }
   return m > 0 && point_on_cut(tris, ids, n, c, tol);
+}
+
+/* The side of the convex part with vertices v (nv) of plane pl: +1 or -1 when all its
+ * vertices lie on that side or within tol of the plane and one lies beyond tol, 0 when it is
+ * flat on the plane or crosses it. */
+static int part_side(const double *v, int nv, const fcm__plane *pl, double tol)
+{
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (int k = 0; k < nv; k++) {
+    const double sd = dot3(pl->n, v + 3 * k) - pl->d;
+    lo = fmin(lo, sd), hi = fmax(hi, sd);
+  }
+  if (lo >= -tol && hi > tol) return 1;
+  if (hi <= tol && lo < -tol) return -1;
+  return 0;
+}
+
+int fcm__embed_linked(const double *a, int na, const double *va, int nva, const double *b, int nb,
+                      const double *vb, int nvb, const double nb_normal[3], double tol, double atol,
+                      const fcm__cut_tri *tris, const fcm_index *ids, size_t n)
+{
+  double x[3 * FCM__POLY_MAX_VERTS], c[3] = {0, 0, 0};
+  int m = 0;
+  if (fcm__embed_overlap(a, na, b, nb, nb_normal, tol, x, &m) <= atol) return 0;
+  const double ctol = ON_CUT_FACTOR * tol;
+  if (!fcm__embed_on_cut(tris, ids, n, x, m, ctol)) return 1;
+  for (int k = 0; k < m; k++)
+    for (int d = 0; d < 3; d++)
+      c[d] += x[3 * k + d] / m;
+  for (size_t k = 0; k < n; k++) {
+    const fcm_index t = ids[k];
+    if (!point_on_cut(tris, &t, 1, c, ctol)) continue;
+    const fcm__plane *pl = &tris[t].plane;
+    return part_side(va, nva, pl, tol) * part_side(vb, nvb, pl, tol) >= 0;
+  }
+  return 1;
 }
 
 static int uf_find(int *uf, int a)
@@ -493,8 +531,9 @@ static int parts_connected(const fcm__embed_cell *cell, const fcm__cut_tri *tris
       const fcm__plane *pb = fp + j * FCM__POLY_MAX_FACES + fb;
       if (dot3(pa->n, pb->n) > -(1.0 - NORMAL_TOL) || fabs(pa->d + pb->d) > mtol) continue;
       const int na = face_coords(a, fa, xa), nb = face_coords(b, fb, xb);
-      if (fcm__embed_overlap(xa, na, xb, nb, pb->n, mtol, NULL) <= atol) continue;
-      if (!fcm__embed_on_cut(tris, P->tcand.ids, ntri, xa, na, mtol)) return 1;
+      if (fcm__embed_linked(xa, na, a->x[0], a->nv, xb, nb, b->x[0], b->nv, pb->n, mtol, atol, tris,
+                            P->tcand.ids, ntri))
+        return 1;
     }
   }
   return 0;
@@ -654,17 +693,17 @@ fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, f
       for (int g = 0; g < cell->num_planes; g++) {
         const fcm__plane *cp = cell->planes + g;
         if (dot3(pl.n, cp->n) < 1.0 - NORMAL_TOL || fabs(pl.d - cp->d) > mtol) continue;
-        const size_t m = (size_t)p->fn[f];
+        const size_t m = (size_t)p->fn[f], mv = m + (size_t)p->nv;
         if (P->nfp + 1 > P->capfp) {
           const size_t cap = P->capfp ? 2 * P->capfp : 64;
           void *q = P->fmeta;
-          FCM_TRY(ctx, fcm__resize(ctx, &q, 3 * P->nfp, 3 * cap, sizeof(int)));
+          FCM_TRY(ctx, fcm__resize(ctx, &q, 4 * P->nfp, 4 * cap, sizeof(int)));
           P->fmeta = q;
           P->capfp = cap;
         }
-        if (P->nfx + m > P->capfx) {
+        if (P->nfx + mv > P->capfx) {
           size_t cap = P->capfx ? 2 * P->capfx : 256;
-          while (cap < P->nfx + m)
+          while (cap < P->nfx + mv)
             cap *= 2;
           void *q = P->fx;
           FCM_TRY(ctx, fcm__resize(ctx, &q, 3 * P->nfx, 3 * cap, sizeof(double)));
@@ -672,11 +711,13 @@ fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, f
           P->capfx = cap;
         }
         face_coords(p, f, P->fx + 3 * P->nfx);
-        P->fmeta[3 * P->nfp] = g;
-        P->fmeta[3 * P->nfp + 1] = P->piece[i];
-        P->fmeta[3 * P->nfp + 2] = (int)m;
+        memcpy(P->fx + 3 * (P->nfx + m), p->x[0], 3 * (size_t)p->nv * sizeof(double));
+        P->fmeta[4 * P->nfp] = g;
+        P->fmeta[4 * P->nfp + 1] = P->piece[i];
+        P->fmeta[4 * P->nfp + 2] = (int)m;
+        P->fmeta[4 * P->nfp + 3] = p->nv;
         P->nfp++;
-        P->nfx += m;
+        P->nfx += mv;
         break;
       }
     }

@@ -38,6 +38,7 @@ void fcm__geom_poly_from_cell(fcm_element_type type, const double *X, fcm__poly 
     for (int k = 0; k < p->fn[f]; k++)
       p->fv[f][k] = info->face_nodes[f][k];
   }
+  fcm__geom_cell_planes(info, X, p->fp);
 }
 
 int fcm__geom_cell_planes(const fcm_element_info *info, const double *X, fcm__plane *planes)
@@ -178,6 +179,7 @@ int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__pol
       if (out->nf >= FCM__POLY_MAX_FACES) goto overflow;
       out->fn[out->nf] = nc;
       memcpy(out->fv[out->nf], cyc, (size_t)nc * sizeof cyc[0]);
+      out->fp[out->nf] = p->fp[f];
       out->nf++;
     }
   }
@@ -193,17 +195,19 @@ int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__pol
       sort_cap(out, pl->n, ids, k);
       out->fn[out->nf] = k;
       memcpy(out->fv[out->nf], ids, (size_t)k * sizeof ids[0]);
+      out->fp[out->nf] = *pl;
       out->nf++;
     }
   }
   if (out->nf < 4) out->nv = out->nf = 0; /* fewer than 4 faces: no volume */
-  /* Copy back only the used parts (the struct is ~11 kB). */
+  /* Copy back only the used parts (the struct is ~26 kB). */
   p->nv = out->nv, p->nf = out->nf;
   memcpy(p->x, out->x, (size_t)out->nv * sizeof out->x[0]);
   for (int f = 0; f < out->nf; f++) {
     p->fn[f] = out->fn[f];
     memcpy(p->fv[f], out->fv[f], (size_t)out->fn[f] * sizeof out->fv[f][0]);
   }
+  memcpy(p->fp, out->fp, (size_t)out->nf * sizeof out->fp[0]);
   return 0;
 overflow:
   p->nv = p->nf = 0;

@@ -98,23 +98,29 @@ void fcm__geom_idbuf_free(fcm_ctx *ctx, fcm__idbuf *buf);
 #define FCM__POLY_MAX_FACES 32
 #define FCM__POLY_MAX_FV    64
 
-/* A convex polyhedron: vertex positions and faces as vertex cycles, counter-
- * clockwise seen from outside. nf == 0 means empty. Plain value type (~25 kB). */
-typedef struct fcm__poly {
-  int nv, nf;
-  double x[FCM__POLY_MAX_VERTS][3];
-  int fn[FCM__POLY_MAX_FACES];
-  int fv[FCM__POLY_MAX_FACES][FCM__POLY_MAX_FV];
-} fcm__poly;
-
 /* A half-space {x : n.x <= d} with unit outward normal n. */
 typedef struct fcm__plane {
   double n[3];
   double d;
 } fcm__plane;
 
+/* A convex polyhedron: vertex positions and faces as vertex cycles, counter-
+ * clockwise seen from outside, each with the plane it lies on (outward): the plane of the
+ * cell face it came from, or the clipping plane that made it. Carrying the plane, instead of
+ * fitting one to the face's vertices, keeps it exact on sliver faces, whose fitted plane is
+ * ill-conditioned (two sides of one face must agree on it). nf == 0 means empty. Plain
+ * value type (~26 kB). */
+typedef struct fcm__poly {
+  int nv, nf;
+  double x[FCM__POLY_MAX_VERTS][3];
+  int fn[FCM__POLY_MAX_FACES];
+  int fv[FCM__POLY_MAX_FACES][FCM__POLY_MAX_FV];
+  fcm__plane fp[FCM__POLY_MAX_FACES];
+} fcm__poly;
+
 /* Polyhedron of a Tet4 (4 nodes) or convex Hex8 (8 nodes, VTK order) cell from its
- * corner coordinates X (npc x 3), faces from the element's face tables. */
+ * corner coordinates X (npc x 3), faces from the element's face tables, their planes from
+ * fcm__geom_cell_planes(). */
 void fcm__geom_poly_from_cell(fcm_element_type type, const double *X, fcm__poly *p);
 
 /* Outward half-spaces of the planar faces of a convex cell from its corners (Newell
