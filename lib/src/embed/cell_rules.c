@@ -405,10 +405,10 @@ cleanup:
 }
 
 /* Renumber the labels (P->piece or P->parent, *count of them) so that labels whose parts
- * keep no volume (all slivers) are removed: those parts get -1. vol (may be NULL) gets the
- * volume of each remaining label. */
-static fcm_status drop_empty(const build *B, fcm__embed_ws *ws, int *label, int *count, double *vol,
-                             cell_sums *sums)
+ * keep no more than vmin of volume (all slivers, or flat on a cut) are removed: those parts get
+ * -1. vol (may be NULL) gets the volume of each remaining label. */
+static fcm_status drop_empty(const build *B, fcm__embed_ws *ws, double vmin, int *label, int *count,
+                             double *vol, cell_sums *sums)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
@@ -418,9 +418,9 @@ static fcm_status drop_empty(const build *B, fcm__embed_ws *ws, int *label, int 
   for (int i = 0; i < *count; i++) {
     double v = 0.0;
     FCM_TRY(ctx, fcm__embed_piece_tets(ctx, P, label, i, ws, sums ? &sums->counts : NULL, &v));
-    renum[i] = v > 0.0 ? kept : -1;
-    if (v > 0.0 && vol) vol[kept] = v;
-    if (v > 0.0) kept++;
+    renum[i] = v > vmin ? kept : -1;
+    if (v > vmin && vol) vol[kept] = v;
+    if (v > vmin) kept++;
   }
   for (size_t j = 0; j < P->n; j++)
     label[j] = label[j] >= 0 ? renum[label[j]] : -1;
@@ -450,8 +450,13 @@ static fcm_status cell_pieces(const build *B, const fcm__embed_cell *cell, fcm__
     sums->counts.degenerate += !(P->split_error <= DEGENERATE_RTOL * cell->volume);
   }
   FCM_ALLOC(ctx, (size_t)P->num_pieces + 1, *vol);
-  FCM_TRY(ctx, drop_empty(B, ws, P->piece, &P->num_pieces, *vol, sums));
-  if (B->prev) FCM_TRY(ctx, drop_empty(B, ws, P->parent, &P->num_parents, NULL, NULL));
+  /* a piece is kept when it holds more than a sliver of the cell (a piece flat on a cut,
+   * whose tets are slivers of a degenerate embedded cell, carries no material and would tie
+   * the nodes of both sides together); the pieces under the earlier cuts whenever they hold
+   * any volume, so that every kept piece lies in one */
+  FCM_TRY(ctx,
+          drop_empty(B, ws, opt->sliver_rtol * cell->volume, P->piece, &P->num_pieces, *vol, sums));
+  if (B->prev) FCM_TRY(ctx, drop_empty(B, ws, 0.0, P->parent, &P->num_parents, NULL, NULL));
 cleanup:
   return st;
 }
@@ -826,7 +831,7 @@ cleanup:
 /* Phase 1c (cuts only): the tree of R's cut triangles, the region (cells sharing a node with
  * a cell the cuts reach) and, when extending `prev` by the triangles from first_new on,
  * the cells to integrate (those the new triangles reach). */
-static fcm_status cut_setup(build *B, const fcm_cell_rules *R, fcm_index first_new)
+static fcm_status cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
@@ -846,12 +851,16 @@ static fcm_status cut_setup(build *B, const fcm_cell_rules *R, fcm_index first_n
   B->cut_tris = R->cut_tris;
   FCM_ALLOC(ctx, (size_t)nc + 1, B->region);
   FCM_ALLOC(ctx, (size_t)nn + 1, node_hit);
+  fcm__free(ctx, R->reached);
+  R->reached = NULL;
+  FCM_ALLOC(ctx, (size_t)nc + 1, R->reached);
   if (B->prev) FCM_ALLOC(ctx, (size_t)nc + 1, B->rebuild);
   for (fcm_index c = 0; c < nc; c++) {
     fcm__embed_cell cell;
     FCM_TRY(ctx, fcm__embed_cell_setup(ctx, mesh, c, B->o->clip_rtol, &cell));
     FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, cell.lo, cell.hi, &ids));
     if (ids.n == 0) continue;
+    R->reached[c] = 1;
     for (int a = 0; a < npc; a++)
       node_hit[cells[(size_t)npc * c + a]] = 1;
     if (B->rebuild && ids.ids[ids.n - 1] >= first_new) B->rebuild[c] = 1;
@@ -1576,6 +1585,7 @@ void fcm_cell_rules_destroy(fcm_cell_rules **rules)
   fcm__free(ctx, R->piece_parent);
   fcm__free(ctx, R->cut_tris);
   fcm__free(ctx, R->links);
+  fcm__free(ctx, R->reached);
   fcm__free(ctx, R->soff);
   fcm__free(ctx, R->cfoff);
   fcm__free(ctx, R->cfxi);

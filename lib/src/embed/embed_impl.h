@@ -69,6 +69,10 @@ struct fcm_cell_rules {
   fcm__cut_tri *cut_tris;
   fcm_index num_links;
   fcm_index *links;
+  /* reached[c]: a cut triangle's box meets cell c's (NULL without cuts). Every cell sharing a
+   * node with such a cell is in the links' region, so the links between the pieces of a
+   * node's support are all known when one of its cells is reached. */
+  unsigned char *reached;
   /* piece_parent[p]: the piece of the rules this object extends that holds piece p (-1
    * for rules made by fcm_cell_rules_create()); prev_num_pieces: how many that object had */
   fcm_index *piece_parent;

@@ -492,7 +492,7 @@ int fcm__embed_linked(const double *a, int na, const double *va, int nva, const 
     const fcm_index t = ids[k];
     if (!point_on_cut(tris, &t, 1, c, ctol)) continue;
     const fcm__plane *pl = &tris[t].plane;
-    return part_side(va, nva, pl, tol) * part_side(vb, nvb, pl, tol) >= 0;
+    return part_side(va, nva, pl, tol) * part_side(vb, nvb, pl, tol) > 0;
   }
   return 1;
 }

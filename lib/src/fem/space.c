@@ -110,11 +110,14 @@ static fcm_status build_copies(fcm_space *s, const fcm_index *inc_ptr, const fcm
     int split = 0;
     for (fcm_index i = 0; i < deg; i++) {
       const fcm_index e = inc[i0 + i], c = s->elem_cell[e];
-      /* cuts reach the node's support: a cell split into pieces, or a piece with a face on
-       * a cut (a cut along cell faces splits no cell but separates them); the links are
+      /* cuts reach the node's support: a cell split into pieces, a piece with a face on a
+       * cut (a cut along cell faces splits no cell but separates them), or a cell a cut
+       * passes near: the material of the support can be connected only through cells
+       * outside it (around a hole), and a cut elsewhere can sever that; the links are
        * known around every such cell */
       split |=
           s->cell_elem[c + 1] - s->cell_elem[c] > 1 ||
+          (s->rules && s->rules->reached && s->rules->reached[c]) ||
           (s->rules && fcm_cell_rules_get_piece_cut_faces(s->rules, s->elem_piece[e], NULL) > 0);
       uf[i] = i;
       pos[e] = i;
