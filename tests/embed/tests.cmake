@@ -48,3 +48,13 @@ fcm_add_test(embed_cell_mask tests/embed/cell_mask.c)
 # build on it with the other cells' classes handed over equals the build on the whole geometry
 # bit for bit (classes, fractions, pieces, own rules, surface triangle ids, outside volumes)
 fcm_add_test(embed_crop tests/embed/crop.c)
+# Cuts near grid planes and body faces: planes tilted 1e-12 .. 1e-5 off grid planes and body
+# faces, through nodes, edge midpoints, face centres and body vertices, single and repeated,
+# on all four elements and four bodies (tet box, hex box, ring, hollow ball): no error, every
+# cell keeps its material to 1e-12, every body on one side of every plane, the number of
+# bodies of an independent reference; the catalogue of configurations that once failed; the
+# long campaign (label slow) runs 20,000 cases per element.
+fcm_add_test(embed_cut_families_catalogue tests/embed/cut_families.c ARGS catalogue)
+fcm_add_test(embed_cut_families tests/embed/cut_families.c ARGS campaign 200 1)
+fcm_add_test(embed_cut_families_long tests/embed/cut_families.c ARGS campaign 20000 5
+             LABELS slow TIMEOUT 7200)

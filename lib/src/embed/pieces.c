@@ -16,11 +16,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Relative tolerances of the connectivity tests: faces match when their planes agree to
- * MATCH_RTOL x the cell size (normals to 1e-6) and overlap by more than AREA_RTOL x size^2. */
+/* Relative tolerances of the connectivity tests: faces match when they face each other and
+ * the vertices of each lie within MATCH_RTOL x the cell size of the other's plane, and they
+ * overlap by more than AREA_RTOL x size^2. (Comparing the planes' normals and offsets
+ * instead would let a face tilted 1e-6 off a cell face through the origin pass for one lying
+ * on it, however far its vertices are.) */
 #define MATCH_RTOL 1e-9
 #define AREA_RTOL  1e-12
-#define NORMAL_TOL 1e-6
 /* The overlap of two faces is on a cut when its vertices lie within this many times the
  * matching tolerance of a cut triangle: clipping one face by the other's edges places new
  * vertices on segments between points within the tolerance, up to rounding. */
@@ -390,6 +392,14 @@ static int face_plane(const fcm__poly *p, int f, fcm__plane *pl)
   return 1;
 }
 
+/* Whether the m points x lie within tol of plane pl. */
+static int points_on_plane(const double *x, int m, const fcm__plane *pl, double tol)
+{
+  for (int k = 0; k < m; k++)
+    if (!(fabs(dot3(pl->n, x + 3 * k) - pl->d) <= tol)) return 0;
+  return 1;
+}
+
 /* Gather face f of p into x (fn x 3). */
 static int face_coords(const fcm__poly *p, int f, double *x)
 {
@@ -488,11 +498,15 @@ int fcm__embed_linked(const double *a, int na, const double *va, int nva, const 
   for (int k = 0; k < m; k++)
     for (int d = 0; d < 3; d++)
       c[d] += x[3 * k + d] / m;
+  /* joined only when on the same side of every cut triangle under the centroid (where cuts
+   * cross, the overlap can lie on two: the parts may share the side of one and not the
+   * other's) */
   for (size_t k = 0; k < n; k++) {
     const fcm_index t = ids[k];
     if (!point_on_cut(tris, &t, 1, c, ctol)) continue;
     const fcm__plane *pl = &tris[t].plane;
-    return part_side(va, nva, pl, tol) * part_side(vb, nvb, pl, tol) > 0;
+    const int sa = part_side(va, nva, pl, tol), sb = part_side(vb, nvb, pl, tol);
+    if (!(sa * sb > 0 || (sa == 0 && sb == 0))) return 0;
   }
   return 1;
 }
@@ -529,8 +543,9 @@ static int parts_connected(const fcm__embed_cell *cell, const fcm__cut_tri *tris
     if (pa->n[0] == 0.0 && pa->n[1] == 0.0 && pa->n[2] == 0.0) continue;
     for (int fb = 0; fb < b->nf; fb++) {
       const fcm__plane *pb = fp + j * FCM__POLY_MAX_FACES + fb;
-      if (dot3(pa->n, pb->n) > -(1.0 - NORMAL_TOL) || fabs(pa->d + pb->d) > mtol) continue;
+      if (dot3(pa->n, pb->n) > -0.5) continue;
       const int na = face_coords(a, fa, xa), nb = face_coords(b, fb, xb);
+      if (!points_on_plane(xa, na, pb, mtol) || !points_on_plane(xb, nb, pa, mtol)) continue;
       if (fcm__embed_linked(xa, na, a->x[0], a->nv, xb, nb, b->x[0], b->nv, pb->n, mtol, atol, tris,
                             P->tcand.ids, ntri))
         return 1;
@@ -692,8 +707,12 @@ fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, f
       if (!face_plane(p, f, &pl)) continue;
       for (int g = 0; g < cell->num_planes; g++) {
         const fcm__plane *cp = cell->planes + g;
-        if (dot3(pl.n, cp->n) < 1.0 - NORMAL_TOL || fabs(pl.d - cp->d) > mtol) continue;
+        if (dot3(pl.n, cp->n) < 0.5) continue;
         const size_t m = (size_t)p->fn[f], mv = m + (size_t)p->nv;
+        int on = 1;
+        for (size_t k = 0; k < m && on; k++)
+          on = fabs(dot3(cp->n, p->x[p->fv[f][k]]) - cp->d) <= mtol;
+        if (!on) continue;
         if (P->nfp + 1 > P->capfp) {
           const size_t cap = P->capfp ? 2 * P->capfp : 64;
           void *q = P->fmeta;

@@ -1,0 +1,667 @@
+/* Cuts near grid planes and body faces (XFEM): planes tilted 1e-12 .. 1e-5 off the planes of
+ * the background grid and of the body's faces, through grid nodes, edge midpoints, face
+ * centres and body vertices, shifted by 0 .. 1e-6 h along their normal, on all four
+ * background elements and four bodies (a tet-meshed box, a box of one hexahedron, a ring
+ * and a hollow ball), applied once and repeatedly (parallel planes 1e-12 .. 1e-6 apart,
+ * crossing planes). Checked in every case, after every cut:
+ *   - the cut succeeds (no error, in particular no internal one);
+ *   - every background cell keeps its material: the volumes of its pieces add up to its
+ *     volume before the cut within 1e-12 of that volume + 1e-13 |K| (pieces flat on a cut,
+ *     at most the sliver volume 1e-14 |K| each, are dropped);
+ *   - every body of the space (elements joined through shared DOF copies) lies on one side
+ *     of every cut plane: its authentic stiffness points are within THICK of that side;
+ *   - the number of bodies is that of an independent reference: the convex bodies are
+ *     split into tets by the planes without any tolerance (vertex signs), each sign vector
+ *     with volume is one region; a region extending more than THICK from each plane must be
+ *     a body of its own, a thinner one may be one or may join a neighbour. The ring and the
+ *     hollow ball are cut by planes that leave material thicker than THICK on both sides,
+ *     whose regions are connected: one or two planes through the ring's axis or the hollow
+ *     ball's centre give 2 or 4 bodies, a plane across the ring's tube 2.
+ * THICK = 50 x the tolerance of the cut (1e-9 of the cell diagonal).
+ * The catalogue ("catalogue") holds three configurations that once failed, with their exact
+ * body counts: a plane tilted 1e-7 off a grid plane across a box (2 bodies), two parallel
+ * planes 1e-7 apart near a face of the box (2, then 3, no error) and a grid plane through a
+ * ring (2).
+ * Usage: embed_cut_families catalogue | campaign N [seed] [verbose]
+ *                          | one BODY ELEMENT px py pz nx ny nz [px py pz nx ny nz ...]
+ *   campaign: N random cases per background element (each body and family in turn);
+ *   one: the cuts given (BODY 0 tet box, 1 hex box, 2 ring, 3 hollow ball; ELEMENT 0 tet4,
+ *   1 tet10, 2 hex8, 3 hex20; the expected count of a hole body is 2 per plane). */
+#include "fcm/fcm.h"
+#include "test.h"
+
+#define MAX_PLANES 3
+#define NELEM      4
+
+static fcm_ctx *ctx;
+static int verbose;
+
+static const fcm_element_type elements[NELEM] = {FCM_ELEMENT_TET4, FCM_ELEMENT_TET10,
+                                                 FCM_ELEMENT_HEX8, FCM_ELEMENT_HEX20};
+
+static const char *ename(fcm_element_type type)
+{
+  return fcm_element_get_info(type)->name;
+}
+
+/* ---------------------------------------------------------------- random numbers */
+
+static unsigned long long rng_state;
+
+static double urand(void) /* [0, 1) */
+{
+  rng_state = rng_state * 6364136223846793005ULL + 1442695040888963407ULL;
+  return (double)(rng_state >> 11) / 9007199254740992.0;
+}
+
+static int irand(int n)
+{
+  return (int)(urand() * n) % n;
+}
+
+/* ---------------------------------------------------------------- geometry helpers */
+
+static double dot3(const double a[3], const double b[3])
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void cross3(const double a[3], const double b[3], double c[3])
+{
+  c[0] = a[1] * b[2] - a[2] * b[1];
+  c[1] = a[2] * b[0] - a[0] * b[2];
+  c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static void normalize(double v[3])
+{
+  const double l = sqrt(dot3(v, v));
+  for (int d = 0; d < 3; d++)
+    v[d] /= l;
+}
+
+typedef struct plane {
+  double p[3], n[3]; /* a point and the unit normal */
+} plane;
+
+static double side(const plane *pl, const double x[3])
+{
+  return (x[0] - pl->p[0]) * pl->n[0] + (x[1] - pl->p[1]) * pl->n[1] +
+         (x[2] - pl->p[2]) * pl->n[2];
+}
+
+/* The axis direction e_axis tilted by the angle eps towards a random direction normal to it. */
+static void tilted(int axis, double eps, double n[3])
+{
+  double t[3] = {urand() - 0.5, urand() - 0.5, urand() - 0.5};
+  t[axis] = 0.0;
+  if (dot3(t, t) == 0.0) t[(axis + 1) % 3] = 1.0;
+  normalize(t);
+  for (int d = 0; d < 3; d++)
+    n[d] = (d == axis ? cos(eps) : 0.0) + sin(eps) * t[d];
+  normalize(n);
+  if (urand() < 0.5)
+    for (int d = 0; d < 3; d++)
+      n[d] = -n[d];
+}
+
+/* ---------------------------------------------------------------- the reference regions */
+
+/* Regions of a convex body (the box [lo, hi] as 6 Kuhn tets) cut by planes: per sign vector
+ * its volume and, per plane, the largest distance of its points from that plane. */
+typedef struct regions {
+  const plane *pl;
+  int np;
+  double vol[1 << MAX_PLANES];
+  double thick[1 << MAX_PLANES][MAX_PLANES];
+} regions;
+
+static double tet_volume(double T[4][3])
+{
+  double a[3], b[3], c[3], x[3];
+  for (int d = 0; d < 3; d++)
+    a[d] = T[1][d] - T[0][d], b[d] = T[2][d] - T[0][d], c[d] = T[3][d] - T[0][d];
+  cross3(a, b, x);
+  return fabs(dot3(x, c)) / 6.0;
+}
+
+static void lerp(const double a[3], double sa, const double b[3], double sb, double out[3])
+{
+  const double t = sa / (sa - sb);
+  for (int d = 0; d < 3; d++)
+    out[d] = a[d] + t * (b[d] - a[d]);
+}
+
+static void split_tet(regions *R, double T[4][3], int k, int code);
+
+static void put_tet(regions *R, const double *a, const double *b, const double *c,
+                    const double *e, int k, int code)
+{
+  double T[4][3];
+  memcpy(T[0], a, sizeof T[0]);
+  memcpy(T[1], b, sizeof T[1]);
+  memcpy(T[2], c, sizeof T[2]);
+  memcpy(T[3], e, sizeof T[3]);
+  split_tet(R, T, k, code);
+}
+
+/* Tet T on the sides `code` of planes 0 .. k-1: split by plane k (vertex signs decide, no
+ * tolerance), or record it when k == np. */
+static void split_tet(regions *R, double T[4][3], int k, int code)
+{
+  if (k == R->np) {
+    const double v = tet_volume(T);
+    if (!(v > 0.0)) return;
+    R->vol[code] += v;
+    for (int j = 0; j < R->np; j++)
+      for (int a = 0; a < 4; a++)
+        R->thick[code][j] = fmax(R->thick[code][j], fabs(side(R->pl + j, T[a])));
+    return;
+  }
+  double s[4];
+  int pos[4], neg[4], np = 0, nn = 0;
+  for (int a = 0; a < 4; a++) {
+    s[a] = side(R->pl + k, T[a]);
+    if (s[a] > 0.0)
+      pos[np++] = a;
+    else
+      neg[nn++] = a;
+  }
+  const int up = code | 1 << k;
+  if (np == 0 || nn == 0) {
+    split_tet(R, T, k + 1, np ? up : code);
+    return;
+  }
+  if (np == 1 || nn == 1) { /* one vertex alone: a tet on its side, a prism on the other */
+    const int a = np == 1 ? pos[0] : neg[0];
+    const int *o = np == 1 ? neg : pos;
+    const int ca = np == 1 ? up : code, co = np == 1 ? code : up;
+    double p[3][3];
+    for (int i = 0; i < 3; i++)
+      lerp(T[a], s[a], T[o[i]], s[o[i]], p[i]);
+    put_tet(R, T[a], p[0], p[1], p[2], k + 1, ca);
+    put_tet(R, T[o[0]], T[o[1]], T[o[2]], p[0], k + 1, co);
+    put_tet(R, T[o[1]], T[o[2]], p[0], p[1], k + 1, co);
+    put_tet(R, T[o[2]], p[0], p[1], p[2], k + 1, co);
+    return;
+  }
+  /* two and two: a wedge on each side */
+  const int a = pos[0], b = pos[1], c = neg[0], e = neg[1];
+  double pac[3], pae[3], pbc[3], pbe[3];
+  lerp(T[a], s[a], T[c], s[c], pac);
+  lerp(T[a], s[a], T[e], s[e], pae);
+  lerp(T[b], s[b], T[c], s[c], pbc);
+  lerp(T[b], s[b], T[e], s[e], pbe);
+  put_tet(R, T[a], pac, pae, T[b], k + 1, up);
+  put_tet(R, pac, pae, T[b], pbc, k + 1, up);
+  put_tet(R, pae, T[b], pbc, pbe, k + 1, up);
+  put_tet(R, T[c], pac, pbc, T[e], k + 1, code);
+  put_tet(R, pac, pbc, T[e], pae, k + 1, code);
+  put_tet(R, pbc, T[e], pae, pbe, k + 1, code);
+}
+
+/* Regions of the box [lo, hi] cut by the planes: *definite (more than `thick` from every
+ * plane) and *thin (the others with volume). */
+static void box_regions(const double lo[3], const double hi[3], const plane *pl, int np,
+                        double thick, int *definite, int *thin)
+{
+  static const int kuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7},
+                                 {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
+  regions R;
+  memset(&R, 0, sizeof R);
+  R.pl = pl;
+  R.np = np;
+  for (int t = 0; t < 6; t++) {
+    double T[4][3];
+    for (int a = 0; a < 4; a++)
+      for (int d = 0; d < 3; d++)
+        T[a][d] = kuhn[t][a] >> d & 1 ? hi[d] : lo[d];
+    split_tet(&R, T, 0, 0);
+  }
+  *definite = *thin = 0;
+  for (int c = 0; c < 1 << np; c++) {
+    if (!(R.vol[c] > 0.0)) continue;
+    int ok = 1;
+    for (int j = 0; j < np; j++)
+      ok &= R.thick[c][j] > thick;
+    *definite += ok;
+    *thin += !ok;
+  }
+}
+
+/* ---------------------------------------------------------------- bodies */
+
+typedef struct body {
+  const char *name;
+  int convex;          /* the box [lo, hi] */
+  double lo[3], hi[3]; /* convex: the box; else: the body's centre in lo */
+  double mlo[3], mhi[3];
+  fcm_index cells[3];
+  fcm_geometry *g;
+} body;
+
+static double ring_phi(const double x[3], void *user)
+{
+  (void)user;
+  const double r = sqrt(x[0] * x[0] + x[1] * x[1]) - 0.9;
+  return sqrt(r * r + x[2] * x[2]) - 0.36;
+}
+
+static void make_bodies(body *B)
+{
+  /* a tet-meshed box (2 x 2 x 2 cubes, Kuhn split) in a 2 x 2 x 2 grid over [0, 2]^3 */
+  B[0] = (body){"tet box", 1, {0.13, 0.21, 0.07}, {1.77, 1.83, 1.91}, {0, 0, 0}, {2, 2, 2},
+                {2, 2, 2}, NULL};
+  const fcm_index gn[3] = {2, 2, 2};
+  TEST_OK(ctx, fcm_geometry_create_box(ctx, B[0].lo, B[0].hi, gn, &B[0].g));
+  /* the same box as one hexahedron, in a 3 x 3 x 3 grid over [0, 2]^3 */
+  B[1] = (body){"hex box", 1, {0.13, 0.21, 0.07}, {1.77, 1.83, 1.91}, {0, 0, 0}, {2, 2, 2},
+                {3, 3, 3}, NULL};
+  double X[24];
+  for (int a = 0; a < 8; a++) { /* VTK order: the bottom face counter-clockwise, then the top */
+    static const int bit[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                                  {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+    for (int d = 0; d < 3; d++)
+      X[3 * a + d] = bit[a][d] ? B[1].hi[d] : B[1].lo[d];
+  }
+  const fcm_index hexc[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+  TEST_OK(ctx, fcm_geometry_create(ctx, FCM_ELEMENT_HEX8, 8, X, 1, hexc, &B[1].g));
+  /* the ring: a level-set torus (axis z, radii 0.9 and 0.36) in a 6^3 grid over [-1.4, 1.4]^3 */
+  B[2] = (body){"ring", 0, {0, 0, 0}, {0, 0, 0}, {-1.4, -1.4, -1.4}, {1.4, 1.4, 1.4},
+                {6, 6, 6}, NULL};
+  fcm_level_set_options lo = fcm_level_set_options_default();
+  lo.estimate_error = 0;
+  TEST_OK(ctx, fcm_geometry_create_from_level_set(ctx, ring_phi, NULL, B[2].mlo, B[2].mhi,
+                                                  B[2].cells, &lo, &B[2].g, NULL));
+  /* the hollow ball (radii 0.5 and 0.9 around (1, 1, 1), holes along the axes) in a 4^3 grid
+   * over [0, 2]^3 */
+  B[3] = (body){"hollow ball", 0, {1, 1, 1}, {0, 0, 0}, {0, 0, 0}, {2, 2, 2}, {4, 4, 4}, NULL};
+  TEST_OK(ctx, fcm_geometry_create_hollow_ball(ctx, B[3].lo, 0.5, 0.9, 0.15, 4, 2, &B[3].g));
+}
+
+/* ---------------------------------------------------------------- one case */
+
+typedef struct setup {
+  fcm_mesh *mesh;
+  fcm_cell_rules *rules; /* uncut */
+} setup;
+
+static void setup_create(const body *b, fcm_element_type type, setup *S)
+{
+  fcm_cell_rules_options o = fcm_cell_rules_options_default();
+  o.min_fraction = 0.0;
+  o.simplify = FCM_CELL_SIMPLIFY_OFF;
+  o.strength[FCM_RULE_STIFFNESS] = 1;
+  o.strength[FCM_RULE_MASS] = 1;
+  o.num_threads = 1;
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, type, b->mlo, b->mhi, b->cells, &S->mesh));
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, S->mesh, b->g, &o, &S->rules));
+}
+
+static void setup_destroy(setup *S)
+{
+  fcm_cell_rules_destroy(&S->rules);
+  fcm_mesh_destroy(&S->mesh);
+}
+
+static long long cases_run, cuts_applied, shifted, thin_regions;
+
+static fcm_index root(fcm_index *uf, fcm_index x)
+{
+  while (uf[x] != x)
+    x = uf[x] = uf[uf[x]];
+  return x;
+}
+
+/* Bodies of a space: elements joined through shared DOF copies; *nb of them, the body of
+ * each element (0 .. nb-1) returned (malloc'ed). */
+static fcm_index *space_bodies(const fcm_space *sp, int *nb)
+{
+  const fcm_index ne = fcm_space_num_elements(sp), nc = fcm_space_num_dofs(sp) / 3;
+  const int nn = fcm_mesh_nodes_per_cell(fcm_space_mesh(sp));
+  fcm_index *uf = malloc((size_t)ne * sizeof *uf), *first = malloc((size_t)nc * sizeof *first);
+  fcm_index *num = malloc((size_t)ne * sizeof *num);
+  for (fcm_index e = 0; e < ne; e++)
+    uf[e] = e, num[e] = -1;
+  for (fcm_index k = 0; k < nc; k++)
+    first[k] = -1;
+  for (fcm_index e = 0; e < ne; e++) {
+    const fcm_index *ed = fcm_space_element_dofs(sp, e);
+    for (int a = 0; a < nn; a++) {
+      const fcm_index k = ed[a] / 3;
+      if (first[k] < 0) {
+        first[k] = e;
+        continue;
+      }
+      const fcm_index x = root(uf, e), y = root(uf, first[k]);
+      if (x != y) uf[x > y ? x : y] = x < y ? x : y;
+    }
+  }
+  int n = 0;
+  for (fcm_index e = 0; e < ne; e++) {
+    const fcm_index r = root(uf, e);
+    if (num[r] < 0) num[r] = n++;
+    num[e] = num[r];
+  }
+  free(uf);
+  free(first);
+  *nb = n;
+  return num;
+}
+
+/* Apply the cuts pl[0 .. np) one after the other to setup S and check every cut. */
+static void run_case(const body *b, fcm_element_type type, const setup *S, const plane *pl,
+                     int np, const char *what)
+{
+  const double thick = 50.0 * 1e-9 * sqrt(3.0) * (b->mhi[0] - b->mlo[0]) / (double)b->cells[0];
+  const fcm_cell_rules *prev = S->rules;
+  fcm_cell_rules *owned = NULL;
+  const fcm_index ncell = fcm_mesh_num_cells(S->mesh);
+  double blo[3], bhi[3], diag = 0.0;
+  fcm_geometry_bounding_box(b->g, blo, bhi);
+  for (int d = 0; d < 3; d++)
+    diag += (bhi[d] - blo[d]) * (bhi[d] - blo[d]);
+  diag = sqrt(diag);
+  for (int d = 0; d < 3; d++)
+    blo[d] -= 0.1 * diag, bhi[d] += 0.1 * diag;
+  cases_run++;
+  const int failures0 = test_failures_;
+  for (int k = 0; k < np; k++) {
+    fcm_surface *cut = NULL;
+    fcm_cell_rules *next = NULL;
+    fcm_space *sp = NULL;
+    TEST_OK(ctx, fcm_surface_create_plane(ctx, pl[k].p, pl[k].n, blo, bhi, &cut));
+    const fcm_status st = fcm_cell_rules_create_cut(ctx, S->mesh, b->g, prev, cut, &next);
+    fcm_surface_destroy(&cut);
+    if (st != FCM_OK) {
+      TEST_FAIL_("%s on %s (%s), cut %d of %d: %s", what, b->name,
+                 ename(type), k + 1, np, fcm_ctx_error_message(ctx));
+      fcm_ctx_error_clear(ctx);
+      break;
+    }
+    cuts_applied++;
+    shifted += fcm_cell_rules_get_stats(next)->cut_attempts > 1;
+    /* every cell keeps its material */
+    double X[3 * 27];
+    for (fcm_index c = 0; c < ncell; c++) {
+      fcm_index f0, f1;
+      const fcm_index n0 = fcm_cell_rules_cell_pieces(prev, c, &f0);
+      const fcm_index n1 = fcm_cell_rules_cell_pieces(next, c, &f1);
+      double v0 = 0.0, v1 = 0.0;
+      for (fcm_index p = f0; p < f0 + n0; p++)
+        v0 += fcm_cell_rules_piece_volume(prev, p);
+      for (fcm_index p = f1; p < f1 + n1; p++)
+        v1 += fcm_cell_rules_piece_volume(next, p);
+      fcm_mesh_cell_coords(S->mesh, c, X);
+      double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+      for (int a = 0; a < fcm_mesh_nodes_per_cell(S->mesh); a++)
+        for (int d = 0; d < 3; d++)
+          lo[d] = fmin(lo[d], X[3 * a + d]), hi[d] = fmax(hi[d], X[3 * a + d]);
+      const double K = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+      if (!(fabs(v1 - v0) <= 1e-12 * v0 + 1e-13 * K))
+        TEST_FAIL_("%s on %s (%s), cut %d: cell %lld holds %.17g instead of %.17g (error %.3g)",
+                   what, b->name, ename(type), k + 1, (long long)c, v1, v0,
+                   fabs(v1 - v0));
+    }
+    /* bodies: one side of every plane each, as many as the reference */
+    TEST_OK(ctx, fcm_space_create_embedded(ctx, S->mesh, next, &sp));
+    int nb = 0;
+    fcm_index *eb = sp ? space_bodies(sp, &nb) : NULL;
+    double(*range)[MAX_PLANES][2] = calloc((size_t)nb + 1, sizeof *range);
+    for (int i = 0; i < nb; i++)
+      for (int j = 0; j <= k; j++)
+        range[i][j][0] = HUGE_VAL, range[i][j][1] = -HUGE_VAL;
+    for (fcm_index c = 0; sp && c < ncell; c++) {
+      fcm_index fe, fp;
+      const fcm_index ne = fcm_space_cell_elements(sp, c, &fe);
+      fcm_cell_rules_cell_pieces(next, c, &fp);
+      fcm_mesh_cell_coords(S->mesh, c, X);
+      for (fcm_index j = 0; j < ne; j++) {
+        int n;
+        const double *pts, *w;
+        const unsigned char *fl;
+        double x[3];
+        TEST_OK(ctx, fcm_cell_rules_get_piece(next, fp + j, FCM_RULE_STIFFNESS, &n, &pts, &w, &fl));
+        for (int q = 0; q < n; q++) {
+          if (fl[q]) continue;
+          fcm_element_map(type, X, pts + 3 * q, x);
+          for (int i = 0; i <= k; i++) {
+            const double s = side(pl + i, x);
+            double *r = range[eb[fe + j]][i];
+            r[0] = fmin(r[0], s), r[1] = fmax(r[1], s);
+          }
+        }
+      }
+    }
+    for (int i = 0; i < nb; i++)
+      for (int j = 0; j <= k; j++)
+        if (range[i][j][0] < -thick && range[i][j][1] > thick)
+          TEST_FAIL_("%s on %s (%s), cut %d: body %d spans plane %d (%.3g .. %.3g)", what,
+                     b->name, ename(type), k + 1, i, j + 1, range[i][j][0],
+                     range[i][j][1]);
+    int definite = 0, thin = 0;
+    if (b->convex) {
+      box_regions(b->lo, b->hi, pl, k + 1, thick, &definite, &thin);
+    } else {
+      definite = 1 << (k + 1); /* the planes through the centre leave 2 and 4 bodies */
+      if (!strcmp(what, "tube plane")) definite = 2;
+    }
+    thin_regions += thin;
+    if (nb < definite || nb > definite + thin)
+      TEST_FAIL_("%s on %s (%s), cut %d of %d: %d bodies, expected %d (+ up to %d thin)", what,
+                 b->name, ename(type), k + 1, np, nb, definite, thin);
+    if (verbose > 1)
+      printf("%s on %s (%s) cut %d: %d bodies (reference %d + %d thin)\n", what, b->name,
+             ename(type), k + 1, nb, definite, thin);
+    free(range);
+    free(eb);
+    fcm_space_destroy(&sp);
+    fcm_cell_rules_destroy(&owned);
+    owned = next;
+    prev = next;
+  }
+  fcm_cell_rules_destroy(&owned);
+  if (test_failures_ > failures0)
+    for (int k = 0; k < np; k++)
+      fprintf(stderr, "  plane %d: point (%.17g, %.17g, %.17g) normal (%.17g, %.17g, %.17g)\n",
+              k + 1, pl[k].p[0], pl[k].p[1], pl[k].p[2], pl[k].n[0], pl[k].n[1], pl[k].n[2]);
+}
+
+/* ---------------------------------------------------------------- families */
+
+static const double tilts[] = {0.0, 1e-12, 1e-11, 1e-10, 1e-9, 1e-8, 1e-7, 1e-6, 1e-5};
+#define NTILT ((int)(sizeof tilts / sizeof tilts[0]))
+
+static double rand_tilt(void)
+{
+  return tilts[irand(NTILT)];
+}
+
+static double rand_shift(double h) /* 0 or +-10^-12 .. 10^-6 h */
+{
+  if (urand() < 0.3) return 0.0;
+  return (urand() < 0.5 ? -1.0 : 1.0) * pow(10.0, -12.0 + 6.0 * urand()) * h;
+}
+
+/* A point of the grid near which planes pass: a node, an edge midpoint or a face centre of a
+ * cell, chosen inside the box [lo, hi] of the body (axis `axis` coordinate on a grid plane). */
+static void grid_point(const body *b, int axis, const double lo[3], const double hi[3],
+                       double p[3])
+{
+  const double h = (b->mhi[0] - b->mlo[0]) / (double)b->cells[0];
+  const int kind = irand(3); /* 0 node, 1 edge midpoint, 2 face centre */
+  for (int d = 0; d < 3; d++) {
+    const int i0 = (int)ceil((lo[d] - b->mlo[d]) / h), i1 = (int)floor((hi[d] - b->mlo[d]) / h);
+    const int i = i1 >= i0 ? i0 + irand(i1 - i0 + 1) : i0;
+    double x = b->mlo[d] + i * h;
+    if (d != axis && ((kind == 1 && d == (axis + 1) % 3) || kind == 2) && x + 0.5 * h < hi[d])
+      x += 0.5 * h;
+    p[d] = x;
+  }
+}
+
+/* One random case of the convex bodies: 1 to 3 cuts of the families. */
+static void convex_case(const body *b, fcm_element_type type, const setup *S)
+{
+  plane pl[MAX_PLANES];
+  const double h = (b->mhi[0] - b->mlo[0]) / (double)b->cells[0];
+  const int family = irand(4), np = family == 3 ? 2 + irand(2) : 1 + irand(2);
+  const char *what = "";
+  for (int k = 0; k < np; k++) {
+    const int axis = irand(3);
+    const double eps = rand_tilt(), sh = rand_shift(h);
+    switch (family) {
+    case 0: /* near a grid plane through a node, an edge midpoint or a face centre */
+      what = "grid plane";
+      grid_point(b, axis, b->lo, b->hi, pl[k].p);
+      break;
+    case 1: /* near a face of the body, through one of its vertices */
+      what = "body face";
+      for (int d = 0; d < 3; d++)
+        pl[k].p[d] = urand() < 0.5 ? b->lo[d] : b->hi[d];
+      break;
+    case 2: /* parallel planes 1e-12 .. 1e-6 apart near a body face or a grid plane */
+      what = "parallel planes";
+      if (k == 0) {
+        if (urand() < 0.5)
+          for (int d = 0; d < 3; d++)
+            pl[k].p[d] = urand() < 0.5 ? b->lo[d] : b->hi[d];
+        else
+          grid_point(b, axis, b->lo, b->hi, pl[k].p);
+        tilted(axis, eps, pl[k].n);
+        for (int d = 0; d < 3; d++)
+          pl[k].p[d] += sh * pl[k].n[d];
+      } else {
+        pl[k] = pl[k - 1];
+        const double gap = pow(10.0, -12.0 + 6.0 * urand()) * h;
+        for (int d = 0; d < 3; d++)
+          pl[k].p[d] -= gap * pl[k].n[d];
+      }
+      continue;
+    default: /* crossing knives: near-grid planes on different axes */
+      what = "crossing planes";
+      grid_point(b, (axis + k) % 3, b->lo, b->hi, pl[k].p);
+      tilted((axis + k) % 3, eps, pl[k].n);
+      for (int d = 0; d < 3; d++)
+        pl[k].p[d] += sh * pl[k].n[d];
+      continue;
+    }
+    tilted(axis, eps, pl[k].n);
+    for (int d = 0; d < 3; d++)
+      pl[k].p[d] += sh * pl[k].n[d];
+  }
+  run_case(b, type, S, pl, np, what);
+}
+
+/* One random case of the ring or the hollow ball: one or two planes through the axis or the
+ * centre, near grid planes; or (ring) one plane across the tube near a grid plane z = c. */
+static void hole_case(const body *b, fcm_element_type type, const setup *S)
+{
+  plane pl[2];
+  const double h = (b->mhi[0] - b->mlo[0]) / (double)b->cells[0];
+  const double *c = b->lo; /* the centre */
+  if (!strcmp(b->name, "ring") && urand() < 0.3) {
+    /* z = c near a node or an edge midpoint, |c| <= h / 2 (both sides thicker than 0.1) */
+    const double zc = (irand(3) - 1) * 0.5 * h;
+    pl[0].p[0] = pl[0].p[1] = 0.0;
+    tilted(2, rand_tilt(), pl[0].n);
+    pl[0].p[2] = zc + rand_shift(h) * pl[0].n[2];
+    run_case(b, type, S, pl, 1, "tube plane");
+    return;
+  }
+  const int np = 1 + irand(2), axis0 = irand(2);
+  for (int k = 0; k < np; k++) {
+    const int axis = (axis0 + k) % 2;
+    tilted(axis, rand_tilt(), pl[k].n);
+    const double sh = rand_shift(h);
+    /* through the centre, or through the nodes or edge midpoints next to it: planes within
+     * h / 2 of the axis, which the ring's hole (radius 0.54) and the ball's cavity (0.5)
+     * keep apart from the material's boundary */
+    const double off = irand(2) * 0.5 * h * (urand() < 0.5 ? -1 : 1);
+    for (int d = 0; d < 3; d++)
+      pl[k].p[d] = c[d] + (d == axis ? off : 0.0) + sh * pl[k].n[d];
+  }
+  run_case(b, type, S, pl, np, np == 1 ? "plane through the axis" : "two planes through the axis");
+}
+
+/* ---------------------------------------------------------------- the catalogue */
+
+static void catalogue(body *B)
+{
+  for (int t = 0; t < NELEM; t++) {
+    setup S;
+    /* a plane tilted 1e-7 off the grid plane z = 1 across the box: 2 bodies */
+    setup_create(&B[0], elements[t], &S);
+    const plane d1 = {{1.5, 2, 1}, {1e-7, 0, 1}};
+    plane p1 = d1;
+    normalize(p1.n);
+    run_case(&B[0], elements[t], &S, &p1, 1, "tilted grid plane");
+    /* two parallel planes 1e-7 apart near the face y = 1.83: 2, then 3 bodies, no error */
+    plane p2[2] = {{{0.13, 1.8299999, 1.91000000000001}, {0, -0.99999999999999512, 9.9999999999999506e-08}},
+                   {{0.13, 1.829999999999, 1.91}, {0, -0.99999999999999512, 9.9999999999999506e-08}}};
+    normalize(p2[0].n);
+    normalize(p2[1].n);
+    run_case(&B[0], elements[t], &S, p2, 2, "parallel planes near a face");
+    setup_destroy(&S);
+    /* a grid plane and a tilted plane through the ring: 2 bodies */
+    setup_create(&B[2], elements[t], &S);
+    plane p3 = {{0, 0, 0}, {1, 0, 0}};
+    run_case(&B[2], elements[t], &S, &p3, 1, "plane through the axis");
+    plane p4 = {{0, 0, 0}, {0.984807753012208, 0.17364817766693, 0.05}};
+    normalize(p4.n);
+    run_case(&B[2], elements[t], &S, &p4, 1, "plane through the axis");
+    setup_destroy(&S);
+  }
+}
+
+int main(int argc, char **argv)
+{
+  if (argc < 2) {
+    fprintf(stderr, "usage: %s catalogue | campaign N [seed] [verbose]\n", argv[0]);
+    return 2;
+  }
+  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  body B[4];
+  make_bodies(B);
+  if (!strcmp(argv[1], "catalogue")) {
+    catalogue(B);
+  } else if (!strcmp(argv[1], "one") && argc >= 10 && (argc - 4) % 6 == 0) {
+    const int b = atoi(argv[2]), t = atoi(argv[3]), np = (argc - 4) / 6;
+    plane pl[MAX_PLANES];
+    for (int k = 0; k < np && k < MAX_PLANES; k++)
+      for (int d = 0; d < 3; d++) {
+        pl[k].p[d] = atof(argv[4 + 6 * k + d]);
+        pl[k].n[d] = atof(argv[7 + 6 * k + d]);
+      }
+    setup S;
+    verbose = 2;
+    setup_create(&B[b], elements[t], &S);
+    run_case(&B[b], elements[t], &S, pl, np < MAX_PLANES ? np : MAX_PLANES, "given planes");
+    setup_destroy(&S);
+  } else {
+    const int n = argc > 2 ? atoi(argv[2]) : 100;
+    rng_state = argc > 3 ? strtoull(argv[3], NULL, 10) : 1;
+    verbose = argc > 4 ? atoi(argv[4]) : 0;
+    for (int t = 0; t < NELEM; t++) {
+      setup S[4];
+      for (int b = 0; b < 4; b++)
+        setup_create(&B[b], elements[t], &S[b]);
+      for (int i = 0; i < n; i++) {
+        const int b = i % 4;
+        if (B[b].convex)
+          convex_case(&B[b], elements[t], &S[b]);
+        else
+          hole_case(&B[b], elements[t], &S[b]);
+      }
+      for (int b = 0; b < 4; b++)
+        setup_destroy(&S[b]);
+    }
+    if (verbose)
+      printf("%lld cases, %lld cuts, %lld shifted, %lld thin reference regions\n", cases_run,
+             cuts_applied, shifted, thin_regions);
+  }
+  for (int b = 0; b < 4; b++)
+    fcm_geometry_destroy(&B[b].g);
+  fcm_ctx_destroy(&ctx);
+  return TEST_RESULT();
+}
