@@ -433,6 +433,28 @@ static void run_case(const body *b, fcm_element_type type, const setup *S, const
         }
       }
     }
+    if (verbose > 2 && sp)
+      for (fcm_index c = 0; c < ncell; c++) {
+        fcm_index fe, fp;
+        const fcm_index ne = fcm_space_cell_elements(sp, c, &fe);
+        fcm_cell_rules_cell_pieces(next, c, &fp);
+        fcm_mesh_cell_coords(S->mesh, c, X);
+        for (fcm_index j = 0; j < ne; j++) {
+          int n;
+          const double *pts, *w;
+          const unsigned char *fl;
+          double x[3], lo = HUGE_VAL, hi = -HUGE_VAL;
+          fcm_cell_rules_get_piece(next, fp + j, FCM_RULE_STIFFNESS, &n, &pts, &w, &fl);
+          for (int q = 0; q < n; q++) {
+            if (fl[q]) continue;
+            fcm_element_map(type, X, pts + 3 * q, x);
+            lo = fmin(lo, side(pl + k, x)), hi = fmax(hi, side(pl + k, x));
+          }
+          printf("  cell %lld piece %lld volume %.3g body %lld side %.3g .. %.3g\n", (long long)c,
+                 (long long)(fp + j), fcm_cell_rules_piece_volume(next, fp + j),
+                 (long long)eb[fe + j], lo, hi);
+        }
+      }
     for (int i = 0; i < nb; i++)
       for (int j = 0; j <= k; j++)
         if (range[i][j][0] < -thick && range[i][j][1] > thick)
@@ -451,8 +473,9 @@ static void run_case(const body *b, fcm_element_type type, const setup *S, const
       TEST_FAIL_("%s on %s (%s), cut %d of %d: %d bodies, expected %d (+ up to %d thin)", what,
                  b->name, ename(type), k + 1, np, nb, definite, thin);
     if (verbose > 1)
-      printf("%s on %s (%s) cut %d: %d bodies (reference %d + %d thin)\n", what, b->name,
-             ename(type), k + 1, nb, definite, thin);
+      printf("%s on %s (%s) cut %d: %d bodies (reference %d + %d thin), %d attempts\n", what,
+             b->name, ename(type), k + 1, nb, definite, thin,
+             fcm_cell_rules_get_stats(next)->cut_attempts);
     free(range);
     free(eb);
     fcm_space_destroy(&sp);
@@ -634,7 +657,7 @@ int main(int argc, char **argv)
         pl[k].n[d] = atof(argv[7 + 6 * k + d]);
       }
     setup S;
-    verbose = 2;
+    verbose = 3;
     setup_create(&B[b], elements[t], &S);
     run_case(&B[b], elements[t], &S, pl, np < MAX_PLANES ? np : MAX_PLANES, "given planes");
     setup_destroy(&S);

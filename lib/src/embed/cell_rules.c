@@ -8,6 +8,7 @@
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
+#include <stdio.h>
 
 #define GIB (1024.0 * 1024.0 * 1024.0)
 
@@ -448,15 +449,21 @@ static fcm_status cell_pieces(const build *B, const fcm__embed_cell *cell, fcm__
   if (P->tcand.n > 0) {
     FCM_TRY(ctx, fcm__embed_cell_pieces(ctx, cell, B->cut_tris, B->first_new, P));
     sums->counts.degenerate += !(P->split_error <= DEGENERATE_RTOL * cell->volume);
+    if (getenv("DBG") && !(P->split_error <= DEGENERATE_RTOL * cell->volume)) fprintf(stderr, "DEGENERATE cell %lld split_error %.3g vol %.3g\n", (long long)cell->id, P->split_error, cell->volume);
   }
   FCM_ALLOC(ctx, (size_t)P->num_pieces + 1, *vol);
-  /* a piece is kept when it holds more than a sliver of the cell (a piece flat on a cut,
-   * whose tets are slivers of a degenerate embedded cell, carries no material and would tie
-   * the nodes of both sides together); the pieces under the earlier cuts whenever they hold
-   * any volume, so that every kept piece lies in one */
-  FCM_TRY(ctx,
-          drop_empty(B, ws, opt->sliver_rtol * cell->volume, P->piece, &P->num_pieces, *vol, sums));
-  if (B->prev) FCM_TRY(ctx, drop_empty(B, ws, 0.0, P->parent, &P->num_parents, NULL, NULL));
+  /* a piece is kept when it holds more than a sliver of the cell (a piece flat on a cut
+   * carries no material and would tie the nodes of both sides together); the pieces under the
+   * earlier cuts alike, as the build that made them kept them */
+  const double vmin = opt->sliver_rtol * cell->volume;
+  if (B->prev) {
+    FCM_TRY(ctx, drop_empty(B, ws, vmin, P->parent, &P->num_parents, NULL, NULL));
+    /* a piece in a removed earlier piece holds no more volume than that one (up to rounding
+     * at the threshold): removed too, so that every kept piece lies in a kept earlier one */
+    for (size_t j = 0; j < P->n; j++)
+      if (P->parent[j] < 0) P->piece[j] = -1;
+  }
+  FCM_TRY(ctx, drop_empty(B, ws, vmin, P->piece, &P->num_pieces, *vol, sums));
 cleanup:
   return st;
 }

@@ -335,7 +335,9 @@ static fcm_status split_part(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
   const int parent = P->parent[i];
   double lo, hi;
   plane_range(P->poly + i, &t->plane, &lo, &hi);
-  if (lo > tol || hi < -tol) return FCM_OK;
+  /* strictly on one side; or flat on the plane (within tol of it everywhere): split, it would
+   * go to both sides; left whole, it is the flat part the links treat as such */
+  if (lo > tol || hi < -tol || (lo >= -tol && hi <= tol)) return FCM_OK;
   for (int e = 0; e < 3; e++) {
     if (t->inner[e]) continue;
     plane_range(P->poly + i, &t->edge[e], &lo, &hi);

@@ -160,10 +160,11 @@ int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__pol
   }
   for (int f = 0; f < p->nf; f++) {
     const int fn = p->fn[f];
-    int cyc[FCM__POLY_MAX_FV], nc = 0, all_on = 1;
+    int cyc[FCM__POLY_MAX_FV], nc = 0, all_on = 1, inside = 0;
     for (int k = 0; k < fn; k++) {
       const int a = p->fv[f][k], b = p->fv[f][(k + 1) % fn];
       all_on &= sg[a] == 0;
+      inside |= sg[a] < 0;
       if (sg[a] <= 0) {
         if (nc >= FCM__POLY_MAX_FV) goto overflow;
         cyc[nc++] = newid[a];
@@ -175,6 +176,9 @@ int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__pol
       }
     }
     cap_face |= all_on;
+    /* a face with vertices outside and none inside keeps only on-plane vertices: what is
+     * left of it lies in the cap (kept, it would be a second face on the cap's vertices) */
+    if (!all_on && !inside) continue;
     if (nc >= 3) {
       if (out->nf >= FCM__POLY_MAX_FACES) goto overflow;
       out->fn[out->nf] = nc;
