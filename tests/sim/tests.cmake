@@ -60,3 +60,8 @@ fcm_sim_test(sim_nitsche_penalty tests/sim/nitsche.c ARGS penalty)
 fcm_sim_test(sim_nitsche_solvers tests/sim/nitsche.c ARGS solvers)
 fcm_sim_test(sim_nitsche_errors tests/sim/nitsche.c ARGS errors)
 fcm_sim_test(sim_nitsche_rigid tests/sim/nitsche.c ARGS rigid)
+# Inverted quadrature points (J = det F <= 0) counted in the step info against an independent
+# count of a prescribed fold; none for a spinning free body.
+foreach(el hex8 tet10)
+  fcm_sim_test(sim_inversion_${el} tests/sim/inversion.c ARGS ${el})
+endforeach()

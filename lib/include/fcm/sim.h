@@ -199,6 +199,16 @@ typedef struct fcm_step_info {
   double elastic_energy;          /**< Psi(u) */
   double external_work;           /**< f_ext(t)^T u */
   double total_energy;            /**< kinetic + elastic - external work */
+  fcm_index inverted_points;      /**< quadrature points of the body (the authentic points:
+                                       fictitious stabilization points of cut cells left out)
+                                       with J = det F <= 0 at the state the step ended in (0 on
+                                       failure); the Cauchy stress of fcm_space_element_stress()
+                                       is NaN there. Counted in the step's last energy
+                                       assembly, at no extra cost */
+  fcm_index inverted_cell;        /**< background cell of the first of them (lowest element,
+                                       then rule order), -1 when there is none */
+  double inverted_position[3];    /**< that point's reference position X (0 when none) */
+  double inverted_det;            /**< J there (<= 0; 0 when none) */
   int tangent_assemblies;         /**< tangent assemblies (Newton and damping matrices) */
   int factorizations;             /**< numeric factorizations or preconditioner setups */
   int direct_fallbacks;           /**< CHOLMOD "not positive definite" -> UMFPACK */

@@ -211,6 +211,21 @@ void fcm__space_copy_support(const fcm_space *s, double *support);
 fcm_status fcm__assembly_element_linear(fcm_assembly_workspace *ws, const fcm_linear_form *form,
                                         fcm_index elem, double *Ke, double *fe);
 
+/* The authentic quadrature points (fictitious stabilization points of cut cells left out) with
+ * J = det F <= 0 in the last hyperelastic assembly through ws
+ * (fcm_assembly_workspace_hyperelastic(), any of its outputs), summed over the local elements (a
+ * local space: this process's elements); *first_elem (may be NULL): the lowest element holding one,
+ * -1 when none. 0 before any hyperelastic assembly. O(local elements), no allocation. (assemble.c)
+ */
+fcm_index fcm__assembly_inverted(const fcm_assembly_workspace *ws, fcm_index *first_elem);
+
+/* The first authentic point of element elem (in its rule's order) with J = det F <= 0 at the
+ * displacement u: its reference position X and J; returns 1, or 0 when it has none (or no
+ * hyperelastic assembly ran yet). Serial (the workspace's first scratch); no allocation.
+ * (assemble.c) */
+int fcm__assembly_inverted_point(fcm_assembly_workspace *ws, fcm_index elem, const double *u,
+                                 double X[3], double *det);
+
 /* One process's piece of a parallel frame (.pvtu + one .vtu per process, written atomically):
  * the cells c with keep[c] != 0 (keep NULL: all) with their nodes renumbered, the point fields
  * displacement, velocity (v may be NULL) of the DOF vectors u, v (replicated) and node_index

@@ -152,8 +152,10 @@ struct fcm_integrator {
   /* cumulative counters */
   long long total_factorizations, total_fallbacks;
 
-  /* energy parts of the current iterate */
+  /* energy parts of the current iterate, and its inverted quadrature points (summed over the
+   * processes; fcm__assembly_inverted()) */
   double psi;
+  double inverted;
 
   /* distributed backend (sim_backend.h); has_backend = 0: serial */
   fcm__sim_backend backend;
