@@ -99,7 +99,10 @@ static void usage(FILE *f, const cli_option *opts)
              "Exit 0 on success, 1 when the run fails, 2 on a usage error, an invalid scene (also\n"
              "one whose files or geometry fail to build: the message names the scene section,\n"
              "e.g. geometry.voxels) or a refused checkpoint. A warning is printed when part of\n"
-             "the body lies outside the background mesh (it is cut off).\n");
+             "the body lies outside the background mesh (it is cut off), on the first step that\n"
+             "ends with inverted quadrature points (J = det F <= 0; the log's inverted_points\n"
+             "column and the summary count them) and on the first frame holding NaN stresses;\n"
+             "with \"solver\": {\"on_inversion\": \"stop\"} such a step ends the run (exit 1).\n");
 }
 
 /* -1 when the arguments are parsed into `o`, else the exit code (0 after --help, 2). */
@@ -237,6 +240,33 @@ static void warn_outside(const fcm_simulation *sim)
           S->mesh_lo[1], S->mesh_hi[1], S->mesh_lo[2], S->mesh_hi[2]);
 }
 
+/* The warning on the first step that ends with inverted quadrature points (the run summary
+ * counts them all). */
+static void warn_inverted(int tty, const fcm_step_info *si, long long step)
+{
+  if (tty) fputc('\n', stderr);
+  fprintf(stderr,
+          "fcm-sim: warning: step %lld (t = %.6g s) ended with %lld inverted quadrature point%s "
+          "(J = det F <= 0)",
+          step, si->time, (long long)si->inverted_points, si->inverted_points == 1 ? "" : "s");
+  if (si->inverted_cell >= 0)
+    fprintf(stderr, ", the first in cell %lld at X = (%.6g, %.6g, %.6g) with J = %.3g",
+            (long long)si->inverted_cell, si->inverted_position[0], si->inverted_position[1],
+            si->inverted_position[2], si->inverted_det);
+  fprintf(stderr, "; the stresses there are NaN (\"solver\": {\"on_inversion\": \"stop\"} ends "
+                  "the run at such a step)\n");
+}
+
+/* The warning on the first frame holding NaN or infinite stresses. */
+static void warn_nonfinite(int tty, const fcm_simulation_counters *c, int frame)
+{
+  if (tty) fputc('\n', stderr);
+  fprintf(stderr,
+          "fcm-sim: warning: frame %d (after step %lld) holds %lld NaN or infinite von Mises "
+          "value%s (points with J = det F <= 0)\n",
+          frame, c->steps, (long long)c->nonfinite_last, c->nonfinite_last == 1 ? "" : "s");
+}
+
 /* Write a checkpoint <dir>/<name>_checkpoint_NNNNNN.fcmck of the current step. */
 static int write_checkpoint(fcm_ctx *ctx, fcm_simulation *sim, const char *dir, const char *name,
                             int quiet)
@@ -340,6 +370,9 @@ static int scene_main(int argc, char **argv)
   fcm_simulation_counters c;
   fcm_simulation_get_counters(sim, &c);
   int frame = (int)c.frames, frames_at_start = frame;
+  /* warn once of each: an earlier run (a resumed checkpoint) may have warned already */
+  int warned_inverted = c.inverted_steps > 0, warned_nonfinite = c.nonfinite_frames > 0;
+  int tty = !o.quiet && isatty(2);
   if (write) {
     if (!make_dirs(dir)) goto done;
     snprintf(logpath, sizeof logpath, "%s/%s_log.csv", dir, name);
@@ -349,7 +382,6 @@ static int scene_main(int argc, char **argv)
       goto done;
     }
   }
-  int tty = !o.quiet && isatty(2);
   double t0 = fcm_wtime();
   long long n = fcm_simulation_num_steps(sim), first = fcm_simulation_step_count(sim);
   while (!fcm_simulation_done(sim)) {
@@ -366,12 +398,21 @@ static int scene_main(int argc, char **argv)
       goto done;
     }
     long long k = fcm_simulation_step_count(sim);
+    if (si.inverted_points > 0 && !warned_inverted) {
+      warn_inverted(tty, &si, k);
+      warned_inverted = 1;
+    }
     if (!o.quiet) progress(tty, k - first, n - first, k, n, &si, fcm_wtime() - t0);
     if (write && fcm_simulation_frame_due(sim)) {
       if (fcm_simulation_write_frame(sim, dir, frame++) != FCM_OK ||
           fcm_simulation_write_log(sim, logpath) != FCM_OK) {
         fcm_ctx_error_view(ctx, stderr);
         goto done;
+      }
+      fcm_simulation_get_counters(sim, &c);
+      if (c.nonfinite_last > 0 && !warned_nonfinite) {
+        warn_nonfinite(tty, &c, frame - 1);
+        warned_nonfinite = 1;
       }
     }
     if (write && fcm_simulation_checkpoint_due(sim) &&

@@ -164,6 +164,10 @@ static const bad_case cases[] = {
      "output.checkpoint_interval: expected an integer in [0, 1000000000], got -1", NULL},
     {"{" BG ", " MAT ", \"solver\": {\"newton\": {\"rule\": \"absolute\"}}}", FCM_ERR_ARG,
      "solver.newton.rule:", "\"representative\""},
+    {"{" BG ", " MAT ", \"solver\": {\"on_inversion\": \"abort\"}}", FCM_ERR_ARG,
+     "solver.on_inversion:", "\"warn\", \"stop\""},
+    {"{" BG ", " MAT ", \"solver\": {\"on_inversion\": true}}", FCM_ERR_ARG,
+     "solver.on_inversion:", NULL},
     /* ---- non-finite: 1e999 parses to infinity */
     {"{" BG ", \"material\": {\"young\": 1e999, \"poisson\": 0.3}}", FCM_ERR_ARG,
      "material.young: expected a finite number > 0, got inf", NULL},

@@ -79,6 +79,7 @@ static void check_full(fcm_ctx *ctx)
   TEST_TRUE(so->newton_rtol == 1e-4 && so->newton_max_iterations == 17);
   TEST_TRUE(so->line_search == 0 && so->project_psd == 1);
   TEST_TRUE(so->representative_acceleration == 10 && so->threads == 3);
+  TEST_TRUE(so->stop_on_inversion == 1);
   TEST_TRUE(so->newton_rule == FCM_NEWTON_TOL_RELATIVE);
 
   const fcm_scene_time *t = fcm_scene_get_time(s);
@@ -176,8 +177,9 @@ static void check_full(fcm_ctx *ctx)
     size_t n = fread(text, 1, sizeof text - 1, f);
     text[n] = '\0';
     fclose(f);
-    const char *words[] = {"full-scene.v1", "tet10",    "tube",     "stvk",      "minres",
-                           "block_jacobi",  "75 steps", "out/full", "effects: 9"};
+    const char *words[] = {
+        "full-scene.v1", "tet10",    "tube",     "stvk",       "minres",
+        "block_jacobi",  "75 steps", "out/full", "effects: 9", "on inversion: stop"};
     for (size_t i = 0; i < sizeof words / sizeof *words; i++)
       TEST_TRUE(strstr(text, words[i]));
     for (int k = 0; k < FCM_EFFECT_TYPE_COUNT; k++)
@@ -218,6 +220,7 @@ static void check_defaults(fcm_ctx *ctx)
   TEST_TRUE(so->newton_rtol == 1e-5 && so->newton_max_iterations == 100);
   TEST_TRUE(so->line_search == 1 && so->project_psd == 0);
   TEST_TRUE(so->representative_acceleration == 9.81 && so->threads == FCM_DEFAULT);
+  TEST_TRUE(so->stop_on_inversion == 0); /* "warn" */
   TEST_TRUE(so->newton_rule == FCM_NEWTON_TOL_AUTO);
   const fcm_scene_time *t = fcm_scene_get_time(s);
   TEST_TRUE(t->integrator == FCM_INTEGRATOR_BACKWARD_EULER && t->dt == 1.0 / 60.0 &&

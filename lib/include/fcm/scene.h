@@ -163,6 +163,12 @@ typedef struct fcm_scene_solver {
                                   (fcm/petsc.h, `fcm-sim --backend petsc`), e.g. "-ksp_type
                                   minres -pc_type jacobi"; the command line wins for a key both
                                   give. NULL (default): none. The serial backend ignores it */
+  int stop_on_inversion;     /**< "on_inversion": what a step that ends with inverted
+                                  quadrature points (J = det F <= 0,
+                                  fcm_step_info.inverted_points) does: "warn" (0, default): the
+                                  run goes on, the log and the summary count them;
+                                  "stop" (1): fcm_simulation_step() returns an error naming the
+                                  step, the time, the count and the first point */
 } fcm_scene_solver;
 
 /** Time stepping ("time"). */

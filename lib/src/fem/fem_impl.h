@@ -231,10 +231,21 @@ int fcm__assembly_inverted_point(fcm_assembly_workspace *ws, fcm_index elem, con
  * displacement, velocity (v may be NULL) of the DOF vectors u, v (replicated) and node_index
  * (the mesh's node), the cell fields process (= rank), cell_index (the mesh's cell), active,
  * volume_fraction and, with mat, stress, von_mises, strain_energy_density (computed here:
- * the kept cells must have their points on this process). Not collective. (fields.c) */
+ * the kept cells must have their points on this process); *nonfinite (may be NULL): the kept
+ * cells whose von_mises is NaN or infinite (0 without mat). Not collective. (fields.c) */
 fcm_status fcm__space_write_vtu_piece(const fcm_space *s, const fcm_material *mat, const double *u,
                                       const double *v, const unsigned char *keep, int rank,
-                                      const char *path);
+                                      const char *path, fcm_index *nonfinite);
+
+/* fcm_space_write_vtu() and fcm_embedded_surface_write_vtu() that also count, in *nonfinite
+ * (may be NULL), the von_mises values they wrote that are NaN or infinite (cells, surface
+ * points; 0 without mat): the stresses of points with J = det F <= 0. (fields.c) */
+fcm_status fcm__space_write_vtu_counted(const fcm_space *s, const fcm_material *mat,
+                                        const double *u, const double *v, const char *path,
+                                        fcm_index *nonfinite);
+fcm_status fcm__embedded_surface_write_vtu_counted(const fcm_embedded_surface *es,
+                                                   const fcm_material *mat, const double *u,
+                                                   const char *path, fcm_index *nonfinite);
 
 /* The mesh nodes of the cells with keep[c] != 0 (keep NULL: all), ascending, each once, in
  * *nodes (allocated with the space's context; free with fcm__free()), their count in *num.

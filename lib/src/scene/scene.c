@@ -76,6 +76,8 @@ static const char *const clamp_names[] = {"clamp", "paper"};
 /* in the order of fcm_fictitious_model */
 static const char *const tangent_names[] = {"projected", "linear", "exact"};
 static const char *const newton_rule_names[] = {"auto", "representative", "relative"};
+/* solver.on_inversion: fcm_scene_solver.stop_on_inversion 0 or 1 */
+static const char *const inversion_names[] = {"warn", "stop"};
 static const int newton_rule_values[] = {FCM_NEWTON_TOL_AUTO, FCM_NEWTON_TOL_REPRESENTATIVE,
                                          FCM_NEWTON_TOL_RELATIVE};
 static const char *const integrator_names[] = {"backward_euler"};
@@ -829,7 +831,7 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   static const char *const keys[] = {
       "method",    "direct",         "preconditioner", "schwarz", "rtol",
       "atol",      "max_iterations", "newton",         "threads", "preconditioner_tangent",
-      "multigrid", "petsc_options"};
+      "multigrid", "petsc_options",  "on_inversion"};
   static const char *const skeys[] = {"threshold", "epsilon", "clamp"};
   static const char *const nkeys[] = {"rtol",        "max_iterations",
                                       "line_search", "project_psd",
@@ -852,6 +854,7 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   s->newton_max_iterations = 100;
   s->line_search = 1;
   s->representative_acceleration = 9.81;
+  s->stop_on_inversion = 0;
   FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "solver", 0, &o));
   if (!o) return FCM_OK;
   ENTER(p, "solver");
@@ -895,6 +898,7 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   if (mg) FCM_TRY(p->ctx, read_multigrid(p, mg, s));
   FCM_TRY(p->ctx, check_multigrid(p, s));
   FCM_TRY(p->ctx, fcm__scene_read_string(p, o, "petsc_options", 0, &s->petsc_options));
+  READ_CHOICE(p, o, "on_inversion", 0, inversion_names, s->stop_on_inversion);
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
@@ -1381,6 +1385,7 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
           CHOICE_NAME(newton_rule_names, newton_rule_values, so->newton_rule), so->newton_rtol,
           so->newton_max_iterations, so->line_search ? "on" : "off", so->project_psd ? "on" : "off",
           so->representative_acceleration, so->threads > 0 ? so->threads : 0);
+  fprintf(f, "on inversion: %s\n", inversion_names[so->stop_on_inversion ? 1 : 0]);
   if (t->integrator == FCM_INTEGRATOR_STATIC)
     fprintf(f, "time: static, %lld step(s) of %g s, %d load step(s) each\n",
             (long long)t->num_steps, t->dt, t->load_steps);
