@@ -1454,7 +1454,9 @@ static void body_displacement_line(const fcm_simulation *S, FILE *f, double body
  * count, the first and the worst (zeros when the body never inverted). */
 static void inversion_lines(FILE *f, const fcm_simulation_counters *c)
 {
-  if (c->inverted_steps == 0) {
+  if (c->inverted_steps == 0 && c->steps == 1) {
+    fprintf(f, "  inversion none: no quadrature point with J = det F <= 0 after the step\n");
+  } else if (c->inverted_steps == 0) {
     fprintf(f,
             "  inversion none: no quadrature point with J = det F <= 0 after any of the %lld "
             "steps\n",
