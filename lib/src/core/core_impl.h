@@ -182,6 +182,17 @@ fcm_status fcm__loop_end(fcm__loop *loop, fcm_index *failed);
   } while (0)
 #endif
 
+/* Largest coordinate magnitude the mesh, geometry and surface readers and constructors
+ * accept: volumes, orientation tests and normals form products of three coordinates (or of
+ * their differences), which overflow to infinity from about 5.6e102 on (squares from about
+ * 1.3e154); beyond 1e100 a coordinate is refused as out of range instead of surfacing later
+ * as a degenerate or non-finite result. */
+#define FCM__COORD_MAX 1e100
+/* The range as messages state it. */
+#define FCM__COORD_RANGE                                                                           \
+  "the supported range [-1e100, 1e100] (larger magnitudes overflow the products of "               \
+  "coordinates in volumes and normals)"
+
 #define FCM_MIN(a, b) ((a) < (b) ? (a) : (b))
 #define FCM_MAX(a, b) ((a) > (b) ? (a) : (b))
 
