@@ -20,9 +20,10 @@ extern "C" {
  * at a time (the caller's); must return a finite value. */
 typedef double (*fcm_level_set_fn)(const double x[3], void *user);
 
-/** Peak bytes fcm_geometry_create_from_level_set() takes per sub-cell the surface crosses
- * (fcm_level_set_info.subcells_cut), everything it builds included: measured 11.4-13.1 kB on
- * spheres and gyroids at refinements 2-32 (about 12 tets per crossed sub-cell). */
+/** Peak bytes fcm_geometry_create_from_level_set() takes per sub-cell it triangulates
+ * (fcm_level_set_info.subcells), everything it builds included: measured 5.5-12.7 kB on
+ * spheres and gyroids at refinements 1-32 (about 12 tets per sub-cell the surface crosses;
+ * the benchmark bench_level_set_memory prints the figures). */
 #define FCM_LEVEL_SET_SUBCELL_BYTES 13000
 
 /** Default of fcm_level_set_options.max_subcells: about 3.9 GB at FCM_LEVEL_SET_SUBCELL_BYTES. */
@@ -47,8 +48,7 @@ typedef struct fcm_level_set_options {
                                are the same); 1: every sub-cube is split on its own */
   fcm_index max_subcells; /**< >= 0: refuse a build (FCM_ERR_UNSUPPORTED, after the cells are
                            classified and before any tet is stored) that would triangulate
-                           more sub-cells than this: those the surface crosses (with
-                           refine_inside: every sub-cube of the cut and inside cells); 0: no
+                           more sub-cells (fcm_level_set_info.subcells) than this; 0: no
                            limit; default FCM_LEVEL_SET_MAX_SUBCELLS */
   fcm_level_set_progress_fn progress; /**< NULL (default): none; else called with the sub-cells
                            marched so far, at most every progress_interval seconds, and once
@@ -66,9 +66,11 @@ typedef struct fcm_level_set_info {
   fcm_index cells_cut;     /**< cells where phi changes sign at the samples (refined) */
   fcm_index cells_outside; /**< cells with every sample outside */
   fcm_index num_tets;      /**< tets of the geometry */
-  fcm_index subcells_cut;  /**< sub-cells of the cut cells where phi changes sign at the
-                                corners (the surface crosses them): the estimate checked
-                                against max_subcells */
+  fcm_index subcells;      /**< the sub-cells the build triangulates, the estimate checked
+                                against max_subcells: those of the cut cells where phi
+                                changes sign at the corners (the surface crosses them), plus
+                                one per cell wholly inside (6 tets); with refine_inside r^3
+                                per cut or inside cell */
   double h;                /**< largest sub-cell edge: max_d (hi - lo)_d / (n_d r) */
   double volume;           /**< volume of the geometry */
   double volume_fine;      /**< the volume with the cells cut at refinement r sampled at 2r

@@ -475,17 +475,20 @@ fcm_status fcm_geometry_create_from_level_set(fcm_ctx *ctx, fcm_level_set_fn phi
         inf.cells_inside += kind == CELL_INSIDE;
         inf.cells_cut += kind == CELL_CUT;
         inf.cells_outside += kind == CELL_OUTSIDE;
-        inf.subcells_cut += cut;
+        inf.subcells += cut;
       }
-  /* refine_inside: every sub-cube of an inside cell and the inside ones of a cut cell are
-   * split on their own, counted alike */
-  const fcm_index estimate =
-      o.refine_inside ? (inf.cells_cut + inf.cells_inside) * r3 : inf.subcells_cut;
+  /* a cell wholly inside becomes 6 tets: counted as one sub-cell (about half the memory of
+   * one the surface crosses); refine_inside: every sub-cube of a cut or inside cell is split
+   * on its own, counted alike */
+  inf.subcells =
+      o.refine_inside ? (inf.cells_cut + inf.cells_inside) * r3 : inf.subcells + inf.cells_inside;
+  const fcm_index estimate = inf.subcells;
   FCM_CHECK(o.max_subcells == 0 || estimate <= o.max_subcells, ctx, FCM_ERR_UNSUPPORTED,
-            "level set: the build would triangulate %lld sub-cells (%lld cut cells at refinement "
-            "%d; about %.3g GB at %d kB each), more than max_subcells = %lld (about %.3g GB); "
-            "raise max_subcells (0: no limit), or lower the refinement or the sampling cells",
-            (long long)estimate, (long long)inf.cells_cut, r,
+            "level set: the build would triangulate %lld sub-cells (%lld cut and %lld inside "
+            "cells at refinement %d; about %.3g GB at %d kB each), more than max_subcells = %lld "
+            "(about %.3g GB); raise max_subcells (0: no limit), or lower the refinement or the "
+            "sampling cells",
+            (long long)estimate, (long long)inf.cells_cut, (long long)inf.cells_inside, r,
             (double)estimate * FCM_LEVEL_SET_SUBCELL_BYTES / 1e9,
             FCM_LEVEL_SET_SUBCELL_BYTES / 1000, (long long)o.max_subcells,
             (double)o.max_subcells * FCM_LEVEL_SET_SUBCELL_BYTES / 1e9);
