@@ -31,8 +31,8 @@ typedef struct fcm_voxel_image fcm_voxel_image;
  *                   selected)
  * @param[out] img   the image, NULL on failure
  * @return FCM_OK, FCM_ERR_ARG (NULL, bad dims, singular or non-finite axes/origin, voxels
- *         reaching beyond +-1e50), FCM_ERR_ALLOC. Allocates; release with
- * fcm_voxel_image_destroy(). */
+ *         reaching beyond +-1e50), FCM_ERR_ALLOC.
+ * Allocates; release with fcm_voxel_image_destroy(). */
 FCM_API fcm_status fcm_voxel_image_create(fcm_ctx *ctx, const fcm_index dims[3],
                                           const double axes[9], const double origin[3],
                                           const double *values, fcm_voxel_image **img);
