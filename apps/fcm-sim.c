@@ -227,7 +227,8 @@ static void geometry_progress(fcm_index done, fcm_index total, void *user)
 
 /* The library's warnings (FCM_LOG_WARNING: NaN voxels, holes filled, solver fallbacks) on
  * stderr, the first SIM_MAX_WARNINGS of them (all with --debug); errors are printed where
- * they end the run. */
+ * they end the run. Called from the library's OpenMP threads too (a simplification
+ * fallback inside the cell loop): the count is atomic. */
 #define SIM_MAX_WARNINGS 10
 typedef struct warn_state {
   int all;     /* --debug: print every warning */
@@ -238,10 +239,12 @@ static void print_warning(void *user, fcm_log_level level, const char *msg)
 {
   warn_state *ws = user;
   if (level != FCM_LOG_WARNING) return;
-  ws->n++;
-  if (ws->all || ws->n <= SIM_MAX_WARNINGS)
+  long long k;
+#pragma omp atomic capture
+  k = ++ws->n;
+  if (ws->all || k <= SIM_MAX_WARNINGS)
     fprintf(stderr, "fcm-sim: warning: %s\n", msg);
-  else if (ws->n == SIM_MAX_WARNINGS + 1)
+  else if (k == SIM_MAX_WARNINGS + 1)
     fprintf(stderr, "fcm-sim: warning: further warnings are not printed (--debug prints all)\n");
 }
 
