@@ -63,8 +63,8 @@ static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS
        "print the scene with every default filled in and exit", 0, 0, 0, NULL, NULL, NULL},
       {"--quiet", "-q", CLI_FLAG, &o->quiet, NULL, "print only errors", 0, 0, 0, NULL, NULL, NULL},
       {"--progress", NULL, CLI_FLAG, &o->progress, NULL,
-       "report the cell-rule build also when stderr is not a\n"
-       "terminal (a line every 2 s; on a terminal: a bar)",
+       "report the level-set and cell-rule builds also when stderr\n"
+       "is not a terminal (a line every 2 s; on a terminal: a bar)",
        0, 0, 0, NULL, NULL, NULL},
       {"--debug", NULL, CLI_FLAG, &o->debug, NULL,
        "print the library's traceback with errors, and every\n"
