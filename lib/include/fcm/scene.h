@@ -96,7 +96,9 @@ typedef struct fcm_scene_geometry {
   const fcm_implicit *implicit; /**< LEVEL_SET: the implicit tree, root last */
   int num_implicit;             /**< LEVEL_SET: nodes, [1, FCM_IMPLICIT_MAX_NODES] */
   int refinement;               /**< LEVEL_SET: sub-cells per cut cell edge (default 4) */
-  int has_box; /**< LEVEL_SET: 1: sampled on min/max/cells; 0: on the background grid */
+  int has_box;            /**< LEVEL_SET: 1: sampled on min/max/cells; 0: on the background grid */
+  fcm_index max_subcells; /**< LEVEL_SET: fcm_level_set_options.max_subcells (default
+                               FCM_LEVEL_SET_MAX_SUBCELLS; 0: no limit) */
 } fcm_scene_geometry;
 
 /** Quadrature settings ("quadrature"). The enums and option structs are the library's own

@@ -28,10 +28,15 @@ typedef struct fcm_simulation_options {
   int checkpoint_interval; /**< >= 0: fcm_simulation_checkpoint_due() every n-th step (0:
                                 never); FCM_DEFAULT (default): the scene's
                                 output.checkpoint_interval */
-  fcm_cell_rules_progress_fn rules_progress; /**< progress of the cell rules build
-                                (fcm_cell_rules_options.progress); NULL (default): none */
-  void *rules_progress_user;                 /**< its argument; default NULL */
-  double rules_progress_interval;            /**< seconds between calls, >= 0; default 0.1 */
+  fcm_cell_rules_progress_fn rules_progress;   /**< progress of the cell rules build
+                                  (fcm_cell_rules_options.progress); NULL (default): none */
+  void *rules_progress_user;                   /**< its argument; default NULL */
+  double rules_progress_interval;              /**< seconds between calls, >= 0; default 0.1
+                                                    (also of geometry_progress) */
+  fcm_level_set_progress_fn geometry_progress; /**< progress of building a level-set geometry
+                                (fcm_level_set_options.progress: sub-cells marched); NULL
+                                (default): none */
+  void *geometry_progress_user;                /**< its argument; default NULL */
 } fcm_simulation_options;
 
 /** Defaults as documented on each member. */

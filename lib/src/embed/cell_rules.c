@@ -1487,6 +1487,7 @@ fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const f
             (long long)fcm_mesh_num_cells(mesh), (long long)prev->num_cells);
   FCM_CHECK(prev->num_cuts < 1 << 20, ctx, FCM_ERR_UNSUPPORTED,
             "embed cut: %d cuts already (limit 2^20)", prev->num_cuts);
+  FCM_TRY(ctx, fcm__embed_cut_check(ctx, cut, "embed cut"));
   const fcm_index nt = fcm_surface_num_triangles(cut);
   const double *x = fcm_surface_coords(cut);
   const fcm_index *tv = fcm_surface_triangles(cut);

@@ -289,6 +289,11 @@ double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
 int fcm__embed_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n, const double *x,
                       int m, double tol);
 
+/* FCM_ERR_GEOMETRY when every triangle of the cut surface has no area (as
+ * fcm__embed_cut_tri_setup() judges it): such a cut separates nothing. The message starts
+ * with `what` and gives the count and the first triangle's vertices. No allocation. */
+fcm_status fcm__embed_cut_check(fcm_ctx *ctx, const fcm_surface *cut, const char *what);
+
 /* The embedding diagnostics of the statistics S (geometry, embedded and sliver volumes
  * already set): bounding boxes, volume ratio, the volume outside the mesh and beyond each
  * face of its bounding box. FCM_ERR_GEOMETRY, with both bounding boxes, when a geometry of

@@ -10,6 +10,7 @@
 
 #include "core/core_impl.h"
 #include "fcm/geom.h"
+#include "fcm/levelset.h"
 
 struct fcm_geometry {
   fcm_ctx *ctx;
@@ -56,6 +57,13 @@ fcm_status fcm__geom_create_take(fcm_ctx *ctx, const char *who, fcm_element_type
 fcm_status fcm__geom_create_subset(fcm_ctx *ctx, const fcm_geometry *g,
                                    const unsigned char *keep_cell, const unsigned char *keep_tri,
                                    fcm_geometry **out);
+
+/* 1 when the sampling spacing h resolves the smallest feature of implicit node q (the rule
+ * of fcm_implicit_check_spacing()); else 0 with *key the member that sets the feature (its
+ * scene key; NULL for a box, whose message names the side) and `msg` the reason with the
+ * value and h. CSG nodes are always resolved. */
+int fcm__implicit_resolved(const fcm_implicit *q, double h, const char **key, char *msg,
+                           size_t len);
 
 /* Bytes of the geometry's arrays (coordinates, cells, triangles, maps) and struct. */
 double fcm__geom_bytes(const fcm_geometry *g);

@@ -302,10 +302,14 @@ static fcm_status build_voxels(fcm_simulation *S, const fcm_scene_geometry *g, f
   FCM_TRY(S->ctx, fcm_geometry_create_from_voxels(S->ctx, img, &vo, raw, &info));
   fcm_index d[3];
   fcm_voxel_image_dims(img, d);
+  char nan_note[64] = "";
+  if (info.num_nan > 0)
+    snprintf(nan_note, sizeof nan_note, "; %lld NaN values counted as outside",
+             (long long)info.num_nan);
   snprintf(S->geometry_note, sizeof S->geometry_note,
-           "voxels: %lld of %lld x %lld x %lld selected, merged into %lld boxes",
+           "voxels: %lld of %lld x %lld x %lld selected, merged into %lld boxes%s",
            (long long)info.num_selected, (long long)d[0], (long long)d[1], (long long)d[2],
-           (long long)info.num_boxes);
+           (long long)info.num_boxes, nan_note);
 cleanup:
   fcm_voxel_image_destroy(&img);
   return st;
@@ -319,6 +323,10 @@ static fcm_status build_level_set(fcm_simulation *S, const fcm_scene_geometry *g
   fcm_level_set_options lo = fcm_level_set_options_default();
   fcm_level_set_info info;
   lo.refinement = g->refinement;
+  lo.max_subcells = g->max_subcells;
+  lo.progress = S->opts.geometry_progress;
+  lo.progress_user = S->opts.geometry_progress_user;
+  lo.progress_interval = S->opts.rules_progress_interval;
   FCM_TRY(S->ctx, fcm_implicit_check(S->ctx, &tree));
   FCM_TRY(S->ctx, fcm_geometry_create_from_level_set(S->ctx, fcm_implicit_eval, &tree, g->min,
                                                      g->max, g->cells, &lo, raw, &info));
@@ -764,6 +772,7 @@ static fcm_status collect_cuts(fcm_simulation *S)
     if (e->cut.kind == FCM_CUT_MESH) { /* read it now: a bad file fails before the run */
       fcm_surface *probe = NULL;
       st = fcm_surface_create_from_file(ctx, e->cut.mesh, &probe);
+      if (st == FCM_OK) st = fcm__embed_cut_check(ctx, probe, e->cut.mesh);
       fcm_surface_destroy(&probe);
       if (st != FCM_OK) {
         char section[64];

@@ -2,6 +2,7 @@
  * in effects.c), the accessors and the normalized summary printed by fcm_scene_view(). */
 #define _POSIX_C_SOURCE 200809L
 #include "scene/scene_impl.h"
+#include "geom/geom_impl.h"
 
 #include <errno.h>
 #include <stdalign.h>
@@ -331,8 +332,8 @@ static const char *const implicit_names[] = {"sphere", "torus",        "box",   
 /* One implicit (an object with one member named by its kind) at the current path into
  * nodes[*n ...]; *root is the index of its node. CSG arrays of k >= 2 operands fold left:
  * ((a op b) op c) ... */
-static fcm_status read_implicit(fcm__scene_parser *p, const fcm__json *node, fcm_implicit *nodes,
-                                int *n, int *root)
+static fcm_status read_implicit(fcm__scene_parser *p, const fcm__json *node, double h,
+                                fcm_implicit *nodes, int *n, int *root)
 {
   fcm_status st = FCM_OK;
   static const char *const sphere_keys[] = {"center", "radius"};
@@ -365,7 +366,7 @@ static fcm_status read_implicit(fcm__scene_parser *p, const fcm__json *node, fcm
     for (const fcm__json *c = fcm__json_child(m); c; c = fcm__json_next(c), i++) {
       size_t o2 = fcm__scene_path_push_index(p, i);
       int ci = -1;
-      FCM_TRY(p->ctx, read_implicit(p, c, nodes, n, &ci));
+      FCM_TRY(p->ctx, read_implicit(p, c, h, nodes, n, &ci));
       fcm__scene_path_pop(p, o2);
       if (r < 0) {
         r = ci;
@@ -426,6 +427,13 @@ static fcm_status read_implicit(fcm__scene_parser *p, const fcm__json *node, fcm
     default:
       break;
     }
+    /* a feature below the sampling spacing only samples noise: refused before building */
+    char why[512];
+    const char *feature;
+    if (!fcm__implicit_resolved(&q, h, &feature, why, sizeof why)) {
+      if (feature) fcm__scene_path_push_key(p, feature);
+      SCENE_CHECK(0, p, FCM_ERR_ARG, "%s", why);
+    }
     nodes[*n] = q;
     *root = (*n)++;
   }
@@ -477,13 +485,12 @@ static fcm_status read_level_set(fcm__scene_parser *p, const fcm__json *o, fcm_s
   fcm_implicit *nodes = fcm__scene_alloc(p->scene, FCM_IMPLICIT_MAX_NODES, sizeof *nodes);
   FCM_CHECK(nodes, p->ctx, FCM_ERR_ALLOC, "scene: out of memory");
   int n = 0, root = -1;
-  ENTER(p, "level_set");
-  FCM_TRY(p->ctx, read_implicit(p, fcm__json_member(o, "level_set"), nodes, &n, &root));
-  fcm__scene_path_pop(p, old);
-  g->implicit = nodes;
-  g->num_implicit = n;
   g->refinement = 4;
   READ_INT(p, o, "refinement", 0, 1, 64, g->refinement);
+  long long max_subcells = FCM_LEVEL_SET_MAX_SUBCELLS;
+  FCM_TRY(p->ctx,
+          fcm__scene_read_int(p, o, "max_subcells", 0, 0, (long long)1 << 50, &max_subcells));
+  g->max_subcells = (fcm_index)max_subcells;
   const int nbox =
       !!fcm__json_member(o, "min") + !!fcm__json_member(o, "max") + !!fcm__json_member(o, "cells");
   SCENE_CHECK(nbox == 0 || nbox == 3, p, FCM_ERR_ARG,
@@ -510,6 +517,15 @@ static fcm_status read_level_set(fcm__scene_parser *p, const fcm__json *o, fcm_s
     memcpy(g->max, b->max, sizeof g->max);
     memcpy(g->cells, b->cells, sizeof g->cells);
   }
+  /* the sampling spacing (fcm_level_set_info.h) every feature of the tree must resolve */
+  double h = 0.0;
+  for (int d = 0; d < 3; d++)
+    h = fmax(h, (g->max[d] - g->min[d]) / ((double)g->cells[d] * g->refinement));
+  ENTER(p, "level_set");
+  FCM_TRY(p->ctx, read_implicit(p, fcm__json_member(o, "level_set"), h, nodes, &n, &root));
+  fcm__scene_path_pop(p, old);
+  g->implicit = nodes;
+  g->num_implicit = n;
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
@@ -549,9 +565,10 @@ static fcm_status read_geometry(fcm__scene_parser *p, const fcm__json *root)
                                          "labels",
                                          "merge",
                                          "level_set",
-                                         "refinement"};
+                                         "refinement",
+                                         "max_subcells"};
   static const char *const voxel_keys[] = {"voxels", "threshold", "labels", "merge", "transform"};
-  static const char *const level_set_keys[] = {"level_set", "refinement", "min",
+  static const char *const level_set_keys[] = {"level_set", "refinement", "max_subcells", "min",
                                                "max",       "cells",      "transform"};
   static const char *const box_keys[] = {"shape", "min", "max", "cells", "transform"};
   static const char *const ball_keys[] = {"shape", "center", "radius", "resolution", "transform"};
