@@ -635,6 +635,11 @@ static fcm_status run_substep(fcm_integrator *I, int dyn, double h, double t1,
 {
   fcm_status st = FCM_OK;
   fcm__sim_eval_constraints(I, t1);
+  if (!dyn && I->rigid_ok != I->con_version + 1) {
+    /* no mass: a body the constraints leave free makes every Newton matrix singular */
+    FCM_TRY(I->ctx, fcm__sim_check_rigid_modes(I, t1));
+    I->rigid_ok = I->con_version + 1;
+  }
   memcpy(I->un, I->u, sizeof(double) * (size_t)I->n);
   if (dyn && I->D && (!I->linear || I->damp_version == 0))
     FCM_TRY(I->ctx, update_damping(I, reason, stats));
