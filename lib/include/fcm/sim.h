@@ -142,6 +142,12 @@ typedef struct fcm_integrator_options {
   double krylov_rtol;                          /**< in [0, 1) (default 1e-8) */
   double krylov_atol;                          /**< >= 0 (default 0) */
   int krylov_max_iterations;                   /**< >= 1 (default 1000) */
+  int krylov_stagnation_window;  /**< CG and MINRES: stop a solve whose smallest residual dropped
+                                      by less than 0.1 % in this many iterations
+                                      (fcm_krylov_options.stagnation_window; >= 0, default 50,
+                                      0: off). Its iterate is still used when finite and
+                                      nonzero; when the Newton iteration then fails, the step's
+                                      reason is FCM_STEP_LINEAR_SOLVER_STAGNATED */
   double schwarz_theta;          /**< cut cells with volume fraction below it get a block, (0, 1]
                                       (default 0.5) */
   fcm_schwarz_options schwarz;   /**< default fcm_schwarz_options_default() */
@@ -169,11 +175,19 @@ typedef enum fcm_step_reason {
                                       no descent direction */
   FCM_STEP_LINEAR_SOLVER_FAILED, /**< direct: both factorizations failed; Krylov: no usable
                                       iterate */
-  FCM_STEP_NONFINITE             /**< NaN/Inf in a load, the energy, the gradient or a solve */
+  FCM_STEP_NONFINITE,            /**< NaN/Inf in a load, the energy, the gradient or a solve */
+  /** The linear solver stopped making progress — a Krylov solve stagnated
+   * (krylov_stagnation_window) or broke down, or the multigrid cycles stalled — and Newton
+   * could not go on with its result (no usable iterate, no descent, no sufficient decrease,
+   * or newton_max_iterations with such a solve last): the Newton matrix is singular or
+   * nearly so (rigid-body modes no constraint holds, which a static step checks before any
+   * solve; a body held at too few points) or, for CG, not positive definite */
+  FCM_STEP_LINEAR_SOLVER_STAGNATED
 } fcm_step_reason;
 
 /** Name of a reason ("converged", "max-newton", "line-search-failed",
- * "linear-solver-failed", "nonfinite", "none"), or "unknown". Static string. */
+ * "linear-solver-failed", "nonfinite", "linear-solver-stagnated", "none"), or "unknown".
+ * Static string. */
 FCM_API const char *fcm_step_reason_name(fcm_step_reason reason);
 
 /** What one fcm_integrator_step() did. Per-step counts cover every attempt of the step;

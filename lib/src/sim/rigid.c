@@ -127,6 +127,12 @@ static fcm_status body_free_modes(fcm_ctx *ctx, const rigid_body *b, int *ft, in
     }
     const double cr[3] = {om[1] * t[2] - om[2] * t[1], om[2] * t[0] - om[0] * t[2],
                           om[0] * t[1] - om[1] * t[0]};
+    int big = 0; /* the sign of an eigenvector is arbitrary: its largest component positive */
+    for (int d = 1; d < 3; d++)
+      if (fabs(om[d]) > fabs(om[big])) big = d;
+    if (om[big] < 0.0)
+      for (int d = 0; d < 3; d++)
+        om[d] = -om[d], t[d] = -t[d];
     for (int d = 0; d < 3; d++) {
       p[d] = wn > 0.0 ? c[d] + cr[d] / wn : c[d];
       a[d] = wn > 0.0 ? om[d] / sqrt(wn) : 0.0;

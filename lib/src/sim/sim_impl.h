@@ -141,6 +141,10 @@ struct fcm_integrator {
   long long mg_con;
   long long mg_applies;
   double *mg_r;
+  /* the last linear solve stagnated or broke down (linsolve.c; newton.c names it as the
+   * failure's reason when Newton cannot go on), and the solver's message */
+  int solve_stalled;
+  char stall_msg[320];
 
   /* Newton matrix cache: H holds base(h) + K(u) (state TANGENT, unmodified) or the
    * eliminated system with a valid factor / preconditioner (state SYSTEM, key below). */
