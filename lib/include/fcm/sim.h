@@ -36,7 +36,9 @@ extern "C" {
 
 /** Integrator kinds. */
 typedef enum fcm_integrator_kind {
-  FCM_INTEGRATOR_STATIC = 0,        /**< equilibrium Psi'(u) = f_ext, load steps, no inertia */
+  FCM_INTEGRATOR_STATIC = 0,        /**< equilibrium Psi'(u) = f_ext, load steps, no inertia;
+                                         the constraints must hold every body's rigid-body
+                                         modes (checked by fcm_integrator_step()) */
   FCM_INTEGRATOR_BACKWARD_EULER = 1 /**< implicit Euler on the incremental potential */
 } fcm_integrator_kind;
 
@@ -431,10 +433,22 @@ FCM_API fcm_status fcm_integrator_setup(fcm_integrator *integ);
  * needed; the multigrid hierarchy then and again whenever the active constrained DOFs
  * change. Later steps allocate nothing through the context (test sim_step_alloc_*);
  * CHOLMOD's and UMFPACK's numeric factorizations allocate internally (SuiteSparse's malloc).
+ * STATIC: before the first solve, and again whenever the active set of constraints changes
+ * (a release), the active constraints must hold the six rigid-body modes of every body of the
+ * space (fcm_space_num_bodies(): cuts separate bodies); a body is held by its constrained
+ * DOFs and its points of active boundary constraints, in their components, when the rigid
+ * motions that vanish there are only the zero motion (the rank of the modes restricted to
+ * them is 6; e.g. three non-collinear nodes in all components). Else the step is refused
+ * with FCM_ERR_SINGULAR before anything is solved or factored, the message naming the first
+ * free body (index, box of its nodes), what holds it and the free modes. This allocates
+ * O(elements + DOFs) scratch through the context. Dynamic steps are not checked (the mass
+ * holds every mode).
  * @param[out] info may be NULL
  * @return FCM_OK; FCM_ERR_NOT_CONVERGED (info->reason says why; the message gives the time,
- * the residual and the tolerance); FCM_ERR_NUMERIC (NaN/Inf in a load, or the last attempt
- * met NaN/Inf); FCM_ERR_ARG (not set up); FCM_ERR_ALLOC and other hard errors. */
+ * the residual and the tolerance); FCM_ERR_SINGULAR (STATIC: a free body, as above; a
+ * direct solver that finds the Newton matrix singular); FCM_ERR_NUMERIC (NaN/Inf in a load,
+ * or the last attempt met NaN/Inf); FCM_ERR_ARG (not set up); FCM_ERR_ALLOC and other hard
+ * errors. */
 FCM_API fcm_status fcm_integrator_step(fcm_integrator *integ, fcm_step_info *info);
 
 /** Number of DOFs (the length of u and v). */

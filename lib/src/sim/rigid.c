@@ -144,32 +144,50 @@ cleanup:
   return st;
 }
 
-/* The per-body data: bounding boxes, tied elements, the boundary-constraint rows (summed over
- * the processes with a backend: each holds the points of its own cells) and the node rows
- * (replicated: every process adds them itself). */
-static fcm_status gather(fcm_integrator *I, const fcm_index *elem_body, const fcm_index *copy_node,
-                         fcm_index *copy_body, unsigned char *held, rigid_body *B, fcm_index nb)
+/* What the check builds: the bodies (element -> body, copy -> node and body) and their data. */
+typedef struct rigid_work {
+  fcm_index *elem_body, *copy_node, *copy_body, nb;
+  unsigned char *held; /* per copy: its constrained components */
+  rigid_body *B;
+  double *sum; /* with a backend: the summed boundary parts, 40 per body */
+} rigid_work;
+
+/* Local phase: the bodies, their bounding boxes and tied elements, and the rows of this
+ * process's boundary-constraint points (a distributed run's own cells hold them). */
+static fcm_status local_rows(fcm_integrator *I, rigid_work *w)
 {
   fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
   const fcm_space *s = I->space;
   const fcm_mesh *mesh = fcm_space_mesh(s);
   const double *X = fcm_mesh_coords(mesh);
   const fcm_index *cells = fcm_mesh_cells(mesh), ncopy = s->num_dofs / 3;
   const int nn = s->nn;
-  for (fcm_index b = 0; b < nb; b++)
+  FCM_ALLOC(ctx, s->num_elems + 1, w->elem_body);
+  FCM_ALLOC(ctx, ncopy + 1, w->copy_node);
+  FCM_ALLOC(ctx, ncopy + 1, w->copy_body);
+  FCM_ALLOC(ctx, ncopy + 1, w->held);
+  FCM_TRY(ctx, fcm__space_body_labels(s, w->elem_body, &w->nb));
+  FCM_ALLOC(ctx, w->nb + 1, w->B);
+  if (I->has_backend) FCM_ALLOC(ctx, 40 * (size_t)w->nb + 1, w->sum);
+  rigid_body *B = w->B;
+  for (fcm_index node = 0; node < s->num_nodes; node++)
+    for (fcm_index c = 0; s->node_dof[node] >= 0 && c < s->node_ncopy[node]; c++)
+      w->copy_node[s->node_dof[node] / 3 + c] = node;
+  for (fcm_index b = 0; b < w->nb; b++)
     for (int d = 0; d < 3; d++) {
       B[b].lo[d] = HUGE_VAL;
       B[b].hi[d] = -HUGE_VAL;
     }
   for (fcm_index k = 0; k < ncopy; k++)
-    copy_body[k] = -1;
+    w->copy_body[k] = -1;
   for (fcm_index e = 0; e < s->num_elems; e++)
     for (int a = 0; a < nn; a++) {
-      const fcm_index k = s->elem_dof[e * nn + a] / 3, b = elem_body[e];
-      copy_body[k] = b;
-      if (copy_node[k] != cells[s->elem_cell[e] * nn + a]) B[b].tied = 1;
+      const fcm_index k = s->elem_dof[e * nn + a] / 3, b = w->elem_body[e];
+      w->copy_body[k] = b;
+      if (w->copy_node[k] != cells[s->elem_cell[e] * nn + a]) B[b].tied = 1;
       for (int d = 0; d < 3; d++) {
-        const double x = X[3 * copy_node[k] + d];
+        const double x = X[3 * w->copy_node[k] + d];
         B[b].lo[d] = x < B[b].lo[d] ? x : B[b].lo[d];
         B[b].hi[d] = x > B[b].hi[d] ? x : B[b].hi[d];
       }
@@ -177,7 +195,7 @@ static fcm_status gather(fcm_integrator *I, const fcm_index *elem_body, const fc
   const sim_bpoints *bp = &I->bp;
   if (I->bcon_active > 0)
     for (fcm_index k = 0; k < bp->nelem; k++) {
-      rigid_body *b = &B[elem_body[bp->elem[k]]];
+      rigid_body *b = &B[w->elem_body[bp->elem[k]]];
       double c[3], L;
       centre_scale(b, c, &L);
       for (fcm_index p = bp->ptr[k]; p < bp->ptr[k + 1]; p++) {
@@ -188,71 +206,74 @@ static fcm_status gather(fcm_integrator *I, const fcm_index *elem_body, const fc
         b->bpoints++;
       }
     }
-  if (I->has_backend) { /* sum the boundary parts: 36 + 4 values per body */
-    double *v = NULL;
-    FCM_ALLOC(I->ctx, 40 * (size_t)nb + 1, v);
-    for (fcm_index b = 0; b < nb; b++) {
-      memcpy(v + 40 * b, B[b].G, sizeof B[b].G);
-      for (int i = 0; i < 3; i++)
-        v[40 * b + 36 + i] = (double)B[b].rows[i];
-      v[40 * b + 39] = (double)B[b].bpoints;
-    }
-    st = fcm__integrator_reduce(I, v, 40 * nb);
-    for (fcm_index b = 0; st == FCM_OK && b < nb; b++) {
-      memcpy(B[b].G, v + 40 * b, sizeof B[b].G);
-      for (int i = 0; i < 3; i++)
-        B[b].rows[i] = (fcm_index)v[40 * b + 36 + i];
-      B[b].bpoints = (fcm_index)v[40 * b + 39];
-    }
-    fcm__free(I->ctx, v);
-    FCM_TRY(I->ctx, st);
-  }
-  for (fcm_index j = 0; j < I->nact; j++) {
-    const fcm_index dof = I->act_dof[j], k = dof / 3;
-    if (copy_body[k] < 0) continue; /* a copy no element uses holds nothing */
-    rigid_body *b = &B[copy_body[k]];
-    double c[3], L;
-    centre_scale(b, c, &L);
-    add_row(b, (int)(dof % 3), X + 3 * copy_node[k], c, L);
-    held[k]++;
-  }
-  for (fcm_index k = 0; k < ncopy; k++)
-    if (held[k] > 0 && copy_body[k] >= 0) {
-      if (held[k] == 3)
-        B[copy_body[k]].full++;
-      else
-        B[copy_body[k]].part++;
-    }
 cleanup:
   return st;
+}
+
+/* With a backend: agree on the local phase's status and sum the boundary parts over the
+ * processes (36 + 4 values per body; the body numbering is the same everywhere). Collective:
+ * every process calls it, whatever its local status. */
+static fcm_status sum_boundary(fcm_integrator *I, fcm_status st, rigid_work *w)
+{
+  double *v = w->sum;
+  if (st == FCM_OK)
+    for (fcm_index b = 0; b < w->nb; b++) {
+      memcpy(v + 40 * b, w->B[b].G, sizeof w->B[b].G);
+      for (int i = 0; i < 3; i++)
+        v[40 * b + 36 + i] = (double)w->B[b].rows[i];
+      v[40 * b + 39] = (double)w->B[b].bpoints;
+    }
+  st = fcm__integrator_reduce_status(I, st, st == FCM_OK ? v : NULL, st == FCM_OK ? 40 * w->nb : 0);
+  if (st != FCM_OK) return st;
+  for (fcm_index b = 0; b < w->nb; b++) {
+    memcpy(w->B[b].G, v + 40 * b, sizeof w->B[b].G);
+    for (int i = 0; i < 3; i++)
+      w->B[b].rows[i] = (fcm_index)v[40 * b + 36 + i];
+    w->B[b].bpoints = (fcm_index)v[40 * b + 39];
+  }
+  return FCM_OK;
+}
+
+/* The rows of the active constrained DOFs (the same on every process) and the held counts. */
+static void node_rows(fcm_integrator *I, rigid_work *w)
+{
+  const double *X = fcm_mesh_coords(fcm_space_mesh(I->space));
+  const fcm_index ncopy = I->space->num_dofs / 3;
+  for (fcm_index j = 0; j < I->nact; j++) {
+    const fcm_index dof = I->act_dof[j], k = dof / 3;
+    if (w->copy_body[k] < 0) continue; /* a copy no element uses holds nothing */
+    rigid_body *b = &w->B[w->copy_body[k]];
+    double c[3], L;
+    centre_scale(b, c, &L);
+    add_row(b, (int)(dof % 3), X + 3 * w->copy_node[k], c, L);
+    w->held[k]++;
+  }
+  for (fcm_index k = 0; k < ncopy; k++)
+    if (w->held[k] > 0 && w->copy_body[k] >= 0) {
+      if (w->held[k] == 3)
+        w->B[w->copy_body[k]].full++;
+      else
+        w->B[w->copy_body[k]].part++;
+    }
 }
 
 fcm_status fcm__sim_check_rigid_modes(fcm_integrator *I, double t)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = I->ctx;
-  const fcm_space *s = I->space;
-  const fcm_index ncopy = s->num_dofs / 3;
-  fcm_index *elem_body = NULL, *copy_node = NULL, *copy_body = NULL, nb = 0;
-  unsigned char *held = NULL;
-  rigid_body *B = NULL;
-  FCM_ALLOC(ctx, s->num_elems + 1, elem_body);
-  FCM_ALLOC(ctx, ncopy + 1, copy_node);
-  FCM_ALLOC(ctx, ncopy + 1, copy_body);
-  FCM_ALLOC(ctx, ncopy + 1, held);
-  FCM_TRY(ctx, fcm__space_body_labels(s, elem_body, &nb));
-  for (fcm_index node = 0; node < s->num_nodes; node++)
-    for (fcm_index c = 0; s->node_dof[node] >= 0 && c < s->node_ncopy[node]; c++)
-      copy_node[s->node_dof[node] / 3 + c] = node;
-  FCM_ALLOC(ctx, nb + 1, B);
-  FCM_TRY(ctx, gather(I, elem_body, copy_node, copy_body, held, B, nb));
+  rigid_work w;
+  memset(&w, 0, sizeof w);
+  st = local_rows(I, &w);
+  if (I->has_backend) st = sum_boundary(I, st, &w);
+  FCM_TRY(ctx, st);
+  node_rows(I, &w);
   fcm_index bad = -1, nbad = 0;
   int ft = 0, fr = 0;
   double p[3] = {0, 0, 0}, a[3] = {0, 0, 0};
-  for (fcm_index b = 0; b < nb; b++) {
+  for (fcm_index b = 0; b < w.nb; b++) {
     int t_free = 0, r_free = 0;
     double pb[3] = {0, 0, 0}, ab[3] = {0, 0, 0};
-    FCM_TRY(ctx, body_free_modes(ctx, &B[b], &t_free, &r_free, pb, ab));
+    FCM_TRY(ctx, body_free_modes(ctx, &w.B[b], &t_free, &r_free, pb, ab));
     if (t_free + r_free == 0) continue;
     if (nbad++ == 0) {
       bad = b;
@@ -263,7 +284,7 @@ fcm_status fcm__sim_check_rigid_modes(fcm_integrator *I, double t)
     }
   }
   if (bad >= 0) {
-    const rigid_body *b = &B[bad];
+    const rigid_body *b = &w.B[bad];
     char modes[96], held_s[256], axis[192] = "", more[96] = "";
     free_modes(modes, sizeof modes, ft, fr);
     held_by(held_s, sizeof held_s, b);
@@ -273,7 +294,7 @@ fcm_status fcm__sim_check_rigid_modes(fcm_integrator *I, double t)
                p[2], a[0], a[1], a[2]);
     if (nbad > 1)
       snprintf(more, sizeof more, " (%lld of the %lld bodies are free)", (long long)nbad,
-               (long long)nb);
+               (long long)w.nb);
     FCM_CHECK(0, ctx, FCM_ERR_SINGULAR,
               "integrator: static step to t = %g refused before any solve: the system is "
               "singular: body %lld of %lld (background nodes in [%.6g, %.6g] x [%.6g, %.6g] x "
@@ -281,14 +302,15 @@ fcm_status fcm__sim_check_rigid_modes(fcm_integrator *I, double t)
               "inertia to hold them. Fix 3 non-collinear points of every body in all "
               "components (fixed or motion regions), hold part of its surface (a boundary "
               "constraint), or run it dynamically",
-              t, (long long)bad, (long long)nb, b->lo[0], b->hi[0], b->lo[1], b->hi[1], b->lo[2],
+              t, (long long)bad, (long long)w.nb, b->lo[0], b->hi[0], b->lo[1], b->hi[1], b->lo[2],
               b->hi[2], held_s, modes, axis, more);
   }
 cleanup:
-  fcm__free(ctx, elem_body);
-  fcm__free(ctx, copy_node);
-  fcm__free(ctx, copy_body);
-  fcm__free(ctx, held);
-  fcm__free(ctx, B);
+  fcm__free(ctx, w.elem_body);
+  fcm__free(ctx, w.copy_node);
+  fcm__free(ctx, w.copy_body);
+  fcm__free(ctx, w.held);
+  fcm__free(ctx, w.B);
+  fcm__free(ctx, w.sum);
   return st;
 }
