@@ -67,8 +67,9 @@ typedef enum fcm_linear_solver {
    * steps, or dynamic ones (M/h^2 + K) with a linear material or a PSD tangent (project_psd).
    * Where it is not SPD the coarsest Cholesky factorization fails, a diagonal is not positive
    * or the cycles do not converge (stalled or diverging): the solve fails softly
-   * (FCM_STEP_LINEAR_SOLVER_FAILED, a warning names the cause) and the step is retried with
-   * half the increment, like a failed Krylov solve. Needs a Hex8 or Hex20 box grid
+   * (FCM_STEP_LINEAR_SOLVER_FAILED, or FCM_STEP_LINEAR_SOLVER_STAGNATED when the cycles
+   * stalled: less than 5 % reduction in 20; a warning names the cause) and the step is
+   * retried with half the increment, like a failed Krylov solve. Needs a Hex8 or Hex20 box grid
    * (fcm_mg_create()): on another mesh the first step fails with FCM_ERR_UNSUPPORTED. */
   FCM_LINEAR_MULTIGRID = 3
 } fcm_linear_solver;

@@ -693,9 +693,9 @@ static fcm_status reject_step(fcm_integrator *I, fcm_status st, fcm_step_reason 
     st = fcm__error(I->ctx, FCM_ERR_NOT_CONVERGED, __FILE__, __LINE__, __func__,
                     "integrator: step %lld from t = %g failed after %d halving(s) (last dt = "
                     "%g): %s, residual %g vs tolerance %g; state left at t = %g. The linear "
-                    "solver stopped reducing its residual (%s): the Newton matrix is singular or "
-                    "nearly so (rigid-body modes no constraint holds, a body held at too few "
-                    "points) or, for CG, not positive definite",
+                    "solver stalled or broke down (%s): the Newton matrix is singular or nearly "
+                    "so (rigid-body modes no constraint holds, a body held at too few points) "
+                    "or, for CG, not positive definite",
                     I->steps + 1, t0, info->halvings, info->dt, fcm_step_reason_name(reason),
                     info->residual, info->tolerance, I->t, I->stall_msg);
   if (st == FCM_OK)

@@ -16,8 +16,8 @@
  * rank. A copy the space's small-copy constraint moved onto another node's copy
  * (fcm_space_options.constrain_ratio) follows translations exactly but not rotations: a body
  * with such an element has only its translations checked (its rotations meet a stiffness of
- * that fragment, tiny but not zero), so the check never refuses a system that is not
- * singular. */
+ * that fragment, tiny but not zero). So a refused system is singular — a free mode is an
+ * exact null vector of the eliminated Newton matrix at rest — or within RIGID_TOL of it. */
 #include "sim/sim_impl.h"
 #include "fem/fem_impl.h"
 #include "la/la_impl.h"
@@ -80,7 +80,8 @@ static void free_modes(char *buf, size_t n, int ft, int fr)
     snprintf(buf, n, "%d rigid-body rotation%s", fr, fr > 1 ? "s" : "");
 }
 
-/* "1 node in all components, 2 in some and 5 boundary points", or "nothing". */
+/* "1 node in all components, 2 nodes in some components and 5 boundary-constraint points",
+ * or "nothing (...)". */
 static void held_by(char *buf, size_t n, const rigid_body *b)
 {
   int len = 0;
