@@ -15,8 +15,12 @@
  *    (density 0, no constraint) under a body-force field fails with
  *    FCM_STEP_LINEAR_SOLVER_STAGNATED and a message naming it for CG (which may break down
  *    first) and MINRES (stagnated); with the stagnation window off MINRES ends with another
- *    reason. */
+ *    reason;
+ * 7. allocation failures in a static step (its k-th allocation fails, k = 0, 1, ...):
+ *    FCM_ERR_ALLOC, nothing leaked, the state unchanged; in the end the refusal (one fixed
+ *    node) or the solve (a fixed face). */
 #include "sim_util.h"
+#include "test_alloc.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -290,6 +294,71 @@ static void test_stagnation(fcm_ctx *ctx)
   fcm_mesh_destroy(&mesh);
 }
 
+/* A static integrator on a Hex8 beam held at `nfix` nodes; setup with the normal allocator,
+ * then one step with the k-th allocation failing. */
+static fcm_status alloc_step(fcm_ctx *ctx, failing *f, long long k, const fcm_space *space,
+                             fcm_index nfix, const fcm_index *fix, int *state_ok)
+{
+  fcm_integrator *I = NULL;
+  const fcm_material mat = {FCM_MATERIAL_LINEAR, 1e6, 0.3, 1000.0};
+  const double g[3] = {0, 0, -9.81};
+  const fcm_motion held = fcm_motion_default();
+  fcm_integrator_options o = fcm_integrator_options_default();
+  o.kind = FCM_INTEGRATOR_STATIC;
+  o.linear_solver = FCM_LINEAR_CG;
+  fcm_status st = fcm_integrator_create(ctx, space, &mat, &o, &I);
+  if (st == FCM_OK) st = fcm_integrator_add_gravity(I, g, NULL, NULL);
+  if (st == FCM_OK) st = fcm_integrator_add_constraint(I, nfix, fix, &held, NULL);
+  if (st == FCM_OK) st = fcm_integrator_setup(I);
+  *state_ok = 1;
+  if (st == FCM_OK) {
+    f->count = 0;
+    f->fail_at = k;
+    st = fcm_integrator_step(I, NULL);
+    f->fail_at = -1;
+    *state_ok = fcm_integrator_time(I) == (st == FCM_OK ? o.dt : 0.0) &&
+                fcm_integrator_step_count(I) == (st == FCM_OK);
+  }
+  fcm_integrator_destroy(&I);
+  return st;
+}
+
+static void test_alloc(void)
+{
+  failing f = {0, -1};
+  fcm_ctx *ctx = failing_ctx(&f);
+  fcm_mesh *mesh = NULL;
+  fcm_space *space = NULL;
+  TEST_OK(ctx, beam_mesh(ctx, FCM_ELEMENT_HEX8, 2, 2.0, &mesh));
+  TEST_OK(ctx, fcm_space_create(ctx, mesh, NULL, &space));
+  fcm_index nface = 0;
+  fcm_index *face = plane_nodes(ctx, mesh, 0, 0.0, &nface);
+  const long long base = fcm_ctx_live_allocations(ctx);
+  for (int held = 0; held < 2; held++) {
+    const fcm_status final = held ? FCM_OK : FCM_ERR_SINGULAR;
+    int done = 0, fails = 0;
+    for (long long k = 0; k < 1000 && !done; k++) {
+      int state_ok = 0;
+      fcm_status st = alloc_step(ctx, &f, k, space, held ? nface : 1, face, &state_ok);
+      if (!(st == final || st == FCM_ERR_ALLOC) || !state_ok ||
+          fcm_ctx_live_allocations(ctx) != base) {
+        TEST_FAIL_("held %d, allocation %lld failed: %s, state %d, %lld live allocations", held, k,
+                   fcm_status_name(st), state_ok, fcm_ctx_live_allocations(ctx) - base);
+        break;
+      }
+      done = st == final;
+      fails += !done;
+      fcm_ctx_error_clear(ctx);
+    }
+    TEST_TRUE(done && fails > 0); /* the check itself allocates */
+  }
+  free(face);
+  fcm_space_destroy(&space);
+  fcm_mesh_destroy(&mesh);
+  TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
+  fcm_ctx_destroy(&ctx);
+}
+
 int main(void)
 {
   fcm_ctx *ctx = NULL;
@@ -300,5 +369,6 @@ int main(void)
   test_release_dynamic(ctx);
   test_stagnation(ctx);
   fcm_ctx_destroy(&ctx);
+  test_alloc();
   return TEST_RESULT();
 }
