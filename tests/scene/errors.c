@@ -162,6 +162,8 @@ static const bad_case cases[] = {
      "output.directory: expected a non-empty string, got an empty string", NULL},
     {"{" BG ", " MAT ", \"output\": {\"checkpoint_interval\": -1}}", FCM_ERR_ARG,
      "output.checkpoint_interval: expected an integer in [0, 1000000000], got -1", NULL},
+    {"{" BG ", " MAT ", \"solver\": {\"stagnation_window\": -1}}", FCM_ERR_ARG,
+     "solver.stagnation_window: expected an integer in [0, 1000000000], got -1", NULL},
     {"{" BG ", " MAT ", \"solver\": {\"newton\": {\"rule\": \"absolute\"}}}", FCM_ERR_ARG,
      "solver.newton.rule:", "\"representative\""},
     {"{" BG ", " MAT ", \"solver\": {\"on_inversion\": \"abort\"}}", FCM_ERR_ARG,

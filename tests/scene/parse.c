@@ -76,6 +76,7 @@ static void check_full(fcm_ctx *ctx)
   TEST_TRUE(so->schwarz_threshold == 0.25 && so->schwarz.epsilon == 1e-12 &&
             so->schwarz.clamp == FCM_SCHWARZ_PAPER);
   TEST_TRUE(so->rtol == 1e-6 && so->atol == 1e-12 && so->max_iterations == 321);
+  TEST_TRUE(so->stagnation_window == 37);
   TEST_TRUE(so->newton_rtol == 1e-4 && so->newton_max_iterations == 17);
   TEST_TRUE(so->line_search == 0 && so->project_psd == 1);
   TEST_TRUE(so->representative_acceleration == 10 && so->threads == 3);
@@ -217,6 +218,7 @@ static void check_defaults(fcm_ctx *ctx)
   TEST_TRUE(so->schwarz_threshold == 0.5 && so->schwarz.epsilon == 1e-13 &&
             so->schwarz.clamp == FCM_SCHWARZ_CLAMP);
   TEST_TRUE(so->rtol == 1e-8 && so->atol == 0 && so->max_iterations == 1000);
+  TEST_TRUE(so->stagnation_window == 50);
   TEST_TRUE(so->newton_rtol == 1e-5 && so->newton_max_iterations == 100);
   TEST_TRUE(so->line_search == 1 && so->project_psd == 0);
   TEST_TRUE(so->representative_acceleration == 9.81 && so->threads == FCM_DEFAULT);

@@ -36,6 +36,7 @@ static const char full_scene_json[] =
     "\"block_jacobi\",\n"
     "    \"schwarz\": {\"threshold\": 0.25, \"epsilon\": 1e-12, \"clamp\": \"paper\"},\n"
     "    \"rtol\": 1e-6, \"atol\": 1e-12, \"max_iterations\": 321, \"on_inversion\": \"stop\",\n"
+    "    \"stagnation_window\": 37,\n"
     "    \"newton\": {\"rtol\": 1e-4, \"max_iterations\": 17, \"line_search\": false,\n"
     "      \"project_psd\": true, \"rule\": \"relative\", \"representative_acceleration\": 10},\n"
     "    \"threads\": 3},\n"

@@ -152,6 +152,10 @@ typedef struct fcm_scene_solver {
   double atol;                 /**< Krylov absolute tolerance; >= 0, default 0 */
   int max_iterations;          /**< Krylov iterations (multigrid solver: cycles) per solve;
                                     >= 1, default 1000 */
+  int stagnation_window;       /**< "cg" and "minres": a solve whose smallest residual drops
+                                    by less than 0.1 % in this many iterations stops as
+                                    stagnated (fcm_integrator_options.krylov_stagnation_window);
+                                    [0, 1e9], default 50, 0: off */
   fcm_newton_tolerance newton_rule;   /**< "auto" (default, FCM_NEWTON_TOL_AUTO),
                                            "representative", "relative" */
   double newton_rtol;                 /**< tolerance of the rule; (0, 1), default 1e-5 */

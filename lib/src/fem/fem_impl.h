@@ -190,6 +190,13 @@ void fcm__space_memory(const fcm_space *s, double *numbering, double *topology);
  * nothing: the integrator calls it every Newton iteration with its own marks. (space.c) */
 void fcm__eliminate_marked(fcm_csr *A, double *b, const unsigned char *con, const double *g);
 
+/* The bodies of the space (fcm_space_num_bodies()): elem_body[e] (num_elems entries) the body
+ * of element e, bodies numbered 0 .. *num_bodies - 1 in the order of their first element
+ * (elements joined through shared DOF copies; every copy lies in exactly one body). Reads only
+ * the numbering (a local space as the full one). Allocates O(num_dofs / 3) scratch.
+ * @return FCM_OK, FCM_ERR_ALLOC. (locate.c) */
+fcm_status fcm__space_body_labels(const fcm_space *s, fcm_index *elem_body, fcm_index *num_bodies);
+
 /* Physical shape-function gradients g (nn x 3) at a point from the reference ones dN (nn x 3)
  * and the nodal coordinates X (nn x 3); returns det J (not positive: g is not written). */
 double fcm__fem_gradients(int nn, const double *X, const double *dN, double *g);

@@ -596,6 +596,7 @@ static fcm_integrator_options integrator_options(fcm_simulation *S)
   o.krylov_rtol = sv->rtol;
   o.krylov_atol = sv->atol;
   o.krylov_max_iterations = sv->max_iterations;
+  o.krylov_stagnation_window = sv->stagnation_window;
   o.schwarz_theta = sv->schwarz_threshold;
   o.schwarz = sv->schwarz;
   o.multigrid = sv->multigrid;

@@ -846,9 +846,9 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
   static const char *const keys[] = {
-      "method",    "direct",         "preconditioner", "schwarz", "rtol",
-      "atol",      "max_iterations", "newton",         "threads", "preconditioner_tangent",
-      "multigrid", "petsc_options",  "on_inversion"};
+      "method",    "direct",         "preconditioner", "schwarz",          "rtol",
+      "atol",      "max_iterations", "newton",         "threads",          "preconditioner_tangent",
+      "multigrid", "petsc_options",  "on_inversion",   "stagnation_window"};
   static const char *const skeys[] = {"threshold", "epsilon", "clamp"};
   static const char *const nkeys[] = {"rtol",        "max_iterations",
                                       "line_search", "project_psd",
@@ -867,6 +867,7 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   s->threads = FCM_DEFAULT;
   s->rtol = 1e-8;
   s->max_iterations = 1000;
+  s->stagnation_window = 50;
   s->newton_rtol = 1e-5;
   s->newton_max_iterations = 100;
   s->line_search = 1;
@@ -895,6 +896,7 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "rtol", 0, (fcm__range){0.0, 1.0, 0, 1}, &s->rtol));
   FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "atol", 0, FCM__NONNEGATIVE, &s->atol));
   READ_INT(p, o, "max_iterations", 0, 1, 1000000000, s->max_iterations);
+  READ_INT(p, o, "stagnation_window", 0, 0, 1000000000, s->stagnation_window);
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "newton", 0, &nw));
   if (nw) {
     ENTER(p, "newton");
@@ -1395,6 +1397,10 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
               clamp_names[so->schwarz.clamp]);
     if (so->preconditioner == FCM_PRECOND_MULTIGRID) view_multigrid(f, &so->multigrid);
     fprintf(f, ", rtol %g, atol %g, at most %d iterations", so->rtol, so->atol, so->max_iterations);
+    if (so->stagnation_window > 0)
+      fprintf(f, ", stagnation window %d", so->stagnation_window);
+    else
+      fprintf(f, ", no stagnation test");
   }
   fprintf(f,
           "; Newton %s rule, rtol %g, at most %d iterations, line search %s, PSD projection %s, "

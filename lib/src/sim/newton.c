@@ -528,6 +528,7 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
   double rep_free = 0.0, r = NAN, r_start = NAN, tol = 0.0;
   int met = 0;
   *reason = FCM_STEP_NONE;
+  I->solve_stalled = 0;
 
   if (o->tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE) rep_free = norm_free(I, I->Ma);
   FCM_TRY(I->ctx, newton_start(I, h, &cur, stats));
@@ -579,6 +580,11 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
     tol = tolerance(I, rep_free, r_start);
     monitor(I, t1, it + 1, r, tol, cur.E, lr.alpha, its, met);
   }
+  /* Newton could not go on with the result of a linear solve that stagnated or broke down:
+   * that, not the line search, is why the substep failed */
+  if (I->solve_stalled &&
+      (*reason == FCM_STEP_LINE_SEARCH_FAILED || *reason == FCM_STEP_MAX_NEWTON))
+    *reason = FCM_STEP_LINEAR_SOLVER_STAGNATED;
 cleanup:
   *residual = r;
   *tol_out = tol;
@@ -639,6 +645,11 @@ static fcm_status run_substep(fcm_integrator *I, int dyn, double h, double t1,
 {
   fcm_status st = FCM_OK;
   fcm__sim_eval_constraints(I, t1);
+  if (!dyn && I->rigid_ok != I->con_version + 1) {
+    /* no mass: a body the constraints leave free makes every Newton matrix singular */
+    FCM_TRY(I->ctx, fcm__sim_check_rigid_modes(I, t1));
+    I->rigid_ok = I->con_version + 1;
+  }
   memcpy(I->un, I->u, sizeof(double) * (size_t)I->n);
   if (dyn && I->D && (!I->linear || I->damp_version == 0))
     FCM_TRY(I->ctx, update_damping(I, reason, stats));
@@ -733,6 +744,15 @@ static fcm_status reject_step(fcm_integrator *I, fcm_status st, fcm_step_reason 
   memcpy(I->load_prev, I->lp_bak, sizeof(double) * (size_t)n);
   fcm__sim_eval_constraints(I, I->t);
   if (!I->linear) I->h_state = SIM_H_INVALID;
+  if (st == FCM_OK && reason == FCM_STEP_LINEAR_SOLVER_STAGNATED)
+    st = fcm__error(I->ctx, FCM_ERR_NOT_CONVERGED, __FILE__, __LINE__, __func__,
+                    "integrator: step %lld from t = %g failed after %d halving(s) (last dt = "
+                    "%g): %s, residual %g vs tolerance %g; state left at t = %g. The linear "
+                    "solver stalled or broke down (%s): the Newton matrix is singular or nearly "
+                    "so (rigid-body modes no constraint holds, a body held at too few points) "
+                    "or, for CG, not positive definite",
+                    I->steps + 1, t0, info->halvings, info->dt, fcm_step_reason_name(reason),
+                    info->residual, info->tolerance, I->t, I->stall_msg);
   if (st == FCM_OK)
     st = fcm__error(I->ctx, reason == FCM_STEP_NONFINITE ? FCM_ERR_NUMERIC : FCM_ERR_NOT_CONVERGED,
                     __FILE__, __LINE__, __func__,
