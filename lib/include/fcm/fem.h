@@ -85,6 +85,13 @@ FCM_API fcm_status fcm_space_create_embedded_with(fcm_ctx *ctx, const fcm_mesh *
 /** Number of DOF copies the options' constraint removed (moved with their piece). */
 FCM_API fcm_index fcm_space_num_constrained_copies(const fcm_space *space);
 
+/** Number of local nodes of element `elem` where it uses, in place of a constrained copy,
+ * the DOFs of the copy that copy moves with (fcm_space_element_dofs() there may name another
+ * node's copy, or another copy of the same node): the field on such an element is not the
+ * one its own copies would give, and fcm_space_transfer() sets no value from it there.
+ * 0 for an element without (or out of range). No allocation; thread safe. */
+FCM_API int fcm_space_element_constrained(const fcm_space *space, fcm_index elem);
+
 /** The cell rules of an embedded space, or NULL. */
 FCM_API const fcm_cell_rules *fcm_space_cell_rules(const fcm_space *space);
 
