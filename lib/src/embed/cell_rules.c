@@ -128,10 +128,11 @@ typedef struct build {
   int stabilize[FCM_RULE_KIND_COUNT];
   /* Cutting: the tree of R->cut_tris (NULL without cuts); region[c]: cell c shares a node
    * with a cell the cuts reach (its face polygons are recorded for the links); rebuild[c]:
-   * integrate cell c (NULL: every cell), else copy its rules from prev. */
+   * integrate cell c (NULL: every cell), else copy its rules from prev; prev_region[c]: the
+   * region of prev, whose links cover the pairs of its cells (NULL: prev has no cuts). */
   fcm_aabb_tree *cut_tree;
   const fcm__cut_tri *cut_tris;
-  unsigned char *region, *rebuild;
+  unsigned char *region, *rebuild, *prev_region;
   const fcm_cell_rules *prev;
   fcm_index first_new;    /* cut triangles from here on are new (those of the cut being added) */
   fcm__rules_reduce *red; /* distributed AUTO: sums the choice's inputs (NULL: none) */
@@ -791,8 +792,9 @@ static void build_release(build *B)
   if (B->ctx) {
     fcm__free(B->ctx, B->region);
     fcm__free(B->ctx, B->rebuild);
+    fcm__free(B->ctx, B->prev_region);
   }
-  B->region = B->rebuild = NULL;
+  B->region = B->rebuild = B->prev_region = NULL;
   fcm_aabb_tree_destroy(&B->tree);
   fcm_aabb_tree_destroy(&B->tri_tree);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
@@ -845,7 +847,7 @@ static fcm_status cut_setup(build *B, const fcm_cell_rules *R, fcm_index first_n
   const int npc = fcm_mesh_nodes_per_cell(mesh);
   const fcm_index *cells = fcm_mesh_cells(mesh);
   double *boxes = NULL;
-  unsigned char *node_hit = NULL;
+  unsigned char *node_hit = NULL; /* 1: a cell the cuts reach holds the node; 2: the earlier */
   fcm__idbuf ids = {NULL, 0, 0};
   FCM_ALLOC(ctx, 6 * (size_t)R->num_cut_tris + 6, boxes);
   for (fcm_index t = 0; t < R->num_cut_tris; t++) {
@@ -857,18 +859,22 @@ static fcm_status cut_setup(build *B, const fcm_cell_rules *R, fcm_index first_n
   FCM_ALLOC(ctx, (size_t)nc + 1, B->region);
   FCM_ALLOC(ctx, (size_t)nn + 1, node_hit);
   if (B->prev) FCM_ALLOC(ctx, (size_t)nc + 1, B->rebuild);
+  if (B->prev && first_new > 0) FCM_ALLOC(ctx, (size_t)nc + 1, B->prev_region);
   for (fcm_index c = 0; c < nc; c++) {
     fcm__embed_cell cell;
     FCM_TRY(ctx, fcm__embed_cell_setup(ctx, mesh, c, B->o->clip_rtol, &cell));
     FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, cell.lo, cell.hi, &ids));
     if (ids.n == 0) continue;
-    for (int a = 0; a < npc; a++)
-      node_hit[cells[(size_t)npc * c + a]] = 1;
+    for (int a = 0; a < npc; a++) /* ids ascending: the earlier cuts' triangles first */
+      node_hit[cells[(size_t)npc * c + a]] |= (unsigned char)(ids.ids[0] < first_new ? 3 : 1);
     if (B->rebuild && ids.ids[ids.n - 1] >= first_new) B->rebuild[c] = 1;
   }
   for (fcm_index c = 0; c < nc; c++)
-    for (int a = 0; a < npc && !B->region[c]; a++)
-      B->region[c] = node_hit[cells[(size_t)npc * c + a]];
+    for (int a = 0; a < npc; a++) {
+      const unsigned char h = node_hit[cells[(size_t)npc * c + a]];
+      B->region[c] |= h != 0;
+      if (B->prev_region) B->prev_region[c] |= (h & 2) != 0;
+    }
 cleanup:
   fcm__free(ctx, boxes);
   fcm__free(ctx, node_hit);
@@ -1140,9 +1146,23 @@ static int cmp_link(const void *a, const void *b)
   return (x[1] > y[1]) - (x[1] < y[1]);
 }
 
+/* Whether the earlier pieces qa of cell ca and qb of cell cb (ca < cb, face neighbours) were
+ * linked in the rules being extended: a cut only separates, so pieces whose parents it had
+ * separated stay apart, whatever the face tests on the new, smaller pieces say (near a cut
+ * within the tolerances those can differ). Cells outside the earlier region had one piece
+ * each, linked to its neighbours'. */
+static int earlier_link(const build *B, fcm_index ca, fcm_index cb, int qa, int qb)
+{
+  if (!B->prev_region || !B->prev_region[ca] || !B->prev_region[cb]) return 1;
+  const fcm_cell_rules *Q = B->prev;
+  const fcm_index key[2] = {Q->piece_off[ca] + qa, Q->piece_off[cb] + qb};
+  return bsearch(key, Q->links, (size_t)Q->num_links, 2 * sizeof *Q->links, cmp_link) != NULL;
+}
+
 /* Phase 3b (cuts only): the links between pieces of face-neighbouring region cells: a
  * polygon of one cell's piece on the shared face overlaps a polygon of the other cell's
- * piece with positive area, and the overlap does not lie on a cut triangle. */
+ * piece with positive area, and the overlap does not lie on a cut triangle, and
+ * their parents were linked (earlier_link()). */
 static fcm_status gather_links(const build *B, fcm_cell_rules *R, const cell_out *out)
 {
   fcm_status st = FCM_OK;
@@ -1196,6 +1216,7 @@ static fcm_status gather_links(const build *B, fcm_cell_rules *R, const cell_out
           }
           FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, lo, hi, &tc));
           if (fcm__embed_on_cut(B->cut_tris, tc.ids, tc.n, A, ma[2], mtol)) continue;
+          if (!earlier_link(B, c, c2, out[c].pc[ma[1]].parent, out[c2].pc[mb[1]].parent)) continue;
           if (nl + 1 > cap) {
             const size_t ncap = cap ? 2 * cap : 256;
             void *q = links;
