@@ -275,7 +275,8 @@ static void print_planes(const plane *pl, int n)
             pl[k].p[1], pl[k].p[2], pl[k].n[0], pl[k].n[1], pl[k].n[2]);
 }
 
-/* Carry track t over the cut from rules r0 to r1 and check; 1 on a failed check. */
+/* Carry track t over the cut that made rules r1 (a space of r1, fcm_space_transfer), check,
+ * and give every DOF a random offset; 1 on a failed check. */
 static int carry(const fcm_mesh *mesh, const fcm_cell_rules *r1, track *t, double rho,
                  unsigned long long *seed)
 {
@@ -303,7 +304,7 @@ static int carry(const fcm_mesh *mesh, const fcm_cell_rules *r1, track *t, doubl
   const double ec = fmax(norm3(dcon) / norm3(p0), norm3(dcon + 3) / norm3(L0));
   worst_m = fmax(worst_m, em), worst_p = fmax(worst_p, ep), worst_L = fmax(worst_L, eL);
   worst_field = fmax(worst_field, df), worst_con = fmax(worst_con, ec);
-  /* the constrained elements are tiny: their share of the momenta stays far below 1 */
+  /* the constrained elements are tiny: their share stays below 100 x constrain_ratio */
   const int bad = !(em <= RTOL && ep <= RTOL && eL <= RTOL && df <= RTOL && ec <= 100.0 * t->ratio);
   if (bad || verbose > 1)
     fprintf(stderr,
