@@ -361,8 +361,10 @@ FCM_API fcm_index fcm_cell_rules_parent_num_pieces(const fcm_cell_rules *rules);
 /** Links between pieces of face-neighbouring cells near the cuts: pairs (p, q), p < q, of
  * pieces that share a part of the cells' common face with positive area not lying on a
  * cut triangle; 2 x num_links entries, sorted. Computed for every pair of cells that share a
- * node with a cell the cuts reach (elsewhere every cell has one piece). The generalized
- * enrichment of fcm_space_create_embedded() groups each node's pieces along these links. */
+ * node with a cell the cuts reach (elsewhere every cell has one piece). A cut only separates:
+ * two pieces are linked only if their parents (fcm_cell_rules_piece_parent()) were, so the
+ * bodies after a cut are parts of the bodies before it. The generalized enrichment of
+ * fcm_space_create_embedded() groups each node's pieces along these links. */
 FCM_API fcm_index fcm_cell_rules_num_links(const fcm_cell_rules *rules);
 FCM_API const fcm_index *fcm_cell_rules_links(const fcm_cell_rules *rules);
 

@@ -70,9 +70,13 @@ struct fcm_cell_rules {
   fcm_index num_links;
   fcm_index *links;
   /* piece_parent[p]: the piece of the rules this object extends that holds piece p (-1
-   * for rules made by fcm_cell_rules_create()); prev_num_pieces: how many that object had */
+   * for rules made by fcm_cell_rules_create()); prev_num_pieces: how many that object had.
+   * piece_component[p]: the number of piece p among the connected components of its cell's
+   * parts before the components without volume were dropped: a later cut numbers the
+   * pieces under the earlier cuts (its parents) the same way, whatever volume they keep */
   fcm_index *piece_parent;
   fcm_index prev_num_pieces;
+  int *piece_component;
   fcm_cell_rules_stats stats;
 };
 

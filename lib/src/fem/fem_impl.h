@@ -26,6 +26,10 @@ struct fcm_space {
   fcm_index num_elems;
   fcm_index *elem_cell, *elem_piece, *elem_dof, *cell_elem;
   fcm_index num_constrained; /* copies constrained to move with their piece (Koschier) */
+  /* elem_con[nn e + a] = 1 where element e uses at local node a, in place of a constrained
+   * copy, the copy it moves with (possibly another copy of the same node); NULL when no copy
+   * is constrained */
+  unsigned char *elem_con;
   /* Everything above is the numbering: O(nodes + elements x nn), the same on every process of
    * a distributed run. The topology below covers the LOCAL elements and copies. A full space
    * (fcm_space_create*(), is_local = 0): every element and copy, local position = element id /
