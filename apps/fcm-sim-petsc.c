@@ -203,13 +203,16 @@ static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
   }
   const double t0 = fcm_wtime();
   const long long n = fcm_simulation_num_steps(sim);
+  fcm_simulation_get_counters(sim, &c); /* a resumed run may have warned already */
+  int warned_inverted = c.inverted_steps > 0;
   while (!fcm_simulation_done(sim)) {
     fcm_step_info si;
+    const long long attempted = fcm_simulation_step_count(sim) + 1;
     st = fcm_simulation_step(sim, &si); /* collective; a failure is the same everywhere */
     const long long k = fcm_simulation_step_count(sim);
-    if (st != FCM_OK) {
+    if (st != FCM_OK) { /* the step failed, or was taken and refused (solver.on_inversion) */
       if (rank == 0) {
-        fprintf(stderr, "fcm-sim: step %lld: %s\n", k + 1, fcm_ctx_error_message(ctx));
+        fprintf(stderr, "fcm-sim: step %lld: %s\n", attempted, fcm_ctx_error_message(ctx));
         if (write) fcm_simulation_write_log(sim, logpath);
       }
       goto done;
@@ -218,6 +221,16 @@ static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
       if (rank == 0) fprintf(stderr, "fcm-sim: non-finite state after step %lld\n", k);
       goto done;
     }
+    /* as the serial fcm-sim: a warning on the first step that ends inverted (the counts are
+     * the same on every process) */
+    if (rank == 0 && si.inverted_points > 0 && !warned_inverted)
+      fprintf(stderr,
+              "fcm-sim: warning: step %lld (t = %.6g s) ended with %lld inverted quadrature "
+              "point%s (J = det F <= 0; the first in cell %lld, -1: not located); the stresses "
+              "there are NaN\n",
+              k, si.time, (long long)si.inverted_points, si.inverted_points == 1 ? "" : "s",
+              (long long)si.inverted_cell);
+    warned_inverted |= si.inverted_points > 0;
     if (talk)
       fprintf(stderr,
               "fcm-sim: step %lld/%lld t = %.6g s: Newton %d, KSP %lld iterations, residual "

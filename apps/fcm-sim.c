@@ -63,11 +63,13 @@ static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS
        "print the scene with every default filled in and exit", 0, 0, 0, NULL, NULL, NULL},
       {"--quiet", "-q", CLI_FLAG, &o->quiet, NULL, "print only errors", 0, 0, 0, NULL, NULL, NULL},
       {"--progress", NULL, CLI_FLAG, &o->progress, NULL,
-       "report the cell-rule build also when stderr is not a\n"
-       "terminal (a line every 2 s; on a terminal: a bar)",
+       "report the level-set and cell-rule builds also when stderr\n"
+       "is not a terminal (a line every 2 s; on a terminal: a bar)",
        0, 0, 0, NULL, NULL, NULL},
       {"--debug", NULL, CLI_FLAG, &o->debug, NULL,
-       "print the library's traceback with build errors", 0, 0, 0, NULL, NULL, NULL},
+       "print the library's traceback with errors, and every\n"
+       "warning (else the first 10)",
+       0, 0, 0, NULL, NULL, NULL},
       {"--backend", NULL, CLI_CHOICE, &o->backend, "NAME",
        "serial (default) or petsc: distributed over the MPI\n"
        "processes (mpirun -n 2 fcm-sim scene.json --backend petsc;\n"
@@ -99,7 +101,13 @@ static void usage(FILE *f, const cli_option *opts)
              "Exit 0 on success, 1 when the run fails, 2 on a usage error, an invalid scene (also\n"
              "one whose files or geometry fail to build: the message names the scene section,\n"
              "e.g. geometry.voxels) or a refused checkpoint. A warning is printed when part of\n"
-             "the body lies outside the background mesh (it is cut off).\n");
+             "the body lies outside the background mesh (it is cut off), on the first step that\n"
+             "ends with inverted quadrature points (J = det F <= 0; the log's inverted_points\n"
+             "column and the summary count them), on the first frame holding NaN stresses and\n"
+             "for what the library reports as a warning (NaN voxels, filled holes, solver\n"
+             "fallbacks); with \"solver\": {\"on_inversion\": \"stop\"} an inverted step ends the\n"
+             "run (exit 1). Errors print the library's message; --debug adds where in the\n"
+             "library it failed.\n");
 }
 
 /* -1 when the arguments are parsed into `o`, else the exit code (0 after --help, 2). */
@@ -200,6 +208,64 @@ static void rules_progress(fcm_index done, fcm_index total, void *user)
   }
 }
 
+/* Progress of a level-set geometry build: a bar on a terminal, else a line per call. */
+static void geometry_progress(fcm_index done, fcm_index total, void *user)
+{
+  const rules_progress_state *ps = user;
+  const double el = fcm_wtime() - ps->t0;
+  if (ps->tty) {
+    const int width = 30, fill = (int)(width * done / (total > 0 ? total : 1));
+    char bar[64];
+    for (int i = 0; i < width; i++)
+      bar[i] = i < fill ? '#' : '.';
+    bar[width] = '\0';
+    const double eta = done > 0 ? el / (double)done * (double)(total - done) : 0.0;
+    fprintf(stderr, "\r[%s] level set %lld/%lld sub-cells  %.0f s  ETA %.0f s   ", bar,
+            (long long)done, (long long)total, el, eta);
+    if (done == total) fputc('\n', stderr);
+  } else {
+    fprintf(stderr, "fcm-sim: level set %lld/%lld sub-cells (%.1f s)\n", (long long)done,
+            (long long)total, el);
+  }
+}
+
+/* The library's warnings (FCM_LOG_WARNING: NaN voxels, holes filled, solver fallbacks) on
+ * stderr, the first SIM_MAX_WARNINGS of them (all with --debug); errors are printed where
+ * they end the run. Called from the library's OpenMP threads too (a simplification
+ * fallback inside the cell loop): the count is atomic. */
+#define SIM_MAX_WARNINGS 10
+typedef struct warn_state {
+  int all;     /* --debug: print every warning */
+  long long n; /* warnings so far */
+} warn_state;
+
+static void print_warning(void *user, fcm_log_level level, const char *msg)
+{
+  warn_state *ws = user;
+  if (level != FCM_LOG_WARNING) return;
+  long long k;
+#pragma omp atomic capture
+  k = ++ws->n;
+  if (ws->all || k <= SIM_MAX_WARNINGS)
+    fprintf(stderr, "fcm-sim: warning: %s\n", msg);
+  else if (k == SIM_MAX_WARNINGS + 1)
+    fprintf(stderr, "fcm-sim: warning: further warnings are not printed (--debug prints all)\n");
+}
+
+/* An error of the run: the library's message, which names the cause and what to change; the
+ * traceback of the library's frames only with --debug. */
+static void report_error(fcm_ctx *ctx, int debug, const char *what)
+{
+  if (debug) {
+    fprintf(stderr, "fcm-sim: %s:\n", what);
+    fcm_ctx_error_view(ctx, stderr);
+    return;
+  }
+  fprintf(stderr, "fcm-sim: %s: %s (%s)\n", what, fcm_ctx_error_message(ctx),
+          fcm_status_name(fcm_ctx_error_status(ctx)));
+  fprintf(stderr, "fcm-sim: --debug shows where in the library it failed\n");
+}
+
 /* Exit code of a failed build: 2 for errors of the input (files, geometry, arguments), 1 for
  * the rest (memory, numerical failures). */
 static int build_exit_code(fcm_status st)
@@ -237,15 +303,42 @@ static void warn_outside(const fcm_simulation *sim)
           S->mesh_lo[1], S->mesh_hi[1], S->mesh_lo[2], S->mesh_hi[2]);
 }
 
+/* The warning on the first step that ends with inverted quadrature points (the run summary
+ * counts them all). */
+static void warn_inverted(int tty, const fcm_step_info *si, long long step)
+{
+  if (tty) fputc('\n', stderr);
+  fprintf(stderr,
+          "fcm-sim: warning: step %lld (t = %.6g s) ended with %lld inverted quadrature point%s "
+          "(J = det F <= 0)",
+          step, si->time, (long long)si->inverted_points, si->inverted_points == 1 ? "" : "s");
+  if (si->inverted_cell >= 0)
+    fprintf(stderr, ", the first in cell %lld at X = (%.6g, %.6g, %.6g) with J = %.3g",
+            (long long)si->inverted_cell, si->inverted_position[0], si->inverted_position[1],
+            si->inverted_position[2], si->inverted_det);
+  fprintf(stderr, "; the stresses there are NaN (\"solver\": {\"on_inversion\": \"stop\"} ends "
+                  "the run at such a step)\n");
+}
+
+/* The warning on the first frame holding NaN or infinite stresses. */
+static void warn_nonfinite(int tty, const fcm_simulation_counters *c, int frame)
+{
+  if (tty) fputc('\n', stderr);
+  fprintf(stderr,
+          "fcm-sim: warning: frame %d (after step %lld) holds %lld NaN or infinite von Mises "
+          "value%s (points with J = det F <= 0)\n",
+          frame, c->steps, (long long)c->nonfinite_last, c->nonfinite_last == 1 ? "" : "s");
+}
+
 /* Write a checkpoint <dir>/<name>_checkpoint_NNNNNN.fcmck of the current step. */
 static int write_checkpoint(fcm_ctx *ctx, fcm_simulation *sim, const char *dir, const char *name,
-                            int quiet)
+                            int quiet, int debug)
 {
   char path[4096];
   snprintf(path, sizeof path, "%s/%s_checkpoint_%06lld.fcmck", dir, name,
            fcm_simulation_step_count(sim));
   if (fcm_simulation_write_checkpoint(sim, path) != FCM_OK) {
-    fcm_ctx_error_view(ctx, stderr);
+    report_error(ctx, debug, "writing a checkpoint");
     return 0;
   }
   if (!quiet && !isatty(2)) fprintf(stderr, "fcm-sim: checkpoint %s\n", path);
@@ -284,7 +377,11 @@ static int scene_main(int argc, char **argv)
   fcm_scene *scene = NULL;
   fcm_simulation *sim = NULL;
   char logpath[4096];
-  if (fcm_ctx_create(NULL, &ctx) != FCM_OK) {
+  warn_state ws = {o.debug, 0};
+  fcm_ctx_options co = fcm_ctx_options_default();
+  co.log = print_warning;
+  co.log_user = &ws;
+  if (fcm_ctx_create(&co, &ctx) != FCM_OK) {
     fprintf(stderr, "fcm-sim: cannot create the fcm context\n");
     return 1;
   }
@@ -311,6 +408,8 @@ static int scene_main(int argc, char **argv)
     so.rules_progress = rules_progress;
     so.rules_progress_user = &rps;
     so.rules_progress_interval = rps.tty ? 0.2 : 2.0;
+    so.geometry_progress = geometry_progress;
+    so.geometry_progress_user = &rps;
   }
   const char *name = fcm_scene_name(scene);
   if (!o.quiet)
@@ -340,24 +439,31 @@ static int scene_main(int argc, char **argv)
   fcm_simulation_counters c;
   fcm_simulation_get_counters(sim, &c);
   int frame = (int)c.frames, frames_at_start = frame;
+  /* warn once of each: an earlier run (a resumed checkpoint) may have warned already */
+  int warned_inverted = c.inverted_steps > 0, warned_nonfinite = c.nonfinite_frames > 0;
+  int tty = !o.quiet && isatty(2);
   if (write) {
     if (!make_dirs(dir)) goto done;
     snprintf(logpath, sizeof logpath, "%s/%s_log.csv", dir, name);
     if ((!o.resume && fcm_simulation_write_frame(sim, dir, frame++) != FCM_OK) ||
         fcm_simulation_write_log(sim, logpath) != FCM_OK) {
-      fcm_ctx_error_view(ctx, stderr);
+      report_error(ctx, o.debug, "writing the output");
       goto done;
     }
   }
-  int tty = !o.quiet && isatty(2);
   double t0 = fcm_wtime();
   long long n = fcm_simulation_num_steps(sim), first = fcm_simulation_step_count(sim);
   while (!fcm_simulation_done(sim)) {
     fcm_step_info si;
     if (fcm_simulation_step(sim, &si) != FCM_OK) {
       if (tty) fputc('\n', stderr);
-      fcm_ctx_error_view(ctx, stderr);
-      if (write) fcm_simulation_write_log(sim, logpath);
+      char what[160];
+      snprintf(what, sizeof what, "scene %s: step %lld (t = %.6g s)", name,
+               fcm_simulation_step_count(sim) + 1,
+               fcm_integrator_time(fcm_simulation_integrator(sim)));
+      report_error(ctx, o.debug, what);
+      if (write && fcm_simulation_write_log(sim, logpath) != FCM_OK)
+        report_error(ctx, o.debug, "writing the log");
       goto done;
     }
     if (!fcm_simulation_state_finite(sim)) {
@@ -366,20 +472,29 @@ static int scene_main(int argc, char **argv)
       goto done;
     }
     long long k = fcm_simulation_step_count(sim);
+    if (si.inverted_points > 0 && !warned_inverted) {
+      warn_inverted(tty, &si, k);
+      warned_inverted = 1;
+    }
     if (!o.quiet) progress(tty, k - first, n - first, k, n, &si, fcm_wtime() - t0);
     if (write && fcm_simulation_frame_due(sim)) {
       if (fcm_simulation_write_frame(sim, dir, frame++) != FCM_OK ||
           fcm_simulation_write_log(sim, logpath) != FCM_OK) {
-        fcm_ctx_error_view(ctx, stderr);
+        report_error(ctx, o.debug, "writing the output");
         goto done;
+      }
+      fcm_simulation_get_counters(sim, &c);
+      if (c.nonfinite_last > 0 && !warned_nonfinite) {
+        warn_nonfinite(tty, &c, frame - 1);
+        warned_nonfinite = 1;
       }
     }
     if (write && fcm_simulation_checkpoint_due(sim) &&
-        !write_checkpoint(ctx, sim, dir, name, o.quiet))
+        !write_checkpoint(ctx, sim, dir, name, o.quiet, o.debug))
       goto done;
   }
   if (write && fcm_simulation_write_log(sim, logpath) != FCM_OK) {
-    fcm_ctx_error_view(ctx, stderr);
+    report_error(ctx, o.debug, "writing the log");
     goto done;
   }
   if (!o.quiet) {

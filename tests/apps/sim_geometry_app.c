@@ -3,11 +3,20 @@
  * wholly outside exits 2 naming the scene section and both bounding boxes, without a
  * traceback unless --debug; a malformed voxel image exits 2 naming geometry.voxels and the
  * file:line of the bad header field; a body smaller than min_fraction of every cell exits 2
- * saying so; --progress prints the cell-rule progress off a
- * terminal and ends at all cells. Usage: sim_geometry_app FCM_SIM WORKDIR */
+ * saying so; --progress prints the cell-rule and level-set progress off a terminal and ends
+ * at all cells and sub-cells. Guards: NaN voxels run with a warning and are counted in the
+ * summary; a missing detached data file names the header that refers to it; a level-set
+ * feature below the sampling spacing and a build above max_subcells are refused at once
+ * (exit 2, naming the key, the value and the spacing, or the estimate, the limit and the
+ * option); a surface vertex at 1e308 is refused as out of range; a cut surface of only
+ * zero-area triangles is refused; a singular static system fails its step (exit 1) with the
+ * message and its hint, the library's traceback only with --debug.
+ * Usage: sim_geometry_app FCM_SIM WORKDIR */
 #define _POSIX_C_SOURCE 200809L
 #include "app_run.h"
 #include "test.h"
+
+#include "fcm/core.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -30,8 +39,9 @@ static int file_has(const char *path, const char *needle)
   return strstr(buf, needle) != NULL;
 }
 
-/* A 1 x 1 x 1 Hex8 grid of 2^3 cells and a geometry section. */
-static void scene(const char *path, const char *geometry)
+/* A 1 x 1 x 1 Hex8 grid of 2^3 cells, a geometry section and effects after gravity (the
+ * bottom face held when `effects` is NULL). */
+static void scene_with(const char *path, const char *geometry, const char *effects)
 {
   char text[4096];
   snprintf(text, sizeof text,
@@ -41,10 +51,97 @@ static void scene(const char *path, const char *geometry)
            " \"geometry\": %s,"
            " \"material\": {\"model\": \"linear\", \"young\": 1e6, \"poisson\": 0.3},"
            " \"time\": {\"static\": true, \"steps\": 1},"
-           " \"effects\": [{\"gravity\": {\"acceleration\": [0, 0, -9.81]}},"
-           " {\"fixed\": {\"region\": {\"box\": {\"min\": [-1, -1, -1], \"max\": [2, 2, 0]}}}}]}",
-           geometry);
+           " \"effects\": [{\"gravity\": {\"acceleration\": [0, 0, -9.81]}}%s]}",
+           geometry,
+           effects ? effects
+                   : ", {\"fixed\": {\"region\": {\"box\": {\"min\": [-1, -1, -1], "
+                     "\"max\": [2, 2, 0]}}}}");
   write_file(path, text);
+}
+
+static void scene(const char *path, const char *geometry)
+{
+  scene_with(path, geometry, NULL);
+}
+
+/* The guards of the geometry inputs and of run-time failures. */
+static void guards(const char *sim, const char *work, const char *path, const char *err,
+                   const char *out)
+{
+  char cmd[8192], file[1024];
+  /* NaN voxels: a warning with the count and the first one, and the summary counts them */
+  snprintf(file, sizeof file, "%s/geo-nan.nrrd", work);
+  write_file(file, "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 2 2\nspacings: 0.25 0.25 0.25\n"
+                   "space origin: (0.375,0.375,0.375)\nencoding: ascii\n\n1 1 nan 1 1 nan 1 1\n");
+  scene(path, "{\"voxels\": \"geo-nan.nrrd\"}");
+  snprintf(cmd, sizeof cmd, "'%s' '%s' --check 2> '%s' > '%s'", sim, path, err, out);
+  TEST_TRUE(app_run(cmd) == 0);
+  TEST_TRUE(file_has(err, "fcm-sim: warning: voxels: 2 of 8 voxel values are NaN and count as "
+                          "outside the body (never selected); the first is voxel (0, 1, 0)"));
+  TEST_TRUE(file_has(out, "6 of 2 x 2 x 2 selected") &&
+            file_has(out, "; 2 NaN values counted as outside"));
+
+  /* a detached data file that is missing: the header and its line are named with it */
+  snprintf(file, sizeof file, "%s/geo-detached.nhdr", work);
+  write_file(file, "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+                   "data file: geo-missing.raw\n");
+  scene(path, "{\"voxels\": \"geo-detached.nhdr\"}");
+  snprintf(cmd, sizeof cmd, "'%s' '%s' --check 2> '%s' > /dev/null", sim, path, err);
+  TEST_TRUE(app_run(cmd) == 2);
+  TEST_TRUE(file_has(err, "geo-detached.nhdr:6: data file: cannot open '") &&
+            file_has(err, "/geo-missing.raw': No such file"));
+
+  /* a gyroid period of 1e-9 at refinement 64: refused when the scene is read, at once */
+  scene(path, "{\"level_set\": {\"gyroid\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1], "
+              "\"period\": 1e-9, \"type\": \"solid\"}}, \"refinement\": 64}");
+  snprintf(cmd, sizeof cmd, "'%s' '%s' --check 2> '%s' > /dev/null", sim, path, err);
+  const double t0 = fcm_wtime();
+  TEST_TRUE(app_run(cmd) == 2);
+  const double took = fcm_wtime() - t0;
+  TEST_TRUE(took < 5.0); /* refused before anything is sampled */
+  TEST_TRUE(file_has(err, "geometry.level_set.gyroid.period: period = 1e-09 is below twice the "
+                          "sampling spacing h = 0.0078125"));
+  /* more sub-cells than max_subcells: the estimate, the limit and the option */
+  scene(path, "{\"level_set\": {\"sphere\": {\"center\": [0.5, 0.5, 0.5], \"radius\": 0.4}}, "
+              "\"max_subcells\": 10}");
+  snprintf(cmd, sizeof cmd, "'%s' '%s' --check 2> '%s' > /dev/null", sim, path, err);
+  TEST_TRUE(app_run(cmd) == 2);
+  TEST_TRUE(file_has(err, "geometry.level_set: level set: the build would triangulate ") &&
+            file_has(err, "more than max_subcells = 10 (") && file_has(err, "raise max_subcells"));
+
+  /* a vertex at 1e308: out of range, naming the file, the vertex and the value */
+  snprintf(file, sizeof file, "%s/geo-far.obj", work);
+  write_file(file, "v 0 0 0\nv 1e308 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  scene(path, "{\"surface\": \"geo-far.obj\"}");
+  snprintf(cmd, sizeof cmd, "'%s' '%s' --check 2> '%s' > /dev/null", sim, path, err);
+  TEST_TRUE(app_run(cmd) == 2);
+  TEST_TRUE(file_has(err, "geo-far.obj: vertex 2 (1-based, as the file's faces number them): "
+                          "coordinate x = 1e+308 is outside the supported range"));
+  TEST_TRUE(!file_has(err, "degenerate"));
+
+  /* a cut surface of zero-area triangles cuts nothing: refused before the run */
+  snprintf(file, sizeof file, "%s/geo-flat.obj", work);
+  write_file(file, "v 0 0.5 0\nv 0.5 0.5 0\nv 1 0.5 0\nf 1 2 3\n");
+  scene_with(
+      path, "{\"shape\": \"box\", \"min\": [0.1, 0.1, 0.1], \"max\": [0.9, 0.9, 0.9]}",
+      ", {\"fixed\": {\"region\": {\"box\": {\"min\": [-1, -1, -1], \"max\": [2, 2, 0.2]}}}},"
+      " {\"cut\": {\"surface\": {\"mesh\": \"geo-flat.obj\"}}}");
+  snprintf(cmd, sizeof cmd, "'%s' '%s' --check 2> '%s' > /dev/null", sim, path, err);
+  TEST_TRUE(app_run(cmd) == 2);
+  TEST_TRUE(file_has(err, "effects[2].cut.surface.mesh") &&
+            file_has(err, "all 1 triangle(s) of the cut surface have zero area"));
+
+  /* a singular static system (nothing held): the step fails with the message and its hint;
+   * the traceback of the library's frames only with --debug */
+  scene_with(path, "{\"shape\": \"box\", \"min\": [0.1, 0.1, 0.1], \"max\": [0.9, 0.9, 0.9]}", "");
+  snprintf(cmd, sizeof cmd, "'%s' '%s' --check 2> '%s' > /dev/null", sim, path, err);
+  TEST_TRUE(app_run(cmd) == 1);
+  TEST_TRUE(file_has(err, "singular") && file_has(err, "rigid"));
+  TEST_TRUE(file_has(err, "fcm-sim: --debug shows where in the library it failed"));
+  TEST_TRUE(!file_has(err, ".c:") && !file_has(err, "fcm error:"));
+  snprintf(cmd, sizeof cmd, "'%s' '%s' --check --debug 2> '%s' > /dev/null", sim, path, err);
+  TEST_TRUE(app_run(cmd) == 1);
+  TEST_TRUE(file_has(err, "fcm error: ") && file_has(err, "  [0] ") && file_has(err, ".c:"));
 }
 
 int main(int argc, char **argv)
@@ -99,10 +196,14 @@ int main(int argc, char **argv)
   snprintf(cmd, sizeof cmd, "'%s' '%s' --check --progress 2> '%s' > '%s'", sim, path, err, out);
   TEST_TRUE(app_run(cmd) == 0);
   TEST_TRUE(file_has(err, "fcm-sim: cell rules 8/8 cells"));
+  /* 8 cut cells of 4^3 sub-cells, and 8^3 each in the error estimate */
+  TEST_TRUE(file_has(err, "fcm-sim: level set 4608/4608 sub-cells"));
   TEST_TRUE(!file_has(err, "warning"));
   /* the summary: what the level set built, the cut-cell statistics and the volumes */
   TEST_TRUE(file_has(out, "geometry  level set: ") && file_has(out, "estimated error"));
   TEST_TRUE(file_has(out, "cells     8: 0 uncut, 8 cut, 0 dropped; cut-cell points stiffness"));
   TEST_TRUE(file_has(out, "(ratio 1.000000), outside the background 0"));
+
+  guards(sim, work, path, err, out);
   return TEST_RESULT();
 }

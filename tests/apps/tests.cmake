@@ -129,3 +129,9 @@ if(FCM_HAVE_PETSC)
                          PROCESSORS ${np} ENVIRONMENT "${FCM_MPI_TEST_ENV}")
   endforeach()
 endif()
+# fcm-sim and inverted elements: a soft block squashed through its held base warns (the log's
+# inverted_points and nonfinite_stresses columns, the summary) and runs on, or with
+# "on_inversion": "stop" exits 1 at the first inverted step leaving whole files; a gentle
+# push reports zero.
+fcm_add_test(app_sim_inversion tests/apps/inversion_app.c LABELS app
+             ARGS $<TARGET_FILE:fcm-sim> ${work})

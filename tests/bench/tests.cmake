@@ -8,3 +8,6 @@ set_tests_properties(bench_shared_cores bench_shared_cores_spin PROPERTIES LABEL
                      TIMEOUT 3600 RUN_SERIAL TRUE)
 set_tests_properties(bench_shared_cores PROPERTIES ENVIRONMENT "OMP_WAIT_POLICY=passive")
 set_tests_properties(bench_shared_cores_spin PROPERTIES ENVIRONMENT "GOMP_SPINCOUNT=300000")
+# Peak bytes of the level-set build per triangulated sub-cell (FCM_LEVEL_SET_SUBCELL_BYTES,
+# the default max_subcells): spheres and gyroids at refinements 1-32.
+fcm_add_test(bench_level_set_memory tests/bench/bench_level_set_memory.c LABELS bench TIMEOUT 600)

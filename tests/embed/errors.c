@@ -1,9 +1,11 @@
 /* Error paths of fcm_cell_rules_create: a non-convex background cell is rejected naming
  * the cell; bad strengths, thresholds, tolerances, thread counts and stabilization
- * settings are FCM_ERR_ARG with the value in the message; *rules stays NULL. Then the
+ * settings are FCM_ERR_ARG with the value in the message; *rules stays NULL; a cut surface
+ * of zero-area triangles only is refused (FCM_ERR_GEOMETRY). Then the
  * allocation-failure loop (fail the k-th allocation, k = 0, 1, ... until success; one
  * thread): FCM_ERR_ALLOC, NULL output, nothing leaked. */
 #include "fcm/embed.h"
+#include "fcm/surface.h"
 #include "test.h"
 #include "test_alloc.h"
 
@@ -112,11 +114,49 @@ static void allocation_failures(void)
   fcm_ctx_destroy(&ctx);
 }
 
+/* A cut surface whose triangles all lack area (collinear, repeated or sliver vertices) would
+ * separate nothing: refused with FCM_ERR_GEOMETRY giving the count and the first; one
+ * triangle of positive area among them makes a cut (the others are skipped). */
+static void degenerate_cut(fcm_ctx *ctx)
+{
+  const double lo[3] = {0, 0, 0}, hi[3] = {2, 1, 1}, c0[3] = {1, 0.5, 0.5};
+  const fcm_index n[3] = {2, 1, 1};
+  fcm_mesh *box = NULL;
+  fcm_geometry *g = NULL;
+  fcm_cell_rules *r0 = NULL, *r1 = NULL;
+  fcm_surface *flat = NULL, *mixed = NULL;
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, n, &box));
+  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c0, 0.4, 2, &g));
+  if (box && g) TEST_OK(ctx, fcm_cell_rules_create(ctx, box, g, NULL, &r0));
+  /* in the plane x = 0.9: collinear; repeated; a sliver 1e-16 off its longest edge; and a
+   * triangle across the whole ball */
+  const double x[] = {0.9,   0,   0, 0.9, 0.5, 0.5, 0.9, 1,   1, 0.9, 0,   1,  0.9, 1,
+                      1e-16, 0.9, 2, 0,   0.9, -1,  -1,  0.9, 3, -1,  0.9, -1, 3};
+  const fcm_index degenerate[] = {0, 1, 2, 0, 0, 3, 0, 4, 5}, with_one[] = {0, 1, 2, 6, 7, 8};
+  TEST_OK(ctx, fcm_surface_create(ctx, 9, x, 3, degenerate, &flat));
+  TEST_OK(ctx, fcm_surface_create(ctx, 9, x, 2, with_one, &mixed));
+  if (r0 && flat && mixed) {
+    TEST_ERR(ctx, fcm_cell_rules_create_cut(ctx, box, g, r0, flat, &r1), FCM_ERR_GEOMETRY,
+             "embed cut: all 3 triangle(s) of the cut surface have zero area (the first: (0.9, "
+             "0, 0), (0.9, 0.5, 0.5), (0.9, 1, 1)), so the cut would separate nothing");
+    TEST_TRUE(r1 == NULL);
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, box, g, r0, mixed, &r1));
+    if (r1) TEST_TRUE(fcm_cell_rules_num_cuts(r1) == 1 && fcm_cell_rules_num_pieces(r1) > 2);
+  }
+  fcm_cell_rules_destroy(&r1);
+  fcm_cell_rules_destroy(&r0);
+  fcm_surface_destroy(&flat);
+  fcm_surface_destroy(&mixed);
+  fcm_mesh_destroy(&box);
+  fcm_geometry_destroy(&g);
+}
+
 int main(void)
 {
   fcm_ctx *ctx = NULL;
   TEST_OK(NULL, fcm_ctx_create(NULL, &ctx));
   arguments(ctx);
+  degenerate_cut(ctx);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
   allocation_failures();

@@ -5,7 +5,9 @@
  * fcm_element_standard_rule and the output fields (cell stress, max displacement, VTU of the
  * space, the embedded surface and its VTU), a local space localized on some cells
  * (fcm__space_create_local() + fcm__space_localize()) and its matrix over the local rows
- * (fcm__space_matrix_create_rows()) returns FCM_ERR_ALLOC, NULL outputs and leaks nothing. */
+ * (fcm__space_matrix_create_rows()), a second cut (fcm_cell_rules_create_cut() on rules that
+ * have one) and a space with constrained copies of a cut (fcm_space_create_embedded_with())
+ * returns FCM_ERR_ALLOC, NULL outputs and leaks nothing. */
 #include "fcm/fcm.h"
 #include "alloc_loop.h"
 #include "fem/fem_impl.h"
@@ -36,6 +38,9 @@ typedef struct fixture {
   fcm_embedded_surface *es_out;
   fcm_geometry *geom;
   fcm_embedded_surface *es;
+  fcm_cell_rules *cut1, *rules_out; /* one cut; the output of the second */
+  fcm_surface *plane;
+  fcm_space_options so;
   double *cell_out; /* 8 x num_cells */
 } fixture;
 
@@ -107,9 +112,25 @@ static fcm_status surface_vtu(void *u)
   fixture *x = u;
   return fcm_embedded_surface_write_vtu(x->es, &x->mat, x->u, "fem_alloc_out/s.vtu");
 }
+static fcm_status second_cut(void *u)
+{
+  fixture *x = u;
+  x->rules_out = (fcm_cell_rules *)x;
+  fcm_status st =
+      fcm_cell_rules_create_cut(x->ctx, x->mesh, x->geom, x->cut1, x->plane, &x->rules_out);
+  return OUT_CHECK(st, x->rules_out);
+}
+static fcm_status constrained_space(void *u)
+{
+  fixture *x = u;
+  x->s_out = (fcm_space *)x;
+  fcm_status st = fcm_space_create_embedded_with(x->ctx, x->mesh, x->cut1, &x->so, &x->s_out);
+  return OUT_CHECK(st, x->s_out);
+}
 static void release(void *u)
 {
   fixture *x = u;
+  fcm_cell_rules_destroy(&x->rules_out);
   fcm_embedded_surface_destroy(&x->es_out);
   fcm_space_destroy(&x->s_out);
   fcm_csr_destroy(&x->A_out);
@@ -254,6 +275,26 @@ int main(void)
   rmdir("fem_alloc_out");
   fcm_embedded_surface_destroy(&x.es);
   free(x.cell_out);
+
+  /* a cut 1e-7 off the cell faces x = 0 (slices of the right cells whose copies are tiny
+   * with the ratio 1e-6), then a second cut across it */
+  const double p1[3] = {1e-7, 0, 0}, n1[3] = {1, 0, 0}, p2[3] = {0, 0.2, 0}, n2[3] = {0.1, 1, 0.2};
+  const double blo[3] = {-1.2, -1.2, -1.2}, bhi[3] = {1.2, 1.2, 1.2};
+  TEST_OK(ctx, fcm_surface_create_plane(ctx, p1, n1, blo, bhi, &x.plane));
+  TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, x.mesh, g, x.rules, x.plane, &x.cut1));
+  fcm_surface_destroy(&x.plane);
+  TEST_OK(ctx, fcm_surface_create_plane(ctx, p2, n2, blo, bhi, &x.plane));
+  x.so = fcm_space_options_default();
+  x.so.constrain_ratio = 1e-6;
+  TEST_OK(ctx, constrained_space(&x));
+  TEST_TRUE(x.s_out && fcm_space_num_constrained_copies(x.s_out) > 0);
+  release(&x);
+  alloc_loop(ctx, &f, "fcm_cell_rules_create_cut (a second cut)", second_cut, release, &x, 5,
+             10000);
+  alloc_loop(ctx, &f, "fcm_space_create_embedded_with (constrained copies)", constrained_space,
+             release, &x, 5, 1000);
+  fcm_surface_destroy(&x.plane);
+  fcm_cell_rules_destroy(&x.cut1);
 
   free(x.f), free(x.u);
   fcm_csr_destroy(&x.K);

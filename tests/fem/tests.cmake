@@ -40,3 +40,13 @@ endforeach()
 fcm_add_test(fem_local_assembly_hex8 tests/fem/local_assembly.c ARGS hex8 6 LABELS unit)
 fcm_add_test(fem_local_assembly_hex8_cut tests/fem/local_assembly.c ARGS hex8 6 cut LABELS unit)
 fcm_add_test(fem_local_assembly_hex20 tests/fem/local_assembly.c ARGS hex20 6 LABELS unit)
+# State transfer across sequences of cuts (random, near cell planes, crossing knives, and
+# fixed cases): piece volumes, the field at every point and mass and momenta carried over by
+# every cut, with and without the constraint of tiny copies. The long version: 20 sequences
+# of 2, 5 and 10 cuts per kind of plane on two bodies (cuts whose pieces lose volume or that
+# are refused end their sequence and are counted: `fem_transfer <el> 20 1 1` lists them).
+foreach(el tet4 tet10 hex8 hex20)
+  fcm_add_test(fem_transfer_${el} tests/fem/transfer.c ARGS ${el})
+  fcm_add_test(fem_transfer_long_${el} tests/fem/transfer.c ARGS ${el} 20 1 LABELS slow
+               TIMEOUT 3600)
+endforeach()

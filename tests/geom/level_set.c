@@ -3,11 +3,15 @@
  * triangles (iso-surface and box faces) are closed and outward (they enclose the volume) and lie on
  * their tets; a box aligned with the lattice is exact; CSG: the union of disjoint spheres has the
  * sum of their volumes, a difference removes the inner ball, an intersection with a half space
- * halves a ball; the torus and gyroid evaluate sensibly; bad trees and arguments fail. */
+ * halves a ball; the torus and gyroid evaluate sensibly; bad trees and arguments fail;
+ * features below the sampling spacing are refused at once; the sub-cell limit refuses a build
+ * before it allocates, and the documented bytes per sub-cell bound a build; progress ends at
+ * its total. */
 #include "fcm/levelset.h"
 #include "test.h"
 
 #include <math.h>
+#include <stdlib.h>
 
 static const double PI = 3.14159265358979323846;
 
@@ -203,6 +207,211 @@ static void csg(fcm_ctx *ctx)
   fcm_geometry_destroy(&g2);
 }
 
+/* Allocation through a counting allocator: live and peak bytes (a size header per block). */
+static size_t live_bytes, peak_bytes;
+
+static void *count_alloc(void *user, size_t n)
+{
+  (void)user;
+  size_t *p = malloc(n + 16);
+  if (!p) return NULL;
+  p[0] = n;
+  live_bytes += n;
+  if (live_bytes > peak_bytes) peak_bytes = live_bytes;
+  return (char *)p + 16;
+}
+
+static void count_release(void *user, void *q)
+{
+  (void)user;
+  if (!q) return;
+  size_t *p = (size_t *)((char *)q - 16);
+  live_bytes -= p[0];
+  free(p);
+}
+
+/* The sub-cells a build at refinement r triangulates, counted here from the samples: the
+ * sub-cubes of n^3 cells on [lo, hi]^3 whose corners have both signs, plus one per cell whose
+ * samples are all inside. */
+static fcm_index count_subcells(const fcm_implicit_tree *t, double lo, double hi, int n, int r)
+{
+  const int N = n * r, m = r + 1;
+  fcm_index count = 0;
+  double *w = malloc(sizeof *w * (size_t)(m * m * m));
+  if (!w) return -1;
+  for (int k = 0; k < n; k++)
+    for (int j = 0; j < n; j++)
+      for (int i = 0; i < n; i++) {
+        int nin = 0;
+        for (int c = 0; c < m; c++)
+          for (int b = 0; b < m; b++)
+            for (int a = 0; a < m; a++) {
+              const int g[3] = {i * r + a, j * r + b, k * r + c};
+              double x[3];
+              for (int d = 0; d < 3; d++)
+                x[d] = g[d] == N ? hi : lo + (hi - lo) * ((double)g[d] / (double)N);
+              w[a + m * (b + m * c)] = fcm_implicit_eval(x, (void *)t);
+              nin += w[a + m * (b + m * c)] < 0;
+            }
+        if (nin == m * m * m) count++;
+        if (nin == 0 || nin == m * m * m) continue;
+        for (int c = 0; c < r; c++)
+          for (int b = 0; b < r; b++)
+            for (int a = 0; a < r; a++) {
+              int in = 0;
+              for (int q = 0; q < 8; q++)
+                in += w[(a + (q & 1)) + m * ((b + !!(q & 2)) + m * (c + !!(q & 4)))] < 0;
+              count += in > 0 && in < 8;
+            }
+      }
+  free(w);
+  return count;
+}
+
+/* Progress calls: monotone, the last at done == total. */
+typedef struct progress_log {
+  int calls, monotone;
+  fcm_index last_done, last_total;
+} progress_log;
+
+static void on_progress(fcm_index done, fcm_index total, void *user)
+{
+  progress_log *p = user;
+  p->monotone &= done >= p->last_done && done <= total && (p->calls == 0 || total == p->last_total);
+  p->calls++, p->last_done = done, p->last_total = total;
+}
+
+/* The sampling must resolve every feature: a feature below the spacing h is refused naming
+ * the node, the member, its value and h; at h it passes. The gyroid of period 1e-9 at
+ * refinement 64 on a 4^3 grid (16.7 million sub-cells of noise) is refused at once. */
+static void spacing(fcm_ctx *ctx)
+{
+  const double h = 0.1;
+  fcm_implicit q[3] = {{0}};
+  fcm_implicit_tree t = {1, q};
+  q[0].kind = FCM_IMPLICIT_SPHERE, q[0].radius = 0.1;
+  TEST_OK(ctx, fcm_implicit_check_spacing(ctx, &t, h));
+  q[0].radius = 0.05;
+  TEST_ERR(ctx, fcm_implicit_check_spacing(ctx, &t, h), FCM_ERR_ARG,
+           "node 0 (sphere): radius = 0.05 is below the sampling spacing h = 0.1");
+  q[0].kind = FCM_IMPLICIT_TORUS, q[0].radius = 1, q[0].minor_radius = 0.09;
+  TEST_ERR(ctx, fcm_implicit_check_spacing(ctx, &t, h), FCM_ERR_ARG,
+           "node 0 (torus): minor_radius = 0.09 is below the sampling spacing h = 0.1");
+  q[0].minor_radius = 0.1;
+  TEST_OK(ctx, fcm_implicit_check_spacing(ctx, &t, h));
+  q[0].kind = FCM_IMPLICIT_BOX;
+  for (int d = 0; d < 3; d++)
+    q[0].min[d] = 0, q[0].max[d] = 1;
+  q[0].max[1] = 0.08;
+  TEST_ERR(ctx, fcm_implicit_check_spacing(ctx, &t, h), FCM_ERR_ARG,
+           "node 0 (box): the side max[1] - min[1] = 0.08 is below the sampling spacing h = 0.1");
+  q[0].max[1] = 0.1;
+  TEST_OK(ctx, fcm_implicit_check_spacing(ctx, &t, h));
+  q[0].kind = FCM_IMPLICIT_GYROID, q[0].period = 0.2, q[0].sheet = 0, q[0].thickness = 0;
+  TEST_OK(ctx, fcm_implicit_check_spacing(ctx, &t, h)); /* two samples per period */
+  q[0].period = 0.19;
+  TEST_ERR(ctx, fcm_implicit_check_spacing(ctx, &t, h), FCM_ERR_ARG,
+           "node 0 (gyroid): period = 0.19 is below twice the sampling spacing h = 0.1");
+  q[0].period = 1, q[0].sheet = 1, q[0].thickness = 0.04; /* a wall 0.08 thick */
+  TEST_ERR(ctx, fcm_implicit_check_spacing(ctx, &t, h), FCM_ERR_ARG,
+           "node 0 (gyroid): thickness = 0.04 is below half the sampling spacing h = 0.1");
+  q[0].thickness = 0.05;
+  TEST_OK(ctx, fcm_implicit_check_spacing(ctx, &t, h));
+  /* in a tree: the node that fails is named; CSG nodes have no feature of their own */
+  q[1].kind = FCM_IMPLICIT_SPHERE, q[1].radius = 0.01;
+  q[2].kind = FCM_IMPLICIT_DIFFERENCE, q[2].a = 0, q[2].b = 1;
+  t.num_nodes = 3;
+  TEST_ERR(ctx, fcm_implicit_check_spacing(ctx, &t, h), FCM_ERR_ARG, "node 1 (sphere): radius");
+  q[1].radius = 0.5;
+  TEST_OK(ctx, fcm_implicit_check_spacing(ctx, &t, h));
+  TEST_ERR(ctx, fcm_implicit_check_spacing(ctx, &t, 0.0), FCM_ERR_ARG, "h = 0 must be positive");
+  q[2].b = 2;
+  TEST_ERR(ctx, fcm_implicit_check_spacing(ctx, &t, h), FCM_ERR_ARG, "operands 0, 2");
+  /* the build checks a built-in tree before sampling anything */
+  fcm_implicit gy = {0};
+  gy.kind = FCM_IMPLICIT_GYROID, gy.period = 1e-9;
+  for (int d = 0; d < 3; d++)
+    gy.min[d] = 0, gy.max[d] = 1;
+  fcm_implicit_tree tg = {1, &gy};
+  fcm_level_set_options o = fcm_level_set_options_default();
+  o.refinement = 64;
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  const fcm_index n4[3] = {4, 4, 4};
+  fcm_geometry *g = NULL;
+  const double t0 = fcm_wtime();
+  TEST_ERR(
+      ctx,
+      fcm_geometry_create_from_level_set(ctx, fcm_implicit_eval, &tg, lo, hi, n4, &o, &g, NULL),
+      FCM_ERR_ARG,
+      "node 0 (gyroid): period = 1e-09 is below twice the sampling spacing h = 0.00390625");
+  TEST_TRUE(fcm_wtime() - t0 < 0.5 && g == NULL);
+}
+
+/* The sub-cell limit: the estimate is the count of crossed sub-cells plus inside cells; a
+ * build one above the limit is refused before it allocates anything of its size, naming the
+ * estimate, the limit and the option; at the limit it builds within
+ * FCM_LEVEL_SET_SUBCELL_BYTES per sub-cell; progress ends at done == total, the sub-cells of
+ * the build and of the error estimate. */
+static void subcell_limit(void)
+{
+  fcm_ctx_options co = fcm_ctx_options_default();
+  co.allocator.alloc = count_alloc, co.allocator.release = count_release;
+  fcm_ctx *ctx = NULL;
+  TEST_OK(ctx, fcm_ctx_create(&co, &ctx));
+  if (!ctx) return;
+  fcm_implicit s = {0};
+  s.kind = FCM_IMPLICIT_SPHERE, s.radius = 0.7, s.center[0] = 0.05;
+  fcm_implicit_tree t = {1, &s};
+  const int n = 6, r = 4;
+  const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
+  const fcm_index nn[3] = {n, n, n};
+  const fcm_index expect = count_subcells(&t, -1, 1, n, r);
+  fcm_level_set_options o = fcm_level_set_options_default();
+  fcm_level_set_info info;
+  fcm_geometry *g = NULL;
+  o.refinement = r;
+  o.max_subcells = expect - 1;
+  const size_t base = live_bytes;
+  peak_bytes = live_bytes;
+  char msg[200];
+  snprintf(msg, sizeof msg, "level set: the build would triangulate %lld sub-cells",
+           (long long)expect);
+  TEST_ERR(
+      ctx,
+      fcm_geometry_create_from_level_set(ctx, fcm_implicit_eval, &t, lo, hi, nn, &o, &g, &info),
+      FCM_ERR_UNSUPPORTED, msg);
+  snprintf(msg, sizeof msg, "more than max_subcells = %lld (", (long long)(expect - 1));
+  TEST_ERR(ctx,
+           fcm_geometry_create_from_level_set(ctx, fcm_implicit_eval, &t, lo, hi, nn, &o, &g, NULL),
+           FCM_ERR_UNSUPPORTED, msg);
+  TEST_TRUE(g == NULL && live_bytes == base);
+  TEST_TRUE(peak_bytes - base < 64 * 1024); /* the samples of one cell and the cell kinds */
+  progress_log pl = {0, 1, 0, 0};
+  o.max_subcells = expect;
+  o.progress = on_progress, o.progress_user = &pl, o.progress_interval = 0;
+  peak_bytes = live_bytes;
+  TEST_OK(ctx, fcm_geometry_create_from_level_set(ctx, fcm_implicit_eval, &t, lo, hi, nn, &o, &g,
+                                                  &info));
+  if (g) {
+    TEST_TRUE(info.subcells == expect);
+    TEST_TRUE((double)(peak_bytes - base) <= (double)FCM_LEVEL_SET_SUBCELL_BYTES * expect);
+    const fcm_index total = info.cells_cut * r * r * r * 9; /* r^3 + (2r)^3 per cut cell */
+    TEST_TRUE(pl.calls >= 2 && pl.monotone && pl.last_done == total && pl.last_total == total);
+  }
+  fcm_geometry_destroy(&g);
+  /* 0: no limit */
+  o.max_subcells = 0, o.progress = NULL;
+  TEST_OK(ctx,
+          fcm_geometry_create_from_level_set(ctx, fcm_implicit_eval, &t, lo, hi, nn, &o, &g, NULL));
+  fcm_geometry_destroy(&g);
+  o.max_subcells = -1;
+  TEST_ERR(ctx,
+           fcm_geometry_create_from_level_set(ctx, fcm_implicit_eval, &t, lo, hi, nn, &o, &g, NULL),
+           FCM_ERR_ARG, "max_subcells = -1 must be >= 0");
+  TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
+  fcm_ctx_destroy(&ctx);
+}
+
 static double nan_phi(const double x[3], void *user)
 {
   (void)user;
@@ -251,6 +460,8 @@ int main(void)
   sphere_rate(ctx);
   csg(ctx);
   errors(ctx);
+  spacing(ctx);
+  subcell_limit();
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();

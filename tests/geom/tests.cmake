@@ -6,6 +6,9 @@ fcm_add_test(geom_shapes tests/geom/shapes.c)
 fcm_add_test(geom_readers tests/geom/readers.c)
 fcm_add_test(geom_errors tests/geom/errors.c)
 fcm_add_test(geom_reader_limits tests/geom/reader_limits.c)
+# Coordinates beyond +-1e100 refused by every reader and array constructor, naming the file,
+# the vertex (in the format's numbering) and the value; finite results at the limit.
+fcm_add_test(geom_coord_range tests/geom/coord_range.c)
 # Allocation failures: geometry from arrays and Gmsh files, AABB tree build and query.
 fcm_add_test(geom_alloc_failure tests/geom/alloc_failure.c)
 fcm_add_test(geom_boundary_cells tests/geom/boundary_cells.c)

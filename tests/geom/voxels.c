@@ -2,7 +2,9 @@
  * into one box and a porous block into far fewer boxes than voxels; without merging the
  * boundary is exact; NRRD (attached, detached, every type, both endians, ascii, byte skip)
  * and MetaImage (.mhd + raw, .mha) round trips of a generated image; header errors name
- * file:line and the field; no selected voxel is an error giving the value range. */
+ * file:line and the field; a missing or short detached data file is named with its header;
+ * an image reaching beyond 1e50 is out of range; no selected voxel is an error giving the
+ * value range; NaN values are never selected, counted and logged as one warning. */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/voxels.h"
 #include "test.h"
@@ -399,10 +401,24 @@ static void errors(fcm_ctx *ctx)
        "linearly dependent", FCM_ERR_ARG},
       {"NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: ascii\n\n1 2 3 x 5 6 7 8",
        "value 3 'x' is not a number", FCM_ERR_FORMAT},
+      /* a detached data file: missing or short, named with the header that refers to it */
       {"NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: "
        "vox_missing.raw\n",
-       "vox_missing.raw", FCM_ERR_IO},
+       "voxel image: vox_err.nrrd:6: data file: cannot open 'vox_missing.raw': No such file",
+       FCM_ERR_IO},
+      {"NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: "
+       "vox_short.raw\n",
+       "vox_short.raw (the data file of vox_err.nrrd): 2 x 2 x 2 raw values need at least 8 "
+       "bytes of data, the file has 3",
+       FCM_ERR_FORMAT},
+      /* voxels reaching beyond 1e50: out of range, whatever the computations would make */
+      {"NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nspacings: 1e50 1 1\nencoding: "
+       "raw\n\n01234567",
+       "vox_err.nrrd: the image reaches |x| = 2.5e+50 (origin, axis vectors and sizes), "
+       "outside the supported range [-1e50, 1e50]",
+       FCM_ERR_ARG},
   };
+  write_text("vox_short.raw", "abc");
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     write_text("vox_err.nrrd", cases[c].text);
     TEST_ERR(ctx, fcm_voxel_image_create_from_file(ctx, "vox_err.nrrd", &img), cases[c].code,
@@ -410,6 +426,11 @@ static void errors(fcm_ctx *ctx)
     TEST_TRUE(img == NULL);
   }
   remove("vox_err.nrrd");
+  remove("vox_short.raw");
+  write_text("vox_err.mhd", "NDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\n"
+                            "ElementDataFile = vox_missing.raw\n");
+  TEST_ERR(ctx, fcm_voxel_image_create_from_file(ctx, "vox_err.mhd", &img), FCM_ERR_IO,
+           "voxel image: vox_err.mhd:4: data file: cannot open 'vox_missing.raw'");
   write_text("vox_err.mhd", "NDims = 3\nDimSize = 2 2 -1\n");
   TEST_ERR(ctx, fcm_voxel_image_create_from_file(ctx, "vox_err.mhd", &img), FCM_ERR_FORMAT,
            "vox_err.mhd:2: DimSize: '2 2 -1' is not 3 integers in [1, 2^40]");
@@ -431,6 +452,77 @@ static void errors(fcm_ctx *ctx)
            "size 0 of axis 1 must be >= 1");
 }
 
+/* What the log callback received: warnings and the last one. */
+typedef struct logbook {
+  int warnings;
+  char last[1024];
+} logbook;
+
+static void log_fn(void *user, fcm_log_level level, const char *msg)
+{
+  logbook *b = user;
+  if (level != FCM_LOG_WARNING) return;
+  b->warnings++;
+  snprintf(b->last, sizeof b->last, "%s", msg);
+}
+
+/* NaN values are never selected; they are counted and logged as one warning naming the
+ * first; an image of NaN only says so. */
+static void nan_values(void)
+{
+  logbook book = {0, ""};
+  fcm_ctx_options co = fcm_ctx_options_default();
+  co.log = log_fn, co.log_user = &book;
+  fcm_ctx *ctx = NULL;
+  TEST_OK(ctx, fcm_ctx_create(&co, &ctx));
+  if (!ctx) return;
+  double v[NX * NY * NZ];
+  fcm_index selected = 0, nans = 0;
+  for (int k = 0; k < NZ; k++)
+    for (int j = 0; j < NY; j++)
+      for (int i = 0; i < NX; i++) {
+        const int hole = (i + 2 * j + 3 * k) % 5 == 1; /* the first: (1, 0, 0) */
+        v[i + NX * (j + NY * k)] = hole ? NAN : porous(i, j, k);
+        nans += hole;
+        selected += !hole && porous(i, j, k) >= 0.5;
+      }
+  const fcm_index dims[3] = {NX, NY, NZ};
+  fcm_voxel_image *img = NULL;
+  fcm_geometry *g = NULL;
+  fcm_voxel_info info;
+  TEST_OK(ctx, fcm_voxel_image_create(ctx, dims, NULL, NULL, v, &img));
+  if (img) TEST_OK(ctx, fcm_geometry_create_from_voxels(ctx, img, NULL, &g, &info));
+  if (g) {
+    TEST_TRUE(info.num_nan == nans && info.num_selected == selected);
+    TEST_NEAR(fcm_geometry_volume(g), (double)selected, 1e-13, 0);
+    char expect[160];
+    snprintf(expect, sizeof expect, "voxels: %lld of %d voxel values are NaN", (long long)nans,
+             NX * NY * NZ);
+    TEST_TRUE(book.warnings == 1 && strstr(book.last, expect) &&
+              strstr(book.last, "the first is voxel (1, 0, 0)"));
+  }
+  fcm_geometry_destroy(&g);
+  fcm_voxel_image_destroy(&img);
+  /* without NaN: no warning */
+  for (int i = 0; i < NX * NY * NZ; i++)
+    v[i] = isnan(v[i]) ? 0 : v[i];
+  book.warnings = 0;
+  TEST_OK(ctx, fcm_voxel_image_create(ctx, dims, NULL, NULL, v, &img));
+  if (img) TEST_OK(ctx, fcm_geometry_create_from_voxels(ctx, img, NULL, &g, &info));
+  TEST_TRUE(book.warnings == 0 && (!g || info.num_nan == 0));
+  fcm_geometry_destroy(&g);
+  fcm_voxel_image_destroy(&img);
+  for (int i = 0; i < NX * NY * NZ; i++)
+    v[i] = NAN;
+  TEST_OK(ctx, fcm_voxel_image_create(ctx, dims, NULL, NULL, v, &img));
+  if (img)
+    TEST_ERR(ctx, fcm_geometry_create_from_voxels(ctx, img, NULL, &g, NULL), FCM_ERR_GEOMETRY,
+             "(every value is NaN)");
+  fcm_voxel_image_destroy(&img);
+  TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
+  fcm_ctx_destroy(&ctx);
+}
+
 int main(void)
 {
   fcm_ctx *ctx = NULL;
@@ -440,6 +532,7 @@ int main(void)
   volumes(ctx);
   boundaries(ctx);
   errors(ctx);
+  nan_values();
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();

@@ -128,7 +128,7 @@ static void test_errors(fcm_ctx *ctx)
   two_cubes(x, cells);
   x[3 * 4 + 1] = NAN;
   TEST_ERR(ctx, fcm_mesh_create(ctx, FCM_ELEMENT_HEX8, 12, x, 2, cells, &m), FCM_ERR_ARG,
-           "coordinate 1 of node 4 is nan");
+           "coordinate 1 of node 4 (0-based) is nan");
   TEST_TRUE(m == NULL);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
 }

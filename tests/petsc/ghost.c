@@ -391,7 +391,7 @@ int main(int argc, char **argv)
     snprintf(ref, sizeof ref, "%s/ref_%d.vtu", dir, rank);
     snprintf(got, sizeof got, "%s/ghost_%d.vtu", dir, rank);
     snprintf(got2, sizeof got2, "%s/ghost2_%d.vtu", dir, rank);
-    TEST_OK(ctx, fcm__space_write_vtu_piece(l, NULL, u, v, own_mask, rank, ref));
+    TEST_OK(ctx, fcm__space_write_vtu_piece(l, NULL, u, v, own_mask, rank, ref, NULL));
     size_t nr = 0, ng = 0, ng2 = 0;
     unsigned char *br = slurp(ref, &nr), *bg = slurp(got, &ng), *bg2 = slurp(got2, &ng2);
     TEST_TRUE(br && bg && bg2 && nr > 0 && nr == ng && ng == ng2);

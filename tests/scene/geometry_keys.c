@@ -1,7 +1,9 @@
 /* The geometry keys "voxels" and "level_set": an implicit tree parses into nodes with their
  * operands and defaults (CSG arrays fold left), the sampling box defaults to the background
  * grid, voxel options (labels, merge) are kept; bad input fails naming the JSON path (nested
- * operands included) and the valid range; a scene with each geometry builds and the
+ * operands included) and the valid range; implicit features below the sampling spacing are
+ * refused while parsing, naming the key, the value and the spacing; max_subcells is kept and
+ * a build above it stops naming it; a scene with each geometry builds and the
  * embedded volume equals what the geometry reports. */
 #include "scene_util.h"
 
@@ -116,6 +118,57 @@ int main(void)
         FCM_ERR_ARG, "give \"min\", \"max\" and \"cells\"");
   parse(ctx, "{\"level_set\": {\"sphere\": {\"radius\": 1}}, \"refinement\": 0}", FCM_ERR_ARG,
         "geometry.refinement");
+  /* features below the sampling spacing (here h = 1 / (4 x 4) = 0.0625), named by their
+   * JSON path, refused while parsing; the spacing follows the refinement and the box */
+  parse(ctx,
+        "{\"level_set\": {\"union\": [{\"sphere\": {\"radius\": 0.5}}, {\"torus\": "
+        "{\"major_radius\": 0.3, \"minor_radius\": 0.05}}]}, \"refinement\": 4}",
+        FCM_ERR_ARG,
+        "geometry.level_set.union[1].torus.minor_radius: minor_radius = 0.05 is below the "
+        "sampling spacing h = 0.0625");
+  parse(ctx,
+        "{\"level_set\": {\"gyroid\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1], \"period\": 1e-9, "
+        "\"type\": \"solid\"}}, \"refinement\": 64}",
+        FCM_ERR_ARG,
+        "geometry.level_set.gyroid.period: period = 1e-09 is below twice the sampling spacing "
+        "h = 0.00390625");
+  parse(ctx,
+        "{\"level_set\": {\"gyroid\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1], \"period\": 0.5, "
+        "\"thickness\": 0.02}}, \"refinement\": 3}",
+        FCM_ERR_ARG, "geometry.level_set.gyroid.thickness: thickness = 0.02 is below half the");
+  parse(ctx,
+        "{\"level_set\": {\"difference\": [{\"sphere\": {\"radius\": 0.5}}, {\"box\": "
+        "{\"min\": [0, 0, 0], \"max\": [1, 0.01, 1]}}]}}",
+        FCM_ERR_ARG,
+        "geometry.level_set.difference[1].box: the side max[1] - min[1] = 0.01 is below the "
+        "sampling spacing h = 0.0625");
+  s = parse(ctx,
+            "{\"level_set\": {\"sphere\": {\"radius\": 0.06}}, \"refinement\": 3, \"min\": [0, 0, "
+            "0], \"max\": [0.5, 0.5, 0.5], \"cells\": [3, 3, 3]}",
+            FCM_OK, NULL); /* h = 0.5 / 9 < 0.06 on its own box (0.083 on the background) */
+  if (s) TEST_TRUE(fcm_scene_get_geometry(s)->max_subcells == FCM_LEVEL_SET_MAX_SUBCELLS);
+  fcm_scene_destroy(&s);
+  /* max_subcells: kept, 0 allowed, negative refused; a build above it stops naming it */
+  s = parse(ctx,
+            "{\"level_set\": {\"sphere\": {\"center\": [0.5, 0.5, 0.5], \"radius\": 0.3}}, "
+            "\"max_subcells\": 0}",
+            FCM_OK, NULL);
+  if (s) TEST_TRUE(fcm_scene_get_geometry(s)->max_subcells == 0);
+  fcm_scene_destroy(&s);
+  parse(ctx, "{\"level_set\": {\"sphere\": {\"radius\": 1}}, \"max_subcells\": -1}", FCM_ERR_ARG,
+        "geometry.max_subcells");
+  parse(ctx, "{\"voxels\": \"v.nrrd\", \"max_subcells\": 10}", FCM_ERR_ARG, "max_subcells");
+  s = parse(ctx,
+            "{\"level_set\": {\"sphere\": {\"center\": [0.5, 0.5, 0.5], \"radius\": 0.3}}, "
+            "\"max_subcells\": 5}",
+            FCM_OK, NULL);
+  if (s) {
+    fcm_simulation *sim = NULL;
+    TEST_ERR(ctx, fcm_simulation_create(ctx, s, NULL, &sim), FCM_ERR_UNSUPPORTED,
+             "geometry.level_set: level set: the build would triangulate");
+    TEST_TRUE(sim == NULL);
+  }
+  fcm_scene_destroy(&s);
   parse(ctx, "{\"voxels\": \"v.nrrd\", \"labels\": [1], \"threshold\": 2}", FCM_ERR_ARG,
         "either \"labels\" or \"threshold\"");
   parse(ctx, "{\"voxels\": \"missing.nrrd\"}", FCM_ERR_IO, "missing.nrrd");

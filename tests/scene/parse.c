@@ -76,9 +76,11 @@ static void check_full(fcm_ctx *ctx)
   TEST_TRUE(so->schwarz_threshold == 0.25 && so->schwarz.epsilon == 1e-12 &&
             so->schwarz.clamp == FCM_SCHWARZ_PAPER);
   TEST_TRUE(so->rtol == 1e-6 && so->atol == 1e-12 && so->max_iterations == 321);
+  TEST_TRUE(so->stagnation_window == 37);
   TEST_TRUE(so->newton_rtol == 1e-4 && so->newton_max_iterations == 17);
   TEST_TRUE(so->line_search == 0 && so->project_psd == 1);
   TEST_TRUE(so->representative_acceleration == 10 && so->threads == 3);
+  TEST_TRUE(so->stop_on_inversion == 1);
   TEST_TRUE(so->newton_rule == FCM_NEWTON_TOL_RELATIVE);
 
   const fcm_scene_time *t = fcm_scene_get_time(s);
@@ -176,8 +178,9 @@ static void check_full(fcm_ctx *ctx)
     size_t n = fread(text, 1, sizeof text - 1, f);
     text[n] = '\0';
     fclose(f);
-    const char *words[] = {"full-scene.v1", "tet10",    "tube",     "stvk",      "minres",
-                           "block_jacobi",  "75 steps", "out/full", "effects: 9"};
+    const char *words[] = {
+        "full-scene.v1", "tet10",    "tube",     "stvk",       "minres",
+        "block_jacobi",  "75 steps", "out/full", "effects: 9", "on inversion: stop"};
     for (size_t i = 0; i < sizeof words / sizeof *words; i++)
       TEST_TRUE(strstr(text, words[i]));
     for (int k = 0; k < FCM_EFFECT_TYPE_COUNT; k++)
@@ -215,9 +218,11 @@ static void check_defaults(fcm_ctx *ctx)
   TEST_TRUE(so->schwarz_threshold == 0.5 && so->schwarz.epsilon == 1e-13 &&
             so->schwarz.clamp == FCM_SCHWARZ_CLAMP);
   TEST_TRUE(so->rtol == 1e-8 && so->atol == 0 && so->max_iterations == 1000);
+  TEST_TRUE(so->stagnation_window == 50);
   TEST_TRUE(so->newton_rtol == 1e-5 && so->newton_max_iterations == 100);
   TEST_TRUE(so->line_search == 1 && so->project_psd == 0);
   TEST_TRUE(so->representative_acceleration == 9.81 && so->threads == FCM_DEFAULT);
+  TEST_TRUE(so->stop_on_inversion == 0); /* "warn" */
   TEST_TRUE(so->newton_rule == FCM_NEWTON_TOL_AUTO);
   const fcm_scene_time *t = fcm_scene_get_time(s);
   TEST_TRUE(t->integrator == FCM_INTEGRATOR_BACKWARD_EULER && t->dt == 1.0 / 60.0 &&

@@ -44,3 +44,7 @@ fcm_add_test(scene_boundary tests/scene/boundary_scene.c)
 foreach(mode agree cut iterations errors)
   fcm_add_test(scene_multigrid_${mode} tests/scene/multigrid_scene.c ARGS ${mode} TIMEOUT 600)
 endforeach()
+# Inverted quadrature points through the runner: counters from the steps, each frame's NaN
+# stresses equal to those its files hold, a checkpoint keeps them; "stop" refuses the first
+# inverted step (FCM_ERR_GEOMETRY naming step, time, count and cell).
+fcm_add_test(scene_inversion tests/scene/inversion_scene.c)

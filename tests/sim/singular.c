@@ -1,13 +1,13 @@
-/* Issue 19: the direct path refuses numerically singular systems with FCM_ERR_SINGULAR and
+/* The direct path refuses numerically singular systems with FCM_ERR_SINGULAR and
  * the likely cause, instead of returning a solution.
  * 1. fcm_direct (CHOLMOD) on [[1, 1], [1, 1 + d]]: d = 1e-14 (pivot 1e-14 of its diagonal)
  *    is refused as numerically singular, with no failed column (the factor completed) and
  *    the hint in the message; d = 1e-6 (ill-conditioned, kappa ~ 4e6, but regular) solves
  *    to the exact answer; the backward error of a good solve is at rounding level.
- * 2. fcm_simulation: a static body with no Dirichlet constraint (free rigid modes) and a
- *    Hex8 background at stiffness quadrature strength 1 (hourglass modes) are refused with
- *    FCM_ERR_SINGULAR naming the cause; the same scenes well posed (fixed face, default
- *    strength) converge.
+ * 2. fcm_simulation: a static body with no Dirichlet constraint (free rigid modes: refused
+ *    before the solve, tests/sim/rigid_modes.c) and a Hex8 background at stiffness quadrature
+ *    strength 1 (hourglass modes: refused by the factorization) fail with FCM_ERR_SINGULAR
+ *    naming the cause; the same scenes well posed (fixed face, default strength) converge.
  * 3. No false positive on a stabilized FCM system with tiny cut cells: an embedded box whose
  *    last cells are cut at volume fractions 1e-6 and 1e-12 (kept: min_fraction 0), static
  *    and dynamic, with the default stabilization (alpha 1e-6), solves with CHOLMOD. */
@@ -98,7 +98,7 @@ static void test_sim(fcm_ctx *ctx)
   static const char *const elements[2] = {"hex20", "tet10"};
   for (int e = 0; e < 2; e++) {
     beam_json(json, sizeof json, elements[e], 0, 0); /* free body */
-    TEST_ERR(ctx, step(ctx, json, &reason), FCM_ERR_SINGULAR, "rigid-body modes are unconstrained");
+    TEST_ERR(ctx, step(ctx, json, &reason), FCM_ERR_SINGULAR, "refused before any solve");
     beam_json(json, sizeof json, elements[e], 1, 1); /* one point per cell: hourglass modes */
     TEST_ERR(ctx, step(ctx, json, &reason), FCM_ERR_SINGULAR, "quadrature rule too weak");
     beam_json(json, sizeof json, elements[e], 1, 0); /* well posed */

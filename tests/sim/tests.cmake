@@ -60,3 +60,13 @@ fcm_sim_test(sim_nitsche_penalty tests/sim/nitsche.c ARGS penalty)
 fcm_sim_test(sim_nitsche_solvers tests/sim/nitsche.c ARGS solvers)
 fcm_sim_test(sim_nitsche_errors tests/sim/nitsche.c ARGS errors)
 fcm_sim_test(sim_nitsche_rigid tests/sim/nitsche.c ARGS rigid)
+# Inverted quadrature points (J = det F <= 0) counted in the step info against an independent
+# count of a prescribed fold; none for a spinning free body.
+foreach(el hex8 tet10)
+  fcm_sim_test(sim_inversion_${el} tests/sim/inversion.c ARGS ${el})
+endforeach()
+# Static steps refuse bodies the constraints leave free (no constraint, one or two fixed
+# nodes, partial supports, a cut half, a boundary constraint in one component, a released
+# region) before any solve with every solver; held bodies and dynamic runs solve; a
+# stagnating Krylov solve is the step's reason.
+fcm_sim_test(sim_rigid_modes tests/sim/rigid_modes.c)

@@ -6,3 +6,6 @@ fcm_add_test(solve_schwarz tests/solve/schwarz.c)
 fcm_add_test(solve_schwarz_space tests/solve/schwarz_space.c)
 fcm_add_test(solve_alloc_failure tests/solve/alloc_failure.c)
 fcm_add_test(solve_threads tests/solve/threads.c)
+# CG and MINRES stop as stagnated on a singular semi-definite system whose right-hand side
+# leaves the range, and converge on a consistent one.
+fcm_add_test(solve_stagnation tests/solve/stagnation.c)

@@ -286,7 +286,8 @@ FCM_API fcm_status fcm_cell_rules_get_surface(const fcm_cell_rules *rules, fcm_i
  * simplify with prev's options, stabilize). A cut that ends inside a cell does not separate it.
  * Only the cells the new cut reaches are integrated again (stats.num_integrated); the rules of
  * every other cell are copied, so adding cuts one at a time costs what the cut touches. Triangles
- * without area are ignored; a cut that misses the body changes nothing but still counts in
+ * without area are ignored (a cut with no triangle of positive area is refused: it would separate
+ * nothing); a cut that misses the body changes nothing but still counts in
  * fcm_cell_rules_num_cuts(). The links between pieces of neighbouring cells
  * (fcm_cell_rules_links()) are recomputed around every cut. `prev` is not changed (it may be
  * destroyed afterwards).
@@ -298,8 +299,9 @@ FCM_API fcm_status fcm_cell_rules_get_surface(const fcm_cell_rules *rules, fcm_i
  * deterministic translation (1e-7, then 1e-6, 1e-5 of the mean cell size; stats.cut_shift,
  * stats.cut_attempts) and applied again, so no volume is ever lost or doubled.
  * @param[in] mesh, geom the mesh and geometry `prev` was built on; @param[in] cut copied
- * @return FCM_OK; FCM_ERR_ARG (NULL, another mesh); FCM_ERR_GEOMETRY (degenerate cells left
- *         after the largest shift); FCM_ERR_INTERNAL (a split exceeding the polyhedron
+ * @return FCM_OK; FCM_ERR_ARG (NULL, another mesh); FCM_ERR_GEOMETRY (every cut triangle
+ *         without area, giving the first; degenerate cells left after the largest shift);
+ *         FCM_ERR_INTERNAL (a split exceeding the polyhedron
  *         capacity); the errors of fcm_cell_rules_create(). Allocates. */
 FCM_API fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh,
                                              const fcm_geometry *geom, const fcm_cell_rules *prev,
@@ -359,8 +361,10 @@ FCM_API fcm_index fcm_cell_rules_parent_num_pieces(const fcm_cell_rules *rules);
 /** Links between pieces of face-neighbouring cells near the cuts: pairs (p, q), p < q, of
  * pieces that share a part of the cells' common face with positive area not lying on a
  * cut triangle; 2 x num_links entries, sorted. Computed for every pair of cells that share a
- * node with a cell the cuts reach (elsewhere every cell has one piece). The generalized
- * enrichment of fcm_space_create_embedded() groups each node's pieces along these links. */
+ * node with a cell the cuts reach (elsewhere every cell has one piece). A cut only separates:
+ * two pieces are linked only if their parents (fcm_cell_rules_piece_parent()) were, so the
+ * bodies after a cut are parts of the bodies before it. The generalized enrichment of
+ * fcm_space_create_embedded() groups each node's pieces along these links. */
 FCM_API fcm_index fcm_cell_rules_num_links(const fcm_cell_rules *rules);
 FCM_API const fcm_index *fcm_cell_rules_links(const fcm_cell_rules *rules);
 

@@ -85,6 +85,13 @@ FCM_API fcm_status fcm_space_create_embedded_with(fcm_ctx *ctx, const fcm_mesh *
 /** Number of DOF copies the options' constraint removed (moved with their piece). */
 FCM_API fcm_index fcm_space_num_constrained_copies(const fcm_space *space);
 
+/** Number of local nodes of element `elem` where it uses, in place of a constrained copy,
+ * the DOFs of the copy that copy moves with (fcm_space_element_dofs() there may name another
+ * node's copy, or another copy of the same node): the field on such an element is not the
+ * one its own copies would give, and fcm_space_transfer() sets no value from it there.
+ * 0 for an element without (or out of range). No allocation; thread safe. */
+FCM_API int fcm_space_element_constrained(const fcm_space *space, fcm_index elem);
+
 /** The cell rules of an embedded space, or NULL. */
 FCM_API const fcm_cell_rules *fcm_space_cell_rules(const fcm_space *space);
 
@@ -118,9 +125,14 @@ FCM_API const fcm_mesh *fcm_space_mesh(const fcm_space *space);
 
 /** Carry a field (displacement, velocity: num_dofs of `from`) over a cut: `to` must be the
  * space of rules that extend the rules of `from` by one cut (fcm_cell_rules_create_cut()).
- * Every copy of `to` takes the value of the copy of `from` whose support component holds
- * its own, so the field is unchanged at every point of the body: mass, linear and angular
- * momentum are preserved up to rounding. @param[out] x_to num_dofs of `to`.
+ * Every copy of `to` takes, from one of the elements that use it, the value that element's
+ * parent piece had at that node in `from` (the cut only splits pieces and links, so all of
+ * them agree), and the field is unchanged at every point of every element of `to`: mass,
+ * linear and angular momentum are preserved up to rounding. The exception are the elements
+ * with a constrained copy's place (fcm_space_element_constrained(): tiny pieces, below
+ * fcm_space_options.constrain_ratio of their nodes' supports): they move with the copy they
+ * follow, so their field, and their share of the momenta, may change with the cut.
+ * @param[out] x_to num_dofs of `to`.
  * @return FCM_OK, FCM_ERR_ARG (NULL, other mesh, unrelated rules). No allocation. */
 FCM_API fcm_status fcm_space_transfer(const fcm_space *from, const fcm_space *to,
                                       const double *x_from, double *x_to);

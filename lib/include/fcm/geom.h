@@ -28,8 +28,9 @@ typedef struct fcm_geometry fcm_geometry;
  * A negatively oriented tet is reoriented (two nodes swapped); zero-volume tets are kept
  * (they contribute nothing). Hex8 cells must be convex with planar faces (relative
  * tolerance 1e-10 of the cell's bounding-box diagonal) and positively oriented.
- * @return FCM_OK; FCM_ERR_ARG (NULL pointers, other types, negative counts, non-finite
- *         coordinate, node id out of range); FCM_ERR_GEOMETRY (non-convex or inverted
+ * @return FCM_OK; FCM_ERR_ARG (NULL pointers, other types, negative counts, a coordinate
+ *         that is not finite or beyond +-1e50 (products of such coordinates overflow),
+ *         node id out of range); FCM_ERR_GEOMETRY (non-convex or inverted
  *         hex, naming the cell); FCM_ERR_ALLOC. Allocates; release with
  *         fcm_geometry_destroy(). Thread safe. */
 FCM_API fcm_status fcm_geometry_create(fcm_ctx *ctx, fcm_element_type type, fcm_index num_nodes,
@@ -47,7 +48,8 @@ FCM_API fcm_status fcm_geometry_create_from_gmsh(fcm_ctx *ctx, const char *path,
  * then "index n0 n1 n2 n3 [attributes]"). Indices start at 0 or 1 (the first point's
  * index sets the base for both files) and are consecutive; '#' starts a comment.
  * @return FCM_OK; FCM_ERR_IO (cannot open/read); FCM_ERR_FORMAT ("path:line: ..." for
- *         malformed content, bad counts, node index out of range); FCM_ERR_UNSUPPORTED
+ *         malformed content, bad counts, node index out of range, a coordinate beyond
+ *         +-1e50 naming the point's index and the value); FCM_ERR_UNSUPPORTED
  *         (dimension other than 3, 10-node tetrahedra); FCM_ERR_ALLOC. Allocates. */
 FCM_API fcm_status fcm_geometry_create_from_tetgen(fcm_ctx *ctx, const char *node_path,
                                                    const char *ele_path, fcm_geometry **geom);

@@ -20,17 +20,41 @@ extern "C" {
  * at a time (the caller's); must return a finite value. */
 typedef double (*fcm_level_set_fn)(const double x[3], void *user);
 
+/** Peak bytes fcm_geometry_create_from_level_set() takes per sub-cell it triangulates
+ * (fcm_level_set_info.subcells), everything it builds included: measured 5.5-12.7 kB on
+ * spheres and gyroids at refinements 1-32 (about 12 tets per sub-cell the surface crosses;
+ * the benchmark bench_level_set_memory prints the figures). */
+#define FCM_LEVEL_SET_SUBCELL_BYTES 13000
+
+/** Default of fcm_level_set_options.max_subcells: about 3.9 GB at FCM_LEVEL_SET_SUBCELL_BYTES. */
+#define FCM_LEVEL_SET_MAX_SUBCELLS 300000
+
+/** Progress of fcm_geometry_create_from_level_set(): `done` of `total` sub-cells marched (a
+ * cut cell counts r^3 in the build and (2r)^3 in the error estimate; with refine_inside an
+ * inside cell counts r^3 too). Called from the calling thread; must not call back into the
+ * library on the geometry being built. */
+typedef void (*fcm_level_set_progress_fn)(fcm_index done, fcm_index total, void *user);
+
 /** Options of fcm_geometry_create_from_level_set(). */
 typedef struct fcm_level_set_options {
-  int refinement;     /**< sub-cells per background-cell edge where phi changes sign,
-                           [1, 64]; default 4 */
-  int estimate_error; /**< 1 (default): also compute the volume at refinement 2r (volume
-                           only, nothing stored) for fcm_level_set_info.error_estimate */
-  int refine_inside;  /**< 0 (default): cells where every sample is inside become 6 tets of
-                           the whole cell, and in cut cells the sub-cubes with every corner
-                           inside are merged into boxes of 6 tets (fewer tets, which do not
-                           conform to the refined ones next to them; the boundary triangles
-                           are the same); 1: every sub-cube is split on its own */
+  int refinement;         /**< sub-cells per background-cell edge where phi changes sign,
+                               [1, 64]; default 4 */
+  int estimate_error;     /**< 1 (default): also compute the volume at refinement 2r (volume
+                               only, nothing stored) for fcm_level_set_info.error_estimate */
+  int refine_inside;      /**< 0 (default): cells where every sample is inside become 6 tets of
+                               the whole cell, and in cut cells the sub-cubes with every corner
+                               inside are merged into boxes of 6 tets (fewer tets, which do not
+                               conform to the refined ones next to them; the boundary triangles
+                               are the same); 1: every sub-cube is split on its own */
+  fcm_index max_subcells; /**< >= 0: refuse a build (FCM_ERR_UNSUPPORTED, after the cells are
+                           classified and before any tet is stored) that would triangulate
+                           more sub-cells (fcm_level_set_info.subcells) than this; 0: no
+                           limit; default FCM_LEVEL_SET_MAX_SUBCELLS */
+  fcm_level_set_progress_fn progress; /**< NULL (default): none; else called with the sub-cells
+                           marched so far, at most every progress_interval seconds, and once
+                           with done == total at the end */
+  void *progress_user;                /**< passed to progress; default NULL */
+  double progress_interval;           /**< seconds between progress calls, >= 0; default 0.1 */
 } fcm_level_set_options;
 
 /** Defaults as documented on each member. */
@@ -42,6 +66,11 @@ typedef struct fcm_level_set_info {
   fcm_index cells_cut;     /**< cells where phi changes sign at the samples (refined) */
   fcm_index cells_outside; /**< cells with every sample outside */
   fcm_index num_tets;      /**< tets of the geometry */
+  fcm_index subcells;      /**< the sub-cells the build triangulates, the estimate checked
+                                against max_subcells: those of the cut cells where phi
+                                changes sign at the corners (the surface crosses them), plus
+                                one per cell wholly inside (6 tets); with refine_inside r^3
+                                per cut or inside cell */
   double h;                /**< largest sub-cell edge: max_d (hi - lo)_d / (n_d r) */
   double volume;           /**< volume of the geometry */
   double volume_fine;      /**< the volume with the cells cut at refinement r sampled at 2r
@@ -58,12 +87,18 @@ typedef struct fcm_level_set_info {
  * (lattice points and edge crossings). The boundary triangles are the surface: the
  * iso-surface pieces of the marched tets (facing along the gradient of the interpolant)
  * and the tet faces on the faces of [lo, hi], each owned by its tet; closed and outward
- * (fcm_geometry_create_transformed() keeps them).
+ * (fcm_geometry_create_transformed() keeps them). The cells are classified first (phi
+ * sampled, nothing stored), so a build above max_subcells is refused before it allocates.
+ * When phi is fcm_implicit_eval, its tree (user) is checked first by
+ * fcm_implicit_check_spacing() with the spacing h of fcm_level_set_info.
  * @param[in] phi, user the function and its argument; @param[in] opts NULL for defaults
  * @param[out] geom the geometry; @param[out] info may be NULL
  * @return FCM_OK; FCM_ERR_ARG (NULL, lo >= hi, n outside [1, 10^4], refinement outside
- *         [1, 64], more than 2^31 sub-cells); FCM_ERR_GEOMETRY (phi not finite at a point,
- *         naming it; the body has no volume in the box); FCM_ERR_ALLOC. Allocates. */
+ *         [1, 64], more than 2^31 sub-cells, max_subcells < 0, progress_interval < 0; an
+ *         implicit tree that is invalid or not resolved by the sampling, naming the node,
+ *         member, value and h); FCM_ERR_UNSUPPORTED (more sub-cells than max_subcells, with
+ *         the estimate, the limit and their memory); FCM_ERR_GEOMETRY (phi not finite at a
+ *         point, naming it; the body has no volume in the box); FCM_ERR_ALLOC. Allocates. */
 FCM_API fcm_status fcm_geometry_create_from_level_set(fcm_ctx *ctx, fcm_level_set_fn phi,
                                                       void *user, const double lo[3],
                                                       const double hi[3], const fcm_index n[3],
@@ -117,6 +152,17 @@ typedef struct fcm_implicit_tree {
  * operands earlier than their node). @return FCM_OK or FCM_ERR_ARG naming the node, member
  * and valid range. No allocation. */
 FCM_API fcm_status fcm_implicit_check(fcm_ctx *ctx, const fcm_implicit_tree *tree);
+
+/** Check that the sampling spacing h (the largest sub-cell edge,
+ * fcm_level_set_info.h) resolves the smallest feature of every node of a tree: a sphere's
+ * radius, a torus's minor_radius and every side (max - min) of a box must be at least h; a
+ * gyroid's period at least 2 h (its channels are half a period wide: a period under two
+ * samples only samples noise) and, for a sheet, its wall 2 thickness at least h. The tree
+ * is validated first (fcm_implicit_check()).
+ * @return FCM_OK or FCM_ERR_ARG naming the node, the member, its value and h (also h not
+ *         positive and finite). No allocation. */
+FCM_API fcm_status fcm_implicit_check_spacing(fcm_ctx *ctx, const fcm_implicit_tree *tree,
+                                              double h);
 
 /** The value of a validated tree (`user`: a const fcm_implicit_tree *) at x: an
  * fcm_level_set_fn. Thread safe, no allocation. */

@@ -26,9 +26,10 @@ typedef struct fcm_mesh fcm_mesh;
  * @param[in]  num_cells number of cells (>= 0); @param[in] cells num_cells x nodes_per_cell
  *                       node ids in [0, num_nodes), VTK order, copied
  * @param[out] mesh      the new mesh, NULL on failure
- * @return FCM_OK; FCM_ERR_ARG (NULL pointers, bad type, negative counts, non-finite
- *         coordinate, node id out of range, node repeated within a cell);
- *         FCM_ERR_GEOMETRY (a face shared by more than two cells); FCM_ERR_ALLOC.
+ * @return FCM_OK; FCM_ERR_ARG (NULL pointers, bad type, negative counts, a coordinate that
+ *         is not finite or beyond +-1e50 (products of such coordinates overflow), node id
+ *         out of range, node repeated within a cell); FCM_ERR_GEOMETRY (a face shared by
+ *         more than two cells); FCM_ERR_ALLOC.
  * Allocates; release with fcm_mesh_destroy(). Thread safe. */
 FCM_API fcm_status fcm_mesh_create(fcm_ctx *ctx, fcm_element_type type, fcm_index num_nodes,
                                    const double *coords, fcm_index num_cells,
@@ -56,7 +57,8 @@ FCM_API fcm_status fcm_mesh_create_box(fcm_ctx *ctx, fcm_element_type type, cons
  * keep their file order.
  * @param[in]  path file name; @param[out] mesh the new mesh, NULL on failure
  * @return FCM_OK; FCM_ERR_IO (cannot open/read the file); FCM_ERR_FORMAT (malformed
- *         content or unknown version: the message says "path:line: expected ...");
+ *         content or unknown version: the message says "path:line: expected ..."; a
+ *         coordinate beyond +-1e50, naming the node tag and the value);
  *         FCM_ERR_UNSUPPORTED (binary file, other volume element types, mixed volume
  *         types, no volume elements); FCM_ERR_GEOMETRY, FCM_ERR_ALLOC as fcm_mesh_create().
  * Allocates; release with fcm_mesh_destroy(). Thread safe (numbers are parsed with

@@ -96,7 +96,9 @@ typedef struct fcm_scene_geometry {
   const fcm_implicit *implicit; /**< LEVEL_SET: the implicit tree, root last */
   int num_implicit;             /**< LEVEL_SET: nodes, [1, FCM_IMPLICIT_MAX_NODES] */
   int refinement;               /**< LEVEL_SET: sub-cells per cut cell edge (default 4) */
-  int has_box; /**< LEVEL_SET: 1: sampled on min/max/cells; 0: on the background grid */
+  int has_box;            /**< LEVEL_SET: 1: sampled on min/max/cells; 0: on the background grid */
+  fcm_index max_subcells; /**< LEVEL_SET: fcm_level_set_options.max_subcells (default
+                               FCM_LEVEL_SET_MAX_SUBCELLS; 0: no limit) */
 } fcm_scene_geometry;
 
 /** Quadrature settings ("quadrature"). The enums and option structs are the library's own
@@ -150,6 +152,10 @@ typedef struct fcm_scene_solver {
   double atol;                 /**< Krylov absolute tolerance; >= 0, default 0 */
   int max_iterations;          /**< Krylov iterations (multigrid solver: cycles) per solve;
                                     >= 1, default 1000 */
+  int stagnation_window;       /**< "cg" and "minres": a solve whose smallest residual drops
+                                    by less than 0.1 % in this many iterations stops as
+                                    stagnated (fcm_integrator_options.krylov_stagnation_window);
+                                    [0, 1e9], default 50, 0: off */
   fcm_newton_tolerance newton_rule;   /**< "auto" (default, FCM_NEWTON_TOL_AUTO),
                                            "representative", "relative" */
   double newton_rtol;                 /**< tolerance of the rule; (0, 1), default 1e-5 */
@@ -163,6 +169,12 @@ typedef struct fcm_scene_solver {
                                   (fcm/petsc.h, `fcm-sim --backend petsc`), e.g. "-ksp_type
                                   minres -pc_type jacobi"; the command line wins for a key both
                                   give. NULL (default): none. The serial backend ignores it */
+  int stop_on_inversion;     /**< "on_inversion": what a step that ends with inverted
+                                  quadrature points (J = det F <= 0,
+                                  fcm_step_info.inverted_points) does: "warn" (0, default): the
+                                  run goes on, the log and the summary count them;
+                                  "stop" (1): fcm_simulation_step() returns an error naming the
+                                  step, the time, the count and the first point */
 } fcm_scene_solver;
 
 /** Time stepping ("time"). */

@@ -36,7 +36,9 @@ extern "C" {
 
 /** Integrator kinds. */
 typedef enum fcm_integrator_kind {
-  FCM_INTEGRATOR_STATIC = 0,        /**< equilibrium Psi'(u) = f_ext, load steps, no inertia */
+  FCM_INTEGRATOR_STATIC = 0,        /**< equilibrium Psi'(u) = f_ext, load steps, no inertia;
+                                         the constraints must hold every body's rigid-body
+                                         modes (checked by fcm_integrator_step()) */
   FCM_INTEGRATOR_BACKWARD_EULER = 1 /**< implicit Euler on the incremental potential */
 } fcm_integrator_kind;
 
@@ -65,8 +67,9 @@ typedef enum fcm_linear_solver {
    * steps, or dynamic ones (M/h^2 + K) with a linear material or a PSD tangent (project_psd).
    * Where it is not SPD the coarsest Cholesky factorization fails, a diagonal is not positive
    * or the cycles do not converge (stalled or diverging): the solve fails softly
-   * (FCM_STEP_LINEAR_SOLVER_FAILED, a warning names the cause) and the step is retried with
-   * half the increment, like a failed Krylov solve. Needs a Hex8 or Hex20 box grid
+   * (FCM_STEP_LINEAR_SOLVER_FAILED, or FCM_STEP_LINEAR_SOLVER_STAGNATED when the cycles
+   * stalled: less than 5 % reduction in 20; a warning names the cause) and the step is
+   * retried with half the increment, like a failed Krylov solve. Needs a Hex8 or Hex20 box grid
    * (fcm_mg_create()): on another mesh the first step fails with FCM_ERR_UNSUPPORTED. */
   FCM_LINEAR_MULTIGRID = 3
 } fcm_linear_solver;
@@ -142,6 +145,12 @@ typedef struct fcm_integrator_options {
   double krylov_rtol;                          /**< in [0, 1) (default 1e-8) */
   double krylov_atol;                          /**< >= 0 (default 0) */
   int krylov_max_iterations;                   /**< >= 1 (default 1000) */
+  int krylov_stagnation_window;  /**< CG and MINRES: stop a solve whose smallest residual dropped
+                                      by less than 0.1 % in this many iterations
+                                      (fcm_krylov_options.stagnation_window; >= 0, default 50,
+                                      0: off). Its iterate is still used when finite and
+                                      nonzero; when the Newton iteration then fails, the step's
+                                      reason is FCM_STEP_LINEAR_SOLVER_STAGNATED */
   double schwarz_theta;          /**< cut cells with volume fraction below it get a block, (0, 1]
                                       (default 0.5) */
   fcm_schwarz_options schwarz;   /**< default fcm_schwarz_options_default() */
@@ -169,11 +178,19 @@ typedef enum fcm_step_reason {
                                       no descent direction */
   FCM_STEP_LINEAR_SOLVER_FAILED, /**< direct: both factorizations failed; Krylov: no usable
                                       iterate */
-  FCM_STEP_NONFINITE             /**< NaN/Inf in a load, the energy, the gradient or a solve */
+  FCM_STEP_NONFINITE,            /**< NaN/Inf in a load, the energy, the gradient or a solve */
+  /** The linear solver stopped making progress — a Krylov solve stagnated
+   * (krylov_stagnation_window) or broke down, or the multigrid cycles stalled — and Newton
+   * could not go on with its result (no usable iterate, no descent, no sufficient decrease,
+   * or newton_max_iterations with such a solve last): the Newton matrix is singular or
+   * nearly so (rigid-body modes no constraint holds, which a static step checks before any
+   * solve; a body held at too few points) or, for CG, not positive definite */
+  FCM_STEP_LINEAR_SOLVER_STAGNATED
 } fcm_step_reason;
 
 /** Name of a reason ("converged", "max-newton", "line-search-failed",
- * "linear-solver-failed", "nonfinite", "none"), or "unknown". Static string. */
+ * "linear-solver-failed", "nonfinite", "linear-solver-stagnated", "none"), or "unknown".
+ * Static string. */
 FCM_API const char *fcm_step_reason_name(fcm_step_reason reason);
 
 /** What one fcm_integrator_step() did. Per-step counts cover every attempt of the step;
@@ -199,6 +216,16 @@ typedef struct fcm_step_info {
   double elastic_energy;          /**< Psi(u) */
   double external_work;           /**< f_ext(t)^T u */
   double total_energy;            /**< kinetic + elastic - external work */
+  fcm_index inverted_points;      /**< quadrature points of the body (the authentic points:
+                                       fictitious stabilization points of cut cells left out)
+                                       with J = det F <= 0 at the state the step ended in (0 on
+                                       failure); the Cauchy stress of fcm_space_element_stress()
+                                       is NaN there. Counted in the step's last energy
+                                       assembly, at no extra cost */
+  fcm_index inverted_cell;        /**< background cell of the first of them (lowest element,
+                                       then rule order), -1 when there is none */
+  double inverted_position[3];    /**< that point's reference position X (0 when none) */
+  double inverted_det;            /**< J there (<= 0; 0 when none) */
   int tangent_assemblies;         /**< tangent assemblies (Newton and damping matrices) */
   int factorizations;             /**< numeric factorizations or preconditioner setups */
   int direct_fallbacks;           /**< CHOLMOD "not positive definite" -> UMFPACK */
@@ -417,10 +444,22 @@ FCM_API fcm_status fcm_integrator_setup(fcm_integrator *integ);
  * needed; the multigrid hierarchy then and again whenever the active constrained DOFs
  * change. Later steps allocate nothing through the context (test sim_step_alloc_*);
  * CHOLMOD's and UMFPACK's numeric factorizations allocate internally (SuiteSparse's malloc).
+ * STATIC: before the first solve, and again whenever the active set of constraints changes
+ * (a release), the active constraints must hold the six rigid-body modes of every body of the
+ * space (fcm_space_num_bodies(): cuts separate bodies); a body is held by its constrained
+ * DOFs and its points of active boundary constraints, in their components, when the rigid
+ * motions that vanish there are only the zero motion (the rank of the modes restricted to
+ * them is 6; e.g. three non-collinear nodes in all components). Else the step is refused
+ * with FCM_ERR_SINGULAR before anything is solved or factored, the message naming the first
+ * free body (index, box of its nodes), what holds it and the free modes. This allocates
+ * O(elements + DOFs) scratch through the context. Dynamic steps are not checked (the mass
+ * holds every mode).
  * @param[out] info may be NULL
  * @return FCM_OK; FCM_ERR_NOT_CONVERGED (info->reason says why; the message gives the time,
- * the residual and the tolerance); FCM_ERR_NUMERIC (NaN/Inf in a load, or the last attempt
- * met NaN/Inf); FCM_ERR_ARG (not set up); FCM_ERR_ALLOC and other hard errors. */
+ * the residual and the tolerance); FCM_ERR_SINGULAR (STATIC: a free body, as above; a
+ * direct solver that finds the Newton matrix singular); FCM_ERR_NUMERIC (NaN/Inf in a load,
+ * or the last attempt met NaN/Inf); FCM_ERR_ARG (not set up); FCM_ERR_ALLOC and other hard
+ * errors. */
 FCM_API fcm_status fcm_integrator_step(fcm_integrator *integ, fcm_step_info *info);
 
 /** Number of DOFs (the length of u and v). */

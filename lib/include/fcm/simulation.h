@@ -28,10 +28,15 @@ typedef struct fcm_simulation_options {
   int checkpoint_interval; /**< >= 0: fcm_simulation_checkpoint_due() every n-th step (0:
                                 never); FCM_DEFAULT (default): the scene's
                                 output.checkpoint_interval */
-  fcm_cell_rules_progress_fn rules_progress; /**< progress of the cell rules build
-                                (fcm_cell_rules_options.progress); NULL (default): none */
-  void *rules_progress_user;                 /**< its argument; default NULL */
-  double rules_progress_interval;            /**< seconds between calls, >= 0; default 0.1 */
+  fcm_cell_rules_progress_fn rules_progress;   /**< progress of the cell rules build
+                                  (fcm_cell_rules_options.progress); NULL (default): none */
+  void *rules_progress_user;                   /**< its argument; default NULL */
+  double rules_progress_interval;              /**< seconds between calls, >= 0; default 0.1
+                                                    (also of geometry_progress) */
+  fcm_level_set_progress_fn geometry_progress; /**< progress of building a level-set geometry
+                                (fcm_level_set_options.progress: sub-cells marched); NULL
+                                (default): none */
+  void *geometry_progress_user;                /**< its argument; default NULL */
 } fcm_simulation_options;
 
 /** Defaults as documented on each member. */
@@ -76,7 +81,24 @@ typedef struct fcm_simulation_counters {
   fcm_index pieces;    /**< separate bodies now (fcm_space_num_bodies()) */
   fcm_index surface_points, surface_triangles; /**< the embedded boundary written per frame
                                                     (without the cut faces) */
-  double time_setup, time_steps, time_output;  /**< seconds */
+  /* Inversion: quadrature points of the body with J = det F <= 0 after a step
+   * (fcm_step_info.inverted_points). After a restored checkpoint these and the frame counts
+   * below are recounted from the log's rows. */
+  long long inverted_steps;      /**< steps that ended with inverted points */
+  long long inverted_first_step; /**< the first of them (0: none) */
+  double inverted_first_time;    /**< its time (0: none) */
+  fcm_index inverted_first_cell; /**< the background cell of its first inverted point (-1: none,
+                                      or not known: a row of an older checkpoint) */
+  fcm_index inverted_max;        /**< the most inverted points after one step (0: none) */
+  long long inverted_max_step;   /**< the first step with that many (0: none) */
+  /* Frames whose von Mises stresses (background cell averages, surface points) hold NaN or
+   * infinite values: the stresses of points with J <= 0 (fcm_space_element_stress()). */
+  long long nonfinite_frames;     /**< frames written with such values */
+  fcm_index nonfinite_last;       /**< such values in the last frame written */
+  fcm_index nonfinite_max;        /**< the most in one frame (0: none) */
+  long long nonfinite_first_step; /**< the step of the first such frame (-1: none; 0: the
+                                       initial state) */
+  double time_setup, time_steps, time_output; /**< seconds */
 } fcm_simulation_counters;
 
 /** A running scene (opaque). */
@@ -103,9 +125,16 @@ FCM_API void fcm_simulation_destroy(fcm_simulation **sim);
  * for a scene without geometry. Valid for the life of the simulation. */
 FCM_API const fcm_cell_rules *fcm_simulation_cell_rules(const fcm_simulation *sim);
 
-/** Advance one step (fcm_integrator_step()) and record it for the log.
+/** Advance one step (fcm_integrator_step()) and record it for the log and the counters (the
+ * inverted quadrature points among them). A step that ends with inverted points when the
+ * scene's solver.on_inversion is "stop" (fcm_scene_solver.stop_on_inversion) is taken and
+ * logged, and then reported as FCM_ERR_GEOMETRY: "simulation <name>: step <k> (t = <t> s)
+ * ended with <n> inverted quadrature points (J = det F <= 0), the first in cell <c> at X =
+ * (x, y, z) with J = <J> ...". The state is that step's; a host stops there (frames written
+ * before stay valid).
  * @param[out] info may be NULL
- * @return as fcm_integrator_step(); FCM_ERR_ARG when the run is done. */
+ * @return as fcm_integrator_step(); FCM_ERR_GEOMETRY (inverted points, "stop");
+ * FCM_ERR_ARG when the run is done. */
 FCM_API fcm_status fcm_simulation_step(fcm_simulation *sim, fcm_step_info *info);
 
 /** 1 when the steps to take (scene or max_steps) are taken, else 0. */
@@ -133,8 +162,9 @@ FCM_API int fcm_simulation_state_finite(const fcm_simulation *sim);
  * collective — every process calls it and writes the piece of its own cells,
  * <dir>/<name>_background_NNNN_<rank>.vtu; process 0 writes <dir>/<name>_background_NNNN.pvtu
  * naming the pieces (the PVD indexes it) and the surface frame; every process counts the
- * frame. @return FCM_OK,
- * FCM_ERR_IO (naming the path), FCM_ERR_ALLOC. */
+ * frame. The von Mises values written that are NaN or infinite (points with J = det F <= 0)
+ * are counted: fcm_simulation_counters.nonfinite_last and the log's nonfinite_stresses.
+ * @return FCM_OK, FCM_ERR_IO (naming the path), FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_simulation_write_frame(fcm_simulation *sim, const char *dir, int index);
 
 /** Write the per-step log as CSV atomically to `path`: header
@@ -142,9 +172,13 @@ FCM_API fcm_status fcm_simulation_write_frame(fcm_simulation *sim, const char *d
  * momentum_y,momentum_z", then for every fixed or motion effect i (its index in the scene's
  * effects) "reaction_<i>_x,reaction_<i>_y,reaction_<i>_z,moment_<i>_x,moment_<i>_y,moment_<i>_z"
  * (fcm_integrator_reaction(): the force the region exerts on the body, inertia included, and
- * its moment about the origin), then "wall_time"; one row per step taken (pieces: separate
- * bodies, fcm_space_num_bodies(); mass and linear momentum over the body's own quadrature
- * points, fcm_space_momentum()). @return FCM_OK, FCM_ERR_IO, FCM_ERR_ALLOC. */
+ * its moment about the origin), then "inverted_points,nonfinite_stresses,wall_time"; one row
+ * per step taken (pieces: separate bodies, fcm_space_num_bodies(); mass and linear momentum
+ * over the body's own quadrature points, fcm_space_momentum(); inverted_points: quadrature
+ * points with J = det F <= 0 after the step, fcm_step_info.inverted_points; nonfinite_stresses:
+ * NaN or infinite von Mises values in the frame written after the step, "nan" when none was;
+ * both "nan" in rows restored from a checkpoint that did not record them, as the reactions).
+ * @return FCM_OK, FCM_ERR_IO, FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_simulation_write_log(fcm_simulation *sim, const char *path);
 
 /** Save the run: write a checkpoint to `path` atomically (a temporary beside it, synced, then
@@ -194,7 +228,9 @@ FCM_API const fcm_space *fcm_simulation_space(const fcm_simulation *sim);
 
 /** Print what was computed and what was skipped, with the counters, to `stream`; also the
  * largest displacement of the body (over its quadrature points and the surface points the
- * frames write) beside the DOF vector's (fictitious nodes included). */
+ * frames write) beside the DOF vector's (fictitious nodes included), and the steps that ended
+ * with inverted quadrature points and the frames with NaN or infinite stresses (the first and
+ * the worst; zero when none). */
 FCM_API void fcm_simulation_summary_view(const fcm_simulation *sim, FILE *stream);
 
 #ifdef __cplusplus

@@ -34,10 +34,14 @@ typedef enum fcm_krylov_reason {
                                              singular Lanczos tridiagonal (gamma = 0) */
   FCM_KRYLOV_INDEFINITE_PRECONDITIONER, /**< r^T S r < 0, or = 0 for r != 0 */
   FCM_KRYLOV_NAN,                       /**< NaN or Inf in b, x0 or an iteration scalar */
-  FCM_KRYLOV_CALLBACK_ERROR             /**< the operator or preconditioner returned an error */
+  FCM_KRYLOV_CALLBACK_ERROR,            /**< the operator or preconditioner returned an error */
+  FCM_KRYLOV_STAGNATED /**< the smallest monitored residual dropped by less than 0.1 % over
+                            stagnation_window iterations: a singular (or nearly singular)
+                            operator whose range b leaves, e.g. a semi-definite stiffness
+                            with free rigid-body modes under a load they feel */
 } fcm_krylov_reason;
 
-/** Name of a reason ("converged-rtol", "max-iterations", ...), or "unknown". */
+/** Name of a reason ("converged-rtol", "max-iterations", "stagnated", ...), or "unknown". */
 FCM_API const char *fcm_krylov_reason_name(fcm_krylov_reason reason);
 
 /** Which residual norm the stopping test and the history use. */
@@ -53,6 +57,10 @@ typedef struct fcm_krylov_options {
   double rtol;             /**< relative tolerance >= 0 (default 1e-8) */
   double atol;             /**< absolute tolerance >= 0 (default 0) */
   int max_iterations;      /**< >= 0 (default 1000) */
+  int stagnation_window;   /**< W >= 0 (default 0: off): every W iterations the smallest
+                                monitored residual so far must have dropped by 0.1 % since
+                                the previous such check, else the solve stops with
+                                FCM_KRYLOV_STAGNATED (x is the last iterate) */
   fcm_krylov_norm norm;    /**< monitored norm (default FCM_KRYLOV_NORM_DEFAULT) */
   int check_true_residual; /**< nonzero: at exit compute ||b - A x||_2 / ||b||_2 into
                                 info.true_residual (one more operator application) */
@@ -62,8 +70,8 @@ typedef struct fcm_krylov_options {
   int history_capacity;    /**< entries of `history`; recording stops when it is full */
 } fcm_krylov_options;
 
-/** Defaults: rtol 1e-8, atol 0, 1000 iterations, default norm, no true-residual
- * check, no history. */
+/** Defaults: rtol 1e-8, atol 0, 1000 iterations, no stagnation test, default norm, no
+ * true-residual check, no history. */
 FCM_API fcm_krylov_options fcm_krylov_options_default(void);
 
 /** What a Krylov solve did. Norms are in the monitored norm unless stated. */
@@ -108,7 +116,10 @@ FCM_API void fcm_krylov_destroy(fcm_krylov **ws);
  * @param[in]     opts   options, NULL for defaults
  * @param[out]    info   what happened, may be NULL
  * @return FCM_OK (converged), FCM_ERR_NOT_CONVERGED (max iterations, breakdown, indefinite
- * preconditioner: see info->reason), FCM_ERR_NUMERIC (NaN/Inf), FCM_ERR_ARG, FCM_ERR_ALLOC
+ * preconditioner, stagnation: see info->reason; on a positive semi-definite A with b outside
+ * its range CG's residual stalls and then grows while x grows without bound, ending in a
+ * breakdown unless the stagnation test stops it first), FCM_ERR_NUMERIC (NaN/Inf),
+ * FCM_ERR_ARG, FCM_ERR_ALLOC
  * (growing the workspace history only), or the status a callback returned.
  * Vector operations use OpenMP; dot products are summed in a fixed order, so the result
  * is bitwise independent of the thread count for deterministic callbacks. */

@@ -22,8 +22,9 @@ typedef struct fcm_surface fcm_surface;
  * @param[in]  num_triangles number of triangles (> 0); @param[in] tris num_triangles x 3
  *             0-based vertex ids
  * @param[out] surf          the new surface, NULL on failure
- * @return FCM_OK; FCM_ERR_ARG (NULL pointers, counts <= 0, non-finite coordinate,
- *         vertex id out of range, naming the triangle); FCM_ERR_ALLOC. Allocates;
+ * @return FCM_OK; FCM_ERR_ARG (NULL pointers, counts <= 0, a coordinate that is not
+ *         finite or beyond +-1e50 (products of such coordinates overflow), vertex id out of
+ *         range, naming the triangle); FCM_ERR_ALLOC. Allocates;
  *         release with fcm_surface_destroy(). Thread safe. */
 FCM_API fcm_status fcm_surface_create(fcm_ctx *ctx, fcm_index num_vertices, const double *coords,
                                       fcm_index num_triangles, const fcm_index *tris,
@@ -44,7 +45,9 @@ FCM_API fcm_status fcm_surface_create(fcm_ctx *ctx, fcm_index num_vertices, cons
  *         big-endian PLY); FCM_ERR_IO (missing or non-regular file); FCM_ERR_FORMAT (any
  *         parse error, out-of-range vertex id, non-finite coordinate, empty mesh: the
  *         message names the file and the line, or the byte offset of binary data, and
- *         what was expected); FCM_ERR_ALLOC. Allocates; release with
+ *         what was expected; a coordinate beyond +-1e50, naming the vertex by its id as
+ *         the format numbers it, from 1 in OBJ and from 0 in OFF and PLY, or by facet and
+ *         corner in STL, and the value); FCM_ERR_ALLOC. Allocates; release with
  *         fcm_surface_destroy(). Thread safe. */
 FCM_API fcm_status fcm_surface_create_from_file(fcm_ctx *ctx, const char *path, fcm_surface **surf);
 

@@ -30,8 +30,9 @@ typedef struct fcm_voxel_image fcm_voxel_image;
  * @param[in] values dims[0] dims[1] dims[2] values, i fastest, copied (NaN allowed: never
  *                   selected)
  * @param[out] img   the image, NULL on failure
- * @return FCM_OK, FCM_ERR_ARG (NULL, bad dims, singular or non-finite axes/origin),
- *         FCM_ERR_ALLOC. Allocates; release with fcm_voxel_image_destroy(). */
+ * @return FCM_OK, FCM_ERR_ARG (NULL, bad dims, singular or non-finite axes/origin, voxels
+ *         reaching beyond +-1e50), FCM_ERR_ALLOC.
+ * Allocates; release with fcm_voxel_image_destroy(). */
 FCM_API fcm_status fcm_voxel_image_create(fcm_ctx *ctx, const fcm_index dims[3],
                                           const double axes[9], const double origin[3],
                                           const double *values, fcm_voxel_image **img);
@@ -44,11 +45,12 @@ FCM_API fcm_status fcm_voxel_image_create(fcm_ctx *ctx, const fcm_index dims[3],
  * header) or ".mhd" / ".mha" (MetaImage: NDims = 3, DimSize, ElementType MET_CHAR ..
  * MET_DOUBLE, ElementSpacing, Offset / Origin / Position, TransformMatrix, ElementByteOrderMSB,
  * HeaderSize, ElementDataFile = file or LOCAL; compressed data refused).
- * @return FCM_OK; FCM_ERR_IO (cannot open/read, naming the file); FCM_ERR_FORMAT
- *         ("path:line: field: ..." naming the bad field, its value and the valid values or
- *         range; data files shorter than announced, with the byte counts); FCM_ERR_UNSUPPORTED
- *         (compressed encodings, dimension other than 3, several channels, other extensions);
- *         FCM_ERR_ALLOC. Allocates. */
+ * @return FCM_OK; FCM_ERR_IO (cannot open/read, naming the file; for a detached data file
+ *         also the header and its line that name it); FCM_ERR_FORMAT ("path:line: field:
+ *         ..." naming the bad field, its value and the valid values or range; data files
+ *         shorter than announced, with the byte counts and the header they belong to);
+ *         FCM_ERR_UNSUPPORTED (compressed encodings, dimension other than 3, several channels,
+ *         other extensions); FCM_ERR_ALLOC. Allocates. */
 FCM_API fcm_status fcm_voxel_image_create_from_file(fcm_ctx *ctx, const char *path,
                                                     fcm_voxel_image **img);
 
@@ -80,6 +82,9 @@ FCM_API fcm_voxel_options fcm_voxel_options_default(void);
 typedef struct fcm_voxel_info {
   fcm_index num_voxels;   /**< voxels in the image */
   fcm_index num_selected; /**< voxels selected */
+  fcm_index num_nan;      /**< voxels whose value is NaN: never selected (outside the body);
+                               when > 0 a warning is logged (FCM_LOG_WARNING) with the count
+                               and the first one */
   fcm_index num_boxes;    /**< Hex8 cells created (= num_selected without merging) */
   double voxel_volume;    /**< |det axes| */
 } fcm_voxel_info;
@@ -89,7 +94,8 @@ typedef struct fcm_voxel_info {
  * the lattice nodes at their corners. The boundary triangles are the exact voxel surface:
  * the box faces next to an unselected voxel or the image's edge, merged into rectangles
  * per box (their corners are extra lattice nodes, not used by any cell), two triangles
- * each, owned by that box, outward; fcm_geometry_create_transformed() keeps them.
+ * each, owned by that box, outward; fcm_geometry_create_transformed() keeps them. NaN
+ * values are never selected; they are counted (info->num_nan) and logged as a warning.
  * @param[in] opts NULL for defaults; @param[out] info may be NULL
  * @return FCM_OK; FCM_ERR_ARG (NULL, num_labels outside [0, 256], labels NULL with
  *         num_labels > 0, non-finite threshold or label); FCM_ERR_GEOMETRY (no voxel

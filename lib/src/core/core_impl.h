@@ -182,6 +182,19 @@ fcm_status fcm__loop_end(fcm__loop *loop, fcm_index *failed);
   } while (0)
 #endif
 
+/* Largest coordinate magnitude the mesh, geometry and surface readers and constructors
+ * accept. The geometry computations form products of up to about six coordinates (or of
+ * their differences): a volume is a cube, the squared norm of a normal a fourth power, a
+ * tolerance times such a norm more; at 1e50 a sixth power of a difference still stays below
+ * 1e303, while squares overflow from about 1.3e154 on and fourth powers from 1.3e77. A
+ * coordinate beyond the limit is refused as out of range instead of surfacing later as a
+ * degenerate triangle or a non-finite volume. */
+#define FCM__COORD_MAX 1e50
+/* The range as messages state it. */
+#define FCM__COORD_RANGE                                                                           \
+  "the supported range [-1e50, 1e50] (larger magnitudes overflow the products of coordinates "     \
+  "in volumes and normals)"
+
 #define FCM_MIN(a, b) ((a) < (b) ? (a) : (b))
 #define FCM_MAX(a, b) ((a) > (b) ? (a) : (b))
 

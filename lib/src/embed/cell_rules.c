@@ -8,7 +8,6 @@
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
-#include <stdio.h>
 
 #define GIB (1024.0 * 1024.0 * 1024.0)
 
@@ -94,7 +93,8 @@ typedef struct piece_out {
   unsigned char skipped[FCM_RULE_KIND_COUNT], fallback[FCM_RULE_KIND_COUNT];
   double residual[FCM_RULE_KIND_COUNT];
   double tsimp[FCM_RULE_KIND_COUNT]; /* fcm_simplify's time_total */
-  int parent; /* the piece of the same cell in the rules being extended that holds this one */
+  int parent;    /* the piece of the same cell in the rules being extended that holds this one */
+  int component; /* its number among the cell's components before empty ones were dropped */
   int ns;
   double *spts, *sw, *snrm;
   fcm_index *stri;
@@ -129,10 +129,11 @@ typedef struct build {
   int stabilize[FCM_RULE_KIND_COUNT];
   /* Cutting: the tree of R->cut_tris (NULL without cuts); region[c]: cell c shares a node
    * with a cell the cuts reach (its face polygons are recorded for the links); rebuild[c]:
-   * integrate cell c (NULL: every cell), else copy its rules from prev. */
+   * integrate cell c (NULL: every cell), else copy its rules from prev; prev_region[c]: the
+   * region of prev, whose links cover the pairs of its cells (NULL: prev has no cuts). */
   fcm_aabb_tree *cut_tree;
   const fcm__cut_tri *cut_tris;
-  unsigned char *region, *rebuild;
+  unsigned char *region, *rebuild, *prev_region;
   const fcm_cell_rules *prev;
   fcm_index first_new;    /* cut triangles from here on are new (those of the cut being added) */
   fcm__rules_reduce *red; /* distributed AUTO: sums the choice's inputs (NULL: none) */
@@ -356,6 +357,7 @@ static fcm_status copy_cell(const build *B, fcm_index c, cell_out *o)
     piece_out *po = o->pc + i;
     const fcm_index p = p0 + i;
     po->volume = Q->piece_volume[p];
+    po->component = Q->piece_component[p];
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
       const size_t a = (size_t)Q->off[k][p], n = (size_t)Q->off[k][p + 1] - a;
       if (n) {
@@ -405,11 +407,11 @@ cleanup:
   return st;
 }
 
-/* Renumber the labels (P->piece or P->parent, *count of them) so that labels whose parts
- * keep no more than vmin of volume (all slivers, or flat on a cut) are removed: those parts get
- * -1. vol (may be NULL) gets the volume of each remaining label. */
+/* Renumber the labels (P->piece, *count of them) so that labels whose parts keep no more than
+ * vmin of volume (all slivers, or flat on a cut) are removed: those parts get -1. vol gets the
+ * volume of each remaining label and was[i] the label that remaining label i had. */
 static fcm_status drop_empty(const build *B, fcm__embed_ws *ws, double vmin, int *label, int *count,
-                             double *vol, cell_sums *sums)
+                             double *vol, int *was, cell_sums *sums)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
@@ -420,8 +422,7 @@ static fcm_status drop_empty(const build *B, fcm__embed_ws *ws, double vmin, int
     double v = 0.0;
     FCM_TRY(ctx, fcm__embed_piece_tets(ctx, P, label, i, ws, sums ? &sums->counts : NULL, &v));
     renum[i] = v > vmin ? kept : -1;
-    if (v > vmin && vol) vol[kept] = v;
-    if (v > vmin) kept++;
+    if (v > vmin) vol[kept] = v, was[kept++] = i;
   }
   for (size_t j = 0; j < P->n; j++)
     label[j] = label[j] >= 0 ? renum[label[j]] : -1;
@@ -434,10 +435,12 @@ cleanup:
 /* The convex parts and material pieces of a cell that cuts reach (or that lies next to
  * such a cell): parts, split, grouped; empty pieces (all slivers) are removed. On return
  * P->piece numbers the pieces with volume, -1 for parts of removed ones; vol[i] is the
- * volume of piece i (P->num_pieces of them); P->parent likewise numbers the pieces under
- * the earlier cuts only (the pieces of the rules being extended). */
+ * volume of piece i (P->num_pieces of them) and comp[i] its number among all the
+ * components; P->parent numbers the components under the earlier cuts only, empty ones
+ * included (the numbering of the pieces of the rules being extended, before their empty
+ * components were dropped: a component can lose its last volume to the new cut). */
 static fcm_status cell_pieces(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
-                              cell_sums *sums, double **vol)
+                              cell_sums *sums, double **vol, int **comp)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
@@ -449,21 +452,25 @@ static fcm_status cell_pieces(const build *B, const fcm__embed_cell *cell, fcm__
   if (P->tcand.n > 0) {
     FCM_TRY(ctx, fcm__embed_cell_pieces(ctx, cell, B->cut_tris, B->first_new, P));
     sums->counts.degenerate += !(P->split_error <= DEGENERATE_RTOL * cell->volume);
-    if (getenv("DBG") && !(P->split_error <= DEGENERATE_RTOL * cell->volume)) fprintf(stderr, "DEGENERATE cell %lld split_error %.3g vol %.3g\n", (long long)cell->id, P->split_error, cell->volume);
   }
   FCM_ALLOC(ctx, (size_t)P->num_pieces + 1, *vol);
-  /* a piece is kept when it holds more than a sliver of the cell (a piece flat on a cut
-   * carries no material and would tie the nodes of both sides together); the pieces under the
-   * earlier cuts alike, as the build that made them kept them */
-  const double vmin = opt->sliver_rtol * cell->volume;
   if (B->prev) {
-    FCM_TRY(ctx, drop_empty(B, ws, vmin, P->parent, &P->num_parents, NULL, NULL));
-    /* a piece in a removed earlier piece holds no more volume than that one (up to rounding
-     * at the threshold): removed too, so that every kept piece lies in a kept earlier one */
-    for (size_t j = 0; j < P->n; j++)
-      if (P->parent[j] < 0) P->piece[j] = -1;
+    /* a piece in an earlier piece that the build that made it removed (no more than a sliver)
+     * holds no more volume than that one, up to rounding at the threshold: removed too, so
+     * that every kept piece lies in a kept earlier one */
+    const fcm_index p0 = B->prev->piece_off[cell->id], had = B->prev->piece_off[cell->id + 1] - p0;
+    for (size_t j = 0; j < P->n; j++) {
+      int found = 0;
+      for (fcm_index q = 0; q < had && !found; q++)
+        found = B->prev->piece_component[p0 + q] == P->parent[j];
+      if (!found) P->piece[j] = -1;
+    }
   }
-  FCM_TRY(ctx, drop_empty(B, ws, vmin, P->piece, &P->num_pieces, *vol, sums));
+  /* a piece is kept when it holds more than a sliver of the cell (a piece flat on a cut
+   * carries no material and would tie the nodes of both sides together) */
+  FCM_ALLOC(ctx, (size_t)P->num_pieces + 1, *comp);
+  FCM_TRY(ctx, drop_empty(B, ws, opt->sliver_rtol * cell->volume, P->piece, &P->num_pieces, *vol,
+                          *comp, sums));
 cleanup:
   return st;
 }
@@ -480,6 +487,7 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   const fcm_cell_rules_options *opt = B->o;
   fcm__embed_cell cell;
   double vol = 0.0, *pvol = NULL;
+  int *pcomp = NULL;
   fcm__parts *P = NULL;
   const int integrate = !B->rebuild || B->rebuild[c];
   const int own = !opt->cell_mask || opt->cell_mask[c]; /* 0: classified, no points */
@@ -488,7 +496,7 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   if (B->cut_tree && B->region[c]) {
     if (!ws->parts) FCM_ALLOC(ctx, 1, ws->parts);
     P = ws->parts;
-    FCM_TRY(ctx, cell_pieces(B, &cell, ws, sums, &pvol));
+    FCM_TRY(ctx, cell_pieces(B, &cell, ws, sums, &pvol, &pcomp));
     for (int i = 0; i < P->num_pieces; i++)
       vol += pvol[i];
     FCM_TRY(ctx, fcm__embed_face_polygons(ctx, &cell, P));
@@ -521,13 +529,19 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   if (o->np == 1) o->pc[0].volume = o->volume;
   for (int i = 0; i < o->np; i++) { /* the earlier piece that holds each piece */
     o->pc[i].parent = i;
+    o->pc[i].component = P ? pcomp[i] : 0;
     if (P && B->prev && integrate) {
+      /* the component under the earlier cuts of the piece's first part, and the earlier
+       * piece numbered so (not its rank among the components that keep volume now) */
+      const fcm_index p0 = B->prev->piece_off[c], had = B->prev->piece_off[c + 1] - p0;
       size_t j = 0;
       while (j < P->n && P->piece[j] != i)
         j++;
-      o->pc[i].parent = j < P->n ? P->parent[j] : -1;
-      const fcm_index had = B->prev->piece_off[c + 1] - B->prev->piece_off[c];
-      FCM_CHECK(o->pc[i].parent >= 0 && o->pc[i].parent < had, ctx, FCM_ERR_INTERNAL,
+      const int comp = j < P->n ? P->parent[j] : -1;
+      o->pc[i].parent = -1;
+      for (fcm_index q = 0; q < had && comp >= 0; q++)
+        if (B->prev->piece_component[p0 + q] == comp) o->pc[i].parent = (int)q;
+      FCM_CHECK(o->pc[i].parent >= 0, ctx, FCM_ERR_INTERNAL,
                 "embed: piece %d of cell %lld lies in no piece of the rules being extended (%lld "
                 "pieces there)",
                 i, (long long)c, (long long)had);
@@ -589,6 +603,7 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   }
 cleanup:
   fcm__free(ctx, pvol);
+  fcm__free(ctx, pcomp);
   return st;
 }
 
@@ -793,8 +808,9 @@ static void build_release(build *B)
   if (B->ctx) {
     fcm__free(B->ctx, B->region);
     fcm__free(B->ctx, B->rebuild);
+    fcm__free(B->ctx, B->prev_region);
   }
-  B->region = B->rebuild = NULL;
+  B->region = B->rebuild = B->prev_region = NULL;
   fcm_aabb_tree_destroy(&B->tree);
   fcm_aabb_tree_destroy(&B->tri_tree);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
@@ -847,7 +863,7 @@ static fcm_status cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new)
   const int npc = fcm_mesh_nodes_per_cell(mesh);
   const fcm_index *cells = fcm_mesh_cells(mesh);
   double *boxes = NULL;
-  unsigned char *node_hit = NULL;
+  unsigned char *node_hit = NULL; /* 1: a cell the cuts reach holds the node; 2: the earlier */
   fcm__idbuf ids = {NULL, 0, 0};
   FCM_ALLOC(ctx, 6 * (size_t)R->num_cut_tris + 6, boxes);
   for (fcm_index t = 0; t < R->num_cut_tris; t++) {
@@ -862,19 +878,23 @@ static fcm_status cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new)
   R->reached = NULL;
   FCM_ALLOC(ctx, (size_t)nc + 1, R->reached);
   if (B->prev) FCM_ALLOC(ctx, (size_t)nc + 1, B->rebuild);
+  if (B->prev && first_new > 0) FCM_ALLOC(ctx, (size_t)nc + 1, B->prev_region);
   for (fcm_index c = 0; c < nc; c++) {
     fcm__embed_cell cell;
     FCM_TRY(ctx, fcm__embed_cell_setup(ctx, mesh, c, B->o->clip_rtol, &cell));
     FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, cell.lo, cell.hi, &ids));
     if (ids.n == 0) continue;
     R->reached[c] = 1;
-    for (int a = 0; a < npc; a++)
-      node_hit[cells[(size_t)npc * c + a]] = 1;
+    for (int a = 0; a < npc; a++) /* ids ascending: the earlier cuts' triangles first */
+      node_hit[cells[(size_t)npc * c + a]] |= (unsigned char)(ids.ids[0] < first_new ? 3 : 1);
     if (B->rebuild && ids.ids[ids.n - 1] >= first_new) B->rebuild[c] = 1;
   }
   for (fcm_index c = 0; c < nc; c++)
-    for (int a = 0; a < npc && !B->region[c]; a++)
-      B->region[c] = node_hit[cells[(size_t)npc * c + a]];
+    for (int a = 0; a < npc; a++) {
+      const unsigned char h = node_hit[cells[(size_t)npc * c + a]];
+      B->region[c] |= h != 0;
+      if (B->prev_region) B->prev_region[c] |= (h & 2) != 0;
+    }
 cleanup:
   fcm__free(ctx, boxes);
   fcm__free(ctx, node_hit);
@@ -1067,6 +1087,7 @@ static fcm_status gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_out *
   FCM_ALLOC(ctx, (size_t)np + 1, R->piece_cell);
   FCM_ALLOC(ctx, (size_t)np + 1, R->piece_volume);
   FCM_ALLOC(ctx, (size_t)np + 1, R->piece_parent);
+  FCM_ALLOC(ctx, (size_t)np + 1, R->piece_component);
   FCM_ALLOC(ctx, (size_t)np + 1, R->soff);
   R->piece_off[0] = 0;
   for (fcm_index c = 0; c < nc; c++) {
@@ -1075,6 +1096,7 @@ static fcm_status gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_out *
       R->piece_cell[R->piece_off[c] + i] = c;
       R->piece_volume[R->piece_off[c] + i] = out[c].pc[i].volume;
       R->piece_parent[R->piece_off[c] + i] = prev ? prev->piece_off[c] + out[c].pc[i].parent : -1;
+      R->piece_component[R->piece_off[c] + i] = out[c].pc[i].component;
     }
   }
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
@@ -1144,9 +1166,23 @@ static int cmp_link(const void *a, const void *b)
   return (x[1] > y[1]) - (x[1] < y[1]);
 }
 
+/* Whether the earlier pieces qa of cell ca and qb of cell cb (ca < cb, face neighbours) were
+ * linked in the rules being extended: a cut only separates, so pieces whose parents it had
+ * separated stay apart, whatever the face tests on the new, smaller pieces say (near a cut
+ * within the tolerances those can differ). Cells outside the earlier region had one piece
+ * each, linked to its neighbours'. */
+static int earlier_link(const build *B, fcm_index ca, fcm_index cb, int qa, int qb)
+{
+  if (!B->prev_region || !B->prev_region[ca] || !B->prev_region[cb]) return 1;
+  const fcm_cell_rules *Q = B->prev;
+  const fcm_index key[2] = {Q->piece_off[ca] + qa, Q->piece_off[cb] + qb};
+  return bsearch(key, Q->links, (size_t)Q->num_links, 2 * sizeof *Q->links, cmp_link) != NULL;
+}
+
 /* Phase 3b (cuts only): the links between pieces of face-neighbouring region cells: a
  * polygon of one cell's piece on the shared face overlaps a polygon of the other cell's
- * piece with positive area, and the overlap does not lie on a cut triangle. */
+ * piece with positive area, and the overlap does not lie on a cut triangle, and
+ * their parents were linked (earlier_link()). */
 static fcm_status gather_links(const build *B, fcm_cell_rules *R, const cell_out *out)
 {
   fcm_status st = FCM_OK;
@@ -1201,6 +1237,7 @@ static fcm_status gather_links(const build *B, fcm_cell_rules *R, const cell_out
           if (!fcm__embed_linked(A, ma[2], A + 3 * ma[2], ma[3], Bx, mb[2], Bx + 3 * mb[2], mb[3],
                                  nbn, mtol, atol, B->cut_tris, tc.ids, tc.n))
             continue;
+          if (!earlier_link(B, c, c2, out[c].pc[ma[1]].parent, out[c2].pc[mb[1]].parent)) continue;
           if (nl + 1 > cap) {
             const size_t ncap = cap ? 2 * cap : 256;
             void *q = links;
@@ -1505,6 +1542,7 @@ fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const f
             (long long)fcm_mesh_num_cells(mesh), (long long)prev->num_cells);
   FCM_CHECK(prev->num_cuts < 1 << 20, ctx, FCM_ERR_UNSUPPORTED,
             "embed cut: %d cuts already (limit 2^20)", prev->num_cuts);
+  FCM_TRY(ctx, fcm__embed_cut_check(ctx, cut, "embed cut"));
   const fcm_index nt = fcm_surface_num_triangles(cut);
   const double *x = fcm_surface_coords(cut);
   const fcm_index *tv = fcm_surface_triangles(cut);
@@ -1590,6 +1628,7 @@ void fcm_cell_rules_destroy(fcm_cell_rules **rules)
   fcm__free(ctx, R->piece_cell);
   fcm__free(ctx, R->piece_volume);
   fcm__free(ctx, R->piece_parent);
+  fcm__free(ctx, R->piece_component);
   fcm__free(ctx, R->cut_tris);
   fcm__free(ctx, R->links);
   fcm__free(ctx, R->reached);

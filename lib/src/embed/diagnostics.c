@@ -1,5 +1,6 @@
 /* Embedding diagnostics: how much of the body lies outside the background mesh, beyond which
- * faces of its bounding box, and the error for a body that misses the mesh entirely. */
+ * faces of its bounding box, and the error for a body that misses the mesh entirely; a cut
+ * surface with no triangle of positive area. */
 #include "embed/embed_impl.h"
 
 #include <math.h>
@@ -81,5 +82,28 @@ fcm_status fcm__embed_outside_sides(fcm_ctx *ctx, const double mlo[3], const dou
   }
 cleanup:
   fcm__free(ctx, p);
+  return st;
+}
+
+fcm_status fcm__embed_cut_check(fcm_ctx *ctx, const fcm_surface *cut, const char *what)
+{
+  fcm_status st = FCM_OK;
+  static const unsigned char none[3] = {0, 0, 0};
+  const fcm_index nt = fcm_surface_num_triangles(cut);
+  const double *x = fcm_surface_coords(cut);
+  const fcm_index *tv = fcm_surface_triangles(cut);
+  for (fcm_index t = 0; t < nt; t++) {
+    fcm__cut_tri probe;
+    if (fcm__embed_cut_tri_setup(x + 3 * tv[3 * t], x + 3 * tv[3 * t + 1], x + 3 * tv[3 * t + 2], 0,
+                                 none, NULL, &probe))
+      return FCM_OK;
+  }
+  const double *a = x + 3 * tv[0], *b = x + 3 * tv[1], *c = x + 3 * tv[2];
+  FCM_CHECK(0, ctx, FCM_ERR_GEOMETRY,
+            "%s: all %lld triangle(s) of the cut surface have zero area (the first: (%g, %g, %g), "
+            "(%g, %g, %g), (%g, %g, %g)), so the cut would separate nothing; give a surface with "
+            "triangles of positive area",
+            what, (long long)nt, a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2]);
+cleanup:
   return st;
 }

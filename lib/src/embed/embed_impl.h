@@ -74,9 +74,13 @@ struct fcm_cell_rules {
    * node's support are all known when one of its cells is reached. */
   unsigned char *reached;
   /* piece_parent[p]: the piece of the rules this object extends that holds piece p (-1
-   * for rules made by fcm_cell_rules_create()); prev_num_pieces: how many that object had */
+   * for rules made by fcm_cell_rules_create()); prev_num_pieces: how many that object had.
+   * piece_component[p]: the number of piece p among the connected components of its cell's
+   * parts before the components without volume were dropped: a later cut numbers the
+   * pieces under the earlier cuts (its parents) the same way, whatever volume they keep */
   fcm_index *piece_parent;
   fcm_index prev_num_pieces;
+  int *piece_component;
   fcm_cell_rules_stats stats;
 };
 
@@ -308,6 +312,11 @@ int fcm__embed_linked(const double *a, int na, const double *va, int nva, const 
  * cuts does not, however thin it is. */
 int fcm__embed_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n, const double *x,
                       int m, double tol);
+
+/* FCM_ERR_GEOMETRY when every triangle of the cut surface has no area (as
+ * fcm__embed_cut_tri_setup() judges it): such a cut separates nothing. The message starts
+ * with `what` and gives the count and the first triangle's vertices. No allocation. */
+fcm_status fcm__embed_cut_check(fcm_ctx *ctx, const fcm_surface *cut, const char *what);
 
 /* The embedding diagnostics of the statistics S (geometry, embedded and sliver volumes
  * already set): bounding boxes, volume ratio, the volume outside the mesh and beyond each

@@ -194,6 +194,7 @@ typedef struct cell_result {
   double energy;
   double bad_det; /* 1 when every det J > 0, else the first offending value */
   int nonfinite;  /* the material returned NaN/Inf */
+  int inverted;   /* hyperelastic: authentic points with det F <= 0 */
 } cell_result;
 
 /* Element matrix Ke (3nn x 3nn, row-major) and/or vector fe (3nn) of one cell.
@@ -206,7 +207,7 @@ typedef struct cell_result {
 static cell_result cell_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
 {
   int ndof = 3 * nn;
-  cell_result res = {0.0, 1.0, 0};
+  cell_result res = {0.0, 1.0, 0, 0};
   double *g = w->g, *H = w->H, *Ke = w->Ke, *fe = w->fe;
   int matrix = kd->kind == KERNEL_STIFFNESS || kd->kind == KERNEL_MASS ||
                (kd->kind == KERNEL_HYPERELASTIC && kd->want_tangent);
@@ -257,10 +258,14 @@ static cell_result cell_kernel(const kernel_data *kd, const cell_rule *r, int nn
         for (int i = 0; i < 3; i++)
           for (int j = 0; j < 3; j++)
             F[3 * i + j] += w->ue[3 * a + i] * g[3 * a + j];
-      if (r->fict && r->fict[q])
+      if (r->fict && r->fict[q]) {
         fictitious_eval(kd, F, &psi, P, kd->want_tangent ? A : NULL);
-      else
+      } else {
+        /* an inverted point of the body: counted, the material still evaluates it (the
+         * Stable Neo-Hookean and corotated models are defined there) */
+        res.inverted += !(fcm__mat3_det(F) > 0.0);
         fcm__material_eval(kd->mat, F, &psi, P, kd->want_tangent ? A : NULL);
+      }
       int finite = isfinite(psi);
       for (int k = 0; k < 9; k++)
         finite &= isfinite(P[k]);
@@ -392,6 +397,7 @@ struct fcm_assembly_workspace {
   double *mem;         /* per-thread element buffers */
   scratch *sc;         /* nthreads views into mem */
   double *cell_energy; /* num_elems: energy per element of the last hyperelastic assembly */
+  int *cell_inverted;  /* num_elems: its authentic points with det F <= 0 per element */
 };
 
 fcm_status fcm_assembly_workspace_create(const fcm_space *space, const fcm_assembly_options *opts,
@@ -417,6 +423,7 @@ fcm_status fcm_assembly_workspace_create(const fcm_space *space, const fcm_assem
   ws->nthreads = omp_get_max_threads();
   FCM_TRY(ctx, scratch_alloc(space, ws->nthreads, &ws->mem, &ws->sc));
   FCM_ALLOC(ctx, space->num_elems + 1, ws->cell_energy);
+  FCM_ALLOC(ctx, space->num_elems + 1, ws->cell_inverted);
   *out = ws;
   ws = NULL;
 cleanup:
@@ -433,6 +440,7 @@ void fcm_assembly_workspace_destroy(fcm_assembly_workspace **wsp)
   fcm__free(ws->ctx, ws->mem);
   fcm__free(ws->ctx, ws->sc);
   fcm__free(ws->ctx, ws->cell_energy);
+  fcm__free(ws->ctx, ws->cell_inverted);
   fcm__free(ws->ctx, ws);
   *wsp = NULL;
 }
@@ -471,6 +479,7 @@ typedef struct pass {
   void *traction_user;
   double *vals, *vec;  /* matrix values (space pattern) and vector, either may be NULL */
   double *cell_energy; /* num_elems, or NULL */
+  int *cell_inverted;  /* num_elems, or NULL */
 } pass;
 
 /* Surface traction of element e into w->fe; returns 0 when it has no surface points. */
@@ -548,6 +557,7 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
             continue;
           }
           if (ps->cell_energy) ps->cell_energy[c] = res.energy;
+          if (ps->cell_inverted) ps->cell_inverted[c] = res.inverted;
         }
         if (ps->vals) scatter_matrix(s, le, w->Ke, ps->vals);
         if (ps->vec) scatter_vector(s, c, w->fe, ps->vec);
@@ -585,6 +595,7 @@ static fcm_status run_volume_pass(fcm_assembly_workspace *ws, const kernel_data 
   ps.vals = vals;
   ps.vec = vec;
   ps.cell_energy = cell_energy;
+  ps.cell_inverted = kd->kind == KERNEL_HYPERELASTIC ? ws->cell_inverted : NULL;
   FCM_TRY(ws->ctx, run_pass(ws, &ps));
 cleanup:
   return st;
@@ -715,6 +726,52 @@ fcm_status fcm_assembly_workspace_hyperelastic(fcm_assembly_workspace *ws,
   }
 cleanup:
   return st;
+}
+
+fcm_index fcm__assembly_inverted(const fcm_assembly_workspace *ws, fcm_index *first_elem)
+{
+  const fcm_space *s = ws->space;
+  fcm_index count = 0, first = -1;
+  for (fcm_index le = 0; le < s->num_local_elems; le++) { /* ascending element ids */
+    const fcm_index e = fcm__space_local_elem(s, le);
+    if (ws->cell_inverted[e] > 0 && first < 0) first = e;
+    count += ws->cell_inverted[e];
+  }
+  if (first_elem) *first_elem = first;
+  return count;
+}
+
+int fcm__assembly_inverted_point(fcm_assembly_workspace *ws, fcm_index elem, const double *u,
+                                 double X[3], double *det)
+{
+  const fcm_space *s = ws->space;
+  const int nn = s->nn;
+  scratch *w = ws->sc;
+  if (!ws->tabulated[0] || elem < 0 || elem >= s->num_elems) return 0;
+  fcm_mesh_cell_coords(s->mesh, s->elem_cell[elem], w->X);
+  const fcm_index *ed = s->elem_dof + elem * nn;
+  for (int a = 0; a < nn; a++)
+    memcpy(w->ue + 3 * a, u + ed[a], 3 * sizeof(double));
+  cell_rule r = get_cell_rule(s, &ws->tab[0], FCM_RULE_STIFFNESS, elem, w->Nb, w->dNb);
+  for (int q = 0; q < r.nq; q++) {
+    if (r.fict && r.fict[q]) continue;
+    double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    if (!(physical_gradients(&r, nn, q, w->X, w->g) > 0.0)) continue;
+    for (int a = 0; a < nn; a++)
+      for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+          F[3 * i + j] += w->ue[3 * a + i] * w->g[3 * a + j];
+    const double J = fcm__mat3_det(F);
+    if (J > 0.0) continue;
+    const double *N = r.N + (size_t)q * nn;
+    X[0] = X[1] = X[2] = 0.0;
+    for (int a = 0; a < nn; a++)
+      for (int i = 0; i < 3; i++)
+        X[i] += N[a] * w->X[3 * a + i];
+    *det = J;
+    return 1;
+  }
+  return 0;
 }
 
 /* ------------------------------------------------------------------ one-shot forms */

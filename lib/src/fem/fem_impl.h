@@ -26,6 +26,10 @@ struct fcm_space {
   fcm_index num_elems;
   fcm_index *elem_cell, *elem_piece, *elem_dof, *cell_elem;
   fcm_index num_constrained; /* copies constrained to move with their piece (Koschier) */
+  /* elem_con[nn e + a] = 1 where element e uses at local node a, in place of a constrained
+   * copy, the copy it moves with (possibly another copy of the same node); NULL when no copy
+   * is constrained */
+  unsigned char *elem_con;
   /* Everything above is the numbering: O(nodes + elements x nn), the same on every process of
    * a distributed run. The topology below covers the LOCAL elements and copies. A full space
    * (fcm_space_create*(), is_local = 0): every element and copy, local position = element id /
@@ -190,6 +194,13 @@ void fcm__space_memory(const fcm_space *s, double *numbering, double *topology);
  * nothing: the integrator calls it every Newton iteration with its own marks. (space.c) */
 void fcm__eliminate_marked(fcm_csr *A, double *b, const unsigned char *con, const double *g);
 
+/* The bodies of the space (fcm_space_num_bodies()): elem_body[e] (num_elems entries) the body
+ * of element e, bodies numbered 0 .. *num_bodies - 1 in the order of their first element
+ * (elements joined through shared DOF copies; every copy lies in exactly one body). Reads only
+ * the numbering (a local space as the full one). Allocates O(num_dofs / 3) scratch.
+ * @return FCM_OK, FCM_ERR_ALLOC. (locate.c) */
+fcm_status fcm__space_body_labels(const fcm_space *s, fcm_index *elem_body, fcm_index *num_bodies);
+
 /* Physical shape-function gradients g (nn x 3) at a point from the reference ones dN (nn x 3)
  * and the nodal coordinates X (nn x 3); returns det J (not positive: g is not written). */
 double fcm__fem_gradients(int nn, const double *X, const double *dN, double *g);
@@ -211,15 +222,41 @@ void fcm__space_copy_support(const fcm_space *s, double *support);
 fcm_status fcm__assembly_element_linear(fcm_assembly_workspace *ws, const fcm_linear_form *form,
                                         fcm_index elem, double *Ke, double *fe);
 
+/* The authentic quadrature points (fictitious stabilization points of cut cells left out) with
+ * J = det F <= 0 in the last hyperelastic assembly through ws
+ * (fcm_assembly_workspace_hyperelastic(), any of its outputs), summed over the local elements (a
+ * local space: this process's elements); *first_elem (may be NULL): the lowest element holding one,
+ * -1 when none. 0 before any hyperelastic assembly. O(local elements), no allocation. (assemble.c)
+ */
+fcm_index fcm__assembly_inverted(const fcm_assembly_workspace *ws, fcm_index *first_elem);
+
+/* The first authentic point of element elem (in its rule's order) with J = det F <= 0 at the
+ * displacement u: its reference position X and J; returns 1, or 0 when it has none (or no
+ * hyperelastic assembly ran yet). Serial (the workspace's first scratch); no allocation.
+ * (assemble.c) */
+int fcm__assembly_inverted_point(fcm_assembly_workspace *ws, fcm_index elem, const double *u,
+                                 double X[3], double *det);
+
 /* One process's piece of a parallel frame (.pvtu + one .vtu per process, written atomically):
  * the cells c with keep[c] != 0 (keep NULL: all) with their nodes renumbered, the point fields
  * displacement, velocity (v may be NULL) of the DOF vectors u, v (replicated) and node_index
  * (the mesh's node), the cell fields process (= rank), cell_index (the mesh's cell), active,
  * volume_fraction and, with mat, stress, von_mises, strain_energy_density (computed here:
- * the kept cells must have their points on this process). Not collective. (fields.c) */
+ * the kept cells must have their points on this process); *nonfinite (may be NULL): the kept
+ * cells whose von_mises is NaN or infinite (0 without mat). Not collective. (fields.c) */
 fcm_status fcm__space_write_vtu_piece(const fcm_space *s, const fcm_material *mat, const double *u,
                                       const double *v, const unsigned char *keep, int rank,
-                                      const char *path);
+                                      const char *path, fcm_index *nonfinite);
+
+/* fcm_space_write_vtu() and fcm_embedded_surface_write_vtu() that also count, in *nonfinite
+ * (may be NULL), the von_mises values they wrote that are NaN or infinite (cells, surface
+ * points; 0 without mat): the stresses of points with J = det F <= 0. (fields.c) */
+fcm_status fcm__space_write_vtu_counted(const fcm_space *s, const fcm_material *mat,
+                                        const double *u, const double *v, const char *path,
+                                        fcm_index *nonfinite);
+fcm_status fcm__embedded_surface_write_vtu_counted(const fcm_embedded_surface *es,
+                                                   const fcm_material *mat, const double *u,
+                                                   const char *path, fcm_index *nonfinite);
 
 /* The mesh nodes of the cells with keep[c] != 0 (keep NULL: all), ascending, each once, in
  * *nodes (allocated with the space's context; free with fcm__free()), their count in *num.

@@ -296,14 +296,31 @@ cleanup:
   return st;
 }
 
+/* Entries of x[0 .. n) that are NaN or infinite. */
+static fcm_index count_nonfinite(fcm_index n, const double *x)
+{
+  fcm_index k = 0;
+  for (fcm_index i = 0; i < n; i++)
+    k += !isfinite(x[i]);
+  return k;
+}
+
 fcm_status fcm_space_write_vtu(const fcm_space *s, const fcm_material *mat, const double *u,
                                const double *v, const char *path)
+{
+  return fcm__space_write_vtu_counted(s, mat, u, v, path, NULL);
+}
+
+fcm_status fcm__space_write_vtu_counted(const fcm_space *s, const fcm_material *mat,
+                                        const double *u, const double *v, const char *path,
+                                        fcm_index *nonfinite)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s ? s->ctx : NULL;
   fcm_vtu *vtu = NULL;
   double *nu = NULL, *nv = NULL, *phi = NULL, *sig = NULL, *vm = NULL, *sed = NULL, *zero = NULL;
   int32_t *active = NULL;
+  if (nonfinite) *nonfinite = 0;
   FCM_CHECK(s && path, ctx, FCM_ERR_ARG, "write vtu: NULL space or path");
   const fcm_index nn = s->num_nodes, nc = s->num_cells;
   FCM_ALLOC(ctx, 3 * nn + 1, nu);
@@ -332,6 +349,7 @@ fcm_status fcm_space_write_vtu(const fcm_space *s, const fcm_material *mat, cons
     FCM_ALLOC(ctx, nc + 1, sed);
     if (!u) FCM_ALLOC(ctx, s->num_dofs + 1, zero);
     FCM_TRY(ctx, fcm_space_cell_stress(s, mat, u ? u : zero, sig, vm, sed));
+    if (nonfinite) *nonfinite = count_nonfinite(nc, vm);
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "stress", 6, nc, sig));
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "von_mises", 1, nc, vm));
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_CELL_DATA, "strain_energy_density", 1, nc, sed));
@@ -350,7 +368,8 @@ cleanup:
  * listed node (nv NULL: no velocity); with mat, the cells' stress of the full DOF vector u. */
 static fcm_status write_piece(const fcm_space *s, const fcm_material *mat, const double *u,
                               const unsigned char *keep, fcm_index np, const fcm_index *nodes,
-                              const double *nu, const double *nv, int rank, const char *path)
+                              const double *nu, const double *nv, int rank, const char *path,
+                              fcm_index *nonfinite)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
@@ -431,6 +450,7 @@ static fcm_status write_piece(const fcm_space *s, const fcm_material *mat, const
       }
       m++;
     }
+  if (mat && nonfinite) *nonfinite = count_nonfinite(ncl, cvm);
   FCM_TRY(ctx, fcm_vtu_create(ctx, &vtu));
   FCM_TRY(ctx, fcm_vtu_set_points(vtu, np, xyz));
   FCM_TRY(ctx,
@@ -459,12 +479,13 @@ cleanup:
 
 fcm_status fcm__space_write_vtu_piece(const fcm_space *s, const fcm_material *mat, const double *u,
                                       const double *v, const unsigned char *keep, int rank,
-                                      const char *path)
+                                      const char *path, fcm_index *nonfinite)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s ? s->ctx : NULL;
   fcm_index np = 0, *nodes = NULL, *dofs = NULL;
   double *nu = NULL, *nv = NULL;
+  if (nonfinite) *nonfinite = 0;
   FCM_CHECK(s && path, ctx, FCM_ERR_ARG, "write vtu piece: NULL space or path");
   FCM_TRY(ctx, fcm__space_piece_nodes(s, keep, &np, &nodes));
   FCM_ALLOC(ctx, np + 1, dofs);
@@ -476,7 +497,7 @@ fcm_status fcm__space_write_vtu_piece(const fcm_space *s, const fcm_material *ma
       nu[3 * i + j] = u && dofs[i] >= 0 ? u[dofs[i] + j] : 0.0;
       if (nv) nv[3 * i + j] = dofs[i] >= 0 ? v[dofs[i] + j] : 0.0;
     }
-  FCM_TRY(ctx, write_piece(s, mat, u, keep, np, nodes, nu, nv, rank, path));
+  FCM_TRY(ctx, write_piece(s, mat, u, keep, np, nodes, nu, nv, rank, path, nonfinite));
 cleanup:
   fcm__free(ctx, nodes);
   fcm__free(ctx, dofs);
@@ -493,7 +514,7 @@ fcm_status fcm__space_write_vtu_piece_values(const fcm_space *s, const unsigned 
   fcm_ctx *ctx = s ? s->ctx : NULL;
   FCM_CHECK(s && path && (np == 0 || (nodes && nu)), ctx, FCM_ERR_ARG,
             "write vtu piece: NULL space, path, nodes or values");
-  FCM_TRY(ctx, write_piece(s, NULL, NULL, keep, np, nodes, nu, nv, rank, path));
+  FCM_TRY(ctx, write_piece(s, NULL, NULL, keep, np, nodes, nu, nv, rank, path, NULL));
 cleanup:
   return st;
 }
@@ -766,10 +787,18 @@ cleanup:
 fcm_status fcm_embedded_surface_write_vtu(const fcm_embedded_surface *es, const fcm_material *mat,
                                           const double *u, const char *path)
 {
+  return fcm__embedded_surface_write_vtu_counted(es, mat, u, path, NULL);
+}
+
+fcm_status fcm__embedded_surface_write_vtu_counted(const fcm_embedded_surface *es,
+                                                   const fcm_material *mat, const double *u,
+                                                   const char *path, fcm_index *nonfinite)
+{
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = es ? es->ctx : NULL;
   fcm_vtu *vtu = NULL;
   double *d = NULL, *sig = NULL, *vm = NULL, *sed = NULL, *zero = NULL;
+  if (nonfinite) *nonfinite = 0;
   FCM_CHECK(es && path, ctx, FCM_ERR_ARG, "embedded surface: write vtu: NULL surface or path");
   const fcm_index np = es->np;
   if (!u) {
@@ -788,6 +817,7 @@ fcm_status fcm_embedded_surface_write_vtu(const fcm_embedded_surface *es, const 
     FCM_ALLOC(ctx, np + 1, vm);
     FCM_ALLOC(ctx, np + 1, sed);
     FCM_TRY(ctx, fcm_embedded_surface_stress(es, mat, u, sig, vm, sed));
+    if (nonfinite) *nonfinite = count_nonfinite(np, vm);
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "stress", 6, np, sig));
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "von_mises", 1, np, vm));
     FCM_TRY(ctx, fcm_vtu_add_field(vtu, FCM_VTU_POINT_DATA, "strain_energy_density", 1, np, sed));

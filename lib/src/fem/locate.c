@@ -242,17 +242,11 @@ fcm_index fcm_space_point_element(const fcm_space *s, fcm_index cell, const doub
   return best;
 }
 
-fcm_index fcm_space_num_bodies(const fcm_space *s)
+/* Union-find of the elements through shared DOF copies: on return uf[e] is the smallest
+ * element of e's body (uf: num_elems entries, first: num_dofs / 3 scratch). */
+static void label_bodies(const fcm_space *s, fcm_index *uf, fcm_index *first)
 {
-  if (!s || s->num_elems == 0) return 0;
   const fcm_index ncopy = s->num_dofs / 3;
-  fcm_index *uf = malloc(sizeof *uf * (size_t)s->num_elems),
-            *first = malloc(sizeof *first * (size_t)ncopy);
-  if (!uf || !first) {
-    free(uf);
-    free(first);
-    return -1;
-  }
   for (fcm_index e = 0; e < s->num_elems; e++)
     uf[e] = e;
   for (fcm_index k = 0; k < ncopy; k++)
@@ -271,10 +265,42 @@ fcm_index fcm_space_num_bodies(const fcm_space *s)
         y = uf[y] = uf[uf[y]];
       if (x != y) uf[x > y ? x : y] = x < y ? x : y;
     }
+  /* every root is the smallest element of its set: resolve in ascending order */
+  for (fcm_index e = 0; e < s->num_elems; e++)
+    uf[e] = uf[uf[e]];
+}
+
+fcm_index fcm_space_num_bodies(const fcm_space *s)
+{
+  if (!s || s->num_elems == 0) return 0;
+  const fcm_index ncopy = s->num_dofs / 3;
+  fcm_index *uf = malloc(sizeof *uf * (size_t)s->num_elems),
+            *first = malloc(sizeof *first * (size_t)(ncopy > 0 ? ncopy : 1));
+  if (!uf || !first) {
+    free(uf);
+    free(first);
+    return -1;
+  }
+  label_bodies(s, uf, first);
   fcm_index count = 0;
   for (fcm_index e = 0; e < s->num_elems; e++)
     count += uf[e] == e;
   free(uf);
   free(first);
   return count;
+}
+
+fcm_status fcm__space_body_labels(const fcm_space *s, fcm_index *elem_body, fcm_index *num_bodies)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *first = NULL;
+  FCM_ALLOC(s->ctx, s->num_dofs / 3 + 1, first);
+  label_bodies(s, elem_body, first);
+  fcm_index nb = 0;
+  for (fcm_index e = 0; e < s->num_elems; e++) /* roots come first in ascending order */
+    elem_body[e] = elem_body[e] == e ? nb++ : elem_body[elem_body[e]];
+  *num_bodies = nb;
+cleanup:
+  fcm__free(s->ctx, first);
+  return st;
 }

@@ -528,10 +528,13 @@ static fcm_status constrain_copies(fcm_space *s, double ratio, const fcm_index *
     count += master[k] >= 0;
   }
   if (count > 0) {
+    FCM_ALLOC(ctx, (size_t)s->num_elems * nn + 1, s->elem_con);
     for (fcm_index e = 0; e < s->num_elems; e++)
       for (int a = 0; a < nn; a++) {
         const fcm_index k = s->elem_dof[e * nn + a] / 3;
-        if (master[k] >= 0) s->elem_dof[e * nn + a] = 3 * master[k];
+        if (master[k] < 0) continue;
+        s->elem_dof[e * nn + a] = 3 * master[k];
+        s->elem_con[e * nn + a] = 1;
       }
     /* renumber the copies still in use, node by node */
     FCM_ALLOC(ctx, ncopy + 1, renum);
@@ -732,6 +735,7 @@ void fcm_space_destroy(fcm_space **sp)
   fcm__free(ctx, s->elem_cell);
   fcm__free(ctx, s->elem_piece);
   fcm__free(ctx, s->elem_dof);
+  fcm__free(ctx, s->elem_con);
   free_topology(s);
   fcm_rule_destroy(&s->mass_rule);
   fcm__free(ctx, s);
@@ -756,6 +760,15 @@ fcm_index fcm_space_node_copies(const fcm_space *s, fcm_index node)
 fcm_index fcm_space_num_constrained_copies(const fcm_space *s)
 {
   return s->num_constrained;
+}
+
+int fcm_space_element_constrained(const fcm_space *s, fcm_index elem)
+{
+  int n = 0;
+  if (!s || !s->elem_con || elem < 0 || elem >= s->num_elems) return 0;
+  for (int a = 0; a < s->nn; a++)
+    n += s->elem_con[elem * s->nn + a];
+  return n;
 }
 
 fcm_index fcm_space_num_elements(const fcm_space *s)
@@ -818,8 +831,10 @@ void fcm__space_memory(const fcm_space *s, double *numbering, double *topology)
   const double ne = (double)s->num_elems, nc = (double)s->num_cells, np = (double)s->num_nodes;
   const double nl = (double)s->num_local_copies, nle = (double)s->num_local_elems;
   const double nadj = s->node_ptr ? (double)s->node_ptr[s->num_local_copies] : 0.0;
-  if (numbering) /* active, node_dof, node_ncopy, cell_elem, elem_cell, elem_piece, elem_dof */
-    *numbering = nc + 2.0 * I * np + I * (nc + 1.0) + 2.0 * I * ne + I * nn * ne;
+  if (numbering) /* active, node_dof, node_ncopy, cell_elem, elem_cell, elem_piece, elem_dof,
+                   elem_con */
+    *numbering = nc + 2.0 * I * np + I * (nc + 1.0) + 2.0 * I * ne + I * nn * ne +
+                 (s->elem_con ? nn * ne : 0.0);
   if (topology) /* node_ptr, node_adj, row_ptr, col_idx (9 per graph entry), elem_off, colours,
                    local lists, elem_lcopy */
     *topology = I * (nl + 1.0) + I * nadj + I * (3.0 * nl + 1.0) +
@@ -1053,11 +1068,11 @@ fcm_status fcm_space_transfer(const fcm_space *from, const fcm_space *to, const 
               "space transfer: element %lld (cell %lld) has parent piece %lld outside the "
               "cell's pieces in the source",
               (long long)e, (long long)c, (long long)pp);
-    const fcm_index *cn = fcm_mesh_cells(to->mesh) + c * to->nn;
     for (int a = 0; a < to->nn; a++) {
-      const fcm_index d = to->elem_dof[e * to->nn + a], n = cn[a];
-      /* a constrained copy's place holds another node's copy: that node's own elements set it */
-      if (d < to->node_dof[n] || d >= to->node_dof[n] + 3 * to->node_ncopy[n]) continue;
+      const fcm_index d = to->elem_dof[e * to->nn + a];
+      /* a constrained copy's place holds the copy it moves with (of another node, or another
+       * copy of this one): that copy's own elements set it, from their parents' values */
+      if (to->elem_con && to->elem_con[e * to->nn + a]) continue;
       for (int i = 0; i < 3; i++)
         x_to[d + i] = x_from[from->elem_dof[fe * from->nn + a] + i];
     }

@@ -226,32 +226,63 @@ int fcm__geom_poly_num_tets(const fcm__poly *p)
   return n;
 }
 
+/* The fan of p's face triangles (each face fanned from its first vertex) from apex c, skipping
+ * the triangles that have vertex `skip` (-1: none) as a corner: their tets have no volume.
+ * Writes the tets and signed volumes (when tets is not NULL); returns their count, and in
+ * *neg the sum of the negative volumes. */
+static int fan_tets(const fcm__poly *p, const double c[3], int skip, double *tets, double *vol,
+                    double *neg)
+{
+  int nt = 0;
+  *neg = 0.0;
+  for (int f = 0; f < p->nf; f++) {
+    const int ia = p->fv[f][0];
+    const double *a = p->x[ia];
+    for (int k = 1; k + 1 < p->fn[f]; k++) {
+      const int ib = p->fv[f][k], ie = p->fv[f][k + 1];
+      if (ia == skip || ib == skip || ie == skip) continue;
+      const double *b = p->x[ib], *e = p->x[ie];
+      double ra[3], rb[3], re[3], cr[3];
+      for (int d = 0; d < 3; d++)
+        ra[d] = a[d] - c[d], rb[d] = b[d] - c[d], re[d] = e[d] - c[d];
+      cross3(ra, rb, cr);
+      const double v = dot3(cr, re) / 6.0;
+      if (v < 0.0) *neg += v;
+      if (tets) {
+        double *t = tets + 12 * nt;
+        for (int d = 0; d < 3; d++)
+          t[d] = c[d], t[3 + d] = a[d], t[6 + d] = b[d], t[9 + d] = e[d];
+        vol[nt] = v;
+      }
+      nt++;
+    }
+  }
+  return nt;
+}
+
 int fcm__geom_poly_tets(const fcm__poly *p, double *tets, double *vol)
 {
-  double c[3] = {0, 0, 0};
-  int nt = 0;
+  double c[3] = {0, 0, 0}, neg;
   if (p->nf == 0) return 0;
   for (int i = 0; i < p->nv; i++)
     for (int d = 0; d < 3; d++)
       c[d] += p->x[i][d];
   for (int d = 0; d < 3; d++)
     c[d] /= p->nv;
-  for (int f = 0; f < p->nf; f++) {
-    const double *a = p->x[p->fv[f][0]];
-    for (int k = 1; k + 1 < p->fn[f]; k++) {
-      const double *b = p->x[p->fv[f][k]], *e = p->x[p->fv[f][k + 1]];
-      double *t = tets + 12 * nt;
-      double ra[3], rb[3], re[3], cr[3];
-      for (int d = 0; d < 3; d++) {
-        t[d] = c[d], t[3 + d] = a[d], t[6 + d] = b[d], t[9 + d] = e[d];
-        ra[d] = a[d] - c[d], rb[d] = b[d] - c[d], re[d] = e[d] - c[d];
-      }
-      cross3(ra, rb, cr);
-      vol[nt] = dot3(cr, re) / 6.0;
-      nt++;
-    }
+  const int nt = fan_tets(p, c, -1, tets, vol, &neg);
+  if (neg == 0.0) return nt;
+  /* A part that the tolerances left slightly non-convex (vertices within the tolerance of a
+   * plane taken as on it: a sliver whose faces are not quite planar) can give tets of
+   * negative volume from its centroid. Every apex gives the same total (the faces' triangles
+   * are the same), so take the vertex whose fan has the least negative volume, none if it can. */
+  int best = -1;
+  double best_neg = neg;
+  for (int a = 0; a < p->nv && best_neg < 0.0; a++) {
+    fan_tets(p, p->x[a], a, NULL, NULL, &neg);
+    if (neg > best_neg) best = a, best_neg = neg;
   }
-  return nt;
+  if (best < 0) return nt;
+  return fan_tets(p, p->x[best], best, tets, vol, &neg);
 }
 
 double fcm__geom_poly_volume(const fcm__poly *p)

@@ -10,6 +10,7 @@
 
 #include "core/core_impl.h"
 #include "fcm/geom.h"
+#include "fcm/levelset.h"
 
 struct fcm_geometry {
   fcm_ctx *ctx;
@@ -56,6 +57,13 @@ fcm_status fcm__geom_create_take(fcm_ctx *ctx, const char *who, fcm_element_type
 fcm_status fcm__geom_create_subset(fcm_ctx *ctx, const fcm_geometry *g,
                                    const unsigned char *keep_cell, const unsigned char *keep_tri,
                                    fcm_geometry **out);
+
+/* 1 when the sampling spacing h resolves the smallest feature of implicit node q (the rule
+ * of fcm_implicit_check_spacing()); else 0 with *key the member that sets the feature (its
+ * scene key; NULL for a box, whose message names the side) and `msg` the reason with the
+ * value and h. CSG nodes are always resolved. */
+int fcm__implicit_resolved(const fcm_implicit *q, double h, const char **key, char *msg,
+                           size_t len);
 
 /* Bytes of the geometry's arrays (coordinates, cells, triangles, maps) and struct. */
 double fcm__geom_bytes(const fcm_geometry *g);
@@ -141,8 +149,11 @@ int fcm__geom_poly_num_tets(const fcm__poly *p);
 
 /* Tetrahedralize p by a fan from its vertex centroid c over a fan triangulation of
  * each face: tet k is (c, a, b, e) stored as 12 doubles in tets[12 k ...] and its
- * signed volume in vol[k] (positive for a convex p with outward faces). Returns the
- * number of tets written. */
+ * signed volume in vol[k] (positive for a convex p with outward faces). When some come out
+ * negative (a part the tolerances left slightly non-convex), the fan from the vertex with the
+ * least negative volume instead (its own faces' triangles skipped); the signed volumes add
+ * up to the same total either way. Returns the number of tets written (at most
+ * fcm__geom_poly_num_tets()). */
 int fcm__geom_poly_tets(const fcm__poly *p, double *tets, double *vol);
 
 /* Volume of p (sum of the signed fan volumes). */

@@ -120,8 +120,9 @@ fcm_status fcm__geom_create_take(fcm_ctx *ctx, const char *who, fcm_element_type
   for (fcm_index a = 0; a < num_nodes; a++)
     for (int d = 0; d < 3; d++) {
       const double v = g->coords[3 * a + d];
-      FCM_CHECK(isfinite(v), ctx, FCM_ERR_ARG, "%s: coordinate %d of node %lld is %g (not finite)",
-                who, d, (long long)a, v);
+      FCM_CHECK(fabs(v) <= FCM__COORD_MAX, ctx, FCM_ERR_ARG,
+                "%s: coordinate %d of node %lld (0-based) is %g, outside " FCM__COORD_RANGE, who, d,
+                (long long)a, v);
       g->lo[d] = v < g->lo[d] ? v : g->lo[d];
       g->hi[d] = v > g->hi[d] ? v : g->hi[d];
     }

@@ -14,6 +14,10 @@ fcm_level_set_options fcm_level_set_options_default(void)
   o.refinement = 4;
   o.estimate_error = 1;
   o.refine_inside = 0;
+  o.max_subcells = FCM_LEVEL_SET_MAX_SUBCELLS;
+  o.progress = NULL;
+  o.progress_user = NULL;
+  o.progress_interval = 0.1;
   return o;
 }
 
@@ -44,7 +48,22 @@ typedef struct builder {
   lnode *tri;     /* boundary triangles: 3 nodes each, outward */
   size_t *towner; /* the tet of each */
   double volume;
+  /* progress: sub-cells marched of the total, reported every interval seconds */
+  const fcm_level_set_options *opts;
+  fcm_index done, total;
+  double last;
 } builder;
+
+/* Count `n` sub-cells marched and report the progress when the interval has passed. */
+static void advance(builder *B, fcm_index n)
+{
+  B->done += n;
+  if (!B->opts->progress) return;
+  const double now = fcm_wtime();
+  if (now - B->last < B->opts->progress_interval) return;
+  B->last = now;
+  B->opts->progress(B->done, B->total, B->opts->progress_user);
+}
 
 static void lattice_x(const builder *B, const int64_t g[3], double x[3])
 {
@@ -279,11 +298,10 @@ static int cube_inside(const lvert *w, int m, int cx, int cy, int cz)
   return 1;
 }
 
-/* Sample cell (ix, iy, iz) at refinement r (B->N = n r) into w ((r+1)^3) and march it;
- * `whole`: a cell with every sample inside becomes the 6 tets of the cell, and the inside
- * sub-cubes of a cut cell are merged into boxes. todo: r^3 bytes of workspace. */
-static fcm_status do_cell(builder *B, const int64_t cell[3], int r, int whole, lvert *w,
-                          unsigned char *todo, cell_kind *kind)
+/* Sample cell (ix, iy, iz) at refinement r (B->N = n r) into w ((r+1)^3): its kind, and in
+ * *cut (may be NULL) the sub-cubes where phi changes sign at the corners. */
+static fcm_status sample_cell(builder *B, const int64_t cell[3], int r, lvert *w, cell_kind *kind,
+                              int64_t *cut)
 {
   fcm_status st = FCM_OK;
   const int m = r + 1;
@@ -302,6 +320,29 @@ static fcm_status do_cell(builder *B, const int64_t cell[3], int r, int whole, l
       }
   const int total = m * m * m;
   *kind = nin == 0 ? CELL_OUTSIDE : nin == total ? CELL_INSIDE : CELL_CUT;
+  if (cut) *cut = 0;
+  if (cut && *kind == CELL_CUT)
+    for (int cz = 0; cz < r; cz++)
+      for (int cy = 0; cy < r; cy++)
+        for (int cx = 0; cx < r; cx++) {
+          int in = 0;
+          for (int k = 0; k < 8; k++)
+            in += w[(cx + (k & 1)) + m * ((cy + !!(k & 2)) + m * (cz + !!(k & 4)))].phi < 0.0;
+          *cut += in > 0 && in < 8;
+        }
+cleanup:
+  return st;
+}
+
+/* Sample cell (ix, iy, iz) at refinement r into w and march it; `whole`: a cell with every
+ * sample inside becomes the 6 tets of the cell, and the inside sub-cubes of a cut cell are
+ * merged into boxes. todo: r^3 bytes of workspace. */
+static fcm_status do_cell(builder *B, const int64_t cell[3], int r, int whole, lvert *w,
+                          unsigned char *todo, cell_kind *kind)
+{
+  fcm_status st = FCM_OK;
+  const int m = r + 1;
+  FCM_TRY(B->ctx, sample_cell(B, cell, r, w, kind, NULL));
   if (*kind == CELL_OUTSIDE) return FCM_OK;
   if (*kind == CELL_INSIDE && whole) {
     const lvert *c[8];
@@ -388,6 +429,11 @@ fcm_status fcm_geometry_create_from_level_set(fcm_ctx *ctx, fcm_level_set_fn phi
   FCM_CHECK(phi && lo && hi && n, ctx, FCM_ERR_ARG, "level set: phi, lo, hi or n is NULL");
   FCM_CHECK(o.refinement >= 1 && o.refinement <= 64, ctx, FCM_ERR_ARG,
             "level set: refinement %d outside [1, 64]", o.refinement);
+  FCM_CHECK(o.max_subcells >= 0, ctx, FCM_ERR_ARG, "level set: max_subcells = %lld must be >= 0",
+            (long long)o.max_subcells);
+  FCM_CHECK(o.progress_interval >= 0.0 && isfinite(o.progress_interval), ctx, FCM_ERR_ARG,
+            "level set: progress_interval = %g must be finite and >= 0 seconds",
+            o.progress_interval);
   double subcells = 1.0;
   for (int d = 0; d < 3; d++) {
     FCM_CHECK(isfinite(lo[d]) && isfinite(hi[d]) && lo[d] < hi[d], ctx, FCM_ERR_ARG,
@@ -403,27 +449,63 @@ fcm_status fcm_geometry_create_from_level_set(fcm_ctx *ctx, fcm_level_set_fn phi
             "%.3g sub-cells, more than 2^31",
             (long long)n[0], (long long)n[1], (long long)n[2], o.refinement, 2 * o.refinement,
             subcells);
-  B.ctx = ctx, B.phi = phi, B.user = user;
+  if (phi == fcm_implicit_eval) { /* a built-in tree: valid, and resolved by the sampling */
+    FCM_TRY(ctx, fcm_implicit_check_spacing(ctx, user, inf.h));
+  }
+  B.ctx = ctx, B.phi = phi, B.user = user, B.opts = &o, B.last = fcm_wtime();
   const int r = o.refinement;
+  const int64_t r3 = (int64_t)r * r * r;
   const size_t ncell = (size_t)n[0] * (size_t)n[1] * (size_t)n[2];
   FCM_ALLOC_RAW(ctx, (size_t)(2 * r + 1) * (size_t)(2 * r + 1) * (size_t)(2 * r + 1), w);
   FCM_ALLOC_RAW(ctx, ncell, kinds);
   FCM_ALLOC_RAW(ctx, (size_t)(2 * r) * (size_t)(2 * r) * (size_t)(2 * r), todo);
-  /* Pass 1: refinement r, stored. */
-  B.store = 1;
   for (int d = 0; d < 3; d++)
     B.N[d] = (int64_t)n[d] * r;
+  /* Pass 0: classify the cells and count the sub-cells the surface crosses (nothing stored),
+   * so that an oversize build is refused before its tets are allocated. */
   size_t ci = 0;
   for (int64_t k = 0; k < n[2]; k++)
     for (int64_t j = 0; j < n[1]; j++)
       for (int64_t i = 0; i < n[0]; i++, ci++) {
         const int64_t cell[3] = {i, j, k};
         cell_kind kind;
-        FCM_TRY(ctx, do_cell(&B, cell, r, !o.refine_inside, w, todo, &kind));
+        int64_t cut = 0;
+        FCM_TRY(ctx, sample_cell(&B, cell, r, w, &kind, &cut));
         kinds[ci] = (unsigned char)kind;
         inf.cells_inside += kind == CELL_INSIDE;
         inf.cells_cut += kind == CELL_CUT;
         inf.cells_outside += kind == CELL_OUTSIDE;
+        inf.subcells += cut;
+      }
+  /* a cell wholly inside becomes 6 tets: counted as one sub-cell (about half the memory of
+   * one the surface crosses); refine_inside: every sub-cube of a cut or inside cell is split
+   * on its own, counted alike */
+  inf.subcells =
+      o.refine_inside ? (inf.cells_cut + inf.cells_inside) * r3 : inf.subcells + inf.cells_inside;
+  const fcm_index estimate = inf.subcells;
+  FCM_CHECK(o.max_subcells == 0 || estimate <= o.max_subcells, ctx, FCM_ERR_UNSUPPORTED,
+            "level set: the build would triangulate %lld sub-cells (%lld cut and %lld inside "
+            "cells at refinement %d; about %.3g GB at %d kB each), more than max_subcells = %lld "
+            "(about %.3g GB); raise max_subcells (0: no limit), or lower the refinement or the "
+            "sampling cells",
+            (long long)estimate, (long long)inf.cells_cut, (long long)inf.cells_inside, r,
+            (double)estimate * FCM_LEVEL_SET_SUBCELL_BYTES / 1e9,
+            FCM_LEVEL_SET_SUBCELL_BYTES / 1000, (long long)o.max_subcells,
+            (double)o.max_subcells * FCM_LEVEL_SET_SUBCELL_BYTES / 1e9);
+  B.total = (inf.cells_cut + (o.refine_inside ? inf.cells_inside : 0)) * r3;
+  if (o.estimate_error) B.total += inf.cells_cut * 8 * r3;
+  /* Pass 1: refinement r, stored. */
+  B.store = 1;
+  ci = 0;
+  for (int64_t k = 0; k < n[2]; k++)
+    for (int64_t j = 0; j < n[1]; j++)
+      for (int64_t i = 0; i < n[0]; i++, ci++) {
+        if (kinds[ci] == CELL_OUTSIDE) continue;
+        const int64_t cell[3] = {i, j, k};
+        cell_kind kind;
+        FCM_TRY(ctx, do_cell(&B, cell, r, !o.refine_inside, w, todo, &kind));
+        kinds[ci] = (unsigned char)kind; /* phi is sampled as in pass 0 */
+        if (kind == CELL_CUT || (kind == CELL_INSIDE && o.refine_inside)) advance(&B, r3);
       }
   inf.volume = B.volume;
   FCM_CHECK(B.nt > 0 && B.volume > 0.0, ctx, FCM_ERR_GEOMETRY,
@@ -443,17 +525,21 @@ fcm_status fcm_geometry_create_from_level_set(fcm_ctx *ctx, fcm_level_set_fn phi
         for (int64_t i = 0; i < n[0]; i++, ci++) {
           const int64_t cell[3] = {i, j, k};
           cell_kind kind;
-          if (kinds[ci] == CELL_CUT)
+          if (kinds[ci] == CELL_CUT) {
             FCM_TRY(ctx, do_cell(&F, cell, 2 * r, 1, w, todo, &kind));
-          else if (kinds[ci] == CELL_INSIDE)
+            advance(&F, 8 * r3);
+          } else if (kinds[ci] == CELL_INSIDE) {
             v_whole += 1.0;
+          }
         }
+    B.done = F.done, B.last = F.last;
     double cv = 1.0;
     for (int d = 0; d < 3; d++)
       cv *= (hi[d] - lo[d]) / (double)n[d];
     inf.volume_fine = F.volume + v_whole * cv;
     inf.error_estimate = 4.0 / 3.0 * fabs(inf.volume - inf.volume_fine);
   }
+  if (o.progress) o.progress(B.total, B.total, o.progress_user);
   /* Nodes: unique keys. */
   const size_t nv = 4 * B.nt;
   FCM_ALLOC_RAW(ctx, nv, ks);
@@ -558,6 +644,73 @@ fcm_status fcm_implicit_check(fcm_ctx *ctx, const fcm_implicit_tree *tree)
       break;
     }
   }
+cleanup:
+  return st;
+}
+
+int fcm__implicit_resolved(const fcm_implicit *q, double h, const char **key, char *msg, size_t len)
+{
+  double size, value;
+  const char *why;
+  *key = NULL;
+  switch (q->kind) {
+  case FCM_IMPLICIT_SPHERE:
+    *key = "radius", size = value = q->radius;
+    why = "a sphere that small is not resolved";
+    break;
+  case FCM_IMPLICIT_TORUS:
+    *key = "minor_radius", size = value = q->minor_radius;
+    why = "a tube that thin is not resolved";
+    break;
+  case FCM_IMPLICIT_BOX: {
+    int dd = 0;
+    for (int d = 1; d < 3; d++)
+      if (q->max[d] - q->min[d] < q->max[dd] - q->min[dd]) dd = d;
+    if (q->max[dd] - q->min[dd] >= h) return 1;
+    snprintf(msg, len,
+             "the side max[%d] - min[%d] = %g is below the sampling spacing h = %g (the largest "
+             "sub-cell edge: sampling box side / (cells x refinement)); a box that thin is not "
+             "resolved: widen it or sample finer (refinement, cells)",
+             dd, dd, q->max[dd] - q->min[dd], h);
+    return 0;
+  }
+  case FCM_IMPLICIT_GYROID:
+    if (q->period >= 2.0 * h && (!q->sheet || 2.0 * q->thickness >= h)) return 1;
+    if (q->period >= 2.0 * h) {
+      *key = "thickness", size = 2.0 * q->thickness, value = q->thickness;
+      why = "a sheet's wall is 2 thickness thick: thinner than h, it falls between the samples";
+    } else {
+      *key = "period", size = 0.5 * q->period, value = q->period;
+      why = "a gyroid's channels are half a period wide: a period under two samples only "
+            "samples noise";
+    }
+    break;
+  default:
+    return 1;
+  }
+  if (size >= h) return 1;
+  snprintf(msg, len,
+           "%s = %g is below %sthe sampling spacing h = %g (the largest sub-cell edge: sampling "
+           "box side / (cells x refinement)); %s: enlarge it or sample finer (refinement, cells)",
+           *key, value,
+           size == value         ? ""
+           : size == 0.5 * value ? "twice "
+                                 : "half ",
+           h, why);
+  return 0;
+}
+
+fcm_status fcm_implicit_check_spacing(fcm_ctx *ctx, const fcm_implicit_tree *tree, double h)
+{
+  fcm_status st = FCM_OK;
+  char msg[512];
+  const char *key;
+  FCM_TRY(ctx, fcm_implicit_check(ctx, tree));
+  FCM_CHECK(h > 0.0 && isfinite(h), ctx, FCM_ERR_ARG,
+            "implicit: sampling spacing h = %g must be positive and finite", h);
+  for (int i = 0; i < tree->num_nodes; i++)
+    FCM_CHECK(fcm__implicit_resolved(tree->nodes + i, h, &key, msg, sizeof msg), ctx, FCM_ERR_ARG,
+              "implicit: node %d (%s): %s", i, kind_names[tree->nodes[i].kind], msg);
 cleanup:
   return st;
 }

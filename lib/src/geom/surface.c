@@ -24,6 +24,18 @@ cleanup:
 fcm_status fcm__sbuild_vertex(fcm__sbuild *B, const double p[3])
 {
   fcm_status st = FCM_OK;
+  for (int k = 0; k < 3; k++) {
+    if (fabs(p[k]) <= FCM__COORD_MAX) continue;
+    if (B->soup)
+      FCM_CHECK(0, B->ctx, FCM_ERR_FORMAT,
+                "surface: %s: facet %zu (counted from 0), corner %zu: coordinate %c = %g is "
+                "outside " FCM__COORD_RANGE,
+                B->path, B->nv / 3, B->nv % 3, "xyz"[k], p[k]);
+    FCM_CHECK(0, B->ctx, FCM_ERR_FORMAT,
+              "surface: %s: vertex %zu (%d-based, as the file's faces number them): coordinate "
+              "%c = %g is outside " FCM__COORD_RANGE,
+              B->path, B->nv + (size_t)B->base, B->base, "xyz"[k], p[k]);
+  }
   FCM_TRY(B->ctx, grow(B->ctx, (void **)&B->x, &B->capv, B->nv + 1, 3 * sizeof(double)));
   for (int k = 0; k < 3; k++)
     B->x[3 * B->nv + (size_t)k] = p[k];
@@ -139,9 +151,9 @@ fcm_status fcm_surface_create(fcm_ctx *ctx, fcm_index num_vertices, const double
             "surface: %lld vertices and %lld triangles (both must be > 0)", (long long)num_vertices,
             (long long)num_triangles);
   for (fcm_index i = 0; i < 3 * num_vertices; i++)
-    FCM_CHECK(isfinite(coords[i]), ctx, FCM_ERR_ARG,
-              "surface: coordinate %d of vertex %lld is not finite", (int)(i % 3),
-              (long long)(i / 3));
+    FCM_CHECK(fabs(coords[i]) <= FCM__COORD_MAX, ctx, FCM_ERR_ARG,
+              "surface: coordinate %d of vertex %lld (0-based) is %g, outside " FCM__COORD_RANGE,
+              (int)(i % 3), (long long)(i / 3), coords[i]);
   for (fcm_index i = 0; i < 3 * num_triangles; i++)
     FCM_CHECK(tris[i] >= 0 && tris[i] < num_vertices, ctx, FCM_ERR_ARG,
               "surface: triangle %lld has vertex id %lld outside [0, %lld)", (long long)(i / 3),

@@ -27,8 +27,12 @@ typedef struct fcm__sbuild {
   double *x;    /* nv x 3 */
   fcm_index *t; /* nt x 3 */
   size_t nv, nt, capv, capt;
+  int base; /* the first vertex id of the format (OBJ 1, the others 0), for messages */
+  int soup; /* 1: 3 vertices per facet, no ids (STL): messages name facet and corner */
 } fcm__sbuild;
 
+/* Append a vertex; a coordinate beyond FCM__COORD_MAX is refused (FCM_ERR_FORMAT) naming the
+ * file, the vertex (its id as the format numbers them, or facet and corner) and the value. */
 fcm_status fcm__sbuild_vertex(fcm__sbuild *B, const double p[3]);
 fcm_status fcm__sbuild_triangle(fcm__sbuild *B, fcm_index a, fcm_index b, fcm_index c);
 /* Merge vertices with exactly equal coordinates (renumbering the triangles). */

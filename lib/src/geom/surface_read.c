@@ -136,6 +136,7 @@ fcm_status fcm__surface_read_obj(fcm__sbuild *B, char *buf, size_t len)
   fcm_status st = FCM_OK;
   text T;
   text_init(&T, B, buf, len, '#');
+  B->base = 1; /* OBJ faces number vertices from 1 */
   do {
     if (!tok_line(&T)) continue;
     if (strcmp(T.tok, "v") == 0) {
@@ -308,6 +309,7 @@ cleanup:
 fcm_status fcm__surface_read_stl(fcm__sbuild *B, char *buf, size_t len)
 {
   fcm_status st = FCM_OK;
+  B->soup = 1;
   const unsigned char *b = (const unsigned char *)buf;
   size_t lead = 0;
   while (lead < len && (is_blank(buf[lead]) || buf[lead] == '\n'))

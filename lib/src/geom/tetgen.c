@@ -146,10 +146,15 @@ fcm_status fcm_geometry_create_from_tetgen(fcm_ctx *ctx, const char *node_path,
     } else {
       FCM_TRY(ctx, token_int(ctx, &N, 0, "point index", base + i, base + i, &v));
     }
-    for (int d = 0; d < 3; d++)
+    for (int d = 0; d < 3; d++) {
       FCM_CHECK(parse_d(N.tok[1 + d], x + 3 * i + d), ctx, FCM_ERR_FORMAT,
                 "%s:%ld: expected a finite coordinate, got \"%s\"", node_path, N.line,
                 N.tok[1 + d]);
+      FCM_CHECK(fabs(x[3 * i + d]) <= FCM__COORD_MAX, ctx, FCM_ERR_FORMAT,
+                "%s:%ld: point %lld (%lld-based, as the file numbers them): coordinate %c = %g is "
+                "outside " FCM__COORD_RANGE,
+                node_path, N.line, base + i, base, "xyz"[d], x[3 * i + d]);
+    }
   }
   /* .ele */
   FCM_TRY(ctx, read_file(ctx, ele_path, &E));

@@ -48,6 +48,15 @@ static fcm_status check_geometry(fcm_ctx *ctx, const char *who, const fcm_index 
               "%s: axis vector %d component %d = %g is not "
               "finite",
               who, i / 3, i % 3, axes[i]);
+  for (int d = 0; d < 3; d++) { /* the farthest voxel corner along coordinate d */
+    double reach = fabs(origin[d]);
+    for (int k = 0; k < 3; k++)
+      reach += ((double)dims[k] + 0.5) * fabs(axes[3 * k + d]);
+    FCM_CHECK(reach <= FCM__COORD_MAX, ctx, FCM_ERR_ARG,
+              "%s: the image reaches |%c| = %g (origin, axis vectors and sizes), "
+              "outside " FCM__COORD_RANGE,
+              who, "xyz"[d], reach);
+  }
   const double det = det3(axes);
   double scale = 1.0;
   for (int d = 0; d < 3; d++)
@@ -133,6 +142,7 @@ typedef struct header {
   long long byte_skip; /* -1: the data are the last bytes of the data file */
   long long line_skip;
   char data_file[4096]; /* "": attached */
+  long data_line;       /* the header line naming data_file */
   size_t data_offset;   /* attached: offset of the data in the header file */
 } header;
 
@@ -295,6 +305,7 @@ static fcm_status join_path(header *H, long line, const char *name)
             sizeof H->data_file - 1);
   memcpy(H->data_file, H->path, dn);
   strcpy(H->data_file + dn, name);
+  H->data_line = line;
 cleanup:
   return st;
 }
@@ -677,6 +688,7 @@ fcm_status fcm_voxel_image_create_from_file(fcm_ctx *ctx, const char *path, fcm_
   size_t len = 0, dlen = 0;
   header *H = NULL;
   fcm_voxel_image *m = NULL;
+  char what[8400];
   FCM_CHECK(ctx && img, ctx, FCM_ERR_ARG, "voxel image: NULL argument");
   *img = NULL;
   FCM_CHECK(path, ctx, FCM_ERR_ARG, "voxel image: file name is NULL");
@@ -697,9 +709,11 @@ fcm_status fcm_voxel_image_create_from_file(fcm_ctx *ctx, const char *path, fcm_
   const char *dpath = path, *data = buf + H->data_offset;
   size_t dl = len - H->data_offset;
   if (H->data_file[0]) {
-    FCM_TRY(ctx,
-            fcm__file_read_all(ctx, "voxel image", H->data_file, VOXEL_MAX_FILE, &dbuf, &dlen));
-    dpath = H->data_file, data = dbuf, dl = dlen;
+    /* messages about the data name the header that refers to them */
+    snprintf(what, sizeof what, "voxel image: %s:%ld: data file", path, H->data_line);
+    FCM_TRY(ctx, fcm__file_read_all(ctx, what, H->data_file, VOXEL_MAX_FILE, &dbuf, &dlen));
+    snprintf(what, sizeof what, "%s (the data file of %s)", H->data_file, path);
+    dpath = what, data = dbuf, dl = dlen;
   }
   /* The announced size must fit in the data before the values are allocated: raw values take
    * their size each, ascii values at least 2 bytes but the last. */
@@ -840,10 +854,11 @@ fcm_status fcm_geometry_create_from_voxels(fcm_ctx *ctx, const fcm_voxel_image *
   const int64_t nx = img->dims[0], ny = img->dims[1], nz = img->dims[2];
   const size_t n = (size_t)(nx * ny * nz);
   FCM_ALLOC_RAW(ctx, n, mask);
-  size_t nsel = 0;
+  size_t nsel = 0, nnan = 0, first_nan = 0;
   double vmin = HUGE_VAL, vmax = -HUGE_VAL;
   for (size_t i = 0; i < n; i++) {
     const double v = img->values[i];
+    if (isnan(v) && nnan++ == 0) first_nan = i;
     int s = 0;
     if (o.num_labels > 0) {
       for (int l = 0; l < o.num_labels && !s; l++)
@@ -855,15 +870,22 @@ fcm_status fcm_geometry_create_from_voxels(fcm_ctx *ctx, const fcm_voxel_image *
     nsel += (size_t)s;
     if (isfinite(v)) vmin = v < vmin ? v : vmin, vmax = v > vmax ? v : vmax;
   }
+  if (nnan > 0)
+    fcm__log(ctx, FCM_LOG_WARNING,
+             "voxels: %zu of %zu voxel values are NaN and count as outside the body (never "
+             "selected); the first is voxel (%lld, %lld, %lld)",
+             nnan, n, (long long)(first_nan % (size_t)nx),
+             (long long)(first_nan / (size_t)nx % (size_t)ny),
+             (long long)(first_nan / ((size_t)nx * (size_t)ny)));
   if (nsel == 0) {
     if (o.num_labels > 0)
       FCM_CHECK(0, ctx, FCM_ERR_GEOMETRY,
                 "voxels: no voxel has one of the %d labels (first %g); the image values lie in "
-                "[%g, %g]",
-                o.num_labels, o.labels[0], vmin, vmax);
+                "[%g, %g]%s",
+                o.num_labels, o.labels[0], vmin, vmax, nnan == n ? " (every value is NaN)" : "");
     FCM_CHECK(0, ctx, FCM_ERR_GEOMETRY,
-              "voxels: no voxel reaches the threshold %g; the image values lie in [%g, %g]",
-              o.threshold, vmin, vmax);
+              "voxels: no voxel reaches the threshold %g; the image values lie in [%g, %g]%s",
+              o.threshold, vmin, vmax, nnan == n ? " (every value is NaN)" : "");
   }
 #define AVAIL(i, j, k) (mask[(size_t)((i) + nx * ((j) + ny * (k)))] == 1)
   for (int64_t k = 0; k < nz; k++)
@@ -970,6 +992,7 @@ fcm_status fcm_geometry_create_from_voxels(fcm_ctx *ctx, const fcm_voxel_image *
   if (info) {
     info->num_voxels = (fcm_index)n;
     info->num_selected = (fcm_index)nsel;
+    info->num_nan = (fcm_index)nnan;
     info->num_boxes = (fcm_index)nb;
     info->voxel_volume = vv;
   }

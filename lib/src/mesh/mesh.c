@@ -169,9 +169,9 @@ static fcm_status check_arrays(fcm_ctx *ctx, const fcm_element_info *info, fcm_i
   FCM_CHECK(cells || num_cells == 0, ctx, FCM_ERR_ARG, "mesh: cells is NULL with %lld cells",
             (long long)num_cells);
   for (fcm_index i = 0; i < 3 * num_nodes; i++)
-    FCM_CHECK(isfinite(coords[i]), ctx, FCM_ERR_ARG,
-              "mesh: coordinate %d of node %lld is %g; coordinates must be finite", (int)(i % 3),
-              (long long)(i / 3), coords[i]);
+    FCM_CHECK(fabs(coords[i]) <= FCM__COORD_MAX, ctx, FCM_ERR_ARG,
+              "mesh: coordinate %d of node %lld (0-based) is %g, outside " FCM__COORD_RANGE,
+              (int)(i % 3), (long long)(i / 3), coords[i]);
   const int npc = info->num_nodes;
   for (fcm_index c = 0; c < num_cells; c++) {
     const fcm_index *cell = cells + (size_t)npc * (size_t)c;

@@ -228,12 +228,18 @@ static fcm_status read_count(reader *r, const char *what, size_t min_bytes, long
 
 enum { MIN_ENTRY_BYTES = 2, MIN_NODE_BYTES = 8 };
 
-static fcm_status read_coords(reader *r, double *x)
+/* The coordinates of the node with Gmsh tag `tag`. */
+static fcm_status read_coords(reader *r, long long tag, double *x)
 {
   fcm_status st = FCM_OK;
   FCM_TRY(r->ctx, read_double(r, "node x coordinate", &x[0]));
   FCM_TRY(r->ctx, read_double(r, "node y coordinate", &x[1]));
   FCM_TRY(r->ctx, read_double(r, "node z coordinate", &x[2]));
+  for (int d = 0; d < 3; d++)
+    FCM_CHECK(fabs(x[d]) <= FCM__COORD_MAX, r->ctx, FCM_ERR_FORMAT,
+              "%s:%ld: node tag %lld (Gmsh tags, from 1): coordinate %c = %g is "
+              "outside " FCM__COORD_RANGE,
+              r->path, r->tokline, tag, "xyz"[d], x[d]);
 cleanup:
   return st;
 }
@@ -261,7 +267,7 @@ static fcm_status read_nodes_v4(reader *r, msh_data *m)
     }
     for (long long i = 0; i < n; i++) {
       double uvw;
-      FCM_TRY(r->ctx, read_coords(r, m->coords + 3 * (first + i)));
+      FCM_TRY(r->ctx, read_coords(r, (long long)m->tags[first + i], m->coords + 3 * (first + i)));
       for (long long k = 0; param && k < dim; k++)
         FCM_TRY(r->ctx, read_double(r, "parametric node coordinate", &uvw));
     }
@@ -284,7 +290,7 @@ static fcm_status read_nodes_v2(reader *r, msh_data *m)
     long long tag;
     FCM_TRY(r->ctx, read_int(r, "node tag", 1, INT64_MAX, &tag));
     FCM_TRY(r->ctx, add_node(r, m, tag));
-    FCM_TRY(r->ctx, read_coords(r, m->coords + 3 * i));
+    FCM_TRY(r->ctx, read_coords(r, tag, m->coords + 3 * i));
   }
   FCM_TRY(r->ctx, expect_word(r, "$EndNodes"));
 cleanup:

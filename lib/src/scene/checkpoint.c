@@ -12,7 +12,9 @@
  *   i64 frames, then frames x f64 frame time
  *   i64 log rows, then rows x (f64 time, residual, energy, wall; i64 newton, linear;
  *   version 2: i64 pieces; f64 mass, momentum x, y, z;
- *   version 3: 6 x f64 per constraint effect: reaction x, y, z, moment x, y, z)
+ *   version 3: 6 x f64 per constraint effect: reaction x, y, z, moment x, y, z;
+ *   version 4: i64 inverted quadrature points, i64 cell of the first (-1: none), i64 NaN or
+ *   infinite von Mises values of the frame after the step (-1: no frame))
  *   num_dofs x f64 displacement, num_dofs x f64 velocity
  *   u64 FNV-1a 64 checksum of every byte before it */
 #define _POSIX_C_SOURCE 200809L
@@ -31,7 +33,7 @@
 #include <sys/stat.h>
 
 #define CKPT_MAGIC   "FCMCKPT"
-#define CKPT_VERSION 3u
+#define CKPT_VERSION 4u
 #define CKPT_BOM     0x0102030405060708ull
 #define FNV_OFFSET   0xcbf29ce484222325ull
 #define FNV_PRIME    0x100000001b3ull
@@ -47,7 +49,8 @@ static uint64_t fnv(uint64_t h, const void *data, size_t n)
 }
 
 /* A fingerprint of what the state depends on: the scene summary without its name line,
- * time span and output section (a resumed run may be longer or write elsewhere), plus the
+ * time span, output section and the reaction to inverted points (a resumed run may be longer,
+ * write elsewhere or stop where the first run warned), plus the
  * exact bits of the step, the material and the discretization's sizes. It guards against
  * resuming the wrong scene; it is a hash, not a proof. */
 static uint64_t fingerprint(const fcm_simulation *S)
@@ -63,7 +66,8 @@ static uint64_t fingerprint(const fcm_simulation *S)
       while (*line) {
         const char *nl = strchr(line, '\n');
         size_t n = nl ? (size_t)(nl - line) + 1 : strlen(line);
-        if (strncmp(line, "scene ", 6) && strncmp(line, "time:", 5) && strncmp(line, "output:", 7))
+        if (strncmp(line, "scene ", 6) && strncmp(line, "time:", 5) &&
+            strncmp(line, "output:", 7) && strncmp(line, "on inversion:", 13))
           h = fnv(h, line, n);
         line += n;
       }
@@ -158,6 +162,9 @@ fcm_status fcm_simulation_write_checkpoint(fcm_simulation *S, const char *path)
     if (S->num_react > 0)
       FCM_TRY(ctx, put(&w, S->react_log + (size_t)k * 6 * (size_t)S->num_react,
                        6 * (size_t)S->num_react * sizeof(double)));
+    FCM_TRY(ctx, put_i64(&w, r->inverted));
+    FCM_TRY(ctx, put_i64(&w, r->inverted_cell));
+    FCM_TRY(ctx, put_i64(&w, r->nonfinite));
   }
   FCM_TRY(ctx, put(&w, fcm_integrator_displacement(S->integ), sizeof(double) * (size_t)n));
   FCM_TRY(ctx, put(&w, fcm_integrator_velocity(S->integ), sizeof(double) * (size_t)n));
@@ -296,9 +303,9 @@ static fcm_status read_file(fcm_simulation *S, const char *path, ckpt_data *d)
             get(&r, d->frame_time, sizeof *d->frame_time * (size_t)d->frames, "the frame times"));
   }
   FCM_TRY(ctx, get_i64(&r, &d->rows, d->steps, d->steps, "log rows (one per step)"));
-  const size_t row_bytes =
-      ver >= 2 ? (8 + (ver >= 3 ? nreact : 0)) * sizeof(double) + 3 * sizeof(int64_t)
-               : 4 * sizeof(double) + 2 * sizeof(int64_t);
+  const size_t row_bytes = ver >= 2 ? (8 + (ver >= 3 ? nreact : 0)) * sizeof(double) +
+                                          (ver >= 4 ? 6 : 3) * sizeof(int64_t)
+                                    : 4 * sizeof(double) + 2 * sizeof(int64_t);
   FCM_TRY(ctx, need(&r, d->rows, row_bytes, "log rows"));
   if (d->rows > 0)
     FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&d->log, &d->log_cap, d->rows, sizeof *d->log));
@@ -326,6 +333,12 @@ static fcm_status read_file(fcm_simulation *S, const char *path, ckpt_data *d)
     } else {
       for (size_t j = 0; j < nreact; j++) /* not recorded by that version */
         d->react[(size_t)k * nreact + j] = NAN;
+    }
+    w->inverted = w->inverted_cell = w->nonfinite = -1; /* not recorded before version 4 */
+    if (ver >= 4) {
+      FCM_TRY(ctx, get_i64(&r, &w->inverted, 0, INT64_MAX, "a log row's inverted points"));
+      FCM_TRY(ctx, get_i64(&r, &w->inverted_cell, -1, INT64_MAX, "a log row's inverted cell"));
+      FCM_TRY(ctx, get_i64(&r, &w->nonfinite, -1, INT64_MAX, "a log row's NaN stresses"));
     }
   }
   FCM_TRY(ctx, need(&r, d->n, 2 * sizeof(double), "displacement and velocity values"));
@@ -391,6 +404,7 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
   S->log = d.log, S->log_cap = d.log_cap, S->log_n = d.rows, d.log = NULL;
   fcm__free(ctx, S->react_log);
   S->react_log = d.react, S->react_cap = d.react_cap, d.react = NULL;
+  fcm__sim_count_log(S);
   S->restored = 1;
 cleanup:
   if (S) ckpt_data_free(S->ctx, &d);

@@ -302,10 +302,14 @@ static fcm_status build_voxels(fcm_simulation *S, const fcm_scene_geometry *g, f
   FCM_TRY(S->ctx, fcm_geometry_create_from_voxels(S->ctx, img, &vo, raw, &info));
   fcm_index d[3];
   fcm_voxel_image_dims(img, d);
+  char nan_note[64] = "";
+  if (info.num_nan > 0)
+    snprintf(nan_note, sizeof nan_note, "; %lld NaN values counted as outside",
+             (long long)info.num_nan);
   snprintf(S->geometry_note, sizeof S->geometry_note,
-           "voxels: %lld of %lld x %lld x %lld selected, merged into %lld boxes",
+           "voxels: %lld of %lld x %lld x %lld selected, merged into %lld boxes%s",
            (long long)info.num_selected, (long long)d[0], (long long)d[1], (long long)d[2],
-           (long long)info.num_boxes);
+           (long long)info.num_boxes, nan_note);
 cleanup:
   fcm_voxel_image_destroy(&img);
   return st;
@@ -319,6 +323,10 @@ static fcm_status build_level_set(fcm_simulation *S, const fcm_scene_geometry *g
   fcm_level_set_options lo = fcm_level_set_options_default();
   fcm_level_set_info info;
   lo.refinement = g->refinement;
+  lo.max_subcells = g->max_subcells;
+  lo.progress = S->opts.geometry_progress;
+  lo.progress_user = S->opts.geometry_progress_user;
+  lo.progress_interval = S->opts.rules_progress_interval;
   FCM_TRY(S->ctx, fcm_implicit_check(S->ctx, &tree));
   FCM_TRY(S->ctx, fcm_geometry_create_from_level_set(S->ctx, fcm_implicit_eval, &tree, g->min,
                                                      g->max, g->cells, &lo, raw, &info));
@@ -588,6 +596,7 @@ static fcm_integrator_options integrator_options(fcm_simulation *S)
   o.krylov_rtol = sv->rtol;
   o.krylov_atol = sv->atol;
   o.krylov_max_iterations = sv->max_iterations;
+  o.krylov_stagnation_window = sv->stagnation_window;
   o.schwarz_theta = sv->schwarz_threshold;
   o.schwarz = sv->schwarz;
   o.multigrid = sv->multigrid;
@@ -764,6 +773,7 @@ static fcm_status collect_cuts(fcm_simulation *S)
     if (e->cut.kind == FCM_CUT_MESH) { /* read it now: a bad file fails before the run */
       fcm_surface *probe = NULL;
       st = fcm_surface_create_from_file(ctx, e->cut.mesh, &probe);
+      if (st == FCM_OK) st = fcm__embed_cut_check(ctx, probe, e->cut.mesh);
       fcm_surface_destroy(&probe);
       if (st != FCM_OK) {
         char section[64];
@@ -921,6 +931,8 @@ simulation_create(fcm_ctx *ctx, const fcm_scene *scene, const fcm_simulation_opt
     FCM_TRY(ctx, fcm_space_create(ctx, S->mesh, NULL, &S->space));
   }
   S->c.num_dofs = fcm_space_num_dofs(S->space);
+  S->c.inverted_first_cell = -1;
+  S->c.nonfinite_first_step = -1;
 
   /* integrator with the scene's effects */
   fcm_integrator_options io = integrator_options(S);
@@ -1033,6 +1045,47 @@ cleanup:
   return st;
 }
 
+/* The inversion counters after log row `step` (1-based) r. */
+static void count_inversion(fcm_simulation_counters *c, long long step, const fcm__log_row *r)
+{
+  if (r->inverted <= 0) return;
+  if (c->inverted_steps++ == 0) {
+    c->inverted_first_step = step;
+    c->inverted_first_time = r->time;
+    c->inverted_first_cell = (fcm_index)r->inverted_cell;
+  }
+  if (r->inverted > c->inverted_max) {
+    c->inverted_max = (fcm_index)r->inverted;
+    c->inverted_max_step = step;
+  }
+}
+
+/* The frame counters after a frame of the state after step `step` with `nonfinite` NaN or
+ * infinite von Mises values. */
+static void count_frame(fcm_simulation_counters *c, long long step, fcm_index nonfinite)
+{
+  c->nonfinite_last = nonfinite;
+  if (nonfinite <= 0) return;
+  if (c->nonfinite_frames++ == 0) c->nonfinite_first_step = step;
+  if (nonfinite > c->nonfinite_max) c->nonfinite_max = nonfinite;
+}
+
+void fcm__sim_count_log(fcm_simulation *S)
+{
+  fcm_simulation_counters *c = &S->c;
+  c->inverted_steps = c->inverted_first_step = c->inverted_max_step = 0;
+  c->inverted_first_time = 0.0;
+  c->inverted_first_cell = -1;
+  c->inverted_max = 0;
+  c->nonfinite_frames = 0;
+  c->nonfinite_last = c->nonfinite_max = 0;
+  c->nonfinite_first_step = -1;
+  for (long long k = 0; k < S->log_n; k++) {
+    count_inversion(c, k + 1, &S->log[k]);
+    if (S->log[k].nonfinite >= 0) count_frame(c, k + 1, (fcm_index)S->log[k].nonfinite);
+  }
+}
+
 /* Force (q[0..3)) and moment about the origin (q[3..6)) of the k-th constraint effect of the
  * log after the step just taken: node constraints from the integrator's residual
  * (fcm_integrator_reaction()); a constraint imposed otherwise (weakly, on the embedded
@@ -1095,7 +1148,25 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   r->energy = si.total_energy;
   r->wall = wall;
   r->pieces = S->pieces;
+  r->inverted = si.inverted_points;
+  r->inverted_cell = si.inverted_cell;
+  r->nonfinite = -1;
+  count_inversion(&S->c, S->c.steps, r);
   FCM_TRY(S->ctx, log_momentum(S, r));
+  if (si.inverted_points > 0 && fcm_scene_get_solver(S->scene)->stop_on_inversion) {
+    char where[256] = "";
+    if (si.inverted_cell >= 0)
+      snprintf(where, sizeof where,
+               ", the first in cell %lld at X = (%.6g, %.6g, %.6g) with J = %.3g",
+               (long long)si.inverted_cell, si.inverted_position[0], si.inverted_position[1],
+               si.inverted_position[2], si.inverted_det);
+    FCM_CHECK(0, S->ctx, FCM_ERR_GEOMETRY,
+              "simulation %s: step %lld (t = %.9g s) ended with %lld inverted quadrature "
+              "point%s (J = det F <= 0)%s; stopped because solver.on_inversion is \"stop\" "
+              "(\"warn\" goes on and counts them)",
+              fcm_scene_name(S->scene), S->c.steps, si.time, (long long)si.inverted_points,
+              si.inverted_points == 1 ? "" : "s", where);
+  }
 cleanup:
   /* distributed: a failure on one process only (outside the integrator's reduces) meets the
    * others here or in their next reduce (FCM_OK without a backend) */
@@ -1173,11 +1244,12 @@ cleanup:
 
 /* A distributed run: this process's piece <name>_background_NNNN_<rank>.vtu of the background
  * frame (its own cells: the rules' cell mask, all cells on the root without rules; the node
- * fields from the replicated state, the stresses of its own cells computed here), then the
- * root's <name>_background_NNNN.pvtu naming the pieces (path). Collective. */
+ * fields from the replicated state, the stresses of its own cells computed here, *nonfinite
+ * of them NaN or infinite), then the root's <name>_background_NNNN.pvtu naming the pieces
+ * (path). Collective. */
 static fcm_status write_background_pieces(fcm_simulation *S, const char *dir, int index,
                                           const double *u, const double *v, int root, char *path,
-                                          size_t path_size)
+                                          size_t path_size, fcm_index *nonfinite)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = S->ctx;
@@ -1202,7 +1274,7 @@ static fcm_status write_background_pieces(fcm_simulation *S, const char *dir, in
   snprintf(path, path_size, "%s/%.1023s_%d.vtu", dir, stem, rank);
   if (st == FCM_OK)
     st = fcm__space_write_vtu_piece(S->space, fcm_scene_get_material(S->scene), u, v, keep, rank,
-                                    path);
+                                    path, nonfinite);
   fcm__free(ctx, keep);
   FCM_TRY(ctx, fcm__integrator_reduce_status(S->integ, st, NULL, 0)); /* agree on st */
   snprintf(path, path_size, "%s/%.1023s.pvtu", dir, stem);
@@ -1218,6 +1290,7 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
   fcm_ctx *ctx = S ? S->ctx : NULL;
   int root = 1, dist = 0;
   double t0 = fcm_wtime(), time = 0.0;
+  fcm_index bad_cells = 0, bad_points = 0; /* NaN or infinite von Mises values written */
   FCM_CHECK(S && dir && index >= 0, ctx, FCM_ERR_ARG,
             "simulation: write_frame needs a directory and index >= 0 (got %d)", index);
   const char *name = fcm_scene_name(S->scene);
@@ -1231,10 +1304,10 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
                              sizeof *S->frame_time));
   /* distributed: every process writes its piece, the root the .pvtu and the PVD */
   if (dist && out->write_background)
-    FCM_TRY(ctx, write_background_pieces(S, dir, index, u, v, root, path, sizeof path));
+    FCM_TRY(ctx, write_background_pieces(S, dir, index, u, v, root, path, sizeof path, &bad_cells));
   else if (out->write_background) {
     snprintf(path, sizeof path, "%s/%s_background_%04d.vtu", dir, name, index);
-    FCM_TRY(ctx, fcm_space_write_vtu(S->space, mat, u, v, path));
+    FCM_TRY(ctx, fcm__space_write_vtu_counted(S->space, mat, u, v, path, &bad_cells));
   }
   if (out->write_background && root) {
     if (!S->pvd_bg) FCM_TRY(ctx, open_pvd(S, dir, "background", &S->pvd_bg));
@@ -1242,7 +1315,7 @@ fcm_status fcm_simulation_write_frame(fcm_simulation *S, const char *dir, int in
   }
   if (S->surf && root) { /* the surface's fields come from u alone: whole on every process */
     snprintf(path, sizeof path, "%s/%s_surface_%04d.vtu", dir, name, index);
-    FCM_TRY(ctx, fcm_embedded_surface_write_vtu(S->surf, mat, u, path));
+    FCM_TRY(ctx, fcm__embedded_surface_write_vtu_counted(S->surf, mat, u, path, &bad_points));
     if (!S->pvd_surf) FCM_TRY(ctx, open_pvd(S, dir, "surface", &S->pvd_surf));
     FCM_TRY(ctx, fcm_pvd_add(S->pvd_surf, time, path));
   }
@@ -1250,9 +1323,18 @@ cleanup:
   /* distributed: a failure on any process (the root's files included) is returned on every
    * process, and no process counts the frame then */
   if (dist) st = fcm__integrator_finish(S->integ, st);
+  if (dist && st == FCM_OK) { /* every process: the pieces' cells and the root's points */
+    double q[2] = {(double)bad_cells, (double)bad_points};
+    st = fcm__integrator_reduce(S->integ, q, 2);
+    bad_cells = (fcm_index)q[0], bad_points = (fcm_index)q[1];
+  }
   if (st == FCM_OK) {
     S->frame_time[S->c.frames++] = time;
     S->c.time_output += fcm_wtime() - t0;
+    count_frame(&S->c, S->c.steps, bad_cells + bad_points);
+    /* the log row of the step this frame shows (none for the initial state) */
+    if (S->c.steps > 0 && S->log_n == S->c.steps)
+      S->log[S->log_n - 1].nonfinite = bad_cells + bad_points;
   }
   return st;
 }
@@ -1275,7 +1357,8 @@ fcm_status fcm_simulation_write_log(fcm_simulation *S, const char *path)
                                           "moment_%d_y,moment_%d_z",
                                           i, i, i, i, i, i));
   }
-  FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, ",wall_time\n"));
+  FCM_TRY(S->ctx,
+          fcm__io_atomic_printf(S->ctx, &af, ",inverted_points,nonfinite_stresses,wall_time\n"));
   for (long long k = 0; k < S->log_n; k++) {
     const fcm__log_row *r = &S->log[k];
     FCM_TRY(S->ctx,
@@ -1286,6 +1369,12 @@ fcm_status fcm_simulation_write_log(fcm_simulation *S, const char *path)
     for (int j = 0; j < 6 * S->num_react; j++)
       FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, ",%.17g",
                                             S->react_log[(size_t)k * 6 * S->num_react + j]));
+    /* counts: nan where not known (no frame after the step; a row of an older checkpoint),
+     * as the reactions such a row lacks */
+    const long long counts[2] = {r->inverted, r->nonfinite};
+    for (int j = 0; j < 2; j++)
+      FCM_TRY(S->ctx, counts[j] >= 0 ? fcm__io_atomic_printf(S->ctx, &af, ",%lld", counts[j])
+                                     : fcm__io_atomic_printf(S->ctx, &af, ",nan"));
     FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, ",%.6g\n", r->wall));
   }
   FCM_TRY(S->ctx, fcm__io_atomic_commit(S->ctx, &af));
@@ -1369,6 +1458,38 @@ static void body_displacement_line(const fcm_simulation *S, FILE *f, double body
   else
     fprintf(f, "  body      max |u| %.6g m over the body's quadrature points; DOF vector: %.6g m\n",
             body, dofs);
+}
+
+/* Inverted quadrature points after the steps and NaN or infinite stresses in the frames: the
+ * count, the first and the worst (zeros when the body never inverted). */
+static void inversion_lines(FILE *f, const fcm_simulation_counters *c)
+{
+  if (c->inverted_steps == 0 && c->steps == 1) {
+    fprintf(f, "  inversion none: no quadrature point with J = det F <= 0 after the step\n");
+  } else if (c->inverted_steps == 0) {
+    fprintf(f,
+            "  inversion none: no quadrature point with J = det F <= 0 after any of the %lld "
+            "steps\n",
+            c->steps);
+  } else {
+    char cell[64] = "";
+    if (c->inverted_first_cell >= 0)
+      snprintf(cell, sizeof cell, ", cell %lld", (long long)c->inverted_first_cell);
+    fprintf(f,
+            "  inversion WARNING: %lld of %lld steps ended with inverted quadrature points (J = "
+            "det F <= 0): first step %lld (t = %.6g s%s), most %lld points (step %lld)\n",
+            c->inverted_steps, c->steps, c->inverted_first_step, c->inverted_first_time, cell,
+            (long long)c->inverted_max, c->inverted_max_step);
+  }
+  if (c->frames == 0) return;
+  if (c->nonfinite_frames == 0)
+    fprintf(f, "  stresses  finite in every frame written (%lld)\n", c->frames);
+  else
+    fprintf(f,
+            "  stresses  WARNING: %lld of %lld frames hold NaN or infinite von Mises values "
+            "(points with J <= 0): first the frame after step %lld, most %lld values in one "
+            "frame\n",
+            c->nonfinite_frames, c->frames, c->nonfinite_first_step, (long long)c->nonfinite_max);
 }
 
 /* The summary with the rules' statistics `gs`, the counters `gc`, the body's largest |u| over
@@ -1488,6 +1609,7 @@ static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_
   snprintf(b, sizeof b, "%lld frames, surface %lld points %lld triangles", c->frames,
            (long long)c->surface_points, (long long)c->surface_triangles);
   line(f, c->frames > 0, "output", b);
+  inversion_lines(f, c);
   body_displacement_line(S, f, body);
   if (S->free_body) {
     /* com_now: the centre of mass computed by every process (a distributed run: collective,

@@ -17,12 +17,16 @@ typedef fcm_status (*fcm__simulation_reduce_fn)(void *user, fcm_status st, doubl
                                                 fcm_index count);
 
 /* One row of the per-step log: the step, and the body after it (separate bodies, mass and
- * linear momentum over the body's own quadrature points, fcm_space_momentum()). */
+ * linear momentum over the body's own quadrature points, fcm_space_momentum(); its inverted
+ * quadrature points and the cell of the first, fcm_step_info; the NaN or infinite von Mises
+ * values of the frame written after the step). -1: not known (inverted and inverted_cell of a
+ * row restored from an older checkpoint; nonfinite of a step without a frame). */
 typedef struct fcm__log_row {
   double time, residual, energy, wall;
   long long newton, linear;
   long long pieces;
   double mass, momentum[3];
+  long long inverted, inverted_cell, nonfinite;
 } fcm__log_row;
 
 struct fcm_simulation {
@@ -83,6 +87,10 @@ struct fcm_simulation {
 
 /* Grow an array of `size`-byte items to hold at least `need` (doubling). */
 fcm_status fcm__sim_grow(fcm_ctx *ctx, void **array, long long *cap, long long need, size_t size);
+
+/* Recount the inversion and frame counters of S->c (inverted_*, nonfinite_*) from the log's
+ * rows, as a restored checkpoint leaves them (run.c). */
+void fcm__sim_count_log(fcm_simulation *S);
 
 /* Apply the next cut of the scene (S->cuts[S->cuts_applied]): rules, space, integrator and the
  * output's element map are replaced; the state carries over (run.c). */

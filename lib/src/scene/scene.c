@@ -2,6 +2,7 @@
  * in effects.c), the accessors and the normalized summary printed by fcm_scene_view(). */
 #define _POSIX_C_SOURCE 200809L
 #include "scene/scene_impl.h"
+#include "geom/geom_impl.h"
 
 #include <errno.h>
 #include <stdalign.h>
@@ -76,6 +77,8 @@ static const char *const clamp_names[] = {"clamp", "paper"};
 /* in the order of fcm_fictitious_model */
 static const char *const tangent_names[] = {"projected", "linear", "exact"};
 static const char *const newton_rule_names[] = {"auto", "representative", "relative"};
+/* solver.on_inversion: fcm_scene_solver.stop_on_inversion 0 or 1 */
+static const char *const inversion_names[] = {"warn", "stop"};
 static const int newton_rule_values[] = {FCM_NEWTON_TOL_AUTO, FCM_NEWTON_TOL_REPRESENTATIVE,
                                          FCM_NEWTON_TOL_RELATIVE};
 static const char *const integrator_names[] = {"backward_euler"};
@@ -329,8 +332,8 @@ static const char *const implicit_names[] = {"sphere", "torus",        "box",   
 /* One implicit (an object with one member named by its kind) at the current path into
  * nodes[*n ...]; *root is the index of its node. CSG arrays of k >= 2 operands fold left:
  * ((a op b) op c) ... */
-static fcm_status read_implicit(fcm__scene_parser *p, const fcm__json *node, fcm_implicit *nodes,
-                                int *n, int *root)
+static fcm_status read_implicit(fcm__scene_parser *p, const fcm__json *node, double h,
+                                fcm_implicit *nodes, int *n, int *root)
 {
   fcm_status st = FCM_OK;
   static const char *const sphere_keys[] = {"center", "radius"};
@@ -363,7 +366,7 @@ static fcm_status read_implicit(fcm__scene_parser *p, const fcm__json *node, fcm
     for (const fcm__json *c = fcm__json_child(m); c; c = fcm__json_next(c), i++) {
       size_t o2 = fcm__scene_path_push_index(p, i);
       int ci = -1;
-      FCM_TRY(p->ctx, read_implicit(p, c, nodes, n, &ci));
+      FCM_TRY(p->ctx, read_implicit(p, c, h, nodes, n, &ci));
       fcm__scene_path_pop(p, o2);
       if (r < 0) {
         r = ci;
@@ -424,6 +427,13 @@ static fcm_status read_implicit(fcm__scene_parser *p, const fcm__json *node, fcm
     default:
       break;
     }
+    /* a feature below the sampling spacing only samples noise: refused before building */
+    char why[512];
+    const char *feature;
+    if (!fcm__implicit_resolved(&q, h, &feature, why, sizeof why)) {
+      if (feature) fcm__scene_path_push_key(p, feature);
+      SCENE_CHECK(0, p, FCM_ERR_ARG, "%s", why);
+    }
     nodes[*n] = q;
     *root = (*n)++;
   }
@@ -475,13 +485,12 @@ static fcm_status read_level_set(fcm__scene_parser *p, const fcm__json *o, fcm_s
   fcm_implicit *nodes = fcm__scene_alloc(p->scene, FCM_IMPLICIT_MAX_NODES, sizeof *nodes);
   FCM_CHECK(nodes, p->ctx, FCM_ERR_ALLOC, "scene: out of memory");
   int n = 0, root = -1;
-  ENTER(p, "level_set");
-  FCM_TRY(p->ctx, read_implicit(p, fcm__json_member(o, "level_set"), nodes, &n, &root));
-  fcm__scene_path_pop(p, old);
-  g->implicit = nodes;
-  g->num_implicit = n;
   g->refinement = 4;
   READ_INT(p, o, "refinement", 0, 1, 64, g->refinement);
+  long long max_subcells = FCM_LEVEL_SET_MAX_SUBCELLS;
+  FCM_TRY(p->ctx,
+          fcm__scene_read_int(p, o, "max_subcells", 0, 0, (long long)1 << 50, &max_subcells));
+  g->max_subcells = (fcm_index)max_subcells;
   const int nbox =
       !!fcm__json_member(o, "min") + !!fcm__json_member(o, "max") + !!fcm__json_member(o, "cells");
   SCENE_CHECK(nbox == 0 || nbox == 3, p, FCM_ERR_ARG,
@@ -508,6 +517,15 @@ static fcm_status read_level_set(fcm__scene_parser *p, const fcm__json *o, fcm_s
     memcpy(g->max, b->max, sizeof g->max);
     memcpy(g->cells, b->cells, sizeof g->cells);
   }
+  /* the sampling spacing (fcm_level_set_info.h) every feature of the tree must resolve */
+  double h = 0.0;
+  for (int d = 0; d < 3; d++)
+    h = fmax(h, (g->max[d] - g->min[d]) / ((double)g->cells[d] * g->refinement));
+  ENTER(p, "level_set");
+  FCM_TRY(p->ctx, read_implicit(p, fcm__json_member(o, "level_set"), h, nodes, &n, &root));
+  fcm__scene_path_pop(p, old);
+  g->implicit = nodes;
+  g->num_implicit = n;
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
@@ -547,9 +565,10 @@ static fcm_status read_geometry(fcm__scene_parser *p, const fcm__json *root)
                                          "labels",
                                          "merge",
                                          "level_set",
-                                         "refinement"};
+                                         "refinement",
+                                         "max_subcells"};
   static const char *const voxel_keys[] = {"voxels", "threshold", "labels", "merge", "transform"};
-  static const char *const level_set_keys[] = {"level_set", "refinement", "min",
+  static const char *const level_set_keys[] = {"level_set", "refinement", "max_subcells", "min",
                                                "max",       "cells",      "transform"};
   static const char *const box_keys[] = {"shape", "min", "max", "cells", "transform"};
   static const char *const ball_keys[] = {"shape", "center", "radius", "resolution", "transform"};
@@ -827,9 +846,9 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
   static const char *const keys[] = {
-      "method",    "direct",         "preconditioner", "schwarz", "rtol",
-      "atol",      "max_iterations", "newton",         "threads", "preconditioner_tangent",
-      "multigrid", "petsc_options"};
+      "method",    "direct",         "preconditioner", "schwarz",          "rtol",
+      "atol",      "max_iterations", "newton",         "threads",          "preconditioner_tangent",
+      "multigrid", "petsc_options",  "on_inversion",   "stagnation_window"};
   static const char *const skeys[] = {"threshold", "epsilon", "clamp"};
   static const char *const nkeys[] = {"rtol",        "max_iterations",
                                       "line_search", "project_psd",
@@ -848,10 +867,12 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   s->threads = FCM_DEFAULT;
   s->rtol = 1e-8;
   s->max_iterations = 1000;
+  s->stagnation_window = 50;
   s->newton_rtol = 1e-5;
   s->newton_max_iterations = 100;
   s->line_search = 1;
   s->representative_acceleration = 9.81;
+  s->stop_on_inversion = 0;
   FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "solver", 0, &o));
   if (!o) return FCM_OK;
   ENTER(p, "solver");
@@ -875,6 +896,7 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "rtol", 0, (fcm__range){0.0, 1.0, 0, 1}, &s->rtol));
   FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "atol", 0, FCM__NONNEGATIVE, &s->atol));
   READ_INT(p, o, "max_iterations", 0, 1, 1000000000, s->max_iterations);
+  READ_INT(p, o, "stagnation_window", 0, 0, 1000000000, s->stagnation_window);
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "newton", 0, &nw));
   if (nw) {
     ENTER(p, "newton");
@@ -895,6 +917,7 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   if (mg) FCM_TRY(p->ctx, read_multigrid(p, mg, s));
   FCM_TRY(p->ctx, check_multigrid(p, s));
   FCM_TRY(p->ctx, fcm__scene_read_string(p, o, "petsc_options", 0, &s->petsc_options));
+  READ_CHOICE(p, o, "on_inversion", 0, inversion_names, s->stop_on_inversion);
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
@@ -1374,6 +1397,10 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
               clamp_names[so->schwarz.clamp]);
     if (so->preconditioner == FCM_PRECOND_MULTIGRID) view_multigrid(f, &so->multigrid);
     fprintf(f, ", rtol %g, atol %g, at most %d iterations", so->rtol, so->atol, so->max_iterations);
+    if (so->stagnation_window > 0)
+      fprintf(f, ", stagnation window %d", so->stagnation_window);
+    else
+      fprintf(f, ", no stagnation test");
   }
   fprintf(f,
           "; Newton %s rule, rtol %g, at most %d iterations, line search %s, PSD projection %s, "
@@ -1381,6 +1408,7 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
           CHOICE_NAME(newton_rule_names, newton_rule_values, so->newton_rule), so->newton_rtol,
           so->newton_max_iterations, so->line_search ? "on" : "off", so->project_psd ? "on" : "off",
           so->representative_acceleration, so->threads > 0 ? so->threads : 0);
+  fprintf(f, "on inversion: %s\n", inversion_names[so->stop_on_inversion ? 1 : 0]);
   if (t->integrator == FCM_INTEGRATOR_STATIC)
     fprintf(f, "time: static, %lld step(s) of %g s, %d load step(s) each\n",
             (long long)t->num_steps, t->dt, t->load_steps);

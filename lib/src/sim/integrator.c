@@ -31,6 +31,7 @@ fcm_integrator_options fcm_integrator_options_default(void)
   o.krylov_rtol = 1e-8;
   o.krylov_atol = 0.0;
   o.krylov_max_iterations = 1000;
+  o.krylov_stagnation_window = 50;
   o.schwarz_theta = 0.5;
   o.schwarz = fcm_schwarz_options_default();
   o.multigrid = fcm_mg_options_default();
@@ -53,6 +54,8 @@ const char *fcm_step_reason_name(fcm_step_reason reason)
     return "linear-solver-failed";
   case FCM_STEP_NONFINITE:
     return "nonfinite";
+  case FCM_STEP_LINEAR_SOLVER_STAGNATED:
+    return "linear-solver-stagnated";
   }
   return "unknown";
 }
@@ -429,6 +432,9 @@ static fcm_status validate_options(fcm_ctx *ctx, const fcm_integrator_options *o
             "integrator: krylov_atol = %g must be finite and >= 0", o->krylov_atol);
   FCM_CHECK(o->krylov_max_iterations >= 1, ctx, FCM_ERR_ARG,
             "integrator: krylov_max_iterations = %d must be >= 1", o->krylov_max_iterations);
+  FCM_CHECK(o->krylov_stagnation_window >= 0, ctx, FCM_ERR_ARG,
+            "integrator: krylov_stagnation_window = %d must be >= 0 (0: off)",
+            o->krylov_stagnation_window);
   FCM_CHECK(o->schwarz_theta > 0.0 && o->schwarz_theta <= 1.0, ctx, FCM_ERR_ARG,
             "integrator: schwarz_theta = %g outside (0, 1]", o->schwarz_theta);
   FCM_CHECK(o->rayleigh_mass >= 0.0 && isfinite(o->rayleigh_mass), ctx, FCM_ERR_ARG,

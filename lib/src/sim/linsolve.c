@@ -21,6 +21,13 @@ long long fcm__sim_analyses(const fcm_integrator *I)
   return a.analyses + b.analyses;
 }
 
+/* Remember that the current linear solve stagnated or broke down, with the solver's message. */
+static void stalled(fcm_integrator *I, const char *msg)
+{
+  I->solve_stalled = 1;
+  snprintf(I->stall_msg, sizeof I->stall_msg, "%s", msg);
+}
+
 /* Map a soft failure of a solver call to a step reason; pass hard errors on. */
 static fcm_status soft(fcm_integrator *I, fcm_status s, fcm_step_reason *reason)
 {
@@ -338,7 +345,7 @@ static fcm_status mg_solve(fcm_integrator *I, const double *b, double *d, fcm_st
   const double target = fmax(I->opts.krylov_rtol * bn, I->opts.krylov_atol);
   double rk = bn, r1 = bn, r_back = bn;
   int k = 0;
-  const char *why = NULL;
+  const char *why = NULL, *const stall = "stalled (less than 5 % reduction in 20 cycles)";
   while (!(rk <= target)) {
     if (k >= max_cycles) {
       why = "cycle limit (krylov_max_iterations) reached";
@@ -358,7 +365,7 @@ static fcm_status mg_solve(fcm_integrator *I, const double *b, double *d, fcm_st
     }
     if (k % 20 == 0) {
       if (rk > 0.95 * r_back) {
-        why = "stalled (less than 5 % reduction in 20 cycles)";
+        why = stall;
         break;
       }
       r_back = rk;
@@ -374,8 +381,11 @@ static fcm_status mg_solve(fcm_integrator *I, const double *b, double *d, fcm_st
                    "mean factor per cycle %.3g",
                    why, bn > 0.0 ? rk / bn : 0.0, k, I->opts.krylov_rtol, I->opts.krylov_atol,
                    factor);
+    if (why == stall) stalled(I, fcm_ctx_error_message(ctx));
   }
   st = mg_soft(I, s, reason);
+  if (st == FCM_OK && *reason == FCM_STEP_LINEAR_SOLVER_FAILED && I->solve_stalled)
+    *reason = FCM_STEP_LINEAR_SOLVER_STAGNATED;
 cleanup:
   return st;
 }
@@ -477,6 +487,7 @@ static fcm_status solve_krylov(fcm_integrator *I, const double *b, double *d,
   ko.rtol = I->opts.krylov_rtol;
   ko.atol = I->opts.krylov_atol;
   ko.max_iterations = I->opts.krylov_max_iterations;
+  ko.stagnation_window = I->opts.krylov_stagnation_window;
   if (I->jacobi && (I->opts.preconditioner == FCM_PRECOND_JACOBI ||
                     I->opts.preconditioner == FCM_PRECOND_BLOCK_JACOBI)) {
     S = fcm_jacobi_operator;
@@ -499,10 +510,13 @@ static fcm_status solve_krylov(fcm_integrator *I, const double *b, double *d,
   stats->linear_iterations += ki.iterations;
   stats->mg_cycles += I->mg_applies - applies0;
   if (s == FCM_ERR_NOT_CONVERGED) {
-    /* Stopped early (iteration limit, CG breakdown on an indefinite matrix): the iterate
-     * is still usable when it is a finite, non-zero vector; the Newton loop checks that
-     * it descends. */
+    /* Stopped early (iteration limit, stagnation, CG breakdown on an indefinite matrix):
+     * the iterate is still usable when it is a finite, non-zero vector; the Newton loop
+     * checks that it descends. A stagnation or breakdown is remembered: it names the
+     * failure should Newton not get on with it. */
     int usable = 1, nonzero = 0;
+    if (ki.reason == FCM_KRYLOV_STAGNATED || ki.reason == FCM_KRYLOV_BREAKDOWN)
+      stalled(I, fcm_ctx_error_message(ctx));
     for (fcm_index i = 0; i < I->n; i++) {
       if (!isfinite(d[i])) usable = 0;
       if (d[i] != 0.0) nonzero = 1;
@@ -514,6 +528,8 @@ static fcm_status solve_krylov(fcm_integrator *I, const double *b, double *d,
     }
   }
   FCM_TRY(ctx, soft(I, s, reason));
+  if (*reason == FCM_STEP_LINEAR_SOLVER_FAILED && I->solve_stalled)
+    *reason = FCM_STEP_LINEAR_SOLVER_STAGNATED;
 cleanup:
   return st;
 }
@@ -524,6 +540,7 @@ fcm_status fcm__sim_solve(fcm_integrator *I, const double *b, double *d, fcm_ste
   fcm_status st = FCM_OK;
   double t0 = fcm_wtime();
   *iterations = 0;
+  I->solve_stalled = 0;
   if (I->has_backend) { /* sim_backend.h */
     int failed = 0;
     st = I->backend.solve(I->backend.user, b, d, iterations, &failed);

@@ -136,10 +136,11 @@ cleanup:
 }
 
 /* Energy parts at x: E, the internal force fint, the gradient g (n each), the elastic
- * energy and the magnitude scale of E (sum of the absolute parts). With `tangent`, H =
- * base + K(x) in the same pass. *finite = 0 when anything is NaN/Inf. */
+ * energy, the magnitude scale of E (sum of the absolute parts) and the inverted quadrature
+ * points the assembly met (fcm__assembly_inverted()). With `tangent`, H = base + K(x) in the
+ * same pass. *finite = 0 when anything is NaN/Inf. */
 typedef struct eval_out {
-  double E, psi, scale;
+  double E, psi, scale, inverted;
   int finite;
 } eval_out;
 
@@ -156,10 +157,11 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
   if (st == FCM_OK && out->finite)
     st = assemble_boundary(I, x, 0, &bnd, fint, tangent ? I->H : NULL, &out->finite, stats);
   {
-    double parts[2] = {psi, bnd};
-    FCM_TRY(I->ctx, reduce_eval(I, st, parts, 2, fint, &out->finite, stats));
+    double parts[3] = {psi, bnd, (double)fcm__assembly_inverted(I->aws, NULL)};
+    FCM_TRY(I->ctx, reduce_eval(I, st, parts, 3, fint, &out->finite, stats));
     psi = parts[0];
     bnd = parts[1];
+    out->inverted = parts[2];
   }
   if (!out->finite) return FCM_OK;
   {
@@ -416,6 +418,7 @@ static fcm_status newton_start(fcm_integrator *I, double h, eval_out *cur, sim_s
   I->h_state = I->linear ? (I->h_state == SIM_H_SYSTEM ? SIM_H_SYSTEM : SIM_H_INVALID)
                          : (cur->finite ? SIM_H_TANGENT : SIM_H_INVALID);
   I->psi = cur->psi;
+  I->inverted = cur->inverted;
 cleanup:
   return st;
 }
@@ -525,6 +528,7 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
   double rep_free = 0.0, r = NAN, r_start = NAN, tol = 0.0;
   int met = 0;
   *reason = FCM_STEP_NONE;
+  I->solve_stalled = 0;
 
   if (o->tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE) rep_free = norm_free(I, I->Ma);
   FCM_TRY(I->ctx, newton_start(I, h, &cur, stats));
@@ -567,6 +571,7 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
     swap(&I->g, &I->g_t);
     cur = trial;
     I->psi = cur.psi;
+    I->inverted = cur.inverted;
     if (!I->linear)
       I->h_state = (lr.speculative && lr.alpha == 1.0) ? SIM_H_TANGENT : SIM_H_INVALID;
     stats->newton_iterations++;
@@ -575,6 +580,11 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
     tol = tolerance(I, rep_free, r_start);
     monitor(I, t1, it + 1, r, tol, cur.E, lr.alpha, its, met);
   }
+  /* Newton could not go on with the result of a linear solve that stagnated or broke down:
+   * that, not the line search, is why the substep failed */
+  if (I->solve_stalled &&
+      (*reason == FCM_STEP_LINE_SEARCH_FAILED || *reason == FCM_STEP_MAX_NEWTON))
+    *reason = FCM_STEP_LINEAR_SOLVER_STAGNATED;
 cleanup:
   *residual = r;
   *tol_out = tol;
@@ -635,6 +645,11 @@ static fcm_status run_substep(fcm_integrator *I, int dyn, double h, double t1,
 {
   fcm_status st = FCM_OK;
   fcm__sim_eval_constraints(I, t1);
+  if (!dyn && I->rigid_ok != I->con_version + 1) {
+    /* no mass: a body the constraints leave free makes every Newton matrix singular */
+    FCM_TRY(I->ctx, fcm__sim_check_rigid_modes(I, t1));
+    I->rigid_ok = I->con_version + 1;
+  }
   memcpy(I->un, I->u, sizeof(double) * (size_t)I->n);
   if (dyn && I->D && (!I->linear || I->damp_version == 0))
     FCM_TRY(I->ctx, update_damping(I, reason, stats));
@@ -644,7 +659,57 @@ cleanup:
   return st;
 }
 
-/* Gather phase of a converged step: time, the static load, the energies. */
+/* Gather phase of a converged step: the inverted quadrature points of the accepted state (its
+ * last energy assembly counted them) and where the first lies: the lowest element's first such
+ * point. With a backend each process offers its own first point in its slot of w1 (1 + cell, X,
+ * J: 5 doubles per process, summed over the processes) and the lowest cell wins; w1 holds
+ * num_dofs doubles, so a run with more than num_dofs / 5 processes reports the count without
+ * the place. */
+static fcm_status record_inversion(fcm_integrator *I, fcm_step_info *info)
+{
+  fcm_status st = FCM_OK;
+  fcm_index elem = -1, cell = -1;
+  double X[3] = {0, 0, 0}, det = 0.0;
+  int rank = 0, nprocs = 1;
+  info->inverted_points = (fcm_index)I->inverted;
+  info->inverted_cell = -1;
+  if (!(I->inverted > 0.0)) return FCM_OK;
+  fcm__assembly_inverted(I->aws, &elem);
+  if (elem >= 0 && fcm__assembly_inverted_point(I->aws, elem, I->u, X, &det))
+    cell = fcm_space_element_cell(I->space, elem);
+  if (I->has_backend) {
+    fcm__integrator_processes(I, &rank, &nprocs);
+    const fcm_index len = 5 * (fcm_index)nprocs;
+    if (len > I->n) return FCM_OK;
+    double *slot = I->w1 + 5 * (fcm_index)rank;
+    memset(I->w1, 0, sizeof *I->w1 * (size_t)len);
+    if (cell >= 0) {
+      slot[0] = 1.0 + (double)cell;
+      memcpy(slot + 1, X, sizeof X);
+      slot[4] = det;
+    }
+    FCM_TRY(I->ctx, fcm__integrator_reduce(I, I->w1, len));
+    cell = -1;
+    for (int p = 0; p < nprocs; p++) {
+      const double *q = I->w1 + 5 * (fcm_index)p;
+      if (q[0] > 0.0 && (cell < 0 || q[0] - 1.0 < (double)cell)) {
+        cell = (fcm_index)(q[0] - 1.0);
+        memcpy(X, q + 1, sizeof X);
+        det = q[4];
+      }
+    }
+  }
+  if (cell >= 0) {
+    info->inverted_cell = cell;
+    memcpy(info->inverted_position, X, sizeof X);
+    info->inverted_det = det;
+  }
+cleanup:
+  return st;
+}
+
+/* Gather phase of a converged step: time, the static load, the energies, the inverted
+ * points. */
 static fcm_status accept_step(fcm_integrator *I, int dyn, double t0, fcm_step_info *info)
 {
   fcm_status st = FCM_OK;
@@ -664,6 +729,7 @@ static fcm_status accept_step(fcm_integrator *I, int dyn, double t0, fcm_step_in
   info->elastic_energy = I->psi;
   info->external_work = dot(n, I->fext, I->u);
   info->total_energy = ekin + I->psi - info->external_work;
+  if (st == FCM_OK) st = record_inversion(I, info);
   return st;
 }
 
@@ -678,6 +744,15 @@ static fcm_status reject_step(fcm_integrator *I, fcm_status st, fcm_step_reason 
   memcpy(I->load_prev, I->lp_bak, sizeof(double) * (size_t)n);
   fcm__sim_eval_constraints(I, I->t);
   if (!I->linear) I->h_state = SIM_H_INVALID;
+  if (st == FCM_OK && reason == FCM_STEP_LINEAR_SOLVER_STAGNATED)
+    st = fcm__error(I->ctx, FCM_ERR_NOT_CONVERGED, __FILE__, __LINE__, __func__,
+                    "integrator: step %lld from t = %g failed after %d halving(s) (last dt = "
+                    "%g): %s, residual %g vs tolerance %g; state left at t = %g. The linear "
+                    "solver stalled or broke down (%s): the Newton matrix is singular or nearly "
+                    "so (rigid-body modes no constraint holds, a body held at too few points) "
+                    "or, for CG, not positive definite",
+                    I->steps + 1, t0, info->halvings, info->dt, fcm_step_reason_name(reason),
+                    info->residual, info->tolerance, I->t, I->stall_msg);
   if (st == FCM_OK)
     st = fcm__error(I->ctx, reason == FCM_STEP_NONFINITE ? FCM_ERR_NUMERIC : FCM_ERR_NOT_CONVERGED,
                     __FILE__, __LINE__, __func__,
@@ -720,6 +795,7 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
   sim_stats stats;
   if (!info) info = &dummy;
   memset(info, 0, sizeof *info);
+  info->inverted_cell = -1;
   memset(&stats, 0, sizeof stats);
   FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
   FCM_CHECK(I->is_setup, I->ctx, FCM_ERR_ARG, "integrator: call fcm_integrator_setup() first");

@@ -101,6 +101,8 @@ struct fcm_integrator {
   unsigned char *is_con; /* n: constrained by an active constraint right now */
   unsigned char *con_on; /* num_cons: constraint active right now */
   long long con_version; /* bumps whenever the active set changes */
+  long long rigid_ok;    /* static: con_version + 1 of the active set whose rigid-mode check
+                            (rigid.c) passed; 0: none yet */
   double *reaction;      /* num_cons x 6: force and moment of each constraint at the last
                             accepted step (fcm_integrator_reaction()) */
   int reaction_valid;    /* 1 after an accepted step; 0 after setup and set_state */
@@ -139,6 +141,10 @@ struct fcm_integrator {
   long long mg_con;
   long long mg_applies;
   double *mg_r;
+  /* the last linear solve stagnated or broke down (linsolve.c; newton.c names it as the
+   * failure's reason when Newton cannot go on), and the solver's message */
+  int solve_stalled;
+  char stall_msg[320];
 
   /* Newton matrix cache: H holds base(h) + K(u) (state TANGENT, unmodified) or the
    * eliminated system with a valid factor / preconditioner (state SYSTEM, key below). */
@@ -152,8 +158,10 @@ struct fcm_integrator {
   /* cumulative counters */
   long long total_factorizations, total_fallbacks;
 
-  /* energy parts of the current iterate */
+  /* energy parts of the current iterate, and its inverted quadrature points (summed over the
+   * processes; fcm__assembly_inverted()) */
   double psi;
+  double inverted;
 
   /* distributed backend (sim_backend.h); has_backend = 0: serial */
   fcm__sim_backend backend;
@@ -162,6 +170,13 @@ struct fcm_integrator {
 };
 
 enum { SIM_H_INVALID = 0, SIM_H_TANGENT = 1, SIM_H_SYSTEM = 2 };
+
+/* Static steps: FCM_OK when the active constraints (node and boundary constraints at the
+ * current active set) hold the rigid-body modes of every body of the space, else
+ * FCM_ERR_SINGULAR naming the first free body (its nodes' bounding box), what holds it and
+ * the free modes; t is the step's end time, for the message. Allocates O(elements + DOFs)
+ * scratch; collective with a backend (the boundary points' part is summed). (rigid.c) */
+fcm_status fcm__sim_check_rigid_modes(fcm_integrator *I, double t);
 
 /* Newton solve of one (sub)step of length h (0: static) from the state u = un, v.
  * Outputs the reason; hard errors are returned as status. (newton.c) */

@@ -47,6 +47,8 @@ const char *fcm_krylov_reason_name(fcm_krylov_reason reason)
     return "nan";
   case FCM_KRYLOV_CALLBACK_ERROR:
     return "callback-error";
+  case FCM_KRYLOV_STAGNATED:
+    return "stagnated";
   }
   return "unknown";
 }
@@ -223,7 +225,8 @@ typedef struct solve {
   fcm_krylov_options o;
   double *hist;
   int hist_cap;
-  double tol; /* max(rtol ||b||, atol) */
+  double tol;             /* max(rtol ||b||, atol) */
+  double best, best_mark; /* smallest monitored residual so far, and at the last checkpoint */
   fcm_krylov_info info;
 } solve;
 
@@ -259,6 +262,30 @@ static int converged(solve *sv, int it, double rnorm)
   return 1;
 }
 
+/* The stagnation rule (fcm_krylov_options.stagnation_window = W > 0): at every W-th
+ * iteration the smallest monitored residual so far must have dropped by STAGNATION_DECREASE
+ * since the previous checkpoint (iteration 0 the first); otherwise the solve stops as
+ * stagnated. Steady convergence too slow for that (a factor below 1 - 2e-5 per iteration
+ * for W = 50) could not meet a tolerance in any practical number of iterations; what the
+ * rule catches is a plateau: a singular system whose right-hand side leaves its range (the
+ * residual cannot go below the part outside), where CG's iterate then grows without bound
+ * and MINRES's stalls. */
+#define STAGNATION_DECREASE 1e-3
+
+static int stagnated(solve *sv, int it, double rnorm)
+{
+  if (it == 0 || rnorm < sv->best) sv->best = rnorm;
+  if (it == 0) sv->best_mark = rnorm;
+  const int W = sv->o.stagnation_window;
+  if (W <= 0 || it == 0 || it % W != 0) return 0;
+  if (sv->best <= (1.0 - STAGNATION_DECREASE) * sv->best_mark) {
+    sv->best_mark = sv->best;
+    return 0;
+  }
+  sv->info.reason = FCM_KRYLOV_STAGNATED;
+  return 1;
+}
+
 static fcm_status check_options(fcm_ctx *ctx, const char *name, const fcm_krylov_options *o)
 {
   fcm_status st = FCM_OK;
@@ -268,6 +295,8 @@ static fcm_status check_options(fcm_ctx *ctx, const char *name, const fcm_krylov
             "%s: atol = %g must be finite and >= 0", name, o->atol);
   FCM_CHECK(o->max_iterations >= 0, ctx, FCM_ERR_ARG, "%s: max_iterations = %d must be >= 0", name,
             o->max_iterations);
+  FCM_CHECK(o->stagnation_window >= 0, ctx, FCM_ERR_ARG,
+            "%s: stagnation_window = %d must be >= 0 (0: off)", name, o->stagnation_window);
   FCM_CHECK(o->norm >= FCM_KRYLOV_NORM_DEFAULT && o->norm <= FCM_KRYLOV_NORM_PRECONDITIONED, ctx,
             FCM_ERR_ARG, "%s: norm = %d out of range [%d, %d]", name, (int)o->norm,
             (int)FCM_KRYLOV_NORM_DEFAULT, (int)FCM_KRYLOV_NORM_PRECONDITIONED);
@@ -323,7 +352,7 @@ static fcm_status run_cg(solve *sv)
         sv->info.initial_residual = rnorm / sv->info.rhs_norm;
         sv->tol = FCM_MAX(sv->o.rtol * sv->info.rhs_norm, sv->o.atol);
       }
-      if (converged(sv, k, rnorm)) goto finish;
+      if (converged(sv, k, rnorm) || stagnated(sv, k, rnorm)) goto finish;
       if (k == maxit) goto maxed;
     }
     if (sv->S) APPLY_S(sv, r, z);
@@ -340,7 +369,7 @@ static fcm_status run_cg(solve *sv)
         sv->info.initial_residual = rnorm / sv->info.rhs_norm;
         sv->tol = FCM_MAX(sv->o.rtol * sv->info.rhs_norm, sv->o.atol);
       }
-      if (converged(sv, k, rnorm)) goto finish;
+      if (converged(sv, k, rnorm) || stagnated(sv, k, rnorm)) goto finish;
       if (k == maxit) goto maxed;
     }
     if (k == 0) {
@@ -359,7 +388,8 @@ static fcm_status run_cg(solve *sv)
       sv->info.reason = FCM_KRYLOV_BREAKDOWN;
       FCM_CHECK(0, ctx, FCM_ERR_NOT_CONVERGED,
                 "cg: breakdown in iteration %d: p^T A p = %.3e <= 0 (operator not positive "
-                "definite; use minres for indefinite systems)",
+                "definite, or singular with b outside its range; use minres for indefinite "
+                "systems)",
                 k + 1, pq);
     }
     double alpha = rho / pq;
@@ -480,7 +510,7 @@ static fcm_status run_minres(solve *sv)
   sv->tol = FCM_MAX(sv->o.rtol * sv->info.rhs_norm, sv->o.atol);
   beta1 = sqrt(betasq);
   sv->info.initial_residual = beta1 / sv->info.rhs_norm;
-  if (converged(sv, 0, beta1)) goto finish;
+  if (converged(sv, 0, beta1) || stagnated(sv, 0, beta1)) goto finish;
   if (maxit == 0) goto maxed;
 
   beta = phibar = beta1;
@@ -572,7 +602,7 @@ static fcm_status run_minres(solve *sv)
     phibar = out.phibar;
     sv->info.iterations = k;
     if (!isfinite(phibar)) goto nan;
-    if (converged(sv, k, phibar)) goto finish;
+    if (converged(sv, k, phibar) || stagnated(sv, k, phibar)) goto finish;
   }
 maxed:
   sv->info.reason = FCM_KRYLOV_MAX_ITERATIONS;
@@ -669,6 +699,13 @@ static fcm_status krylov_solve(fcm_krylov *ws, method m, fcm_operator_fn A, void
               "%s: not converged in max_iterations = %d: relative residual %.3e > rtol = %.3e "
               "(atol = %.3e)",
               name, sv.o.max_iterations, sv.info.relative_residual, sv.o.rtol, sv.o.atol);
+  if (sv.info.reason == FCM_KRYLOV_STAGNATED)
+    FCM_CHECK(0, ctx, FCM_ERR_NOT_CONVERGED,
+              "%s: stagnated: the smallest residual dropped by less than %g %% in the last %d "
+              "iterations (smallest relative residual %.3e, %.3e after %d iterations, rtol = "
+              "%.3e): the operator is singular, or nearly so, and b is not in its range",
+              name, 100.0 * STAGNATION_DECREASE, sv.o.stagnation_window, sv.best / sv.info.rhs_norm,
+              sv.info.relative_residual, sv.info.iterations, sv.o.rtol);
 cleanup:
   if (sv.info.rhs_norm < 0.0) sv.info.rhs_norm = 0.0;
   sv.info.time = fcm_wtime() - t0;
