@@ -448,7 +448,7 @@ static fcm_status cell_pieces(const build *B, const fcm__embed_cell *cell, fcm__
   fcm__parts *P = ws->parts;
   FCM_TRY(ctx, fcm__embed_cell_parts(ctx, B->geom, B->tree, cell, opt->clip_rtol, opt->sliver_rtol,
                                      ws, P, &sums->counts));
-  FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, cell->lo, cell->hi, &P->tcand));
+  FCM_TRY(ctx, fcm__embed_cut_candidates(ctx, B->cut_tree, cell, &P->tcand));
   if (P->tcand.n > 0) {
     FCM_TRY(ctx, fcm__embed_cell_pieces(ctx, cell, B->cut_tris, B->first_new, P));
     sums->counts.degenerate += !(P->split_error <= DEGENERATE_RTOL * cell->volume);
@@ -882,7 +882,7 @@ static fcm_status cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new)
   for (fcm_index c = 0; c < nc; c++) {
     fcm__embed_cell cell;
     FCM_TRY(ctx, fcm__embed_cell_setup(ctx, mesh, c, B->o->clip_rtol, &cell));
-    FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, cell.lo, cell.hi, &ids));
+    FCM_TRY(ctx, fcm__embed_cut_candidates(ctx, B->cut_tree, &cell, &ids));
     if (ids.n == 0) continue;
     R->reached[c] = 1;
     for (int a = 0; a < npc; a++) /* ids ascending: the earlier cuts' triangles first */
@@ -1198,7 +1198,7 @@ static fcm_status gather_links(const build *B, fcm_cell_rules *R, const cell_out
     if (!B->region[c] || oa->np == 0) continue;
     fcm__embed_cell cell;
     FCM_TRY(ctx, fcm__embed_cell_setup(ctx, mesh, c, B->o->clip_rtol, &cell));
-    const double mtol = 1e-9 * cell.size, atol = 1e-12 * cell.size * cell.size;
+    const double mtol = FCM__EMBED_MATCH_RTOL * cell.size, atol = 1e-12 * cell.size * cell.size;
     for (int f = 0; f < nf; f++) {
       const fcm_index c2 = nbr[(size_t)nf * c + f];
       if (c2 <= c || !B->region[c2] || out[c2].np == 0) continue;

@@ -203,6 +203,16 @@ fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
 
 /* ---------------------------------------------------------------- cutting (pieces.c) */
 
+/* The cuts' tolerance, relative to the cell size: a part vertex this close to a cut triangle's
+ * plane lies on it (the splitting and the connectivity tests share it). */
+#define FCM__EMBED_MATCH_RTOL 1e-9
+
+/* The cut triangles that can reach `cell`: those whose boxes meet the cell's box widened by
+ * twice the cuts' tolerance (a triangle that far outside the corners' box still takes part
+ * in the tests of the cell's parts), into buf (ascending). */
+fcm_status fcm__embed_cut_candidates(fcm_ctx *ctx, const fcm_aabb_tree *cut_tree,
+                                     const fcm__embed_cell *cell, fcm__idbuf *buf);
+
 /* Prepare triangle (a, b, c), with the plane of the triangle ref (9 doubles; NULL: its
  * own) oriented as its own; 0 when it has no area (relative 1e-14 of its longest edge
  * squared): such a triangle separates nothing and is skipped. */

@@ -21,12 +21,22 @@
  * overlap by more than AREA_RTOL x size^2. (Comparing the planes' normals and offsets
  * instead would let a face tilted 1e-6 off a cell face through the origin pass for one lying
  * on it, however far its vertices are.) */
-#define MATCH_RTOL 1e-9
+#define MATCH_RTOL FCM__EMBED_MATCH_RTOL
 #define AREA_RTOL  1e-12
 /* The overlap of two faces is on a cut when its vertices lie within this many times the
  * matching tolerance of a cut triangle: clipping one face by the other's edges places new
  * vertices on segments between points within the tolerance, up to rounding. */
 #define ON_CUT_FACTOR 2.0
+
+fcm_status fcm__embed_cut_candidates(fcm_ctx *ctx, const fcm_aabb_tree *cut_tree,
+                                     const fcm__embed_cell *cell, fcm__idbuf *buf)
+{
+  double lo[3], hi[3];
+  const double w = 2.0 * MATCH_RTOL * cell->size;
+  for (int d = 0; d < 3; d++)
+    lo[d] = cell->lo[d] - w, hi[d] = cell->hi[d] + w;
+  return fcm__geom_tree_query(ctx, cut_tree, lo, hi, buf);
+}
 
 static double dot3(const double a[3], const double b[3])
 {
