@@ -189,18 +189,35 @@ int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__pol
   }
   if (!cap_face) {
     /* Cap: the new edge vertices and the kept on-plane vertices. */
-    int ids[FCM__POLY_MAX_VERTS], k = 0;
+    int ids[FCM__POLY_MAX_VERTS], k = 0, kon = 0;
     for (int i = 0; i < p->nv; i++)
       if (sg[i] == 0) ids[k++] = newid[i];
+    kon = k;
     for (int e = 0; e < ncache; e++)
       ids[k++] = cache[e][2];
     if (k >= 3) {
-      if (out->nf >= FCM__POLY_MAX_FACES || k > FCM__POLY_MAX_FV) goto overflow;
+      if (k > FCM__POLY_MAX_FV) goto overflow;
       sort_cap(out, pl->n, ids, k);
-      out->fn[out->nf] = k;
-      memcpy(out->fv[out->nf], ids, (size_t)k * sizeof ids[0]);
-      out->fp[out->nf] = *pl;
-      out->nf++;
+      /* A cap through vertices taken as on the plane within the tolerance is not quite planar:
+       * stored as its fan triangles (each planar), so that a later split of this part cuts
+       * every face into pieces that add up to it exactly; the two halves of this split get
+       * the same triangles (sort_cap starts both at the same vertex). A cap of new edge
+       * vertices only lies on the plane up to rounding and stays one polygon. */
+      const int ntri = kon > 0 ? k - 2 : 1;
+      if (out->nf + ntri > FCM__POLY_MAX_FACES) goto overflow;
+      for (int j = 0; j < ntri; j++) {
+        if (kon > 0) {
+          out->fn[out->nf] = 3;
+          out->fv[out->nf][0] = ids[0];
+          out->fv[out->nf][1] = ids[j + 1];
+          out->fv[out->nf][2] = ids[j + 2];
+        } else {
+          out->fn[out->nf] = k;
+          memcpy(out->fv[out->nf], ids, (size_t)k * sizeof ids[0]);
+        }
+        out->fp[out->nf] = *pl;
+        out->nf++;
+      }
     }
   }
   if (out->nf < 4) out->nv = out->nf = 0; /* fewer than 4 faces: no volume */
