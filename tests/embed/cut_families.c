@@ -321,6 +321,29 @@ static void setup_destroy(setup *S)
 
 static long long cases_run, cuts_applied, shifted, thin_regions, dust_bodies, stuck;
 
+/* Cases and failed cases per element and family (the campaign's summary). */
+#define NFAM 8
+static const char *const families[NFAM] = {"grid plane",
+                                           "body face",
+                                           "parallel planes",
+                                           "crossing planes",
+                                           "plane through the axis",
+                                           "two planes through the axis",
+                                           "tube plane",
+                                           "other"};
+static long long fam_cases[NELEM][NFAM], fam_failed[NELEM][NFAM];
+
+static void count_case(fcm_element_type type, const char *what, int failed)
+{
+  int t = 0, f = 0;
+  while (t < NELEM - 1 && elements[t] != type)
+    t++;
+  while (f < NFAM - 1 && strcmp(families[f], what))
+    f++;
+  fam_cases[t][f]++;
+  fam_failed[t][f] += failed;
+}
+
 static fcm_index root(fcm_index *uf, fcm_index x)
 {
   while (uf[x] != x)
@@ -622,6 +645,7 @@ static void run_case(const body *b, fcm_element_type type, const setup *S, const
     prev = next;
   }
   fcm_cell_rules_destroy(&owned);
+  count_case(type, what, test_failures_ > failures0);
   if (test_failures_ > failures0)
     for (int k = 0; k < np; k++)
       fprintf(stderr, "  plane %d: point (%.17g, %.17g, %.17g) normal (%.17g, %.17g, %.17g)\n",
@@ -816,6 +840,23 @@ int main(int argc, char **argv)
       }
       for (int b = 0; b < 4; b++)
         setup_destroy(&S[b]);
+    }
+    if (verbose) {
+      printf("%-28s", "family");
+      for (int t = 0; t < NELEM; t++)
+        printf(" %14s", ename(elements[t]));
+      printf("\n");
+      for (int f = 0; f < NFAM; f++) {
+        long long any = 0;
+        for (int t = 0; t < NELEM; t++)
+          any += fam_cases[t][f];
+        if (!any) continue;
+        printf("%-28s", families[f]);
+        for (int t = 0; t < NELEM; t++)
+          printf(" %7lld (%4lld)", fam_cases[t][f], fam_failed[t][f]);
+        printf("\n");
+      }
+      printf("(cases, failed in parentheses)\n");
     }
     if (verbose)
       printf("%lld cases, %lld cuts, %lld shifted, %lld thin reference regions, %lld dust "

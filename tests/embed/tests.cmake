@@ -55,6 +55,6 @@ fcm_add_test(embed_crop tests/embed/crop.c)
 # bodies of an independent reference; the catalogue of configurations that once failed; the
 # long campaign (label slow) runs 20,000 cases per element.
 fcm_add_test(embed_cut_families_catalogue tests/embed/cut_families.c ARGS catalogue)
-fcm_add_test(embed_cut_families tests/embed/cut_families.c ARGS campaign 200 1)
+fcm_add_test(embed_cut_families tests/embed/cut_families.c ARGS campaign 50 1)
 fcm_add_test(embed_cut_families_long tests/embed/cut_families.c ARGS campaign 20000 5
              LABELS slow TIMEOUT 7200)

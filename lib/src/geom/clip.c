@@ -10,6 +10,7 @@
  * ordered by angle around the plane normal. */
 #include "geom/geom_impl.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -189,24 +190,31 @@ int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__pol
   }
   if (!cap_face) {
     /* Cap: the new edge vertices and the kept on-plane vertices. */
-    int ids[FCM__POLY_MAX_VERTS], k = 0, kon = 0;
+    int ids[FCM__POLY_MAX_VERTS], k = 0, kon = 0, cap_bent = 0;
+    double scale = fabs(pl->d);
     for (int i = 0; i < p->nv; i++)
-      if (sg[i] == 0) ids[k++] = newid[i];
+      for (int d = 0; d < 3; d++)
+        scale = fmax(scale, fabs(p->x[i][d]));
+    for (int i = 0; i < p->nv; i++)
+      if (sg[i] == 0) {
+        ids[k++] = newid[i];
+        cap_bent |= fabs(s[i]) > 16.0 * DBL_EPSILON * scale; /* off the plane beyond rounding */
+      }
     kon = k;
     for (int e = 0; e < ncache; e++)
       ids[k++] = cache[e][2];
     if (k >= 3) {
       if (k > FCM__POLY_MAX_FV) goto overflow;
       sort_cap(out, pl->n, ids, k);
-      /* A cap through vertices taken as on the plane within the tolerance is not quite planar:
-       * stored as its fan triangles (each planar), so that a later split of this part cuts
-       * every face into pieces that add up to it exactly; the two halves of this split get
-       * the same triangles (sort_cap starts both at the same vertex). A cap of new edge
-       * vertices only lies on the plane up to rounding and stays one polygon. */
-      const int ntri = kon > 0 ? k - 2 : 1;
+      /* A cap through vertices taken as on the plane within the tolerance (and off it beyond
+       * rounding) is not quite planar: stored as its fan triangles (each planar), so that a
+       * later split of this part cuts every face into pieces that add up to it exactly; the
+       * two halves of this split get the same triangles (sort_cap starts both at the same
+       * vertex). A cap on the plane up to rounding stays one polygon. */
+      const int ntri = kon > 0 && cap_bent ? k - 2 : 1;
       if (out->nf + ntri > FCM__POLY_MAX_FACES) goto overflow;
       for (int j = 0; j < ntri; j++) {
-        if (kon > 0) {
+        if (ntri > 1) {
           out->fn[out->nf] = 3;
           out->fv[out->nf][0] = ids[0];
           out->fv[out->nf][1] = ids[j + 1];
@@ -287,7 +295,10 @@ int fcm__geom_poly_tets(const fcm__poly *p, double *tets, double *vol)
   for (int d = 0; d < 3; d++)
     c[d] /= p->nv;
   const int nt = fan_tets(p, c, -1, tets, vol, &neg);
-  if (neg == 0.0) return nt;
+  double total = 0.0;
+  for (int k = 0; k < nt; k++)
+    total += fabs(vol[k]);
+  if (neg >= -64.0 * DBL_EPSILON * total) return nt; /* none beyond rounding */
   /* A part that the tolerances left slightly non-convex (vertices within the tolerance of a
    * plane taken as on it: a sliver whose faces are not quite planar) can give tets of
    * negative volume from its centroid. Every apex gives the same total (the faces' triangles

@@ -103,7 +103,7 @@ void fcm__geom_idbuf_free(fcm_ctx *ctx, fcm__idbuf *buf);
 /* ---------------------------------------------------------------- convex clipping */
 
 #define FCM__POLY_MAX_VERTS 128
-#define FCM__POLY_MAX_FACES 32
+#define FCM__POLY_MAX_FACES 64
 #define FCM__POLY_MAX_FV    64
 
 /* A half-space {x : n.x <= d} with unit outward normal n. */
