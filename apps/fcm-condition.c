@@ -1,7 +1,8 @@
 /* fcm-condition: the conditioning study of Longva et al. 2020, §5.4 / Fig. 5 (lib/METHOD.md §7):
  * kappa(S A) of a backward-Euler step A = M + dt^2 K(u) on a 4x4x4 grid of [0, 4/3]^3 with
  * the box [0, 1 + eps/3]^3 embedded, for S in {none, Jacobi, Schwarz (clamp and as printed)}
- * with and without quadrature stabilization, plus MINRES iteration counts on the same systems.
+ * and on request the ideal S = P^-1, with and without quadrature stabilization, plus MINRES
+ * iteration counts on the same systems.
  *
  * Setup (paper §5.4): cell size 1/3; the box reaches eps/3 into the last layer, so the corner
  * cell keeps the volume (eps/3)^3 and the smallest volume fraction is phi = eps^3 (the swept
