@@ -88,7 +88,8 @@ int condition_write_png(const config *c, const char *path, const result *res, in
     fprintf(stderr, PROG ": cannot write %s: %s\n", script, strerror(errno));
     return 0;
   }
-  static const char *const colors[PREC_COUNT] = {"#000000", "#1f77b4", "#d62728", "#2ca02c"};
+  static const char *const colors[PREC_COUNT] = {"#000000", "#1f77b4", "#d62728", "#2ca02c",
+                                                 "#9467bd"};
   /* one datablock per (stabilization, element, preconditioner) series with finite values;
    * panels: rows = stabilization settings run, columns = element shapes run */
   int series = 0, ids[2][4][PREC_COUNT], row_on[2] = {0, 0}, col_on[2] = {0, 0};
@@ -141,8 +142,8 @@ int condition_write_png(const config *c, const char *path, const result *res, in
         int e = which == 0 ? e0 : e1;
         if (e < 0) continue;
         /* schwarz-paper under schwarz, wider, so coinciding curves stay visible */
-        static const int order[PREC_COUNT] = {PREC_NONE, PREC_JACOBI, PREC_SCHWARZ_PAPER,
-                                              PREC_SCHWARZ};
+        static const int order[PREC_COUNT] = {PREC_NONE, PREC_JACOBI, PREC_EXACT,
+                                              PREC_SCHWARZ_PAPER, PREC_SCHWARZ};
         for (int q = 0; q < PREC_COUNT; q++) {
           int p = order[q], id = ids[sb][e][p];
           if (id < 0) continue;

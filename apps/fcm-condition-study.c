@@ -14,7 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-const char *const prec_names[PREC_COUNT] = {"none", "jacobi", "schwarz", "schwarz-paper"};
+const char *const prec_names[PREC_COUNT] = {"none", "jacobi", "schwarz", "schwarz-paper", "exact"};
 const char *const tangent_model_names[FCM_FICTITIOUS_MODEL_COUNT + 1] = {"projected", "linear",
                                                                          "exact", NULL};
 
@@ -115,6 +115,7 @@ static fcm_status system_build(fcm_ctx *ctx, const config *c, fcm_mesh *mesh, do
   ro.min_fraction = 0.0;  /* keep every non-empty cell, however small */
   ro.sliver_rtol = 1e-20; /* the corner pieces have ~phi/24 of the cell volume */
   ro.simplify = c->simplify;
+  ro.strength[FCM_RULE_STIFFNESS] = c->stiffness_strength;
   ro.stabilization.mode = alpha > 0.0 ? c->stab_mode : FCM_STABILIZATION_OFF;
   if (alpha > 0.0) ro.stabilization.alpha = alpha;
   double t0 = fcm_wtime();
@@ -247,6 +248,12 @@ done:
   return st;
 }
 
+/* S = P^-1 applied through the Cholesky factor of P (PREC_EXACT). */
+static fcm_status direct_operator(void *user, const double *r, double *z)
+{
+  return fcm_direct_solve(user, r, z);
+}
+
 /* kappa of S A for one preconditioner, and a MINRES solve of A x = A 1. */
 static fcm_status measure(fcm_ctx *ctx, const config *c, const linsys *s, int prec,
                           const double *Ad, double *Sd, double *Bd, double *w, result *r)
@@ -254,6 +261,7 @@ static fcm_status measure(fcm_ctx *ctx, const config *c, const linsys *s, int pr
   fcm_status st = FCM_OK;
   fcm_jacobi *J = NULL;
   fcm_schwarz *P = NULL;
+  fcm_direct *D = NULL;
   fcm_krylov *ws = NULL;
   double *e = NULL, *b = NULL, *x = NULL;
   const fcm_index n = s->n;
@@ -274,6 +282,13 @@ static fcm_status measure(fcm_ctx *ctx, const config *c, const linsys *s, int pr
     r->clamped = si.clamped_eigenvalues;
     Sop = fcm_schwarz_operator;
     Suser = P;
+  } else if (prec == PREC_EXACT) { /* P is SPD: fcm-condition refuses --pc-tangent exact */
+    const fcm_csr *Pm = s->Pf ? s->Pf : s->Af;
+    TRY(fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, Pm, &D));
+    TRY(fcm_direct_analyze(D));
+    TRY(fcm_direct_factor(D, fcm_csr_values_read(Pm)));
+    Sop = direct_operator;
+    Suser = D;
   }
 
   /* spectrum */
@@ -303,7 +318,7 @@ static fcm_status measure(fcm_ctx *ctx, const config *c, const linsys *s, int pr
               sqrt(Sd[i + (size_t)i * n] * Sd[j + (size_t)j * n]) * Ad[i + (size_t)j * n];
       TRY(fcm_dense_spectrum_eval(ctx, ni, Bd, NULL, w, NULL));
     } else {
-      for (size_t p = 0; p < nn; p++) /* symmetrize the rounding of the block sums */
+      for (size_t p = 0; p < nn; p++) /* symmetrize the rounding (block sums, solves) */
         Bd[p] = Sd[p];
       for (fcm_index j = 0; j < n; j++)
         for (fcm_index i = 0; i < n; i++)
@@ -351,6 +366,7 @@ static fcm_status measure(fcm_ctx *ctx, const config *c, const linsys *s, int pr
 done:
   fcm_jacobi_destroy(&J);
   fcm_schwarz_destroy(&P);
+  fcm_direct_destroy(&D);
   fcm_krylov_destroy(&ws);
   free(e);
   free(b);

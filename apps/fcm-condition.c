@@ -1,7 +1,8 @@
 /* fcm-condition: the conditioning study of Longva et al. 2020, §5.4 / Fig. 5 (lib/METHOD.md §7):
  * kappa(S A) of a backward-Euler step A = M + dt^2 K(u) on a 4x4x4 grid of [0, 4/3]^3 with
  * the box [0, 1 + eps/3]^3 embedded, for S in {none, Jacobi, Schwarz (clamp and as printed)}
- * with and without quadrature stabilization, plus MINRES iteration counts on the same systems.
+ * and on request the ideal S = P^-1, with and without quadrature stabilization, plus MINRES
+ * iteration counts on the same systems.
  *
  * Setup (paper §5.4): cell size 1/3; the box reaches eps/3 into the last layer, so the corner
  * cell keeps the volume (eps/3)^3 and the smallest volume fraction is phi = eps^3 (the swept
@@ -80,8 +81,8 @@ static int parse_elements(const char *prog, const char *opt, const char *s, void
 
 static int parse_precs(const char *prog, const char *opt, const char *s, void *dest)
 {
-  static const char *const names[PREC_COUNT + 1] = {"none", "jacobi", "schwarz", "schwarz-paper",
-                                                    NULL};
+  static const char *const names[PREC_COUNT + 1] = {"none",          "jacobi", "schwarz",
+                                                    "schwarz-paper", "exact",  NULL};
   config *c = dest;
   char tok[PREC_COUNT][CLI_TOKEN];
   int n = 0;
@@ -126,7 +127,7 @@ typedef struct seen {
 static const char *const on_off[] = {"off", "on", NULL};
 static const char *const stab_modes[] = {"mass+stiffness", "mass", NULL};
 
-#define NUM_OPTIONS 22
+#define NUM_OPTIONS 23
 static void option_table(config *c, int *stab_mode, seen *g, cli_option t[NUM_OPTIONS])
 {
   const cli_option o[NUM_OPTIONS] = {
@@ -138,10 +139,15 @@ static void option_table(config *c, int *stab_mode, seen *g, cli_option t[NUM_OP
        "(1,1e-4,1e-8) or a log sweep A:B:N             (default 1:1e-12:13)",
        0, 0, 0, NULL, parse_fractions, &g->fractions},
       {"--preconditioners", NULL, CLI_CUSTOM, c, "LIST",
-       "none,jacobi,schwarz,schwarz-paper              (default all)\n"
+       "comma list of none,jacobi,schwarz,schwarz-paper,\n"
+       "exact                                          (default all but exact)\n"
        "schwarz: eigenvalues below eps*lambda_max become\n"
        "1/(eps lambda_max) (authors' code); schwarz-paper:\n"
-       "eps/lambda_max (eq. 14 as printed)",
+       "eps/lambda_max (eq. 14 as printed); exact: S = P^-1\n"
+       "(sparse Cholesky), the ideal preconditioner from P:\n"
+       "kappa(P^-1 A) is the part of kappa(S A) that comes\n"
+       "from A's indefiniteness and that no preconditioner\n"
+       "built from P removes",
        0, 0, 0, NULL, parse_precs, NULL},
       {"--stabilization", NULL, CLI_CUSTOM, c, "LIST",
        "on,off                                         (default on,off)", 0, 0, 0, NULL,
@@ -159,8 +165,12 @@ static void option_table(config *c, int *stab_mode, seen *g, cli_option t[NUM_OP
        "Schwarz eigenvalue threshold in (0,1)          (default 1e-13)", 0, 1,
        CLI_LO_OPEN | CLI_HI_OPEN, NULL, NULL, NULL},
       {"--simplify", NULL, CLI_CHOICE, &c->simplify, "on|off",
-       "simplify cut-cell rules (LP)                   (default on)", 0, 0, 0, on_off, NULL,
+       "simplify cut-cell rules (at most M points)     (default on)", 0, 0, 0, on_off, NULL,
        &g->simplify},
+      {"--stiffness-strength", NULL, CLI_INT, &c->stiffness_strength, "N",
+       "strength of the stiffness rules in [1, 20]     (default the element's)\n"
+       "(tet4 2, tet10 3, hex8 2, hex20 4)",
+       1, 20, 0, NULL, NULL, NULL},
       {"--project", NULL, CLI_CHOICE, &c->project, "on|off",
        "PSD-project the material tangent               (default off)", 0, 0, 0, on_off, NULL, NULL},
       {"--fictitious", NULL, CLI_CHOICE, &c->fictitious, "MODEL",
@@ -254,6 +264,13 @@ static int parse_args(int argc, char **argv, config *c)
     if (!g.simplify) c->simplify = 0;
     if (!g.minres) c->minres_max = 1000;
   }
+  for (int k = 0; k < c->num_precs; k++)
+    if (c->precs[k] == PREC_EXACT && c->pc_tangent == FCM_FICTITIOUS_EXACT && !c->project) {
+      fprintf(stderr, PROG ": --preconditioners exact factors P by Cholesky; with --pc-tangent "
+                           "exact and --project off P = A is indefinite (use --pc-tangent "
+                           "projected or linear, or --project on)\n");
+      return 2;
+    }
   return -1;
 }
 
@@ -268,8 +285,8 @@ int main(int argc, char **argv)
   for (int e = 0; e < 4; e++)
     c.elements[e] = (fcm_element_type)e;
   c.num_elements = 4;
-  c.num_precs = PREC_COUNT;
-  for (int p = 0; p < PREC_COUNT; p++)
+  c.num_precs = PREC_DEFAULT_COUNT;
+  for (int p = 0; p < PREC_DEFAULT_COUNT; p++)
     c.precs[p] = p;
   c.stab_on = c.stab_off = 1;
   c.alpha = 1e-6;
@@ -277,6 +294,7 @@ int main(int argc, char **argv)
   c.theta = 0.5;
   c.epsilon = 1e-13;
   c.simplify = 1;
+  c.stiffness_strength = FCM_DEFAULT;
   c.density = 1000.0;
   c.young = 3e6;
   c.poisson = 0.4;
@@ -307,12 +325,15 @@ int main(int argc, char **argv)
     fcm_ctx_destroy(&ctx);
     return 1;
   }
+  char strength[16] = "default";
+  if (c.stiffness_strength != FCM_DEFAULT)
+    snprintf(strength, sizeof strength, "%d", c.stiffness_strength);
   fprintf(stderr,
           PROG ": %d element(s) x %d fraction(s) x %d stabilization setting(s) x %d "
-               "preconditioner(s); simplification %s, alpha %g, theta %g, epsilon %g, %s tangent, "
-               "u = %g X (1,1,-1)\n",
+               "preconditioner(s); simplification %s, stiffness strength %s, alpha %g, theta %g, "
+               "epsilon %g, %s tangent, u = %g X (1,1,-1)\n",
           c.num_elements, c.num_fractions, c.stab_on + c.stab_off, c.num_precs,
-          c.simplify ? "on" : "off", c.alpha, c.theta, c.epsilon,
+          c.simplify ? "on" : "off", strength, c.alpha, c.theta, c.epsilon,
           c.project ? "projected" : "unprojected", c.u_scale);
   const double t0 = fcm_wtime();
   for (int e = 0; e < c.num_elements && st == FCM_OK; e++) {

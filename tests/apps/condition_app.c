@@ -3,7 +3,10 @@
  * numbers: the measured smallest fraction is eps^3 = the nominal one, kappa = max|l|/min|l|
  * >= 1, 3 x (5^3 - 5^2) free DOFs, no cut cell at fraction 1 (so Schwarz = Jacobi there and
  * stabilization changes nothing), equal Schwarz variants when no eigenvalue was clamped;
- * the PNG is a PNG (when gnuplot is installed); bad options exit 2 and write nothing.
+ * the PNG is a PNG (when gnuplot is installed); the ideal preconditioner P^-1 gives kappa 1
+ * when A = P and keeps the inertia of A; --stiffness-strength changes the cut cells' rules
+ * exactly where the integrand's degree says it must; bad options (an indefinite P for
+ * "exact" among them) exit 2 and write nothing.
  * Usage: app_condition PATH_TO_fcm-condition WORK_DIR */
 #define _POSIX_C_SOURCE 200809L
 #include "condition_csv.h"
@@ -68,6 +71,52 @@ int main(int argc, char **argv)
     TEST_TRUE(!app_exists(tmp));
   }
 
+  /* the ideal preconditioner S = P^-1 ("exact"): with --project on A = P, so kappa = 1 and
+   * MINRES converges at once; with the unprojected A, P^-1 A keeps the inertia of A */
+  static cond_row ex[COND_MAX_ROWS];
+  for (int proj = 0; proj < 2; proj++) {
+    snprintf(cmd, sizeof cmd,
+             "OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 '%s' --quick --stabilization on "
+             "--project %s --preconditioners exact,none --csv '%s' > /dev/null 2>&1",
+             argv[1], proj ? "on" : "off", csv);
+    TEST_TRUE(app_run(cmd) == 0);
+    const int ne = cond_read(csv, ex, COND_MAX_ROWS);
+    TEST_TRUE(ne == 2 * 2 * 2);
+    for (int k = 0; k < ne; k++) {
+      if (strcmp(ex[k].prec, "exact")) continue;
+      const cond_row *none = cond_find(ex, ne, ex[k].element, "none", 1, ex[k].phi_nominal);
+      TEST_TRUE(none != NULL && none->negative == ex[k].negative && ex[k].blocks == 0);
+      if (proj) {
+        TEST_NEAR(ex[k].kappa, 1.0, 1e-6, 0.0);
+        TEST_TRUE(ex[k].negative == 0 && ex[k].iterations <= 2);
+      }
+    }
+  }
+
+  /* --stiffness-strength reaches the rules: for the constant deformation gradient the Hex8
+   * stiffness integrand has total degree 4, so strengths 4 and 5 give the same system;
+   * strength 2 underintegrates the cut cells (not the uncut ones: tensor Gauss) */
+  double kap[3][2];
+  static const int strength[3] = {2, 4, 5};
+  for (int k = 0; k < 3; k++) {
+    snprintf(cmd, sizeof cmd,
+             "OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 '%s' --quick --elements hex8 "
+             "--stabilization on --preconditioners none --stiffness-strength %d --csv '%s' "
+             "> /dev/null 2>&1",
+             argv[1], strength[k], csv);
+    TEST_TRUE(app_run(cmd) == 0);
+    const int ne = cond_read(csv, ex, COND_MAX_ROWS);
+    const cond_row *a = cond_find(ex, ne, "hex8", "none", 1, 1.0),
+                   *b = cond_find(ex, ne, "hex8", "none", 1, 1e-8);
+    TEST_TRUE(ne == 2 && a && b);
+    kap[k][0] = a ? a->kappa : NAN;
+    kap[k][1] = b ? b->kappa : NAN;
+  }
+  TEST_NEAR(kap[0][0], kap[1][0], 1e-8, 0.0);
+  TEST_NEAR(kap[2][0], kap[1][0], 1e-8, 0.0);
+  TEST_NEAR(kap[2][1], kap[1][1], 1e-6, 0.0);
+  TEST_TRUE(fabs(kap[0][1] - kap[1][1]) > 1e-3 * kap[1][1]);
+
   /* usage errors: status 2, nothing written */
   static const char *const bad[] = {"--fractions 0",
                                     "--fractions 1,2",
@@ -76,6 +125,9 @@ int main(int argc, char **argv)
                                     "--preconditioners ilu",
                                     "--stabilization maybe",
                                     "--alpha -1",
+                                    "--stiffness-strength 0",
+                                    "--stiffness-strength 21",
+                                    "--preconditioners exact --pc-tangent exact",
                                     "--bogus 1",
                                     "--csv"};
   for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {

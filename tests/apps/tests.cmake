@@ -51,12 +51,15 @@ fcm_add_test(app_sim_geometry tests/apps/sim_geometry_app.c LABELS app
 # fcm-condition: --quick CSV/PNG format and facts; the Fig. 5 claims (Longva et al. 2020)
 fcm_add_test(app_condition tests/apps/condition_app.c LABELS app
              ARGS $<TARGET_FILE:fcm-condition> ${work})
-# Fig. 5 claims in three parts that ctest runs side by side; claim 5 on every decade
-# 1..1e-12 (13 fractions) instead of every other one under slow
+# Fig. 5 claims in parts that ctest runs side by side, each without and with the default
+# simplification; claim 5 on every other decade without simplification, on the decades in
+# between with it, and on every decade 1..1e-12 (13 fractions) with both under slow
 fcm_add_test(app_condition_claims_1-4 tests/apps/condition_claims.c LABELS app TIMEOUT 1200
              ARGS $<TARGET_FILE:fcm-condition> ${work} 1-4)
 fcm_add_test(app_condition_claims_5 tests/apps/condition_claims.c LABELS app TIMEOUT 1200
              ARGS $<TARGET_FILE:fcm-condition> ${work} 5)
+fcm_add_test(app_condition_claims_5-simplify tests/apps/condition_claims.c LABELS app
+             TIMEOUT 1200 ARGS $<TARGET_FILE:fcm-condition> ${work} 5-simplify)
 fcm_add_test(app_condition_claims_6 tests/apps/condition_claims.c LABELS app TIMEOUT 1200
              ARGS $<TARGET_FILE:fcm-condition> ${work} 6)
 fcm_add_test(app_condition_claims_long tests/apps/condition_claims.c LABELS slow TIMEOUT 3600
