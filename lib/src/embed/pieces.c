@@ -5,11 +5,17 @@
  * connected; the connected components are the cell's material pieces. Each piece then goes
  * through the same tetrahedralize -> map -> simplify -> stabilize path as a cut cell.
  *
- * Robustness: each part vertex is classified once per plane with the part's tolerance
+ * Robustness: each part vertex is classified once per plane with the cuts' tolerance
  * (fcm__geom_poly_clip), and both halves of a split are made from the same signed
- * distances, so the two sides of a new face have bitwise equal vertices. A cut through a
- * node, along an edge or in a face of the background or the embedded mesh needs no special
- * case: a face lying on a triangle separates, wherever it came from. */
+ * distances, so the two sides of a new face have bitwise equal vertices; a cap through
+ * vertices within the tolerance is stored as planar triangles, so later splits conserve the
+ * volume exactly. Where two parts touch (in one cell, or across a cell face), what decides
+ * whether they join is not where each placed the cut (the crossing of a plane nearly
+ * parallel to a face is ill-conditioned: two cells can place it apart) but their sides:
+ * parts whose touching face lies on a cut triangle join only when they lie on the same side
+ * of it (fcm__embed_linked). A cut through a node, along an edge or in a face of the
+ * background or the embedded mesh needs no special case: a face lying on a triangle
+ * separates, wherever it came from. */
 #include "embed/embed_impl.h"
 
 #include <math.h>
