@@ -387,6 +387,25 @@ static fcm_index *space_bodies(const fcm_space *sp, int *nb)
   return num;
 }
 
+/* The side range [*lo, *hi] of plane pl over the authentic stiffness points of piece p. */
+static void piece_range(const fcm_mesh *mesh, const fcm_cell_rules *r, fcm_index p, const plane *pl,
+                        double *lo, double *hi)
+{
+  int n;
+  const double *pts, *w;
+  const unsigned char *fl;
+  double X[3 * 27], x[3];
+  const fcm_element_type type = fcm_mesh_element_type(mesh);
+  fcm_mesh_cell_coords(mesh, fcm_cell_rules_piece_cell(r, p), X);
+  *lo = HUGE_VAL, *hi = -HUGE_VAL;
+  TEST_OK(ctx, fcm_cell_rules_get_piece(r, p, FCM_RULE_STIFFNESS, &n, &pts, &w, &fl));
+  for (int q = 0; q < n; q++) {
+    if (fl[q]) continue;
+    fcm_element_map(type, X, pts + 3 * q, x);
+    *lo = fmin(*lo, side(pl, x)), *hi = fmax(*hi, side(pl, x));
+  }
+}
+
 /* Apply the cuts pl[0 .. np) one after the other to setup S and check every cut. */
 static void run_case(const body *b, fcm_element_type type, const setup *S, const plane *given,
                      int np, const char *what)
@@ -459,27 +478,17 @@ static void run_case(const body *b, fcm_element_type type, const setup *S, const
       fcm_index fe, fp;
       const fcm_index ne = fcm_space_cell_elements(sp, c, &fe);
       fcm_cell_rules_cell_pieces(next, c, &fp);
-      fcm_mesh_cell_coords(S->mesh, c, X);
       for (fcm_index j = 0; j < ne; j++) {
-        int n;
-        const double *pts, *w;
-        const unsigned char *fl;
-        double x[3];
         /* a fragment all of whose copies are tiny moves with the largest copies at its nodes
          * (fcm_space_options.constrain_ratio): it belongs to no side of its own */
         if (fcm_space_element_constrained(sp, fe + j) > 0) {
           stuck++;
           continue;
         }
-        TEST_OK(ctx, fcm_cell_rules_get_piece(next, fp + j, FCM_RULE_STIFFNESS, &n, &pts, &w, &fl));
-        for (int q = 0; q < n; q++) {
-          if (fl[q]) continue;
-          fcm_element_map(type, X, pts + 3 * q, x);
-          for (int i = 0; i <= k; i++) {
-            const double s = side(pl + i, x);
-            double *r = range[eb[fe + j]][i];
-            r[0] = fmin(r[0], s), r[1] = fmax(r[1], s);
-          }
+        for (int i = 0; i <= k; i++) {
+          double lo, hi, *r = range[eb[fe + j]][i];
+          piece_range(S->mesh, next, fp + j, pl + i, &lo, &hi);
+          r[0] = fmin(r[0], lo), r[1] = fmax(r[1], hi);
         }
       }
     }
@@ -491,21 +500,8 @@ static void run_case(const body *b, fcm_element_type type, const setup *S, const
         fcm_index fe, fp;
         const fcm_index nce = fcm_space_cell_elements(sp, c, &fe);
         fcm_cell_rules_cell_pieces(next, c, &fp);
-        fcm_mesh_cell_coords(S->mesh, c, X);
-        for (fcm_index j = 0; j < nce; j++) {
-          int n;
-          const double *pts, *w;
-          const unsigned char *fl;
-          double x[3];
-          fcm_cell_rules_get_piece(next, fp + j, FCM_RULE_STIFFNESS, &n, &pts, &w, &fl);
-          elo[fe + j] = HUGE_VAL, ehi[fe + j] = -HUGE_VAL;
-          for (int q = 0; q < n; q++) {
-            if (fl[q]) continue;
-            fcm_element_map(type, X, pts + 3 * q, x);
-            elo[fe + j] = fmin(elo[fe + j], side(pl + k, x));
-            ehi[fe + j] = fmax(ehi[fe + j], side(pl + k, x));
-          }
-        }
+        for (fcm_index j = 0; j < nce; j++)
+          piece_range(S->mesh, next, fp + j, pl + k, elo + fe + j, ehi + fe + j);
       }
       for (fcm_index e = 0; e < ne; e++)
         for (fcm_index f = e + 1; f < ne; f++) {
@@ -527,21 +523,8 @@ static void run_case(const body *b, fcm_element_type type, const setup *S, const
       const fcm_index *L = fcm_cell_rules_links(next);
       for (fcm_index l = 0; l < fcm_cell_rules_num_links(next); l++) {
         double r[2][2];
-        for (int e = 0; e < 2; e++) {
-          const fcm_index p = L[2 * l + e], c = fcm_cell_rules_piece_cell(next, p);
-          int n;
-          const double *pts, *w;
-          const unsigned char *fl;
-          double x[3];
-          fcm_mesh_cell_coords(S->mesh, c, X);
-          fcm_cell_rules_get_piece(next, p, FCM_RULE_STIFFNESS, &n, &pts, &w, &fl);
-          r[e][0] = HUGE_VAL, r[e][1] = -HUGE_VAL;
-          for (int q = 0; q < n; q++) {
-            if (fl[q]) continue;
-            fcm_element_map(type, X, pts + 3 * q, x);
-            r[e][0] = fmin(r[e][0], side(pl + k, x)), r[e][1] = fmax(r[e][1], side(pl + k, x));
-          }
-        }
+        for (int e = 0; e < 2; e++)
+          piece_range(S->mesh, next, L[2 * l + e], pl + k, &r[e][0], &r[e][1]);
         if ((r[0][0] > 0.0 && r[1][1] < 0.0) || (r[0][1] < 0.0 && r[1][0] > 0.0))
           printf("  link %lld - %lld joins sides (%.3g .. %.3g) and (%.3g .. %.3g)\n",
                  (long long)L[2 * l], (long long)L[2 * l + 1], r[0][0], r[0][1], r[1][0], r[1][1]);
@@ -552,18 +535,9 @@ static void run_case(const body *b, fcm_element_type type, const setup *S, const
         fcm_index fe, fp;
         const fcm_index ne = fcm_space_cell_elements(sp, c, &fe);
         fcm_cell_rules_cell_pieces(next, c, &fp);
-        fcm_mesh_cell_coords(S->mesh, c, X);
         for (fcm_index j = 0; j < ne; j++) {
-          int n;
-          const double *pts, *w;
-          const unsigned char *fl;
-          double x[3], lo = HUGE_VAL, hi = -HUGE_VAL;
-          fcm_cell_rules_get_piece(next, fp + j, FCM_RULE_STIFFNESS, &n, &pts, &w, &fl);
-          for (int q = 0; q < n; q++) {
-            if (fl[q]) continue;
-            fcm_element_map(type, X, pts + 3 * q, x);
-            lo = fmin(lo, side(pl + k, x)), hi = fmax(hi, side(pl + k, x));
-          }
+          double lo, hi;
+          piece_range(S->mesh, next, fp + j, pl + k, &lo, &hi);
           printf("  cell %lld piece %lld volume %.3g body %lld side %.3g .. %.3g\n", (long long)c,
                  (long long)(fp + j), fcm_cell_rules_piece_volume(next, fp + j),
                  (long long)eb[fe + j], lo, hi);
