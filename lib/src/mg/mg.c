@@ -108,13 +108,19 @@ struct fcm_mg {
   mg_level lev[32];
   fcm_direct *direct;
   double *spa;             /* dense accumulators, spa_len per thread */
-  fcm_index *mark;         /* positions, max columns */
   unsigned char *cut_cell; /* per mesh cell: cut by the geometry or a cut surface, or split */
   fcm_index blk_max;       /* largest block of the block smoothers */
   int nt;                  /* threads at creation: the most any parallel region uses */
   double *blk_r, *blk_dx;  /* blk_max entries each, per thread */
   fcm_index spa_len;       /* entries of one thread's dense accumulator */
 };
+
+/* Threads of a parallel region: the caller's, at most those of the creation (scratch). */
+static int team(const fcm_mg *m)
+{
+  const int t = omp_get_max_threads();
+  return t < m->nt ? t : m->nt;
+}
 
 fcm_mg_options fcm_mg_options_default(void)
 {
@@ -215,7 +221,6 @@ void fcm_mg_destroy(fcm_mg **mg)
   fcm__free(m->ctx, m->blk_r);
   fcm__free(m->ctx, m->blk_dx);
   fcm__free(m->ctx, m->spa);
-  fcm__free(m->ctx, m->mark);
   fcm__free(m->ctx, m);
   *mg = NULL;
 }
@@ -825,34 +830,41 @@ cleanup:
 
 /* ------------------------------------------------------------------ Galerkin product */
 
-/* Symbolic C = A B (rows of A, columns of B: ncol), sorted columns. mark: ncol entries. */
-static fcm_status spgemm_symbolic(fcm_ctx *ctx, fcm_index nrow, const fcm_index *Ap, const int *Ac,
-                                  const fcm_index *Bp, const int *Bc, fcm_index ncol,
-                                  fcm_index *mark, fcm_index **Cp_out, int **Cc_out)
+/* Symbolic C = A B (rows of A, columns of B: ncol), sorted columns; rows shared by up to nt
+ * threads (each row's columns are found and sorted by one thread). */
+static fcm_status spgemm_symbolic(fcm_ctx *ctx, int nt, fcm_index nrow, const fcm_index *Ap,
+                                  const int *Ac, const fcm_index *Bp, const int *Bc, fcm_index ncol,
+                                  fcm_index **Cp_out, int **Cc_out)
 {
   fcm_status st = FCM_OK;
-  fcm_index *Cp = NULL;
+  fcm_index *Cp = NULL, *mark = NULL;
   int *Cc = NULL;
   FCM_ALLOC(ctx, nrow + 1, Cp);
-  for (fcm_index j = 0; j < ncol; j++)
+  FCM_ALLOC_RAW(ctx, (size_t)nt * (size_t)ncol + 1, mark); /* per thread: ncol entries */
+  for (size_t j = 0; j < (size_t)nt * (size_t)ncol; j++)
     mark[j] = -1;
   for (int pass = 0; pass < 2; pass++) {
-    for (fcm_index i = 0; i < nrow; i++) {
-      fcm_index cnt = 0, base = pass ? Cp[i] : 0;
-      for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
-        const fcm_index k = Ac[p];
-        for (fcm_index q = Bp[k]; q < Bp[k + 1]; q++) {
-          const fcm_index j = Bc[q];
-          if (mark[j] == i + pass * nrow) continue;
-          mark[j] = i + pass * nrow;
-          if (pass) Cc[base + cnt] = (int)j;
-          cnt++;
+#pragma omp parallel num_threads(nt) if (nrow > 4096)
+    {
+      fcm_index *mk = mark + (size_t)omp_get_thread_num() * (size_t)ncol;
+#pragma omp for schedule(dynamic, 256)
+      for (fcm_index i = 0; i < nrow; i++) {
+        fcm_index cnt = 0, base = pass ? Cp[i] : 0;
+        for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
+          const fcm_index k = Ac[p];
+          for (fcm_index q = Bp[k]; q < Bp[k + 1]; q++) {
+            const fcm_index j = Bc[q];
+            if (mk[j] == i + pass * nrow) continue;
+            mk[j] = i + pass * nrow;
+            if (pass) Cc[base + cnt] = (int)j;
+            cnt++;
+          }
         }
+        if (pass)
+          qsort(Cc + base, (size_t)cnt, sizeof *Cc, cmp_int);
+        else
+          Cp[i + 1] = cnt;
       }
-      if (pass)
-        qsort(Cc + base, (size_t)cnt, sizeof *Cc, cmp_int);
-      else
-        Cp[i + 1] = cnt;
     }
     if (!pass) {
       for (fcm_index i = 0; i < nrow; i++)
@@ -865,6 +877,7 @@ static fcm_status spgemm_symbolic(fcm_ctx *ctx, fcm_index nrow, const fcm_index 
 cleanup:
   fcm__free(ctx, Cp);
   fcm__free(ctx, Cc);
+  fcm__free(ctx, mark);
   return st;
 }
 
@@ -946,7 +959,7 @@ static fcm_status galerkin_values(fcm_mg *m, int l)
   const int *cc = fcm_csr_col_idx(C->Aown);
   fcm_index nnz = 0, bad = C->n;
   fcm_csr_get_size(A, NULL, NULL, &nnz);
-#pragma omp parallel num_threads(m->nt) if (nnz >= MG_PARALLEL_NNZ)
+#pragma omp parallel num_threads(team(m)) if (nnz >= MG_PARALLEL_NNZ)
   {
     double *spa = m->spa + (size_t)omp_get_thread_num() * (size_t)m->spa_len;
     spgemm_numeric(F->n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), fcm_csr_values_read(A), F->P_ptr,
@@ -1063,34 +1076,24 @@ cleanup:
  * the threads' work; fewer when the coupling reaches far in the sequence. */
 #define MG_SLABS 16
 
-/* The slab order (see slab_order) of n items with the symmetric adjacency (adj_ptr, adj) and
- * per-item work (>= 0), in the sequence `seq` (n items; NULL: ascending), cut so that slab
- * s + 2 starts past every item that an item of slab s is adjacent to. thick = 0: slabs of at
+/* The slab order (see slab_order) of n items with per-item work (>= 0), in the sequence `seq`
+ * (n items; NULL: ascending), given reach[t] >= t: the furthest sequence position of an item
+ * adjacent (symmetrically) to the item at position t. Cut so that slab s + 2 starts past every
+ * position that slab s reaches. thick = 0: slabs of at
  * least total / MG_SLABS work each, colour 0 first. thick > 0: `thick` slabs of about equal
  * work (colour 0) separated by thin slabs just wide enough to keep them apart (colour 1,
  * swept first), or one slab when the thin ones would hold more than a quarter of the work
  * (coupling that reaches far in the sequence). */
 static fcm_status slabs_create(fcm_ctx *ctx, fcm_index n, const fcm_index *seq,
-                               const fcm_index *adj_ptr, const int *adj, const double *work,
-                               int thick, slab_order *S)
+                               const fcm_index *reach, const double *work, int thick, slab_order *S)
 {
   fcm_status st = FCM_OK;
-  fcm_index *pos = NULL, *reach = NULL, *cut = NULL;
+  fcm_index *cut = NULL;
   slabs_free(ctx, S);
-  FCM_ALLOC_RAW(ctx, n + 1, pos);
-  FCM_ALLOC_RAW(ctx, n + 1, reach);
   FCM_ALLOC_RAW(ctx, n + 2, cut);
   double total = 0.0;
-  for (fcm_index t = 0; t < n; t++) {
-    pos[seq ? seq[t] : t] = t;
+  for (fcm_index t = 0; t < n; t++)
     total += work[t];
-  }
-  for (fcm_index t = 0; t < n; t++) { /* the furthest position an item at t is adjacent to */
-    const fcm_index i = seq ? seq[t] : t;
-    reach[t] = t;
-    for (fcm_index p = adj_ptr[i]; p < adj_ptr[i + 1]; p++)
-      reach[t] = FCM_MAX(reach[t], pos[adj[p]]);
-  }
   /* cut[s]: the first position of slab s; far: 1 + the reach of the slab before the last */
   const double target = thick > 0 ? total / thick : total / MG_SLABS;
   fcm_index ns = 0, t = 0, far = 0;
@@ -1134,8 +1137,6 @@ static fcm_status slabs_create(fcm_ctx *ctx, fcm_index n, const fcm_index *seq,
   }
 cleanup:
   if (st) slabs_free(ctx, S);
-  fcm__free(ctx, pos);
-  fcm__free(ctx, reach);
   fcm__free(ctx, cut);
   return st;
 }
@@ -1155,20 +1156,28 @@ static fcm_status row_slabs(fcm_mg *m, mg_level *L)
   fcm_ctx *ctx = m->ctx;
   const fcm_csr *A = level_matrix(L);
   const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
   double *work = NULL;
+  fcm_index *reach = NULL;
   FCM_ALLOC_RAW(ctx, L->n + 1, work);
-  for (fcm_index i = 0; i < L->n; i++)
+  FCM_ALLOC_RAW(ctx, L->n + 1, reach);
+  for (fcm_index i = 0; i < L->n; i++) {
     work[i] = (double)(rp[i + 1] - rp[i]);
-  FCM_TRY(ctx, slabs_create(ctx, L->n, NULL, rp, fcm_csr_col_idx(A), work, MG_ROW_SLABS_THICK,
-                            &L->rows));
+    reach[i] = i;
+    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+      reach[i] = FCM_MAX(reach[i], ci[p]);
+  }
+  FCM_TRY(ctx, slabs_create(ctx, L->n, NULL, reach, work, MG_ROW_SLABS_THICK, &L->rows));
 cleanup:
   fcm__free(ctx, work);
+  fcm__free(ctx, reach);
   return st;
 }
 
-/* The blocks of a level's block smoother in slabs: blocks j and k are adjacent when a DOF of
- * one couples (or is) a DOF of the other, i.e. when one's update reads or writes what the
- * other writes; work: the residual's and the block product's entries. */
+/* The blocks of a level's block smoother in slabs, in the sequence of their first DOFs (ties
+ * by index), so that it follows the rows. Blocks j and k are adjacent when a DOF of one couples
+ * with (or is) a DOF of the other, i.e. when one's update reads what the other writes; work:
+ * the residual's and the block product's entries. */
 static fcm_status block_slabs(fcm_mg *m, mg_level *L)
 {
   fcm_status st = FCM_OK;
@@ -1177,69 +1186,8 @@ static fcm_status block_slabs(fcm_mg *m, mg_level *L)
   const fcm_index *rp = fcm_csr_row_ptr(A);
   const int *ci = fcm_csr_col_idx(A);
   const fcm_index nb = fcm__schwarz_num_blocks(L->blk), n = L->n;
-  fcm_index *rb_ptr = NULL, *rb = NULL, *bmark = NULL, *rmark = NULL, *adj_ptr = NULL;
-  fcm_index *rows = NULL, *pairs = NULL, *seq = NULL;
-  int *adj = NULL;
+  fcm_index *pairs = NULL, *seq = NULL, *last = NULL, *reach = NULL;
   double *work = NULL;
-  FCM_CHECK(nb <= INT_MAX, ctx, FCM_ERR_UNSUPPORTED, "mg: %lld blocks on level %d exceed %d",
-            (long long)nb, (int)(L - m->lev), INT_MAX);
-  /* the blocks of each row, CSR */
-  FCM_ALLOC(ctx, n + 1, rb_ptr);
-  for (fcm_index k = 0; k < nb; k++) {
-    const fcm_index *d = NULL;
-    const double *S = NULL;
-    const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
-    for (int i = 0; i < bm; i++)
-      rb_ptr[d[i] + 1]++;
-  }
-  for (fcm_index i = 0; i < n; i++)
-    rb_ptr[i + 1] += rb_ptr[i];
-  FCM_ALLOC_RAW(ctx, rb_ptr[n] + 1, rb);
-  FCM_ALLOC(ctx, n + 1, rmark); /* rmark[i] == k + 1: row i seen for block k */
-  for (fcm_index k = 0; k < nb; k++) {
-    const fcm_index *d = NULL;
-    const double *S = NULL;
-    const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
-    for (int i = 0; i < bm; i++)
-      rb[rb_ptr[d[i]] + rmark[d[i]]++] = k; /* rmark counts here, reset below */
-  }
-  memset(rmark, 0, sizeof *rmark * (size_t)(n + 1));
-  FCM_ALLOC(ctx, nb + 1, bmark); /* bmark[j] == k + 1: block j listed for block k */
-  FCM_ALLOC(ctx, nb + 1, adj_ptr);
-  FCM_ALLOC_RAW(ctx, nb + 1, work);
-  FCM_ALLOC_RAW(ctx, n + 1, rows);
-  for (int pass = 0; pass < 2; pass++) {
-    if (pass) {
-      for (fcm_index k = 0; k < nb; k++)
-        adj_ptr[k + 1] += adj_ptr[k];
-      FCM_ALLOC_RAW(ctx, adj_ptr[nb] + 1, adj);
-      memset(bmark, 0, sizeof *bmark * (size_t)(nb + 1));
-      memset(rmark, 0, sizeof *rmark * (size_t)(n + 1));
-    }
-    for (fcm_index k = 0; k < nb; k++) {
-      const fcm_index *d = NULL;
-      const double *S = NULL;
-      const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
-      fcm_index nr = 0, cnt = 0, entries = 0;
-      bmark[k] = k + 1; /* not adjacent to itself */
-      for (int i = 0; i < bm; i++) {
-        entries += rp[d[i] + 1] - rp[d[i]];
-        for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++)
-          if (rmark[ci[p]] != k + 1) rmark[ci[p]] = k + 1, rows[nr++] = ci[p];
-      }
-      for (fcm_index t = 0; t < nr; t++)
-        for (fcm_index q = rb_ptr[rows[t]]; q < rb_ptr[rows[t] + 1]; q++) {
-          const fcm_index j = rb[q];
-          if (bmark[j] == k + 1) continue;
-          bmark[j] = k + 1;
-          if (pass) adj[adj_ptr[k] + cnt] = (int)j;
-          cnt++;
-        }
-      if (!pass) adj_ptr[k + 1] = cnt;
-      work[k] = (double)entries + (double)bm * (double)bm;
-    }
-  }
-  /* the sequence: blocks by their first DOF (ties by index), so that it follows the rows */
   FCM_ALLOC_RAW(ctx, 2 * nb + 1, pairs);
   for (fcm_index k = 0; k < nb; k++) {
     const fcm_index *d = NULL;
@@ -1252,20 +1200,41 @@ static fcm_status block_slabs(fcm_mg *m, mg_level *L)
   }
   if (nb > 0) qsort(pairs, (size_t)nb, 2 * sizeof *pairs, cmp_pair);
   FCM_ALLOC_RAW(ctx, nb + 1, seq);
-  for (fcm_index k = 0; k < nb; k++)
-    seq[k] = pairs[2 * k + 1];
-  FCM_TRY(ctx, slabs_create(ctx, nb, seq, adj_ptr, adj, work, 0, &L->blocks));
+  FCM_ALLOC_RAW(ctx, nb + 1, reach);
+  FCM_ALLOC_RAW(ctx, nb + 1, work);
+  FCM_ALLOC_RAW(ctx, n + 1, last);
+  for (fcm_index i = 0; i < n; i++)
+    last[i] = -1;
+  for (fcm_index t = 0; t < nb; t++) { /* last[i]: the last position of a block holding row i */
+    const fcm_index *d = NULL;
+    const double *S = NULL;
+    seq[t] = pairs[2 * t + 1];
+    const int bm = fcm__schwarz_block(L->blk, seq[t], &d, &S);
+    for (int i = 0; i < bm; i++)
+      last[d[i]] = t;
+  }
+#pragma omp parallel for num_threads(team(m)) schedule(static) if (nb > 1024)
+  for (fcm_index t = 0; t < nb; t++) {
+    const fcm_index *d = NULL;
+    const double *S = NULL;
+    const fcm_index k = seq[t];
+    const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
+    fcm_index r = t, entries = 0;
+    for (int i = 0; i < bm; i++) {
+      entries += rp[d[i] + 1] - rp[d[i]];
+      for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++)
+        r = FCM_MAX(r, last[ci[p]]);
+    }
+    reach[t] = r;
+    work[k] = (double)entries + (double)bm * (double)bm;
+  }
+  FCM_TRY(ctx, slabs_create(ctx, nb, seq, reach, work, 0, &L->blocks));
 cleanup:
-  fcm__free(ctx, rb_ptr);
-  fcm__free(ctx, rb);
-  fcm__free(ctx, bmark);
-  fcm__free(ctx, rmark);
-  fcm__free(ctx, adj_ptr);
-  fcm__free(ctx, adj);
-  fcm__free(ctx, work);
-  fcm__free(ctx, rows);
   fcm__free(ctx, pairs);
   fcm__free(ctx, seq);
+  fcm__free(ctx, last);
+  fcm__free(ctx, reach);
+  fcm__free(ctx, work);
   return st;
 }
 
@@ -1499,7 +1468,6 @@ fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
     maxn = FCM_MAX(maxn, m->lev[l].n);
   m->spa_len = maxn + 1;
   FCM_ALLOC(ctx, (size_t)m->nt * (size_t)m->spa_len, m->spa);
-  FCM_ALLOC(ctx, maxn + 1, m->mark);
   for (int l = 0; l < m->nlev; l++) {
     mg_level *L = &m->lev[l];
     FCM_ALLOC(ctx, L->n + 1, L->x);
@@ -1508,13 +1476,13 @@ fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
     if (l + 1 < m->nlev) {
       mg_level *C = &m->lev[l + 1];
       const fcm_csr *Af = level_matrix(L);
-      FCM_TRY(ctx, spgemm_symbolic(ctx, L->n, fcm_csr_row_ptr(Af), fcm_csr_col_idx(Af), L->P_ptr,
-                                   L->P_col, C->n, m->mark, &L->AP_ptr, &L->AP_col));
+      FCM_TRY(ctx, spgemm_symbolic(ctx, team(m), L->n, fcm_csr_row_ptr(Af), fcm_csr_col_idx(Af),
+                                   L->P_ptr, L->P_col, C->n, &L->AP_ptr, &L->AP_col));
       FCM_ALLOC(ctx, L->AP_ptr[L->n] + 1, L->AP_val);
       fcm_index *cp = NULL;
       int *cc = NULL;
-      FCM_TRY(ctx, spgemm_symbolic(ctx, C->n, L->R_ptr, L->R_col, L->AP_ptr, L->AP_col, C->n,
-                                   m->mark, &cp, &cc));
+      FCM_TRY(ctx, spgemm_symbolic(ctx, team(m), C->n, L->R_ptr, L->R_col, L->AP_ptr, L->AP_col,
+                                   C->n, &cp, &cc));
       st = add_diagonal(ctx, C->n, &cp, &cc); /* rows of empty columns */
       if (st == FCM_OK) st = fcm_csr_create(ctx, C->n, C->n, cp, cc, FCM_CSR_SYMMETRIC, &C->Aown);
       fcm__free(ctx, cp);
@@ -1555,7 +1523,7 @@ fcm_status fcm_mg_setup(fcm_mg *m)
     const double *v = fcm_csr_values_read(L->A);
     const fcm_index n = L->n;
     fcm_index bad = n; /* the first row whose elimination changed */
-#pragma omp parallel for num_threads(m->nt) schedule(static) reduction(min : bad) if (n > 4096)
+#pragma omp parallel for num_threads(team(m)) schedule(static) reduction(min : bad) if (n > 4096)
     for (fcm_index i = 0; i < n; i++) {
       int off = 0;
       for (fcm_index p = rp[i]; p < rp[i + 1] && !off; p++)
@@ -1795,12 +1763,12 @@ static fcm_status cycle(fcm_mg *m, int l, const double *b, double *x)
   fcm_index nnz = 0;
   fcm_csr_get_size(level_matrix(L), NULL, NULL, &nnz);
   const int par = nnz >= MG_PARALLEL_NNZ;
-#pragma omp parallel num_threads(m->nt) if (par)
+#pragma omp parallel num_threads(team(m)) if (par)
   pre_smooth(m, L, C, b, x);
   const int gamma = l + 2 == m->nlev ? 1 : m->opts.cycle_index; /* the coarsest is exact */
   for (int g = 0; g < gamma; g++)
     if ((st = cycle(m, l + 1, C->b, C->x))) return st;
-#pragma omp parallel num_threads(m->nt) if (par)
+#pragma omp parallel num_threads(team(m)) if (par)
   post_smooth(m, L, C, b, x);
   return st;
 }
@@ -1966,6 +1934,7 @@ fcm_status fcm__mg_transfers_create(fcm_ctx *ctx, const fcm_space *space,
   m->opts = fcm_mg_options_default();
   m->opts.max_levels = max_levels;
   m->opts.coarse_dofs = coarse_dofs;
+  m->nt = FCM_MAX(omp_get_max_threads(), 1);
   FCM_TRY(ctx, build_hierarchy(m, NULL, constrained ? constrained : none));
   t = fcm__calloc(ctx, 1, sizeof *t);
   FCM_CHECK(t, ctx, FCM_ERR_ALLOC, "mg_transfers: out of memory");
