@@ -30,7 +30,7 @@
 #include <unistd.h>
 
 #define MAX_ROUNDS 15
-#define MAX_BUSY 64
+#define MAX_BUSY   64
 
 enum { PH_CREATE, PH_MG, PH_SCHWARZ, PH_COUNT };
 static const char *const PH_NAME[PH_COUNT] = {"multigrid hierarchy (fcm_mg_create)",
@@ -214,8 +214,7 @@ int main(int argc, char **argv)
 
   unsigned char *flag = calloc((size_t)nc + 1, 1);
   for (fcm_index k = 0; k < nc; k++)
-    flag[k] = fcm_space_cell_active(B.space, k) &&
-              fcm_cell_rules_class(rules, k) == FCM_CELL_CUT &&
+    flag[k] = fcm_space_cell_active(B.space, k) && fcm_cell_rules_class(rules, k) == FCM_CELL_CUT &&
               fcm_cell_rules_volume_fraction(rules, k) < 0.5;
   fcm_index nb = 0, nd = 0;
   TEST_OK(B.ctx, fcm_space_cell_blocks(B.space, flag, &nb, &nd, NULL, NULL));
@@ -267,8 +266,9 @@ int main(int argc, char **argv)
     printf("  round %d:\n", r + 1);
     for (int ph = 0; ph < nph; ph++) {
       ratio[ph][r] = wall[ph][1][r] / wall[ph][0][r];
-      printf("    %-38s alone %7.3f s (%6.3f s CPU), loaded %7.3f s (%6.3f s CPU): %4.1fx", PH_NAME[ph],
-             wall[ph][0][r], cpu[ph][0][r], wall[ph][1][r], cpu[ph][1][r], ratio[ph][r]);
+      printf("    %-38s alone %7.3f s (%6.3f s CPU), loaded %7.3f s (%6.3f s CPU): %4.1fx",
+             PH_NAME[ph], wall[ph][0][r], cpu[ph][0][r], wall[ph][1][r], cpu[ph][1][r],
+             ratio[ph][r]);
       if (ph != PH_CREATE) printf(", %d iterations", B.iterations[ph][0]);
       printf("\n");
       if (ph != PH_CREATE) {

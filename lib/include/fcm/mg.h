@@ -19,8 +19,14 @@ extern "C" {
 
 /** The smoother of every level but the coarsest. */
 typedef enum fcm_mg_smoother {
-  /** Symmetric Gauss-Seidel (SSOR with omega): a forward then a backward sweep in row order;
-   * sequential, so bitwise independent of the thread count. */
+  /** Symmetric Gauss-Seidel (SSOR with omega): a forward then a backward sweep in a fixed
+   * order of the rows: each level's rows in two ranges and the thin range between them that
+   * keeps them apart (rows couple only within a range or with a neighbouring one); a forward
+   * sweep runs the thin range, then the two others in parallel (each in row order), the
+   * backward sweep the reverse. The order depends on the matrix pattern only, so the result
+   * is bitwise independent of the thread count. Rows that couple far apart in row order
+   * (Hex20's finest level numbers its corner nodes first) form one range, swept
+   * sequentially. */
   FCM_MG_SMOOTHER_SGS = 0,
   /** Damped Jacobi x += omega D^{-1} (b - A x); rows in parallel, deterministic. */
   FCM_MG_SMOOTHER_JACOBI = 1,
@@ -53,9 +59,12 @@ typedef struct fcm_mg_options {
                                  >= 1 (default 2000); that level is solved by CHOLMOD */
   int block_smoothing;      /**< 1 (default): smooth blocks of DOFs where cells hold little
                                  material, after the pre-smoothing and before the
-                                 post-smoothing (a symmetric block Gauss-Seidel sweep,
-                                 sequential; each block inverted by the clamped eigen-inverse
-                                 of the Schwarz preconditioner, fcm/solve.h). Finest level: the
+                                 post-smoothing (a symmetric block Gauss-Seidel sweep in a
+                                 fixed order: the blocks by their first DOF, cut into up to
+                                 16 runs whose even and odd runs each share the threads, as
+                                 the SGS smoother's ranges; each block inverted by the
+                                 clamped eigen-inverse of the Schwarz preconditioner,
+                                 fcm/solve.h). Finest level: the
                                  DOFs around each grid vertex of a cut cell (the copies whose
                                  support lies in the vertex's 8 cells: its own and, on Hex20,
                                  the mid-edge nodes' at it; de Prenter et al. 2020), then all

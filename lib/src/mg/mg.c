@@ -1968,3 +1968,109 @@ cleanup:
   fcm__free(ctx, none);
   return st;
 }
+
+/* ------------------------------------------------------------------ slab check */
+
+/* Slab of each item (-1: none; FCM_ERR_INTERNAL when an item is listed twice). */
+static fcm_status slab_of_items(fcm_ctx *ctx, const slab_order *S, fcm_index n, int level,
+                                const char *what, fcm_index **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *of = NULL;
+  FCM_ALLOC_RAW(ctx, n + 1, of);
+  for (fcm_index i = 0; i < n; i++)
+    of[i] = -1;
+  for (fcm_index k = 0; k < S->nslab; k++)
+    for (fcm_index q = S->ptr[k]; q < S->ptr[k + 1]; q++) {
+      const fcm_index i = S->item[q];
+      FCM_CHECK(i >= 0 && i < n && of[i] < 0, ctx, FCM_ERR_INTERNAL,
+                "mg: level %d: %s %lld listed twice or out of range [0, %lld) (slab %lld)", level,
+                what, (long long)i, (long long)n, (long long)k);
+      of[i] = k;
+    }
+  *out = of;
+  of = NULL;
+cleanup:
+  fcm__free(ctx, of);
+  return st;
+}
+
+fcm_status fcm__mg_slabs_check(const fcm_mg *m, int level, fcm_index *row_slabs,
+                               fcm_index *block_slabs)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m ? m->ctx : NULL;
+  fcm_index *rs = NULL, *bs = NULL, *rb_ptr = NULL, *rb = NULL, *fill = NULL;
+  FCM_CHECK(m && level >= 0 && level + 1 < m->nlev, ctx, FCM_ERR_ARG,
+            "mg_slabs_check: NULL argument or level %d outside [0, %d)", level,
+            m ? m->nlev - 1 : 0);
+  const mg_level *L = &m->lev[level];
+  const fcm_csr *A = level_matrix(L);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const fcm_index n = L->n;
+  if (row_slabs) *row_slabs = L->rows.nslab;
+  if (block_slabs) *block_slabs = L->blocks.nslab;
+  if (L->rows.nslab > 0) {
+    FCM_TRY(ctx, slab_of_items(ctx, &L->rows, n, level, "row", &rs));
+    for (fcm_index i = 0; i < n; i++) {
+      FCM_CHECK(rs[i] >= 0, ctx, FCM_ERR_INTERNAL, "mg: level %d: row %lld in no slab", level,
+                (long long)i);
+      for (fcm_index p = rp[i]; p < rp[i + 1]; p++) {
+        const fcm_index j = ci[p];
+        FCM_CHECK(rs[j] == rs[i] || (rs[j] - rs[i]) % 2 != 0, ctx, FCM_ERR_INTERNAL,
+                  "mg: level %d: rows %lld and %lld are coupled but lie in slabs %lld and %lld "
+                  "of one colour",
+                  level, (long long)i, (long long)j, (long long)rs[i], (long long)rs[j]);
+      }
+    }
+  }
+  if (L->blocks.nslab > 0) {
+    const fcm_index nb = fcm__schwarz_num_blocks(L->blk);
+    FCM_TRY(ctx, slab_of_items(ctx, &L->blocks, nb, level, "block", &bs));
+    /* the blocks of each row */
+    FCM_ALLOC(ctx, n + 1, rb_ptr);
+    FCM_ALLOC(ctx, n + 1, fill);
+    for (fcm_index k = 0; k < nb; k++) {
+      const fcm_index *d = NULL;
+      const double *S = NULL;
+      const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
+      FCM_CHECK(bs[k] >= 0, ctx, FCM_ERR_INTERNAL, "mg: level %d: block %lld in no slab", level,
+                (long long)k);
+      for (int i = 0; i < bm; i++)
+        rb_ptr[d[i] + 1]++;
+    }
+    for (fcm_index i = 0; i < n; i++)
+      rb_ptr[i + 1] += rb_ptr[i];
+    FCM_ALLOC(ctx, rb_ptr[n] + 1, rb);
+    for (fcm_index k = 0; k < nb; k++) {
+      const fcm_index *d = NULL;
+      const double *S = NULL;
+      const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
+      for (int i = 0; i < bm; i++)
+        rb[rb_ptr[d[i]] + fill[d[i]]++] = k;
+    }
+    for (fcm_index k = 0; k < nb; k++) {
+      const fcm_index *d = NULL;
+      const double *S = NULL;
+      const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
+      for (int i = 0; i < bm; i++)
+        for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++)
+          for (fcm_index q = rb_ptr[ci[p]]; q < rb_ptr[ci[p] + 1]; q++) {
+            const fcm_index j = rb[q];
+            FCM_CHECK(bs[j] == bs[k] || (bs[j] - bs[k]) % 2 != 0, ctx, FCM_ERR_INTERNAL,
+                      "mg: level %d: blocks %lld and %lld touch (DOFs %lld, %lld) but lie in "
+                      "slabs %lld and %lld of one colour",
+                      level, (long long)k, (long long)j, (long long)d[i], (long long)ci[p],
+                      (long long)bs[k], (long long)bs[j]);
+          }
+    }
+  }
+cleanup:
+  fcm__free(ctx, rs);
+  fcm__free(ctx, bs);
+  fcm__free(ctx, rb_ptr);
+  fcm__free(ctx, rb);
+  fcm__free(ctx, fill);
+  return st;
+}
