@@ -12,8 +12,10 @@
  * phase alone, then beside `busy` busy-loop child processes (default 8), which are killed
  * afterwards; rounds alternate so a drift of the machine's other load reaches both sides.
  *
- * Usage: bench_mg_shared [n [rounds [busy [mg]]]]   (defaults 40, 3, 8; "mg": the multigrid
- * phases only)
+ * Usage: bench_mg_shared [n [rounds [busy [mg]]]]   (defaults 36, 3, 8; "mg": the multigrid
+ * phases only). Each round also prints the cores that other processes (not this one, not its
+ * busy loops) kept busy during its phases, from /proc/stat: a shared machine's other users
+ * make both times longer and the ratio meaningless when they come and go.
  * Run it as the programs run (OMP_WAIT_POLICY=passive: ctest sets it). Prints figures and
  * asserts only that every solve converges and that the loaded solves are bitwise equal to
  * the lone ones (the result does not depend on the scheduling). */
@@ -53,6 +55,38 @@ typedef struct bench {
 static double cpu_seconds(void)
 {
   return (double)clock() / CLOCKS_PER_SEC;
+}
+
+/* CPU seconds the machine spent busy so far (all processes, /proc/stat), -1 if unknown. */
+static double machine_busy(void)
+{
+  unsigned long long v[8] = {0};
+  FILE *f = fopen("/proc/stat", "r");
+  if (!f) return -1.0;
+  const int got = fscanf(f, "cpu %llu %llu %llu %llu %llu %llu %llu %llu", &v[0], &v[1], &v[2],
+                         &v[3], &v[4], &v[5], &v[6], &v[7]);
+  fclose(f);
+  if (got != 8) return -1.0;
+  /* user nice system idle iowait irq softirq steal: all but idle and iowait */
+  return (double)(v[0] + v[1] + v[2] + v[5] + v[6] + v[7]) / (double)sysconf(_SC_CLK_TCK);
+}
+
+/* CPU seconds of process `pid` so far (/proc/pid/stat utime + stime), 0 if unknown. */
+static double process_cpu(pid_t pid)
+{
+  char path[64], buf[1024];
+  snprintf(path, sizeof path, "/proc/%d/stat", (int)pid);
+  FILE *f = fopen(path, "r");
+  if (!f) return 0.0;
+  const size_t len = fread(buf, 1, sizeof buf - 1, f);
+  fclose(f);
+  buf[len] = '\0';
+  const char *p = strrchr(buf, ')'); /* the command name may hold spaces */
+  unsigned long long ut = 0, stime = 0;
+  if (!p || sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu", &ut,
+                   &stime) != 2)
+    return 0.0;
+  return (double)(ut + stime) / (double)sysconf(_SC_CLK_TCK);
 }
 
 /* Start `count` busy-loop child processes (they die with this process). */
@@ -163,7 +197,7 @@ static void clamp_below(bench *B, const fcm_mesh *mesh, double zmax)
 
 int main(int argc, char **argv)
 {
-  const int ncell = argc > 1 ? atoi(argv[1]) : 40;
+  const int ncell = argc > 1 ? atoi(argv[1]) : 36;
   const int rounds = argc > 2 ? atoi(argv[2]) : 3;
   const int nbusy = argc > 3 ? atoi(argv[3]) : 8;
   const int nph = argc > 4 && !strcmp(argv[4], "mg") ? PH_SCHWARZ : PH_COUNT;
@@ -252,6 +286,7 @@ int main(int argc, char **argv)
   }
   double wall[PH_COUNT][2][MAX_ROUNDS], cpu[PH_COUNT][2][MAX_ROUNDS], ratio[PH_COUNT][MAX_ROUNDS];
   pid_t pids[MAX_BUSY] = {0};
+  double other[2][MAX_ROUNDS]; /* cores used by other processes during the phases */
   for (int r = 0; r < rounds; r++) {
     for (int loaded = 0; loaded < 2; loaded++) {
       if (loaded) {
@@ -259,11 +294,22 @@ int main(int argc, char **argv)
         const struct timespec settle = {0, 200000000};
         nanosleep(&settle, NULL);
       }
+      double kids0 = 0.0, kids1 = 0.0;
+      for (int k = 0; loaded && k < nbusy; k++)
+        kids0 += process_cpu(pids[k]);
+      const double m0 = machine_busy(), c0 = cpu_seconds(), w0 = fcm_wtime();
       for (int ph = 0; ph < nph; ph++)
         run_phase(&B, ph, loaded, &wall[ph][loaded][r], &cpu[ph][loaded][r]);
+      const double m1 = machine_busy(), c1 = cpu_seconds(), w1 = fcm_wtime();
+      for (int k = 0; loaded && k < nbusy; k++)
+        kids1 += process_cpu(pids[k]);
+      const double busy_other = (m1 - m0) - (c1 - c0) - (kids1 - kids0);
+      other[loaded][r] =
+          m0 >= 0.0 && m1 >= 0.0 ? (busy_other > 0.0 ? busy_other : 0.0) / (w1 - w0) : -1.0;
       if (loaded) busy_stop(nbusy, pids);
     }
-    printf("  round %d:\n", r + 1);
+    printf("  round %d (other processes: %.2f cores alone, %.2f loaded):\n", r + 1, other[0][r],
+           other[1][r]);
     for (int ph = 0; ph < nph; ph++) {
       ratio[ph][r] = wall[ph][1][r] / wall[ph][0][r];
       printf("    %-38s alone %7.3f s (%6.3f s CPU), loaded %7.3f s (%6.3f s CPU): %4.1fx",

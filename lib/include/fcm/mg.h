@@ -52,8 +52,8 @@ typedef struct fcm_mg_options {
                                  (default); in [1, 2]. In 3D a W-cycle costs about 4/3 of
                                  the finest level's work against 8/7 for a V-cycle, and it
                                  keeps the iteration counts flat where the V-cycle's factor
-                                 grows with n (hollow ball with holes: V 0.20, 0.33, 0.39,
-                                 W 0.16, 0.21, 0.17 for n = 8, 16, 32) */
+                                 grows with n (hollow ball with holes: V 0.28, 0.35, 0.43,
+                                 W 0.23, 0.22, 0.17 for n = 8, 16, 32) */
   int max_levels;           /**< levels including the finest, >= 1 (default 20) */
   fcm_index coarse_dofs;    /**< stop coarsening once a level has at most this many DOFs,
                                  >= 1 (default 2000); that level is solved by CHOLMOD */

@@ -5,26 +5,33 @@
  * - Done: hierarchy for Hex8 box grids (any cell count, dropped cells, XFEM pieces), per
  *   component trilinear prolongation, restriction = P^T, Galerkin RAP (sparse, pattern once,
  *   values again in fcm_mg_setup()), CHOLMOD on the coarsest level, smoothers SGS
- *   (sequential, default), SGS in multicolour order (colour-parallel) and damped Jacobi, all
- *   deterministic for any thread count; V- and W-cycles as solver (fcm_mg_solve) and as a
- *   symmetric CG preconditioner (fcm_mg_operator); the W-cycle is the default. Hex20: a
- *   p-level to the Hex8 space of the same elements (build_level0). Block smoothing
- *   (block_smoothers_create, block_smooth): level 0 vertex blocks (de Prenter) plus the
- *   element blocks of cut cells, coarser levels the corner DOFs of cells that are not all
- *   material. Measured: Hex20 embedded hemisphere 0.96 per V-cycle without blocks (two-grid on
- *   the p-level alone 0.955, more pointwise sweeps did not help, element blocks alone
- *   0.64-0.84), 0.14-0.29 with vertex blocks; hollow ball with holes (Hex8) 0.40-0.85 growing
- *   with n with level 0 blocks only, V 0.20-0.42 with coarse blocks, W 0.15-0.21 flat (n = 8
- *   ... 64). Used by the scenes (sim/linsolve.c) and apps/fcm-scaling.c. Tests in tests/mg/.
+ *   (default; in slab order, two threads), SGS in multicolour order (colour-parallel) and
+ *   damped Jacobi, all deterministic for any thread count; V- and W-cycles as solver
+ *   (fcm_mg_solve) and as a symmetric CG preconditioner (fcm_mg_operator); the W-cycle is
+ *   the default. Hex20: a p-level to the Hex8 space of the same elements (build_level0).
+ *   Block smoothing (block_smoothers_create, block_smooth): level 0 vertex blocks (de
+ *   Prenter) plus the element blocks of cut cells, coarser levels the corner DOFs of cells
+ *   that are not all material. Measured: Hex20 embedded hemisphere 0.96 per V-cycle without
+ *   blocks (two-grid on the p-level alone 0.955, more pointwise sweeps did not help, element
+ *   blocks alone 0.64-0.84), 0.07-0.32 with vertex blocks; hollow ball with holes (Hex8)
+ *   0.40-0.85 growing with n with level 0 blocks only, V 0.28-0.43 with coarse blocks, W
+ *   0.17-0.23 flat (n = 8 ... 48). Used by the scenes (sim/linsolve.c) and
+ *   apps/fcm-scaling.c. Tests in tests/mg/.
  * - fcm__mg_transfers_create() (mg_impl.h): the hierarchy's prolongations and block lists
  *   without a matrix (build_hierarchy(), the code fcm_mg_create() runs), for PETSc's PCMG
  *   (lib/src/petsc/pcmg.c).
  * - Known: with XFEM cuts the V-cycle factor depends on where the cut lies in the grid
  *   (0.1 to 0.45 measured for n = 4 ... 64 with block smoothing, not growing with n), also
- *   for a cut through the whole body, so not the cut's end; Dick et al. report 0.75 cut. The
- *   Galerkin product, the hierarchy build and the block sweeps are sequential (the W-cycle
- *   with blocks runs on about one core: CPU seconds ~ wall seconds on 2 threads).
+ *   for a cut through the whole body, so not the cut's end; Dick et al. report 0.75 cut.
  *   fcm_mg_setup() needs the same eliminated rows.
+ * - Threads: each level's cycle work runs in two parallel regions (pre_smooth(),
+ *   post_smooth()), the sweeps in slab orders (slab_order: the pointwise SGS in two thick
+ *   row ranges and the thin one between them, the block sweep in up to 16 slabs), the
+ *   Galerkin product and its pattern by rows. Still sequential: the hierarchy's grid build
+ *   (build_hierarchy(), about 2% of fcm_mg_create()), the coarsest factorization and solve,
+ *   the thin slab of each SGS sweep, Hex20's finest pointwise sweeps (numbered corners
+ *   first: one slab). Measured with tests/bench/bench_mg_shared.c (lib/docs/
+ *   multigrid_threads.md).
  * - Dirichlet: eliminated rows (no off-diagonal entry) and coarse DOFs whose coinciding
  *   fine DOFs are all inactive stay in P (leaving them out made P rank deficient); coarse
  *   ones are decoupled in the Galerkin matrix and get no correction.
@@ -968,7 +975,7 @@ static fcm_status galerkin_values(fcm_mg *m, int l)
                    spa);
     /* symmetrize: the pair (i, j), (j, i) with i < j by row i's thread alone */
 #pragma omp for schedule(dynamic, 64)
-    for (fcm_index i = 0; i < C->n; i++)
+    for (fcm_index i = 0; i < C->n; i++) {
       for (fcm_index p = cp[i]; p < cp[i + 1]; p++) {
         const fcm_index j = cc[p];
         if (j <= i) continue;
@@ -976,7 +983,8 @@ static fcm_status galerkin_values(fcm_mg *m, int l)
         const double s = 0.5 * (v[p] + v[q]);
         v[p] = v[q] = s;
       }
-      /* decouple the constrained rows and columns, then the diagonal inverses */
+    }
+    /* decouple the constrained rows and columns, then the diagonal inverses */
 #pragma omp for schedule(static) reduction(min : bad)
     for (fcm_index i = 0; i < C->n; i++) {
       for (fcm_index p = cp[i]; p < cp[i + 1]; p++)
@@ -1078,12 +1086,12 @@ cleanup:
 
 /* The slab order (see slab_order) of n items with per-item work (>= 0), in the sequence `seq`
  * (n items; NULL: ascending), given reach[t] >= t: the furthest sequence position of an item
- * adjacent (symmetrically) to the item at position t. Cut so that slab s + 2 starts past every
- * position that slab s reaches. thick = 0: slabs of at
- * least total / MG_SLABS work each, colour 0 first. thick > 0: `thick` slabs of about equal
- * work (colour 0) separated by thin slabs just wide enough to keep them apart (colour 1,
- * swept first), or one slab when the thin ones would hold more than a quarter of the work
- * (coupling that reaches far in the sequence). */
+ * adjacent (symmetrically) to the item at position t. Cut so that slab s + 2 starts past
+ * every position that slab s reaches. thick = 0: slabs of at least total / MG_SLABS work
+ * each, colour 0 first. thick > 0: `thick` slabs of about equal work (colour 0) separated by
+ * thin slabs just wide enough to keep them apart (colour 1, swept first), or one slab when
+ * the thin ones would hold more than a quarter of the work or reach the end (coupling that
+ * reaches far in the sequence). */
 static fcm_status slabs_create(fcm_ctx *ctx, fcm_index n, const fcm_index *seq,
                                const fcm_index *reach, const double *work, int thick, slab_order *S)
 {
@@ -1112,7 +1120,7 @@ static fcm_status slabs_create(fcm_ctx *ctx, fcm_index n, const fcm_index *seq,
     cut[++ns] = t;
     far = reach_s + 1; /* the slab after the next starts past all this slab reaches */
   }
-  if (thick > 0 && wthin > 0.25 * total) ns = 1, cut[1] = n;
+  if (thick > 0 && (ns == 2 || wthin > 0.25 * total)) ns = 1, cut[1] = n;
   S->nslab = ns;
   S->first = thick > 0 && ns > 1;
   FCM_ALLOC_RAW(ctx, ns + 1, S->ptr);
