@@ -11,3 +11,7 @@ set_tests_properties(bench_shared_cores_spin PROPERTIES ENVIRONMENT "GOMP_SPINCO
 # Peak bytes of the level-set build per triangulated sub-cell (FCM_LEVEL_SET_SUBCELL_BYTES,
 # the default max_subcells): spheres and gyroids at refinements 1-32.
 fcm_add_test(bench_level_set_memory tests/bench/bench_level_set_memory.c LABELS bench TIMEOUT 600)
+# Shared cores, multigrid: CG + multigrid and MINRES + Schwarz steps on the hollow ball alone
+# and beside 8 busy processes; the slowdown of each (figures in lib/docs/multigrid_threads.md).
+fcm_add_test(bench_mg_shared tests/bench/bench_mg_shared.c LABELS bench TIMEOUT 3600)
+set_tests_properties(bench_mg_shared PROPERTIES RUN_SERIAL TRUE)

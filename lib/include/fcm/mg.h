@@ -19,8 +19,14 @@ extern "C" {
 
 /** The smoother of every level but the coarsest. */
 typedef enum fcm_mg_smoother {
-  /** Symmetric Gauss-Seidel (SSOR with omega): a forward then a backward sweep in row order;
-   * sequential, so bitwise independent of the thread count. */
+  /** Symmetric Gauss-Seidel (SSOR with omega): a forward then a backward sweep in a fixed
+   * order of the rows: each level's rows in two ranges and the thin range between them that
+   * keeps them apart (rows couple only within a range or with a neighbouring one); a forward
+   * sweep runs the thin range, then the two others in parallel (each in row order), the
+   * backward sweep the reverse. The order depends on the matrix pattern only, so the result
+   * is bitwise independent of the thread count. Rows that couple far apart in row order
+   * (Hex20's finest level numbers its corner nodes first) form one range, swept
+   * sequentially. */
   FCM_MG_SMOOTHER_SGS = 0,
   /** Damped Jacobi x += omega D^{-1} (b - A x); rows in parallel, deterministic. */
   FCM_MG_SMOOTHER_JACOBI = 1,
@@ -46,16 +52,19 @@ typedef struct fcm_mg_options {
                                  (default); in [1, 2]. In 3D a W-cycle costs about 4/3 of
                                  the finest level's work against 8/7 for a V-cycle, and it
                                  keeps the iteration counts flat where the V-cycle's factor
-                                 grows with n (hollow ball with holes: V 0.20, 0.33, 0.39,
-                                 W 0.16, 0.21, 0.17 for n = 8, 16, 32) */
+                                 grows with n (hollow ball with holes: V 0.28, 0.35, 0.43,
+                                 W 0.23, 0.22, 0.17 for n = 8, 16, 32) */
   int max_levels;           /**< levels including the finest, >= 1 (default 20) */
   fcm_index coarse_dofs;    /**< stop coarsening once a level has at most this many DOFs,
                                  >= 1 (default 2000); that level is solved by CHOLMOD */
   int block_smoothing;      /**< 1 (default): smooth blocks of DOFs where cells hold little
                                  material, after the pre-smoothing and before the
-                                 post-smoothing (a symmetric block Gauss-Seidel sweep,
-                                 sequential; each block inverted by the clamped eigen-inverse
-                                 of the Schwarz preconditioner, fcm/solve.h). Finest level: the
+                                 post-smoothing (a symmetric block Gauss-Seidel sweep in a
+                                 fixed order: the blocks by their first DOF, cut into up to
+                                 16 runs whose even and odd runs each share the threads, as
+                                 the SGS smoother's ranges; each block inverted by the
+                                 clamped eigen-inverse of the Schwarz preconditioner,
+                                 fcm/solve.h). Finest level: the
                                  DOFs around each grid vertex of a cut cell (the copies whose
                                  support lies in the vertex's 8 cells: its own and, on Hex20,
                                  the mid-edge nodes' at it; de Prenter et al. 2020), then all

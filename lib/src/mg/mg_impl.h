@@ -39,4 +39,14 @@ fcm_status fcm__mg_transfers_create(fcm_ctx *ctx, const fcm_space *space,
 /* Destroy; accepts NULL and *t == NULL, sets *t = NULL. */
 void fcm__mg_transfers_destroy(fcm_ctx *ctx, fcm__mg_transfers **t);
 
+/* The slab orders of the smoothers of `mg` (FCM_MG_SMOOTHER_SGS's rows, the block smoother's
+ * blocks; fcm/mg.h) on `level` (< the number of levels - 1): the number of slabs (0 where the
+ * level has none) and whether the order is sound: every item once, and no two slabs of the
+ * same colour holding adjacent items (rows coupled in the level matrix's pattern; blocks one of
+ * which has a DOF coupled with, or equal to, a DOF of the other), so that their sweeps may run
+ * at once. @return FCM_OK, FCM_ERR_ARG (NULL, level out of range), FCM_ERR_INTERNAL (the order
+ * is not sound: names the level, the items and the slabs), FCM_ERR_ALLOC. */
+fcm_status fcm__mg_slabs_check(const fcm_mg *mg, int level, fcm_index *row_slabs,
+                               fcm_index *block_slabs);
+
 #endif /* FCM_MG_IMPL_H */
