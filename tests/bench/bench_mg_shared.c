@@ -83,8 +83,8 @@ static double process_cpu(pid_t pid)
   buf[len] = '\0';
   const char *p = strrchr(buf, ')'); /* the command name may hold spaces */
   unsigned long long ut = 0, stime = 0;
-  if (!p || sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu", &ut,
-                   &stime) != 2)
+  if (!p ||
+      sscanf(p + 2, "%*c %*d %*d %*d %*d %*d %*u %*u %*u %*u %*u %llu %llu", &ut, &stime) != 2)
     return 0.0;
   return (double)(ut + stime) / (double)sysconf(_SC_CLK_TCK);
 }
