@@ -188,9 +188,11 @@ typedef struct rules_progress_state {
   double t0;
 } rules_progress_state;
 
-static void rules_progress(fcm_index done, fcm_index total, void *user)
+/* One progress report of `what` (done of total `unit`): a bar with the elapsed time and the
+ * estimate on a terminal (the unit named when bar_unit is set), else a line. */
+static void progress_report(const rules_progress_state *ps, fcm_index done, fcm_index total,
+                            const char *what, const char *unit, int bar_unit)
 {
-  const rules_progress_state *ps = user;
   const double el = fcm_wtime() - ps->t0;
   if (ps->tty) {
     const int width = 30, fill = (int)(width * done / (total > 0 ? total : 1));
@@ -199,34 +201,24 @@ static void rules_progress(fcm_index done, fcm_index total, void *user)
       bar[i] = i < fill ? '#' : '.';
     bar[width] = '\0';
     const double eta = done > 0 ? el / (double)done * (double)(total - done) : 0.0;
-    fprintf(stderr, "\r[%s] cell rules %lld/%lld  %.0f s  ETA %.0f s   ", bar, (long long)done,
-            (long long)total, el, eta);
+    fprintf(stderr, "\r[%s] %s %lld/%lld%s%s  %.0f s  ETA %.0f s   ", bar, what, (long long)done,
+            (long long)total, bar_unit ? " " : "", bar_unit ? unit : "", el, eta);
     if (done == total) fputc('\n', stderr);
   } else {
-    fprintf(stderr, "fcm-sim: cell rules %lld/%lld cells (%.1f s)\n", (long long)done,
-            (long long)total, el);
+    fprintf(stderr, "fcm-sim: %s %lld/%lld %s (%.1f s)\n", what, (long long)done, (long long)total,
+            unit, el);
   }
 }
 
-/* Progress of a level-set geometry build: a bar on a terminal, else a line per call. */
+static void rules_progress(fcm_index done, fcm_index total, void *user)
+{
+  progress_report(user, done, total, "cell rules", "cells", 0);
+}
+
+/* Progress of a level-set geometry build. */
 static void geometry_progress(fcm_index done, fcm_index total, void *user)
 {
-  const rules_progress_state *ps = user;
-  const double el = fcm_wtime() - ps->t0;
-  if (ps->tty) {
-    const int width = 30, fill = (int)(width * done / (total > 0 ? total : 1));
-    char bar[64];
-    for (int i = 0; i < width; i++)
-      bar[i] = i < fill ? '#' : '.';
-    bar[width] = '\0';
-    const double eta = done > 0 ? el / (double)done * (double)(total - done) : 0.0;
-    fprintf(stderr, "\r[%s] level set %lld/%lld sub-cells  %.0f s  ETA %.0f s   ", bar,
-            (long long)done, (long long)total, el, eta);
-    if (done == total) fputc('\n', stderr);
-  } else {
-    fprintf(stderr, "fcm-sim: level set %lld/%lld sub-cells (%.1f s)\n", (long long)done,
-            (long long)total, el);
-  }
+  progress_report(user, done, total, "level set", "sub-cells", 1);
 }
 
 /* The library's warnings (FCM_LOG_WARNING: NaN voxels, holes filled, solver fallbacks) on
