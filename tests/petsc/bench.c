@@ -9,12 +9,12 @@
  * and the topology's bytes per DOF on each process (fcm__space_memory(): the replicated
  * numbering, the local space's copy graph + pattern + offsets + colours against the full
  * space's, which every process held before the local space). Arguments: element, N, [ball
- * resolution, default 4]. Run: mpirun -n P petsc_bench hex8 24 [8]. */
+ * resolution, default 4]. Run: mpirun -n P ./petsc_bench_np1 hex8 24 [8]. */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
 #include "petsc/petsc_impl.h" /* the problem's space and arrays: topology bytes */
-#include "test.h"
+#include "test_mpi.h"
 
 #include <sys/resource.h>
 
@@ -156,8 +156,5 @@ int main(int argc, char **argv)
   fcm_geometry_destroy(&geom);
   fcm_mesh_destroy(&mesh);
   fcm_ctx_destroy(&ctx);
-  int mine = test_failures_, all = 0;
-  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  fcm_petsc_finalize();
-  return all ? TEST_RESULT() + 1 : 0;
+  return test_mpi_result();
 }
