@@ -182,7 +182,7 @@ int scaling_summary(const settings *o, const table *tb)
         printf("  n=%lld: %.3f (%d levels)", (long long)sr[i]->n, sr[i]->factor, sr[i]->levels);
       printf("\n");
     }
-  printf("\nclaims of issue 13 (per element; bodies ball and hollow, the V-factor on cut; times "
+  printf("\nclaims (per element; bodies ball and hollow, the V-factor on cut; times "
          "setup+solve, %s clock)\n",
          clock_names[o->clock]);
   int all = 1;
@@ -240,13 +240,13 @@ int scaling_summary(const settings *o, const table *tb)
   return all;
 }
 
-/* --backend petsc: the issue-13 summary (printed, not claimed), the PETSc rows' cost per DOF,
+/* --backend petsc: the serial summary (printed, not claimed), the PETSc rows' cost per DOF,
  * and their claims: every PETSc row that ran agrees with the serial solution (CHOLMOD's, else
  * cg-mg's) within --agree and reports its iterations. 1 when every claim holds. */
 int scaling_summary_petsc(const settings *o, const table *tb)
 {
   (void)scaling_summary(o, tb);
-  printf("(with --backend petsc the claims of issue 13 above are printed, not checked)\n");
+  printf("(with --backend petsc the claims above are printed, not checked)\n");
   printf("\nPETSc rows on %d process%s (peak - base RSS summed over the processes; CPU seconds "
          "summed; per DOF)\n",
          o->size, o->size == 1 ? "" : "es");
@@ -261,7 +261,7 @@ int scaling_summary_petsc(const settings *o, const table *tb)
            r->peak_mb >= 0.0 ? (r->peak_mb - r->base_mb) * 1048576.0 / d : 0.0, r->setup_s / d,
            r->solve_s / d, (r->setup_cpu + r->solve_cpu) / d, r->note);
   }
-  printf("\nclaims of the PETSc rows (issue 14)\n");
+  printf("\nclaims of the PETSc rows\n");
   int all = 1;
   for (int ti = 0; ti < o->ntypes; ti++)
     for (int si = 0; si < o->nsolvers; si++) {

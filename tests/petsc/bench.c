@@ -146,7 +146,7 @@ int main(int argc, char **argv)
     if (rank == 0)
       printf("petsc_bench np %d %s N %lld: topology bytes/DOF per process: numbering %.1f "
              "(replicated) + adapter %.1f (replicated); copy graph + pattern + offsets + "
-             "colours: full space %.1f (before: on every process), local space %.1f..%.1f "
+             "colours: full space %.1f (as if on every process), local space %.1f..%.1f "
              "(own + ghost cells)\n",
              size, argv[1], (long long)N, num / n, adapter / n, whole / n, -ext[1] / n, ext[0] / n);
   }

@@ -288,7 +288,7 @@ static void check_steps(fcm_ctx *ctx)
   }
 }
 
-/* fixed and motion on the embedded boundary (issue 18): "boundary" with a region or "all",
+/* fixed and motion on the embedded boundary: "boundary" with a region or "all",
  * the method keys and their defaults; the region selects points by position. */
 static void check_boundary(fcm_ctx *ctx)
 {

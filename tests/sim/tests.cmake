@@ -15,20 +15,20 @@ endforeach()
 fcm_add_test(sim_alloc_failure tests/sim/alloc_failure.c)
 # Allocation failures with a body-force field, a traction, and the energy query.
 fcm_add_test(sim_alloc_effects tests/sim/alloc_effects.c)
-# Issue 19: MINRES + Schwarz on the unprojected Newton systems of the example scenes converges
+# MINRES + Schwarz on the unprojected Newton systems of the example scenes converges
 # and agrees with the direct solve: two quick scenes, one step, by default; every scene, ten
 # steps, under slow (each scene's rules are built twice).
 fcm_add_test(sim_minres_scenes tests/sim/minres_scenes.c
              ARGS ${PROJECT_SOURCE_DIR}/apps/scenes 1 slingshot.json spinning_body.json)
 fcm_add_test(sim_minres_scenes_long tests/sim/minres_scenes.c LABELS slow
              ARGS ${PROJECT_SOURCE_DIR}/apps/scenes 10 TIMEOUT 3600)
-# Issue 19: the preconditioner's tangent (projected, linear, exact): each converges to the
+# The preconditioner's tangent (projected, linear, exact): each converges to the
 # direct solution on a hard twist of a Hex20 tube; the option is parsed and validated.
 fcm_add_test(sim_minres_pc_tangent tests/sim/minres_pc_tangent.c)
-# Issue 19: numerically singular systems are refused by the direct path with the cause;
+# Numerically singular systems are refused by the direct path with the cause;
 # stabilized systems with tiny cut cells are not.
 fcm_add_test(sim_singular tests/sim/singular.c)
-# Issue 15 item 6: steps after the first allocate nothing through the context (direct
+# Steps after the first allocate nothing through the context (direct
 # CHOLMOD with one symbolic analysis, MINRES + Schwarz, CG + Jacobi, CG + block Jacobi).
 foreach(solver direct minres-schwarz cg-jacobi cg-block minres-mg cg-mg mg)
   fcm_add_test(sim_step_alloc_${solver} tests/sim/step_alloc.c ARGS ${solver})
@@ -45,7 +45,7 @@ endforeach()
 foreach(el hex8 tet4)
   fcm_add_test(sim_reaction_${el} tests/sim/reaction.c ARGS ${el})
 endforeach()
-# Issue 18: Dirichlet conditions on the embedded boundary (Nitsche, penalty).
+# Dirichlet conditions on the embedded boundary (Nitsche, penalty).
 fcm_add_test(sim_nitsche_patch_hex8 tests/sim/nitsche.c ARGS patch hex8)
 fcm_add_test(sim_nitsche_patch_tet4 tests/sim/nitsche.c ARGS patch tet4)
 fcm_add_test(sim_nitsche_tangent tests/sim/nitsche.c ARGS tangent)
