@@ -62,6 +62,25 @@ void scaling_print_row(const row *r)
   fflush(stdout);
 }
 
+/* The next plotted series from combination *k on (element ti, body bi, solver si of the
+ * settings, in that nesting): the bodies ball and hollow, with rows that ran, cholmod not in
+ * the iterations panel (1). 1 with its rows in sr[0..*m), 0 after the last. */
+static int next_series(const settings *o, const table *tb, int panel, int *k, int *ti, int *bi,
+                       int *si, const row **sr, int *m)
+{
+  while (*k < o->ntypes * o->nbodies * o->nsolvers) {
+    const int c = (*k)++;
+    *ti = c / (o->nbodies * o->nsolvers), *bi = c / o->nsolvers % o->nbodies;
+    *si = c % o->nsolvers;
+    const int b = o->bodies[*bi], s = o->solvers[*si];
+    if (b != B_BALL && b != B_HOLLOW) continue;
+    *m = scaling_series(tb, o->types[*ti], b, s, sr, 64);
+    if (*m == 0 || (panel == 1 && s == S_CHOLMOD)) continue;
+    return 1;
+  }
+  return 0;
+}
+
 /* Two panels: setup + solve time against DOFs (log-log, the fitted exponents in the legend) and
  * iterations against DOFs, one line per (element, body, solver) of the bodies ball and
  * hollow. The data go inline into the script. */
@@ -92,47 +111,31 @@ int scaling_write_png(const settings *o, const table *tb)
       ADD("set logscale xy\nset ylabel 'iterations (cycles)'\nset title "
           "'iterations to rtol %.0e'\nset key top left font ',8'\n",
           o->rtol);
-    int first = 1;
-    for (int ti = 0; ti < o->ntypes; ti++)
-      for (int bi = 0; bi < o->nbodies; bi++) {
-        const int b = o->bodies[bi];
-        if (b != B_BALL && b != B_HOLLOW) continue;
-        for (int si = 0; si < o->nsolvers; si++) {
-          const int s = o->solvers[si];
-          const row *sr[64];
-          const int m = scaling_series(tb, o->types[ti], b, s, sr, 64);
-          if (m == 0 || (panel == 1 && s == S_CHOLMOD)) continue;
-          const double e = scaling_series_exponent(tb, o->types[ti], b, s, o->clock, 0);
-          const double e1 = scaling_series_exponent(tb, o->types[ti], b, s, o->clock, 1);
-          char expo[40] = "";
-          if (panel == 0 && isfinite(e)) snprintf(expo, sizeof expo, " (%.2f / %.2f)", e, e1);
-          ADD("%s '-' using 1:2 with linespoints lc rgb '%s' pt %d dt %d title '%s %s %s%s'",
-              first ? "plot" : ",", colors[s], 4 + 2 * bi, 1 + ti,
-              fcm_element_get_info(o->types[ti])->name, body_names[b], solver_names[s], expo);
-          first = 0;
-        }
-      }
+    int first = 1, k = 0, ti = 0, bi = 0, si = 0, m = 0;
+    const row *sr[64];
+    while (next_series(o, tb, panel, &k, &ti, &bi, &si, sr, &m)) {
+      const int b = o->bodies[bi], s = o->solvers[si];
+      const double e = scaling_series_exponent(tb, o->types[ti], b, s, o->clock, 0);
+      const double e1 = scaling_series_exponent(tb, o->types[ti], b, s, o->clock, 1);
+      char expo[40] = "";
+      if (panel == 0 && isfinite(e)) snprintf(expo, sizeof expo, " (%.2f / %.2f)", e, e1);
+      ADD("%s '-' using 1:2 with linespoints lc rgb '%s' pt %d dt %d title '%s %s %s%s'",
+          first ? "plot" : ",", colors[s], 4 + 2 * bi, 1 + ti,
+          fcm_element_get_info(o->types[ti])->name, body_names[b], solver_names[s], expo);
+      first = 0;
+    }
     if (first) {
       ADD("plot 1 title 'no data'\n");
       continue;
     }
     ADD("\n");
-    for (int ti = 0; ti < o->ntypes; ti++)
-      for (int bi = 0; bi < o->nbodies; bi++) {
-        const int b = o->bodies[bi];
-        if (b != B_BALL && b != B_HOLLOW) continue;
-        for (int si = 0; si < o->nsolvers; si++) {
-          const int s = o->solvers[si];
-          const row *sr[64];
-          const int m = scaling_series(tb, o->types[ti], b, s, sr, 64);
-          if (m == 0 || (panel == 1 && s == S_CHOLMOD)) continue;
-          for (int i = 0; i < m; i++)
-            ADD("%lld %.6g\n", (long long)sr[i]->dofs,
-                panel == 0 ? fmax(scaling_row_time(sr[i], o->clock, 0), 1e-4)
-                           : (double)sr[i]->iterations);
-          ADD("e\n");
-        }
-      }
+    for (k = 0; next_series(o, tb, panel, &k, &ti, &bi, &si, sr, &m);) {
+      for (int i = 0; i < m; i++)
+        ADD("%lld %.6g\n", (long long)sr[i]->dofs,
+            panel == 0 ? fmax(scaling_row_time(sr[i], o->clock, 0), 1e-4)
+                       : (double)sr[i]->iterations);
+      ADD("e\n");
+    }
   }
   ADD("unset multiplot\n");
 #undef ADD

@@ -199,6 +199,22 @@ static double norm2(fcm_index n, const double *x)
   return sqrt(s);
 }
 
+/* r->relres = ||b - A x|| / ||b|| on the serial problem (0 for b = 0); 0 when it cannot be
+ * computed (no memory), r->relres then untouched. */
+static int relative_residual(const problem *p, const double *x, row *r)
+{
+  double *ax = malloc(sizeof *ax * ((size_t)p->n + 1));
+  const int ok = ax && fcm_csr_apply(p->A, 1.0, x, 0.0, ax) == FCM_OK;
+  if (ok) {
+    for (fcm_index i = 0; i < p->n; i++)
+      ax[i] = p->b[i] - ax[i];
+    const double bn = norm2(p->n, p->b);
+    r->relres = bn > 0.0 ? norm2(p->n, ax) / bn : 0.0;
+  }
+  free(ax);
+  return ok;
+}
+
 /* The commas of a message become semicolons (it goes into a CSV field). */
 static void set_note(row *r, const char *msg)
 {
@@ -208,6 +224,24 @@ static void set_note(row *r, const char *msg)
   r->note[k] = 0;
   for (char *q = r->note; *q; q++)
     if (*q == ',' || *q == '\n') *q = ';';
+}
+
+/* r->diff = ||x - xref|| / ||xref|| (absolute when xref = 0); beyond --agree the row failed,
+ * its note naming the reference `what`. */
+static void compare(const settings *o, fcm_index n, const double *x, const double *xref,
+                    const char *what, row *r)
+{
+  double dn = 0.0;
+  for (fcm_index i = 0; i < n; i++)
+    dn += (x[i] - xref[i]) * (x[i] - xref[i]);
+  const double xn = norm2(n, xref);
+  r->diff = xn > 0.0 ? sqrt(dn) / xn : sqrt(dn);
+  if (!(r->diff <= o->agree)) {
+    r->status = ROW_FAILED;
+    char msg[200];
+    snprintf(msg, sizeof msg, "differs from %s by %.3e > --agree %.1e", what, r->diff, o->agree);
+    set_note(r, msg);
+  }
 }
 
 /* Schwarz blocks of the simulations: cut cells with volume fraction below 0.5. */
@@ -315,16 +349,8 @@ static void run_solver(fcm_ctx *ctx, const settings *o, const problem *p, int s,
   r->peak_mb = r->base_mb >= 0.0 ? rss_peak() : -1.0;
   r->setup_s = w1 - w0, r->solve_s = w2 - w1;
   r->setup_cpu = c1 - c0, r->solve_cpu = c2 - c1;
-  if (st == FCM_OK || st == FCM_ERR_NOT_CONVERGED) { /* the true residual, computed here */
-    double *ax = malloc(sizeof *ax * ((size_t)p->n + 1));
-    if (ax && fcm_csr_apply(p->A, 1.0, x, 0.0, ax) == FCM_OK) {
-      for (fcm_index i = 0; i < p->n; i++)
-        ax[i] = p->b[i] - ax[i];
-      const double bn = norm2(p->n, p->b);
-      r->relres = bn > 0.0 ? norm2(p->n, ax) / bn : 0.0;
-    }
-    free(ax);
-  }
+  if (st == FCM_OK || st == FCM_ERR_NOT_CONVERGED) /* the true residual, computed here */
+    (void)relative_residual(p, x, r);
   if (st == FCM_ERR_UNSUPPORTED && (s == S_CGMG || s == S_MG) && !strcmp(stage, "setup")) {
     r->status = ROW_SKIPPED;
     char msg[400];
@@ -337,17 +363,7 @@ static void run_solver(fcm_ctx *ctx, const settings *o, const problem *p, int s,
     snprintf(msg, sizeof msg, "%s: %s", stage, fcm_ctx_error_message(ctx));
     set_note(r, msg);
   } else if (xref) {
-    double dn = 0.0;
-    for (fcm_index i = 0; i < p->n; i++)
-      dn += (x[i] - xref[i]) * (x[i] - xref[i]);
-    const double xn = norm2(p->n, xref);
-    r->diff = xn > 0.0 ? sqrt(dn) / xn : sqrt(dn);
-    if (!(r->diff <= o->agree)) {
-      r->status = ROW_FAILED;
-      char msg[200];
-      snprintf(msg, sizeof msg, "differs from cholmod by %.3e > --agree %.1e", r->diff, o->agree);
-      set_note(r, msg);
-    }
+    compare(o, p->n, x, xref, "cholmod", r);
   }
   fcm_direct_destroy(&d);
   fcm_jacobi_destroy(&J);
@@ -600,31 +616,11 @@ done:
                (long long)p->n);
       set_note(r, msg);
     } else {
-      double *ax = malloc(sizeof *ax * ((size_t)p->n + 1));
-      if (ax && fcm_csr_apply(p->A, 1.0, u, 0.0, ax) == FCM_OK) {
-        for (fcm_index i = 0; i < p->n; i++)
-          ax[i] = p->b[i] - ax[i];
-        const double bn = norm2(p->n, p->b);
-        r->relres = bn > 0.0 ? norm2(p->n, ax) / bn : 0.0;
+      if (relative_residual(p, u, r))
         r->factor = s == S_PMUMPS                          ? -1.0
                     : r->iterations > 0 && r->relres > 0.0 ? pow(r->relres, 1.0 / r->iterations)
                                                            : 0.0;
-      }
-      free(ax);
-      if (xref) {
-        double dn = 0.0;
-        for (fcm_index i = 0; i < p->n; i++)
-          dn += (u[i] - xref[i]) * (u[i] - xref[i]);
-        const double xn = norm2(p->n, xref);
-        r->diff = xn > 0.0 ? sqrt(dn) / xn : sqrt(dn);
-        if (!(r->diff <= o->agree)) {
-          r->status = ROW_FAILED;
-          char msg[200];
-          snprintf(msg, sizeof msg, "differs from the serial solution by %.3e > --agree %.1e",
-                   r->diff, o->agree);
-          set_note(r, msg);
-        }
-      }
+      if (xref) compare(o, p->n, u, xref, "the serial solution", r);
     }
   }
   free(u);
@@ -637,206 +633,263 @@ done:
 
 /* ------------------------------------------------------------- the study */
 
+/* What one series (element, body) carries from size to size. */
+typedef struct series_state {
+  fcm_element_type t;
+  int body;
+  char skipped[NSOLVER][200];  /* why a solver stopped (it stays skipped at larger sizes) */
+  fcm_index last_n, last_dofs; /* the last problem built */
+  double last_prob_mb, last_prob_s;
+  int failed, fatal;
+} series_state;
+
+/* One size of a series: the solvers wanted, the serial problem and the solutions. */
+typedef struct size_state {
+  fcm_index n;
+  int want[NSOLVER], nserial, npetsc;
+  problem p;
+  int have_p, have_ref, have_mgref; /* built; CHOLMOD's solution, else cg-mg's, in xref */
+  double *x, *xref;
+} size_state;
+
+/* Every wanted serial solver gets a skipped row saying `why`. */
+static void skip_serial(const settings *o, table *tb, series_state *ss, const size_state *sz,
+                        const char *const why[NSOLVER])
+{
+  for (int s = 0; s < NSOLVER; s++)
+    if (sz->want[s] && !IS_PETSC(s) && !add_skip(o, tb, ss->t, ss->body, sz->n, 0, s, why[s]))
+      ss->fatal = 1;
+}
+
+/* 1 when the problem of this size is not built: every serial solver already stopped at a
+ * smaller size, or the problem, estimated from the previous size by the cell ratio, would
+ * exceed the memory or the time budget (the rows say so). */
+static int problem_skipped(const settings *o, table *tb, series_state *ss, const size_state *sz)
+{
+  const char *why[NSOLVER];
+  int all_skipped = 1;
+  for (int s = 0; s < NSOLVER; s++) {
+    why[s] = ss->skipped[s];
+    if (sz->want[s] && !IS_PETSC(s) && !ss->skipped[s][0]) all_skipped = 0;
+  }
+  if (all_skipped) {
+    skip_serial(o, tb, ss, sz, why);
+    return 1;
+  }
+  const double avail = mem_available();
+  if (ss->last_n <= 0) return 0;
+  const double ratio = pow((double)sz->n / (double)ss->last_n, 3.0);
+  const double est_mb = ss->last_prob_mb * ratio, est_s = ss->last_prob_s * ratio;
+  const fcm_index est_dofs = (fcm_index)((double)ss->last_dofs * ratio);
+  char reason[200];
+  reason[0] = 0;
+  if (avail > 0.0 && est_mb > o->mem_fraction * avail)
+    snprintf(reason, sizeof reason,
+             "the problem would need about %.0f MB (%.0f MB available); about %lld dofs", est_mb,
+             avail, (long long)est_dofs);
+  else if (est_s > o->budget)
+    snprintf(reason, sizeof reason,
+             "building the problem would take about %.0f s > --budget %.0f s; about %lld dofs",
+             est_s, o->budget, (long long)est_dofs);
+  if (!reason[0]) return 0;
+  for (int s = 0; s < NSOLVER; s++)
+    why[s] = reason;
+  skip_serial(o, tb, ss, sz, why);
+  return 1;
+}
+
+/* Build the serial problem of this size (timed, its memory measured for the next estimate);
+ * 1 on success, else failed rows for the serial solvers. */
+static int build_size(fcm_ctx *ctx, const settings *o, table *tb, series_state *ss, size_state *sz)
+{
+  const char *en = fcm_element_get_info(ss->t)->name;
+  fprintf(stderr, PROG ": %s %s n=%lld: building the problem\n", en, body_names[ss->body],
+          (long long)sz->n);
+  const double base = scaling_rss_reset();
+  const double w0 = omp_get_wtime();
+  fcm_status st = problem_build(ctx, o, ss->t, ss->body, sz->n, &sz->p);
+  const double build_s = omp_get_wtime() - w0;
+  if (st != FCM_OK) {
+    fprintf(stderr, PROG ": %s %s n=%lld: building the problem failed: %s\n", en,
+            body_names[ss->body], (long long)sz->n, fcm_ctx_error_message(ctx));
+    for (int s = 0; s < NSOLVER; s++)
+      if (sz->want[s] && !IS_PETSC(s) && tb->nrows < MAX_ROWS) {
+        row *r = &tb->rows[tb->nrows++];
+        memset(r, 0, sizeof *r);
+        r->type = ss->t, r->body = ss->body, r->n = sz->n, r->solver = s, r->status = ROW_FAILED;
+        r->factor = r->relres = r->diff = r->peak_mb = r->base_mb = -1.0;
+        r->processes = 1;
+        char msg[400];
+        snprintf(msg, sizeof msg, "problem: %s", fcm_ctx_error_message(ctx));
+        set_note(r, msg);
+        if (!emit(o, tb, r)) ss->fatal = 1;
+      }
+    ss->failed = 1;
+    return 0;
+  }
+  sz->have_p = 1;
+  const double peak = base >= 0.0 ? rss_peak() : -1.0;
+  ss->last_prob_mb = peak >= 0.0 ? fmax(peak - base, 1.0) : 0.0;
+  ss->last_prob_s = build_s, ss->last_n = sz->n, ss->last_dofs = sz->p.n;
+  fprintf(stderr, PROG ": %s %s n=%lld: %lld dofs, built in %.1f s (%.0f MB)\n", en,
+          body_names[ss->body], (long long)sz->n, (long long)sz->p.n, build_s, ss->last_prob_mb);
+  return 1;
+}
+
+/* The serial solvers of one size on process 0, each skipped when its estimate from the
+ * smaller sizes exceeds the memory or the time budget. */
+static void serial_size(fcm_ctx *ctx, const settings *o, table *tb, series_state *ss,
+                        size_state *sz)
+{
+  const fcm_index n = sz->n;
+  const problem *p = &sz->p;
+  if (problem_skipped(o, tb, ss, sz) || !build_size(ctx, o, tb, ss, sz)) return;
+  sz->x = malloc(sizeof *sz->x * ((size_t)p->n + 1));
+  sz->xref = malloc(sizeof *sz->xref * ((size_t)p->n + 1));
+  if (!sz->x || !sz->xref) {
+    fprintf(stderr, PROG ": out of memory for the solution vectors\n");
+    ss->fatal = 1;
+    return;
+  }
+  for (int si = 0; si < o->nsolvers && !ss->fatal; si++) {
+    const int s = o->solvers[si];
+    if (!sz->want[s] || IS_PETSC(s)) continue;
+    if (ss->skipped[s][0]) {
+      if (!add_skip(o, tb, ss->t, ss->body, n, p->n, s, ss->skipped[s])) ss->failed = 1;
+      continue;
+    }
+    double est_s = 0.0, est_mb = 0.0;
+    estimate(tb, ss->t, ss->body, s, p->n, &est_s, &est_mb);
+    const double now_avail = mem_available();
+    char why[200];
+    why[0] = 0;
+    if (now_avail > 0.0 && est_mb > o->mem_fraction * now_avail)
+      snprintf(why, sizeof why, "would need about %.0f MB more (%.0f MB available)", est_mb,
+               now_avail);
+    else if (est_s > o->budget)
+      snprintf(why, sizeof why, "would take about %.0f s > --budget %.0f s", est_s, o->budget);
+    if (why[0]) {
+      char w2[200];
+      snprintf(w2, sizeof w2, "n=%lld %s", (long long)n, why);
+      snprintf(ss->skipped[s], sizeof ss->skipped[s], "%.150s (and larger)", w2);
+      if (!add_skip(o, tb, ss->t, ss->body, n, p->n, s, why)) ss->failed = 1;
+      continue;
+    }
+    if (tb->nrows >= MAX_ROWS) break;
+    row *r = &tb->rows[tb->nrows++];
+    memset(r, 0, sizeof *r);
+    r->type = ss->t, r->body = ss->body, r->n = n, r->dofs = p->n, r->solver = s;
+    r->factor = r->relres = r->diff = -1.0;
+    r->processes = 1;
+    fprintf(stderr, PROG ": %s %s n=%lld %s ...\n", fcm_element_get_info(ss->t)->name,
+            body_names[ss->body], (long long)n, solver_names[s]);
+    run_solver(ctx, o, p, s, s == S_CHOLMOD ? sz->xref : sz->x, sz->have_ref ? sz->xref : NULL, r);
+    if (s == S_CHOLMOD && r->status == ROW_OK) sz->have_ref = 1;
+    /* the PETSc rows' reference when CHOLMOD's is missing: cg-mg's solution */
+    if (s == S_CGMG && r->status == ROW_OK && !sz->have_ref && !sz->have_mgref) {
+      memcpy(sz->xref, sz->x, sizeof *sz->x * (size_t)p->n);
+      sz->have_mgref = 1;
+    }
+    if (r->status == ROW_FAILED) ss->failed = 1;
+    if (r->status == ROW_SKIPPED) snprintf(ss->skipped[s], sizeof ss->skipped[s], "%s", r->note);
+    if (!emit(o, tb, r)) ss->fatal = 1;
+  }
+}
+
+#if FCM_HAVE_PETSC
+/* The PETSc solvers of one size on every process: process 0 decides (skips like the serial
+ * solvers), every process runs the row. */
+static void petsc_size(fcm_ctx *ctx, const settings *o, table *tb, series_state *ss,
+                       const size_state *sz)
+{
+  const int root = o->rank == 0;
+  const fcm_index n = sz->n;
+  for (int si = 0; si < o->nsolvers && sz->npetsc && !ss->fatal; si++) {
+    const int s = o->solvers[si];
+    if (!sz->want[s] || !IS_PETSC(s)) continue;
+    int go = 0;
+    if (root) {
+      const fcm_index dofs = sz->have_p ? sz->p.n : 0;
+      double est_s = 0.0, est_mb = 0.0;
+      estimate(tb, ss->t, ss->body, s, dofs > 0 ? dofs : ss->last_dofs, &est_s, &est_mb);
+      const double now_avail = mem_available();
+      char why[200];
+      why[0] = 0;
+      if (ss->skipped[s][0])
+        snprintf(why, sizeof why, "%s", ss->skipped[s]);
+      else if (now_avail > 0.0 && est_mb > o->mem_fraction * now_avail)
+        snprintf(why, sizeof why, "would need about %.0f MB more (%.0f MB available)", est_mb,
+                 now_avail);
+      else if (est_s > o->budget)
+        snprintf(why, sizeof why, "would take about %.0f s > --budget %.0f s", est_s, o->budget);
+      if (why[0] && !ss->skipped[s][0])
+        snprintf(ss->skipped[s], sizeof ss->skipped[s], "n=%lld %.150s (and larger)", (long long)n,
+                 why);
+      if (why[0]) {
+        if (!add_skip(o, tb, ss->t, ss->body, n, dofs, s, why)) ss->fatal = 1;
+      } else {
+        go = tb->nrows < MAX_ROWS;
+      }
+    }
+    MPI_Bcast(&go, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (!go) continue;
+    row scratch, *r = root ? &tb->rows[tb->nrows++] : &scratch;
+    memset(r, 0, sizeof *r);
+    r->type = ss->t, r->body = ss->body, r->n = n, r->solver = s;
+    r->factor = r->relres = r->diff = -1.0;
+    if (root)
+      fprintf(stderr, PROG ": %s %s n=%lld %s on %d processes ...\n",
+              fcm_element_get_info(ss->t)->name, body_names[ss->body], (long long)n,
+              solver_names[s], o->size);
+    run_petsc(ctx, o, ss->t, ss->body, n, s, sz->have_p ? &sz->p : NULL,
+              sz->have_ref || sz->have_mgref ? sz->xref : NULL, r);
+    if (root) {
+      if (r->status == ROW_FAILED) ss->failed = 1;
+      if (!emit(o, tb, r)) ss->fatal = 1;
+    }
+    MPI_Bcast(&ss->fatal, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  }
+}
+#endif
+
 /* Process 0 runs the serial solvers of one size and decides what runs; the PETSc solvers run
  * on every process (--backend petsc), each other process waiting in sync_processes() while
  * process 0 works alone. */
 int scaling_run_study(fcm_ctx *ctx, const settings *o, table *tb)
 {
   int failed = 0, fatal = 0;
-  const int root = o->rank == 0;
   printf("%-5s %-6s %3s %9s %-14s %6s %7s %9s %9s %8s %9s %9s\n", "elem", "body", "n", "dofs",
          "solver", "its", "factor", "setup_s", "solve_s", "peak_MB", "relres", "diff");
   for (int ti = 0; ti < o->ntypes && !fatal; ti++)
     for (int bi = 0; bi < o->nbodies && !fatal; bi++) {
-      const fcm_element_type t = o->types[ti];
-      const int body = o->bodies[bi];
-      const char *en = fcm_element_get_info(t)->name;
-      char skipped[NSOLVER][200];
-      memset(skipped, 0, sizeof skipped);
-      fcm_index last_n = 0, last_dofs = 0;
-      double last_prob_mb = 0.0, last_prob_s = 0.0;
-      for (int ni = 0; ni < o->nsizes && !fatal; ni++) {
-        const fcm_index n = o->sizes[ni];
-        int want[NSOLVER] = {0}, nserial = 0, npetsc = 0;
+      series_state ss;
+      memset(&ss, 0, sizeof ss);
+      ss.t = o->types[ti], ss.body = o->bodies[bi];
+      for (int ni = 0; ni < o->nsizes && !ss.fatal; ni++) {
+        size_state sz;
+        memset(&sz, 0, sizeof sz);
+        sz.n = o->sizes[ni];
         for (int si = 0; si < o->nsolvers; si++) {
           const int s = o->solvers[si];
-          if ((body == B_CUBE || body == B_CUT) && s != S_MG) continue;
-          want[s] = 1;
+          if ((ss.body == B_CUBE || ss.body == B_CUT) && s != S_MG) continue;
+          sz.want[s] = 1;
           if (IS_PETSC(s))
-            npetsc++;
+            sz.npetsc++;
           else
-            nserial++;
+            sz.nserial++;
         }
-        if (!nserial && !npetsc) continue;
-        problem p;
-        memset(&p, 0, sizeof p);
-        int have_p = 0, have_ref = 0, have_mgref = 0;
-        double *x = NULL, *xref = NULL;
-        char why[200];
-        if (!root || !nserial) goto serial_done;
-        int all_skipped = 1; /* every solver already stopped at a smaller size: no problem */
-        for (int s = 0; s < NSOLVER; s++)
-          if (want[s] && !IS_PETSC(s) && !skipped[s][0]) all_skipped = 0;
-        if (all_skipped) {
-          for (int s = 0; s < NSOLVER; s++)
-            if (want[s] && !IS_PETSC(s) && !add_skip(o, tb, t, body, n, 0, s, skipped[s]))
-              fatal = 1;
-          goto serial_done;
-        }
-        /* the problem itself: estimated from the previous size by the cell ratio */
-        const double avail = mem_available();
-        if (last_n > 0) {
-          const double ratio = pow((double)n / (double)last_n, 3.0);
-          const double est_mb = last_prob_mb * ratio, est_s = last_prob_s * ratio;
-          const fcm_index est_dofs = (fcm_index)((double)last_dofs * ratio);
-          why[0] = 0;
-          if (avail > 0.0 && est_mb > o->mem_fraction * avail)
-            snprintf(why, sizeof why,
-                     "the problem would need about %.0f MB (%.0f MB available); about %lld dofs",
-                     est_mb, avail, (long long)est_dofs);
-          else if (est_s > o->budget)
-            snprintf(why, sizeof why,
-                     "building the problem would take about %.0f s > --budget %.0f s; about %lld "
-                     "dofs",
-                     est_s, o->budget, (long long)est_dofs);
-          if (why[0]) {
-            for (int s = 0; s < NSOLVER; s++)
-              if (want[s] && !IS_PETSC(s) && !add_skip(o, tb, t, body, n, 0, s, why)) fatal = 1;
-            goto serial_done;
-          }
-        }
-        fprintf(stderr, PROG ": %s %s n=%lld: building the problem\n", en, body_names[body],
-                (long long)n);
-        const double base = scaling_rss_reset();
-        const double w0 = omp_get_wtime();
-        fcm_status st = problem_build(ctx, o, t, body, n, &p);
-        const double build_s = omp_get_wtime() - w0;
-        if (st != FCM_OK) {
-          fprintf(stderr, PROG ": %s %s n=%lld: building the problem failed: %s\n", en,
-                  body_names[body], (long long)n, fcm_ctx_error_message(ctx));
-          for (int s = 0; s < NSOLVER; s++)
-            if (want[s] && !IS_PETSC(s) && tb->nrows < MAX_ROWS) {
-              row *r = &tb->rows[tb->nrows++];
-              memset(r, 0, sizeof *r);
-              r->type = t, r->body = body, r->n = n, r->solver = s, r->status = ROW_FAILED;
-              r->factor = r->relres = r->diff = r->peak_mb = r->base_mb = -1.0;
-              r->processes = 1;
-              char msg[400];
-              snprintf(msg, sizeof msg, "problem: %s", fcm_ctx_error_message(ctx));
-              set_note(r, msg);
-              if (!emit(o, tb, r)) fatal = 1;
-            }
-          failed = 1;
-          goto serial_done;
-        }
-        have_p = 1;
-        const double peak = base >= 0.0 ? rss_peak() : -1.0;
-        last_prob_mb = peak >= 0.0 ? fmax(peak - base, 1.0) : 0.0;
-        last_prob_s = build_s, last_n = n, last_dofs = p.n;
-        fprintf(stderr, PROG ": %s %s n=%lld: %lld dofs, built in %.1f s (%.0f MB)\n", en,
-                body_names[body], (long long)n, (long long)p.n, build_s, last_prob_mb);
-        x = malloc(sizeof *x * ((size_t)p.n + 1));
-        xref = malloc(sizeof *xref * ((size_t)p.n + 1));
-        if (!x || !xref) {
-          fprintf(stderr, PROG ": out of memory for the solution vectors\n");
-          fatal = 1;
-          goto serial_done;
-        }
-        for (int si = 0; si < o->nsolvers && !fatal; si++) {
-          const int s = o->solvers[si];
-          if (!want[s] || IS_PETSC(s)) continue;
-          if (skipped[s][0]) {
-            if (!add_skip(o, tb, t, body, n, p.n, s, skipped[s])) failed = 1;
-            continue;
-          }
-          double est_s = 0.0, est_mb = 0.0;
-          estimate(tb, t, body, s, p.n, &est_s, &est_mb);
-          const double now_avail = mem_available();
-          why[0] = 0;
-          if (now_avail > 0.0 && est_mb > o->mem_fraction * now_avail)
-            snprintf(why, sizeof why, "would need about %.0f MB more (%.0f MB available)", est_mb,
-                     now_avail);
-          else if (est_s > o->budget)
-            snprintf(why, sizeof why, "would take about %.0f s > --budget %.0f s", est_s,
-                     o->budget);
-          if (why[0]) {
-            char w2[200];
-            snprintf(w2, sizeof w2, "n=%lld %s", (long long)n, why);
-            snprintf(skipped[s], sizeof skipped[s], "%.150s (and larger)", w2);
-            if (!add_skip(o, tb, t, body, n, p.n, s, why)) failed = 1;
-            continue;
-          }
-          if (tb->nrows >= MAX_ROWS) break;
-          row *r = &tb->rows[tb->nrows++];
-          memset(r, 0, sizeof *r);
-          r->type = t, r->body = body, r->n = n, r->dofs = p.n, r->solver = s;
-          r->factor = r->relres = r->diff = -1.0;
-          r->processes = 1;
-          fprintf(stderr, PROG ": %s %s n=%lld %s ...\n", en, body_names[body], (long long)n,
-                  solver_names[s]);
-          run_solver(ctx, o, &p, s, s == S_CHOLMOD ? xref : x, have_ref ? xref : NULL, r);
-          if (s == S_CHOLMOD && r->status == ROW_OK) have_ref = 1;
-          /* the PETSc rows' reference when CHOLMOD's is missing: cg-mg's solution */
-          if (s == S_CGMG && r->status == ROW_OK && !have_ref && !have_mgref) {
-            memcpy(xref, x, sizeof *x * (size_t)p.n);
-            have_mgref = 1;
-          }
-          if (r->status == ROW_FAILED) failed = 1;
-          if (r->status == ROW_SKIPPED) snprintf(skipped[s], sizeof skipped[s], "%s", r->note);
-          if (!emit(o, tb, r)) fatal = 1;
-        }
-      serial_done:
-        sync_processes(o, &fatal);
+        if (!sz.nserial && !sz.npetsc) continue;
+        if (o->rank == 0 && sz.nserial) serial_size(ctx, o, tb, &ss, &sz);
+        sync_processes(o, &ss.fatal);
 #if FCM_HAVE_PETSC
-        for (int si = 0; si < o->nsolvers && npetsc && !fatal; si++) {
-          const int s = o->solvers[si];
-          if (!want[s] || !IS_PETSC(s)) continue;
-          int go = 0;
-          if (root) {
-            const fcm_index dofs = have_p ? p.n : 0;
-            double est_s = 0.0, est_mb = 0.0;
-            estimate(tb, t, body, s, dofs > 0 ? dofs : last_dofs, &est_s, &est_mb);
-            const double now_avail = mem_available();
-            why[0] = 0;
-            if (skipped[s][0])
-              snprintf(why, sizeof why, "%s", skipped[s]);
-            else if (now_avail > 0.0 && est_mb > o->mem_fraction * now_avail)
-              snprintf(why, sizeof why, "would need about %.0f MB more (%.0f MB available)", est_mb,
-                       now_avail);
-            else if (est_s > o->budget)
-              snprintf(why, sizeof why, "would take about %.0f s > --budget %.0f s", est_s,
-                       o->budget);
-            if (why[0] && !skipped[s][0])
-              snprintf(skipped[s], sizeof skipped[s], "n=%lld %.150s (and larger)", (long long)n,
-                       why);
-            if (why[0]) {
-              if (!add_skip(o, tb, t, body, n, dofs, s, why)) fatal = 1;
-            } else {
-              go = tb->nrows < MAX_ROWS;
-            }
-          }
-          MPI_Bcast(&go, 1, MPI_INT, 0, MPI_COMM_WORLD);
-          if (!go) continue;
-          row scratch, *r = root ? &tb->rows[tb->nrows++] : &scratch;
-          memset(r, 0, sizeof *r);
-          r->type = t, r->body = body, r->n = n, r->solver = s;
-          r->factor = r->relres = r->diff = -1.0;
-          if (root)
-            fprintf(stderr, PROG ": %s %s n=%lld %s on %d processes ...\n", en, body_names[body],
-                    (long long)n, solver_names[s], o->size);
-          run_petsc(ctx, o, t, body, n, s, have_p ? &p : NULL, have_ref || have_mgref ? xref : NULL,
-                    r);
-          if (root) {
-            if (r->status == ROW_FAILED) failed = 1;
-            if (!emit(o, tb, r)) fatal = 1;
-          }
-          MPI_Bcast(&fatal, 1, MPI_INT, 0, MPI_COMM_WORLD);
-        }
+        petsc_size(ctx, o, tb, &ss, &sz);
 #endif
-        free(x);
-        free(xref);
-        if (have_p) problem_free(&p);
+        free(sz.x);
+        free(sz.xref);
+        if (sz.have_p) problem_free(&sz.p);
       }
+      failed |= ss.failed;
+      fatal |= ss.fatal;
     }
   return failed || fatal;
 }
