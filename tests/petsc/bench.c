@@ -9,7 +9,7 @@
  * and the topology's bytes per DOF on each process (fcm__space_memory(): the replicated
  * numbering, the local space's copy graph + pattern + offsets + colours against the full
  * space's, which every process held before the local space). Arguments: element, N, [ball
- * resolution, default 4]. Run: mpirun -n P ./petsc_bench_np1 hex8 24 [8]. */
+ * resolution, default 4]. Run: mpirun -n P petsc_bench hex8 24 [8]. */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
