@@ -170,23 +170,24 @@ int main(int argc, char **argv)
 /* The rows of the study (static: a few hundred kB). */
 static table results;
 
-static int scaling_main(int argc, char **argv, int pargc, char **pargv)
+/* The settings from the command line, validated, with the defaults filled in: -1 to go on, or
+ * the exit code (0 after --help, 2 on a usage error). */
+static int parse_options(int argc, char **argv, settings *o)
 {
-  settings o;
-  memset(&o, 0, sizeof o);
-  o.rtol = 1e-8, o.agree = 1e-4, o.budget = -1.0, o.mem_fraction = 0.8;
-  o.clock = CLOCK_CPU;
-  o.max_iterations = 20000;
-  o.coarse_dofs = 200;
-  o.constrain_ratio = fcm_space_options_default().constrain_ratio;
+  memset(o, 0, sizeof *o);
+  o->rtol = 1e-8, o->agree = 1e-4, o->budget = -1.0, o->mem_fraction = 0.8;
+  o->clock = CLOCK_CPU;
+  o->max_iterations = 20000;
+  o->coarse_dofs = 200;
+  o->constrain_ratio = fcm_space_options_default().constrain_ratio;
   const char *sizes = NULL, *elements = NULL, *bodies = NULL, *solvers = NULL;
   int seen_budget = 0;
   const cli_option opts[] = {
-      {"--quick", NULL, CLI_FLAG, &o.quick, NULL, "hex8, n = 8,16,32, budget 120 s", 0, 0, 0, NULL,
+      {"--quick", NULL, CLI_FLAG, &o->quick, NULL, "hex8, n = 8,16,32, budget 120 s", 0, 0, 0, NULL,
        NULL, NULL},
-      {"--csv", NULL, CLI_STRING, &o.csv, "FILE", "write the rows as CSV (atomically)", 0, 0, 0,
+      {"--csv", NULL, CLI_STRING, &o->csv, "FILE", "write the rows as CSV (atomically)", 0, 0, 0,
        NULL, NULL, NULL},
-      {"--png", NULL, CLI_STRING, &o.png, "FILE",
+      {"--png", NULL, CLI_STRING, &o->png, "FILE",
        "plot time (setup + solve) and iterations against DOFs\n(log-log, needs gnuplot)", 0, 0, 0,
        NULL, NULL, NULL},
       {"--sizes", NULL, CLI_STRING, &sizes, "N,N,...",
@@ -204,41 +205,41 @@ static int scaling_main(int argc, char **argv, int pargc, char **pargv)
        "cholmod first "
        "gives\nthe reference solution",
        0, 0, 0, NULL, NULL, NULL},
-      {"--rtol", NULL, CLI_DOUBLE, &o.rtol, "R", "relative residual of every solver (default 1e-8)",
-       1e-14, 1e-2, 0, NULL, NULL, NULL},
-      {"--agree", NULL, CLI_DOUBLE, &o.agree, "TOL",
+      {"--rtol", NULL, CLI_DOUBLE, &o->rtol, "R",
+       "relative residual of every solver (default 1e-8)", 1e-14, 1e-2, 0, NULL, NULL, NULL},
+      {"--agree", NULL, CLI_DOUBLE, &o->agree, "TOL",
        "largest ||x - x_cholmod||/||x_cholmod|| accepted (default\n1e-4: a residual of rtol allows "
        "an error of up to kappa x\nrtol)",
        0, 1, CLI_LO_OPEN, NULL, NULL, NULL},
-      {"--max-iterations", NULL, CLI_INT, &o.max_iterations, "K",
+      {"--max-iterations", NULL, CLI_INT, &o->max_iterations, "K",
        "iterations / cycles before a solver fails (default 20000)", 1, 1e7, 0, NULL, NULL, NULL},
-      {"--budget", NULL, CLI_DOUBLE, &o.budget, "S",
+      {"--budget", NULL, CLI_DOUBLE, &o->budget, "S",
        "skip a solver (and a problem) whose estimated wall time\nexceeds S seconds (default 900; "
        "--quick 120)",
        0, 1e7, CLI_LO_OPEN, NULL, NULL, &seen_budget},
-      {"--mem-fraction", NULL, CLI_DOUBLE, &o.mem_fraction, "F",
+      {"--mem-fraction", NULL, CLI_DOUBLE, &o->mem_fraction, "F",
        "skip what would need more than F x MemAvailable (default 0.8)", 0, 1, CLI_LO_OPEN, NULL,
        NULL, NULL},
-      {"--coarse-dofs", NULL, CLI_LLONG, &o.coarse_dofs, "N",
+      {"--coarse-dofs", NULL, CLI_LLONG, &o->coarse_dofs, "N",
        "multigrid: coarsen until a level has at most N DOFs\n(fcm_mg_options.coarse_dofs; default "
        "200, so that n = 8 has 2+ levels:\nthe library's 2000 would solve it directly)",
        1, 1e9, 0, NULL, NULL, NULL},
-      {"--constrain-ratio", NULL, CLI_DOUBLE, &o.constrain_ratio, "R",
+      {"--constrain-ratio", NULL, CLI_DOUBLE, &o->constrain_ratio, "R",
        "the space's constrain_ratio (fcm_space_options; default\nthe library's, 1e-9): DOF copies "
        "of smaller support move with\ntheir piece",
        0, 0.5, CLI_HI_OPEN, NULL, NULL, NULL},
-      {"--threads", NULL, CLI_INT, &o.threads, "T",
+      {"--threads", NULL, CLI_INT, &o->threads, "T",
        "OpenMP threads (and CHOLMOD's BLAS threads); 0: the\nenvironment's (default)", 0, 1024, 0,
        NULL, NULL, NULL},
-      {"--clock", NULL, CLI_CHOICE, &o.clock, "C",
+      {"--clock", NULL, CLI_CHOICE, &o->clock, "C",
        "cpu (default: process CPU seconds; on a shared machine\nthe wall clock also measures the "
        "other load) or wall: the\ntimes the exponents, claims and plot use",
        0, 0, 0, clock_names, NULL, NULL},
-      {"--check", NULL, CLI_FLAG, &o.check, NULL,
+      {"--check", NULL, CLI_FLAG, &o->check, NULL,
        "exit 1 when a claim fails or cannot be measured\n(--backend petsc: the "
        "claims on the PETSc rows)",
        0, 0, 0, NULL, NULL, NULL},
-      {"--backend", NULL, CLI_CHOICE, &o.backend, "NAME",
+      {"--backend", NULL, CLI_CHOICE, &o->backend, "NAME",
        "serial (default) or petsc: add the rows of the PETSc\nsolvers petsc-gamg, petsc-mumps "
        "and petsc-mg on every MPI process\n(mpirun -n 2 " PROG " --backend petsc; PETSc "
        "options such as\n-ksp_type go to them; needs a build with PETSc)",
@@ -246,10 +247,8 @@ static int scaling_main(int argc, char **argv, int pargc, char **pargv)
       {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
   const int code = cli_parse_args(PROG, opts, argc, argv, NULL, 0, NULL, usage);
   if (code >= 0) return code;
-  const int petsc = o.backend == BACKEND_PETSC;
+  const int petsc = o->backend == BACKEND_PETSC;
 #if !FCM_HAVE_PETSC
-  (void)pargc;
-  (void)pargv;
   if (petsc) {
     fprintf(stderr, PROG ": --backend petsc: this fcm was built without PETSc (CMake option "
                          "FCM_WITH_PETSC; Debian: bash setup.sh deps --petsc, then rebuild)\n");
@@ -257,43 +256,44 @@ static int scaling_main(int argc, char **argv, int pargc, char **pargv)
   }
 #endif
   const fcm_index def_sizes[4] = {8, 16, 32, 64};
-  o.nsizes = o.quick ? 3 : 4;
-  memcpy(o.sizes, def_sizes, sizeof def_sizes);
-  o.types[0] = FCM_ELEMENT_HEX8, o.types[1] = FCM_ELEMENT_HEX20;
-  o.ntypes = o.quick ? 1 : 2;
+  o->nsizes = o->quick ? 3 : 4;
+  memcpy(o->sizes, def_sizes, sizeof def_sizes);
+  o->types[0] = FCM_ELEMENT_HEX8, o->types[1] = FCM_ELEMENT_HEX20;
+  o->ntypes = o->quick ? 1 : 2;
   for (int b = 0; b < NBODY; b++)
-    o.bodies[b] = b;
-  o.nbodies = NBODY;
+    o->bodies[b] = b;
+  o->nbodies = NBODY;
   for (int s = 0; s < NSOLVER; s++)
-    o.solvers[s] = s;
-  o.nsolvers = NSOLVER;
-  if (!seen_budget) o.budget = o.quick ? 120.0 : 900.0;
-  if (sizes && !parse_sizes(sizes, &o)) return 2;
+    o->solvers[s] = s;
+  o->nsolvers = NSOLVER;
+  if (!seen_budget) o->budget = o->quick ? 120.0 : 900.0;
+  if (sizes && !parse_sizes(sizes, o)) return 2;
   if (elements) {
-    if (!cli_element_list(PROG, "--elements", elements, o.types, &o.ntypes)) return 2;
-    for (int i = 0; i < o.ntypes; i++)
-      if (o.types[i] != FCM_ELEMENT_HEX8 && o.types[i] != FCM_ELEMENT_HEX20) {
+    if (!cli_element_list(PROG, "--elements", elements, o->types, &o->ntypes)) return 2;
+    for (int i = 0; i < o->ntypes; i++)
+      if (o->types[i] != FCM_ELEMENT_HEX8 && o->types[i] != FCM_ELEMENT_HEX20) {
         fprintf(stderr, PROG ": --elements: %s: only hex8 and hex20 (box grids)\n",
-                fcm_element_get_info(o.types[i])->name);
+                fcm_element_get_info(o->types[i])->name);
         return 2;
       }
   }
   if (petsc) { /* default: the embedded bodies; the references and the PETSc solvers */
-    o.bodies[0] = B_BALL, o.bodies[1] = B_HOLLOW, o.nbodies = 2;
-    o.solvers[0] = S_CHOLMOD, o.solvers[1] = S_CGMG, o.solvers[2] = S_PGAMG;
-    o.solvers[3] = S_PMUMPS, o.solvers[4] = S_PMG, o.nsolvers = 5;
+    o->bodies[0] = B_BALL, o->bodies[1] = B_HOLLOW, o->nbodies = 2;
+    o->solvers[0] = S_CHOLMOD, o->solvers[1] = S_CGMG, o->solvers[2] = S_PGAMG;
+    o->solvers[3] = S_PMUMPS, o->solvers[4] = S_PMG, o->nsolvers = 5;
   } else {
-    o.nsolvers = NSOLVER - 3; /* the serial ones */
+    o->nsolvers = NSOLVER - 3; /* the serial ones */
   }
-  if (bodies && !parse_names("--bodies", bodies, body_names, o.bodies, &o.nbodies)) return 2;
-  if (solvers && !parse_names("--solvers", solvers, solver_names, o.solvers, &o.nsolvers)) return 2;
-  for (int i = 0; i < o.nsolvers && !petsc; i++)
-    if (IS_PETSC(o.solvers[i])) {
+  if (bodies && !parse_names("--bodies", bodies, body_names, o->bodies, &o->nbodies)) return 2;
+  if (solvers && !parse_names("--solvers", solvers, solver_names, o->solvers, &o->nsolvers))
+    return 2;
+  for (int i = 0; i < o->nsolvers && !petsc; i++)
+    if (IS_PETSC(o->solvers[i])) {
       fprintf(stderr, PROG ": --solvers: %s runs with --backend petsc only\n",
-              solver_names[o.solvers[i]]);
+              solver_names[o->solvers[i]]);
       return 2;
     }
-  if (petsc && o.constrain_ratio != fcm_space_options_default().constrain_ratio) {
+  if (petsc && o->constrain_ratio != fcm_space_options_default().constrain_ratio) {
     fprintf(stderr,
             PROG ": --constrain-ratio: the PETSc backend builds its space with the "
                  "library's default (%g); drop the option with --backend petsc\n",
@@ -301,11 +301,24 @@ static int scaling_main(int argc, char **argv, int pargc, char **pargv)
     return 2;
   }
   /* cholmod first: it gives the reference solution */
-  for (int i = 1; i < o.nsolvers; i++)
-    if (o.solvers[i] == S_CHOLMOD) {
-      memmove(o.solvers + 1, o.solvers, sizeof *o.solvers * (size_t)i);
-      o.solvers[0] = S_CHOLMOD;
+  for (int i = 1; i < o->nsolvers; i++)
+    if (o->solvers[i] == S_CHOLMOD) {
+      memmove(o->solvers + 1, o->solvers, sizeof *o->solvers * (size_t)i);
+      o->solvers[0] = S_CHOLMOD;
     }
+  return -1;
+}
+
+static int scaling_main(int argc, char **argv, int pargc, char **pargv)
+{
+  settings o;
+  const int code = parse_options(argc, argv, &o);
+  if (code >= 0) return code;
+  const int petsc = o.backend == BACKEND_PETSC;
+#if !FCM_HAVE_PETSC
+  (void)pargc;
+  (void)pargv;
+#endif
   if (o.threads > 0) omp_set_num_threads(o.threads);
   fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   fcm_ctx *ctx = NULL;
