@@ -8,14 +8,14 @@ foreach(np 1 2)
     foreach(kind static dynamic)
       # the default solver (CG + GAMG, rtol 1e-12) with PT-Scotch
       fcm_add_test(petsc_match_${el}_${kind}_np${np} tests/petsc/match.c NP ${np}
-                       ARGS ${el} ${kind} ptscotch)
+                   ARGS ${el} ${kind} ptscotch)
     endforeach()
   endforeach()
   # the Morton-ordered partition and MUMPS (the direct option)
   fcm_add_test(petsc_match_hex8_static_ordered_mumps_np${np} tests/petsc/match.c NP ${np}
-                   ARGS hex8 static ordered ${FCM_MUMPS})
+               ARGS hex8 static ordered ${FCM_MUMPS})
   fcm_add_test(petsc_match_tet4_dynamic_ordered_mumps_np${np} tests/petsc/match.c NP ${np}
-                   ARGS tet4 dynamic ordered ${FCM_MUMPS})
+               ARGS tet4 dynamic ordered ${FCM_MUMPS})
 endforeach()
 # the distributed classification (each process intersects its share of the cells, the classes
 # are gathered) equals the serial build bit for bit: classes, fractions, pieces, DOF numbering,
@@ -27,21 +27,21 @@ foreach(np 1 2)
       set(scene_args ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json)
     endif()
     fcm_add_test(petsc_classify_${el}_np${np} tests/petsc/classify.c NP ${np}
-                     ARGS ${el} ordered ${scene_args})
+                 ARGS ${el} ordered ${scene_args})
   endforeach()
   fcm_add_test(petsc_classify_tet4_ptscotch_np${np} tests/petsc/classify.c NP ${np}
-                   ARGS tet4 ptscotch)
+               ARGS tet4 ptscotch)
   # phase 2 with simplify = auto (the exchange, then the choice's reduce; Hex20) and with a cut
   fcm_add_test(petsc_classify_auto_np${np} tests/petsc/classify.c NP ${np}
-                   ARGS tet4 ordered ${PROJECT_SOURCE_DIR}/apps/scenes twisting_cylinder.json)
+               ARGS tet4 ordered ${PROJECT_SOURCE_DIR}/apps/scenes twisting_cylinder.json)
   fcm_add_test(petsc_classify_cut_np${np} tests/petsc/classify.c NP ${np}
-                   ARGS tet4 ordered ${PROJECT_SOURCE_DIR}/apps/scenes cut_slab.json)
+               ARGS tet4 ordered ${PROJECT_SOURCE_DIR}/apps/scenes cut_slab.json)
 endforeach()
 # a process failing before its rules build (phase 2) or inside it before the per-cell loop
 # (phase 1) ends every process at the classification exchange with the message, no hang
 foreach(np 1 2)
   fcm_add_test(petsc_classify_failure_np${np} tests/petsc/classify_failure.c NP ${np}
-                   TIMEOUT 60)
+               TIMEOUT 60)
 endforeach()
 # the local topology of phase 1 (own + ghost cells): the serial numbering bit for bit, every
 # owned row's pattern the full one (and incomplete without the ghosts), exact preallocation,
@@ -51,7 +51,7 @@ foreach(np 1 2 3)
     list(GET case 0 el)
     list(GET case 1 shape)
     fcm_add_test(petsc_ghost_${el}_${shape}_np${np} tests/petsc/ghost.c NP ${np}
-                     ARGS ${el} ${shape} petsc_ghost_${el}_${shape}_np${np} TIMEOUT 120)
+                 ARGS ${el} ${shape} petsc_ghost_${el}_${shape}_np${np} TIMEOUT 120)
   endforeach()
 endforeach()
 # the local space of a cut body (several DOF copies per node, constrained copies), serial
@@ -65,9 +65,9 @@ endforeach()
 # example scenes: the PETSc backend against the serial fcm_simulation
 foreach(np 1 2)
   fcm_add_test(petsc_scene_cantilever_np${np} tests/petsc/scene.c NP ${np}
-                   ARGS ${PROJECT_SOURCE_DIR}/apps/scenes cantilever.json 1)
+               ARGS ${PROJECT_SOURCE_DIR}/apps/scenes cantilever.json 1)
   fcm_add_test(petsc_scene_vibrating_beam_np${np} tests/petsc/scene.c NP ${np}
-                   ARGS ${PROJECT_SOURCE_DIR}/apps/scenes vibrating_beam.json 10)
+               ARGS ${PROJECT_SOURCE_DIR}/apps/scenes vibrating_beam.json 10)
 endforeach()
 if(FCM_BUILD_APPS)
   # every example scene on 2 processes against the serial fcm-sim: petsc_app_scene_* below
@@ -112,30 +112,30 @@ set(FCM_SCENES ${PROJECT_SOURCE_DIR}/apps/scenes)
 foreach(np 1 2)
   # static Stable Neo-Hookean, penalty boundary constraint, traction, 3 load steps (MUMPS)
   fcm_add_test(petsc_newton_static_snh_np${np} tests/petsc/newton.c NP ${np}
-                   ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json 1)
+               ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json 1)
   # the same with CG + GAMG on the Newton systems
   fcm_add_test(petsc_newton_static_snh_gamg_np${np} tests/petsc/newton.c NP ${np}
-                   ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json 1 1e-8
-                        -ksp_type cg -pc_type gamg)
+               ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json 1 1e-8
+                    -ksp_type cg -pc_type gamg)
   # the same with CG + fcm's multigrid as PCMG (pcmg.c) on the Newton systems
   fcm_add_test(petsc_newton_static_snh_mg_np${np} tests/petsc/newton.c NP ${np}
-                   ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json 1 1e-8
-                        -ksp_type cg -pc_type mg)
+               ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json 1 1e-8
+                    -ksp_type cg -pc_type mg)
   # dynamic SNH, Nitsche on the embedded boundary (fixed and rotating caps), gravity, damping
   fcm_add_test(petsc_newton_clamped_surface_np${np} tests/petsc/newton.c NP ${np}
-                   ARGS ${FCM_SCENES} clamped_surface.json 3)
+               ARGS ${FCM_SCENES} clamped_surface.json 3)
   # linear material through Newton: traction and pressure, load steps, CG + GAMG
   fcm_add_test(petsc_newton_static_beam_np${np} tests/petsc/newton.c NP ${np}
-                   ARGS ${FCM_SCENES} static_beam.json 1)
+               ARGS ${FCM_SCENES} static_beam.json 1)
 endforeach()
 # initial velocity (Hex20, free body: momentum), and a MINRES scene with release and damping
 # (the serial run solves with MINRES to rtol 1e-5 there: compared to 1e-6; MINRES + GAMG to the
 # test's rtol 1e-12 needs up to ~500 iterations, the scene's limit, so the limit is raised: a
 # KSP that stops there makes the integrator halve the step, another path)
 fcm_add_test(petsc_newton_spinning_body_np2 tests/petsc/newton.c NP 2
-                 ARGS ${FCM_SCENES} spinning_body.json 3)
+             ARGS ${FCM_SCENES} spinning_body.json 3)
 fcm_add_test(petsc_newton_slingshot_np2 tests/petsc/newton.c NP 2
-                 ARGS ${FCM_SCENES} slingshot.json 2 1e-6 -ksp_max_it 5000)
+             ARGS ${FCM_SCENES} slingshot.json 2 1e-6 -ksp_max_it 5000)
 # the integrator on PETSc: a failure on one process, in the setup's sums, in the KSP (after the
 # step's halvings) and in a cut between steps on one process end every process with the
 # message, no hang
@@ -146,9 +146,9 @@ endforeach()
 # 3 processes: a DOF's partial Newton rows reach its owner from more than one other process
 # through PETSc's stash (on 2 there is one sender), as do the cut's rebuilt backends
 fcm_add_test(petsc_newton_clamped_surface_np3 tests/petsc/newton.c NP 3
-                 ARGS ${FCM_SCENES} clamped_surface.json 3)
+             ARGS ${FCM_SCENES} clamped_surface.json 3)
 fcm_add_test(petsc_newton_cut_late_np3 tests/petsc/newton_cut.c NP 3
-                 ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6)
+             ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6)
 if(FCM_BUILD_APPS)
   # the state of two checkpoints (fcm-sim's .fcmck or the linear driver's .fcmpk) to a relative
   # tolerance: a tool of the shell tests below (no MPI)
@@ -248,31 +248,31 @@ endif()
 # bookkeeping and the simplification choice equal to the serial ones
 foreach(np 1 2)
   fcm_add_test(petsc_newton_cut_dice_np${np} tests/petsc/newton_cut.c NP ${np}
-                   ARGS ${FCM_SCENES} dice.json 3)
+               ARGS ${FCM_SCENES} dice.json 3)
   fcm_add_test(petsc_newton_cut_slab_np${np} tests/petsc/newton_cut.c NP ${np}
-                   ARGS ${FCM_SCENES} cut_slab.json 3)
+               ARGS ${FCM_SCENES} cut_slab.json 3)
   fcm_add_test(petsc_newton_cut_cracked_beam_np${np} tests/petsc/newton_cut.c NP ${np}
-                   ARGS ${FCM_SCENES} cracked_beam.json 1)
+               ARGS ${FCM_SCENES} cracked_beam.json 1)
   fcm_add_test(petsc_newton_cut_late_np${np} tests/petsc/newton_cut.c NP ${np}
-                   ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6)
+               ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6)
 endforeach()
 # (2 processes: the choice's inputs are summed; on 1 the serial rules build decides)
 fcm_add_test(petsc_newton_auto_twisting_cylinder_np2 tests/petsc/newton_cut.c NP 2
-                 ARGS ${FCM_SCENES} twisting_cylinder.json 1 TIMEOUT 300)
+             ARGS ${FCM_SCENES} twisting_cylinder.json 1 TIMEOUT 300)
 # the late cut with CG + GAMG on the rebuilt KSP
 fcm_add_test(petsc_newton_cut_late_gamg_np2 tests/petsc/newton_cut.c NP 2
-                 ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6 1e-8
-                      -ksp_type cg -pc_type gamg)
+             ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6 1e-8
+                  -ksp_type cg -pc_type gamg)
 # each problem reads its PETSc options under its own prefix (tests/petsc/options.c): strings
 # of earlier problems do not leak into later ones; the command line wins (unprefixed: every
 # problem; -fcm2_...: the second problem alone)
 foreach(np 1 2)
   fcm_add_test(petsc_options_np${np} tests/petsc/options.c NP ${np}
-                   ARGS minres cg gmres jacobi gamg gamg)
+               ARGS minres cg gmres jacobi gamg gamg)
   fcm_add_test(petsc_options_cmdline_np${np} tests/petsc/options.c NP ${np}
-                   ARGS bcgs bcgs bcgs jacobi gamg gamg -ksp_type bcgs)
+               ARGS bcgs bcgs bcgs jacobi gamg gamg -ksp_type bcgs)
   fcm_add_test(petsc_options_prefixed_np${np} tests/petsc/options.c NP ${np}
-                   ARGS minres cg gmres jacobi jacobi gamg -fcm2_pc_type jacobi)
+               ARGS minres cg gmres jacobi jacobi gamg -fcm2_pc_type jacobi)
 endforeach()
 # fcm's geometric multigrid as PCMG (-pc_type mg): the CHOLMOD solution to 1e-8, CG iterations
 # at rtol 1e-10 bounded, fewer than GAMG's by a factor; a clear error on non-box meshes
@@ -286,17 +286,17 @@ endforeach()
 # every allocation on 2 processes, every third on 3 (oversubscribed: slower); Hex20 (its
 # first level is the Hex8 space of the same elements) every fifth on 2
 fcm_add_test(petsc_pcmg_failure_hex8_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 90
-                 ARGS hex8 4 1)
+             ARGS hex8 4 1)
 fcm_add_test(petsc_pcmg_failure_hex8_np3 tests/petsc/pcmg_failure.c NP 3 TIMEOUT 90
-                 ARGS hex8 4 3)
+             ARGS hex8 4 3)
 fcm_add_test(petsc_pcmg_failure_hex20_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 90
-                 ARGS hex20 3 5)
+             ARGS hex20 3 5)
 # the integrator on PETSc's creation (rules, local space, numbering, matrix preallocation,
 # options): every allocation on 2 processes, every third on 3
 fcm_add_test(petsc_newton_create_failure_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 120
-                 ARGS create ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 1)
+             ARGS create ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 1)
 fcm_add_test(petsc_newton_create_failure_np3 tests/petsc/pcmg_failure.c NP 3 TIMEOUT 120
-                 ARGS create ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 3)
+             ARGS create ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 3)
 # phase 2 (the integrator, -pc_type mg): every 37th allocation of the first step
 fcm_add_test(petsc_pcmg_failure_newton_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 120
-                 ARGS scene ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 37)
+             ARGS scene ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 37)
