@@ -20,9 +20,8 @@ int fcm_simplify_pays(double assemblies, double point_cost, double points_before
 /* Core-seconds per cut-cell point per assembly. Measured with
  *   OMP_NUM_THREADS=1 OMP_WAIT_POLICY=passive fcm-converge payoff --csv payoff.csv
  * (column point_cost: the CPU time an assembly saves divided by the points it saves, on the
- * hemisphere at res 8, geometry n 8, with the elements' default strengths; 2026-11-23, one
- * core of the 2-core development machine); re-measure after a change of the assembly
- * kernels. */
+ * hemisphere at res 8, geometry n 8, with the elements' default strengths, on one core);
+ * re-measure after a change of the assembly kernels. */
 double fcm_cell_rules_point_cost(fcm_element_type type, fcm_rule_kind kind)
 {
   static const double cost[FCM_ELEMENT_COUNT][FCM_RULE_KIND_COUNT] = {

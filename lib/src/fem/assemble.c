@@ -122,7 +122,7 @@ typedef struct kernel_data {
   fcm_material_params mat_psd;     /* *mat with project_psd = 1 */
 } kernel_data;
 
-/* The material at a fictitious stabilization point (lib/METHOD.md §7, issue 19): the exact
+/* The material at a fictitious stabilization point (lib/METHOD.md §7): the exact
  * model's tangent times alpha is indefinite and does not lift the small blocks of cut
  * cells, so these points carry a positive semi-definite tangent. PROJECTED keeps the
  * exact energy and force (rotation invariant) and projects the tangent: the Newton

@@ -162,11 +162,11 @@ typedef struct fcm__direct_ops {
   void (*destroy)(fcm_ctx *ctx, void *impl); /* accepts impl == NULL */
 } fcm__direct_ops;
 
-/* Numerical rank checks of the direct path (issue 19; calibration in cholmod_adapter.c and
- * direct.c): a CHOLMOD pivot below this fraction of its column's diagonal, or a solve whose
- * normwise backward error ||b - A x|| / (||A|| ||x|| + ||b||) (infinity norms) exceeds the
- * second value, or an UMFPACK factor whose rcond (min/max |diag U|, row-scaled) is below the
- * third, is refused with FCM_ERR_SINGULAR and the hint below. */
+/* Numerical rank checks of the direct path (calibration in cholmod_adapter.c and direct.c): a
+ * CHOLMOD pivot below this fraction of its column's diagonal, or a solve whose normwise backward
+ * error ||b - A x|| / (||A|| ||x|| + ||b||) (infinity norms) exceeds the second value, or an
+ * UMFPACK factor whose rcond (min/max |diag U|, row-scaled) is below the third, is refused with
+ * FCM_ERR_SINGULAR and the hint below. */
 #define FCM__SINGULAR_PIVOT_RATIO    1e-10
 #define FCM__SINGULAR_BACKWARD_ERROR 1e-8
 #define FCM__SINGULAR_UMFPACK_RCOND  1e-13
