@@ -1,5 +1,6 @@
-/* fem module internals: the space layout shared by space.c, assemble.c and locate.c
- * (immutable after fcm_space_create). */
+/* fem module internals: the space layout shared by the module's files (space.c with
+ * numbering.c and topology.c, assemble.c, eval.c, locate.c, fields.c; immutable after
+ * fcm_space_create). */
 #ifndef FCM_FEM_IMPL_H
 #define FCM_FEM_IMPL_H
 
