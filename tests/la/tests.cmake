@@ -10,3 +10,5 @@ fcm_add_test(la_csr tests/la/csr.c)
 fcm_add_test(la_direct tests/la/direct.c)
 # Allocation failures: fcm_csr_create and fcm_csr_wrap.
 fcm_add_test(la_alloc_failure tests/la/alloc_failure.c)
+# The sparse triple product P^T A P against a dense product, 1 and 2 threads.
+fcm_add_test(la_ptap tests/la/ptap.c)

@@ -122,7 +122,7 @@ typedef struct kernel_data {
   fcm_material_params mat_psd;     /* *mat with project_psd = 1 */
 } kernel_data;
 
-/* The material at a fictitious stabilization point (lib/METHOD.md §7, issue 19): the exact
+/* The material at a fictitious stabilization point (lib/METHOD.md §7): the exact
  * model's tangent times alpha is indefinite and does not lift the small blocks of cut
  * cells, so these points carry a positive semi-definite tangent. PROJECTED keeps the
  * exact energy and force (rotation invariant) and projects the tangent: the Newton
@@ -197,133 +197,185 @@ typedef struct cell_result {
   int inverted;   /* hyperelastic: authentic points with det F <= 0 */
 } cell_result;
 
-/* Element matrix Ke (3nn x 3nn, row-major) and/or vector fe (3nn) of one cell.
- * Linear stiffness: with v the 3nn-vector of all physical gradients at a point,
- * H = sum_q w_q det J_q v v^T (one symmetric rank-one update per point, the only
- * work that grows with the number of points) gives the isotropic element matrix
- * K_(a,i)(b,j) = lambda H_(a,i)(b,j) + mu H_(a,j)(b,i) + mu delta_ij sum_k H_(a,k)(b,k).
- * Hyperelastic: F = I + sum_a u_a (x) g_a; f_(a,i) = sum_q wd P_iJ g_aJ and
- * K_(a,i)(b,k) = sum_q wd g_aJ A_iJkL g_bL with A = dP/dF. */
-static cell_result cell_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
+/* The physical gradients (w->g) at point q of rule r and the weight w_q det J_q; 0 with
+ * res->bad_det set when det J_q is not positive. */
+static int point_weight(const cell_rule *r, int nn, int q, scratch *w, cell_result *res, double *wd)
 {
-  int ndof = 3 * nn;
+  const double det = physical_gradients(r, nn, q, w->X, w->g);
+  if (!(det > 0.0)) {
+    res->bad_det = det;
+    return 0;
+  }
+  *wd = r->w[q] * det;
+  return 1;
+}
+
+/* Linear stiffness Ke (3nn x 3nn, row-major). With v the 3nn-vector of all physical gradients
+ * at a point, H = sum_q w_q det J_q v v^T (one symmetric rank-one update per point, the only
+ * work that grows with the number of points) gives the isotropic element matrix
+ * K_(a,i)(b,j) = lambda H_(a,i)(b,j) + mu H_(a,j)(b,i) + mu delta_ij sum_k H_(a,k)(b,k). */
+static cell_result stiffness_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
+{
+  const int ndof = 3 * nn;
   cell_result res = {0.0, 1.0, 0, 0};
-  double *g = w->g, *H = w->H, *Ke = w->Ke, *fe = w->fe;
-  int matrix = kd->kind == KERNEL_STIFFNESS || kd->kind == KERNEL_MASS ||
-               (kd->kind == KERNEL_HYPERELASTIC && kd->want_tangent);
-  if (kd->kind == KERNEL_STIFFNESS || kd->kind == KERNEL_MASS)
-    memset(H, 0, sizeof *H * (size_t)ndof * ndof);
-  if (matrix) memset(Ke, 0, sizeof *Ke * (size_t)ndof * ndof);
+  double *g = w->g, *H = w->H, *Ke = w->Ke, wd = 0.0;
+  memset(H, 0, sizeof *H * (size_t)ndof * ndof);
+  memset(Ke, 0, sizeof *Ke * (size_t)ndof * ndof);
+  for (int q = 0; q < r->nq; q++) {
+    if (!point_weight(r, nn, q, w, &res, &wd)) return res;
+    for (int a = 0; a < ndof; a++) {
+      double sa = wd * g[a], *Ha = H + (size_t)a * ndof;
+      for (int b = a; b < ndof; b++)
+        Ha[b] += sa * g[b];
+    }
+  }
+  const double l = kd->lambda, m = kd->mu;
+  for (int a = 0; a < ndof; a++) /* complete H from its upper triangle */
+    for (int b = 0; b < a; b++)
+      H[(size_t)a * ndof + b] = H[(size_t)b * ndof + a];
+  for (int a = 0; a < nn; a++)
+    for (int b = a; b < nn; b++) {
+      const double *Hab = H + (size_t)(3 * a) * ndof + 3 * b; /* block (a, b) of H */
+      double tr = m * (Hab[0] + Hab[ndof + 1] + Hab[2 * ndof + 2]);
+      for (int i = 0; i < 3; i++) {
+        double *row = Ke + (size_t)(3 * a + i) * ndof + 3 * b;
+        for (int j = 0; j < 3; j++)
+          row[j] = l * Hab[i * ndof + j] + m * Hab[j * ndof + i];
+        row[i] += tr;
+      }
+    }
+  mirror_blocks(nn, Ke);
+  return res;
+}
+
+/* Consistent mass Ke: the scalar matrix H = sum_q w_q det J_q rho N N^T on each component. */
+static cell_result mass_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
+{
+  const int ndof = 3 * nn;
+  cell_result res = {0.0, 1.0, 0, 0};
+  double *H = w->H, *Ke = w->Ke, wd = 0.0;
+  memset(H, 0, sizeof *H * (size_t)ndof * ndof);
+  memset(Ke, 0, sizeof *Ke * (size_t)ndof * ndof);
+  for (int q = 0; q < r->nq; q++) {
+    if (!point_weight(r, nn, q, w, &res, &wd)) return res;
+    const double *N = r->N + (size_t)q * nn;
+    double rw = wd * kd->rho;
+    for (int a = 0; a < nn; a++) {
+      double sa = rw * N[a], *Ha = H + (size_t)a * nn;
+      for (int b = a; b < nn; b++)
+        Ha[b] += sa * N[b];
+    }
+  }
+  for (int a = 0; a < nn; a++)
+    for (int b = a; b < nn; b++)
+      for (int i = 0; i < 3; i++)
+        Ke[(size_t)(3 * a + i) * ndof + 3 * b + i] = H[(size_t)a * nn + b];
+  mirror_blocks(nn, Ke);
+  return res;
+}
+
+/* Body force fe (3nn): rho * accel, or the force density field b(X), against N. */
+static cell_result body_force_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
+{
+  cell_result res = {0.0, 1.0, 0, 0};
+  double *fe = w->fe, wd = 0.0;
+  memset(fe, 0, sizeof *fe * (size_t)(3 * nn));
+  for (int q = 0; q < r->nq; q++) {
+    if (!point_weight(r, nn, q, w, &res, &wd)) return res;
+    const double *N = r->N + (size_t)q * nn;
+    double b[3] = {kd->rho * kd->accel[0], kd->rho * kd->accel[1], kd->rho * kd->accel[2]};
+    if (kd->field) {
+      double x[3] = {0, 0, 0};
+      for (int a = 0; a < nn; a++)
+        for (int i = 0; i < 3; i++)
+          x[i] += N[a] * w->X[3 * a + i];
+      kd->field(kd->field_user, x, NULL, b);
+    }
+    for (int a = 0; a < nn; a++)
+      for (int i = 0; i < 3; i++)
+        fe[3 * a + i] += wd * b[i] * N[a];
+  }
+  return res;
+}
+
+/* Hyperelastic energy, internal force fe and (want_tangent) tangent Ke at the displacement
+ * w->ue: F = I + sum_a u_a (x) g_a; f_(a,i) = sum_q wd P_iJ g_aJ and
+ * K_(a,i)(b,k) = sum_q wd g_aJ A_iJkL g_bL with A = dP/dF. */
+static cell_result hyperelastic_kernel(const kernel_data *kd, const cell_rule *r, int nn,
+                                       scratch *w)
+{
+  const int ndof = 3 * nn;
+  cell_result res = {0.0, 1.0, 0, 0};
+  double *g = w->g, *Ke = w->Ke, *fe = w->fe, wd = 0.0;
+  if (kd->want_tangent) memset(Ke, 0, sizeof *Ke * (size_t)ndof * ndof);
   memset(fe, 0, sizeof *fe * (size_t)ndof);
   for (int q = 0; q < r->nq; q++) {
-    double det = physical_gradients(r, nn, q, w->X, g);
-    if (!(det > 0.0)) {
-      res.bad_det = det;
+    if (!point_weight(r, nn, q, w, &res, &wd)) return res;
+    double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, psi = 0.0, P[9], A[81];
+    for (int a = 0; a < nn; a++)
+      for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+          F[3 * i + j] += w->ue[3 * a + i] * g[3 * a + j];
+    if (r->fict && r->fict[q]) {
+      fictitious_eval(kd, F, &psi, P, kd->want_tangent ? A : NULL);
+    } else {
+      /* an inverted point of the body: counted, the material still evaluates it (the
+       * Stable Neo-Hookean and corotated models are defined there) */
+      res.inverted += !(fcm__mat3_det(F) > 0.0);
+      fcm__material_eval(kd->mat, F, &psi, P, kd->want_tangent ? A : NULL);
+    }
+    int finite = isfinite(psi);
+    for (int k = 0; k < 9; k++)
+      finite &= isfinite(P[k]);
+    if (!finite) {
+      res.nonfinite = 1;
       return res;
     }
-    double wd = r->w[q] * det;
-    const double *N = r->N + (size_t)q * nn;
-    switch (kd->kind) {
-    case KERNEL_STIFFNESS:
-      for (int a = 0; a < ndof; a++) {
-        double sa = wd * g[a], *Ha = H + (size_t)a * ndof;
-        for (int b = a; b < ndof; b++)
-          Ha[b] += sa * g[b];
-      }
-      break;
-    case KERNEL_MASS: {
-      double rw = wd * kd->rho;
-      for (int a = 0; a < nn; a++) {
-        double sa = rw * N[a], *Ha = H + (size_t)a * nn;
-        for (int b = a; b < nn; b++)
-          Ha[b] += sa * N[b];
-      }
-    } break;
-    case KERNEL_BODY_FORCE: {
-      double b[3] = {kd->rho * kd->accel[0], kd->rho * kd->accel[1], kd->rho * kd->accel[2]};
-      if (kd->field) {
-        double x[3] = {0, 0, 0};
-        for (int a = 0; a < nn; a++)
-          for (int i = 0; i < 3; i++)
-            x[i] += N[a] * w->X[3 * a + i];
-        kd->field(kd->field_user, x, NULL, b);
-      }
-      for (int a = 0; a < nn; a++)
-        for (int i = 0; i < 3; i++)
-          fe[3 * a + i] += wd * b[i] * N[a];
-    } break;
-    case KERNEL_HYPERELASTIC: {
-      double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, psi = 0.0, P[9], A[81];
-      for (int a = 0; a < nn; a++)
-        for (int i = 0; i < 3; i++)
-          for (int j = 0; j < 3; j++)
-            F[3 * i + j] += w->ue[3 * a + i] * g[3 * a + j];
-      if (r->fict && r->fict[q]) {
-        fictitious_eval(kd, F, &psi, P, kd->want_tangent ? A : NULL);
-      } else {
-        /* an inverted point of the body: counted, the material still evaluates it (the
-         * Stable Neo-Hookean and corotated models are defined there) */
-        res.inverted += !(fcm__mat3_det(F) > 0.0);
-        fcm__material_eval(kd->mat, F, &psi, P, kd->want_tangent ? A : NULL);
-      }
-      int finite = isfinite(psi);
-      for (int k = 0; k < 9; k++)
-        finite &= isfinite(P[k]);
-      if (!finite) {
-        res.nonfinite = 1;
-        return res;
-      }
-      res.energy += wd * psi;
-      for (int a = 0; a < nn; a++) {
-        const double *ga = g + 3 * a;
-        for (int i = 0; i < 3; i++)
-          fe[3 * a + i] += wd * (P[3 * i] * ga[0] + P[3 * i + 1] * ga[1] + P[3 * i + 2] * ga[2]);
-      }
-      if (!kd->want_tangent) break;
-      for (int b = 0; b < nn; b++) {
-        /* C[i][J][k] = wd sum_L A_iJkL g_bL, then K_(a,i)(b,k) += sum_J g_aJ C[i][J][k] */
-        const double *gb = g + 3 * b;
-        double C[27];
-        for (int m = 0; m < 27; m++) {
-          const double *Am = A + 3 * m;
-          C[m] = wd * (Am[0] * gb[0] + Am[1] * gb[1] + Am[2] * gb[2]);
-        }
-        for (int a = 0; a <= b; a++) {
-          const double *ga = g + 3 * a;
-          for (int i = 0; i < 3; i++) {
-            double *row = Ke + (size_t)(3 * a + i) * ndof + 3 * b;
-            for (int k = 0; k < 3; k++)
-              row[k] += ga[0] * C[9 * i + k] + ga[1] * C[9 * i + 3 + k] + ga[2] * C[9 * i + 6 + k];
-          }
-        }
-      }
-    } break;
+    res.energy += wd * psi;
+    for (int a = 0; a < nn; a++) {
+      const double *ga = g + 3 * a;
+      for (int i = 0; i < 3; i++)
+        fe[3 * a + i] += wd * (P[3 * i] * ga[0] + P[3 * i + 1] * ga[1] + P[3 * i + 2] * ga[2]);
     }
-  }
-  if (kd->kind == KERNEL_STIFFNESS) {
-    double l = kd->lambda, m = kd->mu;
-    for (int a = 0; a < ndof; a++) /* complete H from its upper triangle */
-      for (int b = 0; b < a; b++)
-        H[(size_t)a * ndof + b] = H[(size_t)b * ndof + a];
-    for (int a = 0; a < nn; a++)
-      for (int b = a; b < nn; b++) {
-        const double *Hab = H + (size_t)(3 * a) * ndof + 3 * b; /* block (a, b) of H */
-        double tr = m * (Hab[0] + Hab[ndof + 1] + Hab[2 * ndof + 2]);
+    if (!kd->want_tangent) continue;
+    for (int b = 0; b < nn; b++) {
+      /* C[i][J][k] = wd sum_L A_iJkL g_bL, then K_(a,i)(b,k) += sum_J g_aJ C[i][J][k] */
+      const double *gb = g + 3 * b;
+      double C[27];
+      for (int m = 0; m < 27; m++) {
+        const double *Am = A + 3 * m;
+        C[m] = wd * (Am[0] * gb[0] + Am[1] * gb[1] + Am[2] * gb[2]);
+      }
+      for (int a = 0; a <= b; a++) {
+        const double *ga = g + 3 * a;
         for (int i = 0; i < 3; i++) {
           double *row = Ke + (size_t)(3 * a + i) * ndof + 3 * b;
-          for (int j = 0; j < 3; j++)
-            row[j] = l * Hab[i * ndof + j] + m * Hab[j * ndof + i];
-          row[i] += tr;
+          for (int k = 0; k < 3; k++)
+            row[k] += ga[0] * C[9 * i + k] + ga[1] * C[9 * i + 3 + k] + ga[2] * C[9 * i + 6 + k];
         }
       }
-  } else if (kd->kind == KERNEL_MASS) {
-    for (int a = 0; a < nn; a++)
-      for (int b = a; b < nn; b++)
-        for (int i = 0; i < 3; i++)
-          Ke[(size_t)(3 * a + i) * ndof + 3 * b + i] = H[(size_t)a * nn + b];
+    }
   }
-  if (matrix) mirror_blocks(nn, Ke);
+  if (kd->want_tangent) mirror_blocks(nn, Ke);
   return res;
+}
+
+/* Element matrix Ke (3nn x 3nn, row-major) and/or vector fe (3nn) of one cell: the kernel of
+ * the integrand. fe is zero after a matrix kernel. */
+static cell_result cell_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
+{
+  switch (kd->kind) {
+  case KERNEL_STIFFNESS:
+    memset(w->fe, 0, sizeof *w->fe * (size_t)(3 * nn));
+    return stiffness_kernel(kd, r, nn, w);
+  case KERNEL_MASS:
+    memset(w->fe, 0, sizeof *w->fe * (size_t)(3 * nn));
+    return mass_kernel(kd, r, nn, w);
+  case KERNEL_BODY_FORCE:
+    return body_force_kernel(kd, r, nn, w);
+  default:
+    return hyperelastic_kernel(kd, r, nn, w);
+  }
 }
 
 /* Add the element matrix of local element le into the values of the space's pattern (its
@@ -833,98 +885,6 @@ fcm_status fcm_assemble_hyperelastic(const fcm_space *s, const fcm_material_para
   FCM_TRY(s->ctx, fcm_assembly_workspace_hyperelastic(ws, mat, u, energy, force, tangent));
 cleanup:
   fcm_assembly_workspace_destroy(&ws);
-  return st;
-}
-
-fcm_status fcm_space_eval(const fcm_space *s, fcm_index cell, const double xi[3], const double *u,
-                          double value[3])
-{
-  fcm_status st = FCM_OK;
-  FCM_CHECK(cell >= 0 && cell < s->num_cells && s->active[cell], s->ctx, FCM_ERR_ARG,
-            "space eval: cell %lld is out of range [0, %lld) or inactive", (long long)cell,
-            (long long)s->num_cells);
-  FCM_CHECK(s->cell_elem[cell + 1] - s->cell_elem[cell] == 1, s->ctx, FCM_ERR_ARG,
-            "space eval: cell %lld is split into %lld pieces by cuts: evaluate per element "
-            "(fcm_space_element_eval())",
-            (long long)cell, (long long)(s->cell_elem[cell + 1] - s->cell_elem[cell]));
-  FCM_TRY(s->ctx, fcm_space_element_eval(s, s->cell_elem[cell], xi, u, value));
-cleanup:
-  return st;
-}
-
-fcm_status fcm_space_element_eval(const fcm_space *s, fcm_index elem, const double xi[3],
-                                  const double *u, double value[3])
-{
-  fcm_status st = FCM_OK;
-  double N[FCM_ELEMENT_MAX_NODES];
-  FCM_CHECK(elem >= 0 && elem < s->num_elems, s->ctx, FCM_ERR_ARG,
-            "space eval: element %lld is out of range [0, %lld)", (long long)elem,
-            (long long)s->num_elems);
-  fcm_element_eval_shape(s->type, xi, N);
-  value[0] = value[1] = value[2] = 0.0;
-  {
-    for (int a = 0; a < s->nn; a++) {
-      fcm_index d = s->elem_dof[elem * s->nn + a];
-      for (int i = 0; i < 3; i++)
-        value[i] += N[a] * u[d + i];
-    }
-  }
-cleanup:
-  return st;
-}
-
-fcm_status fcm_space_momentum(const fcm_space *s, double density, const double *u, const double *v,
-                              double *mass, double linear[3], double angular[3])
-{
-  fcm_status st = FCM_OK;
-  fcm_ctx *ctx = s ? s->ctx : NULL;
-  double m = 0.0, p[3] = {0, 0, 0}, L[3] = {0, 0, 0};
-  FCM_CHECK(s, ctx, FCM_ERR_ARG, "momentum: space is NULL");
-  FCM_CHECK(isfinite(density) && density >= 0.0, ctx, FCM_ERR_ARG,
-            "momentum: density = %g must be finite and >= 0", density);
-  FCM_CHECK(!s->rules || fcm_cell_rules_has_kind(s->rules, FCM_RULE_MASS), ctx, FCM_ERR_ARG,
-            "momentum: integrates with the mass rules, but the space's cell rules were built "
-            "without them (add FCM_RULES_MASS to fcm_cell_rules_options.kinds)");
-  const fcm_rule *full = s->mass_rule;
-  for (fcm_index e = 0; e < s->num_elems; e++) {
-    const fcm_index c = s->elem_cell[e];
-    int nq = 0;
-    const double *pts = NULL, *w = NULL;
-    const unsigned char *fl = NULL;
-    if (!fcm__cell_rules_owns(s->rules, c)) continue; /* another process's cell (cell_mask) */
-    if (s->rules && fcm_cell_rules_class(s->rules, c) != FCM_CELL_UNCUT) {
-      FCM_TRY(ctx, fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], FCM_RULE_MASS, &nq, &pts,
-                                            &w, &fl));
-    } else {
-      nq = fcm_rule_num_points(full);
-      pts = fcm_rule_points(full);
-      w = fcm_rule_weights(full);
-    }
-    double X[3 * FCM_ELEMENT_MAX_NODES], J[9], N[FCM_ELEMENT_MAX_NODES];
-    fcm_mesh_cell_coords(s->mesh, c, X);
-    const fcm_index *ed = s->elem_dof + e * s->nn;
-    for (int q = 0; q < nq; q++) {
-      if (fl && fl[q]) continue; /* fictitious stabilization points: not the body */
-      const double wd = density * w[q] * fcm_element_jacobian(s->type, X, pts + 3 * q, J);
-      fcm_element_eval_shape(s->type, pts + 3 * q, N);
-      double x[3] = {0, 0, 0}, vq[3] = {0, 0, 0};
-      for (int a = 0; a < s->nn; a++)
-        for (int i = 0; i < 3; i++) {
-          x[i] += N[a] * (X[3 * a + i] + (u ? u[ed[a] + i] : 0.0));
-          vq[i] += N[a] * (v ? v[ed[a] + i] : 0.0);
-        }
-      m += wd;
-      for (int i = 0; i < 3; i++)
-        p[i] += wd * vq[i];
-      L[0] += wd * (x[1] * vq[2] - x[2] * vq[1]);
-      L[1] += wd * (x[2] * vq[0] - x[0] * vq[2]);
-      L[2] += wd * (x[0] * vq[1] - x[1] * vq[0]);
-    }
-  }
-  if (mass) *mass = m;
-  if (linear) memcpy(linear, p, sizeof p);
-  if (angular) memcpy(angular, L, sizeof L);
-cleanup:
   return st;
 }
 

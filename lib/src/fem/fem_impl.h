@@ -1,5 +1,6 @@
-/* fem module internals: the space layout shared by space.c, assemble.c and locate.c
- * (immutable after fcm_space_create). */
+/* fem module internals: the space layout shared by the module's files (space.c with
+ * numbering.c and topology.c, assemble.c, eval.c, locate.c, fields.c; immutable after
+ * fcm_space_create). */
 #ifndef FCM_FEM_IMPL_H
 #define FCM_FEM_IMPL_H
 
@@ -204,6 +205,31 @@ fcm_status fcm__space_body_labels(const fcm_space *s, fcm_index *elem_body, fcm_
 /* Physical shape-function gradients g (nn x 3) at a point from the reference ones dN (nn x 3)
  * and the nodal coordinates X (nn x 3); returns det J (not positive: g is not written). */
 double fcm__fem_gradients(int nn, const double *X, const double *dN, double *g);
+
+/* ---- creating a space, phase after phase (space.c drives) */
+
+/* The elements: one per material piece of each active cell (cell_elem, elem_cell, elem_piece;
+ * one per cell without rules). (numbering.c) */
+fcm_status fcm__space_build_elements(fcm_space *s);
+
+/* The elements at each node: CSR over the nodes (*inc_ptr, *inc allocated). (numbering.c) */
+fcm_status fcm__space_build_incidence(fcm_space *s, fcm_index **inc_ptr, fcm_index **inc);
+
+/* The copies of each node (generalized enrichment) and elem_dof. (numbering.c) */
+fcm_status fcm__space_build_copies(fcm_space *s, const fcm_index *inc_ptr, const fcm_index *inc);
+
+/* Koschier's constraint of the copies whose support is below `ratio` of their node's;
+ * renumbers without the unused copies. (numbering.c) */
+fcm_status fcm__space_constrain_copies(fcm_space *s, double ratio, const fcm_index *inc_ptr,
+                                       const fcm_index *inc);
+
+/* The topology (copy graph, pattern, offsets, colours) of every element (!local) or of the
+ * elements of the cells flagged in cell_mask (local); replaces any earlier one.
+ * (topology.c) */
+fcm_status fcm__space_build_topology(fcm_space *s, int local, const unsigned char *cell_mask);
+
+/* Release the topology. (topology.c) */
+void fcm__space_free_topology(fcm_space *s);
 
 /* The support of every DOF copy (num_dofs / 3 entries): the summed volume of the pieces
  * (elements) that use it, 1 per element without rules. Used to pick a node's largest copy

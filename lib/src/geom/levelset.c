@@ -403,6 +403,208 @@ static int cmp_keyslot(const void *a, const void *b)
   return (x->key > y->key) - (x->key < y->key);
 }
 
+/* The arguments (but ctx and geom), B's box and the sampling step inf->h; FCM_ERR_ARG names
+ * the first bad one. */
+static fcm_status check_args(fcm_ctx *ctx, fcm_level_set_fn phi, void *user, const double lo[3],
+                             const double hi[3], const fcm_index n[3],
+                             const fcm_level_set_options *o, builder *B, fcm_level_set_info *inf)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(phi && lo && hi && n, ctx, FCM_ERR_ARG, "level set: phi, lo, hi or n is NULL");
+  FCM_CHECK(o->refinement >= 1 && o->refinement <= 64, ctx, FCM_ERR_ARG,
+            "level set: refinement %d outside [1, 64]", o->refinement);
+  FCM_CHECK(o->max_subcells >= 0, ctx, FCM_ERR_ARG, "level set: max_subcells = %lld must be >= 0",
+            (long long)o->max_subcells);
+  FCM_CHECK(o->progress_interval >= 0.0 && isfinite(o->progress_interval), ctx, FCM_ERR_ARG,
+            "level set: progress_interval = %g must be finite and >= 0 seconds",
+            o->progress_interval);
+  double subcells = 1.0;
+  for (int d = 0; d < 3; d++) {
+    FCM_CHECK(isfinite(lo[d]) && isfinite(hi[d]) && lo[d] < hi[d], ctx, FCM_ERR_ARG,
+              "level set: box axis %d: need finite lo < hi, got [%g, %g]", d, lo[d], hi[d]);
+    FCM_CHECK(n[d] >= 1 && n[d] <= 10000, ctx, FCM_ERR_ARG,
+              "level set: cells on axis %d = %lld outside [1, 10000]", d, (long long)n[d]);
+    subcells *= (double)n[d] * 2.0 * o->refinement;
+    B->lo[d] = lo[d], B->hi[d] = hi[d];
+    inf->h = fmax(inf->h, (hi[d] - lo[d]) / ((double)n[d] * o->refinement));
+  }
+  FCM_CHECK(subcells <= 2147483648.0, ctx, FCM_ERR_ARG,
+            "level set: %lld x %lld x %lld cells at refinement %d (error estimate at %d) give "
+            "%.3g sub-cells, more than 2^31",
+            (long long)n[0], (long long)n[1], (long long)n[2], o->refinement, 2 * o->refinement,
+            subcells);
+  if (phi == fcm_implicit_eval) { /* a built-in tree: valid, and resolved by the sampling */
+    FCM_TRY(ctx, fcm_implicit_check_spacing(ctx, user, inf->h));
+  }
+cleanup:
+  return st;
+}
+
+/* Pass 0: classify the cells (kinds) and count the sub-cells the surface crosses (nothing
+ * stored), so that an oversize build is refused before its tets are allocated; then the
+ * progress total. */
+static fcm_status classify_cells(builder *B, const fcm_index n[3], int r, lvert *w,
+                                 unsigned char *kinds, fcm_level_set_info *inf)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_level_set_options *o = B->opts;
+  const int64_t r3 = (int64_t)r * r * r;
+  size_t ci = 0;
+  for (int64_t k = 0; k < n[2]; k++)
+    for (int64_t j = 0; j < n[1]; j++)
+      for (int64_t i = 0; i < n[0]; i++, ci++) {
+        const int64_t cell[3] = {i, j, k};
+        cell_kind kind;
+        int64_t cut = 0;
+        FCM_TRY(ctx, sample_cell(B, cell, r, w, &kind, &cut));
+        kinds[ci] = (unsigned char)kind;
+        inf->cells_inside += kind == CELL_INSIDE;
+        inf->cells_cut += kind == CELL_CUT;
+        inf->cells_outside += kind == CELL_OUTSIDE;
+        inf->subcells += cut;
+      }
+  /* a cell wholly inside becomes 6 tets: counted as one sub-cell (about half the memory of
+   * one the surface crosses); refine_inside: every sub-cube of a cut or inside cell is split
+   * on its own, counted alike */
+  inf->subcells = o->refine_inside ? (inf->cells_cut + inf->cells_inside) * r3
+                                   : inf->subcells + inf->cells_inside;
+  const fcm_index estimate = inf->subcells;
+  FCM_CHECK(o->max_subcells == 0 || estimate <= o->max_subcells, ctx, FCM_ERR_UNSUPPORTED,
+            "level set: the build would triangulate %lld sub-cells (%lld cut and %lld inside "
+            "cells at refinement %d; about %.3g GB at %d kB each), more than max_subcells = %lld "
+            "(about %.3g GB); raise max_subcells (0: no limit), or lower the refinement or the "
+            "sampling cells",
+            (long long)estimate, (long long)inf->cells_cut, (long long)inf->cells_inside, r,
+            (double)estimate * FCM_LEVEL_SET_SUBCELL_BYTES / 1e9,
+            FCM_LEVEL_SET_SUBCELL_BYTES / 1000, (long long)o->max_subcells,
+            (double)o->max_subcells * FCM_LEVEL_SET_SUBCELL_BYTES / 1e9);
+  B->total = (inf->cells_cut + (o->refine_inside ? inf->cells_inside : 0)) * r3;
+  if (o->estimate_error) B->total += inf->cells_cut * 8 * r3;
+cleanup:
+  return st;
+}
+
+/* Pass 1: the cells that are not outside at refinement r, stored. */
+static fcm_status build_cells(builder *B, const fcm_index n[3], int r, lvert *w,
+                              unsigned char *todo, unsigned char *kinds)
+{
+  fcm_status st = FCM_OK;
+  const int refine_inside = B->opts->refine_inside;
+  const int64_t r3 = (int64_t)r * r * r;
+  B->store = 1;
+  size_t ci = 0;
+  for (int64_t k = 0; k < n[2]; k++)
+    for (int64_t j = 0; j < n[1]; j++)
+      for (int64_t i = 0; i < n[0]; i++, ci++) {
+        if (kinds[ci] == CELL_OUTSIDE) continue;
+        const int64_t cell[3] = {i, j, k};
+        cell_kind kind;
+        FCM_TRY(B->ctx, do_cell(B, cell, r, !refine_inside, w, todo, &kind));
+        kinds[ci] = (unsigned char)kind; /* phi is sampled as in pass 0 */
+        if (kind == CELL_CUT || (kind == CELL_INSIDE && refine_inside)) advance(B, r3);
+      }
+cleanup:
+  return st;
+}
+
+/* Pass 2 (volume only): the cut cells at refinement 2r, the others as they were; the volume at
+ * 2r and the error estimate into inf. */
+static fcm_status estimate_error(builder *B, const fcm_index n[3], int r, lvert *w,
+                                 unsigned char *todo, const unsigned char *kinds,
+                                 fcm_level_set_info *inf)
+{
+  fcm_status st = FCM_OK;
+  const int64_t r3 = (int64_t)r * r * r;
+  builder F = *B;
+  F.store = 0, F.nodes = NULL, F.tri = NULL, F.towner = NULL, F.volume = 0.0;
+  for (int d = 0; d < 3; d++)
+    F.N[d] = (int64_t)n[d] * 2 * r;
+  size_t ci = 0;
+  double v_whole = 0.0;
+  for (int64_t k = 0; k < n[2]; k++)
+    for (int64_t j = 0; j < n[1]; j++)
+      for (int64_t i = 0; i < n[0]; i++, ci++) {
+        const int64_t cell[3] = {i, j, k};
+        cell_kind kind;
+        if (kinds[ci] == CELL_CUT) {
+          FCM_TRY(B->ctx, do_cell(&F, cell, 2 * r, 1, w, todo, &kind));
+          advance(&F, 8 * r3);
+        } else if (kinds[ci] == CELL_INSIDE) {
+          v_whole += 1.0;
+        }
+      }
+  B->done = F.done, B->last = F.last;
+  double cv = 1.0;
+  for (int d = 0; d < 3; d++)
+    cv *= (B->hi[d] - B->lo[d]) / (double)n[d];
+  inf->volume_fine = F.volume + v_whole * cv;
+  inf->error_estimate = 4.0 / 3.0 * fabs(inf->volume - inf->volume_fine);
+cleanup:
+  return st;
+}
+
+/* The tets' nodes made unique by key: coordinates X (*nn nodes), the sorted keys ukeys and
+ * the tets' node indices (4 per tet). */
+static fcm_status unique_nodes(const builder *B, double **X_out, fcm_index **cells_out,
+                               int64_t **ukeys_out, size_t *nn_out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  keyslot *ks = NULL;
+  double *X = NULL;
+  fcm_index *cells = NULL;
+  int64_t *ukeys = NULL;
+  const size_t nv = 4 * B->nt;
+  FCM_ALLOC_RAW(ctx, nv, ks);
+  for (size_t s = 0; s < nv; s++)
+    ks[s].key = B->nodes[s].key, ks[s].slot = s;
+  qsort(ks, nv, sizeof *ks, cmp_keyslot);
+  FCM_ALLOC_RAW(ctx, nv, cells);
+  FCM_ALLOC_RAW(ctx, 3 * nv, X);
+  FCM_ALLOC_RAW(ctx, nv, ukeys);
+  size_t nn = 0;
+  for (size_t s = 0; s < nv; s++) {
+    if (s == 0 || ks[s].key != ks[s - 1].key) {
+      memcpy(X + 3 * nn, B->nodes[ks[s].slot].x, 3 * sizeof(double));
+      ukeys[nn++] = ks[s].key;
+    }
+    cells[ks[s].slot] = (fcm_index)(nn - 1);
+  }
+  *X_out = X, *cells_out = cells, *ukeys_out = ukeys, *nn_out = nn;
+  X = NULL, cells = NULL, ukeys = NULL;
+cleanup:
+  fcm__free(ctx, ks);
+  fcm__free(ctx, X);
+  fcm__free(ctx, cells);
+  fcm__free(ctx, ukeys);
+  return st;
+}
+
+/* The boundary: the iso-surface and box-face triangles (every node is a tet node) as node
+ * indices, and the tet of each. */
+static fcm_status boundary_tris(const builder *B, const int64_t *ukeys, size_t nn,
+                                fcm_index **tris_out, fcm_index **tri_tet_out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  fcm_index *tris = NULL, *tri_tet = NULL;
+  FCM_ALLOC_RAW(ctx, 3 * B->ntri + 1, tris);
+  FCM_ALLOC_RAW(ctx, B->ntri + 1, tri_tet);
+  for (size_t k = 0; k < 3 * B->ntri; k++) {
+    const int64_t *hit = bsearch(&B->tri[k].key, ukeys, nn, sizeof *ukeys, cmp_key);
+    tris[k] = (fcm_index)(hit - ukeys);
+  }
+  for (size_t k = 0; k < B->ntri; k++)
+    tri_tet[k] = (fcm_index)B->towner[k];
+  *tris_out = tris, *tri_tet_out = tri_tet;
+  tris = tri_tet = NULL;
+cleanup:
+  fcm__free(ctx, tris);
+  fcm__free(ctx, tri_tet);
+  return st;
+}
+
 fcm_status fcm_geometry_create_from_level_set(fcm_ctx *ctx, fcm_level_set_fn phi, void *user,
                                               const double lo[3], const double hi[3],
                                               const fcm_index n[3],
@@ -413,156 +615,36 @@ fcm_status fcm_geometry_create_from_level_set(fcm_ctx *ctx, fcm_level_set_fn phi
   builder B = {0};
   lvert *w = NULL;
   unsigned char *kinds = NULL, *todo = NULL;
-  keyslot *ks = NULL;
   int64_t *ukeys = NULL;
   fcm_index *tris = NULL, *tri_tet = NULL;
   double *X = NULL;
   fcm_index *cells = NULL;
+  size_t nn = 0;
   fcm_level_set_info inf = {0};
   const fcm_level_set_options o = opts ? *opts : fcm_level_set_options_default();
   FCM_CHECK(ctx && geom, ctx, FCM_ERR_ARG, "level set: NULL argument");
   *geom = NULL;
   if (info) memset(info, 0, sizeof *info);
-  FCM_CHECK(phi && lo && hi && n, ctx, FCM_ERR_ARG, "level set: phi, lo, hi or n is NULL");
-  FCM_CHECK(o.refinement >= 1 && o.refinement <= 64, ctx, FCM_ERR_ARG,
-            "level set: refinement %d outside [1, 64]", o.refinement);
-  FCM_CHECK(o.max_subcells >= 0, ctx, FCM_ERR_ARG, "level set: max_subcells = %lld must be >= 0",
-            (long long)o.max_subcells);
-  FCM_CHECK(o.progress_interval >= 0.0 && isfinite(o.progress_interval), ctx, FCM_ERR_ARG,
-            "level set: progress_interval = %g must be finite and >= 0 seconds",
-            o.progress_interval);
-  double subcells = 1.0;
-  for (int d = 0; d < 3; d++) {
-    FCM_CHECK(isfinite(lo[d]) && isfinite(hi[d]) && lo[d] < hi[d], ctx, FCM_ERR_ARG,
-              "level set: box axis %d: need finite lo < hi, got [%g, %g]", d, lo[d], hi[d]);
-    FCM_CHECK(n[d] >= 1 && n[d] <= 10000, ctx, FCM_ERR_ARG,
-              "level set: cells on axis %d = %lld outside [1, 10000]", d, (long long)n[d]);
-    subcells *= (double)n[d] * 2.0 * o.refinement;
-    B.lo[d] = lo[d], B.hi[d] = hi[d];
-    inf.h = fmax(inf.h, (hi[d] - lo[d]) / ((double)n[d] * o.refinement));
-  }
-  FCM_CHECK(subcells <= 2147483648.0, ctx, FCM_ERR_ARG,
-            "level set: %lld x %lld x %lld cells at refinement %d (error estimate at %d) give "
-            "%.3g sub-cells, more than 2^31",
-            (long long)n[0], (long long)n[1], (long long)n[2], o.refinement, 2 * o.refinement,
-            subcells);
-  if (phi == fcm_implicit_eval) { /* a built-in tree: valid, and resolved by the sampling */
-    FCM_TRY(ctx, fcm_implicit_check_spacing(ctx, user, inf.h));
-  }
+  FCM_TRY(ctx, check_args(ctx, phi, user, lo, hi, n, &o, &B, &inf));
   B.ctx = ctx, B.phi = phi, B.user = user, B.opts = &o, B.last = fcm_wtime();
   const int r = o.refinement;
-  const int64_t r3 = (int64_t)r * r * r;
   const size_t ncell = (size_t)n[0] * (size_t)n[1] * (size_t)n[2];
   FCM_ALLOC_RAW(ctx, (size_t)(2 * r + 1) * (size_t)(2 * r + 1) * (size_t)(2 * r + 1), w);
   FCM_ALLOC_RAW(ctx, ncell, kinds);
   FCM_ALLOC_RAW(ctx, (size_t)(2 * r) * (size_t)(2 * r) * (size_t)(2 * r), todo);
   for (int d = 0; d < 3; d++)
     B.N[d] = (int64_t)n[d] * r;
-  /* Pass 0: classify the cells and count the sub-cells the surface crosses (nothing stored),
-   * so that an oversize build is refused before its tets are allocated. */
-  size_t ci = 0;
-  for (int64_t k = 0; k < n[2]; k++)
-    for (int64_t j = 0; j < n[1]; j++)
-      for (int64_t i = 0; i < n[0]; i++, ci++) {
-        const int64_t cell[3] = {i, j, k};
-        cell_kind kind;
-        int64_t cut = 0;
-        FCM_TRY(ctx, sample_cell(&B, cell, r, w, &kind, &cut));
-        kinds[ci] = (unsigned char)kind;
-        inf.cells_inside += kind == CELL_INSIDE;
-        inf.cells_cut += kind == CELL_CUT;
-        inf.cells_outside += kind == CELL_OUTSIDE;
-        inf.subcells += cut;
-      }
-  /* a cell wholly inside becomes 6 tets: counted as one sub-cell (about half the memory of
-   * one the surface crosses); refine_inside: every sub-cube of a cut or inside cell is split
-   * on its own, counted alike */
-  inf.subcells =
-      o.refine_inside ? (inf.cells_cut + inf.cells_inside) * r3 : inf.subcells + inf.cells_inside;
-  const fcm_index estimate = inf.subcells;
-  FCM_CHECK(o.max_subcells == 0 || estimate <= o.max_subcells, ctx, FCM_ERR_UNSUPPORTED,
-            "level set: the build would triangulate %lld sub-cells (%lld cut and %lld inside "
-            "cells at refinement %d; about %.3g GB at %d kB each), more than max_subcells = %lld "
-            "(about %.3g GB); raise max_subcells (0: no limit), or lower the refinement or the "
-            "sampling cells",
-            (long long)estimate, (long long)inf.cells_cut, (long long)inf.cells_inside, r,
-            (double)estimate * FCM_LEVEL_SET_SUBCELL_BYTES / 1e9,
-            FCM_LEVEL_SET_SUBCELL_BYTES / 1000, (long long)o.max_subcells,
-            (double)o.max_subcells * FCM_LEVEL_SET_SUBCELL_BYTES / 1e9);
-  B.total = (inf.cells_cut + (o.refine_inside ? inf.cells_inside : 0)) * r3;
-  if (o.estimate_error) B.total += inf.cells_cut * 8 * r3;
-  /* Pass 1: refinement r, stored. */
-  B.store = 1;
-  ci = 0;
-  for (int64_t k = 0; k < n[2]; k++)
-    for (int64_t j = 0; j < n[1]; j++)
-      for (int64_t i = 0; i < n[0]; i++, ci++) {
-        if (kinds[ci] == CELL_OUTSIDE) continue;
-        const int64_t cell[3] = {i, j, k};
-        cell_kind kind;
-        FCM_TRY(ctx, do_cell(&B, cell, r, !o.refine_inside, w, todo, &kind));
-        kinds[ci] = (unsigned char)kind; /* phi is sampled as in pass 0 */
-        if (kind == CELL_CUT || (kind == CELL_INSIDE && o.refine_inside)) advance(&B, r3);
-      }
+  FCM_TRY(ctx, classify_cells(&B, n, r, w, kinds, &inf));
+  FCM_TRY(ctx, build_cells(&B, n, r, w, todo, kinds));
   inf.volume = B.volume;
   FCM_CHECK(B.nt > 0 && B.volume > 0.0, ctx, FCM_ERR_GEOMETRY,
             "level set: the body {phi < 0} has no volume in the box [%g, %g] x [%g, %g] x [%g, "
             "%g] sampled at refinement %d (every sample has phi >= 0)",
             lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], r);
-  /* Pass 2 (volume only): the cut cells at refinement 2r, the others as they were. */
-  if (o.estimate_error) {
-    builder F = B;
-    F.store = 0, F.nodes = NULL, F.tri = NULL, F.towner = NULL, F.volume = 0.0;
-    for (int d = 0; d < 3; d++)
-      F.N[d] = (int64_t)n[d] * 2 * r;
-    ci = 0;
-    double v_whole = 0.0;
-    for (int64_t k = 0; k < n[2]; k++)
-      for (int64_t j = 0; j < n[1]; j++)
-        for (int64_t i = 0; i < n[0]; i++, ci++) {
-          const int64_t cell[3] = {i, j, k};
-          cell_kind kind;
-          if (kinds[ci] == CELL_CUT) {
-            FCM_TRY(ctx, do_cell(&F, cell, 2 * r, 1, w, todo, &kind));
-            advance(&F, 8 * r3);
-          } else if (kinds[ci] == CELL_INSIDE) {
-            v_whole += 1.0;
-          }
-        }
-    B.done = F.done, B.last = F.last;
-    double cv = 1.0;
-    for (int d = 0; d < 3; d++)
-      cv *= (hi[d] - lo[d]) / (double)n[d];
-    inf.volume_fine = F.volume + v_whole * cv;
-    inf.error_estimate = 4.0 / 3.0 * fabs(inf.volume - inf.volume_fine);
-  }
+  if (o.estimate_error) FCM_TRY(ctx, estimate_error(&B, n, r, w, todo, kinds, &inf));
   if (o.progress) o.progress(B.total, B.total, o.progress_user);
-  /* Nodes: unique keys. */
-  const size_t nv = 4 * B.nt;
-  FCM_ALLOC_RAW(ctx, nv, ks);
-  for (size_t s = 0; s < nv; s++)
-    ks[s].key = B.nodes[s].key, ks[s].slot = s;
-  qsort(ks, nv, sizeof *ks, cmp_keyslot);
-  FCM_ALLOC_RAW(ctx, nv, cells);
-  FCM_ALLOC_RAW(ctx, 3 * nv, X);
-  FCM_ALLOC_RAW(ctx, nv, ukeys);
-  size_t nn = 0;
-  for (size_t s = 0; s < nv; s++) {
-    if (s == 0 || ks[s].key != ks[s - 1].key) {
-      memcpy(X + 3 * nn, B.nodes[ks[s].slot].x, 3 * sizeof(double));
-      ukeys[nn++] = ks[s].key;
-    }
-    cells[ks[s].slot] = (fcm_index)(nn - 1);
-  }
-  /* The boundary: the iso-surface and box-face triangles (every node is a tet node). */
-  FCM_ALLOC_RAW(ctx, 3 * B.ntri + 1, tris);
-  FCM_ALLOC_RAW(ctx, B.ntri + 1, tri_tet);
-  for (size_t k = 0; k < 3 * B.ntri; k++) {
-    const int64_t *hit = bsearch(&B.tri[k].key, ukeys, nn, sizeof *ukeys, cmp_key);
-    tris[k] = (fcm_index)(hit - ukeys);
-  }
-  for (size_t k = 0; k < B.ntri; k++)
-    tri_tet[k] = (fcm_index)B.towner[k];
+  FCM_TRY(ctx, unique_nodes(&B, &X, &cells, &ukeys, &nn));
+  FCM_TRY(ctx, boundary_tris(&B, ukeys, nn, &tris, &tri_tet));
   inf.num_tets = (fcm_index)B.nt;
   FCM_TRY(ctx, fcm__geom_create_take(ctx, "level set", FCM_ELEMENT_TET4, (fcm_index)nn, &X,
                                      (fcm_index)B.nt, &cells, 0, geom));
@@ -583,7 +665,6 @@ cleanup:
   fcm__free(ctx, w);
   fcm__free(ctx, kinds);
   fcm__free(ctx, todo);
-  fcm__free(ctx, ks);
   fcm__free(ctx, X);
   fcm__free(ctx, cells);
   return st;

@@ -109,6 +109,41 @@ fcm_status fcm__csr_share_pattern(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols
                                   const fcm_index *row_ptr, const int *col_idx, fcm_csr_kind kind,
                                   fcm_csr **A);
 
+/* The sparse triple product C = P^T A P of a square matrix A (n x n, either kind) and a
+ * prolongation P (n x nc, CSR arrays: P_ptr n + 1 offsets, P_col sorted per row in [0, nc),
+ * P_val), like PETSc's MatPtAP, in two phases: fcm__ptap_create() finds the patterns of A P and
+ * of C once and creates C (nc x nc, A's kind, values zero); fcm__ptap_apply() computes C's
+ * values from A's current ones, as often as they change (same pattern). C = R (A P) with
+ * R = P^T stored: each entry is summed by one thread in a fixed order (the rows of A, then of
+ * P), so C does not depend on the thread count, but rounding may leave c_ij != c_ji for a
+ * symmetric A: a caller that needs exact symmetry averages the pair. Internal rather than in
+ * fcm/la.h: its only user, the multigrid, borrows P as bare arrays and reads R for its
+ * restriction; a public call would take fcm_csr operands. (ptap.c) */
+typedef struct fcm__ptap fcm__ptap;
+
+/* The plan and C. P is borrowed (it must outlive the plan and not change); with_diagonal:
+ * C stores every diagonal entry (zero where P^T A P has none structurally: rows of empty
+ * columns of P). nt >= 1: the most threads fcm__ptap_apply() may use, and those that find the
+ * patterns (nt = 1: serial). @return FCM_OK, FCM_ERR_ARG (NULL, A not square, a column of P
+ * out of range), FCM_ERR_ALLOC; on failure *plan and *C are NULL. Allocates R, A P and nt
+ * accumulators of nc doubles. */
+fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const fcm_index *P_ptr,
+                            const int *P_col, const double *P_val, int with_diagonal, int nt,
+                            fcm__ptap **plan, fcm_csr **C);
+
+/* C's values = P^T A P for A's current values, on `nt` threads (clamped to [1, the plan's]).
+ * A has the pattern given to fcm__ptap_create(), C is the matrix it created. Allocates
+ * nothing; one call at a time per plan. */
+void fcm__ptap_apply(fcm__ptap *plan, const fcm_csr *A, fcm_csr *C, int nt);
+
+/* R = P^T (nc x n) as the plan holds it: row J lists the rows of P with a column J,
+ * ascending. Valid while the plan lives. */
+void fcm__ptap_transpose(const fcm__ptap *plan, const fcm_index **R_ptr, const int **R_col,
+                         const double **R_val);
+
+/* Destroy; accepts NULL and *plan == NULL, sets *plan = NULL. */
+void fcm__ptap_destroy(fcm__ptap **plan);
+
 /* One table per sparse direct-solver adapter (cholmod_adapter.c,
  * umfpack_adapter.c); fcm_direct (direct.c) checks arguments and phases, counts
  * and times, and calls these. `impl` is the adapter's state. The adapter sets
@@ -127,11 +162,11 @@ typedef struct fcm__direct_ops {
   void (*destroy)(fcm_ctx *ctx, void *impl); /* accepts impl == NULL */
 } fcm__direct_ops;
 
-/* Numerical rank checks of the direct path (issue 19; calibration in cholmod_adapter.c and
- * direct.c): a CHOLMOD pivot below this fraction of its column's diagonal, or a solve whose
- * normwise backward error ||b - A x|| / (||A|| ||x|| + ||b||) (infinity norms) exceeds the
- * second value, or an UMFPACK factor whose rcond (min/max |diag U|, row-scaled) is below the
- * third, is refused with FCM_ERR_SINGULAR and the hint below. */
+/* Numerical rank checks of the direct path (calibration in cholmod_adapter.c and direct.c): a
+ * CHOLMOD pivot below this fraction of its column's diagonal, or a solve whose normwise backward
+ * error ||b - A x|| / (||A|| ||x|| + ||b||) (infinity norms) exceeds the second value, or an
+ * UMFPACK factor whose rcond (min/max |diag U|, row-scaled) is below the third, is refused with
+ * FCM_ERR_SINGULAR and the hint below. */
 #define FCM__SINGULAR_PIVOT_RATIO    1e-10
 #define FCM__SINGULAR_BACKWARD_ERROR 1e-8
 #define FCM__SINGULAR_UMFPACK_RCOND  1e-13

@@ -220,6 +220,44 @@ static void accept(ws *s, int n, double *x, double *w)
   t = s->r, s->r = s->r2, s->r2 = t;
 }
 
+/* The scaled Jacobian s->Js (one factor for all coordinate columns, one for all weight
+ * columns: per-column scaling would let tiny-weight points fly to the boundary; s->scale)
+ * and its Gram matrix s->K (J J^T when the system is underdetermined, else J^T J); returns
+ * the mean of K's diagonal. */
+static double scaled_gram(ws *s, int n)
+{
+  const int M = s->M, d = s->d, nc = s->nc, nv = n * nc;
+  const int under = nv >= M, sz = under ? M : nv;
+  double sx = 0.0, sw = 0.0;
+  for (int c = 0; c < nv; c++) {
+    const double *col = s->J + (size_t)M * c;
+    double nrm = 0.0;
+    for (int j = 0; j < M; j++)
+      nrm += col[j] * col[j];
+    if (c % nc == d)
+      sw += nrm;
+    else
+      sx += nrm;
+  }
+  sx = sx > 0.0 ? sqrt(sx / (n * d)) : 1.0;
+  sw = sw > 0.0 ? sqrt(sw / n) : 1.0;
+  for (int c = 0; c < nv; c++) {
+    const double *col = s->J + (size_t)M * c;
+    double *out = s->Js + (size_t)M * c;
+    s->scale[c] = (c % nc == d) ? sw : sx;
+    for (int j = 0; j < M; j++)
+      out[j] = col[j] / s->scale[c];
+  }
+  if (under)
+    fcm__gemm('N', 'T', M, M, nv, 1.0, s->Js, M, s->Js, M, 0.0, s->K, sz);
+  else
+    fcm__gemm('T', 'N', nv, nv, M, 1.0, s->Js, M, s->Js, M, 0.0, s->K, sz);
+  double diag = 0.0;
+  for (int k = 0; k < sz; k++)
+    diag += s->K[(size_t)k * sz + k];
+  return diag / sz;
+}
+
 /* Levenberg–Marquardt on (x, w) with n points, in place. *converged = 1 when
  * max |r_j| <= tol was reached (then s->J, s->r hold the final state). With
  * tol < 0 it only polishes: up to max_iter decreasing steps. After a full step
@@ -229,7 +267,7 @@ static fcm_status lm_solve(ws *s, int n, double *x, double *w, double tol, int m
                            int *converged, double *rinf_out)
 {
   fcm_status st = FCM_OK;
-  const int M = s->M, d = s->d, nc = s->nc, nv = n * nc;
+  const int M = s->M, nc = s->nc, nv = n * nc;
   const int under = nv >= M, sz = under ? M : nv;
   double f, rinf, lambda = 1e-8;
   int slow = 0, have_factor = 0;
@@ -257,36 +295,7 @@ static fcm_status lm_solve(ws *s, int n, double *x, double *w, double tol, int m
       }
       have_factor = 0;
     }
-    /* scaling: one factor for all coordinate columns, one for all weight columns
-     * (per-column scaling would let tiny-weight points fly to the boundary) */
-    double sx = 0.0, sw = 0.0;
-    for (int c = 0; c < nv; c++) {
-      const double *col = s->J + (size_t)M * c;
-      double nrm = 0.0;
-      for (int j = 0; j < M; j++)
-        nrm += col[j] * col[j];
-      if (c % nc == d)
-        sw += nrm;
-      else
-        sx += nrm;
-    }
-    sx = sx > 0.0 ? sqrt(sx / (n * d)) : 1.0;
-    sw = sw > 0.0 ? sqrt(sw / n) : 1.0;
-    for (int c = 0; c < nv; c++) {
-      const double *col = s->J + (size_t)M * c;
-      double *out = s->Js + (size_t)M * c;
-      s->scale[c] = (c % nc == d) ? sw : sx;
-      for (int j = 0; j < M; j++)
-        out[j] = col[j] / s->scale[c];
-    }
-    if (under)
-      fcm__gemm('N', 'T', M, M, nv, 1.0, s->Js, M, s->Js, M, 0.0, s->K, sz);
-    else
-      fcm__gemm('T', 'N', nv, nv, M, 1.0, s->Js, M, s->Js, M, 0.0, s->K, sz);
-    double diag = 0.0;
-    for (int k = 0; k < sz; k++)
-      diag += s->K[(size_t)k * sz + k];
-    diag /= sz;
+    const double diag = scaled_gram(s, n);
     int accepted = 0, nfrozen = 0;
     memset(s->frozen, 0, (size_t)n);
     while (!accepted) {
@@ -399,6 +408,147 @@ static void fill_info(fcm_rulegen_info *info, const ws *s, int n, const double *
   info->seconds = fcm_wtime() - t0;
 }
 
+static void ws_free(ws *s)
+{
+  fcm_ctx *ctx = s->ctx;
+  fcm__free(ctx, s->J);
+  fcm__free(ctx, s->J2);
+  fcm__free(ctx, s->Js);
+  fcm__free(ctx, s->K);
+  fcm__free(ctx, s->Kf);
+  fcm__free(ctx, s->r);
+  fcm__free(ctx, s->r2);
+  fcm__free(ctx, s->y);
+  fcm__free(ctx, s->dlt);
+  fcm__free(ctx, s->scale);
+  fcm__free(ctx, s->x2);
+  fcm__free(ctx, s->w2);
+  fcm__free(ctx, s->frozen);
+}
+
+/* The workspace of rules of up to n0 points (s->ctx, M, nc, d set). */
+static fcm_status ws_alloc(ws *s, int n0)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const size_t nvmax = (size_t)n0 * s->nc, szmax = FCM_MIN((size_t)s->M, nvmax);
+  FCM_ALLOC(ctx, (size_t)s->M * nvmax, s->J);
+  FCM_ALLOC(ctx, (size_t)s->M * nvmax, s->J2);
+  FCM_ALLOC(ctx, (size_t)s->M * nvmax, s->Js);
+  FCM_ALLOC(ctx, szmax * szmax, s->K);
+  FCM_ALLOC(ctx, szmax * szmax, s->Kf);
+  FCM_ALLOC(ctx, s->M, s->r);
+  FCM_ALLOC(ctx, s->M, s->r2);
+  FCM_ALLOC(ctx, FCM_MAX((size_t)s->M, nvmax), s->y);
+  FCM_ALLOC(ctx, nvmax, s->dlt);
+  FCM_ALLOC(ctx, nvmax, s->scale);
+  FCM_ALLOC(ctx, (size_t)n0 * s->d, s->x2);
+  FCM_ALLOC(ctx, n0, s->w2);
+  FCM_ALLOC(ctx, n0, s->frozen);
+cleanup:
+  return st;
+}
+
+/* Scratch of the elimination: trial rules (xt, wt), the points by significance, the points
+ * dropped in a trial. */
+typedef struct trial_buf {
+  double *xt, *wt;
+  sig_entry *sig;
+  char *drop;
+} trial_buf;
+
+/* Remove the least significant points while the rest still integrate the moments: batches
+ * of up to opts->max_batch of the points (grown after a success, halved after a failure), then
+ * one point at a time among the opts->max_candidates least significant; until
+ * opts->target_points, one point, or no candidate succeeds. *n, x, w: the rule, in place;
+ * *rinf: the last solve's residual. */
+static fcm_status remove_points(ws *s, int *n_io, double *x, double *w, trial_buf *t,
+                                fcm_rulegen_info *info, double t0, double *rinf)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_rulegen_options *opts = s->opts;
+  const int nfloor = (int)ceil(1.25 * s->M / s->nc);
+  int n = *n_io, converged = 0;
+  int batch = FCM_MAX(1, (int)(opts->max_batch * n));
+  for (;;) {
+    if (opts->target_points > 0 && n <= opts->target_points) break;
+    if (n <= 1) break;
+    int b = 1;
+    if (opts->max_batch > 0.0 && n > nfloor) {
+      b = FCM_MIN(batch, FCM_MAX(1, (int)(opts->max_batch * n)));
+      b = FCM_MAX(1, FCM_MIN(b, n - nfloor));
+    }
+    if (opts->target_points > 0) b = FCM_MIN(b, n - opts->target_points);
+    int done = 0;
+    if (b > 1) {
+      memset(t->drop, 0, (size_t)n);
+      for (int c = 0; c < b; c++)
+        t->drop[t->sig[c].i] = 1;
+      int nt = copy_without(s->d, n, x, w, t->drop, t->xt, t->wt);
+      FCM_TRY(ctx,
+              lm_solve(s, nt, t->xt, t->wt, opts->tol, opts->max_iterations, &converged, rinf));
+      if (converged) {
+        n = nt;
+        done = 1;
+        batch = FCM_MAX(1, batch + batch / 2);
+      } else {
+        info->failed_attempts++;
+        batch = b / 2;
+        continue;
+      }
+    } else {
+      int tries = FCM_MIN(opts->max_candidates, n);
+      for (int c = 0; c < tries && !done; c++) {
+        memset(t->drop, 0, (size_t)n);
+        t->drop[t->sig[c].i] = 1;
+        int nt = copy_without(s->d, n, x, w, t->drop, t->xt, t->wt);
+        FCM_TRY(ctx,
+                lm_solve(s, nt, t->xt, t->wt, opts->tol, opts->max_iterations, &converged, rinf));
+        if (converged) {
+          n = nt;
+          done = 1;
+        } else {
+          info->failed_attempts++;
+        }
+      }
+      if (!done) break;
+    }
+    memcpy(x, t->xt, sizeof(double) * (size_t)n * s->d);
+    memcpy(w, t->wt, sizeof(double) * (size_t)n);
+    significance(s, n, w, t->sig);
+    info->removals++;
+    if (opts->progress) {
+      fill_info(info, s, n, x, w, *rinf, t0);
+      opts->progress(opts->progress_user, info);
+    }
+  }
+cleanup:
+  *n_io = n;
+  return st;
+}
+
+/* Final polish: a few more steps on (x, w), kept when they lower the max residual (*rinf:
+ * the residual of the rule kept). */
+static fcm_status final_polish(ws *s, int n, double *x, double *w, trial_buf *t, double *rinf)
+{
+  fcm_status st = FCM_OK;
+  double r0, f0, rp;
+  int converged = 0;
+  build(s, n, x, w, s->J, s->r, &f0, &r0);
+  memcpy(t->xt, x, sizeof(double) * (size_t)n * s->d);
+  memcpy(t->wt, w, sizeof(double) * (size_t)n);
+  FCM_TRY(s->ctx, lm_solve(s, n, t->xt, t->wt, -1.0, 4, &converged, &rp));
+  if (rp < r0) {
+    memcpy(x, t->xt, sizeof(double) * (size_t)n * s->d);
+    memcpy(w, t->wt, sizeof(double) * (size_t)n);
+    r0 = rp;
+  }
+  *rinf = r0;
+cleanup:
+  return st;
+}
+
 fcm_status fcm__rulegen_eliminate(fcm_ctx *ctx, fcm_shape shape, int m, int n0, const double *x0,
                                   const double *w0, const fcm_rulegen_options *opts,
                                   fcm_rulegen_info *info, int *n_out, double **x_out,
@@ -406,9 +556,8 @@ fcm_status fcm__rulegen_eliminate(fcm_ctx *ctx, fcm_shape shape, int m, int n0, 
 {
   fcm_status st = FCM_OK;
   ws s;
-  double *x = NULL, *w = NULL, *xt = NULL, *wt = NULL;
-  sig_entry *sig = NULL;
-  char *drop = NULL;
+  double *x = NULL, *w = NULL;
+  trial_buf t = {NULL, NULL, NULL, NULL};
   const double t0 = fcm_wtime(), meas = fcm_shape_measure(shape);
   int n = n0, converged = 0;
   double rinf = 0.0;
@@ -426,105 +575,25 @@ fcm_status fcm__rulegen_eliminate(fcm_ctx *ctx, fcm_shape shape, int m, int n0, 
   s.opts = opts;
   FCM_CHECK(s.d > 0 && s.M > 0 && n0 > 0, ctx, FCM_ERR_ARG,
             "node elimination: shape %d, strength %d, %d points unsupported", (int)shape, m, n0);
-  const size_t nvmax = (size_t)n0 * s.nc, szmax = FCM_MIN((size_t)s.M, nvmax);
-  FCM_ALLOC(ctx, (size_t)s.M * nvmax, s.J);
-  FCM_ALLOC(ctx, (size_t)s.M * nvmax, s.J2);
-  FCM_ALLOC(ctx, (size_t)s.M * nvmax, s.Js);
-  FCM_ALLOC(ctx, szmax * szmax, s.K);
-  FCM_ALLOC(ctx, szmax * szmax, s.Kf);
-  FCM_ALLOC(ctx, s.M, s.r);
-  FCM_ALLOC(ctx, s.M, s.r2);
-  FCM_ALLOC(ctx, FCM_MAX((size_t)s.M, nvmax), s.y);
-  FCM_ALLOC(ctx, nvmax, s.dlt);
-  FCM_ALLOC(ctx, nvmax, s.scale);
-  FCM_ALLOC(ctx, (size_t)n0 * s.d, s.x2);
-  FCM_ALLOC(ctx, n0, s.w2);
-  FCM_ALLOC(ctx, n0, s.frozen);
+  FCM_TRY(ctx, ws_alloc(&s, n0));
   FCM_ALLOC(ctx, (size_t)n0 * s.d, x);
   FCM_ALLOC(ctx, n0, w);
-  FCM_ALLOC(ctx, (size_t)n0 * s.d, xt);
-  FCM_ALLOC(ctx, n0, wt);
-  FCM_ALLOC(ctx, n0, sig);
-  FCM_ALLOC(ctx, n0, drop);
+  FCM_ALLOC(ctx, (size_t)n0 * s.d, t.xt);
+  FCM_ALLOC(ctx, n0, t.wt);
+  FCM_ALLOC(ctx, n0, t.sig);
+  FCM_ALLOC(ctx, n0, t.drop);
   memcpy(x, x0, sizeof(double) * (size_t)n0 * s.d);
   for (int i = 0; i < n0; i++)
     w[i] = w0[i] / meas;
   info->initial_points = n0;
-
   /* polish the start rule in the basis of this strength */
   FCM_TRY(ctx, lm_solve(&s, n, x, w, opts->tol, opts->max_iterations, &converged, &rinf));
   FCM_CHECK(converged, ctx, FCM_ERR_NOT_CONVERGED,
             "node elimination: start rule (%d points) reaches moment residual %.3g, not %.3g", n,
             rinf, opts->tol);
-  significance(&s, n, w, sig);
-
-  const int nfloor = (int)ceil(1.25 * s.M / s.nc);
-  int batch = FCM_MAX(1, (int)(opts->max_batch * n));
-  for (;;) {
-    if (opts->target_points > 0 && n <= opts->target_points) break;
-    if (n <= 1) break;
-    int b = 1;
-    if (opts->max_batch > 0.0 && n > nfloor) {
-      b = FCM_MIN(batch, FCM_MAX(1, (int)(opts->max_batch * n)));
-      b = FCM_MAX(1, FCM_MIN(b, n - nfloor));
-    }
-    if (opts->target_points > 0) b = FCM_MIN(b, n - opts->target_points);
-    int done = 0;
-    if (b > 1) {
-      memset(drop, 0, (size_t)n);
-      for (int c = 0; c < b; c++)
-        drop[sig[c].i] = 1;
-      int nt = copy_without(s.d, n, x, w, drop, xt, wt);
-      FCM_TRY(ctx, lm_solve(&s, nt, xt, wt, opts->tol, opts->max_iterations, &converged, &rinf));
-      if (converged) {
-        n = nt;
-        done = 1;
-        batch = FCM_MAX(1, batch + batch / 2);
-      } else {
-        info->failed_attempts++;
-        batch = b / 2;
-        continue;
-      }
-    } else {
-      int tries = FCM_MIN(opts->max_candidates, n);
-      for (int c = 0; c < tries && !done; c++) {
-        memset(drop, 0, (size_t)n);
-        drop[sig[c].i] = 1;
-        int nt = copy_without(s.d, n, x, w, drop, xt, wt);
-        FCM_TRY(ctx, lm_solve(&s, nt, xt, wt, opts->tol, opts->max_iterations, &converged, &rinf));
-        if (converged) {
-          n = nt;
-          done = 1;
-        } else {
-          info->failed_attempts++;
-        }
-      }
-      if (!done) break;
-    }
-    memcpy(x, xt, sizeof(double) * (size_t)n * s.d);
-    memcpy(w, wt, sizeof(double) * (size_t)n);
-    significance(&s, n, w, sig);
-    info->removals++;
-    if (opts->progress) {
-      fill_info(info, &s, n, x, w, rinf, t0);
-      opts->progress(opts->progress_user, info);
-    }
-  }
-
-  /* final polish: a few more steps, kept when they lower the max residual */
-  {
-    double r0, f0, rp;
-    build(&s, n, x, w, s.J, s.r, &f0, &r0);
-    memcpy(xt, x, sizeof(double) * (size_t)n * s.d);
-    memcpy(wt, w, sizeof(double) * (size_t)n);
-    FCM_TRY(ctx, lm_solve(&s, n, xt, wt, -1.0, 4, &converged, &rp));
-    if (rp < r0) {
-      memcpy(x, xt, sizeof(double) * (size_t)n * s.d);
-      memcpy(w, wt, sizeof(double) * (size_t)n);
-      r0 = rp;
-    }
-    rinf = r0;
-  }
+  significance(&s, n, w, t.sig);
+  FCM_TRY(ctx, remove_points(&s, &n, x, w, &t, info, t0, &rinf));
+  FCM_TRY(ctx, final_polish(&s, n, x, w, &t, &rinf));
   fill_info(info, &s, n, x, w, rinf, t0);
   for (int i = 0; i < n; i++)
     w[i] *= meas;
@@ -533,25 +602,13 @@ fcm_status fcm__rulegen_eliminate(fcm_ctx *ctx, fcm_shape shape, int m, int n0, 
   *w_out = w;
   x = w = NULL;
 cleanup:
-  fcm__free(ctx, s.J);
-  fcm__free(ctx, s.J2);
-  fcm__free(ctx, s.Js);
-  fcm__free(ctx, s.K);
-  fcm__free(ctx, s.Kf);
-  fcm__free(ctx, s.r);
-  fcm__free(ctx, s.r2);
-  fcm__free(ctx, s.y);
-  fcm__free(ctx, s.dlt);
-  fcm__free(ctx, s.scale);
-  fcm__free(ctx, s.x2);
-  fcm__free(ctx, s.w2);
-  fcm__free(ctx, s.frozen);
+  ws_free(&s);
   fcm__free(ctx, x);
   fcm__free(ctx, w);
-  fcm__free(ctx, xt);
-  fcm__free(ctx, wt);
-  fcm__free(ctx, sig);
-  fcm__free(ctx, drop);
+  fcm__free(ctx, t.xt);
+  fcm__free(ctx, t.wt);
+  fcm__free(ctx, t.sig);
+  fcm__free(ctx, t.drop);
   return st;
 }
 

@@ -459,58 +459,111 @@ static mr_out mr_rotate(const mr_in *in, double betasq)
   return o;
 }
 
+/* How the start of MINRES ended. */
+typedef enum mr_start { MR_ITERATE, MR_DONE, MR_NAN, MR_INDEFINITE } mr_start;
+
+/* The start of MINRES: r1 = b - A x (x0_zero: b), y = S r1, *betasq = r1^T S r1 and *beta1
+ * its root, the norm of b (||b||_S with a preconditioner), the tolerance and the initial
+ * residual; *how: MR_ITERATE, MR_DONE (converged or stagnated at the start), MR_NAN or
+ * MR_INDEFINITE (r^T S r <= 0 with r != 0; *betasq the offending value). w is scratch. */
+static fcm_status minres_start(solve *sv, double *r1, double *y, double *w, int x0_zero,
+                               double *betasq, double *beta1, mr_start *how)
+{
+  fcm_status st = FCM_OK;
+  fcm_krylov *ws = sv->ws;
+  const fcm_index n = ws->n;
+  const double *b = sv->b;
+  if (x0_zero) {
+    copy(n, b, r1);
+  } else {
+    APPLY_A(sv, sv->x, r1);
+    rsub(n, b, r1);
+  }
+  const double rr = dot(ws, r1, r1);
+  *how = MR_NAN;
+  if (!isfinite(rr)) goto cleanup;
+  if (sv->S) {
+    APPLY_S(sv, r1, y);
+    *betasq = dot(ws, r1, y);
+  } else {
+    copy(n, r1, y);
+    *betasq = rr;
+  }
+  if (!isfinite(*betasq)) goto cleanup;
+  *how = MR_INDEFINITE;
+  if (*betasq < 0.0 || (*betasq == 0.0 && rr > 0.0)) goto cleanup;
+  if (sv->S) {
+    if (x0_zero) {
+      sv->info.rhs_norm = sqrt(*betasq);
+    } else {
+      APPLY_S(sv, b, w); /* ||b||_S; w is free until the iteration starts */
+      double bsb = dot(ws, b, w);
+      *how = MR_NAN;
+      if (!isfinite(bsb)) goto cleanup;
+      *how = MR_INDEFINITE;
+      if (!(bsb > 0.0)) {
+        *betasq = bsb;
+        goto cleanup;
+      }
+      sv->info.rhs_norm = sqrt(bsb);
+    }
+  }
+  sv->tol = FCM_MAX(sv->o.rtol * sv->info.rhs_norm, sv->o.atol);
+  *beta1 = sqrt(*betasq);
+  sv->info.initial_residual = *beta1 / sv->info.rhs_norm;
+  *how = converged(sv, 0, *beta1) || stagnated(sv, 0, *beta1) ? MR_DONE : MR_ITERATE;
+cleanup:
+  return st;
+}
+
+/* The Lanczos step of MINRES iteration k: y = A v - (beta/oldb) r1 - (alfa/beta) r2 with
+ * alfa = v^T (A v - (beta/oldb) r1), one parallel region after the operator. */
+static fcm_status lanczos_step(solve *sv, int k, double beta, double oldb, const double *r1,
+                               const double *r2, const double *v, double *y, double *alfa)
+{
+  fcm_status st = FCM_OK;
+  fcm_krylov *ws = sv->ws;
+  const fcm_index n = ws->n;
+  const int par = n >= VEC_PARALLEL;
+  double alfa_out = 0.0;
+  APPLY_A(sv, v, y);
+  const double c1 = k >= 2 ? -beta / oldb : 0.0;
+#pragma omp parallel if (par)
+  {
+    const double a = team_axpy_dot(ws, c1, r1, v, y);
+    const double c2 = -a / beta;
+#pragma omp for schedule(static)
+    for (fcm_index i = 0; i < n; i++)
+      y[i] += c2 * r2[i];
+#pragma omp master
+    alfa_out = a;
+  }
+  *alfa = alfa_out;
+cleanup:
+  return st;
+}
+
 static fcm_status run_minres(solve *sv)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = sv->ctx;
   fcm_krylov *ws = sv->ws;
   const fcm_index n = ws->n;
-  const double *b = sv->b;
   double *x = sv->x;
   double *r1 = ws->vecs, *r2 = ws->vecs + n, *y = ws->vecs + 2 * n, *v = ws->vecs + 3 * n;
   double *w = ws->vecs + 4 * n, *w1 = ws->vecs + 5 * n, *w2 = ws->vecs + 6 * n, *tmp;
   const int maxit = sv->o.max_iterations;
   const int x0_zero = all_zero(n, x);
-  double betasq = 0.0, rr, beta1;
+  double betasq = 0.0, beta1 = 0.0;
   double oldb = 0.0, beta, dbar = 0.0, epsln = 0.0, phibar, cs = -1.0, sn = 0.0;
   int k = 0;
   const int par = n >= VEC_PARALLEL;
 
-  if (x0_zero) {
-    copy(n, b, r1);
-  } else {
-    APPLY_A(sv, x, r1);
-    rsub(n, b, r1);
-  }
-  rr = dot(ws, r1, r1);
-  if (!isfinite(rr)) goto nan;
-  if (sv->S) {
-    APPLY_S(sv, r1, y);
-    betasq = dot(ws, r1, y);
-  } else {
-    copy(n, r1, y);
-    betasq = rr;
-  }
-  if (!isfinite(betasq)) goto nan;
-  if (betasq < 0.0 || (betasq == 0.0 && rr > 0.0)) goto indefinite;
-  if (sv->S) {
-    if (x0_zero) {
-      sv->info.rhs_norm = sqrt(betasq);
-    } else {
-      APPLY_S(sv, b, w); /* ||b||_S; w is free until the iteration starts */
-      double bsb = dot(ws, b, w);
-      if (!isfinite(bsb)) goto nan;
-      if (!(bsb > 0.0)) {
-        betasq = bsb;
-        goto indefinite;
-      }
-      sv->info.rhs_norm = sqrt(bsb);
-    }
-  }
-  sv->tol = FCM_MAX(sv->o.rtol * sv->info.rhs_norm, sv->o.atol);
-  beta1 = sqrt(betasq);
-  sv->info.initial_residual = beta1 / sv->info.rhs_norm;
-  if (converged(sv, 0, beta1) || stagnated(sv, 0, beta1)) goto finish;
+  mr_start how = MR_ITERATE;
+  FCM_TRY(ctx, minres_start(sv, r1, y, w, x0_zero, &betasq, &beta1, &how));
+  if (how == MR_NAN) goto nan;
+  if (how == MR_INDEFINITE) goto indefinite;
+  if (how == MR_DONE) goto finish;
   if (maxit == 0) goto maxed;
 
   beta = phibar = beta1;
@@ -528,22 +581,8 @@ static fcm_status run_minres(solve *sv)
    * preconditioner, one parallel region (its dot product, the rotations — computed by
    * every thread alike —, the update of w and x and the next v). */
   for (k = 1; k <= maxit; k++) {
-    /* Lanczos step: y = A v - (beta/oldb) r1 - (alfa/beta) r2 */
-    APPLY_A(sv, v, y);
     double alfa = 0.0;
-    {
-      const double c1 = k >= 2 ? -beta / oldb : 0.0;
-#pragma omp parallel if (par)
-      {
-        const double a = team_axpy_dot(ws, c1, r1, v, y);
-        const double c2 = -a / beta;
-#pragma omp for schedule(static)
-        for (fcm_index i = 0; i < n; i++)
-          y[i] += c2 * r2[i];
-#pragma omp master
-        alfa = a;
-      }
-    }
+    FCM_TRY(ctx, lanczos_step(sv, k, beta, oldb, r1, r2, v, y, &alfa));
     if (!isfinite(alfa)) goto nan;
     tmp = r1;
     r1 = r2;

@@ -1,0 +1,389 @@
+/* The per-cell work of the cut-cell rules build: intersect each background cell with the
+ * geometry, split it into material pieces where cuts reach it, classify it (uncut, cut,
+ * dropped) and hand its cut pieces to the rule building; all cells in parallel. */
+#include "embed/rules_impl.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void piece_out_free(fcm_ctx *ctx, piece_out *o)
+{
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    fcm__free(ctx, o->pts[k]);
+    fcm__free(ctx, o->w[k]);
+    fcm__free(ctx, o->flag[k]);
+    o->pts[k] = o->w[k] = NULL;
+    o->flag[k] = NULL;
+  }
+  fcm__free(ctx, o->spts);
+  fcm__free(ctx, o->sw);
+  fcm__free(ctx, o->snrm);
+  fcm__free(ctx, o->stri);
+  fcm__free(ctx, o->cfxi);
+  o->spts = o->sw = o->snrm = o->cfxi = NULL;
+  o->stri = NULL;
+}
+
+void fcm__embed_cell_out_free(fcm_ctx *ctx, cell_out *o)
+{
+  if (o->pc)
+    for (int i = 0; i < o->np; i++)
+      piece_out_free(ctx, o->pc + i);
+  if (o->pc != &o->one) fcm__free(ctx, o->pc);
+  o->pc = NULL;
+  o->np = 0;
+  fcm__free(ctx, o->fmeta);
+  fcm__free(ctx, o->fx);
+  o->fmeta = NULL;
+  o->fx = NULL;
+}
+
+/* Room for np pieces in o (inline for one). */
+fcm_status fcm__embed_cell_out_pieces(fcm_ctx *ctx, cell_out *o, int np)
+{
+  fcm_status st = FCM_OK;
+  o->np = np;
+  if (np <= 1) {
+    o->pc = &o->one;
+  } else {
+    FCM_ALLOC(ctx, (size_t)np, o->pc);
+  }
+cleanup:
+  return st;
+}
+
+/* Copy the rules of cell c from the previous rules object (a cell no new cut reaches). */
+static fcm_status copy_cell(const build *B, fcm_index c, cell_out *o)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_cell_rules *Q = B->prev;
+  const fcm_index p0 = Q->piece_off[c], np = Q->piece_off[c + 1] - p0;
+  for (fcm_index i = 0; i < np; i++) {
+    piece_out *po = o->pc + i;
+    const fcm_index p = p0 + i;
+    po->volume = Q->piece_volume[p];
+    po->component = Q->piece_component[p];
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+      const size_t a = (size_t)Q->off[k][p], n = (size_t)Q->off[k][p + 1] - a;
+      if (n) {
+        FCM_ALLOC(ctx, 3 * n, po->pts[k]);
+        FCM_ALLOC(ctx, n, po->w[k]);
+        FCM_ALLOC(ctx, n, po->flag[k]);
+        memcpy(po->pts[k], Q->points[k] + 3 * a, 3 * n * sizeof(double));
+        memcpy(po->w[k], Q->weights[k] + a, n * sizeof(double));
+        memcpy(po->flag[k], Q->flags[k] + a, n);
+      }
+      po->n[k] = po->ninit[k] = po->nsimp[k] = (int)n;
+    }
+    const size_t a = (size_t)Q->soff[p], n = (size_t)Q->soff[p + 1] - a;
+    if (n) {
+      FCM_ALLOC(ctx, 3 * n, po->spts);
+      FCM_ALLOC(ctx, n, po->sw);
+      FCM_ALLOC(ctx, 3 * n, po->snrm);
+      FCM_ALLOC(ctx, n, po->stri);
+      memcpy(po->spts, Q->spoints + 3 * a, 3 * n * sizeof(double));
+      memcpy(po->sw, Q->sweights + a, n * sizeof(double));
+      memcpy(po->snrm, Q->snormals + 3 * a, 3 * n * sizeof(double));
+      memcpy(po->stri, Q->stris + a, n * sizeof(fcm_index));
+    }
+    po->ns = (int)n;
+    const size_t c0 = (size_t)Q->cfoff[p], nc = (size_t)Q->cfoff[p + 1] - c0;
+    if (nc) {
+      FCM_ALLOC(ctx, 9 * nc, po->cfxi);
+      memcpy(po->cfxi, Q->cfxi + 9 * c0, 9 * nc * sizeof(double));
+    }
+    po->ncf = (int)nc;
+  }
+cleanup:
+  return st;
+}
+
+/* Renumber the labels (P->piece, *count of them) so that labels whose parts keep no more than
+ * vmin of volume (all slivers, or flat on a cut) are removed: those parts get -1. vol gets the
+ * volume of each remaining label and was[i] the label that remaining label i had. */
+static fcm_status drop_empty(const build *B, fcm__embed_ws *ws, double vmin, int *label, int *count,
+                             double *vol, int *was, cell_sums *sums)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  fcm__parts *P = ws->parts;
+  int kept = 0, *renum = NULL;
+  FCM_ALLOC(ctx, (size_t)*count + 1, renum);
+  for (int i = 0; i < *count; i++) {
+    double v = 0.0;
+    FCM_TRY(ctx, fcm__embed_piece_tets(ctx, P, label, i, ws, sums ? &sums->counts : NULL, &v));
+    renum[i] = v > vmin ? kept : -1;
+    if (v > vmin) vol[kept] = v, was[kept++] = i;
+  }
+  for (size_t j = 0; j < P->n; j++)
+    label[j] = label[j] >= 0 ? renum[label[j]] : -1;
+  *count = kept;
+cleanup:
+  fcm__free(ctx, renum);
+  return st;
+}
+
+/* The convex parts and material pieces of a cell that cuts reach (or that lies next to
+ * such a cell): parts, split, grouped; empty pieces (all slivers) are removed. On return
+ * P->piece numbers the pieces with volume, -1 for parts of removed ones; vol[i] is the
+ * volume of piece i (P->num_pieces of them) and comp[i] its number among all the
+ * components; P->parent numbers the components under the earlier cuts only, empty ones
+ * included (the numbering of the pieces of the rules being extended, before their empty
+ * components were dropped: a component can lose its last volume to the new cut). */
+static fcm_status cell_pieces(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
+                              cell_sums *sums, double **vol, int **comp)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_cell_rules_options *opt = B->o;
+  fcm__parts *P = ws->parts;
+  FCM_TRY(ctx, fcm__embed_cell_parts(ctx, B->geom, B->tree, cell, opt->clip_rtol, opt->sliver_rtol,
+                                     ws, P, &sums->counts));
+  FCM_TRY(ctx, fcm__embed_cut_candidates(ctx, B->cut_tree, cell, &P->tcand));
+  if (P->tcand.n > 0) {
+    FCM_TRY(ctx, fcm__embed_cell_pieces(ctx, cell, B->cut_tris, B->first_new, P));
+    sums->counts.degenerate += !(P->split_error <= DEGENERATE_RTOL * cell->volume);
+  }
+  FCM_ALLOC(ctx, (size_t)P->num_pieces + 1, *vol);
+  if (B->prev) {
+    /* a piece in an earlier piece that the build that made it removed (no more than a sliver)
+     * holds no more volume than that one, up to rounding at the threshold: removed too, so
+     * that every kept piece lies in a kept earlier one */
+    const fcm_index p0 = B->prev->piece_off[cell->id], had = B->prev->piece_off[cell->id + 1] - p0;
+    for (size_t j = 0; j < P->n; j++) {
+      int found = 0;
+      for (fcm_index q = 0; q < had && !found; q++)
+        found = B->prev->piece_component[p0 + q] == P->parent[j];
+      if (!found) P->piece[j] = -1;
+    }
+  }
+  /* a piece is kept when it holds more than a sliver of the cell (a piece flat on a cut
+   * carries no material and would tie the nodes of both sides together) */
+  FCM_ALLOC(ctx, (size_t)P->num_pieces + 1, *comp);
+  FCM_TRY(ctx, drop_empty(B, ws, opt->sliver_rtol * cell->volume, P->piece, &P->num_pieces, *vol,
+                          *comp, sums));
+cleanup:
+  return st;
+}
+
+/* The piece of the rules being extended that holds each piece of o (its own index without
+ * them), and each piece's component number (pcomp; 0 without pieces). */
+static fcm_status piece_parents(const build *B, fcm_index c, const fcm__parts *P, const int *pcomp,
+                                int integrate, cell_out *o)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  for (int i = 0; i < o->np; i++) {
+    o->pc[i].parent = i;
+    o->pc[i].component = P ? pcomp[i] : 0;
+    if (P && B->prev && integrate) {
+      /* the component under the earlier cuts of the piece's first part, and the earlier
+       * piece numbered so (not its rank among the components that keep volume now) */
+      const fcm_index p0 = B->prev->piece_off[c], had = B->prev->piece_off[c + 1] - p0;
+      size_t j = 0;
+      while (j < P->n && P->piece[j] != i)
+        j++;
+      const int comp = j < P->n ? P->parent[j] : -1;
+      o->pc[i].parent = -1;
+      for (fcm_index q = 0; q < had && comp >= 0; q++)
+        if (B->prev->piece_component[p0 + q] == comp) o->pc[i].parent = (int)q;
+      FCM_CHECK(o->pc[i].parent >= 0, ctx, FCM_ERR_INTERNAL,
+                "embed: piece %d of cell %lld lies in no piece of the rules being extended (%lld "
+                "pieces there)",
+                i, (long long)c, (long long)had);
+    }
+  }
+cleanup:
+  return st;
+}
+
+/* The triangles of each piece of o on the cuts (its sides of them), in reference
+ * coordinates. */
+static fcm_status piece_cut_faces(const build *B, const fcm__embed_cell *cell, fcm__parts *P,
+                                  cell_out *o)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  for (int i = 0; i < o->np; i++) {
+    double *phys = NULL;
+    int nt = 0;
+    FCM_TRY(ctx, fcm__embed_cut_faces(ctx, cell, B->cut_tris, P, i, &phys, &nt));
+    o->pc[i].cfxi = phys;
+    o->pc[i].ncf = nt;
+    for (int k = 0; k < 3 * nt; k++) {
+      double xi[3], det;
+      FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, phys + 3 * k, xi, &det));
+      memcpy(phys + 3 * k, xi, sizeof xi);
+    }
+  }
+cleanup:
+  return st;
+}
+
+/* Intersect, classify and build the rules of background cell c into o (the thread's own
+ * buffers); R->cls[c] and R->fraction[c] are written here (one writer per cell). Cells the
+ * cuts reach are split into material pieces first; each piece then takes the
+ * path of a cut cell. */
+static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, fcm__embed_ws *ws,
+                               cell_out *o, cell_sums *sums)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_cell_rules_options *opt = B->o;
+  fcm__embed_cell cell;
+  double vol = 0.0, *pvol = NULL;
+  int *pcomp = NULL;
+  fcm__parts *P = NULL;
+  const int integrate = !B->rebuild || B->rebuild[c];
+  const int own = !opt->cell_mask || opt->cell_mask[c]; /* 0: classified, no points */
+  const double t0 = fcm_wtime();
+  FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
+  if (B->cut_tree && B->region[c]) {
+    if (!ws->parts) FCM_ALLOC(ctx, 1, ws->parts);
+    P = ws->parts;
+    FCM_TRY(ctx, cell_pieces(B, &cell, ws, sums, &pvol, &pcomp));
+    for (int i = 0; i < P->num_pieces; i++)
+      vol += pvol[i];
+    FCM_TRY(ctx, fcm__embed_face_polygons(ctx, &cell, P));
+    if (P->nfp > 0) {
+      FCM_ALLOC(ctx, 4 * P->nfp, o->fmeta);
+      FCM_ALLOC(ctx, 3 * P->nfx, o->fx);
+      memcpy(o->fmeta, P->fmeta, 4 * P->nfp * sizeof(int));
+      memcpy(o->fx, P->fx, 3 * P->nfx * sizeof(double));
+      o->nfp = (int)P->nfp;
+    }
+  } else {
+    FCM_TRY(ctx, fcm__embed_cell_tets(ctx, B->geom, B->tree, &cell, opt->clip_rtol,
+                                      opt->sliver_rtol, ws, &sums->counts, &vol));
+  }
+  const int np = P ? P->num_pieces : ws->num_tets > 0;
+  /* |K ∩ Ω| <= |K|: the clipped volumes can sum to |K| (1 + 1e-12) through rounding. A cut
+   * cell has phi < uncut_fraction <= 1, so its rule needs no rescaling; only the recorded
+   * fraction and volume are clamped. A cell split into several pieces is cut whatever its
+   * fraction. */
+  const double phi = fmin(vol / cell.volume, 1.0);
+  fcm_cell_class cls = FCM_CELL_CUT;
+  if (phi < opt->min_fraction || np == 0)
+    cls = FCM_CELL_DROPPED;
+  else if (phi >= opt->uncut_fraction && np == 1)
+    cls = FCM_CELL_UNCUT;
+  R->cls[c] = (unsigned char)cls;
+  R->fraction[c] = phi;
+  o->volume = phi * cell.volume;
+  FCM_TRY(ctx, fcm__embed_cell_out_pieces(ctx, o, cls == FCM_CELL_DROPPED ? 0 : np));
+  if (o->np == 1) o->pc[0].volume = o->volume;
+  FCM_TRY(ctx, piece_parents(B, c, P, pcomp, integrate, o));
+  for (int i = 0; P && i < o->np && o->np > 1; i++)
+    o->pc[i].volume = pvol[i];
+  if (!integrate) {
+    FCM_CHECK(B->prev->piece_off[c + 1] - B->prev->piece_off[c] == o->np &&
+                  B->prev->cls[c] == R->cls[c],
+              ctx, FCM_ERR_INTERNAL,
+              "embed: cell %lld, which the new cut does not reach, now has %d pieces (class %d) "
+              "instead of %lld (class %d)",
+              (long long)c, o->np, (int)R->cls[c],
+              (long long)(B->prev->piece_off[c + 1] - B->prev->piece_off[c]), (int)B->prev->cls[c]);
+    FCM_TRY(ctx, copy_cell(B, c, o));
+    goto cleanup;
+  }
+  /* the pieces' sides of the cuts: on every cell, masked or not (the space's DOF copies
+   * depend on them: a cut along cell faces separates cells without splitting any) */
+  if (P && P->tcand.n > 0 && cls != FCM_CELL_DROPPED) FCM_TRY(ctx, piece_cut_faces(B, &cell, P, o));
+  if (!own) { /* classification, piece volumes and cut faces only (cell_mask) */
+    sums->time_intersect += fcm_wtime() - t0;
+    goto cleanup;
+  }
+  if (cls == FCM_CELL_CUT) {
+    for (int i = 0; i < o->np; i++) {
+      double v;
+      if (P) FCM_TRY(ctx, fcm__embed_piece_tets(ctx, P, P->piece, i, ws, NULL, &v));
+      FCM_TRY(ctx, fcm__embed_map_piece(B, R, &cell, ws, o->pc + i));
+    }
+  }
+  if (B->tri_rule && cls != FCM_CELL_DROPPED) {
+    for (int i = 0; i < o->np; i++) { /* split cells: each piece its exact share */
+      if (i == 0 || o->np > 1)
+        FCM_TRY(ctx, fcm__embed_cell_surface(ctx, B->geom, B->tri_tree, &cell, o->np > 1 ? P : NULL,
+                                             i, opt->sliver_rtol, B->tri_rule, ws, &sums->counts));
+      FCM_TRY(ctx, fcm__embed_surface_piece(B, &cell, ws, o->pc + i));
+    }
+  }
+  sums->time_intersect += fcm_wtime() - t0;
+  if (cls == FCM_CELL_CUT && opt->simplify != FCM_CELL_SIMPLIFY_AUTO) {
+    const int on = opt->simplify == FCM_CELL_SIMPLIFY_ON;
+    const int simp[FCM_RULE_KIND_COUNT] = {on, on};
+    for (int i = 0; i < o->np; i++)
+      FCM_TRY(ctx, fcm__embed_finish_cell(B, R, o->pc + i, simp, sums));
+  }
+cleanup:
+  fcm__free(ctx, pvol);
+  fcm__free(ctx, pcomp);
+  return st;
+}
+
+/* Phase 2: every cell in parallel into its own cell_out; thread sums into *sums. An error
+ * is that of the lowest failing cell, whatever the thread count. */
+fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads, cell_out *out,
+                                cell_sums *sums, const fcm_cell_rules_options *opt)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_index nc = R->num_cells;
+  fcm_index done = 0;
+  double last = fcm_wtime();
+  fcm__loop loop;
+  fcm__loop_begin(ctx, &loop);
+  memset(sums, 0, sizeof *sums);
+#pragma omp parallel num_threads(nthreads)
+  {
+    cell_sums mine;
+    memset(&mine, 0, sizeof mine);
+    fcm__embed_ws *ws = NULL;
+#pragma omp for schedule(dynamic, 4)
+    for (fcm_index c = 0; c < nc; c++) {
+      if (fcm__loop_skip(&loop, c)) continue;
+      fcm__loop_iter it;
+      fcm__loop_enter(&loop, &it, c);
+      fcm_status s = FCM_OK;
+      if (!ws) { /* the thread's workspace, made by its first cell */
+        ws = fcm__calloc(ctx, 1, sizeof *ws);
+        if (!ws) s = FCM_ERR_ALLOC;
+      }
+      const int remote = B->remote && B->remote[c]; /* classified by another process */
+      if (s == FCM_OK && !remote) s = process_cell(B, R, c, ws, out + c, &mine);
+      fcm__loop_leave(&loop, &it, s);
+      if (opt->progress) { /* counted by all threads, reported by the calling one */
+#pragma omp atomic
+        done++;
+        if (omp_get_thread_num() == 0 && fcm_wtime() - last >= opt->progress_interval) {
+          fcm_index now;
+#pragma omp atomic read
+          now = done;
+          opt->progress(now, nc, opt->progress_user);
+          last = fcm_wtime();
+        }
+      }
+    }
+    if (ws) fcm__embed_ws_free(ctx, ws);
+    fcm__free(ctx, ws);
+#pragma omp critical(fcm_embed_sum)
+    {
+      sums->counts.candidates += mine.counts.candidates;
+      sums->counts.parts += mine.counts.parts;
+      sums->counts.tets += mine.counts.tets;
+      sums->counts.slivers += mine.counts.slivers;
+      sums->counts.surface_triangles += mine.counts.surface_triangles;
+      sums->counts.sliver_volume += mine.counts.sliver_volume;
+      sums->counts.degenerate += mine.counts.degenerate;
+      sums->time_intersect += mine.time_intersect;
+      sums->time_simplify += mine.time_simplify;
+    }
+  }
+  FCM_TRY(ctx, fcm__loop_end(&loop, NULL));
+  if (opt->progress) opt->progress(nc, nc, opt->progress_user);
+cleanup:
+  return st;
+}

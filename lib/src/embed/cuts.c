@@ -1,0 +1,160 @@
+/* Cut surfaces in the cut-cell rules: the cells the cuts reach and their region, and the
+ * links between the material pieces of face-neighbouring cells. */
+#include "embed/rules_impl.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Phase 1c (cuts only): the tree of R's cut triangles, the region (cells sharing a node with
+ * a cell the cuts reach) and, when extending `prev` by the triangles from first_new on,
+ * the cells to integrate (those the new triangles reach). */
+fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_mesh *mesh = B->mesh;
+  const fcm_index nc = fcm_mesh_num_cells(mesh), nn = fcm_mesh_num_nodes(mesh);
+  const int npc = fcm_mesh_nodes_per_cell(mesh);
+  const fcm_index *cells = fcm_mesh_cells(mesh);
+  double *boxes = NULL;
+  unsigned char *node_hit = NULL; /* 1: a cell the cuts reach holds the node; 2: the earlier */
+  fcm__idbuf ids = {NULL, 0, 0};
+  FCM_ALLOC(ctx, 6 * (size_t)R->num_cut_tris + 6, boxes);
+  for (fcm_index t = 0; t < R->num_cut_tris; t++) {
+    memcpy(boxes + 6 * t, R->cut_tris[t].lo, 3 * sizeof(double));
+    memcpy(boxes + 6 * t + 3, R->cut_tris[t].hi, 3 * sizeof(double));
+  }
+  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, R->num_cut_tris, boxes, &B->cut_tree));
+  B->cut_tris = R->cut_tris;
+  FCM_ALLOC(ctx, (size_t)nc + 1, B->region);
+  FCM_ALLOC(ctx, (size_t)nn + 1, node_hit);
+  fcm__free(ctx, R->reached);
+  R->reached = NULL;
+  FCM_ALLOC(ctx, (size_t)nc + 1, R->reached);
+  if (B->prev) FCM_ALLOC(ctx, (size_t)nc + 1, B->rebuild);
+  if (B->prev && first_new > 0) FCM_ALLOC(ctx, (size_t)nc + 1, B->prev_region);
+  for (fcm_index c = 0; c < nc; c++) {
+    fcm__embed_cell cell;
+    FCM_TRY(ctx, fcm__embed_cell_setup(ctx, mesh, c, B->o->clip_rtol, &cell));
+    FCM_TRY(ctx, fcm__embed_cut_candidates(ctx, B->cut_tree, &cell, &ids));
+    if (ids.n == 0) continue;
+    R->reached[c] = 1;
+    for (int a = 0; a < npc; a++) /* ids ascending: the earlier cuts' triangles first */
+      node_hit[cells[(size_t)npc * c + a]] |= (unsigned char)(ids.ids[0] < first_new ? 3 : 1);
+    if (B->rebuild && ids.ids[ids.n - 1] >= first_new) B->rebuild[c] = 1;
+  }
+  for (fcm_index c = 0; c < nc; c++)
+    for (int a = 0; a < npc; a++) {
+      const unsigned char h = node_hit[cells[(size_t)npc * c + a]];
+      B->region[c] |= h != 0;
+      if (B->prev_region) B->prev_region[c] |= (h & 2) != 0;
+    }
+cleanup:
+  fcm__free(ctx, boxes);
+  fcm__free(ctx, node_hit);
+  fcm__geom_idbuf_free(ctx, &ids);
+  return st;
+}
+
+static int cmp_link(const void *a, const void *b)
+{
+  const fcm_index *x = a, *y = b;
+  if (x[0] != y[0]) return x[0] < y[0] ? -1 : 1;
+  return (x[1] > y[1]) - (x[1] < y[1]);
+}
+
+/* Whether the earlier pieces qa of cell ca and qb of cell cb (ca < cb, face neighbours) were
+ * linked in the rules being extended: a cut only separates, so pieces whose parents it had
+ * separated stay apart, whatever the face tests on the new, smaller pieces say (near a cut
+ * within the tolerances those can differ). Cells outside the earlier region had one piece
+ * each, linked to its neighbours'. */
+static int earlier_link(const build *B, fcm_index ca, fcm_index cb, int qa, int qb)
+{
+  if (!B->prev_region || !B->prev_region[ca] || !B->prev_region[cb]) return 1;
+  const fcm_cell_rules *Q = B->prev;
+  const fcm_index key[2] = {Q->piece_off[ca] + qa, Q->piece_off[cb] + qb};
+  return bsearch(key, Q->links, (size_t)Q->num_links, 2 * sizeof *Q->links, cmp_link) != NULL;
+}
+
+/* Phase 3b (cuts only): the links between pieces of face-neighbouring region cells: a
+ * polygon of one cell's piece on the shared face overlaps a polygon of the other cell's
+ * piece with positive area, and the overlap does not lie on a cut triangle, and
+ * their parents were linked (earlier_link()). */
+fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell_out *out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_mesh *mesh = B->mesh;
+  const int nf = fcm_mesh_get_element_info(mesh)->num_faces;
+  const fcm_index *nbr = fcm_mesh_neighbors(mesh);
+  fcm_index *links = NULL;
+  size_t nl = 0, cap = 0;
+  fcm__idbuf tc = {NULL, 0, 0};
+  for (fcm_index c = 0; c < R->num_cells; c++) {
+    const cell_out *oa = out + c;
+    if (!B->region[c] || oa->np == 0) continue;
+    fcm__embed_cell cell;
+    FCM_TRY(ctx, fcm__embed_cell_setup(ctx, mesh, c, B->o->clip_rtol, &cell));
+    const double mtol = FCM__EMBED_MATCH_RTOL * cell.size, atol = 1e-12 * cell.size * cell.size;
+    for (int f = 0; f < nf; f++) {
+      const fcm_index c2 = nbr[(size_t)nf * c + f];
+      if (c2 <= c || !B->region[c2] || out[c2].np == 0) continue;
+      int f2 = 0;
+      while (f2 < nf && nbr[(size_t)nf * c2 + f2] != c)
+        f2++;
+      if (f2 == nf) continue;
+      const cell_out *ob = out + c2;
+      const fcm_index pa0 = R->piece_off[c], pb0 = R->piece_off[c2];
+      size_t xa = 0;
+      for (int i = 0; i < oa->nfp; i++) {
+        const int *ma = oa->fmeta + 4 * i;
+        const double *A = oa->fx + 3 * xa;
+        xa += (size_t)(ma[2] + ma[3]);
+        if (ma[0] != f || ma[1] < 0) continue;
+        size_t xb = 0;
+        for (int j = 0; j < ob->nfp; j++) {
+          const int *mb = ob->fmeta + 4 * j;
+          const double *Bx = ob->fx + 3 * xb;
+          xb += (size_t)(mb[2] + mb[3]);
+          if (mb[0] != f2 || mb[1] < 0) continue;
+          const fcm_index pa = pa0 + ma[1], pb = pb0 + mb[1];
+          int known = 0;
+          for (size_t l = nl; l-- > 0 && !known;)
+            known = links[2 * l] == pa && links[2 * l + 1] == pb;
+          if (known) continue;
+          double lo[3], hi[3];
+          const double *nb = cell.planes[f].n; /* polygon B faces out of c2: normal -n_f */
+          const double nbn[3] = {-nb[0], -nb[1], -nb[2]};
+          for (int d = 0; d < 3; d++) {
+            lo[d] = HUGE_VAL, hi[d] = -HUGE_VAL;
+            for (int k = 0; k < ma[2]; k++)
+              lo[d] = fmin(lo[d], A[3 * k + d] - mtol), hi[d] = fmax(hi[d], A[3 * k + d] + mtol);
+          }
+          FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, lo, hi, &tc));
+          if (!fcm__embed_linked(A, ma[2], A + 3 * ma[2], ma[3], Bx, mb[2], Bx + 3 * mb[2], mb[3],
+                                 nbn, mtol, atol, B->cut_tris, tc.ids, tc.n))
+            continue;
+          if (!earlier_link(B, c, c2, out[c].pc[ma[1]].parent, out[c2].pc[mb[1]].parent)) continue;
+          if (nl + 1 > cap) {
+            const size_t ncap = cap ? 2 * cap : 256;
+            void *q = links;
+            FCM_TRY(ctx, fcm__resize(ctx, &q, 2 * nl, 2 * ncap, sizeof(fcm_index)));
+            links = q;
+            cap = ncap;
+          }
+          links[2 * nl] = pa, links[2 * nl + 1] = pb;
+          nl++;
+        }
+      }
+    }
+  }
+  if (nl) qsort(links, nl, 2 * sizeof *links, cmp_link);
+  R->links = links;
+  R->num_links = (fcm_index)nl;
+  links = NULL;
+cleanup:
+  fcm__free(ctx, links);
+  fcm__geom_idbuf_free(ctx, &tc);
+  return st;
+}

@@ -1,0 +1,337 @@
+/* The phases of the cut-cell rules build around the per-cell work: options and convexity
+ * checks, the result object, what every cell reads (rules, search trees), gathering the
+ * cells' output in cell order and the statistics. */
+#include "embed/rules_impl.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+fcm_status fcm__embed_check_options(fcm_ctx *ctx, const fcm_cell_rules_options *o, int reduced)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(o->kinds != 0 && (o->kinds & ~(unsigned)FCM_RULES_ALL) == 0, ctx, FCM_ERR_ARG,
+            "embed: kinds = 0x%x must be a non-empty set of FCM_RULES_STIFFNESS (0x%x) and "
+            "FCM_RULES_MASS (0x%x)",
+            o->kinds, FCM_RULES_STIFFNESS, FCM_RULES_MASS);
+  FCM_CHECK((int)o->simplify >= 0 && o->simplify < FCM_CELL_SIMPLIFY_COUNT, ctx, FCM_ERR_ARG,
+            "embed: simplify = %d is not a mode (0 off, 1 on, 2 auto)", (int)o->simplify);
+  if (o->simplify == FCM_CELL_SIMPLIFY_AUTO) {
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+      const char *kn = k == FCM_RULE_MASS ? "mass" : "stiffness";
+      FCM_CHECK(isfinite(o->expected_assemblies[k]) && o->expected_assemblies[k] >= 0.0, ctx,
+                FCM_ERR_ARG, "embed: expected_assemblies[%s] = %g must be finite and >= 0", kn,
+                o->expected_assemblies[k]);
+      FCM_CHECK(o->point_cost[k] == FCM_DEFAULT ||
+                    (isfinite(o->point_cost[k]) && o->point_cost[k] > 0.0),
+                ctx, FCM_ERR_ARG,
+                "embed: point_cost[%s] = %g must be > 0 seconds (FCM_DEFAULT: the measured "
+                "constant of the element)",
+                kn, o->point_cost[k]);
+    }
+  }
+  FCM_CHECK(!o->cell_mask || reduced || o->simplify != FCM_CELL_SIMPLIFY_AUTO, ctx, FCM_ERR_ARG,
+            "embed: cell_mask with simplify = auto: the choice would depend on the mask (use on "
+            "or off)");
+  const int smax = o->simplify ? FCM_SIMPLIFY_MAX_STRENGTH : FCM_RULE_MAX_STRENGTH;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    FCM_CHECK(o->strength[k] >= -1 && o->strength[k] <= smax, ctx, FCM_ERR_ARG,
+              "embed: %s strength = %d outside [0, %d] (-1: element default)",
+              k == FCM_RULE_MASS ? "mass" : "stiffness", o->strength[k], smax);
+  FCM_CHECK(o->surface_strength >= -1 && o->surface_strength <= FCM_RULE_MAX_STRENGTH, ctx,
+            FCM_ERR_ARG, "embed: surface strength = %d outside [0, %d] (-1: none)",
+            o->surface_strength, FCM_RULE_MAX_STRENGTH);
+  FCM_CHECK(o->min_fraction >= 0.0 && o->min_fraction < o->uncut_fraction &&
+                o->uncut_fraction <= 1.0,
+            ctx, FCM_ERR_ARG,
+            "embed: thresholds min_fraction = %g, uncut_fraction = %g must satisfy "
+            "0 <= min_fraction < uncut_fraction <= 1",
+            o->min_fraction, o->uncut_fraction);
+  FCM_CHECK(o->clip_rtol >= 0.0 && o->clip_rtol < 1e-3 && o->sliver_rtol >= 0.0 &&
+                o->sliver_rtol < 1e-3 && o->convex_rtol >= 0.0 && o->convex_rtol < 1e-2,
+            ctx, FCM_ERR_ARG,
+            "embed: tolerances clip_rtol = %g, sliver_rtol = %g (each in [0, 1e-3)), "
+            "convex_rtol = %g (in [0, 1e-2)) out of range",
+            o->clip_rtol, o->sliver_rtol, o->convex_rtol);
+  FCM_CHECK(o->progress_interval >= 0.0 && isfinite(o->progress_interval), ctx, FCM_ERR_ARG,
+            "embed: progress_interval = %g must be finite and >= 0 seconds", o->progress_interval);
+  FCM_CHECK(o->max_rule_memory >= 0.0 && !isnan(o->max_rule_memory), ctx, FCM_ERR_ARG,
+            "embed: max_rule_memory = %g bytes must be >= 0 (0: no limit)", o->max_rule_memory);
+  FCM_CHECK(o->num_threads >= 1 || o->num_threads == FCM_DEFAULT, ctx, FCM_ERR_ARG,
+            "embed: num_threads = %d must be >= 1, or FCM_DEFAULT (-1)", o->num_threads);
+  FCM_CHECK((int)o->stabilization.mode >= 0 &&
+                o->stabilization.mode < FCM_STABILIZATION_MODE_COUNT &&
+                (o->stabilization.mode == FCM_STABILIZATION_OFF ||
+                 (isfinite(o->stabilization.alpha) && o->stabilization.alpha > 0.0)),
+            ctx, FCM_ERR_ARG, "embed: stabilization mode %d / alpha = %g invalid (alpha > 0)",
+            (int)o->stabilization.mode, o->stabilization.alpha);
+cleanup:
+  return st;
+}
+
+/* Boxes (n x 6) of the embedded cells or of the boundary triangles. */
+fcm_status fcm__embed_geometry_boxes(fcm_ctx *ctx, const fcm_geometry *g, int tris, double **out,
+                                     fcm_index *n)
+{
+  fcm_status st = FCM_OK;
+  const int npv = tris ? 3 : g->npc;
+  const fcm_index *conn = tris ? g->tris : g->cells;
+  const fcm_index m = tris ? g->num_tris : g->num_cells;
+  double *b = NULL;
+  FCM_ALLOC(ctx, 6 * (size_t)m, b);
+  for (fcm_index i = 0; i < m; i++) {
+    double *bi = b + 6 * i;
+    for (int d = 0; d < 3; d++)
+      bi[d] = HUGE_VAL, bi[3 + d] = -HUGE_VAL;
+    for (int a = 0; a < npv; a++)
+      for (int d = 0; d < 3; d++) {
+        const double v = g->coords[3 * conn[(size_t)npv * (size_t)i + a] + d];
+        bi[d] = fmin(bi[d], v);
+        bi[3 + d] = fmax(bi[3 + d], v);
+      }
+  }
+  *out = b;
+  *n = m;
+cleanup:
+  return st;
+}
+
+/* FCM_ERR_GEOMETRY when background cell c is not convex (the rules build's first check). */
+fcm_status fcm__embed_check_convex(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index c,
+                                   const fcm_cell_rules_options *o)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(fcm_mesh_cell_is_convex(mesh, c, o->convex_rtol), ctx, FCM_ERR_GEOMETRY,
+            "embed: background cell %lld (%s) is not a convex polyhedron with planar faces and "
+            "straight edges (relative tolerance %g); cut-cell quadrature needs convex cells",
+            (long long)c, fcm_mesh_get_element_info(mesh)->name, o->convex_rtol);
+cleanup:
+  return st;
+}
+
+/* Phase 1a: the result object with its per-cell arrays, strengths and catalogue rules. */
+fcm_status fcm__embed_rules_alloc(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                  const fcm_cell_rules_options *o, fcm_cell_rules **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_cell_rules *R = NULL;
+  const fcm_element_info *info = fcm_mesh_get_element_info(mesh);
+  const fcm_index nc = fcm_mesh_num_cells(mesh);
+  const int element_strength[FCM_RULE_KIND_COUNT] = {
+      [FCM_RULE_STIFFNESS] = info->stiffness_strength, [FCM_RULE_MASS] = info->mass_strength};
+  FCM_ALLOC(ctx, 1, R);
+  R->ctx = ctx;
+  R->num_cells = nc;
+  R->type = info->type;
+  R->surface_strength = o->surface_strength;
+  FCM_ALLOC(ctx, (size_t)nc, R->cls);
+  FCM_ALLOC(ctx, (size_t)nc, R->fraction);
+  FCM_ALLOC(ctx, (size_t)nc + 1, R->piece_off);
+  R->opts = *o;
+  R->stats.kinds = o->kinds;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    R->strength[k] = -1;
+    if (!KIND_BUILT(o->kinds, k)) continue;
+    R->strength[k] = o->strength[k] >= 0 ? o->strength[k] : element_strength[k];
+    FCM_TRY(ctx, fcm_rule_create(ctx, info->shape, R->strength[k], &R->uncut[k]));
+    FCM_ALLOC(ctx, (size_t)fcm_rule_num_points(R->uncut[k]), R->uncut_flags[k]);
+  }
+  *out = R;
+  R = NULL;
+cleanup:
+  fcm_cell_rules_destroy(&R);
+  return st;
+}
+
+void fcm__embed_build_release(build *B)
+{
+  fcm_aabb_tree_destroy(&B->cut_tree);
+  if (B->ctx) {
+    fcm__free(B->ctx, B->region);
+    fcm__free(B->ctx, B->rebuild);
+    fcm__free(B->ctx, B->prev_region);
+  }
+  B->region = B->rebuild = B->prev_region = NULL;
+  fcm_aabb_tree_destroy(&B->tree);
+  fcm_aabb_tree_destroy(&B->tri_tree);
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    fcm_rule_destroy(&B->tet_rule[k]);
+  fcm_rule_destroy(&B->tri_rule);
+}
+
+/* Phase 1b: what every cell reads: tet rules, search trees of the embedded cells and
+ * boundary triangles, which kinds get stabilization points. */
+fcm_status fcm__embed_build_setup(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                                  const fcm_cell_rules_options *o, const fcm_cell_rules *R,
+                                  build *B)
+{
+  fcm_status st = FCM_OK;
+  double *boxes = NULL;
+  fcm_index nbox = 0;
+  memset(B, 0, sizeof *B);
+  B->ctx = ctx, B->mesh = mesh, B->geom = geom, B->o = o;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    if (!KIND_BUILT(o->kinds, k)) continue; /* tet_rule[k] NULL marks a kind not built */
+    FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TET, R->strength[k], &B->tet_rule[k]));
+    B->full_rule[k] = R->uncut[k];
+  }
+  B->stabilize[FCM_RULE_STIFFNESS] = o->stabilization.mode == FCM_STABILIZATION_MASS_STIFFNESS;
+  B->stabilize[FCM_RULE_MASS] = o->stabilization.mode != FCM_STABILIZATION_OFF;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    B->stabilize[k] = B->stabilize[k] && B->tet_rule[k];
+  FCM_TRY(ctx, fcm__embed_geometry_boxes(ctx, geom, 0, &boxes, &nbox));
+  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &B->tree));
+  FCM_FREE(ctx, boxes);
+  if (o->surface_strength >= 0) {
+    FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TRI, o->surface_strength, &B->tri_rule));
+    FCM_TRY(ctx, fcm__embed_geometry_boxes(ctx, geom, 1, &boxes, &nbox));
+    FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &B->tri_tree));
+  }
+cleanup:
+  fcm__free(ctx, boxes);
+  if (st != FCM_OK) fcm__embed_build_release(B);
+  return st;
+}
+
+/* Phase 3: concatenate the pieces' volume and surface rules in cell order. */
+fcm_status fcm__embed_gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_out *out,
+                                   const fcm_cell_rules *prev)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index nc = R->num_cells;
+  fcm_index np = 0;
+  for (fcm_index c = 0; c < nc; c++)
+    np += out[c].np;
+  R->num_pieces = np;
+  FCM_ALLOC(ctx, (size_t)np + 1, R->piece_cell);
+  FCM_ALLOC(ctx, (size_t)np + 1, R->piece_volume);
+  FCM_ALLOC(ctx, (size_t)np + 1, R->piece_parent);
+  FCM_ALLOC(ctx, (size_t)np + 1, R->piece_component);
+  FCM_ALLOC(ctx, (size_t)np + 1, R->soff);
+  R->piece_off[0] = 0;
+  for (fcm_index c = 0; c < nc; c++) {
+    R->piece_off[c + 1] = R->piece_off[c] + out[c].np;
+    for (int i = 0; i < out[c].np; i++) {
+      R->piece_cell[R->piece_off[c] + i] = c;
+      R->piece_volume[R->piece_off[c] + i] = out[c].pc[i].volume;
+      R->piece_parent[R->piece_off[c] + i] = prev ? prev->piece_off[c] + out[c].pc[i].parent : -1;
+      R->piece_component[R->piece_off[c] + i] = out[c].pc[i].component;
+    }
+  }
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    fcm_index *off = NULL;
+    FCM_ALLOC(ctx, (size_t)np + 1, R->off[k]);
+    off = R->off[k];
+    for (fcm_index c = 0; c < nc; c++)
+      for (int i = 0; i < out[c].np; i++) {
+        const fcm_index p = R->piece_off[c] + i;
+        off[p + 1] = off[p] + (R->cls[c] == FCM_CELL_CUT ? out[c].pc[i].n[k] : 0);
+      }
+    const size_t tot = (size_t)off[np];
+    FCM_ALLOC(ctx, 3 * tot, R->points[k]);
+    FCM_ALLOC(ctx, tot, R->weights[k]);
+    FCM_ALLOC(ctx, tot, R->flags[k]);
+    for (fcm_index c = 0; c < nc; c++)
+      for (int i = 0; i < out[c].np; i++) {
+        const fcm_index p = R->piece_off[c] + i;
+        const size_t n = (size_t)(off[p + 1] - off[p]), o0 = (size_t)off[p];
+        if (!n) continue;
+        memcpy(R->points[k] + 3 * o0, out[c].pc[i].pts[k], 3 * n * sizeof(double));
+        memcpy(R->weights[k] + o0, out[c].pc[i].w[k], n * sizeof(double));
+        memcpy(R->flags[k] + o0, out[c].pc[i].flag[k], n);
+      }
+  }
+  FCM_ALLOC(ctx, (size_t)np + 1, R->cfoff);
+  for (fcm_index c = 0; c < nc; c++)
+    for (int i = 0; i < out[c].np; i++) {
+      const fcm_index p = R->piece_off[c] + i;
+      R->cfoff[p + 1] = R->cfoff[p] + out[c].pc[i].ncf;
+    }
+  FCM_ALLOC(ctx, 9 * (size_t)R->cfoff[np] + 1, R->cfxi);
+  for (fcm_index c = 0; c < nc; c++)
+    for (int i = 0; i < out[c].np; i++)
+      if (out[c].pc[i].ncf)
+        memcpy(R->cfxi + 9 * R->cfoff[R->piece_off[c] + i], out[c].pc[i].cfxi,
+               9 * (size_t)out[c].pc[i].ncf * sizeof(double));
+  R->soff[0] = 0;
+  for (fcm_index c = 0; c < nc; c++)
+    for (int i = 0; i < out[c].np; i++) {
+      const fcm_index p = R->piece_off[c] + i;
+      R->soff[p + 1] = R->soff[p] + out[c].pc[i].ns;
+    }
+  const size_t tot = (size_t)R->soff[np];
+  FCM_ALLOC(ctx, 3 * tot, R->spoints);
+  FCM_ALLOC(ctx, tot, R->sweights);
+  FCM_ALLOC(ctx, 3 * tot, R->snormals);
+  FCM_ALLOC(ctx, tot, R->stris);
+  for (fcm_index c = 0; c < nc; c++)
+    for (int i = 0; i < out[c].np; i++) {
+      const piece_out *o = out[c].pc + i;
+      const size_t n = (size_t)o->ns, o0 = (size_t)R->soff[R->piece_off[c] + i];
+      if (!n) continue;
+      memcpy(R->spoints + 3 * o0, o->spts, 3 * n * sizeof(double));
+      memcpy(R->sweights + o0, o->sw, n * sizeof(double));
+      memcpy(R->snormals + 3 * o0, o->snrm, 3 * n * sizeof(double));
+      memcpy(R->stris + o0, o->stri, n * sizeof(fcm_index));
+    }
+cleanup:
+  return st;
+}
+
+/* Phase 4: the statistics (times are filled in by the caller). */
+void fcm__embed_gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const cell_out *out,
+                             const cell_sums *sums, int nthreads)
+{
+  fcm_cell_rules_stats *S = &R->stats;
+  const fcm_index nc = R->num_cells;
+  S->num_cells = nc;
+  for (fcm_index c = 0; c < nc; c++) {
+    const cell_out *o = out + c;
+    for (int i = 0; i < o->np; i++) {
+      const piece_out *q = o->pc + i;
+      for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+        S->points_initial[k] += q->ninit[k];
+        S->points_simplified[k] += q->nsimp[k];
+        S->points_stabilization[k] += q->nstab[k];
+        S->simplify_skipped[k] += q->skipped[k];
+        S->simplify_fallbacks[k] += q->fallback[k];
+        S->max_residual[k] = fmax(S->max_residual[k], q->residual[k]);
+        S->decision[k].time_simplify += q->tsimp[k];
+      }
+      for (int j = 0; j < q->ns; j++)
+        S->embedded_area += q->sw[j];
+    }
+    S->num_split += o->np > 1;
+    S->embedded_volume += o->volume;
+    switch ((fcm_cell_class)R->cls[c]) {
+    case FCM_CELL_UNCUT:
+      S->num_uncut++;
+      break;
+    case FCM_CELL_CUT:
+      S->num_cut++;
+      break;
+    default:
+      S->num_dropped++;
+      S->dropped_volume += o->volume;
+      break;
+    }
+  }
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    S->points_total[k] =
+        R->uncut[k] ? R->off[k][R->num_pieces] + S->num_uncut * fcm_rule_num_points(R->uncut[k])
+                    : 0;
+  S->surface_points = R->soff[R->num_pieces];
+  S->num_material_pieces = R->num_pieces;
+  S->num_links = R->num_links;
+  S->num_candidates = sums->counts.candidates;
+  S->num_parts = sums->counts.parts;
+  S->num_tets = sums->counts.tets;
+  S->num_slivers = sums->counts.slivers;
+  S->sliver_volume = sums->counts.sliver_volume;
+  S->num_degenerate = sums->counts.degenerate;
+  S->surface_triangles = sums->counts.surface_triangles;
+  S->geometry_volume = fcm_geometry_volume(geom);
+  S->num_threads = nthreads;
+  S->time_intersect = sums->time_intersect;
+  S->time_simplify = sums->time_simplify;
+}

@@ -1,0 +1,165 @@
+/* embed module, private to the files of the cut-cell rules build: what one cell and one piece
+ * produce, what every cell reads, and the calls between the build's phases (cell_rules.c
+ * drives; rules_build.c, classify.c, cut_cells.c, auto_policy.c, distribute.c, cuts.c). */
+#ifndef FCM_EMBED_RULES_IMPL_H
+#define FCM_EMBED_RULES_IMPL_H
+
+#include "embed/embed_impl.h"
+#include "element/element_impl.h"
+
+#define GIB (1024.0 * 1024.0 * 1024.0)
+
+/* Whether the options / rules ask for volume rules of kind k. */
+#define KIND_BUILT(kinds, k) ((((unsigned)(kinds)) >> (unsigned)(k)) & 1u)
+
+/* A cell whose parts' total volume the cut splitting changes by more than this fraction of
+ * the cell's volume meets the cut in a way the tolerances cannot resolve (near-coincident
+ * vertices classified differently); fcm_cell_rules_create_cut() then shifts the cut. */
+#define DEGENERATE_RTOL 1e-12
+
+/* What one material piece of a cell produced (private to the thread that built it). */
+typedef struct piece_out {
+  int n[FCM_RULE_KIND_COUNT];
+  double *pts[FCM_RULE_KIND_COUNT];
+  double *w[FCM_RULE_KIND_COUNT];
+  unsigned char *flag[FCM_RULE_KIND_COUNT];
+  int ninit[FCM_RULE_KIND_COUNT], nsimp[FCM_RULE_KIND_COUNT], nstab[FCM_RULE_KIND_COUNT];
+  unsigned char skipped[FCM_RULE_KIND_COUNT], fallback[FCM_RULE_KIND_COUNT];
+  double residual[FCM_RULE_KIND_COUNT];
+  double tsimp[FCM_RULE_KIND_COUNT]; /* fcm_simplify's time_total */
+  int parent;    /* the piece of the same cell in the rules being extended that holds this one */
+  int component; /* its number among the cell's components before empty ones were dropped */
+  int ns;
+  double *spts, *sw, *snrm;
+  fcm_index *stri;
+  int ncf;      /* cut-face triangles */
+  double *cfxi; /* 9 reference coordinates each */
+  double volume;
+} piece_out;
+
+/* What one cell produced: its pieces (pc == &one for at most one piece), and for cells
+ * next to cuts the polygons of its pieces on its faces (for the links between cells). */
+typedef struct cell_out {
+  int np;
+  piece_out one;
+  piece_out *pc;
+  double volume;
+  int nfp; /* face polygons: meta (face, piece, vertices, part vertices) x nfp, coordinates fx
+              (the polygon's, then its part's) */
+  int *fmeta;
+  double *fx;
+} cell_out;
+
+/* Everything the per-cell work reads; the trees and rules are owned (fcm__embed_build_release). */
+typedef struct build {
+  fcm_ctx *ctx;
+  const fcm_mesh *mesh;
+  const fcm_geometry *geom;
+  const fcm_cell_rules_options *o;
+  fcm_aabb_tree *tree, *tri_tree;
+  fcm_rule *tet_rule[FCM_RULE_KIND_COUNT];        /* rule mapped onto each tet */
+  const fcm_rule *full_rule[FCM_RULE_KIND_COUNT]; /* catalogue rule of the cell shape (in R) */
+  fcm_rule *tri_rule;                             /* NULL: no surface rules */
+  int stabilize[FCM_RULE_KIND_COUNT];
+  /* Cutting: the tree of R->cut_tris (NULL without cuts); region[c]: cell c shares a node
+   * with a cell the cuts reach (its face polygons are recorded for the links); rebuild[c]:
+   * integrate cell c (NULL: every cell), else copy its rules from prev; prev_region[c]: the
+   * region of prev, whose links cover the pairs of its cells (NULL: prev has no cuts). */
+  fcm_aabb_tree *cut_tree;
+  const fcm__cut_tri *cut_tris;
+  unsigned char *region, *rebuild, *prev_region;
+  const fcm_cell_rules *prev;
+  fcm_index first_new;    /* cut triangles from here on are new (those of the cut being added) */
+  fcm__rules_reduce *red; /* distributed AUTO: sums the choice's inputs (NULL: none) */
+  const unsigned char *remote; /* distributed classification: cells another process classifies
+                                  (skipped here), NULL: none */
+} build;
+
+/* What one thread summed over the cells it built. */
+typedef struct cell_sums {
+  fcm__embed_counts counts;
+  double time_intersect, time_simplify; /* seconds of one core */
+} cell_sums;
+
+/* ---- rules_build.c: around the per-cell work */
+
+/* FCM_ERR_ARG naming the first bad option (reduced: a reduce for the AUTO choice is given). */
+fcm_status fcm__embed_check_options(fcm_ctx *ctx, const fcm_cell_rules_options *o, int reduced);
+
+/* Boxes (n x 6, allocated) of the embedded cells (tris = 0) or of the boundary triangles. */
+fcm_status fcm__embed_geometry_boxes(fcm_ctx *ctx, const fcm_geometry *g, int tris, double **out,
+                                     fcm_index *n);
+
+/* FCM_ERR_GEOMETRY when background cell c is not convex (the rules build's first check). */
+fcm_status fcm__embed_check_convex(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index c,
+                                   const fcm_cell_rules_options *o);
+
+/* Phase 1a: the result object with its per-cell arrays, strengths and catalogue rules. */
+fcm_status fcm__embed_rules_alloc(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                  const fcm_cell_rules_options *o, fcm_cell_rules **out);
+
+/* Phase 1b: what every cell reads (B is zeroed first; fcm__embed_build_release() frees it). */
+fcm_status fcm__embed_build_setup(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                                  const fcm_cell_rules_options *o, const fcm_cell_rules *R,
+                                  build *B);
+void fcm__embed_build_release(build *B);
+
+/* Phase 3: concatenate the pieces' volume and surface rules in cell order. */
+fcm_status fcm__embed_gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_out *out,
+                                   const fcm_cell_rules *prev);
+
+/* Phase 4: the statistics (times are filled in by the caller). */
+void fcm__embed_gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const cell_out *out,
+                             const cell_sums *sums, int nthreads);
+
+/* ---- classify.c: the per-cell work */
+
+void fcm__embed_cell_out_free(fcm_ctx *ctx, cell_out *o);
+
+/* Room for np pieces in o (inline for one). */
+fcm_status fcm__embed_cell_out_pieces(fcm_ctx *ctx, cell_out *o, int np);
+
+/* Phase 2: every cell in parallel into its own cell_out; thread sums into *sums. An error
+ * is that of the lowest failing cell, whatever the thread count. */
+fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads, cell_out *out,
+                                cell_sums *sums, const fcm_cell_rules_options *opt);
+
+/* ---- cut_cells.c: the rules of a cut cell's pieces */
+
+/* Simplify the kinds with simp[k] set, then append the stabilization points. */
+fcm_status fcm__embed_finish_cell(const build *B, const fcm_cell_rules *R, piece_out *o,
+                                  const int simp[FCM_RULE_KIND_COUNT], cell_sums *sums);
+
+/* Map the tets in ws into piece o's initial rules of both kinds (after the memory check). */
+fcm_status fcm__embed_map_piece(const build *B, const fcm_cell_rules *R,
+                                const fcm__embed_cell *cell, fcm__embed_ws *ws, piece_out *o);
+
+/* The surface points in ws into o, mapped to reference coordinates. */
+fcm_status fcm__embed_surface_piece(const build *B, const fcm__embed_cell *cell,
+                                    const fcm__embed_ws *ws, piece_out *o);
+
+/* ---- auto_policy.c */
+
+/* Phase 2b of FCM_CELL_SIMPLIFY_AUTO: choose per kind whether simplification pays, then
+ * finish every piece integrated here. */
+fcm_status fcm__embed_auto_simplify(const build *B, fcm_cell_rules *R, int nthreads, cell_out *out,
+                                    cell_sums *sums);
+
+/* ---- distribute.c */
+
+/* The remote cells' class, fraction and volume from the exchange (x) into R and out;
+ * *exchanged is set once the exchange ran (whatever its outcome). */
+fcm_status fcm__embed_exchange_classes(const build *B, fcm_cell_rules *R,
+                                       const fcm__rules_exchange *x, cell_out *out, cell_sums *sums,
+                                       int *exchanged);
+
+/* ---- cuts.c */
+
+/* Phase 1c (cuts only): the tree of R's cut triangles, the region and the cells to
+ * integrate. */
+fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new);
+
+/* Phase 3b (cuts only): the links between pieces of face-neighbouring region cells. */
+fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell_out *out);
+
+#endif /* FCM_EMBED_RULES_IMPL_H */

@@ -1,0 +1,307 @@
+/* The DOF numbering of a space: its elements (one per material piece of a cell), the elements
+ * at each node, the copies of each node (one per connected component of its support,
+ * generalized enrichment) and the constraint of tiny copies (Koschier et al. 2017). */
+#include "embed/embed_impl.h"
+#include "fem/fem_impl.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Node -> elements incidence as CSR: inc_ptr[num_nodes+1], inc (ascending elements). */
+fcm_status fcm__space_build_incidence(fcm_space *s, fcm_index **inc_ptr, fcm_index **inc)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index *cells = fcm_mesh_cells(s->mesh);
+  fcm_index *ptr = NULL, *list = NULL, *fill = NULL;
+  FCM_ALLOC(ctx, s->num_nodes + 1, ptr);
+  for (fcm_index e = 0; e < s->num_elems; e++)
+    for (int a = 0; a < s->nn; a++)
+      ptr[cells[s->elem_cell[e] * s->nn + a] + 1]++;
+  for (fcm_index n = 0; n < s->num_nodes; n++)
+    ptr[n + 1] += ptr[n];
+  FCM_ALLOC(ctx, ptr[s->num_nodes], list);
+  FCM_ALLOC(ctx, s->num_nodes, fill);
+  for (fcm_index e = 0; e < s->num_elems; e++)
+    for (int a = 0; a < s->nn; a++) {
+      fcm_index n = cells[s->elem_cell[e] * s->nn + a];
+      list[ptr[n] + fill[n]++] = e;
+    }
+  *inc_ptr = ptr;
+  *inc = list;
+  ptr = list = NULL;
+cleanup:
+  fcm__free(ctx, ptr);
+  fcm__free(ctx, list);
+  fcm__free(ctx, fill);
+  return st;
+}
+
+/* The elements: one per piece of every active cell (a space without rules: one per active
+ * cell, with the standard rule). */
+fcm_status fcm__space_build_elements(fcm_space *s)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  fcm_index ne = 0;
+  FCM_ALLOC(ctx, s->num_cells + 1, s->cell_elem);
+  for (fcm_index c = 0; c < s->num_cells; c++) {
+    fcm_index k = s->active[c];
+    if (s->rules && s->active[c]) k = fcm_cell_rules_cell_pieces(s->rules, c, NULL);
+    s->cell_elem[c + 1] = s->cell_elem[c] + k;
+  }
+  ne = s->num_elems = s->cell_elem[s->num_cells];
+  FCM_ALLOC(ctx, ne + 1, s->elem_cell);
+  FCM_ALLOC(ctx, ne + 1, s->elem_piece);
+  FCM_ALLOC(ctx, (size_t)ne * s->nn + 1, s->elem_dof);
+  for (fcm_index c = 0; c < s->num_cells; c++) {
+    fcm_index first = 0;
+    if (s->rules) fcm_cell_rules_cell_pieces(s->rules, c, &first);
+    for (fcm_index e = s->cell_elem[c]; e < s->cell_elem[c + 1]; e++) {
+      s->elem_cell[e] = c;
+      s->elem_piece[e] = s->rules ? first + (e - s->cell_elem[c]) : -1;
+    }
+  }
+cleanup:
+  return st;
+}
+
+static fcm_index uf_find(fcm_index *uf, fcm_index a)
+{
+  while (uf[a] != a)
+    a = uf[a] = uf[uf[a]];
+  return a;
+}
+
+/* Generalized enrichment (Ton-That et al. 2024, XFEM): the elements incident to a node
+ * (its support) are grouped into connected components along the links of the cell rules
+ * (pieces of face-neighbouring cells that share a face part not lying on a cut); each
+ * component gets its own copy of the node. Where every incident cell has one piece, the
+ * node has one copy. Copies are numbered node by node, components by their first element;
+ * elem_dof gets the copy each element uses. */
+fcm_status fcm__space_build_copies(fcm_space *s, const fcm_index *inc_ptr, const fcm_index *inc)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index *cells = fcm_mesh_cells(s->mesh);
+  const fcm_index nl = s->rules ? fcm_cell_rules_num_links(s->rules) : 0;
+  const fcm_index *links = s->rules ? fcm_cell_rules_links(s->rules) : NULL;
+  fcm_index *uf = NULL, *comp = NULL, *pos = NULL, ncopy = 0, maxdeg = 0;
+  FCM_ALLOC(ctx, s->num_nodes, s->node_ncopy);
+  for (fcm_index n = 0; n < s->num_nodes; n++)
+    maxdeg = FCM_MAX(maxdeg, inc_ptr[n + 1] - inc_ptr[n]);
+  FCM_ALLOC(ctx, maxdeg + 1, uf);
+  FCM_ALLOC(ctx, maxdeg + 1, comp);
+  FCM_ALLOC(ctx, s->num_elems + 1, pos);
+  for (fcm_index e = 0; e < s->num_elems; e++)
+    pos[e] = -1;
+  for (fcm_index n = 0; n < s->num_nodes; n++) {
+    const fcm_index i0 = inc_ptr[n], deg = inc_ptr[n + 1] - i0;
+    s->node_dof[n] = -1;
+    if (deg == 0) continue;
+    int split = 0;
+    for (fcm_index i = 0; i < deg; i++) {
+      const fcm_index e = inc[i0 + i], c = s->elem_cell[e];
+      /* cuts reach the node's support: a cell split into pieces, a piece with a face on a
+       * cut (a cut along cell faces splits no cell but separates them), or a cell a cut
+       * passes near: the material of the support can be connected only through cells
+       * outside it (around a hole), and a cut elsewhere can sever that; the links are
+       * known around every such cell */
+      split |=
+          s->cell_elem[c + 1] - s->cell_elem[c] > 1 ||
+          (s->rules && s->rules->reached && s->rules->reached[c]) ||
+          (s->rules && fcm_cell_rules_get_piece_cut_faces(s->rules, s->elem_piece[e], NULL) > 0);
+      uf[i] = i;
+      pos[e] = i;
+    }
+    fcm_index k = 1;
+    if (split) {
+      for (fcm_index i = 0; i < deg; i++) {
+        /* links (p, q) with p the piece of this element: binary search for the first */
+        const fcm_index p = s->elem_piece[inc[i0 + i]];
+        fcm_index lo = 0, hi = nl;
+        while (lo < hi) {
+          const fcm_index mid = lo + (hi - lo) / 2;
+          if (links[2 * mid] < p)
+            lo = mid + 1;
+          else
+            hi = mid;
+        }
+        for (fcm_index l = lo; l < nl && links[2 * l] == p; l++) {
+          /* the element of piece q: pieces and elements of a cell are in the same order */
+          const fcm_index q = links[2 * l + 1];
+          const fcm_index cq = fcm_cell_rules_piece_cell(s->rules, q);
+          fcm_index fq;
+          fcm_cell_rules_cell_pieces(s->rules, cq, &fq);
+          const fcm_index eq = s->cell_elem[cq] + (q - fq);
+          if (pos[eq] < 0) continue; /* not in this node's support */
+          const fcm_index ra = uf_find(uf, i), rb = uf_find(uf, pos[eq]);
+          if (ra != rb) uf[FCM_MAX(ra, rb)] = FCM_MIN(ra, rb);
+        }
+      }
+      k = 0;
+      for (fcm_index i = 0; i < deg; i++) {
+        const fcm_index r = uf_find(uf, i);
+        comp[i] = r == i ? k++ : comp[r];
+      }
+    } else {
+      for (fcm_index i = 0; i < deg; i++)
+        comp[i] = 0;
+    }
+    s->node_ncopy[n] = k;
+    s->node_dof[n] = 3 * ncopy;
+    for (fcm_index i = 0; i < deg; i++) {
+      const fcm_index e = inc[i0 + i];
+      for (int a = 0; a < s->nn; a++)
+        if (cells[s->elem_cell[e] * s->nn + a] == n)
+          s->elem_dof[e * s->nn + a] = 3 * (ncopy + comp[i]);
+      pos[e] = -1;
+    }
+    ncopy += k;
+  }
+  s->num_dofs = 3 * ncopy;
+cleanup:
+  fcm__free(ctx, uf);
+  fcm__free(ctx, comp);
+  fcm__free(ctx, pos);
+  return st;
+}
+
+void fcm__space_copy_support(const fcm_space *s, double *support)
+{
+  const fcm_index nn = s->nn;
+  memset(support, 0, sizeof *support * (size_t)(s->num_dofs / 3));
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    const double v = s->rules ? fcm_cell_rules_piece_volume(s->rules, s->elem_piece[e]) : 1.0;
+    for (int a = 0; a < nn; a++)
+      support[s->elem_dof[e * nn + a] / 3] += v;
+  }
+}
+
+/* Koschier et al. 2017, Sec. 6: a copy whose support (the volume of the pieces that use it)
+ * is below `ratio` of its node's (the pieces of all the node's elements) barely contributes
+ * and makes the system (nearly) singular; it is constrained to move with its piece: its
+ * elements use, in its place, the DOFs of the largest-support copy at another node of those
+ * elements, so the fragment follows that copy (exact for translations). A fragment the cuts
+ * separate completely (every copy its elements use is tiny) has no such copy: all its copies
+ * follow one anchor, the largest copy at any of the fragment's nodes, so the fragment moves
+ * with (translates as) that copy's body — Koschier's "sticking", of material below `ratio`
+ * of its nodes' supports — and never joins two bodies. Unused copies are then removed from
+ * the numbering. Counts in s->num_constrained. */
+fcm_status fcm__space_constrain_copies(fcm_space *s, double ratio, const fcm_index *inc_ptr,
+                                       const fcm_index *inc)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index *cells = fcm_mesh_cells(s->mesh);
+  const fcm_index ncopy = s->num_dofs / 3, nn = s->nn;
+  double *venr = NULL;
+  fcm_index *master = NULL, *renum = NULL, *uf = NULL, *node_of = NULL, *anchor = NULL;
+  unsigned char *tiny = NULL;
+  FCM_ALLOC(ctx, ncopy + 1, venr);
+  FCM_ALLOC(ctx, ncopy + 1, master);
+  FCM_ALLOC(ctx, ncopy + 1, tiny);
+  FCM_ALLOC(ctx, ncopy + 1, uf);
+  FCM_ALLOC(ctx, ncopy + 1, node_of);
+  FCM_ALLOC(ctx, ncopy + 1, anchor);
+  fcm__space_copy_support(s, venr);
+  /* which copies are tiny, each against its own node's support */
+  fcm_index ntiny = 0;
+  for (fcm_index n = 0; n < s->num_nodes; n++) {
+    double vsupp = 0.0;
+    for (fcm_index i = inc_ptr[n]; i < inc_ptr[n + 1]; i++)
+      vsupp += fcm_cell_rules_piece_volume(s->rules, s->elem_piece[inc[i]]);
+    for (fcm_index c = 0; c < s->node_ncopy[n]; c++) {
+      const fcm_index k = s->node_dof[n] / 3 + c;
+      node_of[k] = n;
+      tiny[k] = s->node_ncopy[n] > 1 && venr[k] < ratio * vsupp;
+      ntiny += tiny[k];
+    }
+  }
+  for (fcm_index k = 0; k < ncopy; k++)
+    master[k] = anchor[k] = -1, uf[k] = k;
+  if (ntiny == 0) goto cleanup;
+  /* rule 1: the largest non-tiny copy at another node of an element that uses the copy;
+   * elements using only tiny copies join them into separated fragments (union-find) */
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    const fcm_index *d = s->elem_dof + e * nn;
+    int all_tiny = 1;
+    for (int a = 0; a < nn; a++)
+      all_tiny &= tiny[d[a] / 3];
+    for (int a = 0; a < nn; a++) {
+      const fcm_index k = d[a] / 3;
+      if (!tiny[k]) continue;
+      if (all_tiny) {
+        const fcm_index ra = uf_find(uf, k), rb = uf_find(uf, d[0] / 3);
+        if (ra != rb) uf[FCM_MAX(ra, rb)] = FCM_MIN(ra, rb);
+        continue;
+      }
+      for (int b = 0; b < nn; b++) {
+        const fcm_index m = d[b] / 3;
+        if (cells[s->elem_cell[e] * nn + b] == node_of[k] || tiny[m]) continue;
+        if (master[k] < 0 || venr[m] > venr[master[k]] ||
+            (venr[m] == venr[master[k]] && m < master[k]))
+          master[k] = m;
+      }
+    }
+  }
+  /* rule 2: a fragment none of whose copies found a master follows its anchor */
+  for (fcm_index k = 0; k < ncopy; k++) /* fragments with a rule-1 master are not separated */
+    if (tiny[k] && master[k] >= 0) anchor[uf_find(uf, k)] = -2;
+  for (fcm_index k = 0; k < ncopy; k++) {
+    if (!tiny[k]) continue;
+    const fcm_index r = uf_find(uf, k), n = node_of[k];
+    if (anchor[r] == -2) continue;
+    for (fcm_index c = 0; c < s->node_ncopy[n]; c++) {
+      const fcm_index m = s->node_dof[n] / 3 + c;
+      if (!tiny[m] && (anchor[r] < 0 || venr[m] > venr[anchor[r]])) anchor[r] = m;
+    }
+  }
+  fcm_index count = 0;
+  for (fcm_index k = 0; k < ncopy; k++) {
+    if (!tiny[k]) continue;
+    const fcm_index r = uf_find(uf, k);
+    if (master[k] < 0 && anchor[r] >= 0) master[k] = anchor[r];
+    count += master[k] >= 0;
+  }
+  if (count > 0) {
+    FCM_ALLOC(ctx, (size_t)s->num_elems * nn + 1, s->elem_con);
+    for (fcm_index e = 0; e < s->num_elems; e++)
+      for (int a = 0; a < nn; a++) {
+        const fcm_index k = s->elem_dof[e * nn + a] / 3;
+        if (master[k] < 0) continue;
+        s->elem_dof[e * nn + a] = 3 * master[k];
+        s->elem_con[e * nn + a] = 1;
+      }
+    /* renumber the copies still in use, node by node */
+    FCM_ALLOC(ctx, ncopy + 1, renum);
+    fcm_index next = 0;
+    for (fcm_index n = 0; n < s->num_nodes; n++) {
+      if (s->node_dof[n] < 0) continue;
+      const fcm_index k0 = s->node_dof[n] / 3, nc = s->node_ncopy[n];
+      fcm_index kept = 0;
+      for (fcm_index c = 0; c < nc; c++) {
+        renum[k0 + c] = master[k0 + c] >= 0 ? -1 : next + kept;
+        kept += master[k0 + c] < 0;
+      }
+      s->node_dof[n] = kept ? 3 * next : -1;
+      s->node_ncopy[n] = kept;
+      next += kept;
+    }
+    for (fcm_index e = 0; e < s->num_elems; e++)
+      for (int a = 0; a < nn; a++)
+        s->elem_dof[e * nn + a] = 3 * renum[s->elem_dof[e * nn + a] / 3];
+    s->num_dofs = 3 * next;
+  }
+  s->num_constrained = count;
+cleanup:
+  fcm__free(ctx, venr);
+  fcm__free(ctx, master);
+  fcm__free(ctx, renum);
+  fcm__free(ctx, tiny);
+  fcm__free(ctx, uf);
+  fcm__free(ctx, node_of);
+  fcm__free(ctx, anchor);
+  return st;
+}

@@ -1,0 +1,271 @@
+/* The topology of a space built once after its numbering: the copies' incidence, the copy
+ * graph, the scalar CSR pattern with per-element scatter offsets, and the element colouring;
+ * of every element or of the local cells only. */
+#include "embed/embed_impl.h"
+#include "fem/fem_impl.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* qsort comparator for fcm_index. */
+static int cmp_index(const void *a, const void *b)
+{
+  fcm_index x = *(const fcm_index *)a, y = *(const fcm_index *)b;
+  return (x > y) - (x < y);
+}
+
+/* The element at local position le (a full space: le itself). */
+static fcm_index local_elem(const fcm_space *s, fcm_index le)
+{
+  return s->local_elem ? s->local_elem[le] : le;
+}
+
+/* Copy -> elements incidence over the local topology: for each of the num_local_copies copies,
+ * the local positions of the local elements using it at any local node (ascending, each once),
+ * as CSR. g2l maps a copy rank to its local position (NULL: the identity, a full space). */
+static fcm_status build_copy_incidence(fcm_space *s, const fcm_index *g2l, fcm_index **ptr_out,
+                                       fcm_index **list_out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ncopy = s->num_local_copies, nn = s->nn;
+  fcm_index *ptr = NULL, *list = NULL, *fill = NULL;
+  FCM_ALLOC(ctx, ncopy + 1, ptr);
+  FCM_ALLOC(ctx, ncopy + 1, fill);
+  for (int pass = 0; pass < 2; pass++) {
+    for (fcm_index le = 0; le < s->num_local_elems; le++) {
+      const fcm_index *ed = s->elem_dof + local_elem(s, le) * nn;
+      for (int a = 0; a < nn; a++) {
+        const fcm_index k = g2l ? g2l[ed[a] / 3] : ed[a] / 3;
+        int dup = 0; /* an element may use a copy at two local nodes (constrained copies) */
+        for (int b = 0; b < a && !dup; b++)
+          dup = ed[b] / 3 == ed[a] / 3;
+        if (dup) continue;
+        if (pass)
+          list[ptr[k] + fill[k]++] = le;
+        else
+          ptr[k + 1]++;
+      }
+    }
+    if (!pass) {
+      for (fcm_index k = 0; k < ncopy; k++)
+        ptr[k + 1] += ptr[k];
+      FCM_ALLOC(ctx, ptr[ncopy] + 1, list);
+    }
+  }
+  *ptr_out = ptr, *list_out = list;
+  ptr = list = NULL;
+cleanup:
+  fcm__free(ctx, ptr);
+  fcm__free(ctx, list);
+  fcm__free(ctx, fill);
+  return st;
+}
+
+/* Copy graph over the local topology: for each local copy, the ranks (global) of the copies
+ * sharing a local element with it, sorted. */
+static fcm_status build_node_graph(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
+                                   const fcm_index *cinc)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ncopy = s->num_local_copies, nn = s->nn;
+  fcm_index *mark = NULL;
+  FCM_ALLOC(ctx, ncopy + 1, mark);
+  FCM_ALLOC(ctx, ncopy + 1, s->node_ptr);
+  for (int pass = 0; pass < 2; pass++) {
+    for (fcm_index k = 0; k < ncopy; k++)
+      mark[k] = -1;
+    for (fcm_index k = 0; k < ncopy; k++) {
+      fcm_index cnt = 0, base = pass ? s->node_ptr[k] : 0;
+      for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++) {
+        const fcm_index e = local_elem(s, cinc[i]);
+        for (int b = 0; b < nn; b++) {
+          const fcm_index m = s->elem_dof[e * nn + b] / 3, lm = g2l ? g2l[m] : m;
+          if (mark[lm] == k) continue;
+          mark[lm] = k;
+          if (pass) s->node_adj[base + cnt] = m;
+          cnt++;
+        }
+      }
+      if (pass)
+        qsort(s->node_adj + base, (size_t)cnt, sizeof *s->node_adj, cmp_index);
+      else
+        s->node_ptr[k + 1] = cnt;
+    }
+    if (!pass) {
+      for (fcm_index k = 0; k < ncopy; k++)
+        s->node_ptr[k + 1] += s->node_ptr[k];
+      FCM_ALLOC(ctx, s->node_ptr[ncopy] + 1, s->node_adj);
+    }
+  }
+cleanup:
+  fcm__free(ctx, mark);
+  return st;
+}
+
+/* Scalar pattern from the copy graph (the three rows of each local copy; global columns), and
+ * the offsets of the local elements (and, for a local space, their copies' local positions). */
+static fcm_status build_pattern(fcm_space *s, const fcm_index *g2l)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index nact = s->num_local_copies, nrow = 3 * nact;
+  FCM_ALLOC(ctx, nrow + 1, s->row_ptr);
+  for (fcm_index k = 0; k < nact; k++) {
+    fcm_index deg = s->node_ptr[k + 1] - s->node_ptr[k];
+    for (int i = 0; i < 3; i++)
+      s->row_ptr[3 * k + i + 1] = s->row_ptr[3 * k + i] + 3 * deg;
+  }
+  FCM_ALLOC(ctx, s->row_ptr[nrow], s->col_idx);
+  for (fcm_index k = 0; k < nact; k++)
+    for (int i = 0; i < 3; i++) {
+      int *cols = s->col_idx + s->row_ptr[3 * k + i];
+      for (fcm_index e = s->node_ptr[k]; e < s->node_ptr[k + 1]; e++)
+        for (int j = 0; j < 3; j++)
+          *cols++ = (int)(3 * s->node_adj[e] + j);
+    }
+  FCM_ALLOC(ctx, (size_t)s->num_local_elems * s->nn * s->nn + 1, s->elem_off);
+  if (g2l) FCM_ALLOC(ctx, (size_t)s->num_local_elems * s->nn + 1, s->elem_lcopy);
+  for (fcm_index el = 0; el < s->num_local_elems; el++) {
+    const fcm_index *ed = s->elem_dof + local_elem(s, el) * s->nn;
+    int *off = s->elem_off + (size_t)el * s->nn * s->nn;
+    for (int a = 0; a < s->nn; a++) {
+      fcm_index ka = g2l ? g2l[ed[a] / 3] : ed[a] / 3;
+      if (g2l) s->elem_lcopy[(size_t)el * s->nn + a] = (int)ka;
+      const fcm_index *row = s->node_adj + s->node_ptr[ka];
+      size_t len = (size_t)(s->node_ptr[ka + 1] - s->node_ptr[ka]);
+      for (int b = 0; b < s->nn; b++) {
+        fcm_index kb = ed[b] / 3;
+        const fcm_index *hit = bsearch(&kb, row, len, sizeof *row, cmp_index);
+        FCM_ASSERT(hit != NULL, ctx);
+        off[a * s->nn + b] = (int)(hit - row);
+      }
+    }
+  }
+cleanup:
+  return st;
+}
+
+/* Greedy colouring of the local elements: an element takes the smallest colour not used by an
+ * element sharing a copy (elements sharing a node but using different copies of it may share a
+ * colour). color_elems holds local element positions (a full space: element ids). */
+static fcm_status build_colors(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
+                               const fcm_index *cinc)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ne = s->num_local_elems;
+  int *color = NULL, ncol = 0;
+  fcm_index *forbid = NULL, *fill = NULL;
+  enum { MAX_COLORS = 4096 };
+  FCM_ALLOC(ctx, ne + 1, color);
+  FCM_ALLOC(ctx, MAX_COLORS, forbid);
+  for (int k = 0; k < MAX_COLORS; k++)
+    forbid[k] = -1;
+  for (fcm_index e = 0; e < ne; e++)
+    color[e] = -1;
+  for (fcm_index e = 0; e < ne; e++) {
+    const fcm_index *ed = s->elem_dof + local_elem(s, e) * s->nn;
+    for (int a = 0; a < s->nn; a++) {
+      const fcm_index k = g2l ? g2l[ed[a] / 3] : ed[a] / 3;
+      for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++)
+        if (color[cinc[i]] >= 0) forbid[color[cinc[i]]] = e;
+    }
+    int k = 0;
+    while (k < MAX_COLORS && forbid[k] == e)
+      k++;
+    FCM_CHECK(k < MAX_COLORS, ctx, FCM_ERR_UNSUPPORTED,
+              "space: cell %lld needs more than %d colours (a node shared by too many cells)",
+              (long long)s->elem_cell[local_elem(s, e)], MAX_COLORS);
+    color[e] = k;
+    ncol = FCM_MAX(ncol, k + 1);
+  }
+  s->num_colors = ncol;
+  FCM_ALLOC(ctx, ncol + 1, s->color_ptr);
+  for (fcm_index e = 0; e < ne; e++)
+    s->color_ptr[color[e] + 1]++;
+  for (int k = 0; k < ncol; k++)
+    s->color_ptr[k + 1] += s->color_ptr[k];
+  FCM_ALLOC(ctx, s->color_ptr[ncol] + 1, s->color_elems);
+  FCM_ALLOC(ctx, ncol + 1, fill);
+  for (fcm_index e = 0; e < ne; e++)
+    s->color_elems[s->color_ptr[color[e]] + fill[color[e]]++] = e;
+cleanup:
+  fcm__free(ctx, color);
+  fcm__free(ctx, forbid);
+  fcm__free(ctx, fill);
+  return st;
+}
+
+/* Release the topology (copy graph, pattern, offsets, colours, local lists). */
+void fcm__space_free_topology(fcm_space *s)
+{
+  fcm_ctx *ctx = s->ctx;
+  void *arrays[] = {s->node_ptr,   s->node_adj,   s->row_ptr,   s->col_idx,
+                    s->elem_off,   s->elem_lcopy, s->color_ptr, s->color_elems,
+                    s->local_copy, s->local_elem, s->cell_local};
+  for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
+    fcm__free(ctx, arrays[i]);
+  s->node_ptr = s->node_adj = s->row_ptr = s->local_copy = s->local_elem = NULL;
+  s->color_ptr = s->color_elems = NULL;
+  s->col_idx = s->elem_off = s->elem_lcopy = NULL;
+  s->cell_local = NULL;
+  s->num_colors = 0;
+  s->num_local_copies = s->num_local_elems = 0;
+}
+
+/* The topology of the elements of the cells flagged in cell_mask (local; cell_mask NULL: none)
+ * or of every element (!local, the full space's): their copies, the copy graph, the pattern,
+ * the offsets and the colours. The local copies and elements are listed in ascending order,
+ * so a mask of every active cell gives the full space's arrays. */
+fcm_status fcm__space_build_topology(fcm_space *s, int local, const unsigned char *cell_mask)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ncopy = s->num_dofs / 3;
+  fcm_index *g2l = NULL, *cptr = NULL, *cinc = NULL;
+  fcm__space_free_topology(s);
+  if (local) {
+    fcm_index ne = 0, nl = 0;
+    FCM_ALLOC(ctx, s->num_cells + 1, s->cell_local);
+    for (fcm_index c = 0; c < s->num_cells; c++) {
+      s->cell_local[c] = cell_mask && cell_mask[c] != 0 && s->active[c];
+      if (s->cell_local[c]) ne += s->cell_elem[c + 1] - s->cell_elem[c];
+    }
+    FCM_ALLOC(ctx, ne + 1, s->local_elem);
+    FCM_ALLOC(ctx, ncopy + 1, g2l); /* transient O(copies): the numbering's size */
+    for (fcm_index k = 0; k < ncopy; k++)
+      g2l[k] = -1;
+    for (fcm_index c = 0; c < s->num_cells; c++) {
+      if (!s->cell_local[c]) continue;
+      for (fcm_index e = s->cell_elem[c]; e < s->cell_elem[c + 1]; e++) {
+        s->local_elem[s->num_local_elems++] = e;
+        for (int a = 0; a < s->nn; a++)
+          g2l[s->elem_dof[e * s->nn + a] / 3] = 0;
+      }
+    }
+    for (fcm_index k = 0; k < ncopy; k++)
+      nl += g2l[k] == 0;
+    FCM_ALLOC(ctx, nl + 1, s->local_copy);
+    for (fcm_index k = 0; k < ncopy; k++)
+      if (g2l[k] == 0) {
+        s->local_copy[s->num_local_copies] = k;
+        g2l[k] = s->num_local_copies++;
+      }
+  } else {
+    s->num_local_elems = s->num_elems;
+    s->num_local_copies = ncopy;
+  }
+  FCM_TRY(ctx, build_copy_incidence(s, g2l, &cptr, &cinc));
+  FCM_TRY(ctx, build_node_graph(s, g2l, cptr, cinc));
+  FCM_TRY(ctx, build_pattern(s, g2l));
+  FCM_TRY(ctx, build_colors(s, g2l, cptr, cinc));
+cleanup:
+  if (st != FCM_OK) fcm__space_free_topology(s);
+  fcm__free(ctx, g2l);
+  fcm__free(ctx, cptr);
+  fcm__free(ctx, cinc);
+  return st;
+}

@@ -1,0 +1,249 @@
+/* The sparse triple product C = P^T A P (PETSc's MatPtAP): patterns once, values as often as A
+ * changes, rows shared by the threads with results that do not depend on their number. */
+#include "la/la_impl.h"
+
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct fcm__ptap {
+  fcm_ctx *ctx;
+  fcm_index n, nc; /* A is n x n, P n x nc */
+  int nt;          /* the most threads fcm__ptap_apply() may use */
+  const fcm_index *P_ptr;
+  const int *P_col;
+  const double *P_val;
+  fcm_index *R_ptr; /* R = P^T (nc x n), rows ascending in their columns */
+  int *R_col;
+  double *R_val;
+  fcm_index *AP_ptr; /* A P (n x nc) */
+  int *AP_col;
+  double *AP_val;
+  double *spa; /* nt dense accumulators of nc + 1 doubles, zero between products */
+};
+
+static int cmp_int(const void *a, const void *b)
+{
+  const int x = *(const int *)a, y = *(const int *)b;
+  return (x > y) - (x < y);
+}
+
+/* R = P^T: row J of R lists the rows i of P with a column J, ascending. */
+static fcm_status transpose(fcm_ctx *ctx, fcm_index n, fcm_index nc, const fcm_index *P_ptr,
+                            const int *P_col, const double *P_val, fcm_index **R_ptr, int **R_col,
+                            double **R_val)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *fill = NULL;
+  const fcm_index nnz = P_ptr[n];
+  FCM_ALLOC(ctx, nc + 2, *R_ptr);
+  FCM_ALLOC(ctx, nnz + 1, *R_col);
+  FCM_ALLOC(ctx, nnz + 1, *R_val);
+  FCM_ALLOC(ctx, nc + 1, fill);
+  fcm_index *rp = *R_ptr;
+  for (fcm_index p = 0; p < nnz; p++)
+    rp[P_col[p] + 1]++;
+  for (fcm_index J = 0; J < nc; J++)
+    rp[J + 1] += rp[J];
+  for (fcm_index i = 0; i < n; i++)
+    for (fcm_index p = P_ptr[i]; p < P_ptr[i + 1]; p++) {
+      const fcm_index J = P_col[p];
+      (*R_col)[rp[J] + fill[J]] = (int)i;
+      (*R_val)[rp[J] + fill[J]++] = P_val[p];
+    }
+cleanup:
+  fcm__free(ctx, fill);
+  return st;
+}
+
+/* Pattern of C = A B (nrow rows of A, ncol columns of B), columns sorted; rows shared by nt
+ * threads (each row's columns found and sorted by one thread). */
+static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fcm_index *Ap,
+                                  const int *Ac, const fcm_index *Bp, const int *Bc, fcm_index ncol,
+                                  fcm_index **Cp_out, int **Cc_out)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *Cp = NULL, *mark = NULL;
+  int *Cc = NULL;
+  FCM_ALLOC(ctx, nrow + 1, Cp);
+  FCM_ALLOC_RAW(ctx, (size_t)nt * (size_t)ncol + 1, mark); /* per thread: ncol entries */
+  for (size_t j = 0; j < (size_t)nt * (size_t)ncol; j++)
+    mark[j] = -1;
+  for (int pass = 0; pass < 2; pass++) {
+#pragma omp parallel num_threads(nt) if (nt > 1)
+    {
+      fcm_index *mk = mark + (size_t)omp_get_thread_num() * (size_t)ncol;
+#pragma omp for schedule(dynamic, 256)
+      for (fcm_index i = 0; i < nrow; i++) {
+        fcm_index cnt = 0, base = pass ? Cp[i] : 0;
+        for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
+          const fcm_index k = Ac[p];
+          for (fcm_index q = Bp[k]; q < Bp[k + 1]; q++) {
+            const fcm_index j = Bc[q];
+            if (mk[j] == i + pass * nrow) continue;
+            mk[j] = i + pass * nrow;
+            if (pass) Cc[base + cnt] = (int)j;
+            cnt++;
+          }
+        }
+        if (pass)
+          qsort(Cc + base, (size_t)cnt, sizeof *Cc, cmp_int);
+        else
+          Cp[i + 1] = cnt;
+      }
+    }
+    if (!pass) {
+      for (fcm_index i = 0; i < nrow; i++)
+        Cp[i + 1] += Cp[i];
+      FCM_ALLOC(ctx, Cp[nrow] + 1, Cc);
+    }
+  }
+  *Cp_out = Cp, *Cc_out = Cc;
+  Cp = NULL, Cc = NULL;
+cleanup:
+  fcm__free(ctx, Cp);
+  fcm__free(ctx, Cc);
+  fcm__free(ctx, mark);
+  return st;
+}
+
+/* Insert the missing diagonal entries into a square pattern (rows sorted), in place by
+ * reallocation. */
+static fcm_status add_diagonal(fcm_ctx *ctx, fcm_index n, fcm_index **ptr, int **col)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *p = *ptr, *np = NULL;
+  int *c = *col, *nc = NULL;
+  fcm_index missing = 0;
+  for (fcm_index i = 0; i < n; i++) {
+    int has = 0;
+    for (fcm_index q = p[i]; q < p[i + 1] && !has; q++)
+      has = c[q] == i;
+    missing += !has;
+  }
+  if (missing == 0) goto cleanup;
+  FCM_ALLOC(ctx, n + 1, np);
+  FCM_ALLOC(ctx, p[n] + missing + 1, nc);
+  fcm_index out = 0;
+  for (fcm_index i = 0; i < n; i++) {
+    int done = 0;
+    for (fcm_index q = p[i]; q < p[i + 1]; q++) {
+      if (!done && c[q] > i) nc[out++] = (int)i, done = 1;
+      if (c[q] == i) done = 1;
+      nc[out++] = c[q];
+    }
+    if (!done) nc[out++] = (int)i;
+    np[i + 1] = out;
+  }
+  fcm__free(ctx, p);
+  fcm__free(ctx, c);
+  *ptr = np, *col = nc;
+  np = NULL, nc = NULL;
+cleanup:
+  fcm__free(ctx, np);
+  fcm__free(ctx, nc);
+  return st;
+}
+
+/* Values of C = A B on C's pattern, rows shared by the threads of the enclosing region (ends
+ * with a barrier); spa: the calling thread's accumulator over B's columns (zero on entry and
+ * exit). Each entry is summed in A's row order, then B's. */
+static void product_values(fcm_index nrow, const fcm_index *Ap, const int *Ac, const double *Av,
+                           const fcm_index *Bp, const int *Bc, const double *Bv,
+                           const fcm_index *Cp, const int *Cc, double *Cv, double *spa)
+{
+#pragma omp for schedule(dynamic, 64)
+  for (fcm_index i = 0; i < nrow; i++) {
+    for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
+      const fcm_index k = Ac[p];
+      const double a = Av[p];
+      for (fcm_index q = Bp[k]; q < Bp[k + 1]; q++)
+        spa[Bc[q]] += a * Bv[q];
+    }
+    for (fcm_index p = Cp[i]; p < Cp[i + 1]; p++) {
+      Cv[p] = spa[Cc[p]];
+      spa[Cc[p]] = 0.0;
+    }
+  }
+}
+
+void fcm__ptap_destroy(fcm__ptap **plan)
+{
+  if (!plan || !*plan) return;
+  fcm__ptap *t = *plan;
+  fcm_ctx *ctx = t->ctx;
+  fcm__free(ctx, t->R_ptr);
+  fcm__free(ctx, t->R_col);
+  fcm__free(ctx, t->R_val);
+  fcm__free(ctx, t->AP_ptr);
+  fcm__free(ctx, t->AP_col);
+  fcm__free(ctx, t->AP_val);
+  fcm__free(ctx, t->spa);
+  fcm__free(ctx, t);
+  *plan = NULL;
+}
+
+fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const fcm_index *P_ptr,
+                            const int *P_col, const double *P_val, int with_diagonal, int nt,
+                            fcm__ptap **plan, fcm_csr **C)
+{
+  fcm_status st = FCM_OK;
+  fcm__ptap *t = NULL;
+  fcm_index *cp = NULL;
+  int *cc = NULL;
+  FCM_CHECK(ctx && A && P_ptr && (P_ptr[0] == 0) && plan && C && nc >= 0 && nt >= 1, ctx,
+            FCM_ERR_ARG, "ptap_create: NULL argument, nc = %lld < 0 or nt = %d < 1", (long long)nc,
+            nt);
+  *plan = NULL, *C = NULL;
+  fcm_index n = 0, ncol = 0;
+  fcm_csr_get_size(A, &n, &ncol, NULL);
+  FCM_CHECK(n == ncol, ctx, FCM_ERR_ARG, "ptap_create: A is %lld x %lld, not square", (long long)n,
+            (long long)ncol);
+  for (fcm_index p = 0; p < P_ptr[n]; p++)
+    FCM_CHECK(P_col[p] >= 0 && P_col[p] < nc, ctx, FCM_ERR_ARG,
+              "ptap_create: P entry %lld has column %d outside [0, %lld)", (long long)p, P_col[p],
+              (long long)nc);
+  t = fcm__calloc(ctx, 1, sizeof *t);
+  FCM_CHECK(t, ctx, FCM_ERR_ALLOC, "ptap_create: out of memory");
+  t->ctx = ctx, t->n = n, t->nc = nc, t->nt = nt;
+  t->P_ptr = P_ptr, t->P_col = P_col, t->P_val = P_val;
+  FCM_TRY(ctx, transpose(ctx, n, nc, P_ptr, P_col, P_val, &t->R_ptr, &t->R_col, &t->R_val));
+  FCM_TRY(ctx, product_pattern(ctx, nt, n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), P_ptr, P_col, nc,
+                               &t->AP_ptr, &t->AP_col));
+  FCM_ALLOC(ctx, t->AP_ptr[n] + 1, t->AP_val);
+  FCM_TRY(ctx,
+          product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, &cp, &cc));
+  if (with_diagonal) FCM_TRY(ctx, add_diagonal(ctx, nc, &cp, &cc));
+  FCM_ALLOC(ctx, (size_t)nt * (size_t)(nc + 1), t->spa);
+  FCM_TRY(ctx, fcm_csr_create(ctx, nc, nc, cp, cc, fcm_csr_get_kind(A), C));
+  *plan = t;
+  t = NULL;
+cleanup:
+  fcm__free(ctx, cp);
+  fcm__free(ctx, cc);
+  fcm__ptap_destroy(&t);
+  return st;
+}
+
+void fcm__ptap_apply(fcm__ptap *t, const fcm_csr *A, fcm_csr *C, int nt)
+{
+  const fcm_index n = t->n, nc = t->nc;
+  const fcm_index *cp = fcm_csr_row_ptr(C);
+  const int *cc = fcm_csr_col_idx(C);
+  double *cv = fcm_csr_values(C);
+  nt = nt < 1 ? 1 : nt > t->nt ? t->nt : nt;
+#pragma omp parallel num_threads(nt) if (nt > 1)
+  {
+    double *spa = t->spa + (size_t)omp_get_thread_num() * (size_t)(nc + 1);
+    product_values(n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), fcm_csr_values_read(A), t->P_ptr,
+                   t->P_col, t->P_val, t->AP_ptr, t->AP_col, t->AP_val, spa);
+    product_values(nc, t->R_ptr, t->R_col, t->R_val, t->AP_ptr, t->AP_col, t->AP_val, cp, cc, cv,
+                   spa);
+  }
+}
+
+void fcm__ptap_transpose(const fcm__ptap *t, const fcm_index **R_ptr, const int **R_col,
+                         const double **R_val)
+{
+  *R_ptr = t->R_ptr, *R_col = t->R_col, *R_val = t->R_val;
+}

@@ -1,0 +1,150 @@
+/* The multigrid cycle: V- and W-cycles as a solver (fcm_mg_solve) and as a symmetric
+ * preconditioner (fcm_mg_operator), with the coarsest level solved directly.
+ *
+ * The cycle runs each level's work in two parallel regions (smoothing, residual and
+ * restriction; prolongation and smoothing), so a thread never idles through a long
+ * sequential stretch and then waits to be woken: on shared cores a woken thread may wait a
+ * whole time slice for a core. The functions below run inside such a region (or in a team of
+ * one, when the level is too small to share) and end without a barrier unless said. */
+#include "mg/levels_impl.h"
+
+#include <math.h>
+#include <string.h>
+
+/* Pre-smoothing, then r = b - A x and the coarse right-hand side R r (coarse guess 0). */
+static void pre_smooth(const fcm_mg *m, mg_level *L, mg_level *C, const double *b, double *x)
+{
+  const fcm_csr *A = fcm__mg_level_matrix(L);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const double *v = fcm_csr_values_read(A);
+  const fcm_index n = L->n, nc = C->n;
+  for (int s = 0; s < m->opts.pre_smooth; s++)
+    fcm__mg_smooth(m, L, b, x);
+  if (L->blk && m->opts.pre_smooth > 0) {
+#pragma omp barrier
+    fcm__mg_block_smooth(m, L, b, x);
+  }
+#pragma omp barrier
+#pragma omp for schedule(static)
+  for (fcm_index i = 0; i < n; i++) {
+    double sum = 0.0;
+    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+      sum += v[p] * x[ci[p]];
+    L->r[i] = b[i] - sum;
+  }
+#pragma omp for schedule(static)
+  for (fcm_index J = 0; J < nc; J++) {
+    double sum = 0.0;
+    for (fcm_index p = L->R_ptr[J]; p < L->R_ptr[J + 1]; p++)
+      sum += L->R_val[p] * L->r[L->R_col[p]];
+    C->b[J] = C->inactive[J] ? 0.0 : sum;
+    C->x[J] = 0.0;
+  }
+}
+
+/* x += P x_c (nothing from the coarse Dirichlet DOFs), then post-smoothing. */
+static void post_smooth(const fcm_mg *m, mg_level *L, const mg_level *C, const double *b, double *x)
+{
+  const fcm_index n = L->n;
+#pragma omp for schedule(static)
+  for (fcm_index i = 0; i < n; i++) {
+    double sum = 0.0;
+    for (fcm_index p = L->P_ptr[i]; p < L->P_ptr[i + 1]; p++) {
+      const fcm_index J = L->P_col[p];
+      if (!C->inactive[J]) sum += L->P_val[p] * C->x[J];
+    }
+    x[i] += sum;
+  }
+  if (L->blk && m->opts.post_smooth > 0) {
+    fcm__mg_block_smooth(m, L, b, x);
+#pragma omp barrier
+  }
+  for (int s = 0; s < m->opts.post_smooth; s++)
+    fcm__mg_smooth(m, L, b, x);
+}
+
+static fcm_status cycle(fcm_mg *m, int l, const double *b, double *x)
+{
+  fcm_status st = FCM_OK;
+  mg_level *L = &m->lev[l];
+  if (l == m->nlev - 1) {
+    return fcm_direct_solve(m->direct, b, x); /* level 0 too when there is one level */
+  }
+  mg_level *C = &m->lev[l + 1];
+  fcm_index nnz = 0;
+  fcm_csr_get_size(fcm__mg_level_matrix(L), NULL, NULL, &nnz);
+  const int par = nnz >= MG_PARALLEL_NNZ;
+#pragma omp parallel num_threads(fcm__mg_team(m)) if (par)
+  pre_smooth(m, L, C, b, x);
+  const int gamma = l + 2 == m->nlev ? 1 : m->opts.cycle_index; /* the coarsest is exact */
+  for (int g = 0; g < gamma; g++)
+    if ((st = cycle(m, l + 1, C->b, C->x))) return st;
+#pragma omp parallel num_threads(fcm__mg_team(m)) if (par)
+  post_smooth(m, L, C, b, x);
+  return st;
+}
+
+fcm_status fcm_mg_cycle(fcm_mg *m, const double *b, double *x)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m ? m->ctx : NULL;
+  FCM_CHECK(m && b && x && b != x, ctx, FCM_ERR_ARG, "mg_cycle: NULL or overlapping argument");
+  FCM_TRY(ctx, cycle(m, 0, b, x));
+cleanup:
+  return st;
+}
+
+fcm_status fcm_mg_operator(void *user, const double *r, double *z)
+{
+  fcm_mg *m = user;
+  if (m && z) memset(z, 0, sizeof *z * (size_t)m->lev[0].n);
+  return fcm_mg_cycle(m, r, z);
+}
+
+static double norm2(fcm_index n, const double *v)
+{
+  double s = 0.0;
+  for (fcm_index i = 0; i < n; i++)
+    s += v[i] * v[i];
+  return sqrt(s);
+}
+
+fcm_status fcm_mg_solve(fcm_mg *m, const double *b, double *x, double rtol, int max_cycles,
+                        fcm_mg_solve_info *info)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m ? m->ctx : NULL;
+  fcm_mg_solve_info inf = {0, 0, 0.0, 0.0};
+  FCM_CHECK(m && b && x && b != x, ctx, FCM_ERR_ARG, "mg_solve: NULL or overlapping argument");
+  FCM_CHECK(rtol >= 0.0 && max_cycles >= 0, ctx, FCM_ERR_ARG,
+            "mg_solve: rtol = %g must be >= 0 and max_cycles = %d >= 0", rtol, max_cycles);
+  mg_level *L = &m->lev[0];
+  const fcm_index n = L->n;
+  const double bn = norm2(n, b);
+  double r1 = 0.0, rk = 0.0;
+  for (;;) {
+    fcm_csr_apply(L->A, -1.0, x, 0.0, L->b); /* L->b is free on level 0 */
+    for (fcm_index i = 0; i < n; i++)
+      L->b[i] += b[i];
+    rk = norm2(n, L->b);
+    FCM_CHECK(isfinite(rk), ctx, FCM_ERR_NUMERIC, "mg_solve: residual is %g after %d cycles", rk,
+              inf.cycles);
+    inf.relative_residual = bn > 0.0 ? rk / bn : 0.0;
+    if (inf.cycles == 1) r1 = rk;
+    if (rk <= rtol * bn) {
+      inf.converged = 1;
+      break;
+    }
+    if (inf.cycles >= max_cycles) break;
+    FCM_TRY(ctx, cycle(m, 0, b, x));
+    inf.cycles++;
+  }
+  if (inf.cycles >= 2 && r1 > 0.0) inf.convergence_factor = pow(rk / r1, 1.0 / (inf.cycles - 1));
+  FCM_CHECK(inf.converged, ctx, FCM_ERR_NOT_CONVERGED,
+            "mg_solve: relative residual %g after %d cycles, rtol %g", inf.relative_residual,
+            inf.cycles, rtol);
+cleanup:
+  if (info) *info = inf;
+  return st;
+}

@@ -1,0 +1,161 @@
+/* mg module, private to its files: the levels of the hierarchy, the solver object and the calls
+ * between creation and setup (mg.c), the hierarchy (hierarchy.c), the prolongations
+ * (transfer.c), the smoothers (smoothers.c) and the cycle (cycle.c).
+ *
+ * Data per grid level l (level 0 on Hex8, levels >= 1 on Hex20, whose level 0 has only its
+ * DOFs, matrix and prolongation): cells (the first grid level: the space's elements) with a
+ * grid position and 8 corner copies (corner bits dx + 2 dy + 4 dz), copies with a node grid
+ * position, the connectivity of the cells (face neighbours), and for l < L-1 the DOF
+ * prolongation P_l from level l+1.
+ * DOFs: copy k, component c is row 3k + c of the level matrix on every level (level 0: the
+ * space's numbering); inactive rows are the Dirichlet ones. */
+#ifndef FCM_MG_LEVELS_IMPL_H
+#define FCM_MG_LEVELS_IMPL_H
+
+#include "core/core_impl.h"
+#include "fcm/mg.h"
+#include "la/la_impl.h"
+#include "mg/mg_impl.h"
+#include "solve/solve_impl.h"
+
+#include <omp.h>
+
+/* Two-colour slab order of the items of a graph (the rows of a level matrix, or the blocks of
+ * its block smoother; two items are adjacent when the update of one reads what the other
+ * writes): a sequence of the items cut into consecutive slabs such that slabs s and s + 2 hold
+ * no adjacent items, so the slabs of one colour (slab index parity) are independent. A
+ * Gauss-Seidel sweep in the order "the slabs of colour `first`, then those of the other
+ * colour, each slab's items in sequence" is one sequential sweep in a fixed order, whose slabs
+ * of one colour may run in parallel. The order depends on the pattern only, so the iterates
+ * do not depend on the thread count. */
+typedef struct slab_order {
+  fcm_index nslab;
+  int first;       /* the colour swept first */
+  fcm_index *ptr;  /* nslab + 1 offsets into item */
+  fcm_index *item; /* the items, slab after slab, ascending within a slab */
+  double *mid;     /* per slab: the midpoint of its work within its colour's, in [0, 1] */
+} slab_order;
+
+/* Levels with at least this many stored entries share their work between the threads. */
+#define MG_PARALLEL_NNZ 32768
+
+typedef struct mg_level {
+  fcm_index grid[3];  /* cells per axis */
+  fcm_index ncell;    /* cells (level 0: elements) */
+  fcm_index *ijk;     /* 3 per cell */
+  fcm_index *corner;  /* 8 copies per cell (corner bits dx + 2 dy + 4 dz) */
+  unsigned char *own; /* level 0: the element uses the copy at its own node (1 on coarse) */
+  fcm_index *adj_ptr; /* cell graph (connected face neighbours), CSR */
+  fcm_index *adj;
+  fcm_index ncopy;
+  fcm_index *copy_ijk;     /* 3 per copy: node grid position */
+  fcm_index *dof;          /* 3 per copy: row or -1 */
+  unsigned char *inactive; /* per row: eliminated (level 0) */
+  fcm_index n;             /* rows */
+  const fcm_csr *A;        /* level 0: borrowed */
+  fcm_csr *Aown;           /* levels >= 1 */
+  fcm_index *diag;         /* position of a_ii */
+  double *dinv;            /* 1 / a_ii */
+  /* prolongation from level l+1 (n x n_coarse) */
+  fcm_index *P_ptr;
+  int *P_col;
+  double *P_val;
+  /* the Galerkin product A_{l+1} = P^T A_l P and the restriction R = P^T it holds */
+  fcm__ptap *ptap;
+  const fcm_index *R_ptr;
+  const int *R_col;
+  const double *R_val;
+  double *x, *b, *r; /* work vectors (x, b unused on level 0) */
+  int ncolor;        /* SGS_COLORED: rows by colour, CSR over colours */
+  fcm_index *color_ptr, *color_rows;
+  unsigned char *full; /* grid levels: per cell, 1 when it is all material (uncut, and on
+                          coarse levels made of 8 such cells) */
+  fcm_schwarz *blk;    /* block smoother (block_smoothing): the level's blocks */
+  slab_order rows;     /* SGS: the rows in slabs (levels but the coarsest) */
+  slab_order blocks;   /* the blocks of blk in slabs */
+} mg_level;
+
+struct fcm_mg {
+  fcm_ctx *ctx;
+  const fcm_space *space;
+  fcm_mg_options opts;
+  int nlev;
+  mg_level lev[32];
+  fcm_direct *direct;
+  unsigned char *cut_cell; /* per mesh cell: cut by the geometry or a cut surface, or split */
+  fcm_index blk_max;       /* largest block of the block smoothers */
+  int nt;                  /* threads at creation: the most any parallel region uses */
+  double *blk_r, *blk_dx;  /* blk_max entries each, per thread */
+};
+
+/* Threads of a parallel region: the caller's, at most those of the creation (scratch). */
+static inline int fcm__mg_team(const fcm_mg *m)
+{
+  const int t = omp_get_max_threads();
+  return t < m->nt ? t : m->nt;
+}
+
+static inline const fcm_csr *fcm__mg_level_matrix(const mg_level *L)
+{
+  return L->A ? L->A : L->Aown;
+}
+
+/* ---- hierarchy.c */
+
+/* The levels of m (m->ctx, space, opts set): cells, copies, DOFs, inactive rows and the
+ * prolongations. Level 0's inactive rows are `inactive0` (n bytes, the space's numbering) or,
+ * when it is NULL, the eliminated rows of A; A (NULL with inactive0) is level 0's matrix. No
+ * matrix is read beyond that: the prolongations depend on the space and the inactive rows. */
+fcm_status fcm__mg_build_hierarchy(fcm_mg *m, const fcm_csr *A, const unsigned char *inactive0);
+
+/* Free everything a level holds and zero it. */
+void fcm__mg_level_free(fcm_ctx *ctx, mg_level *L);
+
+/* ---- transfer.c */
+
+/* Hex20: the prolongation P_0 from the p-coarse Hex8 level L (copies `cmap` of the space's
+ * copies, -1 where no element uses a copy at a corner; `copy_node`: each space copy's node)
+ * to level 0: a corner copy from itself, a mid-edge copy the mean of its edge's ends in the
+ * first element that uses it at its own node. */
+fcm_status fcm__mg_p_prolongation(fcm_ctx *ctx, const fcm_space *sp, mg_level *L0,
+                                  const mg_level *L, const fcm_index *cmap,
+                                  const fcm_index *copy_node);
+
+/* The trilinear weights of each fine copy k of F from the corners of the first coarse cell of
+ * C that uses it (cusers[cptr[k]]; none when no cell does): CSR over the fine copies
+ * (scal_ptr, F->ncopy + 1), coarse copies and weights. */
+fcm_status fcm__mg_scalar_prolongation(fcm_ctx *ctx, const mg_level *F, const mg_level *C,
+                                       const fcm_index *cptr, const fcm_index *cusers,
+                                       fcm_index **scal_ptr, fcm_index **scal_col, double **scal_w);
+
+/* P_l (F->n x C->n): the scalar weights for each component of the active DOFs. */
+fcm_status fcm__mg_dof_prolongation(fcm_ctx *ctx, mg_level *F, const mg_level *C,
+                                    const fcm_index *scal_ptr, const fcm_index *scal_col,
+                                    const double *scal_w);
+
+/* ---- smoothers.c */
+
+void fcm__mg_slabs_free(fcm_ctx *ctx, slab_order *S);
+
+/* The rows of a level in slabs (FCM_MG_SMOOTHER_SGS). */
+fcm_status fcm__mg_row_slabs(fcm_mg *m, mg_level *L);
+
+/* The rows of a level grouped by colour (FCM_MG_SMOOTHER_SGS_COLORED). */
+fcm_status fcm__mg_level_colors(fcm_mg *m, mg_level *L);
+
+/* The blocks of level l (< nlev - 1) in its DOF numbering: level 0's vertex and cut element
+ * blocks, a coarser level's corner blocks. CSR over the blocks, allocated here. */
+fcm_status fcm__mg_level_blocks(fcm_mg *m, int l, fcm_index *nb, fcm_index **ptr, fcm_index **dofs);
+
+/* The block smoothers of every level but the coarsest, from the current level matrices. */
+fcm_status fcm__mg_block_smoothers_create(fcm_mg *m);
+
+/* One smoothing step with the pointwise smoother of m's options, by the team of the enclosing
+ * parallel region (no barrier at the end). */
+void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x);
+
+/* A symmetric block Gauss-Seidel sweep over the level's blocks, by the team of the enclosing
+ * parallel region (no barrier at the end). */
+void fcm__mg_block_smooth(const fcm_mg *m, const mg_level *L, const double *b, double *x);
+
+#endif /* FCM_MG_LEVELS_IMPL_H */

@@ -1,0 +1,633 @@
+/* The multigrid's smoothers: pointwise symmetric Gauss-Seidel in slab order (default), in
+ * multicolour order, damped Jacobi, and block Gauss-Seidel over vertex and cut-cell blocks
+ * (de Prenter et al. 2020); the slab orders that let the threads share a sweep with iterates
+ * that do not depend on their number, and the check of those orders. */
+#include "mg/levels_impl.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* Pairs of fcm_index, lexicographically. */
+static int cmp_pair(const void *a, const void *b)
+{
+  const fcm_index *x = a, *y = b;
+  return x[0] != y[0] ? (x[0] > y[0]) - (x[0] < y[0]) : (x[1] > y[1]) - (x[1] < y[1]);
+}
+
+void fcm__mg_slabs_free(fcm_ctx *ctx, slab_order *S)
+{
+  fcm__free(ctx, S->ptr);
+  fcm__free(ctx, S->item);
+  fcm__free(ctx, S->mid);
+  memset(S, 0, sizeof *S);
+}
+
+/* Greedy colouring of the rows of the level matrix in row order (a row takes the smallest
+ * colour no coupled row before it has), then the rows grouped by colour, ascending. */
+fcm_status fcm__mg_level_colors(fcm_mg *m, mg_level *L)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  const fcm_csr *A = fcm__mg_level_matrix(L);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  int *col = NULL, maxc = 0;
+  fcm_index *seen = NULL, *fill = NULL;
+  FCM_ALLOC(ctx, L->n + 1, col);
+  fcm_index maxdeg = 0;
+  for (fcm_index i = 0; i < L->n; i++)
+    maxdeg = FCM_MAX(maxdeg, rp[i + 1] - rp[i]);
+  FCM_ALLOC(ctx, maxdeg + 2, seen); /* seen[c] == i + 1: colour c taken for row i */
+  for (fcm_index i = 0; i < L->n; i++) {
+    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+      if (ci[p] < i && col[ci[p]] <= maxdeg) seen[col[ci[p]]] = i + 1;
+    int c = 0;
+    while (seen[c] == i + 1)
+      c++;
+    col[i] = c;
+    maxc = FCM_MAX(maxc, c + 1);
+  }
+  L->ncolor = maxc;
+  FCM_ALLOC(ctx, maxc + 1, L->color_ptr);
+  FCM_ALLOC(ctx, L->n + 1, L->color_rows);
+  FCM_ALLOC(ctx, maxc + 1, fill);
+  for (fcm_index i = 0; i < L->n; i++)
+    L->color_ptr[col[i] + 1]++;
+  for (int c = 0; c < maxc; c++)
+    L->color_ptr[c + 1] += L->color_ptr[c];
+  for (fcm_index i = 0; i < L->n; i++)
+    L->color_rows[L->color_ptr[col[i]] + fill[col[i]]++] = i;
+cleanup:
+  fcm__free(ctx, col);
+  fcm__free(ctx, seen);
+  fcm__free(ctx, fill);
+  return st;
+}
+
+/* ------------------------------------------------------------------ slab orders */
+
+/* Block slabs: a few per thread and colour on common core counts, so that whole slabs balance
+ * the threads' work; fewer when the coupling reaches far in the sequence. */
+#define MG_SLABS 16
+
+/* The slab order (see slab_order) of n items with per-item work (>= 0), in the sequence `seq`
+ * (n items; NULL: ascending), given reach[t] >= t: the furthest sequence position of an item
+ * adjacent (symmetrically) to the item at position t. Cut so that slab s + 2 starts past
+ * every position that slab s reaches. thick = 0: slabs of at least total / MG_SLABS work
+ * each, colour 0 first. thick > 0: `thick` slabs of about equal work (colour 0) separated by
+ * thin slabs just wide enough to keep them apart (colour 1, swept first), or one slab when
+ * the thin ones would hold more than a quarter of the work or reach the end (coupling that
+ * reaches far in the sequence). */
+static fcm_status slabs_create(fcm_ctx *ctx, fcm_index n, const fcm_index *seq,
+                               const fcm_index *reach, const double *work, int thick, slab_order *S)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *cut = NULL;
+  fcm__mg_slabs_free(ctx, S);
+  FCM_ALLOC_RAW(ctx, n + 2, cut);
+  double total = 0.0;
+  for (fcm_index t = 0; t < n; t++)
+    total += work[t];
+  /* cut[s]: the first position of slab s; far: 1 + the reach of the slab before the last */
+  const double target = thick > 0 ? total / thick : total / MG_SLABS;
+  fcm_index ns = 0, t = 0, far = 0;
+  double wthin = 0.0;
+  cut[0] = 0;
+  while (t < n) {
+    const int thin = thick > 0 && ns % 2 == 1;
+    double acc = 0.0;
+    fcm_index reach_s = t;
+    do {
+      acc += work[seq ? seq[t] : t];
+      reach_s = FCM_MAX(reach_s, reach[t]);
+      t++;
+    } while (t < n && ((!thin && acc < target) || t < far));
+    if (thin) wthin += acc;
+    cut[++ns] = t;
+    far = reach_s + 1; /* the slab after the next starts past all this slab reaches */
+  }
+  if (thick > 0 && (ns == 2 || wthin > 0.25 * total)) ns = 1, cut[1] = n;
+  S->nslab = ns;
+  S->first = thick > 0 && ns > 1;
+  FCM_ALLOC_RAW(ctx, ns + 1, S->ptr);
+  FCM_ALLOC(ctx, ns + 1, S->mid);
+  FCM_ALLOC_RAW(ctx, n + 1, S->item);
+  for (fcm_index k = 0; k <= ns; k++)
+    S->ptr[k] = cut[k];
+  for (fcm_index q = 0; q < n; q++)
+    S->item[q] = seq ? seq[q] : q;
+  for (fcm_index k = 0; k < ns; k++)
+    for (fcm_index q = cut[k]; q < cut[k + 1]; q++)
+      S->mid[k] += work[S->item[q]]; /* the slab's work, for now */
+  for (int c = 0; c < 2; c++) {
+    double tot = 0.0, before = 0.0;
+    for (fcm_index k = c; k < ns; k += 2)
+      tot += S->mid[k];
+    for (fcm_index k = c; k < ns; k += 2) {
+      const double w = S->mid[k];
+      S->mid[k] = tot > 0.0 ? (before + 0.5 * w) / tot : 0.0;
+      before += w;
+    }
+  }
+cleanup:
+  if (st) fcm__mg_slabs_free(ctx, S);
+  fcm__free(ctx, cut);
+  return st;
+}
+
+/* The rows of a level in slabs, in row order: two thick slabs and the thin one between them
+ * (adjacency: the level matrix's pattern, work: stored entries). Pointwise Gauss-Seidel is
+ * sensitive to its order (the Hex8 cube's V-cycle factor 0.29 -> 0.32 with 16 slabs, the
+ * hemisphere's 0.15 -> 0.23, Hex20 0.33 -> 0.55), much less so with one thin slab swept
+ * first (0.29, 0.18, 0.33): the pointwise sweeps share two threads. Hex20's finest level
+ * numbers the corner nodes before the mid-edge nodes; its rows couple far apart in row order
+ * and stay in one slab (sequential). */
+#define MG_ROW_SLABS_THICK 2
+
+fcm_status fcm__mg_row_slabs(fcm_mg *m, mg_level *L)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  const fcm_csr *A = fcm__mg_level_matrix(L);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  double *work = NULL;
+  fcm_index *reach = NULL;
+  FCM_ALLOC_RAW(ctx, L->n + 1, work);
+  FCM_ALLOC_RAW(ctx, L->n + 1, reach);
+  for (fcm_index i = 0; i < L->n; i++) {
+    work[i] = (double)(rp[i + 1] - rp[i]);
+    reach[i] = i;
+    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+      reach[i] = FCM_MAX(reach[i], ci[p]);
+  }
+  FCM_TRY(ctx, slabs_create(ctx, L->n, NULL, reach, work, MG_ROW_SLABS_THICK, &L->rows));
+cleanup:
+  fcm__free(ctx, work);
+  fcm__free(ctx, reach);
+  return st;
+}
+
+/* The blocks of a level's block smoother in slabs, in the sequence of their first DOFs (ties
+ * by index), so that it follows the rows. Blocks j and k are adjacent when a DOF of one couples
+ * with (or is) a DOF of the other, i.e. when one's update reads what the other writes; work:
+ * the residual's and the block product's entries. */
+static fcm_status block_slabs(fcm_mg *m, mg_level *L)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  const fcm_csr *A = fcm__mg_level_matrix(L);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const fcm_index nb = fcm__schwarz_num_blocks(L->blk), n = L->n;
+  fcm_index *pairs = NULL, *seq = NULL, *last = NULL, *reach = NULL;
+  double *work = NULL;
+  FCM_ALLOC_RAW(ctx, 2 * nb + 1, pairs);
+  for (fcm_index k = 0; k < nb; k++) {
+    const fcm_index *d = NULL;
+    const double *S = NULL;
+    const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
+    fcm_index first = n;
+    for (int i = 0; i < bm; i++)
+      first = FCM_MIN(first, d[i]);
+    pairs[2 * k] = first, pairs[2 * k + 1] = k;
+  }
+  if (nb > 0) qsort(pairs, (size_t)nb, 2 * sizeof *pairs, cmp_pair);
+  FCM_ALLOC_RAW(ctx, nb + 1, seq);
+  FCM_ALLOC_RAW(ctx, nb + 1, reach);
+  FCM_ALLOC_RAW(ctx, nb + 1, work);
+  FCM_ALLOC_RAW(ctx, n + 1, last);
+  for (fcm_index i = 0; i < n; i++)
+    last[i] = -1;
+  for (fcm_index t = 0; t < nb; t++) { /* last[i]: the last position of a block holding row i */
+    const fcm_index *d = NULL;
+    const double *S = NULL;
+    seq[t] = pairs[2 * t + 1];
+    const int bm = fcm__schwarz_block(L->blk, seq[t], &d, &S);
+    for (int i = 0; i < bm; i++)
+      last[d[i]] = t;
+  }
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (nb > 1024)
+  for (fcm_index t = 0; t < nb; t++) {
+    const fcm_index *d = NULL;
+    const double *S = NULL;
+    const fcm_index k = seq[t];
+    const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
+    fcm_index r = t, entries = 0;
+    for (int i = 0; i < bm; i++) {
+      entries += rp[d[i] + 1] - rp[d[i]];
+      for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++)
+        r = FCM_MAX(r, last[ci[p]]);
+    }
+    reach[t] = r;
+    work[k] = (double)entries + (double)bm * (double)bm;
+  }
+  FCM_TRY(ctx, slabs_create(ctx, nb, seq, reach, work, 0, &L->blocks));
+cleanup:
+  fcm__free(ctx, pairs);
+  fcm__free(ctx, seq);
+  fcm__free(ctx, last);
+  fcm__free(ctx, reach);
+  fcm__free(ctx, work);
+  return st;
+}
+
+/* Does thread t of nt run slab s? The slabs of one colour go to the threads in contiguous
+ * runs of about equal work (a slab to the thread whose share holds its work's midpoint).
+ * Affects the schedule only: the slabs of one colour are independent. */
+static int slab_mine(const slab_order *S, fcm_index s, int t, int nt)
+{
+  const int owner = (int)(S->mid[s] * nt);
+  return (owner < nt ? owner : nt - 1) == t;
+}
+
+/* ------------------------------------------------------------------ block smoothers */
+
+/* Block smoothers (block_smoothing). Level 0: one block per grid vertex of the cut cells
+ * (de Prenter et al. 2020): the DOFs of the copies whose support lies in the vertex's patch
+ * of 8 cells, the vertex's own and (Hex20) those of the mid-edge nodes of the edges at the
+ * vertex, all copies together; then one block per element of a cut cell (all its DOFs).
+ * Coarser levels: one block per coarse cell that is not all material (its 8 corner copies).
+ * Each block is inverted by the clamped eigen-inverse of fcm_schwarz (Longva et al. 2020,
+ * §5.2). Vertex blocks resolve the nearly dependent functions of one vertex's patch (Hex20:
+ * 0.96 -> 0.2-0.3 per V-cycle), element blocks those of the corners of a sliver cell (Hex8
+ * hollow ball), coarse blocks the same on the Galerkin levels, where thin walls become
+ * cells with little material (the hollow ball's V-cycle grew with n without them). */
+/* Level 0: the vertex blocks, then the element blocks of the cut cells. */
+static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_out,
+                                fcm_index **dofs_out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  const fcm_space *sp = m->space;
+  const fcm_mesh *mesh = fcm_space_mesh(sp);
+  const fcm_element_info *info = fcm_element_get_info(fcm_mesh_element_type(mesh));
+  const int npc = info->num_nodes, mid = npc > 8;
+  const fcm_index *cells = fcm_mesh_cells(mesh), nnode = fcm_mesh_num_nodes(mesh);
+  const fcm_index ne = fcm_space_num_elements(sp);
+  fcm_index nb = 0, np = 0, nu = 0, neb = 0, ned = 0, *ptr = NULL, *dofs = NULL, *pairs = NULL;
+  unsigned char *mark = NULL;
+  FCM_ALLOC(ctx, nnode + 1, mark);
+  for (fcm_index e = 0; e < ne; e++) {
+    const fcm_index c = fcm_space_element_cell(sp, e);
+    if (!m->cut_cell[c]) continue;
+    for (int a = 0; a < 8; a++)
+      mark[cells[(fcm_index)npc * c + a]] = 1;
+  }
+  FCM_ALLOC(ctx, 2 * (size_t)ne * 8 * (mid ? 4 : 1) + 1, pairs);
+  for (fcm_index e = 0; e < ne; e++) {
+    const fcm_index c = fcm_space_element_cell(sp, e), *ed = fcm_space_element_dofs(sp, e);
+    for (int a = 0; a < 8; a++) {
+      const fcm_index v = cells[(fcm_index)npc * c + a];
+      if (!mark[v]) continue;
+      pairs[2 * np] = v, pairs[2 * np + 1] = ed[a] / 3, np++;
+      for (int j = 0; mid && j < info->num_edges; j++)
+        if (info->edge_nodes[j][0] == a || info->edge_nodes[j][1] == a)
+          pairs[2 * np] = v, pairs[2 * np + 1] = ed[info->edge_nodes[j][2]] / 3, np++;
+    }
+  }
+  if (np > 0) qsort(pairs, (size_t)np, 2 * sizeof *pairs, cmp_pair);
+  for (fcm_index i = 0; i < np; i++)
+    if (i == 0 || pairs[2 * i] != pairs[2 * nu - 2] || pairs[2 * i + 1] != pairs[2 * nu - 1])
+      pairs[2 * nu] = pairs[2 * i], pairs[2 * nu + 1] = pairs[2 * i + 1], nu++;
+  for (fcm_index i = 0; i < nu; i++)
+    nb += i == 0 || pairs[2 * i] != pairs[2 * i - 2];
+  FCM_TRY(ctx, fcm_space_cell_blocks(sp, m->cut_cell, &neb, &ned, NULL, NULL));
+  FCM_ALLOC(ctx, nb + neb + 1, ptr);
+  FCM_ALLOC(ctx, 3 * nu + ned + 1, dofs);
+  for (fcm_index i = 0, k = 0; i < nu; i++) {
+    if (i > 0 && pairs[2 * i] != pairs[2 * i - 2]) ptr[++k] = 3 * i;
+    for (int d = 0; d < 3; d++)
+      dofs[3 * i + d] = 3 * pairs[2 * i + 1] + d;
+  }
+  ptr[nb] = 3 * nu;
+  FCM_TRY(ctx, fcm_space_cell_blocks(sp, m->cut_cell, &neb, &ned, ptr + nb, dofs + 3 * nu));
+  for (fcm_index k = nb; k <= nb + neb; k++) /* offsets after the vertex blocks */
+    ptr[k] += 3 * nu;
+  *nb_out = nb + neb, *ptr_out = ptr, *dofs_out = dofs;
+  ptr = dofs = NULL;
+cleanup:
+  fcm__free(ctx, ptr);
+  fcm__free(ctx, dofs);
+  fcm__free(ctx, pairs);
+  fcm__free(ctx, mark);
+  return st;
+}
+
+/* A coarse level: the cells that are not all material, their distinct corner copies. */
+static fcm_status blocks_coarse(fcm_mg *m, const mg_level *L, fcm_index *nb_out,
+                                fcm_index **ptr_out, fcm_index **dofs_out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  fcm_index nb = 0, *ptr = NULL, *dofs = NULL;
+  for (fcm_index c = 0; c < L->ncell; c++)
+    nb += !L->full[c];
+  FCM_ALLOC(ctx, nb + 1, ptr);
+  FCM_ALLOC(ctx, 24 * nb + 1, dofs);
+  fcm_index k = 0, q = 0;
+  for (fcm_index c = 0; c < L->ncell; c++) {
+    if (L->full[c]) continue;
+    const fcm_index q0 = q;
+    for (int b = 0; b < 8; b++) {
+      const fcm_index K = L->corner[8 * c + b];
+      int dup = 0;
+      for (fcm_index t = q0; t < q && !dup; t += 3)
+        dup = dofs[t] == 3 * K;
+      for (int d = 0; !dup && d < 3; d++)
+        dofs[q++] = 3 * K + d;
+    }
+    ptr[++k] = q;
+  }
+  *nb_out = nb, *ptr_out = ptr, *dofs_out = dofs;
+  ptr = dofs = NULL;
+cleanup:
+  fcm__free(ctx, ptr);
+  fcm__free(ctx, dofs);
+  return st;
+}
+
+fcm_status fcm__mg_level_blocks(fcm_mg *m, int l, fcm_index *nb, fcm_index **ptr, fcm_index **dofs)
+{
+  return l == 0 ? blocks_level0(m, nb, ptr, dofs) : blocks_coarse(m, &m->lev[l], nb, ptr, dofs);
+}
+
+fcm_status fcm__mg_block_smoothers_create(fcm_mg *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  fcm_index nb = 0, *ptr = NULL, *dofs = NULL;
+  for (int l = 0; l + 1 < m->nlev; l++) {
+    mg_level *L = &m->lev[l];
+    FCM_TRY(ctx, fcm__mg_level_blocks(m, l, &nb, &ptr, &dofs));
+    for (fcm_index k = 0; k < nb; k++)
+      m->blk_max = FCM_MAX(m->blk_max, ptr[k + 1] - ptr[k]);
+    if (nb > 0) {
+      FCM_TRY(ctx, fcm_schwarz_create(ctx, fcm__mg_level_matrix(L), nb, ptr, dofs, NULL, &L->blk));
+      FCM_TRY(ctx, block_slabs(m, L));
+    }
+    FCM_FREE(ctx, ptr);
+    FCM_FREE(ctx, dofs);
+  }
+  FCM_ALLOC(ctx, (size_t)m->nt * (size_t)m->blk_max + 1, m->blk_r);
+  FCM_ALLOC(ctx, (size_t)m->nt * (size_t)m->blk_max + 1, m->blk_dx);
+cleanup:
+  fcm__free(ctx, ptr);
+  fcm__free(ctx, dofs);
+  return st;
+}
+
+/* ------------------------------------------------------------------ sweeps */
+
+/* The sweeps run inside a parallel region of the cycle (or in a team of one, when the level is
+ * too small to share; cycle.c) and end without a barrier unless said. */
+
+/* What a slab sweep works on: the level, omega (pointwise), b, x and the thread's block
+ * scratch (r, dx). */
+typedef struct sweep_args {
+  const mg_level *L;
+  double w;
+  const double *b;
+  double *x;
+  double *r, *dx;
+} sweep_args;
+
+/* One symmetric Gauss-Seidel sweep in the slab order S (forward, then backward) by the team
+ * of the enclosing region: the slabs of the colour swept first, forward; a barrier; each
+ * thread's slabs of the other colour forward and at once backward (they touch no other slab
+ * of their colour); a barrier; the first colour's slabs backward. The same threads run the
+ * same slabs of the first colour at the start and at the end, so repeated sweeps need no
+ * barrier between them; no barrier at the end. slab(a, s, back) sweeps slab s. */
+static void symmetric_sweep(const slab_order *S,
+                            void (*slab)(const sweep_args *a, fcm_index s, int back),
+                            const sweep_args *a)
+{
+  const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+  const int c0 = S->first, c1 = 1 - S->first;
+  for (fcm_index k = c0; k < S->nslab; k += 2)
+    if (slab_mine(S, k, t, nt)) slab(a, k, 0);
+#pragma omp barrier
+  for (fcm_index k = c1; k < S->nslab; k += 2)
+    if (slab_mine(S, k, t, nt)) {
+      slab(a, k, 0);
+      slab(a, k, 1);
+    }
+#pragma omp barrier
+  for (fcm_index k = c0; k < S->nslab; k += 2)
+    if (slab_mine(S, k, t, nt)) slab(a, k, 1);
+}
+
+/* Gauss-Seidel over the rows of slab s, forward (ascending) or backward. */
+static void sgs_slab(const sweep_args *a, fcm_index s, int back)
+{
+  const mg_level *L = a->L;
+  const double w = a->w, *b = a->b;
+  double *x = a->x;
+  const fcm_csr *A = fcm__mg_level_matrix(L);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const double *v = fcm_csr_values_read(A);
+  const fcm_index q0 = L->rows.ptr[s], q1 = L->rows.ptr[s + 1];
+  for (fcm_index t = 0; t < q1 - q0; t++) {
+    const fcm_index i = L->rows.item[back ? q1 - 1 - t : q0 + t];
+    double sum = b[i];
+    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+      sum -= v[p] * x[ci[p]];
+    x[i] += w * sum * L->dinv[i];
+  }
+}
+
+/* One smoothing step. SGS: a forward then a backward sweep, S = (I - B^-1 A)(I - F^-1 A),
+ * which is A-self-adjoint (B = F^T); pre- and post-smoothing both apply S, so the cycle is
+ * symmetric (post-smoothing must be the adjoint of pre-smoothing: backward-then-forward
+ * would not be). SGS runs in the slab order of the rows (symmetric_sweep()), the coloured
+ * SGS colour after colour (a barrier each), Jacobi in two loops over the rows. */
+void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x)
+{
+  const fcm_csr *A = fcm__mg_level_matrix(L);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const double *v = fcm_csr_values_read(A);
+  const double w = m->opts.omega;
+  const fcm_index n = L->n;
+  if (m->opts.smoother == FCM_MG_SMOOTHER_JACOBI) {
+#pragma omp for schedule(static)
+    for (fcm_index i = 0; i < n; i++) {
+      double sum = 0.0;
+      for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+        sum += v[p] * x[ci[p]];
+      L->r[i] = b[i] - sum;
+    }
+#pragma omp for schedule(static)
+    for (fcm_index i = 0; i < n; i++)
+      x[i] += w * L->r[i] * L->dinv[i];
+    return;
+  }
+  if (m->opts.smoother == FCM_MG_SMOOTHER_SGS_COLORED) {
+    for (int t = 0; t < 2 * L->ncolor; t++) {
+      const int c = t < L->ncolor ? t : 2 * L->ncolor - 1 - t;
+      const fcm_index r0 = L->color_ptr[c], r1 = L->color_ptr[c + 1];
+#pragma omp for schedule(static)
+      for (fcm_index q = r0; q < r1; q++) {
+        const fcm_index i = L->color_rows[q];
+        double sum = b[i];
+        for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+          sum -= v[p] * x[ci[p]];
+        x[i] += w * sum * L->dinv[i];
+      }
+    }
+    return;
+  }
+  const sweep_args a = {L, w, b, x, NULL, NULL};
+  symmetric_sweep(&L->rows, sgs_slab, &a);
+}
+
+/* Block Gauss-Seidel over the blocks of slab s, forward or backward: x_K += S_K (b - A x)_K,
+ * block after block. */
+static void block_slab(const sweep_args *a, fcm_index s, int back)
+{
+  const mg_level *L = a->L;
+  const double *b = a->b;
+  double *x = a->x, *r = a->r, *dx = a->dx;
+  const fcm_csr *A = fcm__mg_level_matrix(L);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const double *v = fcm_csr_values_read(A);
+  const fcm_index q0 = L->blocks.ptr[s], q1 = L->blocks.ptr[s + 1];
+  for (fcm_index t = 0; t < q1 - q0; t++) {
+    const fcm_index k = L->blocks.item[back ? q1 - 1 - t : q0 + t];
+    const fcm_index *d = NULL;
+    const double *S = NULL;
+    const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
+    for (int i = 0; i < bm; i++) {
+      double sum = b[d[i]];
+      for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++)
+        sum -= v[p] * x[ci[p]];
+      r[i] = sum;
+    }
+    for (int i = 0; i < bm; i++) {
+      double sum = 0.0;
+      for (int j = 0; j < bm; j++)
+        sum += S[(size_t)i * (size_t)bm + (size_t)j] * r[j];
+      dx[i] = sum;
+    }
+    for (int i = 0; i < bm; i++)
+      x[d[i]] += dx[i];
+  }
+}
+
+/* A symmetric block Gauss-Seidel sweep over the level's blocks (forward, then backward) in
+ * the slab order of the blocks (symmetric_sweep()). */
+void fcm__mg_block_smooth(const fcm_mg *m, const mg_level *L, const double *b, double *x)
+{
+  const size_t t = (size_t)omp_get_thread_num();
+  const sweep_args a = {
+      L, 0.0, b, x, m->blk_r + t * (size_t)m->blk_max, m->blk_dx + t * (size_t)m->blk_max};
+  symmetric_sweep(&L->blocks, block_slab, &a);
+}
+
+/* ------------------------------------------------------------------ slab check */
+
+/* Slab of each item (-1: none; FCM_ERR_INTERNAL when an item is listed twice). */
+static fcm_status slab_of_items(fcm_ctx *ctx, const slab_order *S, fcm_index n, int level,
+                                const char *what, fcm_index **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *of = NULL;
+  FCM_ALLOC_RAW(ctx, n + 1, of);
+  for (fcm_index i = 0; i < n; i++)
+    of[i] = -1;
+  for (fcm_index k = 0; k < S->nslab; k++)
+    for (fcm_index q = S->ptr[k]; q < S->ptr[k + 1]; q++) {
+      const fcm_index i = S->item[q];
+      FCM_CHECK(i >= 0 && i < n && of[i] < 0, ctx, FCM_ERR_INTERNAL,
+                "mg: level %d: %s %lld listed twice or out of range [0, %lld) (slab %lld)", level,
+                what, (long long)i, (long long)n, (long long)k);
+      of[i] = k;
+    }
+  *out = of;
+  of = NULL;
+cleanup:
+  fcm__free(ctx, of);
+  return st;
+}
+
+fcm_status fcm__mg_slabs_check(const fcm_mg *m, int level, fcm_index *row_slabs,
+                               fcm_index *block_slabs)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m ? m->ctx : NULL;
+  fcm_index *rs = NULL, *bs = NULL, *rb_ptr = NULL, *rb = NULL, *fill = NULL;
+  FCM_CHECK(m && level >= 0 && level + 1 < m->nlev, ctx, FCM_ERR_ARG,
+            "mg_slabs_check: NULL argument or level %d outside [0, %d)", level,
+            m ? m->nlev - 1 : 0);
+  const mg_level *L = &m->lev[level];
+  const fcm_csr *A = fcm__mg_level_matrix(L);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const fcm_index n = L->n;
+  if (row_slabs) *row_slabs = L->rows.nslab;
+  if (block_slabs) *block_slabs = L->blocks.nslab;
+  if (L->rows.nslab > 0) {
+    FCM_TRY(ctx, slab_of_items(ctx, &L->rows, n, level, "row", &rs));
+    for (fcm_index i = 0; i < n; i++) {
+      FCM_CHECK(rs[i] >= 0, ctx, FCM_ERR_INTERNAL, "mg: level %d: row %lld in no slab", level,
+                (long long)i);
+      for (fcm_index p = rp[i]; p < rp[i + 1]; p++) {
+        const fcm_index j = ci[p];
+        FCM_CHECK(rs[j] == rs[i] || (rs[j] - rs[i]) % 2 != 0, ctx, FCM_ERR_INTERNAL,
+                  "mg: level %d: rows %lld and %lld are coupled but lie in slabs %lld and %lld "
+                  "of one colour",
+                  level, (long long)i, (long long)j, (long long)rs[i], (long long)rs[j]);
+      }
+    }
+  }
+  if (L->blocks.nslab > 0) {
+    const fcm_index nb = fcm__schwarz_num_blocks(L->blk);
+    FCM_TRY(ctx, slab_of_items(ctx, &L->blocks, nb, level, "block", &bs));
+    /* the blocks of each row */
+    FCM_ALLOC(ctx, n + 1, rb_ptr);
+    FCM_ALLOC(ctx, n + 1, fill);
+    for (fcm_index k = 0; k < nb; k++) {
+      const fcm_index *d = NULL;
+      const double *S = NULL;
+      const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
+      FCM_CHECK(bs[k] >= 0, ctx, FCM_ERR_INTERNAL, "mg: level %d: block %lld in no slab", level,
+                (long long)k);
+      for (int i = 0; i < bm; i++)
+        rb_ptr[d[i] + 1]++;
+    }
+    for (fcm_index i = 0; i < n; i++)
+      rb_ptr[i + 1] += rb_ptr[i];
+    FCM_ALLOC(ctx, rb_ptr[n] + 1, rb);
+    for (fcm_index k = 0; k < nb; k++) {
+      const fcm_index *d = NULL;
+      const double *S = NULL;
+      const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
+      for (int i = 0; i < bm; i++)
+        rb[rb_ptr[d[i]] + fill[d[i]]++] = k;
+    }
+    for (fcm_index k = 0; k < nb; k++) {
+      const fcm_index *d = NULL;
+      const double *S = NULL;
+      const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
+      for (int i = 0; i < bm; i++)
+        for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++)
+          for (fcm_index q = rb_ptr[ci[p]]; q < rb_ptr[ci[p] + 1]; q++) {
+            const fcm_index j = rb[q];
+            FCM_CHECK(bs[j] == bs[k] || (bs[j] - bs[k]) % 2 != 0, ctx, FCM_ERR_INTERNAL,
+                      "mg: level %d: blocks %lld and %lld touch (DOFs %lld, %lld) but lie in "
+                      "slabs %lld and %lld of one colour",
+                      level, (long long)k, (long long)j, (long long)d[i], (long long)ci[p],
+                      (long long)bs[k], (long long)bs[j]);
+          }
+    }
+  }
+cleanup:
+  fcm__free(ctx, rs);
+  fcm__free(ctx, bs);
+  fcm__free(ctx, rb_ptr);
+  fcm__free(ctx, rb);
+  fcm__free(ctx, fill);
+  return st;
+}
