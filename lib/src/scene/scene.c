@@ -10,6 +10,7 @@
 #include <string.h>
 
 #define COUNT(a) ((int)(sizeof(a) / sizeof *(a)))
+#define GIB      (1024.0 * 1024.0 * 1024.0)
 
 /* ---------------------------------------------------------------- ownership */
 
@@ -74,7 +75,7 @@ static const int cycle_values[] = {1, 2};
 /* background elements the multigrid supports (fcm_mg_create()) */
 static const fcm_element_type multigrid_elements[] = {FCM_ELEMENT_HEX8, FCM_ELEMENT_HEX20};
 static const char *const clamp_names[] = {"clamp", "paper"};
-/* in the order of fcm_fictitious_model */
+/* in the order of fcm_preconditioner_tangent */
 static const char *const tangent_names[] = {"projected", "linear", "exact"};
 static const char *const newton_rule_names[] = {"auto", "representative", "relative"};
 /* solver.on_inversion: fcm_scene_solver.stop_on_inversion 0 or 1 */
@@ -723,22 +724,18 @@ static fcm_status read_quadrature(fcm__scene_parser *p, const fcm__json *root)
                                      "simplify",           "simplify_method",    "stabilization",
                                      "min_fraction",       "max_rule_memory_gib"};
   static const char *const skeys[] = {"mode", "alpha"};
-  fcm_scene_quadrature *q = &p->scene->quadrature;
+  fcm_cell_rules_options *q = &p->scene->quadrature.rules;
   const fcm__json *o = NULL, *stab = NULL;
   size_t old = p->path_len;
-  q->stiffness_strength = q->mass_strength = q->surface_strength = -1;
-  q->simplify = FCM_CELL_SIMPLIFY_ON;
-  q->simplify_method = FCM_SIMPLIFY_AUTO;
-  q->stabilization = fcm_stabilization_options_default();
-  q->min_fraction = 1e-4;
-  q->max_rule_memory_gib = 4.0;
+  *q = fcm_cell_rules_options_default();
+  double gib = q->max_rule_memory / GIB;
   FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "quadrature", 0, &o));
   if (!o) return FCM_OK;
   ENTER(p, "quadrature");
   size_t here = p->path_len;
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
-  READ_INT(p, o, "stiffness_strength", 0, 0, 20, q->stiffness_strength);
-  READ_INT(p, o, "mass_strength", 0, 0, 20, q->mass_strength);
+  READ_INT(p, o, "stiffness_strength", 0, 0, 20, q->strength[FCM_RULE_STIFFNESS]);
+  READ_INT(p, o, "mass_strength", 0, 0, 20, q->strength[FCM_RULE_MASS]);
   READ_INT(p, o, "surface_strength", 0, 0, 20, q->surface_strength);
   {
     int simplify = (int)q->simplify;
@@ -746,7 +743,7 @@ static fcm_status read_quadrature(fcm__scene_parser *p, const fcm__json *root)
                                                  FCM_CELL_SIMPLIFY_AUTO, &simplify));
     q->simplify = (fcm_cell_simplify)simplify;
   }
-  READ_CHOICE(p, o, "simplify_method", 0, simplify_names, q->simplify_method);
+  READ_CHOICE(p, o, "simplify_method", 0, simplify_names, q->simplify_options.method);
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "stabilization", 0, &stab));
   if (stab) {
     ENTER(p, "stabilization");
@@ -758,9 +755,9 @@ static fcm_status read_quadrature(fcm__scene_parser *p, const fcm__json *root)
   }
   FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "min_fraction", 0, (fcm__range){0.0, 1.0, 0, 1},
                                          &q->min_fraction));
-  FCM_TRY(p->ctx,
-          fcm__scene_read_number(p, o, "max_rule_memory_gib", 0, (fcm__range){0.0, 1048576.0, 0, 0},
-                                 &q->max_rule_memory_gib));
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "max_rule_memory_gib", 0,
+                                         (fcm__range){0.0, 1048576.0, 0, 0}, &gib));
+  q->max_rule_memory = gib * GIB;
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
@@ -769,7 +766,8 @@ cleanup:
 /* ---------------------------------------------------------------- solver */
 
 /* "solver.multigrid": the fcm_mg_options of the multigrid (preconditioner or solver). */
-static fcm_status read_multigrid(fcm__scene_parser *p, const fcm__json *mg, fcm_scene_solver *s)
+static fcm_status read_multigrid(fcm__scene_parser *p, const fcm__json *mg,
+                                 fcm_integrator_options *s)
 {
   fcm_status st = FCM_OK;
   static const char *const keys[] = {"smoother", "omega",       "pre_smooth",     "post_smooth",
@@ -806,11 +804,11 @@ cleanup:
 
 /* Cross checks of the multigrid choice: a grid background of a supported element, and a
  * symmetric cycle when it preconditions CG or MINRES. The path is "solver.<key>". */
-static fcm_status check_multigrid(fcm__scene_parser *p, const fcm_scene_solver *s)
+static fcm_status check_multigrid(fcm__scene_parser *p, const fcm_integrator_options *s)
 {
   fcm_status st = FCM_OK;
-  const int as_solver = s->method == FCM_LINEAR_MULTIGRID;
-  const int as_pc = (s->method == FCM_LINEAR_CG || s->method == FCM_LINEAR_MINRES) &&
+  const int as_solver = s->linear_solver == FCM_LINEAR_MULTIGRID;
+  const int as_pc = (s->linear_solver == FCM_LINEAR_CG || s->linear_solver == FCM_LINEAR_MINRES) &&
                     s->preconditioner == FCM_PRECOND_MULTIGRID;
   const fcm_scene_background *b = &p->scene->background;
   size_t old = p->path_len;
@@ -835,7 +833,7 @@ static fcm_status check_multigrid(fcm__scene_parser *p, const fcm_scene_solver *
                 "pre_smooth = %d and post_smooth = %d must be equal when the multigrid "
                 "preconditions \"%s\" (the cycle must be symmetric positive definite)",
                 s->multigrid.pre_smooth, s->multigrid.post_smooth,
-                CHOICE_NAME(solver_names, solver_values, s->method));
+                CHOICE_NAME(solver_names, solver_values, s->linear_solver));
   }
 cleanup:
   fcm__scene_path_pop(p, old);
@@ -853,33 +851,21 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
   static const char *const nkeys[] = {"rtol",        "max_iterations",
                                       "line_search", "project_psd",
                                       "rule",        "representative_acceleration"};
-  fcm_scene_solver *s = &p->scene->solver;
+  fcm_scene_solver *sv = &p->scene->solver;
+  fcm_integrator_options *s = &sv->integrator;
   const fcm__json *o = NULL, *sw = NULL, *nw = NULL, *mg = NULL;
   size_t old = p->path_len;
-  s->method = FCM_LINEAR_DIRECT;
-  s->multigrid = fcm_mg_options_default();
-  s->direct = FCM_DIRECT_CHOLMOD;
-  s->preconditioner = FCM_PRECOND_SCHWARZ;
-  s->preconditioner_tangent = FCM_FICTITIOUS_PROJECTED;
-  s->schwarz_threshold = 0.5;
-  s->schwarz = fcm_schwarz_options_default();
-  s->newton_rule = FCM_NEWTON_TOL_AUTO;
-  s->threads = FCM_DEFAULT;
-  s->rtol = 1e-8;
-  s->max_iterations = 1000;
-  s->stagnation_window = 50;
-  s->newton_rtol = 1e-5;
-  s->newton_max_iterations = 100;
-  s->line_search = 1;
-  s->representative_acceleration = 9.81;
-  s->stop_on_inversion = 0;
+  *s = fcm_integrator_options_default();
+  sv->threads = FCM_DEFAULT;
+  sv->petsc_options = NULL;
+  sv->stop_on_inversion = 0;
   FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "solver", 0, &o));
   if (!o) return FCM_OK;
   ENTER(p, "solver");
   size_t here = p->path_len;
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
-  READ_CHOICE_AS(p, o, "method", 0, solver_names, solver_values, s->method);
-  READ_CHOICE(p, o, "direct", 0, direct_names, s->direct);
+  READ_CHOICE_AS(p, o, "method", 0, solver_names, solver_values, s->linear_solver);
+  READ_CHOICE(p, o, "direct", 0, direct_names, s->direct_method);
   READ_CHOICE(p, o, "preconditioner", 0, preconditioner_names, s->preconditioner);
   READ_CHOICE(p, o, "preconditioner_tangent", 0, tangent_names, s->preconditioner_tangent);
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "schwarz", 0, &sw));
@@ -887,37 +873,38 @@ static fcm_status read_solver(fcm__scene_parser *p, const fcm__json *root)
     ENTER(p, "schwarz");
     FCM_TRY(p->ctx, fcm__scene_check_object(p, sw, skeys, COUNT(skeys)));
     FCM_TRY(p->ctx, fcm__scene_read_number(p, sw, "threshold", 0, (fcm__range){0.0, 1.0, 1, 0},
-                                           &s->schwarz_threshold));
+                                           &s->schwarz_theta));
     FCM_TRY(p->ctx, fcm__scene_read_number(p, sw, "epsilon", 0, (fcm__range){0.0, 1.0, 1, 1},
                                            &s->schwarz.epsilon));
     READ_CHOICE(p, sw, "clamp", 0, clamp_names, s->schwarz.clamp);
     fcm__scene_path_pop(p, here);
   }
-  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "rtol", 0, (fcm__range){0.0, 1.0, 0, 1}, &s->rtol));
-  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "atol", 0, FCM__NONNEGATIVE, &s->atol));
-  READ_INT(p, o, "max_iterations", 0, 1, 1000000000, s->max_iterations);
-  READ_INT(p, o, "stagnation_window", 0, 0, 1000000000, s->stagnation_window);
+  FCM_TRY(p->ctx,
+          fcm__scene_read_number(p, o, "rtol", 0, (fcm__range){0.0, 1.0, 0, 1}, &s->krylov_rtol));
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "atol", 0, FCM__NONNEGATIVE, &s->krylov_atol));
+  READ_INT(p, o, "max_iterations", 0, 1, 1000000000, s->krylov_max_iterations);
+  READ_INT(p, o, "stagnation_window", 0, 0, 1000000000, s->krylov_stagnation_window);
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "newton", 0, &nw));
   if (nw) {
     ENTER(p, "newton");
     FCM_TRY(p->ctx, fcm__scene_check_object(p, nw, nkeys, COUNT(nkeys)));
     FCM_TRY(p->ctx, fcm__scene_read_number(p, nw, "rtol", 0, (fcm__range){0.0, 1.0, 1, 1},
-                                           &s->newton_rtol));
+                                           &s->newton_tolerance));
     READ_INT(p, nw, "max_iterations", 0, 1, 1000000, s->newton_max_iterations);
     FCM_TRY(p->ctx, fcm__scene_read_bool(p, nw, "line_search", 0, &s->line_search));
     FCM_TRY(p->ctx, fcm__scene_read_bool(p, nw, "project_psd", 0, &s->project_psd));
-    READ_CHOICE_AS(p, nw, "rule", 0, newton_rule_names, newton_rule_values, s->newton_rule);
+    READ_CHOICE_AS(p, nw, "rule", 0, newton_rule_names, newton_rule_values, s->tolerance_mode);
     FCM_TRY(p->ctx, fcm__scene_read_number(p, nw, "representative_acceleration", 0, FCM__POSITIVE,
-                                           &s->representative_acceleration));
+                                           &s->rep_acceleration));
     fcm__scene_path_pop(p, here);
   }
-  READ_INT(p, o, "threads", 0, 0, 4096, s->threads);
-  if (s->threads == 0) s->threads = FCM_DEFAULT; /* "threads": 0, the OpenMP default */
+  READ_INT(p, o, "threads", 0, 0, 4096, sv->threads);
+  if (sv->threads == 0) sv->threads = FCM_DEFAULT; /* "threads": 0, the OpenMP default */
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "multigrid", 0, &mg));
   if (mg) FCM_TRY(p->ctx, read_multigrid(p, mg, s));
   FCM_TRY(p->ctx, check_multigrid(p, s));
-  FCM_TRY(p->ctx, fcm__scene_read_string(p, o, "petsc_options", 0, &s->petsc_options));
-  READ_CHOICE(p, o, "on_inversion", 0, inversion_names, s->stop_on_inversion);
+  FCM_TRY(p->ctx, fcm__scene_read_string(p, o, "petsc_options", 0, &sv->petsc_options));
+  READ_CHOICE(p, o, "on_inversion", 0, inversion_names, sv->stop_on_inversion);
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
@@ -1289,8 +1276,8 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
 {
   const fcm_scene_background *b = &s->background;
   const fcm_scene_geometry *g = &s->geometry;
-  const fcm_scene_quadrature *q = &s->quadrature;
-  const fcm_scene_solver *so = &s->solver;
+  const fcm_cell_rules_options *q = &s->quadrature.rules;
+  const fcm_integrator_options *so = &s->solver.integrator;
   const fcm_scene_time *t = &s->time;
   fprintf(f, "scene %s (%s)\n", s->name, s->source);
   if (s->description[0]) fprintf(f, "  %s\n", s->description);
@@ -1374,41 +1361,44 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
           fcm_material_model_name(s->material.model), s->material.young, s->material.poisson,
           s->material.density);
   fprintf(f, "quadrature: strengths");
-  view_strength(f, "stiffness", q->stiffness_strength);
-  view_strength(f, "mass", q->mass_strength);
+  view_strength(f, "stiffness", q->strength[FCM_RULE_STIFFNESS]);
+  view_strength(f, "mass", q->strength[FCM_RULE_MASS]);
   if (q->surface_strength >= 0)
     view_strength(f, "surface", q->surface_strength);
   else
     fprintf(f, " surface automatic");
   fprintf(f, "; simplify %s (%s); stabilization %s alpha %g; min fraction %g\n",
-          fcm_cell_simplify_name(q->simplify), simplify_names[q->simplify_method],
+          fcm_cell_simplify_name(q->simplify), simplify_names[q->simplify_options.method],
           stabilization_names[q->stabilization.mode], q->stabilization.alpha, q->min_fraction);
-  fprintf(f, "solver: %s", CHOICE_NAME(solver_names, solver_values, so->method));
-  if (so->method == FCM_LINEAR_DIRECT)
-    fprintf(f, " (%s)", direct_names[so->direct]);
-  else if (so->method == FCM_LINEAR_MULTIGRID) {
+  fprintf(f, "solver: %s", CHOICE_NAME(solver_names, solver_values, so->linear_solver));
+  if (so->linear_solver == FCM_LINEAR_DIRECT)
+    fprintf(f, " (%s)", direct_names[so->direct_method]);
+  else if (so->linear_solver == FCM_LINEAR_MULTIGRID) {
     view_multigrid(f, &so->multigrid);
-    fprintf(f, ", rtol %g, atol %g, at most %d cycles", so->rtol, so->atol, so->max_iterations);
+    fprintf(f, ", rtol %g, atol %g, at most %d cycles", so->krylov_rtol, so->krylov_atol,
+            so->krylov_max_iterations);
   } else {
     fprintf(f, " preconditioner %s (%s tangent)", preconditioner_names[so->preconditioner],
             tangent_names[so->preconditioner_tangent]);
     if (so->preconditioner == FCM_PRECOND_SCHWARZ)
-      fprintf(f, " (threshold %g, epsilon %g, %s)", so->schwarz_threshold, so->schwarz.epsilon,
+      fprintf(f, " (threshold %g, epsilon %g, %s)", so->schwarz_theta, so->schwarz.epsilon,
               clamp_names[so->schwarz.clamp]);
     if (so->preconditioner == FCM_PRECOND_MULTIGRID) view_multigrid(f, &so->multigrid);
-    fprintf(f, ", rtol %g, atol %g, at most %d iterations", so->rtol, so->atol, so->max_iterations);
-    if (so->stagnation_window > 0)
-      fprintf(f, ", stagnation window %d", so->stagnation_window);
+    fprintf(f, ", rtol %g, atol %g, at most %d iterations", so->krylov_rtol, so->krylov_atol,
+            so->krylov_max_iterations);
+    if (so->krylov_stagnation_window > 0)
+      fprintf(f, ", stagnation window %d", so->krylov_stagnation_window);
     else
       fprintf(f, ", no stagnation test");
   }
   fprintf(f,
           "; Newton %s rule, rtol %g, at most %d iterations, line search %s, PSD projection %s, "
           "|a_rep| %g m/s^2; threads %d\n",
-          CHOICE_NAME(newton_rule_names, newton_rule_values, so->newton_rule), so->newton_rtol,
-          so->newton_max_iterations, so->line_search ? "on" : "off", so->project_psd ? "on" : "off",
-          so->representative_acceleration, so->threads > 0 ? so->threads : 0);
-  fprintf(f, "on inversion: %s\n", inversion_names[so->stop_on_inversion ? 1 : 0]);
+          CHOICE_NAME(newton_rule_names, newton_rule_values, so->tolerance_mode),
+          so->newton_tolerance, so->newton_max_iterations, so->line_search ? "on" : "off",
+          so->project_psd ? "on" : "off", so->rep_acceleration,
+          s->solver.threads > 0 ? s->solver.threads : 0);
+  fprintf(f, "on inversion: %s\n", inversion_names[s->solver.stop_on_inversion ? 1 : 0]);
   if (t->integrator == FCM_INTEGRATOR_STATIC)
     fprintf(f, "time: static, %lld step(s) of %g s, %d load step(s) each\n",
             (long long)t->num_steps, t->dt, t->load_steps);
