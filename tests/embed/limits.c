@@ -108,10 +108,11 @@ static void crowded(fcm_ctx *ctx)
   /* the lowest failing cell, whatever the threads */
   const int threads[3] = {1, 2, 4};
   for (int run = 0; run < 15; run++) {
-    o.num_threads = threads[run % 3];
+    TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, threads[run % 3]));
     TEST_ERR(ctx, fcm_cell_rules_create(ctx, m, g, &o, &R), FCM_ERR_UNSUPPORTED,
              "background cell 0 holds");
   }
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, FCM_DEFAULT));
   /* no limit: the same cells build */
   o.max_rule_memory = 0.0;
   TEST_OK(ctx, fcm_cell_rules_create(ctx, m, g, &o, &R));

@@ -80,7 +80,6 @@ static void same_rules(const fcm_cell_rules_options *a, const fcm_cell_rules_opt
   SAME(a, b, max_rule_memory);
   SAME(a, b, stabilization.mode);
   SAME(a, b, stabilization.alpha);
-  SAME(a, b, num_threads);
   SAME(a, b, progress);
   SAME(a, b, progress_user);
   SAME(a, b, progress_interval);

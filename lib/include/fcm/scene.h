@@ -111,7 +111,7 @@ typedef struct fcm_scene_geometry {
  * "auto"); "simplify_method" rules.simplify_options.method; "stabilization" rules.stabilization;
  * "min_fraction" rules.min_fraction; "max_rule_memory_gib" rules.max_rule_memory (in bytes
  * here: GiB x 2^30). The members the runner sets (kinds, expected_assemblies, progress,
- * cell_mask, num_threads) keep their defaults. */
+ * cell_mask) keep their defaults. */
 typedef struct fcm_scene_quadrature {
   fcm_cell_rules_options rules;
 } fcm_scene_quadrature;
@@ -124,8 +124,9 @@ typedef struct fcm_scene_quadrature {
  * background; its "jacobi" smoother defaults to omega 0.6. */
 typedef struct fcm_scene_solver {
   fcm_integrator_options integrator; /**< the solver keys (fcm/sim.h) */
-  int threads; /**< OpenMP threads >= 1; FCM_DEFAULT ("threads": 0, the default): the OpenMP
-                    default */
+  int threads;               /**< "threads": OpenMP threads >= 1, or FCM_DEFAULT ("threads": 0, the
+                                  default): the context's own count. When given, fcm_simulation_create() makes
+                                  it the context's thread count (fcm_ctx_set_num_threads()) */
   const char *petsc_options; /**< "petsc_options": PETSc options for the PETSc backend
                                   (fcm/petsc.h, `fcm-sim --backend petsc`), e.g. "-ksp_type
                                   minres -pc_type jacobi"; the command line wins for a key both

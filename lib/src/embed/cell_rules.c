@@ -41,7 +41,6 @@ fcm_cell_rules_options fcm_cell_rules_options_default(void)
   o.simplify_options = fcm_simplify_options_default();
   o.stabilization = fcm_stabilization_options_default();
   o.max_rule_memory = 4.0 * GIB;
-  o.num_threads = FCM_DEFAULT;
   o.progress = NULL;
   o.progress_user = NULL;
   o.progress_interval = 0.1;
@@ -657,8 +656,6 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_cell_rules_options *o, i
             "embed: progress_interval = %g must be finite and >= 0 seconds", o->progress_interval);
   FCM_CHECK(o->max_rule_memory >= 0.0 && !isnan(o->max_rule_memory), ctx, FCM_ERR_ARG,
             "embed: max_rule_memory = %g bytes must be >= 0 (0: no limit)", o->max_rule_memory);
-  FCM_CHECK(o->num_threads >= 1 || o->num_threads == FCM_DEFAULT, ctx, FCM_ERR_ARG,
-            "embed: num_threads = %d must be >= 1, or FCM_DEFAULT (-1)", o->num_threads);
   FCM_CHECK((int)o->stabilization.mode >= 0 &&
                 o->stabilization.mode < FCM_STABILIZATION_MODE_COUNT &&
                 (o->stabilization.mode == FCM_STABILIZATION_OFF ||
@@ -1390,7 +1387,7 @@ static fcm_status build_rules_x(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_ge
   FCM_ALLOC(ctx, (size_t)nc, out);
   const double t_setup = fcm_wtime();
   /* 2. parallel per-cell work */
-  const int nthreads = o->num_threads > 0 ? o->num_threads : omp_get_max_threads();
+  const int nthreads = fcm_ctx_num_threads(ctx);
   FCM_TRY(ctx, run_cells(&B, R, nthreads, out, &sums, o));
   if (x) FCM_TRY(ctx, exchange_classes(&B, R, x, out, &sums, exchanged));
   if (o->simplify == FCM_CELL_SIMPLIFY_AUTO)

@@ -1956,7 +1956,7 @@ fcm_status fcm_petsc_problem_create_from_scene(fcm_ctx *ctx, MPI_Comm comm, cons
   o.max_iterations = sv->integrator.krylov_max_iterations;
   o.rules = *q;
   o.rules.surface_strength = -1;
-  o.rules.num_threads = sv->threads;
+  if (sv->threads > 0) FCM_TRY(ctx, fcm_ctx_set_num_threads(ctx, sv->threads));
   const int *str = q->strength;
   o.assembly.stiffness_strength =
       str[FCM_RULE_STIFFNESS] > 0 ? str[FCM_RULE_STIFFNESS] : FCM_DEFAULT;

@@ -540,7 +540,7 @@ static fcm_status build_rules(fcm_simulation *S)
         RUN_ASSEMBLIES_PER_STEP * (double)tm->num_steps * (dynamic ? 1.0 : (double)tm->load_steps);
     ro.expected_assemblies[FCM_RULE_MASS] = dynamic ? 1.0 : 0.0;
   }
-  ro.num_threads = sv->threads;
+  if (sv->threads > 0) FCM_TRY(S->ctx, fcm_ctx_set_num_threads(S->ctx, sv->threads));
   ro.progress = S->opts.rules_progress;
   ro.progress_user = S->opts.rules_progress_user;
   ro.progress_interval = S->opts.rules_progress_interval;
