@@ -15,6 +15,21 @@ static const char *const shape_names[] = {"box", "ball", "hemisphere", "hollow_b
 
 /* ---------------------------------------------------------------- background */
 
+/* The required "min" and "max" of obj, with min[d] < max[d] (checked at the current path). */
+static fcm_status read_min_max(fcm__scene_parser *p, const fcm__json *obj, double min[3],
+                               double max[3])
+{
+  fcm_status st = FCM_OK;
+  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, obj, "min", 1, FCM__ANY, min));
+  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, obj, "max", 1, FCM__ANY, max));
+  for (int d = 0; d < 3; d++)
+    SCENE_CHECK(min[d] < max[d], p, FCM_ERR_ARG,
+                "expected min[%d] < max[%d], got min[%d] = %g >= max[%d] = %g", d, d, d, min[d], d,
+                max[d]);
+cleanup:
+  return st;
+}
+
 /* "fit_background": {"cell_size": h, "margin": m}: a grid of cubes of edge h around the
  * geometry's bounding box grown by m on every side, placed when the simulation is built. */
 static fcm_status read_fit_background(fcm__scene_parser *p, const fcm__json *o,
@@ -85,12 +100,7 @@ fcm_status fcm__scene_read_background(fcm__scene_parser *p, const fcm__json *roo
   {
     size_t o2 = SCENE_ENTER(p, "box");
     FCM_TRY(p->ctx, fcm__scene_check_object(p, box, box_keys, SCENE_COUNT(box_keys)));
-    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, box, "min", 1, FCM__ANY, b->min));
-    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, box, "max", 1, FCM__ANY, b->max));
-    for (int d = 0; d < 3; d++)
-      SCENE_CHECK(b->min[d] < b->max[d], p, FCM_ERR_ARG,
-                  "expected min[%d] < max[%d], got min[%d] = %g >= max[%d] = %g", d, d, d,
-                  b->min[d], d, b->max[d]);
+    FCM_TRY(p->ctx, read_min_max(p, box, b->min, b->max));
     fcm__scene_path_pop(p, o2);
   }
   FCM_TRY(p->ctx, fcm__scene_read_ivec3(p, o, "cells", 1, 1, 1000000, b->cells));
@@ -291,12 +301,7 @@ static fcm_status read_implicit(fcm__scene_parser *p, const fcm__json *node, dou
         FCM_TRY(p->ctx, fcm__scene_check_object(p, m, box_keys, SCENE_COUNT(box_keys)));
       else
         FCM_TRY(p->ctx, fcm__scene_check_object(p, m, gyroid_keys, SCENE_COUNT(gyroid_keys)));
-      FCM_TRY(p->ctx, fcm__scene_read_vec3(p, m, "min", 1, FCM__ANY, q.min));
-      FCM_TRY(p->ctx, fcm__scene_read_vec3(p, m, "max", 1, FCM__ANY, q.max));
-      for (int d = 0; d < 3; d++)
-        SCENE_CHECK(q.min[d] < q.max[d], p, FCM_ERR_ARG,
-                    "expected min[%d] < max[%d], got min[%d] = %g >= max[%d] = %g", d, d, d,
-                    q.min[d], d, q.max[d]);
+      FCM_TRY(p->ctx, read_min_max(p, m, q.min, q.max));
       if (q.kind == FCM_IMPLICIT_GYROID) {
         int type = 0;
         SCENE_READ_CHOICE(p, m, "type", 0, gyroid_types, type);
@@ -384,12 +389,7 @@ static fcm_status read_level_set(fcm__scene_parser *p, const fcm__json *o, fcm_s
               "(or none: the background grid)");
   if (nbox == 3) {
     g->has_box = 1;
-    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "min", 1, FCM__ANY, g->min));
-    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "max", 1, FCM__ANY, g->max));
-    for (int d = 0; d < 3; d++)
-      SCENE_CHECK(g->min[d] < g->max[d], p, FCM_ERR_ARG,
-                  "expected min[%d] < max[%d], got min[%d] = %g >= max[%d] = %g", d, d, d,
-                  g->min[d], d, g->max[d]);
+    FCM_TRY(p->ctx, read_min_max(p, o, g->min, g->max));
     FCM_TRY(p->ctx, fcm__scene_read_ivec3(p, o, "cells", 1, 1, 10000, g->cells));
   } else {
     const fcm_scene_background *b = &p->scene->background;
@@ -437,12 +437,7 @@ static fcm_status read_shape(fcm__scene_parser *p, const fcm__json *o, fcm_scene
   switch (g->kind) {
   case FCM_SCENE_GEOMETRY_BOX:
     FCM_TRY(p->ctx, fcm__scene_check_object(p, o, box_keys, SCENE_COUNT(box_keys)));
-    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "min", 1, FCM__ANY, g->min));
-    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "max", 1, FCM__ANY, g->max));
-    for (int d = 0; d < 3; d++)
-      SCENE_CHECK(g->min[d] < g->max[d], p, FCM_ERR_ARG,
-                  "expected min[%d] < max[%d], got min[%d] = %g >= max[%d] = %g", d, d, d,
-                  g->min[d], d, g->max[d]);
+    FCM_TRY(p->ctx, read_min_max(p, o, g->min, g->max));
     g->cells[0] = g->cells[1] = g->cells[2] = 1;
     FCM_TRY(p->ctx, fcm__scene_read_ivec3(p, o, "cells", 0, 1, 10000, g->cells));
     break;
