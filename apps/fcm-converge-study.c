@@ -640,6 +640,7 @@ static fcm_status nitsche_terms(const cv_study *S, fcm_space *space, fcm_csr *K,
   io.kind = FCM_INTEGRATOR_STATIC;
   io.tolerance_mode = FCM_NEWTON_TOL_RELATIVE;
   io.linear_solver = FCM_LINEAR_CG; /* no factorization: only the boundary terms are used */
+  io.preconditioner = FCM_PRECOND_JACOBI;
   bo.displacement = exact_displacement_cb;
   if (st == FCM_OK) st = fcm_integrator_create(ctx, space, &mat, &io, &I);
   if (st == FCM_OK) st = fcm_integrator_add_boundary_constraint(I, curved_cb, NULL, &m, &bo, NULL);

@@ -63,6 +63,7 @@ int main(int argc, char **argv)
   const fcm_material mat = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 2e5, 0.4, 1100.0};
   fcm_integrator_options io = fcm_integrator_options_default();
   io.kind = FCM_INTEGRATOR_STATIC;
+  io.tolerance_mode = FCM_NEWTON_TOL_REPRESENTATIVE; /* ||g|| <= 1e-5 ||rho a_rep|| */
   io.dt = 1.0;
   io.load_steps = 2;
   CHECK(fcm_integrator_create(ctx, space, &mat, &io, &integ));

@@ -3,6 +3,8 @@
 #include "core/core_impl.h"
 #include "test.h"
 
+#include <omp.h>
+
 typedef struct counting {
   int allocs, releases, fail_at; /* fail the fail_at-th allocation (0-based), -1: never */
 } counting;
@@ -115,6 +117,27 @@ int main(void)
     fcm__log(quiet, FCM_LOG_ERROR, "shown %d", 3);
     TEST_TRUE(book.lines == before + 1 && !strcmp(book.text, "shown 3"));
     fcm_ctx_destroy(&quiet);
+  }
+
+  /* The one thread count: FCM_DEFAULT is OpenMP's, a set count is returned as set. */
+  TEST_TRUE(fcm_ctx_options_default().num_threads == FCM_DEFAULT);
+  TEST_TRUE(fcm_ctx_num_threads(ctx) == omp_get_max_threads());
+  TEST_TRUE(fcm_ctx_num_threads(NULL) == omp_get_max_threads());
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 3));
+  TEST_TRUE(fcm_ctx_num_threads(ctx) == 3);
+  TEST_ERR(ctx, fcm_ctx_set_num_threads(ctx, 0), FCM_ERR_ARG, "num_threads = 0");
+  TEST_TRUE(fcm_ctx_num_threads(ctx) == 3);
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, FCM_DEFAULT));
+  TEST_TRUE(fcm_ctx_num_threads(ctx) == omp_get_max_threads());
+  {
+    fcm_ctx_options t = fcm_ctx_options_default();
+    fcm_ctx *c2 = NULL;
+    t.num_threads = 0;
+    TEST_TRUE(fcm_ctx_create(&t, &c2) == FCM_ERR_ARG && c2 == NULL);
+    t.num_threads = 2;
+    TEST_OK(c2, fcm_ctx_create(&t, &c2));
+    TEST_TRUE(fcm_ctx_num_threads(c2) == 2);
+    fcm_ctx_destroy(&c2);
   }
 
   /* Index narrowing. */

@@ -71,7 +71,7 @@ static int growth(fcm_ctx *ctx, const fcm_geometry *g, fcm_element_type type, in
     fcm_cell_rules *r = NULL;
     fcm_cell_rules_options o = fcm_cell_rules_options_default();
     o.simplify = simplify ? FCM_CELL_SIMPLIFY_ON : FCM_CELL_SIMPLIFY_OFF;
-    o.num_threads = 1;
+    fcm_ctx_set_num_threads(ctx, 1);
     if (fcm_mesh_create_box(ctx, type, lo, hi, nn, &m) != FCM_OK) {
       *failed = 1;
       return 0;
@@ -153,7 +153,7 @@ int main(int argc, char **argv)
       fcm_cell_rules_options o = fcm_cell_rules_options_default();
       o.simplify = 0;
       o.stabilization.mode = FCM_STABILIZATION_OFF;
-      o.num_threads = threads;
+      fcm_ctx_set_num_threads(ctx, threads);
       fcm_cell_rules *r = NULL;
       const clock_t cstart = clock();
       const fcm_status st = fcm_cell_rules_create(ctx, m, g, &o, &r);
@@ -177,7 +177,7 @@ int main(int argc, char **argv)
     if (t == FCM_ELEMENT_HEX20) { /* simplification of the stiffness rules (mass: 1) */
       fcm_cell_rules_options o = fcm_cell_rules_options_default();
       o.strength[FCM_RULE_MASS] = 1;
-      o.num_threads = 2;
+      fcm_ctx_set_num_threads(ctx, 2);
       fcm_cell_rules *r = NULL;
       if (fcm_cell_rules_create(ctx, m, g, &o, &r) == FCM_OK) {
         const fcm_cell_rules_stats *S = fcm_cell_rules_get_stats(r);

@@ -88,7 +88,6 @@ static fcm_cell_rules_options opts(void)
 {
   fcm_cell_rules_options o = fcm_cell_rules_options_default();
   o.min_fraction = 0.0;
-  o.num_threads = 2;
   return o;
 }
 
@@ -447,6 +446,7 @@ static void campaign(const char *what, int n, unsigned seed)
 int main(int argc, char **argv)
 {
   TEST_OK(NULL, fcm_ctx_create(NULL, &ctx));
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 2));
   if (argc > 2 && !strcmp(argv[1], "campaign")) { /* embed_cut campaign N [seed] */
     const int n = atoi(argv[2]);
     const unsigned seed = argc > 3 ? (unsigned)atoi(argv[3]) : 1u;

@@ -146,7 +146,7 @@ static void check(const fcm_mesh *mesh, const geom_case *gc, int m, int simplify
   o.strength[FCM_RULE_STIFFNESS] = m;
   o.strength[FCM_RULE_MASS] = m > 1 ? m - 1 : 1;
   o.min_fraction = 0.0;
-  o.num_threads = 1;
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 1));
   o.simplify = simplify;
   fcm_cell_rules *r = NULL;
   TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, gc->g, &o, &r));

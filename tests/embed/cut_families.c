@@ -297,7 +297,7 @@ static void setup_create(const body *b, fcm_element_type type, setup *S)
   o.simplify = FCM_CELL_SIMPLIFY_OFF;
   o.strength[FCM_RULE_STIFFNESS] = 1;
   o.strength[FCM_RULE_MASS] = 1;
-  o.num_threads = 1;
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 1));
   TEST_OK(ctx, fcm_mesh_create_box(ctx, type, b->mlo, b->mhi, b->cells, &S->mesh));
   TEST_OK(ctx, fcm_cell_rules_create(ctx, S->mesh, b->g, &o, &S->rules));
 }

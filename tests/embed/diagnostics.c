@@ -113,8 +113,9 @@ int main(void)
   fcm_cell_rules_options o = fcm_cell_rules_options_default();
   progress_log log = {0};
   o.progress = on_progress, o.progress_user = &log, o.progress_interval = 0;
-  o.num_threads = 2;
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 2));
   TEST_OK(ctx, fcm_cell_rules_create(ctx, m, g, &o, &r));
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, FCM_DEFAULT));
   TEST_TRUE(log.calls >= 2 && log.last == 64 && log.total == 64);
   TEST_TRUE(!log.decreasing && !log.wrong_thread);
   fcm_cell_rules_destroy(&r);

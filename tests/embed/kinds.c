@@ -17,7 +17,7 @@ static fcm_cell_rules *build(const fcm_mesh *m, const fcm_geometry *g, unsigned 
 {
   fcm_cell_rules_options o = fcm_cell_rules_options_default();
   o.kinds = kinds;
-  o.num_threads = 1;
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 1));
   fcm_cell_rules *r = NULL;
   TEST_OK(ctx, fcm_cell_rules_create(ctx, m, g, &o, &r));
   return r;

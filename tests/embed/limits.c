@@ -108,10 +108,11 @@ static void crowded(fcm_ctx *ctx)
   /* the lowest failing cell, whatever the threads */
   const int threads[3] = {1, 2, 4};
   for (int run = 0; run < 15; run++) {
-    o.num_threads = threads[run % 3];
+    TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, threads[run % 3]));
     TEST_ERR(ctx, fcm_cell_rules_create(ctx, m, g, &o, &R), FCM_ERR_UNSUPPORTED,
              "background cell 0 holds");
   }
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, FCM_DEFAULT));
   /* no limit: the same cells build */
   o.max_rule_memory = 0.0;
   TEST_OK(ctx, fcm_cell_rules_create(ctx, m, g, &o, &R));
@@ -129,11 +130,11 @@ static void scene_key(fcm_ctx *ctx)
   "\"cells\": [1, 1, 1]}, \"material\": {\"young\": 1e6, \"poisson\": 0.3}" q "}"
   fcm_scene *s = NULL;
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, SCENE(""), "t.json", &s));
-  if (s) TEST_TRUE(fcm_scene_get_quadrature(s)->max_rule_memory_gib == 4.0);
+  if (s) TEST_TRUE(fcm_scene_get_quadrature(s)->rules.max_rule_memory == 4.0 * 1024 * 1024 * 1024);
   fcm_scene_destroy(&s);
   TEST_OK(ctx, fcm_scene_create_from_string(
                    ctx, SCENE(", \"quadrature\": {\"max_rule_memory_gib\": 0.5}"), "t.json", &s));
-  if (s) TEST_TRUE(fcm_scene_get_quadrature(s)->max_rule_memory_gib == 0.5);
+  if (s) TEST_TRUE(fcm_scene_get_quadrature(s)->rules.max_rule_memory == 0.5 * 1024 * 1024 * 1024);
   fcm_scene_destroy(&s);
   TEST_ERR(ctx,
            fcm_scene_create_from_string(

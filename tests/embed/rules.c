@@ -18,9 +18,10 @@ static fcm_cell_rules *build(const fcm_mesh *m, const fcm_geometry *g, fcm_stabi
   o.stabilization.mode = mode;
   o.stabilization.alpha = 1e-3;
   o.simplify = simplify;
-  o.num_threads = threads;
   fcm_cell_rules *r = NULL;
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, threads));
   TEST_OK(ctx, fcm_cell_rules_create(ctx, m, g, &o, &r));
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, FCM_DEFAULT));
   return r;
 }
 

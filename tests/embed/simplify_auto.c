@@ -54,13 +54,14 @@ static fcm_cell_rules *build(const fcm_mesh *m, const fcm_geometry *g, fcm_cell_
   o.strength[FCM_RULE_STIFFNESS] = 2;
   o.strength[FCM_RULE_MASS] = 3;
   o.simplify = mode;
-  o.num_threads = threads;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     o.expected_assemblies[k] = assemblies;
     o.point_cost[k] = point_cost;
   }
   fcm_cell_rules *r = NULL;
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, threads));
   TEST_OK(ctx, fcm_cell_rules_create(ctx, m, g, &o, &r));
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, FCM_DEFAULT));
   return r;
 }
 

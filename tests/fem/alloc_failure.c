@@ -216,7 +216,7 @@ int main(void)
   TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, n, &x.mesh));
   TEST_OK(ctx, fcm_geometry_create_ball(ctx, c0, 0.9, 1, &g));
   fcm_cell_rules_options o = fcm_cell_rules_options_default();
-  o.num_threads = 1;
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 1));
   o.surface_strength = 1;
   o.strength[FCM_RULE_MASS] = 2;
   TEST_OK(ctx, fcm_cell_rules_create(ctx, x.mesh, g, &o, &x.rules));

@@ -220,7 +220,7 @@ static void check_papers(fcm_ctx *ctx, const char *dir)
       }
     }
     TEST_TRUE(released == 1);
-    TEST_TRUE(fcm_scene_get_solver(s)->method != FCM_LINEAR_DIRECT);
+    TEST_TRUE(fcm_scene_get_solver(s)->integrator.linear_solver != FCM_LINEAR_DIRECT);
   }
   fcm_scene_destroy(&s);
 

@@ -326,7 +326,7 @@ static void good(fcm_ctx *ctx, const char *element, const char *solver, int smoo
   fcm_scene *scene = NULL;
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "good.json", &scene));
   if (scene) {
-    const fcm_scene_solver *s = fcm_scene_get_solver(scene);
+    const fcm_integrator_options *s = &fcm_scene_get_solver(scene)->integrator;
     TEST_TRUE((int)s->multigrid.smoother == smoother);
     TEST_NEAR(s->multigrid.omega, omega, 0.0, 0.0);
   }
@@ -440,7 +440,7 @@ static void mode_errors(fcm_ctx *ctx)
                     " \"time\": {\"static\": true}, \"effects\": []}";
     TEST_OK(ctx, fcm_scene_create_from_string(ctx, j, "hex20.json", &sc));
     if (sc) {
-      const fcm_mg_options *m = &fcm_scene_get_solver(sc)->multigrid;
+      const fcm_mg_options *m = &fcm_scene_get_solver(sc)->integrator.multigrid;
       TEST_TRUE(m->block_smoothing == 0 && m->cycle_index == 2 && m->coarse_dofs == 77 &&
                 m->pre_smooth == 3 && m->post_smooth == 1);
     }
@@ -452,6 +452,8 @@ static void mode_errors(fcm_ctx *ctx)
   int setup = 0;
   fcm_integrator_options o = fcm_integrator_options_default();
   o.kind = FCM_INTEGRATOR_STATIC;
+  o.tolerance_mode = FCM_NEWTON_TOL_REPRESENTATIVE;
+  o.preconditioner = FCM_PRECOND_JACOBI;
   o.dt = 1.0;
   o.linear_solver = FCM_LINEAR_MULTIGRID;
   o.multigrid.omega = 2.5;

@@ -53,24 +53,27 @@ static void check_full(fcm_ctx *ctx)
             m->density == 1200);
   TEST_OK(ctx, fcm_material_validate(ctx, m));
 
-  const fcm_scene_quadrature *q = fcm_scene_get_quadrature(s);
-  TEST_TRUE(q->stiffness_strength == 5 && q->mass_strength == 7 && q->surface_strength == 6);
-  TEST_TRUE(q->simplify == 0 && q->simplify_method == FCM_SIMPLIFY_RECOMBINE);
+  const fcm_cell_rules_options *q = &fcm_scene_get_quadrature(s)->rules;
+  TEST_TRUE(q->strength[FCM_RULE_STIFFNESS] == 5 && q->strength[FCM_RULE_MASS] == 7 &&
+            q->surface_strength == 6);
+  TEST_TRUE(q->simplify == 0 && q->simplify_options.method == FCM_SIMPLIFY_RECOMBINE);
   TEST_TRUE(q->stabilization.mode == FCM_STABILIZATION_MASS && q->stabilization.alpha == 1e-8);
   TEST_TRUE(q->min_fraction == 0.001);
 
-  const fcm_scene_solver *so = fcm_scene_get_solver(s);
-  TEST_TRUE(so->method == FCM_LINEAR_MINRES && so->direct == FCM_DIRECT_UMFPACK);
+  const fcm_scene_solver *sv = fcm_scene_get_solver(s);
+  const fcm_integrator_options *so = &sv->integrator;
+  TEST_TRUE(so->linear_solver == FCM_LINEAR_MINRES && so->direct_method == FCM_DIRECT_UMFPACK);
   TEST_TRUE(so->preconditioner == FCM_PRECOND_BLOCK_JACOBI);
-  TEST_TRUE(so->schwarz_threshold == 0.25 && so->schwarz.epsilon == 1e-12 &&
+  TEST_TRUE(so->schwarz_theta == 0.25 && so->schwarz.epsilon == 1e-12 &&
             so->schwarz.clamp == FCM_SCHWARZ_PAPER);
-  TEST_TRUE(so->rtol == 1e-6 && so->atol == 1e-12 && so->max_iterations == 321);
-  TEST_TRUE(so->stagnation_window == 37);
-  TEST_TRUE(so->newton_rtol == 1e-4 && so->newton_max_iterations == 17);
+  TEST_TRUE(so->krylov_rtol == 1e-6 && so->krylov_atol == 1e-12 &&
+            so->krylov_max_iterations == 321);
+  TEST_TRUE(so->krylov_stagnation_window == 37);
+  TEST_TRUE(so->newton_tolerance == 1e-4 && so->newton_max_iterations == 17);
   TEST_TRUE(so->line_search == 0 && so->project_psd == 1);
-  TEST_TRUE(so->representative_acceleration == 10 && so->threads == 3);
-  TEST_TRUE(so->stop_on_inversion == 1);
-  TEST_TRUE(so->newton_rule == FCM_NEWTON_TOL_RELATIVE);
+  TEST_TRUE(so->rep_acceleration == 10 && sv->threads == 3);
+  TEST_TRUE(sv->stop_on_inversion == 1);
+  TEST_TRUE(so->tolerance_mode == FCM_NEWTON_TOL_RELATIVE);
 
   const fcm_scene_time *t = fcm_scene_get_time(s);
   TEST_TRUE(t->integrator == FCM_INTEGRATOR_BACKWARD_EULER);
@@ -196,23 +199,25 @@ static void check_defaults(fcm_ctx *ctx)
   TEST_TRUE(fcm_scene_get_geometry(s)->has_transform == 0);
   const fcm_material *m = fcm_scene_get_material(s);
   TEST_TRUE(m->model == FCM_MATERIAL_STABLE_NEO_HOOKEAN && m->density == 1000);
-  const fcm_scene_quadrature *q = fcm_scene_get_quadrature(s);
-  TEST_TRUE(q->stiffness_strength == -1 && q->mass_strength == -1 && q->surface_strength == -1);
-  TEST_TRUE(q->simplify == 1 && q->simplify_method == FCM_SIMPLIFY_AUTO);
+  const fcm_cell_rules_options *q = &fcm_scene_get_quadrature(s)->rules;
+  TEST_TRUE(q->strength[FCM_RULE_STIFFNESS] == -1 && q->strength[FCM_RULE_MASS] == -1 &&
+            q->surface_strength == -1);
+  TEST_TRUE(q->simplify == 1 && q->simplify_options.method == FCM_SIMPLIFY_AUTO);
   TEST_TRUE(q->stabilization.mode == FCM_STABILIZATION_MASS_STIFFNESS);
   TEST_TRUE(q->stabilization.alpha == 1e-6 && q->min_fraction == 1e-4);
-  const fcm_scene_solver *so = fcm_scene_get_solver(s);
-  TEST_TRUE(so->method == FCM_LINEAR_DIRECT && so->direct == FCM_DIRECT_CHOLMOD);
+  const fcm_scene_solver *sv = fcm_scene_get_solver(s);
+  const fcm_integrator_options *so = &sv->integrator;
+  TEST_TRUE(so->linear_solver == FCM_LINEAR_DIRECT && so->direct_method == FCM_DIRECT_CHOLMOD);
   TEST_TRUE(so->preconditioner == FCM_PRECOND_SCHWARZ);
-  TEST_TRUE(so->schwarz_threshold == 0.5 && so->schwarz.epsilon == 1e-13 &&
+  TEST_TRUE(so->schwarz_theta == 0.5 && so->schwarz.epsilon == 1e-13 &&
             so->schwarz.clamp == FCM_SCHWARZ_CLAMP);
-  TEST_TRUE(so->rtol == 1e-8 && so->atol == 0 && so->max_iterations == 1000);
-  TEST_TRUE(so->stagnation_window == 50);
-  TEST_TRUE(so->newton_rtol == 1e-5 && so->newton_max_iterations == 100);
+  TEST_TRUE(so->krylov_rtol == 1e-8 && so->krylov_atol == 0 && so->krylov_max_iterations == 1000);
+  TEST_TRUE(so->krylov_stagnation_window == 50);
+  TEST_TRUE(so->newton_tolerance == 1e-5 && so->newton_max_iterations == 100);
   TEST_TRUE(so->line_search == 1 && so->project_psd == 0);
-  TEST_TRUE(so->representative_acceleration == 9.81 && so->threads == FCM_DEFAULT);
-  TEST_TRUE(so->stop_on_inversion == 0); /* "warn" */
-  TEST_TRUE(so->newton_rule == FCM_NEWTON_TOL_AUTO);
+  TEST_TRUE(so->rep_acceleration == 9.81 && sv->threads == FCM_DEFAULT);
+  TEST_TRUE(sv->stop_on_inversion == 0); /* "warn" */
+  TEST_TRUE(so->tolerance_mode == FCM_NEWTON_TOL_AUTO);
   const fcm_scene_time *t = fcm_scene_get_time(s);
   TEST_TRUE(t->integrator == FCM_INTEGRATOR_BACKWARD_EULER && t->dt == 1.0 / 60.0 &&
             t->num_steps == 60 && t->load_steps == 1);

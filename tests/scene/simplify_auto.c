@@ -39,7 +39,7 @@ static char *summary(fcm_ctx *ctx, const char *json, fcm_cell_simplify expect)
   size_t len = 0;
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "auto.json", &scene));
   if (!scene) return NULL;
-  TEST_TRUE(fcm_scene_get_quadrature(scene)->simplify == expect);
+  TEST_TRUE(fcm_scene_get_quadrature(scene)->rules.simplify == expect);
   TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
   FILE *f = open_memstream(&text, &len);
   if (sim && f) fcm_simulation_summary_view(sim, f);

@@ -3,6 +3,8 @@
 # motion/velocity formulas; allocation-failure torture.
 fcm_add_test(scene_parse tests/scene/parse.c)
 fcm_add_test(scene_errors tests/scene/errors.c)
+# The solver and quadrature sections start from the library's option defaults (no drift).
+fcm_add_test(scene_defaults tests/scene/defaults.c)
 fcm_add_test(scene_alloc tests/scene/alloc.c)
 fcm_add_test(scene_default tests/scene/default.c
              ARGS ${PROJECT_SOURCE_DIR}/apps/scenes/twisting_cylinder.json)

@@ -78,7 +78,7 @@ int main(void)
   TEST_OK(x.ctx, beam_mesh(x.ctx, FCM_ELEMENT_HEX8, 2, 2.0, &mesh));
   TEST_OK(x.ctx, fcm_geometry_create_box(x.ctx, lo, hi, n, &g));
   fcm_cell_rules_options ro = fcm_cell_rules_options_default();
-  ro.num_threads = 1;
+  TEST_OK(x.ctx, fcm_ctx_set_num_threads(x.ctx, 1));
   ro.surface_strength = 2;
   TEST_OK(x.ctx, fcm_cell_rules_create(x.ctx, mesh, g, &ro, &rules));
   TEST_OK(x.ctx, fcm_space_create_embedded(x.ctx, mesh, rules, &x.space));

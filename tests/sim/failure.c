@@ -119,6 +119,7 @@ int main(int argc, char **argv)
   {
     fcm_integrator_options o = fcm_integrator_options_default();
     o.kind = FCM_INTEGRATOR_STATIC;
+    o.tolerance_mode = FCM_NEWTON_TOL_REPRESENTATIVE;
     o.dt = 1.0;
     o.max_backtracks = 0;
     o.max_halvings = 0;
@@ -183,6 +184,7 @@ int main(int argc, char **argv)
     fcm_material light = mat;
     light.density = 0.0;
     o.kind = FCM_INTEGRATOR_STATIC;
+    o.tolerance_mode = FCM_NEWTON_TOL_REPRESENTATIVE;
     TEST_OK(ctx, fcm_integrator_create(ctx, space, &light, &o, &integ));
     TEST_ERR(ctx, fcm_integrator_setup(integ), FCM_ERR_ARG, "representative force");
     fcm_integrator_destroy(&integ);

@@ -100,18 +100,18 @@ int main(int argc, char **argv)
   fcm_scene *scene = NULL;
   TEST_OK(ctx, fcm_scene_create_from_string(
                    ctx, scene_json(json, sizeof json, "\"method\": \"minres\""), "<t>", &scene));
-  TEST_TRUE(scene &&
-            fcm_scene_get_solver(scene)->preconditioner_tangent == FCM_FICTITIOUS_PROJECTED);
+  TEST_TRUE(scene && fcm_scene_get_solver(scene)->integrator.preconditioner_tangent ==
+                         FCM_PC_TANGENT_PROJECTED);
   fcm_scene_destroy(&scene);
   static const char *const names[] = {"projected", "linear", "exact"};
-  static const fcm_fictitious_model models[] = {FCM_FICTITIOUS_PROJECTED, FCM_FICTITIOUS_LINEAR,
-                                                FCM_FICTITIOUS_EXACT};
+  static const fcm_preconditioner_tangent models[] = {FCM_PC_TANGENT_PROJECTED,
+                                                      FCM_PC_TANGENT_LINEAR, FCM_PC_TANGENT_EXACT};
   for (int k = 0; k < 3; k++) {
     char solver[128];
     snprintf(solver, sizeof solver, "\"preconditioner_tangent\": \"%s\"", names[k]);
     TEST_OK(ctx, fcm_scene_create_from_string(ctx, scene_json(json, sizeof json, solver), "<t>",
                                               &scene));
-    TEST_TRUE(scene && fcm_scene_get_solver(scene)->preconditioner_tangent == models[k]);
+    TEST_TRUE(scene && fcm_scene_get_solver(scene)->integrator.preconditioner_tangent == models[k]);
     fcm_scene_destroy(&scene);
   }
   TEST_ERR(
@@ -130,8 +130,8 @@ int main(int argc, char **argv)
     if (sim) {
       fcm_integrator_options o = fcm_integrator_options_default();
       const fcm_material mat = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 5e6, 0.45, 1000.0};
-      TEST_TRUE(o.preconditioner_tangent == FCM_FICTITIOUS_PROJECTED);
-      o.preconditioner_tangent = FCM_FICTITIOUS_MODEL_COUNT;
+      TEST_TRUE(o.preconditioner_tangent == FCM_PC_TANGENT_PROJECTED);
+      o.preconditioner_tangent = FCM_PC_TANGENT_COUNT;
       TEST_OK(ctx, fcm_integrator_create(ctx, fcm_simulation_space(sim), &mat, &o, &I));
       if (I) TEST_ERR(ctx, fcm_integrator_setup(I), FCM_ERR_ARG, "preconditioner_tangent");
       fcm_integrator_destroy(&I);

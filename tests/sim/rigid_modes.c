@@ -266,6 +266,7 @@ static void test_stagnation(fcm_ctx *ctx)
     fcm_integrator_options o = fcm_integrator_options_default();
     o.tolerance_mode = FCM_NEWTON_TOL_RELATIVE;
     o.linear_solver = k == 0 ? FCM_LINEAR_CG : FCM_LINEAR_MINRES;
+    o.preconditioner = FCM_PRECOND_JACOBI;
     o.max_halvings = 1;
     if (k == 2) o.krylov_stagnation_window = 0;
     TEST_OK(ctx, fcm_integrator_create(ctx, space, &mat, &o, &I));
@@ -305,7 +306,9 @@ static fcm_status alloc_step(fcm_ctx *ctx, failing *f, long long k, const fcm_sp
   const fcm_motion held = fcm_motion_default();
   fcm_integrator_options o = fcm_integrator_options_default();
   o.kind = FCM_INTEGRATOR_STATIC;
+  o.tolerance_mode = FCM_NEWTON_TOL_REPRESENTATIVE;
   o.linear_solver = FCM_LINEAR_CG;
+  o.preconditioner = FCM_PRECOND_JACOBI;
   fcm_status st = fcm_integrator_create(ctx, space, &mat, &o, &I);
   if (st == FCM_OK) st = fcm_integrator_add_gravity(I, g, NULL, NULL);
   if (st == FCM_OK) st = fcm_integrator_add_constraint(I, nfix, fix, &held, NULL);

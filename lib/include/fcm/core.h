@@ -80,19 +80,24 @@ typedef struct fcm_ctx_options {
   void *log_user;          /**< passed to `log` */
   fcm_log_level log_level; /**< messages above this level are not formatted (default
                                 WARNING: errors and warnings) */
+  int num_threads;         /**< OpenMP threads of the library's thread-count-aware loops (the
+                                cut-cell rules, fcm_cell_rules_create()), >= 1; FCM_DEFAULT
+                                (default): the OpenMP default, omp_get_max_threads(). Results
+                                do not depend on it. fcm_ctx_set_num_threads() changes it */
 } fcm_ctx_options;
 
 /** The root object: allocator, log callback, last error. No global state exists
  * elsewhere; objects created from a context must be destroyed before it. */
 typedef struct fcm_ctx fcm_ctx;
 
-/** Default options: system allocator, no logging, level FCM_LOG_WARNING. */
+/** Default options: system allocator, no logging, level FCM_LOG_WARNING, FCM_DEFAULT threads. */
 FCM_API fcm_ctx_options fcm_ctx_options_default(void);
 
 /** Create a context.
  * @param[in]  opts options, copied; NULL means fcm_ctx_options_default()
  * @param[out] ctx  the new context, NULL on failure
- * @return FCM_OK, FCM_ERR_ARG (ctx NULL, allocator half set), FCM_ERR_ALLOC.
+ * @return FCM_OK, FCM_ERR_ARG (ctx NULL, allocator half set, num_threads neither >= 1 nor
+ *         FCM_DEFAULT), FCM_ERR_ALLOC.
  * Allocates through the given allocator. Thread safe. */
 FCM_API fcm_status fcm_ctx_create(const fcm_ctx_options *opts, fcm_ctx **ctx);
 
@@ -102,6 +107,15 @@ FCM_API void fcm_ctx_destroy(fcm_ctx **ctx);
 /** Number of allocations made through `ctx` and not yet released (0 when every
  * object created from it has been destroyed). */
 FCM_API long long fcm_ctx_live_allocations(const fcm_ctx *ctx);
+
+/** The context's thread count (fcm_ctx_options.num_threads): the number set, or the OpenMP
+ * default (omp_get_max_threads()) for FCM_DEFAULT or a NULL ctx; always >= 1. */
+FCM_API int fcm_ctx_num_threads(const fcm_ctx *ctx);
+
+/** Set the context's thread count: num_threads >= 1, or FCM_DEFAULT for the OpenMP default.
+ * @return FCM_OK, FCM_ERR_ARG (ctx NULL, num_threads out of range: named). No allocation;
+ * not while another thread calls the library with `ctx`. */
+FCM_API fcm_status fcm_ctx_set_num_threads(fcm_ctx *ctx, int num_threads);
 
 /** Status of the last error recorded in `ctx` (FCM_OK when none). */
 FCM_API fcm_status fcm_ctx_error_status(const fcm_ctx *ctx);

@@ -114,13 +114,12 @@ typedef struct fcm_cell_rules_options {
                                with FCM_ERR_UNSUPPORTED naming the cell, the estimate and the
                                limit; default 4 GiB; 0: no limit */
   fcm_stabilization_options stabilization; /**< default mass + stiffness, alpha 1e-6 */
-  int num_threads; /**< OpenMP threads >= 1; FCM_DEFAULT (default): the OpenMP default */
-  fcm_cell_rules_progress_fn progress; /**< NULL (default): none; else called with the cells
-                              done so far, at most every progress_interval seconds and once
-                              with done == total at the end of the cell loop, always from the
-                              thread that called fcm_cell_rules_create() */
-  void *progress_user;                 /**< passed to progress; default NULL */
-  double progress_interval;            /**< seconds between progress calls, >= 0; default 0.1 */
+  fcm_cell_rules_progress_fn progress;     /**< NULL (default): none; else called with the cells
+                                  done so far, at most every progress_interval seconds and once
+                                  with done == total at the end of the cell loop, always from the
+                                  thread that called fcm_cell_rules_create() */
+  void *progress_user;                     /**< passed to progress; default NULL */
+  double progress_interval;                /**< seconds between progress calls, >= 0; default 0.1 */
   /** NULL (default): every cell's rules; else num_cells flags (read during the call only):
    * cells flagged 0 are classified as usual (class, volume fraction, pieces and their volumes,
    * so a space built on the rules has the same elements and DOFs) but get no quadrature points
@@ -211,7 +210,8 @@ typedef struct fcm_cell_rules fcm_cell_rules;
  * clipping by the cell's face planes, fan tetrahedralization, tet rules mapped into the
  * reference cell (closed-form inverse for affine cells, Newton otherwise), classification;
  * then per cut cell simplification (if enabled) followed by stabilization points (flag 1).
- * Parallel over cells (OpenMP); the output does not depend on the thread count. With
+ * Parallel over cells (OpenMP, fcm_ctx_num_threads(ctx) threads); the output does not depend on
+ * the thread count. With
  * FCM_CELL_SIMPLIFY_AUTO the choice per kind depends on measured times; the rules are then
  * exactly those of OFF or of ON for that kind.
  * @param[in] mesh background mesh; every cell must be convex (straight edges, planar faces)

@@ -101,70 +101,32 @@ typedef struct fcm_scene_geometry {
                                FCM_LEVEL_SET_MAX_SUBCELLS; 0: no limit) */
 } fcm_scene_geometry;
 
-/** Quadrature settings ("quadrature"). The enums and option structs are the library's own
- * (fcm/simplify.h); "automatic" strengths are FCM_DEFAULT. */
+/** Quadrature settings ("quadrature"): the library's cell-rules options with the library's
+ * defaults (fcm_cell_rules_options_default(), documented in fcm/embed.h). The keys set:
+ * "stiffness_strength" and "mass_strength" rules.strength[FCM_RULE_STIFFNESS / MASS] (0 gives
+ * the cut cells a strength-0 rule and keeps the element's rule on full cells);
+ * "surface_strength" rules.surface_strength, whose FCM_DEFAULT means automatic here (the
+ * stiffness strength when a traction or pressure effect, or a fixed or motion effect on the
+ * "boundary", is present, else no surface rules); "simplify" rules.simplify (true, false or
+ * "auto"); "simplify_method" rules.simplify_options.method; "stabilization" rules.stabilization;
+ * "min_fraction" rules.min_fraction; "max_rule_memory_gib" rules.max_rule_memory (in bytes
+ * here: GiB x 2^30). The members the runner sets (kinds, expected_assemblies, progress,
+ * cell_mask) keep their defaults. */
 typedef struct fcm_scene_quadrature {
-  int stiffness_strength; /**< [0, 20]; FCM_DEFAULT (default): the element's default */
-  int mass_strength;      /**< [0, 20]; FCM_DEFAULT (default): the element's default */
-  int surface_strength; /**< [0, 20]; FCM_DEFAULT (default): automatic (the stiffness strength when
-                           a traction or pressure effect, or a fixed or motion effect on the
-                           "boundary", is present, else no surface rules) */
-  fcm_cell_simplify simplify;          /**< "simplify": true (FCM_CELL_SIMPLIFY_ON, default), false
-                                            (OFF) or "auto" (AUTO: per rule kind, where it pays for the
-                                            assemblies the run expects; see fcm_simulation_create()) */
-  fcm_simplify_method simplify_method; /**< "simplify_method": "auto" (default), "lp",
-                                            "recombine", "eliminate" */
-  fcm_stabilization_options stabilization; /**< "stabilization": mode "mass_stiffness"
-                                                (default), "mass", "off"; alpha in (0, 1],
-                                                default 1e-6 */
-  double min_fraction;        /**< cells with smaller volume fraction are dropped; [0, 1),
-                                   default 1e-4 */
-  double max_rule_memory_gib; /**< fcm_cell_rules_options.max_rule_memory in GiB; [0, 2^20],
-                                   default 4; 0: no limit */
+  fcm_cell_rules_options rules;
 } fcm_scene_quadrature;
 
-/** Solver settings ("solver"), in the library's own types (fcm/sim.h, fcm/solve.h). */
+/** Solver settings ("solver"): the library's integrator options with the library's defaults
+ * (fcm_integrator_options_default(), documented in fcm/sim.h, where each member names its key),
+ * and the scene's own keys. The members set by other sections keep their defaults here and are
+ * set by the runner: kind, dt and load_steps ("time"), rayleigh_mass and rayleigh_stiffness
+ * (the "damping" effect), assembly ("quadrature"). "multigrid" needs a hex8 or hex20 "grid"
+ * background; its "jacobi" smoother defaults to omega 0.6. */
 typedef struct fcm_scene_solver {
-  fcm_linear_solver method;                    /**< "direct" (default), "minres", "cg",
-                                                    "multigrid" (FCM_LINEAR_MULTIGRID) */
-  fcm_direct_method direct;                    /**< default FCM_DIRECT_CHOLMOD */
-  fcm_preconditioner preconditioner;           /**< Krylov only: "none", "jacobi", "block_jacobi",
-                                                    "schwarz" (default), "multigrid" */
-  fcm_fictitious_model preconditioner_tangent; /**< "preconditioner_tangent": the tangent
-                                      the preconditioner is built from, "projected" (default),
-                                      "linear", "exact"
-                                      (fcm_integrator_options.preconditioner_tangent) */
-  double schwarz_threshold;    /**< cut cells with volume fraction below it get a block; (0, 1],
-                                    default 0.5 (fcm_integrator_options.schwarz_theta) */
-  fcm_schwarz_options schwarz; /**< epsilon in (0, 1), default 1e-13; clamp "clamp" (default,
-                                    FCM_SCHWARZ_CLAMP) or "paper" (FCM_SCHWARZ_PAPER) */
-  fcm_mg_options multigrid;    /**< "multigrid": smoother "sgs" (default), "jacobi",
-                                    "sgs-colored"; omega in (0, 2) for SGS (default 1), (0, 1]
-                                    for Jacobi (default 0.6); pre_smooth, post_smooth in
-                                    [0, 100] (default 1 each, at least one step, equal for a
-                                    preconditioner); cycle "v" (default, cycle_index 1) or "w"
-                                    (2); coarse_dofs in [1, 1e9] (default 2000);
-                                    block_smoothing true (default) or false. Used by
-                                    "method": "multigrid" and "preconditioner": "multigrid",
-                                    which need a hex8 or hex20 "grid" background */
-  double rtol;                 /**< Krylov (and multigrid solver) relative tolerance; [0, 1),
-                                    default 1e-8 */
-  double atol;                 /**< Krylov absolute tolerance; >= 0, default 0 */
-  int max_iterations;          /**< Krylov iterations (multigrid solver: cycles) per solve;
-                                    >= 1, default 1000 */
-  int stagnation_window;       /**< "cg" and "minres": a solve whose smallest residual drops
-                                    by less than 0.1 % in this many iterations stops as
-                                    stagnated (fcm_integrator_options.krylov_stagnation_window);
-                                    [0, 1e9], default 50, 0: off */
-  fcm_newton_tolerance newton_rule;   /**< "auto" (default, FCM_NEWTON_TOL_AUTO),
-                                           "representative", "relative" */
-  double newton_rtol;                 /**< tolerance of the rule; (0, 1), default 1e-5 */
-  int newton_max_iterations;          /**< >= 1, default 100 */
-  int line_search;                    /**< 1 (default): backtracking line search */
-  int project_psd;                    /**< 1: project element tangents to PSD; default 0 */
-  double representative_acceleration; /**< |a_rep| in m/s^2, > 0, default 9.81 */
-  int threads; /**< OpenMP threads >= 1; FCM_DEFAULT ("threads": 0, the default): the OpenMP
-                    default */
+  fcm_integrator_options integrator; /**< the solver keys (fcm/sim.h) */
+  int threads;               /**< "threads": OpenMP threads >= 1, or FCM_DEFAULT ("threads": 0, the
+                                  default): the context's own count. When given, fcm_simulation_create() makes
+                                  it the context's thread count (fcm_ctx_set_num_threads()) */
   const char *petsc_options; /**< "petsc_options": PETSc options for the PETSc backend
                                   (fcm/petsc.h, `fcm-sim --backend petsc`), e.g. "-ksp_type
                                   minres -pc_type jacobi"; the command line wins for a key both

@@ -91,6 +91,22 @@ typedef enum fcm_preconditioner {
   FCM_PRECOND_MULTIGRID = 4
 } fcm_preconditioner;
 
+/** The material tangent the Krylov preconditioner (Jacobi, block Jacobi, Schwarz, multigrid)
+ * is built from, while the Krylov operator stays the exact Newton matrix base + K(u) (base:
+ * the mass and damping terms). Without effect when the Newton matrix has a PSD tangent already
+ * (project_psd, a linear material, a projection fallback). Scene key
+ * "solver.preconditioner_tangent": "projected", "linear", "exact". */
+typedef enum fcm_preconditioner_tangent {
+  /** base + the PSD-projected tangent at the iterate (one more tangent assembly per
+   * preconditioner setup); the Schwarz blocks of small cut cells are then positive definite
+   * instead of indefinite or nearly singular, and the preconditioner is SPD as MINRES
+   * requires (default) */
+  FCM_PC_TANGENT_PROJECTED = 0,
+  FCM_PC_TANGENT_LINEAR = 1, /**< base + the linear-elastic stiffness at rest (assembled once) */
+  FCM_PC_TANGENT_EXACT = 2,  /**< the Newton matrix itself */
+  FCM_PC_TANGENT_COUNT
+} fcm_preconditioner_tangent;
+
 /** A Newton iteration as reported to the monitor. */
 typedef struct fcm_newton_event {
   double time;           /**< end time of the (sub)step being solved */
@@ -107,61 +123,66 @@ typedef struct fcm_newton_event {
 /** Monitor callback, called after every Newton iteration (must not call the integrator). */
 typedef void (*fcm_newton_monitor_fn)(void *user, const fcm_newton_event *event);
 
-/** Options; initialize with fcm_integrator_options_default(). */
+/** Options; initialize with fcm_integrator_options_default(). These defaults are also the
+ * scene's (the "solver" section of a scene file embeds this struct, fcm/scene.h; the key of
+ * each member there is given in brackets). */
 typedef struct fcm_integrator_options {
-  fcm_integrator_kind kind;            /**< default BACKWARD_EULER */
+  fcm_integrator_kind kind;            /**< default BACKWARD_EULER (scene: "time.static",
+                                            "time.integrator") */
   double dt;                           /**< step > 0: time step, or the pseudo-time of a static step
-                                            (default 1/60) */
-  int load_steps;                      /**< static: increments per step, >= 1 (default 1) */
+                                            (default 1/60; scene: "time.dt") */
+  int load_steps;                      /**< static: increments per step, >= 1 (default 1; scene:
+                                            "time.load_steps") */
   int max_halvings;                    /**< retries of a failed (sub)step with half the increment,
                                             0..20 (default 4) */
-  int newton_max_iterations;           /**< >= 1 (default 100) */
-  fcm_newton_tolerance tolerance_mode; /**< default FCM_NEWTON_TOL_REPRESENTATIVE */
-  double newton_tolerance;             /**< tol in (0, 1) (default 1e-5) */
+  int newton_max_iterations;           /**< >= 1 (default 100) ["newton.max_iterations"] */
+  fcm_newton_tolerance tolerance_mode; /**< default FCM_NEWTON_TOL_AUTO ["newton.rule"] */
+  double newton_tolerance;             /**< tol in (0, 1) (default 1e-5) ["newton.rtol"] */
   double newton_atol;                  /**< RELATIVE mode: absolute floor >= 0 (default 0) */
-  double rep_acceleration; /**< |a_rep| > 0 in m/s^2; FCM_DEFAULT (default): the magnitude of the
-                                first gravity load, or 9.81 without gravity. Its direction
-                                is that gravity's, else (1, 1, 1)/sqrt 3 */
-  int line_search;         /**< 1 (default): backtracking on E; 0: full Newton steps */
+  double rep_acceleration; /**< |a_rep| > 0 in m/s^2 (default 9.81); FCM_DEFAULT: the magnitude of
+                                the first gravity load, or 9.81 without gravity. Its direction
+                                is that gravity's, else (1, 1, 1)/sqrt 3
+                                ["newton.representative_acceleration"] */
+  int line_search;         /**< 1 (default): backtracking on E; 0: full Newton steps
+                                ["newton.line_search"] */
   double armijo;           /**< sufficient decrease c in (0, 0.5) (default 1e-4) */
   double backtrack;        /**< step factor in (0, 1) (default 0.5) */
   int max_backtracks;      /**< >= 0 (default 20) */
   int project_psd;         /**< 1: PSD-projected element tangents (default 0). Without it,
                                 a non-descent Newton direction is recomputed once with the
-                                projected tangent (counted as a projection fallback) */
-  fcm_linear_solver linear_solver;   /**< default FCM_LINEAR_DIRECT */
-  fcm_direct_method direct_method;   /**< first direct method (default CHOLMOD; UMFPACK: LU only) */
-  fcm_preconditioner preconditioner; /**< Krylov only (default JACOBI) */
-  fcm_fictitious_model preconditioner_tangent; /**< Krylov only: the material tangent the
-      preconditioner (Jacobi, block Jacobi, Schwarz, multigrid) is built from, while the Krylov
-      operator stays the exact Newton matrix base + K(u). The values of fcm_fictitious_model
-      name the tangent models: FCM_FICTITIOUS_PROJECTED (default): base + the PSD-projected
-      tangent at the iterate (one more tangent assembly per preconditioner setup); the
-      Schwarz blocks of small cut cells are then positive definite instead of indefinite or
-      nearly singular, and the preconditioner is SPD as MINRES requires;
-      FCM_FICTITIOUS_LINEAR: base + the linear-elastic stiffness at rest (assembled once);
-      FCM_FICTITIOUS_EXACT: the Newton matrix itself. Without effect when the Newton matrix
-      has a PSD tangent already (project_psd, linear material, projection fallback). */
-  double krylov_rtol;                          /**< in [0, 1) (default 1e-8) */
-  double krylov_atol;                          /**< >= 0 (default 0) */
-  int krylov_max_iterations;                   /**< >= 1 (default 1000) */
+                                projected tangent (counted as a projection fallback)
+                                ["newton.project_psd"] */
+  fcm_linear_solver linear_solver;   /**< default FCM_LINEAR_DIRECT ["method"] */
+  fcm_direct_method direct_method;   /**< first direct method (default CHOLMOD; UMFPACK: LU only)
+                                          ["direct"] */
+  fcm_preconditioner preconditioner; /**< Krylov only (default SCHWARZ: Jacobi outside the
+                                          blocks of the small cut cells) ["preconditioner"] */
+  fcm_preconditioner_tangent preconditioner_tangent; /**< Krylov only: the tangent the
+                                          preconditioner is built from (default
+                                          FCM_PC_TANGENT_PROJECTED) ["preconditioner_tangent"] */
+  double krylov_rtol;                                /**< in [0, 1) (default 1e-8) ["rtol"] */
+  double krylov_atol;                                /**< >= 0 (default 0) ["atol"] */
+  int krylov_max_iterations;                         /**< >= 1 (default 1000) ["max_iterations"] */
   int krylov_stagnation_window;  /**< CG and MINRES: stop a solve whose smallest residual dropped
                                       by less than 0.1 % in this many iterations
                                       (fcm_krylov_options.stagnation_window; >= 0, default 50,
                                       0: off). Its iterate is still used when finite and
                                       nonzero; when the Newton iteration then fails, the step's
-                                      reason is FCM_STEP_LINEAR_SOLVER_STAGNATED */
+                                      reason is FCM_STEP_LINEAR_SOLVER_STAGNATED
+                                      ["stagnation_window"] */
   double schwarz_theta;          /**< cut cells with volume fraction below it get a block, (0, 1]
-                                      (default 0.5) */
-  fcm_schwarz_options schwarz;   /**< default fcm_schwarz_options_default() */
+                                      (default 0.5) ["schwarz.threshold"] */
+  fcm_schwarz_options schwarz;   /**< default fcm_schwarz_options_default() ["schwarz.epsilon",
+                                      "schwarz.clamp"] */
   fcm_mg_options multigrid;      /**< FCM_PRECOND_MULTIGRID and FCM_LINEAR_MULTIGRID: the
                                       hierarchy's options (default fcm_mg_options_default(),
                                       ranges as documented there and checked at setup, plus
                                       pre_smooth + post_smooth >= 1, and pre_smooth =
-                                      post_smooth for the preconditioner) */
-  double rayleigh_mass;          /**< alpha_M >= 0 in 1/s (default 0) */
-  double rayleigh_stiffness;     /**< beta_K >= 0 in s (default 0) */
-  fcm_assembly_options assembly; /**< strengths on full cells (default element defaults) */
+                                      post_smooth for the preconditioner) ["multigrid"] */
+  double rayleigh_mass;          /**< alpha_M >= 0 in 1/s (default 0; scene: "damping") */
+  double rayleigh_stiffness;     /**< beta_K >= 0 in s (default 0; scene: "damping") */
+  fcm_assembly_options assembly; /**< strengths on full cells (default element defaults; scene:
+                                      "quadrature") */
   fcm_newton_monitor_fn monitor; /**< NULL (default) or a callback */
   void *monitor_user;
 } fcm_integrator_options;

@@ -2,6 +2,7 @@
  * last error with traceback, status strings. */
 #include "core_impl.h"
 
+#include <omp.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -52,6 +53,7 @@ fcm_ctx_options fcm_ctx_options_default(void)
   fcm_ctx_options o;
   memset(&o, 0, sizeof o);
   o.log_level = FCM_LOG_WARNING;
+  o.num_threads = FCM_DEFAULT;
   return o;
 }
 
@@ -61,6 +63,7 @@ fcm_status fcm_ctx_create(const fcm_ctx_options *opts, fcm_ctx **out)
   if (!out) return FCM_ERR_ARG;
   *out = NULL;
   if (!o.allocator.alloc != !o.allocator.release) return FCM_ERR_ARG;
+  if (o.num_threads < 1 && o.num_threads != FCM_DEFAULT) return FCM_ERR_ARG;
   if (!o.allocator.alloc) {
     o.allocator.alloc = sys_alloc;
     o.allocator.release = sys_release;
@@ -74,6 +77,24 @@ fcm_status fcm_ctx_create(const fcm_ctx_options *opts, fcm_ctx **out)
   ctx->err_status = FCM_OK;
   *out = ctx;
   return FCM_OK;
+}
+
+int fcm_ctx_num_threads(const fcm_ctx *ctx)
+{
+  if (ctx && ctx->opts.num_threads >= 1) return ctx->opts.num_threads;
+  const int n = omp_get_max_threads();
+  return n >= 1 ? n : 1;
+}
+
+fcm_status fcm_ctx_set_num_threads(fcm_ctx *ctx, int num_threads)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(ctx, ctx, FCM_ERR_ARG, "ctx: NULL context");
+  FCM_CHECK(num_threads >= 1 || num_threads == FCM_DEFAULT, ctx, FCM_ERR_ARG,
+            "ctx: num_threads = %d must be >= 1, or FCM_DEFAULT (-1)", num_threads);
+  ctx->opts.num_threads = num_threads;
+cleanup:
+  return st;
 }
 
 void fcm_ctx_destroy(fcm_ctx **ctx)

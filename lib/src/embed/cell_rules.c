@@ -4,7 +4,6 @@
 #include "embed/rules_impl.h"
 
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -29,7 +28,6 @@ fcm_cell_rules_options fcm_cell_rules_options_default(void)
   o.simplify_options = fcm_simplify_options_default();
   o.stabilization = fcm_stabilization_options_default();
   o.max_rule_memory = 4.0 * GIB;
-  o.num_threads = FCM_DEFAULT;
   o.progress = NULL;
   o.progress_user = NULL;
   o.progress_interval = 0.1;
@@ -67,7 +65,7 @@ static fcm_status build_rules_x(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_ge
   FCM_ALLOC(ctx, (size_t)nc, out);
   const double t_setup = fcm_wtime();
   /* 2. parallel per-cell work */
-  const int nthreads = o->num_threads > 0 ? o->num_threads : omp_get_max_threads();
+  const int nthreads = fcm_ctx_num_threads(ctx);
   FCM_TRY(ctx, fcm__embed_run_cells(&B, R, nthreads, out, &sums, o));
   if (x) FCM_TRY(ctx, fcm__embed_exchange_classes(&B, R, x, out, &sums, exchanged));
   if (o->simplify == FCM_CELL_SIMPLIFY_AUTO)

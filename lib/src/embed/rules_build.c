@@ -57,8 +57,6 @@ fcm_status fcm__embed_check_options(fcm_ctx *ctx, const fcm_cell_rules_options *
             "embed: progress_interval = %g must be finite and >= 0 seconds", o->progress_interval);
   FCM_CHECK(o->max_rule_memory >= 0.0 && !isnan(o->max_rule_memory), ctx, FCM_ERR_ARG,
             "embed: max_rule_memory = %g bytes must be >= 0 (0: no limit)", o->max_rule_memory);
-  FCM_CHECK(o->num_threads >= 1 || o->num_threads == FCM_DEFAULT, ctx, FCM_ERR_ARG,
-            "embed: num_threads = %d must be >= 1, or FCM_DEFAULT (-1)", o->num_threads);
   FCM_CHECK((int)o->stabilization.mode >= 0 &&
                 o->stabilization.mode < FCM_STABILIZATION_MODE_COUNT &&
                 (o->stabilization.mode == FCM_STABILIZATION_OFF ||

@@ -1855,7 +1855,7 @@ static fcm_status check_scene(fcm_ctx *ctx, const fcm_scene *scene)
       "scene %s: material.model: the PETSc backend solves linear elasticity only (\"linear\"); "
       "run this scene with the serial backend",
       name);
-  FCM_CHECK(fcm_scene_get_quadrature(scene)->simplify != FCM_CELL_SIMPLIFY_AUTO, ctx,
+  FCM_CHECK(fcm_scene_get_quadrature(scene)->rules.simplify != FCM_CELL_SIMPLIFY_AUTO, ctx,
             FCM_ERR_UNSUPPORTED,
             "scene %s: quadrature.simplify = \"auto\" is not supported by the PETSc backend (its "
             "choice would differ between processes); use true or false",
@@ -1944,7 +1944,7 @@ fcm_status fcm_petsc_problem_create_from_scene(fcm_ctx *ctx, MPI_Comm comm, cons
   if (st == FCM_OK) st = fcm__scene_mesh_geometry(ctx, scene, &mesh, &geom);
   FCM_TRY(ctx, fcm__petsc_agree(ctx, comm, st));
   /* the options as the serial runner derives them (lib/src/scene/run.c) */
-  const fcm_scene_quadrature *q = fcm_scene_get_quadrature(scene);
+  const fcm_cell_rules_options *q = &fcm_scene_get_quadrature(scene)->rules;
   const fcm_scene_solver *sv = fcm_scene_get_solver(scene);
   const fcm_scene_time *tm = fcm_scene_get_time(scene);
   fcm_petsc_options o = fcm_petsc_options_default();
@@ -1952,19 +1952,15 @@ fcm_status fcm_petsc_problem_create_from_scene(fcm_ctx *ctx, MPI_Comm comm, cons
   o.dt = tm->dt;
   o.partition = partition;
   o.petsc_options = sv->petsc_options;
-  o.rtol = sv->rtol > 0.0 ? sv->rtol : o.rtol;
-  o.max_iterations = sv->max_iterations;
-  o.rules.strength[FCM_RULE_STIFFNESS] = q->stiffness_strength;
-  o.rules.strength[FCM_RULE_MASS] = q->mass_strength;
+  o.rtol = sv->integrator.krylov_rtol > 0.0 ? sv->integrator.krylov_rtol : o.rtol;
+  o.max_iterations = sv->integrator.krylov_max_iterations;
+  o.rules = *q;
   o.rules.surface_strength = -1;
-  o.rules.min_fraction = q->min_fraction;
-  o.rules.max_rule_memory = q->max_rule_memory_gib * 1024.0 * 1024.0 * 1024.0;
-  o.rules.simplify = q->simplify;
-  o.rules.simplify_options.method = q->simplify_method;
-  o.rules.stabilization = q->stabilization;
-  o.rules.num_threads = sv->threads;
-  o.assembly.stiffness_strength = q->stiffness_strength > 0 ? q->stiffness_strength : FCM_DEFAULT;
-  o.assembly.mass_strength = q->mass_strength > 0 ? q->mass_strength : FCM_DEFAULT;
+  if (sv->threads > 0) FCM_TRY(ctx, fcm_ctx_set_num_threads(ctx, sv->threads));
+  const int *str = q->strength;
+  o.assembly.stiffness_strength =
+      str[FCM_RULE_STIFFNESS] > 0 ? str[FCM_RULE_STIFFNESS] : FCM_DEFAULT;
+  o.assembly.mass_strength = str[FCM_RULE_MASS] > 0 ? str[FCM_RULE_MASS] : FCM_DEFAULT;
   FCM_TRY(ctx,
           fcm_petsc_problem_create(ctx, comm, mesh, geom, fcm_scene_get_material(scene), &o, &P));
   P->own_mesh = mesh;
@@ -2444,9 +2440,11 @@ fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_sc
   {
     const fcm_scene_solver *sv = fcm_scene_get_solver(scene);
     P->opts.partition = partition;
-    P->direct = sv->method == FCM_LINEAR_DIRECT;
-    P->opts.rtol = sv->rtol > 0.0 ? sv->rtol : P->opts.rtol;
-    P->opts.max_iterations = sv->max_iterations > 0 ? sv->max_iterations : P->opts.max_iterations;
+    const fcm_integrator_options *io = &sv->integrator;
+    P->direct = io->linear_solver == FCM_LINEAR_DIRECT;
+    P->opts.rtol = io->krylov_rtol > 0.0 ? io->krylov_rtol : P->opts.rtol;
+    P->opts.max_iterations =
+        io->krylov_max_iterations > 0 ? io->krylov_max_iterations : P->opts.max_iterations;
     if (sv->petsc_options) {
       size_t len = strlen(sv->petsc_options);
       P->petsc_options = fcm__calloc(ctx, len + 1, 1);

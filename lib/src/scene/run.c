@@ -512,9 +512,9 @@ cleanup:
 static fcm_status build_rules(fcm_simulation *S)
 {
   fcm_status st = FCM_OK;
-  const fcm_scene_quadrature *q = fcm_scene_get_quadrature(S->scene);
+  const fcm_cell_rules_options *q = &fcm_scene_get_quadrature(S->scene)->rules;
   const fcm_scene_solver *sv = fcm_scene_get_solver(S->scene);
-  fcm_cell_rules_options ro = fcm_cell_rules_options_default();
+  fcm_cell_rules_options ro = *q;
   int nsurf = 0;
   for (int k = 0; k < fcm_scene_num_effects(S->scene); k++) {
     const fcm_effect *e = fcm_scene_get_effect(S->scene, k);
@@ -527,19 +527,10 @@ static fcm_status build_rules(fcm_simulation *S)
    * the piece volumes, see log_momentum()). */
   const int dynamic = fcm_scene_get_time(S->scene)->integrator != FCM_INTEGRATOR_STATIC;
   ro.kinds = FCM_RULES_STIFFNESS | (dynamic ? FCM_RULES_MASS : 0u);
-  ro.strength[FCM_RULE_STIFFNESS] = q->stiffness_strength;
-  ro.strength[FCM_RULE_MASS] = q->mass_strength;
-  if (q->surface_strength >= 0)
-    ro.surface_strength = q->surface_strength;
-  else if (nsurf > 0)
-    ro.surface_strength = q->stiffness_strength >= 0
-                              ? q->stiffness_strength
+  if (q->surface_strength < 0 && nsurf > 0) /* automatic */
+    ro.surface_strength = q->strength[FCM_RULE_STIFFNESS] >= 0
+                              ? q->strength[FCM_RULE_STIFFNESS]
                               : fcm_mesh_get_element_info(S->mesh)->stiffness_strength;
-  else
-    ro.surface_strength = -1;
-  ro.min_fraction = q->min_fraction;
-  ro.max_rule_memory = q->max_rule_memory_gib * 1024.0 * 1024.0 * 1024.0;
-  ro.simplify = q->simplify;
   if (q->simplify == FCM_CELL_SIMPLIFY_AUTO) {
     /* The assemblies the run expects: stiffness-kind rules (force + tangent, body forces) once
      * per Newton iteration, about RUN_ASSEMBLIES_PER_STEP per step and load step; mass rules
@@ -549,9 +540,7 @@ static fcm_status build_rules(fcm_simulation *S)
         RUN_ASSEMBLIES_PER_STEP * (double)tm->num_steps * (dynamic ? 1.0 : (double)tm->load_steps);
     ro.expected_assemblies[FCM_RULE_MASS] = dynamic ? 1.0 : 0.0;
   }
-  ro.simplify_options.method = q->simplify_method;
-  ro.stabilization = q->stabilization;
-  ro.num_threads = sv->threads;
+  if (sv->threads > 0) FCM_TRY(S->ctx, fcm_ctx_set_num_threads(S->ctx, sv->threads));
   ro.progress = S->opts.rules_progress;
   ro.progress_user = S->opts.rules_progress_user;
   ro.progress_interval = S->opts.rules_progress_interval;
@@ -574,36 +563,16 @@ cleanup:
 
 static fcm_integrator_options integrator_options(fcm_simulation *S)
 {
-  const fcm_scene_quadrature *q = fcm_scene_get_quadrature(S->scene);
-  const fcm_scene_solver *sv = fcm_scene_get_solver(S->scene);
+  const int *q = fcm_scene_get_quadrature(S->scene)->rules.strength;
   const fcm_scene_time *tm = fcm_scene_get_time(S->scene);
-  fcm_integrator_options o = fcm_integrator_options_default();
+  fcm_integrator_options o = fcm_scene_get_solver(S->scene)->integrator;
   o.kind = tm->integrator;
   o.dt = tm->dt;
   o.load_steps = tm->load_steps;
-  o.newton_max_iterations = sv->newton_max_iterations;
-  o.newton_tolerance = sv->newton_rtol;
-  /* AUTO: static scenes have no mass and no inertia; the force-balance (relative) rule needs
-   * neither, where the representative force would take a body-force pass of its own. */
-  o.tolerance_mode = sv->newton_rule;
-  o.rep_acceleration = sv->representative_acceleration;
-  o.line_search = sv->line_search;
-  o.project_psd = sv->project_psd;
-  o.linear_solver = sv->method;
-  o.direct_method = sv->direct;
-  o.preconditioner = sv->preconditioner;
-  o.preconditioner_tangent = sv->preconditioner_tangent;
-  o.krylov_rtol = sv->rtol;
-  o.krylov_atol = sv->atol;
-  o.krylov_max_iterations = sv->max_iterations;
-  o.krylov_stagnation_window = sv->stagnation_window;
-  o.schwarz_theta = sv->schwarz_threshold;
-  o.schwarz = sv->schwarz;
-  o.multigrid = sv->multigrid;
   /* Full cells: the scene's strength, except that 0 keeps the element's rule there (as the
    * scene README documents for strength 0: only cut cells get the strength-0 rule). */
-  o.assembly.stiffness_strength = q->stiffness_strength > 0 ? q->stiffness_strength : FCM_DEFAULT;
-  o.assembly.mass_strength = q->mass_strength > 0 ? q->mass_strength : FCM_DEFAULT;
+  o.assembly.stiffness_strength = q[FCM_RULE_STIFFNESS] > 0 ? q[FCM_RULE_STIFFNESS] : FCM_DEFAULT;
+  o.assembly.mass_strength = q[FCM_RULE_MASS] > 0 ? q[FCM_RULE_MASS] : FCM_DEFAULT;
   for (int k = 0; k < fcm_scene_num_effects(S->scene); k++) {
     const fcm_effect *e = fcm_scene_get_effect(S->scene, k);
     const fcm__effect_type *t = fcm__scene_effect_type(e->type);
@@ -922,7 +891,7 @@ simulation_create(fcm_ctx *ctx, const fcm_scene *scene, const fcm_simulation_opt
               "quadrature.min_fraction = %g of its volume of the body (embedded volume %g of "
               "%g m^3): the body is too small or thin for the grid; refine the background or "
               "lower quadrature.min_fraction",
-              (long long)rs->num_cells, fcm_scene_get_quadrature(scene)->min_fraction,
+              (long long)rs->num_cells, fcm_scene_get_quadrature(scene)->rules.min_fraction,
               rs->embedded_volume, rs->geometry_volume);
     st = create_space(S, S->rules, S->cell_mask != NULL, &S->space);
     if (st != FCM_OK) fcm__error_prefix(ctx, "geometry");
@@ -1395,7 +1364,7 @@ static void line(FILE *f, int on, const char *what, const char *detail)
 static void multigrid_line(const fcm_simulation *S, FILE *f)
 {
   const fcm_mg *mg = fcm_integrator_multigrid(S->integ);
-  const fcm_mg_options *o = &fcm_scene_get_solver(S->scene)->multigrid;
+  const fcm_mg_options *o = &fcm_scene_get_solver(S->scene)->integrator.multigrid;
   char b[512];
   int len = 0;
   if (!mg) {
@@ -1533,7 +1502,7 @@ static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_
           fprintf(f, " %s %.3g", sides[k], rs->outside_side_volume[k]);
       fputc('\n', f);
     }
-    const fcm_scene_quadrature *q = fcm_scene_get_quadrature(S->scene);
+    const fcm_cell_rules_options *q = &fcm_scene_get_quadrature(S->scene)->rules;
     static const char *const kinds[FCM_RULE_KIND_COUNT] = {"stiffness", "mass"};
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
       const fcm_simplify_decision *d = &rs->decision[k];

@@ -1,5 +1,6 @@
 /* fcm scene, internal part: the JSON tree adapter (cJSON is touched only in
- * json_adapter.c), the typed readers that name JSON paths in errors, and the effect table. */
+ * json_adapter.c), the typed readers that name JSON paths in errors, the section parsers with
+ * the name tables they share with the summary, and the effect table. */
 #ifndef FCM_SCENE_IMPL_H
 #define FCM_SCENE_IMPL_H
 
@@ -172,6 +173,82 @@ fcm_status fcm__scene_check_object(fcm__scene_parser *p, const fcm__json *node,
 
 /* Copy a string into the scene. */
 fcm_status fcm__scene_strdup(fcm__scene_parser *p, const char *s, const char **out);
+
+/* ---------------------------------------------------------------- the sections */
+
+/* Number of entries of an array. */
+#define SCENE_COUNT(a) ((int)(sizeof(a) / sizeof *(a)))
+
+/* Read a choice into an enum of any integer type. */
+#define SCENE_READ_CHOICE(p, obj, key, required, names, out)                                       \
+  do {                                                                                             \
+    int ch_ = (int)(out);                                                                          \
+    FCM_TRY((p)->ctx, fcm__scene_read_choice((p), (obj), (key), (required), (names),               \
+                                             SCENE_COUNT(names), &ch_));                           \
+    (out) = ch_;                                                                                   \
+  } while (0)
+
+/* Read a choice given by names[i] into out = values[i] (the library's enum values, whose
+ * order need not be the names' order). */
+#define SCENE_READ_CHOICE_AS(p, obj, key, required, names, values, out)                            \
+  do {                                                                                             \
+    int ch_ = -1;                                                                                  \
+    FCM_TRY((p)->ctx, fcm__scene_read_choice((p), (obj), (key), (required), (names),               \
+                                             SCENE_COUNT(names), &ch_));                           \
+    if (ch_ >= 0) (out) = (values)[ch_]; /* an enum of the library */                              \
+  } while (0)
+
+/* The name of `value` in a names/values table (for the summary). */
+#define SCENE_CHOICE_NAME(names, values, value)                                                    \
+  fcm__scene_choice_name((names), (values), SCENE_COUNT(names), (int)(value))
+
+/* Read an integer member into an int-like destination. */
+#define SCENE_READ_INT(p, obj, key, required, lo, hi, out)                                         \
+  do {                                                                                             \
+    long long v_ = (long long)(out);                                                               \
+    FCM_TRY((p)->ctx, fcm__scene_read_int((p), (obj), (key), (required), (lo), (hi), &v_));        \
+    (out) = (int)v_;                                                                               \
+  } while (0)
+
+/* Push a key for the checks of one section; popped at cleanup by the caller's `old`. */
+#define SCENE_ENTER(p, key) fcm__scene_path_push_key((p), (key))
+
+/* The name of `value` among n names/values (the summary's names of library enums); "?" if none. */
+const char *fcm__scene_choice_name(const char *const *names, const int *values, int n, int value);
+
+/* Names of the scene's choices (scene.c), read by the section parsers and printed by the
+ * summary. Without a values table the index is the library's enum value. */
+extern const char *const fcm__scene_element_names[4];        /* fcm_element_type */
+extern const char *const fcm__scene_axis_names[3];           /* 0, 1, 2 */
+extern const char *const fcm__scene_implicit_names[7];       /* fcm_implicit_kind */
+extern const char *const fcm__scene_simplify_names[4];       /* fcm_simplify_method */
+extern const char *const fcm__scene_stabilization_names[3];  /* fcm_stabilization_mode */
+extern const char *const fcm__scene_solver_names[4];         /* with fcm__scene_solver_values */
+extern const int fcm__scene_solver_values[4];                /* fcm_linear_solver */
+extern const char *const fcm__scene_direct_names[2];         /* fcm_direct_method */
+extern const char *const fcm__scene_preconditioner_names[5]; /* fcm_preconditioner */
+extern const char *const fcm__scene_smoother_names[4];       /* with fcm__scene_smoother_values */
+extern const int fcm__scene_smoother_values[4];              /* fcm_mg_smoother */
+extern const char *const fcm__scene_clamp_names[2];          /* fcm_schwarz_clamp */
+extern const char *const fcm__scene_tangent_names[3];        /* fcm_preconditioner_tangent */
+extern const char *const fcm__scene_newton_rule_names[3];    /* with the values */
+extern const int fcm__scene_newton_rule_values[3];           /* fcm_newton_tolerance */
+extern const char *const fcm__scene_inversion_names[2];      /* stop_on_inversion 0, 1 */
+extern const char *const fcm__scene_integrator_names[1];     /* with the values */
+extern const int fcm__scene_integrator_values[1];            /* fcm_integrator_kind */
+
+/* The section parsers, in the order parse_root() calls them: each reads its member of the
+ * root object (absent and optional: the defaults) into p->scene and validates it; "geometry"
+ * after "background" (a level set samples the background grid), "solver" after it too
+ * (multigrid needs a hex grid). parse_model.c: background, geometry, material;
+ * parse_solver.c: quadrature, solver, time, output. */
+fcm_status fcm__scene_read_background(fcm__scene_parser *p, const fcm__json *root);
+fcm_status fcm__scene_read_geometry(fcm__scene_parser *p, const fcm__json *root);
+fcm_status fcm__scene_read_material(fcm__scene_parser *p, const fcm__json *root);
+fcm_status fcm__scene_read_quadrature(fcm__scene_parser *p, const fcm__json *root);
+fcm_status fcm__scene_read_solver(fcm__scene_parser *p, const fcm__json *root);
+fcm_status fcm__scene_read_time(fcm__scene_parser *p, const fcm__json *root);
+fcm_status fcm__scene_read_output(fcm__scene_parser *p, const fcm__json *root);
 
 /* ---------------------------------------------------------------- regions and effects */
 

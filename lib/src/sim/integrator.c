@@ -15,10 +15,10 @@ fcm_integrator_options fcm_integrator_options_default(void)
   o.load_steps = 1;
   o.max_halvings = 4;
   o.newton_max_iterations = 100;
-  o.tolerance_mode = FCM_NEWTON_TOL_REPRESENTATIVE;
+  o.tolerance_mode = FCM_NEWTON_TOL_AUTO;
   o.newton_tolerance = 1e-5;
   o.newton_atol = 0.0;
-  o.rep_acceleration = FCM_DEFAULT;
+  o.rep_acceleration = 9.81;
   o.line_search = 1;
   o.armijo = 1e-4;
   o.backtrack = 0.5;
@@ -26,8 +26,8 @@ fcm_integrator_options fcm_integrator_options_default(void)
   o.project_psd = 0;
   o.linear_solver = FCM_LINEAR_DIRECT;
   o.direct_method = FCM_DIRECT_CHOLMOD;
-  o.preconditioner = FCM_PRECOND_JACOBI;
-  o.preconditioner_tangent = FCM_FICTITIOUS_PROJECTED;
+  o.preconditioner = FCM_PRECOND_SCHWARZ;
+  o.preconditioner_tangent = FCM_PC_TANGENT_PROJECTED;
   o.krylov_rtol = 1e-8;
   o.krylov_atol = 0.0;
   o.krylov_max_iterations = 1000;
@@ -421,9 +421,8 @@ static fcm_status validate_options(fcm_ctx *ctx, const fcm_integrator_options *o
             "schwarz, multigrid)",
             (int)o->preconditioner);
   FCM_TRY(ctx, fcm__sim_multigrid_validate(ctx, o));
-  FCM_CHECK(o->preconditioner_tangent >= 0 &&
-                o->preconditioner_tangent < FCM_FICTITIOUS_MODEL_COUNT,
-            ctx, FCM_ERR_ARG,
+  FCM_CHECK(o->preconditioner_tangent >= 0 && o->preconditioner_tangent < FCM_PC_TANGENT_COUNT, ctx,
+            FCM_ERR_ARG,
             "integrator: preconditioner_tangent = %d outside [0, 2] (projected, linear, exact)",
             (int)o->preconditioner_tangent);
   FCM_CHECK(o->krylov_rtol >= 0.0 && o->krylov_rtol < 1.0, ctx, FCM_ERR_ARG,

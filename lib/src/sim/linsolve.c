@@ -138,10 +138,10 @@ static fcm_status pc_matrix(fcm_integrator *I, fcm_csr **P, fcm_step_reason *rea
 {
   fcm_status st = FCM_OK, s;
   fcm_ctx *ctx = I->ctx;
-  const fcm_fictitious_model tm = I->opts.preconditioner_tangent;
+  const fcm_preconditioner_tangent tm = I->opts.preconditioner_tangent;
   fcm_csr *K0 = NULL;
   *P = I->H;
-  if (tm == FCM_FICTITIOUS_EXACT || I->h_psd || I->opts.preconditioner == FCM_PRECOND_NONE)
+  if (tm == FCM_PC_TANGENT_EXACT || I->h_psd || I->opts.preconditioner == FCM_PRECOND_NONE)
     return FCM_OK;
   if (!I->Hpc) FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->Hpc));
   fcm_index nnz = 0;
@@ -149,7 +149,7 @@ static fcm_status pc_matrix(fcm_integrator *I, fcm_csr **P, fcm_step_reason *rea
   double *pv = fcm_csr_values(I->Hpc);
   const double h = I->key_h;
   fcm__sim_set_base(I, h, I->Hpc);
-  if (tm == FCM_FICTITIOUS_LINEAR) {
+  if (tm == FCM_PC_TANGENT_LINEAR) {
     if (!I->K0) { /* kept only when complete */
       fcm_linear_form form = fcm_linear_form_default();
       form.term = FCM_LINEAR_STIFFNESS;
