@@ -3,7 +3,8 @@
  * rotated box's planes reproduces the moments of the independent polytope integration;
  * on-plane vertices, coplanar faces and tolerance cases give the unchanged body or
  * nothing; polygons clip like polyhedra, with coplanar triangles kept by orientation; a
- * sliver with a flat flap splits into halves that add up to it. */
+ * sliver with a flat flap splits into halves that add up to it; a tiny face found on a
+ * plane leaves the cross-section around it closed. */
 #include "geom/geom_impl.h"
 #include "exact.h"
 #include "test.h"
@@ -292,6 +293,38 @@ static void flap_split(void)
   TEST_NEAR(ma[0] + mb[0], whole, 0.0, 1e-14 * K);
 }
 
+/* A tet clipped by a Kuhn cell's planes with a tolerance (1.4e-13) about as large as the
+ * distances between three vertices that the first plane leaves near a cell corner: the third
+ * plane finds that tiny triangle on it, and the cross-section around it must still be closed
+ * (taking the tiny face for the whole cap lost 17 % of the volume). Moments of degree <= 1
+ * against the independent polytope integration. */
+static void tiny_face_on_plane(void)
+{
+  double v[4][3] = {{-0.49999900000000003, 0.49999999999990002, -0.99999999900000003},
+                    {-0.5, -0.49999999999990002, -0.50000000000010003},
+                    {0.11489263943640204, -0.49999999899999997, 1.0000000000000001e-15},
+                    {-0.499999999999999, -0.45073224645856347, 0}};
+  double K[4][3] = {{-1, -1, -1}, {0, -1, -1}, {0, 0, -1}, {0, 0, 0}};
+  double X[12], Y[12];
+  for (int k = 0; k < 4; k++)
+    for (int d = 0; d < 3; d++)
+      X[3 * k + d] = v[k][d], Y[3 * k + d] = K[k][d];
+  fcm__geom_poly_from_cell(FCM_ELEMENT_TET4, X, &P);
+  TEST_TRUE(fcm__geom_poly_volume(&P) > 0.0);
+  fcm__plane cp[4];
+  fcm__geom_cell_planes(fcm_element_get_info(FCM_ELEMENT_TET4), Y, cp);
+  for (int f = 0; f < 4; f++)
+    TEST_TRUE(fcm__geom_poly_clip(&P, cp + f, 1.357e-13, &S) == 0);
+  exact_plane pl[8];
+  exact_tet_planes(v, pl);
+  exact_tet_planes(K, pl + 4);
+  double exact[EXACT_MAX_MONO] = {0}, got[4];
+  exact_polytope_add(pl, 8, 1, 1e-13, exact);
+  poly_moments(&P, got);
+  for (int k = 0; k < 4; k++)
+    TEST_NEAR(got[k], exact[k], 1e-12, 1e-14);
+}
+
 int main(void)
 {
   cube_corner_volumes();
@@ -301,5 +334,6 @@ int main(void)
   cell_planes_outward();
   polygon_clipping();
   flap_split();
+  tiny_face_on_plane();
   return TEST_RESULT();
 }

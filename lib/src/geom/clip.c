@@ -145,9 +145,11 @@ static void start_at_smallest(const fcm__poly *p, int *ids, int k)
  * kept part: every edge of the first nf faces of `out` with both ends on the plane (on[]) is
  * an edge of the cap, traversed the other way. Chaining these edges instead of sorting the
  * on-plane vertices by angle keeps the cap right where the tolerances left the part
- * slightly non-convex (a flat flap on a cut lying over the part's face). The closed walks
- * are split where they touch themselves; walks of two vertices (edges on the plane that
- * both their faces keep: no area) are dropped. cyc gets the cycles one after another, len
+ * slightly non-convex (a flat flap on a cut lying over the part's face). The kept faces that
+ * lie on the plane count too: their edges, reversed, cancel the others' along them, so the
+ * cap covers what those faces do not (nothing when one of them is the whole cross-section).
+ * The closed walks are split where they touch themselves; walks of two vertices (no area)
+ * are dropped. cyc gets the cycles one after another, len
  * their lengths. Returns their count, or -1 when the edges do not chain (a vertex with more
  * edges in than out, or too many edges). */
 static int cap_cycles(const fcm__poly *out, int nf, const unsigned char *on, int *cyc, int *len)
@@ -164,6 +166,11 @@ static int cap_cycles(const fcm__poly *out, int nf, const unsigned char *on, int
     }
   for (int i = 0; i < out->nv; i++)
     if (deg[i] != 0) return -1;
+  /* an edge and its reverse (an edge of a kept face lying on the plane, or an edge on the
+   * plane that both its faces keep) bound no area: both go */
+  for (int a = 0; a < ne; a++)
+    for (int b = a + 1; b < ne && !used[a]; b++)
+      if (!used[b] && from[b] == to[a] && to[b] == from[a]) used[a] = used[b] = 1;
   int ncyc = 0, total = 0, walk[CAP_EDGES + 1];
   for (int e0 = 0; e0 < ne; e0++) {
     if (used[e0]) continue;
@@ -270,7 +277,7 @@ int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__pol
         cyc[nc++] = e;
       }
     }
-    cap_face |= all_on;
+    cap_face |= all_on; /* kept: its edges close the cap's edges on it */
     /* a face with vertices outside and none inside keeps only on-plane vertices: what is
      * left of it lies in the cap (kept, it would be a second face on the cap's vertices) */
     if (!all_on && !inside) continue;
@@ -283,7 +290,7 @@ int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__pol
     }
   }
   const int nfaces_kept = out->nf;
-  if (!cap_face) {
+  {
     double scale = fabs(pl->d);
     for (int i = 0; i < p->nv; i++)
       for (int d = 0; d < 3; d++)
@@ -298,7 +305,7 @@ int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__pol
     if (ncyc >= 0) {
       for (int c = 0, at = 0; c < ncyc; at += len[c++])
         if (store_cap(out, pl, cyc + at, len[c], off) < 0) goto overflow;
-    } else {
+    } else if (!cap_face) {
       /* edges that do not chain into cycles (a part the tolerances left out of shape): the
        * on-plane vertices ordered by angle, the cap of the convex part it should be */
       int ids[FCM__POLY_MAX_VERTS], k = 0;
