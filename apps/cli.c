@@ -8,6 +8,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 int cli_double(const char *prog, const char *opt, const char *s, double lo, double hi,
                unsigned bounds, double *out)
@@ -308,6 +309,35 @@ void cli_output_abort(cli_output **out)
   fcm_ctx_destroy(&(*out)->ctx);
   free(*out);
   *out = NULL;
+}
+
+int cli_make_dirs(const char *prog, const char *dir)
+{
+  char buf[4096];
+  const size_t n = strlen(dir);
+  if (n == 0 || n >= sizeof buf) {
+    fprintf(stderr, "%s: bad output directory '%s'\n", prog, dir);
+    return 0;
+  }
+  memcpy(buf, dir, n + 1);
+  for (size_t k = 1; k <= n; k++) {
+    if (buf[k] != '/' && buf[k] != '\0') continue;
+    const char c = buf[k];
+    buf[k] = '\0';
+    struct stat sb;
+    if (stat(buf, &sb) != 0) {
+      if (mkdir(buf, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "%s: cannot create output directory '%s': %s\n", prog, buf,
+                strerror(errno));
+        return 0;
+      }
+    } else if (!S_ISDIR(sb.st_mode)) {
+      fprintf(stderr, "%s: output path '%s' exists and is not a directory\n", prog, buf);
+      return 0;
+    }
+    buf[k] = c;
+  }
+  return 1;
 }
 
 int cli_gnuplot_png(const char *prog, const char *size, const char *path, const char *body)

@@ -119,4 +119,8 @@ int cli_output_commit(const char *prog, cli_output **out);
 /** Remove the temporary and release *out; accepts NULL and *out == NULL. */
 void cli_output_abort(cli_output **out);
 
+/** mkdir -p: create the directory `dir` and its missing parents. 1 when it exists afterwards;
+ *  0 with a message (a path too long, a part that cannot be created or is not a directory). */
+int cli_make_dirs(const char *prog, const char *dir);
+
 #endif

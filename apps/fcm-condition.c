@@ -12,7 +12,7 @@
  * eliminated (removed), and every preconditioner is built on the reduced matrix
  * P = M + dt^2 K_pc with K_pc the PSD-projected tangent by default (--pc-tangent, as the
  * integrator's preconditioner_tangent): the exact tangent's small cut-cell blocks are
- * indefinite or nearly singular and their Schwarz inverses poor (issue 19). */
+ * indefinite or nearly singular and their Schwarz inverses poor. */
 #include "cli.h"
 #include "fcm-condition-study.h"
 #include "app_env.h"

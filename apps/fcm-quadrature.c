@@ -13,7 +13,7 @@
 /* ---------------------------------------------------------------- tables */
 
 /* Best published counts of positive interior rules (Witherden–Vincent and
- * successors), as given in the rule-tables issue; 0 = not listed. */
+ * successors); 0 = not listed. */
 static const int best_tet[21] = {0, 1,   4, 8,   14, 14,  24, 35,  46, 59, 79,
                                  0, 123, 0, 172, 0,  251, 0,  352, 0,  474};
 static const int best_hex_odd[11] = {1, 6, 14, 34, 58, 90, 148, 199, 282, 369, 505};

@@ -1,17 +1,14 @@
 /* fcm-rulegen: offline generator of the standard-rule tables in quadrature_tables/
  * by node elimination from the computed (tensor / collapsed) rules. */
-#define _POSIX_C_SOURCE 200809L /* mkdir */
 #include "app_env.h"
 #include <fcm/fcm.h>
 #include <fcm/rulegen.h>
 
 #include "cli.h"
 
-#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <time.h>
 
 #define RULEGEN_VERSION "0.1"
@@ -87,13 +84,6 @@ static fcm_rule *read_table(fcm_ctx *ctx, const char *path, fcm_shape shape)
   free(x);
   free(w);
   return rule;
-}
-
-static int ensure_dir(const char *path)
-{
-  if (mkdir(path, 0777) == 0 || errno == EEXIST) return 1;
-  fprintf(stderr, "fcm-rulegen: cannot create directory %s: %s\n", path, strerror(errno));
-  return 0;
 }
 
 static int write_table(const char *path, const fcm_rule *rule, const char *start_desc,
@@ -208,7 +198,7 @@ static int generate(fcm_ctx *ctx, const config *cfg, fcm_shape shape, int m)
   } else if (old > 0 && old < n && !cfg->force) {
     printf(", kept %s (%d points)\n", path, old);
   } else {
-    ok = ensure_dir(cfg->out) && ensure_dir(dir) &&
+    ok = cli_make_dirs("fcm-rulegen", dir) &&
          write_table(path, best, best_desc, best_start_n, best_start_m, &best_info, seconds);
     printf(ok ? ", wrote %s\n" : ", FAILED to write %s\n", path);
   }

@@ -4,7 +4,8 @@
  * "--x=v", aliases, flags and positionals, refuses unknown options and missing values, and
  * prints aligned help; cli_parse_args gives the exit codes; a number option takes one value per
  * metavar word; element names and lists (repeats refused) are read; output files appear only at
- * commit, and an abort or a write error leaves the previous file untouched and no temporary behind.
+ * commit, and an abort or a write error leaves the previous file untouched and no temporary behind;
+ * cli_make_dirs creates missing parents and refuses a file in the way.
  * argv[1]: a scratch directory. */
 #define _POSIX_C_SOURCE 200809L
 #include "../../apps/cli.c"
@@ -254,6 +255,41 @@ static void output(const char *work)
   rmdir(dir);
 }
 
+/* cli_make_dirs: missing parents are created, existing ones accepted; a file in the way, an
+ * empty path and one too long are refused. */
+static void make_dirs(const char *work)
+{
+  char top[4096], deep[4200], file[4200];
+  snprintf(top, sizeof top, "%s/cli-dirs", work);
+  snprintf(deep, sizeof deep, "%s/a/b", top);
+  snprintf(file, sizeof file, "%s/f", top);
+  remove(file);
+  rmdir(deep);
+  snprintf(file, sizeof file, "%s/a", top);
+  rmdir(file);
+  rmdir(top);
+  TEST_TRUE(cli_make_dirs("p", deep));
+  struct stat sb;
+  TEST_TRUE(stat(deep, &sb) == 0 && S_ISDIR(sb.st_mode));
+  TEST_TRUE(cli_make_dirs("p", deep)); /* already there */
+  snprintf(file, sizeof file, "%s/f", top);
+  FILE *f = fopen(file, "w");
+  TEST_TRUE(f != NULL);
+  if (f) fclose(f);
+  snprintf(deep, sizeof deep, "%s/f/g", top);
+  TEST_TRUE(!cli_make_dirs("p", deep));
+  TEST_TRUE(!cli_make_dirs("p", ""));
+  static char longpath[5000];
+  memset(longpath, 'x', sizeof longpath - 1);
+  TEST_TRUE(!cli_make_dirs("p", longpath));
+  remove(file);
+  snprintf(deep, sizeof deep, "%s/a/b", top);
+  rmdir(deep);
+  snprintf(file, sizeof file, "%s/a", top);
+  rmdir(file);
+  rmdir(top);
+}
+
 int main(int argc, char **argv)
 {
   if (argc != 2) return 2;
@@ -267,6 +303,7 @@ int main(int argc, char **argv)
   several_values();
   parse_args();
   output(argv[1]);
+  make_dirs(argv[1]);
   int rc = TEST_RESULT();
   if (rc != 0) {
     char line[512];

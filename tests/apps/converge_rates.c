@@ -8,7 +8,7 @@
  * (0.8 to 1.5 over other level choices; 1.10 and 1.22 fitted over res 6, 8, 10, 12, 16)
  * around the asymptotic first order. The rates in the rates CSV must equal a refit of the
  * levels CSV, and every FCM error is measured over all of Omega.
- * With --boundary nitsche (issue 18: the exact displacement imposed on the curved boundary by
+ * With --boundary nitsche (the exact displacement imposed on the curved boundary by
  * symmetric Nitsche instead of the traction; method fcm-nitsche) the same rates hold, with
  * tolerances L2 >= 1.8 / 2.7, H1 >= 0.9 / 1.8.
  * Usage: app_converge_rates quick|full PATH_TO_fcm-converge WORK_DIR
@@ -87,7 +87,7 @@ int main(int argc, char **argv)
               "--elements hex8,tet10 --methods fcm --levels 3,4,6 --geom-n 4", 3, &nr);
     check(n, nr, 3, "hex8", "fcm", 1.9, 2.6, 0.9, 1.6);
     check(n, nr, 3, "tet10", "fcm", 2.8, 3.6, 1.9, 2.6);
-    /* issue 18: the exact displacement imposed weakly on the curved boundary (symmetric
+    /* the exact displacement imposed weakly on the curved boundary (symmetric
      * Nitsche, --boundary nitsche): the same optimal rates (measured 2.08 / 1.07 for Hex8,
      * 2.97 / 1.96 for Tet10 on these levels) */
     n = study(prog, dir, "converge-rates-nitsche-quick",

@@ -9,7 +9,7 @@
  * residual)^(1/cycles) bound: factor^(cycles-1) >= final residual within a factor; the PNG is a
  * PNG (when gnuplot is installed); bad options exit 2 and write no CSV.
  * Mode quick / full (labels bench, slow): `--quick --check` / `--check` (the full study),
- * which must exit 0: the claims of issue 13 hold (see fcm-scaling --help), and write a CSV.
+ * which must exit 0: the claims hold (see fcm-scaling --help), and write a CSV.
  * Mode petsc (label mpi, a build with PETSc): `MPIEXEC -n NP fcm-scaling --backend petsc` on
  * n = 4, 8 of the ball (Hex8) with --check exits 0 and writes the rows cholmod, cg-mg,
  * petsc-gamg, petsc-mumps, petsc-mg per size; the PETSc rows have status ok, processes NP, the

@@ -20,7 +20,7 @@ fcm_add_test(app_sim_resume tests/apps/sim_app.c LABELS app
              ARGS resume $<TARGET_FILE:fcm-sim> ${work})
 # The README quick start, `fcm-sim` without arguments: the first 6 steps in the default run
 # (frames, PVD indexes and log rows checked step by step); to the end (71 frames, 210 log
-# rows; about 55 s on 2 idle cores) labelled slow.
+# rows; its run time: lib/docs/performance.md) labelled slow.
 fcm_add_test(app_sim_default_quick tests/apps/sim_app.c LABELS app TIMEOUT 900
              ARGS default-quick $<TARGET_FILE:fcm-sim> ${work})
 fcm_add_test(app_sim_default tests/apps/sim_app.c LABELS app slow TIMEOUT 1200
@@ -112,16 +112,16 @@ set_tests_properties(app_cut_accuracy app_cut_dice_hex8 app_cut_dice_tet4 app_cu
                      ENVIRONMENT "OMP_NUM_THREADS=1")
 set_tests_properties(app_cut_accuracy_full app_cut_dice_full PROPERTIES LABELS "app;slow"
                      TIMEOUT 900)
-# fcm-scaling (issue 13): small sizes end to end in the default run (CSV facts: every solver
+# fcm-scaling: small sizes end to end in the default run (CSV facts: every solver
 # converges and agrees with CHOLMOD, cg-mg iterations flat, mg factor < 1, bad options exit 2);
-# the --quick and full studies with --check (the claims of issue 13) under bench / slow.
+# the --quick and full studies with --check (its claims) under bench / slow.
 fcm_add_test(app_scaling tests/apps/scaling_app.c LABELS app TIMEOUT 120
              ARGS small $<TARGET_FILE:fcm-scaling> ${work})
 fcm_add_test(app_scaling_quick tests/apps/scaling_app.c LABELS bench TIMEOUT 900
              ARGS quick $<TARGET_FILE:fcm-scaling> ${work})
 fcm_add_test(app_scaling_full tests/apps/scaling_app.c LABELS slow TIMEOUT 36000
              ARGS full $<TARGET_FILE:fcm-scaling> ${work})
-# fcm-scaling --backend petsc (issue 14) on 1 and 2 MPI processes: the PETSc rows agree with
+# fcm-scaling --backend petsc on 1 and 2 MPI processes: the PETSc rows agree with
 # CHOLMOD's solution, report iterations and the process count; refused options exit non-zero
 if(FCM_HAVE_PETSC)
   foreach(np 1 2)

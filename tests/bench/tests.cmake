@@ -1,6 +1,6 @@
 fcm_add_test(bench_fem tests/bench/bench_fem.c LABELS bench TIMEOUT 1800)
 fcm_add_test(bench_newton_step tests/bench/bench_newton_step.c LABELS bench TIMEOUT 3600)
-# Shared cores (issue 19): MINRES + Schwarz alone and beside 3 busy loops per core; the
+# Shared cores: MINRES + Schwarz alone and beside 3 busy loops per core; the
 # slowdown with the programs' passive waiting and with libgomp's default spinning.
 add_test(NAME bench_shared_cores COMMAND bench_newton_step shared)
 add_test(NAME bench_shared_cores_spin COMMAND bench_newton_step shared)

@@ -2,6 +2,7 @@
  * "hex20"): shape functions, polynomial space, map, inverse map, face/edge tables. */
 #include "fcm/element.h"
 #include "la/mat3.h"
+#include "la/vec3.h"
 #include "test.h"
 
 #include <stdint.h>
@@ -46,23 +47,6 @@ static void centroid(double c[3])
 {
   const double v = info->shape == FCM_SHAPE_HEX ? 0.0 : 0.25;
   c[0] = c[1] = c[2] = v;
-}
-
-static double dot3(const double a[3], const double b[3])
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void sub3(const double a[3], const double b[3], double c[3])
-{
-  c[0] = a[0] - b[0], c[1] = a[1] - b[1], c[2] = a[2] - b[2];
-}
-
-static void cross3(const double a[3], const double b[3], double c[3])
-{
-  c[0] = a[1] * b[2] - a[2] * b[1];
-  c[1] = a[2] * b[0] - a[0] * b[2];
-  c[2] = a[0] * b[1] - a[1] * b[0];
 }
 
 /* ---------------------------------------------------------------- shape functions */
@@ -385,21 +369,21 @@ static void check_faces(void)
     /* normal by the right-hand rule from the corner cycle (Newell's formula) */
     double n[3] = {0.0, 0.0, 0.0}, t[3];
     for (int k = 0; k < nc; k++) {
-      cross3(ref + 3 * fn[k], ref + 3 * fn[(k + 1) % nc], t);
+      fcm__vec3_cross(ref + 3 * fn[k], ref + 3 * fn[(k + 1) % nc], t);
       for (int d = 0; d < 3; d++)
         n[d] += t[d];
     }
     const double *p0 = ref + 3 * fn[0];
     double v[3];
-    sub3(p0, c, v);
-    TEST_TRUE(dot3(n, v) > 0.1); /* outward */
+    fcm__vec3_sub(p0, c, v);
+    TEST_TRUE(fcm__vec3_dot(n, v) > 0.1); /* outward */
     /* exactly the face nodes lie on the face plane; every other node inside */
     for (int a = 0; a < nn; a++) {
       int on = 0;
       for (int k = 0; k < nf; k++)
         on |= fn[k] == a;
-      sub3(ref + 3 * a, p0, v);
-      const double s = dot3(n, v);
+      fcm__vec3_sub(ref + 3 * a, p0, v);
+      const double s = fcm__vec3_dot(n, v);
       if (on)
         TEST_NEAR(s, 0.0, 0.0, EXACT_TOL); /* coplanar */
       else
@@ -408,10 +392,10 @@ static void check_faces(void)
     /* convex, counter-clockwise corner cycle: every corner turns the same way */
     for (int k = 0; k < nc; k++) {
       double e1[3], e2[3];
-      sub3(ref + 3 * fn[(k + 1) % nc], ref + 3 * fn[k], e1);
-      sub3(ref + 3 * fn[(k + 2) % nc], ref + 3 * fn[(k + 1) % nc], e2);
-      cross3(e1, e2, t);
-      TEST_TRUE(dot3(t, n) > 0.0);
+      fcm__vec3_sub(ref + 3 * fn[(k + 1) % nc], ref + 3 * fn[k], e1);
+      fcm__vec3_sub(ref + 3 * fn[(k + 2) % nc], ref + 3 * fn[(k + 1) % nc], e2);
+      fcm__vec3_cross(e1, e2, t);
+      TEST_TRUE(fcm__vec3_dot(t, n) > 0.0);
     }
     /* face edges are element edges; node nc + k is the mid-edge node of (k, k+1) */
     for (int k = 0; k < nc; k++) {

@@ -7,7 +7,7 @@
  * "pts/cpu-s" (1 thread) by the process CPU time of the whole call (clock()), which is
  * robust on a busy machine but includes setup and gathering.
  *
- * Cost growth (issue 15, item 4): for a fixed geometry (a ball of radius 0.8 meshed with
+ * Cost growth: for a fixed geometry (a ball of radius 0.8 meshed with
  * fcm_geometry_create_ball, resolution 6) in box grids of n^3 Hex8 and Hex20 cells over
  * [-1,1]^3, n = 4, 8, 16, 32, the rules time (one thread, CPU seconds of the call) against the
  * number of cut cells (n = 4, 6, 8, 12, 16, 24, 32), the time per cut cell and the

@@ -35,6 +35,7 @@
  *   1 tet10, 2 hex8, 3 hex20; the expected count of a hole body is 2 per plane). */
 #include "fcm/fcm.h"
 #include "test.h"
+#include "la/vec3.h"
 
 #define MAX_PLANES 3
 #define NELEM      4
@@ -67,21 +68,9 @@ static int irand(int n)
 
 /* ---------------------------------------------------------------- geometry helpers */
 
-static double dot3(const double a[3], const double b[3])
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void cross3(const double a[3], const double b[3], double c[3])
-{
-  c[0] = a[1] * b[2] - a[2] * b[1];
-  c[1] = a[2] * b[0] - a[0] * b[2];
-  c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 static void normalize(double v[3])
 {
-  const double l = sqrt(dot3(v, v));
+  const double l = sqrt(fcm__vec3_dot(v, v));
   for (int d = 0; d < 3; d++)
     v[d] /= l;
 }
@@ -100,7 +89,7 @@ static void tilted(int axis, double eps, double n[3])
 {
   double t[3] = {urand() - 0.5, urand() - 0.5, urand() - 0.5};
   t[axis] = 0.0;
-  if (dot3(t, t) == 0.0) t[(axis + 1) % 3] = 1.0;
+  if (fcm__vec3_dot(t, t) == 0.0) t[(axis + 1) % 3] = 1.0;
   normalize(t);
   for (int d = 0; d < 3; d++)
     n[d] = (d == axis ? cos(eps) : 0.0) + sin(eps) * t[d];
@@ -126,8 +115,8 @@ static double tet_volume(double T[4][3])
   double a[3], b[3], c[3], x[3];
   for (int d = 0; d < 3; d++)
     a[d] = T[1][d] - T[0][d], b[d] = T[2][d] - T[0][d], c[d] = T[3][d] - T[0][d];
-  cross3(a, b, x);
-  return fabs(dot3(x, c)) / 6.0;
+  fcm__vec3_cross(a, b, x);
+  return fabs(fcm__vec3_dot(x, c)) / 6.0;
 }
 
 static void lerp(const double a[3], double sa, const double b[3], double sb, double out[3])

@@ -1,10 +1,10 @@
-/* Hard cases of fcm_cell_rules_create (issue 19):
- * - F5: volume fractions never exceed 1 (sums of clipped volumes of a geometry covering
- *   the cells used to give 1 + 2.4e-15 in hundreds of cells), and the embedded volume of
+/* Hard cases of fcm_cell_rules_create:
+ * - volume fractions never exceed 1 (sums of clipped volumes of a geometry covering the
+ *   cells can round to 1 + 2.4e-15 in hundreds of cells), and the embedded volume of
  *   a covered mesh equals the mesh volume;
  * - thin geometry: a slab of thickness t = 1e-6 ... 1e-14 of the cell size, inside a cell
- *   or across a cell face, keeps its volume (relative error <= 1e-12; before: lost
- *   entirely below 1e-13 as "slivers", doubled at 1e-12 across a face);
+ *   or across a cell face, keeps its volume (relative error <= 1e-12; not lost
+ *   as "slivers" below 1e-13, nor doubled at 1e-12 across a face);
  * - memory: a cell whose rule building would exceed max_rule_memory is refused before
  *   allocating, FCM_ERR_UNSUPPORTED naming the cell, the estimate and the limit; 0 lifts
  *   the limit; the scene key quadrature.max_rule_memory_gib (default 4, [0, 2^20]) sets it;

@@ -9,6 +9,7 @@
  * written, each moving with its own body. */
 #include "fem_util.h"
 #include "../io/vtk_reader.h"
+#include "la/mat3.h"
 
 #include <stdint.h>
 
@@ -24,12 +25,6 @@ static void mat3_mul(const double A[9], const double B[9], double C[9])
       C[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
 }
 
-static double det3(const double A[9])
-{
-  return A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) +
-         A[2] * (A[3] * A[7] - A[4] * A[6]);
-}
-
 /* The analytic Cauchy stress (VTK order), von Mises stress and Psi(F) - Psi(I) of F = I + G. */
 static void analytic(const fcm_material *m, double sig[6], double *vm, double *sed)
 {
@@ -41,7 +36,7 @@ static void analytic(const fcm_material *m, double sig[6], double *vm, double *s
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++)
       Ft[3 * i + j] = F[3 * j + i];
-  const double J = det3(F);
+  const double J = fcm__mat3_det(F);
   double psi = 0.0;
   if (m->model == FCM_MATERIAL_LINEAR) {
     double eps[9], tr = G[0] + G[4] + G[8], ee = 0.0;

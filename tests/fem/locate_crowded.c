@@ -1,4 +1,4 @@
-/* fcm_space_locate on a crowded mesh and on failure (issue 19, F4 and F2):
+/* fcm_space_locate on a crowded mesh and on failure:
  * - a fan of 2,000 thin tets around the z axis puts a point in hundreds of cell boxes
  *   (more than the 256 candidates the search keeps at first): every point built inside a
  *   cell is found in that cell, not extrapolated, and maps back to itself;

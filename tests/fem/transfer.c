@@ -35,6 +35,7 @@
  *   sequence's planes and prints a summary, 2 prints every cut. */
 #include "fcm/fcm.h"
 #include "fem_util.h"
+#include "la/vec3.h"
 
 #define MAX_CUTS 10
 #define RTOL     1e-12
@@ -58,11 +59,6 @@ static void normalize(double v[3])
     v[i] /= s;
 }
 
-static double norm3(const double a[3])
-{
-  return sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-}
-
 /* A random unit vector perpendicular to the unit vector n. */
 static void perpendicular(const double n[3], unsigned long long *seed, double w[3])
 {
@@ -73,7 +69,7 @@ static void perpendicular(const double n[3], unsigned long long *seed, double w[
     const double d = r[0] * n[0] + r[1] * n[1] + r[2] * n[2];
     for (int i = 0; i < 3; i++)
       w[i] = r[i] - d * n[i];
-  } while (norm3(w) < 0.1);
+  } while (fcm__vec3_norm(w) < 0.1);
   normalize(w);
 }
 
@@ -117,7 +113,7 @@ static plane random_plane(unsigned long long *seed)
   do {
     for (int i = 0; i < 3; i++)
       pl.n[i] = urand(seed);
-  } while (norm3(pl.n) < 0.1);
+  } while (fcm__vec3_norm(pl.n) < 0.1);
   normalize(pl.n);
   return pl;
 }
@@ -300,8 +296,10 @@ static int carry(const fcm_mesh *mesh, const fcm_cell_rules *r1, track *t, doubl
   double dp[3], dL[3];
   for (int i = 0; i < 3; i++)
     dp[i] = p1[i] - p0[i] - dcon[i], dL[i] = L1[i] - L0[i] - dcon[3 + i];
-  const double em = fabs(m1 - m0) / m0, ep = norm3(dp) / norm3(p0), eL = norm3(dL) / norm3(L0);
-  const double ec = fmax(norm3(dcon) / norm3(p0), norm3(dcon + 3) / norm3(L0));
+  const double em = fabs(m1 - m0) / m0, ep = fcm__vec3_norm(dp) / fcm__vec3_norm(p0),
+               eL = fcm__vec3_norm(dL) / fcm__vec3_norm(L0);
+  const double ec = fmax(fcm__vec3_norm(dcon) / fcm__vec3_norm(p0),
+                         fcm__vec3_norm(dcon + 3) / fcm__vec3_norm(L0));
   worst_m = fmax(worst_m, em), worst_p = fmax(worst_p, ep), worst_L = fmax(worst_L, eL);
   worst_field = fmax(worst_field, df), worst_con = fmax(worst_con, ec);
   /* the constrained elements are tiny: their share stays below 100 x constrain_ratio */

@@ -1,6 +1,6 @@
-/* Readers against hostile inputs (issue 19, F1 and non-regular files): counts in a header
- * are bounded by the size of the file before anything is allocated for them (a 14-byte
- * TetGen .node file used to ask for 2.4 TB, a 23-byte one reached 709 MB; a Gmsh $Nodes
+/* Readers against hostile inputs (counts in headers, non-regular files): counts in a header
+ * are bounded by the size of the file before anything is allocated for them (unchecked, a
+ * 14-byte TetGen .node file asks for 2.4 TB, a 23-byte one for 709 MB; a Gmsh $Nodes
  * count likewise), and directories, character devices (/dev/zero) and pipes are refused
  * with FCM_ERR_IO naming the file, for the TetGen, Gmsh and scene readers, before any
  * read. The allocator records the largest request and refuses anything above 64 MiB, so
@@ -55,7 +55,7 @@ int main(void)
   fcm_scene *s = NULL;
   write_file("rl_ok.ele", "1 4\n1 1 2 3 4\n");
 
-  /* F1: header counts beyond what the file can hold; no allocation above a few KiB. */
+  /* header counts beyond what the file can hold; no allocation above a few KiB. */
   write_file("rl_14.node", "99999999999 3\n"); /* 14 bytes: 2.4 TB of coordinates */
   largest = 0;
   TEST_ERR(ctx, fcm_geometry_create_from_tetgen(ctx, "rl_14.node", "rl_ok.ele", &g), FCM_ERR_FORMAT,

@@ -1,4 +1,4 @@
-/* Temporaries of killed writers (issue 19, F3): a process killed (SIGKILL) between
+/* Temporaries of killed writers: a process killed (SIGKILL) between
  * creating its temporary and committing leaves it behind; the temporary is hidden (no
  * glob for outputs -- "frame_*.vtu", "frame_*", "*" -- lists it) and the next process
  * writing into the same directory removes it. Temporaries of live processes, our own,

@@ -4,7 +4,7 @@
  * bitwise against a serial loop); the symmetry measure; allocation failures. */
 #include "la/la_impl.h"
 #include "la_test_util.h"
-#include "test.h"
+#include "alloc_loop.h"
 
 /* 7-point Laplacian on a g^3 grid as triplets (both triangles), returns count. */
 static fcm_index laplacian_triplets(int g, fcm_index *ti, fcm_index *tj, double *tv)
@@ -220,32 +220,32 @@ static void test_large(fcm_ctx *ctx, rng *r)
   free(ti), free(tj), free(tv), free(x), free(y), free(yref);
 }
 
+typedef struct triplets_case {
+  fcm_ctx *ctx;
+  fcm_csr *A;
+} triplets_case;
+
+static fcm_status create_triplets(void *user)
+{
+  triplets_case *c = user;
+  const fcm_index ti[5] = {0, 1, 1, 2, 0}, tj[5] = {0, 1, 0, 2, 1};
+  const double tv[5] = {1, 2, 3, 4, 5};
+  fcm_status st = fcm_csr_create_triplets(c->ctx, 3, 3, 5, ti, tj, tv, FCM_CSR_SYMMETRIC, &c->A);
+  if (st == FCM_OK) TEST_TRUE(fcm_csr_values(c->A)[fcm_csr_position(c->A, 0, 1)] == 5.0);
+  return st != FCM_OK && c->A ? FCM_ERR_INTERNAL : st;
+}
+
+static void destroy_triplets(void *user)
+{
+  fcm_csr_destroy(&((triplets_case *)user)->A);
+}
+
 static void test_alloc(void)
 {
   failing f;
-  fcm_ctx *ctx = failing_ctx(&f);
-  const fcm_index ti[5] = {0, 1, 1, 2, 0}, tj[5] = {0, 1, 0, 2, 1};
-  const double tv[5] = {1, 2, 3, 4, 5};
-  int ok = 0, failures = 0;
-  for (long long k = 0; k < 40 && !ok; k++) {
-    f.count = 0;
-    f.fail_at = k;
-    fcm_csr *A = NULL;
-    fcm_status st = fcm_csr_create_triplets(ctx, 3, 3, 5, ti, tj, tv, FCM_CSR_SYMMETRIC, &A);
-    f.fail_at = -1;
-    if (st == FCM_OK) {
-      ok = 1;
-      TEST_TRUE(fcm_csr_values(A)[fcm_csr_position(A, 0, 1)] == 5.0);
-      fcm_csr_destroy(&A);
-    } else {
-      failures++;
-      TEST_TRUE(st == FCM_ERR_ALLOC && A == NULL);
-      fcm_ctx_error_clear(ctx);
-    }
-    TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
-  }
-  TEST_TRUE(ok && failures >= 5);
-  fcm_ctx_destroy(&ctx);
+  triplets_case c = {failing_ctx(&f), NULL};
+  alloc_loop(c.ctx, &f, "fcm_csr_create_triplets", create_triplets, destroy_triplets, &c, 5, 40);
+  fcm_ctx_destroy(&c.ctx);
 }
 
 int main(void)

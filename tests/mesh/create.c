@@ -1,5 +1,6 @@
 /* fcm_mesh_create: copies of caller arrays, accessors, face adjacency and boundary
  * faces of small hand-made meshes, argument errors, allocation failures. */
+#include "alloc_loop.h"
 #include "mesh_util.h"
 
 /* Two unit cubes side by side along x: nodes (i, j, k), i in 0..2, j, k in 0..1. */
@@ -133,34 +134,35 @@ static void test_errors(fcm_ctx *ctx)
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
 }
 
+typedef struct two_cubes_case {
+  fcm_ctx *ctx;
+  double x[36];
+  fcm_index cells[16];
+  fcm_mesh *m;
+} two_cubes_case;
+
+static fcm_status create_two_cubes(void *user)
+{
+  two_cubes_case *c = user;
+  fcm_status st = fcm_mesh_create(c->ctx, FCM_ELEMENT_HEX8, 12, c->x, 2, c->cells, &c->m);
+  if (st == FCM_OK) TEST_TRUE(fcm_mesh_num_boundary_faces(c->m) == 10);
+  return st != FCM_OK && c->m ? FCM_ERR_INTERNAL : st;
+}
+
+static void destroy_two_cubes(void *user)
+{
+  fcm_mesh_destroy(&((two_cubes_case *)user)->m);
+}
+
 static void test_alloc_failure(void)
 {
   failing f;
-  fcm_ctx *ctx = failing_ctx(&f);
-  TEST_TRUE(ctx != NULL);
-  if (!ctx) return;
-  double x[36];
-  fcm_index cells[16];
-  two_cubes(x, cells);
-  int ok = 0;
-  for (long k = 0; k < 50 && !ok; k++) {
-    fcm_mesh *m = NULL;
-    f.count = 0;
-    f.fail_at = k;
-    fcm_status st = fcm_mesh_create(ctx, FCM_ELEMENT_HEX8, 12, x, 2, cells, &m);
-    f.fail_at = -1;
-    if (st == FCM_OK) {
-      ok = 1;
-      TEST_TRUE(k > 0 && fcm_mesh_num_boundary_faces(m) == 10);
-      fcm_mesh_destroy(&m);
-    } else {
-      TEST_TRUE(st == FCM_ERR_ALLOC && m == NULL);
-    }
-    TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
-    fcm_ctx_error_clear(ctx);
-  }
-  TEST_TRUE(ok);
-  fcm_ctx_destroy(&ctx);
+  two_cubes_case c = {failing_ctx(&f), {0}, {0}, NULL};
+  TEST_TRUE(c.ctx != NULL);
+  if (!c.ctx) return;
+  two_cubes(c.x, c.cells);
+  alloc_loop(c.ctx, &f, "fcm_mesh_create", create_two_cubes, destroy_two_cubes, &c, 1, 50);
+  fcm_ctx_destroy(&c.ctx);
 }
 
 int main(void)

@@ -14,7 +14,7 @@
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
 #include "petsc/petsc_impl.h" /* the problem's space and arrays: topology bytes */
-#include "test.h"
+#include "test_mpi.h"
 
 #include <sys/resource.h>
 
@@ -146,7 +146,7 @@ int main(int argc, char **argv)
     if (rank == 0)
       printf("petsc_bench np %d %s N %lld: topology bytes/DOF per process: numbering %.1f "
              "(replicated) + adapter %.1f (replicated); copy graph + pattern + offsets + "
-             "colours: full space %.1f (before: on every process), local space %.1f..%.1f "
+             "colours: full space %.1f (as if on every process), local space %.1f..%.1f "
              "(own + ghost cells)\n",
              size, argv[1], (long long)N, num / n, adapter / n, whole / n, -ext[1] / n, ext[0] / n);
   }
@@ -156,8 +156,5 @@ int main(int argc, char **argv)
   fcm_geometry_destroy(&geom);
   fcm_mesh_destroy(&mesh);
   fcm_ctx_destroy(&ctx);
-  int mine = test_failures_, all = 0;
-  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  fcm_petsc_finalize();
-  return all ? TEST_RESULT() + 1 : 0;
+  return test_mpi_result();
 }

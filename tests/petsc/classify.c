@@ -23,7 +23,7 @@
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
 #include "fcm/simulation.h"
-#include "test.h"
+#include "test_mpi.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -313,8 +313,5 @@ int main(int argc, char **argv)
   fcm_geometry_destroy(&geom);
   fcm_mesh_destroy(&mesh);
   fcm_ctx_destroy(&ctx);
-  int mine = test_failures_, all = 0;
-  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  fcm_petsc_finalize();
-  return all ? 1 : 0;
+  return test_mpi_result();
 }

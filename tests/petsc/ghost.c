@@ -27,7 +27,7 @@
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
 #include "petsc/petsc_impl.h"
-#include "test.h"
+#include "test_mpi.h"
 
 #include <sys/stat.h>
 
@@ -412,8 +412,5 @@ done:
   fcm_geometry_destroy(&geom);
   fcm_mesh_destroy(&mesh);
   fcm_ctx_destroy(&ctx);
-  int mine = test_failures_, all = 0;
-  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  fcm_petsc_finalize();
-  return all ? 1 : 0;
+  return test_mpi_result();
 }

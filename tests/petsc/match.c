@@ -11,7 +11,7 @@
  * -pc_factor_mat_solver_type mumps"). */
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
-#include "test.h"
+#include "test_mpi.h"
 
 static const double grav[3] = {0.0, -9.81, 0.0};
 
@@ -202,9 +202,5 @@ int main(int argc, char **argv)
   free(cdofs), free(iscon);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
-  /* any failure on any process fails the run */
-  int mine = test_failures_, all = 0;
-  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  fcm_petsc_finalize();
-  return all ? TEST_RESULT() + 1 : 0;
+  return test_mpi_result();
 }

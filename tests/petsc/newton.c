@@ -29,7 +29,7 @@
 #include "fem/fem_impl.h" /* fcm__space_memory(): the topology's bytes (FCM_TEST_VERBOSE) */
 #include "log_compare.h"
 #include "sim/sim_impl.h" /* the integrator's matrices and vectors (FCM_TEST_VERBOSE) */
-#include "test.h"
+#include "test_mpi.h"
 
 #include <petscsys.h>
 #include <unistd.h>
@@ -242,8 +242,5 @@ int main(int argc, char **argv)
   fcm_scene_destroy(&scene);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
-  int mine = test_failures_, all = 0;
-  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  fcm_petsc_finalize();
-  return all ? TEST_RESULT() + 1 : 0;
+  return test_mpi_result();
 }

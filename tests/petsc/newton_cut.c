@@ -20,7 +20,7 @@
 #include "fcm/petsc.h"
 #include "fcm/simulation.h"
 #include "log_compare.h"
-#include "test.h"
+#include "test_mpi.h"
 
 #include <petscsys.h>
 #include <unistd.h>
@@ -152,8 +152,5 @@ int main(int argc, char **argv)
   fcm_scene_destroy(&scene);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
-  int mine = test_failures_, all = 0;
-  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  fcm_petsc_finalize();
-  return all ? TEST_RESULT() + 1 : 0;
+  return test_mpi_result();
 }

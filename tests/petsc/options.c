@@ -20,7 +20,7 @@
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
 #include "fcm/simulation.h"
-#include "test.h"
+#include "test_mpi.h"
 
 #include <fcntl.h>
 #include <stdio.h>
@@ -166,8 +166,5 @@ int main(int argc, char **argv)
   fcm_mesh_destroy(&mesh);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
-  int mine = test_failures_, all = 0;
-  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  fcm_petsc_finalize();
-  return all ? TEST_RESULT() + 1 : 0;
+  return test_mpi_result();
 }

@@ -16,7 +16,7 @@
 #include "fcm/fcm.h"
 #include "fcm/petsc.h"
 #include "clamp_util.h"
-#include "test.h"
+#include "test_mpi.h"
 
 static const double grav[3] = {0.0, 0.0, -9.81};
 static const fcm_material mat = {FCM_MATERIAL_LINEAR, 1e6, 0.3, 1000.0};
@@ -162,8 +162,5 @@ int main(int argc, char **argv)
   fcm_mesh_destroy(&tet);
   fcm_mesh_destroy(&mesh);
   fcm_ctx_destroy(&ctx);
-  int mine = test_failures_, all = 0;
-  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  fcm_petsc_finalize();
-  return all ? TEST_RESULT() + 1 : 0;
+  return test_mpi_result();
 }

@@ -36,7 +36,7 @@
 #include "fcm/petsc.h"
 #include "fcm/simulation.h"
 #include "clamp_util.h"
-#include "test.h"
+#include "test_mpi.h"
 #include "test_alloc.h"
 
 #include <petscsys.h>
@@ -235,10 +235,7 @@ int main(int argc, char **argv)
     else
       create_main(ctx, &f, argv[2], argc > 3 ? atoll(argv[3]) : 1);
     fcm_ctx_destroy(&ctx);
-    int mine = test_failures_, all = 0;
-    MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-    fcm_petsc_finalize();
-    return all ? TEST_RESULT() + 1 : 0;
+    return test_mpi_result();
   }
   if (argc < 3 || fcm_element_type_from_name(argv[1], &type) != FCM_OK) return 2;
   const fcm_index N = atoi(argv[2]);
@@ -332,8 +329,5 @@ int main(int argc, char **argv)
   fcm_geometry_destroy(&geom);
   fcm_mesh_destroy(&mesh);
   fcm_ctx_destroy(&ctx);
-  int mine = test_failures_, all = 0;
-  MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  fcm_petsc_finalize();
-  return all ? TEST_RESULT() + 1 : 0;
+  return test_mpi_result();
 }

@@ -1,47 +1,21 @@
 # The PETSc backend's tests (label mpi; only in a build with FCM_HAVE_PETSC): each program runs
-# under mpiexec on 1 and 2 processes. The environment lets OpenMPI run as root (the CI container)
-# and on more processes than cores, and keeps one OpenMP thread per process. They are part of the
-# default run (`ctest -LE 'bench|slow'`) of such a build; `ctest -L mpi` runs them alone.
-set(FCM_MPI_TEST_ENV
-    "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMPI_MCA_rmaps_base_oversubscribe=1"
-    "OMPI_MCA_btl_vader_single_copy_mechanism=none;OMP_NUM_THREADS=1;OPENBLAS_NUM_THREADS=1")
-# fcm_add_mpi_test(name source.c NP n [ARGS ...] [TIMEOUT s]): one executable per source.
-function(fcm_add_mpi_test name src)
-  cmake_parse_arguments(T "" "NP;TIMEOUT" "ARGS" ${ARGN})
-  string(MAKE_C_IDENTIFIER "${src}" key)
-  get_property(exe GLOBAL PROPERTY FCM_MPI_TEST_EXE_${key})
-  if(NOT exe)
-    get_filename_component(base ${src} NAME_WE)
-    set(exe petsc_${base})
-    set_property(GLOBAL PROPERTY FCM_MPI_TEST_EXE_${key} ${exe})
-    add_executable(${exe} ${src})
-    target_link_libraries(${exe} PRIVATE fcm_testlib)
-    target_include_directories(${exe} PRIVATE ${PROJECT_SOURCE_DIR}/tests/support)
-    target_compile_options(${exe} PRIVATE ${FCM_WARNINGS} ${FCM_SAN_FLAGS})
-  endif()
-  if(NOT T_TIMEOUT)
-    set(T_TIMEOUT 120)
-  endif()
-  add_test(NAME ${name} COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} ${T_NP}
-                                ${MPIEXEC_PREFLAGS} $<TARGET_FILE:${exe}> ${T_ARGS})
-  set_tests_properties(${name} PROPERTIES LABELS mpi TIMEOUT ${T_TIMEOUT} PROCESSORS ${T_NP}
-                       ENVIRONMENT "${FCM_MPI_TEST_ENV}")
-endfunction()
-
+# under mpiexec on 1 and 2 processes (fcm_add_test(... NP n), the MPI environment of the root
+# CMakeLists.txt). They are part of the default run (`ctest -LE 'bench|slow'`) of such a build;
+# `ctest -L mpi` runs them alone.
 set(FCM_MUMPS "-ksp_type preonly -pc_type cholesky -pc_factor_mat_solver_type mumps")
 foreach(np 1 2)
   foreach(el hex8 tet4 hex20 tet10)
     foreach(kind static dynamic)
       # the default solver (CG + GAMG, rtol 1e-12) with PT-Scotch
-      fcm_add_mpi_test(petsc_match_${el}_${kind}_np${np} tests/petsc/match.c NP ${np}
-                       ARGS ${el} ${kind} ptscotch)
+      fcm_add_test(petsc_match_${el}_${kind}_np${np} tests/petsc/match.c NP ${np}
+                   ARGS ${el} ${kind} ptscotch)
     endforeach()
   endforeach()
   # the Morton-ordered partition and MUMPS (the direct option)
-  fcm_add_mpi_test(petsc_match_hex8_static_ordered_mumps_np${np} tests/petsc/match.c NP ${np}
-                   ARGS hex8 static ordered ${FCM_MUMPS})
-  fcm_add_mpi_test(petsc_match_tet4_dynamic_ordered_mumps_np${np} tests/petsc/match.c NP ${np}
-                   ARGS tet4 dynamic ordered ${FCM_MUMPS})
+  fcm_add_test(petsc_match_hex8_static_ordered_mumps_np${np} tests/petsc/match.c NP ${np}
+               ARGS hex8 static ordered ${FCM_MUMPS})
+  fcm_add_test(petsc_match_tet4_dynamic_ordered_mumps_np${np} tests/petsc/match.c NP ${np}
+               ARGS tet4 dynamic ordered ${FCM_MUMPS})
 endforeach()
 # the distributed classification (each process intersects its share of the cells, the classes
 # are gathered) equals the serial build bit for bit: classes, fractions, pieces, DOF numbering,
@@ -52,22 +26,22 @@ foreach(np 1 2)
     if(el STREQUAL "hex8")
       set(scene_args ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json)
     endif()
-    fcm_add_mpi_test(petsc_classify_${el}_np${np} tests/petsc/classify.c NP ${np}
-                     ARGS ${el} ordered ${scene_args})
+    fcm_add_test(petsc_classify_${el}_np${np} tests/petsc/classify.c NP ${np}
+                 ARGS ${el} ordered ${scene_args})
   endforeach()
-  fcm_add_mpi_test(petsc_classify_tet4_ptscotch_np${np} tests/petsc/classify.c NP ${np}
-                   ARGS tet4 ptscotch)
+  fcm_add_test(petsc_classify_tet4_ptscotch_np${np} tests/petsc/classify.c NP ${np}
+               ARGS tet4 ptscotch)
   # phase 2 with simplify = auto (the exchange, then the choice's reduce; Hex20) and with a cut
-  fcm_add_mpi_test(petsc_classify_auto_np${np} tests/petsc/classify.c NP ${np}
-                   ARGS tet4 ordered ${PROJECT_SOURCE_DIR}/apps/scenes twisting_cylinder.json)
-  fcm_add_mpi_test(petsc_classify_cut_np${np} tests/petsc/classify.c NP ${np}
-                   ARGS tet4 ordered ${PROJECT_SOURCE_DIR}/apps/scenes cut_slab.json)
+  fcm_add_test(petsc_classify_auto_np${np} tests/petsc/classify.c NP ${np}
+               ARGS tet4 ordered ${PROJECT_SOURCE_DIR}/apps/scenes twisting_cylinder.json)
+  fcm_add_test(petsc_classify_cut_np${np} tests/petsc/classify.c NP ${np}
+               ARGS tet4 ordered ${PROJECT_SOURCE_DIR}/apps/scenes cut_slab.json)
 endforeach()
 # a process failing before its rules build (phase 2) or inside it before the per-cell loop
 # (phase 1) ends every process at the classification exchange with the message, no hang
 foreach(np 1 2)
-  fcm_add_mpi_test(petsc_classify_failure_np${np} tests/petsc/classify_failure.c NP ${np}
-                   TIMEOUT 60)
+  fcm_add_test(petsc_classify_failure_np${np} tests/petsc/classify_failure.c NP ${np}
+               TIMEOUT 60)
 endforeach()
 # the local topology of phase 1 (own + ghost cells): the serial numbering bit for bit, every
 # owned row's pattern the full one (and incomplete without the ghosts), exact preallocation,
@@ -76,24 +50,24 @@ foreach(np 1 2 3)
   foreach(case "hex8;ball" "tet4;ball" "hex20;ball" "tet10;ball" "hex8;none")
     list(GET case 0 el)
     list(GET case 1 shape)
-    fcm_add_mpi_test(petsc_ghost_${el}_${shape}_np${np} tests/petsc/ghost.c NP ${np}
-                     ARGS ${el} ${shape} petsc_ghost_${el}_${shape}_np${np} TIMEOUT 120)
+    fcm_add_test(petsc_ghost_${el}_${shape}_np${np} tests/petsc/ghost.c NP ${np}
+                 ARGS ${el} ${shape} petsc_ghost_${el}_${shape}_np${np} TIMEOUT 120)
   endforeach()
 endforeach()
 # the local space of a cut body (several DOF copies per node, constrained copies), serial
 foreach(el hex8 tet4 hex20 tet10)
-  fcm_add_mpi_test(petsc_ghost_${el}_cut tests/petsc/ghost.c NP 1 ARGS ${el} cut unused)
+  fcm_add_test(petsc_ghost_${el}_cut tests/petsc/ghost.c NP 1 ARGS ${el} cut unused)
 endforeach()
 # errors on one or all processes end every process with the message, no hang
 foreach(np 1 2)
-  fcm_add_mpi_test(petsc_failure_np${np} tests/petsc/failure.c NP ${np} TIMEOUT 60)
+  fcm_add_test(petsc_failure_np${np} tests/petsc/failure.c NP ${np} TIMEOUT 60)
 endforeach()
 # example scenes: the PETSc backend against the serial fcm_simulation
 foreach(np 1 2)
-  fcm_add_mpi_test(petsc_scene_cantilever_np${np} tests/petsc/scene.c NP ${np}
-                   ARGS ${PROJECT_SOURCE_DIR}/apps/scenes cantilever.json 1)
-  fcm_add_mpi_test(petsc_scene_vibrating_beam_np${np} tests/petsc/scene.c NP ${np}
-                   ARGS ${PROJECT_SOURCE_DIR}/apps/scenes vibrating_beam.json 10)
+  fcm_add_test(petsc_scene_cantilever_np${np} tests/petsc/scene.c NP ${np}
+               ARGS ${PROJECT_SOURCE_DIR}/apps/scenes cantilever.json 1)
+  fcm_add_test(petsc_scene_vibrating_beam_np${np} tests/petsc/scene.c NP ${np}
+               ARGS ${PROJECT_SOURCE_DIR}/apps/scenes vibrating_beam.json 10)
 endforeach()
 if(FCM_BUILD_APPS)
   # every example scene on 2 processes against the serial fcm-sim: petsc_app_scene_* below
@@ -115,12 +89,12 @@ if(FCM_BUILD_APPS)
 endif()
 # memory and time per DOF on 1 and 2 processes (labels bench, mpi: not in the default run)
 foreach(np 1 2)
-  fcm_add_mpi_test(petsc_bench_np${np} tests/petsc/bench.c NP ${np} ARGS hex8 24 TIMEOUT 1800)
-  set_tests_properties(petsc_bench_np${np} PROPERTIES LABELS "bench;mpi")
+  fcm_add_test(petsc_bench_np${np} tests/petsc/bench.c NP ${np} LABELS bench ARGS hex8 24
+               TIMEOUT 1800)
 endforeach()
 # checkpoints: resume bit for bit on the same processes, to 1e-10 on another count
 foreach(np 1 2)
-  fcm_add_mpi_test(petsc_checkpoint_np${np} tests/petsc/checkpoint.c NP ${np})
+  fcm_add_test(petsc_checkpoint_np${np} tests/petsc/checkpoint.c NP ${np})
 endforeach()
 if(FCM_BUILD_APPS)
   # fcm-sim --backend petsc --checkpoint-every / --resume: byte for byte on 2 processes
@@ -137,44 +111,44 @@ endif()
 set(FCM_SCENES ${PROJECT_SOURCE_DIR}/apps/scenes)
 foreach(np 1 2)
   # static Stable Neo-Hookean, penalty boundary constraint, traction, 3 load steps (MUMPS)
-  fcm_add_mpi_test(petsc_newton_static_snh_np${np} tests/petsc/newton.c NP ${np}
-                   ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json 1)
+  fcm_add_test(petsc_newton_static_snh_np${np} tests/petsc/newton.c NP ${np}
+               ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json 1)
   # the same with CG + GAMG on the Newton systems
-  fcm_add_mpi_test(petsc_newton_static_snh_gamg_np${np} tests/petsc/newton.c NP ${np}
-                   ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json 1 1e-8
-                        -ksp_type cg -pc_type gamg)
+  fcm_add_test(petsc_newton_static_snh_gamg_np${np} tests/petsc/newton.c NP ${np}
+               ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json 1 1e-8
+                    -ksp_type cg -pc_type gamg)
   # the same with CG + fcm's multigrid as PCMG (pcmg.c) on the Newton systems
-  fcm_add_mpi_test(petsc_newton_static_snh_mg_np${np} tests/petsc/newton.c NP ${np}
-                   ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json 1 1e-8
-                        -ksp_type cg -pc_type mg)
+  fcm_add_test(petsc_newton_static_snh_mg_np${np} tests/petsc/newton.c NP ${np}
+               ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes static_snh.json 1 1e-8
+                    -ksp_type cg -pc_type mg)
   # dynamic SNH, Nitsche on the embedded boundary (fixed and rotating caps), gravity, damping
-  fcm_add_mpi_test(petsc_newton_clamped_surface_np${np} tests/petsc/newton.c NP ${np}
-                   ARGS ${FCM_SCENES} clamped_surface.json 3)
+  fcm_add_test(petsc_newton_clamped_surface_np${np} tests/petsc/newton.c NP ${np}
+               ARGS ${FCM_SCENES} clamped_surface.json 3)
   # linear material through Newton: traction and pressure, load steps, CG + GAMG
-  fcm_add_mpi_test(petsc_newton_static_beam_np${np} tests/petsc/newton.c NP ${np}
-                   ARGS ${FCM_SCENES} static_beam.json 1)
+  fcm_add_test(petsc_newton_static_beam_np${np} tests/petsc/newton.c NP ${np}
+               ARGS ${FCM_SCENES} static_beam.json 1)
 endforeach()
 # initial velocity (Hex20, free body: momentum), and a MINRES scene with release and damping
 # (the serial run solves with MINRES to rtol 1e-5 there: compared to 1e-6; MINRES + GAMG to the
 # test's rtol 1e-12 needs up to ~500 iterations, the scene's limit, so the limit is raised: a
 # KSP that stops there makes the integrator halve the step, another path)
-fcm_add_mpi_test(petsc_newton_spinning_body_np2 tests/petsc/newton.c NP 2
-                 ARGS ${FCM_SCENES} spinning_body.json 3)
-fcm_add_mpi_test(petsc_newton_slingshot_np2 tests/petsc/newton.c NP 2
-                 ARGS ${FCM_SCENES} slingshot.json 2 1e-6 -ksp_max_it 5000)
+fcm_add_test(petsc_newton_spinning_body_np2 tests/petsc/newton.c NP 2
+             ARGS ${FCM_SCENES} spinning_body.json 3)
+fcm_add_test(petsc_newton_slingshot_np2 tests/petsc/newton.c NP 2
+             ARGS ${FCM_SCENES} slingshot.json 2 1e-6 -ksp_max_it 5000)
 # the integrator on PETSc: a failure on one process, in the setup's sums, in the KSP (after the
 # step's halvings) and in a cut between steps on one process end every process with the
 # message, no hang
 # (3 processes too: checkpoints with 0, 1 and 2 cuts, whose mean equals one process's count)
 foreach(np 1 2 3)
-  fcm_add_mpi_test(petsc_newton_failure_np${np} tests/petsc/newton_failure.c NP ${np} TIMEOUT 180)
+  fcm_add_test(petsc_newton_failure_np${np} tests/petsc/newton_failure.c NP ${np} TIMEOUT 180)
 endforeach()
 # 3 processes: a DOF's partial Newton rows reach its owner from more than one other process
 # through PETSc's stash (on 2 there is one sender), as do the cut's rebuilt backends
-fcm_add_mpi_test(petsc_newton_clamped_surface_np3 tests/petsc/newton.c NP 3
-                 ARGS ${FCM_SCENES} clamped_surface.json 3)
-fcm_add_mpi_test(petsc_newton_cut_late_np3 tests/petsc/newton_cut.c NP 3
-                 ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6)
+fcm_add_test(petsc_newton_clamped_surface_np3 tests/petsc/newton.c NP 3
+             ARGS ${FCM_SCENES} clamped_surface.json 3)
+fcm_add_test(petsc_newton_cut_late_np3 tests/petsc/newton_cut.c NP 3
+             ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6)
 if(FCM_BUILD_APPS)
   # the state of two checkpoints (fcm-sim's .fcmck or the linear driver's .fcmpk) to a relative
   # tolerance: a tool of the shell tests below (no MPI)
@@ -273,56 +247,56 @@ endif()
 # and twisting_cylinder's "auto" (Hex20): against the serial run step by step, with the cut
 # bookkeeping and the simplification choice equal to the serial ones
 foreach(np 1 2)
-  fcm_add_mpi_test(petsc_newton_cut_dice_np${np} tests/petsc/newton_cut.c NP ${np}
-                   ARGS ${FCM_SCENES} dice.json 3)
-  fcm_add_mpi_test(petsc_newton_cut_slab_np${np} tests/petsc/newton_cut.c NP ${np}
-                   ARGS ${FCM_SCENES} cut_slab.json 3)
-  fcm_add_mpi_test(petsc_newton_cut_cracked_beam_np${np} tests/petsc/newton_cut.c NP ${np}
-                   ARGS ${FCM_SCENES} cracked_beam.json 1)
-  fcm_add_mpi_test(petsc_newton_cut_late_np${np} tests/petsc/newton_cut.c NP ${np}
-                   ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6)
+  fcm_add_test(petsc_newton_cut_dice_np${np} tests/petsc/newton_cut.c NP ${np}
+               ARGS ${FCM_SCENES} dice.json 3)
+  fcm_add_test(petsc_newton_cut_slab_np${np} tests/petsc/newton_cut.c NP ${np}
+               ARGS ${FCM_SCENES} cut_slab.json 3)
+  fcm_add_test(petsc_newton_cut_cracked_beam_np${np} tests/petsc/newton_cut.c NP ${np}
+               ARGS ${FCM_SCENES} cracked_beam.json 1)
+  fcm_add_test(petsc_newton_cut_late_np${np} tests/petsc/newton_cut.c NP ${np}
+               ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6)
 endforeach()
 # (2 processes: the choice's inputs are summed; on 1 the serial rules build decides)
-fcm_add_mpi_test(petsc_newton_auto_twisting_cylinder_np2 tests/petsc/newton_cut.c NP 2
-                 ARGS ${FCM_SCENES} twisting_cylinder.json 1 TIMEOUT 300)
+fcm_add_test(petsc_newton_auto_twisting_cylinder_np2 tests/petsc/newton_cut.c NP 2
+             ARGS ${FCM_SCENES} twisting_cylinder.json 1 TIMEOUT 300)
 # the late cut with CG + GAMG on the rebuilt KSP
-fcm_add_mpi_test(petsc_newton_cut_late_gamg_np2 tests/petsc/newton_cut.c NP 2
-                 ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6 1e-8
-                      -ksp_type cg -pc_type gamg)
+fcm_add_test(petsc_newton_cut_late_gamg_np2 tests/petsc/newton_cut.c NP 2
+             ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes cut_late.json 6 1e-8
+                  -ksp_type cg -pc_type gamg)
 # each problem reads its PETSc options under its own prefix (tests/petsc/options.c): strings
 # of earlier problems do not leak into later ones; the command line wins (unprefixed: every
 # problem; -fcm2_...: the second problem alone)
 foreach(np 1 2)
-  fcm_add_mpi_test(petsc_options_np${np} tests/petsc/options.c NP ${np}
-                   ARGS minres cg gmres jacobi gamg gamg)
-  fcm_add_mpi_test(petsc_options_cmdline_np${np} tests/petsc/options.c NP ${np}
-                   ARGS bcgs bcgs bcgs jacobi gamg gamg -ksp_type bcgs)
-  fcm_add_mpi_test(petsc_options_prefixed_np${np} tests/petsc/options.c NP ${np}
-                   ARGS minres cg gmres jacobi jacobi gamg -fcm2_pc_type jacobi)
+  fcm_add_test(petsc_options_np${np} tests/petsc/options.c NP ${np}
+               ARGS minres cg gmres jacobi gamg gamg)
+  fcm_add_test(petsc_options_cmdline_np${np} tests/petsc/options.c NP ${np}
+               ARGS bcgs bcgs bcgs jacobi gamg gamg -ksp_type bcgs)
+  fcm_add_test(petsc_options_prefixed_np${np} tests/petsc/options.c NP ${np}
+               ARGS minres cg gmres jacobi jacobi gamg -fcm2_pc_type jacobi)
 endforeach()
 # fcm's geometric multigrid as PCMG (-pc_type mg): the CHOLMOD solution to 1e-8, CG iterations
 # at rtol 1e-10 bounded, fewer than GAMG's by a factor; a clear error on non-box meshes
 foreach(np 1 2)
-  fcm_add_mpi_test(petsc_pcmg_hex8_np${np} tests/petsc/pcmg.c NP ${np} ARGS hex8 12 32 0)
-  fcm_add_mpi_test(petsc_pcmg_hex20_np${np} tests/petsc/pcmg.c NP ${np} ARGS hex20 6 40 5)
+  fcm_add_test(petsc_pcmg_hex8_np${np} tests/petsc/pcmg.c NP ${np} ARGS hex8 12 32 0)
+  fcm_add_test(petsc_pcmg_hex20_np${np} tests/petsc/pcmg.c NP ${np} ARGS hex20 6 40 5)
 endforeach()
 # a local failure on ONE process in PCMG's setup (tests/petsc/pcmg_failure.c): every allocation
 # of the setup and first step failed in turn on process 1; every process fails with the
 # message, none hangs (the timeout is the guard)
 # every allocation on 2 processes, every third on 3 (oversubscribed: slower); Hex20 (its
 # first level is the Hex8 space of the same elements) every fifth on 2
-fcm_add_mpi_test(petsc_pcmg_failure_hex8_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 90
-                 ARGS hex8 4 1)
-fcm_add_mpi_test(petsc_pcmg_failure_hex8_np3 tests/petsc/pcmg_failure.c NP 3 TIMEOUT 90
-                 ARGS hex8 4 3)
-fcm_add_mpi_test(petsc_pcmg_failure_hex20_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 90
-                 ARGS hex20 3 5)
+fcm_add_test(petsc_pcmg_failure_hex8_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 90
+             ARGS hex8 4 1)
+fcm_add_test(petsc_pcmg_failure_hex8_np3 tests/petsc/pcmg_failure.c NP 3 TIMEOUT 90
+             ARGS hex8 4 3)
+fcm_add_test(petsc_pcmg_failure_hex20_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 90
+             ARGS hex20 3 5)
 # the integrator on PETSc's creation (rules, local space, numbering, matrix preallocation,
 # options): every allocation on 2 processes, every third on 3
-fcm_add_mpi_test(petsc_newton_create_failure_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 120
-                 ARGS create ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 1)
-fcm_add_mpi_test(petsc_newton_create_failure_np3 tests/petsc/pcmg_failure.c NP 3 TIMEOUT 120
-                 ARGS create ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 3)
+fcm_add_test(petsc_newton_create_failure_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 120
+             ARGS create ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 1)
+fcm_add_test(petsc_newton_create_failure_np3 tests/petsc/pcmg_failure.c NP 3 TIMEOUT 120
+             ARGS create ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 3)
 # phase 2 (the integrator, -pc_type mg): every 37th allocation of the first step
-fcm_add_mpi_test(petsc_pcmg_failure_newton_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 120
-                 ARGS scene ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 37)
+fcm_add_test(petsc_pcmg_failure_newton_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 120
+             ARGS scene ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 37)

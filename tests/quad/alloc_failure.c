@@ -3,8 +3,9 @@
  * FCM_ERR_ALLOC, leaves *rule NULL and frees everything it allocated. */
 #include "fcm/quad.h"
 #include "fcm/rulegen.h"
-#include "test.h"
-#include "test_alloc.h"
+#include "alloc_loop.h"
+
+#include <stdio.h>
 
 enum { MAKE_COMPUTED, MAKE_CATALOGUE, MAKE_JACOBI, MAKE_USER };
 
@@ -23,6 +24,37 @@ static fcm_status make(fcm_ctx *ctx, int kind, fcm_shape shape, int m, fcm_rule 
   }
 }
 
+typedef struct rule_case {
+  fcm_ctx *ctx;
+  int kind, m;
+  fcm_shape shape;
+  fcm_rule *r; /* made by one round, or the rule of the moment residual */
+  double res;  /* the moment residual */
+} rule_case;
+
+static fcm_status make_round(void *user)
+{
+  rule_case *c = user;
+  c->r = (fcm_rule *)c; /* non-NULL: must be reset on failure */
+  fcm_status st = make(c->ctx, c->kind, c->shape, c->m, &c->r);
+  if (st == FCM_OK) TEST_TRUE(c->r != NULL && fcm_rule_num_points(c->r) > 0);
+  return st != FCM_OK && c->r ? FCM_ERR_INTERNAL : st;
+}
+
+static void destroy_rule(void *user)
+{
+  fcm_rule_destroy(&((rule_case *)user)->r);
+}
+
+static fcm_status residual_round(void *user)
+{
+  rule_case *c = user;
+  c->res = -1.0;
+  fcm_status st = fcm_rule_moment_residual(c->ctx, c->r, 4, &c->res);
+  if (st == FCM_OK) TEST_TRUE(c->res >= 0.0 && c->res < 1e-12);
+  return st;
+}
+
 int main(void)
 {
   failing f = {0, -1};
@@ -30,68 +62,27 @@ int main(void)
   opts.allocator.alloc = failing_alloc;
   opts.allocator.release = failing_release;
   opts.allocator.user = &f;
-  fcm_ctx *ctx = NULL;
-  TEST_OK(ctx, fcm_ctx_create(&opts, &ctx));
-  if (!ctx) return TEST_RESULT();
+  rule_case c = {NULL, 0, 0, FCM_SHAPE_LINE, NULL, 0.0};
+  TEST_OK(c.ctx, fcm_ctx_create(&opts, &c.ctx));
+  if (!c.ctx) return TEST_RESULT();
 
+  /* rule struct, points, weights at least: 3 failing rounds */
   for (int kind = MAKE_COMPUTED; kind <= MAKE_USER; kind++)
     for (int s = 0; s < FCM_SHAPE_COUNT; s++) {
       if (kind >= MAKE_JACOBI && s > 0) break;
-      int m = kind == MAKE_JACOBI ? 7 : 5, succeeded = 0, failures = 0;
-      for (long k = 0; k < 100 && !succeeded; k++) {
-        fcm_rule *r = (fcm_rule *)&f; /* non-NULL: must be reset on failure */
-        f.count = 0;
-        f.fail_at = k;
-        fcm_status st = make(ctx, kind, (fcm_shape)s, m, &r);
-        f.fail_at = -1;
-        if (st == FCM_OK) {
-          succeeded = 1;
-          TEST_TRUE(r != NULL && fcm_rule_num_points(r) > 0);
-          fcm_rule_destroy(&r);
-        } else {
-          failures++;
-          if (st != FCM_ERR_ALLOC)
-            TEST_FAIL_("kind %d shape %d: failing allocation %ld gave %s", kind, s, k,
-                       fcm_status_name(st));
-          TEST_TRUE(r == NULL);
-          TEST_TRUE(fcm_ctx_error_status(ctx) == FCM_ERR_ALLOC);
-          fcm_ctx_error_clear(ctx);
-        }
-        if (fcm_ctx_live_allocations(ctx) != 0)
-          TEST_FAIL_("kind %d shape %d: %lld allocations leaked after failing allocation %ld", kind,
-                     s, fcm_ctx_live_allocations(ctx), k);
-      }
-      TEST_TRUE(succeeded);
-      TEST_TRUE(failures >= 3); /* rule struct, points, weights at least */
+      char name[64];
+      snprintf(name, sizeof name, "kind %d shape %d", kind, s);
+      c.kind = kind, c.shape = (fcm_shape)s, c.m = kind == MAKE_JACOBI ? 7 : 5;
+      alloc_loop(c.ctx, &f, name, make_round, destroy_rule, &c, 3, 100);
     }
   /* fcm_rule_moment_residual allocates its moment workspace */
   for (int s = 0; s < FCM_SHAPE_COUNT; s++) {
-    fcm_rule *r = NULL;
-    TEST_OK(ctx, fcm_rule_create(ctx, (fcm_shape)s, 4, &r));
-    int succeeded = 0, failures = 0;
-    const long long live = fcm_ctx_live_allocations(ctx); /* the rule's */
-    for (long k = 0; k < 100 && r && !succeeded; k++) {
-      double res = -1.0;
-      f.count = 0;
-      f.fail_at = k;
-      fcm_status st = fcm_rule_moment_residual(ctx, r, 4, &res);
-      f.fail_at = -1;
-      if (st == FCM_OK) {
-        succeeded = 1;
-        TEST_TRUE(res >= 0.0 && res < 1e-12);
-      } else {
-        failures++;
-        if (st != FCM_ERR_ALLOC || fcm_ctx_error_status(ctx) != FCM_ERR_ALLOC)
-          TEST_FAIL_("moment residual, shape %d: failing allocation %ld gave %s", s, k,
-                     fcm_status_name(st));
-        fcm_ctx_error_clear(ctx);
-      }
-      if (fcm_ctx_live_allocations(ctx) != live)
-        TEST_FAIL_("moment residual, shape %d: leak after failing allocation %ld", s, k);
-    }
-    TEST_TRUE(succeeded && failures >= 1);
-    fcm_rule_destroy(&r);
+    TEST_OK(c.ctx, fcm_rule_create(c.ctx, (fcm_shape)s, 4, &c.r));
+    char name[64];
+    snprintf(name, sizeof name, "moment residual, shape %d", s);
+    if (c.r) alloc_loop(c.ctx, &f, name, residual_round, NULL, &c, 1, 100);
+    fcm_rule_destroy(&c.r);
   }
-  fcm_ctx_destroy(&ctx);
+  fcm_ctx_destroy(&c.ctx);
   return TEST_RESULT();
 }

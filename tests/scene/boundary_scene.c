@@ -1,4 +1,4 @@
-/* Scenes with fixed and motion on the embedded boundary (issue 18): an embedded bar held at
+/* Scenes with fixed and motion on the embedded boundary: an embedded bar held at
  * its left end face and pulled 1 cm at its right end face, both by Nitsche's method on the
  * boundary points in half-spaces, static linear: surface rules are built for them, no node is
  * constrained, and the displacement on the two faces meets the prescribed values (weakly:

@@ -49,7 +49,7 @@ static const char dynamic_json[] =
     "  {\"motion\": {\"region\": {\"half_space\": {\"point\": [1.5, 0, 0], \"normal\": [1, 0, 0]}},"
     "    \"velocity\": [0, 0, 1], \"end\": 0.06, \"release\": true}}]}";
 
-/* the dynamic run on a Hex8 grid with MINRES preconditioned by the multigrid (issue 13): the
+/* the dynamic run on a Hex8 grid with MINRES preconditioned by the multigrid: the
  * restored run builds its hierarchy anew at its first step, the uninterrupted one had it since
  * step 1, the motion's release at t = 0.06 rebuilds it in both */
 static const char mg_json[] =

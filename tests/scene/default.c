@@ -51,7 +51,8 @@ int main(int argc, char **argv)
     TEST_TRUE(g->outer_radius <= bg->max[2] && -g->outer_radius >= bg->min[2]);
     TEST_TRUE(g->length / 2 <= bg->max[1] && -g->length / 2 >= bg->min[1]);
     TEST_OK(ctx, fcm_material_validate(ctx, fcm_scene_get_material(a)));
-    /* Small (about 85 s on 2 cores): at most 150 background cells and 250 steps. */
+    /* Small enough for a demo (lib/docs/performance.md): at most 150 background cells and
+     * 250 steps. */
     TEST_TRUE(bg->cells[0] * bg->cells[1] * bg->cells[2] <= 150);
     TEST_TRUE(t->num_steps >= 10 && t->num_steps <= 250);
     /* One end pushed along the axis, the other twisted about it. */

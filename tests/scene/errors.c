@@ -123,7 +123,7 @@ static const bad_case cases[] = {
     {"{" BASE ", \"effects\": [{\"fixed\": {\"region\": {\"nodes\": [1]}, \"components\": "
      "\"xw\"}}]}",
      FCM_ERR_ARG, "effects[0].fixed.components: expected distinct letters from \"xyz\"", NULL},
-    /* ---- fixed / motion on the embedded boundary (issue 18) */
+    /* ---- fixed / motion on the embedded boundary */
     {"{" BASE ", \"effects\": [{\"fixed\": {\"region\": {\"nodes\": [1]}, \"boundary\": "
      "\"all\"}}]}",
      FCM_ERR_ARG, "effects[0].fixed: expected one of \"region\"", "got both"},

@@ -1,4 +1,4 @@
-/* Issue 13: the cut-aware multigrid in scene runs, as the preconditioner of CG and MINRES
+/* The cut-aware multigrid in scene runs, as the preconditioner of CG and MINRES
  * ("preconditioner": "multigrid") and as the linear solver ("method": "multigrid").
  * Modes (argv[1]):
  *   agree       embedded Hex8 bodies, each run with the direct solver and with CG+MG,

@@ -1,4 +1,4 @@
-/* What a scene run writes for the engineer (issue 18): the log's reaction columns of each
+/* What a scene run writes for the engineer: the log's reaction columns of each
  * constraint effect (an embedded beam clamped at one end hangs under gravity: the reaction is
  * minus the assembled weight, rho g |body| to the stabilization's share, and its moment minus
  * the weight's moment; a dynamic clamped block: the reaction is the log's change of momentum

@@ -2,21 +2,10 @@
  * the documented defaults; relative file names resolve against the scene's directory;
  * the motion, initial-velocity and region formulas satisfy their geometric identities. */
 #include "scene_util.h"
+#include "la/vec3.h"
 
 #include <math.h>
 #include <sys/stat.h>
-
-static double dot3(const double *a, const double *b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void cross3(const double *a, const double *b, double *c)
-{
-  c[0] = a[1] * b[2] - a[2] * b[1];
-  c[1] = a[2] * b[0] - a[0] * b[2];
-  c[2] = a[0] * b[1] - a[1] * b[0];
-}
 
 static void check_vec(const double *got, double x, double y, double z)
 {
@@ -299,7 +288,7 @@ static void check_steps(fcm_ctx *ctx)
   }
 }
 
-/* fixed and motion on the embedded boundary (issue 18): "boundary" with a region or "all",
+/* fixed and motion on the embedded boundary: "boundary" with a region or "all",
  * the method keys and their defaults; the region selects points by position. */
 static void check_boundary(fcm_ctx *ctx)
 {
@@ -356,22 +345,22 @@ static void check_motion(fcm_ctx *ctx)
         r1[d] = y[d] - m->center[d];
       }
       /* Distance to the centre and the axial component are preserved... */
-      TEST_NEAR(dot3(r1, r1), dot3(r0, r0), 1e-13, 1e-14);
-      TEST_NEAR(dot3(r1, m->axis), dot3(r0, m->axis), 1e-13, 1e-14);
+      TEST_NEAR(fcm__vec3_dot(r1, r1), fcm__vec3_dot(r0, r0), 1e-13, 1e-14);
+      TEST_NEAR(fcm__vec3_dot(r1, m->axis), fcm__vec3_dot(r0, m->axis), 1e-13, 1e-14);
       /* ...and the normal components turn by omega tau, right-handed about the axis. */
       double p0[3], p1[3], c[3];
       for (int d = 0; d < 3; d++) {
-        p0[d] = r0[d] - dot3(r0, m->axis) * m->axis[d];
-        p1[d] = r1[d] - dot3(r1, m->axis) * m->axis[d];
+        p0[d] = r0[d] - fcm__vec3_dot(r0, m->axis) * m->axis[d];
+        p1[d] = r1[d] - fcm__vec3_dot(r1, m->axis) * m->axis[d];
       }
-      double rr = dot3(p0, p0), phi = m->angular_speed * tau;
-      cross3(p0, p1, c);
-      TEST_NEAR(dot3(p0, p1), rr * cos(phi), 1e-13, 1e-13);
-      TEST_NEAR(dot3(c, m->axis), rr * sin(phi), 1e-13, 1e-13);
+      double rr = fcm__vec3_dot(p0, p0), phi = m->angular_speed * tau;
+      fcm__vec3_cross(p0, p1, c);
+      TEST_NEAR(fcm__vec3_dot(p0, p1), rr * cos(phi), 1e-13, 1e-13);
+      TEST_NEAR(fcm__vec3_dot(c, m->axis), rr * sin(phi), 1e-13, 1e-13);
       if (t <= 0.25) TEST_TRUE(fabs(u[0]) + fabs(u[1]) + fabs(u[2]) == 0.0);
       /* Velocity: v + omega a x (x - c) while start <= t < end, else 0. */
       double w[3], ax[3];
-      cross3(m->axis, r1, ax);
+      fcm__vec3_cross(m->axis, r1, ax);
       int moving = t >= 0.25 && t < 1.25;
       for (int d = 0; d < 3; d++)
         w[d] = moving ? m->velocity[d] + m->angular_speed * ax[d] : 0.0;
@@ -395,9 +384,12 @@ static void check_motion(fcm_ctx *ctx)
       r[d] = Xs[i][d] - iv->center[d];
     }
     const double *om = iv->angular_velocity;
-    TEST_NEAR(dot3(w, om), 0.0, 0, 1e-13);
-    TEST_NEAR(dot3(w, r), 0.0, 0, 1e-13);
-    TEST_NEAR(dot3(w, w), dot3(om, om) * dot3(r, r) - dot3(om, r) * dot3(om, r), 1e-13, 1e-13);
+    TEST_NEAR(fcm__vec3_dot(w, om), 0.0, 0, 1e-13);
+    TEST_NEAR(fcm__vec3_dot(w, r), 0.0, 0, 1e-13);
+    TEST_NEAR(fcm__vec3_dot(w, w),
+              fcm__vec3_dot(om, om) * fcm__vec3_dot(r, r) -
+                  fcm__vec3_dot(om, r) * fcm__vec3_dot(om, r),
+              1e-13, 1e-13);
   }
   /* About the centre of mass: the velocity at the centre of mass is v0. */
   fcm_effect_initial_velocity spin = *iv;

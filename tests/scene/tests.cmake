@@ -36,9 +36,9 @@ fcm_add_test(scene_rule_kinds tests/scene/rule_kinds.c)
 # equilibrium; change of momentum minus the weight in dynamics), stress arrays in the frames,
 # the surface at reference positions, the summary's max |u| over the body.
 fcm_add_test(scene_output tests/scene/output_scene.c)
-# Issue 18: fixed and motion on the embedded boundary (Nitsche) through the scene runner.
+# Fixed and motion on the embedded boundary (Nitsche) through the scene runner.
 fcm_add_test(scene_boundary tests/scene/boundary_scene.c)
-# Issue 13: the multigrid in scene runs (CG+MG, MINRES+MG, MG alone) agrees with the direct
+# The multigrid in scene runs (CG+MG, MINRES+MG, MG alone) agrees with the direct
 # solver on static (clamped, Nitsche) and dynamic Hex8 embedded bodies and across an XFEM cut;
 # CG+MG needs at most a fifth of CG+Jacobi's iterations; bad options are refused, named.
 foreach(mode agree cut iterations errors)

@@ -31,7 +31,7 @@ static double ramp(void *user, double t)
   return t < 1.0 ? t : 1.0;
 }
 
-/* The embedded end face x = 1.7 (Nitsche boundary constraint, issue 18). */
+/* The embedded end face x = 1.7 (Nitsche boundary constraint). */
 static int end_face(void *user, const double X[3], const double n[3])
 {
   (void)user, (void)n;

@@ -1,4 +1,4 @@
-/* Issue 19: the tangent the MINRES preconditioner is built from
+/* The tangent the MINRES preconditioner is built from
  * (fcm_integrator_options.preconditioner_tangent, scene key solver.preconditioner_tangent).
  * A Hex20 tube cut by a 1 x 2 x 1 grid is twisted and squeezed for two steps (unprojected
  * Stable Neo-Hookean tangent; the preconditioner, Schwarz with Jacobi outside its blocks, is

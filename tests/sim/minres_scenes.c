@@ -1,4 +1,4 @@
-/* Issue 19: "stabilized Schwarz-preconditioned MINRES" works on the systems it is meant for.
+/* "Stabilized Schwarz-preconditioned MINRES" works on the systems it is meant for.
  * Every example scene in the directory argv[1] runs argv[2] steps twice from its own JSON,
  * once with solver {"method": "minres", "preconditioner": "schwarz"} (rtol 1e-8, at most
  * 5000 iterations; the scene's own Newton settings and material, unprojected tangent) and

@@ -1,4 +1,4 @@
-/* Issue 15 item 6, "no per-step waste": after the first step, stepping a simulation makes no
+/* No per-step waste: after the first step, stepping a simulation makes no
  * allocation through the context's allocator. A small embedded dynamic scene (a Neo-Hookean
  * ball in a 3^3 background grid under gravity, held at its base, a patch of it pulled by a
  * prescribed motion, Rayleigh damping: several Newton iterations per step, the tangent and
@@ -35,7 +35,7 @@ static const char *solver_json(const char *name)
   if (!strcmp(name, "cg-block"))
     return "{\"method\": \"cg\", \"preconditioner\": \"block_jacobi\", \"rtol\": 1e-8, "
            "\"max_iterations\": 2000}";
-  /* multigrid (issue 13): the hierarchy is built at the first step and kept (the constrained
+  /* multigrid: the hierarchy is built at the first step and kept (the constrained
    * set does not change); later setups recompute its Galerkin matrices in place */
   if (!strcmp(name, "minres-mg"))
     return "{\"method\": \"minres\", \"preconditioner\": \"multigrid\", \"multigrid\": "

@@ -1,72 +1,65 @@
-# The sim tests run many short parallel regions (assembly per colour, mat-vecs): with
-# OpenMP's default spin-waiting they crawl on an oversubscribed machine, so they wait
-# passively (same results; the library itself never touches the environment).
-function(fcm_sim_test name src)
-  fcm_add_test(${name} ${src} ${ARGN})
-  set_tests_properties(${name} PROPERTIES ENVIRONMENT "OMP_NUM_THREADS=2;OMP_WAIT_POLICY=passive")
-endfunction()
 foreach(el hex8 tet10)
-  fcm_sim_test(sim_static_linear_${el} tests/sim/static_linear.c ARGS ${el})
-  fcm_sim_test(sim_static_snh_${el} tests/sim/static_snh.c ARGS ${el})
-  fcm_sim_test(sim_momentum_${el} tests/sim/momentum.c ARGS ${el})
-  fcm_sim_test(sim_energy_${el} tests/sim/energy.c ARGS ${el})
-  fcm_sim_test(sim_constraints_${el} tests/sim/constraints.c ARGS ${el})
+  fcm_add_test(sim_static_linear_${el} tests/sim/static_linear.c ARGS ${el})
+  fcm_add_test(sim_static_snh_${el} tests/sim/static_snh.c ARGS ${el})
+  fcm_add_test(sim_momentum_${el} tests/sim/momentum.c ARGS ${el})
+  fcm_add_test(sim_energy_${el} tests/sim/energy.c ARGS ${el})
+  fcm_add_test(sim_constraints_${el} tests/sim/constraints.c ARGS ${el})
 endforeach()
-fcm_sim_test(sim_failure tests/sim/failure.c ARGS hex8)
+fcm_add_test(sim_failure tests/sim/failure.c ARGS hex8)
 foreach(el hex8 tet10)
-  fcm_sim_test(sim_solvers_${el} tests/sim/solvers.c ARGS ${el})
+  fcm_add_test(sim_solvers_${el} tests/sim/solvers.c ARGS ${el})
 endforeach()
 foreach(el hex8 tet10)
-  fcm_sim_test(sim_krylov_${el} tests/sim/krylov.c ARGS ${el})
+  fcm_add_test(sim_krylov_${el} tests/sim/krylov.c ARGS ${el})
 endforeach()
-fcm_sim_test(sim_alloc_failure tests/sim/alloc_failure.c)
+fcm_add_test(sim_alloc_failure tests/sim/alloc_failure.c)
 # Allocation failures with a body-force field, a traction, and the energy query.
-fcm_sim_test(sim_alloc_effects tests/sim/alloc_effects.c)
-# Issue 19: MINRES + Schwarz on the unprojected Newton systems of the example scenes converges
+fcm_add_test(sim_alloc_effects tests/sim/alloc_effects.c)
+# MINRES + Schwarz on the unprojected Newton systems of the example scenes converges
 # and agrees with the direct solve: two quick scenes, one step, by default; every scene, ten
 # steps, under slow (each scene's rules are built twice).
-fcm_sim_test(sim_minres_scenes tests/sim/minres_scenes.c
+fcm_add_test(sim_minres_scenes tests/sim/minres_scenes.c
              ARGS ${PROJECT_SOURCE_DIR}/apps/scenes 1 slingshot.json spinning_body.json)
-fcm_sim_test(sim_minres_scenes_long tests/sim/minres_scenes.c LABELS slow
+fcm_add_test(sim_minres_scenes_long tests/sim/minres_scenes.c LABELS slow
              ARGS ${PROJECT_SOURCE_DIR}/apps/scenes 10 TIMEOUT 3600)
-# Issue 19: the preconditioner's tangent (projected, linear, exact): each converges to the
+# The preconditioner's tangent (projected, linear, exact): each converges to the
 # direct solution on a hard twist of a Hex20 tube; the option is parsed and validated.
-fcm_sim_test(sim_minres_pc_tangent tests/sim/minres_pc_tangent.c)
-# Issue 19: numerically singular systems are refused by the direct path with the cause;
+fcm_add_test(sim_minres_pc_tangent tests/sim/minres_pc_tangent.c)
+# Numerically singular systems are refused by the direct path with the cause;
 # stabilized systems with tiny cut cells are not.
-fcm_sim_test(sim_singular tests/sim/singular.c)
-# Issue 15 item 6: steps after the first allocate nothing through the context (direct
+fcm_add_test(sim_singular tests/sim/singular.c)
+# Steps after the first allocate nothing through the context (direct
 # CHOLMOD with one symbolic analysis, MINRES + Schwarz, CG + Jacobi, CG + block Jacobi).
 foreach(solver direct minres-schwarz cg-jacobi cg-block minres-mg cg-mg mg)
-  fcm_sim_test(sim_step_alloc_${solver} tests/sim/step_alloc.c ARGS ${solver})
+  fcm_add_test(sim_step_alloc_${solver} tests/sim/step_alloc.c ARGS ${solver})
 endforeach()
-fcm_sim_test(sim_step_alloc_direct_tet10 tests/sim/step_alloc.c ARGS direct tet10)
-fcm_sim_test(sim_step_alloc_static tests/sim/step_alloc.c ARGS minres-schwarz hex8 static)
+fcm_add_test(sim_step_alloc_direct_tet10 tests/sim/step_alloc.c ARGS direct tet10)
+fcm_add_test(sim_step_alloc_static tests/sim/step_alloc.c ARGS minres-schwarz hex8 static)
 # Cutting between steps (host calls): mass and momenta unchanged at the cut, the halves separate.
 foreach(el tet4 tet10 hex8 hex20)
-  fcm_sim_test(sim_cut_${el} tests/sim/cut.c ARGS ${el})
+  fcm_add_test(sim_cut_${el} tests/sim/cut.c ARGS ${el})
 endforeach()
 # Reactions of constraints: minus the assembled weight and its moment in equilibrium (an
 # embedded beam clamped by a half-space of background nodes), change of momentum minus the
 # weight in dynamics; two constraints add up.
 foreach(el hex8 tet4)
-  fcm_sim_test(sim_reaction_${el} tests/sim/reaction.c ARGS ${el})
+  fcm_add_test(sim_reaction_${el} tests/sim/reaction.c ARGS ${el})
 endforeach()
-# Issue 18: Dirichlet conditions on the embedded boundary (Nitsche, penalty).
-fcm_sim_test(sim_nitsche_patch_hex8 tests/sim/nitsche.c ARGS patch hex8)
-fcm_sim_test(sim_nitsche_patch_tet4 tests/sim/nitsche.c ARGS patch tet4)
-fcm_sim_test(sim_nitsche_tangent tests/sim/nitsche.c ARGS tangent)
-fcm_sim_test(sim_nitsche_penalty tests/sim/nitsche.c ARGS penalty)
-fcm_sim_test(sim_nitsche_solvers tests/sim/nitsche.c ARGS solvers)
-fcm_sim_test(sim_nitsche_errors tests/sim/nitsche.c ARGS errors)
-fcm_sim_test(sim_nitsche_rigid tests/sim/nitsche.c ARGS rigid)
+# Dirichlet conditions on the embedded boundary (Nitsche, penalty).
+fcm_add_test(sim_nitsche_patch_hex8 tests/sim/nitsche.c ARGS patch hex8)
+fcm_add_test(sim_nitsche_patch_tet4 tests/sim/nitsche.c ARGS patch tet4)
+fcm_add_test(sim_nitsche_tangent tests/sim/nitsche.c ARGS tangent)
+fcm_add_test(sim_nitsche_penalty tests/sim/nitsche.c ARGS penalty)
+fcm_add_test(sim_nitsche_solvers tests/sim/nitsche.c ARGS solvers)
+fcm_add_test(sim_nitsche_errors tests/sim/nitsche.c ARGS errors)
+fcm_add_test(sim_nitsche_rigid tests/sim/nitsche.c ARGS rigid)
 # Inverted quadrature points (J = det F <= 0) counted in the step info against an independent
 # count of a prescribed fold; none for a spinning free body.
 foreach(el hex8 tet10)
-  fcm_sim_test(sim_inversion_${el} tests/sim/inversion.c ARGS ${el})
+  fcm_add_test(sim_inversion_${el} tests/sim/inversion.c ARGS ${el})
 endforeach()
 # Static steps refuse bodies the constraints leave free (no constraint, one or two fixed
 # nodes, partial supports, a cut half, a boundary constraint in one component, a released
 # region) before any solve with every solver; held bodies and dynamic runs solve; a
 # stagnating Krylov solve is the step's reason.
-fcm_sim_test(sim_rigid_modes tests/sim/rigid_modes.c)
+fcm_add_test(sim_rigid_modes tests/sim/rigid_modes.c)

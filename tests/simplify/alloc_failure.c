@@ -4,7 +4,34 @@
  * and frees everything it allocated. */
 #include "simplify/simplify_impl.h"
 #include "simplify_util.h"
-#include "test_alloc.h"
+#include "alloc_loop.h"
+
+typedef struct simplify_case {
+  fcm_ctx *ctx;
+  int m, M, n, variant;
+  const double *pts, *w;
+} simplify_case;
+
+/* One round: on success the fallback flag and (both paths) the rule are checked; a failure
+ * leaves the result empty. */
+static fcm_status simplify_round(void *user)
+{
+  simplify_case *c = user;
+  fcm_simplify_options o = fcm_simplify_options_default();
+  o.method = c->variant == 1 ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
+  fcm_simplify_result res;
+  fcm_simplify_info info;
+  fcm_status st =
+      fcm__simplify_hooked(c->ctx, c->m, c->n, c->pts, c->w, &o, c->variant == 2, &res, &info);
+  if (st == FCM_OK) {
+    TEST_TRUE(info.fallback == (c->variant == 2));
+    if (c->variant < 2) util_check("after failures", c->m, c->n, c->pts, c->w, &res, c->M, 1e-12);
+    fcm_simplify_result_destroy(&res);
+  } else if (res.count != 0 || res.indices != NULL || res.weights != NULL) {
+    return FCM_ERR_INTERNAL;
+  }
+  return st;
+}
 
 int main(void)
 {
@@ -22,38 +49,14 @@ int main(void)
   double *pts = malloc(3 * (size_t)n * sizeof *pts), *w = malloc((size_t)n * sizeof *w);
   util_random_box(5, n, lo, 2.0, 1.0, pts, w);
 
+  simplify_case c = {ctx, m, M, n, 0, pts, w};
   for (int variant = 0; variant < 3; variant++) {
-    fcm_simplify_options o = fcm_simplify_options_default();
-    o.method = variant == 1 ? FCM_SIMPLIFY_RECOMBINE : FCM_SIMPLIFY_LP;
-    int succeeded = 0, failures = 0;
-    for (long k = 0; k < 2000 && !succeeded; k++) {
-      fcm_simplify_result res;
-      fcm_simplify_info info;
-      f.count = 0;
-      f.fail_at = k;
-      fcm_status st = fcm__simplify_hooked(ctx, m, n, pts, w, &o, variant == 2, &res, &info);
-      f.fail_at = -1;
-      if (st == FCM_OK) {
-        succeeded = 1;
-        TEST_TRUE(info.fallback == (variant == 2));
-        if (variant < 2) util_check("after failures", m, n, pts, w, &res, M, 1e-12);
-        fcm_simplify_result_destroy(&res);
-      } else {
-        failures++;
-        if (st != FCM_ERR_ALLOC)
-          TEST_FAIL_("variant %d: failing allocation %ld gave %s", variant, k, fcm_status_name(st));
-        TEST_TRUE(res.count == 0 && res.indices == NULL && res.weights == NULL);
-        TEST_TRUE(fcm_ctx_error_status(ctx) == FCM_ERR_ALLOC);
-        fcm_ctx_error_clear(ctx);
-      }
-      if (fcm_ctx_live_allocations(ctx) != 0)
-        TEST_FAIL_("variant %d: %lld allocations leaked after failing allocation %ld", variant,
-                   fcm_ctx_live_allocations(ctx), k);
-    }
-    TEST_TRUE(succeeded);
-    TEST_TRUE(failures >= 8);
+    char name[32];
+    snprintf(name, sizeof name, "variant %d", variant);
+    c.variant = variant;
+    const long failures = alloc_loop(ctx, &f, name, simplify_round, NULL, &c, 8, 2000);
     if (getenv("FCM_TEST_VERBOSE"))
-      fprintf(stderr, "variant %d: %d failing allocations\n", variant, failures);
+      fprintf(stderr, "variant %d: %ld failing allocations\n", variant, failures);
   }
   free(pts);
   free(w);

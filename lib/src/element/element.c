@@ -2,6 +2,7 @@
  * reference shapes, and the dispatching evaluation, map and Jacobian functions. */
 #include "element/element_impl.h"
 #include "core/core_impl.h"
+#include "la/mat3.h"
 
 #include <math.h>
 
@@ -297,12 +298,6 @@ void fcm_element_eval_grad(fcm_element_type type, const double xi[3], double *dN
   }
 }
 
-static inline double det3(const double J[9])
-{
-  return J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6]) +
-         J[2] * (J[3] * J[7] - J[4] * J[6]);
-}
-
 /* x = sum_a N_a X_a; called with a literal n so that the loop is unrolled. */
 static inline void combine(int n, const double *N, const double *X, double x[3])
 {
@@ -327,7 +322,7 @@ static inline double jacobian(int n, const double *dN, const double *X, double J
     j6 += p2 * g0, j7 += p2 * g1, j8 += p2 * g2;
   }
   J[0] = j0, J[1] = j1, J[2] = j2, J[3] = j3, J[4] = j4, J[5] = j5, J[6] = j6, J[7] = j7, J[8] = j8;
-  return det3(J);
+  return fcm__mat3_det(J);
 }
 
 /* Tet10 Jacobian without forming dN (see tet.c, f_i = 4 L_i, c0 = 1 - 4 L0):
@@ -347,7 +342,7 @@ static double jacobian_tet10(const double *X, const double xi[3], double J[9])
     J[3 * i + 1] = x0 + (f2 - 1.0) * P[6] + (f0 - f2) * x6 + f1 * (x5 - x4) + f3 * (x9 - x7);
     J[3 * i + 2] = x0 + (f3 - 1.0) * P[9] + (f0 - f3) * x7 + f1 * (x8 - x4) + f2 * (x9 - x6);
   }
-  return det3(J);
+  return fcm__mat3_det(J);
 }
 
 /* Hex8 Jacobian from edge differences (xm = 1 - xi, xp = 1 + xi, ...):
@@ -369,7 +364,7 @@ static double jacobian_hex8(const double *X, const double xi[3], double J[9])
     J[3 * i + 1] = xmzm * (p3 - p0) + xpzm * (p2 - p1) + xmzp * (p7 - p4) + xpzp * (p6 - p5);
     J[3 * i + 2] = xmym * (p4 - p0) + xpym * (p5 - p1) + xpyp * (p6 - p2) + xmyp * (p7 - p3);
   }
-  return det3(J);
+  return fcm__mat3_det(J);
 }
 
 double fcm__element_jacobian_from_grad(int n, const double *dN, const double *X, double J[9])
@@ -420,7 +415,7 @@ double fcm_element_jacobian(fcm_element_type type, const double *X, const double
       J[3 * i + 1] = X[6 + i] - X[i];
       J[3 * i + 2] = X[9 + i] - X[i];
     }
-    return det3(J);
+    return fcm__mat3_det(J);
   case FCM_ELEMENT_TET10:
     return jacobian_tet10(X, xi, J);
   case FCM_ELEMENT_HEX8:

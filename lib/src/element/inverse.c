@@ -3,6 +3,7 @@
 #include "element/element_impl.h"
 #include "core/core_impl.h"
 #include "la/mat3.h"
+#include "la/vec3.h"
 
 #include <math.h>
 
@@ -13,11 +14,6 @@
 #define INV_MAX_HALVINGS 30    /* backtracking steps per Newton iteration */
 #define INV_ARMIJO       1e-4  /* sufficient decrease of |r| */
 
-static double norm3(const double v[3])
-{
-  return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-}
-
 /* r = x(xi) - b in coordinates relative to node 0 (Xl), so that round-off is
  * relative to the cell size and not to the distance from the origin. */
 static double residual(fcm_element_type type, const double *Xl, const double b[3],
@@ -26,7 +22,7 @@ static double residual(fcm_element_type type, const double *Xl, const double b[3
   double y[3];
   fcm_element_map(type, Xl, xi, y);
   r[0] = y[0] - b[0], r[1] = y[1] - b[1], r[2] = y[2] - b[2];
-  return norm3(r);
+  return fcm__vec3_norm(r);
 }
 
 static int singular(double det, const double J[9])

@@ -17,6 +17,7 @@
  * background or the embedded mesh needs no special case: a face lying on a triangle
  * separates, wherever it came from. */
 #include "embed/embed_impl.h"
+#include "la/vec3.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -44,18 +45,6 @@ fcm_status fcm__embed_cut_candidates(fcm_ctx *ctx, const fcm_aabb_tree *cut_tree
   return fcm__geom_tree_query(ctx, cut_tree, lo, hi, buf);
 }
 
-static double dot3(const double a[3], const double b[3])
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void cross3(const double a[3], const double b[3], double c[3])
-{
-  c[0] = a[1] * b[2] - a[2] * b[1];
-  c[1] = a[2] * b[0] - a[0] * b[2];
-  c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double c[3], int cut,
                              const unsigned char inner[3], const double *ref, fcm__cut_tri *t)
 {
@@ -77,22 +66,23 @@ int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double 
     t->lo[d] = fmin(a[d], fmin(b[d], c[d]));
     t->hi[d] = fmax(a[d], fmax(b[d], c[d]));
   }
-  cross3(e0, e1, n);
-  const double ln = sqrt(dot3(n, n));
+  fcm__vec3_cross(e0, e1, n);
+  const double ln = sqrt(fcm__vec3_dot(n, n));
   if (!(ln > 1e-14 * l2)) return 0;
   for (int d = 0; d < 3; d++)
     t->plane.n[d] = n[d] / ln;
-  t->plane.d = dot3(t->plane.n, a);
+  t->plane.d = fcm__vec3_dot(t->plane.n, a);
   if (ref) { /* the plane of the reference triangle of a coplanar patch, oriented as this one */
     double r0[3], r1[3], nr[3];
     for (int d = 0; d < 3; d++)
       r0[d] = ref[3 + d] - ref[d], r1[d] = ref[6 + d] - ref[d];
-    cross3(r0, r1, nr);
-    const double lr = sqrt(dot3(nr, nr)), sg = dot3(nr, t->plane.n) < 0.0 ? -1.0 : 1.0;
+    fcm__vec3_cross(r0, r1, nr);
+    const double lr = sqrt(fcm__vec3_dot(nr, nr)),
+                 sg = fcm__vec3_dot(nr, t->plane.n) < 0.0 ? -1.0 : 1.0;
     if (lr > 0.0) {
       for (int d = 0; d < 3; d++)
         t->plane.n[d] = sg * nr[d] / lr;
-      t->plane.d = dot3(t->plane.n, ref);
+      t->plane.d = fcm__vec3_dot(t->plane.n, ref);
     }
   }
   for (int k = 0; k < 3; k++) {
@@ -100,11 +90,12 @@ int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double 
     double e[3], m[3];
     for (int d = 0; d < 3; d++)
       e[d] = q[d] - p[d];
-    cross3(e, t->plane.n, m); /* counter-clockwise around n: e x n points out of the triangle */
-    const double lm = sqrt(dot3(m, m));
+    fcm__vec3_cross(e, t->plane.n,
+                    m); /* counter-clockwise around n: e x n points out of the triangle */
+    const double lm = sqrt(fcm__vec3_dot(m, m));
     for (int d = 0; d < 3; d++)
       t->edge[k].n[d] = m[d] / lm;
-    t->edge[k].d = dot3(t->edge[k].n, p);
+    t->edge[k].d = fcm__vec3_dot(t->edge[k].n, p);
   }
   t->cut = cut;
   return 1;
@@ -129,12 +120,12 @@ static int tri_plane(const double *x, const fcm_index *tv, fcm_index t, double n
   double u[3], v[3];
   for (int k = 0; k < 3; k++)
     u[k] = b[k] - a[k], v[k] = c[k] - a[k];
-  cross3(u, v, n);
-  const double ln = sqrt(dot3(n, n));
+  fcm__vec3_cross(u, v, n);
+  const double ln = sqrt(fcm__vec3_dot(n, n));
   if (!(ln > 0.0)) return 0;
   for (int k = 0; k < 3; k++)
     n[k] /= ln;
-  *d = dot3(n, a);
+  *d = fcm__vec3_dot(n, a);
   return 1;
 }
 
@@ -152,8 +143,8 @@ static double tri_area2(const double *x, const fcm_index *tv, fcm_index t)
   double u[3], v[3], n[3];
   for (int k = 0; k < 3; k++)
     u[k] = b[k] - a[k], v[k] = c[k] - a[k];
-  cross3(u, v, n);
-  return sqrt(dot3(n, n));
+  fcm__vec3_cross(u, v, n);
+  return sqrt(fcm__vec3_dot(n, n));
 }
 
 fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsigned char *inner,
@@ -192,14 +183,15 @@ fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsi
       e[k] = x[3 * E[i].b + k] - x[3 * E[i].a + k];
       ps[k] = x[3 * fs + k] - x[3 * E[i].a + k], pr[k] = x[3 * fr + k] - x[3 * E[i].a + k];
     }
-    cross3(e, ps, cs);
-    cross3(e, pr, cr);
-    lmax = fmax(sqrt(dot3(e, e)), fmax(sqrt(dot3(ps, ps)), sqrt(dot3(pr, pr))));
-    const int s_ref = dot3(cs, cs) >= dot3(cr, cr);
+    fcm__vec3_cross(e, ps, cs);
+    fcm__vec3_cross(e, pr, cr);
+    lmax = fmax(sqrt(fcm__vec3_dot(e, e)),
+                fmax(sqrt(fcm__vec3_dot(ps, ps)), sqrt(fcm__vec3_dot(pr, pr))));
+    const int s_ref = fcm__vec3_dot(cs, cs) >= fcm__vec3_dot(cr, cr);
     const double *nref = s_ref ? ns : nr, dref = s_ref ? ds : dr;
     const double *far = x + 3 * (s_ref ? fr : fs);
-    if (fabs(dot3(nref, far) - dref) > 1e-12 * lmax) continue;
-    if (!(dot3(cs, nref) * dot3(cr, nref) < 0.0)) continue;
+    if (fabs(fcm__vec3_dot(nref, far) - dref) > 1e-12 * lmax) continue;
+    if (!(fcm__vec3_dot(cs, nref) * fcm__vec3_dot(cr, nref) < 0.0)) continue;
     inner[E[i].slot] = inner[E[i + 1].slot] = 1;
     const fcm_index ra = tri_find(ref, s), rb = tri_find(ref, r);
     if (ra != rb) ref[FCM_MAX(ra, rb)] = FCM_MIN(ra, rb);
@@ -325,7 +317,7 @@ static void plane_range(const fcm__poly *p, const fcm__plane *pl, double *lo, do
 {
   *lo = HUGE_VAL, *hi = -HUGE_VAL;
   for (int i = 0; i < p->nv; i++) {
-    const double s = dot3(pl->n, p->x[i]) - pl->d;
+    const double s = fcm__vec3_dot(pl->n, p->x[i]) - pl->d;
     *lo = fmin(*lo, s), *hi = fmax(*hi, s);
   }
 }
@@ -403,7 +395,7 @@ static int face_plane(const fcm__poly *p, int f, fcm__plane *pl)
     n[1] += (a[2] - b[2]) * (a[0] + b[0]);
     n[2] += (a[0] - b[0]) * (a[1] + b[1]);
   }
-  if (!(dot3(n, n) > 0.0)) return 0;
+  if (!(fcm__vec3_dot(n, n) > 0.0)) return 0;
   const fcm__plane *q = p->fp + f;
   if (q->n[0] == 0.0 && q->n[1] == 0.0 && q->n[2] == 0.0) return 0;
   *pl = *q;
@@ -414,7 +406,7 @@ static int face_plane(const fcm__poly *p, int f, fcm__plane *pl)
 static int points_on_plane(const double *x, int m, const fcm__plane *pl, double tol)
 {
   for (int k = 0; k < m; k++)
-    if (!(fabs(dot3(pl->n, x + 3 * k) - pl->d) <= tol)) return 0;
+    if (!(fabs(fcm__vec3_dot(pl->n, x + 3 * k) - pl->d) <= tol)) return 0;
   return 1;
 }
 
@@ -439,13 +431,13 @@ double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
     double e[3], mm[3];
     for (int d = 0; d < 3; d++)
       e[d] = q[d] - p[d];
-    cross3(e, nb_normal, mm);
-    const double lm = sqrt(dot3(mm, mm));
+    fcm__vec3_cross(e, nb_normal, mm);
+    const double lm = sqrt(fcm__vec3_dot(mm, mm));
     if (!(lm > 0.0)) continue;
     fcm__plane pl;
     for (int d = 0; d < 3; d++)
       pl.n[d] = mm[d] / lm;
-    pl.d = dot3(pl.n, p);
+    pl.d = fcm__vec3_dot(pl.n, p);
     m = fcm__geom_polygon_clip(x, m, FCM__POLY_MAX_VERTS, &pl, tol, 1, work);
   }
   if (m < 3) return 0.0;
@@ -458,7 +450,7 @@ double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
   }
   if (overlap) memcpy(overlap, x, 3 * (size_t)m * sizeof *x);
   if (num_overlap) *num_overlap = m;
-  return 0.5 * sqrt(dot3(n, n));
+  return 0.5 * sqrt(fcm__vec3_dot(n, n));
 }
 
 /* Whether point x lies on one of the triangles within tol. */
@@ -467,10 +459,10 @@ static int point_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n
 {
   for (size_t k = 0; k < n; k++) {
     const fcm__cut_tri *t = tris + ids[k];
-    if (fabs(dot3(t->plane.n, x) - t->plane.d) > tol) continue;
+    if (fabs(fcm__vec3_dot(t->plane.n, x) - t->plane.d) > tol) continue;
     int in = 1;
     for (int e = 0; e < 3 && in; e++)
-      in = dot3(t->edge[e].n, x) - t->edge[e].d <= tol; /* inner edges too: a point beyond
+      in = fcm__vec3_dot(t->edge[e].n, x) - t->edge[e].d <= tol; /* inner edges too: a point beyond
                                                             an outer edge of the patch is off */
     if (in) return 1;
   }
@@ -496,7 +488,7 @@ static int part_side(const double *v, int nv, const fcm__plane *pl, double tol)
 {
   double lo = HUGE_VAL, hi = -HUGE_VAL;
   for (int k = 0; k < nv; k++) {
-    const double sd = dot3(pl->n, v + 3 * k) - pl->d;
+    const double sd = fcm__vec3_dot(pl->n, v + 3 * k) - pl->d;
     lo = fmin(lo, sd), hi = fmax(hi, sd);
   }
   if (lo >= -tol && hi > tol) return 1;
@@ -561,7 +553,7 @@ static int parts_connected(const fcm__embed_cell *cell, const fcm__cut_tri *tris
     if (pa->n[0] == 0.0 && pa->n[1] == 0.0 && pa->n[2] == 0.0) continue;
     for (int fb = 0; fb < b->nf; fb++) {
       const fcm__plane *pb = fp + j * FCM__POLY_MAX_FACES + fb;
-      if (dot3(pa->n, pb->n) > -0.5) continue;
+      if (fcm__vec3_dot(pa->n, pb->n) > -0.5) continue;
       const int na = face_coords(a, fa, xa), nb = face_coords(b, fb, xb);
       if (!points_on_plane(xa, na, pb, mtol) || !points_on_plane(xb, nb, pa, mtol)) continue;
       if (fcm__embed_linked(xa, na, a->x[0], a->nv, xb, nb, b->x[0], b->nv, pb->n, mtol, atol, tris,
@@ -708,7 +700,7 @@ int fcm__embed_clip_to_part(const fcm__parts *P, size_t i, double *x, int n, int
   for (int f = 0; f < p->nf && n >= 3; f++) {
     fcm__plane pl;
     if (!face_plane(p, f, &pl)) continue;
-    n = fcm__geom_polygon_clip(x, n, cap, &pl, P->tol[i], dot3(nrm, pl.n) > 0.0, work);
+    n = fcm__geom_polygon_clip(x, n, cap, &pl, P->tol[i], fcm__vec3_dot(nrm, pl.n) > 0.0, work);
   }
   return n;
 }
@@ -725,11 +717,11 @@ fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, f
       if (!face_plane(p, f, &pl)) continue;
       for (int g = 0; g < cell->num_planes; g++) {
         const fcm__plane *cp = cell->planes + g;
-        if (dot3(pl.n, cp->n) < 0.5) continue;
+        if (fcm__vec3_dot(pl.n, cp->n) < 0.5) continue;
         const size_t m = (size_t)p->fn[f], mv = m + (size_t)p->nv;
         int on = 1;
         for (size_t k = 0; k < m && on; k++)
-          on = fabs(dot3(cp->n, p->x[p->fv[f][k]]) - cp->d) <= mtol;
+          on = fabs(fcm__vec3_dot(cp->n, p->x[p->fv[f][k]]) - cp->d) <= mtol;
         if (!on) continue;
         if (P->nfp + 1 > P->capfp) {
           const size_t cap = P->capfp ? 2 * P->capfp : 64;

@@ -9,22 +9,11 @@
  * is well conditioned. The cap face is bounded by the kept faces' edges on the plane,
  * chained into cycles. */
 #include "geom/geom_impl.h"
+#include "la/vec3.h"
 
 #include <float.h>
 #include <math.h>
 #include <string.h>
-
-static double dot3(const double a[3], const double b[3])
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void cross3(const double a[3], const double b[3], double c[3])
-{
-  c[0] = a[1] * b[2] - a[2] * b[1];
-  c[1] = a[2] * b[0] - a[0] * b[2];
-  c[2] = a[0] * b[1] - a[1] * b[0];
-}
 
 void fcm__geom_poly_from_cell(fcm_element_type type, const double *X, fcm__poly *p)
 {
@@ -56,12 +45,12 @@ int fcm__geom_cell_planes(const fcm_element_info *info, const double *X, fcm__pl
       for (int d = 0; d < 3; d++)
         c[d] += a[d] / nc;
     }
-    const double len = sqrt(dot3(n, n));
+    const double len = sqrt(fcm__vec3_dot(n, n));
     fcm__plane *pl = planes + f;
     if (len > 0.0) {
       for (int d = 0; d < 3; d++)
         pl->n[d] = n[d] / len;
-      pl->d = dot3(pl->n, c);
+      pl->d = fcm__vec3_dot(pl->n, c);
     } else {
       pl->n[0] = pl->n[1] = pl->n[2] = 0.0;
       pl->d = 0.0;
@@ -98,16 +87,16 @@ static void sort_cap(const fcm__poly *p, const double n[3], int *ids, int k)
       c[d] += p->x[ids[i]][d] / k;
   /* u: any unit vector orthogonal to n; v = n x u. */
   const double ax[3] = {fabs(n[0]) < 0.6 ? 1.0 : 0.0, fabs(n[0]) < 0.6 ? 0.0 : 1.0, 0.0};
-  cross3(n, ax, u);
-  const double lu = sqrt(dot3(u, u));
+  fcm__vec3_cross(n, ax, u);
+  const double lu = sqrt(fcm__vec3_dot(u, u));
   for (int d = 0; d < 3; d++)
     u[d] /= lu;
-  cross3(n, u, v);
+  fcm__vec3_cross(n, u, v);
   for (int i = 0; i < k; i++) {
     double r[3];
     for (int d = 0; d < 3; d++)
       r[d] = p->x[ids[i]][d] - c[d];
-    ang[i] = atan2(dot3(r, v), dot3(r, u));
+    ang[i] = atan2(fcm__vec3_dot(r, v), fcm__vec3_dot(r, u));
   }
   for (int i = 1; i < k; i++) { /* insertion sort: k is small */
     const double a = ang[i];
@@ -240,7 +229,7 @@ int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__pol
   if (p->nf == 0) return 0;
   if (pl->n[0] == 0.0 && pl->n[1] == 0.0 && pl->n[2] == 0.0) return 0;
   for (int i = 0; i < p->nv; i++) {
-    s[i] = dot3(pl->n, p->x[i]) - pl->d;
+    s[i] = fcm__vec3_dot(pl->n, p->x[i]) - pl->d;
     sg[i] = s[i] > tol ? 1 : (s[i] < -tol ? -1 : 0);
     any_out |= sg[i] > 0;
     any_in |= sg[i] < 0;
@@ -359,8 +348,8 @@ static int fan_tets(const fcm__poly *p, const double c[3], int skip, double *tet
       double ra[3], rb[3], re[3], cr[3];
       for (int d = 0; d < 3; d++)
         ra[d] = a[d] - c[d], rb[d] = b[d] - c[d], re[d] = e[d] - c[d];
-      cross3(ra, rb, cr);
-      const double v = dot3(cr, re) / 6.0;
+      fcm__vec3_cross(ra, rb, cr);
+      const double v = fcm__vec3_dot(cr, re) / 6.0;
       if (v < 0.0) *neg += v;
       if (tets) {
         double *t = tets + 12 * nt;
@@ -416,8 +405,8 @@ double fcm__geom_poly_volume(const fcm__poly *p)
       double ra[3], rb[3], re[3], cr[3];
       for (int d = 0; d < 3; d++)
         ra[d] = a[d] - c[d], rb[d] = b[d] - c[d], re[d] = e[d] - c[d];
-      cross3(ra, rb, cr);
-      v += dot3(cr, re) / 6.0;
+      fcm__vec3_cross(ra, rb, cr);
+      v += fcm__vec3_dot(cr, re) / 6.0;
     }
   }
   return v;
@@ -432,7 +421,7 @@ int fcm__geom_polygon_clip(double *x, int n, int cap, const fcm__plane *pl, doub
   if (n > FCM__POLY_MAX_VERTS) return -1;
   if (pl->n[0] == 0.0 && pl->n[1] == 0.0 && pl->n[2] == 0.0) return n;
   for (int i = 0; i < n; i++) {
-    s[i] = dot3(pl->n, x + 3 * i) - pl->d;
+    s[i] = fcm__vec3_dot(pl->n, x + 3 * i) - pl->d;
     sg[i] = s[i] > tol ? 1 : (s[i] < -tol ? -1 : 0);
     any_out |= sg[i] > 0;
     any_in |= sg[i] < 0;

@@ -1,10 +1,6 @@
 /* fcm geom, internal part: the geometry and AABB-tree structs, and the convex
  * polyhedron / polygon clipping kernels the embed module runs per background cell.
- *
- * Module dependencies (one way, below geom): element — the face tables of Tet4/Hex8
- * (element_info) and the cell size; mesh — the Gmsh reader behind
- * fcm_geometry_create_from_gmsh() and the face matcher fcm__mesh_match_faces() behind
- * the boundary triangles (geometry.c). Neither module uses geom. */
+ * What geom may use: lib/docs/architecture.md. */
 #ifndef FCM_GEOM_IMPL_H
 #define FCM_GEOM_IMPL_H
 

@@ -2,6 +2,7 @@
  * taken over), boundary triangles, affine transformation, accessors, view. */
 #include "geom/geom_impl.h"
 #include "element/element_impl.h"
+#include "la/vec3.h"
 #include "mesh/mesh_impl.h"
 
 #include <math.h>
@@ -15,9 +16,7 @@ static double tet_volume(const double *a, const double *b, const double *c, cons
   const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
   const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
   const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-  return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-          u[2] * (v[0] * w[1] - v[1] * w[0])) /
-         6.0;
+  return fcm__vec3_det(u, v, w) / 6.0;
 }
 
 static void gather(const fcm_geometry *g, fcm_index c, double *X)

@@ -2,6 +2,7 @@
  * background grid (nodes shared through lattice and edge keys), and built-in implicits. */
 #include "geom/geom_impl.h"
 #include "fcm/levelset.h"
+#include "la/vec3.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -123,9 +124,7 @@ static fcm_status add_tri(builder *B, lnode a, lnode b, lnode c, const double o[
   double e1[3], e2[3], e3[3];
   for (int k = 0; k < 3; k++)
     e1[k] = b.x[k] - a.x[k], e2[k] = c.x[k] - a.x[k], e3[k] = o[k] - a.x[k];
-  const double det = e1[0] * (e2[1] * e3[2] - e2[2] * e3[1]) -
-                     e1[1] * (e2[0] * e3[2] - e2[2] * e3[0]) +
-                     e1[2] * (e2[0] * e3[1] - e2[1] * e3[0]);
+  const double det = fcm__vec3_det(e1, e2, e3);
   if (B->ntri == B->tcap) {
     const size_t nc = B->tcap ? 2 * B->tcap : 1024;
     FCM_TRY(B->ctx, fcm__resize(B->ctx, (void **)&B->tri, 3 * B->tcap, 3 * nc, sizeof(lnode)));
@@ -183,9 +182,7 @@ static fcm_status emit(builder *B, lnode a, lnode b, lnode c, lnode d)
   double e1[3], e2[3], e3[3];
   for (int k = 0; k < 3; k++)
     e1[k] = b.x[k] - a.x[k], e2[k] = c.x[k] - a.x[k], e3[k] = d.x[k] - a.x[k];
-  const double det = e1[0] * (e2[1] * e3[2] - e2[2] * e3[1]) -
-                     e1[1] * (e2[0] * e3[2] - e2[2] * e3[0]) +
-                     e1[2] * (e2[0] * e3[1] - e2[1] * e3[0]);
+  const double det = fcm__vec3_det(e1, e2, e3);
   B->volume += fabs(det) / 6.0;
   if (!B->store) return FCM_OK;
   if (B->nt == B->cap) {

@@ -2,6 +2,7 @@
  * mapped Kuhn-split structured grid; hollow ball with holes from a radially extruded
  * cube-sphere surface grid split into prisms and tets. */
 #include "geom/geom_impl.h"
+#include "la/vec3.h"
 
 #include <math.h>
 #include <string.h>
@@ -229,8 +230,7 @@ static double tet_vol6(const double *a, const double *b, const double *c, const 
   const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
   const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
   const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-  return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-         u[2] * (v[0] * w[1] - v[1] * w[0]);
+  return fcm__vec3_det(u, v, w);
 }
 
 /* Most shells of a hollow ball (one drop flag per layer lives on the stack). */

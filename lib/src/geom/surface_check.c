@@ -2,6 +2,7 @@
  * enclosed volume, degenerate triangles, self-intersections, consistent orientation and
  * hole filling. */
 #include "geom/surface_impl.h"
+#include "la/vec3.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -49,30 +50,13 @@ cleanup:
 
 /* ---------------------------------------------------------------- predicates */
 
-static void sub(const double *a, const double *b, double *r)
-{
-  r[0] = a[0] - b[0], r[1] = a[1] - b[1], r[2] = a[2] - b[2];
-}
-
-static void cross(const double *a, const double *b, double *r)
-{
-  r[0] = a[1] * b[2] - a[2] * b[1];
-  r[1] = a[2] * b[0] - a[0] * b[2];
-  r[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static double dot(const double *a, const double *b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
 /* 6 x the signed volume of (a, b, c, d). */
 static double orient3(const double *a, const double *b, const double *c, const double *d)
 {
   double u[3], v[3], w[3], n[3];
-  sub(b, a, u), sub(c, a, v), sub(d, a, w);
-  cross(u, v, n);
-  return dot(n, w);
+  fcm__vec3_sub(b, a, u), fcm__vec3_sub(c, a, v), fcm__vec3_sub(d, a, w);
+  fcm__vec3_cross(u, v, n);
+  return fcm__vec3_dot(n, w);
 }
 
 /* Sign with a tolerance: |x| <= eps counts as 0. */
@@ -121,8 +105,8 @@ static int seg_tri(const double *p, const double *q, const double *a, const doub
   if (dp * dq > 0) return 0;
   if (dp == 0 && dq == 0) { /* coplanar: 2D test in the plane's dominant projection */
     double u[3], v[3], n[3];
-    sub(b, a, u), sub(c, a, v);
-    cross(u, v, n);
+    fcm__vec3_sub(b, a, u), fcm__vec3_sub(c, a, v);
+    fcm__vec3_cross(u, v, n);
     int k = fabs(n[0]) >= fabs(n[1]) ? (fabs(n[0]) >= fabs(n[2]) ? 0 : 2)
                                      : (fabs(n[1]) >= fabs(n[2]) ? 1 : 2);
     int i = (k + 1) % 3, j = (k + 2) % 3;
@@ -165,13 +149,13 @@ static int tri_tri(const fcm_surface *s, fcm_index t, fcm_index u)
     /* the shared edge's vertices are the two of A other than oa */
     const double *e0 = a[(oa + 1) % 3], *e1 = a[(oa + 2) % 3];
     double g1[3], g2[3], n[3], w1[3], w2[3], c1[3], c2[3];
-    sub(a[1], a[0], g1), sub(a[2], a[0], g2);
-    cross(g1, g2, n);
+    fcm__vec3_sub(a[1], a[0], g1), fcm__vec3_sub(a[2], a[0], g2);
+    fcm__vec3_cross(g1, g2, n);
     double d[3];
-    sub(e1, e0, d);
-    sub(a[oa], e0, w1), sub(b[ob], e0, w2);
-    cross(d, w1, c1), cross(d, w2, c2);
-    return dot(c1, n) * dot(c2, n) > 0;
+    fcm__vec3_sub(e1, e0, d);
+    fcm__vec3_sub(a[oa], e0, w1), fcm__vec3_sub(b[ob], e0, w2);
+    fcm__vec3_cross(d, w1, c1), fcm__vec3_cross(d, w2, c2);
+    return fcm__vec3_dot(c1, n) * fcm__vec3_dot(c2, n) > 0;
   }
   if (shared == 1) {
     /* common vertex: the edge opposite it in one triangle against the other triangle */
@@ -272,10 +256,10 @@ fcm_status fcm_surface_check(const fcm_surface *s, const fcm_surface_check_optio
     const fcm_index *T = s->tris + 3 * t;
     const double *a = x + 3 * T[0], *b = x + 3 * T[1], *c = x + 3 * T[2];
     double u[3], v[3], w[3], n[3];
-    sub(b, a, u), sub(c, a, v), sub(c, b, w);
-    cross(u, v, n);
-    double twice = sqrt(dot(n, n));
-    double L2 = fmax(dot(u, u), fmax(dot(v, v), dot(w, w)));
+    fcm__vec3_sub(b, a, u), fcm__vec3_sub(c, a, v), fcm__vec3_sub(c, b, w);
+    fcm__vec3_cross(u, v, n);
+    double twice = sqrt(fcm__vec3_dot(n, n));
+    double L2 = fmax(fcm__vec3_dot(u, u), fmax(fcm__vec3_dot(v, v), fcm__vec3_dot(w, w)));
     r->area += 0.5 * twice;
     /* det(a, b, c) / 6, summed: the divergence theorem with the field x / 3 */
     r->signed_volume += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
@@ -573,8 +557,8 @@ fcm_status fcm_surface_create_oriented(fcm_ctx *ctx, const fcm_surface *src, fcm
     const double *a = src->coords + 3 * T[0], *b = src->coords + 3 * T[1],
                  *c = src->coords + 3 * T[2];
     double n[3];
-    cross(b, c, n);
-    vol += dot(a, n);
+    fcm__vec3_cross(b, c, n);
+    vol += fcm__vec3_dot(a, n);
   }
   fcm_index nflip = 0;
   for (fcm_index t = 0; t < m; t++) {
@@ -607,9 +591,9 @@ fcm_surface_fill_options fcm_surface_fill_options_default(void)
 static double tri_area(const double *a, const double *b, const double *c)
 {
   double u[3], v[3], n[3];
-  sub(b, a, u), sub(c, a, v);
-  cross(u, v, n);
-  return 0.5 * sqrt(dot(n, n));
+  fcm__vec3_sub(b, a, u), fcm__vec3_sub(c, a, v);
+  fcm__vec3_cross(u, v, n);
+  return 0.5 * sqrt(fcm__vec3_dot(n, n));
 }
 
 /* Loops up to this size are triangulated by the minimum-area dynamic programme (O(n^3)
@@ -622,9 +606,9 @@ static double tri_area(const double *a, const double *b, const double *c)
 static void unit_normal(const double *a, const double *b, const double *c, double *n)
 {
   double u[3], v[3];
-  sub(b, a, u), sub(c, a, v);
-  cross(u, v, n);
-  double l = sqrt(dot(n, n));
+  fcm__vec3_sub(b, a, u), fcm__vec3_sub(c, a, v);
+  fcm__vec3_cross(u, v, n);
+  double l = sqrt(fcm__vec3_dot(n, n));
   if (l > 0.0) n[0] /= l, n[1] /= l, n[2] /= l;
 }
 
@@ -643,7 +627,7 @@ static double fill_weight(const double *x, const fcm_index *T, const fcm_index *
     if (sides[q] < 0) continue;
     const fcm_index *t = T + 3 * nb[sides[q]];
     unit_normal(x + 3 * t[0], x + 3 * t[1], x + 3 * t[2], no);
-    f += fold * (1.0 - dot(nn, no));
+    f += fold * (1.0 - fcm__vec3_dot(nn, no));
   }
   return w * f;
 }
@@ -731,8 +715,8 @@ fcm_status fcm_surface_create_filled(fcm_ctx *ctx, const fcm_surface *src,
     for (fcm_index i = 0; i < len; i++) {
       const double *p = src->coords + 3 * L.from[loop[i]], *q = src->coords + 3 * L.to[loop[i]];
       double d[3];
-      sub(q, p, d);
-      perim += sqrt(dot(d, d));
+      fcm__vec3_sub(q, p, d);
+      perim += sqrt(fcm__vec3_dot(d, d));
       for (int j = 0; j < 3; j++)
         c[j] += p[j] / (double)len;
     }

@@ -2,23 +2,12 @@
  * rectangle, a disc, and an affine image of any surface. */
 #include "geom/geom_impl.h"
 #include "geom/surface_impl.h"
+#include "la/vec3.h"
 
 #include <math.h>
 #include <string.h>
 
 #define PI 3.14159265358979323846
-
-static double dot3(const double a[3], const double b[3])
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void cross3(const double a[3], const double b[3], double c[3])
-{
-  c[0] = a[1] * b[2] - a[2] * b[1];
-  c[1] = a[2] * b[0] - a[0] * b[2];
-  c[2] = a[0] * b[1] - a[1] * b[0];
-}
 
 static int finite3(const double *v)
 {
@@ -31,7 +20,7 @@ static int finite3(const double *v)
 static int plane_frame(const double normal[3], const double *axis, double n[3], double u[3],
                        double v[3])
 {
-  const double ln = sqrt(dot3(normal, normal));
+  const double ln = sqrt(fcm__vec3_dot(normal, normal));
   if (!(ln > 0.0)) return 0;
   for (int d = 0; d < 3; d++)
     n[d] = normal[d] / ln;
@@ -43,14 +32,14 @@ static int plane_frame(const double normal[3], const double *axis, double n[3], 
     a[1] = fabs(n[0]) < 0.6 ? 0.0 : 1.0;
     a[2] = 0.0;
   }
-  const double an = dot3(a, n);
+  const double an = fcm__vec3_dot(a, n);
   for (int d = 0; d < 3; d++)
     u[d] = a[d] - an * n[d];
-  const double lu = sqrt(dot3(u, u));
-  if (!(lu > 1e-12 * (axis ? sqrt(dot3(a, a)) : 1.0))) return 0;
+  const double lu = sqrt(fcm__vec3_dot(u, u));
+  if (!(lu > 1e-12 * (axis ? sqrt(fcm__vec3_dot(a, a)) : 1.0))) return 0;
   for (int d = 0; d < 3; d++)
     u[d] /= lu;
-  cross3(n, u, v);
+  fcm__vec3_cross(n, u, v);
   return 1;
 }
 
@@ -93,7 +82,7 @@ fcm_status fcm_surface_create_plane(fcm_ctx *ctx, const double point[3], const d
     diag += (hi[d] - lo[d]) * (hi[d] - lo[d]);
   }
   diag = sqrt(diag);
-  const double off = dot3(n, c) - dot3(n, point);
+  const double off = fcm__vec3_dot(n, c) - fcm__vec3_dot(n, point);
   double *ring = x + 3;
   for (int k = 0; k < 4; k++) {
     const double su = (k == 0 || k == 3) ? -diag : diag, sv = k < 2 ? -diag : diag;

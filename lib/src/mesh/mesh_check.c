@@ -1,6 +1,7 @@
 /* Geometric checks of a mesh: positive Jacobian determinant at corners and at
  * caller-given reference points, and the convex / planar-face / straight-edge test. */
 #include "mesh_impl.h"
+#include "la/vec3.h"
 
 #include <math.h>
 
@@ -45,15 +46,6 @@ cleanup:
   return st;
 }
 
-static void sub3(const double *a, const double *b, double *c)
-{
-  c[0] = a[0] - b[0], c[1] = a[1] - b[1], c[2] = a[2] - b[2];
-}
-static double dot3(const double *a, const double *b)
-{
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
 int fcm_mesh_cell_is_convex(const fcm_mesh *mesh, fcm_index cell, double rtol)
 {
   const fcm_element_info *info = mesh->info;
@@ -68,8 +60,8 @@ int fcm_mesh_cell_is_convex(const fcm_mesh *mesh, fcm_index cell, double rtol)
       hi[d] = FCM_MAX(hi[d], X[3 * a + d]);
     }
   double diag[3];
-  sub3(hi, lo, diag);
-  const double tol = rtol * sqrt(dot3(diag, diag));
+  fcm__vec3_sub(hi, lo, diag);
+  const double tol = rtol * sqrt(fcm__vec3_dot(diag, diag));
 
   for (int f = 0; f < info->num_faces; f++) {
     const int fc = info->face_num_corners[f];
@@ -81,25 +73,25 @@ int fcm_mesh_cell_is_convex(const fcm_mesh *mesh, fcm_index cell, double rtol)
     /* Newell's normal: sum of cross products of consecutive corners about the centroid. */
     for (int k = 0; k < fc; k++) {
       double p[3], q[3];
-      sub3(X + 3 * fn[k], cen, p);
-      sub3(X + 3 * fn[(k + 1) % fc], cen, q);
+      fcm__vec3_sub(X + 3 * fn[k], cen, p);
+      fcm__vec3_sub(X + 3 * fn[(k + 1) % fc], cen, q);
       n[0] += p[1] * q[2] - p[2] * q[1];
       n[1] += p[2] * q[0] - p[0] * q[2];
       n[2] += p[0] * q[1] - p[1] * q[0];
     }
-    const double len = sqrt(dot3(n, n));
+    const double len = sqrt(fcm__vec3_dot(n, n));
     if (!(len > 0)) return 0;
     for (int d = 0; d < 3; d++)
       n[d] /= len;
     for (int k = 0; k < fc; k++) {
       double p[3];
-      sub3(X + 3 * fn[k], cen, p);
-      if (!(fabs(dot3(n, p)) <= tol)) return 0; /* corner off the face plane */
+      fcm__vec3_sub(X + 3 * fn[k], cen, p);
+      if (!(fabs(fcm__vec3_dot(n, p)) <= tol)) return 0; /* corner off the face plane */
     }
     for (int a = 0; a < nc; a++) {
       double p[3];
-      sub3(X + 3 * a, cen, p);
-      if (!(dot3(n, p) <= tol)) return 0; /* corner outside the face plane */
+      fcm__vec3_sub(X + 3 * a, cen, p);
+      if (!(fcm__vec3_dot(n, p) <= tol)) return 0; /* corner outside the face plane */
     }
   }
 
@@ -108,14 +100,14 @@ int fcm_mesh_cell_is_convex(const fcm_mesh *mesh, fcm_index cell, double rtol)
       const double *p = X + 3 * info->edge_nodes[e][0], *q = X + 3 * info->edge_nodes[e][1];
       const double *m = X + 3 * info->edge_nodes[e][2];
       double pq[3], pm[3], r[3];
-      sub3(q, p, pq);
-      sub3(m, p, pm);
-      const double l2 = dot3(pq, pq);
+      fcm__vec3_sub(q, p, pq);
+      fcm__vec3_sub(m, p, pm);
+      const double l2 = fcm__vec3_dot(pq, pq);
       if (!(l2 > 0)) return 0;
-      const double t = dot3(pm, pq) / l2;
+      const double t = fcm__vec3_dot(pm, pq) / l2;
       for (int d = 0; d < 3; d++)
         r[d] = pm[d] - t * pq[d];
-      if (!(sqrt(dot3(r, r)) <= tol) || !(t > 0.25 && t < 0.75)) return 0;
+      if (!(sqrt(fcm__vec3_dot(r, r)) <= tol) || !(t > 0.25 && t < 0.75)) return 0;
     }
   }
   return 1;
