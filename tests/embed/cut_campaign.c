@@ -19,7 +19,9 @@
  * ("campaign N"): N random tets with most coordinates snapped to the planes -1, -1/2, 0, 1/2,
  * 1 (plus an offset of 0 or +-1e-15 .. 1e-6) and random rotated boxes (hex8 geometry), each
  * with rules of strength 1 .. 3, initial and simplified, min_fraction 0 (no volume may go).
- * Usage: embed_cut_campaign catalogue | campaign N [seed] [verbose] */
+ * Usage: embed_cut_campaign catalogue | campaign N [seed] [verbose] [first]
+ *   verbose 1 names every case, 2 also prints its tets; first: the cases before it are drawn
+ *   (the same sequence) but not checked, so `campaign K+1 seed 2 K` repeats case K alone. */
 #include "fcm/embed.h"
 #include "../geom/exact.h"
 #include "test.h"
@@ -405,7 +407,8 @@ static double snapped(unsigned long long *rng)
   return fmin(1.0, fmax(-1.0, x));
 }
 
-static void campaign(fcm_mesh *const meshes[2], long long n, unsigned long long seed)
+static void campaign(fcm_mesh *const meshes[2], long long first, long long n,
+                     unsigned long long seed)
 {
   unsigned long long rng = seed;
   char name[96];
@@ -461,7 +464,18 @@ static void campaign(fcm_mesh *const meshes[2], long long n, unsigned long long 
         continue;
       }
     }
-    if (verbose) fprintf(stderr, "%s\n", gc.what);
+    if (i < first) { /* drawn (the same sequence), not checked */
+      fcm_geometry_destroy(&gc.g);
+      continue;
+    }
+    if (verbose) {
+      fprintf(stderr, "%s\n", gc.what);
+      if (verbose > 1)
+        for (int t = 0; t < gc.ntet; t++)
+          for (int a = 0; a < 4; a++)
+            fprintf(stderr, "  tet %d vertex %d: %.17g %.17g %.17g\n", t, a, gc.tet[t][a][0],
+                    gc.tet[t][a][1], gc.tet[t][a][2]);
+    }
     for (int k = 0; k < 2; k++)
       for (int simplify = 0; simplify < 2; simplify++)
         check(meshes[k], &gc, m, simplify);
@@ -473,13 +487,14 @@ static void campaign(fcm_mesh *const meshes[2], long long n, unsigned long long 
 int main(int argc, char **argv)
 {
   if (argc < 2 || (strcmp(argv[1], "catalogue") && strcmp(argv[1], "campaign"))) {
-    fprintf(stderr, "usage: %s catalogue | campaign N [seed] [verbose]\n", argv[0]);
+    fprintf(stderr, "usage: %s catalogue | campaign N [seed] [verbose] [first]\n", argv[0]);
     return 2;
   }
   const int is_campaign = strcmp(argv[1], "campaign") == 0;
   const long long n = is_campaign && argc > 2 ? atoll(argv[2]) : 0;
   const unsigned long long seed = is_campaign && argc > 3 ? strtoull(argv[3], NULL, 10) : 19;
-  verbose = argc > (is_campaign ? 4 : 2);
+  verbose = argc > (is_campaign ? 4 : 2) ? (is_campaign ? atoi(argv[4]) : 1) : 0;
+  const long long first = is_campaign && argc > 5 ? atoll(argv[5]) : 0;
   TEST_OK(NULL, fcm_ctx_create(NULL, &ctx));
   const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
   const fcm_index cells[3] = {2, 2, 2};
@@ -488,7 +503,7 @@ int main(int argc, char **argv)
   TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_TET4, lo, hi, cells, &meshes[1]));
   if (meshes[0] && meshes[1]) {
     if (is_campaign)
-      campaign(meshes, n, seed ? seed : 19);
+      campaign(meshes, first, n, seed ? seed : 19);
     else
       catalogue(meshes);
   }

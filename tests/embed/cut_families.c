@@ -25,8 +25,9 @@
  * THICK = 1e-6 h (1000 times the cuts' tolerance, 1e-9 of the cell diagonal).
  * The catalogue ("catalogue") holds three configurations that once failed, with their exact
  * body counts: a plane tilted 1e-7 off a grid plane across a box (2 bodies), two parallel
- * planes 1e-7 apart near a face of the box (2, then 3, no error) and a grid plane through a
- * ring (2).
+ * planes 1e-7 apart near a face of the box (2, then 3, no error), a grid plane through a
+ * ring (2), and two and three crossing planes whose slivers fold over within the tolerance
+ * (per-cell volumes).
  * Usage: embed_cut_families catalogue | campaign N [seed] [verbose]
  *                          | one BODY ELEMENT px py pz nx ny nz [px py pz nx ny nz ...]
  *   campaign: N random cases per background element (each body and family in turn);
@@ -750,6 +751,18 @@ static void catalogue(body *B)
     normalize(p2[0].n);
     normalize(p2[1].n);
     run_case(&B[0], elements[t], &S, p2, 2, "parallel planes near a face");
+    /* a plane 1e-8 off a grid plane, then a plane nearly parallel to it crossing it in the
+     * box: a sliver part whose faces on the two planes fold over (negative fan tets) */
+    plane p5[2] = {
+        {{1, 1, 1}, {1, 1.7149840491529018e-09, 9.8518439751729277e-09}},
+        {{0.99999999242917037, 1.5, 1.5}, {-1, 9.1202170900265598e-12, -4.1014192946817134e-12}}};
+    run_case(&B[0], elements[t], &S, p5, 2, "crossing planes 1e-8 apart");
+    /* three crossing near-grid planes meeting in a sliver of the same kind */
+    plane p6[3] = {
+        {{1, 1, 1}, {-7.9983454556696551e-08, -6.0022054256554901e-08, -0.999999999999995}},
+        {{1, 1, 1}, {-8.7445113917872581e-07, 0.99999999999950007, -4.8511360029244238e-07}},
+        {{1.5, 1, 0.99999999718382615}, {-7.9157074915949725e-10, -6.1107753114893059e-10, -1}}};
+    run_case(&B[0], elements[t], &S, p6, 3, "crossing planes");
     setup_destroy(&S);
     /* a grid plane and a tilted plane through the ring: 2 bodies */
     setup_create(&B[2], elements[t], &S);

@@ -157,19 +157,33 @@ fcm_status fcm__embed_append_tets(fcm_ctx *ctx, fcm__embed_ws *ws, const fcm__po
   double *t = ws->tets + 12 * ws->num_tets, *v = ws->vol + ws->num_tets;
   const int made = fcm__geom_poly_tets(p, t, v);
   int kept = 0;
+  double neg = 0.0, sum = 0.0;
   for (int i = 0; i < made; i++) {
     if (!(v[i] > vmin)) {
       (*nslivers)++;
       if (v[i] > 0.0) *lost += v[i];
+      if (v[i] < 0.0) neg += v[i];
       continue;
     }
     if (kept != i) {
       memmove(t + 12 * kept, t + 12 * i, 12 * sizeof *t);
       v[kept] = v[i];
     }
-    *vsum += v[i];
+    sum += v[i];
     kept++;
   }
+  /* A part the tolerances left slightly non-convex (vertices taken as on a plane within the
+   * tolerance) can have fan tets of negative volume from every apex (fcm__geom_poly_tets
+   * takes the least): they get no points, and the others are scaled so that the part keeps
+   * its volume, the signed sum of its tets; what that moves is no more than the negative
+   * volume, the tolerance times the part's faces. */
+  if (neg < 0.0 && sum + neg > 0.0) {
+    const double f = (sum + neg) / sum;
+    for (int i = 0; i < kept; i++)
+      v[i] *= f;
+    sum += neg;
+  }
+  *vsum += sum;
   ws->num_tets += (size_t)kept;
 cleanup:
   return st;

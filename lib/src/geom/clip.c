@@ -6,8 +6,8 @@
  * a plane once (with a tolerance relative to the cell size) and that sign decides every
  * face it belongs to, so neighbouring faces agree on the topology. New vertices are
  * made only on edges with ends strictly on opposite sides, hence t = s_a / (s_a - s_b)
- * is well conditioned. The cap face is the convex polygon of the on-plane vertices,
- * ordered by angle around the plane normal. */
+ * is well conditioned. The cap face is bounded by the kept faces' edges on the plane,
+ * chained into cycles. */
 #include "geom/geom_impl.h"
 #include "la/vec3.h"
 
@@ -77,7 +77,8 @@ static int edge_vertex(const fcm__poly *in, const double *s, int a, int b, int (
   return id;
 }
 
-/* Order the on-plane vertices `ids` (k of them) counter-clockwise around n. */
+/* Order the on-plane vertices `ids` (k of them) counter-clockwise around n: the cap of a
+ * convex part whose boundary edges could not be chained. */
 static void sort_cap(const fcm__poly *p, const double n[3], int *ids, int k)
 {
   double c[3] = {0, 0, 0}, u[3], v[3], ang[FCM__POLY_MAX_VERTS];
@@ -107,10 +108,15 @@ static void sort_cap(const fcm__poly *p, const double n[3], int *ids, int k)
     }
     ang[j] = a, ids[j] = id;
   }
-  /* start the cycle at the lexicographically smallest vertex: the two halves of a split
-   * share the cap's vertices bitwise but sort them around opposite normals; starting both
-   * at the same vertex gives both the same fan triangles, so their volumes add up exactly
-   * even where vertices within the tolerance of the plane make the cap slightly non-planar */
+}
+
+/* Rotate the cycle ids (k vertices) to start at its lexicographically smallest vertex: the
+ * two halves of a split share the cap's vertices bitwise and traverse them in opposite
+ * directions; starting both at the same vertex gives both the same fan triangles, so their
+ * volumes add up exactly even where vertices within the tolerance of the plane make the cap
+ * slightly non-planar. */
+static void start_at_smallest(const fcm__poly *p, int *ids, int k)
+{
   int first = 0;
   for (int i = 1; i < k; i++) {
     const double *a = p->x[ids[i]], *b = p->x[ids[first]];
@@ -122,11 +128,104 @@ static void sort_cap(const fcm__poly *p, const double n[3], int *ids, int k)
   memcpy(ids, rot, (size_t)k * sizeof *ids);
 }
 
+#define CAP_EDGES (4 * FCM__POLY_MAX_VERTS)
+
+/* The cap's boundary as cycles of output vertices, counter-clockwise seen from outside the
+ * kept part: every edge of the first nf faces of `out` with both ends on the plane (on[]) is
+ * an edge of the cap, traversed the other way. Chaining these edges instead of sorting the
+ * on-plane vertices by angle keeps the cap right where the tolerances left the part
+ * slightly non-convex (a flat flap on a cut lying over the part's face). The kept faces that
+ * lie on the plane count too: their edges, reversed, cancel the others' along them, so the
+ * cap covers what those faces do not (nothing when one of them is the whole cross-section).
+ * The closed walks are split where they touch themselves; walks of two vertices (no area)
+ * are dropped. cyc gets the cycles one after another, len
+ * their lengths. Returns their count, or -1 when the edges do not chain (a vertex with more
+ * edges in than out, or too many edges). */
+static int cap_cycles(const fcm__poly *out, int nf, const unsigned char *on, int *cyc, int *len)
+{
+  int from[CAP_EDGES], to[CAP_EDGES], ne = 0, deg[FCM__POLY_MAX_VERTS] = {0};
+  unsigned char used[CAP_EDGES] = {0};
+  for (int f = 0; f < nf; f++)
+    for (int j = 0; j < out->fn[f]; j++) {
+      const int u = out->fv[f][j], v = out->fv[f][(j + 1) % out->fn[f]];
+      if (!on[u] || !on[v]) continue;
+      if (ne == CAP_EDGES) return -1;
+      from[ne] = v, to[ne] = u, ne++;
+      deg[v]++, deg[u]--;
+    }
+  for (int i = 0; i < out->nv; i++)
+    if (deg[i] != 0) return -1;
+  /* an edge and its reverse (an edge of a kept face lying on the plane, or an edge on the
+   * plane that both its faces keep) bound no area: both go */
+  for (int a = 0; a < ne; a++)
+    for (int b = a + 1; b < ne && !used[a]; b++)
+      if (!used[b] && from[b] == to[a] && to[b] == from[a]) used[a] = used[b] = 1;
+  int ncyc = 0, total = 0, walk[CAP_EDGES + 1];
+  for (int e0 = 0; e0 < ne; e0++) {
+    if (used[e0]) continue;
+    int n = 0, e = e0;
+    walk[n++] = from[e0];
+    for (;;) {
+      used[e] = 1;
+      const int v = to[e];
+      int at = -1; /* where the walk was at v before */
+      for (int k = 0; k < n && at < 0; k++)
+        if (walk[k] == v) at = k;
+      if (at >= 0) {
+        if (n - at >= 3) {
+          memcpy(cyc + total, walk + at, (size_t)(n - at) * sizeof *walk);
+          len[ncyc++] = n - at, total += n - at;
+        }
+        n = at + 1;
+        if (at == 0) break;
+      } else {
+        walk[n++] = v;
+      }
+      e = -1;
+      for (int k = 0; k < ne && e < 0; k++)
+        if (!used[k] && from[k] == v) e = k;
+      if (e < 0) return -1;
+    }
+  }
+  return ncyc;
+}
+
+/* Append the cap cycle ids (k vertices) of plane pl to out as one face, or as its fan
+ * triangles when a vertex of it was taken as on the plane but lies off it beyond rounding
+ * (off[]): such a cap is not quite planar, and its planar triangles let a later split cut
+ * every face into pieces that add up to it exactly; the two halves of this split get the
+ * same triangles (start_at_smallest). Returns -1 on overflow. */
+static int store_cap(fcm__poly *out, const fcm__plane *pl, int *ids, int k,
+                     const unsigned char *off)
+{
+  int bent = 0;
+  for (int j = 0; j < k; j++)
+    bent |= off[ids[j]];
+  start_at_smallest(out, ids, k);
+  const int ntri = bent ? k - 2 : 1;
+  if (k > FCM__POLY_MAX_FV || out->nf + ntri > FCM__POLY_MAX_FACES) return -1;
+  for (int j = 0; j < ntri; j++) {
+    if (ntri > 1) {
+      out->fn[out->nf] = 3;
+      out->fv[out->nf][0] = ids[0];
+      out->fv[out->nf][1] = ids[j + 1];
+      out->fv[out->nf][2] = ids[j + 2];
+    } else {
+      out->fn[out->nf] = k;
+      memcpy(out->fv[out->nf], ids, (size_t)k * sizeof ids[0]);
+    }
+    out->fp[out->nf] = *pl;
+    out->nf++;
+  }
+  return 0;
+}
+
 int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__poly *out)
 {
   double s[FCM__POLY_MAX_VERTS];
   int sg[FCM__POLY_MAX_VERTS], newid[FCM__POLY_MAX_VERTS], cache[FCM__POLY_MAX_VERTS][3];
   int ncache = 0, any_in = 0, any_out = 0, cap_face = 0;
+  unsigned char on[FCM__POLY_MAX_VERTS]; /* by output vertex: on the plane */
   if (p->nf == 0) return 0;
   if (pl->n[0] == 0.0 && pl->n[1] == 0.0 && pl->n[2] == 0.0) return 0;
   for (int i = 0; i < p->nv; i++) {
@@ -146,6 +245,7 @@ int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__pol
     if (sg[i] <= 0) {
       newid[i] = out->nv++;
       memcpy(out->x[newid[i]], p->x[i], sizeof out->x[0]);
+      on[newid[i]] = sg[i] == 0;
     }
   }
   for (int f = 0; f < p->nf; f++) {
@@ -162,10 +262,11 @@ int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__pol
       if (sg[a] * sg[b] < 0) {
         const int e = edge_vertex(p, s, a, b, cache, &ncache, out);
         if (e < 0 || nc >= FCM__POLY_MAX_FV) goto overflow;
+        on[e] = 1;
         cyc[nc++] = e;
       }
     }
-    cap_face |= all_on;
+    cap_face |= all_on; /* kept: its edges close the cap's edges on it */
     /* a face with vertices outside and none inside keeps only on-plane vertices: what is
      * left of it lies in the cap (kept, it would be a second face on the cap's vertices) */
     if (!all_on && !inside) continue;
@@ -177,43 +278,31 @@ int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__pol
       out->nf++;
     }
   }
-  if (!cap_face) {
-    /* Cap: the new edge vertices and the kept on-plane vertices. */
-    int ids[FCM__POLY_MAX_VERTS], k = 0, kon = 0, cap_bent = 0;
+  const int nfaces_kept = out->nf;
+  {
     double scale = fabs(pl->d);
     for (int i = 0; i < p->nv; i++)
       for (int d = 0; d < 3; d++)
         scale = fmax(scale, fabs(p->x[i][d]));
+    /* off[id]: a kept vertex taken as on the plane within the tolerance but off it beyond
+     * rounding */
+    unsigned char off[FCM__POLY_MAX_VERTS] = {0};
     for (int i = 0; i < p->nv; i++)
-      if (sg[i] == 0) {
-        ids[k++] = newid[i];
-        cap_bent |= fabs(s[i]) > 16.0 * DBL_EPSILON * scale; /* off the plane beyond rounding */
-      }
-    kon = k;
-    for (int e = 0; e < ncache; e++)
-      ids[k++] = cache[e][2];
-    if (k >= 3) {
-      if (k > FCM__POLY_MAX_FV) goto overflow;
-      sort_cap(out, pl->n, ids, k);
-      /* A cap through vertices taken as on the plane within the tolerance (and off it beyond
-       * rounding) is not quite planar: stored as its fan triangles (each planar), so that a
-       * later split of this part cuts every face into pieces that add up to it exactly; the
-       * two halves of this split get the same triangles (sort_cap starts both at the same
-       * vertex). A cap on the plane up to rounding stays one polygon. */
-      const int ntri = kon > 0 && cap_bent ? k - 2 : 1;
-      if (out->nf + ntri > FCM__POLY_MAX_FACES) goto overflow;
-      for (int j = 0; j < ntri; j++) {
-        if (ntri > 1) {
-          out->fn[out->nf] = 3;
-          out->fv[out->nf][0] = ids[0];
-          out->fv[out->nf][1] = ids[j + 1];
-          out->fv[out->nf][2] = ids[j + 2];
-        } else {
-          out->fn[out->nf] = k;
-          memcpy(out->fv[out->nf], ids, (size_t)k * sizeof ids[0]);
-        }
-        out->fp[out->nf] = *pl;
-        out->nf++;
+      if (sg[i] == 0) off[newid[i]] = fabs(s[i]) > 16.0 * DBL_EPSILON * scale;
+    int cyc[CAP_EDGES], len[CAP_EDGES];
+    const int ncyc = cap_cycles(out, nfaces_kept, on, cyc, len);
+    if (ncyc >= 0) {
+      for (int c = 0, at = 0; c < ncyc; at += len[c++])
+        if (store_cap(out, pl, cyc + at, len[c], off) < 0) goto overflow;
+    } else if (!cap_face) {
+      /* edges that do not chain into cycles (a part the tolerances left out of shape): the
+       * on-plane vertices ordered by angle, the cap of the convex part it should be */
+      int ids[FCM__POLY_MAX_VERTS], k = 0;
+      for (int id = 0; id < out->nv; id++)
+        if (on[id]) ids[k++] = id;
+      if (k >= 3) {
+        sort_cap(out, pl->n, ids, k);
+        if (store_cap(out, pl, ids, k, off) < 0) goto overflow;
       }
     }
   }
