@@ -167,8 +167,7 @@ typedef enum fcm_fictitious_model {
    * force and the constant PSD tangent are consistent (a true Hessian), but not
    * rotation invariant (an O(alpha) torque under large rotations). */
   FCM_FICTITIOUS_LINEAR = 1,
-  /** The exact model with its exact (possibly indefinite) tangent: the behaviour before
-   * issue 19. */
+  /** The exact model with its exact tangent, which may be indefinite. */
   FCM_FICTITIOUS_EXACT = 2,
   FCM_FICTITIOUS_MODEL_COUNT
 } fcm_fictitious_model;

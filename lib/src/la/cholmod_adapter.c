@@ -119,7 +119,7 @@ cleanup:
   return st;
 }
 
-/* Rank check of a completed factor (issue 19): CHOLMOD accepts a numerically singular
+/* Rank check of a completed factor: CHOLMOD accepts a numerically singular
  * positive semi-definite matrix whenever rounding leaves its zero pivots positive, and
  * its rcond ((min/max diag L)^2) is no help because it mixes the scales of all rows. The
  * pivot of column j of P A P^T relative to that column's diagonal,

@@ -107,7 +107,7 @@ fcm_status fcm_direct_factor(fcm_direct *s, const double *values)
   fcm_timer_start(&t);
   if (s->n > 0) FCM_TRY(ctx, s->ops->factor(ctx, s->impl, values, &s->info));
   /* UMFPACK's rcond is min/max |diag U| of the row-scaled matrix: ~1e-16 or below for the
-   * numerically singular systems of issue 19 (free static body, too weak quadrature) whose
+   * numerically singular systems (a free static body, too weak a quadrature) whose
    * rounding-level pivot CHOLMOD turned into "not positive definite". */
   FCM_CHECK(s->method != FCM_DIRECT_UMFPACK || s->n == 0 ||
                 !(s->info.rcond < FCM__SINGULAR_UMFPACK_RCOND),
@@ -148,7 +148,7 @@ fcm_status fcm_direct_solve(fcm_direct *s, const double *b, double *x)
   }
   s->info.solves++;
   if (s->n > 0) {
-    /* Residual check (issue 19): a backward-stable solve of a nonsingular system has a
+    /* Residual check: a backward-stable solve of a nonsingular system has a
      * backward error of a few n eps; far above it the system is singular (b outside the
      * range, or a null direction blown up by a rounding-level pivot). */
     double nr = 0.0, nx = 0.0, nb = 0.0;
