@@ -33,22 +33,6 @@ fcm_rulegen_options fcm_rulegen_options_default(void)
   return o;
 }
 
-static int shape_dim(fcm_shape shape)
-{
-  switch (shape) {
-  case FCM_SHAPE_LINE:
-    return 1;
-  case FCM_SHAPE_TRI:
-  case FCM_SHAPE_QUAD:
-    return 2;
-  case FCM_SHAPE_TET:
-  case FCM_SHAPE_HEX:
-    return 3;
-  default:
-    return 0;
-  }
-}
-
 static int is_simplex(fcm_shape shape)
 {
   return shape == FCM_SHAPE_TRI || shape == FCM_SHAPE_TET;
@@ -56,7 +40,7 @@ static int is_simplex(fcm_shape shape)
 
 double fcm__rulegen_min_distance(fcm_shape shape, int n, const double *x)
 {
-  int d = shape_dim(shape);
+  int d = fcm_shape_dim(shape);
   double dmin = HUGE_VAL;
   for (int i = 0; i < n; i++) {
     const double *p = x + (size_t)d * i;
@@ -568,7 +552,7 @@ fcm_status fcm__rulegen_eliminate(fcm_ctx *ctx, fcm_shape shape, int m, int n0, 
   s.ctx = ctx;
   s.shape = shape;
   s.m = m;
-  s.d = shape_dim(shape);
+  s.d = fcm_shape_dim(shape);
   s.nc = s.d + 1;
   s.M = fcm__orthobasis_size(shape, m);
   s.cap = n0;
@@ -615,7 +599,7 @@ cleanup:
 double fcm__rulegen_residual(fcm_ctx *ctx, fcm_shape shape, int m, int n, const double *x,
                              const double *w)
 {
-  int M = fcm__orthobasis_size(shape, m), d = shape_dim(shape);
+  int M = fcm__orthobasis_size(shape, m), d = fcm_shape_dim(shape);
   double meas = fcm_shape_measure(shape), rmax = 0.0;
   double *phi = fcm__calloc(ctx, (size_t)M, sizeof *phi);
   long double *acc = fcm__calloc(ctx, (size_t)M, sizeof *acc);
@@ -638,7 +622,7 @@ double fcm__rulegen_residual(fcm_ctx *ctx, fcm_shape shape, int m, int n, const 
 
 static int shape_supported(fcm_shape shape)
 {
-  return shape_dim(shape) > 0;
+  return fcm_shape_dim(shape) > 0;
 }
 
 fcm_status fcm_rule_moment_residual(fcm_ctx *ctx, const fcm_rule *rule, int strength,
