@@ -80,10 +80,11 @@ typedef struct fcm_ctx_options {
   void *log_user;          /**< passed to `log` */
   fcm_log_level log_level; /**< messages above this level are not formatted (default
                                 WARNING: errors and warnings) */
-  int num_threads;         /**< OpenMP threads of the library's thread-count-aware loops (the
-                                cut-cell rules, fcm_cell_rules_create()), >= 1; FCM_DEFAULT
-                                (default): the OpenMP default, omp_get_max_threads(). Results
-                                do not depend on it. fcm_ctx_set_num_threads() changes it */
+  int num_threads;         /**< OpenMP threads of the library's parallel loops (cut-cell
+                                rules, assembly, solvers, preconditioners, multigrid), >= 1;
+                                FCM_DEFAULT (default): the OpenMP default at each call,
+                                omp_get_max_threads(). Results do not depend on it.
+                                fcm_ctx_set_num_threads() changes it */
 } fcm_ctx_options;
 
 /** The root object: allocator, log callback, last error. No global state exists

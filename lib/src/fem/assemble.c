@@ -445,7 +445,7 @@ struct fcm_assembly_workspace {
   fcm_assembly_options opts;
   tabulation tab[2];   /* standard rules: [0] stiffness, [1] mass */
   int tabulated[2];    /* tab[i] is built */
-  int nthreads;        /* threads the scratch serves (omp_get_max_threads() at creation) */
+  int nthreads;        /* threads the scratch serves (the context's count at creation) */
   double *mem;         /* per-thread element buffers */
   scratch *sc;         /* nthreads views into mem */
   double *cell_energy; /* num_elems: energy per element of the last hyperelastic assembly */
@@ -472,7 +472,7 @@ fcm_status fcm_assembly_workspace_create(const fcm_space *space, const fcm_assem
   ws->ctx = ctx;
   ws->space = space;
   ws->opts = opts ? *opts : fcm_assembly_options_default();
-  ws->nthreads = omp_get_max_threads();
+  ws->nthreads = fcm_ctx_num_threads(ctx);
   FCM_TRY(ctx, scratch_alloc(space, ws->nthreads, &ws->mem, &ws->sc));
   FCM_ALLOC(ctx, space->num_elems + 1, ws->cell_energy);
   FCM_ALLOC(ctx, space->num_elems + 1, ws->cell_inverted);

@@ -119,7 +119,7 @@ fcm_status fcm_space_cell_stress(const fcm_space *s, const fcm_material *mat, co
           fcm_element_standard_rule(s->ctx, s->type, FCM_RULE_STIFFNESS, FCM_DEFAULT, &full));
   {
     const fcm_index nc = s->num_cells;
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(s->ctx)) schedule(dynamic, 64)
     for (fcm_index c = 0; c < nc; c++) {
       double X[3 * FCM_ELEMENT_MAX_NODES], J[9], acc[8] = {0, 0, 0, 0, 0, 0, 0, 0}, vol = 0.0;
       fcm_mesh_cell_coords(s->mesh, c, X);

@@ -125,7 +125,7 @@ fcm_status fcm_space_locate(const fcm_space *s, fcm_index n, const double *X, fc
   double *boxes = NULL, *centroid = NULL;
   fcm_index *tree_cell = NULL, *ids = NULL, nact = 0;
   double reach = 0.0;
-  int nthreads = omp_get_max_threads();
+  const int nthreads = fcm_ctx_num_threads(ctx);
   FCM_CHECK(n >= 0 && (n == 0 || (X && cell && xi)), ctx, FCM_ERR_ARG,
             "locate: n = %lld with NULL arrays", (long long)n);
   for (fcm_index c = 0; c < s->num_cells; c++)
@@ -190,7 +190,7 @@ fcm_status fcm_space_interpolate(const fcm_space *s, fcm_index n, const fcm_inde
   fcm_index bad = -1;
   FCM_CHECK(n >= 0 && (n == 0 || (cell && xi && u && values)), s->ctx, FCM_ERR_ARG,
             "interpolate: n = %lld with NULL arrays", (long long)n);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(s->ctx)) schedule(static)
   for (fcm_index i = 0; i < n; i++) {
     fcm_index c = cell[i];
     if (c < 0 || c >= s->num_cells || !s->active[c] || s->cell_elem[c + 1] - s->cell_elem[c] != 1) {

@@ -350,7 +350,7 @@ fcm_status fcm__space_matrix_apply(const fcm_space *s, const fcm_csr *A, const d
   const double *v = fcm_csr_values_read(A);
   for (fcm_index i = 0; i < s->num_dofs; i++)
     y[i] = 0.0;
-#pragma omp parallel for schedule(static) if (nnz >= 20000)
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(ctx)) schedule(static) if (nnz >= 20000)
   for (fcm_index r = 0; r < nrow; r++) { /* distinct rows write distinct DOFs */
     double sum = 0.0;
     for (fcm_index p = rp[r]; p < rp[r + 1]; p++)
@@ -430,7 +430,7 @@ void fcm__eliminate_marked(fcm_csr *A, double *b, const unsigned char *con, cons
   const fcm_index *rp = fcm_csr_row_ptr(A);
   const int *ci = fcm_csr_col_idx(A);
   double *v = fcm_csr_values(A);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(A->ctx)) schedule(static)
   for (fcm_index i = 0; i < n; i++) {
     if (con[i]) {
       double diag = 1.0;

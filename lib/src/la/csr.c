@@ -324,7 +324,8 @@ fcm_status fcm_csr_apply(const fcm_csr *A, double alpha, const double *x, double
   const fcm_index *rp = A->row_ptr;
   const int *ci = A->col_idx;
   const double *v = A->values;
-#pragma omp parallel for schedule(static) if (A->nnz >= CSR_PARALLEL_NNZ)
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(ctx))                                     \
+    schedule(static) if (A->nnz >= CSR_PARALLEL_NNZ)
   for (fcm_index i = 0; i < n; i++) {
     double s = 0.0;
     for (fcm_index p = rp[i]; p < rp[i + 1]; p++)

@@ -88,10 +88,10 @@ struct fcm_mg {
   double *blk_r, *blk_dx;  /* blk_max entries each, per thread */
 };
 
-/* Threads of a parallel region: the caller's, at most those of the creation (scratch). */
+/* Threads of a parallel region: the context's now, at most those of the creation (scratch). */
 static inline int fcm__mg_team(const fcm_mg *m)
 {
-  const int t = omp_get_max_threads();
+  const int t = fcm_ctx_num_threads(m->ctx);
   return t < m->nt ? t : m->nt;
 }
 

@@ -187,7 +187,7 @@ fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
   m->ctx = ctx;
   m->space = space;
   m->opts = o;
-  m->nt = FCM_MAX(omp_get_max_threads(), 1);
+  m->nt = fcm_ctx_num_threads(ctx);
   FCM_TRY(ctx, fcm__mg_build_hierarchy(m, A, NULL));
   FCM_TRY(ctx, level_diag(m, &m->lev[0]));
   for (int l = 0; l < m->nlev; l++) {
@@ -317,7 +317,7 @@ fcm_status fcm__mg_transfers_create(fcm_ctx *ctx, const fcm_space *space,
   m->opts = fcm_mg_options_default();
   m->opts.max_levels = max_levels;
   m->opts.coarse_dofs = coarse_dofs;
-  m->nt = FCM_MAX(omp_get_max_threads(), 1);
+  m->nt = fcm_ctx_num_threads(ctx);
   FCM_TRY(ctx, fcm__mg_build_hierarchy(m, NULL, constrained ? constrained : none));
   t = fcm__calloc(ctx, 1, sizeof *t);
   FCM_CHECK(t, ctx, FCM_ERR_ALLOC, "mg_transfers: out of memory");

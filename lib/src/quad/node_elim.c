@@ -87,7 +87,8 @@ static void build(const ws *s, int n, const double *x, const double *w, double *
 {
   const int M = s->M, d = s->d, nc = s->nc;
   const int par = (size_t)M * n > 20000; /* threads only pay off on large rules */
-#pragma omp parallel for schedule(static) if (par)
+  const int nt = fcm_ctx_num_threads(s->ctx);
+#pragma omp parallel for num_threads(nt) schedule(static) if (par)
   for (int i = 0; i < n; i++) {
     double *col = J + (size_t)M * nc * i;
     fcm__orthobasis_eval(s->shape, s->m, x + (size_t)d * i, col + (size_t)M * d, col, M);
@@ -96,7 +97,7 @@ static void build(const ws *s, int n, const double *x, const double *w, double *
         col[(size_t)k * M + j] *= w[i];
   }
   double f2 = 0.0, ri = 0.0;
-#pragma omp parallel for schedule(static) reduction(+ : f2) reduction(max : ri) if (par)
+#pragma omp parallel for num_threads(nt) schedule(static) reduction(+ : f2) reduction(max : ri) if (par)
   for (int j = 0; j < M; j++) {
     long double acc = 0.0L;
     for (int i = 0; i < n; i++)

@@ -141,11 +141,13 @@ fcm_status fcm_jacobi_apply(const fcm_jacobi *P, const double *r, double *z)
   const fcm_index n = P->n;
   const double *inv = P->inv;
   if (P->kind == FCM_JACOBI_SCALAR) {
-#pragma omp parallel for schedule(static) if (n >= FCM__SOLVE_PARALLEL_MIN)
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(ctx))                                     \
+    schedule(static) if (n >= FCM__SOLVE_PARALLEL_MIN)
     for (fcm_index i = 0; i < n; i++)
       z[i] = inv[i] * r[i];
   } else {
-#pragma omp parallel for schedule(static) if (n >= FCM__SOLVE_PARALLEL_MIN)
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(ctx))                                     \
+    schedule(static) if (n >= FCM__SOLVE_PARALLEL_MIN)
     for (fcm_index k = 0; k < n / 3; k++)
       fcm__mat3_mulv(inv + 9 * k, r + 3 * k, z + 3 * k);
   }

@@ -103,6 +103,9 @@ void fcm_krylov_destroy(fcm_krylov **ws)
 
 /* ---- vector kernels: parallel over entries, dot products in a fixed order ---- */
 
+/* The threads of a region: the context's count (the results do not depend on it). */
+#define THREADS(ws) fcm_ctx_num_threads((ws)->ctx)
+
 static double dot(const fcm_krylov *ws, const double *x, const double *y)
 {
   const fcm_index n = ws->n, nc = ws->num_chunks;
@@ -113,7 +116,7 @@ static double dot(const fcm_krylov *ws, const double *x, const double *y)
       s += x[i] * y[i];
     return s;
   }
-#pragma omp parallel for schedule(static) if (n >= VEC_PARALLEL)
+#pragma omp parallel for num_threads(THREADS(ws)) schedule(static) if (n >= VEC_PARALLEL)
   for (fcm_index c = 0; c < nc; c++) {
     fcm_index i0 = c * DOT_CHUNK, i1 = FCM_MIN(i0 + DOT_CHUNK, n);
     double s = 0.0;
@@ -190,9 +193,10 @@ static void copy(fcm_index n, const double *x, double *y)
 }
 
 /* r = b - r */
-static void rsub(fcm_index n, const double *b, double *r)
+static void rsub(const fcm_krylov *ws, const double *b, double *r)
 {
-#pragma omp parallel for schedule(static) if (n >= VEC_PARALLEL)
+  const fcm_index n = ws->n;
+#pragma omp parallel for num_threads(THREADS(ws)) schedule(static) if (n >= VEC_PARALLEL)
   for (fcm_index i = 0; i < n; i++)
     r[i] = b[i] - r[i];
 }
@@ -329,7 +333,7 @@ static fcm_status run_cg(solve *sv)
     copy(n, b, r);
   } else {
     APPLY_A(sv, x, r);
-    rsub(n, b, r);
+    rsub(ws, b, r);
   }
   rr = dot(ws, r, r);
   if (!isfinite(rr)) goto nan;
@@ -376,7 +380,7 @@ static fcm_status run_cg(solve *sv)
       copy(n, z, p);
     } else {
       double beta = rho_new / rho;
-#pragma omp parallel for schedule(static) if (n >= VEC_PARALLEL)
+#pragma omp parallel for num_threads(THREADS(ws)) schedule(static) if (n >= VEC_PARALLEL)
       for (fcm_index i = 0; i < n; i++)
         p[i] = z[i] + beta * p[i];
     }
@@ -393,7 +397,7 @@ static fcm_status run_cg(solve *sv)
                 k + 1, pq);
     }
     double alpha = rho / pq;
-#pragma omp parallel for schedule(static) if (n >= VEC_PARALLEL)
+#pragma omp parallel for num_threads(THREADS(ws)) schedule(static) if (n >= VEC_PARALLEL)
     for (fcm_index i = 0; i < n; i++) {
       x[i] += alpha * p[i];
       r[i] -= alpha * q[i];
@@ -477,7 +481,7 @@ static fcm_status minres_start(solve *sv, double *r1, double *y, double *w, int 
     copy(n, b, r1);
   } else {
     APPLY_A(sv, sv->x, r1);
-    rsub(n, b, r1);
+    rsub(ws, b, r1);
   }
   const double rr = dot(ws, r1, r1);
   *how = MR_NAN;
@@ -528,7 +532,7 @@ static fcm_status lanczos_step(solve *sv, int k, double beta, double oldb, const
   double alfa_out = 0.0;
   APPLY_A(sv, v, y);
   const double c1 = k >= 2 ? -beta / oldb : 0.0;
-#pragma omp parallel if (par)
+#pragma omp parallel num_threads(THREADS(ws)) if (par)
   {
     const double a = team_axpy_dot(ws, c1, r1, v, y);
     const double c2 = -a / beta;
@@ -570,7 +574,7 @@ static fcm_status run_minres(solve *sv)
   /* w = w2 = 0, r2 = r1, v = y / beta */
   {
     const double ib = 1.0 / beta;
-#pragma omp parallel for schedule(static) if (par)
+#pragma omp parallel for num_threads(THREADS(ws)) schedule(static) if (par)
     for (fcm_index i = 0; i < n; i++) {
       w[i] = w2[i] = 0.0;
       r2[i] = r1[i];
@@ -598,7 +602,7 @@ static fcm_status run_minres(solve *sv)
     const mr_in in = {beta, dbar, epsln, cs, sn, phibar, alfa};
     mr_out out;
     int updated = 0;
-#pragma omp parallel if (par)
+#pragma omp parallel num_threads(THREADS(ws)) if (par)
     {
       const double bsq = team_copy_dot(ws, !sv->S, r2, y);
       const mr_out o = mr_rotate(&in, bsq);
@@ -730,7 +734,7 @@ static fcm_status krylov_solve(fcm_krylov *ws, method m, fcm_operator_fn A, void
   if (sv.o.check_true_residual) {
     double *t = ws->vecs; /* the methods are done with their vectors */
     APPLY_A(&sv, x, t);
-    rsub(n, b, t);
+    rsub(ws, b, t);
     sv.info.true_residual = sqrt(dot(ws, t, t) / bb);
   }
   if (sv.info.reason == FCM_KRYLOV_MAX_ITERATIONS)

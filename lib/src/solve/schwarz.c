@@ -343,7 +343,7 @@ fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_bloc
   FCM_ALLOC(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->S);
   FCM_TRY(ctx, incidence_and_colors(P));
   /* setup scratch: the eigensolver workspace of the largest need over the block sizes */
-  P->nt = omp_get_max_threads();
+  P->nt = fcm_ctx_num_threads(ctx);
   for (fcm_index b = 0, m_prev = -1; b < num_blocks; b++) {
     const fcm_index m = block_ptr[b + 1] - block_ptr[b];
     size_t lw = 0, liw = 0;
@@ -385,7 +385,8 @@ fcm_status fcm_schwarz_apply(const fcm_schwarz *P, const double *r, double *z)
   const double *dinv = P->dinv;
   const int par = n >= FCM__SOLVE_PARALLEL_MIN || P->s_off[P->num_blocks] >= APPLY_PARALLEL_WORK;
   /* One loop, no barrier inside: z_i is summed by one thread, in ascending block order. */
-#pragma omp parallel for schedule(dynamic, APPLY_CHUNK) if (par)
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(ctx))                                     \
+    schedule(dynamic, APPLY_CHUNK) if (par)
   for (fcm_index i = 0; i < n; i++) {
     double zi = dinv[i] * r[i];
     for (fcm_index q = P->inc_ptr[i]; q < P->inc_ptr[i + 1]; q++) {
