@@ -71,7 +71,7 @@
  * Done (phase 2, the integrator on PETSc):
  * - fcm_petsc_simulation_create(): the scene's own fcm_simulation on every process with the
  *   rules masked to the process's cells (the partition as above) and an internal backend set
- *   in the integrator (lib/src/sim/sim_backend.h: reduce / factor / solve / destroy, set by
+ *   in the integrator (lib/src/solve/solve_backend.h: reduce / factor / solve / destroy, set by
  *   fcm__integrator_set_backend() from the attach callback of
  *   fcm__simulation_create_distributed(), lib/src/scene/run.c). This problem object P is the
  *   backend (borrowed space, refcount: creator + integrator).
@@ -139,7 +139,7 @@
  *   gets its cut faces (cell_rules.c computes the cut faces before the mask check: the space's
  *   DOF copies depend on them, a cut along cell faces separates cells without splitting any).
  *   fcm_integrator_create_cut() asks the old integrator's backend for a new one
- *   (fcm__sim_backend.cut = newton_cut(): agree, newton_unbuild(), newton_build() for the new
+ *   (fcm__backend.cut = newton_setup(): agree, newton_unbuild(), newton_build() for the new
  *   space — numbering, ownership, MATMPIAIJ, vectors, KSP, the scatter made at the first
  *   solve — and one more reference to the same P), before the new integrator's setup (its
  *   mass and load sums). newton_build() checks the replicated topology (DOF and element
@@ -150,7 +150,7 @@
  *   (newton_finish(): agree unless a failure was agreed already), so a process that fails in
  *   the local part of a cut meets the others in the hook's agree (tests/petsc/newton_failure.c
  *   case 4). The "cut missed" counters, pieces, DOFs and the rules' classification equal the
- *   serial run's (tests/petsc/newton_cut.c).
+ *   serial run's (tests/petsc/newton_setup.c).
  * - quadrature.simplify = "auto": the choice's inputs (per kind: cut-cell points, the modelled
  *   simplification time, points kept; from this process's own cut cells with a mask) are summed
  *   over the processes inside the rules build (fcm__cell_rules_create_reduced(), embed_impl.h:
@@ -171,7 +171,7 @@
  *   file, then the processes agree on the read and on the number of cuts
  *   (fcm__integrator_reduce_status()) before the cut replay, which is collective; before
  *   (session 6) a file one process could not read left the others waiting in the replay's
- *   newton_cut() (tests/petsc/newton_failure.c case 5).
+ *   newton_setup() (tests/petsc/newton_failure.c case 5).
  * Done (fcm's geometric multigrid as PCMG, pcmg.c):
  * - fcm__petsc_pcmg_setup(): the hierarchy of lib/src/mg (fcm__mg_transfers_create(), the code
  *   fcm_mg_create() runs, without a matrix; the transfers do not depend on the constrained DOFs)
@@ -288,11 +288,6 @@
  * cells.
  * ------------------------------------------------------------------------------------------ */
 #define _GNU_SOURCE /* RTLD_DEFAULT */
-/* before PETSc's headers: they include complex.h, whose macro I clashes with the integrator
- * parameters these declare */
-#include "scene/run_impl.h"
-#include "sim/sim_backend.h"
-
 #include "petsc/petsc_impl.h"
 
 #include <dlfcn.h>
@@ -1843,171 +1838,13 @@ cleanup:
   return st;
 }
 
-/* ---------------------------------------------------------------- scenes */
-
-/* What the PETSc backend cannot run of a scene, named (local: every process reads the same). */
-static fcm_status check_scene(fcm_ctx *ctx, const fcm_scene *scene)
-{
-  fcm_status st = FCM_OK;
-  const char *name = fcm_scene_name(scene);
-  FCM_CHECK(
-      fcm_scene_get_material(scene)->model == FCM_MATERIAL_LINEAR, ctx, FCM_ERR_UNSUPPORTED,
-      "scene %s: material.model: the PETSc backend solves linear elasticity only (\"linear\"); "
-      "run this scene with the serial backend",
-      name);
-  FCM_CHECK(fcm_scene_get_quadrature(scene)->simplify != FCM_CELL_SIMPLIFY_AUTO, ctx,
-            FCM_ERR_UNSUPPORTED,
-            "scene %s: quadrature.simplify = \"auto\" is not supported by the PETSc backend (its "
-            "choice would differ between processes); use true or false",
-            name);
-  for (int k = 0; k < fcm_scene_num_effects(scene); k++) {
-    const fcm_effect *e = fcm_scene_get_effect(scene, k);
-    const char *what = NULL;
-    switch (e->type) {
-    case FCM_EFFECT_GRAVITY:
-      break;
-    case FCM_EFFECT_FIXED:
-      if (e->fixed.boundary) what = "a fixed effect on the \"boundary\" (Nitsche / penalty)";
-      break;
-    case FCM_EFFECT_MOTION:
-      if (e->motion.boundary)
-        what = "a motion effect on the \"boundary\" (Nitsche / penalty)";
-      else if (e->motion.motion.release)
-        what = "a motion effect with \"release\"";
-      break;
-    default:
-      what = fcm_effect_type_name(e->type);
-    }
-    FCM_CHECK(!what, ctx, FCM_ERR_UNSUPPORTED,
-              "scene %s: effects[%d]: %s is not supported by the PETSc backend yet (gravity, "
-              "fixed and motion on node regions are); run this scene with the serial backend",
-              name, k, what);
-  }
-cleanup:
-  return st;
-}
-
-int fcm_petsc_problem_supports_scene(fcm_ctx *ctx, const fcm_scene *scene)
-{
-  if (!ctx || !scene) return 0;
-  fcm_ctx *tmp = NULL; /* the check's message must not replace the caller's error */
-  if (fcm_ctx_create(NULL, &tmp) != FCM_OK) return 0;
-  const int ok = check_scene(tmp, scene) == FCM_OK;
-  fcm_ctx_destroy(&tmp);
-  return ok;
-}
-
-/* The background nodes of a region (as the serial runner picks them). */
-static fcm_status scene_region_nodes(fcm_ctx *ctx, const fcm_scene *scene, const fcm_mesh *mesh,
-                                     const fcm_region *r, int k, fcm_index **nodes, fcm_index *n)
-{
-  fcm_status st = FCM_OK;
-  const fcm_index nn = fcm_mesh_num_nodes(mesh);
-  const double *X = fcm_mesh_coords(mesh);
-  fcm_index *out = NULL, m = 0;
-  FCM_ALLOC(ctx, (r->kind == FCM_REGION_NODES ? r->num_nodes : nn) + 1, out);
-  if (r->kind == FCM_REGION_NODES) {
-    for (fcm_index j = 0; j < r->num_nodes; j++) {
-      FCM_CHECK(r->nodes[j] >= 0 && r->nodes[j] < nn, ctx, FCM_ERR_ARG,
-                "scene %s: effects[%d]: node %lld out of range [0, %lld)", fcm_scene_name(scene), k,
-                (long long)r->nodes[j], (long long)nn);
-      out[m++] = r->nodes[j];
-    }
-  } else {
-    for (fcm_index a = 0; a < nn; a++)
-      if (fcm_region_contains(r, X + 3 * a)) out[m++] = a;
-  }
-  FCM_CHECK(m > 0, ctx, FCM_ERR_ARG,
-            "scene %s: effects[%d]: the region contains no background-mesh node",
-            fcm_scene_name(scene), k);
-  *nodes = out;
-  *n = m;
-  out = NULL;
-cleanup:
-  fcm__free(ctx, out);
-  return st;
-}
-
-fcm_status fcm_petsc_problem_create_from_scene(fcm_ctx *ctx, MPI_Comm comm, const fcm_scene *scene,
-                                               fcm_petsc_partition partition,
-                                               fcm_petsc_problem **out)
-{
-  fcm_status st = FCM_OK;
-  fcm_mesh *mesh = NULL;
-  fcm_geometry *geom = NULL;
-  fcm_petsc_problem *P = NULL;
-  fcm_index *nodes = NULL, n = 0;
-  FCM_CHECK(out, ctx, FCM_ERR_ARG, "petsc: output pointer is NULL");
-  *out = NULL;
-  FCM_CHECK(ctx && scene, ctx, FCM_ERR_ARG, "petsc: NULL context or scene");
-  st = check_scene(ctx, scene);
-  if (st == FCM_OK) st = fcm__scene_mesh_geometry(ctx, scene, &mesh, &geom);
-  FCM_TRY(ctx, fcm__petsc_agree(ctx, comm, st));
-  /* the options as the serial runner derives them (lib/src/scene/run.c) */
-  const fcm_scene_quadrature *q = fcm_scene_get_quadrature(scene);
-  const fcm_scene_solver *sv = fcm_scene_get_solver(scene);
-  const fcm_scene_time *tm = fcm_scene_get_time(scene);
-  fcm_petsc_options o = fcm_petsc_options_default();
-  o.kind = tm->integrator;
-  o.dt = tm->dt;
-  o.partition = partition;
-  o.petsc_options = sv->petsc_options;
-  o.rtol = sv->rtol > 0.0 ? sv->rtol : o.rtol;
-  o.max_iterations = sv->max_iterations;
-  o.rules.strength[FCM_RULE_STIFFNESS] = q->stiffness_strength;
-  o.rules.strength[FCM_RULE_MASS] = q->mass_strength;
-  o.rules.surface_strength = -1;
-  o.rules.min_fraction = q->min_fraction;
-  o.rules.max_rule_memory = q->max_rule_memory_gib * 1024.0 * 1024.0 * 1024.0;
-  o.rules.simplify = q->simplify;
-  o.rules.simplify_options.method = q->simplify_method;
-  o.rules.stabilization = q->stabilization;
-  o.rules.num_threads = sv->threads;
-  o.assembly.stiffness_strength = q->stiffness_strength > 0 ? q->stiffness_strength : FCM_DEFAULT;
-  o.assembly.mass_strength = q->mass_strength > 0 ? q->mass_strength : FCM_DEFAULT;
-  FCM_TRY(ctx,
-          fcm_petsc_problem_create(ctx, comm, mesh, geom, fcm_scene_get_material(scene), &o, &P));
-  P->own_mesh = mesh;
-  mesh = NULL;
-  fcm_geometry_destroy(&geom); /* only read while the rules were built */
-  for (int k = 0; k < fcm_scene_num_effects(scene); k++) {
-    const fcm_effect *e = fcm_scene_get_effect(scene, k);
-    if (e->type == FCM_EFFECT_GRAVITY) {
-      FCM_TRY(ctx, fcm_petsc_problem_add_gravity(P, e->gravity.acceleration));
-      continue;
-    }
-    if (e->type != FCM_EFFECT_FIXED && e->type != FCM_EFFECT_MOTION) continue;
-    const fcm_region *r = e->type == FCM_EFFECT_FIXED ? &e->fixed.region : &e->motion.region;
-    fcm_motion m = fcm_motion_default();
-    if (e->type == FCM_EFFECT_FIXED)
-      for (int d = 0; d < 3; d++)
-        m.components[d] = e->fixed.components[d];
-    else
-      m = e->motion.motion;
-    fcm__free(ctx, nodes);
-    nodes = NULL;
-    st = scene_region_nodes(ctx, scene, P->mesh, r, k, &nodes, &n);
-    FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
-    FCM_TRY(ctx, fcm_petsc_problem_add_constraint(P, n, nodes, &m));
-  }
-  FCM_TRY(ctx, fcm_petsc_problem_setup(P));
-  *out = P;
-  P = NULL;
-cleanup:
-  fcm__free(ctx, nodes);
-  fcm_petsc_problem_destroy(&P);
-  fcm_geometry_destroy(&geom);
-  fcm_mesh_destroy(&mesh);
-  return st;
-}
-
 /* ---------------------------------------------------------------- the integrator's backend */
 
 /* fcm_petsc_simulation_create(): every process runs the scene's ordinary fcm_simulation (its
  * fcm_integrator: Newton, line search, time stepping, every effect) on a space whose rules
  * carry points on the process's own cells; the integrator sums the partial assemblies through
  * newton_reduce() and solves its eliminated Newton system through newton_factor() and
- * newton_solve() (lib/src/sim/sim_backend.h). The problem object P serves as the backend:
+ * newton_solve() (lib/src/solve/solve_backend.h). The problem object P serves as the backend:
  * partition, DOF ownership and numbering, the MATMPIAIJ, the vectors and the KSP. */
 
 static void newton_release(void *user)
@@ -2051,8 +1888,8 @@ static fcm_status newton_reduce(void *user, fcm_status st, double *values, fcm_i
 }
 
 /* The eliminated Newton matrix into the MATMPIAIJ: each process adds its PARTIAL eliminated
- * matrix H (sim_backend.h) with ADD_VALUES, row by row, skipping the all-zero rows (so a process
- * sends only the rows its cells touch, plus the base on its own rows); the entries of rows
+ * matrix H (solve/solve_backend.h) with ADD_VALUES, row by row, skipping the all-zero rows (so a
+ * process sends only the rows its cells touch, plus the base on its own rows); the entries of rows
  * another process owns go through PETSc's stash at the assembly. The constrained rows are
  * checked against the contract (zero but for the owner's diagonal). The KSP (CG, or MINRES for a
  * possibly indefinite matrix, unless -ksp_type says otherwise) is set up on the sum.
@@ -2274,7 +2111,10 @@ static fcm_status newton_build(fcm_petsc_problem *P, fcm_status st, const fcm_sp
 {
   fcm_ctx *ctx = P->ctx;
   st = newton_agree(P, st);
-  if (st != FCM_OK) return st;   /* another process failed */
+  if (st != FCM_OK) return st; /* another process failed */
+  /* the rules build's classification (rules_exchange()) is over */
+  FCM_FREE(ctx, P->classifier);
+  FCM_FREE(ctx, P->remote);
   P->space = (fcm_space *)space; /* borrowed: P->borrowed_space */
   P->mesh = fcm_space_mesh(space);
   st = own_active_cells(P);
@@ -2284,7 +2124,7 @@ static fcm_status newton_build(fcm_petsc_problem *P, fcm_status st, const fcm_sp
    * using a copy it owns (every owned row complete for create_matrix(), every row its own
    * cells' assembly touches present) */
   if (st == FCM_OK && P->space->is_local) st = localize_space(P);
-  if (st == FCM_OK) { /* the integrator's copy of the ownership (fcm__sim_backend.owned) */
+  if (st == FCM_OK) { /* the integrator's copy of the ownership (fcm__backend.owned) */
     P->owned_dof = fcm__calloc(ctx, (size_t)P->n + 1, 1);
     if (!P->owned_dof)
       st = fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
@@ -2352,12 +2192,12 @@ static void newton_unbuild(fcm_petsc_problem *P)
   P->nlocal = P->first = 0;
 }
 
-static fcm_status newton_cut(void *user, fcm_status st, const fcm_space *space,
-                             fcm__sim_backend *out);
+static fcm_status newton_setup(void *user, fcm_status st, const fcm_space *space,
+                               fcm__backend *out);
 static fcm_status newton_finish(void *user, fcm_status st);
 
 /* The backend handed to an integrator: P itself, one more reference. */
-static void newton_backend(fcm_petsc_problem *P, fcm__sim_backend *b)
+static void newton_backend(fcm_petsc_problem *P, fcm__backend *b)
 {
   memset(b, 0, sizeof *b);
   b->user = P;
@@ -2369,18 +2209,18 @@ static void newton_backend(fcm_petsc_problem *P, fcm__sim_backend *b)
   b->factor = newton_factor;
   b->solve = newton_solve;
   b->destroy = newton_release;
-  b->cut = newton_cut;
+  b->setup = newton_setup;
   b->finish = newton_finish;
   P->refs++;
 }
 
-/* fcm__sim_backend.cut: the integrator of a cut's new space gets this backend again, rebuilt
- * for the new DOF numbering (ownership, PETSc numbering, matrix, vectors, KSP, scatter); the
- * old integrator keeps its reference until it is destroyed, and its factor / solve refuse to
- * run on the rebuilt objects (newton_factor() checks the matrix size, newton_solve() that a
- * matrix was given since). */
-static fcm_status newton_cut(void *user, fcm_status st, const fcm_space *space,
-                             fcm__sim_backend *out)
+/* fcm__backend.setup: the integrator of the simulation's space (every process reached here
+ * unless one failed: the agreement first), and the integrator of a cut's new space, gets this
+ * backend, (re)built for its DOF numbering (ownership, PETSc numbering, matrix, vectors, KSP,
+ * scatter); the old integrator keeps its reference until it is destroyed, and its factor / solve
+ * refuse to run on the rebuilt objects (newton_factor() checks the matrix size, newton_solve() that
+ * a matrix was given since). */
+static fcm_status newton_setup(void *user, fcm_status st, const fcm_space *space, fcm__backend *out)
 {
   fcm_petsc_problem *P = user;
   st = newton_agree(P, st);
@@ -2393,7 +2233,7 @@ static fcm_status newton_cut(void *user, fcm_status st, const fcm_space *space,
   return FCM_OK;
 }
 
-/* fcm__sim_backend.finish: agree unless a failure was agreed already (on every process). */
+/* fcm__backend.finish: agree unless a failure was agreed already (on every process). */
 static fcm_status newton_finish(void *user, fcm_status st)
 {
   fcm_petsc_problem *P = user;
@@ -2401,142 +2241,81 @@ static fcm_status newton_finish(void *user, fcm_status st)
   return newton_agree(P, st);
 }
 
-/* fcm__simulation_attach_fn: the simulation's space is built (every process reached here
- * unless one failed: newton_build() agrees first); number the DOFs, create the matrix, vectors
- * and KSP, and hand the backend to the integrator. */
-static fcm_status newton_attach(void *user, fcm_integrator *integ, const fcm_space *space)
+/* The backend object of a simulation (fcm__petsc_backend_create(), petsc_backend.h): P with the
+ * settings the scene's solver section gives, before any space exists. */
+fcm_status fcm__petsc_backend_create(fcm_ctx *ctx, MPI_Comm comm, fcm_status st,
+                                     const fcm__petsc_backend_options *o, fcm_petsc_problem **out)
 {
-  fcm_petsc_problem *P = user;
-  fcm_status st = newton_build(P, FCM_OK, space);
-  if (st != FCM_OK) return st;
-  fcm__sim_backend b;
-  newton_backend(P, &b);
-  return fcm__integrator_set_backend(integ, &b);
-}
-
-fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_scene *scene,
-                                       fcm_petsc_partition partition,
-                                       const fcm_simulation_options *opts, fcm_simulation **out)
-{
-  fcm_status st = FCM_OK;
-  fcm_mesh *mesh = NULL;
-  fcm_geometry *geom = NULL;
   fcm_petsc_problem *P = NULL;
-  fcm_simulation *S = NULL;
-  unsigned char *mask = NULL;
-  /* local checks, agreed in new_problem() before the first collective call */
-  if (!out)
-    st =
-        fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__, "petsc: output pointer is NULL");
-  else
-    *out = NULL;
-  if (st == FCM_OK && !(ctx && scene))
-    st = fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__, "petsc: NULL context or scene");
-  if (st == FCM_OK && !((int)partition >= 0 && partition < FCM_PETSC_PARTITION_COUNT))
-    st = fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
-                    "petsc: partition = %d is not a method (0 auto, 1 ptscotch, 2 ordered)",
-                    (int)partition);
   st = new_problem(ctx, comm, st, &P);
+  *out = P;
   if (P) P->borrowed_space = 1;
   FCM_TRY(ctx, st);
   P->opts = fcm_petsc_options_default();
   set_prefix(P);
-  {
-    const fcm_scene_solver *sv = fcm_scene_get_solver(scene);
-    P->opts.partition = partition;
-    P->direct = sv->method == FCM_LINEAR_DIRECT;
-    P->opts.rtol = sv->rtol > 0.0 ? sv->rtol : P->opts.rtol;
-    P->opts.max_iterations = sv->max_iterations > 0 ? sv->max_iterations : P->opts.max_iterations;
-    if (sv->petsc_options) {
-      size_t len = strlen(sv->petsc_options);
-      P->petsc_options = fcm__calloc(ctx, len + 1, 1);
-      if (P->petsc_options)
-        memcpy(P->petsc_options, sv->petsc_options, len);
-      else
-        st = FCM_ERR_ALLOC;
-    }
+  P->opts.partition = o->partition;
+  P->direct = o->direct;
+  P->opts.rtol = o->rtol;
+  P->opts.max_iterations = o->max_iterations;
+  if (o->petsc_options) {
+    size_t len = strlen(o->petsc_options);
+    P->petsc_options = fcm__calloc(ctx, len + 1, 1);
+    if (P->petsc_options)
+      memcpy(P->petsc_options, o->petsc_options, len);
+    else
+      st = FCM_ERR_ALLOC;
   }
-  P->mat = *fcm_scene_get_material(scene);
-  if (st == FCM_OK) st = fcm__scene_mesh_geometry(ctx, scene, &mesh, &geom);
-  if (st == FCM_OK && !geom)
-    st = fcm__error(ctx, FCM_ERR_UNSUPPORTED, __FILE__, __LINE__, __func__,
-                    "scene %s: the PETSc backend's integrator path needs an embedded geometry "
-                    "(\"geometry\"): its cell rules carry each process's share of the "
-                    "assembly; run this scene with the serial backend",
-                    fcm_scene_name(scene));
+  P->mat = o->mat;
+  st = newton_agree(P, st);
+cleanup:
+  return st;
+}
+
+fcm_status fcm__petsc_backend_partition(fcm_petsc_problem *P, fcm_status st, const fcm_mesh *mesh,
+                                        const fcm_geometry *geom, unsigned char **mask,
+                                        fcm__backend *backend, fcm__rules_exchange *exchange)
+{
+  fcm_ctx *ctx = P->ctx;
   FCM_TRY(ctx, newton_agree(P, st));
   /* the partition of the candidate cells, as fcm_petsc_problem_create() makes it */
   P->mesh = mesh;
-  FCM_TRY(ctx, partition_cells(P, geom, &mask));
+  st = partition_cells(P, geom, mask);
   P->mesh = NULL;
-  fcm_geometry_destroy(&geom);
-  fcm_mesh_destroy(&mesh);
-  /* the simulation (its mesh is built again from the scene, the same cells): collective from
-   * the rules build's classification exchange on (each process classifies the cells of
-   * P->classifier: rules_exchange()) and newton_attach(); a process that fails outside an
-   * fcm__petsc_agree() ends with one, which meets the fcm__petsc_agree() the others wait in */
-  {
-    const fcm__rules_exchange x = {P->remote, rules_exchange, P};
-    st = fcm__simulation_create_distributed(ctx, scene, opts, mask, newton_reduce, &x,
-                                            newton_attach, P, &S);
-  }
-  if (!P->agreed_fail) st = newton_agree(P, st);
   FCM_TRY(ctx, st);
-  FCM_FREE(ctx, P->classifier);
-  FCM_FREE(ctx, P->remote);
-  *out = S;
-  S = NULL;
+  /* the rules build's classification exchange: each process classifies the cells of
+   * P->classifier (rules_exchange()); newton_build() frees both once the space exists */
+  exchange->remote = P->remote;
+  exchange->exchange = rules_exchange;
+  exchange->user = P;
+  memset(backend, 0, sizeof *backend);
+  backend->user = P;
+  backend->root = P->rank == 0;
+  backend->rank = P->rank;
+  backend->nprocs = P->size;
+  backend->reduce = newton_reduce;
+  backend->setup = newton_setup;
+  backend->finish = newton_finish;
 cleanup:
-  fcm_simulation_destroy(&S);
-  fcm__free(ctx, mask);
-  fcm_geometry_destroy(&geom);
-  fcm_mesh_destroy(&mesh);
+  return st;
+}
+
+void fcm__petsc_backend_release(fcm_petsc_problem *P)
+{
   newton_release(P);
-  return st;
 }
 
-fcm_status fcm_petsc_simulation_summary_view(fcm_simulation *sim, FILE *f)
+int fcm__petsc_backend_info(const fcm__backend *b, fcm_petsc_traffic *traffic, MPI_Comm *comm)
 {
-  fcm_status st = FCM_OK;
-  FCM_CHECK(sim, NULL, FCM_ERR_ARG, "petsc: summary_view: NULL simulation");
-  FCM_CHECK(fcm__integrator_distributed(sim->integ, NULL), sim->ctx, FCM_ERR_ARG,
-            "petsc: summary_view: the simulation is not one of fcm_petsc_simulation_create()");
-  {
-    /* the backend's traffic so far (before the summary's own sums), per Newton matrix; the
-     * largest over the processes */
-    fcm_petsc_traffic t;
-    FCM_TRY(sim->ctx, fcm_petsc_simulation_traffic(sim, &t));
-    FCM_TRY(sim->ctx, fcm__simulation_summary_view_distributed(sim, f));
-    const fcm__sim_backend *b = fcm__integrator_backend(sim->integ);
-    fcm_petsc_problem *P = b->user;
-    double mine[4] = {(double)t.reduce_bytes, (double)t.matrix_bytes_sent, t.cpu_reduce,
-                      t.cpu_matrix},
-           all[4];
-    int rc = MPI_Allreduce(mine, all, 4, MPI_DOUBLE, MPI_MAX, P->comm);
-    FCM_CHECK(rc == MPI_SUCCESS, sim->ctx, FCM_ERR_INTERNAL,
-              "petsc: MPI_Allreduce of the traffic counters failed (error %d)", rc);
-    const double per = t.matrices > 0 ? 1.0 / (double)t.matrices : 0.0;
-    if (f)
-      fprintf(f,
-              "  comm      per process (largest): dense sums %.4g MB (%.3g s CPU), matrix stash "
-              "%.4g MB (%.3g s CPU); per Newton matrix (%lld): %.4g + %.4g kB\n",
-              all[0] / 1e6, all[2], all[1] / 1e6, all[3], t.matrices, all[0] * per / 1e3,
-              all[1] * per / 1e3);
-  }
-cleanup:
-  return st;
+  if (!b || b->reduce != newton_reduce) return 0;
+  const fcm_petsc_problem *P = b->user;
+  if (traffic) *traffic = P->traffic;
+  if (comm) *comm = P->comm;
+  return 1;
 }
 
-fcm_status fcm_petsc_simulation_traffic(const fcm_simulation *sim, fcm_petsc_traffic *out)
+void fcm__petsc_problem_adopt_mesh(fcm_petsc_problem *P, fcm_mesh *mesh)
 {
-  fcm_status st = FCM_OK;
-  FCM_CHECK(sim && out, sim ? sim->ctx : NULL, FCM_ERR_ARG, "petsc: traffic: NULL argument");
-  const fcm__sim_backend *b = fcm__integrator_backend(sim->integ);
-  FCM_CHECK(b && b->reduce == newton_reduce, sim->ctx, FCM_ERR_ARG,
-            "petsc: traffic: the simulation is not one of fcm_petsc_simulation_create()");
-  *out = ((const fcm_petsc_problem *)b->user)->traffic;
-cleanup:
-  return st;
+  P->own_mesh = mesh;
 }
 
 /* ---------------------------------------------------------------- output */

@@ -7,6 +7,7 @@
 #include "fcm/petsc.h"
 
 #include "core/core_impl.h"
+#include "petsc/petsc_backend.h"
 #include "embed/embed_impl.h"
 #include "fem/fem_impl.h"
 
@@ -110,11 +111,6 @@ struct fcm_petsc_problem {
 /* The message of a failed PETSc call as FCM_ERR_INTERNAL (PCALL). */
 fcm_status fcm__petsc_error(fcm_ctx *ctx, PetscErrorCode ierr, const char *call, const char *file,
                             int line, const char *func);
-
-/* Every process learns whether any failed: on failure somewhere, every process returns the
- * status and message of the lowest failing process (the others record it as their error).
- * Collective on comm. */
-fcm_status fcm__petsc_agree(fcm_ctx *ctx, MPI_Comm comm, fcm_status st);
 
 /* fcm__petsc_agree() on P's communicator; a failure is remembered (P->agreed_fail), so that a
  * process that learnt of it there does not start another agreement the others never meet. */

@@ -555,13 +555,14 @@ static fcm_status build_rules(fcm_simulation *S)
   ro.progress = S->opts.rules_progress;
   ro.progress_user = S->opts.rules_progress_user;
   ro.progress_interval = S->opts.rules_progress_interval;
-  ro.cell_mask = S->cell_mask;
-  fcm__rules_reduce red = {S->reduce, S->reduce_user, 0};
-  if (S->rules_exchange) /* distributed: each process classifies its share of the cells */
+  const fcm__simulation_config *cfg = S->config;
+  const fcm__backend *b = cfg ? cfg->backend : NULL;
+  ro.cell_mask = cfg ? cfg->cell_mask : NULL;
+  fcm__rules_reduce red = {b ? b->reduce : NULL, b ? b->user : NULL, 0};
+  if (cfg && cfg->exchange) /* distributed: each process classifies its share of the cells */
     FCM_TRY(S->ctx, fcm__cell_rules_create_distributed(S->ctx, S->mesh, S->geom, &ro,
-                                                       S->reduce ? &red : NULL, S->rules_exchange,
-                                                       &S->rules));
-  else if (S->reduce) /* distributed: the auto choice's inputs summed over the processes */
+                                                       b ? &red : NULL, cfg->exchange, &S->rules));
+  else if (b) /* distributed: the auto choice's inputs summed over the processes */
     FCM_TRY(S->ctx, fcm__cell_rules_create_reduced(S->ctx, S->mesh, S->geom, &ro, &red, &S->rules));
   else
     FCM_TRY(S->ctx, fcm_cell_rules_create(S->ctx, S->mesh, S->geom, &ro, &S->rules));
@@ -851,48 +852,28 @@ cleanup:
   return st;
 }
 
-static fcm_status
-simulation_create(fcm_ctx *ctx, const fcm_scene *scene, const fcm_simulation_options *opts,
-                  const unsigned char *cell_mask, fcm__simulation_reduce_fn reduce,
-                  const fcm__rules_exchange *exchange, fcm__simulation_attach_fn attach,
-                  void *attach_user, fcm_simulation **out);
-
 fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
                                  const fcm_simulation_options *opts, fcm_simulation **out)
 {
-  return simulation_create(ctx, scene, opts, NULL, NULL, NULL, NULL, NULL, out);
+  fcm__simulation_config cfg;
+  memset(&cfg, 0, sizeof cfg);
+  cfg.opts = opts ? *opts : fcm_simulation_options_default();
+  return fcm__simulation_create(ctx, scene, &cfg, out);
 }
 
-fcm_status fcm__simulation_create_distributed(fcm_ctx *ctx, const fcm_scene *scene,
-                                              const fcm_simulation_options *opts,
-                                              const unsigned char *cell_mask,
-                                              fcm__simulation_reduce_fn reduce,
-                                              const fcm__rules_exchange *exchange,
-                                              fcm__simulation_attach_fn attach, void *attach_user,
-                                              fcm_simulation **out)
-{
-  return simulation_create(ctx, scene, opts, cell_mask, reduce, exchange, attach, attach_user, out);
-}
-
-static fcm_status
-simulation_create(fcm_ctx *ctx, const fcm_scene *scene, const fcm_simulation_options *opts,
-                  const unsigned char *cell_mask, fcm__simulation_reduce_fn reduce,
-                  const fcm__rules_exchange *exchange, fcm__simulation_attach_fn attach,
-                  void *attach_user, fcm_simulation **out)
+fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
+                                  const fcm__simulation_config *cfg, fcm_simulation **out)
 {
   fcm_status st = FCM_OK;
   fcm_simulation *S = NULL;
-  FCM_CHECK(ctx && scene && out, ctx, FCM_ERR_ARG, "simulation: NULL argument");
+  FCM_CHECK(ctx && scene && cfg && out, ctx, FCM_ERR_ARG, "simulation: NULL argument");
   *out = NULL;
   double t0 = fcm_wtime();
   FCM_ALLOC(ctx, 1, S);
   S->ctx = ctx;
-  S->cell_mask = cell_mask;
-  S->reduce = reduce;
-  S->reduce_user = attach_user;
-  S->rules_exchange = exchange;
+  S->config = cfg->backend ? cfg : NULL;
   S->scene = scene;
-  S->opts = opts ? *opts : fcm_simulation_options_default();
+  S->opts = cfg->opts;
   FCM_CHECK(S->opts.max_steps >= 1 || S->opts.max_steps == FCM_DEFAULT, ctx, FCM_ERR_ARG,
             "simulation: max_steps = %lld must be >= 1, or FCM_DEFAULT (-1: the scene's)",
             (long long)S->opts.max_steps);
@@ -924,7 +905,7 @@ simulation_create(fcm_ctx *ctx, const fcm_scene *scene, const fcm_simulation_opt
               "lower quadrature.min_fraction",
               (long long)rs->num_cells, fcm_scene_get_quadrature(scene)->min_fraction,
               rs->embedded_volume, rs->geometry_volume);
-    st = create_space(S, S->rules, S->cell_mask != NULL, &S->space);
+    st = create_space(S, S->rules, S->config && S->config->cell_mask, &S->space);
     if (st != FCM_OK) fcm__error_prefix(ctx, "geometry");
     FCM_TRY(ctx, st);
   } else {
@@ -951,7 +932,7 @@ simulation_create(fcm_ctx *ctx, const fcm_scene *scene, const fcm_simulation_opt
     const fcm__effect_type *t = fcm__scene_effect_type(e->type);
     if (t->apply) FCM_TRY(ctx, t->apply(S, e));
   }
-  if (attach) FCM_TRY(ctx, attach(attach_user, S->integ, S->space));
+  if (S->config) FCM_TRY(ctx, fcm__integrator_attach_backend(S->integ, S->config->backend));
   FCM_TRY(ctx, fcm_integrator_setup(S->integ));
   {
     fcm_integrator_setup_info si;
@@ -977,10 +958,7 @@ simulation_create(fcm_ctx *ctx, const fcm_scene *scene, const fcm_simulation_opt
 
   if (S->geom && fcm_scene_get_output(scene)->write_surface) FCM_TRY(ctx, build_surface(S));
   S->c.time_setup = fcm_wtime() - t0;
-  S->cell_mask = NULL; /* borrowed for the create only */
-  S->reduce = NULL;
-  S->reduce_user = NULL;
-  S->rules_exchange = NULL;
+  S->config = NULL; /* borrowed for the create only */
   *out = S;
   S = NULL;
 cleanup:

@@ -2,6 +2,9 @@ list(APPEND FCM_SOURCES lib/src/scene/json_adapter.c lib/src/scene/schema.c
                         lib/src/scene/effects.c lib/src/scene/scene.c
                         lib/src/scene/default_scene.c
                         lib/src/scene/run.c lib/src/scene/checkpoint.c)
+if(FCM_HAVE_PETSC) # the runner on the PETSc backend (fcm/petsc.h)
+  list(APPEND FCM_SOURCES lib/src/scene/run_petsc.c)
+endif()
 
 # The built-in default scene is the example apps/scenes/twisting_cylinder.json, embedded
 # byte for byte at configure time (a byte array: no limit on string literal length), so

@@ -536,7 +536,7 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
     form.term = FCM_LINEAR_MASS;
     st = fcm_assembly_workspace_linear(I->aws, &form, I->M, NULL);
     /* with a backend M stays this process's partial mass matrix (its cells' part; never
-     * summed: every use sums a product, sim_backend.h); agree on the status only */
+     * summed: every use sums a product, solve/solve_backend.h); agree on the status only */
     FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, NULL));
     I->setup_info.mass_assemblies = 1;
   }
@@ -702,7 +702,7 @@ cleanup:
   return st;
 }
 
-fcm_status fcm__integrator_set_backend(fcm_integrator *I, const fcm__sim_backend *b)
+fcm_status fcm__integrator_set_backend(fcm_integrator *I, const fcm__backend *b)
 {
   fcm_status st = FCM_OK;
   if (!I || !b) {
@@ -729,7 +729,21 @@ cleanup:
   return st;
 }
 
-const fcm__sim_backend *fcm__integrator_backend(const fcm_integrator *I)
+fcm_status fcm__integrator_attach_backend(fcm_integrator *I, const fcm__backend *from)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I ? I->ctx : NULL;
+  FCM_CHECK(I && from && from->setup, ctx, FCM_ERR_ARG,
+            "integrator: NULL integrator, or a backend without a setup operation");
+  fcm__backend b;
+  memset(&b, 0, sizeof b);
+  FCM_TRY(ctx, from->setup(from->user, FCM_OK, I->space, &b));
+  FCM_TRY(ctx, fcm__integrator_set_backend(I, &b));
+cleanup:
+  return st;
+}
+
+const fcm__backend *fcm__integrator_backend(const fcm_integrator *I)
 {
   return I && I->has_backend ? &I->backend : NULL;
 }
@@ -773,7 +787,7 @@ fcm_status fcm__integrator_finish(fcm_integrator *I, fcm_status st)
 fcm_status fcm__sim_reduce(fcm_integrator *I, fcm_status st, double *scalars, int ns, double *vec)
 {
   if (!I->has_backend) return st;
-  const fcm__sim_backend *b = &I->backend;
+  const fcm__backend *b = &I->backend;
   st = b->reduce(b->user, st, scalars, ns);
   if (st == FCM_OK && vec) st = b->reduce(b->user, FCM_OK, vec, I->n);
   if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
@@ -804,7 +818,7 @@ fcm_index fcm_integrator_num_constrained(const fcm_integrator *I)
 {
   return I ? I->ncon : 0;
 }
-/* With a distributed backend: this process's partial mass matrix (sim_backend.h). */
+/* With a distributed backend: this process's partial mass matrix (solve/solve_backend.h). */
 const fcm_csr *fcm_integrator_mass(const fcm_integrator *I)
 {
   return I ? I->M : NULL;
@@ -1022,7 +1036,7 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   FCM_CHECK(old && space, ctx, FCM_ERR_ARG, "integrator cut: NULL integrator or space");
   FCM_CHECK(old->is_setup, ctx, FCM_ERR_ARG,
             "integrator cut: the integrator must be set up (fcm_integrator_setup())");
-  /* with a backend (sim_backend.h) a local failure goes into its cut hook, which agrees */
+  /* with a backend (solve/solve_backend.h) a local failure goes into its setup, which agrees */
   st = fcm_integrator_create(ctx, space, &old->mat, &old->opts, &I);
   for (int k = 0; st == FCM_OK && k < old->num_loads; k++) {
     sim_load l = old->loads[k];
@@ -1036,11 +1050,11 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
     st = fcm_integrator_add_boundary_constraint(I, old->bcons[k].select, old->bcons[k].select_user,
                                                 &old->bcons[k].motion, &old->bcons[k].opts, NULL);
   if (old->has_backend) {
-    fcm__sim_backend b;
+    fcm__backend b;
     memset(&b, 0, sizeof b);
-    FCM_CHECK(old->backend.cut, ctx, FCM_ERR_UNSUPPORTED,
+    FCM_CHECK(old->backend.setup, ctx, FCM_ERR_UNSUPPORTED,
               "integrator cut: the integrator's distributed backend cannot be cut");
-    FCM_TRY(ctx, old->backend.cut(old->backend.user, st, space, &b));
+    FCM_TRY(ctx, old->backend.setup(old->backend.user, st, space, &b));
     FCM_TRY(ctx, fcm__integrator_set_backend(I, &b));
   }
   FCM_TRY(ctx, st);
