@@ -40,8 +40,8 @@ static fcm_status soft(fcm_integrator *I, fcm_status s, fcm_step_reason *reason)
   return s;
 }
 
-/* A numerically singular system (issue 19: the direct path refuses it instead of returning
- * garbage) is a hard error, not a step to retry with a shorter time step: re-raise it with
+/* A numerically singular system (the direct path refuses it instead of returning garbage) is
+ * a hard error, not a step to retry with a shorter time step: re-raise it with
  * the cause this integrator can name (no active constraint in a static step) before the
  * direct solver's message. */
 static fcm_status singular(fcm_integrator *I)
@@ -126,7 +126,7 @@ cleanup:
   return st;
 }
 
-/* The matrix the preconditioner is built from (issue 19): the eliminated Newton matrix H
+/* The matrix the preconditioner is built from: the eliminated Newton matrix H
  * when its tangent is PSD already or preconditioner_tangent is EXACT; otherwise
  * Hpc = base(h) + K_pc with the PSD-projected tangent at u (PROJECTED) or the linear-elastic
  * stiffness at rest (LINEAR, assembled once into K0), eliminated like H. The exact tangent of
