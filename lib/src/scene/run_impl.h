@@ -1,5 +1,6 @@
-/* scene module internals: the simulation object shared by run.c (building, stepping,
- * output) and checkpoint.c (saving and restoring a run). */
+/* scene module internals: the simulation object shared by the runner's files (run.c building,
+ * run_effects.c, run_step.c, run_output.c, run_summary.c, run_petsc.c) and checkpoint.c (saving
+ * and restoring a run). */
 #ifndef FCM_SCENE_RUN_IMPL_H
 #define FCM_SCENE_RUN_IMPL_H
 
@@ -98,8 +99,20 @@ struct fcm_simulation {
 fcm_status fcm__sim_grow(fcm_ctx *ctx, void **array, long long *cap, long long need, size_t size);
 
 /* Recount the inversion and frame counters of S->c (inverted_*, nonfinite_*) from the log's
- * rows, as a restored checkpoint leaves them (run.c). */
+ * rows, as a restored checkpoint leaves them (run_step.c). */
 void fcm__sim_count_log(fcm_simulation *S);
+
+/* Centre of mass of the body at displacement u (NULL: the reference one), 1^T M x / 1^T M 1
+ * per component; dynamic scenes only (the mass matrix). Collective in a distributed run
+ * (run_effects.c). */
+fcm_status fcm__sim_center_of_mass(const fcm_simulation *S, const double *u, double com[3]);
+
+/* Run the initialize hooks of the scene's effects into one velocity, set once (run_effects.c). */
+fcm_status fcm__sim_initialize_effects(fcm_simulation *S);
+
+/* The frame counters after a frame of the state after step `step` with `nonfinite` NaN or
+ * infinite von Mises values (run_step.c). */
+void fcm__sim_count_frame(fcm_simulation_counters *c, long long step, fcm_index nonfinite);
 
 /* Apply the next cut of the scene (S->cuts[S->cuts_applied]): rules, space, integrator and the
  * output's element map are replaced; the state carries over (run.c). */
