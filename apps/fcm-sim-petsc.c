@@ -144,6 +144,63 @@ static int resume_checkpoint(fcm_ctx *ctx, fcm_simulation *sim, const char *path
   return 0;
 }
 
+/* What the monitor of the integrator path's run (on_step_newton()) needs and keeps. */
+typedef struct newton_run {
+  fcm_ctx *ctx;
+  const char *dir, *name, *logpath;
+  int write, talk, rank;
+  int frame;           /* the next frame's index */
+  int warned_inverted; /* a resumed run may have warned already */
+  long long attempted; /* the step being taken */
+  int stopped;         /* 1: the monitor ended the run (and reported why) */
+} newton_run;
+
+/* fcm_simulation_monitor_fn of the integrator path (collective): the state's check, the
+ * warning on the first step that ends inverted (as the serial fcm-sim; the counts are the same
+ * on every process), the progress line, the frame and log when due, and the checkpoint when
+ * due (after the frame, as the serial fcm-sim: the checkpoint counts it). */
+static fcm_status on_step_newton(void *user, fcm_simulation *sim,
+                                 const fcm_simulation_step_event *ev)
+{
+  newton_run *r = user;
+  const fcm_step_info *si = ev->info;
+  const long long k = ev->step;
+  int ok = 1;
+  r->stopped = 1;
+  if (!fcm_simulation_state_finite(sim)) {
+    if (r->rank == 0) fprintf(stderr, "fcm-sim: non-finite state after step %lld\n", k);
+    return FCM_ERR_NUMERIC;
+  }
+  if (r->rank == 0 && si->inverted_points > 0 && !r->warned_inverted)
+    fprintf(stderr,
+            "fcm-sim: warning: step %lld (t = %.6g s) ended with %lld inverted quadrature "
+            "point%s (J = det F <= 0; the first in cell %lld, -1: not located); the stresses "
+            "there are NaN\n",
+            k, si->time, (long long)si->inverted_points, si->inverted_points == 1 ? "" : "s",
+            (long long)si->inverted_cell);
+  r->warned_inverted |= si->inverted_points > 0;
+  if (r->talk)
+    fprintf(stderr,
+            "fcm-sim: step %lld/%lld t = %.6g s: Newton %d, KSP %lld iterations, residual "
+            "%.3g\n",
+            k, ev->num_steps, si->time, si->newton_iterations, si->linear_iterations, si->residual);
+  if (r->write && fcm_simulation_frame_due(sim)) {
+    if (!write_frame_newton(r->ctx, sim, r->dir, r->frame++, r->rank)) return FCM_ERR_IO;
+    if (r->rank == 0) {
+      ok = fcm_simulation_write_log(sim, r->logpath) == FCM_OK;
+      if (!ok) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(r->ctx));
+    }
+    MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (!ok) return FCM_ERR_IO;
+  }
+  if (r->write && fcm_simulation_checkpoint_due(sim) &&
+      !write_checkpoint(r->ctx, sim, r->dir, r->name, r->talk, r->rank))
+    return FCM_ERR_IO;
+  r->attempted = k + 1;
+  r->stopped = 0;
+  return FCM_OK;
+}
+
 /* A scene the linear driver does not run (non-linear material, boundary constraints, loads on
  * the boundary, damping, initial velocities, release): the scene's own simulation with the
  * integrator on PETSc (fcm_petsc_simulation_create()). Every process holds the same state and
@@ -202,53 +259,27 @@ static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
     if (!ok) goto done;
   }
   const double t0 = fcm_wtime();
-  const long long n = fcm_simulation_num_steps(sim);
   fcm_simulation_get_counters(sim, &c); /* a resumed run may have warned already */
-  int warned_inverted = c.inverted_steps > 0;
-  while (!fcm_simulation_done(sim)) {
-    fcm_step_info si;
-    const long long attempted = fcm_simulation_step_count(sim) + 1;
-    st = fcm_simulation_step(sim, &si); /* collective; a failure is the same everywhere */
-    const long long k = fcm_simulation_step_count(sim);
-    if (st != FCM_OK) { /* the step failed, or was taken and refused (solver.on_inversion) */
-      if (rank == 0) {
-        fprintf(stderr, "fcm-sim: step %lld: %s\n", attempted, fcm_ctx_error_message(ctx));
-        if (write) fcm_simulation_write_log(sim, logpath);
-      }
-      goto done;
+  newton_run rn = {ctx,
+                   dir,
+                   name,
+                   logpath,
+                   write,
+                   talk,
+                   rank,
+                   frame,
+                   c.inverted_steps > 0,
+                   fcm_simulation_step_count(sim) + 1,
+                   0};
+  st = fcm_simulation_run(sim, on_step_newton, &rn); /* collective; the same status everywhere */
+  if (st != FCM_OK) {
+    if (rn.stopped) goto done;
+    /* the step failed, or was taken and refused (solver.on_inversion) */
+    if (rank == 0) {
+      fprintf(stderr, "fcm-sim: step %lld: %s\n", rn.attempted, fcm_ctx_error_message(ctx));
+      if (write) fcm_simulation_write_log(sim, logpath);
     }
-    if (!fcm_simulation_state_finite(sim)) {
-      if (rank == 0) fprintf(stderr, "fcm-sim: non-finite state after step %lld\n", k);
-      goto done;
-    }
-    /* as the serial fcm-sim: a warning on the first step that ends inverted (the counts are
-     * the same on every process) */
-    if (rank == 0 && si.inverted_points > 0 && !warned_inverted)
-      fprintf(stderr,
-              "fcm-sim: warning: step %lld (t = %.6g s) ended with %lld inverted quadrature "
-              "point%s (J = det F <= 0; the first in cell %lld, -1: not located); the stresses "
-              "there are NaN\n",
-              k, si.time, (long long)si.inverted_points, si.inverted_points == 1 ? "" : "s",
-              (long long)si.inverted_cell);
-    warned_inverted |= si.inverted_points > 0;
-    if (talk)
-      fprintf(stderr,
-              "fcm-sim: step %lld/%lld t = %.6g s: Newton %d, KSP %lld iterations, residual "
-              "%.3g\n",
-              k, n, si.time, si.newton_iterations, si.linear_iterations, si.residual);
-    if (write && fcm_simulation_frame_due(sim)) {
-      if (!write_frame_newton(ctx, sim, dir, frame++, rank)) goto done;
-      if (rank == 0) {
-        ok = fcm_simulation_write_log(sim, logpath) == FCM_OK;
-        if (!ok) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
-      }
-      MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
-      if (!ok) goto done;
-    }
-    /* after the frame, as the serial fcm-sim: the checkpoint counts it */
-    if (write && fcm_simulation_checkpoint_due(sim) &&
-        !write_checkpoint(ctx, sim, dir, name, talk, rank))
-      goto done;
+    goto done;
   }
   if (write && rank == 0) {
     ok = fcm_simulation_write_log(sim, logpath) == FCM_OK;
@@ -271,46 +302,42 @@ done:
   return rc;
 }
 
-int sim_petsc_run(const char *path, const char *outdir, long long steps, int check, int quiet,
-                  int checkpoint_every, const char *resume, int petsc_argc, char **petsc_argv)
+/* A scene the linear driver runs (fcm_petsc_problem_create_from_scene()): its own steps, frames
+ * (<name>.pvd naming the .pvtu frames), log and checkpoints (<name>_checkpoint_NNNNNN.fcmpk);
+ * --resume: every process reads the checkpoint. Returns the exit code (this process's). */
+/* The linear driver's summary (process 0): partition, DOFs and elements per process, steps and
+ * iterations, times, and per DOF; pvdpath NULL: no output written. */
+static void linear_summary(const char *name, int size, const fcm_petsc_info *info, double t_setup,
+                           double tsteps, const char *pvdpath, const char *logpath)
 {
-  int rc = 1, rank = 0, size = 1;
-  fcm_ctx *ctx = NULL;
-  fcm_scene *scene = NULL;
+  printf("scene %s (backend petsc, %d process%s, partition %s)\n", name, size, size > 1 ? "es" : "",
+         fcm_petsc_partition_name(info->partition));
+  printf("  dofs      %lld; elements per process %lld .. %lld\n", (long long)info->num_dofs,
+         (long long)info->min_local_elements, (long long)info->max_local_elements);
+  printf("  steps     %lld, KSP iterations %lld\n", info->steps, info->total_iterations);
+  printf("  time      setup %.3g s (rules %.3g s, assembly %.3g s on process 0), steps %.3g s\n",
+         t_setup, info->time_rules, info->time_assembly, tsteps);
+  printf("  per dof   setup %.3g us, step %.3g us; memory %.0f bytes (all processes), "
+         "matrix %.0f bytes\n",
+         1e6 * t_setup / (double)info->num_dofs,
+         1e6 * tsteps / (double)(info->num_dofs * (info->steps > 0 ? info->steps : 1)),
+         info->memory_total / (double)info->num_dofs, info->matrix_memory / (double)info->num_dofs);
+  if (pvdpath) printf("  output    %s, %s\n", pvdpath, logpath);
+}
+
+static int run_linear(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, long long steps,
+                      int check, int quiet, int checkpoint_every, const char *resume, int rank,
+                      int size)
+{
+  int rc = 1;
+  const char *name = fcm_scene_name(scene);
+  const int talk = rank == 0 && !quiet;
   fcm_petsc_problem *P = NULL;
   fcm_pvd *pvd = NULL;
   double *u = NULL, *v = NULL;
   run_log *rows = NULL;
-  if (fcm_ctx_create(NULL, &ctx) != FCM_OK) {
-    fprintf(stderr, "fcm-sim: cannot create the fcm context\n");
-    return 1;
-  }
-  if (fcm_petsc_initialize(ctx, &petsc_argc, &petsc_argv) != FCM_OK) {
-    fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
-    fcm_ctx_destroy(&ctx);
-    return 1;
-  }
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-  const int talk = rank == 0 && !quiet;
-  /* every process parses the same file; a failure is the same everywhere */
-  fcm_status st =
-      path ? fcm_scene_create_from_file(ctx, path, &scene) : fcm_scene_create_default(ctx, &scene);
-  if (st != FCM_OK) {
-    if (rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
-    rc = 2;
-    goto done;
-  }
-  const char *name = fcm_scene_name(scene);
-  if (talk)
-    fprintf(stderr, "fcm-sim: scene %s (%s): building on %d process%s (backend petsc)\n", name,
-            fcm_scene_source(scene), size, size > 1 ? "es" : "");
-  if (!fcm_petsc_problem_supports_scene(ctx, scene)) {
-    rc = run_newton(ctx, scene, outdir, steps, check, quiet, checkpoint_every, resume, rank, size);
-    goto done;
-  }
   double t0 = fcm_wtime();
-  st =
+  fcm_status st =
       fcm_petsc_problem_create_from_scene(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO, &P);
   if (st != FCM_OK) { /* every process has the error; process 0 prints it */
     if (rank == 0) fprintf(stderr, "fcm-sim: scene %s: %s\n", name, fcm_ctx_error_message(ctx));
@@ -421,23 +448,53 @@ int sim_petsc_run(const char *path, const char *outdir, long long steps, int che
       goto done;
     }
   }
-  if (talk) {
-    const double tsteps = fcm_wtime() - t1;
-    printf("scene %s (backend petsc, %d process%s, partition %s)\n", name, size,
-           size > 1 ? "es" : "", fcm_petsc_partition_name(info.partition));
-    printf("  dofs      %lld; elements per process %lld .. %lld\n", (long long)info.num_dofs,
-           (long long)info.min_local_elements, (long long)info.max_local_elements);
-    printf("  steps     %lld, KSP iterations %lld\n", info.steps, info.total_iterations);
-    printf("  time      setup %.3g s (rules %.3g s, assembly %.3g s on process 0), steps %.3g s\n",
-           t_setup, info.time_rules, info.time_assembly, tsteps);
-    printf("  per dof   setup %.3g us, step %.3g us; memory %.0f bytes (all processes), "
-           "matrix %.0f bytes\n",
-           1e6 * t_setup / (double)info.num_dofs,
-           1e6 * tsteps / (double)(info.num_dofs * (info.steps > 0 ? info.steps : 1)),
-           info.memory_total / (double)info.num_dofs, info.matrix_memory / (double)info.num_dofs);
-    if (write) printf("  output    %s, %s\n", pvdpath, logpath);
-  }
+  if (talk)
+    linear_summary(name, size, &info, t_setup, fcm_wtime() - t1, write ? pvdpath : NULL, logpath);
   rc = 0;
+done:
+  fcm_pvd_destroy(&pvd);
+  free(u);
+  free(v);
+  free(rows);
+  fcm_petsc_problem_destroy(&P);
+  return rc;
+}
+
+int sim_petsc_run(const char *path, const char *outdir, long long steps, int check, int quiet,
+                  int checkpoint_every, const char *resume, int petsc_argc, char **petsc_argv)
+{
+  int rc = 1, rank = 0, size = 1;
+  fcm_ctx *ctx = NULL;
+  fcm_scene *scene = NULL;
+  if (fcm_ctx_create(NULL, &ctx) != FCM_OK) {
+    fprintf(stderr, "fcm-sim: cannot create the fcm context\n");
+    return 1;
+  }
+  if (fcm_petsc_initialize(ctx, &petsc_argc, &petsc_argv) != FCM_OK) {
+    fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+    fcm_ctx_destroy(&ctx);
+    return 1;
+  }
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const int talk = rank == 0 && !quiet;
+  /* every process parses the same file; a failure is the same everywhere */
+  fcm_status st =
+      path ? fcm_scene_create_from_file(ctx, path, &scene) : fcm_scene_create_default(ctx, &scene);
+  if (st != FCM_OK) {
+    if (rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+    rc = 2;
+    goto done;
+  }
+  const char *name = fcm_scene_name(scene);
+  if (talk)
+    fprintf(stderr, "fcm-sim: scene %s (%s): building on %d process%s (backend petsc)\n", name,
+            fcm_scene_source(scene), size, size > 1 ? "es" : "");
+  rc = fcm_petsc_problem_supports_scene(ctx, scene)
+           ? run_linear(ctx, scene, outdir, steps, check, quiet, checkpoint_every, resume, rank,
+                        size)
+           : run_newton(ctx, scene, outdir, steps, check, quiet, checkpoint_every, resume, rank,
+                        size);
 done:
   /* the exit code every process returns: the largest */
   {
@@ -445,11 +502,6 @@ done:
     MPI_Allreduce(&rc, &all, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
     rc = all;
   }
-  fcm_pvd_destroy(&pvd);
-  free(u);
-  free(v);
-  free(rows);
-  fcm_petsc_problem_destroy(&P);
   fcm_scene_destroy(&scene);
   fcm_ctx_destroy(&ctx);
   fcm_petsc_finalize();

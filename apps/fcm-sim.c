@@ -337,6 +337,58 @@ static int write_checkpoint(fcm_ctx *ctx, fcm_simulation *sim, const char *dir, 
   return 1;
 }
 
+/* What the monitor of the run (on_step()) needs and keeps. */
+typedef struct run_state {
+  fcm_ctx *ctx;
+  const scene_options *o;
+  const char *dir, *name, *logpath;
+  int write, tty;
+  int frame; /* the next frame's index */
+  /* warn once of each: an earlier run (a resumed checkpoint) may have warned already */
+  int warned_inverted, warned_nonfinite;
+  int stopped; /* 1: the monitor ended the run (and reported why) */
+} run_state;
+
+/* fcm_simulation_monitor_fn: after each step, the state's check, the warnings, the progress
+ * line, the frame and log when due, and the checkpoint when due (after the frame: it counts
+ * it). */
+static fcm_status on_step(void *user, fcm_simulation *sim, const fcm_simulation_step_event *ev)
+{
+  run_state *r = user;
+  const scene_options *o = r->o;
+  const fcm_step_info *si = ev->info;
+  r->stopped = 1;
+  if (!fcm_simulation_state_finite(sim)) {
+    fprintf(stderr, "fcm-sim: non-finite state after step %lld\n", ev->step);
+    return FCM_ERR_NUMERIC;
+  }
+  if (si->inverted_points > 0 && !r->warned_inverted) {
+    warn_inverted(r->tty, si, ev->step);
+    r->warned_inverted = 1;
+  }
+  if (!o->quiet)
+    progress(r->tty, ev->step - ev->first, ev->num_steps - ev->first, ev->step, ev->num_steps, si,
+             ev->wall);
+  if (r->write && fcm_simulation_frame_due(sim)) {
+    if (fcm_simulation_write_frame(sim, r->dir, r->frame++) != FCM_OK ||
+        fcm_simulation_write_log(sim, r->logpath) != FCM_OK) {
+      report_error(r->ctx, o->debug, "writing the output");
+      return FCM_ERR_IO;
+    }
+    fcm_simulation_counters c;
+    fcm_simulation_get_counters(sim, &c);
+    if (c.nonfinite_last > 0 && !r->warned_nonfinite) {
+      warn_nonfinite(r->tty, &c, r->frame - 1);
+      r->warned_nonfinite = 1;
+    }
+  }
+  if (r->write && fcm_simulation_checkpoint_due(sim) &&
+      !write_checkpoint(r->ctx, sim, r->dir, r->name, o->quiet, o->debug))
+    return FCM_ERR_IO;
+  r->stopped = 0;
+  return FCM_OK;
+}
+
 static int scene_main(int argc, char **argv)
 {
   scene_options o = {NULL, NULL, NULL, 0, -1, 0, 0, 0, 0, 0, 0};
@@ -443,47 +495,20 @@ static int scene_main(int argc, char **argv)
       goto done;
     }
   }
-  double t0 = fcm_wtime();
-  long long n = fcm_simulation_num_steps(sim), first = fcm_simulation_step_count(sim);
-  while (!fcm_simulation_done(sim)) {
-    fcm_step_info si;
-    if (fcm_simulation_step(sim, &si) != FCM_OK) {
-      if (tty) fputc('\n', stderr);
-      char what[160];
-      snprintf(what, sizeof what, "scene %s: step %lld (t = %.6g s)", name,
-               fcm_simulation_step_count(sim) + 1,
-               fcm_integrator_time(fcm_simulation_integrator(sim)));
-      report_error(ctx, o.debug, what);
-      if (write && fcm_simulation_write_log(sim, logpath) != FCM_OK)
-        report_error(ctx, o.debug, "writing the log");
-      goto done;
-    }
-    if (!fcm_simulation_state_finite(sim)) {
-      fprintf(stderr, "fcm-sim: non-finite state after step %lld\n",
-              fcm_simulation_step_count(sim));
-      goto done;
-    }
-    long long k = fcm_simulation_step_count(sim);
-    if (si.inverted_points > 0 && !warned_inverted) {
-      warn_inverted(tty, &si, k);
-      warned_inverted = 1;
-    }
-    if (!o.quiet) progress(tty, k - first, n - first, k, n, &si, fcm_wtime() - t0);
-    if (write && fcm_simulation_frame_due(sim)) {
-      if (fcm_simulation_write_frame(sim, dir, frame++) != FCM_OK ||
-          fcm_simulation_write_log(sim, logpath) != FCM_OK) {
-        report_error(ctx, o.debug, "writing the output");
-        goto done;
-      }
-      fcm_simulation_get_counters(sim, &c);
-      if (c.nonfinite_last > 0 && !warned_nonfinite) {
-        warn_nonfinite(tty, &c, frame - 1);
-        warned_nonfinite = 1;
-      }
-    }
-    if (write && fcm_simulation_checkpoint_due(sim) &&
-        !write_checkpoint(ctx, sim, dir, name, o.quiet, o.debug))
-      goto done;
+  run_state rs = {ctx, &o, dir, name, logpath, write, tty, frame, warned_inverted, warned_nonfinite,
+                  0};
+  st = fcm_simulation_run(sim, on_step, &rs);
+  if (st != FCM_OK) {
+    if (rs.stopped) goto done; /* the monitor said why */
+    if (tty) fputc('\n', stderr);
+    char what[160];
+    snprintf(what, sizeof what, "scene %s: step %lld (t = %.6g s)", name,
+             fcm_simulation_step_count(sim) + 1,
+             fcm_integrator_time(fcm_simulation_integrator(sim)));
+    report_error(ctx, o.debug, what);
+    if (write && fcm_simulation_write_log(sim, logpath) != FCM_OK)
+      report_error(ctx, o.debug, "writing the log");
+    goto done;
   }
   if (write && fcm_simulation_write_log(sim, logpath) != FCM_OK) {
     report_error(ctx, o.debug, "writing the log");

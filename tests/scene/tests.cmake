@@ -11,6 +11,9 @@ fcm_add_test(scene_default tests/scene/default.c
 fcm_add_test(scene_examples tests/scene/examples.c ARGS ${PROJECT_SOURCE_DIR}/apps/scenes)
 # The scene runner: counters of what a scene computes and skips, frames, log, errors.
 fcm_add_test(scene_run_counters tests/scene/run_counters.c)
+# The time loop fcm_simulation_run(): the steps taken by hand, the monitor's events and its
+# stop, a run continued and a finished one.
+fcm_add_test(scene_run_loop tests/scene/run_loop.c)
 # Checkpoints: a restored run continues bit for bit (static, dynamic, free body); errors.
 fcm_add_test(scene_checkpoint tests/scene/checkpoint.c)
 # Allocation failures in the runner: create, step, frames, log, checkpoints, centre of mass,

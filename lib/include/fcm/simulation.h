@@ -137,6 +137,34 @@ FCM_API const fcm_cell_rules *fcm_simulation_cell_rules(const fcm_simulation *si
  * FCM_ERR_ARG when the run is done. */
 FCM_API fcm_status fcm_simulation_step(fcm_simulation *sim, fcm_step_info *info);
 
+/** What fcm_simulation_run() reports to its monitor after each step it took. */
+typedef struct fcm_simulation_step_event {
+  long long step;            /**< steps taken so far (fcm_simulation_step_count()) */
+  long long first;           /**< steps taken when the run started (a restored checkpoint's) */
+  long long num_steps;       /**< steps to take (fcm_simulation_num_steps()) */
+  double wall;               /**< seconds since fcm_simulation_run() started */
+  const fcm_step_info *info; /**< what the step did (valid during the call) */
+} fcm_simulation_step_event;
+
+/** Called by fcm_simulation_run() after each step that succeeded: the host checks the state,
+ * writes frames, the log and checkpoints (fcm_simulation_frame_due(),
+ * fcm_simulation_checkpoint_due()) and reports progress here. FCM_OK goes on; any other
+ * status ends the run, which returns it as it is (the monitor records a message in the
+ * context if it wants one). */
+typedef fcm_status (*fcm_simulation_monitor_fn)(void *user, fcm_simulation *sim,
+                                                const fcm_simulation_step_event *event);
+
+/** The time loop: take the steps left (fcm_simulation_step() until fcm_simulation_done()),
+ * calling `monitor` (may be NULL) after each. The same loop serves a serial simulation and a
+ * distributed one (fcm_petsc_simulation_create(), where it is collective and so must the
+ * monitor be). A failed step ends the run with its status; fcm_simulation_step_count() is
+ * then that of the last step that succeeded (or, for a step refused after it was taken,
+ * solver.on_inversion = "stop", that step's).
+ * @return FCM_OK when the run is done; the status of a failed step (its message in the
+ * context); the monitor's status; FCM_ERR_ARG (NULL simulation). */
+FCM_API fcm_status fcm_simulation_run(fcm_simulation *sim, fcm_simulation_monitor_fn monitor,
+                                      void *user);
+
 /** 1 when the steps to take (scene or max_steps) are taken, else 0. */
 FCM_API int fcm_simulation_done(const fcm_simulation *sim);
 /** Steps taken so far and steps to take. */

@@ -307,7 +307,118 @@ int fcm__petsc_pcmg_grid(const fcm_space *space)
   return t == FCM_ELEMENT_HEX8 || t == FCM_ELEMENT_HEX20;
 }
 
-/* Distributed failures (issue 14): every call here that communicates (PCMGSetLevels, the
+/* -pc_mg_levels under P's prefix, if given: *max_levels (local). */
+static fcm_status levels_option(fcm_petsc_problem *P, int *max_levels)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  PetscInt lv = 0;
+  PetscBool has = PETSC_FALSE;
+  char key[64];
+  snprintf(key, sizeof key, "-%spc_mg_levels", P->prefix);
+  PCALL(ctx, PetscOptionsGetInt(NULL, NULL, key, &lv, &has));
+  if (has) {
+    FCM_CHECK(lv >= 1 && lv <= 32, ctx, FCM_ERR_ARG,
+              "petsc: -pc_mg_levels %d outside [1, 32] (fcm's multigrid levels)", (int)lv);
+    *max_levels = (int)lv;
+  }
+cleanup:
+  return st;
+}
+
+/* The coarse copies of level l + 1 (local): each owned by the owner of the lowest global finer
+ * copy it interpolates to (minf: that finer copy; -1: none, the copy is left out), numbered
+ * contiguously per owner (gidx_c; -1 left out); this process's count and first index. count:
+ * P->size + 1 scratch. */
+static void coarse_numbering(const fcm_petsc_problem *P, const fcm__mg_transfers *T, int l,
+                             const PetscInt *gidx, const int *owner, PetscInt *count,
+                             fcm_index *minf, int *owner_c, PetscInt *gidx_c, PetscInt *nloc_c,
+                             PetscInt *first_c)
+{
+  const fcm_index nf = T->n[l] / 3, nc = T->n[l + 1] / 3;
+  const fcm_index *pp = T->P_ptr[l];
+  const int *pc_ = T->P_col[l];
+  const double *pv = T->P_val[l];
+  for (fcm_index K = 0; K < nc; K++)
+    minf[K] = -1, owner_c[K] = -1;
+  for (fcm_index k = 0; k < nf; k++) {
+    if (gidx[k] < 0) continue;
+    for (fcm_index p = pp[3 * k]; p < pp[3 * k + 1]; p++) {
+      const fcm_index K = pc_[p] / 3;
+      if (pv[p] == 0.0) continue;
+      if (minf[K] < 0 || gidx[k] < gidx[minf[K]]) minf[K] = k;
+    }
+  }
+  memset(count, 0, sizeof *count * (size_t)(P->size + 1));
+  for (fcm_index K = 0; K < nc; K++)
+    if (minf[K] >= 0) owner_c[K] = owner[minf[K]], count[owner_c[K] + 1]++;
+  for (int r = 0; r < P->size; r++)
+    count[r + 1] += count[r];
+  *nloc_c = count[P->rank + 1] - count[P->rank];
+  *first_c = count[P->rank];
+  for (fcm_index K = 0; K < nc; K++)
+    gidx_c[K] = minf[K] >= 0 ? count[owner_c[K]]++ : -1;
+}
+
+/* The preallocation of level l's prolongation (local): per owned row its entries in the
+ * diagonal block (dnz, zeroed by the caller) and the others (onz); returns the widest row. */
+static int prolongation_counts(const fcm_petsc_problem *P, const fcm__mg_transfers *T, int l,
+                               const PetscInt *gidx, const int *owner, const PetscInt *gidx_c,
+                               PetscInt first, PetscInt first_c, PetscInt nloc_c, PetscInt *dnz,
+                               PetscInt *onz)
+{
+  const fcm_index nf = T->n[l] / 3;
+  const fcm_index *pp = T->P_ptr[l];
+  const int *pc_ = T->P_col[l];
+  int width = 0;
+  for (fcm_index k = 0; k < nf; k++) {
+    if (gidx[k] < 0 || owner[k] != P->rank) continue;
+    for (int c = 0; c < 3; c++) {
+      const PetscInt r = 3 * (gidx[k] - first) + c;
+      for (fcm_index p = pp[3 * k + c]; p < pp[3 * k + c + 1]; p++) {
+        const PetscInt J = gidx_c[pc_[p] / 3];
+        if (J < 0) continue;
+        if (J >= first_c && J < first_c + nloc_c)
+          dnz[r]++;
+        else
+          onz[r]++;
+      }
+      width = FCM_MAX(width, (int)(pp[3 * k + c + 1] - pp[3 * k + c]));
+    }
+  }
+  return width;
+}
+
+/* The owned rows of level l's prolongation into Pm (local: MatSetValues; cols and vals hold
+ * the widest row). */
+static fcm_status prolongation_fill(const fcm_petsc_problem *P, const fcm__mg_transfers *T, int l,
+                                    const PetscInt *gidx, const int *owner, const PetscInt *gidx_c,
+                                    PetscInt *cols, PetscScalar *vals, Mat Pm)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index nf = T->n[l] / 3;
+  const fcm_index *pp = T->P_ptr[l];
+  const int *pc_ = T->P_col[l];
+  const double *pv = T->P_val[l];
+  for (fcm_index k = 0; k < nf; k++) {
+    if (gidx[k] < 0 || owner[k] != P->rank) continue;
+    for (int c = 0; c < 3; c++) {
+      const PetscInt row = 3 * gidx[k] + c;
+      PetscInt m = 0;
+      for (fcm_index p = pp[3 * k + c]; p < pp[3 * k + c + 1]; p++) {
+        const PetscInt J = gidx_c[pc_[p] / 3];
+        if (J < 0) continue;
+        cols[m] = 3 * J + pc_[p] % 3;
+        vals[m++] = pv[p];
+      }
+      PCALL(P->ctx, MatSetValues(Pm, 1, &row, m, cols, vals, INSERT_VALUES));
+    }
+  }
+cleanup:
+  return st;
+}
+
+/* Distributed failures: every call here that communicates (PCMGSetLevels, the
  * prolongations' MatCreate .. MatAssemblyEnd, PCSetFromOptions) is preceded by an agreement
  * (AGREE: fcm__petsc_problem_agree()) ending the local work before it, and every exit passes
  * through one agreement (cleanup) unless a failure was agreed already. A process failing in a
@@ -324,6 +435,9 @@ int fcm__petsc_pcmg_grid(const fcm_space *space)
     }                                                                                              \
   } while (0)
 
+/* The setup stays one function (about 150 lines) on purpose: its agreements (AGREE) and the
+ * collective calls between them must come in the same order on every process, and reading them
+ * in one place shows that they do; the local work of each level is in the helpers above. */
 fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned char *constrained,
                                  int optional, int *num_levels)
 {
@@ -340,18 +454,7 @@ fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned cha
   int max_levels = 20;
   const char *prefix = P->prefix;
   if (num_levels) *num_levels = 0;
-  {
-    PetscInt lv = 0;
-    PetscBool has = PETSC_FALSE;
-    char key[64];
-    snprintf(key, sizeof key, "-%spc_mg_levels", prefix);
-    PCALL(ctx, PetscOptionsGetInt(NULL, NULL, key, &lv, &has));
-    if (has) {
-      FCM_CHECK(lv >= 1 && lv <= 32, ctx, FCM_ERR_ARG,
-                "petsc: -pc_mg_levels %d outside [1, 32] (fcm's multigrid levels)", (int)lv);
-      max_levels = (int)lv;
-    }
-  }
+  FCM_TRY(ctx, levels_option(P, &max_levels));
   if (optional && !fcm__petsc_pcmg_grid(P->space)) goto cleanup;
   if (!fcm__petsc_pcmg_grid(P->space)) {
     const fcm_element_type t = fcm_mesh_element_type(fcm_space_mesh(P->space));
@@ -405,51 +508,18 @@ fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned cha
     blocks = !has;
   }
   for (int l = 0; l + 1 < L; l++) {
-    const fcm_index nf = T->n[l] / 3, nc = T->n[l + 1] / 3;
-    const fcm_index *pp = T->P_ptr[l];
-    const int *pc_ = T->P_col[l];
-    const double *pv = T->P_val[l];
+    const fcm_index nc = T->n[l + 1] / 3;
     /* owners and numbering of the coarse copies */
     FCM_ALLOC(ctx, nc + 1, minf);
     FCM_ALLOC(ctx, nc + 1, owner_c);
     FCM_ALLOC(ctx, nc + 1, gidx_c);
-    for (fcm_index K = 0; K < nc; K++)
-      minf[K] = -1, owner_c[K] = -1;
-    for (fcm_index k = 0; k < nf; k++) {
-      if (gidx[k] < 0) continue;
-      for (fcm_index p = pp[3 * k]; p < pp[3 * k + 1]; p++) {
-        const fcm_index K = pc_[p] / 3;
-        if (pv[p] == 0.0) continue;
-        if (minf[K] < 0 || gidx[k] < gidx[minf[K]]) minf[K] = k;
-      }
-    }
-    memset(count, 0, sizeof *count * (size_t)(P->size + 1));
-    for (fcm_index K = 0; K < nc; K++)
-      if (minf[K] >= 0) owner_c[K] = owner[minf[K]], count[owner_c[K] + 1]++;
-    for (int r = 0; r < P->size; r++)
-      count[r + 1] += count[r];
-    const PetscInt nloc_c = count[P->rank + 1] - count[P->rank], first_c = count[P->rank];
-    for (fcm_index K = 0; K < nc; K++)
-      gidx_c[K] = minf[K] >= 0 ? count[owner_c[K]]++ : -1;
+    PetscInt nloc_c = 0, first_c = 0;
+    coarse_numbering(P, T, l, gidx, owner, count, minf, owner_c, gidx_c, &nloc_c, &first_c);
     /* the matrix: owned rows */
     FCM_ALLOC(ctx, 3 * nloc + 1, dnz);
     FCM_ALLOC(ctx, 3 * nloc + 1, onz);
-    int width = 0;
-    for (fcm_index k = 0; k < nf; k++) {
-      if (gidx[k] < 0 || owner[k] != P->rank) continue;
-      for (int c = 0; c < 3; c++) {
-        const PetscInt r = 3 * (gidx[k] - first) + c;
-        for (fcm_index p = pp[3 * k + c]; p < pp[3 * k + c + 1]; p++) {
-          const PetscInt J = gidx_c[pc_[p] / 3];
-          if (J < 0) continue;
-          if (J >= first_c && J < first_c + nloc_c)
-            dnz[r]++;
-          else
-            onz[r]++;
-        }
-        width = FCM_MAX(width, (int)(pp[3 * k + c + 1] - pp[3 * k + c]));
-      }
-    }
+    const int width =
+        prolongation_counts(P, T, l, gidx, owner, gidx_c, first, first_c, nloc_c, dnz, onz);
     FCM_ALLOC(ctx, width + 1, cols);
     FCM_ALLOC(ctx, width + 1, vals);
     AGREE(); /* the level's local part (and the finer level's smoother) */
@@ -458,20 +528,7 @@ fcm_status fcm__petsc_pcmg_setup(fcm_petsc_problem *P, PC pc, const unsigned cha
     PCALL(ctx, MatSetType(Pm, MATMPIAIJ));
     PCALL(ctx, MatSetBlockSizes(Pm, 3, 3));
     PCALL(ctx, MatMPIAIJSetPreallocation(Pm, 0, dnz, 0, onz));
-    for (fcm_index k = 0; k < nf; k++) {
-      if (gidx[k] < 0 || owner[k] != P->rank) continue;
-      for (int c = 0; c < 3; c++) {
-        const PetscInt row = 3 * gidx[k] + c;
-        PetscInt m = 0;
-        for (fcm_index p = pp[3 * k + c]; p < pp[3 * k + c + 1]; p++) {
-          const PetscInt J = gidx_c[pc_[p] / 3];
-          if (J < 0) continue;
-          cols[m] = 3 * J + pc_[p] % 3;
-          vals[m++] = pv[p];
-        }
-        PCALL(ctx, MatSetValues(Pm, 1, &row, m, cols, vals, INSERT_VALUES));
-      }
-    }
+    FCM_TRY(ctx, prolongation_fill(P, T, l, gidx, owner, gidx_c, cols, vals, Pm));
     PCALL(ctx, MatAssemblyBegin(Pm, MAT_FINAL_ASSEMBLY));
     PCALL(ctx, MatAssemblyEnd(Pm, MAT_FINAL_ASSEMBLY));
     PCALL(ctx, PCMGSetInterpolation(pc, L - 1 - l, Pm)); /* PETSc's level: from the coarsest */

@@ -7,6 +7,7 @@
 #include "fcm/petsc.h"
 
 #include "core/core_impl.h"
+#include "petsc/petsc_backend.h"
 #include "embed/embed_impl.h"
 #include "fem/fem_impl.h"
 
@@ -111,14 +112,53 @@ struct fcm_petsc_problem {
 fcm_status fcm__petsc_error(fcm_ctx *ctx, PetscErrorCode ierr, const char *call, const char *file,
                             int line, const char *func);
 
-/* Every process learns whether any failed: on failure somewhere, every process returns the
- * status and message of the lowest failing process (the others record it as their error).
- * Collective on comm. */
-fcm_status fcm__petsc_agree(fcm_ctx *ctx, MPI_Comm comm, fcm_status st);
-
 /* fcm__petsc_agree() on P's communicator; a failure is remembered (P->agreed_fail), so that a
  * process that learnt of it there does not start another agreement the others never meet. */
 fcm_status fcm__petsc_problem_agree(fcm_petsc_problem *P, fcm_status st);
+
+/* The shared steps of the two drivers, by file. */
+
+/* petsc_init.c: P's options prefix ("fcm<k>_", k counting the problems this process made). */
+void fcm__petsc_set_prefix(fcm_petsc_problem *P);
+
+/* petsc_partition.c: the candidate cells of geom (mesh P->mesh) partitioned over the processes
+ * (P->cell_owner, P->weight, P->classifier, P->remote); *mask: this process's cells. Collective. */
+fcm_status fcm__petsc_partition_cells(fcm_petsc_problem *P, const fcm_geometry *geom,
+                                      unsigned char **mask);
+/* petsc_partition.c: the classification exchange of the distributed rules build
+ * (fcm__rules_exchange.exchange; user: P). Collective. */
+fcm_status fcm__petsc_rules_exchange(void *user, fcm_status st, unsigned char *cls,
+                                     double *fraction, double *volume, fcm__embed_counts *counts);
+/* petsc_partition.c: the rules of the cells flagged in mask and the space's numbering. */
+fcm_status fcm__petsc_build_space(fcm_petsc_problem *P, const fcm_geometry *geom,
+                                  const unsigned char *mask);
+/* petsc_partition.c: the part of geom this process's rules build reads (*crop NULL: all). */
+fcm_status fcm__petsc_crop_geometry(fcm_petsc_problem *P, const fcm_geometry *geom,
+                                    const unsigned char *mask, fcm_geometry **crop);
+/* petsc_partition.c: check that every active cell of P->space has an owner and no inactive
+ * one has (FCM_ERR_INTERNAL naming the first; local). */
+fcm_status fcm__petsc_own_active_cells(fcm_petsc_problem *P);
+
+/* petsc_numbering.c: the owner and PETSc index of every DOF copy (P->copy_owner, P->perm,
+ * P->nlocal, P->first). Collective. */
+fcm_status fcm__petsc_number_dofs(fcm_petsc_problem *P);
+/* petsc_numbering.c: P->space narrowed to the own cells and those using an owned copy. */
+fcm_status fcm__petsc_localize_space(fcm_petsc_problem *P);
+/* petsc_numbering.c: a preallocated MATMPIAIJ (block size 3) of the owned rows. Collective. */
+fcm_status fcm__petsc_create_matrix(fcm_petsc_problem *P, Mat *A);
+/* petsc_numbering.c: the distributed vectors (P->f, u, v, b, x, g, w). Collective. */
+fcm_status fcm__petsc_create_vectors(fcm_petsc_problem *P);
+/* petsc_numbering.c: the rigid-body modes as A's near-null space. Collective. */
+fcm_status fcm__petsc_near_null_space(fcm_petsc_problem *P, Mat A);
+
+/* petsc_linear.c: a new problem on (a duplicate of) comm, st agreed first (see there). */
+fcm_status fcm__petsc_new_problem(fcm_ctx *ctx, MPI_Comm comm, fcm_status st,
+                                  fcm_petsc_problem **out);
+/* petsc_linear.c: the problem's options string and the database's options under its prefix. */
+fcm_status fcm__petsc_insert_options(fcm_petsc_problem *P);
+/* petsc_linear.c: the distributed x in the space's numbering into out (n doubles) on every
+ * process (to_zero: on process 0 only). Collective. */
+fcm_status fcm__petsc_gather(fcm_petsc_problem *P, Vec x, double *out, int to_zero);
 
 /* 1 when fcm's geometric multigrid may apply to the space: Hex8 or Hex20 elements (whether the
  * mesh is a box grid is found by fcm__petsc_pcmg_setup()). pcmg.c. */

@@ -1,1 +1,3 @@
-list(APPEND FCM_SOURCES lib/src/petsc/petsc.c lib/src/petsc/pcmg.c)
+list(APPEND FCM_SOURCES lib/src/petsc/petsc_init.c lib/src/petsc/petsc_partition.c
+     lib/src/petsc/petsc_numbering.c lib/src/petsc/petsc_linear.c lib/src/petsc/petsc_newton.c
+     lib/src/petsc/petsc_output.c lib/src/petsc/pcmg.c)

@@ -1,5 +1,6 @@
-/* scene module internals: the simulation object shared by run.c (building, stepping,
- * output) and checkpoint.c (saving and restoring a run). */
+/* scene module internals: the simulation object shared by the runner's files (run.c building,
+ * run_effects.c, run_step.c, run_output.c, run_summary.c, run_petsc.c) and checkpoint.c (saving
+ * and restoring a run). */
 #ifndef FCM_SCENE_RUN_IMPL_H
 #define FCM_SCENE_RUN_IMPL_H
 
@@ -9,12 +10,7 @@
 #include "fcm/io.h"
 #include "fcm/mesh.h"
 #include "fcm/simulation.h"
-
-/* A sum over the backend's processes before the integrator exists (the cell rules' choice of
- * quadrature.simplify = "auto"): agree on st, then sum values[0 .. count) in place, the same
- * bits on every process (as fcm__sim_backend.reduce). Collective. */
-typedef fcm_status (*fcm__simulation_reduce_fn)(void *user, fcm_status st, double *values,
-                                                fcm_index count);
+#include "fem/fem_backend.h"
 
 /* One row of the per-step log: the step, and the body after it (separate bodies, mass and
  * linear momentum over the body's own quadrature points, fcm_space_momentum(); its inverted
@@ -28,6 +24,24 @@ typedef struct fcm__log_row {
   double mass, momentum[3];
   long long inverted, inverted_cell, nonfinite;
 } fcm__log_row;
+
+/* How fcm__simulation_create() makes a simulation: the public options and the backend that
+ * distributes it. */
+typedef struct fcm__simulation_config {
+  fcm_simulation_options opts;
+  /* the distributed backend (fem/fem_backend.h; NULL: serial), borrowed during the create:
+   * its reduce sums the inputs of the rules' quadrature.simplify = "auto" choice over the
+   * processes, and fcm__integrator_attach_backend() gives the integrator its own reference
+   * (set up for the space) before the integrator's setup; the log's partial quantities (mass,
+   * momentum) are summed through it, and cuts hand it on to each new integrator */
+  const fcm__backend *backend;
+  /* with a backend: the cells whose points this process integrates (every cell is still
+   * classified, so the space and its DOF numbering are those of the serial run) */
+  const unsigned char *cell_mask;
+  /* NULL, or with a backend: each process intersects its share of the cells and the exchange
+   * hands over the others' classes (fcm__cell_rules_create_distributed(), embed/embed_impl.h) */
+  const struct fcm__rules_exchange *exchange;
+} fcm__simulation_config;
 
 struct fcm_simulation {
   fcm_ctx *ctx;
@@ -74,13 +88,9 @@ struct fcm_simulation {
   int *react_effect, *react_id;
   double *react_log;
   long long react_cap;
-  /* distributed runs (fcm__simulation_create_distributed()): points on these cells only
-   * (borrowed during the create; NULL afterwards and in serial runs) */
-  const unsigned char *cell_mask;
-  fcm__simulation_reduce_fn reduce; /* with reduce_user: during the create only (NULL after) */
-  void *reduce_user;
-  const struct fcm__rules_exchange *rules_exchange; /* and the classification shared: NULL or as
-                                                       cell_mask (embed/embed_impl.h) */
+  /* the distributed backend of the create (fcm__simulation_config; NULL afterwards and in
+   * serial runs) */
+  const fcm__simulation_config *config;
   /* what the voxel or level-set geometry reported ("" for the other kinds) */
   char geometry_note[256];
 };
@@ -89,8 +99,20 @@ struct fcm_simulation {
 fcm_status fcm__sim_grow(fcm_ctx *ctx, void **array, long long *cap, long long need, size_t size);
 
 /* Recount the inversion and frame counters of S->c (inverted_*, nonfinite_*) from the log's
- * rows, as a restored checkpoint leaves them (run.c). */
+ * rows, as a restored checkpoint leaves them (run_step.c). */
 void fcm__sim_count_log(fcm_simulation *S);
+
+/* Centre of mass of the body at displacement u (NULL: the reference one), 1^T M x / 1^T M 1
+ * per component; dynamic scenes only (the mass matrix). Collective in a distributed run
+ * (run_effects.c). */
+fcm_status fcm__sim_center_of_mass(const fcm_simulation *S, const double *u, double com[3]);
+
+/* Run the initialize hooks of the scene's effects into one velocity, set once (run_effects.c). */
+fcm_status fcm__sim_initialize_effects(fcm_simulation *S);
+
+/* The frame counters after a frame of the state after step `step` with `nonfinite` NaN or
+ * infinite von Mises values (run_step.c). */
+void fcm__sim_count_frame(fcm_simulation_counters *c, long long step, fcm_index nonfinite);
 
 /* Apply the next cut of the scene (S->cuts[S->cuts_applied]): rules, space, integrator and the
  * output's element map are replaced; the state carries over (run.c). */
@@ -102,27 +124,11 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S);
 fcm_status fcm__scene_mesh_geometry(fcm_ctx *ctx, const fcm_scene *scene, fcm_mesh **mesh,
                                     fcm_geometry **geom);
 
-/* Called by fcm__simulation_create_distributed() with the integrator, created with the scene's
- * effects but not set up yet: it sets the integrator's backend (lib/src/sim/sim_backend.h). */
-typedef fcm_status (*fcm__simulation_attach_fn)(void *user, fcm_integrator *integ,
-                                                const fcm_space *space);
-
-/* fcm_simulation_create() for a distributed backend (the PETSc adapter, fcm/petsc.h): the cell
- * rules carry points on the cells flagged in cell_mask only (every cell is still classified,
- * so the space and its DOF numbering are those of the serial run; with `exchange` (may be
- * NULL) each process intersects its share of the cells and the exchange hands over the others'
- * classes: fcm__cell_rules_create_distributed(), embed/embed_impl.h), `reduce` (with
- * attach_user) sums the inputs of the rules' simplify = "auto" choice over the processes, and
- * `attach` sets the integrator's backend before its setup; the log's partial quantities (mass,
- * momentum) are summed through it, and cuts hand it on to each new integrator
- * (fcm__sim_backend.cut). Collective over the backend's processes. (run.c) */
-fcm_status fcm__simulation_create_distributed(fcm_ctx *ctx, const fcm_scene *scene,
-                                              const fcm_simulation_options *opts,
-                                              const unsigned char *cell_mask,
-                                              fcm__simulation_reduce_fn reduce,
-                                              const struct fcm__rules_exchange *exchange,
-                                              fcm__simulation_attach_fn attach, void *attach_user,
-                                              fcm_simulation **out);
+/* fcm_simulation_create() with a configuration: cfg->opts, and the backend that distributes
+ * the run (fcm__simulation_config; the PETSc one: run_petsc.c). Collective over the backend's
+ * processes. (run.c) */
+fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
+                                  const fcm__simulation_config *cfg, fcm_simulation **out);
 
 /* A distributed run's fcm_simulation_summary_view() (collective; f may be NULL on all but one
  * process): the rules' point counts and the body's largest |u| summed / maximized over the

@@ -535,7 +535,7 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
     form.term = FCM_LINEAR_MASS;
     st = fcm_assembly_workspace_linear(I->aws, &form, I->M, NULL);
     /* with a backend M stays this process's partial mass matrix (its cells' part; never
-     * summed: every use sums a product, sim_backend.h); agree on the status only */
+     * summed: every use sums a product, fem/fem_backend.h); agree on the status only */
     FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, NULL));
     I->setup_info.mass_assemblies = 1;
   }
@@ -701,84 +701,6 @@ cleanup:
   return st;
 }
 
-fcm_status fcm__integrator_set_backend(fcm_integrator *I, const fcm__sim_backend *b)
-{
-  fcm_status st = FCM_OK;
-  if (!I || !b) {
-    if (b && b->destroy) b->destroy(b->user);
-    FCM_CHECK(0, I ? I->ctx : NULL, FCM_ERR_ARG, "integrator: NULL integrator or backend");
-  }
-  if (I->is_setup || I->has_backend || !b->reduce || !b->factor || !b->solve || !b->owned) {
-    if (b->destroy) b->destroy(b->user);
-    FCM_CHECK(0, I->ctx, FCM_ERR_ARG,
-              "integrator: a backend needs reduce, factor, solve and the owned DOFs, and is set "
-              "once, before fcm_integrator_setup()");
-  }
-  I->owned = fcm__calloc(I->ctx, (size_t)I->n + 1, 1);
-  if (!I->owned) {
-    if (b->destroy) b->destroy(b->user);
-    FCM_CHECK(0, I->ctx, FCM_ERR_ALLOC, "integrator: out of memory (%lld owned flags)",
-              (long long)I->n);
-  }
-  memcpy(I->owned, b->owned, (size_t)I->n);
-  I->backend = *b;
-  I->backend.owned = I->owned;
-  I->has_backend = 1;
-cleanup:
-  return st;
-}
-
-const fcm__sim_backend *fcm__integrator_backend(const fcm_integrator *I)
-{
-  return I && I->has_backend ? &I->backend : NULL;
-}
-
-int fcm__integrator_distributed(const fcm_integrator *I, int *root)
-{
-  const int dist = I && I->has_backend;
-  if (root) *root = dist ? I->backend.root : 1;
-  return dist;
-}
-
-void fcm__integrator_processes(const fcm_integrator *I, int *rank, int *nprocs)
-{
-  const int dist = I && I->has_backend;
-  *rank = dist ? I->backend.rank : 0;
-  *nprocs = dist ? I->backend.nprocs : 1;
-}
-
-fcm_status fcm__integrator_reduce(fcm_integrator *I, double *values, fcm_index count)
-{
-  return fcm__integrator_reduce_status(I, FCM_OK, values, count);
-}
-
-fcm_status fcm__integrator_reduce_status(fcm_integrator *I, fcm_status st, double *values,
-                                         fcm_index count)
-{
-  if (!I || !I->has_backend) return st;
-  st = I->backend.reduce(I->backend.user, st, values, count);
-  if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
-  return st;
-}
-
-fcm_status fcm__integrator_finish(fcm_integrator *I, fcm_status st)
-{
-  if (!I || !I->has_backend || !I->backend.finish) return st;
-  st = I->backend.finish(I->backend.user, st);
-  if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
-  return st;
-}
-
-fcm_status fcm__sim_reduce(fcm_integrator *I, fcm_status st, double *scalars, int ns, double *vec)
-{
-  if (!I->has_backend) return st;
-  const fcm__sim_backend *b = &I->backend;
-  st = b->reduce(b->user, st, scalars, ns);
-  if (st == FCM_OK && vec) st = b->reduce(b->user, FCM_OK, vec, I->n);
-  if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
-  return st;
-}
-
 fcm_index fcm_integrator_num_dofs(const fcm_integrator *I)
 {
   return I ? I->n : 0;
@@ -803,7 +725,7 @@ fcm_index fcm_integrator_num_constrained(const fcm_integrator *I)
 {
   return I ? I->ncon : 0;
 }
-/* With a distributed backend: this process's partial mass matrix (sim_backend.h). */
+/* With a distributed backend: this process's partial mass matrix (fem/fem_backend.h). */
 const fcm_csr *fcm_integrator_mass(const fcm_integrator *I)
 {
   return I ? I->M : NULL;
@@ -1021,7 +943,7 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   FCM_CHECK(old && space, ctx, FCM_ERR_ARG, "integrator cut: NULL integrator or space");
   FCM_CHECK(old->is_setup, ctx, FCM_ERR_ARG,
             "integrator cut: the integrator must be set up (fcm_integrator_setup())");
-  /* with a backend (sim_backend.h) a local failure goes into its cut hook, which agrees */
+  /* with a backend (fem/fem_backend.h) a local failure goes into its setup, which agrees */
   st = fcm_integrator_create(ctx, space, &old->mat, &old->opts, &I);
   for (int k = 0; st == FCM_OK && k < old->num_loads; k++) {
     sim_load l = old->loads[k];
@@ -1035,11 +957,11 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
     st = fcm_integrator_add_boundary_constraint(I, old->bcons[k].select, old->bcons[k].select_user,
                                                 &old->bcons[k].motion, &old->bcons[k].opts, NULL);
   if (old->has_backend) {
-    fcm__sim_backend b;
+    fcm__backend b;
     memset(&b, 0, sizeof b);
-    FCM_CHECK(old->backend.cut, ctx, FCM_ERR_UNSUPPORTED,
+    FCM_CHECK(old->backend.setup, ctx, FCM_ERR_UNSUPPORTED,
               "integrator cut: the integrator's distributed backend cannot be cut");
-    FCM_TRY(ctx, old->backend.cut(old->backend.user, st, space, &b));
+    FCM_TRY(ctx, old->backend.setup(old->backend.user, st, space, &b));
     FCM_TRY(ctx, fcm__integrator_set_backend(I, &b));
   }
   FCM_TRY(ctx, st);

@@ -40,8 +40,8 @@ static fcm_status soft(fcm_integrator *I, fcm_status s, fcm_step_reason *reason)
   return s;
 }
 
-/* A numerically singular system (issue 19: the direct path refuses it instead of returning
- * garbage) is a hard error, not a step to retry with a shorter time step: re-raise it with
+/* A numerically singular system (the direct path refuses it instead of returning garbage) is
+ * a hard error, not a step to retry with a shorter time step: re-raise it with
  * the cause this integrator can name (no active constraint in a static step) before the
  * direct solver's message. */
 static fcm_status singular(fcm_integrator *I)
@@ -126,7 +126,7 @@ cleanup:
   return st;
 }
 
-/* The matrix the preconditioner is built from (issue 19): the eliminated Newton matrix H
+/* The matrix the preconditioner is built from: the eliminated Newton matrix H
  * when its tangent is PSD already or preconditioner_tangent is EXACT; otherwise
  * Hpc = base(h) + K_pc with the PSD-projected tangent at u (PROJECTED) or the linear-elastic
  * stiffness at rest (LINEAR, assembled once into K0), eliminated like H. The exact tangent of
@@ -434,29 +434,63 @@ static fcm_status mg_factor(fcm_integrator *I, fcm_step_reason *reason, sim_stat
   return mg_prepare(I, I->H, reason);
 }
 
+/* The implementations of the Newton solves: the serial direct, Krylov (CG, MINRES) and
+ * multigrid paths of the options, and a distributed backend (fem/fem_backend.h) when the
+ * integrator has one, which then takes every solve whatever linear_solver says. */
+typedef enum solve_path { PATH_DIRECT, PATH_KRYLOV, PATH_MULTIGRID, PATH_BACKEND } solve_path;
+
+static solve_path path_of(const fcm_integrator *I)
+{
+  if (I->has_backend) return PATH_BACKEND;
+  switch (I->opts.linear_solver) {
+  case FCM_LINEAR_DIRECT:
+    return PATH_DIRECT;
+  case FCM_LINEAR_MULTIGRID:
+    return PATH_MULTIGRID;
+  default:
+    return PATH_KRYLOV;
+  }
+}
+
+/* The backend's factor: its soft failure is a failed linear solve (the step is retried). */
+static fcm_status backend_factor(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
+{
+  int failed = 0;
+  fcm_status st = I->backend.factor(I->backend.user, I->H, I->is_con, I->h_psd, &failed);
+  stats->factorizations++;
+  I->total_factorizations++;
+  if (st == FCM_OK && failed) *reason = FCM_STEP_LINEAR_SOLVER_FAILED;
+  if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
+  return st;
+}
+
+static fcm_status backend_solve(fcm_integrator *I, const double *b, double *d,
+                                fcm_step_reason *reason, int *iterations, sim_stats *stats)
+{
+  int failed = 0;
+  fcm_status st = I->backend.solve(I->backend.user, b, d, iterations, &failed);
+  stats->linear_iterations += *iterations;
+  if (st == FCM_OK && failed) *reason = FCM_STEP_LINEAR_SOLVER_FAILED;
+  return st;
+}
+
 fcm_status fcm__sim_factor(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
 {
   double t0 = fcm_wtime();
   fcm_status st = FCM_OK;
-  if (I->has_backend) { /* sim_backend.h */
-    int failed = 0;
-    st = I->backend.factor(I->backend.user, I->H, I->is_con, I->h_psd, &failed);
-    stats->factorizations++;
-    I->total_factorizations++;
-    if (st == FCM_OK && failed) *reason = FCM_STEP_LINEAR_SOLVER_FAILED;
-    stats->time_factor += fcm_wtime() - t0;
-    if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
-    return st;
-  }
-  switch (I->opts.linear_solver) {
-  case FCM_LINEAR_DIRECT:
+  switch (path_of(I)) {
+  case PATH_BACKEND:
+    st = backend_factor(I, reason, stats);
+    break;
+  case PATH_DIRECT:
     st = factor_direct(I, reason, stats);
     break;
-  case FCM_LINEAR_MULTIGRID:
+  case PATH_MULTIGRID:
     st = mg_factor(I, reason, stats);
     break;
-  default:
+  case PATH_KRYLOV:
     st = setup_preconditioner(I, reason, stats);
+    break;
   }
   stats->time_factor += fcm_wtime() - t0;
   return st;
@@ -541,22 +575,19 @@ fcm_status fcm__sim_solve(fcm_integrator *I, const double *b, double *d, fcm_ste
   double t0 = fcm_wtime();
   *iterations = 0;
   I->solve_stalled = 0;
-  if (I->has_backend) { /* sim_backend.h */
-    int failed = 0;
-    st = I->backend.solve(I->backend.user, b, d, iterations, &failed);
-    stats->linear_iterations += *iterations;
-    if (st == FCM_OK && failed) *reason = FCM_STEP_LINEAR_SOLVER_FAILED;
-  } else {
-    switch (I->opts.linear_solver) {
-    case FCM_LINEAR_DIRECT:
-      st = solve_direct(I, b, d, reason);
-      break;
-    case FCM_LINEAR_MULTIGRID:
-      st = mg_solve(I, b, d, reason, iterations, stats);
-      break;
-    default:
-      st = solve_krylov(I, b, d, reason, iterations, stats);
-    }
+  switch (path_of(I)) {
+  case PATH_BACKEND:
+    st = backend_solve(I, b, d, reason, iterations, stats);
+    break;
+  case PATH_DIRECT:
+    st = solve_direct(I, b, d, reason);
+    break;
+  case PATH_MULTIGRID:
+    st = mg_solve(I, b, d, reason, iterations, stats);
+    break;
+  case PATH_KRYLOV:
+    st = solve_krylov(I, b, d, reason, iterations, stats);
+    break;
   }
   if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
   stats->time_solve += fcm_wtime() - t0;

@@ -92,7 +92,7 @@ static fcm_status assemble_boundary(fcm_integrator *I, const double *x, int proj
 }
 
 /* The base of the Newton matrix into H before the tangent is added. With a backend
- * (sim_backend.h) H stays this process's partial matrix (the backend adds the processes'
+ * (fem/fem_backend.h) H stays this process's partial matrix (the backend adds the processes'
  * matrices): M/h^2 + D/h of its partial M and D, the serial formula. */
 static void tangent_base(fcm_integrator *I, double h)
 {
@@ -101,7 +101,7 @@ static void tangent_base(fcm_integrator *I, double h)
 
 /* With a backend: agree on st and on *finite, and sum the scalars and fint over the processes
  * (every process then holds the same global values); the matrices stay partial
- * (sim_backend.h). */
+ * (fem/fem_backend.h). */
 static fcm_status reduce_eval(fcm_integrator *I, fcm_status st, double *scalars, int ns,
                               double *fint, int *finite, sim_stats *stats)
 {
@@ -224,7 +224,7 @@ static void swap(double **a, double **b)
   *b = t;
 }
 
-/* With a backend (sim_backend.h): fcm__eliminate_marked()'s symmetric elimination on this
+/* With a backend (fem/fem_backend.h): fcm__eliminate_marked()'s symmetric elimination on this
  * process's partial H, with the increments w1 at the constrained DOFs. Every process zeroes the
  * constrained rows and columns of its matrix; the parts that need the summed matrix — the lift
  * H_fc inc_c of the free right-hand side (predictor) and the constrained diagonal (the summed
@@ -592,8 +592,8 @@ cleanup:
 }
 
 /* D = alpha_M M + beta_K K+(u_n) (projected tangent at the start of the substep). With a
- * backend (sim_backend.h) D is this process's PARTIAL damping matrix, not summed: its cells'
- * K+ and alpha_M M of its partial M; the processes' D sum to the serial one (evaluate() sums
+ * backend (fem/fem_backend.h) D is this process's PARTIAL damping matrix, not summed: its
+ * cells' K+ and alpha_M M of its partial M; the processes' D sum to the serial one (evaluate() sums
  * its products, the Newton matrix's base adds it partially). */
 static fcm_status update_damping(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
 {

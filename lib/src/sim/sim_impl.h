@@ -163,8 +163,8 @@ struct fcm_integrator {
   double psi;
   double inverted;
 
-  /* distributed backend (sim_backend.h); has_backend = 0: serial */
-  fcm__sim_backend backend;
+  /* distributed backend (fem/fem_backend.h); has_backend = 0: serial */
+  fcm__backend backend;
   int has_backend;
   unsigned char *owned; /* n: the backend's owned DOFs (a copy of backend.owned) */
 };
@@ -227,7 +227,7 @@ int fcm__sim_boundary_time(fcm_integrator *I, double t);
 fcm_status fcm__sim_boundary_assemble(fcm_integrator *I, const double *x, int projected,
                                       double *energy, double *force, fcm_csr *T, int *finite);
 
-/* With a backend (sim_backend.h): agree on st and sum the partial quantities over the
+/* With a backend (fem/fem_backend.h): agree on st and sum the partial quantities over the
  * processes: the ns scalars and the vector vec (n; may be NULL). No matrix is ever summed
  * (the mass, damping and Newton matrices stay partial). Without one: returns st.
  * (integrator.c) */

@@ -1,0 +1,351 @@
+/* The scene runner, summary: what the run built and did, in words
+ * (fcm_simulation_summary_view()), and its distributed form summed over the processes. */
+#include "scene/run_impl.h"
+#include "scene/scene_impl.h"
+
+#include "core/core_impl.h"
+#include "embed/embed_impl.h"
+#include "fem/fem_impl.h"
+#include "sim/sim_backend.h"
+#include "fcm/embed.h"
+#include "fcm/fem.h"
+#include "fcm/geom.h"
+#include "fcm/io.h"
+#include "fcm/levelset.h"
+#include "fcm/voxels.h"
+#include "fcm/mesh.h"
+#include "io/io_impl.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+
+static void line(FILE *f, int on, const char *what, const char *detail)
+{
+  fprintf(f, "  %-9s %-28s %s\n", on ? "computed" : "skipped", what, detail);
+}
+
+/* The multigrid hierarchy of the current integrator: DOFs per level, finest first (the
+ * coarsest is solved by CHOLMOD), and the cycle. Nothing before the first solve. */
+static void multigrid_line(const fcm_simulation *S, FILE *f)
+{
+  const fcm_mg *mg = fcm_integrator_multigrid(S->integ);
+  const fcm_mg_options *o = &fcm_scene_get_solver(S->scene)->integrator.multigrid;
+  char b[512];
+  int len = 0;
+  if (!mg) {
+    line(f, 0, "multigrid levels", "(no solve yet)");
+    return;
+  }
+  const int nl = fcm_mg_num_levels(mg);
+  len = snprintf(b, sizeof b, "%d, DOFs", nl);
+  for (int l = 0; l < nl && len > 0 && (size_t)len < sizeof b; l++) {
+    fcm_mg_level_info li;
+    if (fcm_mg_get_level_info(mg, l, &li) != FCM_OK) {
+      fcm_ctx_error_clear(S->ctx);
+      return;
+    }
+    len += snprintf(b + len, sizeof b - (size_t)len, "%s%lld", l ? " > " : " ", (long long)li.dofs);
+  }
+  if (len > 0 && (size_t)len < sizeof b)
+    snprintf(b + len, sizeof b - (size_t)len, "; %s-cycle, %d+%d smoothing steps%s",
+             o->cycle_index == 2 ? "W" : "V", o->pre_smooth, o->post_smooth,
+             o->block_smoothing ? " with vertex blocks" : "");
+  line(f, 1, "multigrid levels", b);
+}
+
+/* The largest displacement of the body: over its quadrature points (authentic points of the
+ * stiffness rules) and the embedded-surface points the frames write; beside it, the largest
+ * over the DOF vector, which includes the fictitious nodes outside the body. Without an
+ * embedded geometry the mesh is the body: its nodes count too. */
+static void body_displacement_line(const fcm_simulation *S, FILE *f, double body_points)
+{
+  const double *u = fcm_integrator_displacement(S->integ);
+  const fcm_index n = fcm_integrator_num_dofs(S->integ);
+  double body = body_points, dofs = 0.0, *d = NULL;
+  if (body_points < 0.0 && fcm_space_max_displacement(S->space, u, &body) != FCM_OK) {
+    fcm_ctx_error_clear(S->ctx);
+    return;
+  }
+  fcm_index np = S->surf ? fcm_embedded_surface_num_points(S->surf) : 0;
+  if (np > 0 && (d = fcm__malloc(S->ctx, 3 * (size_t)np, sizeof *d)) != NULL &&
+      fcm_embedded_surface_eval(S->surf, u, d, NULL) == FCM_OK) {
+    for (fcm_index i = 0; i < np; i++)
+      body = FCM_MAX(body, sqrt(d[3 * i] * d[3 * i] + d[3 * i + 1] * d[3 * i + 1] +
+                                d[3 * i + 2] * d[3 * i + 2]));
+  } else {
+    np = 0;
+    fcm_ctx_error_clear(S->ctx);
+  }
+  fcm__free(S->ctx, d);
+  for (fcm_index i = 0; i + 2 < n; i += 3)
+    dofs = FCM_MAX(dofs, sqrt(u[i] * u[i] + u[i + 1] * u[i + 1] + u[i + 2] * u[i + 2]));
+  if (!S->rules) { /* no embedding: every node is the body's */
+    fprintf(f, "  body      max |u| %.6g m over the body (its nodes and quadrature points)\n",
+            FCM_MAX(body, dofs));
+    return;
+  }
+  if (np > 0)
+    fprintf(f,
+            "  body      max |u| %.6g m over the body (its quadrature points and %lld surface "
+            "points); DOF vector, fictitious nodes included: %.6g m\n",
+            body, (long long)np, dofs);
+  else
+    fprintf(f, "  body      max |u| %.6g m over the body's quadrature points; DOF vector: %.6g m\n",
+            body, dofs);
+}
+
+/* Inverted quadrature points after the steps and NaN or infinite stresses in the frames: the
+ * count, the first and the worst (zeros when the body never inverted). */
+static void inversion_lines(FILE *f, const fcm_simulation_counters *c)
+{
+  if (c->inverted_steps == 0 && c->steps == 1) {
+    fprintf(f, "  inversion none: no quadrature point with J = det F <= 0 after the step\n");
+  } else if (c->inverted_steps == 0) {
+    fprintf(f,
+            "  inversion none: no quadrature point with J = det F <= 0 after any of the %lld "
+            "steps\n",
+            c->steps);
+  } else {
+    char cell[64] = "";
+    if (c->inverted_first_cell >= 0)
+      snprintf(cell, sizeof cell, ", cell %lld", (long long)c->inverted_first_cell);
+    fprintf(f,
+            "  inversion WARNING: %lld of %lld steps ended with inverted quadrature points (J = "
+            "det F <= 0): first step %lld (t = %.6g s%s), most %lld points (step %lld)\n",
+            c->inverted_steps, c->steps, c->inverted_first_step, c->inverted_first_time, cell,
+            (long long)c->inverted_max, c->inverted_max_step);
+  }
+  if (c->frames == 0) return;
+  if (c->nonfinite_frames == 0)
+    fprintf(f, "  stresses  finite in every frame written (%lld)\n", c->frames);
+  else
+    fprintf(f,
+            "  stresses  WARNING: %lld of %lld frames hold NaN or infinite von Mises values "
+            "(points with J <= 0): first the frame after step %lld, most %lld values in one "
+            "frame\n",
+            c->nonfinite_frames, c->frames, c->nonfinite_first_step, (long long)c->nonfinite_max);
+}
+
+/* The summary's lines of the cell rules: cells, volumes, what lies outside the background,
+ * the simplification of each kind and the rules built (gs: the statistics to show, NULL: the
+ * rules' own). */
+static void rules_lines(const fcm_simulation *S, FILE *f, const fcm_cell_rules_stats *gs,
+                        const fcm_simulation_counters *c)
+{
+  char b[512];
+  if (S->rules) {
+    const fcm_cell_rules_stats *rs = gs ? gs : fcm_cell_rules_get_stats(S->rules);
+    fprintf(f,
+            "  cells     %lld: %lld uncut, %lld cut, %lld dropped; cut-cell points stiffness "
+            "%lld -> %lld, mass %lld -> %lld (before -> after simplification)\n",
+            (long long)rs->num_cells, (long long)rs->num_uncut, (long long)rs->num_cut,
+            (long long)rs->num_dropped, (long long)rs->points_initial[FCM_RULE_STIFFNESS],
+            (long long)rs->points_simplified[FCM_RULE_STIFFNESS],
+            (long long)rs->points_initial[FCM_RULE_MASS],
+            (long long)rs->points_simplified[FCM_RULE_MASS]);
+    fprintf(f,
+            "  volume    embedded %.6g of %.6g m^3 (ratio %.6f), outside the background %.3g, in "
+            "dropped cells %.3g\n",
+            rs->embedded_volume, rs->geometry_volume, rs->volume_ratio, rs->outside_volume,
+            rs->dropped_volume);
+    if (rs->outside_volume > 0.0) {
+      static const char *const sides[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
+      fprintf(f,
+              "  outside   body [%g, %g] x [%g, %g] x [%g, %g], background [%g, %g] x [%g, %g] "
+              "x [%g, %g]; beyond",
+              rs->geometry_lo[0], rs->geometry_hi[0], rs->geometry_lo[1], rs->geometry_hi[1],
+              rs->geometry_lo[2], rs->geometry_hi[2], rs->mesh_lo[0], rs->mesh_hi[0],
+              rs->mesh_lo[1], rs->mesh_hi[1], rs->mesh_lo[2], rs->mesh_hi[2]);
+      for (int k = 0; k < 6; k++)
+        if (rs->outside_side_volume[k] > 0.0)
+          fprintf(f, " %s %.3g", sides[k], rs->outside_side_volume[k]);
+      fputc('\n', f);
+    }
+    const fcm_cell_rules_options *q = &fcm_scene_get_quadrature(S->scene)->rules;
+    static const char *const kinds[FCM_RULE_KIND_COUNT] = {"stiffness", "mass"};
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+      const fcm_simplify_decision *d = &rs->decision[k];
+      char what[64];
+      snprintf(what, sizeof what, "%s simplification", kinds[k]);
+      if (!fcm_cell_rules_has_kind(S->rules, (fcm_rule_kind)k))
+        snprintf(b, sizeof b, "(no %s rules built)", kinds[k]);
+      else if (q->simplify == FCM_CELL_SIMPLIFY_AUTO)
+        snprintf(b, sizeof b,
+                 "auto: %s for %g expected assemblies; cost model %.3g core-s per point per "
+                 "assembly, %.3g core-s simplifying to %.0f points; estimated %.3g core-s "
+                 "assembling plain vs %.3g simplifying + assembling",
+                 d->simplified ? "on" : "off", d->expected_assemblies, d->point_cost,
+                 d->estimated_time, d->estimated_kept, d->cost_plain, d->cost_simplified);
+      else
+        snprintf(b, sizeof b, "%s (scene), %.3g core-s", fcm_cell_simplify_name(q->simplify),
+                 d->time_simplify);
+      line(f, d->simplified, what, b);
+    }
+  }
+  if (S->rules) { /* which rule kinds the scene called for, with their stored points */
+    const fcm_cell_rules_stats *rs = gs ? gs : fcm_cell_rules_get_stats(S->rules);
+    const int mass = (c->rule_kinds & FCM_RULES_MASS) != 0;
+    snprintf(b, sizeof b, "stiffness (%lld points)%s",
+             (long long)rs->points_total[FCM_RULE_STIFFNESS], mass ? ", mass" : "");
+    if (mass)
+      snprintf(b + strlen(b), sizeof b - strlen(b), " (%lld points)",
+               (long long)rs->points_total[FCM_RULE_MASS]);
+    if (c->surface_rules)
+      snprintf(b + strlen(b), sizeof b - strlen(b), ", surface (%lld points)",
+               (long long)rs->surface_points);
+    if (!mass) snprintf(b + strlen(b), sizeof b - strlen(b), "; mass: not needed (static scene)");
+    line(f, 1, "rules built", b);
+  }
+}
+
+/* The summary with the rules' statistics `gs`, the counters `gc`, the body's largest |u| over
+ * its quadrature points `body` and the free body's centre of mass `com_now` (NULL: not
+ * available) given (a distributed run, gc not NULL: summed over the processes), or taken from
+ * this process (gs and gc NULL, body < 0). */
+static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_stats *gs,
+                         const fcm_simulation_counters *gc, double body, const double *com_now)
+{
+  const fcm_simulation_counters *c = gc ? gc : &S->c;
+  char b[512];
+  fprintf(f, "simulation %s: %lld of %lld steps, %lld DOFs\n", fcm_scene_name(S->scene), c->steps,
+          S->num_steps, (long long)c->num_dofs);
+  line(f, c->cell_rules, "embedded cell rules", c->cell_rules ? "" : "(no geometry)");
+  if (S->geometry_note[0]) fprintf(f, "  geometry  %s\n", S->geometry_note);
+  rules_lines(S, f, gs, c);
+  line(f, c->surface_rules, "surface rules", c->surface_rules ? "" : "(no traction or pressure)");
+  line(f, c->inertia, "inertia (backward Euler)", c->inertia ? "" : "(static scene)");
+  snprintf(b, sizeof b, "%d", c->mass_assemblies);
+  line(f, c->mass_assemblies > 0, "mass assemblies", c->mass_assemblies ? b : "(static scene)");
+  snprintf(b, sizeof b, "%d", c->body_force_assemblies);
+  line(f, c->body_force_assemblies > 0, "body-force assemblies",
+       c->body_force_assemblies ? b : "(no gravity)");
+  if (c->scale_assemblies)
+    line(f, 1, "force-scale assembly",
+         "1 (static, no gravity: body force of rho a_rep for the stopping rule)");
+  snprintf(b, sizeof b, "%d", c->traction_assemblies);
+  line(f, c->traction_assemblies > 0, "surface-load assemblies",
+       c->traction_assemblies ? b : "(no traction or pressure)");
+  line(f, c->damping, "Rayleigh damping matrix", c->damping ? "" : "(no damping)");
+  snprintf(b, sizeof b, "%d", c->initial_velocity);
+  line(f, c->initial_velocity > 0, "initial velocities", c->initial_velocity ? b : "(none)");
+  snprintf(b, sizeof b, "%d sets, %lld nodes, %lld DOFs, %lld embedded-boundary points",
+           c->constraints, (long long)c->constrained_nodes, (long long)c->constrained_dofs,
+           (long long)c->boundary_points);
+  line(f, c->constraints > 0, "constraints", c->constraints ? b : "(none)");
+  snprintf(b, sizeof b, "%lld blocks", (long long)c->schwarz_blocks);
+  line(f, c->schwarz_blocks > 0, "Schwarz blocks",
+       c->schwarz_blocks
+           ? b
+           : (c->krylov ? "(no cell below the threshold, or not asked)" : "(direct solver)"));
+  snprintf(b, sizeof b, "%d applied (%d missed the body), %lld cells integrated again, %lld bodies",
+           c->cuts, c->cuts_missed, (long long)c->cut_cells, (long long)c->pieces);
+  line(f, c->cuts > 0, "cuts", c->cuts ? b : (S->num_cuts ? "(none due yet)" : "(no cut effect)"));
+  snprintf(b, sizeof b, "%lld factorizations, %lld analyses, %lld fallbacks", c->factorizations,
+           c->analyses, c->direct_fallbacks);
+  line(f, 1,
+       c->krylov ? "preconditioner setups"
+                 : (c->multigrid ? "multigrid setups" : "direct factorizations"),
+       b);
+  if (c->multigrid) multigrid_line(S, f);
+  snprintf(b, sizeof b, "%lld Newton, %lld linear iterations, %lld multigrid cycles, %lld tangents",
+           c->newton_iterations, c->linear_iterations, c->multigrid_cycles, c->tangent_assemblies);
+  line(f, 1, "iterations", b);
+  snprintf(b, sizeof b, "%lld frames, surface %lld points %lld triangles", c->frames,
+           (long long)c->surface_points, (long long)c->surface_triangles);
+  line(f, c->frames > 0, "output", b);
+  inversion_lines(f, c);
+  body_displacement_line(S, f, body);
+  if (S->free_body) {
+    /* com_now: the centre of mass computed by every process (a distributed run: collective,
+     * NULL when it failed); else computed here */
+    double com[3];
+    const int have = gc ? com_now != NULL : fcm_simulation_center_of_mass(S, com) == FCM_OK;
+    if (have && gc) memcpy(com, com_now, sizeof com);
+    if (have) {
+      double d[3] = {com[0] - S->com0[0], com[1] - S->com0[1], com[2] - S->com0[2]};
+      fprintf(f, "  centre of mass (free body) at t = 0: (%.9g, %.9g, %.9g) m; drift now %.3e m\n",
+              S->com0[0], S->com0[1], S->com0[2], sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+    }
+  }
+  fprintf(f, "  time [s]  setup %.3f  steps %.3f  output %.3f\n", c->time_setup, c->time_steps,
+          c->time_output);
+}
+
+void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
+{
+  if (!S || !f) return;
+  summary_view(S, f, NULL, NULL, -1.0, NULL);
+}
+
+fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  const fcm_index nc = fcm_mesh_num_cells(S->mesh);
+  const int K = FCM_RULE_KIND_COUNT, nv = 6 * FCM_RULE_KIND_COUNT + 5;
+  fcm_cell_rules_stats gs;
+  fcm_simulation_counters gc = S->c;
+  double *q = NULL, body = 0.0, com[3] = {0, 0, 0};
+  int root = 1, com_ok = 0;
+  fcm__integrator_distributed(S->integ, &root);
+  memset(&gs, 0, sizeof gs);
+  /* per kind: points before / after simplification, stabilization, stored, skipped, kept
+   * unsimplified; then surface triangles and points, tets, slivers; then each own cell's
+   * largest |u| (every process's cells: the point counts are its own cells' only) */
+  q = fcm__calloc(ctx, (size_t)nv + (size_t)nc + 1, sizeof *q);
+  st = q ? FCM_OK
+         : fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
+                      "simulation: out of memory (summary of %lld cells)", (long long)nc);
+  if (st == FCM_OK && S->rules) {
+    gs = *fcm_cell_rules_get_stats(S->rules);
+    for (int k = 0; k < K; k++) {
+      q[6 * k + 0] = (double)gs.points_initial[k];
+      q[6 * k + 1] = (double)gs.points_simplified[k];
+      q[6 * k + 2] = (double)gs.points_stabilization[k];
+      /* stored points: the cut cells' own ones, plus the uncut cells' (every process counts
+       * all of those: the classification is replicated) on the root only */
+      q[6 * k + 3] = (double)(root ? gs.points_total[k]
+                                   : gs.points_simplified[k] + gs.points_stabilization[k]);
+      q[6 * k + 4] = (double)gs.simplify_skipped[k];
+      q[6 * k + 5] = (double)gs.simplify_fallbacks[k];
+    }
+    q[6 * K + 0] = (double)gs.surface_triangles;
+    q[6 * K + 1] = (double)gs.surface_points;
+    q[6 * K + 2] = (double)gs.num_tets;
+    q[6 * K + 3] = (double)gs.num_slivers;
+  }
+  if (q) q[6 * K + 4] = (double)S->c.boundary_points; /* Nitsche's: own cells' */
+  if (st == FCM_OK)
+    st = fcm__space_cell_max_displacement(S->space, fcm_integrator_displacement(S->integ), q + nv);
+  if (st == FCM_OK) {
+    const fcm_cell_rules *R = fcm_space_cell_rules(S->space);
+    for (fcm_index c = 0; c < nc; c++) /* another process's cell: its value (no rules: root's) */
+      if (!fcm__cell_rules_owns(R, c) || (!R && !root)) q[nv + c] = 0.0;
+  }
+  FCM_TRY(ctx, fcm__integrator_reduce_status(S->integ, st, q, (fcm_index)nv + nc));
+  /* the free body's centre of mass: collective (the partial mass matrix), on every process */
+  if (S->free_body) {
+    com_ok = fcm__sim_center_of_mass(S, fcm_integrator_displacement(S->integ), com) == FCM_OK;
+    if (!com_ok) fcm_ctx_error_clear(ctx);
+  }
+  for (int k = 0; k < K; k++) {
+    gs.points_initial[k] = (fcm_index)q[6 * k + 0];
+    gs.points_simplified[k] = (fcm_index)q[6 * k + 1];
+    gs.points_stabilization[k] = (fcm_index)q[6 * k + 2];
+    gs.points_total[k] = (fcm_index)q[6 * k + 3];
+    gs.simplify_skipped[k] = (fcm_index)q[6 * k + 4];
+    gs.simplify_fallbacks[k] = (fcm_index)q[6 * k + 5];
+  }
+  /* surface_triangles, num_tets and num_slivers: the classification exchange summed them
+   * already (every process's stats hold the totals) */
+  gs.surface_points = (fcm_index)q[6 * K + 1];
+  gc.boundary_points = (fcm_index)q[6 * K + 4];
+  for (fcm_index c = 0; c < nc; c++)
+    if (!(q[nv + c] <= body) && body == body) body = q[nv + c]; /* a NaN stays */
+  if (f) summary_view(S, f, S->rules ? &gs : NULL, &gc, body, com_ok ? com : NULL);
+cleanup:
+  fcm__free(ctx, q);
+  return st;
+}
