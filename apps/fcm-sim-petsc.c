@@ -12,6 +12,7 @@
  * (.fcmck) are written by process 0 (run_newton()). */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm-sim-petsc.h"
+#include "cli.h"
 
 #include <fcm/fcm.h>
 #include <fcm/petsc.h>
@@ -23,26 +24,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-
-/* mkdir -p (process 0). */
-static int make_dirs(const char *dir)
-{
-  char buf[4096];
-  size_t n = strlen(dir);
-  if (n == 0 || n >= sizeof buf) return 0;
-  memcpy(buf, dir, n + 1);
-  for (size_t i = 1; i <= n; i++)
-    if (buf[i] == '/' || buf[i] == '\0') {
-      char c = buf[i];
-      buf[i] = '\0';
-      if (mkdir(buf, 0777) != 0 && errno != EEXIST) {
-        fprintf(stderr, "fcm-sim: cannot create directory %s: %s\n", buf, strerror(errno));
-        return 0;
-      }
-      buf[i] = c;
-    }
-  return 1;
-}
 
 typedef struct run_log {
   long long step;
@@ -247,7 +228,7 @@ static int run_newton(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
   int frame = (int)c.frames; /* resumed: the frames the checkpoint had */
   snprintf(logpath, sizeof logpath, "%s/%s_log.csv", dir, name);
   if (write) {
-    if (rank == 0) ok = make_dirs(dir);
+    if (rank == 0) ok = cli_make_dirs("fcm-sim", dir);
     MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
     if (!ok) goto done;
     if (!resume && !write_frame_newton(ctx, sim, dir, frame++, rank)) goto done;
@@ -382,7 +363,7 @@ static int run_linear(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
   snprintf(logpath, sizeof logpath, "%s/%s_log.csv", dir, name);
   snprintf(pvdpath, sizeof pvdpath, "%s/%s.pvd", dir, name);
   if (write && rank == 0) {
-    ok = make_dirs(dir) && fcm_pvd_create(ctx, pvdpath, &pvd) == FCM_OK;
+    ok = cli_make_dirs("fcm-sim", dir) && fcm_pvd_create(ctx, pvdpath, &pvd) == FCM_OK;
     /* resuming: the earlier frames (0, interval, 2 interval, ... <= first) are indexed again and
      * the earlier log rows kept */
     const double dt = fcm_scene_get_time(scene)->dt;

@@ -127,35 +127,6 @@ static int parse_scene_args(int argc, char **argv, scene_options *o)
   return -1;
 }
 
-/* mkdir -p: create `dir` and its missing parents. */
-static int make_dirs(const char *dir)
-{
-  char buf[4096];
-  size_t n = strlen(dir);
-  if (n == 0 || n >= sizeof buf) {
-    fprintf(stderr, "fcm-sim: bad output directory '%s'\n", dir);
-    return 0;
-  }
-  memcpy(buf, dir, n + 1);
-  for (size_t k = 1; k <= n; k++) {
-    if (buf[k] != '/' && buf[k] != '\0') continue;
-    char c = buf[k];
-    buf[k] = '\0';
-    struct stat sb;
-    if (stat(buf, &sb) != 0) {
-      if (mkdir(buf, 0777) != 0 && errno != EEXIST) {
-        fprintf(stderr, "fcm-sim: cannot create output directory '%s': %s\n", buf, strerror(errno));
-        return 0;
-      }
-    } else if (!S_ISDIR(sb.st_mode)) {
-      fprintf(stderr, "fcm-sim: output path '%s' exists and is not a directory\n", buf);
-      return 0;
-    }
-    buf[k] = c;
-  }
-  return 1;
-}
-
 /* One progress report per step on stderr: a bar with ETA on a terminal, else a line. */
 /* k of n steps of this process done; step `step` of `total` in all. */
 static void progress(int tty, long long k, long long n, long long step, long long total,
@@ -487,7 +458,7 @@ static int scene_main(int argc, char **argv)
   int warned_inverted = c.inverted_steps > 0, warned_nonfinite = c.nonfinite_frames > 0;
   int tty = !o.quiet && isatty(2);
   if (write) {
-    if (!make_dirs(dir)) goto done;
+    if (!cli_make_dirs("fcm-sim", dir)) goto done;
     snprintf(logpath, sizeof logpath, "%s/%s_log.csv", dir, name);
     if ((!o.resume && fcm_simulation_write_frame(sim, dir, frame++) != FCM_OK) ||
         fcm_simulation_write_log(sim, logpath) != FCM_OK) {

@@ -380,7 +380,7 @@ fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
       FCM_ALLOC(ctx, 3 * (size_t)np, bp->nrm);
       FCM_ALLOC(ctx, (size_t)np * nn, bp->N);
       FCM_ALLOC(ctx, (size_t)np * nd, bp->G);
-      bp->nthreads = FCM_MAX(omp_get_max_threads(), 1);
+      bp->nthreads = fcm_ctx_num_threads(ctx);
       FCM_ALLOC(ctx, ((size_t)nd * (nd + 2) + 9 * (size_t)nn) * (size_t)bp->nthreads, bp->scratch);
       FCM_ALLOC(ctx, ne + 1, bp->eelem);
     } else {

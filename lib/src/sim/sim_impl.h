@@ -48,7 +48,7 @@ typedef struct sim_bpoints {
   double *gamma;         /* num_elems: Nitsche penalty per element (0: no Nitsche points) */
   double *hk;            /* num_elems: cell size h_K (cube root of the volume) */
   double *scratch;       /* per thread: ue, fe (3nn each), Ke ((3nn)^2), Q (9nn) */
-  int nthreads;          /* threads the scratch serves (omp_get_max_threads() at setup) */
+  int nthreads;          /* threads the scratch serves (the context's count at setup) */
   int num_colors;        /* the space's colours: no two elements of one share a DOF copy */
   fcm_index *color_ptr;  /* num_colors + 1 offsets into color_k */
   fcm_index *color_k;    /* nelem: indices k (into elem) grouped by colour, ascending within */
