@@ -149,57 +149,62 @@ static void traction_modes(int nn, const double *g, const double *N, const int *
   }
 }
 
-/* Penalties of element e from its points [p0, p1): Nitsche's eigenvalue estimate over its
- * Nitsche points (0 when it has none) into *gamma, and the cell size h_K (the penalty method's
- * gamma is penalty E / h_K) into *hk. */
-static fcm_status element_penalty(fcm_integrator *I, fcm_index e, fcm_index p0, fcm_index p1,
-                                  const fcm_rule *full, double *gamma, double *hk)
+/* The volume rule the assembly integrates element e with (stabilization included): the
+ * stiffness rule of its cut piece, or the standard rule full of an uncut cell. */
+static fcm_status element_volume_rule(fcm_integrator *I, fcm_index e, const fcm_rule *full, int *nq,
+                                      const double **pts, const double **wts)
 {
   fcm_status st = FCM_OK;
-  fcm_ctx *ctx = I->ctx;
   const fcm_space *s = I->space;
-  const int nn = s->nn, nd = 3 * nn;
-  double *K = NULL, *T = NULL, *C = NULL, *R = NULL, *ev = NULL;
-  double X[3 * FCM_ELEMENT_MAX_NODES], g[3 * FCM_ELEMENT_MAX_NODES];
-  const fcm_index cell = s->elem_cell[e];
-  const double lambda = I->params.lambda, mu = I->params.mu;
-  fcm_mesh_cell_coords(s->mesh, cell, X);
-  /* the volume rule the assembly integrates the element with (stabilization included) */
-  int nq = 0;
-  const double *pts = NULL, *wts = NULL;
-  if (s->rules && fcm_cell_rules_class(s->rules, cell) != FCM_CELL_UNCUT) {
-    FCM_TRY(ctx, fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], FCM_RULE_STIFFNESS, &nq, &pts,
-                                          &wts, NULL));
+  if (s->rules && fcm_cell_rules_class(s->rules, s->elem_cell[e]) != FCM_CELL_UNCUT) {
+    FCM_TRY(I->ctx, fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], FCM_RULE_STIFFNESS, nq,
+                                             pts, wts, NULL));
   } else {
-    nq = fcm_rule_num_points(full);
-    pts = fcm_rule_points(full);
-    wts = fcm_rule_weights(full);
+    *nq = fcm_rule_num_points(full);
+    *pts = fcm_rule_points(full);
+    *wts = fcm_rule_weights(full);
   }
-  double vol = 0.0; /* |K|: the standard rule integrates 1 exactly */
-  {
-    const int fq = fcm_rule_num_points(full);
-    for (int q = 0; q < fq; q++) {
-      double J[9];
-      vol += fcm_rule_weights(full)[q] *
-             fcm_element_jacobian(s->type, X, fcm_rule_points(full) + 3 * q, J);
-    }
+cleanup:
+  return st;
+}
+
+/* |K| of the cell with nodes X: the standard rule full integrates 1 exactly. */
+static double cell_volume(fcm_element_type type, const double *X, const fcm_rule *full)
+{
+  double vol = 0.0;
+  const int fq = fcm_rule_num_points(full);
+  for (int q = 0; q < fq; q++) {
+    double J[9];
+    vol +=
+        fcm_rule_weights(full)[q] * fcm_element_jacobian(type, X, fcm_rule_points(full) + 3 * q, J);
   }
-  *hk = cbrt(fabs(vol));
-  *gamma = 0.0;
-  double safety = 0.0; /* the largest safety factor of the element's Nitsche points */
+  return vol;
+}
+
+/* The largest safety factor of the Nitsche points [p0, p1) (0 when there are none). */
+static double nitsche_safety(const fcm_integrator *I, fcm_index p0, fcm_index p1)
+{
+  double safety = 0.0;
   for (fcm_index p = p0; p < p1; p++) {
     const sim_bcon *bc = &I->bcons[I->bp.con[p]];
     if (bc->opts.method == FCM_BOUNDARY_NITSCHE) safety = FCM_MAX(safety, bc->opts.nitsche_safety);
   }
-  if (safety == 0.0) goto cleanup;
-  FCM_ALLOC(ctx, (size_t)nd * nd, K);
-  FCM_ALLOC(ctx, (size_t)nd * nd, T);
-  FCM_ALLOC(ctx, (size_t)3 * nd, C);
-  FCM_ALLOC(ctx, (size_t)6 * nd, R);
-  FCM_ALLOC(ctx, nd, ev);
-  for (int q = 0; q < nq; q++) { /* K, linear elasticity */
+  return safety;
+}
+
+/* Add to K (nd x nd) the linear-elastic stiffness at rest of cell `cell` with nodes X, over
+ * the volume rule (nq, pts, wts). */
+static fcm_status elastic_stiffness(const fcm_integrator *I, fcm_index cell, const double *X,
+                                    int nq, const double *pts, const double *wts, double *K)
+{
+  fcm_status st = FCM_OK;
+  const fcm_space *s = I->space;
+  const int nn = s->nn, nd = 3 * nn;
+  const double lambda = I->params.lambda, mu = I->params.mu;
+  double g[3 * FCM_ELEMENT_MAX_NODES];
+  for (int q = 0; q < nq; q++) {
     double det = gradients(s->type, nn, X, pts + 3 * q, g);
-    FCM_CHECK(det > 0.0, ctx, FCM_ERR_GEOMETRY,
+    FCM_CHECK(det > 0.0, I->ctx, FCM_ERR_GEOMETRY,
               "boundary constraint: cell %lld has det J = %g <= 0 at a quadrature point",
               (long long)cell, det);
     const double wd = wts[q] * det;
@@ -213,7 +218,18 @@ static fcm_status element_penalty(fcm_integrator *I, fcm_index e, fcm_index p0, 
                 wd * (lambda * ga[i] * gb[j] + mu * ga[j] * gb[i] + (i == j ? mu * dd : 0.0));
       }
   }
-  for (fcm_index p = p0; p < p1; p++) { /* T = sum w C^T C */
+cleanup:
+  return st;
+}
+
+/* Add to T (nd x nd) the traction energy sum w C^T C of the Nitsche points [p0, p1); C
+ * (3 x nd) is workspace. */
+static void traction_energy(const fcm_integrator *I, fcm_index p0, fcm_index p1, double *C,
+                            double *T)
+{
+  const int nn = I->space->nn, nd = 3 * nn;
+  const double lambda = I->params.lambda, mu = I->params.mu;
+  for (fcm_index p = p0; p < p1; p++) {
     const sim_bcon *bc = &I->bcons[I->bp.con[p]];
     if (bc->opts.method != FCM_BOUNDARY_NITSCHE) continue;
     traction_modes(nn, I->bp.G + (size_t)p * nd, I->bp.nrm + 3 * p, bc->motion.components, lambda,
@@ -223,51 +239,85 @@ static fcm_status element_penalty(fcm_integrator *I, fcm_index e, fcm_index p0, 
         T[(size_t)x * nd + y] +=
             I->bp.w[p] * (C[x] * C[y] + C[nd + x] * C[nd + y] + C[2 * nd + x] * C[2 * nd + y]);
   }
-  /* Rigid modes (translations, rotations about the centroid), orthonormalized; K and T
-   * vanish on them, so B = K + s R R^T is positive definite and has the same eigenvalues
-   * on their complement. */
-  {
-    double c[3] = {0, 0, 0}, tr = 0.0;
-    for (int a = 0; a < nn; a++)
-      for (int i = 0; i < 3; i++)
-        c[i] += X[3 * a + i] / nn;
-    for (int a = 0; a < nn; a++) {
-      double r[3] = {X[3 * a] - c[0], X[3 * a + 1] - c[1], X[3 * a + 2] - c[2]};
-      for (int i = 0; i < 3; i++) {
-        R[(size_t)i * nd + 3 * a + i] = 1.0;
-        /* rotation about axis i: e_i x r */
-        double *Ri = R + (size_t)(3 + i) * nd + 3 * a;
-        const int j = (i + 1) % 3, k = (i + 2) % 3;
-        Ri[k] = r[j];
-        Ri[j] = -r[k];
-      }
+}
+
+/* Rigid modes (translations, rotations about the centroid) of the cell with nodes X,
+ * orthonormalized into R (6 x nd); K and T vanish on them, so K + s R R^T (s the mean
+ * diagonal of K) is positive definite and has the same eigenvalues on their complement. */
+static void lift_rigid_modes(int nn, const double *X, double *R, double *K)
+{
+  const int nd = 3 * nn;
+  double c[3] = {0, 0, 0}, tr = 0.0;
+  for (int a = 0; a < nn; a++)
+    for (int i = 0; i < 3; i++)
+      c[i] += X[3 * a + i] / nn;
+  for (int a = 0; a < nn; a++) {
+    double r[3] = {X[3 * a] - c[0], X[3 * a + 1] - c[1], X[3 * a + 2] - c[2]};
+    for (int i = 0; i < 3; i++) {
+      R[(size_t)i * nd + 3 * a + i] = 1.0;
+      /* rotation about axis i: e_i x r */
+      double *Ri = R + (size_t)(3 + i) * nd + 3 * a;
+      const int j = (i + 1) % 3, k = (i + 2) % 3;
+      Ri[k] = r[j];
+      Ri[j] = -r[k];
     }
-    for (int pass = 0; pass < 2; pass++) /* modified Gram-Schmidt, twice */
-      for (int m = 0; m < 6; m++) {
-        double *rm = R + (size_t)m * nd;
-        for (int l = 0; l < m; l++) {
-          const double *rl = R + (size_t)l * nd;
-          double d = 0.0;
-          for (int x = 0; x < nd; x++)
-            d += rm[x] * rl[x];
-          for (int x = 0; x < nd; x++)
-            rm[x] -= d * rl[x];
-        }
-        double nrm = 0.0;
-        for (int x = 0; x < nd; x++)
-          nrm += rm[x] * rm[x];
-        nrm = sqrt(nrm);
-        for (int x = 0; x < nd; x++)
-          rm[x] /= nrm;
-      }
-    for (int x = 0; x < nd; x++)
-      tr += K[(size_t)x * nd + x];
-    const double sc = tr / nd;
-    for (int m = 0; m < 6; m++)
-      for (int x = 0; x < nd; x++)
-        for (int y = 0; y < nd; y++)
-          K[(size_t)x * nd + y] += sc * R[(size_t)m * nd + x] * R[(size_t)m * nd + y];
   }
+  for (int pass = 0; pass < 2; pass++) /* modified Gram-Schmidt, twice */
+    for (int m = 0; m < 6; m++) {
+      double *rm = R + (size_t)m * nd;
+      for (int l = 0; l < m; l++) {
+        const double *rl = R + (size_t)l * nd;
+        double d = 0.0;
+        for (int x = 0; x < nd; x++)
+          d += rm[x] * rl[x];
+        for (int x = 0; x < nd; x++)
+          rm[x] -= d * rl[x];
+      }
+      double nrm = 0.0;
+      for (int x = 0; x < nd; x++)
+        nrm += rm[x] * rm[x];
+      nrm = sqrt(nrm);
+      for (int x = 0; x < nd; x++)
+        rm[x] /= nrm;
+    }
+  for (int x = 0; x < nd; x++)
+    tr += K[(size_t)x * nd + x];
+  const double sc = tr / nd;
+  for (int m = 0; m < 6; m++)
+    for (int x = 0; x < nd; x++)
+      for (int y = 0; y < nd; y++)
+        K[(size_t)x * nd + y] += sc * R[(size_t)m * nd + x] * R[(size_t)m * nd + y];
+}
+
+/* Penalties of element e from its points [p0, p1): Nitsche's eigenvalue estimate over its
+ * Nitsche points (0 when it has none) into *gamma, and the cell size h_K (the penalty method's
+ * gamma is penalty E / h_K) into *hk. */
+static fcm_status element_penalty(fcm_integrator *I, fcm_index e, fcm_index p0, fcm_index p1,
+                                  const fcm_rule *full, double *gamma, double *hk)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  const fcm_space *s = I->space;
+  const int nn = s->nn, nd = 3 * nn;
+  double *K = NULL, *T = NULL, *C = NULL, *R = NULL, *ev = NULL;
+  double X[3 * FCM_ELEMENT_MAX_NODES];
+  const fcm_index cell = s->elem_cell[e];
+  fcm_mesh_cell_coords(s->mesh, cell, X);
+  int nq = 0;
+  const double *pts = NULL, *wts = NULL;
+  FCM_TRY(ctx, element_volume_rule(I, e, full, &nq, &pts, &wts));
+  *hk = cbrt(fabs(cell_volume(s->type, X, full)));
+  *gamma = 0.0;
+  const double safety = nitsche_safety(I, p0, p1);
+  if (safety == 0.0) goto cleanup;
+  FCM_ALLOC(ctx, (size_t)nd * nd, K);
+  FCM_ALLOC(ctx, (size_t)nd * nd, T);
+  FCM_ALLOC(ctx, (size_t)3 * nd, C);
+  FCM_ALLOC(ctx, (size_t)6 * nd, R);
+  FCM_ALLOC(ctx, nd, ev);
+  FCM_TRY(ctx, elastic_stiffness(I, cell, X, nq, pts, wts, K));
+  traction_energy(I, p0, p1, C, T);
+  lift_rigid_modes(nn, X, R, K);
   {
     fcm_status s2 = fcm__sygv(ctx, nd, T, nd, K, nd, ev);
     if (s2 == FCM_ERR_SINGULAR) {
