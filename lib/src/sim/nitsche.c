@@ -342,104 +342,116 @@ cleanup:
   return st;
 }
 
-fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
+/* One pass over the elements' surface points: pass 0 counts the points each constraint
+ * selects into count, pass 1 stores them (bp, sized by pass 0); *np and *ne get the numbers
+ * of selected points and of elements with any. */
+static fcm_status collect_points(fcm_integrator *I, int pass, fcm_index *count, fcm_index *np_out,
+                                 fcm_index *ne_out)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = I->ctx;
   const fcm_space *s = I->space;
   sim_bpoints *bp = &I->bp;
-  fcm_index *count = NULL, *ecol = NULL;
-  fcm_rule *full = NULL;
   const int nn = s->nn, nd = 3 * nn;
-  if (I->num_bcons == 0) return FCM_OK;
-  FCM_CHECK(s->rules && fcm_cell_rules_surface_strength(s->rules) >= 0, ctx, FCM_ERR_ARG,
-            "boundary constraint 0: the space has no surface rules (build the cell rules with "
-            "surface_strength >= 0)");
-  FCM_ALLOC(ctx, I->num_bcons, I->bcon_on);
-  FCM_ALLOC(ctx, I->num_bcons, count);
-  FCM_ALLOC(ctx, s->num_elems + 1, bp->gamma);
-  FCM_ALLOC(ctx, s->num_elems + 1, bp->hk);
-  /* count the selected points per element */
-  for (int pass = 0; pass < 2; pass++) {
-    fcm_index np = 0, ne = 0;
-    for (fcm_index e = 0; e < s->num_elems; e++) {
-      int nsp = 0;
-      const double *pts = NULL, *wts = NULL, *nrm = NULL;
-      double X[3 * FCM_ELEMENT_MAX_NODES], N[FCM_ELEMENT_MAX_NODES];
-      FCM_TRY(ctx, fcm_cell_rules_get_piece_surface(s->rules, s->elem_piece[e], &nsp, &pts, &wts,
-                                                    &nrm, NULL));
-      if (nsp == 0) continue;
-      fcm_mesh_cell_coords(s->mesh, s->elem_cell[e], X);
-      const fcm_index first = np;
-      for (int q = 0; q < nsp; q++) {
-        double x[3] = {0, 0, 0};
-        fcm_element_eval_shape(s->type, pts + 3 * q, N);
-        for (int a = 0; a < nn; a++)
-          for (int i = 0; i < 3; i++)
-            x[i] += N[a] * X[3 * a + i];
-        const int k = point_owner(I, x, nrm + 3 * q);
-        if (k < 0 || !(wts[q] > 0.0)) continue;
-        if (pass == 1) {
-          bp->con[np] = k;
-          bp->w[np] = wts[q];
-          memcpy(bp->X + 3 * np, x, sizeof x);
-          memcpy(bp->nrm + 3 * np, nrm + 3 * q, 3 * sizeof(double));
-          memcpy(bp->N + (size_t)np * nn, N, sizeof(double) * (size_t)nn);
-          double det = gradients(s->type, nn, X, pts + 3 * q, bp->G + (size_t)np * nd);
-          FCM_CHECK(det > 0.0, ctx, FCM_ERR_GEOMETRY,
-                    "boundary constraint %d: cell %lld has det J = %g <= 0 at a boundary point", k,
-                    (long long)s->elem_cell[e], det);
-        } else {
-          count[k]++;
-        }
-        np++;
+  fcm_index np = 0, ne = 0;
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    int nsp = 0;
+    const double *pts = NULL, *wts = NULL, *nrm = NULL;
+    double X[3 * FCM_ELEMENT_MAX_NODES], N[FCM_ELEMENT_MAX_NODES];
+    FCM_TRY(ctx, fcm_cell_rules_get_piece_surface(s->rules, s->elem_piece[e], &nsp, &pts, &wts,
+                                                  &nrm, NULL));
+    if (nsp == 0) continue;
+    fcm_mesh_cell_coords(s->mesh, s->elem_cell[e], X);
+    const fcm_index first = np;
+    for (int q = 0; q < nsp; q++) {
+      double x[3] = {0, 0, 0};
+      fcm_element_eval_shape(s->type, pts + 3 * q, N);
+      for (int a = 0; a < nn; a++)
+        for (int i = 0; i < 3; i++)
+          x[i] += N[a] * X[3 * a + i];
+      const int k = point_owner(I, x, nrm + 3 * q);
+      if (k < 0 || !(wts[q] > 0.0)) continue;
+      if (pass == 1) {
+        bp->con[np] = k;
+        bp->w[np] = wts[q];
+        memcpy(bp->X + 3 * np, x, sizeof x);
+        memcpy(bp->nrm + 3 * np, nrm + 3 * q, 3 * sizeof(double));
+        memcpy(bp->N + (size_t)np * nn, N, sizeof(double) * (size_t)nn);
+        double det = gradients(s->type, nn, X, pts + 3 * q, bp->G + (size_t)np * nd);
+        FCM_CHECK(det > 0.0, ctx, FCM_ERR_GEOMETRY,
+                  "boundary constraint %d: cell %lld has det J = %g <= 0 at a boundary point", k,
+                  (long long)s->elem_cell[e], det);
+      } else {
+        count[k]++;
       }
-      if (np > first) {
-        if (pass == 1) {
-          bp->elem[ne] = e;
-          bp->ptr[ne] = first;
-        }
-        ne++;
-      }
+      np++;
     }
-    if (pass == 0) {
-      if (I->has_backend) { /* the points of this process's cells: count them all */
-        double c[64];
-        for (int k0 = 0; k0 < I->num_bcons; k0 += 64) {
-          const int m = I->num_bcons - k0 < 64 ? I->num_bcons - k0 : 64;
-          for (int k = 0; k < m; k++)
-            c[k] = (double)count[k0 + k];
-          FCM_TRY(ctx, I->backend.reduce(I->backend.user, FCM_OK, c, m));
-          for (int k = 0; k < m; k++)
-            count[k0 + k] = (fcm_index)c[k];
-        }
+    if (np > first) {
+      if (pass == 1) {
+        bp->elem[ne] = e;
+        bp->ptr[ne] = first;
       }
-      for (int k = 0; k < I->num_bcons; k++)
-        FCM_CHECK(count[k] > 0, ctx, FCM_ERR_ARG,
-                  "boundary constraint %d selects no embedded-boundary point (check its region "
-                  "against the body's surface)",
-                  k);
-      bp->np = np;
-      bp->nelem = ne;
-      FCM_ALLOC(ctx, ne, bp->elem);
-      FCM_ALLOC(ctx, ne + 1, bp->lelem);
-      FCM_ALLOC(ctx, ne + 1, bp->ptr);
-      FCM_ALLOC(ctx, np, bp->con);
-      FCM_ALLOC(ctx, np, bp->w);
-      FCM_ALLOC(ctx, 3 * (size_t)np, bp->X);
-      FCM_ALLOC(ctx, 3 * (size_t)np, bp->nrm);
-      FCM_ALLOC(ctx, (size_t)np * nn, bp->N);
-      FCM_ALLOC(ctx, (size_t)np * nd, bp->G);
-      bp->nthreads = fcm_ctx_num_threads(ctx);
-      FCM_ALLOC(ctx, ((size_t)nd * (nd + 2) + 9 * (size_t)nn) * (size_t)bp->nthreads, bp->scratch);
-      FCM_ALLOC(ctx, ne + 1, bp->eelem);
-    } else {
-      bp->ptr[ne] = np;
+      ne++;
     }
   }
-  /* the elements with points grouped by the space's colours (parallel assembly); a local
-   * space's colours list local positions (fem_impl.h), and its elements with points (those of
-   * the process's own cells) are local */
+cleanup:
+  *np_out = np;
+  *ne_out = ne;
+  return st;
+}
+
+/* After the counting pass: every constraint must select a point (over all processes when a
+ * backend distributes the run); allocate the point arrays for np points on ne elements. */
+static fcm_status size_points(fcm_integrator *I, fcm_index *count, fcm_index np, fcm_index ne)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  sim_bpoints *bp = &I->bp;
+  const int nn = I->space->nn, nd = 3 * nn;
+  if (I->has_backend) { /* the points of this process's cells: count them all */
+    double c[64];
+    for (int k0 = 0; k0 < I->num_bcons; k0 += 64) {
+      const int m = I->num_bcons - k0 < 64 ? I->num_bcons - k0 : 64;
+      for (int k = 0; k < m; k++)
+        c[k] = (double)count[k0 + k];
+      FCM_TRY(ctx, I->backend.reduce(I->backend.user, FCM_OK, c, m));
+      for (int k = 0; k < m; k++)
+        count[k0 + k] = (fcm_index)c[k];
+    }
+  }
+  for (int k = 0; k < I->num_bcons; k++)
+    FCM_CHECK(count[k] > 0, ctx, FCM_ERR_ARG,
+              "boundary constraint %d selects no embedded-boundary point (check its region "
+              "against the body's surface)",
+              k);
+  bp->np = np;
+  bp->nelem = ne;
+  FCM_ALLOC(ctx, ne, bp->elem);
+  FCM_ALLOC(ctx, ne + 1, bp->lelem);
+  FCM_ALLOC(ctx, ne + 1, bp->ptr);
+  FCM_ALLOC(ctx, np, bp->con);
+  FCM_ALLOC(ctx, np, bp->w);
+  FCM_ALLOC(ctx, 3 * (size_t)np, bp->X);
+  FCM_ALLOC(ctx, 3 * (size_t)np, bp->nrm);
+  FCM_ALLOC(ctx, (size_t)np * nn, bp->N);
+  FCM_ALLOC(ctx, (size_t)np * nd, bp->G);
+  bp->nthreads = fcm_ctx_num_threads(ctx);
+  FCM_ALLOC(ctx, ((size_t)nd * (nd + 2) + 9 * (size_t)nn) * (size_t)bp->nthreads, bp->scratch);
+  FCM_ALLOC(ctx, ne + 1, bp->eelem);
+cleanup:
+  return st;
+}
+
+/* The elements with points grouped by the space's colours (parallel assembly); a local
+ * space's colours list local positions (fem_impl.h), and its elements with points (those of
+ * the process's own cells) are local. */
+static fcm_status group_by_colour(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  const fcm_space *s = I->space;
+  sim_bpoints *bp = &I->bp;
+  fcm_index *ecol = NULL;
   for (fcm_index k = 0; k < bp->nelem; k++) {
     bp->lelem[k] = fcm__space_elem_local(s, bp->elem[k]);
     FCM_CHECK(bp->lelem[k] >= 0, ctx, FCM_ERR_INTERNAL,
@@ -463,8 +475,19 @@ fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
   for (int c = s->num_colors; c > 0; c--)
     bp->color_ptr[c] = bp->color_ptr[c - 1];
   bp->color_ptr[0] = 0;
-  /* penalties */
-  FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, FCM_RULE_STIFFNESS,
+cleanup:
+  fcm__free(ctx, ecol);
+  return st;
+}
+
+/* The penalties of the elements with points, and the largest in the setup info. */
+static fcm_status boundary_penalties(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  sim_bpoints *bp = &I->bp;
+  fcm_rule *full = NULL;
+  FCM_TRY(ctx, fcm_element_standard_rule(ctx, I->space->type, FCM_RULE_STIFFNESS,
                                          I->opts.assembly.stiffness_strength, &full));
   I->setup_info.boundary_points = bp->np;
   for (fcm_index k = 0; k < bp->nelem; k++) {
@@ -475,9 +498,38 @@ fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
         I->setup_info.boundary_penalty_max, element_max_penalty(I, k) * bp->hk[e] / I->mat.young);
   }
 cleanup:
-  fcm__free(ctx, count);
-  fcm__free(ctx, ecol);
   fcm_rule_destroy(&full);
+  return st;
+}
+
+fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  const fcm_space *s = I->space;
+  sim_bpoints *bp = &I->bp;
+  fcm_index *count = NULL;
+  if (I->num_bcons == 0) return FCM_OK;
+  FCM_CHECK(s->rules && fcm_cell_rules_surface_strength(s->rules) >= 0, ctx, FCM_ERR_ARG,
+            "boundary constraint 0: the space has no surface rules (build the cell rules with "
+            "surface_strength >= 0)");
+  FCM_ALLOC(ctx, I->num_bcons, I->bcon_on);
+  FCM_ALLOC(ctx, I->num_bcons, count);
+  FCM_ALLOC(ctx, s->num_elems + 1, bp->gamma);
+  FCM_ALLOC(ctx, s->num_elems + 1, bp->hk);
+  /* count the selected points per element, then store them */
+  for (int pass = 0; pass < 2; pass++) {
+    fcm_index np = 0, ne = 0;
+    FCM_TRY(ctx, collect_points(I, pass, count, &np, &ne));
+    if (pass == 0)
+      FCM_TRY(ctx, size_points(I, count, np, ne));
+    else
+      bp->ptr[ne] = np;
+  }
+  FCM_TRY(ctx, group_by_colour(I));
+  FCM_TRY(ctx, boundary_penalties(I));
+cleanup:
+  fcm__free(ctx, count);
   return st;
 }
 
