@@ -549,6 +549,103 @@ static void scatter(const fcm_space *s, fcm_index le, const double *Ke, double *
     }
 }
 
+/* Nitsche's force terms of a point beyond the penalty: fe_(a,i) -= w (S_iL g_aL + p_i t_i N_a),
+ * S_iL = r_j N_J A_jJiL. */
+static void nitsche_force(int nn, const double *G, const double *N, const double nv[3],
+                          const int *pc, const double r[3], const double t[3], const double *A,
+                          double w, double *fe)
+{
+  double S[9] = {0}; /* S_iL = r_j N_J A_jJiL */
+  for (int j = 0; j < 3; j++)
+    for (int J = 0; J < 3; J++) {
+      const double c = r[j] * nv[J];
+      if (c == 0.0) continue;
+      const double *Ar = A + 9 * (3 * j + J);
+      for (int m = 0; m < 9; m++)
+        S[m] += c * Ar[m];
+    }
+  for (int a = 0; a < nn; a++) {
+    const double *ga = G + 3 * a;
+    for (int i = 0; i < 3; i++)
+      fe[3 * a + i] -= w * (S[3 * i] * ga[0] + S[3 * i + 1] * ga[1] + S[3 * i + 2] * ga[2] +
+                            (pc[i] ? t[i] * N[a] : 0.0));
+  }
+}
+
+/* Nitsche's symmetric tangent terms of a point: Ke -= w (V Q + Q^T V^T), V_(a,i),i = p_i N_a,
+ * with the tractions Q (3 x nd) of the shape modes. */
+static void nitsche_tangent(int nn, const double *G, const double *N, const double nv[3],
+                            const int *pc, const double *A, double w, double *Ke, double *Q)
+{
+  const int nd = 3 * nn;
+  /* Q_i(b,k) = B_ikL g_bL with B_ikL = A_iJkL N_J */
+  double B[27];
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < 3; k++)
+      for (int L = 0; L < 3; L++)
+        B[9 * i + 3 * k + L] = A[9 * (3 * i) + 3 * k + L] * nv[0] +
+                               A[9 * (3 * i + 1) + 3 * k + L] * nv[1] +
+                               A[9 * (3 * i + 2) + 3 * k + L] * nv[2];
+  for (int i = 0; i < 3; i++)
+    for (int b = 0; b < nn; b++) {
+      const double *gb = G + 3 * b;
+      for (int k = 0; k < 3; k++) {
+        const double *Bk = B + 9 * i + 3 * k;
+        Q[i * nd + 3 * b + k] = Bk[0] * gb[0] + Bk[1] * gb[1] + Bk[2] * gb[2];
+      }
+    }
+  /* Ke -= w (V Q + Q^T V^T), V_(a,i),i = p_i N_a */
+  for (int a = 0; a < nn; a++)
+    for (int i = 0; i < 3; i++) {
+      if (!pc[i]) continue;
+      const double c = w * N[a];
+      const double *Qi = Q + i * nd;
+      double *row = Ke + (size_t)(3 * a + i) * nd;
+      for (int y = 0; y < nd; y++) {
+        row[y] -= c * Qi[y];
+        Ke[(size_t)y * nd + 3 * a + i] -= c * Qi[y];
+      }
+    }
+}
+
+/* The tangent term of a point from the material's nonlinearity: Ke_(a,i)(b,k) -=
+ * w dA[r (x) N]_iJkL g_aJ g_bL at deformation gradient F, for a residual r of length rn > 0. */
+static void material_derivative_term(const fcm_integrator *I, int nn, const double *G,
+                                     const double nv[3], const double F[9], const double r[3],
+                                     double rn, double w, double *Ke)
+{
+  const int nd = 3 * nn;
+  /* dA along D = r (x) N by central differences, step h along D/|D| (|N| = 1) */
+  const double hstep = 1e-5;
+  double Fp[9], Fm[9], Ap[81], Am[81];
+  for (int i = 0; i < 3; i++)
+    for (int J = 0; J < 3; J++) {
+      const double d = hstep * r[i] / rn * nv[J];
+      Fp[3 * i + J] = F[3 * i + J] + d;
+      Fm[3 * i + J] = F[3 * i + J] - d;
+    }
+  fcm__material_eval(&I->params, Fp, NULL, NULL, Ap);
+  fcm__material_eval(&I->params, Fm, NULL, NULL, Am);
+  const double sc = w * rn / (2.0 * hstep);
+  for (int m = 0; m < 81; m++)
+    Ap[m] = sc * (Ap[m] - Am[m]);
+  /* C[i][J][k] = dA_iJkL g_bL, then Ke_(a,i)(b,k) -= g_aJ C[i][J][k] */
+  for (int b = 0; b < nn; b++) {
+    const double *gb = G + 3 * b;
+    double C[27];
+    for (int m = 0; m < 27; m++)
+      C[m] = Ap[3 * m] * gb[0] + Ap[3 * m + 1] * gb[1] + Ap[3 * m + 2] * gb[2];
+    for (int a = 0; a < nn; a++) {
+      const double *ga = G + 3 * a;
+      for (int i = 0; i < 3; i++) {
+        double *row = Ke + (size_t)(3 * a + i) * nd + 3 * b;
+        for (int k = 0; k < 3; k++)
+          row[k] -= ga[0] * C[9 * i + k] + ga[1] * C[9 * i + 3 + k] + ga[2] * C[9 * i + 6 + k];
+      }
+    }
+  }
+}
+
 /* The terms of one point into fe / Ke (either may be NULL); returns its energy, NaN when the
  * material gives NaN/Inf. */
 static double point_terms(const fcm_integrator *I, fcm_index p, const double *ue, int projected,
@@ -593,84 +690,11 @@ static double point_terms(const fcm_integrator *I, fcm_index p, const double *ue
     t[i] = P[3 * i] * nv[0] + P[3 * i + 1] * nv[1] + P[3 * i + 2] * nv[2];
   energy -= t[0] * r[0] + t[1] * r[1] + t[2] * r[2];
   if (!isfinite(energy)) return NAN;
-  if (fe) {
-    double S[9] = {0}; /* S_iL = r_j N_J A_jJiL */
-    for (int j = 0; j < 3; j++)
-      for (int J = 0; J < 3; J++) {
-        const double c = r[j] * nv[J];
-        if (c == 0.0) continue;
-        const double *Ar = A + 9 * (3 * j + J);
-        for (int m = 0; m < 9; m++)
-          S[m] += c * Ar[m];
-      }
-    for (int a = 0; a < nn; a++) {
-      const double *ga = G + 3 * a;
-      for (int i = 0; i < 3; i++)
-        fe[3 * a + i] -= w * (S[3 * i] * ga[0] + S[3 * i + 1] * ga[1] + S[3 * i + 2] * ga[2] +
-                              (pc[i] ? t[i] * N[a] : 0.0));
-    }
-  }
+  if (fe) nitsche_force(nn, G, N, nv, pc, r, t, A, w, fe);
   if (Ke && !projected) {
-    /* Q_i(b,k) = B_ikL g_bL with B_ikL = A_iJkL N_J */
-    double B[27];
-    for (int i = 0; i < 3; i++)
-      for (int k = 0; k < 3; k++)
-        for (int L = 0; L < 3; L++)
-          B[9 * i + 3 * k + L] = A[9 * (3 * i) + 3 * k + L] * nv[0] +
-                                 A[9 * (3 * i + 1) + 3 * k + L] * nv[1] +
-                                 A[9 * (3 * i + 2) + 3 * k + L] * nv[2];
-    for (int i = 0; i < 3; i++)
-      for (int b = 0; b < nn; b++) {
-        const double *gb = G + 3 * b;
-        for (int k = 0; k < 3; k++) {
-          const double *Bk = B + 9 * i + 3 * k;
-          Q[i * nd + 3 * b + k] = Bk[0] * gb[0] + Bk[1] * gb[1] + Bk[2] * gb[2];
-        }
-      }
-    /* Ke -= w (V Q + Q^T V^T), V_(a,i),i = p_i N_a */
-    for (int a = 0; a < nn; a++)
-      for (int i = 0; i < 3; i++) {
-        if (!pc[i]) continue;
-        const double c = w * N[a];
-        const double *Qi = Q + i * nd;
-        double *row = Ke + (size_t)(3 * a + i) * nd;
-        for (int y = 0; y < nd; y++) {
-          row[y] -= c * Qi[y];
-          Ke[(size_t)y * nd + 3 * a + i] -= c * Qi[y];
-        }
-      }
+    nitsche_tangent(nn, G, N, nv, pc, A, w, Ke, Q);
     const double rn = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
-    if (!I->linear && rn > 0.0) {
-      /* dA along D = r (x) N by central differences, step h along D/|D| (|N| = 1) */
-      const double hstep = 1e-5;
-      double Fp[9], Fm[9], Ap[81], Am[81];
-      for (int i = 0; i < 3; i++)
-        for (int J = 0; J < 3; J++) {
-          const double d = hstep * r[i] / rn * nv[J];
-          Fp[3 * i + J] = F[3 * i + J] + d;
-          Fm[3 * i + J] = F[3 * i + J] - d;
-        }
-      fcm__material_eval(&I->params, Fp, NULL, NULL, Ap);
-      fcm__material_eval(&I->params, Fm, NULL, NULL, Am);
-      const double sc = w * rn / (2.0 * hstep);
-      for (int m = 0; m < 81; m++)
-        Ap[m] = sc * (Ap[m] - Am[m]);
-      /* C[i][J][k] = dA_iJkL g_bL, then Ke_(a,i)(b,k) -= g_aJ C[i][J][k] */
-      for (int b = 0; b < nn; b++) {
-        const double *gb = G + 3 * b;
-        double C[27];
-        for (int m = 0; m < 27; m++)
-          C[m] = Ap[3 * m] * gb[0] + Ap[3 * m + 1] * gb[1] + Ap[3 * m + 2] * gb[2];
-        for (int a = 0; a < nn; a++) {
-          const double *ga = G + 3 * a;
-          for (int i = 0; i < 3; i++) {
-            double *row = Ke + (size_t)(3 * a + i) * nd + 3 * b;
-            for (int k = 0; k < 3; k++)
-              row[k] -= ga[0] * C[9 * i + k] + ga[1] * C[9 * i + 3 + k] + ga[2] * C[9 * i + 6 + k];
-          }
-        }
-      }
-    }
+    if (!I->linear && rn > 0.0) material_derivative_term(I, nn, G, nv, F, r, rn, w, Ke);
   }
   return w * energy;
 }
