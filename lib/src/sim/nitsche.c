@@ -343,8 +343,8 @@ cleanup:
 }
 
 /* One pass over the elements' surface points: pass 0 counts the points each constraint
- * selects into count, pass 1 stores them (bp, sized by pass 0); *np and *ne get the numbers
- * of selected points and of elements with any. */
+ * selects into count, pass 1 stores them (bp, sized by pass 0); *np_out and *ne_out get the
+ * numbers of selected points and of elements with any. */
 static fcm_status collect_points(fcm_integrator *I, int pass, fcm_index *count, fcm_index *np_out,
                                  fcm_index *ne_out)
 {
