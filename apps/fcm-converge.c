@@ -124,7 +124,8 @@ typedef struct cv_option {
 
 #define NUM_OPTIONS 33 /* entries of the table below, sentinel included */
 
-/* The options of subcommand `cmd` (CMD_STUDY or CMD_PAYOFF) writing into c and p. */
+/* The options of subcommand `cmd` (CMD_STUDY or CMD_PAYOFF) writing into c and p. One table
+ * of all the options: splitting it would scatter them, so it stays long. */
 static void option_table(unsigned cmd, config *c, parse_state *p, cli_option t[NUM_OPTIONS])
 {
   cv_setup *s = &c->setup;

@@ -323,121 +323,161 @@ typedef struct acc_opts {
   int max_strength;
 } acc_opts;
 
+/* The cells of the accuracy study: the unit tet, and the unit cube (as 6 Kuhn tets for the
+ * exact moments). */
+static const double acc_tet[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+static const fcm_index acc_tet_cell[4] = {0, 1, 2, 3};
+static const int acc_kuhn[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6},
+                                   {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
+static const double acc_cube[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                                      {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+
+/* What the accuracy study counts over its pieces, and its CSV (NULL: none). */
+typedef struct acc_tally {
+  FILE *csv;
+  double worst;           /* the largest relative moment error */
+  long long rows, over_m; /* pieces, and those with more points than moments */
+} acc_tally;
+
+/* The study's cell (hex: the unit cube, else the unit tet) as a one-cell mesh and geometry. */
+static fcm_status accuracy_cell(fcm_ctx *ctx, int hex, fcm_mesh **mesh, fcm_geometry **geom)
+{
+  fcm_status st;
+  if (hex) {
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    const fcm_index one[3] = {1, 1, 1};
+    st = fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, one, mesh);
+    if (st == FCM_OK) st = fcm_geometry_create_box(ctx, lo, hi, one, geom);
+  } else {
+    st = fcm_mesh_create(ctx, FCM_ELEMENT_TET4, 4, &acc_tet[0][0], 1, acc_tet_cell, mesh);
+    if (st == FCM_OK)
+      st = fcm_geometry_create(ctx, FCM_ELEMENT_TET4, 4, &acc_tet[0][0], 1, acc_tet_cell, geom);
+  }
+  return st;
+}
+
+/* The exact moments up to degree m of the inner piece of the cell (its intersection with the
+ * half-spaces of cc) and of the outer piece (the rest). */
+static void exact_moments(int hex, const cut_case *cc, int m, double *inner, double *outer)
+{
+  const int nm = num_mono(m);
+  double whole[165];
+  tets cellt = {NULL, 0, 0}, in = {NULL, 0, 0};
+  if (hex) {
+    for (int k = 0; k < 6; k++)
+      tets_add(&cellt, acc_cube[acc_kuhn[k][0]], acc_cube[acc_kuhn[k][1]], acc_cube[acc_kuhn[k][2]],
+               acc_cube[acc_kuhn[k][3]]);
+  } else {
+    tets_add(&cellt, acc_tet[0], acc_tet[1], acc_tet[2], acc_tet[3]);
+  }
+  for (int k = 0; k < cellt.n; k++)
+    tets_add(&in, cellt.x + 12 * k, cellt.x + 12 * k + 3, cellt.x + 12 * k + 6,
+             cellt.x + 12 * k + 9);
+  for (int p = 0; p < cc->nplanes; p++)
+    tets_clip(&in, cc->planes[p], cc->planes[p][3]);
+  tets_moments(&cellt, m, whole);
+  tets_moments(&in, m, inner);
+  for (int k = 0; k < nm; k++)
+    outer[k] = whole[k] - inner[k];
+  free(cellt.x);
+  free(in.x);
+}
+
+/* Each piece of the cut rules r (strength m) of the study's cell against the exact piece
+ * (inner or outer moments) with the nearer volume centroid, into the tally, acc_err and the
+ * CSV; *ok = 0 when the cut does not give 2 pieces (the pieces are then skipped). */
+static void check_pieces(const fcm_cell_rules *r, const fcm_mesh *mesh, int hex, int which,
+                         const cut_case *cc, int m, const double *inner, const double *outer,
+                         int *ok, acc_tally *t)
+{
+  const int nm = num_mono(m);
+  double q[165];
+  fcm_index first;
+  const fcm_index np = fcm_cell_rules_cell_pieces(r, 0, &first);
+  if (np != 2) {
+    fprintf(stderr, PROG ": accuracy: %s cut of the %s cell gave %lld pieces, not 2\n", cc->name,
+            hex ? "hex8" : "tet4", (long long)np);
+    *ok = 0;
+  }
+  double X[24], J[9], x[3];
+  fcm_mesh_cell_coords(mesh, 0, X);
+  const fcm_element_type type = hex ? FCM_ELEMENT_HEX8 : FCM_ELEMENT_TET4;
+  int ex[3 * 165];
+  mono_exp(m, ex);
+  for (fcm_index p = first; p < first + np && *ok; p++) {
+    int n;
+    const double *pts, *w;
+    const unsigned char *fl;
+    fcm_cell_rules_get_piece(r, p, FCM_RULE_STIFFNESS, &n, &pts, &w, &fl);
+    memset(q, 0, sizeof q);
+    for (int j = 0; j < n; j++) {
+      fcm_element_map(type, X, pts + 3 * j, x);
+      const double wd = w[j] * fcm_element_jacobian(type, X, pts + 3 * j, J);
+      for (int k = 0; k < nm; k++)
+        q[k] += wd * pow(x[0], ex[3 * k]) * pow(x[1], ex[3 * k + 1]) * pow(x[2], ex[3 * k + 2]);
+    }
+    /* centroid distance to the exact pieces' centroids (moments 1..3 / volume) */
+    double din = 0, dout = 0;
+    for (int d = 1; d <= 3; d++) {
+      din += pow(q[d] / q[0] - inner[d] / inner[0], 2);
+      dout += pow(q[d] / q[0] - outer[d] / outer[0], 2);
+    }
+    const double *E = din < dout ? inner : outer;
+    double err = 0.0;
+    for (int k = 0; k < nm; k++)
+      err = fmax(err, fabs(q[k] - E[k]) / fabs(E[k]));
+    t->worst = fmax(t->worst, err);
+    acc_err[which][hex][m] = fmax(acc_err[which][hex][m], err);
+    t->over_m += n > nm;
+    t->rows++;
+    if (t->csv)
+      fprintf(t->csv, "%s,%s,%d,%lld,%d,%.3e\n", cc->name, hex ? "hex8" : "tet4", m,
+              (long long)(p - first), n, err);
+  }
+}
+
+/* One strength m of one cut (surface surf, half-spaces cc) of the study's cell: the cut cell
+ * rules without stabilization, checked piece by piece (check_pieces()). */
+static fcm_status accuracy_strength(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                                    const fcm_surface *surf, int hex, int which, const cut_case *cc,
+                                    int m, int *ok, acc_tally *t)
+{
+  fcm_cell_rules_options o = fcm_cell_rules_options_default();
+  o.strength[FCM_RULE_STIFFNESS] = o.strength[FCM_RULE_MASS] = m;
+  o.min_fraction = 0.0;
+  o.stabilization.mode = FCM_STABILIZATION_OFF;
+  fcm_cell_rules *r0 = NULL, *r = NULL;
+  fcm_status st = fcm_cell_rules_create(ctx, mesh, geom, &o, &r0);
+  if (st == FCM_OK) st = fcm_cell_rules_create_cut(ctx, mesh, geom, r0, surf, &r);
+  fcm_cell_rules_destroy(&r0);
+  if (st != FCM_OK) return st;
+  double inner[165], outer[165];
+  exact_moments(hex, cc, m, inner, outer);
+  check_pieces(r, mesh, hex, which, cc, m, inner, outer, ok, t);
+  fcm_cell_rules_destroy(&r);
+  return FCM_OK;
+}
+
 static int run_accuracy(fcm_ctx *ctx, const acc_opts *ao)
 {
-  static const double unit_tet[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-  static const fcm_index tet_cell[4] = {0, 1, 2, 3};
-  /* the unit cube as 6 Kuhn tets for the exact moments */
-  static const int kuhn[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6},
-                                 {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
-  static const double cube[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
-                                    {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
   cli_output *out = NULL;
-  FILE *csv = NULL;
+  acc_tally t = {NULL, 0.0, 0, 0};
   int ok = 1;
-  double worst = 0.0;
-  long long rows = 0, over_m = 0;
   if (ao->csv) {
-    csv = cli_output_open(PROG, ao->csv, &out);
-    if (!csv) return 1;
-    fprintf(csv, "surface,element,strength,piece,points,max_rel_error\n");
+    t.csv = cli_output_open(PROG, ao->csv, &out);
+    if (!t.csv) return 1;
+    fprintf(t.csv, "surface,element,strength,piece,points,max_rel_error\n");
   }
   for (int hex = 0; hex < 2 && ok; hex++) {
     fcm_mesh *mesh = NULL;
     fcm_geometry *geom = NULL;
-    fcm_status st;
-    if (hex) {
-      const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
-      const fcm_index one[3] = {1, 1, 1};
-      st = fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, one, &mesh);
-      if (st == FCM_OK) st = fcm_geometry_create_box(ctx, lo, hi, one, &geom);
-    } else {
-      st = fcm_mesh_create(ctx, FCM_ELEMENT_TET4, 4, &unit_tet[0][0], 1, tet_cell, &mesh);
-      if (st == FCM_OK)
-        st = fcm_geometry_create(ctx, FCM_ELEMENT_TET4, 4, &unit_tet[0][0], 1, tet_cell, &geom);
-    }
+    fcm_status st = accuracy_cell(ctx, hex, &mesh, &geom);
     for (int which = 0; which < 3 && st == FCM_OK && ok; which++) {
       fcm_surface *surf = NULL;
       static cut_case cc;
       st = make_cut(ctx, which, hex, &surf, &cc);
-      for (int m = 1; m <= ao->max_strength && st == FCM_OK; m++) {
-        fcm_cell_rules_options o = fcm_cell_rules_options_default();
-        o.strength[FCM_RULE_STIFFNESS] = o.strength[FCM_RULE_MASS] = m;
-        o.min_fraction = 0.0;
-        o.stabilization.mode = FCM_STABILIZATION_OFF;
-        fcm_cell_rules *r0 = NULL, *r = NULL;
-        st = fcm_cell_rules_create(ctx, mesh, geom, &o, &r0);
-        if (st == FCM_OK) st = fcm_cell_rules_create_cut(ctx, mesh, geom, r0, surf, &r);
-        fcm_cell_rules_destroy(&r0);
-        if (st != FCM_OK) break;
-        /* exact moments of the inner piece and of the cell */
-        const int nm = num_mono(m);
-        double inner[165], whole[165], outer[165], q[165];
-        tets cellt = {NULL, 0, 0}, in = {NULL, 0, 0};
-        if (hex) {
-          for (int k = 0; k < 6; k++)
-            tets_add(&cellt, cube[kuhn[k][0]], cube[kuhn[k][1]], cube[kuhn[k][2]],
-                     cube[kuhn[k][3]]);
-        } else {
-          tets_add(&cellt, unit_tet[0], unit_tet[1], unit_tet[2], unit_tet[3]);
-        }
-        for (int k = 0; k < cellt.n; k++)
-          tets_add(&in, cellt.x + 12 * k, cellt.x + 12 * k + 3, cellt.x + 12 * k + 6,
-                   cellt.x + 12 * k + 9);
-        for (int p = 0; p < cc.nplanes; p++)
-          tets_clip(&in, cc.planes[p], cc.planes[p][3]);
-        tets_moments(&cellt, m, whole);
-        tets_moments(&in, m, inner);
-        for (int k = 0; k < nm; k++)
-          outer[k] = whole[k] - inner[k];
-        free(cellt.x);
-        free(in.x);
-        /* each piece of the rules against the exact piece with the nearer volume centroid */
-        fcm_index first;
-        const fcm_index np = fcm_cell_rules_cell_pieces(r, 0, &first);
-        if (np != 2) {
-          fprintf(stderr, PROG ": accuracy: %s cut of the %s cell gave %lld pieces, not 2\n",
-                  cc.name, hex ? "hex8" : "tet4", (long long)np);
-          ok = 0;
-        }
-        double X[24], J[9], x[3];
-        fcm_mesh_cell_coords(mesh, 0, X);
-        const fcm_element_type type = hex ? FCM_ELEMENT_HEX8 : FCM_ELEMENT_TET4;
-        int ex[3 * 165];
-        mono_exp(m, ex);
-        for (fcm_index p = first; p < first + np && ok; p++) {
-          int n;
-          const double *pts, *w;
-          const unsigned char *fl;
-          fcm_cell_rules_get_piece(r, p, FCM_RULE_STIFFNESS, &n, &pts, &w, &fl);
-          memset(q, 0, sizeof q);
-          for (int j = 0; j < n; j++) {
-            fcm_element_map(type, X, pts + 3 * j, x);
-            const double wd = w[j] * fcm_element_jacobian(type, X, pts + 3 * j, J);
-            for (int k = 0; k < nm; k++)
-              q[k] +=
-                  wd * pow(x[0], ex[3 * k]) * pow(x[1], ex[3 * k + 1]) * pow(x[2], ex[3 * k + 2]);
-          }
-          /* centroid distance to the exact pieces' centroids (moments 1..3 / volume) */
-          double din = 0, dout = 0;
-          for (int d = 1; d <= 3; d++) {
-            din += pow(q[d] / q[0] - inner[d] / inner[0], 2);
-            dout += pow(q[d] / q[0] - outer[d] / outer[0], 2);
-          }
-          const double *E = din < dout ? inner : outer;
-          double err = 0.0;
-          for (int k = 0; k < nm; k++)
-            err = fmax(err, fabs(q[k] - E[k]) / fabs(E[k]));
-          worst = fmax(worst, err);
-          acc_err[which][hex][m] = fmax(acc_err[which][hex][m], err);
-          over_m += n > nm;
-          rows++;
-          if (csv)
-            fprintf(csv, "%s,%s,%d,%lld,%d,%.3e\n", cc.name, hex ? "hex8" : "tet4", m,
-                    (long long)(p - first), n, err);
-        }
-        fcm_cell_rules_destroy(&r);
-      }
+      for (int m = 1; m <= ao->max_strength && st == FCM_OK; m++)
+        st = accuracy_strength(ctx, mesh, geom, surf, hex, which, &cc, m, &ok, &t);
       fcm_surface_destroy(&surf);
     }
     if (st != FCM_OK) {
@@ -447,14 +487,14 @@ static int run_accuracy(fcm_ctx *ctx, const acc_opts *ao)
     fcm_geometry_destroy(&geom);
     fcm_mesh_destroy(&mesh);
   }
-  if (csv && ok && !cli_output_commit(PROG, &out)) ok = 0;
+  if (t.csv && ok && !cli_output_commit(PROG, &out)) ok = 0;
   cli_output_abort(&out);
   if (ok && ao->png && !accuracy_png(ao->png, ao->max_strength)) ok = 0;
   if (!ok) return 1;
-  const int pass = worst <= 1e-12 && over_m == 0;
+  const int pass = t.worst <= 1e-12 && t.over_m == 0;
   printf("accuracy: %lld pieces x strengths, largest relative moment error %.2e (claim <= 1e-12: "
          "%s), pieces with more than M points: %lld\n",
-         rows, worst, worst <= 1e-12 ? "holds" : "FAILS", over_m);
+         t.rows, t.worst, t.worst <= 1e-12 ? "holds" : "FAILS", t.over_m);
   return pass ? 0 : 1;
 }
 

@@ -286,70 +286,56 @@ static fcm_status load_geometry(fcm_ctx *ctx, const char *spec, int fill_holes, 
   return fcm_geometry_create_from_gmsh(ctx, spec, g);
 }
 
-int fcm_quadrature_cmd_embed(int argc, char **argv)
+/* The settings of `embed` (its command line). */
+typedef struct embed_args {
+  fcm_element_type type;
+  double box[6], alpha, phimin, max_volume;
+  int cells[3], strength, mstrength, no_simplify, have_box, fill_holes;
+  const char *geometry, *dump;
+} embed_args;
+
+/* The required options present and the box not empty; else the exit code after saying why
+ * (-1: fine). */
+static int embed_check(const embed_args *a)
 {
-  fcm_element_type type = FCM_ELEMENT_COUNT;
-  double box[6] = {0, 0, 0, 0, 0, 0}, alpha = 1e-6, phimin = 1e-4, max_volume = 0.0;
-  int cells[3] = {0, 0, 0}, strength = 0, mstrength = 0, no_simplify = 0, have_box = 0, rc = 1;
-  int fill_holes = 0;
-  const char *geometry = NULL, *dump = NULL;
-  const cli_option opts[] = {
-      {"--element", NULL, CLI_CUSTOM, &type, "E", "background element: tet4, tet10, hex8, hex20", 0,
-       0, 0, NULL, cli_element, NULL},
-      {"--box", NULL, CLI_DOUBLE, box, "X0 Y0 Z0 X1 Y1 Z1", "background box corners", -1e12, 1e12,
-       0, NULL, NULL, &have_box},
-      {"--cells", NULL, CLI_INT, cells, "NX NY NZ", "background cells per direction, 1..100000", 1,
-       100000, 0, NULL, NULL, NULL},
-      {"--geometry", NULL, CLI_STRING, &geometry, "FILE|SHAPE",
-       "by extension: Gmsh .msh (tetrahedra), TetGen\n"
-       "FILE.node / FILE.ele (both read), a closed triangle\n"
-       "surface .obj, .off, .stl, .ply (tetrahedralized\n"
-       "with Gmsh), a voxel image .nrrd, .nhdr, .mhd, .mha\n"
-       "(voxels >= 0.5, merged into boxes); or a shape: ball:CX,CY,CZ,R,N |\n"
-       "hemisphere:CX,CY,CZ,R,N | box:X0,Y0,Z0,X1,Y1,Z1,N",
-       0, 0, 0, NULL, NULL, NULL},
-      {"--fill-holes", NULL, CLI_FLAG, &fill_holes, NULL,
-       "surfaces: close holes before tetrahedralizing", 0, 0, 0, NULL, NULL, NULL},
-      {"--max-volume", NULL, CLI_DOUBLE, &max_volume, "V",
-       "surfaces: largest tet volume wanted (default 0:\nsizes follow the surface)", 0, 1e300, 0,
-       NULL, NULL, NULL},
-      {"--strength", NULL, CLI_INT, &strength, "M", "stiffness rule strength 1..20", 1, 20, 0, NULL,
-       NULL, NULL},
-      {"--mass-strength", NULL, CLI_INT, &mstrength, "M",
-       "mass rule strength 1..20 (default the element's)", 1, 20, 0, NULL, NULL, NULL},
-      {"--no-simplify", NULL, CLI_FLAG, &no_simplify, NULL,
-       "keep the initial (tetrahedralized) rules", 0, 0, 0, NULL, NULL, NULL},
-      {"--stabilization", NULL, CLI_DOUBLE, &alpha, "A",
-       "append the full cell's rule x A to cut cells,\n"
-       "A in [0, 1] (0: off; default 1e-6)",
-       0, 1, 0, NULL, NULL, NULL},
-      {"--min-fraction", NULL, CLI_DOUBLE, &phimin, "PHI",
-       "drop cells with volume fraction below PHI, in [0, 1]\n(default 1e-4)", 0, 1, 0, NULL, NULL,
-       NULL},
-      {"--dump", NULL, CLI_STRING, &dump, "FILE",
-       "one line per stiffness point:\n"
-       "cell xi eta zeta X Y Z w_ref w_phys flag\n"
-       "(w_phys = w_ref |J|; flag 0 embedded, 1 stabilization)",
-       0, 0, 0, NULL, NULL, NULL},
-      {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
-  const int prc = fcm_quadrature_parse(opts, argc, argv, embed_usage);
-  if (prc >= 0) return prc;
-  const int simplify = !no_simplify;
-  const char *missing = type == FCM_ELEMENT_COUNT ? "--element"
-                        : !have_box               ? "--box"
-                        : !cells[0]               ? "--cells"
-                        : !geometry               ? "--geometry"
-                        : !strength               ? "--strength"
-                                                  : NULL;
+  const char *missing = a->type == FCM_ELEMENT_COUNT ? "--element"
+                        : !a->have_box               ? "--box"
+                        : !a->cells[0]               ? "--cells"
+                        : !a->geometry               ? "--geometry"
+                        : !a->strength               ? "--strength"
+                                                     : NULL;
   if (missing) {
     fprintf(stderr, "fcm-quadrature embed: %s is required (see --help)\n", missing);
     return 2;
   }
   for (int d = 0; d < 3; d++)
-    if (!(box[d] < box[d + 3])) {
+    if (!(a->box[d] < a->box[d + 3])) {
       fprintf(stderr, "fcm-quadrature embed: --box: X0 Y0 Z0 must be below X1 Y1 Z1\n");
       return 2;
     }
+  return -1;
+}
+
+/* The cell rules options of the command line. */
+static fcm_cell_rules_options embed_rules_options(const embed_args *a)
+{
+  fcm_cell_rules_options ro = fcm_cell_rules_options_default();
+  ro.strength[FCM_RULE_STIFFNESS] = a->strength;
+  if (a->mstrength) ro.strength[FCM_RULE_MASS] = a->mstrength;
+  ro.simplify = !a->no_simplify;
+  ro.min_fraction = a->phimin;
+  if (a->alpha > 0)
+    ro.stabilization.alpha = a->alpha;
+  else
+    ro.stabilization.mode = FCM_STABILIZATION_OFF;
+  return ro;
+}
+
+/* The background grid, the geometry and the cell rules with their statistics on stdout (and
+ * the points into --dump); the exit code. */
+static int embed_run(const embed_args *a)
+{
+  int rc = 1;
   fcm_ctx *ctx = NULL;
   fcm_mesh *mesh = NULL;
   fcm_geometry *geom = NULL;
@@ -357,12 +343,12 @@ int fcm_quadrature_cmd_embed(int argc, char **argv)
   FILE *out = NULL;
   cli_output *outf = NULL;
   if (fcm_ctx_create(NULL, &ctx) != FCM_OK) return 1;
-  const fcm_index n[3] = {cells[0], cells[1], cells[2]};
-  if (fcm_mesh_create_box(ctx, type, box, box + 3, n, &mesh) != FCM_OK) {
+  const fcm_index n[3] = {a->cells[0], a->cells[1], a->cells[2]};
+  if (fcm_mesh_create_box(ctx, a->type, a->box, a->box + 3, n, &mesh) != FCM_OK) {
     fcm_ctx_error_view(ctx, stderr);
     goto done;
   }
-  fcm_status st = load_geometry(ctx, geometry, fill_holes, max_volume, &geom);
+  fcm_status st = load_geometry(ctx, a->geometry, a->fill_holes, a->max_volume, &geom);
   if (st != FCM_OK) {
     if (fcm_ctx_error_status(ctx) != FCM_OK)
       fcm_ctx_error_view(ctx, stderr);
@@ -370,19 +356,11 @@ int fcm_quadrature_cmd_embed(int argc, char **argv)
       fprintf(stderr,
               "fcm-quadrature embed: --geometry '%s': not a readable file or a shape "
               "spec (see --help)\n",
-              geometry);
+              a->geometry);
     rc = 2;
     goto done;
   }
-  fcm_cell_rules_options ro = fcm_cell_rules_options_default();
-  ro.strength[FCM_RULE_STIFFNESS] = strength;
-  if (mstrength) ro.strength[FCM_RULE_MASS] = mstrength;
-  ro.simplify = simplify;
-  ro.min_fraction = phimin;
-  if (alpha > 0)
-    ro.stabilization.alpha = alpha;
-  else
-    ro.stabilization.mode = FCM_STABILIZATION_OFF;
+  const fcm_cell_rules_options ro = embed_rules_options(a);
   fprintf(stderr, "fcm-quadrature embed: %lld background cells, %lld embedded cells ...\n",
           (long long)fcm_mesh_num_cells(mesh), (long long)fcm_geometry_num_cells(geom));
   if (fcm_cell_rules_create(ctx, mesh, geom, &ro, &rules) != FCM_OK) {
@@ -390,8 +368,8 @@ int fcm_quadrature_cmd_embed(int argc, char **argv)
     goto done;
   }
   fcm_cell_rules_view(rules, stdout);
-  if (dump) {
-    if (!(out = cli_output_open("fcm-quadrature", dump, &outf))) goto done;
+  if (a->dump) {
+    if (!(out = cli_output_open("fcm-quadrature", a->dump, &outf))) goto done;
     if (fcm_cell_rules_view_points(rules, mesh, FCM_RULE_STIFFNESS, out) != FCM_OK) {
       fcm_ctx_error_view(ctx, stderr);
       goto done;
@@ -407,4 +385,54 @@ done:
   fcm_mesh_destroy(&mesh);
   fcm_ctx_destroy(&ctx);
   return rc;
+}
+
+int fcm_quadrature_cmd_embed(int argc, char **argv)
+{
+  embed_args a = {
+      FCM_ELEMENT_COUNT, {0, 0, 0, 0, 0, 0}, 1e-6, 1e-4, 0.0, {0, 0, 0}, 0, 0, 0, 0, 0, NULL, NULL};
+  const cli_option opts[] = {
+      {"--element", NULL, CLI_CUSTOM, &a.type, "E", "background element: tet4, tet10, hex8, hex20",
+       0, 0, 0, NULL, cli_element, NULL},
+      {"--box", NULL, CLI_DOUBLE, a.box, "X0 Y0 Z0 X1 Y1 Z1", "background box corners", -1e12, 1e12,
+       0, NULL, NULL, &a.have_box},
+      {"--cells", NULL, CLI_INT, a.cells, "NX NY NZ", "background cells per direction, 1..100000",
+       1, 100000, 0, NULL, NULL, NULL},
+      {"--geometry", NULL, CLI_STRING, &a.geometry, "FILE|SHAPE",
+       "by extension: Gmsh .msh (tetrahedra), TetGen\n"
+       "FILE.node / FILE.ele (both read), a closed triangle\n"
+       "surface .obj, .off, .stl, .ply (tetrahedralized\n"
+       "with Gmsh), a voxel image .nrrd, .nhdr, .mhd, .mha\n"
+       "(voxels >= 0.5, merged into boxes); or a shape: ball:CX,CY,CZ,R,N |\n"
+       "hemisphere:CX,CY,CZ,R,N | box:X0,Y0,Z0,X1,Y1,Z1,N",
+       0, 0, 0, NULL, NULL, NULL},
+      {"--fill-holes", NULL, CLI_FLAG, &a.fill_holes, NULL,
+       "surfaces: close holes before tetrahedralizing", 0, 0, 0, NULL, NULL, NULL},
+      {"--max-volume", NULL, CLI_DOUBLE, &a.max_volume, "V",
+       "surfaces: largest tet volume wanted (default 0:\nsizes follow the surface)", 0, 1e300, 0,
+       NULL, NULL, NULL},
+      {"--strength", NULL, CLI_INT, &a.strength, "M", "stiffness rule strength 1..20", 1, 20, 0,
+       NULL, NULL, NULL},
+      {"--mass-strength", NULL, CLI_INT, &a.mstrength, "M",
+       "mass rule strength 1..20 (default the element's)", 1, 20, 0, NULL, NULL, NULL},
+      {"--no-simplify", NULL, CLI_FLAG, &a.no_simplify, NULL,
+       "keep the initial (tetrahedralized) rules", 0, 0, 0, NULL, NULL, NULL},
+      {"--stabilization", NULL, CLI_DOUBLE, &a.alpha, "A",
+       "append the full cell's rule x A to cut cells,\n"
+       "A in [0, 1] (0: off; default 1e-6)",
+       0, 1, 0, NULL, NULL, NULL},
+      {"--min-fraction", NULL, CLI_DOUBLE, &a.phimin, "PHI",
+       "drop cells with volume fraction below PHI, in [0, 1]\n(default 1e-4)", 0, 1, 0, NULL, NULL,
+       NULL},
+      {"--dump", NULL, CLI_STRING, &a.dump, "FILE",
+       "one line per stiffness point:\n"
+       "cell xi eta zeta X Y Z w_ref w_phys flag\n"
+       "(w_phys = w_ref |J|; flag 0 embedded, 1 stabilization)",
+       0, 0, 0, NULL, NULL, NULL},
+      {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
+  const int prc = fcm_quadrature_parse(opts, argc, argv, embed_usage);
+  if (prc >= 0) return prc;
+  const int crc = embed_check(&a);
+  if (crc >= 0) return crc;
+  return embed_run(&a);
 }

@@ -171,7 +171,8 @@ int main(int argc, char **argv)
 static table results;
 
 /* The settings from the command line, validated, with the defaults filled in: -1 to go on, or
- * the exit code (0 after --help, 2 on a usage error). */
+ * the exit code (0 after --help, 2 on a usage error). It stays long: it is one table of the
+ * options with their checks, and splitting it would scatter them. */
 static int parse_options(int argc, char **argv, settings *o)
 {
   memset(o, 0, sizeof *o);

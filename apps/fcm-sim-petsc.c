@@ -283,9 +283,6 @@ done:
   return rc;
 }
 
-/* A scene the linear driver runs (fcm_petsc_problem_create_from_scene()): its own steps, frames
- * (<name>.pvd naming the .pvtu frames), log and checkpoints (<name>_checkpoint_NNNNNN.fcmpk);
- * --resume: every process reads the checkpoint. Returns the exit code (this process's). */
 /* The linear driver's summary (process 0): partition, DOFs and elements per process, steps and
  * iterations, times, and per DOF; pvdpath NULL: no output written. */
 static void linear_summary(const char *name, int size, const fcm_petsc_info *info, double t_setup,
@@ -306,22 +303,118 @@ static void linear_summary(const char *name, int size, const fcm_petsc_info *inf
   if (pvdpath) printf("  output    %s, %s\n", pvdpath, logpath);
 }
 
+/* The linear driver's run: its problem, its output and its step log. */
+typedef struct linear_run {
+  fcm_ctx *ctx;
+  fcm_petsc_problem *P;
+  fcm_pvd *pvd;  /* process 0, when writing */
+  run_log *rows; /* nsteps rows */
+  const char *dir, *name;
+  char logpath[4200], pvdpath[4200];
+  int write, talk, rank;
+  int interval, ck_every; /* frame and checkpoint intervals (steps) */
+  long long nsteps;
+  int frame; /* the next frame's index */
+} linear_run;
+
+/* Process 0, when writing: the output directory and the PVD; resuming from step first, the
+ * earlier frames (0, interval, 2 interval, ... <= first) indexed again and the earlier log
+ * rows kept. 0 after reporting a failure. */
+static int linear_output_open(linear_run *L, double dt, int resume, long long first)
+{
+  int ok =
+      cli_make_dirs("fcm-sim", L->dir) && fcm_pvd_create(L->ctx, L->pvdpath, &L->pvd) == FCM_OK;
+  for (long long k = 0; ok && resume && k <= first && k <= L->nsteps; k += L->interval) {
+    char file[600];
+    snprintf(file, sizeof file, "%s_%04d.pvtu", L->name, L->frame++);
+    ok = fcm_pvd_add(L->pvd, (double)k * dt, file) == FCM_OK;
+  }
+  if (resume && first <= L->nsteps) read_old_log(L->logpath, L->rows, first);
+  if (!ok && fcm_ctx_error_status(L->ctx) != FCM_OK)
+    fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(L->ctx));
+  return ok;
+}
+
+/* After step k (collective): the frame and the log when due, the checkpoint when due; 0 after
+ * reporting a failure. */
+static int linear_step_output(linear_run *L, long long k, double time)
+{
+  if (L->write && (k % L->interval == 0 || k == L->nsteps)) {
+    if (!write_frame(L->ctx, L->P, L->dir, L->name, L->frame++, time, L->pvd, L->rank)) return 0;
+    int ok = L->rank != 0 || write_log(L->ctx, L->logpath, L->rows, k) == FCM_OK;
+    if (!ok) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(L->ctx));
+    MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (!ok) return 0;
+  }
+  if (L->write && L->ck_every > 0 && k % L->ck_every == 0) {
+    char ck[4300];
+    snprintf(ck, sizeof ck, "%s/%s_checkpoint_%06lld.fcmpk", L->dir, L->name, k);
+    if (fcm_petsc_problem_write_checkpoint(L->P, ck) != FCM_OK) {
+      if (L->rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(L->ctx));
+      return 0;
+    }
+    if (L->talk) fprintf(stderr, "fcm-sim: checkpoint %s\n", ck);
+  }
+  return 1;
+}
+
+/* Steps first + 1 .. nsteps (collective), each logged into rows with its wall time since t1,
+ * and its output; 0 after reporting a failure. */
+static int linear_steps(linear_run *L, long long first, double t1)
+{
+  for (long long k = first + 1; k <= L->nsteps; k++) {
+    fcm_petsc_step_info si;
+    fcm_status st = fcm_petsc_problem_step(L->P, &si);
+    if (st != FCM_OK) {
+      if (L->rank == 0)
+        fprintf(stderr, "fcm-sim: step %lld: %s\n", k, fcm_ctx_error_message(L->ctx));
+      if (L->write && L->rank == 0) write_log(L->ctx, L->logpath, L->rows, k - 1);
+      return 0;
+    }
+    L->rows[k - 1] = (run_log){k,
+                               si.time,
+                               si.residual,
+                               si.kinetic_energy,
+                               si.elastic_energy,
+                               si.external_work,
+                               fcm_wtime() - t1,
+                               si.iterations};
+    if (L->talk)
+      fprintf(stderr, "fcm-sim: step %lld/%lld t = %.6g s: KSP %d iterations, residual %.3g\n", k,
+              L->nsteps, si.time, si.iterations, si.residual);
+    if (!linear_step_output(L, k, si.time)) return 0;
+  }
+  return 1;
+}
+
+/* Whether the state (u, v) of the n DOFs, read into u and v, is finite. */
+static int linear_state_finite(fcm_petsc_problem *P, fcm_index n, double *u, double *v)
+{
+  int finite = fcm_petsc_problem_get_state(P, u, v) == FCM_OK;
+  for (fcm_index i = 0; finite && i < n; i++)
+    finite = isfinite(u[i]) && isfinite(v[i]);
+  return finite;
+}
+
+/* A scene the linear driver runs (fcm_petsc_problem_create_from_scene()): its own steps, frames
+ * (<name>.pvd naming the .pvtu frames), log and checkpoints (<name>_checkpoint_NNNNNN.fcmpk);
+ * --resume: every process reads the checkpoint. Returns the exit code (this process's). */
 static int run_linear(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, long long steps,
                       int check, int quiet, int checkpoint_every, const char *resume, int rank,
                       int size)
 {
   int rc = 1;
-  const char *name = fcm_scene_name(scene);
-  const int talk = rank == 0 && !quiet;
-  fcm_petsc_problem *P = NULL;
-  fcm_pvd *pvd = NULL;
+  linear_run L = {0};
+  L.ctx = ctx;
+  L.name = fcm_scene_name(scene);
+  L.talk = rank == 0 && !quiet;
+  L.rank = rank;
   double *u = NULL, *v = NULL;
-  run_log *rows = NULL;
   double t0 = fcm_wtime();
-  fcm_status st =
-      fcm_petsc_problem_create_from_scene(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO, &P);
+  fcm_status st = fcm_petsc_problem_create_from_scene(ctx, MPI_COMM_WORLD, scene,
+                                                      FCM_PETSC_PARTITION_AUTO, &L.P);
   if (st != FCM_OK) { /* every process has the error; process 0 prints it */
-    if (rank == 0) fprintf(stderr, "fcm-sim: scene %s: %s\n", name, fcm_ctx_error_message(ctx));
+    if (rank == 0) fprintf(stderr, "fcm-sim: scene %s: %s\n", L.name, fcm_ctx_error_message(ctx));
     rc = st == FCM_ERR_ARG || st == FCM_ERR_IO || st == FCM_ERR_FORMAT || st == FCM_ERR_GEOMETRY ||
                  st == FCM_ERR_UNSUPPORTED
              ? 2
@@ -329,115 +422,63 @@ static int run_linear(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, 
     goto done;
   }
   const double t_setup = fcm_wtime() - t0;
-  long long nsteps = (long long)fcm_scene_get_time(scene)->num_steps;
-  if (steps > 0 && steps < nsteps) nsteps = steps;
-  if (check && nsteps > 3) nsteps = 3;
-  const int write = !check;
-  const char *dir = outdir ? outdir : fcm_scene_get_output(scene)->directory;
-  const int interval = fcm_scene_get_output(scene)->frame_interval > 0
-                           ? fcm_scene_get_output(scene)->frame_interval
-                           : 1;
-  const fcm_index n = fcm_petsc_problem_num_dofs(P);
-  char logpath[4200], pvdpath[4200];
-  int frame = 0, ok = 1;
+  L.nsteps = (long long)fcm_scene_get_time(scene)->num_steps;
+  if (steps > 0 && steps < L.nsteps) L.nsteps = steps;
+  if (check && L.nsteps > 3) L.nsteps = 3;
+  L.write = !check;
+  L.dir = outdir ? outdir : fcm_scene_get_output(scene)->directory;
+  L.interval = fcm_scene_get_output(scene)->frame_interval > 0
+                   ? fcm_scene_get_output(scene)->frame_interval
+                   : 1;
+  const fcm_index n = fcm_petsc_problem_num_dofs(L.P);
+  int ok = 1;
   long long first = 0;
-  const int ck_every =
+  L.ck_every =
       checkpoint_every >= 0 ? checkpoint_every : fcm_scene_get_output(scene)->checkpoint_interval;
   if (resume) { /* every process reads the checkpoint */
-    st = fcm_petsc_problem_read_checkpoint(P, resume);
+    st = fcm_petsc_problem_read_checkpoint(L.P, resume);
     if (st != FCM_OK) {
       if (rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
       rc = 2;
       goto done;
     }
-    first = fcm_petsc_problem_step_count(P);
-    if (talk) fprintf(stderr, "fcm-sim: resumed from %s at step %lld\n", resume, first);
+    first = fcm_petsc_problem_step_count(L.P);
+    if (L.talk) fprintf(stderr, "fcm-sim: resumed from %s at step %lld\n", resume, first);
   }
   u = calloc((size_t)n + 1, sizeof *u);
   v = calloc((size_t)n + 1, sizeof *v);
-  rows = calloc((size_t)nsteps + 1, sizeof *rows);
-  if (!u || !v || !rows) {
+  L.rows = calloc((size_t)L.nsteps + 1, sizeof *L.rows);
+  if (!u || !v || !L.rows) {
     fprintf(stderr, "fcm-sim: out of memory\n");
     MPI_Abort(MPI_COMM_WORLD, 1); /* a local failure the others cannot learn otherwise */
   }
-  snprintf(logpath, sizeof logpath, "%s/%s_log.csv", dir, name);
-  snprintf(pvdpath, sizeof pvdpath, "%s/%s.pvd", dir, name);
-  if (write && rank == 0) {
-    ok = cli_make_dirs("fcm-sim", dir) && fcm_pvd_create(ctx, pvdpath, &pvd) == FCM_OK;
-    /* resuming: the earlier frames (0, interval, 2 interval, ... <= first) are indexed again and
-     * the earlier log rows kept */
-    const double dt = fcm_scene_get_time(scene)->dt;
-    for (long long k = 0; ok && resume && k <= first && k <= nsteps; k += interval) {
-      char file[600];
-      snprintf(file, sizeof file, "%s_%04d.pvtu", name, frame++);
-      ok = fcm_pvd_add(pvd, (double)k * dt, file) == FCM_OK;
-    }
-    if (resume && first <= nsteps) read_old_log(logpath, rows, first);
-    if (!ok && fcm_ctx_error_status(ctx) != FCM_OK)
-      fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
-  }
+  snprintf(L.logpath, sizeof L.logpath, "%s/%s_log.csv", L.dir, L.name);
+  snprintf(L.pvdpath, sizeof L.pvdpath, "%s/%s.pvd", L.dir, L.name);
+  if (L.write && rank == 0)
+    ok = linear_output_open(&L, fcm_scene_get_time(scene)->dt, resume != NULL, first);
   MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  MPI_Bcast(&frame, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  if (!ok || (write && !resume && !write_frame(ctx, P, dir, name, frame++, 0.0, pvd, rank)))
+  MPI_Bcast(&L.frame, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (!ok ||
+      (L.write && !resume && !write_frame(ctx, L.P, L.dir, L.name, L.frame++, 0.0, L.pvd, rank)))
     goto done;
   double t1 = fcm_wtime();
-  for (long long k = first + 1; k <= nsteps; k++) {
-    fcm_petsc_step_info si;
-    st = fcm_petsc_problem_step(P, &si);
-    if (st != FCM_OK) {
-      if (rank == 0) fprintf(stderr, "fcm-sim: step %lld: %s\n", k, fcm_ctx_error_message(ctx));
-      if (write && rank == 0) write_log(ctx, logpath, rows, k - 1);
-      goto done;
-    }
-    rows[k - 1] = (run_log){k,
-                            si.time,
-                            si.residual,
-                            si.kinetic_energy,
-                            si.elastic_energy,
-                            si.external_work,
-                            fcm_wtime() - t1,
-                            si.iterations};
-    if (talk)
-      fprintf(stderr, "fcm-sim: step %lld/%lld t = %.6g s: KSP %d iterations, residual %.3g\n", k,
-              nsteps, si.time, si.iterations, si.residual);
-    if (write && (k % interval == 0 || k == nsteps)) {
-      if (!write_frame(ctx, P, dir, name, frame++, si.time, pvd, rank)) goto done;
-      ok = rank != 0 || write_log(ctx, logpath, rows, k) == FCM_OK;
-      if (!ok) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
-      MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
-      if (!ok) goto done;
-    }
-    if (write && ck_every > 0 && k % ck_every == 0) {
-      char ck[4300];
-      snprintf(ck, sizeof ck, "%s/%s_checkpoint_%06lld.fcmpk", dir, name, k);
-      if (fcm_petsc_problem_write_checkpoint(P, ck) != FCM_OK) {
-        if (rank == 0) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
-        goto done;
-      }
-      if (talk) fprintf(stderr, "fcm-sim: checkpoint %s\n", ck);
-    }
-  }
+  if (!linear_steps(&L, first, t1)) goto done;
   fcm_petsc_info info;
-  if (fcm_petsc_problem_get_info(P, &info) != FCM_OK) goto done;
-  if (check) {
-    st = fcm_petsc_problem_get_state(P, u, v);
-    int finite = st == FCM_OK;
-    for (fcm_index i = 0; finite && i < n; i++)
-      finite = isfinite(u[i]) && isfinite(v[i]);
-    if (!finite) {
-      if (rank == 0) fprintf(stderr, "fcm-sim: non-finite state after %lld steps\n", nsteps);
-      goto done;
-    }
+  if (fcm_petsc_problem_get_info(L.P, &info) != FCM_OK) goto done;
+  if (check && !linear_state_finite(L.P, n, u, v)) {
+    if (rank == 0) fprintf(stderr, "fcm-sim: non-finite state after %lld steps\n", L.nsteps);
+    goto done;
   }
-  if (talk)
-    linear_summary(name, size, &info, t_setup, fcm_wtime() - t1, write ? pvdpath : NULL, logpath);
+  if (L.talk)
+    linear_summary(L.name, size, &info, t_setup, fcm_wtime() - t1, L.write ? L.pvdpath : NULL,
+                   L.logpath);
   rc = 0;
 done:
-  fcm_pvd_destroy(&pvd);
+  fcm_pvd_destroy(&L.pvd);
   free(u);
   free(v);
-  free(rows);
-  fcm_petsc_problem_destroy(&P);
+  free(L.rows);
+  fcm_petsc_problem_destroy(&L.P);
   return rc;
 }
 

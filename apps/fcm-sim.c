@@ -360,6 +360,127 @@ static fcm_status on_step(void *user, fcm_simulation *sim, const fcm_simulation_
   return FCM_OK;
 }
 
+/* --backend petsc: the PETSc driver with the PETSc arguments pargv, or why it cannot run;
+ * the exit code. */
+static int run_petsc_backend(const scene_options *o, int pargc, char **pargv)
+{
+#if FCM_HAVE_PETSC
+  return o->print_scene
+             ? (fprintf(stderr, "fcm-sim: --backend petsc: --print-scene is the "
+                                "serial backend's (drop --backend)\n"),
+                2)
+             : sim_petsc_run(o->path, o->outdir, o->steps, o->check, o->quiet,
+                             o->check ? 0 : o->checkpoint_every, o->resume, pargc, pargv);
+#else
+  (void)o;
+  (void)pargc;
+  (void)pargv;
+  fprintf(stderr, "fcm-sim: --backend petsc: this fcm was built without PETSc (CMake option "
+                  "FCM_WITH_PETSC; Debian: bash setup.sh deps --petsc, then rebuild)\n");
+  return 2;
+#endif
+}
+
+/* The simulation options of the command line: the step limit, the checkpoint interval and
+ * the progress reports of the build (into rps). */
+static fcm_simulation_options simulation_options(const scene_options *o, rules_progress_state *rps)
+{
+  fcm_simulation_options so = fcm_simulation_options_default();
+  so.max_steps = o->check ? (o->steps > 0 && o->steps < 3 ? o->steps : 3)
+                          : (o->steps > 0 ? o->steps : FCM_DEFAULT);
+  so.checkpoint_interval = o->check ? 0 : o->checkpoint_every;
+  if (rps->tty || (o->progress && !o->quiet)) {
+    so.rules_progress = rules_progress;
+    so.rules_progress_user = rps;
+    so.rules_progress_interval = rps->tty ? 0.2 : 2.0;
+    so.geometry_progress = geometry_progress;
+    so.geometry_progress_user = rps;
+  }
+  return so;
+}
+
+/* Build the simulation of the scene (and resume it from the checkpoint of --resume); 0, or the
+ * exit code after reporting why not. */
+static int build_simulation(fcm_ctx *ctx, fcm_scene *scene, const scene_options *o,
+                            rules_progress_state *rps, fcm_simulation **sim)
+{
+  const fcm_simulation_options so = simulation_options(o, rps);
+  const char *name = fcm_scene_name(scene);
+  if (!o->quiet)
+    fprintf(stderr, "fcm-sim: scene %s (%s): building\n", name, fcm_scene_source(scene));
+  fcm_status st = fcm_simulation_create(ctx, scene, &so, sim);
+  if (st != FCM_OK) {
+    if (o->debug)
+      fcm_ctx_error_view(ctx, stderr);
+    else
+      fprintf(stderr, "fcm-sim: scene %s: %s\n", name, fcm_ctx_error_message(ctx));
+    return build_exit_code(st);
+  }
+  warn_outside(*sim);
+  if (o->resume) {
+    if (fcm_simulation_read_checkpoint(*sim, o->resume) != FCM_OK) {
+      fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+      return 2;
+    }
+    if (!o->quiet)
+      fprintf(stderr, "fcm-sim: resumed from %s at step %lld (t = %.9g s)\n", o->resume,
+              fcm_simulation_step_count(*sim),
+              fcm_integrator_time(fcm_simulation_integrator(*sim)));
+  }
+  return 0;
+}
+
+/* The output directory, the log path <dir>/<name>_log.csv (logsize bytes) and, unless the run
+ * resumes, frame *frame (counted); 0 after reporting a failure. */
+static int start_output(fcm_ctx *ctx, fcm_simulation *sim, const scene_options *o, const char *dir,
+                        const char *name, char *logpath, size_t logsize, int *frame)
+{
+  if (!cli_make_dirs("fcm-sim", dir)) return 0;
+  snprintf(logpath, logsize, "%s/%s_log.csv", dir, name);
+  if ((!o->resume && fcm_simulation_write_frame(sim, dir, (*frame)++) != FCM_OK) ||
+      fcm_simulation_write_log(sim, logpath) != FCM_OK) {
+    report_error(ctx, o->debug, "writing the output");
+    return 0;
+  }
+  return 1;
+}
+
+/* After fcm_simulation_run() returned st: the failed step's error (unless the monitor said
+ * why), the final log and the summary; the exit code. */
+static int finish_run(fcm_simulation *sim, fcm_status st, const run_state *rs, int frames_at_start)
+{
+  const scene_options *o = rs->o;
+  const char *dir = rs->dir, *name = rs->name;
+  if (st != FCM_OK) {
+    if (rs->stopped) return 1; /* the monitor said why */
+    if (rs->tty) fputc('\n', stderr);
+    char what[160];
+    snprintf(what, sizeof what, "scene %s: step %lld (t = %.6g s)", name,
+             fcm_simulation_step_count(sim) + 1,
+             fcm_integrator_time(fcm_simulation_integrator(sim)));
+    report_error(rs->ctx, o->debug, what);
+    if (rs->write && fcm_simulation_write_log(sim, rs->logpath) != FCM_OK)
+      report_error(rs->ctx, o->debug, "writing the log");
+    return 1;
+  }
+  if (rs->write && fcm_simulation_write_log(sim, rs->logpath) != FCM_OK) {
+    report_error(rs->ctx, o->debug, "writing the log");
+    return 1;
+  }
+  if (!o->quiet) {
+    fcm_simulation_summary_view(sim, stdout);
+    if (rs->write) {
+      fcm_simulation_counters c;
+      fcm_simulation_get_counters(sim, &c);
+      if (c.frames > 0 && (int)c.frames > frames_at_start)
+        printf("  output    %s/%s_background.pvd, %s/%s_log.csv\n", dir, name, dir, name);
+      else
+        printf("  output    %s/%s_log.csv (no new frame)\n", dir, name);
+    }
+  }
+  return 0;
+}
+
 static int scene_main(int argc, char **argv)
 {
   scene_options o = {NULL, NULL, NULL, 0, -1, 0, 0, 0, 0, 0, 0};
@@ -369,20 +490,7 @@ static int scene_main(int argc, char **argv)
   cli_split_petsc_args(&argc, argv, &pargc, pargv);
   const int parsed = parse_scene_args(argc, argv, &o);
   if (parsed >= 0 || o.backend == 1) {
-    int rc = parsed;
-    if (parsed < 0) {
-#if FCM_HAVE_PETSC
-      rc = o.print_scene ? (fprintf(stderr, "fcm-sim: --backend petsc: --print-scene is the "
-                                            "serial backend's (drop --backend)\n"),
-                            2)
-                         : sim_petsc_run(o.path, o.outdir, o.steps, o.check, o.quiet,
-                                         o.check ? 0 : o.checkpoint_every, o.resume, pargc, pargv);
-#else
-      fprintf(stderr, "fcm-sim: --backend petsc: this fcm was built without PETSc (CMake option "
-                      "FCM_WITH_PETSC; Debian: bash setup.sh deps --petsc, then rebuild)\n");
-      rc = 2;
-#endif
-    }
+    const int rc = parsed >= 0 ? parsed : run_petsc_backend(&o, pargc, pargv);
     free(pargv);
     return rc;
   }
@@ -414,41 +522,11 @@ static int scene_main(int argc, char **argv)
   }
   if (fcm_scene_get_solver(scene)->threads > 0) /* every OpenMP loop of the run */
     omp_set_num_threads(fcm_scene_get_solver(scene)->threads);
-  fcm_simulation_options so = fcm_simulation_options_default();
-  so.max_steps =
-      o.check ? (o.steps > 0 && o.steps < 3 ? o.steps : 3) : (o.steps > 0 ? o.steps : FCM_DEFAULT);
-  so.checkpoint_interval = o.check ? 0 : o.checkpoint_every;
   rules_progress_state rps = {!o.quiet && isatty(2), fcm_wtime()};
-  if (rps.tty || (o.progress && !o.quiet)) {
-    so.rules_progress = rules_progress;
-    so.rules_progress_user = &rps;
-    so.rules_progress_interval = rps.tty ? 0.2 : 2.0;
-    so.geometry_progress = geometry_progress;
-    so.geometry_progress_user = &rps;
-  }
+  rc = build_simulation(ctx, scene, &o, &rps, &sim);
+  if (rc != 0) goto done;
+  rc = 1;
   const char *name = fcm_scene_name(scene);
-  if (!o.quiet)
-    fprintf(stderr, "fcm-sim: scene %s (%s): building\n", name, fcm_scene_source(scene));
-  st = fcm_simulation_create(ctx, scene, &so, &sim);
-  if (st != FCM_OK) {
-    if (o.debug)
-      fcm_ctx_error_view(ctx, stderr);
-    else
-      fprintf(stderr, "fcm-sim: scene %s: %s\n", name, fcm_ctx_error_message(ctx));
-    rc = build_exit_code(st);
-    goto done;
-  }
-  warn_outside(sim);
-  if (o.resume) {
-    if (fcm_simulation_read_checkpoint(sim, o.resume) != FCM_OK) {
-      fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
-      rc = 2;
-      goto done;
-    }
-    if (!o.quiet)
-      fprintf(stderr, "fcm-sim: resumed from %s at step %lld (t = %.9g s)\n", o.resume,
-              fcm_simulation_step_count(sim), fcm_integrator_time(fcm_simulation_integrator(sim)));
-  }
   const char *dir = o.outdir ? o.outdir : fcm_scene_get_output(scene)->directory;
   int write = !o.check;
   fcm_simulation_counters c;
@@ -457,45 +535,11 @@ static int scene_main(int argc, char **argv)
   /* warn once of each: an earlier run (a resumed checkpoint) may have warned already */
   int warned_inverted = c.inverted_steps > 0, warned_nonfinite = c.nonfinite_frames > 0;
   int tty = !o.quiet && isatty(2);
-  if (write) {
-    if (!cli_make_dirs("fcm-sim", dir)) goto done;
-    snprintf(logpath, sizeof logpath, "%s/%s_log.csv", dir, name);
-    if ((!o.resume && fcm_simulation_write_frame(sim, dir, frame++) != FCM_OK) ||
-        fcm_simulation_write_log(sim, logpath) != FCM_OK) {
-      report_error(ctx, o.debug, "writing the output");
-      goto done;
-    }
-  }
+  if (write && !start_output(ctx, sim, &o, dir, name, logpath, sizeof logpath, &frame)) goto done;
   run_state rs = {ctx, &o, dir, name, logpath, write, tty, frame, warned_inverted, warned_nonfinite,
                   0};
   st = fcm_simulation_run(sim, on_step, &rs);
-  if (st != FCM_OK) {
-    if (rs.stopped) goto done; /* the monitor said why */
-    if (tty) fputc('\n', stderr);
-    char what[160];
-    snprintf(what, sizeof what, "scene %s: step %lld (t = %.6g s)", name,
-             fcm_simulation_step_count(sim) + 1,
-             fcm_integrator_time(fcm_simulation_integrator(sim)));
-    report_error(ctx, o.debug, what);
-    if (write && fcm_simulation_write_log(sim, logpath) != FCM_OK)
-      report_error(ctx, o.debug, "writing the log");
-    goto done;
-  }
-  if (write && fcm_simulation_write_log(sim, logpath) != FCM_OK) {
-    report_error(ctx, o.debug, "writing the log");
-    goto done;
-  }
-  if (!o.quiet) {
-    fcm_simulation_summary_view(sim, stdout);
-    if (write) {
-      fcm_simulation_get_counters(sim, &c);
-      if (c.frames > 0 && (int)c.frames > frames_at_start)
-        printf("  output    %s/%s_background.pvd, %s/%s_log.csv\n", dir, name, dir, name);
-      else
-        printf("  output    %s/%s_log.csv (no new frame)\n", dir, name);
-    }
-  }
-  rc = 0;
+  rc = finish_run(sim, st, &rs, frames_at_start);
 done:
   fcm_simulation_destroy(&sim);
   fcm_scene_destroy(&scene);

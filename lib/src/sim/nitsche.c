@@ -149,57 +149,62 @@ static void traction_modes(int nn, const double *g, const double *N, const int *
   }
 }
 
-/* Penalties of element e from its points [p0, p1): Nitsche's eigenvalue estimate over its
- * Nitsche points (0 when it has none) into *gamma, and the cell size h_K (the penalty method's
- * gamma is penalty E / h_K) into *hk. */
-static fcm_status element_penalty(fcm_integrator *I, fcm_index e, fcm_index p0, fcm_index p1,
-                                  const fcm_rule *full, double *gamma, double *hk)
+/* The volume rule the assembly integrates element e with (stabilization included): the
+ * stiffness rule of its cut piece, or the standard rule full of an uncut cell. */
+static fcm_status element_volume_rule(fcm_integrator *I, fcm_index e, const fcm_rule *full, int *nq,
+                                      const double **pts, const double **wts)
 {
   fcm_status st = FCM_OK;
-  fcm_ctx *ctx = I->ctx;
   const fcm_space *s = I->space;
-  const int nn = s->nn, nd = 3 * nn;
-  double *K = NULL, *T = NULL, *C = NULL, *R = NULL, *ev = NULL;
-  double X[3 * FCM_ELEMENT_MAX_NODES], g[3 * FCM_ELEMENT_MAX_NODES];
-  const fcm_index cell = s->elem_cell[e];
-  const double lambda = I->params.lambda, mu = I->params.mu;
-  fcm_mesh_cell_coords(s->mesh, cell, X);
-  /* the volume rule the assembly integrates the element with (stabilization included) */
-  int nq = 0;
-  const double *pts = NULL, *wts = NULL;
-  if (s->rules && fcm_cell_rules_class(s->rules, cell) != FCM_CELL_UNCUT) {
-    FCM_TRY(ctx, fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], FCM_RULE_STIFFNESS, &nq, &pts,
-                                          &wts, NULL));
+  if (s->rules && fcm_cell_rules_class(s->rules, s->elem_cell[e]) != FCM_CELL_UNCUT) {
+    FCM_TRY(I->ctx, fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], FCM_RULE_STIFFNESS, nq,
+                                             pts, wts, NULL));
   } else {
-    nq = fcm_rule_num_points(full);
-    pts = fcm_rule_points(full);
-    wts = fcm_rule_weights(full);
+    *nq = fcm_rule_num_points(full);
+    *pts = fcm_rule_points(full);
+    *wts = fcm_rule_weights(full);
   }
-  double vol = 0.0; /* |K|: the standard rule integrates 1 exactly */
-  {
-    const int fq = fcm_rule_num_points(full);
-    for (int q = 0; q < fq; q++) {
-      double J[9];
-      vol += fcm_rule_weights(full)[q] *
-             fcm_element_jacobian(s->type, X, fcm_rule_points(full) + 3 * q, J);
-    }
+cleanup:
+  return st;
+}
+
+/* |K| of the cell with nodes X: the standard rule full integrates 1 exactly. */
+static double cell_volume(fcm_element_type type, const double *X, const fcm_rule *full)
+{
+  double vol = 0.0;
+  const int fq = fcm_rule_num_points(full);
+  for (int q = 0; q < fq; q++) {
+    double J[9];
+    vol +=
+        fcm_rule_weights(full)[q] * fcm_element_jacobian(type, X, fcm_rule_points(full) + 3 * q, J);
   }
-  *hk = cbrt(fabs(vol));
-  *gamma = 0.0;
-  double safety = 0.0; /* the largest safety factor of the element's Nitsche points */
+  return vol;
+}
+
+/* The largest safety factor of the Nitsche points [p0, p1) (0 when there are none). */
+static double nitsche_safety(const fcm_integrator *I, fcm_index p0, fcm_index p1)
+{
+  double safety = 0.0;
   for (fcm_index p = p0; p < p1; p++) {
     const sim_bcon *bc = &I->bcons[I->bp.con[p]];
     if (bc->opts.method == FCM_BOUNDARY_NITSCHE) safety = FCM_MAX(safety, bc->opts.nitsche_safety);
   }
-  if (safety == 0.0) goto cleanup;
-  FCM_ALLOC(ctx, (size_t)nd * nd, K);
-  FCM_ALLOC(ctx, (size_t)nd * nd, T);
-  FCM_ALLOC(ctx, (size_t)3 * nd, C);
-  FCM_ALLOC(ctx, (size_t)6 * nd, R);
-  FCM_ALLOC(ctx, nd, ev);
-  for (int q = 0; q < nq; q++) { /* K, linear elasticity */
+  return safety;
+}
+
+/* Add to K (nd x nd) the linear-elastic stiffness at rest of cell `cell` with nodes X, over
+ * the volume rule (nq, pts, wts). */
+static fcm_status elastic_stiffness(const fcm_integrator *I, fcm_index cell, const double *X,
+                                    int nq, const double *pts, const double *wts, double *K)
+{
+  fcm_status st = FCM_OK;
+  const fcm_space *s = I->space;
+  const int nn = s->nn, nd = 3 * nn;
+  const double lambda = I->params.lambda, mu = I->params.mu;
+  double g[3 * FCM_ELEMENT_MAX_NODES];
+  for (int q = 0; q < nq; q++) {
     double det = gradients(s->type, nn, X, pts + 3 * q, g);
-    FCM_CHECK(det > 0.0, ctx, FCM_ERR_GEOMETRY,
+    FCM_CHECK(det > 0.0, I->ctx, FCM_ERR_GEOMETRY,
               "boundary constraint: cell %lld has det J = %g <= 0 at a quadrature point",
               (long long)cell, det);
     const double wd = wts[q] * det;
@@ -213,7 +218,18 @@ static fcm_status element_penalty(fcm_integrator *I, fcm_index e, fcm_index p0, 
                 wd * (lambda * ga[i] * gb[j] + mu * ga[j] * gb[i] + (i == j ? mu * dd : 0.0));
       }
   }
-  for (fcm_index p = p0; p < p1; p++) { /* T = sum w C^T C */
+cleanup:
+  return st;
+}
+
+/* Add to T (nd x nd) the traction energy sum w C^T C of the Nitsche points [p0, p1); C
+ * (3 x nd) is workspace. */
+static void traction_energy(const fcm_integrator *I, fcm_index p0, fcm_index p1, double *C,
+                            double *T)
+{
+  const int nn = I->space->nn, nd = 3 * nn;
+  const double lambda = I->params.lambda, mu = I->params.mu;
+  for (fcm_index p = p0; p < p1; p++) {
     const sim_bcon *bc = &I->bcons[I->bp.con[p]];
     if (bc->opts.method != FCM_BOUNDARY_NITSCHE) continue;
     traction_modes(nn, I->bp.G + (size_t)p * nd, I->bp.nrm + 3 * p, bc->motion.components, lambda,
@@ -223,51 +239,85 @@ static fcm_status element_penalty(fcm_integrator *I, fcm_index e, fcm_index p0, 
         T[(size_t)x * nd + y] +=
             I->bp.w[p] * (C[x] * C[y] + C[nd + x] * C[nd + y] + C[2 * nd + x] * C[2 * nd + y]);
   }
-  /* Rigid modes (translations, rotations about the centroid), orthonormalized; K and T
-   * vanish on them, so B = K + s R R^T is positive definite and has the same eigenvalues
-   * on their complement. */
-  {
-    double c[3] = {0, 0, 0}, tr = 0.0;
-    for (int a = 0; a < nn; a++)
-      for (int i = 0; i < 3; i++)
-        c[i] += X[3 * a + i] / nn;
-    for (int a = 0; a < nn; a++) {
-      double r[3] = {X[3 * a] - c[0], X[3 * a + 1] - c[1], X[3 * a + 2] - c[2]};
-      for (int i = 0; i < 3; i++) {
-        R[(size_t)i * nd + 3 * a + i] = 1.0;
-        /* rotation about axis i: e_i x r */
-        double *Ri = R + (size_t)(3 + i) * nd + 3 * a;
-        const int j = (i + 1) % 3, k = (i + 2) % 3;
-        Ri[k] = r[j];
-        Ri[j] = -r[k];
-      }
+}
+
+/* Rigid modes (translations, rotations about the centroid) of the cell with nodes X,
+ * orthonormalized into R (6 x nd); K and T vanish on them, so K + s R R^T (s the mean
+ * diagonal of K) is positive definite and has the same eigenvalues on their complement. */
+static void lift_rigid_modes(int nn, const double *X, double *R, double *K)
+{
+  const int nd = 3 * nn;
+  double c[3] = {0, 0, 0}, tr = 0.0;
+  for (int a = 0; a < nn; a++)
+    for (int i = 0; i < 3; i++)
+      c[i] += X[3 * a + i] / nn;
+  for (int a = 0; a < nn; a++) {
+    double r[3] = {X[3 * a] - c[0], X[3 * a + 1] - c[1], X[3 * a + 2] - c[2]};
+    for (int i = 0; i < 3; i++) {
+      R[(size_t)i * nd + 3 * a + i] = 1.0;
+      /* rotation about axis i: e_i x r */
+      double *Ri = R + (size_t)(3 + i) * nd + 3 * a;
+      const int j = (i + 1) % 3, k = (i + 2) % 3;
+      Ri[k] = r[j];
+      Ri[j] = -r[k];
     }
-    for (int pass = 0; pass < 2; pass++) /* modified Gram-Schmidt, twice */
-      for (int m = 0; m < 6; m++) {
-        double *rm = R + (size_t)m * nd;
-        for (int l = 0; l < m; l++) {
-          const double *rl = R + (size_t)l * nd;
-          double d = 0.0;
-          for (int x = 0; x < nd; x++)
-            d += rm[x] * rl[x];
-          for (int x = 0; x < nd; x++)
-            rm[x] -= d * rl[x];
-        }
-        double nrm = 0.0;
-        for (int x = 0; x < nd; x++)
-          nrm += rm[x] * rm[x];
-        nrm = sqrt(nrm);
-        for (int x = 0; x < nd; x++)
-          rm[x] /= nrm;
-      }
-    for (int x = 0; x < nd; x++)
-      tr += K[(size_t)x * nd + x];
-    const double sc = tr / nd;
-    for (int m = 0; m < 6; m++)
-      for (int x = 0; x < nd; x++)
-        for (int y = 0; y < nd; y++)
-          K[(size_t)x * nd + y] += sc * R[(size_t)m * nd + x] * R[(size_t)m * nd + y];
   }
+  for (int pass = 0; pass < 2; pass++) /* modified Gram-Schmidt, twice */
+    for (int m = 0; m < 6; m++) {
+      double *rm = R + (size_t)m * nd;
+      for (int l = 0; l < m; l++) {
+        const double *rl = R + (size_t)l * nd;
+        double d = 0.0;
+        for (int x = 0; x < nd; x++)
+          d += rm[x] * rl[x];
+        for (int x = 0; x < nd; x++)
+          rm[x] -= d * rl[x];
+      }
+      double nrm = 0.0;
+      for (int x = 0; x < nd; x++)
+        nrm += rm[x] * rm[x];
+      nrm = sqrt(nrm);
+      for (int x = 0; x < nd; x++)
+        rm[x] /= nrm;
+    }
+  for (int x = 0; x < nd; x++)
+    tr += K[(size_t)x * nd + x];
+  const double sc = tr / nd;
+  for (int m = 0; m < 6; m++)
+    for (int x = 0; x < nd; x++)
+      for (int y = 0; y < nd; y++)
+        K[(size_t)x * nd + y] += sc * R[(size_t)m * nd + x] * R[(size_t)m * nd + y];
+}
+
+/* Penalties of element e from its points [p0, p1): Nitsche's eigenvalue estimate over its
+ * Nitsche points (0 when it has none) into *gamma, and the cell size h_K (the penalty method's
+ * gamma is penalty E / h_K) into *hk. */
+static fcm_status element_penalty(fcm_integrator *I, fcm_index e, fcm_index p0, fcm_index p1,
+                                  const fcm_rule *full, double *gamma, double *hk)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  const fcm_space *s = I->space;
+  const int nn = s->nn, nd = 3 * nn;
+  double *K = NULL, *T = NULL, *C = NULL, *R = NULL, *ev = NULL;
+  double X[3 * FCM_ELEMENT_MAX_NODES];
+  const fcm_index cell = s->elem_cell[e];
+  fcm_mesh_cell_coords(s->mesh, cell, X);
+  int nq = 0;
+  const double *pts = NULL, *wts = NULL;
+  FCM_TRY(ctx, element_volume_rule(I, e, full, &nq, &pts, &wts));
+  *hk = cbrt(fabs(cell_volume(s->type, X, full)));
+  *gamma = 0.0;
+  const double safety = nitsche_safety(I, p0, p1);
+  if (safety == 0.0) goto cleanup;
+  FCM_ALLOC(ctx, (size_t)nd * nd, K);
+  FCM_ALLOC(ctx, (size_t)nd * nd, T);
+  FCM_ALLOC(ctx, (size_t)3 * nd, C);
+  FCM_ALLOC(ctx, (size_t)6 * nd, R);
+  FCM_ALLOC(ctx, nd, ev);
+  FCM_TRY(ctx, elastic_stiffness(I, cell, X, nq, pts, wts, K));
+  traction_energy(I, p0, p1, C, T);
+  lift_rigid_modes(nn, X, R, K);
   {
     fcm_status s2 = fcm__sygv(ctx, nd, T, nd, K, nd, ev);
     if (s2 == FCM_ERR_SINGULAR) {
@@ -292,104 +342,116 @@ cleanup:
   return st;
 }
 
-fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
+/* One pass over the elements' surface points: pass 0 counts the points each constraint
+ * selects into count, pass 1 stores them (bp, sized by pass 0); *np_out and *ne_out get the
+ * numbers of selected points and of elements with any. */
+static fcm_status collect_points(fcm_integrator *I, int pass, fcm_index *count, fcm_index *np_out,
+                                 fcm_index *ne_out)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = I->ctx;
   const fcm_space *s = I->space;
   sim_bpoints *bp = &I->bp;
-  fcm_index *count = NULL, *ecol = NULL;
-  fcm_rule *full = NULL;
   const int nn = s->nn, nd = 3 * nn;
-  if (I->num_bcons == 0) return FCM_OK;
-  FCM_CHECK(s->rules && fcm_cell_rules_surface_strength(s->rules) >= 0, ctx, FCM_ERR_ARG,
-            "boundary constraint 0: the space has no surface rules (build the cell rules with "
-            "surface_strength >= 0)");
-  FCM_ALLOC(ctx, I->num_bcons, I->bcon_on);
-  FCM_ALLOC(ctx, I->num_bcons, count);
-  FCM_ALLOC(ctx, s->num_elems + 1, bp->gamma);
-  FCM_ALLOC(ctx, s->num_elems + 1, bp->hk);
-  /* count the selected points per element */
-  for (int pass = 0; pass < 2; pass++) {
-    fcm_index np = 0, ne = 0;
-    for (fcm_index e = 0; e < s->num_elems; e++) {
-      int nsp = 0;
-      const double *pts = NULL, *wts = NULL, *nrm = NULL;
-      double X[3 * FCM_ELEMENT_MAX_NODES], N[FCM_ELEMENT_MAX_NODES];
-      FCM_TRY(ctx, fcm_cell_rules_get_piece_surface(s->rules, s->elem_piece[e], &nsp, &pts, &wts,
-                                                    &nrm, NULL));
-      if (nsp == 0) continue;
-      fcm_mesh_cell_coords(s->mesh, s->elem_cell[e], X);
-      const fcm_index first = np;
-      for (int q = 0; q < nsp; q++) {
-        double x[3] = {0, 0, 0};
-        fcm_element_eval_shape(s->type, pts + 3 * q, N);
-        for (int a = 0; a < nn; a++)
-          for (int i = 0; i < 3; i++)
-            x[i] += N[a] * X[3 * a + i];
-        const int k = point_owner(I, x, nrm + 3 * q);
-        if (k < 0 || !(wts[q] > 0.0)) continue;
-        if (pass == 1) {
-          bp->con[np] = k;
-          bp->w[np] = wts[q];
-          memcpy(bp->X + 3 * np, x, sizeof x);
-          memcpy(bp->nrm + 3 * np, nrm + 3 * q, 3 * sizeof(double));
-          memcpy(bp->N + (size_t)np * nn, N, sizeof(double) * (size_t)nn);
-          double det = gradients(s->type, nn, X, pts + 3 * q, bp->G + (size_t)np * nd);
-          FCM_CHECK(det > 0.0, ctx, FCM_ERR_GEOMETRY,
-                    "boundary constraint %d: cell %lld has det J = %g <= 0 at a boundary point", k,
-                    (long long)s->elem_cell[e], det);
-        } else {
-          count[k]++;
-        }
-        np++;
+  fcm_index np = 0, ne = 0;
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    int nsp = 0;
+    const double *pts = NULL, *wts = NULL, *nrm = NULL;
+    double X[3 * FCM_ELEMENT_MAX_NODES], N[FCM_ELEMENT_MAX_NODES];
+    FCM_TRY(ctx, fcm_cell_rules_get_piece_surface(s->rules, s->elem_piece[e], &nsp, &pts, &wts,
+                                                  &nrm, NULL));
+    if (nsp == 0) continue;
+    fcm_mesh_cell_coords(s->mesh, s->elem_cell[e], X);
+    const fcm_index first = np;
+    for (int q = 0; q < nsp; q++) {
+      double x[3] = {0, 0, 0};
+      fcm_element_eval_shape(s->type, pts + 3 * q, N);
+      for (int a = 0; a < nn; a++)
+        for (int i = 0; i < 3; i++)
+          x[i] += N[a] * X[3 * a + i];
+      const int k = point_owner(I, x, nrm + 3 * q);
+      if (k < 0 || !(wts[q] > 0.0)) continue;
+      if (pass == 1) {
+        bp->con[np] = k;
+        bp->w[np] = wts[q];
+        memcpy(bp->X + 3 * np, x, sizeof x);
+        memcpy(bp->nrm + 3 * np, nrm + 3 * q, 3 * sizeof(double));
+        memcpy(bp->N + (size_t)np * nn, N, sizeof(double) * (size_t)nn);
+        double det = gradients(s->type, nn, X, pts + 3 * q, bp->G + (size_t)np * nd);
+        FCM_CHECK(det > 0.0, ctx, FCM_ERR_GEOMETRY,
+                  "boundary constraint %d: cell %lld has det J = %g <= 0 at a boundary point", k,
+                  (long long)s->elem_cell[e], det);
+      } else {
+        count[k]++;
       }
-      if (np > first) {
-        if (pass == 1) {
-          bp->elem[ne] = e;
-          bp->ptr[ne] = first;
-        }
-        ne++;
-      }
+      np++;
     }
-    if (pass == 0) {
-      if (I->has_backend) { /* the points of this process's cells: count them all */
-        double c[64];
-        for (int k0 = 0; k0 < I->num_bcons; k0 += 64) {
-          const int m = I->num_bcons - k0 < 64 ? I->num_bcons - k0 : 64;
-          for (int k = 0; k < m; k++)
-            c[k] = (double)count[k0 + k];
-          FCM_TRY(ctx, I->backend.reduce(I->backend.user, FCM_OK, c, m));
-          for (int k = 0; k < m; k++)
-            count[k0 + k] = (fcm_index)c[k];
-        }
+    if (np > first) {
+      if (pass == 1) {
+        bp->elem[ne] = e;
+        bp->ptr[ne] = first;
       }
-      for (int k = 0; k < I->num_bcons; k++)
-        FCM_CHECK(count[k] > 0, ctx, FCM_ERR_ARG,
-                  "boundary constraint %d selects no embedded-boundary point (check its region "
-                  "against the body's surface)",
-                  k);
-      bp->np = np;
-      bp->nelem = ne;
-      FCM_ALLOC(ctx, ne, bp->elem);
-      FCM_ALLOC(ctx, ne + 1, bp->lelem);
-      FCM_ALLOC(ctx, ne + 1, bp->ptr);
-      FCM_ALLOC(ctx, np, bp->con);
-      FCM_ALLOC(ctx, np, bp->w);
-      FCM_ALLOC(ctx, 3 * (size_t)np, bp->X);
-      FCM_ALLOC(ctx, 3 * (size_t)np, bp->nrm);
-      FCM_ALLOC(ctx, (size_t)np * nn, bp->N);
-      FCM_ALLOC(ctx, (size_t)np * nd, bp->G);
-      bp->nthreads = fcm_ctx_num_threads(ctx);
-      FCM_ALLOC(ctx, ((size_t)nd * (nd + 2) + 9 * (size_t)nn) * (size_t)bp->nthreads, bp->scratch);
-      FCM_ALLOC(ctx, ne + 1, bp->eelem);
-    } else {
-      bp->ptr[ne] = np;
+      ne++;
     }
   }
-  /* the elements with points grouped by the space's colours (parallel assembly); a local
-   * space's colours list local positions (fem_impl.h), and its elements with points (those of
-   * the process's own cells) are local */
+cleanup:
+  *np_out = np;
+  *ne_out = ne;
+  return st;
+}
+
+/* After the counting pass: every constraint must select a point (over all processes when a
+ * backend distributes the run); allocate the point arrays for np points on ne elements. */
+static fcm_status size_points(fcm_integrator *I, fcm_index *count, fcm_index np, fcm_index ne)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  sim_bpoints *bp = &I->bp;
+  const int nn = I->space->nn, nd = 3 * nn;
+  if (I->has_backend) { /* the points of this process's cells: count them all */
+    double c[64];
+    for (int k0 = 0; k0 < I->num_bcons; k0 += 64) {
+      const int m = I->num_bcons - k0 < 64 ? I->num_bcons - k0 : 64;
+      for (int k = 0; k < m; k++)
+        c[k] = (double)count[k0 + k];
+      FCM_TRY(ctx, I->backend.reduce(I->backend.user, FCM_OK, c, m));
+      for (int k = 0; k < m; k++)
+        count[k0 + k] = (fcm_index)c[k];
+    }
+  }
+  for (int k = 0; k < I->num_bcons; k++)
+    FCM_CHECK(count[k] > 0, ctx, FCM_ERR_ARG,
+              "boundary constraint %d selects no embedded-boundary point (check its region "
+              "against the body's surface)",
+              k);
+  bp->np = np;
+  bp->nelem = ne;
+  FCM_ALLOC(ctx, ne, bp->elem);
+  FCM_ALLOC(ctx, ne + 1, bp->lelem);
+  FCM_ALLOC(ctx, ne + 1, bp->ptr);
+  FCM_ALLOC(ctx, np, bp->con);
+  FCM_ALLOC(ctx, np, bp->w);
+  FCM_ALLOC(ctx, 3 * (size_t)np, bp->X);
+  FCM_ALLOC(ctx, 3 * (size_t)np, bp->nrm);
+  FCM_ALLOC(ctx, (size_t)np * nn, bp->N);
+  FCM_ALLOC(ctx, (size_t)np * nd, bp->G);
+  bp->nthreads = fcm_ctx_num_threads(ctx);
+  FCM_ALLOC(ctx, ((size_t)nd * (nd + 2) + 9 * (size_t)nn) * (size_t)bp->nthreads, bp->scratch);
+  FCM_ALLOC(ctx, ne + 1, bp->eelem);
+cleanup:
+  return st;
+}
+
+/* The elements with points grouped by the space's colours (parallel assembly); a local
+ * space's colours list local positions (fem_impl.h), and its elements with points (those of
+ * the process's own cells) are local. */
+static fcm_status group_by_colour(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  const fcm_space *s = I->space;
+  sim_bpoints *bp = &I->bp;
+  fcm_index *ecol = NULL;
   for (fcm_index k = 0; k < bp->nelem; k++) {
     bp->lelem[k] = fcm__space_elem_local(s, bp->elem[k]);
     FCM_CHECK(bp->lelem[k] >= 0, ctx, FCM_ERR_INTERNAL,
@@ -413,8 +475,19 @@ fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
   for (int c = s->num_colors; c > 0; c--)
     bp->color_ptr[c] = bp->color_ptr[c - 1];
   bp->color_ptr[0] = 0;
-  /* penalties */
-  FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, FCM_RULE_STIFFNESS,
+cleanup:
+  fcm__free(ctx, ecol);
+  return st;
+}
+
+/* The penalties of the elements with points, and the largest in the setup info. */
+static fcm_status boundary_penalties(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  sim_bpoints *bp = &I->bp;
+  fcm_rule *full = NULL;
+  FCM_TRY(ctx, fcm_element_standard_rule(ctx, I->space->type, FCM_RULE_STIFFNESS,
                                          I->opts.assembly.stiffness_strength, &full));
   I->setup_info.boundary_points = bp->np;
   for (fcm_index k = 0; k < bp->nelem; k++) {
@@ -425,9 +498,38 @@ fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
         I->setup_info.boundary_penalty_max, element_max_penalty(I, k) * bp->hk[e] / I->mat.young);
   }
 cleanup:
-  fcm__free(ctx, count);
-  fcm__free(ctx, ecol);
   fcm_rule_destroy(&full);
+  return st;
+}
+
+fcm_status fcm__sim_boundary_setup(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  const fcm_space *s = I->space;
+  sim_bpoints *bp = &I->bp;
+  fcm_index *count = NULL;
+  if (I->num_bcons == 0) return FCM_OK;
+  FCM_CHECK(s->rules && fcm_cell_rules_surface_strength(s->rules) >= 0, ctx, FCM_ERR_ARG,
+            "boundary constraint 0: the space has no surface rules (build the cell rules with "
+            "surface_strength >= 0)");
+  FCM_ALLOC(ctx, I->num_bcons, I->bcon_on);
+  FCM_ALLOC(ctx, I->num_bcons, count);
+  FCM_ALLOC(ctx, s->num_elems + 1, bp->gamma);
+  FCM_ALLOC(ctx, s->num_elems + 1, bp->hk);
+  /* count the selected points per element, then store them */
+  for (int pass = 0; pass < 2; pass++) {
+    fcm_index np = 0, ne = 0;
+    FCM_TRY(ctx, collect_points(I, pass, count, &np, &ne));
+    if (pass == 0)
+      FCM_TRY(ctx, size_points(I, count, np, ne));
+    else
+      bp->ptr[ne] = np;
+  }
+  FCM_TRY(ctx, group_by_colour(I));
+  FCM_TRY(ctx, boundary_penalties(I));
+cleanup:
+  fcm__free(ctx, count);
   return st;
 }
 
@@ -445,6 +547,103 @@ static void scatter(const fcm_space *s, fcm_index le, const double *Ke, double *
         for (int k = 0; k < 3; k++)
           dst[3 * off[a * nn + b] + k] += src[3 * b + k];
     }
+}
+
+/* Nitsche's force terms of a point beyond the penalty: fe_(a,i) -= w (S_iL g_aL + p_i t_i N_a),
+ * S_iL = r_j N_J A_jJiL. */
+static void nitsche_force(int nn, const double *G, const double *N, const double nv[3],
+                          const int *pc, const double r[3], const double t[3], const double *A,
+                          double w, double *fe)
+{
+  double S[9] = {0}; /* S_iL = r_j N_J A_jJiL */
+  for (int j = 0; j < 3; j++)
+    for (int J = 0; J < 3; J++) {
+      const double c = r[j] * nv[J];
+      if (c == 0.0) continue;
+      const double *Ar = A + 9 * (3 * j + J);
+      for (int m = 0; m < 9; m++)
+        S[m] += c * Ar[m];
+    }
+  for (int a = 0; a < nn; a++) {
+    const double *ga = G + 3 * a;
+    for (int i = 0; i < 3; i++)
+      fe[3 * a + i] -= w * (S[3 * i] * ga[0] + S[3 * i + 1] * ga[1] + S[3 * i + 2] * ga[2] +
+                            (pc[i] ? t[i] * N[a] : 0.0));
+  }
+}
+
+/* Nitsche's symmetric tangent terms of a point: Ke -= w (V Q + Q^T V^T), V_(a,i),i = p_i N_a,
+ * with the tractions Q (3 x nd) of the shape modes. */
+static void nitsche_tangent(int nn, const double *G, const double *N, const double nv[3],
+                            const int *pc, const double *A, double w, double *Ke, double *Q)
+{
+  const int nd = 3 * nn;
+  /* Q_i(b,k) = B_ikL g_bL with B_ikL = A_iJkL N_J */
+  double B[27];
+  for (int i = 0; i < 3; i++)
+    for (int k = 0; k < 3; k++)
+      for (int L = 0; L < 3; L++)
+        B[9 * i + 3 * k + L] = A[9 * (3 * i) + 3 * k + L] * nv[0] +
+                               A[9 * (3 * i + 1) + 3 * k + L] * nv[1] +
+                               A[9 * (3 * i + 2) + 3 * k + L] * nv[2];
+  for (int i = 0; i < 3; i++)
+    for (int b = 0; b < nn; b++) {
+      const double *gb = G + 3 * b;
+      for (int k = 0; k < 3; k++) {
+        const double *Bk = B + 9 * i + 3 * k;
+        Q[i * nd + 3 * b + k] = Bk[0] * gb[0] + Bk[1] * gb[1] + Bk[2] * gb[2];
+      }
+    }
+  /* Ke -= w (V Q + Q^T V^T), V_(a,i),i = p_i N_a */
+  for (int a = 0; a < nn; a++)
+    for (int i = 0; i < 3; i++) {
+      if (!pc[i]) continue;
+      const double c = w * N[a];
+      const double *Qi = Q + i * nd;
+      double *row = Ke + (size_t)(3 * a + i) * nd;
+      for (int y = 0; y < nd; y++) {
+        row[y] -= c * Qi[y];
+        Ke[(size_t)y * nd + 3 * a + i] -= c * Qi[y];
+      }
+    }
+}
+
+/* The tangent term of a point from the material's nonlinearity: Ke_(a,i)(b,k) -=
+ * w dA[r (x) N]_iJkL g_aJ g_bL at deformation gradient F, for a residual r of length rn > 0. */
+static void material_derivative_term(const fcm_integrator *I, int nn, const double *G,
+                                     const double nv[3], const double F[9], const double r[3],
+                                     double rn, double w, double *Ke)
+{
+  const int nd = 3 * nn;
+  /* dA along D = r (x) N by central differences, step h along D/|D| (|N| = 1) */
+  const double hstep = 1e-5;
+  double Fp[9], Fm[9], Ap[81], Am[81];
+  for (int i = 0; i < 3; i++)
+    for (int J = 0; J < 3; J++) {
+      const double d = hstep * r[i] / rn * nv[J];
+      Fp[3 * i + J] = F[3 * i + J] + d;
+      Fm[3 * i + J] = F[3 * i + J] - d;
+    }
+  fcm__material_eval(&I->params, Fp, NULL, NULL, Ap);
+  fcm__material_eval(&I->params, Fm, NULL, NULL, Am);
+  const double sc = w * rn / (2.0 * hstep);
+  for (int m = 0; m < 81; m++)
+    Ap[m] = sc * (Ap[m] - Am[m]);
+  /* C[i][J][k] = dA_iJkL g_bL, then Ke_(a,i)(b,k) -= g_aJ C[i][J][k] */
+  for (int b = 0; b < nn; b++) {
+    const double *gb = G + 3 * b;
+    double C[27];
+    for (int m = 0; m < 27; m++)
+      C[m] = Ap[3 * m] * gb[0] + Ap[3 * m + 1] * gb[1] + Ap[3 * m + 2] * gb[2];
+    for (int a = 0; a < nn; a++) {
+      const double *ga = G + 3 * a;
+      for (int i = 0; i < 3; i++) {
+        double *row = Ke + (size_t)(3 * a + i) * nd + 3 * b;
+        for (int k = 0; k < 3; k++)
+          row[k] -= ga[0] * C[9 * i + k] + ga[1] * C[9 * i + 3 + k] + ga[2] * C[9 * i + 6 + k];
+      }
+    }
+  }
 }
 
 /* The terms of one point into fe / Ke (either may be NULL); returns its energy, NaN when the
@@ -491,84 +690,11 @@ static double point_terms(const fcm_integrator *I, fcm_index p, const double *ue
     t[i] = P[3 * i] * nv[0] + P[3 * i + 1] * nv[1] + P[3 * i + 2] * nv[2];
   energy -= t[0] * r[0] + t[1] * r[1] + t[2] * r[2];
   if (!isfinite(energy)) return NAN;
-  if (fe) {
-    double S[9] = {0}; /* S_iL = r_j N_J A_jJiL */
-    for (int j = 0; j < 3; j++)
-      for (int J = 0; J < 3; J++) {
-        const double c = r[j] * nv[J];
-        if (c == 0.0) continue;
-        const double *Ar = A + 9 * (3 * j + J);
-        for (int m = 0; m < 9; m++)
-          S[m] += c * Ar[m];
-      }
-    for (int a = 0; a < nn; a++) {
-      const double *ga = G + 3 * a;
-      for (int i = 0; i < 3; i++)
-        fe[3 * a + i] -= w * (S[3 * i] * ga[0] + S[3 * i + 1] * ga[1] + S[3 * i + 2] * ga[2] +
-                              (pc[i] ? t[i] * N[a] : 0.0));
-    }
-  }
+  if (fe) nitsche_force(nn, G, N, nv, pc, r, t, A, w, fe);
   if (Ke && !projected) {
-    /* Q_i(b,k) = B_ikL g_bL with B_ikL = A_iJkL N_J */
-    double B[27];
-    for (int i = 0; i < 3; i++)
-      for (int k = 0; k < 3; k++)
-        for (int L = 0; L < 3; L++)
-          B[9 * i + 3 * k + L] = A[9 * (3 * i) + 3 * k + L] * nv[0] +
-                                 A[9 * (3 * i + 1) + 3 * k + L] * nv[1] +
-                                 A[9 * (3 * i + 2) + 3 * k + L] * nv[2];
-    for (int i = 0; i < 3; i++)
-      for (int b = 0; b < nn; b++) {
-        const double *gb = G + 3 * b;
-        for (int k = 0; k < 3; k++) {
-          const double *Bk = B + 9 * i + 3 * k;
-          Q[i * nd + 3 * b + k] = Bk[0] * gb[0] + Bk[1] * gb[1] + Bk[2] * gb[2];
-        }
-      }
-    /* Ke -= w (V Q + Q^T V^T), V_(a,i),i = p_i N_a */
-    for (int a = 0; a < nn; a++)
-      for (int i = 0; i < 3; i++) {
-        if (!pc[i]) continue;
-        const double c = w * N[a];
-        const double *Qi = Q + i * nd;
-        double *row = Ke + (size_t)(3 * a + i) * nd;
-        for (int y = 0; y < nd; y++) {
-          row[y] -= c * Qi[y];
-          Ke[(size_t)y * nd + 3 * a + i] -= c * Qi[y];
-        }
-      }
+    nitsche_tangent(nn, G, N, nv, pc, A, w, Ke, Q);
     const double rn = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
-    if (!I->linear && rn > 0.0) {
-      /* dA along D = r (x) N by central differences, step h along D/|D| (|N| = 1) */
-      const double hstep = 1e-5;
-      double Fp[9], Fm[9], Ap[81], Am[81];
-      for (int i = 0; i < 3; i++)
-        for (int J = 0; J < 3; J++) {
-          const double d = hstep * r[i] / rn * nv[J];
-          Fp[3 * i + J] = F[3 * i + J] + d;
-          Fm[3 * i + J] = F[3 * i + J] - d;
-        }
-      fcm__material_eval(&I->params, Fp, NULL, NULL, Ap);
-      fcm__material_eval(&I->params, Fm, NULL, NULL, Am);
-      const double sc = w * rn / (2.0 * hstep);
-      for (int m = 0; m < 81; m++)
-        Ap[m] = sc * (Ap[m] - Am[m]);
-      /* C[i][J][k] = dA_iJkL g_bL, then Ke_(a,i)(b,k) -= g_aJ C[i][J][k] */
-      for (int b = 0; b < nn; b++) {
-        const double *gb = G + 3 * b;
-        double C[27];
-        for (int m = 0; m < 27; m++)
-          C[m] = Ap[3 * m] * gb[0] + Ap[3 * m + 1] * gb[1] + Ap[3 * m + 2] * gb[2];
-        for (int a = 0; a < nn; a++) {
-          const double *ga = G + 3 * a;
-          for (int i = 0; i < 3; i++) {
-            double *row = Ke + (size_t)(3 * a + i) * nd + 3 * b;
-            for (int k = 0; k < 3; k++)
-              row[k] -= ga[0] * C[9 * i + k] + ga[1] * C[9 * i + 3 + k] + ga[2] * C[9 * i + 6 + k];
-          }
-        }
-      }
-    }
+    if (!I->linear && rn > 0.0) material_derivative_term(I, nn, G, nv, F, r, rn, w, Ke);
   }
   return w * energy;
 }
