@@ -50,3 +50,4 @@ foreach(el tet4 tet10 hex8 hex20)
   fcm_add_test(fem_transfer_long_${el} tests/fem/transfer.c ARGS ${el} 20 1 LABELS slow
                TIMEOUT 3600)
 endforeach()
+fcm_add_test(fem_threads tests/fem/threads.c)
