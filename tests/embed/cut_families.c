@@ -28,9 +28,11 @@
  * planes 1e-7 apart near a face of the box (2, then 3, no error), a grid plane through a
  * ring (2), and two and three crossing planes whose slivers fold over within the tolerance
  * (per-cell volumes).
- * Usage: embed_cut_families catalogue | campaign N [seed] [verbose]
+ * Usage: embed_cut_families catalogue | campaign N [seed] [verbose] [element]
  *                          | one BODY ELEMENT px py pz nx ny nz [px py pz nx ny nz ...]
  *   campaign: N random cases per background element (each body and family in turn);
+ *   element (0 .. 3, as below): only that element's cases, the same ones as in the whole
+ *   campaign (the earlier elements' cases are drawn, not run), so the four can run at once;
  *   one: the cuts given (BODY 0 tet box, 1 hex box, 2 ring, 3 hollow ball; ELEMENT 0 tet4,
  *   1 tet10, 2 hex8, 3 hex20; the expected count of a hole body is 2 per plane). */
 #include "fcm/fcm.h"
@@ -397,9 +399,13 @@ static void piece_range(const fcm_mesh *mesh, const fcm_cell_rules *r, fcm_index
 }
 
 /* Apply the cuts pl[0 .. np) one after the other to setup S and check every cut. */
+/* 1: the cases are drawn (the same random sequence) but not run */
+static int dry;
+
 static void run_case(const body *b, fcm_element_type type, const setup *S, const plane *given,
                      int np, const char *what)
 {
+  if (dry) return;
   plane pl[MAX_PLANES];
   memcpy(pl, given, (size_t)np * sizeof *pl);
   const double h = (b->mhi[0] - b->mlo[0]) / (double)b->cells[0], thick = 1e-6 * h;
@@ -778,7 +784,7 @@ static void catalogue(body *B)
 int main(int argc, char **argv)
 {
   if (argc < 2) {
-    fprintf(stderr, "usage: %s catalogue | campaign N [seed] [verbose]\n", argv[0]);
+    fprintf(stderr, "usage: %s catalogue | campaign N [seed] [verbose] [element]\n", argv[0]);
     return 2;
   }
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
@@ -803,9 +809,11 @@ int main(int argc, char **argv)
     const int n = argc > 2 ? atoi(argv[2]) : 100;
     rng_state = argc > 3 ? strtoull(argv[3], NULL, 10) : 1;
     verbose = argc > 4 ? atoi(argv[4]) : 0;
-    for (int t = 0; t < NELEM; t++) {
+    const int only = argc > 5 ? atoi(argv[5]) : -1; /* one element's cases (0 .. 3) */
+    for (int t = 0; t < NELEM && (only < 0 || t <= only); t++) {
       setup S[4];
-      for (int b = 0; b < 4; b++)
+      dry = only >= 0 && t < only;
+      for (int b = 0; b < 4 && !dry; b++)
         setup_create(&B[b], elements[t], &S[b]);
       for (int i = 0; i < n; i++) {
         const int b = i % 4;
@@ -814,9 +822,10 @@ int main(int argc, char **argv)
         else
           hole_case(&B[b], elements[t], &S[b]);
       }
-      for (int b = 0; b < 4; b++)
+      for (int b = 0; b < 4 && !dry; b++)
         setup_destroy(&S[b]);
     }
+    dry = 0;
     if (verbose) {
       printf("%-28s", "family");
       for (int t = 0; t < NELEM; t++)
