@@ -250,8 +250,8 @@ static void polygon_clipping(void)
  * between the face x = 1 and the cut plane, one of its cap's fan triangles (vertices 1, 3, 2,
  * vertex 3 taken as on the cut within the tolerance) lies over the face: a flat flap on a tet.
  * Split by a second plane, the two halves must add up to the part: a cap ordered by angle
- * around its centroid crossed itself here (its vertices nearly collinear) and gained 0.2 %
- * (3.7e-14). Rounding bounds what a sliver's volume can be computed to (coordinates of size
+ * around its centroid would cross itself here (its vertices are nearly collinear) and gain
+ * 0.2 % (3.7e-14). Rounding bounds what a sliver's volume can be computed to (coordinates of size
  * 1 and faces of area 0.03): the halves must add up to 1e-14 of the cell's volume |K|. */
 static void flap_split(void)
 {
@@ -296,7 +296,7 @@ static void flap_split(void)
 /* A tet clipped by a Kuhn cell's planes with a tolerance (1.4e-13) about as large as the
  * distances between three vertices that the first plane leaves near a cell corner: the third
  * plane finds that tiny triangle on it, and the cross-section around it must still be closed
- * (taking the tiny face for the whole cap lost 17 % of the volume). Moments of degree <= 1
+ * (a clip taking the tiny face for the whole cap loses 17 % of the volume). Moments of degree <= 1
  * against the independent polytope integration. */
 static void tiny_face_on_plane(void)
 {
