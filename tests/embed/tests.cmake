@@ -58,3 +58,7 @@ fcm_add_test(embed_cut_families_catalogue tests/embed/cut_families.c ARGS catalo
 fcm_add_test(embed_cut_families tests/embed/cut_families.c ARGS campaign 50 1)
 fcm_add_test(embed_cut_families_long tests/embed/cut_families.c ARGS campaign 20000 5
              LABELS slow TIMEOUT 7200)
+# Cut-cell moments from the boundary surface alone against the clipped volume mesh (every
+# monomial of degree <= 4, per cell, 1e-12 |K|), Hex8 and Tet4, a box on grid planes; the
+# inside test against point-in-tet; an open surface is an error.
+fcm_add_test(embed_surface_moments tests/embed/surface_moments.c)

@@ -397,4 +397,54 @@ fcm_status fcm__cell_rules_create_distributed(fcm_ctx *ctx, const fcm_mesh *mesh
                                               fcm__rules_reduce *red, const fcm__rules_exchange *x,
                                               fcm_cell_rules **rules);
 
+/* ---------------------------------------------------------------- surface moments */
+
+/* The Gauss rules on [0, 1] exact for degrees m, m + 1 and m + 2 and the triangle rule exact
+ * for degree m + 1 that the surface moments of degree m use. */
+typedef struct fcm__moment_quad {
+  int m;
+  int ng[3];
+  double *gt[3], *ga[3];
+  int nt;
+  double *tx, *tw; /* (u, v) on the unit triangle, weights summing to 1/2 */
+} fcm__moment_quad;
+
+fcm_status fcm__moment_quad_create(fcm_ctx *ctx, int m, fcm__moment_quad *q);
+void fcm__moment_quad_free(fcm_ctx *ctx, fcm__moment_quad *q);
+
+/* A signed rule: points (x 3, reference coordinates) with weights of both signs. */
+typedef struct fcm__srule {
+  double *x, *w;
+  size_t n, cap;
+} fcm__srule;
+
+void fcm__srule_free(fcm_ctx *ctx, fcm__srule *s);
+
+/* Crossings of a line with the boundary: xi_3 values and signs (+1 leaving the body). */
+typedef struct fcm__crossings {
+  double *z;
+  int *sign;
+  size_t n, cap;
+} fcm__crossings;
+
+void fcm__crossings_free(fcm_ctx *ctx, fcm__crossings *c);
+
+/* The signed rule s (reference coordinates of `cell`, which must be affine) that integrates
+ * every polynomial of degree <= q->m exactly over the part of the cell inside the body bounded
+ * by g's boundary triangles (closed, counter-clockwise seen from outside; tree: their boxes),
+ * from the triangles that meet the cell (surface_moments.c explains how). *touched: some
+ * triangle has a part of positive area inside the cell. FCM_ERR_GEOMETRY when a line through
+ * the cell shows the surface is not closed. buf and cr are scratch. */
+fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                  const fcm__embed_cell *cell, const fcm__moment_quad *q,
+                                  fcm__idbuf *buf, fcm__crossings *cr, fcm__srule *s, int *touched);
+
+/* The winding number of the body's boundary around the points (a, b, z[i]) (reference
+ * coordinates of `cell`, affine), i < n, into inside[i]: 1 inside the body, 0 outside, decided
+ * consistently for points on the boundary. Same errors and scratch as above. */
+fcm_status fcm__embed_inside_line(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                  const fcm__embed_cell *cell, double a, double b, int n,
+                                  const double *z, int *inside, fcm__idbuf *buf,
+                                  fcm__crossings *cr);
+
 #endif /* FCM_EMBED_IMPL_H */

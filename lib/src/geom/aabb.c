@@ -1,9 +1,10 @@
 /* AABB tree: a static bounding-volume hierarchy over boxes, built by median splits
- * along the longest axis of the box centres; box queries for candidate search. */
+ * along the longest axis of the box centres; box and segment queries for candidate search. */
 #include "geom/geom_impl.h"
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #define LEAF_SIZE 4
 #define MAX_DEPTH 128
@@ -152,8 +153,36 @@ static int cmp_index(const void *a, const void *b)
   return (x > y) - (x < y);
 }
 
-fcm_status fcm__geom_tree_query(fcm_ctx *ctx, const fcm_aabb_tree *t, const double lo[3],
-                                const double hi[3], fcm__idbuf *buf)
+/* What a traversal looks for: a box (lo, hi) or a segment (p0 + t d, t in [0, 1]) against
+ * boxes widened by pad. */
+typedef struct probe {
+  int segment;
+  double lo[3], hi[3];
+  double p0[3], d[3], pad;
+} probe;
+
+static int probe_meets(const probe *q, const double *blo, const double *bhi)
+{
+  if (!q->segment) return overlaps(blo, bhi, q->lo, q->hi);
+  double t0 = 0.0, t1 = 1.0;
+  for (int k = 0; k < 3; k++) {
+    const double lo = blo[k] - q->pad, hi = bhi[k] + q->pad;
+    if (q->d[k] == 0.0) {
+      if (q->p0[k] < lo || q->p0[k] > hi) return 0;
+      continue;
+    }
+    double a = (lo - q->p0[k]) / q->d[k], b = (hi - q->p0[k]) / q->d[k];
+    if (a > b) {
+      const double c = a;
+      a = b, b = c;
+    }
+    t0 = fmax(t0, a), t1 = fmin(t1, b);
+    if (t0 > t1) return 0;
+  }
+  return 1;
+}
+
+static fcm_status traverse(fcm_ctx *ctx, const fcm_aabb_tree *t, const probe *q, fcm__idbuf *buf)
 {
   fcm_status st = FCM_OK;
   fcm_index stack[MAX_DEPTH];
@@ -163,7 +192,7 @@ fcm_status fcm__geom_tree_query(fcm_ctx *ctx, const fcm_aabb_tree *t, const doub
   stack[top++] = 0;
   while (top > 0) {
     const fcm__aabb_node *nd = t->nodes + stack[--top];
-    if (!overlaps(nd->lo, nd->hi, lo, hi)) continue;
+    if (!probe_meets(q, nd->lo, nd->hi)) continue;
     if (nd->count == 0) {
       FCM_CHECK(top + 2 <= MAX_DEPTH, ctx, FCM_ERR_INTERNAL, "aabb tree: depth exceeds %d",
                 MAX_DEPTH);
@@ -174,7 +203,7 @@ fcm_status fcm__geom_tree_query(fcm_ctx *ctx, const fcm_aabb_tree *t, const doub
     for (fcm_index s = nd->first; s < nd->first + nd->count; s++) {
       const fcm_index id = t->perm[s];
       const double *b = t->boxes + 6 * id;
-      if (!overlaps(b, b + 3, lo, hi)) continue;
+      if (!probe_meets(q, b, b + 3)) continue;
       if (buf->n == buf->cap) {
         const size_t cap = buf->cap ? 2 * buf->cap : 64;
         void *grown = buf->ids;
@@ -188,6 +217,28 @@ fcm_status fcm__geom_tree_query(fcm_ctx *ctx, const fcm_aabb_tree *t, const doub
   if (buf->n > 1) qsort(buf->ids, buf->n, sizeof *buf->ids, cmp_index);
 cleanup:
   return st;
+}
+
+fcm_status fcm__geom_tree_query(fcm_ctx *ctx, const fcm_aabb_tree *t, const double lo[3],
+                                const double hi[3], fcm__idbuf *buf)
+{
+  probe q;
+  memset(&q, 0, sizeof q);
+  memcpy(q.lo, lo, sizeof q.lo);
+  memcpy(q.hi, hi, sizeof q.hi);
+  return traverse(ctx, t, &q, buf);
+}
+
+fcm_status fcm__geom_tree_segment(fcm_ctx *ctx, const fcm_aabb_tree *t, const double p0[3],
+                                  const double p1[3], double pad, fcm__idbuf *buf)
+{
+  probe q;
+  memset(&q, 0, sizeof q);
+  q.segment = 1;
+  q.pad = pad;
+  for (int k = 0; k < 3; k++)
+    q.p0[k] = p0[k], q.d[k] = p1[k] - p0[k];
+  return traverse(ctx, t, &q, buf);
 }
 
 void fcm__geom_idbuf_free(fcm_ctx *ctx, fcm__idbuf *buf)

@@ -93,6 +93,11 @@ typedef struct fcm__idbuf {
 fcm_status fcm__geom_tree_query(fcm_ctx *ctx, const fcm_aabb_tree *tree, const double lo[3],
                                 const double hi[3], fcm__idbuf *buf);
 
+/* Ids of the items whose box, widened by pad, meets the segment p0 -> p1, ascending, into
+ * buf (as fcm__geom_tree_query()). */
+fcm_status fcm__geom_tree_segment(fcm_ctx *ctx, const fcm_aabb_tree *tree, const double p0[3],
+                                  const double p1[3], double pad, fcm__idbuf *buf);
+
 /* Release a buffer's storage. */
 void fcm__geom_idbuf_free(fcm_ctx *ctx, fcm__idbuf *buf);
 

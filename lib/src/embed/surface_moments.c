@@ -1,0 +1,518 @@
+/* Exact integrals over the material of an affine background cell from the embedded body's
+ * closed boundary surface, at a cost that follows the boundary triangles meeting the cell
+ * (not the body's volume mesh), and the inside test of points that goes with them.
+ *
+ * In reference coordinates the cell K is the cube [-1, 1]^3 or the unit tetrahedron; both
+ * are bounded below by xi_k >= lo and have one exit facet in direction xi_1 (xi_1 = 1, or
+ * xi_1 = 1 - xi_2 - xi_3). With F(xi) = int_lo^xi_1 f(t, xi_2, xi_3) dt, div(F e_1) = f and
+ * the divergence theorem gives
+ *   int_{V cap K} f = sum over boundary triangles T of int_{T cap K} F n_1 dA
+ *                   + int over the exit facet's part inside V of F n_1 dA,
+ * because F vanishes on xi_1 = lo and n_1 on the other facets. The exit facet term is the
+ * same problem one dimension lower (projected on (xi_2, xi_3): the body's cross-section,
+ * bounded by the segments where the triangles cross the facet's plane, with exit edge
+ * xi_2 = 1 or 1 - xi_3), and that one's exit-edge term is one dimension lower again: the
+ * intervals of the edge inside V, from the points where the segments cross it and the
+ * inside status of the cell corner at its end. Every antiderivative is evaluated by Gauss
+ * rules, so the result is a signed rule (points with weights of both signs, in reference
+ * coordinates) exact for polynomials of degree <= m on V cap K, whose size follows the
+ * triangles that meet the cell.
+ *
+ * Robustness: each plane classifies the triangle vertices once ("above" when the plane's
+ * value is >= 0) and the point on a mesh edge is interpolated from its lower-numbered vertex,
+ * so the two triangles sharing an edge produce the same point bit for bit and a line through
+ * an edge or a vertex counts one crossing. Where two levels' rounding disagrees (a vertex
+ * within rounding of a cell plane) the integrals differ by a region of rounding size: the
+ * result is continuous in the vertex positions, so no decision can make it grossly wrong. The
+ * surface must be closed and consistently oriented; a line whose crossings do not sum to zero
+ * says it is not. */
+#include "embed/embed_impl.h"
+#include "la/mat3.h"
+
+#include <math.h>
+#include <string.h>
+
+/* An affine function s(xi) = c0 + c . xi of reference coordinates; "above" when s >= 0. */
+typedef struct lin {
+  double c0, c[3];
+} lin;
+
+static double lin_eval(const lin *l, const double x[3])
+{
+  return l->c0 + l->c[0] * x[0] + l->c[1] * x[1] + l->c[2] * x[2];
+}
+
+/* The reference cell's planes: inside where every constraint is < 0. */
+typedef struct ref_cell {
+  int tet;
+  double lo;   /* lower bound of every coordinate: -1 (cube) or 0 (tet) */
+  lin exit1;   /* the exit facet's plane: xi_1 - 1 or xi_1 + xi_2 + xi_3 - 1 */
+  lin exit2;   /* the exit edge on that facet (in xi_2, xi_3): xi_2 - 1 or xi_2 + xi_3 - 1 */
+  lin cell[6]; /* the cell's constraints */
+  int ncell;
+  lin face[3]; /* the exit facet's other edges (in xi_2, xi_3) */
+  int nface;
+} ref_cell;
+
+static lin mk(double c0, double a, double b, double c)
+{
+  lin l = {c0, {a, b, c}};
+  return l;
+}
+
+/* The cell's constraints start with the exit facet: a triangle lying in its plane is then
+ * kept or dropped on its own vertices' values, as the exit facet's segments see them. */
+static void ref_cell_init(int tet, ref_cell *r)
+{
+  r->tet = tet;
+  r->lo = tet ? 0.0 : -1.0;
+  r->exit1 = tet ? mk(-1, 1, 1, 1) : mk(-1, 1, 0, 0);
+  r->exit2 = tet ? mk(-1, 0, 1, 1) : mk(-1, 0, 1, 0);
+  r->ncell = 0;
+  r->cell[r->ncell++] = r->exit1;
+  for (int k = 0; k < 3; k++)
+    r->cell[r->ncell++] = mk(r->lo, -(k == 0), -(k == 1), -(k == 2)); /* lo - xi_k */
+  r->nface = 0;
+  r->face[r->nface++] = mk(r->lo, 0, -1, 0);
+  r->face[r->nface++] = mk(r->lo, 0, 0, -1);
+  if (!tet) {
+    r->cell[r->ncell++] = mk(-1, 0, 1, 0);
+    r->cell[r->ncell++] = mk(-1, 0, 0, 1);
+    r->face[r->nface++] = mk(-1, 0, 0, 1);
+  }
+}
+
+/* The exit facet's xi_1 at (xi_2, xi_3) and the exit edge's xi_2 at xi_3. */
+static double exit1_at(const ref_cell *r, double x2, double x3)
+{
+  return r->tet ? 1.0 - x2 - x3 : 1.0;
+}
+
+static double exit2_at(const ref_cell *r, double x3)
+{
+  return r->tet ? 1.0 - x3 : 1.0;
+}
+
+/* ---------------------------------------------------------------- the quadratures */
+
+static fcm_status unit_gauss(fcm_ctx *ctx, int degree, int *n, double **t, double **a)
+{
+  fcm_status st = FCM_OK;
+  fcm_rule *g = NULL;
+  FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_LINE, degree, &g));
+  *n = fcm_rule_num_points(g);
+  FCM_ALLOC(ctx, (size_t)*n, *t);
+  FCM_ALLOC(ctx, (size_t)*n, *a);
+  for (int i = 0; i < *n; i++) { /* [-1, 1] -> [0, 1] */
+    (*t)[i] = 0.5 * (fcm_rule_points(g)[i] + 1.0);
+    (*a)[i] = 0.5 * fcm_rule_weights(g)[i];
+  }
+cleanup:
+  fcm_rule_destroy(&g);
+  return st;
+}
+
+fcm_status fcm__moment_quad_create(fcm_ctx *ctx, int m, fcm__moment_quad *q)
+{
+  fcm_status st = FCM_OK;
+  fcm_rule *tri = NULL;
+  memset(q, 0, sizeof *q);
+  q->m = m;
+  for (int l = 0; l < 3; l++)
+    FCM_TRY(ctx, unit_gauss(ctx, m + l, q->ng + l, q->gt + l, q->ga + l));
+  FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TRI, m + 1, &tri));
+  q->nt = fcm_rule_num_points(tri);
+  FCM_ALLOC(ctx, 2 * (size_t)q->nt, q->tx);
+  FCM_ALLOC(ctx, (size_t)q->nt, q->tw);
+  memcpy(q->tx, fcm_rule_points(tri), 2 * (size_t)q->nt * sizeof *q->tx);
+  memcpy(q->tw, fcm_rule_weights(tri), (size_t)q->nt * sizeof *q->tw);
+cleanup:
+  fcm_rule_destroy(&tri);
+  if (st != FCM_OK) fcm__moment_quad_free(ctx, q);
+  return st;
+}
+
+void fcm__moment_quad_free(fcm_ctx *ctx, fcm__moment_quad *q)
+{
+  for (int l = 0; l < 3; l++) {
+    fcm__free(ctx, q->gt[l]);
+    fcm__free(ctx, q->ga[l]);
+    q->gt[l] = q->ga[l] = NULL;
+  }
+  fcm__free(ctx, q->tx);
+  fcm__free(ctx, q->tw);
+  q->tx = q->tw = NULL;
+}
+
+void fcm__srule_free(fcm_ctx *ctx, fcm__srule *s)
+{
+  fcm__free(ctx, s->x);
+  fcm__free(ctx, s->w);
+  s->x = s->w = NULL;
+  s->n = s->cap = 0;
+}
+
+static fcm_status srule_room(fcm_ctx *ctx, fcm__srule *s, size_t more)
+{
+  fcm_status st = FCM_OK;
+  if (s->n + more <= s->cap) return FCM_OK;
+  size_t cap = s->cap ? s->cap : 1024;
+  while (cap < s->n + more)
+    cap *= 2;
+  void *x = s->x, *w = s->w;
+  FCM_TRY(ctx, fcm__resize(ctx, &x, 3 * s->n, 3 * cap, sizeof(double)));
+  s->x = x;
+  FCM_TRY(ctx, fcm__resize(ctx, &w, s->n, cap, sizeof(double)));
+  s->w = w;
+  s->cap = cap;
+cleanup:
+  return st;
+}
+
+/* W * F(y): F(y) = int_lo^y_1 f(t, y_2, y_3) dt (degree m in t). */
+static fcm_status add_column(fcm_ctx *ctx, const fcm__moment_quad *q, double lo, const double y[3],
+                             double W, fcm__srule *s)
+{
+  fcm_status st = FCM_OK;
+  const int n = q->ng[0];
+  const double len = y[0] - lo;
+  if (len == 0.0 || W == 0.0) return FCM_OK;
+  FCM_TRY(ctx, srule_room(ctx, s, (size_t)n));
+  for (int g = 0; g < n; g++) {
+    double *x = s->x + 3 * s->n;
+    x[0] = lo + len * q->gt[0][g], x[1] = y[1], x[2] = y[2];
+    s->w[s->n++] = W * len * q->ga[0][g];
+  }
+cleanup:
+  return st;
+}
+
+/* W * G(y2, y3): G = int_lo^y2 F(e1(s, y3), s, y3) ds (degree m + 1 in s). */
+static fcm_status add_face(fcm_ctx *ctx, const fcm__moment_quad *q, const ref_cell *r, double y2,
+                           double y3, double W, fcm__srule *s)
+{
+  fcm_status st = FCM_OK;
+  const double len = y2 - r->lo;
+  for (int j = 0; j < q->ng[1] && len != 0.0; j++) {
+    const double z2 = r->lo + len * q->gt[1][j];
+    const double y[3] = {exit1_at(r, z2, y3), z2, y3};
+    FCM_TRY(ctx, add_column(ctx, q, r->lo, y, W * len * q->ga[1][j], s));
+  }
+cleanup:
+  return st;
+}
+
+/* W * H(z): H = int_lo^z G(e2(t), t) dt (degree m + 2 in t). */
+static fcm_status add_edge(fcm_ctx *ctx, const fcm__moment_quad *q, const ref_cell *r, double z,
+                           double W, fcm__srule *s)
+{
+  fcm_status st = FCM_OK;
+  const double len = z - r->lo;
+  for (int k = 0; k < q->ng[2] && len != 0.0; k++) {
+    const double t = r->lo + len * q->gt[2][k];
+    FCM_TRY(ctx, add_face(ctx, q, r, exit2_at(r, t), t, W * len * q->ga[2][k], s));
+  }
+cleanup:
+  return st;
+}
+
+/* ---------------------------------------------------------------- geometry of the levels */
+
+/* A boundary triangle in reference coordinates, with its vertex ids. */
+typedef struct rtri {
+  fcm_index id[3];
+  double x[9];
+} rtri;
+
+static void to_ref(const fcm__embed_cell *cell, const double *p, double xi[3])
+{
+  const double d[3] = {p[0] - cell->X[0], p[1] - cell->X[1], p[2] - cell->X[2]};
+  double s[3];
+  fcm__mat3_mulv(cell->Ainv, d, s);
+  for (int k = 0; k < 3; k++)
+    xi[k] = cell->xi0[k] + s[k];
+}
+
+static void load_tri(const fcm_geometry *g, const fcm__embed_cell *cell, fcm_index t, rtri *T)
+{
+  for (int a = 0; a < 3; a++) {
+    T->id[a] = g->tris[3 * t + a];
+    to_ref(cell, g->coords + 3 * T->id[a], T->x + 3 * a);
+  }
+}
+
+/* The point where mesh edge (i, j) meets the plane with values v, interpolated from the
+ * lower-numbered vertex so both triangles of the edge get it bit for bit. */
+static void edge_point(const rtri *T, const double v[3], int i, int j, double out[3])
+{
+  if (T->id[j] < T->id[i]) {
+    const int k = i;
+    i = j, j = k;
+  }
+  const double t = v[i] / (v[i] - v[j]);
+  for (int d = 0; d < 3; d++)
+    out[d] = T->x[3 * i + d] + t * (T->x[3 * j + d] - T->x[3 * i + d]);
+}
+
+/* The segment P -> Q where T crosses plane l, oriented so that the cross-section of the body
+ * lies on its left seen from the side the plane's normal points to (counter-clockwise around
+ * the cross-section); 0 when T does not cross. */
+static int tri_segment(const rtri *T, const lin *l, double P[3], double Q[3])
+{
+  double v[3];
+  int up[3];
+  for (int a = 0; a < 3; a++) {
+    v[a] = lin_eval(l, T->x + 3 * a);
+    up[a] = v[a] >= 0.0;
+  }
+  if (up[0] == up[1] && up[1] == up[2]) return 0;
+  const int a = up[0] == up[1] ? 2 : up[0] == up[2] ? 1 : 0; /* the vertex alone on its side */
+  const int b = (a + 1) % 3, c = (a + 2) % 3;
+  if (up[a]) {
+    edge_point(T, v, a, b, P);
+    edge_point(T, v, a, c, Q);
+  } else {
+    edge_point(T, v, a, c, P);
+    edge_point(T, v, a, b, Q);
+  }
+  return 1;
+}
+
+/* Where the segment P -> Q crosses plane l: the point and +1 when it leaves the
+ * non-negative side (P above), -1 when it enters; 0 when it does not cross. */
+static int seg_cross(const double P[3], const double Q[3], const lin *l, double X[3])
+{
+  const double vp = lin_eval(l, P), vq = lin_eval(l, Q);
+  if ((vp >= 0.0) == (vq >= 0.0)) return 0;
+  const double t = vp / (vp - vq);
+  for (int d = 0; d < 3; d++)
+    X[d] = P[d] + t * (Q[d] - P[d]);
+  return vp >= 0.0 ? 1 : -1;
+}
+
+/* Keep the part of the segment where every constraint is < 0; 0 when none is left. */
+static int clip_segment(double P[3], double Q[3], const lin *c, int nc)
+{
+  for (int k = 0; k < nc; k++) {
+    const double vp = lin_eval(c + k, P), vq = lin_eval(c + k, Q);
+    const int op = vp >= 0.0, oq = vq >= 0.0;
+    if (op && oq) return 0;
+    if (op == oq) continue;
+    const double t = vp / (vp - vq);
+    double X[3];
+    for (int d = 0; d < 3; d++)
+      X[d] = P[d] + t * (Q[d] - P[d]);
+    memcpy(op ? P : Q, X, sizeof X);
+  }
+  return 1;
+}
+
+#define POLY_CAP 16
+
+/* Clip the polygon (n vertices) by {l < 0} into out; returns the new count. */
+static int clip_polygon(const double *in, int n, const lin *l, double *out)
+{
+  int m = 0;
+  for (int i = 0; i < n && m + 2 <= POLY_CAP; i++) {
+    const double *p = in + 3 * i, *q = in + 3 * ((i + 1) % n);
+    const double vp = lin_eval(l, p), vq = lin_eval(l, q);
+    if (vp < 0.0) memcpy(out + 3 * m++, p, 3 * sizeof *p);
+    if ((vp < 0.0) != (vq < 0.0)) {
+      const double t = vp / (vp - vq);
+      for (int d = 0; d < 3; d++)
+        out[3 * m + d] = p[d] + t * (q[d] - p[d]);
+      m++;
+    }
+  }
+  return m;
+}
+
+/* Level 3: int over T cap K of W F n_1 dA, by a fan of the clipped polygon. */
+static fcm_status add_triangle(fcm_ctx *ctx, const fcm__moment_quad *q, const ref_cell *r,
+                               const rtri *T, fcm__srule *s, int *touched)
+{
+  fcm_status st = FCM_OK;
+  double a[3 * POLY_CAP], b[3 * POLY_CAP];
+  memcpy(a, T->x, sizeof T->x);
+  int n = 3;
+  for (int k = 0; k < r->ncell && n >= 3; k++) {
+    n = clip_polygon(a, n, r->cell + k, b);
+    memcpy(a, b, 3 * (size_t)n * sizeof *a);
+  }
+  if (n < 3) return FCM_OK;
+  *touched = 1;
+  for (int i = 1; i + 1 < n; i++) {
+    const double *p0 = a, *p1 = a + 3 * i, *p2 = a + 3 * (i + 1);
+    double e1[3], e2[3];
+    for (int d = 0; d < 3; d++)
+      e1[d] = p1[d] - p0[d], e2[d] = p2[d] - p0[d];
+    const double n1 = e1[1] * e2[2] - e1[2] * e2[1]; /* 2 x projected area, signed */
+    if (n1 == 0.0) continue;
+    for (int j = 0; j < q->nt; j++) {
+      const double u = q->tx[2 * j], v = q->tx[2 * j + 1];
+      const double y[3] = {p0[0] + u * e1[0] + v * e2[0], p0[1] + u * e1[1] + v * e2[1],
+                           p0[2] + u * e1[2] + v * e2[2]};
+      FCM_TRY(ctx, add_column(ctx, q, r->lo, y, q->tw[j] * n1, s));
+    }
+  }
+cleanup:
+  return st;
+}
+
+/* Level 2: the part of T's segment on the exit facet inside the facet: int G dxi_3 along it. */
+static fcm_status add_segment(fcm_ctx *ctx, const fcm__moment_quad *q, const ref_cell *r,
+                              const rtri *T, fcm__srule *s)
+{
+  fcm_status st = FCM_OK;
+  double P[3], Q[3];
+  if (!tri_segment(T, &r->exit1, P, Q)) return FCM_OK;
+  /* the exit edge first, on the unclipped ends: the same decision and point as the exit
+   * edge's crossings (level 1) */
+  if (!clip_segment(P, Q, &r->exit2, 1) || !clip_segment(P, Q, r->face, r->nface)) return FCM_OK;
+  const double d3 = Q[2] - P[2];
+  if (d3 == 0.0) return FCM_OK;
+  for (int k = 0; k < q->ng[2]; k++) {
+    const double t = q->gt[2][k];
+    FCM_TRY(ctx, add_face(ctx, q, r, P[1] + t * (Q[1] - P[1]), P[2] + t * (Q[2] - P[2]),
+                          q->ga[2][k] * d3, s));
+  }
+cleanup:
+  return st;
+}
+
+/* ---------------------------------------------------------------- lines through the body */
+
+/* Boundary triangles that may cross the reference line base + t dir (any t): the tree's
+ * boxes met by the physical segment that covers the geometry's bounding box. */
+static fcm_status line_candidates(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                  const fcm__embed_cell *cell, const double base[3],
+                                  const double dir[3], fcm__idbuf *buf)
+{
+  double p[3], v[3], p0[3], p1[3], far = 0.0;
+  const double x0[3] = {base[0] - cell->xi0[0], base[1] - cell->xi0[1], base[2] - cell->xi0[2]};
+  fcm__mat3_mulv(cell->A, x0, p);
+  fcm__mat3_mulv(cell->A, dir, v);
+  for (int d = 0; d < 3; d++)
+    p[d] += cell->X[d];
+  const double speed = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  for (int c = 0; c < 8; c++) { /* the farthest corner of the geometry's box */
+    double r2 = 0.0;
+    for (int d = 0; d < 3; d++) {
+      const double e = ((c >> d) & 1 ? g->hi[d] : g->lo[d]) - p[d];
+      r2 += e * e;
+    }
+    far = fmax(far, sqrt(r2));
+  }
+  const double t = far / speed + 1.0;
+  for (int d = 0; d < 3; d++)
+    p0[d] = p[d] - t * v[d], p1[d] = p[d] + t * v[d];
+  return fcm__geom_tree_segment(ctx, tree, p0, p1, 1e-9 * (far + cell->size), buf);
+}
+
+/* The crossings of the body's boundary with the line {l1 = 0, l2 = 0} (base + t dir), as
+ * values of xi_3 with +1 (leaving the body going up in xi_3) or -1; the candidates are the
+ * triangles in buf. *sum: the sum of the signs (0 for a closed surface). */
+static fcm_status line_crossings(fcm_ctx *ctx, const fcm_geometry *g, const fcm__embed_cell *cell,
+                                 const fcm__idbuf *buf, const lin *l1, const lin *l2,
+                                 fcm__crossings *out, int *sum)
+{
+  fcm_status st = FCM_OK;
+  out->n = 0;
+  *sum = 0;
+  for (size_t k = 0; k < buf->n; k++) {
+    rtri T;
+    double P[3], Q[3], X[3];
+    load_tri(g, cell, buf->ids[k], &T);
+    if (!tri_segment(&T, l1, P, Q)) continue;
+    const int sg = seg_cross(P, Q, l2, X);
+    if (!sg) continue;
+    if (out->n == out->cap) {
+      const size_t cap = out->cap ? 2 * out->cap : 16;
+      void *z = out->z, *s = out->sign;
+      FCM_TRY(ctx, fcm__resize(ctx, &z, out->cap, cap, sizeof *out->z));
+      out->z = z;
+      FCM_TRY(ctx, fcm__resize(ctx, &s, out->cap, cap, sizeof *out->sign));
+      out->sign = s;
+      out->cap = cap;
+    }
+    out->z[out->n] = X[2];
+    out->sign[out->n++] = sg;
+    *sum += sg;
+  }
+cleanup:
+  return st;
+}
+
+void fcm__crossings_free(fcm_ctx *ctx, fcm__crossings *c)
+{
+  fcm__free(ctx, c->z);
+  fcm__free(ctx, c->sign);
+  c->z = NULL, c->sign = NULL;
+  c->n = c->cap = 0;
+}
+
+fcm_status fcm__embed_inside_line(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                  const fcm__embed_cell *cell, double a, double b, int n,
+                                  const double *z, int *inside, fcm__idbuf *buf, fcm__crossings *cr)
+{
+  fcm_status st = FCM_OK;
+  const double base[3] = {a, b, 0.0}, dir[3] = {0.0, 0.0, 1.0};
+  const lin l1 = mk(-a, 1, 0, 0), l2 = mk(-b, 0, 1, 0);
+  int sum;
+  FCM_TRY(ctx, line_candidates(ctx, g, tree, cell, base, dir, buf));
+  FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &l1, &l2, cr, &sum));
+  FCM_CHECK(sum == 0, ctx, FCM_ERR_GEOMETRY,
+            "embed: background cell %lld: a line through the body crosses its boundary %d more "
+            "times outward than inward (the boundary surface is not closed)",
+            (long long)cell->id, sum);
+  for (int i = 0; i < n; i++) {
+    int w = 0; /* crossings at or beyond z[i], leaving counted +1: the winding number */
+    for (size_t k = 0; k < cr->n; k++)
+      if (cr->z[k] >= z[i]) w += cr->sign[k];
+    inside[i] = w;
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                  const fcm__embed_cell *cell, const fcm__moment_quad *q,
+                                  fcm__idbuf *buf, fcm__crossings *cr, fcm__srule *s, int *touched)
+{
+  fcm_status st = FCM_OK;
+  ref_cell r;
+  const int tet = cell->info->shape == FCM_SHAPE_TET;
+  ref_cell_init(tet, &r);
+  s->n = 0;
+  *touched = 0;
+  FCM_CHECK(cell->affine, ctx, FCM_ERR_INTERNAL,
+            "embed: background cell %lld is not affine (surface moments need an affine map)",
+            (long long)cell->id);
+  /* levels 3 and 2: the triangles that meet the cell */
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, cell->lo, cell->hi, buf));
+  for (size_t k = 0; k < buf->n; k++) {
+    rtri T;
+    load_tri(g, cell, buf->ids[k], &T);
+    FCM_TRY(ctx, add_triangle(ctx, q, &r, &T, s, touched));
+    FCM_TRY(ctx, add_segment(ctx, q, &r, &T, s));
+  }
+  /* level 1: the exit edge, from the exit facet's corner (xi_3 = lo) to the cell corner */
+  const double base[3] = {tet ? 0.0 : 1.0, 1.0, 0.0}, dir[3] = {0.0, tet ? -1.0 : 0.0, 1.0};
+  int sum, corner = 0;
+  FCM_TRY(ctx, line_candidates(ctx, g, tree, cell, base, dir, buf));
+  FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &r.exit1, &r.exit2, cr, &sum));
+  FCM_CHECK(sum == 0, ctx, FCM_ERR_GEOMETRY,
+            "embed: background cell %lld: its edge line crosses the body's boundary %d more "
+            "times outward than inward (the boundary surface is not closed)",
+            (long long)cell->id, sum);
+  for (size_t k = 0; k < cr->n; k++) {
+    const double z = cr->z[k];
+    if (z >= 1.0)
+      corner += cr->sign[k];
+    else if (z > r.lo)
+      FCM_TRY(ctx, add_edge(ctx, q, &r, z, cr->sign[k], s));
+  }
+  if (corner) FCM_TRY(ctx, add_edge(ctx, q, &r, 1.0, corner, s));
+cleanup:
+  return st;
+}
