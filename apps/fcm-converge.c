@@ -668,6 +668,7 @@ static fcm_status payoff_variant(fcm_ctx *ctx, const config *c, const fcm_mesh *
   fcm_cell_rules_options o = fcm_cell_rules_options_default();
   o.strength[FCM_RULE_STIFFNESS] = c->setup.strength;
   o.simplify = simplify ? FCM_CELL_SIMPLIFY_ON : FCM_CELL_SIMPLIFY_OFF;
+  o.moments = FCM_CELL_MOMENTS_VOLUME; /* the payoff of simplifying the tet rules */
   double t0 = fcm_wtime();
   st = fcm_cell_rules_create(ctx, mesh, geom, &o, &rules);
   if (st != FCM_OK) return st;

@@ -1,7 +1,8 @@
 /* fcm__embed_crop_geometry() (the part of the geometry a distributed rules build reads, the
  * PETSc backend's crop), serially: a ball sticking out of a Hex8 grid (outside volumes), the
  * cells with centroid x < 0.45 classified here, every other one of them owned (points). Asserts
- * - the crop: fewer cells and boundary triangles than the whole, original order (ascending
+ * - the crop: fewer cells than the whole, every boundary triangle (the surface path reads
+ *   lines through the whole body; with moments = volume fewer triangles), original order (ascending
  *   original ids), coordinates of every kept cell and triangle bit for bit the original ones,
  *   the whole geometry's volume and bounding box, triangle cells mapped or -1;
  * - a distributed build on the crop (the other cells' classes handed over from the whole
@@ -87,7 +88,16 @@ int main(void)
   TEST_OK(ctx, fcm__embed_crop_geometry(ctx, mesh, geom, &o, classify, own, &crop));
   if (!whole || !crop) return 1;
   TEST_TRUE(crop->num_cells > 0 && crop->num_cells < geom->num_cells);
-  TEST_TRUE(crop->num_tris > 0 && crop->num_tris < geom->num_tris);
+  /* the surface path (the default) keeps every boundary triangle: lines through the body */
+  TEST_TRUE(crop->num_tris == geom->num_tris);
+  {
+    fcm_geometry *vcrop = NULL;
+    fcm_cell_rules_options ov = o;
+    ov.moments = FCM_CELL_MOMENTS_VOLUME;
+    TEST_OK(ctx, fcm__embed_crop_geometry(ctx, mesh, geom, &ov, classify, own, &vcrop));
+    TEST_TRUE(vcrop && vcrop->num_tris > 0 && vcrop->num_tris < geom->num_tris);
+    fcm_geometry_destroy(&vcrop);
+  }
   TEST_TRUE(crop->orig_cells == geom->num_cells && crop->orig_tris == geom->num_tris);
   TEST_TRUE(same_bits(&crop->volume, &geom->volume, 1));
   TEST_TRUE(same_bits(crop->lo, geom->lo, 3) && same_bits(crop->hi, geom->hi, 3));

@@ -54,6 +54,8 @@ static fcm_cell_rules *build(const fcm_mesh *m, const fcm_geometry *g, fcm_cell_
   o.strength[FCM_RULE_STIFFNESS] = 2;
   o.strength[FCM_RULE_MASS] = 3;
   o.simplify = mode;
+  o.moments = FCM_CELL_MOMENTS_VOLUME; /* the policy weighs the tet rules' initial points (the
+                                          surface path fits at most M points directly) */
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     o.expected_assemblies[k] = assemblies;
     o.point_cost[k] = point_cost;
@@ -168,6 +170,9 @@ static void errors(const fcm_mesh *m, const fcm_geometry *g)
   o.simplify = (fcm_cell_simplify)3;
   TEST_ERR(ctx, fcm_cell_rules_create(ctx, m, g, &o, &r), FCM_ERR_ARG,
            "simplify = 3 is not a mode");
+  o = fcm_cell_rules_options_default();
+  o.moments = (fcm_cell_moments)3;
+  TEST_ERR(ctx, fcm_cell_rules_create(ctx, m, g, &o, &r), FCM_ERR_ARG, "moments = 3 is not a path");
   o = fcm_cell_rules_options_default();
   o.simplify = FCM_CELL_SIMPLIFY_AUTO;
   o.expected_assemblies[FCM_RULE_MASS] = -1.0;

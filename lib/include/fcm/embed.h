@@ -62,6 +62,27 @@ typedef enum fcm_cell_simplify {
 /** Static name of a mode ("off", "on", "auto"; "invalid" outside the enum). */
 FCM_API const char *fcm_cell_simplify_name(fcm_cell_simplify mode);
 
+/** Where fcm_cell_rules_create() takes the rules of a cut cell from. */
+typedef enum fcm_cell_moments {
+  FCM_CELL_MOMENTS_AUTO = 0,    /**< from the body's boundary surface where that applies (default):
+                                     the exact moments of the cell's material in closed form from
+                                     the boundary triangles that meet the cell, then a positive
+                                     rule of at most M points fitted on candidate points inside
+                                     the material; a cost that follows the surface, not the
+                                     geometry's volume mesh. It applies to affine background
+                                     cells of a whole geometry (not a crop) that no cut reaches,
+                                     when simplify is not OFF; elsewhere, and for a cell whose fit
+                                     fails, the VOLUME path (counted in the statistics) */
+  FCM_CELL_MOMENTS_VOLUME = 1,  /**< clip the geometry's cells into tets, map a tet rule onto
+                                    each, simplify (the path of every cell before the surface one) */
+  FCM_CELL_MOMENTS_SURFACE = 2, /**< as AUTO, but a cell whose fit fails is an error
+                                   (FCM_ERR_NUMERIC naming the cell) instead of a fallback */
+  FCM_CELL_MOMENTS_COUNT
+} fcm_cell_moments;
+
+/** Static name of a path ("auto", "volume", "surface"; "invalid" outside the enum). */
+FCM_API const char *fcm_cell_moments_name(fcm_cell_moments path);
+
 /** The cost model of FCM_CELL_SIMPLIFY_AUTO: 1 when simplifying pays, i.e. when
  * (points_before - points_after) * point_cost * assemblies > simplify_time, else 0 (also for
  * non-finite or negative arguments). point_cost: core-seconds one quadrature point costs in
@@ -101,6 +122,7 @@ typedef struct fcm_cell_rules_options {
                              with their volume in the statistics; default 1e-14 */
   double convex_rtol;    /**< tolerance of fcm_mesh_cell_is_convex(); default 1e-10 */
   fcm_cell_simplify simplify; /**< FCM_CELL_SIMPLIFY_ON (default), OFF or AUTO */
+  fcm_cell_moments moments;   /**< FCM_CELL_MOMENTS_AUTO (default), VOLUME or SURFACE */
   double expected_assemblies[FCM_RULE_KIND_COUNT]; /**< AUTO: how many times the rules of each
                               kind will be assembled (>= 0): a static single solve about 1
                               stiffness (Newton iterations), 0 mass; a dynamic run steps x
@@ -182,6 +204,10 @@ typedef struct fcm_cell_rules_stats {
   fcm_index simplify_skipped[FCM_RULE_KIND_COUNT];   /**< cut cells with N <= M */
   fcm_index simplify_fallbacks[FCM_RULE_KIND_COUNT]; /**< kept unsimplified after failure */
   double max_residual[FCM_RULE_KIND_COUNT]; /**< largest relative moment residual reported */
+  fcm_index num_surface_cells;     /**< cut cells whose rules were fitted on surface moments
+                                      (FCM_CELL_MOMENTS_AUTO / SURFACE) */
+  fcm_index num_surface_fallbacks; /**< cells where that fit failed and the volume path built
+                                      the rules (AUTO) */
   fcm_index surface_triangles; /**< clipped boundary triangles kept (per piece in cells that cuts
                                   split) */
   fcm_index surface_points;

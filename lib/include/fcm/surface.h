@@ -225,12 +225,21 @@ typedef struct fcm_surface_mesh_options {
   int check_intersections;
   /** 1 (default): orient the surface first (fcm_surface_create_oriented()). */
   int orient;
+  /** 1 (default): tetrahedralize the volume (Gmsh). 0: no volume mesh: the geometry is the
+   * checked, oriented surface alone (fcm_geometry_num_cells() 0, no Gmsh needed, the set-up
+   * costs what the surface costs). The cut-cell rules then come from the surface
+   * (FCM_CELL_MOMENTS_AUTO); what needs the volume mesh — fcm_cell_rules_create_cut(), the
+   * VOLUME path — refuses such a geometry with FCM_ERR_UNSUPPORTED. max_volume, size and quality
+   * are ignored. */
+  int volume_mesh;
 } fcm_surface_mesh_options;
 
 /** Defaults of fcm_surface_mesh_options. */
 FCM_API fcm_surface_mesh_options fcm_surface_mesh_options_default(void);
 
-/** Tetrahedralize the volume a closed triangle surface encloses, through Gmsh's C API
+/** The geometry of the volume a closed triangle surface encloses: tetrahedralized (volume_mesh,
+ * the default) or the surface alone (volume_mesh = 0, see fcm_surface_mesh_options). It is
+ * tetrahedralized through Gmsh's C API
  * (3D Delaunay with the surface mesh kept: no surface vertex is moved or added, so the
  * tets' volume equals the surface's enclosed volume up to rounding). The surface is
  * checked first (fcm_surface_check(), fcm_surface_report_check()) and oriented.

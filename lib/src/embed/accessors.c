@@ -17,6 +17,12 @@ const char *fcm_cell_simplify_name(fcm_cell_simplify mode)
   return (int)mode >= 0 && mode < FCM_CELL_SIMPLIFY_COUNT ? names[mode] : "invalid";
 }
 
+const char *fcm_cell_moments_name(fcm_cell_moments path)
+{
+  static const char *const names[FCM_CELL_MOMENTS_COUNT] = {"auto", "volume", "surface"};
+  return (int)path >= 0 && path < FCM_CELL_MOMENTS_COUNT ? names[path] : "invalid";
+}
+
 void fcm_cell_rules_destroy(fcm_cell_rules **rules)
 {
   if (!rules || !*rules) return;

@@ -223,6 +223,46 @@ cleanup:
   return st;
 }
 
+/* The surface moments' rounding is about 1e-15 |K| whatever the material's size: a cell whose
+ * surface-moment volume is below this fraction of its own takes the volume path (when the
+ * geometry has cells), whose accuracy follows the material's size. */
+#define SURFACE_MIN_FRACTION 1e-9
+
+/* Without a volume mesh: a cell with less material than this (rounding) holds none. */
+#define SURFACE_EMPTY_FRACTION 1e-13
+
+/* A cut cell on the surface path: its one piece fitted on the surface moments, or, when the
+ * fit fails, built by the volume path (FCM_CELL_MOMENTS_AUTO) or refused (SURFACE). */
+static fcm_status surface_rules(const build *B, const fcm_cell_rules *R,
+                                const fcm__embed_cell *cell, fcm__embed_ws *ws, const double box[6],
+                                cell_out *o, cell_sums *sums)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  int ok;
+  double vol;
+  FCM_TRY(ctx, fcm__embed_surface_piece_fit(B, R, cell, ws, box, o->volume, o->pc, &ok));
+  sums->counts.surface_cells++;
+  if (ok) goto cleanup;
+  sums->counts.surface_fallbacks++;
+  FCM_CHECK(B->o->moments != FCM_CELL_MOMENTS_SURFACE && B->geom->num_cells > 0, ctx,
+            FCM_ERR_NUMERIC,
+            "embed: background cell %lld: no positive rule of at most M points on candidates "
+            "inside the material carries its surface moments (volume fraction %.3g)%s",
+            (long long)cell->id, o->volume / cell->volume,
+            B->geom->num_cells > 0 ? "; moments = auto falls back to the volume mesh"
+                                   : " and the geometry has no volume mesh to fall back on");
+  FCM_TRY(ctx, fcm__embed_cell_tets(ctx, B->geom, B->tree, cell, B->o->clip_rtol, B->o->sliver_rtol,
+                                    ws, &sums->counts, &vol));
+  FCM_CHECK(ws->num_tets > 0, ctx, FCM_ERR_NUMERIC,
+            "embed: background cell %lld: the fit on its surface moments failed and its volume "
+            "mesh has no material in it (volume fraction %.3g by the surface)",
+            (long long)cell->id, o->volume / cell->volume);
+  FCM_TRY(ctx, fcm__embed_map_piece(B, R, cell, ws, o->pc));
+cleanup:
+  return st;
+}
+
 /* Intersect, classify and build the rules of background cell c into o (the thread's own
  * buffers); R->cls[c] and R->fraction[c] are written here (one writer per cell). Cells the
  * cuts reach are split into material pieces first; each piece then takes the
@@ -240,7 +280,9 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   const int integrate = !B->rebuild || B->rebuild[c];
   const int own = !opt->cell_mask || opt->cell_mask[c]; /* 0: classified, no points */
   const double t0 = fcm_wtime();
+  double sbox[6];
   FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
+  int surface = B->surface && cell.affine && !(B->cut_tree && B->region[c]);
   if (B->cut_tree && B->region[c]) {
     if (!ws->parts) FCM_ALLOC(ctx, 1, ws->parts);
     P = ws->parts;
@@ -255,11 +297,16 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
       memcpy(o->fx, P->fx, 3 * P->nfx * sizeof(double));
       o->nfp = (int)P->nfp;
     }
-  } else {
+  } else if (surface) {
+    FCM_TRY(ctx, fcm__embed_surface_volume(B, &cell, ws, &vol, sbox));
+    surface = !(vol < SURFACE_MIN_FRACTION * cell.volume) || B->geom->num_cells == 0;
+    if (vol < SURFACE_EMPTY_FRACTION * cell.volume) vol = 0.0;
+  }
+  if (!surface && !P) {
     FCM_TRY(ctx, fcm__embed_cell_tets(ctx, B->geom, B->tree, &cell, opt->clip_rtol,
                                       opt->sliver_rtol, ws, &sums->counts, &vol));
   }
-  const int np = P ? P->num_pieces : ws->num_tets > 0;
+  const int np = P ? P->num_pieces : surface ? vol > 0.0 : ws->num_tets > 0;
   /* |K ∩ Ω| <= |K|: the clipped volumes can sum to |K| (1 + 1e-12) through rounding. A cut
    * cell has phi < uncut_fraction <= 1, so its rule needs no rescaling; only the recorded
    * fraction and volume are clamped. A cell split into several pieces is cut whatever its
@@ -296,7 +343,8 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
     sums->time_intersect += fcm_wtime() - t0;
     goto cleanup;
   }
-  if (cls == FCM_CELL_CUT) {
+  if (cls == FCM_CELL_CUT && surface) FCM_TRY(ctx, surface_rules(B, R, &cell, ws, sbox, o, sums));
+  if (cls == FCM_CELL_CUT && !surface) {
     for (int i = 0; i < o->np; i++) {
       double v;
       if (P) FCM_TRY(ctx, fcm__embed_piece_tets(ctx, P, P->piece, i, ws, NULL, &v));
@@ -378,6 +426,8 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
       sums->counts.surface_triangles += mine.counts.surface_triangles;
       sums->counts.sliver_volume += mine.counts.sliver_volume;
       sums->counts.degenerate += mine.counts.degenerate;
+      sums->counts.surface_cells += mine.counts.surface_cells;
+      sums->counts.surface_fallbacks += mine.counts.surface_fallbacks;
       sums->time_intersect += mine.time_intersect;
       sums->time_simplify += mine.time_simplify;
     }

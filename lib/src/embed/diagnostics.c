@@ -42,6 +42,38 @@ cleanup:
   return st;
 }
 
+/* The body's volume beyond each flagged side of the box from its boundary alone: beyond the
+ * plane x_d = a, F = (x_d - a) e_d has divergence 1 and vanishes on the plane, so the volume
+ * is the sum over the triangles' parts beyond it of int (x_d - a) n_d dA (the centroid rule is
+ * exact for the linear integrand). */
+static fcm_status surface_sides(fcm_ctx *ctx, const double mlo[3], const double mhi[3],
+                                const fcm_geometry *g, int beyond, double side_volume[6])
+{
+  double poly[3 * 16], work[3 * 16];
+  (void)ctx;
+  for (int side = 0; side < 6; side++) {
+    if (!(beyond >> side & 1)) continue;
+    const int d = side / 2, up = side % 2;
+    const double a = up ? mhi[d] : mlo[d];
+    fcm__plane pl = {{0, 0, 0}, up ? -a : a}; /* keep the part beyond: n.x <= dd */
+    pl.n[d] = up ? -1.0 : 1.0;
+    double v = 0.0;
+    for (fcm_index t = 0; t < g->num_tris; t++) {
+      for (int k = 0; k < 3; k++)
+        memcpy(poly + 3 * k, g->coords + 3 * g->tris[3 * t + k], 3 * sizeof *poly);
+      const int n = fcm__geom_polygon_clip(poly, 3, 16, &pl, 0.0, 1, work);
+      for (int i = 1; i + 1 < n; i++) {
+        const double *p0 = poly, *p1 = poly + 3 * i, *p2 = poly + 3 * (i + 1);
+        const int e = (d + 1) % 3, f = (d + 2) % 3; /* n_d dA = the projected area / 2 */
+        const double nd = (p1[e] - p0[e]) * (p2[f] - p0[f]) - (p1[f] - p0[f]) * (p2[e] - p0[e]);
+        v += ((p0[d] + p1[d] + p2[d]) / 3.0 - a) * nd / 2.0;
+      }
+    }
+    side_volume[side] = v;
+  }
+  return FCM_OK;
+}
+
 fcm_status fcm__embed_outside_sides(fcm_ctx *ctx, const double mlo[3], const double mhi[3],
                                     const fcm_geometry *geom, double side_volume[6])
 {
@@ -53,6 +85,7 @@ fcm_status fcm__embed_outside_sides(fcm_ctx *ctx, const double mlo[3], const dou
   for (int d = 0; d < 3; d++)
     beyond |= (glo[d] < mlo[d]) << (2 * d) | (ghi[d] > mhi[d]) << (2 * d + 1);
   if (!beyond) return FCM_OK;
+  if (geom->num_cells == 0) return surface_sides(ctx, mlo, mhi, geom, beyond, side_volume);
   const int npc = fcm_geometry_nodes_per_cell(geom);
   const fcm_element_type type = fcm_geometry_cell_type(geom);
   const double *GX = fcm_geometry_coords(geom);

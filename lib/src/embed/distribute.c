@@ -71,6 +71,9 @@ fcm_status fcm__embed_crop_geometry(fcm_ctx *ctx, const fcm_mesh *mesh, const fc
   FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &tri_tree));
   FCM_ALLOC(ctx, (size_t)geom->num_cells + 1, keep_cell);
   FCM_ALLOC(ctx, (size_t)geom->num_tris + 1, keep_tri);
+  /* the surface path reads lines through the whole body: it needs every boundary triangle */
+  if (opts->moments != FCM_CELL_MOMENTS_VOLUME && opts->simplify != FCM_CELL_SIMPLIFY_OFF)
+    memset(keep_tri, 1, (size_t)geom->num_tris);
   for (fcm_index c = 0; c < nc; c++) {
     const int cls = classify[c] != 0, srf = surface && surface[c] && opts->surface_strength >= 0;
     if (!cls && !srf) continue;

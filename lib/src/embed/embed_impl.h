@@ -113,9 +113,18 @@ typedef struct fcm__embed_ws {
   size_t num_spts, spt_cap;
   fcm__poly poly, scratch;
   struct fcm__parts *parts; /* cells reached by cuts (and their neighbours): NULL until used */
+  /* the surface path: signed rule, line crossings, candidate points and their status */
+  struct fcm__srule *sr, *bnd; /* the signed rule; points on the material's boundary */
+  struct fcm__crossings *cr;
+  double *cand_x;
+  int *cand_in;
+  size_t cand_cap;
 } fcm__embed_ws;
 
 void fcm__embed_ws_free(fcm_ctx *ctx, fcm__embed_ws *ws);
+
+/* The surface path's part of ws (surface_cells.c). */
+void fcm__embed_surface_ws_free(fcm_ctx *ctx, fcm__embed_ws *ws);
 
 /* Gather cell `id` of `mesh` and compute its planes, size, tolerance, volume and map.
  * FCM_ERR_GEOMETRY when the corner polyhedron has no positive volume. */
@@ -131,6 +140,8 @@ typedef struct fcm__embed_counts {
   fcm_index surface_triangles; /* clipped boundary triangles kept */
   double sliver_volume;        /* summed volume of the dropped slivers */
   fcm_index degenerate;        /* cells whose cut splitting changed the parts' volume */
+  fcm_index surface_cells;     /* cut cells fitted on surface moments */
+  fcm_index surface_fallbacks; /* of those, cells whose fit failed (volume path instead) */
 } fcm__embed_counts;
 
 /* ---------------------------------------------------------------- distributed classification */
@@ -429,15 +440,26 @@ typedef struct fcm__crossings {
 
 void fcm__crossings_free(fcm_ctx *ctx, fcm__crossings *c);
 
+/* *touched: some boundary triangle of g (tree: their boxes) has a part inside the affine
+ * `cell`; then box (lo[3], hi[3], reference coordinates) bounds the material in the cell: those
+ * parts and the cell corners inside the body (else it is empty, lo > hi). bnd (NULL: not
+ * wanted): the vertices and centroids of those parts, points on the material's boundary. */
+fcm_status fcm__embed_material_box(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                   const fcm__embed_cell *cell, fcm__idbuf *buf, fcm__crossings *cr,
+                                   fcm__srule *bnd, double box[6], int *touched);
+
 /* The signed rule s (reference coordinates of `cell`, which must be affine) that integrates
  * every polynomial of degree <= q->m exactly over the part of the cell inside the body bounded
  * by g's boundary triangles (closed, counter-clockwise seen from outside; tree: their boxes),
- * from the triangles that meet the cell (surface_moments.c explains how). *touched: some
- * triangle has a part of positive area inside the cell. FCM_ERR_GEOMETRY when a line through
- * the cell shows the surface is not closed. buf and cr are scratch. */
+ * from the triangles that meet the cell (surface_moments.c explains how). base (NULL: the
+ * cell's lower bounds): where the antiderivative in each direction starts, valid when the
+ * material lies at or above it (the lower corner of its box: the rule's points then stay in
+ * the box). FCM_ERR_GEOMETRY when a line through the cell shows the surface is not closed.
+ * buf and cr are scratch. */
 fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
                                   const fcm__embed_cell *cell, const fcm__moment_quad *q,
-                                  fcm__idbuf *buf, fcm__crossings *cr, fcm__srule *s, int *touched);
+                                  const double base[3], fcm__idbuf *buf, fcm__crossings *cr,
+                                  fcm__srule *s);
 
 /* The winding number of the body's boundary around the points (a, b, z[i]) (reference
  * coordinates of `cell`, affine), i < n, into inside[i]: 1 inside the body, 0 outside, decided

@@ -18,6 +18,7 @@ void fcm__embed_ws_free(fcm_ctx *ctx, fcm__embed_ws *ws)
   fcm__free(ctx, ws->parts);
   ws->parts = NULL;
   fcm__geom_idbuf_free(ctx, &ws->cand);
+  fcm__embed_surface_ws_free(ctx, ws);
   fcm__free(ctx, ws->tets);
   fcm__free(ctx, ws->vol);
   fcm__free(ctx, ws->spts);

@@ -16,6 +16,8 @@ fcm_status fcm__embed_check_options(fcm_ctx *ctx, const fcm_cell_rules_options *
             o->kinds, FCM_RULES_STIFFNESS, FCM_RULES_MASS);
   FCM_CHECK((int)o->simplify >= 0 && o->simplify < FCM_CELL_SIMPLIFY_COUNT, ctx, FCM_ERR_ARG,
             "embed: simplify = %d is not a mode (0 off, 1 on, 2 auto)", (int)o->simplify);
+  FCM_CHECK((int)o->moments >= 0 && o->moments < FCM_CELL_MOMENTS_COUNT, ctx, FCM_ERR_ARG,
+            "embed: moments = %d is not a path (0 auto, 1 volume, 2 surface)", (int)o->moments);
   if (o->simplify == FCM_CELL_SIMPLIFY_AUTO) {
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
       const char *kn = k == FCM_RULE_MASS ? "mass" : "stiffness";
@@ -155,6 +157,7 @@ void fcm__embed_build_release(build *B)
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     fcm_rule_destroy(&B->tet_rule[k]);
   fcm_rule_destroy(&B->tri_rule);
+  if (B->ctx) fcm__moment_quad_free(B->ctx, &B->mq);
 }
 
 /* Phase 1b: what every cell reads: tet rules, search trees of the embedded cells and
@@ -180,10 +183,31 @@ fcm_status fcm__embed_build_setup(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_
   FCM_TRY(ctx, fcm__embed_geometry_boxes(ctx, geom, 0, &boxes, &nbox));
   FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &B->tree));
   FCM_FREE(ctx, boxes);
-  if (o->surface_strength >= 0) {
+  /* the surface path needs the whole closed boundary (a crop keeps it for this path); a
+   * geometry without cells has no other path */
+  FCM_CHECK(geom->num_cells > 0 || o->moments != FCM_CELL_MOMENTS_VOLUME, ctx, FCM_ERR_UNSUPPORTED,
+            "embed: moments = volume with a geometry that has no volume mesh (a surface geometry "
+            "made with volume_mesh = 0); use moments = auto");
+  B->surface = o->moments != FCM_CELL_MOMENTS_VOLUME &&
+               (o->simplify != FCM_CELL_SIMPLIFY_OFF || geom->num_cells == 0) &&
+               geom->num_tris > 0 && (!geom->tri_orig || geom->num_tris == geom->orig_tris);
+  if (o->surface_strength >= 0)
     FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TRI, o->surface_strength, &B->tri_rule));
+  if (o->surface_strength >= 0 || B->surface) {
     FCM_TRY(ctx, fcm__embed_geometry_boxes(ctx, geom, 1, &boxes, &nbox));
     FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &B->tri_tree));
+  }
+  if (B->surface) { /* both kinds' strengths, built or not: the rules of one kind do not
+                       depend on which others are built */
+    const fcm_element_info *info = fcm_mesh_get_element_info(mesh);
+    const int es[FCM_RULE_KIND_COUNT] = {
+        [FCM_RULE_STIFFNESS] = info->stiffness_strength, [FCM_RULE_MASS] = info->mass_strength};
+    int m = 0;
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+      B->fit_strength[k] = o->strength[k] >= 0 ? o->strength[k] : es[k];
+      m = FCM_MAX(m, B->fit_strength[k]);
+    }
+    FCM_TRY(ctx, fcm__moment_quad_create(ctx, m, &B->mq));
   }
 cleanup:
   fcm__free(ctx, boxes);
@@ -328,6 +352,8 @@ void fcm__embed_gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const 
   S->sliver_volume = sums->counts.sliver_volume;
   S->num_degenerate = sums->counts.degenerate;
   S->surface_triangles = sums->counts.surface_triangles;
+  S->num_surface_cells = sums->counts.surface_cells;
+  S->num_surface_fallbacks = sums->counts.surface_fallbacks;
   S->geometry_volume = fcm_geometry_volume(geom);
   S->num_threads = nthreads;
   S->time_intersect = sums->time_intersect;

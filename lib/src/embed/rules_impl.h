@@ -27,6 +27,7 @@ typedef struct piece_out {
   unsigned char skipped[FCM_RULE_KIND_COUNT], fallback[FCM_RULE_KIND_COUNT];
   double residual[FCM_RULE_KIND_COUNT];
   double tsimp[FCM_RULE_KIND_COUNT]; /* fcm_simplify's time_total */
+  unsigned char fitted; /* rules fitted on surface moments (at most M points: not simplified) */
   int parent;    /* the piece of the same cell in the rules being extended that holds this one */
   int component; /* its number among the cell's components before empty ones were dropped */
   int ns;
@@ -60,6 +61,9 @@ typedef struct build {
   fcm_rule *tet_rule[FCM_RULE_KIND_COUNT];        /* rule mapped onto each tet */
   const fcm_rule *full_rule[FCM_RULE_KIND_COUNT]; /* catalogue rule of the cell shape (in R) */
   fcm_rule *tri_rule;                             /* NULL: no surface rules */
+  int surface;                                    /* the surface path is on (tri_tree is built) */
+  fcm__moment_quad mq; /* its quadratures, exact for the largest of fit_strength */
+  int fit_strength[FCM_RULE_KIND_COUNT]; /* each kind's strength, built or not */
   int stabilize[FCM_RULE_KIND_COUNT];
   /* Cutting: the tree of R->cut_tris (NULL without cuts); region[c]: cell c shares a node
    * with a cell the cuts reach (its face polygons are recorded for the links); rebuild[c]:
@@ -137,6 +141,20 @@ fcm_status fcm__embed_map_piece(const build *B, const fcm_cell_rules *R,
 /* The surface points in ws into o, mapped to reference coordinates. */
 fcm_status fcm__embed_surface_piece(const build *B, const fcm__embed_cell *cell,
                                     const fcm__embed_ws *ws, piece_out *o);
+
+/* ---- surface_cells.c: the surface path */
+
+/* The material volume of an affine cell from the surface moments (the signed rule stays in
+ * ws for the fit); box: the reference bounding box of the boundary's parts in the cell. */
+fcm_status fcm__embed_surface_volume(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
+                                     double *vol, double box[6]);
+
+/* After fcm__embed_surface_volume() on the same cell (volume vol, box): piece o's rules of
+ * every kind built, fitted on candidates inside the material (o->fitted); *ok = 0 (o left
+ * without points) when the candidates cannot carry the moments. */
+fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
+                                        const fcm__embed_cell *cell, fcm__embed_ws *ws,
+                                        const double box[6], double vol, piece_out *o, int *ok);
 
 /* ---- auto_policy.c */
 

@@ -46,6 +46,8 @@ static double lin_eval(const lin *l, const double x[3])
 typedef struct ref_cell {
   int tet;
   double lo;   /* lower bound of every coordinate: -1 (cube) or 0 (tet) */
+  double c[3]; /* where the antiderivatives start, per direction: lo, or above it when the
+                  material lies above (shorter columns, no cancellation for small material) */
   lin exit1;   /* the exit facet's plane: xi_1 - 1 or xi_1 + xi_2 + xi_3 - 1 */
   lin exit2;   /* the exit edge on that facet (in xi_2, xi_3): xi_2 - 1 or xi_2 + xi_3 - 1 */
   lin cell[6]; /* the cell's constraints */
@@ -66,6 +68,7 @@ static void ref_cell_init(int tet, ref_cell *r)
 {
   r->tet = tet;
   r->lo = tet ? 0.0 : -1.0;
+  r->c[0] = r->c[1] = r->c[2] = r->lo;
   r->exit1 = tet ? mk(-1, 1, 1, 1) : mk(-1, 1, 0, 0);
   r->exit2 = tet ? mk(-1, 0, 1, 1) : mk(-1, 0, 1, 0);
   r->ncell = 0;
@@ -187,29 +190,29 @@ cleanup:
   return st;
 }
 
-/* W * G(y2, y3): G = int_lo^y2 F(e1(s, y3), s, y3) ds (degree m + 1 in s). */
+/* W * G(y2, y3): G = int_c2^y2 F(e1(s, y3), s, y3) ds (degree m + 1 in s). */
 static fcm_status add_face(fcm_ctx *ctx, const fcm__moment_quad *q, const ref_cell *r, double y2,
                            double y3, double W, fcm__srule *s)
 {
   fcm_status st = FCM_OK;
-  const double len = y2 - r->lo;
+  const double len = y2 - r->c[1];
   for (int j = 0; j < q->ng[1] && len != 0.0; j++) {
-    const double z2 = r->lo + len * q->gt[1][j];
+    const double z2 = r->c[1] + len * q->gt[1][j];
     const double y[3] = {exit1_at(r, z2, y3), z2, y3};
-    FCM_TRY(ctx, add_column(ctx, q, r->lo, y, W * len * q->ga[1][j], s));
+    FCM_TRY(ctx, add_column(ctx, q, r->c[0], y, W * len * q->ga[1][j], s));
   }
 cleanup:
   return st;
 }
 
-/* W * H(z): H = int_lo^z G(e2(t), t) dt (degree m + 2 in t). */
+/* W * H(z): H = int_c3^z G(e2(t), t) dt (degree m + 2 in t). */
 static fcm_status add_edge(fcm_ctx *ctx, const fcm__moment_quad *q, const ref_cell *r, double z,
                            double W, fcm__srule *s)
 {
   fcm_status st = FCM_OK;
-  const double len = z - r->lo;
+  const double len = z - r->c[2];
   for (int k = 0; k < q->ng[2] && len != 0.0; k++) {
-    const double t = r->lo + len * q->gt[2][k];
+    const double t = r->c[2] + len * q->gt[2][k];
     FCM_TRY(ctx, add_face(ctx, q, r, exit2_at(r, t), t, W * len * q->ga[2][k], s));
   }
 cleanup:
@@ -327,20 +330,35 @@ static int clip_polygon(const double *in, int n, const lin *l, double *out)
   return m;
 }
 
-/* Level 3: int over T cap K of W F n_1 dA, by a fan of the clipped polygon. */
-static fcm_status add_triangle(fcm_ctx *ctx, const fcm__moment_quad *q, const ref_cell *r,
-                               const rtri *T, fcm__srule *s, int *touched)
+static void grow_box(double box[6], const double x[3])
 {
-  fcm_status st = FCM_OK;
-  double a[3 * POLY_CAP], b[3 * POLY_CAP];
+  for (int d = 0; d < 3; d++) {
+    box[d] = fmin(box[d], x[d]);
+    box[3 + d] = fmax(box[3 + d], x[d]);
+  }
+}
+
+/* T clipped to K (the exit facet first: a triangle lying in its plane is kept or dropped on
+ * its own vertices' values, as the exit facet's segments see them) into a; its count. */
+static int clip_to_cell(const ref_cell *r, const rtri *T, double *a)
+{
+  double b[3 * POLY_CAP];
   memcpy(a, T->x, sizeof T->x);
   int n = 3;
   for (int k = 0; k < r->ncell && n >= 3; k++) {
     n = clip_polygon(a, n, r->cell + k, b);
     memcpy(a, b, 3 * (size_t)n * sizeof *a);
   }
-  if (n < 3) return FCM_OK;
-  *touched = 1;
+  return n;
+}
+
+/* Level 3: int over T cap K of W F n_1 dA, by a fan of the clipped polygon. */
+static fcm_status add_triangle(fcm_ctx *ctx, const fcm__moment_quad *q, const ref_cell *r,
+                               const rtri *T, fcm__srule *s)
+{
+  fcm_status st = FCM_OK;
+  double a[3 * POLY_CAP];
+  const int n = clip_to_cell(r, T, a);
   for (int i = 1; i + 1 < n; i++) {
     const double *p0 = a, *p1 = a + 3 * i, *p2 = a + 3 * (i + 1);
     double e1[3], e2[3];
@@ -352,7 +370,7 @@ static fcm_status add_triangle(fcm_ctx *ctx, const fcm__moment_quad *q, const re
       const double u = q->tx[2 * j], v = q->tx[2 * j + 1];
       const double y[3] = {p0[0] + u * e1[0] + v * e2[0], p0[1] + u * e1[1] + v * e2[1],
                            p0[2] + u * e1[2] + v * e2[2]};
-      FCM_TRY(ctx, add_column(ctx, q, r->lo, y, q->tw[j] * n1, s));
+      FCM_TRY(ctx, add_column(ctx, q, r->c[0], y, q->tw[j] * n1, s));
     }
   }
 cleanup:
@@ -475,16 +493,71 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__embed_material_box(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                   const fcm__embed_cell *cell, fcm__idbuf *buf, fcm__crossings *cr,
+                                   fcm__srule *bnd, double box[6], int *touched)
+{
+  fcm_status st = FCM_OK;
+  ref_cell r;
+  ref_cell_init(cell->info->shape == FCM_SHAPE_TET, &r);
+  *touched = 0;
+  if (bnd) bnd->n = 0;
+  for (int d = 0; d < 3; d++)
+    box[d] = HUGE_VAL, box[3 + d] = -HUGE_VAL;
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, cell->lo, cell->hi, buf));
+  for (size_t k = 0; k < buf->n; k++) {
+    rtri T;
+    double a[3 * POLY_CAP];
+    load_tri(g, cell, buf->ids[k], &T);
+    const int n = clip_to_cell(&r, &T, a);
+    if (n < 3) continue;
+    *touched = 1;
+    double c[3] = {0.0, 0.0, 0.0};
+    for (int i = 0; i < n; i++) {
+      grow_box(box, a + 3 * i);
+      for (int d = 0; d < 3; d++)
+        c[d] += a[3 * i + d] / n;
+    }
+    if (!bnd) continue;
+    FCM_TRY(ctx, srule_room(ctx, bnd, (size_t)n + 1));
+    memcpy(bnd->x + 3 * bnd->n, a, 3 * (size_t)n * sizeof *a);
+    memcpy(bnd->x + 3 * (bnd->n + (size_t)n), c, sizeof c);
+    for (int i = 0; i <= n; i++)
+      bnd->w[bnd->n + (size_t)i] = 0.0;
+    bnd->n += (size_t)n + 1;
+  }
+  if (!*touched) goto cleanup;
+  /* the corners inside the body: the material's other vertices are on the triangles' parts */
+  const int tet = cell->info->shape == FCM_SHAPE_TET;
+  for (int i = 0; i < 2; i++)
+    for (int j = 0; j < 2; j++) {
+      if (tet && i + j > 1) continue;
+      const double a = i ? 1.0 : r.lo, b = j ? 1.0 : r.lo, z[2] = {r.lo, 1.0};
+      const int nz = tet && i + j == 1 ? 1 : 2;
+      int in[2];
+      FCM_TRY(ctx, fcm__embed_inside_line(ctx, g, tree, cell, a, b, nz, z, in, buf, cr));
+      for (int k = 0; k < nz; k++) {
+        const double x[3] = {a, b, z[k]};
+        if (in[k] == 1) grow_box(box, x);
+      }
+    }
+cleanup:
+  return st;
+}
+
 fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
                                   const fcm__embed_cell *cell, const fcm__moment_quad *q,
-                                  fcm__idbuf *buf, fcm__crossings *cr, fcm__srule *s, int *touched)
+                                  const double base[3], fcm__idbuf *buf, fcm__crossings *cr,
+                                  fcm__srule *s)
 {
   fcm_status st = FCM_OK;
   ref_cell r;
   const int tet = cell->info->shape == FCM_SHAPE_TET;
   ref_cell_init(tet, &r);
+  if (base)
+    for (int d = 0; d < 3; d++)
+      r.c[d] = fmax(r.lo, base[d]);
   s->n = 0;
-  *touched = 0;
   FCM_CHECK(cell->affine, ctx, FCM_ERR_INTERNAL,
             "embed: background cell %lld is not affine (surface moments need an affine map)",
             (long long)cell->id);
@@ -493,13 +566,13 @@ fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm
   for (size_t k = 0; k < buf->n; k++) {
     rtri T;
     load_tri(g, cell, buf->ids[k], &T);
-    FCM_TRY(ctx, add_triangle(ctx, q, &r, &T, s, touched));
+    FCM_TRY(ctx, add_triangle(ctx, q, &r, &T, s));
     FCM_TRY(ctx, add_segment(ctx, q, &r, &T, s));
   }
   /* level 1: the exit edge, from the exit facet's corner (xi_3 = lo) to the cell corner */
-  const double base[3] = {tet ? 0.0 : 1.0, 1.0, 0.0}, dir[3] = {0.0, tet ? -1.0 : 0.0, 1.0};
+  const double lbase[3] = {tet ? 0.0 : 1.0, 1.0, 0.0}, dir[3] = {0.0, tet ? -1.0 : 0.0, 1.0};
   int sum, corner = 0;
-  FCM_TRY(ctx, line_candidates(ctx, g, tree, cell, base, dir, buf));
+  FCM_TRY(ctx, line_candidates(ctx, g, tree, cell, lbase, dir, buf));
   FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &r.exit1, &r.exit2, cr, &sum));
   FCM_CHECK(sum == 0, ctx, FCM_ERR_GEOMETRY,
             "embed: background cell %lld: its edge line crosses the body's boundary %d more "

@@ -45,6 +45,13 @@ fcm_status fcm__geom_create_take(fcm_ctx *ctx, const char *who, fcm_element_type
                                  fcm_index num_nodes, double **coords, fcm_index num_cells,
                                  fcm_index **cells, int require_positive, fcm_geometry **geom);
 
+/* A geometry without cells: the closed, outward-oriented triangle surface (nv vertices, nt
+ * triangles, copied) as its boundary; volume by the divergence theorem (FCM_ERR_GEOMETRY when
+ * not positive: an inward surface). Tet4 type, num_cells 0, tri_cell -1. */
+fcm_status fcm__geom_create_boundary(fcm_ctx *ctx, const char *who, fcm_index nv,
+                                     const double *coords, fcm_index nt, const fcm_index *tris,
+                                     fcm_geometry **geom);
+
 /* A subset of g: the cells with keep_cell[c] and the boundary triangles with keep_tri[t] (not
  * rebuilt from the kept cells), both in their original order, and the nodes they use in
  * theirs (coordinates copied bit for bit); volume and bounding box those of g. Original ids

@@ -167,6 +167,52 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__geom_create_boundary(fcm_ctx *ctx, const char *who, fcm_index nv,
+                                     const double *coords, fcm_index nt, const fcm_index *tris,
+                                     fcm_geometry **geom)
+{
+  fcm_status st = FCM_OK;
+  fcm_geometry *g = NULL;
+  *geom = NULL;
+  FCM_ALLOC(ctx, 1, g);
+  g->ctx = ctx;
+  g->type = FCM_ELEMENT_TET4;
+  g->npc = 4;
+  g->num_nodes = nv;
+  g->num_tris = nt;
+  g->custom_boundary = 1;
+  FCM_ALLOC(ctx, 3 * (size_t)nv + 1, g->coords);
+  FCM_ALLOC(ctx, 1, g->cells);
+  FCM_ALLOC(ctx, 3 * (size_t)nt + 1, g->tris);
+  FCM_ALLOC(ctx, (size_t)nt + 1, g->tri_cell);
+  memcpy(g->coords, coords, 3 * (size_t)nv * sizeof *coords);
+  memcpy(g->tris, tris, 3 * (size_t)nt * sizeof *tris);
+  for (int d = 0; d < 3; d++)
+    g->lo[d] = HUGE_VAL, g->hi[d] = -HUGE_VAL;
+  for (fcm_index a = 0; a < nv; a++)
+    for (int d = 0; d < 3; d++) {
+      g->lo[d] = fmin(g->lo[d], coords[3 * a + d]);
+      g->hi[d] = fmax(g->hi[d], coords[3 * a + d]);
+    }
+  for (fcm_index t = 0; t < nt; t++) { /* sum of the tets (origin, triangle) */
+    const double *a = coords + 3 * tris[3 * t], *b = coords + 3 * tris[3 * t + 1],
+                 *c = coords + 3 * tris[3 * t + 2];
+    g->tri_cell[t] = -1;
+    g->volume += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                  a[2] * (b[0] * c[1] - b[1] * c[0])) /
+                 6.0;
+  }
+  FCM_CHECK(g->volume > 0.0 && isfinite(g->volume), ctx, FCM_ERR_GEOMETRY,
+            "%s: the surface encloses volume %g (must be positive: a closed surface oriented "
+            "outward)",
+            who, g->volume);
+  *geom = g;
+  g = NULL;
+cleanup:
+  fcm_geometry_destroy(&g);
+  return st;
+}
+
 fcm_status fcm_geometry_create(fcm_ctx *ctx, fcm_element_type type, fcm_index num_nodes,
                                const double *coords, fcm_index num_cells, const fcm_index *cells,
                                fcm_geometry **geom)
@@ -269,6 +315,7 @@ fcm_status fcm_geometry_create_transformed(fcm_ctx *ctx, const fcm_geometry *src
     fcm__free(ctx, g->tris);
     fcm__free(ctx, g->tri_cell);
     g->tris = t, g->tri_cell = tc, g->num_tris = src->num_tris, g->custom_boundary = 1;
+    if (src->num_cells == 0) g->volume = src->volume * fabs(det); /* a surface alone */
   }
 cleanup:
   fcm__free(ctx, x);

@@ -1,6 +1,7 @@
 /* The one file that talks to Gmsh's C API (gmshc.h, Debian libgmsh-dev; built when
  * FCM_HAVE_GMSH is defined, Gmsh loaded at run time): tetrahedralization of a closed
  * triangle surface. */
+#include "geom/geom_impl.h"
 #include "geom/surface_impl.h"
 
 #include <math.h>
@@ -8,7 +9,7 @@
 
 fcm_surface_mesh_options fcm_surface_mesh_options_default(void)
 {
-  fcm_surface_mesh_options o = {0.0, 0.0, 0.3, 1, 1};
+  fcm_surface_mesh_options o = {0.0, 0.0, 0.3, 1, 1, 1};
   return o;
 }
 
@@ -311,7 +312,12 @@ fcm_status fcm_geometry_create_from_surface(fcm_ctx *ctx, const fcm_surface *sur
   co.self_intersections = o.check_intersections != 0;
   FCM_TRY(ctx, fcm_surface_check(s, &co, &rep));
   FCM_TRY(ctx, fcm_surface_report_check(s, "surface meshing", &rep));
-  FCM_TRY(ctx, tetrahedralize(ctx, s, &o, geom));
+  if (o.volume_mesh)
+    FCM_TRY(ctx, tetrahedralize(ctx, s, &o, geom));
+  else
+    FCM_TRY(ctx, fcm__geom_create_boundary(ctx, "surface", fcm_surface_num_vertices(s),
+                                           fcm_surface_coords(s), fcm_surface_num_triangles(s),
+                                           fcm_surface_triangles(s), geom));
 cleanup:
   fcm_surface_destroy(&oriented);
   return st;

@@ -175,8 +175,8 @@ static fcm_status read_surface_geometry(fcm__scene_parser *p, const fcm__json *o
 {
   fcm_status st = FCM_OK;
   static const char *const keys[] = {
-      "surface",        "max_volume",         "size",     "quality", "fill_holes",
-      "max_hole_edges", "max_hole_perimeter", "transform"};
+      "surface",        "max_volume",         "size",      "quality",    "fill_holes",
+      "max_hole_edges", "max_hole_perimeter", "transform", "volume_mesh"};
   static const char *const exts[] = {".obj", ".off", ".stl", ".ply"};
   size_t old = p->path_len;
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, SCENE_COUNT(keys)));
@@ -207,6 +207,9 @@ static fcm_status read_surface_geometry(fcm__scene_parser *p, const fcm__json *o
   FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "quality", 0, (fcm__range){0.0, 1.0, 0, 0},
                                          &g->surface.quality));
   FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "fill_holes", 0, &g->fill_holes));
+  g->surface.volume_mesh = -1; /* "auto": only for a scene that cuts */
+  FCM_TRY(p->ctx, fcm__scene_read_bool_or_word(p, o, "volume_mesh", 0, "auto", -1,
+                                               &g->surface.volume_mesh));
   long long me = 0;
   FCM_TRY(p->ctx, fcm__scene_read_int(p, o, "max_hole_edges", 0, 0, 1000000000, &me));
   g->fill.max_edges = (fcm_index)me;
@@ -518,6 +521,7 @@ fcm_status fcm__scene_read_geometry(fcm__scene_parser *p, const fcm__json *root)
                                          "fill_holes",
                                          "max_hole_edges",
                                          "max_hole_perimeter",
+                                         "volume_mesh",
                                          "voxels",
                                          "threshold",
                                          "labels",

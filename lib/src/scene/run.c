@@ -164,6 +164,8 @@ static fcm_status build_surface_geometry(fcm_simulation *S, const fcm_scene_geom
     FCM_TRY(ctx, fcm_surface_report_check(surf, what, &rep));
     mo.check_intersections = 0; /* done above */
     mo.orient = 0;
+    if (mo.volume_mesh < 0) /* auto: cutting splits the geometry's cells */
+      mo.volume_mesh = fcm_scene_count_effects(S->scene, FCM_EFFECT_CUT) > 0;
     FCM_TRY(ctx, fcm_geometry_create_from_surface(ctx, surf, &mo, raw));
   }
 cleanup:

@@ -162,4 +162,24 @@ fcm_status fcm__simplify_reduce(fcm__attempt *a, int rows, int ncols, double *g,
 /* Elimination on all n points when n <= 4 M, else recombination with elimination rounds. */
 fcm_status fcm__simplify_run_eliminate(fcm__attempt *a);
 
+/* ---- moment fitting (fit.c) ---- */
+
+/* A fitted rule: count <= M candidates idx[] (ascending) with positive weights w[] (both
+ * arrays of M entries, the caller's), their relative moment residual; ok = 0 with a message
+ * when the candidates cannot carry the moments. */
+typedef struct fcm__fit {
+  int ok, count;
+  int *idx;
+  double *w;
+  double residual;
+  char message[200];
+} fcm__fit;
+
+/* At most M of the n candidate points (x 3) with positive weights whose moments in the basis of
+ * box equal b (M entries) to max(tol max|b|, atol): relative, down to the absolute level atol
+ * of the moments' own rounding. Not fitting is not an error (ok = 0); errors: FCM_ERR_ALLOC,
+ * GLPK's. */
+fcm_status fcm__simplify_fit(fcm_ctx *ctx, const fcm__cheb_box *box, int n, const double *pts,
+                             const double *b, double tol, double atol, fcm__fit *f);
+
 #endif /* FCM_SIMPLIFY_IMPL_H */

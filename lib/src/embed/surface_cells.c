@@ -1,0 +1,237 @@
+/* The surface path of a background cell (FCM_CELL_MOMENTS_AUTO / SURFACE): its material
+ * volume from the exact surface moments (surface_moments.c), and for a cut cell a positive
+ * rule of at most M points per kind, fitted on candidate points inside the material to those
+ * moments (fcm__simplify_fit). The candidates are the centres of a grid over the material's
+ * bounding box in the cell, fine enough that about CAND_PER_MOMENT x M of them fall inside
+ * the material; a fit that fails is retried once on a grid with GROW times as many points. */
+#include "embed/rules_impl.h"
+#include "simplify/simplify_impl.h"
+
+#include <math.h>
+#include <string.h>
+
+enum { CAND_PER_MOMENT = 4, GROW = 4, GRID_MAX = 64 };
+
+/* Absolute moment residual accepted, per unit of the material box's reference volume: ten times
+ * the moments' own rounding. */
+#define MOMENT_ATOL 1e-14
+
+static fcm_status ws_surface(fcm_ctx *ctx, fcm__embed_ws *ws)
+{
+  fcm_status st = FCM_OK;
+  if (!ws->sr) FCM_ALLOC(ctx, 1, ws->sr);
+  if (!ws->cr) FCM_ALLOC(ctx, 1, ws->cr);
+  if (!ws->bnd) FCM_ALLOC(ctx, 1, ws->bnd);
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_surface_volume(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
+                                     double *vol, double box[6])
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  int touched;
+  FCM_TRY(ctx, ws_surface(ctx, ws));
+  FCM_TRY(ctx, fcm__embed_material_box(ctx, B->geom, B->tri_tree, cell, &ws->cand, ws->cr, ws->bnd,
+                                       box, &touched));
+  FCM_TRY(ctx, fcm__embed_moment_rule(ctx, B->geom, B->tri_tree, cell, &B->mq, touched ? box : NULL,
+                                      &ws->cand, ws->cr, ws->sr));
+  double s = 0.0;
+  for (size_t i = 0; i < ws->sr->n; i++)
+    s += ws->sr->w[i];
+  *vol = s * cell->detA;
+cleanup:
+  return st;
+}
+
+/* Candidates into ws->cand_x (*count of them): the points of an (n + 1)^3 grid over box, its
+ * faces included, that lie inside the reference cell and the body, and the vertices and
+ * centroids of the boundary triangles' parts in the cell (ws->bnd). Points on the material's
+ * boundary let the fit reach moments that interior points alone cannot (a measure's spread). */
+static fcm_status grid_candidates(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
+                                  const double box[6], int n, int *count)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const int tet = cell->info->shape == FCM_SHAPE_TET, np = n + 1;
+  const size_t need = (size_t)np * (size_t)np * (size_t)np + ws->bnd->n;
+  double h[3], *z = NULL;
+  *count = 0;
+  if (need > ws->cand_cap) {
+    void *x = ws->cand_x, *in = ws->cand_in;
+    FCM_TRY(ctx, fcm__resize(ctx, &x, 3 * ws->cand_cap, 3 * need, sizeof(double)));
+    ws->cand_x = x;
+    FCM_TRY(ctx, fcm__resize(ctx, &in, ws->cand_cap, need, sizeof(int)));
+    ws->cand_in = in;
+    ws->cand_cap = need;
+  }
+  FCM_ALLOC(ctx, (size_t)np, z);
+  for (int d = 0; d < 3; d++)
+    h[d] = (box[3 + d] - box[d]) / n;
+  for (int k = 0; k < np; k++)
+    z[k] = k == n ? box[5] : box[2] + k * h[2];
+  for (int i = 0; i < np; i++)
+    for (int j = 0; j < np; j++) {
+      const double a = i == n ? box[3] : box[0] + i * h[0], b = j == n ? box[4] : box[1] + j * h[1];
+      if (tet && a + b + z[0] > 1.0) continue;
+      FCM_TRY(ctx, fcm__embed_inside_line(ctx, B->geom, B->tri_tree, cell, a, b, np, z, ws->cand_in,
+                                          &ws->cand, ws->cr));
+      for (int k = 0; k < np; k++) {
+        if (ws->cand_in[k] != 1 || (tet && a + b + z[k] > 1.0)) continue;
+        double *x = ws->cand_x + 3 * (size_t)*count;
+        x[0] = a, x[1] = b, x[2] = z[k];
+        (*count)++;
+      }
+    }
+  memcpy(ws->cand_x + 3 * (size_t)*count, ws->bnd->x, 3 * ws->bnd->n * sizeof(double));
+  *count += (int)ws->bnd->n;
+cleanup:
+  fcm__free(ctx, z);
+  return st;
+}
+
+/* Grid size that puts about `target` points inside material of reference volume v in box. */
+static int grid_size(const double box[6], double v, double target)
+{
+  const double bv = (box[3] - box[0]) * (box[4] - box[1]) * (box[5] - box[2]);
+  const double n = cbrt(target * bv / fmax(v, 1e-300));
+  return (int)fmin(GRID_MAX, fmax(2.0, ceil(n)));
+}
+
+/* The limit fcm_cell_rules_options.max_rule_memory on the fit's peak: the signed rule (32
+ * bytes a point), the candidate grid (28 bytes a point) and the fit's moment matrices (three of
+ * M x candidates doubles). */
+static fcm_status check_fit_memory(const build *B, const fcm__embed_cell *cell,
+                                   const fcm__embed_ws *ws, int n, int M)
+{
+  fcm_status st = FCM_OK;
+  const double limit = B->o->max_rule_memory,
+               grid = (double)(n + 1) * (n + 1) * (n + 1) + (double)ws->bnd->n;
+  const double need = 32.0 * (double)ws->sr->n + 28.0 * grid + 24.0 * M * grid;
+  FCM_CHECK(limit <= 0.0 || need <= limit, B->ctx, FCM_ERR_UNSUPPORTED,
+            "embed: background cell %lld: fitting its rules on %zu surface-moment points and "
+            "%.0f candidates needs about %.3g GiB, above the limit of %.3g GiB "
+            "(fcm_cell_rules_options.max_rule_memory; scene key quadrature.max_rule_memory_gib): "
+            "raise the limit or lower the rule strengths",
+            (long long)cell->id, ws->sr->n, grid, need / GIB, limit / GIB);
+cleanup:
+  return st;
+}
+
+/* Fit kind k's rule on the candidates (count of them) into o; *ok = 0 when they cannot carry
+ * the moments. */
+static fcm_status fit_kind(const build *B, const fcm_cell_rules *R, const fcm__embed_ws *ws,
+                           const double box[6], int count, int k, piece_out *o, int *ok)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  fcm__cheb_box cb;
+  fcm__fit f;
+  double *mom = NULL, *work = NULL;
+  memset(&f, 0, sizeof f);
+  cb.m = R->strength[k];
+  cb.num_basis = fcm__simplify_num_basis(cb.m);
+  for (int d = 0; d < 3; d++) { /* the material's box -> [-1, 1]: a basis that the small
+                                   material of a sliver cell does not make singular */
+    const double a = box[d], b = box[3 + d];
+    cb.scale[d] = 2.0 / (b - a);
+    cb.shift[d] = -(a + b) / (b - a);
+  }
+  const int M = cb.num_basis;
+  const size_t ns = B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0;
+  FCM_ALLOC(ctx, (size_t)M, mom);
+  FCM_ALLOC(ctx, fcm__simplify_moments_scratch(cb.m), work);
+  FCM_ALLOC(ctx, (size_t)M, f.idx);
+  FCM_ALLOC(ctx, (size_t)M, f.w);
+  fcm__simplify_moments(&cb, (int)ws->sr->n, ws->sr->x, NULL, ws->sr->w, mom, work);
+  /* the moments' rounding: about 1e-15 of the material box's reference volume */
+  const double bv = (box[3] - box[0]) * (box[4] - box[1]) * (box[5] - box[2]);
+  FCM_TRY(ctx, fcm__simplify_fit(ctx, &cb, count, ws->cand_x, mom,
+                                 B->o->simplify_options.residual_tol, MOMENT_ATOL * bv, &f));
+  *ok = f.ok;
+  if (!f.ok) goto cleanup;
+  fcm__free(ctx, o->pts[k]);
+  fcm__free(ctx, o->w[k]);
+  fcm__free(ctx, o->flag[k]);
+  o->pts[k] = o->w[k] = NULL;
+  o->flag[k] = NULL;
+  FCM_ALLOC(ctx, 3 * ((size_t)f.count + ns), o->pts[k]);
+  FCM_ALLOC(ctx, (size_t)f.count + ns, o->w[k]);
+  FCM_ALLOC(ctx, (size_t)f.count + ns, o->flag[k]);
+  for (int i = 0; i < f.count; i++) {
+    memcpy(o->pts[k] + 3 * i, ws->cand_x + 3 * (size_t)f.idx[i], 3 * sizeof(double));
+    o->w[k][i] = f.w[i];
+  }
+  o->n[k] = o->nsimp[k] = f.count;
+  o->ninit[k] = count;
+  o->residual[k] = f.residual;
+cleanup:
+  fcm__free(ctx, mom);
+  fcm__free(ctx, work);
+  fcm__free(ctx, f.idx);
+  fcm__free(ctx, f.w);
+  return st;
+}
+
+fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
+                                        const fcm__embed_cell *cell, fcm__embed_ws *ws,
+                                        const double mbox[6], double vol, piece_out *o, int *ok)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  double box[6];
+  int Mmax = 1;
+  memcpy(box, mbox, sizeof box);
+  *ok = 0;
+  for (int d = 0; d < 3; d++)
+    if (!(box[d] < box[3 + d])) goto cleanup;   /* flat material: leave it to the volume path */
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) /* built or not, as the moments' degree */
+    Mmax = FCM_MAX(Mmax, fcm__simplify_num_basis(B->fit_strength[k]));
+  const double vref = vol / cell->detA;
+  int todo[FCM_RULE_KIND_COUNT], left = 0;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    left += todo[k] = B->tet_rule[k] != NULL;
+  /* each kind on the first grid, then the kinds that failed on the finer one: a kind's rules
+   * do not depend on the other kind */
+  for (int attempt = 0; attempt < 2 && left > 0; attempt++) {
+    const double target = CAND_PER_MOMENT * Mmax * (attempt ? GROW : 1);
+    const int n = grid_size(box, vref, target);
+    int count;
+    FCM_TRY(ctx, check_fit_memory(B, cell, ws, n, Mmax));
+    FCM_TRY(ctx, grid_candidates(B, cell, ws, box, n, &count));
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+      if (!todo[k]) continue;
+      int done;
+      FCM_TRY(ctx, fit_kind(B, R, ws, box, count, k, o, &done));
+      if (done) todo[k] = 0, left--;
+    }
+  }
+  *ok = left == 0;
+cleanup:
+  o->fitted = (unsigned char)*ok;
+  if (!*ok) /* leave no kind half fitted: the volume path starts from an empty piece */
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+      fcm__free(ctx, o->pts[k]);
+      fcm__free(ctx, o->w[k]);
+      fcm__free(ctx, o->flag[k]);
+      o->pts[k] = o->w[k] = NULL;
+      o->flag[k] = NULL;
+      o->n[k] = o->ninit[k] = o->nsimp[k] = 0;
+    }
+  return st;
+}
+
+void fcm__embed_surface_ws_free(fcm_ctx *ctx, fcm__embed_ws *ws)
+{
+  if (ws->sr) fcm__srule_free(ctx, ws->sr);
+  if (ws->cr) fcm__crossings_free(ctx, ws->cr);
+  if (ws->bnd) fcm__srule_free(ctx, ws->bnd);
+  fcm__free(ctx, ws->sr);
+  fcm__free(ctx, ws->cr);
+  fcm__free(ctx, ws->bnd);
+  fcm__free(ctx, ws->cand_x);
+  fcm__free(ctx, ws->cand_in);
+  ws->sr = NULL, ws->cr = NULL, ws->bnd = NULL, ws->cand_x = NULL, ws->cand_in = NULL;
+  ws->cand_cap = 0;
+}
