@@ -228,6 +228,24 @@ cleanup:
  * geometry has cells), whose accuracy follows the material's size. */
 #define SURFACE_MIN_FRACTION 1e-9
 
+/* FCM_CELL_MOMENTS_AUTO takes the surface path for a cell when the tets of the volume mesh
+ * that may meet it carry more initial points, summed over the kinds, than both 20 M
+ * (the volume path then costs more than the surface path's few M candidates, and its rules
+ * more to simplify) and 0.05 M^3 (the surface fit's SVD and LP grow like M^3: measured on one
+ * core, 70 ms a cell at M = 165 against 0.3 us an initial point of the volume path), M and
+ * M^3 summed over the kinds too. */
+static int surface_pays(const build *B, size_t candidates)
+{
+  double points = 0.0, M = 0.0, M3 = 0.0;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) { /* built or not: a kind's rules do not
+                                                      depend on the other kind's */
+    const double m = B->fit_M[k];
+    points += (double)candidates * B->fit_tet_points[k];
+    M += m, M3 += m * m * m;
+  }
+  return points > 20.0 * M && points > 0.05 * M3;
+}
+
 /* Without a volume mesh: a cell with less material than this (rounding) holds none. */
 #define SURFACE_EMPTY_FRACTION 1e-13
 
@@ -241,15 +259,17 @@ static fcm_status surface_rules(const build *B, const fcm_cell_rules *R,
   fcm_ctx *ctx = B->ctx;
   int ok;
   double vol;
-  FCM_TRY(ctx, fcm__embed_surface_piece_fit(B, R, cell, ws, box, o->volume, o->pc, &ok));
+  char why[256] = "";
+  FCM_TRY(ctx, fcm__embed_surface_piece_fit(B, R, cell, ws, box, o->volume, o->pc, &ok, why,
+                                            sizeof why));
   sums->counts.surface_cells++;
   if (ok) goto cleanup;
   sums->counts.surface_fallbacks++;
   FCM_CHECK(B->o->moments != FCM_CELL_MOMENTS_SURFACE && B->geom->num_cells > 0, ctx,
             FCM_ERR_NUMERIC,
             "embed: background cell %lld: no positive rule of at most M points on candidates "
-            "inside the material carries its surface moments (volume fraction %.3g)%s",
-            (long long)cell->id, o->volume / cell->volume,
+            "inside the material carries its surface moments (volume fraction %.3g; %s)%s",
+            (long long)cell->id, o->volume / cell->volume, why,
             B->geom->num_cells > 0 ? "; moments = auto falls back to the volume mesh"
                                    : " and the geometry has no volume mesh to fall back on");
   FCM_TRY(ctx, fcm__embed_cell_tets(ctx, B->geom, B->tree, cell, B->o->clip_rtol, B->o->sliver_rtol,
@@ -283,6 +303,11 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   double sbox[6];
   FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
   int surface = B->surface && cell.affine && !(B->cut_tree && B->region[c]);
+  if (surface && opt->moments == FCM_CELL_MOMENTS_AUTO && B->geom->num_cells > 0) {
+    /* auto: the surface path where the volume path would start from many points */
+    FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->tree, cell.lo, cell.hi, &ws->cand));
+    surface = surface_pays(B, ws->cand.n);
+  }
   if (B->cut_tree && B->region[c]) {
     if (!ws->parts) FCM_ALLOC(ctx, 1, ws->parts);
     P = ws->parts;

@@ -205,6 +205,12 @@ fcm_status fcm__embed_build_setup(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_
     int m = 0;
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
       B->fit_strength[k] = o->strength[k] >= 0 ? o->strength[k] : es[k];
+      B->fit_M[k] =
+          (B->fit_strength[k] + 1) * (B->fit_strength[k] + 2) * (B->fit_strength[k] + 3) / 6;
+      fcm_rule *t = NULL;
+      FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TET, B->fit_strength[k], &t));
+      B->fit_tet_points[k] = fcm_rule_num_points(t);
+      fcm_rule_destroy(&t);
       m = FCM_MAX(m, B->fit_strength[k]);
     }
     FCM_TRY(ctx, fcm__moment_quad_create(ctx, m, &B->mq));

@@ -63,7 +63,9 @@ typedef struct build {
   fcm_rule *tri_rule;                             /* NULL: no surface rules */
   int surface;                                    /* the surface path is on (tri_tree is built) */
   fcm__moment_quad mq; /* its quadratures, exact for the largest of fit_strength */
-  int fit_strength[FCM_RULE_KIND_COUNT]; /* each kind's strength, built or not */
+  int fit_strength[FCM_RULE_KIND_COUNT];   /* each kind's strength, built or not */
+  int fit_M[FCM_RULE_KIND_COUNT];          /* the number of moments of each kind's strength */
+  int fit_tet_points[FCM_RULE_KIND_COUNT]; /* points of the tet rule of that strength */
   int stabilize[FCM_RULE_KIND_COUNT];
   /* Cutting: the tree of R->cut_tris (NULL without cuts); region[c]: cell c shares a node
    * with a cell the cuts reach (its face polygons are recorded for the links); rebuild[c]:
@@ -151,10 +153,11 @@ fcm_status fcm__embed_surface_volume(const build *B, const fcm__embed_cell *cell
 
 /* After fcm__embed_surface_volume() on the same cell (volume vol, box): piece o's rules of
  * every kind built, fitted on candidates inside the material (o->fitted); *ok = 0 (o left
- * without points) when the candidates cannot carry the moments. */
+ * without points, why says what failed) when the candidates cannot carry the moments. */
 fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
                                         const fcm__embed_cell *cell, fcm__embed_ws *ws,
-                                        const double box[6], double vol, piece_out *o, int *ok);
+                                        const double box[6], double vol, piece_out *o, int *ok,
+                                        char *why, size_t why_len);
 
 /* ---- auto_policy.c */
 

@@ -1,16 +1,20 @@
 /* The surface path of a background cell (FCM_CELL_MOMENTS_AUTO / SURFACE): its material
  * volume from the exact surface moments (surface_moments.c), and for a cut cell a positive
  * rule of at most M points per kind, fitted on candidate points inside the material to those
- * moments (fcm__simplify_fit). The candidates are the centres of a grid over the material's
- * bounding box in the cell, fine enough that about CAND_PER_MOMENT x M of them fall inside
- * the material; a fit that fails is retried once on a grid with GROW times as many points. */
+ * moments (fcm__simplify_fit). The candidates are the points of a grid over the material's
+ * bounding box in the cell, fine enough that about CAND_PER_MOMENT x M of them fall inside the
+ * material, and points on the material's boundary; a fit that fails is retried once with GROW
+ * times as many. */
 #include "embed/rules_impl.h"
 #include "simplify/simplify_impl.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
-enum { CAND_PER_MOMENT = 4, GROW = 4, GRID_MAX = 64 };
+/* Grid candidates aimed at per moment, boundary points kept per moment, the finer grid's
+ * factor on a retry, the largest grid per axis. */
+enum { CAND_PER_MOMENT = 2, BOUNDARY_PER_MOMENT = 1, GROW = 4, GRID_MAX = 64 };
 
 /* Absolute moment residual accepted, per unit of the material box's reference volume: ten times
  * the moments' own rounding. */
@@ -46,11 +50,12 @@ cleanup:
 }
 
 /* Candidates into ws->cand_x (*count of them): the points of an (n + 1)^3 grid over box, its
- * faces included, that lie inside the reference cell and the body, and the vertices and
- * centroids of the boundary triangles' parts in the cell (ws->bnd). Points on the material's
- * boundary let the fit reach moments that interior points alone cannot (a measure's spread). */
+ * faces included, that lie inside the reference cell and the body, and up to nbnd of the
+ * vertices and centroids of the boundary triangles' parts in the cell (ws->bnd). Points on the
+ * material's boundary let the fit reach moments that interior points alone cannot (a
+ * measure's spread). */
 static fcm_status grid_candidates(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
-                                  const double box[6], int n, int *count)
+                                  const double box[6], int n, int nbnd, int *count)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
@@ -84,8 +89,13 @@ static fcm_status grid_candidates(const build *B, const fcm__embed_cell *cell, f
         (*count)++;
       }
     }
-  memcpy(ws->cand_x + 3 * (size_t)*count, ws->bnd->x, 3 * ws->bnd->n * sizeof(double));
-  *count += (int)ws->bnd->n;
+  /* at most nb of them, spread over the list (a finely triangulated surface has many) */
+  const size_t nb = FCM_MIN(ws->bnd->n, (size_t)nbnd);
+  for (size_t i = 0; i < nb; i++) {
+    const size_t j = i * ws->bnd->n / nb;
+    memcpy(ws->cand_x + 3 * (size_t)*count, ws->bnd->x + 3 * j, 3 * sizeof(double));
+    (*count)++;
+  }
 cleanup:
   fcm__free(ctx, z);
   return st;
@@ -122,7 +132,8 @@ cleanup:
 /* Fit kind k's rule on the candidates (count of them) into o; *ok = 0 when they cannot carry
  * the moments. */
 static fcm_status fit_kind(const build *B, const fcm_cell_rules *R, const fcm__embed_ws *ws,
-                           const double box[6], int count, int k, piece_out *o, int *ok)
+                           const double box[6], int count, int k, piece_out *o, int *ok, char *why,
+                           size_t why_len)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
@@ -150,7 +161,11 @@ static fcm_status fit_kind(const build *B, const fcm_cell_rules *R, const fcm__e
   FCM_TRY(ctx, fcm__simplify_fit(ctx, &cb, count, ws->cand_x, mom,
                                  B->o->simplify_options.residual_tol, MOMENT_ATOL * bv, &f));
   *ok = f.ok;
-  if (!f.ok) goto cleanup;
+  if (!f.ok) {
+    snprintf(why, why_len, "%s rules of strength %d on %d candidates: %s", fcm_rule_kind_name(k),
+             cb.m, count, f.message);
+    goto cleanup;
+  }
   fcm__free(ctx, o->pts[k]);
   fcm__free(ctx, o->w[k]);
   fcm__free(ctx, o->flag[k]);
@@ -176,7 +191,8 @@ cleanup:
 
 fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
                                         const fcm__embed_cell *cell, fcm__embed_ws *ws,
-                                        const double mbox[6], double vol, piece_out *o, int *ok)
+                                        const double mbox[6], double vol, piece_out *o, int *ok,
+                                        char *why, size_t why_len)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
@@ -199,11 +215,12 @@ fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
     const int n = grid_size(box, vref, target);
     int count;
     FCM_TRY(ctx, check_fit_memory(B, cell, ws, n, Mmax));
-    FCM_TRY(ctx, grid_candidates(B, cell, ws, box, n, &count));
+    FCM_TRY(ctx, grid_candidates(B, cell, ws, box, n,
+                                 BOUNDARY_PER_MOMENT * Mmax * (attempt ? GROW : 1), &count));
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
       if (!todo[k]) continue;
       int done;
-      FCM_TRY(ctx, fit_kind(B, R, ws, box, count, k, o, &done));
+      FCM_TRY(ctx, fit_kind(B, R, ws, box, count, k, o, &done, why, why_len));
       if (done) todo[k] = 0, left--;
     }
   }

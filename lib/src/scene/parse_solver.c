@@ -19,7 +19,7 @@ fcm_status fcm__scene_read_quadrature(fcm__scene_parser *p, const fcm__json *roo
   fcm_status st = FCM_OK;
   static const char *const keys[] = {"stiffness_strength", "mass_strength",      "surface_strength",
                                      "simplify",           "simplify_method",    "stabilization",
-                                     "min_fraction",       "max_rule_memory_gib"};
+                                     "min_fraction",       "max_rule_memory_gib", "moments"};
   static const char *const skeys[] = {"mode", "alpha"};
   fcm_cell_rules_options *q = &p->scene->quadrature.rules;
   const fcm__json *o = NULL, *stab = NULL;
@@ -42,6 +42,7 @@ fcm_status fcm__scene_read_quadrature(fcm__scene_parser *p, const fcm__json *roo
   }
   SCENE_READ_CHOICE(p, o, "simplify_method", 0, fcm__scene_simplify_names,
                     q->simplify_options.method);
+  SCENE_READ_CHOICE(p, o, "moments", 0, fcm__scene_moments_names, q->moments);
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "stabilization", 0, &stab));
   if (stab) {
     SCENE_ENTER(p, "stabilization");

@@ -164,8 +164,9 @@ static fcm_status build_surface_geometry(fcm_simulation *S, const fcm_scene_geom
     FCM_TRY(ctx, fcm_surface_report_check(surf, what, &rep));
     mo.check_intersections = 0; /* done above */
     mo.orient = 0;
-    if (mo.volume_mesh < 0) /* auto: cutting splits the geometry's cells */
-      mo.volume_mesh = fcm_scene_count_effects(S->scene, FCM_EFFECT_CUT) > 0;
+    if (mo.volume_mesh < 0) /* auto: cutting splits the geometry's cells, and the distributed
+                               backend partitions the work by them */
+      mo.volume_mesh = fcm_scene_count_effects(S->scene, FCM_EFFECT_CUT) > 0 || S->distributed;
     FCM_TRY(ctx, fcm_geometry_create_from_surface(ctx, surf, &mo, raw));
   }
 cleanup:
@@ -571,6 +572,7 @@ fcm_status fcm__scene_mesh_geometry(fcm_ctx *ctx, const fcm_scene *scene, fcm_me
   S->ctx = ctx;
   S->scene = scene;
   S->opts = fcm_simulation_options_default();
+  S->distributed = 1; /* the PETSc backend's partition and linear driver */
   FCM_TRY(ctx, build_mesh_geometry(S));
   *mesh = S->mesh;
   *geom = S->geom;
@@ -601,6 +603,7 @@ fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   FCM_ALLOC(ctx, 1, S);
   S->ctx = ctx;
   S->config = cfg->backend ? cfg : NULL;
+  S->distributed = cfg->backend != NULL;
   S->scene = scene;
   S->opts = cfg->opts;
   FCM_CHECK(S->opts.max_steps >= 1 || S->opts.max_steps == FCM_DEFAULT, ctx, FCM_ERR_ARG,

@@ -91,6 +91,7 @@ struct fcm_simulation {
   /* the distributed backend of the create (fcm__simulation_config; NULL afterwards and in
    * serial runs) */
   const fcm__simulation_config *config;
+  int distributed; /* 1: built for the distributed backend (a surface gets a volume mesh) */
   /* what the voxel or level-set geometry reported ("" for the other kinds) */
   char geometry_note[256];
 };

@@ -49,6 +49,7 @@ const char *const fcm__scene_axis_names[] = {"x", "y", "z"};
 const char *const fcm__scene_implicit_names[] = {"sphere", "torus",        "box",       "gyroid",
                                                  "union",  "intersection", "difference"};
 const char *const fcm__scene_simplify_names[] = {"auto", "lp", "recombine", "eliminate"};
+const char *const fcm__scene_moments_names[] = {"auto", "volume", "surface"};
 const char *const fcm__scene_stabilization_names[] = {"mass_stiffness", "mass", "off"};
 const char *const fcm__scene_solver_names[] = {"direct", "minres", "cg", "multigrid"};
 const int fcm__scene_solver_values[] = {FCM_LINEAR_DIRECT, FCM_LINEAR_MINRES, FCM_LINEAR_CG,

@@ -222,6 +222,7 @@ extern const char *const fcm__scene_element_names[4];        /* fcm_element_type
 extern const char *const fcm__scene_axis_names[3];           /* 0, 1, 2 */
 extern const char *const fcm__scene_implicit_names[7];       /* fcm_implicit_kind */
 extern const char *const fcm__scene_simplify_names[4];       /* fcm_simplify_method */
+extern const char *const fcm__scene_moments_names[3];        /* fcm_cell_moments */
 extern const char *const fcm__scene_stabilization_names[3];  /* fcm_stabilization_mode */
 extern const char *const fcm__scene_solver_names[4];         /* with fcm__scene_solver_values */
 extern const int fcm__scene_solver_values[4];                /* fcm_linear_solver */

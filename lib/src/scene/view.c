@@ -158,8 +158,8 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
     view_strength(f, "surface", q->surface_strength);
   else
     fprintf(f, " surface automatic");
-  fprintf(f, "; simplify %s (%s); stabilization %s alpha %g; min fraction %g\n",
-          fcm_cell_simplify_name(q->simplify),
+  fprintf(f, "; moments %s; simplify %s (%s); stabilization %s alpha %g; min fraction %g\n",
+          fcm_cell_moments_name(q->moments), fcm_cell_simplify_name(q->simplify),
           fcm__scene_simplify_names[q->simplify_options.method],
           fcm__scene_stabilization_names[q->stabilization.mode], q->stabilization.alpha,
           q->min_fraction);
