@@ -248,6 +248,20 @@ static double peak_rss(void)
   return 1024.0 * (double)ru.ru_maxrss;
 }
 
+/* Bytes the set-up's cut-cell rules held at their peak, from their statistics: each cut cell's
+ * pieces keep the arrays of their initial points (stabilization included) until the rules are
+ * gathered into one array per kind, which then holds the final points: 33 bytes a point (3
+ * coordinates, weight, flag) in both. The simplification's own work space (per cell, see
+ * fcm_cell_rules_options.max_rule_memory) and the geometry are not included. */
+static double rules_memory(const fcm_cell_rules_stats *rs)
+{
+  double points = 0.0;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    points += (double)rs->points_initial[k] + (double)rs->points_simplified[k] +
+              2.0 * (double)rs->points_stabilization[k];
+  return 33.0 * points;
+}
+
 /* The summary with the rules' statistics `gs`, the cuts' point counts `cs` (cut_lines()), the
  * counters `gc`, the body's largest |u| over its quadrature points `body`, the free body's
  * centre of mass `com_now` (NULL: not available) and the peak resident memory `rss` given (a
@@ -325,7 +339,13 @@ static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_
           "%.3f\n",
           c->time_setup, c->time_steps, c->time_steps - c->time_cuts, c->time_cuts, c->time_log,
           c->time_output);
-  if (rss > 0.0)
+  if (rss > 0.0 && S->rules)
+    fprintf(f,
+            "  memory    peak resident %.1f MiB%s; the set-up's cut-cell rules held about %.1f MiB "
+            "(every cut cell's initial points until they are gathered, then the final ones)\n",
+            rss / (1024.0 * 1024.0), gc ? " (summed over the processes)" : "",
+            rules_memory(gs ? gs : &S->setup_stats) / (1024.0 * 1024.0));
+  else if (rss > 0.0)
     fprintf(f, "  memory    peak resident %.1f MiB%s\n", rss / (1024.0 * 1024.0),
             gc ? " (summed over the processes)" : "");
 }
