@@ -120,10 +120,10 @@ cleanup:
   return st;
 }
 
-/* Mass, linear and angular momentum (unit density) of elements [e0, e1) from their blocks:
- * with x_a = X_a + u_a and (B v)_a = sum_b B_ab v_b, m = sum_ab B_ab, p = sum_a (B v)_a and
- * L = sum_a x_a x (B v)_a, the integrals over the points of sum N_a and sum N_a x_a x N_b v_b
- * exactly. q: m, p, L. */
+/* Mass, linear and angular momentum (unit density) of elements [e0, e1) into q (m, p, L) from
+ * their blocks. The fields are x = sum_a N_a x_a (x_a = X_a + u_a) and v = sum_b N_b v_b, so
+ * with (B v)_a = sum_b B_ab v_b the point sums of 1, v and x cross v are m = sum_ab B_ab
+ * (sum_a N_a = 1), p = sum_a (B v)_a and L = sum_a x_a cross (B v)_a. */
 static void chunk_momentum(const fcm_space *s, const double *blocks, fcm_index e0, fcm_index e1,
                            const double *u, const double *v, double q[7])
 {
