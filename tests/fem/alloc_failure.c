@@ -2,6 +2,7 @@
  * success) of fcm_space_create, fcm_space_create_embedded, fcm_space_matrix_create, every
  * assembly (stiffness, mass, body force, body-force field, surface traction, hyperelastic),
  * fcm_space_apply_dirichlet, fcm_space_locate (points inside cells and extrapolated ones),
+ * the first fcm_space_momentum of a space (its mass blocks),
  * fcm_element_standard_rule and the output fields (cell stress, max displacement, VTU of the
  * space, the embedded surface and its VTU), a local space localized on some cells
  * (fcm__space_create_local() + fcm__space_localize()) and its matrix over the local rows
@@ -67,6 +68,16 @@ static fcm_status space_create_embedded(void *u)
   x->s_out = (fcm_space *)x;
   fcm_status st = fcm_space_create_embedded(x->ctx, x->mesh, x->rules, &x->s_out);
   return OUT_CHECK(st, x->s_out);
+}
+/* A new embedded space and its first fcm_space_momentum() (which builds the mass blocks the
+ * space keeps): each of the two allocations can fail. */
+static fcm_status momentum(void *u)
+{
+  fixture *x = u;
+  double m, p[3], L[3];
+  fcm_status st = fcm_space_create_embedded(x->ctx, x->mesh, x->rules, &x->s_out);
+  if (st == FCM_OK) st = fcm_space_momentum(x->s_out, 1000.0, NULL, NULL, &m, p, L);
+  return st;
 }
 static fcm_status matrix_create(void *u)
 {
@@ -246,6 +257,7 @@ int main(void)
   alloc_loop(ctx, &f, "fcm_space_create", space_create, release, &x, 3, 1000);
   alloc_loop(ctx, &f, "fcm_space_create_embedded", space_create_embedded, release, &x, 3, 1000);
   alloc_loop(ctx, &f, "fcm_space_matrix_create", matrix_create, release, &x, 2, 1000);
+  alloc_loop(ctx, &f, "fcm_space_momentum (the mass blocks)", momentum, release, &x, 4, 1000);
   alloc_loop(ctx, &f, "fcm_element_standard_rule", standard_rule, release, &x, 1, 1000);
   alloc_loop(ctx, &f, "fcm_assemble_stiffness", stiffness, NULL, &x, 1, 1000);
   alloc_loop(ctx, &f, "fcm_assemble_mass", mass, NULL, &x, 1, 1000);

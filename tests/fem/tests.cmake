@@ -51,3 +51,8 @@ foreach(el tet4 tet10 hex8 hex20)
                TIMEOUT 3600)
 endforeach()
 fcm_add_test(fem_threads tests/fem/threads.c)
+# fcm_space_momentum() from the kept element mass blocks equals the sums over the mass-rule
+# points (cut cells, stabilization points, XFEM pieces) to 1e-12.
+foreach(el tet4 tet10 hex8 hex20)
+  fcm_add_test(fem_momentum_${el} tests/fem/momentum.c ARGS ${el})
+endforeach()

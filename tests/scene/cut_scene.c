@@ -30,6 +30,38 @@ static const char *cut_scene(char *buf, size_t cap, const char *cuts, const char
 /* Triangles of the last frame's embedded surface (boundary + cut faces). */
 static long last_surface_cells;
 
+/* The run summary of sim now (malloc'ed text). */
+static char *summary_text(fcm_simulation *sim)
+{
+  char *text = NULL;
+  size_t len = 0;
+  FILE *f = open_memstream(&text, &len);
+  if (f) {
+    fcm_simulation_summary_view(sim, f);
+    fclose(f);
+  }
+  return text;
+}
+
+/* The line of text starting with `head` (static copy; "" when there is none). */
+static const char *summary_line(const char *text, const char *head)
+{
+  static char line[1024];
+  const char *l = text ? strstr(text, head) : NULL;
+  const char *e = l ? strchr(l, '\n') : NULL;
+  const size_t n = !e ? 0 : (size_t)(e - l) < sizeof line - 1 ? (size_t)(e - l) : sizeof line - 1;
+  if (n) memcpy(line, l, n);
+  line[n] = '\0';
+  return line;
+}
+
+/* The summary after the set-up and after the run (NULL: not wanted; free them), and what its
+ * memory line must say of the set-up's rules: 33 bytes per point held (each cut cell's
+ * initial points with its stabilization points until the gather, and the gathered ones). */
+static char *summary_setup, *summary_end;
+static char rules_mib[128];
+static int want_summaries;
+
 /* Run to the end; return the log's columns pieces and mass per row. */
 static int run(fcm_ctx *ctx, const char *json, long long *pieces, double *mass,
                fcm_simulation_counters *c, int *rows)
@@ -41,6 +73,16 @@ static int run(fcm_ctx *ctx, const char *json, long long *pieces, double *mass,
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "cut.json", &scene));
   if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
   if (sim) {
+    if (want_summaries) {
+      const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(fcm_simulation_cell_rules(sim));
+      double held = 0.0;
+      for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+        held += 33.0 * (double)(rs->points_initial[k] + rs->points_simplified[k] +
+                                2 * rs->points_stabilization[k]);
+      snprintf(rules_mib, sizeof rules_mib, "; the set-up's cut-cell rules held about %.1f MiB ",
+               held / 1048576.0);
+      summary_setup = summary_text(sim);
+    }
     while (!fcm_simulation_done(sim)) {
       fcm_step_info si;
       fcm_status st = fcm_simulation_step(sim, &si);
@@ -63,6 +105,7 @@ static int run(fcm_ctx *ctx, const char *json, long long *pieces, double *mass,
     if (f) fclose(f);
     remove(path);
     fcm_simulation_get_counters(sim, c);
+    if (want_summaries) summary_end = summary_text(sim);
     /* a frame: the embedded surface holds the boundary and, after a cut, the cut faces */
     TEST_TRUE(mkdir("scene_cut_frames", 0755) == 0 || errno == EEXIST);
     TEST_OK(ctx, fcm_simulation_write_frame(sim, "scene_cut_frames", 0));
@@ -101,6 +144,7 @@ int main(void)
   fcm_simulation_counters c;
 
   /* cut at t = 0.04: applied before step 3 */
+  want_summaries = 1;
   if (run(ctx,
           cut_scene(
               buf, sizeof buf,
@@ -116,7 +160,18 @@ int main(void)
     TEST_TRUE(c.cuts == 1 && c.cuts_missed == 0 && c.pieces == 2);
     TEST_TRUE(c.cut_cells > 0 && c.cut_cells < 12);
     TEST_TRUE(last_surface_cells > (long)c.surface_triangles); /* cut faces written */
+    /* the summary's set-up lines stay the set-up's; the cut has a line of its own */
+    char cells[1024], cut[1024];
+    snprintf(cells, sizeof cells, "%s", summary_line(summary_setup, "  cells "));
+    TEST_TRUE(cells[0] != '\0' && !strcmp(cells, summary_line(summary_end, "  cells ")));
+    TEST_TRUE(summary_line(summary_setup, "  cut 1 ")[0] == '\0');
+    snprintf(cut, sizeof cut, "  cut 1     t = 0.04 s: %lld cells integrated again, ",
+             (long long)c.cut_cells);
+    TEST_TRUE(strstr(summary_end ? summary_end : "", cut) != NULL);
+    TEST_TRUE(strstr(summary_line(summary_end, "  memory    peak resident "), rules_mib) != NULL);
   }
+  free(summary_setup), free(summary_end);
+  want_summaries = 0;
   /* two cuts at t = 0 (listed out of order, the later one first): three slices */
   if (run(ctx,
           cut_scene(buf, sizeof buf,

@@ -1,9 +1,11 @@
 /* quadrature.simplify: true, false and "auto" parse to ON, OFF and AUTO (bad values are
  * rejected in tests/scene/errors.c); with "auto" the run summary reports the choice per rule
- * kind with its inputs: a static scene expects 1 stiffness assembly per step and no mass
- * assembly (no mass rules are built); a dynamic one 3 stiffness assemblies per step and 1
- * mass assembly; with 300 steps the Hex8 stiffness rules of a ball pay back (break-even below
- * 1 assembly in `fcm-converge payoff`). */
+ * kind with its inputs, every pass over the points counted: stiffness 3 force + tangent
+ * assemblies per step, one body-force assembly per gravity effect and space, and the stresses
+ * of every frame (the first, then every frame_interval-th step and the last); mass (dynamic
+ * only: a static scene builds no mass rules) the mass matrix and the log's mass blocks of each
+ * space; every cut makes a new space. With 300 steps the Hex8 stiffness rules of a ball pay
+ * back (break-even below 1 assembly in `fcm-converge payoff`). */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "test.h"
@@ -12,7 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void scene_json(char *buf, size_t n, const char *simplify, int dynamic, int steps)
+static void scene_json(char *buf, size_t n, const char *simplify, int dynamic, int steps,
+                       const char *cut)
 {
   snprintf(buf, n,
            "{\"version\": 1, \"name\": \"auto\","
@@ -26,8 +29,9 @@ static void scene_json(char *buf, size_t n, const char *simplify, int dynamic, i
            " \"time\": {\"static\": %s, \"steps\": %d, \"dt\": 0.01},"
            " \"effects\": [{\"gravity\": {\"acceleration\": [0, 0, -9.81]}},"
            "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [-0.5, 0, 0],"
-           "    \"normal\": [-1, 0, 0]}}}}]}",
-           simplify, dynamic ? "false" : "true", steps);
+           "    \"normal\": [-1, 0, 0]}}}}%s],"
+           " \"output\": {\"frame_interval\": 4}}",
+           simplify, dynamic ? "false" : "true", steps, cut);
 }
 
 /* The run summary after creating the simulation (no step taken). */
@@ -79,33 +83,52 @@ int main(void)
   char json[2048];
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
 
-  scene_json(json, sizeof json, "true", 1, 2);
+  scene_json(json, sizeof json, "true", 1, 2, "");
   char *s = summary(ctx, json, FCM_CELL_SIMPLIFY_ON);
   TEST_TRUE(line_has(s, "computed  stiffness simplification", " on (scene), "));
   TEST_TRUE(line_has(s, "computed  mass simplification", " on (scene), "));
   free(s);
-  scene_json(json, sizeof json, "false", 1, 2);
+  scene_json(json, sizeof json, "false", 1, 2, "");
   s = summary(ctx, json, FCM_CELL_SIMPLIFY_OFF);
   TEST_TRUE(line_has(s, "skipped   stiffness simplification", " off (scene), "));
   TEST_TRUE(line_has(s, "skipped   mass simplification", " off (scene), "));
   free(s);
 
-  /* static, 2 steps: 3 x 2 stiffness assemblies expected; no mass rules at all */
-  scene_json(json, sizeof json, "\"auto\"", 0, 2);
+  /* static, 2 steps: 3 x 2 force + tangent, 1 body force, frames after steps 0 and 2; no mass
+   * rules at all */
+  scene_json(json, sizeof json, "\"auto\"", 0, 2, "");
   s = summary(ctx, json, FCM_CELL_SIMPLIFY_AUTO);
   TEST_TRUE(line_has(s, "stiffness simplification", " auto: "));
-  TEST_TRUE(line_has(s, "stiffness simplification", " for 6 expected assemblies; "));
+  TEST_TRUE(line_has(s, "stiffness simplification",
+                     " for 9 expected passes (force + tangent 6, body forces 1, frames' "
+                     "stresses 2) over "));
   TEST_TRUE(line_has(s, "skipped   mass simplification", "(no mass rules built)"));
   free(s);
 
-  /* dynamic, 300 steps: 900 stiffness assemblies pay back; 1 mass assembly expected */
-  scene_json(json, sizeof json, "\"auto\"", 1, 300);
+  /* dynamic, 300 steps: 900 force + tangent, 1 body force, 76 frames (0, 4, ..., 300) pay
+   * back; the mass matrix and the log's blocks once each */
+  scene_json(json, sizeof json, "\"auto\"", 1, 300, "");
   s = summary(ctx, json, FCM_CELL_SIMPLIFY_AUTO);
-  TEST_TRUE(
-      line_has(s, "computed  stiffness simplification", " auto: on for 900 expected assemblies; "));
-  TEST_TRUE(line_has(s, "stiffness simplification", " core-s simplifying to "));
-  TEST_TRUE(line_has(s, "mass simplification", " for 1 expected assemblies; "));
-  TEST_TRUE(line_check(s, "mass simplification", "estimated 0 core-s assembling plain", 0));
+  TEST_TRUE(line_has(s, "computed  stiffness simplification",
+                     " auto: on for 977 expected passes (force + tangent 900, body forces 1, "
+                     "frames' stresses 76) over "));
+  TEST_TRUE(line_has(s, "mass simplification",
+                     " for 2 expected passes (mass matrix 1, the log's mass blocks 1) over "));
+  TEST_TRUE(line_check(s, "mass simplification", "estimated 0 core-s plain", 0));
+  free(s);
+
+  /* dynamic, 10 steps, two cuts: three spaces integrate the body forces, the mass matrix and
+   * the log's mass blocks */
+  scene_json(json, sizeof json, "\"auto\"", 1, 10,
+             ", {\"cut\": {\"time\": 0.05, \"surface\": {\"plane\": {\"point\": [0.1, 0, 0], "
+             "\"normal\": [1, 0, 0]}}}}, {\"cut\": {\"time\": 0.07, \"surface\": {\"plane\": "
+             "{\"point\": [0, 0.2, 0], \"normal\": [0, 1, 0]}}}}");
+  s = summary(ctx, json, FCM_CELL_SIMPLIFY_AUTO);
+  TEST_TRUE(line_has(s, "stiffness simplification",
+                     " for 37 expected passes (force + tangent 30, body forces 3, frames' "
+                     "stresses 4) over "));
+  TEST_TRUE(line_has(s, "mass simplification",
+                     " for 6 expected passes (mass matrix 3, the log's mass blocks 3) over "));
   free(s);
 
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);

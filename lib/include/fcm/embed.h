@@ -123,10 +123,13 @@ typedef struct fcm_cell_rules_options {
   double convex_rtol;    /**< tolerance of fcm_mesh_cell_is_convex(); default 1e-10 */
   fcm_cell_simplify simplify; /**< FCM_CELL_SIMPLIFY_ON (default), OFF or AUTO */
   fcm_cell_moments moments;   /**< FCM_CELL_MOMENTS_AUTO (default), VOLUME or SURFACE */
-  double expected_assemblies[FCM_RULE_KIND_COUNT]; /**< AUTO: how many times the rules of each
-                              kind will be assembled (>= 0): a static single solve about 1
-                              stiffness (Newton iterations), 0 mass; a dynamic run steps x
-                              Newton iterations stiffness, 1 mass (assembled once); default 1 */
+  double expected_assemblies[FCM_RULE_KIND_COUNT]; /**< AUTO: how many passes over the points
+                              of each kind the rules will see (>= 0), every use counted: a
+                              static single solve about 1 stiffness per Newton iteration, 0
+                              mass; a dynamic run steps x Newton iterations stiffness (plus
+                              body forces and output stresses), mass 2 per space built on the
+                              rules (the mass matrix, and the element blocks of
+                              fcm_space_momentum()); default 1 */
   double point_cost[FCM_RULE_KIND_COUNT]; /**< AUTO: core-seconds per point per assembly, > 0;
                               FCM_DEFAULT (default): fcm_cell_rules_point_cost() */
   fcm_simplify_options simplify_options;  /**< default fcm_simplify_options_default() */

@@ -143,8 +143,14 @@ FCM_API fcm_status fcm_space_transfer(const fcm_space *from, const fcm_space *to
  * x = X + u. Exact for the polynomial fields of the space where the mass rules are (cut
  * cells: rules of the mass strength), so a cut, which leaves the field unchanged, leaves
  * all three unchanged up to rounding. u and v (num_dofs) may be NULL (zero); outputs may
- * be NULL. @return FCM_OK, FCM_ERR_ARG (NULL space, density < 0, embedded rules built without
- * mass rules). No allocation. */
+ * be NULL. The first call integrates each element's mass block B_ab = int N_a N_b over those
+ * points once and the space keeps the blocks (nn (nn + 1) / 2 doubles per element, freed
+ * with the space; a cut's new space builds its own); every call then reduces m = rho sum
+ * B_ab, p = rho sum B_ab v_b, L = rho sum B_ab x_a cross v_b in O(elements x nn^2), equal
+ * to the sums over the points up to rounding and independent of the thread count.
+ * @return FCM_OK, FCM_ERR_ARG (NULL space, density < 0, embedded rules built without mass
+ * rules), FCM_ERR_ALLOC (the first call). Thread safe: a first call made concurrently
+ * builds the blocks once. */
 FCM_API fcm_status fcm_space_momentum(const fcm_space *space, double density, const double *u,
                                       const double *v, double *mass, double linear[3],
                                       double angular[3]);

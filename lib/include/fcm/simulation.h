@@ -98,7 +98,12 @@ typedef struct fcm_simulation_counters {
   fcm_index nonfinite_max;        /**< the most in one frame (0: none) */
   long long nonfinite_first_step; /**< the step of the first such frame (-1: none; 0: the
                                        initial state) */
-  double time_setup, time_steps, time_output; /**< seconds */
+  double time_setup, time_steps, time_output; /**< seconds; time_steps: the integrator's steps
+                                                    and the cuts */
+  double time_cuts; /**< seconds of the cuts applied after the set-up (rules, space, integrator;
+                         part of time_steps) */
+  double time_log;  /**< seconds of the per-step log rows (mass, momentum, reactions; not part
+                         of time_steps) */
 } fcm_simulation_counters;
 
 /** A running scene (opaque). */

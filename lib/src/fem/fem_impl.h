@@ -1,11 +1,22 @@
 /* fem module internals: the space layout shared by the module's files (space.c with
  * numbering.c and topology.c, assemble.c, eval.c, locate.c, fields.c; immutable after
- * fcm_space_create). */
+ * fcm_space_create, except for the momentum's cache, fcm__space_mass_cache). */
 #ifndef FCM_FEM_IMPL_H
 #define FCM_FEM_IMPL_H
 
 #include "core/core_impl.h"
 #include "fcm/fem.h"
+
+/* What fcm_space_momentum() keeps between calls (eval.c), owned by the space: the mass block
+ * of every element, built by its first call over the authentic points of the mass rules and
+ * freed with the space. The space's rules and numbering never change, so the blocks stay
+ * valid for its life; a cut makes a new space, with a new cache. Allocated with the space
+ * (empty) so that a const space can fill it; filled under an OpenMP critical section. */
+typedef struct fcm__space_mass_cache {
+  /* num_elems x nn (nn + 1) / 2: per element, sum over its authentic mass points of
+   * w det J N_a N_b (unit density), the upper triangle a <= b row by row; NULL until built */
+  double *blocks;
+} fcm__space_mass_cache;
 
 struct fcm_space {
   fcm_ctx *ctx;
@@ -73,6 +84,7 @@ struct fcm_space {
   const fcm_cell_rules *rules;
   int max_cut_points;
   fcm_rule *mass_rule; /* the standard mass rule of full cells (fcm_space_momentum()) */
+  fcm__space_mass_cache *mass_cache; /* fcm_space_momentum()'s element mass blocks */
 };
 
 /* A space whose numbering (node_dof, node_ncopy, elements, cell_elem, num_dofs, constrained
@@ -186,8 +198,15 @@ fcm_status fcm__space_localize(fcm_space *s, const unsigned char *own);
 fcm_status fcm__space_check_assemble(const fcm_space *s, const char *what);
 
 /* Bytes of the space's arrays: the numbering (replicated in a distributed run) and the
- * topology (copy graph, pattern, offsets, colours, local lists). Either may be NULL. */
+ * topology (copy graph, pattern, offsets, colours, local lists). Either may be NULL. The
+ * momentum's mass blocks (built on demand) are not counted: fcm__space_mass_cache_bytes(). */
 void fcm__space_memory(const fcm_space *s, double *numbering, double *topology);
+
+/* Bytes of the mass blocks fcm_space_momentum() has built (0 before its first call). (eval.c) */
+double fcm__space_mass_cache_bytes(const fcm_space *s);
+
+/* Free the mass blocks of fcm_space_momentum() and the cache itself. (eval.c) */
+void fcm__space_mass_cache_free(fcm_space *s);
 
 /* The elimination of fcm_space_apply_dirichlet() on a square A (n x n) with the constrained
  * DOFs already marked: con[i] = 1 for a constrained DOF i (n flags) and g[i] its prescribed

@@ -65,6 +65,7 @@ static fcm_status space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigne
   s->is_local = local;
   FCM_TRY(ctx, fcm__space_build_topology(s, local, cell_mask));
   FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, FCM_RULE_MASS, FCM_DEFAULT, &s->mass_rule));
+  FCM_ALLOC(ctx, 1, s->mass_cache);
   *out = s;
   s = NULL;
 cleanup:
@@ -179,6 +180,7 @@ void fcm_space_destroy(fcm_space **sp)
   fcm__free(ctx, s->elem_con);
   fcm__space_free_topology(s);
   fcm_rule_destroy(&s->mass_rule);
+  fcm__space_mass_cache_free(s);
   fcm__free(ctx, s);
   *sp = NULL;
 }

@@ -270,6 +270,25 @@ cleanup:
  * tangent, plus line-search and predictor force evaluations. */
 #define RUN_ASSEMBLIES_PER_STEP 3.0
 
+/* Every pass the run will make over the points of each rule kind (fcm__auto_uses): the
+ * set-up's space and integrator and those of every cut integrate all cells again (body
+ * forces; mass matrix and the log's mass blocks when dynamic), the Newton iterations
+ * assemble force and tangent, and each frame evaluates the stresses. */
+static fcm__auto_uses expected_uses(const fcm_scene *scene, int dynamic)
+{
+  fcm__auto_uses u;
+  const fcm_scene_time *tm = fcm_scene_get_time(scene);
+  const double spaces = 1.0 + (double)fcm_scene_count_effects(scene, FCM_EFFECT_CUT);
+  const double steps = (double)tm->num_steps;
+  const int every = fcm_scene_get_output(scene)->frame_interval;
+  u.steps = RUN_ASSEMBLIES_PER_STEP * steps * (dynamic ? 1.0 : (double)tm->load_steps);
+  u.loads = spaces * (double)fcm_scene_count_effects(scene, FCM_EFFECT_GRAVITY);
+  u.frames = 1.0 + ceil(steps / (double)(every > 0 ? every : 1)); /* the first and the last */
+  u.matrix = dynamic ? spaces : 0.0;
+  u.momentum = dynamic ? spaces : 0.0;
+  return u;
+}
+
 static fcm_status build_rules(fcm_simulation *S)
 {
   fcm_status st = FCM_OK;
@@ -292,14 +311,11 @@ static fcm_status build_rules(fcm_simulation *S)
     ro.surface_strength = q->strength[FCM_RULE_STIFFNESS] >= 0
                               ? q->strength[FCM_RULE_STIFFNESS]
                               : fcm_mesh_get_element_info(S->mesh)->stiffness_strength;
-  if (q->simplify == FCM_CELL_SIMPLIFY_AUTO) {
-    /* The assemblies the run expects: stiffness-kind rules (force + tangent, body forces) once
-     * per Newton iteration, about RUN_ASSEMBLIES_PER_STEP per step and load step; mass rules
-     * once (the constant mass matrix of a dynamic run), never in a static one. */
-    const fcm_scene_time *tm = fcm_scene_get_time(S->scene);
-    ro.expected_assemblies[FCM_RULE_STIFFNESS] =
-        RUN_ASSEMBLIES_PER_STEP * (double)tm->num_steps * (dynamic ? 1.0 : (double)tm->load_steps);
-    ro.expected_assemblies[FCM_RULE_MASS] = dynamic ? 1.0 : 0.0;
+  if (q->simplify == FCM_CELL_SIMPLIFY_AUTO) { /* every pass the run expects, by kind */
+    const fcm__auto_uses u = expected_uses(S->scene, dynamic);
+    S->auto_uses = u;
+    ro.expected_assemblies[FCM_RULE_STIFFNESS] = u.steps + u.loads + u.frames;
+    ro.expected_assemblies[FCM_RULE_MASS] = u.matrix + u.momentum;
   }
   if (sv->threads > 0) FCM_TRY(S->ctx, fcm_ctx_set_num_threads(S->ctx, sv->threads));
   ro.progress = S->opts.rules_progress;
@@ -316,6 +332,7 @@ static fcm_status build_rules(fcm_simulation *S)
     FCM_TRY(S->ctx, fcm__cell_rules_create_reduced(S->ctx, S->mesh, S->geom, &ro, &red, &S->rules));
   else
     FCM_TRY(S->ctx, fcm_cell_rules_create(S->ctx, S->mesh, S->geom, &ro, &S->rules));
+  S->setup_stats = *fcm_cell_rules_get_stats(S->rules);
   S->c.cell_rules = 1;
   S->c.surface_rules = ro.surface_strength >= 0;
   S->c.rule_kinds = fcm_cell_rules_get_stats(S->rules)->kinds;
@@ -434,6 +451,15 @@ cleanup:
   return st;
 }
 
+/* The element mass blocks of the log's mass and momentum (fcm_space_momentum() keeps them in
+ * the space), built with the space rather than in the first step's log; nothing when the
+ * rules carry no mass rules (a static scene: the log then uses the piece volumes). */
+static fcm_status build_log_blocks(fcm_simulation *S)
+{
+  if (S->rules && !fcm_cell_rules_has_kind(S->rules, FCM_RULE_MASS)) return FCM_OK;
+  return fcm_space_momentum(S->space, 0.0, NULL, NULL, NULL, NULL, NULL);
+}
+
 fcm_status fcm__sim_apply_cut(fcm_simulation *S)
 {
   fcm_status st = FCM_OK;
@@ -443,6 +469,8 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   fcm_cell_rules *rules = NULL;
   fcm_space *space = NULL;
   fcm_integrator *integ = NULL;
+  const double t0 = fcm_wtime();
+  const int k = S->cuts_applied;
   /* A distributed run (the integrator has a backend, sim_backend.h): the rules keep the
    * process's cell mask, the new integrator gets the backend again (its cut hook, which
    * agrees first), and fcm__integrator_finish() at the end agrees on the outcome, so a
@@ -455,7 +483,8 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
     goto cleanup;
   }
   FCM_TRY(ctx, fcm_cell_rules_create_cut(ctx, S->mesh, S->geom, S->rules, surf, &rules));
-  S->c.cut_cells += fcm_cell_rules_get_stats(rules)->num_integrated;
+  S->cut_stats[k] = *fcm_cell_rules_get_stats(rules);
+  S->c.cut_cells += S->cut_stats[k].num_integrated;
   FCM_TRY(ctx, create_space(S, rules, fcm__integrator_distributed(S->integ, NULL), &space));
   /* missed: no cell got a new piece and no node a new copy (a cut along cell faces adds copies
    * without splitting any cell) */
@@ -477,7 +506,9 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   S->pieces = fcm_space_num_bodies(S->space);
   S->c.pieces = S->pieces;
   if (S->surf) FCM_TRY(ctx, fcm_embedded_surface_set_space(S->surf, S->space));
+  FCM_TRY(ctx, build_log_blocks(S));
 cleanup:
+  if (k < S->num_cuts) S->cut_time[k] = fcm_wtime() - t0;
   st = fcm__integrator_finish(S->integ, st);
   fcm_integrator_destroy(&integ);
   fcm_space_destroy(&space);
@@ -494,6 +525,8 @@ static fcm_status collect_cuts(fcm_simulation *S)
   const int n = fcm_scene_count_effects(S->scene, FCM_EFFECT_CUT);
   if (n == 0) return FCM_OK;
   FCM_ALLOC(ctx, (size_t)n, S->cuts);
+  FCM_ALLOC(ctx, (size_t)n, S->cut_stats);
+  FCM_ALLOC(ctx, (size_t)n, S->cut_time);
   for (int k = 0; k < fcm_scene_num_effects(S->scene); k++) {
     const fcm_effect *e = fcm_scene_get_effect(S->scene, k);
     if (e->type != FCM_EFFECT_CUT) continue;
@@ -677,6 +710,7 @@ fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   }
   S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);
   if (S->c.inertia) FCM_TRY(ctx, fcm__sim_initialize_effects(S));
+  FCM_TRY(ctx, build_log_blocks(S));
   S->free_body = S->c.inertia && S->c.constraints == 0 && S->c.body_force_assemblies == 0 &&
                  S->c.traction_assemblies == 0;
   if (S->free_body) FCM_TRY(ctx, fcm__sim_center_of_mass(S, NULL, S->com0));
@@ -716,8 +750,8 @@ void fcm_simulation_destroy(fcm_simulation **sim)
   fcm_cell_rules_destroy(&S->rules);
   fcm_geometry_destroy(&S->geom);
   fcm_mesh_destroy(&S->mesh);
-  void *arrays[] = {S->log,          S->frame_time, S->loads,    S->cuts,
-                    S->react_effect, S->react_id,   S->react_log};
+  void *arrays[] = {S->log,      S->frame_time,   S->loads,    S->cuts,     S->cut_stats,
+                    S->cut_time, S->react_effect, S->react_id, S->react_log};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(ctx, arrays[k]);
   fcm__free(ctx, S);

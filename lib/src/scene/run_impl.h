@@ -25,6 +25,17 @@ typedef struct fcm__log_row {
   long long inverted, inverted_cell, nonfinite;
 } fcm__log_row;
 
+/* The passes over each kind's points that quadrature.simplify = "auto" was told to expect, by
+ * source (their sums are fcm_cell_rules_options.expected_assemblies; run.c), for the summary.
+ * The set-up's space and integrator, and each cut's new ones, integrate every cell again. */
+typedef struct fcm__auto_uses {
+  double steps;    /* stiffness: force and tangent, RUN_ASSEMBLIES_PER_STEP per time or load step */
+  double loads;    /* stiffness: the body-force assemblies of the set-up and of every cut */
+  double frames;   /* stiffness: the stresses of every frame written */
+  double matrix;   /* mass: the mass matrix of the set-up and of every cut */
+  double momentum; /* mass: the log's element mass blocks (fcm_space_momentum()), likewise */
+} fcm__auto_uses;
+
 /* How fcm__simulation_create() makes a simulation: the public options and the backend that
  * distributes it. */
 typedef struct fcm__simulation_config {
@@ -74,6 +85,14 @@ struct fcm_simulation {
   /* cuts ("cut" effects) in time order; the first cuts_applied are in the rules */
   int num_cuts, cuts_applied;
   const fcm_effect **cuts;
+  /* The rule statistics of the set-up (a cut replaces the rules, whose statistics are then
+   * the cut's) and of each cut applied (cut_stats[k], num_cuts entries: the cells that cut
+   * integrated again; zero for a cut whose surface missed the body's box), with its wall
+   * time (cut_time[k]: rules, space and integrator), for the summary. */
+  fcm_cell_rules_stats setup_stats;
+  fcm__auto_uses auto_uses; /* with quadrature.simplify = "auto" */
+  fcm_cell_rules_stats *cut_stats;
+  double *cut_time;
   fcm_index pieces; /* separate bodies of the current space (fcm_space_num_bodies()) */
   long long base_factorizations, base_analyses, base_fallbacks; /* of integrators before cuts */
   fcm_index base_dofs, base_constrained; /* DOFs and constrained DOFs before any cut (the

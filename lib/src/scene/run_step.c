@@ -122,6 +122,7 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
       const double tc = fcm_wtime();
       FCM_TRY(S->ctx, fcm__sim_apply_cut(S));
       S->c.time_steps += fcm_wtime() - tc;
+      S->c.time_cuts += fcm_wtime() - tc;
     }
   }
   double t0 = fcm_wtime();
@@ -141,6 +142,7 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
     goto cleanup;
   }
   S->c.steps++;
+  const double tlog = fcm_wtime();
   for (int k = 0; k < S->num_react; k++)
     FCM_TRY(S->ctx,
             constraint_reaction(
@@ -158,6 +160,7 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   r->nonfinite = -1;
   count_inversion(&S->c, S->c.steps, r);
   FCM_TRY(S->ctx, log_momentum(S, r));
+  S->c.time_log += fcm_wtime() - tlog;
   if (si.inverted_points > 0 && fcm_scene_get_solver(S->scene)->stop_on_inversion) {
     char where[256] = "";
     if (si.inverted_cell >= 0)

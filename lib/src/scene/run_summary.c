@@ -19,6 +19,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 
 static void line(FILE *f, int on, const char *what, const char *detail)
@@ -128,15 +129,34 @@ static void inversion_lines(FILE *f, const fcm_simulation_counters *c)
             c->nonfinite_frames, c->frames, c->nonfinite_first_step, (long long)c->nonfinite_max);
 }
 
-/* The summary's lines of the cell rules: cells, volumes, what lies outside the background,
- * the simplification of each kind and the rules built (gs: the statistics to show, NULL: the
- * rules' own). */
+/* What quadrature.simplify = "auto" decided for kind k and why: the passes expected (by
+ * source), the cut-cell points of a pass plain and simplified, and the modelled costs. */
+static void auto_line(const fcm__auto_uses *u, fcm_rule_kind k, const fcm_simplify_decision *d,
+                      fcm_index plain, char *b, size_t size)
+{
+  char uses[160];
+  if (k == FCM_RULE_STIFFNESS)
+    snprintf(uses, sizeof uses, "force + tangent %g, body forces %g, frames' stresses %g", u->steps,
+             u->loads, u->frames);
+  else
+    snprintf(uses, sizeof uses, "mass matrix %g, the log's mass blocks %g", u->matrix, u->momentum);
+  snprintf(b, size,
+           "auto: %s for %g expected passes (%s) over %lld cut-cell points, %.0f simplified; "
+           "cost model %.3g core-s per point per pass, %.3g core-s simplifying; estimated %.3g "
+           "core-s plain vs %.3g simplifying + passes",
+           d->simplified ? "on" : "off", d->expected_assemblies, uses, (long long)plain,
+           d->estimated_kept, d->point_cost, d->estimated_time, d->cost_plain, d->cost_simplified);
+}
+
+/* The summary's lines of the cell rules the set-up built: cells, volumes, what lies outside the
+ * background, the simplification of each kind and the rules built (gs: the statistics to show,
+ * NULL: the set-up's, S->setup_stats; the cuts have lines of their own, cut_lines()). */
 static void rules_lines(const fcm_simulation *S, FILE *f, const fcm_cell_rules_stats *gs,
                         const fcm_simulation_counters *c)
 {
   char b[512];
   if (S->rules) {
-    const fcm_cell_rules_stats *rs = gs ? gs : fcm_cell_rules_get_stats(S->rules);
+    const fcm_cell_rules_stats *rs = gs ? gs : &S->setup_stats;
     fprintf(f,
             "  cells     %lld: %lld uncut, %lld cut, %lld dropped; cut-cell points stiffness "
             "%lld -> %lld, mass %lld -> %lld (before -> after simplification)\n",
@@ -172,12 +192,7 @@ static void rules_lines(const fcm_simulation *S, FILE *f, const fcm_cell_rules_s
       if (!fcm_cell_rules_has_kind(S->rules, (fcm_rule_kind)k))
         snprintf(b, sizeof b, "(no %s rules built)", kinds[k]);
       else if (q->simplify == FCM_CELL_SIMPLIFY_AUTO)
-        snprintf(b, sizeof b,
-                 "auto: %s for %g expected assemblies; cost model %.3g core-s per point per "
-                 "assembly, %.3g core-s simplifying to %.0f points; estimated %.3g core-s "
-                 "assembling plain vs %.3g simplifying + assembling",
-                 d->simplified ? "on" : "off", d->expected_assemblies, d->point_cost,
-                 d->estimated_time, d->estimated_kept, d->cost_plain, d->cost_simplified);
+        auto_line(&S->auto_uses, (fcm_rule_kind)k, d, rs->points_initial[k], b, sizeof b);
       else
         snprintf(b, sizeof b, "%s (scene), %.3g core-s", fcm_cell_simplify_name(q->simplify),
                  d->time_simplify);
@@ -185,7 +200,7 @@ static void rules_lines(const fcm_simulation *S, FILE *f, const fcm_cell_rules_s
     }
   }
   if (S->rules) { /* which rule kinds the scene called for, with their stored points */
-    const fcm_cell_rules_stats *rs = gs ? gs : fcm_cell_rules_get_stats(S->rules);
+    const fcm_cell_rules_stats *rs = gs ? gs : &S->setup_stats;
     const int mass = (c->rule_kinds & FCM_RULES_MASS) != 0;
     snprintf(b, sizeof b, "stiffness (%lld points)%s",
              (long long)rs->points_total[FCM_RULE_STIFFNESS], mass ? ", mass" : "");
@@ -200,12 +215,61 @@ static void rules_lines(const fcm_simulation *S, FILE *f, const fcm_cell_rules_s
   }
 }
 
-/* The summary with the rules' statistics `gs`, the counters `gc`, the body's largest |u| over
- * its quadrature points `body` and the free body's centre of mass `com_now` (NULL: not
- * available) given (a distributed run, gc not NULL: summed over the processes), or taken from
- * this process (gs and gc NULL, body < 0). */
+/* One line per cut applied: the cells it integrated again, their points before and after
+ * simplification (cs: per cut, stiffness and mass, initial then simplified; NULL: this
+ * process's, S->cut_stats) and its time. */
+static void cut_lines(const fcm_simulation *S, FILE *f, const fcm_index *cs)
+{
+  for (int k = 0; k < S->cuts_applied && S->cut_stats; k++) {
+    const fcm_cell_rules_stats *r = &S->cut_stats[k];
+    fcm_index p[4] = {r->points_initial[FCM_RULE_STIFFNESS], r->points_initial[FCM_RULE_MASS],
+                      r->points_simplified[FCM_RULE_STIFFNESS],
+                      r->points_simplified[FCM_RULE_MASS]};
+    if (cs) memcpy(p, cs + 4 * k, sizeof p);
+    if (r->num_cells == 0) {
+      fprintf(f, "  cut %-5d t = %g s: missed the body's box\n", k + 1, S->cuts[k]->cut.time);
+      continue;
+    }
+    fprintf(f,
+            "  cut %-5d t = %g s: %lld cells integrated again, %lld split; their points "
+            "stiffness %lld -> %lld, mass %lld -> %lld; %.3f s (rules %.3f s)\n",
+            k + 1, S->cuts[k]->cut.time, (long long)r->num_integrated, (long long)r->num_split,
+            (long long)p[0], (long long)p[2], (long long)p[1], (long long)p[3], S->cut_time[k],
+            r->time_total);
+  }
+}
+
+/* The process's peak resident set size in bytes (getrusage(); Linux reports kilobytes), 0
+ * when unknown. */
+static double peak_rss(void)
+{
+  struct rusage ru;
+  if (getrusage(RUSAGE_SELF, &ru) != 0) return 0.0;
+  return 1024.0 * (double)ru.ru_maxrss;
+}
+
+/* Bytes the set-up's cut-cell rules held at their peak, from their statistics: each cut cell's
+ * pieces keep the arrays of their initial points (stabilization included) until the rules are
+ * gathered into one array per kind, which then holds the final points: 33 bytes a point (3
+ * coordinates, weight, flag) in both. The simplification's own work space (per cell, see
+ * fcm_cell_rules_options.max_rule_memory) and the geometry are not included. */
+static double rules_memory(const fcm_cell_rules_stats *rs)
+{
+  double points = 0.0;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    points += (double)rs->points_initial[k] + (double)rs->points_simplified[k] +
+              2.0 * (double)rs->points_stabilization[k];
+  return 33.0 * points;
+}
+
+/* The summary with the rules' statistics `gs`, the cuts' point counts `cs` (cut_lines()), the
+ * counters `gc`, the body's largest |u| over its quadrature points `body`, the free body's
+ * centre of mass `com_now` (NULL: not available) and the peak resident memory `rss` given (a
+ * distributed run, gc not NULL: summed over the processes), or taken from this process (gs, cs
+ * and gc NULL, body < 0). */
 static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_stats *gs,
-                         const fcm_simulation_counters *gc, double body, const double *com_now)
+                         const fcm_index *cs, const fcm_simulation_counters *gc, double body,
+                         const double *com_now, double rss)
 {
   const fcm_simulation_counters *c = gc ? gc : &S->c;
   char b[512];
@@ -242,6 +306,7 @@ static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_
   snprintf(b, sizeof b, "%d applied (%d missed the body), %lld cells integrated again, %lld bodies",
            c->cuts, c->cuts_missed, (long long)c->cut_cells, (long long)c->pieces);
   line(f, c->cuts > 0, "cuts", c->cuts ? b : (S->num_cuts ? "(none due yet)" : "(no cut effect)"));
+  cut_lines(S, f, cs);
   snprintf(b, sizeof b, "%lld factorizations, %lld analyses, %lld fallbacks", c->factorizations,
            c->analyses, c->direct_fallbacks);
   line(f, 1,
@@ -269,14 +334,26 @@ static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_
               S->com0[0], S->com0[1], S->com0[2], sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
     }
   }
-  fprintf(f, "  time [s]  setup %.3f  steps %.3f  output %.3f\n", c->time_setup, c->time_steps,
+  fprintf(f,
+          "  time [s]  setup %.3f  steps %.3f (integrator %.3f, cuts %.3f)  log %.3f  output "
+          "%.3f\n",
+          c->time_setup, c->time_steps, c->time_steps - c->time_cuts, c->time_cuts, c->time_log,
           c->time_output);
+  if (rss > 0.0 && S->rules)
+    fprintf(f,
+            "  memory    peak resident %.1f MiB%s; the set-up's cut-cell rules held about %.1f MiB "
+            "(every cut cell's initial points until they are gathered, then the final ones)\n",
+            rss / (1024.0 * 1024.0), gc ? " (summed over the processes)" : "",
+            rules_memory(gs ? gs : &S->setup_stats) / (1024.0 * 1024.0));
+  else if (rss > 0.0)
+    fprintf(f, "  memory    peak resident %.1f MiB%s\n", rss / (1024.0 * 1024.0),
+            gc ? " (summed over the processes)" : "");
 }
 
 void fcm_simulation_summary_view(const fcm_simulation *S, FILE *f)
 {
   if (!S || !f) return;
-  summary_view(S, f, NULL, NULL, -1.0, NULL);
+  summary_view(S, f, NULL, NULL, NULL, -1.0, NULL, peak_rss());
 }
 
 fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f)
@@ -288,18 +365,22 @@ fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f)
   fcm_cell_rules_stats gs;
   fcm_simulation_counters gc = S->c;
   double *q = NULL, body = 0.0, com[3] = {0, 0, 0};
+  fcm_index *cs = NULL;
   int root = 1, com_ok = 0;
+  const fcm_index ncut = 4 * (fcm_index)S->cuts_applied; /* after the cells: the cuts' points */
   fcm__integrator_distributed(S->integ, &root);
   memset(&gs, 0, sizeof gs);
   /* per kind: points before / after simplification, stabilization, stored, skipped, kept
    * unsimplified; then surface triangles and points, tets, slivers; then each own cell's
-   * largest |u| (every process's cells: the point counts are its own cells' only) */
-  q = fcm__calloc(ctx, (size_t)nv + (size_t)nc + 1, sizeof *q);
-  st = q ? FCM_OK
-         : fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
-                      "simulation: out of memory (summary of %lld cells)", (long long)nc);
+   * largest |u| (every process's cells: the point counts are its own cells' only); then the
+   * cuts' points (cut_lines()) and the process's peak resident memory */
+  q = fcm__calloc(ctx, (size_t)(nv + nc + ncut) + 1, sizeof *q);
+  cs = q ? fcm__calloc(ctx, (size_t)ncut + 1, sizeof *cs) : NULL;
+  st = cs ? FCM_OK
+          : fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
+                       "simulation: out of memory (summary of %lld cells)", (long long)nc);
   if (st == FCM_OK && S->rules) {
-    gs = *fcm_cell_rules_get_stats(S->rules);
+    gs = S->setup_stats;
     for (int k = 0; k < K; k++) {
       q[6 * k + 0] = (double)gs.points_initial[k];
       q[6 * k + 1] = (double)gs.points_simplified[k];
@@ -317,6 +398,15 @@ fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f)
     q[6 * K + 3] = (double)gs.num_slivers;
   }
   if (q) q[6 * K + 4] = (double)S->c.boundary_points; /* Nitsche's: own cells' */
+  for (int k = 0; cs && k < S->cuts_applied; k++) {
+    const fcm_cell_rules_stats *r = &S->cut_stats[k];
+    double *qc = q + nv + nc + 4 * k;
+    qc[0] = (double)r->points_initial[FCM_RULE_STIFFNESS];
+    qc[1] = (double)r->points_initial[FCM_RULE_MASS];
+    qc[2] = (double)r->points_simplified[FCM_RULE_STIFFNESS];
+    qc[3] = (double)r->points_simplified[FCM_RULE_MASS];
+  }
+  if (q) q[nv + nc + ncut] = peak_rss();
   if (st == FCM_OK)
     st = fcm__space_cell_max_displacement(S->space, fcm_integrator_displacement(S->integ), q + nv);
   if (st == FCM_OK) {
@@ -324,7 +414,9 @@ fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f)
     for (fcm_index c = 0; c < nc; c++) /* another process's cell: its value (no rules: root's) */
       if (!fcm__cell_rules_owns(R, c) || (!R && !root)) q[nv + c] = 0.0;
   }
-  FCM_TRY(ctx, fcm__integrator_reduce_status(S->integ, st, q, (fcm_index)nv + nc));
+  FCM_TRY(ctx, fcm__integrator_reduce_status(S->integ, st, q, (fcm_index)nv + nc + ncut + 1));
+  for (fcm_index i = 0; i < ncut; i++)
+    cs[i] = (fcm_index)q[nv + nc + i];
   /* the free body's centre of mass: collective (the partial mass matrix), on every process */
   if (S->free_body) {
     com_ok = fcm__sim_center_of_mass(S, fcm_integrator_displacement(S->integ), com) == FCM_OK;
@@ -344,8 +436,11 @@ fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f)
   gc.boundary_points = (fcm_index)q[6 * K + 4];
   for (fcm_index c = 0; c < nc; c++)
     if (!(q[nv + c] <= body) && body == body) body = q[nv + c]; /* a NaN stays */
-  if (f) summary_view(S, f, S->rules ? &gs : NULL, &gc, body, com_ok ? com : NULL);
+  if (f)
+    summary_view(S, f, S->rules ? &gs : NULL, cs, &gc, body, com_ok ? com : NULL,
+                 q[nv + nc + ncut]);
 cleanup:
+  fcm__free(ctx, cs);
   fcm__free(ctx, q);
   return st;
 }
