@@ -10,6 +10,7 @@
  * - every boundary triangle or part lies on one side of each cut plane (signed distances
  *   within 1e-9 of the cell size), so the cuts split the triangles they cross;
  * - the boundary triangles no cut reaches are the geometry's own, in their order.
+ * The same for a box cut along cell faces through its boundary vertices.
  * Arguments: tet4 | tet10 | hex8 | hex20. */
 #include "fcm/fcm.h"
 #include "fem_util.h"
@@ -213,41 +214,40 @@ static void check(const fcm_space *s, const fcm_embedded_surface *es, const fcm_
   free(u), free(x), free(pb), free(body);
 }
 
-int main(int argc, char **argv)
+/* Cut the body `g` in a 4^3 grid on [-1, 1]^3 by the planes (point pp[k], unit normal pn[k])
+ * one after the other, checking the surface after each (the planes moved by the shift the
+ * cut may have taken). */
+static void run(fcm_element_type type, fcm_geometry *g, int ncut, const double (*pp)[3],
+                const double (*pn)[3])
 {
-  const fcm_element_type type = argc > 1 ? parse(argv[1]) : FCM_ELEMENT_HEX8;
-  TEST_TRUE(type != FCM_ELEMENT_COUNT);
-  TEST_OK(NULL, fcm_ctx_create(NULL, &ctx));
   fcm_mesh *mesh = NULL;
-  fcm_geometry *ball = NULL;
   fcm_cell_rules *r[3] = {NULL, NULL, NULL};
   fcm_space *s[3] = {NULL, NULL, NULL}, *free_space = NULL;
   fcm_surface *plane = NULL;
   fcm_embedded_surface *es = NULL;
-  const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, c[3] = {0.031, -0.017, 0.023};
+  const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
   const fcm_index n3[3] = {4, 4, 4};
   const double h = 0.5;
-  /* two oblique planes through the ball, crossing inside it */
-  const double pp[2][3] = {{0.05, 0.02, -0.03}, {-0.04, 0.06, 0.01}};
-  const double pn[2][3] = {{0.8164965809277261, 0.4082482904638631, 0.4082482904638631},
-                           {-0.2672612419124244, 0.8017837257372732, -0.5345224838248488}};
+  double at[2][3];
   TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, n3, &mesh));
-  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c, 0.8, 6, &ball));
   fcm_cell_rules_options o = fcm_cell_rules_options_default();
   o.kinds = FCM_RULES_STIFFNESS;
   o.simplify = FCM_CELL_SIMPLIFY_OFF;
-  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, ball, &o, &r[0]));
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &o, &r[0]));
   TEST_OK(ctx, fcm_space_create_embedded(ctx, mesh, r[0], &s[0]));
-  TEST_OK(ctx, fcm_embedded_surface_create(s[0], ball, &es));
+  TEST_OK(ctx, fcm_embedded_surface_create(s[0], g, &es));
   if (!es) goto done;
   /* uncut: the geometry's triangles, nothing split */
-  TEST_TRUE(fcm_embedded_surface_num_triangles(es) == fcm_geometry_num_boundary_triangles(ball));
+  TEST_TRUE(fcm_embedded_surface_num_triangles(es) == fcm_geometry_num_boundary_triangles(g));
   TEST_TRUE(fcm_embedded_surface_num_split_triangles(es) == 0);
-  for (int k = 0; k < 2; k++) {
+  for (int k = 0; k < ncut && k < 2; k++) {
     const double bl[3] = {-1.5, -1.5, -1.5}, bh[3] = {1.5, 1.5, 1.5};
     TEST_OK(ctx, fcm_surface_create_plane(ctx, pp[k], pn[k], bl, bh, &plane));
-    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, ball, r[k], plane, &r[k + 1]));
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, r[k], plane, &r[k + 1]));
     fcm_surface_destroy(&plane);
+    if (!r[k + 1]) goto done;
+    for (int d = 0; d < 3; d++)
+      at[k][d] = pp[k][d] + fcm_cell_rules_get_stats(r[k + 1])->cut_shift[d];
     /* the default space (tiny copies constrained: exact for translations) and one without
      * the constraint (exact for every rigid motion) */
     fcm_space_options so = fcm_space_options_default();
@@ -256,9 +256,9 @@ int main(int argc, char **argv)
     TEST_OK(ctx, fcm_space_create_embedded_with(ctx, mesh, r[k + 1], &so, &free_space));
     if (!s[k + 1] || !free_space) goto done;
     TEST_OK(ctx, fcm_embedded_surface_set_space(es, s[k + 1]));
-    check(s[k + 1], es, ball, k + 1, pp, pn, h, 0);
+    check(s[k + 1], es, g, k + 1, (const double(*)[3])at, pn, h, 0);
     TEST_OK(ctx, fcm_embedded_surface_set_space(es, free_space));
-    check(free_space, es, ball, k + 1, pp, pn, h, 1);
+    check(free_space, es, g, k + 1, (const double(*)[3])at, pn, h, 1);
     TEST_OK(ctx, fcm_embedded_surface_set_space(es, s[k + 1]));
     fcm_space_destroy(&free_space);
   }
@@ -269,8 +269,31 @@ done:
     fcm_space_destroy(&s[k]);
     fcm_cell_rules_destroy(&r[k]);
   }
-  fcm_geometry_destroy(&ball);
   fcm_mesh_destroy(&mesh);
+}
+
+int main(int argc, char **argv)
+{
+  const fcm_element_type type = argc > 1 ? parse(argv[1]) : FCM_ELEMENT_HEX8;
+  TEST_TRUE(type != FCM_ELEMENT_COUNT);
+  TEST_OK(NULL, fcm_ctx_create(NULL, &ctx));
+  fcm_geometry *g = NULL;
+  /* a ball of 6,912 boundary triangles cut by two oblique planes crossing inside it */
+  const double c[3] = {0.031, -0.017, 0.023};
+  const double pp[2][3] = {{0.05, 0.02, -0.03}, {-0.04, 0.06, 0.01}};
+  const double pn[2][3] = {{0.8164965809277261, 0.4082482904638631, 0.4082482904638631},
+                           {-0.2672612419124244, 0.8017837257372732, -0.5345224838248488}};
+  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c, 0.8, 6, &g));
+  if (g && type != FCM_ELEMENT_COUNT) run(type, g, 2, pp, pn);
+  fcm_geometry_destroy(&g);
+  /* a box cut along cell faces x = 0, then y = 0, through boundary vertices: the cells keep
+   * one piece each, and the triangles on either side of a vertex on the cut follow theirs */
+  const double glo[3] = {-0.7, -0.7, -0.7}, ghi[3] = {0.7, 0.7, 0.7};
+  const double fn[2][3] = {{1, 0, 0}, {0, 1, 0}}, fp[2][3] = {{0, 0.1, 0.2}, {0.1, 0, 0.3}};
+  const fcm_index gn[3] = {4, 4, 4};
+  TEST_OK(ctx, fcm_geometry_create_box(ctx, glo, ghi, gn, &g));
+  if (g && type != FCM_ELEMENT_COUNT) run(type, g, 2, fp, fn);
+  fcm_geometry_destroy(&g);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
 }

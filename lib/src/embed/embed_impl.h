@@ -326,10 +326,11 @@ void fcm__embed_finder_destroy(fcm__embed_finder **f);
  * the search tree of R's cut triangles. FCM_ERR_ARG when R is on another mesh. */
 fcm_status fcm__embed_finder_set_rules(fcm__embed_finder *f, const fcm_cell_rules *R);
 
-/* Whether triangle x (3 vertices x 3) may cross a cut: the plane of a cut triangle has
- * vertices of it strictly on both sides, and no outer edge plane of that cut triangle has
- * them all strictly outside (conservative: a triangle that passes beside a cut's edge may
- * count, one that a cut crosses always does). 0 without cuts. */
+/* Whether triangle x (3 vertices x 3) may cross or touch a cut: the plane of a cut triangle
+ * has vertices of it strictly on both sides and no outer edge plane of that cut triangle has
+ * them all strictly outside, or a vertex lies on the cut triangle within twice the cuts'
+ * tolerance of a cell of the mesh's mean size (conservative: a triangle that passes beside a
+ * cut's edge may count, one that a cut crosses always does). 0 without cuts. */
 fcm_status fcm__embed_finder_crosses(fcm__embed_finder *f, const double x[9], int *crosses);
 
 /* The piece of R that holds point x of cell c, x on the boundary of the material: the piece of

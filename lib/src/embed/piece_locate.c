@@ -25,6 +25,7 @@ struct fcm__embed_finder {
   fcm_aabb_tree *tree;     /* boxes of the geometry's cells */
   const fcm_cell_rules *R; /* NULL until set */
   fcm_aabb_tree *cut_tree; /* boxes of R's cut triangles (NULL: none) */
+  double on_cut;           /* a point this close to a cut triangle lies on it */
   fcm__idbuf cand;
   fcm__embed_ws ws;
   fcm__parts *P;     /* the parts of `cell` when has_parts */
@@ -54,6 +55,17 @@ fcm_status fcm__embed_finder_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fc
   *out = NULL;
   FCM_ALLOC(ctx, 1, f);
   f->ctx = ctx, f->mesh = mesh, f->geom = geom, f->cell = -1;
+  { /* twice the cuts' tolerance of a cell of the mean size: the bounding box's volume per cell */
+    const double *X = fcm_mesh_coords(mesh);
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (fcm_index i = 0; i < fcm_mesh_num_nodes(mesh); i++)
+      for (int d = 0; d < 3; d++)
+        lo[d] = fmin(lo[d], X[3 * i + d]), hi[d] = fmax(hi[d], X[3 * i + d]);
+    const double v = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+    const double side = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+    const double nc = (double)FCM_MAX(fcm_mesh_num_cells(mesh), 1);
+    f->on_cut = 2.0 * FCM__EMBED_MATCH_RTOL * (v > 0.0 ? cbrt(v / nc) : side / nc);
+  }
   FCM_TRY(ctx, fcm__embed_geometry_boxes(ctx, geom, 0, &boxes, &nbox));
   FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &f->tree));
   *out = f;
@@ -161,27 +173,37 @@ fcm_status fcm__embed_finder_crosses(fcm__embed_finder *f, const double x[9], in
   double lo[3], hi[3];
   *crosses = 0;
   if (!f->cut_tree) return FCM_OK;
+  const double tol = f->on_cut;
   for (int d = 0; d < 3; d++) {
-    lo[d] = fmin(x[d], fmin(x[3 + d], x[6 + d]));
-    hi[d] = fmax(x[d], fmax(x[3 + d], x[6 + d]));
+    lo[d] = fmin(x[d], fmin(x[3 + d], x[6 + d])) - tol;
+    hi[d] = fmax(x[d], fmax(x[3 + d], x[6 + d])) + tol;
   }
   FCM_TRY(f->ctx, fcm__geom_tree_query(f->ctx, f->cut_tree, lo, hi, &f->cand));
   for (size_t k = 0; k < f->cand.n && !*crosses; k++) {
     const fcm__cut_tri *t = f->R->cut_tris + f->cand.ids[k];
-    double smin = HUGE_VAL, smax = -HUGE_VAL;
+    double s[3], smin = HUGE_VAL, smax = -HUGE_VAL;
     for (int a = 0; a < 3; a++) {
-      const double s = fcm__vec3_dot(t->plane.n, x + 3 * a) - t->plane.d;
-      smin = fmin(smin, s), smax = fmax(smax, s);
+      s[a] = fcm__vec3_dot(t->plane.n, x + 3 * a) - t->plane.d;
+      smin = fmin(smin, s[a]), smax = fmax(smax, s[a]);
     }
-    if (!(smin < 0.0 && smax > 0.0)) continue;
-    int beside = 0;
-    for (int e = 0; e < 3 && !beside; e++) {
-      if (t->inner[e]) continue;
-      beside = 1;
-      for (int a = 0; a < 3 && beside; a++)
-        beside = fcm__vec3_dot(t->edge[e].n, x + 3 * a) - t->edge[e].d > 0.0;
+    if (smin < 0.0 && smax > 0.0) { /* across the plane: unless wholly beside the triangle */
+      int beside = 0;
+      for (int e = 0; e < 3 && !beside; e++) {
+        if (t->inner[e]) continue;
+        beside = 1;
+        for (int a = 0; a < 3 && beside; a++)
+          beside = fcm__vec3_dot(t->edge[e].n, x + 3 * a) - t->edge[e].d > 0.0;
+      }
+      *crosses = !beside;
     }
-    *crosses = !beside;
+    /* a vertex on the triangle (a cut through a vertex, e.g. along a cell face, where the
+     * pieces on its two sides may lie in cells of one piece each) */
+    for (int a = 0; a < 3 && !*crosses; a++) {
+      int on = fabs(s[a]) <= tol;
+      for (int e = 0; e < 3 && on; e++)
+        on = fcm__vec3_dot(t->edge[e].n, x + 3 * a) - t->edge[e].d <= tol;
+      *crosses = on;
+    }
   }
 cleanup:
   return st;
