@@ -1,4 +1,4 @@
-/* The embedded surface of a cut body (fcm_embedded_surface_*): a ball of a few thousand
+/* The embedded surface of a cut body (fcm_embedded_surface_*): a ball of 3,072
  * boundary triangles, cut by one oblique plane, then by a second one crossing it. Every body
  * the cuts separate is moved rigidly (its own rotation and translation, an affine field each
  * element reproduces exactly). Then:
@@ -278,12 +278,12 @@ int main(int argc, char **argv)
   TEST_TRUE(type != FCM_ELEMENT_COUNT);
   TEST_OK(NULL, fcm_ctx_create(NULL, &ctx));
   fcm_geometry *g = NULL;
-  /* a ball of 6,912 boundary triangles cut by two oblique planes crossing inside it */
+  /* a ball of 3,072 boundary triangles cut by two oblique planes crossing inside it */
   const double c[3] = {0.031, -0.017, 0.023};
   const double pp[2][3] = {{0.05, 0.02, -0.03}, {-0.04, 0.06, 0.01}};
   const double pn[2][3] = {{0.8164965809277261, 0.4082482904638631, 0.4082482904638631},
                            {-0.2672612419124244, 0.8017837257372732, -0.5345224838248488}};
-  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c, 0.8, 6, &g));
+  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c, 0.8, 8, &g));
   if (g && type != FCM_ELEMENT_COUNT) run(type, g, 2, pp, pn);
   fcm_geometry_destroy(&g);
   /* a box cut along cell faces x = 0, then y = 0, through boundary vertices: the cells keep
