@@ -40,6 +40,7 @@ typedef struct fixture {
   fcm_geometry *geom;
   fcm_embedded_surface *es;
   fcm_cell_rules *cut1, *rules_out; /* one cut; the output of the second */
+  fcm_space *s_cut;                 /* the space of cut1 */
   fcm_surface *plane;
   fcm_space_options so;
   double *cell_out; /* 8 x num_cells */
@@ -122,6 +123,11 @@ static fcm_status surface_vtu(void *u)
 {
   fixture *x = u;
   return fcm_embedded_surface_write_vtu(x->es, &x->mat, x->u, "fem_alloc_out/s.vtu");
+}
+static fcm_status surface_cut(void *u)
+{
+  fixture *x = u;
+  return fcm_embedded_surface_set_space(x->es, x->s_cut);
 }
 static fcm_status second_cut(void *u)
 {
@@ -305,6 +311,14 @@ int main(void)
              10000);
   alloc_loop(ctx, &f, "fcm_space_create_embedded_with (constrained copies)", constrained_space,
              release, &x, 5, 1000);
+  /* the surface moved onto the cut space: the crossed triangles split */
+  TEST_OK(ctx, fcm_space_create_embedded(ctx, x.mesh, x.cut1, &x.s_cut));
+  TEST_OK(ctx, fcm_embedded_surface_create(x.space, g, &x.es));
+  alloc_loop(ctx, &f, "fcm_embedded_surface_set_space (a cut space)", surface_cut, NULL, &x, 5,
+             1000);
+  TEST_TRUE(fcm_embedded_surface_num_split_triangles(x.es) > 0);
+  fcm_embedded_surface_destroy(&x.es);
+  fcm_space_destroy(&x.s_cut);
   fcm_surface_destroy(&x.plane);
   fcm_cell_rules_destroy(&x.cut1);
 

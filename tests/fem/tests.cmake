@@ -56,3 +56,9 @@ fcm_add_test(fem_threads tests/fem/threads.c)
 foreach(el tet4 tet10 hex8 hex20)
   fcm_add_test(fem_momentum_${el} tests/fem/momentum.c ARGS ${el})
 endforeach()
+# The embedded surface of a ball cut once, then twice: with every body moved rigidly, each
+# triangle (boundary, split part, cut face) follows one body (edges keep their length), the
+# parts cover the boundary's area, each lies on one side of every cut plane.
+foreach(el tet4 tet10 hex8 hex20)
+  fcm_add_test(fem_cut_surface_${el} tests/fem/cut_surface.c ARGS ${el})
+endforeach()

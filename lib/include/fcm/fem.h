@@ -470,13 +470,21 @@ FCM_API fcm_status fcm_space_write_vtu(const fcm_space *space, const fcm_materia
  * the geometry (vertices compacted) and, when the space's rules carry cuts, each piece's
  * side of the cut faces (three points per triangle, flagged, each moving with its piece's
  * element, so both sides of a cut show the opening). Points are held at their reference
- * positions X; the element and reference coordinates of each are found once. */
+ * positions X; the cell and reference coordinates of each boundary vertex are found once.
+ * After cuts, every point moves with the piece whose material holds it (the cut cells'
+ * parts are made again from the geometry, as the rules' build made them), and a boundary
+ * triangle that a cut crosses, or with a vertex on a cut, is replaced by its parts: the
+ * triangle clipped by the cells it meets and by the parts of their pieces, exactly as the
+ * pieces split the material, each part moving with its piece (a triangle partly outside the
+ * mesh, whose parts would not cover it, stays whole). Triangles no cut reaches keep their
+ * vertices and order, so the surface of an uncut body is the same as without cuts. */
 typedef struct fcm_embedded_surface fcm_embedded_surface;
 
 /** Locate the boundary vertices of `geom` in `space` (fcm_space_locate(): a vertex in no
  * active cell follows the nearest active cell's extrapolated field).
  * @param[in] space borrowed: must outlive the object (or be replaced by set_space)
- * @param[in] geom  read during the call only
+ * @param[in] geom  borrowed: must outlive the object; the geometry the space's rules were
+ *                  built on (a space with cuts splits the boundary by its cells)
  * @return FCM_OK, FCM_ERR_ARG (NULL, a geometry without boundary triangles), the errors of
  * fcm_space_locate(), FCM_ERR_ALLOC. Allocates. */
 FCM_API fcm_status fcm_embedded_surface_create(const fcm_space *space, const fcm_geometry *geom,
@@ -487,19 +495,25 @@ FCM_API void fcm_embedded_surface_destroy(fcm_embedded_surface **surface);
 
 /** Move to another space on the same mesh (after a cut: fcm_space_create_embedded() of the
  * new rules; the old space may be destroyed before): the element of every vertex is chosen
- * again and the cut faces rebuilt.
- * @return FCM_OK, FCM_ERR_ARG (NULL, other mesh), FCM_ERR_ALLOC. */
+ * again, the triangles the cuts cross split again from the geometry's boundary (a later cut
+ * splits the parts of earlier ones) and the cut faces rebuilt.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, other mesh), FCM_ERR_ALLOC, FCM_ERR_INTERNAL (a part
+ * exceeding the clipping capacity). */
 FCM_API fcm_status fcm_embedded_surface_set_space(fcm_embedded_surface *surface,
                                                   const fcm_space *space);
 
-/** Points (boundary vertices first, then the cut-face points) and triangles; borrowed
- * views valid until the next set_space or destroy: reference positions (3 x num_points),
- * triangles (3 x num_triangles point indices, outward), flags (num_points; 1 on a cut face). */
+/** Points (boundary vertices first, then those of the split triangles' parts, then the
+ * cut-face points) and triangles (the boundary triangles no cut splits, in their order, then
+ * the parts, then the cut faces); borrowed views valid until the next set_space or destroy:
+ * reference positions (3 x num_points), triangles (3 x num_triangles point indices,
+ * outward), flags (num_points; 1 on a cut face). num_split_triangles: the boundary triangles
+ * replaced by their parts. */
 FCM_API fcm_index fcm_embedded_surface_num_points(const fcm_embedded_surface *surface);
 FCM_API fcm_index fcm_embedded_surface_num_triangles(const fcm_embedded_surface *surface);
 FCM_API const double *fcm_embedded_surface_points(const fcm_embedded_surface *surface);
 FCM_API const fcm_index *fcm_embedded_surface_triangles(const fcm_embedded_surface *surface);
 FCM_API const int32_t *fcm_embedded_surface_cut_flags(const fcm_embedded_surface *surface);
+FCM_API fcm_index fcm_embedded_surface_num_split_triangles(const fcm_embedded_surface *surface);
 
 /** The field u (num_dofs of the space) at the points: displacement (3 x num_points) and the
  * deformed positions X + u (3 x num_points); either output may be NULL.

@@ -296,6 +296,68 @@ fcm_status fcm__embed_piece_tets(fcm_ctx *ctx, const fcm__parts *P, const int *l
 int fcm__embed_clip_to_part(const fcm__parts *P, size_t i, double *x, int n, int cap,
                             const double nrm[3], double *work);
 
+/* fcm__embed_clip_to_part with the polygon's own face found with a tolerance: a face on whose
+ * plane every vertex lies within flat_tol keeps the polygon whole (when their normals agree;
+ * else nothing is left) instead of classifying its vertices with the part's clipping
+ * tolerance, which rounding in the polygon's vertices can exceed (flat_tol < 0: no such face,
+ * as fcm__embed_clip_to_part). */
+int fcm__embed_clip_to_part_flat(const fcm__parts *P, size_t i, double *x, int n, int cap,
+                                 const double nrm[3], double flat_tol, double *work);
+
+/* How far x lies outside part i of P: the largest signed distance to the planes of its faces
+ * with area (<= 0 inside). */
+double fcm__embed_part_excess(const fcm__parts *P, size_t i, const double x[3]);
+
+/* ---------------------------------------------------------------- pieces of output points
+ * (piece_locate.c) Where points and triangles of the embedded geometry's boundary lie among
+ * the material pieces of cut-cell rules, for output of the embedded surface: the convex parts
+ * and pieces of a cell are made again exactly as the build of the rules made them (the same
+ * parts, splits by the cut triangles and components, mapped to the rules' pieces through
+ * their component numbers), so what a piece's material holds goes to that piece. */
+typedef struct fcm__embed_finder fcm__embed_finder;
+
+/* Polygons with the rules' piece of each (-1: no piece holds it: a dropped cell or piece):
+ * polygon k has nv[k] vertices, stored consecutively in x (x 3). */
+typedef struct fcm__embed_polys {
+  double *x;
+  int *nv;
+  fcm_index *piece;
+  size_t n, cap, nx, capx;
+} fcm__embed_polys;
+
+void fcm__embed_polys_free(fcm_ctx *ctx, fcm__embed_polys *p);
+
+/* A finder for the geometry `geom` embedded in `mesh` (both borrowed; the search tree of the
+ * geometry's cells is built here, once). */
+fcm_status fcm__embed_finder_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                                    fcm__embed_finder **out);
+void fcm__embed_finder_destroy(fcm__embed_finder **f);
+
+/* Answer for rules R (borrowed until the next call; built on the finder's mesh and geometry):
+ * the search tree of R's cut triangles. FCM_ERR_ARG when R is on another mesh. */
+fcm_status fcm__embed_finder_set_rules(fcm__embed_finder *f, const fcm_cell_rules *R);
+
+/* Whether triangle x (3 vertices x 3) may cross or touch a cut: the plane of a cut triangle
+ * has vertices of it strictly on both sides and no outer edge plane of that cut triangle has
+ * them all strictly outside, or a vertex lies on the cut triangle within twice the cuts'
+ * tolerance of a cell of the mesh's mean size (conservative: a triangle that passes beside a
+ * cut's edge may count, one that a cut crosses always does). 0 without cuts. */
+fcm_status fcm__embed_finder_crosses(fcm__embed_finder *f, const double x[9], int *crosses);
+
+/* The piece of R that holds point x of cell c, x on the boundary of the material: the piece of
+ * every part containing x within the cuts' tolerance (FCM__EMBED_MATCH_RTOL of the cell size).
+ * *piece = -1 when no part of a piece does, -2 when parts of several pieces do (x on a cut). */
+fcm_status fcm__embed_finder_point(fcm__embed_finder *f, fcm_index c, const double x[3],
+                                   fcm_index *piece);
+
+/* The share of the boundary triangle x (3 vertices x 3, counter-clockwise seen from outside)
+ * inside cell c, split between R's pieces in c: clipped by the cell's planes as the surface
+ * rules are (fcm__embed_cell_surface), then, in a cell with several pieces, to every part
+ * (fcm__embed_clip_to_part), each polygon going to its part's piece. Polygons of no more than
+ * 1e-12 of the cell size squared are left out. Appended to *out. */
+fcm_status fcm__embed_finder_clip(fcm__embed_finder *f, fcm_index c, const double x[9],
+                                  fcm__embed_polys *out);
+
 /* The faces of `piece`'s parts that lie on a cut triangle (the piece's side of the cuts),
  * fan-triangulated with their outward orientation: *tri (allocated, 9 doubles = 3 physical
  * vertices per triangle; NULL when none) and *ntri. */

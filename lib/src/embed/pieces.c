@@ -696,13 +696,35 @@ cleanup:
 int fcm__embed_clip_to_part(const fcm__parts *P, size_t i, double *x, int n, int cap,
                             const double nrm[3], double *work)
 {
+  return fcm__embed_clip_to_part_flat(P, i, x, n, cap, nrm, -1.0, work);
+}
+
+int fcm__embed_clip_to_part_flat(const fcm__parts *P, size_t i, double *x, int n, int cap,
+                                 const double nrm[3], double flat_tol, double *work)
+{
   const fcm__poly *p = P->poly + i;
   for (int f = 0; f < p->nf && n >= 3; f++) {
     fcm__plane pl;
     if (!face_plane(p, f, &pl)) continue;
-    n = fcm__geom_polygon_clip(x, n, cap, &pl, P->tol[i], fcm__vec3_dot(nrm, pl.n) > 0.0, work);
+    const int keep = fcm__vec3_dot(nrm, pl.n) > 0.0;
+    if (flat_tol >= 0.0 && points_on_plane(x, n, &pl, flat_tol)) {
+      if (keep) continue;
+      return 0;
+    }
+    n = fcm__geom_polygon_clip(x, n, cap, &pl, P->tol[i], keep, work);
   }
   return n;
+}
+
+double fcm__embed_part_excess(const fcm__parts *P, size_t i, const double x[3])
+{
+  const fcm__poly *p = P->poly + i;
+  double e = -HUGE_VAL;
+  for (int f = 0; f < p->nf; f++) {
+    fcm__plane pl;
+    if (face_plane(p, f, &pl)) e = fmax(e, fcm__vec3_dot(pl.n, x) - pl.d);
+  }
+  return e;
 }
 
 fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P)

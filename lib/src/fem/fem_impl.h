@@ -293,6 +293,27 @@ fcm_status fcm__space_write_vtu_piece(const fcm_space *s, const fcm_material *ma
                                       const double *v, const unsigned char *keep, int rank,
                                       const char *path, fcm_index *nonfinite);
 
+/* The embedded surface (surface.c builds it, fields.c writes it). Points: the boundary
+ * vertices [0, nb), then the vertices of the parts of the boundary triangles the cuts split,
+ * then three per cut-face triangle. Triangles: the boundary triangles no cut splits (in their
+ * order), the parts of the split ones (fans of their polygons), the cut faces. */
+struct fcm_embedded_surface {
+  fcm_ctx *ctx;
+  const fcm_space *space;
+  const fcm_mesh *mesh;     /* of the space (a replaced space may be gone already) */
+  const fcm_geometry *geom; /* borrowed: the cuts' pieces are made again from it */
+  fcm_index nb, nbt;        /* boundary vertices and triangles (fixed) */
+  fcm_index *tri0;          /* nbt x 3: the boundary triangles (vertex ids) */
+  fcm_index np, nt;         /* all points and triangles */
+  fcm_index num_split;      /* boundary triangles replaced by their parts */
+  double *X, *xi;           /* np x 3: reference positions, reference coordinates in the cell */
+  fcm_index *cell, *elem, *tri;
+  int32_t *flag;
+  fcm_index cap_p, cap_t;
+  struct fcm__embed_finder *finder; /* during a rebuild with cuts: the cut cells' pieces */
+  fcm_aabb_tree *cell_tree;         /* during a rebuild with cuts: boxes of the mesh's cells */
+};
+
 /* fcm_space_write_vtu() and fcm_embedded_surface_write_vtu() that also count, in *nonfinite
  * (may be NULL), the von_mises values they wrote that are NaN or infinite (cells, surface
  * points; 0 without mat): the stresses of points with J = det F <= 0. (fields.c) */

@@ -373,18 +373,26 @@ static fcm_index count_schwarz_blocks(const fcm_simulation *S, double theta)
 }
 
 /* The embedded surface written per frame: the boundary triangles' vertices located once
- * (fcm_embedded_surface_create()), the cut faces added after every cut. */
+ * (fcm_embedded_surface_create()), the triangles the cuts cross split and the cut faces added
+ * after every cut. */
 static fcm_status build_surface(fcm_simulation *S)
 {
   fcm_status st = FCM_OK;
+  unsigned char *seen = NULL;
   FCM_TRY(S->ctx, fcm_embedded_surface_create(S->space, S->geom, &S->surf));
-  /* the counters name the boundary only (cut faces come and go with the cuts): 3 points per
-   * cut-face triangle */
+  /* the counters name the geometry's boundary only (split parts and cut faces come and go
+   * with the cuts): its triangles and their distinct vertices */
   const fcm_index nb = fcm_geometry_num_boundary_triangles(S->geom);
+  const fcm_index *tri = fcm_geometry_boundary_triangles(S->geom);
+  FCM_ALLOC(S->ctx, (size_t)fcm_geometry_num_nodes(S->geom) + 1, seen);
   S->c.surface_triangles = nb;
-  S->c.surface_points = fcm_embedded_surface_num_points(S->surf) -
-                        3 * (fcm_embedded_surface_num_triangles(S->surf) - nb);
+  S->c.surface_points = 0;
+  for (fcm_index k = 0; k < 3 * nb; k++) {
+    S->c.surface_points += !seen[tri[k]];
+    seen[tri[k]] = 1;
+  }
 cleanup:
+  fcm__free(S->ctx, seen);
   return st;
 }
 

@@ -1,0 +1,495 @@
+/* The embedded surface for output: the boundary triangles of the geometry located in a space,
+ * every point moving with the element (the material piece) that holds it, and both sides of
+ * the cut faces. Where cuts split the body, a point goes to the piece whose material holds
+ * it, and a boundary triangle that a cut crosses is replaced by its parts, split exactly as
+ * the cut cells' pieces are (the same parts, made again: fcm__embed_finder), so no triangle
+ * joins points of two pieces. Triangles no cut crosses keep their vertices and order. */
+#include "embed/embed_impl.h"
+#include "fem/fem_impl.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A split triangle's parts must add up to its area to this relative tolerance; otherwise (a
+ * triangle partly outside the mesh) it is kept whole. */
+#define SPLIT_AREA_RTOL 1e-9
+
+/* The element of cell c integrating rules piece p; -1 when none does. */
+static fcm_index piece_element(const fcm_space *s, fcm_index c, fcm_index p)
+{
+  if (p < 0) return -1;
+  for (fcm_index e = s->cell_elem[c]; e < s->cell_elem[c + 1]; e++)
+    if (s->elem_piece[e] == p) return e;
+  return -1;
+}
+
+static int cmp_pair(const void *a, const void *b)
+{
+  const fcm_index *x = a, *y = b;
+  if (x[0] != y[0]) return x[0] < y[0] ? -1 : 1;
+  return (x[1] > y[1]) - (x[1] < y[1]);
+}
+
+/* Area of triangle (a, b, c). */
+static double tri_area(const double *a, const double *b, const double *c)
+{
+  double u[3], v[3];
+  for (int d = 0; d < 3; d++)
+    u[d] = b[d] - a[d], v[d] = c[d] - a[d];
+  const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                       u[0] * v[1] - u[1] * v[0]};
+  return 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+}
+
+/* The boundary triangle t's three vertices (9 doubles). */
+static void tri_coords(const fcm_embedded_surface *es, fcm_index t, double x[9])
+{
+  for (int a = 0; a < 3; a++)
+    memcpy(x + 3 * a, es->X + 3 * es->tri0[3 * t + a], 3 * sizeof *x);
+}
+
+/* The search tree of the mesh's cells. */
+static fcm_status cell_tree(fcm_embedded_surface *es)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = es->ctx;
+  const fcm_index nc = fcm_mesh_num_cells(es->mesh);
+  const int npc = fcm_mesh_nodes_per_cell(es->mesh);
+  double *boxes = NULL, X[3 * FCM_ELEMENT_MAX_NODES];
+  if (es->cell_tree) return FCM_OK;
+  FCM_ALLOC_RAW(ctx, 6 * (size_t)nc + 6, boxes);
+  for (fcm_index c = 0; c < nc; c++) {
+    double *b = boxes + 6 * c;
+    fcm_mesh_cell_coords(es->mesh, c, X);
+    for (int d = 0; d < 3; d++)
+      b[d] = HUGE_VAL, b[3 + d] = -HUGE_VAL;
+    for (int a = 0; a < npc; a++)
+      for (int d = 0; d < 3; d++)
+        b[d] = fmin(b[d], X[3 * a + d]), b[3 + d] = fmax(b[3 + d], X[3 * a + d]);
+  }
+  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nc, boxes, &es->cell_tree));
+cleanup:
+  fcm__free(ctx, boxes);
+  return st;
+}
+
+/* The pieces of the boundary vertices in cells that cuts split (es->elem), and which boundary
+ * triangles to split: those a cut crosses and those with a vertex on a cut (parts of two
+ * pieces hold it: each triangle then takes its side). split: nbt flags. */
+static fcm_status mark_split(fcm_embedded_surface *es, unsigned char *split)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = es->ctx;
+  const fcm_space *s = es->space;
+  fcm__embed_finder *f = es->finder;
+  fcm_index *pairs = NULL, n = 0;
+  unsigned char *on_cut = NULL;
+  FCM_ALLOC(ctx, (size_t)es->nb + 1, on_cut);
+  FCM_ALLOC_RAW(ctx, 2 * (size_t)es->nb + 2, pairs);
+  for (fcm_index i = 0; i < es->nb; i++)
+    if (s->cell_elem[es->cell[i] + 1] - s->cell_elem[es->cell[i]] > 1)
+      pairs[2 * n] = es->cell[i], pairs[2 * n + 1] = i, n++;
+  qsort(pairs, (size_t)n, 2 * sizeof *pairs, cmp_pair); /* one cell's parts made once */
+  for (fcm_index k = 0; k < n; k++) {
+    const fcm_index c = pairs[2 * k], i = pairs[2 * k + 1];
+    fcm_index p = -1;
+    FCM_TRY(ctx, fcm__embed_finder_point(f, c, es->X + 3 * i, &p));
+    const fcm_index e = piece_element(s, c, p);
+    if (e >= 0) es->elem[i] = e;
+    on_cut[i] = p == -2;
+  }
+  for (fcm_index t = 0; t < es->nbt; t++) {
+    const fcm_index *v = es->tri0 + 3 * t;
+    int crosses = on_cut[v[0]] || on_cut[v[1]] || on_cut[v[2]];
+    if (!crosses) {
+      double x[9];
+      tri_coords(es, t, x);
+      FCM_TRY(ctx, fcm__embed_finder_crosses(f, x, &crosses));
+    }
+    split[t] = (unsigned char)crosses;
+  }
+cleanup:
+  fcm__free(ctx, pairs);
+  fcm__free(ctx, on_cut);
+  return st;
+}
+
+/* The parts of the flagged boundary triangles, cell by cell: polygon k of *polys came from
+ * triangle (*src)[k] and lies in cell (*pcell)[k]. A triangle whose parts do not add up to
+ * its area (it leaves the mesh) is unflagged and its parts dropped. */
+static fcm_status split_triangles(fcm_embedded_surface *es, unsigned char *split,
+                                  fcm__embed_polys *polys, fcm_index **src, fcm_index **pcell)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = es->ctx;
+  fcm_index *pairs = NULL, *ps = NULL, *pc = NULL;
+  double *area = NULL;
+  size_t n = 0, cap = 0, pcap = 0;
+  fcm__idbuf ids = {NULL, 0, 0};
+  FCM_TRY(ctx, cell_tree(es));
+  for (fcm_index t = 0; t < es->nbt; t++) {
+    if (!split[t]) continue;
+    double x[9], lo[3], hi[3], w = 0.0;
+    tri_coords(es, t, x);
+    for (int d = 0; d < 3; d++) {
+      lo[d] = fmin(x[d], fmin(x[3 + d], x[6 + d]));
+      hi[d] = fmax(x[d], fmax(x[3 + d], x[6 + d]));
+      w = fmax(w, hi[d] - lo[d]);
+    }
+    for (int d = 0; d < 3; d++) /* cells the triangle touches within rounding */
+      lo[d] -= 1e-9 * w, hi[d] += 1e-9 * w;
+    FCM_TRY(ctx, fcm__geom_tree_query(ctx, es->cell_tree, lo, hi, &ids));
+    if (n + ids.n > cap) {
+      size_t ncap = cap ? 2 * cap : 1024;
+      while (ncap < n + ids.n)
+        ncap *= 2;
+      void *q = pairs;
+      FCM_TRY(ctx, fcm__resize(ctx, &q, 2 * n, 2 * ncap, sizeof(fcm_index)));
+      pairs = q;
+      cap = ncap;
+    }
+    for (size_t k = 0; k < ids.n; k++, n++)
+      pairs[2 * n] = ids.ids[k], pairs[2 * n + 1] = t;
+  }
+  qsort(pairs, n, 2 * sizeof *pairs, cmp_pair); /* one cell's parts made once */
+  for (size_t k = 0; k < n; k++) {
+    const fcm_index c = pairs[2 * k], t = pairs[2 * k + 1];
+    double x[9];
+    tri_coords(es, t, x);
+    const size_t n0 = polys->n;
+    FCM_TRY(ctx, fcm__embed_finder_clip(es->finder, c, x, polys));
+    if (polys->n > pcap) {
+      const size_t ncap = FCM_MAX(2 * pcap, polys->n + 256);
+      void *a = ps, *b = pc;
+      FCM_TRY(ctx, fcm__resize(ctx, &a, pcap, ncap, sizeof(fcm_index)));
+      ps = a;
+      FCM_TRY(ctx, fcm__resize(ctx, &b, pcap, ncap, sizeof(fcm_index)));
+      pc = b;
+      pcap = ncap;
+    }
+    for (size_t j = n0; j < polys->n; j++)
+      ps[j] = t, pc[j] = c;
+  }
+  /* the parts cover each triangle: else it stays whole */
+  FCM_ALLOC(ctx, (size_t)es->nbt + 1, area);
+  for (size_t j = 0, off = 0; j < polys->n; off += (size_t)polys->nv[j], j++) {
+    const double *x = polys->x + 3 * off;
+    for (int k = 1; k + 1 < polys->nv[j]; k++)
+      area[ps[j]] += tri_area(x, x + 3 * k, x + 3 * (k + 1));
+  }
+  for (fcm_index t = 0; t < es->nbt; t++) {
+    if (!split[t]) continue;
+    double x[9];
+    tri_coords(es, t, x);
+    const double a = tri_area(x, x + 3, x + 6);
+    if (!(fabs(area[t] - a) <= SPLIT_AREA_RTOL * a)) split[t] = 0;
+  }
+  *src = ps, *pcell = pc;
+  ps = pc = NULL;
+cleanup:
+  fcm__free(ctx, pairs);
+  fcm__free(ctx, ps);
+  fcm__free(ctx, pc);
+  fcm__free(ctx, area);
+  fcm__geom_idbuf_free(ctx, &ids);
+  return st;
+}
+
+/* Room for np points and nt triangles. */
+static fcm_status surface_reserve(fcm_embedded_surface *es, fcm_index np, fcm_index nt)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = es->ctx;
+  if (np > es->cap_p) {
+    const size_t old = (size_t)es->cap_p;
+    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->X, 3 * old, 3 * (size_t)np, sizeof(double)));
+    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->xi, 3 * old, 3 * (size_t)np, sizeof(double)));
+    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->cell, old, (size_t)np, sizeof(fcm_index)));
+    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->elem, old, (size_t)np, sizeof(fcm_index)));
+    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->flag, old, (size_t)np, sizeof(int32_t)));
+    es->cap_p = np;
+  }
+  if (nt > es->cap_t) {
+    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->tri, 3 * (size_t)es->cap_t, 3 * (size_t)nt,
+                             sizeof(fcm_index)));
+    es->cap_t = nt;
+  }
+cleanup:
+  return st;
+}
+
+/* Points [v, v + n) of the split triangles' parts: reference coordinates in their cells and
+ * elements. A part no piece holds (in a dropped cell or piece) follows the element
+ * fcm_space_point_element() picks, in the cell fcm_space_locate() finds when its own has no
+ * element. */
+static fcm_status part_points(fcm_embedded_surface *es, fcm_index v, fcm_index n,
+                              const fcm_index *piece)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = es->ctx;
+  const fcm_space *s = es->space;
+  double X[3 * FCM_ELEMENT_MAX_NODES];
+  fcm_index last = -1, *lost = NULL, nlost = 0;
+  double *lx = NULL, *lxi = NULL;
+  fcm_index *lc = NULL;
+  for (fcm_index i = v; i < v + n; i++) {
+    const fcm_index c = es->cell[i];
+    if (c != last) fcm_mesh_cell_coords(es->mesh, c, X);
+    last = c;
+    FCM_TRY(ctx, fcm_element_inverse_map(ctx, s->type, X, es->X + 3 * i, es->xi + 3 * i));
+    es->elem[i] = piece_element(s, c, piece[i - v]);
+    if (es->elem[i] < 0) es->elem[i] = fcm_space_point_element(s, c, es->xi + 3 * i);
+    if (es->elem[i] < 0) {
+      if (!lost) FCM_ALLOC_RAW(ctx, (size_t)n, lost);
+      lost[nlost++] = i;
+    }
+  }
+  if (nlost) {
+    FCM_ALLOC_RAW(ctx, 3 * (size_t)nlost, lx);
+    FCM_ALLOC_RAW(ctx, 3 * (size_t)nlost, lxi);
+    FCM_ALLOC_RAW(ctx, (size_t)nlost, lc);
+    for (fcm_index k = 0; k < nlost; k++)
+      memcpy(lx + 3 * k, es->X + 3 * lost[k], 3 * sizeof *lx);
+    FCM_TRY(ctx, fcm_space_locate(s, nlost, lx, lc, lxi, NULL));
+    for (fcm_index k = 0; k < nlost; k++) {
+      const fcm_index i = lost[k];
+      es->cell[i] = lc[k];
+      memcpy(es->xi + 3 * i, lxi + 3 * k, 3 * sizeof *lxi);
+      es->elem[i] = fcm_space_point_element(s, lc[k], lxi + 3 * k);
+    }
+  }
+cleanup:
+  fcm__free(ctx, lost);
+  fcm__free(ctx, lx);
+  fcm__free(ctx, lxi);
+  fcm__free(ctx, lc);
+  return st;
+}
+
+/* Element of every boundary vertex, the parts of the boundary triangles the cuts split, and
+ * the cut faces of the current space. */
+static fcm_status surface_rebuild(fcm_embedded_surface *es)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = es->ctx;
+  const fcm_space *s = es->space;
+  const fcm_cell_rules *rules = s->rules;
+  const fcm_index npieces = rules ? fcm_cell_rules_num_pieces(rules) : 0;
+  unsigned char *split = NULL;
+  fcm__embed_polys polys = {NULL, NULL, NULL, 0, 0, 0, 0};
+  fcm_index *src = NULL, *pcell = NULL, *order = NULL, *ppiece = NULL;
+  size_t *first_x = NULL;
+  fcm_index ncf = 0;
+  for (fcm_index p = 0; p < npieces; p++)
+    ncf += fcm_cell_rules_get_piece_cut_faces(rules, p, NULL);
+  for (fcm_index i = 0; i < es->nb; i++) {
+    es->elem[i] = fcm_space_point_element(s, es->cell[i], es->xi + 3 * i);
+    FCM_CHECK(es->elem[i] >= 0, ctx, FCM_ERR_ARG,
+              "embedded surface: vertex %lld lies in cell %lld, which has no element in this "
+              "space (another mesh or active set?)",
+              (long long)i, (long long)es->cell[i]);
+    es->flag[i] = 0;
+  }
+  FCM_ALLOC(ctx, (size_t)es->nbt + 1, split);
+  if (rules && fcm_cell_rules_num_cuts(rules) > 0) {
+    if (!es->finder) FCM_TRY(ctx, fcm__embed_finder_create(ctx, es->mesh, es->geom, &es->finder));
+    FCM_TRY(ctx, fcm__embed_finder_set_rules(es->finder, rules));
+    FCM_TRY(ctx, mark_split(es, split));
+    FCM_TRY(ctx, split_triangles(es, split, &polys, &src, &pcell));
+  }
+  /* the kept parts in triangle order (each triangle's in cell order) */
+  fcm_index nkeep = 0, nsv = 0, nst = 0, nsplit = 0;
+  for (fcm_index t = 0; t < es->nbt; t++)
+    nsplit += split[t];
+  FCM_ALLOC(ctx, polys.n + 1, order);
+  FCM_ALLOC(ctx, polys.n + 1, first_x);
+  for (size_t j = 0, off = 0; j < polys.n; off += (size_t)polys.nv[j], j++) {
+    first_x[j] = off;
+    if (!split[src[j]]) continue;
+    order[nkeep++] = (fcm_index)j;
+    nsv += polys.nv[j];
+    nst += polys.nv[j] - 2;
+  }
+  for (fcm_index k = 1; k < nkeep; k++) { /* insertion sort by triangle: stable, nearly sorted */
+    const fcm_index j = order[k];
+    fcm_index m = k;
+    while (m > 0 && src[order[m - 1]] > src[j])
+      order[m] = order[m - 1], m--;
+    order[m] = j;
+  }
+  const fcm_index np = es->nb + nsv + 3 * ncf, nt = es->nbt - nsplit + nst + ncf;
+  FCM_TRY(ctx, surface_reserve(es, np, nt));
+  fcm_index v = es->nb, t = 0;
+  for (fcm_index k = 0; k < es->nbt; k++)
+    if (!split[k]) memcpy(es->tri + 3 * t++, es->tri0 + 3 * k, 3 * sizeof *es->tri);
+  FCM_ALLOC(ctx, (size_t)nsv + 1, ppiece);
+  for (fcm_index k = 0; k < nkeep; k++) {
+    const fcm_index j = order[k];
+    const int m = polys.nv[j];
+    for (int a = 0; a < m; a++) {
+      memcpy(es->X + 3 * (v + a), polys.x + 3 * (first_x[j] + (size_t)a), 3 * sizeof(double));
+      es->cell[v + a] = pcell[j];
+      es->flag[v + a] = 0;
+      ppiece[v + a - es->nb] = polys.piece[j];
+    }
+    for (int a = 1; a + 1 < m; a++, t++) { /* fan: the polygon keeps the triangle's orientation */
+      es->tri[3 * t] = v;
+      es->tri[3 * t + 1] = v + a;
+      es->tri[3 * t + 2] = v + a + 1;
+    }
+    v += m;
+  }
+  FCM_TRY(ctx, part_points(es, es->nb, nsv, ppiece));
+  double Xc[3 * FCM_ELEMENT_MAX_NODES];
+  for (fcm_index p = 0; p < npieces; p++) {
+    const double *xi;
+    const fcm_index n = fcm_cell_rules_get_piece_cut_faces(rules, p, &xi);
+    if (!n) continue;
+    const fcm_index c = fcm_cell_rules_piece_cell(rules, p);
+    fcm_mesh_cell_coords(s->mesh, c, Xc);
+    for (fcm_index k = 0; k < 3 * n; k++, v++) {
+      fcm_element_map(s->type, Xc, xi + 3 * k, es->X + 3 * v);
+      memcpy(es->xi + 3 * v, xi + 3 * k, 3 * sizeof(double));
+      es->cell[v] = c;
+      es->elem[v] = piece_element(s, c, p);
+      es->flag[v] = 1;
+    }
+    for (fcm_index k = 0; k < n; k++, t++)
+      for (int a = 0; a < 3; a++)
+        es->tri[3 * t + a] = v - 3 * n + 3 * k + a;
+  }
+  es->np = np;
+  es->nt = nt;
+  es->num_split = nsplit;
+cleanup:
+  /* the finder holds the cut cells' parts and the search trees: made per call (per cut) */
+  fcm__embed_finder_destroy(&es->finder);
+  fcm_aabb_tree_destroy(&es->cell_tree);
+  fcm__free(ctx, split);
+  fcm__free(ctx, src);
+  fcm__free(ctx, pcell);
+  fcm__free(ctx, order);
+  fcm__free(ctx, first_x);
+  fcm__free(ctx, ppiece);
+  fcm__embed_polys_free(ctx, &polys);
+  return st;
+}
+
+fcm_status fcm_embedded_surface_create(const fcm_space *s, const fcm_geometry *geom,
+                                       fcm_embedded_surface **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s ? s->ctx : NULL;
+  fcm_embedded_surface *es = NULL;
+  fcm_index *map = NULL;
+  FCM_CHECK(s && geom && out, ctx, FCM_ERR_ARG, "embedded surface: NULL space, geometry or output");
+  *out = NULL;
+  const fcm_index nv = fcm_geometry_num_nodes(geom), nt = fcm_geometry_num_boundary_triangles(geom);
+  const fcm_index *tri = fcm_geometry_boundary_triangles(geom);
+  const double *GX = fcm_geometry_coords(geom);
+  FCM_CHECK(nt > 0, ctx, FCM_ERR_ARG, "embedded surface: the geometry has no boundary triangles");
+  FCM_ALLOC(ctx, 1, es);
+  es->ctx = ctx;
+  es->space = s;
+  es->mesh = s->mesh;
+  es->geom = geom;
+  FCM_ALLOC(ctx, nv, map);
+  for (fcm_index i = 0; i < nv; i++)
+    map[i] = -1;
+  fcm_index nb = 0;
+  for (fcm_index k = 0; k < 3 * nt; k++)
+    if (map[tri[k]] < 0) map[tri[k]] = nb++;
+  es->cap_p = nb;
+  es->cap_t = nt;
+  FCM_ALLOC(ctx, 3 * nb, es->X);
+  FCM_ALLOC(ctx, 3 * nb, es->xi);
+  FCM_ALLOC(ctx, nb, es->cell);
+  FCM_ALLOC(ctx, nb, es->elem);
+  FCM_ALLOC(ctx, nb, es->flag);
+  FCM_ALLOC(ctx, 3 * nt, es->tri);
+  FCM_ALLOC(ctx, 3 * nt, es->tri0);
+  for (fcm_index k = 0; k < 3 * nt; k++)
+    es->tri[k] = es->tri0[k] = map[tri[k]];
+  for (fcm_index i = 0; i < nv; i++)
+    if (map[i] >= 0) memcpy(es->X + 3 * map[i], GX + 3 * i, 3 * sizeof(double));
+  es->nb = nb;
+  es->nbt = nt;
+  FCM_TRY(ctx, fcm_space_locate(s, nb, es->X, es->cell, es->xi, NULL));
+  FCM_TRY(ctx, surface_rebuild(es));
+  *out = es;
+  es = NULL;
+cleanup:
+  fcm__free(ctx, map);
+  fcm_embedded_surface_destroy(&es);
+  return st;
+}
+
+void fcm_embedded_surface_destroy(fcm_embedded_surface **surface)
+{
+  if (!surface || !*surface) return;
+  fcm_embedded_surface *es = *surface;
+  fcm__embed_finder_destroy(&es->finder);
+  fcm_aabb_tree_destroy(&es->cell_tree);
+  void *arrays[] = {es->X, es->xi, es->cell, es->elem, es->tri, es->tri0, es->flag};
+  for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
+    fcm__free(es->ctx, arrays[k]);
+  fcm__free(es->ctx, es);
+  *surface = NULL;
+}
+
+fcm_status fcm_embedded_surface_set_space(fcm_embedded_surface *es, const fcm_space *s)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(es && s, es ? es->ctx : NULL, FCM_ERR_ARG, "embedded surface: NULL surface or space");
+  FCM_CHECK(s->mesh == es->mesh, es->ctx, FCM_ERR_ARG,
+            "embedded surface: the new space is on another mesh");
+  es->space = s;
+  FCM_TRY(es->ctx, surface_rebuild(es));
+cleanup:
+  return st;
+}
+
+fcm_index fcm_embedded_surface_num_points(const fcm_embedded_surface *es)
+{
+  return es ? es->np : 0;
+}
+fcm_index fcm_embedded_surface_num_triangles(const fcm_embedded_surface *es)
+{
+  return es ? es->nt : 0;
+}
+const double *fcm_embedded_surface_points(const fcm_embedded_surface *es)
+{
+  return es ? es->X : NULL;
+}
+const fcm_index *fcm_embedded_surface_triangles(const fcm_embedded_surface *es)
+{
+  return es ? es->tri : NULL;
+}
+const int32_t *fcm_embedded_surface_cut_flags(const fcm_embedded_surface *es)
+{
+  return es ? es->flag : NULL;
+}
+
+fcm_index fcm_embedded_surface_num_split_triangles(const fcm_embedded_surface *es)
+{
+  return es ? es->num_split : 0;
+}
+
+fcm_status fcm_embedded_surface_eval(const fcm_embedded_surface *es, const double *u,
+                                     double *displacement, double *deformed)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(es && u, es ? es->ctx : NULL, FCM_ERR_ARG, "embedded surface: NULL surface or field");
+  for (fcm_index i = 0; i < es->np; i++) {
+    double d[3];
+    FCM_TRY(es->ctx, fcm_space_element_eval(es->space, es->elem[i], es->xi + 3 * i, u, d));
+    if (displacement) memcpy(displacement + 3 * i, d, sizeof d);
+    if (deformed)
+      for (int k = 0; k < 3; k++)
+        deformed[3 * i + k] = es->X[3 * i + k] + d[k];
+  }
+cleanup:
+  return st;
+}
