@@ -97,7 +97,7 @@ static void warn(fcm_ctx *ctx, const fcm_blas_info *b)
   if (!b->fallback || !fcm__ctx_once(ctx, FCM__ONCE_BLAS_KERNELS)) return;
   fcm__log(ctx, FCM_LOG_WARNING,
            "BLAS: %s runs its %s kernels (%s) on a CPU with %s: dense products (DGEMM, and "
-           "so CHOLMOD and UMFPACK) run several times slower than they can; set "
+           "so the sparse direct solvers) run several times slower than they can; set "
            "OPENBLAS_CORETYPE=%s in the environment before the program starts",
            b->name, b->core, fcm_isa_name(b->core_isa), fcm_isa_name(b->cpu_isa), b->cpu_core);
 }
