@@ -1,14 +1,20 @@
-/* apps/app_env.c: the programs wait passively in OpenMP unless the user chose a policy.
+/* apps/app_env.c: the programs wait passively in OpenMP unless the user chose a policy, and
+ * select the CPU's OpenBLAS kernels when OpenBLAS runs older ones, unless the user chose.
  * The test runs itself as a child ("probe") under several environments; the probe counts
  * its executions in an environment variable, calls app_env_init() as the programs do, and
- * reports the policy in its environment and, through omp_display_env(), the one the
- * OpenMP runtime actually uses (libgomp: GOMP_SPINCOUNT 0 means passive). Asserts: with no
- * policy set, the program runs twice and the runtime spins 0 times; with OMP_WAIT_POLICY
- * or GOMP_SPINCOUNT set by the user, it runs once and the user's values are in effect. */
+ * reports the policy and OPENBLAS_CORETYPE in its environment and, through
+ * omp_display_env(), the policy the OpenMP runtime actually uses (libgomp: GOMP_SPINCOUNT 0
+ * means passive). The BLAS cases preload a shim whose OpenBLAS names its kernels "Prescott"
+ * (SSE3) unless OPENBLAS_CORETYPE is set. Asserts: with no policy set, the program runs twice
+ * and the runtime spins 0 times; with OMP_WAIT_POLICY or GOMP_SPINCOUNT set by the user, it
+ * runs once and the user's values are in effect; under the SSE3 kernels on a CPU with AVX or
+ * more, it runs twice with OPENBLAS_CORETYPE = the CPU's kernel set and says so in one line
+ * on stderr; OPENBLAS_CORETYPE set by the user or FCM_BLAS_CORETYPE=keep: one run, no note. */
 #define _POSIX_C_SOURCE 200809L
 #include "../../apps/app_env.h"
 #include "test.h"
 
+#include <fcm/la.h>
 #include <omp.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -22,17 +28,41 @@ static int probe(int argc, char **argv)
   snprintf(buf, sizeof buf, "%d", (r ? atoi(r) : 0) + 1);
   setenv(RUNS_VAR, buf, 1);
   app_env_init(argc, argv);
-  const char *p = getenv("OMP_WAIT_POLICY");
-  printf("runs=%s policy=%s\n", getenv(RUNS_VAR), p ? p : "-");
+  const char *p = getenv("OMP_WAIT_POLICY"), *c = getenv("OPENBLAS_CORETYPE");
+  printf("runs=%s policy=%s coretype=%s\n", getenv(RUNS_VAR), p ? p : "-", c ? c : "-");
   fflush(stdout);
   omp_display_env(1); /* to stderr */
   return 0;
 }
 
-/* Run `self probe` with the variables set (NULL: unset), stdout and stderr into files;
- * return the runs count and the runtime's GOMP_SPINCOUNT (-1 when not reported). */
-static void run(const char *self, const char *dir, const char *policy, const char *spin, int *runs,
-                long long *spincount, char env_policy[64])
+/* The environment of one probe run; NULL members are unset. */
+typedef struct probe_env {
+  const char *policy, *spin; /* OMP_WAIT_POLICY, GOMP_SPINCOUNT */
+  const char *coretype;      /* OPENBLAS_CORETYPE */
+  const char *mode;          /* FCM_BLAS_CORETYPE */
+  const char *preload;       /* LD_PRELOAD */
+} probe_env;
+
+/* What a probe run reported. */
+typedef struct probe_out {
+  int runs;
+  long long spincount; /* the runtime's GOMP_SPINCOUNT (-1 when not reported) */
+  char policy[64];     /* OMP_WAIT_POLICY in its environment, "-" unset */
+  char coretype[64];   /* OPENBLAS_CORETYPE in its environment, "-" unset */
+  int blas_notes;      /* lines on stderr saying which kernels were selected */
+  char blas_note[512]; /* the last one */
+} probe_out;
+
+static void set_or_unset(const char *name, const char *value)
+{
+  if (value)
+    setenv(name, value, 1);
+  else
+    unsetenv(name);
+}
+
+/* Run `self probe` under `e`, stdout and stderr into files, and read what it reported. */
+static void run(const char *self, const char *dir, probe_env e, probe_out *o)
 {
   char out[4096], err[4096];
   snprintf(out, sizeof out, "%s/app_env.out", dir);
@@ -41,15 +71,11 @@ static void run(const char *self, const char *dir, const char *policy, const cha
   if (pid == 0) {
     unsetenv(RUNS_VAR);
     unsetenv("KMP_BLOCKTIME");
-    unsetenv("LD_PRELOAD");
-    if (policy)
-      setenv("OMP_WAIT_POLICY", policy, 1);
-    else
-      unsetenv("OMP_WAIT_POLICY");
-    if (spin)
-      setenv("GOMP_SPINCOUNT", spin, 1);
-    else
-      unsetenv("GOMP_SPINCOUNT");
+    set_or_unset("OMP_WAIT_POLICY", e.policy);
+    set_or_unset("GOMP_SPINCOUNT", e.spin);
+    set_or_unset("OPENBLAS_CORETYPE", e.coretype);
+    set_or_unset("FCM_BLAS_CORETYPE", e.mode);
+    set_or_unset("LD_PRELOAD", e.preload);
     if (!freopen(out, "w", stdout) || !freopen(err, "w", stderr)) _exit(127);
     execl(self, self, "probe", (char *)NULL);
     _exit(127);
@@ -57,18 +83,23 @@ static void run(const char *self, const char *dir, const char *policy, const cha
   int status = -1;
   TEST_TRUE(pid > 0 && waitpid(pid, &status, 0) == pid);
   TEST_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
-  *runs = -1;
-  *spincount = -1;
-  env_policy[0] = 0;
+  memset(o, 0, sizeof *o);
+  o->runs = -1;
+  o->spincount = -1;
   FILE *f = fopen(out, "r");
-  TEST_TRUE(f && fscanf(f, "runs=%d policy=%63s", runs, env_policy) == 2);
+  TEST_TRUE(f &&
+            fscanf(f, "runs=%d policy=%63s coretype=%63s", &o->runs, o->policy, o->coretype) == 3);
   if (f) fclose(f);
   /* the last GOMP_SPINCOUNT line is the final process's */
   f = fopen(err, "r");
   char line[512];
   while (f && fgets(line, sizeof line, f)) {
     const char *s = strstr(line, "GOMP_SPINCOUNT = '");
-    if (s) *spincount = atoll(s + strlen("GOMP_SPINCOUNT = '"));
+    if (s) o->spincount = atoll(s + strlen("GOMP_SPINCOUNT = '"));
+    if (strstr(line, "BLAS:")) {
+      o->blas_notes++;
+      snprintf(o->blas_note, sizeof o->blas_note, "%s", line);
+    }
   }
   if (f) fclose(f);
 }
@@ -76,26 +107,51 @@ static void run(const char *self, const char *dir, const char *policy, const cha
 int main(int argc, char **argv)
 {
   if (argc >= 2 && !strcmp(argv[1], "probe")) return probe(argc, argv);
-  if (argc < 2) {
-    fprintf(stderr, "usage: app_env SCRATCH_DIR\n");
+  if (argc < 3) {
+    fprintf(stderr, "usage: app_env SCRATCH_DIR CORENAME_SHIM\n");
     return 2;
   }
-  int runs;
-  long long spin;
-  char pol[64];
+  const char *self = argv[0], *dir = argv[1], *shim = argv[2];
+  probe_out o;
+  /* OpenMP, with the BLAS kernels as OpenBLAS chose them */
   /* nothing set: re-executed once with passive waiting, and the runtime took it */
-  run(argv[0], argv[1], NULL, NULL, &runs, &spin, pol);
-  TEST_TRUE(runs == 2 && !strcmp(pol, "passive"));
-  TEST_TRUE(spin == 0 || spin == -1); /* -1: a runtime that does not report the spin count */
+  run(self, dir, (probe_env){.mode = "keep"}, &o);
+  TEST_TRUE(o.runs == 2 && !strcmp(o.policy, "passive") && !strcmp(o.coretype, "-"));
+  TEST_TRUE(o.spincount == 0 || o.spincount == -1); /* -1: a runtime that does not report it */
   /* the user's policy wins: one run, the runtime spins */
-  run(argv[0], argv[1], "active", NULL, &runs, &spin, pol);
-  TEST_TRUE(runs == 1 && !strcmp(pol, "active"));
-  TEST_TRUE(spin > 0 || spin == -1);
-  run(argv[0], argv[1], "PASSIVE", NULL, &runs, &spin, pol);
-  TEST_TRUE(runs == 1 && !strcmp(pol, "PASSIVE") && (spin == 0 || spin == -1));
+  run(self, dir, (probe_env){.policy = "active", .mode = "keep"}, &o);
+  TEST_TRUE(o.runs == 1 && !strcmp(o.policy, "active"));
+  TEST_TRUE(o.spincount > 0 || o.spincount == -1);
+  run(self, dir, (probe_env){.policy = "PASSIVE", .mode = "keep"}, &o);
+  TEST_TRUE(o.runs == 1 && !strcmp(o.policy, "PASSIVE"));
+  TEST_TRUE(o.spincount == 0 || o.spincount == -1);
   /* so does a spin count alone */
-  run(argv[0], argv[1], NULL, "777", &runs, &spin, pol);
-  TEST_TRUE(runs == 1 && !strcmp(pol, "-"));
-  TEST_TRUE(spin == 777 || spin == -1);
+  run(self, dir, (probe_env){.spin = "777", .mode = "keep"}, &o);
+  TEST_TRUE(o.runs == 1 && !strcmp(o.policy, "-"));
+  TEST_TRUE(o.spincount == 777 || o.spincount == -1);
+
+  /* BLAS kernels: OpenBLAS (the shim) names its SSE3 kernels */
+  fcm_blas_info b;
+  TEST_TRUE(fcm_blas_info_get(NULL, &b) == FCM_OK);
+  const int avx = b.cpu_isa >= FCM_ISA_AVX && b.cpu_core[0];
+  run(self, dir, (probe_env){.policy = "active", .preload = shim}, &o);
+  if (avx) { /* re-executed once with the CPU's kernels, said in one line */
+    TEST_TRUE(o.runs == 2 && !strcmp(o.coretype, b.cpu_core));
+    TEST_TRUE(o.blas_notes == 1 && strstr(o.blas_note, b.cpu_core) &&
+              strstr(o.blas_note, "in place of Prescott") &&
+              strstr(o.blas_note, "FCM_BLAS_CORETYPE=keep"));
+  } else { /* SSE3 is all the CPU has: nothing to select */
+    TEST_TRUE(o.runs == 1 && !strcmp(o.coretype, "-") && o.blas_notes == 0);
+  }
+  TEST_TRUE(!strcmp(o.policy, "active"));
+  /* one re-execution does both */
+  run(self, dir, (probe_env){.preload = shim, .mode = "auto"}, &o);
+  TEST_TRUE(o.runs == 2 && !strcmp(o.policy, "passive"));
+  TEST_TRUE(!strcmp(o.coretype, avx ? b.cpu_core : "-") && o.blas_notes == avx);
+  /* the user's kernels win, and FCM_BLAS_CORETYPE=keep keeps OpenBLAS's */
+  run(self, dir, (probe_env){.policy = "active", .coretype = "Haswell", .preload = shim}, &o);
+  TEST_TRUE(o.runs == 1 && !strcmp(o.coretype, "Haswell") && o.blas_notes == 0);
+  run(self, dir, (probe_env){.policy = "active", .mode = "keep", .preload = shim}, &o);
+  TEST_TRUE(o.runs == 1 && !strcmp(o.coretype, "-") && o.blas_notes == 0);
   return TEST_RESULT();
 }

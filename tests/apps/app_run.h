@@ -3,7 +3,9 @@
 #ifndef FCM_TEST_APP_RUN_H
 #define FCM_TEST_APP_RUN_H
 
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 
@@ -19,6 +21,20 @@ static inline int app_exists(const char *path)
 {
   struct stat sb;
   return stat(path, &sb) == 0;
+}
+
+/* 1 when a line of the file `path` holds "warning" other than the library's warning about
+ * the BLAS kernels ("warning: BLAS: ..."), which a run on a CPU newer than its OpenBLAS gets
+ * when the kernels are kept (FCM_BLAS_CORETYPE=keep, or OPENBLAS_CORETYPE set to older ones). */
+static inline int app_has_warning(const char *path)
+{
+  char line[4096];
+  int found = 0;
+  FILE *f = fopen(path, "r");
+  while (f && !found && fgets(line, sizeof line, f))
+    found = strstr(line, "warning") && !strstr(line, "warning: BLAS: ");
+  if (f) fclose(f);
+  return found;
 }
 
 #endif

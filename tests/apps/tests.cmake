@@ -89,9 +89,15 @@ fcm_add_test(app_fault_kill_long tests/apps/fault_app.c LABELS app slow TIMEOUT 
 fcm_add_test(app_fault_diskfull tests/apps/fault_app.c LABELS app ARGS diskfull ${fault_args})
 fcm_add_test(app_fault_dirsync tests/apps/fault_app.c LABELS app ARGS dirsync ${fault_args})
 add_dependencies(app_fault_kill fcm_fault_shim fcm-sim) # the program of the app_fault_* tests
-# apps/app_env.c: passive OpenMP waiting by default, the user's OMP_WAIT_POLICY / GOMP_SPINCOUNT kept.
-fcm_add_test(app_env tests/apps/app_env.c LABELS app ARGS ${PROJECT_BINARY_DIR}/app-tests)
+# apps/app_env.c: passive OpenMP waiting by default, the user's OMP_WAIT_POLICY / GOMP_SPINCOUNT
+# kept; the CPU's OpenBLAS kernels selected when a shim makes OpenBLAS name its SSE3 ones, the
+# user's OPENBLAS_CORETYPE and FCM_BLAS_CORETYPE=keep respected.
+add_library(fcm_corename_shim SHARED tests/support/corename_shim.c)
+set_target_properties(fcm_corename_shim PROPERTIES C_VISIBILITY_PRESET default)
+fcm_add_test(app_env tests/apps/app_env.c LABELS app
+             ARGS ${PROJECT_BINARY_DIR}/app-tests $<TARGET_FILE:fcm_corename_shim>)
 target_sources(app_env PRIVATE ${PROJECT_SOURCE_DIR}/apps/app_env.c)
+add_dependencies(app_env fcm_corename_shim)
 # fcm-cut: the cutting experiments check their own claims (exit 1 when one fails): moments of
 # every degree <= m over the pieces of a cut tet and hex within 1e-12 with <= M points, and
 # the 36 sticks of the diced cube with the mass kept, the conditioning of a cut approaching a

@@ -20,6 +20,7 @@
  * asserts only that every solve converges and that the loaded solves are bitwise equal to
  * the lone ones (the result does not depend on the scheduling). */
 #define _GNU_SOURCE /* getloadavg */
+#include "../../apps/app_env.h"
 #include "fcm/fcm.h"
 #include "test.h"
 
@@ -197,6 +198,7 @@ static void clamp_below(bench *B, const fcm_mesh *mesh, double zmax)
 
 int main(int argc, char **argv)
 {
+  app_env_init_blas(argc, argv); /* the CPU's BLAS kernels, as the programs */
   const int ncell = argc > 1 ? atoi(argv[1]) : 36;
   const int rounds = argc > 2 ? atoi(argv[2]) : 3;
   const int nbusy = argc > 3 ? atoi(argv[3]) : 8;

@@ -19,6 +19,7 @@
  * measure (the programs use OMP_WAIT_POLICY=passive, apps/app_env.h). Asserts that every
  * solve converges and that the loaded solves are bitwise equal to the lone ones. */
 #define _GNU_SOURCE /* getloadavg */
+#include "../../apps/app_env.h"
 #include "fcm/fcm.h"
 #include "test.h"
 
@@ -169,7 +170,8 @@ int main(int argc, char **argv)
 {
   const int shared = argc > 1 && !strcmp(argv[1], "shared");
   const int simplify = !(argc > 1 + shared && !strcmp(argv[1 + shared], "nosimplify"));
-  fcm_blas_set_num_threads(1); /* as the programs: no BLAS threads spinning beside OpenMP's */
+  app_env_init_blas(argc, argv); /* the CPU's BLAS kernels, as the programs */
+  fcm_blas_set_num_threads(1);   /* as the programs: no BLAS threads spinning beside OpenMP's */
   fcm_ctx *ctx = NULL;
   fcm_mesh *mesh = NULL;
   fcm_geometry *tube = NULL;

@@ -15,3 +15,13 @@ fcm_add_test(bench_level_set_memory tests/bench/bench_level_set_memory.c LABELS 
 # and beside 8 busy processes; the slowdown of each (figures in lib/docs/multigrid_threads.md).
 fcm_add_test(bench_mg_shared tests/bench/bench_mg_shared.c LABELS bench TIMEOUT 3600)
 set_tests_properties(bench_mg_shared PROPERTIES RUN_SERIAL TRUE)
+# The solver benchmarks select the CPU's OpenBLAS kernels as the programs do (apps/app_env.h).
+foreach(b bench_newton_step bench_mg_shared)
+  target_sources(${b} PRIVATE ${PROJECT_SOURCE_DIR}/apps/app_env.c)
+endforeach()
+# The core's peaks (one-thread DGEMM, STREAM triad) and a CHOLMOD factorization of 3D elasticity,
+# each with OpenBLAS's fallback kernels (Prescott) and the ones selected for the CPU: time, rate,
+# fraction of the peak, a CSV (figures in lib/docs/performance.md).
+fcm_add_test(bench_roofline tests/bench/bench_roofline.c LABELS bench TIMEOUT 1800
+             ARGS ${PROJECT_BINARY_DIR}/bench_roofline.csv)
+set_tests_properties(bench_roofline PROPERTIES RUN_SERIAL TRUE)

@@ -12,3 +12,9 @@ fcm_add_test(la_direct tests/la/direct.c)
 fcm_add_test(la_alloc_failure tests/la/alloc_failure.c)
 # The sparse triple product P^T A P against a dense product, 1 and 2 threads.
 fcm_add_test(la_ptap tests/la/ptap.c)
+# The BLAS kernel query and its once-per-context warning: with the kernels OpenBLAS (or the
+# test environment) chose, and with the SSE3 fallback forced, which every AVX CPU must flag.
+fcm_add_test(la_blas_info tests/la/blas_info.c)
+fcm_add_test(la_blas_info_prescott tests/la/blas_info.c ARGS prescott)
+set_tests_properties(la_blas_info_prescott PROPERTIES ENVIRONMENT
+                     "${FCM_TEST_ENV};OPENBLAS_CORETYPE=Prescott")

@@ -53,7 +53,8 @@ FCM_API const char *fcm_status_name(fcm_status st);
 
 /** Severity of a log message passed to the log callback: ERROR for every recorded error
  * (with its message), WARNING for counted fallbacks that change how a result is computed
- * (a simplification that keeps the input rule, CHOLMOD -> UMFPACK), INFO for housekeeping
+ * (a simplification that keeps the input rule, CHOLMOD -> UMFPACK) and, once per context,
+ * for BLAS kernels below the CPU's instruction set (fcm_blas_info_get()), INFO for housekeeping
  * the caller did not ask for (stale temporary files of dead processes removed). The library
  * emits nothing else, so there is no lower level. */
 typedef enum fcm_log_level {

@@ -197,6 +197,44 @@ FCM_API void fcm_direct_destroy(fcm_direct **solver);
  * fcm programs do). n < 1 only queries. @return the previous count. Not thread safe. */
 FCM_API int fcm_blas_set_num_threads(int n);
 
+/** Instruction-set levels of x86-64 BLAS kernels and CPUs, lowest first. */
+typedef enum fcm_isa {
+  FCM_ISA_UNKNOWN = 0, /**< not an x86-64 CPU, or a kernel set the table does not know */
+  FCM_ISA_SSE2,        /**< baseline x86-64 */
+  FCM_ISA_SSE3,        /**< SSE3 (OpenBLAS Prescott, Core2, Nehalem, Barcelona, ...) */
+  FCM_ISA_AVX,         /**< AVX (Sandybridge, Bulldozer ... Excavator) */
+  FCM_ISA_AVX2,        /**< AVX2 + FMA (Haswell, Zen) */
+  FCM_ISA_AVX512       /**< AVX-512 F/DQ/BW/VL (SkylakeX, Cooperlake, SapphireRapids) */
+} fcm_isa;
+
+/** Which kernels the BLAS runs on, against what the CPU supports (fcm_blas_info_get()). */
+typedef struct fcm_blas_info {
+  const char *name;     /**< "OpenBLAS", or "unknown" (a BLAS that does not say) */
+  const char *config;   /**< the BLAS's build description (openblas_get_config()), or "" */
+  const char *core;     /**< kernel set in use, as the BLAS names it ("Prescott"), or "" */
+  const char *cpu_core; /**< the kernel set for this CPU, as OPENBLAS_CORETYPE takes it
+                             ("SkylakeX", "Zen", "Haswell", "Sandybridge"), or "" */
+  fcm_isa core_isa;     /**< level of `core` */
+  fcm_isa cpu_isa;      /**< level of the CPU (what it and the OS support) */
+  int fallback;         /**< 1: the kernels are below the CPU (core_isa < cpu_isa, both known
+                             and cpu_core set): setting OPENBLAS_CORETYPE=cpu_core before the
+                             program starts selects the right ones */
+} fcm_blas_info;
+
+/** Find the BLAS's kernel set (OpenBLAS's openblas_get_corename() and openblas_get_config(),
+ * looked up at run time, so any BLAS links) and the CPU's instruction set (cpuid). The
+ * strings are static. A fallback is also logged once per context at FCM_LOG_WARNING with the
+ * fix, here and at the first fcm_direct_analyze() (CHOLMOD and UMFPACK spend most of their
+ * time in DGEMM). OpenBLAS reads OPENBLAS_CORETYPE only when it loads: the fcm programs set it
+ * and re-execute themselves (FCM_BLAS_CORETYPE=keep turns that off); a host program sets it
+ * in its environment. @param[in] ctx for the warning (may be NULL)
+ * @param[out] info the result. @return FCM_OK, FCM_ERR_ARG (info NULL). No allocation.
+ * Not thread safe with itself (OpenBLAS writes its config string to a static buffer). */
+FCM_API fcm_status fcm_blas_info_get(fcm_ctx *ctx, fcm_blas_info *info);
+
+/** The name of an instruction-set level ("AVX-512", ...; "unknown" out of range). */
+FCM_API const char *fcm_isa_name(fcm_isa isa);
+
 #ifdef __cplusplus
 }
 #endif

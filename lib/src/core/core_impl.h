@@ -30,6 +30,12 @@ void fcm__error_prefix(fcm_ctx *ctx, const char *prefix);
 /* Format a message and pass it to the log callback when level is enabled. */
 void fcm__log(const fcm_ctx *ctx, fcm_log_level level, const char *fmt, ...) FCM__PRINTF(3, 4);
 
+/* Notices given at most once per context (flags of fcm__ctx_once). */
+enum { FCM__ONCE_BLAS_KERNELS = 1u << 0 };
+
+/* 1 the first time it is called with `flag` on ctx, then 0 (thread safe); 0 for a NULL ctx. */
+int fcm__ctx_once(fcm_ctx *ctx, unsigned flag);
+
 /* Zero-filled array of n elements of `size` bytes through ctx's allocator.
  * Returns NULL on overflow or allocation failure (and records FCM_ERR_ALLOC).
  * n == 0 still returns a valid (1-byte) allocation. */

@@ -19,6 +19,7 @@ typedef struct fcm_frame {
 struct fcm_ctx {
   fcm_ctx_options opts;
   atomic_llong live;
+  atomic_uint once; /* FCM__ONCE_* flags of the notices already given */
   fcm_status err_status;
   char err_msg[FCM__MSG_LEN];
   fcm_frame frames[FCM__MAX_FRAMES];
@@ -74,6 +75,7 @@ fcm_status fcm_ctx_create(const fcm_ctx_options *opts, fcm_ctx **out)
   memset(ctx, 0, sizeof *ctx);
   ctx->opts = o;
   atomic_init(&ctx->live, 0);
+  atomic_init(&ctx->once, 0u);
   ctx->err_status = FCM_OK;
   *out = ctx;
   return FCM_OK;
@@ -324,6 +326,12 @@ void fcm__log(const fcm_ctx *ctx, fcm_log_level level, const char *fmt, ...)
   vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
   ctx->opts.log(ctx->opts.log_user, level, msg);
+}
+
+int fcm__ctx_once(fcm_ctx *ctx, unsigned flag)
+{
+  if (!ctx) return 0;
+  return !(atomic_fetch_or(&ctx->once, flag) & flag);
 }
 
 void *fcm__calloc(fcm_ctx *ctx, size_t n, size_t size)

@@ -78,6 +78,7 @@ fcm_status fcm_direct_analyze(fcm_direct *s)
   fcm_timer t = fcm_timer_init();
   FCM_CHECK(s, ctx, FCM_ERR_ARG, "direct_analyze: solver is NULL");
   if (s->analyzed) goto cleanup;
+  fcm__blas_check(ctx); /* the factorizations spend most of their time in DGEMM */
   fcm_timer_start(&t);
   if (s->n > 0) FCM_TRY(ctx, s->ops->analyze(ctx, s->impl, &s->info));
   s->analyzed = 1;

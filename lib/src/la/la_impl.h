@@ -7,6 +7,16 @@
 #include "core/core_impl.h"
 #include "fcm/la.h"
 
+/* The kernel set the BLAS runs on, as it names it (OpenBLAS's openblas_get_corename(),
+ * "Prescott"), and its build description (openblas_get_config()); "" from a BLAS that has
+ * no such query. Static strings; fcm__blas_config() is not thread safe with itself. */
+const char *fcm__blas_core_name(void);
+const char *fcm__blas_config(void);
+
+/* Log once per context, at FCM_LOG_WARNING, that the BLAS runs on kernels below the CPU's
+ * instruction set (fcm_blas_info_get()), with the fix. Thread safe. */
+void fcm__blas_check(fcm_ctx *ctx);
+
 /* C = alpha op(A) op(B) + beta C, op = 'N' or 'T'. Sizes are not checked: the
  * caller passes valid leading dimensions (cblas would print on bad ones). */
 void fcm__gemm(char transa, char transb, int m, int n, int k, double alpha, const double *a,

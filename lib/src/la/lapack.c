@@ -1,11 +1,14 @@
 /* The one adapter to BLAS (cblas) and LAPACK (LAPACKE): column-major wrappers
  * whose workspace comes from the context allocator and whose `info` codes become
  * fcm statuses with messages. */
+#define _GNU_SOURCE /* RTLD_DEFAULT */
 #include "la/la_impl.h"
 
 #include <cblas.h>
+#include <dlfcn.h>
 #include <lapacke.h>
 #include <math.h>
+#include <string.h>
 
 _Static_assert(sizeof(lapack_int) == sizeof(int), "fcm expects 32-bit LAPACK integers");
 
@@ -18,6 +21,28 @@ int fcm_blas_set_num_threads(int n)
   int old = openblas_get_num_threads();
   if (n >= 1) openblas_set_num_threads(n);
   return old;
+}
+
+/* A string-returning query of the BLAS found at run time (looked up in the library's own
+ * scope, so a BLAS without it still links and loads), or "" when the BLAS has none. */
+static const char *blas_query(const char *symbol)
+{
+  void *sym = dlsym(RTLD_DEFAULT, symbol);
+  if (!sym) return "";
+  char *(*fn)(void);
+  memcpy(&fn, &sym, sizeof fn); /* object to function pointer, as POSIX allows */
+  const char *s = fn();
+  return s ? s : "";
+}
+
+const char *fcm__blas_core_name(void)
+{
+  return blas_query("openblas_get_corename");
+}
+
+const char *fcm__blas_config(void)
+{
+  return blas_query("openblas_get_config");
 }
 
 static CBLAS_TRANSPOSE cblas_trans(char t)
