@@ -17,9 +17,9 @@ static const fcm_element_type multigrid_elements[] = {FCM_ELEMENT_HEX8, FCM_ELEM
 fcm_status fcm__scene_read_quadrature(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"stiffness_strength", "mass_strength",      "surface_strength",
-                                     "simplify",           "simplify_method",    "stabilization",
-                                     "min_fraction",       "max_rule_memory_gib", "moments"};
+  static const char *const keys[] = {
+      "stiffness_strength", "mass_strength", "surface_strength",    "simplify", "simplify_method",
+      "stabilization",      "min_fraction",  "max_rule_memory_gib", "moments"};
   static const char *const skeys[] = {"mode", "alpha"};
   fcm_cell_rules_options *q = &p->scene->quadrature.rules;
   const fcm__json *o = NULL, *stab = NULL;
