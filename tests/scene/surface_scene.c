@@ -1,7 +1,10 @@
 /* Scenes with geometry.surface and background.fit_background: parse errors of the new keys
  * (status, JSON path, message); a cube given as binary STL and an open cube as OBJ (with
  * fill_holes) built and stepped, the fitted grid around the body, the embedded volume equal
- * to the cube's; an open surface without fill_holes refused with its boundary edges. */
+ * to the cube's; an open surface without fill_holes refused with its boundary edges. Without a
+ * cut the surface alone is the geometry (volume_mesh auto, no Gmsh needed): every cut cell's
+ * rules come from the surface moments, none falls back, and the summary says so; with
+ * "volume_mesh": true the cells are tets; a bad volume_mesh value is refused. */
 #include "scene_util.h"
 
 #include <math.h>
@@ -137,6 +140,8 @@ int main(void)
   parse_error(ctx, dir, json, FCM_ERR_ARG, "geometry.max_volume");
   scene_text(json, sizeof json, fit_bg, "{\"surface\": \"cube.stl\", \"quality\": 1.5}");
   parse_error(ctx, dir, json, FCM_ERR_ARG, "geometry.quality");
+  scene_text(json, sizeof json, fit_bg, "{\"surface\": \"cube.stl\", \"volume_mesh\": 2}");
+  parse_error(ctx, dir, json, FCM_ERR_ARG, "geometry.volume_mesh");
   scene_text(json, sizeof json, fit_bg, "{\"surface\": \"cube.stl\", \"fill_holes\": 1}");
   parse_error(ctx, dir, json, FCM_ERR_ARG, "geometry.fill_holes");
   scene_text(json, sizeof json, fit_bg, "{\"surface\": \"cube.stl\", \"max_hole_edges\": 10}");
@@ -173,9 +178,43 @@ int main(void)
   parse_error(ctx, dir, json, FCM_ERR_ARG,
               "background.fit_background: needs an embedded \"geometry\"");
 
+  {
+    /* the surface alone (no cut: volume_mesh auto), no Gmsh needed */
+    fcm_scene *scene = NULL;
+    fcm_simulation *sim = NULL;
+    scene_text(json, sizeof json, fit_bg, "{\"surface\": \"cube.stl\"}");
+    sim = build(ctx, dir, json, &scene);
+    if (sim) {
+      check_fitted(sim);
+      const fcm_space *space = fcm_simulation_space(sim);
+      const fcm_cell_rules_stats *st = fcm_cell_rules_get_stats(fcm_space_cell_rules(space));
+      TEST_TRUE(st->num_cut > 0 && st->num_surface_cells == st->num_cut &&
+                st->num_surface_fallbacks == 0);
+      char *text = NULL;
+      size_t len = 0;
+      FILE *mf = open_memstream(&text, &len);
+      TEST_TRUE(mf != NULL);
+      if (mf) {
+        fcm_simulation_summary_view(sim, mf);
+        fclose(mf);
+        TEST_TRUE(text && strstr(text, "cut cells from the boundary surface") &&
+                  strstr(text, "0 of them fell back"));
+        free(text);
+      }
+    }
+    fcm_simulation_destroy(&sim);
+    fcm_scene_destroy(&scene);
+  }
+
   if (fcm_surface_meshing_available()) {
     fcm_scene *scene = NULL;
     fcm_simulation *sim = NULL;
+    /* with a volume mesh: tets, and the same grid and volume */
+    scene_text(json, sizeof json, fit_bg, "{\"surface\": \"cube.stl\", \"volume_mesh\": true}");
+    sim = build(ctx, dir, json, &scene);
+    if (sim) check_fitted(sim);
+    fcm_simulation_destroy(&sim);
+    fcm_scene_destroy(&scene);
     /* binary STL cube, fitted grid */
     scene_text(json, sizeof json, fit_bg, "{\"surface\": \"cube.stl\", \"max_volume\": 0.01}");
     sim = build(ctx, dir, json, &scene);

@@ -165,6 +165,11 @@ static void rules_lines(const fcm_simulation *S, FILE *f, const fcm_cell_rules_s
             (long long)rs->points_simplified[FCM_RULE_STIFFNESS],
             (long long)rs->points_initial[FCM_RULE_MASS],
             (long long)rs->points_simplified[FCM_RULE_MASS]);
+    if (rs->num_surface_cells > 0)
+      fprintf(f,
+              "  moments   %lld cut cells from the boundary surface (candidates -> fitted points "
+              "above), %lld of them fell back to the volume mesh\n",
+              (long long)rs->num_surface_cells, (long long)rs->num_surface_fallbacks);
     fprintf(f,
             "  volume    embedded %.6g of %.6g m^3 (ratio %.6f), outside the background %.3g, in "
             "dropped cells %.3g\n",
