@@ -5,6 +5,7 @@
  * allocation-failure loop (fail the k-th allocation, k = 0, 1, ... until success; one
  * thread): FCM_ERR_ALLOC, NULL output, nothing leaked. */
 #include "fcm/embed.h"
+#include "geom/geom_impl.h"
 #include "fcm/surface.h"
 #include "test.h"
 #include "test_alloc.h"
@@ -86,6 +87,11 @@ static void allocation_failures(void)
   TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 1)); /* the failing allocator's counter is not atomic */
   o.surface_strength = 1;
   o.strength[FCM_RULE_MASS] = 2;
+  { /* one build first: the geometry keeps the search trees it makes (a cache, not a leak) */
+    fcm_cell_rules *r = NULL;
+    TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &o, &r));
+    fcm_cell_rules_destroy(&r);
+  }
   const long long live = fcm_ctx_live_allocations(ctx);
   int ok = 0, fails = 0;
   for (long k = 0; k < 100000 && !ok && mesh && g; k++) {
@@ -109,6 +115,28 @@ static void allocation_failures(void)
     fcm_ctx_error_clear(ctx);
   }
   TEST_TRUE(ok && fails > 20);
+  /* a fresh geometry each time: the failure also hits the search trees it builds and keeps;
+   * nothing of them outlives the geometry */
+  ok = 0;
+  for (long k = 0; k < 100000 && !ok && mesh; k++) {
+    fcm_geometry *g2 = NULL;
+    const long long live0 = fcm_ctx_live_allocations(ctx);
+    TEST_OK(ctx, fcm_geometry_create_ball(ctx, c0, 0.9, 1, &g2));
+    fcm_cell_rules *r = NULL;
+    f.count = 0, f.fail_at = k;
+    const fcm_status st = g2 ? fcm_cell_rules_create(ctx, mesh, g2, &o, &r) : FCM_ERR_ALLOC;
+    f.fail_at = -1;
+    ok = st == FCM_OK && g2->trees[0] && g2->trees[1];
+    if (st != FCM_OK && !(st == FCM_ERR_ALLOC && r == NULL))
+      TEST_FAIL_("fresh geometry, allocation %ld failing: status %s", k, fcm_status_name(st));
+    fcm_cell_rules_destroy(&r);
+    fcm_geometry_destroy(&g2);
+    if (fcm_ctx_live_allocations(ctx) != live0)
+      TEST_FAIL_("fresh geometry, allocation %ld failing: %lld allocations leaked", k,
+                 fcm_ctx_live_allocations(ctx) - live0);
+    fcm_ctx_error_clear(ctx);
+  }
+  TEST_TRUE(ok);
   fcm_mesh_destroy(&mesh);
   fcm_geometry_destroy(&g);
   fcm_ctx_destroy(&ctx);

@@ -7,7 +7,9 @@
  * - the cells' volumes add up to the geometry's volume within 1e-12;
  * - the inside test: random points against the point-in-tet oracle; points on the box's
  *   faces and edges inside or outside consistently (winding number 0 or 1, never 2 or -1);
- * - an open surface (one triangle missing) is reported as FCM_ERR_GEOMETRY. */
+ * - an open surface (one triangle missing) is reported as FCM_ERR_GEOMETRY;
+ * - the geometry's search trees are built by its first rules build and reused by the next ones
+ *   (the same trees, and the same rules). */
 #include "embed/rules_impl.h"
 #include "fcm/fcm.h"
 #include "test.h"
@@ -39,11 +41,11 @@ static fcm_status trees(fcm_ctx *ctx, const fcm_geometry *g, fixture *f)
   fcm_status st = FCM_OK;
   double *boxes = NULL;
   fcm_index n;
-  FCM_TRY(ctx, fcm__embed_geometry_boxes(ctx, g, 0, &boxes, &n));
+  FCM_TRY(ctx, fcm__geom_boxes(ctx, g, 0, &boxes, &n));
   FCM_TRY(ctx, fcm_aabb_tree_create(ctx, n, boxes, &f->cells));
   fcm__free(ctx, boxes);
   boxes = NULL;
-  FCM_TRY(ctx, fcm__embed_geometry_boxes(ctx, g, 1, &boxes, &n));
+  FCM_TRY(ctx, fcm__geom_boxes(ctx, g, 1, &boxes, &n));
   FCM_TRY(ctx, fcm_aabb_tree_create(ctx, n, boxes, &f->tris));
 cleanup:
   fcm__free(ctx, boxes);
@@ -280,6 +282,29 @@ int main(void)
     run(ctx, types[i], hollow, "hollow ball with holes");
     run(ctx, types[i], rot, "rotated ball");
     run(ctx, types[i], box, "box on grid planes");
+  }
+  { /* the trees: built once per geometry */
+    const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
+    const fcm_index n[3] = {3, 3, 3};
+    fcm_mesh *mesh = NULL;
+    fcm_cell_rules *r1 = NULL, *r2 = NULL;
+    fcm_cell_rules_options o = fcm_cell_rules_options_default();
+    CHECK_OK(fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, n, &mesh));
+    CHECK(ball->trees[0] == NULL && ball->trees[1] == NULL, "trees before any rules build");
+    CHECK_OK(fcm_cell_rules_create(ctx, mesh, ball, &o, &r1));
+    const fcm_aabb_tree *t0 = ball->trees[0], *t1 = ball->trees[1];
+    CHECK(t0 && t1, "the first rules build made no trees");
+    CHECK_OK(fcm_cell_rules_create(ctx, mesh, ball, &o, &r2));
+    CHECK(ball->trees[0] == t0 && ball->trees[1] == t1, "the second rules build made new trees");
+    if (r1 && r2) {
+      const fcm_cell_rules_stats *s1 = fcm_cell_rules_get_stats(r1),
+                                 *s2 = fcm_cell_rules_get_stats(r2);
+      CHECK(s1->embedded_volume == s2->embedded_volume && s1->num_cut == s2->num_cut,
+            "the rules differ between the builds");
+    }
+    fcm_cell_rules_destroy(&r1);
+    fcm_cell_rules_destroy(&r2);
+    fcm_mesh_destroy(&mesh);
   }
   fcm_geometry *ubox = NULL;
   const double ulo[3] = {-0.5, -0.5, -0.5}, uhi[3] = {0.5, 0.5, 0.5};

@@ -64,10 +64,10 @@ fcm_status fcm__embed_crop_geometry(fcm_ctx *ctx, const fcm_mesh *mesh, const fc
             "embed crop: NULL argument (ctx, mesh, geometry, options, classify)");
   FCM_TRY(ctx, fcm__embed_check_options(ctx, opts, 1));
   const fcm_index nc = fcm_mesh_num_cells(mesh);
-  FCM_TRY(ctx, fcm__embed_geometry_boxes(ctx, geom, 0, &boxes, &nbox));
+  FCM_TRY(ctx, fcm__geom_boxes(ctx, geom, 0, &boxes, &nbox));
   FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &tree));
   FCM_FREE(ctx, boxes);
-  FCM_TRY(ctx, fcm__embed_geometry_boxes(ctx, geom, 1, &boxes, &nbox));
+  FCM_TRY(ctx, fcm__geom_boxes(ctx, geom, 1, &boxes, &nbox));
   FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &tri_tree));
   FCM_ALLOC(ctx, (size_t)geom->num_cells + 1, keep_cell);
   FCM_ALLOC(ctx, (size_t)geom->num_tris + 1, keep_tri);

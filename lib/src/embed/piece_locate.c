@@ -66,7 +66,7 @@ fcm_status fcm__embed_finder_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fc
     const double nc = (double)FCM_MAX(fcm_mesh_num_cells(mesh), 1);
     f->on_cut = 2.0 * FCM__EMBED_MATCH_RTOL * (v > 0.0 ? cbrt(v / nc) : side / nc);
   }
-  FCM_TRY(ctx, fcm__embed_geometry_boxes(ctx, geom, 0, &boxes, &nbox));
+  FCM_TRY(ctx, fcm__geom_boxes(ctx, geom, 0, &boxes, &nbox));
   FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &f->tree));
   *out = f;
   f = NULL;

@@ -69,33 +69,6 @@ cleanup:
   return st;
 }
 
-/* Boxes (n x 6) of the embedded cells or of the boundary triangles. */
-fcm_status fcm__embed_geometry_boxes(fcm_ctx *ctx, const fcm_geometry *g, int tris, double **out,
-                                     fcm_index *n)
-{
-  fcm_status st = FCM_OK;
-  const int npv = tris ? 3 : g->npc;
-  const fcm_index *conn = tris ? g->tris : g->cells;
-  const fcm_index m = tris ? g->num_tris : g->num_cells;
-  double *b = NULL;
-  FCM_ALLOC(ctx, 6 * (size_t)m, b);
-  for (fcm_index i = 0; i < m; i++) {
-    double *bi = b + 6 * i;
-    for (int d = 0; d < 3; d++)
-      bi[d] = HUGE_VAL, bi[3 + d] = -HUGE_VAL;
-    for (int a = 0; a < npv; a++)
-      for (int d = 0; d < 3; d++) {
-        const double v = g->coords[3 * conn[(size_t)npv * (size_t)i + a] + d];
-        bi[d] = fmin(bi[d], v);
-        bi[3 + d] = fmax(bi[3 + d], v);
-      }
-  }
-  *out = b;
-  *n = m;
-cleanup:
-  return st;
-}
-
 /* FCM_ERR_GEOMETRY when background cell c is not convex (the rules build's first check). */
 fcm_status fcm__embed_check_convex(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index c,
                                    const fcm_cell_rules_options *o)
@@ -152,8 +125,6 @@ void fcm__embed_build_release(build *B)
     fcm__free(B->ctx, B->prev_region);
   }
   B->region = B->rebuild = B->prev_region = NULL;
-  fcm_aabb_tree_destroy(&B->tree);
-  fcm_aabb_tree_destroy(&B->tri_tree);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     fcm_rule_destroy(&B->tet_rule[k]);
   fcm_rule_destroy(&B->tri_rule);
@@ -167,8 +138,6 @@ fcm_status fcm__embed_build_setup(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_
                                   build *B)
 {
   fcm_status st = FCM_OK;
-  double *boxes = NULL;
-  fcm_index nbox = 0;
   memset(B, 0, sizeof *B);
   B->ctx = ctx, B->mesh = mesh, B->geom = geom, B->o = o;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
@@ -180,9 +149,7 @@ fcm_status fcm__embed_build_setup(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_
   B->stabilize[FCM_RULE_MASS] = o->stabilization.mode != FCM_STABILIZATION_OFF;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     B->stabilize[k] = B->stabilize[k] && B->tet_rule[k];
-  FCM_TRY(ctx, fcm__embed_geometry_boxes(ctx, geom, 0, &boxes, &nbox));
-  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &B->tree));
-  FCM_FREE(ctx, boxes);
+  FCM_TRY(ctx, fcm__geom_tree(ctx, geom, 0, &B->tree));
   /* the surface path needs the whole closed boundary (a crop keeps it for this path); a
    * geometry without cells has no other path */
   FCM_CHECK(geom->num_cells > 0 || o->moments != FCM_CELL_MOMENTS_VOLUME, ctx, FCM_ERR_UNSUPPORTED,
@@ -194,8 +161,7 @@ fcm_status fcm__embed_build_setup(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_
   if (o->surface_strength >= 0)
     FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TRI, o->surface_strength, &B->tri_rule));
   if (o->surface_strength >= 0 || B->surface) {
-    FCM_TRY(ctx, fcm__embed_geometry_boxes(ctx, geom, 1, &boxes, &nbox));
-    FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &B->tri_tree));
+    FCM_TRY(ctx, fcm__geom_tree(ctx, geom, 1, &B->tri_tree));
   }
   if (B->surface) { /* both kinds' strengths, built or not: the rules of one kind do not
                        depend on which others are built */
@@ -216,7 +182,6 @@ fcm_status fcm__embed_build_setup(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_
     FCM_TRY(ctx, fcm__moment_quad_create(ctx, m, &B->mq));
   }
 cleanup:
-  fcm__free(ctx, boxes);
   if (st != FCM_OK) fcm__embed_build_release(B);
   return st;
 }

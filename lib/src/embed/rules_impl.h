@@ -57,7 +57,7 @@ typedef struct build {
   const fcm_mesh *mesh;
   const fcm_geometry *geom;
   const fcm_cell_rules_options *o;
-  fcm_aabb_tree *tree, *tri_tree;
+  const fcm_aabb_tree *tree, *tri_tree;           /* the geometry's own (fcm__geom_tree()) */
   fcm_rule *tet_rule[FCM_RULE_KIND_COUNT];        /* rule mapped onto each tet */
   const fcm_rule *full_rule[FCM_RULE_KIND_COUNT]; /* catalogue rule of the cell shape (in R) */
   fcm_rule *tri_rule;                             /* NULL: no surface rules */
@@ -91,10 +91,6 @@ typedef struct cell_sums {
 
 /* FCM_ERR_ARG naming the first bad option (reduced: a reduce for the AUTO choice is given). */
 fcm_status fcm__embed_check_options(fcm_ctx *ctx, const fcm_cell_rules_options *o, int reduced);
-
-/* Boxes (n x 6, allocated) of the embedded cells (tris = 0) or of the boundary triangles. */
-fcm_status fcm__embed_geometry_boxes(fcm_ctx *ctx, const fcm_geometry *g, int tris, double **out,
-                                     fcm_index *n);
 
 /* FCM_ERR_GEOMETRY when background cell c is not convex (the rules build's first check). */
 fcm_status fcm__embed_check_convex(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index c,

@@ -32,6 +32,10 @@ struct fcm_geometry {
   fcm_index orig_cells, orig_tris;
   int has_outside;
   double outside_mesh_lo[3], outside_mesh_hi[3], outside_side[6];
+  /* Search trees of the boxes of the cells [0] and of the boundary triangles [1]: built on
+   * first use (fcm__geom_tree()), then only read, by every rules build on this geometry,
+   * until the geometry is destroyed. */
+  fcm_aabb_tree *trees[2];
 };
 
 /* Create a geometry that takes ownership of *coords and *cells (allocated with
@@ -99,6 +103,16 @@ typedef struct fcm__idbuf {
  * buffers. */
 fcm_status fcm__geom_tree_query(fcm_ctx *ctx, const fcm_aabb_tree *tree, const double lo[3],
                                 const double hi[3], fcm__idbuf *buf);
+
+/* Boxes (n x 6: lo[3], hi[3], allocated on ctx) of g's cells (tris = 0) or boundary
+ * triangles (tris = 1). */
+fcm_status fcm__geom_boxes(fcm_ctx *ctx, const fcm_geometry *g, int tris, double **out,
+                           fcm_index *n);
+
+/* The search tree of g's cells (tris = 0) or boundary triangles (tris = 1), built on the first
+ * call and kept by g (allocated on g's context; thread safe). Errors: FCM_ERR_ALLOC, on ctx. */
+fcm_status fcm__geom_tree(fcm_ctx *ctx, const fcm_geometry *g, int tris,
+                          const fcm_aabb_tree **tree);
 
 /* Ids of the items whose box, widened by pad, meets the segment p0 -> p1, ascending, into
  * buf (as fcm__geom_tree_query()). */

@@ -323,10 +323,67 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__geom_boxes(fcm_ctx *ctx, const fcm_geometry *g, int tris, double **out,
+                           fcm_index *n)
+{
+  fcm_status st = FCM_OK;
+  const int npv = tris ? 3 : g->npc;
+  const fcm_index *conn = tris ? g->tris : g->cells;
+  const fcm_index m = tris ? g->num_tris : g->num_cells;
+  double *b = NULL;
+  FCM_ALLOC(ctx, 6 * (size_t)m, b);
+  for (fcm_index i = 0; i < m; i++) {
+    double *bi = b + 6 * i;
+    for (int d = 0; d < 3; d++)
+      bi[d] = HUGE_VAL, bi[3 + d] = -HUGE_VAL;
+    for (int a = 0; a < npv; a++)
+      for (int d = 0; d < 3; d++) {
+        const double v = g->coords[3 * conn[(size_t)npv * (size_t)i + a] + d];
+        bi[d] = fmin(bi[d], v);
+        bi[3 + d] = fmax(bi[3 + d], v);
+      }
+  }
+  *out = b;
+  *n = m;
+cleanup:
+  return st;
+}
+
+/* Build g's tree `tris` on g's context (under the caller's lock). */
+static fcm_status build_tree(fcm_geometry *g, int tris)
+{
+  fcm_status st = FCM_OK;
+  double *boxes = NULL;
+  fcm_index n = 0;
+  FCM_TRY(g->ctx, fcm__geom_boxes(g->ctx, g, tris, &boxes, &n));
+  FCM_TRY(g->ctx, fcm_aabb_tree_create(g->ctx, n, boxes, &g->trees[tris]));
+cleanup:
+  fcm__free(g->ctx, boxes);
+  return st;
+}
+
+fcm_status fcm__geom_tree(fcm_ctx *ctx, const fcm_geometry *g, int tris, const fcm_aabb_tree **tree)
+{
+  fcm_status st = FCM_OK;
+  fcm_geometry *cache = (fcm_geometry *)g; /* the trees are a cache: built once, then read */
+  fcm_status built = FCM_OK;
+#pragma omp critical(fcm_geometry_tree)
+  {
+    if (!cache->trees[tris]) built = build_tree(cache, tris);
+  }
+  FCM_CHECK(built == FCM_OK, ctx, built, "geometry: building the search tree of its %s failed (%s)",
+            tris ? "boundary triangles" : "cells", fcm_status_name(built));
+  *tree = g->trees[tris];
+cleanup:
+  return st;
+}
+
 void fcm_geometry_destroy(fcm_geometry **geom)
 {
   if (!geom || !*geom) return;
   fcm_geometry *g = *geom;
+  fcm_aabb_tree_destroy(&g->trees[0]);
+  fcm_aabb_tree_destroy(&g->trees[1]);
   fcm__free(g->ctx, g->coords);
   fcm__free(g->ctx, g->cells);
   fcm__free(g->ctx, g->tris);
