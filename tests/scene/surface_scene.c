@@ -3,7 +3,8 @@
  * fill_holes) built and stepped, the fitted grid around the body, the embedded volume equal
  * to the cube's; an open surface without fill_holes refused with its boundary edges. Without a
  * cut the surface alone is the geometry (volume_mesh auto, no Gmsh needed): every cut cell's
- * rules come from the surface moments, none falls back, and the summary says so; with
+ * rules come from the surface moments, none falls back, and the summary says so (and times the
+ * set-up's phases, each positive, together within the set-up); with
  * "volume_mesh": true the cells are tets; a bad volume_mesh value is refused. */
 #include "scene_util.h"
 
@@ -190,6 +191,14 @@ int main(void)
       const fcm_cell_rules_stats *st = fcm_cell_rules_get_stats(fcm_space_cell_rules(space));
       TEST_TRUE(st->num_cut > 0 && st->num_surface_cells == st->num_cut &&
                 st->num_surface_fallbacks == 0);
+      /* the set-up's phases: each timed, together within the set-up's time */
+      fcm_simulation_counters c;
+      fcm_simulation_get_counters(sim, &c);
+      TEST_TRUE(c.time_setup_geometry > 0.0 && c.time_setup_rules > 0.0 &&
+                c.time_setup_space > 0.0 && c.time_setup_integrator > 0.0);
+      TEST_TRUE(c.time_setup_geometry + c.time_setup_rules + c.time_setup_space +
+                    c.time_setup_integrator <=
+                c.time_setup);
       char *text = NULL;
       size_t len = 0;
       FILE *mf = open_memstream(&text, &len);
@@ -198,7 +207,7 @@ int main(void)
         fcm_simulation_summary_view(sim, mf);
         fclose(mf);
         TEST_TRUE(text && strstr(text, "cut cells from the boundary surface") &&
-                  strstr(text, "0 of them fell back"));
+                  strstr(text, "0 of them fell back") && strstr(text, "set-up    [s] mesh"));
         free(text);
       }
     }

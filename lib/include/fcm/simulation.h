@@ -104,6 +104,12 @@ typedef struct fcm_simulation_counters {
                          part of time_steps) */
   double time_log;  /**< seconds of the per-step log rows (mass, momentum, reactions; not part
                          of time_steps) */
+  double time_setup_geometry;   /**< seconds of the set-up's background mesh and geometry (reading
+                                     files, hole filling, surface checks, meshing) */
+  double time_setup_rules;      /**< seconds of its cut-cell rules (fcm_cell_rules_create()) */
+  double time_setup_space;      /**< seconds of its space (DOFs, element data) */
+  double time_setup_integrator; /**< seconds of its integrator: effects, constraints, the mass
+                                     matrix, the solver's set-up */
 } fcm_simulation_counters;
 
 /** A running scene (opaque). */

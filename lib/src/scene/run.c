@@ -662,12 +662,16 @@ fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
             "simulation: rules_progress_interval = %g must be >= 0 seconds",
             S->opts.rules_progress_interval);
 
+  double tp = fcm_wtime(); /* the phases' times */
   FCM_TRY(ctx, build_mesh_geometry(S));
+  S->c.time_setup_geometry = fcm_wtime() - tp;
   const fcm_scene_geometry *g = fcm_scene_get_geometry(scene);
 
   /* cell rules only when the scene embeds a geometry */
   if (g->kind != FCM_SCENE_GEOMETRY_NONE) {
+    tp = fcm_wtime();
     st = build_rules(S);
+    S->c.time_setup_rules = fcm_wtime() - tp;
     if (st != FCM_OK) fcm__error_prefix(ctx, st == FCM_ERR_GEOMETRY ? "geometry" : "quadrature");
     FCM_TRY(ctx, st);
     const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(S->rules);
@@ -678,12 +682,16 @@ fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
               "lower quadrature.min_fraction",
               (long long)rs->num_cells, fcm_scene_get_quadrature(scene)->rules.min_fraction,
               rs->embedded_volume, rs->geometry_volume);
+    tp = fcm_wtime();
     st = create_space(S, S->rules, S->config && S->config->cell_mask, &S->space);
     if (st != FCM_OK) fcm__error_prefix(ctx, "geometry");
     FCM_TRY(ctx, st);
   } else {
+    tp = fcm_wtime();
     FCM_TRY(ctx, fcm_space_create(ctx, S->mesh, NULL, &S->space));
   }
+  S->c.time_setup_space = fcm_wtime() - tp;
+  tp = fcm_wtime();
   S->c.num_dofs = fcm_space_num_dofs(S->space);
   S->c.inverted_first_cell = -1;
   S->c.nonfinite_first_step = -1;
@@ -717,6 +725,7 @@ fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
     S->c.boundary_points = si.boundary_points;
   }
   S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);
+  S->c.time_setup_integrator = fcm_wtime() - tp;
   if (S->c.inertia) FCM_TRY(ctx, fcm__sim_initialize_effects(S));
   FCM_TRY(ctx, build_log_blocks(S));
   S->free_body = S->c.inertia && S->c.constraints == 0 && S->c.body_force_assemblies == 0 &&

@@ -344,6 +344,13 @@ static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_
           "%.3f\n",
           c->time_setup, c->time_steps, c->time_steps - c->time_cuts, c->time_cuts, c->time_log,
           c->time_output);
+  fprintf(f,
+          "  set-up    [s] mesh and geometry %.3f, cell rules %.3f, space %.3f, integrator %.3f, "
+          "the rest %.3f\n",
+          c->time_setup_geometry, c->time_setup_rules, c->time_setup_space,
+          c->time_setup_integrator,
+          fmax(0.0, c->time_setup - c->time_setup_geometry - c->time_setup_rules -
+                        c->time_setup_space - c->time_setup_integrator));
   if (rss > 0.0 && S->rules)
     fprintf(f,
             "  memory    peak resident %.1f MiB%s; the set-up's cut-cell rules held about %.1f MiB "
