@@ -14,20 +14,6 @@
 
 static fcm_ctx *ctx;
 
-static void tet_moments(const fcm_geometry *g, int m, double *mom)
-{
-  const double *x = fcm_geometry_coords(g);
-  const fcm_index *c = fcm_geometry_cells(g);
-  memset(mom, 0, (size_t)exact_num_mono(m) * sizeof *mom);
-  for (fcm_index k = 0; k < fcm_geometry_num_cells(g); k++) {
-    double v[4][3];
-    for (int a = 0; a < 4; a++)
-      for (int d = 0; d < 3; d++)
-        v[a][d] = x[3 * c[4 * k + a] + d];
-    exact_tet_add(v, m, mom);
-  }
-}
-
 static void moments(const fcm_mesh *mesh, const fcm_geometry *surf, const fcm_geometry *tets)
 {
   fcm_cell_rules_options o = fcm_cell_rules_options_default();
@@ -44,7 +30,7 @@ static void moments(const fcm_mesh *mesh, const fcm_geometry *surf, const fcm_ge
   for (int kind = 0; kind < FCM_RULE_KIND_COUNT; kind++) {
     const int m = fcm_cell_rules_strength(r, (fcm_rule_kind)kind), nm = exact_num_mono(m);
     double exact[EXACT_MAX_MONO], got[EXACT_MAX_MONO] = {0}, absum[EXACT_MAX_MONO] = {0};
-    tet_moments(tets, m, exact);
+    exact_geometry_moments(tets, m, exact);
     for (fcm_index c = 0; c < fcm_mesh_num_cells(mesh); c++) {
       int n;
       const double *p, *w;

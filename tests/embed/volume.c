@@ -11,21 +11,6 @@
 
 static fcm_ctx *ctx;
 
-/* Exact moments of degree <= m of the whole geometry. */
-static void geometry_moments(const fcm_geometry *g, int m, double *mom)
-{
-  const double *x = fcm_geometry_coords(g);
-  const fcm_index *c = fcm_geometry_cells(g);
-  memset(mom, 0, (size_t)exact_num_mono(m) * sizeof *mom);
-  for (fcm_index k = 0; k < fcm_geometry_num_cells(g); k++) {
-    double v[4][3];
-    for (int a = 0; a < 4; a++)
-      for (int d = 0; d < 3; d++)
-        v[a][d] = x[3 * c[4 * k + a] + d];
-    exact_tet_add(v, m, mom);
-  }
-}
-
 /* Exact moments of degree <= m over a Hex8 cell with planar faces (6 Kuhn tets). */
 static void hex_moments(const double *X, int m, double *mom)
 {
@@ -67,7 +52,7 @@ static void check(const fcm_mesh *mesh, const fcm_geometry *g, int simplify, con
     const int m = fcm_cell_rules_strength(r, (fcm_rule_kind)kind);
     const int nm = exact_num_mono(m);
     double exact[EXACT_MAX_MONO], got[EXACT_MAX_MONO] = {0}, absum[EXACT_MAX_MONO] = {0};
-    geometry_moments(g, m, exact);
+    exact_geometry_moments(g, m, exact);
     fcm_index total = 0;
     for (fcm_index c = 0; c < nc; c++) {
       const fcm_cell_class cls = fcm_cell_rules_class(r, c);

@@ -7,6 +7,8 @@
 #ifndef FCM_TEST_GEOM_EXACT_H
 #define FCM_TEST_GEOM_EXACT_H
 
+#include "fcm/geom.h"
+
 #include <math.h>
 #include <string.h>
 
@@ -273,6 +275,22 @@ static inline double exact_rand(unsigned long long *s)
 {
   *s ^= *s >> 12, *s ^= *s << 25, *s ^= *s >> 27;
   return (double)((*s * 2685821657736338717ULL) >> 11) / 9007199254740992.0;
+}
+
+/* Exact moments of degree <= m (exact_num_mono(m) entries, set) of a Tet4 geometry: the sum
+ * over its tets. */
+static inline void exact_geometry_moments(const fcm_geometry *g, int m, double *mom)
+{
+  const double *x = fcm_geometry_coords(g);
+  const fcm_index *c = fcm_geometry_cells(g);
+  memset(mom, 0, (size_t)exact_num_mono(m) * sizeof *mom);
+  for (fcm_index k = 0; k < fcm_geometry_num_cells(g); k++) {
+    double v[4][3];
+    for (int a = 0; a < 4; a++)
+      for (int d = 0; d < 3; d++)
+        v[a][d] = x[3 * c[4 * k + a] + d];
+    exact_tet_add(v, m, mom);
+  }
 }
 
 #endif /* FCM_TEST_GEOM_EXACT_H */
