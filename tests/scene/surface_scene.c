@@ -4,7 +4,7 @@
  * to the cube's; an open surface without fill_holes refused with its boundary edges. Without a
  * cut the surface alone is the geometry (volume_mesh auto, no Gmsh needed): every cut cell's
  * rules come from the surface moments, none falls back, and the summary says so (and times the
- * set-up's phases, each positive, together within the set-up); with
+ * set-up's phases and a step's parts, each positive, together within the whole); with
  * "volume_mesh": true the cells are tets; a bad volume_mesh value is refused. */
 #include "scene_util.h"
 
@@ -199,6 +199,10 @@ int main(void)
       TEST_TRUE(c.time_setup_geometry + c.time_setup_rules + c.time_setup_space +
                     c.time_setup_integrator <=
                 c.time_setup);
+      /* the steps' parts (check_fitted took them): assembly, factorization and solves, each
+       * timed, within the steps' time */
+      TEST_TRUE(c.time_step_assembly > 0.0 && c.time_step_factor > 0.0 && c.time_step_solve > 0.0);
+      TEST_TRUE(c.time_step_assembly + c.time_step_factor + c.time_step_solve <= c.time_steps);
       char *text = NULL;
       size_t len = 0;
       FILE *mf = open_memstream(&text, &len);
@@ -207,7 +211,8 @@ int main(void)
         fcm_simulation_summary_view(sim, mf);
         fclose(mf);
         TEST_TRUE(text && strstr(text, "cut cells from the boundary surface") &&
-                  strstr(text, "0 of them fell back") && strstr(text, "set-up    [s] mesh"));
+                  strstr(text, "0 of them fell back") && strstr(text, "set-up    [s] mesh") &&
+                  strstr(text, "step      [s]") && strstr(text, "each: assembly"));
         free(text);
       }
     }

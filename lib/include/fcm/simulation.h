@@ -110,6 +110,10 @@ typedef struct fcm_simulation_counters {
   double time_setup_space;      /**< seconds of its space (DOFs, element data) */
   double time_setup_integrator; /**< seconds of its integrator: effects, constraints, the mass
                                      matrix, the solver's set-up */
+  double time_step_assembly;    /**< seconds of the steps' energy, force, tangent and damping
+                                     assemblies (fcm_step_info.time_assembly, summed) */
+  double time_step_factor;      /**< seconds of their factorizations or preconditioner set-ups */
+  double time_step_solve;       /**< seconds of their triangular or Krylov solves */
 } fcm_simulation_counters;
 
 /** A running scene (opaque). */

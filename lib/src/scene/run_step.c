@@ -133,6 +133,9 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   S->c.linear_iterations += si.linear_iterations;
   S->c.multigrid_cycles += si.multigrid_cycles;
   S->c.tangent_assemblies += si.tangent_assemblies;
+  S->c.time_step_assembly += si.time_assembly;
+  S->c.time_step_factor += si.time_factor;
+  S->c.time_step_solve += si.time_solve;
   S->c.factorizations = S->base_factorizations + si.total_factorizations;
   S->c.analyses = S->base_analyses + si.total_analyses;
   S->c.direct_fallbacks = S->base_fallbacks + si.total_direct_fallbacks;

@@ -344,6 +344,15 @@ static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_
           "%.3f\n",
           c->time_setup, c->time_steps, c->time_steps - c->time_cuts, c->time_cuts, c->time_log,
           c->time_output);
+  if (c->steps > 0) {
+    const double a = c->time_step_assembly, fa = c->time_step_factor, so = c->time_step_solve,
+                 per = 1.0 / (double)c->steps;
+    fprintf(f,
+            "  step      [s] %.4f each: assembly %.4f, factorization %.4f, solves %.4f, the rest "
+            "%.4f\n",
+            (c->time_steps - c->time_cuts) * per, a * per, fa * per, so * per,
+            (c->time_steps - c->time_cuts - a - fa - so) * per);
+  }
   fprintf(f,
           "  set-up    [s] mesh and geometry %.3f, cell rules %.3f, space %.3f, integrator %.3f, "
           "the rest %.3f\n",
