@@ -36,6 +36,8 @@ static void same_integrator(const fcm_integrator_options *a, const fcm_integrato
   SAME(a, b, backtrack);
   SAME(a, b, max_backtracks);
   SAME(a, b, project_psd);
+  SAME(a, b, reuse_factorization);
+  SAME(a, b, reuse_contraction);
   SAME(a, b, linear_solver);
   SAME(a, b, direct_method);
   SAME(a, b, preconditioner);
@@ -126,7 +128,8 @@ int main(void)
            " \"block_smoothing\": true},"
            " \"rtol\": 1e-8, \"atol\": 0, \"max_iterations\": 1000, \"stagnation_window\": 50,"
            " \"newton\": {\"rule\": \"auto\", \"rtol\": 1e-5, \"max_iterations\": 100,"
-           " \"line_search\": true, \"project_psd\": false,"
+           " \"line_search\": true, \"project_psd\": false, \"reuse_factorization\": true,"
+           " \"reuse_contraction\": 0.25,"
            " \"representative_acceleration\": 9.81},"
            " \"threads\": 0, \"on_inversion\": \"warn\"}}",
            head);

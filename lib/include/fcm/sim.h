@@ -139,19 +139,31 @@ typedef struct fcm_integrator_options {
   fcm_newton_tolerance tolerance_mode; /**< default FCM_NEWTON_TOL_AUTO ["newton.rule"] */
   double newton_tolerance;             /**< tol in (0, 1) (default 1e-5) ["newton.rtol"] */
   double newton_atol;                  /**< RELATIVE mode: absolute floor >= 0 (default 0) */
-  double rep_acceleration; /**< |a_rep| > 0 in m/s^2 (default 9.81); FCM_DEFAULT: the magnitude of
-                                the first gravity load, or 9.81 without gravity. Its direction
-                                is that gravity's, else (1, 1, 1)/sqrt 3
-                                ["newton.representative_acceleration"] */
-  int line_search;         /**< 1 (default): backtracking on E; 0: full Newton steps
-                                ["newton.line_search"] */
-  double armijo;           /**< sufficient decrease c in (0, 0.5) (default 1e-4) */
-  double backtrack;        /**< step factor in (0, 1) (default 0.5) */
-  int max_backtracks;      /**< >= 0 (default 20) */
-  int project_psd;         /**< 1: PSD-projected element tangents (default 0). Without it,
-                                a non-descent Newton direction is recomputed once with the
-                                projected tangent (counted as a projection fallback)
-                                ["newton.project_psd"] */
+  double rep_acceleration;  /**< |a_rep| > 0 in m/s^2 (default 9.81); FCM_DEFAULT: the magnitude of
+                                 the first gravity load, or 9.81 without gravity. Its direction
+                                 is that gravity's, else (1, 1, 1)/sqrt 3
+                                 ["newton.representative_acceleration"] */
+  int line_search;          /**< 1 (default): backtracking on E; 0: full Newton steps
+                                 ["newton.line_search"] */
+  double armijo;            /**< sufficient decrease c in (0, 0.5) (default 1e-4) */
+  double backtrack;         /**< step factor in (0, 1) (default 0.5) */
+  int max_backtracks;       /**< >= 0 (default 20) */
+  int project_psd;          /**< 1: PSD-projected element tangents (default 0). Without it,
+                                 a non-descent Newton direction is recomputed once with the
+                                 projected tangent (counted as a projection fallback)
+                                 ["newton.project_psd"] */
+  int reuse_factorization;  /**< 1 (default): a dynamic step with the direct solver (the
+                                 distributed backend's solver alike) solves a corrector
+                                 iteration with the factorization of an earlier iterate or step
+                                 (dropped by fcm_integrator_drop_factorization(), a change of
+                                 dt, constraints or damping, a failed step), kept while every
+                               iteration solved  with it reduces the residual norm by
+                               reuse_contraction or more  (modified Newton: iterations without a
+                               tangent assembly or a  factorization; the stopping rule is unchanged);
+                               an iteration  that falls short, backtracks or meets a non-descent
+                               direction  makes the next one factor anew. 0: a new tangent and
+                                 factorization every iteration ["newton.reuse_factorization"] */
+  double reuse_contraction; /**< in (0, 1) (default 0.25) ["newton.reuse_contraction"] */
   fcm_linear_solver linear_solver;   /**< default FCM_LINEAR_DIRECT ["method"] */
   fcm_direct_method direct_method;   /**< first direct method (default CHOLMOD; UMFPACK: LU only)
                                           ["direct"] */
@@ -251,6 +263,8 @@ typedef struct fcm_step_info {
   int factorizations;             /**< numeric factorizations or preconditioner setups */
   int direct_fallbacks;           /**< CHOLMOD "not positive definite" -> UMFPACK */
   int projection_fallbacks;       /**< non-descent directions recomputed with PSD tangents */
+  int reused_factorizations;      /**< iterations solved with a kept factorization
+                                       (fcm_integrator_options.reuse_factorization) */
   int inexact_solves;             /**< Krylov solves stopped early whose iterate was used */
   long long total_analyses;       /**< symbolic analyses (CHOLMOD and UMFPACK) */
   long long total_factorizations; /**< numeric factorizations / preconditioner setups */
@@ -509,6 +523,13 @@ FCM_API int fcm_integrator_num_constraints(const fcm_integrator *integ);
  * the last fcm_integrator_set_state()). No allocation. */
 FCM_API fcm_status fcm_integrator_reaction(const fcm_integrator *integ, int id, double force[3],
                                            double moment[3]);
+
+/** Forget the factorization kept for later iterations (fcm_integrator_options.
+ * reuse_factorization): the next Newton iteration assembles and factors anew. A host that
+ * saves the state to resume from it calls this when it saves, so that the run that goes on
+ * and the one resumed later take the same iterations (fcm_simulation_write_checkpoint()
+ * does). Accepts NULL. */
+FCM_API void fcm_integrator_drop_factorization(fcm_integrator *integ);
 
 /** Copy the state out (checkpoint): u, v (num_dofs each, either may be NULL), t, steps
  * (may be NULL). */

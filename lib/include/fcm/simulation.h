@@ -68,10 +68,13 @@ typedef struct fcm_simulation_counters {
   int multigrid;               /**< 1: multigrid, as the Krylov preconditioner or the solver */
   long long steps;             /**< accepted steps */
   long long newton_iterations, linear_iterations, tangent_assemblies;
-  long long multigrid_cycles; /**< multigrid cycles (fcm_step_info.multigrid_cycles, summed;
-                                   not in checkpoints: counted from the restore on) */
-  long long factorizations;   /**< numeric factorizations / preconditioner setups (total) */
-  long long analyses;         /**< symbolic analyses (total) */
+  long long multigrid_cycles;      /**< multigrid cycles (fcm_step_info.multigrid_cycles, summed;
+                                        not in checkpoints: counted from the restore on) */
+  long long factorizations;        /**< numeric factorizations / preconditioner setups (total) */
+  long long reused_factorizations; /**< Newton iterations solved with a kept factorization
+                                        (fcm_step_info.reused_factorizations, summed; not in
+                                        checkpoints: counted from the restore on) */
+  long long analyses;              /**< symbolic analyses (total) */
   long long direct_fallbacks;
   long long frames;    /**< frames written */
   fcm_index num_dofs;  /**< DOFs now (cuts add copies) */
@@ -229,6 +232,9 @@ FCM_API fcm_status fcm_simulation_write_log(fcm_simulation *sim, const char *pat
  * bit, the per-step log, the times of the frames written, the cumulative Newton, linear and
  * tangent counts, and a fingerprint of the scene and its discretization; a checksum closes
  * the file. Host byte order (the header records it). Format: lib/src/scene/checkpoint.c.
+ * A resumed run starts without the integrator's kept factorization (fcm_integrator_options.
+ * reuse_factorization), so this one drops it too: when it writes (one process) and after every
+ * step at which a checkpoint is due (every process of a distributed run).
  * @return FCM_OK, FCM_ERR_ARG (NULL), FCM_ERR_IO (naming the path; nothing is left
  * behind), FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_simulation_write_checkpoint(fcm_simulation *sim, const char *path);

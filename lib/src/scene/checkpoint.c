@@ -128,6 +128,10 @@ fcm_status fcm_simulation_write_checkpoint(fcm_simulation *S, const char *path)
   double t = 0.0;
   long long steps = 0;
   fcm_integrator_get_state(S->integ, NULL, NULL, &t, &steps);
+  /* a run resumed from here starts without a kept factorization: so does this one (with a
+   * backend only one process writes, and every process dropped it when the checkpoint was due:
+   * their Newton iterations must agree) */
+  if (!S->distributed) fcm_integrator_drop_factorization(S->integ);
   FCM_TRY(ctx, fcm__io_atomic_open(ctx, path, 1, NULL, &af));
   {
     char magic[8] = CKPT_MAGIC;

@@ -149,9 +149,14 @@ fcm_status fcm__scene_read_solver(fcm__scene_parser *p, const fcm__json *root)
       "atol",      "max_iterations", "newton",         "threads",          "preconditioner_tangent",
       "multigrid", "petsc_options",  "on_inversion",   "stagnation_window"};
   static const char *const skeys[] = {"threshold", "epsilon", "clamp"};
-  static const char *const nkeys[] = {"rtol",        "max_iterations",
-                                      "line_search", "project_psd",
-                                      "rule",        "representative_acceleration"};
+  static const char *const nkeys[] = {"rtol",
+                                      "max_iterations",
+                                      "line_search",
+                                      "project_psd",
+                                      "rule",
+                                      "representative_acceleration",
+                                      "reuse_factorization",
+                                      "reuse_contraction"};
   fcm_scene_solver *sv = &p->scene->solver;
   fcm_integrator_options *s = &sv->integrator;
   const fcm__json *o = NULL, *sw = NULL, *nw = NULL, *mg = NULL;
@@ -196,6 +201,9 @@ fcm_status fcm__scene_read_solver(fcm__scene_parser *p, const fcm__json *root)
     SCENE_READ_INT(p, nw, "max_iterations", 0, 1, 1000000, s->newton_max_iterations);
     FCM_TRY(p->ctx, fcm__scene_read_bool(p, nw, "line_search", 0, &s->line_search));
     FCM_TRY(p->ctx, fcm__scene_read_bool(p, nw, "project_psd", 0, &s->project_psd));
+    FCM_TRY(p->ctx, fcm__scene_read_bool(p, nw, "reuse_factorization", 0, &s->reuse_factorization));
+    FCM_TRY(p->ctx, fcm__scene_read_number(p, nw, "reuse_contraction", 0,
+                                           (fcm__range){0.0, 1.0, 1, 1}, &s->reuse_contraction));
     SCENE_READ_CHOICE_AS(p, nw, "rule", 0, fcm__scene_newton_rule_names,
                          fcm__scene_newton_rule_values, s->tolerance_mode);
     FCM_TRY(p->ctx, fcm__scene_read_number(p, nw, "representative_acceleration", 0, FCM__POSITIVE,

@@ -132,6 +132,7 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   S->c.newton_iterations += si.newton_iterations;
   S->c.linear_iterations += si.linear_iterations;
   S->c.multigrid_cycles += si.multigrid_cycles;
+  S->c.reused_factorizations += si.reused_factorizations;
   S->c.tangent_assemblies += si.tangent_assemblies;
   S->c.time_step_assembly += si.time_assembly;
   S->c.time_step_factor += si.time_factor;
@@ -145,6 +146,8 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
     goto cleanup;
   }
   S->c.steps++;
+  /* a run resumed from a checkpoint of this step starts without a kept factorization */
+  if (fcm_simulation_checkpoint_due(S)) fcm_integrator_drop_factorization(S->integ);
   const double tlog = fcm_wtime();
   for (int k = 0; k < S->num_react; k++)
     FCM_TRY(S->ctx,

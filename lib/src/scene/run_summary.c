@@ -312,8 +312,14 @@ static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_
            c->cuts, c->cuts_missed, (long long)c->cut_cells, (long long)c->pieces);
   line(f, c->cuts > 0, "cuts", c->cuts ? b : (S->num_cuts ? "(none due yet)" : "(no cut effect)"));
   cut_lines(S, f, cs);
-  snprintf(b, sizeof b, "%lld factorizations, %lld analyses, %lld fallbacks", c->factorizations,
-           c->analyses, c->direct_fallbacks);
+  if (c->reused_factorizations > 0)
+    snprintf(b, sizeof b,
+             "%lld factorizations, %lld analyses, %lld fallbacks; %lld Newton iterations solved "
+             "with a kept one",
+             c->factorizations, c->analyses, c->direct_fallbacks, c->reused_factorizations);
+  else
+    snprintf(b, sizeof b, "%lld factorizations, %lld analyses, %lld fallbacks", c->factorizations,
+             c->analyses, c->direct_fallbacks);
   line(f, 1,
        c->krylov ? "preconditioner setups"
                  : (c->multigrid ? "multigrid setups" : "direct factorizations"),

@@ -24,6 +24,8 @@ fcm_integrator_options fcm_integrator_options_default(void)
   o.backtrack = 0.5;
   o.max_backtracks = 20;
   o.project_psd = 0;
+  o.reuse_factorization = 1;
+  o.reuse_contraction = 0.25;
   o.linear_solver = FCM_LINEAR_DIRECT;
   o.direct_method = FCM_DIRECT_CHOLMOD;
   o.preconditioner = FCM_PRECOND_SCHWARZ;
@@ -408,6 +410,10 @@ static fcm_status validate_options(fcm_ctx *ctx, const fcm_integrator_options *o
             "integrator: backtrack = %g outside (0, 1)", o->backtrack);
   FCM_CHECK(o->max_backtracks >= 0, ctx, FCM_ERR_ARG,
             "integrator: max_backtracks = %d must be >= 0", o->max_backtracks);
+  FCM_CHECK(o->reuse_factorization == 0 || o->reuse_factorization == 1, ctx, FCM_ERR_ARG,
+            "integrator: reuse_factorization = %d must be 0 or 1", o->reuse_factorization);
+  FCM_CHECK(o->reuse_contraction > 0.0 && o->reuse_contraction < 1.0, ctx, FCM_ERR_ARG,
+            "integrator: reuse_contraction = %g outside (0, 1)", o->reuse_contraction);
   FCM_CHECK(o->linear_solver >= FCM_LINEAR_DIRECT && o->linear_solver <= FCM_LINEAR_MULTIGRID, ctx,
             FCM_ERR_ARG,
             "integrator: linear_solver = %d outside [0, 3] (direct, cg, minres, multigrid)",
@@ -654,6 +660,7 @@ cleanup:
 static void setup_initial_state(fcm_integrator *I)
 {
   I->h_state = SIM_H_INVALID;
+  I->kept = 0;
   I->damp_version = 0;
   for (int k = 0; k < I->num_cons; k++)
     I->con_on[k] = 0;
@@ -737,6 +744,11 @@ void fcm_integrator_get_setup_info(const fcm_integrator *I, fcm_integrator_setup
   if (I) *info = I->setup_info;
 }
 
+void fcm_integrator_drop_factorization(fcm_integrator *I)
+{
+  if (I) I->kept = 0;
+}
+
 void fcm_integrator_get_state(const fcm_integrator *I, double *u, double *v, double *t,
                               long long *steps)
 {
@@ -766,6 +778,7 @@ fcm_status fcm_integrator_set_state(fcm_integrator *I, const double *u, const do
   I->steps = steps;
   I->reaction_valid = 0;
   if (!I->linear) I->h_state = SIM_H_INVALID; /* a linear system does not depend on u */
+  I->kept = 0;
   if (I->is_setup) {
     if (steps > 0 && I->opts.kind == FCM_INTEGRATOR_STATIC)
       fcm__sim_eval_loads(I, t, I->load_prev);

@@ -303,6 +303,17 @@ cleanup:
   return st;
 }
 
+/* A corrector iteration of a dynamic step may solve with the kept factorization
+ * (reuse_factorization): the direct solver (or the backend's, which then solves with the
+ * operator it was last given) holds the factor of this h, active set and damping matrix, and
+ * every iteration solved with it contracted enough. */
+static int kept_usable(const fcm_integrator *I, double h)
+{
+  return I->opts.reuse_factorization && !I->linear && h > 0.0 &&
+         I->opts.linear_solver == FCM_LINEAR_DIRECT && I->kept && I->kept_ok && I->kept_h == h &&
+         I->kept_con == I->con_version && I->kept_damp == I->damp_version;
+}
+
 /* Build the eliminated Newton system for the current iterate and factor it, or reuse the
  * factor of a constant (linear) system; b = -g with the constrained increments lifted. */
 static fcm_status build_system(fcm_integrator *I, double h, int predictor, int projected,
@@ -363,10 +374,17 @@ static fcm_status build_system(fcm_integrator *I, double h, int predictor, int p
   I->key_h = h;
   I->key_con = I->con_version;
   I->key_damp = I->damp_version;
+  I->kept = 0;
   FCM_TRY(I->ctx, fcm__sim_factor(I, reason, stats));
   if (*reason != FCM_STEP_NONE || projected) I->h_state = SIM_H_INVALID;
+  if (*reason == FCM_STEP_NONE) {
+    I->kept = I->kept_ok = 1;
+    I->kept_h = h;
+    I->kept_con = I->con_version;
+    I->kept_damp = I->damp_version;
+  }
 cleanup:
-  if (st != FCM_OK) I->h_state = SIM_H_INVALID;
+  if (st != FCM_OK) I->h_state = SIM_H_INVALID, I->kept = 0;
   return st;
 }
 
@@ -405,7 +423,8 @@ static void monitor(const fcm_integrator *I, double t1, int it, double r, double
 }
 
 /* Newton set-up phase: the initial guess u^ = u_n + h v_n on free DOFs (exact for
- * free flight), u_n elsewhere, and its evaluation; the tangent it assembled is kept. */
+ * free flight), u_n elsewhere, and its evaluation; the tangent it assembled is kept (none
+ * when the kept factorization will serve the first iteration). */
 static fcm_status newton_start(fcm_integrator *I, double h, eval_out *cur, sim_stats *stats)
 {
   fcm_status st = FCM_OK;
@@ -414,9 +433,10 @@ static fcm_status newton_start(fcm_integrator *I, double h, eval_out *cur, sim_s
       I->uhat[i] = I->un[i] + h * I->v[i];
       I->u[i] = I->is_con[i] ? I->un[i] : I->uhat[i];
     }
-  FCM_TRY(I->ctx, evaluate(I, h, I->u, !I->linear, I->fint, I->g, cur, stats));
+  const int tangent = !I->linear && !kept_usable(I, h);
+  FCM_TRY(I->ctx, evaluate(I, h, I->u, tangent, I->fint, I->g, cur, stats));
   I->h_state = I->linear ? (I->h_state == SIM_H_SYSTEM ? SIM_H_SYSTEM : SIM_H_INVALID)
-                         : (cur->finite ? SIM_H_TANGENT : SIM_H_INVALID);
+                         : (cur->finite && tangent ? SIM_H_TANGENT : SIM_H_INVALID);
   I->psi = cur->psi;
   I->inverted = cur->inverted;
 cleanup:
@@ -428,10 +448,31 @@ cleanup:
  * tangent, which with M/h^2 (or the constraints) is SPD. *slope = g.d; *reason is set
  * when no usable direction exists. */
 static fcm_status newton_direction(fcm_integrator *I, double h, int predictor, double *slope,
-                                   int *its, fcm_step_reason *reason, sim_stats *stats)
+                                   int *its, int *used_kept, fcm_step_reason *reason,
+                                   sim_stats *stats)
 {
   fcm_status st = FCM_OK;
   int projected = 0;
+  *used_kept = 0;
+  if (!predictor && kept_usable(I, h)) {
+    /* the kept factorization: b = -g, zero on the constrained DOFs (their increments are 0) */
+    for (fcm_index i = 0; i < I->n; i++)
+      I->b[i] = -I->g[i];
+    for (fcm_index j = 0; j < I->nact; j++)
+      I->b[I->act_dof[j]] = 0.0;
+    FCM_TRY(I->ctx, direction(I, 0, reason, its, stats));
+    if (*reason == FCM_STEP_NONE) {
+      *slope = dot(I->n, I->g, I->d);
+      if (*slope < 0.0) {
+        *used_kept = 1;
+        stats->reused_factorizations++;
+        goto cleanup;
+      }
+    }
+    /* not a descent direction, or the solve failed: factor anew at this iterate */
+    *reason = FCM_STEP_NONE;
+    I->kept = 0;
+  }
   FCM_TRY(I->ctx, build_system(I, h, predictor, 0, reason, stats));
   if (*reason == FCM_STEP_NONE) FCM_TRY(I->ctx, direction(I, predictor, reason, its, stats));
   if (*reason == FCM_STEP_LINEAR_SOLVER_FAILED && I->bcon_active > 0 && !I->opts.project_psd) {
@@ -496,7 +537,7 @@ static fcm_status line_search(fcm_integrator *I, double h, int predictor, const 
     if (predictor)
       for (fcm_index j = 0; j < I->nact; j++)
         I->ut[I->act_dof[j]] = I->act_val[j];
-    lr->speculative = !I->linear && bt == 0;
+    lr->speculative = !I->linear && bt == 0 && !kept_usable(I, h);
     FCM_TRY(I->ctx, evaluate(I, h, I->ut, lr->speculative, I->fint_t, I->g_t, trial, stats));
     if (trial->finite) {
       lr->rt = norm_free(I, I->g_t);
@@ -552,12 +593,12 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
       break;
     }
     /* A predictor step first moves the constrained DOFs onto their prescribed values. */
-    int predictor = !met, its = 0;
+    int predictor = !met, its = 0, used_kept = 0;
     double slope = 0.0;
     line_result lr;
     for (fcm_index j = 0; j < I->nact; j++)
       I->act_inc[j] = I->act_val[j] - I->u[I->act_dof[j]];
-    FCM_TRY(I->ctx, newton_direction(I, h, predictor, &slope, &its, reason, stats));
+    FCM_TRY(I->ctx, newton_direction(I, h, predictor, &slope, &its, &used_kept, reason, stats));
     if (*reason != FCM_STEP_NONE) break;
     FCM_TRY(I->ctx, line_search(I, h, predictor, &cur, slope, r, &trial, &lr, stats));
     if (!lr.accepted) {
@@ -575,6 +616,9 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
     if (!I->linear)
       I->h_state = (lr.speculative && lr.alpha == 1.0) ? SIM_H_TANGENT : SIM_H_INVALID;
     stats->newton_iterations++;
+    /* an iteration on the kept factorization that backtracked or contracted too little:
+     * the next one factors anew */
+    if (used_kept && !(lr.alpha == 1.0 && lr.rt <= o->reuse_contraction * r)) I->kept_ok = 0;
     r = lr.rt;
     met = constraints_met(I, I->u);
     tol = tolerance(I, rep_free, r_start);
@@ -617,6 +661,7 @@ static fcm_status update_damping(fcm_integrator *I, fcm_step_reason *reason, sim
     dv[e] = o->rayleigh_stiffness * dv[e] + o->rayleigh_mass * mv[e];
   I->damp_version++;
   if (!I->linear) I->h_state = SIM_H_INVALID;
+  I->kept = 0;
 cleanup:
   return st;
 }
@@ -744,6 +789,7 @@ static fcm_status reject_step(fcm_integrator *I, fcm_status st, fcm_step_reason 
   memcpy(I->load_prev, I->lp_bak, sizeof(double) * (size_t)n);
   fcm__sim_eval_constraints(I, I->t);
   if (!I->linear) I->h_state = SIM_H_INVALID;
+  I->kept = 0;
   if (st == FCM_OK && reason == FCM_STEP_LINEAR_SOLVER_STAGNATED)
     st = fcm__error(I->ctx, FCM_ERR_NOT_CONVERGED, __FILE__, __LINE__, __func__,
                     "integrator: step %lld from t = %g failed after %d halving(s) (last dt = "
@@ -776,6 +822,7 @@ static void record_step_statistics(const fcm_integrator *I, const sim_stats *sta
   info->factorizations = stats->factorizations;
   info->direct_fallbacks = stats->direct_fallbacks;
   info->projection_fallbacks = stats->projection_fallbacks;
+  info->reused_factorizations = stats->reused_factorizations;
   info->inexact_solves = stats->inexact_solves;
   info->total_analyses = fcm__sim_analyses(I);
   info->total_factorizations = I->total_factorizations;
@@ -844,6 +891,7 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
       info->failed_attempts++; /* retry the substep at half the size */
       memcpy(I->u, I->un, sizeof(double) * (size_t)n);
       if (!I->linear) I->h_state = SIM_H_INVALID;
+      I->kept = 0;
       if (level >= H) break;
       level++;
       reason = FCM_STEP_NONE;

@@ -58,7 +58,7 @@ typedef struct sim_bpoints {
 /* Counters and timers of one step (copied into fcm_step_info). */
 typedef struct sim_stats {
   int newton_iterations, backtracks, tangent_assemblies, factorizations;
-  int direct_fallbacks, projection_fallbacks, inexact_solves;
+  int direct_fallbacks, projection_fallbacks, inexact_solves, reused_factorizations;
   long long linear_iterations, mg_cycles;
   double time_assembly, time_factor, time_solve;
 } sim_stats;
@@ -152,6 +152,12 @@ struct fcm_integrator {
   double key_h;
   long long key_con, key_damp;
   long long damp_version;
+  /* A kept factorization (reuse_factorization): the direct solver's factor of the Newton
+   * matrix at an earlier iterate, for h, constraints and damping of the keys below; kept_ok =
+   * 0 once an iteration solved with it fell short of reuse_contraction. */
+  int kept, kept_ok;
+  double kept_h;
+  long long kept_con, kept_damp;
 
   fcm_integrator_setup_info setup_info; /* what the setup assembled */
 
