@@ -48,24 +48,25 @@ static void on_phase(const fcm_setup_phase_event *ev, void *user)
   }
 }
 
-static void on_rules_progress(fcm_index done, fcm_index total, void *user)
+/* A progress call: counted inside or outside the phase that reports it. */
+static void count_progress(recorder *r, fcm_setup_phase phase)
 {
-  recorder *r = user;
-  (void)done, (void)total;
-  if (r->open == FCM_SETUP_CELL_RULES)
+  if (r->open == (int)phase)
     r->progress_in++;
   else
     r->progress_out++;
 }
 
+static void on_rules_progress(fcm_index done, fcm_index total, void *user)
+{
+  (void)done, (void)total;
+  count_progress(user, FCM_SETUP_CELL_RULES);
+}
+
 static void on_geometry_progress(fcm_index done, fcm_index total, void *user)
 {
-  recorder *r = user;
   (void)done, (void)total;
-  if (r->open == FCM_SETUP_GEOMETRY)
-    r->progress_in++;
-  else
-    r->progress_out++;
+  count_progress(user, FCM_SETUP_GEOMETRY);
 }
 
 static recorder *log_target; /* the recorder of the running set-up, for the context's log */

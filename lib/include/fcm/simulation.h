@@ -179,7 +179,10 @@ typedef struct fcm_simulation fcm_simulation;
 /** Build everything a scene needs and set the integrator up at t = 0 (initial velocities
  * applied). No file is created. A failure while building from a scene section has that
  * section's JSON path before the message ("background.mesh: ...", "geometry.voxels: ...",
- * "geometry: embed: the geometry lies wholly outside ...").
+ * "geometry: embed: the geometry lies wholly outside ..."). Each phase of the set-up is
+ * reported to opts->setup_phase as it starts and ends (fcm_setup_phase) and timed in the
+ * counters; the library's warnings on the way (holes filled, NaN voxels, simplification
+ * fallbacks) go to the context's log callback.
  * @param[in]  ctx   context; must outlive the simulation
  * @param[in]  scene borrowed; must outlive the simulation
  * @param[in]  opts  NULL for defaults
