@@ -381,12 +381,8 @@ int main(void)
   }
   TEST_TRUE(fcm_setup_phase_name(FCM_SETUP_PHASE_COUNT)[0] == '?');
 
-  const char *files[] = {"open.obj", "nan.nrrd", "scene.json"};
-  for (int i = 0; i < 3; i++) {
-    snprintf(path, sizeof path, "%s/%s", dir, files[i]);
-    remove(path);
-  }
-  rmdir(dir);
+  const char *const files[] = {"open.obj", "nan.nrrd", "scene.json"};
+  remove_temp_dir(dir, files, 3);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
