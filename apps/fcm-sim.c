@@ -15,6 +15,7 @@
 #include <errno.h>
 #include <omp.h>
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -31,7 +32,7 @@ typedef struct scene_options {
   int checkpoint_every; /* -1: the scene's */
   int check, quiet, print_scene;
   int debug;    /* print the library's traceback with errors */
-  int progress; /* progress of the cell rules also when stderr is not a terminal */
+  int progress; /* the set-up's phases and progress also when stderr is not a terminal */
   int backend;  /* 0 serial, 1 petsc */
 } scene_options;
 
@@ -63,8 +64,11 @@ static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS
        "print the scene with every default filled in and exit", 0, 0, 0, NULL, NULL, NULL},
       {"--quiet", "-q", CLI_FLAG, &o->quiet, NULL, "print only errors", 0, 0, 0, NULL, NULL, NULL},
       {"--progress", NULL, CLI_FLAG, &o->progress, NULL,
-       "report the level-set and cell-rule builds also when stderr\n"
-       "is not a terminal (a line every 2 s; on a terminal: a bar)",
+       "report the set-up also when stderr is not a terminal: a\n"
+       "line when a long phase starts (the cell rules, the level\n"
+       "set, Gmsh's meshing), one with each phase's time as it\n"
+       "ends, and the level-set and cell-rule builds every 2 s\n"
+       "(on a terminal always: what runs now, bars, the times)",
        0, 0, 0, NULL, NULL, NULL},
       {"--debug", NULL, CLI_FLAG, &o->debug, NULL,
        "print the library's traceback with errors, and every\n"
@@ -153,15 +157,19 @@ static void progress(int tty, long long k, long long n, long long step, long lon
   }
 }
 
-/* Progress of the cell rules: a bar on a terminal, else a line per call. */
+/* Progress of the set-up on stderr: its phases, and the cell rules and level set as a bar on
+ * a terminal, else a line per call. open: the characters of a line left open on the terminal
+ * (a phase's start, a bar), which a warning or the phase's end finishes first; atomic: the
+ * library's warnings come from its OpenMP threads too. */
 typedef struct rules_progress_state {
   int tty;
   double t0;
+  atomic_int open;
 } rules_progress_state;
 
 /* One progress report of `what` (done of total `unit`): a bar with the elapsed time and the
  * estimate on a terminal (the unit named when bar_unit is set), else a line. */
-static void progress_report(const rules_progress_state *ps, fcm_index done, fcm_index total,
+static void progress_report(rules_progress_state *ps, fcm_index done, fcm_index total,
                             const char *what, const char *unit, int bar_unit)
 {
   const double el = fcm_wtime() - ps->t0;
@@ -172,9 +180,11 @@ static void progress_report(const rules_progress_state *ps, fcm_index done, fcm_
       bar[i] = i < fill ? '#' : '.';
     bar[width] = '\0';
     const double eta = done > 0 ? el / (double)done * (double)(total - done) : 0.0;
-    fprintf(stderr, "\r[%s] %s %lld/%lld%s%s  %.0f s  ETA %.0f s   ", bar, what, (long long)done,
-            (long long)total, bar_unit ? " " : "", bar_unit ? unit : "", el, eta);
-    if (done == total) fputc('\n', stderr);
+    int n = fprintf(stderr, "\r[%s] %s %lld/%lld%s%s  %.0f s  ETA %.0f s   ", bar, what,
+                    (long long)done, (long long)total, bar_unit ? " " : "", bar_unit ? unit : "",
+                    el, eta);
+    if (done == total) fputc('\n', stderr), n = 0;
+    atomic_store(&ps->open, n);
   } else {
     fprintf(stderr, "fcm-sim: %s %lld/%lld %s (%.1f s)\n", what, (long long)done, (long long)total,
             unit, el);
@@ -192,14 +202,51 @@ static void geometry_progress(fcm_index done, fcm_index total, void *user)
   progress_report(user, done, total, "level set", "sub-cells", 1);
 }
 
+/* Finish the line left open on the terminal, if any. */
+static void close_line(rules_progress_state *ps)
+{
+  if (atomic_exchange(&ps->open, 0) > 0) fputc('\n', stderr);
+}
+
+/* A set-up phase (fcm_setup_phase_fn). Its end: a line with its time. Its start: a line when it
+ * is long (it reports progress, or it is Gmsh's meshing, which cannot: say it runs); on a
+ * terminal the other phases' starts show what runs now on a line that the end replaces. */
+static void setup_phase(const fcm_setup_phase_event *ev, void *user)
+{
+  rules_progress_state *ps = user;
+  const int is_long = ev->progress || ev->phase == FCM_SETUP_VOLUME_MESH;
+  if (!ev->finished) {
+    close_line(ps);
+    ps->t0 = fcm_wtime(); /* the bars' elapsed time and estimate are the phase's */
+    if (is_long) {
+      fprintf(stderr, "fcm-sim: %s: running%s\n", ev->what,
+              ev->progress ? "" : " (Gmsh reports no progress)");
+    } else if (ps->tty) {
+      const int n = fprintf(stderr, "fcm-sim: %s ...", ev->what);
+      atomic_store(&ps->open, n);
+    }
+    fflush(stderr);
+    return;
+  }
+  char line[512];
+  snprintf(line, sizeof line, "fcm-sim: %s: %.2f s", ev->what, ev->seconds);
+  const int n = atomic_exchange(&ps->open, 0);
+  if (ps->tty && n > 0 && !is_long) /* replace the start line */
+    fprintf(stderr, "\r%-*s\n", n, line);
+  else
+    fprintf(stderr, "%s%s\n", n > 0 ? "\n" : "", line);
+  fflush(stderr);
+}
+
 /* The library's warnings (FCM_LOG_WARNING: NaN voxels, holes filled, solver fallbacks) on
  * stderr, the first SIM_MAX_WARNINGS of them (all with --debug); errors are printed where
  * they end the run. Called from the library's OpenMP threads too (a simplification
  * fallback inside the cell loop): the count is atomic. */
 #define SIM_MAX_WARNINGS 10
 typedef struct warn_state {
-  int all;     /* --debug: print every warning */
-  long long n; /* warnings so far */
+  int all;                     /* --debug: print every warning */
+  long long n;                 /* warnings so far */
+  rules_progress_state *setup; /* a line it left open on the terminal is finished first */
 } warn_state;
 
 static void print_warning(void *user, fcm_log_level level, const char *msg)
@@ -209,6 +256,7 @@ static void print_warning(void *user, fcm_log_level level, const char *msg)
   long long k;
 #pragma omp atomic capture
   k = ++ws->n;
+  if ((ws->all || k <= SIM_MAX_WARNINGS + 1) && ws->setup) close_line(ws->setup);
   if (ws->all || k <= SIM_MAX_WARNINGS)
     fprintf(stderr, "fcm-sim: warning: %s\n", msg);
   else if (k == SIM_MAX_WARNINGS + 1)
@@ -395,6 +443,8 @@ static fcm_simulation_options simulation_options(const scene_options *o, rules_p
     so.rules_progress_interval = rps->tty ? 0.2 : 2.0;
     so.geometry_progress = geometry_progress;
     so.geometry_progress_user = rps;
+    so.setup_phase = setup_phase;
+    so.setup_phase_user = rps;
   }
   return so;
 }
@@ -409,6 +459,12 @@ static int build_simulation(fcm_ctx *ctx, fcm_scene *scene, const scene_options 
   if (!o->quiet)
     fprintf(stderr, "fcm-sim: scene %s (%s): building\n", name, fcm_scene_source(scene));
   fcm_status st = fcm_simulation_create(ctx, scene, &so, sim);
+  if (so.setup_phase) close_line(rps);
+  if (st == FCM_OK && so.setup_phase) {
+    fcm_simulation_counters c;
+    fcm_simulation_get_counters(*sim, &c);
+    fprintf(stderr, "fcm-sim: set-up: %.2f s\n", c.time_setup);
+  }
   if (st != FCM_OK) {
     if (o->debug)
       fcm_ctx_error_view(ctx, stderr);
@@ -500,7 +556,8 @@ static int scene_main(int argc, char **argv)
   fcm_scene *scene = NULL;
   fcm_simulation *sim = NULL;
   char logpath[4096];
-  warn_state ws = {o.debug, 0};
+  rules_progress_state rps = {!o.quiet && isatty(2), fcm_wtime(), 0};
+  warn_state ws = {o.debug, 0, &rps};
   fcm_ctx_options co = fcm_ctx_options_default();
   co.log = print_warning;
   co.log_user = &ws;
@@ -522,7 +579,7 @@ static int scene_main(int argc, char **argv)
   }
   if (fcm_scene_get_solver(scene)->threads > 0) /* every OpenMP loop of the run */
     omp_set_num_threads(fcm_scene_get_solver(scene)->threads);
-  rules_progress_state rps = {!o.quiet && isatty(2), fcm_wtime()};
+  rps.t0 = fcm_wtime();
   rc = build_simulation(ctx, scene, &o, &rps, &sim);
   if (rc != 0) goto done;
   rc = 1;

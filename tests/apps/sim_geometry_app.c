@@ -10,7 +10,11 @@
  * (exit 2, naming the key, the value and the spacing, or the estimate, the limit and the
  * option); a surface vertex at 1e308 is refused as out of range; a cut surface of only
  * zero-area triangles is refused; a singular static system fails its step (exit 1) with the
- * message and its hint, the library's traceback only with --debug.
+ * message and its hint, the library's traceback only with --debug. The set-up's phases: with
+ * --progress off a terminal an open surface closed by fill_holes prints a line per phase with
+ * its time, in the set-up's order, the hole-filling warning between the reading and the
+ * filling's end, a start line for the cell rules, and the phases' times add up to at most the
+ * set-up's; without --progress no phase line but the warning still.
  * Usage: sim_geometry_app FCM_SIM WORKDIR */
 #define _POSIX_C_SOURCE 200809L
 #include "app_run.h"
@@ -144,6 +148,102 @@ static void guards(const char *sim, const char *work, const char *path, const ch
   TEST_TRUE(file_has(err, "fcm error: ") && file_has(err, "  [0] ") && file_has(err, ".c:"));
 }
 
+/* The seconds of the first phase-end line "fcm-sim: <what>: <seconds> s" of `text` that
+ * starts with `what` (-1: none; a start line "...: running" is passed over), and where it is
+ * (*at). */
+static double phase_seconds(const char *text, const char *what, const char **at)
+{
+  char key[256];
+  snprintf(key, sizeof key, "\nfcm-sim: %s", what);
+  for (const char *p = strstr(text, key); p; p = strstr(p + 1, key)) {
+    const char *end = strchr(p + 1, '\n');
+    const char *colon = NULL;
+    for (const char *q = p + 1; end && q < end; q++)
+      if (q[0] == ':' && q[1] == ' ') colon = q; /* the last ": " of the line */
+    double s = -1.0;
+    if (colon && sscanf(colon + 2, "%lf s", &s) == 1) {
+      *at = p;
+      return s;
+    }
+  }
+  *at = NULL;
+  return -1.0;
+}
+
+/* --progress off a terminal: the set-up's phases of an open surface closed by fill_holes. */
+static void setup_phases(const char *sim, const char *work, const char *path, const char *err,
+                         const char *out)
+{
+  static char text[1 << 16];
+  char cmd[8192], file[1024];
+  /* [0.2, 0.8]^3 without its top face */
+  snprintf(file, sizeof file, "%s/geo-open.obj", work);
+  write_file(file, "v 0.2 0.2 0.2\nv 0.8 0.2 0.2\nv 0.8 0.8 0.2\nv 0.2 0.8 0.2\n"
+                   "v 0.2 0.2 0.8\nv 0.8 0.2 0.8\nv 0.8 0.8 0.8\nv 0.2 0.8 0.8\n"
+                   "f 1 3 2\nf 1 4 3\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\n"
+                   "f 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n");
+  scene(path, "{\"surface\": \"geo-open.obj\", \"fill_holes\": true}");
+  snprintf(cmd, sizeof cmd, "'%s' '%s' --check --progress 2> '%s' > '%s'", sim, path, err, out);
+  TEST_TRUE(app_run(cmd) == 0);
+  FILE *f = fopen(err, "r");
+  size_t n = f ? fread(text + 1, 1, sizeof text - 2, f) : 0;
+  if (f) fclose(f);
+  text[0] = '\n'; /* every line starts after a newline */
+  text[n + 1] = '\0';
+  /* the phases in order, each with its time */
+  static const char *const phases[] = {"building the background grid (2 x 2 x 2 cells): ",
+                                       "reading the surface geo-open.obj: ",
+                                       "filling the surface's holes: ",
+                                       "checking the surface",
+                                       "building the geometry of 12 surface triangles: ",
+                                       "classifying 8 cells and building the cut cells' rules: ",
+                                       "building the space",
+                                       "setting up the integrator (factorization): ",
+                                       "locating the output surface's 12 triangles"};
+  const int np = (int)(sizeof phases / sizeof phases[0]);
+  const char *prev = text, *at = NULL;
+  double sum = 0.0;
+  for (int k = 0; k < np; k++) {
+    const double s = phase_seconds(prev, phases[k], &at);
+    TEST_TRUE(at != NULL && s >= 0.0);
+    if (!at) {
+      fprintf(stderr, "phase line '%s' missing after:\n%s\n", phases[k], prev);
+      break;
+    }
+    sum += s;
+    prev = at;
+  }
+  /* the times printed (two decimals) add up to at most the set-up's */
+  double setup = -1.0;
+  const char *total = strstr(text, "\nfcm-sim: set-up: ");
+  TEST_TRUE(total && sscanf(total, "\nfcm-sim: set-up: %lf s", &setup) == 1);
+  TEST_TRUE(setup >= 0.0 && sum <= setup + 0.005 * np);
+  TEST_TRUE(total && at && total > at);
+  /* the warning, while the holes were filled */
+  const char *warn = strstr(text, "\nfcm-sim: warning: scene geo: geometry.surface ");
+  const char *read = strstr(text, "\nfcm-sim: reading the surface");
+  const char *fill = strstr(text, "\nfcm-sim: filling the surface's holes: ");
+  TEST_TRUE(warn &&
+            strstr(warn, "fill_holes closed 1 of 1 hole(s) (edges: 4), adding 2 triangles"));
+  TEST_TRUE(warn && read && fill && read < warn && warn < fill);
+  /* the cell rules, long: a start line, then the progress, then the end */
+  const char *start = strstr(text, "\nfcm-sim: classifying 8 cells and building the cut cells' "
+                                   "rules: running\n");
+  const char *bar = strstr(text, "\nfcm-sim: cell rules 8/8 cells");
+  const char *end = strstr(text, "\nfcm-sim: classifying 8 cells and building the cut cells' "
+                                 "rules: 0.");
+  TEST_TRUE(start && bar && end && start < bar && bar < end);
+  /* the summary splits the set-up's parts into phases */
+  TEST_TRUE(file_has(out, "            [s] mesh and geometry: reading ") &&
+            file_has(out, ", filling holes ") && file_has(out, "[s] cell rules: "));
+
+  /* without --progress off a terminal: the warning, no phase line */
+  snprintf(cmd, sizeof cmd, "'%s' '%s' --check 2> '%s' > /dev/null", sim, path, err);
+  TEST_TRUE(app_run(cmd) == 0);
+  TEST_TRUE(file_has(err, "fcm-sim: warning: scene geo: geometry.surface "));
+  TEST_TRUE(!file_has(err, "fcm-sim: reading the surface") && !file_has(err, "fcm-sim: set-up:"));
+}
+
 int main(int argc, char **argv)
 {
   if (argc != 3) return 2;
@@ -205,5 +305,6 @@ int main(int argc, char **argv)
   TEST_TRUE(file_has(out, "(ratio 1.000000), outside the background 0"));
 
   guards(sim, work, path, err, out);
+  setup_phases(sim, work, path, err, out);
   return TEST_RESULT();
 }

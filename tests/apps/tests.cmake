@@ -45,7 +45,9 @@ foreach(scene IN LISTS fcm_check_scenes)
 endforeach()
 # fcm-sim and the embedding diagnostics: the outside-volume warning (half a box beyond +x),
 # a body wholly outside and a bad voxel image exit 2 naming the scene section (traceback
-# only with --debug), --progress off a terminal.
+# only with --debug), --progress off a terminal: the level-set and cell-rule progress, and the
+# set-up's phases of an open surface with fill_holes (a line each with its time, in order, the
+# times within the set-up's, the hole-filling warning inside its phase).
 fcm_add_test(app_sim_geometry tests/apps/sim_geometry_app.c LABELS app
              ARGS $<TARGET_FILE:fcm-sim> ${work})
 # fcm-condition: --quick CSV/PNG format and facts; the Fig. 5 claims (Longva et al. 2020)

@@ -87,6 +87,17 @@ static inline int write_text(const char *path, const char *text)
   return write_bytes(path, text, strlen(text));
 }
 
+/* Remove the n files named in `files` from the directory `dir`, then the directory. */
+static inline void remove_temp_dir(const char *dir, const char *const *files, int n)
+{
+  char path[1024];
+  for (int i = 0; i < n; i++) {
+    snprintf(path, sizeof path, "%s/%s", dir, files[i]);
+    remove(path);
+  }
+  rmdir(dir);
+}
+
 /* A fresh directory under /tmp (template in buf, at least 32 bytes); NULL on failure. */
 static inline char *make_temp_dir(char *buf, size_t len)
 {

@@ -264,12 +264,8 @@ int main(void)
     fcm_scene_destroy(&scene);
   }
 
-  const char *files[] = {"cube.stl", "open.obj", "model.xyz", "scene.json"};
-  for (int i = 0; i < 4; i++) {
-    snprintf(path, sizeof path, "%s/%s", dir, files[i]);
-    remove(path);
-  }
-  rmdir(dir);
+  const char *const files[] = {"cube.stl", "open.obj", "model.xyz", "scene.json"};
+  remove_temp_dir(dir, files, 4);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();

@@ -53,3 +53,7 @@ endforeach()
 # stresses equal to those its files hold, a checkpoint keeps them; "stop" refuses the first
 # inverted step (FCM_ERR_GEOMETRY naming step, time, count and cell).
 fcm_add_test(scene_inversion tests/scene/inversion_scene.c)
+# The set-up's phases (fcm_simulation_options.setup_phase) for surface, Gmsh, level-set, cut,
+# voxel and plain scenes: each once, in order, start before end, the times in the counters
+# within their parts and the set-up; progress and warnings inside the phase that makes them.
+fcm_add_test(scene_setup_phases tests/scene/setup_phases.c)

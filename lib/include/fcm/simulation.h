@@ -21,6 +21,55 @@
 extern "C" {
 #endif
 
+/** The phases of fcm_simulation_create()'s set-up, in the order they run with
+ * background.fit_background (the grid is fitted around the geometry); otherwise the background
+ * mesh comes first. A phase the scene does not need is skipped; none runs twice. */
+typedef enum fcm_setup_phase {
+  FCM_SETUP_READ,           /**< reading the geometry's file: a surface, a Gmsh or TetGen mesh, a
+                                 voxel image */
+  FCM_SETUP_FILL_HOLES,     /**< closing the surface's holes (geometry.fill_holes) */
+  FCM_SETUP_SURFACE_CHECK,  /**< orienting and checking the surface (closed, manifold, no
+                                 self-intersection) */
+  FCM_SETUP_VOLUME_MESH,    /**< tetrahedralizing the surface with Gmsh (reports no progress) */
+  FCM_SETUP_GEOMETRY,       /**< building the geometry: a shape, the voxels merged into boxes, a
+                                 level set marched (progress: geometry_progress), the surface
+                                 alone */
+  FCM_SETUP_TRANSFORM,      /**< geometry.transform applied */
+  FCM_SETUP_BACKGROUND,     /**< the background mesh: a grid (fitted around the geometry), or
+                                 read from a Gmsh file */
+  FCM_SETUP_CELL_RULES,     /**< classifying the cells and building the cut cells' rules,
+                                 simplification included (progress: rules_progress) */
+  FCM_SETUP_SPACE,          /**< the space: DOFs, element data */
+  FCM_SETUP_INTEGRATOR,     /**< the integrator: effects, constraints, the mass matrix and body
+                                 forces, the solver's set-up */
+  FCM_SETUP_LOG,            /**< the element mass blocks of the log's mass and momentum */
+  FCM_SETUP_CUTS,           /**< the cut effects at t = 0 */
+  FCM_SETUP_OUTPUT_SURFACE, /**< the surface the frames write, located in the background cells */
+  FCM_SETUP_PHASE_COUNT
+} fcm_setup_phase;
+
+/** The phase in a few words ("reading", "filling holes", "volume meshing (Gmsh)", ...; "?" out
+ * of range): the names of the run summary. Static storage; thread safe. */
+FCM_API const char *fcm_setup_phase_name(fcm_setup_phase phase);
+
+/** What fcm_simulation_create() reports at the start and at the end of a set-up phase. */
+typedef struct fcm_setup_phase_event {
+  fcm_setup_phase phase;
+  const char *what; /**< the phase and what it works on, in words for a user: "reading the
+                         surface bunny.obj", "meshing the volume with Gmsh"; valid during the
+                         call */
+  int finished;     /**< 0: the phase starts; 1: it ended (a phase that fails reports no end:
+                         fcm_simulation_create() returns the error) */
+  double seconds;   /**< 0 at the start; at the end the phase's wall time
+                         (fcm_simulation_counters.time_setup_phase) */
+  int progress;     /**< 1: the phase reports its progress meanwhile (rules_progress,
+                         geometry_progress); 0: it reports none */
+} fcm_setup_phase_event;
+
+/** Called at the start and end of each set-up phase, on the calling thread, never from inside
+ * a parallel region. */
+typedef void (*fcm_setup_phase_fn)(const fcm_setup_phase_event *event, void *user);
+
 /** Options of fcm_simulation_create(); initialize with fcm_simulation_options_default(). */
 typedef struct fcm_simulation_options {
   fcm_index max_steps;     /**< >= 1: stop after this many steps (fcm_simulation_done());
@@ -37,6 +86,9 @@ typedef struct fcm_simulation_options {
                                 (fcm_level_set_options.progress: sub-cells marched); NULL
                                 (default): none */
   void *geometry_progress_user;                /**< its argument; default NULL */
+  fcm_setup_phase_fn setup_phase;              /**< called when each set-up phase starts and ends
+                                                    (fcm_setup_phase_event); NULL (default): none */
+  void *setup_phase_user;                      /**< its argument; default NULL */
 } fcm_simulation_options;
 
 /** Defaults as documented on each member. */
@@ -113,10 +165,15 @@ typedef struct fcm_simulation_counters {
   double time_setup_space;      /**< seconds of its space (DOFs, element data) */
   double time_setup_integrator; /**< seconds of its integrator: effects, constraints, the mass
                                      matrix, the solver's set-up */
-  double time_step_assembly;    /**< seconds of the steps' energy, force, tangent and damping
-                                     assemblies (fcm_step_info.time_assembly, summed) */
-  double time_step_factor;      /**< seconds of their factorizations or preconditioner set-ups */
-  double time_step_solve;       /**< seconds of their triangular or Krylov solves */
+  double time_setup_phase[FCM_SETUP_PHASE_COUNT]; /**< seconds of each set-up phase
+                                     (fcm_setup_phase; 0: skipped). time_setup_geometry holds
+                                     those up to the background mesh, time_setup_rules,
+                                     time_setup_space and time_setup_integrator the next three;
+                                     together they are at most time_setup */
+  double time_step_assembly; /**< seconds of the steps' energy, force, tangent and damping
+                                  assemblies (fcm_step_info.time_assembly, summed) */
+  double time_step_factor;   /**< seconds of their factorizations or preconditioner set-ups */
+  double time_step_solve;    /**< seconds of their triangular or Krylov solves */
 } fcm_simulation_counters;
 
 /** A running scene (opaque). */
@@ -125,7 +182,10 @@ typedef struct fcm_simulation fcm_simulation;
 /** Build everything a scene needs and set the integrator up at t = 0 (initial velocities
  * applied). No file is created. A failure while building from a scene section has that
  * section's JSON path before the message ("background.mesh: ...", "geometry.voxels: ...",
- * "geometry: embed: the geometry lies wholly outside ...").
+ * "geometry: embed: the geometry lies wholly outside ..."). Each phase of the set-up is
+ * reported to opts->setup_phase as it starts and ends (fcm_setup_phase) and timed in the
+ * counters; the library's warnings on the way (holes filled, NaN voxels, simplification
+ * fallbacks) go to the context's log callback.
  * @param[in]  ctx   context; must outlive the simulation
  * @param[in]  scene borrowed; must outlive the simulation
  * @param[in]  opts  NULL for defaults

@@ -19,6 +19,7 @@
 #include "io/io_impl.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -31,6 +32,59 @@ fcm_simulation_options fcm_simulation_options_default(void)
   o.checkpoint_interval = FCM_DEFAULT;
   o.rules_progress_interval = 0.1;
   return o;
+}
+
+const char *fcm_setup_phase_name(fcm_setup_phase phase)
+{
+  static const char *const names[FCM_SETUP_PHASE_COUNT] = {
+      "reading",       "filling holes", "surface checks",  "volume meshing (Gmsh)",
+      "geometry",      "transform",     "background mesh", "cell rules",
+      "space",         "integrator",    "log mass blocks", "cuts at t = 0",
+      "output surface"};
+  return phase >= 0 && phase < FCM_SETUP_PHASE_COUNT ? names[phase] : "?";
+}
+
+/* A set-up phase starts: `what` (printf format) in words for the user; progress: 1 when it
+ * reports progress meanwhile. The options' setup_phase hears of it; the phase's clock starts
+ * after the call, so the host's printing is not counted in it. */
+#if defined(__GNUC__)
+__attribute__((format(printf, 4, 5)))
+#endif
+static void
+phase_begin(fcm_simulation *S, fcm_setup_phase p, int progress, const char *what, ...)
+{
+  va_list ap;
+  va_start(ap, what);
+  vsnprintf(S->phase_what, sizeof S->phase_what, what, ap);
+  va_end(ap);
+  S->phase = (int)p;
+  S->phase_progress = progress;
+  if (S->opts.setup_phase) {
+    const fcm_setup_phase_event ev = {p, S->phase_what, 0, 0.0, progress};
+    S->opts.setup_phase(&ev, S->opts.setup_phase_user);
+  }
+  S->phase_t0 = fcm_wtime();
+}
+
+/* The running phase ended: its time into the counters, then the options' setup_phase. */
+static void phase_end(fcm_simulation *S)
+{
+  const double t = fcm_wtime() - S->phase_t0;
+  const fcm_setup_phase p = (fcm_setup_phase)S->phase;
+  S->c.time_setup_phase[p] = t;
+  S->phases_run |= 1u << p;
+  S->phase = -1;
+  if (S->opts.setup_phase) {
+    const fcm_setup_phase_event ev = {p, S->phase_what, 1, t, S->phase_progress};
+    S->opts.setup_phase(&ev, S->opts.setup_phase_user);
+  }
+}
+
+/* The last part of a path: what the phases' words name a file by. */
+static const char *base_name(const char *path)
+{
+  const char *slash = strrchr(path, '/');
+  return slash ? slash + 1 : path;
 }
 
 fcm_status fcm__sim_grow(fcm_ctx *ctx, void **array, long long *cap, long long need, size_t size)
@@ -56,8 +110,12 @@ static fcm_status build_voxels(fcm_simulation *S, const fcm_scene_geometry *g, f
   vo.labels = g->labels;
   vo.num_labels = g->num_labels;
   vo.merge = g->merge;
+  phase_begin(S, FCM_SETUP_READ, 0, "reading the voxel image %s", base_name(g->image));
   FCM_TRY(S->ctx, fcm_voxel_image_create_from_file(S->ctx, g->image, &img));
+  phase_end(S);
+  phase_begin(S, FCM_SETUP_GEOMETRY, 0, "merging the selected voxels into boxes");
   FCM_TRY(S->ctx, fcm_geometry_create_from_voxels(S->ctx, img, &vo, raw, &info));
+  phase_end(S);
   fcm_index d[3];
   fcm_voxel_image_dims(img, d);
   char nan_note[64] = "";
@@ -86,8 +144,11 @@ static fcm_status build_level_set(fcm_simulation *S, const fcm_scene_geometry *g
   lo.progress_user = S->opts.geometry_progress_user;
   lo.progress_interval = S->opts.rules_progress_interval;
   FCM_TRY(S->ctx, fcm_implicit_check(S->ctx, &tree));
+  phase_begin(S, FCM_SETUP_GEOMETRY, lo.progress != NULL, "marching the level set (refinement %d)",
+              g->refinement);
   FCM_TRY(S->ctx, fcm_geometry_create_from_level_set(S->ctx, fcm_implicit_eval, &tree, g->min,
                                                      g->max, g->cells, &lo, raw, &info));
+  phase_end(S);
   snprintf(S->geometry_note, sizeof S->geometry_note,
            "level set: %lld tets, %lld cut cells at refinement %d (h %.3g m), volume %.6g m^3, "
            "estimated error %.2g m^3 (%.2g%%)",
@@ -119,16 +180,19 @@ static const char *geometry_path(fcm_scene_geometry_kind k)
 }
 
 /* geometry.surface: read, optionally close holes (logged as a warning with what was
- * closed), tetrahedralize. */
+ * closed), check, then tetrahedralize or keep the surface alone; a phase each. */
 static fcm_status build_surface_geometry(fcm_simulation *S, const fcm_scene_geometry *g,
                                          fcm_geometry **raw)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = S->ctx;
   fcm_surface *surf = NULL, *filled = NULL;
+  phase_begin(S, FCM_SETUP_READ, 0, "reading the surface %s", base_name(g->mesh));
   FCM_TRY(ctx, fcm_surface_create_from_file(ctx, g->mesh, &surf));
+  phase_end(S);
   if (g->fill_holes) {
     fcm_surface_fill_info fi;
+    phase_begin(S, FCM_SETUP_FILL_HOLES, 0, "filling the surface's holes");
     FCM_TRY(ctx, fcm_surface_create_filled(ctx, surf, &g->fill, &filled, &fi));
     if (fi.num_loops > 0) {
       char list[256];
@@ -149,6 +213,7 @@ static fcm_status build_surface_geometry(fcm_simulation *S, const fcm_scene_geom
     fcm_surface_destroy(&surf);
     surf = filled;
     filled = NULL;
+    phase_end(S);
   }
   /* the checks here, so that a failure names the scene and the file */
   {
@@ -156,18 +221,28 @@ static fcm_status build_surface_geometry(fcm_simulation *S, const fcm_scene_geom
     fcm_surface_report rep;
     fcm_surface_mesh_options mo = g->surface;
     snprintf(what, sizeof what, "scene %s: geometry.surface %s", fcm_scene_name(S->scene), g->mesh);
+    phase_begin(S, FCM_SETUP_SURFACE_CHECK, 0,
+                "checking the surface (orientation, closed, manifold, self-intersections)");
     FCM_TRY(ctx, fcm_surface_create_oriented(ctx, surf, &filled, NULL));
     fcm_surface_destroy(&surf);
     surf = filled;
     filled = NULL;
     FCM_TRY(ctx, fcm_surface_check(surf, NULL, &rep));
     FCM_TRY(ctx, fcm_surface_report_check(surf, what, &rep));
+    phase_end(S);
     mo.check_intersections = 0; /* done above */
     mo.orient = 0;
     if (mo.volume_mesh < 0) /* auto: cutting splits the geometry's cells, and the distributed
                                backend partitions the work by them */
       mo.volume_mesh = fcm_scene_count_effects(S->scene, FCM_EFFECT_CUT) > 0 || S->distributed;
+    if (mo.volume_mesh)
+      phase_begin(S, FCM_SETUP_VOLUME_MESH, 0, "meshing the volume inside %lld triangles with Gmsh",
+                  (long long)fcm_surface_num_triangles(surf));
+    else
+      phase_begin(S, FCM_SETUP_GEOMETRY, 0, "building the geometry of %lld surface triangles",
+                  (long long)fcm_surface_num_triangles(surf));
     FCM_TRY(ctx, fcm_geometry_create_from_surface(ctx, surf, &mo, raw));
+    phase_end(S);
   }
 cleanup:
   fcm_surface_destroy(&surf);
@@ -216,6 +291,14 @@ static fcm_status build_geometry(fcm_simulation *S, const fcm_scene_geometry *g)
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = S->ctx;
   fcm_geometry *raw = NULL;
+  static const char *const shapes[] = {"box", "ball", "hemisphere", "hollow ball", "tube"};
+  const int shape = g->kind >= FCM_SCENE_GEOMETRY_BOX && g->kind <= FCM_SCENE_GEOMETRY_TUBE;
+  if (shape)
+    phase_begin(S, FCM_SETUP_GEOMETRY, 0, "building the geometry (%s)",
+                shapes[g->kind - FCM_SCENE_GEOMETRY_BOX]);
+  else if (g->kind == FCM_SCENE_GEOMETRY_GMSH || g->kind == FCM_SCENE_GEOMETRY_TETGEN)
+    phase_begin(S, FCM_SETUP_READ, 0, "reading the %s mesh %s",
+                g->kind == FCM_SCENE_GEOMETRY_GMSH ? "Gmsh" : "TetGen", base_name(g->mesh));
   switch (g->kind) {
   case FCM_SCENE_GEOMETRY_BOX:
     FCM_TRY(ctx, fcm_geometry_create_box(ctx, g->min, g->max, g->cells, &raw));
@@ -254,8 +337,12 @@ static fcm_status build_geometry(fcm_simulation *S, const fcm_scene_geometry *g)
     FCM_CHECK(0, ctx, FCM_ERR_ARG, "scene %s: geometry kind %d outside [1, %d)",
               fcm_scene_name(S->scene), (int)g->kind, (int)FCM_SCENE_GEOMETRY_KIND_COUNT);
   }
+  if (shape || g->kind == FCM_SCENE_GEOMETRY_GMSH || g->kind == FCM_SCENE_GEOMETRY_TETGEN)
+    phase_end(S);
   if (g->has_transform) {
+    phase_begin(S, FCM_SETUP_TRANSFORM, 0, "transforming the geometry");
     FCM_TRY(ctx, fcm_geometry_create_transformed(ctx, raw, g->transform, g->offset, &S->geom));
+    phase_end(S);
   } else {
     S->geom = raw;
     raw = NULL;
@@ -580,17 +667,24 @@ static fcm_status build_mesh_geometry(fcm_simulation *S)
     st = build_geometry(S, g); /* the parser ensured there is one */
     if (st != FCM_OK) name_section(ctx, geometry_path(g->kind));
     FCM_TRY(ctx, st);
+    phase_begin(S, FCM_SETUP_BACKGROUND, 0, "fitting the background grid around the geometry");
     st = fit_background(S, bg, min, max, cells);
     if (st == FCM_OK) st = fcm_mesh_create_box(ctx, bg->element, min, max, cells, &S->mesh);
     if (st != FCM_OK) name_section(ctx, "background.fit_background");
     FCM_TRY(ctx, st);
-  } else if (bg->kind == FCM_SCENE_BACKGROUND_GRID)
+  } else if (bg->kind == FCM_SCENE_BACKGROUND_GRID) {
+    phase_begin(S, FCM_SETUP_BACKGROUND, 0,
+                "building the background grid (%lld x %lld x %lld cells)", (long long)bg->cells[0],
+                (long long)bg->cells[1], (long long)bg->cells[2]);
     st = fcm_mesh_create_box(ctx, bg->element, bg->min, bg->max, bg->cells, &S->mesh);
-  else
+  } else {
+    phase_begin(S, FCM_SETUP_BACKGROUND, 0, "reading the background mesh %s", base_name(bg->mesh));
     st = fcm_mesh_create_from_gmsh(ctx, bg->mesh, &S->mesh);
+  }
   if (st != FCM_OK)
     name_section(ctx, bg->kind == FCM_SCENE_BACKGROUND_GRID ? "background" : "background.mesh");
   FCM_TRY(ctx, st);
+  phase_end(S);
   S->nn = fcm_mesh_num_nodes(S->mesh);
 
   if (g->kind != FCM_SCENE_GEOMETRY_NONE && !S->geom) {
@@ -621,6 +715,52 @@ fcm_status fcm__scene_mesh_geometry(fcm_ctx *ctx, const fcm_scene *scene, fcm_me
   S->geom = NULL;
 cleanup:
   fcm_simulation_destroy(&S);
+  return st;
+}
+
+/* The integrator with the scene's effects, set up (the integrator phase): effects, constraints,
+ * the mass matrix and body forces, the solver's set-up; the counters of what it built. */
+static fcm_status build_integrator(fcm_simulation *S)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  const fcm_scene *scene = S->scene;
+  S->c.num_dofs = fcm_space_num_dofs(S->space);
+  S->c.inverted_first_cell = -1;
+  S->c.nonfinite_first_step = -1;
+  fcm_integrator_options io = integrator_options(S);
+  S->c.inertia = io.kind == FCM_INTEGRATOR_BACKWARD_EULER;
+  S->c.damping = io.rayleigh_mass > 0.0 || io.rayleigh_stiffness > 0.0;
+  S->c.krylov = io.linear_solver == FCM_LINEAR_CG || io.linear_solver == FCM_LINEAR_MINRES;
+  S->c.multigrid = io.linear_solver == FCM_LINEAR_MULTIGRID ||
+                   (S->c.krylov && io.preconditioner == FCM_PRECOND_MULTIGRID);
+  phase_begin(S, FCM_SETUP_INTEGRATOR, 0, "setting up the integrator (%s%s)",
+              S->c.inertia ? "mass matrix, " : "",
+              S->c.krylov ? "preconditioner" : (S->c.multigrid ? "multigrid" : "factorization"));
+  if (S->c.krylov && io.preconditioner == FCM_PRECOND_SCHWARZ) {
+    S->c.schwarz_blocks = count_schwarz_blocks(S, io.schwarz_theta);
+    if (S->c.schwarz_blocks == 0) io.preconditioner = FCM_PRECOND_JACOBI; /* nothing to block */
+  }
+  FCM_TRY(ctx, fcm_integrator_create(ctx, S->space, fcm_scene_get_material(scene), &io, &S->integ));
+  for (int k = 0; k < fcm_scene_num_effects(scene); k++) {
+    const fcm_effect *e = fcm_scene_get_effect(scene, k);
+    const fcm__effect_type *t = fcm__scene_effect_type(e->type);
+    if (t->apply) FCM_TRY(ctx, t->apply(S, e));
+  }
+  if (S->config) FCM_TRY(ctx, fcm__integrator_attach_backend(S->integ, S->config->backend));
+  FCM_TRY(ctx, fcm_integrator_setup(S->integ));
+  {
+    fcm_integrator_setup_info si;
+    fcm_integrator_get_setup_info(S->integ, &si);
+    S->c.mass_assemblies = si.mass_assemblies;
+    S->c.body_force_assemblies = si.body_force_assemblies;
+    S->c.traction_assemblies = si.traction_assemblies;
+    S->c.scale_assemblies = si.scale_assemblies;
+    S->c.boundary_points = si.boundary_points;
+  }
+  S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);
+  phase_end(S);
+cleanup:
   return st;
 }
 
@@ -670,10 +810,14 @@ fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   /* cell rules only when the scene embeds a geometry */
   if (g->kind != FCM_SCENE_GEOMETRY_NONE) {
     tp = fcm_wtime();
+    phase_begin(S, FCM_SETUP_CELL_RULES, S->opts.rules_progress != NULL,
+                "classifying %lld cells and building the cut cells' rules",
+                (long long)fcm_mesh_num_cells(S->mesh));
     st = build_rules(S);
-    S->c.time_setup_rules = fcm_wtime() - tp;
     if (st != FCM_OK) fcm__error_prefix(ctx, st == FCM_ERR_GEOMETRY ? "geometry" : "quadrature");
     FCM_TRY(ctx, st);
+    phase_end(S);
+    S->c.time_setup_rules = fcm_wtime() - tp;
     const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(S->rules);
     FCM_CHECK(rs->num_uncut + rs->num_cut > 0, ctx, FCM_ERR_GEOMETRY,
               "geometry: every one of the %lld background cells holds less than "
@@ -683,51 +827,27 @@ fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
               (long long)rs->num_cells, fcm_scene_get_quadrature(scene)->rules.min_fraction,
               rs->embedded_volume, rs->geometry_volume);
     tp = fcm_wtime();
+    phase_begin(S, FCM_SETUP_SPACE, 0, "building the space (DOFs, element data)");
     st = create_space(S, S->rules, S->config && S->config->cell_mask, &S->space);
     if (st != FCM_OK) fcm__error_prefix(ctx, "geometry");
     FCM_TRY(ctx, st);
   } else {
     tp = fcm_wtime();
+    phase_begin(S, FCM_SETUP_SPACE, 0, "building the space (DOFs, element data)");
     FCM_TRY(ctx, fcm_space_create(ctx, S->mesh, NULL, &S->space));
   }
+  phase_end(S);
   S->c.time_setup_space = fcm_wtime() - tp;
   tp = fcm_wtime();
-  S->c.num_dofs = fcm_space_num_dofs(S->space);
-  S->c.inverted_first_cell = -1;
-  S->c.nonfinite_first_step = -1;
-
-  /* integrator with the scene's effects */
-  fcm_integrator_options io = integrator_options(S);
-  S->c.inertia = io.kind == FCM_INTEGRATOR_BACKWARD_EULER;
-  S->c.damping = io.rayleigh_mass > 0.0 || io.rayleigh_stiffness > 0.0;
-  S->c.krylov = io.linear_solver == FCM_LINEAR_CG || io.linear_solver == FCM_LINEAR_MINRES;
-  S->c.multigrid = io.linear_solver == FCM_LINEAR_MULTIGRID ||
-                   (S->c.krylov && io.preconditioner == FCM_PRECOND_MULTIGRID);
-  if (S->c.krylov && io.preconditioner == FCM_PRECOND_SCHWARZ) {
-    S->c.schwarz_blocks = count_schwarz_blocks(S, io.schwarz_theta);
-    if (S->c.schwarz_blocks == 0) io.preconditioner = FCM_PRECOND_JACOBI; /* nothing to block */
-  }
-  FCM_TRY(ctx, fcm_integrator_create(ctx, S->space, fcm_scene_get_material(scene), &io, &S->integ));
-  for (int k = 0; k < fcm_scene_num_effects(scene); k++) {
-    const fcm_effect *e = fcm_scene_get_effect(scene, k);
-    const fcm__effect_type *t = fcm__scene_effect_type(e->type);
-    if (t->apply) FCM_TRY(ctx, t->apply(S, e));
-  }
-  if (S->config) FCM_TRY(ctx, fcm__integrator_attach_backend(S->integ, S->config->backend));
-  FCM_TRY(ctx, fcm_integrator_setup(S->integ));
-  {
-    fcm_integrator_setup_info si;
-    fcm_integrator_get_setup_info(S->integ, &si);
-    S->c.mass_assemblies = si.mass_assemblies;
-    S->c.body_force_assemblies = si.body_force_assemblies;
-    S->c.traction_assemblies = si.traction_assemblies;
-    S->c.scale_assemblies = si.scale_assemblies;
-    S->c.boundary_points = si.boundary_points;
-  }
-  S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);
+  FCM_TRY(ctx, build_integrator(S));
   S->c.time_setup_integrator = fcm_wtime() - tp;
   if (S->c.inertia) FCM_TRY(ctx, fcm__sim_initialize_effects(S));
-  FCM_TRY(ctx, build_log_blocks(S));
+  if (!S->rules || fcm_cell_rules_has_kind(S->rules, FCM_RULE_MASS)) {
+    phase_begin(S, FCM_SETUP_LOG, 0,
+                "assembling the element mass blocks of the log's mass and momentum");
+    FCM_TRY(ctx, build_log_blocks(S));
+    phase_end(S);
+  }
   S->free_body = S->c.inertia && S->c.constraints == 0 && S->c.body_force_assemblies == 0 &&
                  S->c.traction_assemblies == 0;
   if (S->free_body) FCM_TRY(ctx, fcm__sim_center_of_mass(S, NULL, S->com0));
@@ -736,10 +856,20 @@ fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
   S->pieces = fcm_space_num_bodies(S->space);
   S->c.pieces = S->pieces;
   FCM_TRY(ctx, collect_cuts(S));
-  while (S->cuts_applied < S->num_cuts && S->cuts[S->cuts_applied]->cut.time <= 0.0)
-    FCM_TRY(ctx, fcm__sim_apply_cut(S));
+  if (S->num_cuts > 0 && S->cuts[0]->cut.time <= 0.0) {
+    phase_begin(S, FCM_SETUP_CUTS, 0, "applying the cuts at t = 0");
+    while (S->cuts_applied < S->num_cuts && S->cuts[S->cuts_applied]->cut.time <= 0.0)
+      FCM_TRY(ctx, fcm__sim_apply_cut(S));
+    phase_end(S);
+  }
 
-  if (S->geom && fcm_scene_get_output(scene)->write_surface) FCM_TRY(ctx, build_surface(S));
+  if (S->geom && fcm_scene_get_output(scene)->write_surface) {
+    phase_begin(S, FCM_SETUP_OUTPUT_SURFACE, 0,
+                "locating the output surface's %lld triangles in the background cells",
+                (long long)fcm_geometry_num_boundary_triangles(S->geom));
+    FCM_TRY(ctx, build_surface(S));
+    phase_end(S);
+  }
   S->c.time_setup = fcm_wtime() - t0;
   S->config = NULL; /* borrowed for the create only */
   *out = S;

@@ -113,6 +113,12 @@ struct fcm_simulation {
   int distributed; /* 1: built for the distributed backend (a surface gets a volume mesh) */
   /* what the voxel or level-set geometry reported ("" for the other kinds) */
   char geometry_note[256];
+  /* the set-up phase running (fcm_setup_phase_event; -1: none), its start and its words; bit p
+   * of phases_run: phase p ran (the summary lists those) */
+  int phase, phase_progress;
+  double phase_t0;
+  char phase_what[320];
+  unsigned phases_run;
 };
 
 /* Grow an array of `size`-byte items to hold at least `need` (doubling). */

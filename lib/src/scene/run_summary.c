@@ -267,6 +267,58 @@ static double rules_memory(const fcm_cell_rules_stats *rs)
   return 33.0 * points;
 }
 
+/* One line of the set-up's phases first..last (those that ran) within their part `what` of
+ * `total` seconds; "other": the part's time outside them. */
+static void phase_line(const fcm_simulation *S, FILE *f, const fcm_simulation_counters *c,
+                       const char *what, fcm_setup_phase first, fcm_setup_phase last, double total)
+{
+  char b[512];
+  int any = 0;
+  for (int p = (int)first; p <= (int)last; p++)
+    any |= (S->phases_run >> p) & 1u;
+  if (!any) return;
+  int len = snprintf(b, sizeof b, "            [s] %s:", what);
+  double sum = 0.0;
+  const char *sep = " ";
+  for (int p = (int)first; p <= (int)last && len > 0 && (size_t)len < sizeof b; p++) {
+    if (!(S->phases_run & (1u << p))) continue;
+    len += snprintf(b + len, sizeof b - (size_t)len, "%s%s %.3f", sep,
+                    fcm_setup_phase_name((fcm_setup_phase)p), c->time_setup_phase[p]);
+    sum += c->time_setup_phase[p];
+    sep = ", ";
+  }
+  if (len > 0 && (size_t)len < sizeof b)
+    snprintf(b + len, sizeof b - (size_t)len, ", other %.3f", fmax(0.0, total - sum));
+  fprintf(f, "%s\n", b);
+}
+
+/* The set-up's time: its four parts and the rest, then the phases of each part that has
+ * several, and the cell rules' own parts from their statistics (wall seconds; per-cell work
+ * also in core-seconds). */
+static void setup_lines(const fcm_simulation *S, FILE *f, const fcm_simulation_counters *c)
+{
+  const double rest = fmax(0.0, c->time_setup - c->time_setup_geometry - c->time_setup_rules -
+                                    c->time_setup_space - c->time_setup_integrator);
+  fprintf(f,
+          "  set-up    [s] mesh and geometry %.3f, cell rules %.3f, space %.3f, integrator %.3f, "
+          "the rest %.3f\n",
+          c->time_setup_geometry, c->time_setup_rules, c->time_setup_space,
+          c->time_setup_integrator, rest);
+  phase_line(S, f, c, "mesh and geometry", FCM_SETUP_READ, FCM_SETUP_BACKGROUND,
+             c->time_setup_geometry);
+  if (c->cell_rules) {
+    const fcm_cell_rules_stats *rs = &S->setup_stats;
+    const double cells = fmax(0.0, rs->time_total - rs->time_setup - rs->time_gather);
+    fprintf(f,
+            "            [s] cell rules: index and tet rules %.3f, cells %.3f (classification, "
+            "clipping and rules %.3g core-s, simplification %.3g core-s; %d threads), gathering "
+            "%.3f, other %.3f\n",
+            rs->time_setup, cells, rs->time_intersect, rs->time_simplify, rs->num_threads,
+            rs->time_gather, fmax(0.0, c->time_setup_rules - rs->time_total));
+  }
+  phase_line(S, f, c, "the rest", FCM_SETUP_LOG, FCM_SETUP_OUTPUT_SURFACE, rest);
+}
+
 /* The summary with the rules' statistics `gs`, the cuts' point counts `cs` (cut_lines()), the
  * counters `gc`, the body's largest |u| over its quadrature points `body`, the free body's
  * centre of mass `com_now` (NULL: not available) and the peak resident memory `rss` given (a
@@ -359,13 +411,7 @@ static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_
             (c->time_steps - c->time_cuts) * per, a * per, fa * per, so * per,
             (c->time_steps - c->time_cuts - a - fa - so) * per);
   }
-  fprintf(f,
-          "  set-up    [s] mesh and geometry %.3f, cell rules %.3f, space %.3f, integrator %.3f, "
-          "the rest %.3f\n",
-          c->time_setup_geometry, c->time_setup_rules, c->time_setup_space,
-          c->time_setup_integrator,
-          fmax(0.0, c->time_setup - c->time_setup_geometry - c->time_setup_rules -
-                        c->time_setup_space - c->time_setup_integrator));
+  setup_lines(S, f, c);
   if (rss > 0.0 && S->rules)
     fprintf(f,
             "  memory    peak resident %.1f MiB%s; the set-up's cut-cell rules held about %.1f MiB "
