@@ -15,6 +15,11 @@
  * make the LP's right-hand side noise. What is dropped is checked by the residual. */
 #define FIT_RANK_TOL 1e-11
 
+/* An NNLS minimum residual (relative, as fit_residual()) above which the LP is not tried: the
+ * LP differs from NNLS only by the moments it drops with the singular values below
+ * FIT_RANK_TOL, which change the residual by about that much. */
+#define FIT_INFEASIBLE 1e-8
+
 /* The NNLS polish works on at most this many columns (5 M for M <= 84, strength 6). */
 #define FCM__FIT_MAX_PASSIVE 420
 
@@ -254,7 +259,10 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
         const double c = g[j] * inv[j];
         if (c > best && seen[j] != it && pas[j] != it) best = c, t = j;
       }
-      if (t < 0) goto done; /* optimal: no column lowers the residual */
+      if (t < 0) { /* optimal: no column lowers the residual */
+        rep->optimal = 1;
+        goto done;
+      }
       seen[t] = it;
       nnls_add(&s, t, A + (size_t)t * (size_t)M, norm[t], &added);
     }
@@ -399,6 +407,15 @@ fcm_status fcm__simplify_fit(fcm_ctx *ctx, const fcm__cheb_box *box, int n, cons
   fcm__nnls_report nr;
   FCM_TRY(ctx, nnls_fit(ctx, M, n, P, b, scale, tol, floor, x, f, &nr));
   if (f->ok) goto cleanup;
+  /* the moments are farther from the candidates' cone than the LP's rank cut could explain */
+  const double nnls_rel = 0.5 * tol * nr.residual / nnls_stop(M, b, scale, tol, floor);
+  if (nr.optimal && nnls_rel > FIT_INFEASIBLE) {
+    snprintf(f->message, sizeof f->message,
+             "no positive combination of the %d candidates: the nearest (NNLS) leaves a "
+             "moment residual of %.3g",
+             n, nnls_rel);
+    goto cleanup;
+  }
   FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)n, G);
   memcpy(G, P, (size_t)M * (size_t)n * sizeof *G);
   FCM_ALLOC(ctx, (size_t)k, s);
@@ -426,7 +443,7 @@ fcm_status fcm__simplify_fit(fcm_ctx *ctx, const fcm__cheb_box *box, int n, cons
   if (!rep.ok) {
     snprintf(f->message, sizeof f->message,
              "no positive combination of the %d candidates (NNLS residual %.3g): %.100s", n,
-             nr.residual / (scale * fmax(fabs(b[0]), floor)), rep.message);
+             nnls_rel, rep.message);
     goto cleanup;
   }
   for (int j = 0; j < n; j++)

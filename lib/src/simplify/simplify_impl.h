@@ -175,11 +175,12 @@ typedef struct fcm__fit {
   char message[200];
 } fcm__fit;
 
-/* What fcm__simplify_nnls() found: ok when the residual reached the caller's level, the
- * residual max_i |(b - A x)_i|, the passive set's size (the positive entries of x) and the
- * outer iterations. */
+/* What fcm__simplify_nnls() found: ok when the residual reached the caller's level, optimal
+ * when it stopped short of it because no column lowers the residual (x is then the least-squares
+ * minimizer over x >= 0 up to rounding), the residual max_i |(b - A x)_i|, the passive set's size
+ * (the positive entries of x) and the outer iterations. */
 typedef struct fcm__nnls_report {
-  int ok, passive, iterations;
+  int ok, optimal, passive, iterations;
   double residual;
 } fcm__nnls_report;
 
