@@ -3,7 +3,8 @@
  * consistent one is solved with at most M positive weights; an inconsistent one ends at the
  * nearest point of the columns' cone (a known one, and the KKT conditions on random ones);
  * the fit reproduces the moments of a positive rule among its candidates to 1e-12 and reports
- * moments no positive combination of them can carry. */
+ * a tolerance below rounding (through its LP path) and moments no positive combination of the
+ * candidates can carry. */
 #include "simplify/simplify_impl.h"
 #include "simplify_util.h"
 
@@ -166,6 +167,10 @@ static void fit(fcm_ctx *ctx)
     for (int i = 0; i < M; i++)
       err = fmax(err, fabs(mom[i] - b[i])), bmax = fmax(bmax, fabs(b[i]));
     TEST_TRUE(err <= 1e-12 * bmax);
+    /* a tolerance below rounding: NNLS stops at its optimum short of it, the SVD + LP path
+     * runs, and the failure says by how much the residual misses */
+    TEST_OK(ctx, fcm__simplify_fit(ctx, &box, N, pts, b, 1e-19, 1e-21, &f));
+    TEST_TRUE(!f.ok && strstr(f.message, "above 1e-19") != NULL);
 
     for (int j = 0; j < N; j++) /* candidates in x < 0.5, the rule's points moved to x > 0.6 */
       pts[3 * j] = j < NS ? 0.6 + 0.4 * pts[3 * j] : 0.5 * pts[3 * j];

@@ -1,9 +1,11 @@
 /* Moment fitting: a positive rule of at most M points chosen among candidate points, whose
- * moments equal given ones (computed elsewhere, e.g. exactly from a boundary surface). The
- * moment matrix P (M x n) of the candidates is reduced to its row space by a thin SVD,
- * P = U S V^T, and one LP finds a vertex of {w >= 0 : V_r^T w = S_r^-1 U_r^T b}, which has at
- * most r <= M positive entries; the weights are then verified (and re-fitted on their support
- * by least squares when the vertex misses the tolerance) against P w = b. */
+ * moments equal given ones (computed elsewhere, e.g. exactly from a boundary surface).
+ * Non-negative least squares on the candidates' moment matrix P (M x n) finds them first: its
+ * positive weights sit on independent columns, at most M. Only when it stops short of the
+ * tolerance without proving the moments out of reach, P is reduced to its row space by a thin
+ * SVD, P = U S V^T, and one LP finds a vertex of {w >= 0 : V_r^T w = S_r^-1 U_r^T b}, which has
+ * at most r <= M positive entries; its weights are verified (and re-fitted on their support by
+ * least squares when the vertex misses the tolerance) against P w = b. */
 #include "la/la_impl.h"
 #include "simplify/simplify_impl.h"
 
@@ -104,6 +106,7 @@ static void nnls_add(nnls_qr *s, int t, const double *a, double anorm, int *adde
   double *q = s->R + (size_t)np * (size_t)M, *v = s->v, *u = s->v + M;
   double *Qp = s->Q + (size_t)np * (size_t)M;
   *added = 0;
+  if (np == M) return; /* the passive columns span everything */
   fcm__gemv('T', M, M, 1.0, s->Q, M, a, 0.0, q); /* q = Q^T a, as R's next column */
   double nu = 0.0;                               /* the basis' values are O(1): no scaling needed */
   for (int i = np; i < M; i++)
