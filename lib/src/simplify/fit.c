@@ -106,9 +106,10 @@ static void nnls_add(nnls_qr *s, int t, const double *a, double anorm, int *adde
   double *q = s->R + (size_t)np * (size_t)M, *v = s->v, *u = s->v + M;
   double *Qp = s->Q + (size_t)np * (size_t)M;
   *added = 0;
-  if (np == M) return;                           /* the passive columns span everything */
-  fcm__gemv('T', M, M, 1.0, s->Q, M, a, 0.0, q); /* q = Q^T a, as R's next column */
-  double nu = 0.0;                               /* the basis' values are O(1): no scaling needed */
+  if (np == M) return; /* the passive columns span everything */
+  /* q = Q^T a, as R's next column; the basis' values are O(1): its norm needs no scaling */
+  fcm__gemv('T', M, M, 1.0, s->Q, M, a, 0.0, q);
+  double nu = 0.0;
   for (int i = np; i < M; i++)
     nu += q[i] * q[i];
   nu = sqrt(nu);
