@@ -1,5 +1,6 @@
 # Quadrature simplification (every path), its fallback, errors, allocation failures and
-# threads; stabilization points; the benchmark (label bench, not in the default run).
+# threads; stabilization points; NNLS and the moment fit; the benchmark (label bench, not in
+# the default run).
 # The default path up to strength 10; the GLPK reference paths up to 7 (10 under slow).
 fcm_add_test(simplify_rules_eliminate tests/simplify/rules.c ARGS eliminate)
 fcm_add_test(simplify_rules_lp tests/simplify/rules.c ARGS lp 7)
@@ -15,3 +16,4 @@ fcm_add_test(simplify_threads tests/simplify/threads.c)
 fcm_add_test(simplify_stabilization tests/simplify/stabilization.c)
 fcm_add_test(simplify_bench tests/simplify/bench_simplify.c LABELS bench TIMEOUT 1800)
 fcm_add_test(simplify_names tests/simplify/names.c)
+fcm_add_test(simplify_nnls tests/simplify/nnls.c)

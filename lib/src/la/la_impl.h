@@ -30,6 +30,9 @@ void fcm__gemv(char trans, int m, int n, double alpha, const double *a, int lda,
 void fcm__ger(int m, int n, double alpha, const double *x, const double *y, int incy, double *a,
               int lda);
 
+/* x = inv(A) x with A n x n upper triangular (lda), its diagonal nonzero: BLAS dtrsv. */
+void fcm__trsv_upper(int n, const double *a, int lda, double *x);
+
 /* B = alpha B inv(A) with A n x n unit lower triangular (B m x n, ldb): BLAS dtrsm
  * side right, lower, no transpose, unit diagonal. */
 void fcm__trsm_right_unit_lower(int m, int n, double alpha, const double *a, int lda, double *b,

@@ -72,6 +72,12 @@ void fcm__ger(int m, int n, double alpha, const double *x, const double *y, int 
   cblas_dger(CblasColMajor, m, n, alpha, x, 1, y, incy, a, lda);
 }
 
+void fcm__trsv_upper(int n, const double *a, int lda, double *x)
+{
+  if (n <= 0) return;
+  cblas_dtrsv(CblasColMajor, CblasUpper, CblasNoTrans, CblasNonUnit, n, a, lda, x, 1);
+}
+
 void fcm__trsm_right_unit_lower(int m, int n, double alpha, const double *a, int lda, double *b,
                                 int ldb)
 {

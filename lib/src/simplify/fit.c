@@ -1,9 +1,11 @@
 /* Moment fitting: a positive rule of at most M points chosen among candidate points, whose
- * moments equal given ones (computed elsewhere, e.g. exactly from a boundary surface). The
- * moment matrix P (M x n) of the candidates is reduced to its row space by a thin SVD,
- * P = U S V^T, and one LP finds a vertex of {w >= 0 : V_r^T w = S_r^-1 U_r^T b}, which has at
- * most r <= M positive entries; the weights are then verified (and re-fitted on their support
- * by least squares when the vertex misses the tolerance) against P w = b. */
+ * moments equal given ones (computed elsewhere, e.g. exactly from a boundary surface).
+ * Non-negative least squares on the candidates' moment matrix P (M x n) finds them first: its
+ * positive weights sit on independent columns, at most M. Only when it stops short of the
+ * tolerance without proving the moments out of reach, P is reduced to its row space by a thin
+ * SVD, P = U S V^T, and one LP finds a vertex of {w >= 0 : V_r^T w = S_r^-1 U_r^T b}, which has
+ * at most r <= M positive entries; its weights are verified (and re-fitted on their support by
+ * least squares when the vertex misses the tolerance) against P w = b. */
 #include "la/la_impl.h"
 #include "simplify/simplify_impl.h"
 
@@ -14,6 +16,11 @@
  * dropped: the moments given carry rounding, and dividing it by a tiny singular value would
  * make the LP's right-hand side noise. What is dropped is checked by the residual. */
 #define FIT_RANK_TOL 1e-11
+
+/* An NNLS minimum residual (relative, as fit_residual()) above which the LP is not tried: the
+ * LP differs from NNLS only by the moments it drops with the singular values below
+ * FIT_RANK_TOL, which change the residual by about that much. */
+#define FIT_INFEASIBLE 1e-8
 
 /* The NNLS polish works on at most this many columns (5 M for M <= 84, strength 6). */
 #define FCM__FIT_MAX_PASSIVE 420
@@ -69,78 +76,244 @@ cleanup:
   return st;
 }
 
-/* Non-negative least squares min ||A x - b||, x >= 0 (Lawson and Hanson 1974, ch. 23): A is
- * M x k (ld M), x (k) receives the solution, whose positive entries are the columns of its
- * passive set (linearly independent: at most M). Least squares on the passive set through
- * fcm__lstsq; at most 3 k outer steps. */
-static fcm_status nnls(fcm_ctx *ctx, int M, int k, const double *A, const double *b, double *x)
+/* ---- non-negative least squares (Lawson and Hanson 1974, ch. 23) ----
+ * The passive columns' QR factorization A_P = Q R is kept up to date, a Householder reflection
+ * per added column and Givens rotations per removed one: a step costs O(M^2) besides the
+ * gradient A^T r (O(M k)), where a fresh least-squares solve would cost O(M k^2). */
+
+/* A column whose part orthogonal to the passive columns is below this fraction of its norm is
+ * numerically in their span and not added: its weight would be rounding over that fraction. */
+#define NNLS_DEP_TOL 1e-10
+
+/* A column enters the passive set only when its gradient a_j^T r exceeds this fraction of
+ * ||a_j|| ||r||: below it, r is orthogonal to a_j up to rounding. */
+#define NNLS_GRAD_TOL 1e-12
+
+typedef struct nnls_qr {
+  int M, np;
+  double *Q;   /* M x M orthogonal */
+  double *R;   /* M x M, upper triangular in its first np columns */
+  double *qtb; /* Q^T b */
+  double *v;   /* 2 M scratch */
+  int *pos;    /* the passive columns of A, in R's column order */
+} nnls_qr;
+
+/* Append column t (a, of norm anorm) when it is independent of the passive columns and the
+ * least-squares weight it would get with them is positive; *added says whether it was. */
+static void nnls_add(nnls_qr *s, int t, const double *a, double anorm, int *added)
 {
-  fcm_status st = FCM_OK;
-  const int ld = FCM_MAX(M, k);
-  double *r = NULL, *Ap = NULL, *z = NULL;
-  int *pass = NULL, np = 0;
-  FCM_ALLOC(ctx, (size_t)M, r);
-  FCM_ALLOC(ctx, (size_t)M * (size_t)k, Ap);
-  FCM_ALLOC(ctx, (size_t)ld, z);
-  FCM_ALLOC(ctx, (size_t)k, pass);
-  double bmax = 0.0, amax = 0.0;
-  for (int i = 0; i < M; i++)
-    bmax = fmax(bmax, fabs(b[i]));
-  for (size_t i = 0; i < (size_t)M * (size_t)k; i++)
-    amax = fmax(amax, fabs(A[i]));
-  const double wtol = 1e-13 * amax * bmax;
-  memset(x, 0, (size_t)k * sizeof *x);
-  for (int outer = 0; outer < 3 * k; outer++) {
-    memcpy(r, b, (size_t)M * sizeof *r); /* r = b - A x */
-    fcm__gemv('N', M, k, -1.0, A, M, x, 1.0, r);
-    int t = -1;
-    double wbest = wtol;
-    for (int j = 0; j < k; j++) { /* the most promising column outside the passive set */
-      if (pass[j]) continue;
-      double w = 0.0;
-      for (int i = 0; i < M; i++)
-        w += A[i + (size_t)j * (size_t)M] * r[i];
-      if (w > wbest) wbest = w, t = j;
+  const int M = s->M, np = s->np, m = M - np;
+  double *q = s->R + (size_t)np * (size_t)M, *v = s->v, *u = s->v + M;
+  double *Qp = s->Q + (size_t)np * (size_t)M;
+  *added = 0;
+  if (np == M) return; /* the passive columns span everything */
+  /* q = Q^T a, as R's next column; the basis' values are O(1): its norm needs no scaling */
+  fcm__gemv('T', M, M, 1.0, s->Q, M, a, 0.0, q);
+  double nu = 0.0;
+  for (int i = np; i < M; i++)
+    nu += q[i] * q[i];
+  nu = sqrt(nu);
+  if (!(nu > NNLS_DEP_TOL * anorm)) return;
+  /* H = I - beta v v^T on rows np.. with H q = alpha e_np */
+  const double alpha = q[np] >= 0.0 ? -nu : nu;
+  double vv = 0.0, vb = 0.0;
+  for (int i = 0; i < m; i++)
+    v[i] = q[np + i];
+  v[0] -= alpha;
+  for (int i = 0; i < m; i++)
+    vv += v[i] * v[i], vb += v[i] * s->qtb[np + i];
+  const double beta = 2.0 / vv;
+  if (!((s->qtb[np] - beta * vb * v[0]) / alpha > 0.0)) return; /* its weight would be <= 0 */
+  for (int i = 0; i < m; i++)
+    s->qtb[np + i] -= beta * vb * v[i];
+  fcm__gemv('N', M, m, 1.0, Qp, M, v, 0.0, u); /* Q[:, np:] <- Q[:, np:] H */
+  fcm__ger(M, m, -beta, u, v, 1, Qp, M);
+  q[np] = alpha;
+  for (int i = np + 1; i < M; i++)
+    q[i] = 0.0;
+  s->pos[np] = t;
+  s->np++;
+  *added = 1;
+}
+
+/* Remove the passive column at position p (and its value in xp) and restore R's triangle. */
+static void nnls_remove(nnls_qr *s, int p, double *xp)
+{
+  const int M = s->M;
+  double *R = s->R, *Q = s->Q;
+  for (int j = p; j + 1 < s->np; j++) {
+    memcpy(R + (size_t)j * (size_t)M, R + (size_t)(j + 1) * (size_t)M, (size_t)(j + 2) * sizeof *R);
+    s->pos[j] = s->pos[j + 1];
+    xp[j] = xp[j + 1];
+  }
+  s->np--;
+  for (int j = p; j < s->np; j++) { /* Givens on rows j, j + 1: R is Hessenberg from p on */
+    const double a = R[j + (size_t)j * M], b = R[j + 1 + (size_t)j * M], h = hypot(a, b);
+    if (h == 0.0) continue;
+    const double c = a / h, sn = b / h;
+    for (int l = j; l < s->np; l++) {
+      double *r0 = R + j + (size_t)l * M, *r1 = r0 + 1;
+      const double t0 = *r0, t1 = *r1;
+      *r0 = c * t0 + sn * t1, *r1 = c * t1 - sn * t0;
     }
-    if (t < 0) break;
-    pass[t] = 1, np++;
-    for (int inner = 0; inner < k; inner++) {
-      int c = 0, idx[FCM__FIT_MAX_PASSIVE];
-      for (int j = 0; j < k && c < FCM__FIT_MAX_PASSIVE; j++)
-        if (pass[j]) {
-          idx[c] = j;
-          memcpy(Ap + (size_t)c * (size_t)M, A + (size_t)j * (size_t)M, (size_t)M * sizeof *Ap);
-          c++;
-        }
-      memcpy(z, b, (size_t)M * sizeof *z);
-      st = fcm__lstsq(ctx, M, c, 1, Ap, M, z, ld, -1.0, NULL);
-      if (st != FCM_OK) goto cleanup;
-      double alpha = 1.0;
-      int neg = 0;
-      for (int q = 0; q < c; q++)
-        if (!(z[q] > 0.0)) {
-          neg = 1;
-          const double xi = x[idx[q]], d = xi - z[q];
-          if (d > 0.0) alpha = fmin(alpha, xi / d);
-        }
-      if (!neg) {
-        for (int q = 0; q < c; q++)
-          x[idx[q]] = z[q];
-        break;
-      }
-      for (int q = 0; q < c; q++) { /* step towards z until a weight reaches 0; drop those */
-        const int j = idx[q];
-        x[j] += alpha * (z[q] - x[j]);
-        if (!(x[j] > 1e-15 * bmax)) x[j] = 0.0, pass[j] = 0, np--;
-      }
+    R[j + 1 + (size_t)j * M] = 0.0;
+    const double t0 = s->qtb[j], t1 = s->qtb[j + 1];
+    s->qtb[j] = c * t0 + sn * t1, s->qtb[j + 1] = c * t1 - sn * t0;
+    double *q0 = Q + (size_t)j * M, *q1 = q0 + M;
+    for (int i = 0; i < M; i++) {
+      const double u0 = q0[i], u1 = q1[i];
+      q0[i] = c * u0 + sn * u1, q1[i] = c * u1 - sn * u0;
     }
   }
+}
+
+/* z = R^-1 (Q^T b) on the passive set (back substitution). */
+static void nnls_solve(const nnls_qr *s, double *z)
+{
+  memcpy(z, s->qtb, (size_t)s->np * sizeof *z);
+  fcm__trsv_upper(s->np, s->R, s->M, z);
+}
+
+/* r = b - A x for x = xp on the passive set, from A (exact) or from the factorization; its
+ * largest entry (returned) and 2-norm (*rn). */
+static double nnls_residual(const nnls_qr *s, const double *A, const double *b, const double *xp,
+                            int exact, double *r, double *rn)
+{
+  const int M = s->M;
+  if (exact) {
+    memcpy(r, b, (size_t)M * sizeof *r);
+    for (int q = 0; q < s->np; q++)
+      for (int i = 0; i < M; i++)
+        r[i] -= A[i + (size_t)s->pos[q] * (size_t)M] * xp[q];
+  } else {
+    memset(r, 0, (size_t)M * sizeof *r);
+    fcm__gemv('N', M, M - s->np, 1.0, s->Q + (size_t)s->np * (size_t)M, M, s->qtb + s->np, 0.0, r);
+  }
+  double rmax = 0.0, n2 = 0.0;
+  for (int i = 0; i < M; i++)
+    rmax = fmax(rmax, fabs(r[i])), n2 += r[i] * r[i];
+  *rn = sqrt(n2);
+  return rmax;
+}
+
+/* The inner loop of Lawson and Hanson: move xp towards the passive set's least-squares
+ * solution, dropping the columns whose weight reaches 0 on the way, until it is positive. */
+static void nnls_inner(nnls_qr *s, double *xp, double *z)
+{
+  for (int inner = 0; inner <= s->M && s->np > 0; inner++) {
+    nnls_solve(s, z);
+    double alpha = 2.0;
+    int at = -1;
+    for (int q = 0; q < s->np; q++)
+      if (!(z[q] > 0.0)) {
+        const double d = xp[q] - z[q], a = d > 0.0 ? xp[q] / d : 0.0;
+        if (a < alpha) alpha = a, at = q;
+      }
+    if (at < 0) {
+      memcpy(xp, z, (size_t)s->np * sizeof *xp);
+      return;
+    }
+    for (int q = 0; q < s->np; q++)
+      xp[q] += alpha * (z[q] - xp[q]);
+    xp[at] = 0.0;
+    for (int q = s->np - 1; q >= 0; q--)
+      if (!(xp[q] > 0.0)) nnls_remove(s, q, xp);
+  }
+}
+
+fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const double *b,
+                              double stop, double *x, fcm__nnls_report *rep)
+{
+  fcm_status st = FCM_OK;
+  nnls_qr s = {M, 0, NULL, NULL, NULL, NULL, NULL};
+  double *r = NULL, *g = NULL, *norm = NULL, *inv = NULL, *xp = NULL, *z = NULL;
+  int *seen = NULL, *pas = NULL, exact = 0;
+  memset(rep, 0, sizeof *rep);
+  rep->residual = INFINITY;
+  FCM_ALLOC(ctx, (size_t)M * (size_t)M, s.Q);
+  FCM_ALLOC(ctx, (size_t)M * (size_t)M, s.R);
+  FCM_ALLOC(ctx, (size_t)M, s.qtb);
+  FCM_ALLOC(ctx, 2 * (size_t)M, s.v);
+  FCM_ALLOC(ctx, (size_t)M, s.pos);
+  FCM_ALLOC(ctx, (size_t)M, r);
+  FCM_ALLOC(ctx, (size_t)k, g);
+  FCM_ALLOC(ctx, (size_t)k, norm);
+  FCM_ALLOC(ctx, (size_t)k, inv);
+  FCM_ALLOC(ctx, (size_t)M, xp);
+  FCM_ALLOC(ctx, (size_t)M, z);
+  FCM_ALLOC(ctx, (size_t)k, seen);
+  FCM_ALLOC(ctx, (size_t)k, pas);
+  for (int i = 0; i < M; i++)
+    s.Q[i + (size_t)i * (size_t)M] = 1.0;
+  memcpy(s.qtb, b, (size_t)M * sizeof *b);
+  for (int j = 0; j < k; j++) {
+    double t = 0.0;
+    for (int i = 0; i < M; i++)
+      t += A[i + (size_t)j * (size_t)M] * A[i + (size_t)j * (size_t)M];
+    norm[j] = sqrt(t);
+    inv[j] = norm[j] > 0.0 ? 1.0 / norm[j] : 0.0;
+    seen[j] = pas[j] = -1; /* the iteration that tried j last, that found it passive */
+  }
+  for (int it = 0; it < 3 * k + M; it++) {
+    /* r = b - A x: xp being the passive set's least-squares solution, r = Q_2 Q_2^T b with
+     * Q_2 = Q's last M - np columns (cheaper near the end); confirmed from A and x when small */
+    double rn, rmax = nnls_residual(&s, A, b, xp, exact, r, &rn);
+    if (rmax <= stop && !exact) exact = 1, rmax = nnls_residual(&s, A, b, xp, exact, r, &rn);
+    rep->residual = rmax, rep->iterations = it;
+    if (rmax <= stop) {
+      rep->ok = 1;
+      break;
+    }
+    fcm__gemv('T', M, k, 1.0, A, M, r, 0.0, g);
+    for (int q = 0; q < s.np; q++)
+      pas[s.pos[q]] = it;
+    int added = 0;
+    while (!added) { /* the steepest column that can enter */
+      int t = -1;
+      double best = NNLS_GRAD_TOL * rn; /* the cosine of a_j and r, times ||r|| */
+      for (int j = 0; j < k; j++) {
+        const double c = g[j] * inv[j];
+        if (c > best && seen[j] != it && pas[j] != it) best = c, t = j;
+      }
+      if (t < 0) { /* optimal: no column lowers the residual */
+        rep->optimal = 1;
+        goto done;
+      }
+      seen[t] = it;
+      nnls_add(&s, t, A + (size_t)t * (size_t)M, norm[t], &added);
+    }
+    xp[s.np - 1] = 0.0;
+    nnls_inner(&s, xp, z);
+  }
+done:
+  rep->passive = s.np;
+  memset(x, 0, (size_t)k * sizeof *x);
+  for (int q = 0; q < s.np; q++)
+    x[s.pos[q]] = xp[q];
 cleanup:
+  fcm__free(ctx, s.Q);
+  fcm__free(ctx, s.R);
+  fcm__free(ctx, s.qtb);
+  fcm__free(ctx, s.v);
+  fcm__free(ctx, s.pos);
   fcm__free(ctx, r);
-  fcm__free(ctx, Ap);
+  fcm__free(ctx, g);
+  fcm__free(ctx, norm);
+  fcm__free(ctx, inv);
+  fcm__free(ctx, xp);
   fcm__free(ctx, z);
-  fcm__free(ctx, pass);
+  fcm__free(ctx, seen);
+  fcm__free(ctx, pas);
   return st;
+}
+
+/* The NNLS residual (of the moments scaled by scale) at which fit_residual() is half of tol. */
+static double nnls_stop(int M, const double *b, double scale, double tol, double floor)
+{
+  double bmax = 0.0;
+  for (int i = 0; i < M; i++)
+    bmax = fmax(bmax, fabs(b[i]));
+  return 0.5 * tol * scale * fmax(bmax, floor);
 }
 
 /* After a failed re-fit: NNLS on the vertex's support and up to 4 M other candidates spread
@@ -170,10 +343,11 @@ static fcm_status polish(fcm_ctx *ctx, int M, int n, const double *P, fcm__fit *
     memcpy(A + (size_t)c * (size_t)M, P + (size_t)sel[c] * (size_t)M, (size_t)M * sizeof *A);
   for (int i = 0; i < M; i++)
     bs[i] = scale * b[i];
-  FCM_TRY(ctx, nnls(ctx, M, FCM_MIN(k, FCM__FIT_MAX_PASSIVE), A, bs, x));
+  fcm__nnls_report nr;
+  FCM_TRY(ctx, fcm__simplify_nnls(ctx, M, k, A, bs, nnls_stop(M, b, scale, tol, floor), x, &nr));
   int count = 0, idx[FCM__FIT_MAX_PASSIVE];
   double w[FCM__FIT_MAX_PASSIVE];
-  for (int c = 0; c < FCM_MIN(k, FCM__FIT_MAX_PASSIVE); c++)
+  for (int c = 0; c < k; c++)
     if (x[c] > 0.0 && count < M) idx[count] = sel[c], w[count++] = x[c] / scale;
   const double r = fit_residual(M, P, count, idx, w, b, floor);
   if (count > 0 && count <= M && r <= tol) {
@@ -200,6 +374,29 @@ cleanup:
   return st;
 }
 
+/* NNLS on all candidates, f filled when its weights verify (f->ok). */
+static fcm_status nnls_fit(fcm_ctx *ctx, int M, int n, const double *P, const double *b,
+                           double scale, double tol, double floor, double *x, fcm__fit *f,
+                           fcm__nnls_report *nr)
+{
+  fcm_status st = FCM_OK;
+  double *bs = NULL;
+  FCM_ALLOC(ctx, (size_t)M, bs);
+  for (int i = 0; i < M; i++)
+    bs[i] = scale * b[i];
+  FCM_TRY(ctx, fcm__simplify_nnls(ctx, M, n, P, bs, nnls_stop(M, b, scale, tol, floor), x, nr));
+  if (!nr->ok) goto cleanup;
+  f->count = 0;
+  for (int j = 0; j < n; j++)
+    if (x[j] > 0.0) f->idx[f->count] = j, f->w[f->count++] = x[j] / scale;
+  f->residual = fit_residual(M, P, f->count, f->idx, f->w, b, floor);
+  f->ok = f->residual <= tol;
+  if (!f->ok) f->count = 0, f->residual = INFINITY;
+cleanup:
+  fcm__free(ctx, bs);
+  return st;
+}
+
 fcm_status fcm__simplify_fit(fcm_ctx *ctx, const fcm__cheb_box *box, int n, const double *pts,
                              const double *b, double tol, double atol, fcm__fit *f)
 {
@@ -217,9 +414,25 @@ fcm_status fcm__simplify_fit(fcm_ctx *ctx, const fcm__cheb_box *box, int n, cons
     return FCM_OK;
   }
   FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)n, P);
-  FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)n, G);
   FCM_ALLOC_RAW(ctx, fcm__simplify_moments_scratch(box->m), work);
+  FCM_ALLOC(ctx, (size_t)n, x);
   fcm__simplify_basis_points(box, n, pts, P, work);
+  /* weights of mean 1 (the LP's tolerances are absolute): b scaled by n / b_0, b_0 being the
+   * measure's total (the basis' first function is 1) */
+  const double scale = b[0] > 0.0 ? n / b[0] : 1.0, floor = atol / tol;
+  fcm__nnls_report nr;
+  FCM_TRY(ctx, nnls_fit(ctx, M, n, P, b, scale, tol, floor, x, f, &nr));
+  if (f->ok) goto cleanup;
+  /* the moments are farther from the candidates' cone than the LP's rank cut could explain */
+  const double nnls_rel = 0.5 * tol * nr.residual / nnls_stop(M, b, scale, tol, floor);
+  if (nr.optimal && nnls_rel > FIT_INFEASIBLE) {
+    snprintf(f->message, sizeof f->message,
+             "no positive combination of the %d candidates: the nearest (NNLS) leaves a "
+             "moment residual of %.3g",
+             n, nnls_rel);
+    goto cleanup;
+  }
+  FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)n, G);
   memcpy(G, P, (size_t)M * (size_t)n * sizeof *G);
   FCM_ALLOC(ctx, (size_t)k, s);
   FCM_ALLOC(ctx, (size_t)M * (size_t)k, u);
@@ -235,10 +448,6 @@ fcm_status fcm__simplify_fit(fcm_ctx *ctx, const fcm__cheb_box *box, int n, cons
   while (r < k && s[r] > FIT_RANK_TOL * s[0])
     r++;
   FCM_ALLOC(ctx, (size_t)r, rhs);
-  FCM_ALLOC(ctx, (size_t)n, x);
-  /* weights of mean 1 for the LP (its tolerances are absolute): b scaled by n / b_0, b_0 being
-   * the measure's total (the basis' first function is 1) */
-  const double scale = b[0] > 0.0 ? n / b[0] : 1.0;
   for (int i = 0; i < r; i++) {
     double t = 0.0;
     for (int j = 0; j < M; j++)
@@ -248,8 +457,9 @@ fcm_status fcm__simplify_fit(fcm_ctx *ctx, const fcm__cheb_box *box, int n, cons
   const fcm__lp_params prm = {20 * M + 1000, 0.0, 0};
   FCM_TRY(ctx, fcm__simplify_lp_solve(ctx, r, n, vt, k, rhs, &prm, x, &rep));
   if (!rep.ok) {
-    snprintf(f->message, sizeof f->message, "no positive combination of the %d candidates: %.100s",
-             n, rep.message);
+    snprintf(f->message, sizeof f->message,
+             "no positive combination of the %d candidates (NNLS residual %.3g): %.100s", n,
+             nnls_rel, rep.message);
     goto cleanup;
   }
   for (int j = 0; j < n; j++)
@@ -261,7 +471,6 @@ fcm_status fcm__simplify_fit(fcm_ctx *ctx, const fcm__cheb_box *box, int n, cons
       f->idx[f->count] = j;
       f->w[f->count++] = x[j] / scale;
     }
-  const double floor = atol / tol;
   f->residual = fit_residual(M, P, f->count, f->idx, f->w, b, floor);
   if (f->residual <= tol) {
     f->ok = 1;

@@ -175,6 +175,23 @@ typedef struct fcm__fit {
   char message[200];
 } fcm__fit;
 
+/* What fcm__simplify_nnls() found: ok when the residual reached the caller's level, optimal
+ * when it stopped short of it because no column lowers the residual (x is then the least-squares
+ * minimizer over x >= 0 up to rounding), the residual max_i |(b - A x)_i|, the passive set's size
+ * (the positive entries of x) and the outer iterations. */
+typedef struct fcm__nnls_report {
+  int ok, optimal, passive, iterations;
+  double residual;
+} fcm__nnls_report;
+
+/* Non-negative least squares min ||A x - b||_2, x >= 0 (Lawson and Hanson's active set method
+ * with the passive columns' QR factorization updated column by column): A is M x k (ld M), x
+ * (k) receives the iterate at which max_i |(b - A x)_i| <= stop (rep->ok = 1) or, when no
+ * column lowers the residual any more or after 3 k + M steps, the last one (rep->ok = 0). Its
+ * positive entries are linearly independent columns (at most M). Errors: FCM_ERR_ALLOC. */
+fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const double *b,
+                              double stop, double *x, fcm__nnls_report *rep);
+
 /* At most M of the n candidate points (x 3) with positive weights whose moments in the basis of
  * box equal b (M entries) to max(tol max|b|, atol): relative, down to the absolute level atol
  * of the moments' own rounding. Not fitting is not an error (ok = 0); errors: FCM_ERR_ALLOC,

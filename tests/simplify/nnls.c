@@ -1,0 +1,195 @@
+/* Non-negative least squares (fcm__simplify_nnls) and the moment fit built on it
+ * (fcm__simplify_fit): a tall system's unique non-negative solution is recovered; a wide
+ * consistent one is solved with at most M positive weights; an inconsistent one ends at the
+ * nearest point of the columns' cone (a known one, and the KKT conditions on random ones);
+ * the fit reproduces the moments of a positive rule among its candidates to 1e-12 and reports
+ * a tolerance below rounding (through its LP path) and moments no positive combination of the
+ * candidates can carry. */
+#include "simplify/simplify_impl.h"
+#include "simplify_util.h"
+
+#include <math.h>
+#include <string.h>
+
+/* max_i |(A x - b)_i|, A M x k */
+static double resid(int M, int k, const double *A, const double *x, const double *b)
+{
+  double m = 0.0;
+  for (int i = 0; i < M; i++) {
+    double s = -b[i];
+    for (int j = 0; j < k; j++)
+      s += A[i + (size_t)j * M] * x[j];
+    m = fmax(m, fabs(s));
+  }
+  return m;
+}
+
+/* Random A (M x k, entries in [-1, 1), first row 1) and b = A x* for x* >= 0 with npos
+ * positive entries (the first npos of a random order). */
+static void consistent(uint64_t seed, int M, int k, int npos, double *A, double *xs, double *b)
+{
+  uint64_t s = seed * 0x9E3779B97F4A7C15ULL + 7;
+  for (int j = 0; j < k; j++)
+    for (int i = 0; i < M; i++)
+      A[i + (size_t)j * M] = i == 0 ? 1.0 : 2.0 * util_rand(&s) - 1.0;
+  memset(xs, 0, (size_t)k * sizeof *xs);
+  for (int c = 0; c < npos; c++) {
+    int j = (int)(util_rand(&s) * k);
+    while (xs[j] > 0.0)
+      j = (j + 1) % k;
+    xs[j] = 0.5 + util_rand(&s);
+  }
+  for (int i = 0; i < M; i++) {
+    b[i] = 0.0;
+    for (int j = 0; j < k; j++)
+      b[i] += A[i + (size_t)j * M] * xs[j];
+  }
+}
+
+static void tall_unique(fcm_ctx *ctx)
+{
+  enum { M = 30, K = 20 };
+  double A[M * K], xs[K], b[M], x[K];
+  fcm__nnls_report rep;
+  for (uint64_t seed = 1; seed <= 5; seed++) {
+    consistent(seed, M, K, 12, A, xs, b); /* A has full column rank: x* is the one solution */
+    TEST_OK(ctx, fcm__simplify_nnls(ctx, M, K, A, b, 1e-13, x, &rep));
+    TEST_TRUE(rep.ok && rep.residual <= 1e-13);
+    for (int j = 0; j < K; j++)
+      TEST_NEAR(x[j], xs[j], 0.0, 1e-10);
+  }
+}
+
+static void wide_consistent(fcm_ctx *ctx)
+{
+  enum { M = 35, K = 200 };
+  static double A[M * K];
+  double xs[K], b[M], x[K];
+  fcm__nnls_report rep;
+  for (uint64_t seed = 11; seed <= 15; seed++) {
+    consistent(seed, M, K, 60, A, xs, b);
+    const double stop = 1e-12 * b[0];
+    TEST_OK(ctx, fcm__simplify_nnls(ctx, M, K, A, b, stop, x, &rep));
+    TEST_TRUE(rep.ok);
+    int npos = 0;
+    for (int j = 0; j < K; j++) {
+      TEST_TRUE(x[j] >= 0.0);
+      npos += x[j] > 0.0;
+    }
+    TEST_TRUE(npos == rep.passive && npos <= M);
+    TEST_TRUE(resid(M, K, A, x, b) <= stop);
+  }
+}
+
+/* Columns (1, 0) and (1, 1), b = (0, 1) outside their cone: the nearest point of the cone is
+ * (1/2, 1/2) on the second column, residual 1/2 in each entry. */
+static void known_optimum(fcm_ctx *ctx)
+{
+  const double A[4] = {1.0, 0.0, 1.0, 1.0}, b[2] = {0.0, 1.0};
+  double x[2];
+  fcm__nnls_report rep;
+  TEST_OK(ctx, fcm__simplify_nnls(ctx, 2, 2, A, b, 1e-12, x, &rep));
+  TEST_TRUE(!rep.ok && rep.optimal);
+  TEST_NEAR(x[0], 0.0, 0.0, 0.0);
+  TEST_NEAR(x[1], 0.5, 0.0, 1e-15);
+  TEST_NEAR(rep.residual, 0.5, 0.0, 1e-15);
+}
+
+/* Random inconsistent problems: the result satisfies the KKT conditions of min ||A x - b||,
+ * x >= 0: g = A^T (b - A x) is 0 where x > 0 and <= 0 where x = 0 (to rounding). */
+static void kkt(fcm_ctx *ctx)
+{
+  enum { M = 20, K = 40 };
+  double A[M * K], b[M], x[K], r[M];
+  fcm__nnls_report rep;
+  int infeasible = 0;
+  for (uint64_t seed = 21; seed <= 30; seed++) {
+    uint64_t s = seed;
+    for (int i = 0; i < M * K; i++)
+      A[i] = 2.0 * util_rand(&s) - 1.0;
+    for (int i = 0; i < M; i++)
+      b[i] = 2.0 * util_rand(&s) - 1.0;
+    TEST_OK(ctx, fcm__simplify_nnls(ctx, M, K, A, b, 1e-13, x, &rep));
+    for (int i = 0; i < M; i++) {
+      r[i] = b[i];
+      for (int j = 0; j < K; j++)
+        r[i] -= A[i + (size_t)j * M] * x[j];
+    }
+    if (rep.ok) {
+      TEST_TRUE(resid(M, K, A, x, b) <= 1e-13);
+      continue;
+    }
+    TEST_TRUE(rep.optimal);
+    infeasible++;
+    for (int j = 0; j < K; j++) {
+      double g = 0.0;
+      for (int i = 0; i < M; i++)
+        g += A[i + (size_t)j * M] * r[i];
+      TEST_TRUE(x[j] >= 0.0);
+      if (x[j] > 0.0)
+        TEST_NEAR(g, 0.0, 0.0, 1e-12);
+      else
+        TEST_TRUE(g <= 1e-12);
+    }
+  }
+  TEST_TRUE(infeasible >= 3); /* the KKT branch was exercised */
+}
+
+/* The fit on random candidates in [0, 1]^3 (basis on that box): the moments of a positive
+ * rule on 50 of them are reproduced by at most M positive weights; the moments of points with
+ * x > 0.6 cannot be carried by candidates with x < 0.5 (the first moment in x alone forbids). */
+static void fit(fcm_ctx *ctx)
+{
+  enum { N = 300, NS = 50 };
+  static double pts[3 * N], w[N];
+  const double lo[3] = {0, 0, 0};
+  for (int m = 2; m <= 6; m += 2) {
+    fcm__cheb_box box;
+    box.m = m;
+    box.num_basis = fcm__simplify_num_basis(m);
+    for (int d = 0; d < 3; d++)
+      box.scale[d] = 2.0, box.shift[d] = -1.0;
+    const int M = box.num_basis;
+    static double work[16384];
+    double b[84], mom[84];
+    int idx[84];
+    double fw[84];
+    TEST_TRUE(M <= 84 && fcm__simplify_moments_scratch(m) <= 16384);
+    util_random_box((uint64_t)m, N, lo, 1.0, 1.0, pts, w);
+    fcm__simplify_moments(&box, NS, pts, NULL, w, b, work); /* the first NS candidates' rule */
+    fcm__fit f = {0, 0, idx, fw, 0.0, ""};
+    TEST_OK(ctx, fcm__simplify_fit(ctx, &box, N, pts, b, 1e-12, 1e-14, &f));
+    TEST_TRUE(f.ok && f.count >= 1 && f.count <= M && f.residual <= 1e-12);
+    double err = 0.0, bmax = 0.0;
+    for (int c = 0; c < f.count; c++)
+      TEST_TRUE(fw[c] > 0.0 && idx[c] >= 0 && idx[c] < N && (c == 0 || idx[c] > idx[c - 1]));
+    fcm__simplify_moments(&box, f.count, pts, idx, fw, mom, work);
+    for (int i = 0; i < M; i++)
+      err = fmax(err, fabs(mom[i] - b[i])), bmax = fmax(bmax, fabs(b[i]));
+    TEST_TRUE(err <= 1e-12 * bmax);
+    /* a tolerance below rounding: NNLS stops at its optimum short of it, the SVD + LP path
+     * runs, and the failure says by how much the residual misses */
+    TEST_OK(ctx, fcm__simplify_fit(ctx, &box, N, pts, b, 1e-19, 1e-21, &f));
+    TEST_TRUE(!f.ok && strstr(f.message, "above 1e-19") != NULL);
+
+    for (int j = 0; j < N; j++) /* candidates in x < 0.5, the rule's points moved to x > 0.6 */
+      pts[3 * j] = j < NS ? 0.6 + 0.4 * pts[3 * j] : 0.5 * pts[3 * j];
+    fcm__simplify_moments(&box, NS, pts, NULL, w, b, work);
+    TEST_OK(ctx, fcm__simplify_fit(ctx, &box, N - NS, pts + 3 * NS, b, 1e-12, 1e-14, &f));
+    TEST_TRUE(!f.ok && strstr(f.message, "no positive combination") != NULL);
+  }
+}
+
+int main(void)
+{
+  fcm_ctx *ctx = NULL;
+  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  if (!ctx) return TEST_RESULT();
+  tall_unique(ctx);
+  wide_consistent(ctx);
+  known_optimum(ctx);
+  kkt(ctx);
+  fit(ctx);
+  fcm_ctx_destroy(&ctx);
+  return TEST_RESULT();
+}
