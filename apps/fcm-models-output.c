@@ -215,7 +215,7 @@ int models_write_png(const models_settings *o, const model_pair *pairs, int npai
       "set multiplot layout 1,3 title 'fcm-models: surface path (new) and volume path "
       "(old), %s'\n"
       "set style data histograms\nset style histogram clustered gap 1\n"
-      "set style fill solid 0.8 border -1\nset logscale y\nset grid ytics\n"
+      "set style fill solid 0.8 border -1\nset logscale y\nset grid ytics\nset tmargin 4\n"
       "set xtics rotate by -30 font ',9'\nset key top left\n",
       fcm_element_get_info(o->element)->name);
   for (int panel = 0; panel < 3; panel++) {
