@@ -171,12 +171,13 @@ static int json_escape(const char *s, char *out, size_t cap)
 static int scene_json(const model_input *m, double h, fcm_element_type element, int path,
                       int fill_holes, double scale, int steps, char *out, size_t cap)
 {
-  char file[8192];
-  if (!json_escape(m->path, file, sizeof file)) return 0;
+  char file[8192], name[160];
+  if (!json_escape(m->path, file, sizeof file) || !json_escape(m->name, name, sizeof name))
+    return 0;
   const double hold = m->lo[1] + 0.11 * (m->hi[1] - m->lo[1]);
   const int n = snprintf(
       out, cap,
-      "{\"version\": 1, \"name\": \"%s\",\n"
+      "{\"version\": 1, \"name\": \"%s-%s\",\n"
       " \"background\": {\"element\": \"%s\", \"fit_background\": {\"cell_size\": %.17g, "
       "\"margin\": %.17g}},\n"
       " \"geometry\": {\"surface\": \"%s\", \"fill_holes\": %s, \"transform\": {\"scale\": "
@@ -187,7 +188,7 @@ static int scene_json(const model_input *m, double h, fcm_element_type element, 
       " \"effects\": [{\"gravity\": {\"acceleration\": [0, -9.81, 0]}},\n"
       "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, %.17g, 0], \"normal\": [0, -1, "
       "0]}}}}]}\n",
-      path == PATH_OLD ? "old" : "new", fcm_element_get_info(element)->name, h, 0.5 * h, file,
+      name, path == PATH_OLD ? "old" : "new", fcm_element_get_info(element)->name, h, 0.5 * h, file,
       fill_holes ? "true" : "false", scale, path == PATH_OLD ? ", \"volume_mesh\": true" : "",
       path == PATH_OLD ? ", \"moments\": \"volume\"" : "", 0.01 * steps, hold);
   return n > 0 && (size_t)n < cap;
@@ -311,7 +312,9 @@ void models_run_config(const model_input *m, double h, fcm_element_type element,
   }
   r->ok = 1;
   goto done;
-failed:
+failed: /* the whole message here; the row's note may cut it */
+  fprintf(stderr, PROG ": %s %s: %s\n", m->name, path == PATH_OLD ? "old" : "new",
+          fcm_ctx_error_message(ctx));
   snprintf(r->note, sizeof r->note, "%s", fcm_ctx_error_message(ctx));
 done:
   fcm_simulation_destroy(&sim);

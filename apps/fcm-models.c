@@ -73,14 +73,20 @@ static void usage(FILE *f, const cli_option *opts)
 
 /* ------------------------------------------------------------- models */
 
-/* The model's file stem ("dir/bunny.obj" -> "bunny"). */
+/* The model's name: its file stem ("dir/bunny.obj" -> "bunny"), at most 48 characters, those
+ * outside [A-Za-z0-9_.-] replaced by '_' (it names the scene, with "-new" or "-old"). */
 static void file_stem(const char *path, char *out, size_t cap)
 {
   const char *b = strrchr(path, '/');
   b = b ? b + 1 : path;
-  snprintf(out, cap, "%s", b);
+  snprintf(out, cap < 49 ? cap : 49, "%s", b);
   char *dot = strrchr(out, '.');
   if (dot && dot != out) *dot = 0;
+  for (char *c = out; *c; c++)
+    if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') ||
+          *c == '_' || *c == '-' || *c == '.'))
+      *c = '_';
+  if (!out[0] || !strcmp(out, ".") || !strcmp(out, "..")) snprintf(out, cap, "model");
 }
 
 /* The bounding box of the model's surface after the scale; 0 with a message. */
