@@ -431,8 +431,8 @@ static int models_main(models_settings *o, const model_names *mn)
         if (path == PATH_OLD && (o->new_only || !gmsh)) {
           memset(r, 0, sizeof *r);
           snprintf(r->note, sizeof r->note, "%s",
-                   o->new_only ? "skipped: --new-only"
-                               : "skipped: the volume path needs Gmsh "
+                   o->new_only ? "--new-only"
+                               : "the volume path needs Gmsh "
                                  "(fcm_surface_meshing_available() is 0)");
           continue;
         }
