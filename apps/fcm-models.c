@@ -446,6 +446,13 @@ static int models_main(models_settings *o, const model_names *mn)
       p->moment_diff = moment_diff(&p->run[PATH_NEW], &p->run[PATH_OLD]);
       models_print_pair(o, p);
     }
+  double worst = -1.0;
+  for (int i = 0; i < npairs; i++)
+    worst = fmax(worst, pairs[i].moment_diff);
+  if (worst >= 0.0)
+    printf("\nlargest difference of the two paths' global moments: %.2e of the volume (%s 1e-12, "
+           "the exactness both paths claim)\n",
+           worst, worst <= 1e-12 ? "within" : "ABOVE");
   if (o->csv && !models_write_csv(o, pairs, npairs)) code = 1;
   if (o->png && !models_write_png(o, pairs, npairs)) code = 1;
 done:
