@@ -168,8 +168,8 @@ static int json_escape(const char *s, char *out, size_t cap)
 /* The scene of one configuration: the model on a fitted grid of cells h (margin h/2), SNH,
  * gravity, the bottom 11 % of the model held, dt 0.01 s; the volume path adds the Gmsh volume
  * mesh and sub-tet rules. */
-static int scene_json(const model_input *m, double h, fcm_element_type element, int path,
-                      int fill_holes, double scale, int steps, char *out, size_t cap)
+static int scene_json(const model_input *m, double h, fcm_element_type element, int path, int steps,
+                      char *out, size_t cap)
 {
   char file[8192], name[160];
   if (!json_escape(m->path, file, sizeof file) || !json_escape(m->name, name, sizeof name))
@@ -189,7 +189,7 @@ static int scene_json(const model_input *m, double h, fcm_element_type element, 
       "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, %.17g, 0], \"normal\": [0, -1, "
       "0]}}}}]}\n",
       name, path == PATH_OLD ? "old" : "new", fcm_element_get_info(element)->name, h, 0.5 * h, file,
-      fill_holes ? "true" : "false", scale, path == PATH_OLD ? ", \"volume_mesh\": true" : "",
+      m->fill_holes ? "true" : "false", m->scale, path == PATH_OLD ? ", \"volume_mesh\": true" : "",
       path == PATH_OLD ? ", \"moments\": \"volume\"" : "", 0.01 * steps, hold);
   return n > 0 && (size_t)n < cap;
 }
@@ -266,7 +266,7 @@ static void setup_figures(const fcm_simulation *sim, model_run *r)
 }
 
 void models_run_config(const model_input *m, double h, fcm_element_type element, int path,
-                       int fill_holes, double scale, int steps, model_run *r)
+                       int steps, model_run *r)
 {
   memset(r, 0, sizeof *r);
   r->ran = 1;
@@ -281,7 +281,7 @@ void models_run_config(const model_input *m, double h, fcm_element_type element,
     snprintf(r->note, sizeof r->note, "cannot create a context");
     return;
   }
-  if (!scene_json(m, h, element, path, fill_holes, scale, steps, json, sizeof json)) {
+  if (!scene_json(m, h, element, path, steps, json, sizeof json)) {
     snprintf(r->note, sizeof r->note, "the model's path is too long or holds control characters");
     goto done;
   }

@@ -242,7 +242,7 @@ static int child_main(int argc, char **argv)
   m.fill_holes = atoi(argv[14]);
   m.scale = strtod(argv[15], NULL);
   static model_run r;
-  models_run_config(&m, h, type, path, m.fill_holes, m.scale, atoi(argv[16]), &r);
+  models_run_config(&m, h, type, path, atoi(argv[16]), &r);
   size_t put = 0;
   while (put < sizeof r) {
     const ssize_t k = write(fd, (const char *)&r + put, sizeof r - put);

@@ -93,7 +93,7 @@ int models_write_bumpy(const char *path, long long triangles);
 
 /** Run one configuration in this process and fill *r (the child's work). */
 void models_run_config(const model_input *m, double h, fcm_element_type element, int path,
-                       int fill_holes, double scale, int steps, model_run *r);
+                       int steps, model_run *r);
 
 /** The ball study on the sizes n[0..count); rows into out. 1 when every size ran. */
 int models_ball_study(const int *n, int count, fcm_element_type element, ball_row *out);
