@@ -12,8 +12,12 @@ fcm_add_app(fcm-condition apps/fcm-condition.c apps/fcm-condition-study.c apps/f
 fcm_add_app(fcm-converge apps/fcm-converge.c apps/fcm-converge-study.c apps/fcm-converge-output.c)
 fcm_add_app(fcm-cut apps/fcm-cut.c)
 fcm_add_app(fcm-scaling apps/fcm-scaling.c apps/fcm-scaling-study.c apps/fcm-scaling-output.c)
+fcm_add_app(fcm-models apps/fcm-models.c apps/fcm-models-run.c apps/fcm-models-output.c)
+# fcm-models finds its built-in pebble (apps/scenes/models/pebble.obj) in the source tree.
+target_compile_definitions(fcm-models PRIVATE FCM_MODELS_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 # Every program waits passively in OpenMP and selects the CPU's OpenBLAS kernels unless the user
 # says otherwise (apps/app_env.h).
-foreach(app fcm-sim fcm-rulegen fcm-quadrature fcm-condition fcm-converge fcm-cut fcm-scaling)
+foreach(app fcm-sim fcm-rulegen fcm-quadrature fcm-condition fcm-converge fcm-cut fcm-scaling
+            fcm-models)
   target_sources(${app} PRIVATE apps/app_env.c)
 endforeach()

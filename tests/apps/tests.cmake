@@ -146,3 +146,12 @@ endif()
 # push reports zero.
 fcm_add_test(app_sim_inversion tests/apps/inversion_app.c LABELS app
              ARGS $<TARGET_FILE:fcm-sim> ${work})
+# fcm-models: a small generated model (the bumpy sphere at 4,800 triangles, one cell size)
+# on both paths (the volume path only with Gmsh): CSV columns consistent (rules time > 0, final
+# points per cut cell <= M, equal cut cells, moments of the two paths within 1e-10), the PNG,
+# bad options exit 2; the full ball study with its claim (exponent of
+# rule time against cut cells <= 1.1) under bench.
+fcm_add_test(app_models tests/apps/models_app.c LABELS app TIMEOUT 300
+             ARGS small $<TARGET_FILE:fcm-models> ${work})
+fcm_add_test(app_models_ball tests/apps/models_app.c LABELS bench TIMEOUT 3600
+             ARGS ball $<TARGET_FILE:fcm-models> ${work})
