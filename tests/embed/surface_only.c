@@ -7,7 +7,9 @@
  *   every cut cell fitted on surface moments (no fallback is possible);
  * - a body sticking out of the grid: the volume beyond each side computed from the surface
  *   equals the one computed from the tets (1e-12);
- * - what needs the volume mesh refuses it: a cut, the volume path (FCM_ERR_UNSUPPORTED). */
+ * - what needs the volume mesh refuses it: a cut, the volume path (FCM_ERR_UNSUPPORTED);
+ * - a single tet whose acute vertices end in small corner pieces of cells (2 % of a cell, a
+ *   sharp tip in a corner of its box), on Hex8 and Tet4 grids: every cut cell fitted, exact. */
 #include "fcm/fcm.h"
 #include "../geom/exact.h"
 #include "test.h"
@@ -114,6 +116,31 @@ int main(void)
   fcm_cell_rules_destroy(&a);
   fcm_cell_rules_destroy(&b);
   fcm_mesh_destroy(&mesh);
+
+  /* the tips of a tet: the corner (2, 0, 0) in cell [1.75, 2.25] x [-0.25, 0.25]^2 */
+  {
+    const double tx[12] = {0, 0, 0, 2, 0, 0, 0, 2, 0, 0, 0, 2};
+    const fcm_index tc[4] = {0, 1, 2, 3};
+    const double tlo[3] = {-0.25, -0.25, -0.25}, thi[3] = {2.25, 2.25, 2.25};
+    const fcm_index tn[3] = {5, 5, 5};
+    const fcm_element_type tt[2] = {FCM_ELEMENT_HEX8, FCM_ELEMENT_TET4};
+    fcm_geometry *tet = NULL, *tsurf = NULL;
+    fcm_surface *ts = NULL;
+    TEST_OK(ctx, fcm_geometry_create(ctx, FCM_ELEMENT_TET4, 4, tx, 1, tc, &tet));
+    if (tet) {
+      TEST_OK(ctx, fcm_surface_create(ctx, 4, tx, fcm_geometry_num_boundary_triangles(tet),
+                                      fcm_geometry_boundary_triangles(tet), &ts));
+      TEST_OK(ctx, fcm_geometry_create_from_surface(ctx, ts, &mo, &tsurf));
+    }
+    for (int t = 0; t < 2 && tsurf; t++) {
+      TEST_OK(ctx, fcm_mesh_create_box(ctx, tt[t], tlo, thi, tn, &mesh));
+      if (mesh) moments(mesh, tsurf, tet);
+      fcm_mesh_destroy(&mesh);
+    }
+    fcm_surface_destroy(&ts);
+    fcm_geometry_destroy(&tsurf);
+    fcm_geometry_destroy(&tet);
+  }
   fcm_surface_destroy(&s);
   fcm_geometry_destroy(&surf);
   fcm_geometry_destroy(&tets);

@@ -3,8 +3,10 @@
  * rule of at most M points per kind, fitted on candidate points inside the material to those
  * moments (fcm__simplify_fit). The candidates are the points of a grid over the material's
  * bounding box in the cell, fine enough that about CAND_PER_MOMENT x M of them fall inside the
- * material, and points on the material's boundary; a fit that fails is retried once with GROW
- * times as many. */
+ * material, and points on the material's boundary; a fit that fails is retried with GROW
+ * times as many, up to ATTEMPTS grids in all. The moments of a small piece with a sharp
+ * corner (the tip of a body's acute vertex in a cell) sit close to the corner, which only a
+ * fine grid's points reach. */
 #include "embed/rules_impl.h"
 #include "simplify/simplify_impl.h"
 
@@ -14,7 +16,7 @@
 
 /* Grid candidates aimed at per moment, boundary points kept per moment, the finer grid's
  * factor on a retry, the largest grid per axis. */
-enum { CAND_PER_MOMENT = 2, BOUNDARY_PER_MOMENT = 1, GROW = 4, GRID_MAX = 64 };
+enum { CAND_PER_MOMENT = 2, BOUNDARY_PER_MOMENT = 1, GROW = 4, ATTEMPTS = 4, GRID_MAX = 64 };
 
 /* Absolute moment residual accepted, per unit of the material box's reference volume: ten times
  * the moments' own rounding. */
@@ -208,15 +210,14 @@ fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
   int todo[FCM_RULE_KIND_COUNT], left = 0;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     left += todo[k] = B->tet_rule[k] != NULL;
-  /* each kind on the first grid, then the kinds that failed on the finer one: a kind's rules
+  /* each kind on the first grid, then the kinds that failed on the finer ones: a kind's rules
    * do not depend on the other kind */
-  for (int attempt = 0; attempt < 2 && left > 0; attempt++) {
-    const double target = CAND_PER_MOMENT * Mmax * (attempt ? GROW : 1);
+  for (int attempt = 0, grow = 1; attempt < ATTEMPTS && left > 0; attempt++, grow *= GROW) {
+    const double target = (double)CAND_PER_MOMENT * Mmax * grow;
     const int n = grid_size(box, vref, target);
     int count;
     FCM_TRY(ctx, check_fit_memory(B, cell, ws, n, Mmax));
-    FCM_TRY(ctx, grid_candidates(B, cell, ws, box, n,
-                                 BOUNDARY_PER_MOMENT * Mmax * (attempt ? GROW : 1), &count));
+    FCM_TRY(ctx, grid_candidates(B, cell, ws, box, n, BOUNDARY_PER_MOMENT * Mmax * grow, &count));
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
       if (!todo[k]) continue;
       int done;
