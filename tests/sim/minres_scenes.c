@@ -64,11 +64,13 @@ static const char *object_end(const char *s)
 }
 
 /* The scene text with its top-level "solver" object replaced by `solver` (which gets the
- * scene's "newton" object appended when it has one). malloc'ed. */
+ * scene's "newton" object appended when it has one), full Newton in both runs (a kept
+ * factorization changes the path within the Newton tolerance, not the linear solver's
+ * agreement this compares). malloc'ed. */
 static char *with_solver(const char *json, const char *solver)
 {
   const char *key = strstr(json, "\"solver\"");
-  const char *newton = NULL, *newton_end = NULL, *obj = NULL, *end = NULL;
+  const char *newton = NULL, *newton_open = NULL, *newton_end = NULL, *obj = NULL, *end = NULL;
   if (key) {
     obj = strchr(key, '{');
     end = obj ? object_end(obj) : NULL;
@@ -77,18 +79,20 @@ static char *with_solver(const char *json, const char *solver)
     if (nk && nk < end) {
       newton = nk;
       const char *no = strchr(nk, '{');
+      newton_open = no;
       newton_end = no ? object_end(no) : NULL;
       if (!newton_end || newton_end > end) return NULL;
     }
   }
-  size_t n = strlen(json) + strlen(solver) + (newton ? (size_t)(newton_end - newton) : 0) + 64;
+  size_t n = strlen(json) + strlen(solver) + (newton ? (size_t)(newton_end - newton) : 0) + 128;
   char *out = malloc(n);
   if (!out) return NULL;
   char inner[512];
   if (newton)
-    snprintf(inner, sizeof inner, "{%s, %.*s}", solver, (int)(newton_end - newton), newton);
+    snprintf(inner, sizeof inner, "{%s, \"newton\": {\"reuse_factorization\": false, %.*s}", solver,
+             (int)(newton_end - newton_open - 1), newton_open + 1);
   else
-    snprintf(inner, sizeof inner, "{%s}", solver);
+    snprintf(inner, sizeof inner, "{%s, \"newton\": {\"reuse_factorization\": false}}", solver);
   if (key)
     snprintf(out, n, "%.*s%s%s", (int)(obj - json), json, inner, end);
   else { /* insert after the opening brace of the document */

@@ -50,7 +50,10 @@ int main(int argc, char **argv)
   double *cu = calloc((size_t)n, sizeof *cu), *cv = calloc((size_t)n, sizeof *cv), ct = 0;
   long long cs = 0;
   for (int s = 1; s <= 20; s++) {
-    if (s == 11) fcm_integrator_get_state(integ, cu, cv, &ct, &cs); /* checkpoint */
+    if (s == 11) { /* checkpoint: the state, and no kept factorization, as a resumed run */
+      fcm_integrator_get_state(integ, cu, cv, &ct, &cs);
+      fcm_integrator_drop_factorization(integ);
+    }
     fcm_step_info info;
     TEST_OK(ctx, fcm_integrator_step(integ, &info));
     newton += info.newton_iterations;

@@ -390,6 +390,7 @@ static int solve_ball(fcm_ctx *ctx, const problem *p, fcm_integrator_kind kind,
   o.kind = kind;
   o.dt = kind == FCM_INTEGRATOR_STATIC ? 1.0 : 0.01;
   o.linear_solver = solver;
+  o.reuse_factorization = 0; /* full Newton on every solver: their results are compared */
   o.preconditioner = pc;
   o.krylov_rtol = 1e-12;
   o.krylov_max_iterations = 5000;

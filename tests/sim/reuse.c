@@ -31,11 +31,11 @@ static fcm_integrator_options options(int reuse, double contraction)
 
 /* STEPS steps from rest under gravity; the states after each step into U (STEPS x n). */
 static void run(fcm_ctx *ctx, const fcm_space *space, const fcm_material *mat, fcm_index nfix,
-                const fcm_index *fix, fcm_integrator_options o, double *U, totals *t)
+                const fcm_index *fix, fcm_integrator_options o, double gz, double *U, totals *t)
 {
   fcm_integrator *integ = NULL;
   newton_log log;
-  const double g[3] = {0.0, 0.0, -9.81};
+  const double g[3] = {0.0, 0.0, gz};
   fcm_motion fixed = fcm_motion_default();
   memset(t, 0, sizeof *t);
   o.monitor = newton_log_fn;
@@ -81,9 +81,9 @@ int main(int argc, char **argv)
          *Us = malloc(sizeof *Us * (size_t)n * STEPS);
   TEST_TRUE(Uf && Uk && Us);
   totals full, kept, strict;
-  run(ctx, space, &mat, nfix, fix, options(0, 0.25), Uf, &full);
-  run(ctx, space, &mat, nfix, fix, options(1, 0.25), Uk, &kept);
-  run(ctx, space, &mat, nfix, fix, options(1, 1e-9), Us, &strict);
+  run(ctx, space, &mat, nfix, fix, options(0, 0.25), -9.81, Uf, &full);
+  run(ctx, space, &mat, nfix, fix, options(1, 0.25), -9.81, Uk, &kept);
+  run(ctx, space, &mat, nfix, fix, options(1, 1e-9), -9.81, Us, &strict);
   printf("full Newton: %lld iterations, %lld factorizations, %lld tangents\n", full.newton,
          full.factorizations, full.tangents);
   printf("kept factorization: %lld iterations (%lld on a kept one), %lld factorizations, %lld "
@@ -103,9 +103,22 @@ int main(int argc, char **argv)
   }
   TEST_TRUE(full.reused == 0 && full.factorizations == full.newton);
   TEST_TRUE(kept.reused > 0 && 3 * kept.factorizations <= full.factorizations);
+  /* kept across steps, not only within one */
+  TEST_TRUE(kept.factorizations < STEPS / 2);
   TEST_TRUE(kept.tangents < full.tangents);
   /* a contraction no iteration reaches: each kept solve is followed by a new factorization */
   TEST_TRUE(strict.reused > 0 && strict.reused <= strict.factorizations);
+
+  /* no backtracking and no halving allowed, ten times the gravity: every step still converges
+   * on full steps with the kept factorization in use */
+  {
+    fcm_integrator_options o = options(1, 0.25);
+    totals nb;
+    o.max_backtracks = 0;
+    o.max_halvings = 0;
+    run(ctx, space, &mat, nfix, fix, o, -98.1, Us, &nb);
+    TEST_TRUE(nb.reused > 0);
+  }
 
   /* static steps (no mass to keep the iterates close) never reuse */
   {

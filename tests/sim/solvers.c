@@ -69,6 +69,7 @@ int main(int argc, char **argv)
     fcm_material snh = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 1.0e6, 0.3, 1000.0};
     fcm_integrator_options o = fcm_integrator_options_default();
     o.dt = 0.01;
+    o.reuse_factorization = 0; /* full Newton (the kept factorization: tests/sim/reuse.c) */
     TEST_OK(ctx, make(ctx, space, &snh, &o, nfix, fix, grav, &integ));
     long long updates = 0;
     for (int s = 0; s < 20; s++) {

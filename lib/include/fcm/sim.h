@@ -528,7 +528,9 @@ FCM_API fcm_status fcm_integrator_reaction(const fcm_integrator *integ, int id, 
  * reuse_factorization): the next Newton iteration assembles and factors anew. A host that
  * saves the state to resume from it calls this when it saves, so that the run that goes on
  * and the one resumed later take the same iterations (fcm_simulation_write_checkpoint()
- * does). Accepts NULL. */
+ * does). With a distributed backend every process must call it at the same point between
+ * steps (their Newton iterations must agree, or the collective solves deadlock), not only
+ * the one that writes. Accepts NULL. */
 FCM_API void fcm_integrator_drop_factorization(fcm_integrator *integ);
 
 /** Copy the state out (checkpoint): u, v (num_dofs each, either may be NULL), t, steps

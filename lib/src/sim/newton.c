@@ -433,7 +433,8 @@ static fcm_status newton_start(fcm_integrator *I, double h, eval_out *cur, sim_s
       I->uhat[i] = I->un[i] + h * I->v[i];
       I->u[i] = I->is_con[i] ? I->un[i] : I->uhat[i];
     }
-  const int tangent = !I->linear && !kept_usable(I, h);
+  /* a predictor iteration (constraints off their values) cannot use the kept factorization */
+  const int tangent = !I->linear && !(kept_usable(I, h) && constraints_met(I, I->u));
   FCM_TRY(I->ctx, evaluate(I, h, I->u, tangent, I->fint, I->g, cur, stats));
   I->h_state = I->linear ? (I->h_state == SIM_H_SYSTEM ? SIM_H_SYSTEM : SIM_H_INVALID)
                          : (cur->finite && tangent ? SIM_H_TANGENT : SIM_H_INVALID);
@@ -601,6 +602,14 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
     FCM_TRY(I->ctx, newton_direction(I, h, predictor, &slope, &its, &used_kept, reason, stats));
     if (*reason != FCM_STEP_NONE) break;
     FCM_TRY(I->ctx, line_search(I, h, predictor, &cur, slope, r, &trial, &lr, stats));
+    if (!lr.accepted && used_kept) {
+      /* the kept factorization's direction found no decrease: a fresh one at this iterate */
+      I->kept = 0;
+      its = 0;
+      FCM_TRY(I->ctx, newton_direction(I, h, predictor, &slope, &its, &used_kept, reason, stats));
+      if (*reason != FCM_STEP_NONE) break;
+      FCM_TRY(I->ctx, line_search(I, h, predictor, &cur, slope, r, &trial, &lr, stats));
+    }
     if (!lr.accepted) {
       I->h_state = SIM_H_INVALID;
       *reason = trial.finite ? FCM_STEP_LINE_SEARCH_FAILED : FCM_STEP_NONFINITE;
