@@ -469,6 +469,7 @@ done:
 int main(int argc, char **argv)
 {
   app_env_init(argc, argv);
+  fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   if (argc > 1 && !strcmp(argv[1], CHILD_FLAG)) return child_main(argc, argv);
   static models_settings o;
   raw_options w;

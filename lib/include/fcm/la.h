@@ -189,12 +189,13 @@ FCM_API void fcm_direct_get_info(const fcm_direct *solver, fcm_direct_info *info
  */
 FCM_API void fcm_direct_destroy(fcm_direct **solver);
 
-/** Threads OpenBLAS may use inside one BLAS/LAPACK call (process-wide OpenBLAS state,
- * changed only when you call this). fcm parallelizes over cells with OpenMP (cut-cell
- * rules, Schwarz blocks, assembly) and calls LAPACK inside those loops; with the
- * pthreads build of OpenBLAS each such call may start its own threads and
- * oversubscribe the cores, so programs that use those loops should set 1 here (the
- * fcm programs do). n < 1 only queries. @return the previous count. Not thread safe. */
+/** Threads OpenBLAS may use inside one BLAS/LAPACK call (process-wide OpenBLAS state).
+ * fcm parallelizes over cells with OpenMP (cut-cell rules, Schwarz blocks, assembly) and
+ * calls LAPACK inside those loops; with the pthreads build of OpenBLAS each such call may
+ * start its own threads and oversubscribe the cores, so programs that use those loops should
+ * set 1 here (the fcm programs do). The cut-cell rule builds (fcm_cell_rules_create*()) set 1
+ * for the duration of their cell loops themselves and restore the count after them. n < 1
+ * only queries. @return the previous count. Not thread safe. */
 FCM_API int fcm_blas_set_num_threads(int n);
 
 /** Instruction-set levels of x86-64 BLAS kernels and CPUs, lowest first. */

@@ -1,6 +1,7 @@
 /* FCM_CELL_SIMPLIFY_AUTO: whether simplifying the cut-cell rules pays, from a deterministic
  * model of the simplification time against the assembly time of the points it removes. */
 #include "embed/rules_impl.h"
+#include "fcm/la.h"
 
 #include <math.h>
 #include <omp.h>
@@ -45,6 +46,8 @@ static fcm_status auto_finish(const build *B, const fcm_cell_rules *R, int nthre
   fcm_ctx *ctx = B->ctx;
   fcm__loop loop;
   fcm__loop_begin(ctx, &loop);
+  /* one BLAS thread inside the threads (fcm__embed_run_cells) */
+  const int blas_threads = nthreads > 1 ? fcm_blas_set_num_threads(1) : 0;
 #pragma omp parallel num_threads(nthreads)
   {
     cell_sums mine;
@@ -63,6 +66,7 @@ static fcm_status auto_finish(const build *B, const fcm_cell_rules *R, int nthre
 #pragma omp critical(fcm_embed_auto_sum)
     sums->time_simplify += mine.time_simplify;
   }
+  if (blas_threads > 1) fcm_blas_set_num_threads(blas_threads);
   FCM_TRY(ctx, fcm__loop_end(&loop, NULL));
 cleanup:
   return st;

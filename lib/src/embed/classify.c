@@ -2,6 +2,7 @@
  * geometry, split it into material pieces where cuts reach it, classify it (uncut, cut,
  * dropped) and hand its cut pieces to the rule building; all cells in parallel. */
 #include "embed/rules_impl.h"
+#include "fcm/la.h"
 
 #include <math.h>
 #include <omp.h>
@@ -410,6 +411,9 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
   fcm__loop loop;
   fcm__loop_begin(ctx, &loop);
   memset(sums, 0, sizeof *sums);
+  /* the cells' dense solves run inside the threads: BLAS threads of their own would fight
+   * them for the cores (4 times slower on 2 cores), so one BLAS thread for the loop */
+  const int blas_threads = nthreads > 1 ? fcm_blas_set_num_threads(1) : 0;
 #pragma omp parallel num_threads(nthreads)
   {
     cell_sums mine;
@@ -457,6 +461,7 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
       sums->time_simplify += mine.time_simplify;
     }
   }
+  if (blas_threads > 1) fcm_blas_set_num_threads(blas_threads);
   FCM_TRY(ctx, fcm__loop_end(&loop, NULL));
   if (opt->progress) opt->progress(nc, nc, opt->progress_user);
 cleanup:
