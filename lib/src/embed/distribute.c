@@ -53,9 +53,7 @@ fcm_status fcm__embed_crop_geometry(fcm_ctx *ctx, const fcm_mesh *mesh, const fc
                                     fcm_geometry **out)
 {
   fcm_status st = FCM_OK;
-  double *boxes = NULL;
-  fcm_index nbox = 0;
-  fcm_aabb_tree *tree = NULL, *tri_tree = NULL;
+  const fcm_aabb_tree *tree = NULL, *tri_tree = NULL; /* the geometry's own */
   unsigned char *keep_cell = NULL, *keep_tri = NULL;
   fcm__idbuf ids = {NULL, 0, 0};
   FCM_CHECK(out, ctx, FCM_ERR_ARG, "embed crop: output pointer is NULL");
@@ -64,11 +62,8 @@ fcm_status fcm__embed_crop_geometry(fcm_ctx *ctx, const fcm_mesh *mesh, const fc
             "embed crop: NULL argument (ctx, mesh, geometry, options, classify)");
   FCM_TRY(ctx, fcm__embed_check_options(ctx, opts, 1));
   const fcm_index nc = fcm_mesh_num_cells(mesh);
-  FCM_TRY(ctx, fcm__geom_boxes(ctx, geom, 0, &boxes, &nbox));
-  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &tree));
-  FCM_FREE(ctx, boxes);
-  FCM_TRY(ctx, fcm__geom_boxes(ctx, geom, 1, &boxes, &nbox));
-  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &tri_tree));
+  FCM_TRY(ctx, fcm__geom_tree(ctx, geom, 0, &tree));
+  FCM_TRY(ctx, fcm__geom_tree(ctx, geom, 1, &tri_tree));
   FCM_ALLOC(ctx, (size_t)geom->num_cells + 1, keep_cell);
   FCM_ALLOC(ctx, (size_t)geom->num_tris + 1, keep_tri);
   /* the surface path reads lines through the whole body: it needs every boundary triangle */
@@ -100,11 +95,8 @@ fcm_status fcm__embed_crop_geometry(fcm_ctx *ctx, const fcm_mesh *mesh, const fc
   g->has_outside = 1;
 cleanup:
   if (st != FCM_OK) fcm_geometry_destroy(out);
-  fcm__free(ctx, boxes);
   fcm__free(ctx, keep_cell);
   fcm__free(ctx, keep_tri);
   fcm__geom_idbuf_free(ctx, &ids);
-  fcm_aabb_tree_destroy(&tree);
-  fcm_aabb_tree_destroy(&tri_tree);
   return st;
 }

@@ -22,10 +22,10 @@ struct fcm__embed_finder {
   fcm_ctx *ctx;
   const fcm_mesh *mesh;
   const fcm_geometry *geom;
-  fcm_aabb_tree *tree;     /* boxes of the geometry's cells */
-  const fcm_cell_rules *R; /* NULL until set */
-  fcm_aabb_tree *cut_tree; /* boxes of R's cut triangles (NULL: none) */
-  double on_cut;           /* a point this close to a cut triangle lies on it */
+  const fcm_aabb_tree *tree; /* boxes of the geometry's cells (the geometry's own tree) */
+  const fcm_cell_rules *R;   /* NULL until set */
+  fcm_aabb_tree *cut_tree;   /* boxes of R's cut triangles (NULL: none) */
+  double on_cut;             /* a point this close to a cut triangle lies on it */
   fcm__idbuf cand;
   fcm__embed_ws ws;
   fcm__parts *P;     /* the parts of `cell` when has_parts */
@@ -49,8 +49,6 @@ fcm_status fcm__embed_finder_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fc
 {
   fcm_status st = FCM_OK;
   fcm__embed_finder *f = NULL;
-  double *boxes = NULL;
-  fcm_index nbox = 0;
   FCM_CHECK(mesh && geom && out, ctx, FCM_ERR_ARG, "embed finder: NULL mesh, geometry or output");
   *out = NULL;
   FCM_ALLOC(ctx, 1, f);
@@ -66,12 +64,10 @@ fcm_status fcm__embed_finder_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fc
     const double nc = (double)FCM_MAX(fcm_mesh_num_cells(mesh), 1);
     f->on_cut = 2.0 * FCM__EMBED_MATCH_RTOL * (v > 0.0 ? cbrt(v / nc) : side / nc);
   }
-  FCM_TRY(ctx, fcm__geom_boxes(ctx, geom, 0, &boxes, &nbox));
-  FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nbox, boxes, &f->tree));
+  FCM_TRY(ctx, fcm__geom_tree(ctx, geom, 0, &f->tree));
   *out = f;
   f = NULL;
 cleanup:
-  fcm__free(ctx, boxes);
   fcm__embed_finder_destroy(&f);
   return st;
 }
@@ -80,7 +76,6 @@ void fcm__embed_finder_destroy(fcm__embed_finder **finder)
 {
   if (!finder || !*finder) return;
   fcm__embed_finder *f = *finder;
-  fcm_aabb_tree_destroy(&f->tree);
   fcm_aabb_tree_destroy(&f->cut_tree);
   fcm__geom_idbuf_free(f->ctx, &f->cand);
   fcm__embed_ws_free(f->ctx, &f->ws);
