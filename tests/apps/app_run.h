@@ -1,5 +1,5 @@
-/* Running a program from an app test: the exit status of a shell command and whether a path
- * exists (the program's output, or its absence after a refused run). */
+/* Running a program from an app test: the exit status of a shell command, whether a path
+ * exists (the program's output, or its absence after a refused run), a field of a CSV line. */
 #ifndef FCM_TEST_APP_RUN_H
 #define FCM_TEST_APP_RUN_H
 
@@ -35,6 +35,20 @@ static inline int app_has_warning(const char *path)
     found = strstr(line, "warning") && !strstr(line, "warning: BLAS: ");
   if (f) fclose(f);
   return found;
+}
+
+/* Field k (from 0) of a CSV line without quoting into buf (cap bytes, cut to fit). */
+static inline void field(const char *line, int k, char *buf, size_t cap)
+{
+  const char *p = line;
+  for (int i = 0; i < k && p; i++) {
+    p = strchr(p, ',');
+    if (p) p++;
+  }
+  size_t m = 0;
+  while (p && *p && *p != ',' && *p != '\n' && m + 1 < cap)
+    buf[m++] = *p++;
+  buf[m] = 0;
 }
 
 #endif

@@ -57,19 +57,6 @@ enum {
   C_MDIFF
 };
 
-static void field(const char *line, int k, char *buf, size_t cap)
-{
-  const char *p = line;
-  for (int i = 0; i < k && p; i++) {
-    p = strchr(p, ',');
-    if (p) p++;
-  }
-  size_t m = 0;
-  while (p && *p && *p != ',' && *p != '\n' && m + 1 < cap)
-    buf[m++] = *p++;
-  buf[m] = 0;
-}
-
 static int read_rows(const char *path, const char *header, mrow *rows, int cap)
 {
   FILE *f = fopen(path, "r");

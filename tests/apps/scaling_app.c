@@ -40,20 +40,6 @@ typedef struct srow {
   double factor, setup, solve, peak, relres, diff;
 } srow;
 
-/* Field k of a CSV line (no quoting in this file) into buf. */
-static void field(const char *line, int k, char *buf, size_t cap)
-{
-  const char *p = line;
-  for (int i = 0; i < k && p; i++) {
-    p = strchr(p, ',');
-    if (p) p++;
-  }
-  size_t m = 0;
-  while (p && *p && *p != ',' && *p != '\n' && m + 1 < cap)
-    buf[m++] = *p++;
-  buf[m] = 0;
-}
-
 static double num(const char *line, int k)
 {
   char b[64];
