@@ -212,7 +212,8 @@ int main(void)
         fclose(mf);
         TEST_TRUE(text && strstr(text, "cut cells from the boundary surface") &&
                   strstr(text, "0 of them fell back") && strstr(text, "set-up    [s] mesh") &&
-                  strstr(text, "step      [s]") && strstr(text, "each: assembly"));
+                  strstr(text, "step      [s]") && strstr(text, "each: assembly") &&
+                  strstr(text, "cells of the surface path are fitted either way"));
         free(text);
       }
     }
