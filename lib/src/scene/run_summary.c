@@ -196,17 +196,19 @@ static void rules_lines(const fcm_simulation *S, FILE *f, const fcm_cell_rules_s
       snprintf(what, sizeof what, "%s simplification", kinds[k]);
       if (!fcm_cell_rules_has_kind(S->rules, (fcm_rule_kind)k))
         snprintf(b, sizeof b, "(no %s rules built)", kinds[k]);
-      else if (q->simplify == FCM_CELL_SIMPLIFY_AUTO) {
-        auto_line(&S->auto_uses, (fcm_rule_kind)k, d, rs->points_initial[k], b, sizeof b);
+      else {
+        if (q->simplify == FCM_CELL_SIMPLIFY_AUTO)
+          auto_line(&S->auto_uses, (fcm_rule_kind)k, d, rs->points_initial[k], b, sizeof b);
+        else
+          snprintf(b, sizeof b, "%s (scene), %.3g core-s", fcm_cell_simplify_name(q->simplify),
+                   d->time_simplify);
         const long long fitted = (long long)(rs->num_surface_cells - rs->num_surface_fallbacks);
         if (fitted > 0) /* their candidates are no rule: the fit is not optional */
           snprintf(b + strlen(b), sizeof b - strlen(b),
-                   "; it decides for the volume path's cells only, the %lld cells of the surface "
-                   "path are fitted either way",
+                   "; this decides for the volume path's cells only, the %lld cells of the "
+                   "surface path are fitted either way",
                    fitted);
-      } else
-        snprintf(b, sizeof b, "%s (scene), %.3g core-s", fcm_cell_simplify_name(q->simplify),
-                 d->time_simplify);
+      }
       line(f, d->simplified, what, b);
     }
   }
