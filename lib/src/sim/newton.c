@@ -310,8 +310,8 @@ cleanup:
 static int kept_usable(const fcm_integrator *I, double h)
 {
   return I->opts.reuse_factorization && !I->linear && h > 0.0 &&
-         I->opts.linear_solver == FCM_LINEAR_DIRECT && I->kept && I->kept_ok && I->kept_h == h &&
-         I->kept_con == I->con_version && I->kept_damp == I->damp_version;
+         I->opts.linear_solver == FCM_LINEAR_DIRECT && I->kept && I->kept_ok && I->key_h == h &&
+         I->key_con == I->con_version && I->key_damp == I->damp_version;
 }
 
 /* Build the eliminated Newton system for the current iterate and factor it, or reuse the
@@ -377,12 +377,7 @@ static fcm_status build_system(fcm_integrator *I, double h, int predictor, int p
   I->kept = 0;
   FCM_TRY(I->ctx, fcm__sim_factor(I, reason, stats));
   if (*reason != FCM_STEP_NONE || projected) I->h_state = SIM_H_INVALID;
-  if (*reason == FCM_STEP_NONE) {
-    I->kept = I->kept_ok = 1;
-    I->kept_h = h;
-    I->kept_con = I->con_version;
-    I->kept_damp = I->damp_version;
-  }
+  I->kept = I->kept_ok = *reason == FCM_STEP_NONE; /* for the keys above */
 cleanup:
   if (st != FCM_OK) I->h_state = SIM_H_INVALID, I->kept = 0;
   return st;
@@ -670,7 +665,6 @@ static fcm_status update_damping(fcm_integrator *I, fcm_step_reason *reason, sim
     dv[e] = o->rayleigh_stiffness * dv[e] + o->rayleigh_mass * mv[e];
   I->damp_version++;
   if (!I->linear) I->h_state = SIM_H_INVALID;
-  I->kept = 0;
 cleanup:
   return st;
 }

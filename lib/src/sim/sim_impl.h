@@ -152,12 +152,10 @@ struct fcm_integrator {
   double key_h;
   long long key_con, key_damp;
   long long damp_version;
-  /* A kept factorization (reuse_factorization): the direct solver's factor of the Newton
-   * matrix at an earlier iterate, for h, constraints and damping of the keys below; kept_ok =
-   * 0 once an iteration solved with it fell short of reuse_contraction. */
+  /* A kept factorization (reuse_factorization): the solver's factor of the Newton matrix at
+   * an earlier iterate, for the h, constraints and damping of the keys above; kept_ok = 0 once
+   * an iteration solved with it fell short of reuse_contraction. */
   int kept, kept_ok;
-  double kept_h;
-  long long kept_con, kept_damp;
 
   fcm_integrator_setup_info setup_info; /* what the setup assembled */
 
