@@ -1,17 +1,20 @@
-/* fem module: the interface of a distributed solver backend (internal, no public API), in the
- * spirit of SUNDIALS' SUNLinearSolver and PETSc's KSP types: an object with operations the
- * time integrator (lib/src/sim) calls without knowing which backend it is: sum a partial
- * assembly over the processes, prepare the solves with a Newton matrix, solve, follow a new
- * DOF numbering (a cut), release. It lives here, below petsc and sim, because its operations
- * are those of a linear solver on a space's DOF numbering (a sparse matrix, vectors, a space):
- * an implementation (the PETSc adapter of lib/src/petsc) then includes nothing of the modules
- * above it, and the layer that chooses the backend (the scene's runner) hands it to the
- * integrator.
+/* fem module: the interface of a solver backend (internal, no public API), in the spirit of
+ * SUNDIALS' SUNLinearSolver and PETSc's KSP types: an object with operations the time
+ * integrator (lib/src/sim) calls without knowing which backend it is: sum a partial assembly
+ * over the processes, prepare the solves with a Newton matrix, solve, follow a new DOF
+ * numbering (a cut), release. Two implementations: the serial backend every integrator starts
+ * with (lib/src/sim/integrator_backend.c: one process, whose sums are the values themselves,
+ * owning every DOF; no factor and solve of its own: the integrator's options choose its serial
+ * direct, Krylov or multigrid solver) and the distributed PETSc adapter (lib/src/petsc). It lives
+ * here, below petsc and sim, because its operations are those of a linear solver on a space's DOF
+ * numbering (a sparse matrix, vectors, a space): an implementation (the PETSc adapter of
+ * lib/src/petsc) then includes nothing of the modules above it, and the layer that chooses the
+ * backend (the scene's runner) hands it to the integrator.
  *
  * Contract. Every process runs the same integrator on the same replicated DOF numbering, but
  * its space's cell rules carry points on the process's own cells only, so every assembly
  * (mass, loads, energy, force, tangent, boundary terms) is the process's partial sum. With a
- * backend set:
+ * distributed backend set:
  * - the integrator sums the partial scalars and vectors over the processes right after each
  *   assembly (reduce: energies, the internal force, the loads, the mass and damping matrices'
  *   products; n doubles at most), so the Newton loop, line search, stopping rules, reactions
@@ -61,7 +64,8 @@ struct fcm__backend {
    * and message of the first failing one), then sum values[0 .. count) over the processes in
    * place (the same result, bit for bit, on every process). Collective. */
   fcm_status (*reduce)(void *user, fcm_status st, double *values, fcm_index count);
-  /* Prepare the solves with the eliminated Newton matrix: the sum over the processes of each
+  /* Prepare the solves with the eliminated Newton matrix (factor and solve are NULL in the
+   * serial backend only): the sum over the processes of each
    * process's PARTIAL eliminated matrix H (see above; the backend adds them). H has the rows
    * of the integrator's space (fcm__space_num_rows(): a distributed run's local space has the
    * rows of its local copies only, row r being DOF fcm__space_row_dof(space, r)) and a column

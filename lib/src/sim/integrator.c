@@ -141,6 +141,7 @@ fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space, const fcm
   FCM_ALLOC(ctx, I->n, I->u);
   FCM_ALLOC(ctx, I->n, I->v);
   FCM_ALLOC(ctx, I->n, I->load_prev);
+  FCM_TRY(ctx, fcm__sim_serial_backend(I));
   *integ = I;
   I = NULL;
 cleanup:
@@ -189,7 +190,7 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   fcm_schwarz_destroy(&I->schwarz);
   fcm_mg_destroy(&I->mg);
   fcm_assembly_workspace_destroy(&I->aws);
-  if (I->has_backend && I->backend.destroy) I->backend.destroy(I->backend.user);
+  if (I->backend.destroy) I->backend.destroy(I->backend.user);
   fcm__free(ctx, I);
   *integ = NULL;
 }
@@ -613,9 +614,8 @@ cleanup:
   return st;
 }
 
-/* Set-up phase: the pristine copy (linear), the damping matrix, and the solvers: the
- * direct solver is analyzed once here (the UMFPACK fallback on demand); Schwarz flags
- * the small cut cells. */
+/* Set-up phase: the pristine copy (linear), the damping matrix, and the linear solver
+ * (fcm__sim_solver_setup()). */
 static fcm_status setup_solvers(fcm_integrator *I)
 {
   fcm_status st = FCM_OK;
@@ -625,32 +625,7 @@ static fcm_status setup_solvers(fcm_integrator *I)
   if (o->kind == FCM_INTEGRATOR_BACKWARD_EULER &&
       (o->rayleigh_mass > 0.0 || o->rayleigh_stiffness > 0.0))
     FCM_TRY(ctx, fcm__space_matrix_create_rows(I->space, &I->D));
-  if (I->has_backend) {
-    /* the backend solves: no serial solver */
-  } else if (o->linear_solver == FCM_LINEAR_DIRECT) {
-    if (o->direct_method == FCM_DIRECT_CHOLMOD) {
-      FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, I->H, &I->chol));
-      FCM_TRY(ctx, fcm_direct_analyze(I->chol));
-    } else {
-      FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_UMFPACK, I->H, &I->umf));
-      FCM_TRY(ctx, fcm_direct_analyze(I->umf));
-    }
-  } else if (o->linear_solver == FCM_LINEAR_MULTIGRID) {
-    FCM_ALLOC(ctx, I->n, I->mg_r); /* the hierarchy itself: at the first solve (linsolve.c) */
-  } else {
-    FCM_TRY(ctx, fcm_krylov_create(ctx, I->n, &I->krylov));
-    if (o->preconditioner == FCM_PRECOND_SCHWARZ) {
-      const fcm_mesh *mesh = fcm_space_mesh(I->space);
-      const fcm_cell_rules *rules = fcm_space_cell_rules(I->space);
-      fcm_index nc = fcm_mesh_num_cells(mesh);
-      FCM_ALLOC(ctx, nc, I->schwarz_flag);
-      if (rules)
-        for (fcm_index c = 0; c < nc; c++)
-          I->schwarz_flag[c] = fcm_space_cell_active(I->space, c) &&
-                               fcm_cell_rules_class(rules, c) == FCM_CELL_CUT &&
-                               fcm_cell_rules_volume_fraction(rules, c) < o->schwarz_theta;
-    }
-  }
+  FCM_TRY(ctx, fcm__sim_solver_setup(I));
 cleanup:
   return st;
 }
@@ -692,7 +667,7 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
   FCM_CHECK(I->n > 0, ctx, FCM_ERR_ARG, "integrator: the space has no DOFs");
   /* a local space (a distributed run's own and ghost cells) gives partial sums only: the
    * backend sums them; without one the results would silently miss the other cells */
-  FCM_CHECK(!I->space->is_local || I->has_backend, ctx, FCM_ERR_ARG,
+  FCM_CHECK(!I->space->is_local || fcm__integrator_distributed(I, NULL), ctx, FCM_ERR_ARG,
             "integrator: the space is a local space (a distributed run's cells only) but the "
             "integrator has no distributed backend; build the space with fcm_space_create() "
             "or fcm_space_create_embedded()");
@@ -969,7 +944,8 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   for (int k = 0; st == FCM_OK && k < old->num_bcons; k++)
     st = fcm_integrator_add_boundary_constraint(I, old->bcons[k].select, old->bcons[k].select_user,
                                                 &old->bcons[k].motion, &old->bcons[k].opts, NULL);
-  if (old->has_backend) {
+  {
+    /* the old integrator's backend for the new space (the serial one stays serial) */
     fcm__backend b;
     memset(&b, 0, sizeof b);
     FCM_CHECK(old->backend.setup, ctx, FCM_ERR_UNSUPPORTED,
@@ -977,7 +953,6 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
     FCM_TRY(ctx, old->backend.setup(old->backend.user, st, space, &b));
     FCM_TRY(ctx, fcm__integrator_set_backend(I, &b));
   }
-  FCM_TRY(ctx, st);
   FCM_TRY(ctx, fcm_integrator_setup(I));
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, u);
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, v);

@@ -1,9 +1,69 @@
-/* sim module: the integrator's side of a distributed solver backend (fcm__backend,
- * fem/fem_backend.h): attaching it, and the sums and agreements the integrator and its
- * callers make through it (sim/sim_backend.h). */
+/* sim module: the integrator's side of a solver backend (fcm__backend, fem/fem_backend.h):
+ * the serial backend every integrator starts with, attaching a distributed one, and the sums
+ * and agreements the integrator and its callers make through it (sim/sim_backend.h). */
 #include "sim/sim_impl.h"
 
 #include <string.h>
+
+/* The serial backend's reduce: one process holds the whole sum, and its status is everyone's. */
+static fcm_status serial_reduce(void *user, fcm_status st, double *values, fcm_index count)
+{
+  (void)user;
+  (void)values;
+  (void)count;
+  return st;
+}
+
+static fcm_status serial_setup(void *user, fcm_status st, const fcm_space *space,
+                               fcm__backend *out);
+
+/* The serial backend: one process (the root, rank 0 of 1) owning every DOF; no factor and
+ * solve of its own: the integrator's options choose its serial solver (linsolve.c). */
+static void serial_backend(fcm__backend *b, const unsigned char *owned)
+{
+  memset(b, 0, sizeof *b);
+  b->root = 1;
+  b->rank = 0;
+  b->nprocs = 1;
+  b->owned = owned;
+  b->reduce = serial_reduce;
+  b->setup = serial_setup;
+}
+
+/* A cut's new integrator keeps the serial backend it starts with (fcm__integrator_set_backend()
+ * takes this one as set). */
+static fcm_status serial_setup(void *user, fcm_status st, const fcm_space *space, fcm__backend *out)
+{
+  (void)user;
+  (void)space;
+  serial_backend(out, NULL);
+  return st;
+}
+
+static int is_serial(const fcm__backend *b)
+{
+  return b->reduce == serial_reduce;
+}
+
+/* The status a reduce returned from `in`: a failure is traced where the reduce reports it (a
+ * distributed backend's agreed one, also this process's own; the serial backend only hands
+ * the caller's own back, traced where it arose). */
+static fcm_status reduced(fcm_integrator *I, fcm_status in, fcm_status st)
+{
+  if (st != FCM_OK && (st != in || !is_serial(&I->backend)))
+    fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
+  return st;
+}
+
+fcm_status fcm__sim_serial_backend(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  FCM_ALLOC(I->ctx, (size_t)I->n + 1, I->owned);
+  memset(I->owned, 1, (size_t)I->n + 1);
+  serial_backend(&I->backend, I->owned);
+cleanup:
+  return st;
+}
 
 fcm_status fcm__integrator_set_backend(fcm_integrator *I, const fcm__backend *b)
 {
@@ -12,22 +72,17 @@ fcm_status fcm__integrator_set_backend(fcm_integrator *I, const fcm__backend *b)
     if (b && b->destroy) b->destroy(b->user);
     FCM_CHECK(0, I ? I->ctx : NULL, FCM_ERR_ARG, "integrator: NULL integrator or backend");
   }
-  if (I->is_setup || I->has_backend || !b->reduce || !b->factor || !b->solve || !b->owned) {
+  if (is_serial(b)) return FCM_OK; /* the one every integrator starts with */
+  if (I->is_setup || !is_serial(&I->backend) || !b->reduce || !b->factor || !b->solve ||
+      !b->owned) {
     if (b->destroy) b->destroy(b->user);
     FCM_CHECK(0, I->ctx, FCM_ERR_ARG,
               "integrator: a backend needs reduce, factor, solve and the owned DOFs, and is set "
               "once, before fcm_integrator_setup()");
   }
-  I->owned = fcm__calloc(I->ctx, (size_t)I->n + 1, 1);
-  if (!I->owned) {
-    if (b->destroy) b->destroy(b->user);
-    FCM_CHECK(0, I->ctx, FCM_ERR_ALLOC, "integrator: out of memory (%lld owned flags)",
-              (long long)I->n);
-  }
   memcpy(I->owned, b->owned, (size_t)I->n);
   I->backend = *b;
   I->backend.owned = I->owned;
-  I->has_backend = 1;
 cleanup:
   return st;
 }
@@ -48,21 +103,19 @@ cleanup:
 
 const fcm__backend *fcm__integrator_backend(const fcm_integrator *I)
 {
-  return I && I->has_backend ? &I->backend : NULL;
+  return I && !is_serial(&I->backend) ? &I->backend : NULL;
 }
 
 int fcm__integrator_distributed(const fcm_integrator *I, int *root)
 {
-  const int dist = I && I->has_backend;
-  if (root) *root = dist ? I->backend.root : 1;
-  return dist;
+  if (root) *root = I ? I->backend.root : 1;
+  return I && !is_serial(&I->backend);
 }
 
 void fcm__integrator_processes(const fcm_integrator *I, int *rank, int *nprocs)
 {
-  const int dist = I && I->has_backend;
-  *rank = dist ? I->backend.rank : 0;
-  *nprocs = dist ? I->backend.nprocs : 1;
+  *rank = I ? I->backend.rank : 0;
+  *nprocs = I ? I->backend.nprocs : 1;
 }
 
 fcm_status fcm__integrator_reduce(fcm_integrator *I, double *values, fcm_index count)
@@ -73,15 +126,13 @@ fcm_status fcm__integrator_reduce(fcm_integrator *I, double *values, fcm_index c
 fcm_status fcm__integrator_reduce_status(fcm_integrator *I, fcm_status st, double *values,
                                          fcm_index count)
 {
-  if (!I || !I->has_backend) return st;
-  st = I->backend.reduce(I->backend.user, st, values, count);
-  if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
-  return st;
+  if (!I) return st;
+  return reduced(I, st, I->backend.reduce(I->backend.user, st, values, count));
 }
 
 fcm_status fcm__integrator_finish(fcm_integrator *I, fcm_status st)
 {
-  if (!I || !I->has_backend || !I->backend.finish) return st;
+  if (!I || !I->backend.finish) return st;
   st = I->backend.finish(I->backend.user, st);
   if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
   return st;
@@ -89,10 +140,8 @@ fcm_status fcm__integrator_finish(fcm_integrator *I, fcm_status st)
 
 fcm_status fcm__sim_reduce(fcm_integrator *I, fcm_status st, double *scalars, int ns, double *vec)
 {
-  if (!I->has_backend) return st;
   const fcm__backend *b = &I->backend;
-  st = b->reduce(b->user, st, scalars, ns);
-  if (st == FCM_OK && vec) st = b->reduce(b->user, FCM_OK, vec, I->n);
-  if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
-  return st;
+  fcm_status out = b->reduce(b->user, st, scalars, ns);
+  if (out == FCM_OK && vec) out = b->reduce(b->user, FCM_OK, vec, I->n);
+  return reduced(I, st, out);
 }

@@ -4,7 +4,8 @@
  * (lib/METHOD.md §7), the preconditioner built from a PSD tangent by default
  * (preconditioner_tangent), or multigrid cycles as the solver (SPD Newton matrices). One
  * function per method: factor_direct, setup_preconditioner, mg_factor (set-up) and
- * solve_direct, solve_krylov, mg_solve (solves). */
+ * solve_direct, solve_krylov, mg_solve (solves), gathered with a distributed backend's
+ * factor and solve into the solver tables (sim_solver) the integrator calls. */
 #include "sim/sim_impl.h"
 #include "fem/fem_impl.h"
 #include "la/la_impl.h"
@@ -434,71 +435,11 @@ static fcm_status mg_factor(fcm_integrator *I, fcm_step_reason *reason, sim_stat
   return mg_prepare(I, I->H, reason);
 }
 
-/* The implementations of the Newton solves: the serial direct, Krylov (CG, MINRES) and
- * multigrid paths of the options, and a distributed backend (fem/fem_backend.h) when the
- * integrator has one, which then takes every solve whatever linear_solver says. */
-typedef enum solve_path { PATH_DIRECT, PATH_KRYLOV, PATH_MULTIGRID, PATH_BACKEND } solve_path;
-
-static solve_path path_of(const fcm_integrator *I)
-{
-  if (I->has_backend) return PATH_BACKEND;
-  switch (I->opts.linear_solver) {
-  case FCM_LINEAR_DIRECT:
-    return PATH_DIRECT;
-  case FCM_LINEAR_MULTIGRID:
-    return PATH_MULTIGRID;
-  default:
-    return PATH_KRYLOV;
-  }
-}
-
-/* The backend's factor: its soft failure is a failed linear solve (the step is retried). */
-static fcm_status backend_factor(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
-{
-  int failed = 0;
-  fcm_status st = I->backend.factor(I->backend.user, I->H, I->is_con, I->h_psd, &failed);
-  stats->factorizations++;
-  I->total_factorizations++;
-  if (st == FCM_OK && failed) *reason = FCM_STEP_LINEAR_SOLVER_FAILED;
-  if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
-  return st;
-}
-
-static fcm_status backend_solve(fcm_integrator *I, const double *b, double *d,
-                                fcm_step_reason *reason, int *iterations, sim_stats *stats)
-{
-  int failed = 0;
-  fcm_status st = I->backend.solve(I->backend.user, b, d, iterations, &failed);
-  stats->linear_iterations += *iterations;
-  if (st == FCM_OK && failed) *reason = FCM_STEP_LINEAR_SOLVER_FAILED;
-  return st;
-}
-
-fcm_status fcm__sim_factor(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
-{
-  double t0 = fcm_wtime();
-  fcm_status st = FCM_OK;
-  switch (path_of(I)) {
-  case PATH_BACKEND:
-    st = backend_factor(I, reason, stats);
-    break;
-  case PATH_DIRECT:
-    st = factor_direct(I, reason, stats);
-    break;
-  case PATH_MULTIGRID:
-    st = mg_factor(I, reason, stats);
-    break;
-  case PATH_KRYLOV:
-    st = setup_preconditioner(I, reason, stats);
-    break;
-  }
-  stats->time_factor += fcm_wtime() - t0;
-  return st;
-}
-
 static fcm_status solve_direct(fcm_integrator *I, const double *b, double *d,
-                               fcm_step_reason *reason)
+                               fcm_step_reason *reason, int *iterations, sim_stats *stats)
 {
+  (void)iterations;
+  (void)stats;
   fcm_status st = FCM_OK, s;
   fcm_ctx *ctx = I->ctx;
   FCM_CHECK(I->direct, ctx, FCM_ERR_INTERNAL, "integrator: no valid factorization to solve with");
@@ -568,27 +509,127 @@ cleanup:
   return st;
 }
 
+/* A distributed backend's factor (fem/fem_backend.h): its soft failure is a failed linear
+ * solve (the step is retried). */
+static fcm_status backend_factor(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
+{
+  int failed = 0;
+  fcm_status st = I->backend.factor(I->backend.user, I->H, I->is_con, I->h_psd, &failed);
+  stats->factorizations++;
+  I->total_factorizations++;
+  if (st == FCM_OK && failed) *reason = FCM_STEP_LINEAR_SOLVER_FAILED;
+  if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
+  return st;
+}
+
+static fcm_status backend_solve(fcm_integrator *I, const double *b, double *d,
+                                fcm_step_reason *reason, int *iterations, sim_stats *stats)
+{
+  int failed = 0;
+  fcm_status st = I->backend.solve(I->backend.user, b, d, iterations, &failed);
+  stats->linear_iterations += *iterations;
+  if (st == FCM_OK && failed) *reason = FCM_STEP_LINEAR_SOLVER_FAILED;
+  return st;
+}
+
+/* Set-up of the direct solver: analyzed once here (the UMFPACK fallback on demand). */
+static fcm_status direct_setup(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  if (I->opts.direct_method == FCM_DIRECT_CHOLMOD) {
+    FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, I->H, &I->chol));
+    FCM_TRY(ctx, fcm_direct_analyze(I->chol));
+  } else {
+    FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_UMFPACK, I->H, &I->umf));
+    FCM_TRY(ctx, fcm_direct_analyze(I->umf));
+  }
+cleanup:
+  return st;
+}
+
+/* Set-up of multigrid as the solver: its residual; the hierarchy itself at the first factor. */
+static fcm_status mg_setup(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  FCM_ALLOC(I->ctx, I->n, I->mg_r);
+cleanup:
+  return st;
+}
+
+/* Set-up of a Krylov solver; Schwarz flags the small cut cells. */
+static fcm_status krylov_setup(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  FCM_TRY(ctx, fcm_krylov_create(ctx, I->n, &I->krylov));
+  if (I->opts.preconditioner == FCM_PRECOND_SCHWARZ) {
+    const fcm_mesh *mesh = fcm_space_mesh(I->space);
+    const fcm_cell_rules *rules = fcm_space_cell_rules(I->space);
+    fcm_index nc = fcm_mesh_num_cells(mesh);
+    FCM_ALLOC(ctx, nc, I->schwarz_flag);
+    if (rules)
+      for (fcm_index c = 0; c < nc; c++)
+        I->schwarz_flag[c] = fcm_space_cell_active(I->space, c) &&
+                             fcm_cell_rules_class(rules, c) == FCM_CELL_CUT &&
+                             fcm_cell_rules_volume_fraction(rules, c) < I->opts.schwarz_theta;
+  }
+cleanup:
+  return st;
+}
+
+/* A distributed backend solves with its own solvers: nothing to set up here. */
+static fcm_status backend_setup(fcm_integrator *I)
+{
+  (void)I;
+  return FCM_OK;
+}
+
+/* The linear solvers of the Newton systems: set up once (fcm_integrator_setup()), then factor
+ * (or set up the preconditioner) for each new eliminated matrix H and solve with it. Soft
+ * failures set *reason and return FCM_OK. */
+struct sim_solver {
+  fcm_status (*setup)(fcm_integrator *I);
+  fcm_status (*factor)(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats);
+  fcm_status (*solve)(fcm_integrator *I, const double *b, double *d, fcm_step_reason *reason,
+                      int *iterations, sim_stats *stats);
+};
+
+static const sim_solver solver_direct = {direct_setup, factor_direct, solve_direct};
+static const sim_solver solver_krylov = {krylov_setup, setup_preconditioner, solve_krylov};
+static const sim_solver solver_multigrid = {mg_setup, mg_factor, mg_solve};
+static const sim_solver solver_backend = {backend_setup, backend_factor, backend_solve};
+
+fcm_status fcm__sim_solver_setup(fcm_integrator *I)
+{
+  /* a backend with a factor of its own (a distributed one) takes every solve whatever
+   * linear_solver says; the serial backend leaves them to the options */
+  if (I->backend.factor)
+    I->solver = &solver_backend;
+  else if (I->opts.linear_solver == FCM_LINEAR_DIRECT)
+    I->solver = &solver_direct;
+  else if (I->opts.linear_solver == FCM_LINEAR_MULTIGRID)
+    I->solver = &solver_multigrid;
+  else
+    I->solver = &solver_krylov;
+  return I->solver->setup(I);
+}
+
+fcm_status fcm__sim_factor(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
+{
+  double t0 = fcm_wtime();
+  fcm_status st = I->solver->factor(I, reason, stats);
+  stats->time_factor += fcm_wtime() - t0;
+  return st;
+}
+
 fcm_status fcm__sim_solve(fcm_integrator *I, const double *b, double *d, fcm_step_reason *reason,
                           int *iterations, sim_stats *stats)
 {
-  fcm_status st = FCM_OK;
   double t0 = fcm_wtime();
   *iterations = 0;
   I->solve_stalled = 0;
-  switch (path_of(I)) {
-  case PATH_BACKEND:
-    st = backend_solve(I, b, d, reason, iterations, stats);
-    break;
-  case PATH_DIRECT:
-    st = solve_direct(I, b, d, reason);
-    break;
-  case PATH_MULTIGRID:
-    st = mg_solve(I, b, d, reason, iterations, stats);
-    break;
-  case PATH_KRYLOV:
-    st = solve_krylov(I, b, d, reason, iterations, stats);
-    break;
-  }
+  fcm_status st = I->solver->solve(I, b, d, reason, iterations, stats);
   if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
   stats->time_solve += fcm_wtime() - t0;
   return st;

@@ -99,13 +99,12 @@ static void tangent_base(fcm_integrator *I, double h)
   fcm__sim_set_base(I, h, I->H);
 }
 
-/* With a backend: agree on st and on *finite, and sum the scalars and fint over the processes
- * (every process then holds the same global values); the matrices stay partial
- * (fem/fem_backend.h). */
+/* Agree on st and on *finite, and sum the scalars and fint over the processes of the backend
+ * (every process then holds the same global values; the serial backend's sums are the values
+ * themselves); the matrices stay partial (fem/fem_backend.h). */
 static fcm_status reduce_eval(fcm_integrator *I, fcm_status st, double *scalars, int ns,
                               double *fint, int *finite, sim_stats *stats)
 {
-  if (!I->has_backend) return st;
   double s[4] = {0, 0, 0, 0}; /* up to 3 scalars, then the count of non-finite processes */
   for (int k = 0; k < ns; k++)
     s[k] = scalars[k];
@@ -224,15 +223,17 @@ static void swap(double **a, double **b)
   *b = t;
 }
 
-/* With a backend (fem/fem_backend.h): fcm__eliminate_marked()'s symmetric elimination on this
- * process's partial H, with the increments w1 at the constrained DOFs. Every process zeroes the
- * constrained rows and columns of its matrix; the parts that need the summed matrix — the lift
- * H_fc inc_c of the free right-hand side (predictor) and the constrained diagonal (the summed
- * tangent's, 1 where that is not positive, as the serial rule) — are summed over the processes
- * as vectors: n doubles with a predictor, nact without (the lift is zero then). The diagonal
- * goes on the rows this process owns (act_diag keeps it for the reuse path); b (the same on
- * every process) gets the summed lift and diag * inc on the constrained rows. Collective. */
-static fcm_status eliminate_partial(fcm_integrator *I, int predictor)
+/* fcm__eliminate_marked()'s symmetric elimination on H, with the increments w1 at the
+ * constrained DOFs, written for a backend's partial H (fem/fem_backend.h; the serial
+ * backend's H is the whole matrix and its sums are the values themselves). Every process
+ * zeroes the constrained rows and columns of its matrix; the parts that need the summed
+ * matrix — the lift H_fc inc_c of the free right-hand side (predictor) and the constrained
+ * diagonal (the summed tangent's, 1 where that is not positive, as the serial rule) — are
+ * summed over the processes as vectors: n doubles with a predictor, nact without (the lift is
+ * zero then). The diagonal goes on the rows this process owns (act_diag keeps it for the reuse
+ * path); b (the same on every process) gets the summed lift and diag * inc on the constrained
+ * rows. Collective. */
+static fcm_status eliminate(fcm_integrator *I, int predictor)
 {
   fcm_status st = FCM_OK;
   const fcm_space *s = I->space;
@@ -247,6 +248,7 @@ static fcm_status eliminate_partial(fcm_integrator *I, int predictor)
   /* the matrix has the rows of the space's local copies (all of them on a full space): l is
    * zero on the DOFs without a row (no term of this process there) */
   memset(l, 0, sizeof *l * (size_t)n);
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(I->ctx)) schedule(static)
   for (fcm_index r = 0; r < nrows; r++) {
     const fcm_index i = fcm__space_row_dof(s, r);
     double acc = 0.0;
@@ -337,11 +339,9 @@ static fcm_status build_system(fcm_integrator *I, double h, int predictor, int p
       for (fcm_index i = 0; i < n; i++)
         if (!I->is_con[i]) I->b[i] -= I->w2[i];
     }
-    const double *hv = fcm_csr_values(I->H);
     for (fcm_index j = 0; j < I->nact; j++) {
       fcm_index d = I->act_dof[j];
-      const double diag = I->has_backend ? I->act_diag[j] : hv[fcm_csr_position(I->H, d, d)];
-      I->b[d] = predictor ? diag * I->act_inc[j] : 0.0;
+      I->b[d] = predictor ? I->act_diag[j] * I->act_inc[j] : 0.0;
     }
     return FCM_OK;
   }
@@ -363,12 +363,9 @@ static fcm_status build_system(fcm_integrator *I, double h, int predictor, int p
    * active set act_dof; w1 carries the increments there): nothing allocated per iteration. */
   for (fcm_index j = 0; j < I->nact; j++)
     I->w1[I->act_dof[j]] = predictor ? I->act_inc[j] : 0.0;
-  if (I->has_backend) {
-    /* a local failure there meets the others in the backend's factor (its agreement) */
-    st = eliminate_partial(I, predictor);
-    if (st != FCM_OK) FCM_TRY(I->ctx, fcm__integrator_finish(I, st));
-  } else
-    fcm__eliminate_marked(I->H, I->b, I->is_con, I->w1);
+  /* a local failure there meets the others in the backend's factor (its agreement) */
+  st = eliminate(I, predictor);
+  if (st != FCM_OK) FCM_TRY(I->ctx, fcm__integrator_finish(I, st));
   I->h_state = SIM_H_SYSTEM;
   I->h_psd = projected || I->opts.project_psd || I->linear;
   I->key_h = h;
@@ -709,10 +706,10 @@ cleanup:
 
 /* Gather phase of a converged step: the inverted quadrature points of the accepted state (its
  * last energy assembly counted them) and where the first lies: the lowest element's first such
- * point. With a backend each process offers its own first point in its slot of w1 (1 + cell, X,
- * J: 5 doubles per process, summed over the processes) and the lowest cell wins; w1 holds
- * num_dofs doubles, so a run with more than num_dofs / 5 processes reports the count without
- * the place. */
+ * point. Each process of the backend (one in a serial run) offers its own first point in its
+ * slot of w1 (1 + cell, X, J: 5 doubles per process, summed over the processes) and the lowest
+ * cell wins; w1 holds num_dofs doubles, so a run with more than num_dofs / 5 processes reports
+ * the count without the place. */
 static fcm_status record_inversion(fcm_integrator *I, fcm_step_info *info)
 {
   fcm_status st = FCM_OK;
@@ -725,26 +722,24 @@ static fcm_status record_inversion(fcm_integrator *I, fcm_step_info *info)
   fcm__assembly_inverted(I->aws, &elem);
   if (elem >= 0 && fcm__assembly_inverted_point(I->aws, elem, I->u, X, &det))
     cell = fcm_space_element_cell(I->space, elem);
-  if (I->has_backend) {
-    fcm__integrator_processes(I, &rank, &nprocs);
-    const fcm_index len = 5 * (fcm_index)nprocs;
-    if (len > I->n) return FCM_OK;
-    double *slot = I->w1 + 5 * (fcm_index)rank;
-    memset(I->w1, 0, sizeof *I->w1 * (size_t)len);
-    if (cell >= 0) {
-      slot[0] = 1.0 + (double)cell;
-      memcpy(slot + 1, X, sizeof X);
-      slot[4] = det;
-    }
-    FCM_TRY(I->ctx, fcm__integrator_reduce(I, I->w1, len));
-    cell = -1;
-    for (int p = 0; p < nprocs; p++) {
-      const double *q = I->w1 + 5 * (fcm_index)p;
-      if (q[0] > 0.0 && (cell < 0 || q[0] - 1.0 < (double)cell)) {
-        cell = (fcm_index)(q[0] - 1.0);
-        memcpy(X, q + 1, sizeof X);
-        det = q[4];
-      }
+  fcm__integrator_processes(I, &rank, &nprocs);
+  const fcm_index len = 5 * (fcm_index)nprocs;
+  if (len > I->n) return FCM_OK;
+  double *slot = I->w1 + 5 * (fcm_index)rank;
+  memset(I->w1, 0, sizeof *I->w1 * (size_t)len);
+  if (cell >= 0) {
+    slot[0] = 1.0 + (double)cell;
+    memcpy(slot + 1, X, sizeof X);
+    slot[4] = det;
+  }
+  FCM_TRY(I->ctx, fcm__integrator_reduce(I, I->w1, len));
+  cell = -1;
+  for (int p = 0; p < nprocs; p++) {
+    const double *q = I->w1 + 5 * (fcm_index)p;
+    if (q[0] > 0.0 && (cell < 0 || q[0] - 1.0 < (double)cell)) {
+      cell = (fcm_index)(q[0] - 1.0);
+      memcpy(X, q + 1, sizeof X);
+      det = q[4];
     }
   }
   if (cell >= 0) {

@@ -408,16 +408,14 @@ static fcm_status size_points(fcm_integrator *I, fcm_index *count, fcm_index np,
   fcm_ctx *ctx = I->ctx;
   sim_bpoints *bp = &I->bp;
   const int nn = I->space->nn, nd = 3 * nn;
-  if (I->has_backend) { /* the points of this process's cells: count them all */
+  for (int k0 = 0; k0 < I->num_bcons; k0 += 64) { /* this process's cells' points: all */
     double c[64];
-    for (int k0 = 0; k0 < I->num_bcons; k0 += 64) {
-      const int m = I->num_bcons - k0 < 64 ? I->num_bcons - k0 : 64;
-      for (int k = 0; k < m; k++)
-        c[k] = (double)count[k0 + k];
-      FCM_TRY(ctx, I->backend.reduce(I->backend.user, FCM_OK, c, m));
-      for (int k = 0; k < m; k++)
-        count[k0 + k] = (fcm_index)c[k];
-    }
+    const int m = I->num_bcons - k0 < 64 ? I->num_bcons - k0 : 64;
+    for (int k = 0; k < m; k++)
+      c[k] = (double)count[k0 + k];
+    FCM_TRY(ctx, fcm__integrator_reduce(I, c, m));
+    for (int k = 0; k < m; k++)
+      count[k0 + k] = (fcm_index)c[k];
   }
   for (int k = 0; k < I->num_bcons; k++)
     FCM_CHECK(count[k] > 0, ctx, FCM_ERR_ARG,
@@ -881,7 +879,7 @@ fcm_status fcm_integrator_boundary_reaction(const fcm_integrator *I, int id, dou
     }
   }
 cleanup:
-  if (st == FCM_OK && I->has_backend) { /* partial sums over own cells' points: sum them */
+  if (st == FCM_OK) { /* partial sums over own cells' points: sum them */
     double q[6] = {Fr[0], Fr[1], Fr[2], Mr[0], Mr[1], Mr[2]};
     st = I->backend.reduce(I->backend.user, FCM_OK, q, 6);
     for (int i = 0; i < 3; i++)

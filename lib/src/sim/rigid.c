@@ -170,7 +170,7 @@ static fcm_status local_rows(fcm_integrator *I, rigid_work *w)
   FCM_ALLOC(ctx, ncopy + 1, w->held);
   FCM_TRY(ctx, fcm__space_body_labels(s, w->elem_body, &w->nb));
   FCM_ALLOC(ctx, w->nb + 1, w->B);
-  if (I->has_backend) FCM_ALLOC(ctx, 40 * (size_t)w->nb + 1, w->sum);
+  FCM_ALLOC(ctx, 40 * (size_t)w->nb + 1, w->sum);
   rigid_body *B = w->B;
   for (fcm_index node = 0; node < s->num_nodes; node++)
     for (fcm_index c = 0; s->node_dof[node] >= 0 && c < s->node_ncopy[node]; c++)
@@ -211,9 +211,10 @@ cleanup:
   return st;
 }
 
-/* With a backend: agree on the local phase's status and sum the boundary parts over the
- * processes (36 + 4 values per body; the body numbering is the same everywhere). Collective:
- * every process calls it, whatever its local status. */
+/* Agree on the local phase's status and sum the boundary parts over the processes of the
+ * backend (36 + 4 values per body; the body numbering is the same everywhere; the serial
+ * backend's sums are the parts themselves). Collective: every process calls it, whatever its
+ * local status. */
 static fcm_status sum_boundary(fcm_integrator *I, fcm_status st, rigid_work *w)
 {
   double *v = w->sum;
@@ -265,7 +266,7 @@ fcm_status fcm__sim_check_rigid_modes(fcm_integrator *I, double t)
   rigid_work w;
   memset(&w, 0, sizeof w);
   st = local_rows(I, &w);
-  if (I->has_backend) st = sum_boundary(I, st, &w);
+  st = sum_boundary(I, st, &w);
   FCM_TRY(ctx, st);
   node_rows(I, &w);
   fcm_index bad = -1, nbad = 0;

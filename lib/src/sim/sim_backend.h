@@ -1,7 +1,9 @@
-/* sim module: the integrator's side of a distributed solver backend (internal). The interface
- * itself and its contract (partial assemblies summed, partial Newton matrices handed to the
- * backend) are lib/src/fem/fem_backend.h; the layer that chooses a backend (the scene's
- * runner) attaches it here before the integrator's setup. */
+/* sim module: the integrator's side of a solver backend (internal). The interface itself and
+ * its contract (partial assemblies summed, partial Newton matrices handed to the backend) are
+ * lib/src/fem/fem_backend.h. Every integrator starts with the serial backend (one process:
+ * its sums are the values themselves, it owns every DOF, and the integrator's options choose
+ * the linear solver); the layer that chooses a distributed backend (the scene's runner)
+ * attaches it here before the integrator's setup. */
 #ifndef FCM_SIM_BACKEND_H
 #define FCM_SIM_BACKEND_H
 
@@ -9,10 +11,12 @@
 #include "fcm/sim.h"
 #include "fem/fem_backend.h"
 
-/* Set the backend of an integrator that is not set up yet (before fcm_integrator_setup():
- * the setup sums the loads and M a_rep; the mass matrix stays partial). The integrator owns b->user
- * from now on (b->destroy at fcm_integrator_destroy()), also when this fails. FCM_ERR_ARG after
- * setup. */
+/* Set the distributed backend of an integrator that is not set up yet (before
+ * fcm_integrator_setup(): the setup sums the loads and M a_rep; the mass matrix stays
+ * partial). The integrator owns b->user from now on (b->destroy at fcm_integrator_destroy()),
+ * also when this fails. FCM_ERR_ARG after setup or when a distributed backend is set already.
+ * A serial backend (the serial one's setup, for a cut of a serial integrator) leaves the
+ * integrator with the serial backend it has. */
 fcm_status fcm__integrator_set_backend(fcm_integrator *I, const fcm__backend *b);
 
 /* Attach a backend to an integrator that is not set up yet: from->setup (from borrowed: the
@@ -22,27 +26,27 @@ fcm_status fcm__integrator_set_backend(fcm_integrator *I, const fcm__backend *b)
 fcm_status fcm__integrator_attach_backend(fcm_integrator *I, const fcm__backend *from);
 
 /* Sum values[0 .. count) over the processes of the integrator's backend, in place (a partial
- * quantity of the space, e.g. the log's mass and momentum); FCM_OK without a backend.
- * Collective with a backend. */
+ * quantity of the space, e.g. the log's mass and momentum); the serial backend leaves them.
+ * Collective. */
 fcm_status fcm__integrator_reduce(fcm_integrator *I, double *values, fcm_index count);
 /* The same after a local phase that ended with st: the processes agree on it first (a failure
- * anywhere is returned everywhere, values untouched and may then be NULL). Collective with a
- * backend; st itself without one. */
+ * anywhere is returned everywhere, values untouched and may then be NULL). Collective; the
+ * serial backend returns st. */
 fcm_status fcm__integrator_reduce_status(fcm_integrator *I, fcm_status st, double *values,
                                          fcm_index count);
 
-/* The integrator's backend (NULL without one). */
+/* The integrator's distributed backend (NULL with the serial one). */
 const fcm__backend *fcm__integrator_backend(const fcm_integrator *I);
 
-/* Whether the integrator runs on a distributed backend (0: serial); *root (may be NULL): 1 on
- * the backend's root process, and 1 without a backend. */
+/* Whether the integrator runs on a distributed backend (0: the serial one); *root (may be
+ * NULL): 1 on the backend's root process (the serial backend's one process is the root). */
 int fcm__integrator_distributed(const fcm_integrator *I, int *root);
 
-/* The backend's rank and process count (0 and 1 without a backend). */
+/* The backend's rank and process count (0 and 1 with the serial backend). */
 void fcm__integrator_processes(const fcm_integrator *I, int *rank, int *nprocs);
 
-/* The backend's finish (see fcm__backend.finish, fem/fem_backend.h) on st; st without a
- * backend. Collective with a backend. */
+/* The backend's finish (see fcm__backend.finish, fem/fem_backend.h) on st; st when it has
+ * none (the serial backend). Collective. */
 fcm_status fcm__integrator_finish(fcm_integrator *I, fcm_status st);
 
 #endif /* FCM_SIM_BACKEND_H */

@@ -110,7 +110,7 @@ struct fcm_integrator {
   fcm_index *act_dof;    /* nact DOFs (distinct) */
   double *act_val;       /* their prescribed displacements at the substep's end */
   double *act_inc;       /* increments to reach them */
-  double *act_diag;      /* with a backend: the eliminated matrix's diagonal there (the summed
+  double *act_diag;      /* the eliminated matrix's diagonal there (the summed
                             tangent's, or 1 where that is not positive: fcm__eliminate_marked's
                             rule), from the last elimination */
 
@@ -167,10 +167,11 @@ struct fcm_integrator {
   double psi;
   double inverted;
 
-  /* distributed backend (fem/fem_backend.h); has_backend = 0: serial */
+  /* the solver backend (fem/fem_backend.h): the serial one (integrator_backend.c) unless a
+   * distributed one is attached */
   fcm__backend backend;
-  int has_backend;
-  unsigned char *owned; /* n: the backend's owned DOFs (a copy of backend.owned) */
+  unsigned char *owned;            /* n: the backend's owned DOFs (a copy of backend.owned) */
+  const struct sim_solver *solver; /* the linear solver of the Newton systems (linsolve.c) */
 };
 
 enum { SIM_H_INVALID = 0, SIM_H_TANGENT = 1, SIM_H_SYSTEM = 2 };
@@ -186,6 +187,11 @@ fcm_status fcm__sim_check_rigid_modes(fcm_integrator *I, double t);
  * Outputs the reason; hard errors are returned as status. (newton.c) */
 fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reason *reason,
                            double *residual, double *tolerance, sim_stats *stats);
+
+/* The linear solver of the Newton systems (I->solver): a distributed backend's when it has
+ * a factor of its own, else the serial one linear_solver names; set it up. (linsolve.c) */
+typedef struct sim_solver sim_solver;
+fcm_status fcm__sim_solver_setup(fcm_integrator *I);
 
 /* Factor (direct) or set up the preconditioner (Krylov) for the eliminated matrix H.
  * Soft failures set *reason and return FCM_OK. (linsolve.c) */
@@ -230,6 +236,9 @@ void fcm__sim_boundary_free(fcm_integrator *I);
 int fcm__sim_boundary_time(fcm_integrator *I, double t);
 fcm_status fcm__sim_boundary_assemble(fcm_integrator *I, const double *x, int projected,
                                       double *energy, double *force, fcm_csr *T, int *finite);
+
+/* Give a new integrator the serial backend (its owned flags: every DOF). (integrator_backend.c) */
+fcm_status fcm__sim_serial_backend(fcm_integrator *I);
 
 /* With a backend (fem/fem_backend.h): agree on st and sum the partial quantities over the
  * processes: the ns scalars and the vector vec (n; may be NULL). No matrix is ever summed
