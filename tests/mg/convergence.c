@@ -1,7 +1,8 @@
 /* Multigrid on Hex8 and Hex20 box grids, static linear elasticity (argument: cube, hemisphere, cut:
  * an XFEM plane cut through the hemisphere's top, split: the plane through the whole body,
  * two bodies each clamped, hollow: a hollow ball with three holes; with the suffix -hex20 on Hex20
- * grids, where the first coarse level is the p-level Hex20 -> Hex8 on the same grid; then the cell
+ * grids, where the first coarse level is the p-level Hex20 -> Hex8 on the same grid, and with the
+ * suffix -jacobi smoothed by damped Jacobi at fcm_mg_smoother_omega(); then the cell
  * counts n, default 4 8 16): the V-cycle and the two-grid convergence factors stay below 0.8 for
  * every n and, on the cube and the embedded hemisphere, the factor at the largest n is at most 1.25
  * x the one at the next (with the XFEM cut it varies with the cut's position in the grid), CG
@@ -26,7 +27,10 @@ int main(int argc, char **argv)
   if (argc < 2) return 2;
   char name[32];
   snprintf(name, sizeof name, "%s", argv[1]);
-  const size_t len = strlen(name);
+  size_t len = strlen(name);
+  /* suffix -jacobi: the damped Jacobi smoother at its default relaxation */
+  const int jacobi = len > 7 && !strcmp(name + len - 7, "-jacobi");
+  if (jacobi) name[len -= 7] = '\0';
   const int hex20 = len > 6 && !strcmp(name + len - 6, "-hex20");
   if (hex20) name[len - 6] = '\0';
   const fcm_element_type type = hex20 ? FCM_ELEMENT_HEX20 : FCM_ELEMENT_HEX8;
@@ -61,6 +65,10 @@ int main(int argc, char **argv)
     fcm_mg_options o = fcm_mg_options_default();
     o.coarse_dofs = 50; /* coarsen as far as the grid allows, for every n */
     o.cycle_index = 1;  /* the V-cycle (the default is the W-cycle) */
+    if (jacobi) {
+      o.smoother = FCM_MG_SMOOTHER_JACOBI;
+      o.omega = fcm_mg_smoother_omega(o.smoother);
+    }
     if (getenv("FCM_TEST_MG_SMOOTH"))
       o.pre_smooth = o.post_smooth = atoi(getenv("FCM_TEST_MG_SMOOTH"));
     if (getenv("FCM_TEST_MG_OMEGA")) o.omega = atof(getenv("FCM_TEST_MG_OMEGA"));

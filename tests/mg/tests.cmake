@@ -1,5 +1,6 @@
 # sizes: large enough that the factor has stopped growing where the test compares them
 fcm_add_test(mg_convergence_cube tests/mg/convergence.c ARGS cube 4 8 16)
+fcm_add_test(mg_convergence_cube_jacobi tests/mg/convergence.c ARGS cube-jacobi 4 8 16)
 fcm_add_test(mg_convergence_hemisphere tests/mg/convergence.c ARGS hemisphere 8 16 24)
 fcm_add_test(mg_convergence_cut tests/mg/convergence.c ARGS cut 8 16)
 fcm_add_test(mg_convergence_split tests/mg/convergence.c ARGS split 8 16)

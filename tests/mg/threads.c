@@ -12,7 +12,7 @@ static double *solve(fcm_ctx *ctx, problem *p, fcm_mg_smoother sm, int threads, 
   omp_set_num_threads(threads);
   fcm_mg_options o = fcm_mg_options_default();
   o.smoother = sm;
-  o.omega = sm == FCM_MG_SMOOTHER_JACOBI ? 0.6 : 1.2;
+  o.omega = sm == FCM_MG_SMOOTHER_JACOBI ? fcm_mg_smoother_omega(sm) : 1.2;
   o.coarse_dofs = 100;
   fcm_mg *mg = NULL;
   double *x = calloc((size_t)p->n, sizeof *x);
@@ -46,7 +46,7 @@ int main(void)
       for (int cyc = 1; cyc <= 2; cyc++) {
         fcm_mg_options o = fcm_mg_options_default();
         o.smoother = (fcm_mg_smoother)sm;
-        o.omega = sm == FCM_MG_SMOOTHER_JACOBI ? 0.6 : 1.3;
+        o.omega = sm == FCM_MG_SMOOTHER_JACOBI ? fcm_mg_smoother_omega(sm) : 1.3;
         o.cycle_index = cyc;
         o.coarse_dofs = 100;
         fcm_mg *mg = NULL;

@@ -1,8 +1,9 @@
 /* The scene's solver and quadrature sections embed the library's option structs: a scene that
  * gives none of their keys carries exactly fcm_integrator_options_default() and
  * fcm_cell_rules_options_default(), member by member (a member added to either struct must be
- * added here), and a scene that writes every key with the value the library's default has
- * parses to the same structs. */
+ * added here), a scene that writes every key with the value the library's default has parses
+ * to the same structs, and one that names a multigrid smoother carries the library's relaxation
+ * for it (fcm_mg_smoother_omega()). */
 #include "fcm/fcm.h"
 #include "test.h"
 
@@ -88,13 +89,16 @@ static void same_rules(const fcm_cell_rules_options *a, const fcm_cell_rules_opt
   SAME(a, b, cell_mask);
 }
 
-/* The sections of `json` against the library's defaults. */
-static void check(fcm_ctx *ctx, const char *json)
+/* The sections of `json` against the library's defaults, the multigrid smoother `smoother`
+ * with its default relaxation (fcm_mg_smoother_omega()). */
+static void check_smoother(fcm_ctx *ctx, const char *json, fcm_mg_smoother smoother)
 {
   fcm_scene *s = NULL;
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "defaults.json", &s));
   if (!s) return;
-  const fcm_integrator_options io = fcm_integrator_options_default();
+  fcm_integrator_options io = fcm_integrator_options_default();
+  io.multigrid.smoother = smoother;
+  io.multigrid.omega = fcm_mg_smoother_omega(smoother);
   const fcm_cell_rules_options ro = fcm_cell_rules_options_default();
   same_integrator(&fcm_scene_get_solver(s)->integrator, &io);
   same_rules(&fcm_scene_get_quadrature(s)->rules, &ro);
@@ -102,6 +106,11 @@ static void check(fcm_ctx *ctx, const char *json)
   TEST_TRUE(fcm_scene_get_solver(s)->petsc_options == NULL);
   TEST_TRUE(fcm_scene_get_solver(s)->stop_on_inversion == 0);
   fcm_scene_destroy(&s);
+}
+
+static void check(fcm_ctx *ctx, const char *json)
+{
+  check_smoother(ctx, json, fcm_integrator_options_default().multigrid.smoother);
 }
 
 int main(void)
@@ -134,6 +143,19 @@ int main(void)
            " \"threads\": 0, \"on_inversion\": \"warn\"}}",
            head);
   check(ctx, json);
+  /* Choosing the smoother alone gives it the library's relaxation for it; writing that value
+   * gives the same. Damped Jacobi's differs from the Gauss-Seidel one the defaults pair. */
+  TEST_TRUE(fcm_mg_smoother_omega(FCM_MG_SMOOTHER_JACOBI) <
+            fcm_integrator_options_default().multigrid.omega);
+  snprintf(json, sizeof json, "%s, \"solver\": {\"multigrid\": {\"smoother\": \"jacobi\"}}}", head);
+  check_smoother(ctx, json, FCM_MG_SMOOTHER_JACOBI);
+  snprintf(json, sizeof json,
+           "%s, \"solver\": {\"multigrid\": {\"smoother\": \"jacobi\", \"omega\": %.17g}}}", head,
+           fcm_mg_smoother_omega(FCM_MG_SMOOTHER_JACOBI));
+  check_smoother(ctx, json, FCM_MG_SMOOTHER_JACOBI);
+  snprintf(json, sizeof json, "%s, \"solver\": {\"multigrid\": {\"smoother\": \"sgs_colored\"}}}",
+           head);
+  check_smoother(ctx, json, FCM_MG_SMOOTHER_SGS_COLORED);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
 }

@@ -43,7 +43,9 @@ typedef enum fcm_mg_smoother {
 typedef struct fcm_mg_options {
   fcm_mg_smoother smoother; /**< default FCM_MG_SMOOTHER_SGS */
   double omega;             /**< relaxation: SGS (both orders) in (0, 2), Jacobi in (0, 1];
-                                 default 1.0 for SGS (set 0.6 for Jacobi) */
+                                 default fcm_mg_smoother_omega(FCM_MG_SMOOTHER_SGS) = 1.0;
+                                 choosing another smoother, set its
+                                 fcm_mg_smoother_omega() (Jacobi: 0.6) */
   int pre_smooth;           /**< smoothing steps before the coarse correction, >= 0 (default 1;
                                  one SGS step is a forward and a backward sweep) */
   int post_smooth;          /**< after it, >= 0 (default 1); pre = post keeps the cycle
@@ -78,6 +80,12 @@ typedef struct fcm_mg_options {
 
 /** Defaults as documented on each member. */
 FCM_API fcm_mg_options fcm_mg_options_default(void);
+
+/** The default relaxation omega of a smoother: 1.0 for symmetric Gauss-Seidel (both orders),
+ * 0.6 for damped Jacobi, which over-corrects the high-frequency modes of elasticity near 1
+ * (the V-cycle diverges from omega = 0.7 on a box grid: lib/docs/multigrid.md). The scene's
+ * solver.multigrid takes it with its smoother; 1.0 for a value outside fcm_mg_smoother. */
+FCM_API double fcm_mg_smoother_omega(fcm_mg_smoother smoother);
 
 /** A multigrid hierarchy and its operators for one matrix pattern. */
 typedef struct fcm_mg fcm_mg;

@@ -18,11 +18,16 @@
 #include <stdlib.h>
 #include <string.h>
 
+double fcm_mg_smoother_omega(fcm_mg_smoother smoother)
+{
+  return smoother == FCM_MG_SMOOTHER_JACOBI ? 0.6 : 1.0;
+}
+
 fcm_mg_options fcm_mg_options_default(void)
 {
   fcm_mg_options o;
   o.smoother = FCM_MG_SMOOTHER_SGS;
-  o.omega = 1.0;
+  o.omega = fcm_mg_smoother_omega(o.smoother);
   o.pre_smooth = 1;
   o.post_smooth = 1;
   o.cycle_index = 2;

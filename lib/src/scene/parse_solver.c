@@ -77,8 +77,7 @@ static fcm_status read_multigrid(fcm__scene_parser *p, const fcm__json *mg,
   FCM_TRY(p->ctx, fcm__scene_check_object(p, mg, keys, SCENE_COUNT(keys)));
   SCENE_READ_CHOICE_AS(p, mg, "smoother", 0, fcm__scene_smoother_names, fcm__scene_smoother_values,
                        m->smoother);
-  if (m->smoother == FCM_MG_SMOOTHER_JACOBI)
-    m->omega = 0.6; /* the damped Jacobi default (1.0 over-corrects elasticity) */
+  m->omega = fcm_mg_smoother_omega(m->smoother); /* the library's default for the smoother */
   FCM_TRY(p->ctx,
           fcm__scene_read_number(p, mg, "omega", 0, (fcm__range){0.0, 2.0, 1, 1}, &m->omega));
   if (m->smoother == FCM_MG_SMOOTHER_JACOBI && m->omega > 1.0) {
