@@ -4,7 +4,7 @@
  * patterns, the level info and a CG + MG solve gives FCM_ERR_ALLOC and leaks nothing, until
  * everything succeeds. */
 #include "mg_util.h"
-#include "test_alloc.h"
+#include "alloc_loop.h"
 
 #include <omp.h>
 
@@ -27,27 +27,16 @@ done:
   return st;
 }
 
-/* The failing-allocation loop on one problem; returns the number of failures survived. */
-static long long loop(fcm_ctx *ctx, failing *fl, problem *p, double *x)
+typedef struct mg_round {
+  fcm_ctx *ctx;
+  problem *p;
+  double *x;
+} mg_round;
+
+static fcm_status run_round(void *user)
 {
-  long long k;
-  for (k = 0;; k++) {
-    fl->count = 0;
-    fl->fail_at = k;
-    fcm_status st = run(ctx, p, x);
-    if (fcm_ctx_live_allocations(ctx) != 0)
-      TEST_FAIL_("failing allocation %lld: %lld allocations leaked", k,
-                 fcm_ctx_live_allocations(ctx));
-    if (st == FCM_OK) break;
-    if (st != FCM_ERR_ALLOC) {
-      TEST_FAIL_("failing allocation %lld: %s (%s)", k, fcm_status_name(st),
-                 fcm_ctx_error_message(ctx));
-      break;
-    }
-    fcm_ctx_error_clear(ctx);
-  }
-  fl->fail_at = -1;
-  return k;
+  mg_round *r = user;
+  return run(r->ctx, r->p, r->x);
 }
 
 int main(void)
@@ -64,7 +53,10 @@ int main(void)
     problem_hemisphere_of(ctx0, t ? FCM_ELEMENT_HEX20 : FCM_ELEMENT_HEX8, t ? 4 : 6, 1,
                           fcm_space_options_default().constrain_ratio, &p);
     double *x = calloc((size_t)p.n, sizeof *x);
-    TEST_TRUE(loop(ctx, &fl, &p, x) >= 40); /* the loop did exercise the builders */
+    mg_round r = {ctx, &p, x};
+    /* at least 40 failing rounds: the loop did exercise the builders */
+    alloc_loop(ctx, &fl, t ? "hex20 hierarchy" : "hex8 hierarchy", run_round, NULL, &r, 40,
+               1000000);
     free(x);
     problem_free(&p);
   }
