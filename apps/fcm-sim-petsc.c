@@ -15,7 +15,7 @@
 #include "cli.h"
 
 #include <fcm/fcm.h>
-#include <fcm/petsc.h>
+#include <fcm/scene_petsc.h>
 #include <fcm/simulation.h>
 
 #include <errno.h>
