@@ -207,7 +207,9 @@ FCM_API fcm_status fcm_petsc_problem_write_frame(fcm_petsc_problem *problem, con
 
 /** Save the run: process 0 writes the gathered displacement and velocity (the space's DOF
  * numbering), the time, the step count and a fingerprint (DOFs, elements, kind, dt) to `path`
- * atomically. Collective. @return FCM_OK, FCM_ERR_ARG, FCM_ERR_IO, FCM_ERR_ALLOC. */
+ * atomically (a file of its own format, ".fcmpk"; fcm_simulation_read_checkpoint() also reads
+ * it into the simulation of the same scene, serial or distributed, and converts it).
+ * Collective. @return FCM_OK, FCM_ERR_ARG, FCM_ERR_IO, FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_petsc_problem_write_checkpoint(fcm_petsc_problem *problem, const char *path);
 
 /** Continue a run: every process reads `path` (a shared file system) into a problem set up from

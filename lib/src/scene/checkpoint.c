@@ -257,6 +257,34 @@ static void ckpt_data_free(fcm_ctx *ctx, ckpt_data *d)
   fcm__free(ctx, d->react);
 }
 
+/* The state at the end of a checkpoint: d->n displacement and velocity values, nothing after. */
+static fcm_status read_state(ckpt_reader *r, ckpt_data *d)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = r->ctx;
+  FCM_TRY(ctx, need(r, d->n, 2 * sizeof(double), "displacement and velocity values"));
+  FCM_ALLOC(ctx, d->n, d->u);
+  FCM_ALLOC(ctx, d->n, d->v);
+  FCM_TRY(ctx, get(r, d->u, sizeof *d->u * (size_t)d->n, "the displacement"));
+  FCM_TRY(ctx, get(r, d->v, sizeof *d->v * (size_t)d->n, "the velocity"));
+  FCM_CHECK(r->pos == r->size, ctx, FCM_ERR_FORMAT, "checkpoint %s: %zu unexpected trailing bytes",
+            r->path, r->size - r->pos);
+cleanup:
+  return st;
+}
+
+/* A checkpoint's step count against the steps this run takes. */
+static fcm_status check_steps(const fcm_simulation *S, const char *path, long long steps)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(steps <= S->num_steps, S->ctx, FCM_ERR_ARG,
+            "checkpoint %s: step %lld is beyond the %lld steps this run takes (extend "
+            "time.duration or --steps)",
+            path, steps, S->num_steps);
+cleanup:
+  return st;
+}
+
 /* The older PETSc linear driver's checkpoint (see the top of the file) in data (size bytes)
  * into *d: the state, time and step count; checked against the scene (DOFs, elements, kind and
  * dt). It holds no log: the rows of its steps carry their time alone (the other columns NaN,
@@ -286,17 +314,8 @@ static fcm_status read_petsc_v1(fcm_simulation *S, const char *path, const unsig
             "%lld, %d, %g)",
             path, elems, kind, dt, fcm_scene_name(S->scene),
             (long long)fcm_space_num_elements(S->space), (int)tm->integrator, tm->dt);
-  FCM_CHECK(d->steps <= S->num_steps, ctx, FCM_ERR_ARG,
-            "checkpoint %s: step %lld is beyond the %lld steps this run takes (extend "
-            "time.duration or --steps)",
-            path, d->steps, S->num_steps);
-  FCM_TRY(ctx, need(&r, d->n, 2 * sizeof(double), "displacement and velocity values"));
-  FCM_ALLOC(ctx, d->n, d->u);
-  FCM_ALLOC(ctx, d->n, d->v);
-  FCM_TRY(ctx, get(&r, d->u, sizeof *d->u * (size_t)d->n, "the displacement"));
-  FCM_TRY(ctx, get(&r, d->v, sizeof *d->v * (size_t)d->n, "the velocity"));
-  FCM_CHECK(r.pos == r.size, ctx, FCM_ERR_FORMAT, "checkpoint %s: %zu unexpected trailing bytes",
-            path, r.size - r.pos);
+  FCM_TRY(ctx, check_steps(S, path, d->steps));
+  FCM_TRY(ctx, read_state(&r, d));
   {
     const int every = fcm_scene_get_output(S->scene)->frame_interval;
     const long long interval = every > 0 ? every : 1;
@@ -369,10 +388,7 @@ static fcm_status read_file(fcm_simulation *S, const char *path, ckpt_data *d)
   }
   FCM_TRY(ctx, get_i64(&r, &d->n, 0, INT64_MAX, "num_dofs"));
   FCM_TRY(ctx, get_i64(&r, &d->steps, 0, INT64_MAX, "steps"));
-  FCM_CHECK(d->steps <= S->num_steps, ctx, FCM_ERR_ARG,
-            "checkpoint %s: step %lld is beyond the %lld steps this run takes (extend "
-            "time.duration or --steps)",
-            path, d->steps, S->num_steps);
+  FCM_TRY(ctx, check_steps(S, path, d->steps));
   FCM_TRY(ctx, get(&r, &d->t, sizeof d->t, "time"));
   if (ver >= 2) FCM_TRY(ctx, get_i64(&r, &d->cuts, S->cuts_applied, S->num_cuts, "cuts applied"));
   FCM_TRY(ctx, get_i64(&r, &d->newton, 0, INT64_MAX, "newton_iterations"));
@@ -425,13 +441,7 @@ static fcm_status read_file(fcm_simulation *S, const char *path, ckpt_data *d)
       FCM_TRY(ctx, get_i64(&r, &w->nonfinite, -1, INT64_MAX, "a log row's NaN stresses"));
     }
   }
-  FCM_TRY(ctx, need(&r, d->n, 2 * sizeof(double), "displacement and velocity values"));
-  FCM_ALLOC(ctx, d->n, d->u);
-  FCM_ALLOC(ctx, d->n, d->v);
-  FCM_TRY(ctx, get(&r, d->u, sizeof *d->u * (size_t)d->n, "the displacement"));
-  FCM_TRY(ctx, get(&r, d->v, sizeof *d->v * (size_t)d->n, "the velocity"));
-  FCM_CHECK(r.pos == r.size, ctx, FCM_ERR_FORMAT, "checkpoint %s: %zu unexpected trailing bytes",
-            path, r.size - r.pos);
+  FCM_TRY(ctx, read_state(&r, d));
 cleanup:
   fcm__free(ctx, data);
   return st;
