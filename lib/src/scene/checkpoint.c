@@ -273,6 +273,19 @@ cleanup:
   return st;
 }
 
+/* Room for d->rows log rows and their nreact reaction values each. */
+static fcm_status alloc_rows(fcm_ctx *ctx, ckpt_data *d, size_t nreact)
+{
+  fcm_status st = FCM_OK;
+  if (d->rows > 0)
+    FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&d->log, &d->log_cap, d->rows, sizeof *d->log));
+  if (d->rows > 0 && nreact > 0)
+    FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&d->react, &d->react_cap, d->rows,
+                               nreact * sizeof *d->react));
+cleanup:
+  return st;
+}
+
 /* A checkpoint's step count against the steps this run takes. */
 static fcm_status check_steps(const fcm_simulation *S, const char *path, long long steps)
 {
@@ -326,11 +339,7 @@ static fcm_status read_petsc_v1(fcm_simulation *S, const char *path, const unsig
     for (long long k = 0; k < d->frames; k++)
       d->frame_time[k] = (double)(k * interval) * tm->dt;
     d->rows = d->steps;
-    if (d->rows > 0)
-      FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&d->log, &d->log_cap, d->rows, sizeof *d->log));
-    if (d->rows > 0 && nreact > 0)
-      FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&d->react, &d->react_cap, d->rows,
-                                 nreact * sizeof *d->react));
+    FCM_TRY(ctx, alloc_rows(ctx, d, nreact));
     for (long long k = 0; k < d->rows; k++) {
       fcm__log_row *w = &d->log[k];
       memset(w, 0, sizeof *w);
@@ -407,11 +416,7 @@ static fcm_status read_file(fcm_simulation *S, const char *path, ckpt_data *d)
                                           (ver >= 4 ? 6 : 3) * sizeof(int64_t)
                                     : 4 * sizeof(double) + 2 * sizeof(int64_t);
   FCM_TRY(ctx, need(&r, d->rows, row_bytes, "log rows"));
-  if (d->rows > 0)
-    FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&d->log, &d->log_cap, d->rows, sizeof *d->log));
-  if (d->rows > 0 && nreact > 0)
-    FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&d->react, &d->react_cap, d->rows,
-                               nreact * sizeof *d->react));
+  FCM_TRY(ctx, alloc_rows(ctx, d, nreact));
   for (long long k = 0; k < d->rows; k++) {
     fcm__log_row *w = &d->log[k];
     double x[4];
