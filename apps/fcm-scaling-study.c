@@ -548,9 +548,9 @@ static void run_petsc(fcm_ctx *ctx, const settings *o, fcm_element_type type, in
     TRY(fcm_geometry_create_ball(ctx, c, 0.9, 6, &geom));
   fcm_petsc_options po = fcm_petsc_options_default();
   po.kind = FCM_INTEGRATOR_STATIC;
-  po.rtol = o->rtol;
-  po.max_iterations = o->max_iterations;
-  po.petsc_options = petsc_solver_options(s);
+  po.solver.rtol = o->rtol;
+  po.solver.max_iterations = o->max_iterations;
+  po.solver.petsc_options = petsc_solver_options(s);
   TRY(fcm_petsc_problem_create(ctx, MPI_COMM_WORLD, mesh, geom, &mat, &po, &P));
   {
     const double blo[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, bhi[3] = {HUGE_VAL, -0.5, HUGE_VAL};

@@ -1,14 +1,14 @@
-/* fcm-sim --backend petsc: a scene run on the PETSc + MPI backend (fcm/petsc.h), built when the
- * library has it (FCM_HAVE_PETSC). */
+/* fcm-sim --backend petsc: a scene run on the PETSc + MPI backend (fcm/scene_petsc.h), built when
+ * the library has it (FCM_HAVE_PETSC). */
 #ifndef FCM_SIM_PETSC_H
 #define FCM_SIM_PETSC_H
 
 /* Run the scene `path` (NULL: the built-in scene) on the processes of MPI_COMM_WORLD; steps > 0
  * caps the steps; check: at most 3 steps, no output; quiet: errors only; checkpoint_every > 0:
- * <name>_checkpoint_NNNNNN.fcmpk every that many steps (-1: the scene's interval); resume: a
- * checkpoint to continue from (NULL: none). petsc_argc/argv: the program name and the PETSc
- * options of the command line (-ksp_type ...). Returns the exit code (0 ok, 1 run failed, 2
- * bad input), the same on every process. */
+ * <name>_checkpoint_NNNNNN.fcmck every that many steps (-1: the scene's interval); resume: a
+ * checkpoint to continue from (NULL: none; the serial format, or a .fcmpk of earlier versions).
+ * petsc_argc/argv: the program name and the PETSc options of the command line (-ksp_type ...).
+ * Returns the exit code (0 ok, 1 run failed, 2 bad input), the same on every process. */
 int sim_petsc_run(const char *path, const char *outdir, long long steps, int check, int quiet,
                   int checkpoint_every, const char *resume, int petsc_argc, char **petsc_argv);
 

@@ -78,9 +78,9 @@ static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS
        "serial (default) or petsc: distributed over the MPI\n"
        "processes (mpirun -n 2 fcm-sim scene.json --backend petsc;\n"
        "a build with PETSc). PETSc options (-ksp_type cg ...) may\n"
-       "follow. Every scene runs: a linear material with gravity,\n"
-       "fixed and motion on node regions through the linear\n"
-       "driver, everything else through the integrator on PETSc",
+       "follow. Every scene with an embedded geometry runs, through\n"
+       "the integrator on PETSc: the serial run's loop, log, frames\n"
+       "and checkpoints (--resume also reads older .fcmpk files)",
        0, 0, 0, backend_names, NULL, NULL},
       {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
   memcpy(opts, t, sizeof t);

@@ -49,7 +49,7 @@ int main(int argc, char **argv)
   const fcm_material mat = {FCM_MATERIAL_LINEAR, 1e6, 0.3, 1000.0};
   fcm_petsc_options po = fcm_petsc_options_default();
   po.kind = FCM_INTEGRATOR_STATIC;
-  po.rtol = 1e-8;
+  po.solver.rtol = 1e-8;
   MPI_Barrier(MPI_COMM_WORLD);
   double t0 = MPI_Wtime(), c0 = cpu_seconds();
   TEST_OK(ctx, fcm_petsc_problem_create(ctx, MPI_COMM_WORLD, mesh, geom, &mat, &po, &P));

@@ -27,8 +27,8 @@ static fcm_petsc_problem *make(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh *mesh
   fcm_petsc_options po = fcm_petsc_options_default();
   po.kind = kind;
   po.dt = 0.01;
-  po.petsc_options = solver;
-  po.rtol = 1e-12;
+  po.solver.petsc_options = solver;
+  po.solver.rtol = 1e-12;
   TEST_OK(ctx, fcm_petsc_problem_create(ctx, comm, mesh, geom, &mat, &po, &P));
   const double *X = fcm_mesh_coords(mesh);
   fcm_index nn = fcm_mesh_num_nodes(mesh), *fix = calloc((size_t)nn, sizeof *fix), nfix = 0;

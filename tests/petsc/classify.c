@@ -21,7 +21,7 @@
  * quadrature.simplify = "auto" those of the choice summed over the processes).
  * Arguments: element type, partition (ordered|ptscotch), [scenes directory, scene file]. */
 #include "fcm/fcm.h"
-#include "fcm/petsc.h"
+#include "fcm/scene_petsc.h"
 #include "fcm/simulation.h"
 #include "test_mpi.h"
 
@@ -268,7 +268,7 @@ int main(int argc, char **argv)
   const fcm_material mat = {FCM_MATERIAL_LINEAR, 1.0e6, 0.3, 1000.0};
   fcm_petsc_options po = fcm_petsc_options_default();
   po.kind = FCM_INTEGRATOR_BACKWARD_EULER; /* both volume kinds */
-  po.partition = part;
+  po.solver.partition = part;
   po.rules.simplify = FCM_CELL_SIMPLIFY_ON;
   po.rules.surface_strength = 2;
   fcm_cell_rules_options ro = po.rules; /* as the backend builds them */

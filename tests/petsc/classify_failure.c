@@ -9,7 +9,7 @@
  * its message. Then a valid problem on the same communicator is built (the processes are still
  * in step) and nothing is left allocated. */
 #include "fcm/fcm.h"
-#include "fcm/petsc.h"
+#include "fcm/scene_petsc.h"
 #include "fcm/simulation.h"
 #include "test_mpi.h"
 

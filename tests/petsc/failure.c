@@ -54,7 +54,7 @@ int main(int argc, char **argv)
   fcm_petsc_problem_destroy(&P);
 
   /* 5. a KSP that cannot converge; its reason is named on every process */
-  po.petsc_options = "-ksp_type cg -pc_type none -ksp_max_it 2";
+  po.solver.petsc_options = "-ksp_type cg -pc_type none -ksp_max_it 2";
   const double g[3] = {0, -9.81, 0};
   fcm_index fix[25], nfix = 0;
   const double *X = fcm_mesh_coords(mesh);

@@ -291,7 +291,7 @@ int main(int argc, char **argv)
   fcm_petsc_options po = fcm_petsc_options_default();
   po.kind = FCM_INTEGRATOR_BACKWARD_EULER; /* no constraint needed */
   po.dt = 1e-3;
-  po.rtol = 1e-10;
+  po.solver.rtol = 1e-10;
   TEST_OK(ctx, fcm_petsc_problem_create(ctx, MPI_COMM_WORLD, mesh, geom, &mat, &po, &P));
   if (!P) goto done;
   const fcm_space *l = P->space;

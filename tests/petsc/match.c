@@ -69,11 +69,11 @@ int main(int argc, char **argv)
   fcm_petsc_options po = fcm_petsc_options_default();
   po.kind = dynamic ? FCM_INTEGRATOR_BACKWARD_EULER : FCM_INTEGRATOR_STATIC;
   po.dt = 0.01;
-  po.rtol = 1e-12;
-  po.partition = strcmp(argv[3], "ordered") == 0    ? FCM_PETSC_PARTITION_ORDERED
-                 : strcmp(argv[3], "ptscotch") == 0 ? FCM_PETSC_PARTITION_PTSCOTCH
-                                                    : FCM_PETSC_PARTITION_AUTO;
-  po.petsc_options = argc > 4 ? argv[4] : NULL;
+  po.solver.rtol = 1e-12;
+  po.solver.partition = strcmp(argv[3], "ordered") == 0    ? FCM_PETSC_PARTITION_ORDERED
+                        : strcmp(argv[3], "ptscotch") == 0 ? FCM_PETSC_PARTITION_PTSCOTCH
+                                                           : FCM_PETSC_PARTITION_AUTO;
+  po.solver.petsc_options = argc > 4 ? argv[4] : NULL;
   TEST_OK(ctx, fcm_petsc_problem_create(ctx, MPI_COMM_WORLD, mesh, geom, &mat, &po, &P));
   TEST_OK(ctx, fcm_petsc_problem_add_gravity(P, grav));
   TEST_OK(ctx, fcm_petsc_problem_add_constraint(P, nfix, fix, &clamp));

@@ -24,7 +24,7 @@
  * The KSP runs to rtol 1e-12 (-ksp_rtol, as a user would set it). */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
-#include "fcm/petsc.h"
+#include "fcm/scene_petsc.h"
 #include "fcm/simulation.h"
 #include "fem/fem_impl.h" /* fcm__space_memory(): the topology's bytes (FCM_TEST_VERBOSE) */
 #include "log_compare.h"

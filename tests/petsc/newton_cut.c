@@ -17,7 +17,7 @@
  * The KSP runs to rtol 1e-12. */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
-#include "fcm/petsc.h"
+#include "fcm/scene_petsc.h"
 #include "fcm/simulation.h"
 #include "log_compare.h"
 #include "test_mpi.h"

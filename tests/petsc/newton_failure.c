@@ -17,7 +17,7 @@
  *   (truncated): every process fails before the cut replay (collective), no hang. */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
-#include "fcm/petsc.h"
+#include "fcm/scene_petsc.h"
 #include "fcm/simulation.h"
 #include "test_mpi.h"
 

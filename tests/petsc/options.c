@@ -18,7 +18,7 @@
  *   traceback handler). */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
-#include "fcm/petsc.h"
+#include "fcm/scene_petsc.h"
 #include "fcm/simulation.h"
 #include "test_mpi.h"
 
@@ -69,8 +69,8 @@ int main(int argc, char **argv)
     fcm_petsc_problem *P = NULL;
     fcm_petsc_options po = fcm_petsc_options_default();
     po.kind = FCM_INTEGRATOR_STATIC;
-    po.rtol = 1e-10;
-    po.petsc_options = strings[k];
+    po.solver.rtol = 1e-10;
+    po.solver.petsc_options = strings[k];
     TEST_OK(ctx, fcm_petsc_problem_create(ctx, MPI_COMM_WORLD, mesh, NULL, &mat, &po, &P));
     TEST_OK(ctx, fcm_petsc_problem_add_gravity(P, g));
     TEST_OK(ctx, fcm_petsc_problem_add_constraint(P, nfix, fix, &clamp));
@@ -134,7 +134,7 @@ int main(int argc, char **argv)
     fcm_petsc_problem *P = NULL;
     fcm_petsc_options po = fcm_petsc_options_default();
     po.kind = FCM_INTEGRATOR_STATIC;
-    po.petsc_options = "-pc_type no_such_pc";
+    po.solver.petsc_options = "-pc_type no_such_pc";
     TEST_OK(ctx, fcm_petsc_problem_create(ctx, MPI_COMM_WORLD, mesh, NULL, &mat, &po, &P));
     TEST_OK(ctx, fcm_petsc_problem_add_gravity(P, g));
     TEST_OK(ctx, fcm_petsc_problem_add_constraint(P, nfix, fix, &clamp));

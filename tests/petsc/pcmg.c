@@ -37,9 +37,9 @@ static int solve(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom, c
   fcm_petsc_problem *P = NULL;
   fcm_petsc_options po = fcm_petsc_options_default();
   po.kind = FCM_INTEGRATOR_STATIC;
-  po.rtol = 1e-10;
-  po.petsc_options = options;
-  po.partition = FCM_PETSC_PARTITION_ORDERED;
+  po.solver.rtol = 1e-10;
+  po.solver.petsc_options = options;
+  po.solver.partition = FCM_PETSC_PARTITION_ORDERED;
   fcm_index nfix = 0, *fix = NULL;
   fcm_petsc_step_info si;
   memset(&si, 0, sizeof si);

@@ -33,7 +33,7 @@
  * [stride]; or: create <scene file> [stride]. */
 #define _POSIX_C_SOURCE 200809L /* open_memstream */
 #include "fcm/fcm.h"
-#include "fcm/petsc.h"
+#include "fcm/scene_petsc.h"
 #include "fcm/simulation.h"
 #include "clamp_util.h"
 #include "test_mpi.h"
@@ -56,9 +56,9 @@ static fcm_status round_(fcm_ctx *ctx, failing *f, long long fail_at, const fcm_
   fcm_petsc_problem *P = NULL;
   fcm_petsc_options po = fcm_petsc_options_default();
   po.kind = FCM_INTEGRATOR_STATIC;
-  po.rtol = 1e-10;
-  po.petsc_options = "-pc_type mg";
-  po.partition = FCM_PETSC_PARTITION_ORDERED;
+  po.solver.rtol = 1e-10;
+  po.solver.petsc_options = "-pc_type mg";
+  po.solver.partition = FCM_PETSC_PARTITION_ORDERED;
   fcm_index nfix = 0, *fix = NULL;
   fcm_petsc_step_info si;
   const fcm_motion clamp = fcm_motion_default();

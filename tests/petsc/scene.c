@@ -7,7 +7,7 @@
  * directory, scene file, steps. */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
-#include "fcm/petsc.h"
+#include "fcm/scene_petsc.h"
 #include "fcm/simulation.h"
 #include "test_mpi.h"
 

@@ -3,10 +3,10 @@
 # `fcm-sim SCENE` (label mpi; the table of scenes is in tests/petsc/tests.cmake).
 #   scene_app.sh run MPIEXEC FCM_SIM STATE_DIFF SCENE STEPS RTOL WORK
 #     both take STEPS steps (--steps) with a checkpoint every step; the state of the last
-#     checkpoint (displacement and velocity, fcm-sim's .fcmck or the linear driver's .fcmpk)
-#     agrees to RTOL relative (petsc_state_diff); the KSP runs to -ksp_rtol 1e-12. On the
-#     integrator path (parallel frames <name>_background_NNNN.pvtu, one piece
-#     <name>_background_NNNN_<rank>.vtu per process, indexed by the PVD) the last frame's
+#     checkpoint (displacement and velocity, .fcmck) agrees to RTOL relative
+#     (petsc_state_diff); the KSP runs to -ksp_rtol 1e-12. The parallel frames
+#     (<name>_background_NNNN.pvtu, one piece <name>_background_NNNN_<rank>.vtu per process,
+#     indexed by the PVD) are checked: the last frame's
 #     pieces' displacement and velocity (placed by node_index) and cell fields (stress, von
 #     Mises, strain energy density, placed by cell_index) agree to RTOL with the serial frame.
 #   scene_app.sh summary MPIEXEC FCM_SIM - SCENE - - WORK
@@ -49,14 +49,13 @@ a=$(last "$work/p") b=$(last "$work/s")
 # the same step on both (the serial's last checkpoint names the step)
 [ "${a%.*}" = "$work/p/$(basename "${b%.*}")" ] || { echo "last checkpoints $a, $b" >&2; exit 1; }
 "$diff" "$a" "$b" "$arg"
-if ls "$work/p/${name}"_background_*.pvtu >/dev/null 2>&1; then
-  f=$(ls "$work/p/${name}"_background_*.pvtu | sort | tail -n 1)
-  # one piece per process, and the PVD indexes the .pvtu frames
-  for r in 0 1; do [ -f "${f%.pvtu}_$r.vtu" ] || { echo "piece ${f%.pvtu}_$r.vtu missing" >&2; exit 1; }; done
-  grep -q "$(basename "$f")" "$work/p/${name}_background.pvd" || { echo "PVD lacks $f" >&2; exit 1; }
-  if ls "$work/p/${name}"_background_????.vtu >/dev/null 2>&1; then
-    echo "serial background frames next to the .pvtu" >&2; exit 1
-  fi
-  "$diff" --vtu "$f" "$work/s/$(basename "${f%.pvtu}").vtu" "$arg"
+ls "$work/p/${name}"_background_*.pvtu >/dev/null || { echo "no parallel frames" >&2; exit 1; }
+f=$(ls "$work/p/${name}"_background_*.pvtu | sort | tail -n 1)
+# one piece per process, and the PVD indexes the .pvtu frames
+for r in 0 1; do [ -f "${f%.pvtu}_$r.vtu" ] || { echo "piece ${f%.pvtu}_$r.vtu missing" >&2; exit 1; }; done
+grep -q "$(basename "$f")" "$work/p/${name}_background.pvd" || { echo "PVD lacks $f" >&2; exit 1; }
+if ls "$work/p/${name}"_background_????.vtu >/dev/null 2>&1; then
+  echo "serial background frames next to the .pvtu" >&2; exit 1
 fi
+"$diff" --vtu "$f" "$work/s/$(basename "${f%.pvtu}").vtu" "$arg"
 rm -rf "$work"

@@ -92,15 +92,33 @@ foreach(np 1 2)
   fcm_add_test(petsc_bench_np${np} tests/petsc/bench.c NP ${np} LABELS bench ARGS hex8 24
                TIMEOUT 1800)
 endforeach()
+# a linear scene on the linear driver against the integrator on PETSc (fcm-sim's path): set-up
+# and time per step (labels bench, mpi: not in the default run; lib/docs/petsc_backend.md)
+foreach(np 1 2)
+  fcm_add_test(petsc_driver_paths_np${np} tests/petsc/driver_paths.c NP ${np} LABELS bench
+               ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/vibrating_beam_fine.json 10 3
+               TIMEOUT 600)
+endforeach()
 # checkpoints: resume bit for bit on the same processes, to 1e-10 on another count
 foreach(np 1 2)
   fcm_add_test(petsc_checkpoint_np${np} tests/petsc/checkpoint.c NP ${np})
 endforeach()
+# the linear driver's older checkpoint format (.fcmpk) loads into the integrator on PETSc and the
+# serial simulation (fcm_simulation_read_checkpoint()): its state bit for bit, the next step
+# equal to the driver's to 1e-8; files of another problem and truncated ones refused
+foreach(np 1 2)
+  fcm_add_test(petsc_legacy_checkpoint_np${np} tests/petsc/legacy_checkpoint.c NP ${np}
+               ARGS ${PROJECT_SOURCE_DIR}/apps/scenes vibrating_beam.json 5
+                    ${CMAKE_CURRENT_BINARY_DIR}/petsc_legacy_checkpoint)
+endforeach()
 if(FCM_BUILD_APPS)
-  # fcm-sim --backend petsc --checkpoint-every / --resume: byte for byte on 2 processes
+  # fcm-sim --backend petsc --checkpoint-every / --resume on a linear scene: byte for byte on 2
+  # processes; a .fcmpk of the older format resumes to 1e-8
   add_test(NAME petsc_app_sim_resume
            COMMAND bash ${PROJECT_SOURCE_DIR}/tests/petsc/resume.sh ${MPIEXEC_EXECUTABLE}
-                   $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/vibrating_beam.json
+                   $<TARGET_FILE:fcm-sim> $<TARGET_FILE:petsc_state_diff>
+                   $<TARGET_FILE:petsc_legacy_checkpoint>
+                   ${PROJECT_SOURCE_DIR}/apps/scenes/vibrating_beam.json
                    ${CMAKE_CURRENT_BINARY_DIR}/petsc_app_sim_resume)
   set_tests_properties(petsc_app_sim_resume PROPERTIES LABELS mpi TIMEOUT 300 PROCESSORS 2
                        ENVIRONMENT "${FCM_MPI_TEST_ENV}")

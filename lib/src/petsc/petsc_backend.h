@@ -18,11 +18,8 @@ fcm_status fcm__petsc_agree(fcm_ctx *ctx, MPI_Comm comm, fcm_status st);
 
 /* The integrator backend's settings (fcm__petsc_backend_create()). */
 typedef struct fcm__petsc_backend_options {
-  fcm_petsc_partition partition; /* the cell partition method */
-  int direct;                    /* 1: MUMPS (Cholesky) instead of the Krylov defaults */
-  double rtol;                   /* the KSP's relative tolerance (> 0) */
-  int max_iterations;            /* the KSP's iteration limit (> 0) */
-  const char *petsc_options;     /* options database string (copied; may be NULL) */
+  fcm_petsc_solver_options solver; /* partition and KSP settings (checked) */
+  int direct;                      /* 1: MUMPS (Cholesky) instead of the Krylov defaults */
   fcm_material mat;
 } fcm__petsc_backend_options;
 

@@ -121,6 +121,11 @@ fcm_status fcm__petsc_problem_agree(fcm_petsc_problem *P, fcm_status st);
 /* petsc_init.c: P's options prefix ("fcm<k>_", k counting the problems this process made). */
 void fcm__petsc_set_prefix(fcm_petsc_problem *P);
 
+/* petsc_init.c: check the solver settings o (partition, rtol, max_iterations: the message names
+ * the bad one) and make them P's (P->opts.solver), its options string copied into
+ * P->petsc_options (P->opts.solver.petsc_options is then NULL). Local. */
+fcm_status fcm__petsc_adopt_solver(fcm_petsc_problem *P, const fcm_petsc_solver_options *o);
+
 /* petsc_partition.c: the candidate cells of geom (mesh P->mesh) partitioned over the processes
  * (P->cell_owner, P->weight, P->classifier, P->remote); *mask: this process's cells. Collective. */
 fcm_status fcm__petsc_partition_cells(fcm_petsc_problem *P, const fcm_geometry *geom,

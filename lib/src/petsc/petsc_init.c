@@ -67,6 +67,29 @@ void fcm__petsc_set_prefix(fcm_petsc_problem *P)
   snprintf(P->prefix, sizeof P->prefix, "fcm%lu_", ++fcm_petsc_num_problems);
 }
 
+fcm_status fcm__petsc_adopt_solver(fcm_petsc_problem *P, const fcm_petsc_solver_options *o)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  FCM_CHECK((int)o->partition >= 0 && o->partition < FCM_PETSC_PARTITION_COUNT, ctx, FCM_ERR_ARG,
+            "petsc: solver.partition = %d is not a method (0 auto, 1 ptscotch, 2 ordered)",
+            (int)o->partition);
+  FCM_CHECK(o->rtol > 0.0 && o->rtol < 1.0, ctx, FCM_ERR_ARG,
+            "petsc: solver.rtol = %g outside (0, 1)", o->rtol);
+  FCM_CHECK(o->max_iterations >= 1, ctx, FCM_ERR_ARG,
+            "petsc: solver.max_iterations = %d must be >= 1", o->max_iterations);
+  P->opts.solver = *o;
+  P->opts.solver.petsc_options = NULL;
+  if (o->petsc_options) {
+    const size_t len = strlen(o->petsc_options);
+    P->petsc_options = fcm__calloc(ctx, len + 1, 1);
+    FCM_CHECK(P->petsc_options, ctx, FCM_ERR_ALLOC, "petsc: out of memory (options string)");
+    memcpy(P->petsc_options, o->petsc_options, len);
+  }
+cleanup:
+  return st;
+}
+
 static int fcm_petsc_started_mpi = 0;
 static int fcm_petsc_pushed_handler = 0; /* fcm_petsc_initialize() pushed PETSc's error handler */
 
@@ -119,16 +142,24 @@ const char *fcm_petsc_partition_name(fcm_petsc_partition p)
   }
 }
 
+fcm_petsc_solver_options fcm_petsc_solver_options_default(void)
+{
+  fcm_petsc_solver_options o;
+  memset(&o, 0, sizeof o);
+  o.partition = FCM_PETSC_PARTITION_AUTO;
+  o.petsc_options = NULL;
+  o.rtol = 1e-10;
+  o.max_iterations = 10000;
+  return o;
+}
+
 fcm_petsc_options fcm_petsc_options_default(void)
 {
   fcm_petsc_options o;
   memset(&o, 0, sizeof o);
   o.kind = FCM_INTEGRATOR_BACKWARD_EULER;
   o.dt = 1.0 / 60.0;
-  o.partition = FCM_PETSC_PARTITION_AUTO;
-  o.petsc_options = NULL;
-  o.rtol = 1e-10;
-  o.max_iterations = 10000;
+  o.solver = fcm_petsc_solver_options_default();
   o.rules = fcm_cell_rules_options_default();
   o.assembly = fcm_assembly_options_default();
   return o;

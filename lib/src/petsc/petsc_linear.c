@@ -23,13 +23,6 @@ static fcm_status check_inputs(fcm_petsc_problem *P, const fcm_petsc_options *o)
             FCM_ERR_ARG, "petsc: kind = %d is neither static (0) nor backward Euler (1)",
             (int)o->kind);
   FCM_CHECK(isfinite(o->dt) && o->dt > 0.0, ctx, FCM_ERR_ARG, "petsc: dt = %g must be > 0", o->dt);
-  FCM_CHECK((int)o->partition >= 0 && o->partition < FCM_PETSC_PARTITION_COUNT, ctx, FCM_ERR_ARG,
-            "petsc: partition = %d is not a method (0 auto, 1 ptscotch, 2 ordered)",
-            (int)o->partition);
-  FCM_CHECK(o->rtol > 0.0 && o->rtol < 1.0, ctx, FCM_ERR_ARG, "petsc: rtol = %g outside (0, 1)",
-            o->rtol);
-  FCM_CHECK(o->max_iterations >= 1, ctx, FCM_ERR_ARG, "petsc: max_iterations = %d must be >= 1",
-            o->max_iterations);
   FCM_CHECK(o->rules.simplify != FCM_CELL_SIMPLIFY_AUTO, ctx, FCM_ERR_UNSUPPORTED,
             "petsc: rules.simplify = auto is not supported (the choice would differ between "
             "processes); use on or off");
@@ -89,17 +82,10 @@ fcm_status fcm_petsc_problem_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_mesh 
   P->mesh = mesh;
   P->mat = *mat;
   P->opts = opts ? *opts : fcm_petsc_options_default();
-  if (P->opts.petsc_options) {
-    size_t len = strlen(P->opts.petsc_options);
-    P->petsc_options = fcm__calloc(ctx, len + 1, 1);
-    if (P->petsc_options)
-      memcpy(P->petsc_options, P->opts.petsc_options, len);
-    else
-      st = FCM_ERR_ALLOC;
-  }
-  P->opts.petsc_options = NULL;
   fcm__petsc_set_prefix(P);
-  if (st == FCM_OK) st = check_inputs(P, &P->opts);
+  st = check_inputs(P, &P->opts);
+  const fcm_petsc_solver_options solver = P->opts.solver;
+  if (st == FCM_OK) st = fcm__petsc_adopt_solver(P, &solver);
   FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
 
   /* 1., 2. the candidate cells and their partition */
@@ -487,8 +473,8 @@ fcm_status fcm_petsc_problem_setup(fcm_petsc_problem *P)
     PCALL(ctx, KSPGetPC(P->ksp, &pc));
     PCALL(ctx, PCSetType(pc, PCGAMG));
   }
-  PCALL(ctx, KSPSetTolerances(P->ksp, P->opts.rtol, PETSC_DEFAULT, PETSC_DEFAULT,
-                              P->opts.max_iterations));
+  PCALL(ctx, KSPSetTolerances(P->ksp, P->opts.solver.rtol, PETSC_DEFAULT, PETSC_DEFAULT,
+                              P->opts.solver.max_iterations));
   PCALL(ctx, KSPSetFromOptions(P->ksp));
   {
     PC pc;
@@ -620,7 +606,7 @@ fcm_status fcm_petsc_problem_step(fcm_petsc_problem *P, fcm_petsc_step_info *inf
               "after %d iterations, residual norm %g (rtol %g); change the solver with "
               "-ksp_type / -pc_type or solver.petsc_options",
               t1, kt ? kt : "?", pt ? pt : "?", KSPConvergedReasons[reason], (int)reason, (int)its,
-              (double)rnorm, P->opts.rtol);
+              (double)rnorm, P->opts.solver.rtol);
   }
   /* accept: v = (u1 - u0)/h (dynamic), u = u1 */
   if (P->M) {
@@ -712,7 +698,7 @@ fcm_status fcm_petsc_problem_get_info(fcm_petsc_problem *P, fcm_petsc_info *info
   memset(info, 0, sizeof *info);
   info->size = P->size;
   info->rank = P->rank;
-  info->partition = P->size == 1 && P->opts.partition == FCM_PETSC_PARTITION_AUTO
+  info->partition = P->size == 1 && P->opts.solver.partition == FCM_PETSC_PARTITION_AUTO
                         ? FCM_PETSC_PARTITION_ORDERED
                         : P->partition;
   info->num_dofs = P->n;

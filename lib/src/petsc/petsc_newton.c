@@ -324,8 +324,8 @@ static fcm_status newton_build(fcm_petsc_problem *P, fcm_status st, const fcm_sp
       PCALL(ctx, KSPSetType(P->ksp, KSPCG));
       PCALL(ctx, PCSetType(pc, PCGAMG));
     }
-    PCALL(ctx, KSPSetTolerances(P->ksp, P->opts.rtol, PETSC_DEFAULT, PETSC_DEFAULT,
-                                P->opts.max_iterations));
+    PCALL(ctx, KSPSetTolerances(P->ksp, P->opts.solver.rtol, PETSC_DEFAULT, PETSC_DEFAULT,
+                                P->opts.solver.max_iterations));
     PCALL(ctx, KSPSetFromOptions(P->ksp));
     PCALL(ctx, PetscOptionsHasName(NULL, P->prefix, "-ksp_type", &has));
     P->ksp_type_set = has == PETSC_TRUE;
@@ -424,18 +424,8 @@ fcm_status fcm__petsc_backend_create(fcm_ctx *ctx, MPI_Comm comm, fcm_status st,
   FCM_TRY(ctx, st);
   P->opts = fcm_petsc_options_default();
   fcm__petsc_set_prefix(P);
-  P->opts.partition = o->partition;
   P->direct = o->direct;
-  P->opts.rtol = o->rtol;
-  P->opts.max_iterations = o->max_iterations;
-  if (o->petsc_options) {
-    size_t len = strlen(o->petsc_options);
-    P->petsc_options = fcm__calloc(ctx, len + 1, 1);
-    if (P->petsc_options)
-      memcpy(P->petsc_options, o->petsc_options, len);
-    else
-      st = FCM_ERR_ALLOC;
-  }
+  st = fcm__petsc_adopt_solver(P, &o->solver);
   P->mat = o->mat;
   st = newton_agree(P, st);
 cleanup:

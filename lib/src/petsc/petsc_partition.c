@@ -302,8 +302,8 @@ fcm_status fcm__petsc_partition_cells(fcm_petsc_problem *P, const fcm_geometry *
     P->cell_owner[c] = -1;
     ncand += P->weight[c] != 0;
   }
-  P->partition = P->opts.partition == FCM_PETSC_PARTITION_AUTO ? FCM_PETSC_PARTITION_ORDERED
-                                                               : P->opts.partition;
+  P->partition = P->opts.solver.partition == FCM_PETSC_PARTITION_AUTO ? FCM_PETSC_PARTITION_ORDERED
+                                                                      : P->opts.solver.partition;
   if (P->size == 1) {
     for (fcm_index c = 0; c < nc; c++)
       if (P->weight[c]) P->cell_owner[c] = 0;

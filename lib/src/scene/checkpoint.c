@@ -16,7 +16,12 @@
  *   version 4: i64 inverted quadrature points, i64 cell of the first (-1: none), i64 NaN or
  *   infinite von Mises values of the frame after the step (-1: no frame))
  *   num_dofs x f64 displacement, num_dofs x f64 velocity
- *   u64 FNV-1a 64 checksum of every byte before it */
+ *   u64 FNV-1a 64 checksum of every byte before it
+ *
+ * Earlier versions' PETSc linear driver wrote a format of its own (".fcmpk"): the 16 bytes
+ * "fcm-petsc-ck-1\n\0", i64 num_dofs, elements, steps, integrator kind; f64 time, dt;
+ * num_dofs x f64 displacement, num_dofs x f64 velocity (the space's DOF numbering). The reader
+ * converts it (read_petsc_v1()). */
 #define _POSIX_C_SOURCE 200809L
 #include "scene/run_impl.h"
 
@@ -252,6 +257,105 @@ static void ckpt_data_free(fcm_ctx *ctx, ckpt_data *d)
   fcm__free(ctx, d->react);
 }
 
+/* The state at the end of a checkpoint: d->n displacement and velocity values, nothing after. */
+static fcm_status read_state(ckpt_reader *r, ckpt_data *d)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = r->ctx;
+  FCM_TRY(ctx, need(r, d->n, 2 * sizeof(double), "displacement and velocity values"));
+  FCM_ALLOC(ctx, d->n, d->u);
+  FCM_ALLOC(ctx, d->n, d->v);
+  FCM_TRY(ctx, get(r, d->u, sizeof *d->u * (size_t)d->n, "the displacement"));
+  FCM_TRY(ctx, get(r, d->v, sizeof *d->v * (size_t)d->n, "the velocity"));
+  FCM_CHECK(r->pos == r->size, ctx, FCM_ERR_FORMAT, "checkpoint %s: %zu unexpected trailing bytes",
+            r->path, r->size - r->pos);
+cleanup:
+  return st;
+}
+
+/* Room for d->rows log rows and their nreact reaction values each. */
+static fcm_status alloc_rows(fcm_ctx *ctx, ckpt_data *d, size_t nreact)
+{
+  fcm_status st = FCM_OK;
+  if (d->rows > 0)
+    FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&d->log, &d->log_cap, d->rows, sizeof *d->log));
+  if (d->rows > 0 && nreact > 0)
+    FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&d->react, &d->react_cap, d->rows,
+                               nreact * sizeof *d->react));
+cleanup:
+  return st;
+}
+
+/* A checkpoint's step count against the steps this run takes. */
+static fcm_status check_steps(const fcm_simulation *S, const char *path, long long steps)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(steps <= S->num_steps, S->ctx, FCM_ERR_ARG,
+            "checkpoint %s: step %lld is beyond the %lld steps this run takes (extend "
+            "time.duration or --steps)",
+            path, steps, S->num_steps);
+cleanup:
+  return st;
+}
+
+/* The older PETSc linear driver's checkpoint (see the top of the file) in data (size bytes)
+ * into *d: the state, time and step count; checked against the scene (DOFs, elements, kind and
+ * dt). It holds no log: the rows of its steps carry their time alone (the other columns NaN,
+ * the counts 0, the inversions and frames not recorded), and the frames are those its run
+ * wrote (steps 0, frame_interval, 2 frame_interval, ... up to its step). */
+static const char petsc_v1_magic[16] = "fcm-petsc-ck-1\n";
+
+static fcm_status read_petsc_v1(fcm_simulation *S, const char *path, const unsigned char *data,
+                                size_t size, ckpt_data *d)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  ckpt_reader r = {ctx, path, data, size, sizeof petsc_v1_magic};
+  long long elems = 0, kind = 0;
+  double dt = 0.0;
+  const fcm_scene_time *tm = fcm_scene_get_time(S->scene);
+  FCM_TRY(ctx, get_i64(&r, &d->n, 0, INT64_MAX, "num_dofs"));
+  FCM_TRY(ctx, get_i64(&r, &elems, 0, INT64_MAX, "elements"));
+  FCM_TRY(ctx, get_i64(&r, &d->steps, 0, INT64_MAX, "steps"));
+  FCM_TRY(ctx, get_i64(&r, &kind, 0, 1, "the integrator kind"));
+  FCM_TRY(ctx, get(&r, &d->t, sizeof d->t, "time"));
+  FCM_TRY(ctx, get(&r, &dt, sizeof dt, "dt"));
+  FCM_CHECK(elems == (long long)fcm_space_num_elements(S->space) &&
+                kind == (long long)tm->integrator && dt == tm->dt,
+            ctx, FCM_ERR_ARG,
+            "checkpoint %s is of another problem: %lld elements, kind %lld, dt %g (scene '%s': "
+            "%lld, %d, %g)",
+            path, elems, kind, dt, fcm_scene_name(S->scene),
+            (long long)fcm_space_num_elements(S->space), (int)tm->integrator, tm->dt);
+  FCM_TRY(ctx, check_steps(S, path, d->steps));
+  FCM_TRY(ctx, read_state(&r, d));
+  {
+    const int every = fcm_scene_get_output(S->scene)->frame_interval;
+    const long long interval = every > 0 ? every : 1;
+    const size_t nreact = 6 * (size_t)S->num_react;
+    d->frames = d->steps / interval + 1;
+    FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&d->frame_time, &d->frame_cap, d->frames,
+                               sizeof *d->frame_time));
+    for (long long k = 0; k < d->frames; k++)
+      d->frame_time[k] = (double)(k * interval) * tm->dt;
+    d->rows = d->steps;
+    FCM_TRY(ctx, alloc_rows(ctx, d, nreact));
+    for (long long k = 0; k < d->rows; k++) {
+      fcm__log_row *w = &d->log[k];
+      memset(w, 0, sizeof *w);
+      w->time = (double)(k + 1) * tm->dt;
+      w->residual = w->energy = w->wall = w->mass = NAN;
+      w->momentum[0] = w->momentum[1] = w->momentum[2] = NAN;
+      w->pieces = (long long)S->pieces;
+      w->inverted = w->inverted_cell = w->nonfinite = -1;
+      for (size_t j = 0; j < nreact; j++)
+        d->react[(size_t)k * nreact + j] = NAN;
+    }
+  }
+cleanup:
+  return st;
+}
+
 /* Read and check the whole file `path` into *d (local: no process talks to another). */
 static fcm_status read_file(fcm_simulation *S, const char *path, ckpt_data *d)
 {
@@ -263,6 +367,10 @@ static fcm_status read_file(fcm_simulation *S, const char *path, ckpt_data *d)
   uint64_t ver = 0;
   FCM_TRY(ctx, fcm__file_read_all(ctx, "checkpoint", path, CKPT_MAX_BYTES, (char **)&data, &size));
   ckpt_reader r = {ctx, path, data, size, 0};
+  if (size >= sizeof petsc_v1_magic && !memcmp(data, petsc_v1_magic, sizeof petsc_v1_magic)) {
+    st = read_petsc_v1(S, path, data, size, d);
+    goto cleanup;
+  }
   {
     char magic[8];
     uint64_t version = 0, bom = 0, fp = 0, sum = 0;
@@ -289,10 +397,7 @@ static fcm_status read_file(fcm_simulation *S, const char *path, ckpt_data *d)
   }
   FCM_TRY(ctx, get_i64(&r, &d->n, 0, INT64_MAX, "num_dofs"));
   FCM_TRY(ctx, get_i64(&r, &d->steps, 0, INT64_MAX, "steps"));
-  FCM_CHECK(d->steps <= S->num_steps, ctx, FCM_ERR_ARG,
-            "checkpoint %s: step %lld is beyond the %lld steps this run takes (extend "
-            "time.duration or --steps)",
-            path, d->steps, S->num_steps);
+  FCM_TRY(ctx, check_steps(S, path, d->steps));
   FCM_TRY(ctx, get(&r, &d->t, sizeof d->t, "time"));
   if (ver >= 2) FCM_TRY(ctx, get_i64(&r, &d->cuts, S->cuts_applied, S->num_cuts, "cuts applied"));
   FCM_TRY(ctx, get_i64(&r, &d->newton, 0, INT64_MAX, "newton_iterations"));
@@ -311,11 +416,7 @@ static fcm_status read_file(fcm_simulation *S, const char *path, ckpt_data *d)
                                           (ver >= 4 ? 6 : 3) * sizeof(int64_t)
                                     : 4 * sizeof(double) + 2 * sizeof(int64_t);
   FCM_TRY(ctx, need(&r, d->rows, row_bytes, "log rows"));
-  if (d->rows > 0)
-    FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&d->log, &d->log_cap, d->rows, sizeof *d->log));
-  if (d->rows > 0 && nreact > 0)
-    FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&d->react, &d->react_cap, d->rows,
-                               nreact * sizeof *d->react));
+  FCM_TRY(ctx, alloc_rows(ctx, d, nreact));
   for (long long k = 0; k < d->rows; k++) {
     fcm__log_row *w = &d->log[k];
     double x[4];
@@ -345,13 +446,7 @@ static fcm_status read_file(fcm_simulation *S, const char *path, ckpt_data *d)
       FCM_TRY(ctx, get_i64(&r, &w->nonfinite, -1, INT64_MAX, "a log row's NaN stresses"));
     }
   }
-  FCM_TRY(ctx, need(&r, d->n, 2 * sizeof(double), "displacement and velocity values"));
-  FCM_ALLOC(ctx, d->n, d->u);
-  FCM_ALLOC(ctx, d->n, d->v);
-  FCM_TRY(ctx, get(&r, d->u, sizeof *d->u * (size_t)d->n, "the displacement"));
-  FCM_TRY(ctx, get(&r, d->v, sizeof *d->v * (size_t)d->n, "the velocity"));
-  FCM_CHECK(r.pos == r.size, ctx, FCM_ERR_FORMAT, "checkpoint %s: %zu unexpected trailing bytes",
-            path, r.size - r.pos);
+  FCM_TRY(ctx, read_state(&r, d));
 cleanup:
   fcm__free(ctx, data);
   return st;

@@ -4,6 +4,7 @@
  * simulation whose integrator solves through the PETSc backend (fcm_petsc_simulation_create():
  * the backend partitions the cells, the simulation's cell rules carry this process's share and
  * its integrator sums and solves through the backend, lib/src/fem/fem_backend.h). */
+#include "fcm/scene_petsc.h"
 #include "scene/run_impl.h"
 #include "scene/scene_impl.h"
 
@@ -65,6 +66,21 @@ int fcm_petsc_problem_supports_scene(fcm_ctx *ctx, const fcm_scene *scene)
   return ok;
 }
 
+/* The PETSc solver settings of a scene, the same for both drivers: its solver section's
+ * petsc_options and Krylov tolerance and iteration limit (when the scene gives them; else the
+ * backend's defaults, fcm_petsc_solver_options_default()), and the partition method. */
+static fcm_petsc_solver_options scene_solver(const fcm_scene *scene, fcm_petsc_partition partition)
+{
+  const fcm_scene_solver *sv = fcm_scene_get_solver(scene);
+  const fcm_integrator_options *io = &sv->integrator;
+  fcm_petsc_solver_options o = fcm_petsc_solver_options_default();
+  o.partition = partition;
+  o.petsc_options = sv->petsc_options;
+  if (io->krylov_rtol > 0.0) o.rtol = io->krylov_rtol;
+  if (io->krylov_max_iterations > 0) o.max_iterations = io->krylov_max_iterations;
+  return o;
+}
+
 /* The background nodes of a region (as the serial runner picks them). */
 static fcm_status scene_region_nodes(fcm_ctx *ctx, const fcm_scene *scene, const fcm_mesh *mesh,
                                      const fcm_region *r, int k, fcm_index **nodes, fcm_index *n)
@@ -118,10 +134,7 @@ fcm_status fcm_petsc_problem_create_from_scene(fcm_ctx *ctx, MPI_Comm comm, cons
   fcm_petsc_options o = fcm_petsc_options_default();
   o.kind = tm->integrator;
   o.dt = tm->dt;
-  o.partition = partition;
-  o.petsc_options = sv->petsc_options;
-  o.rtol = sv->integrator.krylov_rtol > 0.0 ? sv->integrator.krylov_rtol : o.rtol;
-  o.max_iterations = sv->integrator.krylov_max_iterations;
+  o.solver = scene_solver(scene, partition);
   o.rules = *q;
   o.rules.surface_strength = -1;
   if (sv->threads > 0) FCM_TRY(ctx, fcm_ctx_set_num_threads(ctx, sv->threads));
@@ -186,23 +199,12 @@ fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_sc
     *out = NULL;
   if (st == FCM_OK && !(ctx && scene))
     st = fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__, "petsc: NULL context or scene");
-  if (st == FCM_OK && !((int)partition >= 0 && partition < FCM_PETSC_PARTITION_COUNT))
-    st = fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
-                    "petsc: partition = %d is not a method (0 auto, 1 ptscotch, 2 ordered)",
-                    (int)partition);
-  /* the backend's settings from the scene's solver section */
+  /* the backend's settings from the scene's solver section (the partition is checked there) */
   fcm__petsc_backend_options bo;
   memset(&bo, 0, sizeof bo);
   if (st == FCM_OK) {
-    const fcm_petsc_options defaults = fcm_petsc_options_default();
-    const fcm_scene_solver *sv = fcm_scene_get_solver(scene);
-    bo.partition = partition;
-    const fcm_integrator_options *io = &sv->integrator;
-    bo.direct = io->linear_solver == FCM_LINEAR_DIRECT;
-    bo.rtol = io->krylov_rtol > 0.0 ? io->krylov_rtol : defaults.rtol;
-    bo.max_iterations =
-        io->krylov_max_iterations > 0 ? io->krylov_max_iterations : defaults.max_iterations;
-    bo.petsc_options = sv->petsc_options;
+    bo.solver = scene_solver(scene, partition);
+    bo.direct = fcm_scene_get_solver(scene)->integrator.linear_solver == FCM_LINEAR_DIRECT;
     bo.mat = *fcm_scene_get_material(scene);
   }
   FCM_TRY(ctx, fcm__petsc_backend_create(ctx, comm, st, &bo, &P));
