@@ -273,11 +273,33 @@ static cell_result volume_cell(const fcm_space *s, const pass *ps, fcm_index e, 
   return fcm__cell_kernel(kd, &r, nn, w);
 }
 
-/* Run the pass over the local elements (a full space: all) colour by colour (parallel within
- * a colour) and scatter each element's result (matrix: into the space's rows, vector: at the
- * element's DOFs, energy: at its element id); an element with det J <= 0 or a non-finite
- * material response is not scattered, and the cell of the lowest such element of the colour
- * is reported. */
+/* Local element le of the pass into the pass's outputs; 0 (with res) when its det J is not
+ * positive somewhere or the material returned NaN or infinity: nothing is scattered then. */
+static int pass_element(const fcm_space *s, const pass *ps, fcm_index le, scratch *w,
+                        cell_result *res)
+{
+  const fcm_index c = fcm__space_local_elem(s, le);
+  /* another process's element (a distributed run's ghost): no points, nothing to add */
+  if (!fcm__cell_rules_owns(s->rules, s->elem_cell[c])) return 1;
+  if (ps->traction) {
+    if (!surface_cell(s, ps, c, w)) return 1;
+  } else {
+    *res = volume_cell(s, ps, c, w);
+    if (!(res->bad_det > 0.0) || res->nonfinite) return 0;
+    if (ps->cell_energy) ps->cell_energy[c] = res->energy;
+    if (ps->cell_inverted) ps->cell_inverted[c] = res->inverted;
+  }
+  if (ps->vals) scatter_matrix(s, le, w->Ke, ps->vals);
+  if (ps->vec) scatter_vector(s, c, w->fe, ps->vec);
+  return 1;
+}
+
+/* Run the pass over the local elements (a full space: all) by the space's coloured blocks of
+ * consecutive elements: colour by colour, a block per thread at a time, its elements in
+ * order, so each matrix entry receives its terms in the same order for any thread count. Each
+ * element's result is scattered (matrix: into the space's rows, vector: at the element's DOFs,
+ * energy: at its element id); an element with det J <= 0 or a non-finite material response is
+ * not, and the cell of the lowest such element of the colour is reported. */
 static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
 {
   fcm_status st = FCM_OK;
@@ -286,34 +308,27 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
   fcm_index bad_cell = -1;
   double bad_det = 1.0;
   int bad_numeric = 0;
-  for (int color = 0; color < s->num_colors; color++) {
-    fcm_index c0 = s->color_ptr[color], c1 = s->color_ptr[color + 1];
+  const fcm_index ne = s->num_local_elems;
+  for (int color = 0; color < s->num_block_colors; color++) {
+    const fcm_index b0 = s->block_color_ptr[color], b1 = s->block_color_ptr[color + 1];
 #pragma omp parallel num_threads(ws->nthreads)
     {
       scratch *w = ws->sc + omp_get_thread_num();
-#pragma omp for schedule(dynamic, 16)
-      for (fcm_index k = c0; k < c1; k++) {
-        const fcm_index le = s->color_elems[k], c = fcm__space_local_elem(s, le);
-        /* another process's element (a distributed run's ghost): no points, nothing to add */
-        if (!fcm__cell_rules_owns(s->rules, s->elem_cell[c])) continue;
-        if (ps->traction) {
-          if (!surface_cell(s, ps, c, w)) continue;
-        } else {
-          cell_result res = volume_cell(s, ps, c, w);
-          if (!(res.bad_det > 0.0) || res.nonfinite) {
+#pragma omp for schedule(dynamic, 1)
+      for (fcm_index k = b0; k < b1; k++) {
+        const fcm_index first = s->block_list[k] * FCM__SPACE_BLOCK;
+        const fcm_index last = FCM_MIN(ne, first + FCM__SPACE_BLOCK);
+        for (fcm_index le = first; le < last; le++) {
+          cell_result res;
+          if (pass_element(s, ps, le, w, &res)) continue;
+          const fcm_index c = fcm__space_local_elem(s, le);
 #pragma omp critical(fcm_assemble_bad)
-            if (bad_cell < 0 || c < bad_cell) {
-              bad_cell = c;
-              bad_det = res.bad_det;
-              bad_numeric = res.nonfinite;
-            }
-            continue;
+          if (bad_cell < 0 || c < bad_cell) {
+            bad_cell = c;
+            bad_det = res.bad_det;
+            bad_numeric = res.nonfinite;
           }
-          if (ps->cell_energy) ps->cell_energy[c] = res.energy;
-          if (ps->cell_inverted) ps->cell_inverted[c] = res.inverted;
         }
-        if (ps->vals) scatter_matrix(s, le, w->Ke, ps->vals);
-        if (ps->vec) scatter_vector(s, c, w->fe, ps->vec);
       }
     }
     FCM_CHECK(bad_cell < 0 || !bad_numeric, ctx, FCM_ERR_NUMERIC,

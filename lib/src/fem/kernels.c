@@ -4,13 +4,13 @@
  *   stiffness  H = sum_q w_q det J_q g_q g_q^T     (g_q the 3nn physical gradients at q)
  *   mass       M = sum_q w_q det J_q rho N_q N_q^T
  *   tangent    K_(a,i)(b,k) = sum_(q,J) g_qaJ [w_q det J_q sum_L A_q,iJkL g_qbL]
- * each as register blocks of 4 rows x 8 columns over the upper triangle (the micro-kernel
- * micro_4x8()). With FCM_MULTIVERSION on x86-64 with GCC and glibc, the kernels are compiled
- * for x86-64-v4 (AVX-512), x86-64-v3 (AVX2 + FMA) and the baseline, and the loader picks the
- * clone for the CPU (an ifunc): a default build runs the AVX-512 code on a CPU that has it.
- * Compiled with -ffp-contract=fast (sources.cmake), so products and sums fuse where the CPU
- * can; the results then differ between instruction sets at round-off, but on one machine
- * they are the same for every thread count. */
+ * each as register blocks of 4 rows x 16 columns (AVX-512) or 4 x 8 over the upper triangle
+ * (the micro-kernels micro_4x16() and micro_4x8()). With FCM_MULTIVERSION on x86-64 with GCC and
+ * glibc, the kernels are compiled for x86-64-v4 (AVX-512), x86-64-v3 (AVX2 + FMA) and the baseline,
+ * and the loader picks the clone for the CPU (an ifunc): a default build runs the AVX-512 code on a
+ * CPU that has it. Compiled with -ffp-contract=fast (sources.cmake), so products and sums fuse
+ * where the CPU can; the results then differ between instruction sets at round-off, but on one
+ * machine they are the same for every thread count. */
 #include "fem/kernels_impl.h"
 
 #include <math.h>
@@ -20,6 +20,7 @@
     !defined(__clang__) && __GNUC__ >= 11 && defined(__GLIBC__)
 #define FCM_KERNEL_CLONES                                                                          \
   __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#define FCM_KERNEL_CLONES_ON
 #else
 #define FCM_KERNEL_CLONES
 #endif
@@ -53,6 +54,29 @@ FCM_KERNEL_INLINE void micro_4x8(int nk, const double *A, int lda, const double 
   memcpy(&t, C + 2 * ldc, sizeof t), t += c2, memcpy(C + 2 * ldc, &t, sizeof t);
   memcpy(&t, C + 3 * ldc, sizeof t), t += c3, memcpy(C + 3 * ldc, &t, sizeof t);
 }
+
+/* The same on 4 x 16 (8 AVX-512 accumulators: two fused multiply-adds per cycle of latency 4
+ * need 8 independent sums; on AVX2 this would spill). */
+FCM_KERNEL_INLINE void micro_4x16(int nk, const double *A, int lda, const double *B, int ldb,
+                                  double *C, int ldc)
+{
+  fcm_v8d c0 = {0}, c1 = {0}, c2 = {0}, c3 = {0}, d0 = {0}, d1 = {0}, d2 = {0}, d3 = {0}, b, e, t;
+  for (int k = 0; k < nk; k++) {
+    const double *a = A + (size_t)k * lda;
+    memcpy(&b, B + (size_t)k * ldb, sizeof b);
+    memcpy(&e, B + (size_t)k * ldb + 8, sizeof e);
+    c0 += a[0] * b, d0 += a[0] * e;
+    c1 += a[1] * b, d1 += a[1] * e;
+    c2 += a[2] * b, d2 += a[2] * e;
+    c3 += a[3] * b, d3 += a[3] * e;
+  }
+#define FCM_ADD_ROW(p, v) (memcpy(&t, (p), sizeof t), t += (v), memcpy((p), &t, sizeof t))
+  FCM_ADD_ROW(C, c0), FCM_ADD_ROW(C + 8, d0);
+  FCM_ADD_ROW(C + ldc, c1), FCM_ADD_ROW(C + ldc + 8, d1);
+  FCM_ADD_ROW(C + 2 * ldc, c2), FCM_ADD_ROW(C + 2 * ldc + 8, d2);
+  FCM_ADD_ROW(C + 3 * ldc, c3), FCM_ADD_ROW(C + 3 * ldc + 8, d3);
+#undef FCM_ADD_ROW
+}
 #else
 FCM_KERNEL_INLINE void micro_4x8(int nk, const double *A, int lda, const double *B, int ldb,
                                  double *C, int ldc)
@@ -66,17 +90,45 @@ FCM_KERNEL_INLINE void micro_4x8(int nk, const double *A, int lda, const double 
     for (int j = 0; j < 8; j++)
       C[(size_t)i * ldc + j] += c[i][j];
 }
+
+FCM_KERNEL_INLINE void micro_4x16(int nk, const double *A, int lda, const double *B, int ldb,
+                                  double *C, int ldc)
+{
+  micro_4x8(nk, A, lda, B, ldb, C, ldc);
+  micro_4x8(nk, A, lda, B + 8, ldb, C + 8, ldc);
+}
 #endif
 
-/* C += A^T B on the blocks of rows [0, rows) (in fours) whose 8 columns reach the diagonal or
- * beyond, columns up to ld: A, B are nk x ld (row stride ld), C is ld x ld. Every entry
- * C[x][y] with x <= y < ld is summed. */
-FCM_KERNEL_INLINE void product_upper(int nk, const double *A, const double *B, int rows, int ld,
-                                     double *C)
+/* Whether the 4 x 16 block pays: the CPU has AVX-512 (32 vector registers) and, with the clones,
+ * runs the x86-64-v4 one. */
+#if defined(FCM_KERNEL_CLONES_ON)
+#define FCM_KERNEL_WIDE() __builtin_cpu_supports("x86-64-v4")
+#elif defined(__AVX512F__)
+#define FCM_KERNEL_WIDE() 1
+#else
+#define FCM_KERNEL_WIDE() 0
+#endif
+
+/* C (4 x nb, nb = 16 when wide, else 8) += the product of micro_4x8() / micro_4x16(). */
+FCM_KERNEL_INLINE void micro(int wide, int nk, const double *A, int lda, const double *B, int ldb,
+                             double *C, int ldc)
 {
+  if (wide)
+    micro_4x16(nk, A, lda, B, ldb, C, ldc);
+  else
+    micro_4x8(nk, A, lda, B, ldb, C, ldc);
+}
+
+/* C += A^T B on the blocks of rows [0, rows) (in fours) whose nb = 8 or 16 columns reach the
+ * diagonal or beyond, columns up to ld (a multiple of 16): A, B are nk x ld (row stride ld), C
+ * is ld x ld. Every entry C[x][y] with x <= y < ld is summed. */
+FCM_KERNEL_INLINE void product_upper(int wide, int nk, const double *A, const double *B, int rows,
+                                     int ld, double *C)
+{
+  const int nb = wide ? 16 : 8;
   for (int a0 = 0; a0 < rows; a0 += 4)
-    for (int b0 = a0 / 8 * 8; b0 < ld; b0 += 8)
-      micro_4x8(nk, A + a0, ld, B + b0, ld, C + (size_t)a0 * ld + b0, ld);
+    for (int b0 = a0 / nb * nb; b0 < ld; b0 += nb)
+      micro(wide, nk, A + a0, ld, B + b0, ld, C + (size_t)a0 * ld + b0, ld);
 }
 
 /* Physical gradients g (nn x 3, then zero to ld) from the reference ones dN and the nodal
@@ -143,14 +195,14 @@ static void mirror_blocks(int nn, double *Ke)
 FCM_KERNEL_CLONES
 static cell_result stiffness_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
 {
-  const int ndof = 3 * nn, ld = fcm__kernel_ld(nn);
+  const int ndof = 3 * nn, ld = fcm__kernel_ld(nn), wide = FCM_KERNEL_WIDE();
   cell_result res = {0.0, 1.0, 0, 0};
   double *H = w->H, *Ke = w->Ke;
   memset(H, 0, sizeof *H * (size_t)ld * ld);
   for (int q0 = 0; q0 < r->nq; q0 += FCM__KERNEL_QB) {
     const int nc = r->nq - q0 < FCM__KERNEL_QB ? r->nq - q0 : FCM__KERNEL_QB;
     if (!chunk_gradients(r, nn, q0, nc, w->X, ld, w, &res, w->WG)) return res;
-    product_upper(nc, w->WG, w->G, ndof, ld, H);
+    product_upper(wide, nc, w->WG, w->G, ndof, ld, H);
   }
   const double l = kd->lambda, m = kd->mu;
   for (int a = 0; a < nn; a++)
@@ -177,7 +229,7 @@ static cell_result stiffness_kernel(const kernel_data *kd, const cell_rule *r, i
 FCM_KERNEL_CLONES
 static cell_result mass_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
 {
-  const int ndof = 3 * nn, ld = (nn + 7) / 8 * 8;
+  const int ndof = 3 * nn, ld = (nn + 15) / 16 * 16, wide = FCM_KERNEL_WIDE();
   cell_result res = {0.0, 1.0, 0, 0};
   double *H = w->H, *Ke = w->Ke;
   memset(H, 0, sizeof *H * (size_t)ld * ld);
@@ -195,7 +247,7 @@ static cell_result mass_kernel(const kernel_data *kd, const cell_rule *r, int nn
       for (int a = 0; a < ld; a++)
         n[a] = a < nn ? N[a] : 0.0, wn[a] = rw * n[a];
     }
-    product_upper(nc, w->WG, w->G, nn, ld, H);
+    product_upper(wide, nc, w->WG, w->G, nn, ld, H);
   }
   for (int a = 0; a < nn; a++)
     for (int b = a; b < nn; b++)
@@ -320,6 +372,7 @@ static cell_result hyperelastic_kernel(const kernel_data *kd, const cell_rule *r
                                        scratch *w)
 {
   const int ndof = 3 * nn, ld = fcm__kernel_ld(nn), na = (nn + 3) / 4 * 4;
+  const int wide = FCM_KERNEL_WIDE(), nb = wide ? 16 : 8;
   cell_result res = {0.0, 1.0, 0, 0};
   double *H = w->H, *Ke = w->Ke;
   if (kd->want_tangent) memset(H, 0, sizeof *H * (size_t)ld * ld);
@@ -333,9 +386,9 @@ static cell_result hyperelastic_kernel(const kernel_data *kd, const cell_rule *r
     for (int i = 0; i < 3; i++) {
       const double *Bi = w->B + (size_t)i * 3 * FCM__KERNEL_QH * ld;
       for (int a0 = 0; a0 < na; a0 += 4)
-        for (int b0 = 3 * a0 / 8 * 8; b0 < ld; b0 += 8)
-          micro_4x8(3 * nc, w->WG + a0, ld, Bi + b0, ld, H + (size_t)(3 * a0 + i) * ld + b0,
-                    3 * ld);
+        for (int b0 = 3 * a0 / nb * nb; b0 < ld; b0 += nb)
+          micro(wide, 3 * nc, w->WG + a0, ld, Bi + b0, ld, H + (size_t)(3 * a0 + i) * ld + b0,
+                3 * ld);
     }
   }
   if (!kd->want_tangent) return res;

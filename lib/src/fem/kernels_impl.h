@@ -8,7 +8,7 @@
 
 /* Points per chunk of the linear kernels (gradients of a chunk, then one blocked product) and
  * of the hyperelastic kernel (its tangent's right factor is 3 x 3 QH rows per chunk). */
-enum { FCM__KERNEL_QB = 16, FCM__KERNEL_QH = 8 };
+enum { FCM__KERNEL_QB = 32, FCM__KERNEL_QH = 8 };
 
 /* The points of one cell's rule with the shape functions evaluated there. */
 typedef struct cell_rule {
@@ -65,10 +65,10 @@ typedef struct cell_result {
   int inverted;   /* hyperelastic: authentic points with det F <= 0 */
 } cell_result;
 
-/* Padded row length of the blocked products for nn nodes: 3 roundup(nn, 4) rounded up to 8. */
+/* Padded row length of the blocked products for nn nodes: 3 roundup(nn, 4) rounded up to 16. */
 static inline int fcm__kernel_ld(int nn)
 {
-  return (3 * ((nn + 3) / 4 * 4) + 7) / 8 * 8;
+  return (3 * ((nn + 3) / 4 * 4) + 15) / 16 * 16;
 }
 
 /* Doubles of one thread's scratch for nn nodes and mq cut-cell points; fcm__kernel_scratch_init()
