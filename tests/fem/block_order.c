@@ -24,13 +24,13 @@ static void check_blocks(const fcm_space *s)
   for (int c = 0; c < s->num_block_colors; c++) {
     for (fcm_index k = 0; k < s->num_dofs / 3; k++)
       owner[k] = -1;
-    for (fcm_index j = s->block_color_ptr[c]; j < s->block_color_ptr[c + 1]; j++) {
-      const fcm_index b = s->block_list[j];
+    for (fcm_index i = s->block_color_ptr[c]; i < s->block_color_ptr[c + 1]; i++) {
+      const fcm_index b = s->block_list[i];
       TEST_TRUE(b >= 0 && b < nb && !seen[b]);
       seen[b] = 1;
-      for (fcm_index e = b * FCM__SPACE_BLOCK; e < FCM_MIN(ne, (b + 1) * FCM__SPACE_BLOCK); e++)
+      for (fcm_index j = b * FCM__SPACE_BLOCK; j < FCM_MIN(ne, (b + 1) * FCM__SPACE_BLOCK); j++)
         for (int a = 0; a < s->nn; a++) {
-          const fcm_index k = s->elem_dof[e * s->nn + a] / 3;
+          const fcm_index k = s->elem_dof[s->block_elems[j] * s->nn + a] / 3;
           TEST_TRUE(owner[k] < 0 || owner[k] == b);
           owner[k] = b;
         }
@@ -38,7 +38,13 @@ static void check_blocks(const fcm_space *s)
   }
   for (fcm_index b = 0; b < nb; b++)
     TEST_TRUE(seen[b]);
-  free(seen), free(owner);
+  unsigned char *once = calloc((size_t)ne, 1); /* block_elems: each element exactly once */
+  for (fcm_index j = 0; j < ne; j++) {
+    const fcm_index e = s->block_elems[j];
+    TEST_TRUE(e >= 0 && e < ne && !once[e]);
+    if (e >= 0 && e < ne) once[e] = 1;
+  }
+  free(seen), free(owner), free(once);
 }
 
 /* Stiffness + mass into A and SNH force + tangent into T, f with `threads` threads. */

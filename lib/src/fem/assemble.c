@@ -295,7 +295,7 @@ static int pass_element(const fcm_space *s, const pass *ps, fcm_index le, scratc
 }
 
 /* Run the pass over the local elements (a full space: all) by the space's coloured blocks of
- * consecutive elements: colour by colour, a block per thread at a time, its elements in
+ * neighbouring elements: colour by colour, a block per thread at a time, its elements in
  * order, so each matrix entry receives its terms in the same order for any thread count. Each
  * element's result is scattered (matrix: into the space's rows, vector: at the element's DOFs,
  * energy: at its element id); an element with det J <= 0 or a non-finite material response is
@@ -318,7 +318,8 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
       for (fcm_index k = b0; k < b1; k++) {
         const fcm_index first = s->block_list[k] * FCM__SPACE_BLOCK;
         const fcm_index last = FCM_MIN(ne, first + FCM__SPACE_BLOCK);
-        for (fcm_index le = first; le < last; le++) {
+        for (fcm_index j = first; j < last; j++) {
+          const fcm_index le = s->block_elems[j];
           cell_result res;
           if (pass_element(s, ps, le, w, &res)) continue;
           const fcm_index c = fcm__space_local_elem(s, le);
