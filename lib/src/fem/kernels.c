@@ -4,13 +4,13 @@
  *   stiffness  H = sum_q w_q det J_q g_q g_q^T     (g_q the 3nn physical gradients at q)
  *   mass       M = sum_q w_q det J_q rho N_q N_q^T
  *   tangent    K_(a,i)(b,k) = sum_(q,J) g_qaJ [w_q det J_q sum_L A_q,iJkL g_qbL]
- * each as register blocks of 4 rows x 16 columns (AVX-512) or 4 x 8 over the upper triangle
- * (the micro-kernels micro_4x16() and micro_4x8()). With FCM_MULTIVERSION on x86-64 with GCC and
- * glibc, the kernels are compiled for x86-64-v4 (AVX-512), x86-64-v3 (AVX2 + FMA) and the baseline,
- * and the loader picks the clone for the CPU (an ifunc): a default build runs the AVX-512 code on a
- * CPU that has it. Compiled with -ffp-contract=fast (sources.cmake), so products and sums fuse
- * where the CPU can; the results then differ between instruction sets at round-off, but on one
- * machine they are the same for every thread count. */
+ * each as register blocks of 4 rows x 16 columns (AVX-512), 4 x 8 (AVX2) or 4 x 4 over the
+ * upper triangle (the micro-kernels micro_4x16(), micro_4x8(), micro_4x4()). With FCM_MULTIVERSION
+ * on x86-64 with GCC and glibc, the kernels are compiled for x86-64-v4 (AVX-512), x86-64-v3 (AVX2 +
+ * FMA) and the baseline, and the loader picks the clone for the CPU (an ifunc): a default build
+ * runs the AVX-512 code on a CPU that has it. Compiled with -ffp-contract=fast (sources.cmake), so
+ * products and sums fuse where the CPU can; the results then differ between instruction sets at
+ * round-off, but on one machine they are the same for every thread count. */
 #include "fem/kernels_impl.h"
 
 #include <math.h>
@@ -33,7 +33,7 @@
 #endif
 
 /* C (4 rows x 8 columns, row stride ldc) += sum_k A[k lda + i] B[k ldb + j]: the register
- * block of every blocked product here (4 x 8 accumulators: 4 AVX-512 or 8 AVX2 registers). */
+ * block of the blocked products with AVX2 (8 registers of accumulators). */
 #if defined(__GNUC__) || defined(__clang__)
 typedef double fcm_v8d __attribute__((vector_size(64)));
 
@@ -41,6 +41,28 @@ FCM_KERNEL_INLINE void micro_4x8(int nk, const double *A, int lda, const double 
                                  double *C, int ldc)
 {
   fcm_v8d c0 = {0}, c1 = {0}, c2 = {0}, c3 = {0}, b, t;
+  for (int k = 0; k < nk; k++) {
+    const double *a = A + (size_t)k * lda;
+    memcpy(&b, B + (size_t)k * ldb, sizeof b);
+    c0 += a[0] * b;
+    c1 += a[1] * b;
+    c2 += a[2] * b;
+    c3 += a[3] * b;
+  }
+  memcpy(&t, C, sizeof t), t += c0, memcpy(C, &t, sizeof t);
+  memcpy(&t, C + ldc, sizeof t), t += c1, memcpy(C + ldc, &t, sizeof t);
+  memcpy(&t, C + 2 * ldc, sizeof t), t += c2, memcpy(C + 2 * ldc, &t, sizeof t);
+  memcpy(&t, C + 3 * ldc, sizeof t), t += c3, memcpy(C + 3 * ldc, &t, sizeof t);
+}
+
+/* The same on 4 x 4 (8 SSE2 registers of accumulators: 4 x 8 would spill the 16 of baseline
+ * x86-64). */
+typedef double fcm_v4d __attribute__((vector_size(32)));
+
+FCM_KERNEL_INLINE void micro_4x4(int nk, const double *A, int lda, const double *B, int ldb,
+                                 double *C, int ldc)
+{
+  fcm_v4d c0 = {0}, c1 = {0}, c2 = {0}, c3 = {0}, b, t;
   for (int k = 0; k < nk; k++) {
     const double *a = A + (size_t)k * lda;
     memcpy(&b, B + (size_t)k * ldb, sizeof b);
@@ -78,17 +100,24 @@ FCM_KERNEL_INLINE void micro_4x16(int nk, const double *A, int lda, const double
 #undef FCM_ADD_ROW
 }
 #else
+FCM_KERNEL_INLINE void micro_4x4(int nk, const double *A, int lda, const double *B, int ldb,
+                                 double *C, int ldc)
+{
+  double c[4][4] = {{0}};
+  for (int k = 0; k < nk; k++)
+    for (int i = 0; i < 4; i++)
+      for (int j = 0; j < 4; j++)
+        c[i][j] += A[(size_t)k * lda + i] * B[(size_t)k * ldb + j];
+  for (int i = 0; i < 4; i++)
+    for (int j = 0; j < 4; j++)
+      C[(size_t)i * ldc + j] += c[i][j];
+}
+
 FCM_KERNEL_INLINE void micro_4x8(int nk, const double *A, int lda, const double *B, int ldb,
                                  double *C, int ldc)
 {
-  double c[4][8] = {{0}};
-  for (int k = 0; k < nk; k++)
-    for (int i = 0; i < 4; i++)
-      for (int j = 0; j < 8; j++)
-        c[i][j] += A[(size_t)k * lda + i] * B[(size_t)k * ldb + j];
-  for (int i = 0; i < 4; i++)
-    for (int j = 0; j < 8; j++)
-      C[(size_t)i * ldc + j] += c[i][j];
+  micro_4x4(nk, A, lda, B, ldb, C, ldc);
+  micro_4x4(nk, A, lda, B + 4, ldb, C + 4, ldc);
 }
 
 FCM_KERNEL_INLINE void micro_4x16(int nk, const double *A, int lda, const double *B, int ldb,
@@ -99,36 +128,41 @@ FCM_KERNEL_INLINE void micro_4x16(int nk, const double *A, int lda, const double
 }
 #endif
 
-/* Whether the 4 x 16 block pays: the CPU has AVX-512 (32 vector registers) and, with the clones,
- * runs the x86-64-v4 one. */
+/* The register block's width for the running code: 16 with AVX-512 (32 vector registers), 8
+ * with AVX2 (16 of 4 doubles), else 4 (16 of 2 doubles); with the clones, the CPU's level is
+ * the clone's. */
 #if defined(FCM_KERNEL_CLONES_ON)
-#define FCM_KERNEL_WIDE() __builtin_cpu_supports("x86-64-v4")
+#define FCM_KERNEL_NB()                                                                            \
+  (__builtin_cpu_supports("x86-64-v4") ? 16 : __builtin_cpu_supports("x86-64-v3") ? 8 : 4)
 #elif defined(__AVX512F__)
-#define FCM_KERNEL_WIDE() 1
+#define FCM_KERNEL_NB() 16
+#elif defined(__AVX2__)
+#define FCM_KERNEL_NB() 8
 #else
-#define FCM_KERNEL_WIDE() 0
+#define FCM_KERNEL_NB() 4
 #endif
 
-/* C (4 x nb, nb = 16 when wide, else 8) += the product of micro_4x8() / micro_4x16(). */
-FCM_KERNEL_INLINE void micro(int wide, int nk, const double *A, int lda, const double *B, int ldb,
+/* C (4 x nb) += the product of micro_4x4(), micro_4x8() or micro_4x16() (nb = 4, 8, 16). */
+FCM_KERNEL_INLINE void micro(int nb, int nk, const double *A, int lda, const double *B, int ldb,
                              double *C, int ldc)
 {
-  if (wide)
+  if (nb == 16)
     micro_4x16(nk, A, lda, B, ldb, C, ldc);
-  else
+  else if (nb == 8)
     micro_4x8(nk, A, lda, B, ldb, C, ldc);
+  else
+    micro_4x4(nk, A, lda, B, ldb, C, ldc);
 }
 
-/* C += A^T B on the blocks of rows [0, rows) (in fours) whose nb = 8 or 16 columns reach the
- * diagonal or beyond, columns up to ld (a multiple of 16): A, B are nk x ld (row stride ld), C
- * is ld x ld. Every entry C[x][y] with x <= y < ld is summed. */
-FCM_KERNEL_INLINE void product_upper(int wide, int nk, const double *A, const double *B, int rows,
+/* C += A^T B on the blocks of rows [0, rows) (in fours) whose nb columns reach the diagonal or
+ * beyond, columns up to ld (a multiple of 16): A, B are nk x ld (row stride ld), C is ld x ld.
+ * Every entry C[x][y] with x <= y < ld is summed. */
+FCM_KERNEL_INLINE void product_upper(int nb, int nk, const double *A, const double *B, int rows,
                                      int ld, double *C)
 {
-  const int nb = wide ? 16 : 8;
   for (int a0 = 0; a0 < rows; a0 += 4)
     for (int b0 = a0 / nb * nb; b0 < ld; b0 += nb)
-      micro(wide, nk, A + a0, ld, B + b0, ld, C + (size_t)a0 * ld + b0, ld);
+      micro(nb, nk, A + a0, ld, B + b0, ld, C + (size_t)a0 * ld + b0, ld);
 }
 
 /* Physical gradients g (nn x 3, then zero to ld) from the reference ones dN and the nodal
@@ -195,14 +229,14 @@ static void mirror_blocks(int nn, double *Ke)
 FCM_KERNEL_CLONES
 static cell_result stiffness_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
 {
-  const int ndof = 3 * nn, ld = fcm__kernel_ld(nn), wide = FCM_KERNEL_WIDE();
+  const int ndof = 3 * nn, ld = fcm__kernel_ld(nn), nb = FCM_KERNEL_NB();
   cell_result res = {0.0, 1.0, 0, 0};
   double *H = w->H, *Ke = w->Ke;
   memset(H, 0, sizeof *H * (size_t)ld * ld);
   for (int q0 = 0; q0 < r->nq; q0 += FCM__KERNEL_QB) {
     const int nc = r->nq - q0 < FCM__KERNEL_QB ? r->nq - q0 : FCM__KERNEL_QB;
     if (!chunk_gradients(r, nn, q0, nc, w->X, ld, w, &res, w->WG)) return res;
-    product_upper(wide, nc, w->WG, w->G, ndof, ld, H);
+    product_upper(nb, nc, w->WG, w->G, ndof, ld, H);
   }
   const double l = kd->lambda, m = kd->mu;
   for (int a = 0; a < nn; a++)
@@ -229,7 +263,7 @@ static cell_result stiffness_kernel(const kernel_data *kd, const cell_rule *r, i
 FCM_KERNEL_CLONES
 static cell_result mass_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
 {
-  const int ndof = 3 * nn, ld = (nn + 15) / 16 * 16, wide = FCM_KERNEL_WIDE();
+  const int ndof = 3 * nn, ld = (nn + 15) / 16 * 16, nb = FCM_KERNEL_NB();
   cell_result res = {0.0, 1.0, 0, 0};
   double *H = w->H, *Ke = w->Ke;
   memset(H, 0, sizeof *H * (size_t)ld * ld);
@@ -247,7 +281,7 @@ static cell_result mass_kernel(const kernel_data *kd, const cell_rule *r, int nn
       for (int a = 0; a < ld; a++)
         n[a] = a < nn ? N[a] : 0.0, wn[a] = rw * n[a];
     }
-    product_upper(wide, nc, w->WG, w->G, nn, ld, H);
+    product_upper(nb, nc, w->WG, w->G, nn, ld, H);
   }
   for (int a = 0; a < nn; a++)
     for (int b = a; b < nn; b++)
@@ -372,7 +406,7 @@ static cell_result hyperelastic_kernel(const kernel_data *kd, const cell_rule *r
                                        scratch *w)
 {
   const int ndof = 3 * nn, ld = fcm__kernel_ld(nn), na = (nn + 3) / 4 * 4;
-  const int wide = FCM_KERNEL_WIDE(), nb = wide ? 16 : 8;
+  const int nb = FCM_KERNEL_NB();
   cell_result res = {0.0, 1.0, 0, 0};
   double *H = w->H, *Ke = w->Ke;
   if (kd->want_tangent) memset(H, 0, sizeof *H * (size_t)ld * ld);
@@ -387,7 +421,7 @@ static cell_result hyperelastic_kernel(const kernel_data *kd, const cell_rule *r
       const double *Bi = w->B + (size_t)i * 3 * FCM__KERNEL_QH * ld;
       for (int a0 = 0; a0 < na; a0 += 4)
         for (int b0 = 3 * a0 / nb * nb; b0 < ld; b0 += nb)
-          micro(wide, 3 * nc, w->WG + a0, ld, Bi + b0, ld, H + (size_t)(3 * a0 + i) * ld + b0,
+          micro(nb, 3 * nc, w->WG + a0, ld, Bi + b0, ld, H + (size_t)(3 * a0 + i) * ld + b0,
                 3 * ld);
     }
   }
