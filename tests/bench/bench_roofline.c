@@ -9,12 +9,14 @@
  * kernel set ("child" mode, one OpenMP and one BLAS thread, times in CPU seconds: on cores
  * shared with other work the wall clock would measure that work too) and collects the rows;
  * OpenBLAS's own choice is measured too when it is neither. `bench_roofline child CELLS` prints the
- * raw rows of the kernels it is started with (e.g. another BLAS preloaded). Each row is a time, a
- * rate (GFLOP/s or GB/s) and the fraction of the core's measured peak: the best DGEMM rate for
- * flop-bound rows, the best STREAM triad bandwidth for memory-bound rows. Prints the table, writes
- * the CSV and ends with a one-line summary. Asserts that each CHOLMOD solve has a small residual
- * and that the kernel sets give the same solution to round-off. Label bench: never in the default
- * run. */
+ * raw rows of the kernels it is started with (e.g. another BLAS preloaded). fcm's own element
+ * kernels and CSR SpMV do not use the BLAS: one more child (`bench_roofline once CELLS`) measures
+ * them once, kernel set "any" in the table, and a last line gives their time per cell. Each row
+ * is a time, a rate (GFLOP/s or GB/s) and the fraction of the core's measured peak: the best DGEMM
+ * rate for flop-bound rows, the best STREAM triad bandwidth for memory-bound rows. Prints the
+ * table, writes the CSV and ends with a one-line summary. Asserts that each CHOLMOD solve has a
+ * small residual and that the kernel sets give the same solution to round-off. Label bench: never
+ * in the default run. */
 #define _POSIX_C_SOURCE 200809L /* popen, readlink */
 #include "fcm/fcm.h"
 #include "la/la_impl.h"
@@ -185,6 +187,214 @@ done:
   return ok;
 }
 
+/* ------------------------------------------------------------------ fcm's element kernels */
+
+/* fcm's own assembly kernels and CSR SpMV do not call the BLAS: they are measured once, in a
+ * child started with the selected kernel set (kernel set "any" in the table). Each assembly row
+ * assembles a box of cells into its matrix, best of 3; size is the number of cells and the
+ * flops are the minimal count of the element matrices (kernel_flops()), not counting the
+ * scatter; the time per cell is printed below the table. */
+
+typedef enum kernel_row { ROW_STIFFNESS, ROW_SNH, ROW_MASS } kernel_row;
+
+typedef struct assembly_args {
+  fcm_assembly_workspace *ws;
+  kernel_row kind;
+  fcm_material mat;
+  fcm_material_params params;
+  const double *u;
+  fcm_csr *A;
+  double *force;
+  int ok;
+} assembly_args;
+
+static void assembly_once(void *p)
+{
+  assembly_args *a = p;
+  fcm_linear_form form = fcm_linear_form_default();
+  form.material = &a->mat;
+  if (a->kind == ROW_SNH) {
+    a->ok &= fcm_assembly_workspace_hyperelastic(a->ws, &a->params, a->u, NULL, a->force, a->A) ==
+             FCM_OK;
+    return;
+  }
+  form.term = a->kind == ROW_MASS ? FCM_LINEAR_MASS : FCM_LINEAR_STIFFNESS;
+  a->ok &= fcm_assembly_workspace_linear(a->ws, &form, a->A, NULL) == FCM_OK;
+}
+
+/* The minimal flops of one element matrix with nn nodes on nq points (a flop = one add or one
+ * multiply, a fused multiply-add is two). Per point: the Jacobian X^T dN (18 nn), its inverse
+ * (about 40) and the physical gradients J^-T dN (18 nn), w det J (1).
+ * - Stiffness: H = sum_q w_q det J_q g_q g_q^T on its upper triangle, ndof (ndof + 1) / 2 entries
+ *   of 2 nq flops, plus w det J g (ndof per point); then per node pair a <= b the 3 x 3 block
+ *   lambda H_ab + mu H_ab^T + mu tr(H_ab) I (33 flops).
+ * - SNH force + tangent: F = I + sum_a u_a g_a^T (18 nn), the force P g_a (6 per DOF), the
+ *   tangent C_b = w det J A g_b (27 entries of 6 flops per node) and per node pair a <= b the
+ *   block g_a^T C_b (9 entries of 6 flops); the material's own P and dP/dF are not counted.
+ * - Mass: the scalar block sum_q w_q det J_q rho N N^T, nn (nn + 1) / 2 entries of 2 nq flops
+ *   (memory-bound: measured in bytes, see run_mass()). */
+static double kernel_flops(kernel_row kind, double nn, double nq)
+{
+  const double ndof = 3 * nn, pairs = nn * (nn + 1) / 2, grad = 36 * nn + 41;
+  switch (kind) {
+  case ROW_STIFFNESS:
+    return nq * (grad + ndof) + ndof * (ndof + 1) / 2 * 2 * nq + 33 * pairs;
+  case ROW_SNH:
+    return nq * (grad + 18 * nn + 6 * ndof + 162 * nn + 54 * pairs);
+  default:
+    return nq * (grad + nn) + pairs * 2 * nq;
+  }
+}
+
+/* Assemble `kind` on a box of n^3 cells of `type` (SNH: at a smooth displacement of about 1 %
+ * strain), best of 3 repetitions of the whole assembly; r->work: flops, or for the mass the
+ * bytes of the global matrix entries it adds to (8 read + 8 written per element matrix entry). */
+static int run_assembly(fcm_ctx *ctx, fcm_element_type type, int n, kernel_row kind,
+                        bench_result *r)
+{
+  int ok = 0;
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  const fcm_index n3[3] = {n, n, n};
+  fcm_mesh *mesh = NULL;
+  fcm_space *space = NULL;
+  double *u = NULL, *force = NULL;
+  fcm_rule *rule = NULL;
+  assembly_args a;
+  memset(&a, 0, sizeof a);
+  a.kind = kind;
+  a.mat = (fcm_material){kind == ROW_SNH ? FCM_MATERIAL_STABLE_NEO_HOOKEAN : FCM_MATERIAL_LINEAR,
+                         1e7, 0.3, 1000};
+  a.ok = 1;
+  if (fcm_mesh_create_box(ctx, type, lo, hi, n3, &mesh) ||
+      fcm_space_create(ctx, mesh, NULL, &space) || fcm_space_matrix_create(space, &a.A) ||
+      fcm_assembly_workspace_create(space, NULL, &a.ws) ||
+      fcm_material_setup(ctx, &a.mat, &a.params) ||
+      fcm_element_standard_rule(ctx, type, kind == ROW_MASS ? FCM_RULE_MASS : FCM_RULE_STIFFNESS,
+                                FCM_DEFAULT, &rule))
+    goto done;
+  const fcm_index ndof = fcm_space_num_dofs(space), nnodes = fcm_mesh_num_nodes(mesh);
+  u = calloc((size_t)ndof, sizeof *u), force = calloc((size_t)ndof, sizeof *force);
+  if (!u || !force) goto done;
+  const double *xyz = fcm_mesh_coords(mesh);
+  for (fcm_index i = 0; i < nnodes; i++) {
+    const double *x = xyz + 3 * i;
+    const fcm_index d = fcm_space_node_dof(space, i);
+    for (int k = 0; k < 3; k++)
+      u[d + k] = 0.01 * sin(3.0 * x[(k + 1) % 3] + k) * x[k];
+  }
+  a.u = u, a.force = force;
+  assembly_once(&a); /* warm-up: tabulation, pages */
+  r->seconds = best_of(3, assembly_once, &a);
+  if (!a.ok) goto done;
+  const double cells = (double)fcm_mesh_num_cells(mesh);
+  const double nn = fcm_element_get_info(type)->num_nodes, nq = fcm_rule_num_points(rule);
+  r->size = cells;
+  r->work = kind == ROW_MASS ? cells * 16.0 * 9 * nn * nn : cells * kernel_flops(kind, nn, nq);
+  fcm_index nnz = 0;
+  fcm_csr_get_size(a.A, NULL, NULL, &nnz);
+  double tr = 0.0; /* every kernel row adds positive diagonal entries */
+  const fcm_index *rp = fcm_csr_row_ptr(a.A);
+  const int *ci = fcm_csr_col_idx(a.A);
+  const double *v = fcm_csr_values(a.A);
+  for (fcm_index i = 0; i < ndof; i++)
+    for (fcm_index k = rp[i]; k < rp[i + 1]; k++)
+      if (ci[k] == i) tr += v[k];
+  r->check = tr;
+  ok = tr > 0.0 && nnz > 0;
+done:
+  if (!ok) fcm_ctx_error_view(ctx, stderr);
+  free(u), free(force);
+  fcm_rule_destroy(&rule);
+  fcm_assembly_workspace_destroy(&a.ws);
+  fcm_csr_destroy(&a.A);
+  fcm_space_destroy(&space);
+  fcm_mesh_destroy(&mesh);
+  return ok;
+}
+
+/* Box sizes at the default 24: 4,096 to 13,824 cells, matrices of 40 to 190 MB (beyond the
+ * last-level cache). */
+static int run_hex8_stiffness(fcm_ctx *ctx, int cells, bench_result *r)
+{
+  return run_assembly(ctx, FCM_ELEMENT_HEX8, cells, ROW_STIFFNESS, r);
+}
+
+static int run_hex20_stiffness(fcm_ctx *ctx, int cells, bench_result *r)
+{
+  return run_assembly(ctx, FCM_ELEMENT_HEX20, (2 * cells + 2) / 3, ROW_STIFFNESS, r);
+}
+
+static int run_tet10_stiffness(fcm_ctx *ctx, int cells, bench_result *r)
+{
+  return run_assembly(ctx, FCM_ELEMENT_TET10, (cells + 1) / 2, ROW_STIFFNESS, r);
+}
+
+static int run_hex20_snh(fcm_ctx *ctx, int cells, bench_result *r)
+{
+  return run_assembly(ctx, FCM_ELEMENT_HEX20, (2 * cells + 2) / 3, ROW_SNH, r);
+}
+
+static int run_hex20_mass(fcm_ctx *ctx, int cells, bench_result *r)
+{
+  return run_assembly(ctx, FCM_ELEMENT_HEX20, (2 * cells + 2) / 3, ROW_MASS, r);
+}
+
+typedef struct spmv_args {
+  const fcm_csr *A;
+  const double *x;
+  double *y;
+  int ok;
+} spmv_args;
+
+static void spmv_once(void *p)
+{
+  spmv_args *s = p;
+  s->ok &= fcm_csr_apply(s->A, 1.0, s->x, 0.0, s->y) == FCM_OK;
+}
+
+/* y = K x with the Hex8 elasticity matrix of (4 cells / 3)^3 cells (100 MB at the default 24,
+ * beyond the last-level cache), best of 10. Bytes: the values (8)
+ * and column indices (4) of every entry, the row pointers (8 per row), x read and y written once
+ * (8 + 8 per row): the least a CSR SpMV moves. The check: x^T K x > 0. */
+static int run_spmv(fcm_ctx *ctx, int cells, bench_result *r)
+{
+  int ok = 0;
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  const fcm_index m = 4 * (fcm_index)cells / 3, n3[3] = {m, m, m};
+  const fcm_material mat = {FCM_MATERIAL_LINEAR, 1e7, 0.3, 1000};
+  fcm_mesh *mesh = NULL;
+  fcm_space *space = NULL;
+  fcm_csr *K = NULL;
+  double *x = NULL, *y = NULL;
+  if (fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, n3, &mesh) ||
+      fcm_space_create(ctx, mesh, NULL, &space) || fcm_space_matrix_create(space, &K) ||
+      fcm_assemble_stiffness(space, &mat, NULL, K))
+    goto done;
+  fcm_index n = 0, nnz = 0;
+  fcm_csr_get_size(K, &n, NULL, &nnz);
+  x = malloc((size_t)n * sizeof *x), y = malloc((size_t)n * sizeof *y);
+  if (!x || !y) goto done;
+  for (fcm_index i = 0; i < n; i++)
+    x[i] = 1.0 + 0.5 * sin(0.37 * (double)i);
+  spmv_args s = {K, x, y, 1};
+  spmv_once(&s);
+  r->seconds = best_of(10, spmv_once, &s);
+  double xkx = 0.0;
+  for (fcm_index i = 0; i < n; i++)
+    xkx += x[i] * y[i];
+  r->size = (double)n;
+  r->work = 12.0 * (double)nnz + 24.0 * (double)n;
+  r->check = xkx;
+  ok = s.ok && xkx > 0.0;
+done:
+  if (!ok) fcm_ctx_error_view(ctx, stderr);
+  free(x), free(y);
+  fcm_csr_destroy(&K);
+  fcm_space_destroy(&space);
+  fcm_mesh_destroy(&mesh);
+  return ok;
+}
+
 /* The rows, in order. A kernel of fcm goes here as one more entry (element stiffness and
  * tangent assembly against "dgemm", CSR SpMV and mass assembly against "triad"); the peaks
  * ("dgemm", "triad") come first. */
@@ -195,8 +405,32 @@ static const bench_item items[] = {
 };
 enum { NITEMS = sizeof items / sizeof items[0] };
 
-/* Child: one line "ROW item size seconds work check" per item on stdout. */
-static int child(int cells)
+/* fcm's kernels that do not use the BLAS: measured once (kernel set "any"), not per set. */
+static const bench_item once_items[] = {
+    {"hex8_stiffness", "GFLOP/s", "dgemm", run_hex8_stiffness},
+    {"hex20_stiffness", "GFLOP/s", "dgemm", run_hex20_stiffness},
+    {"tet10_stiffness", "GFLOP/s", "dgemm", run_tet10_stiffness},
+    {"hex20_snh", "GFLOP/s", "dgemm", run_hex20_snh},
+    {"hex20_mass", "GB/s", "triad", run_hex20_mass},
+    {"csr_spmv", "GB/s", "triad", run_spmv},
+};
+enum { NALL = NITEMS + (int)(sizeof once_items / sizeof once_items[0]) };
+
+/* Item i of items[] followed by once_items[] (i < NALL). */
+static const bench_item *item_at(int i)
+{
+  return i < NITEMS ? &items[i] : &once_items[i - NITEMS];
+}
+
+/* The number of items measured per kernel set (once = 0) or once (once = 1). */
+static int count_items(int once)
+{
+  return once ? NALL - NITEMS : NITEMS;
+}
+
+/* Child: one line "ROW item size seconds work check" per item measured per kernel set
+ * (once = 0) or once (once = 1) on stdout. */
+static int child(int cells, int once)
 {
   fcm_blas_set_num_threads(1);
   fcm_ctx_options o = fcm_ctx_options_default();
@@ -204,13 +438,14 @@ static int child(int cells)
   fcm_ctx *ctx = NULL;
   TEST_OK(ctx, fcm_ctx_create(&o, &ctx));
   if (!ctx) return 1;
-  for (int i = 0; i < NITEMS; i++) {
+  for (int i = once ? NITEMS : 0; i < (once ? NALL : NITEMS); i++) {
     bench_result r = {0, 0, 0, 0};
-    if (!items[i].run(ctx, cells, &r)) {
-      TEST_FAIL_("bench_roofline: %s failed", items[i].name);
+    if (!item_at(i)->run(ctx, cells, &r)) {
+      TEST_FAIL_("bench_roofline: %s failed", item_at(i)->name);
       continue;
     }
-    printf("ROW %s %.17g %.17g %.17g %.17g\n", items[i].name, r.size, r.seconds, r.work, r.check);
+    printf("ROW %s %.17g %.17g %.17g %.17g\n", item_at(i)->name, r.size, r.seconds, r.work,
+           r.check);
     fflush(stdout);
   }
   fcm_ctx_destroy(&ctx);
@@ -226,25 +461,27 @@ typedef struct row {
   bench_result r;
 } row;
 
-/* The index of the item named `name` in items[], -1 when none is. */
+/* The index of the item named `name` in items[] then once_items[], -1 when none is. */
 static int item_index(const char *name)
 {
-  for (int i = 0; i < NITEMS; i++)
-    if (!strcmp(items[i].name, name)) return i;
+  for (int i = 0; i < NALL; i++)
+    if (!strcmp(item_at(i)->name, name)) return i;
   return -1;
 }
 
-/* Run `self child CELLS` under OPENBLAS_CORETYPE=core (NULL: as loaded) and append its rows. */
-static void measure(const char *self, int cells, const char *core, const char *role, row *rows,
-                    int *nrows)
+/* Run `self child CELLS` (once: `self once CELLS`, the items that do not use the BLAS) under
+ * OPENBLAS_CORETYPE=core (NULL: as loaded) and append its rows. */
+static void measure(const char *self, int cells, const char *core, const char *role, int once,
+                    row *rows, int *nrows)
 {
   char cmd[4200];
+  const char *mode = once ? "once" : "child";
   if (core)
     snprintf(cmd, sizeof cmd,
-             "OPENBLAS_CORETYPE=%s OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 '%s' child %d", core,
-             self, cells);
+             "OPENBLAS_CORETYPE=%s OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 '%s' %s %d", core, self,
+             mode, cells);
   else
-    snprintf(cmd, sizeof cmd, "OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 '%s' child %d", self,
+    snprintf(cmd, sizeof cmd, "OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 '%s' %s %d", self, mode,
              cells);
   FILE *p = popen(cmd, "r");
   TEST_TRUE(p != NULL);
@@ -259,13 +496,13 @@ static void measure(const char *self, int cells, const char *core, const char *r
       continue;
     w.item = item_index(name);
     if (w.item < 0) continue;
-    snprintf(w.set, sizeof w.set, "%s", core ? core : "as loaded");
+    snprintf(w.set, sizeof w.set, "%s", once ? "any" : core ? core : "as loaded");
     snprintf(w.role, sizeof w.role, "%s", role);
     rows[(*nrows)++] = w;
     got++;
   }
   TEST_TRUE(pclose(p) == 0);
-  TEST_TRUE(got == NITEMS);
+  TEST_TRUE(got == count_items(once));
 }
 
 /* GFLOP/s or GB/s (work in flops or bytes). */
@@ -279,7 +516,7 @@ static double peak_of(const row *rows, int nrows, const char *name)
 {
   double p = 0.0;
   for (int i = 0; i < nrows; i++)
-    if (!strcmp(items[rows[i].item].name, name)) p = fmax(p, rate(&rows[i]));
+    if (!strcmp(item_at(rows[i].item)->name, name)) p = fmax(p, rate(&rows[i]));
   return p;
 }
 
@@ -287,7 +524,7 @@ static double peak_of(const row *rows, int nrows, const char *name)
 static const row *find(const row *rows, int nrows, const char *name, const char *role)
 {
   for (int i = 0; i < nrows; i++)
-    if (!strcmp(items[rows[i].item].name, name) && !strcmp(rows[i].role, role)) return &rows[i];
+    if (!strcmp(item_at(rows[i].item)->name, name) && !strcmp(rows[i].role, role)) return &rows[i];
   return NULL;
 }
 
@@ -300,7 +537,7 @@ static void report(const row *rows, int nrows, const char *csv_path)
          "rate", "unit", "peak");
   for (int i = 0; i < nrows; i++) {
     const row *w = &rows[i];
-    const bench_item *it = &items[w->item];
+    const bench_item *it = item_at(w->item);
     const double pk = peak_of(rows, nrows, it->peak), x = rate(w);
     printf("%-12s %-9s %-15s %10.0f %10.4f %10.2f %-8s %6.1f%%\n", w->set, w->role, it->name,
            w->r.size, w->r.seconds, x, it->unit, pk > 0 ? 100.0 * x / pk : 0.0);
@@ -327,9 +564,31 @@ static void summary(const row *rows, int nrows)
   printf("\n");
 }
 
+/* fcm's kernels (the rows measured once): time per cell (per SpMV for csr_spmv) and the
+ * fraction of the peak, one line. */
+static void report_kernels(const row *rows, int nrows)
+{
+  const double dpk = peak_of(rows, nrows, "dgemm"), tpk = peak_of(rows, nrows, "triad");
+  printf("fcm kernels (any kernel set):");
+  for (int i = 0; i < nrows; i++) {
+    const row *w = &rows[i];
+    const bench_item *it = item_at(w->item);
+    if (w->item < NITEMS) continue;
+    const double pk = strcmp(it->peak, "dgemm") ? tpk : dpk;
+    if (strcmp(it->name, "csr_spmv"))
+      printf(" %s %.2f us/cell %.1f%%;", it->name, 1e6 * w->r.seconds / w->r.size,
+             pk > 0 ? 100.0 * rate(w) / pk : 0.0);
+    else
+      printf(" %s %.2f ms %.1f%%;", it->name, 1e3 * w->r.seconds,
+             pk > 0 ? 100.0 * rate(w) / pk : 0.0);
+  }
+  printf("\n");
+}
+
 int main(int argc, char **argv)
 {
-  if (argc >= 3 && !strcmp(argv[1], "child")) return child(atoi(argv[2]));
+  if (argc >= 3 && !strcmp(argv[1], "child")) return child(atoi(argv[2]), 0);
+  if (argc >= 3 && !strcmp(argv[1], "once")) return child(atoi(argv[2]), 1);
   const char *csv = argc > 1 ? argv[1] : "bench_roofline.csv";
   const int cells = argc > 2 ? atoi(argv[2]) : 24;
   if (cells < 2 || cells > 200) {
@@ -354,13 +613,15 @@ int main(int argc, char **argv)
   int nrows = 0;
   if (strcmp(b.name, "OpenBLAS") == 0 && b.cpu_core[0]) {
     /* the set OpenBLAS falls back to on a CPU it does not know, then the selected one */
-    measure(self, cells, "Prescott", "fallback", rows, &nrows);
-    measure(self, cells, b.cpu_core, "selected", rows, &nrows);
+    measure(self, cells, "Prescott", "fallback", 0, rows, &nrows);
+    measure(self, cells, b.cpu_core, "selected", 0, rows, &nrows);
     /* and OpenBLAS's own choice, when it is a third set */
     if (b.core[0] && strcmp(b.core, "Prescott") && strcmp(b.core, b.cpu_core))
-      measure(self, cells, b.core, "loaded", rows, &nrows);
+      measure(self, cells, b.core, "loaded", 0, rows, &nrows);
+    measure(self, cells, b.cpu_core, "fcm", 1, rows, &nrows);
   } else {
-    measure(self, cells, NULL, "loaded", rows, &nrows);
+    measure(self, cells, NULL, "loaded", 0, rows, &nrows);
+    measure(self, cells, NULL, "fcm", 1, rows, &nrows);
   }
   report(rows, nrows, csv);
   /* the same solution, to round-off, with every kernel set */
@@ -368,5 +629,6 @@ int main(int argc, char **argv)
   const row *c1 = find(rows, nrows, "cholmod_factor", "selected");
   if (c0 && c1) TEST_NEAR(c1->r.check, c0->r.check, 1e-10, 0.0);
   summary(rows, nrows);
+  report_kernels(rows, nrows);
   return TEST_RESULT();
 }

@@ -51,6 +51,11 @@ foreach(el tet4 tet10 hex8 hex20)
                TIMEOUT 3600)
 endforeach()
 fcm_add_test(fem_threads tests/fem/threads.c)
+# Assembly's coloured element blocks (a valid parallel order, results bitwise the same for 1-3
+# threads) and the blocked element kernels against the per-point formulas.
+foreach(el tet10 hex8 hex20)
+  fcm_add_test(fem_block_order_${el} tests/fem/block_order.c ARGS ${el})
+endforeach()
 # fcm_space_momentum() from the kept element mass blocks equals the sums over the mass-rule
 # points (cut cells, stabilization points, XFEM pieces) to 1e-12.
 foreach(el tet4 tet10 hex8 hex20)

@@ -4,9 +4,8 @@
  * colour by colour in parallel (deterministic for any thread count). The space is
  * only read; rules, tabulations and scratch live in an fcm_assembly_workspace. */
 #include "embed/embed_impl.h"
-#include "fem/fem_impl.h"
+#include "fem/kernels_impl.h"
 #include "la/mat3.h"
-#include "material/material_impl.h"
 
 #include <math.h>
 #include <omp.h>
@@ -39,15 +38,6 @@ fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type, fcm_ru
 cleanup:
   return st;
 }
-
-/* The points of one cell's rule with the shape functions evaluated there. */
-typedef struct cell_rule {
-  int nq;
-  const double *w;           /* nq weights; det J_K(xi) still to be applied */
-  const double *N;           /* nq x nn */
-  const double *dN;          /* nq x nn x 3 reference gradients */
-  const unsigned char *fict; /* nq flags (1: fictitious stabilization point), or NULL */
-} cell_rule;
 
 /* Shape values and reference gradients of the element at the standard rule's points. */
 typedef struct tabulation {
@@ -101,283 +91,6 @@ static cell_rule get_cell_rule(const fcm_space *s, const tabulation *t, fcm_rule
   return r;
 }
 
-/* What a kernel computes for one cell. */
-typedef enum kernel_kind {
-  KERNEL_STIFFNESS,   /* linear elastic K */
-  KERNEL_MASS,        /* consistent mass */
-  KERNEL_BODY_FORCE,  /* rho * accel, or a force density field */
-  KERNEL_HYPERELASTIC /* energy, internal force and tangent at a displacement */
-} kernel_kind;
-
-typedef struct kernel_data {
-  kernel_kind kind;
-  double lambda, mu, rho;
-  double accel[3];
-  fcm_field_fn field; /* body force density b(X) (per volume), replaces rho*accel */
-  void *field_user;
-  const fcm_material_params *mat;
-  const double *u; /* displacement per DOF */
-  int want_force, want_tangent;
-  fcm_fictitious_model fictitious; /* model at fictitious points (hyperelastic) */
-  fcm_material_params mat_psd;     /* *mat with project_psd = 1 */
-} kernel_data;
-
-/* The material at a fictitious stabilization point (lib/METHOD.md §7): the exact
- * model's tangent times alpha is indefinite and does not lift the small blocks of cut
- * cells, so these points carry a positive semi-definite tangent. PROJECTED keeps the
- * exact energy and force (rotation invariant) and projects the tangent: the Newton
- * matrix then differs from the true Hessian by alpha (K - K_psd) on these points only,
- * the residual and hence the solution stay exact. LINEAR uses linear elasticity at rest
- * for all three, a consistent energy but an O(alpha) torque under rotations. */
-static void fictitious_eval(const kernel_data *kd, const double F[9], double *psi, double P[9],
-                            double *A)
-{
-  switch (kd->fictitious) {
-  case FCM_FICTITIOUS_LINEAR:
-    fcm__material_linear(kd->mat->mu, kd->mat->lambda, F, psi, P, A);
-    return;
-  case FCM_FICTITIOUS_PROJECTED:
-    fcm__material_eval(kd->mat, F, psi, P, NULL);
-    if (A) fcm__material_eval(&kd->mat_psd, F, NULL, NULL, A);
-    return;
-  default:
-    fcm__material_eval(kd->mat, F, psi, P, A);
-    return;
-  }
-}
-
-/* Jacobian at point q of rule r: physical gradients g (nn x 3); returns det J. */
-double fcm__fem_gradients(int nn, const double *X, const double *dN, double *g)
-{
-  double J[9] = {0}, Ji[9] = {0};
-  for (int a = 0; a < nn; a++)
-    for (int i = 0; i < 3; i++)
-      for (int j = 0; j < 3; j++)
-        J[3 * i + j] += X[3 * a + i] * dN[3 * a + j];
-  double det = fcm__mat3_inv(J, Ji);
-  if (!(det > 0.0)) return det;
-  for (int a = 0; a < nn; a++)
-    fcm__mat3_tmulv(Ji, dN + 3 * a, g + 3 * a);
-  return det;
-}
-
-static double physical_gradients(const cell_rule *r, int nn, int q, const double *X, double *g)
-{
-  return fcm__fem_gradients(nn, X, r->dN + (size_t)q * nn * 3, g);
-}
-
-/* Fill the lower node blocks of a symmetric element matrix from the upper ones. */
-static void mirror_blocks(int nn, double *Ke)
-{
-  int ndof = 3 * nn;
-  for (int a = 0; a < nn; a++)
-    for (int b = 0; b < a; b++)
-      for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-          Ke[(size_t)(3 * a + i) * ndof + 3 * b + j] = Ke[(size_t)(3 * b + j) * ndof + 3 * a + i];
-}
-
-/* Per-thread scratch of a kernel. */
-typedef struct scratch {
-  double *X;   /* nn x 3 nodal coordinates */
-  double *ue;  /* 3nn cell displacement */
-  double *g;   /* nn x 3 physical gradients */
-  double *H;   /* (3nn)^2 */
-  double *Ke;  /* (3nn)^2 */
-  double *fe;  /* 3nn */
-  double *Nb;  /* max_cut_points x nn */
-  double *dNb; /* max_cut_points x nn x 3 */
-} scratch;
-
-/* Outcome of a cell kernel. */
-typedef struct cell_result {
-  double energy;
-  double bad_det; /* 1 when every det J > 0, else the first offending value */
-  int nonfinite;  /* the material returned NaN/Inf */
-  int inverted;   /* hyperelastic: authentic points with det F <= 0 */
-} cell_result;
-
-/* The physical gradients (w->g) at point q of rule r and the weight w_q det J_q; 0 with
- * res->bad_det set when det J_q is not positive. */
-static int point_weight(const cell_rule *r, int nn, int q, scratch *w, cell_result *res, double *wd)
-{
-  const double det = physical_gradients(r, nn, q, w->X, w->g);
-  if (!(det > 0.0)) {
-    res->bad_det = det;
-    return 0;
-  }
-  *wd = r->w[q] * det;
-  return 1;
-}
-
-/* Linear stiffness Ke (3nn x 3nn, row-major). With v the 3nn-vector of all physical gradients
- * at a point, H = sum_q w_q det J_q v v^T (one symmetric rank-one update per point, the only
- * work that grows with the number of points) gives the isotropic element matrix
- * K_(a,i)(b,j) = lambda H_(a,i)(b,j) + mu H_(a,j)(b,i) + mu delta_ij sum_k H_(a,k)(b,k). */
-static cell_result stiffness_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
-{
-  const int ndof = 3 * nn;
-  cell_result res = {0.0, 1.0, 0, 0};
-  double *g = w->g, *H = w->H, *Ke = w->Ke, wd = 0.0;
-  memset(H, 0, sizeof *H * (size_t)ndof * ndof);
-  memset(Ke, 0, sizeof *Ke * (size_t)ndof * ndof);
-  for (int q = 0; q < r->nq; q++) {
-    if (!point_weight(r, nn, q, w, &res, &wd)) return res;
-    for (int a = 0; a < ndof; a++) {
-      double sa = wd * g[a], *Ha = H + (size_t)a * ndof;
-      for (int b = a; b < ndof; b++)
-        Ha[b] += sa * g[b];
-    }
-  }
-  const double l = kd->lambda, m = kd->mu;
-  for (int a = 0; a < ndof; a++) /* complete H from its upper triangle */
-    for (int b = 0; b < a; b++)
-      H[(size_t)a * ndof + b] = H[(size_t)b * ndof + a];
-  for (int a = 0; a < nn; a++)
-    for (int b = a; b < nn; b++) {
-      const double *Hab = H + (size_t)(3 * a) * ndof + 3 * b; /* block (a, b) of H */
-      double tr = m * (Hab[0] + Hab[ndof + 1] + Hab[2 * ndof + 2]);
-      for (int i = 0; i < 3; i++) {
-        double *row = Ke + (size_t)(3 * a + i) * ndof + 3 * b;
-        for (int j = 0; j < 3; j++)
-          row[j] = l * Hab[i * ndof + j] + m * Hab[j * ndof + i];
-        row[i] += tr;
-      }
-    }
-  mirror_blocks(nn, Ke);
-  return res;
-}
-
-/* Consistent mass Ke: the scalar matrix H = sum_q w_q det J_q rho N N^T on each component. */
-static cell_result mass_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
-{
-  const int ndof = 3 * nn;
-  cell_result res = {0.0, 1.0, 0, 0};
-  double *H = w->H, *Ke = w->Ke, wd = 0.0;
-  memset(H, 0, sizeof *H * (size_t)ndof * ndof);
-  memset(Ke, 0, sizeof *Ke * (size_t)ndof * ndof);
-  for (int q = 0; q < r->nq; q++) {
-    if (!point_weight(r, nn, q, w, &res, &wd)) return res;
-    const double *N = r->N + (size_t)q * nn;
-    double rw = wd * kd->rho;
-    for (int a = 0; a < nn; a++) {
-      double sa = rw * N[a], *Ha = H + (size_t)a * nn;
-      for (int b = a; b < nn; b++)
-        Ha[b] += sa * N[b];
-    }
-  }
-  for (int a = 0; a < nn; a++)
-    for (int b = a; b < nn; b++)
-      for (int i = 0; i < 3; i++)
-        Ke[(size_t)(3 * a + i) * ndof + 3 * b + i] = H[(size_t)a * nn + b];
-  mirror_blocks(nn, Ke);
-  return res;
-}
-
-/* Body force fe (3nn): rho * accel, or the force density field b(X), against N. */
-static cell_result body_force_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
-{
-  cell_result res = {0.0, 1.0, 0, 0};
-  double *fe = w->fe, wd = 0.0;
-  memset(fe, 0, sizeof *fe * (size_t)(3 * nn));
-  for (int q = 0; q < r->nq; q++) {
-    if (!point_weight(r, nn, q, w, &res, &wd)) return res;
-    const double *N = r->N + (size_t)q * nn;
-    double b[3] = {kd->rho * kd->accel[0], kd->rho * kd->accel[1], kd->rho * kd->accel[2]};
-    if (kd->field) {
-      double x[3] = {0, 0, 0};
-      for (int a = 0; a < nn; a++)
-        for (int i = 0; i < 3; i++)
-          x[i] += N[a] * w->X[3 * a + i];
-      kd->field(kd->field_user, x, NULL, b);
-    }
-    for (int a = 0; a < nn; a++)
-      for (int i = 0; i < 3; i++)
-        fe[3 * a + i] += wd * b[i] * N[a];
-  }
-  return res;
-}
-
-/* Hyperelastic energy, internal force fe and (want_tangent) tangent Ke at the displacement
- * w->ue: F = I + sum_a u_a (x) g_a; f_(a,i) = sum_q wd P_iJ g_aJ and
- * K_(a,i)(b,k) = sum_q wd g_aJ A_iJkL g_bL with A = dP/dF. */
-static cell_result hyperelastic_kernel(const kernel_data *kd, const cell_rule *r, int nn,
-                                       scratch *w)
-{
-  const int ndof = 3 * nn;
-  cell_result res = {0.0, 1.0, 0, 0};
-  double *g = w->g, *Ke = w->Ke, *fe = w->fe, wd = 0.0;
-  if (kd->want_tangent) memset(Ke, 0, sizeof *Ke * (size_t)ndof * ndof);
-  memset(fe, 0, sizeof *fe * (size_t)ndof);
-  for (int q = 0; q < r->nq; q++) {
-    if (!point_weight(r, nn, q, w, &res, &wd)) return res;
-    double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, psi = 0.0, P[9], A[81];
-    for (int a = 0; a < nn; a++)
-      for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-          F[3 * i + j] += w->ue[3 * a + i] * g[3 * a + j];
-    if (r->fict && r->fict[q]) {
-      fictitious_eval(kd, F, &psi, P, kd->want_tangent ? A : NULL);
-    } else {
-      /* an inverted point of the body: counted, the material still evaluates it (the
-       * Stable Neo-Hookean and corotated models are defined there) */
-      res.inverted += !(fcm__mat3_det(F) > 0.0);
-      fcm__material_eval(kd->mat, F, &psi, P, kd->want_tangent ? A : NULL);
-    }
-    int finite = isfinite(psi);
-    for (int k = 0; k < 9; k++)
-      finite &= isfinite(P[k]);
-    if (!finite) {
-      res.nonfinite = 1;
-      return res;
-    }
-    res.energy += wd * psi;
-    for (int a = 0; a < nn; a++) {
-      const double *ga = g + 3 * a;
-      for (int i = 0; i < 3; i++)
-        fe[3 * a + i] += wd * (P[3 * i] * ga[0] + P[3 * i + 1] * ga[1] + P[3 * i + 2] * ga[2]);
-    }
-    if (!kd->want_tangent) continue;
-    for (int b = 0; b < nn; b++) {
-      /* C[i][J][k] = wd sum_L A_iJkL g_bL, then K_(a,i)(b,k) += sum_J g_aJ C[i][J][k] */
-      const double *gb = g + 3 * b;
-      double C[27];
-      for (int m = 0; m < 27; m++) {
-        const double *Am = A + 3 * m;
-        C[m] = wd * (Am[0] * gb[0] + Am[1] * gb[1] + Am[2] * gb[2]);
-      }
-      for (int a = 0; a <= b; a++) {
-        const double *ga = g + 3 * a;
-        for (int i = 0; i < 3; i++) {
-          double *row = Ke + (size_t)(3 * a + i) * ndof + 3 * b;
-          for (int k = 0; k < 3; k++)
-            row[k] += ga[0] * C[9 * i + k] + ga[1] * C[9 * i + 3 + k] + ga[2] * C[9 * i + 6 + k];
-        }
-      }
-    }
-  }
-  if (kd->want_tangent) mirror_blocks(nn, Ke);
-  return res;
-}
-
-/* Element matrix Ke (3nn x 3nn, row-major) and/or vector fe (3nn) of one cell: the kernel of
- * the integrand. fe is zero after a matrix kernel. */
-static cell_result cell_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
-{
-  switch (kd->kind) {
-  case KERNEL_STIFFNESS:
-    memset(w->fe, 0, sizeof *w->fe * (size_t)(3 * nn));
-    return stiffness_kernel(kd, r, nn, w);
-  case KERNEL_MASS:
-    memset(w->fe, 0, sizeof *w->fe * (size_t)(3 * nn));
-    return mass_kernel(kd, r, nn, w);
-  case KERNEL_BODY_FORCE:
-    return body_force_kernel(kd, r, nn, w);
-  default:
-    return hyperelastic_kernel(kd, r, nn, w);
-  }
-}
-
 /* Add the element matrix of local element le into the values of the space's pattern (its
  * rows: a full space's DOFs, a local space's local copies). */
 static void scatter_matrix(const fcm_space *s, fcm_index le, const double *Ke, double *vals)
@@ -412,24 +125,12 @@ static void scatter_vector(const fcm_space *s, fcm_index e, const double *fe, do
 static fcm_status scratch_alloc(const fcm_space *s, int nthreads, double **mem, scratch **sc)
 {
   fcm_status st = FCM_OK;
-  int nn = s->nn, ndof = 3 * nn;
-  size_t mq = (size_t)FCM_MAX(s->max_cut_points, 1);
-  size_t per =
-      3 * (size_t)nn + 2 * (size_t)ndof + 3 * (size_t)nn + 2 * (size_t)ndof * ndof + mq * nn * 4;
+  const size_t mq = (size_t)FCM_MAX(s->max_cut_points, 1);
+  const size_t per = fcm__kernel_scratch_size(s->nn, mq);
   FCM_ALLOC(s->ctx, per * (size_t)nthreads, *mem);
   FCM_ALLOC(s->ctx, nthreads, *sc);
-  for (int t = 0; t < nthreads; t++) {
-    double *p = *mem + per * (size_t)t;
-    scratch *w = *sc + t;
-    w->X = p, p += 3 * nn;
-    w->ue = p, p += ndof;
-    w->fe = p, p += ndof;
-    w->g = p, p += 3 * nn;
-    w->H = p, p += (size_t)ndof * ndof;
-    w->Ke = p, p += (size_t)ndof * ndof;
-    w->Nb = p, p += mq * nn;
-    w->dNb = p;
-  }
+  for (int t = 0; t < nthreads; t++)
+    fcm__kernel_scratch_init(s->nn, mq, *mem + per * (size_t)t, *sc + t);
 cleanup:
   return st;
 }
@@ -569,14 +270,36 @@ static cell_result volume_cell(const fcm_space *s, const pass *ps, fcm_index e, 
       memcpy(w->ue + 3 * a, kd->u + ed[a], 3 * sizeof(double));
   }
   cell_rule r = get_cell_rule(s, ps->tab, ps->kind, e, w->Nb, w->dNb);
-  return cell_kernel(kd, &r, nn, w);
+  return fcm__cell_kernel(kd, &r, nn, w);
 }
 
-/* Run the pass over the local elements (a full space: all) colour by colour (parallel within
- * a colour) and scatter each element's result (matrix: into the space's rows, vector: at the
- * element's DOFs, energy: at its element id); an element with det J <= 0 or a non-finite
- * material response is not scattered, and the cell of the lowest such element of the colour
- * is reported. */
+/* Local element le of the pass into the pass's outputs; 0 (with res) when its det J is not
+ * positive somewhere or the material returned NaN or infinity: nothing is scattered then. */
+static int pass_element(const fcm_space *s, const pass *ps, fcm_index le, scratch *w,
+                        cell_result *res)
+{
+  const fcm_index c = fcm__space_local_elem(s, le);
+  /* another process's element (a distributed run's ghost): no points, nothing to add */
+  if (!fcm__cell_rules_owns(s->rules, s->elem_cell[c])) return 1;
+  if (ps->traction) {
+    if (!surface_cell(s, ps, c, w)) return 1;
+  } else {
+    *res = volume_cell(s, ps, c, w);
+    if (!(res->bad_det > 0.0) || res->nonfinite) return 0;
+    if (ps->cell_energy) ps->cell_energy[c] = res->energy;
+    if (ps->cell_inverted) ps->cell_inverted[c] = res->inverted;
+  }
+  if (ps->vals) scatter_matrix(s, le, w->Ke, ps->vals);
+  if (ps->vec) scatter_vector(s, c, w->fe, ps->vec);
+  return 1;
+}
+
+/* Run the pass over the local elements (a full space: all) by the space's coloured blocks of
+ * neighbouring elements: colour by colour, a block per thread at a time, its elements in
+ * order, so each matrix entry receives its terms in the same order for any thread count. Each
+ * element's result is scattered (matrix: into the space's rows, vector: at the element's DOFs,
+ * energy: at its element id); an element with det J <= 0 or a non-finite material response is
+ * not, and the cell of the lowest such element of the colour is reported. */
 static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
 {
   fcm_status st = FCM_OK;
@@ -585,34 +308,28 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
   fcm_index bad_cell = -1;
   double bad_det = 1.0;
   int bad_numeric = 0;
-  for (int color = 0; color < s->num_colors; color++) {
-    fcm_index c0 = s->color_ptr[color], c1 = s->color_ptr[color + 1];
+  const fcm_index ne = s->num_local_elems;
+  for (int color = 0; color < s->num_block_colors; color++) {
+    const fcm_index b0 = s->block_color_ptr[color], b1 = s->block_color_ptr[color + 1];
 #pragma omp parallel num_threads(ws->nthreads)
     {
       scratch *w = ws->sc + omp_get_thread_num();
-#pragma omp for schedule(dynamic, 16)
-      for (fcm_index k = c0; k < c1; k++) {
-        const fcm_index le = s->color_elems[k], c = fcm__space_local_elem(s, le);
-        /* another process's element (a distributed run's ghost): no points, nothing to add */
-        if (!fcm__cell_rules_owns(s->rules, s->elem_cell[c])) continue;
-        if (ps->traction) {
-          if (!surface_cell(s, ps, c, w)) continue;
-        } else {
-          cell_result res = volume_cell(s, ps, c, w);
-          if (!(res.bad_det > 0.0) || res.nonfinite) {
+#pragma omp for schedule(dynamic, 1)
+      for (fcm_index k = b0; k < b1; k++) {
+        const fcm_index first = s->block_list[k] * FCM__SPACE_BLOCK;
+        const fcm_index last = FCM_MIN(ne, first + FCM__SPACE_BLOCK);
+        for (fcm_index j = first; j < last; j++) {
+          const fcm_index le = s->block_elems[j];
+          cell_result res;
+          if (pass_element(s, ps, le, w, &res)) continue;
+          const fcm_index c = fcm__space_local_elem(s, le);
 #pragma omp critical(fcm_assemble_bad)
-            if (bad_cell < 0 || c < bad_cell) {
-              bad_cell = c;
-              bad_det = res.bad_det;
-              bad_numeric = res.nonfinite;
-            }
-            continue;
+          if (bad_cell < 0 || c < bad_cell) {
+            bad_cell = c;
+            bad_det = res.bad_det;
+            bad_numeric = res.nonfinite;
           }
-          if (ps->cell_energy) ps->cell_energy[c] = res.energy;
-          if (ps->cell_inverted) ps->cell_inverted[c] = res.inverted;
         }
-        if (ps->vals) scatter_matrix(s, le, w->Ke, ps->vals);
-        if (ps->vec) scatter_vector(s, c, w->fe, ps->vec);
       }
     }
     FCM_CHECK(bad_cell < 0 || !bad_numeric, ctx, FCM_ERR_NUMERIC,
@@ -808,7 +525,7 @@ int fcm__assembly_inverted_point(fcm_assembly_workspace *ws, fcm_index elem, con
   for (int q = 0; q < r.nq; q++) {
     if (r.fict && r.fict[q]) continue;
     double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-    if (!(physical_gradients(&r, nn, q, w->X, w->g) > 0.0)) continue;
+    if (!(fcm__fem_gradients(nn, w->X, r.dN + (size_t)q * nn * 3, w->g) > 0.0)) continue;
     for (int a = 0; a < nn; a++)
       for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++)

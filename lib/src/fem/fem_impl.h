@@ -18,6 +18,9 @@ typedef struct fcm__space_mass_cache {
   double *blocks;
 } fcm__space_mass_cache;
 
+/* Local elements per block of assembly's visiting order (block_color_ptr, block_list). */
+enum { FCM__SPACE_BLOCK = 128 };
+
 struct fcm_space {
   fcm_ctx *ctx;
   const fcm_mesh *mesh;
@@ -78,6 +81,17 @@ struct fcm_space {
   int num_colors;
   fcm_index *color_ptr;
   fcm_index *color_elems;
+  /* Assembly's visiting order: block_elems lists the local element positions in the Morton
+   * order of their cells' centres; block b is its entries [b B, min((b + 1) B,
+   * num_local_elems)) (B = FCM__SPACE_BLOCK), a compact cluster of cells. The blocks are
+   * coloured so that no two of a colour share a copy: block_color_ptr[c]..block_color_ptr[c+1]
+   * index block_list, the blocks of colour c ascending. One thread assembles a whole block, so
+   * neighbouring cells follow each other and their matrix rows are still in cache
+   * (assemble.c). */
+  int num_block_colors;
+  fcm_index *block_color_ptr;
+  fcm_index *block_list;
+  fcm_index *block_elems; /* num_local_elems */
   /* Embedded case: per-cell rules of cut cells (borrowed) and the most points any cut
    * cell has in either rule. Nothing here changes after creation: assembly scratch lives
    * in fcm_assembly_workspace (assemble.c). */

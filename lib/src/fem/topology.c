@@ -1,6 +1,6 @@
 /* The topology of a space built once after its numbering: the copies' incidence, the copy
- * graph, the scalar CSR pattern with per-element scatter offsets, and the element colouring;
- * of every element or of the local cells only. */
+ * graph, the scalar CSR pattern with per-element scatter offsets, the element colouring and
+ * assembly's colouring of element blocks; of every element or of the local cells only. */
 #include "embed/embed_impl.h"
 #include "fem/fem_impl.h"
 
@@ -199,20 +199,150 @@ cleanup:
   return st;
 }
 
+/* A local element position with the Morton key of its cell's centre. */
+typedef struct morton_elem {
+  uint64_t key;
+  fcm_index le;
+} morton_elem;
+
+static int cmp_morton(const void *a, const void *b)
+{
+  const morton_elem *x = a, *y = b;
+  if (x->key != y->key) return (x->key > y->key) - (x->key < y->key);
+  return (x->le > y->le) - (x->le < y->le);
+}
+
+/* The 21 low bits of v spread to every third bit. */
+static uint64_t spread3(uint64_t v)
+{
+  v &= 0x1fffff;
+  v = (v | v << 32) & 0x1f00000000ffffULL;
+  v = (v | v << 16) & 0x1f0000ff0000ffULL;
+  v = (v | v << 8) & 0x100f00f00f00f00fULL;
+  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+  v = (v | v << 2) & 0x1249249249249249ULL;
+  return v;
+}
+
+/* block_elems: the local element positions in the Morton (Z-curve) order of their cells'
+ * centres on a 2^21 grid over the elements' bounding box (ties, the pieces of one cell, by
+ * position), so that runs of FCM__SPACE_BLOCK of them are compact clusters of cells. */
+static fcm_status build_block_order(fcm_space *s)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ne = s->num_local_elems;
+  const int nn = s->nn;
+  morton_elem *m = NULL;
+  double *ctr = NULL, X[3 * FCM_ELEMENT_MAX_NODES], lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL},
+         hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  FCM_ALLOC(ctx, ne + 1, m);
+  FCM_ALLOC(ctx, 3 * ne + 1, ctr);
+  for (fcm_index e = 0; e < ne; e++) {
+    fcm_mesh_cell_coords(s->mesh, s->elem_cell[local_elem(s, e)], X);
+    for (int d = 0; d < 3; d++) {
+      double c = 0.0;
+      for (int a = 0; a < nn; a++)
+        c += X[3 * a + d];
+      ctr[3 * e + d] = c / nn;
+      lo[d] = fmin(lo[d], c / nn), hi[d] = fmax(hi[d], c / nn);
+    }
+  }
+  for (fcm_index e = 0; e < ne; e++) {
+    uint64_t key = 0;
+    for (int d = 0; d < 3; d++) {
+      const double t = hi[d] > lo[d] ? (ctr[3 * e + d] - lo[d]) / (hi[d] - lo[d]) : 0.0;
+      key |= spread3((uint64_t)(t * 2097151.0)) << d;
+    }
+    m[e].key = key, m[e].le = e;
+  }
+  qsort(m, (size_t)ne, sizeof *m, cmp_morton);
+  FCM_ALLOC(ctx, ne + 1, s->block_elems);
+  for (fcm_index e = 0; e < ne; e++)
+    s->block_elems[e] = m[e].le;
+cleanup:
+  fcm__free(ctx, m);
+  fcm__free(ctx, ctr);
+  return st;
+}
+
+/* Greedy colouring of the blocks of FCM__SPACE_BLOCK consecutive entries of block_elems: a
+ * block takes the smallest colour not used by a block with an element sharing a copy with one
+ * of its own. */
+static fcm_status build_block_colors(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
+                                     const fcm_index *cinc)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ne = s->num_local_elems, nb = (ne + FCM__SPACE_BLOCK - 1) / FCM__SPACE_BLOCK;
+  int *color = NULL, ncol = 0;
+  fcm_index *forbid = NULL, *fill = NULL, *block_of = NULL;
+  enum { MAX_COLORS = 4096 };
+  FCM_TRY(ctx, build_block_order(s));
+  FCM_ALLOC(ctx, ne + 1, block_of);
+  for (fcm_index j = 0; j < ne; j++)
+    block_of[s->block_elems[j]] = j / FCM__SPACE_BLOCK;
+  FCM_ALLOC(ctx, nb + 1, color);
+  FCM_ALLOC(ctx, MAX_COLORS, forbid);
+  for (int k = 0; k < MAX_COLORS; k++)
+    forbid[k] = -1;
+  for (fcm_index b = 0; b < nb; b++)
+    color[b] = -1;
+  for (fcm_index b = 0; b < nb; b++) {
+    const fcm_index e1 = FCM_MIN(ne, (b + 1) * FCM__SPACE_BLOCK);
+    for (fcm_index j = b * FCM__SPACE_BLOCK; j < e1; j++) {
+      const fcm_index *ed = s->elem_dof + local_elem(s, s->block_elems[j]) * s->nn;
+      for (int a = 0; a < s->nn; a++) {
+        const fcm_index k = g2l ? g2l[ed[a] / 3] : ed[a] / 3;
+        for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++) {
+          const int c = color[block_of[cinc[i]]];
+          if (c >= 0) forbid[c] = b;
+        }
+      }
+    }
+    int k = 0;
+    while (k < MAX_COLORS && forbid[k] == b)
+      k++;
+    FCM_CHECK(k < MAX_COLORS, ctx, FCM_ERR_UNSUPPORTED,
+              "space: element block %lld needs more than %d colours (a node shared by too many "
+              "cells)",
+              (long long)b, MAX_COLORS);
+    color[b] = k;
+    ncol = FCM_MAX(ncol, k + 1);
+  }
+  s->num_block_colors = ncol;
+  FCM_ALLOC(ctx, ncol + 1, s->block_color_ptr);
+  for (fcm_index b = 0; b < nb; b++)
+    s->block_color_ptr[color[b] + 1]++;
+  for (int k = 0; k < ncol; k++)
+    s->block_color_ptr[k + 1] += s->block_color_ptr[k];
+  FCM_ALLOC(ctx, nb + 1, s->block_list);
+  FCM_ALLOC(ctx, ncol + 1, fill);
+  for (fcm_index b = 0; b < nb; b++)
+    s->block_list[s->block_color_ptr[color[b]] + fill[color[b]]++] = b;
+cleanup:
+  fcm__free(ctx, color);
+  fcm__free(ctx, forbid);
+  fcm__free(ctx, fill);
+  fcm__free(ctx, block_of);
+  return st;
+}
+
 /* Release the topology (copy graph, pattern, offsets, colours, local lists). */
 void fcm__space_free_topology(fcm_space *s)
 {
   fcm_ctx *ctx = s->ctx;
-  void *arrays[] = {s->node_ptr,   s->node_adj,   s->row_ptr,   s->col_idx,
-                    s->elem_off,   s->elem_lcopy, s->color_ptr, s->color_elems,
-                    s->local_copy, s->local_elem, s->cell_local};
+  void *arrays[] = {s->node_ptr,   s->node_adj,        s->row_ptr,     s->col_idx,    s->elem_off,
+                    s->elem_lcopy, s->color_ptr,       s->color_elems, s->local_copy, s->local_elem,
+                    s->cell_local, s->block_color_ptr, s->block_list,  s->block_elems};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
     fcm__free(ctx, arrays[i]);
   s->node_ptr = s->node_adj = s->row_ptr = s->local_copy = s->local_elem = NULL;
   s->color_ptr = s->color_elems = NULL;
   s->col_idx = s->elem_off = s->elem_lcopy = NULL;
   s->cell_local = NULL;
-  s->num_colors = 0;
+  s->block_color_ptr = s->block_list = s->block_elems = NULL;
+  s->num_colors = s->num_block_colors = 0;
   s->num_local_copies = s->num_local_elems = 0;
 }
 
@@ -262,6 +392,7 @@ fcm_status fcm__space_build_topology(fcm_space *s, int local, const unsigned cha
   FCM_TRY(ctx, build_node_graph(s, g2l, cptr, cinc));
   FCM_TRY(ctx, build_pattern(s, g2l));
   FCM_TRY(ctx, build_colors(s, g2l, cptr, cinc));
+  FCM_TRY(ctx, build_block_colors(s, g2l, cptr, cinc));
 cleanup:
   if (st != FCM_OK) fcm__space_free_topology(s);
   fcm__free(ctx, g2l);
