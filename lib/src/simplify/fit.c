@@ -91,11 +91,12 @@ cleanup:
 
 typedef struct nnls_qr {
   int M, np;
-  double *Q;   /* M x M orthogonal */
-  double *R;   /* M x M, upper triangular in its first np columns */
-  double *qtb; /* Q^T b */
-  double *v;   /* 2 M scratch */
-  int *pos;    /* the passive columns of A, in R's column order */
+  double *Q;    /* M x M orthogonal */
+  double *R;    /* M x M, upper triangular in its first np columns */
+  double *qtb;  /* Q^T b */
+  double *v;    /* 2 M scratch */
+  int *pos;     /* the passive columns of A, in R's column order */
+  double flops; /* of the QR updates, solves and residuals */
 } nnls_qr;
 
 /* Append column t (a, of norm anorm) when it is independent of the passive columns and the
@@ -109,6 +110,7 @@ static void nnls_add(nnls_qr *s, int t, const double *a, double anorm, int *adde
   if (np == M) return; /* the passive columns span everything */
   /* q = Q^T a, as R's next column; the basis' values are O(1): its norm needs no scaling */
   fcm__gemv('T', M, M, 1.0, s->Q, M, a, 0.0, q);
+  s->flops += 2.0 * M * M + 6.0 * m;
   double nu = 0.0;
   for (int i = np; i < M; i++)
     nu += q[i] * q[i];
@@ -128,6 +130,7 @@ static void nnls_add(nnls_qr *s, int t, const double *a, double anorm, int *adde
     s->qtb[np + i] -= beta * vb * v[i];
   fcm__gemv('N', M, m, 1.0, Qp, M, v, 0.0, u); /* Q[:, np:] <- Q[:, np:] H */
   fcm__ger(M, m, -beta, u, v, 1, Qp, M);
+  s->flops += 4.0 * M * m + 2.0 * m;
   q[np] = alpha;
   for (int i = np + 1; i < M; i++)
     q[i] = 0.0;
@@ -147,6 +150,7 @@ static void nnls_remove(nnls_qr *s, int p, double *xp)
     xp[j] = xp[j + 1];
   }
   s->np--;
+  s->flops += 6.0 * (s->np - p) * (s->np - p + 2 * M) / 2.0;
   for (int j = p; j < s->np; j++) { /* Givens on rows j, j + 1: R is Hessenberg from p on */
     const double a = R[j + (size_t)j * M], b = R[j + 1 + (size_t)j * M], h = hypot(a, b);
     if (h == 0.0) continue;
@@ -168,18 +172,20 @@ static void nnls_remove(nnls_qr *s, int p, double *xp)
 }
 
 /* z = R^-1 (Q^T b) on the passive set (back substitution). */
-static void nnls_solve(const nnls_qr *s, double *z)
+static void nnls_solve(nnls_qr *s, double *z)
 {
+  s->flops += (double)s->np * s->np;
   memcpy(z, s->qtb, (size_t)s->np * sizeof *z);
   fcm__trsv_upper(s->np, s->R, s->M, z);
 }
 
 /* r = b - A x for x = xp on the passive set, from A (exact) or from the factorization; its
  * largest entry (returned) and 2-norm (*rn). */
-static double nnls_residual(const nnls_qr *s, const double *A, const double *b, const double *xp,
+static double nnls_residual(nnls_qr *s, const double *A, const double *b, const double *xp,
                             int exact, double *r, double *rn)
 {
   const int M = s->M;
+  s->flops += 2.0 * M * (exact ? s->np : M - s->np) + 3.0 * M;
   if (exact) {
     memcpy(r, b, (size_t)M * sizeof *r);
     for (int q = 0; q < s->np; q++)
@@ -225,7 +231,7 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
                               double stop, double *x, fcm__nnls_report *rep)
 {
   fcm_status st = FCM_OK;
-  nnls_qr s = {M, 0, NULL, NULL, NULL, NULL, NULL};
+  nnls_qr s = {M, 0, NULL, NULL, NULL, NULL, NULL, 0.0};
   double *r = NULL, *g = NULL, *norm = NULL, *inv = NULL, *xp = NULL, *z = NULL;
   int *seen = NULL, *pas = NULL, exact = 0;
   memset(rep, 0, sizeof *rep);
@@ -265,6 +271,7 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
       break;
     }
     fcm__gemv('T', M, k, 1.0, A, M, r, 0.0, g);
+    s.flops += 2.0 * M * k + 2.0 * k;
     for (int q = 0; q < s.np; q++)
       pas[s.pos[q]] = it;
     int added = 0;
@@ -287,6 +294,7 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
   }
 done:
   rep->passive = s.np;
+  rep->flops = s.flops + 2.0 * M * k; /* and the column norms */
   memset(x, 0, (size_t)k * sizeof *x);
   for (int q = 0; q < s.np; q++)
     x[s.pos[q]] = xp[q];
@@ -385,6 +393,7 @@ static fcm_status nnls_fit(fcm_ctx *ctx, int M, int n, const double *P, const do
   for (int i = 0; i < M; i++)
     bs[i] = scale * b[i];
   FCM_TRY(ctx, fcm__simplify_nnls(ctx, M, n, P, bs, nnls_stop(M, b, scale, tol, floor), x, nr));
+  f->flops += nr->flops;
   if (!nr->ok) goto cleanup;
   f->count = 0;
   for (int j = 0; j < n; j++)
@@ -408,6 +417,7 @@ fcm_status fcm__simplify_fit(fcm_ctx *ctx, const fcm__cheb_box *box, int n, cons
   f->count = 0;
   f->ok = 0;
   f->residual = INFINITY;
+  f->flops = 0.0;
   f->message[0] = '\0';
   if (n < 1) {
     snprintf(f->message, sizeof f->message, "no candidate points");
