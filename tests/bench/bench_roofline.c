@@ -265,22 +265,37 @@ static int in_tet(const double *v, const double *x)
   return l[0] >= -eps && l[1] >= -eps && l[2] >= -eps && l[0] + l[1] + l[2] <= 1.0 + eps;
 }
 
-/* 1 when the physical point x lies in one of the geometry's tets. */
-static int in_geometry(const fcm_geometry *g, const double *x)
+/* The geometry's tets that meet the box lo..hi (up to rounding): their ids into near, count
+ * returned. */
+static fcm_index tets_near(const fcm_geometry *g, const double lo[3], const double hi[3],
+                           fcm_index *near)
 {
   const double *X = fcm_geometry_coords(g);
   const fcm_index *cells = fcm_geometry_cells(g);
+  fcm_index n = 0;
   for (fcm_index t = 0; t < fcm_geometry_num_cells(g); t++) {
-    double v[12];
-    int near = 1;
-    for (int a = 0; a < 4; a++)
-      memcpy(v + 3 * a, X + 3 * cells[4 * t + a], 3 * sizeof *v);
-    for (int d = 0; d < 3 && near; d++) {
-      const double lo = fmin(fmin(v[d], v[3 + d]), fmin(v[6 + d], v[9 + d]));
-      const double hi = fmax(fmax(v[d], v[3 + d]), fmax(v[6 + d], v[9 + d]));
-      near = x[d] >= lo - 1e-12 && x[d] <= hi + 1e-12;
+    int meets = 1;
+    for (int d = 0; d < 3 && meets; d++) {
+      double a = 1e30, b = -1e30;
+      for (int v = 0; v < 4; v++)
+        a = fmin(a, X[3 * cells[4 * t + v] + d]), b = fmax(b, X[3 * cells[4 * t + v] + d]);
+      meets = a <= hi[d] + 1e-12 && b >= lo[d] - 1e-12;
     }
-    if (near && in_tet(v, x)) return 1;
+    if (meets) near[n++] = t;
+  }
+  return n;
+}
+
+/* 1 when the physical point x lies in one of the geometry's tets near[0..n). */
+static int in_geometry(const fcm_geometry *g, fcm_index n, const fcm_index *near, const double *x)
+{
+  const double *X = fcm_geometry_coords(g);
+  const fcm_index *cells = fcm_geometry_cells(g);
+  for (fcm_index k = 0; k < n; k++) {
+    double v[12];
+    for (int a = 0; a < 4; a++)
+      memcpy(v + 3 * a, X + 3 * cells[4 * near[k] + a], 3 * sizeof *v);
+    if (in_tet(v, x)) return 1;
   }
   return 0;
 }
@@ -320,8 +335,9 @@ static int clip_triangle(const double *X, const fcm_index *tri, const double lo[
  * the material's box (reference mbox) inside the geometry, sized for about 2 M grow of them, and
  * up to M grow boundary points (the vertices and centroids of the boundary triangles' parts in
  * the cell), grow = SIMP_GROW^a. */
-static int simp_candidates(const fcm_geometry *g, const double clo[3], const double chi[3], int M,
-                           double vol, const double mbox[6], int a, simp_cell *c)
+static int simp_candidates(const fcm_geometry *g, fcm_index nnear, const fcm_index *near,
+                           const double clo[3], const double chi[3], int M, double vol,
+                           const double mbox[6], int a, simp_cell *c)
 {
   int grow = 1;
   for (int k = 0; k < a; k++)
@@ -346,7 +362,7 @@ static int simp_candidates(const fcm_geometry *g, const double clo[3], const dou
           xi[d] = mbox[d] + (mbox[3 + d] - mbox[d]) * ijk[d] / n;
           x[d] = clo[d] + 0.5 * (xi[d] + 1.0) * (chi[d] - clo[d]);
         }
-        if (in_geometry(g, x)) memcpy(cand + 3 * (size_t)nc++, xi, sizeof xi);
+        if (in_geometry(g, nnear, near, x)) memcpy(cand + 3 * (size_t)nc++, xi, sizeof xi);
       }
   size_t nb = 0;
   for (fcm_index t = 0; t < nt; t++) { /* the parts' vertices, then their centroid */
@@ -372,8 +388,8 @@ static int simp_candidates(const fcm_geometry *g, const double clo[3], const dou
 
 /* The material's box in the cell lo..hi, in reference coordinates (as the surface path): the
  * boundary triangles' parts in the cell and the cell's corners inside the body. */
-static void material_box(const fcm_geometry *g, const double lo[3], const double hi[3],
-                         double mbox[6])
+static void material_box(const fcm_geometry *g, fcm_index nnear, const fcm_index *near,
+                         const double lo[3], const double hi[3], double mbox[6])
 {
   const fcm_index *tri = fcm_geometry_boundary_triangles(g);
   const double *X = fcm_geometry_coords(g);
@@ -385,7 +401,7 @@ static void material_box(const fcm_geometry *g, const double lo[3], const double
     if (k < 8) { /* a corner of the cell */
       for (int d = 0; d < 3; d++)
         poly[d] = (k >> d) & 1 ? hi[d] : lo[d];
-      if (!in_geometry(g, poly)) continue;
+      if (!in_geometry(g, nnear, near, poly)) continue;
     } else {
       np = clip_triangle(X, tri + 3 * (k - 8), lo, hi, poly);
     }
@@ -424,6 +440,7 @@ static int simp_setup(fcm_ctx *ctx, int m, simp_input *in)
   fcm_index cut[SIMP_GRID * SIMP_GRID * SIMP_GRID], ncut = 0;
   double *work = NULL, *wf = NULL;
   int *idx = NULL;
+  fcm_index *near = NULL;
   memset(in, 0, sizeof *in);
   in->m = m;
   fcm_cell_rules_options o = fcm_cell_rules_options_default();
@@ -443,7 +460,8 @@ static int simp_setup(fcm_ctx *ctx, int m, simp_input *in)
   }
   work = malloc(fcm__simplify_moments_scratch(m) * sizeof *work);
   idx = malloc((size_t)M * sizeof *idx), wf = malloc((size_t)M * sizeof *wf);
-  if (ncut < SIMP_CELLS || !work || !idx || !wf) goto done;
+  near = malloc((size_t)fcm_geometry_num_cells(g) * sizeof *near);
+  if (ncut < SIMP_CELLS || !work || !idx || !wf || !near) goto done;
   for (int k = 0; k < SIMP_CELLS; k++) {
     const fcm_index cell = cut[(size_t)k * (size_t)ncut / SIMP_CELLS];
     simp_cell *c = &in->c[in->cells++];
@@ -463,7 +481,8 @@ static int simp_setup(fcm_ctx *ctx, int m, simp_input *in)
       for (int d = 0; d < 3; d++)
         clo[d] = fmin(clo[d], X[3 * a + d]), chi[d] = fmax(chi[d], X[3 * a + d]);
     double mbox[6], vol = 0.0;
-    material_box(g, clo, chi, mbox);
+    const fcm_index nnear = tets_near(g, clo, chi, near);
+    material_box(g, nnear, near, clo, chi, mbox);
     for (int j = 0; j < n; j++) {
       vol += w[j];
       for (int d = 0; d < 3; d++)
@@ -480,7 +499,7 @@ static int simp_setup(fcm_ctx *ctx, int m, simp_input *in)
     memset(&f, 0, sizeof f);
     f.idx = idx, f.w = wf;
     for (int a = 0; a < SIMP_GRIDS && !f.ok; a++) { /* the sets until one fits */
-      if (!simp_candidates(g, clo, chi, M, vol, mbox, a, c)) goto done;
+      if (!simp_candidates(g, nnear, near, clo, chi, M, vol, mbox, a, c)) goto done;
       c->grids = a + 1;
       if (fcm__simplify_fit(ctx, &c->box, c->nc[a], c->cand[a], c->mom, 1e-12, c->atol, &f))
         goto done;
@@ -494,7 +513,7 @@ static int simp_setup(fcm_ctx *ctx, int m, simp_input *in)
   ok = 1;
 done:
   if (!ok) fcm_ctx_error_view(ctx, stderr), simp_free(in);
-  free(work), free(idx), free(wf);
+  free(work), free(idx), free(wf), free(near);
   fcm_cell_rules_destroy(&rules);
   fcm_geometry_destroy(&g);
   fcm_mesh_destroy(&mesh);

@@ -89,14 +89,23 @@ cleanup:
  * ||a_j|| ||r||: below it, r is orthogonal to a_j up to rounding. */
 #define NNLS_GRAD_TOL 1e-12
 
+/* Columns an outer iteration adds at most (deviation maximization; Dessole, Dell'Orto and
+ * Marcuzzi 2023): besides the steepest, the columns whose cosine with the residual is at least
+ * NNLS_BATCH_TAU of the steepest's and whose cosine with each column added before in the same
+ * iteration is below NNLS_BATCH_DELTA in magnitude. Each gradient A^T r (2 M k flops, the
+ * main cost when k >> M) then serves several columns. */
+#define NNLS_BATCH       16
+#define NNLS_BATCH_TAU   0.8
+#define NNLS_BATCH_DELTA 0.5
+
 typedef struct nnls_qr {
-  int M, np;
-  double *Q;    /* M x M orthogonal */
-  double *R;    /* M x M, upper triangular in its first np columns */
-  double *qtb;  /* Q^T b */
-  double *v;    /* 2 M scratch */
-  int *pos;     /* the passive columns of A, in R's column order */
-  double flops; /* of the QR updates, solves and residuals */
+  int M, np, kcols; /* rows, passive columns, columns of A */
+  double *Q;        /* M x M orthogonal */
+  double *R;        /* M x M, upper triangular in its first np columns */
+  double *qtb;      /* Q^T b */
+  double *v;        /* 2 M scratch */
+  int *pos;         /* the passive columns of A, in R's column order */
+  double flops;     /* of the QR updates, solves and residuals */
 } nnls_qr;
 
 /* Append column t (a, of norm anorm) when it is independent of the passive columns and the
@@ -202,6 +211,59 @@ static double nnls_residual(nnls_qr *s, const double *A, const double *b, const 
   return rmax;
 }
 
+/* After the steepest column (the last passive one) entered: up to NNLS_BATCH - 1 more, in the
+ * order of their cosine with the residual (g[j] inv[j] = cos(a_j, r) ||r||), each at least
+ * NNLS_BATCH_TAU of the steepest's and of cosine below NNLS_BATCH_DELTA with the columns added in
+ * this iteration (deviation maximization). order: k ints of scratch. */
+static void nnls_more(nnls_qr *s, const double *A, const double *norm, const double *inv,
+                      const double *g, int it, int *seen, const int *pas, int *order)
+{
+  const int M = s->M, first = s->pos[s->np - 1];
+  const double floor = NNLS_BATCH_TAU * g[first] * inv[first];
+  int nc = 0, chosen[NNLS_BATCH], nch = 1;
+  chosen[0] = first;
+  for (int j = 0; j < s->kcols; j++)
+    if (seen[j] != it && pas[j] != it && g[j] * inv[j] >= floor) order[nc++] = j;
+  for (int a = 0; a < nc && nch < NNLS_BATCH && s->np < M; a++) {
+    /* the steepest of the rest: a partial selection sort (few are taken) */
+    int b = a;
+    for (int c = a + 1; c < nc; c++)
+      if (g[order[c]] * inv[order[c]] > g[order[b]] * inv[order[b]]) b = c;
+    const int j = order[b];
+    order[b] = order[a], order[a] = j;
+    seen[j] = it;
+    const double *aj = A + (size_t)j * (size_t)M;
+    int apart = 1;
+    for (int c = 0; c < nch && apart; c++) {
+      const double *ac = A + (size_t)chosen[c] * (size_t)M;
+      double d = 0.0;
+      for (int i = 0; i < M; i++)
+        d += aj[i] * ac[i];
+      apart = fabs(d) * inv[j] * inv[chosen[c]] < NNLS_BATCH_DELTA;
+    }
+    s->flops += 2.0 * M * nch;
+    if (!apart) continue;
+    int added;
+    nnls_add(s, j, aj, norm[j], &added);
+    if (added) chosen[nch++] = j;
+  }
+}
+
+/* The least-squares weights z of the passive set with the columns np0.. added this iteration:
+ * while one of those is <= 0, the last of them leaves (the first one's weight is positive when
+ * it is the only one: nnls_add checked). */
+static void nnls_keep_positive(nnls_qr *s, int np0, double *z)
+{
+  for (;;) {
+    nnls_solve(s, z);
+    int bad = 0;
+    for (int q = np0; q < s->np && !bad; q++)
+      bad = !(z[q] > 0.0);
+    if (!bad || s->np <= np0 + 1) return;
+    s->np--; /* the last column: R's triangle and Q need no rotation */
+  }
+}
+
 /* The inner loop of Lawson and Hanson: move xp towards the passive set's least-squares
  * solution, dropping the columns whose weight reaches 0 on the way, until it is positive. */
 static void nnls_inner(nnls_qr *s, double *xp, double *z)
@@ -231,9 +293,9 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
                               double stop, double *x, fcm__nnls_report *rep)
 {
   fcm_status st = FCM_OK;
-  nnls_qr s = {M, 0, NULL, NULL, NULL, NULL, NULL, 0.0};
+  nnls_qr s = {M, 0, k, NULL, NULL, NULL, NULL, NULL, 0.0};
   double *r = NULL, *g = NULL, *norm = NULL, *inv = NULL, *xp = NULL, *z = NULL;
-  int *seen = NULL, *pas = NULL, exact = 0;
+  int *seen = NULL, *pas = NULL, *order = NULL, exact = 0;
   memset(rep, 0, sizeof *rep);
   rep->residual = INFINITY;
   FCM_ALLOC(ctx, (size_t)M * (size_t)M, s.Q);
@@ -249,6 +311,7 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
   FCM_ALLOC(ctx, (size_t)M, z);
   FCM_ALLOC(ctx, (size_t)k, seen);
   FCM_ALLOC(ctx, (size_t)k, pas);
+  FCM_ALLOC(ctx, (size_t)k, order);
   for (int i = 0; i < M; i++)
     s.Q[i + (size_t)i * (size_t)M] = 1.0;
   memcpy(s.qtb, b, (size_t)M * sizeof *b);
@@ -261,6 +324,7 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
     seen[j] = pas[j] = -1; /* the iteration that tried j last, that found it passive */
   }
   for (int it = 0; it < 3 * k + M; it++) {
+    const int np0 = s.np;
     /* r = b - A x: xp being the passive set's least-squares solution, r = Q_2 Q_2^T b with
      * Q_2 = Q's last M - np columns (cheaper near the end); confirmed from A and x when small */
     double rn, rmax = nnls_residual(&s, A, b, xp, exact, r, &rn);
@@ -289,7 +353,10 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
       seen[t] = it;
       nnls_add(&s, t, A + (size_t)t * (size_t)M, norm[t], &added);
     }
-    xp[s.np - 1] = 0.0;
+    nnls_more(&s, A, norm, inv, g, it, seen, pas, order);
+    for (int q = np0; q < s.np; q++)
+      xp[q] = 0.0;
+    nnls_keep_positive(&s, np0, z);
     nnls_inner(&s, xp, z);
   }
 done:
@@ -312,6 +379,7 @@ cleanup:
   fcm__free(ctx, z);
   fcm__free(ctx, seen);
   fcm__free(ctx, pas);
+  fcm__free(ctx, order);
   return st;
 }
 
