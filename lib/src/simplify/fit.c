@@ -183,9 +183,17 @@ static void nnls_remove(nnls_qr *s, int p, double *xp)
 /* z = R^-1 (Q^T b) on the passive set (back substitution). */
 static void nnls_solve(nnls_qr *s, double *z)
 {
-  s->flops += (double)s->np * s->np;
-  memcpy(z, s->qtb, (size_t)s->np * sizeof *z);
-  fcm__trsv_upper(s->np, s->R, s->M, z);
+  const int np = s->np, M = s->M;
+  s->flops += (double)np * np;
+  memcpy(z, s->qtb, (size_t)np * sizeof *z);
+  /* by columns of R (contiguous): at these sizes faster than a BLAS call */
+  for (int j = np - 1; j >= 0; j--) {
+    const double *restrict rj = s->R + (size_t)j * (size_t)M;
+    const double zj = z[j] / rj[j];
+    z[j] = zj;
+    for (int i = 0; i < j; i++)
+      z[i] -= zj * rj[i];
+  }
 }
 
 /* r = b - A x for x = xp on the passive set, from A (exact) or from the factorization; its
@@ -265,11 +273,12 @@ static void nnls_keep_positive(nnls_qr *s, int np0, double *z)
 }
 
 /* The inner loop of Lawson and Hanson: move xp towards the passive set's least-squares
- * solution, dropping the columns whose weight reaches 0 on the way, until it is positive. */
+ * solution (in z on entry), dropping the columns whose weight reaches 0 on the way, until it
+ * is positive. */
 static void nnls_inner(nnls_qr *s, double *xp, double *z)
 {
   for (int inner = 0; inner <= s->M && s->np > 0; inner++) {
-    nnls_solve(s, z);
+    if (inner > 0) nnls_solve(s, z); /* the first: nnls_keep_positive() solved */
     double alpha = 2.0;
     int at = -1;
     for (int q = 0; q < s->np; q++)
