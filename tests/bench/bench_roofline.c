@@ -12,7 +12,8 @@
  * raw rows of the kernels it is started with (e.g. another BLAS preloaded). Each row is a time, a
  * rate (GFLOP/s or GB/s) and the fraction of the core's measured peak: the best DGEMM rate for
  * flop-bound rows, the best STREAM triad bandwidth for memory-bound rows. Prints the table, writes
- * the CSV and ends with a one-line summary. Asserts that each CHOLMOD solve has a small residual
+ * the CSV and ends with a one-line summary (and one line per strength of the simplification
+ * rows, see run_simp()). Asserts that each CHOLMOD solve has a small residual
  * and that the kernel sets give the same solution to round-off. Label bench: never in the default
  * run. */
 #define _POSIX_C_SOURCE 200809L /* popen, readlink */
@@ -756,6 +757,29 @@ static void summary(const row *rows, int nrows)
   printf("\n");
 }
 
+/* One line per strength: ms per cell of the default path (the surface path's fit), the rank-1
+ * elimination (the old path) and the blocked one, with the kernels fcm selects (or the only set
+ * measured), and the default and the blocked elimination against the rank-1 one. */
+static void simp_summary(const row *rows, int nrows)
+{
+  const char *role = find(rows, nrows, "dgemm", "selected") ? "selected" : "loaded";
+  static const int ms[] = {3, 5, 7, 9};
+  for (int k = 0; k < 4; k++) {
+    char n[3][32];
+    const row *w[3];
+    snprintf(n[0], sizeof n[0], "simp_fit_m%d", ms[k]);
+    snprintf(n[1], sizeof n[1], "simp_elim1_m%d", ms[k]);
+    snprintf(n[2], sizeof n[2], "simp_elim_m%d", ms[k]);
+    for (int p = 0; p < 3; p++)
+      w[p] = find(rows, nrows, n[p], role);
+    if (!w[0] || !w[1] || !w[2]) continue;
+    printf("simplification m = %d (%s kernels), ms per cell: default (fit) %.3f, elimination "
+           "rank-1 (old) %.3f, blocked %.3f; against the old: default %.2fx, blocked %.2fx\n",
+           ms[k], role, 1e3 * w[0]->r.seconds, 1e3 * w[1]->r.seconds, 1e3 * w[2]->r.seconds,
+           w[1]->r.seconds / w[0]->r.seconds, w[1]->r.seconds / w[2]->r.seconds);
+  }
+}
+
 int main(int argc, char **argv)
 {
   if (argc >= 3 && !strcmp(argv[1], "child")) return child(atoi(argv[2]));
@@ -797,5 +821,6 @@ int main(int argc, char **argv)
   const row *c1 = find(rows, nrows, "cholmod_factor", "selected");
   if (c0 && c1) TEST_NEAR(c1->r.check, c0->r.check, 1e-10, 0.0);
   summary(rows, nrows);
+  simp_summary(rows, nrows);
   return TEST_RESULT();
 }
