@@ -47,7 +47,7 @@ typedef struct fcm_simplify_options {
                                (their rank-1 updates applied together as one matrix product),
                                1 ... 256; 1: one at a time, a rank-1 update per pivot (the
                                unblocked elimination, kept to measure against); FCM_DEFAULT
-                               (default): the measured block (tests/bench/bench_roofline.c) */
+                               (default): 32 (measured: lib/docs/performance.md) */
 } fcm_simplify_options;
 
 /** The simplified rule: a subset of the input points with new weights. */

@@ -222,7 +222,8 @@ static double nnls_residual(nnls_qr *s, const double *A, const double *b, const 
 /* After the steepest column (the last passive one) entered: up to NNLS_BATCH - 1 more, in the
  * order of their cosine with the residual (g[j] inv[j] = cos(a_j, r) ||r||), each at least
  * NNLS_BATCH_TAU of the steepest's and of cosine below NNLS_BATCH_DELTA with the columns added in
- * this iteration (deviation maximization). order: k ints of scratch. */
+ * this iteration (deviation maximization); at most 4 NNLS_BATCH tried (a selection sort each).
+ * order: k ints of scratch. */
 static void nnls_more(nnls_qr *s, const double *A, const double *norm, const double *inv,
                       const double *g, int it, int *seen, const int *pas, int *order)
 {
@@ -232,7 +233,7 @@ static void nnls_more(nnls_qr *s, const double *A, const double *norm, const dou
   chosen[0] = first;
   for (int j = 0; j < s->kcols; j++)
     if (seen[j] != it && pas[j] != it && g[j] * inv[j] >= floor) order[nc++] = j;
-  for (int a = 0; a < nc && nch < NNLS_BATCH && s->np < M; a++) {
+  for (int a = 0; a < nc && a < 4 * NNLS_BATCH && nch < NNLS_BATCH && s->np < M; a++) {
     /* the steepest of the rest: a partial selection sort (few are taken) */
     int b = a;
     for (int c = a + 1; c < nc; c++)
