@@ -197,9 +197,11 @@ done:
  * - the surface path's input (FCM_CELL_MOMENTS_AUTO, the default): candidates as that path
  *   picks them (the points of a grid over the material's box in the cell inside the material,
  *   about 2 M of them, and up to M points on the material's boundary: vertices and centroids of
- *   the boundary triangles in the cell) and the material's moments in the basis of the
+ *   the boundary triangles' parts in the cell; the sets 4, 16, 64 times larger that path
+ *   retries on, up to the first that fits) and the material's moments in the basis of the
  *   material's box (here from the volume rule, exact to rounding for a polyhedral body).
- * Rows per strength: "simp_fit_mM" the default path (fcm__simplify_fit: NNLS on the candidates),
+ * Rows per strength: "simp_fit_mM" the default path (fcm__simplify_fit on each candidate set in
+ * turn until one fits, all of them timed),
  * "simp_elim1_mM" fcm_simplify's elimination one direction at a time (elimination_block = 1,
  * the unblocked path), "simp_elim_mM" the same with the default blocked elimination. Time: mean
  * over the cells of the best of SIMP_REPS calls, the whole call (basis, factorization,
