@@ -62,6 +62,11 @@ int main(void)
   o.lp_time_limit = NAN;
   EXPECT_ARG(fcm_simplify(ctx, 2, N, pts, w, &o, &res, NULL), "lp_time_limit = nan");
   o = fcm_simplify_options_default();
+  o.elimination_block = 0;
+  EXPECT_ARG(fcm_simplify(ctx, 2, N, pts, w, &o, &res, NULL), "elimination_block = 0");
+  o.elimination_block = FCM__ELIM_BLOCK_MAX + 1;
+  EXPECT_ARG(fcm_simplify(ctx, 2, N, pts, w, &o, &res, NULL), "elimination_block = 257");
+  o = fcm_simplify_options_default();
   EXPECT_ARG(fcm__simplify_hooked(ctx, 2, N, pts, w, &o, 3, &res, NULL), "force_lp_failure = 3");
 
   /* Stabilization. */

@@ -157,7 +157,7 @@ static void fit(fcm_ctx *ctx)
     TEST_TRUE(M <= 84 && fcm__simplify_moments_scratch(m) <= 16384);
     util_random_box((uint64_t)m, N, lo, 1.0, 1.0, pts, w);
     fcm__simplify_moments(&box, NS, pts, NULL, w, b, work); /* the first NS candidates' rule */
-    fcm__fit f = {0, 0, idx, fw, 0.0, ""};
+    fcm__fit f = {0, 0, idx, fw, 0.0, 0.0, ""};
     TEST_OK(ctx, fcm__simplify_fit(ctx, &box, N, pts, b, 1e-12, 1e-14, &f));
     TEST_TRUE(f.ok && f.count >= 1 && f.count <= M && f.residual <= 1e-12);
     double err = 0.0, bmax = 0.0;

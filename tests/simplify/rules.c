@@ -1,5 +1,6 @@
 /* Simplification of positive rules for strengths m = 1..argv[2] (default 10) with the path
- * given as argv[1] ("lp", "recombine" or "eliminate"): random rules in a box, unions of conical
+ * given as argv[1] ("lp", "recombine" or "eliminate"; argv[3]: the elimination_block option,
+ * default FCM_DEFAULT): random rules in a box, unions of conical
  * rules on red-refined sub-tets of the unit tet (whole, and cut by a sphere). Each result has at
  * most M points, is an ascending subset of the input (hence inside the tet), has
  * positive weights and integrates every monomial of degree <= m like the input. */
@@ -7,6 +8,8 @@
 
 /* Relative monomial tolerance (to sum w0 |mono|), the contract's 1e-12. */
 #define RTOL 1e-12
+
+static int block = FCM_DEFAULT; /* fcm_simplify_options.elimination_block */
 
 static void run(fcm_ctx *ctx, fcm_simplify_method method, const char *what, int m, int n,
                 const double *pts, const double *w)
@@ -16,6 +19,7 @@ static void run(fcm_ctx *ctx, fcm_simplify_method method, const char *what, int 
   fcm_simplify_result res;
   fcm_simplify_info info;
   o.method = method;
+  o.elimination_block = block;
   snprintf(label, sizeof label, "%s m=%d N=%d %s", what, m, n, fcm_simplify_method_name(method));
   TEST_OK(ctx, fcm_simplify(ctx, m, n, pts, w, &o, &res, &info));
   if (info.fallback || info.attempts != 1 || info.method_used != method || info.skipped)
@@ -48,6 +52,7 @@ int main(int argc, char **argv)
   if (argc > 1 && !strcmp(argv[1], "recombine")) method = FCM_SIMPLIFY_RECOMBINE;
   if (argc > 1 && !strcmp(argv[1], "eliminate")) method = FCM_SIMPLIFY_ELIMINATE;
   const int mmax = argc > 2 ? atoi(argv[2]) : 10;
+  if (argc > 3) block = atoi(argv[3]);
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
   if (!ctx) return TEST_RESULT();
 

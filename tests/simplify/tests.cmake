@@ -3,6 +3,10 @@
 # the default run).
 # The default path up to strength 10; the GLPK reference paths up to 7 (10 under slow).
 fcm_add_test(simplify_rules_eliminate tests/simplify/rules.c ARGS eliminate)
+# The elimination one direction at a time (rank-1 updates) and in blocks of 3 (a flush every
+# few pivots, a partial block at the end).
+fcm_add_test(simplify_rules_eliminate_rank1 tests/simplify/rules.c ARGS eliminate 8 1)
+fcm_add_test(simplify_rules_eliminate_block3 tests/simplify/rules.c ARGS eliminate 8 3)
 fcm_add_test(simplify_rules_lp tests/simplify/rules.c ARGS lp 7)
 fcm_add_test(simplify_rules_recombine tests/simplify/rules.c ARGS recombine 7)
 fcm_add_test(simplify_rules_lp_full tests/simplify/rules.c ARGS lp 10 LABELS slow TIMEOUT 1800)

@@ -43,6 +43,11 @@ typedef struct fcm_simplify_options {
   int lp_iteration_limit; /**< simplex iterations per LP, >= 1; FCM_DEFAULT (default):
                                20 M + 1000 */
   double lp_time_limit;   /**< seconds per LP; 0: none; default 60 */
+  int elimination_block;  /**< ELIMINATE: null-space directions taken per blocked tableau update
+                               (their rank-1 updates applied together as one matrix product),
+                               1 ... 256; 1: one at a time, a rank-1 update per pivot (the
+                               unblocked elimination, kept to measure against); FCM_DEFAULT
+                               (default): 32 (measured: lib/docs/performance.md) */
 } fcm_simplify_options;
 
 /** The simplified rule: a subset of the input points with new weights. */
@@ -75,9 +80,14 @@ typedef struct fcm_simplify_info {
   /** Seconds in: the basis and moments; SVDs and LU factorizations; LPs and eliminations;
    * the least-squares re-fit and verification; the whole call. */
   double time_basis, time_svd, time_lp, time_refit, time_total;
+  /** Floating-point operations of the eliminations' LU factorizations, triangular solves and
+   * tableau updates (0 on the GLPK paths): the arithmetic of the algorithm, not of the basis
+   * evaluation or the verification. */
+  double flops;
 } fcm_simplify_info;
 
-/** Defaults: AUTO, rank_tol 1e-13, residual_tol 1e-12, automatic iteration limit, 60 s. */
+/** Defaults: AUTO, rank_tol 1e-13, residual_tol 1e-12, automatic iteration limit, 60 s,
+ * the measured elimination block. */
 FCM_API fcm_simplify_options fcm_simplify_options_default(void);
 
 /** Reduce a positive rule to at most M = (m+3 choose 3) of its own points with positive

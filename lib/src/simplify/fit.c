@@ -89,13 +89,23 @@ cleanup:
  * ||a_j|| ||r||: below it, r is orthogonal to a_j up to rounding. */
 #define NNLS_GRAD_TOL 1e-12
 
+/* Columns an outer iteration adds at most (deviation maximization; Dessole, Dell'Orto and
+ * Marcuzzi 2023): besides the steepest, the columns whose cosine with the residual is at least
+ * NNLS_BATCH_TAU of the steepest's and whose cosine with each column added before in the same
+ * iteration is below NNLS_BATCH_DELTA in magnitude. Each gradient A^T r (2 M k flops, the
+ * main cost when k >> M) then serves several columns. */
+#define NNLS_BATCH       16
+#define NNLS_BATCH_TAU   0.8
+#define NNLS_BATCH_DELTA 0.5
+
 typedef struct nnls_qr {
-  int M, np;
-  double *Q;   /* M x M orthogonal */
-  double *R;   /* M x M, upper triangular in its first np columns */
-  double *qtb; /* Q^T b */
-  double *v;   /* 2 M scratch */
-  int *pos;    /* the passive columns of A, in R's column order */
+  int M, np, kcols; /* rows, passive columns, columns of A */
+  double *Q;        /* M x M orthogonal */
+  double *R;        /* M x M, upper triangular in its first np columns */
+  double *qtb;      /* Q^T b */
+  double *v;        /* 2 M scratch */
+  int *pos;         /* the passive columns of A, in R's column order */
+  double flops;     /* of the QR updates, solves and residuals */
 } nnls_qr;
 
 /* Append column t (a, of norm anorm) when it is independent of the passive columns and the
@@ -109,6 +119,7 @@ static void nnls_add(nnls_qr *s, int t, const double *a, double anorm, int *adde
   if (np == M) return; /* the passive columns span everything */
   /* q = Q^T a, as R's next column; the basis' values are O(1): its norm needs no scaling */
   fcm__gemv('T', M, M, 1.0, s->Q, M, a, 0.0, q);
+  s->flops += 2.0 * M * M + 6.0 * m;
   double nu = 0.0;
   for (int i = np; i < M; i++)
     nu += q[i] * q[i];
@@ -128,6 +139,7 @@ static void nnls_add(nnls_qr *s, int t, const double *a, double anorm, int *adde
     s->qtb[np + i] -= beta * vb * v[i];
   fcm__gemv('N', M, m, 1.0, Qp, M, v, 0.0, u); /* Q[:, np:] <- Q[:, np:] H */
   fcm__ger(M, m, -beta, u, v, 1, Qp, M);
+  s->flops += 4.0 * M * m + 2.0 * m;
   q[np] = alpha;
   for (int i = np + 1; i < M; i++)
     q[i] = 0.0;
@@ -147,6 +159,7 @@ static void nnls_remove(nnls_qr *s, int p, double *xp)
     xp[j] = xp[j + 1];
   }
   s->np--;
+  s->flops += 6.0 * (s->np - p) * (s->np - p + 2 * M) / 2.0;
   for (int j = p; j < s->np; j++) { /* Givens on rows j, j + 1: R is Hessenberg from p on */
     const double a = R[j + (size_t)j * M], b = R[j + 1 + (size_t)j * M], h = hypot(a, b);
     if (h == 0.0) continue;
@@ -168,18 +181,28 @@ static void nnls_remove(nnls_qr *s, int p, double *xp)
 }
 
 /* z = R^-1 (Q^T b) on the passive set (back substitution). */
-static void nnls_solve(const nnls_qr *s, double *z)
+static void nnls_solve(nnls_qr *s, double *z)
 {
-  memcpy(z, s->qtb, (size_t)s->np * sizeof *z);
-  fcm__trsv_upper(s->np, s->R, s->M, z);
+  const int np = s->np, M = s->M;
+  s->flops += (double)np * np;
+  memcpy(z, s->qtb, (size_t)np * sizeof *z);
+  /* by columns of R (contiguous): at these sizes faster than a BLAS call */
+  for (int j = np - 1; j >= 0; j--) {
+    const double *restrict rj = s->R + (size_t)j * (size_t)M;
+    const double zj = z[j] / rj[j];
+    z[j] = zj;
+    for (int i = 0; i < j; i++)
+      z[i] -= zj * rj[i];
+  }
 }
 
 /* r = b - A x for x = xp on the passive set, from A (exact) or from the factorization; its
  * largest entry (returned) and 2-norm (*rn). */
-static double nnls_residual(const nnls_qr *s, const double *A, const double *b, const double *xp,
+static double nnls_residual(nnls_qr *s, const double *A, const double *b, const double *xp,
                             int exact, double *r, double *rn)
 {
   const int M = s->M;
+  s->flops += 2.0 * M * (exact ? s->np : M - s->np) + 3.0 * M;
   if (exact) {
     memcpy(r, b, (size_t)M * sizeof *r);
     for (int q = 0; q < s->np; q++)
@@ -196,12 +219,67 @@ static double nnls_residual(const nnls_qr *s, const double *A, const double *b, 
   return rmax;
 }
 
+/* After the steepest column (the last passive one) entered: up to NNLS_BATCH - 1 more, in the
+ * order of their cosine with the residual (g[j] inv[j] = cos(a_j, r) ||r||), each at least
+ * NNLS_BATCH_TAU of the steepest's and of cosine below NNLS_BATCH_DELTA with the columns added in
+ * this iteration (deviation maximization); at most 4 NNLS_BATCH tried (a selection sort each).
+ * order: k ints of scratch. */
+static void nnls_more(nnls_qr *s, const double *A, const double *norm, const double *inv,
+                      const double *g, int it, int *seen, const int *pas, int *order)
+{
+  const int M = s->M, first = s->pos[s->np - 1];
+  const double floor = NNLS_BATCH_TAU * g[first] * inv[first];
+  int nc = 0, chosen[NNLS_BATCH], nch = 1;
+  chosen[0] = first;
+  for (int j = 0; j < s->kcols; j++)
+    if (seen[j] != it && pas[j] != it && g[j] * inv[j] >= floor) order[nc++] = j;
+  for (int a = 0; a < nc && a < 4 * NNLS_BATCH && nch < NNLS_BATCH && s->np < M; a++) {
+    /* the steepest of the rest: a partial selection sort (few are taken) */
+    int b = a;
+    for (int c = a + 1; c < nc; c++)
+      if (g[order[c]] * inv[order[c]] > g[order[b]] * inv[order[b]]) b = c;
+    const int j = order[b];
+    order[b] = order[a], order[a] = j;
+    seen[j] = it;
+    const double *aj = A + (size_t)j * (size_t)M;
+    int apart = 1;
+    for (int c = 0; c < nch && apart; c++) {
+      const double *ac = A + (size_t)chosen[c] * (size_t)M;
+      double d = 0.0;
+      for (int i = 0; i < M; i++)
+        d += aj[i] * ac[i];
+      apart = fabs(d) * inv[j] * inv[chosen[c]] < NNLS_BATCH_DELTA;
+    }
+    s->flops += 2.0 * M * nch;
+    if (!apart) continue;
+    int added;
+    nnls_add(s, j, aj, norm[j], &added);
+    if (added) chosen[nch++] = j;
+  }
+}
+
+/* The least-squares weights z of the passive set with the columns np0.. added this iteration:
+ * while one of those is <= 0, the last of them leaves (the first one's weight is positive when
+ * it is the only one: nnls_add checked). */
+static void nnls_keep_positive(nnls_qr *s, int np0, double *z)
+{
+  for (;;) {
+    nnls_solve(s, z);
+    int bad = 0;
+    for (int q = np0; q < s->np && !bad; q++)
+      bad = !(z[q] > 0.0);
+    if (!bad || s->np <= np0 + 1) return;
+    s->np--; /* the last column: R's triangle and Q need no rotation */
+  }
+}
+
 /* The inner loop of Lawson and Hanson: move xp towards the passive set's least-squares
- * solution, dropping the columns whose weight reaches 0 on the way, until it is positive. */
+ * solution (in z on entry), dropping the columns whose weight reaches 0 on the way, until it
+ * is positive. */
 static void nnls_inner(nnls_qr *s, double *xp, double *z)
 {
   for (int inner = 0; inner <= s->M && s->np > 0; inner++) {
-    nnls_solve(s, z);
+    if (inner > 0) nnls_solve(s, z); /* the first: nnls_keep_positive() solved */
     double alpha = 2.0;
     int at = -1;
     for (int q = 0; q < s->np; q++)
@@ -225,9 +303,9 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
                               double stop, double *x, fcm__nnls_report *rep)
 {
   fcm_status st = FCM_OK;
-  nnls_qr s = {M, 0, NULL, NULL, NULL, NULL, NULL};
+  nnls_qr s = {M, 0, k, NULL, NULL, NULL, NULL, NULL, 0.0};
   double *r = NULL, *g = NULL, *norm = NULL, *inv = NULL, *xp = NULL, *z = NULL;
-  int *seen = NULL, *pas = NULL, exact = 0;
+  int *seen = NULL, *pas = NULL, *order = NULL, exact = 0;
   memset(rep, 0, sizeof *rep);
   rep->residual = INFINITY;
   FCM_ALLOC(ctx, (size_t)M * (size_t)M, s.Q);
@@ -243,6 +321,7 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
   FCM_ALLOC(ctx, (size_t)M, z);
   FCM_ALLOC(ctx, (size_t)k, seen);
   FCM_ALLOC(ctx, (size_t)k, pas);
+  FCM_ALLOC(ctx, (size_t)k, order);
   for (int i = 0; i < M; i++)
     s.Q[i + (size_t)i * (size_t)M] = 1.0;
   memcpy(s.qtb, b, (size_t)M * sizeof *b);
@@ -255,6 +334,7 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
     seen[j] = pas[j] = -1; /* the iteration that tried j last, that found it passive */
   }
   for (int it = 0; it < 3 * k + M; it++) {
+    const int np0 = s.np;
     /* r = b - A x: xp being the passive set's least-squares solution, r = Q_2 Q_2^T b with
      * Q_2 = Q's last M - np columns (cheaper near the end); confirmed from A and x when small */
     double rn, rmax = nnls_residual(&s, A, b, xp, exact, r, &rn);
@@ -265,6 +345,7 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
       break;
     }
     fcm__gemv('T', M, k, 1.0, A, M, r, 0.0, g);
+    s.flops += 2.0 * M * k + 2.0 * k;
     for (int q = 0; q < s.np; q++)
       pas[s.pos[q]] = it;
     int added = 0;
@@ -282,11 +363,15 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
       seen[t] = it;
       nnls_add(&s, t, A + (size_t)t * (size_t)M, norm[t], &added);
     }
-    xp[s.np - 1] = 0.0;
+    nnls_more(&s, A, norm, inv, g, it, seen, pas, order);
+    for (int q = np0; q < s.np; q++)
+      xp[q] = 0.0;
+    nnls_keep_positive(&s, np0, z);
     nnls_inner(&s, xp, z);
   }
 done:
   rep->passive = s.np;
+  rep->flops = s.flops + 2.0 * M * k; /* and the column norms */
   memset(x, 0, (size_t)k * sizeof *x);
   for (int q = 0; q < s.np; q++)
     x[s.pos[q]] = xp[q];
@@ -304,6 +389,7 @@ cleanup:
   fcm__free(ctx, z);
   fcm__free(ctx, seen);
   fcm__free(ctx, pas);
+  fcm__free(ctx, order);
   return st;
 }
 
@@ -385,6 +471,7 @@ static fcm_status nnls_fit(fcm_ctx *ctx, int M, int n, const double *P, const do
   for (int i = 0; i < M; i++)
     bs[i] = scale * b[i];
   FCM_TRY(ctx, fcm__simplify_nnls(ctx, M, n, P, bs, nnls_stop(M, b, scale, tol, floor), x, nr));
+  f->flops += nr->flops;
   if (!nr->ok) goto cleanup;
   f->count = 0;
   for (int j = 0; j < n; j++)
@@ -408,6 +495,7 @@ fcm_status fcm__simplify_fit(fcm_ctx *ctx, const fcm__cheb_box *box, int n, cons
   f->count = 0;
   f->ok = 0;
   f->residual = INFINITY;
+  f->flops = 0.0;
   f->message[0] = '\0';
   if (n < 1) {
     snprintf(f->message, sizeof f->message, "no candidate points");

@@ -38,6 +38,7 @@ fcm_simplify_options fcm_simplify_options_default(void)
   o.residual_tol = 1e-12;
   o.lp_iteration_limit = FCM_DEFAULT;
   o.lp_time_limit = 60.0;
+  o.elimination_block = FCM_DEFAULT;
   return o;
 }
 
@@ -247,6 +248,11 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_simplify_options *o)
             o->lp_iteration_limit);
   FCM_CHECK(o->lp_time_limit >= 0.0 && isfinite(o->lp_time_limit), ctx, FCM_ERR_ARG,
             "simplify: lp_time_limit = %g must be finite and >= 0 (0: none)", o->lp_time_limit);
+  FCM_CHECK((o->elimination_block >= 1 && o->elimination_block <= FCM__ELIM_BLOCK_MAX) ||
+                o->elimination_block == FCM_DEFAULT,
+            ctx, FCM_ERR_ARG,
+            "simplify: elimination_block = %d out of range [1, %d], or FCM_DEFAULT (-1: measured)",
+            o->elimination_block, FCM__ELIM_BLOCK_MAX);
 cleanup:
   return st;
 }
@@ -373,6 +379,7 @@ static fcm_status setup_attempt(simplify_run *r, int strength, const double *wei
   a->lp.it_lim = o->lp_iteration_limit > 0 ? o->lp_iteration_limit : 20 * M + 1000;
   a->lp.tm_lim = o->lp_time_limit;
   a->lp.force_failure = force_lp_failure;
+  a->elim_block = o->elimination_block > 0 ? o->elimination_block : FCM__ELIM_BLOCK;
   double t0 = fcm_wtime();
   fcm__simplify_box(strength, np, r->points, &a->box);
   a->time_basis += fcm_wtime() - t0;
@@ -481,6 +488,7 @@ static void record_statistics(const fcm__attempt *a, double t_start, fcm_simplif
   info->time_basis = a->time_basis;
   info->time_svd = a->time_svd;
   info->time_lp = a->time_lp;
+  info->flops = a->flops;
   info->time_total = fcm_wtime() - t_start;
 }
 

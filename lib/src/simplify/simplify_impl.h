@@ -97,6 +97,7 @@ typedef struct fcm__attempt {
   fcm__lp_params lp;
   double pivot_tol; /* elimination: an LU pivot <= pivot_tol * max pivot means rank-deficient */
   int eliminate;    /* recombination: 1 rounds by Carathéodory elimination, 0 by SVD + GLPK */
+  int elim_block;   /* null-space directions per blocked tableau update (1: rank-1 updates) */
   double *ws;       /* elimination scratch, grown on demand, released by the driver */
   int *iws;
   size_t ws_cap, iws_cap;
@@ -112,6 +113,7 @@ typedef struct fcm__attempt {
   long long lp_iterations;
   int num_lps, num_eliminations, rounds;
   double time_basis, time_svd, time_lp;
+  double flops; /* of the eliminations: LU, triangular solve, tableau updates */
 } fcm__attempt;
 
 /* Set a->moments (once) to the sum of the ncols columns of g (M rows, ld M) times lam
@@ -145,6 +147,11 @@ fcm_status fcm__simplify_run_lp(fcm__attempt *a);
  * a final step on single points, each an LP (or, with a->eliminate, a Carathéodory elimination). */
 fcm_status fcm__simplify_run_recombine(fcm__attempt *a);
 
+/* Largest and default elimination_block (fcm_simplify_options): the default measured by
+ * tests/bench/bench_roofline.c. */
+#define FCM__ELIM_BLOCK_MAX 256
+#define FCM__ELIM_BLOCK     32
+
 /* Carathéodory elimination (caratheodory.c) on the rows x ncols matrix g (ld ldg): lam
  * (ncols, >= 0, entries <= 0 are set to 0) is replaced by weights with the same g lam and at
  * most `rows` positive entries. *deficient = 1 (lam unchanged) when the LU pivots say the
@@ -165,23 +172,26 @@ fcm_status fcm__simplify_run_eliminate(fcm__attempt *a);
 /* ---- moment fitting (fit.c) ---- */
 
 /* A fitted rule: count <= M candidates idx[] (ascending) with positive weights w[] (both
- * arrays of M entries, the caller's), their relative moment residual; ok = 0 with a message
- * when the candidates cannot carry the moments. */
+ * arrays of M entries, the caller's), their relative moment residual and the NNLS fit's
+ * floating-point operations (not those of the LP that follows when NNLS stops short); ok = 0
+ * with a message when the candidates cannot carry the moments. */
 typedef struct fcm__fit {
   int ok, count;
   int *idx;
   double *w;
   double residual;
+  double flops; /* of the NNLS fit on all candidates (fcm__nnls_report.flops) */
   char message[200];
 } fcm__fit;
 
 /* What fcm__simplify_nnls() found: ok when the residual reached the caller's level, optimal
  * when it stopped short of it because no column lowers the residual (x is then the least-squares
  * minimizer over x >= 0 up to rounding), the residual max_i |(b - A x)_i|, the passive set's size
- * (the positive entries of x) and the outer iterations. */
+ * (the positive entries of x), the outer iterations and the floating-point operations. */
 typedef struct fcm__nnls_report {
   int ok, optimal, passive, iterations;
   double residual;
+  double flops; /* of the algorithm: gradients, QR updates, solves, residuals */
 } fcm__nnls_report;
 
 /* Non-negative least squares min ||A x - b||_2, x >= 0 (Lawson and Hanson's active set method
