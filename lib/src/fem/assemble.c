@@ -90,7 +90,7 @@ static cell_rule get_cell_rule(const fcm_space *s, const tabulation *t, fcm_rule
                                fcm_index e, double *Nbuf, double *dNbuf)
 {
   cell_rule r = {0, NULL, Nbuf, dNbuf, NULL};
-  if (!fcm__cell_rules_owns(s->rules, s->elem_cell[e])) return r; /* another process's cell */
+  if (!fcm__space_owns(s, s->elem_cell[e])) return r; /* another process's cell */
   if (!s->rules || fcm_cell_rules_class(s->rules, s->elem_cell[e]) == FCM_CELL_UNCUT) return t->r;
   const double *pts = NULL;
   fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], kind, &r.nq, &pts, &r.w, &r.fict);
@@ -594,7 +594,7 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
       for (fcm_index k = c0; k < c1; k++) {
         const fcm_index le = s->color_elems[k], c = fcm__space_local_elem(s, le);
         /* another process's element (a distributed run's ghost): no points, nothing to add */
-        if (!fcm__cell_rules_owns(s->rules, s->elem_cell[c])) continue;
+        if (!fcm__space_owns(s, s->elem_cell[c])) continue;
         if (ps->traction) {
           if (!surface_cell(s, ps, c, w)) continue;
         } else {
