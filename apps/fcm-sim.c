@@ -78,7 +78,7 @@ static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS
        "serial (default) or petsc: distributed over the MPI\n"
        "processes (mpirun -n 2 fcm-sim scene.json --backend petsc;\n"
        "a build with PETSc). PETSc options (-ksp_type cg ...) may\n"
-       "follow. Every scene with an embedded geometry runs, through\n"
+       "follow. Every scene runs, through\n"
        "the integrator on PETSc: the serial run's loop, log, frames\n"
        "and checkpoints (--resume also reads older .fcmpk files)",
        0, 0, 0, backend_names, NULL, NULL},

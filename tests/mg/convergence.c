@@ -2,7 +2,8 @@
  * an XFEM plane cut through the hemisphere's top, split: the plane through the whole body,
  * two bodies each clamped, hollow: a hollow ball with three holes; with the suffix -hex20 on Hex20
  * grids, where the first coarse level is the p-level Hex20 -> Hex8 on the same grid, and with the
- * suffix -jacobi smoothed by damped Jacobi at fcm_mg_smoother_omega(); then the cell
+ * suffix -jacobi smoothed by damped Jacobi, omega left at the default (the smoother's own,
+ * fcm_mg_smoother_omega()); then the cell
  * counts n, default 4 8 16): the V-cycle and the two-grid convergence factors stay below 0.8 for
  * every n and, on the cube and the embedded hemisphere, the factor at the largest n is at most 1.25
  * x the one at the next (with the XFEM cut it varies with the cut's position in the grid), CG
@@ -65,10 +66,8 @@ int main(int argc, char **argv)
     fcm_mg_options o = fcm_mg_options_default();
     o.coarse_dofs = 50; /* coarsen as far as the grid allows, for every n */
     o.cycle_index = 1;  /* the V-cycle (the default is the W-cycle) */
-    if (jacobi) {
+    if (jacobi) /* omega left at its default: the smoother's own (fcm_mg_smoother_omega()) */
       o.smoother = FCM_MG_SMOOTHER_JACOBI;
-      o.omega = fcm_mg_smoother_omega(o.smoother);
-    }
     if (getenv("FCM_TEST_MG_SMOOTH"))
       o.pre_smooth = o.post_smooth = atoi(getenv("FCM_TEST_MG_SMOOTH"));
     if (getenv("FCM_TEST_MG_OMEGA")) o.omega = atof(getenv("FCM_TEST_MG_OMEGA"));

@@ -90,23 +90,6 @@ int main(int argc, char **argv)
       FCM_ERR_ARG, "selects no embedded-boundary point");
   fcm_scene_destroy(&scene);
 
-  /* 2b. a scene without an embedded geometry is refused (no rules carry the processes' shares:
-   * every process would add every element) */
-  TEST_OK(ctx, fcm_scene_create_from_string(
-                   ctx,
-                   "{\"version\": 1, \"name\": \"nogeom\", \"background\": {\"element\": "
-                   "\"hex8\", \"box\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1]}, \"cells\": "
-                   "[2, 2, 2]}, \"material\": {\"model\": \"snh\", \"young\": 1e5, "
-                   "\"poisson\": 0.3, \"density\": 1000}, \"time\": {\"dt\": 0.01, "
-                   "\"duration\": 0.02}, \"effects\": [{\"gravity\": {}}]}",
-                   NULL, &scene));
-  TEST_ERR(
-      ctx,
-      fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO, NULL, &sim),
-      FCM_ERR_UNSUPPORTED, "needs an embedded geometry");
-  TEST_TRUE(sim == NULL);
-  fcm_scene_destroy(&scene);
-
   /* 3. a KSP that cannot converge: the step fails everywhere after its halvings */
   TEST_OK(ctx, fcm_scene_create_from_string(
                    ctx,

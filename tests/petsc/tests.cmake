@@ -145,6 +145,10 @@ foreach(np 1 2)
   # linear material through Newton: traction and pressure, load steps, CG + GAMG
   fcm_add_test(petsc_newton_static_beam_np${np} tests/petsc/newton.c NP ${np}
                ARGS ${FCM_SCENES} static_beam.json 1)
+  # plain FEM without an embedded geometry (each process integrates its own cells; no cell
+  # rules): gravity, a clamp and a moving end, backward Euler (MUMPS)
+  fcm_add_test(petsc_newton_plain_beam_np${np} tests/petsc/newton.c NP ${np}
+               ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes plain_beam.json 5)
 endforeach()
 # initial velocity (Hex20, free body: momentum), and a MINRES scene with release and damping
 # (the serial run solves with MINRES to rtol 1e-5 there: compared to 1e-6; MINRES + GAMG to the

@@ -2,8 +2,9 @@
  * gives none of their keys carries exactly fcm_integrator_options_default() and
  * fcm_cell_rules_options_default(), member by member (a member added to either struct must be
  * added here), a scene that writes every key with the value the library's default has parses
- * to the same structs, and one that names a multigrid smoother carries the library's relaxation
- * for it (fcm_mg_smoother_omega()). */
+ * to the same structs, and one that names a multigrid smoother alone keeps the default relaxation
+ * omega = 0, the smoother's own (fcm_mg_smoother_omega(), resolved by fcm_mg_create()), while a
+ * written omega is kept as written. */
 #include "fcm/fcm.h"
 #include "test.h"
 
@@ -90,15 +91,15 @@ static void same_rules(const fcm_cell_rules_options *a, const fcm_cell_rules_opt
 }
 
 /* The sections of `json` against the library's defaults, the multigrid smoother `smoother`
- * with its default relaxation (fcm_mg_smoother_omega()). */
-static void check_smoother(fcm_ctx *ctx, const char *json, fcm_mg_smoother smoother)
+ * with the relaxation omega (0: the default, the smoother's own). */
+static void check_smoother(fcm_ctx *ctx, const char *json, fcm_mg_smoother smoother, double omega)
 {
   fcm_scene *s = NULL;
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "defaults.json", &s));
   if (!s) return;
   fcm_integrator_options io = fcm_integrator_options_default();
   io.multigrid.smoother = smoother;
-  io.multigrid.omega = fcm_mg_smoother_omega(smoother);
+  io.multigrid.omega = omega;
   const fcm_cell_rules_options ro = fcm_cell_rules_options_default();
   same_integrator(&fcm_scene_get_solver(s)->integrator, &io);
   same_rules(&fcm_scene_get_quadrature(s)->rules, &ro);
@@ -110,7 +111,7 @@ static void check_smoother(fcm_ctx *ctx, const char *json, fcm_mg_smoother smoot
 
 static void check(fcm_ctx *ctx, const char *json)
 {
-  check_smoother(ctx, json, fcm_integrator_options_default().multigrid.smoother);
+  check_smoother(ctx, json, fcm_integrator_options_default().multigrid.smoother, 0.0);
 }
 
 int main(void)
@@ -132,7 +133,7 @@ int main(void)
            " \"solver\": {\"method\": \"direct\", \"direct\": \"cholmod\","
            " \"preconditioner\": \"schwarz\", \"preconditioner_tangent\": \"projected\","
            " \"schwarz\": {\"threshold\": 0.5, \"epsilon\": 1e-13, \"clamp\": \"clamp\"},"
-           " \"multigrid\": {\"smoother\": \"sgs\", \"omega\": 1, \"pre_smooth\": 1,"
+           " \"multigrid\": {\"smoother\": \"sgs\", \"omega\": 0, \"pre_smooth\": 1,"
            " \"post_smooth\": 1, \"cycle\": \"w\", \"coarse_dofs\": 2000,"
            " \"block_smoothing\": true},"
            " \"rtol\": 1e-8, \"atol\": 0, \"max_iterations\": 1000, \"stagnation_window\": 50,"
@@ -143,19 +144,21 @@ int main(void)
            " \"threads\": 0, \"on_inversion\": \"warn\"}}",
            head);
   check(ctx, json);
-  /* Choosing the smoother alone gives it the library's relaxation for it; writing that value
-   * gives the same. Damped Jacobi's differs from the Gauss-Seidel one the defaults pair. */
+  /* The library's default relaxation is "the smoother's own" (0), so choosing the smoother
+   * alone keeps it; damped Jacobi's own differs from the Gauss-Seidel one. A written value is
+   * kept. */
+  TEST_TRUE(fcm_integrator_options_default().multigrid.omega == 0.0);
   TEST_TRUE(fcm_mg_smoother_omega(FCM_MG_SMOOTHER_JACOBI) <
-            fcm_integrator_options_default().multigrid.omega);
+            fcm_mg_smoother_omega(FCM_MG_SMOOTHER_SGS));
   snprintf(json, sizeof json, "%s, \"solver\": {\"multigrid\": {\"smoother\": \"jacobi\"}}}", head);
-  check_smoother(ctx, json, FCM_MG_SMOOTHER_JACOBI);
+  check_smoother(ctx, json, FCM_MG_SMOOTHER_JACOBI, 0.0);
   snprintf(json, sizeof json,
            "%s, \"solver\": {\"multigrid\": {\"smoother\": \"jacobi\", \"omega\": %.17g}}}", head,
            fcm_mg_smoother_omega(FCM_MG_SMOOTHER_JACOBI));
-  check_smoother(ctx, json, FCM_MG_SMOOTHER_JACOBI);
+  check_smoother(ctx, json, FCM_MG_SMOOTHER_JACOBI, fcm_mg_smoother_omega(FCM_MG_SMOOTHER_JACOBI));
   snprintf(json, sizeof json, "%s, \"solver\": {\"multigrid\": {\"smoother\": \"sgs_colored\"}}}",
            head);
-  check_smoother(ctx, json, FCM_MG_SMOOTHER_SGS_COLORED);
+  check_smoother(ctx, json, FCM_MG_SMOOTHER_SGS_COLORED, 0.0);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
 }

@@ -381,7 +381,9 @@ static void mode_errors(fcm_ctx *ctx)
       " \"multigrid\": {\"smoother\": \"gs\"}}",
       "solver.multigrid.smoother", "sgs-colored");
   bad(ctx, "hex8", "{\"method\": \"multigrid\", \"multigrid\": {\"omega\": 2}}",
-      "solver.multigrid.omega", "(0, 2)");
+      "solver.multigrid.omega", "[0, 2)");
+  bad(ctx, "hex8", "{\"method\": \"multigrid\", \"multigrid\": {\"omega\": -0.5}}",
+      "solver.multigrid.omega", "[0, 2)");
   bad(ctx, "hex8",
       "{\"method\": \"multigrid\", \"multigrid\": {\"smoother\": \"jacobi\","
       " \"omega\": 1.2}}",
@@ -416,15 +418,15 @@ static void mode_errors(fcm_ctx *ctx)
   bad(ctx, "hex8", "{\"method\": \"mg\"}", "solver.method", "\"multigrid\"");
   /* accepted: defaults, the Jacobi default omega, an unsymmetric cycle for the solver, the
    * options unused by another method, the underscore spelling */
-  good(ctx, "hex8", "{\"method\": \"multigrid\"}", FCM_MG_SMOOTHER_SGS, 1.0);
+  good(ctx, "hex8", "{\"method\": \"multigrid\"}", FCM_MG_SMOOTHER_SGS, 0.0);
   good(ctx, "hex8", "{\"method\": \"multigrid\", \"multigrid\": {\"smoother\": \"jacobi\"}}",
-       FCM_MG_SMOOTHER_JACOBI, 0.6);
+       FCM_MG_SMOOTHER_JACOBI, 0.0);
   good(ctx, "hex8",
        "{\"method\": \"multigrid\", \"multigrid\": {\"pre_smooth\": 2, \"post_smooth\": 0,"
        " \"smoother\": \"sgs_colored\", \"omega\": 1.5}}",
        FCM_MG_SMOOTHER_SGS_COLORED, 1.5);
   good(ctx, "tet4", "{\"method\": \"direct\", \"preconditioner\": \"multigrid\"}",
-       FCM_MG_SMOOTHER_SGS, 1.0);
+       FCM_MG_SMOOTHER_SGS, 0.0);
   good(ctx, "hex20",
        "{\"method\": \"cg\", \"preconditioner\": \"multigrid\", \"multigrid\": "
        "{\"block_smoothing\": false, \"smoother\": \"jacobi\", \"omega\": 0.5}}",

@@ -43,9 +43,10 @@ typedef enum fcm_mg_smoother {
 typedef struct fcm_mg_options {
   fcm_mg_smoother smoother; /**< default FCM_MG_SMOOTHER_SGS */
   double omega;             /**< relaxation: SGS (both orders) in (0, 2), Jacobi in (0, 1];
-                                 default fcm_mg_smoother_omega(FCM_MG_SMOOTHER_SGS) = 1.0;
-                                 choosing another smoother, set its
-                                 fcm_mg_smoother_omega() (Jacobi: 0.6) */
+                                 0 (default): the smoother's own,
+                                 fcm_mg_smoother_omega() (1.0 SGS, 0.6 Jacobi), resolved by
+                                 fcm_mg_create(), so choosing another smoother alone gives
+                                 it its relaxation */
   int pre_smooth;           /**< smoothing steps before the coarse correction, >= 0 (default 1;
                                  one SGS step is a forward and a backward sweep) */
   int post_smooth;          /**< after it, >= 0 (default 1); pre = post keeps the cycle
@@ -83,8 +84,8 @@ FCM_API fcm_mg_options fcm_mg_options_default(void);
 
 /** The default relaxation omega of a smoother: 1.0 for symmetric Gauss-Seidel (both orders),
  * 0.6 for damped Jacobi, which over-corrects the high-frequency modes of elasticity near 1
- * (the V-cycle diverges from omega = 0.7 on a box grid: lib/docs/multigrid.md). The scene's
- * solver.multigrid takes it with its smoother; 1.0 for a value outside fcm_mg_smoother. */
+ * (the V-cycle diverges from omega = 0.7 on a box grid: lib/docs/multigrid.md): what
+ * fcm_mg_options.omega = 0 (the default) stands for; 1.0 for a value outside fcm_mg_smoother. */
 FCM_API double fcm_mg_smoother_omega(fcm_mg_smoother smoother);
 
 /** A multigrid hierarchy and its operators for one matrix pattern. */
@@ -114,7 +115,8 @@ typedef struct fcm_mg fcm_mg;
  * @param[in]  A     symmetric positive definite, the space's pattern (fcm_space_matrix_create());
  *                   borrowed: must outlive the object, values read by this call and by
  *                   fcm_mg_setup(), applied in every cycle
- * @param[in]  opts  copied; NULL for defaults
+ * @param[in]  opts  copied (omega 0: fcm_mg_smoother_omega() of the smoother); NULL for
+ *                   defaults
  * @param[out] mg    the new object, NULL on failure
  * @return FCM_OK, FCM_ERR_ARG (NULL, option out of range, A not the space's size),
  * FCM_ERR_UNSUPPORTED (not a Hex8 or Hex20 box grid: the message names the cell),

@@ -39,7 +39,7 @@
 #include "fcm/geom.h"
 #include "fcm/material.h"
 #include "fcm/mesh.h"
-#include "fcm/sim.h"
+#include "fcm/motion.h"
 
 #ifdef __cplusplus
 extern "C" {

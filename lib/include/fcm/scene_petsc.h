@@ -74,8 +74,9 @@ FCM_API int fcm_petsc_problem_supports_scene(fcm_ctx *ctx, const fcm_scene *scen
  * the matrices and the solve are what is distributed. Collective.
  * @param[in] partition the cell partition method (AUTO: Morton-ordered)
  * @param[in] opts      simulation options (NULL: defaults)
- * @return FCM_OK; FCM_ERR_UNSUPPORTED (a scene without an embedded geometry: its cell rules
- * carry each process's share); the errors of fcm_simulation_create(); FCM_ERR_INTERNAL
+ * A scene without an embedded geometry (plain FEM on the background mesh) runs too: its space
+ * integrates this process's cells only.
+ * @return FCM_OK; the errors of fcm_simulation_create(); FCM_ERR_INTERNAL
  * (PETSc or MPI failed: its message). On every process when any failed. */
 FCM_API fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_scene *scene,
                                                fcm_petsc_partition partition,

@@ -28,19 +28,12 @@
 #include "fcm/la.h"
 #include "fcm/material.h"
 #include "fcm/mg.h"
+#include "fcm/motion.h"
 #include "fcm/solve.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-/** Integrator kinds. */
-typedef enum fcm_integrator_kind {
-  FCM_INTEGRATOR_STATIC = 0,        /**< equilibrium Psi'(u) = f_ext, load steps, no inertia;
-                                         the constraints must hold every body's rigid-body
-                                         modes (checked by fcm_integrator_step()) */
-  FCM_INTEGRATOR_BACKWARD_EULER = 1 /**< implicit Euler on the incremental potential */
-} fcm_integrator_kind;
 
 /** Newton stopping rules (g = gradient of E restricted to the free DOFs, 2-norm). */
 typedef enum fcm_newton_tolerance {
@@ -277,33 +270,6 @@ typedef struct fcm_step_info {
 
 /** A scalar function of time, e.g. the time scaling of a load. */
 typedef double (*fcm_time_fn)(void *user, double t);
-
-/** Prescribed motion of a node set: with tau = clamp(t - start, 0, end - start), a node with
- * reference position X is at x(t) = c + R(axis, angular_speed tau) (X - c) + velocity tau
- * (R: right-handed rotation about the unit axis through the centre c), i.e.
- * u = x(t) - X. After `end` the nodes are held, or free when `release` is set. Only the
- * components with components[i] != 0 are constrained. fcm_motion_default(): fixed (u = 0). */
-typedef struct fcm_motion {
-  double velocity[3];   /**< translation velocity (default 0) */
-  double center[3];     /**< a point of the rotation axis (default 0) */
-  double axis[3];       /**< rotation axis, normalized by the integrator (default (0, 0, 1)) */
-  double angular_speed; /**< rad/s, sign by the right-hand rule (default 0) */
-  double start;         /**< motion starts (default 0) */
-  double end;           /**< motion stops, >= start (default HUGE_VAL) */
-  int release;          /**< 1: unconstrained after end (default 0: held) */
-  int components[3];    /**< constrained components (default all 1) */
-} fcm_motion;
-
-/** A fixed motion: all components held at the reference position. */
-FCM_API fcm_motion fcm_motion_default(void);
-
-/** Prescribed displacement u (3) and velocity v (3, may be NULL) of the reference point X
- * under `motion` at time t (any axis length; a zero axis means no rotation). Pure. */
-FCM_API void fcm_motion_eval(const fcm_motion *motion, const double X[3], double t, double u[3],
-                             double v[3]);
-
-/** Whether `motion` constrains its nodes at time t: 1 unless released and t > end. Pure. */
-FCM_API int fcm_motion_active(const fcm_motion *motion, double t);
 
 /** An integrator on a space (opaque). */
 typedef struct fcm_integrator fcm_integrator;

@@ -80,7 +80,7 @@ static cell_rule get_cell_rule(const fcm_space *s, const tabulation *t, fcm_rule
                                fcm_index e, double *Nbuf, double *dNbuf)
 {
   cell_rule r = {0, NULL, Nbuf, dNbuf, NULL};
-  if (!fcm__cell_rules_owns(s->rules, s->elem_cell[e])) return r; /* another process's cell */
+  if (!fcm__space_owns(s, s->elem_cell[e])) return r; /* another process's cell */
   if (!s->rules || fcm_cell_rules_class(s->rules, s->elem_cell[e]) == FCM_CELL_UNCUT) return t->r;
   const double *pts = NULL;
   fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], kind, &r.nq, &pts, &r.w, &r.fict);
@@ -280,7 +280,7 @@ static int pass_element(const fcm_space *s, const pass *ps, fcm_index le, scratc
 {
   const fcm_index c = fcm__space_local_elem(s, le);
   /* another process's element (a distributed run's ghost): no points, nothing to add */
-  if (!fcm__cell_rules_owns(s->rules, s->elem_cell[c])) return 1;
+  if (!fcm__space_owns(s, s->elem_cell[c])) return 1;
   if (ps->traction) {
     if (!surface_cell(s, ps, c, w)) return 1;
   } else {

@@ -63,7 +63,7 @@ static fcm_status element_block(const fcm_space *s, fcm_index e, double *B)
   const double *pts = NULL, *w = NULL;
   const unsigned char *fl = NULL;
   memset(B, 0, block_size(nn) * sizeof *B);
-  if (!fcm__cell_rules_owns(s->rules, c)) return FCM_OK; /* another process's cell */
+  if (!fcm__space_owns(s, c)) return FCM_OK; /* another process's cell */
   if (s->rules && fcm_cell_rules_class(s->rules, c) != FCM_CELL_UNCUT) {
     FCM_TRY(s->ctx, fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], FCM_RULE_MASS, &nq, &pts,
                                              &w, &fl));

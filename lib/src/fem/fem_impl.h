@@ -5,6 +5,7 @@
 #define FCM_FEM_IMPL_H
 
 #include "core/core_impl.h"
+#include "embed/embed_impl.h"
 #include "fcm/fem.h"
 
 /* What fcm_space_momentum() keeps between calls (eval.c), owned by the space: the mass block
@@ -54,7 +55,11 @@ struct fcm_space {
    * ascending; a copy's graph row lists the copies sharing a LOCAL element with it, so it is
    * the full row exactly when every element using the copy is local. */
   int is_local;
-  unsigned char *cell_local;  /* num_cells (local space), NULL (full space) */
+  unsigned char *cell_local; /* num_cells (local space), NULL (full space) */
+  /* A local space without rules: the cells whose points this process integrates (its own
+   * cells, fcm__space_localize()); NULL otherwise (the rules' cell mask says it:
+   * fcm__space_owns()) */
+  unsigned char *own;
   fcm_index num_local_elems;  /* full space: num_elems */
   fcm_index *local_elem;      /* num_local_elems, NULL (full space) */
   fcm_index num_local_copies; /* full space: num_dofs / 3 */
@@ -150,6 +155,14 @@ fcm_status fcm__space_check_full(const fcm_space *s, const char *what);
  * A full space: rows are DOFs, local element positions are element ids, every function below
  * is the full space's own (same arrays, same bits). */
 
+/* 1 when this process integrates the points of cell c: the cells the rules' cell mask flags
+ * (fcm__cell_rules_owns()), or for a local space without rules its own cells
+ * (fcm__space_localize()); every cell of a full space without a mask. */
+static inline int fcm__space_owns(const fcm_space *s, fcm_index c)
+{
+  return s->rules ? fcm__cell_rules_owns(s->rules, c) : !s->own || s->own[c];
+}
+
 /* Rows of the space's matrices: 3 num_local_copies (a full space: num_dofs). */
 static inline fcm_index fcm__space_num_rows(const fcm_space *s)
 {
@@ -198,9 +211,12 @@ fcm_status fcm__space_matrix_apply(const fcm_space *s, const fcm_csr *A, const d
 /* Make a local space's topology that of the cells flagged in `own` (num_cells flags; only
  * active cells count) and of every active cell with an element sharing a DOF copy with an
  * element of a flagged cell (one layer of ghosts, found through the copies: every row of a copy
- * used by an own cell is then the full space's row). FCM_ERR_ARG for a full space or NULL
- * arguments. Calls fcm__space_set_local_cells() (on its failure the space has no local
- * elements). Allocates O(num_cells + num_dofs/3) flags while it runs. (space.c) */
+ * used by an own cell is then the full space's row). A space without rules (plain FEM on the
+ * background mesh) keeps a copy of `own` as the cells whose points this process integrates
+ * (fcm__space_owns(): the ghosts get none, as the rules' cell mask gives an embedded space's
+ * ghosts none). FCM_ERR_ARG for a full space or NULL arguments. Calls fcm__space_set_local_cells()
+ * (on its failure the space has no local elements). Allocates O(num_cells + num_dofs/3) flags while
+ * it runs. (space.c) */
 fcm_status fcm__space_localize(fcm_space *s, const unsigned char *own);
 
 /* FCM_OK when assembling on s gives right (partial) results: a full space, or a local space

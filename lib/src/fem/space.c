@@ -171,6 +171,7 @@ void fcm_space_destroy(fcm_space **sp)
   fcm_space *s = *sp;
   fcm_ctx *ctx = s->ctx;
   fcm__free(ctx, s->active);
+  fcm__free(ctx, s->own);
   fcm__free(ctx, s->node_dof);
   fcm__free(ctx, s->node_ncopy);
   fcm__free(ctx, s->cell_elem);
@@ -389,6 +390,11 @@ fcm_status fcm__space_localize(fcm_space *s, const unsigned char *own)
     mask[c] = (unsigned char)hit;
   }
   FCM_TRY(ctx, fcm__space_set_local_cells(s, mask));
+  if (!s->rules) { /* no cell mask of rules: the space keeps which cells get points here */
+    if (!s->own) FCM_ALLOC(ctx, s->num_cells + 1, s->own);
+    for (fcm_index c = 0; c < s->num_cells; c++)
+      s->own[c] = own[c] != 0;
+  }
 cleanup:
   if (s) {
     fcm__free(ctx, mark);
@@ -401,21 +407,24 @@ fcm_status fcm__space_check_assemble(const fcm_space *s, const char *what)
 {
   if (!s) return FCM_ERR_ARG;
   if (!s->is_local) return FCM_OK;
-  /* the rules give points to the cells fcm__cell_rules_owns() flags (all, without a mask):
-   * each active one must be local, or its elements would scatter into rows the space lacks */
+  /* points go to the cells fcm__space_owns() flags (the rules' cell mask, a space without
+   * rules its own cells; all without either): each active one must be local, or its elements
+   * would scatter into rows the space lacks */
   for (fcm_index c = 0; c < s->num_cells; c++) {
-    if (!s->active[c] || !fcm__cell_rules_owns(s->rules, c) || (s->cell_local && s->cell_local[c]))
-      continue;
-    if (!s->rules || !s->rules->own)
+    if (!s->active[c] || !fcm__space_owns(s, c) || (s->cell_local && s->cell_local[c])) continue;
+    if (!s->rules && !s->own)
       return fcm__error(s->ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
-                        "%s: the space is a local space, but its cell rules %s: every active "
-                        "cell gets points, and active cell %lld is not a local cell (build the "
-                        "rules with fcm_cell_rules_options.cell_mask flagging the own cells)",
-                        what,
-                        s->rules ? "were built without a cell_mask"
-                                 : "are missing (no "
-                                   "embedded rules)",
-                        (long long)c);
+                        "%s: the space is a local space without cell rules or own cells: every "
+                        "active cell gets points, and active cell %lld is not a local cell "
+                        "(localize the space on the own cells: fcm__space_localize())",
+                        what, (long long)c);
+    if (s->rules && !s->rules->own)
+      return fcm__error(s->ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                        "%s: the space is a local space, but its cell rules were built without a "
+                        "cell_mask: every active cell gets points, and active cell %lld is not a "
+                        "local cell (build the rules with fcm_cell_rules_options.cell_mask "
+                        "flagging the own cells)",
+                        what, (long long)c);
     return fcm__error(s->ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
                       "%s: the space's cell rules flag active cell %lld in their cell_mask (it "
                       "gets points), but the local space does not cover it (localize the space "

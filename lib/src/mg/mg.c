@@ -27,7 +27,7 @@ fcm_mg_options fcm_mg_options_default(void)
 {
   fcm_mg_options o;
   o.smoother = FCM_MG_SMOOTHER_SGS;
-  o.omega = fcm_mg_smoother_omega(o.smoother);
+  o.omega = 0.0; /* the smoother's own, resolved by fcm_mg_create() */
   o.pre_smooth = 1;
   o.post_smooth = 1;
   o.cycle_index = 2;
@@ -167,10 +167,11 @@ fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
   fcm_mg_options o = opts ? *opts : fcm_mg_options_default();
   FCM_CHECK(o.smoother >= 0 && o.smoother < FCM_MG_SMOOTHER_COUNT, ctx, FCM_ERR_ARG,
             "mg_create: smoother = %d is not a fcm_mg_smoother", (int)o.smoother);
+  if (o.omega == 0.0) o.omega = fcm_mg_smoother_omega(o.smoother);
   FCM_CHECK(isfinite(o.omega) && o.omega > 0.0 &&
                 (o.smoother != FCM_MG_SMOOTHER_JACOBI ? o.omega < 2.0 : o.omega <= 1.0),
-            ctx, FCM_ERR_ARG, "mg_create: omega = %g outside %s", o.omega,
-            o.smoother != FCM_MG_SMOOTHER_JACOBI ? "(0, 2) (SGS)" : "(0, 1] (Jacobi)");
+            ctx, FCM_ERR_ARG, "mg_create: omega = %g outside %s, or 0 (the smoother's own)",
+            o.omega, o.smoother != FCM_MG_SMOOTHER_JACOBI ? "(0, 2) (SGS)" : "(0, 1] (Jacobi)");
   FCM_CHECK(o.pre_smooth >= 0 && o.post_smooth >= 0, ctx, FCM_ERR_ARG,
             "mg_create: pre_smooth = %d, post_smooth = %d must be >= 0", o.pre_smooth,
             o.post_smooth);

@@ -16,6 +16,7 @@
  * the coarse levels then see the Dirichlet rows as springs of the eliminated diagonal rather
  * than decoupling them as fcm_mg does.
  * PETSc numbers its levels from the coarsest (0) to the finest; fcm from the finest. */
+#include "fcm/solve.h"
 #include "mg/mg_impl.h"
 #include "petsc/petsc_impl.h"
 

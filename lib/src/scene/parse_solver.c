@@ -77,14 +77,14 @@ static fcm_status read_multigrid(fcm__scene_parser *p, const fcm__json *mg,
   FCM_TRY(p->ctx, fcm__scene_check_object(p, mg, keys, SCENE_COUNT(keys)));
   SCENE_READ_CHOICE_AS(p, mg, "smoother", 0, fcm__scene_smoother_names, fcm__scene_smoother_values,
                        m->smoother);
-  m->omega = fcm_mg_smoother_omega(m->smoother); /* the library's default for the smoother */
+  /* 0 (the library's default): the smoother's own, fcm_mg_smoother_omega() */
   FCM_TRY(p->ctx,
-          fcm__scene_read_number(p, mg, "omega", 0, (fcm__range){0.0, 2.0, 1, 1}, &m->omega));
+          fcm__scene_read_number(p, mg, "omega", 0, (fcm__range){0.0, 2.0, 0, 1}, &m->omega));
   if (m->smoother == FCM_MG_SMOOTHER_JACOBI && m->omega > 1.0) {
     fcm__scene_path_push_key(p, "omega");
     SCENE_CHECK(0, p, FCM_ERR_ARG,
-                "expected a finite number in (0, 1] with the \"jacobi\" smoother, got %g "
-                "((0, 2) for the Gauss-Seidel smoothers)",
+                "expected a finite number in (0, 1] with the \"jacobi\" smoother, or 0 (its "
+                "own, 0.6), got %g ((0, 2) for the Gauss-Seidel smoothers)",
                 m->omega);
   }
   SCENE_READ_INT(p, mg, "pre_smooth", 0, 0, 100, m->pre_smooth);

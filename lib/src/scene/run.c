@@ -529,18 +529,24 @@ cleanup:
   return st;
 }
 
-/* The space of the rules: a full embedded space; in a distributed run (the rules carry this
- * process's cell mask) a local one, the topology of the process's own cells and one layer of
- * ghosts around them (fcm__space_localize(): every copy an own cell uses has its full row, as
- * the backend's matrix preallocation needs), the numbering the full space's bit for bit. */
-static fcm_status create_space(fcm_simulation *S, const fcm_cell_rules *rules, int distributed,
-                               fcm_space **out)
+/* The space of the rules (NULL: plain FEM on the background mesh): a full space; in a
+ * distributed run (own: this process's cells, the rules' cell mask or the configuration's) a
+ * local one, the topology of the process's own cells and one layer of ghosts around them
+ * (fcm__space_localize(): every copy an own cell uses has its full row, as the backend's matrix
+ * preallocation needs; without rules the space keeps `own` as the cells it integrates), the
+ * numbering the full space's bit for bit. */
+static fcm_status create_space(fcm_simulation *S, const fcm_cell_rules *rules,
+                               const unsigned char *own, fcm_space **out)
 {
   fcm_status st = FCM_OK;
   const fcm_space_options o = fcm_space_options_default();
-  if (!distributed || !rules->own) return fcm_space_create_embedded(S->ctx, S->mesh, rules, out);
-  FCM_TRY(S->ctx, fcm__space_create_local(S->ctx, S->mesh, NULL, rules, &o, NULL, out));
-  FCM_TRY(S->ctx, fcm__space_localize(*out, rules->own));
+  if (!own) {
+    if (!rules) return fcm_space_create(S->ctx, S->mesh, NULL, out);
+    return fcm_space_create_embedded(S->ctx, S->mesh, rules, out);
+  }
+  FCM_TRY(S->ctx,
+          fcm__space_create_local(S->ctx, S->mesh, NULL, rules, rules ? &o : NULL, NULL, out));
+  FCM_TRY(S->ctx, fcm__space_localize(*out, own));
 cleanup:
   if (st != FCM_OK) fcm_space_destroy(out);
   return st;
@@ -580,7 +586,9 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   FCM_TRY(ctx, fcm_cell_rules_create_cut(ctx, S->mesh, S->geom, S->rules, surf, &rules));
   S->cut_stats[k] = *fcm_cell_rules_get_stats(rules);
   S->c.cut_cells += S->cut_stats[k].num_integrated;
-  FCM_TRY(ctx, create_space(S, rules, fcm__integrator_distributed(S->integ, NULL), &space));
+  FCM_TRY(ctx,
+          create_space(S, rules, fcm__integrator_distributed(S->integ, NULL) ? rules->own : NULL,
+                       &space));
   /* missed: no cell got a new piece and no node a new copy (a cut along cell faces adds copies
    * without splitting any cell) */
   if (fcm_cell_rules_num_pieces(rules) == fcm_cell_rules_num_pieces(S->rules) &&
@@ -828,13 +836,14 @@ fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
               rs->embedded_volume, rs->geometry_volume);
     tp = fcm_wtime();
     phase_begin(S, FCM_SETUP_SPACE, 0, "building the space (DOFs, element data)");
-    st = create_space(S, S->rules, S->config && S->config->cell_mask, &S->space);
+    st = create_space(S, S->rules, S->config && S->config->cell_mask ? S->rules->own : NULL,
+                      &S->space);
     if (st != FCM_OK) fcm__error_prefix(ctx, "geometry");
     FCM_TRY(ctx, st);
   } else {
     tp = fcm_wtime();
     phase_begin(S, FCM_SETUP_SPACE, 0, "building the space (DOFs, element data)");
-    FCM_TRY(ctx, fcm_space_create(ctx, S->mesh, NULL, &S->space));
+    FCM_TRY(ctx, create_space(S, NULL, S->config ? S->config->cell_mask : NULL, &S->space));
   }
   phase_end(S);
   S->c.time_setup_space = fcm_wtime() - tp;

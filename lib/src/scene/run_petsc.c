@@ -209,12 +209,6 @@ fcm_status fcm_petsc_simulation_create(fcm_ctx *ctx, MPI_Comm comm, const fcm_sc
   }
   FCM_TRY(ctx, fcm__petsc_backend_create(ctx, comm, st, &bo, &P));
   if (st == FCM_OK) st = fcm__scene_mesh_geometry(ctx, scene, &mesh, &geom);
-  if (st == FCM_OK && !geom)
-    st = fcm__error(ctx, FCM_ERR_UNSUPPORTED, __FILE__, __LINE__, __func__,
-                    "scene %s: the PETSc backend's integrator path needs an embedded geometry "
-                    "(\"geometry\"): its cell rules carry each process's share of the "
-                    "assembly; run this scene with the serial backend",
-                    fcm_scene_name(scene));
   FCM_TRY(ctx, fcm__petsc_backend_partition(P, st, mesh, geom, &mask, &backend, &exchange));
   fcm_geometry_destroy(&geom);
   fcm_mesh_destroy(&mesh);

@@ -50,9 +50,11 @@ static void multigrid_line(const fcm_simulation *S, FILE *f)
     len += snprintf(b + len, sizeof b - (size_t)len, "%s%lld", l ? " > " : " ", (long long)li.dofs);
   }
   if (len > 0 && (size_t)len < sizeof b)
-    snprintf(b + len, sizeof b - (size_t)len, "; %s-cycle, %d+%d smoothing steps%s",
+    snprintf(b + len, sizeof b - (size_t)len, "; %s-cycle, %d+%d smoothing steps%s, %s omega %g",
              o->cycle_index == 2 ? "W" : "V", o->pre_smooth, o->post_smooth,
-             o->block_smoothing ? " with vertex blocks" : "");
+             o->block_smoothing ? " with vertex blocks" : "",
+             SCENE_CHOICE_NAME(fcm__scene_smoother_names, fcm__scene_smoother_values, o->smoother),
+             o->omega != 0.0 ? o->omega : fcm_mg_smoother_omega(o->smoother));
   line(f, 1, "multigrid levels", b);
 }
 

@@ -4,13 +4,19 @@
 
 /* ---------------------------------------------------------------- view */
 
-/* " (sgs omega 1, 1+1 steps, V-cycle, coarse 2000 DOFs)" */
+/* " (sgs omega auto (1), 1+1 steps, V-cycle, coarse 2000 DOFs)": omega 0 is the smoother's
+ * own (fcm_mg_smoother_omega()), shown with its value; a given omega as it is */
 static void view_multigrid(FILE *f, const fcm_mg_options *m)
 {
-  fprintf(f, " (%s omega %g, %d+%d steps%s, %s-cycle, coarse %lld DOFs)",
-          SCENE_CHOICE_NAME(fcm__scene_smoother_names, fcm__scene_smoother_values, m->smoother),
-          m->omega, m->pre_smooth, m->post_smooth, m->block_smoothing ? " with vertex blocks" : "",
-          m->cycle_index == 2 ? "W" : "V", (long long)m->coarse_dofs);
+  fprintf(f, " (%s omega ",
+          SCENE_CHOICE_NAME(fcm__scene_smoother_names, fcm__scene_smoother_values, m->smoother));
+  if (m->omega == 0.0)
+    fprintf(f, "auto (%g)", fcm_mg_smoother_omega(m->smoother));
+  else
+    fprintf(f, "%g", m->omega);
+  fprintf(f, ", %d+%d steps%s, %s-cycle, coarse %lld DOFs)", m->pre_smooth, m->post_smooth,
+          m->block_smoothing ? " with vertex blocks" : "", m->cycle_index == 2 ? "W" : "V",
+          (long long)m->coarse_dofs);
 }
 
 static void view_strength(FILE *f, const char *what, int m)

@@ -215,11 +215,16 @@ fcm_status fcm__sim_multigrid_validate(fcm_ctx *ctx, const fcm_integrator_option
             "integrator: multigrid.smoother = %d outside [0, %d] (sgs, jacobi, sgs colored)",
             (int)m->smoother, (int)FCM_MG_SMOOTHER_COUNT - 1);
   if (m->smoother == FCM_MG_SMOOTHER_JACOBI)
-    FCM_CHECK(isfinite(m->omega) && m->omega > 0.0 && m->omega <= 1.0, ctx, FCM_ERR_ARG,
-              "integrator: multigrid.omega = %g outside (0, 1] (the Jacobi smoother)", m->omega);
+    FCM_CHECK(m->omega == 0.0 || (isfinite(m->omega) && m->omega > 0.0 && m->omega <= 1.0), ctx,
+              FCM_ERR_ARG,
+              "integrator: multigrid.omega = %g outside (0, 1] (the Jacobi smoother), or 0 (the "
+              "smoother's own)",
+              m->omega);
   else
-    FCM_CHECK(isfinite(m->omega) && m->omega > 0.0 && m->omega < 2.0, ctx, FCM_ERR_ARG,
-              "integrator: multigrid.omega = %g outside (0, 2) (the Gauss-Seidel smoothers)",
+    FCM_CHECK(m->omega == 0.0 || (isfinite(m->omega) && m->omega > 0.0 && m->omega < 2.0), ctx,
+              FCM_ERR_ARG,
+              "integrator: multigrid.omega = %g outside (0, 2) (the Gauss-Seidel smoothers), or 0 "
+              "(the smoother's own)",
               m->omega);
   FCM_CHECK(m->pre_smooth >= 0 && m->post_smooth >= 0 && m->pre_smooth + m->post_smooth >= 1, ctx,
             FCM_ERR_ARG,
