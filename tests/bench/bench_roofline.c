@@ -406,7 +406,8 @@ done:
  *   (the geometry's tets clipped by the cell, a tet rule on each; FCM_CELL_MOMENTS_VOLUME);
  * - the surface path's input (FCM_CELL_MOMENTS_AUTO, the default): candidates as that path
  *   picks them (the points of a grid over the material's box in the cell inside the material,
- *   about 2 M of them, and up to M points on the material's boundary: vertices and centroids of
+ *   about c(m) M of them (fcm__fit_candidates_per_moment), and up to M points on the material's
+ *   boundary: vertices and centroids of
  *   the boundary triangles' parts in the cell; the sets 4, 16, 64 times larger that path
  *   retries on, up to the first that fits) and the material's moments in the basis of the
  *   material's box (here from the volume rule, exact to rounding for a polyhedral body).
@@ -544,12 +545,12 @@ static int clip_triangle(const double *X, const fcm_index *tri, const double lo[
   return n;
 }
 
-/* Candidate set `a` of one cell (physical box clo..chi, reference [-1, 1]^3): the grid over
- * the material's box (reference mbox) inside the geometry, sized for about 2 M grow of them, and
- * up to M grow boundary points (the vertices and centroids of the boundary triangles' parts in
- * the cell), grow = SIMP_GROW^a. */
+/* Candidate set `a` of one cell (physical box clo..chi, reference [-1, 1]^3) for strength m:
+ * the grid over the material's box (reference mbox) inside the geometry, sized for about
+ * c(m) M grow of them, and up to M grow boundary points (the vertices and centroids of the
+ * boundary triangles' parts in the cell), grow = SIMP_GROW^a. */
 static int simp_candidates(const fcm_geometry *g, fcm_index nnear, const fcm_index *near,
-                           const double clo[3], const double chi[3], int M, double vol,
+                           const double clo[3], const double chi[3], int m, int M, double vol,
                            const double mbox[6], int a, simp_cell *c)
 {
   int grow = 1;
@@ -557,7 +558,8 @@ static int simp_candidates(const fcm_geometry *g, fcm_index nnear, const fcm_ind
     grow *= SIMP_GROW;
   M *= grow;
   const double bv = (mbox[3] - mbox[0]) * (mbox[4] - mbox[1]) * (mbox[5] - mbox[2]);
-  const int n = (int)fmin(64.0, fmax(2.0, ceil(cbrt(2.0 * M * bv / vol))));
+  const double per = fcm__fit_candidates_per_moment(m);
+  const int n = (int)fmin(64.0, fmax(2.0, ceil(cbrt(per * M * bv / vol))));
   const fcm_index nt = fcm_geometry_num_boundary_triangles(g);
   const fcm_index *tri = fcm_geometry_boundary_triangles(g);
   const double *X = fcm_geometry_coords(g);
@@ -712,7 +714,7 @@ static int simp_setup(fcm_ctx *ctx, int m, simp_input *in)
     memset(&f, 0, sizeof f);
     f.idx = idx, f.w = wf;
     for (int a = 0; a < SIMP_GRIDS && !f.ok; a++) { /* the sets until one fits */
-      if (!simp_candidates(g, nnear, near, clo, chi, M, vol, mbox, a, c)) goto done;
+      if (!simp_candidates(g, nnear, near, clo, chi, m, M, vol, mbox, a, c)) goto done;
       c->grids = a + 1;
       if (fcm__simplify_fit(ctx, &c->box, c->nc[a], c->cand[a], c->mom, 1e-12, c->atol, &f))
         goto done;

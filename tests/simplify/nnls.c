@@ -1,7 +1,8 @@
 /* Non-negative least squares (fcm__simplify_nnls) and the moment fit built on it
  * (fcm__simplify_fit): a tall system's unique non-negative solution is recovered; a wide
  * consistent one is solved with at most M positive weights; an inconsistent one ends at the
- * nearest point of the columns' cone (a known one, and the KKT conditions on random ones);
+ * nearest point of the columns' cone (a known one, and the KKT conditions on random ones, also
+ * on a matrix large enough for NNLS to price a shortlist of columns);
  * the fit reproduces the moments of a positive rule among its candidates to 1e-12 and reports
  * a tolerance below rounding (through its LP path) and moments no positive combination of the
  * candidates can carry. */
@@ -95,12 +96,35 @@ static void known_optimum(fcm_ctx *ctx)
   TEST_NEAR(rep.residual, 0.5, 0.0, 1e-15);
 }
 
+/* The KKT conditions of min ||A x - b||, x >= 0 at x (A M x k, M <= 128): x >= 0 and
+ * g = A^T (b - A x) within tol of 0 where x > 0 and <= tol where x = 0. */
+static void check_kkt(int M, int k, const double *A, const double *b, const double *x, double tol)
+{
+  double r[128];
+  TEST_TRUE(M <= 128);
+  for (int i = 0; i < M && i < 128; i++) {
+    r[i] = b[i];
+    for (int j = 0; j < k; j++)
+      r[i] -= A[i + (size_t)j * M] * x[j];
+  }
+  for (int j = 0; j < k && M <= 128; j++) {
+    double g = 0.0;
+    for (int i = 0; i < M; i++)
+      g += A[i + (size_t)j * M] * r[i];
+    TEST_TRUE(x[j] >= 0.0);
+    if (x[j] > 0.0)
+      TEST_NEAR(g, 0.0, 0.0, tol);
+    else
+      TEST_TRUE(g <= tol);
+  }
+}
+
 /* Random inconsistent problems: the result satisfies the KKT conditions of min ||A x - b||,
  * x >= 0: g = A^T (b - A x) is 0 where x > 0 and <= 0 where x = 0 (to rounding). */
 static void kkt(fcm_ctx *ctx)
 {
   enum { M = 20, K = 40 };
-  double A[M * K], b[M], x[K], r[M];
+  double A[M * K], b[M], x[K];
   fcm__nnls_report rep;
   int infeasible = 0;
   for (uint64_t seed = 21; seed <= 30; seed++) {
@@ -110,29 +134,42 @@ static void kkt(fcm_ctx *ctx)
     for (int i = 0; i < M; i++)
       b[i] = 2.0 * util_rand(&s) - 1.0;
     TEST_OK(ctx, fcm__simplify_nnls(ctx, M, K, A, b, 1e-13, x, &rep));
-    for (int i = 0; i < M; i++) {
-      r[i] = b[i];
-      for (int j = 0; j < K; j++)
-        r[i] -= A[i + (size_t)j * M] * x[j];
-    }
     if (rep.ok) {
       TEST_TRUE(resid(M, K, A, x, b) <= 1e-13);
       continue;
     }
     TEST_TRUE(rep.optimal);
     infeasible++;
-    for (int j = 0; j < K; j++) {
-      double g = 0.0;
-      for (int i = 0; i < M; i++)
-        g += A[i + (size_t)j * M] * r[i];
-      TEST_TRUE(x[j] >= 0.0);
-      if (x[j] > 0.0)
-        TEST_NEAR(g, 0.0, 0.0, 1e-12);
-      else
-        TEST_TRUE(g <= 1e-12);
-    }
+    check_kkt(M, K, A, b, x, 1e-12);
   }
   TEST_TRUE(infeasible >= 3); /* the KKT branch was exercised */
+}
+
+/* A matrix above the size at which NNLS prices a shortlist of columns between full gradients
+ * (1 MiB; here 128 x 1,100): a consistent system is still solved with at most M positive
+ * weights, and on an inconsistent one (b_0 < 0 against a first row of ones) the optimum it
+ * declares satisfies the KKT conditions over every column, not only the shortlist's. */
+static void shortlist(fcm_ctx *ctx)
+{
+  enum { M = 128, K = 1100 };
+  static double A[M * K], xs[K], b[M], x[K];
+  fcm__nnls_report rep;
+  for (uint64_t seed = 41; seed <= 42; seed++) {
+    consistent(seed, M, K, 400, A, xs, b);
+    const double stop = 1e-12 * b[0];
+    TEST_OK(ctx, fcm__simplify_nnls(ctx, M, K, A, b, stop, x, &rep));
+    int npos = 0;
+    for (int j = 0; j < K; j++) {
+      TEST_TRUE(x[j] >= 0.0);
+      npos += x[j] > 0.0;
+    }
+    TEST_TRUE(rep.ok && npos <= M && resid(M, K, A, x, b) <= stop);
+
+    b[0] = -0.5 * b[0]; /* no x >= 0 has a negative sum */
+    TEST_OK(ctx, fcm__simplify_nnls(ctx, M, K, A, b, 1e-13, x, &rep));
+    TEST_TRUE(!rep.ok && rep.optimal);
+    check_kkt(M, K, A, b, x, 1e-10);
+  }
 }
 
 /* The fit on random candidates in [0, 1]^3 (basis on that box): the moments of a positive
@@ -189,6 +226,7 @@ int main(void)
   wide_consistent(ctx);
   known_optimum(ctx);
   kkt(ctx);
+  shortlist(ctx);
   fit(ctx);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();

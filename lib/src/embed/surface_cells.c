@@ -2,9 +2,10 @@
  * volume from the exact surface moments (surface_moments.c), and for a cut cell a positive
  * rule of at most M points per kind, fitted on candidate points inside the material to those
  * moments (fcm__simplify_fit). The candidates are the points of a grid over the material's
- * bounding box in the cell, fine enough that about CAND_PER_MOMENT x M of them fall inside the
- * material, and points on the material's boundary; a fit that fails is retried with GROW
- * times as many, up to ATTEMPTS grids in all. The moments of a small piece with a sharp
+ * bounding box in the cell, fine enough that about c(m) x M of them fall inside the material
+ * (fcm__fit_candidates_per_moment: 2 up to strength 5, more above, where fewer fail), and
+ * points on the material's boundary; a fit that fails is retried with GROW times as many, up
+ * to ATTEMPTS grids in all. The moments of a small piece with a sharp
  * corner (the tip of a body's acute vertex in a cell) sit close to the corner, which only a
  * fine grid's points reach. */
 #include "embed/rules_impl.h"
@@ -14,9 +15,9 @@
 #include <stdio.h>
 #include <string.h>
 
-/* Grid candidates aimed at per moment, boundary points kept per moment, the finer grid's
- * factor on a retry, the largest grid per axis. */
-enum { CAND_PER_MOMENT = 2, BOUNDARY_PER_MOMENT = 1, GROW = 4, ATTEMPTS = 4, GRID_MAX = 64 };
+/* Boundary points kept per moment, the finer grid's factor on a retry, the largest grid per
+ * axis. */
+enum { BOUNDARY_PER_MOMENT = 1, GROW = 4, ATTEMPTS = 4, GRID_MAX = 64 };
 
 /* Absolute moment residual accepted, per unit of the material box's reference volume: ten times
  * the moments' own rounding. */
@@ -199,13 +200,14 @@ fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
   double box[6];
-  int Mmax = 1;
+  int Mmax = 1, mmax = 0;
   memcpy(box, mbox, sizeof box);
   *ok = 0;
   for (int d = 0; d < 3; d++)
     if (!(box[d] < box[3 + d])) goto cleanup;   /* flat material: leave it to the volume path */
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) /* built or not, as the moments' degree */
-    Mmax = FCM_MAX(Mmax, fcm__simplify_num_basis(B->fit_strength[k]));
+    mmax = FCM_MAX(mmax, B->fit_strength[k]);
+  Mmax = FCM_MAX(Mmax, fcm__simplify_num_basis(mmax));
   const double vref = vol / cell->detA;
   int todo[FCM_RULE_KIND_COUNT], left = 0;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
@@ -213,7 +215,7 @@ fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
   /* each kind on the first grid, then the kinds that failed on the finer ones: a kind's rules
    * do not depend on the other kind */
   for (int attempt = 0, grow = 1; attempt < ATTEMPTS && left > 0; attempt++, grow *= GROW) {
-    const double target = (double)CAND_PER_MOMENT * Mmax * grow;
+    const double target = fcm__fit_candidates_per_moment(mmax) * Mmax * grow;
     const int n = grid_size(box, vref, target);
     int count;
     FCM_TRY(ctx, check_fit_memory(B, cell, ws, n, Mmax));

@@ -98,6 +98,17 @@ cleanup:
 #define NNLS_BATCH_TAU   0.8
 #define NNLS_BATCH_DELTA 0.5
 
+/* Partial pricing: when the candidates' matrix A is larger than NNLS_SHORTLIST_BYTES (about a
+ * core's L2 cache; the gradient then streams A from memory), a full gradient keeps the columns
+ * not passive whose cosine with the residual is above NNLS_SHORTLIST_KEEP of the largest as a
+ * shortlist (copied together), and the next NNLS_REFRESH - 1 iterations price only those. An
+ * iteration whose shortlist offers no column prices all of them, so optimality is only ever
+ * declared on the full gradient. At m = 9 (M = 220, 1,300 candidates) 1.3x; at m <= 7, whose
+ * matrices fit the cache, the copy costs what the shorter gradients save. */
+#define NNLS_SHORTLIST_BYTES (1024.0 * 1024.0)
+#define NNLS_SHORTLIST_KEEP  0.25
+#define NNLS_REFRESH         8
+
 typedef struct nnls_qr {
   int M, np, kcols; /* rows, passive columns, columns of A */
   double *Q;        /* M x M orthogonal */
@@ -258,6 +269,24 @@ static void nnls_more(nnls_qr *s, const double *A, const double *norm, const dou
   }
 }
 
+/* After a full gradient g: the shortlist (see NNLS_SHORTLIST_BYTES) into AL (columns) and
+ * lidx (their indices), its length returned. pas[j] == it: j is passive. */
+static int nnls_shortlist(int M, int k, const double *A, const double *inv, const int *pas, int it,
+                          const double *g, double *AL, int *lidx)
+{
+  double top = 0.0;
+  int nl = 0;
+  for (int j = 0; j < k; j++)
+    if (pas[j] != it) top = fmax(top, g[j] * inv[j]);
+  const double keep = NNLS_SHORTLIST_KEEP * top;
+  for (int j = 0; j < k; j++)
+    if (pas[j] != it && g[j] > 0.0 && g[j] * inv[j] > keep) {
+      memcpy(AL + (size_t)nl * (size_t)M, A + (size_t)j * (size_t)M, (size_t)M * sizeof *AL);
+      lidx[nl++] = j;
+    }
+  return nl;
+}
+
 /* The least-squares weights z of the passive set with the columns np0.. added this iteration:
  * while one of those is <= 0, the last of them leaves (the first one's weight is positive when
  * it is the only one: nnls_add checked). */
@@ -305,7 +334,8 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
   fcm_status st = FCM_OK;
   nnls_qr s = {M, 0, k, NULL, NULL, NULL, NULL, NULL, 0.0};
   double *r = NULL, *g = NULL, *norm = NULL, *inv = NULL, *xp = NULL, *z = NULL;
-  int *seen = NULL, *pas = NULL, *order = NULL, exact = 0;
+  int *seen = NULL, *pas = NULL, *order = NULL, *lidx = NULL, exact = 0, nl = -1, last_full = 0;
+  double *AL = NULL, *gl = NULL; /* the shortlist's columns and gradients */
   memset(rep, 0, sizeof *rep);
   rep->residual = INFINITY;
   FCM_ALLOC(ctx, (size_t)M * (size_t)M, s.Q);
@@ -322,6 +352,11 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
   FCM_ALLOC(ctx, (size_t)k, seen);
   FCM_ALLOC(ctx, (size_t)k, pas);
   FCM_ALLOC(ctx, (size_t)k, order);
+  if ((double)M * k * sizeof *A > NNLS_SHORTLIST_BYTES) {
+    FCM_ALLOC(ctx, (size_t)k, lidx);
+    FCM_ALLOC(ctx, (size_t)k, gl);
+    FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)k, AL);
+  }
   for (int i = 0; i < M; i++)
     s.Q[i + (size_t)i * (size_t)M] = 1.0;
   memcpy(s.qtb, b, (size_t)M * sizeof *b);
@@ -344,10 +379,22 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
       rep->ok = 1;
       break;
     }
-    fcm__gemv('T', M, k, 1.0, A, M, r, 0.0, g);
-    s.flops += 2.0 * M * k + 2.0 * k;
     for (int q = 0; q < s.np; q++)
       pas[s.pos[q]] = it;
+    int full = !AL || nl <= 0 || it - last_full >= NNLS_REFRESH;
+  price:
+    if (full) {
+      fcm__gemv('T', M, k, 1.0, A, M, r, 0.0, g);
+      s.flops += 2.0 * M * k + 2.0 * k;
+      last_full = it;
+      if (AL) nl = nnls_shortlist(M, k, A, inv, pas, it, g, AL, lidx);
+    } else { /* the shortlist's gradients, 0 for the other columns */
+      fcm__gemv('T', M, nl, 1.0, AL, M, r, 0.0, gl);
+      s.flops += 2.0 * M * nl + 2.0 * nl;
+      memset(g, 0, (size_t)k * sizeof *g);
+      for (int c = 0; c < nl; c++)
+        g[lidx[c]] = gl[c];
+    }
     int added = 0;
     while (!added) { /* the steepest column that can enter */
       int t = -1;
@@ -355,6 +402,10 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
       for (int j = 0; j < k; j++) {
         const double c = g[j] * inv[j];
         if (c > best && seen[j] != it && pas[j] != it) best = c, t = j;
+      }
+      if (t < 0 && !full) { /* none on the shortlist: price every column */
+        full = 1;
+        goto price;
       }
       if (t < 0) { /* optimal: no column lowers the residual */
         rep->optimal = 1;
@@ -390,6 +441,9 @@ cleanup:
   fcm__free(ctx, seen);
   fcm__free(ctx, pas);
   fcm__free(ctx, order);
+  fcm__free(ctx, lidx);
+  fcm__free(ctx, gl);
+  fcm__free(ctx, AL);
   return st;
 }
 
