@@ -173,15 +173,24 @@ FCM_KERNEL_INLINE void micro(int nb, int nk, const double *A, int lda, const dou
     micro_4x4(nk, A, lda, B, ldb, C, ldc, add);
 }
 
-/* C = (add: +=) A^T B on the blocks of rows [0, rows) (in fours) whose nb columns reach the
- * diagonal or beyond, columns up to ld (a multiple of 16): A, B are nk x ld (row stride ld), C
- * is ld x ld. Every entry C[x][y] with x <= y < ld is summed. */
-FCM_KERNEL_INLINE void product_upper(int nb, int nk, const double *A, const double *B, int rows,
+/* C = (add: +=) A^T B on its upper triangle: A, B are nk x ld (row stride ld), C is ld x ld,
+ * every entry C[x][y] with x <= y < cols summed (some below the diagonal and beyond cols too).
+ * Rows [0, cols) in fours; each run of rows from its diagonal on in blocks of nb columns, the
+ * rest in the narrowest block of nb / 2^k >= 4 columns that covers it (within ld, a multiple of
+ * 16 with cols + 4 <= ld or cols a multiple of 8). */
+FCM_KERNEL_INLINE void product_upper(int nb, int nk, const double *A, const double *B, int cols,
                                      int ld, double *C, int add)
 {
-  for (int a0 = 0; a0 < rows; a0 += 4)
-    for (int b0 = a0 / nb * nb; b0 < ld; b0 += nb)
+  for (int a0 = 0; a0 < cols; a0 += 4) {
+    int b0 = a0;
+    for (; b0 + nb <= cols; b0 += nb)
       micro(nb, nk, A + a0, ld, B + b0, ld, C + (size_t)a0 * ld + b0, ld, add);
+    for (int w = nb; b0 < cols; b0 += w) {
+      while (w > 4 && (w / 2 >= cols - b0 || b0 + w > ld))
+        w /= 2;
+      micro(w, nk, A + a0, ld, B + b0, ld, C + (size_t)a0 * ld + b0, ld, add);
+    }
+  }
 }
 
 /* ------------------------------------------------------------------ the per-point work */
@@ -379,7 +388,7 @@ static cell_result mass_kernel(const kernel_data *kd, const cell_rule *r, int nn
       for (int a = 0; a < ld; a++)
         n[a] = a < nn ? N[a] : 0.0, wn[a] = rw * n[a];
     }
-    product_upper(nb, nc, w->WG, w->G, nn, ld, H, q0 > 0);
+    product_upper(nb, nc, w->WG, w->G, (nn + 3) / 4 * 4, ld, H, q0 > 0);
   }
   for (int a = 0; a < nn; a++)
     for (int b = a; b < nn; b++, Kp += 9) {
