@@ -62,7 +62,8 @@ typedef struct kernel_data {
 typedef struct scratch {
   double *X;   /* nn x 3 nodal coordinates */
   double *ue;  /* 3nn cell displacement */
-  double *g;   /* nn x 3 physical gradients (node-major) */
+  double *g;   /* nn x 3 physical gradients (node-major); a point's reference gradients while a
+                * cut cell's rule is evaluated (assemble.c) */
   double *XT;  /* 3 x na: X by component, zero padded */
   double *UT;  /* 3 x na: ue by component, zero padded */
   double *FT;  /* 3 x na: the hyperelastic internal force by component */
