@@ -39,11 +39,12 @@ cleanup:
   return st;
 }
 
-/* Shape values and reference gradients of the element at the standard rule's points. */
+/* Shape values and reference gradients (by component, kernels_impl.h) of the element at the
+ * standard rule's points. */
 typedef struct tabulation {
   fcm_rule *rule;
   cell_rule r;
-  double *N, *dN;
+  double *N, *dT;
 } tabulation;
 
 static fcm_status tabulate(const fcm_space *s, fcm_rule_kind kind, int strength, tabulation *t)
@@ -53,16 +54,19 @@ static fcm_status tabulate(const fcm_space *s, fcm_rule_kind kind, int strength,
   FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, kind, strength, &t->rule));
   int nq = fcm_rule_num_points(t->rule);
   const double *pts = fcm_rule_points(t->rule);
+  const size_t rows = 3 * (size_t)fcm__kernel_na(s->nn);
   FCM_ALLOC(ctx, (size_t)nq * s->nn, t->N);
-  FCM_ALLOC(ctx, (size_t)nq * s->nn * 3, t->dN);
+  FCM_ALLOC(ctx, (size_t)nq * rows, t->dT);
   for (int q = 0; q < nq; q++) {
+    double dN[3 * FCM_ELEMENT_MAX_NODES];
     fcm_element_eval_shape(s->type, pts + 3 * q, t->N + (size_t)q * s->nn);
-    fcm_element_eval_grad(s->type, pts + 3 * q, t->dN + (size_t)q * s->nn * 3);
+    fcm_element_eval_grad(s->type, pts + 3 * q, dN);
+    fcm__kernel_rows(s->nn, dN, t->dT + (size_t)q * rows);
   }
   t->r.nq = nq;
   t->r.w = fcm_rule_weights(t->rule);
   t->r.N = t->N;
-  t->r.dN = t->dN;
+  t->r.dT = t->dT;
 cleanup:
   return st;
 }
@@ -70,44 +74,78 @@ cleanup:
 static void tabulation_free(fcm_ctx *ctx, tabulation *t)
 {
   FCM_FREE(ctx, t->N);
-  FCM_FREE(ctx, t->dN);
+  FCM_FREE(ctx, t->dT);
   fcm_rule_destroy(&t->rule);
 }
 
 /* The rule of element e: the tabulated standard rule for full cells, else its piece's own
- * points from the embedded rules, evaluated into Nbuf/dNbuf (max_cut_points entries). */
+ * points from the embedded rules, evaluated into w->Nb / w->dTb (max_cut_points entries). */
 static cell_rule get_cell_rule(const fcm_space *s, const tabulation *t, fcm_rule_kind kind,
-                               fcm_index e, double *Nbuf, double *dNbuf)
+                               fcm_index e, scratch *w)
 {
-  cell_rule r = {0, NULL, Nbuf, dNbuf, NULL};
+  cell_rule r = {0, NULL, w->Nb, w->dTb, NULL};
   if (!fcm__space_owns(s, s->elem_cell[e])) return r; /* another process's cell */
   if (!s->rules || fcm_cell_rules_class(s->rules, s->elem_cell[e]) == FCM_CELL_UNCUT) return t->r;
   const double *pts = NULL;
+  const size_t rows = 3 * (size_t)fcm__kernel_na(s->nn);
   fcm_cell_rules_get_piece(s->rules, s->elem_piece[e], kind, &r.nq, &pts, &r.w, &r.fict);
   for (int q = 0; q < r.nq; q++) {
-    fcm_element_eval_shape(s->type, pts + 3 * q, Nbuf + (size_t)q * s->nn);
-    fcm_element_eval_grad(s->type, pts + 3 * q, dNbuf + (size_t)q * s->nn * 3);
+    fcm_element_eval_shape(s->type, pts + 3 * q, w->Nb + (size_t)q * s->nn);
+    fcm_element_eval_grad(s->type, pts + 3 * q, w->g);
+    fcm__kernel_rows(s->nn, w->g, w->dTb + (size_t)q * rows);
   }
   return r;
 }
 
-/* Add the element matrix of local element le into the values of the space's pattern (its
- * rows: a full space's DOFs, a local space's local copies). */
-static void scatter_matrix(const fcm_space *s, fcm_index le, const double *Ke, double *vals)
+/* Add the symmetric element matrix of local element le, given by its upper node blocks Kp
+ * (fcm__cell_kernel()), into the values of the space's pattern (its rows: a full space's DOFs,
+ * a local space's local copies). Row by row of the element's nodes a: block (a, b) for b >= a,
+ * the transpose of block (b, a) for b < a, so each matrix row is swept once (its cache lines
+ * while they are in cache). The three rows of a copy share their columns: one offset per node
+ * pair places its 3 x 3 block. */
+#if defined(__GNUC__) || defined(__clang__)
+typedef double v2d __attribute__((vector_size(16)));
+
+/* d[0..3) += (x, y, z): a pair and a single (baseline x86-64 has vectors of 2), each entry
+ * summed as alone (same bits). */
+static inline void add3(double *d, double x, double y, double z)
 {
-  int nn = s->nn, ndof = 3 * nn;
+  v2d t, u = {x, y};
+  memcpy(&t, d, sizeof t);
+  t += u;
+  memcpy(d, &t, sizeof t);
+  d[2] += z;
+}
+#else
+static inline void add3(double *d, double x, double y, double z)
+{
+  d[0] += x, d[1] += y, d[2] += z;
+}
+#endif
+
+static void scatter_matrix(const fcm_space *s, fcm_index le, const double *Kp, double *vals)
+{
+  const int nn = s->nn;
   const int *off = s->elem_off + (size_t)le * nn * nn;
   for (int a = 0; a < nn; a++) {
-    fcm_index da = fcm__space_elem_row(s, le, a);
-    for (int i = 0; i < 3; i++) {
-      double *dst = vals + s->row_ptr[da + i];
-      const double *src = Ke + (size_t)(3 * a + i) * ndof;
-      for (int b = 0; b < nn; b++) {
-        double *d = dst + 3 * off[a * nn + b];
-        d[0] += src[3 * b];
-        d[1] += src[3 * b + 1];
-        d[2] += src[3 * b + 2];
-      }
+    const fcm_index da = fcm__space_elem_row(s, le, a);
+    double *r0 = vals + s->row_ptr[da], *r1 = vals + s->row_ptr[da + 1];
+    double *r2 = vals + s->row_ptr[da + 2];
+    const int *oa = off + a * nn;
+    /* b < a: the transpose of block (b, a), at 9 (b nn - b (b - 1) / 2 + a - b) */
+    const double *k = Kp + 9 * a;
+    for (int b = 0; b < a; b++) {
+      const int x = 3 * oa[b];
+      add3(r0 + x, k[0], k[3], k[6]);
+      add3(r1 + x, k[1], k[4], k[7]);
+      add3(r2 + x, k[2], k[5], k[8]);
+      k += 9 * (nn - b - 1);
+    }
+    for (int b = a; b < nn; b++, k += 9) { /* b >= a: block (a, b) */
+      const int x = 3 * oa[b];
+      add3(r0 + x, k[0], k[1], k[2]);
+      add3(r1 + x, k[3], k[4], k[5]);
+      add3(r2 + x, k[6], k[7], k[8]);
     }
   }
 }
@@ -269,7 +307,7 @@ static cell_result volume_cell(const fcm_space *s, const pass *ps, fcm_index e, 
     for (int a = 0; a < nn; a++)
       memcpy(w->ue + 3 * a, kd->u + ed[a], 3 * sizeof(double));
   }
-  cell_rule r = get_cell_rule(s, ps->tab, ps->kind, e, w->Nb, w->dNb);
+  cell_rule r = get_cell_rule(s, ps->tab, ps->kind, e, w);
   return fcm__cell_kernel(kd, &r, nn, w);
 }
 
@@ -521,11 +559,12 @@ int fcm__assembly_inverted_point(fcm_assembly_workspace *ws, fcm_index elem, con
   const fcm_index *ed = s->elem_dof + elem * nn;
   for (int a = 0; a < nn; a++)
     memcpy(w->ue + 3 * a, u + ed[a], 3 * sizeof(double));
-  cell_rule r = get_cell_rule(s, &ws->tab[0], FCM_RULE_STIFFNESS, elem, w->Nb, w->dNb);
+  cell_rule r = get_cell_rule(s, &ws->tab[0], FCM_RULE_STIFFNESS, elem, w);
+  const size_t rows = 3 * (size_t)fcm__kernel_na(nn);
   for (int q = 0; q < r.nq; q++) {
     if (r.fict && r.fict[q]) continue;
     double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-    if (!(fcm__fem_gradients(nn, w->X, r.dN + (size_t)q * nn * 3, w->g) > 0.0)) continue;
+    if (!(fcm__kernel_point_gradients(nn, w->X, r.dT + q * rows, w->g) > 0.0)) continue;
     for (int a = 0; a < nn; a++)
       for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++)
@@ -665,7 +704,7 @@ fcm_status fcm__assembly_element_linear(fcm_assembly_workspace *ws, const fcm_li
             "degenerate %s)",
             (long long)s->elem_cell[elem], res.bad_det, fcm_element_get_info(s->type)->name);
   const size_t ndof = 3 * (size_t)s->nn;
-  if (Ke && kd.kind != KERNEL_BODY_FORCE) memcpy(Ke, w->Ke, sizeof *Ke * ndof * ndof);
+  if (Ke && kd.kind != KERNEL_BODY_FORCE) fcm__kernel_unpack(s->nn, w->Ke, Ke);
   if (fe && kd.kind == KERNEL_BODY_FORCE) memcpy(fe, w->fe, sizeof *fe * ndof);
 cleanup:
   return st;

@@ -5,12 +5,15 @@
  *   mass       M = sum_q w_q det J_q rho N_q N_q^T
  *   tangent    K_(a,i)(b,k) = sum_(q,J) g_qaJ [w_q det J_q sum_L A_q,iJkL g_qbL]
  * each as register blocks of 4 rows x 16 columns (AVX-512), 4 x 8 (AVX2) or 4 x 4 over the
- * upper triangle (the micro-kernels micro_4x16(), micro_4x8(), micro_4x4()). With FCM_MULTIVERSION
- * on x86-64 with GCC and glibc, the kernels are compiled for x86-64-v4 (AVX-512), x86-64-v3 (AVX2 +
- * FMA) and the baseline, and the loader picks the clone for the CPU (an ifunc): a default build
- * runs the AVX-512 code on a CPU that has it. Compiled with -ffp-contract=fast (sources.cmake), so
- * products and sums fuse where the CPU can; the results then differ between instruction sets at
- * round-off, but on one machine they are the same for every thread count. */
+ * upper triangle (the micro-kernels micro_4x16(), micro_4x8(), micro_4x4()). The per-point
+ * work runs over the nodes in vectors of 4 on tables by component (the rule's reference
+ * gradients dT, the cell's coordinates, the physical gradients: 3 rows of na nodes, zero
+ * padded), and the element matrices come out as their upper node blocks (kernels_impl.h). With
+ * FCM_MULTIVERSION on x86-64 with GCC and glibc, the kernels are compiled for x86-64-v4 (AVX-512),
+ * x86-64-v3 (AVX2 + FMA) and the baseline, and the loader picks the clone for the CPU (an ifunc): a
+ * default build runs the AVX-512 code on a CPU that has it. Compiled with -ffp-contract=fast
+ * (sources.cmake), so products and sums fuse where the CPU can; the results then differ between
+ * instruction sets at round-off, but on one machine they are the same for every thread count. */
 #include "fem/kernels_impl.h"
 
 #include <math.h>
@@ -36,11 +39,34 @@
  * block of the blocked products with AVX2 (8 registers of accumulators). */
 #if defined(__GNUC__) || defined(__clang__)
 typedef double fcm_v8d __attribute__((vector_size(64)));
+typedef double fcm_v4d __attribute__((vector_size(32)));
+
+/* p[0..8) = v, or p[0..8) += v with add (a row of a register block into C). */
+FCM_KERNEL_INLINE void put8(double *p, fcm_v8d v, int add)
+{
+  if (add) {
+    fcm_v8d o;
+    memcpy(&o, p, sizeof o);
+    v += o;
+  }
+  memcpy(p, &v, sizeof v);
+}
+
+/* p[0..4) = v, or p[0..4) += v with add. */
+FCM_KERNEL_INLINE void put4(double *p, fcm_v4d v, int add)
+{
+  if (add) {
+    fcm_v4d o;
+    memcpy(&o, p, sizeof o);
+    v += o;
+  }
+  memcpy(p, &v, sizeof v);
+}
 
 FCM_KERNEL_INLINE void micro_4x8(int nk, const double *A, int lda, const double *B, int ldb,
-                                 double *C, int ldc)
+                                 double *C, int ldc, int add)
 {
-  fcm_v8d c0 = {0}, c1 = {0}, c2 = {0}, c3 = {0}, b, t;
+  fcm_v8d c0 = {0}, c1 = {0}, c2 = {0}, c3 = {0}, b;
   for (int k = 0; k < nk; k++) {
     const double *a = A + (size_t)k * lda;
     memcpy(&b, B + (size_t)k * ldb, sizeof b);
@@ -49,20 +75,16 @@ FCM_KERNEL_INLINE void micro_4x8(int nk, const double *A, int lda, const double 
     c2 += a[2] * b;
     c3 += a[3] * b;
   }
-  memcpy(&t, C, sizeof t), t += c0, memcpy(C, &t, sizeof t);
-  memcpy(&t, C + ldc, sizeof t), t += c1, memcpy(C + ldc, &t, sizeof t);
-  memcpy(&t, C + 2 * ldc, sizeof t), t += c2, memcpy(C + 2 * ldc, &t, sizeof t);
-  memcpy(&t, C + 3 * ldc, sizeof t), t += c3, memcpy(C + 3 * ldc, &t, sizeof t);
+  put8(C, c0, add), put8(C + ldc, c1, add);
+  put8(C + 2 * ldc, c2, add), put8(C + 3 * ldc, c3, add);
 }
 
 /* The same on 4 x 4 (8 SSE2 registers of accumulators: 4 x 8 would spill the 16 of baseline
  * x86-64). */
-typedef double fcm_v4d __attribute__((vector_size(32)));
-
 FCM_KERNEL_INLINE void micro_4x4(int nk, const double *A, int lda, const double *B, int ldb,
-                                 double *C, int ldc)
+                                 double *C, int ldc, int add)
 {
-  fcm_v4d c0 = {0}, c1 = {0}, c2 = {0}, c3 = {0}, b, t;
+  fcm_v4d c0 = {0}, c1 = {0}, c2 = {0}, c3 = {0}, b;
   for (int k = 0; k < nk; k++) {
     const double *a = A + (size_t)k * lda;
     memcpy(&b, B + (size_t)k * ldb, sizeof b);
@@ -71,18 +93,16 @@ FCM_KERNEL_INLINE void micro_4x4(int nk, const double *A, int lda, const double 
     c2 += a[2] * b;
     c3 += a[3] * b;
   }
-  memcpy(&t, C, sizeof t), t += c0, memcpy(C, &t, sizeof t);
-  memcpy(&t, C + ldc, sizeof t), t += c1, memcpy(C + ldc, &t, sizeof t);
-  memcpy(&t, C + 2 * ldc, sizeof t), t += c2, memcpy(C + 2 * ldc, &t, sizeof t);
-  memcpy(&t, C + 3 * ldc, sizeof t), t += c3, memcpy(C + 3 * ldc, &t, sizeof t);
+  put4(C, c0, add), put4(C + ldc, c1, add);
+  put4(C + 2 * ldc, c2, add), put4(C + 3 * ldc, c3, add);
 }
 
 /* The same on 4 x 16 (8 AVX-512 accumulators: two fused multiply-adds per cycle of latency 4
  * need 8 independent sums; on AVX2 this would spill). */
 FCM_KERNEL_INLINE void micro_4x16(int nk, const double *A, int lda, const double *B, int ldb,
-                                  double *C, int ldc)
+                                  double *C, int ldc, int add)
 {
-  fcm_v8d c0 = {0}, c1 = {0}, c2 = {0}, c3 = {0}, d0 = {0}, d1 = {0}, d2 = {0}, d3 = {0}, b, e, t;
+  fcm_v8d c0 = {0}, c1 = {0}, c2 = {0}, c3 = {0}, d0 = {0}, d1 = {0}, d2 = {0}, d3 = {0}, b, e;
   for (int k = 0; k < nk; k++) {
     const double *a = A + (size_t)k * lda;
     memcpy(&b, B + (size_t)k * ldb, sizeof b);
@@ -92,16 +112,14 @@ FCM_KERNEL_INLINE void micro_4x16(int nk, const double *A, int lda, const double
     c2 += a[2] * b, d2 += a[2] * e;
     c3 += a[3] * b, d3 += a[3] * e;
   }
-#define FCM_ADD_ROW(p, v) (memcpy(&t, (p), sizeof t), t += (v), memcpy((p), &t, sizeof t))
-  FCM_ADD_ROW(C, c0), FCM_ADD_ROW(C + 8, d0);
-  FCM_ADD_ROW(C + ldc, c1), FCM_ADD_ROW(C + ldc + 8, d1);
-  FCM_ADD_ROW(C + 2 * ldc, c2), FCM_ADD_ROW(C + 2 * ldc + 8, d2);
-  FCM_ADD_ROW(C + 3 * ldc, c3), FCM_ADD_ROW(C + 3 * ldc + 8, d3);
-#undef FCM_ADD_ROW
+  put8(C, c0, add), put8(C + 8, d0, add);
+  put8(C + ldc, c1, add), put8(C + ldc + 8, d1, add);
+  put8(C + 2 * ldc, c2, add), put8(C + 2 * ldc + 8, d2, add);
+  put8(C + 3 * ldc, c3, add), put8(C + 3 * ldc + 8, d3, add);
 }
 #else
 FCM_KERNEL_INLINE void micro_4x4(int nk, const double *A, int lda, const double *B, int ldb,
-                                 double *C, int ldc)
+                                 double *C, int ldc, int add)
 {
   double c[4][4] = {{0}};
   for (int k = 0; k < nk; k++)
@@ -110,21 +128,21 @@ FCM_KERNEL_INLINE void micro_4x4(int nk, const double *A, int lda, const double 
         c[i][j] += A[(size_t)k * lda + i] * B[(size_t)k * ldb + j];
   for (int i = 0; i < 4; i++)
     for (int j = 0; j < 4; j++)
-      C[(size_t)i * ldc + j] += c[i][j];
+      C[(size_t)i * ldc + j] = add ? C[(size_t)i * ldc + j] + c[i][j] : c[i][j];
 }
 
 FCM_KERNEL_INLINE void micro_4x8(int nk, const double *A, int lda, const double *B, int ldb,
-                                 double *C, int ldc)
+                                 double *C, int ldc, int add)
 {
-  micro_4x4(nk, A, lda, B, ldb, C, ldc);
-  micro_4x4(nk, A, lda, B + 4, ldb, C + 4, ldc);
+  micro_4x4(nk, A, lda, B, ldb, C, ldc, add);
+  micro_4x4(nk, A, lda, B + 4, ldb, C + 4, ldc, add);
 }
 
 FCM_KERNEL_INLINE void micro_4x16(int nk, const double *A, int lda, const double *B, int ldb,
-                                  double *C, int ldc)
+                                  double *C, int ldc, int add)
 {
-  micro_4x8(nk, A, lda, B, ldb, C, ldc);
-  micro_4x8(nk, A, lda, B + 8, ldb, C + 8, ldc);
+  micro_4x8(nk, A, lda, B, ldb, C, ldc, add);
+  micro_4x8(nk, A, lda, B + 8, ldb, C + 8, ldc, add);
 }
 #endif
 
@@ -142,32 +160,122 @@ FCM_KERNEL_INLINE void micro_4x16(int nk, const double *A, int lda, const double
 #define FCM_KERNEL_NB() 4
 #endif
 
-/* C (4 x nb) += the product of micro_4x4(), micro_4x8() or micro_4x16() (nb = 4, 8, 16). */
+/* C (4 x nb) = (add: +=) the product of micro_4x4(), micro_4x8() or micro_4x16() (nb = 4, 8,
+ * 16). */
 FCM_KERNEL_INLINE void micro(int nb, int nk, const double *A, int lda, const double *B, int ldb,
-                             double *C, int ldc)
+                             double *C, int ldc, int add)
 {
   if (nb == 16)
-    micro_4x16(nk, A, lda, B, ldb, C, ldc);
+    micro_4x16(nk, A, lda, B, ldb, C, ldc, add);
   else if (nb == 8)
-    micro_4x8(nk, A, lda, B, ldb, C, ldc);
+    micro_4x8(nk, A, lda, B, ldb, C, ldc, add);
   else
-    micro_4x4(nk, A, lda, B, ldb, C, ldc);
+    micro_4x4(nk, A, lda, B, ldb, C, ldc, add);
 }
 
-/* C += A^T B on the blocks of rows [0, rows) (in fours) whose nb columns reach the diagonal or
- * beyond, columns up to ld (a multiple of 16): A, B are nk x ld (row stride ld), C is ld x ld.
- * Every entry C[x][y] with x <= y < ld is summed. */
-FCM_KERNEL_INLINE void product_upper(int nb, int nk, const double *A, const double *B, int rows,
-                                     int ld, double *C)
+/* C = (add: +=) A^T B on its upper triangle: A, B are nk x ld (row stride ld), C is ld x ld,
+ * every entry C[x][y] with x <= y < cols summed (some below the diagonal and beyond cols too).
+ * Rows [0, cols) in fours; each run of rows from its diagonal on in blocks of nb columns, the
+ * rest in the narrowest block of nb / 2^k >= 4 columns that covers it (within ld, a multiple of
+ * 16 with cols + 4 <= ld or cols a multiple of 8). */
+FCM_KERNEL_INLINE void product_upper(int nb, int nk, const double *A, const double *B, int cols,
+                                     int ld, double *C, int add)
 {
-  for (int a0 = 0; a0 < rows; a0 += 4)
-    for (int b0 = a0 / nb * nb; b0 < ld; b0 += nb)
-      micro(nb, nk, A + a0, ld, B + b0, ld, C + (size_t)a0 * ld + b0, ld);
+  for (int a0 = 0; a0 < cols; a0 += 4) {
+    int b0 = a0;
+    for (; b0 + nb <= cols; b0 += nb)
+      micro(nb, nk, A + a0, ld, B + b0, ld, C + (size_t)a0 * ld + b0, ld, add);
+    for (int w = nb; b0 < cols; b0 += w) {
+      while (w > 4 && (w / 2 >= cols - b0 || b0 + w > ld))
+        w /= 2;
+      micro(w, nk, A + a0, ld, B + b0, ld, C + (size_t)a0 * ld + b0, ld, add);
+    }
+  }
 }
 
-/* Physical gradients g (nn x 3, then zero to ld) from the reference ones dN and the nodal
+/* ------------------------------------------------------------------ the per-point work */
+
+/* S[3i + j] = sum_a U[i na + a] V[j na + a] for two tables by component (3 rows of na, a
+ * multiple of 4): the Jacobian X^T dN from the coordinates and the reference gradients, or the
+ * displacement gradient sum_a u_a g_a^T. */
+FCM_KERNEL_INLINE void outer_sum(int na, const double *U, const double *V, double S[9])
+{
+#if defined(__GNUC__) || defined(__clang__)
+  fcm_v4d s0 = {0}, s1 = {0}, s2 = {0}, s3 = {0}, s4 = {0}, s5 = {0}, s6 = {0}, s7 = {0}, s8 = {0};
+  for (int a = 0; a < na; a += 4) {
+    fcm_v4d u0, u1, u2, v0, v1, v2;
+    memcpy(&u0, U + a, sizeof u0), memcpy(&u1, U + na + a, sizeof u1);
+    memcpy(&u2, U + 2 * na + a, sizeof u2);
+    memcpy(&v0, V + a, sizeof v0), memcpy(&v1, V + na + a, sizeof v1);
+    memcpy(&v2, V + 2 * na + a, sizeof v2);
+    s0 += u0 * v0, s1 += u0 * v1, s2 += u0 * v2;
+    s3 += u1 * v0, s4 += u1 * v1, s5 += u1 * v2;
+    s6 += u2 * v0, s7 += u2 * v1, s8 += u2 * v2;
+  }
+#define FCM_HSUM(v) (((v)[0] + (v)[1]) + ((v)[2] + (v)[3]))
+  S[0] = FCM_HSUM(s0), S[1] = FCM_HSUM(s1), S[2] = FCM_HSUM(s2);
+  S[3] = FCM_HSUM(s3), S[4] = FCM_HSUM(s4), S[5] = FCM_HSUM(s5);
+  S[6] = FCM_HSUM(s6), S[7] = FCM_HSUM(s7), S[8] = FCM_HSUM(s8);
+#undef FCM_HSUM
+#else
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      double t = 0.0;
+      for (int a = 0; a < na; a++)
+        t += U[i * na + a] * V[j * na + a];
+      S[3 * i + j] = t;
+    }
+#endif
+}
+
+/* out[j na + a] = sum_k C[3k + j] V[k na + a] (add: out += ...) for a table by component V:
+ * the physical gradients J^-T dN from the inverse Jacobian (C = J^-1), or the internal force's
+ * wd sum_J P_iJ g_Ja (C = wd P^T). */
+FCM_KERNEL_INLINE void combine(int na, const double C[9], const double *V, double *out, int add)
+{
+  for (int j = 0; j < 3; j++) {
+    const double c0 = C[j], c1 = C[3 + j], c2 = C[6 + j];
+    double *o = out + (size_t)j * na;
+#if defined(__GNUC__) || defined(__clang__)
+    for (int a = 0; a < na; a += 4) {
+      fcm_v4d v0, v1, v2;
+      memcpy(&v0, V + a, sizeof v0), memcpy(&v1, V + na + a, sizeof v1);
+      memcpy(&v2, V + 2 * na + a, sizeof v2);
+      put4(o + a, c0 * v0 + c1 * v1 + c2 * v2, add);
+    }
+#else
+    for (int a = 0; a < na; a++) {
+      const double t = c0 * V[a] + c1 * V[na + a] + c2 * V[2 * na + a];
+      o[a] = add ? o[a] + t : t;
+    }
+#endif
+  }
+}
+
+/* The physical gradients of a point by component, g = J^-T dN (3 x na, zero where dT is), from
+ * the cell's coordinates XT and the point's reference gradients dT; returns det J (not
+ * positive: g is not written). */
+FCM_KERNEL_INLINE double point_gradients(int na, const double *XT, const double *dT, double *g)
+{
+  double J[9], Ji[9];
+  outer_sum(na, XT, dT, J);
+  const double det = fcm__mat3_inv(J, Ji);
+  if (!(det > 0.0)) return det;
+  combine(na, Ji, dT, g, 0);
+  return det;
+}
+
+/* det J of a point (the mass and body force need no gradients). */
+FCM_KERNEL_INLINE double point_det(int na, const double *XT, const double *dT)
+{
+  double J[9];
+  outer_sum(na, XT, dT, J);
+  return fcm__mat3_det(J);
+}
+
+/* Physical gradients g (nn x 3, node-major) from the reference ones dN and the nodal
  * coordinates X; returns det J (not positive: g is not written). */
-FCM_KERNEL_INLINE double gradients(int nn, const double *X, const double *dN, double *g)
+static double gradients(int nn, const double *X, const double *dN, double *g)
 {
   double J[9] = {0}, Ji[9] = {0};
   for (int a = 0; a < nn; a++)
@@ -187,21 +295,30 @@ double fcm__fem_gradients(int nn, const double *X, const double *dN, double *g)
   return gradients(nn, X, dN, g);
 }
 
-/* The gradients of points [q0, q0 + nc) of rule r into rows of G (zero padded to ld), their
- * weights w det J into wd and, with WG, the rows times w det J into WG; 0 with res->bad_det set
- * at the first point whose det J is not positive. */
-FCM_KERNEL_INLINE int chunk_gradients(const cell_rule *r, int nn, int q0, int nc, const double *X,
-                                      int ld, scratch *w, cell_result *res, double *WG)
+double fcm__kernel_point_gradients(int nn, const double *X, const double *dT, double *g)
 {
-  const int ndof = 3 * nn;
+  const int na = fcm__kernel_na(nn);
+  double dN[3 * FCM_ELEMENT_MAX_NODES];
+  for (int a = 0; a < nn; a++)
+    for (int k = 0; k < 3; k++)
+      dN[3 * a + k] = dT[k * na + a];
+  return gradients(nn, X, dN, g);
+}
+
+/* The gradients by component of points [q0, q0 + nc) of rule r into rows of G (zero padded to
+ * ld), their weights w det J into wd and, with WG, the rows times w det J into WG; 0 with
+ * res->bad_det set at the first point whose det J is not positive. */
+FCM_KERNEL_INLINE int chunk_gradients(const cell_rule *r, int na, int q0, int nc, int ld,
+                                      scratch *w, cell_result *res, double *WG)
+{
   for (int c = 0; c < nc; c++) {
     double *g = w->G + (size_t)c * ld;
-    const double det = gradients(nn, X, r->dN + (size_t)(q0 + c) * nn * 3, g);
+    const double det = point_gradients(na, w->XT, r->dT + (size_t)(q0 + c) * 3 * na, g);
     if (!(det > 0.0)) {
       res->bad_det = det;
       return 0;
     }
-    for (int k = ndof; k < ld; k++)
+    for (int k = 3 * na; k < ld; k++)
       g[k] = 0.0;
     const double wd = r->w[q0 + c] * det;
     w->wd[c] = wd;
@@ -212,66 +329,56 @@ FCM_KERNEL_INLINE int chunk_gradients(const cell_rule *r, int nn, int q0, int nc
   return 1;
 }
 
-/* Fill the lower node blocks of a symmetric element matrix from the upper ones. */
-static void mirror_blocks(int nn, double *Ke)
-{
-  int ndof = 3 * nn;
-  for (int a = 0; a < nn; a++)
-    for (int b = 0; b < a; b++)
-      for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-          Ke[(size_t)(3 * a + i) * ndof + 3 * b + j] = Ke[(size_t)(3 * b + j) * ndof + 3 * a + i];
-}
+/* ------------------------------------------------------------------ the kernels */
 
-/* Linear stiffness Ke (3nn x 3nn, row-major). With H = sum_q w_q det J_q g_q g_q^T (upper
- * triangle, row stride ld) the isotropic element matrix is
- * K_(a,i)(b,j) = lambda H_(a,i)(b,j) + mu H_(a,j)(b,i) + mu delta_ij sum_k H_(a,k)(b,k). */
+/* Linear stiffness. With H = sum_q w_q det J_q g_q g_q^T over the gradients by component (row
+ * and column (i, a) at i na + a; the upper triangle, row stride ld) the isotropic element
+ * matrix is K_(a,i)(b,j) = lambda h_ij + mu h_ji + mu delta_ij sum_k h_kk, h_ij = H_(i,a)(j,b);
+ * for a <= b every h_ij is in the upper triangle as H_(i,a)(j,b) (i <= j) or H_(j,b)(i,a). */
 FCM_KERNEL_CLONES
 static cell_result stiffness_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
 {
-  const int ndof = 3 * nn, ld = fcm__kernel_ld(nn), nb = FCM_KERNEL_NB();
+  const int na = fcm__kernel_na(nn), ld = fcm__kernel_ld(nn), nb = FCM_KERNEL_NB();
   cell_result res = {0.0, 1.0, 0, 0};
-  double *H = w->H, *Ke = w->Ke;
-  memset(H, 0, sizeof *H * (size_t)ld * ld);
+  double *H = w->H, *Kp = w->Ke;
+  fcm__kernel_rows(nn, w->X, w->XT);
+  if (r->nq == 0) memset(H, 0, sizeof *H * (size_t)ld * ld);
   for (int q0 = 0; q0 < r->nq; q0 += FCM__KERNEL_QB) {
     const int nc = r->nq - q0 < FCM__KERNEL_QB ? r->nq - q0 : FCM__KERNEL_QB;
-    if (!chunk_gradients(r, nn, q0, nc, w->X, ld, w, &res, w->WG)) return res;
-    product_upper(nb, nc, w->WG, w->G, ndof, ld, H);
+    if (!chunk_gradients(r, na, q0, nc, ld, w, &res, w->WG)) return res;
+    product_upper(nb, nc, w->WG, w->G, 3 * na, ld, H, q0 > 0);
   }
   const double l = kd->lambda, m = kd->mu;
-  for (int a = 0; a < nn; a++)
-    for (int b = a; b < nn; b++) {
-      double h[3][3]; /* block (a, b) of H; the diagonal blocks from their upper triangle */
-      for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) {
-          const int x = 3 * a + i, y = 3 * b + j;
-          h[i][j] = x <= y ? H[(size_t)x * ld + y] : H[(size_t)y * ld + x];
-        }
-      const double tr = m * (h[0][0] + h[1][1] + h[2][2]);
-      for (int i = 0; i < 3; i++) {
-        double *row = Ke + (size_t)(3 * a + i) * ndof + 3 * b;
-        for (int j = 0; j < 3; j++)
-          row[j] = l * h[i][j] + m * h[j][i];
-        row[i] += tr;
-      }
+  for (int a = 0; a < nn; a++) {
+    const double *H0 = H + (size_t)a * ld, *H1 = H + (size_t)(na + a) * ld;
+    const double *H2 = H + (size_t)(2 * na + a) * ld;
+    for (int b = a; b < nn; b++, Kp += 9) {
+      const double *L0 = H + (size_t)b * ld, *L1 = H + (size_t)(na + b) * ld;
+      const double h00 = H0[b], h01 = H0[na + b], h02 = H0[2 * na + b];
+      const double h10 = L0[na + a], h11 = H1[na + b], h12 = H1[2 * na + b];
+      const double h20 = L0[2 * na + a], h21 = L1[2 * na + a], h22 = H2[2 * na + b];
+      const double tr = m * (h00 + h11 + h22);
+      Kp[0] = l * h00 + m * h00 + tr, Kp[1] = l * h01 + m * h10, Kp[2] = l * h02 + m * h20;
+      Kp[3] = l * h10 + m * h01, Kp[4] = l * h11 + m * h11 + tr, Kp[5] = l * h12 + m * h21;
+      Kp[6] = l * h20 + m * h02, Kp[7] = l * h21 + m * h12, Kp[8] = l * h22 + m * h22 + tr;
     }
-  mirror_blocks(nn, Ke);
+  }
   return res;
 }
 
-/* Consistent mass Ke: the scalar matrix M = sum_q w_q det J_q rho N N^T on each component. */
+/* Consistent mass: the scalar matrix M = sum_q w_q det J_q rho N N^T on each component. */
 FCM_KERNEL_CLONES
 static cell_result mass_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
 {
-  const int ndof = 3 * nn, ld = (nn + 15) / 16 * 16, nb = FCM_KERNEL_NB();
+  const int na = fcm__kernel_na(nn), ld = (nn + 15) / 16 * 16, nb = FCM_KERNEL_NB();
   cell_result res = {0.0, 1.0, 0, 0};
-  double *H = w->H, *Ke = w->Ke;
-  memset(H, 0, sizeof *H * (size_t)ld * ld);
-  memset(Ke, 0, sizeof *Ke * (size_t)ndof * ndof);
+  double *H = w->H, *Kp = w->Ke;
+  fcm__kernel_rows(nn, w->X, w->XT);
+  if (r->nq == 0) memset(H, 0, sizeof *H * (size_t)ld * ld);
   for (int q0 = 0; q0 < r->nq; q0 += FCM__KERNEL_QB) {
     const int nc = r->nq - q0 < FCM__KERNEL_QB ? r->nq - q0 : FCM__KERNEL_QB;
     for (int c = 0; c < nc; c++) {
-      const double det = gradients(nn, w->X, r->dN + (size_t)(q0 + c) * nn * 3, w->g);
+      const double det = point_det(na, w->XT, r->dT + (size_t)(q0 + c) * 3 * na);
       if (!(det > 0.0)) {
         res.bad_det = det;
         return res;
@@ -281,24 +388,28 @@ static cell_result mass_kernel(const kernel_data *kd, const cell_rule *r, int nn
       for (int a = 0; a < ld; a++)
         n[a] = a < nn ? N[a] : 0.0, wn[a] = rw * n[a];
     }
-    product_upper(nb, nc, w->WG, w->G, nn, ld, H);
+    product_upper(nb, nc, w->WG, w->G, (nn + 3) / 4 * 4, ld, H, q0 > 0);
   }
   for (int a = 0; a < nn; a++)
-    for (int b = a; b < nn; b++)
-      for (int i = 0; i < 3; i++)
-        Ke[(size_t)(3 * a + i) * ndof + 3 * b + i] = H[(size_t)a * ld + b];
-  mirror_blocks(nn, Ke);
+    for (int b = a; b < nn; b++, Kp += 9) {
+      const double h = H[(size_t)a * ld + b];
+      Kp[0] = h, Kp[1] = Kp[2] = Kp[3] = 0.0;
+      Kp[4] = h, Kp[5] = Kp[6] = Kp[7] = 0.0;
+      Kp[8] = h;
+    }
   return res;
 }
 
 /* Body force fe (3nn): rho * accel, or the force density field b(X), against N. */
 static cell_result body_force_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
 {
+  const int na = fcm__kernel_na(nn);
   cell_result res = {0.0, 1.0, 0, 0};
   double *fe = w->fe;
   memset(fe, 0, sizeof *fe * (size_t)(3 * nn));
+  fcm__kernel_rows(nn, w->X, w->XT);
   for (int q = 0; q < r->nq; q++) {
-    const double det = gradients(nn, w->X, r->dN + (size_t)q * nn * 3, w->g);
+    const double det = point_det(na, w->XT, r->dT + (size_t)q * 3 * na);
     if (!(det > 0.0)) {
       res.bad_det = det;
       return res;
@@ -343,18 +454,18 @@ FCM_KERNEL_INLINE void fictitious_eval(const kernel_data *kd, const double F[9],
   }
 }
 
-/* The material at point c of a chunk (gradients g): energy, force into fe and, with A, the
- * tangent's factors of the point into the chunk's rows of w->WG (g^T) and w->B
- * (w det J A g_b); 0 with res->nonfinite set when the material returned NaN or infinity. */
+/* The material at point c of a chunk (gradients by component g, row c of w->G): energy, force
+ * into w->FT (by component) and, with A, the tangent's factors of the point into the chunk's
+ * rows of w->WG (g^T) and w->B (w det J A g_b, node-major); 0 with res->nonfinite set when the
+ * material returned NaN or infinity. */
 FCM_KERNEL_INLINE int hyperelastic_point(const kernel_data *kd, const cell_rule *r, int nn, int q,
                                          int c, int ld, scratch *w, cell_result *res)
 {
+  const int na = fcm__kernel_na(nn);
   const double *g = w->G + (size_t)c * ld, wd = w->wd[c];
-  double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, psi = 0.0, P[9], A[81];
-  for (int a = 0; a < nn; a++)
-    for (int i = 0; i < 3; i++)
-      for (int j = 0; j < 3; j++)
-        F[3 * i + j] += w->ue[3 * a + i] * g[3 * a + j];
+  double F[9], psi = 0.0, P[9], A[81], C[9];
+  outer_sum(na, w->UT, g, F);
+  F[0] += 1.0, F[4] += 1.0, F[8] += 1.0;
   if (r->fict && r->fict[q]) {
     fictitious_eval(kd, F, &psi, P, kd->want_tangent ? A : NULL);
   } else {
@@ -371,24 +482,23 @@ FCM_KERNEL_INLINE int hyperelastic_point(const kernel_data *kd, const cell_rule 
     return 0;
   }
   res->energy += wd * psi;
-  for (int a = 0; a < nn; a++) {
-    const double *ga = g + 3 * a;
-    for (int i = 0; i < 3; i++)
-      w->fe[3 * a + i] += wd * (P[3 * i] * ga[0] + P[3 * i + 1] * ga[1] + P[3 * i + 2] * ga[2]);
-  }
+  for (int i = 0; i < 3; i++) /* f_(a,i) += wd sum_J P_iJ g_Ja */
+    for (int J = 0; J < 3; J++)
+      C[3 * J + i] = wd * P[3 * i + J];
+  combine(na, C, g, w->FT, 1);
   if (!kd->want_tangent) return 1;
   const size_t bi = (size_t)3 * FCM__KERNEL_QH * ld; /* B's stride between components i */
   for (int J = 0; J < 3; J++) {
-    double *gt = w->WG + (size_t)(3 * c + J) * ld; /* row (c, J) of the left factor: g_aJ */
-    for (int a = 0; a < ld; a++)
-      gt[a] = a < nn ? g[3 * a + J] : 0.0;
+    const double *gJ = g + (size_t)J * na;
+    /* row (c, J) of the left factor: g_aJ (its first na entries are read) */
+    memcpy(w->WG + (size_t)(3 * c + J) * ld, gJ, sizeof *gJ * (size_t)na);
     for (int i = 0; i < 3; i++) { /* B_i[(c, J)][(b, k)] = wd sum_L A_iJkL g_bL */
       double *row = w->B + i * bi + (size_t)(3 * c + J) * ld;
       const double *Am = A + 9 * (3 * i + J);
-      for (int b = 0; b < nn; b++) {
-        const double *gb = g + 3 * b;
-        for (int k = 0; k < 3; k++)
-          row[3 * b + k] = wd * (Am[3 * k] * gb[0] + Am[3 * k + 1] * gb[1] + Am[3 * k + 2] * gb[2]);
+      for (int k = 0; k < 3; k++) {
+        const double a0 = wd * Am[3 * k], a1 = wd * Am[3 * k + 1], a2 = wd * Am[3 * k + 2];
+        for (int b = 0; b < nn; b++)
+          row[3 * b + k] = a0 * g[b] + a1 * g[na + b] + a2 * g[2 * na + b];
       }
       for (int k = 3 * nn; k < ld; k++)
         row[k] = 0.0;
@@ -397,7 +507,7 @@ FCM_KERNEL_INLINE int hyperelastic_point(const kernel_data *kd, const cell_rule 
   return 1;
 }
 
-/* Hyperelastic energy, internal force fe and (want_tangent) tangent Ke at the displacement
+/* Hyperelastic energy, internal force fe and (want_tangent) tangent at the displacement
  * w->ue: F = I + sum_a u_a (x) g_a; f_(a,i) = sum_q wd P_iJ g_aJ and
  * K_(a,i)(b,k) = sum_q wd g_aJ A_iJkL g_bL with A = dP/dF, summed per chunk of points as
  * K_i[a][(b, k)] += sum_(c,J) g_caJ B_i[(c, J)][(b, k)] (row (a, i) of K, stride 3 ld in H). */
@@ -405,15 +515,16 @@ FCM_KERNEL_CLONES
 static cell_result hyperelastic_kernel(const kernel_data *kd, const cell_rule *r, int nn,
                                        scratch *w)
 {
-  const int ndof = 3 * nn, ld = fcm__kernel_ld(nn), na = (nn + 3) / 4 * 4;
-  const int nb = FCM_KERNEL_NB();
+  const int ld = fcm__kernel_ld(nn), na = fcm__kernel_na(nn), nb = FCM_KERNEL_NB();
   cell_result res = {0.0, 1.0, 0, 0};
-  double *H = w->H, *Ke = w->Ke;
-  if (kd->want_tangent) memset(H, 0, sizeof *H * (size_t)ld * ld);
-  memset(w->fe, 0, sizeof *w->fe * (size_t)ndof);
+  double *H = w->H, *Kp = w->Ke;
+  fcm__kernel_rows(nn, w->X, w->XT);
+  fcm__kernel_rows(nn, w->ue, w->UT);
+  if (kd->want_tangent && r->nq == 0) memset(H, 0, sizeof *H * (size_t)ld * ld);
+  memset(w->FT, 0, sizeof *w->FT * (size_t)(3 * na));
   for (int q0 = 0; q0 < r->nq; q0 += FCM__KERNEL_QH) {
     const int nc = r->nq - q0 < FCM__KERNEL_QH ? r->nq - q0 : FCM__KERNEL_QH;
-    if (!chunk_gradients(r, nn, q0, nc, w->X, ld, w, &res, NULL)) return res;
+    if (!chunk_gradients(r, na, q0, nc, ld, w, &res, NULL)) return res;
     for (int c = 0; c < nc; c++)
       if (!hyperelastic_point(kd, r, nn, q0 + c, c, ld, w, &res)) return res;
     if (!kd->want_tangent) continue;
@@ -421,16 +532,18 @@ static cell_result hyperelastic_kernel(const kernel_data *kd, const cell_rule *r
       const double *Bi = w->B + (size_t)i * 3 * FCM__KERNEL_QH * ld;
       for (int a0 = 0; a0 < na; a0 += 4)
         for (int b0 = 3 * a0 / nb * nb; b0 < ld; b0 += nb)
-          micro(nb, 3 * nc, w->WG + a0, ld, Bi + b0, ld, H + (size_t)(3 * a0 + i) * ld + b0,
-                3 * ld);
+          micro(nb, 3 * nc, w->WG + a0, ld, Bi + b0, ld, H + (size_t)(3 * a0 + i) * ld + b0, 3 * ld,
+                q0 > 0);
     }
   }
+  for (int a = 0; a < nn; a++)
+    for (int i = 0; i < 3; i++)
+      w->fe[3 * a + i] = w->FT[i * na + a];
   if (!kd->want_tangent) return res;
   for (int a = 0; a < nn; a++) /* the upper node blocks a <= b */
-    for (int x = 3 * a; x < 3 * a + 3; x++)
-      memcpy(Ke + (size_t)x * ndof + 3 * a, H + (size_t)x * ld + 3 * a,
-             sizeof *Ke * (size_t)(ndof - 3 * a));
-  mirror_blocks(nn, Ke);
+    for (int b = a; b < nn; b++, Kp += 9)
+      for (int i = 0; i < 3; i++)
+        memcpy(Kp + 3 * i, H + (size_t)(3 * a + i) * ld + 3 * b, sizeof *Kp * 3);
   return res;
 }
 
@@ -450,27 +563,43 @@ cell_result fcm__cell_kernel(const kernel_data *kd, const cell_rule *r, int nn, 
   }
 }
 
+void fcm__kernel_unpack(int nn, const double *Kp, double *Ke)
+{
+  const size_t ndof = 3 * (size_t)nn;
+  for (int a = 0; a < nn; a++)
+    for (int b = a; b < nn; b++, Kp += 9)
+      for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+          Ke[(3 * a + i) * ndof + 3 * b + j] = Ke[(3 * b + j) * ndof + 3 * a + i] = Kp[3 * i + j];
+}
+
 /* Rows of WG: QB (linear kernels) or 3 QH (the hyperelastic kernel's left factor). */
 enum { WG_ROWS = FCM__KERNEL_QB > 3 * FCM__KERNEL_QH ? FCM__KERNEL_QB : 3 * FCM__KERNEL_QH };
 
 size_t fcm__kernel_scratch_size(int nn, size_t mq)
 {
   const size_t ndof = 3 * (size_t)nn, ld = (size_t)fcm__kernel_ld(nn);
-  return 3 * (size_t)nn + 2 * ndof + 3 * (size_t)nn + ld * ld + ndof * ndof + mq * nn * 4 +
-         FCM__KERNEL_QB * ld + WG_ROWS * ld + FCM__KERNEL_QB + 9 * FCM__KERNEL_QH * ld;
+  const size_t na = (size_t)fcm__kernel_na(nn);
+  return 3 * (size_t)nn + 2 * ndof + 3 * (size_t)nn + 3 * 3 * na + ld * ld + ndof * ndof + mq * nn +
+         mq * 3 * na + FCM__KERNEL_QB * ld + WG_ROWS * ld + FCM__KERNEL_QB +
+         9 * FCM__KERNEL_QH * ld;
 }
 
 void fcm__kernel_scratch_init(int nn, size_t mq, double *p, scratch *w)
 {
   const size_t ndof = 3 * (size_t)nn, ld = (size_t)fcm__kernel_ld(nn);
+  const size_t na = (size_t)fcm__kernel_na(nn);
   w->X = p, p += 3 * nn;
   w->ue = p, p += ndof;
   w->fe = p, p += ndof;
   w->g = p, p += 3 * nn;
+  w->XT = p, p += 3 * na;
+  w->UT = p, p += 3 * na;
+  w->FT = p, p += 3 * na;
   w->H = p, p += ld * ld;
   w->Ke = p, p += ndof * ndof;
   w->Nb = p, p += mq * nn;
-  w->dNb = p, p += mq * nn * 3;
+  w->dTb = p, p += mq * 3 * na;
   w->G = p, p += FCM__KERNEL_QB * ld;
   w->WG = p, p += WG_ROWS * ld;
   w->wd = p, p += FCM__KERNEL_QB;

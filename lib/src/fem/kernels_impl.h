@@ -10,14 +10,31 @@
  * of the hyperelastic kernel (its tangent's right factor is 3 x 3 QH rows per chunk). */
 enum { FCM__KERNEL_QB = 32, FCM__KERNEL_QH = 8 };
 
+/* Nodes of the by-component tables (reference gradients, coordinates, physical gradients): nn
+ * rounded up to 4, the entries beyond nn zero, so that their loops run in whole vectors of 4. */
+static inline int fcm__kernel_na(int nn)
+{
+  return (nn + 3) / 4 * 4;
+}
+
 /* The points of one cell's rule with the shape functions evaluated there. */
 typedef struct cell_rule {
   int nq;
   const double *w;           /* nq weights; det J_K(xi) still to be applied */
   const double *N;           /* nq x nn */
-  const double *dN;          /* nq x nn x 3 reference gradients */
+  const double *dT;          /* nq x 3 x na reference gradients by component (fcm__kernel_rows()) */
   const unsigned char *fict; /* nq flags (1: fictitious stabilization point), or NULL */
 } cell_rule;
+
+/* The reference gradients dN (nn x 3, node-major, as fcm_element_eval_grad() gives them) of one
+ * point as the rows of a cell_rule's dT: dT[k na + a] = dN[3 a + k], zero for a >= nn. */
+static inline void fcm__kernel_rows(int nn, const double *dN, double *dT)
+{
+  const int na = fcm__kernel_na(nn);
+  for (int k = 0; k < 3; k++)
+    for (int a = 0; a < na; a++)
+      dT[k * na + a] = a < nn ? dN[3 * a + k] : 0.0;
+}
 
 /* What a kernel computes for one cell. */
 typedef enum kernel_kind {
@@ -45,13 +62,17 @@ typedef struct kernel_data {
 typedef struct scratch {
   double *X;   /* nn x 3 nodal coordinates */
   double *ue;  /* 3nn cell displacement */
-  double *g;   /* nn x 3 physical gradients */
+  double *g;   /* nn x 3 physical gradients (node-major); a point's reference gradients while a
+                * cut cell's rule is evaluated (assemble.c) */
+  double *XT;  /* 3 x na: X by component, zero padded */
+  double *UT;  /* 3 x na: ue by component, zero padded */
+  double *FT;  /* 3 x na: the hyperelastic internal force by component */
   double *H;   /* ld x ld: the blocked products' sums */
-  double *Ke;  /* (3nn)^2 */
+  double *Ke;  /* the element matrix: 9 nn (nn + 1) / 2 upper node blocks (fcm__cell_kernel()) */
   double *fe;  /* 3nn */
   double *Nb;  /* max_cut_points x nn */
-  double *dNb; /* max_cut_points x nn x 3 */
-  double *G;   /* QB x ld: gradients (or shape values) of a chunk of points, zero padded */
+  double *dTb; /* max_cut_points x 3 x na: a cut cell's reference gradients by component */
+  double *G;   /* QB x ld: gradients by component (or shape values) of a chunk of points */
   double *WG;  /* QB x ld: the same times w det J (3 QH x ld for the hyperelastic kernel) */
   double *wd;  /* QB: w det J of the chunk's points */
   double *B;   /* 3 x 3 QH x ld: the hyperelastic tangent's right factors of a chunk */
@@ -65,10 +86,10 @@ typedef struct cell_result {
   int inverted;   /* hyperelastic: authentic points with det F <= 0 */
 } cell_result;
 
-/* Padded row length of the blocked products for nn nodes: 3 roundup(nn, 4) rounded up to 16. */
+/* Padded row length of the blocked products for nn nodes: 3 na rounded up to 16. */
 static inline int fcm__kernel_ld(int nn)
 {
-  return (3 * ((nn + 3) / 4 * 4) + 15) / 16 * 16;
+  return (3 * fcm__kernel_na(nn) + 15) / 16 * 16;
 }
 
 /* Doubles of one thread's scratch for nn nodes and mq cut-cell points; fcm__kernel_scratch_init()
@@ -76,9 +97,19 @@ static inline int fcm__kernel_ld(int nn)
 size_t fcm__kernel_scratch_size(int nn, size_t mq);
 void fcm__kernel_scratch_init(int nn, size_t mq, double *mem, scratch *w);
 
-/* Element matrix w->Ke (3nn x 3nn, row-major) and/or vector w->fe (3nn) of one cell with the
- * nodal coordinates w->X (and displacement w->ue): the kernel of the integrand. fe is zero
- * after a matrix kernel. Built for several instruction sets, selected at run time. */
+/* Element matrix w->Ke and/or vector w->fe (3nn) of one cell with the nodal coordinates w->X
+ * (and displacement w->ue): the kernel of the integrand. The element matrices are symmetric:
+ * w->Ke holds their upper node blocks, block (a, b) for a <= b (row-major 3 x 3, entry [3i + j]
+ * = K_(a,i)(b,j)) at 9 (a nn - a (a - 1) / 2 + b - a), in the order of a, then b
+ * (fcm__kernel_unpack() spreads them into the full matrix). fe is zero after a matrix kernel.
+ * Built for several instruction sets, selected at run time. */
 cell_result fcm__cell_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w);
+
+/* The full element matrix Ke (3nn x 3nn, row-major) from its upper node blocks Kp. */
+void fcm__kernel_unpack(int nn, const double *Kp, double *Ke);
+
+/* Physical gradients g (nn x 3, node-major) at one point from the nodal coordinates X and the
+ * point's rows dT of a cell_rule; returns det J (not positive: g is not written). */
+double fcm__kernel_point_gradients(int nn, const double *X, const double *dT, double *g);
 
 #endif /* FCM_FEM_KERNELS_IMPL_H */
