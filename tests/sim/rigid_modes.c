@@ -261,6 +261,12 @@ static void test_stagnation(fcm_ctx *ctx)
   TEST_OK(ctx, beam_mesh(ctx, FCM_ELEMENT_HEX8, 4, 2.0, &mesh));
   TEST_OK(ctx, fcm_space_create(ctx, mesh, NULL, &space));
   const fcm_material mat = {FCM_MATERIAL_LINEAR, 1e6, 0.3, 0.0}; /* no mass */
+  /* The free beam's K is singular only up to round-off: its rigid-mode eigenvalues are
+   * round-off sized, not zero. MINRES plateaus at the part of b outside the range until it
+   * resolves them and returns a huge iterate the line search refuses; how many iterations that
+   * takes depends on the round-off of the assembled K (beyond 50 for some moduli, within it for
+   * others). A window of 20 closes on the plateau for every modulus tried (3e5 to 2e6). */
+  const int window = 20;
   for (int k = 0; k < 3; k++) {
     fcm_integrator *I = NULL;
     fcm_integrator_options o = fcm_integrator_options_default();
@@ -268,7 +274,7 @@ static void test_stagnation(fcm_ctx *ctx)
     o.linear_solver = k == 0 ? FCM_LINEAR_CG : FCM_LINEAR_MINRES;
     o.preconditioner = FCM_PRECOND_JACOBI;
     o.max_halvings = 1;
-    if (k == 2) o.krylov_stagnation_window = 0;
+    o.krylov_stagnation_window = k == 2 ? 0 : window;
     TEST_OK(ctx, fcm_integrator_create(ctx, space, &mat, &o, &I));
     TEST_OK(ctx, fcm_integrator_add_body_force(I, load_field, NULL, NULL, NULL));
     TEST_OK(ctx, fcm_integrator_setup(I));
