@@ -5,9 +5,9 @@
 #    bitwise reproducible between runs on 2 processes) with a checkpoint every 5, then a copy of its output resumed from
 #    step 5 on 2 processes: the log (all but the wall-time column), the PVD and the frames'
 #    pieces equal the uninterrupted run's byte for byte;
-#  - a checkpoint of the linear driver's older format (.fcmpk, written at step 5 by
-#    petsc_legacy_checkpoint) resumes too: the step-10 state equals the uninterrupted run's to
-#    1e-8 relative;
+#  - checkpoints of the linear driver, of today's format (the serial container) and of its older
+#    one (.fcmpk), written at step 5 by petsc_legacy_checkpoint, resume too: the step-10 state
+#    equals the uninterrupted run's to 1e-8 relative;
 #  - a checkpoint of another scene is refused (exit 2) on every process.
 # Arguments: mpiexec, fcm-sim, petsc_state_diff, petsc_legacy_checkpoint, scene file, work dir.
 set -euo pipefail
@@ -28,13 +28,19 @@ diff <(strip "$work/a/${name}_log.csv") <(strip "$work/b/${name}_log.csv")
 cmp "$work/a/${name}_background.pvd" "$work/b/${name}_background.pvd"
 for f in "$work"/a/${name}_background_000[345]*; do cmp "$f" "$work/b/$(basename "$f")"; done
 "$diff" "$work/a/$ck10" "$work/b/$ck10" 0
-# the older .fcmpk format: the linear driver's state at step 5, resumed to step 10
+# the linear driver's state at step 5 (the older .fcmpk format, then the container), resumed
+# to step 10
 mkdir -p "$work/c"
 (cd "$work/c" && "$mpiexec" -n 2 "$legacy" "${scene%/*}" "$(basename "$scene")" 5 "$work/c/old" keep \
   >/dev/null)
 [ -f "$work/c/old_np2.fcmpk" ]
 "$mpiexec" -n 2 "$sim" "$scene" --backend petsc -o "$work/c" --steps 10 --checkpoint-every 5 -q \
   --resume "$work/c/old_np2.fcmpk" "${ksp[@]}"
+"$diff" "$work/c/$ck10" "$work/a/$ck10" 1e-8
+[ -f "$work/c/old_np2.fcmck" ]
+rm "$work/c/$ck10"
+"$mpiexec" -n 2 "$sim" "$scene" --backend petsc -o "$work/c" --steps 10 --checkpoint-every 5 -q \
+  --resume "$work/c/old_np2.fcmck" "${ksp[@]}"
 "$diff" "$work/c/$ck10" "$work/a/$ck10" 1e-8
 # a checkpoint of another scene is refused (exit 2) on every process
 if "$mpiexec" -n 2 "$sim" "${scene%/*}/cantilever.json" --backend petsc -o "$work/d" -q \

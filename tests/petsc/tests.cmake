@@ -103,9 +103,10 @@ endforeach()
 foreach(np 1 2)
   fcm_add_test(petsc_checkpoint_np${np} tests/petsc/checkpoint.c NP ${np})
 endforeach()
-# the linear driver's older checkpoint format (.fcmpk) loads into the integrator on PETSc and the
-# serial simulation (fcm_simulation_read_checkpoint()): its state bit for bit, the next step
-# equal to the driver's to 1e-8; files of another problem and truncated ones refused
+# the linear driver's checkpoints (the serial container, and the older .fcmpk the test writes)
+# load into the integrator on PETSc, the serial simulation (fcm_simulation_read_checkpoint()) and
+# the driver: its state bit for bit, the next step equal to the driver's to 1e-8; files of
+# another problem, truncated and corrupted ones refused
 foreach(np 1 2)
   fcm_add_test(petsc_legacy_checkpoint_np${np} tests/petsc/legacy_checkpoint.c NP ${np}
                ARGS ${PROJECT_SOURCE_DIR}/apps/scenes vibrating_beam.json 5
@@ -113,7 +114,7 @@ foreach(np 1 2)
 endforeach()
 if(FCM_BUILD_APPS)
   # fcm-sim --backend petsc --checkpoint-every / --resume on a linear scene: byte for byte on 2
-  # processes; a .fcmpk of the older format resumes to 1e-8
+  # processes; the linear driver's checkpoints (the container and the older .fcmpk) resume to 1e-8
   add_test(NAME petsc_app_sim_resume
            COMMAND bash ${PROJECT_SOURCE_DIR}/tests/petsc/resume.sh ${MPIEXEC_EXECUTABLE}
                    $<TARGET_FILE:fcm-sim> $<TARGET_FILE:petsc_state_diff>

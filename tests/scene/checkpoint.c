@@ -6,9 +6,14 @@
  * simulation and running on gives bit for bit the state, time and per-step log (but wall
  * times) of the uninterrupted run. Error paths: restoring into a stepped simulation, a
  * missing file, a directory, a checkpoint beyond the steps to take, an unwritable path (nothing
- * left behind), a simulation of another scene; allocation failures while restoring leave the
- * simulation usable and leak nothing. */
+ * left behind), a simulation of another scene, a corrupted and a truncated file (format errors
+ * naming the file); allocation failures while restoring leave the simulation usable and leak
+ * nothing. A checkpoint without a scene (the PETSc linear driver's: the container's source word
+ * 0 with DOF and element counts, kind, dt, step count and state, written here through io's
+ * container) restores the state bit for bit and is refused when its dt differs. */
 #include "scene_util.h"
+
+#include "io/io_impl.h"
 
 #include <sys/stat.h>
 
@@ -204,6 +209,82 @@ done:
   remove(ck);
 }
 
+/* Copies of the checkpoint ck in dir/bad.fcmck: one byte flipped, the last byte missing. */
+static void check_damaged(fcm_ctx *ctx, fcm_scene *scene, const char *ck, char *path,
+                          const char *dir)
+{
+  FILE *f = fopen(ck, "rb");
+  static unsigned char b[1 << 20];
+  size_t n = f ? fread(b, 1, sizeof b, f) : 0;
+  if (f) fclose(f);
+  TEST_TRUE(n > 64 && n < sizeof b);
+  snprintf(path, 256, "%s/bad.fcmck", dir);
+  for (int k = 0; k < 2 && n > 64; k++) {
+    if (k == 0) b[n / 2] ^= 1;
+    f = fopen(path, "wb");
+    TEST_TRUE(f && fwrite(b, 1, n - (size_t)k, f) == n - (size_t)k);
+    if (f) fclose(f);
+    if (k == 0) b[n / 2] ^= 1;
+    fcm_simulation *sim = NULL;
+    TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
+    TEST_ERR(ctx, fcm_simulation_read_checkpoint(sim, path), FCM_ERR_FORMAT,
+             "bad.fcmck: checksum mismatch");
+    TEST_TRUE(fcm_simulation_step_count(sim) == 0);
+    fcm_simulation_destroy(&sim);
+  }
+  remove(path);
+}
+
+/* A checkpoint without a scene made from the restored state of ck (dt scaled by dt_factor). */
+static void write_linear(fcm_ctx *ctx, const fcm_scene *scene, fcm_simulation *src,
+                         const char *path, double dt_factor)
+{
+  const fcm_scene_time *tm = fcm_scene_get_time(scene);
+  const fcm_integrator *in = fcm_simulation_integrator(src);
+  const fcm__ckpt_linear h = {(long long)fcm_integrator_num_dofs(in),
+                              (long long)fcm_space_num_elements(fcm_simulation_space(src)),
+                              fcm_simulation_step_count(src),
+                              (long long)tm->integrator,
+                              fcm_integrator_time(in),
+                              tm->dt * dt_factor};
+  fcm__ckpt_writer w;
+  TEST_OK(ctx, fcm__ckpt_open(ctx, path, FCM__CKPT_MAGIC, FCM__CKPT_LINEAR_VERSION, &w));
+  TEST_OK(ctx, fcm__ckpt_put_linear(&w, &h, fcm_integrator_displacement(in),
+                                    fcm_integrator_velocity(in)));
+  TEST_OK(ctx, fcm__ckpt_commit(&w));
+}
+
+static void check_linear(fcm_ctx *ctx, fcm_scene *scene, const char *ck, char *path,
+                         const char *dir)
+{
+  fcm_simulation *src = NULL, *sim = NULL;
+  snprintf(path, 256, "%s/linear.fcmck", dir);
+  TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &src));
+  TEST_OK(ctx, fcm_simulation_read_checkpoint(src, ck));
+  if (!src) return;
+  write_linear(ctx, scene, src, path, 1.0);
+  const fcm_integrator *a = fcm_simulation_integrator(src);
+  const fcm_index n = fcm_integrator_num_dofs(a);
+  TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
+  TEST_OK(ctx, fcm_simulation_read_checkpoint(sim, path));
+  const fcm_integrator *b = fcm_simulation_integrator(sim);
+  TEST_TRUE(fcm_integrator_num_dofs(b) == n && n > 0);
+  TEST_TRUE(fcm_simulation_step_count(sim) == fcm_simulation_step_count(src));
+  TEST_TRUE(fcm_integrator_time(b) == fcm_integrator_time(a));
+  TEST_TRUE(!memcmp(fcm_integrator_displacement(b), fcm_integrator_displacement(a),
+                    sizeof(double) * (size_t)n));
+  TEST_TRUE(
+      !memcmp(fcm_integrator_velocity(b), fcm_integrator_velocity(a), sizeof(double) * (size_t)n));
+  fcm_simulation_destroy(&sim);
+  /* another dt: another problem */
+  write_linear(ctx, scene, src, path, 2.0);
+  TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
+  TEST_ERR(ctx, fcm_simulation_read_checkpoint(sim, path), FCM_ERR_ARG, "another problem");
+  fcm_simulation_destroy(&sim);
+  fcm_simulation_destroy(&src);
+  remove(path);
+}
+
 int main(void)
 {
   fcm_ctx *ctx = NULL;
@@ -246,6 +327,8 @@ int main(void)
     TEST_ERR(ctx, fcm_simulation_read_checkpoint(sim, ck), FCM_ERR_ARG, "beyond the 3 steps");
     TEST_TRUE(fcm_simulation_step_count(sim) == 0);
     fcm_simulation_destroy(&sim);
+    check_damaged(ctx, scene, ck, path, dir);
+    check_linear(ctx, scene, ck, path, dir);
     /* another scene */
     TEST_OK(ctx, fcm_simulation_create(ctx, other, NULL, &sim2));
     TEST_ERR(ctx, fcm_simulation_read_checkpoint(sim2, ck), FCM_ERR_ARG, "different scene");

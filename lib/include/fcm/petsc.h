@@ -207,17 +207,21 @@ FCM_API fcm_status fcm_petsc_problem_write_frame(fcm_petsc_problem *problem, con
 
 /** Save the run: process 0 writes the gathered displacement and velocity (the space's DOF
  * numbering), the time, the step count and a fingerprint (DOFs, elements, kind, dt) to `path`
- * atomically (a file of its own format, ".fcmpk"; fcm_simulation_read_checkpoint() also reads
- * it into the simulation of the same scene, serial or distributed, and converts it).
- * Collective. @return FCM_OK, FCM_ERR_ARG, FCM_ERR_IO, FCM_ERR_ALLOC. */
+ * atomically, in the checkpoint container of the scene runs (fcm_simulation_write_checkpoint():
+ * magic, version, byte-order mark, checksum) with no scene as its source;
+ * fcm_simulation_read_checkpoint() also reads it into the simulation of the same scene, serial
+ * or distributed, and converts it. Collective.
+ * @return FCM_OK, FCM_ERR_ARG, FCM_ERR_IO, FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_petsc_problem_write_checkpoint(fcm_petsc_problem *problem, const char *path);
 
 /** Continue a run: every process reads `path` (a shared file system) into a problem set up from
  * the same inputs; any process count reads it. Resumed on the same process count the steps are
  * bit for bit those of the uninterrupted run; on another count they agree to the solver's
- * tolerance (the partition, hence the rounding, differs). Collective.
- * @return FCM_OK; FCM_ERR_IO (cannot open); FCM_ERR_FORMAT (not a checkpoint, truncated);
- * FCM_ERR_ARG (before setup, another problem: the fingerprints named). */
+ * tolerance (the partition, hence the rounding, differs). Reads the files of
+ * fcm_petsc_problem_write_checkpoint() and those of its older format (".fcmpk"). Collective.
+ * @return FCM_OK; FCM_ERR_IO (cannot open); FCM_ERR_FORMAT (not a checkpoint, truncated,
+ * corrupted: the checksum); FCM_ERR_ARG (before setup, another problem: the fingerprints named;
+ * a scene run's checkpoint). */
 FCM_API fcm_status fcm_petsc_problem_read_checkpoint(fcm_petsc_problem *problem, const char *path);
 
 /** Steps taken (restored by fcm_petsc_problem_read_checkpoint()). */

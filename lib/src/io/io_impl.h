@@ -6,6 +6,7 @@
 #include "core/core_impl.h"
 #include "fcm/io.h"
 
+#include <stdint.h>
 #include <stdio.h>
 
 /* Simulated failures for tests of the error paths; library callers pass NULL. */
@@ -78,5 +79,101 @@ fcm_status fcm__vtu_write_fault(fcm_vtu *vtu, const char *path, fcm_vtu_info *in
 /* fcm_pvd_add() with a fault plan (tests only). */
 fcm_status fcm__pvd_add_fault(fcm_pvd *pvd, double time, const char *file,
                               const fcm__io_fault *fault);
+
+/* ---- checkpoint container (checkpoint_file.c) ----
+ *
+ * 8 bytes magic, u64 version, u64 byte-order mark, the writer's payload of typed values, u64
+ * FNV-1a 64 checksum of every byte before it (host byte order). The writer goes through a
+ * durable atomic file: a failed or aborted write leaves the target untouched. */
+
+#define FCM__FNV_OFFSET 0xcbf29ce484222325ull
+
+/* The magic of fcm's checkpoints (8 bytes with the NUL). */
+#define FCM__CKPT_MAGIC "FCMCKPT"
+
+/* FNV-1a 64 of n bytes, continuing h (start with FCM__FNV_OFFSET). */
+uint64_t fcm__io_fnv(uint64_t h, const void *data, size_t n);
+
+typedef struct fcm__ckpt_writer {
+  fcm_ctx *ctx;
+  fcm__atomic_file af;
+  uint64_t hash; /* of every byte written so far */
+} fcm__ckpt_writer;
+
+/* Open the temporary beside `path` and write the header. On failure nothing is left behind. */
+fcm_status fcm__ckpt_open(fcm_ctx *ctx, const char *path, const char magic[8], uint64_t version,
+                          fcm__ckpt_writer *w);
+
+/* Payload values: raw bytes, integers as int64/uint64, doubles as binary64. */
+fcm_status fcm__ckpt_put(fcm__ckpt_writer *w, const void *data, size_t n);
+fcm_status fcm__ckpt_put_u64(fcm__ckpt_writer *w, uint64_t x);
+fcm_status fcm__ckpt_put_i64(fcm__ckpt_writer *w, long long x);
+fcm_status fcm__ckpt_put_f64(fcm__ckpt_writer *w, double x);
+fcm_status fcm__ckpt_put_f64s(fcm__ckpt_writer *w, const double *x, size_t n);
+
+/* Append the checksum and replace the target; on failure the temporary is removed. */
+fcm_status fcm__ckpt_commit(fcm__ckpt_writer *w);
+
+/* Drop an unfinished file (after a failed put); harmless after commit or a failed open. */
+void fcm__ckpt_abort(fcm__ckpt_writer *w);
+
+typedef struct fcm__ckpt_reader {
+  fcm_ctx *ctx;
+  const char *path;
+  unsigned char *data;
+  size_t size;       /* the payload's end (the checksum excluded) */
+  size_t pos;        /* the next value */
+  uint64_t version;  /* the file's (0 for the legacy linear-driver file) */
+  int legacy_linear; /* the linear driver's older ".fcmpk" (no header, no checksum) */
+} fcm__ckpt_reader;
+
+/* Read the whole file and check it: the magic, the byte-order mark, the version in
+ * [1, max_version] and the checksum; the reader then stands at the payload. A file of the
+ * linear driver's older format ("fcm-petsc-ck-1") is accepted with legacy_linear set and the
+ * reader after its magic line (read it with fcm__ckpt_get_linear()). Errors name the file and
+ * what is wrong: FCM_ERR_IO (cannot read), FCM_ERR_FORMAT (not a checkpoint, other byte order,
+ * unknown version, truncated or corrupted), FCM_ERR_ALLOC. Release with
+ * fcm__ckpt_read_close() (also after a failure). */
+fcm_status fcm__ckpt_read_open(fcm_ctx *ctx, const char *path, const char magic[8],
+                               uint64_t max_version, fcm__ckpt_reader *r);
+void fcm__ckpt_read_close(fcm__ckpt_reader *r);
+
+/* The next n bytes (FCM_ERR_FORMAT naming `what` when the file ends first). */
+fcm_status fcm__ckpt_get(fcm__ckpt_reader *r, void *out, size_t n, const char *what);
+fcm_status fcm__ckpt_get_u64(fcm__ckpt_reader *r, uint64_t *x, const char *what);
+/* An integer in [lo, hi] (FCM_ERR_FORMAT naming `what`, the value and the range). */
+fcm_status fcm__ckpt_get_i64(fcm__ckpt_reader *r, long long *x, long long lo, long long hi,
+                             const char *what);
+fcm_status fcm__ckpt_get_f64(fcm__ckpt_reader *r, double *x, const char *what);
+
+/* `count` records of `each` bytes fit in what is left (checked before allocating for them). */
+fcm_status fcm__ckpt_need(fcm__ckpt_reader *r, long long count, size_t each, const char *what);
+
+/* Nothing is left after the payload (FCM_ERR_FORMAT: trailing bytes). */
+fcm_status fcm__ckpt_read_end(fcm__ckpt_reader *r);
+
+/* The payload of a checkpoint without a scene (the PETSc linear driver): the source word
+ * FCM__CKPT_SOURCE_LINEAR where a scene run writes its scene's fingerprint (never 0), then
+ * i64 num_dofs, elements, steps, integrator kind; f64 time, dt; num_dofs x f64 displacement,
+ * num_dofs x f64 velocity (the space's DOF numbering). The older ".fcmpk" holds the same
+ * values after its magic line. */
+#define FCM__CKPT_SOURCE_LINEAR 0ull
+
+/* The container version the linear driver writes (the scene reader reads it from version 4). */
+#define FCM__CKPT_LINEAR_VERSION 4u
+
+typedef struct fcm__ckpt_linear {
+  long long num_dofs, elements, steps, kind;
+  double time, dt;
+} fcm__ckpt_linear;
+
+/* The source word, the counts and the state. */
+fcm_status fcm__ckpt_put_linear(fcm__ckpt_writer *w, const fcm__ckpt_linear *h, const double *u,
+                                const double *v);
+
+/* The counts after the source word (or the legacy magic line), checked in range, and that the
+ * state's 2 num_dofs doubles follow (read them with fcm__ckpt_get(), then
+ * fcm__ckpt_read_end()). */
+fcm_status fcm__ckpt_get_linear(fcm__ckpt_reader *r, fcm__ckpt_linear *h);
 
 #endif /* FCM_IO_IMPL_H */

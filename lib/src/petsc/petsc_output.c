@@ -1,6 +1,8 @@
 /* petsc module: the linear driver's output: parallel VTU frames (one piece per process) and
- * its checkpoints (format "fcm-petsc-ck-1"). */
+ * its checkpoints (io's checkpoint container; the older "fcm-petsc-ck-1" files still load). */
 #include "petsc/petsc_impl.h"
+
+#include "io/io_impl.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -123,21 +125,21 @@ cleanup:
 
 /* ---------------------------------------------------------------- checkpoints */
 
-/* File layout (host byte order, written by process 0): the magic line, then int64 n, elements,
- * steps, kind; double t, dt; n doubles u, n doubles v (the space's DOF numbering, so any
- * process count reads it). */
-static const char ckpt_magic[16] = "fcm-petsc-ck-1\n";
+/* The checkpoint container of io (io_impl.h) with the "no scene" source (fcm__ckpt_linear),
+ * written by process 0: the space's DOF numbering, so any process count reads it. */
+static const char ckpt_magic[8] = FCM__CKPT_MAGIC;
 
 fcm_status fcm_petsc_problem_write_checkpoint(fcm_petsc_problem *P, const char *path)
 {
   fcm_status st = FCM_OK;
   double *u = NULL, *v = NULL;
-  fcm_atomic_file *af = NULL;
+  fcm__ckpt_writer w;
+  memset(&w, 0, sizeof w);
   FCM_CHECK(P, NULL, FCM_ERR_ARG, "petsc: NULL problem");
   fcm_ctx *ctx = P->ctx;
-  st = path ? FCM_OK
-            : fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
-                         "petsc: checkpoint: NULL path");
+  st = path && path[0] ? FCM_OK
+                       : fcm__error(ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                                    "petsc: checkpoint: NULL or empty path");
   if (st == FCM_OK) { /* the state is gathered on process 0 only (O(n) there) */
     const size_t len = P->rank == 0 ? (size_t)P->n + 1 : 1;
     u = fcm__calloc(ctx, len, sizeof *u);
@@ -148,28 +150,16 @@ fcm_status fcm_petsc_problem_write_checkpoint(fcm_petsc_problem *P, const char *
   FCM_TRY(ctx, fcm__petsc_gather(P, P->u, u, 1));
   FCM_TRY(ctx, fcm__petsc_gather(P, P->v, v, 1));
   if (P->rank == 0) {
-    st = fcm_atomic_file_open(ctx, path, &af);
-    if (st == FCM_OK) {
-      FILE *f = fcm_atomic_file_stream(af);
-      const int64_t head[4] = {(int64_t)P->n, (int64_t)P->space->num_elems, (int64_t)P->steps,
-                               (int64_t)P->opts.kind};
-      const double times[2] = {P->t, P->opts.dt};
-      int ok = fwrite(ckpt_magic, 1, sizeof ckpt_magic, f) == sizeof ckpt_magic &&
-               fwrite(head, sizeof head, 1, f) == 1 && fwrite(times, sizeof times, 1, f) == 1 &&
-               fwrite(u, sizeof *u, (size_t)P->n, f) == (size_t)P->n &&
-               fwrite(v, sizeof *v, (size_t)P->n, f) == (size_t)P->n;
-      if (!ok) {
-        fcm_atomic_file_abort(&af);
-        st = fcm__error(ctx, FCM_ERR_IO, __FILE__, __LINE__, __func__,
-                        "petsc: checkpoint %s: write failed", path);
-      } else {
-        st = fcm_atomic_file_commit(&af);
-      }
-    }
+    const fcm__ckpt_linear h = {
+        (long long)P->n, (long long)P->space->num_elems, P->steps, (long long)P->opts.kind, P->t,
+        P->opts.dt};
+    st = fcm__ckpt_open(ctx, path, ckpt_magic, FCM__CKPT_LINEAR_VERSION, &w);
+    if (st == FCM_OK) st = fcm__ckpt_put_linear(&w, &h, u, v);
+    if (st == FCM_OK) st = fcm__ckpt_commit(&w);
   }
   FCM_TRY(ctx, fcm__petsc_agree(ctx, P->comm, st));
 cleanup:
-  fcm_atomic_file_abort(&af);
+  fcm__ckpt_abort(&w);
   if (P) {
     fcm__free(P->ctx, u);
     fcm__free(P->ctx, v);
@@ -177,39 +167,39 @@ cleanup:
   return st;
 }
 
-/* Read and check a checkpoint into u, v (n each), *t and *steps (every process reads). */
+/* Read and check a checkpoint (the container or the older ".fcmpk") into u, v (n each), *t
+ * and *steps (every process reads). */
 static fcm_status read_ckpt(fcm_petsc_problem *P, const char *path, double *u, double *v, double *t,
                             long long *steps)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P->ctx;
-  FILE *f = NULL;
-  char magic[sizeof ckpt_magic];
-  int64_t head[4];
-  double times[2];
-  FCM_CHECK(path, ctx, FCM_ERR_ARG, "petsc: checkpoint: NULL path");
-  f = fopen(path, "rb");
-  FCM_CHECK(f, ctx, FCM_ERR_IO, "petsc: checkpoint %s: cannot open it", path);
-  FCM_CHECK(fread(magic, 1, sizeof magic, f) == sizeof magic &&
-                memcmp(magic, ckpt_magic, sizeof magic) == 0,
-            ctx, FCM_ERR_FORMAT, "petsc: checkpoint %s: not a PETSc-backend checkpoint of fcm",
+  fcm__ckpt_reader r;
+  fcm__ckpt_linear h;
+  uint64_t source = FCM__CKPT_SOURCE_LINEAR;
+  memset(&r, 0, sizeof r);
+  FCM_CHECK(path && path[0], ctx, FCM_ERR_ARG, "petsc: checkpoint: NULL or empty path");
+  FCM_TRY(ctx, fcm__ckpt_read_open(ctx, path, ckpt_magic, FCM__CKPT_LINEAR_VERSION, &r));
+  if (!r.legacy_linear) FCM_TRY(ctx, fcm__ckpt_get_u64(&r, &source, "the source"));
+  FCM_CHECK(source == FCM__CKPT_SOURCE_LINEAR, ctx, FCM_ERR_ARG,
+            "petsc: checkpoint %s was written by a scene run, not by the linear driver "
+            "(fcm_simulation_read_checkpoint() reads it)",
             path);
-  FCM_CHECK(fread(head, sizeof head, 1, f) == 1 && fread(times, sizeof times, 1, f) == 1, ctx,
-            FCM_ERR_FORMAT, "petsc: checkpoint %s: truncated header", path);
-  FCM_CHECK(head[0] == (int64_t)P->n && head[1] == (int64_t)P->space->num_elems &&
-                head[3] == (int64_t)P->opts.kind && times[1] == P->opts.dt && head[2] >= 0,
+  FCM_TRY(ctx, fcm__ckpt_get_linear(&r, &h));
+  FCM_CHECK(h.num_dofs == (long long)P->n && h.elements == (long long)P->space->num_elems &&
+                h.kind == (long long)P->opts.kind && h.dt == P->opts.dt,
             ctx, FCM_ERR_ARG,
             "petsc: checkpoint %s is of another problem: %lld DOFs, %lld elements, kind %lld, "
             "dt %g (this one: %lld, %lld, %d, %g)",
-            path, (long long)head[0], (long long)head[1], (long long)head[3], times[1],
-            (long long)P->n, (long long)P->space->num_elems, (int)P->opts.kind, P->opts.dt);
-  FCM_CHECK(fread(u, sizeof *u, (size_t)P->n, f) == (size_t)P->n &&
-                fread(v, sizeof *v, (size_t)P->n, f) == (size_t)P->n && fgetc(f) == EOF,
-            ctx, FCM_ERR_FORMAT, "petsc: checkpoint %s: truncated or with trailing data", path);
-  *t = times[0];
-  *steps = (long long)head[2];
+            path, h.num_dofs, h.elements, h.kind, h.dt, (long long)P->n,
+            (long long)P->space->num_elems, (int)P->opts.kind, P->opts.dt);
+  FCM_TRY(ctx, fcm__ckpt_get(&r, u, sizeof *u * (size_t)P->n, "the displacement"));
+  FCM_TRY(ctx, fcm__ckpt_get(&r, v, sizeof *v * (size_t)P->n, "the velocity"));
+  FCM_TRY(ctx, fcm__ckpt_read_end(&r));
+  *t = h.time;
+  *steps = h.steps;
 cleanup:
-  if (f) fclose(f);
+  fcm__ckpt_read_close(&r);
   return st;
 }
 
