@@ -1,8 +1,9 @@
 /* petsc_state_diff A B RTOL: the displacement and velocity of two checkpoints agree to RTOL
  * relative (||u_A - u_B|| <= RTOL ||u_B||, the same for v; RTOL 0: bit for bit). Either file
- * may be a checkpoint of fcm-sim (.fcmck: "FCMCKPT", num_dofs at byte 32, u and v the last 2n
- * doubles before the 8-byte checksum) or of the PETSc backend's linear driver (.fcmpk:
- * "fcm-petsc-ck-1", n at byte 16, u and v from byte 64); both hold the state in the space's
+ * may be a checkpoint container (io/checkpoint_file.c: "FCMCKPT", num_dofs at byte 32, u and v
+ * the last 2n doubles before the 8-byte checksum) of fcm-sim or of the PETSc backend's linear
+ * driver, or an older linear driver's .fcmpk ("fcm-petsc-ck-1", n at byte 16, u and v from byte
+ * 64); all hold the state in the space's
  * DOF numbering, which is the same for every backend and process count. Used by the shell
  * tests of tests/petsc; prints the norms, exits 1 when they differ by more.
  * petsc_state_diff --vtu A.vtu B.vtu RTOL: the same for the background frames of fcm-sim
