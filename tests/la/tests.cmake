@@ -18,3 +18,6 @@ fcm_add_test(la_blas_info tests/la/blas_info.c)
 fcm_add_test(la_blas_info_prescott tests/la/blas_info.c ARGS prescott)
 set_tests_properties(la_blas_info_prescott PROPERTIES ENVIRONMENT
                      "${FCM_TEST_ENV};OPENBLAS_CORETYPE=Prescott")
+# Large matrix values on 2 MiB boundaries (huge pages), small ones 64-byte aligned; their
+# allocation failures.
+fcm_add_test(la_csr_large tests/la/csr_large.c)

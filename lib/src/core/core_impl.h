@@ -47,6 +47,16 @@ void *fcm__malloc(fcm_ctx *ctx, size_t n, size_t size);
 /* Release memory from fcm__calloc or fcm__malloc; accepts NULL. */
 void fcm__free(fcm_ctx *ctx, void *ptr);
 
+/* As fcm__calloc for large arrays that are written all over (assembled matrix values): from
+ * 8 MiB on, the array starts on a 2 MiB boundary and, on Linux, is advised to transparent huge
+ * pages before its zero fill touches it; smaller ones are 64-byte aligned. Counted and failing
+ * like fcm__calloc (one allocation through ctx's allocator, a little larger than asked).
+ * Released with fcm__free_large only. */
+void *fcm__calloc_large(fcm_ctx *ctx, size_t n, size_t size);
+
+/* Release memory from fcm__calloc_large; accepts NULL. */
+void fcm__free_large(fcm_ctx *ctx, void *ptr);
+
 /* Grow or shrink an fcm__calloc array, preserving min(old_n, new_n) elements and
  * zero-filling the rest. On failure *ptr is unchanged. */
 fcm_status fcm__resize(fcm_ctx *ctx, void **ptr, size_t old_n, size_t new_n, size_t size);

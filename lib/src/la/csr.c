@@ -114,7 +114,7 @@ fcm_status fcm_csr_create(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols, const 
   A->owned = 1;
   FCM_ALLOC(ctx, nrows + 1, A->own_row_ptr);
   FCM_ALLOC(ctx, A->nnz, A->own_col_idx);
-  FCM_ALLOC(ctx, A->nnz, A->values);
+  FCM__ALLOC_WITH(fcm__calloc_large, ctx, A->nnz, A->values);
   memcpy(A->own_row_ptr, row_ptr, (size_t)(nrows + 1) * sizeof *row_ptr);
   if (A->nnz) memcpy(A->own_col_idx, col_idx, (size_t)A->nnz * sizeof *col_idx);
   A->row_ptr = A->own_row_ptr;
@@ -140,7 +140,7 @@ fcm_status fcm__csr_share_pattern(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols
             "csr_share_pattern: col_idx is NULL with nnz = %lld", (long long)row_ptr[nrows]);
   FCM_TRY(ctx, new_handle(ctx, nrows, ncols, row_ptr[nrows], kind, &A));
   A->owned = 1; /* the values; the pattern is borrowed (own_row_ptr / own_col_idx NULL) */
-  FCM_ALLOC(ctx, A->nnz, A->values);
+  FCM__ALLOC_WITH(fcm__calloc_large, ctx, A->nnz, A->values);
   A->row_ptr = row_ptr;
   A->col_idx = col_idx;
   *out = A;
@@ -263,7 +263,7 @@ void fcm_csr_destroy(fcm_csr **A)
   fcm_ctx *ctx = (*A)->ctx;
   fcm__free(ctx, (*A)->own_row_ptr);
   fcm__free(ctx, (*A)->own_col_idx);
-  if ((*A)->owned) fcm__free(ctx, (*A)->values);
+  if ((*A)->owned) fcm__free_large(ctx, (*A)->values);
   fcm__free(ctx, *A);
   *A = NULL;
 }
