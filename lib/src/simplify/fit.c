@@ -6,6 +6,7 @@
  * SVD, P = U S V^T, and one LP finds a vertex of {w >= 0 : V_r^T w = S_r^-1 U_r^T b}, which has
  * at most r <= M positive entries; its weights are verified (and re-fitted on their support by
  * least squares when the vertex misses the tolerance) against P w = b. */
+#include "core/multiversion.h"
 #include "la/la_impl.h"
 #include "simplify/simplify_impl.h"
 
@@ -160,7 +161,7 @@ static void nnls_add(nnls_qr *s, int t, const double *a, double anorm, int *adde
 }
 
 /* Remove the passive column at position p (and its value in xp) and restore R's triangle. */
-static void nnls_remove(nnls_qr *s, int p, double *xp)
+FCM_MULTIVERSION_CLONES static void nnls_remove(nnls_qr *s, int p, double *xp)
 {
   const int M = s->M;
   double *R = s->R, *Q = s->Q;
@@ -171,35 +172,55 @@ static void nnls_remove(nnls_qr *s, int p, double *xp)
   }
   s->np--;
   s->flops += 6.0 * (s->np - p) * (s->np - p + 2 * M) / 2.0;
-  for (int j = p; j < s->np; j++) { /* Givens on rows j, j + 1: R is Hessenberg from p on */
-    const double a = R[j + (size_t)j * M], b = R[j + 1 + (size_t)j * M], h = hypot(a, b);
-    if (h == 0.0) continue;
-    const double c = a / h, sn = b / h;
-    for (int l = j; l < s->np; l++) {
-      double *r0 = R + j + (size_t)l * M, *r1 = r0 + 1;
-      const double t0 = *r0, t1 = *r1;
-      *r0 = c * t0 + sn * t1, *r1 = c * t1 - sn * t0;
+  /* Givens rotations G_j on rows j, j + 1 (j = p..np - 1: R is Hessenberg from p on), applied
+   * to R column by column (contiguous), each column getting G_p.. in turn; their cosines and
+   * sines kept in v for Q^T b and Q. R's entries are those of the candidates' moments, O(1)
+   * against the range of double: no hypot() needed. */
+  double *cs = s->v, *sn = s->v + M;
+  for (int l = p; l < s->np; l++) {
+    double *rl = R + (size_t)l * M;
+    for (int j = p; j < l; j++) {
+      const double t0 = rl[j], t1 = rl[j + 1];
+      rl[j] = cs[j] * t0 + sn[j] * t1, rl[j + 1] = cs[j] * t1 - sn[j] * t0;
     }
-    R[j + 1 + (size_t)j * M] = 0.0;
-    const double t0 = s->qtb[j], t1 = s->qtb[j + 1];
-    s->qtb[j] = c * t0 + sn * t1, s->qtb[j + 1] = c * t1 - sn * t0;
+    const double a = rl[l], b = rl[l + 1], h = sqrt(a * a + b * b);
+    cs[l] = h > 0.0 ? a / h : 1.0, sn[l] = h > 0.0 ? b / h : 0.0;
+    rl[l] = cs[l] * a + sn[l] * b, rl[l + 1] = 0.0;
+  }
+  for (int j = p; j < s->np; j++) {
+    const double c = cs[j], sj = sn[j], t0 = s->qtb[j], t1 = s->qtb[j + 1];
+    s->qtb[j] = c * t0 + sj * t1, s->qtb[j + 1] = c * t1 - sj * t0;
     double *q0 = Q + (size_t)j * M, *q1 = q0 + M;
     for (int i = 0; i < M; i++) {
       const double u0 = q0[i], u1 = q1[i];
-      q0[i] = c * u0 + sn * u1, q1[i] = c * u1 - sn * u0;
+      q0[i] = c * u0 + sj * u1, q1[i] = c * u1 - sj * u0;
     }
   }
 }
 
 /* z = R^-1 (Q^T b) on the passive set (back substitution). */
-static void nnls_solve(nnls_qr *s, double *z)
+FCM_MULTIVERSION_CLONES static void nnls_solve(nnls_qr *s, double *z)
 {
   const int np = s->np, M = s->M;
   s->flops += (double)np * np;
   memcpy(z, s->qtb, (size_t)np * sizeof *z);
-  /* by columns of R (contiguous): at these sizes faster than a BLAS call */
-  for (int j = np - 1; j >= 0; j--) {
-    const double *restrict rj = s->R + (size_t)j * (size_t)M;
+  /* by blocks of 4 columns of R (contiguous), z read and written once per block: at these
+   * sizes faster than a BLAS call */
+  const double *R = s->R;
+  int j = np - 1;
+  for (; j >= 3; j -= 4) {
+    const double *restrict r0 = R + (size_t)(j - 3) * M, *restrict r1 = r0 + M,
+                           *restrict r2 = r1 + M, *restrict r3 = r2 + M;
+    const double z3 = z[j] / r3[j];
+    const double z2 = (z[j - 1] - z3 * r3[j - 1]) / r2[j - 1];
+    const double z1 = (z[j - 2] - z3 * r3[j - 2] - z2 * r2[j - 2]) / r1[j - 2];
+    const double z0 = (z[j - 3] - z3 * r3[j - 3] - z2 * r2[j - 3] - z1 * r1[j - 3]) / r0[j - 3];
+    z[j] = z3, z[j - 1] = z2, z[j - 2] = z1, z[j - 3] = z0;
+    for (int i = 0; i < j - 3; i++)
+      z[i] -= z3 * r3[i] + z2 * r2[i] + z1 * r1[i] + z0 * r0[i];
+  }
+  for (; j >= 0; j--) {
+    const double *restrict rj = R + (size_t)j * (size_t)M;
     const double zj = z[j] / rj[j];
     z[j] = zj;
     for (int i = 0; i < j; i++)
@@ -209,8 +230,9 @@ static void nnls_solve(nnls_qr *s, double *z)
 
 /* r = b - A x for x = xp on the passive set, from A (exact) or from the factorization; its
  * largest entry (returned) and 2-norm (*rn). */
-static double nnls_residual(nnls_qr *s, const double *A, const double *b, const double *xp,
-                            int exact, double *r, double *rn)
+FCM_MULTIVERSION_CLONES static double nnls_residual(nnls_qr *s, const double *A, const double *b,
+                                                    const double *xp, int exact, double *r,
+                                                    double *rn)
 {
   const int M = s->M;
   s->flops += 2.0 * M * (exact ? s->np : M - s->np) + 3.0 * M;
@@ -235,8 +257,9 @@ static double nnls_residual(nnls_qr *s, const double *A, const double *b, const 
  * NNLS_BATCH_TAU of the steepest's and of cosine below NNLS_BATCH_DELTA with the columns added in
  * this iteration (deviation maximization); at most 4 NNLS_BATCH tried (a selection sort each).
  * order: k ints of scratch. */
-static void nnls_more(nnls_qr *s, const double *A, const double *norm, const double *inv,
-                      const double *g, int it, int *seen, const int *pas, int *order)
+FCM_MULTIVERSION_CLONES static void nnls_more(nnls_qr *s, const double *A, const double *norm,
+                                              const double *inv, const double *g, int it, int *seen,
+                                              const int *pas, int *order)
 {
   const int M = s->M, first = s->pos[s->np - 1];
   const double floor = NNLS_BATCH_TAU * g[first] * inv[first];
