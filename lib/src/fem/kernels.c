@@ -16,17 +16,10 @@
  * instruction sets at round-off, but on one machine they are the same for every thread count. */
 #include "fem/kernels_impl.h"
 
+#include "core/multiversion.h"
+
 #include <math.h>
 #include <string.h>
-
-#if defined(FCM_MULTIVERSION) && defined(__x86_64__) && defined(__GNUC__) &&                       \
-    !defined(__clang__) && __GNUC__ >= 11 && defined(__GLIBC__)
-#define FCM_KERNEL_CLONES                                                                          \
-  __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#define FCM_KERNEL_CLONES_ON
-#else
-#define FCM_KERNEL_CLONES
-#endif
 
 /* Helpers are inlined into each clone, so they get its instruction set. */
 #if defined(__GNUC__) || defined(__clang__)
@@ -149,7 +142,7 @@ FCM_KERNEL_INLINE void micro_4x16(int nk, const double *A, int lda, const double
 /* The register block's width for the running code: 16 with AVX-512 (32 vector registers), 8
  * with AVX2 (16 of 4 doubles), else 4 (16 of 2 doubles); with the clones, the CPU's level is
  * the clone's. */
-#if defined(FCM_KERNEL_CLONES_ON)
+#if FCM_MULTIVERSION_ON
 #define FCM_KERNEL_NB()                                                                            \
   (__builtin_cpu_supports("x86-64-v4") ? 16 : __builtin_cpu_supports("x86-64-v3") ? 8 : 4)
 #elif defined(__AVX512F__)
@@ -335,7 +328,7 @@ FCM_KERNEL_INLINE int chunk_gradients(const cell_rule *r, int na, int q0, int nc
  * and column (i, a) at i na + a; the upper triangle, row stride ld) the isotropic element
  * matrix is K_(a,i)(b,j) = lambda h_ij + mu h_ji + mu delta_ij sum_k h_kk, h_ij = H_(i,a)(j,b);
  * for a <= b every h_ij is in the upper triangle as H_(i,a)(j,b) (i <= j) or H_(j,b)(i,a). */
-FCM_KERNEL_CLONES
+FCM_MULTIVERSION_CLONES
 static cell_result stiffness_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
 {
   const int na = fcm__kernel_na(nn), ld = fcm__kernel_ld(nn), nb = FCM_KERNEL_NB();
@@ -367,7 +360,7 @@ static cell_result stiffness_kernel(const kernel_data *kd, const cell_rule *r, i
 }
 
 /* Consistent mass: the scalar matrix M = sum_q w_q det J_q rho N N^T on each component. */
-FCM_KERNEL_CLONES
+FCM_MULTIVERSION_CLONES
 static cell_result mass_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
 {
   const int na = fcm__kernel_na(nn), ld = (nn + 15) / 16 * 16, nb = FCM_KERNEL_NB();
@@ -511,7 +504,7 @@ FCM_KERNEL_INLINE int hyperelastic_point(const kernel_data *kd, const cell_rule 
  * w->ue: F = I + sum_a u_a (x) g_a; f_(a,i) = sum_q wd P_iJ g_aJ and
  * K_(a,i)(b,k) = sum_q wd g_aJ A_iJkL g_bL with A = dP/dF, summed per chunk of points as
  * K_i[a][(b, k)] += sum_(c,J) g_caJ B_i[(c, J)][(b, k)] (row (a, i) of K, stride 3 ld in H). */
-FCM_KERNEL_CLONES
+FCM_MULTIVERSION_CLONES
 static cell_result hyperelastic_kernel(const kernel_data *kd, const cell_rule *r, int nn,
                                        scratch *w)
 {
