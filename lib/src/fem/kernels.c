@@ -34,26 +34,30 @@
 typedef double fcm_v8d __attribute__((vector_size(64)));
 typedef double fcm_v4d __attribute__((vector_size(32)));
 
-/* p[0..8) = v, or p[0..8) += v with add (a row of a register block into C). */
-FCM_KERNEL_INLINE void put8(double *p, fcm_v8d v, int add)
+/* p[0..8) = *v, or p[0..8) += *v with add (a row of a register block into C). The vectors go
+ * by address: by value they would change the calling convention between instruction sets
+ * (clang's -Wpsabi); the functions are inlined either way. */
+FCM_KERNEL_INLINE void put8(double *p, const fcm_v8d *v, int add)
 {
+  fcm_v8d r = *v;
   if (add) {
     fcm_v8d o;
     memcpy(&o, p, sizeof o);
-    v += o;
+    r += o;
   }
-  memcpy(p, &v, sizeof v);
+  memcpy(p, &r, sizeof r);
 }
 
-/* p[0..4) = v, or p[0..4) += v with add. */
-FCM_KERNEL_INLINE void put4(double *p, fcm_v4d v, int add)
+/* p[0..4) = *v, or p[0..4) += *v with add. */
+FCM_KERNEL_INLINE void put4(double *p, const fcm_v4d *v, int add)
 {
+  fcm_v4d r = *v;
   if (add) {
     fcm_v4d o;
     memcpy(&o, p, sizeof o);
-    v += o;
+    r += o;
   }
-  memcpy(p, &v, sizeof v);
+  memcpy(p, &r, sizeof r);
 }
 
 FCM_KERNEL_INLINE void micro_4x8(int nk, const double *A, int lda, const double *B, int ldb,
@@ -68,8 +72,8 @@ FCM_KERNEL_INLINE void micro_4x8(int nk, const double *A, int lda, const double 
     c2 += a[2] * b;
     c3 += a[3] * b;
   }
-  put8(C, c0, add), put8(C + ldc, c1, add);
-  put8(C + 2 * ldc, c2, add), put8(C + 3 * ldc, c3, add);
+  put8(C, &c0, add), put8(C + ldc, &c1, add);
+  put8(C + 2 * ldc, &c2, add), put8(C + 3 * ldc, &c3, add);
 }
 
 /* The same on 4 x 4 (8 SSE2 registers of accumulators: 4 x 8 would spill the 16 of baseline
@@ -86,8 +90,8 @@ FCM_KERNEL_INLINE void micro_4x4(int nk, const double *A, int lda, const double 
     c2 += a[2] * b;
     c3 += a[3] * b;
   }
-  put4(C, c0, add), put4(C + ldc, c1, add);
-  put4(C + 2 * ldc, c2, add), put4(C + 3 * ldc, c3, add);
+  put4(C, &c0, add), put4(C + ldc, &c1, add);
+  put4(C + 2 * ldc, &c2, add), put4(C + 3 * ldc, &c3, add);
 }
 
 /* The same on 4 x 16 (8 AVX-512 accumulators: two fused multiply-adds per cycle of latency 4
@@ -105,10 +109,10 @@ FCM_KERNEL_INLINE void micro_4x16(int nk, const double *A, int lda, const double
     c2 += a[2] * b, d2 += a[2] * e;
     c3 += a[3] * b, d3 += a[3] * e;
   }
-  put8(C, c0, add), put8(C + 8, d0, add);
-  put8(C + ldc, c1, add), put8(C + ldc + 8, d1, add);
-  put8(C + 2 * ldc, c2, add), put8(C + 2 * ldc + 8, d2, add);
-  put8(C + 3 * ldc, c3, add), put8(C + 3 * ldc + 8, d3, add);
+  put8(C, &c0, add), put8(C + 8, &d0, add);
+  put8(C + ldc, &c1, add), put8(C + ldc + 8, &d1, add);
+  put8(C + 2 * ldc, &c2, add), put8(C + 2 * ldc + 8, &d2, add);
+  put8(C + 3 * ldc, &c3, add), put8(C + 3 * ldc + 8, &d3, add);
 }
 #else
 FCM_KERNEL_INLINE void micro_4x4(int nk, const double *A, int lda, const double *B, int ldb,
@@ -234,7 +238,8 @@ FCM_KERNEL_INLINE void combine(int na, const double C[9], const double *V, doubl
       fcm_v4d v0, v1, v2;
       memcpy(&v0, V + a, sizeof v0), memcpy(&v1, V + na + a, sizeof v1);
       memcpy(&v2, V + 2 * na + a, sizeof v2);
-      put4(o + a, c0 * v0 + c1 * v1 + c2 * v2, add);
+      const fcm_v4d sum = c0 * v0 + c1 * v1 + c2 * v2;
+      put4(o + a, &sum, add);
     }
 #else
     for (int a = 0; a < na; a++) {
