@@ -103,7 +103,7 @@ install_check() {
   if [ "$have" = 1 ]; then
     grep -q "set(FCM_HAVE_PETSC ON)" "$pkgdir/fcmConfig.cmake"
     printf '%s\n' '#include <fcm/petsc.h>' \
-      'int main(void) { return fcm_petsc_options_default().max_iterations > 0 ? 0 : 1; }' \
+      'int main(void) { return fcm_petsc_options_default().solver.max_iterations > 0 ? 0 : 1; }' \
       >"$ex/petsc.c"
     # shellcheck disable=SC2046
     cc -std=c11 "$ex/petsc.c" -o "$ex/petsc-pc" \
