@@ -8,6 +8,8 @@
 #include "embed/embed_impl.h"
 #include "fcm/fem.h"
 
+#include <stdint.h>
+
 /* What fcm_space_momentum() keeps between calls (eval.c), owned by the space: the mass block
  * of every element, built by its first call over the authentic points of the mass rules and
  * freed with the space. The space's rules and numbering never change, so the blocks stay
@@ -150,6 +152,11 @@ fcm_status fcm__space_set_local_cells(fcm_space *s, const unsigned char *cell_ma
 /* FCM_OK for a full space; for a local one FCM_ERR_ARG with "<what>: the space is a local
  * space ..." recorded. (space.c) */
 fcm_status fcm__space_check_full(const fcm_space *s, const char *what);
+
+/* The Morton (Z-curve) key of point x on a 2^21 grid over the box [lo, hi] in each direction
+ * (coordinates clamped to the box; a flat direction counts as 0): sorting by it keeps points
+ * near each other in space near each other in the order. */
+uint64_t fcm__morton_key(const double x[3], const double lo[3], const double hi[3]);
 
 /* ---- Matrices over a space's rows (a local space: its local copies' rows, global columns).
  * A full space: rows are DOFs, local element positions are element ids, every function below

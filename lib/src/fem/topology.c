@@ -224,6 +224,16 @@ static uint64_t spread3(uint64_t v)
   return v;
 }
 
+uint64_t fcm__morton_key(const double x[3], const double lo[3], const double hi[3])
+{
+  uint64_t key = 0;
+  for (int d = 0; d < 3; d++) {
+    const double t = hi[d] > lo[d] ? (x[d] - lo[d]) / (hi[d] - lo[d]) : 0.0;
+    key |= spread3((uint64_t)(fmin(fmax(t, 0.0), 1.0) * 2097151.0)) << d;
+  }
+  return key;
+}
+
 /* block_elems: the local element positions in the Morton (Z-curve) order of their cells'
  * centres on a 2^21 grid over the elements' bounding box (ties, the pieces of one cell, by
  * position), so that runs of FCM__SPACE_BLOCK of them are compact clusters of cells. */
@@ -248,14 +258,8 @@ static fcm_status build_block_order(fcm_space *s)
       lo[d] = fmin(lo[d], c / nn), hi[d] = fmax(hi[d], c / nn);
     }
   }
-  for (fcm_index e = 0; e < ne; e++) {
-    uint64_t key = 0;
-    for (int d = 0; d < 3; d++) {
-      const double t = hi[d] > lo[d] ? (ctr[3 * e + d] - lo[d]) / (hi[d] - lo[d]) : 0.0;
-      key |= spread3((uint64_t)(t * 2097151.0)) << d;
-    }
-    m[e].key = key, m[e].le = e;
-  }
+  for (fcm_index e = 0; e < ne; e++)
+    m[e].key = fcm__morton_key(ctr + 3 * e, lo, hi), m[e].le = e;
   qsort(m, (size_t)ne, sizeof *m, cmp_morton);
   FCM_ALLOC(ctx, ne + 1, s->block_elems);
   for (fcm_index e = 0; e < ne; e++)

@@ -12,18 +12,6 @@
 #include <string.h>
 #include <time.h>
 
-/* Spread the 21 low bits of x to every third bit. */
-static uint64_t spread3(uint64_t x)
-{
-  x &= 0x1fffff;
-  x = (x | x << 32) & 0x1f00000000ffffULL;
-  x = (x | x << 16) & 0x1f0000ff0000ffULL;
-  x = (x | x << 8) & 0x100f00f00f00f00fULL;
-  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
-  x = (x | x << 2) & 0x1249249249249249ULL;
-  return x;
-}
-
 typedef struct keyed {
   uint64_t key;
   fcm_index cell;
@@ -66,13 +54,7 @@ static fcm_status partition_ordered(fcm_petsc_problem *P, const unsigned char *a
     for (int a = 0; a < nn; a++)
       for (int i = 0; i < 3; i++)
         x[i] += X[3 * a + i] / nn;
-    uint64_t key = 0;
-    for (int i = 0; i < 3; i++) {
-      double s = hi[i] > lo[i] ? (x[i] - lo[i]) / (hi[i] - lo[i]) : 0.0;
-      uint64_t q = (uint64_t)(fmin(fmax(s, 0.0), 1.0) * 2097151.0);
-      key |= spread3(q) << i;
-    }
-    k[m].key = key;
+    k[m].key = fcm__morton_key(x, lo, hi);
     k[m].cell = c;
     m++;
   }
