@@ -29,5 +29,6 @@ fcm_add_test(geom_voxel_alloc_failure tests/geom/voxel_alloc.c)
 # Gmsh: the tets' volume equals the enclosed volume to 1e-12 (cube, icosphere, filled
 # open cube and holed sphere); without Gmsh the refusal message.
 fcm_add_test(geom_surface_mesh tests/geom/surface_mesh.c)
+set_tests_properties(geom_surface_mesh PROPERTIES ENVIRONMENT "OMP_NUM_THREADS=3")
 # Allocation failures in the surface checks, reorientation, hole filling and meshing.
 fcm_add_test(geom_surface_alloc tests/geom/surface_alloc.c)

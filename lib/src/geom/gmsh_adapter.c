@@ -17,6 +17,7 @@ fcm_surface_mesh_options fcm_surface_mesh_options_default(void)
 
 #include <dlfcn.h>
 #include <gmshc.h>
+#include <omp.h>
 #include <pthread.h>
 #include <stdlib.h>
 
@@ -240,6 +241,9 @@ static fcm_status tetrahedralize(fcm_ctx *ctx, const fcm_surface *s,
    * does not refine inside a surface much coarser than the size asked for (a 12-triangle
    * cube stays 12 tets); only then, when its tets average more than 4x the requested
    * volume, HXT meshes it instead. */
+  /* Gmsh applies General.NumThreads (1, set in mesh_locked) with omp_set_num_threads(), which
+   * would leave every later OpenMP loop of the calling thread on one thread: restore it. */
+  const int omp_threads = omp_get_max_threads();
   int alg = 1;
   double target = 0.0; /* the volume of a regular tet of the requested edge length */
   if (o->max_volume > 0.0) target = o->max_volume;
@@ -263,6 +267,7 @@ static fcm_status tetrahedralize(fcm_ctx *ctx, const fcm_surface *s,
     fcm_geometry_destroy(geom);
     alg = 10;
   }
+  omp_set_num_threads(omp_threads);
   pthread_mutex_unlock(&gmsh_lock);
   return st;
 }
