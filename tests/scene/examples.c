@@ -3,7 +3,7 @@
  * background box, every fixed or moving region holds at least one background node, every
  * traction or pressure region meets the body's box, and it is small enough to run in
  * minutes. The scenes modelled on the papers keep the papers' defining numbers, and the
- * complete example in README.md parses. */
+ * complete examples of apps/scenes/README.md and of the top-level README.md parse. */
 #include "scene_util.h"
 
 #include <dirent.h>
@@ -241,12 +241,11 @@ static void check_papers(fcm_ctx *ctx, const char *dir)
   fcm_scene_destroy(&s);
 }
 
-/* The first ```json block of README.md is a complete scene. */
-static void check_readme(fcm_ctx *ctx, const char *dir)
+/* The first ```json block of the document `path` is a complete scene named `name` with
+ * `effects` effects. */
+static void check_readme(fcm_ctx *ctx, const char *path, const char *name, int effects)
 {
-  char path[1024];
-  static char text[1 << 16];
-  snprintf(path, sizeof path, "%s/README.md", dir);
+  static char text[1 << 17];
   FILE *f = fopen(path, "rb");
   TEST_TRUE(f != NULL);
   if (!f) return;
@@ -259,8 +258,8 @@ static void check_readme(fcm_ctx *ctx, const char *dir)
   if (!start || !end) return;
   end[1] = '\0';
   fcm_scene *s = NULL;
-  TEST_OK(ctx, fcm_scene_create_from_string(ctx, start + 8, "README.md", &s));
-  if (s) TEST_TRUE(!strcmp(fcm_scene_name(s), "example") && fcm_scene_num_effects(s) == 4);
+  TEST_OK(ctx, fcm_scene_create_from_string(ctx, start + 8, path, &s));
+  if (s) TEST_TRUE(!strcmp(fcm_scene_name(s), name) && fcm_scene_num_effects(s) == effects);
   fcm_scene_destroy(&s);
 }
 
@@ -303,7 +302,13 @@ int main(int argc, char **argv)
     free(files[i]);
   }
   check_papers(ctx, argv[1]);
-  check_readme(ctx, argv[1]);
+  {
+    char path[1024];
+    snprintf(path, sizeof path, "%s/README.md", argv[1]);
+    check_readme(ctx, path, "example", 4);
+    snprintf(path, sizeof path, "%s/../../README.md", argv[1]); /* the top-level README */
+    check_readme(ctx, path, "cut_ball", 3);
+  }
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();

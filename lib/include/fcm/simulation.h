@@ -256,7 +256,7 @@ FCM_API int fcm_simulation_frame_due(const fcm_simulation *sim);
 FCM_API int fcm_simulation_state_finite(const fcm_simulation *sim);
 
 /** Write frame `index` of the current state into the existing directory `dir`, every point at
- * its reference position with a point array `displacement` (README: ParaView recipe):
+ * its reference position with a point array `displacement` (apps/docs/fcm-sim.md: ParaView recipe):
  * <dir>/<name>_background_NNNN.vtu (fcm_space_write_vtu(): displacement and velocity per node;
  * active flag, volume fraction and the cell averages of stress, von Mises stress and strain
  * energy density per cell) and, with a geometry, <dir>/<name>_surface_NNNN.vtu
