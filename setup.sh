@@ -42,10 +42,13 @@ deps() {
   $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 }
 
+# Configure and build; with arguments, only those targets (and what they need).
 configure_and_build() {
+  local targets=()
+  [ $# -gt 0 ] && targets=(--target "$@")
   # shellcheck disable=SC2086
   cmake -S "$here" -B "$build" ${FCM_CMAKE_ARGS:-} >/dev/null
-  cmake --build "$build" -j "$jobs"
+  cmake --build "$build" -j "$jobs" "${targets[@]}"
 }
 
 # Install the build into a temporary prefix, move the tree (nothing may hard-code the build
@@ -128,7 +131,8 @@ case "${1:-}" in
   deps) deps ;;
   demo)
     deps
-    configure_and_build
+    echo "setup.sh: building the library and fcm-sim (a few minutes the first time)"
+    configure_and_build fcm-sim >/dev/null # the library and the program, not the tests
     shift
     "$build/fcm-sim" "$@"
     ;;
