@@ -528,13 +528,23 @@ static int finish_run(fcm_simulation *sim, fcm_status st, const run_state *rs, i
     if (rs->write) {
       fcm_simulation_counters c;
       fcm_simulation_get_counters(sim, &c);
-      if (c.frames > 0 && (int)c.frames > frames_at_start)
-        printf("  output    %s/%s_background.pvd, %s/%s_log.csv\n", dir, name, dir, name);
-      else
-        printf("  output    %s/%s_log.csv (no new frame)\n", dir, name);
+      sim_print_output(dir, name, rs->logpath, !(c.frames > 0 && (int)c.frames > frames_at_start));
     }
   }
   return 0;
+}
+
+void sim_print_output(const char *dir, const char *name, const char *logpath, int no_frame)
+{
+  static const char *const series[] = {"background", "surface"};
+  char path[4096];
+  printf("  output    ");
+  for (int k = 0; k < 2 && !no_frame; k++) {
+    snprintf(path, sizeof path, "%s/%s_%s.pvd", dir, name, series[k]);
+    struct stat sb;
+    if (stat(path, &sb) == 0) printf("%s, ", path);
+  }
+  printf("%s%s\n", logpath, no_frame ? " (no new frame)" : "");
 }
 
 static int scene_main(int argc, char **argv)

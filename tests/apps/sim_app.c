@@ -2,7 +2,8 @@
  *   sim_app check FCM_SIM SCENE       `fcm-sim SCENE --check` exits 0 and prints the summary
  *                                     (SCENE "-": the built-in scene, no file)
  *   sim_app run FCM_SIM WORK_DIR      a small scene run with -o and --steps writes the frames,
- *                                     both PVDs and a CSV log with one row per step
+ *                                     both PVDs and a CSV log with one row per step, and its
+ *                                     summary names the three
  *   sim_app resume FCM_SIM WORK_DIR   a run cut short with checkpoints and resumed ends with
  *                                     frames byte-identical to the uninterrupted run's, the
  *                                     same log (but wall times) and a complete PVD; bad,
@@ -52,7 +53,7 @@ static int csv_numbers(const char *line, double *v, int cap)
 
 static int file_has(const char *path, const char *needle)
 {
-  char buf[8192];
+  static char buf[1 << 16];
   FILE *f = fopen(path, "r");
   if (!f) return 0;
   size_t n = fread(buf, 1, sizeof buf - 1, f);
@@ -99,9 +100,17 @@ static int mode_run(const char *sim, const char *work)
   snprintf(cmd, sizeof cmd, "rm -rf '%s/small-out'", work);
   app_run(cmd);
   /* 10 steps in the scene, cut to 4; frames at steps 0, 2, 4 */
-  snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s' --steps 4 --quiet > /dev/null 2>&1", sim, scene,
-           dir);
+  snprintf(cmd, sizeof cmd,
+           "mkdir -p '%s' && '%s' '%s' -o '%s' --steps 4 > '%s/small-run.txt' 2>&1", work, sim,
+           scene, dir, work);
   TEST_TRUE(app_run(cmd) == 0);
+  /* the summary's output line names every series written */
+  snprintf(path, sizeof path, "%s/small-run.txt", work);
+  char want[4096];
+  snprintf(want, sizeof want,
+           "  output    %s/small_background.pvd, %s/small_surface.pvd, %s/small_log.csv\n", dir,
+           dir, dir);
+  TEST_TRUE(file_has(path, want));
   const char *files[] = {"small_background_0000.vtu", "small_background_0002.vtu",
                          "small_surface_0000.vtu",    "small_surface_0002.vtu",
                          "small_background.pvd",      "small_surface.pvd"};
