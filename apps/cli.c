@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 int cli_double(const char *prog, const char *opt, const char *s, double lo, double hi,
                unsigned bounds, double *out)
@@ -338,6 +339,39 @@ int cli_make_dirs(const char *prog, const char *dir)
     buf[k] = c;
   }
   return 1;
+}
+
+int cli_check_output_dir(const char *prog, const char *dir)
+{
+  char buf[4096];
+  const size_t n = strlen(dir);
+  if (n == 0 || n >= sizeof buf) {
+    fprintf(stderr, "%s: bad output directory '%s'\n", prog, dir);
+    return 0;
+  }
+  memcpy(buf, dir, n + 1);
+  for (;;) { /* the path itself, then each parent up to the first that exists */
+    struct stat sb;
+    if (stat(buf, &sb) == 0) {
+      if (!S_ISDIR(sb.st_mode)) {
+        fprintf(stderr, "%s: output path '%s' exists and is not a directory\n", prog, buf);
+        return 0;
+      }
+      if (access(buf, W_OK | X_OK) != 0) {
+        fprintf(stderr, "%s: cannot write into the output directory '%s': %s\n", prog, buf,
+                strerror(errno));
+        return 0;
+      }
+      return 1;
+    }
+    char *slash = strrchr(buf, '/');
+    if (slash == buf) return 1; /* "/x": the root exists */
+    if (!slash) { /* a relative path none of whose parts exists: the current directory */
+      buf[0] = '.', buf[1] = '\0';
+      continue;
+    }
+    *slash = '\0';
+  }
 }
 
 int cli_gnuplot_png(const char *prog, const char *size, const char *path, const char *body)

@@ -123,4 +123,9 @@ void cli_output_abort(cli_output **out);
  *  0 with a message (a path too long, a part that cannot be created or is not a directory). */
 int cli_make_dirs(const char *prog, const char *dir);
 
+/* Whether the output directory `dir` can be made by cli_make_dirs() without creating
+ * anything: it, or its nearest existing ancestor, is a directory this process may write
+ * into. 0 after printing why not ("<prog>: output path 'x' exists and is not a directory"). */
+int cli_check_output_dir(const char *prog, const char *dir);
+
 #endif

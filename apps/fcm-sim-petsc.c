@@ -248,6 +248,23 @@ int sim_petsc_run(const char *path, const char *outdir, long long steps, int che
     rc = 2;
     goto done;
   }
+  /* the inputs before the set-up: the output directory (the root writes it) and the
+   * checkpoint (every process reads it) */
+  if (!check && rank == 0 &&
+      !cli_check_output_dir("fcm-sim", outdir ? outdir : fcm_scene_get_output(scene)->directory))
+    rc = 2;
+  if (rc != 2 && resume && fcm_simulation_check_checkpoint(ctx, resume) != FCM_OK) {
+    if (rank == 0) fprintf(stderr, "fcm-sim: --resume: %s\n", fcm_ctx_error_message(ctx));
+    rc = 2;
+  }
+  {
+    int bad = rc == 2, any = bad;
+    MPI_Allreduce(&bad, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    if (any) {
+      rc = 2;
+      goto done;
+    }
+  }
   const char *name = fcm_scene_name(scene);
   if (talk)
     fprintf(stderr, "fcm-sim: scene %s (%s): building on %d process%s (backend petsc)\n", name,

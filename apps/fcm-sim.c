@@ -587,6 +587,17 @@ static int scene_main(int argc, char **argv)
     rc = 0;
     goto done;
   }
+  /* every input is checked before the set-up, which may take minutes */
+  if (!o.check && !cli_check_output_dir(
+                      "fcm-sim", o.outdir ? o.outdir : fcm_scene_get_output(scene)->directory)) {
+    rc = 2;
+    goto done;
+  }
+  if (o.resume && fcm_simulation_check_checkpoint(ctx, o.resume) != FCM_OK) {
+    fprintf(stderr, "fcm-sim: --resume: %s\n", fcm_ctx_error_message(ctx));
+    rc = 2;
+    goto done;
+  }
   if (fcm_scene_get_solver(scene)->threads > 0) /* every OpenMP loop of the run */
     omp_set_num_threads(fcm_scene_get_solver(scene)->threads);
   rps.t0 = fcm_wtime();

@@ -16,7 +16,8 @@
  *                                     3rd step), PVDs listing them at t = 0, 0.1, 0.2, and
  *                                     6 log rows at t = k/30 with converged Newton steps
  *   sim_app errors FCM_SIM WORK_DIR   invalid scenes and options exit non-zero with the
- *                                     parser's message and create no output directory */
+ *                                     parser's message and create no output directory; a bad
+ *                                     output path or checkpoint exits 2 before the set-up */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "output_check.h"
@@ -210,6 +211,20 @@ static int mode_errors(const char *sim, const char *work)
   snprintf(cmd, sizeof cmd, "'%s' a.json b.json 2> /dev/null", sim);
   TEST_TRUE(app_run(cmd) == 2);
   TEST_TRUE(!app_exists(dir));
+  /* inputs of a valid scene checked before the set-up (no "building" line): an output path
+   * that is a file, or under one; a --resume file that is not a checkpoint */
+  char file[1024];
+  snprintf(file, sizeof file, "%s/a-file", work);
+  write_file(file, "not a directory\n");
+  const char *early[][2] = {{"-o", "a-file"}, {"-o", "a-file/sub"}, {"--resume", "a-file"}};
+  for (int k = 0; k < 3; k++) {
+    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s %s --steps 1 2> '%s' > /dev/null", work, sim,
+             early[k][0], early[k][1], err);
+    if (app_run(cmd) != 2) TEST_FAIL_("'%s %s' should exit 2", early[k][0], early[k][1]);
+    TEST_TRUE(!file_has(err, "building") &&
+              file_has(err, k < 2 ? "exists and is not a directory" : "not an fcm checkpoint"));
+  }
+  remove(file);
   remove(err);
   return TEST_RESULT();
 }

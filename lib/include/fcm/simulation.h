@@ -314,6 +314,15 @@ FCM_API fcm_status fcm_simulation_write_checkpoint(fcm_simulation *sim, const ch
  * simulation is unchanged. */
 FCM_API fcm_status fcm_simulation_read_checkpoint(fcm_simulation *sim, const char *path);
 
+/** Check that `path` is a checkpoint this build reads (fcm_simulation_write_checkpoint()'s
+ * container: its header, version, byte order and checksum, or an older `.fcmpk`), without a
+ * simulation: a program checks its input before the set-up. Whether it belongs to a given
+ * scene is decided by fcm_simulation_read_checkpoint().
+ * @return FCM_OK; FCM_ERR_IO (cannot open or read, naming the path); FCM_ERR_FORMAT (not a
+ * checkpoint, other byte order or version, truncated, checksum mismatch); FCM_ERR_ARG (NULL
+ * path). */
+FCM_API fcm_status fcm_simulation_check_checkpoint(fcm_ctx *ctx, const char *path);
+
 /** 1 when a checkpoint is due after the step just taken (every checkpoint_interval-th step,
  * from the options or the scene), else 0. */
 FCM_API int fcm_simulation_checkpoint_due(const fcm_simulation *sim);

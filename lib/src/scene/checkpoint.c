@@ -338,6 +338,17 @@ cleanup:
   return st;
 }
 
+fcm_status fcm_simulation_check_checkpoint(fcm_ctx *ctx, const char *path)
+{
+  fcm_status st = FCM_OK;
+  fcm__ckpt_reader r;
+  FCM_CHECK(path, ctx, FCM_ERR_ARG, "checkpoint: NULL path");
+  FCM_TRY(ctx, fcm__ckpt_read_open(ctx, path, ckpt_magic, CKPT_VERSION, &r));
+  fcm__ckpt_read_close(&r);
+cleanup:
+  return st;
+}
+
 fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
 {
   fcm_status st = FCM_OK;
