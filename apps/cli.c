@@ -374,6 +374,16 @@ int cli_check_output_dir(const char *prog, const char *dir)
   }
 }
 
+void cli_report_scene_error(const char *prog, const char *name, const char *message)
+{
+  const size_t n = strlen(name);
+  if (!strncmp(message, "scene ", 6) && !strncmp(message + 6, name, n) &&
+      (message[6 + n] == ':' || message[6 + n] == ' '))
+    fprintf(stderr, "%s: %s\n", prog, message);
+  else
+    fprintf(stderr, "%s: scene %s: %s\n", prog, name, message);
+}
+
 int cli_gnuplot_png(const char *prog, const char *size, const char *path, const char *body)
 {
   char tmp[4096], script[4096], cmd[8400];

@@ -128,4 +128,8 @@ int cli_make_dirs(const char *prog, const char *dir);
  * into. 0 after printing why not ("<prog>: output path 'x' exists and is not a directory"). */
 int cli_check_output_dir(const char *prog, const char *dir);
 
+/* "<prog>: scene <name>: <message>" on stderr, without repeating the scene when the library's
+ * message already starts with "scene <name>". */
+void cli_report_scene_error(const char *prog, const char *name, const char *message);
+
 #endif

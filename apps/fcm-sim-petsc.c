@@ -144,7 +144,7 @@ static int run_scene(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, l
   fcm_status st =
       fcm_petsc_simulation_create(ctx, MPI_COMM_WORLD, scene, FCM_PETSC_PARTITION_AUTO, &so, &sim);
   if (st != FCM_OK) { /* every process has the error; process 0 prints it */
-    if (rank == 0) fprintf(stderr, "fcm-sim: scene %s: %s\n", name, fcm_ctx_error_message(ctx));
+    if (rank == 0) cli_report_scene_error("fcm-sim", name, fcm_ctx_error_message(ctx));
     return st == FCM_ERR_ARG || st == FCM_ERR_IO || st == FCM_ERR_FORMAT ||
                    st == FCM_ERR_GEOMETRY || st == FCM_ERR_UNSUPPORTED
                ? 2

@@ -469,7 +469,7 @@ static int build_simulation(fcm_ctx *ctx, fcm_scene *scene, const scene_options 
     if (o->debug)
       fcm_ctx_error_view(ctx, stderr);
     else
-      fprintf(stderr, "fcm-sim: scene %s: %s\n", name, fcm_ctx_error_message(ctx));
+      cli_report_scene_error("fcm-sim", name, fcm_ctx_error_message(ctx));
     return build_exit_code(st);
   }
   warn_outside(*sim);

@@ -225,6 +225,21 @@ static int mode_errors(const char *sim, const char *work)
               file_has(err, k < 2 ? "exists and is not a directory" : "not an fcm checkpoint"));
   }
   remove(file);
+  /* a region whose nodes are all inactive holds nothing: refused, the scene named once */
+  snprintf(scene, sizeof scene, "%s/inactive.json", work);
+  write_file(scene,
+             "{\"version\": 1, \"name\": \"inactive\","
+             " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0],"
+             " \"max\": [2, 1, 1]}, \"cells\": [4, 2, 2]},"
+             " \"geometry\": {\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [1.2, 1, 1]},"
+             " \"material\": {\"model\": \"linear\", \"young\": 1e6, \"poisson\": 0.3},"
+             " \"effects\": [{\"fixed\": {\"region\": {\"half_space\": {\"point\": [1.9, 0, 0],"
+             " \"normal\": [1, 0, 0]}}}}]}");
+  snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s' 2> '%s' > /dev/null", sim, scene, dir, err);
+  TEST_TRUE(app_run(cmd) == 2);
+  TEST_TRUE(file_has(err, "fcm-sim: scene inactive: effects[0]: the region's 9 background-mesh "
+                          "nodes are all inactive"));
+  remove(scene);
   remove(err);
   return TEST_RESULT();
 }

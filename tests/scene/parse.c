@@ -406,6 +406,12 @@ static void check_motion(fcm_ctx *ctx)
 }
 
 /* File names are resolved against the scene file's directory; absolute names are kept. */
+static void count_warnings(void *user, fcm_log_level level, const char *msg)
+{
+  (void)msg;
+  if (level == FCM_LOG_WARNING) ++*(int *)user;
+}
+
 static void check_files(fcm_ctx *ctx)
 {
   char dir[64], path[256], sub[128], meshes[128], scene_path[256], json[1024];
@@ -458,6 +464,24 @@ static void check_files(fcm_ctx *ctx)
     TEST_TRUE(!strcmp(fcm_scene_get_background(s)->mesh, path));
   }
   fcm_scene_destroy(&s);
+
+  /* Without "name", a file name that is not a usable name gives a sanitized one and a
+   * warning; a usable one is taken as it is. */
+  {
+    int warnings = 0;
+    fcm_ctx_options co = fcm_ctx_options_default();
+    co.log = count_warnings;
+    co.log_user = &warnings;
+    fcm_ctx *c2 = NULL;
+    TEST_OK(c2, fcm_ctx_create(&co, &c2));
+    TEST_OK(c2, fcm_scene_create_from_string(c2, json, "elsewhere/my scene#1.json", &s));
+    TEST_TRUE(s && !strcmp(fcm_scene_name(s), "my_scene_1") && warnings == 1);
+    fcm_scene_destroy(&s);
+    TEST_OK(c2, fcm_scene_create_from_string(c2, json, "elsewhere/x-1.json", &s));
+    TEST_TRUE(s && !strcmp(fcm_scene_name(s), "x-1") && warnings == 1);
+    fcm_scene_destroy(&s);
+    fcm_ctx_destroy(&c2);
+  }
 
   /* Clean up. */
   const char *files[] = {

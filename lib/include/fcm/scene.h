@@ -322,7 +322,9 @@ FCM_API void fcm_effect_initial_velocity_eval(const fcm_effect_initial_velocity 
 typedef struct fcm_scene fcm_scene;
 
 /** Read, parse and validate a scene file. Relative file names inside it are resolved
- * against the directory of `path`; referenced mesh files must exist and be readable.
+ * against the directory of `path`; referenced mesh files must exist and be readable. A scene
+ * without "name" is named after the file's stem, characters outside [A-Za-z0-9_.-] replaced by
+ * '_' (a warning through the context's log says so).
  * @param[in]  ctx   context (allocation, errors); must outlive the scene
  * @param[in]  path  the JSON file
  * @param[out] scene the new scene, NULL on failure

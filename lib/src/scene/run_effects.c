@@ -44,13 +44,15 @@ static void surface_field(void *user, const double x[3], const double normal[3],
   }
 }
 
-/* Background nodes of a region: count only (nodes NULL) or fill. */
+/* Background nodes of a region: count only (nodes NULL) or fill. A region without a node, or
+ * whose nodes are all inactive (no active cell uses them: they would hold nothing), is an
+ * error. */
 static fcm_status region_nodes(fcm_simulation *S, const fcm_region *r, int effect_index,
                                fcm_index *nodes, fcm_index *count)
 {
   fcm_status st = FCM_OK;
   const double *X = fcm_mesh_coords(S->mesh);
-  fcm_index n = 0;
+  fcm_index n = 0, active = 0;
   if (r->kind == FCM_REGION_NODES) {
     for (fcm_index k = 0; k < r->num_nodes; k++) {
       FCM_CHECK(r->nodes[k] >= 0 && r->nodes[k] < S->nn, S->ctx, FCM_ERR_ARG,
@@ -69,6 +71,13 @@ static fcm_status region_nodes(fcm_simulation *S, const fcm_region *r, int effec
   FCM_CHECK(n > 0, S->ctx, FCM_ERR_ARG,
             "scene %s: effects[%d]: the region contains no background-mesh node",
             fcm_scene_name(S->scene), effect_index);
+  if (nodes)
+    for (fcm_index k = 0; k < n; k++)
+      active += fcm_space_node_copies(S->space, nodes[k]) > 0;
+  FCM_CHECK(!nodes || active > 0, S->ctx, FCM_ERR_ARG,
+            "scene %s: effects[%d]: the region's %lld background-mesh nodes are all inactive (no "
+            "cell with material uses them), so it would hold nothing: move it onto the body",
+            fcm_scene_name(S->scene), effect_index, (long long)n);
   *count = n;
 cleanup:
   return st;

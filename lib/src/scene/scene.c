@@ -82,23 +82,29 @@ const char *fcm__scene_choice_name(const char *const *names, const int *values, 
 
 /* ---------------------------------------------------------------- the whole scene */
 
+static int name_char(char c)
+{
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+         c == '-' || c == '.';
+}
+
 /* Whether a name is usable in file names: [A-Za-z0-9_.-], 1..64 characters, not "." or "..". */
 static int valid_name(const char *s)
 {
   size_t n = strlen(s);
   if (n == 0 || n > 64 || !strcmp(s, ".") || !strcmp(s, "..")) return 0;
   for (; *s; s++)
-    if (!((*s >= 'a' && *s <= 'z') || (*s >= 'A' && *s <= 'Z') || (*s >= '0' && *s <= '9') ||
-          *s == '_' || *s == '-' || *s == '.'))
-      return 0;
+    if (!name_char(*s)) return 0;
   return 1;
 }
 
-/* The stem of a path's last component ("dir/x.json" -> "x"); "scene" if that is not a
- * valid name. */
+/* The stem of a path's last component ("dir/x.json" -> "x"), its characters outside
+ * [A-Za-z0-9_.-] replaced by '_' ("my scene.json" -> "my_scene", with a warning through the
+ * context's log); "scene" if nothing usable is left or there is no file (a string). */
 static fcm_status default_name(fcm__scene_parser *p, const char *source, const char **out)
 {
   fcm_status st = FCM_OK;
+  if (!strcmp(source, "<string>")) return fcm__scene_strdup(p, "scene", out); /* no file */
   const char *b = strrchr(source, '/');
   b = b ? b + 1 : source;
   size_t n = strlen(b);
@@ -108,7 +114,17 @@ static fcm_status default_name(fcm__scene_parser *p, const char *source, const c
   char buf[65];
   memcpy(buf, b, n);
   buf[n] = '\0';
-  if (!valid_name(buf)) strcpy(buf, "scene");
+  if (!valid_name(buf)) {
+    char stem[65];
+    memcpy(stem, buf, n + 1);
+    for (size_t k = 0; k < n; k++)
+      if (!name_char(buf[k])) buf[k] = '_';
+    if (!valid_name(buf)) strcpy(buf, "scene");
+    fcm__log(p->ctx, FCM_LOG_WARNING,
+             "scene %s: no \"name\" and the file name '%s' is not a usable one ([A-Za-z0-9_.-], "
+             "1 to 64 characters): named '%s' (its output files start with it)",
+             source, stem, buf);
+  }
   FCM_TRY(p->ctx, fcm__scene_strdup(p, buf, out));
 cleanup:
   return st;
