@@ -283,6 +283,9 @@ int main(void)
     TEST_TRUE(r.num_boundary_edges == 4 && r.num_boundary_loops == 1);
     TEST_ERR(ctx, fcm_surface_report_check(s, "open", &r), FCM_ERR_GEOMETRY,
              "4 boundary edges in 1 loop(s)");
+    /* the ids in the message say how they count */
+    TEST_ERR(ctx, fcm_surface_report_check(s, "open", &r), FCM_ERR_GEOMETRY,
+             "ids count from 0 in the file's order");
     TEST_ERR(ctx, fcm_geometry_create_from_surface(ctx, s, NULL, &g), FCM_ERR_GEOMETRY,
              "not closed: 4 boundary edges");
     TEST_TRUE(g == NULL);

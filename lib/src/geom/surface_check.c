@@ -439,14 +439,15 @@ fcm_status fcm_surface_report_check(const fcm_surface *s, const char *what,
     LOC_EDGES(r->boundary_edges, r->num_boundary_edges);
     return fcm__error(ctx, FCM_ERR_GEOMETRY, __FILE__, __LINE__, __func__,
                       "%s: the surface is not closed: %lld boundary edges in %lld loop(s) "
-                      "(first: vertex ids %s); close small holes with fill_holes",
+                      "(first: vertex ids %s; ids count from 0 in the file's order); close small "
+                      "holes with fill_holes",
                       w, (long long)r->num_boundary_edges, (long long)r->num_boundary_loops, loc);
   }
   if (r->num_nonmanifold_edges > 0) {
     LOC_EDGES(r->nonmanifold_edges, r->num_nonmanifold_edges);
     return fcm__error(ctx, FCM_ERR_GEOMETRY, __FILE__, __LINE__, __func__,
                       "%s: the surface is not manifold: %lld edges shared by 3 or more triangles "
-                      "(first: vertex ids %s)",
+                      "(first: vertex ids %s; ids count from 0 in the file's order)",
                       w, (long long)r->num_nonmanifold_edges, loc);
   }
   if (r->num_degenerate > 0) {
@@ -454,7 +455,8 @@ fcm_status fcm_surface_report_check(const fcm_surface *s, const char *what,
     const fcm_index *T = s->tris + 3 * t;
     return fcm__error(ctx, FCM_ERR_GEOMETRY, __FILE__, __LINE__, __func__,
                       "%s: %lld degenerate (zero-area) triangle(s); the first is triangle %lld "
-                      "with vertices %lld (%g, %g, %g), %lld (%g, %g, %g), %lld (%g, %g, %g)",
+                      "(ids count from 0 in the file's order) with vertices %lld (%g, %g, %g), "
+                      "%lld (%g, %g, %g), %lld (%g, %g, %g)",
                       w, (long long)r->num_degenerate, (long long)t, (long long)T[0], x[3 * T[0]],
                       x[3 * T[0] + 1], x[3 * T[0] + 2], (long long)T[1], x[3 * T[1]],
                       x[3 * T[1] + 1], x[3 * T[1] + 2], (long long)T[2], x[3 * T[2]],
@@ -464,18 +466,21 @@ fcm_status fcm_surface_report_check(const fcm_surface *s, const char *what,
     LOC_EDGES(r->inconsistent_edges, r->num_inconsistent_edges);
     return fcm__error(ctx, FCM_ERR_GEOMETRY, __FILE__, __LINE__, __func__,
                       "%s: inconsistent orientation: %lld edges are run the same way by both "
-                      "their triangles (first: vertex ids %s); reorient with "
+                      "their triangles (first: vertex ids %s; ids count from 0 in the file's "
+                      "order); reorient with "
                       "fcm_surface_create_oriented()",
                       w, (long long)r->num_inconsistent_edges, loc);
   }
   if (r->num_intersections > 0) {
     fcm_index t = r->intersecting[0][0], u = r->intersecting[0][1];
     const double *p = x + 3 * s->tris[3 * t], *q = x + 3 * s->tris[3 * u];
-    return fcm__error(ctx, FCM_ERR_GEOMETRY, __FILE__, __LINE__, __func__,
-                      "%s: the surface intersects itself: %lld triangle pair(s), the first "
-                      "triangles %lld (vertex (%g, %g, %g)) and %lld (vertex (%g, %g, %g))",
-                      w, (long long)r->num_intersections, (long long)t, p[0], p[1], p[2],
-                      (long long)u, q[0], q[1], q[2]);
+    return fcm__error(
+        ctx, FCM_ERR_GEOMETRY, __FILE__, __LINE__, __func__,
+        "%s: the surface intersects itself: %lld triangle pair(s), the first "
+        "triangles %lld (vertex (%g, %g, %g)) and %lld (vertex (%g, %g, %g)); ids count "
+        "from 0 in the file's order",
+        w, (long long)r->num_intersections, (long long)t, p[0], p[1], p[2], (long long)u, q[0],
+        q[1], q[2]);
   }
   if (!(r->signed_volume > 0.0))
     return fcm__error(ctx, FCM_ERR_GEOMETRY, __FILE__, __LINE__, __func__,
