@@ -61,7 +61,7 @@ static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS
        "output directory",
        0, 0, 0, NULL, NULL, NULL},
       {"--print-scene", NULL, CLI_FLAG, &o->print_scene, NULL,
-       "print the scene with every default filled in and exit", 0, 0, 0, NULL, NULL, NULL},
+       "print the scene as JSON with every default filled in and exit", 0, 0, 0, NULL, NULL, NULL},
       {"--quiet", "-q", CLI_FLAG, &o->quiet, NULL, "print only errors", 0, 0, 0, NULL, NULL, NULL},
       {"--progress", NULL, CLI_FLAG, &o->progress, NULL,
        "report the set-up also when stderr is not a terminal: a\n"
@@ -583,7 +583,7 @@ static int scene_main(int argc, char **argv)
     goto done;
   }
   if (o.print_scene) {
-    fcm_scene_view(scene, stdout);
+    printf("%s\n", fcm_scene_json(scene));
     rc = 0;
     goto done;
   }

@@ -69,7 +69,8 @@ static const char mg_json[] =
     " \"time\": {\"dt\": 0.02, \"steps\": 6},"
     " \"effects\": [{\"gravity\": {}}, {\"damping\": {\"stiffness\": 0.01, \"mass\": 0.1}},"
     "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, 0, 0]}}}},"
-    "  {\"motion\": {\"region\": {\"half_space\": {\"point\": [1.25, 0, 0], \"normal\": [1, 0, 0]}},"
+    "  {\"motion\": {\"region\": {\"half_space\": {\"point\": [1.25, 0, 0], \"normal\": [1, 0, "
+    "0]}},"
     "    \"velocity\": [0, 0, 1], \"end\": 0.06, \"release\": true}}]}";
 
 /* a free body spinning in one cell */

@@ -99,6 +99,7 @@ static void check_scene(fcm_ctx *ctx, const char *path, const char *file)
     fprintf(stderr, "  in %s\n", path);
     return;
   }
+  check_normalized(ctx, s, file);
   char stem[128];
   snprintf(stem, sizeof stem, "%s", file);
   *strrchr(stem, '.') = '\0';
@@ -302,6 +303,12 @@ int main(int argc, char **argv)
     free(files[i]);
   }
   check_papers(ctx, argv[1]);
+  {
+    fcm_scene *s = NULL;
+    TEST_OK(ctx, fcm_scene_create_default(ctx, &s));
+    if (s) check_normalized(ctx, s, "the built-in scene");
+    fcm_scene_destroy(&s);
+  }
   {
     char path[1024];
     snprintf(path, sizeof path, "%s/README.md", argv[1]);

@@ -22,6 +22,7 @@ static void check_full(fcm_ctx *ctx)
   TEST_TRUE(!strcmp(fcm_scene_name(s), "full-scene.v1"));
   TEST_TRUE(!strcmp(fcm_scene_description(s), "every key set"));
   TEST_TRUE(!strcmp(fcm_scene_source(s), "full.json"));
+  check_normalized(ctx, s, "the scene of every key");
 
   const fcm_scene_background *b = fcm_scene_get_background(s);
   TEST_TRUE(b->kind == FCM_SCENE_BACKGROUND_GRID && b->element == FCM_ELEMENT_TET10);

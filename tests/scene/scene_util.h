@@ -8,6 +8,7 @@
 #include "test.h"
 #include "test_alloc.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -103,6 +104,46 @@ static inline char *make_temp_dir(char *buf, size_t len)
 {
   snprintf(buf, len, "/tmp/fcm-scene-XXXXXX");
   return mkdtemp(buf);
+}
+
+/* fcm_scene_view() of a scene without its first line (name and source). */
+static inline char *view_body(const fcm_scene *s)
+{
+  char *text = NULL;
+  size_t len = 0;
+  FILE *f = open_memstream(&text, &len);
+  if (!f) return NULL;
+  fcm_scene_view(s, f);
+  fclose(f);
+  char *nl = text ? strchr(text, '\n') : NULL;
+  if (nl) memmove(text, nl + 1, strlen(nl + 1) + 1);
+  return text;
+}
+
+/* The normalized JSON of a scene, parsed again from another directory, is the same scene
+ * (the same view but for the source) and normalizes to the same text. */
+static inline void check_normalized(fcm_ctx *ctx, const fcm_scene *s, const char *file)
+{
+  fcm_scene *again = NULL;
+  TEST_OK(ctx,
+          fcm_scene_create_from_string(ctx, fcm_scene_json(s), "/nonexistent/again.json", &again));
+  if (!again) {
+    fprintf(stderr, "  normalized %s:\n%s\n", file, fcm_scene_json(s));
+    return;
+  }
+  char *a = view_body(s), *b = view_body(again);
+  TEST_TRUE(a && b);
+  if (a && b && strcmp(a, b)) TEST_FAIL_("%s: normalized scene differs:\n%s\nvs\n%s", file, a, b);
+  if (strcmp(fcm_scene_json(s), fcm_scene_json(again)))
+    TEST_FAIL_("%s: normalizing twice changes the text", file);
+  /* every default is filled in: the sections a scene may leave out are there */
+  const char *keys[] = {"\"quadrature\"", "\"solver\"", "\"newton\"", "\"time\"", "\"output\""};
+  for (int k = 0; k < 5; k++)
+    if (!strstr(fcm_scene_json(s), keys[k]))
+      TEST_FAIL_("%s: no %s in the normalized scene", file, keys[k]);
+  free(a);
+  free(b);
+  fcm_scene_destroy(&again);
 }
 
 #endif

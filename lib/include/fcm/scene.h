@@ -360,6 +360,11 @@ FCM_API void fcm_scene_destroy(fcm_scene **scene);
 FCM_API const char *fcm_scene_name(const fcm_scene *scene);        /**< "name" or file stem */
 FCM_API const char *fcm_scene_description(const fcm_scene *scene); /**< "" when none */
 FCM_API const char *fcm_scene_source(const fcm_scene *scene);      /**< file or source name */
+/** The scene as normalized JSON text: every key the parser read, with the value it took —
+ * the defaults filled in, choices by their canonical name, file names absolute — indented.
+ * Parsed again (saved anywhere) it gives the same scene (fcm_scene_view() prints the same).
+ * Keys whose default is computed for the problem (FCM_DEFAULT) are left out. */
+FCM_API const char *fcm_scene_json(const fcm_scene *scene);
 FCM_API const fcm_scene_background *fcm_scene_get_background(const fcm_scene *scene);
 FCM_API const fcm_scene_geometry *fcm_scene_get_geometry(const fcm_scene *scene);
 FCM_API const fcm_material *fcm_scene_get_material(const fcm_scene *scene);

@@ -391,6 +391,7 @@ static fcm_status parse_initial_velocity(fcm__scene_parser *p, const fcm__json *
   FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "angular_velocity", 0, FCM__ANY, v->angular_velocity));
   FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "center", 0, FCM__ANY, v->center));
   v->center_of_mass = fcm__json_member(o, "center") == NULL;
+  if (v->center_of_mass) fcm__scene_forget(p, "center"); /* not the default [0, 0, 0] */
 cleanup:
   return st;
 }

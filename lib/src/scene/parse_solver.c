@@ -27,7 +27,7 @@ fcm_status fcm__scene_read_quadrature(fcm__scene_parser *p, const fcm__json *roo
   *q = fcm_cell_rules_options_default();
   double gib = q->max_rule_memory / GIB;
   FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "quadrature", 0, &o));
-  if (!o) return FCM_OK;
+  if (!o) o = fcm__json_empty_object(); /* the defaults, recorded in the normalized scene */
   SCENE_ENTER(p, "quadrature");
   size_t here = p->path_len;
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, SCENE_COUNT(keys)));
@@ -44,7 +44,8 @@ fcm_status fcm__scene_read_quadrature(fcm__scene_parser *p, const fcm__json *roo
                     q->simplify_options.method);
   SCENE_READ_CHOICE(p, o, "moments", 0, fcm__scene_moments_names, q->moments);
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "stabilization", 0, &stab));
-  if (stab) {
+  if (!stab) stab = fcm__json_empty_object();
+  {
     SCENE_ENTER(p, "stabilization");
     FCM_TRY(p->ctx, fcm__scene_check_object(p, stab, skeys, SCENE_COUNT(skeys)));
     SCENE_READ_CHOICE(p, stab, "mode", 0, fcm__scene_stabilization_names, q->stabilization.mode);
@@ -165,7 +166,7 @@ fcm_status fcm__scene_read_solver(fcm__scene_parser *p, const fcm__json *root)
   sv->petsc_options = NULL;
   sv->stop_on_inversion = 0;
   FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "solver", 0, &o));
-  if (!o) return FCM_OK;
+  if (!o) o = fcm__json_empty_object();
   SCENE_ENTER(p, "solver");
   size_t here = p->path_len;
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, SCENE_COUNT(keys)));
@@ -176,7 +177,8 @@ fcm_status fcm__scene_read_solver(fcm__scene_parser *p, const fcm__json *root)
   SCENE_READ_CHOICE(p, o, "preconditioner_tangent", 0, fcm__scene_tangent_names,
                     s->preconditioner_tangent);
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "schwarz", 0, &sw));
-  if (sw) {
+  if (!sw) sw = fcm__json_empty_object();
+  {
     SCENE_ENTER(p, "schwarz");
     FCM_TRY(p->ctx, fcm__scene_check_object(p, sw, skeys, SCENE_COUNT(skeys)));
     FCM_TRY(p->ctx, fcm__scene_read_number(p, sw, "threshold", 0, (fcm__range){0.0, 1.0, 1, 0},
@@ -192,7 +194,8 @@ fcm_status fcm__scene_read_solver(fcm__scene_parser *p, const fcm__json *root)
   SCENE_READ_INT(p, o, "max_iterations", 0, 1, 1000000000, s->krylov_max_iterations);
   SCENE_READ_INT(p, o, "stagnation_window", 0, 0, 1000000000, s->krylov_stagnation_window);
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "newton", 0, &nw));
-  if (nw) {
+  if (!nw) nw = fcm__json_empty_object();
+  {
     SCENE_ENTER(p, "newton");
     FCM_TRY(p->ctx, fcm__scene_check_object(p, nw, nkeys, SCENE_COUNT(nkeys)));
     FCM_TRY(p->ctx, fcm__scene_read_number(p, nw, "rtol", 0, (fcm__range){0.0, 1.0, 1, 1},
@@ -212,7 +215,7 @@ fcm_status fcm__scene_read_solver(fcm__scene_parser *p, const fcm__json *root)
   SCENE_READ_INT(p, o, "threads", 0, 0, 4096, sv->threads);
   if (sv->threads == 0) sv->threads = FCM_DEFAULT; /* "threads": 0, the OpenMP default */
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "multigrid", 0, &mg));
-  if (mg) FCM_TRY(p->ctx, read_multigrid(p, mg, s));
+  FCM_TRY(p->ctx, read_multigrid(p, mg ? mg : fcm__json_empty_object(), s));
   FCM_TRY(p->ctx, check_multigrid(p, s));
   FCM_TRY(p->ctx, fcm__scene_read_string(p, o, "petsc_options", 0, &sv->petsc_options));
   SCENE_READ_CHOICE(p, o, "on_inversion", 0, fcm__scene_inversion_names, sv->stop_on_inversion);
@@ -283,6 +286,15 @@ fcm_status fcm__scene_read_time(fcm__scene_parser *p, const fcm__json *root)
   t->duration = (double)steps * t->dt;
   SCENE_CHECK(isfinite(t->duration), p, FCM_ERR_ARG,
               "expected a finite simulated time, got steps * dt = %g", t->duration);
+  if (p->norm) { /* the normalized section says what was resolved: keys for this kind only */
+    fcm__json_remove(p->norm, "time");
+    fcm__scene_path_pop(p, old);
+    fcm__scene_put_resolved_time(
+        p, is_static,
+        fcm__scene_integrator_names[fcm__scene_choice_index(
+            fcm__scene_integrator_values, SCENE_COUNT(fcm__scene_integrator_names), (int)dynamic)],
+        t->dt, steps, t->load_steps);
+  }
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
@@ -303,7 +315,7 @@ fcm_status fcm__scene_read_output(fcm__scene_parser *p, const fcm__json *root)
   out->write_background = 1;
   out->write_surface = 1;
   FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "output", 0, &o));
-  if (!o) return FCM_OK;
+  if (!o) o = fcm__json_empty_object();
   SCENE_ENTER(p, "output");
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, SCENE_COUNT(keys)));
   FCM_TRY(p->ctx, fcm__scene_read_string(p, o, "directory", 0, &out->directory));

@@ -75,9 +75,15 @@ const int fcm__scene_integrator_values[] = {FCM_INTEGRATOR_BACKWARD_EULER};
 
 const char *fcm__scene_choice_name(const char *const *names, const int *values, int n, int value)
 {
+  const int i = fcm__scene_choice_index(values, n, value);
+  return i >= 0 ? names[i] : "?";
+}
+
+int fcm__scene_choice_index(const int *values, int n, int value)
+{
   for (int i = 0; i < n; i++)
-    if (values[i] == value) return names[i];
-  return "?";
+    if (values[i] == value) return i;
+  return -1;
 }
 
 /* ---------------------------------------------------------------- the whole scene */
@@ -199,6 +205,8 @@ static fcm_status create(fcm_ctx *ctx, const char *text, size_t length, const ch
   memset(&p, 0, sizeof p);
   p.ctx = ctx;
   p.source = source;
+  p.norm = fcm__json_new_object();
+  FCM_CHECK(p.norm, ctx, FCM_ERR_ALLOC, "scene: out of memory for the normalized scene");
   FCM_ALLOC(ctx, 1, s);
   s->ctx = ctx;
   p.scene = s;
@@ -248,9 +256,17 @@ static fcm_status create(fcm_ctx *ctx, const char *text, size_t length, const ch
               source, line, col, near);
   }
   FCM_TRY(ctx, parse_root(&p, root));
+  {
+    char *json = p.norm_failed ? NULL : fcm__json_print(p.norm);
+    FCM_CHECK(json, ctx, FCM_ERR_ALLOC, "scene: out of memory for the normalized scene");
+    st = fcm__scene_strdup(&p, json, &s->json);
+    fcm__json_free_text(json);
+    FCM_TRY(ctx, st);
+  }
   *out = s;
   s = NULL;
 cleanup:
+  fcm__json_delete(p.norm);
   fcm__json_delete(root);
   fcm_scene_destroy(&s);
   return st;
@@ -294,6 +310,10 @@ const char *fcm_scene_name(const fcm_scene *s)
 const char *fcm_scene_description(const fcm_scene *s)
 {
   return s->description;
+}
+const char *fcm_scene_json(const fcm_scene *s)
+{
+  return s->json;
 }
 const char *fcm_scene_source(const fcm_scene *s)
 {

@@ -46,6 +46,28 @@ int fcm__json_size(const fcm__json *node);
 /* Member of an object by exact (case-sensitive) name, the first one; NULL if absent. */
 const fcm__json *fcm__json_member(const fcm__json *object, const char *key);
 
+/* The normalized scene tree (json_adapter.c): an object to which the parser adds every value
+ * it reads, at its JSON path ("effects[2].motion.end"), with the defaults it fills in. put_*
+ * replace what is at the path; put_copy puts a copy of an input value only where nothing is
+ * yet (a section the readers then complete). They return 0 when an allocation failed. */
+fcm__json *fcm__json_new_object(void);
+/* An object without members: what a section parser reads when the section is absent, so that
+ * its defaults are recorded too. */
+const fcm__json *fcm__json_empty_object(void);
+/* The member `key` of an object of the normalized tree (NULL if none); remove it. */
+fcm__json *fcm__json_member_mutable(fcm__json *object, const char *key);
+void fcm__json_remove(fcm__json *object, const char *key);
+/* Remove the value at `path` of the normalized tree, if there is one. */
+void fcm__json_remove_path(fcm__json *root, const char *path);
+int fcm__json_put_copy(fcm__json *root, const char *path, const fcm__json *value);
+int fcm__json_put_number(fcm__json *root, const char *path, double x);
+int fcm__json_put_bool(fcm__json *root, const char *path, int b);
+int fcm__json_put_string(fcm__json *root, const char *path, const char *s);
+int fcm__json_put_numbers(fcm__json *root, const char *path, const double *x, int n);
+/* The tree as indented JSON text (malloc'd: fcm__json_free_text()), NULL on failure. */
+char *fcm__json_print(const fcm__json *root);
+void fcm__json_free_text(char *text);
+
 /* ---------------------------------------------------------------- the scene */
 
 typedef struct fcm__scene_block fcm__scene_block;
@@ -54,6 +76,7 @@ struct fcm_scene {
   fcm_ctx *ctx;
   fcm__scene_block *blocks; /* every allocation owned by the scene, freed at destroy */
   const char *name, *description, *source;
+  const char *json; /* the normalized scene (fcm_scene_json()) */
   fcm_scene_background background;
   fcm_scene_geometry geometry;
   fcm_material material;
@@ -81,6 +104,8 @@ typedef struct fcm__scene_parser {
   const char *base_dir; /* prefix for relative file names ("" or ending in '/') */
   char path[FCM__SCENE_PATH_LEN];
   size_t path_len;
+  fcm__json *norm; /* the normalized tree (NULL: not recorded) */
+  int norm_failed; /* an allocation of the normalized tree failed */
 } fcm__scene_parser;
 
 /* Record an error "<source>: <path>: <message>" (or "<source>: <message>" at the root). */
@@ -101,6 +126,15 @@ fcm_status fcm__scene_error(fcm__scene_parser *p, fcm_status code, const char *f
 size_t fcm__scene_path_push_key(fcm__scene_parser *p, const char *key);
 size_t fcm__scene_path_push_index(fcm__scene_parser *p, int index);
 void fcm__scene_path_pop(fcm__scene_parser *p, size_t old_len);
+
+/* Remove the value at the parser's path + key from its normalized tree: a key whose absence
+ * means something no value of it says (an initial velocity's "center": the centre of mass). */
+void fcm__scene_forget(fcm__scene_parser *p, const char *key);
+
+/* The normalized scene's "time" section as resolved: static or the integrator, dt, the step
+ * count, and for static scenes the load steps (the parser is at the root). */
+void fcm__scene_put_resolved_time(fcm__scene_parser *p, int is_static, const char *integrator,
+                                  double dt, long long steps, int load_steps);
 
 /* Short description of a JSON value for messages: 3.5, "text", true, null, an array, ... */
 void fcm__scene_describe(const fcm__json *node, char *buf, size_t len);
@@ -192,7 +226,7 @@ fcm_status fcm__scene_strdup(fcm__scene_parser *p, const char *s, const char **o
  * order need not be the names' order). */
 #define SCENE_READ_CHOICE_AS(p, obj, key, required, names, values, out)                            \
   do {                                                                                             \
-    int ch_ = -1;                                                                                  \
+    int ch_ = fcm__scene_choice_index((values), SCENE_COUNT(names), (int)(out));                   \
     FCM_TRY((p)->ctx, fcm__scene_read_choice((p), (obj), (key), (required), (names),               \
                                              SCENE_COUNT(names), &ch_));                           \
     if (ch_ >= 0) (out) = (values)[ch_]; /* an enum of the library */                              \
@@ -215,6 +249,8 @@ fcm_status fcm__scene_strdup(fcm__scene_parser *p, const char *s, const char **o
 
 /* The name of `value` among n names/values (the summary's names of library enums); "?" if none. */
 const char *fcm__scene_choice_name(const char *const *names, const int *values, int n, int value);
+/* The index of `value` among n values; -1 if none. */
+int fcm__scene_choice_index(const int *values, int n, int value);
 
 /* Names of the scene's choices (scene.c), read by the section parsers and printed by the
  * summary. Without a values table the index is the library's enum value. */

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #define DESC_LEN  96
 #define RANGE_LEN 96
@@ -178,6 +179,67 @@ cleanup:
   return st;
 }
 
+/* ------------------------------------------------------ the normalized tree (p->norm) */
+
+static void note(fcm__scene_parser *p, int ok)
+{
+  if (!ok) p->norm_failed = 1;
+}
+
+/* The value at the current path + key: a number, a bool, a string, an array of numbers. */
+static void put_number(fcm__scene_parser *p, const char *key, double x)
+{
+  if (!p->norm) return;
+  size_t o = key ? fcm__scene_path_push_key(p, key) : p->path_len;
+  note(p, fcm__json_put_number(p->norm, p->path, x));
+  fcm__scene_path_pop(p, o);
+}
+
+static void put_bool(fcm__scene_parser *p, const char *key, int b)
+{
+  if (!p->norm) return;
+  size_t o = key ? fcm__scene_path_push_key(p, key) : p->path_len;
+  note(p, fcm__json_put_bool(p->norm, p->path, b));
+  fcm__scene_path_pop(p, o);
+}
+
+static void put_string(fcm__scene_parser *p, const char *key, const char *s)
+{
+  if (!p->norm || !s) return;
+  size_t o = key ? fcm__scene_path_push_key(p, key) : p->path_len;
+  note(p, fcm__json_put_string(p->norm, p->path, s));
+  fcm__scene_path_pop(p, o);
+}
+
+static void put_numbers(fcm__scene_parser *p, const char *key, const double *x, int n)
+{
+  if (!p->norm) return;
+  size_t o = key ? fcm__scene_path_push_key(p, key) : p->path_len;
+  note(p, fcm__json_put_numbers(p->norm, p->path, x, n));
+  fcm__scene_path_pop(p, o);
+}
+
+void fcm__scene_forget(fcm__scene_parser *p, const char *key)
+{
+  if (!p->norm) return;
+  size_t o = fcm__scene_path_push_key(p, key);
+  fcm__json_remove_path(p->norm, p->path);
+  fcm__scene_path_pop(p, o);
+}
+
+void fcm__scene_put_resolved_time(fcm__scene_parser *p, int is_static, const char *integrator,
+                                  double dt, long long steps, int load_steps)
+{
+  if (!p->norm) return;
+  size_t o = fcm__scene_path_push_key(p, "time");
+  put_bool(p, "static", is_static);
+  if (!is_static) put_string(p, "integrator", integrator);
+  put_number(p, "dt", dt);
+  put_number(p, "steps", (double)steps);
+  if (is_static) put_number(p, "load_steps", (double)load_steps);
+  fcm__scene_path_pop(p, o);
+}
+
 fcm_status fcm__scene_field(fcm__scene_parser *p, const fcm__json *obj, const char *key,
                             int required, const char *want, fcm__json_kind kind, int len,
                             const fcm__json **out)
@@ -197,6 +259,7 @@ fcm_status fcm__scene_field(fcm__scene_parser *p, const fcm__json *obj, const ch
     SCENE_CHECK(fcm__json_get_kind(v) == kind && (len < 0 || fcm__json_size(v) == len), p,
                 FCM_ERR_ARG, "expected %s, got %s", want, got);
   }
+  if (p->norm) note(p, fcm__json_put_copy(p->norm, p->path, v));
   *out = v;
 cleanup:
   return st;
@@ -211,8 +274,12 @@ fcm_status fcm__scene_read_number(fcm__scene_parser *p, const fcm__json *obj, co
   size_t old = p->path_len;
   fcm__scene_range_text(range, want, sizeof want);
   FCM_TRY(p->ctx, fcm__scene_field(p, obj, key, required, want, FCM__SCENE_ANY_KIND, -1, &v));
-  if (!v) return FCM_OK;
+  if (!v) { /* the default, where it is a value the key takes */
+    if (in_range(*out, range)) put_number(p, key, *out);
+    return FCM_OK;
+  }
   FCM_TRY(p->ctx, check_number(p, v, range, out));
+  put_number(p, NULL, *out);
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
@@ -227,8 +294,12 @@ fcm_status fcm__scene_read_int(fcm__scene_parser *p, const fcm__json *obj, const
   size_t old = p->path_len;
   snprintf(want, sizeof want, "an integer in [%lld, %lld]", lo, hi);
   FCM_TRY(p->ctx, fcm__scene_field(p, obj, key, required, want, FCM__SCENE_ANY_KIND, -1, &v));
-  if (!v) return FCM_OK;
+  if (!v) {
+    if (*out >= lo && *out <= hi) put_number(p, key, (double)*out);
+    return FCM_OK;
+  }
   FCM_TRY(p->ctx, check_int(p, v, lo, hi, out));
+  put_number(p, NULL, (double)*out);
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
@@ -241,7 +312,10 @@ fcm_status fcm__scene_read_bool(fcm__scene_parser *p, const fcm__json *obj, cons
   const fcm__json *v = NULL;
   size_t old = p->path_len;
   FCM_TRY(p->ctx, fcm__scene_field(p, obj, key, required, "true or false", FCM__JSON_BOOL, -1, &v));
-  if (!v) return FCM_OK;
+  if (!v) {
+    if (*out == 0 || *out == 1) put_bool(p, key, *out);
+    return FCM_OK;
+  }
   *out = fcm__json_bool(v);
 cleanup:
   fcm__scene_path_pop(p, old);
@@ -257,7 +331,13 @@ fcm_status fcm__scene_read_bool_or_word(fcm__scene_parser *p, const fcm__json *o
   size_t old = p->path_len;
   snprintf(want, sizeof want, "true, false or \"%s\"", word);
   FCM_TRY(p->ctx, fcm__scene_field(p, obj, key, required, want, FCM__SCENE_ANY_KIND, -1, &v));
-  if (!v) return FCM_OK;
+  if (!v) {
+    if (*out == word_value)
+      put_string(p, key, word);
+    else if (*out == 0 || *out == 1)
+      put_bool(p, key, *out);
+    return FCM_OK;
+  }
   if (fcm__json_get_kind(v) == FCM__JSON_BOOL) {
     *out = fcm__json_bool(v);
   } else {
@@ -315,6 +395,7 @@ fcm_status fcm__scene_read_string(fcm__scene_parser *p, const fcm__json *obj, co
   const char *raw = NULL;
   FCM_TRY(p->ctx, string_node(p, obj, key, required, "a non-empty string", &raw));
   if (raw) FCM_TRY(p->ctx, fcm__scene_strdup(p, raw, out));
+  if (!raw) put_string(p, key, *out); /* a default, if any */
 cleanup:
   return st;
 }
@@ -335,7 +416,11 @@ fcm_status fcm__scene_read_vec3(fcm__scene_parser *p, const fcm__json *obj, cons
     snprintf(want, sizeof want, "an array of 3 finite numbers%s", tail ? tail + 6 : "");
   }
   FCM_TRY(p->ctx, fcm__scene_field(p, obj, key, required, want, FCM__JSON_ARRAY, 3, &v));
-  if (!v) return FCM_OK;
+  if (!v) {
+    if (in_range(out[0], range) && in_range(out[1], range) && in_range(out[2], range))
+      put_numbers(p, key, out, 3);
+    return FCM_OK;
+  }
   int i = 0;
   for (const fcm__json *c = fcm__json_child(v); c; c = fcm__json_next(c), i++) {
     size_t o = fcm__scene_path_push_index(p, i);
@@ -343,6 +428,7 @@ fcm_status fcm__scene_read_vec3(fcm__scene_parser *p, const fcm__json *obj, cons
     fcm__scene_path_pop(p, o);
   }
   memcpy(out, tmp, sizeof tmp);
+  put_numbers(p, NULL, out, 3);
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
@@ -358,7 +444,13 @@ fcm_status fcm__scene_read_ivec3(fcm__scene_parser *p, const fcm__json *obj, con
   long long tmp[3];
   snprintf(want, sizeof want, "an array of 3 integers in [%lld, %lld]", lo, hi);
   FCM_TRY(p->ctx, fcm__scene_field(p, obj, key, required, want, FCM__JSON_ARRAY, 3, &v));
-  if (!v) return FCM_OK;
+  if (!v) {
+    double x[3] = {(double)out[0], (double)out[1], (double)out[2]};
+    if (out[0] >= lo && out[0] <= hi && out[1] >= lo && out[1] <= hi && out[2] >= lo &&
+        out[2] <= hi)
+      put_numbers(p, key, x, 3);
+    return FCM_OK;
+  }
   int i = 0;
   for (const fcm__json *c = fcm__json_child(v); c; c = fcm__json_next(c), i++) {
     size_t o = fcm__scene_path_push_index(p, i);
@@ -389,7 +481,10 @@ fcm_status fcm__scene_read_choice(fcm__scene_parser *p, const fcm__json *obj, co
   size_t old = p->path_len;
   list_names(names, n, "one of ", want, sizeof want);
   FCM_TRY(p->ctx, string_node(p, obj, key, required, want, &raw));
-  if (!raw) return FCM_OK;
+  if (!raw) {
+    if (*out >= 0 && *out < n) put_string(p, key, names[*out]);
+    return FCM_OK;
+  }
   fcm__scene_path_push_key(p, key);
   int found = -1;
   for (int i = 0; i < n && found < 0; i++)
@@ -398,6 +493,7 @@ fcm_status fcm__scene_read_choice(fcm__scene_parser *p, const fcm__json *obj, co
   fcm__scene_describe(fcm__json_member(obj, key), got, sizeof got);
   SCENE_CHECK(found >= 0, p, FCM_ERR_ARG, "expected %s, got %s", want, got);
   *out = found;
+  put_string(p, NULL, names[found]);
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;
@@ -475,6 +571,12 @@ fcm_status fcm__scene_read_file(fcm__scene_parser *p, const fcm__json *obj, cons
     goto cleanup;
   }
   snprintf(full, n, "%s%s%s", base, raw, suffix);
+  if (p->norm) { /* absolute, so that the normalized scene reads the same file from anywhere */
+    char cwd[4096], name[8192];
+    const int rel = full[0] != '/' && getcwd(cwd, sizeof cwd);
+    snprintf(name, sizeof name, "%s%s%s%s", rel ? cwd : "", rel ? "/" : "", base, raw);
+    put_string(p, NULL, name);
+  }
   struct stat sb;
   if (stat(full, &sb) != 0) {
     sys_error(errno, err, sizeof err);
