@@ -68,3 +68,7 @@ fcm_add_test(sim_rigid_modes tests/sim/rigid_modes.c)
 foreach(el hex8 tet10)
   fcm_add_test(sim_reuse_${el} tests/sim/reuse.c ARGS ${el})
 endforeach()
+# Interactive steps: the fixed-iteration rule runs exactly N Newton iterations and reports the
+# residual it reached; fixed multigrid cycles warm-started from the previous step beat cold
+# ones against the direct solution; fixed cycles without the multigrid solver are refused.
+fcm_add_test(sim_interactive tests/sim/interactive.c)
