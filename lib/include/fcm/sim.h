@@ -165,7 +165,8 @@ typedef struct fcm_integrator_options {
    * FCM_STEP_CONVERGED: a further update would be round-off). A failed line search, a failed
    * linear solve or NaN still fail the (sub)step, which is then halved as usual. The last
    * iteration assembles no tangent for a next one. Combine with multigrid_fixed_cycles for
-   * the cost of Dick et al. (2011): 1 iteration of 3 V-cycles. In [0, 10^6]
+   * the cost of Dick et al. (2011): 1 iteration of 3 V-cycles. newton_max_iterations is then
+   * unused. A predictor iteration (prescribed motion) counts as one. In [0, 10^6]
    * ["newton.fixed_iterations"] */
   int newton_fixed_iterations;
   fcm_linear_solver linear_solver;   /**< default FCM_LINEAR_DIRECT ["method"] */
