@@ -143,16 +143,24 @@ static void progress(int tty, long long k, long long n, long long step, long lon
     for (int i = 0; i < width; i++)
       bar[i] = i < fill ? '#' : '.';
     bar[width] = '\0';
-    fprintf(stderr, "\r[%s] %lld/%lld t=%.4g s newton %d  ETA %.0f s   ", bar, step, total,
-            si->time, si->newton_iterations, eta);
+    /* an interactive step (fixed Newton iterations) shows how far from the tolerance it is */
+    if (si->reason == FCM_STEP_FIXED_ITERATIONS)
+      fprintf(stderr, "\r[%s] %lld/%lld t=%.4g s newton %d residual %.2e > tol %.2e  ETA %.0f s   ",
+              bar, step, total, si->time, si->newton_iterations, si->residual, si->tolerance, eta);
+    else
+      fprintf(stderr, "\r[%s] %lld/%lld t=%.4g s newton %d  ETA %.0f s   ", bar, step, total,
+              si->time, si->newton_iterations, eta);
     if (k == n) fputc('\n', stderr);
   } else {
     char mg[48] = "";
     if (si->multigrid_cycles > 0)
       snprintf(mg, sizeof mg, " multigrid cycles %lld", si->multigrid_cycles);
     fprintf(stderr,
-            "fcm-sim: step %lld/%lld t=%.6g s newton %d linear %lld%s residual %.3e (%.3f s)\n",
+            "fcm-sim: step %lld/%lld t=%.6g s newton %d linear %lld%s residual %.3e tolerance "
+            "%.3e%s (%.3f s)\n",
             step, total, si->time, si->newton_iterations, si->linear_iterations, mg, si->residual,
+            si->tolerance,
+            si->reason == FCM_STEP_FIXED_ITERATIONS ? " (fixed iterations: not converged)" : "",
             si->time_total);
   }
 }

@@ -99,7 +99,7 @@ static void read_log(const char *path, log_rows *L)
       if (c == col_inv) L->inverted[L->n] = v;
       if (c == col_nan) L->nonfinite[L->n] = v;
     }
-    TEST_TRUE(c == col_nan + 2); /* then the wall time */
+    TEST_TRUE(c == col_nan + 3); /* then the Newton tolerance and the wall time */
     L->n++;
   }
   fclose(f);

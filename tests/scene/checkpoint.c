@@ -249,7 +249,8 @@ static void write_linear(fcm_ctx *ctx, const fcm_scene *scene, fcm_simulation *s
                               fcm_integrator_time(in),
                               tm->dt * dt_factor};
   fcm__ckpt_writer w;
-  TEST_OK(ctx, fcm__ckpt_open(ctx, path, FCM__CKPT_MAGIC, FCM__CKPT_LINEAR_VERSION, &w));
+  TEST_OK(ctx, fcm__ckpt_open(ctx, path, FCM__CKPT_MAGIC,
+                              4u /* the first version with this payload */, &w));
   TEST_OK(ctx, fcm__ckpt_put_linear(&w, &h, fcm_integrator_displacement(in),
                                     fcm_integrator_velocity(in)));
   TEST_OK(ctx, fcm__ckpt_commit(&w));

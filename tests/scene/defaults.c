@@ -40,6 +40,7 @@ static void same_integrator(const fcm_integrator_options *a, const fcm_integrato
   SAME(a, b, project_psd);
   SAME(a, b, reuse_factorization);
   SAME(a, b, reuse_contraction);
+  SAME(a, b, newton_fixed_iterations);
   SAME(a, b, linear_solver);
   SAME(a, b, direct_method);
   SAME(a, b, preconditioner);
@@ -48,6 +49,7 @@ static void same_integrator(const fcm_integrator_options *a, const fcm_integrato
   SAME(a, b, krylov_atol);
   SAME(a, b, krylov_max_iterations);
   SAME(a, b, krylov_stagnation_window);
+  SAME(a, b, multigrid_fixed_cycles);
   SAME(a, b, schwarz_theta);
   SAME(a, b, schwarz.epsilon);
   SAME(a, b, schwarz.clamp);
@@ -137,9 +139,10 @@ int main(void)
            " \"post_smooth\": 1, \"cycle\": \"w\", \"coarse_dofs\": 2000,"
            " \"block_smoothing\": true},"
            " \"rtol\": 1e-8, \"atol\": 0, \"max_iterations\": 1000, \"stagnation_window\": 50,"
+           " \"fixed_cycles\": 0,"
            " \"newton\": {\"rule\": \"auto\", \"rtol\": 1e-5, \"max_iterations\": 100,"
            " \"line_search\": true, \"project_psd\": false, \"reuse_factorization\": true,"
-           " \"reuse_contraction\": 0.25,"
+           " \"reuse_contraction\": 0.25, \"fixed_iterations\": 0,"
            " \"representative_acceleration\": 9.81},"
            " \"threads\": 0, \"on_inversion\": \"warn\"}}",
            head);

@@ -95,11 +95,12 @@ static void static_hang(fcm_ctx *ctx)
   char header[1024] = "";
   double rows[8][32];
   int ncol = 0;
-  TEST_TRUE(read_log(sim, header, sizeof header, rows, &ncol) == 1 && ncol == 20);
+  TEST_TRUE(read_log(sim, header, sizeof header, rows, &ncol) == 1 && ncol == 21);
   TEST_TRUE(strstr(header, ",momentum_z,reaction_1_x,reaction_1_y,reaction_1_z,moment_1_x,"
                            "moment_1_y,moment_1_z,inverted_points,nonfinite_stresses,"
-                           "wall_time\n") != NULL);
-  TEST_TRUE(rows[0][17] == 0.0 && isnan(rows[0][18])); /* nothing inverted, no frame */
+                           "tolerance,wall_time\n") != NULL);
+  TEST_TRUE(rows[0][19] > 0.0 && rows[0][4] <= rows[0][19]); /* converged: residual <= tol */
+  TEST_TRUE(rows[0][17] == 0.0 && isnan(rows[0][18]));       /* nothing inverted, no frame */
   /* minus the assembled weight and its moment: sum f and sum (X + u) x f over all copies */
   const fcm_space *space = fcm_simulation_space(sim);
   fcm_integrator *integ = fcm_simulation_integrator(sim);
@@ -199,7 +200,7 @@ static uint64_t fnv(const unsigned char *p, size_t n)
   return h;
 }
 
-/* An older checkpoint made from a current one (version 4) of a one-row log: the `cut` bytes at
+/* An older checkpoint made from a current one (version 5) of a one-row log: the `cut` bytes at
  * row offset `at` (from the row's start) dropped, the version set and the checksum redone. */
 static void derive_checkpoint(const unsigned char *buf, long size, uint64_t version, size_t at,
                               size_t cut, const char *path)
@@ -223,34 +224,36 @@ static void derive_checkpoint(const unsigned char *buf, long size, uint64_t vers
   free(b);
 }
 
-/* Checkpoints keep the reaction columns (version 3) and the inversion counts (version 4); a
- * version-3 file restores with NaN counts, a version-2 file (rows without reactions either)
- * with NaN there too. Row: 8 f64 + 3 i64, the one constraint's 6 f64, then 3 i64 counts. */
+/* Checkpoints keep the reaction columns (version 3), the inversion counts (version 4) and the
+ * Newton tolerance (version 5); a version-4 file restores with a NaN tolerance, a version-3
+ * file with NaN counts too, a version-2 file (rows without reactions either) with NaN there
+ * too. Row: 8 f64 + 3 i64, the one constraint's 6 f64, 3 i64 counts, then 1 f64. */
 static void checkpoint_versions(fcm_ctx *ctx)
 {
   fcm_scene *scene = NULL;
   fcm_simulation *sim = NULL, *back = NULL;
   unsigned char *buf = NULL;
-  const char *v4 = "scene_output_v4.fcmck",
-             *old[2] = {"scene_output_v3.fcmck", "scene_output_v2.fcmck"};
+  const char *v5 = "scene_output_v5.fcmck",
+             *old[3] = {"scene_output_v4.fcmck", "scene_output_v3.fcmck", "scene_output_v2.fcmck"};
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, static_json, "hang.json", &scene));
   if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
   if (!sim) goto done;
   TEST_OK(ctx, fcm_simulation_step(sim, NULL));
-  TEST_OK(ctx, fcm_simulation_write_checkpoint(sim, v4));
+  TEST_OK(ctx, fcm_simulation_write_checkpoint(sim, v5));
   char h1[1024] = "", h2[1024] = "";
   double r1[8][32], r2[8][32];
   int n1 = 0, n2 = 0;
-  TEST_TRUE(read_log(sim, h1, sizeof h1, r1, &n1) == 1 && n1 == 20);
+  TEST_TRUE(read_log(sim, h1, sizeof h1, r1, &n1) == 1 && n1 == 21);
   TEST_TRUE(r1[0][17] == 0.0 && isnan(r1[0][18])); /* nothing inverted; no frame */
+  TEST_TRUE(r1[0][19] > 0.0);                      /* the Newton tolerance */
   TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &back));
-  if (back) TEST_OK(ctx, fcm_simulation_read_checkpoint(back, v4));
+  if (back) TEST_OK(ctx, fcm_simulation_read_checkpoint(back, v5));
   if (back) TEST_TRUE(read_log(back, h2, sizeof h2, r2, &n2) == 1 && n2 == n1);
-  for (int k = 0; k < 18 && back; k++)
-    TEST_TRUE(r1[0][k] == r2[0][k]); /* bit for bit, the reactions and the count too */
+  for (int k = 0; k < 20 && back; k++)
+    TEST_TRUE(k == 18 || r1[0][k] == r2[0][k]); /* bit for bit: reactions, count, tolerance */
   if (back) TEST_TRUE(isnan(r2[0][18]));
   fcm_simulation_destroy(&back);
-  FILE *f = fopen(v4, "rb");
+  FILE *f = fopen(v5, "rb");
   long size = 0;
   if (f && fseek(f, 0, SEEK_END) == 0) size = ftell(f);
   buf = calloc((size_t)size + 256, 1);
@@ -258,27 +261,29 @@ static void checkpoint_versions(fcm_ctx *ctx)
   TEST_TRUE(f && size > 0 && fread(buf, 1, (size_t)size, f) == (size_t)size);
   if (f) fclose(f);
   if (size < 256) {
-    TEST_FAIL_("checkpoint %s has only %ld bytes", v4, size);
+    TEST_FAIL_("checkpoint %s has only %ld bytes", v5, size);
     goto done;
   }
-  derive_checkpoint(buf, size, 3, 8 * 8 + 3 * 8 + 6 * 8, 3 * 8, old[0]);
-  derive_checkpoint(buf, size, 2, 8 * 8 + 3 * 8, 6 * 8 + 3 * 8, old[1]);
-  for (int v = 0; v < 2; v++) {
-    const int kept = v == 0 ? 17 : 11; /* the columns the version recorded */
+  derive_checkpoint(buf, size, 4, 8 * 8 + 3 * 8 + 6 * 8 + 3 * 8, 8, old[0]);
+  derive_checkpoint(buf, size, 3, 8 * 8 + 3 * 8 + 6 * 8, 3 * 8 + 8, old[1]);
+  derive_checkpoint(buf, size, 2, 8 * 8 + 3 * 8, 6 * 8 + 3 * 8 + 8, old[2]);
+  for (int v = 0; v < 3; v++) {
+    const int kept = v == 0 ? 18 : v == 1 ? 17 : 11; /* the columns the version recorded */
     TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &back));
     if (back) TEST_OK(ctx, fcm_simulation_read_checkpoint(back, old[v]));
     if (back) TEST_TRUE(read_log(back, h2, sizeof h2, r2, &n2) == 1 && n2 == n1);
     for (int k = 0; k < kept && back; k++)
       TEST_TRUE(r1[0][k] == r2[0][k]);
-    for (int k = kept; k < 19 && back; k++)
+    for (int k = kept; k < 20 && back; k++)
       TEST_TRUE(isnan(r2[0][k])); /* not recorded by that version */
     fcm_simulation_destroy(&back);
   }
 done:
   free(buf);
-  remove(v4);
+  remove(v5);
   remove(old[0]);
   remove(old[1]);
+  remove(old[2]);
   fcm_simulation_destroy(&back);
   fcm_simulation_destroy(&sim);
   fcm_scene_destroy(&scene);
@@ -298,7 +303,7 @@ static void dynamic_block(fcm_ctx *ctx)
   char header[1024] = "";
   double rows[8][32];
   int ncol = 0;
-  TEST_TRUE(read_log(sim, header, sizeof header, rows, &ncol) == 4 && ncol == 20);
+  TEST_TRUE(read_log(sim, header, sizeof header, rows, &ncol) == 4 && ncol == 21);
   const double W[3] = {0, 0, -1000.0 * 9.81 * 2.0};
   double p0[3] = {0, 0, 0};
   for (int k = 0; k < 4; k++) {

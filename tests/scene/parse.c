@@ -71,6 +71,7 @@ static void check_full(fcm_ctx *ctx)
             so->krylov_max_iterations == 321);
   TEST_TRUE(so->krylov_stagnation_window == 37);
   TEST_TRUE(so->newton_tolerance == 1e-4 && so->newton_max_iterations == 17);
+  TEST_TRUE(so->newton_fixed_iterations == 2 && so->multigrid_fixed_cycles == 0);
   TEST_TRUE(so->line_search == 0 && so->project_psd == 1);
   TEST_TRUE(so->rep_acceleration == 10 && sv->threads == 3);
   TEST_TRUE(sv->stop_on_inversion == 1);
@@ -215,6 +216,7 @@ static void check_defaults(fcm_ctx *ctx)
   TEST_TRUE(so->krylov_rtol == 1e-8 && so->krylov_atol == 0 && so->krylov_max_iterations == 1000);
   TEST_TRUE(so->krylov_stagnation_window == 50);
   TEST_TRUE(so->newton_tolerance == 1e-5 && so->newton_max_iterations == 100);
+  TEST_TRUE(so->newton_fixed_iterations == 0 && so->multigrid_fixed_cycles == 0);
   TEST_TRUE(so->line_search == 1 && so->project_psd == 0);
   TEST_TRUE(so->rep_acceleration == 9.81 && sv->threads == FCM_DEFAULT);
   TEST_TRUE(sv->stop_on_inversion == 0); /* "warn" */

@@ -30,7 +30,7 @@ fcm_add_test(sim_minres_pc_tangent tests/sim/minres_pc_tangent.c)
 fcm_add_test(sim_singular tests/sim/singular.c)
 # Steps after the first allocate nothing through the context (direct
 # CHOLMOD with one symbolic analysis, MINRES + Schwarz, CG + Jacobi, CG + block Jacobi).
-foreach(solver direct minres-schwarz cg-jacobi cg-block minres-mg cg-mg mg)
+foreach(solver direct minres-schwarz cg-jacobi cg-block minres-mg cg-mg mg mg-interactive)
   fcm_add_test(sim_step_alloc_${solver} tests/sim/step_alloc.c ARGS ${solver})
 endforeach()
 fcm_add_test(sim_step_alloc_direct_tet10 tests/sim/step_alloc.c ARGS direct tet10)
@@ -68,3 +68,7 @@ fcm_add_test(sim_rigid_modes tests/sim/rigid_modes.c)
 foreach(el hex8 tet10)
   fcm_add_test(sim_reuse_${el} tests/sim/reuse.c ARGS ${el})
 endforeach()
+# Interactive steps: the fixed-iteration rule runs exactly N Newton iterations and reports the
+# residual it reached; fixed multigrid cycles warm-started from the previous step beat cold
+# ones against the direct solution; fixed cycles without the multigrid solver are refused.
+fcm_add_test(sim_interactive tests/sim/interactive.c)

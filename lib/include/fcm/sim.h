@@ -157,6 +157,18 @@ typedef struct fcm_integrator_options {
                                direction  makes the next one factor anew. 0: a new tangent and
                                  factorization every iteration ["newton.reuse_factorization"] */
   double reuse_contraction; /**< in (0, 1) (default 0.25) ["newton.reuse_contraction"] */
+  /** Interactive steps (the graphics use; 0, the default, is the accurate rule above): N >= 1
+   * makes every (sub)step run N Newton iterations and accept the iterate it reaches whatever
+   * its residual (fcm_step_info.reason FCM_STEP_FIXED_ITERATIONS; residual, tolerance and
+   * residual_reference report how far from the stopping rule it is, and the monitor sees every
+   * iteration). It stops earlier only where the stopping rule already holds (reason
+   * FCM_STEP_CONVERGED: a further update would be round-off). A failed line search, a failed
+   * linear solve or NaN still fail the (sub)step, which is then halved as usual. The last
+   * iteration assembles no tangent for a next one. Combine with multigrid_fixed_cycles for
+   * the cost of Dick et al. (2011): 1 iteration of 3 V-cycles. newton_max_iterations is then
+   * unused. A predictor iteration (prescribed motion) counts as one. In [0, 10^6]
+   * ["newton.fixed_iterations"] */
+  int newton_fixed_iterations;
   fcm_linear_solver linear_solver;   /**< default FCM_LINEAR_DIRECT ["method"] */
   fcm_direct_method direct_method;   /**< first direct method (default CHOLMOD; UMFPACK: LU only)
                                           ["direct"] */
@@ -168,6 +180,17 @@ typedef struct fcm_integrator_options {
   double krylov_rtol;                                /**< in [0, 1) (default 1e-8) ["rtol"] */
   double krylov_atol;                                /**< >= 0 (default 0) ["atol"] */
   int krylov_max_iterations;                         /**< >= 1 (default 1000) ["max_iterations"] */
+  /** FCM_LINEAR_MULTIGRID only (refused with the other solvers: a direct solve is exact and
+   * the Krylov solvers stop at krylov_rtol): K >= 1 makes every solve run exactly K cycles and
+   * take their result without a convergence test (krylov_rtol, krylov_atol and
+   * krylov_max_iterations unused; a non-finite or diverging result, past 1e3 ||b||, still
+   * fails the solve). The first Newton iteration of a (sub)step starts its cycles from the
+   * correction the Newton iterations of the previous accepted (sub)step of the same length
+   * made to their initial guess (Dick et al. 2011: the last solution as the initial guess of
+   * 3 V-cycles with 1 + 1 Gauss-Seidel sweeps), later ones from zero; a change of dt, a
+   * failed step, fcm_integrator_set_state() and fcm_integrator_drop_factorization() start
+   * cold. 0 (default): cycles until the tolerance. In [0, 1000] ["fixed_cycles"] */
+  int multigrid_fixed_cycles;
   int krylov_stagnation_window;  /**< CG and MINRES: stop a solve whose smallest residual dropped
                                       by less than 0.1 % in this many iterations
                                       (fcm_krylov_options.stagnation_window; >= 0, default 50,
@@ -211,18 +234,23 @@ typedef enum fcm_step_reason {
    * or newton_max_iterations with such a solve last): the Newton matrix is singular or
    * nearly so (rigid-body modes no constraint holds, which a static step checks before any
    * solve; a body held at too few points) or, for CG, not positive definite */
-  FCM_STEP_LINEAR_SOLVER_STAGNATED
+  FCM_STEP_LINEAR_SOLVER_STAGNATED,
+  /** Accepted by the fixed-iteration rule (fcm_integrator_options.newton_fixed_iterations):
+   * the Newton iterations ran out before the stopping rule held; fcm_step_info.residual is
+   * above fcm_step_info.tolerance. A success, like FCM_STEP_CONVERGED */
+  FCM_STEP_FIXED_ITERATIONS
 } fcm_step_reason;
 
 /** Name of a reason ("converged", "max-newton", "line-search-failed",
- * "linear-solver-failed", "nonfinite", "linear-solver-stagnated", "none"), or "unknown".
- * Static string. */
+ * "linear-solver-failed", "nonfinite", "linear-solver-stagnated", "fixed-iterations",
+ * "none"), or "unknown". Static string. */
 FCM_API const char *fcm_step_reason_name(fcm_step_reason reason);
 
 /** What one fcm_integrator_step() did. Per-step counts cover every attempt of the step;
  * total_* are cumulative since setup. */
 typedef struct fcm_step_info {
-  fcm_step_reason reason;         /**< CONVERGED on success; else the last failure */
+  fcm_step_reason reason;         /**< CONVERGED or FIXED_ITERATIONS (newton_fixed_iterations)
+                                       on success; else the last failure */
   int newton_iterations;          /**< Newton updates (all attempts) */
   int line_search_backtracks;     /**< step-length halvings */
   long long linear_iterations;    /**< Krylov iterations, or multigrid cycles with
@@ -232,6 +260,10 @@ typedef struct fcm_step_info {
                                        FCM_LINEAR_MULTIGRID (0 otherwise) */
   double residual;                /**< final ||g|| of the last attempt */
   double tolerance;               /**< its threshold */
+  double residual_reference;      /**< the stopping rule's reference: ||M a_rep|| (or the
+                                       equal body force's) for REPRESENTATIVE, R for RELATIVE;
+                                       residual / residual_reference is the relative residual
+                                       that the rule compares with newton_tolerance */
   double dt;                      /**< length of the last (sub)step: time (dynamics) or
                                        pseudo-time (static) */
   int halvings;                   /**< halvings needed (0: the step went through at once) */

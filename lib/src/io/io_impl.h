@@ -159,8 +159,10 @@ fcm_status fcm__ckpt_read_end(fcm__ckpt_reader *r);
  * values after its magic line. */
 #define FCM__CKPT_SOURCE_LINEAR 0ull
 
-/* The container version the linear driver writes (the scene reader reads it from version 4). */
-#define FCM__CKPT_LINEAR_VERSION 4u
+/* The container's version, the same for every writer so that each reader recognizes the other's
+ * files: 4 introduced the linear driver's payload (the scene reader reads it from version 4 on),
+ * 5 the Newton tolerance in a scene run's log rows. */
+#define FCM__CKPT_VERSION 5u
 
 typedef struct fcm__ckpt_linear {
   long long num_dofs, elements, steps, kind;

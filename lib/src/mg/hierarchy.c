@@ -42,6 +42,7 @@ void fcm__mg_level_free(fcm_ctx *ctx, mg_level *L)
   fcm__free(ctx, L->inactive);
   fcm_csr_destroy(&L->Aown);
   fcm__free(ctx, L->diag);
+  fcm__free(ctx, L->tpos);
   fcm__free(ctx, L->dinv);
   fcm__free(ctx, L->P_ptr);
   fcm__free(ctx, L->P_col);

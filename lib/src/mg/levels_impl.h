@@ -55,6 +55,8 @@ typedef struct mg_level {
   const fcm_csr *A;        /* level 0: borrowed */
   fcm_csr *Aown;           /* levels >= 1 */
   fcm_index *diag;         /* position of a_ii */
+  fcm_index *tpos;         /* levels >= 1: per stored entry (i, j) with j > i, the position of
+                              (j, i), for the symmetrization of every Galerkin product */
   double *dinv;            /* 1 / a_ii */
   /* prolongation from level l+1 (n x n_coarse) */
   fcm_index *P_ptr;

@@ -77,7 +77,7 @@ static fcm_status galerkin_values(fcm_mg *m, int l)
       for (fcm_index p = cp[i]; p < cp[i + 1]; p++) {
         const fcm_index j = cc[p];
         if (j <= i) continue;
-        const fcm_index q = fcm_csr_position(C->Aown, j, i);
+        const fcm_index q = C->tpos[p];
         const double s = 0.5 * (v[p] + v[q]);
         v[p] = v[q] = s;
       }
@@ -153,6 +153,19 @@ static fcm_status galerkin_pattern(fcm_mg *m, int l)
                                 nnz >= MG_PARALLEL_NNZ ? fcm__mg_team(m) : 1, &L->ptap, &C->Aown));
   fcm__ptap_transpose(L->ptap, &L->R_ptr, &L->R_col, &L->R_val);
   FCM_TRY(ctx, level_diag(m, C));
+  {
+    /* the transposed positions, found once: every setup symmetrizes with them */
+    const fcm_index *cp = fcm_csr_row_ptr(C->Aown);
+    const int *cc = fcm_csr_col_idx(C->Aown);
+    FCM_ALLOC(ctx, cp[C->n] + 1, C->tpos);
+    for (fcm_index i = 0; i < C->n; i++)
+      for (fcm_index p = cp[i]; p < cp[i + 1]; p++) {
+        C->tpos[p] = cc[p] > i ? fcm_csr_position(C->Aown, cc[p], i) : -1;
+        FCM_CHECK(cc[p] <= i || C->tpos[p] >= 0, ctx, FCM_ERR_INTERNAL,
+                  "mg: level %d: the Galerkin pattern has (%lld, %d) but not its transpose", l + 1,
+                  (long long)i, cc[p]);
+      }
+  }
 cleanup:
   return st;
 }

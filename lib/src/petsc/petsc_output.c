@@ -153,7 +153,7 @@ fcm_status fcm_petsc_problem_write_checkpoint(fcm_petsc_problem *P, const char *
     const fcm__ckpt_linear h = {
         (long long)P->n, (long long)P->space->num_elems, P->steps, (long long)P->opts.kind, P->t,
         P->opts.dt};
-    st = fcm__ckpt_open(ctx, path, ckpt_magic, FCM__CKPT_LINEAR_VERSION, &w);
+    st = fcm__ckpt_open(ctx, path, ckpt_magic, FCM__CKPT_VERSION, &w);
     if (st == FCM_OK) st = fcm__ckpt_put_linear(&w, &h, u, v);
     if (st == FCM_OK) st = fcm__ckpt_commit(&w);
   }
@@ -179,7 +179,7 @@ static fcm_status read_ckpt(fcm_petsc_problem *P, const char *path, double *u, d
   uint64_t source = FCM__CKPT_SOURCE_LINEAR;
   memset(&r, 0, sizeof r);
   FCM_CHECK(path && path[0], ctx, FCM_ERR_ARG, "petsc: checkpoint: NULL or empty path");
-  FCM_TRY(ctx, fcm__ckpt_read_open(ctx, path, ckpt_magic, FCM__CKPT_LINEAR_VERSION, &r));
+  FCM_TRY(ctx, fcm__ckpt_read_open(ctx, path, ckpt_magic, FCM__CKPT_VERSION, &r));
   if (!r.legacy_linear) FCM_TRY(ctx, fcm__ckpt_get_u64(&r, &source, "the source"));
   FCM_CHECK(source == FCM__CKPT_SOURCE_LINEAR, ctx, FCM_ERR_ARG,
             "petsc: checkpoint %s was written by a scene run, not by the linear driver "

@@ -3,8 +3,8 @@
  * simulation of the same scene.
  *
  * The file is the checkpoint container of io (io/checkpoint_file.c: magic "FCMCKPT\0",
- * u64 version, u64 byte-order mark, the payload, u64 FNV-1a 64 checksum), version 4; versions 1
- * to 3 still load. Payload (every integer 8 bytes, doubles IEEE 754 binary64):
+ * u64 version, u64 byte-order mark, the payload, u64 FNV-1a 64 checksum), version 5; versions 1
+ * to 4 still load. Payload (every integer 8 bytes, doubles IEEE 754 binary64):
  *   u64 scene fingerprint (see fingerprint(); never 0, the word of a file without a scene)
  *   i64 num_dofs, i64 steps, f64 time
  *   (version 2) i64 cuts applied (the first k cut effects in time order)
@@ -14,7 +14,8 @@
  *   version 2: i64 pieces; f64 mass, momentum x, y, z;
  *   version 3: 6 x f64 per constraint effect: reaction x, y, z, moment x, y, z;
  *   version 4: i64 inverted quadrature points, i64 cell of the first (-1: none), i64 NaN or
- *   infinite von Mises values of the frame after the step (-1: no frame))
+ *   infinite von Mises values of the frame after the step (-1: no frame);
+ *   version 5: f64 the Newton stopping rule's tolerance)
  *   num_dofs x f64 displacement, num_dofs x f64 velocity
  *
  * The PETSc linear driver (fcm_petsc_problem_write_checkpoint()) writes the same container
@@ -36,7 +37,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#define CKPT_VERSION 4u
+#define CKPT_VERSION FCM__CKPT_VERSION
 
 static const char ckpt_magic[8] = FCM__CKPT_MAGIC;
 
@@ -126,6 +127,7 @@ fcm_status fcm_simulation_write_checkpoint(fcm_simulation *S, const char *path)
     FCM_TRY(ctx, fcm__ckpt_put_i64(&w, r->inverted));
     FCM_TRY(ctx, fcm__ckpt_put_i64(&w, r->inverted_cell));
     FCM_TRY(ctx, fcm__ckpt_put_i64(&w, r->nonfinite));
+    FCM_TRY(ctx, fcm__ckpt_put_f64(&w, r->tolerance));
   }
   FCM_TRY(ctx, fcm__ckpt_put_f64s(&w, fcm_integrator_displacement(S->integ), (size_t)n));
   FCM_TRY(ctx, fcm__ckpt_put_f64s(&w, fcm_integrator_velocity(S->integ), (size_t)n));
@@ -234,7 +236,7 @@ static fcm_status read_linear(fcm_simulation *S, fcm__ckpt_reader *r, ckpt_data 
       fcm__log_row *w = &d->log[k];
       memset(w, 0, sizeof *w);
       w->time = (double)(k + 1) * tm->dt;
-      w->residual = w->energy = w->wall = w->mass = NAN;
+      w->residual = w->tolerance = w->energy = w->wall = w->mass = NAN;
       w->momentum[0] = w->momentum[1] = w->momentum[2] = NAN;
       w->pieces = (long long)S->pieces;
       w->inverted = w->inverted_cell = w->nonfinite = -1;
@@ -272,7 +274,7 @@ static fcm_status read_scene(fcm_simulation *S, fcm__ckpt_reader *r, ckpt_data *
                                "the frame times"));
   }
   FCM_TRY(ctx, fcm__ckpt_get_i64(r, &d->rows, d->steps, d->steps, "log rows (one per step)"));
-  const size_t row_bytes = ver >= 2 ? (8 + (ver >= 3 ? nreact : 0)) * sizeof(double) +
+  const size_t row_bytes = ver >= 2 ? (8 + (ver >= 3 ? nreact : 0) + (ver >= 5)) * sizeof(double) +
                                           (ver >= 4 ? 6 : 3) * sizeof(int64_t)
                                     : 4 * sizeof(double) + 2 * sizeof(int64_t);
   FCM_TRY(ctx, fcm__ckpt_need(r, d->rows, row_bytes, "log rows"));
@@ -307,6 +309,8 @@ static fcm_status read_scene(fcm_simulation *S, fcm__ckpt_reader *r, ckpt_data *
               fcm__ckpt_get_i64(r, &w->inverted_cell, -1, INT64_MAX, "a log row's inverted cell"));
       FCM_TRY(ctx, fcm__ckpt_get_i64(r, &w->nonfinite, -1, INT64_MAX, "a log row's NaN stresses"));
     }
+    w->tolerance = NAN; /* not recorded before version 5 */
+    if (ver >= 5) FCM_TRY(ctx, fcm__ckpt_get(r, &w->tolerance, sizeof w->tolerance, "a log row"));
   }
   FCM_TRY(ctx, read_state(r, d));
 cleanup:

@@ -144,10 +144,14 @@ cleanup:
 fcm_status fcm__scene_read_solver(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {
-      "method",    "direct",         "preconditioner", "schwarz",          "rtol",
-      "atol",      "max_iterations", "newton",         "threads",          "preconditioner_tangent",
-      "multigrid", "petsc_options",  "on_inversion",   "stagnation_window"};
+  static const char *const keys[] = {"method",         "direct",
+                                     "preconditioner", "schwarz",
+                                     "rtol",           "atol",
+                                     "max_iterations", "newton",
+                                     "threads",        "preconditioner_tangent",
+                                     "multigrid",      "petsc_options",
+                                     "on_inversion",   "stagnation_window",
+                                     "fixed_cycles"};
   static const char *const skeys[] = {"threshold", "epsilon", "clamp"};
   static const char *const nkeys[] = {"rtol",
                                       "max_iterations",
@@ -156,7 +160,8 @@ fcm_status fcm__scene_read_solver(fcm__scene_parser *p, const fcm__json *root)
                                       "rule",
                                       "representative_acceleration",
                                       "reuse_factorization",
-                                      "reuse_contraction"};
+                                      "reuse_contraction",
+                                      "fixed_iterations"};
   fcm_scene_solver *sv = &p->scene->solver;
   fcm_integrator_options *s = &sv->integrator;
   const fcm__json *o = NULL, *sw = NULL, *nw = NULL, *mg = NULL;
@@ -193,6 +198,17 @@ fcm_status fcm__scene_read_solver(fcm__scene_parser *p, const fcm__json *root)
   FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "atol", 0, FCM__NONNEGATIVE, &s->krylov_atol));
   SCENE_READ_INT(p, o, "max_iterations", 0, 1, 1000000000, s->krylov_max_iterations);
   SCENE_READ_INT(p, o, "stagnation_window", 0, 0, 1000000000, s->krylov_stagnation_window);
+  SCENE_READ_INT(p, o, "fixed_cycles", 0, 0, 1000, s->multigrid_fixed_cycles);
+  if (s->multigrid_fixed_cycles > 0) {
+    fcm__scene_path_push_key(p, "fixed_cycles");
+    SCENE_CHECK(
+        s->linear_solver == FCM_LINEAR_MULTIGRID, p, FCM_ERR_ARG,
+        "%d fixed cycles need \"method\": \"multigrid\", the method is \"%s\" (a direct "
+        "solve is exact; \"cg\" and \"minres\" stop at \"rtol\")",
+        s->multigrid_fixed_cycles,
+        SCENE_CHOICE_NAME(fcm__scene_solver_names, fcm__scene_solver_values, s->linear_solver));
+    fcm__scene_path_pop(p, here);
+  }
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "newton", 0, &nw));
   if (!nw) nw = fcm__json_empty_object();
   {
@@ -201,6 +217,7 @@ fcm_status fcm__scene_read_solver(fcm__scene_parser *p, const fcm__json *root)
     FCM_TRY(p->ctx, fcm__scene_read_number(p, nw, "rtol", 0, (fcm__range){0.0, 1.0, 1, 1},
                                            &s->newton_tolerance));
     SCENE_READ_INT(p, nw, "max_iterations", 0, 1, 1000000, s->newton_max_iterations);
+    SCENE_READ_INT(p, nw, "fixed_iterations", 0, 0, 1000000, s->newton_fixed_iterations);
     FCM_TRY(p->ctx, fcm__scene_read_bool(p, nw, "line_search", 0, &s->line_search));
     FCM_TRY(p->ctx, fcm__scene_read_bool(p, nw, "project_psd", 0, &s->project_psd));
     FCM_TRY(p->ctx, fcm__scene_read_bool(p, nw, "reuse_factorization", 0, &s->reuse_factorization));

@@ -12,13 +12,15 @@
 #include "fcm/simulation.h"
 #include "fem/fem_backend.h"
 
-/* One row of the per-step log: the step, and the body after it (separate bodies, mass and
+/* One row of the per-step log: the step (its Newton residual and the stopping rule's
+ * tolerance, fcm_step_info), and the body after it (separate bodies, mass and
  * linear momentum over the body's own quadrature points, fcm_space_momentum(); its inverted
  * quadrature points and the cell of the first, fcm_step_info; the NaN or infinite von Mises
  * values of the frame written after the step). -1: not known (inverted and inverted_cell of a
- * row restored from an older checkpoint; nonfinite of a step without a frame). */
+ * row restored from an older checkpoint; nonfinite of a step without a frame); NaN: tolerance
+ * of a row restored from a checkpoint older than version 5. */
 typedef struct fcm__log_row {
-  double time, residual, energy, wall;
+  double time, residual, tolerance, energy, wall;
   long long newton, linear;
   long long pieces;
   double mass, momentum[3];

@@ -158,6 +158,7 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   r->newton = si.newton_iterations;
   r->linear = si.linear_iterations;
   r->residual = si.residual;
+  r->tolerance = si.tolerance;
   r->energy = si.total_energy;
   r->wall = wall;
   r->pieces = S->pieces;

@@ -102,8 +102,11 @@ static void view_solver(FILE *f, const fcm_scene_solver *sv)
     fprintf(f, " (%s)", fcm__scene_direct_names[so->direct_method]);
   else if (so->linear_solver == FCM_LINEAR_MULTIGRID) {
     view_multigrid(f, &so->multigrid);
-    fprintf(f, ", rtol %g, atol %g, at most %d cycles", so->krylov_rtol, so->krylov_atol,
-            so->krylov_max_iterations);
+    if (so->multigrid_fixed_cycles > 0)
+      fprintf(f, ", %d cycles per solve (warm-started, no tolerance)", so->multigrid_fixed_cycles);
+    else
+      fprintf(f, ", rtol %g, atol %g, at most %d cycles", so->krylov_rtol, so->krylov_atol,
+              so->krylov_max_iterations);
   } else {
     fprintf(f, " preconditioner %s (%s tangent)",
             fcm__scene_preconditioner_names[so->preconditioner],
@@ -126,6 +129,11 @@ static void view_solver(FILE *f, const fcm_scene_solver *sv)
                             so->tolerance_mode),
           so->newton_tolerance, so->newton_max_iterations, so->line_search ? "on" : "off",
           so->project_psd ? "on" : "off", so->rep_acceleration, sv->threads > 0 ? sv->threads : 0);
+  if (so->newton_fixed_iterations > 0)
+    fprintf(f,
+            "  interactive steps: %d Newton iteration(s) per step, accepted whatever the "
+            "residual (reported per step)\n",
+            so->newton_fixed_iterations);
 }
 
 void fcm_scene_view(const fcm_scene *s, FILE *f)

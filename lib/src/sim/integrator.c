@@ -26,6 +26,7 @@ fcm_integrator_options fcm_integrator_options_default(void)
   o.project_psd = 0;
   o.reuse_factorization = 1;
   o.reuse_contraction = 0.25;
+  o.newton_fixed_iterations = 0;
   o.linear_solver = FCM_LINEAR_DIRECT;
   o.direct_method = FCM_DIRECT_CHOLMOD;
   o.preconditioner = FCM_PRECOND_SCHWARZ;
@@ -33,6 +34,7 @@ fcm_integrator_options fcm_integrator_options_default(void)
   o.krylov_rtol = 1e-8;
   o.krylov_atol = 0.0;
   o.krylov_max_iterations = 1000;
+  o.multigrid_fixed_cycles = 0;
   o.krylov_stagnation_window = 50;
   o.schwarz_theta = 0.5;
   o.schwarz = fcm_schwarz_options_default();
@@ -58,6 +60,8 @@ const char *fcm_step_reason_name(fcm_step_reason reason)
     return "nonfinite";
   case FCM_STEP_LINEAR_SOLVER_STAGNATED:
     return "linear-solver-stagnated";
+  case FCM_STEP_FIXED_ITERATIONS:
+    return "fixed-iterations";
   }
   return "unknown";
 }
@@ -107,7 +111,8 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   double **vecs[] = {&I->u,        &I->v,      &I->load_prev, &I->act_val, &I->act_inc, &I->Ma,
                      &I->act_diag, &I->u_bak,  &I->v_bak,     &I->lp_bak,  &I->un,      &I->uhat,
                      &I->fext,     &I->fend,   &I->fint,      &I->g,       &I->d,       &I->b,
-                     &I->ut,       &I->fint_t, &I->g_t,       &I->w1,      &I->w2,      &I->mg_r};
+                     &I->ut,       &I->fint_t, &I->g_t,       &I->w1,      &I->w2,      &I->mg_r,
+                     &I->mg_guess, &I->mg_acc};
   for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; k++)
     FCM_FREE(ctx, *vecs[k]);
   fcm__free(ctx, I->con_dof);
@@ -358,6 +363,11 @@ static fcm_status validate_options(fcm_ctx *ctx, const fcm_integrator_options *o
             "integrator: reuse_factorization = %d must be 0 or 1", o->reuse_factorization);
   FCM_CHECK(o->reuse_contraction > 0.0 && o->reuse_contraction < 1.0, ctx, FCM_ERR_ARG,
             "integrator: reuse_contraction = %g outside (0, 1)", o->reuse_contraction);
+  FCM_CHECK(o->newton_fixed_iterations >= 0 && o->newton_fixed_iterations <= 1000000, ctx,
+            FCM_ERR_ARG,
+            "integrator: newton_fixed_iterations = %d outside [0, 10^6] (0: the stopping rule "
+            "alone)",
+            o->newton_fixed_iterations);
   FCM_CHECK(o->linear_solver >= FCM_LINEAR_DIRECT && o->linear_solver <= FCM_LINEAR_MULTIGRID, ctx,
             FCM_ERR_ARG,
             "integrator: linear_solver = %d outside [0, 3] (direct, cg, minres, multigrid)",
@@ -664,7 +674,9 @@ void fcm_integrator_get_setup_info(const fcm_integrator *I, fcm_integrator_setup
 
 void fcm_integrator_drop_factorization(fcm_integrator *I)
 {
-  if (I) I->kept = 0;
+  if (!I) return;
+  I->kept = 0;
+  I->mg_warm = 0; /* the multigrid's warm start too: the next solve starts cold */
 }
 
 void fcm_integrator_get_state(const fcm_integrator *I, double *u, double *v, double *t,
@@ -697,6 +709,7 @@ fcm_status fcm_integrator_set_state(fcm_integrator *I, const double *u, const do
   I->reaction_valid = 0;
   if (!I->linear) I->h_state = SIM_H_INVALID; /* a linear system does not depend on u */
   I->kept = 0;
+  I->mg_warm = 0;
   if (I->is_setup) {
     if (steps > 0 && I->opts.kind == FCM_INTEGRATOR_STATIC)
       fcm__sim_eval_loads(I, t, I->load_prev);

@@ -210,6 +210,15 @@ fcm_status fcm__sim_multigrid_validate(fcm_ctx *ctx, const fcm_integrator_option
   const int as_pc = (o->linear_solver == FCM_LINEAR_CG || o->linear_solver == FCM_LINEAR_MINRES) &&
                     o->preconditioner == FCM_PRECOND_MULTIGRID;
   const fcm_mg_options *m = &o->multigrid;
+  FCM_CHECK(o->multigrid_fixed_cycles >= 0 && o->multigrid_fixed_cycles <= 1000, ctx, FCM_ERR_ARG,
+            "integrator: multigrid_fixed_cycles = %d outside [0, 1000] (0: cycles until the "
+            "tolerance)",
+            o->multigrid_fixed_cycles);
+  FCM_CHECK(o->multigrid_fixed_cycles == 0 || as_solver, ctx, FCM_ERR_ARG,
+            "integrator: multigrid_fixed_cycles = %d needs the multigrid solver (linear_solver "
+            "FCM_LINEAR_MULTIGRID), not linear_solver %d: a direct solve is exact, CG and MINRES "
+            "stop at krylov_rtol (a multigrid preconditioner runs one cycle per iteration)",
+            o->multigrid_fixed_cycles, (int)o->linear_solver);
   if (!as_solver && !as_pc) return FCM_OK;
   FCM_CHECK(m->smoother >= 0 && m->smoother < FCM_MG_SMOOTHER_COUNT, ctx, FCM_ERR_ARG,
             "integrator: multigrid.smoother = %d outside [0, %d] (sgs, jacobi, sgs colored)",
@@ -334,32 +343,52 @@ static double norm2(fcm_index n, const double *v)
   return sqrt(s);
 }
 
-/* FCM_LINEAR_MULTIGRID: cycles on H d = b from d = 0 until ||b - H d|| <= max(krylov_rtol
- * ||b||, krylov_atol). Stops early (soft failure) when the residual grows past 1e3 ||b||
+/* The initial guess of the cycles: the warm start of multigrid_fixed_cycles (the first Newton
+ * iteration of a (sub)step of the warm start's length: the last accepted Newton solve's
+ * correction, its constrained entries the eliminated rows' solutions b / diagonal), else 0. */
+static void mg_initial_guess(fcm_integrator *I, const double *b, double *d)
+{
+  const fcm_index n = I->n;
+  if (I->opts.multigrid_fixed_cycles > 0 && I->mg_warm && I->mg_iteration == 0 &&
+      I->mg_warm_h == I->key_h) {
+    memcpy(d, I->mg_guess, sizeof *d * (size_t)n);
+    for (fcm_index j = 0; j < I->nact; j++)
+      d[I->act_dof[j]] = b[I->act_dof[j]] / I->act_diag[j];
+  } else {
+    memset(d, 0, sizeof *d * (size_t)n);
+  }
+}
+
+/* FCM_LINEAR_MULTIGRID: cycles on H d = b from the initial guess (mg_initial_guess()) until
+ * ||b - H d|| <= max(krylov_rtol ||b||, krylov_atol), or exactly multigrid_fixed_cycles
+ * cycles when that is set. Stops early (soft failure) when the residual grows past 1e3 ||b||
  * or is not finite (diverging: H is not positive definite) or when 20 cycles reduce it by
- * less than 5 % (stalled). */
+ * less than 5 % (stalled). With fixed cycles the residual is computed after the last cycle
+ * only, for that test. */
 static fcm_status mg_solve(fcm_integrator *I, const double *b, double *d, fcm_step_reason *reason,
                            int *iterations, sim_stats *stats)
 {
   fcm_status st = FCM_OK, s = FCM_OK;
   fcm_ctx *ctx = I->ctx;
   const fcm_index n = I->n;
-  const int max_cycles = I->opts.krylov_max_iterations;
+  const int fixed = I->opts.multigrid_fixed_cycles;
+  const int max_cycles = fixed > 0 ? fixed : I->opts.krylov_max_iterations;
   FCM_CHECK(I->mg, ctx, FCM_ERR_INTERNAL, "integrator: no multigrid hierarchy to solve with");
-  memset(d, 0, sizeof *d * (size_t)n);
+  mg_initial_guess(I, b, d);
   const double bn = norm2(n, b);
-  const double target = fmax(I->opts.krylov_rtol * bn, I->opts.krylov_atol);
+  const double target = fixed > 0 ? -1.0 : fmax(I->opts.krylov_rtol * bn, I->opts.krylov_atol);
   double rk = bn, r1 = bn, r_back = bn;
   int k = 0;
   const char *why = NULL, *const stall = "stalled (less than 5 % reduction in 20 cycles)";
   while (!(rk <= target)) {
     if (k >= max_cycles) {
-      why = "cycle limit (krylov_max_iterations) reached";
+      if (fixed == 0) why = "cycle limit (krylov_max_iterations) reached";
       break;
     }
     s = fcm_mg_cycle(I->mg, b, d);
     if (s != FCM_OK) break;
     k++;
+    if (fixed > 0 && k < fixed) continue; /* no test between the fixed cycles */
     FCM_TRY(ctx, fcm_csr_apply(I->H, -1.0, d, 0.0, I->mg_r));
     for (fcm_index i = 0; i < n; i++)
       I->mg_r[i] += b[i];
@@ -369,7 +398,7 @@ static fcm_status mg_solve(fcm_integrator *I, const double *b, double *d, fcm_st
       why = "diverging";
       break;
     }
-    if (k % 20 == 0) {
+    if (fixed == 0 && k % 20 == 0) {
       if (rk > 0.95 * r_back) {
         why = stall;
         break;
@@ -553,11 +582,17 @@ cleanup:
   return st;
 }
 
-/* Set-up of multigrid as the solver: its residual; the hierarchy itself at the first factor. */
+/* Set-up of multigrid as the solver: its residual and, for fixed cycles, the warm start's
+ * vectors; the hierarchy itself at the first factor. */
 static fcm_status mg_setup(fcm_integrator *I)
 {
   fcm_status st = FCM_OK;
   FCM_ALLOC(I->ctx, I->n, I->mg_r);
+  if (I->opts.multigrid_fixed_cycles > 0) {
+    FCM_ALLOC(I->ctx, I->n, I->mg_guess);
+    FCM_ALLOC(I->ctx, I->n, I->mg_acc);
+  }
+  I->mg_warm = 0;
 cleanup:
   return st;
 }
@@ -607,17 +642,25 @@ static const sim_solver solver_backend = {backend_setup, backend_factor, backend
 
 fcm_status fcm__sim_solver_setup(fcm_integrator *I)
 {
+  fcm_status st = FCM_OK;
   /* a backend with a factor of its own (a distributed one) takes every solve whatever
    * linear_solver says; the serial backend leaves them to the options */
-  if (I->backend.factor)
+  if (I->backend.factor) {
+    FCM_CHECK(I->opts.multigrid_fixed_cycles == 0, I->ctx, FCM_ERR_ARG,
+              "integrator: multigrid_fixed_cycles = %d needs the serial multigrid solver; the "
+              "distributed backend solves with its own solver (set it to 0)",
+              I->opts.multigrid_fixed_cycles);
     I->solver = &solver_backend;
-  else if (I->opts.linear_solver == FCM_LINEAR_DIRECT)
+  } else if (I->opts.linear_solver == FCM_LINEAR_DIRECT) {
     I->solver = &solver_direct;
-  else if (I->opts.linear_solver == FCM_LINEAR_MULTIGRID)
+  } else if (I->opts.linear_solver == FCM_LINEAR_MULTIGRID) {
     I->solver = &solver_multigrid;
-  else
+  } else {
     I->solver = &solver_krylov;
-  return I->solver->setup(I);
+  }
+  st = I->solver->setup(I);
+cleanup:
+  return st;
 }
 
 fcm_status fcm__sim_factor(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)

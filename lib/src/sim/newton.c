@@ -206,13 +206,18 @@ static int constraints_met(const fcm_integrator *I, const double *x)
   return 1;
 }
 
-/* Threshold of the stopping rule at the current iterate. */
-static double tolerance(const fcm_integrator *I, double rep_free, double r_start)
+/* Threshold of the stopping rule at the current iterate, and its reference (the force scale
+ * the tolerance multiplies: ||M a_rep|| on the free DOFs, or R). */
+static double tolerance(const fcm_integrator *I, double rep_free, double r_start, double *ref)
 {
   const fcm_integrator_options *o = &I->opts;
-  if (o->tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE) return o->newton_tolerance * rep_free;
+  if (o->tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE) {
+    *ref = rep_free;
+    return o->newton_tolerance * rep_free;
+  }
   double R = FCM_MAX(r_start, sqrt(dot(I->n, I->fint, I->fint)));
   R = FCM_MAX(R, sqrt(dot(I->n, I->fext, I->fext)));
+  *ref = R;
   return FCM_MAX(o->newton_tolerance * R, o->newton_atol);
 }
 
@@ -514,10 +519,11 @@ typedef struct line_result {
 /* Newton line-search phase: backtracking on E (predictor: constrained DOFs land exactly,
  * the free part backs off only if the energy is not finite there). The tangent of a full
  * step is assembled with it: usually it is accepted and the next iteration needs that
- * tangent (one pass instead of two). */
-static fcm_status line_search(fcm_integrator *I, double h, int predictor, const eval_out *cur,
-                              double slope, double r, eval_out *trial, line_result *lr,
-                              sim_stats *stats)
+ * tangent (one pass instead of two); not in the `last` iteration of the fixed-iteration
+ * rule, which has no next one. */
+static fcm_status line_search(fcm_integrator *I, double h, int predictor, int last,
+                              const eval_out *cur, double slope, double r, eval_out *trial,
+                              line_result *lr, sim_stats *stats)
 {
   fcm_status st = FCM_OK;
   const fcm_integrator_options *o = &I->opts;
@@ -530,7 +536,7 @@ static fcm_status line_search(fcm_integrator *I, double h, int predictor, const 
     if (predictor)
       for (fcm_index j = 0; j < I->nact; j++)
         I->ut[I->act_dof[j]] = I->act_val[j];
-    lr->speculative = !I->linear && bt == 0 && !kept_usable(I, h);
+    lr->speculative = !I->linear && !last && bt == 0 && !kept_usable(I, h);
     FCM_TRY(I->ctx, evaluate(I, h, I->ut, lr->speculative, I->fint_t, I->g_t, trial, stats));
     if (trial->finite) {
       lr->rt = norm_free(I, I->g_t);
@@ -553,54 +559,80 @@ cleanup:
   return st;
 }
 
+/* multigrid_fixed_cycles' warm start: the sum of the accepted updates of this Newton solve
+ * (mg_acc; ut - u before the trial is accepted), made the next solve's guess when it ends
+ * in success. */
+static void warm_accumulate(fcm_integrator *I)
+{
+  if (!I->mg_acc) return;
+  for (fcm_index i = 0; i < I->n; i++)
+    I->mg_acc[i] += I->ut[i] - I->u[i];
+}
+
+static void warm_finish(fcm_integrator *I, double h, fcm_step_reason reason)
+{
+  if (!I->mg_acc) return;
+  I->mg_warm = reason == FCM_STEP_CONVERGED || reason == FCM_STEP_FIXED_ITERATIONS;
+  if (!I->mg_warm) return;
+  swap(&I->mg_guess, &I->mg_acc);
+  I->mg_warm_h = h;
+}
+
+/* Why the Newton loop stops before iteration `it` (FCM_STEP_NONE: it goes on): the stopping
+ * rule with the constraints met, then the fixed-iteration rule (newton_fixed_iterations, an
+ * accepted end), then the iteration limit. */
+static fcm_step_reason newton_stop(const fcm_integrator *I, int it, int finite, int met, double r,
+                                   double tol)
+{
+  const int fixed = I->opts.newton_fixed_iterations;
+  if (!finite) return FCM_STEP_NONFINITE;
+  if (met && r <= tol) return FCM_STEP_CONVERGED;
+  if (fixed > 0 && it >= fixed) return met ? FCM_STEP_FIXED_ITERATIONS : FCM_STEP_MAX_NEWTON;
+  if (fixed == 0 && it >= I->opts.newton_max_iterations) return FCM_STEP_MAX_NEWTON;
+  return FCM_STEP_NONE;
+}
+
 fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reason *reason,
-                           double *residual, double *tol_out, sim_stats *stats)
+                           double *residual, double *tol_out, double *ref_out, sim_stats *stats)
 {
   fcm_status st = FCM_OK;
   const fcm_integrator_options *o = &I->opts;
   eval_out cur, trial;
-  double rep_free = 0.0, r = NAN, r_start = NAN, tol = 0.0;
+  double rep_free = 0.0, r = NAN, r_start = NAN, tol = 0.0, ref = 0.0;
   int met = 0;
   *reason = FCM_STEP_NONE;
   I->solve_stalled = 0;
+  if (I->mg_acc) memset(I->mg_acc, 0, sizeof *I->mg_acc * (size_t)I->n);
 
   if (o->tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE) rep_free = norm_free(I, I->Ma);
   FCM_TRY(I->ctx, newton_start(I, h, &cur, stats));
   r = cur.finite ? norm_free(I, I->g) : NAN;
   r_start = r;
-  tol = tolerance(I, rep_free, r_start);
+  tol = tolerance(I, rep_free, r_start, &ref);
   met = constraints_met(I, I->u);
   monitor(I, t1, 0, r, tol, cur.E, 0.0, 0, met);
 
   for (int it = 0;; it++) {
-    if (!cur.finite) {
-      *reason = FCM_STEP_NONFINITE;
-      break;
-    }
-    if (met && r <= tol) {
-      *reason = FCM_STEP_CONVERGED;
-      break;
-    }
-    if (it >= o->newton_max_iterations) {
-      *reason = FCM_STEP_MAX_NEWTON;
-      break;
-    }
+    *reason = newton_stop(I, it, cur.finite, met, r, tol);
+    if (*reason != FCM_STEP_NONE) break;
     /* A predictor step first moves the constrained DOFs onto their prescribed values. */
     int predictor = !met, its = 0, used_kept = 0;
+    const int last = o->newton_fixed_iterations > 0 && it + 1 >= o->newton_fixed_iterations;
     double slope = 0.0;
     line_result lr;
     for (fcm_index j = 0; j < I->nact; j++)
       I->act_inc[j] = I->act_val[j] - I->u[I->act_dof[j]];
+    I->mg_iteration = it;
     FCM_TRY(I->ctx, newton_direction(I, h, predictor, &slope, &its, &used_kept, reason, stats));
     if (*reason != FCM_STEP_NONE) break;
-    FCM_TRY(I->ctx, line_search(I, h, predictor, &cur, slope, r, &trial, &lr, stats));
+    FCM_TRY(I->ctx, line_search(I, h, predictor, last, &cur, slope, r, &trial, &lr, stats));
     if (!lr.accepted && used_kept) {
       /* the kept factorization's direction found no decrease: a fresh one at this iterate */
       I->kept = 0;
       its = 0;
       FCM_TRY(I->ctx, newton_direction(I, h, predictor, &slope, &its, &used_kept, reason, stats));
       if (*reason != FCM_STEP_NONE) break;
-      FCM_TRY(I->ctx, line_search(I, h, predictor, &cur, slope, r, &trial, &lr, stats));
+      FCM_TRY(I->ctx, line_search(I, h, predictor, last, &cur, slope, r, &trial, &lr, stats));
     }
     if (!lr.accepted) {
       I->h_state = SIM_H_INVALID;
@@ -608,6 +640,7 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
       break;
     }
     /* Accept the trial as the new iterate. */
+    warm_accumulate(I);
     swap(&I->u, &I->ut);
     swap(&I->fint, &I->fint_t);
     swap(&I->g, &I->g_t);
@@ -622,7 +655,7 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
     if (used_kept && !(lr.alpha == 1.0 && lr.rt <= o->reuse_contraction * r)) I->kept_ok = 0;
     r = lr.rt;
     met = constraints_met(I, I->u);
-    tol = tolerance(I, rep_free, r_start);
+    tol = tolerance(I, rep_free, r_start, &ref);
     monitor(I, t1, it + 1, r, tol, cur.E, lr.alpha, its, met);
   }
   /* Newton could not go on with the result of a linear solve that stagnated or broke down:
@@ -630,9 +663,11 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
   if (I->solve_stalled &&
       (*reason == FCM_STEP_LINE_SEARCH_FAILED || *reason == FCM_STEP_MAX_NEWTON))
     *reason = FCM_STEP_LINEAR_SOLVER_STAGNATED;
+  warm_finish(I, h, *reason);
 cleanup:
   *residual = r;
   *tol_out = tol;
+  *ref_out = ref;
   return st;
 }
 
@@ -685,7 +720,7 @@ static int substep_load(fcm_integrator *I, int dyn, double t1, double s1, int la
 /* Step phase: one substep of length h (0: static) ending at t1 from the current state:
  * constraints at t1, the damping matrix where it must be rebuilt, Newton. */
 static fcm_status run_substep(fcm_integrator *I, int dyn, double h, double t1,
-                              fcm_step_reason *reason, double *residual, double *tol,
+                              fcm_step_reason *reason, double *residual, double *tol, double *ref,
                               sim_stats *stats)
 {
   fcm_status st = FCM_OK;
@@ -699,7 +734,7 @@ static fcm_status run_substep(fcm_integrator *I, int dyn, double h, double t1,
   if (dyn && I->D && (!I->linear || I->damp_version == 0))
     FCM_TRY(I->ctx, update_damping(I, reason, stats));
   if (*reason == FCM_STEP_NONE)
-    FCM_TRY(I->ctx, fcm__sim_newton(I, h, t1, reason, residual, tol, stats));
+    FCM_TRY(I->ctx, fcm__sim_newton(I, h, t1, reason, residual, tol, ref, stats));
 cleanup:
   return st;
 }
@@ -788,6 +823,7 @@ static fcm_status reject_step(fcm_integrator *I, fcm_status st, fcm_step_reason 
   fcm__sim_eval_constraints(I, I->t);
   if (!I->linear) I->h_state = SIM_H_INVALID;
   I->kept = 0;
+  I->mg_warm = 0;
   if (st == FCM_OK && reason == FCM_STEP_LINEAR_SOLVER_STAGNATED)
     st = fcm__error(I->ctx, FCM_ERR_NOT_CONVERGED, __FILE__, __LINE__, __func__,
                     "integrator: step %lld from t = %g failed after %d halving(s) (last dt = "
@@ -848,7 +884,7 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
     const fcm_integrator_options *o = &I->opts;
     fcm_index n = I->n;
     int dyn = o->kind == FCM_INTEGRATOR_BACKWARD_EULER;
-    double t_begin = fcm_wtime(), t0 = I->t, residual = 0.0, tol = 0.0;
+    double t_begin = fcm_wtime(), t0 = I->t, residual = 0.0, tol = 0.0, ref = 0.0;
     int H = o->max_halvings, level = 0;
     long long units = (long long)(dyn ? 1 : o->load_steps) << H, done = 0;
     fcm_step_reason reason = FCM_STEP_NONE;
@@ -871,13 +907,13 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
                         t1);
         break;
       }
-      st = run_substep(I, dyn, h, t1, &reason, &residual, &tol, &stats);
+      st = run_substep(I, dyn, h, t1, &reason, &residual, &tol, &ref, &stats);
       if (st != FCM_OK) {
         fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
         break;
       }
       info->dt = dyn ? h : o->dt * (double)size / (double)units;
-      if (reason == FCM_STEP_CONVERGED) {
+      if (reason == FCM_STEP_CONVERGED || reason == FCM_STEP_FIXED_ITERATIONS) {
         if (dyn)
           for (fcm_index i = 0; i < n; i++)
             I->v[i] = (I->u[i] - I->un[i]) / h;
@@ -890,6 +926,7 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
       memcpy(I->u, I->un, sizeof(double) * (size_t)n);
       if (!I->linear) I->h_state = SIM_H_INVALID;
       I->kept = 0;
+      I->mg_warm = 0;
       if (level >= H) break;
       level++;
       reason = FCM_STEP_NONE;
@@ -898,7 +935,8 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
     info->halvings = level;
     info->residual = residual;
     info->tolerance = tol;
-    if (st == FCM_OK && reason == FCM_STEP_CONVERGED)
+    info->residual_reference = ref;
+    if (st == FCM_OK && (reason == FCM_STEP_CONVERGED || reason == FCM_STEP_FIXED_ITERATIONS))
       st = accept_step(I, dyn, t0, info);
     else
       st = reject_step(I, st, reason, t0, info);

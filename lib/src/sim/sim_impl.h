@@ -141,6 +141,13 @@ struct fcm_integrator {
   long long mg_con;
   long long mg_applies;
   double *mg_r;
+  /* multigrid_fixed_cycles: the warm start of the first Newton iteration of a (sub)step.
+   * mg_acc sums the updates of the current Newton solve (n); mg_guess is the sum of the last
+   * accepted one (n), valid when mg_warm for (sub)steps of length mg_warm_h; mg_iteration is
+   * the Newton iteration being solved (0: the first) */
+  double *mg_guess, *mg_acc;
+  int mg_warm, mg_iteration;
+  double mg_warm_h;
   /* the last linear solve stagnated or broke down (linsolve.c; newton.c names it as the
    * failure's reason when Newton cannot go on), and the solver's message */
   int solve_stalled;
@@ -184,9 +191,11 @@ enum { SIM_H_INVALID = 0, SIM_H_TANGENT = 1, SIM_H_SYSTEM = 2 };
 fcm_status fcm__sim_check_rigid_modes(fcm_integrator *I, double t);
 
 /* Newton solve of one (sub)step of length h (0: static) from the state u = un, v.
- * Outputs the reason; hard errors are returned as status. (newton.c) */
+ * Outputs the reason, the final residual, the stopping rule's threshold and its reference;
+ * hard errors are returned as status. (newton.c) */
 fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reason *reason,
-                           double *residual, double *tolerance, sim_stats *stats);
+                           double *residual, double *tolerance, double *reference,
+                           sim_stats *stats);
 
 /* The linear solver of the Newton systems (I->solver): a distributed backend's when it has
  * a factor of its own, else the serial one linear_solver names; set it up. (linsolve.c) */
