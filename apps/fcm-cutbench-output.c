@@ -226,7 +226,7 @@ int cutbench_write_png(const char *path, const cutbench_row *rows, int n)
       "set multiplot layout 1,2 title 'fcm-cutbench: fcm beside the papers (log scale)'\n"
       "set datafile missing '?'\nset style data histograms\nset style histogram clustered gap 1\n"
       "set style fill solid 0.8 border -1\nset logscale y\nset grid ytics\nset tmargin 4\n"
-      "set xtics rotate by -30 font ',9'\nset key top left\n");
+      "set xtics rotate by -30 font ',9'\nset key outside bottom center horizontal\n");
   for (int panel = 0; panel < 2; panel++) {
     add(&sc,
         "set title '%s'\nplot '-' using 2:xtic(1) title 'fcm' lc rgb '#1f77b4', '-' using 2 "

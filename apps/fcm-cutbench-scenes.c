@@ -26,11 +26,11 @@ const cutbench_paper cutbench_papers[ROW_COUNT] = {
     {"dick-bunny", "Dick 2011 Table 1", "Bunny", "118k -> 197k hexahedra", 118000, 1, 0.693, 2.42,
      0, 0.5, "1 core of a 2.8 GHz Xeon X5560; corotated linear; 3 V-cycles", "hex8", "corotated",
      0},
-    {"koschier-bunny", "Koschier 2017 7", "bunny, groove carved then peeled", "5,326 -> 9,432 DOFs",
-     5326, 0, 0.646, 1.375, 0, 0.1,
-     "i7-6700HQ, 4 cores; implicit Euler, StVK (cut: 47 % of a step)", "hex8", "snh", 1},
-    {"tonthat-slab", "Ton-That 2024 Table 2", "thin slab, multiple intersecting cuts", "7.2k DOFs",
-     7200, 0, 0.0, 0.627, 3.355, 0.1, "i9-13900K; SNH, 1 Newton iteration", "hex8", "snh", 1},
+    {"koschier-bunny", "Koschier 2017 sec. 7", "bunny: groove carved then peeled",
+     "5326 -> 9432 DOFs", 5326, 0, 0.646, 1.375, 0, 0.1,
+     "i7-6700HQ 4 cores; implicit Euler; StVK (cut: 47 % of a step)", "hex8", "snh", 1},
+    {"tonthat-slab", "Ton-That 2024 Table 2", "thin slab: multiple intersecting cuts", "7.2k DOFs",
+     7200, 0, 0.0, 0.627, 3.355, 0.1, "i9-13900K; SNH; 1 Newton iteration", "hex8", "snh", 1},
 };
 
 /* ------------------------------------------------------------- the bunny-like body */
@@ -421,8 +421,9 @@ static int slab_cuts(const char *dir, const char *surf_dir, const char *name, cu
   return ok;
 }
 
-/* The slab's cell size: the background hugs the body with half a cell around it, (n_d + 1)
- * nodes per axis; the size whose 3 x nodes is nearest the target DOFs. */
+/* The slab's cell size: the background starts half a cell before the body and ends in the
+ * first cell past it, n_d = ceil((L_d + h/2) / h) cells and n_d + 1 nodes per axis, every cell
+ * meeting the body; the size whose 3 x nodes is nearest the target DOFs. */
 static double slab_size(double dofs, const double L[3], fcm_index n[3])
 {
   double best = 0.1, err = HUGE_VAL;
@@ -430,11 +431,11 @@ static double slab_size(double dofs, const double L[3], fcm_index n[3])
     const double h = 0.005 * pow(100.0, i / 4000.0);
     double nodes = 1.0;
     for (int d = 0; d < 3; d++)
-      nodes *= ceil((L[d] + h) / h - 1e-9) + 1.0;
+      nodes *= ceil((L[d] + 0.5 * h) / h - 1e-9) + 1.0;
     if (fabs(3.0 * nodes - dofs) < err) err = fabs(3.0 * nodes - dofs), best = h;
   }
   for (int d = 0; d < 3; d++)
-    n[d] = (fcm_index)ceil((L[d] + best) / best - 1e-9);
+    n[d] = (fcm_index)ceil((L[d] + 0.5 * best) / best - 1e-9);
   return best;
 }
 
@@ -471,7 +472,7 @@ int cutbench_write_scene(cutbench_row_id row, const cutbench_model *m, const cha
     sc->h = size_for(m->volume, m->area, target / 3.0, 2.0);
     ok = koschier_cuts(m, dir, surf_dir, name, sc);
     scene_head(&t, name,
-               "After Koschier et al. 2017 (7, Fig. 1 right): a bunny-like body turning about "
+               "After Koschier et al. 2017 (section 7, Fig. 1 right): a bunny-like body turning about "
                "a vertical axis (its base held by a rotating region) while a knife carves a "
                "curved groove into its flanks, a quarter turn per cut; a last cut peels the "
                "shell outside the groove off. Stable Neo-Hookean, Hex8, dt 5 ms.",
@@ -490,7 +491,7 @@ int cutbench_write_scene(cutbench_row_id row, const cutbench_model *m, const cha
     sc->h = slab_size(target, L, n);
     ok = slab_cuts(dir, surf_dir, name, sc);
     scene_head(&t, name,
-               "After Ton-That et al. 2024 (5.1, Fig. 1, Table 2): a 2 x 0.6 x 0.4 m slab "
+               "After Ton-That et al. 2024 (section 5.1, Fig. 1, Table 2): a 2 x 0.6 x 0.4 m slab "
                "clamped at x = 0 cut into ever thinner sheets by cuts that re-enter the cells "
                "earlier cuts split, then by a cut across all sheets. Stable Neo-Hookean (E = "
                "1e6 Pa, nu = 0.4), Hex8, dt 0.033 s.",
