@@ -471,12 +471,13 @@ int cutbench_write_scene(cutbench_row_id row, const cutbench_model *m, const cha
   } else if (row == ROW_KOSCHIER_BUNNY) {
     sc->h = size_for(m->volume, m->area, target / 3.0, 2.0);
     ok = koschier_cuts(m, dir, surf_dir, name, sc);
-    scene_head(&t, name,
-               "After Koschier et al. 2017 (section 7, Fig. 1 right): a bunny-like body turning about "
-               "a vertical axis (its base held by a rotating region) while a knife carves a "
-               "curved groove into its flanks, a quarter turn per cut; a last cut peels the "
-               "shell outside the groove off. Stable Neo-Hookean, Hex8, dt 5 ms.",
-               m, body, sc->h, "snh", 2e5, 0.4, solver, 0.005, sc->steps);
+    scene_head(
+        &t, name,
+        "After Koschier et al. 2017 (section 7, Fig. 1 right): a bunny-like body turning about "
+        "a vertical axis (its base held by a rotating region) while a knife carves a "
+        "curved groove into its flanks, a quarter turn per cut; a last cut peels the "
+        "shell outside the groove off. Stable Neo-Hookean, Hex8, dt 5 ms.",
+        m, body, sc->h, "snh", 2e5, 0.4, solver, 0.005, sc->steps);
     const double cx = 0.5 * (m->lo[0] + m->hi[0]), cz = 0.5 * (m->lo[2] + m->hi[2]);
     const double rx = 0.2 * (m->hi[0] - m->lo[0]), rz = 0.2 * (m->hi[2] - m->lo[2]);
     put(&t, "    {\"gravity\": {\"acceleration\": [0, -9.81, 0]}},\n");
