@@ -51,7 +51,7 @@ static void print_run(const cutbench_row *r, int k)
   const cutbench_run *q = &r->run[k];
   const char *solver = k ? "interactive" : "defaults";
   if (!q->ok) {
-    printf("%-15s %-11s FAILED: %s\n", p->row, solver, q->note);
+    printf("%-15s %-11s %s: %s\n", p->row, solver, q->skipped ? "skipped" : "FAILED", q->note);
     return;
   }
   printf("%-15s %-11s %7lld %7lld %7lld %3d %8.4f %8.4f %7.4f %7.4f %7.4f %7.4f %8.4f %8.4f "
@@ -79,7 +79,7 @@ static void print_run(const cutbench_row *r, int k)
 void cutbench_print_row(const cutbench_row *r)
 {
   for (int k = 0; k < 2; k++)
-    if (r->run[k].ran) print_run(r, k);
+    if (r->run[k].ran || r->run[k].skipped) print_run(r, k);
   fflush(stdout);
 }
 
@@ -145,7 +145,8 @@ static void csv_run(FILE *f, const cutbench_row *r, int k)
   const int ok = q->ok;
   fprintf(f, "%s", p->row);
   str(f, p->paper), str(f, p->model), str(f, p->size), str(f, p->element), str(f, p->material);
-  str(f, k ? "interactive" : "defaults"), str(f, ok ? "ok" : "failed");
+  str(f, k ? "interactive" : "defaults");
+  str(f, ok ? "ok" : q->skipped ? "skipped" : "failed");
   num(f, r->h);
   const double v[17] = {(double)q->cells,
                         (double)q->dofs_before,
@@ -191,7 +192,7 @@ int cutbench_write_csv(const char *path, const cutbench_row *rows, int n)
   fputs(csv_header, f);
   for (int i = 0; i < n; i++)
     for (int k = 0; k < 2; k++)
-      if (rows[i].run[k].ran) csv_run(f, &rows[i], k);
+      if (rows[i].run[k].ran || rows[i].run[k].skipped) csv_run(f, &rows[i], k);
   return cli_output_commit(PROG, &out);
 }
 

@@ -81,6 +81,7 @@ int cutbench_write_scene(cutbench_row_id row, const cutbench_model *m, const cha
 /** What one run of a row's scene measured. */
 typedef struct cutbench_run {
   int ran, ok;
+  int skipped; /* the option set is not a valid scene solver for this build (see note) */
   char note[256];
   double setup_s;  /* fcm_simulation_create() */
   long long cells; /* active background cells */
