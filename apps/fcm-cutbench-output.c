@@ -5,7 +5,6 @@
 #include "fcm-cutbench.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -123,31 +122,17 @@ static const char csv_header[] =
     "paper_cut_s,paper_step_s,paper_step_max_s,paper_machine,cut_ratio,step_ratio,"
     "step_target_s,cut_ok,step_ok,disp_diff_m,disp_max_m,options,note\n";
 
-/* ",v" (%.6g), or "," alone when v is negative or not finite. */
-static void num(FILE *f, double v)
-{
-  fputc(',', f);
-  if (v >= 0.0 && isfinite(v)) fprintf(f, "%.6g", v);
-}
-
-/* ",text" with commas, quotes and line breaks replaced (the CSV has no quoting). */
-static void str(FILE *f, const char *s)
-{
-  fputc(',', f);
-  for (; *s; s++)
-    fputc(*s == ',' ? ';' : *s == '"' ? '\'' : *s == '\n' || *s == '\r' ? ' ' : *s, f);
-}
-
 static void csv_run(FILE *f, const cutbench_row *r, int k)
 {
   const cutbench_paper *p = &cutbench_papers[r->id];
   const cutbench_run *q = &r->run[k];
   const int ok = q->ok;
   fprintf(f, "%s", p->row);
-  str(f, p->paper), str(f, p->model), str(f, p->size), str(f, p->element), str(f, p->material);
-  str(f, k ? "interactive" : "defaults");
-  str(f, ok ? "ok" : q->skipped ? "skipped" : "failed");
-  num(f, r->h);
+  cli_csv_text(f, p->paper), cli_csv_text(f, p->model), cli_csv_text(f, p->size),
+      cli_csv_text(f, p->element), cli_csv_text(f, p->material);
+  cli_csv_text(f, k ? "interactive" : "defaults");
+  cli_csv_text(f, ok ? "ok" : q->skipped ? "skipped" : "failed");
+  cli_csv_number(f, r->h);
   const double v[17] = {(double)q->cells,
                         (double)q->dofs_before,
                         (double)q->dofs_after,
@@ -166,21 +151,21 @@ static void csv_run(FILE *f, const cutbench_row *r, int k)
                         q->linear,
                         0};
   for (int i = 0; i < 16; i++)
-    num(f, ok ? v[i] : -1.0);
-  num(f, p->cut_s > 0.0 ? p->cut_s : -1.0);
-  num(f, p->step_s);
-  num(f, p->step_max_s > 0.0 ? p->step_max_s : -1.0);
-  str(f, p->machine);
-  num(f, ok && p->cut_s > 0.0 && q->events > 0 ? q->cut_max / p->cut_s : -1.0);
-  num(f, ok ? q->step_mean / p->step_s : -1.0);
-  num(f, p->step_factor * p->step_s);
+    cli_csv_number(f, ok ? v[i] : -1.0);
+  cli_csv_number(f, p->cut_s > 0.0 ? p->cut_s : -1.0);
+  cli_csv_number(f, p->step_s);
+  cli_csv_number(f, p->step_max_s > 0.0 ? p->step_max_s : -1.0);
+  cli_csv_text(f, p->machine);
+  cli_csv_number(f, ok && p->cut_s > 0.0 && q->events > 0 ? q->cut_max / p->cut_s : -1.0);
+  cli_csv_number(f, ok ? q->step_mean / p->step_s : -1.0);
+  cli_csv_number(f, p->step_factor * p->step_s);
   const int c = cut_holds(p, q), s = step_holds(p, q);
-  str(f, c < 0 ? "" : c ? "yes" : "no");
-  str(f, s < 0 ? "" : s ? "yes" : "no");
-  num(f, k == 1 ? r->disp_diff : -1.0);
-  num(f, k == 0 ? r->disp_max : -1.0);
-  str(f, k ? r->interactive : "");
-  str(f, ok ? "" : q->note);
+  cli_csv_text(f, c < 0 ? "" : c ? "yes" : "no");
+  cli_csv_text(f, s < 0 ? "" : s ? "yes" : "no");
+  cli_csv_number(f, k == 1 ? r->disp_diff : -1.0);
+  cli_csv_number(f, k == 0 ? r->disp_max : -1.0);
+  cli_csv_text(f, k ? r->interactive : "");
+  cli_csv_text(f, ok ? "" : q->note);
   fputc('\n', f);
 }
 
@@ -198,38 +183,20 @@ int cutbench_write_csv(const char *path, const cutbench_row *rows, int n)
 
 /* ------------------------------------------------------------- PNG */
 
-/* A growing gnuplot script. */
-typedef struct script {
-  char s[1 << 16];
-  size_t len;
-  int ok;
-} script;
-
-static void add(script *sc, const char *fmt, ...)
-{
-  if (!sc->ok) return;
-  va_list ap;
-  va_start(ap, fmt);
-  const int k = vsnprintf(sc->s + sc->len, sizeof sc->s - sc->len, fmt, ap);
-  va_end(ap);
-  if (k < 0 || (size_t)k >= sizeof sc->s - sc->len)
-    sc->ok = 0;
-  else
-    sc->len += (size_t)k;
-}
-
 int cutbench_write_png(const char *path, const cutbench_row *rows, int n)
 {
-  static script sc;
-  sc.len = 0, sc.ok = 1;
+  static cutbench_text sc;
+  sc.n = 0, sc.ok = 1;
   static const char *const titles[2] = {"largest cut (s)", "mean step (s)"};
-  add(&sc,
+  cutbench_put(
+      &sc,
       "set multiplot layout 1,2 title 'fcm-cutbench: fcm beside the papers (log scale)'\n"
       "set datafile missing '?'\nset style data histograms\nset style histogram clustered gap 1\n"
       "set style fill solid 0.8 border -1\nset logscale y\nset grid ytics\nset tmargin 4\n"
       "set xtics rotate by -30 font ',9'\nset key outside bottom center horizontal\n");
   for (int panel = 0; panel < 2; panel++) {
-    add(&sc,
+    cutbench_put(
+        &sc,
         "set title '%s'\nplot '-' using 2:xtic(1) title 'fcm' lc rgb '#1f77b4', '-' using 2 "
         "title 'paper' lc rgb '#7f7f7f', '-' using 2 title 'target' lc rgb '#2ca02c'\n",
         titles[panel]);
@@ -245,14 +212,14 @@ int cutbench_write_png(const char *path, const cutbench_row *rows, int n)
               : series == 1 ? p->step_s
                             : p->step_factor * p->step_s;
         if (isfinite(v) && v > 0.0)
-          add(&sc, "\"%s\" %.6g\n", p->row, v);
+          cutbench_put(&sc, "\"%s\" %.6g\n", p->row, v);
         else
-          add(&sc, "\"%s\" ?\n", p->row);
+          cutbench_put(&sc, "\"%s\" ?\n", p->row);
       }
-      add(&sc, "e\n");
+      cutbench_put(&sc, "e\n");
     }
   }
-  add(&sc, "unset multiplot\n");
+  cutbench_put(&sc, "unset multiplot\n");
   if (!sc.ok) {
     fprintf(stderr, PROG ": --png: the plot script grew too large\n");
     return 0;

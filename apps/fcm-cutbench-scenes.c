@@ -264,14 +264,7 @@ static double size_for(double V, double A, double n, double c)
 
 /* ------------------------------------------------------------- scenes */
 
-/* A growing text. */
-typedef struct text {
-  char s[32768];
-  size_t n;
-  int ok;
-} text;
-
-static void put(text *t, const char *fmt, ...)
+void cutbench_put(cutbench_text *t, const char *fmt, ...)
 {
   if (!t->ok) return;
   va_list ap;
@@ -286,37 +279,42 @@ static void put(text *t, const char *fmt, ...)
 
 /* The scene's common head: name, description, background (a fitted grid for a surface body),
  * body, material, solver, time. */
-static void scene_head(text *t, const char *name, const char *desc, const cutbench_model *m,
-                       const char *body, double h, const char *material, double young,
-                       double poisson, const char *solver, double dt, int steps)
+static void scene_head(cutbench_text *t, const char *name, const char *desc,
+                       const cutbench_model *m, const char *body, double h, const char *material,
+                       double young, double poisson, const char *solver, double dt, int steps)
 {
-  put(t, "{\n  \"version\": 1,\n  \"name\": \"%s\",\n  \"description\": \"%s\",\n", name, desc);
+  cutbench_put(t, "{\n  \"version\": 1,\n  \"name\": \"%s\",\n  \"description\": \"%s\",\n", name,
+               desc);
   if (m) {
-    put(t,
+    cutbench_put(
+        t,
         "  \"background\": {\"element\": \"hex8\", \"fit_background\": {\"cell_size\": %.6g, "
         "\"margin\": %.6g}},\n",
         h, 0.5 * h);
-    put(t, "  \"geometry\": {\"surface\": \"%s\", \"fill_holes\": %s},\n", body,
-        m->fill_holes ? "true" : "false");
+    cutbench_put(t, "  \"geometry\": {\"surface\": \"%s\", \"fill_holes\": %s},\n", body,
+                 m->fill_holes ? "true" : "false");
   }
-  put(t,
+  cutbench_put(
+      t,
       "  \"material\": {\"model\": \"%s\", \"young\": %g, \"poisson\": %g, \"density\": 1000},\n",
       material, young, poisson);
-  if (solver && solver[0]) put(t, "  \"solver\": {%s},\n", solver);
-  put(t, "  \"time\": {\"dt\": %g, \"duration\": %.9g},\n", dt, dt * steps);
-  put(t, "  \"output\": {\"directory\": \"fcm-output/%s\", \"frame_interval\": 1},\n", name);
-  put(t, "  \"effects\": [\n");
+  if (solver && solver[0]) cutbench_put(t, "  \"solver\": {%s},\n", solver);
+  cutbench_put(t, "  \"time\": {\"dt\": %g, \"duration\": %.9g},\n", dt, dt * steps);
+  cutbench_put(t, "  \"output\": {\"directory\": \"fcm-output/%s\", \"frame_interval\": 1},\n",
+               name);
+  cutbench_put(t, "  \"effects\": [\n");
 }
 
 /* The cut effects: event k at the start of step event_step[k] (1-based), its surface the
  * OBJ <surf_dir>/<name>_cut<k>.obj. */
-static void scene_cuts(text *t, const cutbench_scene *sc, const char *surf_dir, const char *name,
-                       double dt)
+static void scene_cuts(cutbench_text *t, const cutbench_scene *sc, const char *surf_dir,
+                       const char *name, double dt)
 {
   for (int k = 0; k < sc->events; k++)
-    put(t, "    {\"cut\": {\"time\": %.9g, \"surface\": {\"mesh\": \"%s/%s_cut%d.obj\"}}}%s\n",
+    cutbench_put(
+        t, "    {\"cut\": {\"time\": %.9g, \"surface\": {\"mesh\": \"%s/%s_cut%d.obj\"}}}%s\n",
         dt * (sc->event_step[k] - 1), surf_dir, name, k + 1, k + 1 < sc->events ? "," : "");
-  put(t, "  ]\n}\n");
+  cutbench_put(t, "  ]\n}\n");
 }
 
 /* <dir>/<surf_dir>/<name>_cut<k>.obj */
@@ -443,7 +441,7 @@ int cutbench_write_scene(cutbench_row_id row, const cutbench_model *m, const cha
                          double scale, const char *solver, const char *dir, const char *surf_dir,
                          const char *name, cutbench_scene *sc)
 {
-  static text t;
+  static cutbench_text t;
   const cutbench_paper *p = &cutbench_papers[row];
   memset(sc, 0, sizeof *sc);
   t.n = 0, t.ok = 1;
@@ -463,8 +461,9 @@ int cutbench_write_scene(cutbench_row_id row, const cutbench_model *m, const cha
              "six square blades is pushed down into it in four steps (one cut per step).",
              p->model, target);
     scene_head(&t, name, desc, m, body, sc->h, "corotated", 1e5, 0.4, solver, 0.01, sc->steps);
-    put(&t, "    {\"gravity\": {\"acceleration\": [0, -9.81, 0]}},\n");
-    put(&t,
+    cutbench_put(&t, "    {\"gravity\": {\"acceleration\": [0, -9.81, 0]}},\n");
+    cutbench_put(
+        &t,
         "    {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, %.6g, 0], \"normal\": [0, "
         "-1, 0]}}}},\n",
         m->lo[1] + 0.1 * Ly);
@@ -480,8 +479,9 @@ int cutbench_write_scene(cutbench_row_id row, const cutbench_model *m, const cha
         m, body, sc->h, "snh", 2e5, 0.4, solver, 0.005, sc->steps);
     const double cx = 0.5 * (m->lo[0] + m->hi[0]), cz = 0.5 * (m->lo[2] + m->hi[2]);
     const double rx = 0.2 * (m->hi[0] - m->lo[0]), rz = 0.2 * (m->hi[2] - m->lo[2]);
-    put(&t, "    {\"gravity\": {\"acceleration\": [0, -9.81, 0]}},\n");
-    put(&t,
+    cutbench_put(&t, "    {\"gravity\": {\"acceleration\": [0, -9.81, 0]}},\n");
+    cutbench_put(
+        &t,
         "    {\"motion\": {\"region\": {\"box\": {\"min\": [%.6g, %.6g, %.6g], \"max\": [%.6g, "
         "%.6g, %.6g]}},\n      \"rotation\": {\"axis\": [0, 1, 0], \"center\": [%.6g, 0, %.6g], "
         "\"speed\": 4}}},\n",
@@ -512,8 +512,9 @@ int cutbench_write_scene(cutbench_row_id row, const cutbench_model *m, const cha
     memmove(mat + g, mat, tail + 1);
     memcpy(mat, grid, g);
     t.n += g;
-    put(&t, "    {\"gravity\": {\"acceleration\": [0, 0, -9.81]}},\n");
-    put(&t, "    {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, "
+    cutbench_put(&t, "    {\"gravity\": {\"acceleration\": [0, 0, -9.81]}},\n");
+    cutbench_put(
+        &t, "    {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, "
             "0, 0]}}}},\n");
   }
   scene_cuts(&t, sc, surf_dir, name,

@@ -62,6 +62,17 @@ typedef struct cutbench_scene {
   int event_step[CUTBENCH_MAX_EVENTS]; /* the step (1-based) each event precedes */
 } cutbench_scene;
 
+/** A text grown printf-style in a fixed buffer (scene files, gnuplot scripts); ok drops to 0
+ * when it would overflow. */
+typedef struct cutbench_text {
+  char s[1 << 16];
+  size_t n;
+  int ok;
+} cutbench_text;
+
+/** Append to t (nothing once t->ok is 0). */
+void cutbench_put(cutbench_text *t, const char *fmt, ...);
+
 /** Write the generated bunny-like surface (a closed, outward-oriented star-shaped surface
  * with a body, a head, two ears and a tail, about 0.16 m long, its base at y = 0) with about
  * `triangles` triangles to `path`; 1 on success, 0 with a message. */
