@@ -55,9 +55,11 @@ static void usage(FILE *f, const cli_option *opts)
           "  tonthat-slab  Ton-That 2024 Table 2: a slab cut into thin sheets by cuts\n"
           "      re-entering the same cells, then across; 7.2k DOFs; Stable Neo-Hookean\n"
           "The body is a generated closed bunny-like surface (--surface-triangles) unless\n"
-          "--model gives a file. With an interactive option set (--interactive, members of the\n"
-          "scene's \"solver\" object) each row also runs with it and reports the largest\n"
-          "displacement difference to the defaults.\n"
+          "--model gives a file. Each row runs the accurate defaults and then its interactive\n"
+          "option set (Dick: 3 multigrid V-cycles and one Newton iteration a step; Koschier,\n"
+          "Ton-That: one Newton iteration; skipped where this build lacks those keys;\n"
+          "--interactive replaces them, as members of the scene's \"solver\" object) and\n"
+          "reports the largest displacement difference between the two.\n"
           "\n"
           "options:\n");
   cli_print_options(f, opts);
