@@ -1,5 +1,6 @@
-# The programs' shared command-line helper (apps/cli.h), linked into each program.
-add_library(fcm_apps_cli STATIC apps/cli.c)
+# The programs' shared command-line helper (apps/cli.h) and the sphere triangulation their
+# generated surfaces start from (apps/app_sphere.h), linked into each program.
+add_library(fcm_apps_cli STATIC apps/cli.c apps/app_sphere.c)
 target_link_libraries(fcm_apps_cli PUBLIC fcm::fcm)
 target_compile_options(fcm_apps_cli PRIVATE ${FCM_WARNINGS} ${FCM_SAN_FLAGS})
 fcm_add_app(fcm-sim apps/fcm-sim.c)
@@ -13,11 +14,13 @@ fcm_add_app(fcm-converge apps/fcm-converge.c apps/fcm-converge-study.c apps/fcm-
 fcm_add_app(fcm-cut apps/fcm-cut.c)
 fcm_add_app(fcm-scaling apps/fcm-scaling.c apps/fcm-scaling-study.c apps/fcm-scaling-output.c)
 fcm_add_app(fcm-models apps/fcm-models.c apps/fcm-models-run.c apps/fcm-models-output.c)
+fcm_add_app(fcm-cutbench apps/fcm-cutbench.c apps/fcm-cutbench-scenes.c
+            apps/fcm-cutbench-output.c)
 # fcm-models finds its built-in pebble (apps/scenes/models/pebble.obj) in the source tree.
 target_compile_definitions(fcm-models PRIVATE FCM_MODELS_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 # Every program waits passively in OpenMP and selects the CPU's OpenBLAS kernels unless the user
 # says otherwise (apps/app_env.h).
 foreach(app fcm-sim fcm-rulegen fcm-quadrature fcm-condition fcm-converge fcm-cut fcm-scaling
-            fcm-models)
+            fcm-models fcm-cutbench)
   target_sources(${app} PRIVATE apps/app_env.c)
 endforeach()

@@ -447,3 +447,16 @@ void cli_split_petsc_args(int *argc, char **argv, int *pargc, char **pargv)
   *pargc = m;
   pargv[m] = NULL;
 }
+
+void cli_csv_number(FILE *f, double v)
+{
+  fputc(',', f);
+  if (v >= 0.0 && isfinite(v)) fprintf(f, "%.6g", v);
+}
+
+void cli_csv_text(FILE *f, const char *s)
+{
+  fputc(',', f);
+  for (; *s; s++)
+    fputc(*s == ',' ? ';' : *s == '"' ? '\'' : *s == '\n' || *s == '\r' ? ' ' : *s, f);
+}

@@ -119,6 +119,14 @@ int cli_output_commit(const char *prog, cli_output **out);
 /** Remove the temporary and release *out; accepts NULL and *out == NULL. */
 void cli_output_abort(cli_output **out);
 
+/** A CSV field of a number: ",v" (%.6g), or "," alone when v is negative or not finite (the
+ *  programs' CSVs leave a figure that was not measured empty). */
+void cli_csv_number(FILE *f, double v);
+
+/** A CSV field of text: "," and `s` with commas turned into ';', double quotes into single
+ *  ones and line breaks into spaces (the programs' CSVs have no quoting). */
+void cli_csv_text(FILE *f, const char *s);
+
 /** mkdir -p: create the directory `dir` and its missing parents. 1 when it exists afterwards;
  *  0 with a message (a path too long, a part that cannot be created or is not a directory). */
 int cli_make_dirs(const char *prog, const char *dir);

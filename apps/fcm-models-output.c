@@ -75,21 +75,6 @@ static const char csv_header[] =
     "final_points_stiffness,final_points_mass,strength_stiffness,strength_mass,peak_rss_mb,"
     "steps,step_s,step_assembly_s,step_factor_s,step_solve_s,log_s,moment_diff,note\n";
 
-/* ",v" (%.6g), or "," alone when v is negative or not finite. */
-static void num(FILE *f, double v)
-{
-  fputc(',', f);
-  if (v >= 0.0 && isfinite(v)) fprintf(f, "%.6g", v);
-}
-
-/* ",note" with commas and line breaks replaced (the CSV has no quoting). */
-static void note(FILE *f, const char *s)
-{
-  fputc(',', f);
-  for (; *s; s++)
-    fputc(*s == ',' ? ';' : *s == '\n' || *s == '\r' ? ' ' : *s, f);
-}
-
 static void csv_run(FILE *f, const models_settings *o, const model_pair *p, int k)
 {
   const model_run *r = &p->run[k];
@@ -108,16 +93,16 @@ static void csv_run(FILE *f, const models_settings *o, const model_pair *p, int 
                         r->points_initial[1], r->points_final[0], r->points_final[1],
                         r->strength[0],       r->strength[1]};
   for (int i = 0; i < 11; i++)
-    num(f, ok ? v[i] : -1.0);
-  num(f, ok ? r->peak_mb : -1.0);
+    cli_csv_number(f, ok ? v[i] : -1.0);
+  cli_csv_number(f, ok ? r->peak_mb : -1.0);
   fputc(',', f);
   if (ok) fprintf(f, "%lld", r->steps);
   const double s[5] = {r->step_s, r->assembly_s, r->factor_s, r->solve_s, r->log_s};
   for (int i = 0; i < 5; i++)
-    num(f, ok ? s[i] : -1.0);
+    cli_csv_number(f, ok ? s[i] : -1.0);
   fputc(',', f);
   if (p->moment_diff >= 0.0) fprintf(f, "%.3e", p->moment_diff);
-  note(f, ok ? "" : r->note);
+  cli_csv_text(f, ok ? "" : r->note);
   fputc('\n', f);
 }
 
@@ -134,15 +119,15 @@ static void csv_ratio(FILE *f, const models_settings *o, const model_pair *p)
                        n->t_integrator,      n->t_setup,         n->points_initial[0],
                        n->points_initial[1], n->points_final[0], n->points_final[1]};
   for (int i = 0; i < 9; i++)
-    num(f, ratio(a[i], b[i]));
+    cli_csv_number(f, ratio(a[i], b[i]));
   fputs(",,", f);
-  num(f, ratio(d->peak_mb, n->peak_mb));
+  cli_csv_number(f, ratio(d->peak_mb, n->peak_mb));
   fputc(',', f);
-  num(f, ratio(d->step_s, n->step_s));
-  num(f, ratio(d->assembly_s, n->assembly_s));
-  num(f, ratio(d->factor_s, n->factor_s));
-  num(f, ratio(d->solve_s, n->solve_s));
-  num(f, ratio(d->log_s, n->log_s));
+  cli_csv_number(f, ratio(d->step_s, n->step_s));
+  cli_csv_number(f, ratio(d->assembly_s, n->assembly_s));
+  cli_csv_number(f, ratio(d->factor_s, n->factor_s));
+  cli_csv_number(f, ratio(d->solve_s, n->solve_s));
+  cli_csv_number(f, ratio(d->log_s, n->log_s));
   fputs(",,\n", f);
 }
 
@@ -177,7 +162,7 @@ int models_write_ball_csv(const char *path, const ball_row *rows, int count)
               b->strength[0], b->strength[1]);
     else {
       fprintf(f, "%d,,,,,,,,,failed", b->n);
-      note(f, b->note);
+      cli_csv_text(f, b->note);
       fputc('\n', f);
     }
   }

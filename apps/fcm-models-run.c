@@ -2,6 +2,7 @@
  * scene runner in this process (set-up phases, rule statistics, steps, global moments, peak
  * memory), the generated surfaces (a bumpy sphere, a ball) and the ball study. */
 #define _POSIX_C_SOURCE 200809L
+#include "app_sphere.h"
 #include "fcm-models.h"
 
 #include <fcm/simulation.h>
@@ -12,76 +13,6 @@
 #include <string.h>
 
 /* ------------------------------------------------------------- generated surfaces */
-
-/* A sphere triangulation: the surface grid of the cube [-1,1]^3 with m segments per edge (two
- * triangles per square, 12 m^2 in all, oriented outward), every vertex pushed onto the unit
- * sphere. Vertices on the cube's edges are shared, so the surface is closed and manifold. */
-typedef struct sphere_mesh {
-  long long nv, nt;
-  double *x;    /* nv x 3 */
-  fcm_index *t; /* nt x 3 */
-} sphere_mesh;
-
-static void sphere_free(sphere_mesh *s)
-{
-  free(s->x);
-  free(s->t);
-  s->x = NULL, s->t = NULL;
-}
-
-static int cube_sphere(int m, sphere_mesh *s)
-{
-  const long long side = m + 1;
-  long long *id = malloc(sizeof *id * (size_t)(side * side * side));
-  s->x = NULL, s->t = NULL, s->nv = 0, s->nt = 12LL * m * m;
-  if (!id) return 0;
-  for (long long k = 0; k < side; k++)
-    for (long long j = 0; j < side; j++)
-      for (long long i = 0; i < side; i++) {
-        const int on = i == 0 || j == 0 || k == 0 || i == m || j == m || k == m;
-        id[i + side * (j + side * k)] = on ? s->nv++ : -1;
-      }
-  s->x = malloc(sizeof *s->x * 3 * (size_t)s->nv);
-  s->t = malloc(sizeof *s->t * 3 * (size_t)s->nt);
-  if (!s->x || !s->t) {
-    free(id);
-    sphere_free(s);
-    return 0;
-  }
-  for (long long k = 0; k < side; k++)
-    for (long long j = 0; j < side; j++)
-      for (long long i = 0; i < side; i++) {
-        const long long v = id[i + side * (j + side * k)];
-        if (v < 0) continue;
-        double p[3] = {2.0 * (double)i / m - 1.0, 2.0 * (double)j / m - 1.0,
-                       2.0 * (double)k / m - 1.0};
-        const double r = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-        for (int d = 0; d < 3; d++)
-          s->x[3 * v + d] = p[d] / r;
-      }
-  long long t = 0;
-  for (int d = 0; d < 3; d++)
-    for (int sd = 0; sd < 2; sd++) {
-      const int u = (d + 1) % 3, w = (d + 2) % 3;
-      for (int a = 0; a < m; a++)
-        for (int b = 0; b < m; b++) {
-          long long c[4];
-          static const int du[4] = {0, 1, 1, 0}, dw[4] = {0, 0, 1, 1};
-          for (int q = 0; q < 4; q++) {
-            long long p[3];
-            p[d] = sd ? m : 0, p[u] = a + du[q], p[w] = b + dw[q];
-            c[q] = id[p[0] + side * (p[1] + side * p[2])];
-          }
-          /* (c0, c1, c2) turns about +e_d: outward on the side at +1 */
-          const int tri[2][3] = {{0, 1, 2}, {0, 2, 3}};
-          for (int h = 0; h < 2; h++, t++)
-            for (int q = 0; q < 3; q++)
-              s->t[3 * t + q] = c[tri[h][sd ? q : (3 - q) % 3]];
-        }
-    }
-  free(id);
-  return 1;
-}
 
 /* The bumpy sphere's radius in the direction x (unit): 0.5 m modulated by a few real
  * spherical harmonics (degrees 2 to 4; the sum stays within +-25 %, so the surface remains
@@ -99,8 +30,8 @@ int models_write_bumpy(const char *path, long long triangles)
 {
   int m = (int)lround(sqrt((double)triangles / 12.0));
   if (m < 2) m = 2;
-  sphere_mesh s;
-  if (!cube_sphere(m, &s)) {
+  app_sphere_mesh s;
+  if (!app_cube_sphere(m, &s)) {
     fprintf(stderr, PROG ": bumpy: out of memory\n");
     return 0;
   }
@@ -119,7 +50,7 @@ int models_write_bumpy(const char *path, long long triangles)
     ok = fclose(f) == 0 && ok;
   }
   if (!ok) fprintf(stderr, PROG ": cannot write the bumpy sphere to %s\n", path);
-  sphere_free(&s);
+  app_sphere_free(&s);
   return ok;
 }
 
@@ -349,12 +280,12 @@ static void ball_size(fcm_ctx *ctx, int n, fcm_element_type element, ball_row *b
   const double h = 2.0 / n, c[3] = {0.0137 * h, 0.0071 * h, -0.0093 * h};
   /* the cube grid's edge maps to a quarter arc: pi/2 / m = h/2 */
   const int m = (int)ceil(3.14159265358979323846 / h);
-  sphere_mesh s;
+  app_sphere_mesh s;
   fcm_surface *surf = NULL;
   fcm_geometry *geom = NULL;
   fcm_mesh *mesh = NULL;
   fcm_cell_rules *rules = NULL;
-  if (!cube_sphere(m, &s)) {
+  if (!app_cube_sphere(m, &s)) {
     snprintf(b->note, sizeof b->note, "out of memory");
     return;
   }
@@ -389,7 +320,7 @@ done:
   fcm_mesh_destroy(&mesh);
   fcm_geometry_destroy(&geom);
   fcm_surface_destroy(&surf);
-  sphere_free(&s);
+  app_sphere_free(&s);
 }
 
 int models_ball_study(const int *n, int count, fcm_element_type element, ball_row *out)

@@ -37,6 +37,17 @@ static inline int app_has_warning(const char *path)
   return found;
 }
 
+/* 1 when the file `path` starts with the PNG signature. */
+static inline int app_is_png(const char *path)
+{
+  FILE *f = fopen(path, "rb");
+  unsigned char magic[8] = {0};
+  const int ok = f && fread(magic, 1, 8, f) == 8 && magic[0] == 0x89 && magic[1] == 'P' &&
+                 magic[2] == 'N' && magic[3] == 'G';
+  if (f) fclose(f);
+  return ok;
+}
+
 /* Field k (from 0) of a CSV line without quoting into buf (cap bytes, cut to fit). */
 static inline void field(const char *line, int k, char *buf, size_t cap)
 {

@@ -5,7 +5,8 @@
  * prints aligned help; cli_parse_args gives the exit codes; a number option takes one value per
  * metavar word; element names and lists (repeats refused) are read; output files appear only at
  * commit, and an abort or a write error leaves the previous file untouched and no temporary behind;
- * cli_make_dirs creates missing parents and refuses a file in the way.
+ * cli_make_dirs creates missing parents and refuses a file in the way; CSV fields keep a row's
+ * columns.
  * argv[1]: a scratch directory. */
 #define _POSIX_C_SOURCE 200809L
 #include "../../apps/cli.c"
@@ -290,6 +291,28 @@ static void make_dirs(const char *work)
   rmdir(top);
 }
 
+/* CSV fields: numbers at 6 digits, unmeasured ones (negative, NaN, infinite) empty; text with
+ * its commas, double quotes and line breaks replaced, so a row keeps its columns. */
+static void csv_fields(const char *work)
+{
+  char path[4096];
+  snprintf(path, sizeof path, "%s/cli-csv.txt", work);
+  FILE *f = fopen(path, "w");
+  TEST_TRUE(f != NULL);
+  if (!f) return;
+  fputs("a", f);
+  cli_csv_number(f, 0.1234567);
+  cli_csv_number(f, 0.0);
+  cli_csv_number(f, -1.0);
+  cli_csv_number(f, NAN);
+  cli_csv_number(f, INFINITY);
+  cli_csv_text(f, "x,\"y\"\nz");
+  cli_csv_text(f, "");
+  fclose(f);
+  TEST_TRUE(file_is(path, "a,0.123457,0,,,,x;'y' z,"));
+  remove(path);
+}
+
 int main(int argc, char **argv)
 {
   if (argc != 2) return 2;
@@ -304,6 +327,7 @@ int main(int argc, char **argv)
   parse_args();
   output(argv[1]);
   make_dirs(argv[1]);
+  csv_fields(argv[1]);
   int rc = TEST_RESULT();
   if (rc != 0) {
     char line[512];

@@ -202,7 +202,10 @@ if(FCM_BUILD_APPS)
       cracked_beam          1 1e-8
       cut_slab              2 1e-8
       dice                  2 1e-8
-      twisting_cylinder     1 1e-8)
+      twisting_cylinder     1 1e-8
+      cutbench_dick_bunny3    1 1e-8
+      cutbench_koschier_bunny 1 1e-8
+      cutbench_tonthat_slab   1 1e-8)
   # name               the message (grep -E) of the refusal (none: every example scene runs)
   set(FCM_PETSC_SCENES_REFUSED)
   set(listed "")

@@ -21,9 +21,10 @@ static fcm_scene *parse(fcm_ctx *ctx, const char *geometry, fcm_status expect, c
   char text[4096];
   fcm_scene *s = NULL;
   snprintf(text, sizeof text, "{" BG ", \"geometry\": %s, " REST "}", geometry);
-  if (expect == FCM_OK)
+  if (expect == FCM_OK) {
     TEST_OK(ctx, fcm_scene_create_from_string(ctx, text, "t.json", &s));
-  else
+    if (s) check_normalized(ctx, s, geometry); /* every geometry kind round-trips */
+  } else
     TEST_ERR(ctx, fcm_scene_create_from_string(ctx, text, "t.json", &s), expect, msg);
   return s;
 }

@@ -118,6 +118,14 @@ static inline char *view_body(const fcm_scene *s)
   fclose(f);
   char *nl = text ? strchr(text, '\n') : NULL;
   if (nl) memmove(text, nl + 1, strlen(nl + 1) + 1);
+  /* file names relative to the working directory come back absolute: the same files */
+  char cwd[1024];
+  if (text && getcwd(cwd, sizeof cwd - 1)) {
+    strcat(cwd, "/");
+    const size_t n = strlen(cwd);
+    for (char *at = strstr(text, cwd); at; at = strstr(at, cwd))
+      memmove(at, at + n, strlen(at + n) + 1);
+  }
   return text;
 }
 

@@ -157,8 +157,13 @@ typedef struct fcm_simulation_counters {
                                                     and the cuts */
   double time_cuts; /**< seconds of the cuts applied after the set-up (rules, space, integrator;
                          part of time_steps) */
-  double time_log;  /**< seconds of the per-step log rows (mass, momentum, reactions; not part
-                         of time_steps) */
+  double time_cut_rules; /**< of time_cuts: the cut cells' rules (fcm_cell_rules_create_cut()) */
+  double time_cut_space; /**< of time_cuts: the new space (DOFs, element data) */
+  double time_cut_integrator; /**< of time_cuts: the new integrator (set-up, the mass matrix, state
+                                   transfer); the new factorization or multigrid hierarchy is
+                                   built by the next step (time_step_factor) */
+  double time_log; /**< seconds of the per-step log rows (mass, momentum, reactions; not part
+                        of time_steps) */
   double time_setup_geometry;   /**< seconds of the set-up's background mesh and geometry (reading
                                      files, hole filling, surface checks, meshing) */
   double time_setup_rules;      /**< seconds of its cut-cell rules (fcm_cell_rules_create()) */

@@ -218,6 +218,7 @@ static fcm_status read_surface_geometry(fcm__scene_parser *p, const fcm__json *o
   if (!g->fill_holes) {
     static const char *const fill_keys[] = {"max_hole_edges", "max_hole_perimeter"};
     for (int i = 0; i < SCENE_COUNT(fill_keys); i++) {
+      fcm__scene_forget(p, fill_keys[i]); /* the defaults apply to filling only */
       if (!fcm__json_member(o, fill_keys[i])) continue;
       fcm__scene_path_push_key(p, fill_keys[i]);
       SCENE_CHECK(0, p, FCM_ERR_ARG, "only used with \"fill_holes\": true");
@@ -347,6 +348,7 @@ static fcm_status read_voxels(fcm__scene_parser *p, const fcm__json *o, fcm_scen
   g->merge = 1;
   FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "threshold", 0, FCM__ANY, &g->threshold));
   FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "merge", 0, &g->merge));
+  if (fcm__json_member(o, "labels")) fcm__scene_forget(p, "threshold"); /* one or the other */
   FCM_TRY(p->ctx, fcm__scene_field(p, o, "labels", 0, "an array of 1 to 256 numbers",
                                    FCM__JSON_ARRAY, -1, &lab));
   if (lab) {

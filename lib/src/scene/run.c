@@ -572,6 +572,7 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   fcm_integrator *integ = NULL;
   const double t0 = fcm_wtime();
   const int k = S->cuts_applied;
+  S->cut_phase[0] = S->cut_phase[1] = S->cut_phase[2] = 0.0;
   /* A distributed run (the integrator has a backend, sim_backend.h): the rules keep the
    * process's cell mask, the new integrator gets the backend again (its cut hook, which
    * agrees first), and fcm__integrator_finish() at the end agrees on the outcome, so a
@@ -584,17 +585,20 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
     goto cleanup;
   }
   FCM_TRY(ctx, fcm_cell_rules_create_cut(ctx, S->mesh, S->geom, S->rules, surf, &rules));
+  S->cut_phase[0] = fcm_wtime() - t0;
   S->cut_stats[k] = *fcm_cell_rules_get_stats(rules);
   S->c.cut_cells += S->cut_stats[k].num_integrated;
   FCM_TRY(ctx,
           create_space(S, rules, fcm__integrator_distributed(S->integ, NULL) ? rules->own : NULL,
                        &space));
+  S->cut_phase[1] = fcm_wtime() - t0 - S->cut_phase[0];
   /* missed: no cell got a new piece and no node a new copy (a cut along cell faces adds copies
    * without splitting any cell) */
   if (fcm_cell_rules_num_pieces(rules) == fcm_cell_rules_num_pieces(S->rules) &&
       fcm_space_num_dofs(space) == fcm_space_num_dofs(S->space))
     S->c.cuts_missed++;
   FCM_TRY(ctx, fcm_integrator_create_cut(S->integ, space, &integ));
+  S->cut_phase[2] = fcm_wtime() - t0 - S->cut_phase[0] - S->cut_phase[1];
   /* the new integrator counts from zero: keep the totals so far */
   S->base_factorizations = S->c.factorizations;
   S->base_analyses = S->c.analyses;

@@ -95,7 +95,9 @@ struct fcm_simulation {
   fcm__auto_uses auto_uses; /* with quadrature.simplify = "auto" */
   fcm_cell_rules_stats *cut_stats;
   double *cut_time;
-  fcm_index pieces; /* separate bodies of the current space (fcm_space_num_bodies()) */
+  double cut_phase[3]; /* the last cut's rules, space and integrator seconds (the step adds them
+                          to the counters' time_cut_*) */
+  fcm_index pieces;    /* separate bodies of the current space (fcm_space_num_bodies()) */
   long long base_factorizations, base_analyses, base_fallbacks; /* of integrators before cuts */
   fcm_index base_dofs, base_constrained; /* DOFs and constrained DOFs before any cut (the
                                             checkpoint fingerprint) */

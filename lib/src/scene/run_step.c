@@ -123,6 +123,9 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
       FCM_TRY(S->ctx, fcm__sim_apply_cut(S));
       S->c.time_steps += fcm_wtime() - tc;
       S->c.time_cuts += fcm_wtime() - tc;
+      S->c.time_cut_rules += S->cut_phase[0];
+      S->c.time_cut_space += S->cut_phase[1];
+      S->c.time_cut_integrator += S->cut_phase[2];
     }
   }
   double t0 = fcm_wtime();

@@ -395,7 +395,7 @@ fcm_status fcm__scene_read_string(fcm__scene_parser *p, const fcm__json *obj, co
   const char *raw = NULL;
   FCM_TRY(p->ctx, string_node(p, obj, key, required, "a non-empty string", &raw));
   if (raw) FCM_TRY(p->ctx, fcm__scene_strdup(p, raw, out));
-  if (!raw) put_string(p, key, *out); /* a default, if any */
+  if (!raw && *out && **out) put_string(p, key, *out); /* a default, if any (not "") */
 cleanup:
   return st;
 }

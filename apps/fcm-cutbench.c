@@ -1,0 +1,437 @@
+/* fcm-cutbench: the main program — options, the body (the generated bunny-like surface or a
+ * model file), each row's scene written to a temporary directory and run through the scene
+ * runner step by step (the cut events' latency split by phase from the simulation's counters,
+ * the steps' times and iterations), the interactive option set run beside the defaults with
+ * the displacement difference, and the table, CSV and PNG. */
+#define _XOPEN_SOURCE 700 /* realpath, mkdtemp, nftw */
+#include "app_env.h"
+#include "cli.h"
+#include "fcm-cutbench.h"
+
+#include <errno.h>
+#include <ftw.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+/* The option set each row runs beside the defaults when --interactive does not give one ("":
+ * none). */
+static const char *const row_interactive[ROW_COUNT] = {
+    /* Dick: one Newton iteration of three multigrid V-cycles a step (his 3 V-cycles) */
+    "\"method\": \"multigrid\", \"fixed_cycles\": 3, \"newton\": {\"fixed_iterations\": 1}",
+    "\"method\": \"multigrid\", \"fixed_cycles\": 3, \"newton\": {\"fixed_iterations\": 1}",
+    "\"method\": \"multigrid\", \"fixed_cycles\": 3, \"newton\": {\"fixed_iterations\": 1}",
+    /* Koschier, Ton-That: one Newton iteration a step (Ton-That's setting), direct solves */
+    "\"newton\": {\"fixed_iterations\": 1}", "\"newton\": {\"fixed_iterations\": 1}"};
+
+typedef struct settings {
+  int quick, fill_holes;
+  double scale;
+  long long triangles;
+  const char *model, *rows, *interactive, *csv, *png, *write_scenes;
+  int seen_triangles;
+  int selected[ROW_COUNT];
+} settings;
+
+static void usage(FILE *f, const cli_option *opts)
+{
+  fprintf(f,
+          "usage: fcm-cutbench [--quick] [--rows R1,R2] [--scale F] [--model FILE] [options]\n"
+          "       fcm-cutbench --write-scenes DIR [--scale F] [--model FILE]\n"
+          "\n"
+          "Runs the cutting scenarios of three papers as scenes and measures each cut's latency\n"
+          "split by phase (cut surface and rules, space, integrator; the factorization of the\n"
+          "step after it), the mean and largest step time (cuts excluded), Newton and linear\n"
+          "iterations per step, DOFs before and after, beside the papers' figures, with the\n"
+          "targets: cut <= the paper's; mean step <= paper/2 (Dick) or paper/10 (Koschier,\n"
+          "Ton-That). Rows:\n"
+          "  dick-bunny3, dick-bunny2, dick-bunny  Dick 2011 Table 1: a grid of blades pushed\n"
+          "      into the bunny in four steps; 5.48k, 26.1k, 118k active Hex8 cells; corotated\n"
+          "  koschier-bunny  Koschier 2017 7: a groove carved into the turning bunny, then\n"
+          "      peeled off; 5,326 DOFs; Stable Neo-Hookean\n"
+          "  tonthat-slab  Ton-That 2024 Table 2: a slab cut into thin sheets by cuts\n"
+          "      re-entering the same cells, then across; 7.2k DOFs; Stable Neo-Hookean\n"
+          "The body is a generated closed bunny-like surface (--surface-triangles) unless\n"
+          "--model gives a file. Each row runs the accurate defaults and then its interactive\n"
+          "option set (Dick: 3 multigrid V-cycles and one Newton iteration a step; Koschier,\n"
+          "Ton-That: one Newton iteration; skipped where this build lacks those keys;\n"
+          "--interactive replaces them, as members of the scene's \"solver\" object) and\n"
+          "reports the largest displacement difference between the two.\n"
+          "\n"
+          "options:\n");
+  cli_print_options(f, opts);
+  fprintf(f, "\nExit 0 when every row ran (whether the targets hold is reported, not an error),\n"
+             "1 when a row failed, 2 on a usage error (nothing is written).\n");
+}
+
+#define NUM_OPTIONS 13
+static void option_table(settings *o, cli_option opts[NUM_OPTIONS])
+{
+  const cli_option t[NUM_OPTIONS] = {
+      {"--quick", NULL, CLI_FLAG, &o->quick, NULL,
+       "only the smallest row of each paper (dick-bunny3,\nkoschier-bunny, tonthat-slab)", 0, 0, 0,
+       NULL, NULL, NULL},
+      {"--rows", NULL, CLI_STRING, &o->rows, "R1,R2", "the rows to run (default: all)", 0, 0, 0,
+       NULL, NULL, NULL},
+      {"--scale", NULL, CLI_DOUBLE, &o->scale, "F",
+       "size the rows to F times the papers' cells or DOFs\n(default 1)", 0, 4, CLI_LO_OPEN, NULL,
+       NULL, NULL},
+      {"--model", NULL, CLI_STRING, &o->model, "FILE",
+       "the body's surface (OBJ, STL, OFF, PLY) instead of the\ngenerated one", 0, 0, 0, NULL, NULL,
+       NULL},
+      {"--fill-holes", NULL, CLI_FLAG, &o->fill_holes, NULL, "close the holes of --model", 0, 0, 0,
+       NULL, NULL, NULL},
+      {"--surface-triangles", NULL, CLI_LLONG, &o->triangles, "N",
+       "triangles of the generated body (default 70000)", 48, 5e6, 0, NULL, NULL,
+       &o->seen_triangles},
+      {"--interactive", NULL, CLI_STRING, &o->interactive, "MEMBERS",
+       "an option set run beside the defaults, as members of\nthe scene's \"solver\" object, "
+       "e.g. '\"method\": \"cg\"'",
+       0, 0, 0, NULL, NULL, NULL},
+      {"--csv", NULL, CLI_STRING, &o->csv, "FILE", "write the rows as CSV (atomically)", 0, 0, 0,
+       NULL, NULL, NULL},
+      {"--png", NULL, CLI_STRING, &o->png, "FILE",
+       "plot cut and step times against the papers (gnuplot)", 0, 0, 0, NULL, NULL, NULL},
+      {"--write-scenes", NULL, CLI_STRING, &o->write_scenes, "DIR",
+       "write the rows' scenes (DIR/cutbench_<row>.json, the\nbody and cut surfaces under "
+       "DIR/models) and stop",
+       0, 0, 0, NULL, NULL, NULL},
+      {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
+  memcpy(opts, t, sizeof t);
+}
+
+/* -1 when parsed, else the exit code. */
+static int parse_options(int argc, char **argv, settings *o)
+{
+  memset(o, 0, sizeof *o);
+  o->scale = 1.0, o->triangles = 70000;
+  cli_option opts[NUM_OPTIONS];
+  option_table(o, opts);
+  const int rc = cli_parse_args(PROG, opts, argc, argv, NULL, 0, NULL, usage);
+  if (rc >= 0) return rc;
+  if (o->rows && o->quick) {
+    fprintf(stderr, PROG ": --rows and --quick: give one of them\n");
+    return 2;
+  }
+  if (o->model && o->seen_triangles) {
+    fprintf(stderr, PROG ": --surface-triangles: only for the generated body (no --model)\n");
+    return 2;
+  }
+  if (o->fill_holes && !o->model) {
+    fprintf(stderr, PROG ": --fill-holes: only with --model\n");
+    return 2;
+  }
+  if (o->interactive && (strchr(o->interactive, '{') == o->interactive)) {
+    fprintf(stderr, PROG ": --interactive: give the members without the braces: '\"key\": "
+                         "value, ...'\n");
+    return 2;
+  }
+  for (int r = 0; r < ROW_COUNT; r++)
+    o->selected[r] = o->rows ? 0 : o->quick ? cutbench_papers[r].quick : 1;
+  if (o->rows) {
+    char tok[ROW_COUNT * 2][CLI_TOKEN];
+    int n = 0;
+    if (!cli_list(PROG, "--rows", o->rows, tok, ROW_COUNT * 2, &n)) return 2;
+    for (int i = 0; i < n; i++) {
+      int r = 0;
+      while (r < ROW_COUNT && strcmp(tok[i], cutbench_papers[r].row))
+        r++;
+      if (r == ROW_COUNT) {
+        fprintf(stderr, PROG ": --rows: %s: not a row (", tok[i]);
+        for (int k = 0; k < ROW_COUNT; k++)
+          fprintf(stderr, "%s%s", k ? ", " : "", cutbench_papers[k].row);
+        fprintf(stderr, ")\n");
+        return 2;
+      }
+      o->selected[r] = 1;
+    }
+  }
+  return -1;
+}
+
+/* ------------------------------------------------------------- one run */
+
+/* The library's warnings on stderr. */
+static void print_warning(void *user, fcm_log_level level, const char *msg)
+{
+  (void)user;
+  if (level == FCM_LOG_WARNING) fprintf(stderr, PROG ": warning: %s\n", msg);
+}
+
+/* Run the scene step by step: each step's counters against the previous ones give its cut
+ * events (the cuts applied before it) and its own time. With `skip_invalid` a scene that does
+ * not parse is skipped (r->skipped, the parser's message in the note) rather than failed. */
+static void run_scene(const char *json, int steps, const char *label, int skip_invalid,
+                      cutbench_run *r)
+{
+  memset(r, 0, sizeof *r);
+  r->ran = 1;
+  fcm_ctx_options co = fcm_ctx_options_default();
+  co.log = print_warning;
+  fcm_ctx *ctx = NULL;
+  fcm_scene *scene = NULL;
+  fcm_simulation *sim = NULL;
+  if (fcm_ctx_create(&co, &ctx) != FCM_OK) {
+    snprintf(r->note, sizeof r->note, "cannot create a context");
+    return;
+  }
+  if (fcm_scene_create_from_file(ctx, json, &scene) != FCM_OK) {
+    if (!skip_invalid) goto failed;
+    r->ran = 0, r->skipped = 1;
+    snprintf(r->note, sizeof r->note, "the option set is not accepted by this build: %s",
+             fcm_ctx_error_message(ctx));
+    fprintf(stderr, PROG ": %s: skipped: %s\n", label, r->note);
+    goto done;
+  }
+  fcm_simulation_options so = fcm_simulation_options_default();
+  so.max_steps = steps;
+  double t0 = fcm_wtime();
+  if (fcm_simulation_create(ctx, scene, &so, &sim) != FCM_OK) goto failed;
+  r->setup_s = fcm_wtime() - t0;
+  fcm_simulation_counters b, a;
+  fcm_simulation_get_counters(sim, &b);
+  r->dofs_before = (long long)b.num_dofs;
+  r->cells = (long long)fcm_space_num_elements(fcm_simulation_space(sim));
+  fprintf(stderr, PROG ": %s: set up in %.2f s: %lld cells, %lld DOFs\n", label, r->setup_s,
+          r->cells, r->dofs_before);
+  for (int k = 0; k < steps; k++) {
+    const fcm_status st = fcm_simulation_step(sim, NULL);
+    fcm_simulation_get_counters(sim, &a);
+    const double cut = a.time_cuts - b.time_cuts;
+    const double step = a.time_steps - b.time_steps - cut;
+    if (a.cuts > b.cuts) {
+      r->events++;
+      r->cut_mean += cut, r->cut_max = fmax(r->cut_max, cut);
+      r->cut_rules += a.time_cut_rules - b.time_cut_rules;
+      r->cut_space += a.time_cut_space - b.time_cut_space;
+      r->cut_integ += a.time_cut_integrator - b.time_cut_integrator;
+      r->cut_factor += a.time_step_factor - b.time_step_factor;
+      fprintf(stderr,
+              PROG ": %s: step %d: cut %.3f s (rules %.3f, space %.3f, integrator %.3f), "
+                   "%lld DOFs; the step %.3f s (factorization %.3f)\n",
+              label, k + 1, cut, a.time_cut_rules - b.time_cut_rules,
+              a.time_cut_space - b.time_cut_space, a.time_cut_integrator - b.time_cut_integrator,
+              (long long)a.num_dofs, step, a.time_step_factor - b.time_step_factor);
+    }
+    if (st != FCM_OK) goto failed;
+    r->steps++;
+    r->step_mean += step, r->step_max = fmax(r->step_max, step);
+    r->newton += (double)(a.newton_iterations - b.newton_iterations);
+    r->linear += (double)(a.linear_iterations - b.linear_iterations);
+    b = a;
+  }
+  r->dofs_after = (long long)a.num_dofs;
+  if (r->events > 0) {
+    r->cut_mean /= r->events, r->cut_rules /= r->events, r->cut_space /= r->events;
+    r->cut_integ /= r->events, r->cut_factor /= r->events;
+  }
+  r->step_mean /= (double)r->steps, r->newton /= (double)r->steps;
+  r->linear /= (double)r->steps;
+  if (!fcm_simulation_state_finite(sim)) {
+    snprintf(r->note, sizeof r->note, "the state is not finite after %lld steps", r->steps);
+    goto done;
+  }
+  {
+    fcm_integrator *I = fcm_simulation_integrator(sim);
+    r->n = (long long)fcm_integrator_num_dofs(I);
+    r->u = malloc(sizeof *r->u * (size_t)(r->n > 0 ? r->n : 1));
+    if (!r->u) {
+      snprintf(r->note, sizeof r->note, "out of memory");
+      goto done;
+    }
+    memcpy(r->u, fcm_integrator_displacement(I), sizeof *r->u * (size_t)r->n);
+  }
+  r->ok = 1;
+  goto done;
+failed:
+  fprintf(stderr, PROG ": %s: %s\n", label, fcm_ctx_error_message(ctx));
+  snprintf(r->note, sizeof r->note, "%s", fcm_ctx_error_message(ctx));
+done:
+  fcm_simulation_destroy(&sim);
+  fcm_scene_destroy(&scene);
+  fcm_ctx_destroy(&ctx);
+}
+
+/* ------------------------------------------------------------- the body */
+
+/* The model's name: its file stem, [A-Za-z0-9_.-] only, at most 48 characters. */
+static void file_stem(const char *path, char *out, size_t cap)
+{
+  const char *b = strrchr(path, '/');
+  b = b ? b + 1 : path;
+  size_t n = 0;
+  for (; b[n] && n + 1 < cap && n < 48; n++) {
+    const char c = b[n];
+    out[n] = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                     c == '_' || c == '-' || c == '.'
+                 ? c
+                 : '_';
+  }
+  out[n] = 0;
+  char *dot = strrchr(out, '.');
+  if (dot && dot != out) *dot = 0;
+}
+
+/* The body into m: the model file, or the generated surface written to `gen` (a path). */
+static int make_body(fcm_ctx *ctx, const settings *o, const char *gen, cutbench_model *m)
+{
+  memset(m, 0, sizeof *m);
+  if (o->model) {
+    char *abs = realpath(o->model, NULL);
+    if (!abs) {
+      fprintf(stderr, PROG ": --model %s: %s\n", o->model, strerror(errno));
+      return 0;
+    }
+    snprintf(m->path, sizeof m->path, "%s", abs);
+    free(abs);
+    if (strpbrk(m->path, "\"\\")) {
+      fprintf(stderr, PROG ": --model %s: a path with quotes or backslashes\n", m->path);
+      return 0;
+    }
+    file_stem(m->path, m->name, sizeof m->name);
+    m->fill_holes = o->fill_holes;
+  } else {
+    snprintf(m->path, sizeof m->path, "%s", gen);
+    snprintf(m->name, sizeof m->name, "lobed-%lldk", (o->triangles + 500) / 1000);
+    if (!cutbench_write_lobed(m->path, o->triangles)) return 0;
+  }
+  return cutbench_model_measure(ctx, m);
+}
+
+static int remove_entry(const char *path, const struct stat *sb, int flag, struct FTW *ftw)
+{
+  (void)sb, (void)flag, (void)ftw;
+  return remove(path);
+}
+
+/* ------------------------------------------------------------- main */
+
+/* Write the selected rows' scenes for the examples: DIR/cutbench_<row>.json, the generated
+ * body DIR/models/cutbench_body.obj (a --model is named by its absolute path), the cut
+ * surfaces under DIR/models/cutbench. */
+static int write_scenes(fcm_ctx *ctx, const settings *o)
+{
+  char gen[8192];
+  snprintf(gen, sizeof gen, "%s/models/cutbench_body.obj", o->write_scenes);
+  char models[8192];
+  snprintf(models, sizeof models, "%s/models", o->write_scenes);
+  if (!cli_make_dirs(PROG, models)) return 1;
+  cutbench_model m;
+  if (!make_body(ctx, o, gen, &m)) return 1;
+  for (int r = 0; r < ROW_COUNT; r++) {
+    if (!o->selected[r]) continue;
+    char name[128];
+    snprintf(name, sizeof name, "cutbench_%s", cutbench_papers[r].row);
+    for (char *c = name; *c; c++)
+      if (*c == '-') *c = '_';
+    cutbench_scene sc;
+    if (!cutbench_write_scene((cutbench_row_id)r, &m,
+                              o->model ? m.path : "models/cutbench_body.obj", o->scale, "",
+                              o->write_scenes, "models/cutbench", name, &sc))
+      return 1;
+    printf("%s: h = %.6g m, %d steps, %d cut events\n", sc.json_path, sc.h, sc.steps, sc.events);
+  }
+  return 0;
+}
+
+/* Run one row: the defaults, then the interactive set when there is one. */
+static int run_row(const settings *o, const cutbench_model *m, const char *dir, cutbench_row *row)
+{
+  const cutbench_paper *p = &cutbench_papers[row->id];
+  const char *inter = o->interactive ? o->interactive : row_interactive[row->id];
+  snprintf(row->interactive, sizeof row->interactive, "%s", inter);
+  row->disp_diff = row->disp_max = -1.0;
+  int ok = 1;
+  for (int k = 0; k < (inter[0] ? 2 : 1); k++) {
+    char name[128], label[160];
+    snprintf(name, sizeof name, "%s%s", p->row, k ? "-interactive" : "");
+    snprintf(label, sizeof label, "%s (%s)", p->row, k ? "interactive" : "defaults");
+    cutbench_scene sc;
+    if (!cutbench_write_scene(row->id, m, m->path, o->scale, k ? inter : "", dir, "cuts", name,
+                              &sc)) {
+      row->run[k].ran = 1;
+      snprintf(row->run[k].note, sizeof row->run[k].note, "the scene could not be written");
+      ok = 0;
+      continue;
+    }
+    row->h = sc.h;
+    fprintf(stderr, PROG ": %s: h = %.4g m, %d steps, cuts before steps", label, sc.h, sc.steps);
+    for (int e = 0; e < sc.events; e++)
+      fprintf(stderr, " %d", sc.event_step[e]);
+    fprintf(stderr, "\n");
+    /* the program's own option sets may name keys this build lacks: skipped, said so */
+    run_scene(sc.json_path, sc.steps, label, k == 1 && !o->interactive, &row->run[k]);
+    if (!row->run[k].ok && !row->run[k].skipped) ok = 0;
+  }
+  const cutbench_run *a = &row->run[0], *b = &row->run[1];
+  if (a->ok) {
+    row->disp_max = 0.0;
+    for (long long i = 0; i < a->n; i++)
+      row->disp_max = fmax(row->disp_max, fabs(a->u[i]));
+  }
+  if (a->ok && b->ok && a->n == b->n) {
+    row->disp_diff = 0.0;
+    for (long long i = 0; i < a->n; i++)
+      row->disp_diff = fmax(row->disp_diff, fabs(a->u[i] - b->u[i]));
+  }
+  return ok;
+}
+
+static int bench_main(fcm_ctx *ctx, const settings *o)
+{
+  const char *tmp = getenv("TMPDIR");
+  char dir[4096];
+  snprintf(dir, sizeof dir, "%s/fcm-cutbench-XXXXXX", tmp && *tmp ? tmp : "/tmp");
+  if (!mkdtemp(dir)) {
+    fprintf(stderr, PROG ": cannot create a temporary directory %s: %s\n", dir, strerror(errno));
+    return 1;
+  }
+  char gen[8192];
+  snprintf(gen, sizeof gen, "%s/body.obj", dir);
+  static cutbench_row rows[ROW_COUNT];
+  int n = 0, code = 0;
+  cutbench_model m;
+  if (!make_body(ctx, o, gen, &m)) {
+    code = 1;
+    goto done;
+  }
+  printf("fcm-cutbench%s: body %s (%lld x %lld x %lld mm, %.4g l), sizes %g x the papers'\n",
+         o->quick ? " --quick: the smallest row of each paper only" : "", m.name,
+         (long long)lround(1e3 * (m.hi[0] - m.lo[0])), (long long)lround(1e3 * (m.hi[1] - m.lo[1])),
+         (long long)lround(1e3 * (m.hi[2] - m.lo[2])), 1e3 * m.volume, o->scale);
+  cutbench_print_header();
+  for (int r = 0; r < ROW_COUNT; r++) {
+    if (!o->selected[r]) continue;
+    cutbench_row *row = &rows[n++];
+    memset(row, 0, sizeof *row);
+    row->id = (cutbench_row_id)r;
+    if (!run_row(o, &m, dir, row)) code = 1;
+    cutbench_print_row(row);
+  }
+  cutbench_print_verdicts(rows, n);
+  if (o->csv && !cutbench_write_csv(o->csv, rows, n)) code = 1;
+  if (o->png && !cutbench_write_png(o->png, rows, n)) code = 1;
+  for (int i = 0; i < n; i++)
+    for (int k = 0; k < 2; k++)
+      free(rows[i].run[k].u);
+done:
+  nftw(dir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+  return code;
+}
+
+int main(int argc, char **argv)
+{
+  app_env_init(argc, argv);
+  fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
+  static settings o;
+  const int rc = parse_options(argc, argv, &o);
+  if (rc >= 0) return rc;
+  fcm_ctx *ctx = NULL;
+  if (fcm_ctx_create(NULL, &ctx) != FCM_OK) return 1;
+  const int code = o.write_scenes ? write_scenes(ctx, &o) : bench_main(ctx, &o);
+  fcm_ctx_destroy(&ctx);
+  return code;
+}

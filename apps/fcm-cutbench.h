@@ -1,0 +1,135 @@
+/* fcm-cutbench: the cutting scenarios of three papers (Dick et al. 2011, Koschier et al. 2017,
+ * Ton-That et al. 2024) as scenes, run through the scene runner, with each cut's latency split
+ * by phase and the step times beside the papers' figures. Shared types of apps/fcm-cutbench*.c. */
+#ifndef FCM_APPS_CUTBENCH_H
+#define FCM_APPS_CUTBENCH_H
+
+#include <fcm/fcm.h>
+
+#include <stdio.h>
+
+#define PROG "fcm-cutbench"
+
+/** Cut events (cuts applied before one step) a scenario can have. */
+#define CUTBENCH_MAX_EVENTS 16
+
+/** The rows: each scenario of a paper's table. */
+typedef enum cutbench_row_id {
+  ROW_DICK_BUNNY3 = 0, /* Dick 2011 Table 1, Bunny 3 */
+  ROW_DICK_BUNNY2,     /* Bunny 2 */
+  ROW_DICK_BUNNY,      /* Bunny */
+  ROW_KOSCHIER_BUNNY,  /* Koschier 2017 §7, the groove carved and peeled */
+  ROW_TONTHAT_SLAB,    /* Ton-That 2024 Table 2, the thinly cut slab */
+  ROW_COUNT
+} cutbench_row_id;
+
+/** A paper's figures for one row (the constant table in fcm-cutbench-scenes.c). */
+typedef struct cutbench_paper {
+  const char *row;      /* the row's name: "dick-bunny3" */
+  const char *paper;    /* "Dick 2011 Table 1" */
+  const char *model;    /* "Bunny 3" */
+  const char *size;     /* "5.48k -> 8.27k hexahedra" */
+  double size_target;   /* what fcm's row is sized to: active cells (Dick) or DOFs */
+  int size_is_cells;    /* 1: size_target counts cells, 0: DOFs */
+  double cut_s;         /* the paper's cut latency (s); 0: not published */
+  double step_s;        /* the paper's mean step (s) */
+  double step_max_s;    /* the paper's largest step (s); 0: not published */
+  double step_factor;   /* the target: fcm's mean step <= step_factor * step_s */
+  const char *machine;  /* the paper's machine and method */
+  const char *element;  /* fcm's element */
+  const char *material; /* fcm's material model */
+  int quick;            /* 1: --quick runs this row (the smallest of each paper) */
+} cutbench_paper;
+
+/** The papers' rows, ROW_COUNT entries. */
+extern const cutbench_paper cutbench_papers[ROW_COUNT];
+
+/** The body: a closed triangle surface and its measures. */
+typedef struct cutbench_model {
+  char path[4096];     /* the surface file (absolute) */
+  char name[64];       /* "lobed" (generated) or the file's stem */
+  int fill_holes;      /* the scene's geometry.fill_holes */
+  double lo[3], hi[3]; /* bounding box */
+  double volume, area; /* enclosed volume, surface area */
+} cutbench_model;
+
+/** A scenario written out: the scene file (and its cut surfaces beside it). */
+typedef struct cutbench_scene {
+  char json_path[4096];
+  double h;                            /* the background's cell size */
+  int steps;                           /* steps the row runs */
+  int events;                          /* cut events */
+  int event_step[CUTBENCH_MAX_EVENTS]; /* the step (1-based) each event precedes */
+} cutbench_scene;
+
+/** A text grown printf-style in a fixed buffer (scene files, gnuplot scripts); ok drops to 0
+ * when it would overflow. */
+typedef struct cutbench_text {
+  char s[1 << 16];
+  size_t n;
+  int ok;
+} cutbench_text;
+
+/** Append to t (nothing once t->ok is 0). */
+void cutbench_put(cutbench_text *t, const char *fmt, ...);
+
+/** Write the generated bunny-like surface (a closed, outward-oriented star-shaped surface
+ * with a body, a head, two ears and a tail, about 0.16 m long, its base at y = 0) with about
+ * `triangles` triangles to `path`; 1 on success, 0 with a message. */
+int cutbench_write_lobed(const char *path, long long triangles);
+
+/** Read the model's bounding box, volume and area; 0 with a message. */
+int cutbench_model_measure(fcm_ctx *ctx, cutbench_model *m);
+
+/** Write row `row`'s scene into directory `dir` (the scene `<dir>/<name>.json`, its cut
+ * surfaces `<dir>/<surf_dir>/<name>_cut<k>.obj`): sized to `scale` times the paper's size,
+ * the body `body` (a path as the scene will name it: relative to dir, or absolute), `solver`
+ * the members of the scene's solver object ("" for the defaults). 1 on success. */
+int cutbench_write_scene(cutbench_row_id row, const cutbench_model *m, const char *body,
+                         double scale, const char *solver, const char *dir, const char *surf_dir,
+                         const char *name, cutbench_scene *out);
+
+/** What one run of a row's scene measured. */
+typedef struct cutbench_run {
+  int ran, ok;
+  int skipped; /* the option set is not a valid scene solver for this build (see note) */
+  char note[256];
+  double setup_s;  /* fcm_simulation_create() */
+  long long cells; /* active background cells */
+  long long dofs_before, dofs_after;
+  int events;                             /* cut events applied */
+  double cut_mean, cut_max;               /* one event's latency: rules + space + integrator */
+  double cut_rules, cut_space, cut_integ; /* per event, mean */
+  double cut_factor; /* the factorization (or hierarchy) of the step after a cut,
+                        mean over the events */
+  long long steps;
+  double step_mean, step_max; /* wall seconds of a step, the cuts before it excluded */
+  double newton, linear;      /* per step, mean */
+  double *u;                  /* the final displacement (malloc'd), for the comparison */
+  long long n;                /* its length */
+} cutbench_run;
+
+/** One row: the paper's figures, the default run and the interactive one (when an option set
+ * is given), the displacement difference between them. */
+typedef struct cutbench_row {
+  cutbench_row_id id;
+  double h;              /* the cell size used */
+  cutbench_run run[2];   /* 0: the accurate defaults, 1: the interactive option set */
+  char interactive[512]; /* the option set ("" for none): members of "solver" */
+  double disp_diff;      /* max |u_default - u_interactive| (m); -1 when not both ran */
+  double disp_max;       /* max |u_default| (m) */
+} cutbench_row;
+
+/* ---- fcm-cutbench-output.c: table, CSV, PNG */
+
+/** The run a row's targets are judged on: the interactive one when it ran, else the default. */
+const cutbench_run *cutbench_judged(const cutbench_row *r);
+
+void cutbench_print_header(void);
+void cutbench_print_row(const cutbench_row *r);
+/** The verdict lines after the table; returns the number of rows whose targets fail. */
+int cutbench_print_verdicts(const cutbench_row *rows, int n);
+int cutbench_write_csv(const char *path, const cutbench_row *rows, int n);
+int cutbench_write_png(const char *path, const cutbench_row *rows, int n);
+
+#endif /* FCM_APPS_CUTBENCH_H */
