@@ -116,6 +116,12 @@ typedef struct fcm_newton_event {
 /** Monitor callback, called after every Newton iteration (must not call the integrator). */
 typedef void (*fcm_newton_monitor_fn)(void *user, const fcm_newton_event *event);
 
+/** What a cut keeps of an integrator (fcm_integrator_options.cut_reuse, flags). */
+typedef enum fcm_cut_reuse {
+  FCM_CUT_REUSE_BLOCKS = 1,  /**< element mass and load blocks of the elements a cut leaves */
+  FCM_CUT_REUSE_ORDERING = 2 /**< CHOLMOD's fill-reducing ordering, extended */
+} fcm_cut_reuse;
+
 /** Options; initialize with fcm_integrator_options_default(). These defaults are also the
  * scene's (the "solver" section of a scene file embeds this struct, fcm/scene.h; the key of
  * each member there is given in brackets). */
@@ -157,6 +163,17 @@ typedef struct fcm_integrator_options {
                                direction  makes the next one factor anew. 0: a new tangent and
                                  factorization every iteration ["newton.reuse_factorization"] */
   double reuse_contraction; /**< in (0, 1) (default 0.25) ["newton.reuse_contraction"] */
+  int cut_reuse;            /**< what fcm_integrator_create_cut() keeps of this integrator, a sum of
+                                 fcm_cut_reuse flags (default 0: the new integrator is built from scratch).
+                                 FCM_CUT_REUSE_BLOCKS: the integrator keeps each element's mass and load
+                                 blocks (nn (nn + 1) / 2 + 3 nn per load doubles per element; a full serial
+                                 embedded space only) and after a cut integrates only the elements whose
+                                 rules the cut changed: the mass matrix and the loads are bit for bit those
+                                 of a rebuild. FCM_CUT_REUSE_ORDERING: CHOLMOD's analysis after a cut takes
+                                 the old ordering extended by the new DOFs (no AMD / METIS): a faster
+                                 analysis, but a factor with more fill than a fresh ordering's
+                                 (lib/docs/cutting.md). The scene runner sets FCM_CUT_REUSE_BLOCKS for a
+                                 scene with cuts [not a scene key] */
   fcm_linear_solver linear_solver;   /**< default FCM_LINEAR_DIRECT ["method"] */
   fcm_direct_method direct_method;   /**< first direct method (default CHOLMOD; UMFPACK: LU only)
                                           ["direct"] */
@@ -556,6 +573,9 @@ typedef struct fcm_integrator_setup_info {
   fcm_index boundary_points;   /**< embedded-boundary points the boundary constraints hold */
   double boundary_penalty_max; /**< largest gamma h_K / E over the elements (dimensionless;
                                     0 without boundary constraints) */
+  fcm_index cut_kept_elements; /**< after a cut with FCM_CUT_REUSE_BLOCKS: the elements whose
+                                    mass and load blocks were kept (not integrated again);
+                                    else 0 */
 } fcm_integrator_setup_info;
 
 /** Copy the setup counts out (zeros for NULL). */
