@@ -8,7 +8,9 @@
  * the gravity load, M a_rep and the state are the same bits, the cut kept some elements'
  * blocks and integrated others again, and three further steps give the same displacement and
  * velocity bits. The extended ordering is a permutation of the new DOFs, and a cut without
- * the option analyses with CHOLMOD's own ordering. Usage: sim_cut_update <element> */
+ * the option keeps nothing (and its full assembly gives the same mass matrix). The momentum's
+ * mass blocks kept over the cut equal a new space's, and copying every element's block from its
+ * parent (stale blocks of the cut cells) does not. Usage: sim_cut_update <element> */
 #include "fem/fem_impl.h"
 #include "la/la_impl.h"
 #include "sim/sim_impl.h"
@@ -54,6 +56,41 @@ static void step_both(fcm_integrator *a, fcm_integrator *b, int steps)
   }
   TEST_TRUE(same_bits(fcm_integrator_displacement(a), fcm_integrator_displacement(b), n));
   TEST_TRUE(same_bits(fcm_integrator_velocity(a), fcm_integrator_velocity(b), n));
+}
+
+/* The momentum's mass blocks of the cut space `to`, kept from `from`'s, are those of a space
+ * built anew on the same rules; a stale map (every element as its parent) is not. */
+static void check_momentum_blocks(const fcm_space *from, fcm_space *to, const fcm_mesh *mesh,
+                                  const fcm_cell_rules *rules)
+{
+  const fcm_index ne = fcm_space_num_elements(to);
+  const size_t nb = (size_t)ne * (size_t)(to->nn * (to->nn + 1) / 2);
+  fcm_index *same = malloc(sizeof *same * (size_t)ne), kept = 0;
+  fcm_space *fresh = NULL, *stale = NULL;
+  TEST_OK(ctx, fcm_space_momentum(from, 1.0, NULL, NULL, NULL, NULL, NULL));
+  TEST_OK(ctx, fcm__space_cut_same_elements(from, to, same, &kept));
+  TEST_TRUE(kept > 0 && kept < ne);
+  TEST_OK(ctx, fcm__space_momentum_blocks_from(to, from, same));
+  TEST_OK(ctx, fcm_space_create_embedded(ctx, mesh, rules, &fresh));
+  TEST_OK(ctx, fcm_space_create_embedded(ctx, mesh, rules, &stale));
+  if (fresh && stale) {
+    TEST_OK(ctx, fcm_space_momentum(fresh, 1.0, NULL, NULL, NULL, NULL, NULL));
+    TEST_TRUE(same_bits(to->mass_cache->blocks, fresh->mass_cache->blocks, (fcm_index)nb));
+    fcm_index *parent = malloc(sizeof *parent * (size_t)ne);
+    for (fcm_index e = 0; e < ne; e++) { /* the element of the parent piece, as the transfer */
+      const fcm_index c = to->elem_cell[e];
+      fcm_index first = 0;
+      fcm_cell_rules_cell_pieces(from->rules, c, &first);
+      parent[e] =
+          from->cell_elem[c] + (fcm_cell_rules_piece_parent(to->rules, to->elem_piece[e]) - first);
+    }
+    TEST_OK(ctx, fcm__space_momentum_blocks_from(stale, from, parent));
+    TEST_TRUE(!same_bits(stale->mass_cache->blocks, fresh->mass_cache->blocks, (fcm_index)nb));
+    free(parent);
+  }
+  fcm_space_destroy(&fresh);
+  fcm_space_destroy(&stale);
+  free(same);
 }
 
 /* The integrator of `space` built from scratch, in the state old's cut leaves. */
@@ -157,6 +194,7 @@ int main(int argc, char **argv)
     TEST_TRUE(fcm_space_num_dofs(space[k]) > fcm_space_num_dofs(space[k - 1]));
     TEST_OK(ctx, fcm_integrator_create_cut(integ[k - 1], space[k], &integ[k]));
     if (!integ[k]) break;
+    check_momentum_blocks(space[k - 1], space[k], mesh, rules[k]);
     fcm_integrator *ref = rebuild(integ[k - 1], integ[k], space[k], mesh);
     if (ref) {
       compare(integ[k], ref);

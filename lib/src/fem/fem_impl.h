@@ -270,6 +270,16 @@ void fcm__space_memory(const fcm_space *s, double *numbering, double *topology);
 /* Bytes of the mass blocks fcm_space_momentum() has built (0 before its first call). (eval.c) */
 double fcm__space_mass_cache_bytes(const fcm_space *s);
 
+/* Build the mass blocks of fcm_space_momentum() on s (nothing when built already), copying
+ * those of the elements with same[e] >= 0 from from's blocks at element same[e]
+ * (fcm__space_cut_same_elements(): they integrate alike; every block is integrated when from's
+ * are not built). The blocks are then those fcm_space_momentum()'s first call would build, bit
+ * for bit. Not thread safe against a concurrent first fcm_space_momentum() on s.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, different elements), the errors of the integration,
+ * FCM_ERR_ALLOC. (eval.c) */
+fcm_status fcm__space_momentum_blocks_from(const fcm_space *s, const fcm_space *from,
+                                           const fcm_index *same);
+
 /* Free the mass blocks of fcm_space_momentum() and the cache itself. (eval.c) */
 void fcm__space_mass_cache_free(fcm_space *s);
 
