@@ -315,6 +315,11 @@ FCM_API fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space,
  * over by fcm_space_transfer(): every new DOF copy inherits its parent copy's values, so
  * the field, the mass and the linear and angular momentum are unchanged by the cut. A host
  * simulator calls it between steps and then destroys `old` (and old's space and rules).
+ * With old's options' cut_reuse (fcm_cut_reuse): FCM_CUT_REUSE_BLOCKS integrates again only
+ * the elements whose rules the cut changed (the mass matrix and the loads are the same bits as
+ * without it); FCM_CUT_REUSE_ORDERING analyses with old's CHOLMOD ordering extended by the new
+ * DOFs beside their parents (no AMD / METIS; more fill than a fresh ordering). The DOF
+ * numbering is the space's own (fcm_space_create_embedded()), as without them.
  * @return FCM_OK; FCM_ERR_ARG (NULL, old not set up, unrelated space); the errors of
  *         fcm_integrator_setup(); FCM_ERR_ALLOC. Allocates. */
 FCM_API fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space *space,
