@@ -77,13 +77,8 @@ static void check_momentum_blocks(const fcm_space *from, fcm_space *to, const fc
     TEST_OK(ctx, fcm_space_momentum(fresh, 1.0, NULL, NULL, NULL, NULL, NULL));
     TEST_TRUE(same_bits(to->mass_cache->blocks, fresh->mass_cache->blocks, (fcm_index)nb));
     fcm_index *parent = malloc(sizeof *parent * (size_t)ne);
-    for (fcm_index e = 0; e < ne; e++) { /* the element of the parent piece, as the transfer */
-      const fcm_index c = to->elem_cell[e];
-      fcm_index first = 0;
-      fcm_cell_rules_cell_pieces(from->rules, c, &first);
-      parent[e] =
-          from->cell_elem[c] + (fcm_cell_rules_piece_parent(to->rules, to->elem_piece[e]) - first);
-    }
+    for (fcm_index e = 0; e < ne; e++) /* the element of the parent piece, as the transfer */
+      parent[e] = fcm__space_cut_parent_elem(from, to, e);
     TEST_OK(ctx, fcm__space_momentum_blocks_from(stale, from, parent));
     TEST_TRUE(!same_bits(stale->mass_cache->blocks, fresh->mass_cache->blocks, (fcm_index)nb));
     free(parent);
@@ -227,6 +222,15 @@ int main(int argc, char **argv)
     fcm_integrator_destroy(&a);
   }
   fcm_integrator_destroy(&plain);
+  { /* a value that is no sum of the flags is refused at the setup */
+    fcm_integrator_options ob = o;
+    ob.cut_reuse = 4;
+    fcm_integrator *bad = NULL;
+    TEST_OK(ctx, fcm_integrator_create(ctx, space[0], &mat, &ob, &bad));
+    TEST_TRUE(fcm_integrator_setup(bad) == FCM_ERR_ARG);
+    fcm_ctx_error_clear(ctx);
+    fcm_integrator_destroy(&bad);
+  }
   for (int k = 3; k >= 0; k--) {
     fcm_integrator_destroy(&integ[k]);
     fcm_space_destroy(&space[k]);

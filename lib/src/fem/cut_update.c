@@ -7,8 +7,7 @@
 
 #include <string.h>
 
-/* Checks that `to` is `from` after a cut (fcm_space_transfer()'s conditions); names `what`. */
-static fcm_status check_cut_pair(const fcm_space *from, const fcm_space *to, const char *what)
+fcm_status fcm__space_check_cut_pair(const fcm_space *from, const fcm_space *to, const char *what)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = to ? to->ctx : NULL;
@@ -26,25 +25,31 @@ cleanup:
   return st;
 }
 
+fcm_index fcm__space_cut_parent_elem(const fcm_space *from, const fcm_space *to, fcm_index e)
+{
+  const fcm_index c = to->elem_cell[e],
+                  pp = fcm_cell_rules_piece_parent(to->rules, to->elem_piece[e]);
+  fcm_index first = 0;
+  fcm_cell_rules_cell_pieces(from->rules, c, &first);
+  const fcm_index fe = from->cell_elem[c] + (pp - first);
+  return pp >= first && fe < from->cell_elem[c + 1] ? fe : -1;
+}
+
 fcm_status fcm__space_cut_parents(const fcm_space *from, const fcm_space *to, fcm_index *parent)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = to ? to->ctx : NULL;
-  FCM_TRY(ctx, check_cut_pair(from, to, "cut parents"));
+  FCM_TRY(ctx, fcm__space_check_cut_pair(from, to, "cut parents"));
   FCM_CHECK(parent, ctx, FCM_ERR_ARG, "cut parents: parent is NULL");
   const fcm_index nn = to->nn;
   for (fcm_index k = 0; k < to->num_dofs / 3; k++)
     parent[k] = -1;
   for (fcm_index e = 0; e < to->num_elems; e++) {
-    const fcm_index c = to->elem_cell[e],
-                    pp = fcm_cell_rules_piece_parent(to->rules, to->elem_piece[e]);
-    fcm_index first = 0;
-    fcm_cell_rules_cell_pieces(from->rules, c, &first);
-    const fcm_index fe = from->cell_elem[c] + (pp - first);
-    FCM_CHECK(pp >= first && fe < from->cell_elem[c + 1], ctx, FCM_ERR_INTERNAL,
-              "cut parents: element %lld (cell %lld) has parent piece %lld outside the cell's "
+    const fcm_index fe = fcm__space_cut_parent_elem(from, to, e);
+    FCM_CHECK(fe >= 0, ctx, FCM_ERR_INTERNAL,
+              "cut parents: element %lld (cell %lld) has its parent piece outside the cell's "
               "pieces in the source",
-              (long long)e, (long long)c, (long long)pp);
+              (long long)e, (long long)to->elem_cell[e]);
     for (int a = 0; a < nn; a++) {
       const fcm_index k = to->elem_dof[e * nn + a] / 3;
       /* a constrained place holds another copy, which its own elements name */
@@ -93,7 +98,7 @@ fcm_status fcm__space_cut_same_elements(const fcm_space *from, const fcm_space *
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = to ? to->ctx : NULL;
   fcm_index count = 0;
-  FCM_TRY(ctx, check_cut_pair(from, to, "cut elements"));
+  FCM_TRY(ctx, fcm__space_check_cut_pair(from, to, "cut elements"));
   FCM_CHECK(same, ctx, FCM_ERR_ARG, "cut elements: same is NULL");
 #pragma omp parallel for num_threads(fcm_ctx_num_threads(ctx)) schedule(dynamic, 64) \
     reduction(+ : count)
@@ -101,14 +106,12 @@ fcm_status fcm__space_cut_same_elements(const fcm_space *from, const fcm_space *
     const fcm_index c = to->elem_cell[e];
     const fcm_cell_class ct = fcm_cell_rules_class(to->rules, c),
                          cf = fcm_cell_rules_class(from->rules, c);
-    const fcm_index p = to->elem_piece[e], pp = fcm_cell_rules_piece_parent(to->rules, p);
-    fcm_index first = 0;
-    fcm_cell_rules_cell_pieces(from->rules, c, &first);
-    const fcm_index fe = from->cell_elem[c] + (pp - first);
+    const fcm_index fe = fcm__space_cut_parent_elem(from, to, e);
     same[e] = -1;
-    if (ct != cf || pp < first || fe >= from->cell_elem[c + 1]) continue;
+    if (ct != cf || fe < 0) continue;
     /* an uncut cell integrates with the standard rule in both; a cut one with its piece's */
-    if (ct == FCM_CELL_UNCUT || same_piece(to->rules, p, from->rules, pp)) {
+    if (ct == FCM_CELL_UNCUT ||
+        same_piece(to->rules, to->elem_piece[e], from->rules, from->elem_piece[fe])) {
       same[e] = fe;
       count++;
     }
@@ -124,7 +127,7 @@ fcm_status fcm__space_cut_ordering(const fcm_space *from, const fcm_space *to,
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = to ? to->ctx : NULL;
   fcm_index *parent = NULL, *child_ptr = NULL, *child = NULL;
-  FCM_TRY(ctx, check_cut_pair(from, to, "cut ordering"));
+  FCM_TRY(ctx, fcm__space_check_cut_pair(from, to, "cut ordering"));
   FCM_CHECK(old_perm && perm, ctx, FCM_ERR_ARG, "cut ordering: NULL ordering");
   const fcm_index nold = from->num_dofs / 3, nnew = to->num_dofs / 3;
   FCM_ALLOC(ctx, nnew + 1, parent);

@@ -161,6 +161,14 @@ uint64_t fcm__morton_key(const double x[3], const double lo[3], const double hi[
 /* ---- After a cut (cut_update.c): `to` is a space on the cell rules that
  * fcm_cell_rules_create_cut() made from `from`'s rules (fcm_space_transfer()'s conditions). */
 
+/* FCM_OK when `to` is `from` after a cut (both embedded on the same mesh, to's rules made from
+ * from's by fcm_cell_rules_create_cut()); else FCM_ERR_ARG "<what>: ...". */
+fcm_status fcm__space_check_cut_pair(const fcm_space *from, const fcm_space *to, const char *what);
+
+/* The element of `from` holding the parent piece of element e of `to` (the same cell), -1 when
+ * the parent piece is not among the cell's pieces in `from` (not a cut pair). */
+fcm_index fcm__space_cut_parent_elem(const fcm_space *from, const fcm_space *to, fcm_index e);
+
 /* parent[k] (num_dofs(to) / 3 entries): the copy of `from` whose values copy k of `to`
  * inherits, the copy its elements' parent elements use at the same node (the first such
  * element in element order); -1 for none (a cut space has none). No allocation.
