@@ -39,6 +39,11 @@ fcm_add_test(sim_step_alloc_static tests/sim/step_alloc.c ARGS minres-schwarz he
 foreach(el tet4 tet10 hex8 hex20)
   fcm_add_test(sim_cut_${el} tests/sim/cut.c ARGS ${el})
 endforeach()
+# A cut that keeps element blocks and CHOLMOD's ordering (cut_reuse) equals a rebuild bit for bit
+# (mass, load, state after steps) through a plane, a partial rectangle and a plane across both.
+foreach(el tet4 tet10 hex8 hex20)
+  fcm_add_test(sim_cut_update_${el} tests/sim/cut_update.c ARGS ${el})
+endforeach()
 # Reactions of constraints: minus the assembled weight and its moment in equilibrium (an
 # embedded beam clamped by a half-space of background nodes), change of momentum minus the
 # weight in dynamics; two constraints add up.

@@ -116,6 +116,12 @@ typedef struct fcm_newton_event {
 /** Monitor callback, called after every Newton iteration (must not call the integrator). */
 typedef void (*fcm_newton_monitor_fn)(void *user, const fcm_newton_event *event);
 
+/** What a cut keeps of an integrator (fcm_integrator_options.cut_reuse, flags). */
+typedef enum fcm_cut_reuse {
+  FCM_CUT_REUSE_BLOCKS = 1,  /**< element mass and load blocks of the elements a cut leaves */
+  FCM_CUT_REUSE_ORDERING = 2 /**< CHOLMOD's fill-reducing ordering, extended */
+} fcm_cut_reuse;
+
 /** Options; initialize with fcm_integrator_options_default(). These defaults are also the
  * scene's (the "solver" section of a scene file embeds this struct, fcm/scene.h; the key of
  * each member there is given in brackets). */
@@ -169,6 +175,17 @@ typedef struct fcm_integrator_options {
    * unused. A predictor iteration (prescribed motion) counts as one. In [0, 10^6]
    * ["newton.fixed_iterations"] */
   int newton_fixed_iterations;
+  int cut_reuse;            /**< what fcm_integrator_create_cut() keeps of this integrator, a sum of
+                                 fcm_cut_reuse flags (default 0: the new integrator is built from scratch).
+                                 FCM_CUT_REUSE_BLOCKS: the integrator keeps each element's mass and load
+                                 blocks (nn (nn + 1) / 2 + 3 nn per load doubles per element; a full serial
+                                 embedded space only) and after a cut integrates only the elements whose
+                                 rules the cut changed: the mass matrix and the loads are bit for bit those
+                                 of a rebuild. FCM_CUT_REUSE_ORDERING: CHOLMOD's analysis after a cut takes
+                                 the old ordering extended by the new DOFs (no AMD / METIS): a faster
+                                 analysis, but a factor with more fill than a fresh ordering's
+                                 (lib/docs/cutting.md). The scene runner sets FCM_CUT_REUSE_BLOCKS for a
+                                 scene with cuts [not a scene key] */
   fcm_linear_solver linear_solver;   /**< default FCM_LINEAR_DIRECT ["method"] */
   fcm_direct_method direct_method;   /**< first direct method (default CHOLMOD; UMFPACK: LU only)
                                           ["direct"] */
@@ -330,6 +347,11 @@ FCM_API fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space,
  * over by fcm_space_transfer(): every new DOF copy inherits its parent copy's values, so
  * the field, the mass and the linear and angular momentum are unchanged by the cut. A host
  * simulator calls it between steps and then destroys `old` (and old's space and rules).
+ * With old's options' cut_reuse (fcm_cut_reuse): FCM_CUT_REUSE_BLOCKS integrates again only
+ * the elements whose rules the cut changed (the mass matrix and the loads are the same bits as
+ * without it); FCM_CUT_REUSE_ORDERING analyses with old's CHOLMOD ordering extended by the new
+ * DOFs beside their parents (no AMD / METIS; more fill than a fresh ordering). The DOF
+ * numbering is the space's own (fcm_space_create_embedded()), as without them.
  * @return FCM_OK; FCM_ERR_ARG (NULL, old not set up, unrelated space); the errors of
  *         fcm_integrator_setup(); FCM_ERR_ALLOC. Allocates. */
 FCM_API fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space *space,
@@ -588,6 +610,9 @@ typedef struct fcm_integrator_setup_info {
   fcm_index boundary_points;   /**< embedded-boundary points the boundary constraints hold */
   double boundary_penalty_max; /**< largest gamma h_K / E over the elements (dimensionless;
                                     0 without boundary constraints) */
+  fcm_index cut_kept_elements; /**< after a cut with FCM_CUT_REUSE_BLOCKS: the elements whose
+                                    mass and load blocks were kept (not integrated again);
+                                    else 0 */
 } fcm_integrator_setup_info;
 
 /** Copy the setup counts out (zeros for NULL). */

@@ -271,7 +271,48 @@ typedef struct pass {
   double *vals, *vec;  /* matrix values (space pattern) and vector, either may be NULL */
   double *cell_energy; /* num_elems, or NULL */
   int *cell_inverted;  /* num_elems, or NULL */
+  /* Element blocks (fcm__assembly_linear_blocks()): bs doubles per element; an element e with
+   * keep_same[e] >= 0 takes its block from keep_in at that element instead of its kernel;
+   * keep_out (may be NULL) receives every element's block */
+  int bs;
+  const fcm_index *keep_same;
+  const double *keep_in;
+  double *keep_out;
 } pass;
+
+/* An element block of fcm__assembly_linear_blocks(): a mass matrix's upper node blocks are
+ * h I (mass_kernel()): their h, nn (nn + 1) / 2 values; a vector its 3 nn entries. */
+static void block_pack(int nn, const pass *ps, const scratch *w, double *blk)
+{
+  if (ps->vals)
+    for (int k = 0; k < ps->bs; k++)
+      blk[k] = w->Ke[9 * k];
+  else
+    memcpy(blk, w->fe, sizeof(double) * 3 * (size_t)nn);
+}
+
+/* The inverse of block_pack(): the same Ke / fe the kernel gives, bit for bit. */
+static void block_unpack(int nn, const pass *ps, const double *blk, scratch *w)
+{
+  if (ps->vals) {
+    for (int k = 0; k < ps->bs; k++) {
+      double *Kp = w->Ke + 9 * k;
+      const double h = blk[k];
+      Kp[0] = h, Kp[1] = Kp[2] = Kp[3] = 0.0;
+      Kp[4] = h, Kp[5] = Kp[6] = Kp[7] = 0.0;
+      Kp[8] = h;
+    }
+  } else {
+    memcpy(w->fe, blk, sizeof(double) * 3 * (size_t)nn);
+  }
+}
+
+static int piece_has_surface(const fcm_space *s, fcm_index e)
+{
+  int np = 0;
+  fcm_cell_rules_get_piece_surface(s->rules, s->elem_piece[e], &np, NULL, NULL, NULL, NULL);
+  return np > 0;
+}
 
 /* Surface traction of element e into w->fe; returns 0 when it has no surface points. */
 static int surface_cell(const fcm_space *s, const pass *ps, fcm_index e, scratch *w)
@@ -319,14 +360,27 @@ static int pass_element(const fcm_space *s, const pass *ps, fcm_index le, scratc
   const fcm_index c = fcm__space_local_elem(s, le);
   /* another process's element (a distributed run's ghost): no points, nothing to add */
   if (!fcm__space_owns(s, s->elem_cell[c])) return 1;
-  if (ps->traction) {
-    if (!surface_cell(s, ps, c, w)) return 1;
+  const fcm_index same = ps->keep_same ? ps->keep_same[c] : -1;
+  if (same >= 0) {
+    block_unpack(s->nn, ps, ps->keep_in + (size_t)same * ps->bs, w);
+    if (ps->keep_out)
+      memcpy(ps->keep_out + (size_t)c * ps->bs, ps->keep_in + (size_t)same * ps->bs,
+             sizeof(double) * (size_t)ps->bs);
+    /* an element without surface points adds nothing (as surface_cell() says below) */
+    if (ps->traction && !piece_has_surface(s, c)) return 1;
+  } else if (ps->traction) {
+    if (!surface_cell(s, ps, c, w)) {
+      if (ps->keep_out)
+        memset(ps->keep_out + (size_t)c * ps->bs, 0, sizeof(double) * (size_t)ps->bs);
+      return 1;
+    }
   } else {
     *res = volume_cell(s, ps, c, w);
     if (!(res->bad_det > 0.0) || res->nonfinite) return 0;
     if (ps->cell_energy) ps->cell_energy[c] = res->energy;
     if (ps->cell_inverted) ps->cell_inverted[c] = res->inverted;
   }
+  if (ps->keep_out && same < 0) block_pack(s->nn, ps, w, ps->keep_out + (size_t)c * ps->bs);
   if (ps->vals) scatter_matrix(s, le, w->Ke, ps->vals);
   if (ps->vec) scatter_vector(s, c, w->fe, ps->vec);
   return 1;
@@ -385,11 +439,14 @@ cleanup:
 
 /* A volume pass of kernel `kd` on the standard rule of its integrand. */
 static fcm_status run_volume_pass(fcm_assembly_workspace *ws, const kernel_data *kd, double *vals,
-                                  double *vec, double *cell_energy)
+                                  double *vec, double *cell_energy, const pass *keep)
 {
   fcm_status st = FCM_OK;
   pass ps;
-  memset(&ps, 0, sizeof ps);
+  if (keep)
+    ps = *keep;
+  else
+    memset(&ps, 0, sizeof ps);
   ps.kind = kd->kind == KERNEL_MASS ? FCM_RULE_MASS : FCM_RULE_STIFFNESS;
   FCM_CHECK(!ws->space->rules || fcm_cell_rules_has_kind(ws->space->rules, ps.kind), ws->ctx,
             FCM_ERR_ARG,
@@ -438,8 +495,58 @@ fcm_linear_form fcm_linear_form_default(void)
   return f;
 }
 
+static fcm_status linear_impl(fcm_assembly_workspace *ws, const fcm_linear_form *form, fcm_csr *A,
+                              double *f, const pass *keep);
+
 fcm_status fcm_assembly_workspace_linear(fcm_assembly_workspace *ws, const fcm_linear_form *form,
                                          fcm_csr *A, double *f)
+{
+  return linear_impl(ws, form, A, f, NULL);
+}
+
+int fcm__assembly_block_size(const fcm_space *s, fcm_linear_term term)
+{
+  switch (term) {
+  case FCM_LINEAR_MASS:
+    return s->nn * (s->nn + 1) / 2;
+  case FCM_LINEAR_BODY_FORCE:
+  case FCM_LINEAR_BODY_FORCE_FIELD:
+  case FCM_LINEAR_SURFACE_TRACTION:
+    return 3 * s->nn;
+  default:
+    return 0;
+  }
+}
+
+fcm_status fcm__assembly_linear_blocks(fcm_assembly_workspace *ws, const fcm_linear_form *form,
+                                       fcm_csr *A, double *f, const fcm_index *same,
+                                       const double *blocks_in, double *blocks_out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = ws ? ws->ctx : NULL;
+  pass keep;
+  memset(&keep, 0, sizeof keep);
+  FCM_CHECK(ws && form, ctx, FCM_ERR_ARG, "linear assembly (blocks): NULL workspace or form");
+  keep.bs = fcm__assembly_block_size(ws->space, form->term);
+  FCM_CHECK(keep.bs > 0, ctx, FCM_ERR_UNSUPPORTED,
+            "linear assembly (blocks): term %d has no element blocks to keep (the mass, body "
+            "forces and surface traction have)",
+            (int)form->term);
+  FCM_CHECK(!ws->space->is_local, ctx, FCM_ERR_UNSUPPORTED,
+            "linear assembly (blocks): the space is a local space (a distributed run's); "
+            "element blocks are kept for a full space only");
+  FCM_CHECK(!same || blocks_in, ctx, FCM_ERR_ARG,
+            "linear assembly (blocks): elements to take from blocks_in, but blocks_in is NULL");
+  keep.keep_same = same;
+  keep.keep_in = blocks_in;
+  keep.keep_out = blocks_out;
+  FCM_TRY(ctx, linear_impl(ws, form, A, f, &keep));
+cleanup:
+  return st;
+}
+
+static fcm_status linear_impl(fcm_assembly_workspace *ws, const fcm_linear_form *form, fcm_csr *A,
+                              double *f, const pass *keep)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = ws ? ws->ctx : NULL;
@@ -453,14 +560,14 @@ fcm_status fcm_assembly_workspace_linear(fcm_assembly_workspace *ws, const fcm_l
     kd.kind = KERNEL_STIFFNESS;
     FCM_TRY(ctx, fcm_material_lame(ctx, form->material, &kd.lambda, &kd.mu));
     FCM_TRY(ctx, check_matrix(s, A));
-    FCM_TRY(ctx, run_volume_pass(ws, &kd, fcm_csr_values(A), NULL, NULL));
+    FCM_TRY(ctx, run_volume_pass(ws, &kd, fcm_csr_values(A), NULL, NULL, keep));
     break;
   case FCM_LINEAR_MASS:
     kd.kind = KERNEL_MASS;
     FCM_TRY(ctx, fcm_material_lame(ctx, form->material, NULL, NULL));
     FCM_TRY(ctx, check_matrix(s, A));
     kd.rho = form->material->density;
-    FCM_TRY(ctx, run_volume_pass(ws, &kd, fcm_csr_values(A), NULL, NULL));
+    FCM_TRY(ctx, run_volume_pass(ws, &kd, fcm_csr_values(A), NULL, NULL, keep));
     break;
   case FCM_LINEAR_BODY_FORCE: {
     const double *a = form->accel;
@@ -471,18 +578,21 @@ fcm_status fcm_assembly_workspace_linear(fcm_assembly_workspace *ws, const fcm_l
               "body force: acceleration (%g, %g, %g) is not finite", a[0], a[1], a[2]);
     kd.rho = form->material->density;
     memcpy(kd.accel, a, sizeof kd.accel);
-    FCM_TRY(ctx, run_volume_pass(ws, &kd, NULL, f, NULL));
+    FCM_TRY(ctx, run_volume_pass(ws, &kd, NULL, f, NULL, keep));
   } break;
   case FCM_LINEAR_BODY_FORCE_FIELD:
     kd.kind = KERNEL_BODY_FORCE;
     FCM_CHECK(f && form->field, ctx, FCM_ERR_ARG, "body force field: NULL vector or field");
     kd.field = form->field;
     kd.field_user = form->user;
-    FCM_TRY(ctx, run_volume_pass(ws, &kd, NULL, f, NULL));
+    FCM_TRY(ctx, run_volume_pass(ws, &kd, NULL, f, NULL, keep));
     break;
   case FCM_LINEAR_SURFACE_TRACTION: {
     pass ps;
-    memset(&ps, 0, sizeof ps);
+    if (keep)
+      ps = *keep;
+    else
+      memset(&ps, 0, sizeof ps);
     FCM_CHECK(f && form->field, ctx, FCM_ERR_ARG, "surface traction: NULL vector or traction");
     FCM_CHECK(s->rules && fcm_cell_rules_surface_strength(s->rules) >= 0, ctx, FCM_ERR_ARG,
               "surface traction: the space has no surface rules (build the cell rules with "
@@ -524,7 +634,7 @@ fcm_status fcm_assembly_workspace_hyperelastic(fcm_assembly_workspace *ws,
   kd.mat_psd = *mat;
   kd.mat_psd.project_psd = 1;
   FCM_TRY(ctx, run_volume_pass(ws, &kd, tangent ? fcm_csr_values(tangent) : NULL, force,
-                               ws->cell_energy));
+                               ws->cell_energy, NULL));
   if (energy) { /* summed in element order: independent of the thread count */
     double e = 0.0;
     for (fcm_index le = 0; le < s->num_local_elems; le++) /* ascending ids; full space: all */

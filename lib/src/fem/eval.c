@@ -94,8 +94,10 @@ cleanup:
  * chunks), then the chunks in order: the result does not depend on the thread count. */
 #define MOMENTUM_CHUNKS 64
 
-/* Build the space's mass blocks in parallel over the elements. */
-static fcm_status build_blocks(const fcm_space *s, fcm__space_mass_cache *mc)
+/* Build the space's mass blocks in parallel over the elements; an element e with same[e] >= 0
+ * (same NULL: none) copies block same[e] of from_blocks instead. */
+static fcm_status build_blocks(const fcm_space *s, fcm__space_mass_cache *mc, const fcm_index *same,
+                               const double *from_blocks)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
@@ -108,6 +110,10 @@ static fcm_status build_blocks(const fcm_space *s, fcm__space_mass_cache *mc)
 #pragma omp parallel for schedule(dynamic, 16) num_threads(fcm_ctx_num_threads(ctx))
   for (fcm_index e = 0; e < ne; e++) {
     if (fcm__loop_skip(&loop, e)) continue;
+    if (same && same[e] >= 0) {
+      memcpy(blocks + (size_t)e * nb, from_blocks + (size_t)same[e] * nb, nb * sizeof *blocks);
+      continue;
+    }
     fcm__loop_iter it;
     fcm__loop_enter(&loop, &it, e);
     fcm__loop_leave(&loop, &it, element_block(s, e, blocks + (size_t)e * nb));
@@ -184,7 +190,7 @@ fcm_status fcm_space_momentum(const fcm_space *s, double density, const double *
   fcm__space_mass_cache *mc = s->mass_cache;
   /* the first call builds the blocks; a concurrent first call waits for it */
 #pragma omp critical(fcm_space_mass_cache)
-  if (!mc->blocks) st = build_blocks(s, mc);
+  if (!mc->blocks) st = build_blocks(s, mc, NULL, NULL);
   FCM_TRY(ctx, st);
   {
     const fcm_index ne = s->num_elems;
@@ -202,6 +208,21 @@ fcm_status fcm_space_momentum(const fcm_space *s, double density, const double *
     if (linear) linear[i] = density * q[1 + i];
     if (angular) angular[i] = density * q[4 + i];
   }
+cleanup:
+  return st;
+}
+
+fcm_status fcm__space_momentum_blocks_from(const fcm_space *s, const fcm_space *from,
+                                           const fcm_index *same)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s ? s->ctx : NULL;
+  FCM_CHECK(s && from && same, ctx, FCM_ERR_ARG, "momentum blocks: NULL argument");
+  FCM_CHECK(s->nn == from->nn, ctx, FCM_ERR_ARG,
+            "momentum blocks: the spaces have %d and %d nodes per cell", s->nn, from->nn);
+  if (s->mass_cache->blocks) return FCM_OK;
+  st = build_blocks(s, s->mass_cache, from->mass_cache->blocks ? same : NULL,
+                    from->mass_cache->blocks);
 cleanup:
   return st;
 }

@@ -158,6 +158,42 @@ fcm_status fcm__space_check_full(const fcm_space *s, const char *what);
  * near each other in space near each other in the order. */
 uint64_t fcm__morton_key(const double x[3], const double lo[3], const double hi[3]);
 
+/* ---- After a cut (cut_update.c): `to` is a space on the cell rules that
+ * fcm_cell_rules_create_cut() made from `from`'s rules (fcm_space_transfer()'s conditions). */
+
+/* FCM_OK when `to` is `from` after a cut (both embedded on the same mesh, to's rules made from
+ * from's by fcm_cell_rules_create_cut()); else FCM_ERR_ARG "<what>: ...". */
+fcm_status fcm__space_check_cut_pair(const fcm_space *from, const fcm_space *to, const char *what);
+
+/* The element of `from` holding the parent piece of element e of `to` (the same cell), -1 when
+ * the parent piece is not among the cell's pieces in `from` (not a cut pair). */
+fcm_index fcm__space_cut_parent_elem(const fcm_space *from, const fcm_space *to, fcm_index e);
+
+/* parent[k] (num_dofs(to) / 3 entries): the copy of `from` whose values copy k of `to`
+ * inherits, the copy its elements' parent elements use at the same node (the first such
+ * element in element order); -1 for none (a cut space has none). No allocation.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, not a cut pair), FCM_ERR_INTERNAL. */
+fcm_status fcm__space_cut_parents(const fcm_space *from, const fcm_space *to, fcm_index *parent);
+
+/* same[e] (num_elems(to) entries): the element of `from` that element e of `to` integrates
+ * exactly as (same cell and class; an uncut cell, or the same points, weights and flags of
+ * every rule kind and the same surface rule, compared bit by bit, as its parent piece's), -1
+ * where the cut changed it; *num_same (may be NULL) counts the former. Whatever the assembly
+ * computes from an element's rule and cell alone (fcm__assembly_linear_blocks()) is then
+ * the same for both. Reads the rules of the cut cells once; no allocation.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, not a cut pair). */
+fcm_status fcm__space_cut_same_elements(const fcm_space *from, const fcm_space *to, fcm_index *same,
+                                        fcm_index *num_same);
+
+/* The ordering of to's DOFs (perm, num_dofs(to) entries, perm[k] the DOF eliminated k-th)
+ * extended from old_perm, an ordering of from's DOFs: each old DOF's place goes to the same
+ * component of its children (the copies of `to` with it as parent, ascending), a split copy's
+ * new DOFs beside the ones they split from; DOFs without a parent last, ascending. Allocates
+ * O(copies) scratch. @return FCM_OK, FCM_ERR_ARG (NULL, not a cut pair, old_perm not a
+ * permutation of from's DOFs), FCM_ERR_ALLOC, FCM_ERR_INTERNAL. */
+fcm_status fcm__space_cut_ordering(const fcm_space *from, const fcm_space *to,
+                                   const fcm_index *old_perm, fcm_index *perm);
+
 /* ---- Matrices over a space's rows (a local space: its local copies' rows, global columns).
  * A full space: rows are DOFs, local element positions are element ids, every function below
  * is the full space's own (same arrays, same bits). */
@@ -242,6 +278,16 @@ void fcm__space_memory(const fcm_space *s, double *numbering, double *topology);
 /* Bytes of the mass blocks fcm_space_momentum() has built (0 before its first call). (eval.c) */
 double fcm__space_mass_cache_bytes(const fcm_space *s);
 
+/* Build the mass blocks of fcm_space_momentum() on s (nothing when built already), copying
+ * those of the elements with same[e] >= 0 from from's blocks at element same[e]
+ * (fcm__space_cut_same_elements(): they integrate alike; every block is integrated when from's
+ * are not built). The blocks are then those fcm_space_momentum()'s first call would build, bit
+ * for bit. Not thread safe against a concurrent first fcm_space_momentum() on s.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, different elements), the errors of the integration,
+ * FCM_ERR_ALLOC. (eval.c) */
+fcm_status fcm__space_momentum_blocks_from(const fcm_space *s, const fcm_space *from,
+                                           const fcm_index *same);
+
 /* Free the mass blocks of fcm_space_momentum() and the cache itself. (eval.c) */
 void fcm__space_mass_cache_free(fcm_space *s);
 
@@ -303,6 +349,24 @@ void fcm__space_copy_support(const fcm_space *s, double *support);
  * (assemble.c) */
 fcm_status fcm__assembly_element_linear(fcm_assembly_workspace *ws, const fcm_linear_form *form,
                                         fcm_index elem, double *Ke, double *fe);
+
+/* Doubles per element that fcm__assembly_linear_blocks() keeps for `term`: nn (nn + 1) / 2
+ * for the mass (its upper node blocks are multiples of the identity), 3 nn for the force
+ * terms, 0 for the stiffness (not kept). */
+int fcm__assembly_block_size(const fcm_space *s, fcm_linear_term term);
+
+/* fcm_assembly_workspace_linear() (mass, body force, body-force field, surface traction; a full
+ * space) keeping element blocks: element e with same[e] >= 0 (same NULL: none) takes its block
+ * from blocks_in at element same[e] (blocks of fcm__assembly_block_size() doubles, from an
+ * earlier call on a space where that element integrated alike: fcm__space_cut_same_elements())
+ * instead of integrating; every element's block goes to blocks_out (may be NULL; num_elems
+ * blocks). The blocks are scattered exactly as the kernels' results in the same visiting order:
+ * A and f equal fcm_assembly_workspace_linear()'s bit for bit when the kept blocks are.
+ * @return as fcm_assembly_workspace_linear(); FCM_ERR_UNSUPPORTED (stiffness, a local space).
+ * (assemble.c) */
+fcm_status fcm__assembly_linear_blocks(fcm_assembly_workspace *ws, const fcm_linear_form *form,
+                                       fcm_csr *A, double *f, const fcm_index *same,
+                                       const double *blocks_in, double *blocks_out);
 
 /* The authentic quadrature points (fictitious stabilization points of cut cells left out) with
  * J = det F <= 0 in the last hyperelastic assembly through ws

@@ -501,25 +501,13 @@ fcm_status fcm_space_transfer(const fcm_space *from, const fcm_space *to, const 
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = to ? to->ctx : NULL;
   FCM_CHECK(from && to && x_from && x_to, ctx, FCM_ERR_ARG, "space transfer: NULL argument");
-  FCM_CHECK(from->mesh == to->mesh && from->rules && to->rules, ctx, FCM_ERR_ARG,
-            "space transfer: both spaces must be embedded spaces on the same mesh");
-  FCM_CHECK(fcm_cell_rules_parent_num_pieces(to->rules) == fcm_cell_rules_num_pieces(from->rules) &&
-                fcm_cell_rules_parent_num_pieces(to->rules) > 0,
-            ctx, FCM_ERR_ARG,
-            "space transfer: the target's cell rules (made from rules with %lld pieces) do not "
-            "extend the source's (%lld pieces) by a cut (fcm_cell_rules_create_cut())",
-            (long long)fcm_cell_rules_parent_num_pieces(to->rules),
-            (long long)fcm_cell_rules_num_pieces(from->rules));
+  FCM_TRY(ctx, fcm__space_check_cut_pair(from, to, "space transfer"));
   for (fcm_index e = 0; e < to->num_elems; e++) {
-    const fcm_index c = to->elem_cell[e],
-                    pp = fcm_cell_rules_piece_parent(to->rules, to->elem_piece[e]);
-    fcm_index first = 0;
-    fcm_cell_rules_cell_pieces(from->rules, c, &first);
-    const fcm_index fe = from->cell_elem[c] + (pp - first);
-    FCM_CHECK(pp >= first && fe < from->cell_elem[c + 1], ctx, FCM_ERR_INTERNAL,
-              "space transfer: element %lld (cell %lld) has parent piece %lld outside the "
-              "cell's pieces in the source",
-              (long long)e, (long long)c, (long long)pp);
+    const fcm_index fe = fcm__space_cut_parent_elem(from, to, e);
+    FCM_CHECK(fe >= 0, ctx, FCM_ERR_INTERNAL,
+              "space transfer: element %lld (cell %lld) has its parent piece outside the cell's "
+              "pieces in the source",
+              (long long)e, (long long)to->elem_cell[e]);
     for (int a = 0; a < to->nn; a++) {
       const fcm_index d = to->elem_dof[e * to->nn + a];
       /* a constrained copy's place holds the copy it moves with (of another node, or another

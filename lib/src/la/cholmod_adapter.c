@@ -22,6 +22,7 @@ typedef struct chol {
   cholmod_sparse A;          /* header over ap, ai (and the values during factor) */
   SuiteSparse_long *ap, *ai; /* the pattern, as CHOLMOD's integer type */
   cholmod_factor *L;         /* symbolic after analyze, numeric after factor */
+  SuiteSparse_long *given;   /* n: the ordering to analyze with (NULL: CHOLMOD's own) */
   cholmod_dense *X, *Y, *E;  /* solve workspaces, allocated once by cholmod_l_solve2 */
   fcm_index n;
 } chol;
@@ -58,6 +59,7 @@ static void chol_destroy(fcm_ctx *ctx, void *impl)
   }
   fcm__free(ctx, h->ap);
   fcm__free(ctx, h->ai);
+  fcm__free(ctx, h->given);
   fcm__free(ctx, h);
 }
 
@@ -108,7 +110,13 @@ static fcm_status chol_analyze(fcm_ctx *ctx, void *impl, fcm_direct_info *info)
   fcm_status st = FCM_OK;
   chol *h = impl;
   h->c.status = CHOLMOD_OK;
-  h->L = cholmod_l_analyze(&h->A, &h->c);
+  if (h->given) { /* the given ordering alone (CHOLMOD still postorders it) */
+    h->c.nmethods = 1;
+    h->c.method[0].ordering = CHOLMOD_GIVEN;
+    h->L = cholmod_l_analyze_p(&h->A, h->given, NULL, 0, &h->c);
+  } else {
+    h->L = cholmod_l_analyze(&h->A, &h->c);
+  }
   if (!h->L) FCM_TRY(ctx, map_status(ctx, h, "analyze"));
   FCM_CHECK(h->L, ctx, FCM_ERR_INTERNAL, "cholmod analyze: no factor returned (status %d)",
             h->c.status);
@@ -224,5 +232,25 @@ cleanup:
   return st;
 }
 
-const fcm__direct_ops fcm__cholmod_ops = {"cholmod",   chol_create, chol_analyze,
-                                          chol_factor, chol_solve,  chol_destroy};
+static fcm_status chol_set_ordering(fcm_ctx *ctx, void *impl, const fcm_index *perm)
+{
+  fcm_status st = FCM_OK;
+  chol *h = impl;
+  if (!h->given) FCM_ALLOC(ctx, h->n, h->given);
+  for (fcm_index k = 0; k < h->n; k++)
+    h->given[k] = (SuiteSparse_long)perm[k];
+cleanup:
+  return st;
+}
+
+static void chol_get_ordering(const void *impl, fcm_index *perm)
+{
+  const chol *h = impl;
+  const SuiteSparse_long *p = h->L->Perm;
+  for (fcm_index k = 0; k < h->n; k++)
+    perm[k] = p ? (fcm_index)p[k] : k;
+}
+
+const fcm__direct_ops fcm__cholmod_ops = {"cholmod",         chol_create,       chol_analyze,
+                                          chol_set_ordering, chol_get_ordering, chol_factor,
+                                          chol_solve,        chol_destroy};

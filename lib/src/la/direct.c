@@ -88,6 +88,47 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__direct_set_ordering(fcm_direct *s, const fcm_index *perm)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s ? s->ctx : NULL;
+  unsigned char *seen = NULL;
+  FCM_CHECK(s && (perm || s->n == 0), ctx, FCM_ERR_ARG, "direct ordering: NULL solver or perm");
+  FCM_CHECK(!s->analyzed, ctx, FCM_ERR_ARG,
+            "direct ordering: the %s solver is analyzed already; give the ordering before "
+            "fcm_direct_analyze()",
+            s->ops->name);
+  FCM_CHECK(s->ops->set_ordering, ctx, FCM_ERR_UNSUPPORTED,
+            "direct ordering: %s takes no given ordering (cholmod does)", s->ops->name);
+  FCM_ALLOC(ctx, s->n + 1, seen);
+  for (fcm_index k = 0; k < s->n; k++) {
+    FCM_CHECK(perm[k] >= 0 && perm[k] < s->n && !seen[perm[k]], ctx, FCM_ERR_ARG,
+              "direct ordering: perm[%lld] = %lld is outside [0, %lld) or repeated: not a "
+              "permutation",
+              (long long)k, (long long)perm[k], (long long)s->n);
+    seen[perm[k]] = 1;
+  }
+  if (s->n > 0) FCM_TRY(ctx, s->ops->set_ordering(ctx, s->impl, perm));
+cleanup:
+  if (s) fcm__free(ctx, seen);
+  return st;
+}
+
+fcm_status fcm__direct_get_ordering(const fcm_direct *s, fcm_index *perm)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s ? s->ctx : NULL;
+  FCM_CHECK(s && (perm || s->n == 0), ctx, FCM_ERR_ARG, "direct ordering: NULL solver or perm");
+  FCM_CHECK(s->analyzed, ctx, FCM_ERR_ARG,
+            "direct ordering: the %s solver is not analyzed; call fcm_direct_analyze() first",
+            s->ops->name);
+  FCM_CHECK(s->ops->get_ordering, ctx, FCM_ERR_UNSUPPORTED,
+            "direct ordering: %s keeps no symmetric ordering (cholmod does)", s->ops->name);
+  if (s->n > 0) s->ops->get_ordering(s->impl, perm);
+cleanup:
+  return st;
+}
+
 fcm_status fcm_direct_factor(fcm_direct *s, const double *values)
 {
   fcm_status st = FCM_OK;

@@ -168,6 +168,10 @@ typedef struct fcm__direct_ops {
   /* Take the pattern of the square matrix A (its values are not read). */
   fcm_status (*create)(fcm_ctx *ctx, const fcm_csr *A, void **impl);
   fcm_status (*analyze)(fcm_ctx *ctx, void *impl, fcm_direct_info *info);
+  /* A fill-reducing ordering to analyze with instead of computing one (a permutation of
+   * 0..n-1, copied), and the ordering of the analysis; NULL where the method has none. */
+  fcm_status (*set_ordering)(fcm_ctx *ctx, void *impl, const fcm_index *perm);
+  void (*get_ordering)(const void *impl, fcm_index *perm);
   /* Values are finite (checked by the caller). On failure no factor is kept. */
   fcm_status (*factor)(fcm_ctx *ctx, void *impl, const double *values, fcm_direct_info *info);
   /* x may equal b. */
@@ -190,6 +194,20 @@ typedef struct fcm__direct_ops {
   "points (empty or dropped cut cells without stabilization)"
 
 extern const fcm__direct_ops fcm__cholmod_ops;
+
+/* The symbolic analysis of s (not yet analyzed) takes the fill-reducing ordering perm (a
+ * permutation of 0..n-1: perm[k] is the row eliminated k-th; copied) instead of computing one
+ * (AMD / METIS): fcm_direct_analyze() then computes only the elimination tree, the
+ * postordering and the factor's structure. CHOLMOD only. After a cut the new system's
+ * ordering is the old one with the new DOFs beside their parents (sim/cut_update.c).
+ * @return FCM_OK, FCM_ERR_ARG (NULL, analyzed already, not a permutation of 0..n-1),
+ * FCM_ERR_UNSUPPORTED (UMFPACK), FCM_ERR_ALLOC. (direct.c) */
+fcm_status fcm__direct_set_ordering(fcm_direct *s, const fcm_index *perm);
+
+/* The ordering of the analysis (n entries into perm: the row eliminated k-th, after CHOLMOD's
+ * postordering). @return FCM_OK, FCM_ERR_ARG (NULL, not analyzed), FCM_ERR_UNSUPPORTED
+ * (UMFPACK). (direct.c) */
+fcm_status fcm__direct_get_ordering(const fcm_direct *s, fcm_index *perm);
 extern const fcm__direct_ops fcm__umfpack_ops;
 
 #endif /* FCM_LA_IMPL_H */

@@ -185,5 +185,5 @@ cleanup:
   return st;
 }
 
-const fcm__direct_ops fcm__umfpack_ops = {"umfpack",  umf_create, umf_analyze,
-                                          umf_factor, umf_solve,  umf_destroy};
+const fcm__direct_ops fcm__umfpack_ops = {"umfpack", umf_create, umf_analyze, NULL,
+                                          NULL,      umf_factor, umf_solve,   umf_destroy};

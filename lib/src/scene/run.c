@@ -561,6 +561,22 @@ static fcm_status build_log_blocks(fcm_simulation *S)
   return fcm_space_momentum(S->space, 0.0, NULL, NULL, NULL, NULL, NULL);
 }
 
+/* After a cut: the log's mass blocks of the cut space, those of the elements the cut left as
+ * they were copied from the space before it (the same bits as building them anew). */
+static fcm_status keep_log_blocks(fcm_simulation *S, const fcm_space *space)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  fcm_index *same = NULL;
+  if (S->rules && !fcm_cell_rules_has_kind(S->rules, FCM_RULE_MASS)) return FCM_OK;
+  FCM_ALLOC_RAW(ctx, (size_t)fcm_space_num_elements(space) + 1, same);
+  FCM_TRY(ctx, fcm__space_cut_same_elements(S->space, space, same, NULL));
+  FCM_TRY(ctx, fcm__space_momentum_blocks_from(space, S->space, same));
+cleanup:
+  fcm__free(ctx, same);
+  return st;
+}
+
 fcm_status fcm__sim_apply_cut(fcm_simulation *S)
 {
   fcm_status st = FCM_OK;
@@ -599,6 +615,7 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
     S->c.cuts_missed++;
   FCM_TRY(ctx, fcm_integrator_create_cut(S->integ, space, &integ));
   S->cut_phase[2] = fcm_wtime() - t0 - S->cut_phase[0] - S->cut_phase[1];
+  FCM_TRY(ctx, keep_log_blocks(S, space));
   /* the new integrator counts from zero: keep the totals so far */
   S->base_factorizations = S->c.factorizations;
   S->base_analyses = S->c.analyses;
@@ -741,6 +758,9 @@ static fcm_status build_integrator(fcm_simulation *S)
   S->c.inverted_first_cell = -1;
   S->c.nonfinite_first_step = -1;
   fcm_integrator_options io = integrator_options(S);
+  /* a scene with cuts: each cut integrates only the elements it changes */
+  if (S->rules && fcm_scene_count_effects(scene, FCM_EFFECT_CUT) > 0)
+    io.cut_reuse |= FCM_CUT_REUSE_BLOCKS;
   S->c.inertia = io.kind == FCM_INTEGRATOR_BACKWARD_EULER;
   S->c.damping = io.rayleigh_mass > 0.0 || io.rayleigh_stiffness > 0.0;
   S->c.krylov = io.linear_solver == FCM_LINEAR_CG || io.linear_solver == FCM_LINEAR_MINRES;

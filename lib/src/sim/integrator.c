@@ -101,8 +101,10 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   if (!integ || !*integ) return;
   fcm_integrator *I = *integ;
   fcm_ctx *ctx = I->ctx;
-  for (int k = 0; k < I->num_loads; k++)
+  for (int k = 0; k < I->num_loads; k++) {
     fcm__free(ctx, I->loads[k].f);
+    fcm__free(ctx, I->loads[k].blk);
+  }
   fcm__free(ctx, I->loads);
   for (int k = 0; k < I->num_cons; k++)
     fcm__free(ctx, I->cons[k].nodes);
@@ -125,6 +127,9 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   fcm__free(ctx, I->act_dof);
   fcm__free(ctx, I->schwarz_flag);
   fcm__free(ctx, I->owned);
+  fcm__free(ctx, I->cut_ordering);
+  fcm__free(ctx, I->blk_mass);
+  fcm__free(ctx, I->cut_same);
   fcm_csr_destroy(&I->M);
   fcm_csr_destroy(&I->H);
   fcm_csr_destroy(&I->D);
@@ -396,6 +401,10 @@ static fcm_status validate_options(fcm_ctx *ctx, const fcm_integrator_options *o
             o->krylov_stagnation_window);
   FCM_CHECK(o->schwarz_theta > 0.0 && o->schwarz_theta <= 1.0, ctx, FCM_ERR_ARG,
             "integrator: schwarz_theta = %g outside (0, 1]", o->schwarz_theta);
+  FCM_CHECK(o->cut_reuse >= 0 && o->cut_reuse <= (FCM_CUT_REUSE_BLOCKS | FCM_CUT_REUSE_ORDERING),
+            ctx, FCM_ERR_ARG,
+            "integrator: cut_reuse = %d is not a sum of fcm_cut_reuse flags (0 .. %d)",
+            o->cut_reuse, FCM_CUT_REUSE_BLOCKS | FCM_CUT_REUSE_ORDERING);
   FCM_CHECK(o->rayleigh_mass >= 0.0 && isfinite(o->rayleigh_mass), ctx, FCM_ERR_ARG,
             "integrator: rayleigh_mass = %g must be finite and >= 0", o->rayleigh_mass);
   FCM_CHECK(o->rayleigh_stiffness >= 0.0 && isfinite(o->rayleigh_stiffness), ctx, FCM_ERR_ARG,
@@ -493,7 +502,8 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
   if (I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) {
     FCM_TRY(ctx, fcm__space_matrix_create_rows(I->space, &I->M));
     form.term = FCM_LINEAR_MASS;
-    st = fcm_assembly_workspace_linear(I->aws, &form, I->M, NULL);
+    st = fcm__sim_assemble_kept(I, &form, I->M, NULL, &I->blk_mass,
+                                I->cut_old ? I->cut_old->blk_mass : NULL);
     /* with a backend M stays this process's partial mass matrix (its cells' part; never
      * summed: every use sums a product, fem/fem_backend.h); agree on the status only */
     FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, NULL));
@@ -508,7 +518,8 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
     form.term = l->kind == SIM_LOAD_GRAVITY ? FCM_LINEAR_BODY_FORCE
                 : l->kind == SIM_LOAD_BODY  ? FCM_LINEAR_BODY_FORCE_FIELD
                                             : FCM_LINEAR_SURFACE_TRACTION;
-    st = fcm_assembly_workspace_linear(I->aws, &form, NULL, l->f);
+    st = fcm__sim_assemble_kept(I, &form, NULL, l->f, &l->blk,
+                                I->cut_old ? I->cut_old->loads[k].blk : NULL);
     FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, l->f));
     if (l->kind == SIM_LOAD_TRACTION)
       I->setup_info.traction_assemblies++;
@@ -891,7 +902,7 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   st = fcm_integrator_create(ctx, space, &old->mat, &old->opts, &I);
   for (int k = 0; st == FCM_OK && k < old->num_loads; k++) {
     sim_load l = old->loads[k];
-    l.f = NULL;
+    l.f = l.blk = NULL;
     st = add_load(I, &l);
   }
   for (int k = 0; st == FCM_OK && k < old->num_cons; k++)
@@ -909,7 +920,12 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
     FCM_TRY(ctx, old->backend.setup(old->backend.user, st, space, &b));
     FCM_TRY(ctx, fcm__integrator_set_backend(I, &b));
   }
-  FCM_TRY(ctx, fcm_integrator_setup(I));
+  FCM_TRY(ctx, fcm__sim_cut_ordering(old, I));
+  FCM_TRY(ctx, fcm__sim_cut_prepare_blocks(old, I));
+  st = fcm_integrator_setup(I);
+  I->cut_old = NULL; /* borrowed for the setup only */
+  FCM_FREE(ctx, I->cut_same);
+  FCM_TRY(ctx, st);
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, u);
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, v);
   FCM_TRY(ctx, fcm_space_transfer(old->space, space, old->u, u));

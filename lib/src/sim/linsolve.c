@@ -573,6 +573,7 @@ static fcm_status direct_setup(fcm_integrator *I)
   fcm_ctx *ctx = I->ctx;
   if (I->opts.direct_method == FCM_DIRECT_CHOLMOD) {
     FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, I->H, &I->chol));
+    if (I->cut_ordering) FCM_TRY(ctx, fcm__direct_set_ordering(I->chol, I->cut_ordering));
     FCM_TRY(ctx, fcm_direct_analyze(I->chol));
   } else {
     FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_UMFPACK, I->H, &I->umf));

@@ -16,7 +16,8 @@ typedef struct sim_load {
   void *field_user;
   fcm_time_fn scale; /* NULL: 1 */
   void *scale_user;
-  double *f; /* assembled load of scale 1 (n), after setup */
+  double *f;   /* assembled load of scale 1 (n), after setup */
+  double *blk; /* its element blocks (FCM_CUT_REUSE_BLOCKS, cut_update.c), or NULL */
 } sim_load;
 
 typedef struct sim_constraint {
@@ -129,6 +130,15 @@ struct fcm_integrator {
 
   /* solvers */
   fcm_direct *chol, *umf, *direct; /* `direct`: the one holding the current factor */
+  /* n: the fill-reducing ordering CHOLMOD's analysis takes instead of its own (after a cut:
+   * the old system's extended by the new DOFs, cut_update.c); NULL: CHOLMOD's own */
+  fcm_index *cut_ordering;
+  /* FCM_CUT_REUSE_BLOCKS (cut_update.c): the mass matrix's element blocks (or NULL); during
+   * the setup after a cut, the integrator cut from (borrowed) and the element of its space
+   * each element integrates as (cut_same, num_elems; -1: integrate) */
+  double *blk_mass;
+  const fcm_integrator *cut_old;
+  fcm_index *cut_same;
   fcm_krylov *krylov;
   fcm_jacobi *jacobi;
   fcm_schwarz *schwarz;
@@ -224,6 +234,34 @@ void fcm__sim_eval_loads(const fcm_integrator *I, double t, double *f);
 /* A = M/h^2 + D/h (dynamics, h > 0) or 0 (static): the part of the Newton matrix (and of the
  * preconditioner's matrix) the material tangent is added to; A has the pattern of M.
  * (newton.c) */
+/* After a cut (cut_update.c): give I (not set up, direct CHOLMOD, serial) the ordering of old's
+ * CHOLMOD analysis extended to I's space (fcm__space_cut_ordering()), so that its analysis
+ * skips AMD / METIS. Nothing when old has no CHOLMOD analysis or I another solver or a
+ * distributed backend. @return FCM_OK, FCM_ERR_ARG (not a cut pair), FCM_ERR_ALLOC. */
+fcm_status fcm__sim_cut_ordering(const fcm_integrator *old, fcm_integrator *I);
+
+/* fcm_assembly_workspace_linear() on I's space of the mass (blocks = &I->blk_mass, old_blocks
+ * the cut integrator's) or a load (its blk, the old load's): with FCM_CUT_REUSE_BLOCKS on a
+ * full serial embedded space, keeping the element blocks in *blocks and, during the setup after
+ * a cut, taking those of the elements the cut left from old_blocks (counted in
+ * setup_info.cut_kept_elements). @return as the assembly. (cut_update.c) */
+fcm_status fcm__sim_assemble_kept(fcm_integrator *I, const fcm_linear_form *form, fcm_csr *A,
+                                  double *f, double **blocks, const double *old_blocks);
+
+/* After a cut with FCM_CUT_REUSE_BLOCKS (before I's setup): the elements of I's space that
+ * integrate as elements of old's (I->cut_same), so that the setup keeps their blocks.
+ * @return FCM_OK, FCM_ERR_ARG (not a cut pair), FCM_ERR_ALLOC. (cut_update.c) */
+fcm_status fcm__sim_cut_prepare_blocks(const fcm_integrator *old, fcm_integrator *I);
+
+/* The ordering CHOLMOD's analysis of I takes (n entries copied; before fcm_integrator_setup()),
+ * in place of any from a cut. @return FCM_OK, FCM_ERR_ARG (NULL, set up already),
+ * FCM_ERR_ALLOC. (cut_update.c) */
+fcm_status fcm__integrator_set_ordering(fcm_integrator *I, const fcm_index *perm);
+
+/* The ordering of I's CHOLMOD analysis (n entries). @return FCM_OK, FCM_ERR_ARG (NULL, no
+ * CHOLMOD analysis: another solver, or not set up). (cut_update.c) */
+fcm_status fcm__integrator_get_ordering(const fcm_integrator *I, fcm_index *perm);
+
 void fcm__sim_set_base(const fcm_integrator *I, double h, fcm_csr *A);
 
 /* Store the reaction of every constraint from the gradient I->g of the accepted iterate

@@ -1,0 +1,90 @@
+/* The integrator after a cut keeps what the cut leaves valid (fcm_integrator_options.cut_reuse):
+ * the element blocks of the mass matrix and the loads of the elements the cut leaves as they
+ * were, and the fill-reducing ordering of the direct solver's analysis, extended by the new DOFs
+ * beside the ones they split from (fem/cut_update.c), so that the new analysis computes only
+ * the factor's structure. */
+#include "sim/sim_impl.h"
+#include "fem/fem_impl.h"
+#include "la/la_impl.h"
+
+#include <string.h>
+
+fcm_status fcm__integrator_set_ordering(fcm_integrator *I, const fcm_index *perm)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I ? I->ctx : NULL;
+  FCM_CHECK(I && perm, ctx, FCM_ERR_ARG, "integrator ordering: NULL integrator or ordering");
+  FCM_CHECK(!I->is_setup, ctx, FCM_ERR_ARG,
+            "integrator ordering: the integrator is set up already (its analysis is done)");
+  if (!I->cut_ordering) FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, I->cut_ordering);
+  memcpy(I->cut_ordering, perm, sizeof *perm * (size_t)I->n);
+cleanup:
+  return st;
+}
+
+fcm_status fcm__integrator_get_ordering(const fcm_integrator *I, fcm_index *perm)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I ? I->ctx : NULL;
+  FCM_CHECK(I && perm, ctx, FCM_ERR_ARG, "integrator ordering: NULL integrator or ordering");
+  FCM_CHECK(I->chol, ctx, FCM_ERR_ARG,
+            "integrator ordering: the integrator has no CHOLMOD analysis (linear_solver "
+            "direct with direct_method cholmod, after fcm_integrator_setup())");
+  FCM_TRY(ctx, fcm__direct_get_ordering(I->chol, perm));
+cleanup:
+  return st;
+}
+
+fcm_status fcm__sim_cut_ordering(const fcm_integrator *old, fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  fcm_index *old_perm = NULL;
+  if (!(I->opts.cut_reuse & FCM_CUT_REUSE_ORDERING) || !old->chol || I->backend.factor ||
+      I->opts.linear_solver != FCM_LINEAR_DIRECT || I->opts.direct_method != FCM_DIRECT_CHOLMOD)
+    return FCM_OK;
+  FCM_ALLOC_RAW(ctx, (size_t)old->n + 1, old_perm);
+  if (!I->cut_ordering) FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, I->cut_ordering);
+  FCM_TRY(ctx, fcm__integrator_get_ordering(old, old_perm));
+  FCM_TRY(ctx, fcm__space_cut_ordering(old->space, I->space, old_perm, I->cut_ordering));
+cleanup:
+  fcm__free(ctx, old_perm);
+  return st;
+}
+
+/* 1 when I keeps element blocks: the option, on a full serial embedded space. */
+static int keeps_blocks(const fcm_integrator *I)
+{
+  return (I->opts.cut_reuse & FCM_CUT_REUSE_BLOCKS) && I->space->rules && !I->space->is_local &&
+         !fcm__integrator_distributed(I, NULL);
+}
+
+fcm_status fcm__sim_assemble_kept(fcm_integrator *I, const fcm_linear_form *form, fcm_csr *A,
+                                  double *f, double **blocks, const double *old_blocks)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  if (!keeps_blocks(I)) return fcm_assembly_workspace_linear(I->aws, form, A, f);
+  const int bs = fcm__assembly_block_size(I->space, form->term);
+  const fcm_index *same = I->cut_same && old_blocks ? I->cut_same : NULL;
+  FCM_FREE(ctx, *blocks);
+  FCM_ALLOC_RAW(ctx, (size_t)I->space->num_elems * bs + 1, *blocks);
+  FCM_TRY(ctx, fcm__assembly_linear_blocks(I->aws, form, A, f, same, old_blocks, *blocks));
+cleanup:
+  return st;
+}
+
+fcm_status fcm__sim_cut_prepare_blocks(const fcm_integrator *old, fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  fcm_index kept = 0;
+  if (!keeps_blocks(I) || !keeps_blocks(old)) return FCM_OK;
+  FCM_FREE(ctx, I->cut_same);
+  FCM_ALLOC_RAW(ctx, (size_t)I->space->num_elems + 1, I->cut_same);
+  FCM_TRY(ctx, fcm__space_cut_same_elements(old->space, I->space, I->cut_same, &kept));
+  I->cut_old = old;
+  I->setup_info.cut_kept_elements = kept;
+cleanup:
+  return st;
+}
