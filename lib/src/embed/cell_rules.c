@@ -85,6 +85,7 @@ static fcm_status build_rules_x(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_ge
     R->stats.num_integrated = 0;
     for (fcm_index c = 0; c < nc; c++)
       R->stats.num_integrated += B.rebuild[c];
+    R->stats.num_integrated -= R->stats.num_kept;
   }
   R->stats.time_setup = t_setup - t_start;
   R->stats.time_gather = fcm_wtime() - t_loop;

@@ -106,6 +106,7 @@ fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell
       if (f2 == nf) continue;
       const cell_out *ob = out + c2;
       const fcm_index pa0 = R->piece_off[c], pb0 = R->piece_off[c2];
+      const size_t nl0 = nl; /* the links of this pair of cells start here */
       size_t xa = 0;
       for (int i = 0; i < oa->nfp; i++) {
         const int *ma = oa->fmeta + 4 * i;
@@ -120,7 +121,7 @@ fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell
           if (mb[0] != f2 || mb[1] < 0) continue;
           const fcm_index pa = pa0 + ma[1], pb = pb0 + mb[1];
           int known = 0;
-          for (size_t l = nl; l-- > 0 && !known;)
+          for (size_t l = nl; l-- > nl0 && !known;)
             known = links[2 * l] == pa && links[2 * l + 1] == pb;
           if (known) continue;
           double lo[3], hi[3];

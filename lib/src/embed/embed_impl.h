@@ -142,6 +142,7 @@ typedef struct fcm__embed_counts {
   fcm_index degenerate;        /* cells whose cut splitting changed the parts' volume */
   fcm_index surface_cells;     /* cut cells fitted on surface moments */
   fcm_index surface_fallbacks; /* of those, cells whose fit failed (volume path instead) */
+  fcm_index kept;              /* cells a cut reaches whose pieces it leaves unchanged */
 } fcm__embed_counts;
 
 /* ---------------------------------------------------------------- distributed classification */

@@ -27,6 +27,7 @@ typedef struct piece_out {
   unsigned char skipped[FCM_RULE_KIND_COUNT], fallback[FCM_RULE_KIND_COUNT];
   double residual[FCM_RULE_KIND_COUNT];
   double tsimp[FCM_RULE_KIND_COUNT]; /* fcm_simplify's time_total */
+  unsigned char copied; /* rules copied from the rules being extended (not counted as built) */
   unsigned char fitted; /* rules fitted on surface moments (at most M points: not simplified) */
   int parent;    /* the piece of the same cell in the rules being extended that holds this one */
   int component; /* its number among the cell's components before empty ones were dropped */
