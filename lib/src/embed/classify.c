@@ -345,7 +345,7 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   const double t0 = fcm_wtime();
   double sbox[6];
   FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
-  if (!integrate && !B->region[c]) { /* no cut near: nothing of it is needed again */
+  if (!integrate && (!B->region[c] || (B->same_links && B->same_links[c]))) { /* no new work */
     FCM_TRY(ctx, keep_cell(B, R, &cell, o));
     sums->time_intersect += fcm_wtime() - t0;
     goto cleanup;
@@ -377,7 +377,7 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
               "embed: cell %lld, which the new cut does not reach, now has %d pieces instead of "
               "%lld",
               (long long)c, P->num_pieces, (long long)had);
-    if (!integrate || (B->prev && pieces_unchanged(B, c, P))) {
+    if (!integrate || (B->prev && B->keep && pieces_unchanged(B, c, P))) {
       FCM_TRY(ctx, keep_cell(B, R, &cell, o));
       for (int i = 0; integrate && i < o->np; i++) {
         fcm__free(ctx, o->pc[i].cfxi);
@@ -474,7 +474,7 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
     cell_sums mine;
     memset(&mine, 0, sizeof mine);
     fcm__embed_ws *ws = NULL;
-#pragma omp for schedule(dynamic, 4)
+#pragma omp for schedule(dynamic, 1)
     for (fcm_index c = 0; c < nc; c++) {
       if (fcm__loop_skip(&loop, c)) continue;
       fcm__loop_iter it;

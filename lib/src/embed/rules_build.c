@@ -123,8 +123,9 @@ void fcm__embed_build_release(build *B)
     fcm__free(B->ctx, B->region);
     fcm__free(B->ctx, B->rebuild);
     fcm__free(B->ctx, B->prev_region);
+    fcm__free(B->ctx, B->same_links);
   }
-  B->region = B->rebuild = B->prev_region = NULL;
+  B->region = B->rebuild = B->prev_region = B->same_links = NULL;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     fcm_rule_destroy(&B->tet_rule[k]);
   fcm_rule_destroy(&B->tri_rule);
