@@ -266,6 +266,34 @@ cleanup:
   return st;
 }
 
+/* A region cell after its pieces (P) were made: kept (*kept = 1) when the new cut does not reach
+ * it (its face polygons were wanted for the links only) or reaches it without changing its
+ * pieces (pieces_unchanged(); its cut faces are then made again). */
+static fcm_status keep_region_cell(const build *B, fcm_cell_rules *R, const fcm__embed_cell *cell,
+                                   fcm__parts *P, int integrate, cell_out *o, int *kept)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_index c = cell->id;
+  const fcm_index had = B->prev ? B->prev->piece_off[c + 1] - B->prev->piece_off[c] : 0;
+  *kept = 0;
+  FCM_CHECK(integrate || had == 0 || had == P->num_pieces, ctx, FCM_ERR_INTERNAL,
+            "embed: cell %lld, which the new cut does not reach, now has %d pieces instead of "
+            "%lld",
+            (long long)c, P->num_pieces, (long long)had);
+  if (integrate && !(B->prev && B->keep && pieces_unchanged(B, c, P))) return FCM_OK;
+  FCM_TRY(ctx, keep_cell(B, R, cell, o));
+  for (int i = 0; integrate && i < o->np; i++) {
+    fcm__free(ctx, o->pc[i].cfxi);
+    o->pc[i].cfxi = NULL;
+    o->pc[i].ncf = 0;
+  }
+  if (integrate && P->tcand.n > 0) FCM_TRY(ctx, piece_cut_faces(B, cell, P, o));
+  *kept = 1;
+cleanup:
+  return st;
+}
+
 /* The surface moments' rounding is about 1e-15 |K| whatever the material's size: a cell whose
  * surface-moment volume is below this fraction of its own takes the volume path (when the
  * geometry has cells), whose accuracy follows the material's size. */
@@ -370,21 +398,9 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
       memcpy(o->fx, P->fx, 3 * P->nfx * sizeof(double));
       o->nfp = (int)P->nfp;
     }
-    /* a cell no new triangle reaches (its face polygons are wanted for the links), or one
-     * they reach without changing its pieces: kept; the cut faces of the latter made again */
-    const fcm_index had = B->prev ? B->prev->piece_off[c + 1] - B->prev->piece_off[c] : 0;
-    FCM_CHECK(integrate || had == 0 || had == P->num_pieces, ctx, FCM_ERR_INTERNAL,
-              "embed: cell %lld, which the new cut does not reach, now has %d pieces instead of "
-              "%lld",
-              (long long)c, P->num_pieces, (long long)had);
-    if (!integrate || (B->prev && B->keep && pieces_unchanged(B, c, P))) {
-      FCM_TRY(ctx, keep_cell(B, R, &cell, o));
-      for (int i = 0; integrate && i < o->np; i++) {
-        fcm__free(ctx, o->pc[i].cfxi);
-        o->pc[i].cfxi = NULL;
-        o->pc[i].ncf = 0;
-      }
-      if (integrate && P->tcand.n > 0) FCM_TRY(ctx, piece_cut_faces(B, &cell, P, o));
+    int kept;
+    FCM_TRY(ctx, keep_region_cell(B, R, &cell, P, integrate, o, &kept));
+    if (kept) {
       sums->counts.kept += integrate;
       sums->time_intersect += fcm_wtime() - t0;
       goto cleanup;
