@@ -66,3 +66,12 @@ fcm_add_test(embed_surface_moments tests/embed/surface_moments.c)
 # polyhedron integrals (Hex8, Tet4, Hex20), the volume beyond each side of the grid from the
 # surface equals the tets', a cut and the volume path refuse it.
 fcm_add_test(embed_surface_only tests/embed/surface_only.c)
+# The latency of a cut's rule update on a bunny-like body at the papers' grid sizes, per phase
+# (label bench; --model path measures a model instead of the generated body).
+fcm_add_test(embed_cut_bench tests/embed/cut_bench.c LABELS bench TIMEOUT 3600)
+# A cut keeps what it does not change: a box body cut by two tilted planes, a plane beside it
+# and one along a grid plane; every piece exact against the polytope's moments, the result
+# against the cut without its shortcuts (pieces, links, cut faces bit for bit; each cell's
+# rules those of the reference or, kept, of the rules extended); cuts that change nothing
+# integrate nothing and leave every rule bit-identical.
+fcm_add_test(embed_cut_keep tests/embed/cut_keep.c)

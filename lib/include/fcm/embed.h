@@ -187,8 +187,15 @@ typedef struct fcm_cell_rules_stats {
   fcm_index num_split;           /**< cells that cuts split into two or more pieces */
   fcm_index num_links;           /**< fcm_cell_rules_num_links() */
   fcm_index num_integrated;      /**< cells whose rules this call built: every cell for
-                                      fcm_cell_rules_create(), the cells the new cut reaches for
-                                      fcm_cell_rules_create_cut() (the others are copied) */
+                                      fcm_cell_rules_create(), the cells the new cut reaches and
+                                      changes for fcm_cell_rules_create_cut() (the others are
+                                      copied) */
+  fcm_index num_kept;            /**< fcm_cell_rules_create_cut(): cells the new cut reaches
+                                      without changing their material pieces (it divides none
+                                      of their parts and separates none from another: material
+                                      on one side only, an empty cell, a cut along a face); their
+                                      class, fraction, pieces and rules are copied bit for bit,
+                                      their cut faces made again */
   fcm_index num_degenerate;      /**< cells whose splitting by the cuts changed their parts'
                                       volume (0 after a successful fcm_cell_rules_create_cut():
                                       it shifts the cut until there are none) */

@@ -40,7 +40,7 @@ fcm_cell_rules_options fcm_cell_rules_options_default(void)
  * the cells of x->remote are skipped and their classes taken from x->exchange, before the
  * AUTO choice (red). */
 static fcm_status build_rules_x(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
-                                const fcm_cell_rules *prev, fcm_index first_new,
+                                const fcm_cell_rules *prev, fcm_index first_new, int keep,
                                 fcm__rules_reduce *red, fcm_cell_rules *R,
                                 const fcm__rules_exchange *x, int *exchanged)
 {
@@ -59,6 +59,7 @@ static fcm_status build_rules_x(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_ge
   FCM_TRY(ctx, fcm__embed_build_setup(ctx, mesh, geom, o, R, &B));
   B.prev = prev;
   B.first_new = first_new;
+  B.keep = keep;
   B.red = red;
   B.remote = x ? x->remote : NULL;
   if (R->num_cut_tris > 0) FCM_TRY(ctx, fcm__embed_cut_setup(&B, R, first_new));
@@ -85,6 +86,7 @@ static fcm_status build_rules_x(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_ge
     R->stats.num_integrated = 0;
     for (fcm_index c = 0; c < nc; c++)
       R->stats.num_integrated += B.rebuild[c];
+    R->stats.num_integrated -= R->stats.num_kept;
   }
   R->stats.time_setup = t_setup - t_start;
   R->stats.time_gather = fcm_wtime() - t_loop;
@@ -99,11 +101,11 @@ cleanup:
 }
 
 static fcm_status build_rules(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
-                              const fcm_cell_rules *prev, fcm_index first_new,
+                              const fcm_cell_rules *prev, fcm_index first_new, int keep,
                               fcm__rules_reduce *red, fcm_cell_rules *R)
 {
   int exchanged = 0;
-  return build_rules_x(ctx, mesh, geom, prev, first_new, red, R, NULL, &exchanged);
+  return build_rules_x(ctx, mesh, geom, prev, first_new, keep, red, R, NULL, &exchanged);
 }
 
 /* fcm_cell_rules_create() with the AUTO choice's reduce (red) and the distributed
@@ -134,7 +136,7 @@ static fcm_status create_rules(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geo
               "classified by another process",
               (long long)c);
   FCM_TRY(ctx, fcm__embed_rules_alloc(ctx, mesh, &o, &R));
-  FCM_TRY(ctx, build_rules_x(ctx, mesh, geom, NULL, 0,
+  FCM_TRY(ctx, build_rules_x(ctx, mesh, geom, NULL, 0, 0,
                              o.simplify == FCM_CELL_SIMPLIFY_AUTO ? red : NULL, R, x, &exchanged));
   R->masked = o.cell_mask != NULL;
   if (R->masked) {
@@ -203,6 +205,13 @@ fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const f
                                      const fcm_cell_rules *prev, const fcm_surface *cut,
                                      fcm_cell_rules **rules)
 {
+  return fcm__cell_rules_create_cut_keep(ctx, mesh, geom, prev, cut, 1, rules);
+}
+
+fcm_status fcm__cell_rules_create_cut_keep(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                           const fcm_geometry *geom, const fcm_cell_rules *prev,
+                                           const fcm_surface *cut, int keep, fcm_cell_rules **rules)
+{
   fcm_status st = FCM_OK;
   fcm_cell_rules *R = NULL;
   unsigned char *inner = NULL;
@@ -258,7 +267,7 @@ fcm_status fcm_cell_rules_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const f
     /* rules built with a cell_mask: the same cells get points (the others are classified,
      * split and get their cut faces: the same pieces and DOF copies on every process) */
     R->opts.cell_mask = prev->own;
-    st = build_rules(ctx, mesh, geom, prev, prev->num_cut_tris, NULL, R);
+    st = build_rules(ctx, mesh, geom, prev, prev->num_cut_tris, keep, NULL, R);
     R->opts.cell_mask = NULL;
     FCM_TRY(ctx, st);
     degenerate = R->stats.num_degenerate;

@@ -67,6 +67,7 @@ static fcm_status copy_cell(const build *B, fcm_index c, cell_out *o)
     const fcm_index p = p0 + i;
     po->volume = Q->piece_volume[p];
     po->component = Q->piece_component[p];
+    po->copied = 1;
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
       const size_t a = (size_t)Q->off[k][p], n = (size_t)Q->off[k][p + 1] - a;
       if (n) {
@@ -100,6 +101,47 @@ static fcm_status copy_cell(const build *B, fcm_index c, cell_out *o)
   }
 cleanup:
   return st;
+}
+
+/* Keep cell c as the rules being extended have it (the new cut leaves it unchanged): its
+ * class, fraction, pieces and rules bit for bit, cut faces included. */
+static fcm_status keep_cell(const build *B, fcm_cell_rules *R, const fcm__embed_cell *cell,
+                            cell_out *o)
+{
+  fcm_status st = FCM_OK;
+  const fcm_cell_rules *Q = B->prev;
+  const fcm_index c = cell->id;
+  R->cls[c] = Q->cls[c];
+  R->fraction[c] = Q->fraction[c];
+  o->volume = Q->fraction[c] * cell->volume;
+  FCM_TRY(B->ctx,
+          fcm__embed_cell_out_pieces(B->ctx, o, (int)(Q->piece_off[c + 1] - Q->piece_off[c])));
+  for (int i = 0; i < o->np; i++)
+    o->pc[i].parent = i;
+  FCM_TRY(B->ctx, copy_cell(B, c, o));
+cleanup:
+  return st;
+}
+
+/* Whether the new cut's triangles leave the material pieces of a cell they reach as the rules
+ * being extended have them: as many pieces, every kept piece i made of parts of the earlier
+ * piece i only (their component under the earlier cuts, P->parent, is that piece's) and no
+ * part of an earlier piece left out (in no kept piece: a sliver the cut took off). Each piece
+ * is then the earlier one's material whole, whatever the new triangles did inside it (divided
+ * parts that stay together, a crack ending in the cell, a cut along its faces or through
+ * empty space): its rules stay exact and are kept (its cut faces are made again). */
+static int pieces_unchanged(const build *B, fcm_index c, const fcm__parts *P)
+{
+  const fcm_cell_rules *Q = B->prev;
+  const fcm_index p0 = Q->piece_off[c], had = Q->piece_off[c + 1] - p0;
+  if (P->num_pieces != had) return 0;
+  for (size_t j = 0; j < P->n; j++) {
+    const int i = P->piece[j];
+    if (i >= 0 && Q->piece_component[p0 + i] != P->parent[j]) return 0;
+    for (fcm_index q = 0; i < 0 && q < had; q++)
+      if (Q->piece_component[p0 + q] == P->parent[j]) return 0;
+  }
+  return 1;
 }
 
 /* Renumber the labels (P->piece, *count of them) so that labels whose parts keep no more than
@@ -224,6 +266,34 @@ cleanup:
   return st;
 }
 
+/* A region cell after its pieces (P) were made: kept (*kept = 1) when the new cut does not reach
+ * it (its face polygons were wanted for the links only) or reaches it without changing its
+ * pieces (pieces_unchanged(); its cut faces are then made again). */
+static fcm_status keep_region_cell(const build *B, fcm_cell_rules *R, const fcm__embed_cell *cell,
+                                   fcm__parts *P, int integrate, cell_out *o, int *kept)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_index c = cell->id;
+  const fcm_index had = B->prev ? B->prev->piece_off[c + 1] - B->prev->piece_off[c] : 0;
+  *kept = 0;
+  FCM_CHECK(integrate || had == 0 || had == P->num_pieces, ctx, FCM_ERR_INTERNAL,
+            "embed: cell %lld, which the new cut does not reach, now has %d pieces instead of "
+            "%lld",
+            (long long)c, P->num_pieces, (long long)had);
+  if (integrate && !(B->prev && B->keep && pieces_unchanged(B, c, P))) return FCM_OK;
+  FCM_TRY(ctx, keep_cell(B, R, cell, o));
+  for (int i = 0; integrate && i < o->np; i++) {
+    fcm__free(ctx, o->pc[i].cfxi);
+    o->pc[i].cfxi = NULL;
+    o->pc[i].ncf = 0;
+  }
+  if (integrate && P->tcand.n > 0) FCM_TRY(ctx, piece_cut_faces(B, cell, P, o));
+  *kept = 1;
+cleanup:
+  return st;
+}
+
 /* The surface moments' rounding is about 1e-15 |K| whatever the material's size: a cell whose
  * surface-moment volume is below this fraction of its own takes the volume path (when the
  * geometry has cells), whose accuracy follows the material's size. */
@@ -303,6 +373,11 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   const double t0 = fcm_wtime();
   double sbox[6];
   FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
+  if (!integrate && (!B->region[c] || (B->same_links && B->same_links[c]))) { /* no new work */
+    FCM_TRY(ctx, keep_cell(B, R, &cell, o));
+    sums->time_intersect += fcm_wtime() - t0;
+    goto cleanup;
+  }
   int surface = B->surface && cell.affine && !(B->cut_tree && B->region[c]);
   if (surface && opt->moments == FCM_CELL_MOMENTS_AUTO && B->geom->num_cells > 0) {
     /* auto: the surface path where the volume path would start from many points */
@@ -322,6 +397,13 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
       memcpy(o->fmeta, P->fmeta, 4 * P->nfp * sizeof(int));
       memcpy(o->fx, P->fx, 3 * P->nfx * sizeof(double));
       o->nfp = (int)P->nfp;
+    }
+    int kept;
+    FCM_TRY(ctx, keep_region_cell(B, R, &cell, P, integrate, o, &kept));
+    if (kept) {
+      sums->counts.kept += integrate;
+      sums->time_intersect += fcm_wtime() - t0;
+      goto cleanup;
     }
   } else if (surface) {
     FCM_TRY(ctx, fcm__embed_surface_volume(B, &cell, ws, &vol, sbox));
@@ -351,17 +433,6 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   FCM_TRY(ctx, piece_parents(B, c, P, pcomp, integrate, o));
   for (int i = 0; P && i < o->np && o->np > 1; i++)
     o->pc[i].volume = pvol[i];
-  if (!integrate) {
-    FCM_CHECK(B->prev->piece_off[c + 1] - B->prev->piece_off[c] == o->np &&
-                  B->prev->cls[c] == R->cls[c],
-              ctx, FCM_ERR_INTERNAL,
-              "embed: cell %lld, which the new cut does not reach, now has %d pieces (class %d) "
-              "instead of %lld (class %d)",
-              (long long)c, o->np, (int)R->cls[c],
-              (long long)(B->prev->piece_off[c + 1] - B->prev->piece_off[c]), (int)B->prev->cls[c]);
-    FCM_TRY(ctx, copy_cell(B, c, o));
-    goto cleanup;
-  }
   /* the pieces' sides of the cuts: on every cell, masked or not (the space's DOF copies
    * depend on them: a cut along cell faces separates cells without splitting any) */
   if (P && P->tcand.n > 0 && cls != FCM_CELL_DROPPED) FCM_TRY(ctx, piece_cut_faces(B, &cell, P, o));
@@ -419,7 +490,7 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
     cell_sums mine;
     memset(&mine, 0, sizeof mine);
     fcm__embed_ws *ws = NULL;
-#pragma omp for schedule(dynamic, 4)
+#pragma omp for schedule(dynamic, 1)
     for (fcm_index c = 0; c < nc; c++) {
       if (fcm__loop_skip(&loop, c)) continue;
       fcm__loop_iter it;
@@ -457,6 +528,7 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
       sums->counts.degenerate += mine.counts.degenerate;
       sums->counts.surface_cells += mine.counts.surface_cells;
       sums->counts.surface_fallbacks += mine.counts.surface_fallbacks;
+      sums->counts.kept += mine.counts.kept;
       sums->time_intersect += mine.time_intersect;
       sums->time_simplify += mine.time_simplify;
     }

@@ -6,6 +6,45 @@
 #include <stdlib.h>
 #include <string.h>
 
+static int cmp_link(const void *a, const void *b)
+{
+  const fcm_index *x = a, *y = b;
+  if (x[0] != y[0]) return x[0] < y[0] ? -1 : 1;
+  return (x[1] > y[1]) - (x[1] < y[1]);
+}
+
+/* A pair of region cells that the new cut does not reach, both in the region of the rules
+ * being extended: their pieces are those rules' pieces, their face polygons too, and the new
+ * triangles lie beyond the link tests' reach (a triangle within it would be a candidate of
+ * the cells), so the tests give what they gave there and their links are those rules' links. */
+static int links_kept(const build *B, fcm_index a, fcm_index b)
+{
+  return B->keep && B->prev_region && !B->rebuild[a] && !B->rebuild[b] && B->prev_region[a] &&
+         B->prev_region[b];
+}
+
+/* B->same_links: the region cells whose links with every face neighbour in the region are
+ * kept (links_kept()): they need no face polygons. */
+static fcm_status same_links(build *B)
+{
+  fcm_status st = FCM_OK;
+  const fcm_mesh *mesh = B->mesh;
+  const fcm_index nc = fcm_mesh_num_cells(mesh);
+  const int nf = fcm_mesh_get_element_info(mesh)->num_faces;
+  const fcm_index *nbr = fcm_mesh_neighbors(mesh);
+  FCM_ALLOC(B->ctx, (size_t)nc + 1, B->same_links);
+  for (fcm_index c = 0; c < nc; c++) {
+    int same = B->region[c] && links_kept(B, c, c);
+    for (int f = 0; f < nf && same; f++) {
+      const fcm_index c2 = nbr[(size_t)nf * c + f];
+      same = c2 < 0 || !B->region[c2] || links_kept(B, c, c2);
+    }
+    B->same_links[c] = (unsigned char)same;
+  }
+cleanup:
+  return st;
+}
+
 /* Phase 1c (cuts only): the tree of R's cut triangles, the region (cells sharing a node with
  * a cell the cuts reach) and, when extending `prev` by the triangles from first_new on,
  * the cells to integrate (those the new triangles reach). */
@@ -50,18 +89,12 @@ fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new
       B->region[c] |= h != 0;
       if (B->prev_region) B->prev_region[c] |= (h & 2) != 0;
     }
+  if (B->prev_region && B->keep) FCM_TRY(ctx, same_links(B));
 cleanup:
   fcm__free(ctx, boxes);
   fcm__free(ctx, node_hit);
   fcm__geom_idbuf_free(ctx, &ids);
   return st;
-}
-
-static int cmp_link(const void *a, const void *b)
-{
-  const fcm_index *x = a, *y = b;
-  if (x[0] != y[0]) return x[0] < y[0] ? -1 : 1;
-  return (x[1] > y[1]) - (x[1] < y[1]);
 }
 
 /* Whether the earlier pieces qa of cell ca and qb of cell cb (ca < cb, face neighbours) were
@@ -75,6 +108,50 @@ static int earlier_link(const build *B, fcm_index ca, fcm_index cb, int qa, int 
   const fcm_cell_rules *Q = B->prev;
   const fcm_index key[2] = {Q->piece_off[ca] + qa, Q->piece_off[cb] + qb};
   return bsearch(key, Q->links, (size_t)Q->num_links, 2 * sizeof *Q->links, cmp_link) != NULL;
+}
+
+/* Append the link (pa, pb) to *links (*nl of them, room for *cap). */
+static fcm_status push_link(fcm_ctx *ctx, fcm_index pa, fcm_index pb, fcm_index **links, size_t *nl,
+                            size_t *cap)
+{
+  fcm_status st = FCM_OK;
+  if (*nl + 1 > *cap) {
+    const size_t ncap = *cap ? 2 * *cap : 256;
+    void *q = *links;
+    FCM_TRY(ctx, fcm__resize(ctx, &q, 2 * *nl, 2 * ncap, sizeof(fcm_index)));
+    *links = q;
+    *cap = ncap;
+  }
+  (*links)[2 * *nl] = pa, (*links)[2 * *nl + 1] = pb;
+  (*nl)++;
+cleanup:
+  return st;
+}
+
+/* The links between the pieces of cells ca < cb that the rules being extended have
+ * (links_kept()), renumbered as R's pieces (the cells kept theirs, in the same order). */
+static fcm_status copy_links(const build *B, const fcm_cell_rules *R, fcm_index ca, fcm_index cb,
+                             fcm_index **links, size_t *nl, size_t *cap)
+{
+  fcm_status st = FCM_OK;
+  const fcm_cell_rules *Q = B->prev;
+  const fcm_index qa0 = Q->piece_off[ca], qb0 = Q->piece_off[cb], qb1 = Q->piece_off[cb + 1];
+  fcm_index lo = 0, hi = Q->num_links; /* the first link from a piece of ca */
+  while (lo < hi) {
+    const fcm_index mid = lo + (hi - lo) / 2;
+    if (Q->links[2 * mid] < qa0)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  for (fcm_index l = lo; l < Q->num_links && Q->links[2 * l] < Q->piece_off[ca + 1]; l++) {
+    const fcm_index qa = Q->links[2 * l], qb = Q->links[2 * l + 1];
+    if (qb < qb0 || qb >= qb1) continue;
+    FCM_TRY(B->ctx, push_link(B->ctx, R->piece_off[ca] + (qa - qa0), R->piece_off[cb] + (qb - qb0),
+                              links, nl, cap));
+  }
+cleanup:
+  return st;
 }
 
 /* Phase 3b (cuts only): the links between pieces of face-neighbouring region cells: a
@@ -104,8 +181,13 @@ fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell
       while (f2 < nf && nbr[(size_t)nf * c2 + f2] != c)
         f2++;
       if (f2 == nf) continue;
+      if (links_kept(B, c, c2)) {
+        FCM_TRY(ctx, copy_links(B, R, c, c2, &links, &nl, &cap));
+        continue;
+      }
       const cell_out *ob = out + c2;
       const fcm_index pa0 = R->piece_off[c], pb0 = R->piece_off[c2];
+      const size_t nl0 = nl; /* the links of this pair of cells start here */
       size_t xa = 0;
       for (int i = 0; i < oa->nfp; i++) {
         const int *ma = oa->fmeta + 4 * i;
@@ -120,7 +202,7 @@ fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell
           if (mb[0] != f2 || mb[1] < 0) continue;
           const fcm_index pa = pa0 + ma[1], pb = pb0 + mb[1];
           int known = 0;
-          for (size_t l = nl; l-- > 0 && !known;)
+          for (size_t l = nl; l-- > nl0 && !known;)
             known = links[2 * l] == pa && links[2 * l + 1] == pb;
           if (known) continue;
           double lo[3], hi[3];
@@ -136,15 +218,7 @@ fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell
                                  nbn, mtol, atol, B->cut_tris, tc.ids, tc.n))
             continue;
           if (!earlier_link(B, c, c2, out[c].pc[ma[1]].parent, out[c2].pc[mb[1]].parent)) continue;
-          if (nl + 1 > cap) {
-            const size_t ncap = cap ? 2 * cap : 256;
-            void *q = links;
-            FCM_TRY(ctx, fcm__resize(ctx, &q, 2 * nl, 2 * ncap, sizeof(fcm_index)));
-            links = q;
-            cap = ncap;
-          }
-          links[2 * nl] = pa, links[2 * nl + 1] = pb;
-          nl++;
+          FCM_TRY(ctx, push_link(ctx, pa, pb, &links, &nl, &cap));
         }
       }
     }

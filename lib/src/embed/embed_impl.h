@@ -142,6 +142,7 @@ typedef struct fcm__embed_counts {
   fcm_index degenerate;        /* cells whose cut splitting changed the parts' volume */
   fcm_index surface_cells;     /* cut cells fitted on surface moments */
   fcm_index surface_fallbacks; /* of those, cells whose fit failed (volume path instead) */
+  fcm_index kept;              /* cells a cut reaches whose pieces it leaves unchanged */
 } fcm__embed_counts;
 
 /* ---------------------------------------------------------------- distributed classification */
@@ -429,6 +430,15 @@ fcm_status fcm__embed_crop_geometry(fcm_ctx *ctx, const fcm_mesh *mesh, const fc
                                     const fcm_cell_rules_options *opts,
                                     const unsigned char *classify, const unsigned char *surface,
                                     fcm_geometry **out);
+
+/* fcm_cell_rules_create_cut() with keep = 1; keep = 0 integrates again every cell the new cut
+ * reaches, whether it changes its pieces or not, and makes the face polygons of every cell
+ * near the cuts for the links (none taken from prev): the reference its shortcuts are
+ * tested against. */
+fcm_status fcm__cell_rules_create_cut_keep(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                           const fcm_geometry *geom, const fcm_cell_rules *prev,
+                                           const fcm_surface *cut, int keep,
+                                           fcm_cell_rules **rules);
 
 /* 0 when the rules were built with a cell_mask that does not flag `cell` (the cell belongs to
  * another process: no points, uncut or not); 1 otherwise. */

@@ -551,11 +551,14 @@ static int parts_connected(const fcm__embed_cell *cell, const fcm__cut_tri *tris
   for (int fa = 0; fa < a->nf; fa++) {
     const fcm__plane *pa = fp + i * FCM__POLY_MAX_FACES + fa;
     if (pa->n[0] == 0.0 && pa->n[1] == 0.0 && pa->n[2] == 0.0) continue;
+    int na = -1; /* face a's vertices, gathered once a face of b faces it */
     for (int fb = 0; fb < b->nf; fb++) {
       const fcm__plane *pb = fp + j * FCM__POLY_MAX_FACES + fb;
       if (fcm__vec3_dot(pa->n, pb->n) > -0.5) continue;
-      const int na = face_coords(a, fa, xa), nb = face_coords(b, fb, xb);
-      if (!points_on_plane(xa, na, pb, mtol) || !points_on_plane(xb, nb, pa, mtol)) continue;
+      if (na < 0) na = face_coords(a, fa, xa);
+      if (!points_on_plane(xa, na, pb, mtol)) continue;
+      const int nb = face_coords(b, fb, xb);
+      if (!points_on_plane(xb, nb, pa, mtol)) continue;
       if (fcm__embed_linked(xa, na, a->x[0], a->nv, xb, nb, b->x[0], b->nv, pb->n, mtol, atol, tris,
                             P->tcand.ids, ntri))
         return 1;
@@ -592,6 +595,19 @@ cleanup:
   return st;
 }
 
+/* A part's box by its lower x (then its index: qsort is not stable). */
+typedef struct box_key {
+  double x;
+  size_t i;
+} box_key;
+
+static int cmp_box_key(const void *a, const void *b)
+{
+  const box_key *p = a, *q = b;
+  if (p->x != q->x) return p->x < q->x ? -1 : 1;
+  return (p->i > q->i) - (p->i < q->i);
+}
+
 /* Connected components of the parts when the triangles tris[P->tcand.ids[0 .. ntri)]
  * separate: label[i] numbered by first part; *count of them. */
 static fcm_status components(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
@@ -599,6 +615,7 @@ static fcm_status components(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
 {
   fcm_status st = FCM_OK;
   double *box = NULL;
+  box_key *order = NULL;
   fcm__plane *fp = NULL;
   if (P->n > P->ufcap) {
     void *u = P->uf;
@@ -607,6 +624,7 @@ static fcm_status components(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
     P->ufcap = P->n;
   }
   FCM_ALLOC_RAW(ctx, 6 * P->n + 1, box);
+  FCM_ALLOC_RAW(ctx, P->n + 1, order);
   FCM_ALLOC(ctx, FCM__POLY_MAX_FACES * P->n + 1, fp);
   const double mtol = MATCH_RTOL * cell->size;
   for (size_t i = 0; i < P->n; i++) {
@@ -624,11 +642,18 @@ static fcm_status components(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
         bi[3 + d] = fmax(bi[3 + d], P->poly[i].x[v][d] + mtol);
       }
   }
+  /* the pairs whose boxes meet, swept along x (the components, numbered by their lowest part,
+   * do not depend on the order the pairs are joined in) */
   for (size_t i = 0; i < P->n; i++)
-    for (size_t j = i + 1; j < P->n; j++) {
+    order[i].x = box[6 * i], order[i].i = i;
+  qsort(order, P->n, sizeof *order, cmp_box_key);
+  for (size_t a = 0; a < P->n; a++)
+    for (size_t b = a + 1; b < P->n; b++) {
+      if (order[b].x > box[6 * order[a].i + 3]) break; /* the rest start beyond a's box */
+      const size_t i = FCM_MIN(order[a].i, order[b].i), j = FCM_MAX(order[a].i, order[b].i);
       const double *bi = box + 6 * i, *bj = box + 6 * j;
       int apart = 0;
-      for (int d = 0; d < 3; d++)
+      for (int d = 1; d < 3; d++)
         apart |= bi[d] > bj[3 + d] || bj[d] > bi[3 + d];
       if (apart || uf_find(P->uf, (int)i) == uf_find(P->uf, (int)j)) continue;
       if (parts_connected(cell, tris, P, fp, ntri, i, j)) uf_union(P->uf, (int)i, (int)j);
@@ -641,6 +666,7 @@ static fcm_status components(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
   *count = np;
 cleanup:
   fcm__free(ctx, box);
+  fcm__free(ctx, order);
   fcm__free(ctx, fp);
   return st;
 }

@@ -123,8 +123,9 @@ void fcm__embed_build_release(build *B)
     fcm__free(B->ctx, B->region);
     fcm__free(B->ctx, B->rebuild);
     fcm__free(B->ctx, B->prev_region);
+    fcm__free(B->ctx, B->same_links);
   }
-  B->region = B->rebuild = B->prev_region = NULL;
+  B->region = B->rebuild = B->prev_region = B->same_links = NULL;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     fcm_rule_destroy(&B->tet_rule[k]);
   fcm_rule_destroy(&B->tri_rule);
@@ -282,7 +283,7 @@ void fcm__embed_gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const 
     const cell_out *o = out + c;
     for (int i = 0; i < o->np; i++) {
       const piece_out *q = o->pc + i;
-      for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+      for (int k = 0; k < FCM_RULE_KIND_COUNT && !q->copied; k++) {
         S->points_initial[k] += q->ninit[k];
         S->points_simplified[k] += q->nsimp[k];
         S->points_stabilization[k] += q->nstab[k];
@@ -325,6 +326,7 @@ void fcm__embed_gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const 
   S->surface_triangles = sums->counts.surface_triangles;
   S->num_surface_cells = sums->counts.surface_cells;
   S->num_surface_fallbacks = sums->counts.surface_fallbacks;
+  S->num_kept = sums->counts.kept;
   S->geometry_volume = fcm_geometry_volume(geom);
   S->num_threads = nthreads;
   S->time_intersect = sums->time_intersect;

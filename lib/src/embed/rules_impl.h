@@ -27,6 +27,7 @@ typedef struct piece_out {
   unsigned char skipped[FCM_RULE_KIND_COUNT], fallback[FCM_RULE_KIND_COUNT];
   double residual[FCM_RULE_KIND_COUNT];
   double tsimp[FCM_RULE_KIND_COUNT]; /* fcm_simplify's time_total */
+  unsigned char copied; /* rules copied from the rules being extended (not counted as built) */
   unsigned char fitted; /* rules fitted on surface moments (at most M points: not simplified) */
   int parent;    /* the piece of the same cell in the rules being extended that holds this one */
   int component; /* its number among the cell's components before empty ones were dropped */
@@ -70,13 +71,17 @@ typedef struct build {
   /* Cutting: the tree of R->cut_tris (NULL without cuts); region[c]: cell c shares a node
    * with a cell the cuts reach (its face polygons are recorded for the links); rebuild[c]:
    * integrate cell c (NULL: every cell), else copy its rules from prev; prev_region[c]: the
-   * region of prev, whose links cover the pairs of its cells (NULL: prev has no cuts). */
+   * region of prev, whose links cover the pairs of its cells (NULL: prev has no cuts);
+   * same_links[c]: cell c and its face neighbours in the region are in prev's region and
+   * the new cut reaches none of them: their links are prev's, c needs no face polygons. */
   fcm_aabb_tree *cut_tree;
   const fcm__cut_tri *cut_tris;
-  unsigned char *region, *rebuild, *prev_region;
+  unsigned char *region, *rebuild, *prev_region, *same_links;
   const fcm_cell_rules *prev;
-  fcm_index first_new;    /* cut triangles from here on are new (those of the cut being added) */
-  fcm__rules_reduce *red; /* distributed AUTO: sums the choice's inputs (NULL: none) */
+  fcm_index first_new; /* cut triangles from here on are new (those of the cut being added) */
+  int keep; /* cuts: keep the cells the new cut leaves unchanged, and the links of cells it does
+               not reach (fcm__cell_rules_create_cut_keep()) */
+  fcm__rules_reduce *red;      /* distributed AUTO: sums the choice's inputs (NULL: none) */
   const unsigned char *remote; /* distributed classification: cells another process classifies
                                   (skipped here), NULL: none */
 } build;
