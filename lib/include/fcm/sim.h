@@ -175,17 +175,17 @@ typedef struct fcm_integrator_options {
    * unused. A predictor iteration (prescribed motion) counts as one. In [0, 10^6]
    * ["newton.fixed_iterations"] */
   int newton_fixed_iterations;
-  int cut_reuse;            /**< what fcm_integrator_create_cut() keeps of this integrator, a sum of
-                                 fcm_cut_reuse flags (default 0: the new integrator is built from scratch).
-                                 FCM_CUT_REUSE_BLOCKS: the integrator keeps each element's mass and load
-                                 blocks (nn (nn + 1) / 2 + 3 nn per load doubles per element; a full serial
-                                 embedded space only) and after a cut integrates only the elements whose
-                                 rules the cut changed: the mass matrix and the loads are bit for bit those
-                                 of a rebuild. FCM_CUT_REUSE_ORDERING: CHOLMOD's analysis after a cut takes
-                                 the old ordering extended by the new DOFs (no AMD / METIS): a faster
-                                 analysis, but a factor with more fill than a fresh ordering's
-                                 (lib/docs/cutting.md). The scene runner sets FCM_CUT_REUSE_BLOCKS for a
-                                 scene with cuts [not a scene key] */
+  int cut_reuse; /**< what fcm_integrator_create_cut() keeps of this integrator, a sum of
+                      fcm_cut_reuse flags (default 0: the new integrator is built from scratch).
+                      FCM_CUT_REUSE_BLOCKS: the integrator keeps each element's mass and load
+                      blocks (nn (nn + 1) / 2 + 3 nn per load doubles per element; a full serial
+                      embedded space only) and after a cut integrates only the elements whose
+                      rules the cut changed: the mass matrix and the loads are bit for bit those
+                      of a rebuild. FCM_CUT_REUSE_ORDERING: CHOLMOD's analysis after a cut takes
+                      the old ordering extended by the new DOFs (no AMD / METIS): a faster
+                      analysis, but a factor with more fill than a fresh ordering's
+                      (lib/docs/cutting.md). The scene runner sets FCM_CUT_REUSE_BLOCKS for a
+                      scene with cuts [not a scene key] */
   fcm_linear_solver linear_solver;   /**< default FCM_LINEAR_DIRECT ["method"] */
   fcm_direct_method direct_method;   /**< first direct method (default CHOLMOD; UMFPACK: LU only)
                                           ["direct"] */

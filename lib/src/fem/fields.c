@@ -1,6 +1,7 @@
 /* Fields of a solution for output: DOF vectors per background node, stress, von Mises stress
  * and strain energy density at points and as cell averages, the embedded surface, VTU files.
- * Every file holds reference positions with a `displacement` point array (apps/docs/fcm-sim.md: ParaView). */
+ * Every file holds reference positions with a `displacement` point array (apps/docs/fcm-sim.md:
+ * ParaView). */
 #include "fem/fem_impl.h"
 #include "la/mat3.h"
 
