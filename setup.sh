@@ -6,8 +6,8 @@
 #   bash setup.sh deps    only install the Debian packages
 #   bash setup.sh deps --petsc
 #                         also the optional PETSc + MPI backend's (petsc-dev, openmpi-bin;
-#                         `test --petsc` etc. likewise): the build then finds PETSc through
-#                         pkg-config (CMake option FCM_WITH_PETSC, default AUTO) and the
+#                         `test --petsc` etc. likewise): the build then has the backend
+#                         (CMake option FCM_WITH_PETSC=ON; without --petsc it is off) and the
 #                         default test run includes the mpi-labelled tests
 #   bash setup.sh install-check
 #                         build, install into a temporary prefix, move it, and build and run
@@ -25,6 +25,7 @@ packages=(build-essential cmake pkg-config libopenblas-dev liblapacke-dev libglp
 # --petsc (the argument after the command): the PETSc + MPI backend's packages too
 if [ "${2:-}" = "--petsc" ]; then
   packages+=(petsc-dev openmpi-bin)
+  FCM_CMAKE_ARGS="-DFCM_WITH_PETSC=ON ${FCM_CMAKE_ARGS:-}"
   set -- "$1" "${@:3}"
 fi
 
