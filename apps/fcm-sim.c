@@ -93,7 +93,7 @@ static void usage(FILE *f, const cli_option *opts)
           "\n"
           "Runs a scene file (schema: apps/scenes/README.md) with only the effects it names;\n"
           "without a file, the built-in default scene: a hollow cylinder, one end pushed in and\n"
-          "the other twisted (Longva et al. 2020, 6.2; Hex20 FCM, about 55 s on 2 cores).\n"
+          "the other twisted (Longva et al. 2020, 6.2; Hex20 FCM, about 20 s on 2 cores).\n"
           "Frames go to the scene's output directory: <name>_background_NNNN.vtu,\n"
           "<name>_surface_NNNN.vtu, <name>_background.pvd, <name>_surface.pvd (open the .pvd\n"
           "files in ParaView) and the per-step log <name>_log.csv. Example scenes, among them\n"

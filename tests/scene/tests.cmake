@@ -8,6 +8,8 @@ fcm_add_test(scene_defaults tests/scene/defaults.c)
 fcm_add_test(scene_alloc tests/scene/alloc.c)
 fcm_add_test(scene_default tests/scene/default.c
              ARGS ${PROJECT_SOURCE_DIR}/apps/scenes/twisting_cylinder.json)
+# What the README says the built-in scene shows, on its whole run (about 20 s).
+fcm_add_test(scene_default_claim tests/scene/default_claim.c TIMEOUT 1500)
 fcm_add_test(scene_examples tests/scene/examples.c ARGS ${PROJECT_SOURCE_DIR}/apps/scenes)
 # The scene runner: counters of what a scene computes and skips, frames, log, errors.
 fcm_add_test(scene_run_counters tests/scene/run_counters.c)
