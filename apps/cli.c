@@ -312,15 +312,23 @@ void cli_output_abort(cli_output **out)
   *out = NULL;
 }
 
-int cli_make_dirs(const char *prog, const char *dir)
+/* dir into buf (4096 bytes); 0 after saying why it does not fit. */
+static int copy_dir(const char *prog, const char *dir, char buf[4096])
 {
-  char buf[4096];
   const size_t n = strlen(dir);
-  if (n == 0 || n >= sizeof buf) {
+  if (n == 0 || n >= 4096) {
     fprintf(stderr, "%s: bad output directory '%s'\n", prog, dir);
     return 0;
   }
   memcpy(buf, dir, n + 1);
+  return 1;
+}
+
+int cli_make_dirs(const char *prog, const char *dir)
+{
+  char buf[4096];
+  if (!copy_dir(prog, dir, buf)) return 0;
+  const size_t n = strlen(buf);
   for (size_t k = 1; k <= n; k++) {
     if (buf[k] != '/' && buf[k] != '\0') continue;
     const char c = buf[k];
@@ -344,12 +352,7 @@ int cli_make_dirs(const char *prog, const char *dir)
 int cli_check_output_dir(const char *prog, const char *dir)
 {
   char buf[4096];
-  const size_t n = strlen(dir);
-  if (n == 0 || n >= sizeof buf) {
-    fprintf(stderr, "%s: bad output directory '%s'\n", prog, dir);
-    return 0;
-  }
-  memcpy(buf, dir, n + 1);
+  if (!copy_dir(prog, dir, buf)) return 0;
   for (;;) { /* the path itself, then each parent up to the first that exists */
     struct stat sb;
     if (stat(buf, &sb) == 0) {

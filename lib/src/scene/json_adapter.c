@@ -100,6 +100,29 @@ fcm__json *fcm__json_new_object(void)
   return (fcm__json *)cJSON_CreateObject();
 }
 
+/* The next component of a path ("a.b[2].c") at *s: a key (into key, `index` -1) or an index
+ * ([i]: index i); *s moves past it and its '.'. 0 on a malformed index. */
+static int next_component(const char **s, char key[128], long *index)
+{
+  const char *p = *s;
+  size_t n = 0;
+  *index = -1;
+  key[0] = '\0';
+  if (*p == '[') {
+    char *end = NULL;
+    *index = strtol(p + 1, &end, 10);
+    if (!end || *end != ']' || *index < 0) return 0;
+    p = end + 1;
+  } else {
+    while (*p && *p != '.' && *p != '[' && n < 127)
+      key[n++] = *p++;
+    key[n] = '\0';
+  }
+  if (*p == '.') p++;
+  *s = p;
+  return 1;
+}
+
 /* Put `value` (taken over; NULL: an allocation failed) at `path` ("a.b[2].c") under the object
  * `root`, creating the objects (or, before an index, arrays) on the way; an existing value there
  * is replaced, or kept when `keep` is set. 0 when it could not be placed. */
@@ -110,19 +133,8 @@ static int put(cJSON *root, const char *path, cJSON *value, int keep)
   if (!value) return 0;
   while (cur && *s) {
     char key[128];
-    size_t n = 0;
     long index = -1;
-    if (*s == '[') {
-      char *end = NULL;
-      index = strtol(s + 1, &end, 10);
-      if (!end || *end != ']' || index < 0) break;
-      s = end + 1;
-    } else {
-      while (*s && *s != '.' && *s != '[' && n < sizeof key - 1)
-        key[n++] = *s++;
-      key[n] = '\0';
-    }
-    if (*s == '.') s++;
+    if (!next_component(&s, key, &index)) break;
     const int last = *s == '\0', next_index = *s == '[';
     cJSON *next = NULL;
     if (index >= 0) {
@@ -171,19 +183,8 @@ void fcm__json_remove_path(fcm__json *root, const char *path)
   const char *s = path;
   while (cur && *s) {
     char key[128];
-    size_t n = 0;
     long index = -1;
-    if (*s == '[') {
-      char *end = NULL;
-      index = strtol(s + 1, &end, 10);
-      if (!end || *end != ']' || index < 0) return;
-      s = end + 1;
-    } else {
-      while (*s && *s != '.' && *s != '[' && n < sizeof key - 1)
-        key[n++] = *s++;
-      key[n] = '\0';
-    }
-    if (*s == '.') s++;
+    if (!next_component(&s, key, &index)) return;
     if (*s == '\0') {
       if (index >= 0)
         cJSON_DeleteItemFromArray(cur, (int)index);
