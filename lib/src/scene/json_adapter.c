@@ -85,16 +85,6 @@ const fcm__json *fcm__json_empty_object(void)
   return (const fcm__json *)&empty;
 }
 
-void fcm__json_remove(fcm__json *root, const char *key)
-{
-  cJSON_DeleteItemFromObjectCaseSensitive((cJSON *)root, key);
-}
-
-fcm__json *fcm__json_member_mutable(fcm__json *object, const char *key)
-{
-  return (fcm__json *)cJSON_GetObjectItemCaseSensitive((cJSON *)object, key);
-}
-
 fcm__json *fcm__json_new_object(void)
 {
   return (fcm__json *)cJSON_CreateObject();

@@ -304,7 +304,7 @@ fcm_status fcm__scene_read_time(fcm__scene_parser *p, const fcm__json *root)
   SCENE_CHECK(isfinite(t->duration), p, FCM_ERR_ARG,
               "expected a finite simulated time, got steps * dt = %g", t->duration);
   if (p->norm) { /* the normalized section says what was resolved: keys for this kind only */
-    fcm__json_remove(p->norm, "time");
+    fcm__json_remove_path(p->norm, "time");
     fcm__scene_path_pop(p, old);
     fcm__scene_put_resolved_time(
         p, is_static,

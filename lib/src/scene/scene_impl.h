@@ -54,9 +54,6 @@ fcm__json *fcm__json_new_object(void);
 /* An object without members: what a section parser reads when the section is absent, so that
  * its defaults are recorded too. */
 const fcm__json *fcm__json_empty_object(void);
-/* The member `key` of an object of the normalized tree (NULL if none); remove it. */
-fcm__json *fcm__json_member_mutable(fcm__json *object, const char *key);
-void fcm__json_remove(fcm__json *object, const char *key);
 /* Remove the value at `path` of the normalized tree, if there is one. */
 void fcm__json_remove_path(fcm__json *root, const char *path);
 int fcm__json_put_copy(fcm__json *root, const char *path, const fcm__json *value);
