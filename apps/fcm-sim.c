@@ -8,9 +8,7 @@
 #include <fcm/simulation.h>
 
 #include "cli.h"
-#if FCM_HAVE_PETSC
-#include "fcm-sim-petsc.h"
-#endif
+#include "fcm-sim-petsc.h" /* sim_print_output(); sim_petsc_run() is built with FCM_HAVE_PETSC */
 
 #include <errno.h>
 #include <omp.h>
@@ -31,6 +29,7 @@ typedef struct scene_options {
   long long steps;
   int checkpoint_every; /* -1: the scene's */
   int check, quiet, print_scene;
+  int preview;  /* write the preview files and stop before the set-up */
   int debug;    /* print the library's traceback with errors */
   int progress; /* the set-up's phases and progress also when stderr is not a terminal */
   int backend;  /* 0 serial, 1 petsc */
@@ -39,7 +38,7 @@ typedef struct scene_options {
 static const char *const backend_names[] = {"serial", "petsc", NULL};
 
 /* The option table, writing into `o`. */
-#define SIM_NUM_OPTIONS 11
+#define SIM_NUM_OPTIONS 12
 static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS])
 {
   const cli_option t[SIM_NUM_OPTIONS] = {
@@ -59,6 +58,13 @@ static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS
        "continue from a checkpoint of the same scene, bit for bit\n"
        "as the uninterrupted run; frames and log go on in the\n"
        "output directory",
+       0, 0, 0, NULL, NULL, NULL},
+      {"--preview", NULL, CLI_FLAG, &o->preview, NULL,
+       "build only the background and the geometry, write\n"
+       "<name>_preview.pvd into the output directory (the grid\n"
+       "with inside/cut/outside cells, the surface, the nodes\n"
+       "and boundary points of each effect's region, the cut\n"
+       "surfaces), print the counts per region and exit",
        0, 0, 0, NULL, NULL, NULL},
       {"--print-scene", NULL, CLI_FLAG, &o->print_scene, NULL,
        "print the scene as JSON with every default filled in and exit", 0, 0, 0, NULL, NULL, NULL},
@@ -126,6 +132,11 @@ static int parse_scene_args(int argc, char **argv, scene_options *o)
   o->path = npos ? pos[0] : NULL;
   if (o->check && (o->resume || o->checkpoint_every > 0)) {
     fprintf(stderr, "fcm-sim: --check writes nothing: no --resume or --checkpoint-every\n");
+    return 2;
+  }
+  if (o->preview && (o->check || o->resume || o->checkpoint_every > 0 || o->steps > 0)) {
+    fprintf(stderr, "fcm-sim: --preview takes no steps: no --check, --resume, --steps or "
+                    "--checkpoint-every\n");
     return 2;
   }
   return -1;
@@ -421,9 +432,11 @@ static fcm_status on_step(void *user, fcm_simulation *sim, const fcm_simulation_
 static int run_petsc_backend(const scene_options *o, int pargc, char **pargv)
 {
 #if FCM_HAVE_PETSC
-  return o->print_scene
-             ? (fprintf(stderr, "fcm-sim: --backend petsc: --print-scene is the "
-                                "serial backend's (drop --backend)\n"),
+  return o->print_scene || o->preview
+             ? (fprintf(stderr,
+                        "fcm-sim: --backend petsc: %s is the serial backend's (drop "
+                        "--backend: it builds no distributed state)\n",
+                        o->print_scene ? "--print-scene" : "--preview"),
                 2)
              : sim_petsc_run(o->path, o->outdir, o->steps, o->check, o->quiet,
                              o->check ? 0 : o->checkpoint_every, o->resume, pargc, pargv);
@@ -457,6 +470,20 @@ static fcm_simulation_options simulation_options(const scene_options *o, rules_p
   return so;
 }
 
+/* A failed build or preview: the library's message (the traceback with --debug), a pointer to
+ * --preview when a region is refused; the exit code. */
+static int report_build_error(fcm_ctx *ctx, fcm_status st, const char *name, int debug)
+{
+  const char *msg = fcm_ctx_error_message(ctx);
+  if (debug)
+    fcm_ctx_error_view(ctx, stderr);
+  else
+    cli_report_scene_error("fcm-sim", name, msg);
+  if (st == FCM_ERR_ARG && strstr(msg, "effects[") && strstr(msg, "region"))
+    fprintf(stderr, "fcm-sim: --preview writes each region's nodes for a look in ParaView\n");
+  return build_exit_code(st);
+}
+
 /* Build the simulation of the scene (and resume it from the checkpoint of --resume); 0, or the
  * exit code after reporting why not. */
 static int build_simulation(fcm_ctx *ctx, fcm_scene *scene, const scene_options *o,
@@ -473,13 +500,7 @@ static int build_simulation(fcm_ctx *ctx, fcm_scene *scene, const scene_options 
     fcm_simulation_get_counters(*sim, &c);
     fprintf(stderr, "fcm-sim: set-up: %.2f s\n", c.time_setup);
   }
-  if (st != FCM_OK) {
-    if (o->debug)
-      fcm_ctx_error_view(ctx, stderr);
-    else
-      cli_report_scene_error("fcm-sim", name, fcm_ctx_error_message(ctx));
-    return build_exit_code(st);
-  }
+  if (st != FCM_OK) return report_build_error(ctx, st, name, o->debug);
   warn_outside(*sim);
   if (o->resume) {
     if (fcm_simulation_read_checkpoint(*sim, o->resume) != FCM_OK) {
@@ -492,6 +513,34 @@ static int build_simulation(fcm_ctx *ctx, fcm_scene *scene, const scene_options 
               fcm_integrator_time(fcm_simulation_integrator(*sim)));
   }
   return 0;
+}
+
+/* --preview: the background and the geometry only, the preview files in the output directory
+ * and the counts per region (also when a region is refused: the files show it); the exit code. */
+static int run_preview(fcm_ctx *ctx, fcm_scene *scene, const scene_options *o,
+                       rules_progress_state *rps)
+{
+  const char *name = fcm_scene_name(scene);
+  const char *dir = o->outdir ? o->outdir : fcm_scene_get_output(scene)->directory;
+  const int ne = fcm_scene_num_effects(scene);
+  fcm_simulation_preview_info info;
+  fcm_preview_effect *eff = calloc((size_t)ne + 1, sizeof *eff);
+  if (!eff || !cli_make_dirs("fcm-sim", dir)) {
+    free(eff);
+    return 1;
+  }
+  const fcm_simulation_options so = simulation_options(o, rps);
+  if (!o->quiet)
+    fprintf(stderr, "fcm-sim: scene %s (%s): preview\n", name, fcm_scene_source(scene));
+  const fcm_status st = fcm_simulation_write_preview(ctx, scene, &so, dir, &info, eff);
+  if (so.setup_phase) close_line(rps);
+  if (info.files > 0 && !o->quiet) {
+    fcm_simulation_preview_view(scene, &info, eff, stdout);
+    printf("  output      %s/%s_preview.pvd (%d files)\n", dir, name, info.files);
+    fflush(stdout);
+  }
+  free(eff);
+  return st == FCM_OK ? 0 : report_build_error(ctx, st, name, o->debug);
 }
 
 /* The output directory, the log path <dir>/<name>_log.csv (logsize bytes) and, unless the run
@@ -557,7 +606,7 @@ void sim_print_output(const char *dir, const char *name, const char *logpath, in
 
 static int scene_main(int argc, char **argv)
 {
-  scene_options o = {NULL, NULL, NULL, 0, -1, 0, 0, 0, 0, 0, 0};
+  scene_options o = {NULL, NULL, NULL, 0, -1, 0, 0, 0, 0, 0, 0, 0};
   int pargc = 1;
   char **pargv = calloc((size_t)argc + 1, sizeof *pargv);
   if (!pargv) return 1;
@@ -609,6 +658,10 @@ static int scene_main(int argc, char **argv)
   if (fcm_scene_get_solver(scene)->threads > 0) /* every OpenMP loop of the run */
     omp_set_num_threads(fcm_scene_get_solver(scene)->threads);
   rps.t0 = fcm_wtime();
+  if (o.preview) {
+    rc = run_preview(ctx, scene, &o, &rps);
+    goto done;
+  }
   rc = build_simulation(ctx, scene, &o, &rps, &sim);
   if (rc != 0) goto done;
   rc = 1;

@@ -228,7 +228,8 @@ static int mode_errors(const char *sim, const char *work)
               file_has(err, k < 2 ? "exists and is not a directory" : "not an fcm checkpoint"));
   }
   remove(file);
-  /* a region whose nodes are all inactive holds nothing: refused, the scene named once */
+  /* a region whose nodes are all inactive holds nothing: refused before the cell rules (no
+   * such phase with --progress), the scene named once, --preview suggested */
   snprintf(scene, sizeof scene, "%s/inactive.json", work);
   write_file(scene,
              "{\"version\": 1, \"name\": \"inactive\","
@@ -238,10 +239,45 @@ static int mode_errors(const char *sim, const char *work)
              " \"material\": {\"model\": \"linear\", \"young\": 1e6, \"poisson\": 0.3},"
              " \"effects\": [{\"fixed\": {\"region\": {\"half_space\": {\"point\": [1.9, 0, 0],"
              " \"normal\": [1, 0, 0]}}}}]}");
+  snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s' --progress 2> '%s' > /dev/null", sim, scene, dir,
+           err);
+  TEST_TRUE(app_run(cmd) == 2);
+  TEST_TRUE(file_has(err, "fcm-sim: scene inactive: effects[0]: the fixed region (half_space "
+                          "through (1.9, 0, 0) with normal (1, 0, 0)) selects 9 background-mesh "
+                          "nodes, none of them active"));
+  TEST_TRUE(file_has(err, "fcm-sim: building the background grid") && !file_has(err, "cell rules"));
+  TEST_TRUE(file_has(err, "--preview writes each region's nodes"));
+  /* --preview of it: the files and the counts, then the same refusal */
+  char out[1024], pv[1100];
+  snprintf(out, sizeof out, "%s/preview.out", work);
+  snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s' --preview 2> '%s' > '%s'", sim, scene, dir, err,
+           out);
+  TEST_TRUE(app_run(cmd) == 2);
+  TEST_TRUE(file_has(out, "effects[0]  fixed: region selects 9 nodes, 0 active"));
+  TEST_TRUE(file_has(err, "none of them active"));
+  const char *parts[] = {"preview.pvd", "preview_grid.vtu", "preview_surface.vtu",
+                         "preview_nodes.vtu"};
+  for (int k = 0; k < 4; k++) {
+    snprintf(pv, sizeof pv, "%s/inactive_%s", dir, parts[k]);
+    TEST_TRUE(app_exists(pv));
+    remove(pv);
+  }
+  /* the exact check after the rules: a sliver of 2e-5 m (volume fraction 4e-5, below
+   * quadrature.min_fraction) in the last cells makes their nodes look active before the rules,
+   * which drop those cells */
+  write_file(scene,
+             "{\"version\": 1, \"name\": \"inactive\","
+             " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0],"
+             " \"max\": [2, 1, 1]}, \"cells\": [4, 2, 2]},"
+             " \"geometry\": {\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [1.50002, 1, 1]},"
+             " \"material\": {\"model\": \"linear\", \"young\": 1e6, \"poisson\": 0.3},"
+             " \"effects\": [{\"fixed\": {\"region\": {\"half_space\": {\"point\": [1.9, 0, 0],"
+             " \"normal\": [1, 0, 0]}}}}]}");
   snprintf(cmd, sizeof cmd, "'%s' '%s' -o '%s' 2> '%s' > /dev/null", sim, scene, dir, err);
   TEST_TRUE(app_run(cmd) == 2);
   TEST_TRUE(file_has(err, "fcm-sim: scene inactive: effects[0]: the region's 9 background-mesh "
                           "nodes are all inactive"));
+  remove(out);
   remove(scene);
   remove(err);
   return TEST_RESULT();

@@ -210,7 +210,8 @@ int main(void)
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, empty_json, "empty.json", &scene));
   if (scene)
     TEST_ERR(ctx, fcm_simulation_create(ctx, scene, NULL, &sim), FCM_ERR_ARG,
-             "effects[1]: the region contains no background-mesh node");
+             "effects[1]: the fixed region (box [5, 5, 5] to [6, 6, 6]) contains no "
+             "background-mesh node");
   TEST_TRUE(sim == NULL);
   fcm_scene_destroy(&scene);
 

@@ -34,6 +34,10 @@ fcm_add_test(scene_geometry_keys tests/scene/geometry_keys.c)
 # geometry.surface and background.fit_background: parse errors of the new keys; a binary STL
 # cube and an open OBJ cube (refused, then closed with fill_holes) built on a fitted grid.
 fcm_add_test(scene_surface tests/scene/surface_scene.c)
+# fcm_simulation_write_preview() and the region check before the set-up: the coarse cell classes
+# (exact on axis-aligned faces, conservative on a ball against the rules), a region on inactive
+# nodes refused before the cell rules, the preview files counted by hand on a box grid.
+fcm_add_test(scene_preview tests/scene/preview_scene.c)
 # The cut effect: bodies and mass in the log across cuts, cuts at t = 0, no-op cuts, errors.
 fcm_add_test(scene_cut tests/scene/cut_scene.c)
 # Only the rule kinds a scene calls for: a static scene builds no mass rules (statistics,

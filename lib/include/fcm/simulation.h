@@ -195,11 +195,79 @@ typedef struct fcm_simulation fcm_simulation;
  * @param[in]  scene borrowed; must outlive the simulation
  * @param[in]  opts  NULL for defaults
  * @param[out] sim   the new simulation, NULL on failure
- * @return FCM_OK; FCM_ERR_ARG (a region naming a node out of range, or catching no node:
- *         "effects[i]: ..."); errors of the mesh, geometry, cell rules, space and integrator
- *         creation and setup; FCM_ERR_ALLOC. Allocates; not thread safe. */
+ * @return FCM_OK; FCM_ERR_ARG (a fixed or motion region naming a node out of range, catching
+ *         no node, or only nodes no cell with material uses: "effects[i]: ...", refused right
+ *         after the geometry, before the cell rules); errors of the mesh, geometry, cell rules,
+ * space and integrator creation and setup; FCM_ERR_ALLOC. Allocates; not thread safe. */
 FCM_API fcm_status fcm_simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
                                          const fcm_simulation_options *opts, fcm_simulation **sim);
+
+/** What an effect selects, in fcm_preview_effect.selects. */
+typedef enum fcm_preview_selects {
+  FCM_PREVIEW_NOTHING = 0, /**< no region: gravity, damping, cut */
+  FCM_PREVIEW_NODES,       /**< background nodes: fixed and motion with "region",
+                                initial_velocity */
+  FCM_PREVIEW_BOUNDARY     /**< embedded-boundary points: traction, pressure, fixed and motion
+                                with "boundary" */
+} fcm_preview_selects;
+
+/** What fcm_simulation_write_preview() found for one effect of the scene. */
+typedef struct fcm_preview_effect {
+  fcm_preview_selects selects;
+  fcm_index nodes;           /**< NODES: background nodes the region selects */
+  fcm_index active_nodes;    /**< NODES: of them, the active ones (the coarse classification) */
+  fcm_index boundary_points; /**< BOUNDARY: the surface's sample points in the region */
+  fcm_index cut_triangles;   /**< a cut: triangles of its surface (0: a plane missing the body) */
+} fcm_preview_effect;
+
+/** What fcm_simulation_write_preview() found and wrote. The cell classes are coarse: a cell is
+ * cut when a triangle of the embedded surface meets its bounding box (so it may hold no
+ * material, and the run may still drop it below quadrature.min_fraction), else wholly inside or
+ * outside the body; a node is active when a cell inside or cut uses it. */
+typedef struct fcm_simulation_preview_info {
+  fcm_element_type element; /**< of the background mesh */
+  fcm_index num_cells, num_nodes;
+  fcm_index cells[3];          /**< cells per fcm_cell_class: [FCM_CELL_UNCUT] inside,
+                                    [FCM_CELL_CUT] cut, [FCM_CELL_DROPPED] outside; without a
+                                    geometry every cell is inside */
+  fcm_index active_nodes;      /**< nodes a cell inside or cut uses */
+  fcm_index surface_triangles; /**< of the embedded surface (0: no geometry) */
+  fcm_index surface_samples;   /**< points on the surface the boundary regions are tested at:
+                                    per triangle a grid of n x n sub-triangles' centroids, n the
+                                    longest edge over sample_spacing rounded up (at most 16) */
+  double sample_spacing;       /**< the background cells' size, (box volume / cells)^(1/3), m */
+  int files;                   /**< files written, the .pvd included */
+} fcm_simulation_preview_info;
+
+/** Look at a scene before its expensive set-up: build only the background mesh and the embedded
+ * geometry (the first phases of fcm_simulation_create(), reported to opts->setup_phase the same
+ * way), classify the cells coarsely (fcm_simulation_preview_info), and write into the existing
+ * directory `dir`, atomically: <name>_preview_grid.vtu (the background cells with a cell array
+ * `class`, 0 inside, 1 cut, 2 outside, and a point array `active`), <name>_preview_surface.vtu
+ * (the embedded surface's triangles), <name>_preview_nodes.vtu (one vertex per node an effect
+ * selects, with point arrays `effect`, the effect's index, and `active`),
+ * <name>_preview_boundary_points.vtu (the surface's sample points each boundary effect selects,
+ * with `effect`), <name>_preview_cuts.vtu (the triangles of every cut surface, with cell arrays
+ * `effect` and `time`), each only when it has something, and <name>_preview.pvd naming them as
+ * the parts of one data set. Then the checks of fcm_simulation_create() on the regions run: the
+ * files show the region that fails.
+ * @param[in]  opts    NULL for defaults (only the progress callbacks are used)
+ * @param[out] info    may be NULL; filled once the files are written, also when a region fails
+ * @param[out] effects NULL, or fcm_scene_num_effects(scene) entries (caller's), effect i's counts
+ * @return FCM_OK; FCM_ERR_ARG (a region naming a node out of range, selecting no background node
+ *         or only inactive ones: "effects[i]: ..."); the errors of the mesh and geometry
+ *         creation; FCM_ERR_IO (naming the path); FCM_ERR_ALLOC. Allocates; not thread safe. */
+FCM_API fcm_status fcm_simulation_write_preview(fcm_ctx *ctx, const fcm_scene *scene,
+                                                const fcm_simulation_options *opts, const char *dir,
+                                                fcm_simulation_preview_info *info,
+                                                fcm_preview_effect *effects);
+
+/** Print what fcm_simulation_write_preview() found to `stream`: the background's cells by class
+ * and its active nodes, the surface, and per effect with a region the nodes (active ones) or
+ * boundary points it selects, per cut its triangles. effects may be NULL. */
+FCM_API void fcm_simulation_preview_view(const fcm_scene *scene,
+                                         const fcm_simulation_preview_info *info,
+                                         const fcm_preview_effect *effects, FILE *stream);
 
 /** Destroy; accepts NULL and `*sim == NULL`, sets `*sim = NULL`. */
 FCM_API void fcm_simulation_destroy(fcm_simulation **sim);

@@ -480,6 +480,17 @@ fcm_status fcm__cell_rules_create_distributed(fcm_ctx *ctx, const fcm_mesh *mesh
                                               fcm__rules_reduce *red, const fcm__rules_exchange *x,
                                               fcm_cell_rules **rules);
 
+/* ---------------------------------------------------------------- coarse classification */
+
+/* Classify the cells of `mesh` against geom's closed boundary cheaply, without clipping or rules
+ * (classify_coarse.c): cls[c] (num cells) FCM_CELL_CUT when a boundary triangle meets the
+ * bounding box of the cell's nodes (conservative: such a cell may still hold no material, and
+ * the rules build may drop a cut cell below min_fraction), else FCM_CELL_UNCUT (wholly inside the
+ * body) or FCM_CELL_DROPPED (wholly outside). counts (may be NULL): the cells of each class, by
+ * fcm_cell_class. Errors: FCM_ERR_ARG (NULL), FCM_ERR_ALLOC. Single-threaded. */
+fcm_status fcm__embed_classify_coarse(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                                      unsigned char *cls, fcm_index counts[3]);
+
 /* ---------------------------------------------------------------- surface moments */
 
 /* The Gauss rules on [0, 1] exact for degrees m, m + 1 and m + 2 and the triangle rule exact

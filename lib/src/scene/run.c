@@ -483,9 +483,7 @@ cleanup:
   return st;
 }
 
-/* The surface of cut effect c: the plane is clipped to the body's bounding box enlarged
- * by 10 % of its diagonal (before the transform). *surf NULL: a plane that misses the box. */
-static fcm_status cut_surface(fcm_simulation *S, const fcm_effect_cut *c, fcm_surface **surf)
+fcm_status fcm__sim_cut_surface(fcm_simulation *S, const fcm_effect_cut *c, fcm_surface **surf)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = S->ctx;
@@ -593,7 +591,7 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
    * process's cell mask, the new integrator gets the backend again (its cut hook, which
    * agrees first), and fcm__integrator_finish() at the end agrees on the outcome, so a
    * process that fails in the local work meets the others wherever they wait. */
-  FCM_TRY(ctx, cut_surface(S, &e->cut, &surf));
+  FCM_TRY(ctx, fcm__sim_cut_surface(S, &e->cut, &surf));
   S->cuts_applied++;
   S->c.cuts++;
   if (!surf) {
@@ -681,9 +679,7 @@ cleanup:
   return st;
 }
 
-/* The background mesh and the embedded geometry (S->mesh, S->nn, S->geom; no geometry for a
- * scene without one); errors of the inputs name the scene section they come from. */
-static fcm_status build_mesh_geometry(fcm_simulation *S)
+fcm_status fcm__sim_build_mesh_geometry(fcm_simulation *S)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = S->ctx;
@@ -737,7 +733,7 @@ fcm_status fcm__scene_mesh_geometry(fcm_ctx *ctx, const fcm_scene *scene, fcm_me
   S->scene = scene;
   S->opts = fcm_simulation_options_default();
   S->distributed = 1; /* the PETSc backend's partition and linear driver */
-  FCM_TRY(ctx, build_mesh_geometry(S));
+  FCM_TRY(ctx, fcm__sim_build_mesh_geometry(S));
   *mesh = S->mesh;
   *geom = S->geom;
   S->mesh = NULL;
@@ -835,8 +831,10 @@ fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
             S->opts.rules_progress_interval);
 
   double tp = fcm_wtime(); /* the phases' times */
-  FCM_TRY(ctx, build_mesh_geometry(S));
+  FCM_TRY(ctx, fcm__sim_build_mesh_geometry(S));
   S->c.time_setup_geometry = fcm_wtime() - tp;
+  /* a region that can hold nothing is refused now, not after the cell rules */
+  FCM_TRY(ctx, fcm__sim_check_regions(S));
   const fcm_scene_geometry *g = fcm_scene_get_geometry(scene);
 
   /* cell rules only when the scene embeds a geometry */

@@ -44,30 +44,18 @@ static void surface_field(void *user, const double x[3], const double normal[3],
   }
 }
 
-/* Background nodes of a region: count only (nodes NULL) or fill. A region without a node, or
- * whose nodes are all inactive (no active cell uses them: they would hold nothing), is an
- * error. */
+/* Background nodes of a region: count only (nodes NULL) or fill. A region naming a node out of
+ * range or without a node, or whose nodes are all inactive (no active cell uses them: they would
+ * hold nothing), is an error; fcm__sim_check_regions() refused those before the set-up already,
+ * by the coarse classification of the cells, and this is the exact check. */
 static fcm_status region_nodes(fcm_simulation *S, const fcm_region *r, int effect_index,
                                fcm_index *nodes, fcm_index *count)
 {
   fcm_status st = FCM_OK;
-  const double *X = fcm_mesh_coords(S->mesh);
-  fcm_index n = 0, active = 0;
-  if (r->kind == FCM_REGION_NODES) {
-    for (fcm_index k = 0; k < r->num_nodes; k++) {
-      FCM_CHECK(r->nodes[k] >= 0 && r->nodes[k] < S->nn, S->ctx, FCM_ERR_ARG,
-                "scene %s: effects[%d]: node %lld out of range [0, %lld)", fcm_scene_name(S->scene),
-                effect_index, (long long)r->nodes[k], (long long)S->nn);
-      if (nodes) nodes[n] = r->nodes[k];
-      n++;
-    }
-  } else {
-    for (fcm_index a = 0; a < S->nn; a++)
-      if (fcm_region_contains(r, X + 3 * a)) {
-        if (nodes) nodes[n] = a;
-        n++;
-      }
-  }
+  fcm_index active = 0, bad = -1;
+  const fcm_index n = fcm__sim_select_nodes(S->mesh, r, nodes, &bad);
+  FCM_CHECK(bad < 0, S->ctx, FCM_ERR_ARG, "scene %s: effects[%d]: node %lld out of range [0, %lld)",
+            fcm_scene_name(S->scene), effect_index, (long long)bad, (long long)S->nn);
   FCM_CHECK(n > 0, S->ctx, FCM_ERR_ARG,
             "scene %s: effects[%d]: the region contains no background-mesh node",
             fcm_scene_name(S->scene), effect_index);

@@ -148,6 +148,28 @@ void fcm__sim_count_frame(fcm_simulation_counters *c, long long step, fcm_index 
  * output's element map are replaced; the state carries over (run.c). */
 fcm_status fcm__sim_apply_cut(fcm_simulation *S);
 
+/* The background mesh and the embedded geometry (S->mesh, S->nn, S->geom; no geometry for a
+ * scene without one), the set-up's first phases; errors of the inputs name the scene section
+ * they come from (run.c). */
+fcm_status fcm__sim_build_mesh_geometry(fcm_simulation *S);
+
+/* The surface of cut effect c: the plane is clipped to the body's bounding box enlarged by 10 %
+ * of its diagonal (before the transform). *surf NULL: a plane that misses the box (run.c). */
+fcm_status fcm__sim_cut_surface(fcm_simulation *S, const fcm_effect_cut *c, fcm_surface **surf);
+
+/* The background nodes of region r (box, half-space, all: by position; nodes: by id) into nodes
+ * (NULL: count only), ascending; their count. Ids of a nodes region outside [0, num nodes) are
+ * left out, the first of them in *bad (-1: none; bad may be NULL). No allocation (preview.c). */
+fcm_index fcm__sim_select_nodes(const fcm_mesh *mesh, const fcm_region *r, fcm_index *nodes,
+                                fcm_index *bad);
+
+/* Refuse, before the set-up's cell rules, a fixed or motion effect whose region names a node out
+ * of range, selects no background node, or only nodes that no cell with material uses, by the
+ * coarse classification of the cells against the geometry's surface
+ * (fcm__embed_classify_coarse(): conservative, so the exact check after the rules stays):
+ * FCM_ERR_ARG naming effects[i], the region and the counts; FCM_ERR_ALLOC (preview.c). */
+fcm_status fcm__sim_check_regions(fcm_simulation *S);
+
 /* The background mesh and the embedded geometry of a scene (NULL when it has none), built as
  * fcm_simulation_create() builds them, for a driver of its own (the PETSc backend, fcm/petsc.h);
  * the caller destroys both (run.c). */
