@@ -45,6 +45,13 @@ foreach(scene IN LISTS fcm_check_scenes)
   fcm_add_test(app_sim_check_${scene} tests/apps/sim_app.c LABELS ${labels} TIMEOUT 900
                ARGS check $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR}/apps/scenes/${scene}.json)
 endforeach()
+# apps/docs/tutorial.md as written: each of its sh blocks in order in a fresh directory with the
+# programs on PATH (exit 0, the files it names, the output lines it shows), then the log's facts
+# it states; its model is cut, which needs the body's volume mesh: only with Gmsh.
+if(FCM_HAVE_GMSH)
+  fcm_add_test(app_tutorial tests/apps/tutorial_app.c LABELS app TIMEOUT 300
+               ARGS ${PROJECT_SOURCE_DIR}/apps/docs/tutorial.md $<TARGET_FILE_DIR:fcm-sim> ${work})
+endif()
 # fcm-sim and the embedding diagnostics: the outside-volume warning (half a box beyond +x),
 # a body wholly outside and a bad voxel image exit 2 naming the scene section (traceback
 # only with --debug), --progress off a terminal: the level-set and cell-rule progress, and the
