@@ -103,7 +103,8 @@ static void usage(FILE *f, const cli_option *opts)
           "Frames go to the scene's output directory: <name>_background_NNNN.vtu,\n"
           "<name>_surface_NNNN.vtu, <name>_background.pvd, <name>_surface.pvd (open the .pvd\n"
           "files in ParaView) and the per-step log <name>_log.csv. Example scenes, among them\n"
-          "a steel cantilever under its own weight: apps/scenes/.\n"
+          "a steel cantilever under its own weight: apps/scenes/. A first scene from your own\n"
+          "model, step by step: apps/docs/tutorial.md.\n"
           "\n"
           "options:\n");
   cli_print_options(f, opts);
