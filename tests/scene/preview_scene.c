@@ -136,28 +136,29 @@ static void check_refused(fcm_ctx *ctx)
   fcm_scene_destroy(&scene);
 }
 
-/* The values of an Int32 point array of a VTU (n of them into out, at most cap); -1: missing. */
-static long long int32_points(const vr_doc *d, const char *name, int32_t *out, size_t cap)
+/* The values of the array `name` of section `parent` of a VTU ("Points", name NULL: the
+ * points), items of `size` bytes, at most cap into out; their count, -1 when it is missing. */
+static long long read_array(const vr_doc *d, const char *parent, const char *name, size_t size,
+                            void *out, size_t cap)
 {
-  const vr_tag *t = vr_data_array(d, "PointData", name);
+  const vr_tag *t = vr_data_array(d, parent, name);
   if (!t) return -1;
   uint64_t bytes;
   const unsigned char *p = vr_array(d, t, &bytes);
-  const size_t n = bytes / 4 < cap ? bytes / 4 : cap;
-  memcpy(out, p, n * 4);
+  const size_t n = bytes / size < cap ? bytes / size : cap;
+  memcpy(out, p, n * size);
   return (long long)n;
 }
 
-/* The points of a VTU (n x 3 into x, at most cap points); -1: missing. */
+/* Int32 point arrays and the points (x 3) of a VTU. */
+static long long int32_points(const vr_doc *d, const char *name, int32_t *out, size_t cap)
+{
+  return read_array(d, "PointData", name, 4, out, cap);
+}
+
 static long long points(const vr_doc *d, double *x, size_t cap)
 {
-  const vr_tag *t = vr_data_array(d, "Points", NULL);
-  if (!t) return -1;
-  uint64_t bytes;
-  const unsigned char *p = vr_array(d, t, &bytes);
-  const size_t n = bytes / 24 < cap ? bytes / 24 : cap;
-  memcpy(x, p, n * 24);
-  return (long long)n;
+  return read_array(d, "Points", NULL, 24, x, cap);
 }
 
 static int load_vtu(vr_doc *d, const char *dir, const char *part)

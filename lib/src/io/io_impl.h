@@ -76,6 +76,14 @@ void fcm__io_format_double(double x, char buf[32]);
 fcm_status fcm__vtu_write_fault(fcm_vtu *vtu, const char *path, fcm_vtu_info *info,
                                 const fcm__io_fault *fault);
 
+/* A PVD collection of one data set in parts (at time 0): part i is the file files[i] (relative
+ * to the index's directory) named names[i]; n in [0, FCM__PVD_MAX_PARTS]. Written atomically to
+ * `path`.
+ * FCM_ERR_ARG (a name or file empty or unprintable), FCM_ERR_IO, FCM_ERR_ALLOC. */
+#define FCM__PVD_MAX_PARTS 16
+fcm_status fcm__pvd_write_parts(fcm_ctx *ctx, const char *path, int n, const char *const *names,
+                                const char *const *files);
+
 /* fcm_pvd_add() with a fault plan (tests only). */
 fcm_status fcm__pvd_add_fault(fcm_pvd *pvd, double time, const char *file,
                               const fcm__io_fault *fault);

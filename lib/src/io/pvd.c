@@ -18,15 +18,17 @@ struct fcm_pvd {
   fcm_index num_entries, cap_entries;
 };
 
-/* Write the index with its first n entries. */
-static fcm_status rewrite(fcm_pvd *pvd, fcm_index n, const fcm__io_fault *fault)
+/* Write a collection of n entries to `path`: the data set entries[i].file at entries[i].time;
+ * names NULL: all part 0 (a time series); else entry i is part i, named names[i]. */
+static fcm_status write_collection(fcm_ctx *ctx, const char *path, fcm_index n,
+                                   const pvd_entry *entries, const char *const *names,
+                                   const fcm__io_fault *fault)
 {
   fcm_status st = FCM_OK;
-  fcm_ctx *ctx = pvd->ctx;
   fcm__atomic_file af;
   char num[32];
   memset(&af, 0, sizeof af);
-  FCM_TRY(ctx, fcm__io_atomic_open(ctx, pvd->path, 0, fault, &af));
+  FCM_TRY(ctx, fcm__io_atomic_open(ctx, path, 0, fault, &af));
   FCM_TRY(ctx, fcm__io_atomic_printf(ctx, &af,
                                      "<?xml version=\"1.0\"?>\n"
                                      "<VTKFile type=\"Collection\" version=\"0.1\" "
@@ -34,16 +36,48 @@ static fcm_status rewrite(fcm_pvd *pvd, fcm_index n, const fcm__io_fault *fault)
                                      "  <Collection>\n",
                                      fcm__io_byte_order()));
   for (fcm_index i = 0; i < n; i++) {
-    fcm__io_format_double(pvd->entries[i].time, num);
-    FCM_TRY(ctx, fcm__io_atomic_printf(
-                     ctx, &af, "    <DataSet timestep=\"%s\" group=\"\" part=\"0\" file=\"", num));
-    FCM_TRY(ctx, fcm__io_atomic_write_xml(ctx, &af, pvd->entries[i].file));
+    fcm__io_format_double(entries[i].time, num);
+    FCM_TRY(ctx, fcm__io_atomic_printf(ctx, &af,
+                                       "    <DataSet timestep=\"%s\" group=\"\" part=\"%lld\" ",
+                                       num, names ? (long long)i : 0LL));
+    if (names) {
+      FCM_TRY(ctx, fcm__io_atomic_printf(ctx, &af, "name=\""));
+      FCM_TRY(ctx, fcm__io_atomic_write_xml(ctx, &af, names[i]));
+      FCM_TRY(ctx, fcm__io_atomic_printf(ctx, &af, "\" "));
+    }
+    FCM_TRY(ctx, fcm__io_atomic_printf(ctx, &af, "file=\""));
+    FCM_TRY(ctx, fcm__io_atomic_write_xml(ctx, &af, entries[i].file));
     FCM_TRY(ctx, fcm__io_atomic_printf(ctx, &af, "\"/>\n"));
   }
   FCM_TRY(ctx, fcm__io_atomic_printf(ctx, &af, "  </Collection>\n</VTKFile>\n"));
   FCM_TRY(ctx, fcm__io_atomic_commit(ctx, &af));
 cleanup:
   fcm__io_atomic_abort(ctx, &af);
+  return st;
+}
+
+/* Write the index with its first n entries. */
+static fcm_status rewrite(fcm_pvd *pvd, fcm_index n, const fcm__io_fault *fault)
+{
+  return write_collection(pvd->ctx, pvd->path, n, pvd->entries, NULL, fault);
+}
+
+fcm_status fcm__pvd_write_parts(fcm_ctx *ctx, const char *path, int n, const char *const *names,
+                                const char *const *files)
+{
+  fcm_status st = FCM_OK;
+  pvd_entry parts[FCM__PVD_MAX_PARTS];
+  FCM_CHECK(n >= 0 && n <= FCM__PVD_MAX_PARTS && fcm__io_printable(path), ctx, FCM_ERR_ARG,
+            "pvd: %d parts outside [0, %d], or the path is empty or unprintable", n,
+            FCM__PVD_MAX_PARTS);
+  for (int i = 0; i < n; i++) {
+    FCM_CHECK(fcm__io_printable(names[i]) && fcm__io_printable(files[i]), ctx, FCM_ERR_ARG,
+              "pvd '%s': part %d has an empty or unprintable name or file", path, i);
+    parts[i].time = 0.0;
+    parts[i].file = (char *)files[i]; /* read only */
+  }
+  FCM_TRY(ctx, write_collection(ctx, path, n, parts, names, NULL));
+cleanup:
   return st;
 }
 

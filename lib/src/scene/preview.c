@@ -211,35 +211,19 @@ cleanup:
   return st;
 }
 
-/* <dir>/<name>_preview.pvd: the parts of one data set at time 0. */
+/* <dir>/<name>_preview.pvd: the parts of one data set. */
 static fcm_status write_pvd(preview *P)
 {
   fcm_status st = FCM_OK;
-  fcm_ctx *ctx = P->S->ctx;
-  fcm__atomic_file af;
-  char path[4096], file[4200];
-  memset(&af, 0, sizeof af);
+  char path[4096], files[5][512];
+  const char *names[5] = {NULL}, *file[5] = {NULL};
   snprintf(path, sizeof path, "%s/%s_preview.pvd", P->dir, P->name);
-  FCM_TRY(ctx, fcm__io_atomic_open(ctx, path, 0, NULL, &af));
-  FCM_TRY(ctx, fcm__io_atomic_printf(ctx, &af,
-                                     "<?xml version=\"1.0\"?>\n"
-                                     "<VTKFile type=\"Collection\" version=\"0.1\" "
-                                     "byte_order=\"%s\">\n"
-                                     "  <Collection>\n",
-                                     fcm__io_byte_order()));
   for (int k = 0; k < P->num_parts; k++) {
-    snprintf(file, sizeof file, "%s_preview_%s.vtu", P->name, P->parts[k]);
-    FCM_TRY(ctx,
-            fcm__io_atomic_printf(ctx, &af, "    <DataSet timestep=\"0\" part=\"%d\" name=\"", k));
-    FCM_TRY(ctx, fcm__io_atomic_write_xml(ctx, &af, P->parts[k]));
-    FCM_TRY(ctx, fcm__io_atomic_printf(ctx, &af, "\" file=\""));
-    FCM_TRY(ctx, fcm__io_atomic_write_xml(ctx, &af, file));
-    FCM_TRY(ctx, fcm__io_atomic_printf(ctx, &af, "\"/>\n"));
+    snprintf(files[k], sizeof files[k], "%s_preview_%s.vtu", P->name, P->parts[k]);
+    names[k] = P->parts[k], file[k] = files[k];
   }
-  FCM_TRY(ctx, fcm__io_atomic_printf(ctx, &af, "  </Collection>\n</VTKFile>\n"));
-  FCM_TRY(ctx, fcm__io_atomic_commit(ctx, &af));
+  FCM_TRY(P->S->ctx, fcm__pvd_write_parts(P->S->ctx, path, P->num_parts, names, file));
 cleanup:
-  fcm__io_atomic_abort(ctx, &af);
   return st;
 }
 
