@@ -77,18 +77,61 @@ static const char small_scene[] =
     "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, 0, "
     "0]}}}}]}";
 
+/* The numbers after `key` in the first line of the file `path` holding it (at most n); their
+ * count. */
+static int numbers_after(const char *path, const char *key, long long *v, int n)
+{
+  char line[4096];
+  int m = 0;
+  FILE *f = fopen(path, "r");
+  while (f && fgets(line, sizeof line, f)) {
+    const char *p = strstr(line, key);
+    if (!p) continue;
+    for (p += strlen(key); *p && m < n; p++)
+      if (*p >= '0' && *p <= '9') {
+        char *end;
+        v[m++] = strtoll(p, &end, 10);
+        p = end - 1;
+      }
+    break;
+  }
+  if (f) fclose(f);
+  return m;
+}
+
+/* --check runs (at most 3 steps, finite, the summary); --preview writes its files, and its
+ * coarse cell classes are conservative against the rules' (a cell inside is uncut, one outside
+ * dropped, every cut cell is cut). */
 static int mode_check(const char *sim, const char *scene)
 {
-  char cmd[8192], out[1024];
+  char cmd[8192], out[1024], pv[1024], dir[64] = "/tmp/fcm-sim-preview-XXXXXX";
   snprintf(out, sizeof out, "%s.check-%ld.txt", "/tmp/fcm-sim-check", (long)getpid());
-  if (!strcmp(scene, "-"))
-    snprintf(cmd, sizeof cmd, "'%s' --check > '%s' 2> /dev/null", sim, out);
-  else
-    snprintf(cmd, sizeof cmd, "'%s' '%s' --check > '%s' 2> /dev/null", sim, scene, out);
+  snprintf(pv, sizeof pv, "%s.preview-%ld.txt", "/tmp/fcm-sim-check", (long)getpid());
+  if (!mkdtemp(dir)) return 1;
+  const char *file = strcmp(scene, "-") ? scene : "";
+  snprintf(cmd, sizeof cmd, "'%s' %s%s%s --check > '%s' 2> /dev/null", sim, *file ? "'" : "", file,
+           *file ? "'" : "", out);
   TEST_TRUE(app_run(cmd) == 0);
   TEST_TRUE(file_has(out, "steps,") || file_has(out, " steps, "));
   TEST_TRUE(file_has(out, "computed  inertia") || file_has(out, "skipped   inertia"));
+  snprintf(cmd, sizeof cmd, "'%s' %s%s%s --preview -o '%s' > '%s' 2> /dev/null", sim,
+           *file ? "'" : "", file, *file ? "'" : "", dir, pv);
+  TEST_TRUE(app_run(cmd) == 0);
+  long long exact[4], coarse[5];
+  if (numbers_after(out, "  cells     ", exact, 4) == 4 &&
+      numbers_after(pv, "  background  ", coarse, 5) == 5) {
+    /* coarse: the element's digits, cells, inside, cut, outside; exact: cells, uncut, cut,
+     * dropped */
+    TEST_TRUE(coarse[1] == exact[0]);
+    TEST_TRUE(coarse[2] <= exact[1] && coarse[4] <= exact[3] && exact[2] <= coarse[3]);
+  }
+  snprintf(cmd, sizeof cmd, "test -s \"$(ls '%s'/*_preview.pvd)\" && ls '%s'/*_preview_grid.vtu",
+           dir, dir);
+  TEST_TRUE(app_run(cmd) == 0 && file_has(pv, "preview of scene"));
+  snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+  app_run(cmd);
   remove(out);
+  remove(pv);
   return TEST_RESULT();
 }
 
