@@ -4,6 +4,7 @@
 #include "scene_util.h"
 
 #include "../io/vtk_reader.h"
+#include "alloc_loop.h"
 #include "embed/embed_impl.h"
 
 #include <math.h>
@@ -259,6 +260,35 @@ static void check_files(fcm_ctx *ctx, const char *dir)
   fcm_scene_destroy(&scene);
 }
 
+/* The allocation-failure loop over fcm_simulation_write_preview(): FCM_ERR_ALLOC, no leak. */
+typedef struct preview_call {
+  fcm_ctx *ctx;
+  const fcm_scene *scene;
+  const char *dir;
+} preview_call;
+
+static fcm_status call_preview(void *user)
+{
+  preview_call *c = user;
+  fcm_simulation_preview_info info;
+  fcm_preview_effect eff[3];
+  return fcm_simulation_write_preview(c->ctx, c->scene, NULL, c->dir, &info, eff);
+}
+
+static void check_alloc(const char *dir)
+{
+  failing f;
+  fcm_ctx *ctx = failing_ctx(&f);
+  fcm_scene *scene = NULL;
+  if (!ctx) return;
+  TEST_OK(ctx, fcm_scene_create_from_string(ctx, good_scene, NULL, &scene));
+  preview_call c = {ctx, scene, dir};
+  if (scene) alloc_loop(ctx, &f, "write_preview", call_preview, NULL, &c, 20, 5000);
+  fcm_scene_destroy(&scene);
+  TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
+  fcm_ctx_destroy(&ctx);
+}
+
 int main(void)
 {
   fcm_ctx *ctx = NULL;
@@ -267,6 +297,7 @@ int main(void)
   check_classes(ctx);
   check_refused(ctx);
   check_files(ctx, dir);
+  check_alloc(dir);
   vr_rmdir(dir);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
