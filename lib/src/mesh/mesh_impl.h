@@ -20,6 +20,12 @@ struct fcm_mesh {
   fcm_index *neighbors; /* num_cells x info->num_faces, -1 on the boundary */
   fcm_index num_boundary;
   fcm_index *boundary; /* num_boundary x 2: (cell, local face) */
+  /* Octree meshes (mesh_octree.c); NULL / 0 for every other mesh. */
+  unsigned char *cell_level; /* num_cells: refinement level of each cell */
+  int max_level;             /* deepest level */
+  fcm_index num_hanging;     /* (cell, node) pairs: node on cell's boundary, not its node */
+  fcm_index *hang_cell, *hang_node;
+  double *hang_xi; /* num_hanging x 3: the node's reference coordinates in the cell (exact) */
 };
 
 /* Create a mesh that takes ownership of `*coords` and `*cells` (allocated with
