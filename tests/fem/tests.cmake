@@ -67,3 +67,8 @@ endforeach()
 foreach(el tet4 tet10 hex8 hex20)
   fcm_add_test(fem_cut_surface_${el} tests/fem/cut_surface.c ARGS ${el})
 endforeach()
+# Octree backgrounds: continuity through the hanging-node constraints and patch tests across
+# hanging nodes (affine fields; quadratic ones for Hex20).
+foreach(el hex8 hex20)
+  fcm_add_test(fem_octree_patch_${el} tests/fem/octree_patch.c ARGS ${el} LABELS conformance)
+endforeach()
