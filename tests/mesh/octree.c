@@ -32,6 +32,12 @@ static void cell_box(const fcm_mesh *m, fcm_index c, double lo[3], double hi[3])
     lo[d] = X[3 * cn[0] + d], hi[d] = X[3 * cn[6] + d];
 }
 
+static int failing(const double lo[3], const double hi[3], int level, void *user)
+{
+  (void)lo, (void)hi, (void)user;
+  return level == 1 ? -1 : 1;
+}
+
 static unsigned long long seed = 7;
 static double urand01(void)
 {
@@ -184,6 +190,12 @@ static int check(fcm_element_type type)
   o.surface_level = 2;
   TEST_ERR(ctx, fcm_mesh_create_octree(ctx, type, lo, hi, n, &o, &m), FCM_ERR_ARG,
            "needs a surface level set");
+  o = fcm_octree_options_default();
+  o.refine = failing;
+  o.refine_level = 3;
+  TEST_ERR(ctx, fcm_mesh_create_octree(ctx, type, lo, hi, n, &o, &m), FCM_ERR_ARG,
+           "refine callback failed (returned -1) on the level 1 cell");
+  TEST_TRUE(m == NULL);
   TEST_ERR(ctx, fcm_mesh_create_octree(ctx, FCM_ELEMENT_TET4, lo, hi, n, NULL, &m),
            FCM_ERR_UNSUPPORTED, "octree refinement needs hexahedra");
   TEST_ERR(ctx, fcm_mesh_create_octree(ctx, FCM_ELEMENT_TET10, lo, hi, n, NULL, &m),

@@ -61,7 +61,9 @@ FCM_API fcm_status fcm_mesh_create_box(fcm_ctx *ctx, fcm_element_type type, cons
 /** Scalar level set phi(x) (the refinement surface is phi = 0); same signature as
  * fcm_level_set_fn of fcm/levelset.h. */
 typedef double (*fcm_octree_levelset_fn)(const double x[3], void *user);
-/** Refinement predicate: nonzero to split the cell [lo, hi] of `level` into eight. */
+/** Refinement predicate: 1 to split the cell [lo, hi] of `level` into eight, 0 to keep it,
+ * negative when it failed (fcm_mesh_create_octree() then fails with FCM_ERR_ARG naming the
+ * cell; the callback records its own error where it can). */
 typedef int (*fcm_octree_refine_fn)(const double lo[3], const double hi[3], int level, void *user);
 
 /** Refinement criteria of fcm_mesh_create_octree(). A cell is split while one criterion
@@ -98,7 +100,8 @@ FCM_API fcm_octree_options fcm_octree_options_default(void);
  * @param[out] mesh  the new mesh, NULL on failure
  * @return FCM_OK; FCM_ERR_UNSUPPORTED (a tetrahedral type); FCM_ERR_ARG (NULL, box or counts
  *         as fcm_mesh_create_box(), a level beyond FCM_OCTREE_MAX_LEVEL, more than
- *         FCM_OCTREE_MAX_CELLS cells, a criterion level without its function); FCM_ERR_ALLOC.
+ *         FCM_OCTREE_MAX_CELLS cells, a criterion level without its function, a failing
+ *         refine callback); FCM_ERR_ALLOC.
  * Allocates; release with fcm_mesh_destroy(). Thread safe (the callbacks permitting). */
 FCM_API fcm_status fcm_mesh_create_octree(fcm_ctx *ctx, fcm_element_type type, const double lo[3],
                                           const double hi[3], const fcm_index n[3],

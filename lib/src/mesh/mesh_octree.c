@@ -139,7 +139,7 @@ static int levelset_crosses(fcm_octree_levelset_fn phi, void *user, const double
   return 0;
 }
 
-/* Whether some criterion asks to split leaf l. */
+/* Whether some criterion asks to split leaf l: 1 or 0, negative when the callback failed. */
 static int wants_split(const octree *T, const leaf *l)
 {
   const fcm_octree_options *o = T->o;
@@ -154,8 +154,7 @@ static int wants_split(const octree *T, const leaf *l)
   if (o->surface && l->level < o->surface_level &&
       levelset_crosses(o->surface, o->surface_user, blo, bhi))
     return 1;
-  if (o->refine && l->level < o->refine_level && o->refine(blo, bhi, l->level, o->refine_user))
-    return 1;
+  if (o->refine && l->level < o->refine_level) return o->refine(blo, bhi, l->level, o->refine_user);
   return 0;
 }
 
@@ -167,8 +166,18 @@ static fcm_status refine(octree *T)
   for (;;) {
     FCM_ALLOC(T->ctx, T->num, flag);
     fcm_index nflag = 0;
-    for (fcm_index c = 0; c < T->num; c++)
-      nflag += flag[c] = (unsigned char)wants_split(T, T->leaves + c);
+    for (fcm_index c = 0; c < T->num; c++) {
+      const int w = wants_split(T, T->leaves + c);
+      if (w < 0) {
+        double blo[3], bhi[3];
+        leaf_box(T, T->leaves + c, blo, bhi);
+        FCM_CHECK(0, T->ctx, FCM_ERR_ARG,
+                  "mesh_create_octree: the refine callback failed (returned %d) on the level %d "
+                  "cell [%g, %g] x [%g, %g] x [%g, %g]",
+                  w, T->leaves[c].level, blo[0], bhi[0], blo[1], bhi[1], blo[2], bhi[2]);
+      }
+      nflag += flag[c] = (unsigned char)(w > 0);
+    }
     if (nflag == 0) break;
     FCM_TRY(T->ctx, split_flagged(T, flag, nflag));
     FCM_FREE(T->ctx, flag);

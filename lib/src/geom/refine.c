@@ -1,0 +1,71 @@
+/* Octree refinement along an embedded geometry's boundary: the cells its boundary triangles
+ * cross, as a refine callback of fcm_mesh_create_octree(). */
+#include "geom_impl.h"
+
+#include <math.h>
+
+/* Whether the triangle v (3 x 3, relative to the box centre) meets the closed box of half
+ * sizes h: no separating axis among the box axes, the triangle's normal and the nine cross
+ * products of box axes and triangle edges (Akenine-Moeller's test). */
+static int triangle_meets_box(double v[3][3], const double h[3])
+{
+  for (int d = 0; d < 3; d++) {
+    const double lo = fmin(v[0][d], fmin(v[1][d], v[2][d]));
+    const double hi = fmax(v[0][d], fmax(v[1][d], v[2][d]));
+    if (lo > h[d] || hi < -h[d]) return 0;
+  }
+  double e[3][3];
+  for (int k = 0; k < 3; k++)
+    for (int d = 0; d < 3; d++)
+      e[k][d] = v[(k + 1) % 3][d] - v[k][d];
+  double axes[10][3];
+  axes[0][0] = e[0][1] * e[1][2] - e[0][2] * e[1][1]; /* normal */
+  axes[0][1] = e[0][2] * e[1][0] - e[0][0] * e[1][2];
+  axes[0][2] = e[0][0] * e[1][1] - e[0][1] * e[1][0];
+  for (int k = 0; k < 3; k++)
+    for (int d = 0; d < 3; d++) { /* unit vector u_d x e_k */
+      double *a = axes[1 + 3 * k + d];
+      a[d] = 0.0;
+      a[(d + 1) % 3] = -e[k][(d + 2) % 3];
+      a[(d + 2) % 3] = e[k][(d + 1) % 3];
+    }
+  for (int i = 0; i < 10; i++) {
+    const double *a = axes[i];
+    const double r = h[0] * fabs(a[0]) + h[1] * fabs(a[1]) + h[2] * fabs(a[2]);
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (int k = 0; k < 3; k++) {
+      const double p = a[0] * v[k][0] + a[1] * v[k][1] + a[2] * v[k][2];
+      lo = fmin(lo, p), hi = fmax(hi, p);
+    }
+    if (lo > r || hi < -r) return 0;
+  }
+  return 1;
+}
+
+int fcm_geometry_refine_boundary(const double lo[3], const double hi[3], int level, void *geometry)
+{
+  const fcm_geometry *g = geometry;
+  const fcm_aabb_tree *tree = NULL;
+  fcm__idbuf buf = {NULL, 0, 0};
+  int meets = 0;
+  (void)level;
+  if (!g || !lo || !hi) return -1;
+  if (fcm__geom_tree(g->ctx, g, 1, &tree) != FCM_OK) return -1;
+  if (fcm__geom_tree_query(g->ctx, tree, lo, hi, &buf) != FCM_OK) {
+    fcm__geom_idbuf_free(g->ctx, &buf);
+    return -1;
+  }
+  double c[3], h[3];
+  for (int d = 0; d < 3; d++)
+    c[d] = 0.5 * (lo[d] + hi[d]), h[d] = 0.5 * (hi[d] - lo[d]);
+  for (size_t i = 0; i < buf.n && !meets; i++) {
+    const fcm_index *t = g->tris + 3 * buf.ids[i];
+    double v[3][3];
+    for (int k = 0; k < 3; k++)
+      for (int d = 0; d < 3; d++)
+        v[k][d] = g->coords[3 * t[k] + d] - c[d];
+    meets = triangle_meets_box(v, h);
+  }
+  fcm__geom_idbuf_free(g->ctx, &buf);
+  return meets;
+}
