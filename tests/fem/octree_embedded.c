@@ -1,6 +1,7 @@
 /* An embedded ball in an octree background refined along its boundary (Hex8, Hex20): every cell
  * the boundary crosses is at the finest level, the cut-cell rules' volume of the octree's cells
- * of all sizes sums to the ball's volume, the constrained mass totals rho |ball|, and what the
+ * of all sizes sums to the ball's volume (also after refining the cells of small volume
+ * fraction once more), the constrained mass totals rho |ball|, and what the
  * hanging-node constraints do not cover is refused: cuts, the integrators, the multigrid. */
 #include "fem_util.h"
 
@@ -48,6 +49,29 @@ int main(int argc, char **argv)
   const fcm_cell_rules_stats *stats = fcm_cell_rules_get_stats(rules);
   TEST_NEAR(vol, stats->embedded_volume, 1e-12, 0.0);
   TEST_NEAR(stats->embedded_volume, fcm_geometry_volume(ball), 1e-10, 0.0);
+
+  /* refine the cut cells with a small volume fraction once more: the new mesh's rules still
+   * hold the whole ball, and those regions are now one level finer */
+  {
+    unsigned char *flags = calloc((size_t)nc, 1);
+    fcm_index nflag = 0;
+    for (fcm_index k = 0; k < nc; k++) {
+      const double phi = fcm_cell_rules_volume_fraction(rules, k);
+      nflag += flags[k] = phi > 1e-9 && phi < 0.15;
+    }
+    TEST_TRUE(nflag > 0);
+    fcm_mesh *fine = NULL;
+    fcm_cell_rules *fine_rules = NULL;
+    TEST_OK(ctx, fcm_mesh_refine_octree(ctx, mesh, flags, &fine));
+    TEST_TRUE(fcm_mesh_max_level(fine) == 3);
+    TEST_TRUE(fcm_mesh_num_cells(fine) >= nc + 7 * nflag);
+    TEST_OK(ctx, fcm_cell_rules_create(ctx, fine, ball, &ro, &fine_rules));
+    TEST_NEAR(fcm_cell_rules_get_stats(fine_rules)->embedded_volume, fcm_geometry_volume(ball),
+              1e-10, 0.0);
+    fcm_cell_rules_destroy(&fine_rules);
+    fcm_mesh_destroy(&fine);
+    free(flags);
+  }
 
   /* the constrained mass (T^T M T) totals rho |kept ball| */
   TEST_OK(ctx, fcm_space_create_embedded(ctx, mesh, rules, &space));

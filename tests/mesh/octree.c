@@ -45,33 +45,18 @@ static double urand01(void)
   return (double)(seed >> 11) / 9007199254740992.0;
 }
 
-static int check(fcm_element_type type)
+/* The geometric checks of an octree mesh over the unit box (criteria of check(): with_levels,
+ * the levels those criteria give). */
+static void check_mesh(fcm_ctx *ctx, const fcm_mesh *m, fcm_element_type type, int with_levels)
 {
-  fcm_ctx *ctx = NULL;
-  fcm_mesh *m = NULL;
-  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
-  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
-  const fcm_index n[3] = {2, 2, 2};
-  fcm_octree_options o = fcm_octree_options_default();
-  o.surface = sphere;
-  o.surface_level = 3;
-  o.region_level = 1;
-  o.region_lo[0] = o.region_lo[1] = o.region_lo[2] = 0.9;
-  o.region_hi[0] = o.region_hi[1] = o.region_hi[2] = 1.0;
-  o.refine = near_corner;
-  o.refine_level = 4;
-  TEST_OK(ctx, fcm_mesh_create_octree(ctx, type, lo, hi, n, &o, &m));
-  TEST_TRUE(fcm_mesh_is_octree(m));
-  TEST_TRUE(fcm_mesh_max_level(m) == 4);
-  TEST_TRUE(fcm_mesh_num_hanging(m) > 0);
   const fcm_index nc = fcm_mesh_num_cells(m);
   double *B = malloc(sizeof *B * 6 * (size_t)nc);
   double vol = 0.0;
-  int seen[5] = {0};
+  int seen[FCM_OCTREE_MAX_LEVEL + 1] = {0};
   for (fcm_index c = 0; c < nc; c++) {
     cell_box(m, c, B + 6 * c, B + 6 * c + 3);
     const int l = fcm_mesh_cell_level(m, c);
-    TEST_TRUE(l >= 0 && l <= 4);
+    TEST_TRUE(l >= 0 && l <= FCM_OCTREE_MAX_LEVEL);
     seen[l] = 1;
     double v = 1.0;
     for (int d = 0; d < 3; d++) {
@@ -81,7 +66,7 @@ static int check(fcm_element_type type)
     }
     vol += v;
   }
-  TEST_TRUE(seen[1] && seen[2] && seen[3] && seen[4]);
+  if (with_levels) TEST_TRUE(seen[1] && seen[2] && seen[3] && seen[4]);
   TEST_NEAR(vol, 1.0, 1e-13, 0.0);
   /* cells near the sphere are at level >= 3; the region corner is refined */
   for (fcm_index c = 0; c < nc; c++) {
@@ -168,6 +153,56 @@ static int check(fcm_element_type type)
   }
   TEST_OK(ctx, fcm_mesh_validate(ctx, m, 0, NULL, NULL));
   free(B);
+}
+
+static int check(fcm_element_type type)
+{
+  fcm_ctx *ctx = NULL;
+  fcm_mesh *m = NULL;
+  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  const fcm_index n[3] = {2, 2, 2};
+  fcm_octree_options o = fcm_octree_options_default();
+  o.surface = sphere;
+  o.surface_level = 3;
+  o.region_level = 1;
+  o.region_lo[0] = o.region_lo[1] = o.region_lo[2] = 0.9;
+  o.region_hi[0] = o.region_hi[1] = o.region_hi[2] = 1.0;
+  o.refine = near_corner;
+  o.refine_level = 4;
+  TEST_OK(ctx, fcm_mesh_create_octree(ctx, type, lo, hi, n, &o, &m));
+  TEST_TRUE(fcm_mesh_is_octree(m));
+  TEST_TRUE(fcm_mesh_max_level(m) == 4);
+  TEST_TRUE(fcm_mesh_num_hanging(m) > 0);
+  check_mesh(ctx, m, type, 1);
+  /* refine further: cells with centre x < 0.3 are split and the result checked alike */
+  const fcm_index nc = fcm_mesh_num_cells(m);
+  unsigned char *flags = calloc((size_t)nc, 1);
+  fcm_index nflag = 0;
+  for (fcm_index c = 0; c < nc; c++) {
+    double blo[3], bhi[3];
+    cell_box(m, c, blo, bhi);
+    nflag += flags[c] = 0.5 * (blo[0] + bhi[0]) < 0.3;
+  }
+  fcm_mesh *m2 = NULL;
+  TEST_OK(ctx, fcm_mesh_refine_octree(ctx, m, flags, &m2));
+  TEST_TRUE(fcm_mesh_num_cells(m2) >= nc + 7 * nflag);
+  check_mesh(ctx, m2, type, 0);
+  for (fcm_index c = 0; c < nc; c++) { /* every flagged cell's region is one level finer */
+    if (!flags[c]) continue;
+    double blo[3], bhi[3];
+    cell_box(m, c, blo, bhi);
+    for (fcm_index c2 = 0; c2 < fcm_mesh_num_cells(m2); c2++) {
+      double lo2[3], hi2[3];
+      cell_box(m2, c2, lo2, hi2);
+      int inside = 1;
+      for (int d = 0; d < 3; d++)
+        inside &= lo2[d] >= blo[d] && hi2[d] <= bhi[d];
+      if (inside) TEST_TRUE(fcm_mesh_cell_level(m2, c2) > fcm_mesh_cell_level(m, c));
+    }
+  }
+  free(flags);
+  fcm_mesh_destroy(&m2);
   fcm_mesh_destroy(&m);
 
   /* no criteria: the box grid, node for node */
@@ -176,6 +211,13 @@ static int check(fcm_element_type type)
   TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, n, &box));
   TEST_TRUE(fcm_mesh_num_cells(m) == 8 && fcm_mesh_num_hanging(m) == 0);
   TEST_TRUE(fcm_mesh_num_nodes(m) == fcm_mesh_num_nodes(box));
+  {
+    unsigned char none[8] = {0};
+    fcm_mesh *r = NULL;
+    TEST_ERR(ctx, fcm_mesh_refine_octree(ctx, box, none, &r), FCM_ERR_UNSUPPORTED,
+             "only octree meshes are refined");
+    TEST_TRUE(r == NULL);
+  }
   TEST_TRUE(fcm_mesh_num_boundary_faces(m) == fcm_mesh_num_boundary_faces(box));
   fcm_mesh_destroy(&m);
   fcm_mesh_destroy(&box);

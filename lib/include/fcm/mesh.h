@@ -107,6 +107,20 @@ FCM_API fcm_status fcm_mesh_create_octree(fcm_ctx *ctx, fcm_element_type type, c
                                           const double hi[3], const fcm_index n[3],
                                           const fcm_octree_options *opts, fcm_mesh **mesh);
 
+/** Refine an octree mesh further: split the cells with flags[c] != 0 into eight (an error
+ * indicator's marks, cells with a small volume fraction, cut cells of a rules build, ...),
+ * balance 2:1 again and write the new mesh (cells in the tree's depth-first order: unsplit
+ * cells keep their relative order). The input is unchanged.
+ * @param[in]  mesh  made by fcm_mesh_create_octree() or this function
+ * @param[in]  flags num_cells entries
+ * @param[out] out   the new mesh, NULL on failure
+ * @return FCM_OK; FCM_ERR_ARG (NULL, a flagged cell at FCM_OCTREE_MAX_LEVEL, more than
+ *         FCM_OCTREE_MAX_CELLS cells); FCM_ERR_UNSUPPORTED (not an octree mesh: a box grid of
+ *         fcm_mesh_create_box(), a Gmsh mesh, a tetrahedral mesh); FCM_ERR_ALLOC.
+ * Allocates; release with fcm_mesh_destroy(). Thread safe. */
+FCM_API fcm_status fcm_mesh_refine_octree(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                          const unsigned char *flags, fcm_mesh **out);
+
 /** Whether the mesh was made by fcm_mesh_create_octree(). */
 FCM_API int fcm_mesh_is_octree(const fcm_mesh *mesh);
 /** Refinement level of `cell` (0 for a mesh that is not an octree). */

@@ -257,6 +257,7 @@ void fcm_mesh_destroy(fcm_mesh **mesh)
   fcm__free(ctx, m->neighbors);
   fcm__free(ctx, m->boundary);
   fcm__free(ctx, m->cell_level);
+  fcm__free(ctx, m->cell_pos);
   fcm__free(ctx, m->hang_cell);
   fcm__free(ctx, m->hang_node);
   fcm__free(ctx, m->hang_xi);

@@ -22,8 +22,11 @@ struct fcm_mesh {
   fcm_index *boundary; /* num_boundary x 2: (cell, local face) */
   /* Octree meshes (mesh_octree.c); NULL / 0 for every other mesh. */
   unsigned char *cell_level; /* num_cells: refinement level of each cell */
-  int max_level;             /* deepest level */
-  fcm_index num_hanging;     /* (cell, node) pairs: node on cell's boundary, not its node */
+  int64_t *cell_pos;         /* num_cells x 3: position on the lattice of its level */
+  double box_lo[3], box_hi[3];
+  fcm_index box_n[3];    /* the box grid the octree refines */
+  int max_level;         /* deepest level */
+  fcm_index num_hanging; /* (cell, node) pairs: node on cell's boundary, not its node */
   fcm_index *hang_cell, *hang_node;
   double *hang_xi; /* num_hanging x 3: the node's reference coordinates in the cell (exact) */
 };

@@ -387,6 +387,54 @@ cleanup:
   return st;
 }
 
+/* Balance the leaves and write them out as the mesh (cells in leaf order), with the octree's
+ * own data: levels, lattice positions, box, hanging pairs, non-conforming faces. */
+static fcm_status finish(octree *T, fcm_element_type type, fcm_mesh **mesh)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = T->ctx;
+  keytab nodes = {0};
+  fcm_index *cells = NULL;
+  double *x = NULL;
+  fcm_mesh *m = NULL;
+  FCM_TRY(ctx, balance(T));
+  int finest = 0;
+  for (fcm_index c = 0; c < T->num; c++)
+    finest = FCM_MAX(finest, T->leaves[c].level);
+  const fcm_element_info *info = fcm_element_get_info(type);
+  FCM_TRY(ctx, build_nodes(T, info, finest, &nodes, &cells));
+  FCM_ALLOC_RAW(ctx, 3 * FCM_MAX(nodes.count, 1), x);
+  for (fcm_index a = 0; a < nodes.count; a++)
+    for (int d = 0; d < 3; d++) {
+      const int64_t N = T->n[d] << (finest + 1), k = nodes.keys[4 * a + d];
+      x[3 * a + d] = k == N ? T->hi[d] : T->lo[d] + (T->hi[d] - T->lo[d]) * ((double)k / (double)N);
+    }
+  FCM_TRY(ctx, fcm__mesh_create_take(ctx, type, nodes.count, &x, T->num, &cells, &m));
+  FCM_ALLOC_RAW(ctx, FCM_MAX(T->num, 1), m->cell_level);
+  FCM_ALLOC_RAW(ctx, 3 * FCM_MAX(T->num, 1), m->cell_pos);
+  for (fcm_index c = 0; c < T->num; c++) {
+    m->cell_level[c] = (unsigned char)T->leaves[c].level;
+    for (int d = 0; d < 3; d++)
+      m->cell_pos[3 * c + d] = T->leaves[c].x[d];
+  }
+  for (int d = 0; d < 3; d++) {
+    m->box_lo[d] = T->lo[d];
+    m->box_hi[d] = T->hi[d];
+    m->box_n[d] = T->n[d];
+  }
+  m->max_level = finest;
+  FCM_TRY(ctx, find_hanging(T, info, finest, &nodes, m->cells, m));
+  FCM_TRY(ctx, mark_nonconforming(m, T->lo, T->hi));
+  *mesh = m;
+  m = NULL;
+cleanup:
+  fcm_mesh_destroy(&m);
+  keytab_free(ctx, &nodes);
+  fcm__free(ctx, cells);
+  fcm__free(ctx, x);
+  return st;
+}
+
 fcm_status fcm_mesh_create_octree(fcm_ctx *ctx, fcm_element_type type, const double lo[3],
                                   const double hi[3], const fcm_index n[3],
                                   const fcm_octree_options *opts, fcm_mesh **mesh)
@@ -394,10 +442,6 @@ fcm_status fcm_mesh_create_octree(fcm_ctx *ctx, fcm_element_type type, const dou
   fcm_status st = FCM_OK;
   const fcm_octree_options defaults = fcm_octree_options_default();
   octree T = {0};
-  keytab nodes = {0};
-  fcm_index *cells = NULL;
-  double *x = NULL;
-  fcm_mesh *m = NULL;
   FCM_CHECK(ctx && mesh && lo && hi && n, ctx, FCM_ERR_ARG,
             "mesh_create_octree: ctx, lo, hi, n and mesh must not be NULL");
   *mesh = NULL;
@@ -431,36 +475,55 @@ fcm_status fcm_mesh_create_octree(fcm_ctx *ctx, fcm_element_type type, const dou
     T.leaves[q].x[2] = q / (n[0] * n[1]);
   }
   FCM_TRY(ctx, refine(&T));
-  FCM_TRY(ctx, balance(&T));
+  FCM_TRY(ctx, finish(&T, type, mesh));
+cleanup:
+  if (ctx) fcm__free(ctx, T.leaves);
+  return st;
+}
 
-  int finest = 0;
-  for (fcm_index c = 0; c < T.num; c++)
-    finest = FCM_MAX(finest, T.leaves[c].level);
-  const fcm_element_info *info = fcm_element_get_info(type);
-  FCM_TRY(ctx, build_nodes(&T, info, finest, &nodes, &cells));
-  FCM_ALLOC_RAW(ctx, 3 * FCM_MAX(nodes.count, 1), x);
-  for (fcm_index a = 0; a < nodes.count; a++)
-    for (int d = 0; d < 3; d++) {
-      const int64_t N = T.n[d] << (finest + 1), k = nodes.keys[4 * a + d];
-      x[3 * a + d] = k == N ? hi[d] : lo[d] + (hi[d] - lo[d]) * ((double)k / (double)N);
-    }
-  const fcm_index num_nodes = nodes.count;
-  FCM_TRY(ctx, fcm__mesh_create_take(ctx, type, num_nodes, &x, T.num, &cells, &m));
-  FCM_ALLOC_RAW(ctx, FCM_MAX(T.num, 1), m->cell_level);
-  for (fcm_index c = 0; c < T.num; c++)
-    m->cell_level[c] = (unsigned char)T.leaves[c].level;
-  m->max_level = finest;
-  FCM_TRY(ctx, find_hanging(&T, info, finest, &nodes, m->cells, m));
-  FCM_TRY(ctx, mark_nonconforming(m, lo, hi));
-  *mesh = m;
-  m = NULL;
+fcm_status fcm_mesh_refine_octree(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigned char *flags,
+                                  fcm_mesh **out)
+{
+  fcm_status st = FCM_OK;
+  const fcm_octree_options none = fcm_octree_options_default();
+  octree T = {0};
+  unsigned char *split = NULL;
+  FCM_CHECK(ctx && mesh && flags && out, ctx, FCM_ERR_ARG,
+            "mesh_refine_octree: ctx, mesh, flags and out must not be NULL");
+  *out = NULL;
+  FCM_CHECK(mesh->cell_level, ctx, FCM_ERR_UNSUPPORTED,
+            "mesh_refine_octree: the %s mesh was not made by fcm_mesh_create_octree(); only "
+            "octree meshes are refined",
+            mesh->info->name);
+  T.ctx = ctx;
+  T.o = &none;
+  T.num = mesh->num_cells;
+  for (int d = 0; d < 3; d++) {
+    T.lo[d] = mesh->box_lo[d];
+    T.hi[d] = mesh->box_hi[d];
+    T.n[d] = mesh->box_n[d];
+  }
+  FCM_ALLOC_RAW(ctx, FCM_MAX(T.num, 1), T.leaves);
+  FCM_ALLOC(ctx, FCM_MAX(T.num, 1), split);
+  fcm_index nflag = 0;
+  for (fcm_index c = 0; c < T.num; c++) {
+    T.leaves[c].level = mesh->cell_level[c];
+    for (int d = 0; d < 3; d++)
+      T.leaves[c].x[d] = mesh->cell_pos[3 * c + d];
+    if (!flags[c]) continue;
+    FCM_CHECK(mesh->cell_level[c] < FCM_OCTREE_MAX_LEVEL, ctx, FCM_ERR_ARG,
+              "mesh_refine_octree: cell %lld is at level %d already, the deepest "
+              "(FCM_OCTREE_MAX_LEVEL); it cannot be split",
+              (long long)c, (int)mesh->cell_level[c]);
+    split[c] = 1;
+    nflag++;
+  }
+  if (nflag) FCM_TRY(ctx, split_flagged(&T, split, nflag));
+  FCM_TRY(ctx, finish(&T, mesh->type, out));
 cleanup:
   if (ctx) {
-    fcm_mesh_destroy(&m);
-    keytab_free(ctx, &nodes);
     fcm__free(ctx, T.leaves);
-    fcm__free(ctx, cells);
-    fcm__free(ctx, x);
+    fcm__free(ctx, split);
   }
   return st;
 }
