@@ -77,8 +77,9 @@ typedef struct fcm_octree_options {
                                        over the 3 x 3 x 3 corner, edge, face and centre points */
   fcm_octree_levelset_fn surface; /**< the level set (called serially) */
   void *surface_user;
-  int refine_level;            /**< cells the callback flags (e.g. cells of an embedded
-                                    boundary: fcm_geometry_refine_boundary() in fcm/geom.h) */
+  int refine_level;            /**< cells the callback flags: along an embedded boundary
+                                    fcm_geometry_refine_boundary() (fcm/geom.h), along a
+                                    cut surface fcm_surface_refine() (fcm/surface.h) */
   fcm_octree_refine_fn refine; /**< called serially */
   void *refine_user;
 } fcm_octree_options;

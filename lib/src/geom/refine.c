@@ -1,6 +1,7 @@
-/* Octree refinement along an embedded geometry's boundary: the cells its boundary triangles
- * cross, as a refine callback of fcm_mesh_create_octree(). */
+/* Octree refinement along triangle surfaces: the cells an embedded geometry's boundary or a
+ * cut surface crosses, as refine callbacks of fcm_mesh_create_octree(). */
 #include "geom_impl.h"
+#include "surface_impl.h"
 
 #include <math.h>
 
@@ -42,6 +43,17 @@ static int triangle_meets_box(double v[3][3], const double h[3])
   return 1;
 }
 
+/* Whether triangle t (vertex ids into coords) meets the closed box of centre c, half sizes h. */
+static int triangle_id_meets_box(const double *coords, const fcm_index *t, const double c[3],
+                                 const double h[3])
+{
+  double v[3][3];
+  for (int k = 0; k < 3; k++)
+    for (int d = 0; d < 3; d++)
+      v[k][d] = coords[3 * t[k] + d] - c[d];
+  return triangle_meets_box(v, h);
+}
+
 int fcm_geometry_refine_boundary(const double lo[3], const double hi[3], int level, void *geometry)
 {
   const fcm_geometry *g = geometry;
@@ -58,14 +70,23 @@ int fcm_geometry_refine_boundary(const double lo[3], const double hi[3], int lev
   double c[3], h[3];
   for (int d = 0; d < 3; d++)
     c[d] = 0.5 * (lo[d] + hi[d]), h[d] = 0.5 * (hi[d] - lo[d]);
-  for (size_t i = 0; i < buf.n && !meets; i++) {
-    const fcm_index *t = g->tris + 3 * buf.ids[i];
-    double v[3][3];
-    for (int k = 0; k < 3; k++)
-      for (int d = 0; d < 3; d++)
-        v[k][d] = g->coords[3 * t[k] + d] - c[d];
-    meets = triangle_meets_box(v, h);
-  }
+  for (size_t i = 0; i < buf.n && !meets; i++)
+    meets = triangle_id_meets_box(g->coords, g->tris + 3 * buf.ids[i], c, h);
   fcm__geom_idbuf_free(g->ctx, &buf);
   return meets;
+}
+
+int fcm_surface_refine(const double lo[3], const double hi[3], int level, void *surface)
+{
+  const fcm_surface *s = surface;
+  (void)level;
+  if (!s || !lo || !hi) return -1;
+  double c[3], h[3];
+  for (int d = 0; d < 3; d++) {
+    if (s->lo[d] > hi[d] || s->hi[d] < lo[d]) return 0;
+    c[d] = 0.5 * (lo[d] + hi[d]), h[d] = 0.5 * (hi[d] - lo[d]);
+  }
+  for (fcm_index i = 0; i < s->num_triangles; i++)
+    if (triangle_id_meets_box(s->coords, s->tris + 3 * i, c, h)) return 1;
+  return 0;
 }
