@@ -1,7 +1,7 @@
 /* Cells of octree backgrounds refined along an embedded boundary against the uniform grid of the
  * same finest cell size (after Dick et al. 2011, Table 1): an exact sphere (crossed cells by the
  * distance bounds of each box) and the bunny-like body of the cutbench scenes (its surface,
- * fcm_geometry_refine_boundary()). Prints per finest level: uniform cells, octree cells (and per
+ * fcm_geometry_boundary_meets_box()). Prints per finest level: uniform cells, octree cells (and per
  * level), the cells the boundary crosses and, for the sphere, the active cells (crossed or
  * inside) of both; the ratios. Asserts the octree has the uniform grid's crossed cells at the
  * finest level (the same resolution of the boundary). Argument: the body's OBJ file. */
@@ -62,7 +62,7 @@ static int sphere_side_fn(const double *lo, const double *hi, void *user)
 /* The body: 0 crossed, 1 not (no inside test for a surface). */
 static int body_side_fn(const double *lo, const double *hi, void *user)
 {
-  return fcm_geometry_refine_boundary(lo, hi, 0, user) > 0 ? 0 : 1;
+  return fcm_geometry_boundary_meets_box(lo, hi, 0, user) > 0 ? 0 : 1;
 }
 
 int main(int argc, char **argv)
@@ -91,7 +91,7 @@ int main(int argc, char **argv)
     for (int L = 1; L <= 4; L++) {
       fcm_mesh *oct = NULL, *uni = NULL;
       fcm_octree_options o = fcm_octree_options_default();
-      o.refine = model == 0 ? sphere_refine : fcm_geometry_refine_boundary;
+      o.refine = model == 0 ? sphere_refine : fcm_geometry_boundary_meets_box;
       o.refine_user = model == 0 ? NULL : body;
       o.refine_level = L;
       TEST_OK(ctx, fcm_mesh_create_octree(ctx, FCM_ELEMENT_HEX8, lo, hi, n, &o, &oct));

@@ -23,7 +23,7 @@ int main(int argc, char **argv)
   const fcm_index cells[3] = {3, 3, 3};
   TEST_OK(ctx, fcm_geometry_create_ball(ctx, c, 0.3, 3, &ball));
   fcm_octree_options o = fcm_octree_options_default();
-  o.refine = fcm_geometry_refine_boundary;
+  o.refine = fcm_geometry_boundary_meets_box;
   o.refine_user = ball;
   o.refine_level = 2;
   TEST_OK(ctx, fcm_mesh_create_octree(ctx, type, lo, hi, cells, &o, &mesh));
@@ -62,7 +62,7 @@ int main(int argc, char **argv)
     TEST_TRUE(nflag > 0);
     fcm_mesh *fine = NULL;
     fcm_cell_rules *fine_rules = NULL;
-    TEST_OK(ctx, fcm_mesh_refine_octree(ctx, mesh, flags, &fine));
+    TEST_OK(ctx, fcm_mesh_create_refined(ctx, mesh, flags, &fine));
     TEST_TRUE(fcm_mesh_max_level(fine) == 3);
     TEST_TRUE(fcm_mesh_num_cells(fine) >= nc + 7 * nflag);
     TEST_OK(ctx, fcm_cell_rules_create(ctx, fine, ball, &ro, &fine_rules));
@@ -75,12 +75,12 @@ int main(int argc, char **argv)
 
   /* the constrained mass (T^T M T) totals rho |kept ball| */
   TEST_OK(ctx, fcm_space_create_embedded(ctx, mesh, rules, &space));
-  TEST_OK(ctx, fcm_space_hanging_create(space, NULL, &T));
+  TEST_OK(ctx, fcm_space_hanging_matrix_create(space, NULL, &T));
   TEST_OK(ctx, fcm_space_matrix_create(space, &M));
   const double rho = 3.0;
   fcm_material mat = {FCM_MATERIAL_LINEAR, 1.0e3, 0.3, rho};
   TEST_OK(ctx, fcm_assemble_mass(space, &mat, NULL, M));
-  TEST_OK(ctx, fcm_csr_ptap(ctx, M, T, &Mr));
+  TEST_OK(ctx, fcm_csr_create_ptap(ctx, M, T, &Mr));
   fcm_index nr = 0;
   fcm_csr_get_size(Mr, &nr, NULL, NULL);
   double *ones = calloc((size_t)nr, sizeof *ones), *y = calloc((size_t)nr, sizeof *y);

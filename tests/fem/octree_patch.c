@@ -104,7 +104,7 @@ static double constrained_solve(fcm_ctx *ctx, const fcm_space *s, const fcm_csr 
   fcm_index n = 0, nr = 0;
   fcm_csr_get_size(T, &n, &nr, NULL);
   fcm_csr *Kr = NULL;
-  TEST_OK(ctx, fcm_csr_ptap(ctx, K, T, &Kr));
+  TEST_OK(ctx, fcm_csr_create_ptap(ctx, K, T, &Kr));
   double *b = calloc((size_t)nr, sizeof *b), *v = calloc((size_t)nr, sizeof *v);
   double *g = calloc((size_t)nr, sizeof *g), *u = calloc((size_t)n, sizeof *u);
   unsigned char *con = calloc((size_t)nr, 1);
@@ -162,7 +162,7 @@ int main(int argc, char **argv)
   TEST_OK(ctx, fcm_space_create(ctx, mesh, NULL, &space));
   const fcm_index n = fcm_space_num_dofs(space);
   fcm_index *free_dof = calloc((size_t)n, sizeof *free_dof);
-  TEST_OK(ctx, fcm_space_hanging_create(space, free_dof, &T));
+  TEST_OK(ctx, fcm_space_hanging_matrix_create(space, free_dof, &T));
   fcm_index nr = 0, nrows = 0;
   fcm_csr_get_size(T, &nrows, &nr, NULL);
   TEST_TRUE(nrows == n && nr < n && nr > 0);
@@ -171,13 +171,13 @@ int main(int argc, char **argv)
   unsigned char *hangs = calloc((size_t)fcm_mesh_num_nodes(mesh), 1);
   for (fcm_index i = 0; i < fcm_mesh_num_hanging(mesh); i++) {
     fcm_index node = 0;
-    fcm_mesh_hanging(mesh, i, NULL, &node, NULL);
+    fcm_mesh_get_hanging(mesh, i, NULL, &node, NULL);
     hangs[node] = 1;
   }
   int chains = 0;
   for (fcm_index i = 0; i < fcm_mesh_num_hanging(mesh); i++) {
     fcm_index c = 0;
-    fcm_mesh_hanging(mesh, i, &c, NULL, NULL);
+    fcm_mesh_get_hanging(mesh, i, &c, NULL, NULL);
     for (int a = 0; a < fcm_mesh_nodes_per_cell(mesh); a++)
       chains |= hangs[fcm_mesh_cells(mesh)[(size_t)fcm_mesh_nodes_per_cell(mesh) * c + a]];
   }

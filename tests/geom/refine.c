@@ -1,5 +1,5 @@
-/* The octree refinement criteria along triangle surfaces (fcm_surface_refine(),
- * fcm_geometry_refine_boundary()): exact triangle-box overlap on cases a bounding-box test gets
+/* The octree refinement criteria along triangle surfaces (fcm_surface_meets_box(),
+ * fcm_geometry_boundary_meets_box()): exact triangle-box overlap on cases a bounding-box test gets
  * wrong, closed boxes (touching counts), and on random triangles and boxes no miss of a sampled
  * point of the triangle inside the box and no hit farther than the sampling spacing from it. */
 #include "fcm/fcm.h"
@@ -41,14 +41,14 @@ int main(void)
   const fcm_index t[3] = {0, 1, 2};
   TEST_OK(ctx, fcm_surface_create(ctx, 3, v, 1, t, &tri));
   const double lo1[3] = {0.6, 0.6, -0.1}, hi1[3] = {0.9, 0.9, 0.1}; /* boxes overlap, not it */
-  TEST_TRUE(fcm_surface_refine(lo1, hi1, 0, tri) == 0);
+  TEST_TRUE(fcm_surface_meets_box(lo1, hi1, 0, tri) == 0);
   const double lo2[3] = {0.3, 0.3, -0.1}, hi2[3] = {0.45, 0.45, 0.1};
-  TEST_TRUE(fcm_surface_refine(lo2, hi2, 0, tri) == 1);
+  TEST_TRUE(fcm_surface_meets_box(lo2, hi2, 0, tri) == 1);
   const double lo3[3] = {0.2, 0.2, 0.0}, hi3[3] = {0.3, 0.3, 0.5}; /* touches its plane */
-  TEST_TRUE(fcm_surface_refine(lo3, hi3, 0, tri) == 1);
+  TEST_TRUE(fcm_surface_meets_box(lo3, hi3, 0, tri) == 1);
   const double lo4[3] = {0.2, 0.2, 1e-9}, hi4[3] = {0.3, 0.3, 0.5};
-  TEST_TRUE(fcm_surface_refine(lo4, hi4, 0, tri) == 0);
-  TEST_TRUE(fcm_surface_refine(NULL, hi4, 0, tri) == -1);
+  TEST_TRUE(fcm_surface_meets_box(lo4, hi4, 0, tri) == 0);
+  TEST_TRUE(fcm_surface_meets_box(NULL, hi4, 0, tri) == -1);
   fcm_surface_destroy(&tri);
 
   int hits = 0, misses = 0;
@@ -61,7 +61,7 @@ int main(void)
       hi[d] = lo[d] + 0.05 + 0.2 * urand01();
     }
     TEST_OK(ctx, fcm_surface_create(ctx, 3, w, 1, t, &tri));
-    const int r = fcm_surface_refine(lo, hi, 0, tri);
+    const int r = fcm_surface_meets_box(lo, hi, 0, tri);
     const double dist = sampled_distance(w, lo, hi);
     if (dist == 0.0) TEST_TRUE(r == 1);
     if (r == 1) TEST_TRUE(dist <= 0.03); /* the samples are 1/60 of an edge (< sqrt 3) apart */
@@ -77,10 +77,10 @@ int main(void)
   const double in_lo[3] = {-0.2, -0.2, -0.2}, in_hi[3] = {0.2, 0.2, 0.2};
   const double at_lo[3] = {0.9, -0.1, -0.1}, at_hi[3] = {1.1, 0.1, 0.1};
   const double out_lo[3] = {1.2, 1.2, 1.2}, out_hi[3] = {1.5, 1.5, 1.5};
-  TEST_TRUE(fcm_geometry_refine_boundary(in_lo, in_hi, 0, ball) == 0);
-  TEST_TRUE(fcm_geometry_refine_boundary(at_lo, at_hi, 0, ball) == 1);
-  TEST_TRUE(fcm_geometry_refine_boundary(out_lo, out_hi, 0, ball) == 0);
-  TEST_TRUE(fcm_geometry_refine_boundary(in_lo, in_hi, 0, NULL) == -1);
+  TEST_TRUE(fcm_geometry_boundary_meets_box(in_lo, in_hi, 0, ball) == 0);
+  TEST_TRUE(fcm_geometry_boundary_meets_box(at_lo, at_hi, 0, ball) == 1);
+  TEST_TRUE(fcm_geometry_boundary_meets_box(out_lo, out_hi, 0, ball) == 0);
+  TEST_TRUE(fcm_geometry_boundary_meets_box(in_lo, in_hi, 0, NULL) == -1);
   fcm_geometry_destroy(&ball);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);

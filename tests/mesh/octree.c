@@ -142,7 +142,7 @@ static void check_mesh(fcm_ctx *ctx, const fcm_mesh *m, fcm_element_type type, i
   for (fcm_index i = 0; i < fcm_mesh_num_hanging(m); i++) {
     fcm_index c = 0, node = 0;
     double xi[3], X[3 * 20], x[3];
-    fcm_mesh_hanging(m, i, &c, &node, xi);
+    fcm_mesh_get_hanging(m, i, &c, &node, xi);
     fcm_mesh_cell_coords(m, c, X);
     fcm_element_map(type, X, xi, x);
     for (int d = 0; d < 3; d++)
@@ -185,7 +185,7 @@ static int check(fcm_element_type type)
     nflag += flags[c] = 0.5 * (blo[0] + bhi[0]) < 0.3;
   }
   fcm_mesh *m2 = NULL;
-  TEST_OK(ctx, fcm_mesh_refine_octree(ctx, m, flags, &m2));
+  TEST_OK(ctx, fcm_mesh_create_refined(ctx, m, flags, &m2));
   TEST_TRUE(fcm_mesh_num_cells(m2) >= nc + 7 * nflag);
   check_mesh(ctx, m2, type, 0);
   for (fcm_index c = 0; c < nc; c++) { /* every flagged cell's region is one level finer */
@@ -214,7 +214,7 @@ static int check(fcm_element_type type)
   {
     unsigned char none[8] = {0};
     fcm_mesh *r = NULL;
-    TEST_ERR(ctx, fcm_mesh_refine_octree(ctx, box, none, &r), FCM_ERR_UNSUPPORTED,
+    TEST_ERR(ctx, fcm_mesh_create_refined(ctx, box, none, &r), FCM_ERR_UNSUPPORTED,
              "only octree meshes are refined");
     TEST_TRUE(r == NULL);
   }

@@ -129,7 +129,7 @@ FCM_API const fcm_mesh *fcm_space_mesh(const fcm_space *space);
  * there (its shape functions at the node: Hex8 1/2 on an edge, 1/4 on a face; Hex20 the
  * serendipity face or edge functions), with masters that hang themselves replaced by their
  * own masters (chains at 2:1); every other active DOF is free (its row of T is one 1). The
- * constrained system is T^T K T u_free = T^T f (fcm_csr_ptap()); Dirichlet values go on the
+ * constrained system is T^T K T u_free = T^T f (fcm_csr_create_ptap()); Dirichlet values go on the
  * free DOFs. A node hanging only on inactive cells stays free.
  * @param[in]  space    any space on any mesh (a mesh without hanging nodes gives T = I)
  * @param[out] free_dof num_dofs entries (may be NULL): the column of each free DOF, -1 for
@@ -139,8 +139,8 @@ FCM_API const fcm_mesh *fcm_space_mesh(const fcm_space *space);
  *         its cell, with several DOF copies: cuts enrich it; copies constrained to move with
  *         their piece; more free DOFs than 32-bit columns); FCM_ERR_ALLOC.
  * Allocates T and O(num_nodes) scratch. Thread safe. */
-FCM_API fcm_status fcm_space_hanging_create(const fcm_space *space, fcm_index *free_dof,
-                                            fcm_csr **T);
+FCM_API fcm_status fcm_space_hanging_matrix_create(const fcm_space *space, fcm_index *free_dof,
+                                                   fcm_csr **T);
 
 /** Carry a field (displacement, velocity: num_dofs of `from`) over a cut: `to` must be the
  * space of rules that extend the rules of `from` by one cut (fcm_cell_rules_create_cut()).

@@ -78,8 +78,8 @@ typedef struct fcm_octree_options {
   fcm_octree_levelset_fn surface; /**< the level set (called serially) */
   void *surface_user;
   int refine_level;            /**< cells the callback flags: along an embedded boundary
-                                    fcm_geometry_refine_boundary() (fcm/geom.h), along a
-                                    cut surface fcm_surface_refine() (fcm/surface.h) */
+                                    fcm_geometry_boundary_meets_box() (fcm/geom.h), along a
+                                    cut surface fcm_surface_meets_box() (fcm/surface.h) */
   fcm_octree_refine_fn refine; /**< called serially */
   void *refine_user;
 } fcm_octree_options;
@@ -93,8 +93,8 @@ FCM_API fcm_octree_options fcm_octree_options_default(void);
  * only splits). Cells are hexahedra of the given type in the depth-first order of the tree;
  * nodes are shared wherever cells of any levels meet at the same point, so the cells of
  * different sizes are joined through hanging nodes: a node on a face or edge of a coarser
- * cell that is not a node of that cell (fcm_mesh_hanging()); the fem module constrains
- * them (fcm_space_hanging_create() in fcm/fem.h). Faces against finer cells have the
+ * cell that is not a node of that cell (fcm_mesh_get_hanging()); the fem module constrains
+ * them (fcm_space_hanging_matrix_create() in fcm/fem.h). Faces against finer cells have the
  * neighbour FCM_MESH_NEIGHBOR_NONCONFORMING; the boundary faces are the box surface.
  * @param[in]  type  FCM_ELEMENT_HEX8 or FCM_ELEMENT_HEX20
  * @param[in]  opts  criteria (NULL: none); callbacks are called serially
@@ -119,8 +119,8 @@ FCM_API fcm_status fcm_mesh_create_octree(fcm_ctx *ctx, fcm_element_type type, c
  *         FCM_OCTREE_MAX_CELLS cells); FCM_ERR_UNSUPPORTED (not an octree mesh: a box grid of
  *         fcm_mesh_create_box(), a Gmsh mesh, a tetrahedral mesh); FCM_ERR_ALLOC.
  * Allocates; release with fcm_mesh_destroy(). Thread safe. */
-FCM_API fcm_status fcm_mesh_refine_octree(fcm_ctx *ctx, const fcm_mesh *mesh,
-                                          const unsigned char *flags, fcm_mesh **out);
+FCM_API fcm_status fcm_mesh_create_refined(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                           const unsigned char *flags, fcm_mesh **out);
 
 /** Whether the mesh was made by fcm_mesh_create_octree(). */
 FCM_API int fcm_mesh_is_octree(const fcm_mesh *mesh);
@@ -134,8 +134,8 @@ FCM_API fcm_index fcm_mesh_num_hanging(const fcm_mesh *mesh);
  * being one of its nodes; xi are its reference coordinates in the cell (exact: multiples of
  * 1/2 for Hex8, 1/4 for Hex20). A node may be listed with several cells (all around an
  * edge). Outputs may be NULL. No allocation; thread safe. */
-FCM_API void fcm_mesh_hanging(const fcm_mesh *mesh, fcm_index i, fcm_index *cell, fcm_index *node,
-                              double xi[3]);
+FCM_API void fcm_mesh_get_hanging(const fcm_mesh *mesh, fcm_index i, fcm_index *cell,
+                                  fcm_index *node, double xi[3]);
 
 /** Read a Gmsh MSH file, ASCII version 4.1 or 2.x (2.0, 2.1, 2.2). Volume elements of
  * Gmsh types 4 (tet4), 11 (tet10), 5 (hex8) and 17 (hex20) become the cells, in file

@@ -213,9 +213,9 @@ FCM_API fcm_status fcm_surface_create_filled(fcm_ctx *ctx, const fcm_surface *sr
  * closed box [lo, hi] (exact separating-axis test), else 0; -1 for NULL arguments. Refining
  * before the cut resolves the cut's detail where it will happen. Tests every triangle of the
  * surface (O(triangles) per cell: meant for cut surfaces of few triangles; an embedded
- * body's boundary goes through fcm_geometry_refine_boundary(), which searches a tree). No
+ * body's boundary goes through fcm_geometry_boundary_meets_box(), which searches a tree). No
  * allocation; thread safe. */
-FCM_API int fcm_surface_refine(const double lo[3], const double hi[3], int level, void *surface);
+FCM_API int fcm_surface_meets_box(const double lo[3], const double hi[3], int level, void *surface);
 
 /* ------------------------------------------------------------------ tetrahedra */
 

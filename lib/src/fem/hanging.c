@@ -44,11 +44,12 @@ static fcm_status expand(const fcm_space *s, const fcm_index *src, fcm_index nod
   const fcm_mesh *mesh = s->mesh;
   if (src[node] < 0) return terms_push(s->ctx, t, node, w);
   FCM_CHECK(depth < HANG_MAX_DEPTH, s->ctx, FCM_ERR_INTERNAL,
-            "space_hanging: the constraint of node %lld chains over more than %d hanging nodes",
+            "space_hanging_matrix_create: the constraint of node %lld chains over more than %d "
+            "hanging nodes",
             (long long)node, HANG_MAX_DEPTH);
   fcm_index cell = 0;
   double xi[3], N[FCM_ELEMENT_MAX_NODES];
-  fcm_mesh_hanging(mesh, src[node], &cell, NULL, xi);
+  fcm_mesh_get_hanging(mesh, src[node], &cell, NULL, xi);
   fcm_element_eval_shape(s->type, xi, N);
   const fcm_index *cn = fcm_mesh_cells(mesh) + (size_t)s->nn * (size_t)cell;
   for (int a = 0; a < s->nn; a++)
@@ -70,16 +71,18 @@ static fcm_status constraint_sources(const fcm_space *s, fcm_index *src, fcm_ind
     src[n] = -1;
   for (fcm_index i = 0; i < fcm_mesh_num_hanging(mesh); i++) {
     fcm_index cell = 0, node = 0;
-    fcm_mesh_hanging(mesh, i, &cell, &node, NULL);
+    fcm_mesh_get_hanging(mesh, i, &cell, &node, NULL);
     if (!s->active[cell] || s->node_dof[node] < 0 || src[node] >= 0) continue;
     const fcm_index *cn = fcm_mesh_cells(mesh) + (size_t)s->nn * (size_t)cell;
     FCM_CHECK(s->node_ncopy[node] == 1, s->ctx, FCM_ERR_UNSUPPORTED,
-              "space_hanging: hanging node %lld has %lld DOF copies; constraints of enriched "
+              "space_hanging_matrix_create: hanging node %lld has %lld DOF copies; constraints of "
+              "enriched "
               "(cut) nodes on an octree background are not supported",
               (long long)node, (long long)s->node_ncopy[node]);
     for (int a = 0; a < s->nn; a++)
       FCM_CHECK(s->node_ncopy[cn[a]] == 1, s->ctx, FCM_ERR_UNSUPPORTED,
-                "space_hanging: node %lld of cell %lld, on which node %lld hangs, has %lld DOF "
+                "space_hanging_matrix_create: node %lld of cell %lld, on which node %lld hangs, "
+                "has %lld DOF "
                 "copies; constraints of enriched (cut) nodes on an octree background are not "
                 "supported",
                 (long long)cn[a], (long long)cell, (long long)node,
@@ -91,17 +94,18 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_space_hanging_create(const fcm_space *space, fcm_index *free_dof, fcm_csr **T)
+fcm_status fcm_space_hanging_matrix_create(const fcm_space *space, fcm_index *free_dof, fcm_csr **T)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = space ? space->ctx : NULL;
   fcm_index *src = NULL, *col = NULL, *rows = NULL, *cols = NULL;
   double *vals = NULL;
   terms t = {0};
-  FCM_CHECK(space && T, ctx, FCM_ERR_ARG, "space_hanging: space and T must not be NULL");
+  FCM_CHECK(space && T, ctx, FCM_ERR_ARG,
+            "space_hanging_matrix_create: space and T must not be NULL");
   *T = NULL;
   FCM_CHECK(!space->elem_con, ctx, FCM_ERR_UNSUPPORTED,
-            "space_hanging: %lld DOF copies are constrained to move with their piece "
+            "space_hanging_matrix_create: %lld DOF copies are constrained to move with their piece "
             "(constrain_ratio); hanging-node constraints do not combine with them",
             (long long)space->num_constrained);
   FCM_ALLOC_RAW(ctx, FCM_MAX(space->num_nodes, 1), src);
@@ -117,7 +121,7 @@ fcm_status fcm_space_hanging_create(const fcm_space *space, fcm_index *free_dof,
   }
   const fcm_index nd = space->num_dofs;
   FCM_CHECK(3 * num_free <= INT32_MAX, ctx, FCM_ERR_UNSUPPORTED,
-            "space_hanging: %lld free DOFs exceed 32-bit column indices",
+            "space_hanging_matrix_create: %lld free DOFs exceed 32-bit column indices",
             (long long)(3 * num_free));
   if (free_dof)
     for (fcm_index i = 0; i < nd; i++)
@@ -153,9 +157,10 @@ fcm_status fcm_space_hanging_create(const fcm_space *space, fcm_index *free_dof,
       while (i + 1 < t.n && t.node[i + 1] == t.node[i])
         w += t.w[++i];
       if (fabs(w) <= HANG_WEIGHT_EPS) continue;
-      FCM_CHECK(col[t.node[i]] >= 0, ctx, FCM_ERR_INTERNAL,
-                "space_hanging: master node %lld of hanging node %lld has no free DOFs",
-                (long long)t.node[i], (long long)n);
+      FCM_CHECK(
+          col[t.node[i]] >= 0, ctx, FCM_ERR_INTERNAL,
+          "space_hanging_matrix_create: master node %lld of hanging node %lld has no free DOFs",
+          (long long)t.node[i], (long long)n);
       if ((size_t)ntrip + 3 > cap) {
         const size_t nc = 2 * cap + 3;
         FCM_TRY(ctx, fcm__resize(ctx, (void **)&rows, cap, nc, sizeof *rows));

@@ -54,7 +54,8 @@ static int triangle_id_meets_box(const double *coords, const fcm_index *t, const
   return triangle_meets_box(v, h);
 }
 
-int fcm_geometry_refine_boundary(const double lo[3], const double hi[3], int level, void *geometry)
+int fcm_geometry_boundary_meets_box(const double lo[3], const double hi[3], int level,
+                                    void *geometry)
 {
   const fcm_geometry *g = geometry;
   const fcm_aabb_tree *tree = NULL;
@@ -76,7 +77,7 @@ int fcm_geometry_refine_boundary(const double lo[3], const double hi[3], int lev
   return meets;
 }
 
-int fcm_surface_refine(const double lo[3], const double hi[3], int level, void *surface)
+int fcm_surface_meets_box(const double lo[3], const double hi[3], int level, void *surface)
 {
   const fcm_surface *s = surface;
   (void)level;

@@ -248,14 +248,15 @@ void fcm__ptap_transpose(const fcm__ptap *t, const fcm_index **R_ptr, const int 
   *R_ptr = t->R_ptr, *R_col = t->R_col, *R_val = t->R_val;
 }
 
-fcm_status fcm_csr_ptap(fcm_ctx *ctx, const fcm_csr *A, const fcm_csr *P, fcm_csr **C)
+fcm_status fcm_csr_create_ptap(fcm_ctx *ctx, const fcm_csr *A, const fcm_csr *P, fcm_csr **C)
 {
   fcm_status st = FCM_OK;
   fcm__ptap *plan = NULL;
-  FCM_CHECK(ctx && A && P && C, ctx, FCM_ERR_ARG, "csr_ptap: ctx, A, P and C must not be NULL");
+  FCM_CHECK(ctx && A && P && C, ctx, FCM_ERR_ARG,
+            "csr_create_ptap: ctx, A, P and C must not be NULL");
   *C = NULL;
   FCM_CHECK(P->nrows == A->nrows, ctx, FCM_ERR_ARG,
-            "csr_ptap: P has %lld rows, A has %lld; they must agree", (long long)P->nrows,
+            "csr_create_ptap: P has %lld rows, A has %lld; they must agree", (long long)P->nrows,
             (long long)A->nrows);
   FCM_TRY(ctx,
           fcm__ptap_create(ctx, A, P->ncols, P->row_ptr, P->col_idx, P->values, 1, 1, &plan, C));

@@ -481,18 +481,18 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_mesh_refine_octree(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigned char *flags,
-                                  fcm_mesh **out)
+fcm_status fcm_mesh_create_refined(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigned char *flags,
+                                   fcm_mesh **out)
 {
   fcm_status st = FCM_OK;
   const fcm_octree_options none = fcm_octree_options_default();
   octree T = {0};
   unsigned char *split = NULL;
   FCM_CHECK(ctx && mesh && flags && out, ctx, FCM_ERR_ARG,
-            "mesh_refine_octree: ctx, mesh, flags and out must not be NULL");
+            "mesh_create_refined: ctx, mesh, flags and out must not be NULL");
   *out = NULL;
   FCM_CHECK(mesh->cell_level, ctx, FCM_ERR_UNSUPPORTED,
-            "mesh_refine_octree: the %s mesh was not made by fcm_mesh_create_octree(); only "
+            "mesh_create_refined: the %s mesh was not made by fcm_mesh_create_octree(); only "
             "octree meshes are refined",
             mesh->info->name);
   T.ctx = ctx;
@@ -512,7 +512,7 @@ fcm_status fcm_mesh_refine_octree(fcm_ctx *ctx, const fcm_mesh *mesh, const unsi
       T.leaves[c].x[d] = mesh->cell_pos[3 * c + d];
     if (!flags[c]) continue;
     FCM_CHECK(mesh->cell_level[c] < FCM_OCTREE_MAX_LEVEL, ctx, FCM_ERR_ARG,
-              "mesh_refine_octree: cell %lld is at level %d already, the deepest "
+              "mesh_create_refined: cell %lld is at level %d already, the deepest "
               "(FCM_OCTREE_MAX_LEVEL); it cannot be split",
               (long long)c, (int)mesh->cell_level[c]);
     split[c] = 1;
@@ -548,8 +548,8 @@ fcm_index fcm_mesh_num_hanging(const fcm_mesh *mesh)
   return mesh->num_hanging;
 }
 
-void fcm_mesh_hanging(const fcm_mesh *mesh, fcm_index i, fcm_index *cell, fcm_index *node,
-                      double xi[3])
+void fcm_mesh_get_hanging(const fcm_mesh *mesh, fcm_index i, fcm_index *cell, fcm_index *node,
+                          double xi[3])
 {
   if (cell) *cell = mesh->hang_cell[i];
   if (node) *node = mesh->hang_node[i];

@@ -640,7 +640,7 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
   FCM_CHECK(fcm_mesh_num_hanging(fcm_space_mesh(I->space)) == 0, ctx, FCM_ERR_UNSUPPORTED,
             "integrator: the space's mesh is an octree with %lld hanging (cell, node) pairs; the "
             "integrators do not apply hanging-node constraints (a static linear solve does: "
-            "fcm_space_hanging_create() and fcm_csr_ptap())",
+            "fcm_space_hanging_matrix_create() and fcm_csr_create_ptap())",
             (long long)fcm_mesh_num_hanging(fcm_space_mesh(I->space)));
   FCM_TRY(ctx, build_constraints(I));
   FCM_TRY(ctx, setup_storage(I));
