@@ -8,9 +8,7 @@
 #include <fcm/simulation.h>
 
 #include "cli.h"
-#if FCM_HAVE_PETSC
-#include "fcm-sim-petsc.h"
-#endif
+#include "fcm-sim-petsc.h" /* sim_print_output(), defined here, is declared there */
 
 #include <errno.h>
 #include <omp.h>
