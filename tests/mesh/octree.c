@@ -175,6 +175,15 @@ static int check(fcm_element_type type)
   TEST_TRUE(fcm_mesh_max_level(m) == 4);
   TEST_TRUE(fcm_mesh_num_hanging(m) > 0);
   check_mesh(ctx, m, type, 1);
+  { /* the summary reports the cells per level */
+    FILE *f = tmpfile();
+    char text[1024] = {0};
+    fcm_mesh_view(m, f);
+    rewind(f);
+    TEST_TRUE(fread(text, 1, sizeof text - 1, f) > 0);
+    fclose(f);
+    TEST_TRUE(strstr(text, "cells per level: 0: ") != NULL && strstr(text, ", 4: ") != NULL);
+  }
   /* refine further: cells with centre x < 0.3 are split and the result checked alike */
   const fcm_index nc = fcm_mesh_num_cells(m);
   unsigned char *flags = calloc((size_t)nc, 1);
