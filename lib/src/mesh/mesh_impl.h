@@ -48,6 +48,11 @@ fcm_status fcm__mesh_add_mid_edge_nodes(fcm_ctx *ctx, fcm_element_type linear_ty
                                         fcm_index *new_num_nodes, double **new_coords,
                                         fcm_index **new_cells);
 
+/* The box grid arguments of the structured generators: per axis finite lo < hi and
+ * 1 <= n <= 2^20 cells; FCM_ERR_ARG naming `who` and the axis otherwise. (mesh_box.c) */
+fcm_status fcm__mesh_check_grid(fcm_ctx *ctx, const char *who, const double lo[3],
+                                const double hi[3], const fcm_index n[3]);
+
 /* Group the faces of `num_cells` cells of type `info` (connectivity `cells`, num_nodes
  * ids per cell) by their corner node sets: the one face matcher of the library (mesh
  * adjacency, geometry boundary). Faces are numbered c * num_faces + f; for each face i,

@@ -452,12 +452,8 @@ fcm_status fcm_mesh_create_octree(fcm_ctx *ctx, fcm_element_type type, const dou
   T.ctx = ctx;
   T.o = opts ? opts : &defaults;
   FCM_TRY(ctx, check_options(ctx, T.o));
+  FCM_TRY(ctx, fcm__mesh_check_grid(ctx, "mesh_create_octree", lo, hi, n));
   for (int d = 0; d < 3; d++) {
-    FCM_CHECK(isfinite(lo[d]) && isfinite(hi[d]) && lo[d] < hi[d], ctx, FCM_ERR_ARG,
-              "mesh_create_octree: axis %d: need finite lo < hi, got [%g, %g]", d, lo[d], hi[d]);
-    FCM_CHECK(n[d] >= 1 && n[d] <= (1 << 20), ctx, FCM_ERR_ARG,
-              "mesh_create_octree: axis %d: %lld cells out of range [1, %d]", d, (long long)n[d],
-              1 << 20);
     T.lo[d] = lo[d];
     T.hi[d] = hi[d];
     T.n[d] = n[d];
