@@ -75,3 +75,5 @@ endforeach()
 foreach(el hex8 hex20)
   fcm_add_test(fem_octree_embedded_${el} tests/fem/octree_embedded.c ARGS ${el} LABELS conformance)
 endforeach()
+# Allocation failures in the octree's entry points: mesh, refinement, constraints, PtAP.
+fcm_add_test(fem_octree_alloc tests/fem/octree_alloc.c)
