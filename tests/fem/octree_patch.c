@@ -1,5 +1,6 @@
 /* Patch tests across hanging nodes, Hex8 and Hex20 on an octree background refined toward a
- * sphere (levels 0..3, chains of constraints at 2:1):
+ * sphere (levels 0..3, chains of constraints at 2:1), and the stress-jump indicator on their
+ * solutions (zero for the affine field, its definition for the quadratic one):
  * - continuity: a random field u = T u_free, evaluated on both sides of every face and edge at
  *   sample points, agrees to rounding (without the constraints it jumps);
  * - affine displacement with affine Dirichlet data: the constrained static solve
@@ -93,11 +94,60 @@ static double max_jump(const fcm_space *s, const double *u)
   return jump;
 }
 
+/* The stress of the quadratic field at x, components in any fixed order. */
+static void quadratic_stress(const double x[3], double sig[6])
+{
+  const double lam = lam_mu[0], mu = lam_mu[1];
+  double G[9], e[6]; /* grad u by central differences is exact for a quadratic: use it */
+  for (int j = 0; j < 3; j++) {
+    double xp[3] = {x[0], x[1], x[2]}, xm[3] = {x[0], x[1], x[2]}, up[3], um[3];
+    xp[j] += 0.5, xm[j] -= 0.5;
+    quadratic(xp, up), quadratic(xm, um);
+    for (int i = 0; i < 3; i++)
+      G[3 * i + j] = up[i] - um[i];
+  }
+  e[0] = G[0], e[1] = G[4], e[2] = G[8];
+  e[3] = 0.5 * (G[1] + G[3]), e[4] = 0.5 * (G[5] + G[7]), e[5] = 0.5 * (G[2] + G[6]);
+  const double tr = e[0] + e[1] + e[2];
+  for (int k = 0; k < 6; k++)
+    sig[k] = 2.0 * mu * e[k] + (k < 3 ? lam * tr : 0.0);
+}
+
+/* eta of fcm_space_stress_jumps() against its definition for the quadratic field. */
+static void check_jumps(const fcm_mesh *m, const double *eta)
+{
+  const fcm_index nc = fcm_mesh_num_cells(m), nn = fcm_mesh_num_nodes(m);
+  const int npc = fcm_mesh_nodes_per_cell(m);
+  const double *X = fcm_mesh_coords(m);
+  double *lo = malloc(sizeof *lo * 6 * (size_t)nn), *hi = malloc(sizeof *hi * 6 * (size_t)nn);
+  for (fcm_index i = 0; i < 6 * nn; i++)
+    lo[i] = HUGE_VAL, hi[i] = -HUGE_VAL;
+  for (int pass = 0; pass < 2; pass++)
+    for (fcm_index c = 0; c < nc; c++) {
+      const fcm_index *cn = fcm_mesh_cells(m) + (size_t)npc * c;
+      double xc[3], sig[6], h = 0.0, jump = 0.0;
+      for (int d = 0; d < 3; d++)
+        xc[d] = 0.5 * (X[3 * cn[0] + d] + X[3 * cn[6] + d]);
+      h = X[3 * cn[6]] - X[3 * cn[0]];
+      quadratic_stress(xc, sig);
+      for (int a = 0; a < npc; a++)
+        for (int k = 0; k < 6; k++) {
+          double *l = lo + 6 * cn[a] + k, *g = hi + 6 * cn[a] + k;
+          if (pass == 0)
+            *l = fmin(*l, sig[k]), *g = fmax(*g, sig[k]);
+          else
+            jump = fmax(jump, *g - *l);
+        }
+      if (pass == 1) TEST_NEAR(eta[c], sqrt(h * h * h) * jump, 1e-8, 1e-9);
+    }
+  free(lo), free(hi);
+}
+
 /* Solve T^T K T v = T^T f with the exact field prescribed at the free DOFs of boundary nodes;
  * return the largest nodal error of u = T v against the exact field. */
 static double constrained_solve(fcm_ctx *ctx, const fcm_space *s, const fcm_csr *K,
                                 const fcm_csr *T, const fcm_index *free_dof, const double *f,
-                                void (*exact)(const double *, double *))
+                                void (*exact)(const double *, double *), double *u_out)
 {
   const fcm_mesh *m = fcm_space_mesh(s);
   const double *X = fcm_mesh_coords(m);
@@ -138,6 +188,7 @@ static double constrained_solve(fcm_ctx *ctx, const fcm_space *s, const fcm_csr 
     for (int i = 0; i < 3; i++)
       err = fmax(err, fabs(u[fcm_space_node_dof(s, a) + i] - ue[i]));
   }
+  memcpy(u_out, u, sizeof *u * (size_t)n);
   free(b), free(v), free(g), free(u), free(con);
   fcm_csr_destroy(&Kr);
   return err;
@@ -207,15 +258,28 @@ int main(int argc, char **argv)
   fcm_material mat = {FCM_MATERIAL_LINEAR, 2.0e5, 0.3, 1.0};
   TEST_OK(ctx, fcm_assemble_stiffness(space, &mat, NULL, K));
   double *f = calloc((size_t)n, sizeof *f);
-  TEST_NEAR(constrained_solve(ctx, space, K, T, free_dof, f, affine), 0.0, 0.0, 1e-12);
+  double *us = calloc((size_t)n, sizeof *us),
+         *eta = calloc((size_t)fcm_mesh_num_cells(mesh), sizeof *eta);
+  TEST_NEAR(constrained_solve(ctx, space, K, T, free_dof, f, affine, us), 0.0, 0.0, 1e-12);
+  /* the stress-jump indicator vanishes for the constant stress of an affine field (|sigma| ~
+   * E |grad u| = 600) */
+  TEST_OK(ctx, fcm_space_stress_jumps(space, &mat, us, eta));
+  double eta_max = 0.0;
+  for (fcm_index c = 0; c < fcm_mesh_num_cells(mesh); c++)
+    eta_max = fmax(eta_max, eta[c]);
+  TEST_NEAR(eta_max, 0.0, 0.0, 1e-9 * 600.0);
   if (type == FCM_ELEMENT_HEX20) {
     const double lam = lam_mu[0], mu = lam_mu[1];
     const double accel[3] = {-qa * (2 * lam + 4 * mu), 0.0, -qa * (lam + mu)};
     TEST_OK(ctx, fcm_assemble_body_force(space, &mat, accel, NULL, f));
-    TEST_NEAR(constrained_solve(ctx, space, K, T, free_dof, f, quadratic), 0.0, 0.0, 1e-12);
+    TEST_NEAR(constrained_solve(ctx, space, K, T, free_dof, f, quadratic, us), 0.0, 0.0, 1e-12);
+    /* its stress is linear in x: the cell averages are the values at the centres, and the
+     * indicator is sqrt(|c|) x the largest jump of those over the cells at c's nodes */
+    TEST_OK(ctx, fcm_space_stress_jumps(space, &mat, us, eta));
+    check_jumps(mesh, eta);
   }
 
-  free(f), free(v), free(u), free(free_dof);
+  free(f), free(v), free(u), free(free_dof), free(us), free(eta);
   fcm_csr_destroy(&K);
   fcm_csr_destroy(&T);
   fcm_space_destroy(&space);

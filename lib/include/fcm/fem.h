@@ -469,6 +469,18 @@ FCM_API fcm_status fcm_space_cell_stress(const fcm_space *space, const fcm_mater
                                          const double *u, double *stress, double *von_mises,
                                          double *energy_density);
 
+/** A refinement indicator for static runs: eta[c] = sqrt(|c|) x the largest jump, over the
+ * nodes of cell c and the six components, of the cell-averaged stress
+ * (fcm_space_cell_stress()) between the active cells sharing that node. Zero for a constant
+ * stress (an affine u), about h^(5/2) |grad sigma| where the stress varies smoothly, large at
+ * concentrations and singularities. Mark the cells with eta above a fraction of its largest
+ * value and refine them (fcm_mesh_create_refined()). Inactive cells get 0.
+ * @param[out] eta num_cells entries
+ * @return FCM_OK, FCM_ERR_ARG (NULL, bad material), FCM_ERR_ALLOC. Allocates O(cells + nodes)
+ * scratch. Deterministic. */
+FCM_API fcm_status fcm_space_stress_jumps(const fcm_space *space, const fcm_material *mat,
+                                          const double *u, double *eta);
+
 /** The largest |u| over the body's quadrature points (the authentic points of the stiffness
  * rules of every element; the fictitious part of cut cells and inactive nodes do not count).
  * @return FCM_OK, FCM_ERR_ARG (NULL), FCM_ERR_ALLOC (the standard rule). */
