@@ -33,3 +33,6 @@ set_tests_properties(bench_cut_update PROPERTIES RUN_SERIAL TRUE)
 # same finest cell size: cells, crossed and active cells (figures in lib/docs/octree.md).
 fcm_add_test(bench_octree_cells tests/bench/bench_octree_cells.c LABELS bench TIMEOUT 1800
              ARGS ${PROJECT_SOURCE_DIR}/apps/scenes/models/cutbench_body.obj)
+# Convergence toward a corner singularity: octrees grown by the stress-jump indicator against
+# uniform grids, the DOFs at equal error (figures in lib/docs/octree.md).
+fcm_add_test(bench_octree_converge tests/bench/bench_octree_converge.c LABELS bench TIMEOUT 1800)
