@@ -77,3 +77,7 @@ foreach(el hex8 hex20)
 endforeach()
 # Allocation failures in the octree's entry points: mesh, refinement, constraints, PtAP.
 fcm_add_test(fem_octree_alloc tests/fem/octree_alloc.c)
+# Fields carried onto a refined octree: momentum and kinetic energy kept, hanging values.
+foreach(el hex8 hex20)
+  fcm_add_test(fem_octree_transfer_${el} tests/fem/octree_transfer.c ARGS ${el})
+endforeach()

@@ -413,6 +413,19 @@ FCM_API fcm_status fcm_space_locate(const fcm_space *space, fcm_index n, const d
 FCM_API fcm_status fcm_space_interpolate(const fcm_space *space, fcm_index n, const fcm_index *cell,
                                          const double *xi, const double *u, double *values);
 
+/** Carry a field (displacement, velocity: num_dofs of `from`) onto the space `to` of a
+ * refined background (fcm_mesh_create_refined()): each DOF of `to` takes the field of
+ * `from` at its node (fcm_space_locate(), fcm_space_interpolate()). When every field of
+ * `from` lies in `to` — a refinement of the same octree, hanging nodes constrained — the
+ * field is reproduced exactly, so mass, momentum and kinetic energy are kept to rounding;
+ * the hanging nodes of `to` get the values their constraints give.
+ * @param[out] u_to num_dofs of `to`
+ * @return FCM_OK; FCM_ERR_ARG (NULL, other element types, a node of `to` in no active cell of
+ *         `from`: not a refinement); FCM_ERR_UNSUPPORTED (DOF copies: spaces after cuts);
+ *         the errors of fcm_space_locate(); FCM_ERR_ALLOC. Allocates O(nodes). */
+FCM_API fcm_status fcm_space_transfer_refined(const fcm_space *from, const fcm_space *to,
+                                              const double *u, double *u_to);
+
 /* ---------------------------------------------------------------- fields and output
  * What a host writes out of a solution u (num_dofs): node and surface-point fields, stress,
  * VTU files. Output convention: every file holds the points at their REFERENCE positions
