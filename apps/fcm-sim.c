@@ -8,7 +8,7 @@
 #include <fcm/simulation.h>
 
 #include "cli.h"
-#include "fcm-sim-petsc.h" /* sim_print_output(), defined here, is declared there */
+#include "fcm-sim-petsc.h" /* sim_print_output(); sim_petsc_run() is built with FCM_HAVE_PETSC */
 
 #include <errno.h>
 #include <omp.h>
