@@ -29,3 +29,10 @@ set_tests_properties(bench_roofline PROPERTIES RUN_SERIAL TRUE)
 # Hex8 grid around a ball of about 5k and 20k active cells (figures in lib/docs/cutting.md).
 fcm_add_test(bench_cut_update tests/bench/bench_cut_update.c LABELS bench TIMEOUT 1800)
 set_tests_properties(bench_cut_update PROPERTIES RUN_SERIAL TRUE)
+# Octree backgrounds refined along a sphere and the cutbench body against uniform grids of the
+# same finest cell size: cells, crossed and active cells (figures in lib/docs/octree.md).
+fcm_add_test(bench_octree_cells tests/bench/bench_octree_cells.c LABELS bench TIMEOUT 1800
+             ARGS ${PROJECT_SOURCE_DIR}/apps/scenes/models/cutbench_body.obj)
+# Convergence toward a corner singularity: octrees grown by the stress-jump indicator against
+# uniform grids, the DOFs at equal error (figures in lib/docs/octree.md).
+fcm_add_test(bench_octree_converge tests/bench/bench_octree_converge.c LABELS bench TIMEOUT 1800)

@@ -67,3 +67,17 @@ endforeach()
 foreach(el tet4 tet10 hex8 hex20)
   fcm_add_test(fem_cut_surface_${el} tests/fem/cut_surface.c ARGS ${el})
 endforeach()
+# Octree backgrounds: continuity through the hanging-node constraints and patch tests across
+# hanging nodes (affine fields; quadratic ones for Hex20).
+foreach(el hex8 hex20)
+  fcm_add_test(fem_octree_patch_${el} tests/fem/octree_patch.c ARGS ${el} LABELS conformance)
+endforeach()
+foreach(el hex8 hex20)
+  fcm_add_test(fem_octree_embedded_${el} tests/fem/octree_embedded.c ARGS ${el} LABELS conformance)
+endforeach()
+# Allocation failures in the octree's entry points: mesh, refinement, constraints, PtAP.
+fcm_add_test(fem_octree_alloc tests/fem/octree_alloc.c)
+# Fields carried onto a refined octree: momentum and kinetic energy kept, hanging values.
+foreach(el hex8 hex20)
+  fcm_add_test(fem_octree_transfer_${el} tests/fem/octree_transfer.c ARGS ${el})
+endforeach()

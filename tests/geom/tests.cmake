@@ -32,3 +32,5 @@ fcm_add_test(geom_surface_mesh tests/geom/surface_mesh.c)
 set_tests_properties(geom_surface_mesh PROPERTIES ENVIRONMENT "OMP_NUM_THREADS=3")
 # Allocation failures in the surface checks, reorientation, hole filling and meshing.
 fcm_add_test(geom_surface_alloc tests/geom/surface_alloc.c)
+# Octree refinement criteria along triangle surfaces (cut surfaces, an embedded boundary).
+fcm_add_test(geom_refine tests/geom/refine.c)

@@ -7,3 +7,7 @@ fcm_add_test(mesh_gmsh tests/mesh/gmsh.c)
 fcm_add_test(mesh_gmsh_errors tests/mesh/gmsh_errors.c)
 fcm_add_test(mesh_validate tests/mesh/validate.c)
 fcm_add_test(mesh_view tests/mesh/view.c)
+# Octree backgrounds: refinement criteria, 2:1 balance, volumes, boundary, hanging nodes.
+foreach(el hex8 hex20)
+  fcm_add_test(mesh_octree_${el} tests/mesh/octree.c ARGS ${el})
+endforeach()

@@ -123,6 +123,25 @@ FCM_API int fcm_space_num_colors(const fcm_space *space);
 /** The mesh the space was built on. */
 FCM_API const fcm_mesh *fcm_space_mesh(const fcm_space *space);
 
+/** Hanging-node constraints of a space on an octree mesh (fcm_mesh_create_octree()): the
+ * matrix T (num_dofs x num_free) with u = T u_free for every field of the conforming space.
+ * A node hanging on a face or edge of an active cell takes the value of that cell's trace
+ * there (its shape functions at the node: Hex8 1/2 on an edge, 1/4 on a face; Hex20 the
+ * serendipity face or edge functions), with masters that hang themselves replaced by their
+ * own masters (chains at 2:1); every other active DOF is free (its row of T is one 1). The
+ * constrained system is T^T K T u_free = T^T f (fcm_csr_create_ptap()); Dirichlet values go on the
+ * free DOFs. A node hanging only on inactive cells stays free.
+ * @param[in]  space    any space on any mesh (a mesh without hanging nodes gives T = I)
+ * @param[out] free_dof num_dofs entries (may be NULL): the column of each free DOF, -1 for
+ *                      a constrained one
+ * @param[out] T        the new matrix (FCM_CSR_GENERAL), NULL on failure
+ * @return FCM_OK; FCM_ERR_ARG (NULL); FCM_ERR_UNSUPPORTED (a constrained node, or a node of
+ *         its cell, with several DOF copies: cuts enrich it; copies constrained to move with
+ *         their piece; more free DOFs than 32-bit columns); FCM_ERR_ALLOC.
+ * Allocates T and O(num_nodes) scratch. Thread safe. */
+FCM_API fcm_status fcm_space_hanging_matrix_create(const fcm_space *space, fcm_index *free_dof,
+                                                   fcm_csr **T);
+
 /** Carry a field (displacement, velocity: num_dofs of `from`) over a cut: `to` must be the
  * space of rules that extend the rules of `from` by one cut (fcm_cell_rules_create_cut()).
  * Every copy of `to` takes, from one of the elements that use it, the value that element's
@@ -394,6 +413,19 @@ FCM_API fcm_status fcm_space_locate(const fcm_space *space, fcm_index n, const d
 FCM_API fcm_status fcm_space_interpolate(const fcm_space *space, fcm_index n, const fcm_index *cell,
                                          const double *xi, const double *u, double *values);
 
+/** Carry a field (displacement, velocity: num_dofs of `from`) onto the space `to` of a
+ * refined background (fcm_mesh_create_refined()): each DOF of `to` takes the field of
+ * `from` at its node (fcm_space_locate(), fcm_space_interpolate()). When every field of
+ * `from` lies in `to` — a refinement of the same octree, hanging nodes constrained — the
+ * field is reproduced exactly, so mass, momentum and kinetic energy are kept to rounding;
+ * the hanging nodes of `to` get the values their constraints give.
+ * @param[out] u_to num_dofs of `to`
+ * @return FCM_OK; FCM_ERR_ARG (NULL, other element types, a node of `to` in no active cell of
+ *         `from`: not a refinement); FCM_ERR_UNSUPPORTED (DOF copies: spaces after cuts);
+ *         the errors of fcm_space_locate(); FCM_ERR_ALLOC. Allocates O(nodes). */
+FCM_API fcm_status fcm_space_transfer_refined(const fcm_space *from, const fcm_space *to,
+                                              const double *u, double *u_to);
+
 /* ---------------------------------------------------------------- fields and output
  * What a host writes out of a solution u (num_dofs): node and surface-point fields, stress,
  * VTU files. Output convention: every file holds the points at their REFERENCE positions
@@ -449,6 +481,18 @@ FCM_API fcm_status fcm_space_element_stress(const fcm_space *space, const fcm_ma
 FCM_API fcm_status fcm_space_cell_stress(const fcm_space *space, const fcm_material *mat,
                                          const double *u, double *stress, double *von_mises,
                                          double *energy_density);
+
+/** A refinement indicator for static runs: eta[c] = sqrt(|c|) x the largest jump, over the
+ * nodes of cell c and the six components, of the cell-averaged stress
+ * (fcm_space_cell_stress()) between the active cells sharing that node. Zero for a constant
+ * stress (an affine u), about h^(5/2) |grad sigma| where the stress varies smoothly, large at
+ * concentrations and singularities. Mark the cells with eta above a fraction of its largest
+ * value and refine them (fcm_mesh_create_refined()). Inactive cells get 0.
+ * @param[out] eta num_cells entries
+ * @return FCM_OK, FCM_ERR_ARG (NULL, bad material), FCM_ERR_ALLOC. Allocates O(cells + nodes)
+ * scratch. Deterministic. */
+FCM_API fcm_status fcm_space_stress_jumps(const fcm_space *space, const fcm_material *mat,
+                                          const double *u, double *eta);
 
 /** The largest |u| over the body's quadrature points (the authentic points of the stiffness
  * rules of every element; the fictitious part of cut cells and inactive nodes do not count).

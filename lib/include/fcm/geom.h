@@ -128,6 +128,17 @@ FCM_API fcm_index fcm_geometry_num_boundary_triangles(const fcm_geometry *geom);
 FCM_API const fcm_index *fcm_geometry_boundary_triangles(const fcm_geometry *geom);
 FCM_API const fcm_index *fcm_geometry_boundary_cells(const fcm_geometry *geom);
 
+/** Refinement along the embedded boundary, an fcm_octree_refine_fn (fcm/mesh.h) with
+ * `geometry` a const fcm_geometry *: 1 when some boundary triangle meets the closed box
+ * [lo, hi] (exact separating-axis test; the cells the cut-cell rules see as cut, and cells
+ * the surface only touches), else 0; -1 for NULL arguments or when the triangle search
+ * tree cannot be allocated (the error is recorded on the geometry's context). Set
+ * refine = fcm_geometry_boundary_meets_box, refine_user = geometry and refine_level in
+ * fcm_octree_options. Builds the geometry's triangle tree on its first use (kept by the
+ * geometry); allocates a small query buffer. Thread safe. */
+FCM_API int fcm_geometry_boundary_meets_box(const double lo[3], const double hi[3], int level,
+                                            void *geometry);
+
 /** Print type, counts, volume, bounding box and boundary size to `stream`. */
 FCM_API void fcm_geometry_view(const fcm_geometry *geom, FILE *stream);
 

@@ -99,6 +99,16 @@ FCM_API void fcm_csr_set_zero(fcm_csr *A);
 FCM_API fcm_status fcm_csr_apply(const fcm_csr *A, double alpha, const double *x, double beta,
                                  double *y);
 
+/** The triple product C = P^T A P of a square A (n x n) and P (n x m): C is m x m, of A's
+ * kind (a symmetric C has its mirrored entries averaged, so it is exactly symmetric), with
+ * every diagonal entry stored. For a constrained system: P the constraint matrix of
+ * fcm_space_hanging_matrix_create().
+ * @param[out] C the new matrix, NULL on failure
+ * @return FCM_OK, FCM_ERR_ARG (NULL, A not square, P's rows not A's), FCM_ERR_ALLOC.
+ * Allocates C and O(nnz(A P)) scratch. Thread safe. */
+FCM_API fcm_status fcm_csr_create_ptap(fcm_ctx *ctx, const fcm_csr *A, const fcm_csr *P,
+                                       fcm_csr **C);
+
 /** Largest |a_ij - a_ji| over stored entries (an entry whose mirror is not
  * stored counts against 0), divided by max |a_ij| (0 for a zero matrix).
  * @return FCM_OK, FCM_ERR_ARG (A not square). No allocation. Thread safe. */

@@ -49,6 +49,94 @@ FCM_API fcm_status fcm_mesh_create(fcm_ctx *ctx, fcm_element_type type, fcm_inde
 FCM_API fcm_status fcm_mesh_create_box(fcm_ctx *ctx, fcm_element_type type, const double lo[3],
                                        const double hi[3], const fcm_index n[3], fcm_mesh **mesh);
 
+/** Deepest refinement level of an octree mesh (the box grid is level 0). */
+#define FCM_OCTREE_MAX_LEVEL 12
+/** Most cells an octree mesh may have. */
+#define FCM_OCTREE_MAX_CELLS ((fcm_index)1 << 30)
+/** fcm_mesh_neighbors() entry of a face that meets cells of another level (an octree
+ * mesh's face against four finer faces, or a quarter of a coarser one): interior, not
+ * boundary, with no single cell across. */
+#define FCM_MESH_NEIGHBOR_NONCONFORMING (-2)
+
+/** Scalar level set phi(x) (the refinement surface is phi = 0); same signature as
+ * fcm_level_set_fn of fcm/levelset.h. */
+typedef double (*fcm_octree_levelset_fn)(const double x[3], void *user);
+/** Refinement predicate: 1 to split the cell [lo, hi] of `level` into eight, 0 to keep it,
+ * negative when it failed (fcm_mesh_create_octree() then fails with FCM_ERR_ARG naming the
+ * cell; the callback records its own error where it can). */
+typedef int (*fcm_octree_refine_fn)(const double lo[3], const double hi[3], int level, void *user);
+
+/** Refinement criteria of fcm_mesh_create_octree(). A cell is split while one criterion
+ * asks for it and the cell is coarser than that criterion's level (0: criterion off; each
+ * level in [0, FCM_OCTREE_MAX_LEVEL]); the criteria combine by "or". */
+typedef struct fcm_octree_options {
+  int region_level;    /**< cells meeting the closed box [region_lo, region_hi] */
+  double region_lo[3]; /**< region box, lo <= hi per axis */
+  double region_hi[3];
+  int surface_level;              /**< cells the surface phi = 0 crosses: phi changes sign (or is 0)
+                                       over the 3 x 3 x 3 corner, edge, face and centre points */
+  fcm_octree_levelset_fn surface; /**< the level set (called serially) */
+  void *surface_user;
+  int refine_level;            /**< cells the callback flags: along an embedded boundary
+                                    fcm_geometry_boundary_meets_box() (fcm/geom.h), along a
+                                    cut surface fcm_surface_meets_box() (fcm/surface.h) */
+  fcm_octree_refine_fn refine; /**< called serially */
+  void *refine_user;
+} fcm_octree_options;
+
+/** All criteria off: the box grid itself. */
+FCM_API fcm_octree_options fcm_octree_options_default(void);
+
+/** Octree background: the box grid of fcm_mesh_create_box() (n[0] x n[1] x n[2] cubes over
+ * [lo, hi]) with cells split into eight by the criteria of `opts`, then balanced 2:1 across
+ * faces and edges (cells sharing a face or an edge differ by at most one level; balancing
+ * only splits). Cells are hexahedra of the given type in the depth-first order of the tree;
+ * nodes are shared wherever cells of any levels meet at the same point, so the cells of
+ * different sizes are joined through hanging nodes: a node on a face or edge of a coarser
+ * cell that is not a node of that cell (fcm_mesh_get_hanging()); the fem module constrains
+ * them (fcm_space_hanging_matrix_create() in fcm/fem.h). Faces against finer cells have the
+ * neighbour FCM_MESH_NEIGHBOR_NONCONFORMING; the boundary faces are the box surface.
+ * @param[in]  type  FCM_ELEMENT_HEX8 or FCM_ELEMENT_HEX20
+ * @param[in]  opts  criteria (NULL: none); callbacks are called serially
+ * @param[out] mesh  the new mesh, NULL on failure
+ * @return FCM_OK; FCM_ERR_UNSUPPORTED (a tetrahedral type); FCM_ERR_ARG (NULL, box or counts
+ *         as fcm_mesh_create_box(), a level beyond FCM_OCTREE_MAX_LEVEL, more than
+ *         FCM_OCTREE_MAX_CELLS cells, a criterion level without its function, a failing
+ *         refine callback); FCM_ERR_ALLOC.
+ * Allocates; release with fcm_mesh_destroy(). Thread safe (the callbacks permitting). */
+FCM_API fcm_status fcm_mesh_create_octree(fcm_ctx *ctx, fcm_element_type type, const double lo[3],
+                                          const double hi[3], const fcm_index n[3],
+                                          const fcm_octree_options *opts, fcm_mesh **mesh);
+
+/** Refine an octree mesh further: split the cells with flags[c] != 0 into eight (an error
+ * indicator's marks, cells with a small volume fraction, cut cells of a rules build, ...),
+ * balance 2:1 again and write the new mesh (cells in the tree's depth-first order: unsplit
+ * cells keep their relative order). The input is unchanged.
+ * @param[in]  mesh  made by fcm_mesh_create_octree() or this function
+ * @param[in]  flags num_cells entries
+ * @param[out] out   the new mesh, NULL on failure
+ * @return FCM_OK; FCM_ERR_ARG (NULL, a flagged cell at FCM_OCTREE_MAX_LEVEL, more than
+ *         FCM_OCTREE_MAX_CELLS cells); FCM_ERR_UNSUPPORTED (not an octree mesh: a box grid of
+ *         fcm_mesh_create_box(), a Gmsh mesh, a tetrahedral mesh); FCM_ERR_ALLOC.
+ * Allocates; release with fcm_mesh_destroy(). Thread safe. */
+FCM_API fcm_status fcm_mesh_create_refined(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                           const unsigned char *flags, fcm_mesh **out);
+
+/** Whether the mesh was made by fcm_mesh_create_octree(). */
+FCM_API int fcm_mesh_is_octree(const fcm_mesh *mesh);
+/** Refinement level of `cell` (0 for a mesh that is not an octree). */
+FCM_API int fcm_mesh_cell_level(const fcm_mesh *mesh, fcm_index cell);
+/** Deepest level of any cell (0 for a mesh that is not an octree). */
+FCM_API int fcm_mesh_max_level(const fcm_mesh *mesh);
+/** Number of (cell, hanging node) pairs of an octree mesh (0 for other meshes). */
+FCM_API fcm_index fcm_mesh_num_hanging(const fcm_mesh *mesh);
+/** Pair i in [0, fcm_mesh_num_hanging()): `node` lies on a face or edge of `cell` without
+ * being one of its nodes; xi are its reference coordinates in the cell (exact: multiples of
+ * 1/2 for Hex8, 1/4 for Hex20). A node may be listed with several cells (all around an
+ * edge). Outputs may be NULL. No allocation; thread safe. */
+FCM_API void fcm_mesh_get_hanging(const fcm_mesh *mesh, fcm_index i, fcm_index *cell,
+                                  fcm_index *node, double xi[3]);
+
 /** Read a Gmsh MSH file, ASCII version 4.1 or 2.x (2.0, 2.1, 2.2). Volume elements of
  * Gmsh types 4 (tet4), 11 (tet10), 5 (hex8) and 17 (hex20) become the cells, in file
  * order, reordered from Gmsh's to VTK's node order; lower-dimensional elements (points,
@@ -83,7 +171,8 @@ FCM_API const fcm_index *fcm_mesh_cells(const fcm_mesh *mesh);
 FCM_API void fcm_mesh_cell_coords(const fcm_mesh *mesh, fcm_index cell, double *X);
 
 /** Face adjacency: num_cells x num_faces (num_faces of the element info: 4 or 6);
- * entry [nf*c + f] is the cell across local face f of cell c, or -1 on the boundary.
+ * entry [nf*c + f] is the cell across local face f of cell c, or -1 on the boundary, or
+ * FCM_MESH_NEIGHBOR_NONCONFORMING (octree meshes: cells of another level across).
  * Faces are matched by their corner nodes. */
 FCM_API const fcm_index *fcm_mesh_neighbors(const fcm_mesh *mesh);
 

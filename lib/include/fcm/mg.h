@@ -119,7 +119,8 @@ typedef struct fcm_mg fcm_mg;
  *                   defaults
  * @param[out] mg    the new object, NULL on failure
  * @return FCM_OK, FCM_ERR_ARG (NULL, option out of range, A not the space's size),
- * FCM_ERR_UNSUPPORTED (not a Hex8 or Hex20 box grid: the message names the cell),
+ * FCM_ERR_UNSUPPORTED (not a Hex8 or Hex20 box grid: the message names the cell; an octree
+ * mesh with hanging nodes),
  * FCM_ERR_SINGULAR or FCM_ERR_NUMERIC (the coarsest factorization, a zero diagonal),
  * FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,

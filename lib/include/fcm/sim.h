@@ -484,8 +484,10 @@ FCM_API fcm_status fcm_integrator_boundary_eval(fcm_integrator *integ, const dou
  * @return FCM_OK, FCM_ERR_ARG (option out of range: named; DOF constrained twice; zero
  * representative force: set the density or use the relative rule; a boundary constraint on a
  * space without surface rules, or selecting no point), FCM_ERR_NUMERIC (a Nitsche penalty that
- * cannot be estimated: a cell stiffness singular beyond rigid modes, the cell named), errors
- * of the assembly and of the solvers, FCM_ERR_ALLOC. Allocates; a second call is FCM_ERR_ARG. */
+ * cannot be estimated: a cell stiffness singular beyond rigid modes, the cell named),
+ * FCM_ERR_UNSUPPORTED (a space on an octree mesh with hanging nodes: the integrators do not
+ * apply their constraints), errors of the assembly and of the solvers, FCM_ERR_ALLOC.
+ * Allocates; a second call is FCM_ERR_ARG. */
 FCM_API fcm_status fcm_integrator_setup(fcm_integrator *integ);
 
 /** Advance by one step of options.dt (static: solve the equilibrium at t + dt, ramping the

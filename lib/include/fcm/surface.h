@@ -207,6 +207,16 @@ FCM_API fcm_status fcm_surface_create_filled(fcm_ctx *ctx, const fcm_surface *sr
                                              const fcm_surface_fill_options *opts,
                                              fcm_surface **surf, fcm_surface_fill_info *info);
 
+/** Refinement along a cut surface, an fcm_octree_refine_fn (fcm/mesh.h) with `surface` a
+ * const fcm_surface * (a blade: fcm_surface_create_rectangle(), a plane clipped to a box:
+ * fcm_surface_create_plane(), a surface read from a file): 1 when some triangle meets the
+ * closed box [lo, hi] (exact separating-axis test), else 0; -1 for NULL arguments. Refining
+ * before the cut resolves the cut's detail where it will happen. Tests every triangle of the
+ * surface (O(triangles) per cell: meant for cut surfaces of few triangles; an embedded
+ * body's boundary goes through fcm_geometry_boundary_meets_box(), which searches a tree). No
+ * allocation; thread safe. */
+FCM_API int fcm_surface_meets_box(const double lo[3], const double hi[3], int level, void *surface);
+
 /* ------------------------------------------------------------------ tetrahedra */
 
 /** Options of fcm_geometry_create_from_surface(). */

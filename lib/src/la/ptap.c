@@ -247,3 +247,31 @@ void fcm__ptap_transpose(const fcm__ptap *t, const fcm_index **R_ptr, const int 
 {
   *R_ptr = t->R_ptr, *R_col = t->R_col, *R_val = t->R_val;
 }
+
+fcm_status fcm_csr_create_ptap(fcm_ctx *ctx, const fcm_csr *A, const fcm_csr *P, fcm_csr **C)
+{
+  fcm_status st = FCM_OK;
+  fcm__ptap *plan = NULL;
+  FCM_CHECK(ctx && A && P && C, ctx, FCM_ERR_ARG,
+            "csr_create_ptap: ctx, A, P and C must not be NULL");
+  *C = NULL;
+  FCM_CHECK(P->nrows == A->nrows, ctx, FCM_ERR_ARG,
+            "csr_create_ptap: P has %lld rows, A has %lld; they must agree", (long long)P->nrows,
+            (long long)A->nrows);
+  FCM_TRY(ctx,
+          fcm__ptap_create(ctx, A, P->ncols, P->row_ptr, P->col_idx, P->values, 1, 1, &plan, C));
+  fcm__ptap_apply(plan, A, *C, 1);
+  if ((*C)->kind == FCM_CSR_SYMMETRIC) /* average the pairs rounding left unequal */
+    for (fcm_index i = 0; i < (*C)->nrows; i++)
+      for (fcm_index p = (*C)->row_ptr[i]; p < (*C)->row_ptr[i + 1]; p++) {
+        const fcm_index j = (*C)->col_idx[p];
+        if (j <= i) continue;
+        const fcm_index q = fcm_csr_position(*C, j, i);
+        const double m = 0.5 * ((*C)->values[p] + (*C)->values[q]);
+        (*C)->values[p] = (*C)->values[q] = m;
+      }
+cleanup:
+  fcm__ptap_destroy(&plan);
+  if (st != FCM_OK && C) fcm_csr_destroy(C);
+  return st;
+}

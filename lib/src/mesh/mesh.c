@@ -256,6 +256,11 @@ void fcm_mesh_destroy(fcm_mesh **mesh)
   fcm__free(ctx, m->cells);
   fcm__free(ctx, m->neighbors);
   fcm__free(ctx, m->boundary);
+  fcm__free(ctx, m->cell_level);
+  fcm__free(ctx, m->cell_pos);
+  fcm__free(ctx, m->hang_cell);
+  fcm__free(ctx, m->hang_node);
+  fcm__free(ctx, m->hang_xi);
   fcm__free(ctx, m);
   *mesh = NULL;
 }
@@ -362,4 +367,12 @@ void fcm_mesh_view(const fcm_mesh *mesh, FILE *stream)
           (long long)mesh->num_nodes, (long long)mesh->num_cells, (long long)mesh->num_boundary);
   fprintf(stream, "  bounding box [%g, %g] x [%g, %g] x [%g, %g]\n", lo[0], hi[0], lo[1], hi[1],
           lo[2], hi[2]);
+  if (!mesh->cell_level) return;
+  fcm_index per_level[FCM_OCTREE_MAX_LEVEL + 1] = {0};
+  for (fcm_index c = 0; c < mesh->num_cells; c++)
+    per_level[mesh->cell_level[c]]++;
+  fprintf(stream, "  octree: %lld hanging (cell, node) pairs; cells per level:",
+          (long long)mesh->num_hanging);
+  for (int l = 0; l <= mesh->max_level; l++)
+    fprintf(stream, " %d: %lld%s", l, (long long)per_level[l], l < mesh->max_level ? "," : "\n");
 }

@@ -77,6 +77,20 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__mesh_check_grid(fcm_ctx *ctx, const char *who, const double lo[3],
+                                const double hi[3], const fcm_index n[3])
+{
+  fcm_status st = FCM_OK;
+  for (int d = 0; d < 3; d++) {
+    FCM_CHECK(isfinite(lo[d]) && isfinite(hi[d]) && lo[d] < hi[d], ctx, FCM_ERR_ARG,
+              "%s: axis %d: need finite lo < hi, got [%g, %g]", who, d, lo[d], hi[d]);
+    FCM_CHECK(n[d] >= 1 && n[d] <= (1 << 20), ctx, FCM_ERR_ARG,
+              "%s: axis %d: %lld cells out of range [1, %d]", who, d, (long long)n[d], 1 << 20);
+  }
+cleanup:
+  return st;
+}
+
 /* The six Kuhn tetrahedra of the unit cube, as cube corner ids bx + 2 by + 4 bz: for each
  * axis permutation (a, b, c) the path 000 -> e_a -> e_a + e_b -> 111; odd permutations list
  * their two middle vertices swapped so that every tetrahedron is positively oriented. */
@@ -104,13 +118,7 @@ fcm_status fcm_mesh_create_box(fcm_ctx *ctx, fcm_element_type type, const double
   FCM_CHECK(fcm_element_get_info(type), ctx, FCM_ERR_ARG,
             "mesh_create_box: element type %d out of range [0, %d)", (int)type,
             (int)FCM_ELEMENT_COUNT);
-  for (int d = 0; d < 3; d++) {
-    FCM_CHECK(isfinite(lo[d]) && isfinite(hi[d]) && lo[d] < hi[d], ctx, FCM_ERR_ARG,
-              "mesh_create_box: axis %d: need finite lo < hi, got [%g, %g]", d, lo[d], hi[d]);
-    FCM_CHECK(n[d] >= 1 && n[d] <= (1 << 20), ctx, FCM_ERR_ARG,
-              "mesh_create_box: axis %d: %lld cells out of range [1, %d]", d, (long long)n[d],
-              1 << 20);
-  }
+  FCM_TRY(ctx, fcm__mesh_check_grid(ctx, "mesh_create_box", lo, hi, n));
   const double total = 6.0 * (double)n[0] * (double)n[1] * (double)n[2];
   FCM_CHECK(total <= 1e12, ctx, FCM_ERR_ARG,
             "mesh_create_box: %lld x %lld x %lld cubes exceed the limit of 1e12 cells",

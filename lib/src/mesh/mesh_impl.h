@@ -20,6 +20,15 @@ struct fcm_mesh {
   fcm_index *neighbors; /* num_cells x info->num_faces, -1 on the boundary */
   fcm_index num_boundary;
   fcm_index *boundary; /* num_boundary x 2: (cell, local face) */
+  /* Octree meshes (mesh_octree.c); NULL / 0 for every other mesh. */
+  unsigned char *cell_level; /* num_cells: refinement level of each cell */
+  int64_t *cell_pos;         /* num_cells x 3: position on the lattice of its level */
+  double box_lo[3], box_hi[3];
+  fcm_index box_n[3];    /* the box grid the octree refines */
+  int max_level;         /* deepest level */
+  fcm_index num_hanging; /* (cell, node) pairs: node on cell's boundary, not its node */
+  fcm_index *hang_cell, *hang_node;
+  double *hang_xi; /* num_hanging x 3: the node's reference coordinates in the cell (exact) */
 };
 
 /* Create a mesh that takes ownership of `*coords` and `*cells` (allocated with
@@ -38,6 +47,11 @@ fcm_status fcm__mesh_add_mid_edge_nodes(fcm_ctx *ctx, fcm_element_type linear_ty
                                         fcm_index num_cells, const fcm_index *cells,
                                         fcm_index *new_num_nodes, double **new_coords,
                                         fcm_index **new_cells);
+
+/* The box grid arguments of the structured generators: per axis finite lo < hi and
+ * 1 <= n <= 2^20 cells; FCM_ERR_ARG naming `who` and the axis otherwise. (mesh_box.c) */
+fcm_status fcm__mesh_check_grid(fcm_ctx *ctx, const char *who, const double lo[3],
+                                const double hi[3], const fcm_index n[3]);
 
 /* Group the faces of `num_cells` cells of type `info` (connectivity `cells`, num_nodes
  * ids per cell) by their corner node sets: the one face matcher of the library (mesh

@@ -177,6 +177,10 @@ fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
   fcm_mg *m = NULL;
   FCM_CHECK(ctx && space && A && mg, ctx, FCM_ERR_ARG, "mg_create: NULL argument");
   *mg = NULL;
+  FCM_CHECK(fcm_mesh_num_hanging(fcm_space_mesh(space)) == 0, ctx, FCM_ERR_UNSUPPORTED,
+            "mg_create: the space's mesh is an octree with %lld hanging (cell, node) pairs; the "
+            "hierarchy coarsens conforming meshes only",
+            (long long)fcm_mesh_num_hanging(fcm_space_mesh(space)));
   fcm_mg_options o = opts ? *opts : fcm_mg_options_default();
   FCM_CHECK(o.smoother >= 0 && o.smoother < FCM_MG_SMOOTHER_COUNT, ctx, FCM_ERR_ARG,
             "mg_create: smoother = %d is not a fcm_mg_smoother", (int)o.smoother);

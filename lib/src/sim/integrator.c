@@ -635,6 +635,13 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
             "integrator: the space is a local space (a distributed run's cells only) but the "
             "integrator has no distributed backend; build the space with fcm_space_create() "
             "or fcm_space_create_embedded()");
+  /* the integrators solve on the space's DOFs as they are: across the hanging nodes of an
+   * octree mesh that field would not be continuous */
+  FCM_CHECK(fcm_mesh_num_hanging(fcm_space_mesh(I->space)) == 0, ctx, FCM_ERR_UNSUPPORTED,
+            "integrator: the space's mesh is an octree with %lld hanging (cell, node) pairs; the "
+            "integrators do not apply hanging-node constraints (a static linear solve does: "
+            "fcm_space_hanging_matrix_create() and fcm_csr_create_ptap())",
+            (long long)fcm_mesh_num_hanging(fcm_space_mesh(I->space)));
   FCM_TRY(ctx, build_constraints(I));
   FCM_TRY(ctx, setup_storage(I));
   FCM_TRY(ctx, fcm__sim_boundary_setup(I));
