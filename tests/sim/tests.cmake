@@ -77,3 +77,8 @@ endforeach()
 # residual it reached; fixed multigrid cycles warm-started from the previous step beat cold
 # ones against the direct solution; fixed cycles without the multigrid solver are refused.
 fcm_add_test(sim_interactive tests/sim/interactive.c)
+# The integrators on octree backgrounds: the static patch test across hanging nodes, momentum
+# under gravity, an unrefined octree against the uniform grid.
+foreach(el hex8 hex20)
+  fcm_add_test(sim_octree_${el} tests/sim/octree.c ARGS ${el})
+endforeach()

@@ -136,6 +136,7 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   fcm_csr_destroy(&I->H0);
   fcm_csr_destroy(&I->Hpc);
   fcm_csr_destroy(&I->K0);
+  fcm__sim_hanging_destroy(I);
   fcm_direct_destroy(&I->chol);
   fcm_direct_destroy(&I->umf);
   fcm_krylov_destroy(&I->krylov);
@@ -438,6 +439,7 @@ static fcm_status build_constraints(fcm_integrator *I)
         }
     }
   }
+  FCM_TRY(ctx, fcm__sim_hanging_constraints(I, owner));
   I->ncon = count;
   FCM_ALLOC(ctx, count, I->con_dof);
   FCM_ALLOC(ctx, count, I->con_node);
@@ -486,7 +488,10 @@ static fcm_status setup_storage(fcm_integrator *I)
                      &I->ut,   &I->fint_t, &I->g_t,   &I->w1,     &I->w2};
   for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; k++)
     FCM_ALLOC(ctx, I->n, *vecs[k]);
-  FCM_TRY(ctx, fcm__space_matrix_create_rows(I->space, &I->H));
+  if (I->hP)
+    FCM_TRY(ctx, fcm__sim_hanging_storage(I, &I->H));
+  else
+    FCM_TRY(ctx, fcm__space_matrix_create_rows(I->space, &I->H));
   FCM_TRY(ctx, fcm_assembly_workspace_create(I->space, &I->opts.assembly, &I->aws));
 cleanup:
   return st;
@@ -566,6 +571,7 @@ static fcm_status setup_representative_force(fcm_integrator *I)
       I->setup_info.scale_assemblies = 1;
     }
   }
+  fcm__sim_hanging_reduce(I, I->Ma); /* the constrained problem's force, as its residual */
   double s = 0.0;
   for (fcm_index i = 0; i < n; i++)
     s += I->Ma[i] * I->Ma[i];
@@ -585,7 +591,10 @@ static fcm_status setup_solvers(fcm_integrator *I)
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = I->ctx;
   const fcm_integrator_options *o = &I->opts;
-  if (I->linear) FCM_TRY(ctx, fcm__space_matrix_create_rows(I->space, &I->H0));
+  if (I->linear && I->hP)
+    FCM_TRY(ctx, fcm__sim_hanging_storage(I, &I->H0));
+  else if (I->linear)
+    FCM_TRY(ctx, fcm__space_matrix_create_rows(I->space, &I->H0));
   if (o->kind == FCM_INTEGRATOR_BACKWARD_EULER &&
       (o->rayleigh_mass > 0.0 || o->rayleigh_stiffness > 0.0))
     FCM_TRY(ctx, fcm__space_matrix_create_rows(I->space, &I->D));
@@ -635,13 +644,8 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
             "integrator: the space is a local space (a distributed run's cells only) but the "
             "integrator has no distributed backend; build the space with fcm_space_create() "
             "or fcm_space_create_embedded()");
-  /* the integrators solve on the space's DOFs as they are: across the hanging nodes of an
-   * octree mesh that field would not be continuous */
-  FCM_CHECK(fcm_mesh_num_hanging(fcm_space_mesh(I->space)) == 0, ctx, FCM_ERR_UNSUPPORTED,
-            "integrator: the space's mesh is an octree with %lld hanging (cell, node) pairs; the "
-            "integrators do not apply hanging-node constraints (a static linear solve does: "
-            "fcm_space_hanging_matrix_create() and fcm_csr_create_ptap())",
-            (long long)fcm_mesh_num_hanging(fcm_space_mesh(I->space)));
+  /* an octree mesh: the hanging DOFs follow their masters (hanging.c) */
+  FCM_TRY(ctx, fcm__sim_hanging_setup(I));
   FCM_TRY(ctx, build_constraints(I));
   FCM_TRY(ctx, setup_storage(I));
   FCM_TRY(ctx, fcm__sim_boundary_setup(I));

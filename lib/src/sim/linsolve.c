@@ -142,7 +142,9 @@ static fcm_status pc_matrix(fcm_integrator *I, fcm_csr **P, fcm_step_reason *rea
   const fcm_preconditioner_tangent tm = I->opts.preconditioner_tangent;
   fcm_csr *K0 = NULL;
   *P = I->H;
-  if (tm == FCM_PC_TANGENT_EXACT || I->h_psd || I->opts.preconditioner == FCM_PRECOND_NONE)
+  /* hanging nodes (hanging.c): H is the constrained matrix, Hpc would need reducing as well;
+   * the preconditioner is built from H */
+  if (tm == FCM_PC_TANGENT_EXACT || I->h_psd || I->opts.preconditioner == FCM_PRECOND_NONE || I->hP)
     return FCM_OK;
   if (!I->Hpc) FCM_TRY(ctx, fcm_space_matrix_create(I->space, &I->Hpc));
   fcm_index nnz = 0;

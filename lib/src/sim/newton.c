@@ -96,7 +96,7 @@ static fcm_status assemble_boundary(fcm_integrator *I, const double *x, int proj
  * matrices): M/h^2 + D/h of its partial M and D, the serial formula. */
 static void tangent_base(fcm_integrator *I, double h)
 {
-  fcm__sim_set_base(I, h, I->H);
+  fcm__sim_set_base(I, h, fcm__sim_tangent_target(I));
 }
 
 /* Agree on st and on *finite, and sum the scalars and fint over the processes of the backend
@@ -126,9 +126,10 @@ static fcm_status assemble_tangent(fcm_integrator *I, double h, const double *x,
 {
   fcm_status st = FCM_OK;
   tangent_base(I, h);
-  st = assemble(I, projected ? &I->params_psd : &I->params, x, NULL, NULL, I->H, finite, stats);
+  fcm_csr *A = fcm__sim_tangent_target(I);
+  st = assemble(I, projected ? &I->params_psd : &I->params, x, NULL, NULL, A, finite, stats);
   if (st == FCM_OK && *finite)
-    st = assemble_boundary(I, x, projected, NULL, NULL, I->H, finite, stats);
+    st = assemble_boundary(I, x, projected, NULL, NULL, A, finite, stats);
   FCM_TRY(I->ctx, reduce_eval(I, st, NULL, 0, NULL, finite, stats));
 cleanup:
   return st;
@@ -151,10 +152,11 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
   double psi = 0.0, inertia = 0.0, damp = 0.0, wext, bnd = 0.0;
   out->finite = 1;
   memset(fint, 0, sizeof *fint * (size_t)n);
+  fcm_csr *A = tangent ? fcm__sim_tangent_target(I) : NULL;
   if (tangent) tangent_base(I, h);
-  st = assemble(I, &I->params, x, &psi, fint, tangent ? I->H : NULL, &out->finite, stats);
+  st = assemble(I, &I->params, x, &psi, fint, A, &out->finite, stats);
   if (st == FCM_OK && out->finite)
-    st = assemble_boundary(I, x, 0, &bnd, fint, tangent ? I->H : NULL, &out->finite, stats);
+    st = assemble_boundary(I, x, 0, &bnd, fint, A, &out->finite, stats);
   {
     double parts[3] = {psi, bnd, (double)fcm__assembly_inverted(I->aws, NULL)};
     FCM_TRY(I->ctx, reduce_eval(I, st, parts, 3, fint, &out->finite, stats));
@@ -188,6 +190,7 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
           g[i] += I->w2[i] / h;
       }
     }
+    fcm__sim_hanging_reduce(I, g); /* the constrained problem's gradient (hanging.c) */
     wext = dot(n, I->fext, x);
     out->psi = psi;
     out->E = inertia + damp + psi + bnd - wext;
@@ -359,6 +362,7 @@ static fcm_status build_system(fcm_integrator *I, double h, int predictor, int p
       return FCM_OK;
     }
   }
+  if (I->hP) FCM_TRY(I->ctx, fcm__sim_hanging_matrix(I)); /* H = P^T Ha P + I_h */
   if (I->H0) {
     fcm_index nnz = 0;
     fcm_csr_get_size(I->H, NULL, NULL, &nnz);
@@ -399,6 +403,7 @@ static fcm_status direction(fcm_integrator *I, int predictor, fcm_step_reason *r
   }
   for (fcm_index j = 0; j < I->nact; j++)
     I->d[I->act_dof[j]] = predictor ? I->act_inc[j] : 0.0;
+  fcm__sim_hanging_fill(I, I->d); /* hanging DOFs follow their masters */
 cleanup:
   return st;
 }
@@ -430,6 +435,7 @@ static fcm_status newton_start(fcm_integrator *I, double h, eval_out *cur, sim_s
       I->uhat[i] = I->un[i] + h * I->v[i];
       I->u[i] = I->is_con[i] ? I->un[i] : I->uhat[i];
     }
+  fcm__sim_hanging_fill(I, I->u); /* continuous: hanging DOFs follow their masters */
   /* a predictor iteration (constraints off their values) cannot use the kept factorization */
   const int tangent = !I->linear && !(kept_usable(I, h) && constraints_met(I, I->u));
   FCM_TRY(I->ctx, evaluate(I, h, I->u, tangent, I->fint, I->g, cur, stats));

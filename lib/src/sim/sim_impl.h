@@ -115,6 +115,14 @@ struct fcm_integrator {
                             tangent's, or 1 where that is not positive: fcm__eliminate_marked's
                             rule), from the last elimination */
 
+  /* hanging-node constraints of an octree space (hanging.c; NULL / 0 without hanging nodes):
+   * P (n x n) with u = P u for the continuous fields, the hanging DOFs (rows of P that are not
+   * the identity), and Ha, the space-pattern matrix the tangent is assembled into and reduced
+   * from into H = P^T Ha P + I_h (H then has the pattern of fcm_csr_create_ptap()) */
+  fcm_csr *hP, *Ha;
+  fcm_index nhang;
+  fcm_index *hang;
+
   /* matrices (space pattern) */
   fcm_csr *M, *H, *D, *H0; /* mass, Newton matrix, damping (or NULL), pristine copy (linear);
                               with a backend M, D, H and H0 are this process's partial ones */
@@ -292,5 +300,27 @@ fcm_status fcm__sim_serial_backend(fcm_integrator *I);
  * (the mass, damping and Newton matrices stay partial). Without one: returns st.
  * (integrator.c) */
 fcm_status fcm__sim_reduce(fcm_integrator *I, fcm_status st, double *scalars, int ns, double *vec);
+
+/* Hanging-node constraints (hanging.c). setup: P and the hanging DOFs when the space's mesh has
+ * hanging nodes, refusing what cannot apply them (a distributed backend, multigrid, the block
+ * Jacobi and Schwarz preconditioners) with FCM_ERR_UNSUPPORTED. constraints: owner (n: the
+ * constraint + 1 holding each DOF, 0 none; build_constraints()) loses its hanging DOFs, which
+ * follow their masters; FCM_ERR_UNSUPPORTED when a master is not held by the same constraint.
+ * storage: Ha (if not yet) and a matrix *A of H's pattern. fill: x = P x (the hanging entries
+ * from their masters). reduce: g = P^T g (zero on the hanging DOFs). matrix: H = P^T Ha P +
+ * I_h. Nothing of these allocates but setup and storage. */
+fcm_status fcm__sim_hanging_setup(fcm_integrator *I);
+void fcm__sim_hanging_destroy(fcm_integrator *I);
+fcm_status fcm__sim_hanging_constraints(fcm_integrator *I, int *owner);
+fcm_status fcm__sim_hanging_storage(fcm_integrator *I, fcm_csr **A);
+void fcm__sim_hanging_fill(const fcm_integrator *I, double *x);
+void fcm__sim_hanging_reduce(const fcm_integrator *I, double *g);
+fcm_status fcm__sim_hanging_matrix(fcm_integrator *I);
+
+/* The matrix the Newton matrix's tangent is assembled into: H, or Ha with hanging nodes. */
+static inline fcm_csr *fcm__sim_tangent_target(const fcm_integrator *I)
+{
+  return I->hP ? I->Ha : I->H;
+}
 
 #endif /* FCM_SIM_IMPL_H */

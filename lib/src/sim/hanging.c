@@ -1,0 +1,195 @@
+/* sim: hanging-node constraints of an octree space inside the integrator.
+ *
+ * The space's hanging DOFs follow their masters, u = T u_free (fcm_space_hanging_matrix_create()).
+ * The integrator keeps its vectors on all DOFs and writes T as the square matrix P (n x n) whose
+ * row of a free DOF is that DOF itself and whose row of a hanging DOF holds its masters' weights
+ * (the masters are free DOFs). Then the Newton system of the constrained problem,
+ * T^T H T dv = -T^T g, is the system on all DOFs
+ *   (P^T H P + I_h) d = -P^T g,
+ * I_h the identity on the hanging DOFs: their rows and columns of P^T H P are zero, so their
+ * entries of d come out zero and are then filled from the masters (d = P d). The gradient the
+ * Newton loop sees is the reduced one, P^T g (zero on the hanging DOFs): its norms, the stopping
+ * rule and the reactions are those of the constrained problem, and its slope g.d with d = P dv
+ * is the full gradient's. Mass, loads and the boundary terms enter g and H, so they are reduced
+ * alike. The state stays in the range of P: every increment is P times something, and the
+ * initial guess of a step is filled from its masters. */
+#include "sim/sim_impl.h"
+#include "fem/fem_impl.h"
+
+#include <string.h>
+
+fcm_status fcm__sim_hanging_setup(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  const fcm_integrator_options *o = &I->opts;
+  const fcm_index nh = fcm_mesh_num_hanging(fcm_space_mesh(I->space)), n = I->n;
+  fcm_index *free_dof = NULL, *col_dof = NULL, *rows = NULL, *cols = NULL;
+  fcm_csr *T = NULL;
+  if (nh == 0) return FCM_OK;
+  FCM_CHECK(!fcm__integrator_distributed(I, NULL), ctx, FCM_ERR_UNSUPPORTED,
+            "integrator: the space's mesh is an octree with %lld hanging (cell, node) pairs and "
+            "the integrator has a distributed backend; hanging-node constraints are applied by "
+            "the serial solvers only",
+            (long long)nh);
+  FCM_CHECK(o->linear_solver != FCM_LINEAR_MULTIGRID, ctx, FCM_ERR_UNSUPPORTED,
+            "integrator: the space's mesh is an octree with %lld hanging (cell, node) pairs; the "
+            "multigrid solver does not coarsen octrees yet: use the direct solver or CG / MINRES "
+            "with the Jacobi preconditioner",
+            (long long)nh);
+  FCM_CHECK(o->linear_solver == FCM_LINEAR_DIRECT || o->preconditioner == FCM_PRECOND_NONE ||
+                o->preconditioner == FCM_PRECOND_JACOBI,
+            ctx, FCM_ERR_UNSUPPORTED,
+            "integrator: the space's mesh is an octree with %lld hanging (cell, node) pairs; "
+            "preconditioner %d works on the space's nodes and cells as they are (block Jacobi, "
+            "Schwarz and multigrid are not available there yet): use FCM_PRECOND_JACOBI or "
+            "FCM_PRECOND_NONE, or the direct solver",
+            (long long)nh, (int)o->preconditioner);
+  FCM_ALLOC(ctx, n, free_dof);
+  FCM_TRY(ctx, fcm_space_hanging_matrix_create(I->space, free_dof, &T));
+  fcm_index nfree = 0, nnz = 0;
+  fcm_csr_get_size(T, NULL, &nfree, &nnz);
+  FCM_ALLOC(ctx, nfree, col_dof);
+  FCM_ALLOC(ctx, nnz, rows);
+  FCM_ALLOC(ctx, nnz, cols);
+  for (fcm_index d = 0; d < n; d++)
+    if (free_dof[d] >= 0) col_dof[free_dof[d]] = d;
+  {
+    const fcm_index *rp = fcm_csr_row_ptr(T);
+    const int *ci = fcm_csr_col_idx(T);
+    for (fcm_index r = 0; r < n; r++)
+      for (fcm_index e = rp[r]; e < rp[r + 1]; e++) {
+        rows[e] = r;
+        cols[e] = col_dof[ci[e]];
+      }
+    FCM_TRY(ctx, fcm_csr_create_triplets(ctx, n, n, nnz, rows, cols, fcm_csr_values_read(T),
+                                         FCM_CSR_GENERAL, &I->hP));
+  }
+  I->nhang = 0;
+  for (fcm_index d = 0; d < n; d++)
+    I->nhang += free_dof[d] < 0;
+  FCM_ALLOC(ctx, I->nhang, I->hang);
+  I->nhang = 0;
+  for (fcm_index d = 0; d < n; d++)
+    if (free_dof[d] < 0) I->hang[I->nhang++] = d;
+cleanup:
+  fcm_csr_destroy(&T);
+  fcm__free(ctx, free_dof);
+  fcm__free(ctx, col_dof);
+  fcm__free(ctx, rows);
+  fcm__free(ctx, cols);
+  return st;
+}
+
+void fcm__sim_hanging_destroy(fcm_integrator *I)
+{
+  fcm_csr_destroy(&I->hP);
+  fcm_csr_destroy(&I->Ha);
+  fcm__free(I->ctx, I->hang);
+  I->hang = NULL;
+  I->nhang = 0;
+}
+
+fcm_status fcm__sim_hanging_constraints(fcm_integrator *I, int *owner)
+{
+  fcm_status st = FCM_OK;
+  if (!I->hP) return FCM_OK;
+  const fcm_index *rp = fcm_csr_row_ptr(I->hP);
+  const int *ci = fcm_csr_col_idx(I->hP);
+  for (fcm_index k = 0; k < I->nhang; k++) {
+    const fcm_index d = I->hang[k];
+    if (owner[d] == 0) continue;
+    for (fcm_index e = rp[d]; e < rp[d + 1]; e++)
+      FCM_CHECK(owner[ci[e]] == owner[d], I->ctx, FCM_ERR_UNSUPPORTED,
+                "constraint %d: DOF %lld (node %lld, component %c) hangs on a coarser cell of "
+                "the octree, and its master DOF %lld (node %lld) is %s; a hanging node follows "
+                "its masters, so a constraint must hold them too (select the coarse face or "
+                "edge the node lies on, or refine the octree there)",
+                owner[d] - 1, (long long)d, (long long)(d / 3), "xyz"[d % 3], (long long)ci[e],
+                (long long)(ci[e] / 3), owner[ci[e]] == 0 ? "free" : "held by another constraint");
+    owner[d] = 0; /* it follows its masters, which the constraint holds */
+  }
+cleanup:
+  return st;
+}
+
+void fcm__sim_hanging_fill(const fcm_integrator *I, double *x)
+{
+  if (!I->hP) return;
+  const fcm_index *rp = fcm_csr_row_ptr(I->hP);
+  const int *ci = fcm_csr_col_idx(I->hP);
+  const double *pv = fcm_csr_values_read(I->hP);
+  for (fcm_index k = 0; k < I->nhang; k++) {
+    const fcm_index d = I->hang[k];
+    double s = 0.0;
+    for (fcm_index e = rp[d]; e < rp[d + 1]; e++)
+      s += pv[e] * x[ci[e]];
+    x[d] = s;
+  }
+}
+
+void fcm__sim_hanging_reduce(const fcm_integrator *I, double *g)
+{
+  if (!I->hP) return;
+  const fcm_index *rp = fcm_csr_row_ptr(I->hP);
+  const int *ci = fcm_csr_col_idx(I->hP);
+  const double *pv = fcm_csr_values_read(I->hP);
+  for (fcm_index k = 0; k < I->nhang; k++) {
+    const fcm_index d = I->hang[k];
+    for (fcm_index e = rp[d]; e < rp[d + 1]; e++)
+      g[ci[e]] += pv[e] * g[d];
+    g[d] = 0.0;
+  }
+}
+
+fcm_status fcm__sim_hanging_storage(fcm_integrator *I, fcm_csr **A)
+{
+  fcm_status st = FCM_OK;
+  if (!I->Ha) FCM_TRY(I->ctx, fcm__space_matrix_create_rows(I->space, &I->Ha));
+  FCM_TRY(I->ctx, fcm_csr_create_ptap(I->ctx, I->Ha, I->hP, A));
+cleanup:
+  return st;
+}
+
+/* The position of (i, j) in H: the pattern of fcm_csr_create_ptap() holds every product. */
+static fcm_index position(fcm_integrator *I, fcm_index i, fcm_index j)
+{
+  return fcm_csr_position(I->H, i, j);
+}
+
+fcm_status fcm__sim_hanging_matrix(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index n = I->n;
+  const fcm_index *ap = fcm_csr_row_ptr(I->Ha), *pp = fcm_csr_row_ptr(I->hP);
+  const fcm_index *hp = fcm_csr_row_ptr(I->H);
+  const int *ac = fcm_csr_col_idx(I->Ha), *pc = fcm_csr_col_idx(I->hP);
+  const int *hc = fcm_csr_col_idx(I->H);
+  const double *av = fcm_csr_values_read(I->Ha), *pv = fcm_csr_values_read(I->hP);
+  double *hv = fcm_csr_values(I->H);
+  fcm_csr_set_zero(I->H);
+  for (fcm_index r = 0; r < n; r++)
+    for (fcm_index e = ap[r]; e < ap[r + 1]; e++) {
+      const fcm_index c = ac[e];
+      for (fcm_index p = pp[r]; p < pp[r + 1]; p++)
+        for (fcm_index q = pp[c]; q < pp[c + 1]; q++) {
+          const fcm_index pos = position(I, pc[p], pc[q]);
+          FCM_CHECK(pos >= 0, I->ctx, FCM_ERR_INTERNAL,
+                    "integrator: the constrained Newton matrix has no entry (%lld, %lld)",
+                    (long long)pc[p], (long long)pc[q]);
+          hv[pos] += pv[p] * av[e] * pv[q];
+        }
+    }
+  /* exactly symmetric (the sums above run in different orders for (i, j) and (j, i)) */
+  for (fcm_index i = 0; i < n; i++)
+    for (fcm_index e = hp[i]; e < hp[i + 1]; e++)
+      if (hc[e] > i) {
+        const fcm_index m = position(I, hc[e], i);
+        const double s = 0.5 * (hv[e] + hv[m]);
+        hv[e] = hv[m] = s;
+      }
+  for (fcm_index k = 0; k < I->nhang; k++)
+    hv[position(I, I->hang[k], I->hang[k])] = 1.0;
+cleanup:
+  return st;
+}
