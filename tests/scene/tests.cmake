@@ -63,3 +63,5 @@ fcm_add_test(scene_inversion tests/scene/inversion_scene.c)
 # voxel and plain scenes: each once, in order, start before end, the times in the counters
 # within their parts and the set-up; progress and warnings inside the phase that makes them.
 fcm_add_test(scene_setup_phases tests/scene/setup_phases.c)
+# The background key "octree": parse, round trip, refusals, a step on the refined grid.
+fcm_add_test(scene_octree tests/scene/octree_scene.c)

@@ -46,6 +46,12 @@ typedef struct fcm_scene_background {
   double fit_cell_size;     /**< fit: edge of the (cubic) cells, > 0 */
   double fit_margin;        /**< fit: gap between the body's box and the grid's, >= 0 (default:
                                  one cell) */
+  /** GRID with "octree": the grid refined as an octree (fcm_mesh_create_octree()), 2:1
+   * balanced; each level 0 = off, at most FCM_OCTREE_MAX_LEVEL. */
+  int octree;          /**< 1 when "octree" is given */
+  int octree_boundary; /**< "boundary": {"level"}: cells the embedded boundary meets */
+  int octree_region;   /**< "region": {"level"}: cells meeting the box below */
+  double octree_region_min[3], octree_region_max[3]; /**< "region": {"min", "max"} */
 } fcm_scene_background;
 
 /** What the embedded geometry is. */

@@ -63,10 +63,51 @@ cleanup:
   return st;
 }
 
+/* "octree": {"boundary": {"level": L}, "region": {"min", "max", "level": L}}: the grid refined
+ * as an octree along the embedded boundary and in a box. */
+static fcm_status read_octree(fcm__scene_parser *p, const fcm__json *o, fcm_scene_background *b)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"boundary", "region"};
+  static const char *const bkeys[] = {"level"};
+  static const char *const rkeys[] = {"min", "max", "level"};
+  const fcm__json *oct = NULL, *bnd = NULL, *reg = NULL;
+  long long level = 0;
+  size_t old = p->path_len;
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "octree", 0, &oct));
+  if (!oct) return FCM_OK;
+  SCENE_ENTER(p, "octree");
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, oct, keys, SCENE_COUNT(keys)));
+  SCENE_CHECK(fcm__json_member(oct, "boundary") || fcm__json_member(oct, "region"), p, FCM_ERR_ARG,
+              "expected at least one refinement criterion: \"boundary\" ({\"level\": L}, "
+              "along the embedded boundary) or \"region\" ({\"min\", \"max\", \"level\"})");
+  b->octree = 1;
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, oct, "boundary", 0, &bnd));
+  if (bnd) {
+    size_t o2 = SCENE_ENTER(p, "boundary");
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, bnd, bkeys, SCENE_COUNT(bkeys)));
+    FCM_TRY(p->ctx, fcm__scene_read_int(p, bnd, "level", 1, 1, FCM_OCTREE_MAX_LEVEL, &level));
+    b->octree_boundary = (int)level;
+    fcm__scene_path_pop(p, o2);
+  }
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, oct, "region", 0, &reg));
+  if (reg) {
+    size_t o2 = SCENE_ENTER(p, "region");
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, reg, rkeys, SCENE_COUNT(rkeys)));
+    FCM_TRY(p->ctx, read_min_max(p, reg, b->octree_region_min, b->octree_region_max));
+    FCM_TRY(p->ctx, fcm__scene_read_int(p, reg, "level", 1, 1, FCM_OCTREE_MAX_LEVEL, &level));
+    b->octree_region = (int)level;
+    fcm__scene_path_pop(p, o2);
+  }
+cleanup:
+  fcm__scene_path_pop(p, old);
+  return st;
+}
+
 fcm_status fcm__scene_read_background(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"element", "box", "cells", "mesh", "fit_background"};
+  static const char *const keys[] = {"element", "box", "cells", "mesh", "fit_background", "octree"};
   static const char *const box_keys[] = {"min", "max"};
   fcm_scene_background *b = &p->scene->background;
   const fcm__json *o = NULL, *box = NULL;
@@ -76,6 +117,7 @@ fcm_status fcm__scene_read_background(fcm__scene_parser *p, const fcm__json *roo
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, SCENE_COUNT(keys)));
   if (fcm__json_member(o, "fit_background")) {
     FCM_TRY(p->ctx, read_fit_background(p, o, b));
+    FCM_TRY(p->ctx, read_octree(p, o, b));
     goto cleanup;
   }
   if (fcm__json_member(o, "mesh")) {
@@ -84,6 +126,12 @@ fcm_status fcm__scene_read_background(fcm__scene_parser *p, const fcm__json *roo
       fcm__scene_path_push_key(p, keys[i]);
       SCENE_CHECK(0, p, FCM_ERR_ARG,
                   "not allowed with \"mesh\" (the mesh file sets the element type and cells)");
+    }
+    if (fcm__json_member(o, "octree")) {
+      fcm__scene_path_push_key(p, "octree");
+      SCENE_CHECK(0, p, FCM_ERR_ARG,
+                  "not allowed with \"mesh\" (an octree refines a generated grid: give \"box\" "
+                  "and \"cells\" or \"fit_background\")");
     }
     b->kind = FCM_SCENE_BACKGROUND_MESH;
     b->element = FCM_ELEMENT_COUNT;
@@ -105,11 +153,14 @@ fcm_status fcm__scene_read_background(fcm__scene_parser *p, const fcm__json *roo
   }
   FCM_TRY(p->ctx, fcm__scene_read_ivec3(p, o, "cells", 1, 1, 1000000, b->cells));
   {
+    const size_t in_background = p->path_len;
     double total = (double)b->cells[0] * (double)b->cells[1] * (double)b->cells[2];
     fcm__scene_path_push_key(p, "cells");
     SCENE_CHECK(total <= 1e8, p, FCM_ERR_ARG, "expected at most 1e8 cells in total, got %.0f",
                 total);
+    fcm__scene_path_pop(p, in_background);
   }
+  FCM_TRY(p->ctx, read_octree(p, o, b));
 cleanup:
   fcm__scene_path_pop(p, old);
   return st;

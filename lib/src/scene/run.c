@@ -679,6 +679,26 @@ cleanup:
   return st;
 }
 
+/* The background grid over [min, max] with `cells` cubes: a box grid, or with "octree" the grid
+ * refined along the embedded boundary (S->geom, built before) and in the region, 2:1 balanced. */
+static fcm_status create_grid(fcm_simulation *S, const fcm_scene_background *bg,
+                              const double min[3], const double max[3], const fcm_index cells[3])
+{
+  if (!bg->octree) return fcm_mesh_create_box(S->ctx, bg->element, min, max, cells, &S->mesh);
+  fcm_octree_options o = fcm_octree_options_default();
+  o.region_level = bg->octree_region;
+  for (int d = 0; d < 3; d++) {
+    o.region_lo[d] = bg->octree_region_min[d];
+    o.region_hi[d] = bg->octree_region_max[d];
+  }
+  if (bg->octree_boundary > 0) {
+    o.refine_level = bg->octree_boundary;
+    o.refine = fcm_geometry_boundary_meets_box;
+    o.refine_user = S->geom;
+  }
+  return fcm_mesh_create_octree(S->ctx, bg->element, min, max, cells, &o, &S->mesh);
+}
+
 fcm_status fcm__sim_build_mesh_geometry(fcm_simulation *S)
 {
   fcm_status st = FCM_OK;
@@ -694,14 +714,20 @@ fcm_status fcm__sim_build_mesh_geometry(fcm_simulation *S)
     FCM_TRY(ctx, st);
     phase_begin(S, FCM_SETUP_BACKGROUND, 0, "fitting the background grid around the geometry");
     st = fit_background(S, bg, min, max, cells);
-    if (st == FCM_OK) st = fcm_mesh_create_box(ctx, bg->element, min, max, cells, &S->mesh);
+    if (st == FCM_OK) st = create_grid(S, bg, min, max, cells);
     if (st != FCM_OK) name_section(ctx, "background.fit_background");
     FCM_TRY(ctx, st);
   } else if (bg->kind == FCM_SCENE_BACKGROUND_GRID) {
+    if (bg->octree_boundary > 0) { /* refined along the geometry's boundary: built first */
+      st = build_geometry(S, g);
+      if (st != FCM_OK) name_section(ctx, geometry_path(g->kind));
+      FCM_TRY(ctx, st);
+    }
     phase_begin(S, FCM_SETUP_BACKGROUND, 0,
-                "building the background grid (%lld x %lld x %lld cells)", (long long)bg->cells[0],
-                (long long)bg->cells[1], (long long)bg->cells[2]);
-    st = fcm_mesh_create_box(ctx, bg->element, bg->min, bg->max, bg->cells, &S->mesh);
+                "building the background grid (%lld x %lld x %lld cells%s)",
+                (long long)bg->cells[0], (long long)bg->cells[1], (long long)bg->cells[2],
+                bg->octree ? ", refined as an octree" : "");
+    st = create_grid(S, bg, bg->min, bg->max, bg->cells);
   } else {
     phase_begin(S, FCM_SETUP_BACKGROUND, 0, "reading the background mesh %s", base_name(bg->mesh));
     st = fcm_mesh_create_from_gmsh(ctx, bg->mesh, &S->mesh);

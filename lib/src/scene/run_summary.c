@@ -334,6 +334,26 @@ static void setup_lines(const fcm_simulation *S, FILE *f, const fcm_simulation_c
  * centre of mass `com_now` (NULL: not available) and the peak resident memory `rss` given (a
  * distributed run, gc not NULL: summed over the processes), or taken from this process (gs, cs
  * and gc NULL, body < 0). */
+/* The octree background's cells per level and hanging pairs (nothing for a uniform grid). */
+static void octree_line(const fcm_simulation *S, FILE *f)
+{
+  if (!S->mesh || !fcm_mesh_is_octree(S->mesh)) return;
+  long long per_level[FCM_OCTREE_MAX_LEVEL + 1] = {0};
+  const int top = fcm_mesh_max_level(S->mesh);
+  char b[512];
+  int len = 0;
+  for (fcm_index c = 0; c < fcm_mesh_num_cells(S->mesh); c++)
+    per_level[fcm_mesh_cell_level(S->mesh, c)]++;
+  len += snprintf(b + len, sizeof b - (size_t)len,
+                  "%lld cells, per level 0..%d:", (long long)fcm_mesh_num_cells(S->mesh), top);
+  for (int l = 0; l <= top && len < (int)sizeof b; l++)
+    len += snprintf(b + len, sizeof b - (size_t)len, " %lld", per_level[l]);
+  if (len < (int)sizeof b)
+    snprintf(b + len, sizeof b - (size_t)len, "; %lld hanging (cell, node) pairs",
+             (long long)fcm_mesh_num_hanging(S->mesh));
+  line(f, 1, "octree background", b);
+}
+
 static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_stats *gs,
                          const fcm_index *cs, const fcm_simulation_counters *gc, double body,
                          const double *com_now, double rss)
@@ -344,6 +364,7 @@ static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_
           S->num_steps, (long long)c->num_dofs);
   line(f, c->cell_rules, "embedded cell rules", c->cell_rules ? "" : "(no geometry)");
   if (S->geometry_note[0]) fprintf(f, "  geometry  %s\n", S->geometry_note);
+  octree_line(S, f);
   rules_lines(S, f, gs, c);
   line(f, c->surface_rules, "surface rules", c->surface_rules ? "" : "(no traction or pressure)");
   line(f, c->inertia, "inertia (backward Euler)", c->inertia ? "" : "(static scene)");

@@ -169,12 +169,31 @@ static fcm_status parse_root(fcm__scene_parser *p, const fcm__json *root)
     SCENE_CHECK(0, p, FCM_ERR_ARG,
                 "needs an embedded \"geometry\" to fit the grid around (the scene has none)");
   }
+  if (s->background.octree) {
+    fcm__scene_path_push_key(p, "background");
+    fcm__scene_path_push_key(p, "octree");
+    SCENE_CHECK(s->background.element == FCM_ELEMENT_HEX8 ||
+                    s->background.element == FCM_ELEMENT_HEX20,
+                p, FCM_ERR_ARG, "octree refinement needs hexahedra: element \"hex8\" or \"hex20\"");
+    fcm__scene_path_push_key(p, "boundary");
+    SCENE_CHECK(!s->background.octree_boundary || s->geometry.kind != FCM_SCENE_GEOMETRY_NONE, p,
+                FCM_ERR_ARG, "needs an embedded \"geometry\" whose boundary it refines along");
+    fcm__scene_path_pop(p, 0);
+  }
   FCM_TRY(p->ctx, fcm__scene_read_material(p, root));
   FCM_TRY(p->ctx, fcm__scene_read_quadrature(p, root));
   FCM_TRY(p->ctx, fcm__scene_read_solver(p, root));
   FCM_TRY(p->ctx, fcm__scene_read_time(p, root));
   FCM_TRY(p->ctx, fcm__scene_read_output(p, root));
   FCM_TRY(p->ctx, fcm__scene_read_effects(p, root));
+  if (s->background.octree && fcm_scene_count_effects(s, FCM_EFFECT_CUT) > 0) {
+    fcm__scene_path_push_key(p, "background");
+    fcm__scene_path_push_key(p, "octree");
+    SCENE_CHECK(0, p, FCM_ERR_UNSUPPORTED,
+                "cuts on an octree background are not supported yet (the pieces a cut makes "
+                "would have to link across the hanging nodes): drop the \"cut\" effects or the "
+                "octree");
+  }
 cleanup:
   return st;
 }

@@ -154,6 +154,17 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
             b->max[2]);
   else
     fprintf(f, "background: mesh %s\n", b->mesh);
+  if (b->octree) {
+    fprintf(f, "  refined as an octree (2:1 balanced):");
+    if (b->octree_boundary)
+      fprintf(f, " along the embedded boundary to level %d", b->octree_boundary);
+    if (b->octree_region)
+      fprintf(f, "%s in [%g, %g] x [%g, %g] x [%g, %g] m to level %d",
+              b->octree_boundary ? ";" : "", b->octree_region_min[0], b->octree_region_max[0],
+              b->octree_region_min[1], b->octree_region_max[1], b->octree_region_min[2],
+              b->octree_region_max[2], b->octree_region);
+    fprintf(f, "\n");
+  }
   fprintf(f, "geometry: ");
   view_geometry(f, g);
   if (g->has_transform)

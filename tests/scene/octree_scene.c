@@ -1,0 +1,96 @@
+/* The background key "octree": refinement along the embedded boundary and in a region parses
+ * into the background's fields, round-trips through the normalized JSON, and bad input is
+ * refused naming the key (tetrahedra, a boundary criterion without a geometry, an octree over a
+ * mesh file, no criterion, a level beyond the limit, cuts on an octree); a scene with an octree
+ * background builds and runs a step with the cells of every level it asked for. */
+#include "scene_util.h"
+
+#include "fcm/simulation.h"
+
+#define GEOM "\"geometry\": {\"shape\": \"ball\", \"center\": [0, 0, 0], \"radius\": 0.6}, "
+#define REST                                                                                       \
+  "\"material\": {\"model\": \"snh\", \"young\": 1e5, \"poisson\": 0.3, \"density\": 1000}, "      \
+  "\"output\": {\"directory\": \"out\"}, \"time\": {\"dt\": 0.01, \"steps\": 1}"
+
+static fcm_scene *parse(fcm_ctx *ctx, const char *element, const char *octree, const char *geom,
+                        const char *effects, fcm_status expect, const char *msg)
+{
+  char text[4096];
+  fcm_scene *s = NULL;
+  snprintf(text, sizeof text,
+           "{\"background\": {\"element\": \"%s\", \"box\": {\"min\": [-1, -1, -1], \"max\": [1, "
+           "1, 1]}, \"cells\": [2, 2, 2], %s}, %s" REST ", \"effects\": [%s]}",
+           element, octree, geom, effects);
+  if (expect == FCM_OK) {
+    TEST_OK(ctx, fcm_scene_create_from_string(ctx, text, "t.json", &s));
+    if (s) check_normalized(ctx, s, octree);
+  } else {
+    TEST_ERR(ctx, fcm_scene_create_from_string(ctx, text, "t.json", &s), expect, msg);
+  }
+  return s;
+}
+
+int main(void)
+{
+  fcm_ctx *ctx = NULL;
+  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  if (!ctx) return TEST_RESULT();
+  char dir[256];
+  if (!make_temp_dir(dir, sizeof dir) || chdir(dir) != 0) {
+    TEST_FAIL_("cannot make a temporary directory");
+    return TEST_RESULT();
+  }
+  const char *both = "\"octree\": {\"boundary\": {\"level\": 2}, \"region\": {\"min\": [-1, -1, "
+                     "-1], \"max\": [0, 0, -0.5], \"level\": 1}}";
+  fcm_scene *s = parse(ctx, "hex8", both, GEOM, "{\"gravity\": {}}", FCM_OK, NULL);
+  if (s) {
+    const fcm_scene_background *b = fcm_scene_get_background(s);
+    TEST_TRUE(b->octree == 1 && b->octree_boundary == 2 && b->octree_region == 1);
+    TEST_TRUE(b->octree_region_min[0] == -1 && b->octree_region_max[2] == -0.5);
+    /* it builds and steps: cells of levels 0 to 2, hanging nodes constrained */
+    fcm_simulation *sim = NULL;
+    TEST_OK(ctx, fcm_simulation_create(ctx, s, NULL, &sim));
+    if (sim) {
+      TEST_OK(ctx, fcm_simulation_step(sim, NULL));
+      char *text = NULL;
+      size_t len = 0;
+      FILE *f = open_memstream(&text, &len);
+      fcm_simulation_summary_view(sim, f);
+      fclose(f);
+      TEST_TRUE(text && strstr(text, "octree background") && strstr(text, "per level 0..2:"));
+      free(text);
+    }
+    fcm_simulation_destroy(&sim);
+    fcm_scene_destroy(&s);
+  }
+  s = parse(ctx, "hex20",
+            "\"octree\": {\"region\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1], "
+            "\"level\": 1}}",
+            "", "{\"gravity\": {}}", FCM_OK, NULL);
+  if (s) TEST_TRUE(fcm_scene_get_background(s)->octree_boundary == 0);
+  fcm_scene_destroy(&s);
+
+  parse(ctx, "tet10", both, GEOM, "", FCM_ERR_ARG, "needs hexahedra");
+  parse(ctx, "hex8", "\"octree\": {\"boundary\": {\"level\": 1}}", "", "", FCM_ERR_ARG,
+        "background.octree.boundary");
+  parse(ctx, "hex8", "\"octree\": {}", GEOM, "", FCM_ERR_ARG, "at least one refinement");
+  parse(ctx, "hex8", "\"octree\": {\"boundary\": {\"level\": 13}}", GEOM, "", FCM_ERR_ARG,
+        "background.octree.boundary.level");
+  parse(ctx, "hex8", both, GEOM,
+        "{\"cut\": {\"time\": 0.005, \"surface\": {\"plane\": {\"point\": [0, 0, 0], \"normal\": "
+        "[1, 0, 0]}}}}",
+        FCM_ERR_UNSUPPORTED, "cuts on an octree");
+  TEST_ERR(ctx,
+           fcm_scene_create_from_string(
+               ctx,
+               "{\"background\": {\"mesh\": \"m.msh\", \"octree\": {\"boundary\": {\"level\": "
+               "1}}}, " REST ", \"effects\": []}",
+               "t.json", &s),
+           FCM_ERR_ARG, "background.octree");
+
+  if (chdir("/") != 0) TEST_FAIL_("cannot leave the temporary directory");
+  remove_temp_dir(dir, NULL, 0);
+  TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
+  fcm_ctx_destroy(&ctx);
+  return TEST_RESULT();
+}
