@@ -35,10 +35,7 @@ int main(void)
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
   if (!ctx) return TEST_RESULT();
   char dir[256];
-  if (!make_temp_dir(dir, sizeof dir) || chdir(dir) != 0) {
-    TEST_FAIL_("cannot make a temporary directory");
-    return TEST_RESULT();
-  }
+  if (!enter_temp_dir(dir, sizeof dir)) return TEST_RESULT();
 
   /* ((a ∪ b ∪ c) − d): sphere, torus, gyroid, box */
   fcm_scene *s = parse(ctx,

@@ -36,10 +36,7 @@ int main(void)
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
   if (!ctx) return TEST_RESULT();
   char dir[256];
-  if (!make_temp_dir(dir, sizeof dir) || chdir(dir) != 0) {
-    TEST_FAIL_("cannot make a temporary directory");
-    return TEST_RESULT();
-  }
+  if (!enter_temp_dir(dir, sizeof dir)) return TEST_RESULT();
   const char *both = "\"octree\": {\"boundary\": {\"level\": 2}, \"region\": {\"min\": [-1, -1, "
                      "-1], \"max\": [0, 0, -0.5], \"level\": 1}}";
   fcm_scene *s = parse(ctx, "hex8", both, GEOM, "{\"gravity\": {}}", FCM_OK, NULL);

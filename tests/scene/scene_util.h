@@ -107,6 +107,15 @@ static inline char *make_temp_dir(char *buf, size_t len)
   return mkdtemp(buf);
 }
 
+/* A fresh directory under /tmp made the working directory (buf as make_temp_dir()); 0 (and a
+ * failed check) when that fails. */
+static inline int enter_temp_dir(char *buf, size_t len)
+{
+  if (make_temp_dir(buf, len) && chdir(buf) == 0) return 1;
+  TEST_FAIL_("cannot make a temporary directory");
+  return 0;
+}
+
 /* fcm_scene_view() of a scene without its first line (name and source). */
 static inline char *view_body(const fcm_scene *s)
 {

@@ -113,7 +113,10 @@ cleanup:
   return st;
 }
 
-void fcm__sim_hanging_fill(const fcm_integrator *I, double *x)
+/* x = P x (the hanging entries from their masters) or, transposed, x = P^T x (each hanging
+ * entry added to its masters with its weights, then zeroed); the masters are free DOFs, so the
+ * order of the hanging DOFs does not matter. */
+static void apply(const fcm_integrator *I, double *x, int transpose)
 {
   if (!I->hP) return;
   const fcm_index *rp = fcm_csr_row_ptr(I->hP);
@@ -123,23 +126,22 @@ void fcm__sim_hanging_fill(const fcm_integrator *I, double *x)
     const fcm_index d = I->hang[k];
     double s = 0.0;
     for (fcm_index e = rp[d]; e < rp[d + 1]; e++)
-      s += pv[e] * x[ci[e]];
+      if (transpose)
+        x[ci[e]] += pv[e] * x[d];
+      else
+        s += pv[e] * x[ci[e]];
     x[d] = s;
   }
 }
 
+void fcm__sim_hanging_fill(const fcm_integrator *I, double *x)
+{
+  apply(I, x, 0);
+}
+
 void fcm__sim_hanging_reduce(const fcm_integrator *I, double *g)
 {
-  if (!I->hP) return;
-  const fcm_index *rp = fcm_csr_row_ptr(I->hP);
-  const int *ci = fcm_csr_col_idx(I->hP);
-  const double *pv = fcm_csr_values_read(I->hP);
-  for (fcm_index k = 0; k < I->nhang; k++) {
-    const fcm_index d = I->hang[k];
-    for (fcm_index e = rp[d]; e < rp[d + 1]; e++)
-      g[ci[e]] += pv[e] * g[d];
-    g[d] = 0.0;
-  }
+  apply(I, g, 1);
 }
 
 fcm_status fcm__sim_hanging_storage(fcm_integrator *I, fcm_csr **A)
