@@ -480,13 +480,18 @@ FCM_API fcm_status fcm_integrator_boundary_eval(fcm_integrator *integ, const dou
 /** Validate the options, build the constrained DOF list, gather the boundary constraints'
  * points and estimate their penalties, assemble the mass matrix (BACKWARD_EULER only) and the
  * loads, allocate every work array and solver, and run the symbolic analysis (direct).
- * Constrained DOFs get their prescribed velocity at the current time.
+ * Constrained DOFs get their prescribed velocity at the current time. On an octree mesh
+ * (fcm_mesh_create_octree()) the hanging DOFs follow their masters (u = T u_free,
+ * fcm_space_hanging_matrix_create()): each Newton system is solved in the constrained space,
+ * T^T H T with the gradient T^T g; a constraint may hold a hanging node only together with its
+ * masters (the node then follows them).
  * @return FCM_OK, FCM_ERR_ARG (option out of range: named; DOF constrained twice; zero
  * representative force: set the density or use the relative rule; a boundary constraint on a
  * space without surface rules, or selecting no point), FCM_ERR_NUMERIC (a Nitsche penalty that
  * cannot be estimated: a cell stiffness singular beyond rigid modes, the cell named),
- * FCM_ERR_UNSUPPORTED (a space on an octree mesh with hanging nodes: the integrators do not
- * apply their constraints), errors of the assembly and of the solvers, FCM_ERR_ALLOC.
+ * FCM_ERR_UNSUPPORTED (hanging nodes with the multigrid solver or preconditioner, block
+ * Jacobi, Schwarz or a distributed backend; a constraint holding a hanging node but not its
+ * masters), errors of the assembly and of the solvers, FCM_ERR_ALLOC.
  * Allocates; a second call is FCM_ERR_ARG. */
 FCM_API fcm_status fcm_integrator_setup(fcm_integrator *integ);
 
