@@ -8,9 +8,7 @@
 #include <fcm/simulation.h>
 
 #include "cli.h"
-#if FCM_HAVE_PETSC
-#include "fcm-sim-petsc.h"
-#endif
+#include "fcm-sim-petsc.h" /* sim_print_output(); sim_petsc_run() is built with PETSc only */
 
 #include <errno.h>
 #include <omp.h>
