@@ -3,7 +3,7 @@
 add_library(fcm_apps_cli STATIC apps/cli.c apps/app_sphere.c)
 target_link_libraries(fcm_apps_cli PUBLIC fcm::fcm)
 target_compile_options(fcm_apps_cli PRIVATE ${FCM_WARNINGS} ${FCM_SAN_FLAGS})
-fcm_add_app(fcm-sim apps/fcm-sim.c)
+fcm_add_app(fcm-sim apps/fcm-sim.c apps/fcm-sim-plot.c)
 if(FCM_HAVE_PETSC) # --backend petsc: the PETSc component
   target_sources(fcm-sim PRIVATE apps/fcm-sim-petsc.c)
   target_link_libraries(fcm-sim PRIVATE fcm::petsc)

@@ -558,6 +558,22 @@ static char dice_title[6][64];
 
 /* Append the points of space's pieces (displacement u) for the picture; 0 on allocation
  * failure. The stick of a point: its reference (x, y) between the dicing planes `at`. */
+/* The colour of stick (ix, iy) of the 6 x 6, as 0xrrggbb: one of 36, the hue by the column
+ * (cli_palette), the lightness by the row (mixed towards black, then white), so that sticks
+ * side by side in either direction differ. */
+static long dice_colour(int ix, int iy)
+{
+  static const double mix[6] = {-0.5, -0.3, -0.1, 0.1, 0.3, 0.5};
+  const long rgb = strtol(cli_palette[ix] + 1, NULL, 16);
+  long out = 0;
+  for (int k = 2; k >= 0; k--) {
+    const double c = (double)((rgb >> (8 * k)) & 0xff);
+    const double v = mix[iy] < 0 ? c * (1.0 + mix[iy]) : c + (255.0 - c) * mix[iy];
+    out = out << 8 | (long)(v + 0.5);
+  }
+  return out;
+}
+
 static int dice_png_add(const fcm_space *space, const double *u, const double at[5],
                         const char *title)
 {
@@ -607,8 +623,8 @@ static int dice_png_add(const fcm_space *space, const double *u, const double at
         if (!q) return 0;
         dice_data = q, dice_cap = cap;
       }
-      dice_len += (size_t)snprintf(dice_data + dice_len, dice_cap - dice_len, "%d %.5f %.5f %d\n",
-                                   dice_panels, x[0] + d[0], x[1] + d[1], (ix + 2 * iy) % 6);
+      dice_len += (size_t)snprintf(dice_data + dice_len, dice_cap - dice_len, "%d %.5f %.5f %ld\n",
+                                   dice_panels, x[0] + d[0], x[1] + d[1], dice_colour(ix, iy));
     }
   }
   dice_panels++;
@@ -624,21 +640,26 @@ static int dice_png(const char *path)
   n += (size_t)snprintf(body + n, cap - n, "$D << EOD\n");
   if (dice_len) memcpy(body + n, dice_data, dice_len);
   n += dice_len;
+  /* one panel per variant, as many columns as fit in three */
+  const int rows = dice_panels > 3 ? 2 : 1, cols = (dice_panels + rows - 1) / rows;
+  char size[64];
+  snprintf(size, sizeof size, "%d,%d font ',11'", 80 + 400 * cols, 110 + 400 * rows);
   n += (size_t)snprintf(
       body + n, cap - n,
-      "EOD\nset multiplot layout 2,3 title '36 sticks after 5 steps spinning under "
-      "gravity (Ton-That et al. 2024, Fig. 5): quadrature points from above'\n"
-      "unset key\nset size ratio -1\n"
-      "set palette defined (0 '#1f77b4', 1 '#ff7f0e', 2 '#2ca02c', 3 '#d62728', "
-      "4 '#9467bd', 5 '#8c564b')\nunset colorbox\nset xrange [-0.3:1.3]\n"
-      "set yrange [-0.3:1.3]\n");
+      "EOD\nset multiplot layout %d,%d title \"36 sticks after 5 steps spinning under gravity "
+      "(Ton-That et al. 2024, Fig. 5): quadrature points from above\\ncolour: the stick, hue "
+      "by its column (x), lightness by its row (y)\" font ',12'\n"
+      "unset key\nset size ratio -1\nset xrange [-0.3:1.3]\nset yrange [-0.3:1.3]\n"
+      "set xtics -0.25, 0.5\nset ytics -0.25, 0.5\nset format x '%%.2f'\n"
+      "set format y '%%.2f'\nset xlabel 'x (m)'\nset ylabel 'y (m)'\nset grid\n",
+      rows, cols);
   for (int k = 0; k < dice_panels; k++)
     n += (size_t)snprintf(body + n, cap - n,
                           "set title '%s'\nplot $D using ($1 == %d ? $2 : 1/0):3:4 "
-                          "with points pt 7 ps 0.3 lc palette\n",
+                          "with points pt 7 ps 0.35 lc rgb variable\n",
                           dice_title[k], k);
   n += (size_t)snprintf(body + n, cap - n, "unset multiplot");
-  const int ok = cli_gnuplot_png(PROG, "900,600 font ',11'", path, body);
+  const int ok = cli_gnuplot_png(PROG, size, path, body);
   free(body);
   return ok;
 }
