@@ -814,8 +814,9 @@ static int accuracy_png(const char *path, int max_strength)
       n += (size_t)snprintf(body + n, sizeof body - n, "EOD\n");
     }
   n += (size_t)snprintf(body + n, sizeof body - n,
-                        "set logscale y\nset format y '10^{%%L}'\nset grid\n"
-                        "set key outside right font ',9'\nset xlabel 'strength m'\n"
+                        "set logscale y\nset format y '10^{%%L}'\nset grid\nset xtics 1\n"
+                        "set key top left font ',10' opaque box maxrows 4\n"
+                        "set xlabel 'strength m'\n"
                         "set ylabel 'largest relative moment error over the pieces'\n"
                         "set yrange [1e-17:1e-10]\nset title 'cut-cell pieces: moments of degree "
                         "<= m (Koschier et al. 2017, Table 1)'\n"
@@ -837,7 +838,6 @@ static double cond_raw[13][2][2], cond_scaled[13][2][2];
 static int condition_png(const char *path)
 {
   static char body[16384];
-  static const char *const colors[2][2] = {{"#d62728", "#1f77b4"}, {"#ff7f0e", "#2ca02c"}};
   size_t n = 0;
   for (int con = 0; con < 2; con++)
     for (int stab = 0; stab < 2; stab++)
@@ -850,13 +850,16 @@ static int condition_png(const char *path)
         }
         n += (size_t)snprintf(body + n, sizeof body - n, "EOD\n");
       }
-  n += (size_t)snprintf(body + n, sizeof body - n,
-                        "set logscale xy\nset xrange [*:*] reverse\nset format x '10^{%%L}'\n"
-                        "set format y '10^{%%L}'\nset grid\nset key outside right font ',9'\n"
-                        "set xlabel 'distance of the cut to the face / cell size'\n"
-                        "set ylabel 'condition number'\n"
-                        "set title 'kappa(M + dt^2 K), cube of 5 tets cut near a face "
-                        "(Koschier et al. 2017, Fig. 14)'\nplot");
+  n +=
+      (size_t)snprintf(body + n, sizeof body - n,
+                       "set logscale xy\nset xrange [*:*] reverse\nset format x '10^{%%L}'\n"
+                       "set format y '10^{%%L}'\nset grid\n"
+                       "set key below maxrows 4 font ',10'\nset bmargin 9\n"
+                       "set xlabel 'distance of the cut to the face / cell size'\n"
+                       "set ylabel 'condition number'\n"
+                       "set title \"kappa(M + dt^2 K), cube of 5 tets cut near a face "
+                       "(Koschier et al. 2017, Fig. 14)\\nraw and diagonally scaled, a colour each "
+                       "(curves that agree overlap)\" noenhanced\nplot");
   int first = 1;
   for (int con = 0; con < 2; con++)
     for (int stab = 0; stab < 2; stab++)
@@ -864,11 +867,12 @@ static int condition_png(const char *path)
         n += (size_t)snprintf(body + n, sizeof body - n,
                               "%s $D%d%d%d with linespoints lw 2 dt %d lc rgb '%s' title '%s, "
                               "constraint %s, stabilization %s'",
-                              first ? "" : ",", con, stab, sc, sc ? 2 : 1, colors[con][stab],
-                              sc ? "scaled" : "raw", con ? "on" : "off", stab ? "on" : "off");
+                              first ? "" : ",", con, stab, sc, sc ? 2 : 1,
+                              cli_palette[4 * con + 2 * stab + sc], sc ? "scaled" : "raw",
+                              con ? "on" : "off", stab ? "on" : "off");
         first = 0;
       }
-  return cli_gnuplot_png(PROG, "900,600 font ',11'", path, body);
+  return cli_gnuplot_png(PROG, "900,700 font ',11'", path, body);
 }
 
 static int run_condition(fcm_ctx *ctx, const char *csvpath, const char *pngpath)
