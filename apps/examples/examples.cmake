@@ -17,7 +17,8 @@ if(BUILD_TESTING)
   set_tests_properties(app_example_host_static PROPERTIES LABELS app TIMEOUT 300
                        ENVIRONMENT "OMP_NUM_THREADS=2;OMP_WAIT_POLICY=passive;OPENBLAS_NUM_THREADS=1")
 endif()
-# host_petsc: the PETSc component as a host links it (fcm::petsc), run on 2 processes.
+# host_petsc: the PETSc component as a host links it (fcm::petsc); run on 2 processes by the
+# test app_example_host_petsc (tests/petsc/tests.cmake).
 if(FCM_HAVE_PETSC)
   add_executable(fcm_example_host_petsc apps/examples/host_petsc.c)
   target_link_libraries(fcm_example_host_petsc PRIVATE fcm::petsc)
@@ -25,13 +26,6 @@ if(FCM_HAVE_PETSC)
     target_link_libraries(fcm_example_host_petsc PRIVATE m)
   endif()
   target_compile_options(fcm_example_host_petsc PRIVATE ${FCM_WARNINGS} ${FCM_SAN_FLAGS})
-  if(BUILD_TESTING)
-    add_test(NAME app_example_host_petsc
-             COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
-                     $<TARGET_FILE:fcm_example_host_petsc>)
-    set_tests_properties(app_example_host_petsc PROPERTIES LABELS "app;mpi" TIMEOUT 120
-                         PROCESSORS 2 ENVIRONMENT "${FCM_MPI_TEST_ENV}")
-  endif()
 endif()
 include(CheckLanguage)
 check_language(CXX)
