@@ -216,7 +216,7 @@ static int run_scene(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, l
   if (talk) {
     printf("  backend   petsc, %d process%s (Newton on PETSc), steps %.3g s\n", size,
            size > 1 ? "es" : "", fcm_wtime() - t0);
-    if (write) sim_print_output(dir, name, logpath, 0);
+    if (write) sim_print_output(dir, name, logpath, 0, plot);
   }
   rc = 0;
 done:

@@ -15,8 +15,10 @@ int sim_petsc_run(const char *path, const char *outdir, long long steps, int che
                   char **petsc_argv);
 
 /* The summary's output line: every series of <dir>/<name> the run has written (the background
- * and surface PVD indexes, the log at `logpath`), as "  output    a, b, c"; `no_frame`: the
- * run wrote no new frame (said after the log). */
-void sim_print_output(const char *dir, const char *name, const char *logpath, int no_frame);
+ * and surface PVD indexes, the log at `logpath`, with `plot` the log's picture
+ * <name>_log.png), as "  output    a, b, c"; `no_frame`: the run wrote no new frame (said after
+ * the log). */
+void sim_print_output(const char *dir, const char *name, const char *logpath, int no_frame,
+                      int plot);
 
 #endif

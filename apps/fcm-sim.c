@@ -544,13 +544,15 @@ static int finish_run(fcm_simulation *sim, fcm_status st, const run_state *rs, i
     if (rs->write) {
       fcm_simulation_counters c;
       fcm_simulation_get_counters(sim, &c);
-      sim_print_output(dir, name, rs->logpath, !(c.frames > 0 && (int)c.frames > frames_at_start));
+      sim_print_output(dir, name, rs->logpath, !(c.frames > 0 && (int)c.frames > frames_at_start),
+                       o->plot);
     }
   }
   return 0;
 }
 
-void sim_print_output(const char *dir, const char *name, const char *logpath, int no_frame)
+void sim_print_output(const char *dir, const char *name, const char *logpath, int no_frame,
+                      int plot)
 {
   static const char *const series[] = {"background", "surface"};
   char path[4096];
@@ -560,7 +562,11 @@ void sim_print_output(const char *dir, const char *name, const char *logpath, in
     struct stat sb;
     if (stat(path, &sb) == 0) printf("%s, ", path);
   }
-  printf("%s%s\n", logpath, no_frame ? " (no new frame)" : "");
+  printf("%s%s", logpath, no_frame ? " (no new frame)" : "");
+  snprintf(path, sizeof path, "%s/%s_log.png", dir, name);
+  struct stat sb;
+  if (plot && stat(path, &sb) == 0) printf(", %s", path);
+  printf("\n");
 }
 
 static int scene_main(int argc, char **argv)

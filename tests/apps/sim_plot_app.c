@@ -4,7 +4,8 @@
  *                                            data block has one row per log row (the time
  *                                            column the log's), and, with gnuplot
  *                                            installed, <name>_log.png: a PNG of the stated
- *                                            1200 x 900 pixels (four panels)
+ *                                            1200 x 900 pixels (four panels), named on the
+ *                                            summary's output line
  *   sim_plot_app no-gnuplot FCM_SIM WORK_DIR the same run with a PATH that holds no gnuplot:
  *                                            exit 0, the log and the script written, no PNG,
  *                                            and stderr says gnuplot was not found */
@@ -80,8 +81,8 @@ static int run(const char *sim, const char *work, const char *tag, const char *e
   if (!f) return TEST_RESULT();
   fputs(plot_scene, f);
   fclose(f);
-  snprintf(cmd, sizeof cmd, "rm -rf '%s' && %s '%s' '%s' -o '%s' -q --plot 2> '%s'", dir, env, sim,
-           scene, dir, err);
+  snprintf(cmd, sizeof cmd, "rm -rf '%s' && %s '%s' '%s' -o '%s' --plot > '%s.out' 2> '%s'", dir,
+           env, sim, scene, dir, err, err);
   TEST_TRUE(app_run(cmd) == 0);
   double tl[64], ts[64];
   const int nl = log_times(logpath, tl, 64), ns = script_times(gp, ts, 64);
@@ -94,6 +95,15 @@ static int run(const char *sim, const char *work, const char *tag, const char *e
     unsigned long w = 0, h = 0;
     TEST_TRUE(app_png_size(png, &w, &h));
     TEST_TRUE(w == 1200 && h == 900);
+    /* the summary's output line names the picture */
+    char out[1200], line[4096];
+    int named = 0;
+    snprintf(out, sizeof out, "%s.out", err);
+    f = fopen(out, "r");
+    while (f && fgets(line, sizeof line, f))
+      named |= !strncmp(line, "  output", 8) && strstr(line, "plotted_log.png") != NULL;
+    if (f) fclose(f);
+    TEST_TRUE(named);
   } else {
     TEST_TRUE(!app_exists(png));
     f = fopen(err, "r");
