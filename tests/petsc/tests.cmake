@@ -326,3 +326,13 @@ fcm_add_test(petsc_newton_create_failure_np3 tests/petsc/pcmg_failure.c NP 3 TIM
 # phase 2 (the integrator, -pc_type mg): every 37th allocation of the first step
 fcm_add_test(petsc_pcmg_failure_newton_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 120
              ARGS scene ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 37)
+# The example host of the PETSc component (apps/examples/host_petsc.c, linked as a host links
+# it: fcm::petsc) on 2 processes: at the static equilibrium the elastic energy is half the
+# work of the load.
+if(TARGET fcm_example_host_petsc)
+  add_test(NAME app_example_host_petsc
+           COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
+                   $<TARGET_FILE:fcm_example_host_petsc>)
+  set_tests_properties(app_example_host_petsc PROPERTIES LABELS "app;mpi" TIMEOUT 120
+                       PROCESSORS 2 ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+endif()

@@ -4,6 +4,7 @@
 #ifndef FCM_SCENE_RUN_IMPL_H
 #define FCM_SCENE_RUN_IMPL_H
 
+#include "core/core_impl.h"
 #include "fcm/embed.h"
 #include "fcm/fem.h"
 #include "fcm/geom.h"
@@ -173,18 +174,19 @@ fcm_status fcm__sim_check_regions(fcm_simulation *S);
 /* The background mesh and the embedded geometry of a scene (NULL when it has none), built as
  * fcm_simulation_create() builds them, for a driver of its own (the PETSc backend, fcm/petsc.h);
  * the caller destroys both (run.c). */
-fcm_status fcm__scene_mesh_geometry(fcm_ctx *ctx, const fcm_scene *scene, fcm_mesh **mesh,
-                                    fcm_geometry **geom);
+FCM_COMPONENT_API fcm_status fcm__scene_mesh_geometry(fcm_ctx *ctx, const fcm_scene *scene,
+                                                      fcm_mesh **mesh, fcm_geometry **geom);
 
 /* fcm_simulation_create() with a configuration: cfg->opts, and the backend that distributes
  * the run (fcm__simulation_config; the PETSc one: run_petsc.c). Collective over the backend's
  * processes. (run.c) */
-fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
-                                  const fcm__simulation_config *cfg, fcm_simulation **out);
+FCM_COMPONENT_API fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
+                                                    const fcm__simulation_config *cfg,
+                                                    fcm_simulation **out);
 
 /* A distributed run's fcm_simulation_summary_view() (collective; f may be NULL on all but one
  * process): the rules' point counts and the body's largest |u| summed / maximized over the
  * processes' own cells first (each process's rules carry its own cells' points only). */
-fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f);
+FCM_COMPONENT_API fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f);
 
 #endif /* FCM_SCENE_RUN_IMPL_H */
