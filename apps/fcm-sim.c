@@ -40,7 +40,7 @@ typedef struct scene_options {
 static const char *const backend_names[] = {"serial", "petsc", NULL};
 
 /* The option table, writing into `o`. */
-#define SIM_NUM_OPTIONS 12
+#define SIM_NUM_OPTIONS 13
 static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS])
 {
   const cli_option t[SIM_NUM_OPTIONS] = {
@@ -623,7 +623,7 @@ void sim_print_output(const char *dir, const char *name, const char *logpath, in
 
 static int scene_main(int argc, char **argv)
 {
-  scene_options o = {NULL, NULL, NULL, 0, -1, 0, 0, 0, 0, 0, 0, 0};
+  scene_options o = {NULL, NULL, NULL, 0, -1, 0, 0, 0, 0, 0, 0, 0, 0};
   int pargc = 1;
   char **pargv = calloc((size_t)argc + 1, sizeof *pargv);
   if (!pargv) return 1;
