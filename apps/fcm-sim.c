@@ -10,6 +10,9 @@
 #include "cli.h"
 #if FCM_HAVE_PETSC
 #include "fcm-sim-petsc.h"
+#else
+/* the output lines after a run (also the PETSc runner's, declared in fcm-sim-petsc.h) */
+void sim_print_output(const char *dir, const char *name, const char *logpath, int no_frame);
 #endif
 
 #include <errno.h>
