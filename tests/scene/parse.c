@@ -296,6 +296,36 @@ static void check_steps(fcm_ctx *ctx)
   }
 }
 
+/* The time schemes: "integrator" with its parameter, the defaults of the parameter, and the
+ * normalized scene keeps them (round trip). */
+static void check_schemes(fcm_ctx *ctx)
+{
+  const struct {
+    const char *time;
+    fcm_time_scheme scheme;
+    double alpha, rho;
+  } cases[] = {
+      {"{\"integrator\": \"newmark\"}", FCM_SCHEME_NEWMARK, -0.05, 0.8},
+      {"{\"integrator\": \"hht\", \"alpha\": -0.25}", FCM_SCHEME_HHT, -0.25, 0.8},
+      {"{\"integrator\": \"hht\"}", FCM_SCHEME_HHT, -0.05, 0.8},
+      {"{\"integrator\": \"generalized_alpha\", \"rho_inf\": 0}", FCM_SCHEME_GENERALIZED_ALPHA,
+       -0.05, 0.0},
+      {"{\"integrator\": \"backward_euler\"}", FCM_SCHEME_BACKWARD_EULER, -0.05, 0.8},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+    char json[512];
+    snprintf(json, sizeof json, "{" MIN_BG ", " MIN_MAT ", \"time\": %s}", cases[i].time);
+    fcm_scene *s = NULL;
+    TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "t.json", &s));
+    if (!s) continue;
+    const fcm_scene_time *t = fcm_scene_get_time(s);
+    TEST_TRUE(t->integrator == FCM_INTEGRATOR_DYNAMIC && t->scheme == cases[i].scheme &&
+              t->hht_alpha == cases[i].alpha && t->rho_inf == cases[i].rho);
+    check_normalized(ctx, s, cases[i].time);
+    fcm_scene_destroy(&s);
+  }
+}
+
 /* fixed and motion on the embedded boundary: "boundary" with a region or "all",
  * the method keys and their defaults; the region selects points by position. */
 static void check_boundary(fcm_ctx *ctx)
@@ -503,6 +533,7 @@ int main(void)
   check_full(ctx);
   check_defaults(ctx);
   check_steps(ctx);
+  check_schemes(ctx);
   check_motion(ctx);
   check_boundary(ctx);
   check_files(ctx);
