@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# fcm-sim --backend petsc --resume on a linear scene (label mpi): vibrating_beam.json runs through
+# fcm-sim --backend petsc --resume on a linear scene (label mpi): vibrating_beam_euler.json (backward Euler, the
+# linear driver's scheme) runs through
 # the integrator on PETSc like every scene (fcm_simulation_run(), the serial checkpoint format).
 #  - 10 steps on 2 processes (CG + GAMG to rtol 1e-12: MUMPS, the scene's direct solver, is not
 #    bitwise reproducible between runs on 2 processes) with a checkpoint every 5, then a copy of its output resumed from
