@@ -8,12 +8,7 @@
 #include <fcm/simulation.h>
 
 #include "cli.h"
-#if FCM_HAVE_PETSC
-#include "fcm-sim-petsc.h"
-#else
-/* the output lines after a run (also the PETSc runner's, declared in fcm-sim-petsc.h) */
-void sim_print_output(const char *dir, const char *name, const char *logpath, int no_frame);
-#endif
+#include "fcm-sim-petsc.h" /* sim_print_output(); sim_petsc_run() is built with FCM_HAVE_PETSC */
 
 #include <errno.h>
 #include <omp.h>
