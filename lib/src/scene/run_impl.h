@@ -19,9 +19,11 @@
  * quadrature points and the cell of the first, fcm_step_info; the NaN or infinite von Mises
  * values of the frame written after the step). -1: not known (inverted and inverted_cell of a
  * row restored from an older checkpoint; nonfinite of a step without a frame); NaN: tolerance
- * of a row restored from a checkpoint older than version 5. */
+ * of a row restored from a checkpoint older than version 5, the energies (kinetic, elastic and
+ * the load work, fcm_step_info) of one older than version 6. */
 typedef struct fcm__log_row {
   double time, residual, tolerance, energy, wall;
+  double kinetic, elastic, work;
   long long newton, linear;
   long long pieces;
   double mass, momentum[3];
