@@ -13,6 +13,7 @@
 #                         build, install into a temporary prefix, move it, and build and run
 #                         the example host programs (apps/examples) against the installed
 #                         package with `pkg-config --cflags --libs fcm` and find_package(fcm)
+#                         (with the PETSc component, host_petsc with fcm-petsc and fcm::petsc)
 # Environment: FCM_BUILD_DIR (default: build), FCM_CMAKE_ARGS (extra CMake arguments),
 #              FCM_JOBS (parallel build jobs, default: number of cores).
 set -euo pipefail
@@ -65,22 +66,29 @@ install_check() {
   cmake --install "$build" --prefix "$prefix/staging" >/dev/null
   mv "$prefix/staging" "$prefix/fcm"
   pkgdir=$(dirname "$(find "$prefix/fcm" -name fcmConfig.cmake)")
-  if grep -nE '(^|[";( :])/[A-Za-z]|staging' "$pkgdir"/fcmTargets*.cmake; then
+  if grep -nE '(^|[";( :])/[A-Za-z]|staging' "$pkgdir"/fcm*Targets*.cmake; then
     echo "install check: the exported targets hard-code paths (above)" >&2
     return 1
   fi
-  # a shared libfcm exports the public API (fcm_*) only: no internal fcm__ function, no
-  # symbol of another name (OpenMP's named critical sections and the linker's section markers
-  # __bss_start, _edata, _end aside: ld exports those depending on the libraries linked, e.g.
-  # with PETSc and MPI)
-  local so bad
+  # a shared libfcm exports the public API (fcm_*) and, for its PETSc component, the internal
+  # functions declared FCM_COMPONENT_API in lib/src (no other fcm__ name, no symbol of another
+  # name: OpenMP's named critical sections and the linker's section markers __bss_start, _edata,
+  # _end aside); it needs no MPI or PETSc library, whatever the build
+  local so bad component
   so=$(find "$prefix/fcm" -name 'libfcm.so.*' -type f | head -n 1)
   if [ -n "$so" ]; then
+    component=$(grep -rhoE '^FCM_COMPONENT_API [^(]*\bfcm__[a-z0-9_]+\(' "$here/lib/src" |
+                grep -oE 'fcm__[a-z0-9_]+\($' | tr -d '(' | sort -u)
     bad=$(nm -D --defined-only "$so" | awk '{print $3}' |
-          grep -vE '^(fcm_[A-Za-z0-9]|\.gomp_critical_user_|__bss_start$|_edata$|_end$)' || true)
+          grep -vE '^(fcm_[A-Za-z0-9]|\.gomp_critical_user_|__bss_start$|_edata$|_end$)' |
+          grep -vxF -f <(echo "$component") || true)
     if [ -n "$bad" ]; then
       echo "install check: libfcm exports symbols outside the public API:" >&2
       echo "$bad" | head -n 20 >&2
+      return 1
+    fi
+    if readelf -d "$so" | grep -E 'NEEDED.*(mpi|petsc)'; then
+      echo "install check: libfcm needs an MPI or PETSc library (above)" >&2
       return 1
     fi
   fi
@@ -89,7 +97,15 @@ install_check() {
   [ -f "$src/host_dynamic.cpp" ] && [ -f "$src/CMakeLists.txt" ]
   ex="$prefix/examples"
   mkdir -p "$ex/out-pc" "$ex/out-cmake"
-  # pkg-config, as a user would type it
+  # pkg-config, as a user would type it; the serial package names no MPI, built with or
+  # without the PETSc component (its own fcm-petsc.pc carries MPI and PETSc)
+  local pcline
+  pcline="$(PKG_CONFIG_PATH="$pcdir" pkg-config --cflags --libs fcm) \
+$(PKG_CONFIG_PATH="$pcdir" pkg-config --static --libs fcm)"
+  if echo "$pcline" | grep -iE 'mpi|petsc'; then
+    echo "install check: pkg-config fcm names MPI or PETSc (above)" >&2
+    return 1
+  fi
   # shellcheck disable=SC2046
   cc -std=c11 "$src/host_static.c" -o "$ex/host_static-pc" \
     $(PKG_CONFIG_PATH="$pcdir" pkg-config --cflags --libs fcm)
@@ -98,21 +114,27 @@ install_check() {
     $(PKG_CONFIG_PATH="$pcdir" pkg-config --cflags --libs fcm)
   "$ex/host_static-pc" "$ex/out-pc" >/dev/null
   [ -s "$ex/out-pc/host_static_surface.vtu" ] && [ -s "$ex/out-pc/host_static_background.vtu" ]
-  # the package says whether the library has the PETSc backend (pkg-config variable petsc,
-  # FCM_HAVE_PETSC of fcmConfig.cmake and fcm/version.h); with it, fcm/petsc.h (mpi.h through
-  # the .pc file's Requires) compiles and links with the same command
+  # the package says whether fcm has the PETSc component (pkg-config variable petsc,
+  # FCM_HAVE_PETSC of fcmConfig.cmake and fcm/version.h); with it, host_petsc builds with
+  # `pkg-config --cflags --libs fcm-petsc` and runs (alone: MPI's singleton start), and without
+  # it neither its headers nor its .pc file are installed
   local have
   have=$(PKG_CONFIG_PATH="$pcdir" pkg-config --variable=petsc fcm)
   grep -q "FCM_HAVE_PETSC $have" "$prefix/fcm/include/fcm/version.h"
   if [ "$have" = 1 ]; then
     grep -q "set(FCM_HAVE_PETSC ON)" "$pkgdir/fcmConfig.cmake"
-    printf '%s\n' '#include <fcm/petsc.h>' \
-      'int main(void) { return fcm_petsc_options_default().solver.max_iterations > 0 ? 0 : 1; }' \
-      >"$ex/petsc.c"
+    [ -f "$prefix/fcm/include/fcm/petsc.h" ] && [ -f "$prefix/fcm/include/fcm/scene_petsc.h" ]
     # shellcheck disable=SC2046
-    cc -std=c11 "$ex/petsc.c" -o "$ex/petsc-pc" \
-      $(PKG_CONFIG_PATH="$pcdir" pkg-config --cflags --libs fcm)
-    "$ex/petsc-pc"
+    cc -std=c11 "$src/host_petsc.c" -o "$ex/host_petsc-pc" \
+      $(PKG_CONFIG_PATH="$pcdir" pkg-config --cflags --libs fcm-petsc) -lm
+    "$ex/host_petsc-pc" >/dev/null
+  else
+    [ ! -e "$prefix/fcm/include/fcm/petsc.h" ] && [ ! -e "$pcdir/fcm-petsc.pc" ]
+  fi
+  # the serial host programs need no MPI library at run time either
+  if readelf -d "$ex/host_static-pc" "$ex/host_dynamic-pc" | grep -E 'NEEDED.*(mpi|petsc)'; then
+    echo "install check: a serial host program needs MPI or PETSc (above)" >&2
+    return 1
   fi
   # CMake, find_package(fcm)
   cmake -S "$src" -B "$ex/build" -DCMAKE_PREFIX_PATH="$prefix/fcm" >/dev/null
@@ -120,10 +142,19 @@ install_check() {
   "$ex/build/host_static" "$ex/out-cmake" >/dev/null
   "$ex/build/host_dynamic" "$ex/out-cmake" >/dev/null
   [ -s "$ex/out-cmake/host_dynamic_surface.vtu" ]
+  if readelf -d "$ex/build/host_static" "$ex/build/host_dynamic" | grep -E 'NEEDED.*(mpi|petsc)'; then
+    echo "install check: a serial host program (find_package) needs MPI or PETSc (above)" >&2
+    return 1
+  fi
+  if [ "$have" = 1 ]; then # find_package(fcm OPTIONAL_COMPONENTS petsc) built host_petsc
+    "$ex/build/host_petsc" >/dev/null
+  else
+    [ ! -e "$ex/build/host_petsc" ]
+  fi
   # the installed programs find the moved libfcm through their $ORIGIN rpath
   if [ -x "$prefix/fcm/bin/fcm-sim" ]; then "$prefix/fcm/bin/fcm-sim" --help >/dev/null; fi
   echo "install check: examples built against the installed package (pkg-config and"\
-       "find_package) and run: host_static, host_dynamic"
+       "find_package) and run: host_static, host_dynamic$([ "$have" = 1 ] && echo ", host_petsc")"
   [ "${FCM_KEEP_PREFIX:-0}" = 1 ] && echo "install check: prefix kept: $prefix"
   return 0
 }

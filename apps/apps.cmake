@@ -3,9 +3,10 @@
 add_library(fcm_apps_cli STATIC apps/cli.c apps/app_sphere.c)
 target_link_libraries(fcm_apps_cli PUBLIC fcm::fcm)
 target_compile_options(fcm_apps_cli PRIVATE ${FCM_WARNINGS} ${FCM_SAN_FLAGS})
-fcm_add_app(fcm-sim apps/fcm-sim.c)
-if(FCM_HAVE_PETSC) # --backend petsc
+fcm_add_app(fcm-sim apps/fcm-sim.c apps/fcm-sim-plot.c)
+if(FCM_HAVE_PETSC) # --backend petsc: the PETSc component
   target_sources(fcm-sim PRIVATE apps/fcm-sim-petsc.c)
+  target_link_libraries(fcm-sim PRIVATE fcm::petsc)
 endif()
 fcm_add_app(fcm-rulegen apps/fcm-rulegen.c)
 fcm_add_app(fcm-quadrature apps/fcm-quadrature.c apps/fcm-quadrature-embed.c)
@@ -13,6 +14,9 @@ fcm_add_app(fcm-condition apps/fcm-condition.c apps/fcm-condition-study.c apps/f
 fcm_add_app(fcm-converge apps/fcm-converge.c apps/fcm-converge-study.c apps/fcm-converge-output.c)
 fcm_add_app(fcm-cut apps/fcm-cut.c)
 fcm_add_app(fcm-scaling apps/fcm-scaling.c apps/fcm-scaling-study.c apps/fcm-scaling-output.c)
+if(FCM_HAVE_PETSC) # --backend petsc: the PETSc component
+  target_link_libraries(fcm-scaling PRIVATE fcm::petsc)
+endif()
 fcm_add_app(fcm-models apps/fcm-models.c apps/fcm-models-run.c apps/fcm-models-output.c)
 fcm_add_app(fcm-cutbench apps/fcm-cutbench.c apps/fcm-cutbench-scenes.c
             apps/fcm-cutbench-output.c)

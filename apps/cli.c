@@ -387,36 +387,78 @@ void cli_report_scene_error(const char *prog, const char *name, const char *mess
     fprintf(stderr, "%s: scene %s: %s\n", prog, name, message);
 }
 
-int cli_gnuplot_png(const char *prog, const char *size, const char *path, const char *body)
+const char *const cli_palette[CLI_PALETTE_SIZE] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e",
+                                                   "#9467bd", "#8c564b", "#e377c2", "#17becf",
+                                                   "#bcbd22", "#7f7f7f", "#000080", "#800000"};
+
+/* 1 when `gnuplot` runs, else 0 after saying so (naming the Debian package and what is not
+ * written). */
+static int gnuplot_found(const char *prog, const char *path)
 {
-  char tmp[4096], script[4096], cmd[8400];
-  if (system(NULL) == 0 || system("gnuplot --version > /dev/null 2>&1") != 0) {
-    fprintf(stderr, "%s: gnuplot not found (Debian package gnuplot-nox): %s not written\n", prog,
-            path);
-    return 1;
-  }
-  if (snprintf(tmp, sizeof tmp, "%s.tmp.png", path) >= (int)sizeof tmp ||
-      snprintf(script, sizeof script, "%s.gp.tmp", path) >= (int)sizeof script) {
-    fprintf(stderr, "%s: --png: path too long\n", prog);
-    return 0;
-  }
+  if (system(NULL) != 0 && system("gnuplot --version > /dev/null 2>&1") == 0) return 1;
+  fprintf(stderr, "%s: gnuplot not found (Debian package gnuplot-nox): %s not written\n", prog,
+          path);
+  return 0;
+}
+
+/* Write the script `script` drawing `body` into `out` (PNG terminal of `size`); 1 on success. */
+static int gnuplot_write_script(const char *prog, const char *script, const char *size,
+                                const char *out, const char *head, const char *body)
+{
   FILE *f = fopen(script, "w");
   if (!f) {
     fprintf(stderr, "%s: cannot write %s\n", prog, script);
     return 0;
   }
-  fprintf(f, "set terminal png size %s\nset output '%s'\n%s\nset output\n", size, tmp, body);
+  fprintf(f, "%sset terminal png size %s\nset output '%s'\n%s\nset output\n", head, size, out,
+          body);
   const int werr = ferror(f);
   if (fclose(f) != 0 || werr) {
+    fprintf(stderr, "%s: cannot write %s\n", prog, script);
     remove(script);
     return 0;
   }
-  snprintf(cmd, sizeof cmd, "gnuplot '%s' 2>/dev/null", script);
-  const int rc = system(cmd);
+  return 1;
+}
+
+/* Run gnuplot on `script`; 1 when it succeeded. */
+static int gnuplot_run(const char *script)
+{
+  char cmd[4200];
+  if (snprintf(cmd, sizeof cmd, "gnuplot '%s' 2>/dev/null", script) >= (int)sizeof cmd) return 0;
+  return system(cmd) == 0;
+}
+
+int cli_gnuplot_png(const char *prog, const char *size, const char *path, const char *body)
+{
+  char tmp[4096], script[4096];
+  if (!gnuplot_found(prog, path)) return 1;
+  if (snprintf(tmp, sizeof tmp, "%s.tmp.png", path) >= (int)sizeof tmp ||
+      snprintf(script, sizeof script, "%s.gp.tmp", path) >= (int)sizeof script) {
+    fprintf(stderr, "%s: --png: path too long\n", prog);
+    return 0;
+  }
+  if (!gnuplot_write_script(prog, script, size, tmp, "", body)) return 0;
+  const int ran = gnuplot_run(script);
   remove(script);
-  if (rc != 0 || rename(tmp, path) != 0) {
+  if (!ran || rename(tmp, path) != 0) {
     remove(tmp);
     fprintf(stderr, "%s: gnuplot failed; %s not written\n", prog, path);
+    return 0;
+  }
+  return 1;
+}
+
+int cli_gnuplot_script_png(const char *prog, const char *script, const char *size, const char *path,
+                           const char *body)
+{
+  char head[4400];
+  snprintf(head, sizeof head, "# Draws %s; re-draw with: gnuplot %s\n", path, script);
+  if (!gnuplot_write_script(prog, script, size, path, head, body)) return 0;
+  if (!gnuplot_found(prog, path)) return 1;
+  if (!gnuplot_run(script)) {
+    remove(path);
+    fprintf(stderr, "%s: gnuplot failed on %s; %s not written\n", prog, script, path);
     return 0;
   }
   return 1;

@@ -43,6 +43,18 @@ int cli_element(const char *prog, const char *opt, const char *s, void *dest);
  * gnuplot is missing (said on stderr, naming the Debian package), 0 on an error. */
 int cli_gnuplot_png(const char *prog, const char *size, const char *path, const char *body);
 
+/** As cli_gnuplot_png(), keeping the script: `body` is written to `script` (a gnuplot script
+ * that draws `path` when run again: `gnuplot script`), then run. The script is written even
+ * when gnuplot is missing. 1 on success or when gnuplot is missing (said on stderr), 0 on an
+ * error (said on stderr). */
+int cli_gnuplot_script_png(const char *prog, const char *script, const char *size, const char *path,
+                           const char *body);
+
+/** Colours for the plots' series, distinguishable from each other, "#rrggbb": one per series
+ * or piece; more series than this take a colour ramp with a colour box instead. */
+#define CLI_PALETTE_SIZE 12
+extern const char *const cli_palette[CLI_PALETTE_SIZE];
+
 /** --backend petsc (or --backend=petsc) among the arguments: the PETSc options of the command
  * line (a single dash and a word, "-ksp_type", with the value after it unless that is an
  * option) are moved from argv into pargv (after the program name argv[0]; pargv has room for

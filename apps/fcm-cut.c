@@ -558,6 +558,22 @@ static char dice_title[6][64];
 
 /* Append the points of space's pieces (displacement u) for the picture; 0 on allocation
  * failure. The stick of a point: its reference (x, y) between the dicing planes `at`. */
+/* The colour of stick (ix, iy) of the 6 x 6, as 0xrrggbb: one of 36, the hue by the column
+ * (cli_palette), the lightness by the row (mixed towards black, then white), so that sticks
+ * side by side in either direction differ. */
+static long dice_colour(int ix, int iy)
+{
+  static const double mix[6] = {-0.5, -0.3, -0.1, 0.1, 0.3, 0.5};
+  const long rgb = strtol(cli_palette[ix] + 1, NULL, 16);
+  long out = 0;
+  for (int k = 2; k >= 0; k--) {
+    const double c = (double)((rgb >> (8 * k)) & 0xff);
+    const double v = mix[iy] < 0 ? c * (1.0 + mix[iy]) : c + (255.0 - c) * mix[iy];
+    out = out << 8 | (long)(v + 0.5);
+  }
+  return out;
+}
+
 static int dice_png_add(const fcm_space *space, const double *u, const double at[5],
                         const char *title)
 {
@@ -607,8 +623,8 @@ static int dice_png_add(const fcm_space *space, const double *u, const double at
         if (!q) return 0;
         dice_data = q, dice_cap = cap;
       }
-      dice_len += (size_t)snprintf(dice_data + dice_len, dice_cap - dice_len, "%d %.5f %.5f %d\n",
-                                   dice_panels, x[0] + d[0], x[1] + d[1], (ix + 2 * iy) % 6);
+      dice_len += (size_t)snprintf(dice_data + dice_len, dice_cap - dice_len, "%d %.5f %.5f %ld\n",
+                                   dice_panels, x[0] + d[0], x[1] + d[1], dice_colour(ix, iy));
     }
   }
   dice_panels++;
@@ -624,21 +640,26 @@ static int dice_png(const char *path)
   n += (size_t)snprintf(body + n, cap - n, "$D << EOD\n");
   if (dice_len) memcpy(body + n, dice_data, dice_len);
   n += dice_len;
+  /* one panel per variant, as many columns as fit in three */
+  const int rows = dice_panels > 3 ? 2 : 1, cols = (dice_panels + rows - 1) / rows;
+  char size[64];
+  snprintf(size, sizeof size, "%d,%d font ',11'", 80 + 400 * cols, 110 + 400 * rows);
   n += (size_t)snprintf(
       body + n, cap - n,
-      "EOD\nset multiplot layout 2,3 title '36 sticks after 5 steps spinning under "
-      "gravity (Ton-That et al. 2024, Fig. 5): quadrature points from above'\n"
-      "unset key\nset size ratio -1\n"
-      "set palette defined (0 '#1f77b4', 1 '#ff7f0e', 2 '#2ca02c', 3 '#d62728', "
-      "4 '#9467bd', 5 '#8c564b')\nunset colorbox\nset xrange [-0.3:1.3]\n"
-      "set yrange [-0.3:1.3]\n");
+      "EOD\nset multiplot layout %d,%d title \"36 sticks after 5 steps spinning under gravity "
+      "(Ton-That et al. 2024, Fig. 5): quadrature points from above\\ncolour: the stick, hue "
+      "by its column (x), lightness by its row (y)\" font ',12'\n"
+      "unset key\nset size ratio -1\nset xrange [-0.3:1.3]\nset yrange [-0.3:1.3]\n"
+      "set xtics -0.25, 0.5\nset ytics -0.25, 0.5\nset format x '%%.2f'\n"
+      "set format y '%%.2f'\nset xlabel 'x (m)'\nset ylabel 'y (m)'\nset grid\n",
+      rows, cols);
   for (int k = 0; k < dice_panels; k++)
     n += (size_t)snprintf(body + n, cap - n,
                           "set title '%s'\nplot $D using ($1 == %d ? $2 : 1/0):3:4 "
-                          "with points pt 7 ps 0.3 lc palette\n",
+                          "with points pt 7 ps 0.35 lc rgb variable\n",
                           dice_title[k], k);
   n += (size_t)snprintf(body + n, cap - n, "unset multiplot");
-  const int ok = cli_gnuplot_png(PROG, "900,600 font ',11'", path, body);
+  const int ok = cli_gnuplot_png(PROG, size, path, body);
   free(body);
   return ok;
 }
@@ -793,8 +814,9 @@ static int accuracy_png(const char *path, int max_strength)
       n += (size_t)snprintf(body + n, sizeof body - n, "EOD\n");
     }
   n += (size_t)snprintf(body + n, sizeof body - n,
-                        "set logscale y\nset format y '10^{%%L}'\nset grid\n"
-                        "set key outside right font ',9'\nset xlabel 'strength m'\n"
+                        "set logscale y\nset format y '10^{%%L}'\nset grid\nset xtics 1\n"
+                        "set key top left font ',10' opaque box maxrows 4\n"
+                        "set xlabel 'strength m'\n"
                         "set ylabel 'largest relative moment error over the pieces'\n"
                         "set yrange [1e-17:1e-10]\nset title 'cut-cell pieces: moments of degree "
                         "<= m (Koschier et al. 2017, Table 1)'\n"
@@ -816,7 +838,6 @@ static double cond_raw[13][2][2], cond_scaled[13][2][2];
 static int condition_png(const char *path)
 {
   static char body[16384];
-  static const char *const colors[2][2] = {{"#d62728", "#1f77b4"}, {"#ff7f0e", "#2ca02c"}};
   size_t n = 0;
   for (int con = 0; con < 2; con++)
     for (int stab = 0; stab < 2; stab++)
@@ -829,13 +850,16 @@ static int condition_png(const char *path)
         }
         n += (size_t)snprintf(body + n, sizeof body - n, "EOD\n");
       }
-  n += (size_t)snprintf(body + n, sizeof body - n,
-                        "set logscale xy\nset xrange [*:*] reverse\nset format x '10^{%%L}'\n"
-                        "set format y '10^{%%L}'\nset grid\nset key outside right font ',9'\n"
-                        "set xlabel 'distance of the cut to the face / cell size'\n"
-                        "set ylabel 'condition number'\n"
-                        "set title 'kappa(M + dt^2 K), cube of 5 tets cut near a face "
-                        "(Koschier et al. 2017, Fig. 14)'\nplot");
+  n +=
+      (size_t)snprintf(body + n, sizeof body - n,
+                       "set logscale xy\nset xrange [*:*] reverse\nset format x '10^{%%L}'\n"
+                       "set format y '10^{%%L}'\nset grid\n"
+                       "set key below maxrows 4 font ',10'\nset bmargin 9\n"
+                       "set xlabel 'distance of the cut to the face / cell size'\n"
+                       "set ylabel 'condition number'\n"
+                       "set title \"kappa(M + dt^2 K), cube of 5 tets cut near a face "
+                       "(Koschier et al. 2017, Fig. 14)\\nraw and diagonally scaled, a colour each "
+                       "(curves that agree overlap)\" noenhanced\nplot");
   int first = 1;
   for (int con = 0; con < 2; con++)
     for (int stab = 0; stab < 2; stab++)
@@ -843,11 +867,12 @@ static int condition_png(const char *path)
         n += (size_t)snprintf(body + n, sizeof body - n,
                               "%s $D%d%d%d with linespoints lw 2 dt %d lc rgb '%s' title '%s, "
                               "constraint %s, stabilization %s'",
-                              first ? "" : ",", con, stab, sc, sc ? 2 : 1, colors[con][stab],
-                              sc ? "scaled" : "raw", con ? "on" : "off", stab ? "on" : "off");
+                              first ? "" : ",", con, stab, sc, sc ? 2 : 1,
+                              cli_palette[4 * con + 2 * stab + sc], sc ? "scaled" : "raw",
+                              con ? "on" : "off", stab ? "on" : "off");
         first = 0;
       }
-  return cli_gnuplot_png(PROG, "900,600 font ',11'", path, body);
+  return cli_gnuplot_png(PROG, "900,700 font ',11'", path, body);
 }
 
 static int run_condition(fcm_ctx *ctx, const char *csvpath, const char *pngpath)

@@ -193,7 +193,9 @@ int cutbench_write_png(const char *path, const cutbench_row *rows, int n)
       "set multiplot layout 1,2 title 'fcm-cutbench: fcm beside the papers (log scale)'\n"
       "set datafile missing '?'\nset style data histograms\nset style histogram clustered gap 1\n"
       "set style fill solid 0.8 border -1\nset logscale y\nset grid ytics\nset tmargin 4\n"
-      "set xtics rotate by -30 font ',9'\nset key outside bottom center horizontal\n");
+      "set xtics rotate by -30 font ',9'\nset key outside bottom center horizontal\n"
+      "set xrange [-0.6:%d.6]\n", /* the groups only: no empty slot beside them */
+      n - 1);
   for (int panel = 0; panel < 2; panel++) {
     cutbench_put(
         &sc,

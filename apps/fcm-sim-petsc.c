@@ -9,6 +9,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "fcm-sim-petsc.h"
 #include "cli.h"
+#include "fcm-sim-plot.h"
 
 #include <fcm/fcm.h>
 #include <fcm/scene_petsc.h>
@@ -130,8 +131,8 @@ static fcm_status on_step(void *user, fcm_simulation *sim, const fcm_simulation_
  * checkpoint (fcm_simulation_read_checkpoint(): also the linear driver's .fcmpk files of
  * earlier versions). Returns the exit code (the same on every process). */
 static int run_scene(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, long long steps,
-                     int check, int quiet, int checkpoint_every, const char *resume, int rank,
-                     int size)
+                     int check, int quiet, int plot, int checkpoint_every, const char *resume,
+                     int rank, int size)
 {
   const char *name = fcm_scene_name(scene);
   const int talk = rank == 0 && !quiet;
@@ -204,6 +205,7 @@ static int run_scene(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, l
   if (write && rank == 0) {
     ok = fcm_simulation_write_log(sim, logpath) == FCM_OK;
     if (!ok) fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));
+    if (ok && plot) ok = sim_plot_log("fcm-sim", logpath);
   }
   MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
   if (!ok) goto done;
@@ -214,7 +216,7 @@ static int run_scene(fcm_ctx *ctx, const fcm_scene *scene, const char *outdir, l
   if (talk) {
     printf("  backend   petsc, %d process%s (Newton on PETSc), steps %.3g s\n", size,
            size > 1 ? "es" : "", fcm_wtime() - t0);
-    if (write) sim_print_output(dir, name, logpath, 0);
+    if (write) sim_print_output(dir, name, logpath, 0, plot);
   }
   rc = 0;
 done:
@@ -223,7 +225,8 @@ done:
 }
 
 int sim_petsc_run(const char *path, const char *outdir, long long steps, int check, int quiet,
-                  int checkpoint_every, const char *resume, int petsc_argc, char **petsc_argv)
+                  int plot, int checkpoint_every, const char *resume, int petsc_argc,
+                  char **petsc_argv)
 {
   int rc = 1, rank = 0, size = 1;
   fcm_ctx *ctx = NULL;
@@ -269,7 +272,8 @@ int sim_petsc_run(const char *path, const char *outdir, long long steps, int che
   if (talk)
     fprintf(stderr, "fcm-sim: scene %s (%s): building on %d process%s (backend petsc)\n", name,
             fcm_scene_source(scene), size, size > 1 ? "es" : "");
-  rc = run_scene(ctx, scene, outdir, steps, check, quiet, checkpoint_every, resume, rank, size);
+  rc = run_scene(ctx, scene, outdir, steps, check, quiet, plot, checkpoint_every, resume, rank,
+                 size);
 done:
   /* the exit code every process returns: the largest */
   {

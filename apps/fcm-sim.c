@@ -8,7 +8,8 @@
 #include <fcm/simulation.h>
 
 #include "cli.h"
-#include "fcm-sim-petsc.h" /* sim_print_output(); sim_petsc_run() is built with FCM_HAVE_PETSC */
+#include "fcm-sim-petsc.h" /* sim_print_output(); sim_petsc_run() is built with PETSc only */
+#include "fcm-sim-plot.h"
 
 #include <errno.h>
 #include <omp.h>
@@ -30,6 +31,7 @@ typedef struct scene_options {
   int checkpoint_every; /* -1: the scene's */
   int check, quiet, print_scene;
   int preview;  /* write the preview files and stop before the set-up */
+  int plot;     /* --plot: <name>_log.png (and .gp) beside the log at the end */
   int debug;    /* print the library's traceback with errors */
   int progress; /* the set-up's phases and progress also when stderr is not a terminal */
   int backend;  /* 0 serial, 1 petsc */
@@ -38,7 +40,7 @@ typedef struct scene_options {
 static const char *const backend_names[] = {"serial", "petsc", NULL};
 
 /* The option table, writing into `o`. */
-#define SIM_NUM_OPTIONS 12
+#define SIM_NUM_OPTIONS 13
 static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS])
 {
   const cli_option t[SIM_NUM_OPTIONS] = {
@@ -68,6 +70,11 @@ static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS
        0, 0, 0, NULL, NULL, NULL},
       {"--print-scene", NULL, CLI_FLAG, &o->print_scene, NULL,
        "print the scene as JSON with every default filled in and exit", 0, 0, 0, NULL, NULL, NULL},
+      {"--plot", NULL, CLI_FLAG, &o->plot, NULL,
+       "at the end, draw the log against time into <name>_log.png\n"
+       "(energy, momentum, Newton iterations, reactions; gnuplot,\n"
+       "through the script <name>_log.gp written beside it)",
+       0, 0, 0, NULL, NULL, NULL},
       {"--quiet", "-q", CLI_FLAG, &o->quiet, NULL, "print only errors", 0, 0, 0, NULL, NULL, NULL},
       {"--progress", NULL, CLI_FLAG, &o->progress, NULL,
        "report the set-up also when stderr is not a terminal: a\n"
@@ -131,13 +138,13 @@ static int parse_scene_args(int argc, char **argv, scene_options *o)
   const int rc = cli_parse_args("fcm-sim", opts, argc, argv, pos, 1, &npos, usage);
   if (rc >= 0) return rc;
   o->path = npos ? pos[0] : NULL;
-  if (o->check && (o->resume || o->checkpoint_every > 0)) {
-    fprintf(stderr, "fcm-sim: --check writes nothing: no --resume or --checkpoint-every\n");
+  if (o->check && (o->resume || o->checkpoint_every > 0 || o->plot)) {
+    fprintf(stderr, "fcm-sim: --check writes nothing: no --resume, --checkpoint-every or --plot\n");
     return 2;
   }
-  if (o->preview && (o->check || o->resume || o->checkpoint_every > 0 || o->steps > 0)) {
-    fprintf(stderr, "fcm-sim: --preview takes no steps: no --check, --resume, --steps or "
-                    "--checkpoint-every\n");
+  if (o->preview && (o->check || o->resume || o->checkpoint_every > 0 || o->steps > 0 || o->plot)) {
+    fprintf(stderr, "fcm-sim: --preview takes no steps: no --check, --resume, --steps, "
+                    "--checkpoint-every or --plot\n");
     return 2;
   }
   return -1;
@@ -439,7 +446,7 @@ static int run_petsc_backend(const scene_options *o, int pargc, char **pargv)
                         "--backend: it builds no distributed state)\n",
                         o->print_scene ? "--print-scene" : "--preview"),
                 2)
-             : sim_petsc_run(o->path, o->outdir, o->steps, o->check, o->quiet,
+             : sim_petsc_run(o->path, o->outdir, o->steps, o->check, o->quiet, o->plot,
                              o->check ? 0 : o->checkpoint_every, o->resume, pargc, pargv);
 #else
   (void)o;
@@ -575,24 +582,29 @@ static int finish_run(fcm_simulation *sim, fcm_status st, const run_state *rs, i
     report_error(rs->ctx, o->debug, what);
     if (rs->write && fcm_simulation_write_log(sim, rs->logpath) != FCM_OK)
       report_error(rs->ctx, o->debug, "writing the log");
+    else if (rs->write && o->plot)
+      sim_plot_log("fcm-sim", rs->logpath); /* the steps up to the failure */
     return 1;
   }
   if (rs->write && fcm_simulation_write_log(sim, rs->logpath) != FCM_OK) {
     report_error(rs->ctx, o->debug, "writing the log");
     return 1;
   }
+  if (rs->write && o->plot && !sim_plot_log("fcm-sim", rs->logpath)) return 1;
   if (!o->quiet) {
     fcm_simulation_summary_view(sim, stdout);
     if (rs->write) {
       fcm_simulation_counters c;
       fcm_simulation_get_counters(sim, &c);
-      sim_print_output(dir, name, rs->logpath, !(c.frames > 0 && (int)c.frames > frames_at_start));
+      sim_print_output(dir, name, rs->logpath, !(c.frames > 0 && (int)c.frames > frames_at_start),
+                       o->plot);
     }
   }
   return 0;
 }
 
-void sim_print_output(const char *dir, const char *name, const char *logpath, int no_frame)
+void sim_print_output(const char *dir, const char *name, const char *logpath, int no_frame,
+                      int plot)
 {
   static const char *const series[] = {"background", "surface"};
   char path[4096];
@@ -602,12 +614,16 @@ void sim_print_output(const char *dir, const char *name, const char *logpath, in
     struct stat sb;
     if (stat(path, &sb) == 0) printf("%s, ", path);
   }
-  printf("%s%s\n", logpath, no_frame ? " (no new frame)" : "");
+  printf("%s%s", logpath, no_frame ? " (no new frame)" : "");
+  snprintf(path, sizeof path, "%s/%s_log.png", dir, name);
+  struct stat sb;
+  if (plot && stat(path, &sb) == 0) printf(", %s", path);
+  printf("\n");
 }
 
 static int scene_main(int argc, char **argv)
 {
-  scene_options o = {NULL, NULL, NULL, 0, -1, 0, 0, 0, 0, 0, 0, 0};
+  scene_options o = {NULL, NULL, NULL, 0, -1, 0, 0, 0, 0, 0, 0, 0, 0};
   int pargc = 1;
   char **pargv = calloc((size_t)argc + 1, sizeof *pargv);
   if (!pargv) return 1;

@@ -5,7 +5,7 @@
 # Their sources and CMake project are installed with the documentation
 # (<prefix>/share/doc/fcm/examples), where the install check builds them.
 install(FILES apps/examples/host_static.c apps/examples/host_dynamic.cpp
-              apps/examples/CMakeLists.txt
+              apps/examples/host_petsc.c apps/examples/CMakeLists.txt
         DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples)
 add_executable(fcm_example_host_static apps/examples/host_static.c)
 target_link_libraries(fcm_example_host_static PRIVATE fcm::fcm)
@@ -16,6 +16,16 @@ if(BUILD_TESTING)
            COMMAND fcm_example_host_static ${PROJECT_BINARY_DIR}/examples-out)
   set_tests_properties(app_example_host_static PROPERTIES LABELS app TIMEOUT 300
                        ENVIRONMENT "OMP_NUM_THREADS=2;OMP_WAIT_POLICY=passive;OPENBLAS_NUM_THREADS=1")
+endif()
+# host_petsc: the PETSc component as a host links it (fcm::petsc); run on 2 processes by the
+# test app_example_host_petsc (tests/petsc/tests.cmake).
+if(FCM_HAVE_PETSC)
+  add_executable(fcm_example_host_petsc apps/examples/host_petsc.c)
+  target_link_libraries(fcm_example_host_petsc PRIVATE fcm::petsc)
+  if(FCM_MATH_LIBRARY)
+    target_link_libraries(fcm_example_host_petsc PRIVATE m)
+  endif()
+  target_compile_options(fcm_example_host_petsc PRIVATE ${FCM_WARNINGS} ${FCM_SAN_FLAGS})
 endif()
 include(CheckLanguage)
 check_language(CXX)

@@ -48,6 +48,25 @@ static inline int app_is_png(const char *path)
   return ok;
 }
 
+/* The width and height of the PNG `path` from its IHDR chunk (the signature, then the chunk
+ * length 13 and type "IHDR", then width and height as big-endian 32-bit integers); 1 when the
+ * file is a PNG with that header, else 0. */
+static inline int app_png_size(const char *path, unsigned long *width, unsigned long *height)
+{
+  static const unsigned char head[16] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n',
+                                         0,    0,   0,   13,  'I',  'H',  'D',  'R'};
+  unsigned char b[24] = {0};
+  FILE *f = fopen(path, "rb");
+  const int ok = f && fread(b, 1, 24, f) == 24 && !memcmp(b, head, 16);
+  if (f) fclose(f);
+  if (!ok) return 0;
+  *width =
+      (unsigned long)b[16] << 24 | (unsigned long)b[17] << 16 | (unsigned long)b[18] << 8 | b[19];
+  *height =
+      (unsigned long)b[20] << 24 | (unsigned long)b[21] << 16 | (unsigned long)b[22] << 8 | b[23];
+  return 1;
+}
+
 /* Field k (from 0) of a CSV line without quoting into buf (cap bytes, cut to fit). */
 static inline void field(const char *line, int k, char *buf, size_t cap)
 {

@@ -99,7 +99,8 @@ static void read_log(const char *path, log_rows *L)
       if (c == col_inv) L->inverted[L->n] = v;
       if (c == col_nan) L->nonfinite[L->n] = v;
     }
-    TEST_TRUE(c == col_nan + 3); /* then the Newton tolerance and the wall time */
+    /* then the Newton tolerance, the energies (kinetic, elastic, load work) and the wall time */
+    TEST_TRUE(c == col_nan + 6);
     L->n++;
   }
   fclose(f);

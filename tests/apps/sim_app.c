@@ -173,14 +173,16 @@ static int mode_run(const char *sim, const char *work)
      * points and the NaN stresses of the step's frame, the Newton tolerance, then the wall
      * time */
     TEST_TRUE(fgets(line, sizeof line, f) &&
-              !strcmp(line, "step,time,newton_iterations,linear_iterations,residual,energy,"
-                            "pieces,mass,momentum_x,momentum_y,momentum_z,reaction_1_x,"
-                            "reaction_1_y,reaction_1_z,moment_1_x,moment_1_y,moment_1_z,"
-                            "inverted_points,nonfinite_stresses,tolerance,wall_time\n"));
+              !strcmp(line,
+                      "step,time,newton_iterations,linear_iterations,residual,energy,"
+                      "pieces,mass,momentum_x,momentum_y,momentum_z,reaction_1_x,"
+                      "reaction_1_y,reaction_1_z,moment_1_x,moment_1_y,moment_1_z,"
+                      "inverted_points,nonfinite_stresses,tolerance,kinetic_energy,elastic_energy,"
+                      "load_work,wall_time\n"));
     int rows = 0;
     double v[32];
-    while (fgets(line, sizeof line, f) && csv_numbers(line, v, 32) == 21) {
-      const double mass = v[7], wall = v[20], res = v[4];
+    while (fgets(line, sizeof line, f) && csv_numbers(line, v, 32) == 24) {
+      const double mass = v[7], wall = v[23], res = v[4];
       /* converged steps: the residual is within the stopping rule's tolerance */
       TEST_TRUE(v[19] > 0.0 && res <= v[19]);
       /* a hanging beam: nothing inverted; a frame (NaN-free) after every second step */
@@ -520,10 +522,11 @@ static int mode_default_quick(const char *sim, const char *work)
     TEST_TRUE(fgets(line, sizeof line, f) && !strncmp(line, "step,time,newton_iterations,", 28));
     /* two motion effects (indices 1 and 2): 12 reaction columns before the wall time */
     TEST_TRUE(strstr(line, ",moment_1_z,reaction_2_x,") &&
-              strstr(line, ",moment_2_z,inverted_points,nonfinite_stresses,tolerance,wall_time\n"));
+              strstr(line, ",moment_2_z,inverted_points,nonfinite_stresses,tolerance,"
+                           "kinetic_energy,elastic_energy,load_work,wall_time\n"));
     int rows = 0;
     double v[32];
-    while (fgets(line, sizeof line, f) && csv_numbers(line, v, 32) == 27) {
+    while (fgets(line, sizeof line, f) && csv_numbers(line, v, 32) == 30) {
       TEST_TRUE(v[23] == 0.0); /* the tube buckles, but no point inverts */
       TEST_TRUE(v[6] == 1 && v[7] > 0.0);
       rows++;

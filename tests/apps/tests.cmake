@@ -18,6 +18,19 @@ fcm_add_test(app_sim_errors tests/apps/sim_app.c LABELS app
              ARGS errors $<TARGET_FILE:fcm-sim> ${work})
 fcm_add_test(app_sim_resume tests/apps/sim_app.c LABELS app
              ARGS resume $<TARGET_FILE:fcm-sim> ${work})
+# fcm-sim --plot: the log drawn into <name>_log.png (a PNG of the stated size) through the
+# script <name>_log.gp, whose data block has the log's rows; without gnuplot on the PATH the
+# run still succeeds, writes the script and says that gnuplot was not found.
+fcm_add_test(app_sim_plot tests/apps/sim_plot_app.c LABELS app
+             ARGS plot $<TARGET_FILE:fcm-sim> ${work})
+fcm_add_test(app_sim_plot_no_gnuplot tests/apps/sim_plot_app.c LABELS app
+             ARGS no-gnuplot $<TARGET_FILE:fcm-sim> ${work})
+# The README's picture (apps/docs/img/demo.png): its command on 6 steps of the demo's scene
+# makes a PNG of the stated size (skipped without gnuplot, after checking the script says so).
+add_test(NAME app_demo_picture COMMAND bash ${PROJECT_SOURCE_DIR}/tests/apps/demo_picture.sh
+                                       $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR} ${work})
+set_tests_properties(app_demo_picture PROPERTIES LABELS app TIMEOUT 300 SKIP_RETURN_CODE 77
+                     ENVIRONMENT "${FCM_TEST_ENV}")
 # The README quick start, `fcm-sim` without arguments: the first 6 steps in the default run
 # (frames, PVD indexes and log rows checked step by step); to the end (71 frames, 210 log
 # rows; its run time: lib/docs/performance.md) labelled slow.

@@ -3,7 +3,8 @@
  * the library no longer writes: old_writer() below writes it) load into a scene's simulation
  * through fcm_simulation_read_checkpoint(), the one reader of the serial and the PETSc runs, and
  * into the driver through fcm_petsc_problem_read_checkpoint() (label mpi; 1 and 2 processes).
- * vibrating_beam.json: the linear driver takes K steps and writes its checkpoint; then
+ * vibrating_beam_euler.json (tests/petsc/scenes: backward Euler): the linear driver takes K steps
+ * and writes its checkpoint; then
  *  - the integrator on PETSc (fcm_petsc_simulation_create()) and the serial fcm_simulation read
  *    either file: the state bit for bit the driver's, the time and step count its own, the log
  *    rows of the K steps (time k dt, the other columns NaN) and the frames the driver's run wrote

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# fcm-sim --backend petsc --resume on a linear scene (label mpi): vibrating_beam.json runs through
-# the integrator on PETSc like every scene (fcm_simulation_run(), the serial checkpoint format).
+# fcm-sim --backend petsc --resume on a linear scene (label mpi): tests/petsc/scenes/
+# vibrating_beam_euler.json (backward Euler, the linear driver's scheme) runs through the
+# integrator on PETSc like every scene (fcm_simulation_run(), the serial checkpoint format).
 #  - 10 steps on 2 processes (CG + GAMG to rtol 1e-12: MUMPS, the scene's direct solver, is not
 #    bitwise reproducible between runs on 2 processes) with a checkpoint every 5, then a copy of its output resumed from
 #    step 5 on 2 processes: the log (all but the wall-time column), the PVD and the frames'
@@ -43,7 +44,7 @@ rm "$work/c/$ck10"
   --resume "$work/c/old_np2.fcmck" "${ksp[@]}"
 "$diff" "$work/c/$ck10" "$work/a/$ck10" 1e-8
 # a checkpoint of another scene is refused (exit 2) on every process
-if "$mpiexec" -n 2 "$sim" "${scene%/*}/cantilever.json" --backend petsc -o "$work/d" -q \
+if "$mpiexec" -n 2 "$sim" "${scene%/*}/../../../apps/scenes/cantilever.json" --backend petsc -o "$work/d" -q \
      --resume "$work/a/$ck5" 2>"$work/err"; then
   echo "resume of another scene's checkpoint succeeded" >&2
   exit 1

@@ -1,10 +1,10 @@
 /* Example scenes on the PETSc backend (label mpi; 1 and 2 processes): the scene's first steps
  * through fcm_petsc_problem_create_from_scene() give the displacement (and velocity) of the
  * serial fcm_simulation to 1e-8 relative — cantilever.json (static, Hex20, conforming) and
- * vibrating_beam.json (backward Euler, Hex8, embedded). The KSP runs to rtol 1e-12 (set in the
- * options database, as a user would with -ksp_rtol). Then a parallel VTU frame: the .pvtu names
- * one piece per process and the pieces hold every active cell once. Arguments: scenes
- * directory, scene file, steps. */
+ * tests/petsc/scenes/vibrating_beam_euler.json (backward Euler, Hex8, embedded). The KSP runs to
+ * rtol 1e-12 (set in the options database, as a user would with -ksp_rtol). Then a parallel VTU
+ * frame: the .pvtu names one piece per process and the pieces hold every active cell once.
+ * Arguments: scenes directory, scene file, steps. */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/fcm.h"
 #include "fcm/scene_petsc.h"

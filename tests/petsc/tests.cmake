@@ -67,7 +67,7 @@ foreach(np 1 2)
   fcm_add_test(petsc_scene_cantilever_np${np} tests/petsc/scene.c NP ${np}
                ARGS ${PROJECT_SOURCE_DIR}/apps/scenes cantilever.json 1)
   fcm_add_test(petsc_scene_vibrating_beam_np${np} tests/petsc/scene.c NP ${np}
-               ARGS ${PROJECT_SOURCE_DIR}/apps/scenes vibrating_beam.json 10)
+               ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes vibrating_beam_euler.json 10)
 endforeach()
 if(FCM_BUILD_APPS)
   # every example scene on 2 processes against the serial fcm-sim: petsc_app_scene_* below
@@ -109,7 +109,7 @@ endforeach()
 # another problem, truncated and corrupted ones refused
 foreach(np 1 2)
   fcm_add_test(petsc_legacy_checkpoint_np${np} tests/petsc/legacy_checkpoint.c NP ${np}
-               ARGS ${PROJECT_SOURCE_DIR}/apps/scenes vibrating_beam.json 5
+               ARGS ${PROJECT_SOURCE_DIR}/tests/petsc/scenes vibrating_beam_euler.json 5
                     ${CMAKE_CURRENT_BINARY_DIR}/petsc_legacy_checkpoint)
 endforeach()
 if(FCM_BUILD_APPS)
@@ -119,7 +119,7 @@ if(FCM_BUILD_APPS)
            COMMAND bash ${PROJECT_SOURCE_DIR}/tests/petsc/resume.sh ${MPIEXEC_EXECUTABLE}
                    $<TARGET_FILE:fcm-sim> $<TARGET_FILE:petsc_state_diff>
                    $<TARGET_FILE:petsc_legacy_checkpoint>
-                   ${PROJECT_SOURCE_DIR}/apps/scenes/vibrating_beam.json
+                   ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/vibrating_beam_euler.json
                    ${CMAKE_CURRENT_BINARY_DIR}/petsc_app_sim_resume)
   set_tests_properties(petsc_app_sim_resume PROPERTIES LABELS mpi TIMEOUT 300 PROCESSORS 2
                        ENVIRONMENT "${FCM_MPI_TEST_ENV}")
@@ -326,3 +326,13 @@ fcm_add_test(petsc_newton_create_failure_np3 tests/petsc/pcmg_failure.c NP 3 TIM
 # phase 2 (the integrator, -pc_type mg): every 37th allocation of the first step
 fcm_add_test(petsc_pcmg_failure_newton_np2 tests/petsc/pcmg_failure.c NP 2 TIMEOUT 120
              ARGS scene ${PROJECT_SOURCE_DIR}/tests/petsc/scenes/static_snh.json 37)
+# The example host of the PETSc component (apps/examples/host_petsc.c, linked as a host links
+# it: fcm::petsc) on 2 processes: at the static equilibrium the elastic energy is half the
+# work of the load.
+if(TARGET fcm_example_host_petsc)
+  add_test(NAME app_example_host_petsc
+           COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 ${MPIEXEC_PREFLAGS}
+                   $<TARGET_FILE:fcm_example_host_petsc>)
+  set_tests_properties(app_example_host_petsc PROPERTIES LABELS "app;mpi" TIMEOUT 120
+                       PROCESSORS 2 ENVIRONMENT "${FCM_MPI_TEST_ENV}")
+endif()

@@ -2,9 +2,11 @@
  * Schwarz blocks, a dynamic nonlinear run with damping, a released motion and MINRES, and a
  * free spinning body with the direct solver, the dynamic run on Hex8 with MINRES and the
  * multigrid preconditioner, and a spinning body cut in two during the run
- * (checkpoints before and after the cut), running K steps, saving, restoring into a new
- * simulation and running on gives bit for bit the state, time and per-step log (but wall
- * times) of the uninterrupted run. Error paths: restoring into a stepped simulation, a
+ * (checkpoints before and after the cut), and the dynamic run with Newmark and HHT and the cut
+ * one with generalized-alpha, running K steps, saving, restoring into a new
+ * simulation and running on gives bit for bit the state (acceleration included), time and
+ * per-step log (but wall times) of the uninterrupted run; a checkpoint of another time scheme
+ * is refused. Error paths: restoring into a stepped simulation, a
  * missing file, a directory, a checkpoint beyond the steps to take, an unwritable path (nothing
  * left behind), a simulation of another scene, a corrupted and a truncated file (format errors
  * naming the file); allocation failures while restoring leave the simulation usable and leak
@@ -98,9 +100,20 @@ static const char cut_json[] =
     "  {\"cut\": {\"time\": 0.04, \"surface\": {\"plane\": {\"point\": [0.43, 0.25, 0.25],"
     "    \"normal\": [1, 0.1, 0]}}}}]}";
 
+/* Build `out` from a scene text with its "time" section replaced by `time` (the other time
+ * schemes on the scenes above: their state holds the acceleration too). */
+static void with_time(const char *json, const char *time, char *out, size_t cap)
+{
+  const char *a = strstr(json, " \"time\": {"), *b = a ? strchr(a, '}') : NULL;
+  out[0] = '\0';
+  if (!a || !b) return;
+  snprintf(out, cap, "%.*s \"time\": %s%s", (int)(a - json), json, time, b + 1);
+}
+
 typedef struct run_state {
   fcm_index n;
-  double *u, *v, t;
+  double *u, *v, *a, t;
+  int a_known;
   long long steps;
   fcm_simulation_counters c;
 } run_state;
@@ -111,7 +124,9 @@ static void capture(fcm_simulation *sim, run_state *r)
   r->n = fcm_integrator_num_dofs(I);
   r->u = calloc((size_t)r->n, sizeof *r->u);
   r->v = calloc((size_t)r->n, sizeof *r->v);
+  r->a = calloc((size_t)r->n, sizeof *r->a);
   if (r->u && r->v) fcm_integrator_get_state(I, r->u, r->v, &r->t, &r->steps);
+  if (r->a) r->a_known = fcm_integrator_get_acceleration(I, r->a);
   fcm_simulation_get_counters(sim, &r->c);
 }
 
@@ -119,6 +134,7 @@ static void release(run_state *r)
 {
   free(r->u);
   free(r->v);
+  free(r->a);
   memset(r, 0, sizeof *r);
 }
 
@@ -192,6 +208,7 @@ static void check_scene(fcm_ctx *ctx, const char *json, const char *dir, long lo
   if (res.u && full.u && res.n == full.n) {
     TEST_TRUE(!memcmp(res.u, full.u, sizeof *res.u * (size_t)res.n));
     TEST_TRUE(!memcmp(res.v, full.v, sizeof *res.v * (size_t)res.n));
+    TEST_TRUE(res.a_known == full.a_known && !memcmp(res.a, full.a, sizeof *res.a * (size_t)res.n));
   }
   /* the log is complete and equal; the cumulative iteration counts continue */
   TEST_TRUE(log_a[0] && !strcmp(log_a, log_b));
@@ -299,6 +316,42 @@ int main(void)
   check_scene(ctx, spin_json, dir, 3);
   check_scene(ctx, cut_json, dir, 1); /* before the cut */
   check_scene(ctx, cut_json, dir, 4); /* after it */
+  { /* Newmark (nonlinear, damping, a release, MINRES) and generalized-alpha across a cut */
+    static char nm[4096], ga[4096], hht[4096];
+    with_time(dynamic_json, "{\"integrator\": \"newmark\", \"dt\": 0.02, \"steps\": 6}", nm,
+              sizeof nm);
+    with_time(cut_json,
+              "{\"integrator\": \"generalized_alpha\", \"rho_inf\": 0.6, \"dt\": 0.02, "
+              "\"steps\": 6}",
+              ga, sizeof ga);
+    with_time(dynamic_json,
+              "{\"integrator\": \"hht\", \"alpha\": -0.2, \"dt\": 0.02, \"steps\": 6}", hht,
+              sizeof hht);
+    check_scene(ctx, nm, dir, 3);
+    check_scene(ctx, ga, dir, 2); /* before the cut */
+    check_scene(ctx, ga, dir, 4); /* after it */
+    check_scene(ctx, hht, dir, 2);
+    /* a checkpoint of another scheme (not part of the fingerprint) is refused, named */
+    fcm_scene *a = NULL, *b = NULL;
+    fcm_simulation *sa = NULL, *sb = NULL;
+    char ckp[256];
+    snprintf(ckp, sizeof ckp, "%s/scheme.fcmck", dir);
+    TEST_OK(ctx, fcm_scene_create_from_string(ctx, nm, "ck.json", &a));
+    TEST_OK(ctx, fcm_scene_create_from_string(ctx, hht, "ck.json", &b));
+    if (a) TEST_OK(ctx, fcm_simulation_create(ctx, a, NULL, &sa));
+    if (b) TEST_OK(ctx, fcm_simulation_create(ctx, b, NULL, &sb));
+    if (sa && sb) {
+      step_to(ctx, sa, 1);
+      TEST_OK(ctx, fcm_simulation_write_checkpoint(sa, ckp));
+      TEST_ERR(ctx, fcm_simulation_read_checkpoint(sb, ckp), FCM_ERR_ARG,
+               "written with time.integrator \"newmark\"");
+    }
+    remove(ckp);
+    fcm_simulation_destroy(&sa);
+    fcm_simulation_destroy(&sb);
+    fcm_scene_destroy(&a);
+    fcm_scene_destroy(&b);
+  }
 
   /* error paths */
   fcm_scene *scene = NULL, *other = NULL;

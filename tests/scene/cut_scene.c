@@ -95,11 +95,12 @@ static int run(fcm_ctx *ctx, const char *json, long long *pieces, double *mass,
     char line[1024];
     if (f && fgets(line, sizeof line, f)) {
       long long step, nw, lin;
-      double t, res, en, p[3], inverted, nonfinite, tol, wall;
+      double t, res, en, p[3], inverted, nonfinite, tol, ek, el, wk, wall;
       while (*rows < 16 &&
-             fscanf(f, "%lld,%lf,%lld,%lld,%lf,%lf,%lld,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf\n", &step,
-                    &t, &nw, &lin, &res, &en, &pieces[*rows], &mass[*rows], &p[0], &p[1], &p[2],
-                    &inverted, &nonfinite, &tol, &wall) == 15)
+             fscanf(f,
+                    "%lld,%lf,%lld,%lld,%lf,%lf,%lld,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf\n",
+                    &step, &t, &nw, &lin, &res, &en, &pieces[*rows], &mass[*rows], &p[0], &p[1],
+                    &p[2], &inverted, &nonfinite, &tol, &ek, &el, &wk, &wall) == 18)
         (*rows)++;
     }
     if (f) fclose(f);

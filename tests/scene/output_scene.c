@@ -95,12 +95,15 @@ static void static_hang(fcm_ctx *ctx)
   char header[1024] = "";
   double rows[8][32];
   int ncol = 0;
-  TEST_TRUE(read_log(sim, header, sizeof header, rows, &ncol) == 1 && ncol == 21);
-  TEST_TRUE(strstr(header, ",momentum_z,reaction_1_x,reaction_1_y,reaction_1_z,moment_1_x,"
-                           "moment_1_y,moment_1_z,inverted_points,nonfinite_stresses,"
-                           "tolerance,wall_time\n") != NULL);
+  TEST_TRUE(read_log(sim, header, sizeof header, rows, &ncol) == 1 && ncol == 24);
+  TEST_TRUE(strstr(header,
+                   ",momentum_z,reaction_1_x,reaction_1_y,reaction_1_z,moment_1_x,"
+                   "moment_1_y,moment_1_z,inverted_points,nonfinite_stresses,"
+                   "tolerance,kinetic_energy,elastic_energy,load_work,wall_time\n") != NULL);
   TEST_TRUE(rows[0][19] > 0.0 && rows[0][4] <= rows[0][19]); /* converged: residual <= tol */
   TEST_TRUE(rows[0][17] == 0.0 && isnan(rows[0][18]));       /* nothing inverted, no frame */
+  /* static: no kinetic energy; gravity did work on the sagging body */
+  TEST_TRUE(rows[0][20] == 0.0 && rows[0][22] > 0.0);
   /* minus the assembled weight and its moment: sum f and sum (X + u) x f over all copies */
   const fcm_space *space = fcm_simulation_space(sim);
   fcm_integrator *integ = fcm_simulation_integrator(sim);
@@ -224,17 +227,20 @@ static void derive_checkpoint(const unsigned char *buf, long size, uint64_t vers
   free(b);
 }
 
-/* Checkpoints keep the reaction columns (version 3), the inversion counts (version 4) and the
- * Newton tolerance (version 5); a version-4 file restores with a NaN tolerance, a version-3
- * file with NaN counts too, a version-2 file (rows without reactions either) with NaN there
- * too. Row: 8 f64 + 3 i64, the one constraint's 6 f64, 3 i64 counts, then 1 f64. */
+/* Checkpoints keep the reaction columns (version 3), the inversion counts (version 4), the
+ * Newton tolerance (version 5) and the energies (version 6, with the time scheme's block of
+ * 5 x 8 bytes after the rows); a version-5 file restores with NaN energies, a version-4 file
+ * with a NaN tolerance too, a version-3 file with NaN counts too, a version-2 file (rows
+ * without reactions either) with NaN there too. Row: 8 f64 + 3 i64, the one constraint's 6 f64,
+ * 3 i64 counts, 1 f64 tolerance, 3 f64 energies. */
 static void checkpoint_versions(fcm_ctx *ctx)
 {
   fcm_scene *scene = NULL;
   fcm_simulation *sim = NULL, *back = NULL;
   unsigned char *buf = NULL;
-  const char *v5 = "scene_output_v5.fcmck",
-             *old[3] = {"scene_output_v4.fcmck", "scene_output_v3.fcmck", "scene_output_v2.fcmck"};
+  const char *v5 = "scene_output_v6.fcmck",
+             *old[4] = {"scene_output_v5.fcmck", "scene_output_v4.fcmck", "scene_output_v3.fcmck",
+                        "scene_output_v2.fcmck"};
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, static_json, "hang.json", &scene));
   if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
   if (!sim) goto done;
@@ -243,14 +249,14 @@ static void checkpoint_versions(fcm_ctx *ctx)
   char h1[1024] = "", h2[1024] = "";
   double r1[8][32], r2[8][32];
   int n1 = 0, n2 = 0;
-  TEST_TRUE(read_log(sim, h1, sizeof h1, r1, &n1) == 1 && n1 == 21);
+  TEST_TRUE(read_log(sim, h1, sizeof h1, r1, &n1) == 1 && n1 == 24);
   TEST_TRUE(r1[0][17] == 0.0 && isnan(r1[0][18])); /* nothing inverted; no frame */
   TEST_TRUE(r1[0][19] > 0.0);                      /* the Newton tolerance */
   TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &back));
   if (back) TEST_OK(ctx, fcm_simulation_read_checkpoint(back, v5));
   if (back) TEST_TRUE(read_log(back, h2, sizeof h2, r2, &n2) == 1 && n2 == n1);
-  for (int k = 0; k < 20 && back; k++)
-    TEST_TRUE(k == 18 || r1[0][k] == r2[0][k]); /* bit for bit: reactions, count, tolerance */
+  for (int k = 0; k < 23 && back; k++) /* bit for bit: reactions, count, tolerance, energies */
+    TEST_TRUE(k == 18 || r1[0][k] == r2[0][k]);
   if (back) TEST_TRUE(isnan(r2[0][18]));
   fcm_simulation_destroy(&back);
   FILE *f = fopen(v5, "rb");
@@ -264,18 +270,21 @@ static void checkpoint_versions(fcm_ctx *ctx)
     TEST_FAIL_("checkpoint %s has only %ld bytes", v5, size);
     goto done;
   }
-  derive_checkpoint(buf, size, 4, 8 * 8 + 3 * 8 + 6 * 8 + 3 * 8, 8, old[0]);
-  derive_checkpoint(buf, size, 3, 8 * 8 + 3 * 8 + 6 * 8, 3 * 8 + 8, old[1]);
-  derive_checkpoint(buf, size, 2, 8 * 8 + 3 * 8, 6 * 8 + 3 * 8 + 8, old[2]);
-  for (int v = 0; v < 3; v++) {
-    const int kept = v == 0 ? 18 : v == 1 ? 17 : 11; /* the columns the version recorded */
+  const size_t tail = 3 * 8 + 5 * 8; /* the row's energies and the scheme's block */
+  derive_checkpoint(buf, size, 5, 8 * 8 + 3 * 8 + 6 * 8 + 3 * 8 + 8, tail, old[0]);
+  derive_checkpoint(buf, size, 4, 8 * 8 + 3 * 8 + 6 * 8 + 3 * 8, 8 + tail, old[1]);
+  derive_checkpoint(buf, size, 3, 8 * 8 + 3 * 8 + 6 * 8, 3 * 8 + 8 + tail, old[2]);
+  derive_checkpoint(buf, size, 2, 8 * 8 + 3 * 8, 6 * 8 + 3 * 8 + 8 + tail, old[3]);
+  for (int v = 0; v < 4; v++) {
+    /* the columns the version recorded */
+    const int kept = v == 0 ? 20 : v == 1 ? 18 : v == 2 ? 17 : 11;
     TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &back));
     if (back) TEST_OK(ctx, fcm_simulation_read_checkpoint(back, old[v]));
     if (back) TEST_TRUE(read_log(back, h2, sizeof h2, r2, &n2) == 1 && n2 == n1);
     for (int k = 0; k < kept && back; k++)
-      TEST_TRUE(r1[0][k] == r2[0][k]);
-    for (int k = kept; k < 20 && back; k++)
-      TEST_TRUE(isnan(r2[0][k])); /* not recorded by that version */
+      TEST_TRUE(k == 18 || r1[0][k] == r2[0][k]); /* 18: no frame, NaN */
+    for (int k = kept; k < 23 && back; k++)
+      TEST_TRUE(k == 18 || isnan(r2[0][k])); /* not recorded by that version */
     fcm_simulation_destroy(&back);
   }
 done:
@@ -284,6 +293,7 @@ done:
   remove(old[0]);
   remove(old[1]);
   remove(old[2]);
+  remove(old[3]);
   fcm_simulation_destroy(&back);
   fcm_simulation_destroy(&sim);
   fcm_scene_destroy(&scene);
@@ -303,7 +313,15 @@ static void dynamic_block(fcm_ctx *ctx)
   char header[1024] = "";
   double rows[8][32];
   int ncol = 0;
-  TEST_TRUE(read_log(sim, header, sizeof header, rows, &ncol) == 4 && ncol == 21);
+  TEST_TRUE(read_log(sim, header, sizeof header, rows, &ncol) == 4 && ncol == 24);
+  /* backward Euler dissipates (linear material, at rest at t = 0): kinetic + elastic energy stay
+   * below the work of gravity, and kinetic + elastic - work decreases step by step */
+  for (int k = 0; k < 4; k++) {
+    TEST_TRUE(rows[k][22] > 0.0 && rows[k][20] + rows[k][21] <= rows[k][22]);
+    if (k > 0)
+      TEST_TRUE(rows[k][20] + rows[k][21] - rows[k][22] <=
+                rows[k - 1][20] + rows[k - 1][21] - rows[k - 1][22]);
+  }
   const double W[3] = {0, 0, -1000.0 * 9.81 * 2.0};
   double p0[3] = {0, 0, 0};
   for (int k = 0; k < 4; k++) {

@@ -269,6 +269,16 @@ static void check_defaults(fcm_ctx *ctx)
   fcm_scene_destroy(&s);
 }
 
+/* The minimal scene with the given "time" section (NULL, reported, when it does not parse). */
+static fcm_scene *time_scene(fcm_ctx *ctx, const char *time)
+{
+  char json[512];
+  snprintf(json, sizeof json, "{" MIN_BG ", " MIN_MAT ", \"time\": %s}", time);
+  fcm_scene *s = NULL;
+  TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "t.json", &s));
+  return s;
+}
+
 /* A duration that is a whole number of steps up to rounding keeps that count; otherwise
  * the count rounds up. */
 static void check_steps(fcm_ctx *ctx)
@@ -285,13 +295,37 @@ static void check_steps(fcm_ctx *ctx)
       {"{\"dt\": 2, \"duration\": 1}", 1, 2.0},
   };
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
-    char json[512];
-    snprintf(json, sizeof json, "{" MIN_BG ", " MIN_MAT ", \"time\": %s}", cases[i].time);
-    fcm_scene *s = NULL;
-    TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "t.json", &s));
+    fcm_scene *s = time_scene(ctx, cases[i].time);
     if (!s) continue;
     TEST_TRUE(fcm_scene_get_time(s)->num_steps == cases[i].steps);
     TEST_NEAR(fcm_scene_get_time(s)->duration, cases[i].duration, 1e-14, 0);
+    fcm_scene_destroy(&s);
+  }
+}
+
+/* The time schemes: "integrator" with its parameter, the defaults of the parameter, and the
+ * normalized scene keeps them (round trip). */
+static void check_schemes(fcm_ctx *ctx)
+{
+  const struct {
+    const char *time;
+    fcm_time_scheme scheme;
+    double alpha, rho;
+  } cases[] = {
+      {"{\"integrator\": \"newmark\"}", FCM_SCHEME_NEWMARK, -0.05, 0.8},
+      {"{\"integrator\": \"hht\", \"alpha\": -0.25}", FCM_SCHEME_HHT, -0.25, 0.8},
+      {"{\"integrator\": \"hht\"}", FCM_SCHEME_HHT, -0.05, 0.8},
+      {"{\"integrator\": \"generalized_alpha\", \"rho_inf\": 0}", FCM_SCHEME_GENERALIZED_ALPHA,
+       -0.05, 0.0},
+      {"{\"integrator\": \"backward_euler\"}", FCM_SCHEME_BACKWARD_EULER, -0.05, 0.8},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+    fcm_scene *s = time_scene(ctx, cases[i].time);
+    if (!s) continue;
+    const fcm_scene_time *t = fcm_scene_get_time(s);
+    TEST_TRUE(t->integrator == FCM_INTEGRATOR_DYNAMIC && t->scheme == cases[i].scheme &&
+              t->hht_alpha == cases[i].alpha && t->rho_inf == cases[i].rho);
+    check_normalized(ctx, s, cases[i].time);
     fcm_scene_destroy(&s);
   }
 }
@@ -503,6 +537,7 @@ int main(void)
   check_full(ctx);
   check_defaults(ctx);
   check_steps(ctx);
+  check_schemes(ctx);
   check_motion(ctx);
   check_boundary(ctx);
   check_files(ctx);

@@ -13,10 +13,13 @@ extern "C" {
 
 /** Integrator kinds. */
 typedef enum fcm_integrator_kind {
-  FCM_INTEGRATOR_STATIC = 0,        /**< equilibrium Psi'(u) = f_ext, load steps, no inertia;
-                                         the constraints must hold every body's rigid-body
-                                         modes (checked by fcm_integrator_step()) */
-  FCM_INTEGRATOR_BACKWARD_EULER = 1 /**< implicit Euler on the incremental potential */
+  FCM_INTEGRATOR_STATIC = 0, /**< equilibrium Psi'(u) = f_ext, load steps, no inertia;
+                                  the constraints must hold every body's rigid-body
+                                  modes (checked by fcm_integrator_step()) */
+  /** Dynamics (inertia): the integrator's options choose the time scheme
+   * (fcm_integrator_options.scheme in fcm/sim.h; backward Euler by default) */
+  FCM_INTEGRATOR_BACKWARD_EULER = 1,
+  FCM_INTEGRATOR_DYNAMIC = 1 /**< the same kind, named for the schemes other than backward Euler */
 } fcm_integrator_kind;
 
 /** Prescribed motion of a node set: with tau = clamp(t - start, 0, end - start), a node with

@@ -150,8 +150,11 @@ typedef struct fcm_scene_solver {
 typedef struct fcm_scene_time {
   fcm_integrator_kind integrator; /**< FCM_INTEGRATOR_STATIC ("static": true: quasi-static
                                        equilibrium at each step, no inertia) or
-                                       FCM_INTEGRATOR_BACKWARD_EULER ("integrator":
-                                       "backward_euler", the default) */
+                                       FCM_INTEGRATOR_DYNAMIC (the default) */
+  fcm_time_scheme scheme;         /**< dynamic: "integrator": "backward_euler" (the default),
+                                       "newmark", "hht" or "generalized_alpha" */
+  double hht_alpha;               /**< "hht": "alpha" in [-1/3, 0], default -0.05 */
+  double rho_inf;                 /**< "generalized_alpha": "rho_inf" in [0, 1], default 0.8 */
   double dt;                      /**< step in s, > 0, default 1/60 */
   fcm_index num_steps;            /**< steps to take (>= 1), from "steps" or "duration" */
   double duration;                /**< num_steps * dt: the simulated time in s */

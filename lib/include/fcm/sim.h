@@ -19,7 +19,25 @@
  * the tangent at the start of the (sub)step, projected to positive semi-definite and held
  * fixed during the step, so the damping force D v_{n+1} derives from the quadratic term above
  * (the Newton system stays symmetric, the line search sees a true energy, and D >= 0
- * dissipates). Static: E(u) = Psi(u) - f_ext^T u. */
+ * dissipates). Static: E(u) = Psi(u) - f_ext^T u.
+ *
+ * Newmark (average acceleration), HHT-alpha and generalized-alpha (fcm_time_scheme; Chung and
+ * Hulbert 1993) solve the same kind of incremental potential. With a_{n+1} = (u - u~)/(beta h^2),
+ * u~ = u_n + h v_n + h^2 (1/2 - beta) a_n, v_{n+1} = v_n + h ((1 - gamma) a_n + gamma a_{n+1}),
+ * the balance (1 - alpha_m) M a_{n+1} + alpha_m M a_n + (1 - alpha_f) (f_int(u_{n+1}) +
+ * D v_{n+1} - f_ext(t_{n+1})) + alpha_f (f_int(u_n) + D v_n - f_ext(t_n)) = 0, divided by
+ * 1 - alpha_f, is the gradient of
+ *   E(u) = c/2 |u - u~|_M^2 + Psi(u) - f_ext(t_{n+1})^T u + gamma/(2 beta h) |u - u_d|_D^2
+ *          - f_a^T u,   c = (1 - alpha_m)/((1 - alpha_f) beta h^2),
+ * u_d = u~ - beta h/gamma (v_n + h (1 - gamma) a_n) and the constant force of the step
+ * f_a = (alpha_f (f_ext(t_n) - f_int(u_n) - D v_n) - alpha_m M a_n)/(1 - alpha_f): the
+ * internal and damping forces are interpolated (the HHT form), f_int includes the boundary
+ * constraints' forces. Newmark: alpha_m = alpha_f = 0, beta = 1/4, gamma = 1/2; HHT (alpha in
+ * [-1/3, 0]): alpha_m = 0, alpha_f = -alpha, beta = (1 - alpha)^2/4, gamma = 1/2 - alpha;
+ * generalized-alpha (rho_inf in [0, 1]): alpha_m = (2 rho_inf - 1)/(rho_inf + 1), alpha_f =
+ * rho_inf/(rho_inf + 1), gamma = 1/2 - alpha_m + alpha_f, beta = (1 - alpha_m + alpha_f)^2/4.
+ * The first step computes a_0 from M a_0 = f_ext(t_0) - f_int(u_0) - D v_0 (lib/docs/
+ * time_integration.md). */
 #ifndef FCM_SIM_H
 #define FCM_SIM_H
 
@@ -48,6 +66,27 @@ typedef enum fcm_newton_tolerance {
    * (which has no mass; the force-balance rule needs no extra body-force pass). */
   FCM_NEWTON_TOL_AUTO = 2
 } fcm_newton_tolerance;
+
+/** Time scheme of the dynamic kind (FCM_INTEGRATOR_DYNAMIC = FCM_INTEGRATOR_BACKWARD_EULER);
+ * the formulas are at the top of this header. All are implicit, solved by the same Newton
+ * iteration, and hold for linear and hyperelastic materials. */
+typedef enum fcm_time_scheme {
+  FCM_SCHEME_BACKWARD_EULER = 0, /**< first order, strongly dissipative (default) */
+  /** Newmark's average acceleration (trapezoidal) rule, beta = 1/4, gamma = 1/2: second order,
+   * no numerical dissipation (a linear undamped body keeps its energy) */
+  FCM_SCHEME_NEWMARK = 1,
+  /** Hilber-Hughes-Taylor alpha (fcm_integrator_options.hht_alpha): second order, dissipates
+   * the high frequencies the more the more negative alpha is */
+  FCM_SCHEME_HHT = 2,
+  /** Chung-Hulbert generalized-alpha (fcm_integrator_options.rho_inf): second order, spectral
+   * radius rho_inf at infinite frequency (1: none, 0: asymptotic annihilation) */
+  FCM_SCHEME_GENERALIZED_ALPHA = 3,
+  FCM_SCHEME_COUNT
+} fcm_time_scheme;
+
+/** Static name of a scheme ("backward_euler", "newmark", "hht", "generalized_alpha"; "invalid"
+ * otherwise), the scene's "time.integrator" words. */
+FCM_API const char *fcm_time_scheme_name(fcm_time_scheme scheme);
 
 /** Linear solver of the Newton systems. */
 typedef enum fcm_linear_solver {
@@ -128,6 +167,13 @@ typedef enum fcm_cut_reuse {
 typedef struct fcm_integrator_options {
   fcm_integrator_kind kind;            /**< default BACKWARD_EULER (scene: "time.static",
                                             "time.integrator") */
+  fcm_time_scheme scheme;              /**< dynamic kind: default FCM_SCHEME_BACKWARD_EULER (scene:
+                                            "time.integrator"); STATIC ignores it */
+  double hht_alpha;                    /**< FCM_SCHEME_HHT: alpha in [-1/3, 0] (default -0.05;
+                                            scene: "time.alpha") */
+  double rho_inf;                      /**< FCM_SCHEME_GENERALIZED_ALPHA: spectral radius at
+                                            infinite frequency in [0, 1] (default 0.8; scene:
+                                            "time.rho_inf") */
   double dt;                           /**< step > 0: time step, or the pseudo-time of a static step
                                             (default 1/60; scene: "time.dt") */
   int load_steps;                      /**< static: increments per step, >= 1 (default 1; scene:
@@ -291,6 +337,11 @@ typedef struct fcm_step_info {
   double elastic_energy;          /**< Psi(u) */
   double external_work;           /**< f_ext(t)^T u */
   double total_energy;            /**< kinetic + elastic - external work */
+  double load_work;               /**< cumulative work of the external loads (gravity, body
+                                       forces, tractions) since the start, in J: the sum over the
+                                       accepted (sub)steps of 1/2 (f_ext(t_k) + f_ext(t_{k+1}))^T
+                                       (u_{k+1} - u_k) (trapezoidal in time;
+                                       fcm_integrator_load_work()) */
   fcm_index inverted_points;      /**< quadrature points of the body (the authentic points:
                                        fictitious stabilization points of cut cells left out)
                                        with J = det F <= 0 at the state the step ended in (0 on
@@ -345,7 +396,8 @@ FCM_API fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space,
  * loads assembled on the new space; the direct solver analyses the new pattern once, at the
  * first solve), and starts from old's time, step count, displacement and velocity carried
  * over by fcm_space_transfer(): every new DOF copy inherits its parent copy's values, so
- * the field, the mass and the linear and angular momentum are unchanged by the cut. A host
+ * the field, the mass and the linear and angular momentum are unchanged by the cut; the
+ * acceleration (when known) likewise, and the load work. A host
  * simulator calls it between steps and then destroys `old` (and old's space and rules).
  * With old's options' cut_reuse (fcm_cut_reuse): FCM_CUT_REUSE_BLOCKS integrates again only
  * the elements whose rules the cut changed (the mass matrix and the loads are the same bits as
@@ -566,14 +618,37 @@ FCM_API void fcm_integrator_get_state(const fcm_integrator *integ, double *u, do
                                       long long *steps);
 
 /** Replace the state (resume, initial conditions): u and v copied (either may be NULL to
- * keep it), time t and step count. Invalidates cached tangents; for static integrators the
+ * keep it), time t and step count. Invalidates cached tangents and forgets the acceleration
+ * (fcm_integrator_set_acceleration()); the load work stays; for static integrators the
  * load of the last accepted step becomes f_ext(t) (zero when steps == 0).
  * @return FCM_OK, FCM_ERR_ARG (non-finite entry: named), errors of the load evaluation. */
 FCM_API fcm_status fcm_integrator_set_state(fcm_integrator *integ, const double *u, const double *v,
                                             double t, long long steps);
 
+/** The acceleration of the state (num_dofs values into `a`, may be NULL): that of the last
+ * accepted step of Newmark, HHT or generalized-alpha, or the initial one their first step
+ * computed. @return 1 when it is known, 0 when not (backward Euler keeps none; before the first
+ * step and after fcm_integrator_set_state() without fcm_integrator_set_acceleration(); `a` is
+ * then zeroed). */
+FCM_API int fcm_integrator_get_acceleration(const fcm_integrator *integ, double *a);
+
+/** Replace the acceleration of the state (resume): `a` (num_dofs values, copied), or NULL to
+ * have the next step of a scheme that needs it solve M a = f_ext - f_int(u) - D v at the
+ * current time (with the linear solver of the Newton systems, the active constrained DOFs at
+ * zero acceleration). Call after fcm_integrator_set_state(), which forgets it.
+ * @return FCM_OK, FCM_ERR_ARG (NULL integrator, non-finite entry: named). No allocation. */
+FCM_API fcm_status fcm_integrator_set_acceleration(fcm_integrator *integ, const double *a);
+
+/** Cumulative work of the external loads (fcm_step_info.load_work; 0 at creation). */
+FCM_API double fcm_integrator_load_work(const fcm_integrator *integ);
+
+/** Replace the cumulative load work (resume). @return FCM_OK, FCM_ERR_ARG (NULL, not
+ * finite). */
+FCM_API fcm_status fcm_integrator_set_load_work(fcm_integrator *integ, double work);
+
 /** Set a rigid initial velocity v = v0 + omega x (X + u - c) at every node (v0, omega, c:
- * 3 each; NULL means zero). @return FCM_OK, FCM_ERR_ARG (non-finite). */
+ * 3 each; NULL means zero); forgets the acceleration (the next step solves for it). @return FCM_OK,
+ * FCM_ERR_ARG (non-finite). */
 FCM_API fcm_status fcm_integrator_set_rigid_velocity(fcm_integrator *integ, const double v0[3],
                                                      const double omega[3], const double c[3]);
 

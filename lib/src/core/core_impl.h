@@ -14,18 +14,29 @@
 #define FCM__PRINTF(f, a)
 #endif
 
+/* An internal function that fcm's PETSc component (libfcm_petsc: lib/src/petsc and the scene
+ * runner's distributed path, a library of its own on top of libfcm) calls: exported by the
+ * shared libfcm, as the FCM_API functions are, but declared in no installed header, so it is no
+ * part of the API (the fcm__ prefix). Only functions the component needs carry it; `bash
+ * setup.sh install-check` checks that libfcm exports no other internal name. */
+#if defined(FCM_BUILDING_LIBRARY) && defined(__GNUC__)
+#define FCM_COMPONENT_API __attribute__((visibility("default")))
+#else
+#define FCM_COMPONENT_API
+#endif
+
 /* Record a new error in ctx (replacing any previous one, starting a fresh
  * traceback at file:line), log it at FCM_LOG_ERROR and return `code`.
  * Thread safe: concurrent errors keep one of them. ctx may be NULL. */
-fcm_status fcm__error(fcm_ctx *ctx, fcm_status code, const char *file, int line, const char *func,
-                      const char *fmt, ...) FCM__PRINTF(6, 7);
+FCM_COMPONENT_API fcm_status fcm__error(fcm_ctx *ctx, fcm_status code, const char *file, int line,
+                                        const char *func, const char *fmt, ...) FCM__PRINTF(6, 7);
 
 /* Append a traceback frame to the recorded error. */
-void fcm__trace(fcm_ctx *ctx, const char *file, int line, const char *func);
+FCM_COMPONENT_API void fcm__trace(fcm_ctx *ctx, const char *file, int line, const char *func);
 
 /* Prepend "prefix: " to the message of the error recorded in ctx (its traceback is kept);
  * nothing when no error is recorded. Not for use inside a parallel loop iteration. */
-void fcm__error_prefix(fcm_ctx *ctx, const char *prefix);
+FCM_COMPONENT_API void fcm__error_prefix(fcm_ctx *ctx, const char *prefix);
 
 /* Format a message and pass it to the log callback when level is enabled. */
 void fcm__log(const fcm_ctx *ctx, fcm_log_level level, const char *fmt, ...) FCM__PRINTF(3, 4);
@@ -39,13 +50,13 @@ int fcm__ctx_once(fcm_ctx *ctx, unsigned flag);
 /* Zero-filled array of n elements of `size` bytes through ctx's allocator.
  * Returns NULL on overflow or allocation failure (and records FCM_ERR_ALLOC).
  * n == 0 still returns a valid (1-byte) allocation. */
-void *fcm__calloc(fcm_ctx *ctx, size_t n, size_t size);
+FCM_COMPONENT_API void *fcm__calloc(fcm_ctx *ctx, size_t n, size_t size);
 
 /* As fcm__calloc, without the zero fill: for arrays written in full before they are read. */
-void *fcm__malloc(fcm_ctx *ctx, size_t n, size_t size);
+FCM_COMPONENT_API void *fcm__malloc(fcm_ctx *ctx, size_t n, size_t size);
 
 /* Release memory from fcm__calloc or fcm__malloc; accepts NULL. */
-void fcm__free(fcm_ctx *ctx, void *ptr);
+FCM_COMPONENT_API void fcm__free(fcm_ctx *ctx, void *ptr);
 
 /* As fcm__calloc for large arrays that are written all over (assembled matrix values): from
  * 8 MiB on, the array starts on a 2 MiB boundary and, on Linux, is advised to transparent huge
@@ -59,7 +70,8 @@ void fcm__free_large(fcm_ctx *ctx, void *ptr);
 
 /* Grow or shrink an fcm__calloc array, preserving min(old_n, new_n) elements and
  * zero-filling the rest. On failure *ptr is unchanged. */
-fcm_status fcm__resize(fcm_ctx *ctx, void **ptr, size_t old_n, size_t new_n, size_t size);
+FCM_COMPONENT_API fcm_status fcm__resize(fcm_ctx *ctx, void **ptr, size_t old_n, size_t new_n,
+                                         size_t size);
 
 /* Checked narrowing of a global index to int (LAPACK, GLPK, CHOLMOD sizes). */
 fcm_status fcm__index_to_int(fcm_ctx *ctx, fcm_index v, const char *what, int *out);

@@ -426,10 +426,12 @@ fcm_status fcm__embed_outside_sides(fcm_ctx *ctx, const double mlo[3], const dou
  * geom bit for bit (candidates are taken in ascending id order; the surface points carry the
  * original triangle ids). The options are checked as the rules build checks them (with a
  * reduce), and every flagged cell for convexity, with the build's messages. */
-fcm_status fcm__embed_crop_geometry(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
-                                    const fcm_cell_rules_options *opts,
-                                    const unsigned char *classify, const unsigned char *surface,
-                                    fcm_geometry **out);
+FCM_COMPONENT_API fcm_status fcm__embed_crop_geometry(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                                      const fcm_geometry *geom,
+                                                      const fcm_cell_rules_options *opts,
+                                                      const unsigned char *classify,
+                                                      const unsigned char *surface,
+                                                      fcm_geometry **out);
 
 /* fcm_cell_rules_create_cut() with keep = 1; keep = 0 integrates again every cell the new cut
  * reaches, whether it changes its pieces or not, and makes the face polygons of every cell
@@ -474,11 +476,12 @@ fcm_status fcm__cell_rules_create_reduced(fcm_ctx *ctx, const fcm_mesh *mesh,
  * still called, in that order. simplify = AUTO needs red. The statistics' counters are this
  * process's unless the exchange sums them; time_intersect covers this process's cells.
  * Collective. */
-fcm_status fcm__cell_rules_create_distributed(fcm_ctx *ctx, const fcm_mesh *mesh,
-                                              const fcm_geometry *geom,
-                                              const fcm_cell_rules_options *opts,
-                                              fcm__rules_reduce *red, const fcm__rules_exchange *x,
-                                              fcm_cell_rules **rules);
+FCM_COMPONENT_API fcm_status fcm__cell_rules_create_distributed(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                                                const fcm_geometry *geom,
+                                                                const fcm_cell_rules_options *opts,
+                                                                fcm__rules_reduce *red,
+                                                                const fcm__rules_exchange *x,
+                                                                fcm_cell_rules **rules);
 
 /* ---------------------------------------------------------------- coarse classification */
 

@@ -139,15 +139,18 @@ struct fcm_space {
  * ADD_VALUES (fcm__space_row_dof() names each row's DOF); fcm__space_matrix_apply() multiplies.
  * @return FCM_OK, FCM_ERR_ARG (as fcm_space_create*(); rules and cell_active both given),
  * FCM_ERR_ALLOC, FCM_ERR_UNSUPPORTED (colours). (space.c) */
-fcm_status fcm__space_create_local(fcm_ctx *ctx, const fcm_mesh *mesh,
-                                   const unsigned char *cell_active, const fcm_cell_rules *rules,
-                                   const fcm_space_options *opts, const unsigned char *cell_mask,
-                                   fcm_space **out);
+FCM_COMPONENT_API fcm_status fcm__space_create_local(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                                     const unsigned char *cell_active,
+                                                     const fcm_cell_rules *rules,
+                                                     const fcm_space_options *opts,
+                                                     const unsigned char *cell_mask,
+                                                     fcm_space **out);
 
 /* Rebuild the topology of a local space for the cells flagged in cell_mask (NULL: none); the
  * numbering is unchanged. On failure the space has no local elements (and the error). FCM_ERR_ARG
  * for a full space. (space.c) */
-fcm_status fcm__space_set_local_cells(fcm_space *s, const unsigned char *cell_mask);
+FCM_COMPONENT_API fcm_status fcm__space_set_local_cells(fcm_space *s,
+                                                        const unsigned char *cell_mask);
 
 /* FCM_OK for a full space; for a local one FCM_ERR_ARG with "<what>: the space is a local
  * space ..." recorded. (space.c) */
@@ -156,7 +159,8 @@ fcm_status fcm__space_check_full(const fcm_space *s, const char *what);
 /* The Morton (Z-curve) key of point x on a 2^21 grid over the box [lo, hi] in each direction
  * (coordinates clamped to the box; a flat direction counts as 0): sorting by it keeps points
  * near each other in space near each other in the order. */
-uint64_t fcm__morton_key(const double x[3], const double lo[3], const double hi[3]);
+FCM_COMPONENT_API uint64_t fcm__morton_key(const double x[3], const double lo[3],
+                                           const double hi[3]);
 
 /* ---- After a cut (cut_update.c): `to` is a space on the cell rules that
  * fcm_cell_rules_create_cut() made from `from`'s rules (fcm_space_transfer()'s conditions). */
@@ -347,8 +351,9 @@ void fcm__space_copy_support(const fcm_space *s, double *support);
  * @return FCM_OK, FCM_ERR_ARG (NULL, element out of range, bad material, rules without the
  * kind), FCM_ERR_UNSUPPORTED (another term), FCM_ERR_GEOMETRY (det J <= 0), FCM_ERR_ALLOC.
  * (assemble.c) */
-fcm_status fcm__assembly_element_linear(fcm_assembly_workspace *ws, const fcm_linear_form *form,
-                                        fcm_index elem, double *Ke, double *fe);
+FCM_COMPONENT_API fcm_status fcm__assembly_element_linear(fcm_assembly_workspace *ws,
+                                                          const fcm_linear_form *form,
+                                                          fcm_index elem, double *Ke, double *fe);
 
 /* Doubles per element that fcm__assembly_linear_blocks() keeps for `term`: nn (nn + 1) / 2
  * for the mass (its upper node blocks are multiples of the identity), 3 nn for the force
@@ -428,28 +433,30 @@ fcm_status fcm__embedded_surface_write_vtu_counted(const fcm_embedded_surface *e
 /* The mesh nodes of the cells with keep[c] != 0 (keep NULL: all), ascending, each once, in
  * *nodes (allocated with the space's context; free with fcm__free()), their count in *num.
  * O(kept cells) memory. (fields.c) */
-fcm_status fcm__space_piece_nodes(const fcm_space *s, const unsigned char *keep, fcm_index *num,
-                                  fcm_index **nodes);
+FCM_COMPONENT_API fcm_status fcm__space_piece_nodes(const fcm_space *s, const unsigned char *keep,
+                                                    fcm_index *num, fcm_index **nodes);
 
 /* dofs[i]: the first DOF fcm_space_node_field() reads at node nodes[i] (-1: an inactive node),
  * for n nodes: the copy of the largest support when a node has several. Allocates the copies'
  * supports (O(DOFs) doubles) when some node has two copies. (fields.c) */
-fcm_status fcm__space_node_field_dofs(const fcm_space *s, fcm_index n, const fcm_index *nodes,
-                                      fcm_index *dofs);
+FCM_COMPONENT_API fcm_status fcm__space_node_field_dofs(const fcm_space *s, fcm_index n,
+                                                        const fcm_index *nodes, fcm_index *dofs);
 
 /* fcm__space_write_vtu_piece() without stress, from the node values of the piece only: nodes
  * as fcm__space_piece_nodes() lists them for keep, nu / nv 3 values per listed node (the
  * values fcm_space_node_field() would give there; nv NULL: no velocity). The same file as
  * fcm__space_write_vtu_piece() with mat NULL and those values, without any DOF vector.
  * (fields.c) */
-fcm_status fcm__space_write_vtu_piece_values(const fcm_space *s, const unsigned char *keep,
-                                             fcm_index np, const fcm_index *nodes, const double *nu,
-                                             const double *nv, int rank, const char *path);
+FCM_COMPONENT_API fcm_status fcm__space_write_vtu_piece_values(const fcm_space *s,
+                                                               const unsigned char *keep,
+                                                               fcm_index np, const fcm_index *nodes,
+                                                               const double *nu, const double *nv,
+                                                               int rank, const char *path);
 
 /* The .pvtu index (written atomically) of the pieces <stem>_0.vtu .. <stem>_<nprocs-1>.vtu that
  * fcm__space_write_vtu_piece() wrote with the same velocity / mat choice. (fields.c) */
-fcm_status fcm__write_pvtu(fcm_ctx *ctx, const char *path, const char *stem, int nprocs,
-                           int with_velocity, int with_stress);
+FCM_COMPONENT_API fcm_status fcm__write_pvtu(fcm_ctx *ctx, const char *path, const char *stem,
+                                             int nprocs, int with_velocity, int with_stress);
 
 /* fcm_space_max_displacement() per cell: the largest |u| over each cell's authentic points
  * (0 for a cell without points). */

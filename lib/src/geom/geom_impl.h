@@ -73,7 +73,7 @@ int fcm__implicit_resolved(const fcm_implicit *q, double h, const char **key, ch
                            size_t len);
 
 /* Bytes of the geometry's arrays (coordinates, cells, triangles, maps) and struct. */
-double fcm__geom_bytes(const fcm_geometry *g);
+FCM_COMPONENT_API double fcm__geom_bytes(const fcm_geometry *g);
 
 /* ---------------------------------------------------------------- AABB tree */
 

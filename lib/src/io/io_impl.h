@@ -109,8 +109,8 @@ typedef struct fcm__ckpt_writer {
 } fcm__ckpt_writer;
 
 /* Open the temporary beside `path` and write the header. On failure nothing is left behind. */
-fcm_status fcm__ckpt_open(fcm_ctx *ctx, const char *path, const char magic[8], uint64_t version,
-                          fcm__ckpt_writer *w);
+FCM_COMPONENT_API fcm_status fcm__ckpt_open(fcm_ctx *ctx, const char *path, const char magic[8],
+                                            uint64_t version, fcm__ckpt_writer *w);
 
 /* Payload values: raw bytes, integers as int64/uint64, doubles as binary64. */
 fcm_status fcm__ckpt_put(fcm__ckpt_writer *w, const void *data, size_t n);
@@ -120,10 +120,10 @@ fcm_status fcm__ckpt_put_f64(fcm__ckpt_writer *w, double x);
 fcm_status fcm__ckpt_put_f64s(fcm__ckpt_writer *w, const double *x, size_t n);
 
 /* Append the checksum and replace the target; on failure the temporary is removed. */
-fcm_status fcm__ckpt_commit(fcm__ckpt_writer *w);
+FCM_COMPONENT_API fcm_status fcm__ckpt_commit(fcm__ckpt_writer *w);
 
 /* Drop an unfinished file (after a failed put); harmless after commit or a failed open. */
-void fcm__ckpt_abort(fcm__ckpt_writer *w);
+FCM_COMPONENT_API void fcm__ckpt_abort(fcm__ckpt_writer *w);
 
 typedef struct fcm__ckpt_reader {
   fcm_ctx *ctx;
@@ -142,13 +142,15 @@ typedef struct fcm__ckpt_reader {
  * what is wrong: FCM_ERR_IO (cannot read), FCM_ERR_FORMAT (not a checkpoint, other byte order,
  * unknown version, truncated or corrupted), FCM_ERR_ALLOC. Release with
  * fcm__ckpt_read_close() (also after a failure). */
-fcm_status fcm__ckpt_read_open(fcm_ctx *ctx, const char *path, const char magic[8],
-                               uint64_t max_version, fcm__ckpt_reader *r);
-void fcm__ckpt_read_close(fcm__ckpt_reader *r);
+FCM_COMPONENT_API fcm_status fcm__ckpt_read_open(fcm_ctx *ctx, const char *path,
+                                                 const char magic[8], uint64_t max_version,
+                                                 fcm__ckpt_reader *r);
+FCM_COMPONENT_API void fcm__ckpt_read_close(fcm__ckpt_reader *r);
 
 /* The next n bytes (FCM_ERR_FORMAT naming `what` when the file ends first). */
-fcm_status fcm__ckpt_get(fcm__ckpt_reader *r, void *out, size_t n, const char *what);
-fcm_status fcm__ckpt_get_u64(fcm__ckpt_reader *r, uint64_t *x, const char *what);
+FCM_COMPONENT_API fcm_status fcm__ckpt_get(fcm__ckpt_reader *r, void *out, size_t n,
+                                           const char *what);
+FCM_COMPONENT_API fcm_status fcm__ckpt_get_u64(fcm__ckpt_reader *r, uint64_t *x, const char *what);
 /* An integer in [lo, hi] (FCM_ERR_FORMAT naming `what`, the value and the range). */
 fcm_status fcm__ckpt_get_i64(fcm__ckpt_reader *r, long long *x, long long lo, long long hi,
                              const char *what);
@@ -158,7 +160,7 @@ fcm_status fcm__ckpt_get_f64(fcm__ckpt_reader *r, double *x, const char *what);
 fcm_status fcm__ckpt_need(fcm__ckpt_reader *r, long long count, size_t each, const char *what);
 
 /* Nothing is left after the payload (FCM_ERR_FORMAT: trailing bytes). */
-fcm_status fcm__ckpt_read_end(fcm__ckpt_reader *r);
+FCM_COMPONENT_API fcm_status fcm__ckpt_read_end(fcm__ckpt_reader *r);
 
 /* The payload of a checkpoint without a scene (the PETSc linear driver): the source word
  * FCM__CKPT_SOURCE_LINEAR where a scene run writes its scene's fingerprint (never 0), then
@@ -169,8 +171,9 @@ fcm_status fcm__ckpt_read_end(fcm__ckpt_reader *r);
 
 /* The container's version, the same for every writer so that each reader recognizes the other's
  * files: 4 introduced the linear driver's payload (the scene reader reads it from version 4 on),
- * 5 the Newton tolerance in a scene run's log rows. */
-#define FCM__CKPT_VERSION 5u
+ * 5 the Newton tolerance in a scene run's log rows, 6 the time scheme, its parameters, the
+ * acceleration and the load work of a scene run (and the energies in its log rows). */
+#define FCM__CKPT_VERSION 6u
 
 typedef struct fcm__ckpt_linear {
   long long num_dofs, elements, steps, kind;
@@ -178,12 +181,12 @@ typedef struct fcm__ckpt_linear {
 } fcm__ckpt_linear;
 
 /* The source word, the counts and the state. */
-fcm_status fcm__ckpt_put_linear(fcm__ckpt_writer *w, const fcm__ckpt_linear *h, const double *u,
-                                const double *v);
+FCM_COMPONENT_API fcm_status fcm__ckpt_put_linear(fcm__ckpt_writer *w, const fcm__ckpt_linear *h,
+                                                  const double *u, const double *v);
 
 /* The counts after the source word (or the legacy magic line), checked in range, and that the
  * state's 2 num_dofs doubles follow (read them with fcm__ckpt_get(), then
  * fcm__ckpt_read_end()). */
-fcm_status fcm__ckpt_get_linear(fcm__ckpt_reader *r, fcm__ckpt_linear *h);
+FCM_COMPONENT_API fcm_status fcm__ckpt_get_linear(fcm__ckpt_reader *r, fcm__ckpt_linear *h);
 
 #endif /* FCM_IO_IMPL_H */

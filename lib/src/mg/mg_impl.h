@@ -3,6 +3,7 @@
 #ifndef FCM_MG_IMPL_H
 #define FCM_MG_IMPL_H
 
+#include "core/core_impl.h"
 #include "fcm/mg.h"
 
 /* The prolongations of the hierarchy fcm_mg_create() builds, without a matrix. Level 0 is the
@@ -32,12 +33,13 @@ typedef struct fcm__mg_transfers {
  * prolongations are those fcm_mg_create() builds (the same code) for a matrix whose eliminated
  * rows are the constrained ones. @return FCM_OK, FCM_ERR_ARG, FCM_ERR_UNSUPPORTED (not a box
  * grid: named), FCM_ERR_ALLOC. */
-fcm_status fcm__mg_transfers_create(fcm_ctx *ctx, const fcm_space *space,
-                                    const unsigned char *constrained, int max_levels,
-                                    fcm_index coarse_dofs, fcm__mg_transfers **out);
+FCM_COMPONENT_API fcm_status fcm__mg_transfers_create(fcm_ctx *ctx, const fcm_space *space,
+                                                      const unsigned char *constrained,
+                                                      int max_levels, fcm_index coarse_dofs,
+                                                      fcm__mg_transfers **out);
 
 /* Destroy; accepts NULL and *t == NULL, sets *t = NULL. */
-void fcm__mg_transfers_destroy(fcm_ctx *ctx, fcm__mg_transfers **t);
+FCM_COMPONENT_API void fcm__mg_transfers_destroy(fcm_ctx *ctx, fcm__mg_transfers **t);
 
 /* The slab orders of the smoothers of `mg` (FCM_MG_SMOOTHER_SGS's rows, the block smoother's
  * blocks; fcm/mg.h) on `level` (< the number of levels - 1): the number of slabs (0 where the

@@ -3,8 +3,10 @@
  * simulation of the same scene.
  *
  * The file is the checkpoint container of io (io/checkpoint_file.c: magic "FCMCKPT\0",
- * u64 version, u64 byte-order mark, the payload, u64 FNV-1a 64 checksum), version 5; versions 1
- * to 4 still load. Payload (every integer 8 bytes, doubles IEEE 754 binary64):
+ * u64 version, u64 byte-order mark, the payload, u64 FNV-1a 64 checksum), version 6; versions 1
+ * to 5 still load for backward Euler and static scenes (they hold no acceleration: a scene with
+ * another time scheme refuses them). Payload (every integer 8 bytes, doubles IEEE 754
+ * binary64):
  *   u64 scene fingerprint (see fingerprint(); never 0, the word of a file without a scene)
  *   i64 num_dofs, i64 steps, f64 time
  *   (version 2) i64 cuts applied (the first k cut effects in time order)
@@ -15,8 +17,12 @@
  *   version 3: 6 x f64 per constraint effect: reaction x, y, z, moment x, y, z;
  *   version 4: i64 inverted quadrature points, i64 cell of the first (-1: none), i64 NaN or
  *   infinite von Mises values of the frame after the step (-1: no frame);
- *   version 5: f64 the Newton stopping rule's tolerance)
- *   num_dofs x f64 displacement, num_dofs x f64 velocity
+ *   version 5: f64 the Newton stopping rule's tolerance;
+ *   version 6: f64 kinetic energy, elastic energy, load work)
+ *   (version 6) i64 time scheme (fcm_time_scheme), f64 HHT alpha, f64 rho_inf, f64 load work,
+ *   i64 1 when the acceleration follows (else 0)
+ *   num_dofs x f64 displacement, num_dofs x f64 velocity, (version 6, when flagged) num_dofs x
+ *   f64 acceleration
  *
  * The PETSc linear driver (fcm_petsc_problem_write_checkpoint()) writes the same container
  * with the "no scene" source word 0 and its counts (io_impl.h, fcm__ckpt_linear); earlier
@@ -86,6 +92,7 @@ fcm_status fcm_simulation_write_checkpoint(fcm_simulation *S, const char *path)
 {
   fcm_status st = FCM_OK;
   fcm__ckpt_writer w;
+  double *acc = NULL;
   memset(&w, 0, sizeof w);
   FCM_CHECK(S && path && path[0], S ? S->ctx : NULL, FCM_ERR_ARG,
             "simulation: write_checkpoint needs a simulation and a path");
@@ -128,12 +135,26 @@ fcm_status fcm_simulation_write_checkpoint(fcm_simulation *S, const char *path)
     FCM_TRY(ctx, fcm__ckpt_put_i64(&w, r->inverted_cell));
     FCM_TRY(ctx, fcm__ckpt_put_i64(&w, r->nonfinite));
     FCM_TRY(ctx, fcm__ckpt_put_f64(&w, r->tolerance));
+    const double e[3] = {r->kinetic, r->elastic, r->work};
+    FCM_TRY(ctx, fcm__ckpt_put_f64s(&w, e, 3));
   }
-  FCM_TRY(ctx, fcm__ckpt_put_f64s(&w, fcm_integrator_displacement(S->integ), (size_t)n));
-  FCM_TRY(ctx, fcm__ckpt_put_f64s(&w, fcm_integrator_velocity(S->integ), (size_t)n));
+  {
+    const fcm_scene_time *tm = fcm_scene_get_time(S->scene);
+    FCM_ALLOC(ctx, n, acc);
+    const int known = fcm_integrator_get_acceleration(S->integ, acc);
+    FCM_TRY(ctx, fcm__ckpt_put_i64(&w, (long long)tm->scheme));
+    FCM_TRY(ctx, fcm__ckpt_put_f64(&w, tm->hht_alpha));
+    FCM_TRY(ctx, fcm__ckpt_put_f64(&w, tm->rho_inf));
+    FCM_TRY(ctx, fcm__ckpt_put_f64(&w, fcm_integrator_load_work(S->integ)));
+    FCM_TRY(ctx, fcm__ckpt_put_i64(&w, known));
+    FCM_TRY(ctx, fcm__ckpt_put_f64s(&w, fcm_integrator_displacement(S->integ), (size_t)n));
+    FCM_TRY(ctx, fcm__ckpt_put_f64s(&w, fcm_integrator_velocity(S->integ), (size_t)n));
+    if (known) FCM_TRY(ctx, fcm__ckpt_put_f64s(&w, acc, (size_t)n));
+  }
   FCM_TRY(ctx, fcm__ckpt_commit(&w));
 cleanup:
   if (st != FCM_OK) fcm__ckpt_abort(&w);
+  if (S) fcm__free(S->ctx, acc);
   return st;
 }
 
@@ -142,8 +163,8 @@ cleanup:
 /* What a checkpoint file holds, read and checked against the simulation (not applied yet). */
 typedef struct ckpt_data {
   long long n, steps, frames, rows, cuts, newton, linear, tangents;
-  double t;
-  double *u, *v, *frame_time, *react;
+  double t, work;                         /* work: the load work (version 6; 0 before) */
+  double *u, *v, *a, *frame_time, *react; /* a: the acceleration, NULL when not recorded */
   fcm__log_row *log;
   long long frame_cap, log_cap, react_cap;
 } ckpt_data;
@@ -152,21 +173,28 @@ static void ckpt_data_free(fcm_ctx *ctx, ckpt_data *d)
 {
   fcm__free(ctx, d->u);
   fcm__free(ctx, d->v);
+  fcm__free(ctx, d->a);
   fcm__free(ctx, d->frame_time);
   fcm__free(ctx, d->log);
   fcm__free(ctx, d->react);
 }
 
-/* The state at the end of a checkpoint: d->n displacement and velocity values, nothing after. */
-static fcm_status read_state(fcm__ckpt_reader *r, ckpt_data *d)
+/* The state at the end of a checkpoint: d->n displacement and velocity values (and acceleration
+ * values when `acc`), nothing after. */
+static fcm_status read_state(fcm__ckpt_reader *r, ckpt_data *d, int acc)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = r->ctx;
-  FCM_TRY(ctx, fcm__ckpt_need(r, d->n, 2 * sizeof(double), "displacement and velocity values"));
+  FCM_TRY(ctx, fcm__ckpt_need(r, d->n, (2 + (acc != 0)) * sizeof(double),
+                              "displacement, velocity (and acceleration) values"));
   FCM_ALLOC(ctx, d->n, d->u);
   FCM_ALLOC(ctx, d->n, d->v);
   FCM_TRY(ctx, fcm__ckpt_get(r, d->u, sizeof *d->u * (size_t)d->n, "the displacement"));
   FCM_TRY(ctx, fcm__ckpt_get(r, d->v, sizeof *d->v * (size_t)d->n, "the velocity"));
+  if (acc) {
+    FCM_ALLOC(ctx, d->n, d->a);
+    FCM_TRY(ctx, fcm__ckpt_get(r, d->a, sizeof *d->a * (size_t)d->n, "the acceleration"));
+  }
   FCM_TRY(ctx, fcm__ckpt_read_end(r));
 cleanup:
   return st;
@@ -220,7 +248,11 @@ static fcm_status read_linear(fcm_simulation *S, fcm__ckpt_reader *r, ckpt_data 
             path, h.elements, h.kind, h.dt, fcm_scene_name(S->scene),
             (long long)fcm_space_num_elements(S->space), (int)tm->integrator, tm->dt);
   FCM_TRY(ctx, check_steps(S, path, d->steps));
-  FCM_TRY(ctx, read_state(r, d));
+  FCM_CHECK(tm->scheme == FCM_SCHEME_BACKWARD_EULER, ctx, FCM_ERR_ARG,
+            "checkpoint %s of the PETSc linear driver (backward Euler) cannot resume scene '%s' "
+            "with time.integrator \"%s\"",
+            path, fcm_scene_name(S->scene), fcm_time_scheme_name(tm->scheme));
+  FCM_TRY(ctx, read_state(r, d, 0));
   {
     const int every = fcm_scene_get_output(S->scene)->frame_interval;
     const long long interval = every > 0 ? every : 1;
@@ -237,6 +269,7 @@ static fcm_status read_linear(fcm_simulation *S, fcm__ckpt_reader *r, ckpt_data 
       memset(w, 0, sizeof *w);
       w->time = (double)(k + 1) * tm->dt;
       w->residual = w->tolerance = w->energy = w->wall = w->mass = NAN;
+      w->kinetic = w->elastic = w->work = NAN;
       w->momentum[0] = w->momentum[1] = w->momentum[2] = NAN;
       w->pieces = (long long)S->pieces;
       w->inverted = w->inverted_cell = w->nonfinite = -1;
@@ -244,6 +277,42 @@ static fcm_status read_linear(fcm_simulation *S, fcm__ckpt_reader *r, ckpt_data 
         d->react[(size_t)k * nreact + j] = NAN;
     }
   }
+cleanup:
+  return st;
+}
+
+/* Version 6: the time scheme and its parameters (the scene's, else refused: they are not part of
+ * the fingerprint), the load work and whether the acceleration follows the state. An older
+ * version holds none of them: a scene whose scheme needs the acceleration refuses it. */
+static fcm_status read_scheme(fcm_simulation *S, fcm__ckpt_reader *r, ckpt_data *d, int *acc)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  const fcm_scene_time *tm = fcm_scene_get_time(S->scene);
+  const int dynamic = tm->integrator != FCM_INTEGRATOR_STATIC;
+  long long scheme = 0, known = 0;
+  double alpha = 0.0, rho = 0.0;
+  *acc = 0;
+  FCM_CHECK(r->version >= 6 || !dynamic || tm->scheme == FCM_SCHEME_BACKWARD_EULER, ctx,
+            FCM_ERR_ARG,
+            "checkpoint %s: version %llu holds no acceleration; time.integrator \"%s\" of scene "
+            "'%s' needs version 6 or later (run it again from the start)",
+            r->path, (unsigned long long)r->version, fcm_time_scheme_name(tm->scheme),
+            fcm_scene_name(S->scene));
+  if (r->version < 6) return FCM_OK;
+  FCM_TRY(ctx, fcm__ckpt_get_i64(r, &scheme, 0, FCM_SCHEME_COUNT - 1, "the time scheme"));
+  FCM_TRY(ctx, fcm__ckpt_get_f64(r, &alpha, "the HHT alpha"));
+  FCM_TRY(ctx, fcm__ckpt_get_f64(r, &rho, "rho_inf"));
+  FCM_TRY(ctx, fcm__ckpt_get_f64(r, &d->work, "the load work"));
+  FCM_TRY(ctx, fcm__ckpt_get_i64(r, &known, 0, 1, "the acceleration flag"));
+  FCM_CHECK(!dynamic ||
+                (scheme == (long long)tm->scheme && alpha == tm->hht_alpha && rho == tm->rho_inf),
+            ctx, FCM_ERR_ARG,
+            "checkpoint %s: written with time.integrator \"%s\" (alpha %g, rho_inf %g), scene "
+            "'%s' has \"%s\" (alpha %g, rho_inf %g)",
+            r->path, fcm_time_scheme_name((fcm_time_scheme)scheme), alpha, rho,
+            fcm_scene_name(S->scene), fcm_time_scheme_name(tm->scheme), tm->hht_alpha, tm->rho_inf);
+  *acc = (int)known;
 cleanup:
   return st;
 }
@@ -256,6 +325,7 @@ static fcm_status read_scene(fcm_simulation *S, fcm__ckpt_reader *r, ckpt_data *
   const char *path = r->path;
   const uint64_t ver = r->version;
   const size_t nreact = 6 * (size_t)S->num_react;
+  int acc = 0;
   FCM_TRY(ctx, fcm__ckpt_get_i64(r, &d->n, 0, INT64_MAX, "num_dofs"));
   FCM_TRY(ctx, fcm__ckpt_get_i64(r, &d->steps, 0, INT64_MAX, "steps"));
   FCM_TRY(ctx, check_steps(S, path, d->steps));
@@ -274,9 +344,10 @@ static fcm_status read_scene(fcm_simulation *S, fcm__ckpt_reader *r, ckpt_data *
                                "the frame times"));
   }
   FCM_TRY(ctx, fcm__ckpt_get_i64(r, &d->rows, d->steps, d->steps, "log rows (one per step)"));
-  const size_t row_bytes = ver >= 2 ? (8 + (ver >= 3 ? nreact : 0) + (ver >= 5)) * sizeof(double) +
-                                          (ver >= 4 ? 6 : 3) * sizeof(int64_t)
-                                    : 4 * sizeof(double) + 2 * sizeof(int64_t);
+  const size_t row_bytes =
+      ver >= 2 ? (8 + (ver >= 3 ? nreact : 0) + (ver >= 5) + 3 * (ver >= 6)) * sizeof(double) +
+                     (ver >= 4 ? 6 : 3) * sizeof(int64_t)
+               : 4 * sizeof(double) + 2 * sizeof(int64_t);
   FCM_TRY(ctx, fcm__ckpt_need(r, d->rows, row_bytes, "log rows"));
   FCM_TRY(ctx, alloc_rows(ctx, d, nreact));
   for (long long k = 0; k < d->rows; k++) {
@@ -311,8 +382,12 @@ static fcm_status read_scene(fcm_simulation *S, fcm__ckpt_reader *r, ckpt_data *
     }
     w->tolerance = NAN; /* not recorded before version 5 */
     if (ver >= 5) FCM_TRY(ctx, fcm__ckpt_get(r, &w->tolerance, sizeof w->tolerance, "a log row"));
+    double e[3] = {NAN, NAN, NAN}; /* not recorded before version 6 */
+    if (ver >= 6) FCM_TRY(ctx, fcm__ckpt_get(r, e, sizeof e, "a log row"));
+    w->kinetic = e[0], w->elastic = e[1], w->work = e[2];
   }
-  FCM_TRY(ctx, read_state(r, d));
+  FCM_TRY(ctx, read_scheme(S, r, d, &acc));
+  FCM_TRY(ctx, read_state(r, d, acc));
 cleanup:
   return st;
 }
@@ -393,6 +468,8 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
   }
   /* Everything read and checked: apply (set_state validates finiteness first). */
   FCM_TRY(ctx, fcm_integrator_set_state(S->integ, d.u, d.v, d.t, d.steps));
+  FCM_TRY(ctx, fcm_integrator_set_acceleration(S->integ, d.a)); /* NULL: solved for */
+  FCM_TRY(ctx, fcm_integrator_set_load_work(S->integ, d.work));
   S->c.steps = d.steps;
   S->c.newton_iterations = d.newton;
   S->c.linear_iterations = d.linear;

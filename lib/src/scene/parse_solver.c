@@ -246,8 +246,8 @@ cleanup:
 fcm_status fcm__scene_read_time(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"static",   "integrator", "dt",
-                                     "duration", "steps",      "load_steps"};
+  static const char *const keys[] = {"static", "integrator", "alpha", "rho_inf",
+                                     "dt",     "duration",   "steps", "load_steps"};
   fcm_scene_time *t = &p->scene->time;
   const fcm__json *o = NULL;
   size_t old = p->path_len;
@@ -255,7 +255,10 @@ fcm_status fcm__scene_read_time(fcm__scene_parser *p, const fcm__json *root)
   long long steps = 0;
   size_t here = 0;
   int is_static = 0;
-  fcm_integrator_kind dynamic = FCM_INTEGRATOR_BACKWARD_EULER;
+  const fcm_integrator_options def = fcm_integrator_options_default();
+  t->scheme = def.scheme;
+  t->hht_alpha = def.hht_alpha;
+  t->rho_inf = def.rho_inf;
   t->dt = 1.0 / 60.0;
   t->load_steps = 1;
   FCM_TRY(p->ctx, fcm__scene_read_object(p, root, "time", 0, &o));
@@ -265,7 +268,11 @@ fcm_status fcm__scene_read_time(fcm__scene_parser *p, const fcm__json *root)
     FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, SCENE_COUNT(keys)));
     FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "static", 0, &is_static));
     SCENE_READ_CHOICE_AS(p, o, "integrator", 0, fcm__scene_integrator_names,
-                         fcm__scene_integrator_values, dynamic);
+                         fcm__scene_integrator_values, t->scheme);
+    FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "alpha", 0, (fcm__range){-1.0 / 3.0, 0.0, 0, 0},
+                                           &t->hht_alpha));
+    FCM_TRY(p->ctx,
+            fcm__scene_read_number(p, o, "rho_inf", 0, (fcm__range){0.0, 1.0, 0, 0}, &t->rho_inf));
     FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "dt", 0, FCM__POSITIVE, &t->dt));
     FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "duration", 0, FCM__POSITIVE, &duration));
     FCM_TRY(p->ctx, fcm__scene_read_int(p, o, "steps", 0, 1, 1000000000, &steps));
@@ -282,8 +289,20 @@ fcm_status fcm__scene_read_time(fcm__scene_parser *p, const fcm__json *root)
       SCENE_CHECK(!is_static, p, FCM_ERR_ARG, "not used by static scenes (\"static\": true)");
       fcm__scene_path_pop(p, here);
     }
+    /* each scheme's parameter only with that scheme */
+    static const char *const param[] = {"alpha", "rho_inf"};
+    static const fcm_time_scheme owner[] = {FCM_SCHEME_HHT, FCM_SCHEME_GENERALIZED_ALPHA};
+    for (int k = 0; k < 2; k++) {
+      if (!fcm__json_member(o, param[k])) continue;
+      fcm__scene_path_push_key(p, param[k]);
+      SCENE_CHECK(!is_static && t->scheme == owner[k], p, FCM_ERR_ARG,
+                  "only for \"integrator\": \"%s\" (the integrator is \"%s\")",
+                  fcm_time_scheme_name(owner[k]),
+                  is_static ? "static" : fcm_time_scheme_name(t->scheme));
+      fcm__scene_path_pop(p, here);
+    }
   }
-  t->integrator = is_static ? FCM_INTEGRATOR_STATIC : dynamic;
+  t->integrator = is_static ? FCM_INTEGRATOR_STATIC : FCM_INTEGRATOR_DYNAMIC;
   if (steps == 0 && !(duration > 0.0)) {
     if (is_static)
       steps = 1;
@@ -306,11 +325,7 @@ fcm_status fcm__scene_read_time(fcm__scene_parser *p, const fcm__json *root)
   if (p->norm) { /* the normalized section says what was resolved: keys for this kind only */
     fcm__json_remove_path(p->norm, "time");
     fcm__scene_path_pop(p, old);
-    fcm__scene_put_resolved_time(
-        p, is_static,
-        fcm__scene_integrator_names[fcm__scene_choice_index(
-            fcm__scene_integrator_values, SCENE_COUNT(fcm__scene_integrator_names), (int)dynamic)],
-        t->dt, steps, t->load_steps);
+    fcm__scene_put_resolved_time(p, t);
   }
 cleanup:
   fcm__scene_path_pop(p, old);

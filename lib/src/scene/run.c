@@ -433,6 +433,9 @@ static fcm_integrator_options integrator_options(fcm_simulation *S)
   const fcm_scene_time *tm = fcm_scene_get_time(S->scene);
   fcm_integrator_options o = fcm_scene_get_solver(S->scene)->integrator;
   o.kind = tm->integrator;
+  o.scheme = tm->scheme;
+  o.hht_alpha = tm->hht_alpha;
+  o.rho_inf = tm->rho_inf;
   o.dt = tm->dt;
   o.load_steps = tm->load_steps;
   /* Full cells: the scene's strength, except that 0 keeps the element's rule there (as the

@@ -4,6 +4,7 @@
 #ifndef FCM_SCENE_RUN_IMPL_H
 #define FCM_SCENE_RUN_IMPL_H
 
+#include "core/core_impl.h"
 #include "fcm/embed.h"
 #include "fcm/fem.h"
 #include "fcm/geom.h"
@@ -18,9 +19,11 @@
  * quadrature points and the cell of the first, fcm_step_info; the NaN or infinite von Mises
  * values of the frame written after the step). -1: not known (inverted and inverted_cell of a
  * row restored from an older checkpoint; nonfinite of a step without a frame); NaN: tolerance
- * of a row restored from a checkpoint older than version 5. */
+ * of a row restored from a checkpoint older than version 5, the energies (kinetic, elastic and
+ * the load work, fcm_step_info) of one older than version 6. */
 typedef struct fcm__log_row {
   double time, residual, tolerance, energy, wall;
+  double kinetic, elastic, work;
   long long newton, linear;
   long long pieces;
   double mass, momentum[3];
@@ -173,18 +176,19 @@ fcm_status fcm__sim_check_regions(fcm_simulation *S);
 /* The background mesh and the embedded geometry of a scene (NULL when it has none), built as
  * fcm_simulation_create() builds them, for a driver of its own (the PETSc backend, fcm/petsc.h);
  * the caller destroys both (run.c). */
-fcm_status fcm__scene_mesh_geometry(fcm_ctx *ctx, const fcm_scene *scene, fcm_mesh **mesh,
-                                    fcm_geometry **geom);
+FCM_COMPONENT_API fcm_status fcm__scene_mesh_geometry(fcm_ctx *ctx, const fcm_scene *scene,
+                                                      fcm_mesh **mesh, fcm_geometry **geom);
 
 /* fcm_simulation_create() with a configuration: cfg->opts, and the backend that distributes
  * the run (fcm__simulation_config; the PETSc one: run_petsc.c). Collective over the backend's
  * processes. (run.c) */
-fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
-                                  const fcm__simulation_config *cfg, fcm_simulation **out);
+FCM_COMPONENT_API fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
+                                                    const fcm__simulation_config *cfg,
+                                                    fcm_simulation **out);
 
 /* A distributed run's fcm_simulation_summary_view() (collective; f may be NULL on all but one
  * process): the rules' point counts and the body's largest |u| summed / maximized over the
  * processes' own cells first (each process's rules carry its own cells' points only). */
-fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f);
+FCM_COMPONENT_API fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f);
 
 #endif /* FCM_SCENE_RUN_IMPL_H */

@@ -160,8 +160,10 @@ fcm_status fcm_simulation_write_log(fcm_simulation *S, const char *path)
                                           "moment_%d_y,moment_%d_z",
                                           i, i, i, i, i, i));
   }
-  FCM_TRY(S->ctx, fcm__io_atomic_printf(
-                      S->ctx, &af, ",inverted_points,nonfinite_stresses,tolerance,wall_time\n"));
+  FCM_TRY(S->ctx,
+          fcm__io_atomic_printf(S->ctx, &af,
+                                ",inverted_points,nonfinite_stresses,tolerance,kinetic_energy,"
+                                "elastic_energy,load_work,wall_time\n"));
   for (long long k = 0; k < S->log_n; k++) {
     const fcm__log_row *r = &S->log[k];
     FCM_TRY(S->ctx,
@@ -180,7 +182,8 @@ fcm_status fcm_simulation_write_log(fcm_simulation *S, const char *path)
                                      : fcm__io_atomic_printf(S->ctx, &af, ",nan"));
     /* the stopping rule's tolerance beside the residual: an interactive step
      * (newton_fixed_iterations) may end above it */
-    FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, ",%.17g,%.6g\n", r->tolerance, r->wall));
+    FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, ",%.17g,%.17g,%.17g,%.17g,%.6g\n",
+                                          r->tolerance, r->kinetic, r->elastic, r->work, r->wall));
   }
   FCM_TRY(S->ctx, fcm__io_atomic_commit(S->ctx, &af));
 cleanup:

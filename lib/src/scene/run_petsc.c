@@ -132,6 +132,11 @@ fcm_status fcm_petsc_problem_create_from_scene(fcm_ctx *ctx, MPI_Comm comm, cons
   const fcm_scene_solver *sv = fcm_scene_get_solver(scene);
   const fcm_scene_time *tm = fcm_scene_get_time(scene);
   fcm_petsc_options o = fcm_petsc_options_default();
+  FCM_CHECK(tm->integrator == FCM_INTEGRATOR_STATIC || tm->scheme == FCM_SCHEME_BACKWARD_EULER, ctx,
+            FCM_ERR_UNSUPPORTED,
+            "scene %s: time.integrator \"%s\": the PETSc linear driver steps with backward Euler "
+            "only; run this scene with the serial backend or the distributed simulation",
+            fcm_scene_name(scene), fcm_time_scheme_name(tm->scheme));
   o.kind = tm->integrator;
   o.dt = tm->dt;
   o.solver = scene_solver(scene, partition);

@@ -163,6 +163,9 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   r->residual = si.residual;
   r->tolerance = si.tolerance;
   r->energy = si.total_energy;
+  r->kinetic = si.kinetic_energy;
+  r->elastic = si.elastic_energy;
+  r->work = si.load_work;
   r->wall = wall;
   r->pieces = S->pieces;
   r->inverted = si.inverted_points;

@@ -70,8 +70,11 @@ const char *const fcm__scene_newton_rule_names[] = {"auto", "representative", "r
 const char *const fcm__scene_inversion_names[] = {"warn", "stop"};
 const int fcm__scene_newton_rule_values[] = {FCM_NEWTON_TOL_AUTO, FCM_NEWTON_TOL_REPRESENTATIVE,
                                              FCM_NEWTON_TOL_RELATIVE};
-const char *const fcm__scene_integrator_names[] = {"backward_euler"};
-const int fcm__scene_integrator_values[] = {FCM_INTEGRATOR_BACKWARD_EULER};
+/* time.integrator: the dynamic schemes (fcm_time_scheme_name()) */
+const char *const fcm__scene_integrator_names[] = {"backward_euler", "newmark", "hht",
+                                                   "generalized_alpha"};
+const int fcm__scene_integrator_values[] = {FCM_SCHEME_BACKWARD_EULER, FCM_SCHEME_NEWMARK,
+                                            FCM_SCHEME_HHT, FCM_SCHEME_GENERALIZED_ALPHA};
 
 const char *fcm__scene_choice_name(const char *const *names, const int *values, int n, int value)
 {

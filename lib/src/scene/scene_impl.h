@@ -128,10 +128,10 @@ void fcm__scene_path_pop(fcm__scene_parser *p, size_t old_len);
  * means something no value of it says (an initial velocity's "center": the centre of mass). */
 void fcm__scene_forget(fcm__scene_parser *p, const char *key);
 
-/* The normalized scene's "time" section as resolved: static or the integrator, dt, the step
- * count, and for static scenes the load steps (the parser is at the root). */
-void fcm__scene_put_resolved_time(fcm__scene_parser *p, int is_static, const char *integrator,
-                                  double dt, long long steps, int load_steps);
+/* The normalized scene's "time" section as resolved (t): static or the integrator with its
+ * parameter ("alpha" of "hht", "rho_inf" of "generalized_alpha"), dt, the step count, and for
+ * static scenes the load steps (the parser is at the root). */
+void fcm__scene_put_resolved_time(fcm__scene_parser *p, const fcm_scene_time *t);
 
 /* Short description of a JSON value for messages: 3.5, "text", true, null, an array, ... */
 void fcm__scene_describe(const fcm__json *node, char *buf, size_t len);
@@ -268,8 +268,8 @@ extern const char *const fcm__scene_tangent_names[3];        /* fcm_precondition
 extern const char *const fcm__scene_newton_rule_names[3];    /* with the values */
 extern const int fcm__scene_newton_rule_values[3];           /* fcm_newton_tolerance */
 extern const char *const fcm__scene_inversion_names[2];      /* stop_on_inversion 0, 1 */
-extern const char *const fcm__scene_integrator_names[1];     /* with the values */
-extern const int fcm__scene_integrator_values[1];            /* fcm_integrator_kind */
+extern const char *const fcm__scene_integrator_names[4];     /* with the values */
+extern const int fcm__scene_integrator_values[4];            /* fcm_time_scheme */
 
 /* The section parsers, in the order parse_root() calls them: each reads its member of the
  * root object (absent and optional: the defaults) into p->scene and validates it; "geometry"

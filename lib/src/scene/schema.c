@@ -227,16 +227,18 @@ void fcm__scene_forget(fcm__scene_parser *p, const char *key)
   fcm__scene_path_pop(p, o);
 }
 
-void fcm__scene_put_resolved_time(fcm__scene_parser *p, int is_static, const char *integrator,
-                                  double dt, long long steps, int load_steps)
+void fcm__scene_put_resolved_time(fcm__scene_parser *p, const fcm_scene_time *t)
 {
   if (!p->norm) return;
+  const int is_static = t->integrator == FCM_INTEGRATOR_STATIC;
   size_t o = fcm__scene_path_push_key(p, "time");
   put_bool(p, "static", is_static);
-  if (!is_static) put_string(p, "integrator", integrator);
-  put_number(p, "dt", dt);
-  put_number(p, "steps", (double)steps);
-  if (is_static) put_number(p, "load_steps", (double)load_steps);
+  if (!is_static) put_string(p, "integrator", fcm_time_scheme_name(t->scheme));
+  if (!is_static && t->scheme == FCM_SCHEME_HHT) put_number(p, "alpha", t->hht_alpha);
+  if (!is_static && t->scheme == FCM_SCHEME_GENERALIZED_ALPHA) put_number(p, "rho_inf", t->rho_inf);
+  put_number(p, "dt", t->dt);
+  put_number(p, "steps", (double)t->num_steps);
+  if (is_static) put_number(p, "load_steps", (double)t->load_steps);
   fcm__scene_path_pop(p, o);
 }
 

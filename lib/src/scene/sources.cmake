@@ -7,8 +7,8 @@ list(APPEND FCM_SOURCES lib/src/scene/json_adapter.c lib/src/scene/schema.c
                         lib/src/scene/run_step.c lib/src/scene/run_output.c
                         lib/src/scene/run_summary.c lib/src/scene/checkpoint.c
                         lib/src/scene/preview.c)
-if(FCM_HAVE_PETSC) # the runner on the PETSc backend (fcm/petsc.h)
-  list(APPEND FCM_SOURCES lib/src/scene/run_petsc.c)
+if(FCM_HAVE_PETSC) # the runner on the PETSc backend (fcm/scene_petsc.h): in libfcm_petsc
+  list(APPEND FCM_PETSC_SOURCES lib/src/scene/run_petsc.c)
 endif()
 
 # The built-in default scene is the example apps/scenes/twisting_cylinder.json, embedded

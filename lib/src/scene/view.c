@@ -193,11 +193,14 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
   if (t->integrator == FCM_INTEGRATOR_STATIC)
     fprintf(f, "time: static, %lld step(s) of %g s, %d load step(s) each\n",
             (long long)t->num_steps, t->dt, t->load_steps);
-  else
-    fprintf(
-        f, "time: %s, %lld steps of dt = %g s, %g s in all\n",
-        SCENE_CHOICE_NAME(fcm__scene_integrator_names, fcm__scene_integrator_values, t->integrator),
-        (long long)t->num_steps, t->dt, t->duration);
+  else {
+    char par[64] = ""; /* the scheme's parameter */
+    if (t->scheme == FCM_SCHEME_HHT) snprintf(par, sizeof par, " (alpha %g)", t->hht_alpha);
+    if (t->scheme == FCM_SCHEME_GENERALIZED_ALPHA)
+      snprintf(par, sizeof par, " (rho_inf %g)", t->rho_inf);
+    fprintf(f, "time: %s%s, %lld steps of dt = %g s, %g s in all\n",
+            fcm_time_scheme_name(t->scheme), par, (long long)t->num_steps, t->dt, t->duration);
+  }
   fprintf(f, "output: %s, every %d step(s), background %s, surface %s", s->output.directory,
           s->output.frame_interval, s->output.write_background ? "yes" : "no",
           s->output.write_surface ? "yes" : "no");

@@ -11,6 +11,9 @@ fcm_integrator_options fcm_integrator_options_default(void)
   fcm_integrator_options o;
   memset(&o, 0, sizeof o);
   o.kind = FCM_INTEGRATOR_BACKWARD_EULER;
+  o.scheme = FCM_SCHEME_BACKWARD_EULER;
+  o.hht_alpha = -0.05;
+  o.rho_inf = 0.8;
   o.dt = 1.0 / 60.0;
   o.load_steps = 1;
   o.max_halvings = 4;
@@ -87,6 +90,7 @@ fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space, const fcm
   I->n = fcm_space_num_dofs(space);
   FCM_ALLOC(ctx, I->n, I->u);
   FCM_ALLOC(ctx, I->n, I->v);
+  FCM_ALLOC(ctx, I->n, I->a);
   FCM_ALLOC(ctx, I->n, I->load_prev);
   FCM_TRY(ctx, fcm__sim_serial_backend(I));
   *integ = I;
@@ -114,7 +118,8 @@ void fcm_integrator_destroy(fcm_integrator **integ)
                      &I->act_diag, &I->u_bak,  &I->v_bak,     &I->lp_bak,  &I->un,      &I->uhat,
                      &I->fext,     &I->fend,   &I->fint,      &I->g,       &I->d,       &I->b,
                      &I->ut,       &I->fint_t, &I->g_t,       &I->w1,      &I->w2,      &I->mg_r,
-                     &I->mg_guess, &I->mg_acc};
+                     &I->mg_guess, &I->mg_acc, &I->a,         &I->a_bak,   &I->ud,      &I->fstep,
+                     &I->fprev};
   for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; k++)
     FCM_FREE(ctx, *vecs[k]);
   fcm__free(ctx, I->con_dof);
@@ -332,8 +337,8 @@ static fcm_status validate_options(fcm_ctx *ctx, const fcm_integrator_options *o
 {
   fcm_status st = FCM_OK;
   FCM_CHECK(o->kind == FCM_INTEGRATOR_STATIC || o->kind == FCM_INTEGRATOR_BACKWARD_EULER, ctx,
-            FCM_ERR_ARG, "integrator: kind = %d must be STATIC (0) or BACKWARD_EULER (1)",
-            (int)o->kind);
+            FCM_ERR_ARG, "integrator: kind = %d must be STATIC (0) or DYNAMIC (1)", (int)o->kind);
+  FCM_TRY(ctx, fcm__sim_scheme_validate(ctx, o));
   FCM_CHECK(isfinite(o->dt) && o->dt > 0.0, ctx, FCM_ERR_ARG,
             "integrator: dt = %g must be positive and finite", o->dt);
   FCM_CHECK(o->load_steps >= 1, ctx, FCM_ERR_ARG, "integrator: load_steps = %d must be >= 1",
@@ -485,7 +490,7 @@ static fcm_status setup_storage(fcm_integrator *I)
   fcm_ctx *ctx = I->ctx;
   double **vecs[] = {&I->Ma,   &I->u_bak,  &I->v_bak, &I->lp_bak, &I->un, &I->uhat,
                      &I->fext, &I->fend,   &I->fint,  &I->g,      &I->d,  &I->b,
-                     &I->ut,   &I->fint_t, &I->g_t,   &I->w1,     &I->w2};
+                     &I->ut,   &I->fint_t, &I->g_t,   &I->w1,     &I->w2, &I->fprev};
   for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; k++)
     FCM_ALLOC(ctx, I->n, *vecs[k]);
   if (I->hP)
@@ -648,6 +653,7 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
   FCM_TRY(ctx, fcm__sim_hanging_setup(I));
   FCM_TRY(ctx, build_constraints(I));
   FCM_TRY(ctx, setup_storage(I));
+  FCM_TRY(ctx, fcm__sim_scheme_setup(I));
   FCM_TRY(ctx, fcm__sim_boundary_setup(I));
   FCM_TRY(ctx, setup_mass_and_loads(I));
   if (I->opts.tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE)
@@ -728,6 +734,7 @@ fcm_status fcm_integrator_set_state(fcm_integrator *I, const double *u, const do
   if (v) memcpy(I->v, v, sizeof *v * (size_t)I->n);
   I->t = t;
   I->steps = steps;
+  I->a_valid = 0;
   I->reaction_valid = 0;
   if (!I->linear) I->h_state = SIM_H_INVALID; /* a linear system does not depend on u */
   I->kept = 0;
@@ -773,6 +780,7 @@ fcm_status fcm_integrator_set_rigid_velocity(fcm_integrator *I, const double v0[
       }
     }
   }
+  I->a_valid = 0; /* the initial acceleration depends on v through the damping */
 cleanup:
   return st;
 }
@@ -903,7 +911,7 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = old ? old->ctx : NULL;
   fcm_integrator *I = NULL;
-  double *u = NULL, *v = NULL;
+  double *u = NULL, *v = NULL, *a = NULL;
   FCM_CHECK(integ, ctx, FCM_ERR_ARG, "integrator cut: output pointer is NULL");
   *integ = NULL;
   FCM_CHECK(old && space, ctx, FCM_ERR_ARG, "integrator cut: NULL integrator or space");
@@ -942,11 +950,18 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   FCM_TRY(ctx, fcm_space_transfer(old->space, space, old->u, u));
   FCM_TRY(ctx, fcm_space_transfer(old->space, space, old->v, v));
   FCM_TRY(ctx, fcm_integrator_set_state(I, u, v, old->t, old->steps));
+  if (old->a_valid) { /* the acceleration too (every new copy inherits its parent's) */
+    FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, a);
+    FCM_TRY(ctx, fcm_space_transfer(old->space, space, old->a, a));
+    FCM_TRY(ctx, fcm_integrator_set_acceleration(I, a));
+  }
+  I->load_work = old->load_work;
   *integ = I;
   I = NULL;
 cleanup:
   fcm__free(ctx, u);
   fcm__free(ctx, v);
+  fcm__free(ctx, a);
   fcm_integrator_destroy(&I);
   return st;
 }

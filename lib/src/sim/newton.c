@@ -39,25 +39,6 @@ static int all_finite(fcm_index n, const double *a)
   return 1;
 }
 
-void fcm__sim_set_base(const fcm_integrator *I, double h, fcm_csr *A)
-{
-  fcm_index nnz = 0;
-  fcm_csr_get_size(A, NULL, NULL, &nnz);
-  double *v = fcm_csr_values(A);
-  if (h > 0.0) {
-    const double *mv = fcm_csr_values_read(I->M), a = 1.0 / (h * h);
-    for (fcm_index e = 0; e < nnz; e++)
-      v[e] = a * mv[e];
-    if (I->D) {
-      const double *dv = fcm_csr_values_read(I->D);
-      for (fcm_index e = 0; e < nnz; e++)
-        v[e] += dv[e] / h;
-    }
-  } else {
-    memset(v, 0, sizeof *v * (size_t)nnz);
-  }
-}
-
 /* Hyperelastic assembly that turns FCM_ERR_NUMERIC (material NaN/Inf) into *finite = 0. */
 static fcm_status assemble(fcm_integrator *I, const fcm_material_params *p, const double *x,
                            double *psi, double *fint, fcm_csr *T, int *finite, sim_stats *stats)
@@ -135,6 +116,21 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__sim_internal_force(fcm_integrator *I, const double *x, double *fint, int *finite,
+                                   sim_stats *stats)
+{
+  fcm_status st = FCM_OK;
+  double psi = 0.0, bnd = 0.0;
+  *finite = 1;
+  memset(fint, 0, sizeof *fint * (size_t)I->n);
+  st = assemble(I, &I->params, x, &psi, fint, NULL, finite, stats);
+  if (st == FCM_OK && *finite) st = assemble_boundary(I, x, 0, &bnd, fint, NULL, finite, stats);
+  FCM_TRY(I->ctx, reduce_eval(I, st, NULL, 0, fint, finite, stats));
+  if (*finite) *finite = all_finite(I->n, fint);
+cleanup:
+  return st;
+}
+
 /* Energy parts at x: E, the internal force fint, the gradient g (n each), the elastic
  * energy, the magnitude scale of E (sum of the absolute parts) and the inverted quadrature
  * points the assembly met (fcm__assembly_inverted()). With `tangent`, H = base + K(x) in the
@@ -175,23 +171,30 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
       /* with a backend M is this process's partial matrix: sum the product (n doubles) */
       st = fcm__space_matrix_apply(I->space, I->M, I->w1, I->w2);
       FCM_TRY(I->ctx, fcm__integrator_reduce_status(I, st, I->w2, n));
-      double a = 1.0 / (h * h);
+      const double a = fcm__sim_mass_coeff(I, h);
       inertia = 0.5 * a * dot(n, I->w1, I->w2);
       for (fcm_index i = 0; i < n; i++)
         g[i] += a * I->w2[i];
       if (I->D) {
+        /* the damping centre: u_n (backward Euler) or u_d (the other schemes, sim.h) */
+        const double *c = I->ud ? I->ud : I->un, hd = fcm__sim_damp_length(I, h);
         for (fcm_index i = 0; i < n; i++)
-          I->w1[i] = x[i] - I->un[i];
+          I->w1[i] = x[i] - c[i];
         /* with a backend D is this process's partial matrix: sum the product (n doubles) */
         st = fcm__space_matrix_apply(I->space, I->D, I->w1, I->w2);
         FCM_TRY(I->ctx, fcm__integrator_reduce_status(I, st, I->w2, n));
-        damp = 0.5 / h * dot(n, I->w1, I->w2);
+        damp = 0.5 / hd * dot(n, I->w1, I->w2);
         for (fcm_index i = 0; i < n; i++)
-          g[i] += I->w2[i] / h;
+          g[i] += I->w2[i] / hd;
       }
     }
     fcm__sim_hanging_reduce(I, g); /* the constrained problem's gradient (hanging.c) */
     wext = dot(n, I->fext, x);
+    if (h > 0.0 && I->fstep) { /* the step's constant force f_a (schemes other than BE) */
+      for (fcm_index i = 0; i < n; i++)
+        g[i] -= I->fstep[i];
+      wext += dot(n, I->fstep, x);
+    }
     out->psi = psi;
     out->E = inertia + damp + psi + bnd - wext;
     out->scale = fabs(inertia) + fabs(damp) + fabs(psi) + fabs(bnd) + fabs(wext);
@@ -241,7 +244,7 @@ static void swap(double **a, double **b)
  * zero then). The diagonal goes on the rows this process owns (act_diag keeps it for the reuse
  * path); b (the same on every process) gets the summed lift and diag * inc on the constrained
  * rows. Collective. */
-static fcm_status eliminate(fcm_integrator *I, int predictor)
+fcm_status fcm__sim_eliminate(fcm_integrator *I, int predictor)
 {
   fcm_status st = FCM_OK;
   const fcm_space *s = I->space;
@@ -373,7 +376,7 @@ static fcm_status build_system(fcm_integrator *I, double h, int predictor, int p
   for (fcm_index j = 0; j < I->nact; j++)
     I->w1[I->act_dof[j]] = predictor ? I->act_inc[j] : 0.0;
   /* a local failure there meets the others in the backend's factor (its agreement) */
-  st = eliminate(I, predictor);
+  st = fcm__sim_eliminate(I, predictor);
   if (st != FCM_OK) FCM_TRY(I->ctx, fcm__integrator_finish(I, st));
   I->h_state = SIM_H_SYSTEM;
   I->h_psd = projected || I->opts.project_psd || I->linear;
@@ -430,11 +433,7 @@ static void monitor(const fcm_integrator *I, double t1, int it, double r, double
 static fcm_status newton_start(fcm_integrator *I, double h, eval_out *cur, sim_stats *stats)
 {
   fcm_status st = FCM_OK;
-  if (h > 0.0)
-    for (fcm_index i = 0; i < I->n; i++) {
-      I->uhat[i] = I->un[i] + h * I->v[i];
-      I->u[i] = I->is_con[i] ? I->un[i] : I->uhat[i];
-    }
+  if (h > 0.0) fcm__sim_scheme_predict(I, h);
   fcm__sim_hanging_fill(I, I->u); /* continuous: hanging DOFs follow their masters */
   /* a predictor iteration (constraints off their values) cannot use the kept factorization */
   const int tangent = !I->linear && !(kept_usable(I, h) && constraints_met(I, I->u));
@@ -681,7 +680,7 @@ cleanup:
  * backend (fem/fem_backend.h) D is this process's PARTIAL damping matrix, not summed: its
  * cells' K+ and alpha_M M of its partial M; the processes' D sum to the serial one (evaluate() sums
  * its products, the Newton matrix's base adds it partially). */
-static fcm_status update_damping(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
+fcm_status fcm__sim_update_damping(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats)
 {
   fcm_status st = FCM_OK;
   const fcm_integrator_options *o = &I->opts;
@@ -730,6 +729,9 @@ static fcm_status run_substep(fcm_integrator *I, int dyn, double h, double t1,
                               sim_stats *stats)
 {
   fcm_status st = FCM_OK;
+  /* f_int(u_n) of HHT and generalized-alpha, the boundary constraints at the substep's start */
+  if (dyn && I->sch.af != 0.0) FCM_TRY(I->ctx, fcm__sim_scheme_force(I, reason, stats));
+  if (*reason != FCM_STEP_NONE) return FCM_OK;
   fcm__sim_eval_constraints(I, t1);
   if (!dyn && I->rigid_ok != I->con_version + 1) {
     /* no mass: a body the constraints leave free makes every Newton matrix singular */
@@ -738,7 +740,8 @@ static fcm_status run_substep(fcm_integrator *I, int dyn, double h, double t1,
   }
   memcpy(I->un, I->u, sizeof(double) * (size_t)I->n);
   if (dyn && I->D && (!I->linear || I->damp_version == 0))
-    FCM_TRY(I->ctx, update_damping(I, reason, stats));
+    FCM_TRY(I->ctx, fcm__sim_update_damping(I, reason, stats));
+  if (*reason == FCM_STEP_NONE && dyn && I->fstep) FCM_TRY(I->ctx, fcm__sim_scheme_begin(I));
   if (*reason == FCM_STEP_NONE)
     FCM_TRY(I->ctx, fcm__sim_newton(I, h, t1, reason, residual, tol, ref, stats));
 cleanup:
@@ -813,6 +816,7 @@ static fcm_status accept_step(fcm_integrator *I, int dyn, double t0, fcm_step_in
   info->elastic_energy = I->psi;
   info->external_work = dot(n, I->fext, I->u);
   info->total_energy = ekin + I->psi - info->external_work;
+  info->load_work = I->load_work;
   if (st == FCM_OK) st = record_inversion(I, info);
   return st;
 }
@@ -826,6 +830,7 @@ static fcm_status reject_step(fcm_integrator *I, fcm_status st, fcm_step_reason 
   memcpy(I->u, I->u_bak, sizeof(double) * (size_t)n);
   memcpy(I->v, I->v_bak, sizeof(double) * (size_t)n);
   memcpy(I->load_prev, I->lp_bak, sizeof(double) * (size_t)n);
+  if (I->a_bak) memcpy(I->a, I->a_bak, sizeof(double) * (size_t)n);
   fcm__sim_eval_constraints(I, I->t);
   if (!I->linear) I->h_state = SIM_H_INVALID;
   I->kept = 0;
@@ -890,7 +895,7 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
     const fcm_integrator_options *o = &I->opts;
     fcm_index n = I->n;
     int dyn = o->kind == FCM_INTEGRATOR_BACKWARD_EULER;
-    double t_begin = fcm_wtime(), t0 = I->t, residual = 0.0, tol = 0.0, ref = 0.0;
+    double t_begin = fcm_wtime(), t0 = I->t, residual = 0.0, tol = 0.0, ref = 0.0, work = 0.0;
     int H = o->max_halvings, level = 0;
     long long units = (long long)(dyn ? 1 : o->load_steps) << H, done = 0;
     fcm_step_reason reason = FCM_STEP_NONE;
@@ -898,6 +903,19 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
     memcpy(I->v_bak, I->v, sizeof(double) * (size_t)n);
     memcpy(I->lp_bak, I->load_prev, sizeof(double) * (size_t)n);
     if (!dyn) fcm__sim_eval_loads(I, t0 + o->dt, I->fend);
+    /* the load at the start (the load work's trapezoid; f_ext(t_n) of HHT, generalized-alpha) */
+    if (dyn)
+      fcm__sim_eval_loads(I, t0, I->fprev);
+    else
+      memcpy(I->fprev, I->lp_bak, sizeof(double) * (size_t)n);
+    if (dyn && I->a_bak && !I->a_valid) {
+      st = fcm__sim_initial_acceleration(I, &stats);
+      if (st != FCM_OK) {
+        fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
+        goto finish;
+      }
+    }
+    if (I->a_bak) memcpy(I->a_bak, I->a, sizeof(double) * (size_t)n);
 
     while (done < units) {
       long long size = 1LL << (H - level);
@@ -920,9 +938,12 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
       }
       info->dt = dyn ? h : o->dt * (double)size / (double)units;
       if (reason == FCM_STEP_CONVERGED || reason == FCM_STEP_FIXED_ITERATIONS) {
-        if (dyn)
-          for (fcm_index i = 0; i < n; i++)
-            I->v[i] = (I->u[i] - I->un[i]) / h;
+        double dw = 0.0;
+        for (fcm_index i = 0; i < n; i++)
+          dw += (I->fprev[i] + I->fext[i]) * (I->u[i] - I->un[i]);
+        work += 0.5 * dw;
+        memcpy(I->fprev, I->fext, sizeof(double) * (size_t)n);
+        if (dyn) fcm__sim_scheme_update(I, h);
         done += size;
         info->substeps++;
         reason = done < units ? FCM_STEP_NONE : reason;
@@ -937,14 +958,16 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
       level++;
       reason = FCM_STEP_NONE;
     }
+  finish:
     info->reason = reason;
     info->halvings = level;
     info->residual = residual;
     info->tolerance = tol;
     info->residual_reference = ref;
-    if (st == FCM_OK && (reason == FCM_STEP_CONVERGED || reason == FCM_STEP_FIXED_ITERATIONS))
+    if (st == FCM_OK && (reason == FCM_STEP_CONVERGED || reason == FCM_STEP_FIXED_ITERATIONS)) {
+      I->load_work += work;
       st = accept_step(I, dyn, t0, info);
-    else
+    } else
       st = reject_step(I, st, reason, t0, info);
     record_step_statistics(I, &stats, t_begin, info);
   }

@@ -7,6 +7,7 @@
 #ifndef FCM_SIM_BACKEND_H
 #define FCM_SIM_BACKEND_H
 
+#include "core/core_impl.h"
 #include "fcm/la.h"
 #include "fcm/sim.h"
 #include "fem/fem_backend.h"
@@ -36,11 +37,11 @@ fcm_status fcm__integrator_reduce_status(fcm_integrator *I, fcm_status st, doubl
                                          fcm_index count);
 
 /* The integrator's distributed backend (NULL with the serial one). */
-const fcm__backend *fcm__integrator_backend(const fcm_integrator *I);
+FCM_COMPONENT_API const fcm__backend *fcm__integrator_backend(const fcm_integrator *I);
 
 /* Whether the integrator runs on a distributed backend (0: the serial one); *root (may be
  * NULL): 1 on the backend's root process (the serial backend's one process is the root). */
-int fcm__integrator_distributed(const fcm_integrator *I, int *root);
+FCM_COMPONENT_API int fcm__integrator_distributed(const fcm_integrator *I, int *root);
 
 /* The backend's rank and process count (0 and 1 with the serial backend). */
 void fcm__integrator_processes(const fcm_integrator *I, int *rank, int *nprocs);

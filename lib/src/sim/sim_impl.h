@@ -56,6 +56,13 @@ typedef struct sim_bpoints {
   double *eelem;         /* nelem: energy of each element's points (summed in order) */
 } sim_bpoints;
 
+/* The time scheme's constants (scheme.c): the generalized-alpha family (backward Euler: kind
+ * only). cmass = (1 - am)/((1 - af) beta): the mass term's coefficient times h^2. */
+typedef struct sim_scheme {
+  fcm_time_scheme kind;
+  double am, af, beta, gamma, cmass;
+} sim_scheme;
+
 /* Counters and timers of one step (copied into fcm_step_info). */
 typedef struct sim_stats {
   int newton_iterations, backtracks, tangent_assemblies, factorizations;
@@ -91,6 +98,9 @@ struct fcm_integrator {
 
   /* state */
   double *u, *v;
+  double *a;        /* acceleration (n; scheme.c), valid when a_valid */
+  int a_valid;      /* 0: the next step of a scheme other than backward Euler solves for it */
+  double load_work; /* cumulative work of the external loads (fcm_step_info.load_work) */
   double t;
   long long steps;
   double *load_prev; /* static: external load of the last accepted step */
@@ -135,6 +145,11 @@ struct fcm_integrator {
   double *u_bak, *v_bak, *lp_bak; /* state at the start of the step */
   double *un;                     /* displacement at the start of the substep */
   double *uhat, *fext, *fend, *fint, *g, *d, *b, *ut, *fint_t, *g_t, *w1, *w2;
+  double *fprev; /* external load at the substep's start (the load work) */
+  /* schemes other than backward Euler (scheme.c; NULL for it): the acceleration at the step's
+   * start, the damping term's centre u_d and the step's constant force f_a (sim.h) */
+  double *a_bak, *ud, *fstep;
+  sim_scheme sch;
 
   /* solvers */
   fcm_direct *chol, *umf, *direct; /* `direct`: the one holding the current factor */
@@ -291,6 +306,42 @@ void fcm__sim_boundary_free(fcm_integrator *I);
 int fcm__sim_boundary_time(fcm_integrator *I, double t);
 fcm_status fcm__sim_boundary_assemble(fcm_integrator *I, const double *x, int projected,
                                       double *energy, double *force, fcm_csr *T, int *finite);
+
+/* Time schemes (scheme.c). Options: FCM_ERR_ARG naming the member and its range. */
+fcm_status fcm__sim_scheme_validate(fcm_ctx *ctx, const fcm_integrator_options *o);
+/* The constants of the options' scheme (static and backward Euler: the kind alone). */
+sim_scheme fcm__sim_scheme_constants(const fcm_integrator_options *o);
+/* Set-up: the scheme's work vectors (a_bak, ud, fstep). */
+fcm_status fcm__sim_scheme_setup(fcm_integrator *I);
+/* The coefficient of M in the Newton matrix and the length h_d the damping matrix is divided by,
+ * for a (sub)step h > 0: backward Euler 1/h^2 and h; the others cmass/h^2 and beta h/gamma. */
+double fcm__sim_mass_coeff(const fcm_integrator *I, double h);
+double fcm__sim_damp_length(const fcm_integrator *I, double h);
+/* Newton's start of a dynamic substep from u_n = un: the inertia centre uhat, the damping centre
+ * (ud; backward Euler: un) and the initial guess into u (free DOFs; un on the constrained). */
+void fcm__sim_scheme_predict(fcm_integrator *I, double h);
+/* Before a substep's constraints move to its end: f_int(u_n) (with the boundary constraints'
+ * force at their current time) into fstep, when alpha_f != 0. *reason = NONFINITE when it is not
+ * finite. */
+fcm_status fcm__sim_scheme_force(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats);
+/* After the damping matrix of the substep is set: the step's constant force f_a into fstep (from
+ * f_int(u_n) there, fprev, D v and M a). */
+fcm_status fcm__sim_scheme_begin(fcm_integrator *I);
+/* The state update of a converged substep of length h: v (and a) from u, un. */
+void fcm__sim_scheme_update(fcm_integrator *I, double h);
+/* Before a step of a scheme that needs it: a = M^-1 (f_ext(t) - f_int(u) - D v) with the
+ * active constrained DOFs at zero, solved by the Newton systems' solver; a failed solve is an
+ * error naming the cause. */
+fcm_status fcm__sim_initial_acceleration(fcm_integrator *I, sim_stats *stats);
+
+/* newton.c, for scheme.c: the internal force at x with the boundary constraints' (summed over a
+ * backend's processes; *finite = 0 on NaN/Inf); the damping matrix at un (*reason NONFINITE);
+ * the symmetric elimination of the active constraints on H with the increments w1 (b lifted
+ * when predictor). */
+fcm_status fcm__sim_internal_force(fcm_integrator *I, const double *x, double *fint, int *finite,
+                                   sim_stats *stats);
+fcm_status fcm__sim_update_damping(fcm_integrator *I, fcm_step_reason *reason, sim_stats *stats);
+fcm_status fcm__sim_eliminate(fcm_integrator *I, int predictor);
 
 /* Give a new integrator the serial backend (its owned flags: every DOF). (integrator_backend.c) */
 fcm_status fcm__sim_serial_backend(fcm_integrator *I);
