@@ -188,13 +188,13 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
           g[i] += I->w2[i] / hd;
       }
     }
-    fcm__sim_hanging_reduce(I, g); /* the constrained problem's gradient (hanging.c) */
     wext = dot(n, I->fext, x);
     if (h > 0.0 && I->fstep) { /* the step's constant force f_a (schemes other than BE) */
       for (fcm_index i = 0; i < n; i++)
         g[i] -= I->fstep[i];
       wext += dot(n, I->fstep, x);
     }
+    fcm__sim_hanging_reduce(I, g); /* the constrained problem's gradient (hanging.c) */
     out->psi = psi;
     out->E = inertia + damp + psi + bnd - wext;
     out->scale = fabs(inertia) + fabs(damp) + fabs(psi) + fabs(bnd) + fabs(wext);

@@ -232,9 +232,16 @@ fcm_status fcm__sim_initial_acceleration(fcm_integrator *I, sim_stats *stats)
       I->b[i] -= I->w2[i];
   }
   /* H = M with the active constrained rows and columns eliminated (zero increments there: the
-   * constrained DOFs start without acceleration), factored and solved as a Newton system */
-  fcm_csr_get_size(I->H, NULL, NULL, &nnz);
-  memcpy(fcm_csr_values(I->H), fcm_csr_values_read(I->M), sizeof(double) * (size_t)nnz);
+   * constrained DOFs start without acceleration), factored and solved as a Newton system; with
+   * hanging nodes M and the right-hand side are reduced as the Newton system is (hanging.c) and
+   * the hanging DOFs' accelerations follow their masters' */
+  fcm_csr_get_size(I->M, NULL, NULL, &nnz);
+  memcpy(fcm_csr_values(fcm__sim_tangent_target(I)), fcm_csr_values_read(I->M),
+         sizeof(double) * (size_t)nnz);
+  if (I->hP) {
+    FCM_TRY(I->ctx, fcm__sim_hanging_matrix(I));
+    fcm__sim_hanging_reduce(I, I->b);
+  }
   memset(I->w1, 0, sizeof *I->w1 * (size_t)n);
   st = fcm__sim_eliminate(I, 0);
   /* a local failure there meets the others in the backend's factor (its agreement) */
@@ -261,6 +268,7 @@ fcm_status fcm__sim_initial_acceleration(fcm_integrator *I, sim_stats *stats)
             I->t, fcm_time_scheme_name(I->sch.kind), fcm_step_reason_name(reason), its);
   for (fcm_index j = 0; j < I->nact; j++)
     I->a[I->act_dof[j]] = 0.0;
+  fcm__sim_hanging_fill(I, I->a);
   I->a_valid = 1;
 cleanup:
   if (st != FCM_OK) I->h_state = SIM_H_INVALID, I->kept = 0;
