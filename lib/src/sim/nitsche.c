@@ -531,9 +531,7 @@ cleanup:
   return st;
 }
 
-/* Add the element matrix Ke (3nn x 3nn) of the element at local position le into the values
- * of the pattern (a matrix over the space's rows, fcm__space_matrix_create_rows()). */
-static void scatter(const fcm_space *s, fcm_index le, const double *Ke, double *vals)
+void fcm__sim_scatter(const fcm_space *s, fcm_index le, const double *Ke, double *vals)
 {
   const int nn = s->nn, nd = 3 * nn;
   const int *off = s->elem_off + (size_t)le * nn * nn;
@@ -736,7 +734,7 @@ fcm_status fcm__sim_boundary_assemble(fcm_integrator *I, const double *x, int pr
           for (int a = 0; a < nn; a++)
             for (int i = 0; i < 3; i++)
               force[ed[a] + i] += fe[3 * a + i];
-        if (T) scatter(s, bp->lelem[k], Ke, vals);
+        if (T) fcm__sim_scatter(s, bp->lelem[k], Ke, vals);
       }
     }
   }
