@@ -113,6 +113,24 @@ static int gradient(fcm_ctx *ctx)
   }
   if (!(den > 0.0 && sqrt(num / den) <= 1e-6))
     TEST_FAIL_("tangent: relative error %.3g against the force's differences", sqrt(num / den));
+  {
+    /* the cost of the barrier's energy, force and Newton matrix per surface point (printed,
+     * not asserted: lib/docs/contact.md) */
+    fcm_index np = 0;
+    for (fcm_index cell = 0; cell < fcm_mesh_num_cells(p.mesh); cell++) {
+      int q = 0;
+      TEST_OK(ctx, fcm_cell_rules_get_surface(p.rules, cell, &q, NULL, NULL, NULL, NULL));
+      np += q;
+    }
+    const int reps = 200;
+    const double t0 = fcm_wtime();
+    for (int k = 0; k < reps; k++)
+      TEST_OK(ctx, fcm_integrator_contact_eval(I, u, t, &e0, f0, T));
+    const double dt = (fcm_wtime() - t0) / reps;
+    printf("contact eval (energy, force, Newton matrix): %lld surface points, %.3g s per call, "
+           "%.3g us per point\n",
+           (long long)np, dt, 1e6 * dt / (double)(np > 0 ? np : 1));
+  }
   free(u), free(d), free(f0), free(fp), free(fm), free(Td);
   fcm_csr_destroy(&T);
   fcm_integrator_destroy(&I);

@@ -333,6 +333,17 @@ double fcm__sim_contact_step_bound(const fcm_integrator *I, const double *x, con
   return amax;
 }
 
+void fcm__sim_contact_pull_back(fcm_integrator *I)
+{
+  for (fcm_index i = 0; i < I->n; i++)
+    I->w1[i] = I->u[i] - I->un[i];
+  const double amax = fcm__sim_contact_step_bound(I, I->un, I->w1);
+  if (amax > 1.0) return;
+  for (fcm_index i = 0; i < I->n; i++)
+    I->u[i] = I->un[i] + 0.9 * amax * I->w1[i];
+  I->contact_pullbacks++;
+}
+
 fcm_status fcm_integrator_contact_info(const fcm_integrator *I, int id, double force[3],
                                        double *min_distance, double *dhat, double *kappa)
 {
@@ -376,15 +387,7 @@ fcm_status fcm_integrator_contact_eval(fcm_integrator *I, const double *u, doubl
   fcm_ctx *ctx = I->ctx;
   FCM_CHECK(I->is_setup && u, ctx, FCM_ERR_ARG,
             "contact eval: NULL displacement, or the integrator is not set up");
-  if (tangent) {
-    fcm_index nr = -1, nc = -1, nnz = -1;
-    fcm_csr_get_size(tangent, &nr, &nc, &nnz);
-    const fcm_index nrow = fcm__space_num_rows(I->space);
-    FCM_CHECK(I->space->row_ptr && nr == nrow && nc == I->n && nnz == I->space->row_ptr[nrow], ctx,
-              FCM_ERR_ARG,
-              "contact eval: the matrix does not have the space's pattern (use "
-              "fcm_space_matrix_create())");
-  }
+  FCM_TRY(ctx, fcm__sim_check_pattern(I, tangent, "contact eval"));
   FCM_TRY(ctx, fcm__sim_contact_check(I, u, t));
   {
     const double t_saved = I->bc_time;

@@ -441,17 +441,7 @@ static fcm_status newton_start(fcm_integrator *I, double h, eval_out *cur, sim_s
   fcm_status st = FCM_OK;
   if (h > 0.0) fcm__sim_scheme_predict(I, h);
   fcm__sim_hanging_fill(I, I->u); /* continuous: hanging DOFs follow their masters */
-  if (I->num_contacts > 0) {
-    /* a guess behind an obstacle: pulled back towards the substep's start (contact.c) */
-    for (fcm_index i = 0; i < I->n; i++)
-      I->w1[i] = I->u[i] - I->un[i];
-    const double amax = fcm__sim_contact_step_bound(I, I->un, I->w1);
-    if (amax <= 1.0) {
-      for (fcm_index i = 0; i < I->n; i++)
-        I->u[i] = I->un[i] + 0.9 * amax * I->w1[i];
-      I->contact_pullbacks++;
-    }
-  }
+  if (I->num_contacts > 0) fcm__sim_contact_pull_back(I);
   /* a predictor iteration (constraints off their values) cannot use the kept factorization */
   const int tangent = !I->linear && !(kept_usable(I, h) && constraints_met(I, I->u));
   FCM_TRY(I->ctx, evaluate(I, h, I->u, tangent, I->fint, I->g, cur, stats));

@@ -334,6 +334,9 @@ fcm_status fcm__sim_boundary_assemble(fcm_integrator *I, const double *x, int pr
  * of the pattern (a matrix over the space's rows, fcm__space_matrix_create_rows()).
  * (nitsche.c) */
 void fcm__sim_scatter(const fcm_space *s, fcm_index le, const double *Ke, double *vals);
+/* FCM_ERR_ARG (named after `who`) unless T (may be NULL) has the space's matrix pattern.
+ * (nitsche.c) */
+fcm_status fcm__sim_check_pattern(const fcm_integrator *I, const fcm_csr *T, const char *who);
 
 /* Contact obstacles (contact.c). setup: the embedded surface's points and the defaults of
  * the barrier parameters, refusing a start in penetration; free. assemble: the barrier's
@@ -347,6 +350,9 @@ void fcm__sim_contact_free(fcm_integrator *I);
 void fcm__sim_contact_assemble(fcm_integrator *I, const double *x, double *energy, double *force,
                                fcm_csr *T, int *finite);
 double fcm__sim_contact_step_bound(const fcm_integrator *I, const double *x, const double *dx);
+/* A substep's first guess u behind an obstacle: pulled back to un + 0.9 alpha (u - un), alpha
+ * the step bound from un (w1 holds u - un afterwards). */
+void fcm__sim_contact_pull_back(fcm_integrator *I);
 fcm_status fcm__sim_contact_check(const fcm_integrator *I, const double *x, double t);
 
 /* Time schemes (scheme.c). Options: FCM_ERR_ARG naming the member and its range. */
