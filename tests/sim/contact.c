@@ -2,6 +2,8 @@
  *   gradient   on an embedded ball near a tilted moving plane, with a random displacement:
  *              central differences of the barrier energy match its force, and of the force
  *              its Newton matrix (relative error <= 1e-6); the matrix is symmetric
+ *   push       a floor moving up at constant velocity V hits a ball at rest (no gravity):
+ *              never crossed, the ball leaves it at a speed in [V, 2 V]
  *   errors     a ball starting across the plane is refused naming the point and its
  *              distance; bad normals and negative options are named
  *   drop <scheme>  a Hex8 ball dropped under gravity onto a floor: no surface point ever at
@@ -235,6 +237,46 @@ static int drop(fcm_ctx *ctx, fcm_time_scheme scheme, int argc_steps)
   return 0;
 }
 
+/* A floor moving up at V = 0.2 m/s hits a ball at rest (no gravity), backward Euler: no point
+ * ever at or below the moving floor, and the ball leaves it with a centre-of-mass velocity in
+ * [V, 2 V] (between a fully inelastic and an elastic collision with an infinitely heavy wall). */
+static int push(fcm_ctx *ctx)
+{
+  problem p = {ctx, NULL, NULL, NULL, NULL};
+  fcm_integrator *I = NULL;
+  const double c[3] = {0.5, 0.5, 0.5}, r = 0.35, up[3] = {0, 0, 1}, vel[3] = {0, 0, 0.2};
+  const double floor_pt[3] = {0.5, 0.5, c[2] - r - 0.01};
+  fcm_material mat = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 1e5, 0.3, 1000.0};
+  fcm_integrator_options o = fcm_integrator_options_default();
+  o.kind = FCM_INTEGRATOR_BACKWARD_EULER;
+  o.dt = 0.01;
+  TEST_OK(ctx, ball_build(&p, c, r, 6));
+  TEST_OK(ctx, fcm_integrator_create(ctx, p.space, &mat, &o, &I));
+  TEST_OK(ctx, fcm_integrator_add_contact_plane(I, floor_pt, up, vel, NULL, NULL));
+  TEST_OK(ctx, fcm_integrator_setup(I));
+  const fcm_index n = fcm_space_num_dofs(p.space);
+  double *ez = calloc((size_t)n, sizeof *ez), *w = calloc((size_t)n, sizeof *w);
+  double dmin_all = HUGE_VAL, vcom = 0.0, mass = 0.0;
+  for (int s = 0; s < 100; s++) {
+    fcm_step_info info;
+    double dmin = 0.0;
+    TEST_OK(ctx, fcm_integrator_step(I, &info));
+    TEST_OK(ctx, fcm_integrator_contact_info(I, 0, NULL, &dmin, NULL, NULL));
+    dmin_all = fmin(dmin_all, dmin);
+  }
+  vcom = com_velocity(I, n, ez, w, &mass);
+  printf("push: min distance %.4g m, final vz %.4g m/s\n", dmin_all, vcom);
+  if (!(dmin_all > 0.0)) TEST_FAIL_("push: a surface point reached distance %.3g", dmin_all);
+  /* a collision with an infinitely heavy wall moving at V leaves the body between V (fully
+   * inelastic) and 2 V (elastic) */
+  if (!(vcom >= 0.95 * vel[2] && vcom <= 2.05 * vel[2]))
+    TEST_FAIL_("push: centre-of-mass velocity %.3g m/s outside [V, 2 V], V = %g", vcom, vel[2]);
+  free(ez), free(w);
+  fcm_integrator_destroy(&I);
+  problem_free(&p);
+  return 0;
+}
+
 int main(int argc, char **argv)
 {
   fcm_ctx *ctx = NULL;
@@ -242,6 +284,8 @@ int main(int argc, char **argv)
   const char *mode = argc > 1 ? argv[1] : "gradient";
   if (!strcmp(mode, "gradient")) {
     gradient(ctx);
+  } else if (!strcmp(mode, "push")) {
+    push(ctx);
   } else if (!strcmp(mode, "errors")) {
     errors(ctx);
   } else if (!strcmp(mode, "drop")) {
