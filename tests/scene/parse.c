@@ -87,12 +87,12 @@ static void check_full(fcm_ctx *ctx)
   TEST_TRUE(o->checkpoint_interval == 9);
   TEST_TRUE(o->write_background == 0 && o->write_surface == 0);
 
-  TEST_TRUE(fcm_scene_num_effects(s) == 9);
-  TEST_TRUE(fcm_scene_get_effect(s, 9) == NULL && fcm_scene_get_effect(s, -1) == NULL);
-  const int expect_count[FCM_EFFECT_TYPE_COUNT] = {1, 1, 1, 2, 1, 1, 1, 1};
+  TEST_TRUE(fcm_scene_num_effects(s) == 10);
+  TEST_TRUE(fcm_scene_get_effect(s, 10) == NULL && fcm_scene_get_effect(s, -1) == NULL);
+  const int expect_count[FCM_EFFECT_TYPE_COUNT] = {1, 1, 1, 2, 1, 1, 1, 1, 1};
   for (int k = 0; k < FCM_EFFECT_TYPE_COUNT; k++)
     TEST_TRUE(fcm_scene_count_effects(s, (fcm_effect_type)k) == expect_count[k]);
-  for (int i = 0; i < 9; i++)
+  for (int i = 0; i < 10; i++)
     TEST_TRUE(fcm_scene_get_effect(s, i)->index == i);
 
   const fcm_effect *e = fcm_scene_get_effect(s, 0);
@@ -162,6 +162,13 @@ static void check_full(fcm_ctx *ctx)
   TEST_TRUE(e->cut.size[0] == 0.5 && e->cut.size[1] == 0.25 && e->cut.has_transform);
   check_vec(e->cut.offset, 0, 0, 1);
 
+  e = fcm_scene_get_effect(s, 9);
+  TEST_TRUE(e->type == FCM_EFFECT_CONTACT);
+  check_vec(e->contact.point, 0, 0, -2);
+  check_vec(e->contact.normal, 0, 0, 1);
+  check_vec(e->contact.velocity, 0, 0, 0.5);
+  TEST_TRUE(e->contact.options.distance == 0.01 && e->contact.options.stiffness == 2e6);
+
   /* The summary names every section and effect. */
   FILE *f = tmpfile();
   TEST_TRUE(f != NULL);
@@ -173,8 +180,8 @@ static void check_full(fcm_ctx *ctx)
     text[n] = '\0';
     fclose(f);
     const char *words[] = {
-        "full-scene.v1", "tet10",    "tube",     "stvk",       "minres",
-        "block_jacobi",  "75 steps", "out/full", "effects: 9", "on inversion: stop"};
+        "full-scene.v1", "tet10",    "tube",     "stvk",        "minres",
+        "block_jacobi",  "75 steps", "out/full", "effects: 10", "on inversion: stop"};
     for (size_t i = 0; i < sizeof words / sizeof *words; i++)
       TEST_TRUE(strstr(text, words[i]));
     for (int k = 0; k < FCM_EFFECT_TYPE_COUNT; k++)

@@ -70,7 +70,10 @@ static const char full_scene_json[] =
     "    {\"cut\": {\"time\": 0.5, \"surface\": {\"rectangle\": {\"center\": [1, 2, 3], "
     "\"normal\": [0, 0, 2],\n"
     "      \"axis\": [1, 0, 1], \"size\": [0.5, 0.25], \"transform\": {\"translation\": [0, 0, "
-    "1]}}}}}\n"
+    "1]}}}}},\n"
+    "    {\"contact\": {\"plane\": {\"point\": [0, 0, -2], \"normal\": [0, 0, 3], "
+    "\"velocity\": [0, 0, 0.5]},\n"
+    "      \"distance\": 0.01, \"stiffness\": 2e6}}\n"
     "  ]\n"
     "}\n";
 

@@ -65,3 +65,7 @@ fcm_add_test(scene_inversion tests/scene/inversion_scene.c)
 fcm_add_test(scene_setup_phases tests/scene/setup_phases.c)
 # The background key "octree": parse, round trip, refusals, a step on the refined grid.
 fcm_add_test(scene_octree tests/scene/octree_scene.c)
+# The contact effect: apps/scenes/ball_on_floor.json round-trips through the normalized JSON,
+# never gets below its floor and comes to rest on it with the reaction m g; bad keys and a
+# scene without a geometry are refused, named.
+fcm_add_test(scene_contact tests/scene/contact_scene.c ARGS ${PROJECT_SOURCE_DIR}/apps/scenes)

@@ -86,3 +86,13 @@ endforeach()
 # fitted temporal orders, Newmark's energy over 1000 steps, the contraction per step at
 # infinite frequency against rho_inf, option errors.
 fcm_add_test(sim_schemes tests/sim/schemes.c)
+# Contact with rigid planes: the log barrier's force and Newton matrix against central
+# differences; a start in penetration and bad options refused; a moving floor hits a ball
+# and throws it at a speed in [V, 2 V]; a ball dropped on a floor
+# never crosses it, comes to rest on it with the reaction m g (backward Euler), bounces
+# (Newmark).
+fcm_add_test(sim_contact_gradient tests/sim/contact.c ARGS gradient)
+fcm_add_test(sim_contact_errors tests/sim/contact.c ARGS errors)
+fcm_add_test(sim_contact_push tests/sim/contact.c ARGS push)
+fcm_add_test(sim_contact_drop_be tests/sim/contact.c ARGS drop backward_euler)
+fcm_add_test(sim_contact_drop_newmark tests/sim/contact.c ARGS drop newmark)

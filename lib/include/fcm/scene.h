@@ -211,6 +211,7 @@ typedef enum fcm_effect_type {
   FCM_EFFECT_TRACTION,         /**< "traction": force per area on the embedded boundary */
   FCM_EFFECT_PRESSURE,         /**< "pressure": p along the inward normal of the boundary */
   FCM_EFFECT_CUT,              /**< "cut": a cut surface inserted at a time (XFEM) */
+  FCM_EFFECT_CONTACT,          /**< "contact": a rigid plane obstacle (log barrier) */
   FCM_EFFECT_TYPE_COUNT
 } fcm_effect_type;
 
@@ -303,6 +304,16 @@ typedef struct fcm_effect_cut {
   double transform[9], offset[3]; /**< x -> transform x + offset (identity when none) */
 } fcm_effect_cut;
 
+/** A rigid half-space obstacle (fcm_integrator_add_contact_plane()): the plane through
+ * point + velocity t with the unit normal pointing to the body's side; the barrier's
+ * threshold and stiffness (0: the defaults of fcm_contact_options). */
+typedef struct fcm_effect_contact {
+  double point[3];             /**< m */
+  double normal[3];            /**< unit (normalized by the parser) */
+  double velocity[3];          /**< m/s (default 0: a static obstacle) */
+  fcm_contact_options options; /**< "distance" (m), "stiffness" (Pa/m), >= 0 */
+} fcm_effect_contact;
+
 /** One effect of the scene: a tagged union. */
 typedef struct fcm_effect {
   fcm_effect_type type; /**< selects the member */
@@ -316,6 +327,7 @@ typedef struct fcm_effect {
     fcm_effect_traction traction;
     fcm_effect_pressure pressure;
     fcm_effect_cut cut;
+    fcm_effect_contact contact;
   };
 } fcm_effect;
 

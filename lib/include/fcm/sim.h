@@ -529,6 +529,65 @@ FCM_API fcm_status fcm_integrator_boundary_reaction(const fcm_integrator *integ,
 FCM_API fcm_status fcm_integrator_boundary_eval(fcm_integrator *integ, const double *u, double t,
                                                 double *energy, double *force, fcm_csr *tangent);
 
+/** Options of fcm_integrator_add_contact_plane(); fcm_contact_options_default(). */
+typedef struct fcm_contact_options {
+  double distance;  /**< the barrier's threshold d^ (m), > 0; 0 (default): 0.1 h, h the
+                         largest extent of a cell holding embedded-surface points */
+  double stiffness; /**< the barrier's stiffness kappa (Pa/m), > 0; 0 (default): E / h, E the
+                         material's Young modulus */
+} fcm_contact_options;
+
+/** The defaults listed on each member. */
+FCM_API fcm_contact_options fcm_contact_options_default(void);
+
+/** A rigid half-space obstacle: the body stays on the side n . (x - p(t)) > 0 of the plane
+ * through p(t) = point + velocity t with unit normal n = normal / |normal|. The contact acts
+ * on the embedded surface's points (the surface rules of the space's cell rules, at their
+ * current positions x = X + u(X)) through the smooth log barrier of Li et al. (2020,
+ * incremental potential contact): with the distance d = n . (x - p(t)) of a point of area
+ * weight w, the energy gains w kappa b(d), b(d) = -(d - d^)^2 ln(d / d^) for 0 < d < d^ and 0
+ * beyond (C2 at d^, infinite at 0, convex: its Hessian w kappa b''(d) N_a N_b n (x) n is
+ * positive semidefinite). Its gradient and Newton matrix join the incremental potential's, and
+ * the line search never crosses into penetration: every Newton step is first shortened to 0.9
+ * times the largest fraction that keeps each point at d > 0 (the distance is linear in the
+ * step for a plane), then backtracked on the energy; a substep's first guess that penetrates is
+ * pulled back the same way from the substep's start. A state on or behind a plane (d <= 0) is
+ * refused by the setup and by each step with the point and its distance. Not supported yet:
+ * friction, boxes, spheres, triangle-surface obstacles, contact between bodies or with itself,
+ * distributed backends. Before setup.
+ * @param[out] id the obstacle's index (may be NULL)
+ * @return FCM_OK, FCM_ERR_ARG (NULL integrator or vector; a zero or non-finite normal; a
+ * non-finite point or velocity; a negative or non-finite option, named; after setup),
+ * FCM_ERR_ALLOC. The setup fails with FCM_ERR_ARG when the space has no surface rules or a
+ * point starts on or behind a plane, FCM_ERR_UNSUPPORTED with a distributed backend. */
+FCM_API fcm_status fcm_integrator_add_contact_plane(fcm_integrator *integ, const double point[3],
+                                                    const double normal[3],
+                                                    const double velocity[3],
+                                                    const fcm_contact_options *opts, int *id);
+
+/** Contact obstacle `id` at the current state and time: the force the obstacle exerts on the
+ * body (sum over the points of -w kappa b'(d) n; zero beyond the threshold) and the smallest
+ * distance of an embedded-surface point to it (either may be NULL); its threshold and stiffness
+ * (the defaults resolved) in dhat and kappa (each may be NULL). After setup. Allocates nothing.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, not set up, id out of range). */
+FCM_API fcm_status fcm_integrator_contact_info(const fcm_integrator *integ, int id, double force[3],
+                                               double *min_distance, double *dhat, double *kappa);
+
+/** How often the contact filter acted since setup: the Newton steps it shortened before the
+ * line search (*filtered) and the substeps whose first guess it pulled back in front of an
+ * obstacle (*pullbacks); either may be NULL; zeros without obstacles.
+ * @return FCM_OK, FCM_ERR_ARG (NULL integrator). */
+FCM_API fcm_status fcm_integrator_contact_counters(const fcm_integrator *integ, long long *filtered,
+                                                   long long *pullbacks);
+
+/** The contact obstacles' part of the energy alone at displacement u and time t: energy,
+ * force (added, num_dofs) and Newton matrix (added; the space's pattern,
+ * fcm_space_matrix_create()), each may be NULL. After setup. Allocates nothing.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, not set up, wrong matrix; a point on or behind an
+ * obstacle, named with its distance). */
+FCM_API fcm_status fcm_integrator_contact_eval(fcm_integrator *integ, const double *u, double t,
+                                               double *energy, double *force, fcm_csr *tangent);
+
 /** Validate the options, build the constrained DOF list, gather the boundary constraints'
  * points and estimate their penalties, assemble the mass matrix (BACKWARD_EULER only) and the
  * loads, allocate every work array and solver, and run the symbolic analysis (direct).

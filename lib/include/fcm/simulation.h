@@ -112,6 +112,7 @@ typedef struct fcm_simulation_counters {
   int damping;                 /**< 1: a Rayleigh damping matrix is used */
   int initial_velocity;        /**< initial-velocity effects applied */
   int constraints;             /**< constraint sets (fixed and motion effects) */
+  int contacts;                /**< contact obstacles (contact effects) */
   fcm_index constrained_nodes; /**< background nodes named by them (with or without DOFs) */
   fcm_index constrained_dofs;  /**< constrained DOFs after setup */
   fcm_index boundary_points;   /**< embedded-boundary points held by `boundary` constraints */

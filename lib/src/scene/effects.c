@@ -593,6 +593,47 @@ static void view_cut(const fcm_effect *e, FILE *f)
   if (c->has_transform) fprintf(f, " (transformed)");
 }
 
+static fcm_status parse_contact(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"plane", "distance", "stiffness"};
+  static const char *const plane_keys[] = {"point", "normal", "velocity"};
+  fcm_effect_contact *c = &e->contact;
+  const fcm__json *pl = NULL;
+  memset(c, 0, sizeof *c);
+  c->options = fcm_contact_options_default();
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "plane", 1, &pl));
+  size_t old = fcm__scene_path_push_key(p, "plane");
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, pl, plane_keys, COUNT(plane_keys)));
+  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, pl, "point", 1, FCM__ANY, c->point));
+  FCM_TRY(p->ctx, read_unit(p, pl, "normal", c->normal));
+  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, pl, "velocity", 0, FCM__ANY, c->velocity));
+  fcm__scene_path_pop(p, old);
+  FCM_TRY(p->ctx,
+          fcm__scene_read_number(p, o, "distance", 0, FCM__NONNEGATIVE, &c->options.distance));
+  FCM_TRY(p->ctx,
+          fcm__scene_read_number(p, o, "stiffness", 0, FCM__NONNEGATIVE, &c->options.stiffness));
+cleanup:
+  return st;
+}
+
+static void view_contact(const fcm_effect *e, FILE *f)
+{
+  const fcm_effect_contact *c = &e->contact;
+  const double *q = c->point, *n = c->normal, *v = c->velocity;
+  fprintf(f, "plane through (%g, %g, %g), normal (%g, %g, %g), velocity (%g, %g, %g) m/s", q[0],
+          q[1], q[2], n[0], n[1], n[2], v[0], v[1], v[2]);
+  if (c->options.distance > 0.0)
+    fprintf(f, ", threshold %g m", c->options.distance);
+  else
+    fprintf(f, ", threshold 0.1 h");
+  if (c->options.stiffness > 0.0)
+    fprintf(f, ", stiffness %g Pa/m", c->options.stiffness);
+  else
+    fprintf(f, ", stiffness E / h");
+}
+
 /* The one table of effect modules. Order = enum fcm_effect_type. */
 static const fcm__effect_type effect_types[FCM_EFFECT_TYPE_COUNT] = {
     {.type = FCM_EFFECT_GRAVITY,
@@ -652,6 +693,13 @@ static const fcm__effect_type effect_types[FCM_EFFECT_TYPE_COUNT] = {
      .allowed_static = 1,
      .parse = parse_cut,
      .view = view_cut},
+    {.type = FCM_EFFECT_CONTACT,
+     .name = "contact",
+     .summary = "a rigid plane obstacle, static or moving (log barrier on the embedded surface)",
+     .parse = parse_contact,
+     .view = view_contact,
+     .needs = FCM__NEEDS_SURFACE_RULES,
+     .apply = fcm__effect_apply_contact},
 };
 
 const fcm__effect_type *fcm__scene_effect_type(fcm_effect_type type)

@@ -141,6 +141,20 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__effect_apply_contact(fcm_simulation *S, const fcm_effect *e)
+{
+  fcm_status st = FCM_OK;
+  const fcm_effect_contact *c = &e->contact;
+  FCM_CHECK(S->c.surface_rules, S->ctx, FCM_ERR_ARG,
+            "scene %s: effects[%d]: contact needs an embedded geometry with surface rules",
+            fcm_scene_name(S->scene), e->index);
+  FCM_TRY(S->ctx, fcm_integrator_add_contact_plane(S->integ, c->point, c->normal, c->velocity,
+                                                   &c->options, NULL));
+  S->c.contacts++;
+cleanup:
+  return st;
+}
+
 void fcm__effect_configure_damping(const fcm_effect *e, fcm_integrator_options *o)
 {
   if (o->kind != FCM_INTEGRATOR_BACKWARD_EULER) return; /* (static scenes reject damping) */

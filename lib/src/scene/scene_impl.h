@@ -331,6 +331,7 @@ void fcm__effect_configure_damping(const fcm_effect *effect, fcm_integrator_opti
 fcm_status fcm__effect_apply_gravity(fcm_simulation *sim, const fcm_effect *effect);
 fcm_status fcm__effect_apply_constraint(fcm_simulation *sim, const fcm_effect *effect);
 fcm_status fcm__effect_apply_surface_load(fcm_simulation *sim, const fcm_effect *effect);
+fcm_status fcm__effect_apply_contact(fcm_simulation *sim, const fcm_effect *effect);
 fcm_status fcm__effect_initialize_velocity(fcm_simulation *sim, const fcm_effect *effect,
                                            fcm__effect_init *init);
 

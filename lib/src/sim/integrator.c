@@ -114,6 +114,7 @@ void fcm_integrator_destroy(fcm_integrator **integ)
     fcm__free(ctx, I->cons[k].nodes);
   fcm__free(ctx, I->cons);
   fcm__sim_boundary_free(I);
+  fcm__sim_contact_free(I);
   double **vecs[] = {&I->u,        &I->v,      &I->load_prev, &I->act_val, &I->act_inc, &I->Ma,
                      &I->act_diag, &I->u_bak,  &I->v_bak,     &I->lp_bak,  &I->un,      &I->uhat,
                      &I->fext,     &I->fend,   &I->fint,      &I->g,       &I->d,       &I->b,
@@ -660,6 +661,7 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
     FCM_TRY(ctx, setup_representative_force(I));
   FCM_TRY(ctx, setup_solvers(I));
   setup_initial_state(I);
+  FCM_TRY(ctx, fcm__sim_contact_setup(I));
 cleanup:
   return st;
 }
@@ -930,6 +932,10 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   for (int k = 0; st == FCM_OK && k < old->num_bcons; k++)
     st = fcm_integrator_add_boundary_constraint(I, old->bcons[k].select, old->bcons[k].select_user,
                                                 &old->bcons[k].motion, &old->bcons[k].opts, NULL);
+  for (int k = 0; st == FCM_OK && k < old->num_contacts; k++) {
+    const sim_contact *c = &old->contacts[k];
+    st = fcm_integrator_add_contact_plane(I, c->point, c->normal, c->velocity, &c->opts, NULL);
+  }
   {
     /* the old integrator's backend for the new space (the serial one stays serial) */
     fcm__backend b;

@@ -57,16 +57,22 @@ static fcm_status assemble(fcm_integrator *I, const fcm_material_params *p, cons
   return st;
 }
 
-/* The boundary constraints' terms (nitsche.c) at x: energy, force, tangent (projected: the
- * PSD penalty part only), timed with the assembly. */
+/* The boundary constraints' terms (nitsche.c) and the contact barrier's (contact.c) at x:
+ * energy, force, tangent (projected: the boundary constraints' PSD penalty part only), timed
+ * with the assembly. */
 static fcm_status assemble_boundary(fcm_integrator *I, const double *x, int projected,
                                     double *energy, double *fint, fcm_csr *T, int *finite,
                                     sim_stats *stats)
 {
-  if (I->bcon_active == 0) return FCM_OK;
+  if (I->bcon_active == 0 && I->num_contacts == 0) return FCM_OK;
   double t0 = fcm_wtime();
-  fcm_status st = fcm__sim_boundary_assemble(
-      I, x, projected || I->params.project_psd || (T && I->bc_psd_only), energy, fint, T, finite);
+  fcm_status st = FCM_OK;
+  if (I->bcon_active > 0)
+    st = fcm__sim_boundary_assemble(
+        I, x, projected || I->params.project_psd || (T && I->bc_psd_only), energy, fint, T, finite);
+  /* the contact barrier (contact.c): its Hessian is positive semidefinite as it is */
+  if (st == FCM_OK && *finite && I->num_contacts > 0)
+    fcm__sim_contact_assemble(I, x, energy, fint, T, finite);
   stats->time_assembly += fcm_wtime() - t0;
   if (st != FCM_OK) fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
   return st;
@@ -435,6 +441,7 @@ static fcm_status newton_start(fcm_integrator *I, double h, eval_out *cur, sim_s
   fcm_status st = FCM_OK;
   if (h > 0.0) fcm__sim_scheme_predict(I, h);
   fcm__sim_hanging_fill(I, I->u); /* continuous: hanging DOFs follow their masters */
+  if (I->num_contacts > 0) fcm__sim_contact_pull_back(I);
   /* a predictor iteration (constraints off their values) cannot use the kept factorization */
   const int tangent = !I->linear && !(kept_usable(I, h) && constraints_met(I, I->u));
   FCM_TRY(I->ctx, evaluate(I, h, I->u, tangent, I->fint, I->g, cur, stats));
@@ -533,6 +540,13 @@ static fcm_status line_search(fcm_integrator *I, double h, int predictor, int la
   fcm_status st = FCM_OK;
   const fcm_integrator_options *o = &I->opts;
   lr->alpha = 1.0;
+  if (I->num_contacts > 0) { /* never into penetration: 0.9 of the largest safe fraction */
+    const double amax = fcm__sim_contact_step_bound(I, I->u, I->d);
+    if (0.9 * amax < 1.0) {
+      lr->alpha = 0.9 * amax;
+      I->contact_filtered++;
+    }
+  }
   lr->accepted = lr->speculative = 0;
   lr->rt = NAN;
   for (int bt = 0;; bt++) {
@@ -891,6 +905,7 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
   memset(&stats, 0, sizeof stats);
   FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
   FCM_CHECK(I->is_setup, I->ctx, FCM_ERR_ARG, "integrator: call fcm_integrator_setup() first");
+  if (I->num_contacts > 0) FCM_TRY(I->ctx, fcm__sim_contact_check(I, I->u, I->t));
   {
     const fcm_integrator_options *o = &I->opts;
     fcm_index n = I->n;

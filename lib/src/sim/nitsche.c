@@ -531,9 +531,7 @@ cleanup:
   return st;
 }
 
-/* Add the element matrix Ke (3nn x 3nn) of the element at local position le into the values
- * of the pattern (a matrix over the space's rows, fcm__space_matrix_create_rows()). */
-static void scatter(const fcm_space *s, fcm_index le, const double *Ke, double *vals)
+void fcm__sim_scatter(const fcm_space *s, fcm_index le, const double *Ke, double *vals)
 {
   const int nn = s->nn, nd = 3 * nn;
   const int *off = s->elem_off + (size_t)le * nn * nn;
@@ -736,7 +734,7 @@ fcm_status fcm__sim_boundary_assemble(fcm_integrator *I, const double *x, int pr
           for (int a = 0; a < nn; a++)
             for (int i = 0; i < 3; i++)
               force[ed[a] + i] += fe[3 * a + i];
-        if (T) scatter(s, bp->lelem[k], Ke, vals);
+        if (T) fcm__sim_scatter(s, bp->lelem[k], Ke, vals);
       }
     }
   }
@@ -793,6 +791,22 @@ double fcm_integrator_boundary_penalty(const fcm_integrator *I, fcm_index elem)
   return lo < bp->nelem && bp->elem[lo] == elem ? element_max_penalty(I, lo) : 0.0;
 }
 
+fcm_status fcm__sim_check_pattern(const fcm_integrator *I, const fcm_csr *T, const char *who)
+{
+  fcm_status st = FCM_OK;
+  fcm_index nr = -1, nc = -1, nnz = -1;
+  if (!T) return FCM_OK;
+  fcm_csr_get_size(T, &nr, &nc, &nnz);
+  const fcm_index nrow = fcm__space_num_rows(I->space);
+  FCM_CHECK(I->space->row_ptr && nr == nrow && nc == I->n && nnz == I->space->row_ptr[nrow], I->ctx,
+            FCM_ERR_ARG,
+            "%s: the matrix does not have the space's pattern (use "
+            "fcm_space_matrix_create(); a distributed run: the integrator's local rows)",
+            who);
+cleanup:
+  return st;
+}
+
 fcm_status fcm_integrator_boundary_eval(fcm_integrator *I, const double *u, double t,
                                         double *energy, double *force, fcm_csr *tangent)
 {
@@ -801,15 +815,7 @@ fcm_status fcm_integrator_boundary_eval(fcm_integrator *I, const double *u, doub
   fcm_ctx *ctx = I->ctx;
   FCM_CHECK(I->is_setup && u, ctx, FCM_ERR_ARG,
             "boundary eval: NULL displacement, or the integrator is not set up");
-  if (tangent) {
-    fcm_index nr = -1, nc = -1, nnz = -1;
-    fcm_csr_get_size(tangent, &nr, &nc, &nnz);
-    const fcm_index nrow = fcm__space_num_rows(I->space);
-    FCM_CHECK(I->space->row_ptr && nr == nrow && nc == I->n && nnz == I->space->row_ptr[nrow], ctx,
-              FCM_ERR_ARG,
-              "boundary eval: the matrix does not have the space's pattern (use "
-              "fcm_space_matrix_create(); a distributed run: the integrator's local rows)");
-  }
+  FCM_TRY(ctx, fcm__sim_check_pattern(I, tangent, "boundary eval"));
   {
     const double t_saved = I->bc_time;
     int finite = 1;

@@ -56,6 +56,24 @@ typedef struct sim_bpoints {
   double *eelem;         /* nelem: energy of each element's points (summed in order) */
 } sim_bpoints;
 
+/* A contact obstacle (contact.c): the half-space n . (x - p0 - v t) <= 0 (n unit). */
+typedef struct sim_contact {
+  double point[3], normal[3], velocity[3];
+  fcm_contact_options opts; /* as given (0: default) */
+  double dhat, kappa;       /* the barrier's threshold and stiffness (setup) */
+} sim_contact;
+
+/* The embedded surface's points the contact barrier acts on (setup), grouped by element. */
+typedef struct sim_cpoints {
+  fcm_index nelem;       /* elements with points */
+  fcm_index *elem, *ptr; /* nelem, nelem + 1 */
+  fcm_index *lelem;      /* nelem: local position of elem[k] in the space */
+  fcm_index np;          /* points */
+  double *w, *X, *N;     /* np weights, np x 3 reference positions, np x nn shape values */
+  double h;              /* the largest extent of a cell holding points */
+  double *scratch;       /* fe (3nn), Ke ((3nn)^2) */
+} sim_cpoints;
+
 /* The time scheme's constants (scheme.c): the generalized-alpha family (backward Euler: kind
  * only). cmass = (1 - am)/((1 - af) beta): the mass term's coefficient times h^2. */
 typedef struct sim_scheme {
@@ -95,6 +113,11 @@ struct fcm_integrator {
   int bcon_active;        /* how many are */
   double bc_time;         /* time their motions are evaluated at */
   int bc_psd_only;        /* 1: their tangent is the PSD penalty part (Newton's retry) */
+  sim_contact *contacts;  /* contact obstacles (contact.c) */
+  int num_contacts;
+  sim_cpoints cp;
+  long long contact_filtered;  /* Newton steps the contact filter shortened (cumulative) */
+  long long contact_pullbacks; /* substep guesses pulled back in front of an obstacle */
 
   /* state */
   double *u, *v;
@@ -306,6 +329,31 @@ void fcm__sim_boundary_free(fcm_integrator *I);
 int fcm__sim_boundary_time(fcm_integrator *I, double t);
 fcm_status fcm__sim_boundary_assemble(fcm_integrator *I, const double *x, int projected,
                                       double *energy, double *force, fcm_csr *T, int *finite);
+
+/* Add the element matrix Ke (3nn x 3nn) of the element at local position le into the values
+ * of the pattern (a matrix over the space's rows, fcm__space_matrix_create_rows()).
+ * (nitsche.c) */
+void fcm__sim_scatter(const fcm_space *s, fcm_index le, const double *Ke, double *vals);
+/* FCM_ERR_ARG (named after `who`) unless T (may be NULL) has the space's matrix pattern.
+ * (nitsche.c) */
+fcm_status fcm__sim_check_pattern(const fcm_integrator *I, const fcm_csr *T, const char *who);
+
+/* Contact obstacles (contact.c). setup: the embedded surface's points and the defaults of
+ * the barrier parameters, refusing a start in penetration; free. assemble: the barrier's
+ * energy, force and tangent at x and time I->bc_time added to *energy, force and T (each may
+ * be NULL); *finite = 0 when a point lies on or behind an obstacle. step_bound: the largest
+ * fraction in (0, 1] of the step x + alpha dx keeping every point at positive distance,
+ * scaled by the safety factor (1 when nothing limits it). check: FCM_ERR_ARG naming the
+ * first point on or behind an obstacle at x and time t. */
+fcm_status fcm__sim_contact_setup(fcm_integrator *I);
+void fcm__sim_contact_free(fcm_integrator *I);
+void fcm__sim_contact_assemble(fcm_integrator *I, const double *x, double *energy, double *force,
+                               fcm_csr *T, int *finite);
+double fcm__sim_contact_step_bound(const fcm_integrator *I, const double *x, const double *dx);
+/* A substep's first guess u behind an obstacle: pulled back to un + 0.9 alpha (u - un), alpha
+ * the step bound from un (w1 holds u - un afterwards). */
+void fcm__sim_contact_pull_back(fcm_integrator *I);
+fcm_status fcm__sim_contact_check(const fcm_integrator *I, const double *x, double t);
 
 /* Time schemes (scheme.c). Options: FCM_ERR_ARG naming the member and its range. */
 fcm_status fcm__sim_scheme_validate(fcm_ctx *ctx, const fcm_integrator_options *o);
