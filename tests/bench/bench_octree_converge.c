@@ -1,4 +1,4 @@
-/* Convergence toward a corner singularity, adaptive against uniform (issue's study): linear
+/* Convergence toward a corner singularity, adaptive against uniform: linear
  * elasticity on the unit cube, Hex8, with the manufactured solution u = c r^alpha (r the
  * distance to the corner 0; alpha = 0.2: grad u ~ r^-0.8), its body force and Dirichlet data on
  * the whole boundary. Uniform grids n = 2..24 against octrees grown from the 2^3 grid by the

@@ -10,28 +10,13 @@
  *              or below the floor; backward Euler: it comes to rest (centre-of-mass velocity
  *              small) and the floor's reaction is m g within 3 %; Newmark: it bounces (the
  *              centre of mass moves up after the impact) */
+#include "sim_util.h"
 #include "fcm/fcm.h"
 #include "test.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-typedef struct problem {
-  fcm_ctx *ctx;
-  fcm_mesh *mesh;
-  fcm_geometry *geom;
-  fcm_cell_rules *rules;
-  fcm_space *space;
-} problem;
-
-static void problem_free(problem *p)
-{
-  fcm_space_destroy(&p->space);
-  fcm_cell_rules_destroy(&p->rules);
-  fcm_geometry_destroy(&p->geom);
-  fcm_mesh_destroy(&p->mesh);
-}
 
 /* A ball of radius r at c on a box mesh of nc^3 Hex8 cells over [0, 1]^3. */
 static fcm_status ball_build(problem *p, const double c[3], double r, fcm_index nc)

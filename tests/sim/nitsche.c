@@ -15,6 +15,7 @@
  *                    Schwarz) agree,
  *                    static and dynamic; the clamp holds (|u| small on the cap)
  *   errors           bad options and a region selecting nothing are named */
+#include "sim_util.h"
 #include "fcm/fcm.h"
 #include "test.h"
 
@@ -22,22 +23,6 @@
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
-
-typedef struct problem {
-  fcm_ctx *ctx;
-  fcm_mesh *mesh;
-  fcm_geometry *geom;
-  fcm_cell_rules *rules;
-  fcm_space *space;
-} problem;
-
-static void problem_free(problem *p)
-{
-  fcm_space_destroy(&p->space);
-  fcm_cell_rules_destroy(&p->rules);
-  fcm_geometry_destroy(&p->geom);
-  fcm_mesh_destroy(&p->mesh);
-}
 
 static fcm_status problem_build(problem *p, fcm_element_type type, const fcm_index cells[3],
                                 const double mlo[3], const double mhi[3], fcm_geometry *geom,

@@ -68,4 +68,22 @@ static inline void newton_log_fn(void *user, const fcm_newton_event *ev)
   }
 }
 
+/* An embedded problem: the mesh, the geometry, its cell rules and the space (owned; freed by
+ * problem_free() in reverse order; NULL members are skipped). */
+typedef struct problem {
+  fcm_ctx *ctx;
+  fcm_mesh *mesh;
+  fcm_geometry *geom;
+  fcm_cell_rules *rules;
+  fcm_space *space;
+} problem;
+
+static inline void problem_free(problem *p)
+{
+  fcm_space_destroy(&p->space);
+  fcm_cell_rules_destroy(&p->rules);
+  fcm_geometry_destroy(&p->geom);
+  fcm_mesh_destroy(&p->mesh);
+}
+
 #endif
