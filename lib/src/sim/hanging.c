@@ -18,6 +18,23 @@
 
 #include <string.h>
 
+static const char *precond_name(fcm_preconditioner p)
+{
+  switch (p) {
+  case FCM_PRECOND_NONE:
+    return "FCM_PRECOND_NONE";
+  case FCM_PRECOND_JACOBI:
+    return "FCM_PRECOND_JACOBI";
+  case FCM_PRECOND_BLOCK_JACOBI:
+    return "FCM_PRECOND_BLOCK_JACOBI";
+  case FCM_PRECOND_SCHWARZ:
+    return "FCM_PRECOND_SCHWARZ";
+  case FCM_PRECOND_MULTIGRID:
+    return "FCM_PRECOND_MULTIGRID";
+  }
+  return "(unknown)";
+}
+
 fcm_status fcm__sim_hanging_setup(fcm_integrator *I)
 {
   fcm_status st = FCM_OK;
@@ -41,10 +58,10 @@ fcm_status fcm__sim_hanging_setup(fcm_integrator *I)
                 o->preconditioner == FCM_PRECOND_JACOBI,
             ctx, FCM_ERR_UNSUPPORTED,
             "integrator: the space's mesh is an octree with %lld hanging (cell, node) pairs; "
-            "preconditioner %d works on the space's nodes and cells as they are (block Jacobi, "
+            "preconditioner %s works on the space's nodes and cells as they are (block Jacobi, "
             "Schwarz and multigrid are not available there yet): use FCM_PRECOND_JACOBI or "
             "FCM_PRECOND_NONE, or the direct solver",
-            (long long)nh, (int)o->preconditioner);
+            (long long)nh, precond_name(o->preconditioner));
   FCM_ALLOC(ctx, n, free_dof);
   FCM_TRY(ctx, fcm_space_hanging_matrix_create(I->space, free_dof, &T));
   fcm_index nfree = 0, nnz = 0;
