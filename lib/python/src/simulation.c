@@ -1,0 +1,850 @@
+/* fcm's Python binding: spaces, integrators (a host-owned time loop, cuts between steps,
+ * boundary constraints selected by a Python callable), embedded surfaces, scenes and their
+ * simulations (a Python monitor after each step). */
+#include "fcmpy.h"
+
+#define IO(member) offsetof(fcm_integrator_options, member)
+static const fcmpy_option integrator_table[] = {
+    {"kind", 'i', 1, IO(kind)},
+    {"scheme", 'i', 1, IO(scheme)},
+    {"hht_alpha", 'd', 1, IO(hht_alpha)},
+    {"rho_inf", 'd', 1, IO(rho_inf)},
+    {"dt", 'd', 1, IO(dt)},
+    {"load_steps", 'i', 1, IO(load_steps)},
+    {"max_halvings", 'i', 1, IO(max_halvings)},
+    {"newton_max_iterations", 'i', 1, IO(newton_max_iterations)},
+    {"tolerance_mode", 'i', 1, IO(tolerance_mode)},
+    {"newton_tolerance", 'd', 1, IO(newton_tolerance)},
+    {"newton_atol", 'd', 1, IO(newton_atol)},
+    {"rep_acceleration", 'd', 1, IO(rep_acceleration)},
+    {"line_search", 'i', 1, IO(line_search)},
+    {"armijo", 'd', 1, IO(armijo)},
+    {"backtrack", 'd', 1, IO(backtrack)},
+    {"max_backtracks", 'i', 1, IO(max_backtracks)},
+    {"project_psd", 'i', 1, IO(project_psd)},
+    {"reuse_factorization", 'i', 1, IO(reuse_factorization)},
+    {"reuse_contraction", 'd', 1, IO(reuse_contraction)},
+    {"newton_fixed_iterations", 'i', 1, IO(newton_fixed_iterations)},
+    {"cut_reuse", 'i', 1, IO(cut_reuse)},
+    {"linear_solver", 'i', 1, IO(linear_solver)},
+    {"direct_method", 'i', 1, IO(direct_method)},
+    {"preconditioner", 'i', 1, IO(preconditioner)},
+    {"preconditioner_tangent", 'i', 1, IO(preconditioner_tangent)},
+    {"krylov_rtol", 'd', 1, IO(krylov_rtol)},
+    {"krylov_atol", 'd', 1, IO(krylov_atol)},
+    {"krylov_max_iterations", 'i', 1, IO(krylov_max_iterations)},
+    {"multigrid_fixed_cycles", 'i', 1, IO(multigrid_fixed_cycles)},
+    {"krylov_stagnation_window", 'i', 1, IO(krylov_stagnation_window)},
+    {"schwarz_theta", 'd', 1, IO(schwarz_theta)},
+    {"rayleigh_mass", 'd', 1, IO(rayleigh_mass)},
+    {"rayleigh_stiffness", 'd', 1, IO(rayleigh_stiffness)},
+    {NULL, 0, 0, 0}};
+#undef IO
+
+/* long long and fcm_index are both 64-bit integers: 'n'. */
+#define SI(member) offsetof(fcm_step_info, member)
+static const fcmpy_option step_table[] = {
+    {"reason", 'i', 1, SI(reason)},
+    {"newton_iterations", 'i', 1, SI(newton_iterations)},
+    {"line_search_backtracks", 'i', 1, SI(line_search_backtracks)},
+    {"linear_iterations", 'n', 1, SI(linear_iterations)},
+    {"multigrid_cycles", 'n', 1, SI(multigrid_cycles)},
+    {"residual", 'd', 1, SI(residual)},
+    {"tolerance", 'd', 1, SI(tolerance)},
+    {"residual_reference", 'd', 1, SI(residual_reference)},
+    {"dt", 'd', 1, SI(dt)},
+    {"halvings", 'i', 1, SI(halvings)},
+    {"substeps", 'i', 1, SI(substeps)},
+    {"failed_attempts", 'i', 1, SI(failed_attempts)},
+    {"time", 'd', 1, SI(time)},
+    {"kinetic_energy", 'd', 1, SI(kinetic_energy)},
+    {"elastic_energy", 'd', 1, SI(elastic_energy)},
+    {"external_work", 'd', 1, SI(external_work)},
+    {"total_energy", 'd', 1, SI(total_energy)},
+    {"load_work", 'd', 1, SI(load_work)},
+    {"inverted_points", 'n', 1, SI(inverted_points)},
+    {"inverted_cell", 'n', 1, SI(inverted_cell)},
+    {"inverted_position", 'd', 3, SI(inverted_position)},
+    {"inverted_det", 'd', 1, SI(inverted_det)},
+    {"tangent_assemblies", 'i', 1, SI(tangent_assemblies)},
+    {"factorizations", 'i', 1, SI(factorizations)},
+    {"direct_fallbacks", 'i', 1, SI(direct_fallbacks)},
+    {"projection_fallbacks", 'i', 1, SI(projection_fallbacks)},
+    {"reused_factorizations", 'i', 1, SI(reused_factorizations)},
+    {"inexact_solves", 'i', 1, SI(inexact_solves)},
+    {"total_analyses", 'n', 1, SI(total_analyses)},
+    {"total_factorizations", 'n', 1, SI(total_factorizations)},
+    {"total_direct_fallbacks", 'n', 1, SI(total_direct_fallbacks)},
+    {"time_assembly", 'd', 1, SI(time_assembly)},
+    {"time_factor", 'd', 1, SI(time_factor)},
+    {"time_solve", 'd', 1, SI(time_solve)},
+    {"time_total", 'd', 1, SI(time_total)},
+    {NULL, 0, 0, 0}};
+#undef SI
+
+#define MO(member) offsetof(fcm_motion, member)
+static const fcmpy_option motion_table[] = {{"velocity", 'd', 3, MO(velocity)},
+                                            {"center", 'd', 3, MO(center)},
+                                            {"axis", 'd', 3, MO(axis)},
+                                            {"angular_speed", 'd', 1, MO(angular_speed)},
+                                            {"start", 'd', 1, MO(start)},
+                                            {"end", 'd', 1, MO(end)},
+                                            {"release", 'i', 1, MO(release)},
+                                            {"components", 'i', 3, MO(components)},
+                                            {NULL, 0, 0, 0}};
+#undef MO
+
+#define BO(member) offsetof(fcm_boundary_options, member)
+static const fcmpy_option boundary_table[] = {{"method", 'i', 1, BO(method)},
+                                              {"nitsche_safety", 'd', 1, BO(nitsche_safety)},
+                                              {"penalty", 'd', 1, BO(penalty)},
+                                              {NULL, 0, 0, 0}};
+#undef BO
+
+/* A new handle of `kind` made in the context of `parent` from the handles `deps`. */
+static PyObject *made(fcm_status st, fcmpy_handle *parent, fcmpy_kind kind, void *ptr,
+                      PyObject *dep1, PyObject *dep2)
+{
+  if (st != FCM_OK) return fcmpy_raise(parent->ctx, st);
+  PyObject *ctx_h =
+      parent->kind == FCMPY_CTX ? (PyObject *)parent : PyList_GET_ITEM(parent->keep, 0);
+  PyObject *deps[3] = {ctx_h, dep1, dep2};
+  return fcmpy_handle_new(kind, ptr, parent->ctx, deps, 3);
+}
+
+/* A DOF vector of `n` doubles (a copy when it is not one already). */
+static PyArrayObject *dof_vector(PyObject *obj, fcm_index n, const char *what)
+{
+  PyArrayObject *a = fcmpy_input(obj, NPY_DOUBLE, 1, -1, what);
+  if (a && PyArray_DIM(a, 0) != n) {
+    PyErr_Format(PyExc_ValueError, "%s: expected %lld values (the space's DOFs), got %zd", what,
+                 (long long)n, (Py_ssize_t)PyArray_DIM(a, 0));
+    Py_CLEAR(a);
+  }
+  return a;
+}
+
+/* ---------------------------------------------------------------- spaces */
+
+static PyObject *space_create(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *ch, *mh, *rh;
+  if (!PyArg_ParseTuple(args, "OOO", &ch, &mh, &rh)) return NULL;
+  fcmpy_handle *c = fcmpy_handle_of(ch, FCMPY_CTX);
+  fcmpy_handle *m = c ? fcmpy_handle_of(mh, FCMPY_MESH) : NULL;
+  if (!m) return NULL;
+  fcm_space *space = NULL;
+  fcm_status st;
+  if (rh == Py_None) {
+    st = fcm_space_create(c->ptr, m->ptr, NULL, &space);
+  } else {
+    fcmpy_handle *r = fcmpy_handle_of(rh, FCMPY_RULES);
+    if (!r) return NULL;
+    st = fcm_space_create_embedded(c->ptr, m->ptr, r->ptr, &space);
+  }
+  return made(st, c, FCMPY_SPACE, space, mh, rh == Py_None ? NULL : rh);
+}
+
+static PyObject *space_info(PyObject *self, PyObject *sh)
+{
+  (void)self;
+  const fcm_space *s = fcmpy_get(sh, FCMPY_SPACE);
+  if (!s) return NULL;
+  return Py_BuildValue("{s:L,s:L,s:L,s:i,s:L}", "num_dofs", (long long)fcm_space_num_dofs(s),
+                       "num_elements", (long long)fcm_space_num_elements(s), "num_bodies",
+                       (long long)fcm_space_num_bodies(s), "num_colors", fcm_space_num_colors(s),
+                       "num_nodes", (long long)fcm_mesh_num_nodes(fcm_space_mesh(s)));
+}
+
+static PyObject *space_node_field(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *sh, *u_o;
+  if (!PyArg_ParseTuple(args, "OO", &sh, &u_o)) return NULL;
+  fcmpy_handle *h = fcmpy_handle_of(sh, FCMPY_SPACE);
+  PyArrayObject *u = h ? dof_vector(u_o, fcm_space_num_dofs(h->ptr), "dofs") : NULL;
+  if (!u) return NULL;
+  npy_intp dims[2] = {fcm_mesh_num_nodes(fcm_space_mesh(h->ptr)), 3};
+  PyObject *out = PyArray_SimpleNew(2, dims, NPY_DOUBLE);
+  fcm_status st =
+      out ? fcm_space_node_field(h->ptr, PyArray_DATA(u), PyArray_DATA((PyArrayObject *)out))
+          : FCM_ERR_ALLOC;
+  Py_DECREF(u);
+  if (!out) return NULL;
+  if (st != FCM_OK) {
+    Py_DECREF(out);
+    return fcmpy_raise(h->ctx, st);
+  }
+  return out;
+}
+
+static PyObject *space_cell_stress(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *sh, *mat_o, *u_o;
+  fcm_material mat;
+  if (!PyArg_ParseTuple(args, "OOO", &sh, &mat_o, &u_o) || fcmpy_material(mat_o, &mat) < 0)
+    return NULL;
+  fcmpy_handle *h = fcmpy_handle_of(sh, FCMPY_SPACE);
+  PyArrayObject *u = h ? dof_vector(u_o, fcm_space_num_dofs(h->ptr), "u") : NULL;
+  if (!u) return NULL;
+  const fcm_index nc = fcm_mesh_num_cells(fcm_space_mesh(h->ptr));
+  npy_intp d2[2] = {nc, 6}, d1[1] = {nc};
+  PyObject *s = PyArray_SimpleNew(2, d2, NPY_DOUBLE), *vm = PyArray_SimpleNew(1, d1, NPY_DOUBLE);
+  PyObject *e = PyArray_SimpleNew(1, d1, NPY_DOUBLE);
+  fcm_status st = FCM_ERR_ALLOC;
+  if (s && vm && e)
+    st = fcm_space_cell_stress(h->ptr, &mat, PyArray_DATA(u), PyArray_DATA((PyArrayObject *)s),
+                               PyArray_DATA((PyArrayObject *)vm), PyArray_DATA((PyArrayObject *)e));
+  Py_DECREF(u);
+  if (st != FCM_OK) {
+    Py_XDECREF(s);
+    Py_XDECREF(vm);
+    Py_XDECREF(e);
+    return s && vm && e ? fcmpy_raise(h->ctx, st) : NULL;
+  }
+  return Py_BuildValue("NNN", s, vm, e);
+}
+
+static PyObject *space_momentum(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *sh, *u_o, *v_o;
+  double rho, mass = 0, p[3], L[3];
+  if (!PyArg_ParseTuple(args, "OdOO", &sh, &rho, &u_o, &v_o)) return NULL;
+  fcmpy_handle *h = fcmpy_handle_of(sh, FCMPY_SPACE);
+  const fcm_index n = h ? fcm_space_num_dofs(h->ptr) : 0;
+  PyArrayObject *u = h ? dof_vector(u_o, n, "u") : NULL;
+  PyArrayObject *v = u ? dof_vector(v_o, n, "v") : NULL;
+  if (!v) {
+    Py_XDECREF(u);
+    return NULL;
+  }
+  fcm_status st = fcm_space_momentum(h->ptr, rho, PyArray_DATA(u), PyArray_DATA(v), &mass, p, L);
+  Py_DECREF(u);
+  Py_DECREF(v);
+  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
+  return Py_BuildValue("d(ddd)(ddd)", mass, p[0], p[1], p[2], L[0], L[1], L[2]);
+}
+
+static PyObject *space_max_displacement(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *sh, *u_o;
+  double m = 0;
+  if (!PyArg_ParseTuple(args, "OO", &sh, &u_o)) return NULL;
+  fcmpy_handle *h = fcmpy_handle_of(sh, FCMPY_SPACE);
+  PyArrayObject *u = h ? dof_vector(u_o, fcm_space_num_dofs(h->ptr), "u") : NULL;
+  if (!u) return NULL;
+  fcm_status st = fcm_space_max_displacement(h->ptr, PyArray_DATA(u), &m);
+  Py_DECREF(u);
+  return st == FCM_OK ? PyFloat_FromDouble(m) : fcmpy_raise(h->ctx, st);
+}
+
+static PyObject *space_write_vtu(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *sh, *mat_o, *u_o, *v_o;
+  const char *path;
+  fcm_material mat;
+  if (!PyArg_ParseTuple(args, "OOOOs", &sh, &mat_o, &u_o, &v_o, &path) ||
+      fcmpy_material(mat_o, &mat) < 0)
+    return NULL;
+  fcmpy_handle *h = fcmpy_handle_of(sh, FCMPY_SPACE);
+  const fcm_index n = h ? fcm_space_num_dofs(h->ptr) : 0;
+  PyArrayObject *u = h ? dof_vector(u_o, n, "u") : NULL;
+  PyArrayObject *v = u && v_o != Py_None ? dof_vector(v_o, n, "v") : NULL;
+  if (!u || (v_o != Py_None && !v)) {
+    Py_XDECREF(u);
+    return NULL;
+  }
+  fcm_status st =
+      fcm_space_write_vtu(h->ptr, &mat, PyArray_DATA(u), v ? PyArray_DATA(v) : NULL, path);
+  Py_DECREF(u);
+  Py_XDECREF(v);
+  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
+  Py_RETURN_NONE;
+}
+
+static PyObject *space_transfer(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *fh, *th, *x_o;
+  if (!PyArg_ParseTuple(args, "OOO", &fh, &th, &x_o)) return NULL;
+  fcmpy_handle *from = fcmpy_handle_of(fh, FCMPY_SPACE);
+  fcmpy_handle *to = from ? fcmpy_handle_of(th, FCMPY_SPACE) : NULL;
+  PyArrayObject *x = to ? dof_vector(x_o, fcm_space_num_dofs(from->ptr), "x") : NULL;
+  if (!x) return NULL;
+  npy_intp dims[1] = {fcm_space_num_dofs(to->ptr)};
+  PyObject *out = PyArray_SimpleNew(1, dims, NPY_DOUBLE);
+  fcm_status st = out ? fcm_space_transfer(from->ptr, to->ptr, PyArray_DATA(x),
+                                           PyArray_DATA((PyArrayObject *)out))
+                      : FCM_ERR_ALLOC;
+  Py_DECREF(x);
+  if (!out) return NULL;
+  if (st != FCM_OK) {
+    Py_DECREF(out);
+    return fcmpy_raise(from->ctx, st);
+  }
+  return out;
+}
+
+/* ---------------------------------------------------------------- integrators */
+
+static PyObject *integrator_defaults(PyObject *self, PyObject *noargs)
+{
+  (void)self;
+  (void)noargs;
+  const fcm_integrator_options o = fcm_integrator_options_default();
+  return fcmpy_options_dict(integrator_table, &o);
+}
+
+static PyObject *integrator_create(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *ch, *sh, *mat_o, *opts_o;
+  fcm_material mat;
+  fcm_integrator_options o = fcm_integrator_options_default();
+  if (!PyArg_ParseTuple(args, "OOOO", &ch, &sh, &mat_o, &opts_o) ||
+      fcmpy_material(mat_o, &mat) < 0 ||
+      fcmpy_set_options(integrator_table, &o, opts_o, "Integrator") < 0)
+    return NULL;
+  fcmpy_handle *c = fcmpy_handle_of(ch, FCMPY_CTX);
+  fcmpy_handle *s = c ? fcmpy_handle_of(sh, FCMPY_SPACE) : NULL;
+  if (!s) return NULL;
+  fcm_integrator *integ = NULL;
+  fcm_status st = fcm_integrator_create(c->ptr, s->ptr, &mat, &o, &integ);
+  return made(st, c, FCMPY_INTEGRATOR, integ, sh, NULL);
+}
+
+static PyObject *integrator_create_cut(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *ih, *sh;
+  if (!PyArg_ParseTuple(args, "OO", &ih, &sh)) return NULL;
+  fcmpy_handle *old = fcmpy_handle_of(ih, FCMPY_INTEGRATOR);
+  fcmpy_handle *s = old ? fcmpy_handle_of(sh, FCMPY_SPACE) : NULL;
+  if (!s) return NULL;
+  fcm_integrator *integ = NULL;
+  fcm_status st = fcm_integrator_create_cut(old->ptr, s->ptr, &integ);
+  PyObject *h = made(st, old, FCMPY_INTEGRATOR, integ, sh, NULL);
+  /* the new integrator calls the old one's boundary selectors: it keeps them */
+  for (Py_ssize_t i = 0; h && i < PyList_GET_SIZE(old->keep); i++) {
+    PyObject *o = PyList_GET_ITEM(old->keep, i);
+    if (PyCapsule_CheckExact(o) && fcmpy_keep(h, o) < 0) Py_CLEAR(h);
+  }
+  return h;
+}
+
+static PyObject *integrator_add_gravity(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *ih, *g_o;
+  double g[3];
+  if (!PyArg_ParseTuple(args, "OO", &ih, &g_o)) return NULL;
+  fcmpy_handle *h = fcmpy_handle_of(ih, FCMPY_INTEGRATOR);
+  if (!h || fcmpy_vec(g_o, g, 3, "acceleration") < 0) return NULL;
+  fcm_status st = fcm_integrator_add_gravity(h->ptr, g, NULL, NULL);
+  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
+  Py_RETURN_NONE;
+}
+
+static PyObject *integrator_add_constraint(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *ih, *nodes_o, *motion_o;
+  fcm_motion motion = fcm_motion_default();
+  if (!PyArg_ParseTuple(args, "OOO", &ih, &nodes_o, &motion_o)) return NULL;
+  fcmpy_handle *h = fcmpy_handle_of(ih, FCMPY_INTEGRATOR);
+  if (!h || fcmpy_set_options(motion_table, &motion, motion_o, "motion") < 0) return NULL;
+  PyArrayObject *nodes = fcmpy_input(nodes_o, NPY_INT64, 1, -1, "nodes");
+  if (!nodes) return NULL;
+  int id = -1;
+  fcm_status st = fcm_integrator_add_constraint(h->ptr, PyArray_DIM(nodes, 0), PyArray_DATA(nodes),
+                                                &motion, &id);
+  Py_DECREF(nodes);
+  return st == FCM_OK ? PyLong_FromLong(id) : fcmpy_raise(h->ctx, st);
+}
+
+/* The Python selector of boundary points: called with X and the normal (float64 arrays of
+ * shape (3,)); truthy selects. After an exception it selects nothing more and the setup
+ * raises it. */
+static int boundary_select(void *user, const double X[3], const double normal[3])
+{
+  fcmpy_callback *cb = user;
+  PyGILState_STATE gil = PyGILState_Ensure();
+  int r = 0;
+  if (!cb->type) {
+    npy_intp dims[1] = {3};
+    PyObject *x = fcmpy_copy(X, NPY_DOUBLE, 1, dims), *n = fcmpy_copy(normal, NPY_DOUBLE, 1, dims);
+    PyObject *v = x && n ? PyObject_CallFunctionObjArgs(cb->fn, x, n, NULL) : NULL;
+    r = v ? PyObject_IsTrue(v) : -1;
+    Py_XDECREF(x);
+    Py_XDECREF(n);
+    Py_XDECREF(v);
+    if (r < 0) {
+      fcmpy_callback_fail(cb);
+      r = 0;
+    }
+  }
+  PyGILState_Release(gil);
+  return r;
+}
+
+static PyObject *integrator_add_boundary_constraint(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *ih, *fn, *motion_o, *opts_o, *capsule = NULL;
+  fcm_motion motion = fcm_motion_default();
+  fcm_boundary_options bo = fcm_boundary_options_default();
+  if (!PyArg_ParseTuple(args, "OOOO", &ih, &fn, &motion_o, &opts_o)) return NULL;
+  fcmpy_handle *h = fcmpy_handle_of(ih, FCMPY_INTEGRATOR);
+  if (!h || fcmpy_set_options(motion_table, &motion, motion_o, "motion") < 0 ||
+      fcmpy_set_options(boundary_table, &bo, opts_o, "boundary options") < 0)
+    return NULL;
+  fcmpy_callback *cb = fcmpy_callback_new(fn, &capsule);
+  if (!cb) return NULL;
+  int rc = fcmpy_keep((PyObject *)h, capsule);
+  Py_DECREF(capsule); /* the integrator's list keeps it */
+  if (rc < 0) return NULL;
+  int id = -1;
+  fcm_status st =
+      fcm_integrator_add_boundary_constraint(h->ptr, boundary_select, cb, &motion, &bo, &id);
+  return st == FCM_OK ? PyLong_FromLong(id) : fcmpy_raise(h->ctx, st);
+}
+
+/* Call the integrator, the GIL released (a boundary selector may run on any thread); a
+ * selector's exception is raised in place of the library's error. */
+static PyObject *integrator_call(fcmpy_handle *h, fcm_status st)
+{
+  if (fcmpy_callbacks_restore(h->keep)) {
+    fcm_ctx_error_clear(h->ctx);
+    return NULL;
+  }
+  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
+  Py_RETURN_NONE;
+}
+
+static PyObject *integrator_setup(PyObject *self, PyObject *ih)
+{
+  (void)self;
+  fcmpy_handle *h = fcmpy_handle_of(ih, FCMPY_INTEGRATOR);
+  if (!h) return NULL;
+  fcm_status st;
+  Py_BEGIN_ALLOW_THREADS st = fcm_integrator_setup(h->ptr);
+  Py_END_ALLOW_THREADS return integrator_call(h, st);
+}
+
+static PyObject *integrator_step(PyObject *self, PyObject *ih)
+{
+  (void)self;
+  fcmpy_handle *h = fcmpy_handle_of(ih, FCMPY_INTEGRATOR);
+  if (!h) return NULL;
+  fcm_step_info info;
+  fcm_status st;
+  memset(&info, 0, sizeof info);
+  Py_BEGIN_ALLOW_THREADS st = fcm_integrator_step(h->ptr, &info);
+  Py_END_ALLOW_THREADS PyObject *r = integrator_call(h, st);
+  if (!r) return NULL;
+  Py_DECREF(r);
+  return fcmpy_options_dict(step_table, &info);
+}
+
+/* (u, v, t, steps): copies (the integrator overwrites its state every step). */
+static PyObject *integrator_state(PyObject *self, PyObject *ih)
+{
+  (void)self;
+  fcmpy_handle *h = fcmpy_handle_of(ih, FCMPY_INTEGRATOR);
+  if (!h) return NULL;
+  npy_intp dims[1] = {fcm_integrator_num_dofs(h->ptr)};
+  PyObject *u = PyArray_SimpleNew(1, dims, NPY_DOUBLE), *v = PyArray_SimpleNew(1, dims, NPY_DOUBLE);
+  if (!u || !v) {
+    Py_XDECREF(u);
+    Py_XDECREF(v);
+    return NULL;
+  }
+  double t = 0;
+  long long steps = 0;
+  fcm_integrator_get_state(h->ptr, PyArray_DATA((PyArrayObject *)u),
+                           PyArray_DATA((PyArrayObject *)v), &t, &steps);
+  return Py_BuildValue("NNdL", u, v, t, steps);
+}
+
+static PyObject *integrator_set_state(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *ih, *u_o, *v_o;
+  double t;
+  long long steps;
+  if (!PyArg_ParseTuple(args, "OOOdL", &ih, &u_o, &v_o, &t, &steps)) return NULL;
+  fcmpy_handle *h = fcmpy_handle_of(ih, FCMPY_INTEGRATOR);
+  const fcm_index n = h ? fcm_integrator_num_dofs(h->ptr) : 0;
+  PyArrayObject *u = h ? dof_vector(u_o, n, "u") : NULL;
+  PyArrayObject *v = u ? dof_vector(v_o, n, "v") : NULL;
+  if (!v) {
+    Py_XDECREF(u);
+    return NULL;
+  }
+  fcm_status st = fcm_integrator_set_state(h->ptr, PyArray_DATA(u), PyArray_DATA(v), t, steps);
+  Py_DECREF(u);
+  Py_DECREF(v);
+  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
+  Py_RETURN_NONE;
+}
+
+static PyObject *integrator_reaction(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *ih;
+  int id, boundary;
+  double f[3], m[3];
+  if (!PyArg_ParseTuple(args, "Oip", &ih, &id, &boundary)) return NULL;
+  fcmpy_handle *h = fcmpy_handle_of(ih, FCMPY_INTEGRATOR);
+  if (!h) return NULL;
+  fcm_status st = boundary ? fcm_integrator_boundary_reaction(h->ptr, id, f, m)
+                           : fcm_integrator_reaction(h->ptr, id, f, m);
+  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
+  return Py_BuildValue("(ddd)(ddd)", f[0], f[1], f[2], m[0], m[1], m[2]);
+}
+
+static PyObject *integrator_energy(PyObject *self, PyObject *ih)
+{
+  (void)self;
+  fcmpy_handle *h = fcmpy_handle_of(ih, FCMPY_INTEGRATOR);
+  double k = 0, e = 0, w = 0, p[3], L[3];
+  if (!h) return NULL;
+  fcm_status st = fcm_integrator_energy(h->ptr, &k, &e, &w);
+  if (st == FCM_OK) st = fcm_integrator_momentum(h->ptr, p, L);
+  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
+  return Py_BuildValue("{s:d,s:d,s:d,s:(ddd),s:(ddd),s:d,s:L}", "kinetic", k, "elastic", e,
+                       "external_work", w, "linear_momentum", p[0], p[1], p[2], "angular_momentum",
+                       L[0], L[1], L[2], "time", fcm_integrator_time(h->ptr), "step_count",
+                       fcm_integrator_step_count(h->ptr));
+}
+
+/* ---------------------------------------------------------------- embedded surfaces */
+
+static PyObject *esurf_create(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *sh, *gh;
+  if (!PyArg_ParseTuple(args, "OO", &sh, &gh)) return NULL;
+  fcmpy_handle *s = fcmpy_handle_of(sh, FCMPY_SPACE);
+  const fcm_geometry *g = s ? fcmpy_get(gh, FCMPY_GEOMETRY) : NULL;
+  if (!g) return NULL;
+  fcm_embedded_surface *es = NULL;
+  fcm_status st = fcm_embedded_surface_create(s->ptr, g, &es);
+  return made(st, s, FCMPY_EMBEDDED_SURFACE, es, sh, gh);
+}
+
+static PyObject *esurf_set_space(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *eh, *sh;
+  if (!PyArg_ParseTuple(args, "OO", &eh, &sh)) return NULL;
+  fcmpy_handle *e = fcmpy_handle_of(eh, FCMPY_EMBEDDED_SURFACE);
+  fcmpy_handle *s = e ? fcmpy_handle_of(sh, FCMPY_SPACE) : NULL;
+  if (!s) return NULL;
+  fcm_status st = fcm_embedded_surface_set_space(e->ptr, s->ptr);
+  if (st != FCM_OK) return fcmpy_raise(e->ctx, st);
+  /* depend on the new space instead of the old one */
+  for (Py_ssize_t i = 0; i < PyList_GET_SIZE(e->keep); i++) {
+    PyObject *o = PyList_GET_ITEM(e->keep, i);
+    if (PyObject_TypeCheck(o, &fcmpy_handle_type) && ((fcmpy_handle *)o)->kind == FCMPY_SPACE) {
+      Py_INCREF(o);
+      Py_INCREF(s);
+      s->users++;
+      if (PyList_SetItem(e->keep, i, (PyObject *)s) < 0) { /* steals s */
+        Py_DECREF(o);
+        return NULL;
+      }
+      fcmpy_handle_release_user((fcmpy_handle *)o);
+      Py_DECREF(o);
+      break;
+    }
+  }
+  Py_RETURN_NONE;
+}
+
+static PyObject *esurf_arrays(PyObject *self, PyObject *eh)
+{
+  (void)self;
+  const fcm_embedded_surface *e = fcmpy_get(eh, FCMPY_EMBEDDED_SURFACE);
+  if (!e) return NULL;
+  npy_intp dp[2] = {fcm_embedded_surface_num_points(e), 3};
+  npy_intp dt[2] = {fcm_embedded_surface_num_triangles(e), 3};
+  return Py_BuildValue("NN", fcmpy_view(eh, fcm_embedded_surface_points(e), NPY_DOUBLE, 2, dp),
+                       fcmpy_view(eh, fcm_embedded_surface_triangles(e), NPY_INT64, 2, dt));
+}
+
+static PyObject *esurf_eval(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *eh, *u_o;
+  if (!PyArg_ParseTuple(args, "OO", &eh, &u_o)) return NULL;
+  fcmpy_handle *e = fcmpy_handle_of(eh, FCMPY_EMBEDDED_SURFACE);
+  if (!e) return NULL;
+  PyArrayObject *u = fcmpy_input(u_o, NPY_DOUBLE, 1, -1, "u");
+  if (!u) return NULL;
+  npy_intp dims[2] = {fcm_embedded_surface_num_points(e->ptr), 3};
+  PyObject *d = PyArray_SimpleNew(2, dims, NPY_DOUBLE), *x = PyArray_SimpleNew(2, dims, NPY_DOUBLE);
+  fcm_status st = FCM_ERR_ALLOC;
+  if (d && x)
+    st = fcm_embedded_surface_eval(e->ptr, PyArray_DATA(u), PyArray_DATA((PyArrayObject *)d),
+                                   PyArray_DATA((PyArrayObject *)x));
+  Py_DECREF(u);
+  if (st != FCM_OK) {
+    Py_XDECREF(d);
+    Py_XDECREF(x);
+    return d && x ? fcmpy_raise(e->ctx, st) : NULL;
+  }
+  return Py_BuildValue("NN", d, x);
+}
+
+static PyObject *esurf_write_vtu(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *eh, *mat_o, *u_o;
+  const char *path;
+  fcm_material mat;
+  if (!PyArg_ParseTuple(args, "OOOs", &eh, &mat_o, &u_o, &path) || fcmpy_material(mat_o, &mat) < 0)
+    return NULL;
+  fcmpy_handle *e = fcmpy_handle_of(eh, FCMPY_EMBEDDED_SURFACE);
+  PyArrayObject *u = e ? fcmpy_input(u_o, NPY_DOUBLE, 1, -1, "u") : NULL;
+  if (!u) return NULL;
+  fcm_status st = fcm_embedded_surface_write_vtu(e->ptr, &mat, PyArray_DATA(u), path);
+  Py_DECREF(u);
+  if (st != FCM_OK) return fcmpy_raise(e->ctx, st);
+  Py_RETURN_NONE;
+}
+
+/* ---------------------------------------------------------------- scenes, simulations */
+
+static PyObject *scene_create(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *ch;
+  const char *how, *text = NULL, *name = NULL;
+  if (!PyArg_ParseTuple(args, "Os|zz", &ch, &how, &text, &name)) return NULL;
+  fcmpy_handle *c = fcmpy_handle_of(ch, FCMPY_CTX);
+  if (!c) return NULL;
+  fcm_scene *scene = NULL;
+  fcm_status st;
+  if (!strcmp(how, "file") && text)
+    st = fcm_scene_create_from_file(c->ptr, text, &scene);
+  else if (!strcmp(how, "string") && text)
+    st = fcm_scene_create_from_string(c->ptr, text, name, &scene);
+  else if (!strcmp(how, "default"))
+    st = fcm_scene_create_default(c->ptr, &scene);
+  else
+    return PyErr_Format(PyExc_ValueError, "scene_create: unknown source '%s'", how);
+  return made(st, c, FCMPY_SCENE, scene, NULL, NULL);
+}
+
+static PyObject *scene_info(PyObject *self, PyObject *sh)
+{
+  (void)self;
+  const fcm_scene *s = fcmpy_get(sh, FCMPY_SCENE);
+  if (!s) return NULL;
+  const fcm_material *m = fcm_scene_get_material(s);
+  return Py_BuildValue("{s:s,s:s,s:s,s:s,s:i,s:(iddd)}", "name", fcm_scene_name(s), "description",
+                       fcm_scene_description(s), "source", fcm_scene_source(s), "json",
+                       fcm_scene_json(s), "num_effects", fcm_scene_num_effects(s), "material",
+                       (int)m->model, m->young, m->poisson, m->density);
+}
+
+static PyObject *simulation_create(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *ch, *sh;
+  long long max_steps;
+  if (!PyArg_ParseTuple(args, "OOL", &ch, &sh, &max_steps)) return NULL;
+  fcmpy_handle *c = fcmpy_handle_of(ch, FCMPY_CTX);
+  const fcm_scene *scene = c ? fcmpy_get(sh, FCMPY_SCENE) : NULL;
+  if (!scene) return NULL;
+  fcm_simulation_options o = fcm_simulation_options_default();
+  o.max_steps = (fcm_index)max_steps;
+  fcm_simulation *sim = NULL;
+  fcm_status st;
+  Py_BEGIN_ALLOW_THREADS st = fcm_simulation_create(c->ptr, scene, &o, &sim);
+  Py_END_ALLOW_THREADS return made(st, c, FCMPY_SIMULATION, sim, sh, NULL);
+}
+
+static PyObject *simulation_step(PyObject *self, PyObject *simh)
+{
+  (void)self;
+  fcmpy_handle *h = fcmpy_handle_of(simh, FCMPY_SIMULATION);
+  if (!h) return NULL;
+  fcm_step_info info;
+  fcm_status st;
+  memset(&info, 0, sizeof info);
+  Py_BEGIN_ALLOW_THREADS st = fcm_simulation_step(h->ptr, &info);
+  Py_END_ALLOW_THREADS if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
+  return fcmpy_options_dict(step_table, &info);
+}
+
+/* The monitor of fcm_simulation_run(): the Python callable gets (step, num_steps, info);
+ * False stops the run (FCM_OK returned: a host's own choice), an exception too (raised). */
+typedef struct monitor_state {
+  fcmpy_callback *cb;
+  int stopped;
+} monitor_state;
+
+static fcm_status run_monitor(void *user, fcm_simulation *sim, const fcm_simulation_step_event *ev)
+{
+  (void)sim;
+  monitor_state *ms = user;
+  PyGILState_STATE gil = PyGILState_Ensure();
+  PyObject *info = fcmpy_options_dict(step_table, ev->info);
+  PyObject *r =
+      info ? PyObject_CallFunction(ms->cb->fn, "LLO", ev->step, ev->num_steps, info) : NULL;
+  Py_XDECREF(info);
+  fcm_status st = FCM_OK;
+  if (!r) {
+    fcmpy_callback_fail(ms->cb);
+    st = FCM_ERR_INTERNAL;
+  } else if (r == Py_False) {
+    ms->stopped = 1;
+    st = FCM_ERR_INTERNAL;
+  }
+  Py_XDECREF(r);
+  PyGILState_Release(gil);
+  return st;
+}
+
+static PyObject *simulation_run(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *simh, *fn, *capsule = NULL;
+  if (!PyArg_ParseTuple(args, "OO", &simh, &fn)) return NULL;
+  fcmpy_handle *h = fcmpy_handle_of(simh, FCMPY_SIMULATION);
+  if (!h) return NULL;
+  monitor_state ms = {NULL, 0};
+  if (fn != Py_None && !(ms.cb = fcmpy_callback_new(fn, &capsule))) return NULL;
+  fcm_status st;
+  Py_BEGIN_ALLOW_THREADS st = fcm_simulation_run(h->ptr, ms.cb ? run_monitor : NULL, &ms);
+  Py_END_ALLOW_THREADS int raised = fcmpy_callback_restore(ms.cb);
+  Py_XDECREF(capsule);
+  if (raised || ms.stopped) {
+    fcm_ctx_error_clear(h->ctx);
+    if (raised) return NULL;
+    Py_RETURN_FALSE;
+  }
+  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
+  Py_RETURN_TRUE;
+}
+
+static PyObject *simulation_info(PyObject *self, PyObject *simh)
+{
+  (void)self;
+  fcm_simulation *s = fcmpy_get(simh, FCMPY_SIMULATION);
+  if (!s) return NULL;
+  return Py_BuildValue("{s:i,s:L,s:L,s:i,s:i}", "done", fcm_simulation_done(s), "step_count",
+                       fcm_simulation_step_count(s), "num_steps", fcm_simulation_num_steps(s),
+                       "frame_due", fcm_simulation_frame_due(s), "state_finite",
+                       fcm_simulation_state_finite(s));
+}
+
+/* (u, v, t, node displacement (num_nodes, 3)): copies of the current state. */
+static PyObject *simulation_state(PyObject *self, PyObject *simh)
+{
+  (void)self;
+  fcmpy_handle *h = fcmpy_handle_of(simh, FCMPY_SIMULATION);
+  if (!h) return NULL;
+  fcm_integrator *integ = fcm_simulation_integrator(h->ptr);
+  const fcm_space *space = fcm_simulation_space(h->ptr);
+  npy_intp dims[1] = {fcm_integrator_num_dofs(integ)};
+  npy_intp dn[2] = {fcm_mesh_num_nodes(fcm_space_mesh(space)), 3};
+  PyObject *u = PyArray_SimpleNew(1, dims, NPY_DOUBLE), *v = PyArray_SimpleNew(1, dims, NPY_DOUBLE);
+  PyObject *un = PyArray_SimpleNew(2, dn, NPY_DOUBLE);
+  double t = 0;
+  long long steps = 0;
+  fcm_status st = FCM_ERR_ALLOC;
+  if (u && v && un) {
+    fcm_integrator_get_state(integ, PyArray_DATA((PyArrayObject *)u),
+                             PyArray_DATA((PyArrayObject *)v), &t, &steps);
+    st = fcm_space_node_field(space, PyArray_DATA((PyArrayObject *)u),
+                              PyArray_DATA((PyArrayObject *)un));
+  }
+  if (st != FCM_OK) {
+    Py_XDECREF(u);
+    Py_XDECREF(v);
+    Py_XDECREF(un);
+    return u && v && un ? fcmpy_raise(h->ctx, st) : NULL;
+  }
+  return Py_BuildValue("NNdN", u, v, t, un);
+}
+
+static PyObject *simulation_write(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *simh;
+  const char *what, *path;
+  int index = 0;
+  if (!PyArg_ParseTuple(args, "Oss|i", &simh, &what, &path, &index)) return NULL;
+  fcmpy_handle *h = fcmpy_handle_of(simh, FCMPY_SIMULATION);
+  if (!h) return NULL;
+  fcm_status st;
+  if (!strcmp(what, "log"))
+    st = fcm_simulation_write_log(h->ptr, path);
+  else if (!strcmp(what, "frame"))
+    st = fcm_simulation_write_frame(h->ptr, path, index);
+  else if (!strcmp(what, "checkpoint"))
+    st = fcm_simulation_write_checkpoint(h->ptr, path);
+  else if (!strcmp(what, "restore"))
+    st = fcm_simulation_read_checkpoint(h->ptr, path);
+  else
+    return PyErr_Format(PyExc_ValueError, "simulation_write: unknown output '%s'", what);
+  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
+  Py_RETURN_NONE;
+}
+
+static PyObject *simulation_summary(PyObject *self, PyObject *simh)
+{
+  (void)self;
+  const fcm_simulation *s = fcmpy_get(simh, FCMPY_SIMULATION);
+  char *buf;
+  size_t len;
+  FILE *f = s ? fcmpy_stream_open(&buf, &len) : NULL;
+  if (!f) return NULL;
+  fcm_simulation_summary_view(s, f);
+  return fcmpy_stream_close(f, buf, len);
+}
+
+PyMethodDef fcmpy_simulation_methods[] = {
+    {"space_create", space_create, METH_VARARGS, NULL},
+    {"space_info", space_info, METH_O, NULL},
+    {"space_node_field", space_node_field, METH_VARARGS, NULL},
+    {"space_cell_stress", space_cell_stress, METH_VARARGS, NULL},
+    {"space_momentum", space_momentum, METH_VARARGS, NULL},
+    {"space_max_displacement", space_max_displacement, METH_VARARGS, NULL},
+    {"space_write_vtu", space_write_vtu, METH_VARARGS, NULL},
+    {"space_transfer", space_transfer, METH_VARARGS, NULL},
+    {"integrator_defaults", integrator_defaults, METH_NOARGS, NULL},
+    {"integrator_create", integrator_create, METH_VARARGS, NULL},
+    {"integrator_create_cut", integrator_create_cut, METH_VARARGS, NULL},
+    {"integrator_add_gravity", integrator_add_gravity, METH_VARARGS, NULL},
+    {"integrator_add_constraint", integrator_add_constraint, METH_VARARGS, NULL},
+    {"integrator_add_boundary_constraint", integrator_add_boundary_constraint, METH_VARARGS, NULL},
+    {"integrator_setup", integrator_setup, METH_O, NULL},
+    {"integrator_step", integrator_step, METH_O, NULL},
+    {"integrator_state", integrator_state, METH_O, NULL},
+    {"integrator_set_state", integrator_set_state, METH_VARARGS, NULL},
+    {"integrator_reaction", integrator_reaction, METH_VARARGS, NULL},
+    {"integrator_energy", integrator_energy, METH_O, NULL},
+    {"esurf_create", esurf_create, METH_VARARGS, NULL},
+    {"esurf_set_space", esurf_set_space, METH_VARARGS, NULL},
+    {"esurf_arrays", esurf_arrays, METH_O, NULL},
+    {"esurf_eval", esurf_eval, METH_VARARGS, NULL},
+    {"esurf_write_vtu", esurf_write_vtu, METH_VARARGS, NULL},
+    {"scene_create", scene_create, METH_VARARGS, NULL},
+    {"scene_info", scene_info, METH_O, NULL},
+    {"simulation_create", simulation_create, METH_VARARGS, NULL},
+    {"simulation_step", simulation_step, METH_O, NULL},
+    {"simulation_run", simulation_run, METH_VARARGS, NULL},
+    {"simulation_info", simulation_info, METH_O, NULL},
+    {"simulation_state", simulation_state, METH_O, NULL},
+    {"simulation_write", simulation_write, METH_VARARGS, NULL},
+    {"simulation_summary", simulation_summary, METH_O, NULL},
+    {NULL, NULL, 0, NULL}};
