@@ -110,7 +110,8 @@ class FcmObject:
         return False
 
     def __repr__(self):
-        state = " closed" if self._h.closed else ""
+        h = getattr(self, "_h", None)
+        state = " closed" if h is None or h.closed else ""
         return f"<fcm.{type(self).__name__}{state}>"
 
 

@@ -27,45 +27,45 @@ class Geometry(FcmObject):
     @classmethod
     def from_arrays(cls, ctx, element_type, coords, cells):
         """A geometry of TET4 or HEX8 cells from caller arrays (copied)."""
-        return cls(_fcm.geometry_create(ctx._h, int(element_type), coords, cells))
+        return cls(_fcm.geometry_create(ctx, int(element_type), coords, cells))
 
     @classmethod
     def box(cls, ctx, lo, hi, n):
         """The box [lo, hi] as n[0] x n[1] x n[2] cubes of 6 tets each."""
-        return cls(_fcm.geometry_shape(ctx._h, "box", lo, hi, n))
+        return cls(_fcm.geometry_shape(ctx, "box", lo, hi, n))
 
     @classmethod
     def ball(cls, ctx, center, radius, n):
         """A ball (48 n^3 tets; n cubes per radius), volume converging like O(n^-2)."""
-        return cls(_fcm.geometry_shape(ctx._h, "ball", center, float(radius), int(n)))
+        return cls(_fcm.geometry_shape(ctx, "ball", center, float(radius), int(n)))
 
     @classmethod
     def hemisphere(cls, ctx, center, radius, n):
         """The half y >= center[1] of :meth:`ball`, its flat face exactly on that plane."""
-        return cls(_fcm.geometry_shape(ctx._h, "hemisphere", center, float(radius), int(n)))
+        return cls(_fcm.geometry_shape(ctx, "hemisphere", center, float(radius), int(n)))
 
     @classmethod
     def hollow_ball(cls, ctx, center, r_in, r_out, hole_radius, n, layers):
         """A hollow ball r_in <= r <= r_out with three axis holes (0: none)."""
-        return cls(_fcm.geometry_shape(ctx._h, "hollow_ball", center, float(r_in),
+        return cls(_fcm.geometry_shape(ctx, "hollow_ball", center, float(r_in),
                                        float(r_out), float(hole_radius), int(n), int(layers)))
 
     @classmethod
     def tube(cls, ctx, center, axis, r_in, r_out, length, n_r, n_theta, n_axial):
         """A tube r_in <= r <= r_out around axis (0, 1, 2) through center."""
-        return cls(_fcm.geometry_shape(ctx._h, "tube", center, int(axis), float(r_in),
+        return cls(_fcm.geometry_shape(ctx, "tube", center, int(axis), float(r_in),
                                        float(r_out), float(length), int(n_r), int(n_theta),
                                        int(n_axial)))
 
     @classmethod
     def from_gmsh(cls, ctx, path):
         """Read a Gmsh MSH file of tet4 or hex8 cells."""
-        return cls(_fcm.geometry_from_files(ctx._h, str(path)))
+        return cls(_fcm.geometry_from_files(ctx, str(path)))
 
     @classmethod
     def from_tetgen(cls, ctx, node_path, ele_path):
         """Read a TetGen mesh (.node and .ele files)."""
-        return cls(_fcm.geometry_from_files(ctx._h, str(node_path), str(ele_path)))
+        return cls(_fcm.geometry_from_files(ctx, str(node_path), str(ele_path)))
 
     @classmethod
     def from_level_set(cls, ctx, phi, lo, hi, n, **options):
@@ -77,14 +77,14 @@ class Geometry(FcmObject):
         estimate_error (1), refine_inside (0), max_subcells. The build's report (volume,
         error estimate, counts) is in ``.info``.
         """
-        handle, info = _fcm.geometry_from_level_set(ctx._h, phi, lo, hi, n, options)
+        handle, info = _fcm.geometry_from_level_set(ctx, phi, lo, hi, n, options)
         return cls(handle, info)
 
     @classmethod
     def from_voxels(cls, image, threshold=0.5, labels=None, merge=True):
         """The selected voxels of a :class:`VoxelImage` (value >= threshold, or equal to one
         of `labels`) as Hex8 boxes (merged greedily unless merge=False)."""
-        handle, info = _fcm.geometry_from_voxels(image._h, float(threshold), labels, int(merge))
+        handle, info = _fcm.geometry_from_voxels(image, float(threshold), labels, int(merge))
         return cls(handle, info)
 
     @classmethod
@@ -93,7 +93,7 @@ class Geometry(FcmObject):
         volume_mesh=0 the checked, oriented surface alone (cut-cell rules from its moments).
         Options (``fcm_surface_mesh_options``): max_volume, size, quality,
         check_intersections, orient, volume_mesh."""
-        return cls(_fcm.geometry_from_surface(surface._h, options))
+        return cls(_fcm.geometry_from_surface(surface, options))
 
     def transformed(self, A, b):
         """A copy with every node mapped by x -> A x + b (A a 3 x 3 matrix)."""
@@ -128,17 +128,17 @@ class Surface(FcmObject):
     @classmethod
     def from_arrays(cls, ctx, coords, triangles):
         """A surface from vertices (n, 3) and triangles (m, 3), copied."""
-        return cls(_fcm.surface_create(ctx._h, coords, triangles))
+        return cls(_fcm.surface_create(ctx, coords, triangles))
 
     @classmethod
     def from_file(cls, ctx, path):
         """Read an OBJ, OFF, STL or PLY file."""
-        return cls(_fcm.surface_from_file(ctx._h, str(path)))
+        return cls(_fcm.surface_from_file(ctx, str(path)))
 
     @classmethod
     def plane(cls, ctx, point, normal, lo, hi):
         """The plane through point with normal, clipped to the box [lo, hi] (a cut)."""
-        return cls(_fcm.surface_plane(ctx._h, point, normal, lo, hi))
+        return cls(_fcm.surface_plane(ctx, point, normal, lo, hi))
 
     coords = property(lambda self: _fcm.surface_array(self._h, "coords"),
                       doc="Vertices (n, 3), a read-only view.")
@@ -155,12 +155,12 @@ class VoxelImage(FcmObject):
     @classmethod
     def from_array(cls, ctx, values, axes=np.eye(3), origin=(0.0, 0.0, 0.0)):
         """An image from a 3-D array values[k, j, i] (copied)."""
-        return cls(_fcm.voxels_create(ctx._h, values, np.asarray(axes, float).ravel(), origin))
+        return cls(_fcm.voxels_create(ctx, values, np.asarray(axes, float).ravel(), origin))
 
     @classmethod
     def from_file(cls, ctx, path):
         """Read a NRRD (.nrrd, .nhdr) or MetaImage (.mha, .mhd) file."""
-        return cls(_fcm.voxels_from_file(ctx._h, str(path)))
+        return cls(_fcm.voxels_from_file(ctx, str(path)))
 
     values = property(lambda self: _fcm.voxels_values(self._h),
                       doc="The values [k, j, i], a read-only view.")

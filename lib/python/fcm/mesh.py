@@ -20,14 +20,14 @@ class Mesh(FcmObject):
         """A mesh from caller arrays (copied): coords (n, 3) float, cells (m, npc) int node
         ids in VTK order. Raises fcm.Error for ids out of range, repeated nodes, a face shared
         by more than two cells."""
-        return cls(_fcm.mesh_create(ctx._h, int(element_type), coords, cells))
+        return cls(_fcm.mesh_create(ctx, int(element_type), coords, cells))
 
     @classmethod
     def box(cls, ctx, element_type, lo, hi, n):
         """A structured grid of n[0] x n[1] x n[2] cubes over the box [lo, hi]: one hexahedron
         per cube (HEX8, HEX20) or six tetrahedra (TET4, TET10, Kuhn split). Grid corner (i, j,
         k) is node i + (n0+1)(j + (n1+1)k); cube (i, j, k) is cell i + n0 (j + n1 k)."""
-        return cls(_fcm.mesh_box(ctx._h, int(element_type), lo, hi, n))
+        return cls(_fcm.mesh_box(ctx, int(element_type), lo, hi, n))
 
     @classmethod
     def octree(cls, ctx, element_type, lo, hi, n, region_level=0, region_lo=None,
@@ -35,14 +35,14 @@ class Mesh(FcmObject):
         """An octree background (HEX8 or HEX20): the box grid with cells split into eight
         where they meet the box [region_lo, region_hi] (down to region_level) or the boundary
         of `geometry` (down to refine_level), balanced 2:1; hanging nodes join the levels."""
-        return cls(_fcm.mesh_octree(ctx._h, int(element_type), lo, hi, n, int(region_level),
+        return cls(_fcm.mesh_octree(ctx, int(element_type), lo, hi, n, int(region_level),
                                     region_lo, region_hi, int(refine_level),
-                                    None if geometry is None else geometry._h))
+                                    None if geometry is None else geometry))
 
     @classmethod
     def from_gmsh(cls, ctx, path):
         """Read a Gmsh MSH file (ASCII 4.1 or 2.x) of tet4, tet10, hex8 or hex20 cells."""
-        return cls(_fcm.mesh_from_gmsh(ctx._h, str(path)))
+        return cls(_fcm.mesh_from_gmsh(ctx, str(path)))
 
     def refined(self, flags):
         """A new octree mesh with the cells flagged nonzero (one flag per cell) split."""

@@ -39,7 +39,7 @@ class CellRules(FcmObject):
 
     def __init__(self, ctx, mesh, geometry, cell_mask=None, _handle=None, **options):
         super().__init__(_handle if _handle is not None else
-                         _fcm.rules_create(ctx._h, mesh._h, geometry._h, options, cell_mask))
+                         _fcm.rules_create(ctx, mesh, geometry, options, cell_mask))
         #: The background mesh the rules were built on.
         self.mesh = mesh
         #: The embedded geometry.
@@ -54,7 +54,7 @@ class CellRules(FcmObject):
         """The rules extended by a cut (XFEM): the surface splits the cells it crosses into
         material pieces, each with its own rules; the other cells' rules are copied. These
         rules are unchanged."""
-        h = _fcm.rules_cut(ctx._h, self.mesh._h, self.geometry._h, self._h, surface._h)
+        h = _fcm.rules_cut(ctx, self.mesh, self.geometry, self._h, surface)
         return CellRules(None, self.mesh, self.geometry, _handle=h)
 
     @property
@@ -99,11 +99,11 @@ class CellRules(FcmObject):
     def points(self, kind=STIFFNESS):
         """Every point of `kind` over all cells (copies): a dict of cell, xi (reference),
         x (physical), weight, physical_weight (w det J) and flag."""
-        return _fcm.rules_gather(self._h, self.mesh._h, int(kind))
+        return _fcm.rules_gather(self._h, self.mesh, int(kind))
 
     def surface_points(self):
         """Every surface point (copies): cell, xi, x, weight (= physical_weight), normal."""
-        return _fcm.rules_gather(self._h, self.mesh._h, -1)
+        return _fcm.rules_gather(self._h, self.mesh, -1)
 
     def __str__(self):
         return _fcm.rules_view(self._h)

@@ -20,17 +20,17 @@ class Scene(FcmObject):
     @classmethod
     def from_file(cls, ctx, path):
         """Parse a scene file; relative file names in it are relative to the file."""
-        return cls(_fcm.scene_create(ctx._h, "file", str(path)))
+        return cls(_fcm.scene_create(ctx, "file", str(path)))
 
     @classmethod
     def from_string(cls, ctx, text, name=None):
         """Parse a scene from JSON text (name: used in messages)."""
-        return cls(_fcm.scene_create(ctx._h, "string", text, name))
+        return cls(_fcm.scene_create(ctx, "string", text, name))
 
     @classmethod
     def default(cls, ctx):
         """The built-in default scene."""
-        return cls(_fcm.scene_create(ctx._h, "default"))
+        return cls(_fcm.scene_create(ctx, "default"))
 
     @property
     def info(self):
@@ -50,7 +50,7 @@ class Simulation(FcmObject):
     __slots__ = ("scene",)
 
     def __init__(self, ctx, scene, max_steps=DEFAULT):
-        super().__init__(_fcm.simulation_create(ctx._h, scene._h, int(max_steps)))
+        super().__init__(_fcm.simulation_create(ctx, scene, int(max_steps)))
         self.scene = scene
 
     def step(self):

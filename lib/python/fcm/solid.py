@@ -74,7 +74,7 @@ class Space(FcmObject):
     __slots__ = ("mesh", "rules")
 
     def __init__(self, ctx, mesh, rules=None):
-        super().__init__(_fcm.space_create(ctx._h, mesh._h, None if rules is None else rules._h))
+        super().__init__(_fcm.space_create(ctx, mesh, None if rules is None else rules))
         self.mesh = mesh
         self.rules = rules
 
@@ -110,7 +110,7 @@ class Space(FcmObject):
 
     def transfer(self, to, x):
         """Carry a field of this space onto `to`, the space of rules cut from these."""
-        return _fcm.space_transfer(self._h, to._h, x)
+        return _fcm.space_transfer(self._h, to, x)
 
 
 StepInfo = dict
@@ -138,7 +138,7 @@ class Integrator(FcmObject):
 
     def __init__(self, ctx, space, material, _handle=None, **options):
         super().__init__(_handle if _handle is not None else
-                         _fcm.integrator_create(ctx._h, space._h, tuple(material), options))
+                         _fcm.integrator_create(ctx, space, tuple(material), options))
         self.space = space
         self.material = Material(*material)
 
@@ -189,7 +189,7 @@ class Integrator(FcmObject):
         """A new integrator on `space` (of rules cut from this one's) continuing this one's
         state, loads and constraints."""
         return Integrator(None, space, self.material,
-                          _handle=_fcm.integrator_create_cut(self._h, space._h))
+                          _handle=_fcm.integrator_create_cut(self._h, space))
 
     def state(self):
         """(u, v, t, steps): copies of the displacement, velocity, time and step count."""
@@ -220,11 +220,11 @@ class EmbeddedSurface(FcmObject):
     __slots__ = ()
 
     def __init__(self, space, geometry):
-        super().__init__(_fcm.esurf_create(space._h, geometry._h))
+        super().__init__(_fcm.esurf_create(space, geometry))
 
     def set_space(self, space):
         """Move to another space on the same mesh (after a cut)."""
-        _fcm.esurf_set_space(self._h, space._h)
+        _fcm.esurf_set_space(self._h, space)
 
     points = property(lambda self: _fcm.esurf_arrays(self._h)[0],
                       doc="Reference positions of the points (n, 3), a read-only view.")

@@ -282,11 +282,12 @@ FILE *fcmpy_stream_open(char **buf, size_t *len)
   return f;
 }
 
-PyObject *fcmpy_stream_close(FILE *f, char *buf, size_t len)
+PyObject *fcmpy_stream_close(FILE *f, char **buf, size_t *len)
 {
-  fclose(f);
-  PyObject *s = PyUnicode_DecodeUTF8(buf ? buf : "", (Py_ssize_t)len, "replace");
-  free(buf);
+  fclose(f); /* sets *buf and *len */
+  PyObject *s = PyUnicode_DecodeUTF8(*buf ? *buf : "", (Py_ssize_t)*len, "replace");
+  free(*buf);
+  *buf = NULL;
   return s;
 }
 

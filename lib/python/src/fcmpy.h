@@ -81,7 +81,7 @@ int fcmpy_index3(PyObject *obj, fcm_index out[3], const char *what);
 int fcmpy_set_options(const fcmpy_option *table, void *opts, PyObject *kwargs, const char *what);
 PyObject *fcmpy_options_dict(const fcmpy_option *table, const void *opts);
 FILE *fcmpy_stream_open(char **buf, size_t *len);
-PyObject *fcmpy_stream_close(FILE *f, char *buf, size_t len);
+PyObject *fcmpy_stream_close(FILE *f, char **buf, size_t *len);
 fcmpy_callback *fcmpy_callback_new(PyObject *fn, PyObject **capsule);
 void fcmpy_callback_fail(fcmpy_callback *cb);
 int fcmpy_callback_restore(fcmpy_callback *cb);

@@ -168,7 +168,7 @@ static PyObject *rules_view(PyObject *self, PyObject *rh)
   FILE *f = r ? fcmpy_stream_open(&buf, &len) : NULL;
   if (!f) return NULL;
   fcm_cell_rules_view(r, f);
-  return fcmpy_stream_close(f, buf, len);
+  return fcmpy_stream_close(f, &buf, &len);
 }
 
 static int rule_kind(int kind)

@@ -809,7 +809,7 @@ static PyObject *simulation_summary(PyObject *self, PyObject *simh)
   FILE *f = s ? fcmpy_stream_open(&buf, &len) : NULL;
   if (!f) return NULL;
   fcm_simulation_summary_view(s, f);
-  return fcmpy_stream_close(f, buf, len);
+  return fcmpy_stream_close(f, &buf, &len);
 }
 
 PyMethodDef fcmpy_simulation_methods[] = {
