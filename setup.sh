@@ -4,6 +4,10 @@
 #   bash setup.sh test    install what is missing, build, run the default test suite
 #   bash setup.sh bench   build and run the benchmarks (ctest label "bench")
 #   bash setup.sh deps    only install the Debian packages
+#   bash setup.sh install [PREFIX]
+#                         install what is missing, build, install the library, programs and
+#                         the Python package fcm into PREFIX (default /usr/local, where
+#                         Debian's python3 finds the package)
 #   bash setup.sh deps --petsc
 #                         also the optional PETSc + MPI backend's (petsc-dev, openmpi-bin;
 #                         `test --petsc` etc. likewise): the build then has the backend
@@ -22,7 +26,8 @@ here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 build=${FCM_BUILD_DIR:-$here/build}
 jobs=${FCM_JOBS:-$(nproc 2>/dev/null || echo 2)}
 packages=(build-essential cmake pkg-config libopenblas-dev liblapacke-dev libglpk-dev
-          libsuitesparse-dev libcjson-dev libgmsh-dev gnuplot-nox)
+          libsuitesparse-dev libcjson-dev libgmsh-dev gnuplot-nox
+          python3-dev python3-numpy python3-pytest python3-matplotlib)
 # --petsc (the argument after the command): the PETSc + MPI backend's packages too
 if [ "${2:-}" = "--petsc" ]; then
   packages+=(petsc-dev openmpi-bin)
@@ -151,6 +156,15 @@ $(PKG_CONFIG_PATH="$pcdir" pkg-config --static --libs fcm)"
   else
     [ ! -e "$ex/build/host_petsc" ]
   fi
+  # the Python package (when built) imports from the moved tree: its module finds the moved
+  # libfcm through its $ORIGIN rpath
+  local pyinit python
+  pyinit=$(find "$prefix/fcm" -path '*/fcm/__init__.py' | head -n 1)
+  if [ -n "$pyinit" ]; then
+    python=$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$build/CMakeCache.txt")
+    PYTHONPATH=$(dirname "$(dirname "$pyinit")") "${python:-python3}" -c \
+      "import fcm; ctx = fcm.Context(); assert fcm.__version__ and fcm.Mesh.box(ctx, fcm.HEX8, [0, 0, 0], [1, 1, 1], [1, 1, 1]).num_cells == 1"
+  fi
   # the installed programs find the moved libfcm through their $ORIGIN rpath
   if [ -x "$prefix/fcm/bin/fcm-sim" ]; then "$prefix/fcm/bin/fcm-sim" --help >/dev/null; fi
   echo "install check: examples built against the installed package (pkg-config and"\
@@ -173,6 +187,12 @@ case "${1:-}" in
     configure_and_build
     (cd "$build" && ctest --output-on-failure -j "$jobs" -LE 'bench|slow')
     ;;
+  install)
+    deps
+    configure_and_build
+    cmake --install "$build" --prefix "${2:-/usr/local}" >/dev/null
+    echo "setup.sh: installed into ${2:-/usr/local}"
+    ;;
   install-check)
     deps
     configure_and_build
@@ -184,7 +204,7 @@ case "${1:-}" in
     (cd "$build" && ctest --output-on-failure -L bench)
     ;;
   *)
-    sed -n '2,17p' "$0"
+    sed -n '2,21p' "$0"
     exit 2
     ;;
 esac
