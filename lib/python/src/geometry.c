@@ -231,7 +231,7 @@ static PyObject *mesh_nodes_in_box(PyObject *self, PyObject *args)
     FILE *f_ = fcmpy_stream_open(&buf_, &len_);                                                    \
     if (!f_) return NULL;                                                                          \
     fn(obj, f_);                                                                                   \
-    return fcmpy_stream_close(f_, &buf_, &len_);                                                     \
+    return fcmpy_stream_close(f_, &buf_, &len_);                                                   \
   } while (0)
 
 static PyObject *mesh_view(PyObject *self, PyObject *mh)

@@ -327,7 +327,15 @@ static PyObject *integrator_create_cut(PyObject *self, PyObject *args)
   fcmpy_handle *s = old ? fcmpy_handle_of(sh, FCMPY_SPACE) : NULL;
   if (!s) return NULL;
   fcm_integrator *integ = NULL;
-  fcm_status st = fcm_integrator_create_cut(old->ptr, s->ptr, &integ);
+  fcm_status st;
+  PyThreadState *gil = PyEval_SaveThread();
+  st = fcm_integrator_create_cut(old->ptr, s->ptr, &integ);
+  PyEval_RestoreThread(gil);
+  if (fcmpy_callbacks_restore(old->keep)) {
+    fcm_integrator_destroy(&integ);
+    fcm_ctx_error_clear(old->ctx);
+    return NULL;
+  }
   PyObject *h = made(st, old, FCMPY_INTEGRATOR, integ, sh, NULL);
   /* the new integrator calls the old one's boundary selectors: it keeps them */
   for (Py_ssize_t i = 0; h && i < PyList_GET_SIZE(old->keep); i++) {
@@ -432,8 +440,10 @@ static PyObject *integrator_setup(PyObject *self, PyObject *ih)
   fcmpy_handle *h = fcmpy_handle_of(ih, FCMPY_INTEGRATOR);
   if (!h) return NULL;
   fcm_status st;
-  Py_BEGIN_ALLOW_THREADS st = fcm_integrator_setup(h->ptr);
-  Py_END_ALLOW_THREADS return integrator_call(h, st);
+  PyThreadState *gil = PyEval_SaveThread();
+  st = fcm_integrator_setup(h->ptr);
+  PyEval_RestoreThread(gil);
+  return integrator_call(h, st);
 }
 
 static PyObject *integrator_step(PyObject *self, PyObject *ih)
@@ -444,8 +454,10 @@ static PyObject *integrator_step(PyObject *self, PyObject *ih)
   fcm_step_info info;
   fcm_status st;
   memset(&info, 0, sizeof info);
-  Py_BEGIN_ALLOW_THREADS st = fcm_integrator_step(h->ptr, &info);
-  Py_END_ALLOW_THREADS PyObject *r = integrator_call(h, st);
+  PyThreadState *gil = PyEval_SaveThread();
+  st = fcm_integrator_step(h->ptr, &info);
+  PyEval_RestoreThread(gil);
+  PyObject *r = integrator_call(h, st);
   if (!r) return NULL;
   Py_DECREF(r);
   return fcmpy_options_dict(step_table, &info);
@@ -667,8 +679,10 @@ static PyObject *simulation_create(PyObject *self, PyObject *args)
   o.max_steps = (fcm_index)max_steps;
   fcm_simulation *sim = NULL;
   fcm_status st;
-  Py_BEGIN_ALLOW_THREADS st = fcm_simulation_create(c->ptr, scene, &o, &sim);
-  Py_END_ALLOW_THREADS return made(st, c, FCMPY_SIMULATION, sim, sh, NULL);
+  PyThreadState *gil = PyEval_SaveThread();
+  st = fcm_simulation_create(c->ptr, scene, &o, &sim);
+  PyEval_RestoreThread(gil);
+  return made(st, c, FCMPY_SIMULATION, sim, sh, NULL);
 }
 
 static PyObject *simulation_step(PyObject *self, PyObject *simh)
@@ -679,8 +693,10 @@ static PyObject *simulation_step(PyObject *self, PyObject *simh)
   fcm_step_info info;
   fcm_status st;
   memset(&info, 0, sizeof info);
-  Py_BEGIN_ALLOW_THREADS st = fcm_simulation_step(h->ptr, &info);
-  Py_END_ALLOW_THREADS if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
+  PyThreadState *gil = PyEval_SaveThread();
+  st = fcm_simulation_step(h->ptr, &info);
+  PyEval_RestoreThread(gil);
+  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
   return fcmpy_options_dict(step_table, &info);
 }
 
@@ -723,8 +739,10 @@ static PyObject *simulation_run(PyObject *self, PyObject *args)
   monitor_state ms = {NULL, 0};
   if (fn != Py_None && !(ms.cb = fcmpy_callback_new(fn, &capsule))) return NULL;
   fcm_status st;
-  Py_BEGIN_ALLOW_THREADS st = fcm_simulation_run(h->ptr, ms.cb ? run_monitor : NULL, &ms);
-  Py_END_ALLOW_THREADS int raised = fcmpy_callback_restore(ms.cb);
+  PyThreadState *gil = PyEval_SaveThread();
+  st = fcm_simulation_run(h->ptr, ms.cb ? run_monitor : NULL, &ms);
+  PyEval_RestoreThread(gil);
+  int raised = fcmpy_callback_restore(ms.cb);
   Py_XDECREF(capsule);
   if (raised || ms.stopped) {
     fcm_ctx_error_clear(h->ctx);

@@ -172,12 +172,14 @@ int main(int argc, char **argv)
   fcm_ctx *ctx = NULL;
   int ok = 0;
   if (fcm_ctx_create(NULL, &ctx) != FCM_OK) return 1;
-  if (argc == 3 && !strcmp(argv[1], "static")) ok = run_static(ctx, argv[2]);
+  if (argc == 3 && !strcmp(argv[1], "static"))
+    ok = run_static(ctx, argv[2]);
   else if (argc == 5 && !strcmp(argv[1], "dynamic"))
     ok = run_dynamic(ctx, atoi(argv[2]), atoi(argv[3]), argv[4]);
   else if (argc == 5 && !strcmp(argv[1], "scene"))
     ok = run_scene(ctx, argv[2], atoi(argv[3]), argv[4]);
-  else fprintf(stderr, "usage: python_reference static|dynamic|scene ... <out>\n");
+  else
+    fprintf(stderr, "usage: python_reference static|dynamic|scene ... <out>\n");
   fcm_ctx_destroy(&ctx);
   return ok ? 0 : 1;
 }
