@@ -11,8 +11,8 @@ set(_fcm_py_why "")
 if(FCM_WITH_PYTHON STREQUAL "OFF")
   set(_fcm_py_why "FCM_WITH_PYTHON=OFF")
 elseif(FCM_SANITIZE OR FCM_FUZZ)
-  set(_fcm_py_why "not with FCM_SANITIZE or FCM_FUZZ (the sanitizer runtime and a Python "
-                  "interpreter do not mix)")
+  set(_fcm_py_why "not with FCM_SANITIZE or FCM_FUZZ: the sanitizer runtime and a Python "
+                  "interpreter do not mix")
 else()
   # The interpreter: Python3_EXECUTABLE when given, else the first python3 on the PATH that
   # imports NumPy, else the system's /usr/bin/python3 (a python3 of pyenv or a virtual

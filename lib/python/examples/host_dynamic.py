@@ -16,9 +16,8 @@ import sys
 import fcm
 
 
-def main(out_dir=".", steps=20, cut_step=10):
-    steps, cut_step = int(steps), int(cut_step)
-    ctx = fcm.Context()
+def run(ctx, steps, cut_step, report=print):
+    """The run; returns (integrator at the end, embedded surface, material, checks held)."""
     mesh = fcm.Mesh.box(ctx, fcm.HEX8, [0, 0, 0], [2, 0.5, 0.5], [8, 2, 2])
     bar = fcm.Geometry.box(ctx, [0, 0.05, 0.05], [1.8, 0.45, 0.45], [18, 4, 4])
     mat = fcm.Material(fcm.MaterialModel.STABLE_NEO_HOOKEAN, 1e6, 0.3, 1000.0)
@@ -42,7 +41,7 @@ def main(out_dir=".", steps=20, cut_step=10):
     for step in range(1, steps + 1):
         info = integ.step()
         m, p = momentum(integ)
-        print(f"t = {integ.time:.2f} s  Newton {info['newton_iterations']}  bodies "
+        report(f"t = {integ.time:.2f} s  Newton {info['newton_iterations']}  bodies "
               f"{integ.space.num_bodies}  mass {m:.6g} kg  p_z {p[2]:.4g} kg m/s")
         if step != cut_step:
             continue
@@ -51,12 +50,17 @@ def main(out_dir=".", steps=20, cut_step=10):
         integ = integ.cut(space)
         surf.set_space(space)
         m1, p1 = momentum(integ)
-        print(f"cut at t = {integ.time:.2f} s: {space.num_bodies} bodies, mass {m:.6g} -> "
+        report(f"cut at t = {integ.time:.2f} s: {space.num_bodies} bodies, mass {m:.6g} -> "
               f"{m1:.6g} kg, p_z {p[2]:.6g} -> {p1[2]:.6g}")
         if (space.num_bodies != 2 or abs(m1 - m) > 1e-10 * m
                 or abs(p1[2] - p[2]) > 1e-9 * (abs(p[2]) + m)):
             print("host_dynamic: the cut changed the bodies, mass or momentum", file=sys.stderr)
             good = False
+    return integ, surf, mat, good
+
+
+def main(out_dir=".", steps=20, cut_step=10):
+    integ, surf, mat, good = run(fcm.Context(), int(steps), int(cut_step))
     # The surface at reference positions with displacement and stresses (Warp By Vector).
     surf.write_vtu(f"{out_dir}/host_dynamic_surface.vtu", mat, integ.displacement)
     return good

@@ -17,14 +17,13 @@ import numpy as np
 import fcm
 
 
-def main(out_dir="."):
-    ctx = fcm.Context()
+def solve(ctx):
+    """Set up and solve; returns (integrator, clamp id, step info, rules, ball, material)."""
     # Background: 6 x 6 x 6 Hex8 cells over [-0.6, 0.6]^3; body: a ball of radius 0.5.
     mesh = fcm.Mesh.box(ctx, fcm.HEX8, [-0.6] * 3, [0.6] * 3, [6, 6, 6])
     ball = fcm.Geometry.ball(ctx, [0, 0, 0], 0.5, 3)
     # A static problem needs stiffness rules only; the clamp needs surface rules.
     rules = fcm.CellRules(ctx, mesh, ball, kinds=fcm.RULES_STIFFNESS, surface_strength=2)
-    print(rules)
     space = fcm.Space(ctx, mesh, rules)
     # Soft rubber, static equilibrium under gravity in 2 load steps.
     mat = fcm.Material(fcm.MaterialModel.STABLE_NEO_HOOKEAN, 2e5, 0.4, 1100.0)
@@ -35,7 +34,14 @@ def main(out_dir="."):
     # Clamp the lower cap (u = 0 there) weakly by Nitsche's method (the default method).
     clamp = integ.add_boundary_constraint(lambda X, normal: X[2] < -0.35)
     integ.setup()
-    info = integ.step()
+    return integ, clamp, integ.step(), rules, ball, mat
+
+
+def main(out_dir="."):
+    ctx = fcm.Context()
+    integ, clamp, info, rules, ball, mat = solve(ctx)
+    space = integ.space
+    print(rules)
     print(f"static solve: {info['newton_iterations']} Newton iterations, "
           f"residual {info['residual']:.3g}")
     u = integ.displacement

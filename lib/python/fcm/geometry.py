@@ -27,7 +27,7 @@ class Geometry(FcmObject):
     @classmethod
     def from_arrays(cls, ctx, element_type, coords, cells):
         """A geometry of TET4 or HEX8 cells from caller arrays (copied)."""
-        return cls(_fcm.geometry_create(ctx, int(element_type), coords, cells))
+        return cls(_fcm.mesh_create(ctx, int(element_type), coords, cells, True))
 
     @classmethod
     def box(cls, ctx, lo, hi, n):
@@ -60,12 +60,12 @@ class Geometry(FcmObject):
     @classmethod
     def from_gmsh(cls, ctx, path):
         """Read a Gmsh MSH file of tet4 or hex8 cells."""
-        return cls(_fcm.geometry_from_files(ctx, str(path)))
+        return cls(_fcm.read_file(ctx, "geometry", str(path)))
 
     @classmethod
     def from_tetgen(cls, ctx, node_path, ele_path):
         """Read a TetGen mesh (.node and .ele files)."""
-        return cls(_fcm.geometry_from_files(ctx, str(node_path), str(ele_path)))
+        return cls(_fcm.read_file(ctx, "tetgen", str(node_path), str(ele_path)))
 
     @classmethod
     def from_level_set(cls, ctx, phi, lo, hi, n, **options):
@@ -117,7 +117,7 @@ class Geometry(FcmObject):
                               doc="The cell owning each boundary triangle, a read-only view.")
 
     def __str__(self):
-        return _fcm.geometry_view(self._h)
+        return _fcm.text(self._h)
 
 
 class Surface(FcmObject):
@@ -133,7 +133,7 @@ class Surface(FcmObject):
     @classmethod
     def from_file(cls, ctx, path):
         """Read an OBJ, OFF, STL or PLY file."""
-        return cls(_fcm.surface_from_file(ctx, str(path)))
+        return cls(_fcm.read_file(ctx, "surface", str(path)))
 
     @classmethod
     def plane(cls, ctx, point, normal, lo, hi):
@@ -160,7 +160,7 @@ class VoxelImage(FcmObject):
     @classmethod
     def from_file(cls, ctx, path):
         """Read a NRRD (.nrrd, .nhdr) or MetaImage (.mha, .mhd) file."""
-        return cls(_fcm.voxels_from_file(ctx, str(path)))
+        return cls(_fcm.read_file(ctx, "voxels", str(path)))
 
     values = property(lambda self: _fcm.voxels_values(self._h),
                       doc="The values [k, j, i], a read-only view.")

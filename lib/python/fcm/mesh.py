@@ -20,7 +20,7 @@ class Mesh(FcmObject):
         """A mesh from caller arrays (copied): coords (n, 3) float, cells (m, npc) int node
         ids in VTK order. Raises fcm.Error for ids out of range, repeated nodes, a face shared
         by more than two cells."""
-        return cls(_fcm.mesh_create(ctx, int(element_type), coords, cells))
+        return cls(_fcm.mesh_create(ctx, int(element_type), coords, cells, False))
 
     @classmethod
     def box(cls, ctx, element_type, lo, hi, n):
@@ -42,7 +42,7 @@ class Mesh(FcmObject):
     @classmethod
     def from_gmsh(cls, ctx, path):
         """Read a Gmsh MSH file (ASCII 4.1 or 2.x) of tet4, tet10, hex8 or hex20 cells."""
-        return cls(_fcm.mesh_from_gmsh(ctx, str(path)))
+        return cls(_fcm.read_file(ctx, "mesh", str(path)))
 
     def refined(self, flags):
         """A new octree mesh with the cells flagged nonzero (one flag per cell) split."""
@@ -74,4 +74,4 @@ class Mesh(FcmObject):
         return _fcm.mesh_nodes_in_box(self._h, lo, hi, float(tol))
 
     def __str__(self):
-        return _fcm.mesh_view(self._h)
+        return _fcm.text(self._h)

@@ -106,4 +106,4 @@ class CellRules(FcmObject):
         return _fcm.rules_gather(self._h, self.mesh, -1)
 
     def __str__(self):
-        return _fcm.rules_view(self._h)
+        return _fcm.text(self._h)

@@ -111,4 +111,4 @@ class Simulation(FcmObject):
         return out
 
     def __str__(self):
-        return _fcm.simulation_summary(self._h)
+        return _fcm.text(self._h)

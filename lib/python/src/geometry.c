@@ -49,22 +49,28 @@ static int nodes_cells(PyObject *coords, PyObject *cells, fcm_element_type type,
 
 /* ---------------------------------------------------------------- meshes */
 
+/* A mesh, or (geometry true) a geometry, from caller arrays. */
 static PyObject *mesh_create(PyObject *self, PyObject *args)
 {
   (void)self;
   PyObject *ch, *coords, *cells;
-  int type;
+  int type, geometry;
   fcm_ctx *ctx;
   fcm_element_type et;
   PyArrayObject *x, *c;
-  if (!PyArg_ParseTuple(args, "OiOO", &ch, &type, &coords, &cells) || !ctx_handle(ch, &ctx) ||
-      element_type(type, &et) < 0 || nodes_cells(coords, cells, et, &x, &c) < 0)
+  if (!PyArg_ParseTuple(args, "OiOOp", &ch, &type, &coords, &cells, &geometry) ||
+      !ctx_handle(ch, &ctx) || element_type(type, &et) < 0 ||
+      nodes_cells(coords, cells, et, &x, &c) < 0)
     return NULL;
   fcm_mesh *mesh = NULL;
-  fcm_status st = fcm_mesh_create(ctx, et, PyArray_DIM(x, 0), PyArray_DATA(x), PyArray_DIM(c, 0),
-                                  PyArray_DATA(c), &mesh);
+  fcm_geometry *g = NULL;
+  fcm_status st = geometry ? fcm_geometry_create(ctx, et, PyArray_DIM(x, 0), PyArray_DATA(x),
+                                                 PyArray_DIM(c, 0), PyArray_DATA(c), &g)
+                           : fcm_mesh_create(ctx, et, PyArray_DIM(x, 0), PyArray_DATA(x),
+                                             PyArray_DIM(c, 0), PyArray_DATA(c), &mesh);
   Py_DECREF(x);
   Py_DECREF(c);
+  if (geometry) return made(st, ctx, FCMPY_GEOMETRY, g, ch, NULL);
   return made(st, ctx, FCMPY_MESH, mesh, ch, NULL);
 }
 
@@ -137,16 +143,43 @@ static PyObject *mesh_refined(PyObject *self, PyObject *args)
   return made(st, h->ctx, FCMPY_MESH, out, ctx_h, NULL);
 }
 
-static PyObject *mesh_from_gmsh(PyObject *self, PyObject *args)
+/* Objects read from files: ("mesh" | "geometry" | "surface" | "voxels", path) or
+ * ("tetgen", node_path, ele_path). */
+static PyObject *read_file(PyObject *self, PyObject *args)
 {
   (void)self;
   PyObject *ch;
-  const char *path;
+  const char *what, *path, *ele = NULL;
   fcm_ctx *ctx;
-  if (!PyArg_ParseTuple(args, "Os", &ch, &path) || !ctx_handle(ch, &ctx)) return NULL;
+  if (!PyArg_ParseTuple(args, "Oss|s", &ch, &what, &path, &ele) || !ctx_handle(ch, &ctx))
+    return NULL;
+  void *obj = NULL;
+  fcmpy_kind kind = FCMPY_GEOMETRY;
   fcm_mesh *mesh = NULL;
-  fcm_status st = fcm_mesh_create_from_gmsh(ctx, path, &mesh);
-  return made(st, ctx, FCMPY_MESH, mesh, ch, NULL);
+  fcm_geometry *geom = NULL;
+  fcm_surface *surf = NULL;
+  fcm_voxel_image *img = NULL;
+  fcm_status st;
+  if (!strcmp(what, "mesh")) {
+    kind = FCMPY_MESH;
+    st = fcm_mesh_create_from_gmsh(ctx, path, &mesh);
+    obj = mesh;
+  } else if (!strcmp(what, "geometry") || (!strcmp(what, "tetgen") && ele)) {
+    st = ele ? fcm_geometry_create_from_tetgen(ctx, path, ele, &geom)
+             : fcm_geometry_create_from_gmsh(ctx, path, &geom);
+    obj = geom;
+  } else if (!strcmp(what, "surface")) {
+    kind = FCMPY_SURFACE;
+    st = fcm_surface_create_from_file(ctx, path, &surf);
+    obj = surf;
+  } else if (!strcmp(what, "voxels")) {
+    kind = FCMPY_VOXELS;
+    st = fcm_voxel_image_create_from_file(ctx, path, &img);
+    obj = img;
+  } else {
+    return PyErr_Format(PyExc_ValueError, "read_file: cannot read a '%s'", what);
+  }
+  return made(st, ctx, kind, obj, ch, NULL);
 }
 
 static PyObject *mesh_info(PyObject *self, PyObject *mh)
@@ -223,45 +256,7 @@ static PyObject *mesh_nodes_in_box(PyObject *self, PyObject *args)
   return a;
 }
 
-/* The text of fcm_x_view(obj, stream). */
-#define FCMPY_VIEW_TEXT(fn, obj)                                                                   \
-  do {                                                                                             \
-    char *buf_;                                                                                    \
-    size_t len_;                                                                                   \
-    FILE *f_ = fcmpy_stream_open(&buf_, &len_);                                                    \
-    if (!f_) return NULL;                                                                          \
-    fn(obj, f_);                                                                                   \
-    return fcmpy_stream_close(f_, &buf_, &len_);                                                   \
-  } while (0)
-
-static PyObject *mesh_view(PyObject *self, PyObject *mh)
-{
-  (void)self;
-  const fcm_mesh *m = fcmpy_get(mh, FCMPY_MESH);
-  if (!m) return NULL;
-  FCMPY_VIEW_TEXT(fcm_mesh_view, m);
-}
-
 /* ---------------------------------------------------------------- geometries */
-
-static PyObject *geometry_create(PyObject *self, PyObject *args)
-{
-  (void)self;
-  PyObject *ch, *coords, *cells;
-  int type;
-  fcm_ctx *ctx;
-  fcm_element_type et;
-  PyArrayObject *x, *c;
-  if (!PyArg_ParseTuple(args, "OiOO", &ch, &type, &coords, &cells) || !ctx_handle(ch, &ctx) ||
-      element_type(type, &et) < 0 || nodes_cells(coords, cells, et, &x, &c) < 0)
-    return NULL;
-  fcm_geometry *g = NULL;
-  fcm_status st = fcm_geometry_create(ctx, et, PyArray_DIM(x, 0), PyArray_DATA(x),
-                                      PyArray_DIM(c, 0), PyArray_DATA(c), &g);
-  Py_DECREF(x);
-  Py_DECREF(c);
-  return made(st, ctx, FCMPY_GEOMETRY, g, ch, NULL);
-}
 
 /* Procedural shapes: ("box", lo, hi, n), ("ball" | "hemisphere", center, radius, n),
  * ("hollow_ball", center, r_in, r_out, hole_radius, n, layers),
@@ -309,19 +304,6 @@ static PyObject *geometry_shape(PyObject *self, PyObject *args)
   } else {
     return PyErr_Format(PyExc_ValueError, "unknown shape '%s'", shape);
   }
-  return made(st, ctx, FCMPY_GEOMETRY, g, ch, NULL);
-}
-
-static PyObject *geometry_from_files(PyObject *self, PyObject *args)
-{
-  (void)self;
-  PyObject *ch;
-  const char *path, *ele = NULL;
-  fcm_ctx *ctx;
-  if (!PyArg_ParseTuple(args, "Os|z", &ch, &path, &ele) || !ctx_handle(ch, &ctx)) return NULL;
-  fcm_geometry *g = NULL;
-  fcm_status st = ele ? fcm_geometry_create_from_tetgen(ctx, path, ele, &g)
-                      : fcm_geometry_create_from_gmsh(ctx, path, &g);
   return made(st, ctx, FCMPY_GEOMETRY, g, ch, NULL);
 }
 
@@ -450,18 +432,6 @@ static PyObject *voxels_create(PyObject *self, PyObject *args)
   return made(st, ctx, FCMPY_VOXELS, img, ch, NULL);
 }
 
-static PyObject *voxels_from_file(PyObject *self, PyObject *args)
-{
-  (void)self;
-  PyObject *ch;
-  const char *path;
-  fcm_ctx *ctx;
-  if (!PyArg_ParseTuple(args, "Os", &ch, &path) || !ctx_handle(ch, &ctx)) return NULL;
-  fcm_voxel_image *img = NULL;
-  fcm_status st = fcm_voxel_image_create_from_file(ctx, path, &img);
-  return made(st, ctx, FCMPY_VOXELS, img, ch, NULL);
-}
-
 static PyObject *voxels_values(PyObject *self, PyObject *vh)
 {
   (void)self;
@@ -542,14 +512,6 @@ static PyObject *geometry_array(PyObject *self, PyObject *args)
   return PyErr_Format(PyExc_ValueError, "unknown geometry array '%s'", which);
 }
 
-static PyObject *geometry_view(PyObject *self, PyObject *gh)
-{
-  (void)self;
-  const fcm_geometry *g = fcmpy_get(gh, FCMPY_GEOMETRY);
-  if (!g) return NULL;
-  FCMPY_VIEW_TEXT(fcm_geometry_view, g);
-}
-
 /* ---------------------------------------------------------------- triangle surfaces */
 
 static PyObject *surface_create(PyObject *self, PyObject *args)
@@ -569,18 +531,6 @@ static PyObject *surface_create(PyObject *self, PyObject *args)
                                      PyArray_DATA(t), &s);
   Py_DECREF(x);
   Py_DECREF(t);
-  return made(st, ctx, FCMPY_SURFACE, s, ch, NULL);
-}
-
-static PyObject *surface_from_file(PyObject *self, PyObject *args)
-{
-  (void)self;
-  PyObject *ch;
-  const char *path;
-  fcm_ctx *ctx;
-  if (!PyArg_ParseTuple(args, "Os", &ch, &path) || !ctx_handle(ch, &ctx)) return NULL;
-  fcm_surface *s = NULL;
-  fcm_status st = fcm_surface_create_from_file(ctx, path, &s);
   return made(st, ctx, FCMPY_SURFACE, s, ch, NULL);
 }
 
@@ -620,26 +570,20 @@ PyMethodDef fcmpy_geometry_methods[] = {
     {"mesh_box", mesh_box, METH_VARARGS, NULL},
     {"mesh_octree", mesh_octree, METH_VARARGS, NULL},
     {"mesh_refined", mesh_refined, METH_VARARGS, NULL},
-    {"mesh_from_gmsh", mesh_from_gmsh, METH_VARARGS, NULL},
+    {"read_file", read_file, METH_VARARGS, NULL},
     {"mesh_info", mesh_info, METH_O, NULL},
     {"mesh_array", mesh_array, METH_VARARGS, NULL},
     {"mesh_nodes_in_box", mesh_nodes_in_box, METH_VARARGS, NULL},
-    {"mesh_view", mesh_view, METH_O, NULL},
-    {"geometry_create", geometry_create, METH_VARARGS, NULL},
     {"geometry_shape", geometry_shape, METH_VARARGS, NULL},
-    {"geometry_from_files", geometry_from_files, METH_VARARGS, NULL},
     {"geometry_transformed", geometry_transformed, METH_VARARGS, NULL},
     {"geometry_from_level_set", geometry_from_level_set, METH_VARARGS, NULL},
     {"geometry_from_surface", geometry_from_surface, METH_VARARGS, NULL},
     {"geometry_from_voxels", geometry_from_voxels, METH_VARARGS, NULL},
     {"geometry_info", geometry_info, METH_O, NULL},
     {"geometry_array", geometry_array, METH_VARARGS, NULL},
-    {"geometry_view", geometry_view, METH_O, NULL},
     {"voxels_create", voxels_create, METH_VARARGS, NULL},
-    {"voxels_from_file", voxels_from_file, METH_VARARGS, NULL},
     {"voxels_values", voxels_values, METH_O, NULL},
     {"surface_create", surface_create, METH_VARARGS, NULL},
-    {"surface_from_file", surface_from_file, METH_VARARGS, NULL},
     {"surface_plane", surface_plane, METH_VARARGS, NULL},
     {"surface_array", surface_array, METH_VARARGS, NULL},
     {NULL, NULL, 0, NULL}};

@@ -324,10 +324,42 @@ static PyObject *status_name(PyObject *self, PyObject *arg)
   return PyUnicode_FromString(fcm_status_name((fcm_status)st));
 }
 
+/* The text an fcm_x_view() prints for a mesh, geometry, rules or simulation. */
+static PyObject *object_text(PyObject *self, PyObject *obj)
+{
+  (void)self;
+  PyObject *inner = PyObject_TypeCheck(obj, &fcmpy_handle_type) ? NULL : obj;
+  fcmpy_handle *h = (fcmpy_handle *)obj;
+  if (inner || h->closed || !h->ptr)
+    return PyErr_Format(PyExc_TypeError, "text: expected an open fcm handle");
+  char *buf;
+  size_t len;
+  FILE *f = fcmpy_stream_open(&buf, &len);
+  if (!f) return NULL;
+  switch (h->kind) {
+  case FCMPY_MESH:
+    fcm_mesh_view(h->ptr, f);
+    break;
+  case FCMPY_GEOMETRY:
+    fcm_geometry_view(h->ptr, f);
+    break;
+  case FCMPY_RULES:
+    fcm_cell_rules_view(h->ptr, f);
+    break;
+  case FCMPY_SIMULATION:
+    fcm_simulation_summary_view(h->ptr, f);
+    break;
+  default:
+    break;
+  }
+  return fcmpy_stream_close(f, &buf, &len);
+}
+
 static PyMethodDef module_methods[] = {{"ctx_create", ctx_create, METH_VARARGS, NULL},
                                        {"ctx_num_threads", ctx_num_threads, METH_VARARGS, NULL},
                                        {"ctx_live_allocations", ctx_live_allocations, METH_O, NULL},
                                        {"status_name", status_name, METH_O, NULL},
+                                       {"text", object_text, METH_O, NULL},
                                        {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module_def = {

@@ -159,18 +159,6 @@ static PyObject *rules_stats(PyObject *self, PyObject *rh)
   return r ? fcmpy_options_dict(stats_table, fcm_cell_rules_get_stats(r)) : NULL;
 }
 
-static PyObject *rules_view(PyObject *self, PyObject *rh)
-{
-  (void)self;
-  const fcm_cell_rules *r = fcmpy_get(rh, FCMPY_RULES);
-  char *buf;
-  size_t len;
-  FILE *f = r ? fcmpy_stream_open(&buf, &len) : NULL;
-  if (!f) return NULL;
-  fcm_cell_rules_view(r, f);
-  return fcmpy_stream_close(f, &buf, &len);
-}
-
 static int rule_kind(int kind)
 {
   if (kind < 0 || kind >= FCM_RULE_KIND_COUNT) {
@@ -360,7 +348,6 @@ PyMethodDef fcmpy_rules_methods[] = {{"rules_defaults", rules_defaults, METH_NOA
                                      {"rules_cut", rules_cut, METH_VARARGS, NULL},
                                      {"rules_info", rules_info, METH_O, NULL},
                                      {"rules_stats", rules_stats, METH_O, NULL},
-                                     {"rules_view", rules_view, METH_O, NULL},
                                      {"rules_get", rules_get, METH_VARARGS, NULL},
                                      {"rules_get_surface", rules_get_surface, METH_VARARGS, NULL},
                                      {"rules_gather", rules_gather, METH_VARARGS, NULL},

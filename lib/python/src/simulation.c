@@ -818,18 +818,6 @@ static PyObject *simulation_write(PyObject *self, PyObject *args)
   Py_RETURN_NONE;
 }
 
-static PyObject *simulation_summary(PyObject *self, PyObject *simh)
-{
-  (void)self;
-  const fcm_simulation *s = fcmpy_get(simh, FCMPY_SIMULATION);
-  char *buf;
-  size_t len;
-  FILE *f = s ? fcmpy_stream_open(&buf, &len) : NULL;
-  if (!f) return NULL;
-  fcm_simulation_summary_view(s, f);
-  return fcmpy_stream_close(f, &buf, &len);
-}
-
 PyMethodDef fcmpy_simulation_methods[] = {
     {"space_create", space_create, METH_VARARGS, NULL},
     {"space_info", space_info, METH_O, NULL},
@@ -864,5 +852,4 @@ PyMethodDef fcmpy_simulation_methods[] = {
     {"simulation_info", simulation_info, METH_O, NULL},
     {"simulation_state", simulation_state, METH_O, NULL},
     {"simulation_write", simulation_write, METH_VARARGS, NULL},
-    {"simulation_summary", simulation_summary, METH_O, NULL},
     {NULL, NULL, 0, NULL}};

@@ -2,6 +2,7 @@
 binding equal the same problems run through the C API alone (the program python_reference)
 bit for bit."""
 
+import importlib.util
 import subprocess
 
 import numpy as np
@@ -16,25 +17,18 @@ def c_result(reference, scratch, *args):
     return np.fromfile(out, dtype=np.float64)
 
 
-def static_ball(ctx):
-    """host_static's problem: an embedded ball under gravity clamped on its lower cap."""
-    mesh = fcm.Mesh.box(ctx, fcm.HEX8, [-0.6] * 3, [0.6] * 3, [6, 6, 6])
-    ball = fcm.Geometry.ball(ctx, [0, 0, 0], 0.5, 3)
-    rules = fcm.CellRules(ctx, mesh, ball, kinds=fcm.RULES_STIFFNESS, surface_strength=2)
-    space = fcm.Space(ctx, mesh, rules)
-    mat = fcm.Material(fcm.MaterialModel.STABLE_NEO_HOOKEAN, 2e5, 0.4, 1100.0)
-    integ = fcm.Integrator(ctx, space, mat, kind=fcm.IntegratorKind.STATIC,
-                           tolerance_mode=fcm.NewtonTolerance.REPRESENTATIVE, dt=1.0,
-                           load_steps=2)
-    integ.add_gravity([0, 0, -9.81])
-    clamp = integ.add_boundary_constraint(lambda X, n: X[2] < -0.35)
-    integ.setup()
-    info = integ.step()
-    return integ, clamp, info, rules
+def example(source_dir, name):
+    """A module of lib/python/examples (their set-ups are the problems compared here)."""
+    path = source_dir / "lib" / "python" / "examples" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
-def test_static_bit_for_bit(ctx, reference, scratch):
-    integ, clamp, info, rules = static_ball(ctx)
+def test_static_bit_for_bit(ctx, reference, scratch, source_dir):
+    """host_static.py's problem: an embedded ball under gravity clamped on its lower cap."""
+    integ, clamp, info, rules, _, _ = example(source_dir, "host_static").solve(ctx)
     assert info["reason"] == 1  # converged
     u = integ.displacement
     assert np.array_equal(u, c_result(reference, scratch, "static"))
@@ -44,38 +38,13 @@ def test_static_bit_for_bit(ctx, reference, scratch):
     assert force[2] == pytest.approx(weight, rel=0.02)
 
 
-def bar_with_cut(ctx, steps, cut_after):
-    """host_dynamic's problem: a clamped bar swinging down, cut at x = 1.1 after a step."""
-    mesh = fcm.Mesh.box(ctx, fcm.HEX8, [0, 0, 0], [2, 0.5, 0.5], [8, 2, 2])
-    bar = fcm.Geometry.box(ctx, [0, 0.05, 0.05], [1.8, 0.45, 0.45], [18, 4, 4])
-    rules = fcm.CellRules(ctx, mesh, bar)
-    space = fcm.Space(ctx, mesh, rules)
-    mat = fcm.Material(fcm.MaterialModel.STABLE_NEO_HOOKEAN, 1e6, 0.3, 1000.0)
-    integ = fcm.Integrator(ctx, space, mat, dt=0.01)
-    integ.add_gravity([0, 0, -9.81])
-    integ.add_constraint(mesh.nodes_in_box([-1, -1, -1], [0, 1, 1], 1e-9))
-    integ.setup()
-    cut = fcm.Surface.from_arrays(ctx, [[1.1, -1, -1], [1.1, 2, -1], [1.1, 2, 2], [1.1, -1, 2]],
-                                  [[0, 1, 2], [0, 2, 3]])
-    masses = []
-
-    def after_step(current, info):
-        u, v, _, step = current.state()
-        masses.append(current.space.momentum(mat.density, u, v))
-        if step != cut_after:
-            return None
-        new_rules = current.space.rules.cut(ctx, cut)
-        return current.cut(fcm.Space(ctx, mesh, new_rules))
-
-    integ = integ.run(steps, after_step)
-    return integ, masses
-
-
-def test_dynamic_with_cut_bit_for_bit(ctx, reference, scratch):
-    integ, masses = bar_with_cut(ctx, 6, 3)
-    assert integ.space.num_bodies == 2
+def test_dynamic_with_cut_bit_for_bit(ctx, reference, scratch, source_dir):
+    """host_dynamic.py's problem: a clamped bar swinging down, cut at x = 1.1 after step 3
+    (the example checks that the cut keeps the mass and momentum)."""
+    lines = []
+    integ, _, _, good = example(source_dir, "host_dynamic").run(ctx, 6, 3, lines.append)
+    assert good and len(lines) == 7 and integ.space.num_bodies == 2
     assert np.array_equal(integ.displacement, c_result(reference, scratch, "dynamic", 6, 3))
-    assert masses[-1][0] == pytest.approx(masses[0][0], rel=1e-10)  # the cut keeps the mass
 
 
 def test_scene_bit_for_bit(ctx, reference, scratch, source_dir):
