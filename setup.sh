@@ -17,7 +17,8 @@
 #                         build, install into a temporary prefix, move it, and build and run
 #                         the example host programs (apps/examples) against the installed
 #                         package with `pkg-config --cflags --libs fcm` and find_package(fcm)
-#                         (with the PETSc component, host_petsc with fcm-petsc and fcm::petsc)
+#                         (with the PETSc component, host_petsc with fcm-petsc and fcm::petsc),
+#                         and import the Python package fcm from the moved tree
 # Environment: FCM_BUILD_DIR (default: build), FCM_CMAKE_ARGS (extra CMake arguments),
 #              FCM_JOBS (parallel build jobs, default: number of cores).
 set -euo pipefail
@@ -160,15 +161,17 @@ $(PKG_CONFIG_PATH="$pcdir" pkg-config --static --libs fcm)"
   # libfcm through its $ORIGIN rpath
   local pyinit python
   pyinit=$(find "$prefix/fcm" -path '*/fcm/__init__.py' | head -n 1)
+  local pymsg=""
   if [ -n "$pyinit" ]; then
     python=$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$build/CMakeCache.txt")
     PYTHONPATH=$(dirname "$(dirname "$pyinit")") "${python:-python3}" -c \
       "import fcm; ctx = fcm.Context(); assert fcm.__version__ and fcm.Mesh.box(ctx, fcm.HEX8, [0, 0, 0], [1, 1, 1], [1, 1, 1]).num_cells == 1"
+    pymsg="; the Python package imported from the moved tree"
   fi
   # the installed programs find the moved libfcm through their $ORIGIN rpath
   if [ -x "$prefix/fcm/bin/fcm-sim" ]; then "$prefix/fcm/bin/fcm-sim" --help >/dev/null; fi
   echo "install check: examples built against the installed package (pkg-config and"\
-       "find_package) and run: host_static, host_dynamic$([ "$have" = 1 ] && echo ", host_petsc")"
+       "find_package) and run: host_static, host_dynamic$([ "$have" = 1 ] && echo ", host_petsc")$pymsg"
   [ "${FCM_KEEP_PREFIX:-0}" = 1 ] && echo "install check: prefix kept: $prefix"
   return 0
 }
@@ -204,7 +207,7 @@ case "${1:-}" in
     (cd "$build" && ctest --output-on-failure -L bench)
     ;;
   *)
-    sed -n '2,21p' "$0"
+    sed -n '2,23p' "$0"
     exit 2
     ;;
 esac

@@ -368,13 +368,15 @@ int fcmpy_callbacks_restore(PyObject *keep)
 int fcmpy_material(PyObject *obj, fcm_material *mat)
 {
   PyObject *t = PySequence_Check(obj) ? PySequence_Tuple(obj) : NULL;
-  if (!t || !PyArg_ParseTuple(t, "iddd;material: expected (model, young, poisson, density)",
-                              (int *)&mat->model, &mat->young, &mat->poisson, &mat->density)) {
+  int model = 0;
+  if (!t || !PyArg_ParseTuple(t, "iddd;material: expected (model, young, poisson, density)", &model,
+                              &mat->young, &mat->poisson, &mat->density)) {
     if (!t && !PyErr_Occurred())
       PyErr_SetString(PyExc_TypeError, "material: expected (model, young, poisson, density)");
     Py_XDECREF(t);
     return -1;
   }
   Py_DECREF(t);
+  mat->model = (fcm_material_model)model; /* the library validates the range */
   return 0;
 }
