@@ -87,6 +87,11 @@ class Space(FcmObject):
     num_bodies = property(lambda self: self.info["num_bodies"],
                           doc="Separate bodies (connected components of the elements).")
 
+    def node_dofs(self):
+        """(first DOF of each mesh node, -1 where inactive; its number of copies): the x, y, z
+        DOFs of copy k of node a are first[a] + 3 k + (0, 1, 2)."""
+        return _fcm.space_node_dofs(self._h)
+
     def node_field(self, dofs):
         """A DOF vector as one 3-vector per mesh node (num_nodes, 3); inactive nodes 0."""
         return _fcm.space_node_field(self._h, dofs)

@@ -157,6 +157,27 @@ static PyObject *space_info(PyObject *self, PyObject *sh)
                        "num_nodes", (long long)fcm_mesh_num_nodes(fcm_space_mesh(s)));
 }
 
+/* The first DOF of every mesh node (-1: inactive) and its number of copies: copies. */
+static PyObject *space_node_dofs(PyObject *self, PyObject *sh)
+{
+  (void)self;
+  const fcm_space *s = fcmpy_get(sh, FCMPY_SPACE);
+  if (!s) return NULL;
+  npy_intp dims[1] = {fcm_mesh_num_nodes(fcm_space_mesh(s))};
+  PyObject *first = PyArray_SimpleNew(1, dims, NPY_INT64);
+  PyObject *copies = PyArray_SimpleNew(1, dims, NPY_INT64);
+  if (!first || !copies) {
+    Py_XDECREF(first);
+    Py_XDECREF(copies);
+    return NULL;
+  }
+  for (npy_intp a = 0; a < dims[0]; a++) {
+    ((int64_t *)PyArray_DATA((PyArrayObject *)first))[a] = fcm_space_node_dof(s, a);
+    ((int64_t *)PyArray_DATA((PyArrayObject *)copies))[a] = fcm_space_node_copies(s, a);
+  }
+  return Py_BuildValue("NN", first, copies);
+}
+
 static PyObject *space_node_field(PyObject *self, PyObject *args)
 {
   (void)self;
@@ -821,6 +842,7 @@ static PyObject *simulation_write(PyObject *self, PyObject *args)
 PyMethodDef fcmpy_simulation_methods[] = {
     {"space_create", space_create, METH_VARARGS, NULL},
     {"space_info", space_info, METH_O, NULL},
+    {"space_node_dofs", space_node_dofs, METH_O, NULL},
     {"space_node_field", space_node_field, METH_VARARGS, NULL},
     {"space_cell_stress", space_cell_stress, METH_VARARGS, NULL},
     {"space_momentum", space_momentum, METH_VARARGS, NULL},
