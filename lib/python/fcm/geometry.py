@@ -12,7 +12,8 @@ class Geometry(FcmObject):
     integrates over, with its boundary triangles. Immutable. Made by the class methods:
     procedural shapes (:meth:`box`, :meth:`ball`, :meth:`hemisphere`, :meth:`hollow_ball`,
     :meth:`tube`), files (:meth:`from_gmsh`, :meth:`from_tetgen`), a level-set function
-    (:meth:`from_level_set`, any Python callable), voxel images (:meth:`from_voxels`),
+    (:meth:`from_level_set`, any Python callable; :meth:`from_implicit`, the library's
+    implicit functions and their unions, intersections, differences), voxel images (:meth:`from_voxels`),
     triangle surfaces (:meth:`from_surface`), caller arrays (:meth:`from_arrays`) and
     :meth:`transformed`.
     """
@@ -78,6 +79,27 @@ class Geometry(FcmObject):
         error estimate, counts) is in ``.info``.
         """
         handle, info = _fcm.geometry_from_level_set(ctx, phi, lo, hi, n, options)
+        return cls(handle, info)
+
+    #: Kinds of :meth:`from_implicit` nodes (``fcm_implicit_kind``).
+    IMPLICIT_KINDS = ("sphere", "torus", "box", "gyroid", "union", "intersection", "difference")
+
+    @classmethod
+    def from_implicit(cls, ctx, nodes, lo, hi, n, **options):
+        """As :meth:`from_level_set` with phi a tree of the library's implicit functions,
+        evaluated in C: nodes is a list of dicts, the root last, each with "kind" (one of
+        IMPLICIT_KINDS) and its members (``fcm_implicit``): sphere center, radius; torus
+        center, radius, minor_radius, axis; box min, max; gyroid min, max, period,
+        thickness, sheet; union / intersection / difference the operand indices a, b (earlier
+        nodes). Invalid trees raise fcm.Error naming the node and member."""
+        tree = []
+        for node in nodes:
+            node = dict(node)
+            kind = node.pop("kind")
+            if kind not in cls.IMPLICIT_KINDS:
+                raise ValueError(f"implicit kind {kind!r}: expected one of {cls.IMPLICIT_KINDS}")
+            tree.append(dict(node, kind=cls.IMPLICIT_KINDS.index(kind)))
+        handle, info = _fcm.geometry_from_implicit(ctx, tree, lo, hi, n, options)
         return cls(handle, info)
 
     @classmethod

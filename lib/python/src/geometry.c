@@ -389,6 +389,63 @@ static PyObject *geometry_from_level_set(PyObject *self, PyObject *args)
                        info.error_estimate);
 }
 
+#define IM(member) offsetof(fcm_implicit, member)
+static const fcmpy_option implicit_table[] = {{"kind", 'i', 1, IM(kind)},
+                                              {"center", 'd', 3, IM(center)},
+                                              {"radius", 'd', 1, IM(radius)},
+                                              {"minor_radius", 'd', 1, IM(minor_radius)},
+                                              {"axis", 'i', 1, IM(axis)},
+                                              {"min", 'd', 3, IM(min)},
+                                              {"max", 'd', 3, IM(max)},
+                                              {"period", 'd', 1, IM(period)},
+                                              {"thickness", 'd', 1, IM(thickness)},
+                                              {"sheet", 'i', 1, IM(sheet)},
+                                              {"a", 'i', 1, IM(a)},
+                                              {"b", 'i', 1, IM(b)},
+                                              {NULL, 0, 0, 0}};
+#undef IM
+
+/* A level set from a tree of built-in implicit functions (a list of dicts of fcm_implicit
+ * members, the root last), evaluated by the library itself. */
+static PyObject *geometry_from_implicit(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *ch, *nodes_o, *lo_o, *hi_o, *n_o, *opts_o;
+  double lo[3], hi[3];
+  fcm_index n[3];
+  fcm_ctx *ctx;
+  fcm_level_set_options o = fcm_level_set_options_default();
+  fcm_implicit nodes[FCM_IMPLICIT_MAX_NODES];
+  if (!PyArg_ParseTuple(args, "OO!OOOO", &ch, &PyList_Type, &nodes_o, &lo_o, &hi_o, &n_o,
+                        &opts_o) ||
+      !ctx_handle(ch, &ctx) || fcmpy_vec(lo_o, lo, 3, "lo") < 0 ||
+      fcmpy_vec(hi_o, hi, 3, "hi") < 0 || fcmpy_index3(n_o, n, "n") < 0 ||
+      fcmpy_set_options(level_set_table, &o, opts_o, "Geometry.from_implicit") < 0)
+    return NULL;
+  const Py_ssize_t count = PyList_GET_SIZE(nodes_o);
+  if (count < 1 || count > FCM_IMPLICIT_MAX_NODES)
+    return PyErr_Format(PyExc_ValueError, "implicit tree: %zd nodes, expected 1 to %d", count,
+                        FCM_IMPLICIT_MAX_NODES);
+  memset(nodes, 0, sizeof nodes);
+  for (Py_ssize_t i = 0; i < count; i++)
+    if (fcmpy_set_options(implicit_table, &nodes[i], PyList_GET_ITEM(nodes_o, i), "implicit node") <
+        0)
+      return NULL;
+  const fcm_implicit_tree tree = {(int)count, nodes};
+  fcm_status st = fcm_implicit_check(ctx, &tree);
+  fcm_geometry *g = NULL;
+  fcm_level_set_info info;
+  if (st == FCM_OK)
+    st = fcm_geometry_create_from_level_set(ctx, fcm_implicit_eval, (void *)&tree, lo, hi, n, &o,
+                                            &g, &info);
+  PyObject *h = made(st, ctx, FCMPY_GEOMETRY, g, ch, NULL);
+  if (!h) return NULL;
+  return Py_BuildValue("N{s:L,s:L,s:L,s:L,s:d,s:d}", h, "cells_cut", (long long)info.cells_cut,
+                       "num_tets", (long long)info.num_tets, "subcells", (long long)info.subcells,
+                       "cells_inside", (long long)info.cells_inside, "volume", info.volume,
+                       "error_estimate", info.error_estimate);
+}
+
 static const fcmpy_option surface_mesh_table[] = {
     {"max_volume", 'd', 1, offsetof(fcm_surface_mesh_options, max_volume)},
     {"size", 'd', 1, offsetof(fcm_surface_mesh_options, size)},
@@ -577,6 +634,7 @@ PyMethodDef fcmpy_geometry_methods[] = {
     {"geometry_shape", geometry_shape, METH_VARARGS, NULL},
     {"geometry_transformed", geometry_transformed, METH_VARARGS, NULL},
     {"geometry_from_level_set", geometry_from_level_set, METH_VARARGS, NULL},
+    {"geometry_from_implicit", geometry_from_implicit, METH_VARARGS, NULL},
     {"geometry_from_surface", geometry_from_surface, METH_VARARGS, NULL},
     {"geometry_from_voxels", geometry_from_voxels, METH_VARARGS, NULL},
     {"geometry_info", geometry_info, METH_O, NULL},

@@ -81,3 +81,28 @@ def test_octree_background(ctx):
     region = fcm.Mesh.octree(ctx, fcm.HEX8, [0, 0, 0], [1, 1, 1], [1, 1, 1], region_level=1,
                              region_lo=[0, 0, 0], region_hi=[0.1, 0.1, 0.1])
     assert region.num_cells == 8
+
+
+def test_implicit_tree(ctx):
+    """A sphere minus a box through its centre by the library's implicit functions: the
+    volume converges to the exact one as O(h^2), and an invalid tree names the member."""
+    nodes = [{"kind": "sphere", "center": [0, 0, 0], "radius": 0.4},
+             {"kind": "box", "min": [0, -1, -1], "max": [1, 1, 1]},
+             {"kind": "difference", "a": 0, "b": 1}]
+    exact = 2 / 3 * np.pi * 0.4 ** 3  # the half x < 0
+    errors = []
+    for refinement in (2, 4):
+        g = fcm.Geometry.from_implicit(ctx, nodes, [-0.5] * 3, [0.5] * 3, [5, 5, 5],
+                                       refinement=refinement)
+        assert g.info["volume"] == pytest.approx(g.volume, rel=1e-13)
+        assert g.coords[:, 0].max() <= 1e-15
+        errors.append(abs(g.volume - exact))
+    assert errors[1] < errors[0] / 3
+    with pytest.raises(fcm.Error, match="radius"):
+        fcm.Geometry.from_implicit(ctx, [{"kind": "sphere", "radius": -1.0}], [-1] * 3, [1] * 3,
+                                   [2, 2, 2])
+    with pytest.raises(ValueError, match="implicit kind 'cone'"):
+        fcm.Geometry.from_implicit(ctx, [{"kind": "cone"}], [-1] * 3, [1] * 3, [2, 2, 2])
+    with pytest.raises(TypeError, match="unknown option 'radiuss'"):
+        fcm.Geometry.from_implicit(ctx, [{"kind": "sphere", "radiuss": 1}], [-1] * 3, [1] * 3,
+                                   [2, 2, 2])
