@@ -65,7 +65,7 @@ if(FCM_HAVE_PYTHON)
   set(FCM_PYTHON_DIR ${PROJECT_BINARY_DIR}/python) # the build tree's package (PYTHONPATH)
   Python3_add_library(fcm_python MODULE WITH_SOABI lib/python/src/module.c
                       lib/python/src/arrays.c lib/python/src/geometry.c lib/python/src/rules.c
-                      lib/python/src/simulation.c)
+                      lib/python/src/simulation.c lib/python/src/scene.c)
   target_link_libraries(fcm_python PRIVATE fcm::fcm Python3::NumPy)
   target_include_directories(fcm_python PRIVATE ${PROJECT_SOURCE_DIR}/lib/python/src)
   target_compile_definitions(fcm_python PRIVATE NPY_NO_DEPRECATED_API=NPY_1_7_API_VERSION)

@@ -124,8 +124,9 @@ StepInfo = dict
 class Integrator(FcmObject):
     """A static or dynamic solver on a space: ``Integrator(ctx, space, material, **options)``.
 
-    Add loads and constraints (:meth:`add_gravity`, :meth:`add_constraint`,
-    :meth:`add_boundary_constraint`), then :meth:`setup` and :meth:`step` as often as wanted:
+    Add loads, constraints and obstacles (:meth:`add_gravity`, :meth:`add_body_force`,
+    :meth:`add_traction`, :meth:`add_constraint`, :meth:`add_boundary_constraint`,
+    :meth:`add_contact_plane`), then :meth:`setup` and :meth:`step` as often as wanted:
     the host owns the time loop. Between steps :meth:`cut` continues the state on the space
     of cut rules (like apps/examples/host_dynamic.cpp).
 
@@ -152,9 +153,33 @@ class Integrator(FcmObject):
         """The default options as a dict."""
         return _fcm.integrator_defaults()
 
-    def add_gravity(self, acceleration=(0.0, 0.0, -9.81)):
-        """A uniform body acceleration (m/s^2)."""
-        _fcm.integrator_add_gravity(self._h, acceleration)
+    def add_gravity(self, acceleration=(0.0, 0.0, -9.81), scale=None):
+        """A uniform body acceleration (m/s^2), times scale(t) when given (a callable)."""
+        _fcm.integrator_add_load(self._h, "gravity", acceleration, scale)
+
+    def add_body_force(self, field, scale=None):
+        """A body force density b = field(x, None) (N/m^3, three numbers at the physical point
+        x), times scale(t). Called from the assembly's threads during setup and steps; an
+        exception it raises fails that call and is raised there."""
+        _fcm.integrator_add_load(self._h, "body_force", field, scale)
+
+    def add_traction(self, field, scale=None):
+        """A traction t = field(x, normal) (N/m^2) on the embedded boundary (the rules need
+        surface_strength), times scale(t); called as :meth:`add_body_force`'s field."""
+        _fcm.integrator_add_load(self._h, "traction", field, scale)
+
+    def add_contact_plane(self, point, normal, velocity=(0.0, 0.0, 0.0), distance=0.0,
+                          stiffness=0.0):
+        """A rigid half-space obstacle (the plane through point, normal pointing to the body's
+        side, moving at velocity) by the log barrier on the embedded surface's points
+        (distance: the barrier's threshold, 0: 0.1 h; stiffness: 0: E / h). Needs surface
+        rules. Returns its id for :meth:`contact_info`."""
+        return _fcm.integrator_add_contact_plane(self._h, point, normal, velocity,
+                                                 float(distance), float(stiffness))
+
+    def contact_info(self, obstacle_id):
+        """force, min_distance, distance (threshold) and stiffness of a contact obstacle."""
+        return _fcm.integrator_contact_info(self._h, int(obstacle_id))
 
     def add_constraint(self, nodes, **motion):
         """Hold mesh nodes (ids) fixed, or move them by a motion: velocity, center, axis,

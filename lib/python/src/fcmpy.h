@@ -71,6 +71,8 @@ void *fcmpy_get(PyObject *obj, fcmpy_kind kind);
 int fcmpy_keep(PyObject *handle, PyObject *obj);
 void fcmpy_handle_release_user(fcmpy_handle *h);
 PyObject *fcmpy_raise(fcm_ctx *ctx, fcm_status st);
+PyObject *fcmpy_made(fcm_status st, fcmpy_handle *parent, fcmpy_kind kind, void *ptr,
+                     PyObject *dep1, PyObject *dep2);
 
 /* arrays.c */
 PyObject *fcmpy_view(PyObject *owner, const void *data, int typenum, int nd, const npy_intp *dims);
@@ -92,5 +94,9 @@ int fcmpy_material(PyObject *obj, fcm_material *mat);
 extern PyMethodDef fcmpy_geometry_methods[];
 extern PyMethodDef fcmpy_rules_methods[];
 extern PyMethodDef fcmpy_simulation_methods[];
+extern PyMethodDef fcmpy_scene_methods[];
+
+/* The members of fcm_step_info, for the step reports of integrators and simulations. */
+extern const fcmpy_option fcmpy_step_table[];
 
 #endif /* FCMPY_H */

@@ -171,6 +171,17 @@ int fcmpy_keep(PyObject *handle, PyObject *obj)
   return h->keep ? PyList_Append(h->keep, obj) : 0;
 }
 
+/* A new handle of `kind` made in the context of `parent` from the handles `deps`. */
+PyObject *fcmpy_made(fcm_status st, fcmpy_handle *parent, fcmpy_kind kind, void *ptr,
+                     PyObject *dep1, PyObject *dep2)
+{
+  if (st != FCM_OK) return fcmpy_raise(parent->ctx, st);
+  PyObject *ctx_h =
+      parent->kind == FCMPY_CTX ? (PyObject *)parent : PyList_GET_ITEM(parent->keep, 0);
+  PyObject *deps[3] = {ctx_h, dep1, dep2};
+  return fcmpy_handle_new(kind, ptr, parent->ctx, deps, 3);
+}
+
 PyObject *fcmpy_raise(fcm_ctx *ctx, fcm_status st)
 {
   const char *msg = ctx ? fcm_ctx_error_message(ctx) : "";
@@ -395,7 +406,8 @@ PyMODINIT_FUNC PyInit__fcm(void)
       PyModule_AddIntConstant(m, "DEFAULT", FCM_DEFAULT) < 0 || add_statuses(m) < 0 ||
       PyModule_AddFunctions(m, fcmpy_geometry_methods) < 0 ||
       PyModule_AddFunctions(m, fcmpy_rules_methods) < 0 ||
-      PyModule_AddFunctions(m, fcmpy_simulation_methods) < 0) {
+      PyModule_AddFunctions(m, fcmpy_simulation_methods) < 0 ||
+      PyModule_AddFunctions(m, fcmpy_scene_methods) < 0) {
     Py_DECREF(m);
     return NULL;
   }

@@ -1,7 +1,9 @@
-/* fcm's Python binding: spaces, integrators (a host-owned time loop, cuts between steps,
- * boundary constraints selected by a Python callable), embedded surfaces, scenes and their
- * simulations (a Python monitor after each step). */
+/* fcm's Python binding: spaces, integrators (a host-owned time loop, cuts between steps, loads,
+ * constraints and boundary selectors given by Python callables, contact planes) and embedded
+ * surfaces. */
 #include "fcmpy.h"
+
+#include <math.h>
 
 #define IO(member) offsetof(fcm_integrator_options, member)
 static const fcmpy_option integrator_table[] = {
@@ -43,7 +45,7 @@ static const fcmpy_option integrator_table[] = {
 
 /* long long and fcm_index are both 64-bit integers: 'n'. */
 #define SI(member) offsetof(fcm_step_info, member)
-static const fcmpy_option step_table[] = {
+const fcmpy_option fcmpy_step_table[] = {
     {"reason", 'i', 1, SI(reason)},
     {"newton_iterations", 'i', 1, SI(newton_iterations)},
     {"line_search_backtracks", 'i', 1, SI(line_search_backtracks)},
@@ -101,16 +103,7 @@ static const fcmpy_option boundary_table[] = {{"method", 'i', 1, BO(method)},
                                               {NULL, 0, 0, 0}};
 #undef BO
 
-/* A new handle of `kind` made in the context of `parent` from the handles `deps`. */
-static PyObject *made(fcm_status st, fcmpy_handle *parent, fcmpy_kind kind, void *ptr,
-                      PyObject *dep1, PyObject *dep2)
-{
-  if (st != FCM_OK) return fcmpy_raise(parent->ctx, st);
-  PyObject *ctx_h =
-      parent->kind == FCMPY_CTX ? (PyObject *)parent : PyList_GET_ITEM(parent->keep, 0);
-  PyObject *deps[3] = {ctx_h, dep1, dep2};
-  return fcmpy_handle_new(kind, ptr, parent->ctx, deps, 3);
-}
+static fcmpy_callback *kept_callback(fcmpy_handle *h, PyObject *fn);
 
 /* A DOF vector of `n` doubles (a copy when it is not one already). */
 static PyArrayObject *dof_vector(PyObject *obj, fcm_index n, const char *what)
@@ -143,7 +136,7 @@ static PyObject *space_create(PyObject *self, PyObject *args)
     if (!r) return NULL;
     st = fcm_space_create_embedded(c->ptr, m->ptr, r->ptr, &space);
   }
-  return made(st, c, FCMPY_SPACE, space, mh, rh == Py_None ? NULL : rh);
+  return fcmpy_made(st, c, FCMPY_SPACE, space, mh, rh == Py_None ? NULL : rh);
 }
 
 static PyObject *space_info(PyObject *self, PyObject *sh)
@@ -336,7 +329,7 @@ static PyObject *integrator_create(PyObject *self, PyObject *args)
   if (!s) return NULL;
   fcm_integrator *integ = NULL;
   fcm_status st = fcm_integrator_create(c->ptr, s->ptr, &mat, &o, &integ);
-  return made(st, c, FCMPY_INTEGRATOR, integ, sh, NULL);
+  return fcmpy_made(st, c, FCMPY_INTEGRATOR, integ, sh, NULL);
 }
 
 static PyObject *integrator_create_cut(PyObject *self, PyObject *args)
@@ -357,26 +350,13 @@ static PyObject *integrator_create_cut(PyObject *self, PyObject *args)
     fcm_ctx_error_clear(old->ctx);
     return NULL;
   }
-  PyObject *h = made(st, old, FCMPY_INTEGRATOR, integ, sh, NULL);
+  PyObject *h = fcmpy_made(st, old, FCMPY_INTEGRATOR, integ, sh, NULL);
   /* the new integrator calls the old one's boundary selectors: it keeps them */
   for (Py_ssize_t i = 0; h && i < PyList_GET_SIZE(old->keep); i++) {
     PyObject *o = PyList_GET_ITEM(old->keep, i);
     if (PyCapsule_CheckExact(o) && fcmpy_keep(h, o) < 0) Py_CLEAR(h);
   }
   return h;
-}
-
-static PyObject *integrator_add_gravity(PyObject *self, PyObject *args)
-{
-  (void)self;
-  PyObject *ih, *g_o;
-  double g[3];
-  if (!PyArg_ParseTuple(args, "OO", &ih, &g_o)) return NULL;
-  fcmpy_handle *h = fcmpy_handle_of(ih, FCMPY_INTEGRATOR);
-  if (!h || fcmpy_vec(g_o, g, 3, "acceleration") < 0) return NULL;
-  fcm_status st = fcm_integrator_add_gravity(h->ptr, g, NULL, NULL);
-  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
-  Py_RETURN_NONE;
 }
 
 static PyObject *integrator_add_constraint(PyObject *self, PyObject *args)
@@ -424,7 +404,7 @@ static int boundary_select(void *user, const double X[3], const double normal[3]
 static PyObject *integrator_add_boundary_constraint(PyObject *self, PyObject *args)
 {
   (void)self;
-  PyObject *ih, *fn, *motion_o, *opts_o, *capsule = NULL;
+  PyObject *ih, *fn, *motion_o, *opts_o;
   fcm_motion motion = fcm_motion_default();
   fcm_boundary_options bo = fcm_boundary_options_default();
   if (!PyArg_ParseTuple(args, "OOOO", &ih, &fn, &motion_o, &opts_o)) return NULL;
@@ -432,15 +412,126 @@ static PyObject *integrator_add_boundary_constraint(PyObject *self, PyObject *ar
   if (!h || fcmpy_set_options(motion_table, &motion, motion_o, "motion") < 0 ||
       fcmpy_set_options(boundary_table, &bo, opts_o, "boundary options") < 0)
     return NULL;
-  fcmpy_callback *cb = fcmpy_callback_new(fn, &capsule);
+  fcmpy_callback *cb = kept_callback(h, fn);
   if (!cb) return NULL;
-  int rc = fcmpy_keep((PyObject *)h, capsule);
-  Py_DECREF(capsule); /* the integrator's list keeps it */
-  if (rc < 0) return NULL;
   int id = -1;
   fcm_status st =
       fcm_integrator_add_boundary_constraint(h->ptr, boundary_select, cb, &motion, &bo, &id);
   return st == FCM_OK ? PyLong_FromLong(id) : fcmpy_raise(h->ctx, st);
+}
+
+/* The Python field of a body force or traction: value = field(x, normal) (normal None for
+ * volume fields), called from the assembly's threads (each takes the GIL). After an
+ * exception the value is NaN, which fails the step; the exception is raised instead. */
+static void field_eval(void *user, const double x[3], const double normal[3], double value[3])
+{
+  fcmpy_callback *cb = user;
+  PyGILState_STATE gil = PyGILState_Ensure();
+  value[0] = value[1] = value[2] = NAN;
+  if (!cb->type) {
+    npy_intp dims[1] = {3};
+    PyObject *xa = fcmpy_copy(x, NPY_DOUBLE, 1, dims);
+    PyObject *na = normal ? fcmpy_copy(normal, NPY_DOUBLE, 1, dims) : Py_NewRef(Py_None);
+    PyObject *r = xa && na ? PyObject_CallFunctionObjArgs(cb->fn, xa, na, NULL) : NULL;
+    double v[3];
+    if (r && fcmpy_vec(r, v, 3, "the field's value") == 0) memcpy(value, v, sizeof v);
+    Py_XDECREF(xa);
+    Py_XDECREF(na);
+    Py_XDECREF(r);
+    if (PyErr_Occurred()) fcmpy_callback_fail(cb);
+  }
+  PyGILState_Release(gil);
+}
+
+/* The Python time scale of a load: scale(t), a float. */
+static double time_scale(void *user, double t)
+{
+  fcmpy_callback *cb = user;
+  PyGILState_STATE gil = PyGILState_Ensure();
+  double v = NAN;
+  if (!cb->type) {
+    PyObject *r = PyObject_CallFunction(cb->fn, "d", t);
+    v = r ? PyFloat_AsDouble(r) : NAN;
+    Py_XDECREF(r);
+    if (PyErr_Occurred()) {
+      fcmpy_callback_fail(cb);
+      v = NAN;
+    }
+  }
+  PyGILState_Release(gil);
+  return v;
+}
+
+/* A callable kept by the integrator for as long as the library may call it. */
+static fcmpy_callback *kept_callback(fcmpy_handle *h, PyObject *fn)
+{
+  PyObject *capsule = NULL;
+  fcmpy_callback *cb = fcmpy_callback_new(fn, &capsule);
+  if (!cb) return NULL;
+  int rc = fcmpy_keep((PyObject *)h, capsule);
+  Py_DECREF(capsule);
+  return rc < 0 ? NULL : cb;
+}
+
+/* ("gravity", accel, scale) | ("body_force" | "traction", field, scale); scale None: 1. */
+static PyObject *integrator_add_load(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *ih, *what_o, *scale_o;
+  const char *what;
+  if (!PyArg_ParseTuple(args, "OsOO", &ih, &what, &what_o, &scale_o)) return NULL;
+  fcmpy_handle *h = fcmpy_handle_of(ih, FCMPY_INTEGRATOR);
+  if (!h) return NULL;
+  fcmpy_callback *scale = NULL, *field = NULL;
+  double g[3];
+  if (scale_o != Py_None && !(scale = kept_callback(h, scale_o))) return NULL;
+  fcm_time_fn sfn = scale ? time_scale : NULL;
+  fcm_status st;
+  if (!strcmp(what, "gravity")) {
+    if (fcmpy_vec(what_o, g, 3, "acceleration") < 0) return NULL;
+    st = fcm_integrator_add_gravity(h->ptr, g, sfn, scale);
+  } else if (!strcmp(what, "body_force") || !strcmp(what, "traction")) {
+    if (!(field = kept_callback(h, what_o))) return NULL;
+    st = what[0] == 'b' ? fcm_integrator_add_body_force(h->ptr, field_eval, field, sfn, scale)
+                        : fcm_integrator_add_traction(h->ptr, field_eval, field, sfn, scale);
+  } else {
+    return PyErr_Format(PyExc_ValueError, "unknown load '%s'", what);
+  }
+  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
+  Py_RETURN_NONE;
+}
+
+static PyObject *integrator_add_contact_plane(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *ih, *p_o, *n_o, *v_o;
+  double p[3], n[3], v[3], distance, stiffness;
+  if (!PyArg_ParseTuple(args, "OOOOdd", &ih, &p_o, &n_o, &v_o, &distance, &stiffness)) return NULL;
+  fcmpy_handle *h = fcmpy_handle_of(ih, FCMPY_INTEGRATOR);
+  if (!h || fcmpy_vec(p_o, p, 3, "point") < 0 || fcmpy_vec(n_o, n, 3, "normal") < 0 ||
+      fcmpy_vec(v_o, v, 3, "velocity") < 0)
+    return NULL;
+  fcm_contact_options o = fcm_contact_options_default();
+  o.distance = distance;
+  o.stiffness = stiffness;
+  int id = -1;
+  fcm_status st = fcm_integrator_add_contact_plane(h->ptr, p, n, v, &o, &id);
+  return st == FCM_OK ? PyLong_FromLong(id) : fcmpy_raise(h->ctx, st);
+}
+
+static PyObject *integrator_contact_info(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *ih;
+  int id;
+  double f[3], dmin = 0, dhat = 0, kappa = 0;
+  if (!PyArg_ParseTuple(args, "Oi", &ih, &id)) return NULL;
+  fcmpy_handle *h = fcmpy_handle_of(ih, FCMPY_INTEGRATOR);
+  if (!h) return NULL;
+  fcm_status st = fcm_integrator_contact_info(h->ptr, id, f, &dmin, &dhat, &kappa);
+  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
+  return Py_BuildValue("{s:(ddd),s:d,s:d,s:d}", "force", f[0], f[1], f[2], "min_distance", dmin,
+                       "distance", dhat, "stiffness", kappa);
 }
 
 /* Call the integrator, the GIL released (a boundary selector may run on any thread); a
@@ -481,7 +572,7 @@ static PyObject *integrator_step(PyObject *self, PyObject *ih)
   PyObject *r = integrator_call(h, st);
   if (!r) return NULL;
   Py_DECREF(r);
-  return fcmpy_options_dict(step_table, &info);
+  return fcmpy_options_dict(fcmpy_step_table, &info);
 }
 
 /* (u, v, t, steps): copies (the integrator overwrites its state every step). */
@@ -568,7 +659,7 @@ static PyObject *esurf_create(PyObject *self, PyObject *args)
   if (!g) return NULL;
   fcm_embedded_surface *es = NULL;
   fcm_status st = fcm_embedded_surface_create(s->ptr, g, &es);
-  return made(st, s, FCMPY_EMBEDDED_SURFACE, es, sh, gh);
+  return fcmpy_made(st, s, FCMPY_EMBEDDED_SURFACE, es, sh, gh);
 }
 
 static PyObject *esurf_set_space(PyObject *self, PyObject *args)
@@ -652,193 +743,6 @@ static PyObject *esurf_write_vtu(PyObject *self, PyObject *args)
   Py_RETURN_NONE;
 }
 
-/* ---------------------------------------------------------------- scenes, simulations */
-
-static PyObject *scene_create(PyObject *self, PyObject *args)
-{
-  (void)self;
-  PyObject *ch;
-  const char *how, *text = NULL, *name = NULL;
-  if (!PyArg_ParseTuple(args, "Os|zz", &ch, &how, &text, &name)) return NULL;
-  fcmpy_handle *c = fcmpy_handle_of(ch, FCMPY_CTX);
-  if (!c) return NULL;
-  fcm_scene *scene = NULL;
-  fcm_status st;
-  if (!strcmp(how, "file") && text)
-    st = fcm_scene_create_from_file(c->ptr, text, &scene);
-  else if (!strcmp(how, "string") && text)
-    st = fcm_scene_create_from_string(c->ptr, text, name, &scene);
-  else if (!strcmp(how, "default"))
-    st = fcm_scene_create_default(c->ptr, &scene);
-  else
-    return PyErr_Format(PyExc_ValueError, "scene_create: unknown source '%s'", how);
-  return made(st, c, FCMPY_SCENE, scene, NULL, NULL);
-}
-
-static PyObject *scene_info(PyObject *self, PyObject *sh)
-{
-  (void)self;
-  const fcm_scene *s = fcmpy_get(sh, FCMPY_SCENE);
-  if (!s) return NULL;
-  const fcm_material *m = fcm_scene_get_material(s);
-  return Py_BuildValue("{s:s,s:s,s:s,s:s,s:i,s:(iddd)}", "name", fcm_scene_name(s), "description",
-                       fcm_scene_description(s), "source", fcm_scene_source(s), "json",
-                       fcm_scene_json(s), "num_effects", fcm_scene_num_effects(s), "material",
-                       (int)m->model, m->young, m->poisson, m->density);
-}
-
-static PyObject *simulation_create(PyObject *self, PyObject *args)
-{
-  (void)self;
-  PyObject *ch, *sh;
-  long long max_steps;
-  if (!PyArg_ParseTuple(args, "OOL", &ch, &sh, &max_steps)) return NULL;
-  fcmpy_handle *c = fcmpy_handle_of(ch, FCMPY_CTX);
-  const fcm_scene *scene = c ? fcmpy_get(sh, FCMPY_SCENE) : NULL;
-  if (!scene) return NULL;
-  fcm_simulation_options o = fcm_simulation_options_default();
-  o.max_steps = (fcm_index)max_steps;
-  fcm_simulation *sim = NULL;
-  fcm_status st;
-  PyThreadState *gil = PyEval_SaveThread();
-  st = fcm_simulation_create(c->ptr, scene, &o, &sim);
-  PyEval_RestoreThread(gil);
-  return made(st, c, FCMPY_SIMULATION, sim, sh, NULL);
-}
-
-static PyObject *simulation_step(PyObject *self, PyObject *simh)
-{
-  (void)self;
-  fcmpy_handle *h = fcmpy_handle_of(simh, FCMPY_SIMULATION);
-  if (!h) return NULL;
-  fcm_step_info info;
-  fcm_status st;
-  memset(&info, 0, sizeof info);
-  PyThreadState *gil = PyEval_SaveThread();
-  st = fcm_simulation_step(h->ptr, &info);
-  PyEval_RestoreThread(gil);
-  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
-  return fcmpy_options_dict(step_table, &info);
-}
-
-/* The monitor of fcm_simulation_run(): the Python callable gets (step, num_steps, info);
- * False stops the run (FCM_OK returned: a host's own choice), an exception too (raised). */
-typedef struct monitor_state {
-  fcmpy_callback *cb;
-  int stopped;
-} monitor_state;
-
-static fcm_status run_monitor(void *user, fcm_simulation *sim, const fcm_simulation_step_event *ev)
-{
-  (void)sim;
-  monitor_state *ms = user;
-  PyGILState_STATE gil = PyGILState_Ensure();
-  PyObject *info = fcmpy_options_dict(step_table, ev->info);
-  PyObject *r =
-      info ? PyObject_CallFunction(ms->cb->fn, "LLO", ev->step, ev->num_steps, info) : NULL;
-  Py_XDECREF(info);
-  fcm_status st = FCM_OK;
-  if (!r) {
-    fcmpy_callback_fail(ms->cb);
-    st = FCM_ERR_INTERNAL;
-  } else if (r == Py_False) {
-    ms->stopped = 1;
-    st = FCM_ERR_INTERNAL;
-  }
-  Py_XDECREF(r);
-  PyGILState_Release(gil);
-  return st;
-}
-
-static PyObject *simulation_run(PyObject *self, PyObject *args)
-{
-  (void)self;
-  PyObject *simh, *fn, *capsule = NULL;
-  if (!PyArg_ParseTuple(args, "OO", &simh, &fn)) return NULL;
-  fcmpy_handle *h = fcmpy_handle_of(simh, FCMPY_SIMULATION);
-  if (!h) return NULL;
-  monitor_state ms = {NULL, 0};
-  if (fn != Py_None && !(ms.cb = fcmpy_callback_new(fn, &capsule))) return NULL;
-  fcm_status st;
-  PyThreadState *gil = PyEval_SaveThread();
-  st = fcm_simulation_run(h->ptr, ms.cb ? run_monitor : NULL, &ms);
-  PyEval_RestoreThread(gil);
-  int raised = fcmpy_callback_restore(ms.cb);
-  Py_XDECREF(capsule);
-  if (raised || ms.stopped) {
-    fcm_ctx_error_clear(h->ctx);
-    if (raised) return NULL;
-    Py_RETURN_FALSE;
-  }
-  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
-  Py_RETURN_TRUE;
-}
-
-static PyObject *simulation_info(PyObject *self, PyObject *simh)
-{
-  (void)self;
-  fcm_simulation *s = fcmpy_get(simh, FCMPY_SIMULATION);
-  if (!s) return NULL;
-  return Py_BuildValue("{s:i,s:L,s:L,s:i,s:i}", "done", fcm_simulation_done(s), "step_count",
-                       fcm_simulation_step_count(s), "num_steps", fcm_simulation_num_steps(s),
-                       "frame_due", fcm_simulation_frame_due(s), "state_finite",
-                       fcm_simulation_state_finite(s));
-}
-
-/* (u, v, t, node displacement (num_nodes, 3)): copies of the current state. */
-static PyObject *simulation_state(PyObject *self, PyObject *simh)
-{
-  (void)self;
-  fcmpy_handle *h = fcmpy_handle_of(simh, FCMPY_SIMULATION);
-  if (!h) return NULL;
-  fcm_integrator *integ = fcm_simulation_integrator(h->ptr);
-  const fcm_space *space = fcm_simulation_space(h->ptr);
-  npy_intp dims[1] = {fcm_integrator_num_dofs(integ)};
-  npy_intp dn[2] = {fcm_mesh_num_nodes(fcm_space_mesh(space)), 3};
-  PyObject *u = PyArray_SimpleNew(1, dims, NPY_DOUBLE), *v = PyArray_SimpleNew(1, dims, NPY_DOUBLE);
-  PyObject *un = PyArray_SimpleNew(2, dn, NPY_DOUBLE);
-  double t = 0;
-  long long steps = 0;
-  fcm_status st = FCM_ERR_ALLOC;
-  if (u && v && un) {
-    fcm_integrator_get_state(integ, PyArray_DATA((PyArrayObject *)u),
-                             PyArray_DATA((PyArrayObject *)v), &t, &steps);
-    st = fcm_space_node_field(space, PyArray_DATA((PyArrayObject *)u),
-                              PyArray_DATA((PyArrayObject *)un));
-  }
-  if (st != FCM_OK) {
-    Py_XDECREF(u);
-    Py_XDECREF(v);
-    Py_XDECREF(un);
-    return u && v && un ? fcmpy_raise(h->ctx, st) : NULL;
-  }
-  return Py_BuildValue("NNdN", u, v, t, un);
-}
-
-static PyObject *simulation_write(PyObject *self, PyObject *args)
-{
-  (void)self;
-  PyObject *simh;
-  const char *what, *path;
-  int index = 0;
-  if (!PyArg_ParseTuple(args, "Oss|i", &simh, &what, &path, &index)) return NULL;
-  fcmpy_handle *h = fcmpy_handle_of(simh, FCMPY_SIMULATION);
-  if (!h) return NULL;
-  fcm_status st;
-  if (!strcmp(what, "log"))
-    st = fcm_simulation_write_log(h->ptr, path);
-  else if (!strcmp(what, "frame"))
-    st = fcm_simulation_write_frame(h->ptr, path, index);
-  else if (!strcmp(what, "checkpoint"))
-    st = fcm_simulation_write_checkpoint(h->ptr, path);
-  else if (!strcmp(what, "restore"))
-    st = fcm_simulation_read_checkpoint(h->ptr, path);
-  else
-    return PyErr_Format(PyExc_ValueError, "simulation_write: unknown output '%s'", what);
-  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
-  Py_RETURN_NONE;
-}
-
 PyMethodDef fcmpy_simulation_methods[] = {
     {"space_create", space_create, METH_VARARGS, NULL},
     {"space_info", space_info, METH_O, NULL},
@@ -852,7 +756,9 @@ PyMethodDef fcmpy_simulation_methods[] = {
     {"integrator_defaults", integrator_defaults, METH_NOARGS, NULL},
     {"integrator_create", integrator_create, METH_VARARGS, NULL},
     {"integrator_create_cut", integrator_create_cut, METH_VARARGS, NULL},
-    {"integrator_add_gravity", integrator_add_gravity, METH_VARARGS, NULL},
+    {"integrator_add_load", integrator_add_load, METH_VARARGS, NULL},
+    {"integrator_add_contact_plane", integrator_add_contact_plane, METH_VARARGS, NULL},
+    {"integrator_contact_info", integrator_contact_info, METH_VARARGS, NULL},
     {"integrator_add_constraint", integrator_add_constraint, METH_VARARGS, NULL},
     {"integrator_add_boundary_constraint", integrator_add_boundary_constraint, METH_VARARGS, NULL},
     {"integrator_setup", integrator_setup, METH_O, NULL},
@@ -866,12 +772,4 @@ PyMethodDef fcmpy_simulation_methods[] = {
     {"esurf_arrays", esurf_arrays, METH_O, NULL},
     {"esurf_eval", esurf_eval, METH_VARARGS, NULL},
     {"esurf_write_vtu", esurf_write_vtu, METH_VARARGS, NULL},
-    {"scene_create", scene_create, METH_VARARGS, NULL},
-    {"scene_info", scene_info, METH_O, NULL},
-    {"simulation_create", simulation_create, METH_VARARGS, NULL},
-    {"simulation_step", simulation_step, METH_O, NULL},
-    {"simulation_run", simulation_run, METH_VARARGS, NULL},
-    {"simulation_info", simulation_info, METH_O, NULL},
-    {"simulation_state", simulation_state, METH_O, NULL},
-    {"simulation_write", simulation_write, METH_VARARGS, NULL},
     {NULL, NULL, 0, NULL}};
