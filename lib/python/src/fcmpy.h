@@ -70,6 +70,10 @@ fcmpy_handle *fcmpy_handle_of(PyObject *obj, fcmpy_kind kind);
 void *fcmpy_get(PyObject *obj, fcmpy_kind kind);
 int fcmpy_keep(PyObject *handle, PyObject *obj);
 void fcmpy_handle_release_user(fcmpy_handle *h);
+/* Keep an object alive across a call that runs Python code (a callback, or another thread
+ * while the GIL is released), even if that code closes it. */
+void fcmpy_pin(fcmpy_handle *h);
+void fcmpy_unpin(fcmpy_handle *h);
 PyObject *fcmpy_raise(fcm_ctx *ctx, fcm_status st);
 PyObject *fcmpy_made(fcm_status st, fcmpy_handle *parent, fcmpy_kind kind, void *ptr,
                      PyObject *dep1, PyObject *dep2);

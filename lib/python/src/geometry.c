@@ -356,13 +356,13 @@ static const fcmpy_option level_set_table[] = {
 static PyObject *geometry_from_level_set(PyObject *self, PyObject *args)
 {
   (void)self;
-  PyObject *ch, *fn, *lo_o, *hi_o, *n_o, *opts_o, *capsule = NULL;
+  PyObject *ch, *fn, *lo_o, *hi_o, *n_o, *opts_o, *capsule = NULL, *pinned;
   double lo[3], hi[3];
   fcm_index n[3];
   fcm_ctx *ctx;
   fcm_level_set_options o = fcm_level_set_options_default();
   if (!PyArg_ParseTuple(args, "OOOOOO", &ch, &fn, &lo_o, &hi_o, &n_o, &opts_o) ||
-      !ctx_handle(ch, &ctx) || fcmpy_vec(lo_o, lo, 3, "lo") < 0 ||
+      !(pinned = ctx_handle(ch, &ctx)) || fcmpy_vec(lo_o, lo, 3, "lo") < 0 ||
       fcmpy_vec(hi_o, hi, 3, "hi") < 0 || fcmpy_index3(n_o, n, "n") < 0 ||
       fcmpy_set_options(level_set_table, &o, opts_o, "Geometry.from_level_set") < 0)
     return NULL;
@@ -370,16 +370,18 @@ static PyObject *geometry_from_level_set(PyObject *self, PyObject *args)
   if (!cb) return NULL;
   fcm_geometry *g = NULL;
   fcm_level_set_info info;
+  PyObject *h = NULL;
+  fcmpy_pin((fcmpy_handle *)pinned); /* phi may close the context */
   fcm_status st =
       fcm_geometry_create_from_level_set(ctx, level_set_phi, cb, lo, hi, n, &o, &g, &info);
   if (fcmpy_callback_restore(cb)) {
     fcm_geometry_destroy(&g);
     fcm_ctx_error_clear(ctx);
-    Py_DECREF(capsule);
-    return NULL;
+  } else {
+    h = made(st, ctx, FCMPY_GEOMETRY, g, pinned, NULL);
   }
   Py_DECREF(capsule);
-  PyObject *h = made(st, ctx, FCMPY_GEOMETRY, g, ch, NULL);
+  fcmpy_unpin((fcmpy_handle *)pinned);
   if (!h) return NULL;
   return Py_BuildValue("N{s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d}", h, "cells_inside",
                        (long long)info.cells_inside, "cells_cut", (long long)info.cells_cut,

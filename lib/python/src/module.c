@@ -77,6 +77,19 @@ void fcmpy_handle_release_user(fcmpy_handle *h)
   try_release(h);
 }
 
+void fcmpy_pin(fcmpy_handle *h)
+{
+  Py_INCREF(h);
+  h->views++;
+}
+
+void fcmpy_unpin(fcmpy_handle *h)
+{
+  h->views--;
+  try_release(h);
+  Py_DECREF(h);
+}
+
 /* Called by the view guard of arrays.c when a view ends. */
 void fcmpy_handle_view_ended(fcmpy_handle *h);
 void fcmpy_handle_view_ended(fcmpy_handle *h)

@@ -47,11 +47,16 @@ static PyObject *simulation_create(PyObject *self, PyObject *args)
   fcm_simulation_options o = fcm_simulation_options_default();
   o.max_steps = (fcm_index)max_steps;
   fcm_simulation *sim = NULL;
-  fcm_status st;
+  fcmpy_handle *scene_h = fcmpy_handle_of(sh, FCMPY_SCENE);
+  fcmpy_pin(c);
+  fcmpy_pin(scene_h);
   PyThreadState *gil = PyEval_SaveThread();
-  st = fcm_simulation_create(c->ptr, scene, &o, &sim);
+  fcm_status st = fcm_simulation_create(c->ptr, scene, &o, &sim);
   PyEval_RestoreThread(gil);
-  return fcmpy_made(st, c, FCMPY_SIMULATION, sim, sh, NULL);
+  PyObject *h = fcmpy_made(st, c, FCMPY_SIMULATION, sim, sh, NULL);
+  fcmpy_unpin(scene_h);
+  fcmpy_unpin(c);
+  return h;
 }
 
 static PyObject *simulation_step(PyObject *self, PyObject *simh)
@@ -62,11 +67,14 @@ static PyObject *simulation_step(PyObject *self, PyObject *simh)
   fcm_step_info info;
   fcm_status st;
   memset(&info, 0, sizeof info);
+  fcmpy_pin(h);
   PyThreadState *gil = PyEval_SaveThread();
   st = fcm_simulation_step(h->ptr, &info);
   PyEval_RestoreThread(gil);
-  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
-  return fcmpy_options_dict(fcmpy_step_table, &info);
+  PyObject *r =
+      st == FCM_OK ? fcmpy_options_dict(fcmpy_step_table, &info) : fcmpy_raise(h->ctx, st);
+  fcmpy_unpin(h);
+  return r;
 }
 
 /* The monitor of fcm_simulation_run(): the Python callable gets (step, num_steps, info);
@@ -107,19 +115,22 @@ static PyObject *simulation_run(PyObject *self, PyObject *args)
   if (!h) return NULL;
   monitor_state ms = {NULL, 0};
   if (fn != Py_None && !(ms.cb = fcmpy_callback_new(fn, &capsule))) return NULL;
-  fcm_status st;
+  fcmpy_pin(h); /* the monitor may close the simulation */
   PyThreadState *gil = PyEval_SaveThread();
-  st = fcm_simulation_run(h->ptr, ms.cb ? run_monitor : NULL, &ms);
+  fcm_status st = fcm_simulation_run(h->ptr, ms.cb ? run_monitor : NULL, &ms);
   PyEval_RestoreThread(gil);
-  int raised = fcmpy_callback_restore(ms.cb);
-  Py_XDECREF(capsule);
-  if (raised || ms.stopped) {
+  PyObject *r = NULL;
+  if (fcmpy_callback_restore(ms.cb)) {
     fcm_ctx_error_clear(h->ctx);
-    if (raised) return NULL;
-    Py_RETURN_FALSE;
+  } else if (ms.stopped) {
+    fcm_ctx_error_clear(h->ctx);
+    r = Py_NewRef(Py_False);
+  } else {
+    r = st == FCM_OK ? Py_NewRef(Py_True) : fcmpy_raise(h->ctx, st);
   }
-  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
-  Py_RETURN_TRUE;
+  Py_XDECREF(capsule);
+  fcmpy_unpin(h);
+  return r;
 }
 
 static PyObject *simulation_info(PyObject *self, PyObject *simh)

@@ -342,20 +342,25 @@ static PyObject *integrator_create_cut(PyObject *self, PyObject *args)
   if (!s) return NULL;
   fcm_integrator *integ = NULL;
   fcm_status st;
+  PyObject *h = NULL;
+  fcmpy_pin(old);
+  fcmpy_pin(s);
   PyThreadState *gil = PyEval_SaveThread();
   st = fcm_integrator_create_cut(old->ptr, s->ptr, &integ);
   PyEval_RestoreThread(gil);
   if (fcmpy_callbacks_restore(old->keep)) {
     fcm_integrator_destroy(&integ);
     fcm_ctx_error_clear(old->ctx);
-    return NULL;
+  } else {
+    h = fcmpy_made(st, old, FCMPY_INTEGRATOR, integ, sh, NULL);
   }
-  PyObject *h = fcmpy_made(st, old, FCMPY_INTEGRATOR, integ, sh, NULL);
-  /* the new integrator calls the old one's boundary selectors: it keeps them */
+  /* the new integrator calls the old one's callables: it keeps them */
   for (Py_ssize_t i = 0; h && i < PyList_GET_SIZE(old->keep); i++) {
     PyObject *o = PyList_GET_ITEM(old->keep, i);
     if (PyCapsule_CheckExact(o) && fcmpy_keep(h, o) < 0) Py_CLEAR(h);
   }
+  fcmpy_unpin(s);
+  fcmpy_unpin(old);
   return h;
 }
 
@@ -551,11 +556,13 @@ static PyObject *integrator_setup(PyObject *self, PyObject *ih)
   (void)self;
   fcmpy_handle *h = fcmpy_handle_of(ih, FCMPY_INTEGRATOR);
   if (!h) return NULL;
-  fcm_status st;
+  fcmpy_pin(h);
   PyThreadState *gil = PyEval_SaveThread();
-  st = fcm_integrator_setup(h->ptr);
+  fcm_status st = fcm_integrator_setup(h->ptr);
   PyEval_RestoreThread(gil);
-  return integrator_call(h, st);
+  PyObject *r = integrator_call(h, st);
+  fcmpy_unpin(h);
+  return r;
 }
 
 static PyObject *integrator_step(PyObject *self, PyObject *ih)
@@ -566,10 +573,12 @@ static PyObject *integrator_step(PyObject *self, PyObject *ih)
   fcm_step_info info;
   fcm_status st;
   memset(&info, 0, sizeof info);
+  fcmpy_pin(h);
   PyThreadState *gil = PyEval_SaveThread();
   st = fcm_integrator_step(h->ptr, &info);
   PyEval_RestoreThread(gil);
   PyObject *r = integrator_call(h, st);
+  fcmpy_unpin(h);
   if (!r) return NULL;
   Py_DECREF(r);
   return fcmpy_options_dict(fcmpy_step_table, &info);

@@ -87,3 +87,37 @@ def test_cycle_through_callback_is_collected(ctx):
     gc.collect()
     assert ref() is None
     assert ctx.live_allocations == 0
+
+
+def test_closed_inside_callbacks():
+    """A callback that closes the objects the running call uses: the call completes on them
+    (they end afterwards) and nothing reads freed memory."""
+    c = fcm.Context()
+
+    def phi(x):
+        c.close()
+        return float(np.linalg.norm(x)) - 0.3
+
+    g = fcm.Geometry.from_level_set(c, phi, [-0.5] * 3, [0.5] * 3, [2, 2, 2])
+    assert c.closed and g.volume > 0
+    del g
+    gc.collect()
+
+    ctx = fcm.Context()
+    mesh = fcm.Mesh.box(ctx, fcm.HEX8, [0, 0, 0], [2, 0.5, 0.5], [4, 1, 1])
+    bar = fcm.Geometry.box(ctx, [0, 0.05, 0.05], [1.8, 0.45, 0.45], [4, 1, 1])
+    rules = fcm.CellRules(ctx, mesh, bar)
+    integ = fcm.Integrator(ctx, fcm.Space(ctx, mesh, rules),
+                           fcm.Material(fcm.MaterialModel.LINEAR, 1e6, 0.3, 1e3), dt=0.01)
+
+    def field(x, normal):
+        integ.close()
+        return (0.0, 0.0, -9810.0)
+
+    integ.add_body_force(field)
+    integ.add_constraint(mesh.nodes_in_box([-1, -1, -1], [0, 1, 1], 1e-9))
+    integ.setup()  # completes; the integrator ends after it
+    assert integ.closed and integ._h.released
+    del integ, rules, mesh, bar
+    gc.collect()
+    assert ctx.live_allocations == 0
