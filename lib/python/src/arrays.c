@@ -1,37 +1,10 @@
-/* fcm's Python binding: NumPy views that keep their owner alive, checked array and vector
- * inputs, options set by keyword, captured view output, Python callables called by fcm. */
+/* fcm's Python binding: checked array and vector inputs, copies out, options set by keyword,
+ * captured view output, Python callables called by fcm. */
 #define _POSIX_C_SOURCE 200809L /* open_memstream */
 #include "fcmpy.h"
 
 #include <stdlib.h>
 #include <string.h>
-
-void fcmpy_handle_view_ended(fcmpy_handle *h);
-
-/* The base object of a view: holds the handle and counts itself in its views, so the fcm
- * object outlives every view into it even when the handle is closed first. */
-typedef struct guard {
-  PyObject_HEAD fcmpy_handle *owner;
-} guard;
-
-static void guard_dealloc(guard *g)
-{
-  fcmpy_handle *h = g->owner;
-  g->owner = NULL;
-  if (h) {
-    fcmpy_handle_view_ended(h);
-    Py_DECREF(h);
-  }
-  PyObject_Free(g);
-}
-
-PyTypeObject fcmpy_guard_type = {
-    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "fcm._fcm.ViewOwner",
-    .tp_basicsize = sizeof(guard),
-    .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "Keeps an fcm object alive while a NumPy view reads its memory.",
-    .tp_dealloc = (destructor)guard_dealloc,
-};
 
 PyObject *fcmpy_copy(const void *data, int typenum, int nd, const npy_intp *dims)
 {
@@ -39,35 +12,6 @@ PyObject *fcmpy_copy(const void *data, int typenum, int nd, const npy_intp *dims
   if (!a) return NULL;
   size_t bytes = (size_t)PyArray_NBYTES((PyArrayObject *)a);
   if (bytes > 0 && data) memcpy(PyArray_DATA((PyArrayObject *)a), data, bytes);
-  return a;
-}
-
-PyObject *fcmpy_view(PyObject *owner, const void *data, int typenum, int nd, const npy_intp *dims)
-{
-  npy_intp size = 1;
-  for (int d = 0; d < nd; d++)
-    size *= dims[d];
-  if (!data || size == 0) { /* nothing to share: an empty (or zero) array of its own */
-    PyObject *a = PyArray_ZEROS(nd, (npy_intp *)dims, typenum, 0);
-    if (a) PyArray_CLEARFLAGS((PyArrayObject *)a, NPY_ARRAY_WRITEABLE);
-    return a;
-  }
-  guard *g = PyObject_New(guard, &fcmpy_guard_type);
-  if (!g) return NULL;
-  fcmpy_handle *h = (fcmpy_handle *)owner;
-  Py_INCREF(h);
-  h->views++;
-  g->owner = h;
-  PyObject *a = PyArray_New(&PyArray_Type, nd, (npy_intp *)dims, typenum, NULL, (void *)data, 0,
-                            NPY_ARRAY_CARRAY_RO, NULL);
-  if (!a) {
-    Py_DECREF(g);
-    return NULL;
-  }
-  if (PyArray_SetBaseObject((PyArrayObject *)a, (PyObject *)g) < 0) { /* steals g */
-    Py_DECREF(a);
-    return NULL;
-  }
   return a;
 }
 

@@ -64,6 +64,7 @@ extern PyTypeObject fcmpy_handle_type;
 extern PyObject *fcmpy_error_type;
 
 /* module.c */
+PyObject *fcmpy_view(PyObject *owner, const void *data, int typenum, int nd, const npy_intp *dims);
 PyObject *fcmpy_handle_new(fcmpy_kind kind, void *ptr, fcm_ctx *ctx, PyObject *const *deps,
                            int num_deps);
 fcmpy_handle *fcmpy_handle_of(PyObject *obj, fcmpy_kind kind);
@@ -79,7 +80,6 @@ PyObject *fcmpy_made(fcm_status st, fcmpy_handle *parent, fcmpy_kind kind, void 
                      PyObject *dep1, PyObject *dep2);
 
 /* arrays.c */
-PyObject *fcmpy_view(PyObject *owner, const void *data, int typenum, int nd, const npy_intp *dims);
 PyObject *fcmpy_copy(const void *data, int typenum, int nd, const npy_intp *dims);
 PyArrayObject *fcmpy_input(PyObject *obj, int typenum, int nd, npy_intp cols, const char *what);
 int fcmpy_vec(PyObject *obj, double *out, int n, const char *what);

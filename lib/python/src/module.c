@@ -1,10 +1,9 @@
-/* fcm's Python binding: the module fcm._fcm, the handle type every fcm object lives in, the
- * exception fcm.Error, and the context. */
+/* fcm's Python binding: the module fcm._fcm, the handle type every fcm object lives in and
+ * the NumPy views that keep it alive, the exception fcm.Error, and the context. */
 #define FCMPY_IMPORT_ARRAY
 #include "fcmpy.h"
 
 PyObject *fcmpy_error_type = NULL;
-extern PyTypeObject fcmpy_guard_type;
 
 static const char *const kind_names[FCMPY_KIND_COUNT] = {
     "Context", "Mesh",       "Geometry",        "Surface", "VoxelImage", "CellRules",
@@ -90,12 +89,59 @@ void fcmpy_unpin(fcmpy_handle *h)
   Py_DECREF(h);
 }
 
-/* Called by the view guard of arrays.c when a view ends. */
-void fcmpy_handle_view_ended(fcmpy_handle *h);
-void fcmpy_handle_view_ended(fcmpy_handle *h)
+/* The base object of a view: holds the handle and counts itself in its views, so the fcm
+ * object outlives every view into it even when the handle is closed first. */
+typedef struct guard {
+  PyObject_HEAD fcmpy_handle *owner;
+} guard;
+
+static void guard_dealloc(guard *g)
 {
-  h->views--;
-  try_release(h);
+  fcmpy_handle *h = g->owner;
+  g->owner = NULL;
+  if (h) {
+    h->views--;
+    try_release(h);
+    Py_DECREF(h);
+  }
+  PyObject_Free(g);
+}
+
+static PyTypeObject fcmpy_guard_type = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "fcm._fcm.ViewOwner",
+    .tp_basicsize = sizeof(guard),
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "Keeps an fcm object alive while a NumPy view reads its memory.",
+    .tp_dealloc = (destructor)guard_dealloc,
+};
+
+PyObject *fcmpy_view(PyObject *owner, const void *data, int typenum, int nd, const npy_intp *dims)
+{
+  npy_intp size = 1;
+  for (int d = 0; d < nd; d++)
+    size *= dims[d];
+  if (!data || size == 0) { /* nothing to share: an empty (or zero) array of its own */
+    PyObject *a = PyArray_ZEROS(nd, (npy_intp *)dims, typenum, 0);
+    if (a) PyArray_CLEARFLAGS((PyArrayObject *)a, NPY_ARRAY_WRITEABLE);
+    return a;
+  }
+  guard *g = PyObject_New(guard, &fcmpy_guard_type);
+  if (!g) return NULL;
+  fcmpy_handle *h = (fcmpy_handle *)owner;
+  Py_INCREF(h);
+  h->views++;
+  g->owner = h;
+  PyObject *a = PyArray_New(&PyArray_Type, nd, (npy_intp *)dims, typenum, NULL, (void *)data, 0,
+                            NPY_ARRAY_CARRAY_RO, NULL);
+  if (!a) {
+    Py_DECREF(g);
+    return NULL;
+  }
+  if (PyArray_SetBaseObject((PyArrayObject *)a, (PyObject *)g) < 0) { /* steals g */
+    Py_DECREF(a);
+    return NULL;
+  }
+  return a;
 }
 
 PyObject *fcmpy_handle_new(fcmpy_kind kind, void *ptr, fcm_ctx *ctx, PyObject *const *deps,
