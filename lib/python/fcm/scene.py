@@ -55,7 +55,7 @@ class Simulation(FcmObject):
 
     def step(self):
         """One step: its report as a dict (``fcm_step_info``)."""
-        return _fcm.simulation_step(self._h)
+        return _fcm.step(self._h)
 
     def run(self, monitor=None):
         """Take the steps left. monitor(step, num_steps, step_info), called after each step,

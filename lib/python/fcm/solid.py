@@ -200,7 +200,7 @@ class Integrator(FcmObject):
     def step(self):
         """One step (a static solve, or one time step): the step's report as a dict
         (``fcm_step_info``: reason, newton_iterations, residual, time, energies, ...)."""
-        return _fcm.integrator_step(self._h)
+        return _fcm.step(self._h)
 
     def run(self, steps, callback=None):
         """Take `steps` steps; after each, callback(integrator, step_info) may return a new

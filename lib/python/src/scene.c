@@ -59,24 +59,6 @@ static PyObject *simulation_create(PyObject *self, PyObject *args)
   return h;
 }
 
-static PyObject *simulation_step(PyObject *self, PyObject *simh)
-{
-  (void)self;
-  fcmpy_handle *h = fcmpy_handle_of(simh, FCMPY_SIMULATION);
-  if (!h) return NULL;
-  fcm_step_info info;
-  fcm_status st;
-  memset(&info, 0, sizeof info);
-  fcmpy_pin(h);
-  PyThreadState *gil = PyEval_SaveThread();
-  st = fcm_simulation_step(h->ptr, &info);
-  PyEval_RestoreThread(gil);
-  PyObject *r =
-      st == FCM_OK ? fcmpy_options_dict(fcmpy_step_table, &info) : fcmpy_raise(h->ctx, st);
-  fcmpy_unpin(h);
-  return r;
-}
-
 /* The monitor of fcm_simulation_run(): the Python callable gets (step, num_steps, info);
  * False stops the run (FCM_OK returned: a host's own choice), an exception too (raised). */
 typedef struct monitor_state {
@@ -201,7 +183,6 @@ static PyObject *simulation_write(PyObject *self, PyObject *args)
 PyMethodDef fcmpy_scene_methods[] = {{"scene_create", scene_create, METH_VARARGS, NULL},
                                      {"scene_info", scene_info, METH_O, NULL},
                                      {"simulation_create", simulation_create, METH_VARARGS, NULL},
-                                     {"simulation_step", simulation_step, METH_O, NULL},
                                      {"simulation_run", simulation_run, METH_VARARGS, NULL},
                                      {"simulation_info", simulation_info, METH_O, NULL},
                                      {"simulation_state", simulation_state, METH_O, NULL},

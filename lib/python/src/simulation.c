@@ -565,17 +565,20 @@ static PyObject *integrator_setup(PyObject *self, PyObject *ih)
   return r;
 }
 
-static PyObject *integrator_step(PyObject *self, PyObject *ih)
+/* One step of an integrator or of a simulation (the handle says which): its report. */
+static PyObject *take_step(PyObject *self, PyObject *obj)
 {
   (void)self;
-  fcmpy_handle *h = fcmpy_handle_of(ih, FCMPY_INTEGRATOR);
+  const int sim = PyObject_TypeCheck(obj, &fcmpy_handle_type) &&
+                  ((fcmpy_handle *)obj)->kind == FCMPY_SIMULATION;
+  fcmpy_handle *h = fcmpy_handle_of(obj, sim ? FCMPY_SIMULATION : FCMPY_INTEGRATOR);
   if (!h) return NULL;
   fcm_step_info info;
   fcm_status st;
   memset(&info, 0, sizeof info);
   fcmpy_pin(h);
   PyThreadState *gil = PyEval_SaveThread();
-  st = fcm_integrator_step(h->ptr, &info);
+  st = sim ? fcm_simulation_step(h->ptr, &info) : fcm_integrator_step(h->ptr, &info);
   PyEval_RestoreThread(gil);
   PyObject *r = integrator_call(h, st);
   fcmpy_unpin(h);
@@ -771,7 +774,7 @@ PyMethodDef fcmpy_simulation_methods[] = {
     {"integrator_add_constraint", integrator_add_constraint, METH_VARARGS, NULL},
     {"integrator_add_boundary_constraint", integrator_add_boundary_constraint, METH_VARARGS, NULL},
     {"integrator_setup", integrator_setup, METH_O, NULL},
-    {"integrator_step", integrator_step, METH_O, NULL},
+    {"step", take_step, METH_O, NULL},
     {"integrator_state", integrator_state, METH_O, NULL},
     {"integrator_set_state", integrator_set_state, METH_VARARGS, NULL},
     {"integrator_reaction", integrator_reaction, METH_VARARGS, NULL},

@@ -58,3 +58,16 @@ def test_scene_bit_for_bit(ctx, reference, scratch, source_dir):
     log = sim.log()
     assert list(log["step"]) == [1, 2, 3]
     assert np.all(np.diff(log["time"]) > 0) and np.all(np.isfinite(log["mass"]))
+
+
+def test_scene_host_loop(ctx, reference, scratch, source_dir):
+    """The same steps taken one by one by the host equal the run and the C API's."""
+    path = source_dir / "apps" / "scenes" / "cut_slab.json"
+    sim = fcm.Simulation(ctx, fcm.Scene.from_file(ctx, path), max_steps=3)
+    times = []
+    while not sim.done:
+        times.append(sim.step()["time"])
+    assert len(times) == 3 and times == sorted(times)
+    assert np.array_equal(sim.state()[0], c_result(reference, scratch, "scene", path, 3))
+    with pytest.raises(fcm.Error):
+        sim.step()  # the run is done
