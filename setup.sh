@@ -4,6 +4,10 @@
 #   bash setup.sh test    install what is missing, build, run the default test suite
 #   bash setup.sh bench   build and run the benchmarks (ctest label "bench")
 #   bash setup.sh deps    only install the Debian packages
+#   bash setup.sh install [PREFIX]
+#                         install what is missing, build, install the library, programs and
+#                         the Python package fcm into PREFIX (default /usr/local, where
+#                         Debian's python3 finds the package)
 #   bash setup.sh deps --petsc
 #                         also the optional PETSc + MPI backend's (petsc-dev, openmpi-bin;
 #                         `test --petsc` etc. likewise): the build then has the backend
@@ -13,7 +17,8 @@
 #                         build, install into a temporary prefix, move it, and build and run
 #                         the example host programs (apps/examples) against the installed
 #                         package with `pkg-config --cflags --libs fcm` and find_package(fcm)
-#                         (with the PETSc component, host_petsc with fcm-petsc and fcm::petsc)
+#                         (with the PETSc component, host_petsc with fcm-petsc and fcm::petsc),
+#                         and import the Python package fcm from the moved tree
 # Environment: FCM_BUILD_DIR (default: build), FCM_CMAKE_ARGS (extra CMake arguments),
 #              FCM_JOBS (parallel build jobs, default: number of cores).
 set -euo pipefail
@@ -22,7 +27,8 @@ here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 build=${FCM_BUILD_DIR:-$here/build}
 jobs=${FCM_JOBS:-$(nproc 2>/dev/null || echo 2)}
 packages=(build-essential cmake pkg-config libopenblas-dev liblapacke-dev libglpk-dev
-          libsuitesparse-dev libcjson-dev libgmsh-dev gnuplot-nox)
+          libsuitesparse-dev libcjson-dev libgmsh-dev gnuplot-nox
+          python3-dev python3-numpy python3-pytest python3-matplotlib)
 # --petsc (the argument after the command): the PETSc + MPI backend's packages too
 if [ "${2:-}" = "--petsc" ]; then
   packages+=(petsc-dev openmpi-bin)
@@ -151,10 +157,21 @@ $(PKG_CONFIG_PATH="$pcdir" pkg-config --static --libs fcm)"
   else
     [ ! -e "$ex/build/host_petsc" ]
   fi
+  # the Python package (when built) imports from the moved tree: its module finds the moved
+  # libfcm through its $ORIGIN rpath
+  local pyinit python
+  pyinit=$(find "$prefix/fcm" -path '*/fcm/__init__.py' | head -n 1)
+  local pymsg=""
+  if [ -n "$pyinit" ]; then
+    python=$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$build/CMakeCache.txt")
+    PYTHONPATH=$(dirname "$(dirname "$pyinit")") "${python:-python3}" -c \
+      "import fcm; ctx = fcm.Context(); assert fcm.__version__ and fcm.Mesh.box(ctx, fcm.HEX8, [0, 0, 0], [1, 1, 1], [1, 1, 1]).num_cells == 1"
+    pymsg="; the Python package imported from the moved tree"
+  fi
   # the installed programs find the moved libfcm through their $ORIGIN rpath
   if [ -x "$prefix/fcm/bin/fcm-sim" ]; then "$prefix/fcm/bin/fcm-sim" --help >/dev/null; fi
   echo "install check: examples built against the installed package (pkg-config and"\
-       "find_package) and run: host_static, host_dynamic$([ "$have" = 1 ] && echo ", host_petsc")"
+       "find_package) and run: host_static, host_dynamic$([ "$have" = 1 ] && echo ", host_petsc")$pymsg"
   [ "${FCM_KEEP_PREFIX:-0}" = 1 ] && echo "install check: prefix kept: $prefix"
   return 0
 }
@@ -173,6 +190,12 @@ case "${1:-}" in
     configure_and_build
     (cd "$build" && ctest --output-on-failure -j "$jobs" -LE 'bench|slow')
     ;;
+  install)
+    deps
+    configure_and_build
+    cmake --install "$build" --prefix "${2:-/usr/local}" >/dev/null
+    echo "setup.sh: installed into ${2:-/usr/local}"
+    ;;
   install-check)
     deps
     configure_and_build
@@ -184,7 +207,7 @@ case "${1:-}" in
     (cd "$build" && ctest --output-on-failure -L bench)
     ;;
   *)
-    sed -n '2,17p' "$0"
+    sed -n '2,23p' "$0"
     exit 2
     ;;
 esac
