@@ -6,6 +6,12 @@
 // solution; optionally compares its nodal values with fcm's solution of the same problem.
 //
 //   dealii_kinked RULES.fcmr [--degree P] [--compare FCM_SOLUTION.txt] [--tolerance T]
+//   dealii_kinked --levelset N Q
+//
+// The second form measures, for contrast, deal.II's own cut-cell rules on the same body: its
+// NonMatching::QuadratureGenerator (Saye's algorithm, QGauss<1>(Q) base) on the N^3 grid with
+// the body's level set max over its faces (exact on the faces, not smooth at the kinks), and
+// prints the errors of the volume and the centroid it integrates.
 //
 // The mapping between deal.II's cells and fcm's is explicit and checked: every deal.II cell is
 // matched to the fcm cell with the same centre, its eight vertices must be fcm's nodes in VTK
@@ -27,6 +33,7 @@
 #include <deal.II/lac/sparse_direct.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/vector.h>
+#include <deal.II/non_matching/quadrature_generator.h>
 
 #include <boost/property_tree/json_parser.hpp>
 #include <boost/property_tree/ptree.hpp>
@@ -464,6 +471,115 @@ double KinkedProblem::compare(const std::string &fcm_solution) const
   if (!lines) throw std::runtime_error(fcm_solution + ": no nodes");
   return diff / scale;
 }
+// ------------------------------------------------------------------ deal.II's own rules
+
+// The body's level set: the largest of its face functions, each affine in x and zero on its
+// face (in the parameter coordinates p = A^-1 (x - c): -s, s - 1, ..., s + t + r - cut).
+class BodyLevelSet : public Function<3>
+{
+public:
+  BodyLevelSet()
+  {
+    const double *a = kinked_A;
+    const double det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
+                       a[2] * (a[3] * a[7] - a[4] * a[6]);
+    inv_ = {{(a[4] * a[8] - a[5] * a[7]) / det, (a[2] * a[7] - a[1] * a[8]) / det,
+             (a[1] * a[5] - a[2] * a[4]) / det, (a[5] * a[6] - a[3] * a[8]) / det,
+             (a[0] * a[8] - a[2] * a[6]) / det, (a[2] * a[3] - a[0] * a[5]) / det,
+             (a[3] * a[7] - a[4] * a[6]) / det, (a[1] * a[6] - a[0] * a[7]) / det,
+             (a[0] * a[4] - a[1] * a[3]) / det}};
+  }
+
+  double value(const Point<3> &x, const unsigned = 0) const override
+  {
+    Tensor<1, 3> g;
+    return face(x, g);
+  }
+
+  Tensor<1, 3> gradient(const Point<3> &x, const unsigned = 0) const override
+  {
+    Tensor<1, 3> g;
+    face(x, g);
+    return g;
+  }
+
+private:
+  // The largest face function at x, and its gradient in g.
+  double face(const Point<3> &x, Tensor<1, 3> &g) const
+  {
+    double p[3];
+    for (int i = 0; i < 3; i++) {
+      p[i] = 0;
+      for (int j = 0; j < 3; j++)
+        p[i] += inv_[3 * i + j] * (x[j] - kinked_c[j]);
+    }
+    double best = -1e300;
+    for (int f = 0; f < 7; f++) {
+      double v, dp[3] = {0, 0, 0}; // the face function and its gradient in p
+      if (f < 6) {
+        const int i = f / 2;
+        v = f % 2 ? p[i] - 1 : -p[i];
+        dp[i] = f % 2 ? 1 : -1;
+      } else {
+        v = p[0] + p[1] + p[2] - KINKED_CUT;
+        dp[0] = dp[1] = dp[2] = 1;
+      }
+      if (v > best) {
+        best = v;
+        for (int j = 0; j < 3; j++)
+          g[j] = inv_[j] * dp[0] + inv_[3 + j] * dp[1] + inv_[6 + j] * dp[2];
+      }
+    }
+    return best;
+  }
+
+  std::array<double, 9> inv_;
+};
+
+// The volume and centroid errors of deal.II's inside rules on the N^3 grid; 0 on success.
+int levelset_study(unsigned n, unsigned q)
+{
+  // exact volume and centroid from the body's tetrahedra
+  double xyz[3 * KINKED_NODES], vol = 0, mom[3] = {0, 0, 0};
+  long long tets[4 * KINKED_TETS];
+  kinked_body(xyz, tets);
+  for (int t = 0; t < KINKED_TETS; t++) {
+    const double *v[4];
+    for (int k = 0; k < 4; k++)
+      v[k] = xyz + 3 * tets[4 * t + k];
+    Tensor<2, 3> e;
+    for (int k = 0; k < 3; k++)
+      for (int d = 0; d < 3; d++)
+        e[k][d] = v[k + 1][d] - v[0][d];
+    const double vt = std::abs(determinant(e)) / 6;
+    vol += vt;
+    for (int d = 0; d < 3; d++)
+      mom[d] += vt * (v[0][d] + v[1][d] + v[2][d] + v[3][d]) / 4;
+  }
+  Triangulation<3> tria;
+  GridGenerator::subdivided_hyper_rectangle(tria, {n, n, n}, Point<3>(0, 0, 0), Point<3>(1, 1, 1));
+  const BodyLevelSet phi;
+  const hp::QCollection<1> base{QGauss<1>(q)};
+  NonMatching::QuadratureGenerator<3> gen(base);
+  double v = 0, m[3] = {0, 0, 0};
+  for (const auto &cell : tria.active_cell_iterators()) {
+    const BoundingBox<3> box(std::make_pair(cell->vertex(0), cell->vertex(7)));
+    gen.generate(phi, box);
+    const Quadrature<3> &in = gen.get_inside_quadrature();
+    for (unsigned k = 0; k < in.size(); k++) {
+      v += in.weight(k);
+      for (int d = 0; d < 3; d++)
+        m[d] += in.weight(k) * in.point(k)[d];
+    }
+  }
+  double cerr = 0;
+  for (int d = 0; d < 3; d++)
+    cerr = std::max(cerr, std::abs(m[d] / v - mom[d] / vol));
+  std::printf("dealii_kinked --levelset: N = %u, QGauss<1>(%u): volume %.15g (exact %.15g, "
+              "relative error %.2e), centroid error %.2e\n",
+              n, q, v, vol, std::abs(v - vol) / vol, cerr);
+  return 0;
+}
 } // namespace
 
 int main(int argc, char **argv)
@@ -471,6 +587,14 @@ int main(int argc, char **argv)
   std::string rules, compare;
   unsigned degree = 1;
   double tolerance = 1e-10;
+  if (argc == 4 && std::string(argv[1]) == "--levelset") {
+    const int n = std::atoi(argv[2]), q = std::atoi(argv[3]);
+    if (n < 1 || n > 256 || q < 1 || q > 10) {
+      std::cerr << "dealii_kinked --levelset N Q: N in [1, 256], Q in [1, 10]\n";
+      return 2;
+    }
+    return levelset_study(static_cast<unsigned>(n), static_cast<unsigned>(q));
+  }
   for (int i = 1; i < argc; i++) {
     const std::string a = argv[i];
     if (a == "--degree" && i + 1 < argc)
