@@ -193,147 +193,9 @@ static void embed_usage(FILE *f, const cli_option *opts)
   cli_print_options(f, opts);
 }
 
-static int has_ext(const char *path, const char *ext)
-{
-  size_t n = strlen(path), e = strlen(ext);
-  if (n <= e) return 0;
-  for (size_t i = 0; i < e; i++)
-    if (tolower((unsigned char)path[n - e + i]) != ext[i]) return 0;
-  return 1;
-}
-
-/* A triangle surface file: read, holes closed when asked (reported on stderr),
- * tetrahedralized. */
-static fcm_status load_surface(fcm_ctx *ctx, const char *path, int fill_holes, double max_volume,
-                               fcm_geometry **g)
-{
-  fcm_surface *s = NULL, *f = NULL;
-  fcm_status st = fcm_surface_create_from_file(ctx, path, &s);
-  if (st == FCM_OK && fill_holes) {
-    fcm_surface_fill_info fi;
-    st = fcm_surface_create_filled(ctx, s, NULL, &f, &fi);
-    if (st == FCM_OK) {
-      fprintf(stderr,
-              "fcm-quadrature embed: %s: fill_holes closed %lld of %lld hole(s), adding %lld "
-              "triangles of total area %g\n",
-              path, (long long)fi.num_filled, (long long)fi.num_loops,
-              (long long)fi.triangles_added, fi.area_added);
-      fcm_surface_destroy(&s);
-      s = f;
-    }
-  }
-  if (st == FCM_OK) {
-    fcm_surface_mesh_options mo = fcm_surface_mesh_options_default();
-    mo.max_volume = max_volume;
-    st = fcm_geometry_create_from_surface(ctx, s, &mo, g);
-  }
-  fcm_surface_destroy(&s);
-  return st;
-}
-
-/* A voxel image (NRRD, MetaImage): the voxels >= 0.5 merged into boxes. */
-static fcm_status load_voxels(fcm_ctx *ctx, const char *path, fcm_geometry **g)
-{
-  fcm_voxel_image *img = NULL;
-  fcm_status st = fcm_voxel_image_create_from_file(ctx, path, &img);
-  if (st == FCM_OK) st = fcm_geometry_create_from_voxels(ctx, img, NULL, g, NULL);
-  fcm_voxel_image_destroy(&img);
-  return st;
-}
-
-/* Procedural geometry "name:a,b,c,..." or a file, by its extension. */
-static fcm_status load_geometry(fcm_ctx *ctx, const char *spec, int fill_holes, double max_volume,
-                                fcm_geometry **g)
-{
-  double v[8];
-  int n = 0;
-  const char *colon = strchr(spec, ':');
-  if (colon && !strchr(spec, '/') && colon - spec <= 12) {
-    char name[16] = {0};
-    memcpy(name, spec, (size_t)(colon - spec));
-    const char *p = colon + 1;
-    while (*p && n < 8) {
-      char *end = NULL;
-      v[n++] = strtod(p, &end);
-      if (end == p) return FCM_ERR_ARG;
-      p = *end == ',' ? end + 1 : end;
-      if (*end && *end != ',') return FCM_ERR_ARG;
-    }
-    if (!strcmp(name, "ball") && n == 5)
-      return fcm_geometry_create_ball(ctx, v, v[3], (int)v[4], g);
-    if (!strcmp(name, "hemisphere") && n == 5)
-      return fcm_geometry_create_hemisphere(ctx, v, v[3], (int)v[4], g);
-    if (!strcmp(name, "box") && n == 7) {
-      fcm_index nn[3] = {(fcm_index)v[6], (fcm_index)v[6], (fcm_index)v[6]};
-      return fcm_geometry_create_box(ctx, v, v + 3, nn, g);
-    }
-    return FCM_ERR_ARG;
-  }
-  size_t len = strlen(spec);
-  if (has_ext(spec, ".node") || has_ext(spec, ".ele")) { /* TetGen: base.node + base.ele */
-    char node[4096], ele[4096];
-    int base = (int)(len - (has_ext(spec, ".node") ? 5 : 4));
-    snprintf(node, sizeof node, "%.*s.node", base, spec);
-    snprintf(ele, sizeof ele, "%.*s.ele", base, spec);
-    return fcm_geometry_create_from_tetgen(ctx, node, ele, g);
-  }
-  if (has_ext(spec, ".obj") || has_ext(spec, ".off") || has_ext(spec, ".stl") ||
-      has_ext(spec, ".ply"))
-    return load_surface(ctx, spec, fill_holes, max_volume, g);
-  if (has_ext(spec, ".nrrd") || has_ext(spec, ".nhdr") || has_ext(spec, ".mhd") ||
-      has_ext(spec, ".mha"))
-    return load_voxels(ctx, spec, g);
-  return fcm_geometry_create_from_gmsh(ctx, spec, g);
-}
-
-/* The settings of `embed` (its command line). */
-typedef struct embed_args {
-  fcm_element_type type;
-  double box[6], alpha, phimin, max_volume;
-  int cells[3], strength, mstrength, no_simplify, have_box, fill_holes;
-  const char *geometry, *dump;
-} embed_args;
-
-/* The required options present and the box not empty; else the exit code after saying why
- * (-1: fine). */
-static int embed_check(const embed_args *a)
-{
-  const char *missing = a->type == FCM_ELEMENT_COUNT ? "--element"
-                        : !a->have_box               ? "--box"
-                        : !a->cells[0]               ? "--cells"
-                        : !a->geometry               ? "--geometry"
-                        : !a->strength               ? "--strength"
-                                                     : NULL;
-  if (missing) {
-    fprintf(stderr, "fcm-quadrature embed: %s is required (see --help)\n", missing);
-    return 2;
-  }
-  for (int d = 0; d < 3; d++)
-    if (!(a->box[d] < a->box[d + 3])) {
-      fprintf(stderr, "fcm-quadrature embed: --box: X0 Y0 Z0 must be below X1 Y1 Z1\n");
-      return 2;
-    }
-  return -1;
-}
-
-/* The cell rules options of the command line. */
-static fcm_cell_rules_options embed_rules_options(const embed_args *a)
-{
-  fcm_cell_rules_options ro = fcm_cell_rules_options_default();
-  ro.strength[FCM_RULE_STIFFNESS] = a->strength;
-  if (a->mstrength) ro.strength[FCM_RULE_MASS] = a->mstrength;
-  ro.simplify = !a->no_simplify;
-  ro.min_fraction = a->phimin;
-  if (a->alpha > 0)
-    ro.stabilization.alpha = a->alpha;
-  else
-    ro.stabilization.mode = FCM_STABILIZATION_OFF;
-  return ro;
-}
-
 /* The background grid, the geometry and the cell rules with their statistics on stdout (and
  * the points into --dump); the exit code. */
-static int embed_run(const embed_args *a)
+static int embed_run(const fcm_quadrature_grid *a, const char *dump)
 {
   int rc = 1;
   fcm_ctx *ctx = NULL;
@@ -343,24 +205,9 @@ static int embed_run(const embed_args *a)
   FILE *out = NULL;
   cli_output *outf = NULL;
   if (fcm_ctx_create(NULL, &ctx) != FCM_OK) return 1;
-  const fcm_index n[3] = {a->cells[0], a->cells[1], a->cells[2]};
-  if (fcm_mesh_create_box(ctx, a->type, a->box, a->box + 3, n, &mesh) != FCM_OK) {
-    fcm_ctx_error_view(ctx, stderr);
-    goto done;
-  }
-  fcm_status st = load_geometry(ctx, a->geometry, a->fill_holes, a->max_volume, &geom);
-  if (st != FCM_OK) {
-    if (fcm_ctx_error_status(ctx) != FCM_OK)
-      fcm_ctx_error_view(ctx, stderr);
-    else
-      fprintf(stderr,
-              "fcm-quadrature embed: --geometry '%s': not a readable file or a shape "
-              "spec (see --help)\n",
-              a->geometry);
-    rc = 2;
-    goto done;
-  }
-  const fcm_cell_rules_options ro = embed_rules_options(a);
+  if ((rc = fcm_quadrature_grid_build(ctx, a, "embed", &mesh, &geom)) != 0) goto done;
+  rc = 1;
+  const fcm_cell_rules_options ro = fcm_quadrature_grid_rules_options(a);
   fprintf(stderr, "fcm-quadrature embed: %lld background cells, %lld embedded cells ...\n",
           (long long)fcm_mesh_num_cells(mesh), (long long)fcm_geometry_num_cells(geom));
   if (fcm_cell_rules_create(ctx, mesh, geom, &ro, &rules) != FCM_OK) {
@@ -368,8 +215,8 @@ static int embed_run(const embed_args *a)
     goto done;
   }
   fcm_cell_rules_view(rules, stdout);
-  if (a->dump) {
-    if (!(out = cli_output_open("fcm-quadrature", a->dump, &outf))) goto done;
+  if (dump) {
+    if (!(out = cli_output_open("fcm-quadrature", dump, &outf))) goto done;
     if (fcm_cell_rules_view_points(rules, mesh, FCM_RULE_STIFFNESS, out) != FCM_OK) {
       fcm_ctx_error_view(ctx, stderr);
       goto done;
@@ -389,50 +236,20 @@ done:
 
 int fcm_quadrature_cmd_embed(int argc, char **argv)
 {
-  embed_args a = {
-      FCM_ELEMENT_COUNT, {0, 0, 0, 0, 0, 0}, 1e-6, 1e-4, 0.0, {0, 0, 0}, 0, 0, 0, 0, 0, NULL, NULL};
-  const cli_option opts[] = {
-      {"--element", NULL, CLI_CUSTOM, &a.type, "E", "background element: tet4, tet10, hex8, hex20",
-       0, 0, 0, NULL, cli_element, NULL},
-      {"--box", NULL, CLI_DOUBLE, a.box, "X0 Y0 Z0 X1 Y1 Z1", "background box corners", -1e12, 1e12,
-       0, NULL, NULL, &a.have_box},
-      {"--cells", NULL, CLI_INT, a.cells, "NX NY NZ", "background cells per direction, 1..100000",
-       1, 100000, 0, NULL, NULL, NULL},
-      {"--geometry", NULL, CLI_STRING, &a.geometry, "FILE|SHAPE",
-       "by extension: Gmsh .msh (tetrahedra), TetGen\n"
-       "FILE.node / FILE.ele (both read), a closed triangle\n"
-       "surface .obj, .off, .stl, .ply (tetrahedralized\n"
-       "with Gmsh), a voxel image .nrrd, .nhdr, .mhd, .mha\n"
-       "(voxels >= 0.5, merged into boxes); or a shape: ball:CX,CY,CZ,R,N |\n"
-       "hemisphere:CX,CY,CZ,R,N | box:X0,Y0,Z0,X1,Y1,Z1,N",
-       0, 0, 0, NULL, NULL, NULL},
-      {"--fill-holes", NULL, CLI_FLAG, &a.fill_holes, NULL,
-       "surfaces: close holes before tetrahedralizing", 0, 0, 0, NULL, NULL, NULL},
-      {"--max-volume", NULL, CLI_DOUBLE, &a.max_volume, "V",
-       "surfaces: largest tet volume wanted (default 0:\nsizes follow the surface)", 0, 1e300, 0,
-       NULL, NULL, NULL},
-      {"--strength", NULL, CLI_INT, &a.strength, "M", "stiffness rule strength 1..20", 1, 20, 0,
-       NULL, NULL, NULL},
-      {"--mass-strength", NULL, CLI_INT, &a.mstrength, "M",
-       "mass rule strength 1..20 (default the element's)", 1, 20, 0, NULL, NULL, NULL},
-      {"--no-simplify", NULL, CLI_FLAG, &a.no_simplify, NULL,
-       "keep the initial (tetrahedralized) rules", 0, 0, 0, NULL, NULL, NULL},
-      {"--stabilization", NULL, CLI_DOUBLE, &a.alpha, "A",
-       "append the full cell's rule x A to cut cells,\n"
-       "A in [0, 1] (0: off; default 1e-6)",
-       0, 1, 0, NULL, NULL, NULL},
-      {"--min-fraction", NULL, CLI_DOUBLE, &a.phimin, "PHI",
-       "drop cells with volume fraction below PHI, in [0, 1]\n(default 1e-4)", 0, 1, 0, NULL, NULL,
-       NULL},
-      {"--dump", NULL, CLI_STRING, &a.dump, "FILE",
-       "one line per stiffness point:\n"
-       "cell xi eta zeta X Y Z w_ref w_phys flag\n"
-       "(w_phys = w_ref |J|; flag 0 embedded, 1 stabilization)",
-       0, 0, 0, NULL, NULL, NULL},
-      {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
+  fcm_quadrature_grid g;
+  const char *dump = NULL;
+  cli_option opts[FCM_QUADRATURE_GRID_OPTIONS + 2];
+  fcm_quadrature_grid_init(&g, opts);
+  const cli_option own[] = {{"--dump", NULL, CLI_STRING, &dump, "FILE",
+                             "one line per stiffness point:\n"
+                             "cell xi eta zeta X Y Z w_ref w_phys flag\n"
+                             "(w_phys = w_ref |J|; flag 0 embedded, 1 stabilization)",
+                             0, 0, 0, NULL, NULL, NULL},
+                            {NULL, NULL, CLI_FLAG, NULL, NULL, NULL, 0, 0, 0, NULL, NULL, NULL}};
+  memcpy(opts + FCM_QUADRATURE_GRID_OPTIONS, own, sizeof own);
   const int prc = fcm_quadrature_parse(opts, argc, argv, embed_usage);
   if (prc >= 0) return prc;
-  const int crc = embed_check(&a);
+  const int crc = fcm_quadrature_grid_check(&g, "embed");
   if (crc >= 0) return crc;
-  return embed_run(&a);
+  return embed_run(&g, dump);
 }

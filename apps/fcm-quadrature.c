@@ -236,6 +236,8 @@ static const subcommand commands[] = {
      fcm_quadrature_cmd_accuracy},
     {"embed", "embed a geometry in a background grid, print the cut-cell rule statistics",
      fcm_quadrature_cmd_embed},
+    {"export", "write every cell's rules (points, weights, pieces, surface) for other codes",
+     fcm_quadrature_cmd_export},
     {"tables", "stored rule tables: counts vs best published, --check re-verifies", cmd_tables},
 };
 

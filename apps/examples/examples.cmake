@@ -43,3 +43,7 @@ if(CMAKE_CXX_COMPILER)
                          ENVIRONMENT "OMP_NUM_THREADS=2;OMP_WAIT_POLICY=passive;OPENBLAS_NUM_THREADS=1")
   endif()
 endif()
+# The deal.II interop example (FCM_WITH_DEALII): apps/examples/dealii/dealii.cmake.
+if(FCM_HAVE_DEALII)
+  include(apps/examples/dealii/dealii.cmake)
+endif()

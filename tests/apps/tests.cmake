@@ -6,6 +6,10 @@ set(work ${PROJECT_BINARY_DIR}/app-tests)
 fcm_add_test(app_cli tests/apps/cli.c LABELS app ARGS ${work})
 fcm_add_test(app_quadrature tests/apps/quadrature_app.c LABELS app
              ARGS $<TARGET_FILE:fcm-quadrature> ${work})
+# fcm-quadrature export: a cut box body's rules file (pieces on one side of the cut, volumes
+# exact); bad arguments exit 2 with the reason and leave no file.
+fcm_add_test(app_export tests/apps/export_app.c LABELS app
+             ARGS $<TARGET_FILE:fcm-quadrature> ${work})
 # fcm-rulegen: tables written for the shapes and strengths asked for (positive weights adding
 # up to the reference measure); --dry-run and bad options write nothing, bad options exit 2.
 fcm_add_test(app_rulegen tests/apps/rulegen_app.c LABELS app

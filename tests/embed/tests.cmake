@@ -75,3 +75,7 @@ fcm_add_test(embed_cut_bench tests/embed/cut_bench.c LABELS bench TIMEOUT 3600)
 # rules those of the reference or, kept, of the rules extended); cuts that change nothing
 # integrate nothing and leave every rule bit-identical.
 fcm_add_test(embed_cut_keep tests/embed/cut_keep.c)
+# The rules file for other codes read back: bitwise the accessors' rules piece by piece (with
+# and without a cut), exact volumes and monomials, a closed surface rule (sum w n = 0,
+# sum w x.n = 3 V), bad arguments refused leaving no temporary and the old file intact.
+fcm_add_test(embed_rules_write tests/embed/rules_write.c)

@@ -421,6 +421,48 @@ FCM_API void fcm_cell_rules_view(const fcm_cell_rules *rules, FILE *stream);
 FCM_API fcm_status fcm_cell_rules_view_points(const fcm_cell_rules *rules, const fcm_mesh *mesh,
                                               fcm_rule_kind kind, FILE *stream);
 
+/** Map reference points of `cell` to physical coordinates: x_j = X(xi_j) and det_j = det
+ * J_K(xi_j), so a volume weight w_j of the cell's rules integrates physically as w_j det_j
+ * (fcm/embed.h, top). Works for the points of any of the cell's rules (volume, surface,
+ * pieces). `mesh` must be the mesh the rules were built on.
+ * @param[in]  xi  num_points x 3 reference coordinates
+ * @param[out] x   num_points x 3 physical coordinates; may be NULL
+ * @param[out] det num_points Jacobian determinants; may be NULL
+ * @return FCM_OK, FCM_ERR_ARG (NULL rules, mesh or xi with points; num_points < 0; cell out
+ * of range; a mesh of another cell count or element type). No allocation; thread safe. */
+FCM_API fcm_status fcm_cell_rules_map_points(const fcm_cell_rules *rules, const fcm_mesh *mesh,
+                                             fcm_index cell, int num_points, const double *xi,
+                                             double *x, double *det);
+
+/** Options of fcm_cell_rules_write(); initialize with fcm_cell_rules_write_options_default(). */
+typedef struct fcm_cell_rules_write_options {
+  int include_mesh;        /**< 1 (default): the mesh's node coordinates and cell connectivity
+                                (arrays "mesh/nodes", "mesh/cells"), so a reader can match its
+                                own cells to fcm's; 0: only counts and the bounding box */
+  int include_physical;    /**< 1 (default): physical points and weights beside the reference
+                                ones ("points_phys", "weights_phys"); 0: reference only */
+  const char *description; /**< NULL (default) or text stored as the header's "description"
+                                (the command line, the geometry's name, ...); copied */
+} fcm_cell_rules_write_options;
+
+/** Defaults as documented on each member. */
+FCM_API fcm_cell_rules_write_options fcm_cell_rules_write_options_default(void);
+
+/** Write every cell's rules to a file for other codes (format: lib/docs/rules_format.md):
+ * a JSON header (version, element type, counts, mesh description, the table of arrays with
+ * name, dtype, shape, byte offset and byte order) followed by raw little-endian arrays in CSR
+ * layout: per cell its class, volume fraction and pieces; per piece its cell, volume and the
+ * offsets of its points in each volume rule built and in the surface rule; per point the
+ * reference (and physical) coordinates, weights and flags; surface normals and triangles.
+ * The file is written atomically: a temporary beside `path` replaces it only when complete.
+ * @param[in] mesh the mesh the rules were built on; @param[in] opts NULL for defaults
+ * @return FCM_OK; FCM_ERR_ARG (NULL rules, mesh or path, another mesh, a description with
+ * control characters); FCM_ERR_IO (cannot create, write or rename; the previous file is left
+ * intact and no temporary remains); FCM_ERR_ALLOC. Allocates transiently; thread safe for
+ * distinct paths. */
+FCM_API fcm_status fcm_cell_rules_write(const fcm_cell_rules *rules, const fcm_mesh *mesh,
+                                        const char *path, const fcm_cell_rules_write_options *opts);
+
 #ifdef __cplusplus
 }
 #endif

@@ -30,6 +30,7 @@ from .solid import (MaterialModel, Material, IntegratorKind, TimeScheme, LinearS
                     Preconditioner, NewtonTolerance, BoundaryMethod, Space, Integrator,
                     EmbeddedSurface)
 from .scene import Scene, Simulation
+from . import rulesfile
 
 __version__ = _fcm.version
 
@@ -39,5 +40,5 @@ __all__ = [
     "Moments", "SimplifyMethod", "StabilizationMode", "Status", "DEFAULT", "Mesh", "Geometry",
     "Surface", "VoxelImage", "CellRules", "MaterialModel", "Material", "IntegratorKind",
     "TimeScheme", "LinearSolver", "Preconditioner", "NewtonTolerance", "BoundaryMethod",
-    "Space", "Integrator", "EmbeddedSurface", "Scene", "Simulation", "__version__",
+    "Space", "Integrator", "EmbeddedSurface", "Scene", "Simulation", "rulesfile", "__version__",
 ]

@@ -358,7 +358,7 @@ fcm_status fcm_cell_rules_view_points(const fcm_cell_rules *rules, const fcm_mes
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = rules ? rules->ctx : NULL;
-  double X[3 * FCM_ELEMENT_MAX_NODES], J[9], x[3];
+  double x[3], det;
   FCM_CHECK(rules && mesh && stream, ctx, FCM_ERR_ARG,
             "cell rules view: NULL argument (rules, mesh and stream are required)");
   FCM_TRY(ctx, check_kind(rules, kind, "cell rules view"));
@@ -373,11 +373,8 @@ fcm_status fcm_cell_rules_view_points(const fcm_cell_rules *rules, const fcm_mes
     const double *p, *w;
     const unsigned char *f;
     FCM_TRY(ctx, fcm_cell_rules_get(rules, c, kind, &n, &p, &w, &f));
-    if (!n) continue;
-    fcm_mesh_cell_coords(mesh, c, X);
     for (int j = 0; j < n; j++) {
-      fcm_element_map(rules->type, X, p + 3 * j, x);
-      const double det = fcm_element_jacobian(rules->type, X, p + 3 * j, J);
+      FCM_TRY(ctx, fcm_cell_rules_map_points(rules, mesh, c, 1, p + 3 * j, x, &det));
       FCM_CHECK(fprintf(stream, "%lld %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %d\n",
                         (long long)c, p[3 * j], p[3 * j + 1], p[3 * j + 2], x[0], x[1], x[2], w[j],
                         w[j] * det, (int)f[j]) > 0,
