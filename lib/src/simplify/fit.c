@@ -79,8 +79,10 @@ cleanup:
 
 /* ---- non-negative least squares (Lawson and Hanson 1974, ch. 23) ----
  * The passive columns' QR factorization A_P = Q R is kept up to date, a Householder reflection
- * per added column and Givens rotations per removed one: a step costs O(M^2) besides the
- * gradient A^T r (O(M k)), where a fresh least-squares solve would cost O(M k^2). */
+ * per added column (applied to Q once per iteration for all its columns, nnls_flush()) and
+ * Givens rotations per removed one: a step costs O(M^2) besides the gradient A^T r (O(M k),
+ * priced in single precision, NNLS_SINGLE_TRUST), where a fresh least-squares solve would cost
+ * O(M k^2). */
 
 /* A column whose part orthogonal to the passive columns is below this fraction of its norm is
  * numerically in their span and not added: its weight would be rounding over that fraction. */
