@@ -8,8 +8,9 @@
  * OpenBLAS reads OPENBLAS_CORETYPE only when it loads, so the program runs itself once per
  * kernel set ("child" mode, one OpenMP and one BLAS thread, times in CPU seconds: on cores
  * shared with other work the wall clock would measure that work too) and collects the rows;
- * OpenBLAS's own choice is measured too when it is neither. `bench_roofline child CELLS` prints the
- * raw rows of the kernels it is started with (e.g. another BLAS preloaded). fcm's own element
+ * OpenBLAS's own choice is measured too when it is neither. `bench_roofline child CELLS [ROW]`
+ * prints the raw rows of the kernels it is started with (e.g. another BLAS preloaded), or the
+ * one row named ROW (`once` likewise). fcm's own element
  * kernels and CSR SpMV do not use the BLAS: one more child (`bench_roofline once CELLS`) measures
  * them once, kernel set "any" in the table, and a last line gives their time per cell. Each row
  * is a time, a rate (GFLOP/s or GB/s) and the fraction of the core's measured peak: the best DGEMM
@@ -863,8 +864,8 @@ static int count_items(int once)
 }
 
 /* Child: one line "ROW item size seconds work check" per item measured per kernel set
- * (once = 0) or once (once = 1) on stdout. */
-static int child(int cells, int once)
+ * (once = 0) or once (once = 1) on stdout; only the item named `only` when it is not NULL. */
+static int child(int cells, int once, const char *only)
 {
   fcm_blas_set_num_threads(1);
   fcm_ctx_options o = fcm_ctx_options_default();
@@ -874,6 +875,7 @@ static int child(int cells, int once)
   if (!ctx) return 1;
   for (int i = once ? NITEMS : 0; i < (once ? NALL : NITEMS); i++) {
     bench_result r = {0, 0, 0, 0};
+    if (only && strcmp(only, item_at(i)->name)) continue;
     if (!item_at(i)->run(ctx, cells, &r)) {
       TEST_FAIL_("bench_roofline: %s failed", item_at(i)->name);
       continue;
@@ -903,6 +905,12 @@ static int item_index(const char *name)
   return -1;
 }
 
+/* The children's environment: one BLAS and one OpenMP thread. OMP_THREAD_LIMIT too: CHOLMOD
+ * (SuiteSparse 5.x) runs the scatter loops of its supernodal factorization in OpenMP teams of a
+ * size fixed when it was built (num_threads(CHOLMOD_OMP_NUM_THREADS), 4 in Debian's build),
+ * which OMP_NUM_THREADS does not limit; their CPU time would count in a one-thread row. */
+#define ONE_THREAD "OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 OMP_THREAD_LIMIT=1"
+
 /* Run `self child CELLS` (once: `self once CELLS`, the items that do not use the BLAS) under
  * OPENBLAS_CORETYPE=core (NULL: as loaded) and append its rows. */
 static void measure(const char *self, int cells, const char *core, const char *role, int once,
@@ -911,12 +919,10 @@ static void measure(const char *self, int cells, const char *core, const char *r
   char cmd[4200];
   const char *mode = once ? "once" : "child";
   if (core)
-    snprintf(cmd, sizeof cmd,
-             "OPENBLAS_CORETYPE=%s OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 '%s' %s %d", core, self,
-             mode, cells);
-  else
-    snprintf(cmd, sizeof cmd, "OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 '%s' %s %d", self, mode,
+    snprintf(cmd, sizeof cmd, "OPENBLAS_CORETYPE=%s " ONE_THREAD " '%s' %s %d", core, self, mode,
              cells);
+  else
+    snprintf(cmd, sizeof cmd, ONE_THREAD " '%s' %s %d", self, mode, cells);
   FILE *p = popen(cmd, "r");
   TEST_TRUE(p != NULL);
   if (!p) return;
@@ -1044,8 +1050,8 @@ static void simp_summary(const row *rows, int nrows)
 
 int main(int argc, char **argv)
 {
-  if (argc >= 3 && !strcmp(argv[1], "child")) return child(atoi(argv[2]), 0);
-  if (argc >= 3 && !strcmp(argv[1], "once")) return child(atoi(argv[2]), 1);
+  if (argc >= 3 && !strcmp(argv[1], "child")) return child(atoi(argv[2]), 0, argv[3]);
+  if (argc >= 3 && !strcmp(argv[1], "once")) return child(atoi(argv[2]), 1, argv[3]);
   const char *csv = argc > 1 ? argv[1] : "bench_roofline.csv";
   const int cells = argc > 2 ? atoi(argv[2]) : 24;
   if (cells < 2 || cells > 200) {

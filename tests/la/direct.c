@@ -3,10 +3,14 @@
  * analysis (info.analyses == 1); an indefinite symmetric matrix makes CHOLMOD fail
  * with FCM_ERR_SINGULAR naming a column, after which UMFPACK solves it; UMFPACK
  * solves an unsymmetric system and reports singular ones; phase and argument
- * errors; NaN values; x == b. */
+ * errors; NaN values; x == b. A caller with one OpenMP thread gets no other thread from
+ * CHOLMOD's factorization, and its OpenMP dynamic-adjustment setting back. */
 #include "la/la_impl.h"
 #include "la_test_util.h"
 #include "test.h"
+
+#include <omp.h>
+#include <stdio.h>
 
 enum { G = 20 };
 
@@ -312,11 +316,52 @@ static void test_alloc(fcm_direct_method method)
   fcm_ctx_destroy(&ctx);
 }
 
+/* The threads of this process (Linux: /proc/self/status), -1 when unknown. */
+static int process_threads(void)
+{
+  FILE *f = fopen("/proc/self/status", "r");
+  char line[256];
+  int n = -1;
+  if (!f) return -1;
+  while (fgets(line, sizeof line, f))
+    if (sscanf(line, "Threads: %d", &n) == 1) break;
+  fclose(f);
+  return n;
+}
+
+/* CHOLMOD runs loops of its factorization in OpenMP teams of a size fixed when it was built
+ * (4 in Debian's SuiteSparse 5); fcm lets the runtime fit them to the caller's thread count.
+ * Called first, before any OpenMP team of this process: with one OpenMP thread the process
+ * has no more threads after factorizations of the 20^3 Laplacian than before them (the BLAS
+ * may have its own), and the caller's dynamic-adjustment setting (off, then on) is as it
+ * was. */
+static void test_threads(fcm_ctx *ctx)
+{
+  const int before = omp_get_max_threads(), dynamic = omp_get_dynamic();
+  const int base = process_threads();
+  omp_set_num_threads(1);
+  for (int dyn = 0; dyn <= 1; dyn++) {
+    omp_set_dynamic(dyn);
+    fcm_csr *A = grid_matrix(ctx, 6.0, 0.0, FCM_CSR_SYMMETRIC);
+    fcm_direct *s = NULL;
+    TEST_OK(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, A, &s));
+    TEST_OK(ctx, fcm_direct_analyze(s));
+    TEST_OK(ctx, fcm_direct_factor(s, fcm_csr_values(A)));
+    TEST_TRUE(omp_get_dynamic() == dyn);
+    TEST_TRUE(process_threads() == base);
+    fcm_direct_destroy(&s);
+    fcm_csr_destroy(&A);
+  }
+  omp_set_dynamic(dynamic);
+  omp_set_num_threads(before);
+}
+
 int main(void)
 {
   fcm_ctx *ctx = NULL;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
   rng r = {8675309};
+  test_threads(ctx);
   test_spd(ctx, &r);
   test_unsymmetric(ctx, &r);
   test_singular(ctx);

@@ -2,7 +2,8 @@
  * (fcm__simplify_fit): a tall system's unique non-negative solution is recovered; a wide
  * consistent one is solved with at most M positive weights; an inconsistent one ends at the
  * nearest point of the columns' cone (a known one, and the KKT conditions on random ones, also
- * on a matrix large enough for NNLS to price a shortlist of columns);
+ * on a matrix large enough for NNLS to price a shortlist of columns, and where the one column
+ * that lowers the residual has a gradient that cancels in single precision);
  * the fit reproduces the moments of a positive rule among its candidates to 1e-12 and reports
  * a tolerance below rounding (through its LP path) and moments no positive combination of the
  * candidates can carry. */
@@ -172,6 +173,21 @@ static void shortlist(fcm_ctx *ctx)
   }
 }
 
+/* A gradient that cancels in single precision (NNLS prices in float when A has more columns
+ * than rows): b = (1, 1), columns -e_1, -e_2 and a = (1, -1 + 1e-9), whose gradient a^T b =
+ * 1e-9 is the only positive one and is 0 in float (-1 + 1e-9 rounds to -1). The optimum puts
+ * the weight a^T b / a^T a = 5e-10 on a; declaring x = 0 optimal breaks the KKT conditions. */
+static void cancelling(fcm_ctx *ctx)
+{
+  const double A[2 * 3] = {-1.0, 0.0, 0.0, -1.0, 1.0, -1.0 + 1e-9}, b[2] = {1.0, 1.0};
+  double x[3];
+  fcm__nnls_report rep;
+  TEST_OK(ctx, fcm__simplify_nnls(ctx, 2, 3, A, b, 1e-13, x, &rep));
+  TEST_TRUE(!rep.ok && rep.optimal);
+  check_kkt(2, 3, A, b, x, 1e-12);
+  TEST_NEAR(x[2], (A[4] * b[0] + A[5] * b[1]) / (A[4] * A[4] + A[5] * A[5]), 1e-6, 0.0);
+}
+
 /* The fit on random candidates in [0, 1]^3 (basis on that box): the moments of a positive
  * rule on 50 of them are reproduced by at most M positive weights; the moments of points with
  * x > 0.6 cannot be carried by candidates with x < 0.5 (the first moment in x alone forbids). */
@@ -227,6 +243,7 @@ int main(void)
   known_optimum(ctx);
   kkt(ctx);
   shortlist(ctx);
+  cancelling(ctx);
   fit(ctx);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();

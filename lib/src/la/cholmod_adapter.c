@@ -6,10 +6,19 @@
  * stored triangles are fine. The symbolic analysis (fill-reducing ordering,
  * supernodes) is done once; each factorization reuses it with new values. CHOLMOD
  * never prints (Common->print = 0, no error handler): its Common->status is
- * mapped to fcm statuses after every call. */
+ * mapped to fcm statuses after every call.
+ *
+ * CHOLMOD 3.x (SuiteSparse 5.x) runs loops of its supernodal factorization in OpenMP teams
+ * of CHOLMOD_OMP_NUM_THREADS threads, a number fixed when it was built (4 in Debian's),
+ * whatever the caller's thread count: on 2 shared cores their forks and joins cost a solve
+ * of 46,875 DOFs a fifth of its time (lib/docs/performance.md). The factorization runs with
+ * the OpenMP runtime's dynamic adjustment on for the calling thread (its own setting is
+ * restored), which lets the runtime give those teams no more threads than the caller's
+ * thread count and the free cores; each entry is still computed by one thread, the same way. */
 #include "la/la_impl.h"
 
 #include <cholmod.h>
+#include <omp.h>
 #include <string.h>
 #include <math.h>
 
@@ -178,7 +187,10 @@ static fcm_status chol_factor(fcm_ctx *ctx, void *impl, const double *values, fc
   h->A.x = (void *)values; /* read only: cholmod_l_factorize does not write A */
   h->A.xtype = CHOLMOD_REAL;
   h->c.status = CHOLMOD_OK;
+  const int dynamic = omp_get_dynamic(); /* a data-environment setting: this thread's only */
+  omp_set_dynamic(1);
   int ok = cholmod_l_factorize(&h->A, h->L, &h->c);
+  omp_set_dynamic(dynamic);
   h->A.x = NULL;
   h->A.xtype = CHOLMOD_PATTERN;
   if (h->c.status == CHOLMOD_NOT_POSDEF) {

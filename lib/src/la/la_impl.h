@@ -26,6 +26,10 @@ void fcm__gemm(char transa, char transb, int m, int n, int k, double alpha, cons
 void fcm__gemv(char trans, int m, int n, double alpha, const double *a, int lda, const double *x,
                double beta, double *y);
 
+/* The same in single precision (BLAS sgemv). */
+void fcm__sgemv(char trans, int m, int n, float alpha, const float *a, int lda, const float *x,
+                float beta, float *y);
+
 /* A += alpha x y^T, A m x n (lda), x stride 1, y stride incy (BLAS dger). */
 void fcm__ger(int m, int n, double alpha, const double *x, const double *y, int incy, double *a,
               int lda);

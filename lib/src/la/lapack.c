@@ -65,6 +65,13 @@ void fcm__gemv(char trans, int m, int n, double alpha, const double *a, int lda,
   cblas_dgemv(CblasColMajor, cblas_trans(trans), m, n, alpha, a, lda, x, 1, beta, y, 1);
 }
 
+void fcm__sgemv(char trans, int m, int n, float alpha, const float *a, int lda, const float *x,
+                float beta, float *y)
+{
+  if (m <= 0 || n <= 0) return;
+  cblas_sgemv(CblasColMajor, cblas_trans(trans), m, n, alpha, a, lda, x, 1, beta, y, 1);
+}
+
 void fcm__ger(int m, int n, double alpha, const double *x, const double *y, int incy, double *a,
               int lda)
 {

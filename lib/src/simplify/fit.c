@@ -79,8 +79,10 @@ cleanup:
 
 /* ---- non-negative least squares (Lawson and Hanson 1974, ch. 23) ----
  * The passive columns' QR factorization A_P = Q R is kept up to date, a Householder reflection
- * per added column and Givens rotations per removed one: a step costs O(M^2) besides the
- * gradient A^T r (O(M k)), where a fresh least-squares solve would cost O(M k^2). */
+ * per added column (applied to Q once per iteration for all its columns, nnls_flush()) and
+ * Givens rotations per removed one: a step costs O(M^2) besides the gradient A^T r (O(M k),
+ * priced in single precision, NNLS_SINGLE_TRUST), where a fresh least-squares solve would cost
+ * O(M k^2). */
 
 /* A column whose part orthogonal to the passive columns is below this fraction of its norm is
  * numerically in their span and not added: its weight would be rounding over that fraction. */
@@ -110,27 +112,90 @@ cleanup:
 #define NNLS_SHORTLIST_KEEP  0.25
 #define NNLS_REFRESH         8
 
+/* Pricing in single precision: the full gradient A^T r is computed from a float copy of A (half
+ * the bytes the gradient streams, its main cost) when A has more columns than rows. Its error is
+ * below M eps_float ||a_j|| ||r|| (a cosine of about 1e-5 at M = 220), so a column whose cosine
+ * with the residual comes out above NNLS_SINGLE_TRUST is a column of positive gradient; below
+ * it, and before optimality is declared, the gradient is computed again in double. Which column
+ * enters may differ from double pricing among near ties; every weight, the residual and the
+ * optimality test stay in double. */
+#define NNLS_SINGLE_TRUST 1e-3
+
 typedef struct nnls_qr {
   int M, np, kcols; /* rows, passive columns, columns of A */
-  double *Q;        /* M x M orthogonal */
+  double *Q;        /* M x M orthogonal, times the pending reflections (nref) */
   double *R;        /* M x M, upper triangular in its first np columns */
   double *qtb;      /* Q^T b */
   double *v;        /* 2 M scratch */
   int *pos;         /* the passive columns of A, in R's column order */
   double flops;     /* of the QR updates, solves and residuals */
+  /* The Householder reflections H_i = I - beta_i v_i v_i^T of the columns added since Q was last
+   * brought up to date (nnls_flush()): v_i in column i of V (M x NNLS_BATCH, zero above row
+   * at[i]); W (2 M x NNLS_BATCH) and T (NNLS_BATCH^2) scratch for their blocked product. */
+  int nref, at[NNLS_BATCH];
+  double beta[NNLS_BATCH], *V, *W, *T;
 } nnls_qr;
+
+/* Q <- Q H_1 ... H_nref (the pending reflections, see nnls_qr) as one blocked product: with
+ * V's columns from row at[0] on, H_1 ... H_n = I - V T V^T (T upper triangular, LAPACK's dlarft),
+ * so Q's columns from at[0] on take Q_p - (Q_p V) T V^T: two passes over Q instead of three per
+ * reflection. */
+static void nnls_flush(nnls_qr *s)
+{
+  const int M = s->M, n = s->nref, off = n > 0 ? s->at[0] : 0, m = M - off;
+  if (n == 0) return;
+  double *T = s->T, *W = s->W, *W2 = s->W + (size_t)M * NNLS_BATCH;
+  const double *V = s->V + off;
+  /* T (n x n, column-major): T_ii = beta_i, T[0:i, i] = -beta_i T[0:i, 0:i] (V_:,0:i^T v_i) */
+  memset(T, 0, (size_t)n * (size_t)n * sizeof *T);
+  for (int i = 0; i < n; i++) {
+    double y[NNLS_BATCH];
+    const double *vi = V + (size_t)i * (size_t)M;
+    for (int j = 0; j < i; j++) {
+      const double *vj = V + (size_t)j * (size_t)M;
+      double d = 0.0;
+      for (int r = s->at[i] - off; r < m; r++)
+        d += vj[r] * vi[r];
+      y[j] = d;
+    }
+    for (int j = 0; j < i; j++) {
+      double t = 0.0;
+      for (int l = j; l < i; l++)
+        t += T[j + (size_t)l * n] * y[l];
+      T[j + (size_t)i * n] = -s->beta[i] * t;
+    }
+    T[i + (size_t)i * n] = s->beta[i];
+  }
+  double *Qp = s->Q + (size_t)off * (size_t)M;
+  fcm__gemm('N', 'N', M, n, m, 1.0, Qp, M, V, M, 0.0, W, M);
+  fcm__gemm('N', 'N', M, n, n, 1.0, W, M, T, n, 0.0, W2, M);
+  fcm__gemm('N', 'T', M, m, n, -1.0, W2, M, V, M, 1.0, Qp, M);
+  s->flops += 4.0 * M * m * n + 2.0 * M * n * n + 2.0 * m * n * n;
+  s->nref = 0;
+}
 
 /* Append column t (a, of norm anorm) when it is independent of the passive columns and the
  * least-squares weight it would get with them is positive; *added says whether it was. */
 static void nnls_add(nnls_qr *s, int t, const double *a, double anorm, int *added)
 {
   const int M = s->M, np = s->np, m = M - np;
-  double *q = s->R + (size_t)np * (size_t)M, *v = s->v, *u = s->v + M;
-  double *Qp = s->Q + (size_t)np * (size_t)M;
+  double *q = s->R + (size_t)np * (size_t)M, *v = s->v;
   *added = 0;
   if (np == M) return; /* the passive columns span everything */
-  /* q = Q^T a, as R's next column; the basis' values are O(1): its norm needs no scaling */
+  if (s->nref == NNLS_BATCH) nnls_flush(s);
+  /* q = Q^T a, as R's next column, with Q's pending reflections applied to it in their order;
+   * the basis' values are O(1): its norm needs no scaling */
   fcm__gemv('T', M, M, 1.0, s->Q, M, a, 0.0, q);
+  for (int i = 0; i < s->nref; i++) {
+    const double *vi = s->V + (size_t)i * (size_t)M;
+    double d = 0.0;
+    for (int r = s->at[i]; r < M; r++)
+      d += vi[r] * q[r];
+    d *= s->beta[i];
+    for (int r = s->at[i]; r < M; r++)
+      q[r] -= d * vi[r];
+    s->flops += 4.0 * (M - s->at[i]);
+  }
   s->flops += 2.0 * M * M + 6.0 * m;
   double nu = 0.0;
   for (int i = np; i < M; i++)
@@ -149,9 +214,12 @@ static void nnls_add(nnls_qr *s, int t, const double *a, double anorm, int *adde
   if (!((s->qtb[np] - beta * vb * v[0]) / alpha > 0.0)) return; /* its weight would be <= 0 */
   for (int i = 0; i < m; i++)
     s->qtb[np + i] -= beta * vb * v[i];
-  fcm__gemv('N', M, m, 1.0, Qp, M, v, 0.0, u); /* Q[:, np:] <- Q[:, np:] H */
-  fcm__ger(M, m, -beta, u, v, 1, Qp, M);
-  s->flops += 4.0 * M * m + 2.0 * m;
+  /* Q <- Q H later, with the others of this iteration (nnls_flush()) */
+  double *vn = s->V + (size_t)s->nref * (size_t)M;
+  memset(vn, 0, (size_t)np * sizeof *vn);
+  memcpy(vn + np, v, (size_t)m * sizeof *vn);
+  s->at[s->nref] = np, s->beta[s->nref++] = beta;
+  s->flops += 2.0 * m;
   q[np] = alpha;
   for (int i = np + 1; i < M; i++)
     q[i] = 0.0;
@@ -355,16 +423,22 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
                               double stop, double *x, fcm__nnls_report *rep)
 {
   fcm_status st = FCM_OK;
-  nnls_qr s = {M, 0, k, NULL, NULL, NULL, NULL, NULL, 0.0};
+  nnls_qr s;
+  memset(&s, 0, sizeof s);
+  s.M = M, s.kcols = k;
   double *r = NULL, *g = NULL, *norm = NULL, *inv = NULL, *xp = NULL, *z = NULL;
   int *seen = NULL, *pas = NULL, *order = NULL, *lidx = NULL, exact = 0, nl = -1, last_full = 0;
-  double *AL = NULL, *gl = NULL; /* the shortlist's columns and gradients */
+  double *AL = NULL, *gl = NULL;            /* the shortlist's columns and gradients */
+  float *Af = NULL, *rf = NULL, *gf = NULL; /* A, r and A^T r in single precision */
   memset(rep, 0, sizeof *rep);
   rep->residual = INFINITY;
   FCM_ALLOC(ctx, (size_t)M * (size_t)M, s.Q);
   FCM_ALLOC(ctx, (size_t)M * (size_t)M, s.R);
   FCM_ALLOC(ctx, (size_t)M, s.qtb);
   FCM_ALLOC(ctx, 2 * (size_t)M, s.v);
+  FCM_ALLOC_RAW(ctx, (size_t)M * NNLS_BATCH, s.V);
+  FCM_ALLOC_RAW(ctx, 2 * (size_t)M * NNLS_BATCH, s.W);
+  FCM_ALLOC_RAW(ctx, (size_t)NNLS_BATCH * NNLS_BATCH, s.T);
   FCM_ALLOC(ctx, (size_t)M, s.pos);
   FCM_ALLOC(ctx, (size_t)M, r);
   FCM_ALLOC(ctx, (size_t)k, g);
@@ -379,6 +453,13 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
     FCM_ALLOC(ctx, (size_t)k, lidx);
     FCM_ALLOC(ctx, (size_t)k, gl);
     FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)k, AL);
+  }
+  if (k > M) {
+    FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)k, Af);
+    FCM_ALLOC_RAW(ctx, (size_t)M, rf);
+    FCM_ALLOC_RAW(ctx, (size_t)k, gf);
+    for (size_t e = 0; e < (size_t)M * (size_t)k; e++)
+      Af[e] = (float)A[e];
   }
   for (int i = 0; i < M; i++)
     s.Q[i + (size_t)i * (size_t)M] = 1.0;
@@ -404,9 +485,25 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
     }
     for (int q = 0; q < s.np; q++)
       pas[s.pos[q]] = it;
-    int full = !AL || nl <= 0 || it - last_full >= NNLS_REFRESH;
+    int full = !AL || nl <= 0 || it - last_full >= NNLS_REFRESH, single = Af != NULL;
   price:
-    if (full) {
+    if (full && single) {
+      for (int i = 0; i < M; i++)
+        rf[i] = (float)r[i];
+      fcm__sgemv('T', M, k, 1.0f, Af, M, rf, 0.0f, gf);
+      double top = 0.0;
+      for (int j = 0; j < k; j++) {
+        g[j] = (double)gf[j];
+        if (pas[j] != it) top = fmax(top, g[j] * inv[j]);
+      }
+      s.flops += 2.0 * M * k + 2.0 * k;
+      if (!(top > NNLS_SINGLE_TRUST * rn)) { /* near optimality: price in double */
+        single = 0;
+        goto price;
+      }
+      last_full = it;
+      if (AL) nl = nnls_shortlist(M, k, A, inv, pas, it, g, AL, lidx);
+    } else if (full) {
       fcm__gemv('T', M, k, 1.0, A, M, r, 0.0, g);
       s.flops += 2.0 * M * k + 2.0 * k;
       last_full = it;
@@ -426,8 +523,8 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
         const double c = g[j] * inv[j];
         if (c > best && seen[j] != it && pas[j] != it) best = c, t = j;
       }
-      if (t < 0 && !full) { /* none on the shortlist: price every column */
-        full = 1;
+      if (t < 0 && (!full || single)) { /* none on the shortlist or priced in single */
+        full = 1, single = 0;
         goto price;
       }
       if (t < 0) { /* optimal: no column lowers the residual */
@@ -438,6 +535,7 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
       nnls_add(&s, t, A + (size_t)t * (size_t)M, norm[t], &added);
     }
     nnls_more(&s, A, norm, inv, g, it, seen, pas, order);
+    nnls_flush(&s);
     for (int q = np0; q < s.np; q++)
       xp[q] = 0.0;
     nnls_keep_positive(&s, np0, z);
@@ -454,6 +552,9 @@ cleanup:
   fcm__free(ctx, s.R);
   fcm__free(ctx, s.qtb);
   fcm__free(ctx, s.v);
+  fcm__free(ctx, s.V);
+  fcm__free(ctx, s.W);
+  fcm__free(ctx, s.T);
   fcm__free(ctx, s.pos);
   fcm__free(ctx, r);
   fcm__free(ctx, g);
@@ -467,6 +568,9 @@ cleanup:
   fcm__free(ctx, lidx);
   fcm__free(ctx, gl);
   fcm__free(ctx, AL);
+  fcm__free(ctx, Af);
+  fcm__free(ctx, rf);
+  fcm__free(ctx, gf);
   return st;
 }
 
