@@ -18,22 +18,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* A ball of radius r at c on a box mesh of nc^3 Hex8 cells over [0, 1]^3. */
-static fcm_status ball_build(problem *p, const double c[3], double r, fcm_index nc)
-{
-  fcm_status st;
-  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
-  const fcm_index cells[3] = {nc, nc, nc};
-  fcm_cell_rules_options ro = fcm_cell_rules_options_default();
-  st = fcm_geometry_create_ball(p->ctx, c, r, 3, &p->geom);
-  if (st == FCM_OK) st = fcm_mesh_create_box(p->ctx, FCM_ELEMENT_HEX8, lo, hi, cells, &p->mesh);
-  ro.surface_strength = 4;
-  ro.min_fraction = 1e-4;
-  if (st == FCM_OK) st = fcm_cell_rules_create(p->ctx, p->mesh, p->geom, &ro, &p->rules);
-  if (st == FCM_OK) st = fcm_space_create_embedded(p->ctx, p->mesh, p->rules, &p->space);
-  return st;
-}
-
 static double dotn(fcm_index n, const double *a, const double *b)
 {
   double s = 0.0;
@@ -60,7 +44,7 @@ static int gradient(fcm_ctx *ctx)
   co.distance = 0.05;
   for (int i = 0; i < 3; i++)
     pt[i] = c[i] - (r + 0.3 * co.distance) * nu[i] - vel[i];
-  TEST_OK(ctx, ball_build(&p, c, r, 4));
+  TEST_OK(ctx, ball_problem(&p, c, r, 4));
   TEST_OK(ctx, fcm_integrator_create(ctx, p.space, &mat, &o, &I));
   TEST_OK(ctx, fcm_integrator_add_contact_plane(I, pt, nrm, vel, &co, NULL));
   TEST_OK(ctx, fcm_integrator_setup(I));
@@ -133,7 +117,7 @@ static int errors(fcm_ctx *ctx)
   fcm_material mat = {FCM_MATERIAL_LINEAR, 1e5, 0.3, 1000.0};
   fcm_integrator_options o = fcm_integrator_options_default();
   fcm_contact_options co = fcm_contact_options_default();
-  TEST_OK(ctx, ball_build(&p, c, 0.35, 4));
+  TEST_OK(ctx, ball_problem(&p, c, 0.35, 4));
   TEST_OK(ctx, fcm_integrator_create(ctx, p.space, &mat, &o, &I));
   TEST_ERR(ctx, fcm_integrator_add_contact_plane(I, c, zero, NULL, NULL, NULL), FCM_ERR_ARG,
            "no direction");
@@ -175,7 +159,7 @@ static int drop(fcm_ctx *ctx, fcm_time_scheme scheme, int argc_steps)
   o.kind = FCM_INTEGRATOR_BACKWARD_EULER;
   o.scheme = scheme;
   o.dt = scheme == FCM_SCHEME_BACKWARD_EULER ? 0.02 : 0.01;
-  TEST_OK(ctx, ball_build(&p, c, r, 6));
+  TEST_OK(ctx, ball_problem(&p, c, r, 6));
   TEST_OK(ctx, fcm_integrator_create(ctx, p.space, &mat, &o, &I));
   TEST_OK(ctx, fcm_integrator_add_gravity(I, g, NULL, NULL));
   TEST_OK(ctx, fcm_integrator_add_contact_plane(I, floor_pt, up, NULL, NULL, NULL));
@@ -235,7 +219,7 @@ static int push(fcm_ctx *ctx)
   fcm_integrator_options o = fcm_integrator_options_default();
   o.kind = FCM_INTEGRATOR_BACKWARD_EULER;
   o.dt = 0.01;
-  TEST_OK(ctx, ball_build(&p, c, r, 6));
+  TEST_OK(ctx, ball_problem(&p, c, r, 6));
   TEST_OK(ctx, fcm_integrator_create(ctx, p.space, &mat, &o, &I));
   TEST_OK(ctx, fcm_integrator_add_contact_plane(I, floor_pt, up, vel, NULL, NULL));
   TEST_OK(ctx, fcm_integrator_setup(I));

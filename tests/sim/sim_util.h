@@ -86,4 +86,21 @@ static inline void problem_free(problem *p)
   fcm_mesh_destroy(&p->mesh);
 }
 
+/* An embedded ball of radius r at c on a box mesh of nc^3 Hex8 cells over [0, 1]^3, with
+ * surface rules (the points contact acts on). */
+static inline fcm_status ball_problem(problem *p, const double c[3], double r, fcm_index nc)
+{
+  fcm_status st;
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  const fcm_index cells[3] = {nc, nc, nc};
+  fcm_cell_rules_options ro = fcm_cell_rules_options_default();
+  st = fcm_geometry_create_ball(p->ctx, c, r, 3, &p->geom);
+  if (st == FCM_OK) st = fcm_mesh_create_box(p->ctx, FCM_ELEMENT_HEX8, lo, hi, cells, &p->mesh);
+  ro.surface_strength = 4;
+  ro.min_fraction = 1e-4;
+  if (st == FCM_OK) st = fcm_cell_rules_create(p->ctx, p->mesh, p->geom, &ro, &p->rules);
+  if (st == FCM_OK) st = fcm_space_create_embedded(p->ctx, p->mesh, p->rules, &p->space);
+  return st;
+}
+
 #endif

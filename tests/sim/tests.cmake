@@ -96,3 +96,14 @@ fcm_add_test(sim_contact_errors tests/sim/contact.c ARGS errors)
 fcm_add_test(sim_contact_push tests/sim/contact.c ARGS push)
 fcm_add_test(sim_contact_drop_be tests/sim/contact.c ARGS drop backward_euler)
 fcm_add_test(sim_contact_drop_newmark tests/sim/contact.c ARGS drop newmark)
+# Spheres, boxes and closed triangle surfaces as contact obstacles: the point-triangle distance
+# in each region and every kind's distance against differences, the barrier's force against
+# differences, balls dropped onto and pushed by each kind, and the refusals.
+fcm_add_test(sim_contact_triangle tests/sim/contact_obstacles.c ARGS triangle)
+fcm_add_test(sim_contact_distance tests/sim/contact_obstacles.c ARGS distance)
+fcm_add_test(sim_contact_obstacle_errors tests/sim/contact_obstacles.c ARGS errors)
+foreach(kind sphere box surface)
+  fcm_add_test(sim_contact_force_${kind} tests/sim/contact_obstacles.c ARGS force ${kind})
+  fcm_add_test(sim_contact_drop_${kind} tests/sim/contact_obstacles.c ARGS drop ${kind})
+  fcm_add_test(sim_contact_push_${kind} tests/sim/contact_obstacles.c ARGS push ${kind})
+endforeach()
