@@ -5,9 +5,9 @@
  * floor's reaction is m g within 3 %. apps/scenes/ball_off_wedge.json (a closed OBJ wedge and a
  * floor): every point stays outside the wedge (signed, by a ray test) and above the floor at
  * every step, and the ball touches both. A contact scene without a geometry, bad contact keys
- * (negative threshold or stiffness, a non-positive radius, a box with max <= min, two obstacles
- * in one effect), an open obstacle surface and a body starting inside a sphere, a box or a
- * surface are refused, named. */
+ * (negative threshold, stiffness, friction or friction velocity, a non-positive radius, a box with
+ * max <= min, two obstacles in one effect), an open obstacle surface and a body starting inside a
+ * sphere, a box or a surface are refused, named. */
 #include "scene_util.h"
 
 #include <math.h>
@@ -201,6 +201,13 @@ int main(int argc, char **argv)
                 "expected exactly one obstacle");
   refused_parse(ctx, "\"plane\": {\"point\": [0, 0, -1], \"normal\": [0, 0, 1]}, \"stiffness\": -1",
                 "effects[0].contact.stiffness");
+  refused_parse(ctx,
+                "\"plane\": {\"point\": [0, 0, -1], \"normal\": [0, 0, 1]}, \"friction\": -0.3",
+                "effects[0].contact.friction");
+  refused_parse(ctx,
+                "\"plane\": {\"point\": [0, 0, -1], \"normal\": [0, 0, 1]},"
+                " \"friction_velocity\": -1",
+                "effects[0].contact.friction_velocity");
   /* a body starting inside each kind */
   refused_setup(ctx, "\"sphere\": {\"center\": [0, 0, -0.6], \"radius\": 0.3}",
                 "contact sphere 0: the body starts in penetration");

@@ -5,7 +5,8 @@
  *   push       a floor moving up at constant velocity V hits a ball at rest (no gravity):
  *              never crossed, the ball leaves it at a speed in [V, 2 V]
  *   errors     a ball starting across the plane is refused naming the point and its
- *              distance; bad normals and negative options are named
+ *              distance; bad normals and negative options (threshold, stiffness, friction,
+ *              friction velocity) are named
  *   drop <scheme>  a Hex8 ball dropped under gravity onto a floor: no surface point ever at
  *              or below the floor; backward Euler: it comes to rest (centre-of-mass velocity
  *              small) and the floor's reaction is m g within 3 %; Newmark: it bounces (the
@@ -128,6 +129,14 @@ static int errors(fcm_ctx *ctx)
   co.stiffness = -2.0;
   TEST_ERR(ctx, fcm_integrator_add_contact_plane(I, c, up, NULL, &co, NULL), FCM_ERR_ARG,
            "stiffness = -2");
+  co.stiffness = 0.0;
+  co.friction = -0.5;
+  TEST_ERR(ctx, fcm_integrator_add_contact_plane(I, c, up, NULL, &co, NULL), FCM_ERR_ARG,
+           "contact plane 0: friction = -0.5 must be finite and >= 0");
+  co.friction = 0.5;
+  co.friction_velocity = -1.0;
+  TEST_ERR(ctx, fcm_integrator_add_contact_plane(I, c, up, NULL, &co, NULL), FCM_ERR_ARG,
+           "contact plane 0: friction_velocity = -1 must be finite and >= 0");
   /* the plane through the centre: half of the surface lies behind it */
   TEST_OK(ctx, fcm_integrator_add_contact_plane(I, c, up, NULL, NULL, NULL));
   TEST_ERR(ctx, fcm_integrator_setup(I), FCM_ERR_ARG, "lies at distance");

@@ -107,3 +107,10 @@ foreach(kind sphere box surface)
   fcm_add_test(sim_contact_drop_${kind} tests/sim/contact_obstacles.c ARGS drop ${kind})
   fcm_add_test(sim_contact_push_${kind} tests/sim/contact_obstacles.c ARGS push ${kind})
 endforeach()
+# Lagged, smoothed Coulomb friction: its force and Newton matrix against differences with the
+# lagged quantities fixed (a moving plane, a translating and rotating box); a block on a floor
+# under tilted gravity sticks with mu > tan theta and slides at g (sin theta - mu cos theta)
+# with mu < tan theta.
+fcm_add_test(sim_contact_friction_fd tests/sim/contact_friction.c ARGS fd)
+fcm_add_test(sim_contact_friction_stick tests/sim/contact_friction.c ARGS incline 0.6)
+fcm_add_test(sim_contact_friction_slide tests/sim/contact_friction.c ARGS incline 0.2)

@@ -327,7 +327,8 @@ typedef struct fcm_effect_contact {
   const char *mesh;              /**< SURFACE: the .obj, .off, .stl or .ply file (resolved) */
   fcm_motion motion;             /**< SPHERE, BOX, SURFACE: "velocity", "rotation", "start",
                                       "end" as the motion effect (default: static) */
-  fcm_contact_options options;   /**< "distance" (m), "stiffness" (Pa/m), >= 0 */
+  fcm_contact_options options;   /**< "distance" (m), "stiffness" (Pa/m), "friction" (mu),
+                                      "friction_velocity" (m/s), each >= 0 */
 } fcm_effect_contact;
 
 /** One effect of the scene: a tagged union. */

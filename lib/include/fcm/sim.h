@@ -535,6 +535,12 @@ typedef struct fcm_contact_options {
                          largest extent of a cell holding embedded-surface points */
   double stiffness; /**< the barrier's stiffness kappa (Pa/m), > 0; 0 (default): E / h, E the
                          material's Young modulus */
+  double friction;  /**< Coulomb coefficient mu >= 0 (default 0: frictionless); lagged and
+                         smoothed as in IPC: each point's normal force and tangent plane from
+                         the substep's start, the slip's dissipation potential
+                         mu lambda f0(|slip|) smoothed below eps_v h (dynamic schemes only) */
+  double friction_velocity; /**< eps_v (m/s) >= 0: slip velocities below it see a friction
+                                 force that falls smoothly to 0; 0 (default): 1e-3 m/s */
 } fcm_contact_options;
 
 /** The defaults listed on each member. */

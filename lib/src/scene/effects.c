@@ -606,7 +606,8 @@ static void view_cut(const fcm_effect *e, FILE *f)
 static fcm_status parse_contact(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"plane", "sphere", "box", "surface", "distance", "stiffness"};
+  static const char *const keys[] = {"plane",    "sphere",    "box",      "surface",
+                                     "distance", "stiffness", "friction", "friction_velocity"};
   static const char *const plane_keys[] = {"point", "normal", "velocity"};
   static const char *const sphere_keys[] = {"center",   "radius", "velocity",
                                             "rotation", "start",  "end"};
@@ -668,6 +669,10 @@ static fcm_status parse_contact(fcm__scene_parser *p, const fcm__json *o, fcm_ef
           fcm__scene_read_number(p, o, "distance", 0, FCM__NONNEGATIVE, &c->options.distance));
   FCM_TRY(p->ctx,
           fcm__scene_read_number(p, o, "stiffness", 0, FCM__NONNEGATIVE, &c->options.stiffness));
+  FCM_TRY(p->ctx,
+          fcm__scene_read_number(p, o, "friction", 0, FCM__NONNEGATIVE, &c->options.friction));
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "friction_velocity", 0, FCM__NONNEGATIVE,
+                                         &c->options.friction_velocity));
 cleanup:
   return st;
 }
@@ -710,6 +715,9 @@ static void view_contact(const fcm_effect *e, FILE *f)
     fprintf(f, ", stiffness %g Pa/m", c->options.stiffness);
   else
     fprintf(f, ", stiffness E / h");
+  if (c->options.friction > 0.0)
+    fprintf(f, ", friction %g (smoothed below %g m/s)", c->options.friction,
+            c->options.friction_velocity > 0.0 ? c->options.friction_velocity : 1e-3);
 }
 
 /* The one table of effect modules. Order = enum fcm_effect_type. */

@@ -47,6 +47,14 @@ static fcm_status add_obstacle(fcm_integrator *I, sim_contact *c, const fcm_cont
   FCM_CHECK(c->opts.stiffness >= 0.0 && isfinite(c->opts.stiffness), ctx, FCM_ERR_ARG,
             "contact %s %d: stiffness = %g must be finite and >= 0 (0: the default)", kn, k,
             c->opts.stiffness);
+  FCM_CHECK(c->opts.friction >= 0.0 && isfinite(c->opts.friction), ctx, FCM_ERR_ARG,
+            "contact %s %d: friction = %g must be finite and >= 0 (0: frictionless)", kn, k,
+            c->opts.friction);
+  FCM_CHECK(c->opts.friction_velocity >= 0.0 && isfinite(c->opts.friction_velocity), ctx,
+            FCM_ERR_ARG,
+            "contact %s %d: friction_velocity = %g must be finite and >= 0 (0: the default)", kn, k,
+            c->opts.friction_velocity);
+  if (c->opts.friction_velocity == 0.0) c->opts.friction_velocity = 1e-3;
   c->motion = fcm_motion_default();
   if (motion) {
     const fcm_motion *m = motion;
@@ -224,6 +232,8 @@ void fcm__sim_contact_free(fcm_integrator *I)
   fcm__free(ctx, cp->N);
   fcm__free(ctx, cp->scratch);
   fcm__free(ctx, cp->pose);
+  fcm__free(ctx, cp->pose0);
+  fcm__free(ctx, cp->lag);
   fcm__geom_idbuf_free(ctx, &cp->buf);
   for (int k = 0; k < I->num_contacts; k++) {
     sim_contact *c = &I->contacts[k];
@@ -394,6 +404,10 @@ fcm_status fcm__sim_contact_setup(fcm_integrator *I)
   FCM_ALLOC(ctx, (size_t)np * nn, cp->N);
   FCM_ALLOC(ctx, (size_t)nd * (nd + 1), cp->scratch);
   FCM_ALLOC(ctx, I->num_contacts, cp->pose);
+  if (fcm__sim_contact_has_friction(I)) {
+    FCM_ALLOC(ctx, I->num_contacts, cp->pose0);
+    FCM_ALLOC(ctx, 7 * (size_t)np * (size_t)I->num_contacts, cp->lag);
+  }
   FCM_TRY(ctx, collect(I, 1, &np, &ne));
   cp->ptr[ne] = np;
   for (int c = 0; c < I->num_contacts; c++) {
@@ -451,6 +465,36 @@ static int point_terms(fcm_integrator *I, const double y[3], double w, const dou
   return 1;
 }
 
+/* The friction of point p at y (element start displacements u0) added to fe and Ke. */
+static void friction_terms(const fcm_integrator *I, fcm_index p, const double y[3],
+                           const double *u0, int nn, double *fe, double *Ke, int *any, double *etot)
+{
+  const sim_cpoints *cp = &I->cp;
+  const double *N = cp->N + (size_t)p * nn;
+  const int nd = 3 * nn;
+  double y0[3], g[3], H[9];
+  point_position(cp, nn, p, u0, y0);
+  const double e = fcm__sim_contact_friction(I, p, y, y0, g, H);
+  if (e == 0.0 && g[0] == 0.0 && g[1] == 0.0 && g[2] == 0.0) return;
+  if (!*any) {
+    memset(fe, 0, sizeof(double) * (size_t)nd);
+    if (Ke) memset(Ke, 0, sizeof(double) * (size_t)nd * nd);
+    *any = 1;
+  }
+  *etot += e;
+  for (int a = 0; a < nn; a++)
+    for (int i = 0; i < 3; i++)
+      fe[3 * a + i] += N[a] * g[i];
+  if (Ke)
+    for (int a = 0; a < nn; a++)
+      for (int i = 0; i < 3; i++) {
+        double *row = Ke + (size_t)(3 * a + i) * nd;
+        for (int b = 0; b < nn; b++)
+          for (int m = 0; m < 3; m++)
+            row[3 * b + m] += N[a] * N[b] * H[3 * i + m];
+      }
+}
+
 void fcm__sim_contact_assemble(fcm_integrator *I, const double *x, double *energy, double *force,
                                fcm_csr *T, int *finite)
 {
@@ -458,7 +502,8 @@ void fcm__sim_contact_assemble(fcm_integrator *I, const double *x, double *energ
   const sim_cpoints *cp = &I->cp;
   const int nn = s->nn, nd = 3 * nn;
   double *vals = T ? fcm_csr_values(T) : NULL, etot = 0.0;
-  double ue[3 * FCM_ELEMENT_MAX_NODES], *fe = cp->scratch, *Ke = T ? fe + nd : NULL;
+  double ue[3 * FCM_ELEMENT_MAX_NODES], u0[3 * FCM_ELEMENT_MAX_NODES];
+  double *fe = cp->scratch, *Ke = T ? fe + nd : NULL;
   if (cp->swallowed) {
     *finite = 0;
     return;
@@ -467,6 +512,7 @@ void fcm__sim_contact_assemble(fcm_integrator *I, const double *x, double *energ
   for (fcm_index k = 0; k < cp->nelem; k++) {
     int any = 0;
     gather(s, cp->elem[k], x, ue);
+    if (cp->lag) gather(s, cp->elem[k], I->un, u0);
     for (fcm_index p = cp->ptr[k]; p < cp->ptr[k + 1]; p++) {
       double y[3];
       point_position(cp, nn, p, ue, y);
@@ -474,6 +520,7 @@ void fcm__sim_contact_assemble(fcm_integrator *I, const double *x, double *energ
         *finite = 0;
         return;
       }
+      if (cp->lag) friction_terms(I, p, y, u0, nn, fe, Ke, &any, &etot);
     }
     if (!any) continue;
     if (force) {

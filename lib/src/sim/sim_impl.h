@@ -99,6 +99,9 @@ typedef struct sim_cpoints {
   fcm__idbuf buf;        /* triangle ids of surface-obstacle queries */
   sim_pose *pose;        /* num_contacts: the obstacles' placements at the time evaluated */
   int swallowed;         /* a moving surface obstacle swallowed a point of the substep's start */
+  double *lag;           /* np x num_contacts x 7 (friction only): lambda, T (3 x 2) */
+  sim_pose *pose0;       /* num_contacts (friction only): the placements at the substep's start */
+  double t0, hstep;      /* the substep's start and length (friction) */
 } sim_cpoints;
 
 /* The time scheme's constants (scheme.c): the generalized-alpha family (backward Euler: kind
@@ -382,6 +385,14 @@ double fcm__sim_contact_step_bound(fcm_integrator *I, const double *x, const dou
  * swallowed a point of un makes the substep's energies non-finite (cp.swallowed). */
 void fcm__sim_contact_pull_back(fcm_integrator *I);
 fcm_status fcm__sim_contact_check(fcm_integrator *I, const double *x, double t);
+/* Friction (contact_friction.c). has_friction: an obstacle has mu > 0. lag: each point's
+ * normal force and tangent basis from u_n (obstacles at bc_time), the substep's start
+ * bc_time - h. friction: the dissipation potential of point p at y (substep start y0), its
+ * gradient and Hessian in y (written). */
+int fcm__sim_contact_has_friction(const fcm_integrator *I);
+fcm_status fcm__sim_contact_lag(fcm_integrator *I, double h);
+double fcm__sim_contact_friction(const fcm_integrator *I, fcm_index p, const double y[3],
+                                 const double y0[3], double grad[3], double hess[9]);
 /* Re-add old's obstacle c to I (fcm_integrator_cut()). */
 fcm_status fcm__sim_contact_copy(fcm_integrator *I, const sim_contact *c);
 
