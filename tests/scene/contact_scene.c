@@ -102,6 +102,10 @@ static void wedge(fcm_ctx *ctx, const char *dir)
     printf("ball_off_wedge: min distance to the wedge %.4g m, to the floor %.4g m; largest "
            "forces %.4g N and %.4g N\n",
            dmin[0], dmin[1], fbig[0], fbig[1]);
+    fcm_simulation_counters c;
+    fcm_simulation_get_counters(sim, &c);
+    TEST_TRUE(c.contacts == 2 && c.friction_dissipation > 0.0); /* it rolls with friction */
+    TEST_NEAR(c.contact_min_distance, fmin(dmin[0], dmin[1]), 1e-12, 0.0);
     for (int k = 0; k < 2; k++) {
       if (!(dmin[k] > 0.0)) TEST_FAIL_("obstacle %d: a surface point reached %.3g", k, dmin[k]);
       if (!(fbig[k] > 0.0)) TEST_FAIL_("obstacle %d: never touched", k);
@@ -139,6 +143,10 @@ int main(int argc, char **argv)
     }
     fcm_simulation_get_counters(sim, &c);
     TEST_TRUE(c.contacts == 1 && c.surface_rules == 1);
+    /* the counters report the contact: evaluated, the smallest distance the one seen here */
+    TEST_TRUE(c.contact_evaluations > 0 && c.contact_points_max > 0);
+    TEST_NEAR(c.contact_min_distance, dmin_all, 1e-12, 0.0);
+    TEST_TRUE(c.contact_energy_max > 0.0 && c.friction_dissipation == 0.0);
     if (!(dmin_all > 0.0)) TEST_FAIL_("a surface point reached distance %.3g", dmin_all);
     /* the log's last row: momentum_z / mass, and the weight m g */
     char dir[] = "/tmp/fcm_contact_XXXXXX", log[1100];
@@ -166,6 +174,22 @@ int main(int argc, char **argv)
       if (*p == ',') p++;
     }
     TEST_TRUE(got == 11 && !strncmp(head, "step,time", 9));
+    /* the contact columns close the row: at rest on the floor, points within d^, a positive
+     * barrier energy, no friction */
+    TEST_TRUE(strstr(head, ",contact_points,contact_min_distance,contact_energy,"
+                           "friction_dissipation\n") != NULL);
+    {
+      double tail[4] = {0, 0, 0, -1};
+      char *q = last + strlen(last);
+      for (int j = 3; j >= 0 && q > last; j--) {
+        while (q > last && q[-1] != ',')
+          q--;
+        tail[j] = strtod(q, NULL);
+        if (q > last) q--;
+        *q = '\0';
+      }
+      TEST_TRUE(tail[0] > 0 && tail[1] > 0.0 && tail[2] > 0.0 && tail[3] == 0.0);
+    }
     if (got == 11) {
       const double mass = col[7], vz = col[10] / mass, v_impact = sqrt(2.0 * 9.81 * 0.1);
       printf("ball_on_floor: min distance %.4g m, final vz %.3g m/s, reaction %.6g N, m g "

@@ -638,6 +638,25 @@ FCM_API fcm_status fcm_integrator_contact_distance(const fcm_integrator *integ, 
 FCM_API fcm_status fcm_integrator_contact_info(const fcm_integrator *integ, int id, double force[3],
                                                double *min_distance, double *dhat, double *kappa);
 
+/** The contact obstacles' state, for logs and summaries (fcm_integrator_contact_stats()). */
+typedef struct fcm_contact_stats {
+  long long evaluations;       /**< evaluations of the contact terms since setup (energy, force
+                                    or Newton matrix: each Newton iterate and line-search trial);
+                                    0 without obstacles */
+  long long active_points;     /**< point-obstacle pairs closer than the threshold d^ now */
+  double min_distance;         /**< the smallest signed distance of a surface point to an
+                                    obstacle now (HUGE_VAL without obstacles) */
+  double barrier_energy;       /**< sum of w kappa b(d) now (J) */
+  double friction_dissipation; /**< the work of the friction forces over the last substep's slip
+                                    (J, >= 0; 0 without friction) */
+} fcm_contact_stats;
+
+/** The contact obstacles' state at the current displacement and time. Before setup, or
+ * without obstacles: the evaluation count (0) and no contact. Allocates workspace only.
+ * @return FCM_OK, FCM_ERR_ARG (NULL), FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_integrator_contact_stats(const fcm_integrator *integ,
+                                                fcm_contact_stats *stats);
+
 /** How often the contact filter acted since setup: the Newton steps it shortened before the
  * line search (*filtered) and the substeps whose first guess it pulled back in front of an
  * obstacle (*pullbacks); either may be NULL; zeros without obstacles.

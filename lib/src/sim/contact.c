@@ -504,6 +504,7 @@ void fcm__sim_contact_assemble(fcm_integrator *I, const double *x, double *energ
   double *vals = T ? fcm_csr_values(T) : NULL, etot = 0.0;
   double ue[3 * FCM_ELEMENT_MAX_NODES], u0[3 * FCM_ELEMENT_MAX_NODES];
   double *fe = cp->scratch, *Ke = T ? fe + nd : NULL;
+  I->contact_evals++;
   if (cp->swallowed) {
     *finite = 0;
     return;
@@ -729,5 +730,53 @@ fcm_status fcm_integrator_contact_counters(const fcm_integrator *I, long long *f
   if (filtered) *filtered = I->contact_filtered;
   if (pullbacks) *pullbacks = I->contact_pullbacks;
 cleanup:
+  return st;
+}
+
+fcm_status fcm_integrator_contact_stats(const fcm_integrator *I, fcm_contact_stats *out)
+{
+  fcm_status st = FCM_OK;
+  fcm__idbuf buf = {NULL, 0, 0};
+  FCM_CHECK(I && out, I ? I->ctx : NULL, FCM_ERR_ARG, "contact stats: NULL integrator or stats");
+  fcm_ctx *ctx = I->ctx;
+  memset(out, 0, sizeof *out);
+  out->evaluations = I->contact_evals;
+  out->min_distance = HUGE_VAL;
+  if (!I->is_setup || I->num_contacts == 0) return FCM_OK;
+  {
+    const sim_cpoints *cp = &I->cp;
+    const int nn = I->space->nn;
+    double ue[3 * FCM_ELEMENT_MAX_NODES], u0[3 * FCM_ELEMENT_MAX_NODES];
+    for (int c = 0; c < I->num_contacts; c++) {
+      double dmin = HUGE_VAL;
+      FCM_TRY(ctx, fcm_integrator_contact_info(I, c, NULL, &dmin, NULL, NULL));
+      out->min_distance = FCM_MIN(out->min_distance, dmin);
+    }
+    for (fcm_index k = 0; k < cp->nelem; k++) {
+      gather(I->space, cp->elem[k], I->u, ue);
+      if (cp->lag) gather(I->space, cp->elem[k], I->un, u0);
+      for (fcm_index p = cp->ptr[k]; p < cp->ptr[k + 1]; p++) {
+        double y[3], d, g[3], b1, b2;
+        point_position(cp, nn, p, ue, y);
+        for (int c = 0; c < I->num_contacts; c++) {
+          const sim_contact *ct = &I->contacts[c];
+          sim_pose P;
+          fcm__sim_contact_pose(ct, I->t, &P);
+          FCM_TRY(ctx,
+                  fcm__sim_contact_distance(ctx, ct, &P, y, I->t, ct->dhat, &buf, &d, g, NULL));
+          if (!(d > 0.0) || d >= ct->dhat) continue;
+          out->active_points++;
+          out->barrier_energy += cp->w[p] * ct->kappa * barrier(d, ct->dhat, &b1, &b2);
+        }
+        if (cp->lag) {
+          double y0[3];
+          point_position(cp, nn, p, u0, y0);
+          out->friction_dissipation += fcm__sim_contact_friction_work(I, p, y, y0);
+        }
+      }
+    }
+  }
+cleanup:
+  if (I) fcm__geom_idbuf_free(I->ctx, &buf);
   return st;
 }

@@ -121,6 +121,27 @@ static void relative_motion(const sim_cpoints *cp, const sim_contact *ct, int c,
   }
 }
 
+double fcm__sim_contact_friction_work(const fcm_integrator *I, fcm_index p, const double y[3],
+                                      const double y0[3])
+{
+  const sim_cpoints *cp = &I->cp;
+  const int nc = I->num_contacts;
+  double work = 0.0;
+  for (int c = 0; c < nc && cp->lag; c++) {
+    const sim_contact *ct = &I->contacts[c];
+    const double *L = cp->lag + 7 * ((size_t)p * nc + c), *T = L + 1;
+    const double eps = ct->opts.friction_velocity * cp->hstep;
+    double delta[3], J[9];
+    if (!(L[0] > 0.0) || !(eps > 0.0)) continue;
+    relative_motion(cp, ct, c, y, y0, delta, J);
+    const double s0 = fcm__vec3_dot(T, delta), s1 = fcm__vec3_dot(T + 3, delta);
+    const double x = sqrt(s0 * s0 + s1 * s1);
+    const double f1 = x < eps ? 2.0 * x / eps - x * x / (eps * eps) : 1.0;
+    work += ct->opts.friction * L[0] * f1 * x;
+  }
+  return work;
+}
+
 double fcm__sim_contact_friction(const fcm_integrator *I, fcm_index p, const double y[3],
                                  const double y0[3], double grad[3], double hess[9])
 {

@@ -147,6 +147,7 @@ struct fcm_integrator {
   int num_contacts;
   sim_cpoints cp;
   long long contact_filtered;  /* Newton steps the contact filter shortened (cumulative) */
+  long long contact_evals;     /* evaluations of the contact terms (cumulative) */
   long long contact_pullbacks; /* substep guesses pulled back in front of an obstacle */
 
   /* state */
@@ -393,6 +394,9 @@ int fcm__sim_contact_has_friction(const fcm_integrator *I);
 fcm_status fcm__sim_contact_lag(fcm_integrator *I, double h);
 double fcm__sim_contact_friction(const fcm_integrator *I, fcm_index p, const double y[3],
                                  const double y0[3], double grad[3], double hess[9]);
+/* The work of point p's friction forces over its slip from y0 to y: sum of mu lambda f1 |s|. */
+double fcm__sim_contact_friction_work(const fcm_integrator *I, fcm_index p, const double y[3],
+                                      const double y0[3]);
 /* Re-add old's obstacle c to I (fcm_integrator_cut()). */
 fcm_status fcm__sim_contact_copy(fcm_integrator *I, const sim_contact *c);
 
