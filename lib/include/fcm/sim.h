@@ -558,8 +558,9 @@ FCM_API fcm_contact_options fcm_contact_options_default(void);
  * times the largest fraction that keeps each point at d > 0 (the distance is linear in the
  * step for a plane), then backtracked on the energy; a substep's first guess that penetrates is
  * pulled back the same way from the substep's start. A state on or behind a plane (d <= 0) is
- * refused by the setup and by each step with the point and its distance. Not supported yet:
- * friction, contact between bodies or with itself, distributed backends. Before setup.
+ * refused by the setup and by each step with the point and its distance. Coulomb friction:
+ * fcm_contact_options.friction. Not supported yet: contact between bodies or with itself,
+ * distributed backends. Before setup.
  * @param[out] id the obstacle's index (may be NULL)
  * @return FCM_OK, FCM_ERR_ARG (NULL integrator or vector; a zero or non-finite normal; a
  * non-finite point or velocity; a negative or non-finite option, named; after setup),

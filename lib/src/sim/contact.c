@@ -424,64 +424,17 @@ cleanup:
   return st;
 }
 
-/* The barrier terms of one point at y (area weight w, shape values N) added to fe and Ke
- * (zeroed first when *any is 0); returns 0 when the point is on or behind an obstacle, or a
- * query failed. The Newton matrix keeps w kappa b''(d) g g^T: the PSD part of the point's
- * exact 3 x 3 Hessian w kappa (b'' g g^T + b' H) (H g = 0 and H is PSD while b' <= 0, so that
- * is its projection; exact for planes and the faces of boxes and surfaces). */
-static int point_terms(fcm_integrator *I, const double y[3], double w, const double *N, int nn,
-                       double *fe, double *Ke, int *any, double *etot)
+/* A point's force g (3) and Newton matrix H (3 x 3) added to the element's fe and Ke (zeroed
+ * first when *any is 0) through its shape values N. */
+static void add_point(const double *N, int nn, const double g[3], const double H[9], double *fe,
+                      double *Ke, int *any)
 {
   const int nd = 3 * nn;
-  const double t = I->bc_time;
-  for (int c = 0; c < I->num_contacts; c++) {
-    const sim_contact *ct = &I->contacts[c];
-    double d, g[3], b1, b2;
-    if (fcm__sim_contact_distance(I->ctx, ct, &I->cp.pose[c], y, t, ct->dhat, &I->cp.buf, &d, g,
-                                  NULL) != FCM_OK)
-      return 0;
-    if (!(d > 0.0)) return 0;
-    if (d >= ct->dhat) continue;
-    if (!*any) {
-      memset(fe, 0, sizeof(double) * (size_t)nd);
-      if (Ke) memset(Ke, 0, sizeof(double) * (size_t)nd * nd);
-      *any = 1;
-    }
-    *etot += w * ct->kappa * barrier(d, ct->dhat, &b1, &b2);
-    const double c1 = w * ct->kappa * b1, c2 = w * ct->kappa * b2;
-    for (int a = 0; a < nn; a++)
-      for (int i = 0; i < 3; i++)
-        fe[3 * a + i] += c1 * N[a] * g[i];
-    if (Ke)
-      for (int a = 0; a < nn; a++)
-        for (int i = 0; i < 3; i++) {
-          double *row = Ke + (size_t)(3 * a + i) * nd;
-          const double ca = c2 * N[a] * g[i];
-          for (int b = 0; b < nn; b++)
-            for (int m = 0; m < 3; m++)
-              row[3 * b + m] += ca * N[b] * g[m];
-        }
-  }
-  return 1;
-}
-
-/* The friction of point p at y (element start displacements u0) added to fe and Ke. */
-static void friction_terms(const fcm_integrator *I, fcm_index p, const double y[3],
-                           const double *u0, int nn, double *fe, double *Ke, int *any, double *etot)
-{
-  const sim_cpoints *cp = &I->cp;
-  const double *N = cp->N + (size_t)p * nn;
-  const int nd = 3 * nn;
-  double y0[3], g[3], H[9];
-  point_position(cp, nn, p, u0, y0);
-  const double e = fcm__sim_contact_friction(I, p, y, y0, g, H);
-  if (e == 0.0 && g[0] == 0.0 && g[1] == 0.0 && g[2] == 0.0) return;
   if (!*any) {
     memset(fe, 0, sizeof(double) * (size_t)nd);
     if (Ke) memset(Ke, 0, sizeof(double) * (size_t)nd * nd);
     *any = 1;
   }
-  *etot += e;
   for (int a = 0; a < nn; a++)
     for (int i = 0; i < 3; i++)
       fe[3 * a + i] += N[a] * g[i];
@@ -493,6 +446,48 @@ static void friction_terms(const fcm_integrator *I, fcm_index p, const double y[
           for (int m = 0; m < 3; m++)
             row[3 * b + m] += N[a] * N[b] * H[3 * i + m];
       }
+}
+
+/* The barrier terms of one point at y (area weight w, shape values N) added to fe and Ke;
+ * returns 0 when the point is on or behind an obstacle, or a query failed. The Newton matrix
+ * keeps w kappa b''(d) g g^T: the PSD part of the point's exact 3 x 3 Hessian
+ * w kappa (b'' g g^T + b' H) (H g = 0 and H is PSD while b' <= 0, so that is its projection;
+ * exact for planes and the faces of boxes and surfaces). */
+static int point_terms(fcm_integrator *I, const double y[3], double w, const double *N, int nn,
+                       double *fe, double *Ke, int *any, double *etot)
+{
+  const double t = I->bc_time;
+  for (int c = 0; c < I->num_contacts; c++) {
+    const sim_contact *ct = &I->contacts[c];
+    double d, g[3], b1, b2, f[3], H[9];
+    if (fcm__sim_contact_distance(I->ctx, ct, &I->cp.pose[c], y, t, ct->dhat, &I->cp.buf, &d, g,
+                                  NULL) != FCM_OK)
+      return 0;
+    if (!(d > 0.0)) return 0;
+    if (d >= ct->dhat) continue;
+    *etot += w * ct->kappa * barrier(d, ct->dhat, &b1, &b2);
+    const double c1 = w * ct->kappa * b1, c2 = w * ct->kappa * b2;
+    for (int i = 0; i < 3; i++) {
+      f[i] = c1 * g[i];
+      for (int m = 0; m < 3; m++)
+        H[3 * i + m] = c2 * g[i] * g[m];
+    }
+    add_point(N, nn, f, H, fe, Ke, any);
+  }
+  return 1;
+}
+
+/* The friction of point p at y (element start displacements u0) added to fe and Ke. */
+static void friction_terms(const fcm_integrator *I, fcm_index p, const double y[3],
+                           const double *u0, int nn, double *fe, double *Ke, int *any, double *etot)
+{
+  const sim_cpoints *cp = &I->cp;
+  double y0[3], g[3], H[9];
+  point_position(cp, nn, p, u0, y0);
+  const double e = fcm__sim_contact_friction(I, p, y, y0, g, H);
+  if (e == 0.0 && g[0] == 0.0 && g[1] == 0.0 && g[2] == 0.0) return;
+  *etot += e;
+  add_point(cp->N + (size_t)p * nn, nn, g, H, fe, Ke, any);
 }
 
 void fcm__sim_contact_assemble(fcm_integrator *I, const double *x, double *energy, double *force,
