@@ -72,6 +72,10 @@ endif()
 # times within the set-up's, the hole-filling warning inside its phase).
 fcm_add_test(app_sim_geometry tests/apps/sim_geometry_app.c LABELS app
              ARGS $<TARGET_FILE:fcm-sim> ${work})
+# fcm-sim on bad contact input (negative friction, a box with max <= min, a body starting inside
+# a sphere or a closed surface, an open obstacle surface): exit 2 naming the field.
+fcm_add_test(app_sim_contact tests/apps/sim_contact_app.c LABELS app
+             ARGS $<TARGET_FILE:fcm-sim> ${work})
 # fcm-condition: --quick CSV/PNG format and facts; the Fig. 5 claims (Longva et al. 2020)
 fcm_add_test(app_condition tests/apps/condition_app.c LABELS app
              ARGS $<TARGET_FILE:fcm-condition> ${work})
