@@ -54,56 +54,25 @@ static int gradient(fcm_ctx *ctx)
   TEST_NEAR(kappa, mat.young * 4.0, 1e-12, 0.0); /* default E / h, h = 1/4 */
   const fcm_index n = fcm_space_num_dofs(p.space);
   double *u = calloc((size_t)n, sizeof *u), *d = calloc((size_t)n, sizeof *d);
-  double *f0 = calloc((size_t)n, sizeof *f0), *fp = calloc((size_t)n, sizeof *fp);
-  double *fm = calloc((size_t)n, sizeof *fm), *Td = calloc((size_t)n, sizeof *Td);
+  double *f0 = calloc((size_t)n, sizeof *f0);
   srand(7);
   for (fcm_index i = 0; i < n; i++) {
     u[i] = 0.002 * ((double)rand() / RAND_MAX - 0.5);
     d[i] = (double)rand() / RAND_MAX - 0.5;
   }
   TEST_OK(ctx, fcm_space_matrix_create(p.space, &T));
-  const double t = 1.0, eps = 1e-7;
-  double e0 = 0.0, ep = 0.0, em = 0.0, asym = 1.0;
+  const double t = 1.0;
+  double e0 = 0.0, asym = 1.0, err_e = 1.0, err_t = 1.0;
   TEST_OK(ctx, fcm_integrator_contact_eval(I, u, t, &e0, f0, T));
   TEST_TRUE(e0 > 0.0);
   TEST_OK(ctx, fcm_csr_asymmetry(T, &asym));
   if (!(asym <= 1e-13)) TEST_FAIL_("tangent: relative asymmetry %.3g", asym);
-  for (fcm_index i = 0; i < n; i++)
-    u[i] += eps * d[i];
-  TEST_OK(ctx, fcm_integrator_contact_eval(I, u, t, &ep, fp, NULL));
-  for (fcm_index i = 0; i < n; i++)
-    u[i] -= 2.0 * eps * d[i];
-  TEST_OK(ctx, fcm_integrator_contact_eval(I, u, t, &em, fm, NULL));
-  const double de = (ep - em) / (2.0 * eps), fd = dotn(n, f0, d);
-  TEST_NEAR(de, fd, 1e-6, 0.0);
-  TEST_OK(ctx, fcm_csr_apply(T, 1.0, d, 0.0, Td));
-  double num = 0.0, den = 0.0;
-  for (fcm_index i = 0; i < n; i++) {
-    const double x = (fp[i] - fm[i]) / (2.0 * eps);
-    num += (x - Td[i]) * (x - Td[i]);
-    den += Td[i] * Td[i];
-  }
-  if (!(den > 0.0 && sqrt(num / den) <= 1e-6))
-    TEST_FAIL_("tangent: relative error %.3g against the force's differences", sqrt(num / den));
-  {
-    /* the cost of the barrier's energy, force and Newton matrix per surface point (printed,
-     * not asserted: lib/docs/contact.md) */
-    fcm_index np = 0;
-    for (fcm_index cell = 0; cell < fcm_mesh_num_cells(p.mesh); cell++) {
-      int q = 0;
-      TEST_OK(ctx, fcm_cell_rules_get_surface(p.rules, cell, &q, NULL, NULL, NULL, NULL));
-      np += q;
-    }
-    const int reps = 200;
-    const double t0 = fcm_wtime();
-    for (int k = 0; k < reps; k++)
-      TEST_OK(ctx, fcm_integrator_contact_eval(I, u, t, &e0, f0, T));
-    const double dt = (fcm_wtime() - t0) / reps;
-    printf("contact eval (energy, force, Newton matrix): %lld surface points, %.3g s per call, "
-           "%.3g us per point\n",
-           (long long)np, dt, 1e6 * dt / (double)(np > 0 ? np : 1));
-  }
-  free(u), free(d), free(f0), free(fp), free(fm), free(Td);
+  contact_fd(ctx, I, n, u, d, t, 1e-7, f0, T, &err_e, &err_t);
+  if (!(err_e <= 1e-6)) TEST_FAIL_("force: relative error %.3g against the energy's", err_e);
+  if (!(err_t <= 1e-6))
+    TEST_FAIL_("tangent: relative error %.3g against the force's differences", err_t);
+  contact_eval_cost(ctx, I, &p, u, t, f0, T, "plane");
+  free(u), free(d), free(f0);
   fcm_csr_destroy(&T);
   fcm_integrator_destroy(&I);
   problem_free(&p);
