@@ -49,7 +49,7 @@ fcm_add_test(app_sim_default tests/apps/sim_app.c LABELS app slow TIMEOUT 1200
 # cutbench bunny scenes, whose cuts need the body's volume mesh.
 set(fcm_check_scenes spinning_body slingshot hollow_ball static_beam cantilever twisting_cylinder
     voxel_block gyroid_lattice cut_slab dice cracked_beam clamped_surface hollow_ball_multigrid
-    vibrating_beam octree_ball_hex8 octree_ball_hex20 ball_on_floor)
+    vibrating_beam octree_ball_hex8 octree_ball_hex20 ball_on_floor ball_off_wedge)
 list(APPEND fcm_check_scenes cutbench_tonthat_slab)
 if(FCM_HAVE_GMSH)
   list(APPEND fcm_check_scenes surface_drop cutbench_dick_bunny3 cutbench_koschier_bunny)
@@ -75,6 +75,10 @@ endif()
 # set-up's phases of an open surface with fill_holes (a line each with its time, in order, the
 # times within the set-up's, the hole-filling warning inside its phase).
 fcm_add_test(app_sim_geometry tests/apps/sim_geometry_app.c LABELS app
+             ARGS $<TARGET_FILE:fcm-sim> ${work})
+# fcm-sim on bad contact input (negative friction, a box with max <= min, a body starting inside
+# a sphere or a closed surface, an open obstacle surface): exit 2 naming the field.
+fcm_add_test(app_sim_contact tests/apps/sim_contact_app.c LABELS app
              ARGS $<TARGET_FILE:fcm-sim> ${work})
 # fcm-condition: --quick CSV/PNG format and facts; the Fig. 5 claims (Longva et al. 2020)
 fcm_add_test(app_condition tests/apps/condition_app.c LABELS app

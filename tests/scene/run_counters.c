@@ -5,6 +5,7 @@
 #include "fcm/fcm.h"
 #include "test.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -113,6 +114,9 @@ int main(void)
     fcm_simulation_get_counters(sim, &c);
     TEST_TRUE(c.inertia == 1 && c.mass_assemblies == 1 && c.scale_assemblies == 0);
     TEST_TRUE(c.body_force_assemblies == 1 && c.traction_assemblies == 0);
+    /* no contact effect: no contact term evaluated, nothing reported */
+    TEST_TRUE(c.contacts == 0 && c.contact_evaluations == 0 && c.contact_points_max == 0);
+    TEST_TRUE(c.contact_min_distance == HUGE_VAL && c.friction_dissipation == 0.0);
     TEST_TRUE(c.steps == 4);
     TEST_TRUE(c.analyses == 1);
     TEST_TRUE(c.factorizations == 1);

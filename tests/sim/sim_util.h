@@ -7,6 +7,10 @@
 #include "fcm/sim.h"
 #include "test.h"
 
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
 /* A beam [0, lx] x [0, 1] x [0, 1] of nx x 1 x 1 cubes (nx cells of `type`, tets split). */
 static inline fcm_status beam_mesh(fcm_ctx *ctx, fcm_element_type type, fcm_index nx, double lx,
                                    fcm_mesh **mesh)
@@ -84,6 +88,80 @@ static inline void problem_free(problem *p)
   fcm_cell_rules_destroy(&p->rules);
   fcm_geometry_destroy(&p->geom);
   fcm_mesh_destroy(&p->mesh);
+}
+
+/* An embedded ball of radius r at c on a box mesh of nc^3 Hex8 cells over [0, 1]^3, with
+ * surface rules (the points contact acts on). */
+static inline fcm_status ball_problem(problem *p, const double c[3], double r, fcm_index nc)
+{
+  fcm_status st;
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  const fcm_index cells[3] = {nc, nc, nc};
+  fcm_cell_rules_options ro = fcm_cell_rules_options_default();
+  st = fcm_geometry_create_ball(p->ctx, c, r, 3, &p->geom);
+  if (st == FCM_OK) st = fcm_mesh_create_box(p->ctx, FCM_ELEMENT_HEX8, lo, hi, cells, &p->mesh);
+  ro.surface_strength = 4;
+  ro.min_fraction = 1e-4;
+  if (st == FCM_OK) st = fcm_cell_rules_create(p->ctx, p->mesh, p->geom, &ro, &p->rules);
+  if (st == FCM_OK) st = fcm_space_create_embedded(p->ctx, p->mesh, p->rules, &p->space);
+  return st;
+}
+
+/* Central differences (step eps) of fcm_integrator_contact_eval() at u (restored on return)
+ * and time t along d against its force f0 and Newton matrix T there (T may be NULL): the
+ * relative errors of the energy's difference against f0 . d and of the force's against T d
+ * (0 when T is NULL). */
+static inline void contact_fd(fcm_ctx *ctx, fcm_integrator *I, fcm_index n, double *u,
+                              const double *d, double t, double eps, const double *f0,
+                              const fcm_csr *T, double *err_energy, double *err_tangent)
+{
+  double *fp = calloc((size_t)n, sizeof *fp), *fm = calloc((size_t)n, sizeof *fm);
+  double *Td = calloc((size_t)n, sizeof *Td), ep = 0.0, em = 0.0, fd = 0.0, num = 0.0, den = 0.0;
+  for (fcm_index i = 0; i < n; i++)
+    u[i] += eps * d[i];
+  TEST_OK(ctx, fcm_integrator_contact_eval(I, u, t, &ep, fp, NULL));
+  for (fcm_index i = 0; i < n; i++)
+    u[i] -= 2.0 * eps * d[i];
+  TEST_OK(ctx, fcm_integrator_contact_eval(I, u, t, &em, fm, NULL));
+  for (fcm_index i = 0; i < n; i++) {
+    u[i] += eps * d[i];
+    fd += f0[i] * d[i];
+  }
+  *err_energy = fabs((ep - em) / (2.0 * eps) - fd) / fabs(fd);
+  *err_tangent = 0.0;
+  if (T) {
+    TEST_OK(ctx, fcm_csr_apply(T, 1.0, d, 0.0, Td));
+    for (fcm_index i = 0; i < n; i++) {
+      const double x = (fp[i] - fm[i]) / (2.0 * eps);
+      num += (x - Td[i]) * (x - Td[i]);
+      den += Td[i] * Td[i];
+    }
+    *err_tangent = den > 0.0 ? sqrt(num / den) : HUGE_VAL;
+  }
+  free(fp), free(fm), free(Td);
+}
+
+/* The time of one fcm_integrator_contact_eval() (energy, force, Newton matrix T) at u and t
+ * per embedded-surface point of the rules, printed (not asserted: lib/docs/contact.md). */
+static inline void contact_eval_cost(fcm_ctx *ctx, fcm_integrator *I, const problem *p,
+                                     const double *u, double t, double *f, fcm_csr *T,
+                                     const char *what)
+{
+  fcm_index np = 0;
+  double e = 0.0;
+  for (fcm_index cell = 0; cell < fcm_mesh_num_cells(p->mesh); cell++) {
+    int q = 0;
+    TEST_OK(ctx, fcm_cell_rules_get_surface(p->rules, cell, &q, NULL, NULL, NULL, NULL));
+    np += q;
+  }
+  const int reps = 100;
+  const double t0 = fcm_wtime();
+  for (int k = 0; k < reps; k++)
+    TEST_OK(ctx, fcm_integrator_contact_eval(I, u, t, &e, f, T));
+  const double dt = (fcm_wtime() - t0) / reps;
+  printf("%s: contact eval (energy, force, Newton matrix): %lld surface points, %.3g s per call, "
+         "%.3g us per point\n",
+         what, (long long)np, dt, 1e6 * dt / (double)(np > 0 ? np : 1));
 }
 
 #endif

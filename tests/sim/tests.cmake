@@ -96,3 +96,21 @@ fcm_add_test(sim_contact_errors tests/sim/contact.c ARGS errors)
 fcm_add_test(sim_contact_push tests/sim/contact.c ARGS push)
 fcm_add_test(sim_contact_drop_be tests/sim/contact.c ARGS drop backward_euler)
 fcm_add_test(sim_contact_drop_newmark tests/sim/contact.c ARGS drop newmark)
+# Spheres, boxes and closed triangle surfaces as contact obstacles: the point-triangle distance
+# in each region and every kind's distance against differences, the barrier's force against
+# differences, balls dropped onto and pushed by each kind, and the refusals.
+fcm_add_test(sim_contact_triangle tests/sim/contact_obstacles.c ARGS triangle)
+fcm_add_test(sim_contact_distance tests/sim/contact_obstacles.c ARGS distance)
+fcm_add_test(sim_contact_obstacle_errors tests/sim/contact_obstacles.c ARGS errors)
+foreach(kind sphere box surface)
+  fcm_add_test(sim_contact_force_${kind} tests/sim/contact_obstacles.c ARGS force ${kind})
+  fcm_add_test(sim_contact_drop_${kind} tests/sim/contact_obstacles.c ARGS drop ${kind})
+  fcm_add_test(sim_contact_push_${kind} tests/sim/contact_obstacles.c ARGS push ${kind})
+endforeach()
+# Lagged, smoothed Coulomb friction: its force and Newton matrix against differences with the
+# lagged quantities fixed (a moving plane, a translating and rotating box); a block on a floor
+# under tilted gravity sticks with mu > tan theta and slides at g (sin theta - mu cos theta)
+# with mu < tan theta.
+fcm_add_test(sim_contact_friction_fd tests/sim/contact_friction.c ARGS fd)
+fcm_add_test(sim_contact_friction_stick tests/sim/contact_friction.c ARGS incline 0.6)
+fcm_add_test(sim_contact_friction_slide tests/sim/contact_friction.c ARGS incline 0.2)

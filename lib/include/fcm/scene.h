@@ -304,14 +304,31 @@ typedef struct fcm_effect_cut {
   double transform[9], offset[3]; /**< x -> transform x + offset (identity when none) */
 } fcm_effect_cut;
 
-/** A rigid half-space obstacle (fcm_integrator_add_contact_plane()): the plane through
- * point + velocity t with the unit normal pointing to the body's side; the barrier's
- * threshold and stiffness (0: the defaults of fcm_contact_options). */
+/** Contact obstacle kinds of the "contact" effect. */
+typedef enum fcm_contact_obstacle {
+  FCM_CONTACT_PLANE = 0, /**< "plane": fcm_integrator_add_contact_plane() */
+  FCM_CONTACT_SPHERE,    /**< "sphere": fcm_integrator_add_contact_sphere() */
+  FCM_CONTACT_BOX,       /**< "box": fcm_integrator_add_contact_box() */
+  FCM_CONTACT_SURFACE    /**< "surface": fcm_integrator_add_contact_surface() from a file */
+} fcm_contact_obstacle;
+
+/** A rigid obstacle: a half-space (the plane through point + velocity t with the unit normal
+ * pointing to the body's side), a sphere, a box or the solid a closed triangle surface bounds,
+ * the last three static or moved by a rigid motion; the barrier's threshold and stiffness (0:
+ * the defaults of fcm_contact_options). */
 typedef struct fcm_effect_contact {
-  double point[3];             /**< m */
-  double normal[3];            /**< unit (normalized by the parser) */
-  double velocity[3];          /**< m/s (default 0: a static obstacle) */
-  fcm_contact_options options; /**< "distance" (m), "stiffness" (Pa/m), >= 0 */
+  fcm_contact_obstacle obstacle; /**< which of the members below apply */
+  double point[3];               /**< PLANE: m */
+  double normal[3];              /**< PLANE: unit (normalized by the parser) */
+  double velocity[3];            /**< PLANE: m/s (default 0: a static obstacle) */
+  double center[3];              /**< SPHERE: m */
+  double radius;                 /**< SPHERE: m, > 0 */
+  double min[3], max[3];         /**< BOX: corners, min < max */
+  const char *mesh;              /**< SURFACE: the .obj, .off, .stl or .ply file (resolved) */
+  fcm_motion motion;             /**< SPHERE, BOX, SURFACE: "velocity", "rotation", "start",
+                                      "end" as the motion effect (default: static) */
+  fcm_contact_options options;   /**< "distance" (m), "stiffness" (Pa/m), "friction" (mu),
+                                      "friction_velocity" (m/s), each >= 0 */
 } fcm_effect_contact;
 
 /** One effect of the scene: a tagged union. */

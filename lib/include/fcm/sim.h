@@ -535,6 +535,12 @@ typedef struct fcm_contact_options {
                          largest extent of a cell holding embedded-surface points */
   double stiffness; /**< the barrier's stiffness kappa (Pa/m), > 0; 0 (default): E / h, E the
                          material's Young modulus */
+  double friction;  /**< Coulomb coefficient mu >= 0 (default 0: frictionless); lagged and
+                         smoothed as in IPC: each point's normal force and tangent plane from
+                         the substep's start, the slip's dissipation potential
+                         mu lambda f0(|slip|) smoothed below eps_v h (dynamic schemes only) */
+  double friction_velocity; /**< eps_v (m/s) >= 0: slip velocities below it see a friction
+                                 force that falls smoothly to 0; 0 (default): 1e-3 m/s */
 } fcm_contact_options;
 
 /** The defaults listed on each member. */
@@ -552,8 +558,8 @@ FCM_API fcm_contact_options fcm_contact_options_default(void);
  * times the largest fraction that keeps each point at d > 0 (the distance is linear in the
  * step for a plane), then backtracked on the energy; a substep's first guess that penetrates is
  * pulled back the same way from the substep's start. A state on or behind a plane (d <= 0) is
- * refused by the setup and by each step with the point and its distance. Not supported yet:
- * friction, boxes, spheres, triangle-surface obstacles, contact between bodies or with itself,
+ * refused by the setup and by each step with the point and its distance. Coulomb friction:
+ * fcm_contact_options.friction. Not supported yet: contact between bodies or with itself,
  * distributed backends. Before setup.
  * @param[out] id the obstacle's index (may be NULL)
  * @return FCM_OK, FCM_ERR_ARG (NULL integrator or vector; a zero or non-finite normal; a
@@ -565,13 +571,92 @@ FCM_API fcm_status fcm_integrator_add_contact_plane(fcm_integrator *integ, const
                                                     const double velocity[3],
                                                     const fcm_contact_options *opts, int *id);
 
+/** A rigid solid sphere of `radius` about `center`, static (motion NULL) or moved rigidly by
+ * `motion` (fcm_motion_eval(): x(t) = c + R(tau) (X - c) + velocity tau, held after `end`;
+ * `components` and `release` are ignored): the body stays outside it. The barrier is that of
+ * fcm_integrator_add_contact_plane() with the distance d = |x - c(t)| - radius. Each point's
+ * Newton matrix is w kappa b''(d) g g^T with g the distance's gradient: the positive
+ * semidefinite part of its exact Hessian w kappa (b'' g g^T + b' H), H the distance's Hessian
+ * (fcm_integrator_contact_distance()); the force is exact. The step filter is the exact first
+ * parameter where a point's straight path meets the sphere (the obstacle is fixed within a
+ * Newton iteration, at the substep's end). A point on or inside the sphere is refused as for
+ * planes (the message gives its depth). Before setup.
+ * @return FCM_OK, FCM_ERR_ARG (NULL integrator or centre; a radius <= 0 or non-finite; a
+ * non-finite motion, end < start, a rotation about a zero axis; a negative or non-finite
+ * option, named; after setup), FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_integrator_add_contact_sphere(fcm_integrator *integ, const double center[3],
+                                                     double radius, const fcm_motion *motion,
+                                                     const fcm_contact_options *opts, int *id);
+
+/** A rigid solid box [lo, hi] (in its own frame, placed by `motion` as for
+ * fcm_integrator_add_contact_sphere(), NULL: static): the body stays outside it. The distance
+ * is the Euclidean distance to the box (its faces, edges and corners), negative inside.
+ * Otherwise as fcm_integrator_add_contact_sphere().
+ * @return as fcm_integrator_add_contact_sphere(), FCM_ERR_ARG also for lo[i] >= hi[i]. */
+FCM_API fcm_status fcm_integrator_add_contact_box(fcm_integrator *integ, const double lo[3],
+                                                  const double hi[3], const fcm_motion *motion,
+                                                  const fcm_contact_options *opts, int *id);
+
+/** A rigid solid bounded by a closed triangle surface (coords: num_vertices x 3, tris:
+ * num_triangles x 3 0-based, both copied; in its own frame, placed by `motion` as for
+ * fcm_integrator_add_contact_sphere(), NULL: static): the body stays outside it. The distance
+ * of a point is the point-triangle distance to its closest triangle (face, edge or vertex
+ * region), found through an AABB tree over the triangles within the threshold d^, so the cost
+ * per point grows with the triangles near it, not with all of them; inside is decided by the
+ * parity of a ray's crossings, which needs the surface closed: an open or non-manifold
+ * surface is refused, naming its first open edge. The step filter is the exact first crossing
+ * of a point's straight path with a triangle. A moving surface that swallows a point within a
+ * substep makes that substep fail (it is halved like any non-finite substep). Otherwise as
+ * fcm_integrator_add_contact_sphere().
+ * @return as fcm_integrator_add_contact_sphere(), FCM_ERR_ARG also for NULL arrays, fewer than
+ * 4 vertices or triangles, a vertex id out of range or a non-finite coordinate, a surface not
+ * closed or not manifold (naming the first such edge). */
+FCM_API fcm_status fcm_integrator_add_contact_surface(fcm_integrator *integ, fcm_index num_vertices,
+                                                      const double *coords, fcm_index num_triangles,
+                                                      const fcm_index *tris,
+                                                      const fcm_motion *motion,
+                                                      const fcm_contact_options *opts, int *id);
+
+/** The signed distance of the world point x to obstacle `id` at time t (negative inside or
+ * behind it), its gradient (3) and Hessian (9, row-major; may be NULL each): planes are
+ * affine (H = 0), spheres give (I - g g^T) / |x - c|, boxes and surfaces the Hessian of the
+ * closest face (0), edge ((I - e e^T - g g^T) / d, e the edge's unit direction) or corner
+ * ((I - g g^T) / d). A surface's closest triangle is searched without a threshold. Before or
+ * after setup. Allocates workspace only.
+ * @return FCM_OK, FCM_ERR_ARG (NULL integrator, point or distance; id out of range),
+ * FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_integrator_contact_distance(const fcm_integrator *integ, int id,
+                                                   const double x[3], double t, double *distance,
+                                                   double gradient[3], double hessian[9]);
+
 /** Contact obstacle `id` at the current state and time: the force the obstacle exerts on the
- * body (sum over the points of -w kappa b'(d) n; zero beyond the threshold) and the smallest
- * distance of an embedded-surface point to it (either may be NULL); its threshold and stiffness
- * (the defaults resolved) in dhat and kappa (each may be NULL). After setup. Allocates nothing.
- * @return FCM_OK, FCM_ERR_ARG (NULL, not set up, id out of range). */
+ * body (sum over the points of -w kappa b'(d) g, g the distance's gradient; zero beyond the
+ * threshold) and the smallest signed distance of an embedded-surface point to it (either may
+ * be NULL; a surface obstacle tests each point's side with a ray); its threshold and stiffness
+ * (the defaults resolved) in dhat and kappa (each may be NULL). After setup. Allocates
+ * workspace only for surface obstacles.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, not set up, id out of range), FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_integrator_contact_info(const fcm_integrator *integ, int id, double force[3],
                                                double *min_distance, double *dhat, double *kappa);
+
+/** The contact obstacles' state, for logs and summaries (fcm_integrator_contact_stats()). */
+typedef struct fcm_contact_stats {
+  long long evaluations;       /**< evaluations of the contact terms since setup (energy, force
+                                    or Newton matrix: each Newton iterate and line-search trial);
+                                    0 without obstacles */
+  long long active_points;     /**< point-obstacle pairs closer than the threshold d^ now */
+  double min_distance;         /**< the smallest signed distance of a surface point to an
+                                    obstacle now (HUGE_VAL without obstacles) */
+  double barrier_energy;       /**< sum of w kappa b(d) now (J) */
+  double friction_dissipation; /**< the work of the friction forces over the last substep's slip
+                                    (J, >= 0; 0 without friction) */
+} fcm_contact_stats;
+
+/** The contact obstacles' state at the current displacement and time. Before setup, or
+ * without obstacles: the evaluation count (0) and no contact. Allocates workspace only.
+ * @return FCM_OK, FCM_ERR_ARG (NULL), FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_integrator_contact_stats(const fcm_integrator *integ,
+                                                fcm_contact_stats *stats);
 
 /** How often the contact filter acted since setup: the Newton steps it shortened before the
  * line search (*filtered) and the substeps whose first guess it pulled back in front of an

@@ -96,30 +96,36 @@ FCM_API fcm_simulation_options fcm_simulation_options_default(void);
 
 /** What the pipeline computed (counts) and which stages it used (flags 0/1). */
 typedef struct fcm_simulation_counters {
-  int cell_rules;              /**< 1: embedded cell rules were built (scene has a geometry) */
-  int surface_rules;           /**< 1: the cell rules carry surface rules */
-  unsigned rule_kinds;         /**< volume rule kinds built (FCM_RULES_* bits of fcm/embed.h):
-                                    stiffness always, mass only for a dynamic scene; 0 without
-                                    cell rules */
-  int inertia;                 /**< 1: dynamic integrator (inertia term); 0: static */
-  int mass_assemblies;         /**< consistent-mass assemblies: 1 for dynamic scenes, 0 static */
-  int body_force_assemblies;   /**< body-force assemblies the integrator's setup made (one per
-                                    gravity effect) */
-  int scale_assemblies;        /**< 1: a static scene without gravity assembled the body force of
-                                    rho a_rep once for the Newton force scale (see sim.h) */
-  int traction_assemblies;     /**< surface load assemblies the setup made (one per traction or
-                                    pressure effect) */
-  int damping;                 /**< 1: a Rayleigh damping matrix is used */
-  int initial_velocity;        /**< initial-velocity effects applied */
-  int constraints;             /**< constraint sets (fixed and motion effects) */
-  int contacts;                /**< contact obstacles (contact effects) */
-  fcm_index constrained_nodes; /**< background nodes named by them (with or without DOFs) */
-  fcm_index constrained_dofs;  /**< constrained DOFs after setup */
-  fcm_index boundary_points;   /**< embedded-boundary points held by `boundary` constraints */
-  fcm_index schwarz_blocks;    /**< cut cells given a Schwarz block (0: no Schwarz set up) */
-  int krylov;                  /**< 1: Krylov solves (CG, MINRES); 0: direct or multigrid */
-  int multigrid;               /**< 1: multigrid, as the Krylov preconditioner or the solver */
-  long long steps;             /**< accepted steps */
+  int cell_rules;                /**< 1: embedded cell rules were built (scene has a geometry) */
+  int surface_rules;             /**< 1: the cell rules carry surface rules */
+  unsigned rule_kinds;           /**< volume rule kinds built (FCM_RULES_* bits of fcm/embed.h):
+                                      stiffness always, mass only for a dynamic scene; 0 without
+                                      cell rules */
+  int inertia;                   /**< 1: dynamic integrator (inertia term); 0: static */
+  int mass_assemblies;           /**< consistent-mass assemblies: 1 for dynamic scenes, 0 static */
+  int body_force_assemblies;     /**< body-force assemblies the integrator's setup made (one per
+                                      gravity effect) */
+  int scale_assemblies;          /**< 1: a static scene without gravity assembled the body force of
+                                      rho a_rep once for the Newton force scale (see sim.h) */
+  int traction_assemblies;       /**< surface load assemblies the setup made (one per traction or
+                                      pressure effect) */
+  int damping;                   /**< 1: a Rayleigh damping matrix is used */
+  int initial_velocity;          /**< initial-velocity effects applied */
+  int constraints;               /**< constraint sets (fixed and motion effects) */
+  int contacts;                  /**< contact obstacles (contact effects) */
+  long long contact_evaluations; /**< evaluations of the contact terms (0 without contact) */
+  long long contact_points_max;  /**< the most point-obstacle pairs within d^ after a step */
+  double contact_min_distance;   /**< the smallest signed distance to an obstacle after a step
+                                      (HUGE_VAL: no contact effect or no step) */
+  double contact_energy_max;     /**< the largest barrier energy after a step (J) */
+  double friction_dissipation;   /**< the friction's work summed over the steps (J) */
+  fcm_index constrained_nodes;   /**< background nodes named by them (with or without DOFs) */
+  fcm_index constrained_dofs;    /**< constrained DOFs after setup */
+  fcm_index boundary_points;     /**< embedded-boundary points held by `boundary` constraints */
+  fcm_index schwarz_blocks;      /**< cut cells given a Schwarz block (0: no Schwarz set up) */
+  int krylov;                    /**< 1: Krylov solves (CG, MINRES); 0: direct or multigrid */
+  int multigrid;                 /**< 1: multigrid, as the Krylov preconditioner or the solver */
+  long long steps;               /**< accepted steps */
   long long newton_iterations, linear_iterations, tangent_assemblies;
   long long multigrid_cycles;      /**< multigrid cycles (fcm_step_info.multigrid_cycles, summed;
                                         not in checkpoints: counted from the restore on) */

@@ -270,6 +270,8 @@ static fcm_status read_linear(fcm_simulation *S, fcm__ckpt_reader *r, ckpt_data 
       w->time = (double)(k + 1) * tm->dt;
       w->residual = w->tolerance = w->energy = w->wall = w->mass = NAN;
       w->kinetic = w->elastic = w->work = NAN;
+      w->contact_points = -1;
+      w->contact_dmin = w->contact_energy = w->friction = NAN;
       w->momentum[0] = w->momentum[1] = w->momentum[2] = NAN;
       w->pieces = (long long)S->pieces;
       w->inverted = w->inverted_cell = w->nonfinite = -1;
@@ -385,6 +387,8 @@ static fcm_status read_scene(fcm_simulation *S, fcm__ckpt_reader *r, ckpt_data *
     double e[3] = {NAN, NAN, NAN}; /* not recorded before version 6 */
     if (ver >= 6) FCM_TRY(ctx, fcm__ckpt_get(r, e, sizeof e, "a log row"));
     w->kinetic = e[0], w->elastic = e[1], w->work = e[2];
+    w->contact_points = -1; /* contact columns are not kept */
+    w->contact_dmin = w->contact_energy = w->friction = NAN;
   }
   FCM_TRY(ctx, read_scheme(S, r, d, &acc));
   FCM_TRY(ctx, read_state(r, d, acc));

@@ -327,18 +327,13 @@ static void view_fixed(const fcm_effect *e, FILE *f)
   view_target(&e->fixed.region, e->fixed.boundary, &e->fixed.boundary_options, f);
 }
 
-static fcm_status parse_motion(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
+/* A rigid motion's "velocity", "rotation" {"axis", "center", "speed"} and window ("start",
+ * "end") into m (its other members untouched). */
+static fcm_status read_rigid_motion(fcm__scene_parser *p, const fcm__json *o, fcm_motion *m)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"region", "boundary", "velocity", "rotation",       "start",
-                                     "end",    "release",  "method",   "nitsche_safety", "penalty"};
   static const char *const rkeys[] = {"axis", "center", "speed"};
-  fcm_motion *m = &e->motion.motion;
   const fcm__json *rot = NULL;
-  *m = fcm_motion_default();
-  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
-  FCM_TRY(p->ctx,
-          read_target(p, o, &e->motion.region, &e->motion.boundary, &e->motion.boundary_options));
   FCM_TRY(p->ctx, fcm__scene_read_vec3(p, o, "velocity", 0, FCM__ANY, m->velocity));
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "rotation", 0, &rot));
   if (rot) {
@@ -356,6 +351,21 @@ static fcm_status parse_motion(fcm__scene_parser *p, const fcm__json *o, fcm_eff
     fcm__scene_path_pop(p, old);
   }
   FCM_TRY(p->ctx, read_window(p, o, &m->start, &m->end));
+cleanup:
+  return st;
+}
+
+static fcm_status parse_motion(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
+{
+  fcm_status st = FCM_OK;
+  static const char *const keys[] = {"region", "boundary", "velocity", "rotation",       "start",
+                                     "end",    "release",  "method",   "nitsche_safety", "penalty"};
+  fcm_motion *m = &e->motion.motion;
+  *m = fcm_motion_default();
+  FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
+  FCM_TRY(p->ctx,
+          read_target(p, o, &e->motion.region, &e->motion.boundary, &e->motion.boundary_options));
+  FCM_TRY(p->ctx, read_rigid_motion(p, o, m));
   FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "release", 0, &m->release));
   if (m->release) {
     size_t old = fcm__scene_path_push_key(p, "release");
@@ -596,24 +606,73 @@ static void view_cut(const fcm_effect *e, FILE *f)
 static fcm_status parse_contact(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"plane", "distance", "stiffness"};
+  static const char *const keys[] = {"plane",    "sphere",    "box",      "surface",
+                                     "distance", "stiffness", "friction", "friction_velocity"};
   static const char *const plane_keys[] = {"point", "normal", "velocity"};
+  static const char *const sphere_keys[] = {"center",   "radius", "velocity",
+                                            "rotation", "start",  "end"};
+  static const char *const box_keys[] = {"min", "max", "velocity", "rotation", "start", "end"};
+  static const char *const surface_keys[] = {"mesh", "velocity", "rotation", "start", "end"};
   fcm_effect_contact *c = &e->contact;
-  const fcm__json *pl = NULL;
+  const fcm__json *ob = NULL;
+  const char *kind = NULL;
+  int count = 0;
   memset(c, 0, sizeof *c);
   c->options = fcm_contact_options_default();
+  c->motion = fcm_motion_default();
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
-  FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "plane", 1, &pl));
-  size_t old = fcm__scene_path_push_key(p, "plane");
-  FCM_TRY(p->ctx, fcm__scene_check_object(p, pl, plane_keys, COUNT(plane_keys)));
-  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, pl, "point", 1, FCM__ANY, c->point));
-  FCM_TRY(p->ctx, read_unit(p, pl, "normal", c->normal));
-  FCM_TRY(p->ctx, fcm__scene_read_vec3(p, pl, "velocity", 0, FCM__ANY, c->velocity));
+  for (int k = 0; k < 4; k++)
+    if (fcm__json_member(o, keys[k])) {
+      count++;
+      kind = keys[k];
+      c->obstacle = (fcm_contact_obstacle)k;
+    }
+  SCENE_CHECK(count == 1, p, FCM_ERR_ARG,
+              "expected exactly one obstacle of \"plane\", \"sphere\", \"box\", \"surface\", "
+              "got %d",
+              count);
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, o, kind, 1, &ob));
+  size_t old = fcm__scene_path_push_key(p, kind);
+  switch (c->obstacle) {
+  case FCM_CONTACT_PLANE:
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, ob, plane_keys, COUNT(plane_keys)));
+    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, ob, "point", 1, FCM__ANY, c->point));
+    FCM_TRY(p->ctx, read_unit(p, ob, "normal", c->normal));
+    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, ob, "velocity", 0, FCM__ANY, c->velocity));
+    break;
+  case FCM_CONTACT_SPHERE:
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, ob, sphere_keys, COUNT(sphere_keys)));
+    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, ob, "center", 1, FCM__ANY, c->center));
+    FCM_TRY(p->ctx, fcm__scene_read_number(p, ob, "radius", 1, FCM__POSITIVE, &c->radius));
+    break;
+  case FCM_CONTACT_BOX:
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, ob, box_keys, COUNT(box_keys)));
+    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, ob, "min", 1, FCM__ANY, c->min));
+    FCM_TRY(p->ctx, fcm__scene_read_vec3(p, ob, "max", 1, FCM__ANY, c->max));
+    {
+      size_t o2 = fcm__scene_path_push_key(p, "max");
+      for (int i = 0; i < 3; i++)
+        SCENE_CHECK(c->max[i] > c->min[i], p, FCM_ERR_ARG,
+                    "expected each component above \"min\"'s, got %g <= %g in component %d",
+                    c->max[i], c->min[i], i);
+      fcm__scene_path_pop(p, o2);
+    }
+    break;
+  default:
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, ob, surface_keys, COUNT(surface_keys)));
+    FCM_TRY(p->ctx, fcm__scene_read_file(p, ob, "mesh", 1, NULL, &c->mesh));
+    break;
+  }
+  if (c->obstacle != FCM_CONTACT_PLANE) FCM_TRY(p->ctx, read_rigid_motion(p, ob, &c->motion));
   fcm__scene_path_pop(p, old);
   FCM_TRY(p->ctx,
           fcm__scene_read_number(p, o, "distance", 0, FCM__NONNEGATIVE, &c->options.distance));
   FCM_TRY(p->ctx,
           fcm__scene_read_number(p, o, "stiffness", 0, FCM__NONNEGATIVE, &c->options.stiffness));
+  FCM_TRY(p->ctx,
+          fcm__scene_read_number(p, o, "friction", 0, FCM__NONNEGATIVE, &c->options.friction));
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "friction_velocity", 0, FCM__NONNEGATIVE,
+                                         &c->options.friction_velocity));
 cleanup:
   return st;
 }
@@ -621,9 +680,33 @@ cleanup:
 static void view_contact(const fcm_effect *e, FILE *f)
 {
   const fcm_effect_contact *c = &e->contact;
-  const double *q = c->point, *n = c->normal, *v = c->velocity;
-  fprintf(f, "plane through (%g, %g, %g), normal (%g, %g, %g), velocity (%g, %g, %g) m/s", q[0],
-          q[1], q[2], n[0], n[1], n[2], v[0], v[1], v[2]);
+  const fcm_motion *m = &c->motion;
+  switch (c->obstacle) {
+  case FCM_CONTACT_PLANE: {
+    const double *q = c->point, *n = c->normal, *v = c->velocity;
+    fprintf(f, "plane through (%g, %g, %g), normal (%g, %g, %g), velocity (%g, %g, %g) m/s", q[0],
+            q[1], q[2], n[0], n[1], n[2], v[0], v[1], v[2]);
+    break;
+  }
+  case FCM_CONTACT_SPHERE:
+    fprintf(f, "sphere at (%g, %g, %g), radius %g m", c->center[0], c->center[1], c->center[2],
+            c->radius);
+    break;
+  case FCM_CONTACT_BOX:
+    fprintf(f, "box (%g, %g, %g) to (%g, %g, %g)", c->min[0], c->min[1], c->min[2], c->max[0],
+            c->max[1], c->max[2]);
+    break;
+  default:
+    fprintf(f, "surface %s", c->mesh);
+    break;
+  }
+  if (c->obstacle != FCM_CONTACT_PLANE) {
+    fprintf(f, ", velocity (%g, %g, %g) m/s", m->velocity[0], m->velocity[1], m->velocity[2]);
+    if (m->angular_speed != 0.0)
+      fprintf(f, ", rotation %g rad/s about (%g, %g, %g) through (%g, %g, %g)", m->angular_speed,
+              m->axis[0], m->axis[1], m->axis[2], m->center[0], m->center[1], m->center[2]);
+    view_window(m->start, m->end, f);
+  }
   if (c->options.distance > 0.0)
     fprintf(f, ", threshold %g m", c->options.distance);
   else
@@ -632,6 +715,9 @@ static void view_contact(const fcm_effect *e, FILE *f)
     fprintf(f, ", stiffness %g Pa/m", c->options.stiffness);
   else
     fprintf(f, ", stiffness E / h");
+  if (c->options.friction > 0.0)
+    fprintf(f, ", friction %g (smoothed below %g m/s)", c->options.friction,
+            c->options.friction_velocity > 0.0 ? c->options.friction_velocity : 1e-3);
 }
 
 /* The one table of effect modules. Order = enum fcm_effect_type. */

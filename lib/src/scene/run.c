@@ -782,6 +782,7 @@ static fcm_status build_integrator(fcm_simulation *S)
   S->c.num_dofs = fcm_space_num_dofs(S->space);
   S->c.inverted_first_cell = -1;
   S->c.nonfinite_first_step = -1;
+  S->c.contact_min_distance = HUGE_VAL;
   fcm_integrator_options io = integrator_options(S);
   /* a scene with cuts: each cut integrates only the elements it changes */
   if (S->rules && fcm_scene_count_effects(scene, FCM_EFFECT_CUT) > 0)

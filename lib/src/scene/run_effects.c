@@ -11,6 +11,7 @@
 #include "fcm/embed.h"
 #include "fcm/fem.h"
 #include "fcm/geom.h"
+#include "fcm/surface.h"
 #include "fcm/io.h"
 #include "fcm/levelset.h"
 #include "fcm/voxels.h"
@@ -145,13 +146,41 @@ fcm_status fcm__effect_apply_contact(fcm_simulation *S, const fcm_effect *e)
 {
   fcm_status st = FCM_OK;
   const fcm_effect_contact *c = &e->contact;
+  fcm_surface *surf = NULL;
   FCM_CHECK(S->c.surface_rules, S->ctx, FCM_ERR_ARG,
             "scene %s: effects[%d]: contact needs an embedded geometry with surface rules",
             fcm_scene_name(S->scene), e->index);
-  FCM_TRY(S->ctx, fcm_integrator_add_contact_plane(S->integ, c->point, c->normal, c->velocity,
+  switch (c->obstacle) {
+  case FCM_CONTACT_PLANE:
+    FCM_TRY(S->ctx, fcm_integrator_add_contact_plane(S->integ, c->point, c->normal, c->velocity,
+                                                     &c->options, NULL));
+    break;
+  case FCM_CONTACT_SPHERE:
+    FCM_TRY(S->ctx, fcm_integrator_add_contact_sphere(S->integ, c->center, c->radius, &c->motion,
+                                                      &c->options, NULL));
+    break;
+  case FCM_CONTACT_BOX:
+    FCM_TRY(S->ctx, fcm_integrator_add_contact_box(S->integ, c->min, c->max, &c->motion,
                                                    &c->options, NULL));
+    break;
+  default:
+    FCM_TRY(S->ctx, fcm_surface_create_from_file(S->ctx, c->mesh, &surf));
+    st = fcm_integrator_add_contact_surface(
+        S->integ, fcm_surface_num_vertices(surf), fcm_surface_coords(surf),
+        fcm_surface_num_triangles(surf), fcm_surface_triangles(surf), &c->motion, &c->options,
+        NULL);
+    if (st != FCM_OK) {
+      char prefix[1200];
+      snprintf(prefix, sizeof prefix, "scene %s: effects[%d]: %s", fcm_scene_name(S->scene),
+               e->index, c->mesh);
+      fcm__error_prefix(S->ctx, prefix);
+      goto cleanup;
+    }
+    break;
+  }
   S->c.contacts++;
 cleanup:
+  fcm_surface_destroy(&surf);
   return st;
 }
 

@@ -28,6 +28,10 @@ typedef struct fcm__log_row {
   long long pieces;
   double mass, momentum[3];
   long long inverted, inverted_cell, nonfinite;
+  /* contact scenes (fcm_integrator_contact_stats() after the step; not kept by checkpoints:
+   * -1 and NaN in rows restored from one) */
+  long long contact_points;
+  double contact_dmin, contact_energy, friction;
 } fcm__log_row;
 
 /* The passes over each kind's points that quadrature.simplify = "auto" was told to expect, by

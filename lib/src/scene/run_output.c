@@ -163,7 +163,10 @@ fcm_status fcm_simulation_write_log(fcm_simulation *S, const char *path)
   FCM_TRY(S->ctx,
           fcm__io_atomic_printf(S->ctx, &af,
                                 ",inverted_points,nonfinite_stresses,tolerance,kinetic_energy,"
-                                "elastic_energy,load_work,wall_time\n"));
+                                "elastic_energy,load_work,wall_time%s\n",
+                                S->c.contacts > 0 ? ",contact_points,contact_min_distance,"
+                                                    "contact_energy,friction_dissipation"
+                                                  : ""));
   for (long long k = 0; k < S->log_n; k++) {
     const fcm__log_row *r = &S->log[k];
     FCM_TRY(S->ctx,
@@ -182,8 +185,15 @@ fcm_status fcm_simulation_write_log(fcm_simulation *S, const char *path)
                                      : fcm__io_atomic_printf(S->ctx, &af, ",nan"));
     /* the stopping rule's tolerance beside the residual: an interactive step
      * (newton_fixed_iterations) may end above it */
-    FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, ",%.17g,%.17g,%.17g,%.17g,%.6g\n",
+    FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, ",%.17g,%.17g,%.17g,%.17g,%.6g",
                                           r->tolerance, r->kinetic, r->elastic, r->work, r->wall));
+    if (S->c.contacts > 0)
+      FCM_TRY(S->ctx,
+              r->contact_points >= 0
+                  ? fcm__io_atomic_printf(S->ctx, &af, ",%lld,%.17g,%.17g,%.17g", r->contact_points,
+                                          r->contact_dmin, r->contact_energy, r->friction)
+                  : fcm__io_atomic_printf(S->ctx, &af, ",nan,nan,nan,nan"));
+    FCM_TRY(S->ctx, fcm__io_atomic_printf(S->ctx, &af, "\n"));
   }
   FCM_TRY(S->ctx, fcm__io_atomic_commit(S->ctx, &af));
 cleanup:

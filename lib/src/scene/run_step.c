@@ -85,7 +85,17 @@ void fcm__sim_count_log(fcm_simulation *S)
   c->nonfinite_frames = 0;
   c->nonfinite_last = c->nonfinite_max = 0;
   c->nonfinite_first_step = -1;
+  c->contact_points_max = 0;
+  c->contact_min_distance = HUGE_VAL;
+  c->contact_energy_max = c->friction_dissipation = 0.0;
   for (long long k = 0; k < S->log_n; k++) {
+    const fcm__log_row *r = &S->log[k];
+    if (r->contact_points >= 0) { /* rows of this run (checkpoints do not keep them) */
+      c->contact_points_max = FCM_MAX(c->contact_points_max, r->contact_points);
+      c->contact_min_distance = FCM_MIN(c->contact_min_distance, r->contact_dmin);
+      c->contact_energy_max = FCM_MAX(c->contact_energy_max, r->contact_energy);
+      c->friction_dissipation += r->friction;
+    }
     count_inversion(c, k + 1, &S->log[k]);
     if (S->log[k].nonfinite >= 0) fcm__sim_count_frame(c, k + 1, (fcm_index)S->log[k].nonfinite);
   }
@@ -171,6 +181,21 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
   r->inverted = si.inverted_points;
   r->inverted_cell = si.inverted_cell;
   r->nonfinite = -1;
+  r->contact_points = -1;
+  r->contact_dmin = r->contact_energy = r->friction = NAN;
+  if (S->c.contacts > 0) {
+    fcm_contact_stats cs;
+    FCM_TRY(S->ctx, fcm_integrator_contact_stats(S->integ, &cs));
+    r->contact_points = cs.active_points;
+    r->contact_dmin = cs.min_distance;
+    r->contact_energy = cs.barrier_energy;
+    r->friction = cs.friction_dissipation;
+    S->c.contact_evaluations = cs.evaluations;
+    S->c.contact_points_max = FCM_MAX(S->c.contact_points_max, cs.active_points);
+    S->c.contact_min_distance = FCM_MIN(S->c.contact_min_distance, cs.min_distance);
+    S->c.contact_energy_max = FCM_MAX(S->c.contact_energy_max, cs.barrier_energy);
+    S->c.friction_dissipation += cs.friction_dissipation;
+  }
   count_inversion(&S->c, S->c.steps, r);
   FCM_TRY(S->ctx, log_momentum(S, r));
   S->c.time_log += fcm_wtime() - tlog;

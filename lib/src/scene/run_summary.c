@@ -386,7 +386,16 @@ static void summary_view(const fcm_simulation *S, FILE *f, const fcm_cell_rules_
            c->constraints, (long long)c->constrained_nodes, (long long)c->constrained_dofs,
            (long long)c->boundary_points);
   line(f, c->constraints > 0, "constraints", c->constraints ? b : "(none)");
-  snprintf(b, sizeof b, "%d plane%s", c->contacts, c->contacts == 1 ? "" : "s");
+  if (c->contacts > 0 && c->contact_min_distance < HUGE_VAL)
+    snprintf(b, sizeof b,
+             "%d obstacle%s; up to %lld point-obstacle pairs within the threshold, smallest "
+             "distance %.3g m, barrier energy up to %.3g J, friction work %.3g J; %lld "
+             "evaluations",
+             c->contacts, c->contacts == 1 ? "" : "s", c->contact_points_max,
+             c->contact_min_distance, c->contact_energy_max, c->friction_dissipation,
+             c->contact_evaluations);
+  else
+    snprintf(b, sizeof b, "%d obstacle%s", c->contacts, c->contacts == 1 ? "" : "s");
   line(f, c->contacts > 0, "contact obstacles", c->contacts ? b : "(no contact effect)");
   snprintf(b, sizeof b, "%lld blocks", (long long)c->schwarz_blocks);
   line(f, c->schwarz_blocks > 0, "Schwarz blocks",

@@ -933,8 +933,7 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
     st = fcm_integrator_add_boundary_constraint(I, old->bcons[k].select, old->bcons[k].select_user,
                                                 &old->bcons[k].motion, &old->bcons[k].opts, NULL);
   for (int k = 0; st == FCM_OK && k < old->num_contacts; k++) {
-    const sim_contact *c = &old->contacts[k];
-    st = fcm_integrator_add_contact_plane(I, c->point, c->normal, c->velocity, &c->opts, NULL);
+    st = fcm__sim_contact_copy(I, &old->contacts[k]);
   }
   {
     /* the old integrator's backend for the new space (the serial one stays serial) */

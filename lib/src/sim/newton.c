@@ -441,7 +441,10 @@ static fcm_status newton_start(fcm_integrator *I, double h, eval_out *cur, sim_s
   fcm_status st = FCM_OK;
   if (h > 0.0) fcm__sim_scheme_predict(I, h);
   fcm__sim_hanging_fill(I, I->u); /* continuous: hanging DOFs follow their masters */
-  if (I->num_contacts > 0) fcm__sim_contact_pull_back(I);
+  if (I->num_contacts > 0) {
+    FCM_TRY(I->ctx, fcm__sim_contact_lag(I, h)); /* friction's normal forces and tangents */
+    fcm__sim_contact_pull_back(I);
+  }
   /* a predictor iteration (constraints off their values) cannot use the kept factorization */
   const int tangent = !I->linear && !(kept_usable(I, h) && constraints_met(I, I->u));
   FCM_TRY(I->ctx, evaluate(I, h, I->u, tangent, I->fint, I->g, cur, stats));

@@ -4,6 +4,7 @@
 #define FCM_SIM_IMPL_H
 
 #include "core/core_impl.h"
+#include "geom/geom_impl.h"
 #include "fcm/sim.h"
 #include "sim/sim_backend.h"
 
@@ -56,12 +57,35 @@ typedef struct sim_bpoints {
   double *eelem;         /* nelem: energy of each element's points (summed in order) */
 } sim_bpoints;
 
-/* A contact obstacle (contact.c): the half-space n . (x - p0 - v t) <= 0 (n unit). */
+/* Contact obstacle kinds (contact.c, contact_obstacle.c). */
+typedef enum sim_contact_kind {
+  SIM_CONTACT_PLANE = 0, /* the half-space n . (x - p0 - v t) <= 0 (n unit) */
+  SIM_CONTACT_SPHERE,    /* the ball |X - c| <= r in the obstacle's frame */
+  SIM_CONTACT_BOX,       /* the box lo <= X <= hi in the obstacle's frame */
+  SIM_CONTACT_SURFACE    /* the volume a closed triangle surface encloses, in its frame */
+} sim_contact_kind;
+
+/* A contact obstacle. Spheres, boxes and surfaces are given in their own frame, placed at
+ * time t by the rigid motion x = o(t) + R(t) X that `motion` prescribes (fcm_motion_eval()). */
 typedef struct sim_contact {
-  double point[3], normal[3], velocity[3];
-  fcm_contact_options opts; /* as given (0: default) */
-  double dhat, kappa;       /* the barrier's threshold and stiffness (setup) */
+  sim_contact_kind kind;
+  double point[3], normal[3], velocity[3]; /* plane */
+  double center[3], radius;                /* sphere */
+  double lo[3], hi[3];                     /* box; surface: its vertices' bounding box */
+  fcm_motion motion;                       /* sphere, box, surface */
+  int moving;                              /* the motion is not the identity at every t */
+  fcm_index nv, nt;                        /* surface: vertices, triangles */
+  double *xyz;                             /* surface: nv x 3 */
+  fcm_index *tri;                          /* surface: nt x 3 */
+  fcm_aabb_tree *tree;                     /* surface: over the triangles */
+  fcm_contact_options opts;                /* as given (0: default) */
+  double dhat, kappa;                      /* the barrier's threshold and stiffness (setup) */
 } sim_contact;
+
+/* An obstacle's placement at one time: world x = o + R X (R row-major). */
+typedef struct sim_pose {
+  double R[9], o[3];
+} sim_pose;
 
 /* The embedded surface's points the contact barrier acts on (setup), grouped by element. */
 typedef struct sim_cpoints {
@@ -72,6 +96,12 @@ typedef struct sim_cpoints {
   double *w, *X, *N;     /* np weights, np x 3 reference positions, np x nn shape values */
   double h;              /* the largest extent of a cell holding points */
   double *scratch;       /* fe (3nn), Ke ((3nn)^2) */
+  fcm__idbuf buf;        /* triangle ids of surface-obstacle queries */
+  sim_pose *pose;        /* num_contacts: the obstacles' placements at the time evaluated */
+  int swallowed;         /* a moving surface obstacle swallowed a point of the substep's start */
+  double *lag;           /* np x num_contacts x 7 (friction only): lambda, T (3 x 2) */
+  sim_pose *pose0;       /* num_contacts (friction only): the placements at the substep's start */
+  double t0, hstep;      /* the substep's start and length (friction) */
 } sim_cpoints;
 
 /* The time scheme's constants (scheme.c): the generalized-alpha family (backward Euler: kind
@@ -117,6 +147,7 @@ struct fcm_integrator {
   int num_contacts;
   sim_cpoints cp;
   long long contact_filtered;  /* Newton steps the contact filter shortened (cumulative) */
+  long long contact_evals;     /* evaluations of the contact terms (cumulative) */
   long long contact_pullbacks; /* substep guesses pulled back in front of an obstacle */
 
   /* state */
@@ -349,11 +380,52 @@ fcm_status fcm__sim_contact_setup(fcm_integrator *I);
 void fcm__sim_contact_free(fcm_integrator *I);
 void fcm__sim_contact_assemble(fcm_integrator *I, const double *x, double *energy, double *force,
                                fcm_csr *T, int *finite);
-double fcm__sim_contact_step_bound(const fcm_integrator *I, const double *x, const double *dx);
+double fcm__sim_contact_step_bound(fcm_integrator *I, const double *x, const double *dx);
 /* A substep's first guess u behind an obstacle: pulled back to un + 0.9 alpha (u - un), alpha
- * the step bound from un (w1 holds u - un afterwards). */
+ * the step bound from un (w1 holds u - un afterwards). A moving surface obstacle that
+ * swallowed a point of un makes the substep's energies non-finite (cp.swallowed). */
 void fcm__sim_contact_pull_back(fcm_integrator *I);
-fcm_status fcm__sim_contact_check(const fcm_integrator *I, const double *x, double t);
+fcm_status fcm__sim_contact_check(fcm_integrator *I, const double *x, double t);
+/* Friction (contact_friction.c). has_friction: an obstacle has mu > 0. lag: each point's
+ * normal force and tangent basis from u_n (obstacles at bc_time), the substep's start
+ * bc_time - h. friction: the dissipation potential of point p at y (substep start y0), its
+ * gradient and Hessian in y (written). */
+int fcm__sim_contact_has_friction(const fcm_integrator *I);
+fcm_status fcm__sim_contact_lag(fcm_integrator *I, double h);
+double fcm__sim_contact_friction(const fcm_integrator *I, fcm_index p, const double y[3],
+                                 const double y0[3], double grad[3], double hess[9]);
+/* The work of point p's friction forces over its slip from y0 to y: sum of mu lambda f1 |s|. */
+double fcm__sim_contact_friction_work(const fcm_integrator *I, fcm_index p, const double y[3],
+                                      const double y0[3]);
+/* Re-add old's obstacle c to I (fcm_integrator_cut()). */
+fcm_status fcm__sim_contact_copy(fcm_integrator *I, const sim_contact *c);
+
+/* Obstacle geometry (contact_obstacle.c). pose: the obstacle's placement at t. distance: d,
+ * its world gradient g and Hessian H (may be NULL) at the world point y; a surface's closest
+ * triangle is searched within `radius` (d = HUGE_VAL beyond). toi: the smallest s in
+ * [0, smax] with y + s dy on the obstacle (0 when y is not outside; HUGE_VAL: none; planes,
+ * spheres and boxes search every s >= 0). inside: y on or inside the obstacle. surface_setup:
+ * the closure check (FCM_ERR_ARG naming obstacle k and the first open edge) and the tree.
+ * point_triangle: the closest point q of (a, b, c) to p and its region (0 the face, 1..3 the
+ * edges ab, bc, ca with the unit direction e, 4..6 the vertices a, b, c); with _distance the
+ * distance, unit gradient and Hessian (may be NULL) of that region. */
+void fcm__sim_contact_pose(const sim_contact *c, double t, sim_pose *P);
+fcm_status fcm__sim_contact_distance(fcm_ctx *ctx, const sim_contact *c, const sim_pose *P,
+                                     const double y[3], double t, double radius, fcm__idbuf *buf,
+                                     double *d, double g[3], double *H);
+fcm_status fcm__sim_contact_toi(fcm_ctx *ctx, const sim_contact *c, const sim_pose *P,
+                                const double y[3], const double dy[3], double t, double smax,
+                                fcm__idbuf *buf, double *s);
+fcm_status fcm__sim_contact_inside(fcm_ctx *ctx, const sim_contact *c, const sim_pose *P,
+                                   const double y[3], double t, fcm__idbuf *buf, int *inside);
+fcm_status fcm__sim_contact_surface_setup(fcm_ctx *ctx, int k, sim_contact *c);
+/* A search radius about y that holds the surface's closest triangle. */
+double fcm__sim_contact_reach(const sim_contact *c, const sim_pose *P, const double y[3]);
+int fcm__sim_point_triangle(const double p[3], const double a[3], const double b[3],
+                            const double c[3], double q[3], double e[3]);
+void fcm__sim_point_triangle_distance(const double p[3], const double a[3], const double b[3],
+                                      const double c[3], double *d, double g[3], double *H,
+                                      int *region);
 
 /* Time schemes (scheme.c). Options: FCM_ERR_ARG naming the member and its range. */
 fcm_status fcm__sim_scheme_validate(fcm_ctx *ctx, const fcm_integrator_options *o);
