@@ -162,6 +162,28 @@ int main(int argc, char **argv)
           memcpy(last, line, sizeof line);
       fclose(f);
     }
+    /* a checkpoint keeps the contact columns: the restored run writes the same log */
+    {
+      char ck[1100], log2[1100];
+      snprintf(ck, sizeof ck, "%s/run.fcmck", dir);
+      snprintf(log2, sizeof log2, "%s/log2.csv", dir);
+      fcm_simulation *back = NULL;
+      TEST_OK(ctx, fcm_simulation_write_checkpoint(sim, ck));
+      TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &back));
+      if (back) TEST_OK(ctx, fcm_simulation_read_checkpoint(back, ck));
+      if (back) TEST_OK(ctx, fcm_simulation_write_log(back, log2));
+      FILE *a = fopen(log, "r"), *b = fopen(log2, "r");
+      int same = a && b, ca = 0, cb = 0;
+      while (same && (ca = fgetc(a)) != EOF && (cb = fgetc(b)) != EOF)
+        same = ca == cb;
+      if (same) same = ca == EOF && fgetc(b) == EOF;
+      if (!same) TEST_FAIL_("the log restored from %s differs from the run's", ck);
+      if (a) fclose(a);
+      if (b) fclose(b);
+      fcm_simulation_destroy(&back);
+      remove(ck);
+      remove(log2);
+    }
     remove(log);
     rmdir(dir);
     /* columns: step,time,newton_iterations,linear_iterations,residual,energy,pieces,mass,

@@ -228,19 +228,20 @@ static void derive_checkpoint(const unsigned char *buf, long size, uint64_t vers
 }
 
 /* Checkpoints keep the reaction columns (version 3), the inversion counts (version 4), the
- * Newton tolerance (version 5) and the energies (version 6, with the time scheme's block of
- * 5 x 8 bytes after the rows); a version-5 file restores with NaN energies, a version-4 file
- * with a NaN tolerance too, a version-3 file with NaN counts too, a version-2 file (rows
- * without reactions either) with NaN there too. Row: 8 f64 + 3 i64, the one constraint's 6 f64,
- * 3 i64 counts, 1 f64 tolerance, 3 f64 energies. */
+ * Newton tolerance (version 5), the energies (version 6, with the time scheme's block of
+ * 5 x 8 bytes after the rows) and the contact columns (version 7: 1 i64 + 3 f64 per row, not in
+ * this scene's log: a version-6 file restores the same log); a version-5 file restores with NaN
+ * energies, a version-4 file with a NaN tolerance too, a version-3 file with NaN counts too, a
+ * version-2 file (rows without reactions either) with NaN there too. Row: 8 f64 + 3 i64, the one
+ * constraint's 6 f64, 3 i64 counts, 1 f64 tolerance, 3 f64 energies, the contact block. */
 static void checkpoint_versions(fcm_ctx *ctx)
 {
   fcm_scene *scene = NULL;
   fcm_simulation *sim = NULL, *back = NULL;
   unsigned char *buf = NULL;
-  const char *v5 = "scene_output_v6.fcmck",
-             *old[4] = {"scene_output_v5.fcmck", "scene_output_v4.fcmck", "scene_output_v3.fcmck",
-                        "scene_output_v2.fcmck"};
+  const char *v5 = "scene_output_v7.fcmck",
+             *old[5] = {"scene_output_v6.fcmck", "scene_output_v5.fcmck", "scene_output_v4.fcmck",
+                        "scene_output_v3.fcmck", "scene_output_v2.fcmck"};
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, static_json, "hang.json", &scene));
   if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
   if (!sim) goto done;
@@ -270,14 +271,16 @@ static void checkpoint_versions(fcm_ctx *ctx)
     TEST_FAIL_("checkpoint %s has only %ld bytes", v5, size);
     goto done;
   }
-  const size_t tail = 3 * 8 + 5 * 8; /* the row's energies and the scheme's block */
-  derive_checkpoint(buf, size, 5, 8 * 8 + 3 * 8 + 6 * 8 + 3 * 8 + 8, tail, old[0]);
-  derive_checkpoint(buf, size, 4, 8 * 8 + 3 * 8 + 6 * 8 + 3 * 8, 8 + tail, old[1]);
-  derive_checkpoint(buf, size, 3, 8 * 8 + 3 * 8 + 6 * 8, 3 * 8 + 8 + tail, old[2]);
-  derive_checkpoint(buf, size, 2, 8 * 8 + 3 * 8, 6 * 8 + 3 * 8 + 8 + tail, old[3]);
-  for (int v = 0; v < 4; v++) {
+  const size_t contact = 4 * 8;                /* the row's contact block */
+  const size_t tail = 3 * 8 + contact + 5 * 8; /* the energies, contact and the scheme's block */
+  derive_checkpoint(buf, size, 6, 8 * 8 + 3 * 8 + 6 * 8 + 3 * 8 + 8 + 3 * 8, contact, old[0]);
+  derive_checkpoint(buf, size, 5, 8 * 8 + 3 * 8 + 6 * 8 + 3 * 8 + 8, tail, old[1]);
+  derive_checkpoint(buf, size, 4, 8 * 8 + 3 * 8 + 6 * 8 + 3 * 8, 8 + tail, old[2]);
+  derive_checkpoint(buf, size, 3, 8 * 8 + 3 * 8 + 6 * 8, 3 * 8 + 8 + tail, old[3]);
+  derive_checkpoint(buf, size, 2, 8 * 8 + 3 * 8, 6 * 8 + 3 * 8 + 8 + tail, old[4]);
+  for (int v = 0; v < 5; v++) {
     /* the columns the version recorded */
-    const int kept = v == 0 ? 20 : v == 1 ? 18 : v == 2 ? 17 : 11;
+    const int kept = v == 0 ? 23 : v == 1 ? 20 : v == 2 ? 18 : v == 3 ? 17 : 11;
     TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &back));
     if (back) TEST_OK(ctx, fcm_simulation_read_checkpoint(back, old[v]));
     if (back) TEST_TRUE(read_log(back, h2, sizeof h2, r2, &n2) == 1 && n2 == n1);
@@ -294,6 +297,7 @@ done:
   remove(old[1]);
   remove(old[2]);
   remove(old[3]);
+  remove(old[4]);
   fcm_simulation_destroy(&back);
   fcm_simulation_destroy(&sim);
   fcm_scene_destroy(&scene);

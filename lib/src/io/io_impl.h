@@ -172,8 +172,9 @@ FCM_COMPONENT_API fcm_status fcm__ckpt_read_end(fcm__ckpt_reader *r);
 /* The container's version, the same for every writer so that each reader recognizes the other's
  * files: 4 introduced the linear driver's payload (the scene reader reads it from version 4 on),
  * 5 the Newton tolerance in a scene run's log rows, 6 the time scheme, its parameters, the
- * acceleration and the load work of a scene run (and the energies in its log rows). */
-#define FCM__CKPT_VERSION 6u
+ * acceleration and the load work of a scene run (and the energies in its log rows), 7 the
+ * contact columns of its log rows. */
+#define FCM__CKPT_VERSION 7u
 
 typedef struct fcm__ckpt_linear {
   long long num_dofs, elements, steps, kind;

@@ -3,26 +3,22 @@
  * simulation of the same scene.
  *
  * The file is the checkpoint container of io (io/checkpoint_file.c: magic "FCMCKPT\0",
- * u64 version, u64 byte-order mark, the payload, u64 FNV-1a 64 checksum), version 6; versions 1
- * to 5 still load for backward Euler and static scenes (they hold no acceleration: a scene with
- * another time scheme refuses them). Payload (every integer 8 bytes, doubles IEEE 754
- * binary64):
- *   u64 scene fingerprint (see fingerprint(); never 0, the word of a file without a scene)
- *   i64 num_dofs, i64 steps, f64 time
- *   (version 2) i64 cuts applied (the first k cut effects in time order)
- *   i64 newton_iterations, i64 linear_iterations, i64 tangent_assemblies
- *   i64 frames, then frames x f64 frame time
- *   i64 log rows, then rows x (f64 time, residual, energy, wall; i64 newton, linear;
- *   version 2: i64 pieces; f64 mass, momentum x, y, z;
- *   version 3: 6 x f64 per constraint effect: reaction x, y, z, moment x, y, z;
- *   version 4: i64 inverted quadrature points, i64 cell of the first (-1: none), i64 NaN or
- *   infinite von Mises values of the frame after the step (-1: no frame);
- *   version 5: f64 the Newton stopping rule's tolerance;
- *   version 6: f64 kinetic energy, elastic energy, load work)
- *   (version 6) i64 time scheme (fcm_time_scheme), f64 HHT alpha, f64 rho_inf, f64 load work,
- *   i64 1 when the acceleration follows (else 0)
- *   num_dofs x f64 displacement, num_dofs x f64 velocity, (version 6, when flagged) num_dofs x
- *   f64 acceleration
+ * u64 version, u64 byte-order mark, the payload, u64 FNV-1a 64 checksum), version 7; earlier
+ * versions still load (1 to 5 for backward Euler and static scenes only: they hold no
+ * acceleration, so a scene with another time scheme refuses them). Payload (every integer 8 bytes,
+ * doubles IEEE 754 binary64): u64 scene fingerprint (see fingerprint(); never 0, the word of a file
+ * without a scene) i64 num_dofs, i64 steps, f64 time (version 2) i64 cuts applied (the first k cut
+ * effects in time order) i64 newton_iterations, i64 linear_iterations, i64 tangent_assemblies i64
+ * frames, then frames x f64 frame time i64 log rows, then rows x (f64 time, residual, energy, wall;
+ * i64 newton, linear; version 2: i64 pieces; f64 mass, momentum x, y, z; version 3: 6 x f64 per
+ * constraint effect: reaction x, y, z, moment x, y, z; version 4: i64 inverted quadrature points,
+ * i64 cell of the first (-1: none), i64 NaN or infinite von Mises values of the frame after the
+ * step (-1: no frame); version 5: f64 the Newton stopping rule's tolerance; version 6: f64 kinetic
+ * energy, elastic energy, load work; version 7: i64 contact points (-1: not known), f64 smallest
+ * contact distance, contact energy, friction dissipation) (version 6) i64 time scheme
+ * (fcm_time_scheme), f64 HHT alpha, f64 rho_inf, f64 load work, i64 1 when the acceleration follows
+ * (else 0) num_dofs x f64 displacement, num_dofs x f64 velocity, (version 6, when flagged) num_dofs
+ * x f64 acceleration
  *
  * The PETSc linear driver (fcm_petsc_problem_write_checkpoint()) writes the same container
  * with the "no scene" source word 0 and its counts (io_impl.h, fcm__ckpt_linear); earlier
@@ -137,6 +133,9 @@ fcm_status fcm_simulation_write_checkpoint(fcm_simulation *S, const char *path)
     FCM_TRY(ctx, fcm__ckpt_put_f64(&w, r->tolerance));
     const double e[3] = {r->kinetic, r->elastic, r->work};
     FCM_TRY(ctx, fcm__ckpt_put_f64s(&w, e, 3));
+    const double c[3] = {r->contact_dmin, r->contact_energy, r->friction};
+    FCM_TRY(ctx, fcm__ckpt_put_i64(&w, r->contact_points));
+    FCM_TRY(ctx, fcm__ckpt_put_f64s(&w, c, 3));
   }
   {
     const fcm_scene_time *tm = fcm_scene_get_time(S->scene);
@@ -347,8 +346,9 @@ static fcm_status read_scene(fcm_simulation *S, fcm__ckpt_reader *r, ckpt_data *
   }
   FCM_TRY(ctx, fcm__ckpt_get_i64(r, &d->rows, d->steps, d->steps, "log rows (one per step)"));
   const size_t row_bytes =
-      ver >= 2 ? (8 + (ver >= 3 ? nreact : 0) + (ver >= 5) + 3 * (ver >= 6)) * sizeof(double) +
-                     (ver >= 4 ? 6 : 3) * sizeof(int64_t)
+      ver >= 2 ? (8 + (ver >= 3 ? nreact : 0) + (ver >= 5) + 3 * (ver >= 6) + 3 * (ver >= 7)) *
+                         sizeof(double) +
+                     ((ver >= 4 ? 6 : 3) + (ver >= 7)) * sizeof(int64_t)
                : 4 * sizeof(double) + 2 * sizeof(int64_t);
   FCM_TRY(ctx, fcm__ckpt_need(r, d->rows, row_bytes, "log rows"));
   FCM_TRY(ctx, alloc_rows(ctx, d, nreact));
@@ -387,8 +387,15 @@ static fcm_status read_scene(fcm_simulation *S, fcm__ckpt_reader *r, ckpt_data *
     double e[3] = {NAN, NAN, NAN}; /* not recorded before version 6 */
     if (ver >= 6) FCM_TRY(ctx, fcm__ckpt_get(r, e, sizeof e, "a log row"));
     w->kinetic = e[0], w->elastic = e[1], w->work = e[2];
-    w->contact_points = -1; /* contact columns are not kept */
+    w->contact_points = -1; /* not recorded before version 7 */
     w->contact_dmin = w->contact_energy = w->friction = NAN;
+    if (ver >= 7) {
+      double c[3];
+      FCM_TRY(ctx, fcm__ckpt_get_i64(r, &w->contact_points, -1, INT64_MAX,
+                                     "a log row's contact points"));
+      FCM_TRY(ctx, fcm__ckpt_get(r, c, sizeof c, "a log row"));
+      w->contact_dmin = c[0], w->contact_energy = c[1], w->friction = c[2];
+    }
   }
   FCM_TRY(ctx, read_scheme(S, r, d, &acc));
   FCM_TRY(ctx, read_state(r, d, acc));
