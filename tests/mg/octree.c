@@ -18,115 +18,6 @@
 #include <math.h>
 #include <stdio.h>
 
-typedef struct oct_problem {
-  fcm_mesh *mesh;
-  fcm_geometry *geom;
-  fcm_cell_rules *rules;
-  fcm_space *space;
-  fcm_csr *K, *P, *A;
-  fcm_index *free_dof;
-  double *b;
-  fcm_index n;
-} oct_problem;
-
-static void oct_free(oct_problem *p)
-{
-  fcm_csr_destroy(&p->A);
-  fcm_csr_destroy(&p->P);
-  fcm_csr_destroy(&p->K);
-  fcm_space_destroy(&p->space);
-  fcm_cell_rules_destroy(&p->rules);
-  fcm_geometry_destroy(&p->geom);
-  fcm_mesh_destroy(&p->mesh);
-  free(p->free_dof);
-  free(p->b);
-  memset(p, 0, sizeof *p);
-}
-
-/* P (n x n): the row of a free DOF is that DOF, the row of a hanging DOF its masters' weights. */
-static void square_constraints(fcm_ctx *ctx, oct_problem *p)
-{
-  fcm_csr *T = NULL;
-  p->free_dof = calloc((size_t)p->n + 1, sizeof *p->free_dof);
-  TEST_OK(ctx, fcm_space_hanging_matrix_create(p->space, p->free_dof, &T));
-  fcm_index nfree = 0, nnz = 0;
-  fcm_csr_get_size(T, NULL, &nfree, &nnz);
-  fcm_index *col_dof = calloc((size_t)nfree + 1, sizeof *col_dof);
-  fcm_index *rows = calloc((size_t)nnz + 1, sizeof *rows), *cols = calloc((size_t)nnz + 1, 8);
-  for (fcm_index d = 0; d < p->n; d++)
-    if (p->free_dof[d] >= 0) col_dof[p->free_dof[d]] = d;
-  const fcm_index *rp = fcm_csr_row_ptr(T);
-  const int *ci = fcm_csr_col_idx(T);
-  for (fcm_index r = 0; r < p->n; r++)
-    for (fcm_index e = rp[r]; e < rp[r + 1]; e++)
-      rows[e] = r, cols[e] = col_dof[ci[e]];
-  TEST_OK(ctx, fcm_csr_create_triplets(ctx, p->n, p->n, nnz, rows, cols, fcm_csr_values_read(T),
-                                       FCM_CSR_GENERAL, &p->P));
-  free(col_dof), free(rows), free(cols);
-  fcm_csr_destroy(&T);
-}
-
-static void oct_problem_create(fcm_ctx *ctx, fcm_element_type type, int depth, oct_problem *p)
-{
-  const double lo[3] = {-1.1, 0, -1.1}, hi[3] = {1.1, 1.1, 1.1}, c[3] = {0, 0, 0};
-  const fcm_index cells[3] = {6, 3, 6};
-  memset(p, 0, sizeof *p);
-  TEST_OK(ctx, fcm_geometry_create_hemisphere(ctx, c, 1.0, 4, &p->geom));
-  fcm_octree_options oo = fcm_octree_options_default();
-  oo.refine = fcm_geometry_boundary_meets_box;
-  oo.refine_user = p->geom;
-  oo.refine_level = depth;
-  TEST_OK(ctx, fcm_mesh_create_octree(ctx, type, lo, hi, cells, &oo, &p->mesh));
-  TEST_TRUE(fcm_mesh_max_level(p->mesh) == depth && fcm_mesh_num_hanging(p->mesh) > 0);
-  fcm_cell_rules_options ro = fcm_cell_rules_options_default();
-  ro.simplify = FCM_CELL_SIMPLIFY_OFF;
-  TEST_OK(ctx, fcm_cell_rules_create(ctx, p->mesh, p->geom, &ro, &p->rules));
-  TEST_OK(ctx, fcm_space_create_embedded(ctx, p->mesh, p->rules, &p->space));
-  p->n = fcm_space_num_dofs(p->space);
-  fcm_material mat = {FCM_MATERIAL_LINEAR, 1.0e5, 0.3, 1000.0};
-  const double g[3] = {0.0, -9.81, 0.0};
-  double *f = calloc((size_t)p->n + 1, sizeof *f);
-  TEST_OK(ctx, fcm_space_matrix_create(p->space, &p->K));
-  TEST_OK(ctx, fcm_assemble_stiffness(p->space, &mat, NULL, p->K));
-  TEST_OK(ctx, fcm_assemble_body_force(p->space, &mat, g, NULL, f));
-  square_constraints(ctx, p);
-  /* A = P^T K P + I_h, b = P^T f */
-  TEST_OK(ctx, fcm_csr_create_ptap(ctx, p->K, p->P, &p->A));
-  double *av = fcm_csr_values(p->A);
-  for (fcm_index d = 0; d < p->n; d++)
-    if (p->free_dof[d] < 0) {
-      const fcm_index q = fcm_csr_position(p->A, d, d);
-      TEST_TRUE(q >= 0);
-      if (q >= 0) av[q] = 1.0;
-    }
-  p->b = calloc((size_t)p->n + 1, sizeof *p->b);
-  {
-    const fcm_index *rp = fcm_csr_row_ptr(p->P);
-    const int *ci = fcm_csr_col_idx(p->P);
-    const double *pv = fcm_csr_values_read(p->P);
-    for (fcm_index r = 0; r < p->n; r++)
-      for (fcm_index e = rp[r]; e < rp[r + 1]; e++)
-        p->b[ci[e]] += pv[e] * f[r];
-  }
-  free(f);
-  /* clamp the free DOFs on y = 0 (the hanging ones there follow their clamped masters) */
-  const double flo[3] = {-2, 0, -2}, fhi[3] = {2, 0, 2};
-  fcm_index cnt = 0, nd = 0;
-  TEST_OK(ctx, fcm_mesh_nodes_in_box(ctx, p->mesh, flo, fhi, 1e-9, 0, NULL, &cnt));
-  fcm_index *nodes = calloc((size_t)cnt + 1, sizeof *nodes);
-  fcm_index *dofs = calloc(3 * (size_t)cnt + 1, sizeof *dofs);
-  TEST_OK(ctx, fcm_mesh_nodes_in_box(ctx, p->mesh, flo, fhi, 1e-9, cnt, nodes, &cnt));
-  for (fcm_index i = 0; i < cnt; i++) {
-    const fcm_index d0 = fcm_space_node_dof(p->space, nodes[i]);
-    for (int d = 0; d0 >= 0 && d < 3; d++)
-      if (p->free_dof[d0 + d] >= 0) dofs[nd++] = d0 + d;
-  }
-  TEST_TRUE(nd > 0);
-  TEST_OK(ctx, fcm_space_apply_dirichlet(p->space, nd, dofs, NULL, p->A, p->b));
-  free(nodes);
-  free(dofs);
-}
-
 /* The field the nested prolongations reproduce: affine (Hex8), quadratic (Hex20), per
  * component c. */
 static double field(const double *x, int c, int quadratic)
@@ -219,7 +110,7 @@ int main(int argc, char **argv)
   int it_mg[8] = {0};
   for (int s = 0; s < nd; s++) {
     oct_problem p;
-    oct_problem_create(ctx, type, depths[s], &p);
+    oct_problem_create(ctx, type, 6, depths[s], &p);
     fcm_mg_options o = fcm_mg_options_default();
     o.coarse_dofs = 50; /* coarsen as far as the grids allow */
     o.cycle_index = 1;  /* V-cycle */
