@@ -33,6 +33,17 @@ static inline void problem_free(problem *p)
   memset(p, 0, sizeof *p);
 }
 
+/* x = A^-1 b by CHOLMOD. */
+static inline void direct_solve(fcm_ctx *ctx, const fcm_csr *A, const double *b, double *x)
+{
+  fcm_direct *d = NULL;
+  TEST_OK(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, A, &d));
+  TEST_OK(ctx, fcm_direct_analyze(d));
+  TEST_OK(ctx, fcm_direct_factor(d, fcm_csr_values_read(A)));
+  TEST_OK(ctx, fcm_direct_solve(d, b, x));
+  fcm_direct_destroy(&d);
+}
+
 /* Clamp every copy of every active node in the box [lo, hi]. */
 static inline void clamp_box(fcm_ctx *ctx, problem *p, const double lo[3], const double hi[3])
 {

@@ -82,16 +82,6 @@ static void check_nested(fcm_ctx *ctx, const oct_problem *p, const fcm_mg *mg, i
   TEST_TRUE(hang == 0.0);
 }
 
-static void direct(fcm_ctx *ctx, const fcm_csr *A, const double *b, double *x)
-{
-  fcm_direct *d = NULL;
-  TEST_OK(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, A, &d));
-  TEST_OK(ctx, fcm_direct_analyze(d));
-  TEST_OK(ctx, fcm_direct_factor(d, fcm_csr_values_read(A)));
-  TEST_OK(ctx, fcm_direct_solve(d, b, x));
-  fcm_direct_destroy(&d);
-}
-
 int main(int argc, char **argv)
 {
   fcm_ctx *ctx = NULL;
@@ -147,7 +137,7 @@ int main(int argc, char **argv)
     TEST_TRUE(si2.convergence_factor < bound);
     fcm_mg_destroy(&mg2);
     /* CG + V-cycle against CHOLMOD */
-    direct(ctx, p.A, p.b, xd);
+    direct_solve(ctx, p.A, p.b, xd);
     fcm_krylov_options ko = fcm_krylov_options_default();
     ko.rtol = 1e-10;
     ko.max_iterations = 5000;
