@@ -347,6 +347,10 @@ static fcm_status octree_level0(fcm_mg *m, const fcm_csr *A, const unsigned char
               (long long)v, (long long)k);
     nk += k;
   }
+  oct_base g;
+  base_of(mesh, &g);
+  for (int d = 0; d < 3; d++) /* the lattice of the finest cells */
+    L0->grid[d] = g.n[d] << fcm_mesh_max_level(mesh);
   L0->A = A;
   L0->n = fcm_space_num_dofs(sp);
   L0->ncopy = nk;
@@ -407,11 +411,10 @@ static fcm_status octree_coarsen(fcm_mg *m, int l, const level_cons *cf, level_c
   C->n = fcm_space_num_dofs(t.sc);
   C->ncopy = C->n / 3;
   C->ncell = fcm_space_num_elements(t.sc);
-  for (int d = 0; d < 3; d++) {
-    oct_base g;
-    base_of(cm, &g);
+  oct_base g;
+  base_of(cm, &g);
+  for (int d = 0; d < 3; d++) /* the lattice of the finest cells */
     C->grid[d] = g.n[d] << fcm_mesh_max_level(cm);
-  }
   FCM_ALLOC(ctx, C->n + 1, C->dof);
   FCM_ALLOC(ctx, C->n + 1, C->inactive);
   for (fcm_index i = 0; i < C->n; i++)
