@@ -240,7 +240,8 @@ static inline void square_constraints(fcm_ctx *ctx, oct_problem *p)
   fcm_index nfree = 0, nnz = 0;
   fcm_csr_get_size(T, NULL, &nfree, &nnz);
   fcm_index *col_dof = calloc((size_t)nfree + 1, sizeof *col_dof);
-  fcm_index *rows = calloc((size_t)nnz + 1, sizeof *rows), *cols = calloc((size_t)nnz + 1, 8);
+  fcm_index *rows = calloc((size_t)nnz + 1, sizeof *rows);
+  fcm_index *cols = calloc((size_t)nnz + 1, sizeof *cols);
   for (fcm_index d = 0; d < p->n; d++)
     if (p->free_dof[d] >= 0) col_dof[p->free_dof[d]] = d;
   const fcm_index *rp = fcm_csr_row_ptr(T);

@@ -63,7 +63,8 @@ static void check_nested(fcm_ctx *ctx, const oct_problem *p, const fcm_mg *mg, i
     fcm_csr_destroy(&T);
     TEST_OK(ctx, fcm_space_hanging_matrix_create(sf, ffree, &T));
     fcm_csr_destroy(&T);
-    double *X = dof_positions(sf), *Xc = dof_positions(C->sp), *uc = calloc((size_t)C->n + 1, 8);
+    double *X = dof_positions(sf), *Xc = dof_positions(C->sp);
+    double *uc = calloc((size_t)C->n + 1, sizeof *uc);
     for (fcm_index J = 0; J < C->n; J++)
       uc[J] = cfree[J] >= 0 ? field(Xc + 3 * J, (int)(J % 3), quadratic) : 1e3;
     for (fcm_index i = 0; i < F->n; i++) {
