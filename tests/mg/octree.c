@@ -11,7 +11,9 @@
  * V-cycle needs at most 1.5 x the iterations of the shallowest depth at every depth (flat), and
  * CG + Jacobi does not converge in 3 x those at the deepest; its
  * solution equals CHOLMOD's to the tolerance, with the hanging entries zero. The square matrix
- * K itself (not the constrained operator) is refused. FCM_TEST_VERBOSE=1 prints the figures. */
+ * K itself (not the constrained operator) is refused. Argument balls (then depths): two balls
+ * on an octree and on the uniform grid of its finest cells (balls()). FCM_TEST_VERBOSE=1 prints
+ * the figures. */
 #include "mg/levels_impl.h"
 #include "mg_util.h"
 
@@ -83,11 +85,85 @@ static void check_nested(fcm_ctx *ctx, const oct_problem *p, const fcm_mg *mg, i
   TEST_TRUE(hang == 0.0);
 }
 
+/* CG + V-cycle on A x = b (rtol 1e-10) equal to CHOLMOD's solution (1e-7); the iterations, and
+ * the bodies of level 0 and of the coarsest level. */
+static int cg_mg(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A, const double *b,
+                 fcm_index n, fcm_index bodies[2])
+{
+  fcm_mg_options o = fcm_mg_options_default();
+  o.coarse_dofs = 50;
+  o.cycle_index = 1;
+  fcm_mg *mg = NULL;
+  TEST_OK(ctx, fcm_mg_create(ctx, space, A, &o, &mg));
+  if (!mg) return -1;
+  double *x = calloc((size_t)n + 1, sizeof *x), *xd = calloc((size_t)n + 1, sizeof *xd);
+  fcm_krylov_options ko = fcm_krylov_options_default();
+  ko.rtol = 1e-10;
+  ko.max_iterations = 5000;
+  fcm_krylov_info ki;
+  TEST_OK(ctx,
+          fcm_cg_solve(ctx, n, fcm_csr_operator, (void *)A, fcm_mg_operator, mg, b, x, &ko, &ki));
+  direct_solve(ctx, A, b, xd);
+  double dn = 0.0, xn = 0.0;
+  for (fcm_index i = 0; i < n; i++)
+    dn += (x[i] - xd[i]) * (x[i] - xd[i]), xn += xd[i] * xd[i];
+  TEST_TRUE(sqrt(dn) <= 1e-7 * sqrt(xn));
+  fcm_mg_level_info li;
+  TEST_OK(ctx, fcm_mg_get_level_info(mg, 0, &li));
+  bodies[0] = li.bodies;
+  TEST_OK(ctx, fcm_mg_get_level_info(mg, fcm_mg_num_levels(mg) - 1, &li));
+  bodies[1] = li.bodies;
+  free(x), free(xd);
+  fcm_mg_destroy(&mg);
+  return ki.iterations;
+}
+
+/* Two balls of radius 0.3, 0.3 apart, in [0, 2] x [0, 1]^2 (K + M): on the octree over the
+ * 4 x 2 x 2 grid refined along their boundaries to each depth, and on the uniform grid of the
+ * same finest cells. Both solve to CHOLMOD's solution and the fine spaces hold two bodies; the
+ * box-grid hierarchy keeps them apart on every level, the octree's coarser octrees join them
+ * (one DOF per node), which costs iterations (lib/docs/octree.md). */
+static void balls(fcm_ctx *ctx, const int *depths, int nd, int verbose)
+{
+  const double lo[3] = {0, 0, 0}, hi[3] = {2, 1, 1};
+  const double c1[3] = {0.55, 0.5, 0.5}, c2[3] = {1.45, 0.5, 0.5};
+  const fcm_index base[3] = {4, 2, 2};
+  for (int s = 0; s < nd; s++) {
+    oct_problem p;
+    problem q;
+    fcm_index bo[2] = {0, 0}, bu[2] = {0, 0};
+    memset(&p, 0, sizeof p);
+    two_balls(ctx, c1, c2, &p.geom);
+    oct_problem_embed(ctx, FCM_ELEMENT_HEX8, lo, hi, base, depths[s], &p);
+    oct_problem_assemble(ctx, &p, 1);
+    const int it_oct = cg_mg(ctx, p.space, p.A, p.b, p.n, bo);
+    memset(&q, 0, sizeof q);
+    const fcm_index cells[3] = {base[0] << depths[s], base[1] << depths[s], base[2] << depths[s]};
+    TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, cells, &q.mesh));
+    two_balls(ctx, c1, c2, &q.geom);
+    fcm_cell_rules_options ro = fcm_cell_rules_options_default();
+    ro.simplify = FCM_CELL_SIMPLIFY_OFF;
+    TEST_OK(ctx, fcm_cell_rules_create(ctx, q.mesh, q.geom, &ro, &q.rules0));
+    TEST_OK(ctx, fcm_space_create_embedded(ctx, q.mesh, q.rules0, &q.space));
+    finish_space(ctx, &q, 1);
+    const int it_uni = cg_mg(ctx, q.space, q.A, q.b, q.n, bu);
+    TEST_TRUE(bo[0] == 2 && bu[0] == 2 && bu[1] == 2);
+    if (verbose)
+      printf("two balls, depth %d: octree %lld DOFs, CG+MG %d, bodies %lld on level 0, %lld on "
+             "the coarsest; uniform grid %lld DOFs, CG+MG %d, bodies %lld, %lld\n",
+             depths[s], (long long)p.n, it_oct, (long long)bo[0], (long long)bo[1], (long long)q.n,
+             it_uni, (long long)bu[0], (long long)bu[1]);
+    oct_free(&p);
+    problem_free(&q);
+  }
+}
+
 int main(int argc, char **argv)
 {
   fcm_ctx *ctx = NULL;
-  fcm_element_type type;
-  if (argc < 2 || fcm_element_type_from_name(argv[1], &type) != FCM_OK) return 2;
+  fcm_element_type type = FCM_ELEMENT_HEX8;
+  const int two = argc >= 2 && !strcmp(argv[1], "balls");
+  if (argc < 2 || (!two && fcm_element_type_from_name(argv[1], &type) != FCM_OK)) return 2;
   int depths[8] = {1, 2, 3}, nd = 3;
   if (argc > 2) {
     nd = 0;
@@ -98,6 +174,12 @@ int main(int argc, char **argv)
   /* measured 0.09-0.13 on Hex8, 0.46-0.49 on Hex20 (depths 1-3 and 1-2) */
   const double bound = type == FCM_ELEMENT_HEX20 ? 0.6 : 0.5;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  if (two) {
+    balls(ctx, depths, nd, verbose);
+    TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
+    fcm_ctx_destroy(&ctx);
+    return TEST_RESULT();
+  }
   int it_mg[8] = {0};
   for (int s = 0; s < nd; s++) {
     oct_problem p;

@@ -123,7 +123,8 @@ typedef struct fcm_mg fcm_mg;
  * hierarchy then continues as above. Between octree levels the prolongation is the exact
  * nested interpolation: each fine free DOF takes the coarse conforming field at its node; fine
  * hanging DOFs get no correction, coarse hanging DOFs are inactive. Separate bodies are kept
- * apart on the grid levels only: an octree level has one DOF per node.
+ * apart on the grid levels only: an octree level has one DOF per node, so bodies closer than its
+ * cells share its DOFs (converges, more slowly: lib/docs/octree.md).
  * @param[in]  ctx   context; must outlive the object
  * @param[in]  space borrowed: must outlive the object
  * @param[in]  A     symmetric positive definite, the space's pattern (fcm_space_matrix_create();
