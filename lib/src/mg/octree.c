@@ -109,16 +109,25 @@ static fcm_status truncate_mesh(fcm_ctx *ctx, const fcm_mesh *fine, fcm_mesh **c
   const int lmax = fcm_mesh_max_level(fine);
   fcm_index ns = 0;
   base_of(fine, &g);
-  FCM_ALLOC(ctx, (size_t)nf * (size_t)lmax + 1, split);
+  /* the cells the truncation splits (levels below lmax - 1): each cell's ancestor of level
+   * min(its level, lmax - 1) - 1, then level by level from the deepest the parents of those
+   * found (fewer than nf distinct) */
+  FCM_ALLOC(ctx, 2 * (size_t)nf + 1, split);
   for (fcm_index c = 0; c < nf; c++) {
     const oct_key key = cell_key(fine, &g, c);
-    for (long long l = 0; l < key.lvl && l < lmax - 1; l++)
-      split[ns++] = ancestor(key, l);
+    const long long a = (key.lvl < lmax - 1 ? key.lvl : lmax - 1) - 1;
+    if (a >= 0) split[ns++] = ancestor(key, a);
   }
-  qsort(split, (size_t)ns, sizeof *split, cmp_key);
   fcm_index nu = 0;
-  for (fcm_index i = 0; i < ns; i++)
-    if (nu == 0 || cmp_key(&split[i], &split[nu - 1]) != 0) split[nu++] = split[i];
+  for (long long lvl = lmax - 1; lvl >= 0; lvl--) {
+    qsort(split, (size_t)ns, sizeof *split, cmp_key);
+    nu = 0;
+    for (fcm_index i = 0; i < ns; i++)
+      if (nu == 0 || cmp_key(&split[i], &split[nu - 1]) != 0) split[nu++] = split[i];
+    ns = nu;
+    for (fcm_index i = 0; i < nu && lvl >= 1; i++)
+      if (split[i].lvl == lvl) split[ns++] = ancestor(split[i], lvl - 1);
+  }
   trunc_user u = {&g, split, nu};
   fcm_octree_options o = fcm_octree_options_default();
   o.refine = trunc_refine;
