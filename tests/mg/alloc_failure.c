@@ -1,6 +1,7 @@
 /* Allocation failures in the multigrid: failing the k-th allocation for k = 0, 1, ... of
  * building the hierarchy (cut hemisphere on Hex8 and Hex20 grids: pieces, links, the grown
- * cell graph, the p-level, the block smoother), the Galerkin
+ * cell graph, the p-level, the block smoother; the hemisphere on a Hex8 octree: the coarser
+ * octrees, their spaces and constraints, the nested prolongations), the Galerkin
  * patterns, the level info and a CG + MG solve gives FCM_ERR_ALLOC and leaks nothing, until
  * everything succeeds. */
 #include "mg_util.h"
@@ -59,6 +60,16 @@ int main(void)
                1000000);
     free(x);
     problem_free(&p);
+  }
+  {
+    oct_problem op;
+    oct_problem_create(ctx0, FCM_ELEMENT_HEX8, 4, 2, &op);
+    problem p = {.space = op.space, .A = op.A, .b = op.b, .n = op.n};
+    double *x = calloc((size_t)p.n, sizeof *x);
+    mg_round r = {ctx, &p, x};
+    alloc_loop(ctx, &fl, "octree hierarchy", run_round, NULL, &r, 40, 1000000);
+    free(x);
+    oct_free(&op);
   }
   fcm_ctx_destroy(&ctx);
   TEST_TRUE(fcm_ctx_live_allocations(ctx0) == 0);

@@ -12,16 +12,6 @@
  * equals CHOLMOD's to the tolerance. FCM_TEST_VERBOSE=1 prints the figures. */
 #include "mg_util.h"
 
-static void direct(fcm_ctx *ctx, const fcm_csr *A, const double *b, double *x)
-{
-  fcm_direct *d = NULL;
-  TEST_OK(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, A, &d));
-  TEST_OK(ctx, fcm_direct_analyze(d));
-  TEST_OK(ctx, fcm_direct_factor(d, fcm_csr_values_read(A)));
-  TEST_OK(ctx, fcm_direct_solve(d, b, x));
-  fcm_direct_destroy(&d);
-}
-
 int main(int argc, char **argv)
 {
   fcm_ctx *ctx = NULL;
@@ -87,7 +77,7 @@ int main(int argc, char **argv)
     factor[s] = si.convergence_factor;
     fmax = fmax > factor[s] ? fmax : factor[s];
     /* CG + MG against CHOLMOD */
-    direct(ctx, p.A, p.b, xd);
+    direct_solve(ctx, p.A, p.b, xd);
     fcm_krylov_options ko = fcm_krylov_options_default();
     ko.rtol = 1e-10;
     ko.max_iterations = 5000;

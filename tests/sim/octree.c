@@ -3,7 +3,8 @@
  * - static patch test: a linear body on an octree refined to level 2 in a corner region, every
  *   boundary node that does not hang prescribed to an affine field (the hanging ones follow
  *   their masters): the solution is that field at every node, hanging ones included, to 1e-12,
- *   with the direct solver and with CG + Jacobi;
+ *   with the direct solver, CG + Jacobi, CG + multigrid and the multigrid solver (the
+ *   hierarchy coarsening the octree: at least 3 levels);
  * - a constraint holding a hanging node without its masters is refused; a face pulled at a
  *   constant velocity carries its hanging nodes along exactly;
  * - dynamics: a free Stable Neo-Hookean body spinning under gravity on the same octree, with
@@ -57,7 +58,7 @@ static int on_boundary(const double x[3])
 }
 
 static void static_patch(fcm_ctx *ctx, fcm_element_type type, const char *name,
-                         fcm_linear_solver solver)
+                         fcm_linear_solver solver, fcm_preconditioner pc)
 {
   fcm_mesh *mesh = NULL;
   fcm_space *space = NULL;
@@ -70,8 +71,9 @@ static void static_patch(fcm_ctx *ctx, fcm_element_type type, const char *name,
   o.kind = FCM_INTEGRATOR_STATIC;
   o.dt = 1.0;
   o.linear_solver = solver;
-  o.preconditioner = FCM_PRECOND_JACOBI;
+  o.preconditioner = pc;
   o.krylov_rtol = 1e-14;
+  o.multigrid.coarse_dofs = 30; /* coarsen the octree to its base grid */
   TEST_OK(ctx, fcm_integrator_create(ctx, space, &mat, &o, &integ));
   unsigned char *hang = hanging_nodes(mesh);
   const double *X = fcm_mesh_coords(mesh);
@@ -93,6 +95,9 @@ static void static_patch(fcm_ctx *ctx, fcm_element_type type, const char *name,
   fcm_step_info info;
   TEST_OK(ctx, fcm_integrator_step(integ, &info));
   TEST_TRUE(info.reason == FCM_STEP_CONVERGED);
+  const int mg = solver == FCM_LINEAR_MULTIGRID || pc == FCM_PRECOND_MULTIGRID;
+  /* the multigrid: the octree's levels 2, 1 and the base grid */
+  if (mg) TEST_TRUE(fcm_mg_num_levels(fcm_integrator_multigrid(integ)) >= 3);
   const double *u = fcm_integrator_displacement(integ);
   double err = 0.0;
   for (fcm_index a = 0; a < fcm_mesh_num_nodes(mesh); a++) {
@@ -103,7 +108,11 @@ static void static_patch(fcm_ctx *ctx, fcm_element_type type, const char *name,
       err = fmax(err, fabs(u[d + i] - ue[i]));
   }
   printf("%s %s: %lld hanging pairs, affine patch error %.3e\n", name,
-         solver == FCM_LINEAR_DIRECT ? "direct" : "cg", (long long)fcm_mesh_num_hanging(mesh), err);
+         solver == FCM_LINEAR_DIRECT      ? "direct"
+         : solver == FCM_LINEAR_MULTIGRID ? "multigrid"
+         : pc == FCM_PRECOND_MULTIGRID    ? "cg + multigrid"
+                                          : "cg + jacobi",
+         (long long)fcm_mesh_num_hanging(mesh), err);
   TEST_TRUE(err <= 1e-12);
   fcm_integrator_destroy(&integ);
 
@@ -116,7 +125,7 @@ static void static_patch(fcm_ctx *ctx, fcm_element_type type, const char *name,
   TEST_OK(ctx, fcm_integrator_add_constraint(integ, 1, &h, &m, NULL));
   TEST_ERR(ctx, fcm_integrator_setup(integ), FCM_ERR_UNSUPPORTED, "hangs on a coarser cell");
   fcm_integrator_destroy(&integ);
-  /* the multigrid and the cell-based preconditioners do not apply the constraints yet */
+  /* the cell-based preconditioners do not apply the constraints yet */
   o.linear_solver = FCM_LINEAR_CG;
   o.preconditioner = FCM_PRECOND_BLOCK_JACOBI;
   TEST_OK(ctx, fcm_integrator_create(ctx, space, &mat, &o, &integ));
@@ -261,8 +270,10 @@ int main(int argc, char **argv)
   fcm_element_type type;
   if (argc != 2 || fcm_element_type_from_name(argv[1], &type) != FCM_OK) return 2;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
-  static_patch(ctx, type, argv[1], FCM_LINEAR_DIRECT);
-  static_patch(ctx, type, argv[1], FCM_LINEAR_CG);
+  static_patch(ctx, type, argv[1], FCM_LINEAR_DIRECT, FCM_PRECOND_JACOBI);
+  static_patch(ctx, type, argv[1], FCM_LINEAR_CG, FCM_PRECOND_JACOBI);
+  static_patch(ctx, type, argv[1], FCM_LINEAR_CG, FCM_PRECOND_MULTIGRID);
+  static_patch(ctx, type, argv[1], FCM_LINEAR_MULTIGRID, FCM_PRECOND_JACOBI);
 
   double *u = NULL, *v = NULL, *ub = NULL, *vb = NULL;
   TEST_OK(ctx, octree(ctx, type, 2, &mesh));

@@ -5,7 +5,9 @@
  * coarse DOFs are duplicated per component. Trilinear prolongation per component, restriction
  * its transpose, Galerkin coarse matrices P^T A P, a CHOLMOD solve on the coarsest level,
  * symmetric Gauss-Seidel or damped Jacobi smoothing, V- or W-cycles. Use it as a solver
- * (fcm_mg_solve()) or as the preconditioner of fcm_krylov_cg() (fcm_mg_operator()). */
+ * (fcm_mg_solve()) or as the preconditioner of fcm_krylov_cg() (fcm_mg_operator()). On an octree
+ * background with hanging nodes the hierarchy first coarsens the octree level by level (Dick et
+ * al. Sec. 5), then the uniform grid it reaches. */
 #ifndef FCM_MG_H
 #define FCM_MG_H
 
@@ -93,34 +95,49 @@ typedef struct fcm_mg fcm_mg;
 
 /** Build the hierarchy of `space` and the operators of `A`. The space must live on a structured
  * Hex8 or Hex20 box grid (fcm_mesh_create_box(): every cell an axis-aligned box of one size at an
- * integer grid position); any cell counts, dropped cells and cut (XFEM) pieces are allowed. Level
- * 0 is the space itself: its elements (pieces) and DOF copies. On Hex20, level 1 is the Hex8 space
- * of the same elements with the copies they use at their corners: those copies are injected, a
- * mid-edge copy takes the mean of the corner copies at the ends of its edge (exact for trilinear
- * fields); the 2x2x2 coarsening below starts from level 1. Two elements of face-neighbouring cells
- * are connected when they use the same copy at a node of the common face and, where cuts reach
- * either cell, the cell rules link their pieces (fcm_cell_rules_links()); coarse cells are the
- * connected components of the elements (cells) of each 2x2x2 block, and coarse cells are connected
- * when some of their fine cells are. A coarse cell has its own copy at each of its 8 corners; two
- * coarse cells share a corner's copy when a fine copy that interpolates from that corner is used
- * by fine elements of both, so the coarse space separates exactly what the fine one separates (two
- * bodies never share a coarse DOF) and the prolongation is single valued. Rows of A whose off-
- * diagonal entries are all zero (DOFs eliminated by fcm_space_apply_dirichlet()) mark the
- * Dirichlet boundary: a coarse DOF whose coinciding fine DOFs are all eliminated (or, coarser,
- * constrained) is constrained (decoupled in the coarse matrix, no correction from it), so coarse
- * corrections vanish there. The prolongation stays injective, so every coarse matrix is positive
- * definite.
+ * integer grid position) or an octree over one (below); any cell counts, dropped cells and cut
+ * (XFEM) pieces are allowed. Level 0 is the space itself: its elements (pieces) and DOF copies. On
+ * Hex20, level 1 is the Hex8 space of the same elements with the copies they use at their corners:
+ * those copies are injected, a mid-edge copy takes the mean of the corner copies at the ends of its
+ * edge (exact for trilinear fields); the 2x2x2 coarsening below starts from level 1. Two elements
+ * of face-neighbouring cells are connected when they use the same copy at a node of the common face
+ * and, where cuts reach either cell, the cell rules link their pieces (fcm_cell_rules_links());
+ * coarse cells are the connected components of the elements (cells) of each 2x2x2 block, and coarse
+ * cells are connected when some of their fine cells are. A coarse cell has its own copy at each of
+ * its 8 corners; two coarse cells share a corner's copy when a fine copy that interpolates from
+ * that corner is used by fine elements of both, so the coarse space separates exactly what the fine
+ * one separates (two bodies never share a coarse DOF) and the prolongation is single valued. Rows
+ * of A whose off-diagonal entries are all zero (DOFs eliminated by fcm_space_apply_dirichlet())
+ * mark the Dirichlet boundary: a coarse DOF whose coinciding fine DOFs are all eliminated (or,
+ * coarser, constrained) is constrained (decoupled in the coarse matrix, no correction from it), so
+ * coarse corrections vanish there. The prolongation stays injective, so every coarse matrix is
+ * positive definite.
+ *
+ * Octree backgrounds (fcm_mesh_create_octree(), Hex8 or Hex20, with hanging nodes; one DOF copy
+ * per node: no cuts): A must be the constrained operator the integrators solve, P^T K P + I_h
+ * (P the square hanging-node matrix of fcm_space_hanging_matrix_create() written on all DOFs,
+ * I_h the identity on the hanging DOFs, lib/docs/octree.md), its hanging rows decoupled
+ * identity rows. Level 1 is the octree without its deepest level (every family of 8 finest
+ * leaves replaced by its parent), its cells active where an active cell of level 0 lies, its
+ * hanging nodes constrained alike, and so on until the octree is a uniform grid, whose
+ * hierarchy then continues as above. Between octree levels the prolongation is the exact
+ * nested interpolation: each fine free DOF takes the coarse conforming field at its node; fine
+ * hanging DOFs get no correction, coarse hanging DOFs are inactive. Separate bodies are kept
+ * apart on the grid levels only: an octree level has one DOF per node, so bodies closer than its
+ * cells share its DOFs (converges, more slowly: lib/docs/octree.md).
  * @param[in]  ctx   context; must outlive the object
  * @param[in]  space borrowed: must outlive the object
- * @param[in]  A     symmetric positive definite, the space's pattern (fcm_space_matrix_create());
+ * @param[in]  A     symmetric positive definite, the space's pattern (fcm_space_matrix_create();
+ *                   on an octree that of fcm_csr_create_ptap());
  *                   borrowed: must outlive the object, values read by this call and by
  *                   fcm_mg_setup(), applied in every cycle
  * @param[in]  opts  copied (omega 0: fcm_mg_smoother_omega() of the smoother); NULL for
  *                   defaults
  * @param[out] mg    the new object, NULL on failure
- * @return FCM_OK, FCM_ERR_ARG (NULL, option out of range, A not the space's size),
- * FCM_ERR_UNSUPPORTED (not a Hex8 or Hex20 box grid: the message names the cell; an octree
- * mesh with hanging nodes),
+ * @return FCM_OK, FCM_ERR_ARG (NULL, option out of range, A not the space's size; on an octree:
+ * a hanging DOF's row coupled, i.e. A is not the constrained operator),
+ * FCM_ERR_UNSUPPORTED (not a Hex8 or Hex20 box grid or octree: the message names the cell; an
+ * octree space with several DOF copies at a node),
  * FCM_ERR_SINGULAR or FCM_ERR_NUMERIC (the coarsest factorization, a zero diagonal),
  * FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,

@@ -697,6 +697,8 @@ fcm_status fcm__mg_build_hierarchy(fcm_mg *m, const fcm_csr *A, const unsigned c
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
   const fcm_mg_options o = m->opts;
+  if (fcm_mesh_num_hanging(fcm_space_mesh(m->space)) > 0)
+    return fcm__mg_octree_hierarchy(m, A, inactive0);
   FCM_TRY(ctx, build_level0(m, A, inactive0));
   m->nlev = 1;
   if (m->lev[1].ncell > 0) { /* Hex20: the p-coarse Hex8 level */
@@ -745,14 +747,15 @@ fcm_status fcm_mg_get_level_info(const fcm_mg *m, int level, fcm_mg_level_info *
   FCM_ALLOC(ctx, L->ncell + L->ncopy + 1, uf);
   for (fcm_index i = 0; i < L->ncell + L->ncopy; i++)
     uf[i] = i;
-  const int npc = fcm_element_get_info(fcm_mesh_element_type(fcm_space_mesh(m->space)))->num_nodes;
+  const fcm_space *sp = L->sp ? L->sp : m->space; /* the Hex20 level 0 or an octree level */
+  const int npc = fcm_element_get_info(fcm_mesh_element_type(fcm_space_mesh(sp)))->num_nodes;
   for (fcm_index c = 0; c < L->ncell; c++)
     if (L->corner)
       for (int b = 0; b < 8; b++)
         uf_union(uf, c, L->ncell + L->corner[8 * c + b]);
     else
       for (int a = 0; a < npc; a++)
-        uf_union(uf, c, L->ncell + fcm_space_element_dofs(m->space, c)[a] / 3);
+        uf_union(uf, c, L->ncell + fcm_space_element_dofs(sp, c)[a] / 3);
   fcm_index nb = 0;
   for (fcm_index c = 0; c < L->ncell; c++)
     nb += uf_find(uf, c) == c;

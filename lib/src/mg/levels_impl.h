@@ -75,6 +75,8 @@ typedef struct mg_level {
   fcm_schwarz *blk;    /* block smoother (block_smoothing): the level's blocks */
   slab_order rows;     /* SGS: the rows in slabs (levels but the coarsest) */
   slab_order blocks;   /* the blocks of blk in slabs */
+  const fcm_space *sp; /* octree hierarchies: the level's space (level 0: the given one;
+                          coarser: owned by fcm_mg), whose DOF numbering the level has */
 } mg_level;
 
 struct fcm_mg {
@@ -84,10 +86,12 @@ struct fcm_mg {
   int nlev;
   mg_level lev[32];
   fcm_direct *direct;
-  unsigned char *cut_cell; /* per mesh cell: cut by the geometry or a cut surface, or split */
-  fcm_index blk_max;       /* largest block of the block smoothers */
-  int nt;                  /* threads at creation: the most any parallel region uses */
-  double *blk_r, *blk_dx;  /* blk_max entries each, per thread */
+  unsigned char *cut_cell;  /* per mesh cell: cut by the geometry or a cut surface, or split */
+  fcm_index blk_max;        /* largest block of the block smoothers */
+  int nt;                   /* threads at creation: the most any parallel region uses */
+  double *blk_r, *blk_dx;   /* blk_max entries each, per thread */
+  fcm_mesh *oct_mesh[32];   /* octree hierarchies: the coarser octrees of levels 1, 2, ... */
+  fcm_space *oct_space[32]; /* and their spaces */
 };
 
 /* Threads of a parallel region: the context's now, at most those of the creation (scratch). */
@@ -109,6 +113,14 @@ static inline const fcm_csr *fcm__mg_level_matrix(const mg_level *L)
  * when it is NULL, the eliminated rows of A; A (NULL with inactive0) is level 0's matrix. No
  * matrix is read beyond that: the prolongations depend on the space and the inactive rows. */
 fcm_status fcm__mg_build_hierarchy(fcm_mg *m, const fcm_csr *A, const unsigned char *inactive0);
+
+/* ---- octree.c */
+
+/* The levels of m on a space whose mesh is an octree with hanging nodes (as
+ * fcm__mg_build_hierarchy()): the octree coarsened level by level (each coarser space nested
+ * in the finer one, its hanging DOFs inactive), then the box-grid hierarchy of the uniform
+ * grid the truncations reach. Level 0's inactive rows include the hanging DOFs. */
+fcm_status fcm__mg_octree_hierarchy(fcm_mg *m, const fcm_csr *A, const unsigned char *inactive0);
 
 /* Free everything a level holds and zero it. */
 void fcm__mg_level_free(fcm_ctx *ctx, mg_level *L);

@@ -44,6 +44,10 @@ void fcm_mg_destroy(fcm_mg **mg)
   for (int l = 0; l < 32; l++)
     fcm__mg_level_free(m->ctx, &m->lev[l]);
   fcm_direct_destroy(&m->direct);
+  for (int l = 0; l < 32; l++) {
+    fcm_space_destroy(&m->oct_space[l]);
+    fcm_mesh_destroy(&m->oct_mesh[l]);
+  }
   fcm__free(m->ctx, m->cut_cell);
   fcm__free(m->ctx, m->blk_r);
   fcm__free(m->ctx, m->blk_dx);
@@ -177,10 +181,6 @@ fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
   fcm_mg *m = NULL;
   FCM_CHECK(ctx && space && A && mg, ctx, FCM_ERR_ARG, "mg_create: NULL argument");
   *mg = NULL;
-  FCM_CHECK(fcm_mesh_num_hanging(fcm_space_mesh(space)) == 0, ctx, FCM_ERR_UNSUPPORTED,
-            "mg_create: the space's mesh is an octree with %lld hanging (cell, node) pairs; the "
-            "hierarchy coarsens conforming meshes only",
-            (long long)fcm_mesh_num_hanging(fcm_space_mesh(space)));
   fcm_mg_options o = opts ? *opts : fcm_mg_options_default();
   FCM_CHECK(o.smoother >= 0 && o.smoother < FCM_MG_SMOOTHER_COUNT, ctx, FCM_ERR_ARG,
             "mg_create: smoother = %d is not a fcm_mg_smoother", (int)o.smoother);

@@ -321,12 +321,13 @@ static fcm_status blocks_coarse(fcm_mg *m, const mg_level *L, fcm_index *nb_out,
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
   fcm_index nb = 0, *ptr = NULL, *dofs = NULL;
-  for (fcm_index c = 0; c < L->ncell; c++)
+  const fcm_index ncell = L->full ? L->ncell : 0; /* an octree level has no grid cells */
+  for (fcm_index c = 0; c < ncell; c++)
     nb += !L->full[c];
   FCM_ALLOC(ctx, nb + 1, ptr);
   FCM_ALLOC(ctx, 24 * nb + 1, dofs);
   fcm_index k = 0, q = 0;
-  for (fcm_index c = 0; c < L->ncell; c++) {
+  for (fcm_index c = 0; c < ncell; c++) {
     if (L->full[c]) continue;
     const fcm_index q0 = q;
     for (int b = 0; b < 8; b++) {

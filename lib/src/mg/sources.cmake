@@ -1,2 +1,2 @@
-list(APPEND FCM_SOURCES lib/src/mg/mg.c lib/src/mg/hierarchy.c lib/src/mg/transfer.c
+list(APPEND FCM_SOURCES lib/src/mg/mg.c lib/src/mg/hierarchy.c lib/src/mg/transfer.c lib/src/mg/octree.c
      lib/src/mg/smoothers.c lib/src/mg/cycle.c)

@@ -49,18 +49,16 @@ fcm_status fcm__sim_hanging_setup(fcm_integrator *I)
             "the integrator has a distributed backend; hanging-node constraints are applied by "
             "the serial solvers only",
             (long long)nh);
-  FCM_CHECK(o->linear_solver != FCM_LINEAR_MULTIGRID, ctx, FCM_ERR_UNSUPPORTED,
-            "integrator: the space's mesh is an octree with %lld hanging (cell, node) pairs; the "
-            "multigrid solver does not coarsen octrees yet: use the direct solver or CG / MINRES "
-            "with the Jacobi preconditioner",
-            (long long)nh);
-  FCM_CHECK(o->linear_solver == FCM_LINEAR_DIRECT || o->preconditioner == FCM_PRECOND_NONE ||
-                o->preconditioner == FCM_PRECOND_JACOBI,
+  /* the multigrid (solver and preconditioner) coarsens the octree itself (fcm/mg.h) on the
+   * constrained matrix below */
+  FCM_CHECK(o->linear_solver == FCM_LINEAR_DIRECT || o->linear_solver == FCM_LINEAR_MULTIGRID ||
+                o->preconditioner == FCM_PRECOND_NONE || o->preconditioner == FCM_PRECOND_JACOBI ||
+                o->preconditioner == FCM_PRECOND_MULTIGRID,
             ctx, FCM_ERR_UNSUPPORTED,
             "integrator: the space's mesh is an octree with %lld hanging (cell, node) pairs; "
-            "preconditioner %s works on the space's nodes and cells as they are (block Jacobi, "
-            "Schwarz and multigrid are not available there yet): use FCM_PRECOND_JACOBI or "
-            "FCM_PRECOND_NONE, or the direct solver",
+            "preconditioner %s works on the space's nodes and cells as they are (block Jacobi "
+            "and Schwarz are not available there yet): use FCM_PRECOND_JACOBI, "
+            "FCM_PRECOND_MULTIGRID or FCM_PRECOND_NONE, or the direct or multigrid solver",
             (long long)nh, precond_name(o->preconditioner));
   FCM_ALLOC(ctx, n, free_dof);
   FCM_TRY(ctx, fcm_space_hanging_matrix_create(I->space, free_dof, &T));
