@@ -196,10 +196,12 @@ typedef struct fcm__fit {
 
 /* What fcm__simplify_nnls() found: ok when the residual reached the caller's level, optimal
  * when it stopped short of it because no column lowers the residual (x is then the least-squares
- * minimizer over x >= 0 up to rounding), the residual max_i |(b - A x)_i|, the passive set's size
- * (the positive entries of x), the outer iterations and the floating-point operations. */
+ * minimizer over x >= 0 up to rounding), infeasible when it stopped on a proof that no x >= 0
+ * reaches the caller's `reach` (x is then the last iterate), the residual max_i |(b - A x)_i|,
+ * the passive set's size (the positive entries of x), the outer iterations and the
+ * floating-point operations. */
 typedef struct fcm__nnls_report {
-  int ok, optimal, passive, iterations;
+  int ok, optimal, infeasible, passive, iterations;
   double residual;
   double flops; /* of the algorithm: gradients, QR updates, solves, residuals */
 } fcm__nnls_report;
@@ -208,9 +210,13 @@ typedef struct fcm__nnls_report {
  * with the passive columns' QR factorization updated column by column): A is M x k (ld M), x
  * (k) receives the iterate at which max_i |(b - A x)_i| <= stop (rep->ok = 1) or, when no
  * column lowers the residual any more or after 3 k + M steps, the last one (rep->ok = 0). Its
- * positive entries are linearly independent columns (at most M). Errors: FCM_ERR_ALLOC. */
+ * positive entries are linearly independent columns (at most M). With reach > 0 and row 0 of A
+ * positive (the moments of the constant function), it also stops (rep->infeasible = 1) once a
+ * residual proves that no x >= 0 has max_i |(A x - b)_i| <= reach (a Farkas certificate:
+ * y with A^T y <= 0 and b^T y > reach ||y||_1); reach 0: run to optimality. Errors:
+ * FCM_ERR_ALLOC. */
 fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const double *b,
-                              double stop, double *x, fcm__nnls_report *rep);
+                              double stop, double reach, double *x, fcm__nnls_report *rep);
 
 /* At most M of the n candidate points (x 3) with positive weights whose moments in the basis of
  * box equal b (M entries) to max(tol max|b|, atol): relative, down to the absolute level atol
