@@ -172,13 +172,15 @@ fcm_status fcm__simplify_run_eliminate(fcm__attempt *a);
 /* ---- moment fitting (fit.c) ---- */
 
 /* Interior candidates per moment that a fit's first candidate set of strength m aims at. NNLS
- * costs more the more candidates it prices, but a set whose cone misses the moments costs a
- * whole NNLS run to prove it and then a set four times larger: on real cut cells (ball, cut
+ * costs more the more candidates it prices, but a set whose cone misses the moments costs an
+ * NNLS run to prove it and then a set four times larger: on real cut cells (ball, cut
  * fractions 0.25..0.75; tests/bench/bench_roofline.c) 2 per moment fails on half the cells at
- * m = 7 and on all at m = 9, (m - 1) / 2 on none, for about 1.3x the candidates. */
+ * m = 7 and on all at m = 9, 2.5 at m = 7 and (m - 1) / 2 at m = 9 on none; on a scanned model
+ * at m = 7 2.5 and 3 fail on the same 6 % of the cells (the smaller set the faster), and below
+ * 2.5 the four sets of a small piece can all fail (lib/docs/performance.md). */
 static inline double fcm__fit_candidates_per_moment(int m)
 {
-  return m > 5 ? 0.5 * (m - 1) : 2.0;
+  return m > 7 ? 0.5 * (m - 1) : m > 5 ? 2.5 : 2.0;
 }
 
 /* A fitted rule: count <= M candidates idx[] (ascending) with positive weights w[] (both
