@@ -4,9 +4,10 @@
  * nearest point of the columns' cone (a known one, and the KKT conditions on random ones, also
  * on a matrix large enough for NNLS to price a shortlist of columns, and where the one column
  * that lowers the residual has a gradient that cancels in single precision);
- * the fit reproduces the moments of a positive rule among its candidates to 1e-12 and reports
- * a tolerance below rounding (through its LP path) and moments no positive combination of the
- * candidates can carry. */
+ * NNLS's early stop on a proof that no x >= 0 reaches b never stops a solvable system and stops
+ * only unsolvable ones; the fit reproduces the moments of a positive rule among its candidates
+ * to 1e-12 and reports a tolerance below rounding (through its LP path) and moments no positive
+ * combination of the candidates can carry (proved by a separating polynomial). */
 #include "simplify/simplify_impl.h"
 #include "simplify_util.h"
 
@@ -55,7 +56,7 @@ static void tall_unique(fcm_ctx *ctx)
   fcm__nnls_report rep;
   for (uint64_t seed = 1; seed <= 5; seed++) {
     consistent(seed, M, K, 12, A, xs, b); /* A has full column rank: x* is the one solution */
-    TEST_OK(ctx, fcm__simplify_nnls(ctx, M, K, A, b, 1e-13, x, &rep));
+    TEST_OK(ctx, fcm__simplify_nnls(ctx, M, K, A, b, 1e-13, 0.0, x, &rep));
     TEST_TRUE(rep.ok && rep.residual <= 1e-13);
     for (int j = 0; j < K; j++)
       TEST_NEAR(x[j], xs[j], 0.0, 1e-10);
@@ -71,7 +72,7 @@ static void wide_consistent(fcm_ctx *ctx)
   for (uint64_t seed = 11; seed <= 15; seed++) {
     consistent(seed, M, K, 60, A, xs, b);
     const double stop = 1e-12 * b[0];
-    TEST_OK(ctx, fcm__simplify_nnls(ctx, M, K, A, b, stop, x, &rep));
+    TEST_OK(ctx, fcm__simplify_nnls(ctx, M, K, A, b, stop, 0.0, x, &rep));
     TEST_TRUE(rep.ok);
     int npos = 0;
     for (int j = 0; j < K; j++) {
@@ -90,7 +91,7 @@ static void known_optimum(fcm_ctx *ctx)
   const double A[4] = {1.0, 0.0, 1.0, 1.0}, b[2] = {0.0, 1.0};
   double x[2];
   fcm__nnls_report rep;
-  TEST_OK(ctx, fcm__simplify_nnls(ctx, 2, 2, A, b, 1e-12, x, &rep));
+  TEST_OK(ctx, fcm__simplify_nnls(ctx, 2, 2, A, b, 1e-12, 0.0, x, &rep));
   TEST_TRUE(!rep.ok && rep.optimal);
   TEST_NEAR(x[0], 0.0, 0.0, 0.0);
   TEST_NEAR(x[1], 0.5, 0.0, 1e-15);
@@ -134,7 +135,7 @@ static void kkt(fcm_ctx *ctx)
       A[i] = 2.0 * util_rand(&s) - 1.0;
     for (int i = 0; i < M; i++)
       b[i] = 2.0 * util_rand(&s) - 1.0;
-    TEST_OK(ctx, fcm__simplify_nnls(ctx, M, K, A, b, 1e-13, x, &rep));
+    TEST_OK(ctx, fcm__simplify_nnls(ctx, M, K, A, b, 1e-13, 0.0, x, &rep));
     if (rep.ok) {
       TEST_TRUE(resid(M, K, A, x, b) <= 1e-13);
       continue;
@@ -158,7 +159,7 @@ static void shortlist(fcm_ctx *ctx)
   for (uint64_t seed = 41; seed <= 42; seed++) {
     consistent(seed, M, K, 400, A, xs, b);
     const double stop = 1e-12 * b[0];
-    TEST_OK(ctx, fcm__simplify_nnls(ctx, M, K, A, b, stop, x, &rep));
+    TEST_OK(ctx, fcm__simplify_nnls(ctx, M, K, A, b, stop, 0.0, x, &rep));
     int npos = 0;
     for (int j = 0; j < K; j++) {
       TEST_TRUE(x[j] >= 0.0);
@@ -167,7 +168,7 @@ static void shortlist(fcm_ctx *ctx)
     TEST_TRUE(rep.ok && npos <= M && resid(M, K, A, x, b) <= stop);
 
     b[0] = -0.5 * b[0]; /* no x >= 0 has a negative sum */
-    TEST_OK(ctx, fcm__simplify_nnls(ctx, M, K, A, b, 1e-13, x, &rep));
+    TEST_OK(ctx, fcm__simplify_nnls(ctx, M, K, A, b, 1e-13, 0.0, x, &rep));
     TEST_TRUE(!rep.ok && rep.optimal);
     check_kkt(M, K, A, b, x, 1e-10);
   }
@@ -182,10 +183,52 @@ static void cancelling(fcm_ctx *ctx)
   const double A[2 * 3] = {-1.0, 0.0, 0.0, -1.0, 1.0, -1.0 + 1e-9}, b[2] = {1.0, 1.0};
   double x[3];
   fcm__nnls_report rep;
-  TEST_OK(ctx, fcm__simplify_nnls(ctx, 2, 3, A, b, 1e-13, x, &rep));
+  TEST_OK(ctx, fcm__simplify_nnls(ctx, 2, 3, A, b, 1e-13, 0.0, x, &rep));
   TEST_TRUE(!rep.ok && rep.optimal);
   check_kkt(2, 3, A, b, x, 1e-12);
   TEST_NEAR(x[2], (A[4] * b[0] + A[5] * b[1]) / (A[4] * A[4] + A[5] * A[5]), 1e-6, 0.0);
+}
+
+/* The infeasibility certificate (reach > 0): it never stops a system that some x >= 0 solves to
+ * within reach (b = A x* + e, |e_i| <= reach / 2, x* on many columns or on a few, b then on a
+ * low-dimensional face of the cone), in double and single pricing (k <= M, k > M); on systems
+ * no x >= 0 solves (a negative sum against a first row of ones, random right-hand sides), when
+ * it stops, the optimum found without it misses b by more than reach, and it stops no later. */
+static void certificate(fcm_ctx *ctx)
+{
+  enum { M = 35, K = 200 };
+  static double A[M * K], xs[K], b[M], x[K];
+  fcm__nnls_report rep, opt;
+  const int ks[3] = {K, M, 20}, nps[3] = {60, 3, 10};
+  for (uint64_t seed = 51; seed <= 58; seed++)
+    for (int c = 0; c < 3; c++) {
+      const int k = ks[c];
+      consistent(seed, M, k, nps[c], A, xs, b);
+      uint64_t s = seed;
+      const double reach = 1e-9 * b[0];
+      for (int i = 0; i < M; i++)
+        b[i] += reach * (util_rand(&s) - 0.5);
+      TEST_OK(ctx, fcm__simplify_nnls(ctx, M, k, A, b, 1e-13 * b[0], reach, x, &rep));
+      TEST_TRUE(!rep.infeasible && resid(M, k, A, x, b) <= reach);
+    }
+  int stopped = 0;
+  for (uint64_t seed = 61; seed <= 70; seed++) {
+    const int k = seed % 2 ? K : M;
+    consistent(seed, M, k, 25, A, xs, b);
+    uint64_t s = seed;
+    if (seed % 4 < 2)
+      b[0] = -0.5 * b[0]; /* no x >= 0 has a negative sum */
+    else
+      for (int i = 1; i < M; i++)
+        b[i] = 2.0 * k * (util_rand(&s) - 0.5);
+    const double reach = 1e-9 * fabs(b[0]);
+    TEST_OK(ctx, fcm__simplify_nnls(ctx, M, k, A, b, 1e-13, 0.0, x, &opt));
+    TEST_OK(ctx, fcm__simplify_nnls(ctx, M, k, A, b, 1e-13, reach, x, &rep));
+    if (!rep.infeasible) continue;
+    stopped++;
+    TEST_TRUE(!opt.ok && opt.residual > reach && rep.iterations <= opt.iterations);
+  }
+  TEST_TRUE(stopped >= 5);
 }
 
 /* The fit on random candidates in [0, 1]^3 (basis on that box): the moments of a positive
@@ -230,6 +273,7 @@ static void fit(fcm_ctx *ctx)
     fcm__simplify_moments(&box, NS, pts, NULL, w, b, work);
     TEST_OK(ctx, fcm__simplify_fit(ctx, &box, N - NS, pts + 3 * NS, b, 1e-12, 1e-14, &f));
     TEST_TRUE(!f.ok && strstr(f.message, "no positive combination") != NULL);
+    TEST_TRUE(strstr(f.message, "separating polynomial") != NULL); /* proved, not run out */
   }
 }
 
@@ -244,6 +288,7 @@ int main(void)
   kkt(ctx);
   shortlist(ctx);
   cancelling(ctx);
+  certificate(ctx);
   fit(ctx);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();

@@ -10,6 +10,7 @@
 #include "la/la_impl.h"
 #include "simplify/simplify_impl.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -25,6 +26,13 @@
 
 /* The NNLS polish works on at most this many columns (5 M for M <= 84, strength 6). */
 #define FCM__FIT_MAX_PASSIVE 420
+
+/* The larger of a and b, a when b is NaN: a comparison the compiler keeps in the loop, where
+ * fmax() is a library call (NNLS's per-column scans spent 5 % of the fit in it). */
+static inline double max2(double a, double b)
+{
+  return b > a ? b : a;
+}
 
 /* max_i |(P_S w)_i - b_i| / max(max_i |b_i|, atol / tol) over the support S (columns idx of P,
  * ld M): relative to the moments, or to the floor below which they are rounding. */
@@ -315,7 +323,7 @@ FCM_MULTIVERSION_CLONES static double nnls_residual(nnls_qr *s, const double *A,
   }
   double rmax = 0.0, n2 = 0.0;
   for (int i = 0; i < M; i++)
-    rmax = fmax(rmax, fabs(r[i])), n2 += r[i] * r[i];
+    rmax = max2(rmax, fabs(r[i])), n2 += r[i] * r[i];
   *rn = sqrt(n2);
   return rmax;
 }
@@ -368,7 +376,7 @@ static int nnls_shortlist(int M, int k, const double *A, const double *inv, cons
   double top = 0.0;
   int nl = 0;
   for (int j = 0; j < k; j++)
-    if (pas[j] != it) top = fmax(top, g[j] * inv[j]);
+    if (pas[j] != it) top = max2(top, g[j] * inv[j]);
   const double keep = NNLS_SHORTLIST_KEEP * top;
   for (int j = 0; j < k; j++)
     if (pas[j] != it && g[j] > 0.0 && g[j] * inv[j] > keep) {
@@ -376,6 +384,26 @@ static int nnls_shortlist(int M, int k, const double *A, const double *inv, cons
       lidx[nl++] = j;
     }
   return nl;
+}
+
+/* Farkas certificate that no x >= 0 has max_i |(A x - b)_i| <= reach, from the residual r of a
+ * full gradient g (computed with absolute error at most err ||a_j|| per column): with row 0 of A
+ * positive (inv0[j] = 1 / A_0j; the constant function's moments), y = r - gamma e_0 and gamma =
+ * max_j (g_j + err ||a_j||) / A_0j make every a_j^T y <= 0, so any x >= 0 with A x = b + e gives
+ * b^T y = sum_j x_j a_j^T y - e^T y <= ||e||_inf ||y||_1: b^T y > reach ||y||_1 rules out every
+ * such x. 1 when it does (with a margin for the rounding of b^T y). */
+static int nnls_farkas(int M, int k, const double *b, const double *r, const double *g,
+                       const double *norm, const double *inv0, double err, double reach)
+{
+  double gamma = -INFINITY;
+  for (int j = 0; j < k; j++)
+    gamma = max2(gamma, (g[j] + err * norm[j]) * inv0[j]);
+  double by = -gamma * b[0], mag = fabs(gamma * b[0]), y1 = fabs(r[0] - gamma);
+  for (int i = 0; i < M; i++)
+    by += b[i] * r[i], mag += fabs(b[i] * r[i]);
+  for (int i = 1; i < M; i++)
+    y1 += fabs(r[i]);
+  return by - 4.0 * (M + 2) * DBL_EPSILON * mag > reach * y1;
 }
 
 /* The least-squares weights z of the passive set with the columns np0.. added this iteration:
@@ -420,13 +448,13 @@ static void nnls_inner(nnls_qr *s, double *xp, double *z)
 }
 
 fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const double *b,
-                              double stop, double *x, fcm__nnls_report *rep)
+                              double stop, double reach, double *x, fcm__nnls_report *rep)
 {
   fcm_status st = FCM_OK;
   nnls_qr s;
   memset(&s, 0, sizeof s);
   s.M = M, s.kcols = k;
-  double *r = NULL, *g = NULL, *norm = NULL, *inv = NULL, *xp = NULL, *z = NULL;
+  double *r = NULL, *g = NULL, *norm = NULL, *inv = NULL, *xp = NULL, *z = NULL, *inv0 = NULL;
   int *seen = NULL, *pas = NULL, *order = NULL, *lidx = NULL, exact = 0, nl = -1, last_full = 0;
   double *AL = NULL, *gl = NULL;            /* the shortlist's columns and gradients */
   float *Af = NULL, *rf = NULL, *gf = NULL; /* A, r and A^T r in single precision */
@@ -472,6 +500,16 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
     inv[j] = norm[j] > 0.0 ? 1.0 / norm[j] : 0.0;
     seen[j] = pas[j] = -1; /* the iteration that tried j last, that found it passive */
   }
+  if (reach > 0.0) { /* the infeasibility certificate needs row 0 positive (nnls_farkas()) */
+    FCM_ALLOC(ctx, (size_t)k, inv0);
+    for (int j = 0; j < k && inv0; j++)
+      if (A[(size_t)j * (size_t)M] > 0.0) {
+        inv0[j] = 1.0 / A[(size_t)j * (size_t)M];
+      } else {
+        fcm__free(ctx, inv0);
+        inv0 = NULL;
+      }
+  }
   for (int it = 0; it < 3 * k + M; it++) {
     const int np0 = s.np;
     /* r = b - A x: xp being the passive set's least-squares solution, r = Q_2 Q_2^T b with
@@ -486,6 +524,7 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
     for (int q = 0; q < s.np; q++)
       pas[s.pos[q]] = it;
     int full = !AL || nl <= 0 || it - last_full >= NNLS_REFRESH, single = Af != NULL;
+    double gerr = -1.0; /* a full gradient's error per unit ||a_j||, once computed */
   price:
     if (full && single) {
       for (int i = 0; i < M; i++)
@@ -494,18 +533,20 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
       double top = 0.0;
       for (int j = 0; j < k; j++) {
         g[j] = (double)gf[j];
-        if (pas[j] != it) top = fmax(top, g[j] * inv[j]);
+        if (pas[j] != it) top = max2(top, g[j] * inv[j]);
       }
       s.flops += 2.0 * M * k + 2.0 * k;
       if (!(top > NNLS_SINGLE_TRUST * rn)) { /* near optimality: price in double */
         single = 0;
         goto price;
       }
+      gerr = 2.0 * (M + 2) * FLT_EPSILON * rn;
       last_full = it;
       if (AL) nl = nnls_shortlist(M, k, A, inv, pas, it, g, AL, lidx);
     } else if (full) {
       fcm__gemv('T', M, k, 1.0, A, M, r, 0.0, g);
       s.flops += 2.0 * M * k + 2.0 * k;
+      gerr = 2.0 * (M + 2) * DBL_EPSILON * rn;
       last_full = it;
       if (AL) nl = nnls_shortlist(M, k, A, inv, pas, it, g, AL, lidx);
     } else { /* the shortlist's gradients, 0 for the other columns */
@@ -514,6 +555,10 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
       memset(g, 0, (size_t)k * sizeof *g);
       for (int c = 0; c < nl; c++)
         g[lidx[c]] = gl[c];
+    }
+    if (gerr >= 0.0 && inv0 && nnls_farkas(M, k, b, r, g, norm, inv0, gerr, reach)) {
+      rep->infeasible = 1; /* out of reach: the way on to optimality cannot change that */
+      break;
     }
     int added = 0;
     while (!added) { /* the steepest column that can enter */
@@ -560,6 +605,7 @@ cleanup:
   fcm__free(ctx, g);
   fcm__free(ctx, norm);
   fcm__free(ctx, inv);
+  fcm__free(ctx, inv0);
   fcm__free(ctx, xp);
   fcm__free(ctx, z);
   fcm__free(ctx, seen);
@@ -611,7 +657,8 @@ static fcm_status polish(fcm_ctx *ctx, int M, int n, const double *P, fcm__fit *
   for (int i = 0; i < M; i++)
     bs[i] = scale * b[i];
   fcm__nnls_report nr;
-  FCM_TRY(ctx, fcm__simplify_nnls(ctx, M, k, A, bs, nnls_stop(M, b, scale, tol, floor), x, &nr));
+  FCM_TRY(ctx,
+          fcm__simplify_nnls(ctx, M, k, A, bs, nnls_stop(M, b, scale, tol, floor), 0.0, x, &nr));
   int count = 0, idx[FCM__FIT_MAX_PASSIVE];
   double w[FCM__FIT_MAX_PASSIVE];
   for (int c = 0; c < k; c++)
@@ -651,7 +698,9 @@ static fcm_status nnls_fit(fcm_ctx *ctx, int M, int n, const double *P, const do
   FCM_ALLOC(ctx, (size_t)M, bs);
   for (int i = 0; i < M; i++)
     bs[i] = scale * b[i];
-  FCM_TRY(ctx, fcm__simplify_nnls(ctx, M, n, P, bs, nnls_stop(M, b, scale, tol, floor), x, nr));
+  /* a certificate that no positive combination verifies (to tol) ends a hopeless run early */
+  const double stop = nnls_stop(M, b, scale, tol, floor);
+  FCM_TRY(ctx, fcm__simplify_nnls(ctx, M, n, P, bs, stop, 2.0 * stop, x, nr));
   f->flops += nr->flops;
   if (!nr->ok) goto cleanup;
   f->count = 0;
@@ -692,8 +741,16 @@ fcm_status fcm__simplify_fit(fcm_ctx *ctx, const fcm__cheb_box *box, int n, cons
   fcm__nnls_report nr;
   FCM_TRY(ctx, nnls_fit(ctx, M, n, P, b, scale, tol, floor, x, f, &nr));
   if (f->ok) goto cleanup;
-  /* the moments are farther from the candidates' cone than the LP's rank cut could explain */
+  /* the moments are farther from the candidates' cone than the LP's rank cut could explain, or
+   * proved beyond tol of it */
   const double nnls_rel = 0.5 * tol * nr.residual / nnls_stop(M, b, scale, tol, floor);
+  if (nr.infeasible) {
+    snprintf(f->message, sizeof f->message,
+             "no positive combination of the %d candidates within the tolerance: a separating "
+             "polynomial proves it (NNLS residual %.3g when found)",
+             n, nnls_rel);
+    goto cleanup;
+  }
   if (nr.optimal && nnls_rel > FIT_INFEASIBLE) {
     snprintf(f->message, sizeof f->message,
              "no positive combination of the %d candidates: the nearest (NNLS) leaves a "

@@ -172,13 +172,15 @@ fcm_status fcm__simplify_run_eliminate(fcm__attempt *a);
 /* ---- moment fitting (fit.c) ---- */
 
 /* Interior candidates per moment that a fit's first candidate set of strength m aims at. NNLS
- * costs more the more candidates it prices, but a set whose cone misses the moments costs a
- * whole NNLS run to prove it and then a set four times larger: on real cut cells (ball, cut
+ * costs more the more candidates it prices, but a set whose cone misses the moments costs an
+ * NNLS run to prove it and then a set four times larger: on real cut cells (ball, cut
  * fractions 0.25..0.75; tests/bench/bench_roofline.c) 2 per moment fails on half the cells at
- * m = 7 and on all at m = 9, (m - 1) / 2 on none, for about 1.3x the candidates. */
+ * m = 7 and on all at m = 9, 2.5 at m = 7 and (m - 1) / 2 at m = 9 on none; on a scanned model
+ * at m = 7 2.5 and 3 fail on the same 6 % of the cells (the smaller set the faster), and below
+ * 2.5 the four sets of a small piece can all fail (lib/docs/performance.md). */
 static inline double fcm__fit_candidates_per_moment(int m)
 {
-  return m > 5 ? 0.5 * (m - 1) : 2.0;
+  return m > 7 ? 0.5 * (m - 1) : m > 5 ? 2.5 : 2.0;
 }
 
 /* A fitted rule: count <= M candidates idx[] (ascending) with positive weights w[] (both
@@ -196,10 +198,12 @@ typedef struct fcm__fit {
 
 /* What fcm__simplify_nnls() found: ok when the residual reached the caller's level, optimal
  * when it stopped short of it because no column lowers the residual (x is then the least-squares
- * minimizer over x >= 0 up to rounding), the residual max_i |(b - A x)_i|, the passive set's size
- * (the positive entries of x), the outer iterations and the floating-point operations. */
+ * minimizer over x >= 0 up to rounding), infeasible when it stopped on a proof that no x >= 0
+ * reaches the caller's `reach` (x is then the last iterate), the residual max_i |(b - A x)_i|,
+ * the passive set's size (the positive entries of x), the outer iterations and the
+ * floating-point operations. */
 typedef struct fcm__nnls_report {
-  int ok, optimal, passive, iterations;
+  int ok, optimal, infeasible, passive, iterations;
   double residual;
   double flops; /* of the algorithm: gradients, QR updates, solves, residuals */
 } fcm__nnls_report;
@@ -208,9 +212,13 @@ typedef struct fcm__nnls_report {
  * with the passive columns' QR factorization updated column by column): A is M x k (ld M), x
  * (k) receives the iterate at which max_i |(b - A x)_i| <= stop (rep->ok = 1) or, when no
  * column lowers the residual any more or after 3 k + M steps, the last one (rep->ok = 0). Its
- * positive entries are linearly independent columns (at most M). Errors: FCM_ERR_ALLOC. */
+ * positive entries are linearly independent columns (at most M). With reach > 0 and row 0 of A
+ * positive (the moments of the constant function), it also stops (rep->infeasible = 1) once a
+ * residual proves that no x >= 0 has max_i |(A x - b)_i| <= reach (a Farkas certificate:
+ * y with A^T y <= 0 and b^T y > reach ||y||_1); reach 0: run to optimality. Errors:
+ * FCM_ERR_ALLOC. */
 fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const double *b,
-                              double stop, double *x, fcm__nnls_report *rep);
+                              double stop, double reach, double *x, fcm__nnls_report *rep);
 
 /* At most M of the n candidate points (x 3) with positive weights whose moments in the basis of
  * box equal b (M entries) to max(tol max|b|, atol): relative, down to the absolute level atol
