@@ -13,6 +13,9 @@ fcm_add_test(embed_exact_tet_simplified_full tests/embed/exactness.c ARGS tet si
 fcm_add_test(embed_volume tests/embed/volume.c)
 fcm_add_test(embed_degenerate tests/embed/degenerate.c)
 fcm_add_test(embed_surface tests/embed/surface.c)
+# The boundary area in dropped cells: a face-parallel sliver's face in closed form; dropped and
+# kept areas add up to the surface's.
+fcm_add_test(embed_dropped_area tests/embed/dropped_area.c)
 fcm_add_test(embed_rules tests/embed/rules.c)
 fcm_add_test(embed_errors tests/embed/errors.c)
 # Simplify only where it pays: the cost model on both sides of a break-even, AUTO = ON with

@@ -237,6 +237,10 @@ typedef struct fcm_cell_rules_stats {
   double time_setup, time_intersect, time_simplify, time_gather, time_total;
   int num_threads;
   fcm_simplify_decision decision[FCM_RULE_KIND_COUNT]; /**< per kind (see the mode) */
+  double dropped_area; /**< the embedded surface's area in dropped cells: boundary that no
+                            surface rule carries (their traction or Nitsche terms are lost);
+                            embedded_area + dropped_area is the surface's area. Computed only
+                            when surface rules are built (surface_strength >= 0), else 0 */
 } fcm_cell_rules_stats;
 
 /** Per-cell quadrature of an embedded geometry in a background mesh (opaque). */

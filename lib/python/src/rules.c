@@ -62,6 +62,7 @@ static const fcmpy_option stats_table[] = {
     {"embedded_volume", 'd', 1, RS(embedded_volume)},
     {"dropped_volume", 'd', 1, RS(dropped_volume)},
     {"embedded_area", 'd', 1, RS(embedded_area)},
+    {"dropped_area", 'd', 1, RS(dropped_area)},
     {"geometry_volume", 'd', 1, RS(geometry_volume)},
     {"outside_volume", 'd', 1, RS(outside_volume)},
     {"outside_side_volume", 'd', 6, RS(outside_side_volume)},

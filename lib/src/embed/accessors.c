@@ -308,12 +308,15 @@ void fcm_cell_rules_view(const fcm_cell_rules *rules, FILE *stream)
   fprintf(stream,
           "cell rules: %s, %lld cells: %lld uncut, %lld cut, %lld dropped (%d threads)\n"
           "  candidates %lld, convex parts %lld, tets %lld, slivers dropped %lld (volume %.3g)\n"
-          "  embedded volume %.17g (geometry %.17g, in dropped cells %.3g)\n",
+          "  embedded volume %.17g (geometry %.17g, in dropped cells %.3g",
           fcm_element_get_info(rules->type)->name, (long long)S->num_cells, (long long)S->num_uncut,
           (long long)S->num_cut, (long long)S->num_dropped, S->num_threads,
           (long long)S->num_candidates, (long long)S->num_parts, (long long)S->num_tets,
           (long long)S->num_slivers, S->sliver_volume, S->embedded_volume, S->geometry_volume,
           S->dropped_volume);
+  if (rules->surface_strength >= 0) /* the boundary those cells' surface rules lose */
+    fprintf(stream, ", boundary area in dropped cells %.3g", S->dropped_area);
+  fputs(")\n", stream);
   fprintf(stream, "  embedded / geometry volume %.6f; outside the background mesh %.3g",
           S->volume_ratio, S->outside_volume);
   static const char *const sides[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
@@ -382,5 +385,47 @@ fcm_status fcm_cell_rules_view_points(const fcm_cell_rules *rules, const fcm_mes
     }
   }
 cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_selected_area(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                                    const fcm_cell_rules *rules, fcm__embed_select_fn select,
+                                    void *user, double *kept, double *dropped)
+{
+  fcm_status st = FCM_OK;
+  fcm__embed_ws ws;
+  fcm__embed_counts none;
+  fcm_rule *tri_rule = NULL;
+  const fcm_aabb_tree *tree = NULL;
+  double X[3 * FCM_ELEMENT_MAX_NODES], x[3];
+  memset(&ws, 0, sizeof ws);
+  memset(&none, 0, sizeof none);
+  *kept = *dropped = 0.0;
+  if (rules->surface_strength < 0) return FCM_OK;
+  FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TRI, rules->surface_strength, &tri_rule));
+  FCM_TRY(ctx, fcm__geom_tree(ctx, geom, 1, &tree));
+  for (fcm_index c = 0; c < rules->num_cells; c++) {
+    if (rules->masked && !rules->own[c]) continue; /* another process's cell */
+    if (rules->cls[c] != FCM_CELL_DROPPED) {
+      const fcm_index s0 = rules->soff[rules->piece_off[c]],
+                      s1 = rules->soff[rules->piece_off[c + 1]];
+      if (s0 == s1) continue;
+      fcm_mesh_cell_coords(mesh, c, X);
+      for (fcm_index s = s0; s < s1; s++) {
+        fcm_element_map(rules->type, X, rules->spoints + 3 * s, x);
+        if (select(user, x, rules->snormals + 3 * s)) *kept += rules->sweights[s];
+      }
+      continue;
+    }
+    fcm__embed_cell cell; /* a dropped cell: its surface clipped as a kept cell's would be */
+    FCM_TRY(ctx, fcm__embed_cell_setup(ctx, mesh, c, rules->opts.clip_rtol, &cell));
+    FCM_TRY(ctx, fcm__embed_cell_surface(ctx, geom, tree, &cell, NULL, 0, rules->opts.sliver_rtol,
+                                         tri_rule, &ws, &none));
+    for (size_t j = 0; j < ws.num_spts; j++)
+      if (select(user, ws.spts + 3 * j, ws.snrm + 3 * j)) *dropped += ws.sw[j];
+  }
+cleanup:
+  fcm__embed_ws_free(ctx, &ws);
+  fcm_rule_destroy(&tri_rule);
   return st;
 }

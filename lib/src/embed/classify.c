@@ -105,6 +105,26 @@ cleanup:
 
 /* Keep cell c as the rules being extended have it (the new cut leaves it unchanged): its
  * class, fraction, pieces and rules bit for bit, cut faces included. */
+/* A dropped cell's share of the embedded surface into o->dropped_area: the area its surface
+ * rule would have had (the same clipping, so that the kept and dropped cells' areas add up to
+ * the surface's). Only when surface rules are built; the cell's own points are not kept. */
+static fcm_status dropped_area(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
+                               cell_out *o)
+{
+  fcm_status st = FCM_OK;
+  fcm__embed_counts none;
+  memset(&none, 0, sizeof none);
+  o->dropped_area = 0.0;
+  if (!B->tri_rule) return FCM_OK;
+  FCM_TRY(B->ctx, fcm__embed_cell_surface(B->ctx, B->geom, B->tri_tree, cell, NULL, 0,
+                                          B->o->sliver_rtol, B->tri_rule, ws, &none));
+  for (size_t j = 0; j < ws->num_spts; j++)
+    o->dropped_area += ws->sw[j];
+  ws->num_spts = 0;
+cleanup:
+  return st;
+}
+
 static fcm_status keep_cell(const build *B, fcm_cell_rules *R, const fcm__embed_cell *cell,
                             cell_out *o)
 {
@@ -375,6 +395,7 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
   if (!integrate && (!B->region[c] || (B->same_links && B->same_links[c]))) { /* no new work */
     FCM_TRY(ctx, keep_cell(B, R, &cell, o));
+    if (own && R->cls[c] == FCM_CELL_DROPPED) FCM_TRY(ctx, dropped_area(B, &cell, ws, o));
     sums->time_intersect += fcm_wtime() - t0;
     goto cleanup;
   }
@@ -401,6 +422,7 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
     int kept;
     FCM_TRY(ctx, keep_region_cell(B, R, &cell, P, integrate, o, &kept));
     if (kept) {
+      if (own && R->cls[c] == FCM_CELL_DROPPED) FCM_TRY(ctx, dropped_area(B, &cell, ws, o));
       sums->counts.kept += integrate;
       sums->time_intersect += fcm_wtime() - t0;
       goto cleanup;
@@ -440,6 +462,7 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
     sums->time_intersect += fcm_wtime() - t0;
     goto cleanup;
   }
+  if (cls == FCM_CELL_DROPPED) FCM_TRY(ctx, dropped_area(B, &cell, ws, o));
   if (cls == FCM_CELL_CUT && surface) FCM_TRY(ctx, surface_rules(B, R, &cell, ws, sbox, o, sums));
   if (cls == FCM_CELL_CUT && !surface) {
     for (int i = 0; i < o->np; i++) {

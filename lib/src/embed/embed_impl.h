@@ -213,6 +213,19 @@ fcm_status fcm__embed_cell_surface(fcm_ctx *ctx, const fcm_geometry *geom,
                                    const fcm_rule *tri_rule, fcm__embed_ws *ws,
                                    fcm__embed_counts *counts);
 
+/* A selection of embedded-boundary points: nonzero when the point x (physical, reference
+ * configuration) with unit outward normal n belongs to it. */
+typedef int (*fcm__embed_select_fn)(void *user, const double x[3], const double n[3]);
+
+/* The area of the embedded boundary that select() takes (decided at each surface point): in
+ * the cells `rules` keeps (their surface weights) and in the cells it dropped (their part of
+ * the boundary clipped and integrated as a kept cell's would be; only those cells are
+ * clipped). Both 0 when the rules carry no surface rules; a masked build counts its own cells.
+ * `mesh` and `geom` are the rules'. Allocates scratch (accessors.c). */
+fcm_status fcm__embed_selected_area(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,
+                                    const fcm_cell_rules *rules, fcm__embed_select_fn select,
+                                    void *user, double *kept, double *dropped);
+
 /* ---------------------------------------------------------------- cutting (pieces.c) */
 
 /* The cuts' tolerance, relative to the cell size: a part vertex this close to a cut triangle's

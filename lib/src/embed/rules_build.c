@@ -307,6 +307,7 @@ void fcm__embed_gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const 
     default:
       S->num_dropped++;
       S->dropped_volume += o->volume;
+      S->dropped_area += o->dropped_area;
       break;
     }
   }

@@ -46,6 +46,7 @@ typedef struct cell_out {
   piece_out one;
   piece_out *pc;
   double volume;
+  double dropped_area; /* a dropped cell's share of the embedded surface (surface rules on) */
   int nfp; /* face polygons: meta (face, piece, vertices, part vertices) x nfp, coordinates fx
               (the polygon's, then its part's) */
   int *fmeta;
