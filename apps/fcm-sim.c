@@ -119,7 +119,9 @@ static void usage(FILE *f, const cli_option *opts)
              "Exit 0 on success, 1 when the run fails, 2 on a usage error, an invalid scene (also\n"
              "one whose files or geometry fail to build: the message names the scene section,\n"
              "e.g. geometry.voxels) or a refused checkpoint. A warning is printed when part of\n"
-             "the body lies outside the background mesh (it is cut off), on the first step that\n"
+             "the body lies outside the background mesh (it is cut off), when a traction,\n"
+             "pressure or boundary constraint loses more than 0.1%% of its boundary to cells\n"
+             "below quadrature.min_fraction (dropped), on the first step that\n"
              "ends with inverted quadrature points (J = det F <= 0; the log's inverted_points\n"
              "column and the summary count them), on the first frame holding NaN stresses and\n"
              "for what the library reports as a warning (NaN voxels, filled holes, solver\n"
@@ -341,6 +343,26 @@ static void warn_outside(const fcm_simulation *sim)
           S->mesh_lo[1], S->mesh_hi[1], S->mesh_lo[2], S->mesh_hi[2]);
 }
 
+/* The warning when a boundary effect (traction, pressure, a fixed or motion constraint on the
+ * "boundary") loses more than this share of its boundary to dropped cells, where no surface
+ * rule carries its load or constraint. */
+#define SIM_DROPPED_BOUNDARY_SHARE 1e-3
+static void warn_dropped_boundary(const fcm_simulation *sim, const fcm_scene *scene)
+{
+  fcm_simulation_counters c;
+  fcm_simulation_get_counters(sim, &c);
+  if (!(c.effect_dropped_fraction > SIM_DROPPED_BOUNDARY_SHARE)) return;
+  const fcm_effect *e = fcm_scene_get_effect(scene, c.effect_dropped_index);
+  fprintf(stderr,
+          "fcm-sim: warning: effects[%d] (%s) loses %.3g%% of the boundary area its region "
+          "selects: it lies in cells with a volume fraction below quadrature.min_fraction = %g, "
+          "which are dropped with their surface rules (%.3g of %.6g m^2 of the whole boundary); "
+          "lower quadrature.min_fraction in the scene (0 keeps every cell with material)\n",
+          c.effect_dropped_index, e ? fcm_effect_type_name(e->type) : "?",
+          100.0 * c.effect_dropped_fraction, fcm_scene_get_quadrature(scene)->rules.min_fraction,
+          c.dropped_area, c.boundary_area);
+}
+
 /* The warning on the first step that ends with inverted quadrature points (the run summary
  * counts them all). */
 static void warn_inverted(int tty, const fcm_step_info *si, long long step)
@@ -510,6 +532,7 @@ static int build_simulation(fcm_ctx *ctx, fcm_scene *scene, const scene_options 
   }
   if (st != FCM_OK) return report_build_error(ctx, st, name, o->debug);
   warn_outside(*sim);
+  warn_dropped_boundary(*sim, scene);
   if (o->resume) {
     if (fcm_simulation_read_checkpoint(*sim, o->resume) != FCM_OK) {
       fprintf(stderr, "fcm-sim: %s\n", fcm_ctx_error_message(ctx));

@@ -63,6 +63,9 @@ fcm_add_test(scene_inversion tests/scene/inversion_scene.c)
 # voxel and plain scenes: each once, in order, start before end, the times in the counters
 # within their parts and the set-up; progress and warnings inside the phase that makes them.
 fcm_add_test(scene_setup_phases tests/scene/setup_phases.c)
+# Boundary in dropped cells: the counters, the rules' phase words and the summary line with a
+# traction on a sliver face; none of it when nothing is dropped.
+fcm_add_test(scene_dropped_boundary tests/scene/dropped_boundary.c)
 # The background key "octree": parse, round trip, refusals, a step on the refined grid.
 fcm_add_test(scene_octree tests/scene/octree_scene.c)
 # The contact effect: apps/scenes/ball_on_floor.json round-trips through the normalized JSON,

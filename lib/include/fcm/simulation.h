@@ -57,7 +57,8 @@ typedef struct fcm_setup_phase_event {
   fcm_setup_phase phase;
   const char *what; /**< the phase and what it works on, in words for a user: "reading the
                          surface bunny.obj", "meshing the volume with Gmsh"; valid during the
-                         call */
+                         call. The cell rules' end adds the share of the boundary area in
+                         dropped cells when there is any */
   int finished;     /**< 0: the phase starts; 1: it ended (a phase that fails reports no end:
                          fcm_simulation_create() returns the error) */
   double seconds;   /**< 0 at the start; at the end the phase's wall time
@@ -186,6 +187,18 @@ typedef struct fcm_simulation_counters {
                                   assemblies (fcm_step_info.time_assembly, summed) */
   double time_step_factor;   /**< seconds of their factorizations or preconditioner set-ups */
   double time_step_solve;    /**< seconds of their triangular or Krylov solves */
+  /* The embedded boundary in cells the set-up's rules dropped (volume fraction below
+   * quadrature.min_fraction): no surface rule carries it, so loads and boundary constraints
+   * there are lost. 0 without surface rules. */
+  double boundary_area;           /**< the boundary's area: the rules' embedded_area plus
+                                       dropped_area (fcm_cell_rules_stats) */
+  double dropped_area;            /**< of it, the area in dropped cells */
+  double effect_dropped_fraction; /**< the largest share, over the traction and pressure effects
+                                       and the fixed and motion effects on the "boundary", of
+                                       the boundary area an effect's region selects that lies
+                                       in dropped cells (0: none) */
+  int effect_dropped_index;       /**< that effect's index in the scene (meaningful when
+                                       effect_dropped_fraction > 0) */
 } fcm_simulation_counters;
 
 /** A running scene (opaque). */

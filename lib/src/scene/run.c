@@ -80,6 +80,20 @@ static void phase_end(fcm_simulation *S)
   }
 }
 
+/* The set-up rules' boundary area in dropped cells into the counters and, when there is any,
+ * into the words of the rules' phase (its end tells the host). */
+static void dropped_boundary(fcm_simulation *S)
+{
+  const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(S->rules);
+  S->c.dropped_area = rs->dropped_area;
+  S->c.boundary_area = rs->embedded_area + rs->dropped_area;
+  if (!(rs->dropped_area > 0.0)) return;
+  const size_t n = strlen(S->phase_what);
+  snprintf(S->phase_what + n, sizeof S->phase_what - n,
+           "; %.3g%% of the boundary area (%.3g of %.6g m^2) in dropped cells",
+           100.0 * S->c.dropped_area / S->c.boundary_area, S->c.dropped_area, S->c.boundary_area);
+}
+
 /* The last part of a path: what the phases' words name a file by. */
 static const char *base_name(const char *path)
 {
@@ -876,6 +890,7 @@ fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
     st = build_rules(S);
     if (st != FCM_OK) fcm__error_prefix(ctx, st == FCM_ERR_GEOMETRY ? "geometry" : "quadrature");
     FCM_TRY(ctx, st);
+    dropped_boundary(S);
     phase_end(S);
     S->c.time_setup_rules = fcm_wtime() - tp;
     const fcm_cell_rules_stats *rs = fcm_cell_rules_get_stats(S->rules);

@@ -45,6 +45,35 @@ static void surface_field(void *user, const double x[3], const double normal[3],
   }
 }
 
+/* A surface load's region as a selection of boundary points (fcm__embed_select_fn). */
+static int load_select(void *user, const double x[3], const double n[3])
+{
+  const fcm_effect *e = user;
+  (void)n;
+  return fcm_region_contains(
+      e->type == FCM_EFFECT_TRACTION ? &e->traction.region : &e->pressure.region, x);
+}
+
+/* The share of the boundary that effect e selects (select, user) in cells the rules dropped,
+ * where its load or constraint terms are lost: the largest share over the effects into the
+ * counters. Clips only the dropped cells, and only when the rules dropped any boundary. */
+static fcm_status dropped_share(fcm_simulation *S, const fcm_effect *e, fcm__embed_select_fn select,
+                                void *user)
+{
+  fcm_status st = FCM_OK;
+  double kept, dropped;
+  if (!S->rules || !(fcm_cell_rules_get_stats(S->rules)->dropped_area > 0.0)) return FCM_OK;
+  FCM_TRY(S->ctx, fcm__embed_selected_area(S->ctx, S->mesh, S->geom, S->rules, select, user, &kept,
+                                           &dropped));
+  const double share = dropped > 0.0 ? dropped / (kept + dropped) : 0.0;
+  if (share > S->c.effect_dropped_fraction) {
+    S->c.effect_dropped_fraction = share;
+    S->c.effect_dropped_index = e->index;
+  }
+cleanup:
+  return st;
+}
+
 /* Background nodes of a region: count only (nodes NULL) or fill. A region naming a node out of
  * range or without a node, or whose nodes are all inactive (no active cell uses them: they would
  * hold nothing), is an error; fcm__sim_check_regions() refused those before the set-up already,
@@ -102,6 +131,7 @@ fcm_status fcm__effect_apply_constraint(fcm_simulation *S, const fcm_effect *e)
     S->react_effect[S->num_react] = e->index;
     S->react_id[S->num_react++] = -1 - id; /* negative: a boundary constraint */
     S->c.constraints++;
+    FCM_TRY(S->ctx, dropped_share(S, e, fcm_region_select, (void *)r));
     goto cleanup;
   }
   FCM_TRY(S->ctx, region_nodes(S, r, e->index, NULL, &n));
@@ -138,6 +168,7 @@ fcm_status fcm__effect_apply_surface_load(fcm_simulation *S, const fcm_effect *e
   fcm_effect *copy = &S->loads[S->num_loads++];
   *copy = *e; /* its region arrays stay the scene's, read only */
   FCM_TRY(S->ctx, fcm_integrator_add_traction(S->integ, surface_field, copy, window_scale, copy));
+  FCM_TRY(S->ctx, dropped_share(S, e, load_select, copy));
 cleanup:
   return st;
 }

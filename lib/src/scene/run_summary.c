@@ -177,6 +177,18 @@ static void rules_lines(const fcm_simulation *S, FILE *f, const fcm_cell_rules_s
             "dropped cells %.3g\n",
             rs->embedded_volume, rs->geometry_volume, rs->volume_ratio, rs->outside_volume,
             rs->dropped_volume);
+    if (c->dropped_area > 0.0) { /* boundary no surface rule carries */
+      fprintf(f,
+              "  boundary  %.6g m^2, of it %.3g m^2 (%.3g%%) in dropped cells (volume fraction "
+              "below quadrature.min_fraction = %g): no load or boundary constraint acts there",
+              c->boundary_area, c->dropped_area, 100.0 * c->dropped_area / c->boundary_area,
+              fcm_scene_get_quadrature(S->scene)->rules.min_fraction);
+      if (c->effect_dropped_fraction > 0.0)
+        fprintf(f, "; effects[%d] (%s) loses %.3g%% of its boundary", c->effect_dropped_index,
+                fcm_effect_type_name(fcm_scene_get_effect(S->scene, c->effect_dropped_index)->type),
+                100.0 * c->effect_dropped_fraction);
+      fputc('\n', f);
+    }
     if (rs->outside_volume > 0.0) {
       static const char *const sides[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
       fprintf(f,
