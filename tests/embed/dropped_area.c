@@ -4,6 +4,7 @@
  * faceted surface's area; nothing is dropped with min_fraction = 0 or counted without
  * surface rules. The area a selection of boundary points takes splits the same way
  * (fcm__embed_selected_area): all of it, and the half-space x > 1 that holds the sliver. */
+#include "../geom/exact.h"
 #include "embed/embed_impl.h"
 #include "fcm/embed.h"
 #include "test.h"
@@ -11,21 +12,6 @@
 #include <string.h>
 
 static fcm_ctx *ctx;
-
-static double boundary_area(const fcm_geometry *g)
-{
-  const double *x = fcm_geometry_coords(g);
-  const fcm_index *t = fcm_geometry_boundary_triangles(g);
-  double area = 0.0;
-  for (fcm_index k = 0; k < fcm_geometry_num_boundary_triangles(g); k++) {
-    const double *a = x + 3 * t[3 * k], *b = x + 3 * t[3 * k + 1], *c = x + 3 * t[3 * k + 2];
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    area += 0.5 * hypot(hypot(u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2]),
-                        u[0] * v[1] - u[1] * v[0]);
-  }
-  return area;
-}
 
 static int select_all(void *user, const double x[3], const double n[3])
 {
@@ -93,12 +79,12 @@ static void sliver_box(fcm_element_type type)
   const double face = (b - a) * (b - a), strips = 4 * (b - a) * eps;
   stats(mesh, g, 2, 1e-4, &S);
   TEST_NEAR(S.dropped_area, face + strips, 1e-12, 0);
-  TEST_NEAR(S.dropped_area + S.embedded_area, boundary_area(g), 1e-12, 0);
+  TEST_NEAR(S.dropped_area + S.embedded_area, exact_boundary_area(g), 1e-12, 0);
   TEST_NEAR(S.dropped_volume, face * eps, 1e-6, 0);
   /* min_fraction = 0 keeps the sliver: all of the area in the rules */
   stats(mesh, g, 2, 0.0, &S);
   TEST_TRUE(S.dropped_area == 0.0);
-  TEST_NEAR(S.embedded_area, boundary_area(g), 1e-12, 0);
+  TEST_NEAR(S.embedded_area, exact_boundary_area(g), 1e-12, 0);
   /* without surface rules there is nothing to count */
   stats(mesh, g, -1, 1e-4, &S);
   TEST_TRUE(S.dropped_area == 0.0 && S.num_dropped > 0);
@@ -123,7 +109,7 @@ static void ball(fcm_element_type type)
   if (!mesh || !g) goto done;
   stats(mesh, g, 3, 0.05, &S);
   TEST_TRUE(S.dropped_volume > 0.0 && S.dropped_area > 0.0);
-  TEST_NEAR(S.dropped_area + S.embedded_area, boundary_area(g), 1e-12, 0);
+  TEST_NEAR(S.dropped_area + S.embedded_area, exact_boundary_area(g), 1e-12, 0);
 done:
   fcm_mesh_destroy(&mesh);
   fcm_geometry_destroy(&g);

@@ -293,4 +293,20 @@ static inline void exact_geometry_moments(const fcm_geometry *g, int m, double *
   }
 }
 
+/* The area of the geometry's boundary triangles. */
+static inline double exact_boundary_area(const fcm_geometry *g)
+{
+  const double *x = fcm_geometry_coords(g);
+  const fcm_index *t = fcm_geometry_boundary_triangles(g);
+  double area = 0.0;
+  for (fcm_index k = 0; k < fcm_geometry_num_boundary_triangles(g); k++) {
+    const double *a = x + 3 * t[3 * k], *b = x + 3 * t[3 * k + 1], *c = x + 3 * t[3 * k + 2];
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    area += 0.5 * hypot(hypot(u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2]),
+                        u[0] * v[1] - u[1] * v[0]);
+  }
+  return area;
+}
+
 #endif /* FCM_TEST_GEOM_EXACT_H */
