@@ -447,176 +447,208 @@ static void nnls_inner(nnls_qr *s, double *xp, double *z)
   }
 }
 
+/* NNLS's arrays besides the QR factorization (nnls_qr): per column of A its gradient g, norm and
+ * inverse norm, the iteration that tried it last (seen) and that found it passive (pas); the
+ * residual r, the passive weights xp and their least-squares solution z; the single-precision
+ * copies for pricing (Af, rf, gf; NULL when k <= M); the shortlist (AL, gl, lidx; NULL below
+ * NNLS_SHORTLIST_BYTES) and inv0 (1 / A_0j for the certificate; NULL without one). */
+typedef struct nnls_work {
+  double *r, *g, *norm, *inv, *xp, *z, *inv0, *AL, *gl;
+  int *seen, *pas, *order, *lidx;
+  float *Af, *rf, *gf;
+  int nl, last_full; /* the shortlist's length (-1: none yet), the last full gradient's iteration */
+} nnls_work;
+
+/* Allocate and start NNLS on A (M x k) and b: Q = I, Q^T b = b, the column norms; with reach > 0
+ * and row 0 of A positive, inv0 for the certificate. */
+static fcm_status nnls_start(fcm_ctx *ctx, int M, int k, const double *A, const double *b,
+                             double reach, nnls_qr *s, nnls_work *w)
+{
+  fcm_status st = FCM_OK;
+  s->M = M, s->kcols = k;
+  w->nl = -1;
+  FCM_ALLOC(ctx, (size_t)M * (size_t)M, s->Q);
+  FCM_ALLOC(ctx, (size_t)M * (size_t)M, s->R);
+  FCM_ALLOC(ctx, (size_t)M, s->qtb);
+  FCM_ALLOC(ctx, 2 * (size_t)M, s->v);
+  FCM_ALLOC_RAW(ctx, (size_t)M * NNLS_BATCH, s->V);
+  FCM_ALLOC_RAW(ctx, 2 * (size_t)M * NNLS_BATCH, s->W);
+  FCM_ALLOC_RAW(ctx, (size_t)NNLS_BATCH * NNLS_BATCH, s->T);
+  FCM_ALLOC(ctx, (size_t)M, s->pos);
+  FCM_ALLOC(ctx, (size_t)M, w->r);
+  FCM_ALLOC(ctx, (size_t)k, w->g);
+  FCM_ALLOC(ctx, (size_t)k, w->norm);
+  FCM_ALLOC(ctx, (size_t)k, w->inv);
+  FCM_ALLOC(ctx, (size_t)M, w->xp);
+  FCM_ALLOC(ctx, (size_t)M, w->z);
+  FCM_ALLOC(ctx, (size_t)k, w->seen);
+  FCM_ALLOC(ctx, (size_t)k, w->pas);
+  FCM_ALLOC(ctx, (size_t)k, w->order);
+  if ((double)M * k * sizeof *A > NNLS_SHORTLIST_BYTES) {
+    FCM_ALLOC(ctx, (size_t)k, w->lidx);
+    FCM_ALLOC(ctx, (size_t)k, w->gl);
+    FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)k, w->AL);
+  }
+  if (k > M) {
+    FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)k, w->Af);
+    FCM_ALLOC_RAW(ctx, (size_t)M, w->rf);
+    FCM_ALLOC_RAW(ctx, (size_t)k, w->gf);
+    for (size_t e = 0; e < (size_t)M * (size_t)k; e++)
+      w->Af[e] = (float)A[e];
+  }
+  for (int i = 0; i < M; i++)
+    s->Q[i + (size_t)i * (size_t)M] = 1.0;
+  memcpy(s->qtb, b, (size_t)M * sizeof *b);
+  for (int j = 0; j < k; j++) {
+    double t = 0.0;
+    for (int i = 0; i < M; i++)
+      t += A[i + (size_t)j * (size_t)M] * A[i + (size_t)j * (size_t)M];
+    w->norm[j] = sqrt(t);
+    w->inv[j] = w->norm[j] > 0.0 ? 1.0 / w->norm[j] : 0.0;
+    w->seen[j] = w->pas[j] = -1; /* the iteration that tried j last, that found it passive */
+  }
+  if (reach > 0.0) { /* the infeasibility certificate needs row 0 positive (nnls_farkas()) */
+    FCM_ALLOC(ctx, (size_t)k, w->inv0);
+    for (int j = 0; j < k && w->inv0; j++)
+      if (A[(size_t)j * (size_t)M] > 0.0) {
+        w->inv0[j] = 1.0 / A[(size_t)j * (size_t)M];
+      } else {
+        fcm__free(ctx, w->inv0);
+        w->inv0 = NULL;
+      }
+  }
+cleanup:
+  return st;
+}
+
+/* Free what nnls_start() allocated (also after it failed part-way). */
+static void nnls_end(fcm_ctx *ctx, nnls_qr *s, nnls_work *w)
+{
+  void *p[] = {s->Q,   s->R,     s->qtb,  s->v,   s->V,    s->W,  s->T,  s->pos,
+               w->r,   w->g,     w->norm, w->inv, w->inv0, w->xp, w->z,  w->seen,
+               w->pas, w->order, w->lidx, w->gl,  w->AL,   w->Af, w->rf, w->gf};
+  for (size_t i = 0; i < sizeof p / sizeof p[0]; i++)
+    fcm__free(ctx, p[i]);
+}
+
+/* The gradient g = A^T r of iteration it (residual norm rn): in full (*single: from the float
+ * copy, falling back to double near optimality) or on the shortlist (g 0 elsewhere). Returns a
+ * full gradient's error per unit ||a_j|| (for the certificate), -1 for the shortlist's. */
+static double nnls_price(nnls_qr *s, nnls_work *w, const double *A, int it, int full, int *single,
+                         double rn)
+{
+  const int M = s->M, k = s->kcols;
+  double *g = w->g;
+  if (full && *single) {
+    for (int i = 0; i < M; i++)
+      w->rf[i] = (float)w->r[i];
+    fcm__sgemv('T', M, k, 1.0f, w->Af, M, w->rf, 0.0f, w->gf);
+    double top = 0.0;
+    for (int j = 0; j < k; j++) {
+      g[j] = (double)w->gf[j];
+      if (w->pas[j] != it) top = max2(top, g[j] * w->inv[j]);
+    }
+    s->flops += 2.0 * M * k + 2.0 * k;
+    if (top > NNLS_SINGLE_TRUST * rn) {
+      w->last_full = it;
+      if (w->AL) w->nl = nnls_shortlist(M, k, A, w->inv, w->pas, it, g, w->AL, w->lidx);
+      return 2.0 * (M + 2) * FLT_EPSILON * rn;
+    }
+    *single = 0; /* near optimality: price in double */
+  }
+  if (full) {
+    fcm__gemv('T', M, k, 1.0, A, M, w->r, 0.0, g);
+    s->flops += 2.0 * M * k + 2.0 * k;
+    w->last_full = it;
+    if (w->AL) w->nl = nnls_shortlist(M, k, A, w->inv, w->pas, it, g, w->AL, w->lidx);
+    return 2.0 * (M + 2) * DBL_EPSILON * rn;
+  }
+  fcm__gemv('T', M, w->nl, 1.0, w->AL, M, w->r, 0.0, w->gl);
+  s->flops += 2.0 * M * w->nl + 2.0 * w->nl;
+  memset(g, 0, (size_t)k * sizeof *g);
+  for (int c = 0; c < w->nl; c++)
+    g[w->lidx[c]] = w->gl[c];
+  return -1.0;
+}
+
+enum { NNLS_ADDED, NNLS_OPTIMAL, NNLS_INFEASIBLE };
+
+/* Iteration it's entering column: price (the shortlist when it is current), stop on a
+ * certificate (reach) or at optimality, else add the steepest column that can enter (re-priced
+ * in full and in double before optimality is declared). */
+static int nnls_enter(nnls_qr *s, nnls_work *w, const double *A, const double *b, double reach,
+                      int it, double rn)
+{
+  const int k = s->kcols;
+  int full = !w->AL || w->nl <= 0 || it - w->last_full >= NNLS_REFRESH, single = w->Af != NULL;
+  for (;;) {
+    const double gerr = nnls_price(s, w, A, it, full, &single, rn);
+    if (gerr >= 0.0 && w->inv0 &&
+        nnls_farkas(s->M, k, b, w->r, w->g, w->norm, w->inv0, gerr, reach))
+      return NNLS_INFEASIBLE; /* out of reach: the way on to optimality cannot change that */
+    for (;;) {                /* the steepest column that can enter */
+      int t = -1;
+      double best = NNLS_GRAD_TOL * rn; /* the cosine of a_j and r, times ||r|| */
+      for (int j = 0; j < k; j++) {
+        const double c = w->g[j] * w->inv[j];
+        if (c > best && w->seen[j] != it && w->pas[j] != it) best = c, t = j;
+      }
+      if (t < 0 && (!full || single)) { /* none on the shortlist or priced in single */
+        full = 1, single = 0;
+        break;
+      }
+      if (t < 0) return NNLS_OPTIMAL; /* no column lowers the residual */
+      w->seen[t] = it;
+      int added;
+      nnls_add(s, t, A + (size_t)t * (size_t)s->M, w->norm[t], &added);
+      if (added) return NNLS_ADDED;
+    }
+  }
+}
+
 fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const double *b,
                               double stop, double reach, double *x, fcm__nnls_report *rep)
 {
   fcm_status st = FCM_OK;
   nnls_qr s;
+  nnls_work w;
   memset(&s, 0, sizeof s);
-  s.M = M, s.kcols = k;
-  double *r = NULL, *g = NULL, *norm = NULL, *inv = NULL, *xp = NULL, *z = NULL, *inv0 = NULL;
-  int *seen = NULL, *pas = NULL, *order = NULL, *lidx = NULL, exact = 0, nl = -1, last_full = 0;
-  double *AL = NULL, *gl = NULL;            /* the shortlist's columns and gradients */
-  float *Af = NULL, *rf = NULL, *gf = NULL; /* A, r and A^T r in single precision */
+  memset(&w, 0, sizeof w);
   memset(rep, 0, sizeof *rep);
   rep->residual = INFINITY;
-  FCM_ALLOC(ctx, (size_t)M * (size_t)M, s.Q);
-  FCM_ALLOC(ctx, (size_t)M * (size_t)M, s.R);
-  FCM_ALLOC(ctx, (size_t)M, s.qtb);
-  FCM_ALLOC(ctx, 2 * (size_t)M, s.v);
-  FCM_ALLOC_RAW(ctx, (size_t)M * NNLS_BATCH, s.V);
-  FCM_ALLOC_RAW(ctx, 2 * (size_t)M * NNLS_BATCH, s.W);
-  FCM_ALLOC_RAW(ctx, (size_t)NNLS_BATCH * NNLS_BATCH, s.T);
-  FCM_ALLOC(ctx, (size_t)M, s.pos);
-  FCM_ALLOC(ctx, (size_t)M, r);
-  FCM_ALLOC(ctx, (size_t)k, g);
-  FCM_ALLOC(ctx, (size_t)k, norm);
-  FCM_ALLOC(ctx, (size_t)k, inv);
-  FCM_ALLOC(ctx, (size_t)M, xp);
-  FCM_ALLOC(ctx, (size_t)M, z);
-  FCM_ALLOC(ctx, (size_t)k, seen);
-  FCM_ALLOC(ctx, (size_t)k, pas);
-  FCM_ALLOC(ctx, (size_t)k, order);
-  if ((double)M * k * sizeof *A > NNLS_SHORTLIST_BYTES) {
-    FCM_ALLOC(ctx, (size_t)k, lidx);
-    FCM_ALLOC(ctx, (size_t)k, gl);
-    FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)k, AL);
-  }
-  if (k > M) {
-    FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)k, Af);
-    FCM_ALLOC_RAW(ctx, (size_t)M, rf);
-    FCM_ALLOC_RAW(ctx, (size_t)k, gf);
-    for (size_t e = 0; e < (size_t)M * (size_t)k; e++)
-      Af[e] = (float)A[e];
-  }
-  for (int i = 0; i < M; i++)
-    s.Q[i + (size_t)i * (size_t)M] = 1.0;
-  memcpy(s.qtb, b, (size_t)M * sizeof *b);
-  for (int j = 0; j < k; j++) {
-    double t = 0.0;
-    for (int i = 0; i < M; i++)
-      t += A[i + (size_t)j * (size_t)M] * A[i + (size_t)j * (size_t)M];
-    norm[j] = sqrt(t);
-    inv[j] = norm[j] > 0.0 ? 1.0 / norm[j] : 0.0;
-    seen[j] = pas[j] = -1; /* the iteration that tried j last, that found it passive */
-  }
-  if (reach > 0.0) { /* the infeasibility certificate needs row 0 positive (nnls_farkas()) */
-    FCM_ALLOC(ctx, (size_t)k, inv0);
-    for (int j = 0; j < k && inv0; j++)
-      if (A[(size_t)j * (size_t)M] > 0.0) {
-        inv0[j] = 1.0 / A[(size_t)j * (size_t)M];
-      } else {
-        fcm__free(ctx, inv0);
-        inv0 = NULL;
-      }
-  }
+  FCM_TRY(ctx, nnls_start(ctx, M, k, A, b, reach, &s, &w));
+  int exact = 0;
   for (int it = 0; it < 3 * k + M; it++) {
     const int np0 = s.np;
     /* r = b - A x: xp being the passive set's least-squares solution, r = Q_2 Q_2^T b with
      * Q_2 = Q's last M - np columns (cheaper near the end); confirmed from A and x when small */
-    double rn, rmax = nnls_residual(&s, A, b, xp, exact, r, &rn);
-    if (rmax <= stop && !exact) exact = 1, rmax = nnls_residual(&s, A, b, xp, exact, r, &rn);
+    double rn, rmax = nnls_residual(&s, A, b, w.xp, exact, w.r, &rn);
+    if (rmax <= stop && !exact) exact = 1, rmax = nnls_residual(&s, A, b, w.xp, exact, w.r, &rn);
     rep->residual = rmax, rep->iterations = it;
     if (rmax <= stop) {
       rep->ok = 1;
       break;
     }
     for (int q = 0; q < s.np; q++)
-      pas[s.pos[q]] = it;
-    int full = !AL || nl <= 0 || it - last_full >= NNLS_REFRESH, single = Af != NULL;
-    double gerr = -1.0; /* a full gradient's error per unit ||a_j||, once computed */
-  price:
-    if (full && single) {
-      for (int i = 0; i < M; i++)
-        rf[i] = (float)r[i];
-      fcm__sgemv('T', M, k, 1.0f, Af, M, rf, 0.0f, gf);
-      double top = 0.0;
-      for (int j = 0; j < k; j++) {
-        g[j] = (double)gf[j];
-        if (pas[j] != it) top = max2(top, g[j] * inv[j]);
-      }
-      s.flops += 2.0 * M * k + 2.0 * k;
-      if (!(top > NNLS_SINGLE_TRUST * rn)) { /* near optimality: price in double */
-        single = 0;
-        goto price;
-      }
-      gerr = 2.0 * (M + 2) * FLT_EPSILON * rn;
-      last_full = it;
-      if (AL) nl = nnls_shortlist(M, k, A, inv, pas, it, g, AL, lidx);
-    } else if (full) {
-      fcm__gemv('T', M, k, 1.0, A, M, r, 0.0, g);
-      s.flops += 2.0 * M * k + 2.0 * k;
-      gerr = 2.0 * (M + 2) * DBL_EPSILON * rn;
-      last_full = it;
-      if (AL) nl = nnls_shortlist(M, k, A, inv, pas, it, g, AL, lidx);
-    } else { /* the shortlist's gradients, 0 for the other columns */
-      fcm__gemv('T', M, nl, 1.0, AL, M, r, 0.0, gl);
-      s.flops += 2.0 * M * nl + 2.0 * nl;
-      memset(g, 0, (size_t)k * sizeof *g);
-      for (int c = 0; c < nl; c++)
-        g[lidx[c]] = gl[c];
-    }
-    if (gerr >= 0.0 && inv0 && nnls_farkas(M, k, b, r, g, norm, inv0, gerr, reach)) {
-      rep->infeasible = 1; /* out of reach: the way on to optimality cannot change that */
-      break;
-    }
-    int added = 0;
-    while (!added) { /* the steepest column that can enter */
-      int t = -1;
-      double best = NNLS_GRAD_TOL * rn; /* the cosine of a_j and r, times ||r|| */
-      for (int j = 0; j < k; j++) {
-        const double c = g[j] * inv[j];
-        if (c > best && seen[j] != it && pas[j] != it) best = c, t = j;
-      }
-      if (t < 0 && (!full || single)) { /* none on the shortlist or priced in single */
-        full = 1, single = 0;
-        goto price;
-      }
-      if (t < 0) { /* optimal: no column lowers the residual */
-        rep->optimal = 1;
-        goto done;
-      }
-      seen[t] = it;
-      nnls_add(&s, t, A + (size_t)t * (size_t)M, norm[t], &added);
-    }
-    nnls_more(&s, A, norm, inv, g, it, seen, pas, order);
+      w.pas[s.pos[q]] = it;
+    const int how = nnls_enter(&s, &w, A, b, reach, it, rn);
+    if (how == NNLS_INFEASIBLE) rep->infeasible = 1;
+    if (how == NNLS_OPTIMAL) rep->optimal = 1;
+    if (how != NNLS_ADDED) break;
+    nnls_more(&s, A, w.norm, w.inv, w.g, it, w.seen, w.pas, w.order);
     nnls_flush(&s);
     for (int q = np0; q < s.np; q++)
-      xp[q] = 0.0;
-    nnls_keep_positive(&s, np0, z);
-    nnls_inner(&s, xp, z);
+      w.xp[q] = 0.0;
+    nnls_keep_positive(&s, np0, w.z);
+    nnls_inner(&s, w.xp, w.z);
   }
-done:
   rep->passive = s.np;
   rep->flops = s.flops + 2.0 * M * k; /* and the column norms */
   memset(x, 0, (size_t)k * sizeof *x);
   for (int q = 0; q < s.np; q++)
-    x[s.pos[q]] = xp[q];
+    x[s.pos[q]] = w.xp[q];
 cleanup:
-  fcm__free(ctx, s.Q);
-  fcm__free(ctx, s.R);
-  fcm__free(ctx, s.qtb);
-  fcm__free(ctx, s.v);
-  fcm__free(ctx, s.V);
-  fcm__free(ctx, s.W);
-  fcm__free(ctx, s.T);
-  fcm__free(ctx, s.pos);
-  fcm__free(ctx, r);
-  fcm__free(ctx, g);
-  fcm__free(ctx, norm);
-  fcm__free(ctx, inv);
-  fcm__free(ctx, inv0);
-  fcm__free(ctx, xp);
-  fcm__free(ctx, z);
-  fcm__free(ctx, seen);
-  fcm__free(ctx, pas);
-  fcm__free(ctx, order);
-  fcm__free(ctx, lidx);
-  fcm__free(ctx, gl);
-  fcm__free(ctx, AL);
-  fcm__free(ctx, Af);
-  fcm__free(ctx, rf);
-  fcm__free(ctx, gf);
+  nnls_end(ctx, &s, &w);
   return st;
 }
 
