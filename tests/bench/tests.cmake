@@ -25,6 +25,9 @@ endforeach()
 fcm_add_test(bench_roofline tests/bench/bench_roofline.c LABELS bench TIMEOUT 1800
              ARGS ${PROJECT_BINARY_DIR}/bench_roofline.csv)
 set_tests_properties(bench_roofline PROPERTIES RUN_SERIAL TRUE)
+target_sources(bench_roofline PRIVATE ${PROJECT_SOURCE_DIR}/tests/bench/roofline_peaks.c
+                                      ${PROJECT_SOURCE_DIR}/tests/bench/roofline_kernels.c
+                                      ${PROJECT_SOURCE_DIR}/tests/bench/roofline_simplify.c)
 # The space and integrator part of a cut, with and without what the cut keeps (cut_reuse), on a
 # Hex8 grid around a ball of about 5k and 20k active cells (figures in lib/docs/cutting.md).
 fcm_add_test(bench_cut_update tests/bench/bench_cut_update.c LABELS bench TIMEOUT 1800)
