@@ -543,10 +543,13 @@ static double nnls_price(nnls_qr *s, nnls_work *w, const double *A, int it, int 
     for (int i = 0; i < M; i++)
       w->rf[i] = (float)w->r[i];
     fcm__sgemv('T', M, k, 1.0f, w->Af, M, w->rf, 0.0f, w->gf);
+    const float *gf = w->gf;
+    const double *inv = w->inv;
+    const int *pas = w->pas;
     double top = 0.0;
     for (int j = 0; j < k; j++) {
-      g[j] = (double)w->gf[j];
-      if (w->pas[j] != it) top = max2(top, g[j] * w->inv[j]);
+      g[j] = (double)gf[j];
+      if (pas[j] != it) top = max2(top, g[j] * inv[j]);
     }
     s->flops += 2.0 * M * k + 2.0 * k;
     if (top > NNLS_SINGLE_TRUST * rn) {
@@ -566,8 +569,10 @@ static double nnls_price(nnls_qr *s, nnls_work *w, const double *A, int it, int 
   fcm__gemv('T', M, w->nl, 1.0, w->AL, M, w->r, 0.0, w->gl);
   s->flops += 2.0 * M * w->nl + 2.0 * w->nl;
   memset(g, 0, (size_t)k * sizeof *g);
+  const int *lidx = w->lidx;
+  const double *gl = w->gl;
   for (int c = 0; c < w->nl; c++)
-    g[w->lidx[c]] = w->gl[c];
+    g[lidx[c]] = gl[c];
   return -1.0;
 }
 
@@ -586,12 +591,14 @@ static int nnls_enter(nnls_qr *s, nnls_work *w, const double *A, const double *b
     if (gerr >= 0.0 && w->inv0 &&
         nnls_farkas(s->M, k, b, w->r, w->g, w->norm, w->inv0, gerr, reach))
       return NNLS_INFEASIBLE; /* out of reach: the way on to optimality cannot change that */
-    for (;;) {                /* the steepest column that can enter */
+    const double *g = w->g, *inv = w->inv;
+    const int *seen = w->seen, *pas = w->pas;
+    for (;;) { /* the steepest column that can enter */
       int t = -1;
       double best = NNLS_GRAD_TOL * rn; /* the cosine of a_j and r, times ||r|| */
       for (int j = 0; j < k; j++) {
-        const double c = w->g[j] * w->inv[j];
-        if (c > best && w->seen[j] != it && w->pas[j] != it) best = c, t = j;
+        const double c = g[j] * inv[j];
+        if (c > best && seen[j] != it && pas[j] != it) best = c, t = j;
       }
       if (t < 0 && (!full || single)) { /* none on the shortlist or priced in single */
         full = 1, single = 0;
