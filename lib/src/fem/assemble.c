@@ -123,7 +123,38 @@ static inline void add3(double *d, double x, double y, double z)
 }
 #endif
 
-static void scatter_matrix(const fcm_space *s, fcm_index le, const double *Kp, double *vals)
+/* Prefetch, for writing, the entries of node a's three rows that the scatter of local element
+ * le adds to. Inlined: as a function of its own GCC finds it without side effects and drops
+ * its calls. */
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((always_inline))
+#endif
+static inline void
+prefetch_rows(const fcm_space *s, fcm_index le, int a, const double *vals)
+{
+#if defined(__GNUC__) || defined(__clang__)
+  const int nn = s->nn;
+  const int *oa = s->elem_off + ((size_t)le * nn + a) * nn;
+  const fcm_index da = fcm__space_elem_row(s, le, a);
+  const double *r0 = vals + s->row_ptr[da], *r1 = vals + s->row_ptr[da + 1];
+  const double *r2 = vals + s->row_ptr[da + 2];
+  for (int b = 0; b < nn; b++) {
+    __builtin_prefetch(r0 + 3 * oa[b], 1, 3);
+    __builtin_prefetch(r1 + 3 * oa[b], 1, 3);
+    __builtin_prefetch(r2 + 3 * oa[b], 1, 3);
+  }
+#else
+  (void)s, (void)le, (void)a, (void)vals;
+#endif
+}
+
+/* With next >= 0, the entries the scatter of local element `next` will add to are prefetched
+ * row by row along the way: on a matrix far beyond the caches they come from memory while
+ * next's kernel runs, where at its own scatter they would stall it (about 15 % of a Hex20
+ * stiffness assembly of 16^3 cells). Prefetching them all at once before the kernel does not
+ * overlap: the misses queue up and stall at once. */
+static void scatter_matrix(const fcm_space *s, fcm_index le, const double *Kp, double *vals,
+                           fcm_index next)
 {
   const int nn = s->nn;
   const int *off = s->elem_off + (size_t)le * nn * nn;
@@ -131,6 +162,7 @@ static void scatter_matrix(const fcm_space *s, fcm_index le, const double *Kp, d
     const fcm_index da = fcm__space_elem_row(s, le, a);
     double *r0 = vals + s->row_ptr[da], *r1 = vals + s->row_ptr[da + 1];
     double *r2 = vals + s->row_ptr[da + 2];
+    if (next >= 0) prefetch_rows(s, next, a, vals);
     const int *oa = off + a * nn;
     /* b < a: the transpose of block (b, a), at 9 (b nn - b (b - 1) / 2 + a - b) */
     const double *k = Kp + 9 * a;
@@ -353,9 +385,10 @@ static cell_result volume_cell(const fcm_space *s, const pass *ps, fcm_index e, 
 }
 
 /* Local element le of the pass into the pass's outputs; 0 (with res) when its det J is not
- * positive somewhere or the material returned NaN or infinity: nothing is scattered then. */
-static int pass_element(const fcm_space *s, const pass *ps, fcm_index le, scratch *w,
-                        cell_result *res)
+ * positive somewhere or the material returned NaN or infinity: nothing is scattered then.
+ * next: the element the thread takes after le (its matrix entries are prefetched), or -1. */
+static int pass_element(const fcm_space *s, const pass *ps, fcm_index le, fcm_index next,
+                        scratch *w, cell_result *res)
 {
   const fcm_index c = fcm__space_local_elem(s, le);
   /* another process's element (a distributed run's ghost): no points, nothing to add */
@@ -381,7 +414,7 @@ static int pass_element(const fcm_space *s, const pass *ps, fcm_index le, scratc
     if (ps->cell_inverted) ps->cell_inverted[c] = res->inverted;
   }
   if (ps->keep_out && same < 0) block_pack(s->nn, ps, w, ps->keep_out + (size_t)c * ps->bs);
-  if (ps->vals) scatter_matrix(s, le, w->Ke, ps->vals);
+  if (ps->vals) scatter_matrix(s, le, w->Ke, ps->vals, next);
   if (ps->vec) scatter_vector(s, c, w->fe, ps->vec);
   return 1;
 }
@@ -412,8 +445,9 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
         const fcm_index last = FCM_MIN(ne, first + FCM__SPACE_BLOCK);
         for (fcm_index j = first; j < last; j++) {
           const fcm_index le = s->block_elems[j];
+          const fcm_index next = j + 1 < last ? s->block_elems[j + 1] : -1;
           cell_result res;
-          if (pass_element(s, ps, le, w, &res)) continue;
+          if (pass_element(s, ps, le, next, w, &res)) continue;
           const fcm_index c = fcm__space_local_elem(s, le);
 #pragma omp critical(fcm_assemble_bad)
           if (bad_cell < 0 || c < bad_cell) {
