@@ -123,14 +123,15 @@ static inline void add3(double *d, double x, double y, double z)
 }
 #endif
 
-/* Prefetch, for writing, the entries of node a's three rows that the scatter of local element
- * le adds to. Inlined: as a function of its own GCC finds it without side effects and drops
- * its calls. */
+/* Prefetch, for writing and into L2, the entries of node a's three rows that the scatter of
+ * local element le adds to. Always inlined: as a function of its own GCC finds it free of side
+ * effects and drops its calls. */
 #if defined(__GNUC__) || defined(__clang__)
-__attribute__((always_inline))
+#define PREFETCH_INLINE static inline __attribute__((always_inline))
+#else
+#define PREFETCH_INLINE static inline
 #endif
-static inline void
-prefetch_rows(const fcm_space *s, fcm_index le, int a, const double *vals)
+PREFETCH_INLINE void prefetch_rows(const fcm_space *s, fcm_index le, int a, const double *vals)
 {
 #if defined(__GNUC__) || defined(__clang__)
   const int nn = s->nn;
@@ -139,20 +140,24 @@ prefetch_rows(const fcm_space *s, fcm_index le, int a, const double *vals)
   const double *r0 = vals + s->row_ptr[da], *r1 = vals + s->row_ptr[da + 1];
   const double *r2 = vals + s->row_ptr[da + 2];
   for (int b = 0; b < nn; b++) {
-    __builtin_prefetch(r0 + 3 * oa[b], 1, 3);
-    __builtin_prefetch(r1 + 3 * oa[b], 1, 3);
-    __builtin_prefetch(r2 + 3 * oa[b], 1, 3);
+    __builtin_prefetch(r0 + 3 * oa[b], 1, 2);
+    __builtin_prefetch(r1 + 3 * oa[b], 1, 2);
+    __builtin_prefetch(r2 + 3 * oa[b], 1, 2);
   }
 #else
   (void)s, (void)le, (void)a, (void)vals;
 #endif
 }
 
+/* Matrices with at least this many bytes of values (beyond a core's L2 cache) have the entries
+ * of an element's scatter prefetched SCATTER_AHEAD elements before (scatter_matrix()). */
+#define SCATTER_PREFETCH_BYTES (4.0 * 1024 * 1024)
+#define SCATTER_AHEAD          2
+
 /* With next >= 0, the entries the scatter of local element `next` will add to are prefetched
- * row by row along the way: on a matrix far beyond the caches they come from memory while
- * next's kernel runs, where at its own scatter they would stall it (about 15 % of a Hex20
- * stiffness assembly of 16^3 cells). Prefetching them all at once before the kernel does not
- * overlap: the misses queue up and stall at once. */
+ * into L2 row by row along the way: on a matrix far beyond the caches they come from memory
+ * while the elements in between are computed, where at next's own scatter they would stall it
+ * (a fifth of a Hex20 stiffness assembly of 16^3 cells: lib/docs/performance.md). */
 static void scatter_matrix(const fcm_space *s, fcm_index le, const double *Kp, double *vals,
                            fcm_index next)
 {
@@ -386,7 +391,7 @@ static cell_result volume_cell(const fcm_space *s, const pass *ps, fcm_index e, 
 
 /* Local element le of the pass into the pass's outputs; 0 (with res) when its det J is not
  * positive somewhere or the material returned NaN or infinity: nothing is scattered then.
- * next: the element the thread takes after le (its matrix entries are prefetched), or -1. */
+ * next: an element the thread takes after le (its matrix entries are prefetched), or -1. */
 static int pass_element(const fcm_space *s, const pass *ps, fcm_index le, fcm_index next,
                         scratch *w, cell_result *res)
 {
@@ -434,6 +439,8 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
   double bad_det = 1.0;
   int bad_numeric = 0;
   const fcm_index ne = s->num_local_elems;
+  const double bytes = (double)s->row_ptr[fcm__space_num_rows(s)] * sizeof(double);
+  const int ahead = ps->vals && bytes >= SCATTER_PREFETCH_BYTES ? SCATTER_AHEAD : 0;
   for (int color = 0; color < s->num_block_colors; color++) {
     const fcm_index b0 = s->block_color_ptr[color], b1 = s->block_color_ptr[color + 1];
 #pragma omp parallel num_threads(ws->nthreads)
@@ -445,7 +452,7 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
         const fcm_index last = FCM_MIN(ne, first + FCM__SPACE_BLOCK);
         for (fcm_index j = first; j < last; j++) {
           const fcm_index le = s->block_elems[j];
-          const fcm_index next = j + 1 < last ? s->block_elems[j + 1] : -1;
+          const fcm_index next = ahead && j + ahead < last ? s->block_elems[j + ahead] : -1;
           cell_result res;
           if (pass_element(s, ps, le, next, w, &res)) continue;
           const fcm_index c = fcm__space_local_elem(s, le);
