@@ -154,6 +154,15 @@ PREFETCH_INLINE void prefetch_rows(const fcm_space *s, fcm_index le, int a, cons
 #define SCATTER_PREFETCH_BYTES (4.0 * 1024 * 1024)
 #define SCATTER_AHEAD          2
 
+/* How many elements ahead the scatter into vals (NULL: none) prefetches: 0 below
+ * SCATTER_PREFETCH_BYTES. */
+static int scatter_ahead(const fcm_space *s, const double *vals)
+{
+  if (!vals) return 0;
+  const double bytes = (double)s->row_ptr[fcm__space_num_rows(s)] * sizeof(double);
+  return bytes >= SCATTER_PREFETCH_BYTES ? SCATTER_AHEAD : 0;
+}
+
 /* With next >= 0, the entries the scatter of local element `next` will add to are prefetched
  * into L2 row by row along the way: on a matrix far beyond the caches they come from memory
  * while the elements in between are computed, where at next's own scatter they would stall it
@@ -439,8 +448,7 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
   double bad_det = 1.0;
   int bad_numeric = 0;
   const fcm_index ne = s->num_local_elems;
-  const double bytes = (double)s->row_ptr[fcm__space_num_rows(s)] * sizeof(double);
-  const int ahead = ps->vals && bytes >= SCATTER_PREFETCH_BYTES ? SCATTER_AHEAD : 0;
+  const int ahead = scatter_ahead(s, ps->vals);
   for (int color = 0; color < s->num_block_colors; color++) {
     const fcm_index b0 = s->block_color_ptr[color], b1 = s->block_color_ptr[color + 1];
 #pragma omp parallel num_threads(ws->nthreads)
