@@ -62,8 +62,11 @@ typedef enum sim_contact_kind {
   SIM_CONTACT_PLANE = 0, /* the half-space n . (x - p0 - v t) <= 0 (n unit) */
   SIM_CONTACT_SPHERE,    /* the ball |X - c| <= r in the obstacle's frame */
   SIM_CONTACT_BOX,       /* the box lo <= X <= hi in the obstacle's frame */
-  SIM_CONTACT_SURFACE    /* the volume a closed triangle surface encloses, in its frame */
+  SIM_CONTACT_SURFACE,   /* the volume a closed triangle surface encloses, in its frame */
+  SIM_CONTACT_BODIES     /* the other bodies and cut pieces of the space (contact_bodies.c) */
 } sim_contact_kind;
+
+struct sim_bodies;
 
 /* A contact obstacle. Spheres, boxes and surfaces are given in their own frame, placed at
  * time t by the rigid motion x = o(t) + R(t) X that `motion` prescribes (fcm_motion_eval()). */
@@ -80,6 +83,8 @@ typedef struct sim_contact {
   fcm_aabb_tree *tree;                     /* surface: over the triangles */
   fcm_contact_options opts;                /* as given (0: default) */
   double dhat, kappa;                      /* the barrier's threshold and stiffness (setup) */
+  const fcm_geometry *geom;                /* bodies: the geometry the space was built on */
+  struct sim_bodies *bodies;               /* bodies: the surface and its pairs (setup) */
 } sim_contact;
 
 /* An obstacle's placement at one time: world x = o + R X (R row-major). */
@@ -421,6 +426,48 @@ fcm_status fcm__sim_contact_inside(fcm_ctx *ctx, const sim_contact *c, const sim
 fcm_status fcm__sim_contact_surface_setup(fcm_ctx *ctx, int k, sim_contact *c);
 /* A search radius about y that holds the surface's closest triangle. */
 double fcm__sim_contact_reach(const sim_contact *c, const sim_pose *P, const double y[3]);
+/* A bounding-volume hierarchy with one subtree per group (contact_bvh.c). build: over the
+ * items k < n with group[k] >= 0 and their boxes (n x 6: lo, hi); refit: the same tree over
+ * moved boxes; query: append to buf (not reset) the items of group g whose box meets
+ * [lo, hi]. */
+typedef struct sim_bvh_node {
+  double lo[3], hi[3];
+  fcm_index first, count, right; /* a leaf: perm[first, first + count); else the right child */
+} sim_bvh_node;
+typedef struct sim_bvh {
+  sim_bvh_node *node;
+  fcm_index nnodes, cap;
+  fcm_index *perm, *root, num_groups;
+} sim_bvh;
+fcm_status fcm__sim_bvh_build(fcm_ctx *ctx, sim_bvh *T, fcm_index n, const fcm_index *group,
+                              fcm_index num_groups, const double *boxes);
+void fcm__sim_bvh_refit(sim_bvh *T, const double *boxes);
+fcm_status fcm__sim_bvh_query(fcm_ctx *ctx, const sim_bvh *T, fcm_index g, const double *boxes,
+                              const double lo[3], const double hi[3], fcm__idbuf *buf);
+void fcm__sim_bvh_free(fcm_ctx *ctx, sim_bvh *T);
+
+/* Contact between bodies and cut pieces (contact_bodies.c), the obstacle kind
+ * SIM_CONTACT_BODIES: setup builds the embedded surface of the space (c->bodies); free releases
+ * it. prepare: at a substep's start (state un), the sample points that started within d^ of
+ * another piece become blind to it until they are d^ away (cut faces start in contact).
+ * assemble / step_bound as the obstacles' (the tangent a block-diagonal bound of the pairs'
+ * Hessians, the step bound conservative). stats: pairs within d^, the smallest distance, the
+ * barrier energy at x. */
+fcm_status fcm__sim_bodies_setup(fcm_integrator *I, sim_contact *c);
+void fcm__sim_bodies_free(fcm_ctx *ctx, sim_contact *c);
+fcm_status fcm__sim_bodies_prepare(fcm_integrator *I, sim_contact *c, const double *x);
+void fcm__sim_bodies_assemble(fcm_integrator *I, sim_contact *c, const double *x,
+                              double *energy, double *force, fcm_csr *T, int *finite);
+double fcm__sim_bodies_step_bound(fcm_integrator *I, sim_contact *c, const double *x,
+                                  const double *dx);
+fcm_status fcm__sim_bodies_stats(const fcm_integrator *I, const sim_contact *c, const double *x,
+                                 long long *pairs, double *min_distance, double *energy);
+/* The largest depth of a sample inside another body at x (a ray's parity, then the distance
+ * to that body's nearest triangle; 0: none) and where (may be NULL). */
+fcm_status fcm__sim_bodies_depth(const fcm_integrator *I, const sim_contact *c, const double *x,
+                                 double *depth, double where[3]);
+/* The search trees built so far (each evaluation, step bound and stats builds one). */
+long long fcm__sim_bodies_builds(const sim_contact *c);
 int fcm__sim_point_triangle(const double p[3], const double a[3], const double b[3],
                             const double c[3], double q[3], double e[3]);
 void fcm__sim_point_triangle_distance(const double p[3], const double a[3], const double b[3],
