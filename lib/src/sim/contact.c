@@ -320,9 +320,14 @@ static fcm_status collect(fcm_integrator *I, int pass, fcm_index *np_out, fcm_in
     double X[3 * FCM_ELEMENT_MAX_NODES], N[FCM_ELEMENT_MAX_NODES];
     FCM_TRY(I->ctx, fcm_cell_rules_get_piece_surface(s->rules, s->elem_piece[e], &nsp, &pts, &wts,
                                                      &nrm, NULL));
-    if (nsp == 0) continue;
+    const fcm_index nextra = fcm__sim_bodies_element_nodes(I, e, NULL, NULL, NULL);
+    if (nsp == 0 && nextra == 0) continue;
     fcm_mesh_cell_coords(s->mesh, s->elem_cell[e], X);
     const fcm_index first = np;
+    /* contact between bodies: its surface's nodes in e too (the cut faces have no rule) */
+    if (pass == 1)
+      fcm__sim_bodies_element_nodes(I, e, cp->w + np, cp->X + 3 * np, cp->N + (size_t)np * nn);
+    np += nextra;
     for (int q = 0; q < nsp; q++) {
       if (!(wts[q] > 0.0)) continue;
       if (pass == 1) {
@@ -412,6 +417,9 @@ fcm_status fcm__sim_contact_setup(fcm_integrator *I)
   fcm_index np = 0, ne = 0;
   if (I->num_contacts == 0) return FCM_OK;
   const char *kn = kind_name(I->contacts[0].kind);
+  for (int c = 0; c < I->num_contacts; c++) /* the surface first: its nodes join the points */
+    if (I->contacts[c].kind == SIM_CONTACT_BODIES)
+      FCM_TRY(ctx, fcm__sim_bodies_setup(I, &I->contacts[c]));
   FCM_CHECK(!fcm__integrator_distributed(I, NULL), ctx, FCM_ERR_UNSUPPORTED,
             "contact %s 0: contact is not supported with a distributed backend", kn);
   FCM_CHECK(s->rules && fcm_cell_rules_surface_strength(s->rules) >= 0, ctx, FCM_ERR_ARG,
@@ -445,7 +453,6 @@ fcm_status fcm__sim_contact_setup(fcm_integrator *I)
               "contact %s %d: threshold %g or stiffness %g not positive (set distance and "
               "stiffness, or give the material a Young modulus)",
               kind_name(ct->kind), c, ct->dhat, ct->kappa);
-    if (ct->kind == SIM_CONTACT_BODIES) FCM_TRY(ctx, fcm__sim_bodies_setup(I, ct));
   }
   FCM_TRY(ctx, fcm__sim_contact_check(I, I->u, I->t));
 cleanup:

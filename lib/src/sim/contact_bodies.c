@@ -47,8 +47,20 @@
 #include <float.h>
 #include <math.h>
 #include <string.h>
+#include <stdio.h>
+#include <stdlib.h>
 
 #define SIM_BLIND 8
+/* The direction's refinement: preconditioned CG iterations at most, relative residual. */
+#define SIM_REFINE_MAX 200
+#define SIM_REFINE_RTOL 1e-10
+
+/* A pair within d^ at the Newton matrix's assembly: sample n, triangle t, the distance's
+ * gradient g, the closest point's barycentric coordinates beta, w kappa b''(d). */
+typedef struct sim_pair {
+  fcm_index n, t;
+  double g[3], beta[3], c2;
+} sim_pair;
 
 typedef struct sim_bodies {
   fcm_embedded_surface *es;
@@ -64,8 +76,13 @@ typedef struct sim_bodies {
   double *y, *dy, *boxes; /* nv x 3, nv x 3, nt x 6 */
   double *Ke;             /* (3 nn)^2 */
   fcm_index num_bodies;
+  fcm_index *eptr, *enode; /* num_elems + 1 offsets, nv: the nodes of each element */
+  double *vw;              /* nv: a node's weight against the obstacles */
   sim_bvh bvh;
   int built;
+  sim_pair *pairs; /* the pairs within d^ at the last Newton matrix's assembly */
+  size_t npairs, cap_pairs;
+  double *w1, *w2, *w3, *w4; /* n each: the direction's refinement */
   fcm__idbuf buf;
   long long builds;
 } sim_bodies;
@@ -80,6 +97,9 @@ void fcm__sim_bodies_free(fcm_ctx *ctx, sim_contact *c)
   if (!B) return;
   fcm_embedded_surface_destroy(&B->es);
   fcm__free(ctx, B->velem);
+  fcm__free(ctx, B->eptr);
+  fcm__free(ctx, B->enode);
+  fcm__free(ctx, B->vw);
   fcm__free(ctx, B->vX);
   fcm__free(ctx, B->vN);
   fcm__free(ctx, B->tbody);
@@ -92,6 +112,11 @@ void fcm__sim_bodies_free(fcm_ctx *ctx, sim_contact *c)
   fcm__free(ctx, B->boxes);
   fcm__free(ctx, B->Ke);
   fcm__sim_bvh_free(ctx, &B->bvh);
+  fcm__free(ctx, B->pairs);
+  fcm__free(ctx, B->w1);
+  fcm__free(ctx, B->w2);
+  fcm__free(ctx, B->w3);
+  fcm__free(ctx, B->w4);
   fcm__geom_idbuf_free(ctx, &B->buf);
   fcm__free(ctx, B);
   c->bodies = NULL;
@@ -104,6 +129,54 @@ static double tri_area(const double *a, const double *b, const double *c)
   fcm__vec3_sub(c, a, v);
   fcm__vec3_cross(u, v, n);
   return 0.5 * fcm__vec3_norm(n);
+}
+
+/* The nodes grouped by element (eptr, enode) and their weights against the obstacles (vw):
+ * the area about them of the cut-face triangles, 1e-3 of their area (area) elsewhere. */
+static fcm_status obstacle_nodes(fcm_integrator *I, sim_bodies *B, const double *area)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  const fcm_index ne = I->space->num_elems;
+  FCM_ALLOC(ctx, (size_t)ne + 2, B->eptr);
+  FCM_ALLOC(ctx, (size_t)B->nv + 1, B->enode);
+  FCM_ALLOC(ctx, (size_t)B->nv + 1, B->vw);
+  for (fcm_index t = 0; t < B->nt; t++) {
+    const fcm_index *tv = B->tri + 3 * t;
+    if (B->tbody[t] < 0) continue;
+    const double A = tri_area(B->vX + 3 * tv[0], B->vX + 3 * tv[1], B->vX + 3 * tv[2]);
+    for (int k = 0; k < 3; k++)
+      if (B->es->flag[tv[k]]) B->vw[tv[k]] += A / 3.0;
+  }
+  for (fcm_index v = 0; v < B->nv; v++) {
+    if (!(B->vw[v] > 0.0)) B->vw[v] = 1e-3 * area[v];
+    if (B->vw[v] > 0.0 && B->velem[v] >= 0) B->eptr[B->velem[v] + 2]++;
+  }
+  for (fcm_index e = 0; e < ne; e++)
+    B->eptr[e + 2] += B->eptr[e + 1];
+  for (fcm_index v = 0; v < B->nv; v++)
+    if (B->vw[v] > 0.0 && B->velem[v] >= 0) B->enode[B->eptr[B->velem[v] + 1]++] = v;
+cleanup:
+  return st;
+}
+
+fcm_index fcm__sim_bodies_element_nodes(const fcm_integrator *I, fcm_index e, double *w,
+                                        double *X, double *N)
+{
+  const int nn = I->space->nn;
+  for (int c = 0; c < I->num_contacts; c++) {
+    const sim_bodies *B = I->contacts[c].bodies;
+    if (!B || !B->eptr) continue;
+    const fcm_index n = B->eptr[e + 1] - B->eptr[e];
+    for (fcm_index k = 0; w && k < n; k++) {
+      const fcm_index v = B->enode[B->eptr[e] + k];
+      w[k] = B->vw[v];
+      memcpy(X + 3 * k, B->vX + 3 * v, 3 * sizeof(double));
+      memcpy(N + (size_t)k * nn, B->vN + (size_t)v * nn, sizeof(double) * (size_t)nn);
+    }
+    return n;
+  }
+  return 0;
 }
 
 /* The nodes' elements, shape values and bodies, the triangles' bodies and the samples. */
@@ -147,6 +220,7 @@ static fcm_status build_samples(fcm_integrator *I, sim_bodies *B)
   }
   for (fcm_index v = 0; v < B->nv; v++)
     B->ns += vw[v] > 0.0;
+  FCM_TRY(ctx, obstacle_nodes(I, B, vw));
   FCM_ALLOC(ctx, (size_t)B->ns + 1, B->stri);
   FCM_ALLOC(ctx, 3 * (size_t)B->ns + 1, B->slam);
   FCM_ALLOC(ctx, (size_t)B->ns + 1, B->sw);
@@ -195,6 +269,10 @@ fcm_status fcm__sim_bodies_setup(fcm_integrator *I, sim_contact *c)
   FCM_ALLOC(ctx, 3 * (size_t)B->nv + 1, B->dy);
   FCM_ALLOC(ctx, 6 * (size_t)B->nt + 1, B->boxes);
   FCM_ALLOC(ctx, (size_t)9 * nn * nn, B->Ke);
+  FCM_ALLOC(ctx, (size_t)I->n + 1, B->w1);
+  FCM_ALLOC(ctx, (size_t)I->n + 1, B->w2);
+  FCM_ALLOC(ctx, (size_t)I->n + 1, B->w3);
+  FCM_ALLOC(ctx, (size_t)I->n + 1, B->w4);
 cleanup:
   return st;
 }
@@ -421,6 +499,27 @@ static double barrier(double d, double dh, double *b1, double *b2)
   return -r * r * l;
 }
 
+static fcm_status record(fcm_ctx *ctx, sim_bodies *B, fcm_index n, fcm_index t,
+                         const double g[3], const double beta[3], double c2)
+{
+  fcm_status st = FCM_OK;
+  if (B->npairs == B->cap_pairs) {
+    const size_t cap = B->cap_pairs ? 2 * B->cap_pairs : 256;
+    void *grown = B->pairs;
+    FCM_TRY(ctx, fcm__resize(ctx, &grown, B->cap_pairs, cap, sizeof *B->pairs));
+    B->pairs = grown;
+    B->cap_pairs = cap;
+  }
+  sim_pair *q = B->pairs + B->npairs++;
+  q->n = n;
+  q->t = t;
+  memcpy(q->g, g, sizeof q->g);
+  memcpy(q->beta, beta, sizeof q->beta);
+  q->c2 = c2;
+cleanup:
+  return st;
+}
+
 void fcm__sim_bodies_assemble(fcm_integrator *I, sim_contact *c, const double *x, double *energy,
                               double *force, fcm_csr *T, int *finite)
 {
@@ -436,6 +535,7 @@ void fcm__sim_bodies_assemble(fcm_integrator *I, sim_contact *c, const double *x
     *finite = 0;
     return;
   }
+  if (vals) B->npairs = 0;
   for (fcm_index n = 0; n < B->ns; n++) {
     double p[3], lo[3], hi[3];
     sample_point(B, n, B->y, p);
@@ -460,10 +560,17 @@ void fcm__sim_bodies_assemble(fcm_integrator *I, sim_contact *c, const double *x
       const double wk = B->sw[n] * c->kappa;
       etot += wk * barrier(d, c->dhat, &b1, &b2);
       pair_terms(I, B, n, t, g, beta, wk * b1, wk * b2, force, vals);
+      if (vals && record(I->ctx, B, n, t, g, beta, wk * b2) != FCM_OK) {
+        *finite = 0;
+        return;
+      }
     }
   }
   if (!isfinite(etot)) *finite = 0;
   if (energy) *energy += etot;
+  /* pieces in contact: a factorization kept from another iterate lacks their coupling (and
+   * its refinement the pairs), so Newton factors anew */
+  if (etot > 0.0) I->kept = 0;
 }
 
 double fcm__sim_bodies_step_bound(fcm_integrator *I, sim_contact *c, const double *x,
@@ -633,6 +740,111 @@ fcm_status fcm__sim_bodies_depth(const fcm_integrator *I, const sim_contact *c, 
         if (where) memcpy(where, p, sizeof p);
       }
     }
+  }
+cleanup:
+  return st;
+}
+
+/* out += (C - C_bd) v over the recorded pairs: C = sum c2 G G^T couples the pieces, C_bd the
+ * block-diagonal bound the Newton matrix holds (m sum_e G_e G_e^T); constrained DOFs (mask)
+ * neither take nor give. */
+static void coupling_apply(const fcm_integrator *I, const sim_bodies *B, const double *v,
+                           double *out)
+{
+  const fcm_space *s = I->space;
+  const int nn = s->nn;
+  for (size_t k = 0; k < B->npairs; k++) {
+    const sim_pair *q = B->pairs + k;
+    fcm_index node[6], elem[6];
+    double coef[6], Gv[6], tot = 0.0;
+    int ne = 0, which[6];
+    for (int j = 0; j < 3; j++) {
+      node[j] = B->tri[3 * B->stri[q->n] + j];
+      coef[j] = B->slam[3 * q->n + j];
+      node[3 + j] = B->tri[3 * q->t + j];
+      coef[3 + j] = -q->beta[j];
+    }
+    for (int m = 0; m < 6; m++) {
+      const fcm_index e = B->velem[node[m]];
+      int w = -1;
+      which[m] = -1;
+      if (coef[m] == 0.0) continue; /* as pair_terms: its element is not counted */
+      for (int j = 0; j < ne; j++)
+        if (elem[j] == e) w = j;
+      if (w < 0) {
+        w = ne;
+        elem[ne] = e;
+        Gv[ne++] = 0.0;
+      }
+      which[m] = w;
+      const fcm_index *ed = s->elem_dof + e * nn;
+      const double *N = B->vN + (size_t)node[m] * nn;
+      for (int a = 0; a < nn; a++)
+        for (int i = 0; i < 3; i++)
+          if (!I->is_con[ed[a] + i]) Gv[w] += coef[m] * N[a] * q->g[i] * v[ed[a] + i];
+    }
+    for (int j = 0; j < ne; j++)
+      tot += Gv[j];
+    for (int m = 0; m < 6; m++) {
+      if (which[m] < 0) continue;
+      const fcm_index *ed = s->elem_dof + B->velem[node[m]] * nn;
+      const double *N = B->vN + (size_t)node[m] * nn;
+      const double c = q->c2 * coef[m] * (tot - ne * Gv[which[m]]);
+      for (int a = 0; a < nn; a++)
+        for (int i = 0; i < 3; i++)
+          if (!I->is_con[ed[a] + i]) out[ed[a] + i] += c * N[a] * q->g[i];
+    }
+  }
+}
+
+static double dotv(fcm_index n, const double *a, const double *b)
+{
+  double s = 0.0;
+  for (fcm_index i = 0; i < n; i++)
+    s += a[i] * b[i];
+  return s;
+}
+
+fcm_status fcm__sim_bodies_refine(fcm_integrator *I, const double *b, double *d,
+                                  fcm_step_reason *reason, int *its, sim_stats *stats)
+{
+  fcm_status st = FCM_OK;
+  sim_bodies *B = NULL;
+  const fcm_index n = I->n;
+  for (int c = 0; c < I->num_contacts; c++)
+    if (I->contacts[c].bodies) B = I->contacts[c].bodies;
+  if (!B || B->npairs == 0 || I->hP || !I->H) return FCM_OK;
+  double *r = B->w1, *z = B->w2, *p = B->w3, *q = B->w4;
+  const double bn = sqrt(dotv(n, b, b));
+  /* r = b - A d, A = H + C - C_bd */
+  FCM_TRY(I->ctx, fcm_csr_apply(I->H, -1.0, d, 0.0, r));
+  memset(q, 0, sizeof(double) * (size_t)n);
+  coupling_apply(I, B, d, q);
+  for (fcm_index i = 0; i < n; i++)
+    r[i] += b[i] - q[i];
+  FCM_TRY(I->ctx, fcm__sim_solve(I, r, z, reason, its, stats));
+  if (*reason != FCM_STEP_NONE) return FCM_OK;
+  memcpy(p, z, sizeof(double) * (size_t)n);
+  double rz = dotv(n, r, z);
+  if (getenv("FCM_DBG")) fprintf(stderr, "refine npairs %zu r %g b %g\n", B->npairs, sqrt(dotv(n, r, r)), bn);
+  for (int k = 0; k < SIM_REFINE_MAX && sqrt(dotv(n, r, r)) > SIM_REFINE_RTOL * bn; k++) {
+    int its1 = 0;
+    FCM_TRY(I->ctx, fcm_csr_apply(I->H, 1.0, p, 0.0, q));
+    coupling_apply(I, B, p, q);
+    const double pq = dotv(n, p, q);
+    if (!(pq > 0.0)) break;
+    const double alpha = rz / pq;
+    for (fcm_index i = 0; i < n; i++) {
+      d[i] += alpha * p[i];
+      r[i] -= alpha * q[i];
+    }
+    FCM_TRY(I->ctx, fcm__sim_solve(I, r, z, reason, &its1, stats));
+    *its += its1 + 1;
+    if (*reason != FCM_STEP_NONE) return FCM_OK;
+    const double rz1 = dotv(n, r, z);
+    for (fcm_index i = 0; i < n; i++)
+      p[i] = z[i] + rz1 / rz * p[i];
+    rz = rz1;
   }
 cleanup:
   return st;

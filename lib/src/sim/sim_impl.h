@@ -466,6 +466,18 @@ fcm_status fcm__sim_bodies_stats(const fcm_integrator *I, const sim_contact *c, 
  * to that body's nearest triangle; 0: none) and where (may be NULL). */
 fcm_status fcm__sim_bodies_depth(const fcm_integrator *I, const sim_contact *c, const double *x,
                                  double *depth, double where[3]);
+/* The surface nodes of the contact between bodies that lie in element e (0 without it): their
+ * count and, where the arrays are given, their obstacle weights (the area of the cut-face
+ * triangles about them; 1e-3 of their area elsewhere, where the surface rules act already),
+ * reference positions and shape values. */
+fcm_index fcm__sim_bodies_element_nodes(const fcm_integrator *I, fcm_index e, double *w,
+                                        double *X, double *N);
+/* Newton's direction d (H d = b solved by the factorization of the Newton matrix H, which
+ * holds a block-diagonal bound of the pairs' coupling) refined by preconditioned conjugate
+ * gradients on the coupled matrix (H + C - C_bd, the recorded pairs), preconditioned by H's
+ * solve; nothing without pairs or on an octree mesh. */
+fcm_status fcm__sim_bodies_refine(fcm_integrator *I, const double *b, double *d,
+                                  fcm_step_reason *reason, int *its, sim_stats *stats);
 /* The search trees built so far (each evaluation, step bound and stats builds one). */
 long long fcm__sim_bodies_builds(const sim_contact *c);
 int fcm__sim_point_triangle(const double p[3], const double a[3], const double b[3],
