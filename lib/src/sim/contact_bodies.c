@@ -47,12 +47,10 @@
 #include <float.h>
 #include <math.h>
 #include <string.h>
-#include <stdio.h>
-#include <stdlib.h>
 
 #define SIM_BLIND 8
 /* The direction's refinement: preconditioned CG iterations at most, relative residual. */
-#define SIM_REFINE_MAX 200
+#define SIM_REFINE_MAX  200
 #define SIM_REFINE_RTOL 1e-10
 
 /* A pair within d^ at the Newton matrix's assembly: sample n, triangle t, the distance's
@@ -65,13 +63,13 @@ typedef struct sim_pair {
 typedef struct sim_bodies {
   fcm_embedded_surface *es;
   fcm_index nv, nt, ns;
-  fcm_index *velem;  /* nv: the element holding node v */
-  double *vX, *vN;   /* nv x 3 reference positions, nv x nn shape values */
+  fcm_index *velem;     /* nv: the element holding node v */
+  double *vX, *vN;      /* nv x 3 reference positions, nv x nn shape values */
   const fcm_index *tri; /* nt x 3 (the surface's) */
-  fcm_index *tbody;  /* nt: the triangle's body, -1 for a triangle without area */
-  fcm_index *stri;   /* ns: the sample's triangle */
-  double *slam, *sw; /* ns x 3 barycentric coordinates, ns weights */
-  fcm_index *blind;  /* ns x SIM_BLIND: bodies the sample ignores (-1: none) */
+  fcm_index *tbody;     /* nt: the triangle's body, -1 for a triangle without area */
+  fcm_index *stri;      /* ns: the sample's triangle */
+  double *slam, *sw;    /* ns x 3 barycentric coordinates, ns weights */
+  fcm_index *blind;     /* ns x SIM_BLIND: bodies the sample ignores (-1: none) */
   int prepared;
   double *y, *dy, *boxes; /* nv x 3, nv x 3, nt x 6 */
   double *Ke;             /* (3 nn)^2 */
@@ -87,9 +85,8 @@ typedef struct sim_bodies {
   long long builds;
 } sim_bodies;
 
-static const double rule3[3][3] = {{2.0 / 3, 1.0 / 6, 1.0 / 6},
-                                   {1.0 / 6, 2.0 / 3, 1.0 / 6},
-                                   {1.0 / 6, 1.0 / 6, 2.0 / 3}};
+static const double rule3[3][3] = {
+    {2.0 / 3, 1.0 / 6, 1.0 / 6}, {1.0 / 6, 2.0 / 3, 1.0 / 6}, {1.0 / 6, 1.0 / 6, 2.0 / 3}};
 
 void fcm__sim_bodies_free(fcm_ctx *ctx, sim_contact *c)
 {
@@ -160,8 +157,8 @@ cleanup:
   return st;
 }
 
-fcm_index fcm__sim_bodies_element_nodes(const fcm_integrator *I, fcm_index e, double *w,
-                                        double *X, double *N)
+fcm_index fcm__sim_bodies_element_nodes(const fcm_integrator *I, fcm_index e, double *w, double *X,
+                                        double *N)
 {
   const int nn = I->space->nn;
   for (int c = 0; c < I->num_contacts; c++) {
@@ -439,8 +436,8 @@ cleanup:
 /* Pair (sample n, triangle t) at distance d with gradient g, closest barycentrics beta: the
  * force c1 G and the Newton matrix bound of c2 G G^T added. */
 static void pair_terms(fcm_integrator *I, sim_bodies *B, fcm_index n, fcm_index t,
-                       const double g[3], const double beta[3], double c1, double c2,
-                       double *force, double *vals)
+                       const double g[3], const double beta[3], double c1, double c2, double *force,
+                       double *vals)
 {
   const fcm_space *s = I->space;
   const int nn = s->nn, nd = 3 * nn;
@@ -499,8 +496,8 @@ static double barrier(double d, double dh, double *b1, double *b2)
   return -r * r * l;
 }
 
-static fcm_status record(fcm_ctx *ctx, sim_bodies *B, fcm_index n, fcm_index t,
-                         const double g[3], const double beta[3], double c2)
+static fcm_status record(fcm_ctx *ctx, sim_bodies *B, fcm_index n, fcm_index t, const double g[3],
+                         const double beta[3], double c2)
 {
   fcm_status st = FCM_OK;
   if (B->npairs == B->cap_pairs) {
@@ -674,8 +671,8 @@ static int crosses(const double o[3], const double r[3], const double *a, const 
 
 /* The depth of p inside body g (0 outside): the parity of a ray's crossings with g's
  * triangles, and inside, the distance to the nearest of them. */
-static fcm_status depth_in(fcm_ctx *ctx, sim_bodies *B, fcm_index g, const double p[3],
-                           double len, double *depth)
+static fcm_status depth_in(fcm_ctx *ctx, sim_bodies *B, fcm_index g, const double p[3], double len,
+                           double *depth)
 {
   fcm_status st = FCM_OK;
   static const double dir[3] = {0.5377304, 0.3180952, 0.7808866};
@@ -826,7 +823,6 @@ fcm_status fcm__sim_bodies_refine(fcm_integrator *I, const double *b, double *d,
   if (*reason != FCM_STEP_NONE) return FCM_OK;
   memcpy(p, z, sizeof(double) * (size_t)n);
   double rz = dotv(n, r, z);
-  if (getenv("FCM_DBG")) fprintf(stderr, "refine npairs %zu r %g b %g\n", B->npairs, sqrt(dotv(n, r, r)), bn);
   for (int k = 0; k < SIM_REFINE_MAX && sqrt(dotv(n, r, r)) > SIM_REFINE_RTOL * bn; k++) {
     int its1 = 0;
     FCM_TRY(I->ctx, fcm_csr_apply(I->H, 1.0, p, 0.0, q));

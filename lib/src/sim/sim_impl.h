@@ -456,8 +456,8 @@ void fcm__sim_bvh_free(fcm_ctx *ctx, sim_bvh *T);
 fcm_status fcm__sim_bodies_setup(fcm_integrator *I, sim_contact *c);
 void fcm__sim_bodies_free(fcm_ctx *ctx, sim_contact *c);
 fcm_status fcm__sim_bodies_prepare(fcm_integrator *I, sim_contact *c, const double *x);
-void fcm__sim_bodies_assemble(fcm_integrator *I, sim_contact *c, const double *x,
-                              double *energy, double *force, fcm_csr *T, int *finite);
+void fcm__sim_bodies_assemble(fcm_integrator *I, sim_contact *c, const double *x, double *energy,
+                              double *force, fcm_csr *T, int *finite);
 double fcm__sim_bodies_step_bound(fcm_integrator *I, sim_contact *c, const double *x,
                                   const double *dx);
 fcm_status fcm__sim_bodies_stats(const fcm_integrator *I, const sim_contact *c, const double *x,
@@ -470,8 +470,8 @@ fcm_status fcm__sim_bodies_depth(const fcm_integrator *I, const sim_contact *c, 
  * count and, where the arrays are given, their obstacle weights (the area of the cut-face
  * triangles about them; 1e-3 of their area elsewhere, where the surface rules act already),
  * reference positions and shape values. */
-fcm_index fcm__sim_bodies_element_nodes(const fcm_integrator *I, fcm_index e, double *w,
-                                        double *X, double *N);
+fcm_index fcm__sim_bodies_element_nodes(const fcm_integrator *I, fcm_index e, double *w, double *X,
+                                        double *N);
 /* Newton's direction d (H d = b solved by the factorization of the Newton matrix H, which
  * holds a block-diagonal bound of the pairs' coupling) refined by preconditioned conjugate
  * gradients on the coupled matrix (H + C - C_bd, the recorded pairs), preconditioned by H's
