@@ -35,6 +35,12 @@ add_test(NAME app_demo_picture COMMAND bash ${PROJECT_SOURCE_DIR}/tests/apps/dem
                                        $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR} ${work})
 set_tests_properties(app_demo_picture PROPERTIES LABELS app TIMEOUT 300 SKIP_RETURN_CODE 77
                      ENVIRONMENT "${FCM_TEST_ENV}")
+# The dice pictures (apps/docs/img/dice_landing.png): their command on 3 steps of
+# apps/scenes/dice_on_floor.json makes a PNG of the stated size (skipped without gnuplot).
+add_test(NAME app_dice_picture COMMAND bash ${PROJECT_SOURCE_DIR}/tests/apps/dice_picture.sh
+                                       $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR} ${work})
+set_tests_properties(app_dice_picture PROPERTIES LABELS app TIMEOUT 300 SKIP_RETURN_CODE 77
+                     ENVIRONMENT "${FCM_TEST_ENV}")
 # The README quick start, `fcm-sim` without arguments: the first 6 steps in the default run
 # (frames, PVD indexes and log rows checked step by step); to the end (71 frames, 210 log
 # rows; its run time: lib/docs/performance.md) labelled slow.
