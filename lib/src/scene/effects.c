@@ -640,11 +640,6 @@ static fcm_status parse_contact(fcm__scene_parser *p, const fcm__json *o, fcm_ef
                 "expected true (contact between the bodies and cut pieces; leave the effect out "
                 "for none), got false");
     fcm__scene_path_pop(p, old);
-    SCENE_CHECK(!fcm__json_member(o, "friction"), p, FCM_ERR_ARG,
-                "\"friction\": friction between bodies is not supported (remove the key)");
-    SCENE_CHECK(!fcm__json_member(o, "friction_velocity"), p, FCM_ERR_ARG,
-                "\"friction_velocity\": friction between bodies is not supported (remove the "
-                "key)");
     goto options;
   }
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, kind, 1, &ob));
@@ -690,6 +685,13 @@ options:
           fcm__scene_read_number(p, o, "friction", 0, FCM__NONNEGATIVE, &c->options.friction));
   FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "friction_velocity", 0, FCM__NONNEGATIVE,
                                          &c->options.friction_velocity));
+  if (c->obstacle == FCM_CONTACT_BODIES) {
+    size_t o3 = fcm__scene_path_push_key(p, "friction");
+    SCENE_CHECK(c->options.friction == 0.0, p, FCM_ERR_ARG,
+                "expected 0 with \"bodies\" (friction between bodies is not supported), got %g",
+                c->options.friction);
+    fcm__scene_path_pop(p, o3);
+  }
 cleanup:
   return st;
 }
