@@ -16,6 +16,10 @@
  *            above the floor and no sample lies inside another stick by more than 1e-3 m, the
  *            sticks reach the floor (closer than half its threshold) and meet each other, and
  *            the energy never exceeds its start by more than 1e-3 of the work of gravity
+ *   cost <scenes>  not asserted (lib/docs/contact.md): the BVH's build and refit over random
+ *            boxes; on dice_on_floor.json after the landing, one evaluation of the contact terms
+ *            (energy, force, Newton matrix) per sample point, and the step time with and without
+ *            the contact between the pieces
  *   errors   bad "bodies" input in a scene (false, with friction) refused naming the field; a
  *            second call and a NULL geometry refused; a scene with obstacles only builds no
  *            search tree and evaluates no pair (counters zero) */
@@ -25,6 +29,7 @@
 #include "test.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -306,6 +311,114 @@ static int dice(fcm_ctx *ctx, const char *dir)
   return 0;
 }
 
+/* The wall time of a run of `scene` (steps and set-up), its steps, and in *per_sample the time
+ * of one contact evaluation per sample point at the end (with bodies only). */
+static double run_time(fcm_ctx *ctx, fcm_scene *scene, int *steps, double *per_sample,
+                       fcm_index *samples, fcm_index *tris)
+{
+  fcm_simulation *sim = NULL;
+  double dt = 0.0;
+  *steps = 0;
+  TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
+  if (!sim) return 0.0;
+  const double t0 = fcm_wtime();
+  while (!fcm_simulation_done(sim)) {
+    fcm_step_info info;
+    TEST_OK(ctx, fcm_simulation_step(sim, &info));
+    if (fcm_ctx_error_status(ctx) != FCM_OK) break;
+    (*steps)++;
+  }
+  dt = fcm_wtime() - t0;
+  fcm_integrator *I = fcm_simulation_integrator(sim);
+  *per_sample = 0.0;
+  for (int c = 0; c < I->num_contacts; c++) {
+    if (I->contacts[c].kind != SIM_CONTACT_BODIES) continue;
+    const fcm_index n = fcm_space_num_dofs(fcm_simulation_space(sim));
+    double *f = calloc((size_t)n, sizeof *f), e = 0.0;
+    fcm_csr *T = NULL;
+    TEST_OK(ctx, fcm_space_matrix_create(fcm_simulation_space(sim), &T));
+    *samples = fcm__sim_bodies_samples(&I->contacts[c], tris);
+    const int reps = 50;
+    const double t1 = fcm_wtime();
+    for (int k = 0; k < reps; k++) {
+      int finite = 1;
+      e = 0.0;
+      fcm__sim_bodies_assemble(I, &I->contacts[c], I->u, &e, f, T, &finite);
+    }
+    *per_sample = (fcm_wtime() - t1) / reps / (double)*samples;
+    fcm_csr_destroy(&T);
+    free(f);
+  }
+  fcm_simulation_destroy(&sim);
+  return dt;
+}
+
+static int cost(fcm_ctx *ctx, const char *dir)
+{
+  char path[1024];
+  fcm_scene *with = NULL, *without = NULL;
+  for (int k = 0; k < 2; k++) { /* the BVH alone: build and refit over n random boxes */
+    const fcm_index n = k ? 20000 : 1584;
+    double *boxes = malloc(sizeof(double) * 6 * (size_t)n);
+    fcm_index *group = calloc((size_t)n, sizeof *group);
+    sim_bvh T;
+    memset(&T, 0, sizeof T);
+    srand(3);
+    for (fcm_index i = 0; i < n; i++)
+      for (int d = 0; d < 3; d++) {
+        const double c = (double)rand() / RAND_MAX, w = 0.02 * (double)rand() / RAND_MAX;
+        boxes[6 * i + d] = c - w;
+        boxes[6 * i + 3 + d] = c + w;
+      }
+    const int reps = 200;
+    double t0 = fcm_wtime();
+    for (int r = 0; r < reps; r++)
+      TEST_OK(ctx, fcm__sim_bvh_build(ctx, &T, n, group, 1, boxes));
+    const double tb = (fcm_wtime() - t0) / reps;
+    t0 = fcm_wtime();
+    for (int r = 0; r < reps; r++)
+      fcm__sim_bvh_refit(&T, boxes);
+    const double tr = (fcm_wtime() - t0) / reps;
+    printf("bvh over %lld boxes: build %.3g ms, refit %.3g ms\n", (long long)n, 1e3 * tb, 1e3 * tr);
+    fcm__sim_bvh_free(ctx, &T);
+    free(boxes), free(group);
+  }
+  snprintf(path, sizeof path, "%s/dice_on_floor.json", dir);
+  TEST_OK(ctx, fcm_scene_create_from_file(ctx, path, &with));
+  {
+    /* without: the same scene without its "bodies" effect */
+    static const char key[] = "{\"contact\": {\"bodies\": true, \"distance\": 0.02}},";
+    FILE *f = fopen(path, "rb");
+    char *text = calloc(1 << 16, 1), *at = NULL;
+    if (f) {
+      size_t len = fread(text, 1, (1 << 16) - 1, f);
+      text[len] = 0;
+      fclose(f);
+    }
+    at = strstr(text, key);
+    TEST_TRUE(at != NULL);
+    if (at) memmove(at, at + strlen(key), strlen(at + strlen(key)) + 1);
+    TEST_OK(ctx, fcm_scene_create_from_string(ctx, text, path, &without));
+    free(text);
+  }
+  if (with && without) {
+    int s1 = 0, s0 = 0;
+    fcm_index ns = 0, nt = 0, ns0 = 0, nt0 = 0;
+    double ps = 0.0, ps0 = 0.0;
+    const double t1 = run_time(ctx, with, &s1, &ps, &ns, &nt);
+    const double t0 = run_time(ctx, without, &s0, &ps0, &ns0, &nt0);
+    printf("dice_on_floor: %lld samples on %lld triangles; one evaluation of the contact "
+           "between the pieces (energy, force, Newton matrix) %.3g us per sample point after "
+           "the landing; %d steps %.3g s with it, %.3g s without (%.3g ms per step, %.3g us per "
+           "sample point and step)\n",
+           (long long)ns, (long long)nt, 1e6 * ps, s1, t1, t0, 1e3 * (t1 - t0) / s1,
+           1e6 * (t1 - t0) / s1 / (double)(ns > 0 ? ns : 1));
+  }
+  fcm_scene_destroy(&with);
+  fcm_scene_destroy(&without);
+  return 0;
+}
+
 /* A scene of a box (cut in two at x = 0.5) with the given contact effects. */
 static void cut_scene(char *out, size_t len, const char *contact)
 {
@@ -397,6 +510,8 @@ int main(int argc, char **argv)
     stack(ctx);
   else if (!strcmp(argv[1], "dice") && argc > 2)
     dice(ctx, argv[2]);
+  else if (!strcmp(argv[1], "cost") && argc > 2)
+    cost(ctx, argv[2]);
   else if (!strcmp(argv[1], "errors"))
     errors(ctx);
   else

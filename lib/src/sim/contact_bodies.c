@@ -78,7 +78,8 @@ typedef struct sim_bodies {
   double *vw;              /* nv: a node's weight against the obstacles */
   sim_bvh bvh;
   int built;
-  sim_pair *pairs; /* the pairs within d^ at the last Newton matrix's assembly */
+  fcm_index *near_ptr, *near; /* num_bodies + 1, num_bodies^2: the bodies near each body */
+  sim_pair *pairs;            /* the pairs within d^ at the last Newton matrix's assembly */
   size_t npairs, cap_pairs;
   double *w1, *w2, *w3, *w4; /* n each: the direction's refinement */
   fcm__idbuf buf;
@@ -109,6 +110,8 @@ void fcm__sim_bodies_free(fcm_ctx *ctx, sim_contact *c)
   fcm__free(ctx, B->boxes);
   fcm__free(ctx, B->Ke);
   fcm__sim_bvh_free(ctx, &B->bvh);
+  fcm__free(ctx, B->near_ptr);
+  fcm__free(ctx, B->near);
   fcm__free(ctx, B->pairs);
   fcm__free(ctx, B->w1);
   fcm__free(ctx, B->w2);
@@ -266,6 +269,8 @@ fcm_status fcm__sim_bodies_setup(fcm_integrator *I, sim_contact *c)
   FCM_ALLOC(ctx, 3 * (size_t)B->nv + 1, B->dy);
   FCM_ALLOC(ctx, 6 * (size_t)B->nt + 1, B->boxes);
   FCM_ALLOC(ctx, (size_t)9 * nn * nn, B->Ke);
+  FCM_ALLOC(ctx, (size_t)B->num_bodies + 1, B->near_ptr);
+  FCM_ALLOC(ctx, (size_t)B->num_bodies * B->num_bodies + 1, B->near);
   FCM_ALLOC(ctx, (size_t)I->n + 1, B->w1);
   FCM_ALLOC(ctx, (size_t)I->n + 1, B->w2);
   FCM_ALLOC(ctx, (size_t)I->n + 1, B->w3);
@@ -293,9 +298,31 @@ static void node_positions(const fcm_space *s, const sim_bodies *B, const double
 
 /* The triangles' boxes at the node positions y, swept over y + s dy for s in [0, 2] when dy
  * is given; then the tree built again (rebuild) or refitted to them. */
-static fcm_status tree_boxes(fcm_ctx *ctx, sim_bodies *B, const double *y, const double *dy,
-                             int rebuild)
+/* For each body the other bodies whose boxes come within pad of its box (near_ptr, near). */
+static void near_bodies(sim_bodies *B, double pad)
 {
+  const fcm_index nb = B->num_bodies;
+  fcm_index m = 0;
+  for (fcm_index g = 0; g < nb; g++) {
+    B->near_ptr[g] = m;
+    if (B->bvh.root[g] < 0) continue;
+    const sim_bvh_node *a = B->bvh.node + B->bvh.root[g];
+    for (fcm_index h = 0; h < nb; h++) {
+      if (h == g || B->bvh.root[h] < 0) continue;
+      const sim_bvh_node *b = B->bvh.node + B->bvh.root[h];
+      int meet = 1;
+      for (int i = 0; i < 3; i++)
+        meet &= a->lo[i] - pad <= b->hi[i] && b->lo[i] <= a->hi[i] + pad;
+      if (meet) B->near[m++] = h;
+    }
+  }
+  B->near_ptr[nb] = m;
+}
+
+static fcm_status tree_boxes(fcm_ctx *ctx, sim_bodies *B, const double *y, const double *dy,
+                             int rebuild, double pad)
+{
+  fcm_status st = FCM_OK;
   for (fcm_index t = 0; t < B->nt; t++) {
     const fcm_index *tv = B->tri + 3 * t;
     for (int i = 0; i < 3; i++) {
@@ -312,10 +339,13 @@ static fcm_status tree_boxes(fcm_ctx *ctx, sim_bodies *B, const double *y, const
   B->builds++;
   if (rebuild || !B->built) {
     B->built = 1;
-    return fcm__sim_bvh_build(ctx, &B->bvh, B->nt, B->tbody, B->num_bodies, B->boxes);
+    FCM_TRY(ctx, fcm__sim_bvh_build(ctx, &B->bvh, B->nt, B->tbody, B->num_bodies, B->boxes));
+  } else {
+    fcm__sim_bvh_refit(&B->bvh, B->boxes);
   }
-  fcm__sim_bvh_refit(&B->bvh, B->boxes);
-  return FCM_OK;
+  near_bodies(B, pad);
+cleanup:
+  return st;
 }
 
 /* Sample n's position (and motion, when dy is given) from the node arrays. */
@@ -350,8 +380,13 @@ static fcm_status candidates(fcm_ctx *ctx, sim_bodies *B, fcm_index n, const dou
   fcm_status st = FCM_OK;
   const fcm_index own = B->tbody[B->stri[n]];
   B->buf.n = 0;
-  for (fcm_index g = 0; g < B->num_bodies; g++) {
-    if (g == own || (!all && is_blind(B, n, g))) continue;
+  for (fcm_index k = B->near_ptr[own]; k < B->near_ptr[own + 1]; k++) {
+    const fcm_index g = B->near[k], r = B->bvh.root[g];
+    const sim_bvh_node *nd = B->bvh.node + r; /* the body's box first: most miss it */
+    if (nd->lo[0] > hi[0] || lo[0] > nd->hi[0] || nd->lo[1] > hi[1] || lo[1] > nd->hi[1] ||
+        nd->lo[2] > hi[2] || lo[2] > nd->hi[2])
+      continue;
+    if (!all && is_blind(B, n, g)) continue;
     FCM_TRY(ctx, fcm__sim_bvh_query(ctx, &B->bvh, g, B->boxes, lo, hi, &B->buf));
   }
 cleanup:
@@ -391,7 +426,7 @@ fcm_status fcm__sim_bodies_prepare(fcm_integrator *I, sim_contact *c, const doub
   unsigned char *near = NULL;
   if (!B) return FCM_OK;
   node_positions(I->space, B, x, 0, B->y);
-  FCM_TRY(ctx, tree_boxes(ctx, B, B->y, NULL, 1));
+  FCM_TRY(ctx, tree_boxes(ctx, B, B->y, NULL, 1, c->dhat));
   FCM_ALLOC(ctx, (size_t)B->num_bodies + 1, near);
   for (fcm_index n = 0; n < B->ns; n++) {
     fcm_index *bl = B->blind + (size_t)n * SIM_BLIND;
@@ -528,7 +563,7 @@ void fcm__sim_bodies_assemble(fcm_integrator *I, sim_contact *c, const double *x
     return;
   }
   node_positions(I->space, B, x, 0, B->y);
-  if (tree_boxes(I->ctx, B, B->y, NULL, 0) != FCM_OK) {
+  if (tree_boxes(I->ctx, B, B->y, NULL, 0, c->dhat) != FCM_OK) {
     *finite = 0;
     return;
   }
@@ -581,7 +616,7 @@ double fcm__sim_bodies_step_bound(fcm_integrator *I, sim_contact *c, const doubl
   for (fcm_index v = 0; v < B->nv; v++)
     M = FCM_MAX(M, fcm__vec3_norm(B->dy + 3 * v));
   if (M == 0.0) return amax;
-  if (tree_boxes(I->ctx, B, B->y, B->dy, 0) != FCM_OK) return 0.0;
+  if (tree_boxes(I->ctx, B, B->y, B->dy, 0, 0.0) != FCM_OK) return 0.0;
   for (fcm_index n = 0; n < B->ns; n++) {
     double p[3], dp[3], lo[3], hi[3];
     sample_point(B, n, B->y, p);
@@ -619,7 +654,7 @@ fcm_status fcm__sim_bodies_stats(const fcm_integrator *I, const sim_contact *c, 
   *energy = 0.0;
   if (!B) return FCM_OK;
   node_positions(I->space, B, x, 0, B->y);
-  FCM_TRY(ctx, tree_boxes(ctx, B, B->y, NULL, 0));
+  FCM_TRY(ctx, tree_boxes(ctx, B, B->y, NULL, 0, c->dhat));
   for (fcm_index n = 0; n < B->ns; n++) {
     double p[3], lo[3], hi[3];
     sample_point(B, n, B->y, p);
@@ -715,7 +750,7 @@ fcm_status fcm__sim_bodies_depth(const fcm_integrator *I, const sim_contact *c, 
   *depth = 0.0;
   if (!B) return FCM_OK;
   node_positions(I->space, B, x, 0, B->y);
-  FCM_TRY(ctx, tree_boxes(ctx, B, B->y, NULL, 0));
+  FCM_TRY(ctx, tree_boxes(ctx, B, B->y, NULL, 0, c->dhat));
   for (fcm_index g = 0; g < B->num_bodies; g++) {
     if (B->bvh.root[g] < 0) continue;
     const sim_bvh_node *nd = B->bvh.node + B->bvh.root[g];
@@ -844,4 +879,10 @@ fcm_status fcm__sim_bodies_refine(fcm_integrator *I, const double *b, double *d,
   }
 cleanup:
   return st;
+}
+
+fcm_index fcm__sim_bodies_samples(const sim_contact *c, fcm_index *triangles)
+{
+  if (triangles) *triangles = c->bodies ? c->bodies->nt : 0;
+  return c->bodies ? c->bodies->ns : 0;
 }

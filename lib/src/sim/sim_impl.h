@@ -478,6 +478,8 @@ fcm_index fcm__sim_bodies_element_nodes(const fcm_integrator *I, fcm_index e, do
  * solve; nothing without pairs or on an octree mesh. */
 fcm_status fcm__sim_bodies_refine(fcm_integrator *I, const double *b, double *d,
                                   fcm_step_reason *reason, int *its, sim_stats *stats);
+/* The sample points and (in *triangles, may be NULL) the triangles of the surface. */
+fcm_index fcm__sim_bodies_samples(const sim_contact *c, fcm_index *triangles);
 /* The search trees built so far (each evaluation, step bound and stats builds one). */
 long long fcm__sim_bodies_builds(const sim_contact *c);
 int fcm__sim_point_triangle(const double p[3], const double a[3], const double b[3],
