@@ -625,10 +625,12 @@ FCM_API fcm_status fcm_integrator_add_contact_surface(fcm_integrator *integ, fcm
  * three interior points per triangle, weighted by area) are kept away from the triangles of
  * every other body by the barrier of fcm_integrator_add_contact_plane() on the point-triangle
  * distance (exact force on the DOFs of the sample's and the triangle's elements; the Newton
- * matrix a block-diagonal bound of the pairs' positive semidefinite part, as the space's
- * pattern does not couple different pieces). Broad phase: an AABB tree over the deformed
- * triangles, rebuilt at each evaluation. The step filter keeps every pair at positive
- * distance (a conservative bound from the points' motions). Self-contact of one body is off.
+ * matrix holds a block-diagonal bound of the pairs' positive semidefinite part, as the space's
+ * pattern does not couple different pieces, and Newton's direction is refined by conjugate
+ * gradients on the coupled matrix, preconditioned by its factorization). Broad phase: a
+ * bounding-volume hierarchy per body over the deformed triangles, rebuilt at each substep and
+ * refitted at each evaluation. The step filter keeps every pair at positive distance (a
+ * conservative bound from the points' motions). Self-contact of one body is off.
  * Pieces that start within d^ of each other (the two sides of a cut) ignore each other at a
  * sample until it is d^ away at a substep's start. One per integrator; carried over by
  * fcm_integrator_create_cut() (the surface is split again by the new cuts). Friction between

@@ -26,11 +26,14 @@
  * the obstacles). G spans the elements of up to six nodes in different pieces, whose DOFs the
  * space's matrix pattern does not couple; the Newton matrix therefore gets the block-diagonal
  * bound m sum_e G_e G_e^T >= G G^T (m the number of distinct elements, Cauchy-Schwarz), which
- * fits the pattern and keeps the Newton step a descent direction for the energy line search.
+ * fits the pattern, and Newton's direction is refined by preconditioned conjugate gradients on
+ * the coupled matrix (the pairs recorded at the matrix's assembly, applied matrix-free; the
+ * factorization of the assembled matrix preconditions).
  *
- * Broad phase: an AABB tree over the deformed triangles, built again at every evaluation
- * (cheap against the pairs: lib/docs/contact.md measures it); each sample queries the box of
- * radius d^ about it.
+ * Broad phase: a bounding-volume hierarchy with one subtree per body (contact_bvh.c), built
+ * again at each substep's start and refitted to the deformed triangles at every evaluation;
+ * each sample queries the box of radius d^ about it in the subtrees of the bodies whose boxes
+ * come within d^ of its own body's box.
  *
  * Step filter (no sample crosses a triangle): along x + alpha dx the distance of a pair is at
  * least d - alpha (|dp| + max_k |dz_k|), the triangle's points moving by at most its nodes'
