@@ -446,6 +446,43 @@ fcm_status fcm__sim_bvh_query(fcm_ctx *ctx, const sim_bvh *T, fcm_index g, const
                               const double lo[3], const double hi[3], fcm__idbuf *buf);
 void fcm__sim_bvh_free(fcm_ctx *ctx, sim_bvh *T);
 
+/* Contact between bodies (contact_bodies.c, contact_bodies_solve.c): a sample's blind list
+ * holds up to SIM_BLIND bodies. */
+#define SIM_BLIND 8
+
+/* A pair within d^ at the Newton matrix's assembly: sample n, triangle t, the distance's
+ * gradient g, the closest point's barycentric coordinates beta, w kappa b''(d). */
+typedef struct sim_pair {
+  fcm_index n, t;
+  double g[3], beta[3], c2;
+} sim_pair;
+
+typedef struct sim_bodies {
+  fcm_embedded_surface *es;
+  fcm_index nv, nt, ns;
+  fcm_index *velem;     /* nv: the element holding node v */
+  double *vX, *vN;      /* nv x 3 reference positions, nv x nn shape values */
+  const fcm_index *tri; /* nt x 3 (the surface's) */
+  fcm_index *tbody;     /* nt: the triangle's body, -1 for a triangle without area */
+  fcm_index *stri;      /* ns: the sample's triangle */
+  double *slam, *sw;    /* ns x 3 barycentric coordinates, ns weights */
+  fcm_index *blind;     /* ns x SIM_BLIND: bodies the sample ignores (-1: none) */
+  int prepared;
+  double *y, *dy, *boxes; /* nv x 3, nv x 3, nt x 6 */
+  double *Ke;             /* (3 nn)^2 */
+  fcm_index num_bodies;
+  fcm_index *eptr, *enode; /* num_elems + 1 offsets, nv: the nodes of each element */
+  double *vw;              /* nv: a node's weight against the obstacles */
+  sim_bvh bvh;
+  int built;
+  fcm_index *near_ptr, *near; /* num_bodies + 1, num_bodies^2: the bodies near each body */
+  sim_pair *pairs;            /* the pairs within d^ at the last Newton matrix's assembly */
+  size_t npairs, cap_pairs;
+  double *w1, *w2, *w3, *w4; /* n each: the direction's refinement */
+  fcm__idbuf buf;
+  long long builds;
+} sim_bodies;
+
 /* Contact between bodies and cut pieces (contact_bodies.c), the obstacle kind
  * SIM_CONTACT_BODIES: setup builds the embedded surface of the space (c->bodies); free releases
  * it. prepare: at a substep's start (state un), the sample points that started within d^ of
