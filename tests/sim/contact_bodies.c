@@ -16,6 +16,13 @@
  *            above the floor and no sample lies inside another stick by more than 1e-3 m, the
  *            sticks reach the floor (closer than half its threshold) and meet each other, and
  *            the energy never exceeds its start by more than 1e-3 of the work of gravity
+ *   rest <scenes>  apps/scenes/cut_bar_resting.json (a bar cut along its length, dropped onto a
+ *            floor: the upper half lands on the lower one): at every step the upper half lies
+ *            at most 5e-3 m deep in the lower one and every point above the floor; at the end
+ *            the bar rests (centre-of-mass velocity below 0.01 m/s), the energy never grew by
+ *            more than 1e-3 of the work of gravity, and the force of the contact (barrier and
+ *            the penalty of the halves that started in contact) matches differences of its
+ *            energy (relative error <= 1e-6)
  *   cost <scenes>  not asserted (lib/docs/contact.md): the BVH's build and refit over random
  *            boxes; on dice_on_floor.json after the landing, one evaluation of the contact terms
  *            (energy, force, Newton matrix) per sample point, and the step time with and without
@@ -311,6 +318,81 @@ static int dice(fcm_ctx *ctx, const char *dir)
   return 0;
 }
 
+/* apps/scenes/cut_bar_resting.json: the upper half of a cut bar lands on the lower one and
+ * rests; the sides of the cut start in contact, so the penalty on the lagged gap holds it. */
+static int rest(fcm_ctx *ctx, const char *dir)
+{
+  char path[1024];
+  fcm_scene *scene = NULL;
+  fcm_simulation *sim = NULL;
+  snprintf(path, sizeof path, "%s/cut_bar_resting.json", dir);
+  TEST_OK(ctx, fcm_scene_create_from_file(ctx, path, &scene));
+  if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
+  if (!sim) {
+    fcm_scene_destroy(&scene);
+    return 0;
+  }
+  double depth = 0.0, dfloor = HUGE_VAL, e0 = 0.0, emax = -HUGE_VAL, wmax = 0.0, vz = 0.0;
+  int steps = 0;
+  while (!fcm_simulation_done(sim)) {
+    fcm_step_info info;
+    fcm_contact_stats cs;
+    double d0 = 0.0;
+    TEST_OK(ctx, fcm_simulation_step(sim, &info));
+    if (fcm_ctx_error_status(ctx) != FCM_OK) break;
+    fcm_integrator *I = fcm_simulation_integrator(sim);
+    TEST_OK(ctx, fcm_integrator_contact_stats(I, &cs));
+    TEST_OK(ctx, fcm_integrator_contact_info(I, 0, NULL, &d0, NULL, NULL));
+    const double E = info.total_energy + cs.barrier_energy;
+    if (steps++ == 0) e0 = E;
+    emax = fmax(emax, E);
+    wmax = fmax(wmax, fabs(info.load_work));
+    depth = fmax(depth, cs.body_depth);
+    dfloor = fmin(dfloor, d0);
+    if (getenv("FCM_TEST_VERBOSE"))
+      printf("step %d: depth %.3g m, floor %.4g m, pairs %lld, barrier + penalty %.4g J\n", steps,
+             cs.body_depth, d0, cs.body_pairs, cs.barrier_energy);
+  }
+  {
+    /* the centre-of-mass velocity of the whole bar at the end */
+    fcm_integrator *I = fcm_simulation_integrator(sim);
+    const fcm_index n = fcm_integrator_num_dofs(I);
+    const fcm_csr *M = fcm_integrator_mass(I);
+    double *ez = calloc((size_t)n, sizeof *ez), *w = calloc((size_t)n, sizeof *w), m = 0.0;
+    for (fcm_index i = 0; i < n; i++)
+      ez[i] = i % 3 == 2 ? 1.0 : 0.0;
+    TEST_OK(ctx, fcm_csr_apply(M, 1.0, ez, 0.0, w));
+    for (fcm_index i = 0; i < n; i++) {
+      m += ez[i] * w[i];
+      vz += fcm_integrator_velocity(I)[i] * w[i];
+    }
+    vz /= m;
+    /* the lagged penalty's force against differences of its energy */
+    double *u = malloc(sizeof(double) * (size_t)n), *f = calloc((size_t)n, sizeof *f);
+    double *d = malloc(sizeof(double) * (size_t)n), e = 0.0, ee = 0.0, et = 0.0;
+    const double t = fcm_integrator_time(I);
+    fcm_integrator_get_state(I, u, NULL, NULL, NULL);
+    TEST_OK(ctx, fcm_integrator_contact_eval(I, u, t, &e, f, NULL));
+    srand(11);
+    for (fcm_index i = 0; i < n; i++)
+      d[i] = (double)rand() / RAND_MAX - 0.5;
+    contact_fd(ctx, I, n, u, d, t, 1e-8, f, NULL, &ee, &et);
+    printf("rest: contact energy %.6g J at the end, force against differences %.3g\n", e, ee);
+    if (!(ee <= 1e-6)) TEST_FAIL_("force against differences: relative error %.3g", ee);
+    free(ez), free(w), free(u), free(f), free(d);
+  }
+  printf("rest: %d steps; largest depth of the upper half in the lower %.3g m; smallest distance "
+         "to the floor %.4g m; final centre-of-mass velocity %.3g m/s; energy growth %.3g J\n",
+         steps, depth, dfloor, vz, emax - e0);
+  if (!(depth <= 5e-3)) TEST_FAIL_("the upper half sank %.3g m into the lower", depth);
+  if (!(dfloor > 0.0)) TEST_FAIL_("a surface point reached the floor: %.3g m", dfloor);
+  if (!(fabs(vz) < 0.01)) TEST_FAIL_("the bar does not rest: vz = %.3g m/s", vz);
+  if (!(emax - e0 <= 1e-3 * wmax)) TEST_FAIL_("energy grew by %.3g J", emax - e0);
+  fcm_simulation_destroy(&sim);
+  fcm_scene_destroy(&scene);
+  return 0;
+}
+
 /* The wall time of a run of `scene` (steps and set-up), its steps, and in *per_sample the time
  * of one contact evaluation per sample point at the end (with bodies only). */
 static double run_time(fcm_ctx *ctx, fcm_scene *scene, int *steps, double *per_sample,
@@ -510,6 +592,8 @@ int main(int argc, char **argv)
     stack(ctx);
   else if (!strcmp(argv[1], "dice") && argc > 2)
     dice(ctx, argv[2]);
+  else if (!strcmp(argv[1], "rest") && argc > 2)
+    rest(ctx, argv[2]);
   else if (!strcmp(argv[1], "cost") && argc > 2)
     cost(ctx, argv[2]);
   else if (!strcmp(argv[1], "errors"))

@@ -122,3 +122,5 @@ fcm_add_test(sim_contact_bodies_stack tests/sim/contact_bodies.c ARGS stack)
 fcm_add_test(sim_contact_bodies_errors tests/sim/contact_bodies.c ARGS errors)
 fcm_add_test(sim_contact_bodies_dice tests/sim/contact_bodies.c ARGS dice
              ${PROJECT_SOURCE_DIR}/apps/scenes)
+fcm_add_test(sim_contact_bodies_rest tests/sim/contact_bodies.c ARGS rest
+             ${PROJECT_SOURCE_DIR}/apps/scenes)

@@ -75,6 +75,8 @@ void fcm__sim_bodies_free(fcm_ctx *ctx, sim_contact *c)
   fcm__free(ctx, B->slam);
   fcm__free(ctx, B->sw);
   fcm__free(ctx, B->blind);
+  fcm__free(ctx, B->lag_t);
+  fcm__free(ctx, B->lag);
   fcm__free(ctx, B->y);
   fcm__free(ctx, B->dy);
   fcm__free(ctx, B->boxes);
@@ -233,6 +235,8 @@ fcm_status fcm__sim_bodies_setup(fcm_integrator *I, sim_contact *c)
   FCM_TRY(ctx, fcm_embedded_surface_create(I->space, c->geom, &B->es));
   FCM_TRY(ctx, build_samples(I, B));
   FCM_ALLOC(ctx, (size_t)B->ns * SIM_BLIND + 1, B->blind);
+  FCM_ALLOC(ctx, (size_t)B->ns * SIM_BLIND + 1, B->lag_t);
+  FCM_ALLOC(ctx, (size_t)B->ns * SIM_BLIND * 6 + 1, B->lag);
   for (fcm_index k = 0; k < B->ns * SIM_BLIND; k++)
     B->blind[k] = -1;
   FCM_ALLOC(ctx, 3 * (size_t)B->nv + 1, B->y);
@@ -388,6 +392,39 @@ static double pair_distance(const sim_bodies *B, const double p[3], fcm_index t,
   return d;
 }
 
+/* For each body sample n ignores: its closest triangle among the candidates in B->buf, the
+ * closest point's barycentric coordinates and the triangle's unit outward normal (lag_t, lag;
+ * -1 when none is within reach). */
+static void lag_blind(sim_bodies *B, fcm_index n, const double p[3])
+{
+  const fcm_index *bl = B->blind + (size_t)n * SIM_BLIND;
+  for (int k = 0; k < SIM_BLIND; k++) {
+    fcm_index *lt = B->lag_t + (size_t)n * SIM_BLIND + k;
+    double *L = B->lag + 6 * ((size_t)n * SIM_BLIND + k), best = HUGE_VAL;
+    *lt = -1;
+    if (bl[k] < 0) continue;
+    for (size_t j = 0; j < B->buf.n; j++) {
+      const fcm_index t = B->buf.ids[j];
+      double g[3], beta[3];
+      if (B->tbody[t] != bl[k]) continue;
+      const double d = pair_distance(B, p, t, B->y, g, beta);
+      if (d >= best) continue;
+      best = d;
+      *lt = t;
+      memcpy(L, beta, sizeof beta);
+    }
+    if (*lt < 0) continue;
+    const fcm_index *tv = B->tri + 3 * *lt;
+    double e1[3], e2[3];
+    fcm__vec3_sub(B->y + 3 * tv[1], B->y + 3 * tv[0], e1);
+    fcm__vec3_sub(B->y + 3 * tv[2], B->y + 3 * tv[0], e2);
+    fcm__vec3_cross(e1, e2, L + 3);
+    const double l = fcm__vec3_norm(L + 3);
+    for (int i = 0; i < 3; i++)
+      L[3 + i] = l > 0.0 ? L[3 + i] / l : 0.0;
+  }
+}
+
 fcm_status fcm__sim_bodies_prepare(fcm_integrator *I, sim_contact *c, const double *x)
 {
   fcm_status st = FCM_OK;
@@ -429,6 +466,7 @@ fcm_status fcm__sim_bodies_prepare(fcm_integrator *I, sim_contact *c, const doub
       for (int k = 0; k < SIM_BLIND; k++)
         if (bl[k] >= 0 && !near[bl[k]]) bl[k] = -1;
     }
+    lag_blind(B, n, p);
     for (size_t k = 0; k < B->buf.n; k++)
       if (B->tbody[B->buf.ids[k]] >= 0) near[B->tbody[B->buf.ids[k]]] = 0;
   }
@@ -440,7 +478,7 @@ cleanup:
 
 /* Pair (sample n, triangle t) at distance d with gradient g, closest barycentrics beta: the
  * force c1 G and the Newton matrix bound of c2 G G^T added. */
-static void pair_terms(fcm_integrator *I, sim_bodies *B, fcm_index n, fcm_index t,
+static void pair_terms(const fcm_integrator *I, sim_bodies *B, fcm_index n, fcm_index t,
                        const double g[3], const double beta[3], double c1, double c2, double *force,
                        double *vals)
 {
@@ -522,6 +560,34 @@ cleanup:
   return st;
 }
 
+/* The penalty that keeps sample n at p out of the bodies it ignores: with the triangle, the
+ * closest point's beta and the outward normal nv lagged at the substep's start, the signed gap
+ * s = nv . (p - sum_k beta_k z_k) is linear in the DOFs, and s < 0 adds w kappa s^2 / 2 (its
+ * force exact, its Newton matrix w kappa G G^T, G = ds/du, through the pairs' path). */
+static fcm_status lagged_terms(const fcm_integrator *I, const sim_contact *c, fcm_index n,
+                               const double p[3], double *etot, double *force, double *vals)
+{
+  fcm_status st = FCM_OK;
+  sim_bodies *B = c->bodies;
+  for (int k = 0; k < SIM_BLIND; k++) {
+    const fcm_index t = B->lag_t[(size_t)n * SIM_BLIND + k];
+    if (B->blind[(size_t)n * SIM_BLIND + k] < 0 || t < 0) continue;
+    const double *L = B->lag + 6 * ((size_t)n * SIM_BLIND + k);
+    const fcm_index *tv = B->tri + 3 * t;
+    double s = 0.0;
+    for (int i = 0; i < 3; i++)
+      s += L[3 + i] * (p[i] - L[0] * B->y[3 * tv[0] + i] - L[1] * B->y[3 * tv[1] + i] -
+                       L[2] * B->y[3 * tv[2] + i]);
+    if (!(s < 0.0)) continue;
+    const double wk = B->sw[n] * c->kappa;
+    *etot += 0.5 * wk * s * s;
+    pair_terms(I, B, n, t, L + 3, L, wk * s, wk, force, vals);
+    if (vals) FCM_TRY(I->ctx, record(I->ctx, B, n, t, L + 3, L, wk));
+  }
+cleanup:
+  return st;
+}
+
 void fcm__sim_bodies_assemble(fcm_integrator *I, sim_contact *c, const double *x, double *energy,
                               double *force, fcm_csr *T, int *finite)
 {
@@ -566,6 +632,10 @@ void fcm__sim_bodies_assemble(fcm_integrator *I, sim_contact *c, const double *x
         *finite = 0;
         return;
       }
+    }
+    if (lagged_terms(I, c, n, p, &etot, force, vals) != FCM_OK) {
+      *finite = 0;
+      return;
     }
   }
   if (!isfinite(etot)) *finite = 0;
@@ -643,6 +713,7 @@ fcm_status fcm__sim_bodies_stats(const fcm_integrator *I, const sim_contact *c, 
       (*pairs)++;
       *energy += B->sw[n] * c->kappa * barrier(d, c->dhat, &b1, &b2);
     }
+    FCM_TRY(ctx, lagged_terms(I, c, n, p, energy, NULL, NULL));
   }
 cleanup:
   return st;

@@ -467,6 +467,8 @@ typedef struct sim_bodies {
   fcm_index *stri;      /* ns: the sample's triangle */
   double *slam, *sw;    /* ns x 3 barycentric coordinates, ns weights */
   fcm_index *blind;     /* ns x SIM_BLIND: bodies the sample ignores (-1: none) */
+  fcm_index *lag_t;     /* ns x SIM_BLIND: their closest triangle at the substep's start */
+  double *lag;          /* ns x SIM_BLIND x 6: its closest point's beta and its unit normal */
   int prepared;
   double *y, *dy, *boxes; /* nv x 3, nv x 3, nt x 6 */
   double *Ke;             /* (3 nn)^2 */
