@@ -631,8 +631,10 @@ FCM_API fcm_status fcm_integrator_add_contact_surface(fcm_integrator *integ, fcm
  * bounding-volume hierarchy per body over the deformed triangles, rebuilt at each substep and
  * refitted at each evaluation. The step filter keeps every pair at positive distance (a
  * conservative bound from the points' motions). Self-contact of one body is off.
- * Pieces that start within d^ of each other (the two sides of a cut) ignore each other at a
- * sample until it is d^ away at a substep's start. One per integrator; carried over by
+ * Pieces that start within d^ of each other (the two sides of a cut) see, instead of the
+ * barrier, a penalty w kappa s^2 / 2 on the gap s < 0 below the other piece's closest face (lagged
+ * at each substep's start) until the sample is d^ away at a substep's start; from then on the
+ * barrier keeps them apart. One per integrator; carried over by
  * fcm_integrator_create_cut() (the surface is split again by the new cuts). Friction between
  * bodies is not supported. Before setup; the setup needs surface rules.
  * @param[in] geom borrowed: the geometry the space's rules were built on; must outlive the
