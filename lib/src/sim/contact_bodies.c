@@ -41,8 +41,11 @@
  *
  * The faces of a cut start in contact (both sides of a cut face coincide), and so do pieces
  * that touch at a cut's start: at the first substep every sample records the bodies within d^
- * of it (at most SIM_BLIND) and ignores them until it is d^ away from them at a substep's
- * start; from then on they repel it. */
+ * of it (at most SIM_BLIND); the barrier ignores them until it is d^ away from them at a
+ * substep's start, from then on they repel it. Until then a penalty w kappa s^2 / 2 acts on
+ * the signed gap s < 0 below each such body's closest triangle, lagged at the substep's start
+ * (the triangle, the closest point's barycentric coordinates and the outward normal fixed, so
+ * s is linear in the DOFs). */
 #include "sim/sim_impl.h"
 #include "fem/fem_impl.h"
 #include "la/vec3.h"
