@@ -35,6 +35,12 @@ add_test(NAME app_demo_picture COMMAND bash ${PROJECT_SOURCE_DIR}/tests/apps/dem
                                        $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR} ${work})
 set_tests_properties(app_demo_picture PROPERTIES LABELS app TIMEOUT 300 SKIP_RETURN_CODE 77
                      ENVIRONMENT "${FCM_TEST_ENV}")
+# The dice pictures (apps/docs/img/dice_landing.png): their command on 3 steps of
+# apps/scenes/dice_on_floor.json makes a PNG of the stated size (skipped without gnuplot).
+add_test(NAME app_dice_picture COMMAND bash ${PROJECT_SOURCE_DIR}/tests/apps/dice_picture.sh
+                                       $<TARGET_FILE:fcm-sim> ${PROJECT_SOURCE_DIR} ${work})
+set_tests_properties(app_dice_picture PROPERTIES LABELS app TIMEOUT 300 SKIP_RETURN_CODE 77
+                     ENVIRONMENT "${FCM_TEST_ENV}")
 # The README quick start, `fcm-sim` without arguments: the first 6 steps in the default run
 # (frames, PVD indexes and log rows checked step by step); to the end (71 frames, 210 log
 # rows; its run time: lib/docs/performance.md) labelled slow.
@@ -50,7 +56,7 @@ fcm_add_test(app_sim_default tests/apps/sim_app.c LABELS app slow TIMEOUT 1200
 set(fcm_check_scenes spinning_body slingshot hollow_ball static_beam cantilever twisting_cylinder
     voxel_block gyroid_lattice cut_slab dice cracked_beam clamped_surface hollow_ball_multigrid
     vibrating_beam octree_ball_hex8 octree_ball_hex20 octree_ball_multigrid ball_on_floor
-    ball_off_wedge)
+    ball_off_wedge dice_on_floor cut_bar_resting)
 list(APPEND fcm_check_scenes cutbench_tonthat_slab)
 if(FCM_HAVE_GMSH)
   list(APPEND fcm_check_scenes surface_drop cutbench_dick_bunny3 cutbench_koschier_bunny)

@@ -212,7 +212,9 @@ if(FCM_BUILD_APPS)
       octree_ball_hex20 "octree with [0-9]+ hanging .*applied by the serial solvers only"
       octree_ball_multigrid "octree with [0-9]+ hanging .*applied by the serial solvers only"
       ball_on_floor     "contact is not supported with a distributed backend"
-      ball_off_wedge    "contact is not supported with a distributed backend")
+      ball_off_wedge    "contact is not supported with a distributed backend"
+      dice_on_floor     "contact is not supported with a distributed backend"
+      cut_bar_resting   "contact is not supported with a distributed backend")
   set(listed "")
   set(run ${FCM_PETSC_SCENES_RUN})
   while(run)

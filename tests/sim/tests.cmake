@@ -114,3 +114,13 @@ endforeach()
 fcm_add_test(sim_contact_friction_fd tests/sim/contact_friction.c ARGS fd)
 fcm_add_test(sim_contact_friction_stick tests/sim/contact_friction.c ARGS incline 0.6)
 fcm_add_test(sim_contact_friction_slide tests/sim/contact_friction.c ARGS incline 0.2)
+# Contact between bodies and cut pieces: the barrier's force against differences, the step
+# bound, a box dropped onto another, bad input and zero work without the key, and the dice
+# (36 sticks landing on a floor without passing through each other or the floor).
+fcm_add_test(sim_contact_bodies_fd tests/sim/contact_bodies.c ARGS fd)
+fcm_add_test(sim_contact_bodies_stack tests/sim/contact_bodies.c ARGS stack)
+fcm_add_test(sim_contact_bodies_errors tests/sim/contact_bodies.c ARGS errors)
+fcm_add_test(sim_contact_bodies_dice tests/sim/contact_bodies.c ARGS dice
+             ${PROJECT_SOURCE_DIR}/apps/scenes)
+fcm_add_test(sim_contact_bodies_rest tests/sim/contact_bodies.c ARGS rest
+             ${PROJECT_SOURCE_DIR}/apps/scenes)

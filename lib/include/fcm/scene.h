@@ -309,7 +309,9 @@ typedef enum fcm_contact_obstacle {
   FCM_CONTACT_PLANE = 0, /**< "plane": fcm_integrator_add_contact_plane() */
   FCM_CONTACT_SPHERE,    /**< "sphere": fcm_integrator_add_contact_sphere() */
   FCM_CONTACT_BOX,       /**< "box": fcm_integrator_add_contact_box() */
-  FCM_CONTACT_SURFACE    /**< "surface": fcm_integrator_add_contact_surface() from a file */
+  FCM_CONTACT_SURFACE,   /**< "surface": fcm_integrator_add_contact_surface() from a file */
+  FCM_CONTACT_BODIES     /**< "bodies": true: fcm_integrator_add_contact_bodies() (the bodies and
+                              cut pieces repel each other) */
 } fcm_contact_obstacle;
 
 /** A rigid obstacle: a half-space (the plane through point + velocity t with the unit normal

@@ -559,8 +559,8 @@ FCM_API fcm_contact_options fcm_contact_options_default(void);
  * step for a plane), then backtracked on the energy; a substep's first guess that penetrates is
  * pulled back the same way from the substep's start. A state on or behind a plane (d <= 0) is
  * refused by the setup and by each step with the point and its distance. Coulomb friction:
- * fcm_contact_options.friction. Not supported yet: contact between bodies or with itself,
- * distributed backends. Before setup.
+ * fcm_contact_options.friction. Contact between bodies: fcm_integrator_add_contact_bodies().
+ * Not supported: distributed backends. Before setup.
  * @param[out] id the obstacle's index (may be NULL)
  * @return FCM_OK, FCM_ERR_ARG (NULL integrator or vector; a zero or non-finite normal; a
  * non-finite point or velocity; a negative or non-finite option, named; after setup),
@@ -617,6 +617,34 @@ FCM_API fcm_status fcm_integrator_add_contact_surface(fcm_integrator *integ, fcm
                                                       const fcm_motion *motion,
                                                       const fcm_contact_options *opts, int *id);
 
+/** Contact between the separate bodies of the space and between the pieces its cuts make
+ * (fcm_space_num_bodies(): elements joined through shared DOF copies). The surface is the
+ * embedded surface of `geom` in the space (fcm_embedded_surface_create(): the boundary
+ * triangles split by the cuts, and both sides of every cut face), each point moving with the
+ * element that holds it. Sample points of each body's surface (the triangles' vertices and
+ * three interior points per triangle, weighted by area) are kept away from the triangles of
+ * every other body by the barrier of fcm_integrator_add_contact_plane() on the point-triangle
+ * distance (exact force on the DOFs of the sample's and the triangle's elements; the Newton
+ * matrix holds a block-diagonal bound of the pairs' positive semidefinite part, as the space's
+ * pattern does not couple different pieces, and Newton's direction is refined by conjugate
+ * gradients on the coupled matrix, preconditioned by its factorization). Broad phase: a
+ * bounding-volume hierarchy per body over the deformed triangles, rebuilt at each substep and
+ * refitted at each evaluation. The step filter keeps every pair at positive distance (a
+ * conservative bound from the points' motions). Self-contact of one body is off.
+ * Pieces that start within d^ of each other (the two sides of a cut) see, instead of the
+ * barrier, a penalty w kappa s^2 / 2 on the gap s < 0 below the other piece's closest face (lagged
+ * at each substep's start) until the sample is d^ away at a substep's start; from then on the
+ * barrier keeps them apart. One per integrator; carried over by
+ * fcm_integrator_create_cut() (the surface is split again by the new cuts). Friction between
+ * bodies is not supported. Before setup; the setup needs surface rules.
+ * @param[in] geom borrowed: the geometry the space's rules were built on; must outlive the
+ *                 integrator (and the integrators its cuts create)
+ * @return FCM_OK, FCM_ERR_ARG (NULL; a second call; friction > 0; the options as for
+ * planes), FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_integrator_add_contact_bodies(fcm_integrator *integ,
+                                                     const fcm_geometry *geom,
+                                                     const fcm_contact_options *opts, int *id);
+
 /** The signed distance of the world point x to obstacle `id` at time t (negative inside or
  * behind it), its gradient (3) and Hessian (9, row-major; may be NULL each): planes are
  * affine (H = 0), spheres give (I - g g^T) / |x - c|, boxes and surfaces the Hessian of the
@@ -650,6 +678,13 @@ typedef struct fcm_contact_stats {
   double barrier_energy;       /**< sum of w kappa b(d) now (J) */
   double friction_dissipation; /**< the work of the friction forces over the last substep's slip
                                     (J, >= 0; 0 without friction) */
+  long long body_pairs;        /**< sample-triangle pairs between bodies closer than d^ now
+                                    (also in active_points); 0 without contact between bodies */
+  long long tree_builds;       /**< search-tree builds and refits over the deformed surface for
+                                    contact between bodies since setup; 0 without it */
+  double body_depth;           /**< the largest depth of a surface sample inside another body
+                                    now (m; a ray's parity, then the distance to that body's
+                                    nearest triangle); 0 when none is, or without it */
 } fcm_contact_stats;
 
 /** The contact obstacles' state at the current displacement and time. Before setup, or

@@ -606,8 +606,9 @@ static void view_cut(const fcm_effect *e, FILE *f)
 static fcm_status parse_contact(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"plane",    "sphere",    "box",      "surface",
-                                     "distance", "stiffness", "friction", "friction_velocity"};
+  static const char *const keys[] = {"plane",     "sphere",   "box",
+                                     "surface",   "bodies",   "distance",
+                                     "stiffness", "friction", "friction_velocity"};
   static const char *const plane_keys[] = {"point", "normal", "velocity"};
   static const char *const sphere_keys[] = {"center",   "radius", "velocity",
                                             "rotation", "start",  "end"};
@@ -621,7 +622,7 @@ static fcm_status parse_contact(fcm__scene_parser *p, const fcm__json *o, fcm_ef
   c->options = fcm_contact_options_default();
   c->motion = fcm_motion_default();
   FCM_TRY(p->ctx, fcm__scene_check_object(p, o, keys, COUNT(keys)));
-  for (int k = 0; k < 4; k++)
+  for (int k = 0; k < 5; k++)
     if (fcm__json_member(o, keys[k])) {
       count++;
       kind = keys[k];
@@ -629,8 +630,18 @@ static fcm_status parse_contact(fcm__scene_parser *p, const fcm__json *o, fcm_ef
     }
   SCENE_CHECK(count == 1, p, FCM_ERR_ARG,
               "expected exactly one obstacle of \"plane\", \"sphere\", \"box\", \"surface\", "
-              "got %d",
+              "or \"bodies\", got %d",
               count);
+  if (c->obstacle == FCM_CONTACT_BODIES) {
+    int on = 0;
+    FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "bodies", 1, &on));
+    size_t old = fcm__scene_path_push_key(p, "bodies");
+    SCENE_CHECK(on, p, FCM_ERR_ARG,
+                "expected true (contact between the bodies and cut pieces; leave the effect out "
+                "for none), got false");
+    fcm__scene_path_pop(p, old);
+    goto options;
+  }
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, kind, 1, &ob));
   size_t old = fcm__scene_path_push_key(p, kind);
   switch (c->obstacle) {
@@ -665,6 +676,7 @@ static fcm_status parse_contact(fcm__scene_parser *p, const fcm__json *o, fcm_ef
   }
   if (c->obstacle != FCM_CONTACT_PLANE) FCM_TRY(p->ctx, read_rigid_motion(p, ob, &c->motion));
   fcm__scene_path_pop(p, old);
+options:
   FCM_TRY(p->ctx,
           fcm__scene_read_number(p, o, "distance", 0, FCM__NONNEGATIVE, &c->options.distance));
   FCM_TRY(p->ctx,
@@ -673,6 +685,13 @@ static fcm_status parse_contact(fcm__scene_parser *p, const fcm__json *o, fcm_ef
           fcm__scene_read_number(p, o, "friction", 0, FCM__NONNEGATIVE, &c->options.friction));
   FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "friction_velocity", 0, FCM__NONNEGATIVE,
                                          &c->options.friction_velocity));
+  if (c->obstacle == FCM_CONTACT_BODIES) {
+    size_t o3 = fcm__scene_path_push_key(p, "friction");
+    SCENE_CHECK(c->options.friction == 0.0, p, FCM_ERR_ARG,
+                "expected 0 with \"bodies\" (friction between bodies is not supported), got %g",
+                c->options.friction);
+    fcm__scene_path_pop(p, o3);
+  }
 cleanup:
   return st;
 }
@@ -696,11 +715,14 @@ static void view_contact(const fcm_effect *e, FILE *f)
     fprintf(f, "box (%g, %g, %g) to (%g, %g, %g)", c->min[0], c->min[1], c->min[2], c->max[0],
             c->max[1], c->max[2]);
     break;
+  case FCM_CONTACT_BODIES:
+    fprintf(f, "between the bodies and cut pieces");
+    break;
   default:
     fprintf(f, "surface %s", c->mesh);
     break;
   }
-  if (c->obstacle != FCM_CONTACT_PLANE) {
+  if (c->obstacle != FCM_CONTACT_PLANE && c->obstacle != FCM_CONTACT_BODIES) {
     fprintf(f, ", velocity (%g, %g, %g) m/s", m->velocity[0], m->velocity[1], m->velocity[2]);
     if (m->angular_speed != 0.0)
       fprintf(f, ", rotation %g rad/s about (%g, %g, %g) through (%g, %g, %g)", m->angular_speed,

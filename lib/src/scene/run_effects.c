@@ -194,6 +194,9 @@ fcm_status fcm__effect_apply_contact(fcm_simulation *S, const fcm_effect *e)
     FCM_TRY(S->ctx, fcm_integrator_add_contact_box(S->integ, c->min, c->max, &c->motion,
                                                    &c->options, NULL));
     break;
+  case FCM_CONTACT_BODIES:
+    FCM_TRY(S->ctx, fcm_integrator_add_contact_bodies(S->integ, S->geom, &c->options, NULL));
+    break;
   default:
     FCM_TRY(S->ctx, fcm_surface_create_from_file(S->ctx, c->mesh, &surf));
     st = fcm_integrator_add_contact_surface(

@@ -25,7 +25,7 @@ fcm_contact_options fcm_contact_options_default(void)
 
 static const char *kind_name(sim_contact_kind k)
 {
-  static const char *const names[] = {"plane", "sphere", "box", "surface"};
+  static const char *const names[] = {"plane", "sphere", "box", "surface", "bodies"};
   return names[k];
 }
 
@@ -54,6 +54,9 @@ static fcm_status add_obstacle(fcm_integrator *I, sim_contact *c, const fcm_cont
             FCM_ERR_ARG,
             "contact %s %d: friction_velocity = %g must be finite and >= 0 (0: the default)", kn, k,
             c->opts.friction_velocity);
+  FCM_CHECK(c->kind != SIM_CONTACT_BODIES || c->opts.friction == 0.0, ctx, FCM_ERR_ARG,
+            "contact bodies %d: friction = %g: friction between bodies is not supported (0)", k,
+            c->opts.friction);
   if (c->opts.friction_velocity == 0.0) c->opts.friction_velocity = 1e-3;
   c->motion = fcm_motion_default();
   if (motion) {
@@ -205,9 +208,31 @@ cleanup:
   return st;
 }
 
+fcm_status fcm_integrator_add_contact_bodies(fcm_integrator *I, const fcm_geometry *geom,
+                                             const fcm_contact_options *opts, int *id)
+{
+  fcm_status st = FCM_OK;
+  sim_contact c;
+  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
+  fcm_ctx *ctx = I->ctx;
+  const int k = I->num_contacts;
+  FCM_CHECK(geom, ctx, FCM_ERR_ARG, "contact bodies %d: NULL geometry", k);
+  for (int j = 0; j < I->num_contacts; j++)
+    FCM_CHECK(I->contacts[j].kind != SIM_CONTACT_BODIES, ctx, FCM_ERR_ARG,
+              "contact bodies %d: contact between bodies is already on (contact %d)", k, j);
+  memset(&c, 0, sizeof c);
+  c.kind = SIM_CONTACT_BODIES;
+  c.geom = geom;
+  FCM_TRY(ctx, add_obstacle(I, &c, opts, NULL, id));
+cleanup:
+  return st;
+}
+
 fcm_status fcm__sim_contact_copy(fcm_integrator *I, const sim_contact *c)
 {
   switch (c->kind) {
+  case SIM_CONTACT_BODIES:
+    return fcm_integrator_add_contact_bodies(I, c->geom, &c->opts, NULL);
   case SIM_CONTACT_PLANE:
     return fcm_integrator_add_contact_plane(I, c->point, c->normal, c->velocity, &c->opts, NULL);
   case SIM_CONTACT_SPHERE:
@@ -237,6 +262,7 @@ void fcm__sim_contact_free(fcm_integrator *I)
   fcm__geom_idbuf_free(ctx, &cp->buf);
   for (int k = 0; k < I->num_contacts; k++) {
     sim_contact *c = &I->contacts[k];
+    fcm__sim_bodies_free(ctx, c);
     fcm_aabb_tree_destroy(&c->tree);
     fcm__free(ctx, c->xyz);
     fcm__free(ctx, c->tri);
@@ -294,9 +320,14 @@ static fcm_status collect(fcm_integrator *I, int pass, fcm_index *np_out, fcm_in
     double X[3 * FCM_ELEMENT_MAX_NODES], N[FCM_ELEMENT_MAX_NODES];
     FCM_TRY(I->ctx, fcm_cell_rules_get_piece_surface(s->rules, s->elem_piece[e], &nsp, &pts, &wts,
                                                      &nrm, NULL));
-    if (nsp == 0) continue;
+    const fcm_index nextra = fcm__sim_bodies_element_nodes(I, e, NULL, NULL, NULL);
+    if (nsp == 0 && nextra == 0) continue;
     fcm_mesh_cell_coords(s->mesh, s->elem_cell[e], X);
     const fcm_index first = np;
+    /* contact between bodies: its surface's nodes in e too (the cut faces have no rule) */
+    if (pass == 1)
+      fcm__sim_bodies_element_nodes(I, e, cp->w + np, cp->X + 3 * np, cp->N + (size_t)np * nn);
+    np += nextra;
     for (int q = 0; q < nsp; q++) {
       if (!(wts[q] > 0.0)) continue;
       if (pass == 1) {
@@ -356,6 +387,7 @@ fcm_status fcm__sim_contact_check(fcm_integrator *I, const double *x, double t)
       point_position(cp, nn, p, ue, y);
       for (int c = 0; c < I->num_contacts; c++) {
         const sim_contact *ct = &I->contacts[c];
+        if (ct->kind == SIM_CONTACT_BODIES) continue;
         FCM_TRY(ctx, fcm__sim_contact_inside(ctx, ct, &cp->pose[c], y, t, &cp->buf, &inside));
         if (!inside) continue;
         FCM_TRY(ctx, fcm__sim_contact_distance(ctx, ct, &cp->pose[c], y, t,
@@ -385,6 +417,9 @@ fcm_status fcm__sim_contact_setup(fcm_integrator *I)
   fcm_index np = 0, ne = 0;
   if (I->num_contacts == 0) return FCM_OK;
   const char *kn = kind_name(I->contacts[0].kind);
+  for (int c = 0; c < I->num_contacts; c++) /* the surface first: its nodes join the points */
+    if (I->contacts[c].kind == SIM_CONTACT_BODIES)
+      FCM_TRY(ctx, fcm__sim_bodies_setup(I, &I->contacts[c]));
   FCM_CHECK(!fcm__integrator_distributed(I, NULL), ctx, FCM_ERR_UNSUPPORTED,
             "contact %s 0: contact is not supported with a distributed backend", kn);
   FCM_CHECK(s->rules && fcm_cell_rules_surface_strength(s->rules) >= 0, ctx, FCM_ERR_ARG,
@@ -460,6 +495,7 @@ static int point_terms(fcm_integrator *I, const double y[3], double w, const dou
   for (int c = 0; c < I->num_contacts; c++) {
     const sim_contact *ct = &I->contacts[c];
     double d, g[3], b1, b2, f[3], H[9];
+    if (ct->kind == SIM_CONTACT_BODIES) continue;
     if (fcm__sim_contact_distance(I->ctx, ct, &I->cp.pose[c], y, t, ct->dhat, &I->cp.buf, &d, g,
                                   NULL) != FCM_OK)
       return 0;
@@ -527,6 +563,9 @@ void fcm__sim_contact_assemble(fcm_integrator *I, const double *x, double *energ
     }
     if (T) fcm__sim_scatter(s, cp->lelem[k], Ke, vals);
   }
+  for (int c = 0; c < I->num_contacts && *finite; c++)
+    if (I->contacts[c].kind == SIM_CONTACT_BODIES)
+      fcm__sim_bodies_assemble(I, &I->contacts[c], x, &etot, force, T, finite);
   if (!isfinite(etot)) *finite = 0;
   if (energy) *energy += etot;
 }
@@ -550,6 +589,7 @@ double fcm__sim_contact_step_bound(fcm_integrator *I, const double *x, const dou
           dy[i] += N[a] * de[3 * a + i];
       for (int c = 0; c < I->num_contacts; c++) {
         double sc = HUGE_VAL;
+        if (I->contacts[c].kind == SIM_CONTACT_BODIES) continue;
         /* fractions beyond 1 / 0.9 never limit a step: the segment's search stops at 2 */
         if (fcm__sim_contact_toi(I->ctx, &I->contacts[c], &cp->pose[c], y, dy, I->bc_time, 2.0,
                                  &cp->buf, &sc) != FCM_OK)
@@ -559,6 +599,9 @@ double fcm__sim_contact_step_bound(fcm_integrator *I, const double *x, const dou
       }
     }
   }
+  for (int c = 0; c < I->num_contacts; c++)
+    if (I->contacts[c].kind == SIM_CONTACT_BODIES)
+      amax = FCM_MIN(amax, fcm__sim_bodies_step_bound(I, &I->contacts[c], x, dx));
   return amax;
 }
 
@@ -616,6 +659,16 @@ fcm_status fcm_integrator_contact_info(const fcm_integrator *I, int id, double f
   FCM_CHECK(I->is_setup, ctx, FCM_ERR_ARG, "contact info: the integrator is not set up");
   FCM_CHECK(id >= 0 && id < I->num_contacts, ctx, FCM_ERR_ARG,
             "contact info: obstacle %d out of range [0, %d)", id, I->num_contacts);
+  if (I->contacts[id].kind == SIM_CONTACT_BODIES) { /* no net force: the pieces push each other */
+    long long pairs = 0;
+    double dmin = HUGE_VAL, e = 0.0;
+    FCM_TRY(ctx, fcm__sim_bodies_stats(I, &I->contacts[id], I->u, &pairs, &dmin, &e));
+    if (force) force[0] = force[1] = force[2] = 0.0;
+    if (min_distance) *min_distance = dmin;
+    if (dhat) *dhat = I->contacts[id].dhat;
+    if (kappa) *kappa = I->contacts[id].kappa;
+    return FCM_OK;
+  }
   {
     const sim_cpoints *cp = &I->cp;
     const sim_contact *ct = &I->contacts[id];
@@ -671,6 +724,8 @@ fcm_status fcm_integrator_contact_distance(const fcm_integrator *I, int id, cons
   FCM_CHECK(id >= 0 && id < I->num_contacts, ctx, FCM_ERR_ARG,
             "contact distance: obstacle %d out of range [0, %d)", id, I->num_contacts);
   FCM_CHECK(x && distance, ctx, FCM_ERR_ARG, "contact distance: NULL point or distance");
+  FCM_CHECK(I->contacts[id].kind != SIM_CONTACT_BODIES, ctx, FCM_ERR_ARG,
+            "contact distance: contact %d is between bodies (no obstacle to measure to)", id);
   {
     const sim_contact *ct = &I->contacts[id];
     double g[3], H[9];
@@ -756,6 +811,7 @@ fcm_status fcm_integrator_contact_stats(const fcm_integrator *I, fcm_contact_sta
         for (int c = 0; c < I->num_contacts; c++) {
           const sim_contact *ct = &I->contacts[c];
           sim_pose P;
+          if (ct->kind == SIM_CONTACT_BODIES) continue;
           fcm__sim_contact_pose(ct, I->t, &P);
           FCM_TRY(ctx,
                   fcm__sim_contact_distance(ctx, ct, &P, y, I->t, ct->dhat, &buf, &d, g, NULL));
@@ -769,6 +825,17 @@ fcm_status fcm_integrator_contact_stats(const fcm_integrator *I, fcm_contact_sta
           out->friction_dissipation += fcm__sim_contact_friction_work(I, p, y, y0);
         }
       }
+    }
+    for (int c = 0; c < I->num_contacts; c++) {
+      long long pairs = 0;
+      double dmin = HUGE_VAL, e = 0.0;
+      if (I->contacts[c].kind != SIM_CONTACT_BODIES) continue;
+      FCM_TRY(ctx, fcm__sim_bodies_stats(I, &I->contacts[c], I->u, &pairs, &dmin, &e));
+      out->active_points += pairs;
+      out->body_pairs += pairs;
+      out->barrier_energy += e;
+      out->tree_builds += fcm__sim_bodies_builds(&I->contacts[c]);
+      FCM_TRY(ctx, fcm__sim_bodies_depth(I, &I->contacts[c], I->u, &out->body_depth, NULL));
     }
   }
 cleanup:

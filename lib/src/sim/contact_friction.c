@@ -52,6 +52,9 @@ fcm_status fcm__sim_contact_lag(fcm_integrator *I, double h)
   sim_cpoints *cp = &I->cp;
   const int nn = I->space->nn, nc = I->num_contacts;
   double ue[3 * FCM_ELEMENT_MAX_NODES];
+  for (int c = 0; c < nc; c++) /* contact between bodies: who starts near whom */
+    if (I->contacts[c].kind == SIM_CONTACT_BODIES)
+      FCM_TRY(ctx, fcm__sim_bodies_prepare(I, &I->contacts[c], I->un));
   if (!cp->lag) return FCM_OK;
   cp->t0 = I->bc_time - h;
   cp->hstep = h;

@@ -406,6 +406,10 @@ static fcm_status direction(fcm_integrator *I, int predictor, fcm_step_reason *r
   fcm_status st = FCM_OK;
   FCM_TRY(I->ctx, fcm__sim_solve(I, I->b, I->d, reason, its, stats));
   if (*reason != FCM_STEP_NONE) return FCM_OK;
+  /* contact between bodies: the pieces' coupling the space's pattern cannot hold */
+  if (I->num_contacts > 0)
+    FCM_TRY(I->ctx, fcm__sim_bodies_refine(I, I->b, I->d, reason, its, stats));
+  if (*reason != FCM_STEP_NONE) return FCM_OK;
   if (!all_finite(I->n, I->d)) {
     *reason = FCM_STEP_NONFINITE;
     return FCM_OK;

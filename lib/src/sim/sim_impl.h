@@ -62,8 +62,11 @@ typedef enum sim_contact_kind {
   SIM_CONTACT_PLANE = 0, /* the half-space n . (x - p0 - v t) <= 0 (n unit) */
   SIM_CONTACT_SPHERE,    /* the ball |X - c| <= r in the obstacle's frame */
   SIM_CONTACT_BOX,       /* the box lo <= X <= hi in the obstacle's frame */
-  SIM_CONTACT_SURFACE    /* the volume a closed triangle surface encloses, in its frame */
+  SIM_CONTACT_SURFACE,   /* the volume a closed triangle surface encloses, in its frame */
+  SIM_CONTACT_BODIES     /* the other bodies and cut pieces of the space (contact_bodies.c) */
 } sim_contact_kind;
+
+struct sim_bodies;
 
 /* A contact obstacle. Spheres, boxes and surfaces are given in their own frame, placed at
  * time t by the rigid motion x = o(t) + R(t) X that `motion` prescribes (fcm_motion_eval()). */
@@ -80,6 +83,8 @@ typedef struct sim_contact {
   fcm_aabb_tree *tree;                     /* surface: over the triangles */
   fcm_contact_options opts;                /* as given (0: default) */
   double dhat, kappa;                      /* the barrier's threshold and stiffness (setup) */
+  const fcm_geometry *geom;                /* bodies: the geometry the space was built on */
+  struct sim_bodies *bodies;               /* bodies: the surface and its pairs (setup) */
 } sim_contact;
 
 /* An obstacle's placement at one time: world x = o + R X (R row-major). */
@@ -421,6 +426,101 @@ fcm_status fcm__sim_contact_inside(fcm_ctx *ctx, const sim_contact *c, const sim
 fcm_status fcm__sim_contact_surface_setup(fcm_ctx *ctx, int k, sim_contact *c);
 /* A search radius about y that holds the surface's closest triangle. */
 double fcm__sim_contact_reach(const sim_contact *c, const sim_pose *P, const double y[3]);
+/* A bounding-volume hierarchy with one subtree per group (contact_bvh.c). build: over the
+ * items k < n with group[k] >= 0 and their boxes (n x 6: lo, hi); refit: the same tree over
+ * moved boxes; query: append to buf (not reset) the items of group g whose box meets
+ * [lo, hi]. */
+typedef struct sim_bvh_node {
+  double lo[3], hi[3];
+  fcm_index first, count, right; /* a leaf: perm[first, first + count); else the right child */
+} sim_bvh_node;
+typedef struct sim_bvh {
+  sim_bvh_node *node;
+  fcm_index nnodes, cap;
+  fcm_index *perm, *root, num_groups;
+} sim_bvh;
+fcm_status fcm__sim_bvh_build(fcm_ctx *ctx, sim_bvh *T, fcm_index n, const fcm_index *group,
+                              fcm_index num_groups, const double *boxes);
+void fcm__sim_bvh_refit(sim_bvh *T, const double *boxes);
+fcm_status fcm__sim_bvh_query(fcm_ctx *ctx, const sim_bvh *T, fcm_index g, const double *boxes,
+                              const double lo[3], const double hi[3], fcm__idbuf *buf);
+void fcm__sim_bvh_free(fcm_ctx *ctx, sim_bvh *T);
+
+/* Contact between bodies (contact_bodies.c, contact_bodies_solve.c): a sample's blind list
+ * holds up to SIM_BLIND bodies. */
+#define SIM_BLIND 8
+
+/* A pair within d^ at the Newton matrix's assembly: sample n, triangle t, the distance's
+ * gradient g, the closest point's barycentric coordinates beta, w kappa b''(d). */
+typedef struct sim_pair {
+  fcm_index n, t;
+  double g[3], beta[3], c2;
+} sim_pair;
+
+typedef struct sim_bodies {
+  fcm_embedded_surface *es;
+  fcm_index nv, nt, ns;
+  fcm_index *velem;     /* nv: the element holding node v */
+  double *vX, *vN;      /* nv x 3 reference positions, nv x nn shape values */
+  const fcm_index *tri; /* nt x 3 (the surface's) */
+  fcm_index *tbody;     /* nt: the triangle's body, -1 for a triangle without area */
+  fcm_index *stri;      /* ns: the sample's triangle */
+  double *slam, *sw;    /* ns x 3 barycentric coordinates, ns weights */
+  fcm_index *blind;     /* ns x SIM_BLIND: bodies the sample ignores (-1: none) */
+  fcm_index *lag_t;     /* ns x SIM_BLIND: their closest triangle at the substep's start */
+  double *lag;          /* ns x SIM_BLIND x 6: its closest point's beta and its unit normal */
+  int prepared;
+  double *y, *dy, *boxes; /* nv x 3, nv x 3, nt x 6 */
+  double *Ke;             /* (3 nn)^2 */
+  fcm_index num_bodies;
+  fcm_index *eptr, *enode; /* num_elems + 1 offsets, nv: the nodes of each element */
+  double *vw;              /* nv: a node's weight against the obstacles */
+  sim_bvh bvh;
+  int built;
+  fcm_index *near_ptr, *near; /* num_bodies + 1, num_bodies^2: the bodies near each body */
+  sim_pair *pairs;            /* the pairs within d^ at the last Newton matrix's assembly */
+  size_t npairs, cap_pairs;
+  double *w1, *w2, *w3, *w4; /* n each: the direction's refinement */
+  fcm__idbuf buf;
+  long long builds;
+} sim_bodies;
+
+/* Contact between bodies and cut pieces (contact_bodies.c), the obstacle kind
+ * SIM_CONTACT_BODIES: setup builds the embedded surface of the space (c->bodies); free releases
+ * it. prepare: at a substep's start (state un), the sample points that started within d^ of
+ * another piece become blind to it until they are d^ away (cut faces start in contact).
+ * assemble / step_bound as the obstacles' (the tangent a block-diagonal bound of the pairs'
+ * Hessians, the step bound conservative). stats: pairs within d^, the smallest distance, the
+ * barrier energy at x. */
+fcm_status fcm__sim_bodies_setup(fcm_integrator *I, sim_contact *c);
+void fcm__sim_bodies_free(fcm_ctx *ctx, sim_contact *c);
+fcm_status fcm__sim_bodies_prepare(fcm_integrator *I, sim_contact *c, const double *x);
+void fcm__sim_bodies_assemble(fcm_integrator *I, sim_contact *c, const double *x, double *energy,
+                              double *force, fcm_csr *T, int *finite);
+double fcm__sim_bodies_step_bound(fcm_integrator *I, sim_contact *c, const double *x,
+                                  const double *dx);
+fcm_status fcm__sim_bodies_stats(const fcm_integrator *I, const sim_contact *c, const double *x,
+                                 long long *pairs, double *min_distance, double *energy);
+/* The largest depth of a sample inside another body at x (a ray's parity, then the distance
+ * to that body's nearest triangle; 0: none) and where (may be NULL). */
+fcm_status fcm__sim_bodies_depth(const fcm_integrator *I, const sim_contact *c, const double *x,
+                                 double *depth, double where[3]);
+/* The surface nodes of the contact between bodies that lie in element e (0 without it): their
+ * count and, where the arrays are given, their obstacle weights (the area of the cut-face
+ * triangles about them; 1e-3 of their area elsewhere, where the surface rules act already),
+ * reference positions and shape values. */
+fcm_index fcm__sim_bodies_element_nodes(const fcm_integrator *I, fcm_index e, double *w, double *X,
+                                        double *N);
+/* Newton's direction d (H d = b solved by the factorization of the Newton matrix H, which
+ * holds a block-diagonal bound of the pairs' coupling) refined by preconditioned conjugate
+ * gradients on the coupled matrix (H + C - C_bd, the recorded pairs), preconditioned by H's
+ * solve; nothing without pairs or on an octree mesh. */
+fcm_status fcm__sim_bodies_refine(fcm_integrator *I, const double *b, double *d,
+                                  fcm_step_reason *reason, int *its, sim_stats *stats);
+/* The sample points and (in *triangles, may be NULL) the triangles of the surface. */
+fcm_index fcm__sim_bodies_samples(const sim_contact *c, fcm_index *triangles);
+/* The search trees built so far (each evaluation, step bound and stats builds one). */
+long long fcm__sim_bodies_builds(const sim_contact *c);
 int fcm__sim_point_triangle(const double p[3], const double a[3], const double b[3],
                             const double c[3], double q[3], double e[3]);
 void fcm__sim_point_triangle_distance(const double p[3], const double a[3], const double b[3],
