@@ -58,8 +58,8 @@ static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS
        1, 1e9, 0, NULL, NULL, NULL},
       {"--resume", NULL, CLI_STRING, &o->resume, "FILE",
        "continue from a checkpoint of the same scene, bit for bit\n"
-       "as the uninterrupted run; frames and log go on in the\n"
-       "output directory",
+       "as the uninterrupted run with the same checkpoint\n"
+       "interval; frames and log go on in the output directory",
        0, 0, 0, NULL, NULL, NULL},
       {"--preview", NULL, CLI_FLAG, &o->preview, NULL,
        "build only the background and the geometry, write\n"
@@ -75,7 +75,8 @@ static void scene_option_table(scene_options *o, cli_option opts[SIM_NUM_OPTIONS
        "(energy, momentum, Newton iterations, reactions; gnuplot,\n"
        "through the script <name>_log.gp written beside it)",
        0, 0, 0, NULL, NULL, NULL},
-      {"--quiet", "-q", CLI_FLAG, &o->quiet, NULL, "print only errors", 0, 0, 0, NULL, NULL, NULL},
+      {"--quiet", "-q", CLI_FLAG, &o->quiet, NULL, "print only errors and warnings", 0, 0, 0, NULL,
+       NULL, NULL},
       {"--progress", NULL, CLI_FLAG, &o->progress, NULL,
        "report the set-up also when stderr is not a terminal: a\n"
        "line when a long phase starts (the cell rules, the level\n"
