@@ -259,7 +259,10 @@ static fcm_status transfer_points(fcm_ctx *ctx, oct_transfer *t)
   FCM_ALLOC(ctx, nn + 1, t->node);
   for (fcm_index v = 0; v < nn; v++) {
     const fcm_index d = fcm_space_node_dof(t->sf, v);
-    if (d >= 0 && t->cf->free_dof[d] >= 0) t->node[t->nnode++] = v;
+    int any = 0;
+    for (fcm_index k = 0; d >= 0 && k < fcm_space_node_copies(t->sf, v); k++)
+      any |= t->cf->free_dof[d + 3 * k] >= 0;
+    if (any) t->node[t->nnode++] = v;
   }
   FCM_ALLOC(ctx, 3 * t->nnode + 1, P);
   FCM_ALLOC(ctx, 3 * t->nnode + 1, t->xi);
@@ -306,15 +309,20 @@ static fcm_status octree_prolongation(fcm_ctx *ctx, oct_transfer *t, mg_level *F
   FCM_ALLOC(ctx, C->n + 1, used);
   FCM_ALLOC(ctx, F->n + 1, F->P_ptr);
   for (fcm_index i = 0; i < t->nnode; i++)
-    for (int c = 0; c < 3; c++)
-      F->P_ptr[fcm_space_node_dof(t->sf, t->node[i]) + c + 1] = transfer_row(t, i, c);
+    for (fcm_index r = fcm_space_node_dof(t->sf, t->node[i]),
+                   r1 = r + 3 * fcm_space_node_copies(t->sf, t->node[i]);
+         r < r1; r++)
+      if (t->cf->free_dof[r] >= 0) F->P_ptr[r + 1] = transfer_row(t, i, (int)(r % 3));
   for (fcm_index r = 0; r < F->n; r++)
     F->P_ptr[r + 1] += F->P_ptr[r];
   FCM_ALLOC(ctx, F->P_ptr[F->n] + 1, F->P_col);
   FCM_ALLOC(ctx, F->P_ptr[F->n] + 1, F->P_val);
   for (fcm_index i = 0; i < t->nnode; i++)
-    for (int c = 0; c < 3; c++) {
-      const fcm_index r = fcm_space_node_dof(t->sf, t->node[i]) + c, q = transfer_row(t, i, c);
+    for (fcm_index r = fcm_space_node_dof(t->sf, t->node[i]),
+                   r1 = r + 3 * fcm_space_node_copies(t->sf, t->node[i]);
+         r < r1; r++) {
+      if (t->cf->free_dof[r] < 0) continue;
+      const fcm_index q = transfer_row(t, i, (int)(r % 3));
       for (fcm_index p = 0; p < q; p++) {
         const fcm_index J = (fcm_index)t->buf[2 * p];
         F->P_col[F->P_ptr[r] + p] = (int)J;
@@ -348,14 +356,8 @@ static fcm_status octree_level0(fcm_mg *m, const fcm_csr *A, const unsigned char
   const fcm_index nn = fcm_mesh_num_nodes(mesh), nc = fcm_mesh_num_cells(mesh);
   const fcm_cell_rules *rules = fcm_space_cell_rules(sp);
   fcm_index nk = 0;
-  for (fcm_index v = 0; v < nn; v++) {
-    const fcm_index k = fcm_space_node_copies(sp, v);
-    FCM_CHECK(k <= 1, ctx, FCM_ERR_UNSUPPORTED,
-              "mg: node %lld of the octree space has %lld DOF copies; the octree hierarchy needs "
-              "one copy per node (no cuts)",
-              (long long)v, (long long)k);
-    nk += k;
-  }
+  for (fcm_index v = 0; v < nn; v++)
+    nk += fcm_space_node_copies(sp, v);
   oct_base g;
   base_of(mesh, &g);
   for (int d = 0; d < 3; d++) /* the lattice of the finest cells */
