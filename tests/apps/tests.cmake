@@ -49,9 +49,10 @@ fcm_add_test(app_sim_default tests/apps/sim_app.c LABELS app slow TIMEOUT 1200
 # cutbench bunny scenes, whose cuts need the body's volume mesh.
 set(fcm_check_scenes spinning_body slingshot hollow_ball static_beam cantilever twisting_cylinder
     voxel_block gyroid_lattice cut_slab dice cracked_beam clamped_surface hollow_ball_multigrid
-    vibrating_beam octree_ball_hex8 octree_ball_hex20 octree_ball_multigrid octree_cut_ball_hex8
-    octree_cut_ball_hex20 ball_on_floor ball_off_wedge)
+    vibrating_beam octree_ball_hex8 octree_ball_hex20 octree_ball_multigrid ball_on_floor
+    ball_off_wedge)
 list(APPEND fcm_check_scenes cutbench_tonthat_slab)
+list(APPEND fcm_check_scenes octree_cut_ball_hex8 octree_cut_ball_hex20)
 if(FCM_HAVE_GMSH)
   list(APPEND fcm_check_scenes surface_drop cutbench_dick_bunny3 cutbench_koschier_bunny)
 endif()
