@@ -58,6 +58,7 @@ set(fcm_check_scenes spinning_body slingshot hollow_ball static_beam cantilever 
     vibrating_beam octree_ball_hex8 octree_ball_hex20 octree_ball_multigrid ball_on_floor
     ball_off_wedge dice_on_floor cut_bar_resting)
 list(APPEND fcm_check_scenes cutbench_tonthat_slab)
+list(APPEND fcm_check_scenes octree_cut_ball_hex8 octree_cut_ball_hex20)
 if(FCM_HAVE_GMSH)
   list(APPEND fcm_check_scenes surface_drop cutbench_dick_bunny3 cutbench_koschier_bunny)
 endif()

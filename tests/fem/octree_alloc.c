@@ -1,14 +1,17 @@
 /* Allocation-failure torture for the octree: fcm_mesh_create_octree, fcm_mesh_create_refined,
- * fcm_space_hanging_matrix_create and fcm_csr_create_ptap, Hex8 and Hex20: failing the k-th
+ * fcm_space_hanging_matrix_create and fcm_csr_create_ptap, and on a cut octree
+ * fcm_space_hanging_matrix_create (copies per component), Hex8 and Hex20: failing the k-th
  * allocation (k = 0, 1, ... until success) returns FCM_ERR_ALLOC, leaves the output NULL and
  * leaks nothing. */
 #include "alloc_loop.h"
 #include "fcm/fcm.h"
 
 #include <math.h>
+#include <string.h>
 
 typedef struct octree_case {
   fcm_ctx *ctx;
+  failing *f;
   fcm_element_type type;
   const fcm_mesh *base;
   const fcm_space *space;
@@ -69,10 +72,37 @@ static void release(void *user)
   fcm_csr_destroy(&c->C);
 }
 
+/* The cut octree: a box body cut through by a tilted plane across the level changes. */
+static void cut_case(octree_case *c)
+{
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, clo[3] = {-1, -1, -1}, chi[3] = {2, 2, 2};
+  const double p[3] = {0.43, 0.5, 0.5}, n[3] = {1, 0.2, 0.1};
+  const fcm_index nb[3] = {1, 1, 1};
+  fcm_geometry *body = NULL;
+  fcm_cell_rules *rules = NULL, *cr = NULL;
+  fcm_surface *plane_cut = NULL;
+  fcm_space *space = NULL;
+  TEST_OK(c->ctx, fcm_geometry_create_box(c->ctx, lo, hi, nb, &body));
+  TEST_OK(c->ctx, fcm_cell_rules_create(c->ctx, c->base, body, NULL, &rules));
+  TEST_OK(c->ctx, fcm_surface_create_plane(c->ctx, p, n, clo, chi, &plane_cut));
+  TEST_OK(c->ctx, fcm_cell_rules_create_cut(c->ctx, c->base, body, rules, plane_cut, &cr));
+  TEST_OK(c->ctx, fcm_space_create_embedded(c->ctx, c->base, cr, &space));
+  TEST_TRUE(space && fcm_space_num_bodies(space) == 2);
+  c->space = space;
+  alloc_loop(c->ctx, c->f, "hanging_matrix_create (cut)", hanging, release, c, 5, 400);
+  fcm_space_destroy(&space);
+  fcm_cell_rules_destroy(&cr);
+  fcm_cell_rules_destroy(&rules);
+  fcm_surface_destroy(&plane_cut);
+  fcm_geometry_destroy(&body);
+}
+
 int main(void)
 {
   failing f;
-  octree_case c = {failing_ctx(&f), FCM_ELEMENT_HEX8, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
+  octree_case c;
+  memset(&c, 0, sizeof c);
+  c.ctx = failing_ctx(&f), c.f = &f, c.type = FCM_ELEMENT_HEX8;
   TEST_TRUE(c.ctx != NULL);
   if (!c.ctx) return TEST_RESULT();
   for (int t = 0; t < 2; t++) {
@@ -96,6 +126,7 @@ int main(void)
     TEST_OK(c.ctx, fcm_space_matrix_create(space, &K));
     c.K = K, c.T = T;
     alloc_loop(c.ctx, &f, "create_ptap", ptap, release, &c, 3, 400);
+    cut_case(&c);
     fcm_csr_destroy(&K);
     fcm_csr_destroy(&T);
     fcm_space_destroy(&space);

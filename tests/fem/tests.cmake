@@ -75,6 +75,11 @@ endforeach()
 foreach(el hex8 hex20)
   fcm_add_test(fem_octree_embedded_${el} tests/fem/octree_embedded.c ARGS ${el} LABELS conformance)
 endforeach()
+# Cuts (XFEM) on octrees: copies of hanging nodes per material component, the patch test on
+# each side of a through-cut, the sides independent, the cut equal to the uniform grid's.
+foreach(el hex8 hex20)
+  fcm_add_test(fem_octree_cut_${el} tests/fem/octree_cut.c ARGS ${el} LABELS conformance)
+endforeach()
 # Allocation failures in the octree's entry points: mesh, refinement, constraints, PtAP.
 fcm_add_test(fem_octree_alloc tests/fem/octree_alloc.c)
 # Fields carried onto a refined octree: momentum and kinetic energy kept, hanging values.

@@ -1,16 +1,20 @@
 /* The background key "octree": refinement along the embedded boundary and in a region parses
  * into the background's fields, round-trips through the normalized JSON, and bad input is
  * refused naming the key (tetrahedra, a boundary criterion without a geometry, an octree over a
- * mesh file, no criterion, a level beyond the limit, cuts on an octree); a scene with an octree
- * background builds and runs a step with the cells of every level it asked for. */
+ * mesh file, no criterion, a level beyond the limit, refinement along cuts without cut effects);
+ * a scene with an octree background builds and runs a step with the cells of every level it
+ * asked for, and one refined along a cut and the boundary cuts the ball in two during the run. */
 #include "scene_util.h"
 
 #include "fcm/simulation.h"
 
 #define GEOM "\"geometry\": {\"shape\": \"ball\", \"center\": [0, 0, 0], \"radius\": 0.6}, "
+#define CUT                                                                                        \
+  "{\"cut\": {\"time\": 0.005, \"surface\": {\"plane\": {\"point\": [0.03, 0, 0], "                \
+  "\"normal\": [1, 0.1, 0]}}}}"
 #define REST                                                                                       \
   "\"material\": {\"model\": \"snh\", \"young\": 1e5, \"poisson\": 0.3, \"density\": 1000}, "      \
-  "\"output\": {\"directory\": \"out\"}, \"time\": {\"dt\": 0.01, \"steps\": 1}"
+  "\"output\": {\"directory\": \"out\"}, \"time\": {\"dt\": 0.01, \"steps\": 2}"
 
 static fcm_scene *parse(fcm_ctx *ctx, const char *element, const char *octree, const char *geom,
                         const char *effects, fcm_status expect, const char *msg)
@@ -67,16 +71,38 @@ int main(void)
   if (s) TEST_TRUE(fcm_scene_get_background(s)->octree_boundary == 0);
   fcm_scene_destroy(&s);
 
+  /* refined along a cut (before it applies) and the boundary; the cut applies during the run
+   * and separates the ball into two bodies */
+  s = parse(ctx, "hex8", "\"octree\": {\"boundary\": {\"level\": 1}, \"cuts\": {\"level\": 2}}",
+            GEOM, CUT, FCM_OK, NULL);
+  if (s) {
+    TEST_TRUE(fcm_scene_get_background(s)->octree_cuts == 2);
+    fcm_simulation *sim = NULL;
+    TEST_OK(ctx, fcm_simulation_create(ctx, s, NULL, &sim));
+    if (sim) {
+      TEST_OK(ctx, fcm_simulation_step(sim, NULL));
+      TEST_OK(ctx, fcm_simulation_step(sim, NULL));
+      char *text = NULL;
+      size_t len = 0;
+      FILE *f = open_memstream(&text, &len);
+      fcm_simulation_summary_view(sim, f);
+      fclose(f);
+      TEST_TRUE(text && strstr(text, "per level 0..2:") && strstr(text, "1 applied") &&
+                strstr(text, "2 bodies"));
+      if (!(text && strstr(text, "2 bodies")) && text) fputs(text, stderr);
+      free(text);
+    }
+    fcm_simulation_destroy(&sim);
+    fcm_scene_destroy(&s);
+  }
   parse(ctx, "tet10", both, GEOM, "", FCM_ERR_ARG, "needs hexahedra");
   parse(ctx, "hex8", "\"octree\": {\"boundary\": {\"level\": 1}}", "", "", FCM_ERR_ARG,
         "background.octree.boundary");
   parse(ctx, "hex8", "\"octree\": {}", GEOM, "", FCM_ERR_ARG, "at least one refinement");
   parse(ctx, "hex8", "\"octree\": {\"boundary\": {\"level\": 13}}", GEOM, "", FCM_ERR_ARG,
         "background.octree.boundary.level");
-  parse(ctx, "hex8", both, GEOM,
-        "{\"cut\": {\"time\": 0.005, \"surface\": {\"plane\": {\"point\": [0, 0, 0], \"normal\": "
-        "[1, 0, 0]}}}}",
-        FCM_ERR_UNSUPPORTED, "cuts on an octree");
+  parse(ctx, "hex8", "\"octree\": {\"cuts\": {\"level\": 1}}", GEOM, "", FCM_ERR_ARG,
+        "background.octree.cuts");
   TEST_ERR(ctx,
            fcm_scene_create_from_string(
                ctx,

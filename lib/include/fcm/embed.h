@@ -339,8 +339,9 @@ FCM_API fcm_status fcm_cell_rules_get_surface(const fcm_cell_rules *rules, fcm_i
  * deterministic translation (1e-7, then 1e-6, 1e-5 of the mean cell size; stats.cut_shift,
  * stats.cut_attempts) and applied again, so no volume is ever lost or doubled.
  * @param[in] mesh, geom the mesh and geometry `prev` was built on; @param[in] cut copied
- * @return FCM_OK; FCM_ERR_ARG (NULL, another mesh); FCM_ERR_UNSUPPORTED (an octree mesh with
- *         hanging nodes: pieces are linked across conforming faces only); FCM_ERR_GEOMETRY
+ * On an octree mesh pieces are also linked across faces between cells of different levels,
+ * where a piece's part of the finer face overlaps a coarser piece's part of the coarser face.
+ * @return FCM_OK; FCM_ERR_ARG (NULL, another mesh); FCM_ERR_GEOMETRY
  *         (every cut triangle without area, giving the first; degenerate cells left after
  *         the largest shift);
  *         FCM_ERR_INTERNAL (a split exceeding the polyhedron

@@ -130,15 +130,19 @@ FCM_API const fcm_mesh *fcm_space_mesh(const fcm_space *space);
  * serendipity face or edge functions), with masters that hang themselves replaced by their
  * own masters (chains at 2:1); every other active DOF is free (its row of T is one 1). The
  * constrained system is T^T K T u_free = T^T f (fcm_csr_create_ptap()); Dirichlet values go on the
- * free DOFs. A node hanging only on inactive cells stays free.
+ * free DOFs. A node hanging only on inactive cells stays free. After cuts (DOF copies), each copy
+ * of a hanging node follows the coarse cell's piece in its own material component (the pieces
+ * around the node joined by the rules' links, across faces of any levels): the copies of the
+ * masters that piece uses; a copy whose component holds no coarse piece stays free.
  * @param[in]  space    any space on any mesh (a mesh without hanging nodes gives T = I)
  * @param[out] free_dof num_dofs entries (may be NULL): the column of each free DOF, -1 for
  *                      a constrained one
  * @param[out] T        the new matrix (FCM_CSR_GENERAL), NULL on failure
- * @return FCM_OK; FCM_ERR_ARG (NULL); FCM_ERR_UNSUPPORTED (a constrained node, or a node of
- *         its cell, with several DOF copies: cuts enrich it; copies constrained to move with
- *         their piece; more free DOFs than 32-bit columns); FCM_ERR_ALLOC.
- * Allocates T and O(num_nodes) scratch. Thread safe. */
+ * @return FCM_OK; FCM_ERR_ARG (NULL); FCM_ERR_UNSUPPORTED (a copy whose component joins two
+ *         pieces of the coarse cell that use different copies of a master: ambiguous; copies
+ *         constrained to move with their piece; more free DOFs than 32-bit columns);
+ *         FCM_ERR_ALLOC.
+ * Allocates T and O(num_nodes + num_elems x nodes per cell) scratch. Thread safe. */
 FCM_API fcm_status fcm_space_hanging_matrix_create(const fcm_space *space, fcm_index *free_dof,
                                                    fcm_csr **T);
 

@@ -51,6 +51,8 @@ typedef struct fcm_scene_background {
   int octree;          /**< 1 when "octree" is given */
   int octree_boundary; /**< "boundary": {"level"}: cells the embedded boundary meets */
   int octree_region;   /**< "region": {"level"}: cells meeting the box below */
+  int octree_cuts;     /**< "cuts": {"level"}: cells the cut effects' surfaces meet (before the
+                            cuts apply) */
   double octree_region_min[3], octree_region_max[3]; /**< "region": {"min", "max"} */
 } fcm_scene_background;
 

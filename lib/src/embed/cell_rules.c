@@ -224,11 +224,6 @@ fcm_status fcm__cell_rules_create_cut_keep(fcm_ctx *ctx, const fcm_mesh *mesh,
                 fcm_mesh_element_type(mesh) == prev->type,
             ctx, FCM_ERR_ARG, "embed cut: the mesh (%lld cells) is not the rules' mesh (%lld)",
             (long long)fcm_mesh_num_cells(mesh), (long long)prev->num_cells);
-  FCM_CHECK(fcm_mesh_num_hanging(mesh) == 0, ctx, FCM_ERR_UNSUPPORTED,
-            "embed cut: the mesh is an octree with %lld hanging nodes; cuts link material pieces "
-            "across conforming faces only, so cutting (XFEM enrichment) needs a background "
-            "without hanging nodes",
-            (long long)fcm_mesh_num_hanging(mesh));
   FCM_CHECK(geom->num_cells > 0, ctx, FCM_ERR_UNSUPPORTED,
             "embed cut: the geometry has no volume mesh (a surface geometry made with "
             "volume_mesh = 0): cutting splits the geometry's cells; create it with a volume mesh");

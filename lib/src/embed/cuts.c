@@ -45,6 +45,124 @@ cleanup:
   return st;
 }
 
+/* A face between cells of different octree levels: face ff of the finer cell lies inside face
+ * fc of the coarser one (a quarter of it under 2:1 balance). */
+typedef struct nc_pair {
+  fcm_index fine, coarse;
+  int ff, fc;
+} nc_pair;
+
+static int cmp_nc_pair(const void *a, const void *b)
+{
+  const nc_pair *x = a, *y = b;
+  if (x->fine != y->fine) return x->fine < y->fine ? -1 : 1;
+  return (x->ff > y->ff) - (x->ff < y->ff);
+}
+
+/* Face fc of the coarse cell whose plane holds face ff of the fine cell, and that contains the
+ * centre of that face, or -1. */
+static int nc_match(const fcm__embed_cell *fine, int ff, const fcm__embed_cell *coarse)
+{
+  const fcm__plane *pf = fine->planes + ff;
+  const double tol = FCM__EMBED_MATCH_RTOL * fine->size;
+  double x[3], s = pf->d;
+  for (int d = 0; d < 3; d++)
+    x[d] = 0.5 * (fine->lo[d] + fine->hi[d]);
+  for (int d = 0; d < 3; d++)
+    s -= pf->n[d] * x[d];
+  for (int d = 0; d < 3; d++) {
+    x[d] += s * pf->n[d];
+    if (x[d] < coarse->lo[d] || x[d] > coarse->hi[d]) return -1;
+  }
+  for (int g = 0; g < coarse->num_planes; g++) {
+    const fcm__plane *pc = coarse->planes + g;
+    if (pc->n[0] * pf->n[0] + pc->n[1] * pf->n[1] + pc->n[2] * pf->n[2] > -0.5) continue;
+    if (fabs(pc->d + pf->d) <= tol) return g;
+  }
+  return -1;
+}
+
+/* The non-conforming face pairs of an octree mesh (none without hanging nodes), one per face of
+ * a finer cell, sorted: found through the hanging pairs, since every such face has a corner
+ * hanging on the coarser cell (the coarse face's centre). */
+static fcm_status nc_pairs(const build *B, nc_pair **out, size_t *np)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_mesh *mesh = B->mesh;
+  const fcm_index nc = fcm_mesh_num_cells(mesh), nn = fcm_mesh_num_nodes(mesh);
+  const fcm_index nh = fcm_mesh_num_hanging(mesh);
+  const int npc = fcm_mesh_nodes_per_cell(mesh), nf = fcm_mesh_get_element_info(mesh)->num_faces;
+  const fcm_index *cells = fcm_mesh_cells(mesh), *nbr = fcm_mesh_neighbors(mesh);
+  fcm_index *ptr = NULL, *inc = NULL;
+  nc_pair *p = NULL;
+  size_t n = 0, cap = 0;
+  *out = NULL, *np = 0;
+  if (nh == 0) return FCM_OK;
+  FCM_ALLOC(ctx, (size_t)nn + 2, ptr);
+  for (size_t i = 0; i < (size_t)nc * (size_t)npc; i++)
+    ptr[cells[i] + 2]++;
+  for (fcm_index k = 0; k < nn; k++)
+    ptr[k + 2] += ptr[k + 1];
+  FCM_ALLOC(ctx, (size_t)nc * (size_t)npc + 1, inc);
+  for (size_t i = 0; i < (size_t)nc * (size_t)npc; i++)
+    inc[ptr[cells[i] + 1]++] = (fcm_index)(i / (size_t)npc);
+  for (fcm_index i = 0; i < nh; i++) {
+    fcm_index c2 = 0, h = 0;
+    fcm_mesh_get_hanging(mesh, i, &c2, &h, NULL);
+    fcm__embed_cell coarse;
+    FCM_TRY(ctx, fcm__embed_cell_setup(ctx, mesh, c2, B->o->clip_rtol, &coarse));
+    for (fcm_index k = ptr[h]; k < ptr[h + 1]; k++) {
+      const fcm_index c = inc[k];
+      fcm__embed_cell fine;
+      int setup = 0;
+      for (int f = 0; f < nf; f++) {
+        if (nbr[(size_t)nf * c + f] != FCM_MESH_NEIGHBOR_NONCONFORMING) continue;
+        if (!setup) FCM_TRY(ctx, fcm__embed_cell_setup(ctx, mesh, c, B->o->clip_rtol, &fine));
+        setup = 1;
+        const int g = nc_match(&fine, f, &coarse);
+        if (g < 0) continue;
+        if (n == cap) {
+          const size_t ncap = cap ? 2 * cap : 64;
+          void *q = p;
+          FCM_TRY(ctx, fcm__resize(ctx, &q, cap, ncap, sizeof *p));
+          p = q, cap = ncap;
+        }
+        p[n++] = (nc_pair){c, c2, f, g};
+      }
+    }
+  }
+  if (n) qsort(p, n, sizeof *p, cmp_nc_pair);
+  size_t u = 0;
+  for (size_t i = 0; i < n; i++)
+    if (u == 0 || cmp_nc_pair(p + u - 1, p + i) != 0) p[u++] = p[i];
+  *out = p, *np = u;
+  p = NULL;
+cleanup:
+  fcm__free(ctx, ptr);
+  fcm__free(ctx, inc);
+  fcm__free(ctx, p);
+  return st;
+}
+
+/* Cells whose links across a non-conforming face are not the extended rules' need their face
+ * polygons (B->same_links cleared). */
+static fcm_status nc_same_links(build *B)
+{
+  fcm_status st = FCM_OK;
+  nc_pair *p = NULL;
+  size_t np = 0;
+  FCM_TRY(B->ctx, nc_pairs(B, &p, &np));
+  for (size_t i = 0; i < np; i++) {
+    const fcm_index a = FCM_MIN(p[i].fine, p[i].coarse), b = FCM_MAX(p[i].fine, p[i].coarse);
+    if (!B->region[a] || !B->region[b] || links_kept(B, a, b)) continue;
+    B->same_links[a] = B->same_links[b] = 0;
+  }
+cleanup:
+  fcm__free(B->ctx, p);
+  return st;
+}
+
 /* Phase 1c (cuts only): the tree of R's cut triangles, the region (cells sharing a node with
  * a cell the cuts reach) and, when extending `prev` by the triangles from first_new on,
  * the cells to integrate (those the new triangles reach). */
@@ -90,6 +208,7 @@ fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new
       if (B->prev_region) B->prev_region[c] |= (h & 2) != 0;
     }
   if (B->prev_region && B->keep) FCM_TRY(ctx, same_links(B));
+  if (B->same_links) FCM_TRY(ctx, nc_same_links(B));
 cleanup:
   fcm__free(ctx, boxes);
   fcm__free(ctx, node_hit);
@@ -151,6 +270,78 @@ static fcm_status copy_links(const build *B, const fcm_cell_rules *R, fcm_index 
                               links, nl, cap));
   }
 cleanup:
+  return st;
+}
+
+/* The links across one non-conforming face: a polygon of a piece of the fine cell on its face
+ * overlaps a polygon of a piece of the coarse cell on the coarse face (the overlap test does not
+ * need equal faces: the fine face is a part of the coarse one), as in
+ * fcm__embed_gather_links(); each link is stored from the piece of the lower-numbered cell. */
+static fcm_status nc_link_pair(const build *B, const fcm_cell_rules *R, const cell_out *out,
+                               const nc_pair *p, fcm__idbuf *tc, fcm_index **links, size_t *nl,
+                               size_t *cap)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_index c = p->fine, c2 = p->coarse;
+  const fcm_index ca = FCM_MIN(c, c2), cb = FCM_MAX(c, c2);
+  if (!B->region[c] || !B->region[c2] || out[c].np == 0 || out[c2].np == 0) return FCM_OK;
+  if (links_kept(B, ca, cb)) return copy_links(B, R, ca, cb, links, nl, cap);
+  fcm__embed_cell cell;
+  FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, B->o->clip_rtol, &cell));
+  const double mtol = FCM__EMBED_MATCH_RTOL * cell.size, atol = 1e-12 * cell.size * cell.size;
+  const double *nf = cell.planes[p->ff].n; /* the coarse polygons face out of c2: normal -n */
+  const double nbn[3] = {-nf[0], -nf[1], -nf[2]};
+  const cell_out *oa = out + c, *ob = out + c2;
+  const size_t nl0 = *nl;
+  size_t xa = 0;
+  for (int i = 0; i < oa->nfp; i++) {
+    const int *ma = oa->fmeta + 4 * i;
+    const double *A = oa->fx + 3 * xa;
+    xa += (size_t)(ma[2] + ma[3]);
+    if (ma[0] != p->ff || ma[1] < 0) continue;
+    size_t xb = 0;
+    for (int j = 0; j < ob->nfp; j++) {
+      const int *mb = ob->fmeta + 4 * j;
+      const double *Bx = ob->fx + 3 * xb;
+      xb += (size_t)(mb[2] + mb[3]);
+      if (mb[0] != p->fc || mb[1] < 0) continue;
+      const int qa = c < c2 ? ma[1] : mb[1], qb = c < c2 ? mb[1] : ma[1];
+      const fcm_index pa = R->piece_off[ca] + qa, pb = R->piece_off[cb] + qb;
+      int known = 0;
+      for (size_t l = *nl; l-- > nl0 && !known;)
+        known = (*links)[2 * l] == pa && (*links)[2 * l + 1] == pb;
+      if (known) continue;
+      double lo[3], hi[3];
+      for (int d = 0; d < 3; d++) {
+        lo[d] = HUGE_VAL, hi[d] = -HUGE_VAL;
+        for (int k = 0; k < ma[2]; k++)
+          lo[d] = fmin(lo[d], A[3 * k + d] - mtol), hi[d] = fmax(hi[d], A[3 * k + d] + mtol);
+      }
+      FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, lo, hi, tc));
+      if (!fcm__embed_linked(A, ma[2], A + 3 * ma[2], ma[3], Bx, mb[2], Bx + 3 * mb[2], mb[3], nbn,
+                             mtol, atol, B->cut_tris, tc->ids, tc->n))
+        continue;
+      if (!earlier_link(B, ca, cb, out[ca].pc[qa].parent, out[cb].pc[qb].parent)) continue;
+      FCM_TRY(ctx, push_link(ctx, pa, pb, links, nl, cap));
+    }
+  }
+cleanup:
+  return st;
+}
+
+/* The links across every non-conforming face of an octree mesh (nc_link_pair()). */
+static fcm_status nc_links(const build *B, const fcm_cell_rules *R, const cell_out *out,
+                           fcm__idbuf *tc, fcm_index **links, size_t *nl, size_t *cap)
+{
+  fcm_status st = FCM_OK;
+  nc_pair *p = NULL;
+  size_t np = 0;
+  FCM_TRY(B->ctx, nc_pairs(B, &p, &np));
+  for (size_t i = 0; i < np; i++)
+    FCM_TRY(B->ctx, nc_link_pair(B, R, out, p + i, tc, links, nl, cap));
+cleanup:
+  fcm__free(B->ctx, p);
   return st;
 }
 
@@ -223,6 +414,7 @@ fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell
       }
     }
   }
+  FCM_TRY(ctx, nc_links(B, R, out, &tc, &links, &nl, &cap));
   if (nl) qsort(links, nl, 2 * sizeof *links, cmp_link);
   R->links = links;
   R->num_links = (fcm_index)nl;

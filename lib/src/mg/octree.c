@@ -246,8 +246,9 @@ static fcm_index transfer_row(const oct_transfer *t, fcm_index i, int c)
   return out;
 }
 
-/* The fine nodes with free DOFs, their coarse cells and reference coordinates there (the
- * nodes of nested octrees sit at dyadic reference points: snapped to multiples of 1/4). */
+/* The fine nodes with free DOFs (unless t->node lists them already), their coarse cells and
+ * reference coordinates there (the nodes of nested octrees sit at dyadic reference points:
+ * snapped to multiples of 1/4). */
 static fcm_status transfer_points(fcm_ctx *ctx, oct_transfer *t)
 {
   fcm_status st = FCM_OK;
@@ -256,10 +257,14 @@ static fcm_status transfer_points(fcm_ctx *ctx, oct_transfer *t)
   const double *X = fcm_mesh_coords(fm);
   double *P = NULL;
   int *extra = NULL;
-  FCM_ALLOC(ctx, nn + 1, t->node);
-  for (fcm_index v = 0; v < nn; v++) {
+  const int select = !t->node;
+  if (select) FCM_ALLOC(ctx, nn + 1, t->node);
+  for (fcm_index v = 0; select && v < nn; v++) {
     const fcm_index d = fcm_space_node_dof(t->sf, v);
-    if (d >= 0 && t->cf->free_dof[d] >= 0) t->node[t->nnode++] = v;
+    int any = 0;
+    for (fcm_index k = 0; d >= 0 && k < fcm_space_node_copies(t->sf, v); k++)
+      any |= t->cf->free_dof[d + 3 * k] >= 0;
+    if (any) t->node[t->nnode++] = v;
   }
   FCM_ALLOC(ctx, 3 * t->nnode + 1, P);
   FCM_ALLOC(ctx, 3 * t->nnode + 1, t->xi);
@@ -306,15 +311,20 @@ static fcm_status octree_prolongation(fcm_ctx *ctx, oct_transfer *t, mg_level *F
   FCM_ALLOC(ctx, C->n + 1, used);
   FCM_ALLOC(ctx, F->n + 1, F->P_ptr);
   for (fcm_index i = 0; i < t->nnode; i++)
-    for (int c = 0; c < 3; c++)
-      F->P_ptr[fcm_space_node_dof(t->sf, t->node[i]) + c + 1] = transfer_row(t, i, c);
+    for (fcm_index r = fcm_space_node_dof(t->sf, t->node[i]),
+                   r1 = r + 3 * fcm_space_node_copies(t->sf, t->node[i]);
+         r < r1; r++)
+      if (t->cf->free_dof[r] >= 0) F->P_ptr[r + 1] = transfer_row(t, i, (int)(r % 3));
   for (fcm_index r = 0; r < F->n; r++)
     F->P_ptr[r + 1] += F->P_ptr[r];
   FCM_ALLOC(ctx, F->P_ptr[F->n] + 1, F->P_col);
   FCM_ALLOC(ctx, F->P_ptr[F->n] + 1, F->P_val);
   for (fcm_index i = 0; i < t->nnode; i++)
-    for (int c = 0; c < 3; c++) {
-      const fcm_index r = fcm_space_node_dof(t->sf, t->node[i]) + c, q = transfer_row(t, i, c);
+    for (fcm_index r = fcm_space_node_dof(t->sf, t->node[i]),
+                   r1 = r + 3 * fcm_space_node_copies(t->sf, t->node[i]);
+         r < r1; r++) {
+      if (t->cf->free_dof[r] < 0) continue;
+      const fcm_index q = transfer_row(t, i, (int)(r % 3));
       for (fcm_index p = 0; p < q; p++) {
         const fcm_index J = (fcm_index)t->buf[2 * p];
         F->P_col[F->P_ptr[r] + p] = (int)J;
@@ -348,14 +358,8 @@ static fcm_status octree_level0(fcm_mg *m, const fcm_csr *A, const unsigned char
   const fcm_index nn = fcm_mesh_num_nodes(mesh), nc = fcm_mesh_num_cells(mesh);
   const fcm_cell_rules *rules = fcm_space_cell_rules(sp);
   fcm_index nk = 0;
-  for (fcm_index v = 0; v < nn; v++) {
-    const fcm_index k = fcm_space_node_copies(sp, v);
-    FCM_CHECK(k <= 1, ctx, FCM_ERR_UNSUPPORTED,
-              "mg: node %lld of the octree space has %lld DOF copies; the octree hierarchy needs "
-              "one copy per node (no cuts)",
-              (long long)v, (long long)k);
-    nk += k;
-  }
+  for (fcm_index v = 0; v < nn; v++)
+    nk += fcm_space_node_copies(sp, v);
   oct_base g;
   base_of(mesh, &g);
   for (int d = 0; d < 3; d++) /* the lattice of the finest cells */
@@ -395,9 +399,9 @@ cleanup:
   return st;
 }
 
-/* The octree of level l's space without its deepest level, as level l + 1: the coarse mesh and
- * space (owned by m), its constraints, its DOFs and P_l. */
-static fcm_status octree_coarsen(fcm_mg *m, int l, const level_cons *cf, level_cons *cc)
+/* The octree of level l without its deepest level: the coarse mesh and space of level l + 1
+ * (owned by m, cells active where an active finer cell lies) and its constraints. */
+static fcm_status coarse_space(fcm_mg *m, int l, level_cons *cc)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
@@ -406,8 +410,7 @@ static fcm_status octree_coarsen(fcm_mg *m, int l, const level_cons *cf, level_c
   const fcm_index nf = fcm_mesh_num_cells(fm);
   fcm_index *parent = NULL;
   unsigned char *active = NULL;
-  oct_transfer t = {.sf = sf, .cf = cf, .cc = cc};
-  mg_level *F = &m->lev[l], *C = &m->lev[l + 1];
+  mg_level *C = &m->lev[l + 1];
   FCM_ALLOC(ctx, nf + 1, parent);
   FCM_TRY(ctx, truncate_mesh(ctx, fm, &m->oct_mesh[l + 1], parent));
   const fcm_mesh *cm = m->oct_mesh[l + 1];
@@ -415,27 +418,46 @@ static fcm_status octree_coarsen(fcm_mg *m, int l, const level_cons *cf, level_c
   for (fcm_index c = 0; c < nf; c++)
     if (fcm_space_cell_active(sf, c)) active[parent[c]] = 1;
   FCM_TRY(ctx, fcm_space_create(ctx, cm, active, &m->oct_space[l + 1]));
-  t.sc = C->sp = m->oct_space[l + 1];
-  FCM_TRY(ctx, cons_create(ctx, t.sc, cc));
-  C->n = fcm_space_num_dofs(t.sc);
-  C->ncopy = C->n / 3;
-  C->ncell = fcm_space_num_elements(t.sc);
+  C->sp = m->oct_space[l + 1];
+  FCM_TRY(ctx, cons_create(ctx, C->sp, cc));
   oct_base g;
   base_of(cm, &g);
   for (int d = 0; d < 3; d++) /* the lattice of the finest cells */
     C->grid[d] = g.n[d] << fcm_mesh_max_level(cm);
+cleanup:
+  fcm__free(ctx, parent);
+  fcm__free(ctx, active);
+  return st;
+}
+
+static void transfer_free(fcm_ctx *ctx, oct_transfer *t)
+{
+  fcm__free(ctx, t->node);
+  fcm__free(ctx, t->cell);
+  fcm__free(ctx, t->xi);
+  fcm__free(ctx, t->buf);
+}
+
+/* The octree of level l's space without its deepest level, as level l + 1: the coarse mesh and
+ * space (owned by m), its constraints, its DOFs and P_l. */
+static fcm_status octree_coarsen(fcm_mg *m, int l, const level_cons *cf, level_cons *cc)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  oct_transfer t = {.sf = l == 0 ? m->space : m->lev[l].sp, .cf = cf, .cc = cc};
+  mg_level *F = &m->lev[l], *C = &m->lev[l + 1];
+  FCM_TRY(ctx, coarse_space(m, l, cc));
+  t.sc = C->sp;
+  C->n = fcm_space_num_dofs(t.sc);
+  C->ncopy = C->n / 3;
+  C->ncell = fcm_space_num_elements(t.sc);
   FCM_ALLOC(ctx, C->n + 1, C->dof);
   FCM_ALLOC(ctx, C->n + 1, C->inactive);
   for (fcm_index i = 0; i < C->n; i++)
     C->dof[i] = i;
   FCM_TRY(ctx, octree_prolongation(ctx, &t, F, C));
 cleanup:
-  fcm__free(ctx, parent);
-  fcm__free(ctx, active);
-  fcm__free(ctx, t.node);
-  fcm__free(ctx, t.cell);
-  fcm__free(ctx, t.xi);
-  fcm__free(ctx, t.buf);
+  transfer_free(ctx, &t);
   return st;
 }
 
@@ -470,15 +492,312 @@ cleanup:
   return st;
 }
 
+/* ---- separated bodies (cuts): coarse copies per body on the octree levels
+ *
+ * A level's copies that the next coarser level interpolates to: per copy its mesh node, its
+ * body and its first row (-1: a hanging copy, which takes no correction). The coarse level has
+ * one copy per (free coarse node, body) pair that some fine copy of that body reads: the
+ * prolongation gives a fine copy the coarse conforming field of its own body, so bodies the
+ * cuts separate stay apart on every octree level (with one DOF per node they would share the
+ * coarse DOFs where they come closer than a coarse cell). */
+typedef struct oct_copies {
+  fcm_index n, nbody;
+  fcm_index *node, *body, *row;
+} oct_copies;
+
+static void copies_free(fcm_ctx *ctx, oct_copies *c)
+{
+  fcm__free(ctx, c->node);
+  fcm__free(ctx, c->body);
+  fcm__free(ctx, c->row);
+  memset(c, 0, sizeof *c);
+}
+
+static fcm_index find_root(fcm_index *uf, fcm_index a)
+{
+  while (uf[a] != a)
+    a = uf[a] = uf[uf[a]];
+  return a;
+}
+
+/* Level 0's copies: the space's, with the bodies its elements join (copies shared by an
+ * element are in one body). */
+static fcm_status level0_copies(fcm_ctx *ctx, const fcm_space *sp, const level_cons *cf,
+                                oct_copies *out)
+{
+  fcm_status st = FCM_OK;
+  const fcm_mesh *mesh = fcm_space_mesh(sp);
+  const fcm_index nk = fcm_space_num_dofs(sp) / 3, nn = fcm_mesh_num_nodes(mesh);
+  const int npc = fcm_mesh_nodes_per_cell(mesh);
+  fcm_index *uf = NULL;
+  FCM_ALLOC(ctx, nk + 1, uf);
+  FCM_ALLOC(ctx, nk + 1, out->node);
+  FCM_ALLOC(ctx, nk + 1, out->body);
+  FCM_ALLOC(ctx, nk + 1, out->row);
+  out->n = nk;
+  for (fcm_index k = 0; k < nk; k++)
+    uf[k] = k, out->body[k] = -1;
+  for (fcm_index e = 0; e < fcm_space_num_elements(sp); e++) {
+    const fcm_index *ed = fcm_space_element_dofs(sp, e);
+    for (int a = 1; a < npc; a++) {
+      const fcm_index r0 = find_root(uf, ed[0] / 3), r1 = find_root(uf, ed[a] / 3);
+      if (r0 != r1) uf[FCM_MAX(r0, r1)] = FCM_MIN(r0, r1);
+    }
+  }
+  for (fcm_index k = 0; k < nk; k++) {
+    const fcm_index r = find_root(uf, k);
+    out->body[k] = r == k ? out->nbody++ : out->body[r];
+    out->row[k] = cf->free_dof[3 * k] >= 0 ? 3 * k : -1;
+  }
+  for (fcm_index v = 0; v < nn; v++)
+    for (fcm_index k = 0, d = fcm_space_node_dof(sp, v); d >= 0 && k < fcm_space_node_copies(sp, v);
+         k++)
+      out->node[d / 3 + k] = v;
+cleanup:
+  fcm__free(ctx, uf);
+  return st;
+}
+
+/* (coarse node, body) pairs, sorted; the index of one (binary search), -1 when absent. */
+static int cmp_pair(const void *pa, const void *pb)
+{
+  const fcm_index *a = pa, *b = pb;
+  if (a[0] != b[0]) return (a[0] > b[0]) - (a[0] < b[0]);
+  return (a[1] > b[1]) - (a[1] < b[1]);
+}
+
+static fcm_index pair_index(const fcm_index *pairs, fcm_index np, fcm_index node, fcm_index body)
+{
+  const fcm_index key[2] = {node, body};
+  const fcm_index *hit = bsearch(key, pairs, (size_t)np, 2 * sizeof *pairs, cmp_pair);
+  return hit ? (fcm_index)(hit - pairs) / 2 : -1;
+}
+
+/* The coarse copies: the (free coarse node, body) pairs the fine free copies read (t located
+ * their nodes; at[v] is node v's position in t->node); sc_node[J / 3] the coarse node of DOF J. */
+static fcm_status coarse_pairs(fcm_ctx *ctx, const oct_transfer *t, const oct_copies *fc,
+                               const fcm_index *at, const fcm_index *sc_node, fcm_index **pairs,
+                               fcm_index *np)
+{
+  fcm_status st = FCM_OK;
+  size_t n = 0, cap = 0;
+  fcm_index *p = NULL;
+  for (fcm_index k = 0; k < fc->n; k++) {
+    if (fc->row[k] < 0) continue;
+    const fcm_index q = transfer_row(t, at[fc->node[k]], 0);
+    for (fcm_index e = 0; e < q; e++) {
+      if (n == cap) {
+        const size_t nc = cap ? 2 * cap : 1024;
+        void *v = p;
+        FCM_TRY(ctx, fcm__resize(ctx, &v, 2 * cap, 2 * nc, sizeof *p));
+        p = v, cap = nc;
+      }
+      p[2 * n] = sc_node[(fcm_index)t->buf[2 * e] / 3], p[2 * n + 1] = fc->body[k];
+      n++;
+    }
+  }
+  if (n) qsort(p, n, 2 * sizeof *p, cmp_pair);
+  size_t u = 0;
+  for (size_t i = 0; i < n; i++)
+    if (u == 0 || cmp_pair(p + 2 * (u - 1), p + 2 * i) != 0)
+      p[2 * u] = p[2 * i], p[2 * u + 1] = p[2 * i + 1], u++;
+  *pairs = p, *np = (fcm_index)u;
+  p = NULL;
+cleanup:
+  fcm__free(ctx, p);
+  return st;
+}
+
+/* The first pair of coarse node `node` (np when none). */
+static fcm_index first_pair(const fcm_index *pairs, fcm_index np, fcm_index node)
+{
+  fcm_index lo = 0, hi = np;
+  while (lo < hi) {
+    const fcm_index mid = lo + (hi - lo) / 2;
+    if (pairs[2 * mid] < node)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
+/* The coarse level's cells for its statistics (fcm_mg_get_level_info(): bodies): one per
+ * (active coarse cell, body at one of its corners), with its 8 corner copies (a corner without
+ * a copy of that body takes one that has: the cell's body is joined all the same). */
+static fcm_status coarse_cells(fcm_ctx *ctx, mg_level *C, const fcm_index *pairs, fcm_index np)
+{
+  fcm_status st = FCM_OK;
+  const fcm_mesh *cm = fcm_space_mesh(C->sp);
+  const int npc = fcm_mesh_nodes_per_cell(cm);
+  const fcm_index *cells = fcm_mesh_cells(cm);
+  size_t n = 0, cap = 0;
+  fcm_index *corner = NULL;
+  for (fcm_index c = 0; c < fcm_mesh_num_cells(cm); c++) {
+    if (!fcm_space_cell_active(C->sp, c)) continue;
+    const fcm_index *cn = cells + (size_t)npc * c;
+    const size_t n0 = n;
+    for (int a = 0; a < 8; a++)
+      for (fcm_index q = first_pair(pairs, np, cn[a]); q < np && pairs[2 * q] == cn[a]; q++) {
+        const fcm_index b = pairs[2 * q + 1];
+        int seen = 0;
+        for (size_t i = n0; i < n && !seen; i++)
+          seen = pairs[2 * corner[8 * i] + 1] == b;
+        if (seen) continue;
+        if (n == cap) {
+          const size_t nc = cap ? 2 * cap : 256;
+          void *v = corner;
+          FCM_TRY(ctx, fcm__resize(ctx, &v, 8 * cap, 8 * nc, sizeof *corner));
+          corner = v, cap = nc;
+        }
+        for (int k = 0; k < 8; k++) {
+          const fcm_index K = pair_index(pairs, np, cn[k], b);
+          corner[8 * n + k] = K >= 0 ? K : q;
+        }
+        n++;
+      }
+  }
+  C->ncell = (fcm_index)n;
+  C->corner = corner;
+  corner = NULL;
+cleanup:
+  fcm__free(ctx, corner);
+  return st;
+}
+
+/* P_l on the coarse pairs: a fine free copy takes the coarse conforming field of its body. */
+static fcm_status pair_prolongation(fcm_ctx *ctx, const oct_transfer *t, const oct_copies *fc,
+                                    const fcm_index *at, const fcm_index *sc_node,
+                                    const fcm_index *pairs, fcm_index np, mg_level *F, mg_level *C)
+{
+  fcm_status st = FCM_OK;
+  FCM_ALLOC(ctx, F->n + 1, F->P_ptr);
+  for (fcm_index k = 0; k < fc->n; k++)
+    for (int c = 0; c < 3 && fc->row[k] >= 0; c++)
+      F->P_ptr[fc->row[k] + c + 1] = transfer_row(t, at[fc->node[k]], c);
+  for (fcm_index r = 0; r < F->n; r++)
+    F->P_ptr[r + 1] += F->P_ptr[r];
+  FCM_ALLOC(ctx, F->P_ptr[F->n] + 1, F->P_col);
+  FCM_ALLOC(ctx, F->P_ptr[F->n] + 1, F->P_val);
+  for (fcm_index k = 0; k < fc->n; k++)
+    for (int c = 0; c < 3 && fc->row[k] >= 0; c++) {
+      const fcm_index r = fc->row[k] + c, q = transfer_row(t, at[fc->node[k]], c);
+      for (fcm_index e = 0; e < q; e++) {
+        const fcm_index K =
+            pair_index(pairs, np, sc_node[(fcm_index)t->buf[2 * e] / 3], fc->body[k]);
+        FCM_CHECK(K >= 0, ctx, FCM_ERR_INTERNAL, "mg: octree copy %lld reads no coarse copy",
+                  (long long)k);
+        F->P_col[F->P_ptr[r] + e] = (int)(3 * K + c);
+        F->P_val[F->P_ptr[r] + e] = t->buf[2 * e + 1];
+      }
+    }
+  /* a coarse copy whose coinciding fine row is inactive (the Dirichlet boundary) is too */
+  for (fcm_index r = 0; r < F->n; r++)
+    if (F->P_ptr[r + 1] - F->P_ptr[r] == 1 && F->P_val[F->P_ptr[r]] == 1.0 && F->inactive[r])
+      C->inactive[F->P_col[F->P_ptr[r]]] = 1;
+cleanup:
+  return st;
+}
+
+/* Level l + 1 of a hierarchy with separated bodies: the truncated octree with a copy per (free
+ * node, body) pair, P_l, and the coarse copies (*out) for the next coarsening. */
+static fcm_status octree_coarsen_bodies(fcm_mg *m, int l, const level_cons *cf, level_cons *cc,
+                                        const oct_copies *fc, oct_copies *out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  oct_transfer t = {.sf = l == 0 ? m->space : m->lev[l].sp, .cf = cf, .cc = cc};
+  mg_level *F = &m->lev[l], *C = &m->lev[l + 1];
+  fcm_index *at = NULL, *sc_node = NULL, *pairs = NULL, np = 0;
+  FCM_TRY(ctx, coarse_space(m, l, cc));
+  t.sc = C->sp;
+  const fcm_index nn = fcm_mesh_num_nodes(fcm_space_mesh(t.sf));
+  FCM_ALLOC(ctx, nn + 1, at);
+  FCM_ALLOC(ctx, nn + 1, t.node);
+  for (fcm_index v = 0; v < nn; v++)
+    at[v] = -1;
+  for (fcm_index k = 0; k < fc->n; k++)
+    if (fc->row[k] >= 0 && at[fc->node[k]] < 0)
+      at[fc->node[k]] = t.nnode, t.node[t.nnode++] = fc->node[k];
+  FCM_TRY(ctx, transfer_points(ctx, &t));
+  {
+    const fcm_index *tp = fcm_csr_row_ptr(cc->T), nr = fcm_space_num_dofs(t.sc);
+    fcm_index tmax = 1;
+    for (fcm_index J = 0; J < nr; J++)
+      tmax = FCM_MAX(tmax, tp[J + 1] - tp[J]);
+    t.bufmax = 27 * tmax;
+    FCM_ALLOC(ctx, 2 * t.bufmax + 1, t.buf);
+    FCM_ALLOC(ctx, nr / 3 + 1, sc_node);
+    const fcm_mesh *cm = fcm_space_mesh(t.sc);
+    for (fcm_index v = 0; v < fcm_mesh_num_nodes(cm); v++)
+      if (fcm_space_node_dof(t.sc, v) >= 0) sc_node[fcm_space_node_dof(t.sc, v) / 3] = v;
+  }
+  FCM_TRY(ctx, coarse_pairs(ctx, &t, fc, at, sc_node, &pairs, &np));
+  C->ncopy = np;
+  C->n = 3 * np;
+  FCM_ALLOC(ctx, C->n + 1, C->dof);
+  FCM_ALLOC(ctx, C->n + 1, C->inactive);
+  for (fcm_index i = 0; i < C->n; i++)
+    C->dof[i] = i;
+  FCM_TRY(ctx, pair_prolongation(ctx, &t, fc, at, sc_node, pairs, np, F, C));
+  FCM_TRY(ctx, coarse_cells(ctx, C, pairs, np));
+  out->n = np, out->nbody = fc->nbody;
+  FCM_ALLOC(ctx, np + 1, out->node);
+  FCM_ALLOC(ctx, np + 1, out->body);
+  FCM_ALLOC(ctx, np + 1, out->row);
+  for (fcm_index k = 0; k < np; k++)
+    out->node[k] = pairs[2 * k], out->body[k] = pairs[2 * k + 1], out->row[k] = 3 * k;
+cleanup:
+  transfer_free(ctx, &t);
+  fcm__free(ctx, at);
+  fcm__free(ctx, sc_node);
+  fcm__free(ctx, pairs);
+  return st;
+}
+
+/* The octree levels of a space with separated bodies (octree_coarsen_bodies()) down to the
+ * uniform grid, which stays the coarsest level (the box-grid hierarchy works on spaces with
+ * their own cuts; this level's copies come from the finer one). */
+static fcm_status bodies_hierarchy(fcm_mg *m, level_cons *cf, oct_copies *fc)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  level_cons cc = {0};
+  oct_copies next = {0};
+  for (int l = 0;; l++) {
+    const fcm_space *sf = l == 0 ? m->space : m->lev[l].sp;
+    if (l + 1 >= m->opts.max_levels || m->lev[l].n <= m->opts.coarse_dofs) break;
+    if (fcm_mesh_num_hanging(fcm_space_mesh(sf)) == 0) break;
+    FCM_TRY(ctx, octree_coarsen_bodies(m, l, cf, &cc, fc, &next));
+    m->nlev = l + 2;
+    cons_free(ctx, cf);
+    *cf = cc;
+    memset(&cc, 0, sizeof cc);
+    copies_free(ctx, fc);
+    *fc = next;
+    memset(&next, 0, sizeof next);
+  }
+cleanup:
+  cons_free(ctx, &cc);
+  copies_free(ctx, &next);
+  return st;
+}
+
 fcm_status fcm__mg_octree_hierarchy(fcm_mg *m, const fcm_csr *A, const unsigned char *inactive0)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
   level_cons cf = {0}, cc = {0};
+  oct_copies fc = {0};
   int l = 0;
   FCM_TRY(ctx, cons_create(ctx, m->space, &cf));
   FCM_TRY(ctx, octree_level0(m, A, inactive0, &cf));
   m->nlev = 1;
+  FCM_TRY(ctx, level0_copies(ctx, m->space, &cf, &fc));
+  if (fc.nbody > 1) {
+    FCM_TRY(ctx, bodies_hierarchy(m, &cf, &fc));
+    goto cleanup;
+  }
   for (;;) {
     const fcm_space *sf = l == 0 ? m->space : m->lev[l].sp;
     if (l + 1 >= m->opts.max_levels || m->lev[l].n <= m->opts.coarse_dofs) break;
@@ -495,5 +814,6 @@ fcm_status fcm__mg_octree_hierarchy(fcm_mg *m, const fcm_csr *A, const unsigned 
 cleanup:
   cons_free(ctx, &cf);
   cons_free(ctx, &cc);
+  copies_free(ctx, &fc);
   return st;
 }

@@ -63,24 +63,28 @@ cleanup:
   return st;
 }
 
-/* "octree": {"boundary": {"level": L}, "region": {"min", "max", "level": L}}: the grid refined
- * as an octree along the embedded boundary and in a box. */
+/* "octree": {"boundary": {"level": L}, "region": {"min", "max", "level": L}, "cuts": {"level":
+ * L}}: the grid refined as an octree along the embedded boundary, in a box and along the cut
+ * effects' surfaces. */
 static fcm_status read_octree(fcm__scene_parser *p, const fcm__json *o, fcm_scene_background *b)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"boundary", "region"};
+  static const char *const keys[] = {"boundary", "region", "cuts"};
   static const char *const bkeys[] = {"level"};
   static const char *const rkeys[] = {"min", "max", "level"};
-  const fcm__json *oct = NULL, *bnd = NULL, *reg = NULL;
+  const fcm__json *oct = NULL, *bnd = NULL, *reg = NULL, *cuts = NULL;
   long long level = 0;
   size_t old = p->path_len;
   FCM_TRY(p->ctx, fcm__scene_read_object(p, o, "octree", 0, &oct));
   if (!oct) return FCM_OK;
   SCENE_ENTER(p, "octree");
   FCM_TRY(p->ctx, fcm__scene_check_object(p, oct, keys, SCENE_COUNT(keys)));
-  SCENE_CHECK(fcm__json_member(oct, "boundary") || fcm__json_member(oct, "region"), p, FCM_ERR_ARG,
+  SCENE_CHECK(fcm__json_member(oct, "boundary") || fcm__json_member(oct, "region") ||
+                  fcm__json_member(oct, "cuts"),
+              p, FCM_ERR_ARG,
               "expected at least one refinement criterion: \"boundary\" ({\"level\": L}, "
-              "along the embedded boundary) or \"region\" ({\"min\", \"max\", \"level\"})");
+              "along the embedded boundary), \"region\" ({\"min\", \"max\", \"level\"}) or "
+              "\"cuts\" ({\"level\": L}, along the cut effects' surfaces)");
   b->octree = 1;
   FCM_TRY(p->ctx, fcm__scene_read_object(p, oct, "boundary", 0, &bnd));
   if (bnd) {
@@ -97,6 +101,14 @@ static fcm_status read_octree(fcm__scene_parser *p, const fcm__json *o, fcm_scen
     FCM_TRY(p->ctx, read_min_max(p, reg, b->octree_region_min, b->octree_region_max));
     FCM_TRY(p->ctx, fcm__scene_read_int(p, reg, "level", 1, 1, FCM_OCTREE_MAX_LEVEL, &level));
     b->octree_region = (int)level;
+    fcm__scene_path_pop(p, o2);
+  }
+  FCM_TRY(p->ctx, fcm__scene_read_object(p, oct, "cuts", 0, &cuts));
+  if (cuts) {
+    size_t o2 = SCENE_ENTER(p, "cuts");
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, cuts, bkeys, SCENE_COUNT(bkeys)));
+    FCM_TRY(p->ctx, fcm__scene_read_int(p, cuts, "level", 1, 1, FCM_OCTREE_MAX_LEVEL, &level));
+    b->octree_cuts = (int)level;
     fcm__scene_path_pop(p, o2);
   }
 cleanup:

@@ -696,11 +696,36 @@ cleanup:
   return st;
 }
 
+/* What the octree background refines along: the embedded boundary to one level, the cut
+ * effects' surfaces (before they apply) to another. */
+typedef struct grid_refine {
+  const fcm_geometry *geom;
+  int boundary_level, cut_level, num_cuts;
+  fcm_surface **cuts;
+} grid_refine;
+
+static int grid_refine_fn(const double lo[3], const double hi[3], int level, void *user)
+{
+  const grid_refine *g = user;
+  if (level < g->boundary_level) {
+    const int r = fcm_geometry_boundary_meets_box(lo, hi, level, (void *)g->geom);
+    if (r) return r;
+  }
+  for (int k = 0; k < g->num_cuts && level < g->cut_level; k++) {
+    const int r = g->cuts[k] ? fcm_surface_meets_box(lo, hi, level, g->cuts[k]) : 0;
+    if (r) return r;
+  }
+  return 0;
+}
+
 /* The background grid over [min, max] with `cells` cubes: a box grid, or with "octree" the grid
- * refined along the embedded boundary (S->geom, built before) and in the region, 2:1 balanced. */
+ * refined along the embedded boundary (S->geom, built before), in the region and along the cut
+ * surfaces, 2:1 balanced. */
 static fcm_status create_grid(fcm_simulation *S, const fcm_scene_background *bg,
                               const double min[3], const double max[3], const fcm_index cells[3])
 {
+  fcm_status st = FCM_OK;
+  grid_refine g = {S->geom, bg->octree_boundary, bg->octree_cuts, 0, NULL};
   if (!bg->octree) return fcm_mesh_create_box(S->ctx, bg->element, min, max, cells, &S->mesh);
   fcm_octree_options o = fcm_octree_options_default();
   o.region_level = bg->octree_region;
@@ -708,12 +733,32 @@ static fcm_status create_grid(fcm_simulation *S, const fcm_scene_background *bg,
     o.region_lo[d] = bg->octree_region_min[d];
     o.region_hi[d] = bg->octree_region_max[d];
   }
-  if (bg->octree_boundary > 0) {
-    o.refine_level = bg->octree_boundary;
-    o.refine = fcm_geometry_boundary_meets_box;
-    o.refine_user = S->geom;
+  if (bg->octree_cuts > 0) {
+    const int n = fcm_scene_count_effects(S->scene, FCM_EFFECT_CUT);
+    FCM_ALLOC(S->ctx, (size_t)n, g.cuts);
+    for (int k = 0; k < fcm_scene_num_effects(S->scene); k++) {
+      const fcm_effect *e = fcm_scene_get_effect(S->scene, k);
+      if (e->type != FCM_EFFECT_CUT) continue;
+      st = fcm__sim_cut_surface(S, &e->cut, &g.cuts[g.num_cuts++]);
+      if (st != FCM_OK) {
+        char section[64];
+        snprintf(section, sizeof section, "effects[%d].cut", k);
+        name_section(S->ctx, section);
+        goto cleanup;
+      }
+    }
   }
-  return fcm_mesh_create_octree(S->ctx, bg->element, min, max, cells, &o, &S->mesh);
+  if (bg->octree_boundary > 0 || bg->octree_cuts > 0) {
+    o.refine_level = FCM_MAX(bg->octree_boundary, bg->octree_cuts);
+    o.refine = grid_refine_fn;
+    o.refine_user = &g;
+  }
+  FCM_TRY(S->ctx, fcm_mesh_create_octree(S->ctx, bg->element, min, max, cells, &o, &S->mesh));
+cleanup:
+  for (int k = 0; k < g.num_cuts; k++)
+    fcm_surface_destroy(&g.cuts[k]);
+  fcm__free(S->ctx, g.cuts);
+  return st;
 }
 
 fcm_status fcm__sim_build_mesh_geometry(fcm_simulation *S)
@@ -735,7 +780,8 @@ fcm_status fcm__sim_build_mesh_geometry(fcm_simulation *S)
     if (st != FCM_OK) name_section(ctx, "background.fit_background");
     FCM_TRY(ctx, st);
   } else if (bg->kind == FCM_SCENE_BACKGROUND_GRID) {
-    if (bg->octree_boundary > 0) { /* refined along the geometry's boundary: built first */
+    if (bg->octree_boundary > 0 || bg->octree_cuts > 0) { /* refined along the geometry's
+                                                             boundary or cuts: built first */
       st = build_geometry(S, g);
       if (st != FCM_OK) name_section(ctx, geometry_path(g->kind));
       FCM_TRY(ctx, st);

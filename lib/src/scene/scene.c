@@ -189,13 +189,12 @@ static fcm_status parse_root(fcm__scene_parser *p, const fcm__json *root)
   FCM_TRY(p->ctx, fcm__scene_read_time(p, root));
   FCM_TRY(p->ctx, fcm__scene_read_output(p, root));
   FCM_TRY(p->ctx, fcm__scene_read_effects(p, root));
-  if (s->background.octree && fcm_scene_count_effects(s, FCM_EFFECT_CUT) > 0) {
+  if (s->background.octree_cuts && fcm_scene_count_effects(s, FCM_EFFECT_CUT) == 0) {
     fcm__scene_path_push_key(p, "background");
     fcm__scene_path_push_key(p, "octree");
-    SCENE_CHECK(0, p, FCM_ERR_UNSUPPORTED,
-                "cuts on an octree background are not supported yet (the pieces a cut makes "
-                "would have to link across the hanging nodes): drop the \"cut\" effects or the "
-                "octree");
+    fcm__scene_path_push_key(p, "cuts");
+    SCENE_CHECK(0, p, FCM_ERR_ARG,
+                "needs \"cut\" effects whose surfaces it refines along (the scene has none)");
   }
 cleanup:
   return st;
