@@ -83,3 +83,4 @@ fcm_add_test(embed_cut_keep tests/embed/cut_keep.c)
 # sum w x.n = 3 V), bad arguments refused leaving no temporary and the old file intact.
 fcm_add_test(embed_rules_write tests/embed/rules_write.c)
 fcm_add_test(embed_cut_surface tests/embed/cut_surface.c)
+fcm_add_test(embed_cut_surface_scene tests/embed/cut_surface_scene.c)
