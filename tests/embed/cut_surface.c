@@ -7,7 +7,9 @@
  * many material components along the links. Knives: a tilted plane through the whole body (its
  * edges run outside the body in cells the body reaches: material must not join around them), a
  * rectangle ending inside the body (a crack), a V of two half-planes (non-planar) and a second
- * plane crossing the first one in cells it already split. Hex8 and Tet4 backgrounds. */
+ * plane crossing the first one in cells it already split, a square cutting off a cap of the
+ * ball whose edges end outside the ball in cells that hold material on both sides. Hex8 and Tet4
+ * backgrounds (argument "quadratic": Hex20 and Tet10). */
 #include "fcm/embed.h"
 #include "fcm/surface.h"
 #include "test.h"
@@ -28,7 +30,7 @@ static fcm_ctx *ctx;
  * rounding is about 1e-15. */
 #define TOL 1e-12
 
-enum { MAX_M = 120 }; /* monomials of degree <= 7 */
+enum { MAX_M = 455 }; /* monomials of degree <= 12 */
 
 /* Moments of x^a y^b z^c (a + b + c <= m) of piece p's authentic points of kind k. */
 static int piece_monomials(const fcm_cell_rules *r, fcm_index p, fcm_rule_kind k, int m,
@@ -93,7 +95,8 @@ static int components(const fcm_mesh *mesh, const fcm_cell_rules *r)
 static double compare(const fcm_mesh *mesh, const fcm_cell_rules *rv, const fcm_cell_rules *rs,
                       const char *what)
 {
-  const double vref = fcm_mesh_element_type(mesh) == FCM_ELEMENT_TET4 ? 1.0 / 6.0 : 8.0;
+  const fcm_element_type type = fcm_mesh_element_type(mesh);
+  const double vref = type == FCM_ELEMENT_TET4 || type == FCM_ELEMENT_TET10 ? 1.0 / 6.0 : 8.0;
   double worst = 0.0, mv[MAX_M], ms[MAX_M];
   for (fcm_index c = 0; c < fcm_mesh_num_cells(mesh); c++) {
     fcm_index fv, fs;
@@ -105,6 +108,7 @@ static double compare(const fcm_mesh *mesh, const fcm_cell_rules *rv, const fcm_
     TEST_TRUE(fcm_cell_rules_class(rv, c) == fcm_cell_rules_class(rs, c));
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
       const int m = fcm_cell_rules_strength(rv, (fcm_rule_kind)k);
+      TEST_TRUE((m + 1) * (m + 2) * (m + 3) / 6 <= MAX_M);
       unsigned char used[64] = {0};
       for (fcm_index p = fv; p < fv + kv; p++) {
         const int M = piece_monomials(rv, p, (fcm_rule_kind)k, m, mv);
@@ -175,7 +179,10 @@ static void v_cut(double x0, double y0, fcm_surface **cut)
 
 static void run(fcm_element_type type)
 {
-  const char *name = type == FCM_ELEMENT_TET4 ? "tet4" : "hex8";
+  const char *name = type == FCM_ELEMENT_TET4    ? "tet4"
+                     : type == FCM_ELEMENT_TET10 ? "tet10"
+                     : type == FCM_ELEMENT_HEX20 ? "hex20"
+                                                 : "hex8";
   const double lo[3] = {-1.1, -1.1, -1.1}, hi[3] = {1.1, 1.1, 1.1}, c0[3] = {0, 0, 0};
   const fcm_index n[3] = {4, 4, 4};
   fcm_mesh *mesh = NULL;
@@ -189,7 +196,7 @@ static void run(fcm_element_type type)
   o.simplify_options.residual_tol = 1e-14;
   TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, gv, &o, &rv));
   TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, gs, &o, &rs));
-  fcm_surface *knife[4] = {NULL, NULL, NULL, NULL};
+  fcm_surface *knife[5] = {NULL, NULL, NULL, NULL, NULL};
   const double p0[3] = {0.13, 0.05, -0.02}, n0[3] = {1, 0.3, 0.2};
   const double blo[3] = {-1.05, -1.05, -1.05}, bhi[3] = {1.05, 1.05, 1.05};
   TEST_OK(ctx, fcm_surface_create_plane(ctx, p0, n0, blo, bhi, &knife[0]));
@@ -199,8 +206,13 @@ static void run(fcm_element_type type)
   v_cut(0.45, -0.1, &knife[2]);
   const double p3[3] = {0.0, 0.07, 0.0}, n3[3] = {0.15, 1, -0.25};
   TEST_OK(ctx, fcm_surface_create_plane(ctx, p3, n3, blo, bhi, &knife[3]));
-  const char *names[4] = {"plane", "crack", "V", "crossing plane"};
-  for (int k = 0; k < 4; k++) {
+  /* the cap z > 0.8 cut off by a square whose edges end outside the ball in cells that hold
+   * material on both sides of it */
+  const double qc[3] = {0.02, -0.03, 0.8}, qn[3] = {0.05, 0.02, 1}, qa[3] = {1, 0.1, 0},
+               qsz[2] = {1.4, 1.4};
+  TEST_OK(ctx, fcm_surface_create_rectangle(ctx, qc, qn, qa, qsz, &knife[4]));
+  const char *names[5] = {"plane", "crack", "V", "crossing plane", "cap"};
+  for (int k = 0; k < 5; k++) {
     fcm_cell_rules *nv = NULL, *ns = NULL;
     TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, gv, rv, knife[k], &nv));
     TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, gs, rs, knife[k], &ns));
@@ -210,10 +222,13 @@ static void run(fcm_element_type type)
     char what[64];
     snprintf(what, sizeof what, "%s, %s", name, names[k]);
     const double worst = compare(mesh, rv, rs, what);
-    printf("%s: %lld pieces, %d components, moments agree to %.2e of |K_ref|\n", what,
-           (long long)fcm_cell_rules_num_pieces(rs), components(mesh, rs), worst);
+    const fcm_cell_rules_stats *S = fcm_cell_rules_get_stats(rs);
+    printf("%s: %lld pieces, %d components, %lld cells fitted on surface moments (%lld pieces "
+           "split by the boundary instead), moments agree to %.2e of |K_ref|\n",
+           what, (long long)fcm_cell_rules_num_pieces(rs), components(mesh, rs),
+           (long long)S->num_surface_cells, (long long)S->num_surface_fallbacks, worst);
   }
-  for (int k = 0; k < 4; k++)
+  for (int k = 0; k < 5; k++)
     fcm_surface_destroy(&knife[k]);
   fcm_cell_rules_destroy(&rv);
   fcm_cell_rules_destroy(&rs);
@@ -222,12 +237,17 @@ static void run(fcm_element_type type)
   fcm_mesh_destroy(&mesh);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
   TEST_OK(NULL, fcm_ctx_create(NULL, &ctx));
   TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 2));
-  run(FCM_ELEMENT_HEX8);
-  run(FCM_ELEMENT_TET4);
+  if (argc > 1 && !strcmp(argv[1], "quadratic")) { /* embed_cut_surface_quadratic (slow) */
+    run(FCM_ELEMENT_HEX20);
+    run(FCM_ELEMENT_TET10);
+  } else {
+    run(FCM_ELEMENT_HEX8);
+    run(FCM_ELEMENT_TET4);
+  }
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
 }
