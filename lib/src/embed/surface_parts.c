@@ -62,6 +62,9 @@ fcm_status fcm__material_status(fcm__material *m)
   return st;
 }
 
+/* A tet whose 6 x volume is below this fraction of its size cubed is flat (skipped). */
+#define FLAT_RTOL 1e-12
+
 /* Tet (c, a, b, e) (12 doubles) as an affine Tet4 cell: node 0 at xi = 0. */
 static void tet_cell(const double *T, fcm_index id, fcm__embed_cell *k)
 {
@@ -98,7 +101,9 @@ static fcm_status tets_material(fcm_ctx *ctx, fcm__material *m, const double *te
     if (vol[t] == 0.0) continue;
     fcm__embed_cell k;
     tet_cell(tets + 12 * t, cell ? cell->id : -1, &k);
-    if (!(k.detA != 0.0 && isfinite(k.detA))) continue;
+    /* a fan tet flat to rounding (near-coplanar vertices of a part) holds no material that
+     * counts, and its map to the unit tet is too ill-conditioned for the line crossings */
+    if (!(fabs(k.detA) > FLAT_RTOL * k.size * k.size * k.size && isfinite(k.detA))) continue;
     FCM_TRY(ctx,
             fcm__embed_moment_rule(ctx, m->geom, m->tree, &k, q, NULL, &m->buf, &m->cr, &m->sr));
     if (out && out->n + m->sr.n > out->cap) {
