@@ -120,6 +120,10 @@ typedef struct fcm__embed_ws {
   int *cand_in;
   const struct fcm__parts *cand_parts; /* non-NULL: candidates inside piece cand_piece only */
   int cand_piece;
+  /* the face planes of that piece's parts, part after part: a count c, the part's tolerance,
+   * then c planes (n, d) */
+  double *cand_pl;
+  size_t cand_npl, cand_plcap;
   size_t cand_cap;
 } fcm__embed_ws;
 
@@ -282,6 +286,7 @@ typedef struct fcm__parts {
    * only through faces whose overlap holds material. NULL: the parts are embedded cells. */
   struct fcm__material *mat;
   double *mvol;
+  int whole; /* with mat: the one part is the cell itself, unsplit */
 } fcm__parts;
 
 void fcm__embed_parts_free(fcm_ctx *ctx, fcm__parts *P);
@@ -623,6 +628,14 @@ fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell,
 
 /* Surface body (P->mat): the body's volume in each part into P->mvol; parts with no more
  * than their vmin are dropped. Nothing without P->mat. */
-fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, fcm__parts *P);
+fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P);
+
+/* The planes of the faces with area of part i of P into pl (room for FCM__POLY_MAX_FACES);
+ * their count. */
+int fcm__embed_part_planes(const fcm__parts *P, size_t i, fcm__plane *pl);
+
+/* As fcm__material_poly() for the whole affine cell: the surface moments of the cell itself. */
+fcm_status fcm__material_cell(fcm_ctx *ctx, fcm__material *m, const fcm__moment_quad *q,
+                              const fcm__embed_cell *cell, fcm__srule *out, double *volume);
 
 #endif /* FCM_EMBED_IMPL_H */

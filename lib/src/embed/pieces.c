@@ -306,7 +306,8 @@ fcm_status fcm__embed_cell_parts(fcm_ctx *ctx, const fcm_geometry *geom, const f
     fcm__geom_poly_from_cell(cell->info->num_corners == 4 ? FCM_ELEMENT_TET4 : FCM_ELEMENT_HEX8,
                              cell->X, &ws->poly);
     FCM_TRY(ctx, parts_put(ctx, P, 0, &ws->poly, cell->tol, sliver_rtol * cell->volume, 0));
-    FCM_TRY(ctx, fcm__embed_drop_dry(ctx, P));
+    P->whole = 1;
+    FCM_TRY(ctx, fcm__embed_drop_dry(ctx, cell, P));
     if (counts) counts->parts += (fcm_index)P->n;
     P->num_pieces = P->num_parents = P->n > 0;
     return FCM_OK;
@@ -370,6 +371,7 @@ static fcm_status split_part(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
     plane_range(P->poly + i, &t->edge[e], &lo, &hi);
     if (lo > tol) return FCM_OK;
   }
+  P->whole = 0;
   fcm__poly *W = P->w; /* W[0]: the part; W[1]: one side; W[2]: outside an edge */
   poly_copy(&W[0], P->poly + i);
   size_t slot = i;
@@ -628,12 +630,15 @@ static void parts_compact(fcm__parts *P)
   P->n = kept;
 }
 
-fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, fcm__parts *P)
+fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P)
 {
   fcm_status st = FCM_OK;
   if (!P->mat) return FCM_OK;
   for (size_t i = 0; i < P->n; i++) {
-    FCM_TRY(ctx, fcm__material_poly(ctx, P->mat, P->poly + i, NULL, NULL, NULL, P->mvol + i));
+    if (P->whole && cell->affine)
+      FCM_TRY(ctx, fcm__material_cell(ctx, P->mat, NULL, cell, NULL, P->mvol + i));
+    else
+      FCM_TRY(ctx, fcm__material_poly(ctx, P->mat, P->poly + i, NULL, NULL, NULL, P->mvol + i));
     if (!(P->mvol[i] > P->vmin[i])) P->poly[i].nv = P->poly[i].nf = 0;
   }
   parts_compact(P);
@@ -661,7 +666,7 @@ static fcm_status split_parts(fcm_ctx *ctx, const fcm__embed_cell *cell, const f
   for (size_t i = 0; i < P->n; i++)
     after += fcm__geom_poly_volume(P->poly + i);
   *change = fabs(after - before);
-  if (k1 > k0) FCM_TRY(ctx, fcm__embed_drop_dry(ctx, P));
+  if (k1 > k0) FCM_TRY(ctx, fcm__embed_drop_dry(ctx, cell, P));
 cleanup:
   return st;
 }
@@ -807,6 +812,14 @@ int fcm__embed_clip_to_part_flat(const fcm__parts *P, size_t i, double *x, int n
     }
     n = fcm__geom_polygon_clip(x, n, cap, &pl, P->tol[i], keep, work);
   }
+  return n;
+}
+
+int fcm__embed_part_planes(const fcm__parts *P, size_t i, fcm__plane *pl)
+{
+  int n = 0;
+  for (int f = 0; f < P->poly[i].nf; f++)
+    n += face_plane(P->poly + i, f, pl + n);
   return n;
 }
 

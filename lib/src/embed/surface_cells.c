@@ -57,15 +57,22 @@ cleanup:
  * its parts, within the part's tolerance); 1 without a piece to test. */
 static int in_piece(const fcm__embed_cell *cell, const fcm__embed_ws *ws, const double xi[3])
 {
-  const fcm__parts *P = ws->cand_parts;
-  if (!P) return 1;
+  if (!ws->cand_parts) return 1;
   const double s[3] = {xi[0] - cell->xi0[0], xi[1] - cell->xi0[1], xi[2] - cell->xi0[2]};
   double x[3];
   fcm__mat3_mulv(cell->A, s, x);
   for (int d = 0; d < 3; d++)
     x[d] += cell->X[d];
-  for (size_t j = 0; j < P->n; j++)
-    if (P->piece[j] == ws->cand_piece && fcm__embed_part_excess(P, j, x) <= P->tol[j]) return 1;
+  for (size_t k = 0; k < ws->cand_npl;) {
+    const size_t c = (size_t)ws->cand_pl[k];
+    const double tol = ws->cand_pl[k + 1], *pl = ws->cand_pl + k + 2;
+    size_t f = 0;
+    while (f < c &&
+           pl[4 * f] * x[0] + pl[4 * f + 1] * x[1] + pl[4 * f + 2] * x[2] - pl[4 * f + 3] <= tol)
+      f++;
+    if (f == c) return 1;
+    k += 2 + 4 * c;
+  }
   return 0;
 }
 
@@ -343,6 +350,9 @@ void fcm__embed_surface_ws_free(fcm_ctx *ctx, fcm__embed_ws *ws)
   fcm__free(ctx, ws->bnd);
   fcm__free(ctx, ws->cand_x);
   fcm__free(ctx, ws->cand_in);
+  fcm__free(ctx, ws->cand_pl);
+  ws->cand_pl = NULL;
+  ws->cand_npl = ws->cand_plcap = 0;
   ws->sr = NULL, ws->cr = NULL, ws->bnd = NULL, ws->cand_x = NULL, ws->cand_in = NULL;
   ws->cand_cap = 0;
 }
@@ -368,6 +378,7 @@ fcm_status fcm__embed_surface_cut_piece(const build *B, const fcm_cell_rules *R,
   for (int d = 0; d < 3; d++)
     box[d] = HUGE_VAL, box[3 + d] = -HUGE_VAL;
   ws->sr->n = 0;
+  ws->cand_npl = 0;
   for (size_t j = 0; j < P->n; j++) {
     if (P->piece[j] != piece) continue;
     for (int a = 0; a < P->poly[j].nv; a++) {
@@ -376,7 +387,28 @@ fcm_status fcm__embed_surface_cut_piece(const build *B, const fcm_cell_rules *R,
       for (int d = 0; d < 3; d++)
         box[d] = fmin(box[d], xi[d]), box[3 + d] = fmax(box[3 + d], xi[d]);
     }
-    FCM_TRY(ctx, fcm__material_poly(ctx, P->mat, P->poly + j, &B->mq, cell, ws->sr, &v));
+    if (P->whole)
+      FCM_TRY(ctx, fcm__material_cell(ctx, P->mat, &B->mq, cell, ws->sr, &v));
+    else
+      FCM_TRY(ctx, fcm__material_poly(ctx, P->mat, P->poly + j, &B->mq, cell, ws->sr, &v));
+    fcm__plane pl[FCM__POLY_MAX_FACES];
+    const int c = fcm__embed_part_planes(P, j, pl);
+    if (ws->cand_npl + 2 + 4 * (size_t)c > ws->cand_plcap) {
+      size_t cap = ws->cand_plcap ? 2 * ws->cand_plcap : 1024;
+      while (cap < ws->cand_npl + 2 + 4 * (size_t)c)
+        cap *= 2;
+      void *q = ws->cand_pl;
+      FCM_TRY(ctx, fcm__resize(ctx, &q, ws->cand_npl, cap, sizeof(double)));
+      ws->cand_pl = q;
+      ws->cand_plcap = cap;
+    }
+    ws->cand_pl[ws->cand_npl++] = c;
+    ws->cand_pl[ws->cand_npl++] = P->tol[j];
+    for (int f = 0; f < c; f++) {
+      memcpy(ws->cand_pl + ws->cand_npl, pl[f].n, 3 * sizeof(double));
+      ws->cand_pl[ws->cand_npl + 3] = pl[f].d;
+      ws->cand_npl += 4;
+    }
   }
   for (int d = 0; d < 3 && touched; d++) /* the material's own box where the surface bounds it */
     box[d] = fmax(box[d], mbox[d]), box[3 + d] = fmin(box[3 + d], mbox[3 + d]);

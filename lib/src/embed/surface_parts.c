@@ -163,6 +163,35 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__material_cell(fcm_ctx *ctx, fcm__material *m, const fcm__moment_quad *q,
+                              const fcm__embed_cell *cell, fcm__srule *out, double *volume)
+{
+  fcm_status st = FCM_OK;
+  double sum = 0.0;
+  FCM_TRY(ctx, fcm__embed_moment_rule(ctx, m->geom, m->tree, cell, q ? q : &m->q0, NULL, &m->buf,
+                                      &m->cr, &m->sr));
+  if (out && out->n + m->sr.n > out->cap) {
+    size_t cap = out->cap ? out->cap : 1024;
+    while (cap < out->n + m->sr.n)
+      cap *= 2;
+    void *x = out->x, *w = out->w;
+    FCM_TRY(ctx, fcm__resize(ctx, &x, 3 * out->n, 3 * cap, sizeof(double)));
+    out->x = x;
+    FCM_TRY(ctx, fcm__resize(ctx, &w, out->n, cap, sizeof(double)));
+    out->w = w;
+    out->cap = cap;
+  }
+  for (size_t i = 0; i < m->sr.n; i++) {
+    sum += m->sr.w[i];
+    if (!out) continue;
+    memcpy(out->x + 3 * out->n, m->sr.x + 3 * i, 3 * sizeof(double));
+    out->w[out->n++] = m->sr.w[i];
+  }
+  *volume = sum * cell->detA;
+cleanup:
+  return st;
+}
+
 int fcm__material_on_face(fcm_ctx *ctx, fcm__material *m, const double *x, int n,
                           const double nrm[3], double h, double atol)
 {
