@@ -616,6 +616,9 @@ int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const double *a,
 fcm_status fcm__embed_parts_split(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *t,
                                   fcm__parts *P);
 
+/* Drop the parts left empty (nf == 0). */
+void fcm__embed_parts_compact(fcm__parts *P);
+
 /* The parts of P in piece `piece` into Q (its parts replaced). */
 fcm_status fcm__embed_parts_copy(fcm_ctx *ctx, const fcm__parts *P, int piece, fcm__parts *Q);
 

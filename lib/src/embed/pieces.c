@@ -346,8 +346,6 @@ static fcm__plane flip(const fcm__plane *pl)
   return q;
 }
 
-static void parts_compact(fcm__parts *P);
-
 /* Split part i by triangle t into up to 8 parts (both sides of its plane, each side
  * inside or outside each edge plane); the first stays in slot i, the rest are appended.
  * A part strictly on one side of the plane or strictly outside an edge plane is left. */
@@ -412,7 +410,7 @@ fcm_status fcm__embed_parts_split(fcm_ctx *ctx, const fcm__embed_cell *cell, con
   const size_t n0 = P->n;
   for (size_t i = 0; i < n0; i++)
     FCM_TRY(ctx, split_part(ctx, cell, t, P, i));
-  parts_compact(P);
+  fcm__embed_parts_compact(P);
 cleanup:
   return st;
 }
@@ -612,8 +610,7 @@ static int parts_connected(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm_
   return 0;
 }
 
-/* Drop the parts left empty (nf == 0). */
-static void parts_compact(fcm__parts *P)
+void fcm__embed_parts_compact(fcm__parts *P)
 {
   size_t kept = 0;
   for (size_t i = 0; i < P->n; i++) {
@@ -628,22 +625,6 @@ static void parts_compact(fcm__parts *P)
     kept++;
   }
   P->n = kept;
-}
-
-fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P)
-{
-  fcm_status st = FCM_OK;
-  if (!P->mat) return FCM_OK;
-  for (size_t i = 0; i < P->n; i++) {
-    if (P->whole && cell->affine)
-      FCM_TRY(ctx, fcm__material_cell(ctx, P->mat, NULL, cell, NULL, P->mvol + i));
-    else
-      FCM_TRY(ctx, fcm__material_poly(ctx, P->mat, P->poly + i, NULL, NULL, NULL, P->mvol + i));
-    if (!(P->mvol[i] > P->vmin[i])) P->poly[i].nv = P->poly[i].nf = 0;
-  }
-  parts_compact(P);
-cleanup:
-  return st;
 }
 
 /* Split every part by the triangles tris[P->tcand.ids[k0 .. k1)], then drop the parts the
@@ -662,7 +643,7 @@ static fcm_status split_parts(fcm_ctx *ctx, const fcm__embed_cell *cell, const f
     for (size_t i = 0; i < n0; i++)
       FCM_TRY(ctx, split_part(ctx, cell, t, P, i));
   }
-  parts_compact(P);
+  fcm__embed_parts_compact(P);
   for (size_t i = 0; i < P->n; i++)
     after += fcm__geom_poly_volume(P->poly + i);
   *change = fabs(after - before);

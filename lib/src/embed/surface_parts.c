@@ -280,3 +280,19 @@ cleanup:
   fcm__free(ctx, Q);
   return st;
 }
+
+fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P)
+{
+  fcm_status st = FCM_OK;
+  if (!P->mat) return FCM_OK;
+  for (size_t i = 0; i < P->n; i++) {
+    if (P->whole && cell->affine)
+      FCM_TRY(ctx, fcm__material_cell(ctx, P->mat, NULL, cell, NULL, P->mvol + i));
+    else
+      FCM_TRY(ctx, fcm__material_poly(ctx, P->mat, P->poly + i, NULL, NULL, NULL, P->mvol + i));
+    if (!(P->mvol[i] > P->vmin[i])) P->poly[i].nv = P->poly[i].nf = 0;
+  }
+  fcm__embed_parts_compact(P);
+cleanup:
+  return st;
+}
