@@ -629,9 +629,14 @@ fcm_status fcm__embed_parts_copy(fcm_ctx *ctx, const fcm__parts *P, int piece, f
 fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P,
                                       int piece, fcm__embed_ws *ws, double *volume);
 
-/* Surface body (P->mat): the body's volume in each part into P->mvol; parts with no more
- * than their vmin are dropped. Nothing without P->mat. */
+/* Surface body (P->mat): the body's volume in each part into P->mvol where it is not known
+ * (0: not computed; < 0: a piece of a part wholly inside the body, its own volume); parts with
+ * no more than their vmin are dropped. Nothing without P->mat. */
 fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P);
+
+/* Surface body: whether part i lies wholly inside the body (its material, P->mvol, is its
+ * volume up to rounding). */
+int fcm__embed_part_full(const fcm__parts *P, size_t i);
 
 /* The planes of the faces with area of part i of P into pl (room for FCM__POLY_MAX_FACES);
  * their count. */

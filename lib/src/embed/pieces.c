@@ -359,6 +359,7 @@ static fcm_status split_part(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
    * face goes through it instead of cutting off a slice thinner than the tolerance */
   const double tol = fmax(P->tol[i], MATCH_RTOL * cell->size), vmin = P->vmin[i];
   const int parent = P->parent[i];
+  const double full = P->mat && fcm__embed_part_full(P, i) ? -1.0 : 0.0; /* the pieces' too */
   double lo, hi;
   plane_range(P->poly + i, &t->plane, &lo, &hi);
   /* strictly on one side; or flat on the plane (within tol of it everywhere): split, it would
@@ -386,11 +387,13 @@ static fcm_status split_part(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
       overflow |= fcm__geom_poly_clip(&W[1], &t->edge[e], tol, &P->scratch);
       if (W[2].nf > 0) {
         FCM_TRY(ctx, parts_put(ctx, P, slot, &W[2], P->tol[i], vmin, parent));
+        P->mvol[slot] = full;
         slot = P->n;
       }
     }
     if (W[1].nf > 0) {
       FCM_TRY(ctx, parts_put(ctx, P, slot, &W[1], P->tol[i], vmin, parent));
+      P->mvol[slot] = full;
       slot = P->n;
     }
   }
@@ -603,7 +606,8 @@ static int parts_connected(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm_
       if (!points_on_plane(xb, nb, pa, mtol)) continue;
       if (fcm__embed_linked(xa, na, a->x[0], a->nv, xb, nb, b->x[0], b->nv, pb->n, mtol, atol, tris,
                             P->tcand.ids, ntri) &&
-          (!P->mat || fcm__embed_overlap_material(ctx, P->mat, xa, na, xb, nb, pb->n, cell->size)))
+          (!P->mat || fcm__embed_part_full(P, i) || fcm__embed_part_full(P, j) ||
+           fcm__embed_overlap_material(ctx, P->mat, xa, na, xb, nb, pb->n, cell->size)))
         return 1;
     }
   }

@@ -357,6 +357,49 @@ void fcm__embed_surface_ws_free(fcm_ctx *ctx, fcm__embed_ws *ws)
   ws->cand_cap = 0;
 }
 
+/* The points of the strongest built tet rule on the fan tets of the convex polyhedron p,
+ * appended to s (reference coordinates of cell): the exact rule of a part the body fills. */
+static fcm_status full_part_rule(const build *B, const fcm__embed_cell *cell, const fcm__poly *p,
+                                 fcm__srule *s)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_rule *rule = piece_rule(B);
+  const int nq = fcm_rule_num_points(rule), nt0 = fcm__geom_poly_num_tets(p);
+  const double *eta = fcm_rule_points(rule), *l = fcm_rule_weights(rule);
+  double *tets = NULL, *vol = NULL;
+  FCM_ALLOC(ctx, 12 * (size_t)nt0 + 12, tets);
+  FCM_ALLOC(ctx, (size_t)nt0 + 1, vol);
+  const int nt = fcm__geom_poly_tets(p, tets, vol);
+  if (s->n + (size_t)nt * nq > s->cap) {
+    size_t cap = s->cap ? s->cap : 1024;
+    while (cap < s->n + (size_t)nt * nq)
+      cap *= 2;
+    void *x = s->x, *w = s->w;
+    FCM_TRY(ctx, fcm__resize(ctx, &x, 3 * s->n, 3 * cap, sizeof(double)));
+    s->x = x;
+    FCM_TRY(ctx, fcm__resize(ctx, &w, s->n, cap, sizeof(double)));
+    s->w = w;
+    s->cap = cap;
+  }
+  for (int t = 0; t < nt; t++) {
+    const double *T = tets + 12 * t;
+    for (int q = 0; q < nq; q++) {
+      const double *e = eta + 3 * q;
+      double x[3], det;
+      for (int d = 0; d < 3; d++)
+        x[d] =
+            T[d] + e[0] * (T[3 + d] - T[d]) + e[1] * (T[6 + d] - T[d]) + e[2] * (T[9 + d] - T[d]);
+      FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, x, s->x + 3 * s->n, &det));
+      s->w[s->n++] = l[q] * 6.0 * vol[t] / det;
+    }
+  }
+cleanup:
+  fcm__free(ctx, tets);
+  fcm__free(ctx, vol);
+  return st;
+}
+
 fcm_status fcm__embed_surface_cut_piece(const build *B, const fcm_cell_rules *R,
                                         const fcm__embed_cell *cell, fcm__embed_ws *ws,
                                         fcm__parts *P, int piece, piece_out *o, int *fell_back)
@@ -389,6 +432,8 @@ fcm_status fcm__embed_surface_cut_piece(const build *B, const fcm_cell_rules *R,
     }
     if (P->whole)
       FCM_TRY(ctx, fcm__material_cell(ctx, P->mat, &B->mq, cell, ws->sr, &v));
+    else if (fcm__embed_part_full(P, j)) /* wholly inside the body: a tet rule on its fan */
+      FCM_TRY(ctx, full_part_rule(B, cell, P->poly + j, ws->sr));
     else
       FCM_TRY(ctx, fcm__material_poly(ctx, P->mat, P->poly + j, &B->mq, cell, ws->sr, &v));
     fcm__plane pl[FCM__POLY_MAX_FACES];

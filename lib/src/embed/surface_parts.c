@@ -62,6 +62,9 @@ fcm_status fcm__material_status(fcm__material *m)
   return st;
 }
 
+/* A part whose material is within this fraction of its volume lies wholly inside the body. */
+#define FULL_RTOL 1e-12
+
 /* A tet whose 6 x volume is below this fraction of its size cubed is flat (skipped). */
 #define FLAT_RTOL 1e-12
 
@@ -281,11 +284,20 @@ cleanup:
   return st;
 }
 
+int fcm__embed_part_full(const fcm__parts *P, size_t i)
+{
+  return P->mvol[i] < 0.0 || P->mvol[i] >= (1.0 - FULL_RTOL) * fcm__geom_poly_volume(P->poly + i);
+}
+
 fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P)
 {
   fcm_status st = FCM_OK;
   if (!P->mat) return FCM_OK;
   for (size_t i = 0; i < P->n; i++) {
+    if (P->mvol[i] != 0.0) { /* known; or a piece of a part wholly inside the body */
+      if (P->mvol[i] < 0.0) P->mvol[i] = fcm__geom_poly_volume(P->poly + i);
+      continue;
+    }
     if (P->whole && cell->affine)
       FCM_TRY(ctx, fcm__material_cell(ctx, P->mat, NULL, cell, NULL, P->mvol + i));
     else
