@@ -359,7 +359,6 @@ static fcm_status split_part(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
    * face goes through it instead of cutting off a slice thinner than the tolerance */
   const double tol = fmax(P->tol[i], MATCH_RTOL * cell->size), vmin = P->vmin[i];
   const int parent = P->parent[i];
-  const double full = P->mat && fcm__embed_part_full(P, i) ? -1.0 : 0.0; /* the pieces' too */
   double lo, hi;
   plane_range(P->poly + i, &t->plane, &lo, &hi);
   /* strictly on one side; or flat on the plane (within tol of it everywhere): split, it would
@@ -371,6 +370,7 @@ static fcm_status split_part(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
     if (lo > tol) return FCM_OK;
   }
   P->whole = 0;
+  const double full = P->mat && fcm__embed_part_full(P, i) ? -1.0 : 0.0; /* the pieces' too */
   fcm__poly *W = P->w; /* W[0]: the part; W[1]: one side; W[2]: outside an edge */
   poly_copy(&W[0], P->poly + i);
   size_t slot = i;
