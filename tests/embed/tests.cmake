@@ -82,3 +82,12 @@ fcm_add_test(embed_cut_keep tests/embed/cut_keep.c)
 # and without a cut), exact volumes and monomials, a closed surface rule (sum w n = 0,
 # sum w x.n = 3 V), bad arguments refused leaving no temporary and the old file intact.
 fcm_add_test(embed_rules_write tests/embed/rules_write.c)
+# Cuts of a body without a volume mesh: a faceted ball given as tets and as its boundary alone,
+# cut by a plane, a crack, a V, a crossing plane and a square cutting off a cap; every cell as
+# many pieces, matched pieces' monomials up to the rules' strengths within 1e-12 of the
+# reference cell, as many components (Hex8, Tet4; the slow one Hex20, Tet10).
+fcm_add_test(embed_cut_surface tests/embed/cut_surface.c)
+fcm_add_test(embed_cut_surface_quadratic tests/embed/cut_surface.c ARGS quadratic LABELS slow)
+# A cutting scene on a surface file: no Gmsh phase, the same DOFs and centre of mass (1e-12) as
+# the volume path, the largest displacement within 1 %.
+fcm_add_test(embed_cut_surface_scene tests/embed/cut_surface_scene.c)

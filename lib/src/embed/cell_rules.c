@@ -224,9 +224,10 @@ fcm_status fcm__cell_rules_create_cut_keep(fcm_ctx *ctx, const fcm_mesh *mesh,
                 fcm_mesh_element_type(mesh) == prev->type,
             ctx, FCM_ERR_ARG, "embed cut: the mesh (%lld cells) is not the rules' mesh (%lld)",
             (long long)fcm_mesh_num_cells(mesh), (long long)prev->num_cells);
-  FCM_CHECK(geom->num_cells > 0, ctx, FCM_ERR_UNSUPPORTED,
-            "embed cut: the geometry has no volume mesh (a surface geometry made with "
-            "volume_mesh = 0): cutting splits the geometry's cells; create it with a volume mesh");
+  FCM_CHECK(geom->num_cells > 0 || prev->opts.moments != FCM_CELL_MOMENTS_VOLUME, ctx,
+            FCM_ERR_UNSUPPORTED,
+            "embed cut: moments = volume with a geometry that has no volume mesh (a surface "
+            "geometry made with volume_mesh = 0); use moments = auto");
   FCM_CHECK(prev->num_cuts < 1 << 20, ctx, FCM_ERR_UNSUPPORTED,
             "embed cut: %d cuts already (limit 2^20)", prev->num_cuts);
   FCM_TRY(ctx, fcm__embed_cut_check(ctx, cut, "embed cut"));

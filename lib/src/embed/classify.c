@@ -177,7 +177,10 @@ static fcm_status drop_empty(const build *B, fcm__embed_ws *ws, double vmin, int
   FCM_ALLOC(ctx, (size_t)*count + 1, renum);
   for (int i = 0; i < *count; i++) {
     double v = 0.0;
-    FCM_TRY(ctx, fcm__embed_piece_tets(ctx, P, label, i, ws, sums ? &sums->counts : NULL, &v));
+    for (size_t j = 0; P->mat && j < P->n; j++) /* a surface body: its material in the parts */
+      v += label[j] == i ? P->mvol[j] : 0.0;
+    if (!P->mat)
+      FCM_TRY(ctx, fcm__embed_piece_tets(ctx, P, label, i, ws, sums ? &sums->counts : NULL, &v));
     renum[i] = v > vmin ? kept : -1;
     if (v > vmin) vol[kept] = v, was[kept++] = i;
   }
@@ -467,6 +470,13 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   if (cls == FCM_CELL_CUT && !surface) {
     for (int i = 0; i < o->np; i++) {
       double v;
+      if (P && P->mat) {
+        int fell;
+        FCM_TRY(ctx, fcm__embed_surface_cut_piece(B, R, &cell, ws, P, i, o->pc + i, &fell));
+        sums->counts.surface_cells++;
+        sums->counts.surface_fallbacks += fell;
+        continue;
+      }
       if (P) FCM_TRY(ctx, fcm__embed_piece_tets(ctx, P, P->piece, i, ws, NULL, &v));
       FCM_TRY(ctx, fcm__embed_map_piece(B, R, &cell, ws, o->pc + i));
     }

@@ -359,6 +359,8 @@ fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell
   fcm_index *links = NULL;
   size_t nl = 0, cap = 0;
   fcm__idbuf tc = {NULL, 0, 0};
+  fcm__material *mat = NULL; /* no volume mesh: links only where the overlap holds material */
+  if (B->geom->num_cells == 0) FCM_TRY(ctx, fcm__material_create(ctx, B->geom, &mat));
   for (fcm_index c = 0; c < R->num_cells; c++) {
     const cell_out *oa = out + c;
     if (!B->region[c] || oa->np == 0) continue;
@@ -409,6 +411,9 @@ fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell
                                  nbn, mtol, atol, B->cut_tris, tc.ids, tc.n))
             continue;
           if (!earlier_link(B, c, c2, out[c].pc[ma[1]].parent, out[c2].pc[mb[1]].parent)) continue;
+          if (mat && !fcm__embed_overlap_material(ctx, mat, A, ma[2], Bx, mb[2], nbn, cell.size))
+            continue;
+          if (mat) FCM_TRY(ctx, fcm__material_status(mat));
           FCM_TRY(ctx, push_link(ctx, pa, pb, &links, &nl, &cap));
         }
       }
@@ -422,5 +427,6 @@ fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell
 cleanup:
   fcm__free(ctx, links);
   fcm__geom_idbuf_free(ctx, &tc);
+  fcm__material_destroy(ctx, &mat);
   return st;
 }

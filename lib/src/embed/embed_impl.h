@@ -118,6 +118,12 @@ typedef struct fcm__embed_ws {
   struct fcm__crossings *cr;
   double *cand_x;
   int *cand_in;
+  const struct fcm__parts *cand_parts; /* non-NULL: candidates inside piece cand_piece only */
+  int cand_piece;
+  /* the face planes of that piece's parts, part after part: a count c, the part's tolerance,
+   * then c planes (n, d) */
+  double *cand_pl;
+  size_t cand_npl, cand_plcap;
   size_t cand_cap;
 } fcm__embed_ws;
 
@@ -275,6 +281,12 @@ typedef struct fcm__parts {
   int *uf;            /* union-find scratch, n entries */
   double split_error; /* |parts' volume after the splits - before| (fcm__embed_cell_pieces) */
   size_t ufcap;
+  /* A geometry without a volume mesh (surface_parts.c): the parts are the cell split by the
+   * cuts, mvol[i] the body's volume inside part i (parts without are dropped), and parts join
+   * only through faces whose overlap holds material. NULL: the parts are embedded cells. */
+  struct fcm__material *mat;
+  double *mvol;
+  int whole; /* with mat: the one part is the cell itself, unsplit */
 } fcm__parts;
 
 void fcm__embed_parts_free(fcm_ctx *ctx, fcm__parts *P);
@@ -567,5 +579,71 @@ fcm_status fcm__embed_inside_line(fcm_ctx *ctx, const fcm_geometry *g, const fcm
                                   const fcm__embed_cell *cell, double a, double b, int n,
                                   const double *z, int *inside, fcm__idbuf *buf,
                                   fcm__crossings *cr);
+
+/* ---------------------------------------------------------------- parts of a surface body
+ * (surface_parts.c) */
+
+/* The body of a geometry without a volume mesh (its closed boundary) and the scratch of the
+ * material tests on it; one per thread. */
+typedef struct fcm__material fcm__material;
+
+fcm_status fcm__material_create(fcm_ctx *ctx, const fcm_geometry *geom, fcm__material **out);
+void fcm__material_destroy(fcm_ctx *ctx, fcm__material **m);
+
+/* The volume of the body inside the convex polyhedron p (surface moments on the tets of a fan
+ * of p). With out (cell affine): also the signed rule of degree q->m of that material,
+ * appended to out in cell's reference coordinates. */
+fcm_status fcm__material_poly(fcm_ctx *ctx, fcm__material *m, const fcm__poly *p,
+                              const fcm__moment_quad *q, const fcm__embed_cell *cell,
+                              fcm__srule *out, double *volume);
+
+/* Whether the body covers more than atol of the area of the planar convex polygon x (n
+ * vertices, unit normal nrm): its volume in the prism of half-height h on the polygon,
+ * over 2 h. An error is kept in m and the answer is then 1. */
+int fcm__material_on_face(fcm_ctx *ctx, fcm__material *m, const double *x, int n,
+                          const double nrm[3], double h, double atol);
+
+/* The first error fcm__material_on_face() kept (FCM_OK: none), cleared. */
+fcm_status fcm__material_status(fcm__material *m);
+
+/* Whether the overlap of the touching faces a (na vertices) and b (nb, outward normal
+ * nb_normal) of two parts in cells of size `size` holds material (fcm__material_on_face()). */
+int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const double *a, int na,
+                                const double *b, int nb, const double nb_normal[3], double size);
+
+/* Split every part of P by triangle t (its plane and edge planes, as a cut's) and drop the
+ * emptied ones. */
+fcm_status fcm__embed_parts_split(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *t,
+                                  fcm__parts *P);
+
+/* Drop the parts left empty (nf == 0). */
+void fcm__embed_parts_compact(fcm__parts *P);
+
+/* The parts of P in piece `piece` into Q (its parts replaced). */
+fcm_status fcm__embed_parts_copy(fcm_ctx *ctx, const fcm__parts *P, int piece, fcm__parts *Q);
+
+/* Surface body (P->mat): the parts of piece `piece` split by the body's boundary triangles
+ * that meet the cell into parts wholly inside or outside the body; the inside ones
+ * fan-tetrahedralized into ws->tets (as fcm__embed_piece_tets), their volume *volume. The
+ * volume path's start for a piece whose surface fit fails. */
+fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P,
+                                      int piece, fcm__embed_ws *ws, double *volume);
+
+/* Surface body (P->mat): the body's volume in each part into P->mvol where it is not known
+ * (0: not computed; < 0: a piece of a part wholly inside the body, its own volume); parts with
+ * no more than their vmin are dropped. Nothing without P->mat. */
+fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P);
+
+/* Surface body: whether part i lies wholly inside the body (its material, P->mvol, is its
+ * volume up to rounding). */
+int fcm__embed_part_full(const fcm__parts *P, size_t i);
+
+/* The planes of the faces with area of part i of P into pl (room for FCM__POLY_MAX_FACES);
+ * their count. */
+int fcm__embed_part_planes(const fcm__parts *P, size_t i, fcm__plane *pl);
+
+/* As fcm__material_poly() for the whole affine cell: the surface moments of the cell itself. */
+fcm_status fcm__material_cell(fcm_ctx *ctx, fcm__material *m, const fcm__moment_quad *q,
+                              const fcm__embed_cell *cell, fcm__srule *out, double *volume);
 
 #endif /* FCM_EMBED_IMPL_H */

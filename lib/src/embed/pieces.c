@@ -226,6 +226,9 @@ void fcm__embed_parts_free(fcm_ctx *ctx, fcm__parts *P)
   fcm__free(ctx, P->fmeta);
   fcm__free(ctx, P->uf);
   fcm__geom_idbuf_free(ctx, &P->tcand);
+  fcm__material_destroy(ctx, &P->mat);
+  fcm__free(ctx, P->mvol);
+  P->mvol = NULL;
   P->poly = NULL;
   P->tol = P->vmin = P->fx = NULL;
   P->piece = P->parent = P->fmeta = P->uf = NULL;
@@ -251,6 +254,9 @@ static fcm_status parts_grow(fcm_ctx *ctx, fcm__parts *P, size_t need)
   P->piece = q;
   FCM_TRY(ctx, fcm__resize(ctx, &r, P->n, cap, sizeof(int)));
   P->parent = r;
+  void *mv = P->mvol;
+  FCM_TRY(ctx, fcm__resize(ctx, &mv, P->n, cap, sizeof(double)));
+  P->mvol = mv;
   P->cap = cap;
 cleanup:
   return st;
@@ -282,6 +288,7 @@ static fcm_status parts_put(fcm_ctx *ctx, fcm__parts *P, size_t slot, const fcm_
   P->vmin[slot] = vmin;
   P->piece[slot] = 0;
   P->parent[slot] = parent;
+  P->mvol[slot] = 0.0;
 cleanup:
   return st;
 }
@@ -294,6 +301,17 @@ fcm_status fcm__embed_cell_parts(fcm_ctx *ctx, const fcm_geometry *geom, const f
   fcm_index nparts = 0;
   P->n = 0;
   P->num_pieces = 0;
+  if (geom->num_cells == 0) { /* no volume mesh: the cell itself, if the body is in it */
+    if (!P->mat) FCM_TRY(ctx, fcm__material_create(ctx, geom, &P->mat));
+    fcm__geom_poly_from_cell(cell->info->num_corners == 4 ? FCM_ELEMENT_TET4 : FCM_ELEMENT_HEX8,
+                             cell->X, &ws->poly);
+    FCM_TRY(ctx, parts_put(ctx, P, 0, &ws->poly, cell->tol, sliver_rtol * cell->volume, 0));
+    P->whole = 1;
+    FCM_TRY(ctx, fcm__embed_drop_dry(ctx, cell, P));
+    if (counts) counts->parts += (fcm_index)P->n;
+    P->num_pieces = P->num_parents = P->n > 0;
+    return FCM_OK;
+  }
   FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, cell->lo, cell->hi, &ws->cand));
   for (size_t k = 0; k < ws->cand.n; k++) {
     double tol, vmin;
@@ -351,6 +369,8 @@ static fcm_status split_part(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
     plane_range(P->poly + i, &t->edge[e], &lo, &hi);
     if (lo > tol) return FCM_OK;
   }
+  P->whole = 0;
+  const double full = P->mat && fcm__embed_part_full(P, i) ? -1.0 : 0.0; /* the pieces' too */
   fcm__poly *W = P->w; /* W[0]: the part; W[1]: one side; W[2]: outside an edge */
   poly_copy(&W[0], P->poly + i);
   size_t slot = i;
@@ -367,11 +387,13 @@ static fcm_status split_part(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
       overflow |= fcm__geom_poly_clip(&W[1], &t->edge[e], tol, &P->scratch);
       if (W[2].nf > 0) {
         FCM_TRY(ctx, parts_put(ctx, P, slot, &W[2], P->tol[i], vmin, parent));
+        P->mvol[slot] = full;
         slot = P->n;
       }
     }
     if (W[1].nf > 0) {
       FCM_TRY(ctx, parts_put(ctx, P, slot, &W[1], P->tol[i], vmin, parent));
+      P->mvol[slot] = full;
       slot = P->n;
     }
   }
@@ -380,6 +402,29 @@ static fcm_status split_part(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
             "the polyhedron capacity (%d vertices, %d faces)",
             (long long)cell->id, FCM__POLY_MAX_VERTS, FCM__POLY_MAX_FACES);
   if (slot == i) P->poly[i].nv = P->poly[i].nf = 0; /* nothing left: compacted later */
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_parts_split(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *t,
+                                  fcm__parts *P)
+{
+  fcm_status st = FCM_OK;
+  const size_t n0 = P->n;
+  for (size_t i = 0; i < n0; i++)
+    FCM_TRY(ctx, split_part(ctx, cell, t, P, i));
+  fcm__embed_parts_compact(P);
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_parts_copy(fcm_ctx *ctx, const fcm__parts *P, int piece, fcm__parts *Q)
+{
+  fcm_status st = FCM_OK;
+  Q->n = 0;
+  for (size_t j = 0; j < P->n; j++)
+    if (P->piece[j] == piece)
+      FCM_TRY(ctx, parts_put(ctx, Q, Q->n, P->poly + j, P->tol[j], P->vmin[j], 0));
 cleanup:
   return st;
 }
@@ -541,7 +586,7 @@ static void uf_union(int *uf, int a, int b)
 
 /* Whether parts i and j share a face of positive area that does not lie on a cut triangle;
  * fp holds every part's face planes (FCM__POLY_MAX_FACES each; zero normal: no area). */
-static int parts_connected(const fcm__embed_cell *cell, const fcm__cut_tri *tris,
+static int parts_connected(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
                            const fcm__parts *P, const fcm__plane *fp, size_t ntri, size_t i,
                            size_t j)
 {
@@ -560,25 +605,17 @@ static int parts_connected(const fcm__embed_cell *cell, const fcm__cut_tri *tris
       const int nb = face_coords(b, fb, xb);
       if (!points_on_plane(xb, nb, pa, mtol)) continue;
       if (fcm__embed_linked(xa, na, a->x[0], a->nv, xb, nb, b->x[0], b->nv, pb->n, mtol, atol, tris,
-                            P->tcand.ids, ntri))
+                            P->tcand.ids, ntri) &&
+          (!P->mat || fcm__embed_part_full(P, i) || fcm__embed_part_full(P, j) ||
+           fcm__embed_overlap_material(ctx, P->mat, xa, na, xb, nb, pb->n, cell->size)))
         return 1;
     }
   }
   return 0;
 }
 
-/* Split every part by the triangles tris[P->tcand.ids[k0 .. k1)], then drop the parts the
- * tolerance emptied. */
-static fcm_status split_parts(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
-                              size_t k0, size_t k1, fcm__parts *P)
+void fcm__embed_parts_compact(fcm__parts *P)
 {
-  fcm_status st = FCM_OK;
-  for (size_t k = k0; k < k1; k++) {
-    const fcm__cut_tri *t = tris + P->tcand.ids[k];
-    const size_t n0 = P->n;
-    for (size_t i = 0; i < n0; i++)
-      FCM_TRY(ctx, split_part(ctx, cell, t, P, i));
-  }
   size_t kept = 0;
   for (size_t i = 0; i < P->n; i++) {
     if (P->poly[i].nf == 0) continue;
@@ -587,10 +624,34 @@ static fcm_status split_parts(fcm_ctx *ctx, const fcm__embed_cell *cell, const f
       P->tol[kept] = P->tol[i];
       P->vmin[kept] = P->vmin[i];
       P->parent[kept] = P->parent[i];
+      P->mvol[kept] = P->mvol[i];
     }
     kept++;
   }
   P->n = kept;
+}
+
+/* Split every part by the triangles tris[P->tcand.ids[k0 .. k1)], then drop the parts the
+ * tolerance emptied; *change: how much that changed the parts' total volume. Parts of a
+ * surface body without material are dropped too (after the volume is compared). */
+static fcm_status split_parts(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
+                              size_t k0, size_t k1, fcm__parts *P, double *change)
+{
+  fcm_status st = FCM_OK;
+  double before = 0.0, after = 0.0;
+  for (size_t i = 0; i < P->n; i++)
+    before += fcm__geom_poly_volume(P->poly + i);
+  for (size_t k = k0; k < k1; k++) {
+    const fcm__cut_tri *t = tris + P->tcand.ids[k];
+    const size_t n0 = P->n;
+    for (size_t i = 0; i < n0; i++)
+      FCM_TRY(ctx, split_part(ctx, cell, t, P, i));
+  }
+  fcm__embed_parts_compact(P);
+  for (size_t i = 0; i < P->n; i++)
+    after += fcm__geom_poly_volume(P->poly + i);
+  *change = fabs(after - before);
+  if (k1 > k0) FCM_TRY(ctx, fcm__embed_drop_dry(ctx, cell, P));
 cleanup:
   return st;
 }
@@ -656,8 +717,9 @@ static fcm_status components(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
       for (int d = 1; d < 3; d++)
         apart |= bi[d] > bj[3 + d] || bj[d] > bi[3 + d];
       if (apart || uf_find(P->uf, (int)i) == uf_find(P->uf, (int)j)) continue;
-      if (parts_connected(cell, tris, P, fp, ntri, i, j)) uf_union(P->uf, (int)i, (int)j);
+      if (parts_connected(ctx, cell, tris, P, fp, ntri, i, j)) uf_union(P->uf, (int)i, (int)j);
     }
+  if (P->mat) FCM_TRY(ctx, fcm__material_status(P->mat));
   int np = 0;
   for (size_t i = 0; i < P->n; i++) {
     const int r = uf_find(P->uf, (int)i);
@@ -676,12 +738,10 @@ fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
 {
   fcm_status st = FCM_OK;
   size_t nold = 0;
-  double before = 0.0, after = 0.0;
-  for (size_t i = 0; i < P->n; i++)
-    before += fcm__geom_poly_volume(P->poly + i);
+  double e0 = 0.0, e1 = 0.0;
   while (nold < P->tcand.n && P->tcand.ids[nold] < first_new)
     nold++;
-  FCM_TRY(ctx, split_parts(ctx, cell, tris, 0, nold, P));
+  FCM_TRY(ctx, split_parts(ctx, cell, tris, 0, nold, P, &e0));
   if (nold > 0) {
     FCM_TRY(ctx, components(ctx, cell, tris, nold, P, P->parent, &P->num_parents));
   } else {
@@ -689,10 +749,8 @@ fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
       P->parent[i] = 0;
     P->num_parents = P->n > 0;
   }
-  FCM_TRY(ctx, split_parts(ctx, cell, tris, nold, P->tcand.n, P));
-  for (size_t i = 0; i < P->n; i++)
-    after += fcm__geom_poly_volume(P->poly + i);
-  P->split_error = fabs(after - before);
+  FCM_TRY(ctx, split_parts(ctx, cell, tris, nold, P->tcand.n, P, &e1));
+  P->split_error = e0 + e1;
   FCM_TRY(ctx, components(ctx, cell, tris, P->tcand.n, P, P->piece, &P->num_pieces));
 cleanup:
   return st;
@@ -739,6 +797,14 @@ int fcm__embed_clip_to_part_flat(const fcm__parts *P, size_t i, double *x, int n
     }
     n = fcm__geom_polygon_clip(x, n, cap, &pl, P->tol[i], keep, work);
   }
+  return n;
+}
+
+int fcm__embed_part_planes(const fcm__parts *P, size_t i, fcm__plane *pl)
+{
+  int n = 0;
+  for (int f = 0; f < P->poly[i].nf; f++)
+    n += face_plane(P->poly + i, f, pl + n);
   return n;
 }
 

@@ -161,6 +161,15 @@ fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
                                         const double box[6], double vol, piece_out *o, int *ok,
                                         char *why, size_t why_len);
 
+/* Piece `piece` of a cell of a body without a volume mesh (P->mat, the parts split by the
+ * cuts): its rules of every kind built, fitted on points inside the piece to the moments of the
+ * body in its parts (o->fitted); where no fit is found (*fell_back = 1), the initial rules of
+ * the volume path on its parts split by the boundary (fcm__embed_piece_body_tets()), to be
+ * simplified. */
+fcm_status fcm__embed_surface_cut_piece(const build *B, const fcm_cell_rules *R,
+                                        const fcm__embed_cell *cell, fcm__embed_ws *ws,
+                                        fcm__parts *P, int piece, piece_out *o, int *fell_back);
+
 /* ---- auto_policy.c */
 
 /* Phase 2b of FCM_CELL_SIMPLIFY_AUTO: choose per kind whether simplification pays, then

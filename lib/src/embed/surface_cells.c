@@ -9,6 +9,7 @@
  * corner (the tip of a body's acute vertex in a cell) sit close to the corner, which only a
  * fine grid's points reach. */
 #include "embed/rules_impl.h"
+#include "la/mat3.h"
 #include "simplify/simplify_impl.h"
 
 #include <math.h>
@@ -52,18 +53,113 @@ cleanup:
   return st;
 }
 
+/* Whether the reference point xi lies in piece ws->cand_piece of ws->cand_parts (in one of
+ * its parts, within the part's tolerance); 1 without a piece to test. */
+static int in_piece(const fcm__embed_cell *cell, const fcm__embed_ws *ws, const double xi[3])
+{
+  if (!ws->cand_parts) return 1;
+  const double s[3] = {xi[0] - cell->xi0[0], xi[1] - cell->xi0[1], xi[2] - cell->xi0[2]};
+  double x[3];
+  fcm__mat3_mulv(cell->A, s, x);
+  for (int d = 0; d < 3; d++)
+    x[d] += cell->X[d];
+  for (size_t k = 0; k < ws->cand_npl;) {
+    const size_t c = (size_t)ws->cand_pl[k];
+    const double tol = ws->cand_pl[k + 1], *pl = ws->cand_pl + k + 2;
+    size_t f = 0;
+    while (f < c &&
+           pl[4 * f] * x[0] + pl[4 * f + 1] * x[1] + pl[4 * f + 2] * x[2] - pl[4 * f + 3] <= tol)
+      f++;
+    if (f == c) return 1;
+    k += 2 + 4 * c;
+  }
+  return 0;
+}
+
+/* The tet rule whose points piece_candidates() takes: the strongest built. */
+static const fcm_rule *piece_rule(const build *B)
+{
+  const fcm_rule *r = NULL;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    if (B->tet_rule[k] && (!r || fcm_rule_num_points(B->tet_rule[k]) > fcm_rule_num_points(r)))
+      r = B->tet_rule[k];
+  return r;
+}
+
+/* How many points piece_candidates() may add. */
+static size_t piece_points(const build *B, const fcm__embed_ws *ws)
+{
+  const fcm__parts *P = ws->cand_parts;
+  size_t n = 0;
+  for (size_t j = 0; P && j < P->n; j++)
+    if (P->piece[j] == ws->cand_piece) n += (size_t)fcm__geom_poly_num_tets(P->poly + j);
+  return n * (size_t)fcm_rule_num_points(piece_rule(B)) + ws->sr->n;
+}
+
+/* Candidates of a small or thin piece that the grid misses, those inside the body: the points
+ * of a tet rule on the tets of a fan of each of its parts (a positive rule of the part) and
+ * the points of its signed rule inside the piece (they lie on columns through the material). */
+static fcm_status piece_candidates(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
+                                   int *count)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm__parts *P = ws->cand_parts;
+  const fcm_rule *rule = piece_rule(B);
+  const int nq = fcm_rule_num_points(rule);
+  const double *eta = fcm_rule_points(rule);
+  double *tets = NULL, *vol = NULL;
+  FCM_ALLOC(ctx, 12 * FCM__POLY_MAX_FACES * FCM__POLY_MAX_FV, tets);
+  FCM_ALLOC(ctx, FCM__POLY_MAX_FACES * FCM__POLY_MAX_FV, vol);
+  for (size_t j = 0; j < P->n; j++) {
+    if (P->piece[j] != ws->cand_piece) continue;
+    const int nt = fcm__geom_poly_tets(P->poly + j, tets, vol);
+    for (int t = 0; t < nt; t++) {
+      const double *T = tets + 12 * t;
+      if (!(vol[t] > 0.0)) continue;
+      for (int q = 0; q < nq; q++) {
+        const double *e = eta + 3 * q;
+        double x[3], det;
+        int in;
+        for (int d = 0; d < 3; d++)
+          x[d] =
+              T[d] + e[0] * (T[3 + d] - T[d]) + e[1] * (T[6 + d] - T[d]) + e[2] * (T[9 + d] - T[d]);
+        double *xi = ws->cand_x + 3 * (size_t)*count;
+        FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, x, xi, &det));
+        FCM_TRY(ctx, fcm__embed_inside_line(ctx, B->geom, B->tri_tree, cell, xi[0], xi[1], 1,
+                                            xi + 2, &in, &ws->cand, ws->cr));
+        *count += in == 1;
+      }
+    }
+  }
+  for (size_t i = 0; i < ws->sr->n; i++) {
+    double *xi = ws->cand_x + 3 * (size_t)*count;
+    int in;
+    memcpy(xi, ws->sr->x + 3 * i, 3 * sizeof *xi);
+    if (!in_piece(cell, ws, xi)) continue;
+    FCM_TRY(ctx, fcm__embed_inside_line(ctx, B->geom, B->tri_tree, cell, xi[0], xi[1], 1, xi + 2,
+                                        &in, &ws->cand, ws->cr));
+    *count += in == 1;
+  }
+cleanup:
+  fcm__free(ctx, tets);
+  fcm__free(ctx, vol);
+  return st;
+}
+
 /* Candidates into ws->cand_x (*count of them): the points of an (n + 1)^3 grid over box, its
  * faces included, that lie inside the reference cell and the body, and up to nbnd of the
  * vertices and centroids of the boundary triangles' parts in the cell (ws->bnd). Points on the
  * material's boundary let the fit reach moments that interior points alone cannot (a
  * measure's spread). */
 static fcm_status grid_candidates(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
-                                  const double box[6], int n, int nbnd, int *count)
+                                  const double box[6], int n, int nbnd, int extra, int *count)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
   const int tet = cell->info->shape == FCM_SHAPE_TET, np = n + 1;
-  const size_t need = (size_t)np * (size_t)np * (size_t)np + ws->bnd->n;
+  const size_t nx = extra ? piece_points(B, ws) : 0;
+  const size_t need = (size_t)np * (size_t)np * (size_t)np + ws->bnd->n + nx;
   double h[3], *z = NULL;
   *count = 0;
   if (need > ws->cand_cap) {
@@ -89,7 +185,7 @@ static fcm_status grid_candidates(const build *B, const fcm__embed_cell *cell, f
         if (ws->cand_in[k] != 1 || (tet && a + b + z[k] > 1.0)) continue;
         double *x = ws->cand_x + 3 * (size_t)*count;
         x[0] = a, x[1] = b, x[2] = z[k];
-        (*count)++;
+        *count += in_piece(cell, ws, x);
       }
     }
   /* at most nb of them, spread over the list (a finely triangulated surface has many) */
@@ -97,8 +193,9 @@ static fcm_status grid_candidates(const build *B, const fcm__embed_cell *cell, f
   for (size_t i = 0; i < nb; i++) {
     const size_t j = i * ws->bnd->n / nb;
     memcpy(ws->cand_x + 3 * (size_t)*count, ws->bnd->x + 3 * j, 3 * sizeof(double));
-    (*count)++;
+    *count += in_piece(cell, ws, ws->cand_x + 3 * (size_t)*count);
   }
+  if (nx) FCM_TRY(ctx, piece_candidates(B, cell, ws, count));
 cleanup:
   fcm__free(ctx, z);
   return st;
@@ -219,7 +316,8 @@ fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
     const int n = grid_size(box, vref, target);
     int count;
     FCM_TRY(ctx, check_fit_memory(B, cell, ws, n, Mmax));
-    FCM_TRY(ctx, grid_candidates(B, cell, ws, box, n, BOUNDARY_PER_MOMENT * Mmax * grow, &count));
+    FCM_TRY(ctx, grid_candidates(B, cell, ws, box, n, BOUNDARY_PER_MOMENT * Mmax * grow,
+                                 attempt > 0 && ws->cand_parts, &count));
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
       if (!todo[k]) continue;
       int done;
@@ -252,6 +350,127 @@ void fcm__embed_surface_ws_free(fcm_ctx *ctx, fcm__embed_ws *ws)
   fcm__free(ctx, ws->bnd);
   fcm__free(ctx, ws->cand_x);
   fcm__free(ctx, ws->cand_in);
+  fcm__free(ctx, ws->cand_pl);
+  ws->cand_pl = NULL;
+  ws->cand_npl = ws->cand_plcap = 0;
   ws->sr = NULL, ws->cr = NULL, ws->bnd = NULL, ws->cand_x = NULL, ws->cand_in = NULL;
   ws->cand_cap = 0;
+}
+
+/* The points of the strongest built tet rule on the fan tets of the convex polyhedron p,
+ * appended to s (reference coordinates of cell): the exact rule of a part the body fills. */
+static fcm_status full_part_rule(const build *B, const fcm__embed_cell *cell, const fcm__poly *p,
+                                 fcm__srule *s)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_rule *rule = piece_rule(B);
+  const int nq = fcm_rule_num_points(rule), nt0 = fcm__geom_poly_num_tets(p);
+  const double *eta = fcm_rule_points(rule), *l = fcm_rule_weights(rule);
+  double *tets = NULL, *vol = NULL;
+  FCM_ALLOC(ctx, 12 * (size_t)nt0 + 12, tets);
+  FCM_ALLOC(ctx, (size_t)nt0 + 1, vol);
+  const int nt = fcm__geom_poly_tets(p, tets, vol);
+  if (s->n + (size_t)nt * nq > s->cap) {
+    size_t cap = s->cap ? s->cap : 1024;
+    while (cap < s->n + (size_t)nt * nq)
+      cap *= 2;
+    void *x = s->x, *w = s->w;
+    FCM_TRY(ctx, fcm__resize(ctx, &x, 3 * s->n, 3 * cap, sizeof(double)));
+    s->x = x;
+    FCM_TRY(ctx, fcm__resize(ctx, &w, s->n, cap, sizeof(double)));
+    s->w = w;
+    s->cap = cap;
+  }
+  for (int t = 0; t < nt; t++) {
+    const double *T = tets + 12 * t;
+    for (int q = 0; q < nq; q++) {
+      const double *e = eta + 3 * q;
+      double x[3], det;
+      for (int d = 0; d < 3; d++)
+        x[d] =
+            T[d] + e[0] * (T[3 + d] - T[d]) + e[1] * (T[6 + d] - T[d]) + e[2] * (T[9 + d] - T[d]);
+      FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, x, s->x + 3 * s->n, &det));
+      s->w[s->n++] = l[q] * 6.0 * vol[t] / det;
+    }
+  }
+cleanup:
+  fcm__free(ctx, tets);
+  fcm__free(ctx, vol);
+  return st;
+}
+
+fcm_status fcm__embed_surface_cut_piece(const build *B, const fcm_cell_rules *R,
+                                        const fcm__embed_cell *cell, fcm__embed_ws *ws,
+                                        fcm__parts *P, int piece, piece_out *o, int *fell_back)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  double mbox[6], box[6], v;
+  int touched, ok = 0;
+  char why[256] = "";
+  *fell_back = 0;
+  FCM_CHECK(cell->affine, ctx, FCM_ERR_UNSUPPORTED,
+            "embed: background cell %lld, which a cut reaches, is not affine: the pieces of a "
+            "body without a volume mesh take their moments from its surface, which needs an "
+            "affine cell",
+            (long long)cell->id);
+  FCM_TRY(ctx, ws_surface(ctx, ws));
+  FCM_TRY(ctx, fcm__embed_material_box(ctx, B->geom, B->tri_tree, cell, &ws->cand, ws->cr, ws->bnd,
+                                       mbox, &touched));
+  for (int d = 0; d < 3; d++)
+    box[d] = HUGE_VAL, box[3 + d] = -HUGE_VAL;
+  ws->sr->n = 0;
+  ws->cand_npl = 0;
+  for (size_t j = 0; j < P->n; j++) {
+    if (P->piece[j] != piece) continue;
+    for (int a = 0; a < P->poly[j].nv; a++) {
+      double xi[3], det;
+      FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, P->poly[j].x[a], xi, &det));
+      for (int d = 0; d < 3; d++)
+        box[d] = fmin(box[d], xi[d]), box[3 + d] = fmax(box[3 + d], xi[d]);
+    }
+    if (P->whole)
+      FCM_TRY(ctx, fcm__material_cell(ctx, P->mat, &B->mq, cell, ws->sr, &v));
+    else if (fcm__embed_part_full(P, j)) /* wholly inside the body: a tet rule on its fan */
+      FCM_TRY(ctx, full_part_rule(B, cell, P->poly + j, ws->sr));
+    else
+      FCM_TRY(ctx, fcm__material_poly(ctx, P->mat, P->poly + j, &B->mq, cell, ws->sr, &v));
+    fcm__plane pl[FCM__POLY_MAX_FACES];
+    const int c = fcm__embed_part_planes(P, j, pl);
+    if (ws->cand_npl + 2 + 4 * (size_t)c > ws->cand_plcap) {
+      size_t cap = ws->cand_plcap ? 2 * ws->cand_plcap : 1024;
+      while (cap < ws->cand_npl + 2 + 4 * (size_t)c)
+        cap *= 2;
+      void *q = ws->cand_pl;
+      FCM_TRY(ctx, fcm__resize(ctx, &q, ws->cand_npl, cap, sizeof(double)));
+      ws->cand_pl = q;
+      ws->cand_plcap = cap;
+    }
+    ws->cand_pl[ws->cand_npl++] = c;
+    ws->cand_pl[ws->cand_npl++] = P->tol[j];
+    for (int f = 0; f < c; f++) {
+      memcpy(ws->cand_pl + ws->cand_npl, pl[f].n, 3 * sizeof(double));
+      ws->cand_pl[ws->cand_npl + 3] = pl[f].d;
+      ws->cand_npl += 4;
+    }
+  }
+  for (int d = 0; d < 3 && touched; d++) /* the material's own box where the surface bounds it */
+    box[d] = fmax(box[d], mbox[d]), box[3 + d] = fmin(box[3 + d], mbox[3 + d]);
+  ws->cand_parts = P, ws->cand_piece = piece;
+  st = fcm__embed_surface_piece_fit(B, R, cell, ws, box, o->volume, o, &ok, why, sizeof why);
+  ws->cand_parts = NULL;
+  FCM_TRY(ctx, st);
+  if (!ok) { /* a thin or small piece: its parts split by the boundary triangles, the volume path */
+    FCM_TRY(ctx, fcm__embed_piece_body_tets(ctx, cell, P, piece, ws, &v));
+    FCM_CHECK(ws->num_tets > 0, ctx, FCM_ERR_GEOMETRY,
+              "embed: background cell %lld, piece %d: no positive rule on points inside the piece "
+              "carries its surface moments (volume %.3g; %s), and splitting it by the boundary "
+              "triangles leaves no material",
+              (long long)cell->id, piece, o->volume, why);
+    FCM_TRY(ctx, fcm__embed_map_piece(B, R, cell, ws, o));
+    *fell_back = 1;
+  }
+cleanup:
+  return st;
 }

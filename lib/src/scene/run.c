@@ -246,9 +246,12 @@ static fcm_status build_surface_geometry(fcm_simulation *S, const fcm_scene_geom
     phase_end(S);
     mo.check_intersections = 0; /* done above */
     mo.orient = 0;
-    if (mo.volume_mesh < 0) /* auto: cutting splits the geometry's cells, and the distributed
-                               backend partitions the work by them */
-      mo.volume_mesh = fcm_scene_count_effects(S->scene, FCM_EFFECT_CUT) > 0 || S->distributed;
+    if (mo.volume_mesh < 0) /* auto: the distributed backend partitions the work by the
+                               geometry's cells; cuts split the surface body's cells without
+                               them, unless the volume path is asked for */
+      mo.volume_mesh = S->distributed || (fcm_scene_count_effects(S->scene, FCM_EFFECT_CUT) > 0 &&
+                                          fcm_scene_get_quadrature(S->scene)->rules.moments ==
+                                              FCM_CELL_MOMENTS_VOLUME);
     if (mo.volume_mesh)
       phase_begin(S, FCM_SETUP_VOLUME_MESH, 0, "meshing the volume inside %lld triangles with Gmsh",
                   (long long)fcm_surface_num_triangles(surf));

@@ -1,0 +1,310 @@
+/* Cut cells of a body given by its closed boundary alone (no volume mesh). The convex parts of
+ * such a cell are the cell itself split by the cut triangles (pieces.c); the material of a part
+ * is the body inside it, measured exactly by the surface moments (surface_moments.c) on the
+ * tets of a fan of the part: each tet is an affine Tet4 cell of its own, and the moments cost
+ * what the boundary triangles meeting it cost. A part without material is dropped, and two
+ * parts (of one cell, or of two cells across a face) join only where the overlap of their
+ * faces holds material: the body's volume in a thin prism on the overlap. So the pieces are
+ * the components of the material as the volume mesh's parts give them, except that the body
+ * inside one part counts as one piece even where the part holds two separate lumps of it. */
+#include "embed/embed_impl.h"
+#include "element/element_impl.h"
+#include "la/mat3.h"
+
+#include <math.h>
+#include <string.h>
+
+struct fcm__material {
+  const fcm_geometry *geom;
+  const fcm_aabb_tree *tree; /* the boundary triangles' */
+  fcm__moment_quad q0;       /* degree 0: volumes */
+  fcm__idbuf buf;
+  fcm__crossings cr;
+  fcm__srule sr;
+  double *tets, *vol;
+  int cap;
+  fcm_status st; /* the first error of fcm__material_on_face() */
+};
+
+fcm_status fcm__material_create(fcm_ctx *ctx, const fcm_geometry *geom, fcm__material **out)
+{
+  fcm_status st = FCM_OK;
+  fcm__material *m = NULL;
+  FCM_ALLOC(ctx, 1, m);
+  m->geom = geom;
+  FCM_TRY(ctx, fcm__geom_tree(ctx, geom, 1, &m->tree));
+  FCM_TRY(ctx, fcm__moment_quad_create(ctx, 0, &m->q0));
+  *out = m;
+  m = NULL;
+cleanup:
+  fcm__material_destroy(ctx, &m);
+  return st;
+}
+
+void fcm__material_destroy(fcm_ctx *ctx, fcm__material **pm)
+{
+  if (!pm || !*pm) return;
+  fcm__material *m = *pm;
+  fcm__moment_quad_free(ctx, &m->q0);
+  fcm__geom_idbuf_free(ctx, &m->buf);
+  fcm__crossings_free(ctx, &m->cr);
+  fcm__srule_free(ctx, &m->sr);
+  fcm__free(ctx, m->tets);
+  fcm__free(ctx, m->vol);
+  fcm__free(ctx, m);
+  *pm = NULL;
+}
+
+fcm_status fcm__material_status(fcm__material *m)
+{
+  const fcm_status st = m->st;
+  m->st = FCM_OK;
+  return st;
+}
+
+/* A part whose material is within this fraction of its volume lies wholly inside the body. */
+#define FULL_RTOL 1e-12
+
+/* A tet whose 6 x volume is below this fraction of its size cubed is flat (skipped). */
+#define FLAT_RTOL 1e-12
+
+/* Tet (c, a, b, e) (12 doubles) as an affine Tet4 cell: node 0 at xi = 0. */
+static void tet_cell(const double *T, fcm_index id, fcm__embed_cell *k)
+{
+  k->type = FCM_ELEMENT_TET4;
+  k->info = fcm_element_get_info(FCM_ELEMENT_TET4);
+  k->id = id;
+  memcpy(k->X, T, 12 * sizeof *T);
+  k->num_planes = 0;
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      k->A[3 * i + j] = T[3 * (j + 1) + i] - T[i];
+  k->xi0[0] = k->xi0[1] = k->xi0[2] = 0.0;
+  k->detA = fcm__mat3_inv(k->A, k->Ainv);
+  k->affine = 1;
+  k->size = fcm__element_cell_size(4, T);
+  k->tol = 0.0;
+  k->volume = fabs(k->detA) / 6.0;
+  for (int d = 0; d < 3; d++) {
+    k->lo[d] = HUGE_VAL, k->hi[d] = -HUGE_VAL;
+    for (int a = 0; a < 4; a++)
+      k->lo[d] = fmin(k->lo[d], T[3 * a + d]), k->hi[d] = fmax(k->hi[d], T[3 * a + d]);
+  }
+}
+
+/* The body's signed rule of degree q->m on each of the nt tets (tets, vol), summed into
+ * *volume; appended to out (cell's reference coordinates) when out is given. */
+static fcm_status tets_material(fcm_ctx *ctx, fcm__material *m, const double *tets,
+                                const double *vol, int nt, const fcm__moment_quad *q,
+                                const fcm__embed_cell *cell, fcm__srule *out, double *volume)
+{
+  fcm_status st = FCM_OK;
+  double sum = 0.0;
+  for (int t = 0; t < nt; t++) {
+    if (vol[t] == 0.0) continue;
+    fcm__embed_cell k;
+    tet_cell(tets + 12 * t, cell ? cell->id : -1, &k);
+    /* a fan tet flat to rounding (near-coplanar vertices of a part) holds no material that
+     * counts, and its map to the unit tet is too ill-conditioned for the line crossings */
+    if (!(fabs(k.detA) > FLAT_RTOL * k.size * k.size * k.size && isfinite(k.detA))) continue;
+    FCM_TRY(ctx,
+            fcm__embed_moment_rule(ctx, m->geom, m->tree, &k, q, NULL, &m->buf, &m->cr, &m->sr));
+    if (out && out->n + m->sr.n > out->cap) {
+      size_t cap = out->cap ? out->cap : 1024;
+      while (cap < out->n + m->sr.n)
+        cap *= 2;
+      void *x = out->x, *w = out->w;
+      FCM_TRY(ctx, fcm__resize(ctx, &x, 3 * out->n, 3 * cap, sizeof(double)));
+      out->x = x;
+      FCM_TRY(ctx, fcm__resize(ctx, &w, out->n, cap, sizeof(double)));
+      out->w = w;
+      out->cap = cap;
+    }
+    for (size_t i = 0; i < m->sr.n; i++) {
+      const double w = m->sr.w[i] * k.detA;
+      sum += w;
+      if (!out) continue;
+      double x[3], det;
+      fcm__mat3_mulv(k.A, m->sr.x + 3 * i, x);
+      for (int d = 0; d < 3; d++)
+        x[d] += k.X[d];
+      FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, x, out->x + 3 * out->n, &det));
+      out->w[out->n++] = w / det;
+    }
+  }
+  *volume = sum;
+cleanup:
+  return st;
+}
+
+/* Room for nt tets in m. */
+static fcm_status tets_room(fcm_ctx *ctx, fcm__material *m, int nt)
+{
+  fcm_status st = FCM_OK;
+  if (nt <= m->cap) return FCM_OK;
+  void *t = m->tets, *v = m->vol;
+  FCM_TRY(ctx, fcm__resize(ctx, &t, 0, 12 * (size_t)nt, sizeof(double)));
+  m->tets = t;
+  FCM_TRY(ctx, fcm__resize(ctx, &v, 0, (size_t)nt, sizeof(double)));
+  m->vol = v;
+  m->cap = nt;
+cleanup:
+  return st;
+}
+
+fcm_status fcm__material_poly(fcm_ctx *ctx, fcm__material *m, const fcm__poly *p,
+                              const fcm__moment_quad *q, const fcm__embed_cell *cell,
+                              fcm__srule *out, double *volume)
+{
+  fcm_status st = FCM_OK;
+  *volume = 0.0;
+  if (p->nf == 0) return FCM_OK;
+  FCM_TRY(ctx, tets_room(ctx, m, fcm__geom_poly_num_tets(p)));
+  const int nt = fcm__geom_poly_tets(p, m->tets, m->vol);
+  FCM_TRY(ctx, tets_material(ctx, m, m->tets, m->vol, nt, q ? q : &m->q0, cell, out, volume));
+cleanup:
+  return st;
+}
+
+fcm_status fcm__material_cell(fcm_ctx *ctx, fcm__material *m, const fcm__moment_quad *q,
+                              const fcm__embed_cell *cell, fcm__srule *out, double *volume)
+{
+  fcm_status st = FCM_OK;
+  double sum = 0.0;
+  FCM_TRY(ctx, fcm__embed_moment_rule(ctx, m->geom, m->tree, cell, q ? q : &m->q0, NULL, &m->buf,
+                                      &m->cr, &m->sr));
+  if (out && out->n + m->sr.n > out->cap) {
+    size_t cap = out->cap ? out->cap : 1024;
+    while (cap < out->n + m->sr.n)
+      cap *= 2;
+    void *x = out->x, *w = out->w;
+    FCM_TRY(ctx, fcm__resize(ctx, &x, 3 * out->n, 3 * cap, sizeof(double)));
+    out->x = x;
+    FCM_TRY(ctx, fcm__resize(ctx, &w, out->n, cap, sizeof(double)));
+    out->w = w;
+    out->cap = cap;
+  }
+  for (size_t i = 0; i < m->sr.n; i++) {
+    sum += m->sr.w[i];
+    if (!out) continue;
+    memcpy(out->x + 3 * out->n, m->sr.x + 3 * i, 3 * sizeof(double));
+    out->w[out->n++] = m->sr.w[i];
+  }
+  *volume = sum * cell->detA;
+cleanup:
+  return st;
+}
+
+int fcm__material_on_face(fcm_ctx *ctx, fcm__material *m, const double *x, int n,
+                          const double nrm[3], double h, double atol)
+{
+  fcm_status st = FCM_OK;
+  double v = 0.0;
+  if (n < 3) return 0;
+  FCM_TRY(ctx, tets_room(ctx, m, 3 * (n - 2)));
+  /* the prism on each fan triangle (p, q, r): three tets of one orientation */
+  for (int k = 1; k + 1 < n; k++) {
+    const double *c[3] = {x, x + 3 * k, x + 3 * (k + 1)};
+    double lo[3][3], up[3][3];
+    for (int a = 0; a < 3; a++)
+      for (int d = 0; d < 3; d++)
+        lo[a][d] = c[a][d] - h * nrm[d], up[a][d] = c[a][d] + h * nrm[d];
+    const double *tv[3][4] = {
+        {lo[0], lo[1], lo[2], up[0]}, {lo[1], lo[2], up[0], up[1]}, {lo[2], up[0], up[1], up[2]}};
+    for (int t = 0; t < 3; t++) {
+      double *T = m->tets + 12 * (3 * (k - 1) + t);
+      for (int a = 0; a < 4; a++)
+        memcpy(T + 3 * a, tv[t][a], 3 * sizeof *T);
+      m->vol[3 * (k - 1) + t] = 1.0;
+    }
+  }
+  FCM_TRY(ctx, tets_material(ctx, m, m->tets, m->vol, 3 * (n - 2), &m->q0, NULL, NULL, &v));
+cleanup:
+  if (st != FCM_OK) {
+    if (m->st == FCM_OK) m->st = st;
+    return 1;
+  }
+  return fabs(v) / (2.0 * h) > atol;
+}
+
+/* The prism's half-height and the area that counts as material on a face, relative to the
+ * cell size (and its square): far above the surface moments' rounding (1e-15 of the prism). */
+#define PRISM_RTOL     1e-6
+#define FACE_AREA_RTOL 1e-9
+
+int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const double *a, int na,
+                                const double *b, int nb, const double nb_normal[3], double size)
+{
+  double x[3 * FCM__POLY_MAX_VERTS];
+  int n = 0;
+  fcm__embed_overlap(a, na, b, nb, nb_normal, FCM__EMBED_MATCH_RTOL * size, x, &n);
+  return fcm__material_on_face(ctx, m, x, n, nb_normal, PRISM_RTOL * size,
+                               FACE_AREA_RTOL * size * size);
+}
+
+fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P,
+                                      int piece, fcm__embed_ws *ws, double *volume)
+{
+  fcm_status st = FCM_OK;
+  fcm__material *m = P->mat;
+  const fcm_geometry *g = m->geom;
+  fcm__parts *Q = NULL;
+  double lost = 0.0;
+  fcm_index nslivers = 0;
+  static const unsigned char outer[3] = {0, 0, 0};
+  *volume = 0.0;
+  ws->num_tets = 0;
+  FCM_ALLOC(ctx, 1, Q);
+  FCM_TRY(ctx, fcm__embed_parts_copy(ctx, P, piece, Q));
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, m->tree, cell->lo, cell->hi, &m->buf));
+  for (size_t k = 0; k < m->buf.n && Q->n > 0; k++) {
+    const fcm_index *tv = g->tris + 3 * m->buf.ids[k];
+    fcm__cut_tri t;
+    if (!fcm__embed_cut_tri_setup(g->coords + 3 * tv[0], g->coords + 3 * tv[1],
+                                  g->coords + 3 * tv[2], 0, outer, NULL, &t))
+      continue;
+    FCM_TRY(ctx, fcm__embed_parts_split(ctx, cell, &t, Q));
+  }
+  for (size_t i = 0; i < Q->n; i++) { /* no boundary triangle crosses a part: one point decides */
+    const fcm__poly *q = Q->poly + i;
+    double c[3] = {0.0, 0.0, 0.0}, xi[3], det;
+    int in;
+    for (int a = 0; a < q->nv; a++)
+      for (int d = 0; d < 3; d++)
+        c[d] += q->x[a][d] / q->nv;
+    FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, c, xi, &det));
+    FCM_TRY(ctx, fcm__embed_inside_line(ctx, g, m->tree, cell, xi[0], xi[1], 1, xi + 2, &in,
+                                        &m->buf, &m->cr));
+    if (in == 1)
+      FCM_TRY(ctx, fcm__embed_append_tets(ctx, ws, q, Q->vmin[i], volume, &lost, &nslivers));
+  }
+cleanup:
+  if (Q) fcm__embed_parts_free(ctx, Q);
+  fcm__free(ctx, Q);
+  return st;
+}
+
+int fcm__embed_part_full(const fcm__parts *P, size_t i)
+{
+  return P->mvol[i] < 0.0 || P->mvol[i] >= (1.0 - FULL_RTOL) * fcm__geom_poly_volume(P->poly + i);
+}
+
+fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P)
+{
+  fcm_status st = FCM_OK;
+  if (!P->mat) return FCM_OK;
+  for (size_t i = 0; i < P->n; i++) {
+    if (P->mvol[i] != 0.0) { /* known; or a piece of a part wholly inside the body */
+      if (P->mvol[i] < 0.0) P->mvol[i] = fcm__geom_poly_volume(P->poly + i);
+      continue;
+    }
+    if (P->whole && cell->affine)
+      FCM_TRY(ctx, fcm__material_cell(ctx, P->mat, NULL, cell, NULL, P->mvol + i));
+    else
+      FCM_TRY(ctx, fcm__material_poly(ctx, P->mat, P->poly + i, NULL, NULL, NULL, P->mvol + i));
+    if (!(P->mvol[i] > P->vmin[i])) P->poly[i].nv = P->poly[i].nf = 0;
+  }
+  fcm__embed_parts_compact(P);
+cleanup:
+  return st;
+}

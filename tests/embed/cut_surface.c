@@ -1,0 +1,253 @@
+/* Cutting a body given by its boundary surface alone (no volume mesh): the same body as a
+ * volume geometry (the ball of fcm_geometry_create_ball(), its boundary triangles as the
+ * surface) is cut by the same knives, and the two cut-cell rules must agree: every cell has as
+ * many pieces, the pieces match one to one, and each matched pair integrates every monomial of
+ * reference coordinates up to the rule's strength alike to TOL of the reference cell's volume
+ * (both rules are exact for those moments up to their fits' residuals); the pieces form as
+ * many material components along the links. Knives: a tilted plane through the whole body (its
+ * edges run outside the body in cells the body reaches: material must not join around them), a
+ * rectangle ending inside the body (a crack), a V of two half-planes (non-planar) and a second
+ * plane crossing the first one in cells it already split, a square cutting off a cap of the
+ * ball whose edges end outside the ball in cells that hold material on both sides. Hex8 and Tet4
+ * backgrounds (argument "quadratic": Hex20 and Tet10). */
+#include "fcm/embed.h"
+#include "fcm/surface.h"
+#include "test.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static fcm_ctx *ctx;
+
+#define TEST_TRUE_MSG(cond, ...)                                                                   \
+  do {                                                                                             \
+    if (!(cond)) TEST_FAIL_(__VA_ARGS__);                                                          \
+  } while (0)
+
+/* Agreement of matched pieces' moments, relative to the reference cell's volume: the fits of
+ * both paths reach 1e-14 relative residual of their moments (set below), the surface moments'
+ * rounding is about 1e-15. */
+#define TOL 1e-12
+
+enum { MAX_M = 455 }; /* monomials of degree <= 12 */
+
+/* Moments of x^a y^b z^c (a + b + c <= m) of piece p's authentic points of kind k. */
+static int piece_monomials(const fcm_cell_rules *r, fcm_index p, fcm_rule_kind k, int m,
+                           double *mom)
+{
+  int n, M = 0;
+  const double *x, *w;
+  const unsigned char *fl;
+  TEST_OK(ctx, fcm_cell_rules_get_piece(r, p, k, &n, &x, &w, &fl));
+  for (int a = 0; a <= m; a++)
+    for (int b = 0; a + b <= m; b++)
+      for (int c = 0; a + b + c <= m; c++, M++) {
+        double s = 0.0;
+        for (int j = 0; j < n; j++)
+          if (!fl[j]) s += w[j] * pow(x[3 * j], a) * pow(x[3 * j + 1], b) * pow(x[3 * j + 2], c);
+        mom[M] = s;
+      }
+  return M;
+}
+
+static int uf_find(fcm_index *uf, fcm_index a)
+{
+  while (uf[a] != a)
+    a = uf[a] = uf[uf[a]];
+  return (int)a;
+}
+
+/* Material components: pieces joined along the links, single pieces of cells without links
+ * joined with their face neighbours' (as tests/embed/cut.c counts them). */
+static int components(const fcm_mesh *mesh, const fcm_cell_rules *r)
+{
+  const fcm_index np = fcm_cell_rules_num_pieces(r), nc = fcm_mesh_num_cells(mesh);
+  const int nf = fcm_mesh_get_element_info(mesh)->num_faces;
+  const fcm_index *nbr = fcm_mesh_neighbors(mesh), *L = fcm_cell_rules_links(r);
+  fcm_index *uf = malloc((size_t)np * sizeof *uf);
+  unsigned char *linked = calloc((size_t)np, 1);
+  for (fcm_index p = 0; p < np; p++)
+    uf[p] = p;
+  for (fcm_index l = 0; l < fcm_cell_rules_num_links(r); l++) {
+    linked[L[2 * l]] = linked[L[2 * l + 1]] = 1;
+    uf[uf_find(uf, L[2 * l])] = uf_find(uf, L[2 * l + 1]);
+  }
+  for (fcm_index c = 0; c < nc; c++) {
+    fcm_index f0, f1;
+    if (fcm_cell_rules_cell_pieces(r, c, &f0) != 1 || linked[f0]) continue;
+    for (int f = 0; f < nf; f++) {
+      const fcm_index c2 = nbr[nf * c + f];
+      if (c2 >= 0 && fcm_cell_rules_cell_pieces(r, c2, &f1) == 1 && !linked[f1])
+        uf[uf_find(uf, f0)] = uf_find(uf, f1);
+    }
+  }
+  int k = 0;
+  for (fcm_index p = 0; p < np; p++)
+    k += uf_find(uf, p) == p;
+  free(uf);
+  free(linked);
+  return k;
+}
+
+/* The rules of the volume path (rv) and the surface path (rs) agree; returns the largest
+ * moment difference relative to the reference cell's volume. */
+static double compare(const fcm_mesh *mesh, const fcm_cell_rules *rv, const fcm_cell_rules *rs,
+                      const char *what)
+{
+  const fcm_element_type type = fcm_mesh_element_type(mesh);
+  const double vref = type == FCM_ELEMENT_TET4 || type == FCM_ELEMENT_TET10 ? 1.0 / 6.0 : 8.0;
+  double worst = 0.0, mv[MAX_M], ms[MAX_M];
+  for (fcm_index c = 0; c < fcm_mesh_num_cells(mesh); c++) {
+    fcm_index fv, fs;
+    const fcm_index kv = fcm_cell_rules_cell_pieces(rv, c, &fv),
+                    ks = fcm_cell_rules_cell_pieces(rs, c, &fs);
+    TEST_TRUE_MSG(kv == ks, "%s: cell %lld has %lld pieces on the volume path, %lld on the surface",
+                  what, (long long)c, (long long)kv, (long long)ks);
+    if (kv != ks) continue;
+    TEST_TRUE(fcm_cell_rules_class(rv, c) == fcm_cell_rules_class(rs, c));
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+      const int m = fcm_cell_rules_strength(rv, (fcm_rule_kind)k);
+      TEST_TRUE((m + 1) * (m + 2) * (m + 3) / 6 <= MAX_M);
+      unsigned char used[64] = {0};
+      for (fcm_index p = fv; p < fv + kv; p++) {
+        const int M = piece_monomials(rv, p, (fcm_rule_kind)k, m, mv);
+        double best = HUGE_VAL;
+        int bq = -1;
+        for (fcm_index q = 0; q < ks && q < 64; q++) {
+          if (used[q]) continue;
+          piece_monomials(rs, fs + q, (fcm_rule_kind)k, m, ms);
+          double d = 0.0;
+          for (int i = 0; i < M; i++)
+            d = fmax(d, fabs(mv[i] - ms[i]) / vref);
+          if (d < best) best = d, bq = (int)q;
+        }
+        if (bq >= 0) used[bq] = 1;
+        worst = fmax(worst, best);
+        TEST_TRUE_MSG(best <= TOL,
+                      "%s: cell %lld piece %lld (%s): moments differ by %.3g of the "
+                      "reference volume",
+                      what, (long long)c, (long long)(p - fv),
+                      k == FCM_RULE_MASS ? "mass" : "stiffness", best);
+      }
+    }
+  }
+  TEST_TRUE_MSG(components(mesh, rv) == components(mesh, rs),
+                "%s: %d components on the volume "
+                "path, %d on the surface",
+                what, components(mesh, rv), components(mesh, rs));
+  return worst;
+}
+
+/* The boundary of g as a surface geometry without a volume mesh. */
+static void surface_of(const fcm_geometry *g, fcm_geometry **gs)
+{
+  const fcm_index nt = fcm_geometry_num_boundary_triangles(g), nv = fcm_geometry_num_nodes(g);
+  const fcm_index *t = fcm_geometry_boundary_triangles(g);
+  const double *x = fcm_geometry_coords(g);
+  fcm_index *id = malloc((size_t)nv * sizeof *id), *tv = malloc(3 * (size_t)nt * sizeof *tv), n = 0;
+  double *y = malloc(3 * (size_t)nv * sizeof *y);
+  for (fcm_index v = 0; v < nv; v++)
+    id[v] = -1;
+  for (fcm_index k = 0; k < 3 * nt; k++) {
+    if (id[t[k]] < 0) {
+      memcpy(y + 3 * n, x + 3 * t[k], 3 * sizeof *y);
+      id[t[k]] = n++;
+    }
+    tv[k] = id[t[k]];
+  }
+  fcm_surface *s = NULL;
+  TEST_OK(ctx, fcm_surface_create(ctx, n, y, nt, tv, &s));
+  fcm_surface_mesh_options mo = fcm_surface_mesh_options_default();
+  mo.volume_mesh = 0;
+  TEST_OK(ctx, fcm_geometry_create_from_surface(ctx, s, &mo, gs));
+  fcm_surface_destroy(&s);
+  free(id);
+  free(tv);
+  free(y);
+}
+
+/* A V of two half-planes from a ridge along z through (x0, y0), opening towards -x. */
+static void v_cut(double x0, double y0, fcm_surface **cut)
+{
+  const double v[6][3] = {{x0, y0, -2},           {x0, y0, 2},
+                          {x0 - 1.5, y0 + 2, -2}, {x0 - 1.5, y0 + 2, 2},
+                          {x0 - 1.5, y0 - 2, -2}, {x0 - 1.5, y0 - 2, 2}};
+  const fcm_index t[12] = {0, 2, 3, 0, 3, 1, 0, 1, 5, 0, 5, 4};
+  TEST_OK(ctx, fcm_surface_create(ctx, 6, &v[0][0], 4, t, cut));
+}
+
+static void run(fcm_element_type type)
+{
+  const char *name = type == FCM_ELEMENT_TET4    ? "tet4"
+                     : type == FCM_ELEMENT_TET10 ? "tet10"
+                     : type == FCM_ELEMENT_HEX20 ? "hex20"
+                                                 : "hex8";
+  const double lo[3] = {-1.1, -1.1, -1.1}, hi[3] = {1.1, 1.1, 1.1}, c0[3] = {0, 0, 0};
+  const fcm_index n[3] = {4, 4, 4};
+  fcm_mesh *mesh = NULL;
+  fcm_geometry *gv = NULL, *gs = NULL;
+  fcm_cell_rules *rv = NULL, *rs = NULL;
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, n, &mesh));
+  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c0, 1.0, 2, &gv));
+  surface_of(gv, &gs);
+  fcm_cell_rules_options o = fcm_cell_rules_options_default();
+  o.min_fraction = 0.0;
+  o.simplify_options.residual_tol = 1e-14;
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, gv, &o, &rv));
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, gs, &o, &rs));
+  fcm_surface *knife[5] = {NULL, NULL, NULL, NULL, NULL};
+  const double p0[3] = {0.13, 0.05, -0.02}, n0[3] = {1, 0.3, 0.2};
+  const double blo[3] = {-1.05, -1.05, -1.05}, bhi[3] = {1.05, 1.05, 1.05};
+  TEST_OK(ctx, fcm_surface_create_plane(ctx, p0, n0, blo, bhi, &knife[0]));
+  const double rc[3] = {-0.3, 0.1, 0.55}, rn[3] = {0.1, 0.2, 1}, ra[3] = {1, 0, 0},
+               rsz[2] = {1.2, 0.9};
+  TEST_OK(ctx, fcm_surface_create_rectangle(ctx, rc, rn, ra, rsz, &knife[1]));
+  v_cut(0.45, -0.1, &knife[2]);
+  const double p3[3] = {0.0, 0.07, 0.0}, n3[3] = {0.15, 1, -0.25};
+  TEST_OK(ctx, fcm_surface_create_plane(ctx, p3, n3, blo, bhi, &knife[3]));
+  /* the cap z > 0.8 cut off by a square whose edges end outside the ball in cells that hold
+   * material on both sides of it */
+  const double qc[3] = {0.02, -0.03, 0.8}, qn[3] = {0.05, 0.02, 1}, qa[3] = {1, 0.1, 0},
+               qsz[2] = {1.4, 1.4};
+  TEST_OK(ctx, fcm_surface_create_rectangle(ctx, qc, qn, qa, qsz, &knife[4]));
+  const char *names[5] = {"plane", "crack", "V", "crossing plane", "cap"};
+  for (int k = 0; k < 5; k++) {
+    fcm_cell_rules *nv = NULL, *ns = NULL;
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, gv, rv, knife[k], &nv));
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, gs, rs, knife[k], &ns));
+    fcm_cell_rules_destroy(&rv);
+    fcm_cell_rules_destroy(&rs);
+    rv = nv, rs = ns;
+    char what[64];
+    snprintf(what, sizeof what, "%s, %s", name, names[k]);
+    const double worst = compare(mesh, rv, rs, what);
+    const fcm_cell_rules_stats *S = fcm_cell_rules_get_stats(rs);
+    printf("%s: %lld pieces, %d components, %lld cells fitted on surface moments (%lld pieces "
+           "split by the boundary instead), moments agree to %.2e of |K_ref|\n",
+           what, (long long)fcm_cell_rules_num_pieces(rs), components(mesh, rs),
+           (long long)S->num_surface_cells, (long long)S->num_surface_fallbacks, worst);
+  }
+  for (int k = 0; k < 5; k++)
+    fcm_surface_destroy(&knife[k]);
+  fcm_cell_rules_destroy(&rv);
+  fcm_cell_rules_destroy(&rs);
+  fcm_geometry_destroy(&gv);
+  fcm_geometry_destroy(&gs);
+  fcm_mesh_destroy(&mesh);
+}
+
+int main(int argc, char **argv)
+{
+  TEST_OK(NULL, fcm_ctx_create(NULL, &ctx));
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 2));
+  if (argc > 1 && !strcmp(argv[1], "quadratic")) { /* embed_cut_surface_quadratic (slow) */
+    run(FCM_ELEMENT_HEX20);
+    run(FCM_ELEMENT_TET10);
+  } else {
+    run(FCM_ELEMENT_HEX8);
+    run(FCM_ELEMENT_TET4);
+  }
+  fcm_ctx_destroy(&ctx);
+  return TEST_RESULT();
+}
