@@ -17,13 +17,23 @@
 #   scene_app.sh refused MPIEXEC FCM_SIM - SCENE - REGEX WORK
 #     the backend refuses the scene: exit 2 on every process, the message matches REGEX
 #     (grep -E), nothing is stepped.
+# The distributed backend partitions a surface body by its volume mesh ("volume_mesh": "auto"
+# builds one there), the serial run integrates it from the surface alone: the serial run
+# takes the same scene with "volume_mesh": true, so both integrate the same cells alike.
 set -euo pipefail
 mode=$1 mpiexec=$2 sim=$3 diff=$4 scene=$5 steps=$6 arg=$7 work=$8
 name=$(basename "$scene" .json)
 rm -rf "$work" && mkdir -p "$work"
+serial_scene=$work/serial/$name.json
+make_serial_scene() {
+  mkdir -p "$work/serial"
+  "$sim" "$scene" --print-scene | sed 's/"volume_mesh": "auto"/"volume_mesh": true/' \
+    >"$serial_scene"
+}
 if [ "$mode" = summary ]; then
   "$mpiexec" -n 2 "$sim" "$scene" --backend petsc --check -ksp_rtol 1e-12 >"$work/p.txt"
-  "$sim" "$scene" --check >"$work/s.txt"
+  make_serial_scene
+  "$sim" "$serial_scene" --check >"$work/s.txt"
   pick() { grep -E '^  (cells|volume|body) |^  computed  (rules built|constraints) ' "$1"; }
   [ "$(pick "$work/s.txt" | wc -l)" -ge 4 ] || { echo "summary lines missing" >&2; exit 1; }
   diff <(pick "$work/s.txt") <(pick "$work/p.txt")
@@ -43,7 +53,8 @@ if [ "$mode" = refused ]; then
 fi
 "$mpiexec" -n 2 "$sim" "$scene" --backend petsc -o "$work/p" -q --steps "$steps" \
   --checkpoint-every 1 -ksp_rtol 1e-12
-"$sim" "$scene" -o "$work/s" -q --steps "$steps" --checkpoint-every 1
+make_serial_scene
+"$sim" "$serial_scene" -o "$work/s" -q --steps "$steps" --checkpoint-every 1
 last() { ls "$1"/"$name"_checkpoint_* | sort | tail -n 1; }
 a=$(last "$work/p") b=$(last "$work/s")
 # the same step on both (the serial's last checkpoint names the step)

@@ -273,39 +273,39 @@ cleanup:
   return st;
 }
 
-/* The links across one non-conforming face: a polygon of a piece of the fine cell on its face
- * overlaps a polygon of a piece of the coarse cell on the coarse face (the overlap test does not
- * need equal faces: the fine face is a part of the coarse one), as in
- * fcm__embed_gather_links(); each link is stored from the piece of the lower-numbered cell. */
-static fcm_status nc_link_pair(const build *B, const fcm_cell_rules *R, const cell_out *out,
-                               const nc_pair *p, fcm__idbuf *tc, fcm_index **links, size_t *nl,
-                               size_t *cap)
+/* The links across one face shared by cells c (its face f) and c2 (its face f2), `cell` set
+ * up for c: a polygon of a piece of c on the face overlaps a polygon of a piece of c2 on its
+ * face with positive area, the overlap does not lie on a cut triangle, their parents were
+ * linked (earlier_link()) and, without a volume mesh (`mat`), the overlap holds material.
+ * The overlap test does not need equal faces, so a fine face inside a coarse one (an octree's
+ * non-conforming face) is tested alike. Each link is stored from the piece of the
+ * lower-numbered cell. */
+static fcm_status face_links(const build *B, const fcm_cell_rules *R, const cell_out *out,
+                             const fcm__embed_cell *cell, fcm_index c, int f, fcm_index c2, int f2,
+                             fcm__material *mat, fcm__idbuf *tc, fcm_index **links, size_t *nl,
+                             size_t *cap)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
-  const fcm_index c = p->fine, c2 = p->coarse;
   const fcm_index ca = FCM_MIN(c, c2), cb = FCM_MAX(c, c2);
-  if (!B->region[c] || !B->region[c2] || out[c].np == 0 || out[c2].np == 0) return FCM_OK;
   if (links_kept(B, ca, cb)) return copy_links(B, R, ca, cb, links, nl, cap);
-  fcm__embed_cell cell;
-  FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, B->o->clip_rtol, &cell));
-  const double mtol = FCM__EMBED_MATCH_RTOL * cell.size, atol = 1e-12 * cell.size * cell.size;
-  const double *nf = cell.planes[p->ff].n; /* the coarse polygons face out of c2: normal -n */
+  const double mtol = FCM__EMBED_MATCH_RTOL * cell->size, atol = 1e-12 * cell->size * cell->size;
+  const double *nf = cell->planes[f].n; /* the polygons of c2 face out of c2: normal -n_f */
   const double nbn[3] = {-nf[0], -nf[1], -nf[2]};
   const cell_out *oa = out + c, *ob = out + c2;
-  const size_t nl0 = *nl;
+  const size_t nl0 = *nl; /* the links of this pair of cells start here */
   size_t xa = 0;
   for (int i = 0; i < oa->nfp; i++) {
     const int *ma = oa->fmeta + 4 * i;
     const double *A = oa->fx + 3 * xa;
     xa += (size_t)(ma[2] + ma[3]);
-    if (ma[0] != p->ff || ma[1] < 0) continue;
+    if (ma[0] != f || ma[1] < 0) continue;
     size_t xb = 0;
     for (int j = 0; j < ob->nfp; j++) {
       const int *mb = ob->fmeta + 4 * j;
       const double *Bx = ob->fx + 3 * xb;
       xb += (size_t)(mb[2] + mb[3]);
-      if (mb[0] != p->fc || mb[1] < 0) continue;
+      if (mb[0] != f2 || mb[1] < 0) continue;
       const int qa = c < c2 ? ma[1] : mb[1], qb = c < c2 ? mb[1] : ma[1];
       const fcm_index pa = R->piece_off[ca] + qa, pb = R->piece_off[cb] + qb;
       int known = 0;
@@ -323,6 +323,9 @@ static fcm_status nc_link_pair(const build *B, const fcm_cell_rules *R, const ce
                              mtol, atol, B->cut_tris, tc->ids, tc->n))
         continue;
       if (!earlier_link(B, ca, cb, out[ca].pc[qa].parent, out[cb].pc[qb].parent)) continue;
+      if (mat && !fcm__embed_overlap_material(ctx, mat, A, ma[2], Bx, mb[2], nbn, cell->size))
+        continue;
+      if (mat) FCM_TRY(ctx, fcm__material_status(mat));
       FCM_TRY(ctx, push_link(ctx, pa, pb, links, nl, cap));
     }
   }
@@ -330,16 +333,23 @@ cleanup:
   return st;
 }
 
-/* The links across every non-conforming face of an octree mesh (nc_link_pair()). */
+/* The links across every non-conforming face of an octree mesh (face_links() from the fine
+ * cell's side). */
 static fcm_status nc_links(const build *B, const fcm_cell_rules *R, const cell_out *out,
-                           fcm__idbuf *tc, fcm_index **links, size_t *nl, size_t *cap)
+                           fcm__material *mat, fcm__idbuf *tc, fcm_index **links, size_t *nl,
+                           size_t *cap)
 {
   fcm_status st = FCM_OK;
   nc_pair *p = NULL;
   size_t np = 0;
   FCM_TRY(B->ctx, nc_pairs(B, &p, &np));
-  for (size_t i = 0; i < np; i++)
-    FCM_TRY(B->ctx, nc_link_pair(B, R, out, p + i, tc, links, nl, cap));
+  for (size_t i = 0; i < np; i++) {
+    const fcm_index c = p[i].fine, c2 = p[i].coarse;
+    if (!B->region[c] || !B->region[c2] || out[c].np == 0 || out[c2].np == 0) continue;
+    fcm__embed_cell cell;
+    FCM_TRY(B->ctx, fcm__embed_cell_setup(B->ctx, B->mesh, c, B->o->clip_rtol, &cell));
+    FCM_TRY(B->ctx, face_links(B, R, out, &cell, c, p[i].ff, c2, p[i].fc, mat, tc, links, nl, cap));
+  }
 cleanup:
   fcm__free(B->ctx, p);
   return st;
@@ -362,11 +372,9 @@ fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell
   fcm__material *mat = NULL; /* no volume mesh: links only where the overlap holds material */
   if (B->geom->num_cells == 0) FCM_TRY(ctx, fcm__material_create(ctx, B->geom, &mat));
   for (fcm_index c = 0; c < R->num_cells; c++) {
-    const cell_out *oa = out + c;
-    if (!B->region[c] || oa->np == 0) continue;
+    if (!B->region[c] || out[c].np == 0) continue;
     fcm__embed_cell cell;
     FCM_TRY(ctx, fcm__embed_cell_setup(ctx, mesh, c, B->o->clip_rtol, &cell));
-    const double mtol = FCM__EMBED_MATCH_RTOL * cell.size, atol = 1e-12 * cell.size * cell.size;
     for (int f = 0; f < nf; f++) {
       const fcm_index c2 = nbr[(size_t)nf * c + f];
       if (c2 <= c || !B->region[c2] || out[c2].np == 0) continue;
@@ -374,52 +382,10 @@ fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell
       while (f2 < nf && nbr[(size_t)nf * c2 + f2] != c)
         f2++;
       if (f2 == nf) continue;
-      if (links_kept(B, c, c2)) {
-        FCM_TRY(ctx, copy_links(B, R, c, c2, &links, &nl, &cap));
-        continue;
-      }
-      const cell_out *ob = out + c2;
-      const fcm_index pa0 = R->piece_off[c], pb0 = R->piece_off[c2];
-      const size_t nl0 = nl; /* the links of this pair of cells start here */
-      size_t xa = 0;
-      for (int i = 0; i < oa->nfp; i++) {
-        const int *ma = oa->fmeta + 4 * i;
-        const double *A = oa->fx + 3 * xa;
-        xa += (size_t)(ma[2] + ma[3]);
-        if (ma[0] != f || ma[1] < 0) continue;
-        size_t xb = 0;
-        for (int j = 0; j < ob->nfp; j++) {
-          const int *mb = ob->fmeta + 4 * j;
-          const double *Bx = ob->fx + 3 * xb;
-          xb += (size_t)(mb[2] + mb[3]);
-          if (mb[0] != f2 || mb[1] < 0) continue;
-          const fcm_index pa = pa0 + ma[1], pb = pb0 + mb[1];
-          int known = 0;
-          for (size_t l = nl; l-- > nl0 && !known;)
-            known = links[2 * l] == pa && links[2 * l + 1] == pb;
-          if (known) continue;
-          double lo[3], hi[3];
-          const double *nb = cell.planes[f].n; /* polygon B faces out of c2: normal -n_f */
-          const double nbn[3] = {-nb[0], -nb[1], -nb[2]};
-          for (int d = 0; d < 3; d++) {
-            lo[d] = HUGE_VAL, hi[d] = -HUGE_VAL;
-            for (int k = 0; k < ma[2]; k++)
-              lo[d] = fmin(lo[d], A[3 * k + d] - mtol), hi[d] = fmax(hi[d], A[3 * k + d] + mtol);
-          }
-          FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, lo, hi, &tc));
-          if (!fcm__embed_linked(A, ma[2], A + 3 * ma[2], ma[3], Bx, mb[2], Bx + 3 * mb[2], mb[3],
-                                 nbn, mtol, atol, B->cut_tris, tc.ids, tc.n))
-            continue;
-          if (!earlier_link(B, c, c2, out[c].pc[ma[1]].parent, out[c2].pc[mb[1]].parent)) continue;
-          if (mat && !fcm__embed_overlap_material(ctx, mat, A, ma[2], Bx, mb[2], nbn, cell.size))
-            continue;
-          if (mat) FCM_TRY(ctx, fcm__material_status(mat));
-          FCM_TRY(ctx, push_link(ctx, pa, pb, &links, &nl, &cap));
-        }
-      }
+      FCM_TRY(ctx, face_links(B, R, out, &cell, c, f, c2, f2, mat, &tc, &links, &nl, &cap));
     }
   }
-  FCM_TRY(ctx, nc_links(B, R, out, &tc, &links, &nl, &cap));
+  FCM_TRY(ctx, nc_links(B, R, out, mat, &tc, &links, &nl, &cap));
   if (nl) qsort(links, nl, 2 * sizeof *links, cmp_link);
   R->links = links;
   R->num_links = (fcm_index)nl;
