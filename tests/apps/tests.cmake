@@ -51,16 +51,17 @@ fcm_add_test(app_sim_default tests/apps/sim_app.c LABELS app slow TIMEOUT 1200
 # Every example scene with --check: at most 3 steps, finite state, the run summary. The
 # twisting cylinder is the built-in scene (byte for byte, see scene_default) that
 # app_sim_default_quick already runs, so its --check is labelled slow. surface_drop embeds an
-# OBJ surface, tetrahedralized with Gmsh: only when fcm was built with it; so do the two
-# cutbench bunny scenes, whose cuts need the body's volume mesh.
+# OBJ surface, tetrahedralized with Gmsh: only when fcm was built with it. The cutbench bunny
+# scenes cut a surface body without a volume mesh.
 set(fcm_check_scenes spinning_body slingshot hollow_ball static_beam cantilever twisting_cylinder
     voxel_block gyroid_lattice cut_slab dice cracked_beam clamped_surface hollow_ball_multigrid
     vibrating_beam octree_ball_hex8 octree_ball_hex20 octree_ball_multigrid ball_on_floor
     ball_off_wedge dice_on_floor cut_bar_resting)
 list(APPEND fcm_check_scenes cutbench_tonthat_slab)
-list(APPEND fcm_check_scenes octree_cut_ball_hex8 octree_cut_ball_hex20)
+list(APPEND fcm_check_scenes octree_cut_ball_hex8 octree_cut_ball_hex20 cutbench_dick_bunny3
+     cutbench_koschier_bunny)
 if(FCM_HAVE_GMSH)
-  list(APPEND fcm_check_scenes surface_drop cutbench_dick_bunny3 cutbench_koschier_bunny)
+  list(APPEND fcm_check_scenes surface_drop)
 endif()
 foreach(scene IN LISTS fcm_check_scenes)
   set(labels app)
@@ -197,11 +198,9 @@ fcm_add_test(app_models_ball tests/apps/models_app.c LABELS bench TIMEOUT 3600
 # triangles) with a looser Newton tolerance as the interactive option set: the CSV's rows and
 # columns (every figure finite, cut events, DOFs growing, phases within the cut, ratios and
 # verdicts consistent, the two runs' displacements close), the PNG, the written scenes parse,
-# bad options exit 2; every row at the papers' sizes under bench. The bunny scenes cut a
-# surface body, which needs Gmsh's volume mesh.
-if(FCM_HAVE_GMSH)
-  fcm_add_test(app_cutbench_quick tests/apps/cutbench_app.c LABELS app TIMEOUT 300
-               ARGS quick $<TARGET_FILE:fcm-cutbench> ${work})
-  fcm_add_test(app_cutbench_full tests/apps/cutbench_app.c LABELS bench TIMEOUT 36000
-               ARGS full $<TARGET_FILE:fcm-cutbench> ${work})
-endif()
+# bad options exit 2; every row at the papers' sizes under bench. The bunny rows cut the
+# surface body without a volume mesh (no Gmsh).
+fcm_add_test(app_cutbench_quick tests/apps/cutbench_app.c LABELS app TIMEOUT 300
+             ARGS quick $<TARGET_FILE:fcm-cutbench> ${work})
+fcm_add_test(app_cutbench_full tests/apps/cutbench_app.c LABELS bench TIMEOUT 36000
+             ARGS full $<TARGET_FILE:fcm-cutbench> ${work})

@@ -94,7 +94,8 @@ typedef struct fcm_scene_geometry {
   double transform[9]; /**< A, row-major: rotation times scale (identity when none) */
   double offset[3];    /**< b */
   fcm_surface_mesh_options surface; /**< SURFACE: tetrahedralization options; volume_mesh -1
-                                         ("auto"): a volume mesh only when the scene cuts */
+                                         ("auto"): a volume mesh only on the distributed
+                                         backend or for cuts with moments = volume */
   int fill_holes;                   /**< SURFACE: 1: close holes first */
   fcm_surface_fill_options fill;    /**< SURFACE: which holes fill_holes closes */
   const char *image;    /**< VOXELS: the image file (.nrrd, .nhdr, .mhd, .mha; resolved path) */

@@ -238,9 +238,10 @@ typedef struct fcm_surface_mesh_options {
   /** 1 (default): tetrahedralize the volume (Gmsh). 0: no volume mesh: the geometry is the
    * checked, oriented surface alone (fcm_geometry_num_cells() 0, no Gmsh needed, the set-up
    * costs what the surface costs). The cut-cell rules then come from the surface
-   * (FCM_CELL_MOMENTS_AUTO); what needs the volume mesh — fcm_cell_rules_create_cut(), the
-   * VOLUME path — refuses such a geometry with FCM_ERR_UNSUPPORTED. max_volume, size and quality
-   * are ignored. */
+   * (FCM_CELL_MOMENTS_AUTO), and so do the pieces of the cells fcm_cell_rules_create_cut()
+   * splits; what needs the volume mesh — the VOLUME moments and the distributed backend —
+   * refuses such a geometry with FCM_ERR_UNSUPPORTED. max_volume, size and quality are
+   * ignored. */
   int volume_mesh;
 } fcm_surface_mesh_options;
 
