@@ -418,25 +418,7 @@ static void symmetric_sweep(const slab_order *S,
     if (slab_mine(S, k, t, nt)) slab(a, k, 1);
 }
 
-/* sum_p v[p] x[ci[p]] over p in [p0, p1) in four interleaved partial sums: the sweeps'
- * time is these sums, and one sequential chain of additions would wait on each addition. */
-static inline double row_dot(const double *v, const int *ci, fcm_index p0, fcm_index p1,
-                             const double *x)
-{
-  double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-  fcm_index p = p0;
-  for (; p + 4 <= p1; p += 4) {
-    s0 += v[p] * x[ci[p]];
-    s1 += v[p + 1] * x[ci[p + 1]];
-    s2 += v[p + 2] * x[ci[p + 2]];
-    s3 += v[p + 3] * x[ci[p + 3]];
-  }
-  for (; p < p1; p++)
-    s0 += v[p] * x[ci[p]];
-  return (s0 + s1) + (s2 + s3);
-}
-
-/* sum_j a[j] r[j], j < m, as row_dot(). */
+/* sum_j a[j] r[j], j < m, as fcm__mg_row_dot(). */
 static inline double dense_dot(const double *a, const double *r, int m)
 {
   double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
@@ -465,7 +447,7 @@ static void sgs_slab(const sweep_args *a, fcm_index s, int back)
   const fcm_index q0 = L->rows.ptr[s], q1 = L->rows.ptr[s + 1];
   for (fcm_index t = 0; t < q1 - q0; t++) {
     const fcm_index i = L->rows.item[back ? q1 - 1 - t : q0 + t];
-    x[i] += w * (b[i] - row_dot(v, ci, rp[i], rp[i + 1], x)) * L->dinv[i];
+    x[i] += w * (b[i] - fcm__mg_row_dot(v, ci, rp[i], rp[i + 1], x)) * L->dinv[i];
   }
 }
 
@@ -532,7 +514,7 @@ static void block_slab(const sweep_args *a, fcm_index s, int back)
     const double *S = NULL;
     const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
     for (int i = 0; i < bm; i++)
-      r[i] = b[d[i]] - row_dot(v, ci, rp[d[i]], rp[d[i] + 1], x);
+      r[i] = b[d[i]] - fcm__mg_row_dot(v, ci, rp[d[i]], rp[d[i] + 1], x);
     for (int i = 0; i < bm; i++)
       dx[i] = dense_dot(S + (size_t)i * (size_t)bm, r, bm);
     for (int i = 0; i < bm; i++)
