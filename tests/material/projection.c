@@ -5,7 +5,9 @@
  *  - it equals the reference projection (LAPACK eigen-decomposition of the unprojected
  *    tangent, eigenvalues clamped at 0) to 1e-9 relative; since that projection is
  *    1-Lipschitz, this checks the analytic eigensystem independently;
- *  - Psi and P do not depend on the projection flag (bitwise);
+ *  - Psi and P do not depend on the projection flag, nor on whether the tangent is asked for
+ *    in the same call, and the projected tangent not on whether Psi and P are (bitwise: the
+ *    assembly evaluates a projected fictitious point in one call);
  *  - the unprojected tangent through the analytic eigensystem equals the closed form
  *    (StVK, SNH) to 1e-10 relative;
  *  - an already positive semi-definite tangent (F = I, a moderate stretch, and for the
@@ -58,6 +60,12 @@ static int check_projection(fcm_ctx *ctx, int n, const double F[9])
   fcm_material_eval(&pp, F, &psip, Pp, Dp);
   TEST_TRUE(psip == psi);
   TEST_TRUE(memcmp(Pp, P, sizeof P) == 0);
+  {
+    double psi1, P1[9], D1[81];
+    fcm_material_eval(&params, F, &psi1, P1, NULL);
+    fcm_material_eval(&pp, F, NULL, NULL, D1);
+    TEST_TRUE(psi1 == psi && memcmp(P1, P, sizeof P) == 0 && memcmp(D1, Dp, sizeof D1) == 0);
+  }
   const double scale = max_abs(D, 81);
 
   eig9(ctx, Dp, w, NULL);

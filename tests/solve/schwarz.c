@@ -3,7 +3,9 @@
  * sum R^T C_K^{-1} R + D^{-1} computed independently by LU; an indefinite block gives an
  * SPD S_K with eigenvalues 1/|lambda|; the CLAMP and PAPER variants differ exactly on
  * the designed small eigenvalue; a block spanning more than 1/eps shows why CLAMP is
- * the default; bad input fails with named blocks. */
+ * the default; positive definite blocks up to the Cholesky path's condition bound and beyond
+ * it (eigen path) both give C_K^{-1} to their conditioning; bad input fails with named
+ * blocks. */
 #include "solve_test_util.h"
 
 /* Symmetric dense n x n (column-major) -> CSR with every entry stored. */
@@ -249,6 +251,45 @@ static void check_clamp_study(fcm_ctx *ctx)
   fcm_csr_destroy(&A);
 }
 
+/* A positive definite 24 x 24 block with eigenvalues spread geometrically over [1/kappa, 1]:
+ * S_K = C_K^{-1} to 24 kappa times the unit round-off (relative, Frobenius), without clamped
+ * or negative eigenvalues, on both sides of the Cholesky path's bound (kappa = 1e2, 1e8: the
+ * Cholesky inverse; 1e12: the eigen-inverse). */
+static void check_conditioned(fcm_ctx *ctx)
+{
+  enum { m = 24 };
+  static double Q[m * m], M[m * m], S[m * m], E[m * m], lam[m], inv[m];
+  const double kappas[3] = {1e2, 1e8, 1e12};
+  rng r = {33};
+  for (int t = 0; t < 3; t++) {
+    random_orthogonal(ctx, m, &r, Q);
+    for (int k = 0; k < m; k++) {
+      lam[k] = pow(kappas[t], -(double)k / (m - 1));
+      inv[k] = 1.0 / lam[k];
+    }
+    compose(m, Q, lam, M);
+    compose(m, Q, inv, E);
+    fcm_csr *A = csr_of_dense(ctx, m, M);
+    const fcm_index bptr[2] = {0, m};
+    fcm_index bd[m];
+    for (int i = 0; i < m; i++)
+      bd[i] = (7 * i) % m; /* any order */
+    fcm_schwarz *P = NULL;
+    TEST_OK(ctx, fcm_schwarz_create(ctx, A, 1, bptr, bd, NULL, &P));
+    fcm_schwarz_info si;
+    fcm_schwarz_get_info(P, &si);
+    TEST_TRUE(si.clamped_eigenvalues == 0 && si.negative_eigenvalues == 0);
+    dense_of(fcm_schwarz_operator, P, m, S);
+    double d = 0.0, e = 0.0;
+    for (int i = 0; i < m * m; i++)
+      d += (S[i] - E[i]) * (S[i] - E[i]), e += E[i] * E[i];
+    printf("schwarz: kappa %.0e, |S - C^-1|_F / |C^-1|_F = %.2e\n", kappas[t], sqrt(d / e));
+    TEST_TRUE(sqrt(d / e) <= 24.0 * kappas[t] * 1.2e-16);
+    fcm_schwarz_destroy(&P);
+    fcm_csr_destroy(&A);
+  }
+}
+
 static void check_errors(fcm_ctx *ctx)
 {
   const fcm_index ri[4] = {0, 1, 2, 3};
@@ -323,6 +364,7 @@ int main(void)
   check_additive(ctx);
   check_clamp(ctx);
   check_clamp_study(ctx);
+  check_conditioned(ctx);
   check_errors(ctx);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);

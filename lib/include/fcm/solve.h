@@ -246,7 +246,7 @@ typedef struct fcm_schwarz fcm_schwarz;
  * @return FCM_OK, FCM_ERR_ARG (bad block: the message names it and the DOF), and the
  * codes of fcm_schwarz_setup(). Allocates the blocks (sum of squared sizes), O(n), and the
  * setup scratch of omp_get_max_threads() threads (a largest block, its eigenvalues and
- * dsyevd workspace each), so that fcm_schwarz_setup() allocates nothing.
+ * dsyevd workspace, n ints of the gather each), so that fcm_schwarz_setup() allocates nothing.
  * Blocks of cells of a finite element space: fcm_space_cell_blocks() (fcm/fem.h). Thread
  * safe. */
 FCM_API fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
@@ -255,7 +255,10 @@ FCM_API fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index 
 
 /** Recompute the blocks and the diagonal from new values of C (same size): dense block
  * gather, symmetric eigendecomposition (LAPACK dsyevd, lower triangle), eigenvalue
- * reflection and clamping, S_K = V diag(s) V^T. Parallel over blocks (OpenMP, at most the
+ * reflection and clamping, S_K = V diag(s) V^T; a block that is positive definite with
+ * eps ||C_K||_F ||C_K^{-1}||_F <= 1e-3 (no eigenvalue near the clamp) is C_K^{-1} through its
+ * Cholesky factor instead, the same matrix to rounding of order cond(C_K) times the unit
+ * round-off. Parallel over blocks (OpenMP, at most the
  * thread count of the creation); each block is computed by one thread, so the result does
  * not depend on the thread count.
  * @return FCM_OK, FCM_ERR_ARG (size mismatch), FCM_ERR_SINGULAR (a zero block or a zero

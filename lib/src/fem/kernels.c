@@ -443,8 +443,10 @@ FCM_KERNEL_INLINE void fictitious_eval(const kernel_data *kd, const double F[9],
     fcm__material_linear(kd->mat->mu, kd->mat->lambda, F, psi, P, A);
     return;
   case FCM_FICTITIOUS_PROJECTED:
-    fcm__material_eval(kd->mat, F, psi, P, NULL);
-    if (A) fcm__material_eval(&kd->mat_psd, F, NULL, NULL, A);
+    /* one evaluation: mat_psd differs from mat in the tangent's projection only, so its
+     * energy and force are mat's, bit for bit (and the corotated model's one SVD serves all
+     * three outputs) */
+    fcm__material_eval(&kd->mat_psd, F, psi, P, A);
     return;
   default:
     fcm__material_eval(kd->mat, F, psi, P, A);

@@ -27,18 +27,13 @@ static void pre_smooth(const fcm_mg *m, mg_level *L, mg_level *C, const double *
   }
 #pragma omp barrier
 #pragma omp for schedule(static)
-  for (fcm_index i = 0; i < n; i++) {
-    double sum = 0.0;
-    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
-      sum += v[p] * x[ci[p]];
-    L->r[i] = b[i] - sum;
-  }
+  for (fcm_index i = 0; i < n; i++)
+    L->r[i] = b[i] - fcm__mg_row_dot(v, ci, rp[i], rp[i + 1], x);
 #pragma omp for schedule(static)
   for (fcm_index J = 0; J < nc; J++) {
-    double sum = 0.0;
-    for (fcm_index p = L->R_ptr[J]; p < L->R_ptr[J + 1]; p++)
-      sum += L->R_val[p] * L->r[L->R_col[p]];
-    C->b[J] = C->inactive[J] ? 0.0 : sum;
+    C->b[J] = C->inactive[J]
+                  ? 0.0
+                  : fcm__mg_row_dot(L->R_val, L->R_col, L->R_ptr[J], L->R_ptr[J + 1], L->r);
     C->x[J] = 0.0;
   }
 }

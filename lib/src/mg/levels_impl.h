@@ -106,6 +106,25 @@ static inline const fcm_csr *fcm__mg_level_matrix(const mg_level *L)
   return L->A ? L->A : L->Aown;
 }
 
+/* sum_p v[p] x[ci[p]] over p in [p0, p1) in four interleaved partial sums: the smoothers'
+ * and residuals' time is these sums, and one sequential chain of additions would wait on each
+ * addition. */
+static inline double fcm__mg_row_dot(const double *v, const int *ci, fcm_index p0, fcm_index p1,
+                                     const double *x)
+{
+  double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+  fcm_index p = p0;
+  for (; p + 4 <= p1; p += 4) {
+    s0 += v[p] * x[ci[p]];
+    s1 += v[p + 1] * x[ci[p + 1]];
+    s2 += v[p + 2] * x[ci[p + 2]];
+    s3 += v[p + 3] * x[ci[p + 3]];
+  }
+  for (; p < p1; p++)
+    s0 += v[p] * x[ci[p]];
+  return (s0 + s1) + (s2 + s3);
+}
+
 /* ---- hierarchy.c */
 
 /* The levels of m (m->ctx, space, opts set): cells, copies, DOFs, inactive rows and the

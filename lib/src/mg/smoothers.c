@@ -418,6 +418,22 @@ static void symmetric_sweep(const slab_order *S,
     if (slab_mine(S, k, t, nt)) slab(a, k, 1);
 }
 
+/* sum_j a[j] r[j], j < m, as fcm__mg_row_dot(). */
+static inline double dense_dot(const double *a, const double *r, int m)
+{
+  double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+  int j = 0;
+  for (; j + 4 <= m; j += 4) {
+    s0 += a[j] * r[j];
+    s1 += a[j + 1] * r[j + 1];
+    s2 += a[j + 2] * r[j + 2];
+    s3 += a[j + 3] * r[j + 3];
+  }
+  for (; j < m; j++)
+    s0 += a[j] * r[j];
+  return (s0 + s1) + (s2 + s3);
+}
+
 /* Gauss-Seidel over the rows of slab s, forward (ascending) or backward. */
 static void sgs_slab(const sweep_args *a, fcm_index s, int back)
 {
@@ -431,10 +447,7 @@ static void sgs_slab(const sweep_args *a, fcm_index s, int back)
   const fcm_index q0 = L->rows.ptr[s], q1 = L->rows.ptr[s + 1];
   for (fcm_index t = 0; t < q1 - q0; t++) {
     const fcm_index i = L->rows.item[back ? q1 - 1 - t : q0 + t];
-    double sum = b[i];
-    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
-      sum -= v[p] * x[ci[p]];
-    x[i] += w * sum * L->dinv[i];
+    x[i] += w * (b[i] - fcm__mg_row_dot(v, ci, rp[i], rp[i + 1], x)) * L->dinv[i];
   }
 }
 
@@ -500,18 +513,10 @@ static void block_slab(const sweep_args *a, fcm_index s, int back)
     const fcm_index *d = NULL;
     const double *S = NULL;
     const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
-    for (int i = 0; i < bm; i++) {
-      double sum = b[d[i]];
-      for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++)
-        sum -= v[p] * x[ci[p]];
-      r[i] = sum;
-    }
-    for (int i = 0; i < bm; i++) {
-      double sum = 0.0;
-      for (int j = 0; j < bm; j++)
-        sum += S[(size_t)i * (size_t)bm + (size_t)j] * r[j];
-      dx[i] = sum;
-    }
+    for (int i = 0; i < bm; i++)
+      r[i] = b[d[i]] - fcm__mg_row_dot(v, ci, rp[d[i]], rp[d[i] + 1], x);
+    for (int i = 0; i < bm; i++)
+      dx[i] = dense_dot(S + (size_t)i * (size_t)bm, r, bm);
     for (int i = 0; i < bm; i++)
       x[d[i]] += dx[i];
   }
