@@ -540,6 +540,9 @@ typedef struct fcm__srule {
   size_t n, cap;
 } fcm__srule;
 
+/* Room in s for `more` points beyond its n (capacity doubled from 1024). */
+fcm_status fcm__srule_room(fcm_ctx *ctx, fcm__srule *s, size_t more);
+
 void fcm__srule_free(fcm_ctx *ctx, fcm__srule *s);
 
 /* Crossings of a line with the boundary: xi_3 values and signs (+1 leaving the body). */

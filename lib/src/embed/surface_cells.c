@@ -371,17 +371,7 @@ static fcm_status full_part_rule(const build *B, const fcm__embed_cell *cell, co
   FCM_ALLOC(ctx, 12 * (size_t)nt0 + 12, tets);
   FCM_ALLOC(ctx, (size_t)nt0 + 1, vol);
   const int nt = fcm__geom_poly_tets(p, tets, vol);
-  if (s->n + (size_t)nt * nq > s->cap) {
-    size_t cap = s->cap ? s->cap : 1024;
-    while (cap < s->n + (size_t)nt * nq)
-      cap *= 2;
-    void *x = s->x, *w = s->w;
-    FCM_TRY(ctx, fcm__resize(ctx, &x, 3 * s->n, 3 * cap, sizeof(double)));
-    s->x = x;
-    FCM_TRY(ctx, fcm__resize(ctx, &w, s->n, cap, sizeof(double)));
-    s->w = w;
-    s->cap = cap;
-  }
+  FCM_TRY(ctx, fcm__srule_room(ctx, s, (size_t)nt * nq));
   for (int t = 0; t < nt; t++) {
     const double *T = tets + 12 * t;
     for (int q = 0; q < nq; q++) {

@@ -155,7 +155,7 @@ void fcm__srule_free(fcm_ctx *ctx, fcm__srule *s)
   s->n = s->cap = 0;
 }
 
-static fcm_status srule_room(fcm_ctx *ctx, fcm__srule *s, size_t more)
+fcm_status fcm__srule_room(fcm_ctx *ctx, fcm__srule *s, size_t more)
 {
   fcm_status st = FCM_OK;
   if (s->n + more <= s->cap) return FCM_OK;
@@ -180,7 +180,7 @@ static fcm_status add_column(fcm_ctx *ctx, const fcm__moment_quad *q, double lo,
   const int n = q->ng[0];
   const double len = y[0] - lo;
   if (len == 0.0 || W == 0.0) return FCM_OK;
-  FCM_TRY(ctx, srule_room(ctx, s, (size_t)n));
+  FCM_TRY(ctx, fcm__srule_room(ctx, s, (size_t)n));
   for (int g = 0; g < n; g++) {
     double *x = s->x + 3 * s->n;
     x[0] = lo + len * q->gt[0][g], x[1] = y[1], x[2] = y[2];
@@ -519,7 +519,7 @@ fcm_status fcm__embed_material_box(fcm_ctx *ctx, const fcm_geometry *g, const fc
         c[d] += a[3 * i + d] / n;
     }
     if (!bnd) continue;
-    FCM_TRY(ctx, srule_room(ctx, bnd, (size_t)n + 1));
+    FCM_TRY(ctx, fcm__srule_room(ctx, bnd, (size_t)n + 1));
     memcpy(bnd->x + 3 * bnd->n, a, 3 * (size_t)n * sizeof *a);
     memcpy(bnd->x + 3 * (bnd->n + (size_t)n), c, sizeof c);
     for (int i = 0; i <= n; i++)
