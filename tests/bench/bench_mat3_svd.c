@@ -189,7 +189,7 @@ int main(void)
         for (int i = 0; i < 9; i++)
           F[m][i] = uniform();
       else {
-        double A[9], R[9], S[9], lam[3], Q[2][9];
+        double A[9], R[9], S[9], Q[2][9];
         for (int r = 0; r < 2; r++) {
           for (int i = 0; i < 9; i++)
             A[i] = uniform();
@@ -199,7 +199,6 @@ int main(void)
           for (int k = 0; k < 3; k++)
             R[3 * i + k] = Q[0][3 * i + k] * (k == 2 ? 1e-6 : 1.0);
         fcm__mat3_mul(R, Q[1], F[m]);
-        (void)lam;
       }
     }
     double best_ref = 1e30, best_new = 1e30, sw_ref = 0, sw_new = 0;
