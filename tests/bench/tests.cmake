@@ -39,3 +39,6 @@ fcm_add_test(bench_octree_cells tests/bench/bench_octree_cells.c LABELS bench TI
 # Convergence toward a corner singularity: octrees grown by the stress-jump indicator against
 # uniform grids, the DOFs at equal error (figures in lib/docs/octree.md).
 fcm_add_test(bench_octree_converge tests/bench/bench_octree_converge.c LABELS bench TIMEOUT 1800)
+# The 3x3 SVD of the corotated model: ns per call against the reference Jacobi with three dot
+# products a pair, paired in the same run (figures in lib/docs/cutting.md).
+fcm_add_test(bench_mat3_svd tests/bench/bench_mat3_svd.c LABELS bench TIMEOUT 600)

@@ -6,6 +6,8 @@ fcm_add_test(la_lstsq tests/la/lstsq.c)
 fcm_add_test(la_dense_alloc tests/la/dense_alloc.c)
 fcm_add_test(la_mat3_eig tests/la/mat3_eig.c)
 fcm_add_test(la_mat3_svd tests/la/mat3_svd.c)
+# Random and adversarial F: orthogonality, reconstruction, signs and order to 1e-14.
+fcm_add_test(la_mat3_svd_sweep tests/la/mat3_svd_sweep.c)
 fcm_add_test(la_csr tests/la/csr.c)
 fcm_add_test(la_direct tests/la/direct.c)
 # Allocation failures: fcm_csr_create and fcm_csr_wrap.

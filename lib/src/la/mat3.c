@@ -118,6 +118,42 @@ int fcm__mat3_sym_eig(const double A[9], double lambda[3], double Q[9])
   return sweep;
 }
 
+/* One Jacobi rotation of the columns p, q of F V (b, v: columns), given their
+ * squared norms d[p], d[q]; returns 1 if it rotated. The tangent t of
+ * jacobi_tangent is written as num / den with one square root, and (c, s) as
+ * (den, num) / |(den, num)|: three long operations on the critical path instead of
+ * five (the one-sided Jacobi's cost is their latency). The rotated squared norms
+ * follow from the 2x2 Gram matrix (d[p] - t gamma, d[q] + t gamma) without dot
+ * products; each sweep starts from freshly computed ones, so the test of the last
+ * sweep, which rotates nothing, is made on exact norms. */
+static int svd_rotate(double b[3][3], double v[3][3], double d[3], int p, int q)
+{
+  double gamma = dot3(b[p], b[q]);
+  /* |gamma| <= 4 eps sqrt(d[p] d[q]), squared (no square root; the inputs' range
+   * keeps the squares normal at any relevant size). */
+  if (gamma * gamma <= 16.0 * DBL_EPSILON * DBL_EPSILON * (d[p] * d[q])) return 0;
+  double delta = d[q] - d[p], r2 = delta * delta + 4.0 * gamma * gamma;
+  double c, s, tg;
+  if (r2 > 0x1p-900) {
+    double num = copysign(2.0, delta) * gamma, den = fabs(delta) + sqrt(r2);
+    double h = 1.0 / sqrt(den * den + num * num);
+    c = den * h, s = num * h, tg = num * gamma / den;
+  } else { /* tiny columns: the quotient form never underflows */
+    double t = jacobi_tangent(d[p], d[q], gamma);
+    c = 1.0 / sqrt(1.0 + t * t), s = t * c, tg = t * gamma;
+  }
+  for (int i = 0; i < 3; i++) {
+    double bp = b[p][i], bq = b[q][i], vp = v[p][i], vq = v[q][i];
+    b[p][i] = c * bp - s * bq;
+    b[q][i] = s * bp + c * bq;
+    v[p][i] = c * vp - s * vq;
+    v[q][i] = s * vp + c * vq;
+  }
+  d[p] -= tg;
+  d[q] += tg;
+  return 1;
+}
+
 int fcm__mat3_svd(const double F[9], double U[9], double sigma[3], double V[9])
 {
   double b[3][3], v[3][3], u[3][3], nrm[3], amax = 0.0; /* b[k], v[k], u[k]: columns */
@@ -133,9 +169,15 @@ int fcm__mat3_svd(const double F[9], double U[9], double sigma[3], double V[9])
       sigma[k] = finite ? 0.0 : NAN;
     return finite ? 0 : -1;
   }
-  frexp(amax, &e);
-  const double down = (e > -1000 && e < 1000) ? ldexp(1.0, -e) : 0.0;
-  const double up = (e > -1000 && e < 1000) ? ldexp(1.0, e) : 0.0;
+  /* Within 2^-126 <= amax <= 2^126 the squares and their products neither over- nor
+   * underflow at a relevant size, and scaling by a power of two changes no result:
+   * skip it there. */
+  double down = 1.0, up = 1.0;
+  if (amax < 0x1p-126 || amax > 0x1p126) {
+    frexp(amax, &e);
+    down = (e > -1000 && e < 1000) ? ldexp(1.0, -e) : 0.0;
+    up = (e > -1000 && e < 1000) ? ldexp(1.0, e) : 0.0;
+  }
   for (int k = 0; k < 3; k++)
     for (int i = 0; i < 3; i++) {
       b[k][i] = scale2(F[3 * i + k], down, -e);
@@ -144,29 +186,21 @@ int fcm__mat3_svd(const double F[9], double U[9], double sigma[3], double V[9])
 
   /* Rotate pairs of columns of F V until all are orthogonal to working precision. */
   for (sweep = 0; sweep < MAT3_MAX_SWEEPS; sweep++) {
-    int rotated = 0;
-    for (int r = 0; r < 3; r++) {
-      int p = pair_p[r], q = pair_q[r];
-      double alpha = dot3(b[p], b[p]), beta = dot3(b[q], b[q]), gamma = dot3(b[p], b[q]);
-      if (fabs(gamma) <= 4.0 * DBL_EPSILON * sqrt(alpha * beta)) continue;
-      double t = jacobi_tangent(alpha, beta, gamma);
-      double c = 1.0 / sqrt(1.0 + t * t), s = t * c;
-      for (int i = 0; i < 3; i++) {
-        double bp = b[p][i], bq = b[q][i], vp = v[p][i], vq = v[q][i];
-        b[p][i] = c * bp - s * bq;
-        b[q][i] = s * bp + c * bq;
-        v[p][i] = c * vp - s * vq;
-        v[q][i] = s * vp + c * vq;
-      }
-      rotated = 1;
-    }
+    for (int k = 0; k < 3; k++)
+      nrm[k] = dot3(b[k], b[k]);
+    int rotated = svd_rotate(b, v, nrm, 0, 1);
+    rotated |= svd_rotate(b, v, nrm, 0, 2);
+    rotated |= svd_rotate(b, v, nrm, 1, 2);
     if (!rotated) break;
   }
 
   /* Descending column norms; a swap negates one column of both B and V, so
    * F V = B still holds and det V stays +1. */
+  if (sweep == MAT3_MAX_SWEEPS)
+    for (int k = 0; k < 3; k++)
+      nrm[k] = dot3(b[k], b[k]);
   for (int k = 0; k < 3; k++)
-    nrm[k] = sqrt(dot3(b[k], b[k]));
+    nrm[k] = sqrt(nrm[k]);
   for (int i = 0; i < 2; i++)
     for (int j = 0; j < 2 - i; j++)
       if (nrm[j] < nrm[j + 1]) {
