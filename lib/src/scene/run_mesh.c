@@ -208,6 +208,7 @@ cleanup:
   return st;
 }
 
+/* The embedded geometry of the scene (S->geom); an error names the section of its kind. */
 static fcm_status build_geometry(fcm_simulation *S, const fcm_scene_geometry *g)
 {
   fcm_status st = FCM_OK;
@@ -271,6 +272,7 @@ static fcm_status build_geometry(fcm_simulation *S, const fcm_scene_geometry *g)
     raw = NULL;
   }
 cleanup:
+  if (st != FCM_OK) fcm__sim_name_section(ctx, geometry_path(g->kind));
   fcm_geometry_destroy(&raw);
   return st;
 }
@@ -350,9 +352,7 @@ fcm_status fcm__sim_build_mesh_geometry(fcm_simulation *S)
   if (bg->kind == FCM_SCENE_BACKGROUND_GRID && bg->fit) {
     double min[3], max[3];
     fcm_index cells[3];
-    st = build_geometry(S, g); /* the parser ensured there is one */
-    if (st != FCM_OK) fcm__sim_name_section(ctx, geometry_path(g->kind));
-    FCM_TRY(ctx, st);
+    FCM_TRY(ctx, build_geometry(S, g)); /* the parser ensured there is one */
     fcm__sim_phase_begin(S, FCM_SETUP_BACKGROUND, 0,
                          "fitting the background grid around the geometry");
     st = fit_background(S, bg, min, max, cells);
@@ -362,9 +362,7 @@ fcm_status fcm__sim_build_mesh_geometry(fcm_simulation *S)
   } else if (bg->kind == FCM_SCENE_BACKGROUND_GRID) {
     if (bg->octree_boundary > 0 || bg->octree_cuts > 0) { /* refined along the geometry's
                                                              boundary or cuts: built first */
-      st = build_geometry(S, g);
-      if (st != FCM_OK) fcm__sim_name_section(ctx, geometry_path(g->kind));
-      FCM_TRY(ctx, st);
+      FCM_TRY(ctx, build_geometry(S, g));
     }
     fcm__sim_phase_begin(S, FCM_SETUP_BACKGROUND, 0,
                          "building the background grid (%lld x %lld x %lld cells%s)",
@@ -384,9 +382,7 @@ fcm_status fcm__sim_build_mesh_geometry(fcm_simulation *S)
   S->nn = fcm_mesh_num_nodes(S->mesh);
 
   if (g->kind != FCM_SCENE_GEOMETRY_NONE && !S->geom) {
-    st = build_geometry(S, g);
-    if (st != FCM_OK) fcm__sim_name_section(ctx, geometry_path(g->kind));
-    FCM_TRY(ctx, st);
+    FCM_TRY(ctx, build_geometry(S, g));
   }
 cleanup:
   return st;
