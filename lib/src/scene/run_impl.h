@@ -1,6 +1,6 @@
 /* scene module internals: the simulation object shared by the runner's files (run.c building,
- * run_effects.c, run_step.c, run_output.c, run_summary.c, run_petsc.c) and checkpoint.c (saving
- * and restoring a run). */
+ * run_mesh.c, run_effects.c, run_step.c, run_output.c, run_summary.c, run_petsc.c) and checkpoint.c
+ * (saving and restoring a run). */
 #ifndef FCM_SCENE_RUN_IMPL_H
 #define FCM_SCENE_RUN_IMPL_H
 
@@ -132,6 +132,19 @@ struct fcm_simulation {
   unsigned phases_run;
 };
 
+/* A set-up phase starts: `what` (printf format) in words for the user; progress: 1 when it
+ * reports progress meanwhile. The options' setup_phase hears of it; the phase's clock starts
+ * after the call, so the host's printing is not counted in it (run.c). */
+void fcm__sim_phase_begin(fcm_simulation *S, fcm_setup_phase p, int progress, const char *what, ...)
+    FCM__PRINTF(4, 5);
+
+/* The running phase ended: its time into the counters, then the options' setup_phase (run.c). */
+void fcm__sim_phase_end(fcm_simulation *S);
+
+/* Put the scene section `path` before the recorded error's message, unless the message
+ * names it already (run.c). */
+void fcm__sim_name_section(fcm_ctx *ctx, const char *path);
+
 /* Grow an array of `size`-byte items to hold at least `need` (doubling). */
 fcm_status fcm__sim_grow(fcm_ctx *ctx, void **array, long long *cap, long long need, size_t size);
 
@@ -157,7 +170,7 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S);
 
 /* The background mesh and the embedded geometry (S->mesh, S->nn, S->geom; no geometry for a
  * scene without one), the set-up's first phases; errors of the inputs name the scene section
- * they come from (run.c). */
+ * they come from (run_mesh.c). */
 fcm_status fcm__sim_build_mesh_geometry(fcm_simulation *S);
 
 /* The surface of cut effect c: the plane is clipped to the body's bounding box enlarged by 10 %
@@ -179,7 +192,7 @@ fcm_status fcm__sim_check_regions(fcm_simulation *S);
 
 /* The background mesh and the embedded geometry of a scene (NULL when it has none), built as
  * fcm_simulation_create() builds them, for a driver of its own (the PETSc backend, fcm/petsc.h);
- * the caller destroys both (run.c). */
+ * the caller destroys both (run_mesh.c). */
 FCM_COMPONENT_API fcm_status fcm__scene_mesh_geometry(fcm_ctx *ctx, const fcm_scene *scene,
                                                       fcm_mesh **mesh, fcm_geometry **geom);
 
