@@ -5,8 +5,9 @@
  * what the boundary triangles meeting it cost. A part without material is dropped, and two
  * parts (of one cell, or of two cells across a face) join only where the overlap of their
  * faces holds material: the body's volume in a thin prism on the overlap. So the pieces are
- * the components of the material as the volume mesh's parts give them, except that the body
- * inside one part counts as one piece even where the part holds two separate lumps of it. */
+ * the components of the material as the volume mesh's parts give them. A part that holds two
+ * separate lumps of the body is replaced by its pieces inside the body (split by the boundary
+ * triangles), which join only within a lump. */
 #include "embed/embed_impl.h"
 #include "element/element_impl.h"
 #include "la/mat3.h"
@@ -242,21 +243,15 @@ int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const double *a,
                                FACE_AREA_RTOL * size * size);
 }
 
-fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P,
-                                      int piece, fcm__embed_ws *ws, double *volume)
+/* Split the parts of Q by the boundary triangles that meet the box lo, hi (the parts' box)
+ * and drop the pieces outside the body: no boundary triangle crosses them, one point decides. */
+static fcm_status body_split(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
+                             const double lo[3], const double hi[3], fcm__parts *Q)
 {
   fcm_status st = FCM_OK;
-  fcm__material *m = P->mat;
   const fcm_geometry *g = m->geom;
-  fcm__parts *Q = NULL;
-  double lost = 0.0;
-  fcm_index nslivers = 0;
   static const unsigned char outer[3] = {0, 0, 0};
-  *volume = 0.0;
-  ws->num_tets = 0;
-  FCM_ALLOC(ctx, 1, Q);
-  FCM_TRY(ctx, fcm__embed_parts_copy(ctx, P, piece, Q));
-  FCM_TRY(ctx, fcm__geom_tree_query(ctx, m->tree, cell->lo, cell->hi, &m->buf));
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, m->tree, lo, hi, &m->buf));
   for (size_t k = 0; k < m->buf.n && Q->n > 0; k++) {
     const fcm_index *tv = g->tris + 3 * m->buf.ids[k];
     fcm__cut_tri t;
@@ -265,8 +260,8 @@ fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell,
       continue;
     FCM_TRY(ctx, fcm__embed_parts_split(ctx, cell, &t, Q));
   }
-  for (size_t i = 0; i < Q->n; i++) { /* no boundary triangle crosses a part: one point decides */
-    const fcm__poly *q = Q->poly + i;
+  for (size_t i = 0; i < Q->n; i++) {
+    fcm__poly *q = Q->poly + i;
     double c[3] = {0.0, 0.0, 0.0}, xi[3], det;
     int in;
     for (int a = 0; a < q->nv; a++)
@@ -275,12 +270,72 @@ fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell,
     FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, c, xi, &det));
     FCM_TRY(ctx, fcm__embed_inside_line(ctx, g, m->tree, cell, xi[0], xi[1], 1, xi + 2, &in,
                                         &m->buf, &m->cr));
-    if (in == 1)
-      FCM_TRY(ctx, fcm__embed_append_tets(ctx, ws, q, Q->vmin[i], volume, &lost, &nslivers));
+    if (in != 1) q->nv = q->nf = 0;
+  }
+  fcm__embed_parts_compact(Q);
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P,
+                                      int piece, fcm__embed_ws *ws, double *volume)
+{
+  fcm_status st = FCM_OK;
+  fcm__parts *Q = NULL;
+  double lost = 0.0;
+  fcm_index nslivers = 0;
+  *volume = 0.0;
+  ws->num_tets = 0;
+  FCM_ALLOC(ctx, 1, Q);
+  FCM_TRY(ctx, fcm__embed_parts_copy(ctx, P, piece, Q));
+  FCM_TRY(ctx, body_split(ctx, P->mat, cell, cell->lo, cell->hi, Q));
+  for (size_t i = 0; i < Q->n; i++)
+    FCM_TRY(ctx,
+            fcm__embed_append_tets(ctx, ws, Q->poly + i, Q->vmin[i], volume, &lost, &nslivers));
+cleanup:
+  if (Q) fcm__embed_parts_free(ctx, Q);
+  fcm__free(ctx, Q);
+  return st;
+}
+
+fcm_status fcm__embed_split_lumps(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P)
+{
+  fcm_status st = FCM_OK;
+  fcm__parts *Q = NULL; /* no material of its own: its parts join through any shared face */
+  int *label = NULL, nc;
+  if (!P->mat) return FCM_OK;
+  const size_t n0 = P->n;
+  for (size_t i = 0; i < n0; i++) {
+    if (fcm__embed_part_full(P, i)) continue;
+    if (!Q) FCM_ALLOC(ctx, 1, Q);
+    const fcm__poly *p = P->poly + i;
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (int a = 0; a < p->nv; a++)
+      for (int d = 0; d < 3; d++)
+        lo[d] = fmin(lo[d], p->x[a][d]), hi[d] = fmax(hi[d], p->x[a][d]);
+    Q->n = 0;
+    FCM_TRY(ctx, fcm__embed_parts_put(ctx, Q, 0, p, P->tol[i], P->vmin[i], 0));
+    FCM_TRY(ctx, body_split(ctx, P->mat, cell, lo, hi, Q));
+    if (Q->n < 2) continue;
+    fcm__free(ctx, label);
+    label = NULL;
+    FCM_ALLOC(ctx, Q->n, label);
+    FCM_TRY(ctx, fcm__embed_parts_components(ctx, cell, NULL, 0, Q, label, &nc));
+    if (nc < 2) continue;
+    /* the lumps' pieces replace the part, each wholly inside the body */
+    const double tol = P->tol[i], vmin = P->vmin[i];
+    const int parent = P->parent[i];
+    for (size_t j = 0; j < Q->n; j++) {
+      const size_t slot = j == 0 ? i : P->n;
+      FCM_TRY(ctx, fcm__embed_parts_put(ctx, P, slot, Q->poly + j, tol, vmin, parent));
+      P->mvol[slot] = fcm__geom_poly_volume(Q->poly + j);
+    }
+    P->whole = 0;
   }
 cleanup:
   if (Q) fcm__embed_parts_free(ctx, Q);
   fcm__free(ctx, Q);
+  fcm__free(ctx, label);
   return st;
 }
 
