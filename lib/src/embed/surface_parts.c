@@ -11,8 +11,10 @@
 #include "embed/embed_impl.h"
 #include "element/element_impl.h"
 #include "la/mat3.h"
+#include "la/vec3.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 struct fcm__material {
@@ -24,6 +26,8 @@ struct fcm__material {
   fcm__srule sr;
   double *tets, *vol;
   int cap;
+  int *edges, *uf; /* fcm__embed_split_lumps(): the boundary's edges in a part, a union-find */
+  size_t ecap;
   fcm_status st; /* the first error of fcm__material_on_face() */
 };
 
@@ -52,6 +56,8 @@ void fcm__material_destroy(fcm_ctx *ctx, fcm__material **pm)
   fcm__srule_free(ctx, &m->sr);
   fcm__free(ctx, m->tets);
   fcm__free(ctx, m->vol);
+  fcm__free(ctx, m->edges);
+  fcm__free(ctx, m->uf);
   fcm__free(ctx, m);
   *pm = NULL;
 }
@@ -298,6 +304,108 @@ cleanup:
   return st;
 }
 
+static int cmp_edge(const void *a, const void *b)
+{
+  const int *p = a, *q = b;
+  if (p[0] != q[0]) return p[0] < q[0] ? -1 : 1;
+  return (p[1] > q[1]) - (p[1] < q[1]);
+}
+
+static int lump_find(int *uf, int a)
+{
+  while (uf[a] != a)
+    a = uf[a] = uf[uf[a]];
+  return a;
+}
+
+/* Whether segment a b meets the inside of the convex part with planes pl (np), farther than
+ * tol from its faces: the middle of its clipped share decides (that share is convex). */
+static int segment_inside(const double *a, const double *b, const fcm__plane *pl, int np,
+                          double tol)
+{
+  double t0 = 0.0, t1 = 1.0, e[3], x[3];
+  for (int d = 0; d < 3; d++)
+    e[d] = b[d] - a[d];
+  for (int f = 0; f < np && t0 <= t1; f++) {
+    const double s0 = fcm__vec3_dot(pl[f].n, a) - pl[f].d, ds = fcm__vec3_dot(pl[f].n, e);
+    if (ds == 0.0) {
+      if (s0 > 0.0) return 0;
+    } else if (ds > 0.0) {
+      t1 = fmin(t1, -s0 / ds);
+    } else {
+      t0 = fmax(t0, -s0 / ds);
+    }
+  }
+  if (!(t0 <= t1)) return 0;
+  for (int d = 0; d < 3; d++)
+    x[d] = a[d] + 0.5 * (t0 + t1) * e[d];
+  for (int f = 0; f < np; f++)
+    if (!(fcm__vec3_dot(pl[f].n, x) - pl[f].d < -tol)) return 0;
+  return 1;
+}
+
+/* Whether part i of P holds at most one lump of the body: the boundary triangles that reach
+ * inside it, joined through their shared edges where these do, form at most one component.
+ * (Every lump of a part not wholly inside the body is bounded by one of these triangles, and
+ * the material along one component of them is one lump.) A false 0 only costs the split. */
+static fcm_status one_lump(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
+                           const fcm__parts *P, size_t i, const double lo[3], const double hi[3],
+                           int *one)
+{
+  fcm_status st = FCM_OK;
+  const fcm_geometry *g = m->geom;
+  const double tol = FCM__EMBED_MATCH_RTOL * cell->size;
+  fcm__plane pl[FCM__POLY_MAX_FACES];
+  const int np = fcm__embed_part_planes(P, i, pl);
+  double x[3 * FCM__POLY_MAX_VERTS], work[3 * FCM__POLY_MAX_VERTS];
+  *one = 1;
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, m->tree, lo, hi, &m->buf));
+  if (3 * m->buf.n > m->ecap) {
+    void *e = m->edges, *u = m->uf;
+    FCM_TRY(ctx, fcm__resize(ctx, &e, 0, 9 * m->buf.n, sizeof(int)));
+    m->edges = e;
+    FCM_TRY(ctx, fcm__resize(ctx, &u, 0, 3 * m->buf.n, sizeof(int)));
+    m->uf = u;
+    m->ecap = 3 * m->buf.n;
+  }
+  int nk = 0, ne = 0; /* triangles reaching inside the part; their edges (a < b, triangle) */
+  for (size_t k = 0; k < m->buf.n; k++) {
+    const fcm_index *tv = g->tris + 3 * m->buf.ids[k];
+    double u[3], v[3], nrm[3], c[3] = {0.0, 0.0, 0.0};
+    for (int a = 0; a < 3; a++)
+      memcpy(x + 3 * a, g->coords + 3 * tv[a], 3 * sizeof *x);
+    for (int d = 0; d < 3; d++)
+      u[d] = x[3 + d] - x[d], v[d] = x[6 + d] - x[d];
+    fcm__vec3_cross(u, v, nrm);
+    const int n = fcm__embed_clip_to_part(P, i, x, 3, FCM__POLY_MAX_VERTS, nrm, work);
+    if (n < 3) continue;
+    for (int a = 0; a < n; a++)
+      for (int d = 0; d < 3; d++)
+        c[d] += x[3 * a + d] / n;
+    if (!(fcm__embed_part_excess(P, i, c) < -tol)) continue;
+    for (int a = 0; a < 3; a++, ne++) {
+      const int p = (int)tv[a], q = (int)tv[(a + 1) % 3];
+      m->edges[3 * ne] = FCM_MIN(p, q), m->edges[3 * ne + 1] = FCM_MAX(p, q);
+      m->edges[3 * ne + 2] = nk;
+    }
+    m->uf[nk] = nk;
+    nk++;
+  }
+  if (nk < 2) goto cleanup;
+  qsort(m->edges, (size_t)ne, 3 * sizeof(int), cmp_edge);
+  for (int e = 0; e + 1 < ne; e++) {
+    const int *a = m->edges + 3 * e, *b = a + 3;
+    if (a[0] != b[0] || a[1] != b[1]) continue;
+    if (!segment_inside(g->coords + 3 * (size_t)a[0], g->coords + 3 * (size_t)a[1], pl, np, tol))
+      continue;
+    m->uf[lump_find(m->uf, a[2])] = lump_find(m->uf, b[2]);
+  }
+  for (int t = 1; t < nk && *one; t++)
+    *one = lump_find(m->uf, t) == lump_find(m->uf, 0);
+cleanup:
+  return st;
+}
+
 fcm_status fcm__embed_split_lumps(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P)
 {
   fcm_status st = FCM_OK;
@@ -307,12 +415,15 @@ fcm_status fcm__embed_split_lumps(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm
   const size_t n0 = P->n;
   for (size_t i = 0; i < n0; i++) {
     if (fcm__embed_part_full(P, i)) continue;
-    if (!Q) FCM_ALLOC(ctx, 1, Q);
     const fcm__poly *p = P->poly + i;
     double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
     for (int a = 0; a < p->nv; a++)
       for (int d = 0; d < 3; d++)
         lo[d] = fmin(lo[d], p->x[a][d]), hi[d] = fmax(hi[d], p->x[a][d]);
+    int one;
+    FCM_TRY(ctx, one_lump(ctx, P->mat, cell, P, i, lo, hi, &one));
+    if (one) continue;
+    if (!Q) FCM_ALLOC(ctx, 1, Q);
     Q->n = 0;
     FCM_TRY(ctx, fcm__embed_parts_put(ctx, Q, 0, p, P->tol[i], P->vmin[i], 0));
     FCM_TRY(ctx, body_split(ctx, P->mat, cell, lo, hi, Q));
