@@ -27,6 +27,8 @@ struct fcm__material {
   double *tets, *vol;
   int cap;
   int *edges, *uf; /* fcm__embed_split_lumps(): the boundary's edges in a part, a union-find */
+  fcm_index *kept; /* the boundary triangles reaching inside that part */
+  size_t nkept;
   size_t ecap;
   fcm_status st; /* the first error of fcm__material_on_face() */
 };
@@ -58,6 +60,7 @@ void fcm__material_destroy(fcm_ctx *ctx, fcm__material **pm)
   fcm__free(ctx, m->vol);
   fcm__free(ctx, m->edges);
   fcm__free(ctx, m->uf);
+  fcm__free(ctx, m->kept);
   fcm__free(ctx, m);
   *pm = NULL;
 }
@@ -249,17 +252,16 @@ int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const double *a,
                                FACE_AREA_RTOL * size * size);
 }
 
-/* Split the parts of Q by the boundary triangles that meet the box lo, hi (the parts' box)
- * and drop the pieces outside the body: no boundary triangle crosses them, one point decides. */
+/* Split the parts of Q by the boundary triangles ids (n; all that reach inside the parts) and
+ * drop the pieces outside the body: no boundary triangle crosses them, one point decides. */
 static fcm_status body_split(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
-                             const double lo[3], const double hi[3], fcm__parts *Q)
+                             const fcm_index *ids, size_t n, fcm__parts *Q)
 {
   fcm_status st = FCM_OK;
   const fcm_geometry *g = m->geom;
   static const unsigned char outer[3] = {0, 0, 0};
-  FCM_TRY(ctx, fcm__geom_tree_query(ctx, m->tree, lo, hi, &m->buf));
-  for (size_t k = 0; k < m->buf.n && Q->n > 0; k++) {
-    const fcm_index *tv = g->tris + 3 * m->buf.ids[k];
+  for (size_t k = 0; k < n && Q->n > 0; k++) { /* before m->buf serves the inside tests */
+    const fcm_index *tv = g->tris + 3 * ids[k];
     fcm__cut_tri t;
     if (!fcm__embed_cut_tri_setup(g->coords + 3 * tv[0], g->coords + 3 * tv[1],
                                   g->coords + 3 * tv[2], 0, outer, NULL, &t))
@@ -294,7 +296,8 @@ fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell,
   ws->num_tets = 0;
   FCM_ALLOC(ctx, 1, Q);
   FCM_TRY(ctx, fcm__embed_parts_copy(ctx, P, piece, Q));
-  FCM_TRY(ctx, body_split(ctx, P->mat, cell, cell->lo, cell->hi, Q));
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, P->mat->tree, cell->lo, cell->hi, &P->mat->buf));
+  FCM_TRY(ctx, body_split(ctx, P->mat, cell, P->mat->buf.ids, P->mat->buf.n, Q));
   for (size_t i = 0; i < Q->n; i++)
     FCM_TRY(ctx,
             fcm__embed_append_tets(ctx, ws, Q->poly + i, Q->vmin[i], volume, &lost, &nslivers));
@@ -345,7 +348,8 @@ static int segment_inside(const double *a, const double *b, const fcm__plane *pl
 }
 
 /* Whether part i of P holds at most one lump of the body: the boundary triangles that reach
- * inside it, joined through their shared edges where these do, form at most one component.
+ * inside it (into m->kept), joined through their shared edges where these do, form at most one
+ * component.
  * (Every lump of a part not wholly inside the body is bounded by one of these triangles, and
  * the material along one component of them is one lump.) A false 0 only costs the split. */
 static fcm_status one_lump(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
@@ -359,6 +363,7 @@ static fcm_status one_lump(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell
   const int np = fcm__embed_part_planes(P, i, pl);
   double x[3 * FCM__POLY_MAX_VERTS], work[3 * FCM__POLY_MAX_VERTS];
   *one = 1;
+  m->nkept = 0;
   FCM_TRY(ctx, fcm__geom_tree_query(ctx, m->tree, lo, hi, &m->buf));
   if (3 * m->buf.n > m->ecap) {
     void *e = m->edges, *u = m->uf;
@@ -366,6 +371,9 @@ static fcm_status one_lump(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell
     m->edges = e;
     FCM_TRY(ctx, fcm__resize(ctx, &u, 0, 3 * m->buf.n, sizeof(int)));
     m->uf = u;
+    void *k = m->kept;
+    FCM_TRY(ctx, fcm__resize(ctx, &k, 0, 3 * m->buf.n, sizeof(fcm_index)));
+    m->kept = k;
     m->ecap = 3 * m->buf.n;
   }
   int nk = 0, ne = 0; /* triangles reaching inside the part; their edges (a < b, triangle) */
@@ -389,8 +397,9 @@ static fcm_status one_lump(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell
       m->edges[3 * ne + 2] = nk;
     }
     m->uf[nk] = nk;
-    nk++;
+    m->kept[nk++] = m->buf.ids[k];
   }
+  m->nkept = (size_t)nk;
   if (nk < 2) goto cleanup;
   qsort(m->edges, (size_t)ne, 3 * sizeof(int), cmp_edge);
   for (int e = 0; e + 1 < ne; e++) {
@@ -426,7 +435,7 @@ fcm_status fcm__embed_split_lumps(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm
     if (!Q) FCM_ALLOC(ctx, 1, Q);
     Q->n = 0;
     FCM_TRY(ctx, fcm__embed_parts_put(ctx, Q, 0, p, P->tol[i], P->vmin[i], 0));
-    FCM_TRY(ctx, body_split(ctx, P->mat, cell, lo, hi, Q));
+    FCM_TRY(ctx, body_split(ctx, P->mat, cell, P->mat->kept, P->mat->nkept, Q));
     if (Q->n < 2) continue;
     fcm__free(ctx, label);
     label = NULL;
