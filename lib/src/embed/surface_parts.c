@@ -28,6 +28,7 @@ struct fcm__material {
   int cap;
   int *edges, *uf; /* fcm__embed_split_lumps(): the boundary's edges in a part, a union-find */
   fcm_index *kept; /* the boundary triangles reaching inside that part */
+  double *rep;     /* per kept triangle: a point inside the part on it, its unit normal */
   size_t nkept;
   size_t ecap;
   fcm_status st; /* the first error of fcm__material_on_face() */
@@ -61,6 +62,7 @@ void fcm__material_destroy(fcm_ctx *ctx, fcm__material **pm)
   fcm__free(ctx, m->edges);
   fcm__free(ctx, m->uf);
   fcm__free(ctx, m->kept);
+  fcm__free(ctx, m->rep);
   fcm__free(ctx, m);
   *pm = NULL;
 }
@@ -347,9 +349,88 @@ static int segment_inside(const double *a, const double *b, const fcm__plane *pl
   return 1;
 }
 
+/* Whether the closed segment p q meets triangle (a, b, c) (a relative slack of 1e-9 counts a
+ * near miss as a hit). */
+static int segment_hits_triangle(const double *p, const double *q, const double *a, const double *b,
+                                 const double *c)
+{
+  const double eps = 1e-9;
+  double e1[3], e2[3], dir[3], h[3], sa[3], qv[3];
+  for (int d = 0; d < 3; d++)
+    e1[d] = b[d] - a[d], e2[d] = c[d] - a[d], dir[d] = q[d] - p[d], sa[d] = p[d] - a[d];
+  fcm__vec3_cross(dir, e2, h);
+  const double det = fcm__vec3_dot(e1, h);
+  if (det == 0.0) return 1; /* parallel: counted as a hit (only costs the split) */
+  const double u = fcm__vec3_dot(sa, h) / det;
+  if (u < -eps || u > 1.0 + eps) return 0;
+  fcm__vec3_cross(sa, e1, qv);
+  const double v = fcm__vec3_dot(dir, qv) / det;
+  if (v < -eps || u + v > 1.0 + eps) return 0;
+  const double t = fcm__vec3_dot(e2, qv) / det;
+  return t >= -eps && t <= 1.0 + eps;
+}
+
+/* Whether the polyline x[0 .. 3] meets none of the kept triangles but skip0 on its first leg
+ * and skip1 on its last. */
+static int path_clear(const fcm__material *m, int nk, const double x[4][3], int skip0, int skip1)
+{
+  const fcm_geometry *g = m->geom;
+  for (int t = 0; t < nk; t++) {
+    const fcm_index *tv = g->tris + 3 * m->kept[t];
+    const double *a = g->coords + 3 * tv[0], *b = g->coords + 3 * tv[1], *c = g->coords + 3 * tv[2];
+    for (int l = 0; l < 3; l++) {
+      if ((l == 0 && t == skip0) || (l == 2 && t == skip1)) continue;
+      if (segment_hits_triangle(x[l], x[l + 1], a, b, c)) return 0;
+    }
+  }
+  return 1;
+}
+
+/* Twice the area of boundary triangle t of g. */
+static double tri_area2(const fcm_geometry *g, fcm_index t)
+{
+  const fcm_index *tv = g->tris + 3 * t;
+  double u[3], v[3], n[3];
+  for (int d = 0; d < 3; d++) {
+    u[d] = g->coords[3 * tv[1] + d] - g->coords[3 * tv[0] + d];
+    v[d] = g->coords[3 * tv[2] + d] - g->coords[3 * tv[0] + d];
+  }
+  fcm__vec3_cross(u, v, n);
+  return sqrt(fcm__vec3_dot(n, n));
+}
+
+/* Join the components of the kept triangles (m->uf) whose material a path inside the body and
+ * the part links: from a point of one triangle a short step inwards, straight to such a point
+ * of the other's, crossing no boundary triangle. Up to 4 triangles of each component try. */
+static void join_through_body(fcm__material *m, const fcm__parts *P, size_t i, int nk, double tol)
+{
+  enum { TRIES = 4 };
+  int *tried = m->edges; /* per component root (the edges are no longer needed) */
+  for (int t = 0; t < nk; t++)
+    tried[t] = 0;
+  for (int s = 0; s < nk; s++) {
+    if (tried[lump_find(m->uf, s)]++ >= TRIES) continue;
+    for (int t = s + 1; t < nk; t++) {
+      if (lump_find(m->uf, s) == lump_find(m->uf, t)) continue;
+      double x[4][3];
+      const double *cs = m->rep + 6 * s, *ct = m->rep + 6 * t;
+      const double hs = 1e-4 * sqrt(tri_area2(m->geom, m->kept[s])),
+                   ht = 1e-4 * sqrt(tri_area2(m->geom, m->kept[t]));
+      for (int d = 0; d < 3; d++) {
+        x[0][d] = cs[d], x[1][d] = cs[d] - hs * cs[3 + d];
+        x[3][d] = ct[d], x[2][d] = ct[d] - ht * ct[3 + d];
+      }
+      if (!(fcm__embed_part_excess(P, i, x[1]) < -tol && fcm__embed_part_excess(P, i, x[2]) < -tol))
+        continue;
+      if (path_clear(m, nk, (const double(*)[3])x, s, t))
+        m->uf[lump_find(m->uf, s)] = lump_find(m->uf, t);
+    }
+  }
+}
+
 /* Whether part i of P holds at most one lump of the body: the boundary triangles that reach
- * inside it (into m->kept), joined through their shared edges where these do, form at most one
- * component.
+ * inside it (into m->kept), joined through their shared edges where these do and through
+ * paths inside the body (join_through_body()), form at most one component.
  * (Every lump of a part not wholly inside the body is bounded by one of these triangles, and
  * the material along one component of them is one lump.) A false 0 only costs the split. */
 static fcm_status one_lump(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
@@ -374,6 +455,9 @@ static fcm_status one_lump(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell
     void *k = m->kept;
     FCM_TRY(ctx, fcm__resize(ctx, &k, 0, 3 * m->buf.n, sizeof(fcm_index)));
     m->kept = k;
+    void *r = m->rep;
+    FCM_TRY(ctx, fcm__resize(ctx, &r, 0, 18 * m->buf.n, sizeof(double)));
+    m->rep = r;
     m->ecap = 3 * m->buf.n;
   }
   int nk = 0, ne = 0; /* triangles reaching inside the part; their edges (a < b, triangle) */
@@ -396,6 +480,9 @@ static fcm_status one_lump(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell
       m->edges[3 * ne] = FCM_MIN(p, q), m->edges[3 * ne + 1] = FCM_MAX(p, q);
       m->edges[3 * ne + 2] = nk;
     }
+    const double ln = sqrt(fcm__vec3_dot(nrm, nrm));
+    for (int d = 0; d < 3; d++)
+      m->rep[6 * nk + d] = c[d], m->rep[6 * nk + 3 + d] = nrm[d] / ln;
     m->uf[nk] = nk;
     m->kept[nk++] = m->buf.ids[k];
   }
@@ -409,6 +496,7 @@ static fcm_status one_lump(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell
       continue;
     m->uf[lump_find(m->uf, a[2])] = lump_find(m->uf, b[2]);
   }
+  join_through_body(m, P, i, nk, tol);
   for (int t = 1; t < nk && *one; t++)
     *one = lump_find(m->uf, t) == lump_find(m->uf, 0);
 cleanup:
