@@ -613,6 +613,11 @@ int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const double *a,
 
 /* Split every part of P by triangle t (its plane and edge planes, as a cut's) and drop the
  * emptied ones. */
+/* Split part i of P by triangle t (as fcm__embed_parts_split does each part): its pieces in slot
+ * i and appended; slot i emptied (nf == 0) when nothing is left, to be compacted. */
+fcm_status fcm__embed_part_split(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *t,
+                                 fcm__parts *P, size_t i);
+
 fcm_status fcm__embed_parts_split(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *t,
                                   fcm__parts *P);
 

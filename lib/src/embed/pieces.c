@@ -349,8 +349,8 @@ static fcm__plane flip(const fcm__plane *pl)
 /* Split part i by triangle t into up to 8 parts (both sides of its plane, each side
  * inside or outside each edge plane); the first stays in slot i, the rest are appended.
  * A part strictly on one side of the plane or strictly outside an edge plane is left. */
-static fcm_status split_part(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *t,
-                             fcm__parts *P, size_t i)
+fcm_status fcm__embed_part_split(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *t,
+                                 fcm__parts *P, size_t i)
 {
   fcm_status st = FCM_OK;
   /* the cut planes classify with the connectivity tests' tolerance (a vertex within
@@ -412,7 +412,7 @@ fcm_status fcm__embed_parts_split(fcm_ctx *ctx, const fcm__embed_cell *cell, con
   fcm_status st = FCM_OK;
   const size_t n0 = P->n;
   for (size_t i = 0; i < n0; i++)
-    FCM_TRY(ctx, split_part(ctx, cell, t, P, i));
+    FCM_TRY(ctx, fcm__embed_part_split(ctx, cell, t, P, i));
   fcm__embed_parts_compact(P);
 cleanup:
   return st;
@@ -646,7 +646,7 @@ static fcm_status split_parts(fcm_ctx *ctx, const fcm__embed_cell *cell, const f
     const fcm__cut_tri *t = tris + P->tcand.ids[k];
     const size_t n0 = P->n;
     for (size_t i = 0; i < n0; i++)
-      FCM_TRY(ctx, split_part(ctx, cell, t, P, i));
+      FCM_TRY(ctx, fcm__embed_part_split(ctx, cell, t, P, i));
   }
   fcm__embed_parts_compact(P);
   for (size_t i = 0; i < P->n; i++)

@@ -254,8 +254,9 @@ int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const double *a,
                                FACE_AREA_RTOL * size * size);
 }
 
-/* Split the parts of Q by the boundary triangles ids (n; all that reach inside the parts) and
- * drop the pieces outside the body: no boundary triangle crosses them, one point decides. */
+/* Split the parts of Q by the boundary triangles ids (n; all that reach inside the parts), each
+ * part only by the triangles that meet it, and drop the pieces outside the body: no boundary
+ * triangle crosses them, one point decides. */
 static fcm_status body_split(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
                              const fcm_index *ids, size_t n, fcm__parts *Q)
 {
@@ -268,7 +269,16 @@ static fcm_status body_split(fcm_ctx *ctx, fcm__material *m, const fcm__embed_ce
     if (!fcm__embed_cut_tri_setup(g->coords + 3 * tv[0], g->coords + 3 * tv[1],
                                   g->coords + 3 * tv[2], 0, outer, NULL, &t))
       continue;
-    FCM_TRY(ctx, fcm__embed_parts_split(ctx, cell, &t, Q));
+    double x[3 * FCM__POLY_MAX_VERTS], work[3 * FCM__POLY_MAX_VERTS];
+    const size_t n0 = Q->n;
+    for (size_t j = 0; j < n0; j++) {
+      for (int a = 0; a < 3; a++)
+        memcpy(x + 3 * a, g->coords + 3 * tv[a], 3 * sizeof *x);
+      const int m3 = fcm__embed_clip_to_part(Q, j, x, 3, FCM__POLY_MAX_VERTS, t.plane.n, work);
+      if (m3 >= 3 || m3 < 0) /* meets the part (or overflowed: split to be safe) */
+        FCM_TRY(ctx, fcm__embed_part_split(ctx, cell, &t, Q, j));
+    }
+    fcm__embed_parts_compact(Q);
   }
   for (size_t i = 0; i < Q->n; i++) {
     fcm__poly *q = Q->poly + i;
