@@ -9,7 +9,10 @@
  * rectangle ending inside the body (a crack), a V of two half-planes (non-planar) and a second
  * plane crossing the first one in cells it already split, a square cutting off a cap of the
  * ball whose edges end outside the ball in cells that hold material on both sides. Hex8 and Tet4
- * backgrounds (argument "quadratic": Hex20 and Tet10). */
+ * backgrounds (argument "quadratic": Hex20 and Tet10). A U-shaped body of tets (two prongs
+ * joined by a base) whose two prongs lie in one background cell, apart there, is cut across
+ * both prongs: the part of the cell beyond the cut holds two separate lumps of the body, which
+ * the volume path keeps as two pieces; so must the surface path. */
 #include "fcm/embed.h"
 #include "fcm/surface.h"
 #include "test.h"
@@ -237,6 +240,82 @@ static void run(fcm_element_type type)
   fcm_mesh_destroy(&mesh);
 }
 
+/* The box [0.03, 3.01] x [0.02, 2.04] x [0.01, 0.97] of 3 x 2 x 1 Kuhn-split cubes without
+ * cube (1, 1, 0): a U with prongs along y from y = 1.03 at x < 1.02 and x > 2.02. */
+static void u_body(fcm_geometry **gv)
+{
+  const double lo[3] = {0.03, 0.02, 0.01}, hi[3] = {3.01, 2.04, 0.97};
+  const fcm_index n[3] = {3, 2, 1};
+  fcm_geometry *box = NULL;
+  TEST_OK(ctx, fcm_geometry_create_box(ctx, lo, hi, n, &box));
+  const fcm_index nc = fcm_geometry_num_cells(box), *cv = fcm_geometry_cells(box);
+  const double *x = fcm_geometry_coords(box);
+  fcm_index *kept = malloc(4 * (size_t)nc * sizeof *kept), m = 0;
+  for (fcm_index c = 0; c < nc; c++) {
+    double g[3] = {0, 0, 0};
+    for (int a = 0; a < 4; a++)
+      for (int d = 0; d < 3; d++)
+        g[d] += x[3 * cv[4 * c + a] + d] / 4.0;
+    if (g[0] > 1.02 && g[0] < 2.02 && g[1] > 1.03) continue; /* the gap between the prongs */
+    memcpy(kept + 4 * m++, cv + 4 * c, 4 * sizeof *kept);
+  }
+  TEST_OK(ctx,
+          fcm_geometry_create(ctx, FCM_ELEMENT_TET4, fcm_geometry_num_nodes(box), x, m, kept, gv));
+  free(kept);
+  fcm_geometry_destroy(&box);
+}
+
+/* The U cut by a plane across both prongs, then by a crack ending between the prongs (across
+ * the first prong only), in a background of 1 x 2 x 1 cells whose upper cell holds both
+ * prongs' ends. */
+static void run_u(fcm_element_type type)
+{
+  const char *name = type == FCM_ELEMENT_TET4 ? "U, tet4" : "U, hex8";
+  const double lo[3] = {-0.41, -0.37, -0.33}, hi[3] = {3.43, 2.63, 1.29};
+  const fcm_index n[3] = {1, 2, 1};
+  fcm_mesh *mesh = NULL;
+  fcm_geometry *gv = NULL, *gs = NULL;
+  fcm_cell_rules *rv = NULL, *rs = NULL;
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, n, &mesh));
+  u_body(&gv);
+  surface_of(gv, &gs);
+  fcm_cell_rules_options o = fcm_cell_rules_options_default();
+  o.min_fraction = 0.0;
+  o.simplify_options.residual_tol = 1e-14;
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, gv, &o, &rv));
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, gs, &o, &rs));
+  fcm_surface *knife[2] = {NULL, NULL};
+  const double p0[3] = {1.5, 1.75, 0.5}, n0[3] = {-0.08, 1, 0.15};
+  const double blo[3] = {-0.2, -0.2, -0.2}, bhi[3] = {3.2, 2.3, 1.2};
+  TEST_OK(ctx, fcm_surface_create_plane(ctx, p0, n0, blo, bhi, &knife[0]));
+  const double rc[3] = {0.6, 1.45, 0.5}, rn[3] = {0.05, 1, 0.1}, ra[3] = {1, 0, 0},
+               rsz[2] = {1.8, 2.0};
+  TEST_OK(ctx, fcm_surface_create_rectangle(ctx, rc, rn, ra, rsz, &knife[1]));
+  const char *names[2] = {"plane across both prongs", "crack across one prong"};
+  for (int k = 0; k < 2; k++) {
+    fcm_cell_rules *nv = NULL, *ns = NULL;
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, gv, rv, knife[k], &nv));
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, gs, rs, knife[k], &ns));
+    fcm_cell_rules_destroy(&rv);
+    fcm_cell_rules_destroy(&rs);
+    rv = nv, rs = ns;
+    char what[64];
+    snprintf(what, sizeof what, "%s, %s", name, names[k]);
+    const double worst = compare(mesh, rv, rs, what);
+    printf("%s: %lld pieces (volume path %lld), %d components, moments agree to %.2e of "
+           "|K_ref|\n",
+           what, (long long)fcm_cell_rules_num_pieces(rs), (long long)fcm_cell_rules_num_pieces(rv),
+           components(mesh, rs), worst);
+  }
+  for (int k = 0; k < 2; k++)
+    fcm_surface_destroy(&knife[k]);
+  fcm_cell_rules_destroy(&rv);
+  fcm_cell_rules_destroy(&rs);
+  fcm_geometry_destroy(&gv);
+  fcm_geometry_destroy(&gs);
+  fcm_mesh_destroy(&mesh);
+}
+
 int main(int argc, char **argv)
 {
   TEST_OK(NULL, fcm_ctx_create(NULL, &ctx));
@@ -247,6 +326,8 @@ int main(int argc, char **argv)
   } else {
     run(FCM_ELEMENT_HEX8);
     run(FCM_ELEMENT_TET4);
+    run_u(FCM_ELEMENT_HEX8);
+    run_u(FCM_ELEMENT_TET4);
   }
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();

@@ -616,6 +616,11 @@ int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const double *a,
 
 /* Split every part of P by triangle t (its plane and edge planes, as a cut's) and drop the
  * emptied ones. */
+/* Split part i of P by triangle t (as fcm__embed_parts_split does each part): its pieces in slot
+ * i and appended; slot i emptied (nf == 0) when nothing is left, to be compacted. */
+fcm_status fcm__embed_part_split(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *t,
+                                 fcm__parts *P, size_t i);
+
 fcm_status fcm__embed_parts_split(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *t,
                                   fcm__parts *P);
 
@@ -624,6 +629,22 @@ void fcm__embed_parts_compact(fcm__parts *P);
 
 /* The parts of P in piece `piece` into Q (its parts replaced). */
 fcm_status fcm__embed_parts_copy(fcm_ctx *ctx, const fcm__parts *P, int piece, fcm__parts *Q);
+
+/* Store polyhedron q as part `slot` of P (slot == P->n appends), material not known. */
+fcm_status fcm__embed_parts_put(fcm_ctx *ctx, fcm__parts *P, size_t slot, const fcm__poly *q,
+                                double tol, double vmin, int parent);
+
+/* Connected components of the parts of P when the triangles tris[P->tcand.ids[0 .. ntri)]
+ * separate (and, with P->mat, faces without material): label[i] numbered by first part,
+ * *count of them. */
+fcm_status fcm__embed_parts_components(fcm_ctx *ctx, const fcm__embed_cell *cell,
+                                       const fcm__cut_tri *tris, size_t ntri, fcm__parts *P,
+                                       int *label, int *count);
+
+/* Surface body (P->mat): every part that holds more than one separate lump of the body is
+ * replaced by its pieces wholly inside the body (split by the boundary triangles), so that the
+ * components of the parts are the material's. The parts wholly inside the body are left. */
+fcm_status fcm__embed_split_lumps(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P);
 
 /* Surface body (P->mat): the parts of piece `piece` split by the body's boundary triangles
  * that meet the cell into parts wholly inside or outside the body; the inside ones

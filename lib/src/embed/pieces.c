@@ -274,9 +274,8 @@ static void poly_copy(fcm__poly *dst, const fcm__poly *src)
   memcpy(dst->fp, src->fp, (size_t)src->nf * sizeof src->fp[0]);
 }
 
-/* Store polyhedron q as part `slot` (slot == P->n appends). */
-static fcm_status parts_put(fcm_ctx *ctx, fcm__parts *P, size_t slot, const fcm__poly *q,
-                            double tol, double vmin, int parent)
+fcm_status fcm__embed_parts_put(fcm_ctx *ctx, fcm__parts *P, size_t slot, const fcm__poly *q,
+                                double tol, double vmin, int parent)
 {
   fcm_status st = FCM_OK;
   if (slot == P->n) {
@@ -305,7 +304,8 @@ fcm_status fcm__embed_cell_parts(fcm_ctx *ctx, const fcm_geometry *geom, const f
     if (!P->mat) FCM_TRY(ctx, fcm__material_create(ctx, geom, &P->mat));
     fcm__geom_poly_from_cell(cell->info->num_corners == 4 ? FCM_ELEMENT_TET4 : FCM_ELEMENT_HEX8,
                              cell->X, &ws->poly);
-    FCM_TRY(ctx, parts_put(ctx, P, 0, &ws->poly, cell->tol, sliver_rtol * cell->volume, 0));
+    FCM_TRY(ctx,
+            fcm__embed_parts_put(ctx, P, 0, &ws->poly, cell->tol, sliver_rtol * cell->volume, 0));
     P->whole = 1;
     FCM_TRY(ctx, fcm__embed_drop_dry(ctx, cell, P));
     if (counts) counts->parts += (fcm_index)P->n;
@@ -319,7 +319,7 @@ fcm_status fcm__embed_cell_parts(fcm_ctx *ctx, const fcm_geometry *geom, const f
                                       &tol, &vmin));
     if (ws->poly.nf == 0) continue;
     nparts++;
-    FCM_TRY(ctx, parts_put(ctx, P, P->n, &ws->poly, tol, vmin, 0));
+    FCM_TRY(ctx, fcm__embed_parts_put(ctx, P, P->n, &ws->poly, tol, vmin, 0));
   }
   if (counts) {
     counts->candidates += (fcm_index)ws->cand.n;
@@ -349,8 +349,8 @@ static fcm__plane flip(const fcm__plane *pl)
 /* Split part i by triangle t into up to 8 parts (both sides of its plane, each side
  * inside or outside each edge plane); the first stays in slot i, the rest are appended.
  * A part strictly on one side of the plane or strictly outside an edge plane is left. */
-static fcm_status split_part(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *t,
-                             fcm__parts *P, size_t i)
+fcm_status fcm__embed_part_split(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *t,
+                                 fcm__parts *P, size_t i)
 {
   fcm_status st = FCM_OK;
   /* the cut planes classify with the connectivity tests' tolerance (a vertex within
@@ -386,13 +386,13 @@ static fcm_status split_part(fcm_ctx *ctx, const fcm__embed_cell *cell, const fc
       overflow |= fcm__geom_poly_clip(&W[2], &out, tol, &P->scratch);
       overflow |= fcm__geom_poly_clip(&W[1], &t->edge[e], tol, &P->scratch);
       if (W[2].nf > 0) {
-        FCM_TRY(ctx, parts_put(ctx, P, slot, &W[2], P->tol[i], vmin, parent));
+        FCM_TRY(ctx, fcm__embed_parts_put(ctx, P, slot, &W[2], P->tol[i], vmin, parent));
         P->mvol[slot] = full;
         slot = P->n;
       }
     }
     if (W[1].nf > 0) {
-      FCM_TRY(ctx, parts_put(ctx, P, slot, &W[1], P->tol[i], vmin, parent));
+      FCM_TRY(ctx, fcm__embed_parts_put(ctx, P, slot, &W[1], P->tol[i], vmin, parent));
       P->mvol[slot] = full;
       slot = P->n;
     }
@@ -412,7 +412,7 @@ fcm_status fcm__embed_parts_split(fcm_ctx *ctx, const fcm__embed_cell *cell, con
   fcm_status st = FCM_OK;
   const size_t n0 = P->n;
   for (size_t i = 0; i < n0; i++)
-    FCM_TRY(ctx, split_part(ctx, cell, t, P, i));
+    FCM_TRY(ctx, fcm__embed_part_split(ctx, cell, t, P, i));
   fcm__embed_parts_compact(P);
 cleanup:
   return st;
@@ -424,7 +424,7 @@ fcm_status fcm__embed_parts_copy(fcm_ctx *ctx, const fcm__parts *P, int piece, f
   Q->n = 0;
   for (size_t j = 0; j < P->n; j++)
     if (P->piece[j] == piece)
-      FCM_TRY(ctx, parts_put(ctx, Q, Q->n, P->poly + j, P->tol[j], P->vmin[j], 0));
+      FCM_TRY(ctx, fcm__embed_parts_put(ctx, Q, Q->n, P->poly + j, P->tol[j], P->vmin[j], 0));
 cleanup:
   return st;
 }
@@ -633,7 +633,8 @@ void fcm__embed_parts_compact(fcm__parts *P)
 
 /* Split every part by the triangles tris[P->tcand.ids[k0 .. k1)], then drop the parts the
  * tolerance emptied; *change: how much that changed the parts' total volume. Parts of a
- * surface body without material are dropped too (after the volume is compared). */
+ * surface body without material are dropped too (after the volume is compared), and parts
+ * holding separate lumps of it split into them. */
 static fcm_status split_parts(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
                               size_t k0, size_t k1, fcm__parts *P, double *change)
 {
@@ -645,13 +646,16 @@ static fcm_status split_parts(fcm_ctx *ctx, const fcm__embed_cell *cell, const f
     const fcm__cut_tri *t = tris + P->tcand.ids[k];
     const size_t n0 = P->n;
     for (size_t i = 0; i < n0; i++)
-      FCM_TRY(ctx, split_part(ctx, cell, t, P, i));
+      FCM_TRY(ctx, fcm__embed_part_split(ctx, cell, t, P, i));
   }
   fcm__embed_parts_compact(P);
   for (size_t i = 0; i < P->n; i++)
     after += fcm__geom_poly_volume(P->poly + i);
   *change = fabs(after - before);
-  if (k1 > k0) FCM_TRY(ctx, fcm__embed_drop_dry(ctx, cell, P));
+  if (k1 > k0) {
+    FCM_TRY(ctx, fcm__embed_drop_dry(ctx, cell, P));
+    FCM_TRY(ctx, fcm__embed_split_lumps(ctx, cell, P));
+  }
 cleanup:
   return st;
 }
@@ -669,10 +673,9 @@ static int cmp_box_key(const void *a, const void *b)
   return (p->i > q->i) - (p->i < q->i);
 }
 
-/* Connected components of the parts when the triangles tris[P->tcand.ids[0 .. ntri)]
- * separate: label[i] numbered by first part; *count of them. */
-static fcm_status components(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
-                             size_t ntri, fcm__parts *P, int *label, int *count)
+fcm_status fcm__embed_parts_components(fcm_ctx *ctx, const fcm__embed_cell *cell,
+                                       const fcm__cut_tri *tris, size_t ntri, fcm__parts *P,
+                                       int *label, int *count)
 {
   fcm_status st = FCM_OK;
   double *box = NULL;
@@ -743,7 +746,7 @@ fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
     nold++;
   FCM_TRY(ctx, split_parts(ctx, cell, tris, 0, nold, P, &e0));
   if (nold > 0) {
-    FCM_TRY(ctx, components(ctx, cell, tris, nold, P, P->parent, &P->num_parents));
+    FCM_TRY(ctx, fcm__embed_parts_components(ctx, cell, tris, nold, P, P->parent, &P->num_parents));
   } else {
     for (size_t i = 0; i < P->n; i++)
       P->parent[i] = 0;
@@ -751,7 +754,8 @@ fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
   }
   FCM_TRY(ctx, split_parts(ctx, cell, tris, nold, P->tcand.n, P, &e1));
   P->split_error = e0 + e1;
-  FCM_TRY(ctx, components(ctx, cell, tris, P->tcand.n, P, P->piece, &P->num_pieces));
+  FCM_TRY(ctx,
+          fcm__embed_parts_components(ctx, cell, tris, P->tcand.n, P, P->piece, &P->num_pieces));
 cleanup:
   return st;
 }

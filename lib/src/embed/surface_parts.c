@@ -5,13 +5,16 @@
  * what the boundary triangles meeting it cost. A part without material is dropped, and two
  * parts (of one cell, or of two cells across a face) join only where the overlap of their
  * faces holds material: the body's volume in a thin prism on the overlap. So the pieces are
- * the components of the material as the volume mesh's parts give them, except that the body
- * inside one part counts as one piece even where the part holds two separate lumps of it. */
+ * the components of the material as the volume mesh's parts give them. A part that holds two
+ * separate lumps of the body is replaced by its pieces inside the body (split by the boundary
+ * triangles), which join only within a lump. */
 #include "embed/embed_impl.h"
 #include "element/element_impl.h"
 #include "la/mat3.h"
+#include "la/vec3.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 struct fcm__material {
@@ -23,6 +26,11 @@ struct fcm__material {
   fcm__srule sr;
   double *tets, *vol;
   int cap;
+  int *edges, *uf; /* fcm__embed_split_lumps(): the boundary's edges in a part, a union-find */
+  fcm_index *kept; /* the boundary triangles reaching inside that part */
+  double *rep;     /* per kept triangle: a point inside the part on it, its unit normal */
+  size_t nkept;
+  size_t ecap;
   fcm_status st; /* the first error of fcm__material_on_face() */
 };
 
@@ -51,6 +59,10 @@ void fcm__material_destroy(fcm_ctx *ctx, fcm__material **pm)
   fcm__srule_free(ctx, &m->sr);
   fcm__free(ctx, m->tets);
   fcm__free(ctx, m->vol);
+  fcm__free(ctx, m->edges);
+  fcm__free(ctx, m->uf);
+  fcm__free(ctx, m->kept);
+  fcm__free(ctx, m->rep);
   fcm__free(ctx, m);
   *pm = NULL;
 }
@@ -242,31 +254,34 @@ int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const double *a,
                                FACE_AREA_RTOL * size * size);
 }
 
-fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P,
-                                      int piece, fcm__embed_ws *ws, double *volume)
+/* Split the parts of Q by the boundary triangles ids (n; all that reach inside the parts), each
+ * part only by the triangles that meet it, and drop the pieces outside the body: no boundary
+ * triangle crosses them, one point decides. */
+static fcm_status body_split(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
+                             const fcm_index *ids, size_t n, fcm__parts *Q)
 {
   fcm_status st = FCM_OK;
-  fcm__material *m = P->mat;
   const fcm_geometry *g = m->geom;
-  fcm__parts *Q = NULL;
-  double lost = 0.0;
-  fcm_index nslivers = 0;
   static const unsigned char outer[3] = {0, 0, 0};
-  *volume = 0.0;
-  ws->num_tets = 0;
-  FCM_ALLOC(ctx, 1, Q);
-  FCM_TRY(ctx, fcm__embed_parts_copy(ctx, P, piece, Q));
-  FCM_TRY(ctx, fcm__geom_tree_query(ctx, m->tree, cell->lo, cell->hi, &m->buf));
-  for (size_t k = 0; k < m->buf.n && Q->n > 0; k++) {
-    const fcm_index *tv = g->tris + 3 * m->buf.ids[k];
+  for (size_t k = 0; k < n && Q->n > 0; k++) { /* before m->buf serves the inside tests */
+    const fcm_index *tv = g->tris + 3 * ids[k];
     fcm__cut_tri t;
     if (!fcm__embed_cut_tri_setup(g->coords + 3 * tv[0], g->coords + 3 * tv[1],
                                   g->coords + 3 * tv[2], 0, outer, NULL, &t))
       continue;
-    FCM_TRY(ctx, fcm__embed_parts_split(ctx, cell, &t, Q));
+    double x[3 * FCM__POLY_MAX_VERTS], work[3 * FCM__POLY_MAX_VERTS];
+    const size_t n0 = Q->n;
+    for (size_t j = 0; j < n0; j++) {
+      for (int a = 0; a < 3; a++)
+        memcpy(x + 3 * a, g->coords + 3 * tv[a], 3 * sizeof *x);
+      const int m3 = fcm__embed_clip_to_part(Q, j, x, 3, FCM__POLY_MAX_VERTS, t.plane.n, work);
+      if (m3 >= 3 || m3 < 0) /* meets the part (or overflowed: split to be safe) */
+        FCM_TRY(ctx, fcm__embed_part_split(ctx, cell, &t, Q, j));
+    }
+    fcm__embed_parts_compact(Q);
   }
-  for (size_t i = 0; i < Q->n; i++) { /* no boundary triangle crosses a part: one point decides */
-    const fcm__poly *q = Q->poly + i;
+  for (size_t i = 0; i < Q->n; i++) {
+    fcm__poly *q = Q->poly + i;
     double c[3] = {0.0, 0.0, 0.0}, xi[3], det;
     int in;
     for (int a = 0; a < q->nv; a++)
@@ -275,12 +290,270 @@ fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell,
     FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, c, xi, &det));
     FCM_TRY(ctx, fcm__embed_inside_line(ctx, g, m->tree, cell, xi[0], xi[1], 1, xi + 2, &in,
                                         &m->buf, &m->cr));
-    if (in == 1)
-      FCM_TRY(ctx, fcm__embed_append_tets(ctx, ws, q, Q->vmin[i], volume, &lost, &nslivers));
+    if (in != 1) q->nv = q->nf = 0;
+  }
+  fcm__embed_parts_compact(Q);
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P,
+                                      int piece, fcm__embed_ws *ws, double *volume)
+{
+  fcm_status st = FCM_OK;
+  fcm__parts *Q = NULL;
+  double lost = 0.0;
+  fcm_index nslivers = 0;
+  *volume = 0.0;
+  ws->num_tets = 0;
+  FCM_ALLOC(ctx, 1, Q);
+  FCM_TRY(ctx, fcm__embed_parts_copy(ctx, P, piece, Q));
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, P->mat->tree, cell->lo, cell->hi, &P->mat->buf));
+  FCM_TRY(ctx, body_split(ctx, P->mat, cell, P->mat->buf.ids, P->mat->buf.n, Q));
+  for (size_t i = 0; i < Q->n; i++)
+    FCM_TRY(ctx,
+            fcm__embed_append_tets(ctx, ws, Q->poly + i, Q->vmin[i], volume, &lost, &nslivers));
+cleanup:
+  if (Q) fcm__embed_parts_free(ctx, Q);
+  fcm__free(ctx, Q);
+  return st;
+}
+
+static int cmp_edge(const void *a, const void *b)
+{
+  const int *p = a, *q = b;
+  if (p[0] != q[0]) return p[0] < q[0] ? -1 : 1;
+  return (p[1] > q[1]) - (p[1] < q[1]);
+}
+
+static int lump_find(int *uf, int a)
+{
+  while (uf[a] != a)
+    a = uf[a] = uf[uf[a]];
+  return a;
+}
+
+/* Whether segment a b meets the inside of the convex part with planes pl (np), farther than
+ * tol from its faces: the middle of its clipped share decides (that share is convex). */
+static int segment_inside(const double *a, const double *b, const fcm__plane *pl, int np,
+                          double tol)
+{
+  double t0 = 0.0, t1 = 1.0, e[3], x[3];
+  for (int d = 0; d < 3; d++)
+    e[d] = b[d] - a[d];
+  for (int f = 0; f < np && t0 <= t1; f++) {
+    const double s0 = fcm__vec3_dot(pl[f].n, a) - pl[f].d, ds = fcm__vec3_dot(pl[f].n, e);
+    if (ds == 0.0) {
+      if (s0 > 0.0) return 0;
+    } else if (ds > 0.0) {
+      t1 = fmin(t1, -s0 / ds);
+    } else {
+      t0 = fmax(t0, -s0 / ds);
+    }
+  }
+  if (!(t0 <= t1)) return 0;
+  for (int d = 0; d < 3; d++)
+    x[d] = a[d] + 0.5 * (t0 + t1) * e[d];
+  for (int f = 0; f < np; f++)
+    if (!(fcm__vec3_dot(pl[f].n, x) - pl[f].d < -tol)) return 0;
+  return 1;
+}
+
+/* Whether the closed segment p q meets triangle (a, b, c) (a relative slack of 1e-9 counts a
+ * near miss as a hit). */
+static int segment_hits_triangle(const double *p, const double *q, const double *a, const double *b,
+                                 const double *c)
+{
+  const double eps = 1e-9;
+  double e1[3], e2[3], dir[3], h[3], sa[3], qv[3];
+  for (int d = 0; d < 3; d++)
+    e1[d] = b[d] - a[d], e2[d] = c[d] - a[d], dir[d] = q[d] - p[d], sa[d] = p[d] - a[d];
+  fcm__vec3_cross(dir, e2, h);
+  const double det = fcm__vec3_dot(e1, h);
+  if (det == 0.0) return 1; /* parallel: counted as a hit (only costs the split) */
+  const double u = fcm__vec3_dot(sa, h) / det;
+  if (u < -eps || u > 1.0 + eps) return 0;
+  fcm__vec3_cross(sa, e1, qv);
+  const double v = fcm__vec3_dot(dir, qv) / det;
+  if (v < -eps || u + v > 1.0 + eps) return 0;
+  const double t = fcm__vec3_dot(e2, qv) / det;
+  return t >= -eps && t <= 1.0 + eps;
+}
+
+/* Whether the polyline x[0 .. 3] meets none of the kept triangles but skip0 on its first leg
+ * and skip1 on its last. */
+static int path_clear(const fcm__material *m, int nk, const double x[4][3], int skip0, int skip1)
+{
+  const fcm_geometry *g = m->geom;
+  for (int t = 0; t < nk; t++) {
+    const fcm_index *tv = g->tris + 3 * m->kept[t];
+    const double *a = g->coords + 3 * tv[0], *b = g->coords + 3 * tv[1], *c = g->coords + 3 * tv[2];
+    for (int l = 0; l < 3; l++) {
+      if ((l == 0 && t == skip0) || (l == 2 && t == skip1)) continue;
+      if (segment_hits_triangle(x[l], x[l + 1], a, b, c)) return 0;
+    }
+  }
+  return 1;
+}
+
+/* Twice the area of boundary triangle t of g. */
+static double tri_area2(const fcm_geometry *g, fcm_index t)
+{
+  const fcm_index *tv = g->tris + 3 * t;
+  double u[3], v[3], n[3];
+  for (int d = 0; d < 3; d++) {
+    u[d] = g->coords[3 * tv[1] + d] - g->coords[3 * tv[0] + d];
+    v[d] = g->coords[3 * tv[2] + d] - g->coords[3 * tv[0] + d];
+  }
+  fcm__vec3_cross(u, v, n);
+  return sqrt(fcm__vec3_dot(n, n));
+}
+
+/* Join the components of the kept triangles (m->uf) whose material a path inside the body and
+ * the part links: from a point of one triangle a short step inwards, straight to such a point
+ * of the other's, crossing no boundary triangle. Up to 4 triangles of each component try. */
+static void join_through_body(fcm__material *m, const fcm__parts *P, size_t i, int nk, double tol)
+{
+  enum { TRIES = 4 };
+  int *tried = m->edges; /* per component root (the edges are no longer needed) */
+  for (int t = 0; t < nk; t++)
+    tried[t] = 0;
+  for (int s = 0; s < nk; s++) {
+    if (tried[lump_find(m->uf, s)]++ >= TRIES) continue;
+    for (int t = s + 1; t < nk; t++) {
+      if (lump_find(m->uf, s) == lump_find(m->uf, t)) continue;
+      double x[4][3];
+      const double *cs = m->rep + 6 * s, *ct = m->rep + 6 * t;
+      const double hs = 1e-4 * sqrt(tri_area2(m->geom, m->kept[s])),
+                   ht = 1e-4 * sqrt(tri_area2(m->geom, m->kept[t]));
+      for (int d = 0; d < 3; d++) {
+        x[0][d] = cs[d], x[1][d] = cs[d] - hs * cs[3 + d];
+        x[3][d] = ct[d], x[2][d] = ct[d] - ht * ct[3 + d];
+      }
+      if (!(fcm__embed_part_excess(P, i, x[1]) < -tol && fcm__embed_part_excess(P, i, x[2]) < -tol))
+        continue;
+      if (path_clear(m, nk, (const double(*)[3])x, s, t))
+        m->uf[lump_find(m->uf, s)] = lump_find(m->uf, t);
+    }
+  }
+}
+
+/* Whether part i of P holds at most one lump of the body: the boundary triangles that reach
+ * inside it (into m->kept), joined through their shared edges where these do and through
+ * paths inside the body (join_through_body()), form at most one component.
+ * (Every lump of a part not wholly inside the body is bounded by one of these triangles, and
+ * the material along one component of them is one lump.) A false 0 only costs the split. */
+static fcm_status one_lump(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
+                           const fcm__parts *P, size_t i, const double lo[3], const double hi[3],
+                           int *one)
+{
+  fcm_status st = FCM_OK;
+  const fcm_geometry *g = m->geom;
+  const double tol = FCM__EMBED_MATCH_RTOL * cell->size;
+  fcm__plane pl[FCM__POLY_MAX_FACES];
+  const int np = fcm__embed_part_planes(P, i, pl);
+  double x[3 * FCM__POLY_MAX_VERTS], work[3 * FCM__POLY_MAX_VERTS];
+  *one = 1;
+  m->nkept = 0;
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, m->tree, lo, hi, &m->buf));
+  if (3 * m->buf.n > m->ecap) {
+    void *e = m->edges, *u = m->uf;
+    FCM_TRY(ctx, fcm__resize(ctx, &e, 0, 9 * m->buf.n, sizeof(int)));
+    m->edges = e;
+    FCM_TRY(ctx, fcm__resize(ctx, &u, 0, 3 * m->buf.n, sizeof(int)));
+    m->uf = u;
+    void *k = m->kept;
+    FCM_TRY(ctx, fcm__resize(ctx, &k, 0, 3 * m->buf.n, sizeof(fcm_index)));
+    m->kept = k;
+    void *r = m->rep;
+    FCM_TRY(ctx, fcm__resize(ctx, &r, 0, 18 * m->buf.n, sizeof(double)));
+    m->rep = r;
+    m->ecap = 3 * m->buf.n;
+  }
+  int nk = 0, ne = 0; /* triangles reaching inside the part; their edges (a < b, triangle) */
+  for (size_t k = 0; k < m->buf.n; k++) {
+    const fcm_index *tv = g->tris + 3 * m->buf.ids[k];
+    double u[3], v[3], nrm[3], c[3] = {0.0, 0.0, 0.0};
+    for (int a = 0; a < 3; a++)
+      memcpy(x + 3 * a, g->coords + 3 * tv[a], 3 * sizeof *x);
+    for (int d = 0; d < 3; d++)
+      u[d] = x[3 + d] - x[d], v[d] = x[6 + d] - x[d];
+    fcm__vec3_cross(u, v, nrm);
+    const int n = fcm__embed_clip_to_part(P, i, x, 3, FCM__POLY_MAX_VERTS, nrm, work);
+    if (n < 3) continue;
+    for (int a = 0; a < n; a++)
+      for (int d = 0; d < 3; d++)
+        c[d] += x[3 * a + d] / n;
+    if (!(fcm__embed_part_excess(P, i, c) < -tol)) continue;
+    for (int a = 0; a < 3; a++, ne++) {
+      const int p = (int)tv[a], q = (int)tv[(a + 1) % 3];
+      m->edges[3 * ne] = FCM_MIN(p, q), m->edges[3 * ne + 1] = FCM_MAX(p, q);
+      m->edges[3 * ne + 2] = nk;
+    }
+    const double ln = sqrt(fcm__vec3_dot(nrm, nrm));
+    for (int d = 0; d < 3; d++)
+      m->rep[6 * nk + d] = c[d], m->rep[6 * nk + 3 + d] = nrm[d] / ln;
+    m->uf[nk] = nk;
+    m->kept[nk++] = m->buf.ids[k];
+  }
+  m->nkept = (size_t)nk;
+  if (nk < 2) goto cleanup;
+  qsort(m->edges, (size_t)ne, 3 * sizeof(int), cmp_edge);
+  for (int e = 0; e + 1 < ne; e++) {
+    const int *a = m->edges + 3 * e, *b = a + 3;
+    if (a[0] != b[0] || a[1] != b[1]) continue;
+    if (!segment_inside(g->coords + 3 * (size_t)a[0], g->coords + 3 * (size_t)a[1], pl, np, tol))
+      continue;
+    m->uf[lump_find(m->uf, a[2])] = lump_find(m->uf, b[2]);
+  }
+  join_through_body(m, P, i, nk, tol);
+  for (int t = 1; t < nk && *one; t++)
+    *one = lump_find(m->uf, t) == lump_find(m->uf, 0);
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_split_lumps(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P)
+{
+  fcm_status st = FCM_OK;
+  fcm__parts *Q = NULL; /* no material of its own: its parts join through any shared face */
+  int *label = NULL, nc;
+  if (!P->mat) return FCM_OK;
+  const size_t n0 = P->n;
+  for (size_t i = 0; i < n0; i++) {
+    if (fcm__embed_part_full(P, i)) continue;
+    const fcm__poly *p = P->poly + i;
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (int a = 0; a < p->nv; a++)
+      for (int d = 0; d < 3; d++)
+        lo[d] = fmin(lo[d], p->x[a][d]), hi[d] = fmax(hi[d], p->x[a][d]);
+    int one;
+    FCM_TRY(ctx, one_lump(ctx, P->mat, cell, P, i, lo, hi, &one));
+    if (one) continue;
+    if (!Q) FCM_ALLOC(ctx, 1, Q);
+    Q->n = 0;
+    FCM_TRY(ctx, fcm__embed_parts_put(ctx, Q, 0, p, P->tol[i], P->vmin[i], 0));
+    FCM_TRY(ctx, body_split(ctx, P->mat, cell, P->mat->kept, P->mat->nkept, Q));
+    if (Q->n < 2) continue;
+    fcm__free(ctx, label);
+    label = NULL;
+    FCM_ALLOC(ctx, Q->n, label);
+    FCM_TRY(ctx, fcm__embed_parts_components(ctx, cell, NULL, 0, Q, label, &nc));
+    if (nc < 2) continue;
+    /* the lumps' pieces replace the part, each wholly inside the body */
+    const double tol = P->tol[i], vmin = P->vmin[i];
+    const int parent = P->parent[i];
+    for (size_t j = 0; j < Q->n; j++) {
+      const size_t slot = j == 0 ? i : P->n;
+      FCM_TRY(ctx, fcm__embed_parts_put(ctx, P, slot, Q->poly + j, tol, vmin, parent));
+      P->mvol[slot] = fcm__geom_poly_volume(Q->poly + j);
+    }
+    P->whole = 0;
   }
 cleanup:
   if (Q) fcm__embed_parts_free(ctx, Q);
   fcm__free(ctx, Q);
+  fcm__free(ctx, label);
   return st;
 }
 
