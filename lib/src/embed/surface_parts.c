@@ -121,17 +121,7 @@ static fcm_status tets_material(fcm_ctx *ctx, fcm__material *m, const double *te
     if (!(fabs(k.detA) > FLAT_RTOL * k.size * k.size * k.size && isfinite(k.detA))) continue;
     FCM_TRY(ctx,
             fcm__embed_moment_rule(ctx, m->geom, m->tree, &k, q, NULL, &m->buf, &m->cr, &m->sr));
-    if (out && out->n + m->sr.n > out->cap) {
-      size_t cap = out->cap ? out->cap : 1024;
-      while (cap < out->n + m->sr.n)
-        cap *= 2;
-      void *x = out->x, *w = out->w;
-      FCM_TRY(ctx, fcm__resize(ctx, &x, 3 * out->n, 3 * cap, sizeof(double)));
-      out->x = x;
-      FCM_TRY(ctx, fcm__resize(ctx, &w, out->n, cap, sizeof(double)));
-      out->w = w;
-      out->cap = cap;
-    }
+    if (out) FCM_TRY(ctx, fcm__srule_room(ctx, out, m->sr.n));
     for (size_t i = 0; i < m->sr.n; i++) {
       const double w = m->sr.w[i] * k.detA;
       sum += w;
@@ -185,17 +175,7 @@ fcm_status fcm__material_cell(fcm_ctx *ctx, fcm__material *m, const fcm__moment_
   double sum = 0.0;
   FCM_TRY(ctx, fcm__embed_moment_rule(ctx, m->geom, m->tree, cell, q ? q : &m->q0, NULL, &m->buf,
                                       &m->cr, &m->sr));
-  if (out && out->n + m->sr.n > out->cap) {
-    size_t cap = out->cap ? out->cap : 1024;
-    while (cap < out->n + m->sr.n)
-      cap *= 2;
-    void *x = out->x, *w = out->w;
-    FCM_TRY(ctx, fcm__resize(ctx, &x, 3 * out->n, 3 * cap, sizeof(double)));
-    out->x = x;
-    FCM_TRY(ctx, fcm__resize(ctx, &w, out->n, cap, sizeof(double)));
-    out->w = w;
-    out->cap = cap;
-  }
+  if (out) FCM_TRY(ctx, fcm__srule_room(ctx, out, m->sr.n));
   for (size_t i = 0; i < m->sr.n; i++) {
     sum += m->sr.w[i];
     if (!out) continue;
