@@ -685,6 +685,12 @@ typedef struct fcm_contact_stats {
   double body_depth;           /**< the largest depth of a surface sample inside another body
                                     now (m; a ray's parity, then the distance to that body's
                                     nearest triangle); 0 when none is, or without it */
+  double step_min_distance;    /**< the smallest signed distance over every state the last
+                                    step accepted: the end of each of its substeps (load steps,
+                                    halved substeps) and the current state (<= min_distance;
+                                    HUGE_VAL without obstacles). The Newton iterates inside a
+                                    substep are not states: the step filter keeps each of them
+                                    at d > 0 by construction */
 } fcm_contact_stats;
 
 /** The contact obstacles' state at the current displacement and time. Before setup, or

@@ -913,6 +913,7 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
   FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
   FCM_CHECK(I->is_setup, I->ctx, FCM_ERR_ARG, "integrator: call fcm_integrator_setup() first");
   if (I->num_contacts > 0) FCM_TRY(I->ctx, fcm__sim_contact_check(I, I->u, I->t));
+  I->contact_inner_states = 0;
   {
     const fcm_integrator_options *o = &I->opts;
     fcm_index n = I->n;
@@ -968,6 +969,11 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
         if (dyn) fcm__sim_scheme_update(I, h);
         done += size;
         info->substeps++;
+        /* the contact's smallest distance over every accepted state of the step */
+        if (I->num_contacts > 0 && done < units) {
+          st = fcm__sim_contact_track(I);
+          if (st != FCM_OK) break;
+        }
         reason = done < units ? FCM_STEP_NONE : reason;
         continue;
       }

@@ -154,6 +154,9 @@ struct fcm_integrator {
   long long contact_filtered;  /* Newton steps the contact filter shortened (cumulative) */
   long long contact_evals;     /* evaluations of the contact terms (cumulative) */
   long long contact_pullbacks; /* substep guesses pulled back in front of an obstacle */
+  double contact_dmin_inner;   /* smallest distance at the current step's accepted substeps
+                                  before its last (valid when contact_inner_states > 0) */
+  int contact_inner_states;
 
   /* state */
   double *u, *v;
@@ -390,6 +393,11 @@ double fcm__sim_contact_step_bound(fcm_integrator *I, const double *x, const dou
  * the step bound from un (w1 holds u - un afterwards). A moving surface obstacle that
  * swallowed a point of un makes the substep's energies non-finite (cp.swallowed). */
 void fcm__sim_contact_pull_back(fcm_integrator *I);
+fcm_status fcm__sim_contact_track(fcm_integrator *I);
+fcm_status fcm__sim_contact_support(fcm_integrator *I, const double *x, double t,
+                                    void (*fn)(void *user, fcm_index elem, const double y[3],
+                                               const double g[3]),
+                                    void *user);
 fcm_status fcm__sim_contact_check(fcm_integrator *I, const double *x, double t);
 /* Friction (contact_friction.c). has_friction: an obstacle has mu > 0. lag: each point's
  * normal force and tangent basis from u_n (obstacles at bc_time), the substep's start
