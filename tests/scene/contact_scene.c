@@ -254,6 +254,10 @@ int main(int argc, char **argv)
                 "\"plane\": {\"point\": [0, 0, -1], \"normal\": [0, 0, 1]},"
                 " \"friction_velocity\": -1",
                 "effects[0].contact.friction_velocity");
+  refused_parse(ctx,
+                "\"plane\": {\"point\": [0, 0, -1], \"normal\": [0, 0, 1]},"
+                " \"friction_updates\": 21",
+                "effects[0].contact.friction_updates");
   /* a body starting inside each kind */
   refused_setup(ctx, "\"sphere\": {\"center\": [0, 0, -0.6], \"radius\": 0.3}",
                 "contact sphere 0: the body starts in penetration");

@@ -118,6 +118,10 @@ static int errors(fcm_ctx *ctx)
   co.friction_velocity = -1.0;
   TEST_ERR(ctx, fcm_integrator_add_contact_plane(I, c, up, NULL, &co, NULL), FCM_ERR_ARG,
            "contact plane 0: friction_velocity = -1 must be finite and >= 0");
+  co.friction_velocity = 0.0;
+  co.friction_updates = -1;
+  TEST_ERR(ctx, fcm_integrator_add_contact_plane(I, c, up, NULL, &co, NULL), FCM_ERR_ARG,
+           "contact plane 0: friction_updates = -1 must be in [0, 20]");
   /* the plane through the centre: half of the surface lies behind it */
   TEST_OK(ctx, fcm_integrator_add_contact_plane(I, c, up, NULL, NULL, NULL));
   TEST_ERR(ctx, fcm_integrator_setup(I), FCM_ERR_ARG, "lies at distance");

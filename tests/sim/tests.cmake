@@ -118,6 +118,8 @@ endforeach()
 fcm_add_test(sim_contact_friction_fd tests/sim/contact_friction.c ARGS fd)
 fcm_add_test(sim_contact_friction_stick tests/sim/contact_friction.c ARGS incline 0.6)
 fcm_add_test(sim_contact_friction_slide tests/sim/contact_friction.c ARGS incline 0.2)
+fcm_add_test(sim_contact_friction_stick_updates tests/sim/contact_friction.c ARGS incline 0.6 3)
+fcm_add_test(sim_contact_friction_slide_updates tests/sim/contact_friction.c ARGS incline 0.2 3)
 # Contact between bodies and cut pieces: the barrier's force against differences, the step
 # bound, a box dropped onto another, bad input and zero work without the key, and the dice
 # (36 sticks landing on a floor without passing through each other or the floor).

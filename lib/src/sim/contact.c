@@ -54,6 +54,9 @@ static fcm_status add_obstacle(fcm_integrator *I, sim_contact *c, const fcm_cont
             FCM_ERR_ARG,
             "contact %s %d: friction_velocity = %g must be finite and >= 0 (0: the default)", kn, k,
             c->opts.friction_velocity);
+  FCM_CHECK(c->opts.friction_updates >= 0 && c->opts.friction_updates <= 20, ctx, FCM_ERR_ARG,
+            "contact %s %d: friction_updates = %d must be in [0, 20]", kn, k,
+            c->opts.friction_updates);
   FCM_CHECK(c->kind != SIM_CONTACT_BODIES || c->opts.friction == 0.0, ctx, FCM_ERR_ARG,
             "contact bodies %d: friction = %g: friction between bodies is not supported (0)", k,
             c->opts.friction);
@@ -843,6 +846,7 @@ fcm_status fcm_integrator_contact_stats(const fcm_integrator *I, fcm_contact_sta
   fcm_ctx *ctx = I->ctx;
   memset(out, 0, sizeof *out);
   out->evaluations = I->contact_evals;
+  out->friction_updates = I->cp.relags;
   out->min_distance = out->step_min_distance = HUGE_VAL;
   if (!I->is_setup || I->num_contacts == 0) return FCM_OK;
   {
