@@ -811,6 +811,7 @@ static const fcm__effect_type effect_types[FCM_EFFECT_TYPE_COUNT] = {
     {.type = FCM_EFFECT_CONTACT,
      .name = "contact",
      .summary = "a rigid plane obstacle, static or moving (log barrier on the embedded surface)",
+     .allowed_static = 1, /* the body must start within d^ of obstacles holding it */
      .parse = parse_contact,
      .view = view_contact,
      .needs = FCM__NEEDS_SURFACE_RULES,
