@@ -22,7 +22,8 @@
  *              on its top face, in load steps of the static kind: every step converges, no
  *              point reaches a plane, the floor's reaction equals the load within 1 % and the
  *              walls' net force vanishes; the same block 0.02 m (beyond d^) above the floor
- *              is refused as a free body (FCM_ERR_SINGULAR), the message naming the contact */
+ *              is refused as a free body (FCM_ERR_SINGULAR), the message naming the contact,
+ *              and so is the block on the floor alone (2 translations and 1 rotation free) */
 #include "sim_util.h"
 #include "fcm/fcm.h"
 #include "test.h"
@@ -317,7 +318,7 @@ static void top_traction(void *user, const double x[3], const double normal[3], 
   out[2] = normal[2] > 0.5 ? -2000.0 : 0.0;
 }
 
-static int static_block(fcm_ctx *ctx, double gap)
+static int static_block(fcm_ctx *ctx, double gap, int walls)
 {
   problem p = {ctx, NULL, NULL, NULL, NULL};
   fcm_integrator *I = NULL;
@@ -343,7 +344,7 @@ static int static_block(fcm_ctx *ctx, double gap)
   {
     const double fp[3] = {0.5, 0.5, blo[2] - gap}, up[3] = {0, 0, 1};
     TEST_OK(ctx, fcm_integrator_add_contact_plane(I, fp, up, NULL, &co, NULL));
-    for (int a = 0; a < 2; a++)
+    for (int a = 0; a < 2 * walls; a++)
       for (int side = 0; side < 2; side++) {
         double pt[3] = {0.5, 0.5, 0.2}, n[3] = {0, 0, 0};
         pt[a] = side ? bhi[a] + gap : blo[a] - gap;
@@ -352,13 +353,15 @@ static int static_block(fcm_ctx *ctx, double gap)
       }
   }
   TEST_OK(ctx, fcm_integrator_setup(I));
-  if (gap > co.distance) { /* beyond the threshold: nothing holds the block */
+  if (gap > co.distance || !walls) { /* nothing, or the floor alone, holds the block */
     fcm_step_info info;
     const char *msg;
     TEST_TRUE(fcm_integrator_step(I, &info) == FCM_ERR_SINGULAR);
     msg = fcm_ctx_error_message(ctx);
-    printf("static, gap %g m: %s\n", gap, msg);
+    printf("static, gap %g m, %s: %s\n", gap, walls ? "walls" : "no walls", msg);
     TEST_TRUE(strstr(msg, "contact obstacle") != NULL);
+    TEST_TRUE(strstr(msg, walls ? "3 rigid-body translations and 3 rotations"
+                                : "2 rigid-body translations and 1 rotation free") != NULL);
     fcm_ctx_error_clear(ctx);
     fcm_integrator_destroy(&I);
     problem_free(&p);
@@ -404,8 +407,9 @@ int main(int argc, char **argv)
   } else if (!strcmp(mode, "iterates")) {
     iterates(ctx);
   } else if (!strcmp(mode, "static")) {
-    static_block(ctx, 0.003);
-    static_block(ctx, 0.02);
+    static_block(ctx, 0.003, 1);
+    static_block(ctx, 0.02, 1);
+    static_block(ctx, 0.003, 0);
   } else if (!strcmp(mode, "errors")) {
     errors(ctx);
   } else if (!strcmp(mode, "drop")) {
