@@ -75,6 +75,33 @@ static void refused_parse(fcm_ctx *ctx, const char *contact, const char *want)
   fcm_scene_destroy(&scene);
 }
 
+/* A static scene: contact is accepted, and a ball beyond the floor's threshold is refused at
+ * its first step as a free body, naming the contact. */
+static void static_scene(fcm_ctx *ctx)
+{
+  static const char json[] =
+      "{\"version\": 1, \"name\": \"c\","
+      " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [-0.4, -0.4, -0.4],"
+      "   \"max\": [0.4, 0.4, 0.4]}, \"cells\": [4, 4, 4]},"
+      " \"geometry\": {\"shape\": \"ball\", \"center\": [0, 0, 0], \"radius\": 0.35},"
+      " \"material\": {\"model\": \"snh\", \"young\": 1e5, \"poisson\": 0.3},"
+      " \"time\": {\"static\": true, \"steps\": 1},"
+      " \"effects\": [{\"gravity\": {\"acceleration\": [0, 0, -9.81]}},"
+      "   {\"contact\": {\"plane\": {\"point\": [0, 0, -0.4], \"normal\": [0, 0, 1]},"
+      "     \"distance\": 0.01}}]}";
+  fcm_scene *scene = NULL;
+  fcm_simulation *sim = NULL;
+  TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "c.json", &scene));
+  if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
+  if (sim) {
+    fcm_step_info si;
+    TEST_ERR(ctx, fcm_simulation_step(sim, &si), FCM_ERR_SINGULAR,
+             "no surface point within a contact obstacle's threshold");
+  }
+  fcm_simulation_destroy(&sim);
+  fcm_scene_destroy(&scene);
+}
+
 /* ball_off_wedge.json: outside the wedge and above the floor at every step, touching both. */
 static void wedge(fcm_ctx *ctx, const char *dir)
 {
@@ -123,6 +150,7 @@ int main(int argc, char **argv)
   if (argc < 2) return TEST_RESULT();
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
   if (!ctx) return TEST_RESULT();
+  static_scene(ctx);
   snprintf(path, sizeof path, "%s/ball_on_floor.json", argv[1]);
   fcm_scene *scene = NULL;
   fcm_simulation *sim = NULL;
@@ -254,6 +282,10 @@ int main(int argc, char **argv)
                 "\"plane\": {\"point\": [0, 0, -1], \"normal\": [0, 0, 1]},"
                 " \"friction_velocity\": -1",
                 "effects[0].contact.friction_velocity");
+  refused_parse(ctx,
+                "\"plane\": {\"point\": [0, 0, -1], \"normal\": [0, 0, 1]},"
+                " \"friction_updates\": 21",
+                "effects[0].contact.friction_updates");
   /* a body starting inside each kind */
   refused_setup(ctx, "\"sphere\": {\"center\": [0, 0, -0.6], \"radius\": 0.3}",
                 "contact sphere 0: the body starts in penetration");

@@ -10,7 +10,20 @@
  *   drop <scheme>  a Hex8 ball dropped under gravity onto a floor: no surface point ever at
  *              or below the floor; backward Euler: it comes to rest (centre-of-mass velocity
  *              small) and the floor's reaction is m g within 3 %; Newmark: it bounces (the
- *              centre of mass moves up after the impact) */
+ *              centre of mass moves up after the impact)
+ *   iterates   a ball dropped onto a floor with Newmark (it bounces), Newton limited to 6
+ *              iterations so that the impact's steps are halved into substeps: every Newton
+ *              iterate (seen by the monitor) keeps every point in front of the floor, and each
+ *              step's step_min_distance lies between the smallest distance over its iterates
+ *              (every accepted state is an iterate) and the distance after the step
+ *   static     a block (0.6 x 0.6 x 0.2 m) held in a cup of five planes within d^ of its faces
+ *              (floor and four walls: the walls' barrier fixes the horizontal rigid motions a
+ *              static solve cannot), pressed onto the floor by gravity and a downward traction
+ *              on its top face, in load steps of the static kind: every step converges, no
+ *              point reaches a plane, the floor's reaction equals the load within 1 % and the
+ *              walls' net force vanishes; the same block 0.02 m (beyond d^) above the floor
+ *              is refused as a free body (FCM_ERR_SINGULAR), the message naming the contact,
+ *              and so is the block on the floor alone (2 translations and 1 rotation free) */
 #include "sim_util.h"
 #include "fcm/fcm.h"
 #include "test.h"
@@ -106,6 +119,10 @@ static int errors(fcm_ctx *ctx)
   co.friction_velocity = -1.0;
   TEST_ERR(ctx, fcm_integrator_add_contact_plane(I, c, up, NULL, &co, NULL), FCM_ERR_ARG,
            "contact plane 0: friction_velocity = -1 must be finite and >= 0");
+  co.friction_velocity = 0.0;
+  co.friction_updates = -1;
+  TEST_ERR(ctx, fcm_integrator_add_contact_plane(I, c, up, NULL, &co, NULL), FCM_ERR_ARG,
+           "contact plane 0: friction_updates = -1 must be in [0, 20]");
   /* the plane through the centre: half of the surface lies behind it */
   TEST_OK(ctx, fcm_integrator_add_contact_plane(I, c, up, NULL, NULL, NULL));
   TEST_ERR(ctx, fcm_integrator_setup(I), FCM_ERR_ARG, "lies at distance");
@@ -224,6 +241,160 @@ static int push(fcm_ctx *ctx)
   return 0;
 }
 
+/* The Newton monitor's view of the iterates: the smallest distance to obstacle 0 over the
+ * iterates since the last reset. */
+typedef struct iterate_watch {
+  fcm_integrator *I;
+  double dmin;
+  long long seen;
+} iterate_watch;
+
+static void watch_iterate(void *user, const fcm_newton_event *ev)
+{
+  iterate_watch *w = user;
+  double d = HUGE_VAL;
+  (void)ev;
+  if (!w->I || fcm_integrator_contact_info(w->I, 0, NULL, &d, NULL, NULL) != FCM_OK) d = NAN;
+  w->dmin = isnan(d) ? NAN : fmin(w->dmin, d);
+  w->seen++;
+}
+
+static int iterates(fcm_ctx *ctx)
+{
+  problem p = {ctx, NULL, NULL, NULL, NULL};
+  fcm_integrator *I = NULL;
+  iterate_watch w = {NULL, HUGE_VAL, 0};
+  const double c[3] = {0.5, 0.5, 0.5}, r = 0.35, up[3] = {0, 0, 1}, g[3] = {0, 0, -9.81};
+  const double floor_pt[3] = {0.5, 0.5, c[2] - r - 0.03};
+  fcm_material mat = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 1e5, 0.3, 1000.0};
+  fcm_integrator_options o = fcm_integrator_options_default();
+  o.kind = FCM_INTEGRATOR_DYNAMIC;
+  o.scheme = FCM_SCHEME_NEWMARK;
+  o.dt = 0.02;
+  o.newton_max_iterations = 6;
+  o.max_halvings = 6;
+  o.monitor = watch_iterate;
+  o.monitor_user = &w;
+  TEST_OK(ctx, ball_problem(&p, c, r, 4));
+  TEST_OK(ctx, fcm_integrator_create(ctx, p.space, &mat, &o, &I));
+  TEST_OK(ctx, fcm_integrator_add_gravity(I, g, NULL, NULL));
+  TEST_OK(ctx, fcm_integrator_add_contact_plane(I, floor_pt, up, NULL, NULL, NULL));
+  TEST_OK(ctx, fcm_integrator_setup(I));
+  w.I = I;
+  int split = 0, closer = 0;
+  double dmin_all = HUGE_VAL;
+  for (int s = 0; s < 30; s++) {
+    fcm_step_info info;
+    fcm_contact_stats cs;
+    w.dmin = HUGE_VAL;
+    TEST_OK(ctx, fcm_integrator_step(I, &info));
+    TEST_OK(ctx, fcm_integrator_contact_stats(I, &cs));
+    dmin_all = fmin(dmin_all, w.dmin);
+    split += info.substeps > 1;
+    closer += cs.step_min_distance < cs.min_distance;
+    if (!(w.dmin > 0.0)) TEST_FAIL_("step %d: a Newton iterate reached distance %.3g", s, w.dmin);
+    if (!(w.dmin <= cs.step_min_distance && cs.step_min_distance <= cs.min_distance))
+      TEST_FAIL_("step %d (%d substeps): iterates' minimum %.6g, step minimum %.6g, after the "
+                 "step %.6g: not in order",
+                 s, info.substeps, w.dmin, cs.step_min_distance, cs.min_distance);
+    if (info.substeps > 1 && getenv("CONTACT_TRACE"))
+      printf("step %d: %d substeps, iterates %.4g, step %.4g, after %.4g\n", s, info.substeps,
+             w.dmin, cs.step_min_distance, cs.min_distance);
+  }
+  printf("iterates: %lld Newton iterates, smallest distance %.4g m; %d steps split into "
+         "substeps, %d with an earlier substep closer than the step's end\n",
+         w.seen, dmin_all, split, closer);
+  TEST_TRUE(split > 0 && closer > 0);
+  fcm_integrator_destroy(&I);
+  problem_free(&p);
+  return 0;
+}
+
+/* Static contact: see the header. The load is m g plus a traction q over the top face. */
+static void top_traction(void *user, const double x[3], const double normal[3], double out[3])
+{
+  (void)user, (void)x;
+  out[0] = out[1] = 0.0;
+  out[2] = normal[2] > 0.5 ? -2000.0 : 0.0;
+}
+
+static int static_block(fcm_ctx *ctx, double gap, int walls)
+{
+  problem p = {ctx, NULL, NULL, NULL, NULL};
+  fcm_integrator *I = NULL;
+  const double blo[3] = {0.2, 0.2, 0.1}, bhi[3] = {0.8, 0.8, 0.3}, lo[3] = {0, 0, 0},
+               hi[3] = {1, 1, 0.5}, g[3] = {0, 0, -9.81};
+  const fcm_index gcells[3] = {2, 2, 1}, cells[3] = {5, 5, 3};
+  fcm_material mat = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 1e6, 0.3, 1000.0};
+  fcm_integrator_options o = fcm_integrator_options_default();
+  fcm_contact_options co = fcm_contact_options_default();
+  fcm_cell_rules_options ro = fcm_cell_rules_options_default();
+  o.kind = FCM_INTEGRATOR_STATIC;
+  o.load_steps = 4;
+  co.distance = 0.01;
+  ro.surface_strength = 2;
+  ro.min_fraction = 1e-4;
+  TEST_OK(ctx, fcm_geometry_create_box(ctx, blo, bhi, gcells, &p.geom));
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, cells, &p.mesh));
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, p.mesh, p.geom, &ro, &p.rules));
+  TEST_OK(ctx, fcm_space_create_embedded(ctx, p.mesh, p.rules, &p.space));
+  TEST_OK(ctx, fcm_integrator_create(ctx, p.space, &mat, &o, &I));
+  TEST_OK(ctx, fcm_integrator_add_gravity(I, g, NULL, NULL));
+  TEST_OK(ctx, fcm_integrator_add_traction(I, top_traction, NULL, NULL, NULL));
+  {
+    const double fp[3] = {0.5, 0.5, blo[2] - gap}, up[3] = {0, 0, 1};
+    TEST_OK(ctx, fcm_integrator_add_contact_plane(I, fp, up, NULL, &co, NULL));
+    for (int a = 0; a < 2 * walls; a++)
+      for (int side = 0; side < 2; side++) {
+        double pt[3] = {0.5, 0.5, 0.2}, n[3] = {0, 0, 0};
+        pt[a] = side ? bhi[a] + gap : blo[a] - gap;
+        n[a] = side ? -1.0 : 1.0;
+        TEST_OK(ctx, fcm_integrator_add_contact_plane(I, pt, n, NULL, &co, NULL));
+      }
+  }
+  TEST_OK(ctx, fcm_integrator_setup(I));
+  if (gap > co.distance || !walls) { /* nothing, or the floor alone, holds the block */
+    fcm_step_info info;
+    const char *msg;
+    TEST_TRUE(fcm_integrator_step(I, &info) == FCM_ERR_SINGULAR);
+    msg = fcm_ctx_error_message(ctx);
+    printf("static, gap %g m, %s: %s\n", gap, walls ? "walls" : "no walls", msg);
+    TEST_TRUE(strstr(msg, "contact obstacle") != NULL);
+    TEST_TRUE(strstr(msg, walls ? "3 rigid-body translations and 3 rotations"
+                                : "2 rigid-body translations and 1 rotation free") != NULL);
+    fcm_ctx_error_clear(ctx);
+    fcm_integrator_destroy(&I);
+    problem_free(&p);
+    return 0;
+  }
+  double dmin_all = HUGE_VAL, F[3] = {0, 0, 0}, W[3] = {0, 0, 0};
+  {
+    fcm_step_info info;
+    TEST_OK(ctx, fcm_integrator_step(I, &info));
+    TEST_TRUE(info.reason == FCM_STEP_CONVERGED);
+  }
+  for (int c = 0; c < 5; c++) {
+    double f[3], dmin = 0.0;
+    TEST_OK(ctx, fcm_integrator_contact_info(I, c, f, &dmin, NULL, NULL));
+    dmin_all = fmin(dmin_all, dmin);
+    for (int i = 0; i < 3; i++)
+      (c == 0 ? F : W)[i] += f[i];
+  }
+  const double mg = 1000.0 * 0.6 * 0.6 * 0.2 * 9.81, load = mg + 2000.0 * 0.6 * 0.6;
+  printf("static: min distance %.3g m; floor reaction %.6g N against the load %.6g N; walls' "
+         "net force (%.3g, %.3g, %.3g) N\n",
+         dmin_all, F[2], load, W[0], W[1], W[2]);
+  if (!(dmin_all > 0.0)) TEST_FAIL_("static: a point reached distance %.3g", dmin_all);
+  TEST_NEAR(F[2], load, 0.01, 0.0);
+  TEST_NEAR(F[0], 0.0, 0.0, 1e-3 * load);
+  TEST_NEAR(F[1], 0.0, 0.0, 1e-3 * load);
+  for (int i = 0; i < 3; i++)
+    TEST_NEAR(W[i], 0.0, 0.0, 1e-3 * load);
+  fcm_integrator_destroy(&I);
+  problem_free(&p);
+  return 0;
+}
+
 int main(int argc, char **argv)
 {
   fcm_ctx *ctx = NULL;
@@ -233,6 +404,12 @@ int main(int argc, char **argv)
     gradient(ctx);
   } else if (!strcmp(mode, "push")) {
     push(ctx);
+  } else if (!strcmp(mode, "iterates")) {
+    iterates(ctx);
+  } else if (!strcmp(mode, "static")) {
+    static_block(ctx, 0.003, 1);
+    static_block(ctx, 0.02, 1);
+    static_block(ctx, 0.003, 0);
   } else if (!strcmp(mode, "errors")) {
     errors(ctx);
   } else if (!strcmp(mode, "drop")) {

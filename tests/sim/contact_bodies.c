@@ -13,7 +13,8 @@
  *            + elastic + barrier - work of gravity) never grows by more than 1e-6 of the work
  *   dice <scenes>  apps/scenes/dice_on_floor.json (a cube cut into 36 sticks, spun and dropped
  *            onto a floor, contact between the pieces): at every step every surface point stays
- *            above the floor and no sample lies inside another stick by more than 1e-3 m, the
+ *            above the floor (also at the ends of the step's substeps: step_min_distance > 0)
+ *            and no sample lies inside another stick by more than 1e-3 m, the
  *            sticks reach the floor (closer than half its threshold) and meet each other, and
  *            the energy never exceeds its start by more than 1e-3 of the work of gravity
  *   rest <scenes>  apps/scenes/cut_bar_resting.json (a bar cut along its length, dropped onto a
@@ -277,7 +278,7 @@ static int dice(fcm_ctx *ctx, const char *dir)
     fcm_scene_destroy(&scene);
     return 0;
   }
-  double e0 = 0.0, emax = -HUGE_VAL, wmax = 0.0, depth = 0.0, dfloor = HUGE_VAL;
+  double e0 = 0.0, emax = -HUGE_VAL, wmax = 0.0, depth = 0.0, dfloor = HUGE_VAL, dstep = HUGE_VAL;
   long long pairs = 0;
   int steps = 0;
   const double t0 = fcm_wtime();
@@ -296,6 +297,7 @@ static int dice(fcm_ctx *ctx, const char *dir)
     wmax = fmax(wmax, fabs(info.load_work));
     depth = fmax(depth, cs.body_depth);
     dfloor = fmin(dfloor, d0);
+    dstep = fmin(dstep, cs.step_min_distance); /* every substep's state, floor and pieces */
     pairs = cs.body_pairs > pairs ? cs.body_pairs : pairs;
   }
   double dhat = 0.0;
@@ -309,6 +311,8 @@ static int dice(fcm_ctx *ctx, const char *dir)
          steps, fcm_wtime() - t0, (long long)c.pieces, dfloor, depth, pairs, emax - e0, wmax);
   TEST_TRUE(c.pieces == 36);
   if (!(dfloor > 0.0)) TEST_FAIL_("a surface point reached the floor: %.3g m", dfloor);
+  if (!(dstep > 0.0 && dstep <= dfloor))
+    TEST_FAIL_("the substeps' smallest distance %.3g m: not in (0, %.3g]", dstep, dfloor);
   if (!(dfloor < 0.5 * dhat)) TEST_FAIL_("the sticks never reached the floor (%.3g m)", dfloor);
   if (!(pairs > 0)) TEST_FAIL_("the sticks never met each other");
   if (!(depth <= 1e-3)) TEST_FAIL_("a sample got %.3g m inside another stick", depth);

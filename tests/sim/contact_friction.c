@@ -10,7 +10,10 @@
  *              with mu = 0.6 > tan theta it stays: its centre of mass moves along the slope by at
  *              most eps_v per second once settled (the smoothed static friction's creep bound);
  *              with mu = 0.2 it slides with the acceleration g (sin theta - mu cos theta)
- *              within 3 %; no point ever below the floor */
+ *              within 3 %; no point ever below the floor
+ *   incline <mu> <updates>  the same with the normal forces and tangents taken anew at each
+ *              converged state up to <updates> times per substep (fixed-point iterations):
+ *              the same bounds hold, and updates are counted */
 #include "sim_util.h"
 #include "fcm/fcm.h"
 #include "sim/sim_impl.h"
@@ -119,7 +122,7 @@ static void com_x(const fcm_integrator *I, fcm_index n, double *v, double *u)
   free(ex), free(w);
 }
 
-static int incline(fcm_ctx *ctx, double mu)
+static int incline(fcm_ctx *ctx, double mu, int updates)
 {
   problem p = {ctx, NULL, NULL, NULL, NULL};
   fcm_integrator *I = NULL;
@@ -136,6 +139,7 @@ static int incline(fcm_ctx *ctx, double mu)
   o.dt = 0.01;
   co.friction = mu;
   co.distance = 0.01;
+  co.friction_updates = updates;
   ro.surface_strength = 2;
   ro.min_fraction = 1e-4;
   TEST_OK(ctx, fcm_geometry_create_box(ctx, blo, bhi, gcells, &p.geom));
@@ -160,6 +164,14 @@ static int incline(fcm_ctx *ctx, double mu)
     if (s + 1 == settle) com_x(I, n, &v1, &u1);
   }
   com_x(I, n, &v2, &u2);
+  {
+    fcm_contact_stats cs;
+    TEST_OK(ctx, fcm_integrator_contact_stats(I, &cs));
+    printf("incline: %lld friction updates over %d steps\n", cs.friction_updates, steps);
+    /* updates happen where the normal forces moved over the substep: at least at the start */
+    if (updates > 0 ? cs.friction_updates == 0 : cs.friction_updates != 0)
+      TEST_FAIL_("%lld friction updates with friction_updates = %d", cs.friction_updates, updates);
+  }
   const double T = (steps - settle) * o.dt;
   printf("incline mu = %g: min distance %.3g m; after settling: slope displacement %.4g m, "
          "velocity %.4g -> %.4g m/s over %g s\n",
@@ -188,7 +200,7 @@ int main(int argc, char **argv)
     fd_one(ctx, 0);
     fd_one(ctx, 1);
   } else if (!strcmp(mode, "incline") && argc > 2) {
-    incline(ctx, atof(argv[2]));
+    incline(ctx, atof(argv[2]), argc > 3 ? atoi(argv[3]) : 0);
   } else {
     return 2;
   }

@@ -90,12 +90,16 @@ fcm_add_test(sim_schemes tests/sim/schemes.c)
 # differences; a start in penetration and bad options refused; a moving floor hits a ball
 # and throws it at a speed in [V, 2 V]; a ball dropped on a floor
 # never crosses it, comes to rest on it with the reaction m g (backward Euler), bounces
-# (Newmark).
+# (Newmark); every Newton iterate stays in front of the floor and the step's smallest distance
+# covers its substeps; a block held in a cup of planes reaches static equilibrium (reaction =
+# load).
 fcm_add_test(sim_contact_gradient tests/sim/contact.c ARGS gradient)
 fcm_add_test(sim_contact_errors tests/sim/contact.c ARGS errors)
 fcm_add_test(sim_contact_push tests/sim/contact.c ARGS push)
 fcm_add_test(sim_contact_drop_be tests/sim/contact.c ARGS drop backward_euler)
 fcm_add_test(sim_contact_drop_newmark tests/sim/contact.c ARGS drop newmark)
+fcm_add_test(sim_contact_iterates tests/sim/contact.c ARGS iterates)
+fcm_add_test(sim_contact_static tests/sim/contact.c ARGS static)
 # Spheres, boxes and closed triangle surfaces as contact obstacles: the point-triangle distance
 # in each region and every kind's distance against differences, the barrier's force against
 # differences, balls dropped onto and pushed by each kind, and the refusals.
@@ -114,6 +118,8 @@ endforeach()
 fcm_add_test(sim_contact_friction_fd tests/sim/contact_friction.c ARGS fd)
 fcm_add_test(sim_contact_friction_stick tests/sim/contact_friction.c ARGS incline 0.6)
 fcm_add_test(sim_contact_friction_slide tests/sim/contact_friction.c ARGS incline 0.2)
+fcm_add_test(sim_contact_friction_stick_updates tests/sim/contact_friction.c ARGS incline 0.6 3)
+fcm_add_test(sim_contact_friction_slide_updates tests/sim/contact_friction.c ARGS incline 0.2 3)
 # Contact between bodies and cut pieces: the barrier's force against differences, the step
 # bound, a box dropped onto another, bad input and zero work without the key, and the dice
 # (36 sticks landing on a floor without passing through each other or the floor).

@@ -333,7 +333,8 @@ typedef struct fcm_effect_contact {
   fcm_motion motion;             /**< SPHERE, BOX, SURFACE: "velocity", "rotation", "start",
                                       "end" as the motion effect (default: static) */
   fcm_contact_options options;   /**< "distance" (m), "stiffness" (Pa/m), "friction" (mu),
-                                      "friction_velocity" (m/s), each >= 0 */
+                                      "friction_velocity" (m/s), each >= 0;
+                                      "friction_updates" in [0, 20] */
 } fcm_effect_contact;
 
 /** One effect of the scene: a tagged union. */

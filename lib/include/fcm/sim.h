@@ -541,6 +541,13 @@ typedef struct fcm_contact_options {
                          mu lambda f0(|slip|) smoothed below eps_v h (dynamic schemes only) */
   double friction_velocity; /**< eps_v (m/s) >= 0: slip velocities below it see a friction
                                  force that falls smoothly to 0; 0 (default): 1e-3 m/s */
+  int friction_updates;     /**< in [0, 20]: after a substep's Newton solve converged, up to
+                                 this many times the lagged normal forces and tangents are taken
+                                 anew at the converged state and Newton solves again from it
+                                 (fixed-point outer iterations; they stop once the largest
+                                 normal force changes by at most 1e-3 of the largest); 0
+                                 (default): lagged from the substep's start only. The largest
+                                 value over the obstacles applies */
 } fcm_contact_options;
 
 /** The defaults listed on each member. */
@@ -685,6 +692,15 @@ typedef struct fcm_contact_stats {
   double body_depth;           /**< the largest depth of a surface sample inside another body
                                     now (m; a ray's parity, then the distance to that body's
                                     nearest triangle); 0 when none is, or without it */
+  long long friction_updates;  /**< the friction's normal forces and tangents taken anew at a
+                                    converged state since setup
+                                    (fcm_contact_options.friction_updates) */
+  double step_min_distance;    /**< the smallest signed distance over every state the last
+                                    step accepted: the end of each of its substeps (load steps,
+                                    halved substeps) and the current state (<= min_distance;
+                                    HUGE_VAL without obstacles). The Newton iterates inside a
+                                    substep are not states: the step filter keeps each of them
+                                    at d > 0 by construction */
 } fcm_contact_stats;
 
 /** The contact obstacles' state at the current displacement and time. Before setup, or

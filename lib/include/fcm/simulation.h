@@ -116,8 +116,9 @@ typedef struct fcm_simulation_counters {
   int contacts;                  /**< contact obstacles (contact effects) */
   long long contact_evaluations; /**< evaluations of the contact terms (0 without contact) */
   long long contact_points_max;  /**< the most point-obstacle pairs within d^ after a step */
-  double contact_min_distance;   /**< the smallest signed distance to an obstacle after a step
-                                      (HUGE_VAL: no contact effect or no step) */
+  double contact_min_distance;   /**< the smallest signed distance to an obstacle over every
+                                      accepted state (each substep's end; HUGE_VAL: no contact
+                                      effect or no step) */
   double contact_energy_max;     /**< the largest barrier energy after a step (J) */
   double friction_dissipation;   /**< the friction's work summed over the steps (J) */
   fcm_index constrained_nodes;   /**< background nodes named by them (with or without DOFs) */

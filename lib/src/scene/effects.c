@@ -606,9 +606,9 @@ static void view_cut(const fcm_effect *e, FILE *f)
 static fcm_status parse_contact(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"plane",     "sphere",   "box",
-                                     "surface",   "bodies",   "distance",
-                                     "stiffness", "friction", "friction_velocity"};
+  static const char *const keys[] = {
+      "plane",    "sphere",    "box",      "surface",           "bodies",
+      "distance", "stiffness", "friction", "friction_velocity", "friction_updates"};
   static const char *const plane_keys[] = {"point", "normal", "velocity"};
   static const char *const sphere_keys[] = {"center",   "radius", "velocity",
                                             "rotation", "start",  "end"};
@@ -685,6 +685,11 @@ options:
           fcm__scene_read_number(p, o, "friction", 0, FCM__NONNEGATIVE, &c->options.friction));
   FCM_TRY(p->ctx, fcm__scene_read_number(p, o, "friction_velocity", 0, FCM__NONNEGATIVE,
                                          &c->options.friction_velocity));
+  {
+    long long updates = 0;
+    FCM_TRY(p->ctx, fcm__scene_read_int(p, o, "friction_updates", 0, 0, 20, &updates));
+    c->options.friction_updates = (int)updates;
+  }
   if (c->obstacle == FCM_CONTACT_BODIES) {
     size_t o3 = fcm__scene_path_push_key(p, "friction");
     SCENE_CHECK(c->options.friction == 0.0, p, FCM_ERR_ARG,
@@ -740,6 +745,8 @@ static void view_contact(const fcm_effect *e, FILE *f)
   if (c->options.friction > 0.0)
     fprintf(f, ", friction %g (smoothed below %g m/s)", c->options.friction,
             c->options.friction_velocity > 0.0 ? c->options.friction_velocity : 1e-3);
+  if (c->options.friction > 0.0 && c->options.friction_updates > 0)
+    fprintf(f, ", up to %d friction updates per substep", c->options.friction_updates);
 }
 
 /* The one table of effect modules. Order = enum fcm_effect_type. */
@@ -804,6 +811,7 @@ static const fcm__effect_type effect_types[FCM_EFFECT_TYPE_COUNT] = {
     {.type = FCM_EFFECT_CONTACT,
      .name = "contact",
      .summary = "a rigid plane obstacle, static or moving (log barrier on the embedded surface)",
+     .allowed_static = 1, /* the body must start within d^ of obstacles holding it */
      .parse = parse_contact,
      .view = view_contact,
      .needs = FCM__NEEDS_SURFACE_RULES,

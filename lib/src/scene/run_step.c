@@ -187,12 +187,12 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
     fcm_contact_stats cs;
     FCM_TRY(S->ctx, fcm_integrator_contact_stats(S->integ, &cs));
     r->contact_points = cs.active_points;
-    r->contact_dmin = cs.min_distance;
+    r->contact_dmin = cs.step_min_distance;
     r->contact_energy = cs.barrier_energy;
     r->friction = cs.friction_dissipation;
     S->c.contact_evaluations = cs.evaluations;
     S->c.contact_points_max = FCM_MAX(S->c.contact_points_max, cs.active_points);
-    S->c.contact_min_distance = FCM_MIN(S->c.contact_min_distance, cs.min_distance);
+    S->c.contact_min_distance = FCM_MIN(S->c.contact_min_distance, cs.step_min_distance);
     S->c.contact_energy_max = FCM_MAX(S->c.contact_energy_max, cs.barrier_energy);
     S->c.friction_dissipation += cs.friction_dissipation;
   }

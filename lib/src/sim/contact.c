@@ -54,6 +54,9 @@ static fcm_status add_obstacle(fcm_integrator *I, sim_contact *c, const fcm_cont
             FCM_ERR_ARG,
             "contact %s %d: friction_velocity = %g must be finite and >= 0 (0: the default)", kn, k,
             c->opts.friction_velocity);
+  FCM_CHECK(c->opts.friction_updates >= 0 && c->opts.friction_updates <= 20, ctx, FCM_ERR_ARG,
+            "contact %s %d: friction_updates = %d must be in [0, 20]", kn, k,
+            c->opts.friction_updates);
   FCM_CHECK(c->kind != SIM_CONTACT_BODIES || c->opts.friction == 0.0, ctx, FCM_ERR_ARG,
             "contact bodies %d: friction = %g: friction between bodies is not supported (0)", k,
             c->opts.friction);
@@ -649,6 +652,58 @@ void fcm__sim_contact_pull_back(fcm_integrator *I)
   I->contact_pullbacks++;
 }
 
+/* Every embedded-surface point within d^ of an obstacle at the state x and time t: its
+ * element, position and the distance's gradient, for the static rigid-mode check (the
+ * barrier's Newton matrix holds the point along that gradient). */
+fcm_status fcm__sim_contact_support(fcm_integrator *I, const double *x, double t,
+                                    void (*fn)(void *user, fcm_index elem, const double y[3],
+                                               const double g[3]),
+                                    void *user)
+{
+  fcm_status st = FCM_OK;
+  fcm__idbuf buf = {NULL, 0, 0};
+  const sim_cpoints *cp = &I->cp;
+  const int nn = I->space->nn;
+  double ue[3 * FCM_ELEMENT_MAX_NODES];
+  for (fcm_index k = 0; k < cp->nelem; k++) {
+    gather(I->space, cp->elem[k], x, ue);
+    for (fcm_index p = cp->ptr[k]; p < cp->ptr[k + 1]; p++) {
+      double y[3], d, g[3];
+      point_position(cp, nn, p, ue, y);
+      for (int c = 0; c < I->num_contacts; c++) {
+        const sim_contact *ct = &I->contacts[c];
+        sim_pose P;
+        if (ct->kind == SIM_CONTACT_BODIES) continue;
+        fcm__sim_contact_pose(ct, t, &P);
+        FCM_TRY(I->ctx,
+                fcm__sim_contact_distance(I->ctx, ct, &P, y, t, ct->dhat, &buf, &d, g, NULL));
+        if (d > 0.0 && d < ct->dhat) fn(user, cp->elem[k], y, g);
+      }
+    }
+  }
+cleanup:
+  fcm__geom_idbuf_free(I->ctx, &buf);
+  return st;
+}
+
+/* The smallest signed distance to any obstacle or other body at the state just accepted,
+ * folded into the step's running minimum (the last substep's state is the current one, which
+ * fcm_integrator_contact_stats() measures itself). */
+fcm_status fcm__sim_contact_track(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  double dmin = HUGE_VAL;
+  for (int c = 0; c < I->num_contacts; c++) {
+    double d = HUGE_VAL;
+    FCM_TRY(I->ctx, fcm_integrator_contact_info(I, c, NULL, &d, NULL, NULL));
+    dmin = FCM_MIN(dmin, d);
+  }
+  I->contact_dmin_inner = I->contact_inner_states > 0 ? FCM_MIN(I->contact_dmin_inner, dmin) : dmin;
+  I->contact_inner_states++;
+cleanup:
+  return st;
+}
+
 fcm_status fcm_integrator_contact_info(const fcm_integrator *I, int id, double force[3],
                                        double *min_distance, double *dhat, double *kappa)
 {
@@ -791,7 +846,8 @@ fcm_status fcm_integrator_contact_stats(const fcm_integrator *I, fcm_contact_sta
   fcm_ctx *ctx = I->ctx;
   memset(out, 0, sizeof *out);
   out->evaluations = I->contact_evals;
-  out->min_distance = HUGE_VAL;
+  out->friction_updates = I->cp.relags;
+  out->min_distance = out->step_min_distance = HUGE_VAL;
   if (!I->is_setup || I->num_contacts == 0) return FCM_OK;
   {
     const sim_cpoints *cp = &I->cp;
@@ -802,6 +858,9 @@ fcm_status fcm_integrator_contact_stats(const fcm_integrator *I, fcm_contact_sta
       FCM_TRY(ctx, fcm_integrator_contact_info(I, c, NULL, &dmin, NULL, NULL));
       out->min_distance = FCM_MIN(out->min_distance, dmin);
     }
+    out->step_min_distance = out->min_distance;
+    if (I->contact_inner_states > 0)
+      out->step_min_distance = FCM_MIN(out->step_min_distance, I->contact_dmin_inner);
     for (fcm_index k = 0; k < cp->nelem; k++) {
       gather(I->space, cp->elem[k], I->u, ue);
       if (cp->lag) gather(I->space, cp->elem[k], I->un, u0);

@@ -45,13 +45,56 @@ int fcm__sim_contact_has_friction(const fcm_integrator *I)
   return 0;
 }
 
-fcm_status fcm__sim_contact_lag(fcm_integrator *I, double h)
+/* The normal forces and tangents of every point within d^ of an obstacle with friction at
+ * the state x (obstacles placed at the substep's end); *change (may be NULL): the largest
+ * change of a normal force over the largest normal force, old or new. */
+static fcm_status lag_at(fcm_integrator *I, const double *x, double *change)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = I->ctx;
   sim_cpoints *cp = &I->cp;
   const int nn = I->space->nn, nc = I->num_contacts;
-  double ue[3 * FCM_ELEMENT_MAX_NODES];
+  double ue[3 * FCM_ELEMENT_MAX_NODES], dmax = 0.0, lmax = 0.0;
+  for (fcm_index k = 0; k < cp->nelem; k++) {
+    const fcm_index *ed = I->space->elem_dof + cp->elem[k] * nn;
+    for (int a = 0; a < nn; a++)
+      memcpy(ue + 3 * a, x + ed[a], 3 * sizeof(double));
+    for (fcm_index p = cp->ptr[k]; p < cp->ptr[k + 1]; p++) {
+      const double *N = cp->N + (size_t)p * nn;
+      double y[3];
+      for (int i = 0; i < 3; i++)
+        y[i] = cp->X[3 * p + i];
+      for (int a = 0; a < nn; a++)
+        for (int i = 0; i < 3; i++)
+          y[i] += N[a] * ue[3 * a + i];
+      for (int c = 0; c < nc; c++) {
+        const sim_contact *ct = &I->contacts[c];
+        double d, g[3], *L = cp->lag + 7 * ((size_t)p * nc + c), old = L[0];
+        if (!(ct->opts.friction > 0.0)) continue;
+        memset(L, 0, 7 * sizeof *L);
+        FCM_TRY(ctx, fcm__sim_contact_distance(ctx, ct, &cp->pose[c], y, I->bc_time, ct->dhat,
+                                               &cp->buf, &d, g, NULL));
+        if (d > 0.0 && d < ct->dhat) {
+          const double r = d - ct->dhat, b1 = -2.0 * r * log(d / ct->dhat) - r * r / d;
+          L[0] = cp->w[p] * ct->kappa * fabs(b1);
+          tangent_basis(g, L + 1);
+        }
+        dmax = FCM_MAX(dmax, fabs(L[0] - old));
+        lmax = FCM_MAX(lmax, FCM_MAX(L[0], old));
+      }
+    }
+  }
+  if (change) *change = lmax > 0.0 ? dmax / lmax : 0.0;
+cleanup:
+  return st;
+}
+
+fcm_status fcm__sim_contact_lag(fcm_integrator *I, double h)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  sim_cpoints *cp = &I->cp;
+  const int nc = I->num_contacts;
   for (int c = 0; c < nc; c++) /* contact between bodies: who starts near whom */
     if (I->contacts[c].kind == SIM_CONTACT_BODIES)
       FCM_TRY(ctx, fcm__sim_bodies_prepare(I, &I->contacts[c], I->un));
@@ -63,31 +106,25 @@ fcm_status fcm__sim_contact_lag(fcm_integrator *I, double h)
     fcm__sim_contact_pose(&I->contacts[c], cp->t0, &cp->pose0[c]);
   }
   memset(cp->lag, 0, sizeof(double) * 7 * (size_t)cp->np * (size_t)nc);
-  for (fcm_index k = 0; k < cp->nelem; k++) {
-    const fcm_index *ed = I->space->elem_dof + cp->elem[k] * nn;
-    for (int a = 0; a < nn; a++)
-      memcpy(ue + 3 * a, I->un + ed[a], 3 * sizeof(double));
-    for (fcm_index p = cp->ptr[k]; p < cp->ptr[k + 1]; p++) {
-      const double *N = cp->N + (size_t)p * nn;
-      double y[3];
-      for (int i = 0; i < 3; i++)
-        y[i] = cp->X[3 * p + i];
-      for (int a = 0; a < nn; a++)
-        for (int i = 0; i < 3; i++)
-          y[i] += N[a] * ue[3 * a + i];
-      for (int c = 0; c < nc; c++) {
-        const sim_contact *ct = &I->contacts[c];
-        double d, g[3], *L = cp->lag + 7 * ((size_t)p * nc + c);
-        if (!(ct->opts.friction > 0.0)) continue;
-        FCM_TRY(ctx, fcm__sim_contact_distance(ctx, ct, &cp->pose[c], y, I->bc_time, ct->dhat,
-                                               &cp->buf, &d, g, NULL));
-        if (!(d > 0.0) || d >= ct->dhat) continue;
-        const double r = d - ct->dhat, b1 = -2.0 * r * log(d / ct->dhat) - r * r / d;
-        L[0] = cp->w[p] * ct->kappa * fabs(b1);
-        tangent_basis(g, L + 1);
-      }
-    }
-  }
+  FCM_TRY(ctx, lag_at(I, I->un, NULL));
+cleanup:
+  return st;
+}
+
+int fcm__sim_contact_updates(const fcm_integrator *I)
+{
+  int k = 0;
+  if (!I->cp.lag || !(I->cp.hstep > 0.0)) return 0; /* no friction, or static */
+  for (int c = 0; c < I->num_contacts; c++)
+    if (I->contacts[c].opts.friction > 0.0) k = FCM_MAX(k, I->contacts[c].opts.friction_updates);
+  return k;
+}
+
+fcm_status fcm__sim_contact_relag(fcm_integrator *I, double *change)
+{
+  fcm_status st = FCM_OK;
+  FCM_TRY(I->ctx, lag_at(I, I->u, change));
+  I->cp.relags++;
 cleanup:
   return st;
 }

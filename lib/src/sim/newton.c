@@ -443,9 +443,9 @@ static void monitor(const fcm_integrator *I, double t1, int it, double r, double
 static fcm_status newton_start(fcm_integrator *I, double h, eval_out *cur, sim_stats *stats)
 {
   fcm_status st = FCM_OK;
-  if (h > 0.0) fcm__sim_scheme_predict(I, h);
+  if (h > 0.0 && !I->newton_resume) fcm__sim_scheme_predict(I, h);
   fcm__sim_hanging_fill(I, I->u); /* continuous: hanging DOFs follow their masters */
-  if (I->num_contacts > 0) {
+  if (I->num_contacts > 0 && !I->newton_resume) {
     FCM_TRY(I->ctx, fcm__sim_contact_lag(I, h)); /* friction's normal forces and tangents */
     fcm__sim_contact_pull_back(I);
   }
@@ -765,6 +765,18 @@ static fcm_status run_substep(fcm_integrator *I, int dyn, double h, double t1,
   if (*reason == FCM_STEP_NONE && dyn && I->fstep) FCM_TRY(I->ctx, fcm__sim_scheme_begin(I));
   if (*reason == FCM_STEP_NONE)
     FCM_TRY(I->ctx, fcm__sim_newton(I, h, t1, reason, residual, tol, ref, stats));
+  /* friction's fixed point: the normal forces and tangents at the converged state, and Newton
+   * again from it, until they settle */
+  for (int k = 0, nk = I->num_contacts > 0 ? fcm__sim_contact_updates(I) : 0;
+       k < nk && (*reason == FCM_STEP_CONVERGED); k++) {
+    double change = 0.0;
+    FCM_TRY(I->ctx, fcm__sim_contact_relag(I, &change));
+    if (change <= 1e-3) break;
+    I->newton_resume = 1;
+    st = fcm__sim_newton(I, h, t1, reason, residual, tol, ref, stats);
+    I->newton_resume = 0;
+    FCM_TRY(I->ctx, st);
+  }
 cleanup:
   return st;
 }
@@ -913,6 +925,7 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
   FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
   FCM_CHECK(I->is_setup, I->ctx, FCM_ERR_ARG, "integrator: call fcm_integrator_setup() first");
   if (I->num_contacts > 0) FCM_TRY(I->ctx, fcm__sim_contact_check(I, I->u, I->t));
+  I->contact_inner_states = 0;
   {
     const fcm_integrator_options *o = &I->opts;
     fcm_index n = I->n;
@@ -968,6 +981,11 @@ fcm_status fcm_integrator_step(fcm_integrator *I, fcm_step_info *info)
         if (dyn) fcm__sim_scheme_update(I, h);
         done += size;
         info->substeps++;
+        /* the contact's smallest distance over every accepted state of the step */
+        if (I->num_contacts > 0 && done < units) {
+          st = fcm__sim_contact_track(I);
+          if (st != FCM_OK) break;
+        }
         reason = done < units ? FCM_STEP_NONE : reason;
         continue;
       }

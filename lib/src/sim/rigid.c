@@ -9,11 +9,14 @@
  * holds a mode: a constrained DOF where the mode moves (component i at node X: the row
  * (e_i, (e_m x (X - c))_i for m = x, y, z)), and an embedded-boundary point of a boundary
  * constraint (Nitsche or penalty: the same row at the point, whose energy there is
- * gamma/2 |P_c u|^2 > 0 for a moving rigid mode). The modes that no row holds are the null
- * space of the 6 x 6 Gram matrix of the rows: a body is free when that matrix is singular
- * (eigenvalues below RIGID_TOL of the largest; exactly collinear points give rounding-level
- * values, about 1e-16). Partial constraints (some components only) are covered by the same
- * rank. A copy the space's small-copy constraint moved onto another node's copy
+ * gamma/2 |P_c u|^2 > 0 for a moving rigid mode), and an embedded-surface point within the
+ * threshold d^ of a contact obstacle at the step's start (the row of its distance's gradient g,
+ * (g, y x g): the barrier's Newton matrix w kappa b''(d) g g^T > 0 holds the modes that move it
+ * along g; a body beyond every threshold is not held by the obstacles). The modes that no row holds
+ * are the null space of the 6 x 6 Gram matrix of the rows: a body is free when that matrix is
+ * singular (eigenvalues below RIGID_TOL of the largest; exactly collinear points give
+ * rounding-level values, about 1e-16). Partial constraints (some components only) are covered by
+ * the same rank. A copy the space's small-copy constraint moved onto another node's copy
  * (fcm_space_options.constrain_ratio) follows translations exactly but not rotations: a body
  * with such an element has only its translations checked (its rotations meet a stiffness of
  * that fragment, tiny but not zero). So a refused system is singular — a free mode is an
@@ -38,6 +41,7 @@ typedef struct rigid_body {
   fcm_index rows[3];    /* constrained rows per component (translations held: rows > 0) */
   fcm_index full, part; /* nodes held in all / in some components */
   fcm_index bpoints;    /* boundary-constraint points */
+  fcm_index cpoints;    /* surface points within the barrier's reach of a contact obstacle */
   int tied;             /* an element uses another node's copy (translations only) */
 } rigid_body;
 
@@ -56,6 +60,26 @@ static void add_row(rigid_body *b, int i, const double X[3], const double c[3], 
     for (int q = 0; q < 6; q++)
       b->G[p + 6 * q] += r[p] * r[q];
   b->rows[i]++;
+}
+
+/* Add the row of the direction g (unit) at the point X: the rigid mode's velocity along g,
+ * (g, y x g) with y = (X - c) / L (a contact barrier's stiffness acts along its distance's
+ * gradient). */
+static void add_direction_row(rigid_body *b, const double g[3], const double X[3],
+                              const double c[3], double L)
+{
+  double r[6], y[3];
+  for (int d = 0; d < 3; d++)
+    y[d] = (X[d] - c[d]) / L;
+  r[0] = g[0], r[1] = g[1], r[2] = g[2];
+  r[3] = y[1] * g[2] - y[2] * g[1];
+  r[4] = y[2] * g[0] - y[0] * g[2];
+  r[5] = y[0] * g[1] - y[1] * g[0];
+  for (int p = 0; p < 6; p++)
+    for (int q = 0; q < 6; q++)
+      b->G[p + 6 * q] += r[p] * r[q];
+  for (int i = 0; i < 3; i++)
+    if (fabs(g[i]) > 1e-9) b->rows[i]++;
 }
 
 static void centre_scale(const rigid_body *b, double c[3], double *L)
@@ -96,7 +120,15 @@ static void held_by(char *buf, size_t n, const rigid_body *b)
   if (b->bpoints > 0)
     len += snprintf(buf + len, n - (size_t)len, "%s%lld boundary-constraint point%s",
                     len ? " and " : "", (long long)b->bpoints, b->bpoints > 1 ? "s" : "");
-  if (len == 0) snprintf(buf, n, "nothing (no constrained node, no boundary-constraint point)");
+  if (b->cpoints > 0)
+    len += snprintf(buf + len, n - (size_t)len,
+                    "%s%lld surface point%s within a contact "
+                    "obstacle's threshold",
+                    len ? " and " : "", (long long)b->cpoints, b->cpoints > 1 ? "s" : "");
+  if (len == 0)
+    snprintf(buf, n,
+             "nothing (no constrained node, no boundary-constraint point, no surface point "
+             "within a contact obstacle's threshold)");
 }
 
 /* Free modes of body b: *ft free translations, *fr free rotations; for a single free
@@ -259,6 +291,18 @@ static void node_rows(fcm_integrator *I, rigid_work *w)
     }
 }
 
+/* A surface point within d^ of a contact obstacle (fcm__sim_contact_support()): the
+ * barrier's Newton matrix w kappa b''(d) g g^T holds the modes that move the point along g. */
+static void contact_row(void *user, fcm_index elem, const double y[3], const double g[3])
+{
+  rigid_work *w = user;
+  rigid_body *b = &w->B[w->elem_body[elem]];
+  double c[3], L;
+  centre_scale(b, c, &L);
+  add_direction_row(b, g, y, c, L);
+  b->cpoints++;
+}
+
 fcm_status fcm__sim_check_rigid_modes(fcm_integrator *I, double t)
 {
   fcm_status st = FCM_OK;
@@ -269,6 +313,7 @@ fcm_status fcm__sim_check_rigid_modes(fcm_integrator *I, double t)
   st = sum_boundary(I, st, &w);
   FCM_TRY(ctx, st);
   node_rows(I, &w);
+  if (I->num_contacts > 0) FCM_TRY(ctx, fcm__sim_contact_support(I, I->u, t, contact_row, &w));
   fcm_index bad = -1, nbad = 0;
   int ft = 0, fr = 0;
   double p[3] = {0, 0, 0}, a[3] = {0, 0, 0};
@@ -303,7 +348,8 @@ fcm_status fcm__sim_check_rigid_modes(fcm_integrator *I, double t)
               "[%.6g, %.6g]) is held by %s, which leaves %s free%s%s, and a static step has no "
               "inertia to hold them. Fix 3 non-collinear points of every body in all "
               "components (fixed or motion regions), hold part of its surface (a boundary "
-              "constraint), or run it dynamically",
+              "constraint), start it within the threshold of contact obstacles that hold it, "
+              "or run it dynamically",
               t, (long long)bad, (long long)w.nb, b->lo[0], b->hi[0], b->lo[1], b->hi[1], b->lo[2],
               b->hi[2], held_s, modes, axis, more);
   }

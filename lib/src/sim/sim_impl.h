@@ -107,6 +107,7 @@ typedef struct sim_cpoints {
   double *lag;           /* np x num_contacts x 7 (friction only): lambda, T (3 x 2) */
   sim_pose *pose0;       /* num_contacts (friction only): the placements at the substep's start */
   double t0, hstep;      /* the substep's start and length (friction) */
+  long long relags;      /* friction's normal forces and tangents taken anew (cumulative) */
 } sim_cpoints;
 
 /* The time scheme's constants (scheme.c): the generalized-alpha family (backward Euler: kind
@@ -154,6 +155,10 @@ struct fcm_integrator {
   long long contact_filtered;  /* Newton steps the contact filter shortened (cumulative) */
   long long contact_evals;     /* evaluations of the contact terms (cumulative) */
   long long contact_pullbacks; /* substep guesses pulled back in front of an obstacle */
+  double contact_dmin_inner;   /* smallest distance at the current step's accepted substeps
+                                  before its last (valid when contact_inner_states > 0) */
+  int contact_inner_states;
+  int newton_resume; /* the Newton solve goes on from u: no predictor, friction lag, pull-back */
 
   /* state */
   double *u, *v;
@@ -390,6 +395,11 @@ double fcm__sim_contact_step_bound(fcm_integrator *I, const double *x, const dou
  * the step bound from un (w1 holds u - un afterwards). A moving surface obstacle that
  * swallowed a point of un makes the substep's energies non-finite (cp.swallowed). */
 void fcm__sim_contact_pull_back(fcm_integrator *I);
+fcm_status fcm__sim_contact_track(fcm_integrator *I);
+fcm_status fcm__sim_contact_support(fcm_integrator *I, const double *x, double t,
+                                    void (*fn)(void *user, fcm_index elem, const double y[3],
+                                               const double g[3]),
+                                    void *user);
 fcm_status fcm__sim_contact_check(fcm_integrator *I, const double *x, double t);
 /* Friction (contact_friction.c). has_friction: an obstacle has mu > 0. lag: each point's
  * normal force and tangent basis from u_n (obstacles at bc_time), the substep's start
@@ -397,6 +407,10 @@ fcm_status fcm__sim_contact_check(fcm_integrator *I, const double *x, double t);
  * gradient and Hessian in y (written). */
 int fcm__sim_contact_has_friction(const fcm_integrator *I);
 fcm_status fcm__sim_contact_lag(fcm_integrator *I, double h);
+/* Friction's fixed-point updates per substep (0: none, static, or frictionless) and one update
+ * at the current state (*change: the largest normal force's relative change). */
+int fcm__sim_contact_updates(const fcm_integrator *I);
+fcm_status fcm__sim_contact_relag(fcm_integrator *I, double *change);
 double fcm__sim_contact_friction(const fcm_integrator *I, fcm_index p, const double y[3],
                                  const double y0[3], double grad[3], double hess[9]);
 /* The work of point p's friction forces over its slip from y0 to y: sum of mu lambda f1 |s|. */
