@@ -7,7 +7,7 @@ dir=$(dirname "$0"); out=${TMPDIR:-/tmp}/fcm_dick_table1
 levels=${*:-2 3}
 for L in $levels; do for kind in octree uniform; do for sol in direct multigrid; do
   name=dick_table1_${kind}_L${L}_${sol}
-  /usr/bin/time -v "$sim" "$dir/$name.json" -q -o "$out/$name" > "$out.$name.txt" 2>&1 \
+  /usr/bin/time -v "$sim" "$dir/$name.json" -o "$out/$name" > "$out.$name.txt" 2>&1 \
     || echo "$name: failed (exit $?), see $out.$name.txt"
   echo "== $name"
   grep -E 'DOFs|octree background|^  cells|computed  iterations|body      max|time \[s\]|step      \[s\]|Maximum resident' "$out.$name.txt"
