@@ -266,18 +266,24 @@ static int stack(fcm_ctx *ctx)
   return 0;
 }
 
-static int dice(fcm_ctx *ctx, const char *dir)
+/* DIR/NAME as a scene and its simulation; both NULL (the failure recorded) when either fails. */
+static void open_scene(fcm_ctx *ctx, const char *dir, const char *name, fcm_scene **scene,
+                       fcm_simulation **sim)
 {
   char path[1024];
-  fcm_scene *scene = NULL;
-  fcm_simulation *sim = NULL;
-  snprintf(path, sizeof path, "%s/dice_on_floor.json", dir);
-  TEST_OK(ctx, fcm_scene_create_from_file(ctx, path, &scene));
-  if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
-  if (!sim) {
-    fcm_scene_destroy(&scene);
-    return 0;
-  }
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  *scene = NULL, *sim = NULL;
+  TEST_OK(ctx, fcm_scene_create_from_file(ctx, path, scene));
+  if (*scene) TEST_OK(ctx, fcm_simulation_create(ctx, *scene, NULL, sim));
+  if (!*sim) fcm_scene_destroy(scene);
+}
+
+static int dice(fcm_ctx *ctx, const char *dir)
+{
+  fcm_scene *scene;
+  fcm_simulation *sim;
+  open_scene(ctx, dir, "dice_on_floor.json", &scene, &sim);
+  if (!sim) return 0;
   double e0 = 0.0, emax = -HUGE_VAL, wmax = 0.0, depth = 0.0, dfloor = HUGE_VAL, dstep = HUGE_VAL;
   long long pairs = 0;
   int steps = 0;
@@ -326,16 +332,10 @@ static int dice(fcm_ctx *ctx, const char *dir)
  * rests; the sides of the cut start in contact, so the penalty on the lagged gap holds it. */
 static int rest(fcm_ctx *ctx, const char *dir)
 {
-  char path[1024];
-  fcm_scene *scene = NULL;
-  fcm_simulation *sim = NULL;
-  snprintf(path, sizeof path, "%s/cut_bar_resting.json", dir);
-  TEST_OK(ctx, fcm_scene_create_from_file(ctx, path, &scene));
-  if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
-  if (!sim) {
-    fcm_scene_destroy(&scene);
-    return 0;
-  }
+  fcm_scene *scene;
+  fcm_simulation *sim;
+  open_scene(ctx, dir, "cut_bar_resting.json", &scene, &sim);
+  if (!sim) return 0;
   double depth = 0.0, dfloor = HUGE_VAL, e0 = 0.0, emax = -HUGE_VAL, wmax = 0.0, vz = 0.0;
   int steps = 0;
   while (!fcm_simulation_done(sim)) {
