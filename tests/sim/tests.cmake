@@ -82,6 +82,11 @@ fcm_add_test(sim_interactive tests/sim/interactive.c)
 foreach(el hex8 hex20)
   fcm_add_test(sim_octree_${el} tests/sim/octree.c ARGS ${el})
 endforeach()
+# Refinement during a run: mass, momentum and kinetic energy kept, the fields reproduced at the
+# old nodes, the held face's new nodes held, bad input refused.
+foreach(el hex8 hex20)
+  fcm_add_test(sim_octree_refine_${el} tests/sim/octree_refine.c ARGS ${el})
+endforeach()
 # The time schemes (backward Euler, Newmark, HHT, generalized-alpha) on a linear cantilever:
 # fitted temporal orders, Newmark's energy over 1000 steps, the contraction per step at
 # infinite frequency against rho_inf, option errors.

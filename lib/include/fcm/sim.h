@@ -409,6 +409,35 @@ FCM_API fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space,
 FCM_API fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space *space,
                                              fcm_integrator **integ);
 
+/** Continue a run on a refined background: `space` is a space (fcm_space_create(), or
+ * fcm_space_create_embedded() on rules of the same geometry) on a refinement of old's octree
+ * mesh (fcm_mesh_create_refined(): every new cell inside an old one). The new integrator has
+ * old's material, options, loads, boundary constraints (Nitsche) and contacts (the same
+ * callbacks and user pointers), and old's node constraints mapped onto the new mesh: a node
+ * is held by a constraint when the old field at its position depends only on nodes the
+ * constraint held (an old held node; a new node on an edge, a face or inside an old cell
+ * whose nodes there are all held: the motions are affine in the position, so the old
+ * constraint fixed the field there already). It is set up (mass and loads assembled on the
+ * new space) and starts from old's time, step count and load work, and its displacement,
+ * velocity and (when known) acceleration interpolated at the new nodes. The new space
+ * contains the old one (a refined octree with its hanging nodes constrained), so the fields
+ * are reproduced exactly: on a plain space (no rules) or rules that integrate the same body
+ * exactly, the mass, the linear and angular momentum and the kinetic energy are kept to
+ * rounding. Embedded rules are built anew on the finer cells, so an embedded body's
+ * quadrature changes; a new node in no active old cell (a cell the old rules dropped below
+ * min_fraction whose finer cells hold enough material) takes the old field extrapolated
+ * from the nearest old cell, counted in fcm_integrator_setup_info.refine_extrapolated.
+ * Not carried: contact state (friction anchors restart, as after a cut), the direct
+ * solver's analysis and factorization. A host simulator calls it between steps and then
+ * destroys `old` (and old's space, rules and mesh).
+ * @return FCM_OK; FCM_ERR_ARG (NULL, old not set up, other element type); FCM_ERR_UNSUPPORTED
+ *         (a space with DOF copies, i.e. after a cut: refinement is supported before the first
+ *         cut only; a distributed backend); the errors of fcm_space_locate() and
+ *         fcm_integrator_setup() (e.g. a held hanging node whose masters are free);
+ *         FCM_ERR_ALLOC. Allocates. */
+FCM_API fcm_status fcm_integrator_create_refined(const fcm_integrator *old, const fcm_space *space,
+                                                 fcm_integrator **integ);
+
 FCM_API void fcm_integrator_destroy(fcm_integrator **integ);
 
 /** Add gravity: body force rho a, times scale(t) when `scale` is given (else 1). Before
@@ -890,6 +919,9 @@ typedef struct fcm_integrator_setup_info {
   fcm_index cut_kept_elements; /**< after a cut with FCM_CUT_REUSE_BLOCKS: the elements whose
                                     mass and load blocks were kept (not integrated again);
                                     else 0 */
+  fcm_index refine_extrapolated; /**< after fcm_integrator_create_refined(): the new DOF nodes
+                                      in no active cell of the old space, whose state was
+                                      extrapolated from the nearest old cell; else 0 */
 } fcm_integrator_setup_info;
 
 /** Copy the setup counts out (zeros for NULL). */

@@ -902,6 +902,22 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__sim_copy_effects(const fcm_integrator *old, fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  for (int k = 0; st == FCM_OK && k < old->num_loads; k++) {
+    sim_load l = old->loads[k];
+    l.f = l.blk = NULL;
+    st = add_load(I, &l);
+  }
+  for (int k = 0; st == FCM_OK && k < old->num_bcons; k++)
+    st = fcm_integrator_add_boundary_constraint(I, old->bcons[k].select, old->bcons[k].select_user,
+                                                &old->bcons[k].motion, &old->bcons[k].opts, NULL);
+  for (int k = 0; st == FCM_OK && k < old->num_contacts; k++)
+    st = fcm__sim_contact_copy(I, &old->contacts[k]);
+  return st;
+}
+
 int fcm_integrator_num_constraints(const fcm_integrator *I)
 {
   return I ? I->num_cons : 0;
@@ -921,20 +937,10 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
             "integrator cut: the integrator must be set up (fcm_integrator_setup())");
   /* with a backend (fem/fem_backend.h) a local failure goes into its setup, which agrees */
   st = fcm_integrator_create(ctx, space, &old->mat, &old->opts, &I);
-  for (int k = 0; st == FCM_OK && k < old->num_loads; k++) {
-    sim_load l = old->loads[k];
-    l.f = l.blk = NULL;
-    st = add_load(I, &l);
-  }
+  if (st == FCM_OK) st = fcm__sim_copy_effects(old, I);
   for (int k = 0; st == FCM_OK && k < old->num_cons; k++)
     st = fcm_integrator_add_constraint(I, old->cons[k].num_nodes, old->cons[k].nodes,
                                        &old->cons[k].motion, NULL);
-  for (int k = 0; st == FCM_OK && k < old->num_bcons; k++)
-    st = fcm_integrator_add_boundary_constraint(I, old->bcons[k].select, old->bcons[k].select_user,
-                                                &old->bcons[k].motion, &old->bcons[k].opts, NULL);
-  for (int k = 0; st == FCM_OK && k < old->num_contacts; k++) {
-    st = fcm__sim_contact_copy(I, &old->contacts[k]);
-  }
   {
     /* the old integrator's backend for the new space (the serial one stays serial) */
     fcm__backend b;

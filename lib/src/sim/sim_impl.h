@@ -326,6 +326,9 @@ void fcm__sim_eval_loads(const fcm_integrator *I, double t, double *f);
  * skips AMD / METIS. Nothing when old has no CHOLMOD analysis or I another solver or a
  * distributed backend. @return FCM_OK, FCM_ERR_ARG (not a cut pair), FCM_ERR_ALLOC. */
 fcm_status fcm__sim_cut_ordering(const fcm_integrator *old, fcm_integrator *I);
+/* old's loads, boundary constraints and contacts added to I (not its node constraints: a cut
+ * keeps the node numbering, a refinement maps the nodes) */
+fcm_status fcm__sim_copy_effects(const fcm_integrator *old, fcm_integrator *I);
 
 /* fcm_assembly_workspace_linear() on I's space of the mass (blocks = &I->blk_mass, old_blocks
  * the cut integrator's) or a load (its blk, the old load's): with FCM_CUT_REUSE_BLOCKS on a
