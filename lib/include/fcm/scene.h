@@ -48,11 +48,16 @@ typedef struct fcm_scene_background {
                                  one cell) */
   /** GRID with "octree": the grid refined as an octree (fcm_mesh_create_octree()), 2:1
    * balanced; each level 0 = off, at most FCM_OCTREE_MAX_LEVEL. */
-  int octree;          /**< 1 when "octree" is given */
-  int octree_boundary; /**< "boundary": {"level"}: cells the embedded boundary meets */
-  int octree_region;   /**< "region": {"level"}: cells meeting the box below */
-  int octree_cuts;     /**< "cuts": {"level"}: cells the cut effects' surfaces meet (before the
-                            cuts apply) */
+  int octree;             /**< 1 when "octree" is given */
+  int octree_boundary;    /**< "boundary": {"level"}: cells the embedded boundary meets */
+  int octree_region;      /**< "region": {"level"}: cells meeting the box below */
+  int octree_cuts;        /**< "cuts": {"level"}: cells the cut effects' surfaces meet (before the
+                               cuts apply) */
+  int octree_cuts_at_cut; /**< "cuts": {"when"}: 0 "setup" (default): the grid is built refined
+                               along the cuts; 1 "cut": the run starts on the grid without
+                               that refinement and refines along every cut's surface when the
+                               first cut applies, just before it (the state carried by
+                               fcm_integrator_create_refined()) */
   double octree_region_min[3], octree_region_max[3]; /**< "region": {"min", "max"} */
 } fcm_scene_background;
 

@@ -64,14 +64,17 @@ cleanup:
 }
 
 /* "octree": {"boundary": {"level": L}, "region": {"min", "max", "level": L}, "cuts": {"level":
- * L}}: the grid refined as an octree along the embedded boundary, in a box and along the cut
- * effects' surfaces. */
+ * L, "when": "setup" | "cut"}}: the grid refined as an octree along the embedded boundary, in a
+ * box and along the cut effects' surfaces (at set-up, or during the run when the first cut
+ * applies). */
 static fcm_status read_octree(fcm__scene_parser *p, const fcm__json *o, fcm_scene_background *b)
 {
   fcm_status st = FCM_OK;
   static const char *const keys[] = {"boundary", "region", "cuts"};
   static const char *const bkeys[] = {"level"};
   static const char *const rkeys[] = {"min", "max", "level"};
+  static const char *const ckeys[] = {"level", "when"};
+  static const char *const when[] = {"setup", "cut"};
   const fcm__json *oct = NULL, *bnd = NULL, *reg = NULL, *cuts = NULL;
   long long level = 0;
   size_t old = p->path_len;
@@ -106,9 +109,12 @@ static fcm_status read_octree(fcm__scene_parser *p, const fcm__json *o, fcm_scen
   FCM_TRY(p->ctx, fcm__scene_read_object(p, oct, "cuts", 0, &cuts));
   if (cuts) {
     size_t o2 = SCENE_ENTER(p, "cuts");
-    FCM_TRY(p->ctx, fcm__scene_check_object(p, cuts, bkeys, SCENE_COUNT(bkeys)));
+    FCM_TRY(p->ctx, fcm__scene_check_object(p, cuts, ckeys, SCENE_COUNT(ckeys)));
     FCM_TRY(p->ctx, fcm__scene_read_int(p, cuts, "level", 1, 1, FCM_OCTREE_MAX_LEVEL, &level));
     b->octree_cuts = (int)level;
+    b->octree_cuts_at_cut = 0;
+    FCM_TRY(p->ctx, fcm__scene_read_choice(p, cuts, "when", 0, when, SCENE_COUNT(when),
+                                           &b->octree_cuts_at_cut));
     fcm__scene_path_pop(p, o2);
   }
 cleanup:

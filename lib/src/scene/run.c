@@ -329,6 +329,113 @@ cleanup:
   return st;
 }
 
+/* The octree mesh refined along the surfaces `surf` (n, NULL entries skipped) to `level`:
+ * the cells a surface meets split until they reach it (2:1 balanced each pass); *out NULL when
+ * no cell needs it. */
+static fcm_status refine_along(fcm_simulation *S, fcm_surface **surf, int n, int level,
+                               fcm_mesh **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  unsigned char *flags = NULL;
+  fcm_mesh *mesh = NULL, *next = NULL;
+  double X[3 * FCM_ELEMENT_MAX_NODES];
+  *out = NULL;
+  for (int pass = 0; pass < level; pass++) {
+    const fcm_mesh *m = mesh ? mesh : S->mesh;
+    const fcm_index nc = fcm_mesh_num_cells(m);
+    const int npc = fcm_mesh_nodes_per_cell(m);
+    fcm_index count = 0;
+    FCM_FREE(ctx, flags);
+    FCM_ALLOC(ctx, (size_t)nc + 1, flags);
+    for (fcm_index c = 0; c < nc; c++) {
+      const int lev = fcm_mesh_cell_level(m, c);
+      double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+      if (lev >= level) continue;
+      fcm_mesh_cell_coords(m, c, X);
+      for (int a = 0; a < npc; a++)
+        for (int d = 0; d < 3; d++)
+          lo[d] = fmin(lo[d], X[3 * a + d]), hi[d] = fmax(hi[d], X[3 * a + d]);
+      for (int k = 0; k < n && !flags[c]; k++)
+        flags[c] = surf[k] && fcm_surface_meets_box(lo, hi, lev, surf[k]) > 0;
+      count += flags[c];
+    }
+    if (count == 0) break;
+    FCM_TRY(ctx, fcm_mesh_create_refined(ctx, m, flags, &next));
+    fcm_mesh_destroy(&mesh);
+    mesh = next;
+    next = NULL;
+  }
+  *out = mesh;
+  mesh = NULL;
+cleanup:
+  fcm__free(ctx, flags);
+  fcm_mesh_destroy(&mesh);
+  return st;
+}
+
+/* "octree": {"cuts": {"when": "cut"}}: before the first cut, the background refined along
+ * every cut's surface, the rules, space and integrator built on it and the state carried over
+ * (fcm_integrator_create_refined()). */
+static fcm_status refine_for_cuts(fcm_simulation *S)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  const fcm_scene_background *bg = fcm_scene_get_background(S->scene);
+  fcm_surface **surf = NULL;
+  fcm_mesh *mesh = NULL, *old_mesh = S->mesh;
+  fcm_cell_rules *old_rules = S->rules;
+  fcm_space *space = NULL;
+  fcm_integrator *integ = NULL;
+  const double t0 = fcm_wtime();
+  S->refined = 1;
+  FCM_CHECK(!S->distributed, ctx, FCM_ERR_UNSUPPORTED,
+            "background.octree.cuts.when: \"cut\" (refinement during the run) is not supported "
+            "in a distributed run; use \"setup\"");
+  FCM_ALLOC(ctx, (size_t)S->num_cuts, surf);
+  for (int k = 0; k < S->num_cuts; k++)
+    FCM_TRY(ctx, fcm__sim_cut_surface(S, &S->cuts[k]->cut, &surf[k]));
+  FCM_TRY(ctx, refine_along(S, surf, S->num_cuts, bg->octree_cuts, &mesh));
+  S->refined_at = fcm_integrator_time(S->integ);
+  S->refine_cells[0] = S->refine_cells[1] = fcm_mesh_num_cells(S->mesh);
+  if (!mesh) goto cleanup;
+  S->mesh = mesh;
+  S->rules = NULL;
+  st = build_rules(S);
+  if (st == FCM_OK) st = create_space(S, S->rules, NULL, &space);
+  if (st == FCM_OK) st = fcm_integrator_create_refined(S->integ, space, &integ);
+  if (st != FCM_OK) { /* back to the run as it was */
+    fcm_cell_rules_destroy(&S->rules);
+    S->mesh = old_mesh, S->rules = old_rules;
+    fcm__sim_name_section(ctx, "background.octree.cuts");
+    goto cleanup;
+  }
+  fcm_integrator_destroy(&S->integ);
+  fcm_space_destroy(&S->space);
+  fcm_cell_rules_destroy(&old_rules);
+  fcm_mesh_destroy(&old_mesh);
+  S->integ = integ, S->space = space;
+  integ = NULL, space = NULL;
+  S->refine_cells[1] = fcm_mesh_num_cells(S->mesh);
+  S->c.num_dofs = fcm_space_num_dofs(S->space);
+  S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);
+  S->pieces = S->c.pieces = fcm_space_num_bodies(S->space);
+  if (S->surf) {
+    fcm_embedded_surface_destroy(&S->surf);
+    FCM_TRY(ctx, build_surface(S));
+  }
+  FCM_TRY(ctx, build_log_blocks(S));
+cleanup:
+  S->refine_seconds = fcm_wtime() - t0;
+  for (int k = 0; surf && k < S->num_cuts; k++)
+    fcm_surface_destroy(&surf[k]);
+  fcm__free(ctx, surf);
+  fcm_integrator_destroy(&integ);
+  fcm_space_destroy(&space);
+  if (S->mesh != mesh) fcm_mesh_destroy(&mesh);
+  return st;
+}
+
 fcm_status fcm__sim_apply_cut(fcm_simulation *S)
 {
   fcm_status st = FCM_OK;
@@ -341,6 +448,8 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   const double t0 = fcm_wtime();
   const int k = S->cuts_applied;
   S->cut_phase[0] = S->cut_phase[1] = S->cut_phase[2] = 0.0;
+  if (k == 0 && !S->refined && fcm_scene_get_background(S->scene)->octree_cuts_at_cut)
+    FCM_TRY(ctx, refine_for_cuts(S));
   /* A distributed run (the integrator has a backend, sim_backend.h): the rules keep the
    * process's cell mask, the new integrator gets the backend again (its cut hook, which
    * agrees first), and fcm__integrator_finish() at the end agrees on the outcome, so a

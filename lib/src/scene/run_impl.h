@@ -106,6 +106,11 @@ struct fcm_simulation {
                           to the counters' time_cut_*) */
   fcm_index pieces;    /* separate bodies of the current space (fcm_space_num_bodies()) */
   long long base_factorizations, base_analyses, base_fallbacks; /* of integrators before cuts */
+  /* "octree": {"cuts": {"when": "cut"}}: the refinement along the cuts done when the first cut
+   * applied: the time, the cells before and after, the wall time (refined 0: not yet) */
+  int refined;
+  double refined_at, refine_seconds;
+  fcm_index refine_cells[2];
   fcm_index base_dofs, base_constrained; /* DOFs and constrained DOFs before any cut (the
                                             checkpoint fingerprint) */
   /* log */

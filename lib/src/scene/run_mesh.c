@@ -306,7 +306,9 @@ static fcm_status create_grid(fcm_simulation *S, const fcm_scene_background *bg,
                               const double min[3], const double max[3], const fcm_index cells[3])
 {
   fcm_status st = FCM_OK;
-  grid_refine g = {S->geom, bg->octree_boundary, bg->octree_cuts, 0, NULL};
+  /* "when": "cut": the cuts' refinement waits for the first cut (run.c) */
+  const int cut_level = bg->octree_cuts_at_cut ? 0 : bg->octree_cuts;
+  grid_refine g = {S->geom, bg->octree_boundary, cut_level, 0, NULL};
   if (!bg->octree) return fcm_mesh_create_box(S->ctx, bg->element, min, max, cells, &S->mesh);
   fcm_octree_options o = fcm_octree_options_default();
   o.region_level = bg->octree_region;
@@ -314,7 +316,7 @@ static fcm_status create_grid(fcm_simulation *S, const fcm_scene_background *bg,
     o.region_lo[d] = bg->octree_region_min[d];
     o.region_hi[d] = bg->octree_region_max[d];
   }
-  if (bg->octree_cuts > 0) {
+  if (cut_level > 0) {
     const int n = fcm_scene_count_effects(S->scene, FCM_EFFECT_CUT);
     FCM_ALLOC(S->ctx, (size_t)n, g.cuts);
     for (int k = 0; k < fcm_scene_num_effects(S->scene); k++) {
@@ -329,8 +331,8 @@ static fcm_status create_grid(fcm_simulation *S, const fcm_scene_background *bg,
       }
     }
   }
-  if (bg->octree_boundary > 0 || bg->octree_cuts > 0) {
-    o.refine_level = FCM_MAX(bg->octree_boundary, bg->octree_cuts);
+  if (bg->octree_boundary > 0 || cut_level > 0) {
+    o.refine_level = FCM_MAX(bg->octree_boundary, cut_level);
     o.refine = grid_refine_fn;
     o.refine_user = &g;
   }

@@ -361,8 +361,14 @@ static void octree_line(const fcm_simulation *S, FILE *f)
   for (int l = 0; l <= top && len < (int)sizeof b; l++)
     len += snprintf(b + len, sizeof b - (size_t)len, " %lld", per_level[l]);
   if (len < (int)sizeof b)
-    snprintf(b + len, sizeof b - (size_t)len, "; %lld hanging (cell, node) pairs",
-             (long long)fcm_mesh_num_hanging(S->mesh));
+    len += snprintf(b + len, sizeof b - (size_t)len, "; %lld hanging (cell, node) pairs",
+                    (long long)fcm_mesh_num_hanging(S->mesh));
+  if (S->refined && len < (int)sizeof b) /* "cuts": {"when": "cut"} */
+    snprintf(b + len, sizeof b - (size_t)len,
+             "; refined along the cuts at t = %g s, before the first cut: %lld -> %lld cells "
+             "(%.2f s)",
+             S->refined_at, (long long)S->refine_cells[0], (long long)S->refine_cells[1],
+             S->refine_seconds);
   line(f, 1, "octree background", b);
 }
 

@@ -164,8 +164,9 @@ void fcm_scene_view(const fcm_scene *s, FILE *f)
               b->octree_region_min[1], b->octree_region_max[1], b->octree_region_min[2],
               b->octree_region_max[2], b->octree_region);
     if (b->octree_cuts)
-      fprintf(f, "%s along the cut surfaces to level %d",
-              b->octree_boundary || b->octree_region ? ";" : "", b->octree_cuts);
+      fprintf(f, "%s along the cut surfaces to level %d%s",
+              b->octree_boundary || b->octree_region ? ";" : "", b->octree_cuts,
+              b->octree_cuts_at_cut ? " when the first cut applies (during the run)" : "");
     fprintf(f, "\n");
   }
   fprintf(f, "geometry: ");
