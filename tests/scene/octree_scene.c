@@ -3,7 +3,10 @@
  * refused naming the key (tetrahedra, a boundary criterion without a geometry, an octree over a
  * mesh file, no criterion, a level beyond the limit, refinement along cuts without cut effects);
  * a scene with an octree background builds and runs a step with the cells of every level it
- * asked for, and one refined along a cut and the boundary cuts the ball in two during the run. */
+ * asked for, and one refined along a cut and the boundary cuts the ball in two during the run;
+ * with "cuts": {"when": "cut"} (Hex8, Hex20) the refinement along the cut happens during the
+ * run, just before the cut, which then applies on the refined background; a bad "when" and an
+ * unknown key refused. */
 #include "scene_util.h"
 
 #include "fcm/simulation.h"
@@ -12,6 +15,8 @@
 #define CUT                                                                                        \
   "{\"cut\": {\"time\": 0.005, \"surface\": {\"plane\": {\"point\": [0.03, 0, 0], "                \
   "\"normal\": [1, 0.1, 0]}}}}"
+#define HOLD                                                                                       \
+  "{\"fixed\": {\"region\": {\"half_space\": {\"point\": [-0.3, 0, 0], \"normal\": [-1, 0, 0]}}}}"
 #define REST                                                                                       \
   "\"material\": {\"model\": \"snh\", \"young\": 1e5, \"poisson\": 0.3, \"density\": 1000}, "      \
   "\"output\": {\"directory\": \"out\"}, \"time\": {\"dt\": 0.01, \"steps\": 2}"
@@ -32,6 +37,41 @@ static fcm_scene *parse(fcm_ctx *ctx, const char *element, const char *octree, c
     TEST_ERR(ctx, fcm_scene_create_from_string(ctx, text, "t.json", &s), expect, msg);
   }
   return s;
+}
+
+/* The summary of `sim` as a string (malloc'ed). */
+static char *summary(fcm_simulation *sim)
+{
+  char *text = NULL;
+  size_t len = 0;
+  FILE *f = open_memstream(&text, &len);
+  fcm_simulation_summary_view(sim, f);
+  fclose(f);
+  return text;
+}
+
+/* A scene refining along its cut when the cut applies: levels 0..1 at set-up, 0..2 after the
+ * first step (the cut at t = 0.005 applies once the run has passed it, at t = 0.01), the cut
+ * applied after the refinement, two bodies, and the run goes on. */
+static void refine_at_cut(fcm_ctx *ctx, const fcm_scene *s)
+{
+  fcm_simulation *sim = NULL;
+  TEST_TRUE(fcm_scene_get_background(s)->octree_cuts == 2);
+  TEST_TRUE(fcm_scene_get_background(s)->octree_cuts_at_cut == 1);
+  TEST_OK(ctx, fcm_simulation_create(ctx, s, NULL, &sim));
+  if (!sim) return;
+  char *text = summary(sim);
+  TEST_TRUE(text && strstr(text, "per level 0..1:") && !strstr(text, "refined along the cuts"));
+  free(text);
+  for (int k = 0; k < 2; k++)
+    TEST_OK(ctx, fcm_simulation_step(sim, NULL));
+  text = summary(sim);
+  TEST_TRUE(text && strstr(text, "per level 0..2:") &&
+            strstr(text, "refined along the cuts at t = 0.01 s, before the first cut") &&
+            strstr(text, "1 applied") && strstr(text, "2 bodies") && strstr(text, "2 of 2 steps"));
+  if (text && !strstr(text, "refined along the cuts at t = 0.01 s")) fputs(text, stderr);
+  free(text);
+  fcm_simulation_destroy(&sim);
 }
 
 int main(void)
@@ -77,6 +117,8 @@ int main(void)
             GEOM, CUT, FCM_OK, NULL);
   if (s) {
     TEST_TRUE(fcm_scene_get_background(s)->octree_cuts == 2);
+    TEST_TRUE(fcm_scene_get_background(s)->octree_cuts_at_cut == 0);
+    TEST_TRUE(strstr(fcm_scene_json(s), "\"setup\"") != NULL); /* the default, normalized */
     fcm_simulation *sim = NULL;
     TEST_OK(ctx, fcm_simulation_create(ctx, s, NULL, &sim));
     if (sim) {
@@ -95,6 +137,20 @@ int main(void)
     fcm_simulation_destroy(&sim);
     fcm_scene_destroy(&s);
   }
+  /* "when": "cut": the run starts without the cuts' refinement and refines when the first cut
+   * applies, just before it (Hex8 and Hex20, the left side held) */
+  for (int el = 0; el < 2; el++) {
+    s = parse(ctx, el ? "hex20" : "hex8",
+              "\"octree\": {\"boundary\": {\"level\": 1}, \"cuts\": {\"level\": 2, \"when\": "
+              "\"cut\"}}",
+              GEOM, HOLD ", " CUT, FCM_OK, NULL);
+    if (s) refine_at_cut(ctx, s);
+    fcm_scene_destroy(&s);
+  }
+  parse(ctx, "hex8", "\"octree\": {\"cuts\": {\"level\": 1, \"when\": \"later\"}}", GEOM, CUT,
+        FCM_ERR_ARG, "background.octree.cuts.when");
+  parse(ctx, "hex8", "\"octree\": {\"cuts\": {\"level\": 1, \"at\": 0}}", GEOM, CUT, FCM_ERR_ARG,
+        "background.octree.cuts");
   parse(ctx, "tet10", both, GEOM, "", FCM_ERR_ARG, "needs hexahedra");
   parse(ctx, "hex8", "\"octree\": {\"boundary\": {\"level\": 1}}", "", "", FCM_ERR_ARG,
         "background.octree.boundary");
