@@ -59,7 +59,7 @@ set(fcm_check_scenes spinning_body slingshot hollow_ball static_beam cantilever 
     ball_off_wedge dice_on_floor cut_bar_resting)
 list(APPEND fcm_check_scenes cutbench_tonthat_slab)
 list(APPEND fcm_check_scenes octree_cut_ball_hex8 octree_cut_ball_hex20 cutbench_dick_bunny3
-     cutbench_koschier_bunny)
+     cutbench_koschier_bunny octree_refine_cut_hex8)
 if(FCM_HAVE_GMSH)
   list(APPEND fcm_check_scenes surface_drop)
 endif()

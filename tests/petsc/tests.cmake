@@ -213,6 +213,7 @@ if(FCM_BUILD_APPS)
       octree_ball_multigrid "octree with [0-9]+ hanging .*applied by the serial solvers only"
       octree_cut_ball_hex8 "octree with [0-9]+ hanging .*applied by the serial solvers only"
       octree_cut_ball_hex20 "octree with [0-9]+ hanging .*applied by the serial solvers only"
+      octree_refine_cut_hex8 "octree with [0-9]+ hanging .*applied by the serial solvers only"
       ball_on_floor     "contact is not supported with a distributed backend"
       ball_off_wedge    "contact is not supported with a distributed backend"
       dice_on_floor     "contact is not supported with a distributed backend"
