@@ -10,7 +10,11 @@
  *   (u = T u_free, 1e-13);
  * - time, step count and load work carried; the held face's new nodes are held: more DOFs held
  *   than before, and after 2 more steps every node of the face is still at rest (exactly 0);
- * - refused: a NULL argument, an integrator not set up, a space of another element type. */
+ * - refused: a NULL argument, an integrator not set up, a space of another element type, an
+ *   integrator on a cut space (a box body cut through by a plane: DOF copies);
+ * - allocation failures (Hex8; the k-th failing, k = 0, 1, ...): FCM_ERR_ALLOC, no output, no
+ *   leak. */
+#include "alloc_loop.h"
 #include "sim_util.h"
 
 #include <string.h>
@@ -229,6 +233,84 @@ static void run(fcm_ctx *ctx, fcm_element_type type)
   fcm_mesh_destroy(&mesh);
 }
 
+typedef struct refine_case {
+  fcm_ctx *ctx;
+  const fcm_integrator *old;
+  const fcm_space *space;
+  fcm_integrator *out;
+} refine_case;
+
+static fcm_status refine_call(void *user)
+{
+  refine_case *c = user;
+  c->out = (fcm_integrator *)c; /* must be reset to NULL on failure */
+  fcm_status st = fcm_integrator_create_refined(c->old, c->space, &c->out);
+  return st != FCM_OK && c->out ? FCM_ERR_INTERNAL : st;
+}
+
+static void refine_release(void *user)
+{
+  fcm_integrator_destroy(&((refine_case *)user)->out);
+}
+
+/* The allocation loop on a failing context, and the refusal of a cut space. */
+static void alloc_and_cut(fcm_element_type type)
+{
+  failing f;
+  fcm_ctx *ctx = failing_ctx(&f);
+  TEST_TRUE(ctx != NULL);
+  if (!ctx) return;
+  fcm_mesh *mesh = NULL, *fine = NULL;
+  fcm_space *space = NULL, *fspace = NULL, *cspace = NULL;
+  fcm_integrator *integ = NULL, *cinteg = NULL, *bad = NULL;
+  fcm_geometry *body = NULL;
+  fcm_cell_rules *rules = NULL, *cut = NULL;
+  fcm_surface *plane = NULL;
+  fcm_material mat = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 1.0e5, 0.35, 800.0};
+  const double g[3] = {0.0, 0.0, -9.81};
+  TEST_OK(ctx, base_mesh(ctx, type, &mesh));
+  TEST_OK(ctx, refined_mesh(ctx, mesh, &fine));
+  TEST_OK(ctx, fcm_space_create(ctx, mesh, NULL, &space));
+  TEST_OK(ctx, fcm_space_create(ctx, fine, NULL, &fspace));
+  TEST_OK(ctx, fcm_integrator_create(ctx, space, &mat, NULL, &integ));
+  TEST_OK(ctx, fcm_integrator_add_gravity(integ, g, NULL, NULL));
+  const fcm_index held[2] = {0, 1};
+  const fcm_motion hold = fcm_motion_default();
+  TEST_OK(ctx, fcm_integrator_add_constraint(integ, 2, held, &hold, NULL));
+  TEST_OK(ctx, fcm_integrator_setup(integ));
+  refine_case c = {ctx, integ, fspace, NULL};
+  if (type == FCM_ELEMENT_HEX8) /* the same code for Hex20, only slower */
+    alloc_loop(ctx, &f, "integrator_create_refined", refine_call, refine_release, &c, 10, 4000);
+
+  const double lo[3] = {0, 0, 0}, hi[3] = {1.0, 0.5, 0.5}, clo[3] = {-1, -1, -1};
+  const double chi[3] = {2, 2, 2}, p[3] = {0.43, 0.25, 0.25}, n[3] = {1, 0.2, 0.1};
+  const fcm_index nb[3] = {1, 1, 1};
+  TEST_OK(ctx, fcm_geometry_create_box(ctx, lo, hi, nb, &body));
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, body, NULL, &rules));
+  TEST_OK(ctx, fcm_surface_create_plane(ctx, p, n, clo, chi, &plane));
+  TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, body, rules, plane, &cut));
+  TEST_OK(ctx, fcm_space_create_embedded(ctx, mesh, cut, &cspace));
+  TEST_TRUE(cspace && fcm_space_num_bodies(cspace) == 2);
+  TEST_OK(ctx, fcm_integrator_create(ctx, cspace, &mat, NULL, &cinteg));
+  TEST_OK(ctx, fcm_integrator_setup(cinteg));
+  TEST_ERR(ctx, fcm_integrator_create_refined(cinteg, fspace, &bad), FCM_ERR_UNSUPPORTED,
+           "before the first cut");
+  TEST_TRUE(bad == NULL);
+  fcm_integrator_destroy(&cinteg);
+  fcm_integrator_destroy(&integ);
+  fcm_space_destroy(&cspace);
+  fcm_space_destroy(&fspace);
+  fcm_space_destroy(&space);
+  fcm_cell_rules_destroy(&cut);
+  fcm_cell_rules_destroy(&rules);
+  fcm_surface_destroy(&plane);
+  fcm_geometry_destroy(&body);
+  fcm_mesh_destroy(&fine);
+  fcm_mesh_destroy(&mesh);
+  TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
+  fcm_ctx_destroy(&ctx);
+}
+
 int main(int argc, char **argv)
 {
   fcm_ctx *ctx = NULL;
@@ -236,6 +318,7 @@ int main(int argc, char **argv)
   if (argc != 2 || fcm_element_type_from_name(argv[1], &type) != FCM_OK) return 2;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
   run(ctx, type);
+  alloc_and_cut(type);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
