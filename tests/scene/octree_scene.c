@@ -5,8 +5,8 @@
  * a scene with an octree background builds and runs a step with the cells of every level it
  * asked for, and one refined along a cut and the boundary cuts the ball in two during the run;
  * with "cuts": {"when": "cut"} (Hex8, Hex20) the refinement along the cut happens during the
- * run, just before the cut, which then applies on the refined background; a bad "when" and an
- * unknown key refused. */
+ * run, just before the cut, which then applies on the refined background, and a checkpoint
+ * of that run restores on a new simulation; a bad "when" and an unknown key refused. */
 #include "scene_util.h"
 
 #include "fcm/simulation.h"
@@ -71,6 +71,25 @@ static void refine_at_cut(fcm_ctx *ctx, const fcm_scene *s)
             strstr(text, "1 applied") && strstr(text, "2 bodies") && strstr(text, "2 of 2 steps"));
   if (text && !strstr(text, "refined along the cuts at t = 0.01 s")) fputs(text, stderr);
   free(text);
+  /* a checkpoint of the refined, cut run restores on a new simulation (the refinement and the
+   * cut replayed onto the same space) */
+  fcm_simulation *again = NULL;
+  TEST_OK(ctx, fcm_simulation_write_checkpoint(sim, "refined.fcmck"));
+  TEST_OK(ctx, fcm_simulation_create(ctx, s, NULL, &again));
+  if (again) TEST_OK(ctx, fcm_simulation_read_checkpoint(again, "refined.fcmck"));
+  if (again) {
+    fcm_integrator *a = fcm_simulation_integrator(sim), *b = fcm_simulation_integrator(again);
+    const fcm_index n = fcm_integrator_num_dofs(a);
+    int same = n == fcm_integrator_num_dofs(b) && fcm_integrator_time(a) == fcm_integrator_time(b);
+    for (fcm_index i = 0; same && i < n; i++)
+      same = fcm_integrator_displacement(a)[i] == fcm_integrator_displacement(b)[i] &&
+             fcm_integrator_velocity(a)[i] == fcm_integrator_velocity(b)[i];
+    TEST_TRUE(same);
+    text = summary(again);
+    TEST_TRUE(text && strstr(text, "per level 0..2:") && strstr(text, "2 bodies"));
+    free(text);
+  }
+  fcm_simulation_destroy(&again);
   fcm_simulation_destroy(&sim);
 }
 
@@ -168,7 +187,8 @@ int main(void)
            FCM_ERR_ARG, "background.octree");
 
   if (chdir("/") != 0) TEST_FAIL_("cannot leave the temporary directory");
-  remove_temp_dir(dir, NULL, 0);
+  const char *files[] = {"refined.fcmck"};
+  remove_temp_dir(dir, files, 1);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();

@@ -71,8 +71,9 @@ static uint64_t fingerprint(const fcm_simulation *S)
   }
   const fcm_scene_time *tm = fcm_scene_get_time(S->scene);
   const fcm_material *mat = fcm_scene_get_material(S->scene);
-  /* sizes before any cut: a restored run re-applies the cuts the checkpoint had */
-  int64_t sizes[5] = {(int64_t)S->base_dofs, (int64_t)S->nn, (int64_t)fcm_mesh_num_cells(S->mesh),
+  /* sizes before any cut and any refinement during the run: a restored run re-applies the
+   * cuts the checkpoint had (and the refinement before the first) */
+  int64_t sizes[5] = {(int64_t)S->base_dofs, (int64_t)S->base_nodes, (int64_t)S->base_cells,
                       (int64_t)S->base_constrained, (int64_t)tm->load_steps};
   double reals[4] = {tm->dt, mat->young, mat->poisson, mat->density};
   int flags[2] = {tm->integrator == FCM_INTEGRATOR_STATIC, (int)mat->model};

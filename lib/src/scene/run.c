@@ -417,6 +417,7 @@ static fcm_status refine_for_cuts(fcm_simulation *S)
   S->integ = integ, S->space = space;
   integ = NULL, space = NULL;
   S->refine_cells[1] = fcm_mesh_num_cells(S->mesh);
+  S->nn = fcm_mesh_num_nodes(S->mesh);
   S->c.num_dofs = fcm_space_num_dofs(S->space);
   S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);
   S->pieces = S->c.pieces = fcm_space_num_bodies(S->space);
@@ -685,6 +686,8 @@ fcm_status fcm__simulation_create(fcm_ctx *ctx, const fcm_scene *scene,
                  S->c.traction_assemblies == 0;
   if (S->free_body) FCM_TRY(ctx, fcm__sim_center_of_mass(S, NULL, S->com0));
   S->base_dofs = S->c.num_dofs;
+  S->base_nodes = S->nn;
+  S->base_cells = fcm_mesh_num_cells(S->mesh);
   S->base_constrained = S->c.constrained_dofs;
   S->pieces = fcm_space_num_bodies(S->space);
   S->c.pieces = S->pieces;
