@@ -111,8 +111,8 @@ struct fcm_simulation {
   int refined;
   double refined_at, refine_seconds;
   fcm_index refine_cells[2];
-  fcm_index base_nodes, base_cells; /* the background before a refinement during the run (the
-                                       checkpoint fingerprint) */
+  fcm_index base_nodes, base_cells;      /* the background before a refinement during the run (the
+                                            checkpoint fingerprint) */
   fcm_index base_dofs, base_constrained; /* DOFs and constrained DOFs before any cut (the
                                             checkpoint fingerprint) */
   /* log */
