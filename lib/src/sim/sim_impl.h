@@ -497,6 +497,9 @@ typedef struct sim_bodies {
   double *w1, *w2, *w3, *w4; /* n each: the direction's refinement */
   fcm__idbuf buf;
   long long builds;
+  int self;             /* self-contact (fcm_contact_options.self_contact) */
+  double rho;           /* 2 d^: own triangles closer in the reference state are excluded */
+  long long self_tests; /* own-body candidates tested against the exclusion */
 } sim_bodies;
 
 /* Contact between bodies and cut pieces (contact_bodies.c), the obstacle kind
@@ -531,6 +534,28 @@ fcm_index fcm__sim_bodies_element_nodes(const fcm_integrator *I, fcm_index e, do
  * solve; nothing without pairs or on an octree mesh. */
 fcm_status fcm__sim_bodies_refine(fcm_integrator *I, const double *b, double *d,
                                   fcm_step_reason *reason, int *its, sim_stats *stats);
+/* Helpers shared with contact_bodies_depth.c: the nodes' positions X + u at x (motion: the
+ * motion u only); the triangles' boxes (swept over y + s dy, s in [0, 2], when dy is given)
+ * and the tree built again or refitted to them; sample n's position at node positions y; the
+ * distance of p to triangle t at node positions y, its unit gradient and the closest point's
+ * barycentric coordinates. */
+void fcm__sim_bodies_positions(const fcm_space *s, const sim_bodies *B, const double *x, int motion,
+                               double *out);
+fcm_status fcm__sim_bodies_boxes(fcm_ctx *ctx, sim_bodies *B, const double *y, const double *dy,
+                                 int rebuild, double pad);
+void fcm__sim_bodies_sample(const sim_bodies *B, fcm_index n, const double *y, double p[3]);
+double fcm__sim_bodies_distance(const sim_bodies *B, const double p[3], fcm_index t,
+                                const double *y, double g[3], double beta[3]);
+/* Whether the pair (sample n, triangle t of its own body) is excluded from self-contact: its
+ * reference distance below B->rho (counted in self_tests). */
+int fcm__sim_bodies_excluded(sim_bodies *B, fcm_index n, fcm_index t);
+/* Self-contact at x: the own-body pairs within d^ (pairs), and the largest depth of an interior
+ * sample inside its own body (depth, where: may be NULL), computed with or without the option
+ * (contact_bodies_depth.c). */
+fcm_status fcm__sim_bodies_self_stats(const fcm_integrator *I, const sim_contact *c,
+                                      const double *x, long long *pairs, double *depth,
+                                      double where[3]);
+long long fcm__sim_bodies_self_tests(const sim_contact *c);
 /* The sample points and (in *triangles, may be NULL) the triangles of the surface. */
 fcm_index fcm__sim_bodies_samples(const sim_contact *c, fcm_index *triangles);
 /* The search trees built so far (each evaluation, step bound and stats builds one). */
