@@ -130,3 +130,8 @@ fcm_add_test(sim_contact_bodies_dice tests/sim/contact_bodies.c ARGS dice
              ${PROJECT_SOURCE_DIR}/apps/scenes)
 fcm_add_test(sim_contact_bodies_rest tests/sim/contact_bodies.c ARGS rest
              ${PROJECT_SOURCE_DIR}/apps/scenes)
+# Self-contact of one body: a C-shaped body whose loaded arm folds onto the other (kept out
+# with the option, passing through without it), the force against differences, bad input.
+fcm_add_test(sim_contact_self_fd tests/sim/contact_self.c ARGS fd)
+fcm_add_test(sim_contact_self_fold tests/sim/contact_self.c ARGS fold)
+fcm_add_test(sim_contact_self_errors tests/sim/contact_self.c ARGS errors)
