@@ -135,3 +135,7 @@ fcm_add_test(sim_contact_bodies_rest tests/sim/contact_bodies.c ARGS rest
 fcm_add_test(sim_contact_self_fd tests/sim/contact_self.c ARGS fd)
 fcm_add_test(sim_contact_self_fold tests/sim/contact_self.c ARGS fold)
 fcm_add_test(sim_contact_self_errors tests/sim/contact_self.c ARGS errors)
+# Friction between bodies: a block pulled sideways on a plate sticks below mu g and slides with
+# the acceleration a_x - mu g above; the friction force against differences.
+fcm_add_test(sim_contact_bodies_friction_stick tests/sim/contact_bodies_friction.c ARGS stick)
+fcm_add_test(sim_contact_bodies_friction_slide tests/sim/contact_bodies_friction.c ARGS slide)

@@ -657,11 +657,15 @@ FCM_API fcm_status fcm_integrator_add_contact_surface(fcm_integrator *integ, fcm
  * barrier, a penalty w kappa s^2 / 2 on the gap s < 0 below the other piece's closest face (lagged
  * at each substep's start) until the sample is d^ away at a substep's start; from then on the
  * barrier keeps them apart. One per integrator; carried over by
- * fcm_integrator_create_cut() (the surface is split again by the new cuts). Friction between
- * bodies is not supported. Before setup; the setup needs surface rules.
+ * fcm_integrator_create_cut() (the surface is split again by the new cuts). Friction
+ * (fcm_contact_options.friction > 0, dynamic schemes): each pair within d^ at the substep's
+ * start keeps its normal force, closest point and tangent plane (lagged), and the sample's slip
+ * relative to that point of the triangle over the substep gets the smoothed Coulomb potential
+ * of the obstacles (friction_velocity, friction_updates as there); the pieces that started in
+ * contact at a cut (the penalty) have none. Before setup; the setup needs surface rules.
  * @param[in] geom borrowed: the geometry the space's rules were built on; must outlive the
  *                 integrator (and the integrators its cuts create)
- * @return FCM_OK, FCM_ERR_ARG (NULL; a second call; friction > 0; self_contact not 0 or 1; the
+ * @return FCM_OK, FCM_ERR_ARG (NULL; a second call; self_contact not 0 or 1; the
  * options as for planes), FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_integrator_add_contact_bodies(fcm_integrator *integ,
                                                      const fcm_geometry *geom,

@@ -702,13 +702,6 @@ options:
     fcm__scene_path_pop(p, o4);
     c->options.self_contact = self;
   }
-  if (c->obstacle == FCM_CONTACT_BODIES) {
-    size_t o3 = fcm__scene_path_push_key(p, "friction");
-    SCENE_CHECK(c->options.friction == 0.0, p, FCM_ERR_ARG,
-                "expected 0 with \"bodies\" (friction between bodies is not supported), got %g",
-                c->options.friction);
-    fcm__scene_path_pop(p, o3);
-  }
 cleanup:
   return st;
 }

@@ -57,9 +57,6 @@ static fcm_status add_obstacle(fcm_integrator *I, sim_contact *c, const fcm_cont
   FCM_CHECK(c->opts.friction_updates >= 0 && c->opts.friction_updates <= 20, ctx, FCM_ERR_ARG,
             "contact %s %d: friction_updates = %d must be in [0, 20]", kn, k,
             c->opts.friction_updates);
-  FCM_CHECK(c->kind != SIM_CONTACT_BODIES || c->opts.friction == 0.0, ctx, FCM_ERR_ARG,
-            "contact bodies %d: friction = %g: friction between bodies is not supported (0)", k,
-            c->opts.friction);
   FCM_CHECK(c->opts.self_contact == 0 ||
                 (c->opts.self_contact == 1 && c->kind == SIM_CONTACT_BODIES),
             ctx, FCM_ERR_ARG,
@@ -908,6 +905,7 @@ fcm_status fcm_integrator_contact_stats(const fcm_integrator *I, fcm_contact_sta
         out->body_depth = FCM_MAX(out->body_depth, out->self_depth);
       }
       out->self_tests += fcm__sim_bodies_self_tests(&I->contacts[c]);
+      out->friction_dissipation += fcm__sim_bodies_friction_work(I, &I->contacts[c], I->u);
     }
   }
 cleanup:

@@ -94,6 +94,8 @@ void fcm__sim_bodies_free(fcm_ctx *ctx, sim_contact *c)
   fcm__free(ctx, B->w2);
   fcm__free(ctx, B->w3);
   fcm__free(ctx, B->w4);
+  fcm__free(ctx, B->y0);
+  fcm__free(ctx, B->fp);
   fcm__geom_idbuf_free(ctx, &B->buf);
   fcm__free(ctx, B);
   c->bodies = NULL;
@@ -356,7 +358,7 @@ int fcm__sim_bodies_excluded(sim_bodies *B, fcm_index n, fcm_index t)
 
 /* Whether triangle t is a target of sample n: with area; of another body not ignored, or of its
  * own body with self-contact and beyond the reference exclusion. */
-static int target(sim_bodies *B, fcm_index n, fcm_index t)
+int fcm__sim_bodies_target(sim_bodies *B, fcm_index n, fcm_index t)
 {
   const fcm_index bt = B->tbody[t], own = B->tbody[B->stri[n]];
   if (bt < 0) return 0;
@@ -366,8 +368,8 @@ static int target(sim_bodies *B, fcm_index n, fcm_index t)
 
 /* The triangles of the bodies sample n sees (not its own, not ignored; all bodies but its own
  * when all is set) whose boxes meet [lo, hi], into B->buf. */
-static fcm_status candidates(fcm_ctx *ctx, sim_bodies *B, fcm_index n, const double lo[3],
-                             const double hi[3], int all)
+fcm_status fcm__sim_bodies_candidates(fcm_ctx *ctx, sim_bodies *B, fcm_index n, const double lo[3],
+                                      const double hi[3], int all)
 {
   fcm_status st = FCM_OK;
   const fcm_index own = B->tbody[B->stri[n]];
@@ -469,7 +471,7 @@ fcm_status fcm__sim_bodies_prepare(fcm_integrator *I, sim_contact *c, const doub
       lo[i] = p[i] - c->dhat;
       hi[i] = p[i] + c->dhat;
     }
-    FCM_TRY(ctx, candidates(ctx, B, n, lo, hi, 1));
+    FCM_TRY(ctx, fcm__sim_bodies_candidates(ctx, B, n, lo, hi, 1));
     for (size_t k = 0; k < B->buf.n; k++) {
       const fcm_index t = B->buf.ids[k], bt = B->tbody[t];
       if (bt < 0 || bt == own || near[bt]) continue;
@@ -607,6 +609,68 @@ cleanup:
   return st;
 }
 
+/* The eigenpairs of the symmetric 2 x 2 matrix [a b; b d]: values sig, unit vectors e (2 x 2,
+ * column-major). */
+static void eig2(double a, double b, double d, double sig[2], double e[4])
+{
+  const double m = 0.5 * (a + d), r = sqrt(0.25 * (a - d) * (a - d) + b * b);
+  sig[0] = m + r;
+  sig[1] = m - r;
+  if (!(fabs(b) > 1e-14 * (fabs(a) + fabs(d)))) {
+    const int k = a >= d ? 0 : 1;
+    sig[0] = k ? d : a, sig[1] = k ? a : d;
+    e[0] = k ? 0.0 : 1.0, e[1] = k ? 1.0 : 0.0;
+  } else {
+    const double l = sqrt(b * b + (sig[0] - a) * (sig[0] - a));
+    e[0] = b / l, e[1] = (sig[0] - a) / l;
+  }
+  e[2] = -e[1], e[3] = e[0];
+}
+
+/* The lagged friction of the pairs at the node positions B->y (fcm__sim_bodies_slip()): the
+ * potential mu lambda f0(|T^T delta|), its force exact, its Hessian A = T Hs T^T (positive
+ * semidefinite, in the tangent plane) through the pairs' path as its two eigenpairs
+ * sigma v v^T, v = T e, like a barrier pair's c2 g g^T. */
+static fcm_status friction_terms(const fcm_integrator *I, const sim_contact *c, double *etot,
+                                 double *force, double *vals)
+{
+  fcm_status st = FCM_OK;
+  sim_bodies *B = c->bodies;
+  const double eps = c->opts.friction_velocity * I->cp.hstep;
+  if (!(c->opts.friction > 0.0) || !(eps > 0.0)) return FCM_OK;
+  for (size_t k = 0; k < B->nfp; k++) {
+    const sim_fpair *q = B->fp + k;
+    double delta[3], G[3], A[9], Hs[4], sig[2], e[4];
+    fcm__sim_bodies_slip(B, q, delta);
+    *etot += fcm__sim_friction_potential(c->opts.friction * q->lambda, eps, q->T, delta, G, A);
+    const double gn = fcm__vec3_norm(G);
+    if (force && gn > 0.0) {
+      const double gu[3] = {G[0] / gn, G[1] / gn, G[2] / gn};
+      pair_terms(I, B, q->n, q->t, gu, q->beta, gn, 0.0, force, NULL);
+    }
+    if (!vals) continue;
+    for (int a = 0; a < 2; a++) /* Hs = T^T A T */
+      for (int b = 0; b < 2; b++) {
+        double v = 0.0;
+        for (int i = 0; i < 3; i++)
+          for (int j = 0; j < 3; j++)
+            v += q->T[3 * a + i] * A[3 * i + j] * q->T[3 * b + j];
+        Hs[2 * a + b] = v;
+      }
+    eig2(Hs[0], 0.5 * (Hs[1] + Hs[2]), Hs[3], sig, e);
+    for (int m = 0; m < 2; m++) {
+      double v[3];
+      if (!(sig[m] > 0.0)) continue;
+      for (int i = 0; i < 3; i++)
+        v[i] = q->T[i] * e[2 * m] + q->T[3 + i] * e[2 * m + 1];
+      pair_terms(I, B, q->n, q->t, v, q->beta, 0.0, sig[m], NULL, vals);
+      FCM_TRY(I->ctx, record(I->ctx, B, q->n, q->t, v, q->beta, sig[m]));
+    }
+  }
+cleanup:
+  return st;
+}
+
 void fcm__sim_bodies_assemble(fcm_integrator *I, sim_contact *c, const double *x, double *energy,
                               double *force, fcm_csr *T, int *finite)
 {
@@ -630,14 +694,14 @@ void fcm__sim_bodies_assemble(fcm_integrator *I, sim_contact *c, const double *x
       lo[i] = p[i] - c->dhat;
       hi[i] = p[i] + c->dhat;
     }
-    if (candidates(I->ctx, B, n, lo, hi, 0) != FCM_OK) {
+    if (fcm__sim_bodies_candidates(I->ctx, B, n, lo, hi, 0) != FCM_OK) {
       *finite = 0;
       return;
     }
     for (size_t k = 0; k < B->buf.n; k++) {
       const fcm_index t = B->buf.ids[k];
       double g[3], beta[3], b1, b2;
-      if (!target(B, n, t)) continue;
+      if (!fcm__sim_bodies_target(B, n, t)) continue;
       const double d = fcm__sim_bodies_distance(B, p, t, B->y, g, beta);
       if (!(d > 0.0)) {
         *finite = 0;
@@ -657,6 +721,7 @@ void fcm__sim_bodies_assemble(fcm_integrator *I, sim_contact *c, const double *x
       return;
     }
   }
+  if (friction_terms(I, c, &etot, force, vals) != FCM_OK) *finite = 0;
   if (!isfinite(etot)) *finite = 0;
   if (energy) *energy += etot;
   /* pieces in contact: a factorization kept from another iterate lacks their coupling (and
@@ -687,11 +752,11 @@ double fcm__sim_bodies_step_bound(fcm_integrator *I, sim_contact *c, const doubl
       lo[i] = FCM_MIN(p[i], p[i] + 2.0 * dp[i]);
       hi[i] = FCM_MAX(p[i], p[i] + 2.0 * dp[i]);
     }
-    if (candidates(I->ctx, B, n, lo, hi, 0) != FCM_OK) return 0.0;
+    if (fcm__sim_bodies_candidates(I->ctx, B, n, lo, hi, 0) != FCM_OK) return 0.0;
     for (size_t k = 0; k < B->buf.n; k++) {
       const fcm_index t = B->buf.ids[k], *tv = B->tri + 3 * t;
       double g[3], beta[3], mt = 0.0, rel = 0.0, dr[3];
-      if (!target(B, n, t)) continue;
+      if (!fcm__sim_bodies_target(B, n, t)) continue;
       const double d = fcm__sim_bodies_distance(B, p, t, B->y, g, beta);
       if (!(d > 0.0)) return 0.0;
       if (B->tbody[t] == B->tbody[B->stri[n]]) {
@@ -731,11 +796,11 @@ fcm_status fcm__sim_bodies_stats(const fcm_integrator *I, const sim_contact *c, 
       lo[i] = p[i] - c->dhat;
       hi[i] = p[i] + c->dhat;
     }
-    FCM_TRY(ctx, candidates(ctx, B, n, lo, hi, 0));
+    FCM_TRY(ctx, fcm__sim_bodies_candidates(ctx, B, n, lo, hi, 0));
     for (size_t k = 0; k < B->buf.n; k++) {
       const fcm_index t = B->buf.ids[k];
       double g[3], beta[3], b1, b2;
-      if (!target(B, n, t)) continue;
+      if (!fcm__sim_bodies_target(B, n, t)) continue;
       const double d = fcm__sim_bodies_distance(B, p, t, B->y, g, beta);
       *min_distance = FCM_MIN(*min_distance, d);
       if (!(d > 0.0) || d >= c->dhat) continue;
