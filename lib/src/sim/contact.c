@@ -772,39 +772,6 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_integrator_contact_distance(const fcm_integrator *I, int id, const double x[3],
-                                           double t, double *distance, double gradient[3],
-                                           double hessian[9])
-{
-  fcm_status st = FCM_OK;
-  fcm__idbuf buf = {NULL, 0, 0};
-  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
-  fcm_ctx *ctx = I->ctx;
-  FCM_CHECK(id >= 0 && id < I->num_contacts, ctx, FCM_ERR_ARG,
-            "contact distance: obstacle %d out of range [0, %d)", id, I->num_contacts);
-  FCM_CHECK(x && distance, ctx, FCM_ERR_ARG, "contact distance: NULL point or distance");
-  FCM_CHECK(I->contacts[id].kind != SIM_CONTACT_BODIES, ctx, FCM_ERR_ARG,
-            "contact distance: contact %d is between bodies (no obstacle to measure to)", id);
-  {
-    const sim_contact *ct = &I->contacts[id];
-    double g[3], H[9];
-    int inside = 0;
-    sim_pose P;
-    fcm__sim_contact_pose(ct, t, &P);
-    FCM_TRY(ctx, fcm__sim_contact_distance(ctx, ct, &P, x, t, fcm__sim_contact_reach(ct, &P, x),
-                                           &buf, distance, g, H));
-    if (ct->kind == SIM_CONTACT_SURFACE) {
-      FCM_TRY(ctx, fcm__sim_contact_inside(ctx, ct, &P, x, t, &buf, &inside));
-      if (inside) *distance = -*distance;
-    }
-    if (gradient) memcpy(gradient, g, sizeof g);
-    if (hessian) memcpy(hessian, H, sizeof H);
-  }
-cleanup:
-  if (I) fcm__geom_idbuf_free(I->ctx, &buf);
-  return st;
-}
-
 fcm_status fcm_integrator_contact_eval(fcm_integrator *I, const double *u, double t, double *energy,
                                        double *force, fcm_csr *tangent)
 {
