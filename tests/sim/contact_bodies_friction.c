@@ -194,6 +194,7 @@ int main(int argc, char **argv)
     run(ctx, 0.2);
   else
     TEST_FAIL_("unknown mode %s", argv[1]);
+  TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
 }

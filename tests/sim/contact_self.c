@@ -399,6 +399,7 @@ int main(int argc, char **argv)
     errors(ctx);
   else
     TEST_FAIL_("unknown mode %s", argv[1]);
+  TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
 }
