@@ -1,4 +1,5 @@
-/* Friction between bodies (fcm_contact_options.friction with fcm_integrator_add_contact_bodies()):
+/* Friction between bodies (fcm_contact_options.friction with fcm_integrator_add_contact_bodies())
+ * and static contact between bodies:
  * a block (0.4 x 0.4 x 0.145 m, E = 1e6 Pa) falls 0.06 m onto a plate clamped at its bottom,
  * settles under gravity, and from t = 0.25 s is pulled sideways by a body force of density
  * rho a_x, a_x = 0.5 g (backward Euler dt 0.01 s, eps_v = 0.01 m/s); by mode:
@@ -8,7 +9,13 @@
  *            force against central differences of its energy (relative error <= 1e-6, the lag
  *            of the last substep), the Newton matrix positive semidefinite along them, and
  *            friction work reported
- * In both no sample lies inside the other body (depth <= 1e-6 m). */
+ * In both no sample lies inside the other body (depth <= 1e-6 m).
+ *   static   the same plate and block in a static solve (gravity, 4 load steps), the block held
+ *            in x and y at its nodes but not along z: with d^ = 0.1 m (the block starts 0.065 m
+ *            above the plate) the plate holds it through the barrier, the solve converges and
+ *            the plate's clamp carries the weight of both (1 %); with d^ = 0.03 m nothing holds
+ *            the block's vertical translation and the step is refused (FCM_ERR_SINGULAR, naming
+ *            it) */
 #include "sim_util.h"
 #include "fcm/fcm.h"
 #include "sim/sim_impl.h"
@@ -19,7 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define G0 9.81
+#define G0         9.81
 #define PULL_START 0.25
 
 /* The plate [0.05, 0.95]^2 x [0.05, 0.24] and the block [0.3, 0.7]^2 x [0.305, 0.45] (one
@@ -181,6 +188,67 @@ static int run(fcm_ctx *ctx, double mu)
   return 0;
 }
 
+static int static_rest(fcm_ctx *ctx, double dhat)
+{
+  problem p = {ctx, NULL, NULL, NULL, NULL};
+  fcm_integrator *I = NULL;
+  fcm_material mat = {FCM_MATERIAL_STABLE_NEO_HOOKEAN, 1e6, 0.3, 1000.0};
+  fcm_integrator_options o = fcm_integrator_options_default();
+  fcm_contact_options co = fcm_contact_options_default();
+  const double g[3] = {0, 0, -G0};
+  int clamp = -1;
+  o.kind = FCM_INTEGRATOR_STATIC;
+  o.load_steps = 4;
+  co.distance = dhat;
+  TEST_OK(ctx, plate_block(&p));
+  if (!p.space) return 0;
+  TEST_OK(ctx, fcm_integrator_create(ctx, p.space, &mat, &o, &I));
+  if (!I) return 0;
+  {
+    const fcm_index nn = fcm_mesh_num_nodes(p.mesh);
+    const double *X = fcm_mesh_coords(p.mesh);
+    fcm_index *low = malloc(sizeof(fcm_index) * (size_t)nn),
+              *high = malloc(sizeof(fcm_index) * (size_t)nn);
+    fcm_index nl = 0, nh = 0;
+    fcm_motion held = fcm_motion_default(), side = fcm_motion_default();
+    for (fcm_index v = 0; v < nn; v++) {
+      if (X[3 * v + 2] < 0.11) low[nl++] = v;
+      if (X[3 * v + 2] > 0.27) high[nh++] = v;
+    }
+    side.components[2] = 0;
+    TEST_OK(ctx, fcm_integrator_add_constraint(I, nl, low, &held, &clamp));
+    TEST_OK(ctx, fcm_integrator_add_constraint(I, nh, high, &side, NULL));
+    free(low), free(high);
+  }
+  TEST_OK(ctx, fcm_integrator_add_gravity(I, g, NULL, NULL));
+  TEST_OK(ctx, fcm_integrator_add_contact_bodies(I, p.geom, &co, NULL));
+  TEST_OK(ctx, fcm_integrator_setup(I));
+  fcm_step_info info;
+  if (dhat < 0.065) {
+    TEST_TRUE(fcm_integrator_step(I, &info) == FCM_ERR_SINGULAR);
+    const char *msg = fcm_ctx_error_message(ctx);
+    printf("static, d^ = %g m: %s\n", dhat, msg);
+    TEST_TRUE(strstr(msg, "1 rigid-body translation free") != NULL);
+    fcm_ctx_error_clear(ctx);
+  } else {
+    fcm_contact_stats cs;
+    double R[3] = {0, 0, 0};
+    TEST_OK(ctx, fcm_integrator_step(I, &info));
+    TEST_TRUE(info.reason == FCM_STEP_CONVERGED);
+    TEST_OK(ctx, fcm_integrator_contact_stats(I, &cs));
+    TEST_OK(ctx, fcm_integrator_reaction(I, clamp, R, NULL));
+    const double w = 1000.0 * G0 * (0.9 * 0.9 * 0.19 + 0.4 * 0.4 * 0.145);
+    printf("static, d^ = %g m: %d Newton iterations; %lld pairs, smallest distance %.4g m, "
+           "depth %.3g m; the clamp's reaction %.6g N against the weight of both %.6g N\n",
+           dhat, info.newton_iterations, cs.body_pairs, cs.min_distance, cs.body_depth, R[2], w);
+    TEST_TRUE(cs.body_pairs > 0 && cs.min_distance > 0.0 && cs.body_depth <= 1e-6);
+    TEST_NEAR(R[2], w, 0.01, 0.0);
+  }
+  fcm_integrator_destroy(&I);
+  problem_free(&p);
+  return 0;
+}
+
 int main(int argc, char **argv)
 {
   fcm_ctx *ctx = NULL;
@@ -192,7 +260,10 @@ int main(int argc, char **argv)
     run(ctx, 0.8);
   else if (!strcmp(argv[1], "slide"))
     run(ctx, 0.2);
-  else
+  else if (!strcmp(argv[1], "static")) {
+    static_rest(ctx, 0.1);
+    static_rest(ctx, 0.03);
+  } else
     TEST_FAIL_("unknown mode %s", argv[1]);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);

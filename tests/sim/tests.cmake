@@ -139,3 +139,6 @@ fcm_add_test(sim_contact_self_errors tests/sim/contact_self.c ARGS errors)
 # the acceleration a_x - mu g above; the friction force against differences.
 fcm_add_test(sim_contact_bodies_friction_stick tests/sim/contact_bodies_friction.c ARGS stick)
 fcm_add_test(sim_contact_bodies_friction_slide tests/sim/contact_bodies_friction.c ARGS slide)
+# Static contact between bodies: the plate holds the block's vertical translation (the clamp
+# carries both weights); beyond the threshold the step is refused.
+fcm_add_test(sim_contact_bodies_static tests/sim/contact_bodies_friction.c ARGS static)

@@ -446,12 +446,21 @@ static void lag_blind(sim_bodies *B, fcm_index n, const double p[3])
   }
 }
 
+double fcm__sim_bodies_blind_start(const fcm_integrator *I, const sim_contact *c)
+{
+  return I->opts.kind == FCM_INTEGRATOR_STATIC ? 1e-9 * c->dhat : c->dhat;
+}
+
 fcm_status fcm__sim_bodies_prepare(fcm_integrator *I, sim_contact *c, const double *x)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = I->ctx;
   sim_bodies *B = c->bodies;
   unsigned char *near = NULL;
+  /* the pieces a sample ignores from the first substep: those within d^ of it; a static solve,
+   * which has no inertia to land a piece from afar, ignores only those within 1e-9 d^ (the
+   * sides of a cut) and lets the barrier hold the others at once */
+  const double first = fcm__sim_bodies_blind_start(I, c);
   if (!B) return FCM_OK;
   fcm__sim_bodies_positions(I->space, B, x, 0, B->y);
   FCM_TRY(ctx, fcm__sim_bodies_boxes(ctx, B, B->y, NULL, 1, c->dhat));
@@ -475,7 +484,8 @@ fcm_status fcm__sim_bodies_prepare(fcm_integrator *I, sim_contact *c, const doub
     for (size_t k = 0; k < B->buf.n; k++) {
       const fcm_index t = B->buf.ids[k], bt = B->tbody[t];
       if (bt < 0 || bt == own || near[bt]) continue;
-      if (fcm__sim_bodies_distance(B, p, t, B->y, g, beta) < c->dhat) near[bt] = 1;
+      if (fcm__sim_bodies_distance(B, p, t, B->y, g, beta) < (B->prepared ? c->dhat : first))
+        near[bt] = 1;
     }
     if (!B->prepared) { /* the bodies it starts near */
       int m = 0;

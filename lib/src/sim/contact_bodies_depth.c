@@ -205,3 +205,46 @@ long long fcm__sim_bodies_self_tests(const sim_contact *c)
 {
   return c->bodies ? c->bodies->self_tests : 0;
 }
+
+fcm_status fcm__sim_bodies_support(const fcm_integrator *I, const sim_contact *c, const double *x,
+                                   void (*fn)(void *user, fcm_index elem_a, const double ya[3],
+                                              fcm_index elem_b, const double yb[3],
+                                              const double g[3]),
+                                   void *user)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  sim_bodies *B = c->bodies;
+  const double first = fcm__sim_bodies_blind_start(I, c);
+  if (!B) return FCM_OK;
+  fcm__sim_bodies_positions(I->space, B, x, 0, B->y);
+  FCM_TRY(ctx, fcm__sim_bodies_boxes(ctx, B, B->y, NULL, 0, c->dhat));
+  for (fcm_index n = 0; n < B->ns; n++) {
+    const fcm_index own = B->tbody[B->stri[n]], *sv = B->tri + 3 * B->stri[n];
+    const double *l = B->slam + 3 * n;
+    double p[3], lo[3], hi[3];
+    fcm__sim_bodies_sample(B, n, B->y, p);
+    for (int i = 0; i < 3; i++) {
+      lo[i] = p[i] - c->dhat;
+      hi[i] = p[i] + c->dhat;
+    }
+    /* not the bodies the sample ignores (the barrier does not hold them) */
+    FCM_TRY(ctx, fcm__sim_bodies_candidates(ctx, B, n, lo, hi, 0));
+    for (size_t k = 0; k < B->buf.n; k++) {
+      const fcm_index t = B->buf.ids[k], *tv = B->tri + 3 * t;
+      double g[3], beta[3], q[3];
+      if (B->tbody[t] < 0 || B->tbody[t] == own) continue;
+      const double d = fcm__sim_bodies_distance(B, p, t, B->y, g, beta);
+      if (!(d < c->dhat) || !(d >= (B->prepared ? 0.0 : first)) || !(d > 0.0)) continue;
+      for (int i = 0; i < 3; i++)
+        q[i] = p[i] - d * g[i];
+      /* an element of each side: the node of the largest weight */
+      const int js = l[0] >= l[1] ? (l[0] >= l[2] ? 0 : 2) : (l[1] >= l[2] ? 1 : 2);
+      const int jt =
+          beta[0] >= beta[1] ? (beta[0] >= beta[2] ? 0 : 2) : (beta[1] >= beta[2] ? 1 : 2);
+      fn(user, B->velem[sv[js]], p, B->velem[tv[jt]], q, g);
+    }
+  }
+cleanup:
+  return st;
+}

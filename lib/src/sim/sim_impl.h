@@ -590,6 +590,17 @@ fcm_status fcm__sim_bodies_self_stats(const fcm_integrator *I, const sim_contact
                                       const double *x, long long *pairs, double *depth,
                                       double where[3]);
 long long fcm__sim_bodies_self_tests(const sim_contact *c);
+/* The distance below which a sample ignores another body from the first substep on: d^, or
+ * 1e-9 d^ in a static solve (only the sides of a cut). */
+double fcm__sim_bodies_blind_start(const fcm_integrator *I, const sim_contact *c);
+/* Each pair of a sample and a triangle of another body within d^ at x that the barrier holds
+ * (not ignored): fn with an element of each side, the sample's position ya, the closest point
+ * yb and the unit direction g from yb to ya (the static check of the rigid modes, rigid.c). */
+fcm_status fcm__sim_bodies_support(const fcm_integrator *I, const sim_contact *c, const double *x,
+                                   void (*fn)(void *user, fcm_index elem_a, const double ya[3],
+                                              fcm_index elem_b, const double yb[3],
+                                              const double g[3]),
+                                   void *user);
 /* The sample points and (in *triangles, may be NULL) the triangles of the surface. */
 fcm_index fcm__sim_bodies_samples(const sim_contact *c, fcm_index *triangles);
 /* The search trees built so far (each evaluation, step bound and stats builds one). */
