@@ -662,7 +662,10 @@ FCM_API fcm_status fcm_integrator_add_contact_surface(fcm_integrator *integ, fcm
  * start keeps its normal force, closest point and tangent plane (lagged), and the sample's slip
  * relative to that point of the triangle over the substep gets the smoothed Coulomb potential
  * of the obstacles (friction_velocity, friction_updates as there); the pieces that started in
- * contact at a cut (the penalty) have none. Before setup; the setup needs surface rules.
+ * contact at a cut (the penalty) have none. Static solves: a piece within d^ of a piece held
+ * in all its rigid modes counts as held along the pairs' directions (the static check of the
+ * rigid modes), and only the pieces within 1e-9 d^ of each other at the start (the sides of a
+ * cut) ignore each other. Before setup; the setup needs surface rules.
  * @param[in] geom borrowed: the geometry the space's rules were built on; must outlive the
  *                 integrator (and the integrators its cuts create)
  * @return FCM_OK, FCM_ERR_ARG (NULL; a second call; self_contact not 0 or 1; the
