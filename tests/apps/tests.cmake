@@ -56,7 +56,7 @@ fcm_add_test(app_sim_default tests/apps/sim_app.c LABELS app slow TIMEOUT 1200
 set(fcm_check_scenes spinning_body slingshot hollow_ball static_beam cantilever twisting_cylinder
     voxel_block gyroid_lattice cut_slab dice cracked_beam clamped_surface hollow_ball_multigrid
     vibrating_beam octree_ball_hex8 octree_ball_hex20 octree_ball_multigrid ball_on_floor
-    ball_off_wedge dice_on_floor cut_bar_resting)
+    ball_off_wedge dice_on_floor cut_bar_resting folding_c)
 list(APPEND fcm_check_scenes cutbench_tonthat_slab)
 list(APPEND fcm_check_scenes octree_cut_ball_hex8 octree_cut_ball_hex20 cutbench_dick_bunny3
      cutbench_koschier_bunny octree_refine_cut_hex8)

@@ -217,7 +217,8 @@ if(FCM_BUILD_APPS)
       ball_on_floor     "contact is not supported with a distributed backend"
       ball_off_wedge    "contact is not supported with a distributed backend"
       dice_on_floor     "contact is not supported with a distributed backend"
-      cut_bar_resting   "contact is not supported with a distributed backend")
+      cut_bar_resting   "contact is not supported with a distributed backend"
+      folding_c         "contact is not supported with a distributed backend")
   set(listed "")
   set(run ${FCM_PETSC_SCENES_RUN})
   while(run)

@@ -28,7 +28,7 @@
  *            boxes; on dice_on_floor.json after the landing, one evaluation of the contact terms
  *            (energy, force, Newton matrix) per sample point, and the step time with and without
  *            the contact between the pieces
- *   errors   bad "bodies" input in a scene (false, with friction) refused naming the field; a
+ *   errors   bad "bodies" input in a scene (false, negative friction) refused naming the field; a
  *            second call and a NULL geometry refused; a scene with obstacles only builds no
  *            search tree and evaluates no pair (counters zero) */
 #include "sim_util.h"
@@ -46,32 +46,6 @@ static double rnd(void)
   return (double)rand() / RAND_MAX - 0.5;
 }
 
-/* The tets of the boxes A and B merged into one geometry. */
-static fcm_status two_boxes(fcm_ctx *ctx, const double alo[3], const double ahi[3],
-                            const double blo[3], const double bhi[3], fcm_geometry **out)
-{
-  fcm_geometry *a = NULL, *b = NULL;
-  const fcm_index n[3] = {2, 2, 1};
-  fcm_status st = fcm_geometry_create_box(ctx, alo, ahi, n, &a);
-  if (st == FCM_OK) st = fcm_geometry_create_box(ctx, blo, bhi, n, &b);
-  if (st == FCM_OK) {
-    const fcm_index na = fcm_geometry_num_nodes(a), nb = fcm_geometry_num_nodes(b);
-    const fcm_index ca = fcm_geometry_num_cells(a), cb = fcm_geometry_num_cells(b);
-    double *x = malloc(sizeof(double) * 3 * (size_t)(na + nb));
-    fcm_index *c = malloc(sizeof(fcm_index) * 4 * (size_t)(ca + cb));
-    memcpy(x, fcm_geometry_coords(a), sizeof(double) * 3 * (size_t)na);
-    memcpy(x + 3 * na, fcm_geometry_coords(b), sizeof(double) * 3 * (size_t)nb);
-    memcpy(c, fcm_geometry_cells(a), sizeof(fcm_index) * 4 * (size_t)ca);
-    for (fcm_index k = 0; k < 4 * cb; k++)
-      c[4 * ca + k] = fcm_geometry_cells(b)[k] + na;
-    st = fcm_geometry_create(ctx, FCM_ELEMENT_TET4, na + nb, x, ca + cb, c, out);
-    free(x), free(c);
-  }
-  fcm_geometry_destroy(&a);
-  fcm_geometry_destroy(&b);
-  return st;
-}
-
 /* Box A = [0.1, 0.9]^2 x [0.05, 0.2] and B = [0.3, 0.7]^2 x [0.55, 0.8] on 4^3 Hex8 cells over
  * [0, 1]^3: the cell layer z in [0.25, 0.5] is empty, so they share no DOF. */
 static fcm_status boxes_problem(problem *p)
@@ -81,7 +55,8 @@ static fcm_status boxes_problem(problem *p)
   const double blo[3] = {0.3, 0.3, 0.55}, bhi[3] = {0.7, 0.7, 0.8};
   const fcm_index cells[3] = {4, 4, 4};
   fcm_cell_rules_options ro = fcm_cell_rules_options_default();
-  fcm_status st = two_boxes(p->ctx, alo, ahi, blo, bhi, &p->geom);
+  const fcm_index n[3] = {2, 2, 1};
+  fcm_status st = merged_boxes(p->ctx, alo, ahi, blo, bhi, n, &p->geom);
   if (st == FCM_OK) st = fcm_mesh_create_box(p->ctx, FCM_ELEMENT_HEX8, lo, hi, cells, &p->mesh);
   ro.surface_strength = 2;
   ro.min_fraction = 1e-4;
@@ -533,7 +508,7 @@ static int errors(fcm_ctx *ctx)
   cut_scene(json, sizeof json, "{\"contact\": {\"bodies\": 1}},");
   TEST_ERR(ctx, fcm_scene_create_from_string(ctx, json, "c.json", &scene), FCM_ERR_ARG, "bodies");
   fcm_scene_destroy(&scene);
-  cut_scene(json, sizeof json, "{\"contact\": {\"bodies\": true, \"friction\": 0.3}},");
+  cut_scene(json, sizeof json, "{\"contact\": {\"bodies\": true, \"friction\": -0.3}},");
   TEST_ERR(ctx, fcm_scene_create_from_string(ctx, json, "c.json", &scene), FCM_ERR_ARG, "friction");
   fcm_scene_destroy(&scene);
   cut_scene(json, sizeof json, "{\"contact\": {\"bodies\": true, \"distance\": -1}},");
@@ -546,7 +521,7 @@ static int errors(fcm_ctx *ctx)
     fcm_contact_options co = fcm_contact_options_default();
     TEST_ERR(ctx, fcm_integrator_add_contact_bodies(I, NULL, NULL, NULL), FCM_ERR_ARG,
              "NULL geometry");
-    co.friction = 0.2;
+    co.friction = -0.2;
     TEST_ERR(ctx, fcm_integrator_add_contact_bodies(I, p.geom, &co, NULL), FCM_ERR_ARG, "friction");
     TEST_OK(ctx, fcm_integrator_add_contact_bodies(I, p.geom, NULL, NULL));
     TEST_ERR(ctx, fcm_integrator_add_contact_bodies(I, p.geom, NULL, NULL), FCM_ERR_ARG,

@@ -107,6 +107,32 @@ static inline fcm_status ball_problem(problem *p, const double c[3], double r, f
   return st;
 }
 
+/* The tets of the boxes A and B (n cubes per axis each) merged into one geometry. */
+static inline fcm_status merged_boxes(fcm_ctx *ctx, const double alo[3], const double ahi[3],
+                                      const double blo[3], const double bhi[3],
+                                      const fcm_index n[3], fcm_geometry **out)
+{
+  fcm_geometry *a = NULL, *b = NULL;
+  fcm_status st = fcm_geometry_create_box(ctx, alo, ahi, n, &a);
+  if (st == FCM_OK) st = fcm_geometry_create_box(ctx, blo, bhi, n, &b);
+  if (st == FCM_OK) {
+    const fcm_index na = fcm_geometry_num_nodes(a), nb = fcm_geometry_num_nodes(b);
+    const fcm_index ca = fcm_geometry_num_cells(a), cb = fcm_geometry_num_cells(b);
+    double *x = malloc(sizeof(double) * 3 * (size_t)(na + nb));
+    fcm_index *c = malloc(sizeof(fcm_index) * 4 * (size_t)(ca + cb));
+    memcpy(x, fcm_geometry_coords(a), sizeof(double) * 3 * (size_t)na);
+    memcpy(x + 3 * na, fcm_geometry_coords(b), sizeof(double) * 3 * (size_t)nb);
+    memcpy(c, fcm_geometry_cells(a), sizeof(fcm_index) * 4 * (size_t)ca);
+    for (fcm_index k = 0; k < 4 * cb; k++)
+      c[4 * ca + k] = fcm_geometry_cells(b)[k] + na;
+    st = fcm_geometry_create(ctx, FCM_ELEMENT_TET4, na + nb, x, ca + cb, c, out);
+    free(x), free(c);
+  }
+  fcm_geometry_destroy(&a);
+  fcm_geometry_destroy(&b);
+  return st;
+}
+
 /* Central differences (step eps) of fcm_integrator_contact_eval() at u (restored on return)
  * and time t along d against its force f0 and Newton matrix T there (T may be NULL): the
  * relative errors of the energy's difference against f0 . d and of the force's against T d

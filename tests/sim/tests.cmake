@@ -135,3 +135,15 @@ fcm_add_test(sim_contact_bodies_dice tests/sim/contact_bodies.c ARGS dice
              ${PROJECT_SOURCE_DIR}/apps/scenes)
 fcm_add_test(sim_contact_bodies_rest tests/sim/contact_bodies.c ARGS rest
              ${PROJECT_SOURCE_DIR}/apps/scenes)
+# Self-contact of one body: a C-shaped body whose loaded arm folds onto the other (kept out
+# with the option, passing through without it), the force against differences, bad input.
+fcm_add_test(sim_contact_self_fd tests/sim/contact_self.c ARGS fd)
+fcm_add_test(sim_contact_self_fold tests/sim/contact_self.c ARGS fold)
+fcm_add_test(sim_contact_self_errors tests/sim/contact_self.c ARGS errors)
+# Friction between bodies: a block pulled sideways on a plate sticks below mu g and slides with
+# the acceleration a_x - mu g above; the friction force against differences.
+fcm_add_test(sim_contact_bodies_friction_stick tests/sim/contact_bodies_friction.c ARGS stick)
+fcm_add_test(sim_contact_bodies_friction_slide tests/sim/contact_bodies_friction.c ARGS slide)
+# Static contact between bodies: the plate holds the block's vertical translation (the clamp
+# carries both weights); beyond the threshold the step is refused.
+fcm_add_test(sim_contact_bodies_static tests/sim/contact_bodies_friction.c ARGS static)

@@ -577,6 +577,15 @@ typedef struct fcm_contact_options {
                                  normal force changes by at most 1e-3 of the largest); 0
                                  (default): lagged from the substep's start only. The largest
                                  value over the obstacles applies */
+  int self_contact;         /**< 0 (default) or 1, fcm_integrator_add_contact_bodies() only
+                                 (the obstacles refuse 1): also keep each body's samples off
+                                 its own triangles (self-contact), except the pairs whose
+                                 reference distance (the sample to the triangle, both
+                                 undeformed) is below 2 d^: a sample always lies on its own and
+                                 adjacent triangles, and parts that close in the reference state
+                                 are taken to be joined by material. Costs a reference
+                                 point-triangle distance per own triangle within d^ of each
+                                 sample at each evaluation (lib/docs/contact.md) */
 } fcm_contact_options;
 
 /** The defaults listed on each member. */
@@ -666,17 +675,30 @@ FCM_API fcm_status fcm_integrator_add_contact_surface(fcm_integrator *integ, fcm
  * gradients on the coupled matrix, preconditioned by its factorization). Broad phase: a
  * bounding-volume hierarchy per body over the deformed triangles, rebuilt at each substep and
  * refitted at each evaluation. The step filter keeps every pair at positive distance (a
- * conservative bound from the points' motions). Self-contact of one body is off.
+ * conservative bound from the points' motions). Self-contact of one body:
+ * fcm_contact_options.self_contact (off by default): a body's samples are also kept off its
+ * own triangles, but for the pairs within 2 d^ of each other in the reference state (never
+ * repelled; parts of a body closer than 2 d^ undeformed do not see each other); the step
+ * filter bounds these pairs by the relative motion (a rigid motion of the body never limits a
+ * step). A self pair that starts at distance <= 0 (a deformed start) makes the first
+ * evaluation non-finite.
  * Pieces that start within d^ of each other (the two sides of a cut) see, instead of the
  * barrier, a penalty w kappa s^2 / 2 on the gap s < 0 below the other piece's closest face (lagged
  * at each substep's start) until the sample is d^ away at a substep's start; from then on the
  * barrier keeps them apart. One per integrator; carried over by
- * fcm_integrator_create_cut() (the surface is split again by the new cuts). Friction between
- * bodies is not supported. Before setup; the setup needs surface rules.
+ * fcm_integrator_create_cut() (the surface is split again by the new cuts). Friction
+ * (fcm_contact_options.friction > 0, dynamic schemes): each pair within d^ at the substep's
+ * start keeps its normal force, closest point and tangent plane (lagged), and the sample's slip
+ * relative to that point of the triangle over the substep gets the smoothed Coulomb potential
+ * of the obstacles (friction_velocity, friction_updates as there); the pieces that started in
+ * contact at a cut (the penalty) have none. Static solves: a piece within d^ of a piece held
+ * in all its rigid modes counts as held along the pairs' directions (the static check of the
+ * rigid modes), and only the pieces within 1e-9 d^ of each other at the start (the sides of a
+ * cut) ignore each other. Before setup; the setup needs surface rules.
  * @param[in] geom borrowed: the geometry the space's rules were built on; must outlive the
  *                 integrator (and the integrators its cuts create)
- * @return FCM_OK, FCM_ERR_ARG (NULL; a second call; friction > 0; the options as for
- * planes), FCM_ERR_ALLOC. */
+ * @return FCM_OK, FCM_ERR_ARG (NULL; a second call; self_contact not 0 or 1; the
+ * options as for planes), FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_integrator_add_contact_bodies(fcm_integrator *integ,
                                                      const fcm_geometry *geom,
                                                      const fcm_contact_options *opts, int *id);
@@ -724,6 +746,16 @@ typedef struct fcm_contact_stats {
   long long friction_updates;  /**< the friction's normal forces and tangents taken anew at a
                                     converged state since setup
                                     (fcm_contact_options.friction_updates) */
+  long long self_pairs;        /**< sample-triangle pairs of one body closer than d^ now (also
+                                    in body_pairs); 0 without self-contact */
+  long long self_tests;        /**< own-body sample-triangle candidates tested against the
+                                    reference exclusion since setup; 0 without self-contact */
+  double self_depth;           /**< the largest depth of a sample inside its own body now (m,
+                                    also in body_depth; the three interior samples of each
+                                    triangle, moved off it by 1e-7 of the body's size, by a
+                                    ray's parity against the body's triangles, then the distance
+                                    to its nearest triangle not excluded); 0 without
+                                    self-contact */
   double step_min_distance;    /**< the smallest signed distance over every state the last
                                     step accepted: the end of each of its substeps (load steps,
                                     halved substeps) and the current state (<= min_distance;

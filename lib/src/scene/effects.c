@@ -608,7 +608,8 @@ static fcm_status parse_contact(fcm__scene_parser *p, const fcm__json *o, fcm_ef
   fcm_status st = FCM_OK;
   static const char *const keys[] = {
       "plane",    "sphere",    "box",      "surface",           "bodies",
-      "distance", "stiffness", "friction", "friction_velocity", "friction_updates"};
+      "distance", "stiffness", "friction", "friction_velocity", "friction_updates",
+      "self"};
   static const char *const plane_keys[] = {"point", "normal", "velocity"};
   static const char *const sphere_keys[] = {"center",   "radius", "velocity",
                                             "rotation", "start",  "end"};
@@ -690,12 +691,16 @@ options:
     FCM_TRY(p->ctx, fcm__scene_read_int(p, o, "friction_updates", 0, 0, 20, &updates));
     c->options.friction_updates = (int)updates;
   }
-  if (c->obstacle == FCM_CONTACT_BODIES) {
-    size_t o3 = fcm__scene_path_push_key(p, "friction");
-    SCENE_CHECK(c->options.friction == 0.0, p, FCM_ERR_ARG,
-                "expected 0 with \"bodies\" (friction between bodies is not supported), got %g",
-                c->options.friction);
-    fcm__scene_path_pop(p, o3);
+  {
+    int self = 0;
+    FCM_TRY(p->ctx, fcm__scene_read_bool(p, o, "self", 0, &self));
+    size_t o4 = fcm__scene_path_push_key(p, "self");
+    SCENE_CHECK(!self || c->obstacle == FCM_CONTACT_BODIES, p, FCM_ERR_ARG,
+                "expected false or absent with \"%s\" (self-contact is an option of "
+                "\"bodies\"), got true",
+                kind);
+    fcm__scene_path_pop(p, o4);
+    c->options.self_contact = self;
   }
 cleanup:
   return st;
@@ -722,6 +727,7 @@ static void view_contact(const fcm_effect *e, FILE *f)
     break;
   case FCM_CONTACT_BODIES:
     fprintf(f, "between the bodies and cut pieces");
+    if (c->options.self_contact) fprintf(f, ", self-contact of each body");
     break;
   default:
     fprintf(f, "surface %s", c->mesh);

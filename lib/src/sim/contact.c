@@ -57,9 +57,12 @@ static fcm_status add_obstacle(fcm_integrator *I, sim_contact *c, const fcm_cont
   FCM_CHECK(c->opts.friction_updates >= 0 && c->opts.friction_updates <= 20, ctx, FCM_ERR_ARG,
             "contact %s %d: friction_updates = %d must be in [0, 20]", kn, k,
             c->opts.friction_updates);
-  FCM_CHECK(c->kind != SIM_CONTACT_BODIES || c->opts.friction == 0.0, ctx, FCM_ERR_ARG,
-            "contact bodies %d: friction = %g: friction between bodies is not supported (0)", k,
-            c->opts.friction);
+  FCM_CHECK(c->opts.self_contact == 0 ||
+                (c->opts.self_contact == 1 && c->kind == SIM_CONTACT_BODIES),
+            ctx, FCM_ERR_ARG,
+            "contact %s %d: self_contact = %d must be 0 or 1, and 1 only for contact between "
+            "bodies",
+            kn, k, c->opts.self_contact);
   if (c->opts.friction_velocity == 0.0) c->opts.friction_velocity = 1e-3;
   c->motion = fcm_motion_default();
   if (motion) {
@@ -451,6 +454,7 @@ fcm_status fcm__sim_contact_setup(fcm_integrator *I)
   for (int c = 0; c < I->num_contacts; c++) {
     sim_contact *ct = &I->contacts[c];
     ct->dhat = ct->opts.distance > 0.0 ? ct->opts.distance : 0.1 * cp->h;
+    if (ct->bodies) ct->bodies->rho = 2.0 * ct->dhat;
     ct->kappa = ct->opts.stiffness > 0.0 ? ct->opts.stiffness : I->mat.young / cp->h;
     FCM_CHECK(ct->dhat > 0.0 && ct->kappa > 0.0 && isfinite(ct->kappa), ctx, FCM_ERR_ARG,
               "contact %s %d: threshold %g or stiffness %g not positive (set distance and "
@@ -768,39 +772,6 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_integrator_contact_distance(const fcm_integrator *I, int id, const double x[3],
-                                           double t, double *distance, double gradient[3],
-                                           double hessian[9])
-{
-  fcm_status st = FCM_OK;
-  fcm__idbuf buf = {NULL, 0, 0};
-  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
-  fcm_ctx *ctx = I->ctx;
-  FCM_CHECK(id >= 0 && id < I->num_contacts, ctx, FCM_ERR_ARG,
-            "contact distance: obstacle %d out of range [0, %d)", id, I->num_contacts);
-  FCM_CHECK(x && distance, ctx, FCM_ERR_ARG, "contact distance: NULL point or distance");
-  FCM_CHECK(I->contacts[id].kind != SIM_CONTACT_BODIES, ctx, FCM_ERR_ARG,
-            "contact distance: contact %d is between bodies (no obstacle to measure to)", id);
-  {
-    const sim_contact *ct = &I->contacts[id];
-    double g[3], H[9];
-    int inside = 0;
-    sim_pose P;
-    fcm__sim_contact_pose(ct, t, &P);
-    FCM_TRY(ctx, fcm__sim_contact_distance(ctx, ct, &P, x, t, fcm__sim_contact_reach(ct, &P, x),
-                                           &buf, distance, g, H));
-    if (ct->kind == SIM_CONTACT_SURFACE) {
-      FCM_TRY(ctx, fcm__sim_contact_inside(ctx, ct, &P, x, t, &buf, &inside));
-      if (inside) *distance = -*distance;
-    }
-    if (gradient) memcpy(gradient, g, sizeof g);
-    if (hessian) memcpy(hessian, H, sizeof H);
-  }
-cleanup:
-  if (I) fcm__geom_idbuf_free(I->ctx, &buf);
-  return st;
-}
-
 fcm_status fcm_integrator_contact_eval(fcm_integrator *I, const double *u, double t, double *energy,
                                        double *force, fcm_csr *tangent)
 {
@@ -895,6 +866,13 @@ fcm_status fcm_integrator_contact_stats(const fcm_integrator *I, fcm_contact_sta
       out->barrier_energy += e;
       out->tree_builds += fcm__sim_bodies_builds(&I->contacts[c]);
       FCM_TRY(ctx, fcm__sim_bodies_depth(I, &I->contacts[c], I->u, &out->body_depth, NULL));
+      if (I->contacts[c].opts.self_contact) {
+        FCM_TRY(ctx, fcm__sim_bodies_self_stats(I, &I->contacts[c], I->u, &out->self_pairs,
+                                                &out->self_depth, NULL));
+        out->body_depth = FCM_MAX(out->body_depth, out->self_depth);
+      }
+      out->self_tests += fcm__sim_bodies_self_tests(&I->contacts[c]);
+      out->friction_dissipation += fcm__sim_bodies_friction_work(I, &I->contacts[c], I->u);
     }
   }
 cleanup:

@@ -6,8 +6,10 @@
  * its points ("nodes") moving with the element that holds it: y_v = X_v + sum_a N_a(X_v) u_a.
  * A triangle is the flat triangle through its three deformed nodes. A piece is a body of the
  * space (fcm__space_body_labels(): elements joined through shared DOF copies); a triangle
- * belongs to the body of its nodes' elements. Self-contact is off: a sample never sees the
- * triangles of its own body.
+ * belongs to the body of its nodes' elements. Without self-contact a sample never sees the
+ * triangles of its own body; with it (fcm_contact_options.self_contact) it sees those farther
+ * than rho = 2 d^ from it in the reference state (fcm__sim_bodies_excluded()), and the step
+ * filter bounds these pairs by the relative motion of the triangle's nodes to the sample.
  *
  * Samples: every node (the vertices) and the three interior points of each triangle's
  * three-point rule (barycentric (2/3, 1/6, 1/6) and its permutations), a sample being a
@@ -92,6 +94,8 @@ void fcm__sim_bodies_free(fcm_ctx *ctx, sim_contact *c)
   fcm__free(ctx, B->w2);
   fcm__free(ctx, B->w3);
   fcm__free(ctx, B->w4);
+  fcm__free(ctx, B->y0);
+  fcm__free(ctx, B->fp);
   fcm__geom_idbuf_free(ctx, &B->buf);
   fcm__free(ctx, B);
   c->bodies = NULL;
@@ -235,6 +239,7 @@ fcm_status fcm__sim_bodies_setup(fcm_integrator *I, sim_contact *c)
   fcm__sim_bodies_free(ctx, c);
   FCM_ALLOC(ctx, 1, B);
   c->bodies = B;
+  B->self = c->opts.self_contact;
   FCM_TRY(ctx, fcm_embedded_surface_create(I->space, c->geom, &B->es));
   FCM_TRY(ctx, build_samples(I, B));
   FCM_ALLOC(ctx, (size_t)B->ns * SIM_BLIND + 1, B->blind);
@@ -257,8 +262,8 @@ cleanup:
 }
 
 /* The nodes' positions X + u (x NULL: the motion dx only, into out). */
-static void node_positions(const fcm_space *s, const sim_bodies *B, const double *x, int motion,
-                           double *out)
+void fcm__sim_bodies_positions(const fcm_space *s, const sim_bodies *B, const double *x, int motion,
+                               double *out)
 {
   const int nn = s->nn;
   for (fcm_index v = 0; v < B->nv; v++) {
@@ -296,8 +301,8 @@ static void near_bodies(sim_bodies *B, double pad)
   B->near_ptr[nb] = m;
 }
 
-static fcm_status tree_boxes(fcm_ctx *ctx, sim_bodies *B, const double *y, const double *dy,
-                             int rebuild, double pad)
+fcm_status fcm__sim_bodies_boxes(fcm_ctx *ctx, sim_bodies *B, const double *y, const double *dy,
+                                 int rebuild, double pad)
 {
   fcm_status st = FCM_OK;
   for (fcm_index t = 0; t < B->nt; t++) {
@@ -326,7 +331,7 @@ cleanup:
 }
 
 /* Sample n's position (and motion, when dy is given) from the node arrays. */
-static void sample_point(const sim_bodies *B, fcm_index n, const double *y, double p[3])
+void fcm__sim_bodies_sample(const sim_bodies *B, fcm_index n, const double *y, double p[3])
 {
   const fcm_index *tv = B->tri + 3 * B->stri[n];
   const double *l = B->slam + 3 * n;
@@ -342,17 +347,29 @@ static int is_blind(const sim_bodies *B, fcm_index n, fcm_index body)
   return 0;
 }
 
-/* Whether triangle t is a target of sample n: of another body, with area, not ignored. */
-static int target(const sim_bodies *B, fcm_index n, fcm_index t)
+int fcm__sim_bodies_excluded(sim_bodies *B, fcm_index n, fcm_index t)
 {
-  const fcm_index bt = B->tbody[t];
-  return bt >= 0 && bt != B->tbody[B->stri[n]] && !is_blind(B, n, bt);
+  double X[3], g[3], beta[3];
+  B->self_tests++;
+  if (t == B->stri[n]) return 1;
+  fcm__sim_bodies_sample(B, n, B->vX, X);
+  return fcm__sim_bodies_distance(B, X, t, B->vX, g, beta) < B->rho;
+}
+
+/* Whether triangle t is a target of sample n: with area; of another body not ignored, or of its
+ * own body with self-contact and beyond the reference exclusion. */
+int fcm__sim_bodies_target(sim_bodies *B, fcm_index n, fcm_index t)
+{
+  const fcm_index bt = B->tbody[t], own = B->tbody[B->stri[n]];
+  if (bt < 0) return 0;
+  if (bt == own) return B->self && !fcm__sim_bodies_excluded(B, n, t);
+  return !is_blind(B, n, bt);
 }
 
 /* The triangles of the bodies sample n sees (not its own, not ignored; all bodies but its own
  * when all is set) whose boxes meet [lo, hi], into B->buf. */
-static fcm_status candidates(fcm_ctx *ctx, sim_bodies *B, fcm_index n, const double lo[3],
-                             const double hi[3], int all)
+fcm_status fcm__sim_bodies_candidates(fcm_ctx *ctx, sim_bodies *B, fcm_index n, const double lo[3],
+                                      const double hi[3], int all)
 {
   fcm_status st = FCM_OK;
   const fcm_index own = B->tbody[B->stri[n]];
@@ -366,14 +383,15 @@ static fcm_status candidates(fcm_ctx *ctx, sim_bodies *B, fcm_index n, const dou
     if (!all && is_blind(B, n, g)) continue;
     FCM_TRY(ctx, fcm__sim_bvh_query(ctx, &B->bvh, g, B->boxes, lo, hi, &B->buf));
   }
+  if (B->self) FCM_TRY(ctx, fcm__sim_bvh_query(ctx, &B->bvh, own, B->boxes, lo, hi, &B->buf));
 cleanup:
   return st;
 }
 
 /* The distance of p to triangle t at the node positions y, the unit gradient g and the
  * closest point's barycentric coordinates beta. */
-static double pair_distance(const sim_bodies *B, const double p[3], fcm_index t, const double *y,
-                            double g[3], double beta[3])
+double fcm__sim_bodies_distance(const sim_bodies *B, const double p[3], fcm_index t,
+                                const double *y, double g[3], double beta[3])
 {
   const fcm_index *tv = B->tri + 3 * t;
   const double *a = y + 3 * tv[0], *b = y + 3 * tv[1], *c = y + 3 * tv[2];
@@ -410,7 +428,7 @@ static void lag_blind(sim_bodies *B, fcm_index n, const double p[3])
       const fcm_index t = B->buf.ids[j];
       double g[3], beta[3];
       if (B->tbody[t] != bl[k]) continue;
-      const double d = pair_distance(B, p, t, B->y, g, beta);
+      const double d = fcm__sim_bodies_distance(B, p, t, B->y, g, beta);
       if (d >= best) continue;
       best = d;
       *lt = t;
@@ -428,15 +446,24 @@ static void lag_blind(sim_bodies *B, fcm_index n, const double p[3])
   }
 }
 
+double fcm__sim_bodies_blind_start(const fcm_integrator *I, const sim_contact *c)
+{
+  return I->opts.kind == FCM_INTEGRATOR_STATIC ? 1e-9 * c->dhat : c->dhat;
+}
+
 fcm_status fcm__sim_bodies_prepare(fcm_integrator *I, sim_contact *c, const double *x)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = I->ctx;
   sim_bodies *B = c->bodies;
   unsigned char *near = NULL;
+  /* the pieces a sample ignores from the first substep: those within d^ of it; a static solve,
+   * which has no inertia to land a piece from afar, ignores only those within 1e-9 d^ (the
+   * sides of a cut) and lets the barrier hold the others at once */
+  const double first = fcm__sim_bodies_blind_start(I, c);
   if (!B) return FCM_OK;
-  node_positions(I->space, B, x, 0, B->y);
-  FCM_TRY(ctx, tree_boxes(ctx, B, B->y, NULL, 1, c->dhat));
+  fcm__sim_bodies_positions(I->space, B, x, 0, B->y);
+  FCM_TRY(ctx, fcm__sim_bodies_boxes(ctx, B, B->y, NULL, 1, c->dhat));
   FCM_ALLOC(ctx, (size_t)B->num_bodies + 1, near);
   for (fcm_index n = 0; n < B->ns; n++) {
     fcm_index *bl = B->blind + (size_t)n * SIM_BLIND;
@@ -448,16 +475,17 @@ fcm_status fcm__sim_bodies_prepare(fcm_integrator *I, sim_contact *c, const doub
         any |= bl[k] >= 0;
       if (!any) continue;
     }
-    sample_point(B, n, B->y, p);
+    fcm__sim_bodies_sample(B, n, B->y, p);
     for (int i = 0; i < 3; i++) {
       lo[i] = p[i] - c->dhat;
       hi[i] = p[i] + c->dhat;
     }
-    FCM_TRY(ctx, candidates(ctx, B, n, lo, hi, 1));
+    FCM_TRY(ctx, fcm__sim_bodies_candidates(ctx, B, n, lo, hi, 1));
     for (size_t k = 0; k < B->buf.n; k++) {
       const fcm_index t = B->buf.ids[k], bt = B->tbody[t];
       if (bt < 0 || bt == own || near[bt]) continue;
-      if (pair_distance(B, p, t, B->y, g, beta) < c->dhat) near[bt] = 1;
+      if (fcm__sim_bodies_distance(B, p, t, B->y, g, beta) < (B->prepared ? c->dhat : first))
+        near[bt] = 1;
     }
     if (!B->prepared) { /* the bodies it starts near */
       int m = 0;
@@ -591,6 +619,68 @@ cleanup:
   return st;
 }
 
+/* The eigenpairs of the symmetric 2 x 2 matrix [a b; b d]: values sig, unit vectors e (2 x 2,
+ * column-major). */
+static void eig2(double a, double b, double d, double sig[2], double e[4])
+{
+  const double m = 0.5 * (a + d), r = sqrt(0.25 * (a - d) * (a - d) + b * b);
+  sig[0] = m + r;
+  sig[1] = m - r;
+  if (!(fabs(b) > 1e-14 * (fabs(a) + fabs(d)))) {
+    const int k = a >= d ? 0 : 1;
+    sig[0] = k ? d : a, sig[1] = k ? a : d;
+    e[0] = k ? 0.0 : 1.0, e[1] = k ? 1.0 : 0.0;
+  } else {
+    const double l = sqrt(b * b + (sig[0] - a) * (sig[0] - a));
+    e[0] = b / l, e[1] = (sig[0] - a) / l;
+  }
+  e[2] = -e[1], e[3] = e[0];
+}
+
+/* The lagged friction of the pairs at the node positions B->y (fcm__sim_bodies_slip()): the
+ * potential mu lambda f0(|T^T delta|), its force exact, its Hessian A = T Hs T^T (positive
+ * semidefinite, in the tangent plane) through the pairs' path as its two eigenpairs
+ * sigma v v^T, v = T e, like a barrier pair's c2 g g^T. */
+static fcm_status friction_terms(const fcm_integrator *I, const sim_contact *c, double *etot,
+                                 double *force, double *vals)
+{
+  fcm_status st = FCM_OK;
+  sim_bodies *B = c->bodies;
+  const double eps = c->opts.friction_velocity * I->cp.hstep;
+  if (!(c->opts.friction > 0.0) || !(eps > 0.0)) return FCM_OK;
+  for (size_t k = 0; k < B->nfp; k++) {
+    const sim_fpair *q = B->fp + k;
+    double delta[3], G[3], A[9], Hs[4], sig[2], e[4];
+    fcm__sim_bodies_slip(B, q, delta);
+    *etot += fcm__sim_friction_potential(c->opts.friction * q->lambda, eps, q->T, delta, G, A);
+    const double gn = fcm__vec3_norm(G);
+    if (force && gn > 0.0) {
+      const double gu[3] = {G[0] / gn, G[1] / gn, G[2] / gn};
+      pair_terms(I, B, q->n, q->t, gu, q->beta, gn, 0.0, force, NULL);
+    }
+    if (!vals) continue;
+    for (int a = 0; a < 2; a++) /* Hs = T^T A T */
+      for (int b = 0; b < 2; b++) {
+        double v = 0.0;
+        for (int i = 0; i < 3; i++)
+          for (int j = 0; j < 3; j++)
+            v += q->T[3 * a + i] * A[3 * i + j] * q->T[3 * b + j];
+        Hs[2 * a + b] = v;
+      }
+    eig2(Hs[0], 0.5 * (Hs[1] + Hs[2]), Hs[3], sig, e);
+    for (int m = 0; m < 2; m++) {
+      double v[3];
+      if (!(sig[m] > 0.0)) continue;
+      for (int i = 0; i < 3; i++)
+        v[i] = q->T[i] * e[2 * m] + q->T[3 + i] * e[2 * m + 1];
+      pair_terms(I, B, q->n, q->t, v, q->beta, 0.0, sig[m], NULL, vals);
+      FCM_TRY(I->ctx, record(I->ctx, B, q->n, q->t, v, q->beta, sig[m]));
+    }
+  }
+cleanup:
+  return st;
+}
+
 void fcm__sim_bodies_assemble(fcm_integrator *I, sim_contact *c, const double *x, double *energy,
                               double *force, fcm_csr *T, int *finite)
 {
@@ -601,28 +691,28 @@ void fcm__sim_bodies_assemble(fcm_integrator *I, sim_contact *c, const double *x
     *finite = 0;
     return;
   }
-  node_positions(I->space, B, x, 0, B->y);
-  if (tree_boxes(I->ctx, B, B->y, NULL, 0, c->dhat) != FCM_OK) {
+  fcm__sim_bodies_positions(I->space, B, x, 0, B->y);
+  if (fcm__sim_bodies_boxes(I->ctx, B, B->y, NULL, 0, c->dhat) != FCM_OK) {
     *finite = 0;
     return;
   }
   if (vals) B->npairs = 0;
   for (fcm_index n = 0; n < B->ns; n++) {
     double p[3], lo[3], hi[3];
-    sample_point(B, n, B->y, p);
+    fcm__sim_bodies_sample(B, n, B->y, p);
     for (int i = 0; i < 3; i++) {
       lo[i] = p[i] - c->dhat;
       hi[i] = p[i] + c->dhat;
     }
-    if (candidates(I->ctx, B, n, lo, hi, 0) != FCM_OK) {
+    if (fcm__sim_bodies_candidates(I->ctx, B, n, lo, hi, 0) != FCM_OK) {
       *finite = 0;
       return;
     }
     for (size_t k = 0; k < B->buf.n; k++) {
       const fcm_index t = B->buf.ids[k];
       double g[3], beta[3], b1, b2;
-      if (!target(B, n, t)) continue;
-      const double d = pair_distance(B, p, t, B->y, g, beta);
+      if (!fcm__sim_bodies_target(B, n, t)) continue;
+      const double d = fcm__sim_bodies_distance(B, p, t, B->y, g, beta);
       if (!(d > 0.0)) {
         *finite = 0;
         return;
@@ -641,6 +731,7 @@ void fcm__sim_bodies_assemble(fcm_integrator *I, sim_contact *c, const double *x
       return;
     }
   }
+  if (friction_terms(I, c, &etot, force, vals) != FCM_OK) *finite = 0;
   if (!isfinite(etot)) *finite = 0;
   if (energy) *energy += etot;
   /* pieces in contact: a factorization kept from another iterate lacks their coupling (and
@@ -654,16 +745,16 @@ double fcm__sim_bodies_step_bound(fcm_integrator *I, sim_contact *c, const doubl
   sim_bodies *B = c->bodies;
   double amax = DBL_MAX, M = 0.0;
   if (!B) return amax;
-  node_positions(I->space, B, x, 0, B->y);
-  node_positions(I->space, B, dx, 1, B->dy);
+  fcm__sim_bodies_positions(I->space, B, x, 0, B->y);
+  fcm__sim_bodies_positions(I->space, B, dx, 1, B->dy);
   for (fcm_index v = 0; v < B->nv; v++)
     M = FCM_MAX(M, fcm__vec3_norm(B->dy + 3 * v));
   if (M == 0.0) return amax;
-  if (tree_boxes(I->ctx, B, B->y, B->dy, 0, 0.0) != FCM_OK) return 0.0;
+  if (fcm__sim_bodies_boxes(I->ctx, B, B->y, B->dy, 0, 0.0) != FCM_OK) return 0.0;
   for (fcm_index n = 0; n < B->ns; n++) {
     double p[3], dp[3], lo[3], hi[3];
-    sample_point(B, n, B->y, p);
-    sample_point(B, n, B->dy, dp);
+    fcm__sim_bodies_sample(B, n, B->y, p);
+    fcm__sim_bodies_sample(B, n, B->dy, dp);
     const double mp = fcm__vec3_norm(dp);
     /* fractions beyond 2 never limit a step (the filter takes 0.9 of at most 1): the swept
      * boxes over [0, 2] of the sample and the triangles */
@@ -671,13 +762,23 @@ double fcm__sim_bodies_step_bound(fcm_integrator *I, sim_contact *c, const doubl
       lo[i] = FCM_MIN(p[i], p[i] + 2.0 * dp[i]);
       hi[i] = FCM_MAX(p[i], p[i] + 2.0 * dp[i]);
     }
-    if (candidates(I->ctx, B, n, lo, hi, 0) != FCM_OK) return 0.0;
+    if (fcm__sim_bodies_candidates(I->ctx, B, n, lo, hi, 0) != FCM_OK) return 0.0;
     for (size_t k = 0; k < B->buf.n; k++) {
       const fcm_index t = B->buf.ids[k], *tv = B->tri + 3 * t;
-      double g[3], beta[3], mt = 0.0;
-      if (!target(B, n, t)) continue;
-      const double d = pair_distance(B, p, t, B->y, g, beta);
+      double g[3], beta[3], mt = 0.0, rel = 0.0, dr[3];
+      if (!fcm__sim_bodies_target(B, n, t)) continue;
+      const double d = fcm__sim_bodies_distance(B, p, t, B->y, g, beta);
       if (!(d > 0.0)) return 0.0;
+      if (B->tbody[t] == B->tbody[B->stri[n]]) {
+        /* one body: in the sample's frame the triangle's points move by at most its nodes'
+         * largest motion relative to the sample, so a rigid motion never limits the step */
+        for (int j = 0; j < 3; j++) {
+          fcm__vec3_sub(B->dy + 3 * tv[j], dp, dr);
+          rel = FCM_MAX(rel, fcm__vec3_norm(dr));
+        }
+        if (rel > 0.0) amax = FCM_MIN(amax, d / rel);
+        continue;
+      }
       for (int j = 0; j < 3; j++)
         mt = FCM_MAX(mt, fcm__vec3_norm(B->dy + 3 * tv[j]));
       if (mp + mt > 0.0) amax = FCM_MIN(amax, d / (mp + mt));
@@ -696,21 +797,21 @@ fcm_status fcm__sim_bodies_stats(const fcm_integrator *I, const sim_contact *c, 
   *min_distance = HUGE_VAL;
   *energy = 0.0;
   if (!B) return FCM_OK;
-  node_positions(I->space, B, x, 0, B->y);
-  FCM_TRY(ctx, tree_boxes(ctx, B, B->y, NULL, 0, c->dhat));
+  fcm__sim_bodies_positions(I->space, B, x, 0, B->y);
+  FCM_TRY(ctx, fcm__sim_bodies_boxes(ctx, B, B->y, NULL, 0, c->dhat));
   for (fcm_index n = 0; n < B->ns; n++) {
     double p[3], lo[3], hi[3];
-    sample_point(B, n, B->y, p);
+    fcm__sim_bodies_sample(B, n, B->y, p);
     for (int i = 0; i < 3; i++) {
       lo[i] = p[i] - c->dhat;
       hi[i] = p[i] + c->dhat;
     }
-    FCM_TRY(ctx, candidates(ctx, B, n, lo, hi, 0));
+    FCM_TRY(ctx, fcm__sim_bodies_candidates(ctx, B, n, lo, hi, 0));
     for (size_t k = 0; k < B->buf.n; k++) {
       const fcm_index t = B->buf.ids[k];
       double g[3], beta[3], b1, b2;
-      if (!target(B, n, t)) continue;
-      const double d = pair_distance(B, p, t, B->y, g, beta);
+      if (!fcm__sim_bodies_target(B, n, t)) continue;
+      const double d = fcm__sim_bodies_distance(B, p, t, B->y, g, beta);
       *min_distance = FCM_MIN(*min_distance, d);
       if (!(d > 0.0) || d >= c->dhat) continue;
       (*pairs)++;
@@ -725,100 +826,6 @@ cleanup:
 long long fcm__sim_bodies_builds(const sim_contact *c)
 {
   return c->bodies ? c->bodies->builds : 0;
-}
-
-/* Whether the segment o -> o + r (r the ray, parameter in [0, 1]) crosses triangle (a, b, c)
- * (Moller-Trumbore; a segment in the triangle's plane does not). */
-static int crosses(const double o[3], const double r[3], const double *a, const double *b,
-                   const double *c)
-{
-  double e1[3], e2[3], pv[3], tv[3], qv[3];
-  fcm__vec3_sub(b, a, e1);
-  fcm__vec3_sub(c, a, e2);
-  fcm__vec3_cross(r, e2, pv);
-  const double det = fcm__vec3_dot(e1, pv);
-  if (!(fabs(det) > 1e-14 * fcm__vec3_norm(e1) * fcm__vec3_norm(e2) * fcm__vec3_norm(r))) return 0;
-  fcm__vec3_sub(o, a, tv);
-  const double u = fcm__vec3_dot(tv, pv) / det;
-  if (u < 0.0 || u > 1.0) return 0;
-  fcm__vec3_cross(tv, e1, qv);
-  const double v = fcm__vec3_dot(r, qv) / det;
-  if (v < 0.0 || u + v > 1.0) return 0;
-  const double s = fcm__vec3_dot(e2, qv) / det;
-  return s >= 0.0 && s <= 1.0;
-}
-
-/* The depth of p inside body g (0 outside): the parity of a ray's crossings with g's
- * triangles, and inside, the distance to the nearest of them. */
-static fcm_status depth_in(fcm_ctx *ctx, sim_bodies *B, fcm_index g, const double p[3], double len,
-                           double *depth)
-{
-  fcm_status st = FCM_OK;
-  static const double dir[3] = {0.5377304, 0.3180952, 0.7808866};
-  const sim_bvh_node *root = B->bvh.node + B->bvh.root[g];
-  double r[3], lo[3], hi[3];
-  int count = 0;
-  *depth = 0.0;
-  for (int i = 0; i < 3; i++)
-    if (p[i] < root->lo[i] || p[i] > root->hi[i]) return FCM_OK;
-  for (int i = 0; i < 3; i++) {
-    r[i] = len * dir[i];
-    lo[i] = FCM_MIN(p[i], p[i] + r[i]);
-    hi[i] = FCM_MAX(p[i], p[i] + r[i]);
-  }
-  B->buf.n = 0;
-  FCM_TRY(ctx, fcm__sim_bvh_query(ctx, &B->bvh, g, B->boxes, lo, hi, &B->buf));
-  for (size_t k = 0; k < B->buf.n; k++) {
-    const fcm_index *tv = B->tri + 3 * B->buf.ids[k];
-    count += crosses(p, r, B->y + 3 * tv[0], B->y + 3 * tv[1], B->y + 3 * tv[2]);
-  }
-  if (count % 2 == 0) return FCM_OK;
-  B->buf.n = 0;
-  FCM_TRY(ctx, fcm__sim_bvh_query(ctx, &B->bvh, g, B->boxes, root->lo, root->hi, &B->buf));
-  *depth = HUGE_VAL;
-  for (size_t k = 0; k < B->buf.n; k++) {
-    double gr[3], beta[3];
-    *depth = FCM_MIN(*depth, pair_distance(B, p, B->buf.ids[k], B->y, gr, beta));
-  }
-cleanup:
-  return st;
-}
-
-fcm_status fcm__sim_bodies_depth(const fcm_integrator *I, const sim_contact *c, const double *x,
-                                 double *depth, double where[3])
-{
-  fcm_status st = FCM_OK;
-  fcm_ctx *ctx = I->ctx;
-  sim_bodies *B = c->bodies;
-  double len = 0.0;
-  *depth = 0.0;
-  if (!B) return FCM_OK;
-  node_positions(I->space, B, x, 0, B->y);
-  FCM_TRY(ctx, tree_boxes(ctx, B, B->y, NULL, 0, c->dhat));
-  for (fcm_index g = 0; g < B->num_bodies; g++) {
-    if (B->bvh.root[g] < 0) continue;
-    const sim_bvh_node *nd = B->bvh.node + B->bvh.root[g];
-    double l = 0.0;
-    for (int i = 0; i < 3; i++)
-      l += (nd->hi[i] - nd->lo[i]) * (nd->hi[i] - nd->lo[i]);
-    len = FCM_MAX(len, 2.0 * sqrt(l) + 1e-12);
-  }
-  for (fcm_index n = 0; n < B->ns; n++) {
-    double p[3];
-    const fcm_index own = B->tbody[B->stri[n]];
-    sample_point(B, n, B->y, p);
-    for (fcm_index g = 0; g < B->num_bodies; g++) {
-      double dg = 0.0;
-      if (g == own || B->bvh.root[g] < 0) continue;
-      FCM_TRY(ctx, depth_in(ctx, B, g, p, len, &dg));
-      if (dg > *depth) {
-        *depth = dg;
-        if (where) memcpy(where, p, sizeof p);
-      }
-    }
-  }
-cleanup:
-  return st;
 }
 
 fcm_index fcm__sim_bodies_samples(const sim_contact *c, fcm_index *triangles)

@@ -22,8 +22,7 @@
 #include <math.h>
 #include <string.h>
 
-/* Unit tangents t1, t2 normal to the unit vector g (T column-major: t1 then t2). */
-static void tangent_basis(const double g[3], double T[6])
+void fcm__sim_tangent_basis(const double g[3], double T[6])
 {
   double e[3] = {0, 0, 0}, t1[3], t2[3];
   const int k = fabs(g[0]) <= fabs(g[1]) ? (fabs(g[0]) <= fabs(g[2]) ? 0 : 2)
@@ -70,14 +69,14 @@ static fcm_status lag_at(fcm_integrator *I, const double *x, double *change)
       for (int c = 0; c < nc; c++) {
         const sim_contact *ct = &I->contacts[c];
         double d, g[3], *L = cp->lag + 7 * ((size_t)p * nc + c), old = L[0];
-        if (!(ct->opts.friction > 0.0)) continue;
+        if (!(ct->opts.friction > 0.0) || ct->kind == SIM_CONTACT_BODIES) continue;
         memset(L, 0, 7 * sizeof *L);
         FCM_TRY(ctx, fcm__sim_contact_distance(ctx, ct, &cp->pose[c], y, I->bc_time, ct->dhat,
                                                &cp->buf, &d, g, NULL));
         if (d > 0.0 && d < ct->dhat) {
           const double r = d - ct->dhat, b1 = -2.0 * r * log(d / ct->dhat) - r * r / d;
           L[0] = cp->w[p] * ct->kappa * fabs(b1);
-          tangent_basis(g, L + 1);
+          fcm__sim_tangent_basis(g, L + 1);
         }
         dmax = FCM_MAX(dmax, fabs(L[0] - old));
         lmax = FCM_MAX(lmax, FCM_MAX(L[0], old));
@@ -107,6 +106,9 @@ fcm_status fcm__sim_contact_lag(fcm_integrator *I, double h)
   }
   memset(cp->lag, 0, sizeof(double) * 7 * (size_t)cp->np * (size_t)nc);
   FCM_TRY(ctx, lag_at(I, I->un, NULL));
+  for (int c = 0; c < nc; c++)
+    if (I->contacts[c].kind == SIM_CONTACT_BODIES)
+      FCM_TRY(ctx, fcm__sim_bodies_friction_lag(I, &I->contacts[c], I->un, 1, NULL));
 cleanup:
   return st;
 }
@@ -124,6 +126,12 @@ fcm_status fcm__sim_contact_relag(fcm_integrator *I, double *change)
 {
   fcm_status st = FCM_OK;
   FCM_TRY(I->ctx, lag_at(I, I->u, change));
+  for (int c = 0; c < I->num_contacts; c++)
+    if (I->contacts[c].kind == SIM_CONTACT_BODIES) {
+      double ch = 0.0;
+      FCM_TRY(I->ctx, fcm__sim_bodies_friction_lag(I, &I->contacts[c], I->u, 0, &ch));
+      *change = FCM_MAX(*change, ch);
+    }
   I->cp.relags++;
 cleanup:
   return st;
@@ -174,12 +182,54 @@ double fcm__sim_contact_friction_work(const fcm_integrator *I, fcm_index p, cons
     double delta[3], J[9];
     if (!(L[0] > 0.0) || !(eps > 0.0)) continue;
     relative_motion(cp, ct, c, y, y0, delta, J);
-    const double s0 = fcm__vec3_dot(T, delta), s1 = fcm__vec3_dot(T + 3, delta);
-    const double x = sqrt(s0 * s0 + s1 * s1);
-    const double f1 = x < eps ? 2.0 * x / eps - x * x / (eps * eps) : 1.0;
-    work += ct->opts.friction * L[0] * f1 * x;
+    work += fcm__sim_friction_work(ct->opts.friction * L[0], eps, T, delta);
   }
   return work;
+}
+
+double fcm__sim_friction_potential(double ml, double eps, const double T[6], const double delta[3],
+                                   double G[3], double A[9])
+{
+  double s[2], gs[2], Hs[4], e;
+  s[0] = fcm__vec3_dot(T, delta);
+  s[1] = fcm__vec3_dot(T + 3, delta);
+  const double x = sqrt(s[0] * s[0] + s[1] * s[1]);
+  if (x < eps) {
+    const double q = 2.0 / eps - x / (eps * eps); /* f1(x) / x */
+    e = ml * (-x * x * x / (3.0 * eps * eps) + x * x / eps + eps / 3.0);
+    for (int i = 0; i < 2; i++) {
+      gs[i] = ml * q * s[i];
+      for (int j = 0; j < 2; j++)
+        Hs[2 * i + j] = ml * ((i == j) * q - (x > 0.0 ? s[i] * s[j] / (eps * eps * x) : 0.0));
+    }
+  } else {
+    e = ml * x;
+    for (int i = 0; i < 2; i++) {
+      gs[i] = ml * s[i] / x;
+      for (int j = 0; j < 2; j++)
+        Hs[2 * i + j] = ml / x * ((i == j) - s[i] * s[j] / (x * x));
+    }
+  }
+  /* to delta: G = T gs, A = T Hs T^T */
+  for (int i = 0; i < 3; i++) {
+    G[i] = T[i] * gs[0] + T[3 + i] * gs[1];
+    for (int j = 0; j < 3; j++) {
+      double v = 0.0;
+      for (int a = 0; a < 2; a++)
+        for (int b = 0; b < 2; b++)
+          v += T[3 * a + i] * Hs[2 * a + b] * T[3 * b + j];
+      A[3 * i + j] = v;
+    }
+  }
+  return e;
+}
+
+double fcm__sim_friction_work(double ml, double eps, const double T[6], const double delta[3])
+{
+  const double s0 = fcm__vec3_dot(T, delta), s1 = fcm__vec3_dot(T + 3, delta);
+  const double x = sqrt(s0 * s0 + s1 * s1);
+  const double f1 = x < eps ? 2.0 * x / eps - x * x / (eps * eps) : 1.0;
+  return ml * f1 * x;
 }
 
 double fcm__sim_contact_friction(const fcm_integrator *I, fcm_index p, const double y[3],
@@ -195,38 +245,10 @@ double fcm__sim_contact_friction(const fcm_integrator *I, fcm_index p, const dou
     const double *L = cp->lag + 7 * ((size_t)p * nc + c), *T = L + 1;
     const double eps = ct->opts.friction_velocity * cp->hstep;
     if (!(L[0] > 0.0) || !(eps > 0.0)) continue;
-    double delta[3], J[9], s[2], gs[2], Hs[4], G[3], A[9];
+    double delta[3], J[9], G[3], A[9];
     relative_motion(cp, ct, c, y, y0, delta, J);
-    s[0] = fcm__vec3_dot(T, delta);
-    s[1] = fcm__vec3_dot(T + 3, delta);
-    const double x = sqrt(s[0] * s[0] + s[1] * s[1]), ml = ct->opts.friction * L[0];
-    if (x < eps) {
-      const double q = 2.0 / eps - x / (eps * eps); /* f1(x) / x */
-      e += ml * (-x * x * x / (3.0 * eps * eps) + x * x / eps + eps / 3.0);
-      for (int i = 0; i < 2; i++) {
-        gs[i] = ml * q * s[i];
-        for (int j = 0; j < 2; j++)
-          Hs[2 * i + j] = ml * ((i == j) * q - (x > 0.0 ? s[i] * s[j] / (eps * eps * x) : 0.0));
-      }
-    } else {
-      e += ml * x;
-      for (int i = 0; i < 2; i++) {
-        gs[i] = ml * s[i] / x;
-        for (int j = 0; j < 2; j++)
-          Hs[2 * i + j] = ml / x * ((i == j) - s[i] * s[j] / (x * x));
-      }
-    }
-    /* to delta: G = T gs, A = T Hs T^T; to y: J^T G, J^T A J */
-    for (int i = 0; i < 3; i++) {
-      G[i] = T[i] * gs[0] + T[3 + i] * gs[1];
-      for (int j = 0; j < 3; j++) {
-        double v = 0.0;
-        for (int a = 0; a < 2; a++)
-          for (int b = 0; b < 2; b++)
-            v += T[3 * a + i] * Hs[2 * a + b] * T[3 * b + j];
-        A[3 * i + j] = v;
-      }
-    }
+    e += fcm__sim_friction_potential(ct->opts.friction * L[0], eps, T, delta, G, A);
+    /* to y: J^T G, J^T A J */
     for (int i = 0; i < 3; i++) {
       for (int k = 0; k < 3; k++)
         grad[i] += J[3 * k + i] * G[k];

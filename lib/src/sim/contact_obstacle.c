@@ -1,5 +1,6 @@
 /* sim: the geometry of the contact obstacles — distance, its gradient and Hessian, the first
- * time a straight path meets an obstacle, and the inside test.
+ * time a straight path meets an obstacle, and the inside test (and the public query
+ * fcm_integrator_contact_distance()).
  *
  * Spheres, boxes and triangle surfaces are described in their own frame and placed at time t by
  * a rigid motion x = o + R X (fcm_motion_eval()); a world point y is seen at X = R^T (y - o),
@@ -462,4 +463,37 @@ double fcm__sim_contact_reach(const sim_contact *c, const sim_pose *P, const dou
     diag += (c->hi[i] - c->lo[i]) * (c->hi[i] - c->lo[i]);
   }
   return sqrt(r) + sqrt(diag);
+}
+
+fcm_status fcm_integrator_contact_distance(const fcm_integrator *I, int id, const double x[3],
+                                           double t, double *distance, double gradient[3],
+                                           double hessian[9])
+{
+  fcm_status st = FCM_OK;
+  fcm__idbuf buf = {NULL, 0, 0};
+  FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
+  fcm_ctx *ctx = I->ctx;
+  FCM_CHECK(id >= 0 && id < I->num_contacts, ctx, FCM_ERR_ARG,
+            "contact distance: obstacle %d out of range [0, %d)", id, I->num_contacts);
+  FCM_CHECK(x && distance, ctx, FCM_ERR_ARG, "contact distance: NULL point or distance");
+  FCM_CHECK(I->contacts[id].kind != SIM_CONTACT_BODIES, ctx, FCM_ERR_ARG,
+            "contact distance: contact %d is between bodies (no obstacle to measure to)", id);
+  {
+    const sim_contact *ct = &I->contacts[id];
+    double g[3], H[9];
+    int inside = 0;
+    sim_pose P;
+    fcm__sim_contact_pose(ct, t, &P);
+    FCM_TRY(ctx, fcm__sim_contact_distance(ctx, ct, &P, x, t, fcm__sim_contact_reach(ct, &P, x),
+                                           &buf, distance, g, H));
+    if (ct->kind == SIM_CONTACT_SURFACE) {
+      FCM_TRY(ctx, fcm__sim_contact_inside(ctx, ct, &P, x, t, &buf, &inside));
+      if (inside) *distance = -*distance;
+    }
+    if (gradient) memcpy(gradient, g, sizeof g);
+    if (hessian) memcpy(hessian, H, sizeof H);
+  }
+cleanup:
+  if (I) fcm__geom_idbuf_free(I->ctx, &buf);
+  return st;
 }

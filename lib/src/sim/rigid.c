@@ -12,7 +12,9 @@
  * gamma/2 |P_c u|^2 > 0 for a moving rigid mode), and an embedded-surface point within the
  * threshold d^ of a contact obstacle at the step's start (the row of its distance's gradient g,
  * (g, y x g): the barrier's Newton matrix w kappa b''(d) g g^T > 0 holds the modes that move it
- * along g; a body beyond every threshold is not held by the obstacles). The modes that no row holds
+ * along g; a body beyond every threshold is not held by the obstacles), and a sample within d^
+ * of another body's triangle (contact between bodies) once that body is held in all its modes
+ * (the same row; body_pair_rows()). The modes that no row holds
  * are the null space of the 6 x 6 Gram matrix of the rows: a body is free when that matrix is
  * singular (eigenvalues below RIGID_TOL of the largest; exactly collinear points give
  * rounding-level values, about 1e-16). Partial constraints (some components only) are covered by
@@ -42,6 +44,7 @@ typedef struct rigid_body {
   fcm_index full, part; /* nodes held in all / in some components */
   fcm_index bpoints;    /* boundary-constraint points */
   fcm_index cpoints;    /* surface points within the barrier's reach of a contact obstacle */
+  fcm_index ppoints;    /* surface points within the barrier's reach of a held body */
   int tied;             /* an element uses another node's copy (translations only) */
 } rigid_body;
 
@@ -125,6 +128,10 @@ static void held_by(char *buf, size_t n, const rigid_body *b)
                     "%s%lld surface point%s within a contact "
                     "obstacle's threshold",
                     len ? " and " : "", (long long)b->cpoints, b->cpoints > 1 ? "s" : "");
+  if (b->ppoints > 0)
+    len += snprintf(buf + len, n - (size_t)len,
+                    "%s%lld surface point%s within the threshold of a held body",
+                    len ? " and " : "", (long long)b->ppoints, b->ppoints > 1 ? "s" : "");
   if (len == 0)
     snprintf(buf, n,
              "nothing (no constrained node, no boundary-constraint point, no surface point "
@@ -178,11 +185,21 @@ cleanup:
 }
 
 /* What the check builds: the bodies (element -> body, copy -> node and body) and their data. */
+/* A pair of surface points of two bodies within the threshold of the contact between bodies. */
+typedef struct rigid_pair {
+  fcm_index a, b;
+  double ya[3], yb[3], g[3];
+} rigid_pair;
+
 typedef struct rigid_work {
   fcm_index *elem_body, *copy_node, *copy_body, nb;
   unsigned char *held; /* per copy: its constrained components */
   rigid_body *B;
   double *sum; /* with a backend: the summed boundary parts, 40 per body */
+  rigid_pair *pairs;
+  size_t npairs, cap_pairs;
+  int failed; /* out of memory while collecting the pairs */
+  fcm_ctx *ctx;
 } rigid_work;
 
 /* Local phase: the bodies, their bounding boxes and tied elements, and the rows of this
@@ -303,6 +320,86 @@ static void contact_row(void *user, fcm_index elem, const double y[3], const dou
   b->cpoints++;
 }
 
+static void pair_row(void *user, fcm_index ea, const double ya[3], fcm_index eb, const double yb[3],
+                     const double g[3])
+{
+  rigid_work *w = user;
+  if (w->npairs == w->cap_pairs) {
+    const size_t cap = w->cap_pairs ? 2 * w->cap_pairs : 64;
+    void *grown = w->pairs;
+    if (w->failed || fcm__resize(w->ctx, &grown, w->cap_pairs, cap, sizeof *w->pairs) != FCM_OK) {
+      w->failed = 1;
+      return;
+    }
+    w->pairs = grown;
+    w->cap_pairs = cap;
+  }
+  rigid_pair *q = w->pairs + w->npairs++;
+  q->a = w->elem_body[ea];
+  q->b = w->elem_body[eb];
+  memcpy(q->ya, ya, sizeof q->ya);
+  memcpy(q->yb, yb, sizeof q->yb);
+  memcpy(q->g, g, sizeof q->g);
+}
+
+/* Whether body b's modes are all held by its rows so far. */
+static fcm_status body_held(fcm_ctx *ctx, const rigid_body *b, int *held)
+{
+  int ft = 0, fr = 0;
+  double p[3], a[3];
+  fcm_status st = body_free_modes(ctx, b, &ft, &fr, p, a);
+  *held = st == FCM_OK && ft + fr == 0;
+  return st;
+}
+
+/* Contact between bodies: a pair within d^ couples two bodies through the barrier's
+ * w kappa b''(d) G G^T, so a body held in all six modes holds its partner along g at the pair's
+ * point, as an obstacle would. In passes: the bodies held so far (pass 0: by constraints and
+ * obstacles) hold their partners; a partner then held in all its modes holds its own partners
+ * at the next pass. Each pair adds its row once, in the pass after its holding side became
+ * held. */
+static fcm_status body_pair_rows(fcm_integrator *I, rigid_work *w)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  int *when = NULL, held = 0;
+  const sim_contact *bc = NULL;
+  for (int c = 0; c < I->num_contacts; c++)
+    if (I->contacts[c].kind == SIM_CONTACT_BODIES) bc = &I->contacts[c];
+  if (!bc || w->nb < 2) return FCM_OK;
+  w->ctx = ctx;
+  FCM_TRY(ctx, fcm__sim_bodies_support(I, bc, I->u, pair_row, w));
+  FCM_CHECK(!w->failed, ctx, FCM_ERR_ALLOC, "integrator: out of memory (rigid-mode check)");
+  FCM_ALLOC(ctx, (size_t)w->nb, when);
+  for (fcm_index b = 0; b < w->nb; b++) {
+    FCM_TRY(ctx, body_held(ctx, &w->B[b], &held));
+    when[b] = held ? 0 : -1;
+  }
+  for (int pass = 1; pass <= w->nb; pass++) {
+    int any = 0;
+    for (size_t k = 0; k < w->npairs; k++) {
+      const rigid_pair *q = w->pairs + k;
+      for (int side = 0; side < 2; side++) {
+        const fcm_index from = side ? q->a : q->b, to = side ? q->b : q->a;
+        if (from == to || when[from] != pass - 1 || when[to] >= 0) continue;
+        double c[3], L;
+        centre_scale(&w->B[to], c, &L);
+        add_direction_row(&w->B[to], q->g, side ? q->yb : q->ya, c, L);
+        w->B[to].ppoints++;
+      }
+    }
+    for (fcm_index b = 0; b < w->nb; b++) {
+      if (when[b] >= 0) continue;
+      FCM_TRY(ctx, body_held(ctx, &w->B[b], &held));
+      if (held) when[b] = pass, any = 1;
+    }
+    if (!any) break;
+  }
+cleanup:
+  fcm__free(ctx, when);
+  return st;
+}
+
 fcm_status fcm__sim_check_rigid_modes(fcm_integrator *I, double t)
 {
   fcm_status st = FCM_OK;
@@ -314,6 +411,7 @@ fcm_status fcm__sim_check_rigid_modes(fcm_integrator *I, double t)
   FCM_TRY(ctx, st);
   node_rows(I, &w);
   if (I->num_contacts > 0) FCM_TRY(ctx, fcm__sim_contact_support(I, I->u, t, contact_row, &w));
+  if (I->num_contacts > 0) FCM_TRY(ctx, body_pair_rows(I, &w));
   fcm_index bad = -1, nbad = 0;
   int ft = 0, fr = 0;
   double p[3] = {0, 0, 0}, a[3] = {0, 0, 0};
@@ -360,5 +458,6 @@ cleanup:
   fcm__free(ctx, w.held);
   fcm__free(ctx, w.B);
   fcm__free(ctx, w.sum);
+  fcm__free(ctx, w.pairs);
   return st;
 }

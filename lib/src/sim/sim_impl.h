@@ -414,6 +414,13 @@ fcm_status fcm__sim_contact_lag(fcm_integrator *I, double h);
  * at the current state (*change: the largest normal force's relative change). */
 int fcm__sim_contact_updates(const fcm_integrator *I);
 fcm_status fcm__sim_contact_relag(fcm_integrator *I, double *change);
+/* The smoothed friction potential mu lambda f0(|s|) (ml = mu lambda), s = T^T delta: its value,
+ * gradient G and Hessian A (3 x 3) in delta; the work ml f1(|s|) |s| of its force over delta;
+ * an orthonormal tangent basis T (3 x 2, column-major) of the plane normal to unit g. */
+double fcm__sim_friction_potential(double ml, double eps, const double T[6], const double delta[3],
+                                   double G[3], double A[9]);
+double fcm__sim_friction_work(double ml, double eps, const double T[6], const double delta[3]);
+void fcm__sim_tangent_basis(const double g[3], double T[6]);
 double fcm__sim_contact_friction(const fcm_integrator *I, fcm_index p, const double y[3],
                                  const double y0[3], double grad[3], double hess[9]);
 /* The work of point p's friction forces over its slip from y0 to y: sum of mu lambda f1 |s|. */
@@ -474,6 +481,14 @@ typedef struct sim_pair {
   double g[3], beta[3], c2;
 } sim_pair;
 
+/* A pair's lagged friction (contact_bodies_friction.c): sample n, triangle t, the closest
+ * point's barycentric coordinates beta, the normal force lambda = w kappa |b'(d)| and the
+ * tangent basis T (3 x 2, column-major) at the substep's start. */
+typedef struct sim_fpair {
+  fcm_index n, t;
+  double beta[3], lambda, T[6];
+} sim_fpair;
+
 typedef struct sim_bodies {
   fcm_embedded_surface *es;
   fcm_index nv, nt, ns;
@@ -500,6 +515,12 @@ typedef struct sim_bodies {
   double *w1, *w2, *w3, *w4; /* n each: the direction's refinement */
   fcm__idbuf buf;
   long long builds;
+  int self;             /* self-contact (fcm_contact_options.self_contact) */
+  double rho;           /* 2 d^: own triangles closer in the reference state are excluded */
+  long long self_tests; /* own-body candidates tested against the exclusion */
+  double *y0;           /* nv x 3: the nodes at the substep's start (friction) */
+  sim_fpair *fp;        /* the pairs' lagged friction */
+  size_t nfp, cap_fp;
 } sim_bodies;
 
 /* Contact between bodies and cut pieces (contact_bodies.c), the obstacle kind
@@ -534,6 +555,55 @@ fcm_index fcm__sim_bodies_element_nodes(const fcm_integrator *I, fcm_index e, do
  * solve; nothing without pairs or on an octree mesh. */
 fcm_status fcm__sim_bodies_refine(fcm_integrator *I, const double *b, double *d,
                                   fcm_step_reason *reason, int *its, sim_stats *stats);
+/* Helpers shared with contact_bodies_depth.c: the nodes' positions X + u at x (motion: the
+ * motion u only); the triangles' boxes (swept over y + s dy, s in [0, 2], when dy is given)
+ * and the tree built again or refitted to them; sample n's position at node positions y; the
+ * distance of p to triangle t at node positions y, its unit gradient and the closest point's
+ * barycentric coordinates. */
+void fcm__sim_bodies_positions(const fcm_space *s, const sim_bodies *B, const double *x, int motion,
+                               double *out);
+fcm_status fcm__sim_bodies_boxes(fcm_ctx *ctx, sim_bodies *B, const double *y, const double *dy,
+                                 int rebuild, double pad);
+void fcm__sim_bodies_sample(const sim_bodies *B, fcm_index n, const double *y, double p[3]);
+double fcm__sim_bodies_distance(const sim_bodies *B, const double p[3], fcm_index t,
+                                const double *y, double g[3], double beta[3]);
+/* The triangles sample n sees (its own with self-contact; not the bodies it ignores, unless
+ * all) whose boxes meet [lo, hi], into B->buf; whether triangle t is a target of sample n. */
+fcm_status fcm__sim_bodies_candidates(fcm_ctx *ctx, sim_bodies *B, fcm_index n, const double lo[3],
+                                      const double hi[3], int all);
+int fcm__sim_bodies_target(sim_bodies *B, fcm_index n, fcm_index t);
+/* Friction between bodies (contact_bodies_friction.c). lag: at x, each pair within d^ keeps its
+ * normal force, closest point and tangent basis (start: x is the substep's start, whose node
+ * positions the slip counts from; change, may be NULL: the relative change of the sum of the
+ * normal forces). slip: pair q's sample motion since the substep's start relative to its
+ * triangle's closest point, at the node positions B->y. work: the friction forces' work over
+ * the slip at x. */
+fcm_status fcm__sim_bodies_friction_lag(fcm_integrator *I, sim_contact *c, const double *x,
+                                        int start, double *change);
+void fcm__sim_bodies_slip(const sim_bodies *B, const sim_fpair *q, double delta[3]);
+double fcm__sim_bodies_friction_work(const fcm_integrator *I, const sim_contact *c,
+                                     const double *x);
+/* Whether the pair (sample n, triangle t of its own body) is excluded from self-contact: its
+ * reference distance below B->rho (counted in self_tests). */
+int fcm__sim_bodies_excluded(sim_bodies *B, fcm_index n, fcm_index t);
+/* Self-contact at x: the own-body pairs within d^ (pairs), and the largest depth of an interior
+ * sample inside its own body (depth, where: may be NULL), computed with or without the option
+ * (contact_bodies_depth.c). */
+fcm_status fcm__sim_bodies_self_stats(const fcm_integrator *I, const sim_contact *c,
+                                      const double *x, long long *pairs, double *depth,
+                                      double where[3]);
+long long fcm__sim_bodies_self_tests(const sim_contact *c);
+/* The distance below which a sample ignores another body from the first substep on: d^, or
+ * 1e-9 d^ in a static solve (only the sides of a cut). */
+double fcm__sim_bodies_blind_start(const fcm_integrator *I, const sim_contact *c);
+/* Each pair of a sample and a triangle of another body within d^ at x that the barrier holds
+ * (not ignored): fn with an element of each side, the sample's position ya, the closest point
+ * yb and the unit direction g from yb to ya (the static check of the rigid modes, rigid.c). */
+fcm_status fcm__sim_bodies_support(const fcm_integrator *I, const sim_contact *c, const double *x,
+                                   void (*fn)(void *user, fcm_index elem_a, const double ya[3],
+                                              fcm_index elem_b, const double yb[3],
+                                              const double g[3]),
+                                   void *user);
 /* The sample points and (in *triangles, may be NULL) the triangles of the surface. */
 fcm_index fcm__sim_bodies_samples(const sim_contact *c, fcm_index *triangles);
 /* The search trees built so far (each evaluation, step bound and stats builds one). */
