@@ -34,6 +34,28 @@ static inline double max2(double a, double b)
   return b > a ? b : a;
 }
 
+/* x^T y over n entries in 8 partial sums (one per vector lane, added in a fixed tree at the
+ * end): a single running sum is a chain of n dependent additions. */
+static inline double dot(int n, const double *x, const double *y)
+{
+#if defined(__GNUC__) || defined(__clang__)
+  typedef double v8d __attribute__((vector_size(64)));
+  v8d acc = {0}, a, b;
+  int i = 0;
+  for (; i + 8 <= n; i += 8) {
+    memcpy(&a, x + i, sizeof a), memcpy(&b, y + i, sizeof b);
+    acc += a * b;
+  }
+  double t = ((acc[0] + acc[4]) + (acc[2] + acc[6])) + ((acc[1] + acc[5]) + (acc[3] + acc[7]));
+#else
+  double t = 0.0;
+  int i = 0;
+#endif
+  for (; i < n; i++)
+    t += x[i] * y[i];
+  return t;
+}
+
 /* max_i |(P_S w)_i - b_i| / max(max_i |b_i|, atol / tol) over the support S (columns idx of P,
  * ld M): relative to the moments, or to the floor below which they are rounding. */
 static double fit_residual(int M, const double *P, int count, const int *idx, const double *w,
@@ -129,6 +151,9 @@ cleanup:
  * optimality test stay in double. */
 #define NNLS_SINGLE_TRUST 1e-3
 
+/* Rows of the float copy of A (and of the residual): M padded to a multiple of 16. */
+#define NNLS_MF(M) (((M) + 15) / 16 * 16)
+
 typedef struct nnls_qr {
   int M, np, kcols; /* rows, passive columns, columns of A */
   double *Q;        /* M x M orthogonal, times the pending reflections (nref) */
@@ -161,10 +186,7 @@ static void nnls_flush(nnls_qr *s)
     const double *vi = V + (size_t)i * (size_t)M;
     for (int j = 0; j < i; j++) {
       const double *vj = V + (size_t)j * (size_t)M;
-      double d = 0.0;
-      for (int r = s->at[i] - off; r < m; r++)
-        d += vj[r] * vi[r];
-      y[j] = d;
+      y[j] = dot(m - (s->at[i] - off), vj + s->at[i] - off, vi + s->at[i] - off);
     }
     for (int j = 0; j < i; j++) {
       double t = 0.0;
@@ -193,31 +215,23 @@ static void nnls_add(nnls_qr *s, int t, const double *a, double anorm, int *adde
   if (s->nref == NNLS_BATCH) nnls_flush(s);
   /* q = Q^T a, as R's next column, with Q's pending reflections applied to it in their order;
    * the basis' values are O(1): its norm needs no scaling */
-  fcm__gemv('T', M, M, 1.0, s->Q, M, a, 0.0, q);
+  fcm__fit_dgemv_t(M, M, s->Q, M, a, q);
   for (int i = 0; i < s->nref; i++) {
     const double *vi = s->V + (size_t)i * (size_t)M;
-    double d = 0.0;
-    for (int r = s->at[i]; r < M; r++)
-      d += vi[r] * q[r];
-    d *= s->beta[i];
+    const double d = s->beta[i] * dot(M - s->at[i], vi + s->at[i], q + s->at[i]);
     for (int r = s->at[i]; r < M; r++)
       q[r] -= d * vi[r];
     s->flops += 4.0 * (M - s->at[i]);
   }
   s->flops += 2.0 * M * M + 6.0 * m;
-  double nu = 0.0;
-  for (int i = np; i < M; i++)
-    nu += q[i] * q[i];
-  nu = sqrt(nu);
+  const double nu = sqrt(dot(m, q + np, q + np));
   if (!(nu > NNLS_DEP_TOL * anorm)) return;
   /* H = I - beta v v^T on rows np.. with H q = alpha e_np */
   const double alpha = q[np] >= 0.0 ? -nu : nu;
-  double vv = 0.0, vb = 0.0;
   for (int i = 0; i < m; i++)
     v[i] = q[np + i];
   v[0] -= alpha;
-  for (int i = 0; i < m; i++)
-    vv += v[i] * v[i], vb += v[i] * s->qtb[np + i];
+  const double vv = dot(m, v, v), vb = dot(m, v, s->qtb + np);
   const double beta = 2.0 / vv;
   if (!((s->qtb[np] - beta * vb * v[0]) / alpha > 0.0)) return; /* its weight would be <= 0 */
   for (int i = 0; i < m; i++)
@@ -355,9 +369,7 @@ FCM_MULTIVERSION_CLONES static void nnls_more(nnls_qr *s, const double *A, const
     int apart = 1;
     for (int c = 0; c < nch && apart; c++) {
       const double *ac = A + (size_t)chosen[c] * (size_t)M;
-      double d = 0.0;
-      for (int i = 0; i < M; i++)
-        d += aj[i] * ac[i];
+      const double d = dot(M, aj, ac);
       apart = fabs(d) * inv[j] * inv[chosen[c]] < NNLS_BATCH_DELTA;
     }
     s->flops += 2.0 * M * nch;
@@ -489,12 +501,14 @@ static fcm_status nnls_start(fcm_ctx *ctx, int M, int k, const double *A, const 
     FCM_ALLOC(ctx, (size_t)k, w->gl);
     FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)k, w->AL);
   }
-  if (k > M) {
-    FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)k, w->Af);
-    FCM_ALLOC_RAW(ctx, (size_t)M, w->rf);
+  if (k > M) { /* rows padded with zeros to NNLS_MF(M) (fcm__fit_sgemv_t()) */
+    const size_t mf = (size_t)NNLS_MF(M);
+    FCM_ALLOC_RAW(ctx, mf * (size_t)k, w->Af);
+    FCM_ALLOC(ctx, mf, w->rf);
     FCM_ALLOC_RAW(ctx, (size_t)k, w->gf);
-    for (size_t e = 0; e < (size_t)M * (size_t)k; e++)
-      w->Af[e] = (float)A[e];
+    for (size_t j = 0; j < (size_t)k; j++)
+      for (size_t i = 0; i < mf; i++)
+        w->Af[j * mf + i] = i < (size_t)M ? (float)A[j * (size_t)M + i] : 0.0f;
   }
   for (int i = 0; i < M; i++)
     s->Q[i + (size_t)i * (size_t)M] = 1.0;
@@ -542,7 +556,7 @@ static double nnls_price(nnls_qr *s, nnls_work *w, const double *A, int it, int 
   if (full && *single) {
     for (int i = 0; i < M; i++)
       w->rf[i] = (float)w->r[i];
-    fcm__sgemv('T', M, k, 1.0f, w->Af, M, w->rf, 0.0f, w->gf);
+    fcm__fit_sgemv_t(NNLS_MF(M), k, w->Af, NNLS_MF(M), w->rf, w->gf);
     const float *gf = w->gf;
     const double *inv = w->inv;
     const int *pas = w->pas;
@@ -560,13 +574,13 @@ static double nnls_price(nnls_qr *s, nnls_work *w, const double *A, int it, int 
     *single = 0; /* near optimality: price in double */
   }
   if (full) {
-    fcm__gemv('T', M, k, 1.0, A, M, w->r, 0.0, g);
+    fcm__fit_dgemv_t(M, k, A, M, w->r, g);
     s->flops += 2.0 * M * k + 2.0 * k;
     w->last_full = it;
     if (w->AL) w->nl = nnls_shortlist(M, k, A, w->inv, w->pas, it, g, w->AL, w->lidx);
     return 2.0 * (M + 2) * DBL_EPSILON * rn;
   }
-  fcm__gemv('T', M, w->nl, 1.0, w->AL, M, w->r, 0.0, w->gl);
+  fcm__fit_dgemv_t(M, w->nl, w->AL, M, w->r, w->gl);
   s->flops += 2.0 * M * w->nl + 2.0 * w->nl;
   memset(g, 0, (size_t)k * sizeof *g);
   const int *lidx = w->lidx;

@@ -217,6 +217,11 @@ typedef struct fcm__nnls_report {
  * residual proves that no x >= 0 has max_i |(A x - b)_i| <= reach (a Farkas certificate:
  * y with A^T y <= 0 and b^T y > reach ||y||_1); reach 0: run to optimality. Errors:
  * FCM_ERR_ALLOC. */
+/* y = A^T x for A (m x n, column-major, leading dimension lda): NNLS's products
+ * (fit_kernels.c). The single-precision one needs m a multiple of 16 (rows padded with zeros). */
+void fcm__fit_dgemv_t(int m, int n, const double *A, int lda, const double *x, double *y);
+void fcm__fit_sgemv_t(int m, int n, const float *A, int lda, const float *x, float *y);
+
 fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const double *b,
                               double stop, double reach, double *x, fcm__nnls_report *rep);
 
