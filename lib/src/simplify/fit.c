@@ -159,6 +159,7 @@ typedef struct nnls_qr {
   double *Q;        /* M x M orthogonal, times the pending reflections (nref) */
   double *R;        /* M x M, upper triangular in its first np columns */
   double *qtb;      /* Q^T b */
+  double *dinv;     /* 1 / R_jj of the passive columns (the back substitutions multiply) */
   double *v;        /* 2 M scratch */
   int *pos;         /* the passive columns of A, in R's column order */
   double flops;     /* of the QR updates, solves and residuals */
@@ -243,11 +244,23 @@ static void nnls_add(nnls_qr *s, int t, const double *a, double anorm, int *adde
   s->at[s->nref] = np, s->beta[s->nref++] = beta;
   s->flops += 2.0 * m;
   q[np] = alpha;
+  s->dinv[np] = 1.0 / alpha;
   for (int i = np + 1; i < M; i++)
     q[i] = 0.0;
   s->pos[np] = t;
   s->np++;
   *added = 1;
+}
+
+/* The Givens rotation G_l (cosine and sine into s->v, s->v + M) that zeroes entry l + 1 of R's
+ * column rl, whose entry l is a after the rotations before; rl and 1 / R_ll updated. */
+static inline void nnls_givens(nnls_qr *s, int l, double a, double *rl)
+{
+  double *cs = s->v, *sn = s->v + s->M;
+  const double b = rl[l + 1], h = sqrt(a * a + b * b);
+  cs[l] = h > 0.0 ? a / h : 1.0, sn[l] = h > 0.0 ? b / h : 0.0;
+  rl[l] = cs[l] * a + sn[l] * b, rl[l + 1] = 0.0;
+  s->dinv[l] = 1.0 / rl[l];
 }
 
 /* Remove the passive column at position p (and its value in xp) and restore R's triangle. */
@@ -267,15 +280,28 @@ FCM_MULTIVERSION_CLONES static void nnls_remove(nnls_qr *s, int p, double *xp)
    * sines kept in v for Q^T b and Q. R's entries are those of the candidates' moments, O(1)
    * against the range of double: no hypot() needed. */
   double *cs = s->v, *sn = s->v + M;
-  for (int l = p; l < s->np; l++) {
-    double *rl = R + (size_t)l * M;
+  int l = p;
+  /* two columns at a time, the entry a rotation passes on kept in a register: two independent
+   * chains of rotations (the same operations as one column after the other) */
+  for (; l + 1 < s->np; l += 2) {
+    double *ra = R + (size_t)l * M, *rb = ra + M, ta = ra[p], tb = rb[p];
     for (int j = p; j < l; j++) {
-      const double t0 = rl[j], t1 = rl[j + 1];
-      rl[j] = cs[j] * t0 + sn[j] * t1, rl[j + 1] = cs[j] * t1 - sn[j] * t0;
+      const double c = cs[j], sj = sn[j], ua = ra[j + 1], ub = rb[j + 1];
+      ra[j] = c * ta + sj * ua, rb[j] = c * tb + sj * ub;
+      ta = c * ua - sj * ta, tb = c * ub - sj * tb;
     }
-    const double a = rl[l], b = rl[l + 1], h = sqrt(a * a + b * b);
-    cs[l] = h > 0.0 ? a / h : 1.0, sn[l] = h > 0.0 ? b / h : 0.0;
-    rl[l] = cs[l] * a + sn[l] * b, rl[l + 1] = 0.0;
+    nnls_givens(s, l, ta, ra);
+    const double ub = rb[l + 1];
+    rb[l] = cs[l] * tb + sn[l] * ub, tb = cs[l] * ub - sn[l] * tb;
+    nnls_givens(s, l + 1, tb, rb);
+  }
+  if (l < s->np) {
+    double *rl = R + (size_t)l * M, t = rl[p];
+    for (int j = p; j < l; j++) {
+      const double u = rl[j + 1];
+      rl[j] = cs[j] * t + sn[j] * u, t = cs[j] * u - sn[j] * t;
+    }
+    nnls_givens(s, l, t, rl);
   }
   for (int j = p; j < s->np; j++) {
     const double c = cs[j], sj = sn[j], t0 = s->qtb[j], t1 = s->qtb[j + 1];
@@ -301,17 +327,18 @@ FCM_MULTIVERSION_CLONES static void nnls_solve(nnls_qr *s, double *z)
   for (; j >= 3; j -= 4) {
     const double *restrict r0 = R + (size_t)(j - 3) * M, *restrict r1 = r0 + M,
                            *restrict r2 = r1 + M, *restrict r3 = r2 + M;
-    const double z3 = z[j] / r3[j];
-    const double z2 = (z[j - 1] - z3 * r3[j - 1]) / r2[j - 1];
-    const double z1 = (z[j - 2] - z3 * r3[j - 2] - z2 * r2[j - 2]) / r1[j - 2];
-    const double z0 = (z[j - 3] - z3 * r3[j - 3] - z2 * r2[j - 3] - z1 * r1[j - 3]) / r0[j - 3];
+    const double *d = s->dinv; /* multiplications: the divisions' latency chained the block */
+    const double z3 = z[j] * d[j];
+    const double z2 = (z[j - 1] - z3 * r3[j - 1]) * d[j - 1];
+    const double z1 = (z[j - 2] - z3 * r3[j - 2] - z2 * r2[j - 2]) * d[j - 2];
+    const double z0 = (z[j - 3] - z3 * r3[j - 3] - z2 * r2[j - 3] - z1 * r1[j - 3]) * d[j - 3];
     z[j] = z3, z[j - 1] = z2, z[j - 2] = z1, z[j - 3] = z0;
     for (int i = 0; i < j - 3; i++)
       z[i] -= z3 * r3[i] + z2 * r2[i] + z1 * r1[i] + z0 * r0[i];
   }
   for (; j >= 0; j--) {
     const double *restrict rj = R + (size_t)j * (size_t)M;
-    const double zj = z[j] / rj[j];
+    const double zj = z[j] * s->dinv[j];
     z[j] = zj;
     for (int i = 0; i < j; i++)
       z[i] -= zj * rj[i];
@@ -482,6 +509,7 @@ static fcm_status nnls_start(fcm_ctx *ctx, int M, int k, const double *A, const 
   FCM_ALLOC(ctx, (size_t)M * (size_t)M, s->Q);
   FCM_ALLOC(ctx, (size_t)M * (size_t)M, s->R);
   FCM_ALLOC(ctx, (size_t)M, s->qtb);
+  FCM_ALLOC(ctx, (size_t)M, s->dinv);
   FCM_ALLOC(ctx, 2 * (size_t)M, s->v);
   FCM_ALLOC_RAW(ctx, (size_t)M * NNLS_BATCH, s->V);
   FCM_ALLOC_RAW(ctx, 2 * (size_t)M * NNLS_BATCH, s->W);
@@ -538,9 +566,9 @@ cleanup:
 /* Free what nnls_start() allocated (also after it failed part-way). */
 static void nnls_end(fcm_ctx *ctx, nnls_qr *s, nnls_work *w)
 {
-  void *p[] = {s->Q,   s->R,     s->qtb,  s->v,   s->V,    s->W,  s->T,  s->pos,
-               w->r,   w->g,     w->norm, w->inv, w->inv0, w->xp, w->z,  w->seen,
-               w->pas, w->order, w->lidx, w->gl,  w->AL,   w->Af, w->rf, w->gf};
+  void *p[] = {s->Q,     s->R,    s->qtb,  s->dinv, s->v,    s->V,  s->W, s->T,    s->pos,
+               w->r,     w->g,    w->norm, w->inv,  w->inv0, w->xp, w->z, w->seen, w->pas,
+               w->order, w->lidx, w->gl,   w->AL,   w->Af,   w->rf, w->gf};
   for (size_t i = 0; i < sizeof p / sizeof p[0]; i++)
     fcm__free(ctx, p[i]);
 }
