@@ -34,28 +34,6 @@ static inline double max2(double a, double b)
   return b > a ? b : a;
 }
 
-/* x^T y over n entries in 8 partial sums (one per vector lane, added in a fixed tree at the
- * end): a single running sum is a chain of n dependent additions. */
-static inline double dot(int n, const double *x, const double *y)
-{
-#if defined(__GNUC__) || defined(__clang__)
-  typedef double v8d __attribute__((vector_size(64)));
-  v8d acc = {0}, a, b;
-  int i = 0;
-  for (; i + 8 <= n; i += 8) {
-    memcpy(&a, x + i, sizeof a), memcpy(&b, y + i, sizeof b);
-    acc += a * b;
-  }
-  double t = ((acc[0] + acc[4]) + (acc[2] + acc[6])) + ((acc[1] + acc[5]) + (acc[3] + acc[7]));
-#else
-  double t = 0.0;
-  int i = 0;
-#endif
-  for (; i < n; i++)
-    t += x[i] * y[i];
-  return t;
-}
-
 /* max_i |(P_S w)_i - b_i| / max(max_i |b_i|, atol / tol) over the support S (columns idx of P,
  * ld M): relative to the moments, or to the floor below which they are rounding. */
 static double fit_residual(int M, const double *P, int count, const int *idx, const double *w,
@@ -187,7 +165,7 @@ static void nnls_flush(nnls_qr *s)
     const double *vi = V + (size_t)i * (size_t)M;
     for (int j = 0; j < i; j++) {
       const double *vj = V + (size_t)j * (size_t)M;
-      y[j] = dot(m - (s->at[i] - off), vj + s->at[i] - off, vi + s->at[i] - off);
+      y[j] = fcm__fit_dot(m - (s->at[i] - off), vj + s->at[i] - off, vi + s->at[i] - off);
     }
     for (int j = 0; j < i; j++) {
       double t = 0.0;
@@ -219,20 +197,20 @@ static void nnls_add(nnls_qr *s, int t, const double *a, double anorm, int *adde
   fcm__fit_dgemv_t(M, M, s->Q, M, a, q);
   for (int i = 0; i < s->nref; i++) {
     const double *vi = s->V + (size_t)i * (size_t)M;
-    const double d = s->beta[i] * dot(M - s->at[i], vi + s->at[i], q + s->at[i]);
+    const double d = s->beta[i] * fcm__fit_dot(M - s->at[i], vi + s->at[i], q + s->at[i]);
     for (int r = s->at[i]; r < M; r++)
       q[r] -= d * vi[r];
     s->flops += 4.0 * (M - s->at[i]);
   }
   s->flops += 2.0 * M * M + 6.0 * m;
-  const double nu = sqrt(dot(m, q + np, q + np));
+  const double nu = sqrt(fcm__fit_dot(m, q + np, q + np));
   if (!(nu > NNLS_DEP_TOL * anorm)) return;
   /* H = I - beta v v^T on rows np.. with H q = alpha e_np */
   const double alpha = q[np] >= 0.0 ? -nu : nu;
   for (int i = 0; i < m; i++)
     v[i] = q[np + i];
   v[0] -= alpha;
-  const double vv = dot(m, v, v), vb = dot(m, v, s->qtb + np);
+  const double vv = fcm__fit_dot(m, v, v), vb = fcm__fit_dot(m, v, s->qtb + np);
   const double beta = 2.0 / vv;
   if (!((s->qtb[np] - beta * vb * v[0]) / alpha > 0.0)) return; /* its weight would be <= 0 */
   for (int i = 0; i < m; i++)
@@ -396,7 +374,7 @@ FCM_MULTIVERSION_CLONES static void nnls_more(nnls_qr *s, const double *A, const
     int apart = 1;
     for (int c = 0; c < nch && apart; c++) {
       const double *ac = A + (size_t)chosen[c] * (size_t)M;
-      const double d = dot(M, aj, ac);
+      const double d = fcm__fit_dot(M, aj, ac);
       apart = fabs(d) * inv[j] * inv[chosen[c]] < NNLS_BATCH_DELTA;
     }
     s->flops += 2.0 * M * nch;
