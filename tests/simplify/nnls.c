@@ -7,10 +7,13 @@
  * NNLS's early stop on a proof that no x >= 0 reaches b never stops a solvable system and stops
  * only unsolvable ones; the fit reproduces the moments of a positive rule among its candidates
  * to 1e-12 and reports a tolerance below rounding (through its LP path) and moments no positive
- * combination of the candidates can carry (proved by a separating polynomial). */
+ * combination of the candidates can carry (proved by a separating polynomial); NNLS's own
+ * products A^T x (double, and single precision on rows padded to 16) agree with the sums
+ * they compute to the rounding of those sums, on shapes with every remainder of their blocks. */
 #include "simplify/simplify_impl.h"
 #include "simplify_util.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -277,6 +280,41 @@ static void fit(fcm_ctx *ctx)
   }
 }
 
+/* fcm__fit_dgemv_t / fcm__fit_sgemv_t against the sums in long double: |error| <= m eps
+ * sum_i |a_i x_i| (any summation order), for m rows of every remainder modulo 8 (double; the
+ * single-precision kernel takes rows padded to 16) and n of every remainder modulo 8. */
+static void products(void)
+{
+  enum { LDA = 70, NMAX = 19 };
+  uint64_t s = 12345;
+  double A[LDA * NMAX], x[LDA], y[NMAX];
+  float Af[LDA * NMAX], xf[LDA], yf[NMAX];
+  for (int e = 0; e < LDA * NMAX; e++)
+    A[e] = 2.0 * util_rand(&s) - 1.0, Af[e] = (float)A[e];
+  for (int i = 0; i < LDA; i++)
+    x[i] = 2.0 * util_rand(&s) - 1.0, xf[i] = (float)x[i];
+  int bad = 0;
+  for (int m = 1; m <= 64; m++)
+    for (int n = 0; n <= NMAX; n += 1) {
+      fcm__fit_dgemv_t(m, n, A, LDA, x, y);
+      for (int j = 0; j < n; j++) {
+        long double t = 0.0L, mag = 0.0L;
+        for (int i = 0; i < m; i++)
+          t += (long double)A[j * LDA + i] * x[i], mag += fabsl((long double)A[j * LDA + i] * x[i]);
+        bad += !(fabsl((long double)y[j] - t) <= m * DBL_EPSILON * mag + 1e-300);
+      }
+      if (m % 16) continue;
+      fcm__fit_sgemv_t(m, n, Af, LDA, xf, yf);
+      for (int j = 0; j < n; j++) {
+        double t = 0.0, mag = 0.0;
+        for (int i = 0; i < m; i++)
+          t += (double)Af[j * LDA + i] * xf[i], mag += fabs((double)Af[j * LDA + i] * xf[i]);
+        bad += !(fabs((double)yf[j] - t) <= m * FLT_EPSILON * mag + 1e-30);
+      }
+    }
+  TEST_TRUE(bad == 0);
+}
+
 int main(void)
 {
   fcm_ctx *ctx = NULL;
@@ -290,6 +328,7 @@ int main(void)
   cancelling(ctx);
   certificate(ctx);
   fit(ctx);
+  products();
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
 }

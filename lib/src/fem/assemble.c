@@ -44,7 +44,7 @@ cleanup:
 typedef struct tabulation {
   fcm_rule *rule;
   cell_rule r;
-  double *N, *dT;
+  double *N, *dT, *dQ;
 } tabulation;
 
 static fcm_status tabulate(const fcm_space *s, fcm_rule_kind kind, int strength, tabulation *t)
@@ -57,16 +57,21 @@ static fcm_status tabulate(const fcm_space *s, fcm_rule_kind kind, int strength,
   const size_t rows = 3 * (size_t)fcm__kernel_na(s->nn);
   FCM_ALLOC(ctx, (size_t)nq * s->nn, t->N);
   FCM_ALLOC(ctx, (size_t)nq * rows, t->dT);
+  const int qp = (nq + 7) / 8 * 8;
+  FCM_ALLOC(ctx, (size_t)qp * 3 * (size_t)s->nn, t->dQ);
   for (int q = 0; q < nq; q++) {
     double dN[3 * FCM_ELEMENT_MAX_NODES];
     fcm_element_eval_shape(s->type, pts + 3 * q, t->N + (size_t)q * s->nn);
     fcm_element_eval_grad(s->type, pts + 3 * q, dN);
     fcm__kernel_rows(s->nn, dN, t->dT + (size_t)q * rows);
+    for (int e = 0; e < 3 * s->nn; e++)
+      t->dQ[(size_t)e * qp + q] = dN[e];
   }
   t->r.nq = nq;
   t->r.w = fcm_rule_weights(t->rule);
   t->r.N = t->N;
   t->r.dT = t->dT;
+  t->r.dQ = t->dQ, t->r.qp = qp;
 cleanup:
   return st;
 }
@@ -75,6 +80,7 @@ static void tabulation_free(fcm_ctx *ctx, tabulation *t)
 {
   FCM_FREE(ctx, t->N);
   FCM_FREE(ctx, t->dT);
+  FCM_FREE(ctx, t->dQ);
   fcm_rule_destroy(&t->rule);
 }
 
@@ -83,7 +89,7 @@ static void tabulation_free(fcm_ctx *ctx, tabulation *t)
 static cell_rule get_cell_rule(const fcm_space *s, const tabulation *t, fcm_rule_kind kind,
                                fcm_index e, scratch *w)
 {
-  cell_rule r = {0, NULL, w->Nb, w->dTb, NULL};
+  cell_rule r = {0, NULL, w->Nb, w->dTb, NULL, NULL, 0};
   if (!fcm__space_owns(s, s->elem_cell[e])) return r; /* another process's cell */
   if (!s->rules || fcm_cell_rules_class(s->rules, s->elem_cell[e]) == FCM_CELL_UNCUT) return t->r;
   const double *pts = NULL;

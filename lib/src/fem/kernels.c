@@ -303,15 +303,67 @@ double fcm__kernel_point_gradients(int nn, const double *X, const double *dT, do
   return gradients(nn, X, dN, g);
 }
 
+/* With the rule's point-minor table (r->dQ): det J and J^-1 (row-major, Ji[k QB + c] entry k
+ * of point q0 + c) of points [q0, q0 + nc) (q0 a multiple of 8), 8 points at a time in the
+ * vector lanes: J_ij = sum_a X_ai dN_aj, then J^-1 = C^T / det J from the cofactors C (as
+ * fcm__mat3_inv()). 0 without the table or vector types: the caller goes point by point. */
+FCM_KERNEL_INLINE int chunk_jacobians(const cell_rule *r, int nn, const double *X, int q0, int nc,
+                                      double *Ji, double *det)
+{
+#if defined(__GNUC__) || defined(__clang__)
+  if (!r->dQ) return 0;
+  const size_t qp = (size_t)r->qp;
+  for (int c0 = 0; c0 < nc; c0 += 8) {
+    fcm_v8d J[9] = {{0}}, C[9], d0, d1, d2;
+    const double *d = r->dQ + q0 + c0;
+    for (int a = 0; a < nn; a++, d += 3 * qp) {
+      memcpy(&d0, d, sizeof d0), memcpy(&d1, d + qp, sizeof d1), memcpy(&d2, d + 2 * qp, sizeof d2);
+      for (int i = 0; i < 3; i++) {
+        const double x = X[3 * a + i];
+        J[3 * i] += x * d0, J[3 * i + 1] += x * d1, J[3 * i + 2] += x * d2;
+      }
+    }
+    C[0] = J[4] * J[8] - J[5] * J[7], C[1] = J[5] * J[6] - J[3] * J[8];
+    C[2] = J[3] * J[7] - J[4] * J[6], C[3] = J[2] * J[7] - J[1] * J[8];
+    C[4] = J[0] * J[8] - J[2] * J[6], C[5] = J[1] * J[6] - J[0] * J[7];
+    C[6] = J[1] * J[5] - J[2] * J[4], C[7] = J[2] * J[3] - J[0] * J[5];
+    C[8] = J[0] * J[4] - J[1] * J[3];
+    const fcm_v8d dt = J[0] * C[0] + J[1] * C[1] + J[2] * C[2], s = 1.0 / dt;
+    memcpy(det + c0, &dt, sizeof dt);
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++) {
+        const fcm_v8d v = s * C[3 * j + i];
+        memcpy(Ji + (size_t)(3 * i + j) * FCM__KERNEL_QB + c0, &v, sizeof v);
+      }
+  }
+  return 1;
+#else
+  (void)r, (void)nn, (void)X, (void)q0, (void)nc, (void)Ji, (void)det;
+  return 0;
+#endif
+}
+
 /* The gradients by component of points [q0, q0 + nc) of rule r into rows of G (zero padded to
  * ld), their weights w det J into wd and, with WG, the rows times w det J into WG; 0 with
  * res->bad_det set at the first point whose det J is not positive. */
-FCM_KERNEL_INLINE int chunk_gradients(const cell_rule *r, int na, int q0, int nc, int ld,
+FCM_KERNEL_INLINE int chunk_gradients(const cell_rule *r, int nn, int na, int q0, int nc, int ld,
                                       scratch *w, cell_result *res, double *WG)
 {
+  double Ji[9 * FCM__KERNEL_QB], dets[FCM__KERNEL_QB];
+  const int lanes = chunk_jacobians(r, nn, w->X, q0, nc, Ji, dets);
   for (int c = 0; c < nc; c++) {
     double *g = w->G + (size_t)c * ld;
-    const double det = point_gradients(na, w->XT, r->dT + (size_t)(q0 + c) * 3 * na, g);
+    const double *dT = r->dT + (size_t)(q0 + c) * 3 * na;
+    double det;
+    if (lanes) {
+      double Jc[9];
+      for (int k = 0; k < 9; k++)
+        Jc[k] = Ji[k * FCM__KERNEL_QB + c];
+      det = dets[c];
+      if (det > 0.0) combine(na, Jc, dT, g, 0);
+    } else {
+      det = point_gradients(na, w->XT, dT, g);
+    }
     if (!(det > 0.0)) {
       res->bad_det = det;
       return 0;
@@ -343,7 +395,7 @@ static cell_result stiffness_kernel(const kernel_data *kd, const cell_rule *r, i
   if (r->nq == 0) memset(H, 0, sizeof *H * (size_t)ld * ld);
   for (int q0 = 0; q0 < r->nq; q0 += FCM__KERNEL_QB) {
     const int nc = r->nq - q0 < FCM__KERNEL_QB ? r->nq - q0 : FCM__KERNEL_QB;
-    if (!chunk_gradients(r, na, q0, nc, ld, w, &res, w->WG)) return res;
+    if (!chunk_gradients(r, nn, na, q0, nc, ld, w, &res, w->WG)) return res;
     product_upper(nb, nc, w->WG, w->G, 3 * na, ld, H, q0 > 0);
   }
   const double l = kd->lambda, m = kd->mu;
@@ -524,7 +576,7 @@ static cell_result hyperelastic_kernel(const kernel_data *kd, const cell_rule *r
   memset(w->FT, 0, sizeof *w->FT * (size_t)(3 * na));
   for (int q0 = 0; q0 < r->nq; q0 += FCM__KERNEL_QH) {
     const int nc = r->nq - q0 < FCM__KERNEL_QH ? r->nq - q0 : FCM__KERNEL_QH;
-    if (!chunk_gradients(r, na, q0, nc, ld, w, &res, NULL)) return res;
+    if (!chunk_gradients(r, nn, na, q0, nc, ld, w, &res, NULL)) return res;
     for (int c = 0; c < nc; c++)
       if (!hyperelastic_point(kd, r, nn, q0 + c, c, ld, w, &res)) return res;
     if (!kd->want_tangent) continue;

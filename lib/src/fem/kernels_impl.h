@@ -24,6 +24,11 @@ typedef struct cell_rule {
   const double *N;           /* nq x nn */
   const double *dT;          /* nq x 3 x na reference gradients by component (fcm__kernel_rows()) */
   const unsigned char *fict; /* nq flags (1: fictitious stabilization point), or NULL */
+  /* NULL, or the reference gradients point-minor (a standard rule's, tabulated once):
+   * dQ[(3 a + k) qp + q] = dN_ak at point q, qp = nq rounded up to 8, zero for q >= nq; the
+   * kernels then compute the Jacobians of 8 points at a time in the vector lanes */
+  const double *dQ;
+  int qp;
 } cell_rule;
 
 /* The reference gradients dN (nn x 3, node-major, as fcm_element_eval_grad() gives them) of one

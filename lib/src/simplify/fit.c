@@ -129,11 +129,15 @@ cleanup:
  * optimality test stay in double. */
 #define NNLS_SINGLE_TRUST 1e-3
 
+/* Rows of the float copy of A (and of the residual): M padded to a multiple of 16. */
+#define NNLS_MF(M) (((M) + 15) / 16 * 16)
+
 typedef struct nnls_qr {
   int M, np, kcols; /* rows, passive columns, columns of A */
   double *Q;        /* M x M orthogonal, times the pending reflections (nref) */
   double *R;        /* M x M, upper triangular in its first np columns */
   double *qtb;      /* Q^T b */
+  double *dinv;     /* 1 / R_jj of the passive columns (the back substitutions multiply) */
   double *v;        /* 2 M scratch */
   int *pos;         /* the passive columns of A, in R's column order */
   double flops;     /* of the QR updates, solves and residuals */
@@ -161,10 +165,7 @@ static void nnls_flush(nnls_qr *s)
     const double *vi = V + (size_t)i * (size_t)M;
     for (int j = 0; j < i; j++) {
       const double *vj = V + (size_t)j * (size_t)M;
-      double d = 0.0;
-      for (int r = s->at[i] - off; r < m; r++)
-        d += vj[r] * vi[r];
-      y[j] = d;
+      y[j] = fcm__fit_dot(m - (s->at[i] - off), vj + s->at[i] - off, vi + s->at[i] - off);
     }
     for (int j = 0; j < i; j++) {
       double t = 0.0;
@@ -193,31 +194,23 @@ static void nnls_add(nnls_qr *s, int t, const double *a, double anorm, int *adde
   if (s->nref == NNLS_BATCH) nnls_flush(s);
   /* q = Q^T a, as R's next column, with Q's pending reflections applied to it in their order;
    * the basis' values are O(1): its norm needs no scaling */
-  fcm__gemv('T', M, M, 1.0, s->Q, M, a, 0.0, q);
+  fcm__fit_dgemv_t(M, M, s->Q, M, a, q);
   for (int i = 0; i < s->nref; i++) {
     const double *vi = s->V + (size_t)i * (size_t)M;
-    double d = 0.0;
-    for (int r = s->at[i]; r < M; r++)
-      d += vi[r] * q[r];
-    d *= s->beta[i];
+    const double d = s->beta[i] * fcm__fit_dot(M - s->at[i], vi + s->at[i], q + s->at[i]);
     for (int r = s->at[i]; r < M; r++)
       q[r] -= d * vi[r];
     s->flops += 4.0 * (M - s->at[i]);
   }
   s->flops += 2.0 * M * M + 6.0 * m;
-  double nu = 0.0;
-  for (int i = np; i < M; i++)
-    nu += q[i] * q[i];
-  nu = sqrt(nu);
+  const double nu = sqrt(fcm__fit_dot(m, q + np, q + np));
   if (!(nu > NNLS_DEP_TOL * anorm)) return;
   /* H = I - beta v v^T on rows np.. with H q = alpha e_np */
   const double alpha = q[np] >= 0.0 ? -nu : nu;
-  double vv = 0.0, vb = 0.0;
   for (int i = 0; i < m; i++)
     v[i] = q[np + i];
   v[0] -= alpha;
-  for (int i = 0; i < m; i++)
-    vv += v[i] * v[i], vb += v[i] * s->qtb[np + i];
+  const double vv = fcm__fit_dot(m, v, v), vb = fcm__fit_dot(m, v, s->qtb + np);
   const double beta = 2.0 / vv;
   if (!((s->qtb[np] - beta * vb * v[0]) / alpha > 0.0)) return; /* its weight would be <= 0 */
   for (int i = 0; i < m; i++)
@@ -229,11 +222,23 @@ static void nnls_add(nnls_qr *s, int t, const double *a, double anorm, int *adde
   s->at[s->nref] = np, s->beta[s->nref++] = beta;
   s->flops += 2.0 * m;
   q[np] = alpha;
+  s->dinv[np] = 1.0 / alpha;
   for (int i = np + 1; i < M; i++)
     q[i] = 0.0;
   s->pos[np] = t;
   s->np++;
   *added = 1;
+}
+
+/* The Givens rotation G_l (cosine and sine into s->v, s->v + M) that zeroes entry l + 1 of R's
+ * column rl, whose entry l is a after the rotations before; rl and 1 / R_ll updated. */
+static inline void nnls_givens(nnls_qr *s, int l, double a, double *rl)
+{
+  double *cs = s->v, *sn = s->v + s->M;
+  const double b = rl[l + 1], h = sqrt(a * a + b * b);
+  cs[l] = h > 0.0 ? a / h : 1.0, sn[l] = h > 0.0 ? b / h : 0.0;
+  rl[l] = cs[l] * a + sn[l] * b, rl[l + 1] = 0.0;
+  s->dinv[l] = 1.0 / rl[l];
 }
 
 /* Remove the passive column at position p (and its value in xp) and restore R's triangle. */
@@ -253,15 +258,28 @@ FCM_MULTIVERSION_CLONES static void nnls_remove(nnls_qr *s, int p, double *xp)
    * sines kept in v for Q^T b and Q. R's entries are those of the candidates' moments, O(1)
    * against the range of double: no hypot() needed. */
   double *cs = s->v, *sn = s->v + M;
-  for (int l = p; l < s->np; l++) {
-    double *rl = R + (size_t)l * M;
+  int l = p;
+  /* two columns at a time, the entry a rotation passes on kept in a register: two independent
+   * chains of rotations (the same operations as one column after the other) */
+  for (; l + 1 < s->np; l += 2) {
+    double *ra = R + (size_t)l * M, *rb = ra + M, ta = ra[p], tb = rb[p];
     for (int j = p; j < l; j++) {
-      const double t0 = rl[j], t1 = rl[j + 1];
-      rl[j] = cs[j] * t0 + sn[j] * t1, rl[j + 1] = cs[j] * t1 - sn[j] * t0;
+      const double c = cs[j], sj = sn[j], ua = ra[j + 1], ub = rb[j + 1];
+      ra[j] = c * ta + sj * ua, rb[j] = c * tb + sj * ub;
+      ta = c * ua - sj * ta, tb = c * ub - sj * tb;
     }
-    const double a = rl[l], b = rl[l + 1], h = sqrt(a * a + b * b);
-    cs[l] = h > 0.0 ? a / h : 1.0, sn[l] = h > 0.0 ? b / h : 0.0;
-    rl[l] = cs[l] * a + sn[l] * b, rl[l + 1] = 0.0;
+    nnls_givens(s, l, ta, ra);
+    const double ub = rb[l + 1];
+    rb[l] = cs[l] * tb + sn[l] * ub, tb = cs[l] * ub - sn[l] * tb;
+    nnls_givens(s, l + 1, tb, rb);
+  }
+  if (l < s->np) {
+    double *rl = R + (size_t)l * M, t = rl[p];
+    for (int j = p; j < l; j++) {
+      const double u = rl[j + 1];
+      rl[j] = cs[j] * t + sn[j] * u, t = cs[j] * u - sn[j] * t;
+    }
+    nnls_givens(s, l, t, rl);
   }
   for (int j = p; j < s->np; j++) {
     const double c = cs[j], sj = sn[j], t0 = s->qtb[j], t1 = s->qtb[j + 1];
@@ -287,17 +305,18 @@ FCM_MULTIVERSION_CLONES static void nnls_solve(nnls_qr *s, double *z)
   for (; j >= 3; j -= 4) {
     const double *restrict r0 = R + (size_t)(j - 3) * M, *restrict r1 = r0 + M,
                            *restrict r2 = r1 + M, *restrict r3 = r2 + M;
-    const double z3 = z[j] / r3[j];
-    const double z2 = (z[j - 1] - z3 * r3[j - 1]) / r2[j - 1];
-    const double z1 = (z[j - 2] - z3 * r3[j - 2] - z2 * r2[j - 2]) / r1[j - 2];
-    const double z0 = (z[j - 3] - z3 * r3[j - 3] - z2 * r2[j - 3] - z1 * r1[j - 3]) / r0[j - 3];
+    const double *d = s->dinv; /* multiplications: the divisions' latency chained the block */
+    const double z3 = z[j] * d[j];
+    const double z2 = (z[j - 1] - z3 * r3[j - 1]) * d[j - 1];
+    const double z1 = (z[j - 2] - z3 * r3[j - 2] - z2 * r2[j - 2]) * d[j - 2];
+    const double z0 = (z[j - 3] - z3 * r3[j - 3] - z2 * r2[j - 3] - z1 * r1[j - 3]) * d[j - 3];
     z[j] = z3, z[j - 1] = z2, z[j - 2] = z1, z[j - 3] = z0;
     for (int i = 0; i < j - 3; i++)
       z[i] -= z3 * r3[i] + z2 * r2[i] + z1 * r1[i] + z0 * r0[i];
   }
   for (; j >= 0; j--) {
     const double *restrict rj = R + (size_t)j * (size_t)M;
-    const double zj = z[j] / rj[j];
+    const double zj = z[j] * s->dinv[j];
     z[j] = zj;
     for (int i = 0; i < j; i++)
       z[i] -= zj * rj[i];
@@ -355,9 +374,7 @@ FCM_MULTIVERSION_CLONES static void nnls_more(nnls_qr *s, const double *A, const
     int apart = 1;
     for (int c = 0; c < nch && apart; c++) {
       const double *ac = A + (size_t)chosen[c] * (size_t)M;
-      double d = 0.0;
-      for (int i = 0; i < M; i++)
-        d += aj[i] * ac[i];
+      const double d = fcm__fit_dot(M, aj, ac);
       apart = fabs(d) * inv[j] * inv[chosen[c]] < NNLS_BATCH_DELTA;
     }
     s->flops += 2.0 * M * nch;
@@ -470,6 +487,7 @@ static fcm_status nnls_start(fcm_ctx *ctx, int M, int k, const double *A, const 
   FCM_ALLOC(ctx, (size_t)M * (size_t)M, s->Q);
   FCM_ALLOC(ctx, (size_t)M * (size_t)M, s->R);
   FCM_ALLOC(ctx, (size_t)M, s->qtb);
+  FCM_ALLOC(ctx, (size_t)M, s->dinv);
   FCM_ALLOC(ctx, 2 * (size_t)M, s->v);
   FCM_ALLOC_RAW(ctx, (size_t)M * NNLS_BATCH, s->V);
   FCM_ALLOC_RAW(ctx, 2 * (size_t)M * NNLS_BATCH, s->W);
@@ -489,12 +507,14 @@ static fcm_status nnls_start(fcm_ctx *ctx, int M, int k, const double *A, const 
     FCM_ALLOC(ctx, (size_t)k, w->gl);
     FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)k, w->AL);
   }
-  if (k > M) {
-    FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)k, w->Af);
-    FCM_ALLOC_RAW(ctx, (size_t)M, w->rf);
+  if (k > M) { /* rows padded with zeros to NNLS_MF(M) (fcm__fit_sgemv_t()) */
+    const size_t mf = (size_t)NNLS_MF(M);
+    FCM_ALLOC_RAW(ctx, mf * (size_t)k, w->Af);
+    FCM_ALLOC(ctx, mf, w->rf);
     FCM_ALLOC_RAW(ctx, (size_t)k, w->gf);
-    for (size_t e = 0; e < (size_t)M * (size_t)k; e++)
-      w->Af[e] = (float)A[e];
+    for (size_t j = 0; j < (size_t)k; j++)
+      for (size_t i = 0; i < mf; i++)
+        w->Af[j * mf + i] = i < (size_t)M ? (float)A[j * (size_t)M + i] : 0.0f;
   }
   for (int i = 0; i < M; i++)
     s->Q[i + (size_t)i * (size_t)M] = 1.0;
@@ -524,9 +544,9 @@ cleanup:
 /* Free what nnls_start() allocated (also after it failed part-way). */
 static void nnls_end(fcm_ctx *ctx, nnls_qr *s, nnls_work *w)
 {
-  void *p[] = {s->Q,   s->R,     s->qtb,  s->v,   s->V,    s->W,  s->T,  s->pos,
-               w->r,   w->g,     w->norm, w->inv, w->inv0, w->xp, w->z,  w->seen,
-               w->pas, w->order, w->lidx, w->gl,  w->AL,   w->Af, w->rf, w->gf};
+  void *p[] = {s->Q,     s->R,    s->qtb,  s->dinv, s->v,    s->V,  s->W, s->T,    s->pos,
+               w->r,     w->g,    w->norm, w->inv,  w->inv0, w->xp, w->z, w->seen, w->pas,
+               w->order, w->lidx, w->gl,   w->AL,   w->Af,   w->rf, w->gf};
   for (size_t i = 0; i < sizeof p / sizeof p[0]; i++)
     fcm__free(ctx, p[i]);
 }
@@ -542,7 +562,7 @@ static double nnls_price(nnls_qr *s, nnls_work *w, const double *A, int it, int 
   if (full && *single) {
     for (int i = 0; i < M; i++)
       w->rf[i] = (float)w->r[i];
-    fcm__sgemv('T', M, k, 1.0f, w->Af, M, w->rf, 0.0f, w->gf);
+    fcm__fit_sgemv_t(NNLS_MF(M), k, w->Af, NNLS_MF(M), w->rf, w->gf);
     const float *gf = w->gf;
     const double *inv = w->inv;
     const int *pas = w->pas;
@@ -560,13 +580,13 @@ static double nnls_price(nnls_qr *s, nnls_work *w, const double *A, int it, int 
     *single = 0; /* near optimality: price in double */
   }
   if (full) {
-    fcm__gemv('T', M, k, 1.0, A, M, w->r, 0.0, g);
+    fcm__fit_dgemv_t(M, k, A, M, w->r, g);
     s->flops += 2.0 * M * k + 2.0 * k;
     w->last_full = it;
     if (w->AL) w->nl = nnls_shortlist(M, k, A, w->inv, w->pas, it, g, w->AL, w->lidx);
     return 2.0 * (M + 2) * DBL_EPSILON * rn;
   }
-  fcm__gemv('T', M, w->nl, 1.0, w->AL, M, w->r, 0.0, w->gl);
+  fcm__fit_dgemv_t(M, w->nl, w->AL, M, w->r, w->gl);
   s->flops += 2.0 * M * w->nl + 2.0 * w->nl;
   memset(g, 0, (size_t)k * sizeof *g);
   const int *lidx = w->lidx;

@@ -6,6 +6,8 @@
 #include "core/core_impl.h"
 #include "fcm/simplify.h"
 
+#include <string.h>
+
 /* fcm_simplify() with a test hook that makes every LP and elimination fail: force_lp_failure
  * 0 off (what fcm_simplify() passes), 1 every LP stops at an iteration limit of 0, 2 every LP
  * triggers a GLPK fatal error (caught); with 1 and 2 every elimination finds its LU pivots
@@ -207,6 +209,33 @@ typedef struct fcm__nnls_report {
   double residual;
   double flops; /* of the algorithm: gradients, QR updates, solves, residuals */
 } fcm__nnls_report;
+
+/* x^T y over n entries in 8 partial sums (one per vector lane, added in a fixed tree at the
+ * end): a single running sum is a chain of n dependent additions. */
+static inline double fcm__fit_dot(int n, const double *x, const double *y)
+{
+#if defined(__GNUC__) || defined(__clang__)
+  typedef double v8d __attribute__((vector_size(64)));
+  v8d acc = {0}, a, b;
+  int i = 0;
+  for (; i + 8 <= n; i += 8) {
+    memcpy(&a, x + i, sizeof a), memcpy(&b, y + i, sizeof b);
+    acc += a * b;
+  }
+  double t = ((acc[0] + acc[4]) + (acc[2] + acc[6])) + ((acc[1] + acc[5]) + (acc[3] + acc[7]));
+#else
+  double t = 0.0;
+  int i = 0;
+#endif
+  for (; i < n; i++)
+    t += x[i] * y[i];
+  return t;
+}
+
+/* y = A^T x for A (m x n, column-major, leading dimension lda): NNLS's products
+ * (fit_kernels.c). The single-precision one needs m a multiple of 16 (rows padded with zeros). */
+void fcm__fit_dgemv_t(int m, int n, const double *A, int lda, const double *x, double *y);
+void fcm__fit_sgemv_t(int m, int n, const float *A, int lda, const float *x, float *y);
 
 /* Non-negative least squares min ||A x - b||_2, x >= 0 (Lawson and Hanson's active set method
  * with the passive columns' QR factorization updated column by column): A is M x k (ld M), x
