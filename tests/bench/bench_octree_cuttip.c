@@ -26,30 +26,17 @@ static int by_eta_desc(const void *a, const void *b)
   return (x < y) - (x > y);
 }
 
-/* Distance of the box [lo, hi] to the front line x = X0, y = Y0. */
-static double front_dist(const double lo[3], const double hi[3])
-{
-  const double dx = fmax(fmax(lo[0] - CUTTIP_X0, CUTTIP_X0 - hi[0]), 0.0);
-  const double dy = fmax(fmax(lo[1] - CUTTIP_Y0, CUTTIP_Y0 - hi[1]), 0.0);
-  return hypot(dx, dy);
-}
-
-static int near_front(const double lo[3], const double hi[3], int level, void *user)
-{
-  (void)level;
-  const double c = *(const double *)user, h = hi[0] - lo[0];
-  return h > c * pow(fmax(front_dist(lo, hi), h), 0.6);
-}
-
 typedef struct sequence {
   int steps;
-  double err[MAX_STEPS], dofs[MAX_STEPS], cells[MAX_STEPS];
+  double err[MAX_STEPS], energy[MAX_STEPS], dofs[MAX_STEPS], cells[MAX_STEPS];
 } sequence;
 
-static void print_step(const char *name, int step, double nf, const fcm_mesh *m, double err)
+static void print_step(const char *name, int step, double nf, const fcm_mesh *m,
+                       const double err[2])
 {
-  printf("%6s %4d  %9.0f  %7lld  %9d  %.4e\n", name, step, nf, (long long)fcm_mesh_num_cells(m),
-         fcm_mesh_max_level(m), err);
+  printf("%6s %4d  %9.0f  %7lld  %9d  %.4e  %.4e\n", name, step, nf,
+         (long long)fcm_mesh_num_cells(m), fcm_mesh_max_level(m), err[0], err[1]);
+  fflush(stdout);
 }
 
 /* Doerfler on the stress jumps from the 2^3 octree until max_dofs. */
@@ -64,9 +51,11 @@ static void run_jumps(fcm_ctx *ctx, fcm_element_type type, double max_dofs, sequ
     const fcm_index nc = fcm_mesh_num_cells(m);
     double *eta = calloc((size_t)nc, sizeof *eta), *sorted = calloc((size_t)nc, sizeof *sorted);
     fcm_index nf = 0;
-    TEST_OK(ctx, cuttip_solve(ctx, m, &nf, &q->err[step], eta));
+    double e2[2];
+    TEST_OK(ctx, cuttip_solve(ctx, m, &nf, e2, NULL, eta));
+    q->err[step] = e2[0], q->energy[step] = e2[1];
     q->dofs[step] = (double)nf, q->cells[step] = (double)nc, q->steps = step + 1;
-    print_step("jumps", step, (double)nf, m, q->err[step]);
+    print_step("jumps", step, (double)nf, m, e2);
     double total = 0.0, acc = 0.0, cut = HUGE_VAL;
     for (fcm_index c = 0; c < nc; c++)
       sorted[c] = eta[c] * eta[c], total += sorted[c];
@@ -94,14 +83,16 @@ static void run_front(fcm_ctx *ctx, fcm_element_type type, double max_dofs, sequ
   for (int step = 0; step < MAX_STEPS; step++) {
     double c = 0.6 * pow(0.85, step);
     fcm_octree_options o = fcm_octree_options_default();
-    o.refine = near_front, o.refine_user = &c, o.refine_level = FCM_OCTREE_MAX_LEVEL;
+    o.refine = cuttip_near_front, o.refine_user = &c, o.refine_level = FCM_OCTREE_MAX_LEVEL;
     fcm_mesh *m = NULL;
     fcm_index nf = 0;
+    double e2[2];
     TEST_OK(ctx, fcm_mesh_create_octree(ctx, type, lo, hi, n2, &o, &m));
-    TEST_OK(ctx, cuttip_solve(ctx, m, &nf, &q->err[step], NULL));
+    TEST_OK(ctx, cuttip_solve(ctx, m, &nf, e2, NULL, NULL));
+    q->err[step] = e2[0], q->energy[step] = e2[1];
     q->dofs[step] = (double)nf, q->cells[step] = (double)fcm_mesh_num_cells(m);
     q->steps = step + 1;
-    print_step("front", step, (double)nf, m, q->err[step]);
+    print_step("front", step, (double)nf, m, e2);
     fcm_mesh_destroy(&m);
     if (nf >= max_dofs) break;
   }
@@ -143,24 +134,26 @@ int main(int argc, char **argv)
   const int nu = hex20 ? 5 : 7;
   const int *sizes = hex20 ? sizes20 : sizes8;
   const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
-  double udofs[8], uerr[8], uh[8];
+  double udofs[8], uerr[8], uen[8], uh[8];
   printf("%s, crack front x = %.2f, y = %.2f; relative H1-seminorm errors\n",
          hex20 ? "Hex20" : "Hex8", CUTTIP_X0, CUTTIP_Y0);
-  printf("uniform n  free DOFs  cells  H1 error\n");
+  printf("uniform n  free DOFs  cells  H1 error    energy error\n");
   for (int k = 0; k < nu; k++) {
     fcm_mesh *m = NULL;
     const fcm_index n3[3] = {sizes[k], sizes[k], sizes[k]};
     fcm_index nf = 0;
+    double e2[2];
     TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, n3, &m));
-    TEST_OK(ctx, cuttip_solve(ctx, m, &nf, &uerr[k], NULL));
+    TEST_OK(ctx, cuttip_solve(ctx, m, &nf, e2, NULL, NULL));
+    uerr[k] = e2[0], uen[k] = e2[1];
     udofs[k] = (double)nf, uh[k] = 1.0 / sizes[k];
-    printf("%9d  %9lld  %5lld  %.4e\n", sizes[k], (long long)nf, (long long)fcm_mesh_num_cells(m),
-           uerr[k]);
+    printf("%9d  %9lld  %5lld  %.4e  %.4e\n", sizes[k], (long long)nf,
+           (long long)fcm_mesh_num_cells(m), uerr[k], uen[k]);
     fflush(stdout);
     fcm_mesh_destroy(&m);
   }
   sequence qj, qf;
-  printf("  seq step  free DOFs    cells  max level  H1 error\n");
+  printf("  seq step  free DOFs    cells  max level  H1 error    energy error\n");
   run_jumps(ctx, type, 1.5 * udofs[nu - 1], &qj);
   run_front(ctx, type, 1.5 * udofs[nu - 1], &qf);
   printf("\nuniform n  error       uniform DOFs  uniform cells | jumps: DOFs  ratio  cells  ratio "
@@ -176,11 +169,15 @@ int main(int argc, char **argv)
         jc > 0 ? ucells / jc : 0.0, fd, fd > 0 ? udofs[k] / fd : 0.0, fc,
         fc > 0 ? ucells / fc : 0.0);
   }
-  printf("rates: uniform h^%.2f (last three grids), N^-%.3f; jumps N^-%.3f, front N^-%.3f (last "
-         "three steps)\n",
+  printf("H1 rates: uniform h^%.2f (last three grids), N^-%.3f; jumps N^-%.3f, front N^-%.3f "
+         "(last three steps)\n",
          fit_rate(uh, uerr, nu - 3, nu - 1), -fit_rate(udofs, uerr, nu - 3, nu - 1),
          -fit_rate(qj.dofs, qj.err, qj.steps - 3, qj.steps - 1),
          -fit_rate(qf.dofs, qf.err, qf.steps - 3, qf.steps - 1));
+  printf("energy rates: uniform h^%.2f, N^-%.3f; jumps N^-%.3f, front N^-%.3f\n",
+         fit_rate(uh, uen, nu - 3, nu - 1), -fit_rate(udofs, uen, nu - 3, nu - 1),
+         -fit_rate(qj.dofs, qj.energy, qj.steps - 3, qj.steps - 1),
+         -fit_rate(qf.dofs, qf.energy, qf.steps - 3, qf.steps - 1));
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
 }

@@ -29,12 +29,13 @@ static const double cuttip_E = 1.0, cuttip_nu = 0.3, cuttip_K1 = 1.0, cuttip_K2 
 
 /* The angle around the front on branch `side`: 0 the principal one (theta in (-pi, pi], the
  * branch cut on the crack); +1 the upper side's field continued across the crack below it
- * (theta in (pi, 3pi/2)); -1 the lower side's continued above it. */
+ * (theta in (pi, 3pi/2)); -1 the lower side's continued above it (theta in [-3pi/2, -pi],
+ * -pi on the crack itself). */
 static inline double cuttip_theta(double dx, double dy, int side)
 {
   double t = atan2(dy, dx);
   if (side > 0 && dy < 0.0 && dx < 0.0) t += 2.0 * CUTTIP_PI;
-  if (side < 0 && dy > 0.0 && dx < 0.0) t -= 2.0 * CUTTIP_PI;
+  if (side < 0 && dy >= 0.0 && dx < 0.0) t -= 2.0 * CUTTIP_PI; /* on the crack: -pi */
   return t;
 }
 
@@ -128,11 +129,12 @@ static const double cuttip_gx[4] = {-0.8611363115940526, -0.3399810435848563, 0.
 static const double cuttip_gw[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461,
                                     0.3478548451374538};
 
-/* Adds the squared error and the squared exact gradient over the box [a, b] (inside cell
- * [lo, hi], on one side of the crack) of the element with DOFs ed. */
+/* Adds, over the box [a, b] (inside cell [lo, hi], on one side of the crack) of the element with
+ * DOFs ed, the squared H1 seminorms of the error and of the exact field (acc[0], acc[1]) and
+ * their energies, the integrals of eps : C eps (acc[2], acc[3]). */
 static inline void cuttip_box_error(const fcm_space *s, const fcm_index *ed, const double *u,
                                     const double lo[3], const double hi[3], const double a[3],
-                                    const double b[3], int depth, double acc[2])
+                                    const double b[3], int depth, double acc[4])
 {
   const double cx = fmin(fabs(a[0] - CUTTIP_X0), fabs(b[0] - CUTTIP_X0)),
                cy = fmin(fabs(a[1] - CUTTIP_Y0), fabs(b[1] - CUTTIP_Y0));
@@ -151,6 +153,8 @@ static inline void cuttip_box_error(const fcm_space *s, const fcm_index *ed, con
   const fcm_element_type type = fcm_mesh_element_type(fcm_space_mesh(s));
   const int npc = fcm_mesh_nodes_per_cell(fcm_space_mesh(s));
   const int side = 0.5 * (a[1] + b[1]) > CUTTIP_Y0 ? 1 : -1;
+  const double mu = cuttip_E / (2.0 * (1.0 + cuttip_nu)),
+               lam = cuttip_E * cuttip_nu / ((1.0 + cuttip_nu) * (1.0 - 2.0 * cuttip_nu));
   for (int q = 0; q < 64; q++) {
     const int iq[3] = {q % 4, (q / 4) % 4, q / 16};
     double x[3], xi[3], wq = 1.0, dN[3 * FCM_ELEMENT_MAX_NODES], Gh[9] = {0}, Ge[9], ue[3];
@@ -165,16 +169,30 @@ static inline void cuttip_box_error(const fcm_space *s, const fcm_index *ed, con
         for (int j = 0; j < 3; j++)
           Gh[3 * i + j] += u[ed[n] + i] * dN[3 * n + j] * 2.0 / (hi[j] - lo[j]);
     cuttip_exact(x, side, ue, Ge);
-    for (int k = 0; k < 9; k++)
-      acc[0] += wq * (Gh[k] - Ge[k]) * (Gh[k] - Ge[k]), acc[1] += wq * Ge[k] * Ge[k];
+    double D[9], tr_d = 0.0, tr_e = 0.0, dd = 0.0, ee = 0.0;
+    for (int k = 0; k < 9; k++) {
+      D[k] = Gh[k] - Ge[k];
+      acc[0] += wq * D[k] * D[k], acc[1] += wq * Ge[k] * Ge[k];
+    }
+    for (int i = 0; i < 3; i++) {
+      tr_d += D[4 * i], tr_e += Ge[4 * i];
+      for (int j = 0; j < 3; j++) {
+        const double sd = 0.5 * (D[3 * i + j] + D[3 * j + i]);
+        const double se = 0.5 * (Ge[3 * i + j] + Ge[3 * j + i]);
+        dd += sd * sd, ee += se * se;
+      }
+    }
+    acc[2] += wq * (lam * tr_d * tr_d + 2.0 * mu * dd);
+    acc[3] += wq * (lam * tr_e * tr_e + 2.0 * mu * ee);
   }
 }
 
-/* Relative H1-seminorm error of u (all DOFs of the cut space s). */
-static inline double cuttip_h1_error(const fcm_space *s, const double *u)
+/* The relative errors of u (all DOFs of the cut space s): err[0] in the H1 seminorm, err[1] in
+ * the energy norm. */
+static inline void cuttip_errors(const fcm_space *s, const double *u, double err[2])
 {
   const fcm_mesh *m = fcm_space_mesh(s);
-  double acc[2] = {0.0, 0.0};
+  double acc[4] = {0.0, 0.0, 0.0, 0.0};
   for (fcm_index c = 0; c < fcm_mesh_num_cells(m); c++) {
     double lo[3], hi[3];
     cuttip_cell_box(m, c, lo, hi);
@@ -194,7 +212,20 @@ static inline double cuttip_h1_error(const fcm_space *s, const double *u)
         cuttip_box_error(s, fcm_space_element_dofs(s, e), u, lo, hi, a, b, 0, acc);
       }
   }
-  return sqrt(acc[0] / acc[1]);
+  err[0] = sqrt(acc[0] / acc[1]), err[1] = sqrt(acc[2] / acc[3]);
+}
+
+/* Octree refinement toward the front: a cell of size h at distance d from the front is split
+ * while h > c max(d, h)^(3/5), c = *(double *)user. The grading h = c r^(3/5) equidistributes
+ * the Hex8 interpolation error of the r^(1/2) field (h^5 r^-3 per cell) down to the cells at
+ * the front, of size c^(5/2). */
+static inline int cuttip_near_front(const double lo[3], const double hi[3], int level, void *user)
+{
+  (void)level;
+  const double c = *(const double *)user, h = hi[0] - lo[0];
+  const double dx = fmax(fmax(lo[0] - CUTTIP_X0, CUTTIP_X0 - hi[0]), 0.0);
+  const double dy = fmax(fmax(lo[1] - CUTTIP_Y0, CUTTIP_Y0 - hi[1]), 0.0);
+  return h > c * pow(fmax(hypot(dx, dy), h), 0.6);
 }
 
 /* Cut rules of the crack on mesh m (body: the unit cube). */
@@ -219,9 +250,11 @@ static inline fcm_status cuttip_rules(fcm_ctx *ctx, const fcm_mesh *m, fcm_cell_
 }
 
 /* The cut-tip problem on mesh m: the reduced system's size (hanging copies eliminated, boundary
- * DOFs included), the relative H1 error and (eta != NULL) the stress-jump indicator per cell. */
+ * DOFs included), the relative errors of cuttip_errors() (error[2]), (interp != NULL) those of
+ * the interpolant in the constrained space (every free copy at the exact field of its branch,
+ * the hanging ones following: u = T v) and (eta != NULL) the stress-jump indicator per cell. */
 static inline fcm_status cuttip_solve(fcm_ctx *ctx, const fcm_mesh *m, fcm_index *nfree,
-                                      double *error, double *eta)
+                                      double error[2], double interp[2], double *eta)
 {
   fcm_cell_rules *R = NULL;
   fcm_space *s = NULL;
@@ -254,21 +287,28 @@ static inline fcm_status cuttip_solve(fcm_ctx *ctx, const fcm_mesh *m, fcm_index
     int bnd = 0;
     for (int d = 0; d < 3; d++)
       bnd |= X[3 * a + d] == 0.0 || X[3 * a + d] == 1.0;
-    for (fcm_index k = 0; bnd && d0 >= 0 && k < fcm_space_node_copies(s, a); k++) {
+    for (fcm_index k = 0; d0 >= 0 && k < fcm_space_node_copies(s, a); k++) {
       const fcm_index dk = d0 + 3 * k;
       if (free_dof[dk] < 0) continue;
       double ue[3];
       cuttip_exact(X + 3 * a, branch[dk / 3], ue, NULL);
       for (int i = 0; i < 3; i++)
-        con[free_dof[dk + i]] = 1, g[free_dof[dk + i]] = ue[i];
+        con[free_dof[dk + i]] = (unsigned char)bnd, g[free_dof[dk + i]] = ue[i];
     }
   }
+  if (interp) {
+    st = fcm_csr_apply(T, 1.0, g, 0.0, u);
+    if (st != FCM_OK) goto done;
+    cuttip_errors(s, u, interp);
+  }
+  for (fcm_index i = 0; i < nr; i++)
+    if (!con[i]) g[i] = 0.0;
   fcm__eliminate_marked(Kr, b, con, g);
   st = direct_solve(ctx, Kr, b, v);
   if (st == FCM_OK) st = fcm_csr_apply(T, 1.0, v, 0.0, u);
   if (st == FCM_OK) {
     *nfree = nr;
-    *error = cuttip_h1_error(s, u);
+    cuttip_errors(s, u, error);
     if (eta) st = fcm_space_stress_jumps(s, &mat, u, eta);
   }
 done:
