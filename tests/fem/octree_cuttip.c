@@ -11,7 +11,8 @@
  * - an octree graded toward the front (levels 0-4) reaches a smaller error than the uniform
  *   16^3 grid (0.133 against 0.189) with fewer DOFs and cells (8,841 and 2,864 against 15,555
  *   and 4,096), and is optimal in energy against its interpolant too (the interpolant in the
- *   constrained space: hanging copies follow their masters). */
+ *   constrained space: hanging copies follow their masters);
+ * - the stress-jump indicator is zero on a through-cut with each side's own affine field. */
 #include "cuttip.h"
 
 #include <string.h>
@@ -83,6 +84,65 @@ static void check_field(void)
   TEST_NEAR(sif, 0.0, 0.0, 1e-12);
 }
 
+/* The stress-jump indicator on a through-cut (the plane y = Y0) of an octree mesh with each
+ * side's own affine field: every element's stress is its side's constant, so the indicator is
+ * zero wherever the enrichment separates the sides (a cell-averaged indicator over nodes
+ * would see the jump across the cut). */
+static void check_indicator(fcm_ctx *ctx, const fcm_material *mat)
+{
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, blo[3] = {-0.2, -0.2, -0.2},
+               bhi[3] = {1.2, 1.2, 1.2}, p[3] = {0.5, CUTTIP_Y0, 0.5}, nrm[3] = {0, 1, 0};
+  const fcm_index n2[3] = {2, 2, 2}, n1[3] = {1, 1, 1};
+  double c = 0.4;
+  fcm_octree_options o = fcm_octree_options_default();
+  o.refine = cuttip_near_front, o.refine_user = &c, o.refine_level = FCM_OCTREE_MAX_LEVEL;
+  fcm_mesh *m = NULL;
+  fcm_geometry *body = NULL;
+  fcm_surface *plane = NULL;
+  fcm_cell_rules *r0 = NULL, *r1 = NULL;
+  fcm_space *s = NULL;
+  fcm_cell_rules_options ro = fcm_cell_rules_options_default();
+  TEST_OK(ctx, fcm_mesh_create_octree(ctx, FCM_ELEMENT_HEX8, lo, hi, n2, &o, &m));
+  TEST_OK(ctx, fcm_geometry_create_box(ctx, lo, hi, n1, &body));
+  TEST_OK(ctx, fcm_surface_create_plane(ctx, p, nrm, blo, bhi, &plane));
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, m, body, &ro, &r0));
+  TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, m, body, r0, plane, &r1));
+  TEST_OK(ctx, fcm_space_create_embedded(ctx, m, r1, &s));
+  TEST_TRUE(fcm_space_num_bodies(s) == 2);
+  const fcm_index nd = fcm_space_num_dofs(s), nc = fcm_mesh_num_cells(m);
+  int *branch = malloc(sizeof *branch * (size_t)(nd / 3));
+  double *u = calloc((size_t)nd, sizeof *u), *eta = calloc((size_t)nc, sizeof *eta);
+  cuttip_copy_branches(s, branch);
+  static const double A[2][9] = {{0.1, 0.02, 0.0, -0.03, 0.05, 0.01, 0.0, 0.04, -0.02},
+                                 {-0.2, 0.0, 0.03, 0.06, 0.1, 0.0, 0.02, -0.05, 0.07}};
+  const double *X = fcm_mesh_coords(m);
+  for (fcm_index a = 0; a < fcm_mesh_num_nodes(m); a++) {
+    const fcm_index d0 = fcm_space_node_dof(s, a);
+    for (fcm_index k = 0; d0 >= 0 && k < fcm_space_node_copies(s, a); k++) {
+      const fcm_index r = d0 / 3 + k;
+      TEST_TRUE(branch[r] != 0);
+      const double *Ak = A[branch[r] > 0];
+      for (int i = 0; i < 3; i++)
+        u[3 * r + i] =
+            Ak[3 * i] * X[3 * a] + Ak[3 * i + 1] * X[3 * a + 1] + Ak[3 * i + 2] * X[3 * a + 2];
+    }
+  }
+  TEST_OK(ctx, fcm_space_stress_jumps(s, mat, u, eta));
+  double emax = 0.0;
+  for (fcm_index k = 0; k < nc; k++)
+    emax = fmax(emax, eta[k]);
+  if (getenv("FCM_TEST_VERBOSE"))
+    printf("indicator on a through-cut, %lld cells: largest %.1e\n", (long long)nc, emax);
+  TEST_NEAR(emax, 0.0, 0.0, 1e-12);
+  free(branch), free(u), free(eta);
+  fcm_space_destroy(&s);
+  fcm_cell_rules_destroy(&r0);
+  fcm_cell_rules_destroy(&r1);
+  fcm_surface_destroy(&plane);
+  fcm_geometry_destroy(&body);
+  fcm_mesh_destroy(&m);
+}
+
 int main(int argc, char **argv)
 {
   (void)argc, (void)argv;
@@ -91,6 +151,7 @@ int main(int argc, char **argv)
   const fcm_material mat = {FCM_MATERIAL_LINEAR, cuttip_E, cuttip_nu, 1.0};
   TEST_OK(ctx, fcm_material_setup(ctx, &mat, &params));
   check_field();
+  check_indicator(ctx, &mat);
 
   const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
   static const int sizes[3] = {4, 8, 16};
