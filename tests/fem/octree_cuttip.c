@@ -40,7 +40,7 @@ static void check_field(void)
                          0.5 + 0.5 * urand(&seed)};
     const double r = hypot(x[0] - CUTTIP_X0, x[1] - CUTTIP_Y0);
     if (r < 0.05 || fabs(x[1] - CUTTIP_Y0) < 0.01) continue;
-    double u[3], G[9], P[9], dP[3] = {0, 0, 0};
+    double u[3], G[9], dP[3] = {0, 0, 0};
     cuttip_exact(x, side, u, G);
     const double scale = 1.0 / sqrt(r); /* of the gradient and the stress */
     for (int j = 0; j < 3; j++) {
@@ -56,7 +56,6 @@ static void check_field(void)
     }
     for (int i = 0; i < 3; i++)
       div = fmax(div, fabs(dP[i]) / (scale / r));
-    (void)P;
   }
   /* on the crack faces (theta = +-pi) and ahead of the front (theta = 0) */
   for (int k = 1; k <= 20; k++) {
