@@ -42,3 +42,8 @@ fcm_add_test(bench_octree_converge tests/bench/bench_octree_converge.c LABELS be
 # The 3x3 SVD of the corotated model: ns per call against the reference Jacobi with three dot
 # products a pair, paired in the same run (figures in lib/docs/cutting.md).
 fcm_add_test(bench_mat3_svd tests/bench/bench_mat3_svd.c LABELS bench TIMEOUT 600)
+# Convergence toward a crack front (a cut ending inside the body, the exact Williams field):
+# uniform grids against octrees refined by the stress jumps and toward the front, Hex8 and Hex20
+# (tables in lib/docs/octree.md).
+fcm_add_test(bench_octree_cuttip tests/bench/bench_octree_cuttip.c ARGS hex8 LABELS bench TIMEOUT 3600)
+fcm_add_test(bench_octree_cuttip_hex20 tests/bench/bench_octree_cuttip.c ARGS hex20 LABELS bench TIMEOUT 3600)

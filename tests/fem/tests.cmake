@@ -86,3 +86,6 @@ fcm_add_test(fem_octree_alloc tests/fem/octree_alloc.c)
 foreach(el hex8 hex20)
   fcm_add_test(fem_octree_transfer_${el} tests/fem/octree_transfer.c ARGS ${el})
 endforeach()
+# The crack-tip field of the cut-tip study (tests/fem/cuttip.h): an exact solution with
+# traction-free crack faces, and convergence toward the front, uniform against an octree.
+fcm_add_test(fem_octree_cuttip tests/fem/octree_cuttip.c)

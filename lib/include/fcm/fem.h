@@ -488,7 +488,10 @@ FCM_API fcm_status fcm_space_cell_stress(const fcm_space *space, const fcm_mater
 
 /** A refinement indicator for static runs: eta[c] = sqrt(|c|) x the largest jump, over the
  * nodes of cell c and the six components, of the cell-averaged stress
- * (fcm_space_cell_stress()) between the active cells sharing that node. Zero for a constant
+ * (fcm_space_cell_stress()) between the active cells sharing that node. On a cut space the
+ * averages are per element (each piece of a split cell apart) and the jumps between the
+ * elements sharing a DOF copy: the jump across a cut, which the enrichment resolves, counts
+ * nothing. Zero for a constant
  * stress (an affine u), about h^(5/2) |grad sigma| where the stress varies smoothly, large at
  * concentrations and singularities. Mark the cells with eta above a fraction of its largest
  * value and refine them (fcm_mesh_create_refined()). Inactive cells get 0.
