@@ -49,7 +49,7 @@ static int write_body(soup *s, const char *dir, const char *surf_dir, const char
  * height); five of them straddle the cut's line z = 0.4. */
 #define PLATE_LX 1.2
 #define PLATE_LZ 0.8
-#define PLATE_T 0.05
+#define PLATE_T  0.05
 typedef struct plate_object {
   int kind;
   double x, z, r, a;
@@ -111,7 +111,13 @@ static void plate_surface(soup *s, long long triangles)
   /* the sides: each boundary edge (a, b) of the grid with its top and bottom vertices */
   for (int side = 0; side < 4; side++) {
     const int n = side < 2 ? nx : nz;
-    const double out[3] = {side == 2 ? -1 : side == 3 ? 1 : 0, 0, side == 0 ? -1 : side == 1 ? 1 : 0};
+    const double out[3] = {side == 2   ? -1
+                           : side == 3 ? 1
+                                       : 0,
+                           0,
+                           side == 0   ? -1
+                           : side == 1 ? 1
+                                       : 0};
     for (int k = 0; k < n; k++) {
       long long a, b;
       if (side < 2) /* z = 0 (side 0) or z = Lz (side 1) */
@@ -146,7 +152,7 @@ int cutbench_koschier_plate(cutbench_text *t, const cutbench_paper *p, double sc
   memset(&m, 0, sizeof m);
   int ok = write_body(&s, dir, surf_dir, name, &m);
   /* the nodes of a thin plate's active cells: the factor fitted to the DOFs at scale 1 */
-  sc->h = 0.964 * size_for(m.volume, m.area, p->size_target * scale / 3.0, 1.45);
+  sc->h = 0.995 * size_for(m.volume, m.area, p->size_target * scale / 3.0, 1.45);
   /* five events, each cutting the next fifth of the length; triangles of about 0.7 cells (the
    * rules' cost grows with the triangles per cell; at scale 1 four per shortest wavelength) */
   const double x0 = -0.05, x1 = PLATE_LX + 0.05, e = 0.7 * sc->h;
@@ -161,12 +167,13 @@ int cutbench_koschier_plate(cutbench_text *t, const cutbench_paper *p, double sc
   }
   soup_clear(&s);
   free(s.x), free(s.t);
-  scene_head(t, name,
-             "After Koschier et al. 2017 (section 7, Fig. 1 left): a 1.2 x 0.05 x 0.8 m plate "
-             "with domes, posts and a ridge standing on it, held at both ends under gravity, cut "
-             "along its length by a long bumpy surface (noise down to three cells' wavelength, "
-             "some cells cut into several pieces by it) in five steps. Stable Neo-Hookean, Hex8, dt 5 ms.",
-             &m, m.path, sc->h, "snh", 1e6, 0.4, solver, 0.005, sc->steps);
+  scene_head(
+      t, name,
+      "After Koschier et al. 2017 (section 7, Fig. 1 left): a 1.2 x 0.05 x 0.8 m plate "
+      "with domes, posts and a ridge standing on it, held at both ends under gravity, cut "
+      "along its length by a long bumpy surface (noise down to three cells' wavelength, "
+      "some cells cut into several pieces by it) in five steps. Stable Neo-Hookean, Hex8, dt 5 ms.",
+      &m, m.path, sc->h, "snh", 1e6, 0.4, solver, 0.005, sc->steps);
   /* cells holding less than 0.5 % material (the objects' rims barely entering a cell layer)
    * are dropped rather than given a rule */
   scene_insert(t, "  \"material\"", "  \"quadrature\": {\"min_fraction\": 0.005},\n");
@@ -297,8 +304,8 @@ int cutbench_tonthat_octopus(cutbench_text *t, const cutbench_paper *p, double s
   soup_rect(&s, 0, 0.3, jlo, jhi);
   ok = write_event(&s, dir, surf_dir, name, 1) && ok;
   /* the tentacles: a horizontal cut through all eight below the head */
-  const double tlo[3] = {m.lo[0] - 0.1, 0, m.lo[2] - 0.1}, thi[3] = {m.hi[0] + 0.1, 0,
-                                                                      m.hi[2] + 0.1};
+  const double tlo[3] = {m.lo[0] - 0.1, 0, m.lo[2] - 0.1},
+               thi[3] = {m.hi[0] + 0.1, 0, m.hi[2] + 0.1};
   soup_rect(&s, 1, OCTO_Y - 0.95, tlo, thi);
   ok = write_event(&s, dir, surf_dir, name, 2) && ok;
   soup_clear(&s);

@@ -320,8 +320,8 @@ void scene_head(cutbench_text *t, const char *name, const char *desc, const cutb
   cutbench_put(t, "  \"effects\": [\n");
 }
 
-void scene_cuts(cutbench_text *t, const cutbench_scene *sc, const char *surf_dir,
-                const char *name, double dt)
+void scene_cuts(cutbench_text *t, const cutbench_scene *sc, const char *surf_dir, const char *name,
+                double dt)
 {
   for (int k = 0; k < sc->events; k++)
     cutbench_put(

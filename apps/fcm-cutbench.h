@@ -15,12 +15,12 @@
 
 /** The rows: each scenario of a paper's table. */
 typedef enum cutbench_row_id {
-  ROW_DICK_BUNNY3 = 0, /* Dick 2011 Table 1, Bunny 3 */
-  ROW_DICK_BUNNY2,     /* Bunny 2 */
-  ROW_DICK_BUNNY,      /* Bunny */
-  ROW_KOSCHIER_BUNNY,  /* Koschier 2017 §7, the groove carved and peeled */
-  ROW_KOSCHIER_PLATE,  /* Koschier 2017 §7, the plate with attached objects, bumpy cut */
-  ROW_TONTHAT_SLAB,    /* Ton-That 2024 Table 2, the thinly cut slab */
+  ROW_DICK_BUNNY3 = 0,   /* Dick 2011 Table 1, Bunny 3 */
+  ROW_DICK_BUNNY2,       /* Bunny 2 */
+  ROW_DICK_BUNNY,        /* Bunny */
+  ROW_KOSCHIER_BUNNY,    /* Koschier 2017 §7, the groove carved and peeled */
+  ROW_KOSCHIER_PLATE,    /* Koschier 2017 §7, the plate with attached objects, bumpy cut */
+  ROW_TONTHAT_SLAB,      /* Ton-That 2024 Table 2, the thinly cut slab */
   ROW_TONTHAT_ACCORDION, /* Ton-That 2024 Table 2, the hanging cube cut into an accordion */
   ROW_TONTHAT_OCTOPUS,   /* Ton-That 2024 Table 2, the octopus: mouth, jaw, tentacles */
   ROW_COUNT
@@ -168,8 +168,8 @@ int scene_insert(cutbench_text *t, const char *key, const char *text);
  * around it) and the box geometry before the scene's material; 0 when it does not fit. */
 int scene_box_grid(cutbench_text *t, const double L[3], double h, const fcm_index n[3]);
 /** The cut effects of sc (event k at the start of step event_step[k]) and the scene's end. */
-void scene_cuts(cutbench_text *t, const cutbench_scene *sc, const char *surf_dir,
-                const char *name, double dt);
+void scene_cuts(cutbench_text *t, const cutbench_scene *sc, const char *surf_dir, const char *name,
+                double dt);
 
 /** Rows with a generated body of their own (fcm-cutbench-bodies.c): write the body, the cut
  * surfaces and the scene text into t (the plate, the accordion, the octopus); 1 on success. */
