@@ -1,6 +1,8 @@
-/* fcm-cutbench: the papers' figures, the generated bunny-like body, and the scenes of the three
- * scenarios written as scene files with their cut surfaces (triangle surfaces in OBJ files
- * beside them), so that a row runs exactly what `fcm-sim` would run from those files. */
+/* fcm-cutbench: the papers' figures, the generated bunny-like body, the helpers every scene
+ * writer shares, and the scenes of the bunny and slab rows written as scene files with their
+ * cut surfaces (triangle surfaces in OBJ files beside them), so that a row runs exactly what
+ * `fcm-sim` would run from those files (the rows with bodies of their own:
+ * fcm-cutbench-bodies.c). */
 #define _POSIX_C_SOURCE 200809L
 #include "app_sphere.h"
 #include "cli.h"
