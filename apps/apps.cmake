@@ -19,7 +19,7 @@ if(FCM_HAVE_PETSC) # --backend petsc: the PETSc component
   target_link_libraries(fcm-scaling PRIVATE fcm::petsc)
 endif()
 fcm_add_app(fcm-models apps/fcm-models.c apps/fcm-models-run.c apps/fcm-models-output.c)
-fcm_add_app(fcm-cutbench apps/fcm-cutbench.c apps/fcm-cutbench-scenes.c
+fcm_add_app(fcm-cutbench apps/fcm-cutbench.c apps/fcm-cutbench-scenes.c apps/fcm-cutbench-bodies.c
             apps/fcm-cutbench-output.c)
 # fcm-models finds its built-in pebble (apps/scenes/models/pebble.obj) in the source tree.
 target_compile_definitions(fcm-models PRIVATE FCM_MODELS_SOURCE_DIR="${PROJECT_SOURCE_DIR}")

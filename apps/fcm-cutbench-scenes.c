@@ -1,6 +1,8 @@
-/* fcm-cutbench: the papers' figures, the generated bunny-like body, and the scenes of the three
- * scenarios written as scene files with their cut surfaces (triangle surfaces in OBJ files
- * beside them), so that a row runs exactly what `fcm-sim` would run from those files. */
+/* fcm-cutbench: the papers' figures, the generated bunny-like body, the helpers every scene
+ * writer shares, and the scenes of the bunny and slab rows written as scene files with their
+ * cut surfaces (triangle surfaces in OBJ files beside them), so that a row runs exactly what
+ * `fcm-sim` would run from those files (the rows with bodies of their own:
+ * fcm-cutbench-bodies.c). */
 #define _POSIX_C_SOURCE 200809L
 #include "app_sphere.h"
 #include "cli.h"
@@ -29,8 +31,17 @@ const cutbench_paper cutbench_papers[ROW_COUNT] = {
     {"koschier-bunny", "Koschier 2017 sec. 7", "bunny: groove carved then peeled",
      "5326 -> 9432 DOFs", 5326, 0, 0.646, 1.375, 0, 0.1,
      "i7-6700HQ 4 cores; implicit Euler; StVK (cut: 47 % of a step)", "hex8", "snh", 1},
+    {"koschier-plate", "Koschier 2017 sec. 7", "plate with attached objects: bumpy cut",
+     "47643 -> 53326 DOFs", 47643, 0, 1.639, 9.365, 0, 0.1,
+     "i7-6700HQ 4 cores; implicit Euler; StVK (cut: 17.5 % of a step)", "hex8", "snh", 0},
     {"tonthat-slab", "Ton-That 2024 Table 2", "thin slab: multiple intersecting cuts", "7.2k DOFs",
      7200, 0, 0.0, 0.627, 3.355, 0.1, "i9-13900K; SNH; 1 Newton iteration", "hex8", "snh", 1},
+    {"tonthat-accordion", "Ton-That 2024 Table 2", "accordion: hanging cube cut into pleats",
+     "22.8k DOFs", 22800, 0, 0.0, 5.785, 9.203, 0.1, "i9-13900K; SNH; 1 Newton iteration", "hex8",
+     "snh", 0},
+    {"tonthat-octopus", "Ton-That 2024 Table 2", "octopus: mouth carved, jaw and tentacles cut",
+     "20.8k DOFs", 20800, 0, 0.0, 2.05, 17.3, 0.1, "i9-13900K; SNH; 1 Newton iteration", "hex8",
+     "snh", 0},
 };
 
 /* ------------------------------------------------------------- the bunny-like body */
@@ -124,15 +135,7 @@ int cutbench_model_measure(fcm_ctx *ctx, cutbench_model *m)
 
 /* ------------------------------------------------------------- cut surfaces */
 
-/* A triangle soup written as an OBJ. */
-typedef struct soup {
-  double *x;
-  long long nv, nt, capv, capt;
-  long long *t;
-  int ok;
-} soup;
-
-static long long soup_vertex(soup *s, const double p[3])
+long long soup_vertex(soup *s, const double p[3])
 {
   if (s->nv == s->capv) {
     s->capv = s->capv ? 2 * s->capv : 256;
@@ -144,7 +147,7 @@ static long long soup_vertex(soup *s, const double p[3])
   return s->nv++;
 }
 
-static void soup_triangle(soup *s, long long a, long long b, long long c)
+void soup_triangle(soup *s, long long a, long long b, long long c)
 {
   if (!s->ok) return;
   if (s->nt == s->capt) {
@@ -160,10 +163,7 @@ static void soup_triangle(soup *s, long long a, long long b, long long c)
   s->nt++;
 }
 
-/* A patch p(u, v), (u, v) in [0,1]^2, as an nu x nv grid of quads, two triangles each. */
-typedef void (*patch_fn)(double u, double v, const double *par, double p[3]);
-
-static void soup_patch(soup *s, patch_fn f, const double *par, int nu, int nv)
+void soup_patch(soup *s, patch_fn f, const double *par, int nu, int nv)
 {
   const long long base = s->nv;
   for (int j = 0; j <= nv; j++)
@@ -187,9 +187,7 @@ static void rect_patch(double u, double v, const double *par, double p[3])
     p[d] = par[d] + (u - 0.5) * par[3 + d] + (v - 0.5) * par[6 + d];
 }
 
-/* An axis-aligned rectangle in the plane x_axis = value, spanning [lo, hi] on the two other
- * axes. */
-static void soup_rect(soup *s, int axis, double value, const double lo[3], const double hi[3])
+void soup_rect(soup *s, int axis, double value, const double lo[3], const double hi[3])
 {
   const int a = (axis + 1) % 3, b = (axis + 2) % 3;
   double par[9] = {0};
@@ -219,7 +217,7 @@ static void ring_patch(double u, double v, const double *par, double p[3])
   p[0] = par[0] + r * cos(th), p[2] = par[2] + r * sin(th), p[1] = par[6];
 }
 
-static int soup_write(soup *s, const char *path)
+int soup_write(soup *s, const char *path)
 {
   if (!s->ok) {
     fprintf(stderr, PROG ": %s: out of memory\n", path);
@@ -236,7 +234,7 @@ static int soup_write(soup *s, const char *path)
   return cli_output_commit(PROG, &out);
 }
 
-static void soup_clear(soup *s)
+void soup_clear(soup *s)
 {
   free(s->x);
   free(s->t);
@@ -244,12 +242,33 @@ static void soup_clear(soup *s)
   s->ok = 1;
 }
 
+void soup_measure(const soup *s, cutbench_model *m)
+{
+  double vol = 0.0, area = 0.0;
+  for (int d = 0; d < 3; d++)
+    m->lo[d] = HUGE_VAL, m->hi[d] = -HUGE_VAL;
+  for (long long v = 0; v < s->nv; v++)
+    for (int d = 0; d < 3; d++)
+      m->lo[d] = fmin(m->lo[d], s->x[3 * v + d]), m->hi[d] = fmax(m->hi[d], s->x[3 * v + d]);
+  for (long long k = 0; k < s->nt; k++) {
+    const double *a = s->x + 3 * s->t[3 * k], *b = s->x + 3 * s->t[3 * k + 1],
+                 *c = s->x + 3 * s->t[3 * k + 2];
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                         u[0] * v[1] - u[1] * v[0]};
+    area += 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    vol += (a[0] * n[0] + a[1] * n[1] + a[2] * n[2]) / 6.0;
+  }
+  m->volume = fabs(vol), m->area = area;
+}
+
 /* ------------------------------------------------------------- sizes */
 
 /* The cell size h at which a body of volume V and area A has about n active cells (interior
  * V/h^3 plus a layer of cut cells, c A/h^2): c = 0.75 for cells, 2.0 for the nodes of the
  * active cells (fitted to the Stanford bunny at h = 6 mm: 4,752 cells, 6,740 nodes). */
-static double size_for(double V, double A, double n, double c)
+double size_for(double V, double A, double n, double c)
 {
   double lo = 1e-6, hi = 10.0 * cbrt(V) + 1.0;
   for (int it = 0; it < 200; it++) {
@@ -277,11 +296,9 @@ void cutbench_put(cutbench_text *t, const char *fmt, ...)
     t->n += (size_t)k;
 }
 
-/* The scene's common head: name, description, background (a fitted grid for a surface body),
- * body, material, solver, time. */
-static void scene_head(cutbench_text *t, const char *name, const char *desc,
-                       const cutbench_model *m, const char *body, double h, const char *material,
-                       double young, double poisson, const char *solver, double dt, int steps)
+void scene_head(cutbench_text *t, const char *name, const char *desc, const cutbench_model *m,
+                const char *body, double h, const char *material, double young, double poisson,
+                const char *solver, double dt, int steps)
 {
   cutbench_put(t, "{\n  \"version\": 1,\n  \"name\": \"%s\",\n  \"description\": \"%s\",\n", name,
                desc);
@@ -305,10 +322,8 @@ static void scene_head(cutbench_text *t, const char *name, const char *desc,
   cutbench_put(t, "  \"effects\": [\n");
 }
 
-/* The cut effects: event k at the start of step event_step[k] (1-based), its surface the
- * OBJ <surf_dir>/<name>_cut<k>.obj. */
-static void scene_cuts(cutbench_text *t, const cutbench_scene *sc, const char *surf_dir,
-                       const char *name, double dt)
+void scene_cuts(cutbench_text *t, const cutbench_scene *sc, const char *surf_dir, const char *name,
+                double dt)
 {
   for (int k = 0; k < sc->events; k++)
     cutbench_put(
@@ -317,8 +332,7 @@ static void scene_cuts(cutbench_text *t, const cutbench_scene *sc, const char *s
   cutbench_put(t, "  ]\n}\n");
 }
 
-/* <dir>/<surf_dir>/<name>_cut<k>.obj */
-static int write_event(soup *s, const char *dir, const char *surf_dir, const char *name, int k)
+int write_event(soup *s, const char *dir, const char *surf_dir, const char *name, int k)
 {
   char path[8192];
   snprintf(path, sizeof path, "%s/%s/%s_cut%d.obj", dir, surf_dir, name, k + 1);
@@ -419,10 +433,9 @@ static int slab_cuts(const char *dir, const char *surf_dir, const char *name, cu
   return ok;
 }
 
-/* The slab's cell size: the background starts half a cell before the body and ends in the
- * first cell past it, n_d = ceil((L_d + h/2) / h) cells and n_d + 1 nodes per axis, every cell
- * meeting the body; the size whose 3 x nodes is nearest the target DOFs. */
-static double slab_size(double dofs, const double L[3], fcm_index n[3])
+/* The background starts half a cell before the box and ends in the first cell past it, n_d =
+ * ceil((L_d + h/2) / h) cells and n_d + 1 nodes per axis, every cell meeting the body. */
+double slab_size(double dofs, const double L[3], fcm_index n[3])
 {
   double best = 0.1, err = HUGE_VAL;
   for (int i = 0; i < 4000; i++) {
@@ -435,6 +448,31 @@ static double slab_size(double dofs, const double L[3], fcm_index n[3])
   for (int d = 0; d < 3; d++)
     n[d] = (fcm_index)ceil((L[d] + 0.5 * best) / best - 1e-9);
   return best;
+}
+
+int scene_insert(cutbench_text *t, const char *key, const char *text)
+{
+  char *at = t->ok ? strstr(t->s, key) : NULL;
+  const size_t g = strlen(text);
+  if (!at || t->n + g + 1 >= sizeof t->s) return t->ok = 0, 0;
+  memmove(at + g, at, strlen(at) + 1);
+  memcpy(at, text, g);
+  t->n += g;
+  return 1;
+}
+
+int scene_box_grid(cutbench_text *t, const double L[3], double h, const fcm_index n[3])
+{
+  char grid[512];
+  snprintf(grid, sizeof grid,
+           "  \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [%.6g, %.6g, %.6g], "
+           "\"max\": [%.6g, %.6g, %.6g]}, \"cells\": [%lld, %lld, %lld]},\n"
+           "  \"geometry\": {\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [%.6g, %.6g, "
+           "%.6g]},\n",
+           -0.5 * h, -0.5 * h, -0.5 * h, -0.5 * h + n[0] * h, -0.5 * h + n[1] * h,
+           -0.5 * h + n[2] * h, (long long)n[0], (long long)n[1], (long long)n[2], L[0], L[1],
+           L[2]);
+  return scene_insert(t, "  \"material\"", grid);
 }
 
 int cutbench_write_scene(cutbench_row_id row, const cutbench_model *m, const char *body,
@@ -451,7 +489,13 @@ int cutbench_write_scene(cutbench_row_id row, const cutbench_model *m, const cha
   const double target = p->size_target * scale;
   const double Ly = m ? m->hi[1] - m->lo[1] : 0.0;
   int ok = 1;
-  if (row <= ROW_DICK_BUNNY) {
+  if (row == ROW_KOSCHIER_PLATE)
+    ok = cutbench_koschier_plate(&t, p, scale, m->triangles, solver, dir, surf_dir, name, sc);
+  else if (row == ROW_TONTHAT_ACCORDION)
+    ok = cutbench_tonthat_accordion(&t, p, scale, solver, dir, surf_dir, name, sc);
+  else if (row == ROW_TONTHAT_OCTOPUS)
+    ok = cutbench_tonthat_octopus(&t, p, scale, m->triangles, solver, dir, surf_dir, name, sc);
+  else if (row <= ROW_DICK_BUNNY) {
     sc->h = size_for(m->volume, m->area, target, 0.75);
     ok = dick_cuts(m, dir, surf_dir, name, sc);
     char desc[512];
@@ -497,30 +541,18 @@ int cutbench_write_scene(cutbench_row_id row, const cutbench_model *m, const cha
                "earlier cuts split, then by a cut across all sheets. Stable Neo-Hookean (E = "
                "1e6 Pa, nu = 0.4), Hex8, dt 0.033 s.",
                NULL, NULL, 0.0, "snh", 1e6, 0.4, solver, 0.033, sc->steps);
-    /* the background before the material: insert it after the description */
-    char grid[512];
-    snprintf(grid, sizeof grid,
-             "  \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [%.6g, %.6g, %.6g], "
-             "\"max\": [%.6g, %.6g, %.6g]}, \"cells\": [%lld, %lld, %lld]},\n"
-             "  \"geometry\": {\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [2, 0.6, 0.4]},\n",
-             -0.5 * sc->h, -0.5 * sc->h, -0.5 * sc->h, -0.5 * sc->h + n[0] * sc->h,
-             -0.5 * sc->h + n[1] * sc->h, -0.5 * sc->h + n[2] * sc->h, (long long)n[0],
-             (long long)n[1], (long long)n[2]);
-    char *mat = strstr(t.s, "  \"material\"");
-    const size_t g = strlen(grid), tail = strlen(mat);
-    if (t.n + g + 1 >= sizeof t.s) return 0;
-    memmove(mat + g, mat, tail + 1);
-    memcpy(mat, grid, g);
-    t.n += g;
+    /* the background before the material: inserted after the description */
+    if (!scene_box_grid(&t, L, sc->h, n)) return 0;
     cutbench_put(&t, "    {\"gravity\": {\"acceleration\": [0, 0, -9.81]}},\n");
     cutbench_put(
         &t, "    {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0, 0], \"normal\": [-1, "
             "0, 0]}}}},\n");
   }
-  scene_cuts(&t, sc, surf_dir, name,
-             row == ROW_KOSCHIER_BUNNY ? 0.005
-             : row == ROW_TONTHAT_SLAB ? 0.033
-                                       : 0.01);
+  if (row <= ROW_KOSCHIER_BUNNY || row == ROW_TONTHAT_SLAB)
+    scene_cuts(&t, sc, surf_dir, name,
+               row == ROW_KOSCHIER_BUNNY ? 0.005
+               : row == ROW_TONTHAT_SLAB ? 0.033
+                                         : 0.01);
   if (!ok || !t.ok) {
     fprintf(stderr, PROG ": %s: the scene could not be written\n", name);
     return 0;

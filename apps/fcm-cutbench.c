@@ -25,7 +25,9 @@ static const char *const row_interactive[ROW_COUNT] = {
     "\"method\": \"multigrid\", \"fixed_cycles\": 3, \"newton\": {\"fixed_iterations\": 1}",
     "\"method\": \"multigrid\", \"fixed_cycles\": 3, \"newton\": {\"fixed_iterations\": 1}",
     /* Koschier, Ton-That: one Newton iteration a step (Ton-That's setting), direct solves */
-    "\"newton\": {\"fixed_iterations\": 1}", "\"newton\": {\"fixed_iterations\": 1}"};
+    "\"newton\": {\"fixed_iterations\": 1}", "\"newton\": {\"fixed_iterations\": 1}",
+    "\"newton\": {\"fixed_iterations\": 1}", "\"newton\": {\"fixed_iterations\": 1}",
+    "\"newton\": {\"fixed_iterations\": 1}"};
 
 typedef struct settings {
   int quick, fill_holes;
@@ -52,10 +54,18 @@ static void usage(FILE *f, const cli_option *opts)
           "      into the bunny in four steps; 5.48k, 26.1k, 118k active Hex8 cells; corotated\n"
           "  koschier-bunny  Koschier 2017 7: a groove carved into the turning bunny, then\n"
           "      peeled off; 5,326 DOFs; Stable Neo-Hookean\n"
+          "  koschier-plate  Koschier 2017 7: a plate with attached objects (a generated\n"
+          "      body) cut along its length by a long bumpy surface in five steps; 47,643 DOFs\n"
           "  tonthat-slab  Ton-That 2024 Table 2: a slab cut into thin sheets by cuts\n"
           "      re-entering the same cells, then across; 7.2k DOFs; Stable Neo-Hookean\n"
-          "The body is a generated closed bunny-like surface (--surface-triangles) unless\n"
-          "--model gives a file. Each row runs the accurate defaults and then its interactive\n"
+          "  tonthat-accordion  Ton-That 2024 Table 2: a hanging cube cut half through at eight\n"
+          "      levels from alternate sides, then a vertical cut rips the top layers; 22.8k DOFs\n"
+          "  tonthat-octopus  Ton-That 2024 Table 2: a generated octopus, a wavy mouth carved,\n"
+          "      a cut across it drops the jaw, then the tentacles cut; 20.8k DOFs\n"
+          "The rows after the first of each paper are left out of --quick.\n"
+          "The bunny rows' body is a generated closed bunny-like surface (--surface-triangles)\n"
+          "unless --model gives a file; the plate and the octopus generate their own (as many\n"
+          "triangles). Each row runs the accurate defaults and then its interactive\n"
           "option set (Dick: 3 multigrid V-cycles and one Newton iteration a step; Koschier,\n"
           "Ton-That: one Newton iteration; skipped where this build lacks those keys;\n"
           "--interactive replaces them, as members of the scene's \"solver\" object) and\n"
@@ -80,13 +90,13 @@ static void option_table(settings *o, cli_option opts[NUM_OPTIONS])
        "size the rows to F times the papers' cells or DOFs\n(default 1)", 0, 4, CLI_LO_OPEN, NULL,
        NULL, NULL},
       {"--model", NULL, CLI_STRING, &o->model, "FILE",
-       "the body's surface (OBJ, STL, OFF, PLY) instead of the\ngenerated one", 0, 0, 0, NULL, NULL,
-       NULL},
+       "the bunny rows' body surface (OBJ, STL, OFF, PLY)\ninstead of the generated one", 0, 0, 0,
+       NULL, NULL, NULL},
       {"--fill-holes", NULL, CLI_FLAG, &o->fill_holes, NULL, "close the holes of --model", 0, 0, 0,
        NULL, NULL, NULL},
       {"--surface-triangles", NULL, CLI_LLONG, &o->triangles, "N",
-       "triangles of the generated body (default 70000)", 48, 5e6, 0, NULL, NULL,
-       &o->seen_triangles},
+       "triangles of the generated bodies: the bunny, the\nplate, the octopus (default 70000)", 48,
+       5e6, 0, NULL, NULL, &o->seen_triangles},
       {"--interactive", NULL, CLI_STRING, &o->interactive, "MEMBERS",
        "an option set run beside the defaults, as members of\nthe scene's \"solver\" object, "
        "e.g. '\"method\": \"cg\"'",
@@ -279,6 +289,7 @@ static void file_stem(const char *path, char *out, size_t cap)
 static int make_body(fcm_ctx *ctx, const settings *o, const char *gen, cutbench_model *m)
 {
   memset(m, 0, sizeof *m);
+  m->triangles = o->model ? 70000 : o->triangles;
   if (o->model) {
     char *abs = realpath(o->model, NULL);
     if (!abs) {

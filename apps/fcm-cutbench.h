@@ -15,11 +15,14 @@
 
 /** The rows: each scenario of a paper's table. */
 typedef enum cutbench_row_id {
-  ROW_DICK_BUNNY3 = 0, /* Dick 2011 Table 1, Bunny 3 */
-  ROW_DICK_BUNNY2,     /* Bunny 2 */
-  ROW_DICK_BUNNY,      /* Bunny */
-  ROW_KOSCHIER_BUNNY,  /* Koschier 2017 §7, the groove carved and peeled */
-  ROW_TONTHAT_SLAB,    /* Ton-That 2024 Table 2, the thinly cut slab */
+  ROW_DICK_BUNNY3 = 0,   /* Dick 2011 Table 1, Bunny 3 */
+  ROW_DICK_BUNNY2,       /* Bunny 2 */
+  ROW_DICK_BUNNY,        /* Bunny */
+  ROW_KOSCHIER_BUNNY,    /* Koschier 2017 §7, the groove carved and peeled */
+  ROW_KOSCHIER_PLATE,    /* Koschier 2017 §7, the plate with attached objects, bumpy cut */
+  ROW_TONTHAT_SLAB,      /* Ton-That 2024 Table 2, the thinly cut slab */
+  ROW_TONTHAT_ACCORDION, /* Ton-That 2024 Table 2, the hanging cube cut into an accordion */
+  ROW_TONTHAT_OCTOPUS,   /* Ton-That 2024 Table 2, the octopus: mouth, jaw, tentacles */
   ROW_COUNT
 } cutbench_row_id;
 
@@ -51,6 +54,7 @@ typedef struct cutbench_model {
   int fill_holes;      /* the scene's geometry.fill_holes */
   double lo[3], hi[3]; /* bounding box */
   double volume, area; /* enclosed volume, surface area */
+  long long triangles; /* triangles of the rows' generated bodies (plate, octopus) */
 } cutbench_model;
 
 /** A scenario written out: the scene file (and its cut surfaces beside it). */
@@ -119,6 +123,65 @@ typedef struct cutbench_row {
   double disp_diff;      /* max |u_default - u_interactive| (m); -1 when not both ran */
   double disp_max;       /* max |u_default| (m) */
 } cutbench_row;
+
+/* ---- shared by the scene writers (fcm-cutbench-scenes.c, fcm-cutbench-bodies.c) */
+
+/** A triangle soup written as an OBJ; ok drops to 0 when out of memory. */
+typedef struct soup {
+  double *x;
+  long long nv, nt, capv, capt;
+  long long *t;
+  int ok;
+} soup;
+
+long long soup_vertex(soup *s, const double p[3]);
+void soup_triangle(soup *s, long long a, long long b, long long c);
+/** A patch p(u, v), (u, v) in [0,1]^2, as an nu x nv grid of quads, two triangles each. */
+typedef void (*patch_fn)(double u, double v, const double *par, double p[3]);
+void soup_patch(soup *s, patch_fn f, const double *par, int nu, int nv);
+/** An axis-aligned rectangle in the plane x_axis = value, spanning [lo, hi] on the others. */
+void soup_rect(soup *s, int axis, double value, const double lo[3], const double hi[3]);
+int soup_write(soup *s, const char *path);
+/** Free the soup's arrays and make it empty (ok again). */
+void soup_clear(soup *s);
+/** The soup's bounding box, enclosed volume and area into m (a closed surface). */
+void soup_measure(const soup *s, cutbench_model *m);
+/** Write the soup as the cut surface of event k: <dir>/<surf_dir>/<name>_cut<k+1>.obj, then
+ * clear it. */
+int write_event(soup *s, const char *dir, const char *surf_dir, const char *name, int k);
+
+/** The cell size at which a body of volume V and area A has about n cells (c = 0.75) or nodes
+ * of active cells (c = 2.0). */
+double size_for(double V, double A, double n, double c);
+/** The box [0, L]'s cell size whose grid (half a cell around it) has 3 x nodes nearest `dofs`,
+ * its cells per axis into n. */
+double slab_size(double dofs, const double L[3], fcm_index n[3]);
+/** The scene's head: name, description, background (fitted grid for a surface body m), body,
+ * material, solver, time; then the start of the effects list. */
+void scene_head(cutbench_text *t, const char *name, const char *desc, const cutbench_model *m,
+                const char *body, double h, const char *material, double young, double poisson,
+                const char *solver, double dt, int steps);
+/** Insert `text` before the first occurrence of `key` in t; 0 (and t->ok 0) when key is
+ * missing or the text does not fit. */
+int scene_insert(cutbench_text *t, const char *key, const char *text);
+/** Insert the background grid of the box [0, L] (n cells of size h per axis, half a cell
+ * around it) and the box geometry before the scene's material; 0 when it does not fit. */
+int scene_box_grid(cutbench_text *t, const double L[3], double h, const fcm_index n[3]);
+/** The cut effects of sc (event k at the start of step event_step[k]) and the scene's end. */
+void scene_cuts(cutbench_text *t, const cutbench_scene *sc, const char *surf_dir, const char *name,
+                double dt);
+
+/** Rows with a generated body of their own (fcm-cutbench-bodies.c): write the body, the cut
+ * surfaces and the scene text into t (the plate, the accordion, the octopus); 1 on success. */
+int cutbench_koschier_plate(cutbench_text *t, const cutbench_paper *p, double scale,
+                            long long triangles, const char *solver, const char *dir,
+                            const char *surf_dir, const char *name, cutbench_scene *sc);
+int cutbench_tonthat_accordion(cutbench_text *t, const cutbench_paper *p, double scale,
+                               const char *solver, const char *dir, const char *surf_dir,
+                               const char *name, cutbench_scene *sc);
+int cutbench_tonthat_octopus(cutbench_text *t, const cutbench_paper *p, double scale,
+                             long long triangles, const char *solver, const char *dir,
+                             const char *surf_dir, const char *name, cutbench_scene *sc);
 
 /* ---- fcm-cutbench-output.c: table, CSV, PNG */
 

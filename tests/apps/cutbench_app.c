@@ -7,9 +7,13 @@
  * the paper's and the verdicts follow from them; both runs of a row end on the same DOFs and
  * differ in displacement by less than a tenth of the largest displacement. The PNG is a PNG
  * (with gnuplot). --write-scenes writes scenes that parse. Bad options exit 2 and write no CSV.
+ * Mode rows (label app): the rows left out of --quick — the accordion runs at 0.1 of its size
+ * (both runs ok, every figure finite, its five cut events add DOFs, at least one Newton
+ * iteration a step, the same DOFs in both runs); the plate's, accordion's and octopus's scenes
+ * written with --write-scenes parse with their cut events.
  * Mode full (label bench): every row at the papers' sizes runs, the defaults ok, the program's
  * interactive sets ok or skipped (a build without their keys).
- * Usage: app_cutbench quick|full PATH_TO_fcm-cutbench WORK_DIR */
+ * Usage: app_cutbench quick|rows|full PATH_TO_fcm-cutbench WORK_DIR */
 #define _POSIX_C_SOURCE 200809L
 #include "app_run.h"
 #include "fcm/fcm.h"
@@ -179,15 +183,66 @@ static void quick(const char *prog, const char *work)
   }
 }
 
-static void full(const char *prog, const char *work)
+/* The scenes of `rows` (names as the files spell them) written to <work>/<sub> parse, each
+ * with its cut events. */
+static void check_scenes(const char *prog, const char *work, const char *sub, const char *opts,
+                         const char *const *names, const double *events, int n)
+{
+  char cmd[8192], dir[1024];
+  snprintf(dir, sizeof dir, "%s/%s", work, sub);
+  snprintf(cmd, sizeof cmd, "rm -rf '%s' && '%s' --write-scenes '%s' %s > /dev/null", dir, prog,
+           dir, opts);
+  TEST_TRUE(app_run(cmd) == 0);
+  fcm_ctx *ctx = NULL;
+  TEST_TRUE(fcm_ctx_create(NULL, &ctx) == FCM_OK);
+  for (int i = 0; i < n; i++) {
+    char path[2048];
+    snprintf(path, sizeof path, "%s/cutbench_%s.json", dir, names[i]);
+    fcm_scene *scene = NULL;
+    TEST_TRUE(fcm_scene_create_from_file(ctx, path, &scene) == FCM_OK);
+    TEST_TRUE(scene && fcm_scene_count_effects(scene, FCM_EFFECT_CUT) == (int)events[i]);
+    fcm_scene_destroy(&scene);
+  }
+  fcm_ctx_destroy(&ctx);
+}
+
+static void rows_mode(const char *prog, const char *work)
 {
   char cmd[8192], csv[1024];
   static crow rows[16];
+  snprintf(csv, sizeof csv, "%s/cutbench-accordion.csv", work);
+  remove(csv);
+  snprintf(cmd, sizeof cmd, "'%s' --rows tonthat-accordion --scale 0.1 --csv '%s' > /dev/null 2>&1",
+           prog, csv);
+  TEST_TRUE(app_run(cmd) == 0);
+  const int n = read_rows(csv, rows, 16);
+  TEST_TRUE(n == 2);
+  if (n == 2) {
+    const crow *d = &rows[0], *q = &rows[1];
+    TEST_TRUE(!strcmp(d->f[C_ROW], "tonthat-accordion") && !strcmp(q->f[C_ROW], d->f[C_ROW]));
+    TEST_TRUE(!strcmp(d->f[C_SOLVER], "defaults") && !strcmp(q->f[C_SOLVER], "interactive"));
+    check_run(d, 5);
+    check_run(q, 5);
+    TEST_TRUE(q->v[C_DOFS1] == d->v[C_DOFS1] && q->v[C_DOFS0] == d->v[C_DOFS0]);
+    TEST_TRUE(d->v[C_DMAX] > 0.0 && isfinite(q->v[C_DIFF]));
+  }
+  static const char *const names[3] = {"koschier_plate", "tonthat_accordion", "tonthat_octopus"};
+  static const double events[3] = {5, 5, 3};
+  check_scenes(prog, work, "cutbench-rows-scenes",
+               "--rows koschier-plate,tonthat-accordion,tonthat-octopus --scale 0.1 "
+               "--surface-triangles 2000",
+               names, events, 3);
+}
+
+static void full(const char *prog, const char *work)
+{
+  char cmd[8192], csv[1024];
+  static crow rows[32];
   snprintf(csv, sizeof csv, "%s/cutbench-full.csv", work);
   remove(csv);
   snprintf(cmd, sizeof cmd, "'%s' --csv '%s'", prog, csv);
   TEST_TRUE(app_run(cmd) == 0);
-  const int n = read_rows(csv, rows, 16);
+  const int n = read_rows(csv, rows, 32);
   int defaults = 0;
   for (int i = 0; i < n; i++) {
     const int d = !strcmp(rows[i].f[C_SOLVER], "defaults");
@@ -196,7 +251,7 @@ static void full(const char *prog, const char *work)
     TEST_TRUE(!strcmp(rows[i].f[C_STATUS], "ok") ||
               (!d && !strcmp(rows[i].f[C_STATUS], "skipped")));
   }
-  TEST_TRUE(defaults == 5 && n == 10);
+  TEST_TRUE(defaults == 8 && n == 16);
 }
 
 int main(int argc, char **argv)
@@ -204,6 +259,8 @@ int main(int argc, char **argv)
   if (argc != 4) return 2;
   if (!strcmp(argv[1], "full"))
     full(argv[2], argv[3]);
+  else if (!strcmp(argv[1], "rows"))
+    rows_mode(argv[2], argv[3]);
   else
     quick(argv[2], argv[3]);
   return TEST_RESULT();
