@@ -355,6 +355,85 @@ cleanup:
   return st;
 }
 
+/* The links of region cell c with its face neighbours of higher number into the cell's own
+ * list (links, nl, cap). */
+static fcm_status cell_links(const build *B, const fcm_cell_rules *R, const cell_out *out,
+                             fcm_index c, fcm__material *mat, fcm__idbuf *tc, fcm_index **links,
+                             size_t *nl, size_t *cap)
+{
+  fcm_status st = FCM_OK;
+  const fcm_mesh *mesh = B->mesh;
+  const int nf = fcm_mesh_get_element_info(mesh)->num_faces;
+  const fcm_index *nbr = fcm_mesh_neighbors(mesh);
+  fcm__embed_cell cell;
+  FCM_TRY(B->ctx, fcm__embed_cell_setup(B->ctx, mesh, c, B->o->clip_rtol, &cell));
+  for (int f = 0; f < nf; f++) {
+    const fcm_index c2 = nbr[(size_t)nf * c + f];
+    if (c2 <= c || !B->region[c2] || out[c2].np == 0) continue;
+    int f2 = 0;
+    while (f2 < nf && nbr[(size_t)nf * c2 + f2] != c)
+      f2++;
+    if (f2 == nf) continue;
+    FCM_TRY(B->ctx, face_links(B, R, out, &cell, c, f, c2, f2, mat, tc, links, nl, cap));
+  }
+cleanup:
+  return st;
+}
+
+/* Each region cell's links (cell_links()), in parallel: the cells' lists, in cell order, in
+ * *links (*nl of them). The set does not depend on the threads; the caller sorts it. */
+static fcm_status region_links(const build *B, const fcm_cell_rules *R, const cell_out *out,
+                               fcm_index **links, size_t *nl, size_t *cap)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_index nc = R->num_cells;
+  fcm_index **cl = NULL; /* per cell: its links (NULL: none) */
+  size_t *cn = NULL, total = 0;
+  fcm__loop loop;
+  FCM_ALLOC(ctx, (size_t)nc + 1, cl);
+  FCM_ALLOC(ctx, (size_t)nc + 1, cn);
+  fcm__loop_begin(ctx, &loop);
+#pragma omp parallel num_threads(fcm_ctx_num_threads(ctx))
+  {
+    fcm__material *mat = NULL; /* no volume mesh: links only where the overlap holds material */
+    fcm__idbuf tc = {NULL, 0, 0};
+    int made = 0;
+#pragma omp for schedule(dynamic, 4)
+    for (fcm_index c = 0; c < nc; c++) {
+      if (!B->region[c] || out[c].np == 0 || fcm__loop_skip(&loop, c)) continue;
+      fcm__loop_iter it;
+      fcm__loop_enter(&loop, &it, c);
+      fcm_status s = FCM_OK;
+      if (!made && B->geom->num_cells == 0) s = fcm__material_create(ctx, B->geom, &mat);
+      made = s == FCM_OK;
+      size_t ccap = 0;
+      if (s == FCM_OK) s = cell_links(B, R, out, c, mat, &tc, cl + c, cn + c, &ccap);
+      fcm__loop_leave(&loop, &it, s);
+    }
+    fcm__geom_idbuf_free(ctx, &tc);
+    fcm__material_destroy(ctx, &mat);
+  }
+  FCM_TRY(ctx, fcm__loop_end(&loop, NULL));
+  for (fcm_index c = 0; c < nc; c++)
+    total += cn[c];
+  if (total > 0) {
+    FCM_ALLOC(ctx, 2 * total, *links);
+    *cap = total;
+  }
+  for (fcm_index c = 0; c < nc; c++)
+    if (cn[c]) {
+      memcpy(*links + 2 * *nl, cl[c], 2 * cn[c] * sizeof **links);
+      *nl += cn[c];
+    }
+cleanup:
+  for (fcm_index c = 0; cl && c < nc; c++)
+    fcm__free(ctx, cl[c]);
+  fcm__free(ctx, cl);
+  fcm__free(ctx, cn);
+  return st;
+}
+
 /* Phase 3b (cuts only): the links between pieces of face-neighbouring region cells: a
  * polygon of one cell's piece on the shared face overlaps a polygon of the other cell's
  * piece with positive area, and the overlap does not lie on a cut triangle, and
@@ -363,28 +442,13 @@ fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
-  const fcm_mesh *mesh = B->mesh;
-  const int nf = fcm_mesh_get_element_info(mesh)->num_faces;
-  const fcm_index *nbr = fcm_mesh_neighbors(mesh);
   fcm_index *links = NULL;
   size_t nl = 0, cap = 0;
   fcm__idbuf tc = {NULL, 0, 0};
-  fcm__material *mat = NULL; /* no volume mesh: links only where the overlap holds material */
-  if (B->geom->num_cells == 0) FCM_TRY(ctx, fcm__material_create(ctx, B->geom, &mat));
-  for (fcm_index c = 0; c < R->num_cells; c++) {
-    if (!B->region[c] || out[c].np == 0) continue;
-    fcm__embed_cell cell;
-    FCM_TRY(ctx, fcm__embed_cell_setup(ctx, mesh, c, B->o->clip_rtol, &cell));
-    for (int f = 0; f < nf; f++) {
-      const fcm_index c2 = nbr[(size_t)nf * c + f];
-      if (c2 <= c || !B->region[c2] || out[c2].np == 0) continue;
-      int f2 = 0;
-      while (f2 < nf && nbr[(size_t)nf * c2 + f2] != c)
-        f2++;
-      if (f2 == nf) continue;
-      FCM_TRY(ctx, face_links(B, R, out, &cell, c, f, c2, f2, mat, &tc, &links, &nl, &cap));
-    }
-  }
+  fcm__material *mat = NULL;
+  FCM_TRY(ctx, region_links(B, R, out, &links, &nl, &cap));
+  if (B->geom->num_cells == 0 && fcm_mesh_num_hanging(B->mesh) > 0)
+    FCM_TRY(ctx, fcm__material_create(ctx, B->geom, &mat));
   FCM_TRY(ctx, nc_links(B, R, out, mat, &tc, &links, &nl, &cap));
   if (nl) qsort(links, nl, 2 * sizeof *links, cmp_link);
   R->links = links;

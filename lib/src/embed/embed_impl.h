@@ -393,6 +393,12 @@ fcm_status fcm__embed_cut_faces(fcm_ctx *ctx, const fcm__embed_cell *cell, const
 /* Record the polygons of part faces lying on the cell's faces (P->fx, P->fmeta). */
 fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P);
 
+/* The plane face f of p lies on (the one it carries) into pl; 0 when the face has no area. */
+int fcm__embed_face_plane(const fcm__poly *p, int f, fcm__plane *pl);
+
+/* Gather face f of p into x (fn x 3); its vertex count. */
+int fcm__embed_face_coords(const fcm__poly *p, int f, double *x);
+
 /* Area of the part of polygon a (na vertices) inside the convex polygon b (nb vertices,
  * counter-clockwise around its unit normal nb_normal), both on one plane; `tol` is the
  * on-edge tolerance. overlap (may be NULL; room for 3 x FCM__POLY_MAX_VERTS) gets that part,

@@ -187,6 +187,49 @@ cleanup:
   return st;
 }
 
+/* The answer of fcm__material_on_face() for the prism made of the nt tets (the tets of one
+ * orientation, half-height h) without their moments, where no boundary triangle's box meets
+ * the prism's box: then the body fills it or misses it, and one inside test decides. *sure:
+ * 1 covered, -1 not, 0 undecided here (a triangle near the prism, or the area within a factor
+ * two of atol, where the moments' rounding could decide otherwise). */
+static fcm_status prism_clear(fcm_ctx *ctx, fcm__material *m, const double *tets, int nt, double h,
+                              double atol, int *sure)
+{
+  fcm_status st = FCM_OK;
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  double v = 0.0;
+  fcm__embed_cell k;
+  int in = 0, first = -1;
+  *sure = 0;
+  for (int i = 0; i < 4 * nt; i++)
+    for (int d = 0; d < 3; d++)
+      lo[d] = fmin(lo[d], tets[3 * i + d]), hi[d] = fmax(hi[d], tets[3 * i + d]);
+  const double w = 1e-9 * (hi[0] - lo[0] + hi[1] - lo[1] + hi[2] - lo[2]);
+  for (int d = 0; d < 3; d++)
+    lo[d] -= w, hi[d] += w;
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, m->tree, lo, hi, &m->buf));
+  if (m->buf.n > 0) goto cleanup;
+  for (int t = 0; t < nt; t++) { /* the tets tets_material() would count */
+    tet_cell(tets + 12 * t, -1, &k);
+    if (!(fabs(k.detA) > FLAT_RTOL * k.size * k.size * k.size && isfinite(k.detA))) continue;
+    if (first < 0) first = t;
+    v += fabs(k.detA) / 6.0;
+  }
+  if (first < 0) {
+    *sure = -1;
+    goto cleanup;
+  }
+  const double a = v / (2.0 * h);
+  if (!(a > 2.0 * atol)) goto cleanup;
+  const double z = 0.25;
+  tet_cell(tets + 12 * first, -1, &k);
+  FCM_TRY(ctx, fcm__embed_inside_line(ctx, m->geom, m->tree, &k, 0.25, 0.25, 1, &z, &in, &m->buf,
+                                      &m->cr));
+  *sure = in != 0 ? 1 : -1; /* -1 inside a tet of negative orientation */
+cleanup:
+  return st;
+}
+
 int fcm__material_on_face(fcm_ctx *ctx, fcm__material *m, const double *x, int n,
                           const double nrm[3], double h, double atol)
 {
@@ -210,6 +253,9 @@ int fcm__material_on_face(fcm_ctx *ctx, fcm__material *m, const double *x, int n
       m->vol[3 * (k - 1) + t] = 1.0;
     }
   }
+  int sure = 0;
+  FCM_TRY(ctx, prism_clear(ctx, m, m->tets, 3 * (n - 2), h, atol, &sure));
+  if (sure) return sure > 0;
   FCM_TRY(ctx, tets_material(ctx, m, m->tets, m->vol, 3 * (n - 2), &m->q0, NULL, NULL, &v));
 cleanup:
   if (st != FCM_OK) {
