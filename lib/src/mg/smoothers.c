@@ -8,6 +8,12 @@
 #include <string.h>
 
 /* Pairs of fcm_index, lexicographically. */
+static int cmp_index(const void *a, const void *b)
+{
+  const fcm_index x = *(const fcm_index *)a, y = *(const fcm_index *)b;
+  return (x > y) - (x < y);
+}
+
 static int cmp_pair(const void *a, const void *b)
 {
   const fcm_index *x = a, *y = b;
@@ -253,6 +259,61 @@ static int slab_mine(const slab_order *S, fcm_index s, int t, int nt)
  * 0.96 -> 0.2-0.3 per V-cycle), element blocks those of the corners of a sliver cell (Hex8
  * hollow ball), coarse blocks the same on the Galerkin levels, where thin walls become
  * cells with little material (the hollow ball's V-cycle grew with n without them). */
+/* On a space with hanging nodes the level-0 matrix is the constrained operator, whose hanging
+ * rows are identity rows: a block's hanging DOFs carry none of the functions the block is to
+ * resolve, their masters do (the constrained functions of a cut element are those of its free
+ * DOFs and of its hanging DOFs' masters). Each block's hanging DOFs are replaced by their
+ * masters' (T of fcm_space_hanging_matrix_create()), each block's DOFs sorted and unique. */
+static fcm_status blocks_masters(fcm_ctx *ctx, const fcm_space *sp, fcm_index nb, fcm_index *ptr,
+                                 fcm_index **dofs)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index n = fcm_space_num_dofs(sp);
+  fcm_index *free_dof = NULL, *col_dof = NULL, *out = NULL, nfree = 0;
+  fcm_csr *T = NULL;
+  FCM_ALLOC(ctx, n + 1, free_dof);
+  FCM_TRY(ctx, fcm_space_hanging_matrix_create(sp, free_dof, &T));
+  fcm_csr_get_size(T, NULL, &nfree, NULL);
+  FCM_ALLOC(ctx, nfree + 1, col_dof);
+  for (fcm_index d = 0; d < n; d++)
+    if (free_dof[d] >= 0) col_dof[free_dof[d]] = d;
+  const fcm_index *tp = fcm_csr_row_ptr(T);
+  const int *tc = fcm_csr_col_idx(T);
+  fcm_index total = 0;
+  for (fcm_index q = 0; q < ptr[nb]; q++) {
+    const fcm_index d = (*dofs)[q];
+    total += free_dof[d] >= 0 ? 1 : tp[d + 1] - tp[d];
+  }
+  FCM_ALLOC(ctx, total + 1, out);
+  fcm_index w = 0, p0 = 0;
+  for (fcm_index k = 0; k < nb; k++) {
+    const fcm_index w0 = w;
+    for (fcm_index q = p0; q < ptr[k + 1]; q++) {
+      const fcm_index d = (*dofs)[q];
+      if (free_dof[d] >= 0)
+        out[w++] = d;
+      else
+        for (fcm_index e = tp[d]; e < tp[d + 1]; e++)
+          out[w++] = col_dof[tc[e]];
+    }
+    qsort(out + w0, (size_t)(w - w0), sizeof *out, cmp_index);
+    fcm_index u = w0;
+    for (fcm_index q = w0; q < w; q++)
+      if (u == w0 || out[q] != out[u - 1]) out[u++] = out[q];
+    p0 = ptr[k + 1];
+    ptr[k + 1] = w = u;
+  }
+  fcm__free(ctx, *dofs);
+  *dofs = out;
+  out = NULL;
+cleanup:
+  fcm_csr_destroy(&T);
+  fcm__free(ctx, free_dof);
+  fcm__free(ctx, col_dof);
+  fcm__free(ctx, out);
+  return st;
+}
+
 /* Level 0: the vertex blocks, then the element blocks of the cut cells. */
 static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_out,
                                 fcm_index **dofs_out)
@@ -304,6 +365,7 @@ static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_ou
   FCM_TRY(ctx, fcm_space_cell_blocks(sp, m->cut_cell, &neb, &ned, ptr + nb, dofs + 3 * nu));
   for (fcm_index k = nb; k <= nb + neb; k++) /* offsets after the vertex blocks */
     ptr[k] += 3 * nu;
+  if (fcm_mesh_num_hanging(mesh) > 0) FCM_TRY(ctx, blocks_masters(ctx, sp, nb + neb, ptr, &dofs));
   *nb_out = nb + neb, *ptr_out = ptr, *dofs_out = dofs;
   ptr = dofs = NULL;
 cleanup:
