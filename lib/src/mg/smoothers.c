@@ -410,9 +410,114 @@ cleanup:
   return st;
 }
 
+/* A block's hash (FNV-1a over its DOFs) with its index, to find identical blocks. */
+typedef struct block_key {
+  unsigned long long h;
+  fcm_index b;
+} block_key;
+
+static int cmp_block_key(const void *pa, const void *pb)
+{
+  const block_key *a = pa, *b = pb;
+  if (a->h != b->h) return (a->h > b->h) - (a->h < b->h);
+  return (a->b > b->b) - (a->b < b->b);
+}
+
+/* Drop the blocks identical to an earlier one (in place; the order of the others kept). */
+static fcm_status blocks_unique(fcm_ctx *ctx, fcm_index *nb, fcm_index *ptr, fcm_index *dofs)
+{
+  fcm_status st = FCM_OK;
+  block_key *key = NULL;
+  unsigned char *drop = NULL;
+  FCM_ALLOC(ctx, *nb + 1, key);
+  FCM_ALLOC(ctx, *nb + 1, drop);
+  for (fcm_index k = 0; k < *nb; k++) {
+    unsigned long long h = 1469598103934665603ULL;
+    for (fcm_index q = ptr[k]; q < ptr[k + 1]; q++)
+      h = (h ^ (unsigned long long)dofs[q]) * 1099511628211ULL;
+    key[k].h = h, key[k].b = k;
+  }
+  qsort(key, (size_t)*nb, sizeof *key, cmp_block_key);
+  for (fcm_index i = 1, first = 0; i < *nb; i++) {
+    if (key[i].h != key[first].h) {
+      first = i;
+      continue;
+    }
+    const fcm_index a = key[first].b, b = key[i].b, m = ptr[a + 1] - ptr[a];
+    drop[b] =
+        m == ptr[b + 1] - ptr[b] && !memcmp(dofs + ptr[a], dofs + ptr[b], (size_t)m * sizeof *dofs);
+  }
+  fcm_index w = 0, kept = 0;
+  for (fcm_index k = 0, p0 = 0; k < *nb; k++) {
+    const fcm_index p1 = ptr[k + 1];
+    if (!drop[k]) {
+      memmove(dofs + w, dofs + p0, (size_t)(p1 - p0) * sizeof *dofs);
+      w += p1 - p0;
+      ptr[++kept] = w;
+    }
+    p0 = p1;
+  }
+  *nb = kept;
+cleanup:
+  fcm__free(ctx, key);
+  fcm__free(ctx, drop);
+  return st;
+}
+
+/* A coarser octree level of a hierarchy with separated bodies (its cells are no grid cells):
+ * the images of the finer level's blocks (level 0: vertex and cut-element blocks) under
+ * P_{l-1}, each the coarse DOFs its rows read: the coarse copies (of one body, masters for
+ * hanging nodes) of the coarse cells around the cut cells' vertices and of those holding the
+ * cut cells. A cut's sliver pieces stay on the coarser octrees (a leaf above the deepest level
+ * is a leaf there too) with their nearly dependent functions, which pointwise smoothing cannot
+ * resolve (Hex20, the cut hemisphere at depth 2: CG + V-cycle 27 iterations with pointwise
+ * smoothing there, 26 with the element blocks' images alone, 19 with these; the uncut Hex20
+ * octree gains nothing from them and pays 30 % more time: lib/docs/octree.md). Identical
+ * images once. */
+static fcm_status blocks_image(fcm_mg *m, int l, fcm_index *nb_out, fcm_index **ptr_out,
+                               fcm_index **dofs_out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  const mg_level *F = &m->lev[l - 1];
+  fcm_index fnb = 0, *fptr = NULL, *fdofs = NULL, *ptr = NULL, *dofs = NULL, total = 0, w = 0;
+  if (l == 1)
+    FCM_TRY(ctx, blocks_level0(m, &fnb, &fptr, &fdofs));
+  else
+    FCM_TRY(ctx, blocks_image(m, l - 1, &fnb, &fptr, &fdofs));
+  for (fcm_index q = 0; q < fptr[fnb]; q++)
+    total += F->P_ptr[fdofs[q] + 1] - F->P_ptr[fdofs[q]];
+  FCM_ALLOC(ctx, fnb + 1, ptr);
+  FCM_ALLOC(ctx, total + 1, dofs);
+  fcm_index nb = 0;
+  for (fcm_index k = 0; k < fnb; k++) {
+    const fcm_index w0 = w;
+    for (fcm_index q = fptr[k]; q < fptr[k + 1]; q++)
+      for (fcm_index p = F->P_ptr[fdofs[q]]; p < F->P_ptr[fdofs[q] + 1]; p++)
+        dofs[w++] = F->P_col[p];
+    qsort(dofs + w0, (size_t)(w - w0), sizeof *dofs, cmp_index);
+    fcm_index u = w0;
+    for (fcm_index q = w0; q < w; q++)
+      if (u == w0 || dofs[q] != dofs[u - 1]) dofs[u++] = dofs[q];
+    w = u;
+    if (w > w0) ptr[++nb] = w;
+  }
+  FCM_TRY(ctx, blocks_unique(ctx, &nb, ptr, dofs));
+  *nb_out = nb, *ptr_out = ptr, *dofs_out = dofs;
+  ptr = dofs = NULL;
+cleanup:
+  fcm__free(ctx, fptr);
+  fcm__free(ctx, fdofs);
+  fcm__free(ctx, ptr);
+  fcm__free(ctx, dofs);
+  return st;
+}
+
 fcm_status fcm__mg_level_blocks(fcm_mg *m, int l, fcm_index *nb, fcm_index **ptr, fcm_index **dofs)
 {
-  return l == 0 ? blocks_level0(m, nb, ptr, dofs) : blocks_coarse(m, &m->lev[l], nb, ptr, dofs);
+  if (l == 0) return blocks_level0(m, nb, ptr, dofs);
+  if (m->lev[l].oct_node) return blocks_image(m, l, nb, ptr, dofs);
+  return blocks_coarse(m, &m->lev[l], nb, ptr, dofs);
 }
 
 fcm_status fcm__mg_block_smoothers_create(fcm_mg *m)
