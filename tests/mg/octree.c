@@ -302,7 +302,7 @@ int main(int argc, char **argv)
       depths[nd++] = atoi(argv[a]);
   }
   const int verbose = getenv("FCM_TEST_VERBOSE") != NULL;
-  /* measured 0.09-0.13 on Hex8, 0.46-0.49 on Hex20 (depths 1-3 and 1-2) */
+  /* measured 0.09-0.13 on Hex8, 0.47-0.50 on Hex20 (depths 1-3 and 1-2) */
   const double bound = type == FCM_ELEMENT_HEX20 ? 0.6 : 0.5;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
   if (two) {
