@@ -7,13 +7,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Pairs of fcm_index, lexicographically. */
 static int cmp_index(const void *a, const void *b)
 {
   const fcm_index x = *(const fcm_index *)a, y = *(const fcm_index *)b;
   return (x > y) - (x < y);
 }
 
+/* Pairs of fcm_index, lexicographically. */
 static int cmp_pair(const void *a, const void *b)
 {
   const fcm_index *x = a, *y = b;
@@ -249,22 +249,12 @@ static int slab_mine(const slab_order *S, fcm_index s, int t, int nt)
 
 /* ------------------------------------------------------------------ block smoothers */
 
-/* Block smoothers (block_smoothing). Level 0: one block per grid vertex of the cut cells
- * (de Prenter et al. 2020): the DOFs of the copies whose support lies in the vertex's patch
- * of 8 cells, the vertex's own and (Hex20) those of the mid-edge nodes of the edges at the
- * vertex, all copies together; then one block per element of a cut cell (all its DOFs).
- * Coarser levels: one block per coarse cell that is not all material (its 8 corner copies).
- * Each block is inverted by the clamped eigen-inverse of fcm_schwarz (Longva et al. 2020,
- * §5.2). Vertex blocks resolve the nearly dependent functions of one vertex's patch (Hex20:
- * 0.96 -> 0.2-0.3 per V-cycle), element blocks those of the corners of a sliver cell (Hex8
- * hollow ball), coarse blocks the same on the Galerkin levels, where thin walls become
- * cells with little material (the hollow ball's V-cycle grew with n without them). */
 /* On a space with hanging nodes the level-0 matrix is the constrained operator, whose hanging
  * rows are identity rows: a block's hanging DOFs carry none of the functions the block is to
  * resolve, their masters do (the constrained functions of a cut element are those of its free
  * DOFs and of its hanging DOFs' masters). Each block's hanging DOFs are replaced by their
  * masters' (T of fcm_space_hanging_matrix_create()), each block's DOFs sorted and unique. */
-static fcm_status blocks_masters(fcm_ctx *ctx, const fcm_space *sp, fcm_index nb, fcm_index *ptr,
+static fcm_status blocks_masters(fcm_ctx *ctx, const fcm_space *sp, fcm_index *nb, fcm_index *ptr,
                                  fcm_index **dofs)
 {
   fcm_status st = FCM_OK;
@@ -280,13 +270,13 @@ static fcm_status blocks_masters(fcm_ctx *ctx, const fcm_space *sp, fcm_index nb
   const fcm_index *tp = fcm_csr_row_ptr(T);
   const int *tc = fcm_csr_col_idx(T);
   fcm_index total = 0;
-  for (fcm_index q = 0; q < ptr[nb]; q++) {
+  for (fcm_index q = 0; q < ptr[*nb]; q++) {
     const fcm_index d = (*dofs)[q];
     total += free_dof[d] >= 0 ? 1 : tp[d + 1] - tp[d];
   }
   FCM_ALLOC(ctx, total + 1, out);
-  fcm_index w = 0, p0 = 0;
-  for (fcm_index k = 0; k < nb; k++) {
+  fcm_index w = 0, p0 = 0, kept = 0;
+  for (fcm_index k = 0; k < *nb; k++) {
     const fcm_index w0 = w;
     for (fcm_index q = p0; q < ptr[k + 1]; q++) {
       const fcm_index d = (*dofs)[q];
@@ -301,8 +291,10 @@ static fcm_status blocks_masters(fcm_ctx *ctx, const fcm_space *sp, fcm_index nb
     for (fcm_index q = w0; q < w; q++)
       if (u == w0 || out[q] != out[u - 1]) out[u++] = out[q];
     p0 = ptr[k + 1];
-    ptr[k + 1] = w = u;
+    w = u;
+    if (w > w0) ptr[++kept] = w; /* a block of hanging DOFs without masters: none */
   }
+  *nb = kept;
   fcm__free(ctx, *dofs);
   *dofs = out;
   out = NULL;
@@ -314,6 +306,18 @@ cleanup:
   return st;
 }
 
+/* Block smoothers (block_smoothing). Level 0: one block per grid vertex of the cut cells
+ * (de Prenter et al. 2020): the DOFs of the copies whose support lies in the vertex's patch
+ * of 8 cells, the vertex's own and (Hex20) those of the mid-edge nodes of the edges at the
+ * vertex, all copies together; then one block per element of a cut cell (all its DOFs).
+ * Coarser levels: one block per coarse cell that is not all material (its 8 corner copies).
+ * Each block is inverted by the clamped eigen-inverse of fcm_schwarz (Longva et al. 2020,
+ * §5.2). Vertex blocks resolve the nearly dependent functions of one vertex's patch (Hex20:
+ * 0.96 -> 0.2-0.3 per V-cycle), element blocks those of the corners of a sliver cell (Hex8
+ * hollow ball), coarse blocks the same on the Galerkin levels, where thin walls become
+ * cells with little material (the hollow ball's V-cycle grew with n without them). On octree
+ * spaces level 0's blocks take the masters of their hanging DOFs (blocks_masters()), and the
+ * octree levels of a cut space the images of the finer blocks (blocks_image()). */
 /* Level 0: the vertex blocks, then the element blocks of the cut cells. */
 static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_out,
                                 fcm_index **dofs_out)
@@ -365,8 +369,9 @@ static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_ou
   FCM_TRY(ctx, fcm_space_cell_blocks(sp, m->cut_cell, &neb, &ned, ptr + nb, dofs + 3 * nu));
   for (fcm_index k = nb; k <= nb + neb; k++) /* offsets after the vertex blocks */
     ptr[k] += 3 * nu;
-  if (fcm_mesh_num_hanging(mesh) > 0) FCM_TRY(ctx, blocks_masters(ctx, sp, nb + neb, ptr, &dofs));
-  *nb_out = nb + neb, *ptr_out = ptr, *dofs_out = dofs;
+  nb += neb;
+  if (fcm_mesh_num_hanging(mesh) > 0) FCM_TRY(ctx, blocks_masters(ctx, sp, &nb, ptr, &dofs));
+  *nb_out = nb, *ptr_out = ptr, *dofs_out = dofs;
   ptr = dofs = NULL;
 cleanup:
   fcm__free(ctx, ptr);
