@@ -14,7 +14,8 @@
  * K itself (not the constrained operator) is refused. Argument balls (then depths): two balls
  * on an octree and on the uniform grid of its finest cells (balls()). Arguments cut_hex8 and
  * cut_hex20 (then depths): the hemisphere cut through by a plane (cut_hemisphere()).
- * FCM_TEST_VERBOSE=1 prints the figures. */
+ * FCM_TEST_VERBOSE=1 prints the figures; FCM_TEST_MG_CYCLE=2 runs the two-body problems (balls,
+ * cut_*) with the W-cycle instead. */
 #include "mg/levels_impl.h"
 #include "mg_util.h"
 
@@ -159,7 +160,7 @@ static int cg_mg(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A, const d
 {
   fcm_mg_options o = fcm_mg_options_default();
   o.coarse_dofs = 50;
-  o.cycle_index = 1;
+  o.cycle_index = getenv("FCM_TEST_MG_CYCLE") ? atoi(getenv("FCM_TEST_MG_CYCLE")) : 1;
   fcm_mg *mg = NULL;
   TEST_OK(ctx, fcm_mg_create(ctx, space, A, &o, &mg));
   if (!mg) return -1;
@@ -277,10 +278,11 @@ static void cut_hemisphere(fcm_ctx *ctx, fcm_element_type type, const int *depth
     TEST_TRUE(its[s] > 0 && bodies[0] == 2 && bodies[1] == 2);
     TEST_TRUE(its[s] <= 1.5 * its[0]);
     if (verbose)
-      printf("cut hemisphere, %s, depth %d: %lld DOFs, %lld hanging pairs, V-cycle %.3f, "
+      printf("cut hemisphere, %s, depth %d: %lld DOFs, %lld hanging pairs, %s %.3f, "
              "two-grid %.3f, CG+MG %d\n",
              type == FCM_ELEMENT_HEX20 ? "hex20" : "hex8", depths[s], (long long)p.n,
-             (long long)fcm_mesh_num_hanging(p.mesh), f[0], f[1], its[s]);
+             (long long)fcm_mesh_num_hanging(p.mesh),
+             getenv("FCM_TEST_MG_CYCLE") ? "cycle" : "V-cycle", f[0], f[1], its[s]);
     free(nodes), free(dofs);
     fcm_surface_destroy(&cut);
     oct_free(&p);
