@@ -12,8 +12,10 @@
  * CG + Jacobi does not converge in 3 x those at the deepest; its
  * solution equals CHOLMOD's to the tolerance, with the hanging entries zero. The square matrix
  * K itself (not the constrained operator) is refused. Argument balls (then depths): two balls
- * on an octree and on the uniform grid of its finest cells (balls()). FCM_TEST_VERBOSE=1 prints
- * the figures. */
+ * on an octree and on the uniform grid of its finest cells (balls()). Arguments cut_hex8 and
+ * cut_hex20 (then depths): the hemisphere cut through by a plane (cut_hemisphere()).
+ * FCM_TEST_VERBOSE=1 prints the figures; FCM_TEST_MG_CYCLE=2 runs the two-body problems (balls,
+ * cut_*) with the W-cycle instead. */
 #include "mg/levels_impl.h"
 #include "mg_util.h"
 
@@ -85,17 +87,85 @@ static void check_nested(fcm_ctx *ctx, const oct_problem *p, const fcm_mg *mg, i
   TEST_TRUE(hang == 0.0);
 }
 
+/* The prolongations between the octree levels of a hierarchy with separated bodies reproduce
+ * each body's field (the field plus 3 x its body: the bodies differ) on the fine copies of
+ * that body to 1e-12 from the coarse copies of that body, and nothing goes to the fine hanging
+ * copies; every level holds both bodies. */
+static void check_bodies(fcm_ctx *ctx, const fcm_space *space, const fcm_mg *mg, int quadratic)
+{
+  double err = 0.0, hang = 0.0;
+  int noct = 0;
+  fcm_index *free0 = calloc((size_t)fcm_space_num_dofs(space) + 1, sizeof *free0);
+  fcm_csr *T = NULL;
+  TEST_OK(ctx, fcm_space_hanging_matrix_create(space, free0, &T));
+  fcm_csr_destroy(&T);
+  for (int l = 0; l + 1 < fcm_mg_num_levels(mg); l++) {
+    const mg_level *F = &mg->lev[l], *C = &mg->lev[l + 1];
+    if (!F->oct_node || !C->oct_node) break;
+    noct++;
+    const double *Xf = fcm_mesh_coords(fcm_space_mesh(l == 0 ? space : F->sp));
+    const double *Xc = fcm_mesh_coords(fcm_space_mesh(C->sp));
+    double *uc = calloc((size_t)C->n + 1, sizeof *uc);
+    for (fcm_index J = 0; J < C->n; J++)
+      uc[J] =
+          field(Xc + 3 * C->oct_node[J / 3], (int)(J % 3), quadratic) + 3.0 * C->oct_body[J / 3];
+    for (fcm_index i = 0; i < F->n; i++) {
+      double s = 0.0;
+      for (fcm_index q = F->P_ptr[i]; q < F->P_ptr[i + 1]; q++)
+        s += F->P_val[q] * uc[F->P_col[q]];
+      if (l == 0 && free0[i] < 0)
+        hang = fmax(hang, fabs(s));
+      else
+        err = fmax(err, fabs(s - field(Xf + 3 * F->oct_node[i / 3], (int)(i % 3), quadratic) -
+                             3.0 * F->oct_body[i / 3]));
+    }
+    free(uc);
+  }
+  for (int l = 0; l < fcm_mg_num_levels(mg); l++) {
+    fcm_mg_level_info li;
+    TEST_OK(ctx, fcm_mg_get_level_info(mg, l, &li));
+    TEST_TRUE(li.bodies == 2);
+  }
+  free(free0);
+  TEST_TRUE(noct >= 1);
+  TEST_TRUE(err <= 1e-12);
+  TEST_TRUE(hang == 0.0);
+}
+
+/* The V-cycle's and the two-grid method's (the first coarsening solved exactly) mean factors
+ * per cycle on A x = b. */
+static void factors(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A, const double *b,
+                    fcm_index n, const fcm_mg *mg, const fcm_mg_options *o, double f[2])
+{
+  double *x = calloc((size_t)n + 1, sizeof *x);
+  fcm_mg_solve_info si;
+  fcm_mg *mg2 = NULL;
+  TEST_OK(ctx, fcm_mg_solve((fcm_mg *)mg, b, x, 1e-8, 200, &si));
+  f[0] = si.convergence_factor;
+  fcm_mg_options o2 = *o;
+  o2.max_levels = 2;
+  TEST_OK(ctx, fcm_mg_create(ctx, space, A, &o2, &mg2));
+  memset(x, 0, sizeof *x * (size_t)n);
+  if (mg2) TEST_OK(ctx, fcm_mg_solve(mg2, b, x, 1e-8, 200, &si));
+  f[1] = si.convergence_factor;
+  fcm_mg_destroy(&mg2);
+  free(x);
+}
+
 /* CG + V-cycle on A x = b (rtol 1e-10) equal to CHOLMOD's solution (1e-7); the iterations, and
- * the bodies of level 0 and of the coarsest level. */
+ * the bodies of level 0 and of the coarsest level. With cut >= 0 (a cut space; 1: Hex20) the
+ * prolongations and bodies are checked (check_bodies()), and with f the factors measured. */
 static int cg_mg(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A, const double *b,
-                 fcm_index n, fcm_index bodies[2])
+                 fcm_index n, fcm_index bodies[2], int cut, double *f)
 {
   fcm_mg_options o = fcm_mg_options_default();
   o.coarse_dofs = 50;
-  o.cycle_index = 1;
+  o.cycle_index = getenv("FCM_TEST_MG_CYCLE") ? atoi(getenv("FCM_TEST_MG_CYCLE")) : 1;
   fcm_mg *mg = NULL;
   TEST_OK(ctx, fcm_mg_create(ctx, space, A, &o, &mg));
   if (!mg) return -1;
+  if (cut >= 0) check_bodies(ctx, space, mg, cut);
+  if (f) factors(ctx, space, A, b, n, mg, &o, f);
   double *x = calloc((size_t)n + 1, sizeof *x), *xd = calloc((size_t)n + 1, sizeof *xd);
   fcm_krylov_options ko = fcm_krylov_options_default();
   ko.rtol = 1e-10;
@@ -136,7 +206,7 @@ static void balls(fcm_ctx *ctx, const int *depths, int nd, int verbose)
     two_balls(ctx, c1, c2, &p.geom);
     oct_problem_embed(ctx, FCM_ELEMENT_HEX8, lo, hi, base, depths[s], &p);
     oct_problem_assemble(ctx, &p, 1);
-    const int it_oct = cg_mg(ctx, p.space, p.A, p.b, p.n, bo);
+    const int it_oct = cg_mg(ctx, p.space, p.A, p.b, p.n, bo, -1, NULL);
     memset(&q, 0, sizeof q);
     const fcm_index cells[3] = {base[0] << depths[s], base[1] << depths[s], base[2] << depths[s]};
     TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, cells, &q.mesh));
@@ -146,7 +216,7 @@ static void balls(fcm_ctx *ctx, const int *depths, int nd, int verbose)
     TEST_OK(ctx, fcm_cell_rules_create(ctx, q.mesh, q.geom, &ro, &q.rules0));
     TEST_OK(ctx, fcm_space_create_embedded(ctx, q.mesh, q.rules0, &q.space));
     finish_space(ctx, &q, 1);
-    const int it_uni = cg_mg(ctx, q.space, q.A, q.b, q.n, bu);
+    const int it_uni = cg_mg(ctx, q.space, q.A, q.b, q.n, bu, -1, NULL);
     TEST_TRUE(bo[0] == 2 && bu[0] == 2 && bu[1] == 2);
     if (verbose)
       printf("two balls, depth %d: octree %lld DOFs, CG+MG %d, bodies %lld on level 0, %lld on "
@@ -159,11 +229,13 @@ static void balls(fcm_ctx *ctx, const int *depths, int nd, int verbose)
 }
 
 /* The hemisphere of oct_problem_create() cut through by a plane across its clamped face (two
- * bodies, each clamped): the multigrid on the cut octree space (copies of hanging nodes per
- * material component on level 0, a copy per node and body on the coarser octrees) converges to
- * CHOLMOD's solution, keeps the two bodies apart down to its coarsest level, and CG + V-cycle
- * needs at most 1.5 x the iterations of the shallowest depth at every depth (flat); the
- * iterations per depth go to *its. */
+ * bodies, each clamped; the plane leaves slivers in cells of every level): the multigrid on
+ * the cut octree space (copies of hanging nodes per material component on level 0, a copy per
+ * node and body on the coarser octrees) converges to CHOLMOD's solution, holds the two bodies
+ * apart on every level, its prolongations reproduce each body's field (affine on Hex8,
+ * quadratic on Hex20) from that body's coarse copies, and CG + V-cycle needs at most 1.5 x the
+ * iterations of the shallowest depth at every depth (flat); the iterations per depth go to
+ * *its. */
 static void cut_hemisphere(fcm_ctx *ctx, fcm_element_type type, const int *depths, int nd,
                            int verbose, int *its)
 {
@@ -200,13 +272,17 @@ static void cut_hemisphere(fcm_ctx *ctx, fcm_element_type type, const int *depth
         if (p.free_dof[d0 + d] >= 0 && ndof < 6 * cnt) dofs[ndof++] = d0 + d;
     }
     TEST_OK(ctx, fcm_space_apply_dirichlet(p.space, ndof, dofs, NULL, p.A, p.b));
-    its[s] = cg_mg(ctx, p.space, p.A, p.b, p.n, bodies);
+    double f[2] = {0.0, 0.0};
+    its[s] =
+        cg_mg(ctx, p.space, p.A, p.b, p.n, bodies, type == FCM_ELEMENT_HEX20, verbose ? f : NULL);
     TEST_TRUE(its[s] > 0 && bodies[0] == 2 && bodies[1] == 2);
     TEST_TRUE(its[s] <= 1.5 * its[0]);
     if (verbose)
-      printf("cut hemisphere, %s, depth %d: %lld DOFs, %lld hanging pairs, CG+MG %d\n",
+      printf("cut hemisphere, %s, depth %d: %lld DOFs, %lld hanging pairs, %s %.3f, "
+             "two-grid %.3f, CG+MG %d\n",
              type == FCM_ELEMENT_HEX20 ? "hex20" : "hex8", depths[s], (long long)p.n,
-             (long long)fcm_mesh_num_hanging(p.mesh), its[s]);
+             (long long)fcm_mesh_num_hanging(p.mesh),
+             getenv("FCM_TEST_MG_CYCLE") ? "cycle" : "V-cycle", f[0], f[1], its[s]);
     free(nodes), free(dofs);
     fcm_surface_destroy(&cut);
     oct_free(&p);
@@ -228,7 +304,7 @@ int main(int argc, char **argv)
       depths[nd++] = atoi(argv[a]);
   }
   const int verbose = getenv("FCM_TEST_VERBOSE") != NULL;
-  /* measured 0.09-0.13 on Hex8, 0.46-0.49 on Hex20 (depths 1-3 and 1-2) */
+  /* measured 0.09-0.13 on Hex8, 0.47-0.50 on Hex20 (depths 1-3 and 1-2) */
   const double bound = type == FCM_ELEMENT_HEX20 ? 0.6 : 0.5;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
   if (two) {

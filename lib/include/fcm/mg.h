@@ -73,8 +73,11 @@ typedef struct fcm_mg_options {
                                  DOFs around each grid vertex of a cut cell (the copies whose
                                  support lies in the vertex's 8 cells: its own and, on Hex20,
                                  the mid-edge nodes' at it; de Prenter et al. 2020), then all
-                                 DOFs of each cut element; coarser levels: the corner DOFs of
-                                 each coarse cell that is not all material. Small cut
+                                 DOFs of each cut element (on an octree a block's hanging
+                                 DOFs replaced by their masters); coarser levels: the corner
+                                 DOFs of each coarse cell that is not all material, on the
+                                 octree levels of a cut space the coarse DOFs each finer
+                                 block's rows of the prolongation read. Small cut
                                  fractions and thin walls make such basis functions nearly
                                  linearly dependent, which pointwise smoothing cannot resolve
                                  (the Hex20 V-cycle stalls near 0.95 without it, the hollow

@@ -54,6 +54,8 @@ void fcm__mg_level_free(fcm_ctx *ctx, mg_level *L)
   fcm__free(ctx, L->color_ptr);
   fcm__free(ctx, L->color_rows);
   fcm__free(ctx, L->full);
+  fcm__free(ctx, L->oct_node);
+  fcm__free(ctx, L->oct_body);
   fcm_schwarz_destroy(&L->blk);
   fcm__mg_slabs_free(ctx, &L->rows);
   fcm__mg_slabs_free(ctx, &L->blocks);

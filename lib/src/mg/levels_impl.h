@@ -77,6 +77,8 @@ typedef struct mg_level {
   slab_order blocks;   /* the blocks of blk in slabs */
   const fcm_space *sp; /* octree hierarchies: the level's space (level 0: the given one;
                           coarser: owned by fcm_mg), whose DOF numbering the level has */
+  fcm_index *oct_node; /* octree levels with separated bodies: per copy its node of sp's mesh */
+  fcm_index *oct_body; /* and its body (the prolongations' check reads them) */
 } mg_level;
 
 struct fcm_mg {

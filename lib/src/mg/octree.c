@@ -755,6 +755,18 @@ cleanup:
   return st;
 }
 
+/* Level L's copies' nodes and bodies, kept with the level. */
+static fcm_status keep_copies(fcm_ctx *ctx, mg_level *L, const oct_copies *c)
+{
+  fcm_status st = FCM_OK;
+  FCM_ALLOC(ctx, c->n + 1, L->oct_node);
+  FCM_ALLOC(ctx, c->n + 1, L->oct_body);
+  memcpy(L->oct_node, c->node, (size_t)c->n * sizeof *c->node);
+  memcpy(L->oct_body, c->body, (size_t)c->n * sizeof *c->body);
+cleanup:
+  return st;
+}
+
 /* The octree levels of a space with separated bodies (octree_coarsen_bodies()) down to the
  * uniform grid, which stays the coarsest level (the box-grid hierarchy works on spaces with
  * their own cuts; this level's copies come from the finer one). */
@@ -764,12 +776,14 @@ static fcm_status bodies_hierarchy(fcm_mg *m, level_cons *cf, oct_copies *fc)
   fcm_ctx *ctx = m->ctx;
   level_cons cc = {0};
   oct_copies next = {0};
+  FCM_TRY(ctx, keep_copies(ctx, &m->lev[0], fc));
   for (int l = 0;; l++) {
     const fcm_space *sf = l == 0 ? m->space : m->lev[l].sp;
     if (l + 1 >= m->opts.max_levels || m->lev[l].n <= m->opts.coarse_dofs) break;
     if (fcm_mesh_num_hanging(fcm_space_mesh(sf)) == 0) break;
     FCM_TRY(ctx, octree_coarsen_bodies(m, l, cf, &cc, fc, &next));
     m->nlev = l + 2;
+    FCM_TRY(ctx, keep_copies(ctx, &m->lev[l + 1], &next));
     cons_free(ctx, cf);
     *cf = cc;
     memset(&cc, 0, sizeof cc);

@@ -7,6 +7,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+static int cmp_index(const void *a, const void *b)
+{
+  const fcm_index x = *(const fcm_index *)a, y = *(const fcm_index *)b;
+  return (x > y) - (x < y);
+}
+
 /* Pairs of fcm_index, lexicographically. */
 static int cmp_pair(const void *a, const void *b)
 {
@@ -243,6 +249,63 @@ static int slab_mine(const slab_order *S, fcm_index s, int t, int nt)
 
 /* ------------------------------------------------------------------ block smoothers */
 
+/* On a space with hanging nodes the level-0 matrix is the constrained operator, whose hanging
+ * rows are identity rows: a block's hanging DOFs carry none of the functions the block is to
+ * resolve, their masters do (the constrained functions of a cut element are those of its free
+ * DOFs and of its hanging DOFs' masters). Each block's hanging DOFs are replaced by their
+ * masters' (T of fcm_space_hanging_matrix_create()), each block's DOFs sorted and unique. */
+static fcm_status blocks_masters(fcm_ctx *ctx, const fcm_space *sp, fcm_index *nb, fcm_index *ptr,
+                                 fcm_index **dofs)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index n = fcm_space_num_dofs(sp);
+  fcm_index *free_dof = NULL, *col_dof = NULL, *out = NULL, nfree = 0;
+  fcm_csr *T = NULL;
+  FCM_ALLOC(ctx, n + 1, free_dof);
+  FCM_TRY(ctx, fcm_space_hanging_matrix_create(sp, free_dof, &T));
+  fcm_csr_get_size(T, NULL, &nfree, NULL);
+  FCM_ALLOC(ctx, nfree + 1, col_dof);
+  for (fcm_index d = 0; d < n; d++)
+    if (free_dof[d] >= 0) col_dof[free_dof[d]] = d;
+  const fcm_index *tp = fcm_csr_row_ptr(T);
+  const int *tc = fcm_csr_col_idx(T);
+  fcm_index total = 0;
+  for (fcm_index q = 0; q < ptr[*nb]; q++) {
+    const fcm_index d = (*dofs)[q];
+    total += free_dof[d] >= 0 ? 1 : tp[d + 1] - tp[d];
+  }
+  FCM_ALLOC(ctx, total + 1, out);
+  fcm_index w = 0, p0 = 0, kept = 0;
+  for (fcm_index k = 0; k < *nb; k++) {
+    const fcm_index w0 = w;
+    for (fcm_index q = p0; q < ptr[k + 1]; q++) {
+      const fcm_index d = (*dofs)[q];
+      if (free_dof[d] >= 0)
+        out[w++] = d;
+      else
+        for (fcm_index e = tp[d]; e < tp[d + 1]; e++)
+          out[w++] = col_dof[tc[e]];
+    }
+    qsort(out + w0, (size_t)(w - w0), sizeof *out, cmp_index);
+    fcm_index u = w0;
+    for (fcm_index q = w0; q < w; q++)
+      if (u == w0 || out[q] != out[u - 1]) out[u++] = out[q];
+    p0 = ptr[k + 1];
+    w = u;
+    if (w > w0) ptr[++kept] = w; /* a block of hanging DOFs without masters: none */
+  }
+  *nb = kept;
+  fcm__free(ctx, *dofs);
+  *dofs = out;
+  out = NULL;
+cleanup:
+  fcm_csr_destroy(&T);
+  fcm__free(ctx, free_dof);
+  fcm__free(ctx, col_dof);
+  fcm__free(ctx, out);
+  return st;
+}
+
 /* Block smoothers (block_smoothing). Level 0: one block per grid vertex of the cut cells
  * (de Prenter et al. 2020): the DOFs of the copies whose support lies in the vertex's patch
  * of 8 cells, the vertex's own and (Hex20) those of the mid-edge nodes of the edges at the
@@ -252,7 +315,9 @@ static int slab_mine(const slab_order *S, fcm_index s, int t, int nt)
  * §5.2). Vertex blocks resolve the nearly dependent functions of one vertex's patch (Hex20:
  * 0.96 -> 0.2-0.3 per V-cycle), element blocks those of the corners of a sliver cell (Hex8
  * hollow ball), coarse blocks the same on the Galerkin levels, where thin walls become
- * cells with little material (the hollow ball's V-cycle grew with n without them). */
+ * cells with little material (the hollow ball's V-cycle grew with n without them). On octree
+ * spaces level 0's blocks take the masters of their hanging DOFs (blocks_masters()), and the
+ * octree levels of a cut space the images of the finer blocks (blocks_image()). */
 /* Level 0: the vertex blocks, then the element blocks of the cut cells. */
 static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_out,
                                 fcm_index **dofs_out)
@@ -304,7 +369,9 @@ static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_ou
   FCM_TRY(ctx, fcm_space_cell_blocks(sp, m->cut_cell, &neb, &ned, ptr + nb, dofs + 3 * nu));
   for (fcm_index k = nb; k <= nb + neb; k++) /* offsets after the vertex blocks */
     ptr[k] += 3 * nu;
-  *nb_out = nb + neb, *ptr_out = ptr, *dofs_out = dofs;
+  nb += neb;
+  if (fcm_mesh_num_hanging(mesh) > 0) FCM_TRY(ctx, blocks_masters(ctx, sp, &nb, ptr, &dofs));
+  *nb_out = nb, *ptr_out = ptr, *dofs_out = dofs;
   ptr = dofs = NULL;
 cleanup:
   fcm__free(ctx, ptr);
@@ -348,9 +415,114 @@ cleanup:
   return st;
 }
 
+/* A block's hash (FNV-1a over its DOFs) with its index, to find identical blocks. */
+typedef struct block_key {
+  unsigned long long h;
+  fcm_index b;
+} block_key;
+
+static int cmp_block_key(const void *pa, const void *pb)
+{
+  const block_key *a = pa, *b = pb;
+  if (a->h != b->h) return (a->h > b->h) - (a->h < b->h);
+  return (a->b > b->b) - (a->b < b->b);
+}
+
+/* Drop the blocks identical to an earlier one (in place; the order of the others kept). */
+static fcm_status blocks_unique(fcm_ctx *ctx, fcm_index *nb, fcm_index *ptr, fcm_index *dofs)
+{
+  fcm_status st = FCM_OK;
+  block_key *key = NULL;
+  unsigned char *drop = NULL;
+  FCM_ALLOC(ctx, *nb + 1, key);
+  FCM_ALLOC(ctx, *nb + 1, drop);
+  for (fcm_index k = 0; k < *nb; k++) {
+    unsigned long long h = 1469598103934665603ULL;
+    for (fcm_index q = ptr[k]; q < ptr[k + 1]; q++)
+      h = (h ^ (unsigned long long)dofs[q]) * 1099511628211ULL;
+    key[k].h = h, key[k].b = k;
+  }
+  qsort(key, (size_t)*nb, sizeof *key, cmp_block_key);
+  for (fcm_index i = 1, first = 0; i < *nb; i++) {
+    if (key[i].h != key[first].h) {
+      first = i;
+      continue;
+    }
+    const fcm_index a = key[first].b, b = key[i].b, m = ptr[a + 1] - ptr[a];
+    drop[b] =
+        m == ptr[b + 1] - ptr[b] && !memcmp(dofs + ptr[a], dofs + ptr[b], (size_t)m * sizeof *dofs);
+  }
+  fcm_index w = 0, kept = 0;
+  for (fcm_index k = 0, p0 = 0; k < *nb; k++) {
+    const fcm_index p1 = ptr[k + 1];
+    if (!drop[k]) {
+      memmove(dofs + w, dofs + p0, (size_t)(p1 - p0) * sizeof *dofs);
+      w += p1 - p0;
+      ptr[++kept] = w;
+    }
+    p0 = p1;
+  }
+  *nb = kept;
+cleanup:
+  fcm__free(ctx, key);
+  fcm__free(ctx, drop);
+  return st;
+}
+
+/* A coarser octree level of a hierarchy with separated bodies (its cells are no grid cells):
+ * the images of the finer level's blocks (level 0: vertex and cut-element blocks) under
+ * P_{l-1}, each the coarse DOFs its rows read: the coarse copies (of one body, masters for
+ * hanging nodes) of the coarse cells around the cut cells' vertices and of those holding the
+ * cut cells. A cut's sliver pieces stay on the coarser octrees (a leaf above the deepest level
+ * is a leaf there too) with their nearly dependent functions, which pointwise smoothing cannot
+ * resolve (Hex20, the cut hemisphere at depth 2: CG + V-cycle 27 iterations with pointwise
+ * smoothing there, 26 with the element blocks' images alone, 19 with these; the uncut Hex20
+ * octree gains nothing from them and pays 30 % more time: lib/docs/octree.md). Identical
+ * images once. */
+static fcm_status blocks_image(fcm_mg *m, int l, fcm_index *nb_out, fcm_index **ptr_out,
+                               fcm_index **dofs_out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  const mg_level *F = &m->lev[l - 1];
+  fcm_index fnb = 0, *fptr = NULL, *fdofs = NULL, *ptr = NULL, *dofs = NULL, total = 0, w = 0;
+  if (l == 1)
+    FCM_TRY(ctx, blocks_level0(m, &fnb, &fptr, &fdofs));
+  else
+    FCM_TRY(ctx, blocks_image(m, l - 1, &fnb, &fptr, &fdofs));
+  for (fcm_index q = 0; q < fptr[fnb]; q++)
+    total += F->P_ptr[fdofs[q] + 1] - F->P_ptr[fdofs[q]];
+  FCM_ALLOC(ctx, fnb + 1, ptr);
+  FCM_ALLOC(ctx, total + 1, dofs);
+  fcm_index nb = 0;
+  for (fcm_index k = 0; k < fnb; k++) {
+    const fcm_index w0 = w;
+    for (fcm_index q = fptr[k]; q < fptr[k + 1]; q++)
+      for (fcm_index p = F->P_ptr[fdofs[q]]; p < F->P_ptr[fdofs[q] + 1]; p++)
+        dofs[w++] = F->P_col[p];
+    qsort(dofs + w0, (size_t)(w - w0), sizeof *dofs, cmp_index);
+    fcm_index u = w0;
+    for (fcm_index q = w0; q < w; q++)
+      if (u == w0 || dofs[q] != dofs[u - 1]) dofs[u++] = dofs[q];
+    w = u;
+    if (w > w0) ptr[++nb] = w;
+  }
+  FCM_TRY(ctx, blocks_unique(ctx, &nb, ptr, dofs));
+  *nb_out = nb, *ptr_out = ptr, *dofs_out = dofs;
+  ptr = dofs = NULL;
+cleanup:
+  fcm__free(ctx, fptr);
+  fcm__free(ctx, fdofs);
+  fcm__free(ctx, ptr);
+  fcm__free(ctx, dofs);
+  return st;
+}
+
 fcm_status fcm__mg_level_blocks(fcm_mg *m, int l, fcm_index *nb, fcm_index **ptr, fcm_index **dofs)
 {
-  return l == 0 ? blocks_level0(m, nb, ptr, dofs) : blocks_coarse(m, &m->lev[l], nb, ptr, dofs);
+  if (l == 0) return blocks_level0(m, nb, ptr, dofs);
+  if (m->lev[l].oct_node) return blocks_image(m, l, nb, ptr, dofs);
+  return blocks_coarse(m, &m->lev[l], nb, ptr, dofs);
 }
 
 fcm_status fcm__mg_block_smoothers_create(fcm_mg *m)
