@@ -88,8 +88,7 @@ cleanup:
   return st;
 }
 
-double fcm__sim_bodies_friction_work(const fcm_integrator *I, const sim_contact *c,
-                                     const double *x)
+double fcm__sim_bodies_friction_work(const fcm_integrator *I, const sim_contact *c, const double *x)
 {
   sim_bodies *B = c->bodies;
   const double eps = c->opts.friction_velocity * I->cp.hstep;
