@@ -158,6 +158,25 @@ PREFETCH_INLINE void prefetch_rows(const fcm_space *s, fcm_index le, int a, cons
 #endif
 }
 
+/* Prefetch, for reading and into L2, the scatter offsets and row numbers of local element le
+ * (the element after `next` in scatter_matrix(): those of next are then in cache when its
+ * prefetches read them). Always inlined, as prefetch_rows(). */
+PREFETCH_INLINE void prefetch_layout(const fcm_space *s, fcm_index le)
+{
+#if defined(__GNUC__) || defined(__clang__)
+  const size_t nn = (size_t)s->nn;
+  const char *o = (const char *)(s->elem_off + (size_t)le * nn * nn);
+  for (size_t i = 0; i < nn * nn * sizeof(int) + 64; i += 64)
+    __builtin_prefetch(o + i, 0, 2);
+  const char *d = s->elem_lcopy ? (const char *)(s->elem_lcopy + (size_t)le * nn)
+                                : (const char *)(s->elem_dof + (size_t)le * nn);
+  for (size_t i = 0; i < nn * sizeof(fcm_index) + 64; i += 64)
+    __builtin_prefetch(d + i, 0, 2);
+#else
+  (void)s, (void)le;
+#endif
+}
+
 /* Matrices with at least this many bytes of values (beyond a core's L2 cache) have the entries
  * of an element's scatter prefetched SCATTER_AHEAD elements before (scatter_matrix()). */
 #define SCATTER_PREFETCH_BYTES (4.0 * 1024 * 1024)
@@ -175,11 +194,13 @@ static int scatter_ahead(const fcm_space *s, const double *vals)
 /* With next >= 0, the entries the scatter of local element `next` will add to are prefetched
  * into L2 row by row along the way: on a matrix far beyond the caches they come from memory
  * while the elements in between are computed, where at next's own scatter they would stall it
- * (a fifth of a Hex20 stiffness assembly of 16^3 cells: lib/docs/performance.md). */
+ * (a fifth of a Hex20 stiffness assembly of 16^3 cells: lib/docs/performance.md); with
+ * far >= 0, the offsets and rows of local element `far` that those prefetches will read. */
 static void scatter_matrix(const fcm_space *s, fcm_index le, const double *Kp, double *vals,
-                           fcm_index next)
+                           fcm_index next, fcm_index far)
 {
   const int nn = s->nn;
+  if (far >= 0) prefetch_layout(s, far);
   const int *off = s->elem_off + (size_t)le * nn * nn;
   for (int a = 0; a < nn; a++) {
     const fcm_index da = fcm__space_elem_row(s, le, a);
@@ -409,9 +430,10 @@ static cell_result volume_cell(const fcm_space *s, const pass *ps, fcm_index e, 
 
 /* Local element le of the pass into the pass's outputs; 0 (with res) when its det J is not
  * positive somewhere or the material returned NaN or infinity: nothing is scattered then.
- * next: an element the thread takes after le (its matrix entries are prefetched), or -1. */
+ * next: an element the thread takes after le (its matrix entries are prefetched), or -1;
+ * far: one it takes after next (its scatter offsets are prefetched), or -1. */
 static int pass_element(const fcm_space *s, const pass *ps, fcm_index le, fcm_index next,
-                        scratch *w, cell_result *res)
+                        fcm_index far, scratch *w, cell_result *res)
 {
   const fcm_index c = fcm__space_local_elem(s, le);
   /* another process's element (a distributed run's ghost): no points, nothing to add */
@@ -437,7 +459,7 @@ static int pass_element(const fcm_space *s, const pass *ps, fcm_index le, fcm_in
     if (ps->cell_inverted) ps->cell_inverted[c] = res->inverted;
   }
   if (ps->keep_out && same < 0) block_pack(s->nn, ps, w, ps->keep_out + (size_t)c * ps->bs);
-  if (ps->vals) scatter_matrix(s, le, w->Ke, ps->vals, next);
+  if (ps->vals) scatter_matrix(s, le, w->Ke, ps->vals, next, far);
   if (ps->vec) scatter_vector(s, c, w->fe, ps->vec);
   return 1;
 }
@@ -470,8 +492,9 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
         for (fcm_index j = first; j < last; j++) {
           const fcm_index le = s->block_elems[j];
           const fcm_index next = ahead && j + ahead < last ? s->block_elems[j + ahead] : -1;
+          const fcm_index far = ahead && j + ahead + 2 < last ? s->block_elems[j + ahead + 2] : -1;
           cell_result res;
-          if (pass_element(s, ps, le, next, w, &res)) continue;
+          if (pass_element(s, ps, le, next, far, w, &res)) continue;
           const fcm_index c = fcm__space_local_elem(s, le);
 #pragma omp critical(fcm_assemble_bad)
           if (bad_cell < 0 || c < bad_cell) {
