@@ -159,8 +159,8 @@ PREFETCH_INLINE void prefetch_rows(const fcm_space *s, fcm_index le, int a, cons
 }
 
 /* Prefetch, for reading and into L2, the scatter offsets and row numbers of local element le
- * (the element after `next` in scatter_matrix(): those of next are then in cache when its
- * prefetches read them). Always inlined, as prefetch_rows(). */
+ * (`far` in scatter_matrix(), two elements after `next`: when le becomes `next`, its prefetches
+ * find them in cache). Always inlined, as prefetch_rows(). */
 PREFETCH_INLINE void prefetch_layout(const fcm_space *s, fcm_index le)
 {
 #if defined(__GNUC__) || defined(__clang__)
