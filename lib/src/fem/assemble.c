@@ -180,7 +180,7 @@ PREFETCH_INLINE void prefetch_layout(const fcm_space *s, fcm_index le)
 /* Matrices with at least this many bytes of values (beyond a core's L2 cache) have the entries
  * of an element's scatter prefetched SCATTER_AHEAD elements before (scatter_matrix()). */
 #define SCATTER_PREFETCH_BYTES (4.0 * 1024 * 1024)
-#define SCATTER_AHEAD          2
+#define SCATTER_AHEAD          1
 
 /* How many elements ahead the scatter into vals (NULL: none) prefetches: 0 below
  * SCATTER_PREFETCH_BYTES. */
