@@ -130,8 +130,10 @@ static inline void add3(double *d, double x, double y, double z)
 #endif
 
 /* Prefetch, for writing and into L2, the entries of node a's three rows that the scatter of
- * local element le adds to. Always inlined: as a function of its own GCC finds it free of side
- * effects and drops its calls. */
+ * local element le adds to: each run of 3 by its first and its last entry, since a quarter of
+ * the runs cross a cache line (without the last entry's line those runs stall the scatter;
+ * testing for the crossing costs more than the prefetch). Always inlined: as a function of its own
+ * GCC finds it free of side effects and drops its calls. */
 #if defined(__GNUC__) || defined(__clang__)
 #define PREFETCH_INLINE static inline __attribute__((always_inline))
 #else
@@ -146,19 +148,39 @@ PREFETCH_INLINE void prefetch_rows(const fcm_space *s, fcm_index le, int a, cons
   const double *r0 = vals + s->row_ptr[da], *r1 = vals + s->row_ptr[da + 1];
   const double *r2 = vals + s->row_ptr[da + 2];
   for (int b = 0; b < nn; b++) {
-    __builtin_prefetch(r0 + 3 * oa[b], 1, 2);
-    __builtin_prefetch(r1 + 3 * oa[b], 1, 2);
-    __builtin_prefetch(r2 + 3 * oa[b], 1, 2);
+    const int x = 3 * oa[b];
+    __builtin_prefetch(r0 + x, 1, 2), __builtin_prefetch(r0 + x + 2, 1, 2);
+    __builtin_prefetch(r1 + x, 1, 2), __builtin_prefetch(r1 + x + 2, 1, 2);
+    __builtin_prefetch(r2 + x, 1, 2), __builtin_prefetch(r2 + x + 2, 1, 2);
   }
 #else
   (void)s, (void)le, (void)a, (void)vals;
 #endif
 }
 
+/* Prefetch, for reading and into L2, the scatter offsets and row numbers of local element le
+ * (`far` in scatter_matrix(), two elements after `next`: when le becomes `next`, its prefetches
+ * find them in cache). Always inlined, as prefetch_rows(). */
+PREFETCH_INLINE void prefetch_layout(const fcm_space *s, fcm_index le)
+{
+#if defined(__GNUC__) || defined(__clang__)
+  const size_t nn = (size_t)s->nn;
+  const char *o = (const char *)(s->elem_off + (size_t)le * nn * nn);
+  for (size_t i = 0; i < nn * nn * sizeof(int) + 64; i += 64)
+    __builtin_prefetch(o + i, 0, 2);
+  const char *d = s->elem_lcopy ? (const char *)(s->elem_lcopy + (size_t)le * nn)
+                                : (const char *)(s->elem_dof + (size_t)le * nn);
+  for (size_t i = 0; i < nn * sizeof(fcm_index) + 64; i += 64)
+    __builtin_prefetch(d + i, 0, 2);
+#else
+  (void)s, (void)le;
+#endif
+}
+
 /* Matrices with at least this many bytes of values (beyond a core's L2 cache) have the entries
  * of an element's scatter prefetched SCATTER_AHEAD elements before (scatter_matrix()). */
 #define SCATTER_PREFETCH_BYTES (4.0 * 1024 * 1024)
-#define SCATTER_AHEAD          2
+#define SCATTER_AHEAD          1
 
 /* How many elements ahead the scatter into vals (NULL: none) prefetches: 0 below
  * SCATTER_PREFETCH_BYTES. */
@@ -172,11 +194,13 @@ static int scatter_ahead(const fcm_space *s, const double *vals)
 /* With next >= 0, the entries the scatter of local element `next` will add to are prefetched
  * into L2 row by row along the way: on a matrix far beyond the caches they come from memory
  * while the elements in between are computed, where at next's own scatter they would stall it
- * (a fifth of a Hex20 stiffness assembly of 16^3 cells: lib/docs/performance.md). */
+ * (a fifth of a Hex20 stiffness assembly of 16^3 cells: lib/docs/performance.md); with
+ * far >= 0, the offsets and rows of local element `far` that those prefetches will read. */
 static void scatter_matrix(const fcm_space *s, fcm_index le, const double *Kp, double *vals,
-                           fcm_index next)
+                           fcm_index next, fcm_index far)
 {
   const int nn = s->nn;
+  if (far >= 0) prefetch_layout(s, far);
   const int *off = s->elem_off + (size_t)le * nn * nn;
   for (int a = 0; a < nn; a++) {
     const fcm_index da = fcm__space_elem_row(s, le, a);
@@ -406,9 +430,10 @@ static cell_result volume_cell(const fcm_space *s, const pass *ps, fcm_index e, 
 
 /* Local element le of the pass into the pass's outputs; 0 (with res) when its det J is not
  * positive somewhere or the material returned NaN or infinity: nothing is scattered then.
- * next: an element the thread takes after le (its matrix entries are prefetched), or -1. */
+ * next: an element the thread takes after le (its matrix entries are prefetched), or -1;
+ * far: one it takes after next (its scatter offsets are prefetched), or -1. */
 static int pass_element(const fcm_space *s, const pass *ps, fcm_index le, fcm_index next,
-                        scratch *w, cell_result *res)
+                        fcm_index far, scratch *w, cell_result *res)
 {
   const fcm_index c = fcm__space_local_elem(s, le);
   /* another process's element (a distributed run's ghost): no points, nothing to add */
@@ -434,7 +459,7 @@ static int pass_element(const fcm_space *s, const pass *ps, fcm_index le, fcm_in
     if (ps->cell_inverted) ps->cell_inverted[c] = res->inverted;
   }
   if (ps->keep_out && same < 0) block_pack(s->nn, ps, w, ps->keep_out + (size_t)c * ps->bs);
-  if (ps->vals) scatter_matrix(s, le, w->Ke, ps->vals, next);
+  if (ps->vals) scatter_matrix(s, le, w->Ke, ps->vals, next, far);
   if (ps->vec) scatter_vector(s, c, w->fe, ps->vec);
   return 1;
 }
@@ -467,8 +492,9 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
         for (fcm_index j = first; j < last; j++) {
           const fcm_index le = s->block_elems[j];
           const fcm_index next = ahead && j + ahead < last ? s->block_elems[j + ahead] : -1;
+          const fcm_index far = ahead && j + ahead + 2 < last ? s->block_elems[j + ahead + 2] : -1;
           cell_result res;
-          if (pass_element(s, ps, le, next, w, &res)) continue;
+          if (pass_element(s, ps, le, next, far, w, &res)) continue;
           const fcm_index c = fcm__space_local_elem(s, le);
 #pragma omp critical(fcm_assemble_bad)
           if (bad_cell < 0 || c < bad_cell) {
