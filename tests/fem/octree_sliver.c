@@ -1,8 +1,8 @@
 /* A cut on an octree background that leaves sliver pieces next to hanging nodes, on a space whose
  * tiny DOF copies are constrained to move with their piece (fcm_space_options.constrain_ratio):
- * the plane x = 1/2 + 1e-4 cuts a 1e-4 thick sliver off the cells right of x = 1/2, whose copies
- * at the nodes x = 5/8 and 3/4 are tiny, among them copies of hanging nodes, and the coarse cells
- * with such slivers are the sources of hanging copies.
+ * the plane x = 1/2 + 1e-4 cuts a 1e-4 thick sliver off the cells right of x = 1/2 (levels 1-3),
+ * whose copies at the cells' nodes right of the cut are tiny, among them copies of hanging
+ * nodes, and the coarse cells with such slivers are the sources of hanging copies.
  * - the space builds with constrained copies, and its hanging-node matrix T with them;
  * - T gives every hanging copy its side's value, from the DOFs its coarse piece reads: for a
  *   rigid translation of each side at every copy (1e-12); for an affine field on each side at
