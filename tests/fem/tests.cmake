@@ -80,6 +80,11 @@ endforeach()
 foreach(el hex8 hex20)
   fcm_add_test(fem_octree_cut_${el} tests/fem/octree_cut.c ARGS ${el} LABELS conformance)
 endforeach()
+# A cut leaving sliver pieces next to hanging nodes, their tiny copies constrained: the
+# hanging-node matrix built from the DOFs the pieces read, the patch test, a dynamic run.
+foreach(el hex8 hex20)
+  fcm_add_test(fem_octree_sliver_${el} tests/fem/octree_sliver.c ARGS ${el} LABELS conformance)
+endforeach()
 # Allocation failures in the octree's entry points: mesh, refinement, constraints, PtAP.
 fcm_add_test(fem_octree_alloc tests/fem/octree_alloc.c)
 # Fields carried onto a refined octree: momentum and kinetic energy kept, hanging values.

@@ -133,14 +133,17 @@ FCM_API const fcm_mesh *fcm_space_mesh(const fcm_space *space);
  * free DOFs. A node hanging only on inactive cells stays free. After cuts (DOF copies), each copy
  * of a hanging node follows the coarse cell's piece in its own material component (the pieces
  * around the node joined by the rules' links, across faces of any levels): the copies of the
- * masters that piece uses; a copy whose component holds no coarse piece stays free.
+ * masters that piece uses; a copy whose component holds no coarse piece stays free. With
+ * copies constrained to move with their piece (fcm_space_options.constrain_ratio), a row is
+ * built from the DOFs the coarse piece's element reads (at a constrained slot, those of the
+ * copy it follows), and a constrained copy has no row (it left the system).
  * @param[in]  space    any space on any mesh (a mesh without hanging nodes gives T = I)
  * @param[out] free_dof num_dofs entries (may be NULL): the column of each free DOF, -1 for
  *                      a constrained one
  * @param[out] T        the new matrix (FCM_CSR_GENERAL), NULL on failure
  * @return FCM_OK; FCM_ERR_ARG (NULL); FCM_ERR_UNSUPPORTED (a copy whose component joins two
- *         pieces of the coarse cell that use different copies of a master: ambiguous; copies
- *         constrained to move with their piece; more free DOFs than 32-bit columns);
+ *         pieces of the coarse cell that use different copies of a master: ambiguous; more
+ *         free DOFs than 32-bit columns);
  *         FCM_ERR_ALLOC.
  * Allocates T and O(num_nodes + num_elems x nodes per cell) scratch. Thread safe. */
 FCM_API fcm_status fcm_space_hanging_matrix_create(const fcm_space *space, fcm_index *free_dof,

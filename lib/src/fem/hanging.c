@@ -1,7 +1,11 @@
 /* Hanging-node constraints of a space on an octree mesh: the matrix T with u = T u_free that
  * makes the field continuous across faces between cells of different levels. With cuts (DOF
  * copies, XFEM), each copy of a hanging node follows the coarse cell's piece of its own material
- * component: the copies of the masters that piece uses. */
+ * component: the copies of the masters that piece uses. With copies constrained to move with
+ * their piece (constrain_ratio), the element DOFs already name, at a constrained slot, the copy
+ * it follows: a row reads what its coarse piece's element reads, a master is expanded through
+ * what its own source reads, and a constrained hanging copy has left the numbering (no row; its
+ * elements read the copy it follows, continuous up to the tiny piece's "sticking"). */
 #include "fem_impl.h"
 
 #include <math.h>
@@ -255,8 +259,11 @@ static fcm_status node_sources(const fcm_space *s, const hang_index *H, around *
   around_join(s, A);
   for (fcm_index r = r0; r < r0 + s->node_ncopy[h]; r++) {
     fcm_index root = -1;
+    /* a slot reading r in place of a constrained copy lies in the tiny piece's component,
+     * not in r's own */
     for (fcm_index k = H->sp[h]; k < H->sp[h + 1] && root < 0; k++)
-      if (s->elem_dof[H->sl[k]] / 3 == r) root = uf_find(A->uf, A->pos[H->sl[k] / nn]);
+      if (s->elem_dof[H->sl[k]] / 3 == r && !(s->elem_con && s->elem_con[H->sl[k]]))
+        root = uf_find(A->uf, A->pos[H->sl[k] / nn]);
     if (root >= 0) FCM_TRY(s->ctx, copy_source(s, H, A, h, r, root, src));
     src->num += src->elem[r] >= 0;
   }
@@ -348,10 +355,6 @@ fcm_status fcm_space_hanging_matrix_create(const fcm_space *space, fcm_index *fr
   FCM_CHECK(space && T, ctx, FCM_ERR_ARG,
             "space_hanging_matrix_create: space and T must not be NULL");
   *T = NULL;
-  FCM_CHECK(!space->elem_con, ctx, FCM_ERR_UNSUPPORTED,
-            "space_hanging_matrix_create: %lld DOF copies are constrained to move with their piece "
-            "(constrain_ratio); hanging-node constraints do not combine with them",
-            (long long)space->num_constrained);
   const fcm_index nd = space->num_dofs, ncopy = nd / 3;
   FCM_TRY(ctx, constraint_sources(space, &src));
   /* columns: the free copies in DOF order */

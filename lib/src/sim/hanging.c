@@ -15,6 +15,7 @@
  * initial guess of a step is filled from its masters. */
 #include "sim/sim_impl.h"
 #include "fem/fem_impl.h"
+#include "la/la_impl.h"
 
 #include <string.h>
 
@@ -100,6 +101,9 @@ void fcm__sim_hanging_destroy(fcm_integrator *I)
 {
   fcm_csr_destroy(&I->hP);
   fcm_csr_destroy(&I->Ha);
+  fcm__ptap_destroy(&I->hptap);
+  fcm__free(I->ctx, I->hmirror);
+  I->hmirror = NULL;
   fcm__free(I->ctx, I->hang);
   I->hang = NULL;
   I->nhang = 0;
@@ -168,45 +172,52 @@ cleanup:
   return st;
 }
 
-/* The position of (i, j) in H: the pattern of fcm_csr_create_ptap() holds every product. */
-static fcm_index position(fcm_integrator *I, fcm_index i, fcm_index j)
-{
-  return fcm_csr_position(I->H, i, j);
-}
-
+/* H = P^T Ha P + I_h through the Galerkin product's plan (la/ptap.c: patterns once, values on
+ * the context's threads, independent of their number), made at the first call on Ha's pattern:
+ * its C has H's pattern (fcm__sim_hanging_storage() makes H by the same product), so its values
+ * go to H directly and C itself is dropped. */
 fcm_status fcm__sim_hanging_matrix(fcm_integrator *I)
 {
   fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
   const fcm_index n = I->n;
-  const fcm_index *ap = fcm_csr_row_ptr(I->Ha), *pp = fcm_csr_row_ptr(I->hP);
-  const fcm_index *hp = fcm_csr_row_ptr(I->H);
-  const int *ac = fcm_csr_col_idx(I->Ha), *pc = fcm_csr_col_idx(I->hP);
-  const int *hc = fcm_csr_col_idx(I->H);
-  const double *av = fcm_csr_values_read(I->Ha), *pv = fcm_csr_values_read(I->hP);
+  fcm_csr *C = NULL;
+  const int nt = fcm_ctx_num_threads(ctx);
+  if (!I->hptap) {
+    FCM_TRY(ctx, fcm__ptap_create(ctx, I->Ha, n, fcm_csr_row_ptr(I->hP), fcm_csr_col_idx(I->hP),
+                                  fcm_csr_values_read(I->hP), 1, nt, &I->hptap, &C));
+    fcm_index nnz_c = 0, nnz_h = 0;
+    fcm_csr_get_size(C, NULL, NULL, &nnz_c);
+    fcm_csr_get_size(I->H, NULL, NULL, &nnz_h);
+    FCM_CHECK(nnz_c == nnz_h, ctx, FCM_ERR_INTERNAL,
+              "integrator: the constrained Newton matrix has %lld entries, its product %lld",
+              (long long)nnz_h, (long long)nnz_c);
+    FCM_ALLOC_RAW(ctx, (size_t)nnz_h + 1, I->hmirror);
+    const fcm_index *hp = fcm_csr_row_ptr(I->H);
+    const int *hc = fcm_csr_col_idx(I->H);
+    for (fcm_index i = 0; i < n; i++)
+      for (fcm_index e = hp[i]; e < hp[i + 1]; e++)
+        I->hmirror[e] = hc[e] > i ? fcm_csr_position(I->H, hc[e], i) : -1;
+  }
+  fcm__ptap_apply(I->hptap, I->Ha, I->H, nt);
+  fcm_index nnz = 0;
+  fcm_csr_get_size(I->H, NULL, NULL, &nnz);
   double *hv = fcm_csr_values(I->H);
-  fcm_csr_set_zero(I->H);
-  for (fcm_index r = 0; r < n; r++)
-    for (fcm_index e = ap[r]; e < ap[r + 1]; e++) {
-      const fcm_index c = ac[e];
-      for (fcm_index p = pp[r]; p < pp[r + 1]; p++)
-        for (fcm_index q = pp[c]; q < pp[c + 1]; q++) {
-          const fcm_index pos = position(I, pc[p], pc[q]);
-          FCM_CHECK(pos >= 0, I->ctx, FCM_ERR_INTERNAL,
-                    "integrator: the constrained Newton matrix has no entry (%lld, %lld)",
-                    (long long)pc[p], (long long)pc[q]);
-          hv[pos] += pv[p] * av[e] * pv[q];
-        }
+  /* exactly symmetric (the product sums (i, j) and (j, i) in different orders) */
+  for (fcm_index e = 0; e < nnz; e++)
+    if (I->hmirror[e] >= 0) {
+      const fcm_index m = I->hmirror[e];
+      const double s = 0.5 * (hv[e] + hv[m]);
+      hv[e] = hv[m] = s;
     }
-  /* exactly symmetric (the sums above run in different orders for (i, j) and (j, i)) */
-  for (fcm_index i = 0; i < n; i++)
-    for (fcm_index e = hp[i]; e < hp[i + 1]; e++)
-      if (hc[e] > i) {
-        const fcm_index m = position(I, hc[e], i);
-        const double s = 0.5 * (hv[e] + hv[m]);
-        hv[e] = hv[m] = s;
-      }
   for (fcm_index k = 0; k < I->nhang; k++)
-    hv[position(I, I->hang[k], I->hang[k])] = 1.0;
+    hv[fcm_csr_position(I->H, I->hang[k], I->hang[k])] = 1.0;
 cleanup:
+  fcm_csr_destroy(&C);
+  if (st != FCM_OK) {
+    fcm__ptap_destroy(&I->hptap);
+    fcm__free(ctx, I->hmirror);
+    I->hmirror = NULL;
+  }
   return st;
 }

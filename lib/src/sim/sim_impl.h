@@ -192,8 +192,12 @@ struct fcm_integrator {
   /* hanging-node constraints of an octree space (hanging.c; NULL / 0 without hanging nodes):
    * P (n x n) with u = P u for the continuous fields, the hanging DOFs (rows of P that are not
    * the identity), and Ha, the space-pattern matrix the tangent is assembled into and reduced
-   * from into H = P^T Ha P + I_h (H then has the pattern of fcm_csr_create_ptap()) */
+   * from into H = P^T Ha P + I_h (H then has the pattern of fcm_csr_create_ptap()); hptap: the
+   * Galerkin product's plan (la/ptap.c), made at the first product; hmirror[e]: the position
+   * of entry e's transpose in H (above the diagonal, -1 elsewhere) */
   fcm_csr *hP, *Ha;
+  struct fcm__ptap *hptap;
+  fcm_index *hmirror;
   fcm_index nhang;
   fcm_index *hang;
 
