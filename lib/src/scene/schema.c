@@ -76,8 +76,8 @@ void fcm__scene_path_pop(fcm__scene_parser *p, size_t old_len)
 static void format_number(double x, char *buf, size_t len)
 {
   for (int prec = 15; prec <= 17; prec++) {
-    snprintf(buf, len, "%.*g", prec, x);
-    if (!isfinite(x) || strtod(buf, NULL) == x) return;
+    const int n = snprintf(buf, len, "%.*g", prec, x);
+    if (n < 0 || (size_t)n >= len || !isfinite(x) || strtod(buf, NULL) == x) return;
   }
 }
 
