@@ -3,8 +3,6 @@
  * applied later, and its destruction. Background mesh and geometry: run_mesh.c; stepping:
  * run_step.c; output: run_output.c; summary: run_summary.c; the effects' run-time hooks:
  * run_effects.c. */
-#include <stdlib.h>
-#include <stdio.h>
 #include "scene/run_impl.h"
 #include "scene/scene_impl.h"
 
@@ -457,11 +455,7 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
    * process's cell mask, the new integrator gets the backend again (its cut hook, which
    * agrees first), and fcm__integrator_finish() at the end agrees on the outcome, so a
    * process that fails in the local work meets the others wherever they wait. */
-  {
-    double tq = fcm_wtime();
-    FCM_TRY(ctx, fcm__sim_cut_surface(S, &e->cut, &surf));
-    if (getenv("FCM_CUTPHASE_DEBUG")) fprintf(stderr, "DBG cut_surface %.3f\n", fcm_wtime() - tq);
-  }
+  FCM_TRY(ctx, fcm__sim_cut_surface(S, &e->cut, &surf));
   S->cuts_applied++;
   S->c.cuts++;
   if (!surf) {
@@ -483,11 +477,7 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
     S->c.cuts_missed++;
   FCM_TRY(ctx, fcm_integrator_create_cut(S->integ, space, &integ));
   S->cut_phase[2] = fcm_wtime() - t0 - S->cut_phase[0] - S->cut_phase[1];
-  {
-    double tq = fcm_wtime();
-    FCM_TRY(ctx, keep_log_blocks(S, space));
-    if (getenv("FCM_CUTPHASE_DEBUG")) fprintf(stderr, "DBG keep_log %.3f\n", fcm_wtime() - tq);
-  }
+  FCM_TRY(ctx, keep_log_blocks(S, space));
   /* the new integrator counts from zero: keep the totals so far */
   S->base_factorizations = S->c.factorizations;
   S->base_analyses = S->c.analyses;
@@ -501,16 +491,8 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);
   S->pieces = fcm_space_num_bodies(S->space);
   S->c.pieces = S->pieces;
-  {
-    double tq = fcm_wtime();
-    if (S->surf) {
-      FCM_TRY(ctx, fcm_embedded_surface_set_space(S->surf, S->space));
-    }
-    if (getenv("FCM_CUTPHASE_DEBUG")) fprintf(stderr, "DBG set_space %.3f\n", fcm_wtime() - tq);
-    tq = fcm_wtime();
-    FCM_TRY(ctx, build_log_blocks(S));
-    if (getenv("FCM_CUTPHASE_DEBUG")) fprintf(stderr, "DBG build_log %.3f\n", fcm_wtime() - tq);
-  }
+  if (S->surf) FCM_TRY(ctx, fcm_embedded_surface_set_space(S->surf, S->space));
+  FCM_TRY(ctx, build_log_blocks(S));
 cleanup:
   if (k < S->num_cuts) S->cut_time[k] = fcm_wtime() - t0;
   st = fcm__integrator_finish(S->integ, st);
