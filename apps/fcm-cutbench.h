@@ -101,9 +101,9 @@ typedef struct cutbench_run {
   double setup_s;  /* fcm_simulation_create() */
   long long cells; /* active background cells */
   long long dofs_before, dofs_after;
-  int events;                             /* cut events applied */
-  double cut_mean, cut_max;               /* one event's latency: rules + space + integrator */
-  double cut_rules, cut_space, cut_integ; /* per event, mean */
+  int events;               /* cut events applied */
+  double cut_mean, cut_max; /* one event's latency: rules + space + integrator */
+  double cut_rules, cut_space, cut_integ, cut_other; /* per event, mean */
   double cut_factor; /* the factorization (or hierarchy) of the step after a cut,
                         mean over the events */
   long long steps;

@@ -10,10 +10,16 @@
  * - every boundary triangle or part lies on one side of each cut plane (signed distances
  *   within 1e-9 of the cell size), so the cuts split the triangles they cross;
  * - the boundary triangles no cut reaches are the geometry's own, in their order.
+ * - the surface set to each cut space (the second reusing what the first cut found in the
+ *   cells the second does not reach) has the bits of one made on that space anew: points,
+ *   triangles, flags and the displacements of a field.
  * The same for a box cut along cell faces through its boundary vertices.
  * Arguments: tet4 | tet10 | hex8 | hex20. */
 #include "fcm/fcm.h"
 #include "fem_util.h"
+
+#include <stdlib.h>
+#include <string.h>
 
 static fcm_ctx *ctx;
 
@@ -214,6 +220,44 @@ static void check(const fcm_space *s, const fcm_embedded_surface *es, const fcm_
   free(u), free(x), free(pb), free(body);
 }
 
+/* The surface set to space s after earlier spaces (the second cut's reuses what the first
+ * found in the cells it does not reach) has the same bits as one made on s anew. */
+static void same_as_new(const fcm_embedded_surface *es, const fcm_space *s, const fcm_geometry *g)
+{
+  fcm_embedded_surface *fresh = NULL;
+  TEST_OK(ctx, fcm_embedded_surface_create(s, g, &fresh));
+  if (!fresh) return;
+  const fcm_index np = fcm_embedded_surface_num_points(es),
+                  nt = fcm_embedded_surface_num_triangles(es);
+  TEST_TRUE(np == fcm_embedded_surface_num_points(fresh));
+  TEST_TRUE(nt == fcm_embedded_surface_num_triangles(fresh));
+  TEST_TRUE(fcm_embedded_surface_num_split_triangles(es) ==
+            fcm_embedded_surface_num_split_triangles(fresh));
+  if (np == fcm_embedded_surface_num_points(fresh) &&
+      nt == fcm_embedded_surface_num_triangles(fresh)) {
+    TEST_TRUE(!memcmp(fcm_embedded_surface_points(es), fcm_embedded_surface_points(fresh),
+                      3 * (size_t)np * sizeof(double)));
+    TEST_TRUE(!memcmp(fcm_embedded_surface_triangles(es), fcm_embedded_surface_triangles(fresh),
+                      3 * (size_t)nt * sizeof(fcm_index)));
+    TEST_TRUE(!memcmp(fcm_embedded_surface_cut_flags(es), fcm_embedded_surface_cut_flags(fresh),
+                      (size_t)np * sizeof(int32_t)));
+    /* the elements: the displacement of a field that differs on every DOF */
+    const fcm_index n = fcm_space_num_dofs(s);
+    double *u = malloc(sizeof *u * (size_t)(n + 1)),
+           *d0 = malloc(sizeof *d0 * 3 * (size_t)(np + 1));
+    double *d1 = malloc(sizeof *d1 * 3 * (size_t)(np + 1));
+    if (u && d0 && d1) {
+      for (fcm_index i = 0; i < n; i++)
+        u[i] = 1.0 + 0.001 * (double)i;
+      TEST_OK(ctx, fcm_embedded_surface_eval(es, u, d0, NULL));
+      TEST_OK(ctx, fcm_embedded_surface_eval(fresh, u, d1, NULL));
+      TEST_TRUE(!memcmp(d0, d1, 3 * (size_t)np * sizeof *d0));
+    }
+    free(u), free(d0), free(d1);
+  }
+  fcm_embedded_surface_destroy(&fresh);
+}
+
 /* Cut the body `g` in a 4^3 grid on [-1, 1]^3 by the planes (point pp[k], unit normal pn[k])
  * one after the other, checking the surface after each (the planes moved by the shift the
  * cut may have taken). */
@@ -256,6 +300,7 @@ static void run(fcm_element_type type, fcm_geometry *g, int ncut, const double (
     TEST_OK(ctx, fcm_space_create_embedded_with(ctx, mesh, r[k + 1], &so, &free_space));
     if (!s[k + 1] || !free_space) goto done;
     TEST_OK(ctx, fcm_embedded_surface_set_space(es, s[k + 1]));
+    same_as_new(es, s[k + 1], g);
     check(s[k + 1], es, g, k + 1, (const double(*)[3])at, pn, h, 0);
     TEST_OK(ctx, fcm_embedded_surface_set_space(es, free_space));
     check(free_space, es, g, k + 1, (const double(*)[3])at, pn, h, 1);

@@ -418,6 +418,18 @@ struct fcm_embedded_surface {
   fcm_index cap_p, cap_t;
   struct fcm__embed_finder *finder; /* during a rebuild with cuts: the cut cells' pieces */
   fcm_aabb_tree *cell_tree;         /* during a rebuild with cuts: boxes of the mesh's cells */
+  /* What the last rebuild with cuts found, for the next one on rules that extend its rules
+   * by further cuts (surface.c: cells no new cut triangle reaches keep their answers):
+   * those rules' cut triangles (copied), pieces per cell (piece_off, num cells + 1), the
+   * piece of each boundary vertex in a cell of several pieces (vpiece, nb; -3: not looked
+   * up), and the parts of each (cell, triangle) pair clipped (pairs sorted, 2 x npairs;
+   * pair k's polygons [poff[k], poff[k + 1]) of polys). */
+  struct fcm__cut_tri *prev_tris;
+  fcm_index prev_ntris, prev_ncells;
+  double prev_rtol[2]; /* the rules' clip_rtol and sliver_rtol */
+  fcm_index *prev_piece_off, *vpiece, *pairs;
+  size_t npairs, *poff, *xoff; /* xoff: pair k's first polygon vertex */
+  fcm__embed_polys polys;
 };
 
 /* fcm_space_write_vtu() and fcm_embedded_surface_write_vtu() that also count, in *nonfinite

@@ -75,22 +75,183 @@ cleanup:
   return st;
 }
 
+/* A piece of the last rebuild's rules in cell c in the current rules' numbering (-1: none,
+ * -2: on a cut, as they are). */
+static fcm_index map_piece(const fcm_embedded_surface *es, fcm_index c, fcm_index p)
+{
+  return p < 0 ? p : p - es->prev_piece_off[c] + es->space->rules->piece_off[c];
+}
+
+/* changed[c] (num cells): 0 where the last rebuild's answers still hold, as the finder would
+ * give them again: the current rules extend that rebuild's (its cut triangles first, the
+ * same cells), cell c has as many pieces, each the child of the one in its place, and no
+ * new cut triangle's box comes within a millionth of the mesh's size of the cell's box (the
+ * finder takes the cut triangles within 2e-9 of a cell's size), with the same tolerances of
+ * the parts. All 1 otherwise. */
+static fcm_status changed_cells(fcm_embedded_surface *es, unsigned char *changed)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = es->ctx;
+  const fcm_cell_rules *R = es->space->rules;
+  const fcm_index nc = R->num_cells;
+  fcm__idbuf ids = {NULL, 0, 0};
+  const int extends =
+      es->prev_tris && R->piece_parent && nc == es->prev_ncells &&
+      R->opts.clip_rtol == es->prev_rtol[0] && R->opts.sliver_rtol == es->prev_rtol[1] &&
+      R->num_cut_tris >= es->prev_ntris &&
+      !memcmp(R->cut_tris, es->prev_tris, (size_t)es->prev_ntris * sizeof *R->cut_tris);
+  for (fcm_index c = 0; c < nc; c++) {
+    const fcm_index p0 = R->piece_off[c], n = R->piece_off[c + 1] - p0;
+    changed[c] = !extends || n != es->prev_piece_off[c + 1] - es->prev_piece_off[c];
+    for (fcm_index i = 0; i < n && !changed[c]; i++)
+      changed[c] = R->piece_parent[p0 + i] != es->prev_piece_off[c] + i;
+  }
+  if (!extends) return FCM_OK;
+  FCM_TRY(ctx, cell_tree(es));
+  double mlo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, mhi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  const fcm_index nn = fcm_mesh_num_nodes(es->mesh);
+  const double *mx = fcm_mesh_coords(es->mesh);
+  for (fcm_index i = 0; i < nn; i++)
+    for (int d = 0; d < 3; d++)
+      mlo[d] = fmin(mlo[d], mx[3 * i + d]), mhi[d] = fmax(mhi[d], mx[3 * i + d]);
+  const double w = 1e-6 * fmax(mhi[0] - mlo[0], fmax(mhi[1] - mlo[1], mhi[2] - mlo[2]));
+  for (fcm_index t = es->prev_ntris; t < R->num_cut_tris; t++) {
+    double lo[3], hi[3];
+    for (int d = 0; d < 3; d++)
+      lo[d] = R->cut_tris[t].lo[d] - w, hi[d] = R->cut_tris[t].hi[d] + w;
+    FCM_TRY(ctx, fcm__geom_tree_query(ctx, es->cell_tree, lo, hi, &ids));
+    for (size_t k = 0; k < ids.n; k++)
+      changed[ids.ids[k]] = 1;
+  }
+cleanup:
+  fcm__geom_idbuf_free(ctx, &ids);
+  return st;
+}
+
+/* Forget what the last rebuild with cuts found. */
+static void cache_clear(fcm_embedded_surface *es)
+{
+  void *arrays[] = {es->prev_tris, es->prev_piece_off, es->vpiece, es->pairs, es->poff, es->xoff};
+  for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
+    fcm__free(es->ctx, arrays[k]);
+  fcm__embed_polys_free(es->ctx, &es->polys);
+  es->prev_tris = NULL, es->prev_piece_off = es->vpiece = es->pairs = NULL;
+  es->poff = es->xoff = NULL;
+  es->prev_ntris = es->prev_ncells = 0;
+  es->npairs = 0;
+}
+
+/* Keep the rules' cut triangles and pieces per cell for the next rebuild. */
+static fcm_status cache_rules(fcm_embedded_surface *es)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = es->ctx;
+  const fcm_cell_rules *R = es->space->rules;
+  fcm__free(ctx, es->prev_tris);
+  fcm__free(ctx, es->prev_piece_off);
+  es->prev_tris = NULL, es->prev_piece_off = NULL;
+  FCM_ALLOC_RAW(ctx, (size_t)R->num_cut_tris + 1, es->prev_tris);
+  memcpy(es->prev_tris, R->cut_tris, (size_t)R->num_cut_tris * sizeof *R->cut_tris);
+  FCM_ALLOC_RAW(ctx, (size_t)R->num_cells + 1, es->prev_piece_off);
+  memcpy(es->prev_piece_off, R->piece_off, ((size_t)R->num_cells + 1) * sizeof *R->piece_off);
+  es->prev_ntris = R->num_cut_tris;
+  es->prev_ncells = R->num_cells;
+  es->prev_rtol[0] = R->opts.clip_rtol, es->prev_rtol[1] = R->opts.sliver_rtol;
+cleanup:
+  if (st != FCM_OK) cache_clear(es);
+  return st;
+}
+
+/* Keep the clipped parts of the (cell, triangle) pairs (*pairs, n, sorted) for the next
+ * rebuild: the arrays are taken, the polygons copied. */
+static fcm_status cache_parts(fcm_embedded_surface *es, const fcm__embed_polys *polys,
+                              fcm_index **pairs, size_t n, size_t **poff, size_t **xoff)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = es->ctx;
+  fcm__embed_polys copy = {NULL, NULL, NULL, 0, 0, 0, 0};
+  FCM_ALLOC_RAW(ctx, 3 * polys->nx + 3, copy.x);
+  FCM_ALLOC_RAW(ctx, polys->n + 1, copy.nv);
+  FCM_ALLOC_RAW(ctx, polys->n + 1, copy.piece);
+  memcpy(copy.x, polys->x, 3 * polys->nx * sizeof *copy.x);
+  memcpy(copy.nv, polys->nv, polys->n * sizeof *copy.nv);
+  memcpy(copy.piece, polys->piece, polys->n * sizeof *copy.piece);
+  copy.n = copy.cap = polys->n;
+  copy.nx = copy.capx = polys->nx;
+  fcm__embed_polys_free(ctx, &es->polys);
+  es->polys = copy;
+  copy.x = NULL, copy.nv = NULL, copy.piece = NULL;
+  fcm__free(ctx, es->pairs);
+  fcm__free(ctx, es->poff);
+  fcm__free(ctx, es->xoff);
+  es->pairs = *pairs, es->poff = *poff, es->xoff = *xoff, es->npairs = n;
+  *pairs = NULL, *poff = NULL, *xoff = NULL;
+cleanup:
+  fcm__embed_polys_free(ctx, &copy);
+  return st;
+}
+
+/* Append polygon j of `from` (its piece p) to `to`. */
+static fcm_status polys_append(fcm_ctx *ctx, fcm__embed_polys *to, const fcm__embed_polys *from,
+                               size_t j, size_t first_x, fcm_index p)
+{
+  fcm_status st = FCM_OK;
+  const int n = from->nv[j];
+  if (to->n + 1 > to->cap) {
+    const size_t cap = to->cap ? 2 * to->cap : 64;
+    void *a = to->nv, *b = to->piece;
+    FCM_TRY(ctx, fcm__resize(ctx, &a, to->n, cap, sizeof(int)));
+    to->nv = a;
+    FCM_TRY(ctx, fcm__resize(ctx, &b, to->n, cap, sizeof(fcm_index)));
+    to->piece = b;
+    to->cap = cap;
+  }
+  if (to->nx + (size_t)n > to->capx) {
+    size_t cap = to->capx ? 2 * to->capx : 256;
+    while (cap < to->nx + (size_t)n)
+      cap *= 2;
+    void *a = to->x;
+    FCM_TRY(ctx, fcm__resize(ctx, &a, 3 * to->nx, 3 * cap, sizeof(double)));
+    to->x = a;
+    to->capx = cap;
+  }
+  memcpy(to->x + 3 * to->nx, from->x + 3 * first_x, 3 * (size_t)n * sizeof *to->x);
+  to->nv[to->n] = n;
+  to->piece[to->n] = p;
+  to->n++;
+  to->nx += (size_t)n;
+cleanup:
+  return st;
+}
+
 /* The pieces of the boundary vertices in cells that cuts split (es->elem), and which boundary
  * triangles to split: those a cut crosses and those with a vertex on a cut (parts of two
  * pieces hold it: each triangle then takes its side). split: nbt flags. */
-static fcm_status mark_split(fcm_embedded_surface *es, unsigned char *split)
+static fcm_status mark_split(fcm_embedded_surface *es, const unsigned char *changed,
+                             unsigned char *split)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = es->ctx;
   const fcm_space *s = es->space;
   fcm__embed_finder *f = es->finder;
-  fcm_index *pairs = NULL, n = 0;
+  fcm_index *pairs = NULL, *vpiece = NULL, n = 0;
   unsigned char *on_cut = NULL;
   FCM_ALLOC(ctx, (size_t)es->nb + 1, on_cut);
   FCM_ALLOC_RAW(ctx, 2 * (size_t)es->nb + 2, pairs);
-  for (fcm_index i = 0; i < es->nb; i++)
-    if (s->cell_elem[es->cell[i] + 1] - s->cell_elem[es->cell[i]] > 1)
-      pairs[2 * n] = es->cell[i], pairs[2 * n + 1] = i, n++;
+  FCM_ALLOC_RAW(ctx, (size_t)es->nb + 1, vpiece);
+  for (fcm_index i = 0; i < es->nb; i++) {
+    const fcm_index c = es->cell[i];
+    vpiece[i] = -3;
+    if (s->cell_elem[c + 1] - s->cell_elem[c] <= 1) continue;
+    if (es->vpiece && !changed[c] && es->vpiece[i] != -3) { /* as the last rebuild found */
+      const fcm_index p = map_piece(es, c, es->vpiece[i]), e = piece_element(s, c, p);
+      if (e >= 0) es->elem[i] = e;
+      on_cut[i] = p == -2;
+      vpiece[i] = p;
+      continue;
+    }
+    pairs[2 * n] = c, pairs[2 * n + 1] = i, n++;
+  }
   qsort(pairs, (size_t)n, 2 * sizeof *pairs, cmp_pair); /* one cell's parts made once */
   for (fcm_index k = 0; k < n; k++) {
     const fcm_index c = pairs[2 * k], i = pairs[2 * k + 1];
@@ -99,7 +260,11 @@ static fcm_status mark_split(fcm_embedded_surface *es, unsigned char *split)
     const fcm_index e = piece_element(s, c, p);
     if (e >= 0) es->elem[i] = e;
     on_cut[i] = p == -2;
+    vpiece[i] = p;
   }
+  fcm__free(ctx, es->vpiece);
+  es->vpiece = vpiece;
+  vpiece = NULL;
   for (fcm_index t = 0; t < es->nbt; t++) {
     const fcm_index *v = es->tri0 + 3 * t;
     int crosses = on_cut[v[0]] || on_cut[v[1]] || on_cut[v[2]];
@@ -112,6 +277,7 @@ static fcm_status mark_split(fcm_embedded_surface *es, unsigned char *split)
   }
 cleanup:
   fcm__free(ctx, pairs);
+  fcm__free(ctx, vpiece);
   fcm__free(ctx, on_cut);
   return st;
 }
@@ -119,12 +285,14 @@ cleanup:
 /* The parts of the flagged boundary triangles, cell by cell: polygon k of *polys came from
  * triangle (*src)[k] and lies in cell (*pcell)[k]. A triangle whose parts do not add up to
  * its area (it leaves the mesh) is unflagged and its parts dropped. */
-static fcm_status split_triangles(fcm_embedded_surface *es, unsigned char *split,
-                                  fcm__embed_polys *polys, fcm_index **src, fcm_index **pcell)
+static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char *changed,
+                                  unsigned char *split, fcm__embed_polys *polys, fcm_index **src,
+                                  fcm_index **pcell)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = es->ctx;
   fcm_index *pairs = NULL, *ps = NULL, *pc = NULL;
+  size_t *poff = NULL, *xoff = NULL;
   double *area = NULL;
   size_t n = 0, cap = 0, pcap = 0;
   fcm__idbuf ids = {NULL, 0, 0};
@@ -154,12 +322,24 @@ static fcm_status split_triangles(fcm_embedded_surface *es, unsigned char *split
       pairs[2 * n] = ids.ids[k], pairs[2 * n + 1] = t;
   }
   qsort(pairs, n, 2 * sizeof *pairs, cmp_pair); /* one cell's parts made once */
-  for (size_t k = 0; k < n; k++) {
+  FCM_ALLOC_RAW(ctx, n + 1, poff);
+  FCM_ALLOC_RAW(ctx, n + 1, xoff);
+  for (size_t k = 0, j = 0; k < n; k++) {
     const fcm_index c = pairs[2 * k], t = pairs[2 * k + 1];
-    double x[9];
-    tri_coords(es, t, x);
     const size_t n0 = polys->n;
-    FCM_TRY(ctx, fcm__embed_finder_clip(es->finder, c, x, polys));
+    poff[k] = n0, xoff[k] = polys->nx;
+    while (j < es->npairs && cmp_pair(es->pairs + 2 * j, pairs + 2 * k) < 0)
+      j++;
+    if (!changed[c] && j < es->npairs && !cmp_pair(es->pairs + 2 * j, pairs + 2 * k)) {
+      size_t first_x = es->xoff[j]; /* the parts the last rebuild clipped */
+      for (size_t q = es->poff[j]; q < es->poff[j + 1]; first_x += (size_t)es->polys.nv[q++])
+        FCM_TRY(ctx, polys_append(ctx, polys, &es->polys, q, first_x,
+                                  map_piece(es, c, es->polys.piece[q])));
+    } else {
+      double x[9];
+      tri_coords(es, t, x);
+      FCM_TRY(ctx, fcm__embed_finder_clip(es->finder, c, x, polys));
+    }
     if (polys->n > pcap) {
       const size_t ncap = FCM_MAX(2 * pcap, polys->n + 256);
       void *a = ps, *b = pc;
@@ -169,9 +349,11 @@ static fcm_status split_triangles(fcm_embedded_surface *es, unsigned char *split
       pc = b;
       pcap = ncap;
     }
-    for (size_t j = n0; j < polys->n; j++)
-      ps[j] = t, pc[j] = c;
+    for (size_t q = n0; q < polys->n; q++)
+      ps[q] = t, pc[q] = c;
   }
+  poff[n] = polys->n, xoff[n] = polys->nx;
+  FCM_TRY(ctx, cache_parts(es, polys, &pairs, n, &poff, &xoff));
   /* the parts cover each triangle: else it stays whole */
   FCM_ALLOC(ctx, (size_t)es->nbt + 1, area);
   for (size_t j = 0, off = 0; j < polys->n; off += (size_t)polys->nv[j], j++) {
@@ -190,6 +372,8 @@ static fcm_status split_triangles(fcm_embedded_surface *es, unsigned char *split
   ps = pc = NULL;
 cleanup:
   fcm__free(ctx, pairs);
+  fcm__free(ctx, poff);
+  fcm__free(ctx, xoff);
   fcm__free(ctx, ps);
   fcm__free(ctx, pc);
   fcm__free(ctx, area);
@@ -277,7 +461,7 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
   const fcm_space *s = es->space;
   const fcm_cell_rules *rules = s->rules;
   const fcm_index npieces = rules ? fcm_cell_rules_num_pieces(rules) : 0;
-  unsigned char *split = NULL;
+  unsigned char *split = NULL, *changed = NULL;
   fcm__embed_polys polys = {NULL, NULL, NULL, 0, 0, 0, 0};
   fcm_index *src = NULL, *pcell = NULL, *order = NULL, *ppiece = NULL;
   size_t *first_x = NULL;
@@ -296,8 +480,13 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
   if (rules && fcm_cell_rules_num_cuts(rules) > 0) {
     if (!es->finder) FCM_TRY(ctx, fcm__embed_finder_create(ctx, es->mesh, es->geom, &es->finder));
     FCM_TRY(ctx, fcm__embed_finder_set_rules(es->finder, rules));
-    FCM_TRY(ctx, mark_split(es, split));
-    FCM_TRY(ctx, split_triangles(es, split, &polys, &src, &pcell));
+    FCM_ALLOC_RAW(ctx, (size_t)rules->num_cells + 1, changed);
+    FCM_TRY(ctx, changed_cells(es, changed));
+    FCM_TRY(ctx, mark_split(es, changed, split));
+    FCM_TRY(ctx, split_triangles(es, changed, split, &polys, &src, &pcell));
+    FCM_TRY(ctx, cache_rules(es));
+  } else {
+    cache_clear(es);
   }
   /* the kept parts in triangle order (each triangle's in cell order) */
   fcm_index nkeep = 0, nsv = 0, nst = 0, nsplit = 0;
@@ -364,10 +553,12 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
   es->nt = nt;
   es->num_split = nsplit;
 cleanup:
+  if (st != FCM_OK) cache_clear(es);
   /* the finder holds the cut cells' parts and the search trees: made per call (per cut) */
   fcm__embed_finder_destroy(&es->finder);
   fcm_aabb_tree_destroy(&es->cell_tree);
   fcm__free(ctx, split);
+  fcm__free(ctx, changed);
   fcm__free(ctx, src);
   fcm__free(ctx, pcell);
   fcm__free(ctx, order);
@@ -432,6 +623,7 @@ void fcm_embedded_surface_destroy(fcm_embedded_surface **surface)
   fcm_embedded_surface *es = *surface;
   fcm__embed_finder_destroy(&es->finder);
   fcm_aabb_tree_destroy(&es->cell_tree);
+  cache_clear(es);
   void *arrays[] = {es->X, es->xi, es->cell, es->elem, es->tri, es->tri0, es->flag};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(es->ctx, arrays[k]);
