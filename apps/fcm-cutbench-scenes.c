@@ -104,6 +104,19 @@ int cutbench_write_lobed(const char *path, long long triangles)
   return f && cli_output_commit(PROG, &out);
 }
 
+/* Adds triangle abc's area and its signed volume against the origin (the divergence theorem's
+ * term: a closed surface's sum is its enclosed volume). */
+static void triangle_measure(const double *a, const double *b, const double *c, double *vol,
+                             double *area)
+{
+  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                       u[0] * v[1] - u[1] * v[0]};
+  *area += 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  *vol += (a[0] * n[0] + a[1] * n[1] + a[2] * n[2]) / 6.0;
+}
+
 int cutbench_model_measure(fcm_ctx *ctx, cutbench_model *m)
 {
   fcm_surface *s = NULL;
@@ -117,12 +130,7 @@ int cutbench_model_measure(fcm_ctx *ctx, cutbench_model *m)
   double vol = 0.0, area = 0.0;
   for (fcm_index k = 0; k < nt; k++) {
     const double *a = x + 3 * t[3 * k], *b = x + 3 * t[3 * k + 1], *c = x + 3 * t[3 * k + 2];
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
-                         u[0] * v[1] - u[1] * v[0]};
-    area += 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    vol += (a[0] * n[0] + a[1] * n[1] + a[2] * n[2]) / 6.0;
+    triangle_measure(a, b, c, &vol, &area);
   }
   m->volume = fabs(vol), m->area = area;
   fcm_surface_destroy(&s);
@@ -253,12 +261,7 @@ void soup_measure(const soup *s, cutbench_model *m)
   for (long long k = 0; k < s->nt; k++) {
     const double *a = s->x + 3 * s->t[3 * k], *b = s->x + 3 * s->t[3 * k + 1],
                  *c = s->x + 3 * s->t[3 * k + 2];
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
-                         u[0] * v[1] - u[1] * v[0]};
-    area += 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    vol += (a[0] * n[0] + a[1] * n[1] + a[2] * n[2]) / 6.0;
+    triangle_measure(a, b, c, &vol, &area);
   }
   m->volume = fabs(vol), m->area = area;
 }
