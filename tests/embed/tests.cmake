@@ -65,6 +65,9 @@ fcm_add_test(embed_cut_families_long tests/embed/cut_families.c ARGS campaign 20
 # monomial of degree <= 4, per cell, 1e-12 |K|), Hex8 and Tet4, a box on grid planes; the
 # inside test against point-in-tet; an open surface is an error.
 fcm_add_test(embed_surface_moments tests/embed/surface_moments.c)
+# Surface moments and inside tests on sliver tets (cond(A) up to 1e12, as a cut part's fan
+# tets): a closed ball gives every rule (no crossing triangle left out of the candidates).
+fcm_add_test(embed_sliver_lines tests/embed/sliver_lines.c)
 # A geometry of its boundary surface alone (volume_mesh = 0): global moments equal the exact
 # polyhedron integrals (Hex8, Tet4, Hex20), the volume beyond each side of the grid from the
 # surface equals the tets', a cut and the volume path refuse it.

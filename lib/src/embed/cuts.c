@@ -323,8 +323,7 @@ static fcm_status face_links(const build *B, const fcm_cell_rules *R, const cell
                              mtol, atol, B->cut_tris, tc->ids, tc->n))
         continue;
       if (!earlier_link(B, ca, cb, out[ca].pc[qa].parent, out[cb].pc[qb].parent)) continue;
-      if (mat && !fcm__embed_overlap_material(ctx, mat, A, ma[2], Bx, mb[2], nbn, cell->size))
-        continue;
+      if (mat && !fcm__embed_overlap_material(ctx, mat, cell, A, ma[2], Bx, mb[2], nbn)) continue;
       if (mat) FCM_TRY(ctx, fcm__material_status(mat));
       FCM_TRY(ctx, push_link(ctx, pa, pb, links, nl, cap));
     }

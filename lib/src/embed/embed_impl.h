@@ -600,25 +600,28 @@ fcm_status fcm__material_create(fcm_ctx *ctx, const fcm_geometry *geom, fcm__mat
 void fcm__material_destroy(fcm_ctx *ctx, fcm__material **m);
 
 /* The volume of the body inside the convex polyhedron p (surface moments on the tets of a fan
- * of p). With out (cell affine): also the signed rule of degree q->m of that material,
- * appended to out in cell's reference coordinates. */
+ * of p), a part of cell (which names the errors). With out (cell affine): also the signed
+ * rule of degree q->m of that material, appended to out in cell's reference coordinates. */
 fcm_status fcm__material_poly(fcm_ctx *ctx, fcm__material *m, const fcm__poly *p,
                               const fcm__moment_quad *q, const fcm__embed_cell *cell,
                               fcm__srule *out, double *volume);
 
 /* Whether the body covers more than atol of the area of the planar convex polygon x (n
- * vertices, unit normal nrm): its volume in the prism of half-height h on the polygon,
- * over 2 h. An error is kept in m and the answer is then 1. */
-int fcm__material_on_face(fcm_ctx *ctx, fcm__material *m, const double *x, int n,
-                          const double nrm[3], double h, double atol);
+ * vertices, unit normal nrm) on a face of cell (which names the errors): its volume in the
+ * prism of half-height h on the polygon, over 2 h. An error is kept in m and the answer is
+ * then 1. */
+int fcm__material_on_face(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
+                          const double *x, int n, const double nrm[3], double h, double atol);
 
 /* The first error fcm__material_on_face() kept (FCM_OK: none), cleared. */
 fcm_status fcm__material_status(fcm__material *m);
 
 /* Whether the overlap of the touching faces a (na vertices) and b (nb, outward normal
- * nb_normal) of two parts in cells of size `size` holds material (fcm__material_on_face()). */
-int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const double *a, int na,
-                                const double *b, int nb, const double nb_normal[3], double size);
+ * nb_normal) of two parts, on a face of cell (its size sets the tolerances), holds material
+ * (fcm__material_on_face()). */
+int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
+                                const double *a, int na, const double *b, int nb,
+                                const double nb_normal[3]);
 
 /* Split every part of P by triangle t (its plane and edge planes, as a cut's) and drop the
  * emptied ones. */

@@ -425,7 +425,7 @@ static int parts_connected(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm_
       if (fcm__embed_linked(xa, na, a->x[0], a->nv, xb, nb, b->x[0], b->nv, pb->n, mtol, atol, tris,
                             P->tcand.ids, ntri) &&
           (!P->mat || fcm__embed_part_full(P, i) || fcm__embed_part_full(P, j) ||
-           fcm__embed_overlap_material(ctx, P->mat, xa, na, xb, nb, pb->n, cell->size)))
+           fcm__embed_overlap_material(ctx, P->mat, cell, xa, na, xb, nb, pb->n)))
         return 1;
     }
   }

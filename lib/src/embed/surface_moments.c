@@ -29,6 +29,7 @@
 #include "embed/embed_impl.h"
 #include "la/mat3.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -401,7 +402,10 @@ cleanup:
 /* ---------------------------------------------------------------- lines through the body */
 
 /* Boundary triangles that may cross the reference line base + t dir (any t): the tree's
- * boxes met by the physical segment that covers the geometry's bounding box. */
+ * boxes met by the physical segment that covers the geometry's bounding box, widened by the
+ * distance the rounding of the map to reference coordinates can move a triangle across the
+ * line: about eps cond(A) times the distance to the cell (a sliver tet of a fan has cond(A)
+ * up to 1e12, and a triangle the reference line crosses can then miss a tighter segment). */
 static fcm_status line_candidates(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
                                   const fcm__embed_cell *cell, const double base[3],
                                   const double dir[3], fcm__idbuf *buf)
@@ -424,7 +428,11 @@ static fcm_status line_candidates(fcm_ctx *ctx, const fcm_geometry *g, const fcm
   const double t = far / speed + 1.0;
   for (int d = 0; d < 3; d++)
     p0[d] = p[d] - t * v[d], p1[d] = p[d] + t * v[d];
-  return fcm__geom_tree_segment(ctx, tree, p0, p1, 1e-9 * (far + cell->size), buf);
+  double na = 0.0, ni = 0.0; /* Frobenius norms: cond(A) <= na ni */
+  for (int k = 0; k < 9; k++)
+    na += cell->A[k] * cell->A[k], ni += cell->Ainv[k] * cell->Ainv[k];
+  const double rel = 1e-9 + 64.0 * DBL_EPSILON * sqrt(na * ni);
+  return fcm__geom_tree_segment(ctx, tree, p0, p1, rel * (far + cell->size), buf);
 }
 
 /* The crossings of the body's boundary with the line {l1 = 0, l2 = 0} (base + t dir), as

@@ -104,8 +104,9 @@ static void tet_cell(const double *T, fcm_index id, fcm__embed_cell *k)
   }
 }
 
-/* The body's signed rule of degree q->m on each of the nt tets (tets, vol), summed into
- * *volume; appended to out (cell's reference coordinates) when out is given. */
+/* The body's signed rule of degree q->m on each of the nt tets (tets, vol) inside cell (which
+ * names the errors), summed into *volume; appended to out (cell's reference coordinates) when
+ * out is given. */
 static fcm_status tets_material(fcm_ctx *ctx, fcm__material *m, const double *tets,
                                 const double *vol, int nt, const fcm__moment_quad *q,
                                 const fcm__embed_cell *cell, fcm__srule *out, double *volume)
@@ -115,7 +116,7 @@ static fcm_status tets_material(fcm_ctx *ctx, fcm__material *m, const double *te
   for (int t = 0; t < nt; t++) {
     if (vol[t] == 0.0) continue;
     fcm__embed_cell k;
-    tet_cell(tets + 12 * t, cell ? cell->id : -1, &k);
+    tet_cell(tets + 12 * t, cell->id, &k);
     /* a fan tet flat to rounding (near-coplanar vertices of a part) holds no material that
      * counts, and its map to the unit tet is too ill-conditioned for the line crossings */
     if (!(fabs(k.detA) > FLAT_RTOL * k.size * k.size * k.size && isfinite(k.detA))) continue;
@@ -191,9 +192,10 @@ cleanup:
  * orientation, half-height h) without their moments, where no boundary triangle's box meets
  * the prism's box: then the body fills it or misses it, and one inside test decides. *sure:
  * 1 covered, -1 not, 0 undecided here (a triangle near the prism, or the area within a factor
- * two of atol, where the moments' rounding could decide otherwise). */
+ * two of atol, where the moments' rounding could decide otherwise). id: the cell, which names
+ * the errors. */
 static fcm_status prism_clear(fcm_ctx *ctx, fcm__material *m, const double *tets, int nt, double h,
-                              double atol, int *sure)
+                              double atol, fcm_index id, int *sure)
 {
   fcm_status st = FCM_OK;
   double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
@@ -210,7 +212,7 @@ static fcm_status prism_clear(fcm_ctx *ctx, fcm__material *m, const double *tets
   FCM_TRY(ctx, fcm__geom_tree_query(ctx, m->tree, lo, hi, &m->buf));
   if (m->buf.n > 0) goto cleanup;
   for (int t = 0; t < nt; t++) { /* the tets tets_material() would count */
-    tet_cell(tets + 12 * t, -1, &k);
+    tet_cell(tets + 12 * t, id, &k);
     if (!(fabs(k.detA) > FLAT_RTOL * k.size * k.size * k.size && isfinite(k.detA))) continue;
     if (first < 0) first = t;
     v += fabs(k.detA) / 6.0;
@@ -222,7 +224,7 @@ static fcm_status prism_clear(fcm_ctx *ctx, fcm__material *m, const double *tets
   const double a = v / (2.0 * h);
   if (!(a > 2.0 * atol)) goto cleanup;
   const double z = 0.25;
-  tet_cell(tets + 12 * first, -1, &k);
+  tet_cell(tets + 12 * first, id, &k);
   FCM_TRY(ctx, fcm__embed_inside_line(ctx, m->geom, m->tree, &k, 0.25, 0.25, 1, &z, &in, &m->buf,
                                       &m->cr));
   *sure = in != 0 ? 1 : -1; /* -1 inside a tet of negative orientation */
@@ -230,8 +232,8 @@ cleanup:
   return st;
 }
 
-int fcm__material_on_face(fcm_ctx *ctx, fcm__material *m, const double *x, int n,
-                          const double nrm[3], double h, double atol)
+int fcm__material_on_face(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
+                          const double *x, int n, const double nrm[3], double h, double atol)
 {
   fcm_status st = FCM_OK;
   double v = 0.0;
@@ -254,9 +256,9 @@ int fcm__material_on_face(fcm_ctx *ctx, fcm__material *m, const double *x, int n
     }
   }
   int sure = 0;
-  FCM_TRY(ctx, prism_clear(ctx, m, m->tets, 3 * (n - 2), h, atol, &sure));
+  FCM_TRY(ctx, prism_clear(ctx, m, m->tets, 3 * (n - 2), h, atol, cell->id, &sure));
   if (sure) return sure > 0;
-  FCM_TRY(ctx, tets_material(ctx, m, m->tets, m->vol, 3 * (n - 2), &m->q0, NULL, NULL, &v));
+  FCM_TRY(ctx, tets_material(ctx, m, m->tets, m->vol, 3 * (n - 2), &m->q0, cell, NULL, &v));
 cleanup:
   if (st != FCM_OK) {
     if (m->st == FCM_OK) m->st = st;
@@ -270,13 +272,15 @@ cleanup:
 #define PRISM_RTOL     1e-6
 #define FACE_AREA_RTOL 1e-9
 
-int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const double *a, int na,
-                                const double *b, int nb, const double nb_normal[3], double size)
+int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
+                                const double *a, int na, const double *b, int nb,
+                                const double nb_normal[3])
 {
+  const double size = cell->size;
   double x[3 * FCM__POLY_MAX_VERTS];
   int n = 0;
   fcm__embed_overlap(a, na, b, nb, nb_normal, FCM__EMBED_MATCH_RTOL * size, x, &n);
-  return fcm__material_on_face(ctx, m, x, n, nb_normal, PRISM_RTOL * size,
+  return fcm__material_on_face(ctx, m, cell, x, n, nb_normal, PRISM_RTOL * size,
                                FACE_AREA_RTOL * size * size);
 }
 
@@ -600,7 +604,7 @@ fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__p
     if (P->whole && cell->affine)
       FCM_TRY(ctx, fcm__material_cell(ctx, P->mat, NULL, cell, NULL, P->mvol + i));
     else
-      FCM_TRY(ctx, fcm__material_poly(ctx, P->mat, P->poly + i, NULL, NULL, NULL, P->mvol + i));
+      FCM_TRY(ctx, fcm__material_poly(ctx, P->mat, P->poly + i, NULL, cell, NULL, P->mvol + i));
     if (!(P->mvol[i] > P->vmin[i])) P->poly[i].nv = P->poly[i].nf = 0;
   }
   fcm__embed_parts_compact(P);
