@@ -1,7 +1,8 @@
-/* fcm-converge: what the study's source files (fcm-converge-study.c: the problems;
- * fcm-converge-reference.c: the reference solution and point location in tets;
- * fcm-converge-run.c: one run and its errors) share beyond the app's interface
- * fcm-converge-study.h: the study's state and the helpers one file defines for another. */
+/* fcm-converge: what the study's source files share beyond the app's interface
+ * fcm-converge-study.h: the study's state and the helpers one file defines for another.
+ * fcm-converge-study.c holds the problems; fcm-converge-reference.c the reference solution
+ * and point location in tets (it uses the problems); fcm-converge-run.c the study's
+ * lifetime, one run and its errors (it uses both). */
 #ifndef FCM_CONVERGE_INTERNAL_H
 #define FCM_CONVERGE_INTERNAL_H
 
@@ -35,6 +36,9 @@ struct cv_study {
   tet_index ref_tets;
   double ref_time;
 };
+
+/* The curved boundary facets of S->geom into S->facets (fcm-converge-study.c). */
+fcm_status cv_build_facets(cv_study *S);
 
 /* Ji = J^{-1}; returns det J. */
 double cv_inv3(const double J[9], double Ji[9]);

@@ -1,9 +1,9 @@
-/* fcm-converge: one run of the convergence study on one mesh and method (FCM with the
- * embedded or Nitsche boundary, or staircase FEM): the cell rules, assembly and CHOLMOD
- * solve with their wall/CPU timings, the L2 and H1 errors against the exact field or the
- * reference solution, and the least-squares rate fit of an error series. The problems
- * themselves (fields, loads, boundary conditions, the discrete system) are defined in
- * fcm-converge-study.c; the reference solution in fcm-converge-reference.c. */
+/* fcm-converge: the study's lifetime (geometry, facets, reference solution) and one run
+ * of it on one mesh and method (FCM with the embedded or Nitsche boundary, or staircase
+ * FEM): the cell rules, assembly and CHOLMOD solve with their wall/CPU timings, the L2 and H1
+ * errors against the exact field or the reference solution, and the least-squares rate fit of an
+ * error series. The problems themselves (fields, loads, boundary conditions, the discrete system)
+ * are defined in fcm-converge-study.c; the reference solution in fcm-converge-reference.c. */
 #include "fcm-converge-internal.h"
 
 #include <fcm/quad.h>
@@ -13,6 +13,49 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+
+/* ---------------------------------------------------------------- the study */
+
+fcm_status cv_study_create(fcm_ctx *ctx, const cv_setup *setup, cv_study **study)
+{
+  fcm_status st = FCM_OK;
+  const double c[3] = {0, 0, 0};
+  cv_study *S = calloc(1, sizeof *S);
+  *study = NULL;
+  if (!S) return FCM_ERR_ALLOC;
+  S->ctx = ctx;
+  S->s = *setup;
+  const fcm_material mat = {FCM_MATERIAL_LINEAR, setup->young, setup->poisson, 0.0};
+  st = fcm_material_lame(ctx, &mat, &S->lambda, &S->mu);
+  if (st == FCM_OK)
+    st = fcm_geometry_create_hemisphere(ctx, c, setup->radius, setup->geom_n, &S->geom);
+  if (st == FCM_OK)
+    st = cv_tet_index_create(ctx, fcm_geometry_coords(S->geom), fcm_geometry_cells(S->geom), 4,
+                             fcm_geometry_num_cells(S->geom), &S->geo_tets);
+  if (st == FCM_OK) st = cv_build_facets(S);
+  if (st == FCM_OK && setup->problem == CV_REFERENCE) st = cv_reference_create(S);
+  if (st != FCM_OK) {
+    cv_study_destroy(&S);
+    return st;
+  }
+  *study = S;
+  return st;
+}
+
+void cv_study_destroy(cv_study **study)
+{
+  if (!study || !*study) return;
+  cv_study *S = *study;
+  fcm_aabb_tree_destroy(&S->geo_tets.tree);
+  fcm_aabb_tree_destroy(&S->ref_tets.tree);
+  free(S->facets);
+  free(S->ref_u);
+  fcm_space_destroy(&S->ref_space);
+  fcm_mesh_destroy(&S->ref_mesh);
+  fcm_geometry_destroy(&S->geom);
+  free(S);
+  *study = NULL;
+}
 
 /* ---------------------------------------------------------------- one run */
 

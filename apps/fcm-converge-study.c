@@ -1,8 +1,8 @@
-/* fcm-converge: the problems of the convergence study — the study's state (geometry,
- * curved boundary facets), the fields, loads and boundary conditions, and the discrete
- * system (linear elasticity) that every run and the reference solution assemble and solve
- * with CHOLMOD. One run and its errors are in fcm-converge-run.c; the reference solution
- * in fcm-converge-reference.c.
+/* fcm-converge: the problems of the convergence study — the curved boundary facets of the
+ * geometry, the fields, loads and boundary conditions, and the discrete system (linear
+ * elasticity) that every run and the reference solution assemble and solve with CHOLMOD.
+ * The study's lifetime, one run and its errors are in fcm-converge-run.c; the reference
+ * solution in fcm-converge-reference.c.
  *
  * Manufactured problem (lib/METHOD.md §10): on the polyhedral domain Omega (the tet mesh
  * of the hemisphere) the exact field is u_i = A_i sin(k_i . x + phi_i); the body force is
@@ -93,11 +93,11 @@ static double dot(const double a[3], const double b[3])
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-/* ---------------------------------------------------------------- the study */
+/* ---------------------------------------------------------------- curved boundary facets */
 
 #define FACET_STRIDE 16
 
-static fcm_status build_facets(cv_study *S)
+fcm_status cv_build_facets(cv_study *S)
 {
   const fcm_index nt = fcm_geometry_num_boundary_triangles(S->geom);
   const fcm_index *tri = fcm_geometry_boundary_triangles(S->geom);
@@ -431,45 +431,4 @@ fcm_status cv_assemble_system(const cv_study *S, fcm_space *space, int embedded_
   free(dofs);
   free(vals);
   return st;
-}
-
-fcm_status cv_study_create(fcm_ctx *ctx, const cv_setup *setup, cv_study **study)
-{
-  fcm_status st = FCM_OK;
-  const double c[3] = {0, 0, 0};
-  cv_study *S = calloc(1, sizeof *S);
-  *study = NULL;
-  if (!S) return FCM_ERR_ALLOC;
-  S->ctx = ctx;
-  S->s = *setup;
-  const fcm_material mat = {FCM_MATERIAL_LINEAR, setup->young, setup->poisson, 0.0};
-  st = fcm_material_lame(ctx, &mat, &S->lambda, &S->mu);
-  if (st == FCM_OK)
-    st = fcm_geometry_create_hemisphere(ctx, c, setup->radius, setup->geom_n, &S->geom);
-  if (st == FCM_OK)
-    st = cv_tet_index_create(ctx, fcm_geometry_coords(S->geom), fcm_geometry_cells(S->geom), 4,
-                             fcm_geometry_num_cells(S->geom), &S->geo_tets);
-  if (st == FCM_OK) st = build_facets(S);
-  if (st == FCM_OK && setup->problem == CV_REFERENCE) st = cv_reference_create(S);
-  if (st != FCM_OK) {
-    cv_study_destroy(&S);
-    return st;
-  }
-  *study = S;
-  return st;
-}
-
-void cv_study_destroy(cv_study **study)
-{
-  if (!study || !*study) return;
-  cv_study *S = *study;
-  fcm_aabb_tree_destroy(&S->geo_tets.tree);
-  fcm_aabb_tree_destroy(&S->ref_tets.tree);
-  free(S->facets);
-  free(S->ref_u);
-  fcm_space_destroy(&S->ref_space);
-  fcm_mesh_destroy(&S->ref_mesh);
-  fcm_geometry_destroy(&S->geom);
-  free(S);
-  *study = NULL;
 }
