@@ -4,7 +4,7 @@
  * tree over tet boxes, barycentric test) that both the reference evaluation and the
  * staircase classification of fcm-converge-study.c and fcm-converge-run.c use. It is
  * built once per study and evaluated at every error quadrature point of every run. */
-#include "fcm-converge-internal.h"
+#include "fcm-converge-study-impl.h"
 
 #include <fcm/quad.h>
 #include <fcm/sim.h>

@@ -4,7 +4,7 @@
  * errors against the exact field or the reference solution, and the least-squares rate fit of an
  * error series. The problems themselves (fields, loads, boundary conditions, the discrete system)
  * are defined in fcm-converge-study.c; the reference solution in fcm-converge-reference.c. */
-#include "fcm-converge-internal.h"
+#include "fcm-converge-study-impl.h"
 
 #include <fcm/quad.h>
 #include <fcm/sim.h>

@@ -14,7 +14,7 @@
  * implementation notes): body load -5e5 y exp(-1/(1 - 9 r^2)) e_y for 3 r < 1, u = 0 on
  * y = 0, traction free; the reference is boundary-conforming Tet10 on the geometry's own
  * tets (optionally refined), so both live on exactly the same polyhedron. */
-#include "fcm-converge-internal.h"
+#include "fcm-converge-study-impl.h"
 
 #include <fcm/quad.h>
 #include <fcm/sim.h>

@@ -3,8 +3,8 @@
  * fcm-converge-study.c holds the problems; fcm-converge-reference.c the reference solution
  * and point location in tets (it uses the problems); fcm-converge-run.c the study's
  * lifetime, one run and its errors (it uses both). */
-#ifndef FCM_CONVERGE_INTERNAL_H
-#define FCM_CONVERGE_INTERNAL_H
+#ifndef FCM_CONVERGE_STUDY_IMPL_H
+#define FCM_CONVERGE_STUDY_IMPL_H
 
 #include "fcm-converge-study.h"
 
@@ -66,4 +66,4 @@ fcm_status cv_reference_create(cv_study *S);
 /* Reference displacement and gradient at x; returns 0 when x lies in no reference tet. */
 int cv_reference_eval(const cv_study *S, const double x[3], double u[3], double G[9]);
 
-#endif /* FCM_CONVERGE_INTERNAL_H */
+#endif /* FCM_CONVERGE_STUDY_IMPL_H */
