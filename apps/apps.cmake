@@ -12,7 +12,8 @@ fcm_add_app(fcm-rulegen apps/fcm-rulegen.c)
 fcm_add_app(fcm-quadrature apps/fcm-quadrature.c apps/fcm-quadrature-embed.c
             apps/fcm-quadrature-export.c apps/fcm-quadrature-grid.c)
 fcm_add_app(fcm-condition apps/fcm-condition.c apps/fcm-condition-study.c apps/fcm-condition-output.c)
-fcm_add_app(fcm-converge apps/fcm-converge.c apps/fcm-converge-study.c apps/fcm-converge-output.c)
+fcm_add_app(fcm-converge apps/fcm-converge.c apps/fcm-converge-study.c
+            apps/fcm-converge-reference.c apps/fcm-converge-run.c apps/fcm-converge-output.c)
 fcm_add_app(fcm-cut apps/fcm-cut.c apps/fcm-cut-accuracy.c)
 fcm_add_app(fcm-scaling apps/fcm-scaling.c apps/fcm-scaling-study.c apps/fcm-scaling-output.c)
 if(FCM_HAVE_PETSC) # --backend petsc: the PETSc component

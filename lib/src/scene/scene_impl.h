@@ -306,7 +306,7 @@ typedef struct fcm__effect_init {
   double com[3];
 } fcm__effect_init;
 
-/* An effect module: parsing and printing (effects.c), what it needs from the pipeline,
+/* An effect module: parsing and printing (effects*.c), what it needs from the pipeline,
  * and the hooks through which the scene runner (run.c) lets it contribute. A NULL hook means
  * the effect has nothing to do at that stage. */
 typedef struct fcm__effect_type {
@@ -349,5 +349,21 @@ fcm_status fcm__scene_read_effects(fcm__scene_parser *p, const fcm__json *root);
 
 /* Print a region on one line (no newline). */
 void fcm__scene_region_view(const fcm_region *r, FILE *stream);
+
+/* Time window members "start" (>= 0, default 0) and "end" (> start, default HUGE_VAL) of
+ * obj; its printer (", t in [a, b] s", ", from t = a s" or nothing). (effects_region.c) */
+fcm_status fcm__scene_read_window(fcm__scene_parser *p, const fcm__json *obj, double *start,
+                                  double *end);
+void fcm__scene_view_window(double start, double end, FILE *stream);
+
+/* A rigid motion's "velocity", "rotation" {"axis", "center", "speed"} and window ("start",
+ * "end") of o into m (its other members untouched). (effects_region.c) */
+fcm_status fcm__scene_read_rigid_motion(fcm__scene_parser *p, const fcm__json *o, fcm_motion *m);
+
+/* The cut and contact effects' parsers and printers (effects_contact.c). */
+fcm_status fcm__effect_parse_cut(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e);
+void fcm__effect_view_cut(const fcm_effect *e, FILE *stream);
+fcm_status fcm__effect_parse_contact(fcm__scene_parser *p, const fcm__json *o, fcm_effect *e);
+void fcm__effect_view_contact(const fcm_effect *e, FILE *stream);
 
 #endif /* FCM_SCENE_IMPL_H */

@@ -1,5 +1,6 @@
 list(APPEND FCM_SOURCES lib/src/scene/json_adapter.c lib/src/scene/schema.c
-                        lib/src/scene/effects.c lib/src/scene/scene.c
+                        lib/src/scene/effects.c lib/src/scene/effects_region.c
+                        lib/src/scene/effects_contact.c lib/src/scene/scene.c
                         lib/src/scene/parse_model.c lib/src/scene/parse_solver.c
                         lib/src/scene/view.c
                         lib/src/scene/default_scene.c
