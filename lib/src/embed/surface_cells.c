@@ -302,6 +302,31 @@ cleanup:
   return st;
 }
 
+/* Kind k's rule as kind j's, fitted on the same candidates at the same strength: the same
+ * moments and basis give the same fit. */
+static fcm_status copy_kind(const build *B, int j, int k, piece_out *o)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const size_t n = (size_t)o->n[j],
+               ns = B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0;
+  fcm__free(ctx, o->pts[k]);
+  fcm__free(ctx, o->w[k]);
+  fcm__free(ctx, o->flag[k]);
+  o->pts[k] = o->w[k] = NULL;
+  o->flag[k] = NULL;
+  FCM_ALLOC(ctx, 3 * (n + ns), o->pts[k]);
+  FCM_ALLOC(ctx, n + ns, o->w[k]);
+  FCM_ALLOC(ctx, n + ns, o->flag[k]);
+  memcpy(o->pts[k], o->pts[j], 3 * n * sizeof(double));
+  memcpy(o->w[k], o->w[j], n * sizeof(double));
+  o->n[k] = o->nsimp[k] = o->n[j];
+  o->ninit[k] = o->ninit[j];
+  o->residual[k] = o->residual[j];
+cleanup:
+  return st;
+}
+
 fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
                                         const fcm__embed_cell *cell, fcm__embed_ws *ws,
                                         const double mbox[6], double vol, piece_out *o, int *ok,
@@ -346,11 +371,19 @@ fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
       fcm__free(ctx, work);
       work = NULL;
     }
+    int fitted[FCM_RULE_KIND_COUNT] = {0}; /* on this grid */
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
       if (!todo[k]) continue;
-      int done;
-      FCM_TRY(ctx, fit_kind(B, R, ws, box, count, k, P, cb.num_basis, o, &done, why, why_len));
-      if (done) todo[k] = 0, left--;
+      int done, same = -1;
+      for (int j = 0; j < k; j++)
+        if (fitted[j] && R->strength[j] == R->strength[k]) same = j;
+      if (same >= 0) {
+        FCM_TRY(ctx, copy_kind(B, same, k, o));
+        done = 1;
+      } else {
+        FCM_TRY(ctx, fit_kind(B, R, ws, box, count, k, P, cb.num_basis, o, &done, why, why_len));
+      }
+      if (done) todo[k] = 0, left--, fitted[k] = 1;
     }
   }
   *ok = left == 0;
