@@ -229,37 +229,49 @@ cleanup:
   return st;
 }
 
+/* The moment basis of strength m on the material's box mapped to [-1, 1]: a basis that the
+ * small material of a sliver cell does not make singular. */
+static void fit_box(const double box[6], int m, fcm__cheb_box *cb)
+{
+  cb->m = m;
+  cb->num_basis = fcm__simplify_num_basis(m);
+  for (int d = 0; d < 3; d++) {
+    const double a = box[d], b = box[3 + d];
+    cb->scale[d] = 2.0 / (b - a);
+    cb->shift[d] = -(a + b) / (b - a);
+  }
+}
+
 /* Fit kind k's rule on the candidates (count of them) into o; *ok = 0 when they cannot carry
- * the moments. */
+ * the moments. P: the candidates' basis at a strength >= kind k's (Ptop rows, ld Ptop), of
+ * which the fit takes the leading rows, its own basis (in degree order, bit for bit). */
 static fcm_status fit_kind(const build *B, const fcm_cell_rules *R, const fcm__embed_ws *ws,
-                           const double box[6], int count, int k, piece_out *o, int *ok, char *why,
-                           size_t why_len)
+                           const double box[6], int count, int k, const double *P, int Ptop,
+                           piece_out *o, int *ok, char *why, size_t why_len)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
   fcm__cheb_box cb;
   fcm__fit f;
-  double *mom = NULL, *work = NULL;
+  double *mom = NULL, *work = NULL, *Pk = NULL;
   memset(&f, 0, sizeof f);
-  cb.m = R->strength[k];
-  cb.num_basis = fcm__simplify_num_basis(cb.m);
-  for (int d = 0; d < 3; d++) { /* the material's box -> [-1, 1]: a basis that the small
-                                   material of a sliver cell does not make singular */
-    const double a = box[d], b = box[3 + d];
-    cb.scale[d] = 2.0 / (b - a);
-    cb.shift[d] = -(a + b) / (b - a);
-  }
+  fit_box(box, R->strength[k], &cb);
   const int M = cb.num_basis;
   const size_t ns = B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0;
   FCM_ALLOC(ctx, (size_t)M, mom);
   FCM_ALLOC(ctx, fcm__simplify_moments_scratch(cb.m), work);
   FCM_ALLOC(ctx, (size_t)M, f.idx);
   FCM_ALLOC(ctx, (size_t)M, f.w);
+  if (M < Ptop && count > 0) {
+    FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)count, Pk);
+    for (int j = 0; j < count; j++)
+      memcpy(Pk + (size_t)j * M, P + (size_t)j * Ptop, (size_t)M * sizeof *Pk);
+  }
   fcm__simplify_moments(&cb, (int)ws->sr->n, ws->sr->x, NULL, ws->sr->w, mom, work);
   /* the moments' rounding: about 1e-15 of the material box's reference volume */
   const double bv = (box[3] - box[0]) * (box[4] - box[1]) * (box[5] - box[2]);
-  FCM_TRY(ctx, fcm__simplify_fit(ctx, &cb, count, ws->cand_x, mom,
-                                 B->o->simplify_options.residual_tol, MOMENT_ATOL * bv, &f));
+  FCM_TRY(ctx, fcm__simplify_fit_basis(ctx, M, count, Pk ? Pk : P, mom,
+                                       B->o->simplify_options.residual_tol, MOMENT_ATOL * bv, &f));
   *ok = f.ok;
   if (!f.ok) {
     snprintf(why, why_len, "%s rules of strength %d on %d candidates: %s", fcm_rule_kind_name(k),
@@ -284,8 +296,34 @@ static fcm_status fit_kind(const build *B, const fcm_cell_rules *R, const fcm__e
 cleanup:
   fcm__free(ctx, mom);
   fcm__free(ctx, work);
+  fcm__free(ctx, Pk);
   fcm__free(ctx, f.idx);
   fcm__free(ctx, f.w);
+  return st;
+}
+
+/* Kind k's rule as kind j's, fitted on the same candidates at the same strength: the same
+ * moments and basis give the same fit. */
+static fcm_status copy_kind(const build *B, int j, int k, piece_out *o)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const size_t n = (size_t)o->n[j],
+               ns = B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0;
+  fcm__free(ctx, o->pts[k]);
+  fcm__free(ctx, o->w[k]);
+  fcm__free(ctx, o->flag[k]);
+  o->pts[k] = o->w[k] = NULL;
+  o->flag[k] = NULL;
+  FCM_ALLOC(ctx, 3 * (n + ns), o->pts[k]);
+  FCM_ALLOC(ctx, n + ns, o->w[k]);
+  FCM_ALLOC(ctx, n + ns, o->flag[k]);
+  memcpy(o->pts[k], o->pts[j], 3 * n * sizeof(double));
+  memcpy(o->w[k], o->w[j], n * sizeof(double));
+  o->n[k] = o->nsimp[k] = o->n[j];
+  o->ninit[k] = o->ninit[j];
+  o->residual[k] = o->residual[j];
+cleanup:
   return st;
 }
 
@@ -296,7 +334,7 @@ fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
-  double box[6];
+  double box[6], *P = NULL, *work = NULL;
   int Mmax = 1, mmax = 0;
   memcpy(box, mbox, sizeof box);
   *ok = 0;
@@ -318,15 +356,40 @@ fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
     FCM_TRY(ctx, check_fit_memory(B, cell, ws, n, Mmax));
     FCM_TRY(ctx, grid_candidates(B, cell, ws, box, n, BOUNDARY_PER_MOMENT * Mmax * grow,
                                  attempt > 0 && ws->cand_parts, &count));
+    /* the kinds' bases on the candidates, evaluated once at the highest strength left */
+    int mtop = 0;
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+      if (todo[k]) mtop = FCM_MAX(mtop, R->strength[k]);
+    fcm__cheb_box cb;
+    fit_box(box, mtop, &cb);
+    fcm__free(ctx, P);
+    P = NULL;
+    if (count > 0) {
+      FCM_ALLOC_RAW(ctx, (size_t)cb.num_basis * (size_t)count, P);
+      FCM_ALLOC_RAW(ctx, fcm__simplify_moments_scratch(mtop), work);
+      fcm__simplify_basis_points(&cb, count, ws->cand_x, P, work);
+      fcm__free(ctx, work);
+      work = NULL;
+    }
+    int fitted[FCM_RULE_KIND_COUNT] = {0}; /* on this grid */
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
       if (!todo[k]) continue;
-      int done;
-      FCM_TRY(ctx, fit_kind(B, R, ws, box, count, k, o, &done, why, why_len));
-      if (done) todo[k] = 0, left--;
+      int done, same = -1;
+      for (int j = 0; j < k; j++)
+        if (fitted[j] && R->strength[j] == R->strength[k]) same = j;
+      if (same >= 0) {
+        FCM_TRY(ctx, copy_kind(B, same, k, o));
+        done = 1;
+      } else {
+        FCM_TRY(ctx, fit_kind(B, R, ws, box, count, k, P, cb.num_basis, o, &done, why, why_len));
+      }
+      if (done) todo[k] = 0, left--, fitted[k] = 1;
     }
   }
   *ok = left == 0;
 cleanup:
+  fcm__free(ctx, P);
+  fcm__free(ctx, work);
   o->fitted = (unsigned char)*ok;
   if (!*ok) /* leave no kind half fitted: the volume path starts from an empty piece */
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {

@@ -777,9 +777,25 @@ fcm_status fcm__simplify_fit(fcm_ctx *ctx, const fcm__cheb_box *box, int n, cons
                              const double *b, double tol, double atol, fcm__fit *f)
 {
   fcm_status st = FCM_OK;
-  const int M = box->num_basis, k = FCM_MIN(M, n);
-  double *P = NULL, *G = NULL, *s = NULL, *u = NULL, *vt = NULL, *rhs = NULL, *x = NULL,
-         *work = NULL;
+  const int M = box->num_basis;
+  double *P = NULL, *work = NULL;
+  if (n < 1) return fcm__simplify_fit_basis(ctx, M, n, NULL, b, tol, atol, f);
+  FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)n, P);
+  FCM_ALLOC_RAW(ctx, fcm__simplify_moments_scratch(box->m), work);
+  fcm__simplify_basis_points(box, n, pts, P, work);
+  FCM_TRY(ctx, fcm__simplify_fit_basis(ctx, M, n, P, b, tol, atol, f));
+cleanup:
+  fcm__free(ctx, P);
+  fcm__free(ctx, work);
+  return st;
+}
+
+fcm_status fcm__simplify_fit_basis(fcm_ctx *ctx, int M, int n, const double *P, const double *b,
+                                   double tol, double atol, fcm__fit *f)
+{
+  fcm_status st = FCM_OK;
+  const int k = FCM_MIN(M, n);
+  double *G = NULL, *s = NULL, *u = NULL, *vt = NULL, *rhs = NULL, *x = NULL;
   fcm__lp_report rep;
   f->count = 0;
   f->ok = 0;
@@ -790,10 +806,7 @@ fcm_status fcm__simplify_fit(fcm_ctx *ctx, const fcm__cheb_box *box, int n, cons
     snprintf(f->message, sizeof f->message, "no candidate points");
     return FCM_OK;
   }
-  FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)n, P);
-  FCM_ALLOC_RAW(ctx, fcm__simplify_moments_scratch(box->m), work);
   FCM_ALLOC(ctx, (size_t)n, x);
-  fcm__simplify_basis_points(box, n, pts, P, work);
   /* weights of mean 1 (the LP's tolerances are absolute): b scaled by n / b_0, b_0 being the
    * measure's total (the basis' first function is 1) */
   const double scale = b[0] > 0.0 ? n / b[0] : 1.0, floor = atol / tol;
@@ -870,13 +883,11 @@ fcm_status fcm__simplify_fit(fcm_ctx *ctx, const fcm__cheb_box *box, int n, cons
                f->residual, tol, r, M);
   }
 cleanup:
-  fcm__free(ctx, P);
   fcm__free(ctx, G);
   fcm__free(ctx, s);
   fcm__free(ctx, u);
   fcm__free(ctx, vt);
   fcm__free(ctx, rhs);
   fcm__free(ctx, x);
-  fcm__free(ctx, work);
   return st;
 }

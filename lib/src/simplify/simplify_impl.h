@@ -256,4 +256,11 @@ fcm_status fcm__simplify_nnls(fcm_ctx *ctx, int M, int k, const double *A, const
 fcm_status fcm__simplify_fit(fcm_ctx *ctx, const fcm__cheb_box *box, int n, const double *pts,
                              const double *b, double tol, double atol, fcm__fit *f);
 
+/* fcm__simplify_fit on the candidates' basis values P (M x n, ld M, column j the basis of
+ * fcm__simplify_basis_points at point j): callers fitting several degrees on the same points
+ * and box evaluate the basis once at the highest and take the leading rows (the basis is
+ * ordered by degree, and its lower-degree values do not depend on the highest degree). */
+fcm_status fcm__simplify_fit_basis(fcm_ctx *ctx, int M, int n, const double *P, const double *b,
+                                   double tol, double atol, fcm__fit *f);
+
 #endif /* FCM_SIMPLIFY_IMPL_H */
