@@ -58,8 +58,11 @@ static inline __attribute__((always_inline)) void dcols8(int m, const double *A,
   }
 }
 
-FCM_MULTIVERSION_CLONES void fcm__fit_dgemv_t(int m, int n, const double *A, int lda,
-                                              const double *x, double *y)
+/* The clones are static: a cloned function's dispatcher would otherwise be exported from the
+ * shared library whatever the visibility (the ifunc resolver keeps default visibility), so the
+ * module's entry points below only call them. */
+FCM_MULTIVERSION_CLONES static void dgemv_t(int m, int n, const double *A, int lda, const double *x,
+                                            double *y)
 {
   int j = 0;
   for (; j + 8 <= n; j += 8)
@@ -96,8 +99,8 @@ static inline __attribute__((always_inline)) void scols8(int m, const float *A, 
   memcpy(y, &out, sizeof out);
 }
 
-FCM_MULTIVERSION_CLONES void fcm__fit_sgemv_t(int m, int n, const float *A, int lda, const float *x,
-                                              float *y)
+FCM_MULTIVERSION_CLONES static void sgemv_t(int m, int n, const float *A, int lda, const float *x,
+                                            float *y)
 {
   int j = 0;
   for (; j + 8 <= n; j += 8)
@@ -109,6 +112,16 @@ FCM_MULTIVERSION_CLONES void fcm__fit_sgemv_t(int m, int n, const float *A, int 
       t += a[r] * x[r];
     y[j] = t;
   }
+}
+
+void fcm__fit_dgemv_t(int m, int n, const double *A, int lda, const double *x, double *y)
+{
+  dgemv_t(m, n, A, lda, x, y);
+}
+
+void fcm__fit_sgemv_t(int m, int n, const float *A, int lda, const float *x, float *y)
+{
+  sgemv_t(m, n, A, lda, x, y);
 }
 #else
 void fcm__fit_dgemv_t(int m, int n, const double *A, int lda, const double *x, double *y)
