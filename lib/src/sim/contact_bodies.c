@@ -388,6 +388,20 @@ cleanup:
   return st;
 }
 
+/* Sample n's point p in the positions B->y and the candidates within r of it (as
+ * fcm__sim_bodies_candidates() on the box of half-width r about p). */
+fcm_status fcm__sim_bodies_near(fcm_ctx *ctx, sim_bodies *B, fcm_index n, double r, int all,
+                                double p[3])
+{
+  double lo[3], hi[3];
+  fcm__sim_bodies_sample(B, n, B->y, p);
+  for (int i = 0; i < 3; i++) {
+    lo[i] = p[i] - r;
+    hi[i] = p[i] + r;
+  }
+  return fcm__sim_bodies_candidates(ctx, B, n, lo, hi, all);
+}
+
 /* The distance of p to triangle t at the node positions y, the unit gradient g and the
  * closest point's barycentric coordinates beta. */
 double fcm__sim_bodies_distance(const sim_bodies *B, const double p[3], fcm_index t,
@@ -468,19 +482,14 @@ fcm_status fcm__sim_bodies_prepare(fcm_integrator *I, sim_contact *c, const doub
   for (fcm_index n = 0; n < B->ns; n++) {
     fcm_index *bl = B->blind + (size_t)n * SIM_BLIND;
     const fcm_index own = B->tbody[B->stri[n]];
-    double p[3], lo[3], hi[3], g[3], beta[3];
+    double p[3], g[3], beta[3];
     if (B->prepared) {
       int any = 0;
       for (int k = 0; k < SIM_BLIND; k++)
         any |= bl[k] >= 0;
       if (!any) continue;
     }
-    fcm__sim_bodies_sample(B, n, B->y, p);
-    for (int i = 0; i < 3; i++) {
-      lo[i] = p[i] - c->dhat;
-      hi[i] = p[i] + c->dhat;
-    }
-    FCM_TRY(ctx, fcm__sim_bodies_candidates(ctx, B, n, lo, hi, 1));
+    FCM_TRY(ctx, fcm__sim_bodies_near(ctx, B, n, c->dhat, 1, p));
     for (size_t k = 0; k < B->buf.n; k++) {
       const fcm_index t = B->buf.ids[k], bt = B->tbody[t];
       if (bt < 0 || bt == own || near[bt]) continue;
@@ -698,13 +707,8 @@ void fcm__sim_bodies_assemble(fcm_integrator *I, sim_contact *c, const double *x
   }
   if (vals) B->npairs = 0;
   for (fcm_index n = 0; n < B->ns; n++) {
-    double p[3], lo[3], hi[3];
-    fcm__sim_bodies_sample(B, n, B->y, p);
-    for (int i = 0; i < 3; i++) {
-      lo[i] = p[i] - c->dhat;
-      hi[i] = p[i] + c->dhat;
-    }
-    if (fcm__sim_bodies_candidates(I->ctx, B, n, lo, hi, 0) != FCM_OK) {
+    double p[3];
+    if (fcm__sim_bodies_near(I->ctx, B, n, c->dhat, 0, p) != FCM_OK) {
       *finite = 0;
       return;
     }
@@ -800,13 +804,8 @@ fcm_status fcm__sim_bodies_stats(const fcm_integrator *I, const sim_contact *c, 
   fcm__sim_bodies_positions(I->space, B, x, 0, B->y);
   FCM_TRY(ctx, fcm__sim_bodies_boxes(ctx, B, B->y, NULL, 0, c->dhat));
   for (fcm_index n = 0; n < B->ns; n++) {
-    double p[3], lo[3], hi[3];
-    fcm__sim_bodies_sample(B, n, B->y, p);
-    for (int i = 0; i < 3; i++) {
-      lo[i] = p[i] - c->dhat;
-      hi[i] = p[i] + c->dhat;
-    }
-    FCM_TRY(ctx, fcm__sim_bodies_candidates(ctx, B, n, lo, hi, 0));
+    double p[3];
+    FCM_TRY(ctx, fcm__sim_bodies_near(ctx, B, n, c->dhat, 0, p));
     for (size_t k = 0; k < B->buf.n; k++) {
       const fcm_index t = B->buf.ids[k];
       double g[3], beta[3], b1, b2;

@@ -222,14 +222,9 @@ fcm_status fcm__sim_bodies_support(const fcm_integrator *I, const sim_contact *c
   for (fcm_index n = 0; n < B->ns; n++) {
     const fcm_index own = B->tbody[B->stri[n]], *sv = B->tri + 3 * B->stri[n];
     const double *l = B->slam + 3 * n;
-    double p[3], lo[3], hi[3];
-    fcm__sim_bodies_sample(B, n, B->y, p);
-    for (int i = 0; i < 3; i++) {
-      lo[i] = p[i] - c->dhat;
-      hi[i] = p[i] + c->dhat;
-    }
+    double p[3];
     /* not the bodies the sample ignores (the barrier does not hold them) */
-    FCM_TRY(ctx, fcm__sim_bodies_candidates(ctx, B, n, lo, hi, 0));
+    FCM_TRY(ctx, fcm__sim_bodies_near(ctx, B, n, c->dhat, 0, p));
     for (size_t k = 0; k < B->buf.n; k++) {
       const fcm_index t = B->buf.ids[k], *tv = B->tri + 3 * t;
       double g[3], beta[3], q[3];

@@ -61,13 +61,8 @@ fcm_status fcm__sim_bodies_friction_lag(fcm_integrator *I, sim_contact *c, const
     old += B->fp[k].lambda;
   B->nfp = 0;
   for (fcm_index n = 0; n < B->ns; n++) {
-    double p[3], lo[3], hi[3];
-    fcm__sim_bodies_sample(B, n, B->y, p);
-    for (int i = 0; i < 3; i++) {
-      lo[i] = p[i] - c->dhat;
-      hi[i] = p[i] + c->dhat;
-    }
-    FCM_TRY(ctx, fcm__sim_bodies_candidates(ctx, B, n, lo, hi, 0));
+    double p[3];
+    FCM_TRY(ctx, fcm__sim_bodies_near(ctx, B, n, c->dhat, 0, p));
     for (size_t k = 0; k < B->buf.n; k++) {
       sim_fpair q;
       double g[3];

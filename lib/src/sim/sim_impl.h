@@ -576,6 +576,9 @@ double fcm__sim_bodies_distance(const sim_bodies *B, const double p[3], fcm_inde
 fcm_status fcm__sim_bodies_candidates(fcm_ctx *ctx, sim_bodies *B, fcm_index n, const double lo[3],
                                       const double hi[3], int all);
 int fcm__sim_bodies_target(sim_bodies *B, fcm_index n, fcm_index t);
+/* Sample n's point p in B->y and the candidates within r of it, into B->buf. */
+fcm_status fcm__sim_bodies_near(fcm_ctx *ctx, sim_bodies *B, fcm_index n, double r, int all,
+                                double p[3]);
 /* Friction between bodies (contact_bodies_friction.c). lag: at x, each pair within d^ keeps its
  * normal force, closest point and tangent basis (start: x is the substep's start, whose node
  * positions the slip counts from; change, may be NULL: the relative change of the sum of the
