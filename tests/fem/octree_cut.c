@@ -12,8 +12,7 @@
  * - the cut on an octree that is uniform (the finest level) around the cut equals the cut on the
  *   uniform grid of the finest cells: the same pieces in every cell the cut reaches, piece by
  *   piece (volumes to 1e-13), and the same volume on each side, the exact one. */
-#include "fem/fem_impl.h"
-#include "fem_util.h"
+#include "octree_cut_util.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -103,39 +102,20 @@ static void copy_sides(const fcm_space *s, const fcm_cell_rules *R, int *side, d
   }
 }
 
-/* The static solve of T^T K T v = 0 with ue prescribed on the free copies of box-boundary nodes;
- * the largest error of u = T v against ue, and of side 0's copies against ue. */
-static void patch_solve(fcm_ctx *ctx, const fcm_space *s, const fcm_csr *K, const fcm_csr *T,
-                        const fcm_index *free_dof, const int *side, const double *ue,
-                        double *err_all, double *err_side0)
+/* The patch solve's largest error against ue, and of side 0's copies against 0. */
+static void patch_errors(fcm_ctx *ctx, const fcm_space *s, const fcm_csr *K, const fcm_csr *T,
+                         const fcm_index *free_dof, const int *side, const double *ue,
+                         double *err_all, double *err_side0)
 {
-  const fcm_mesh *m = fcm_space_mesh(s);
-  const double *X = fcm_mesh_coords(m);
-  fcm_index n = 0, nr = 0;
-  fcm_csr_get_size(T, &n, &nr, NULL);
-  fcm_csr *Kr = NULL;
-  TEST_OK(ctx, fcm_csr_create_ptap(ctx, K, T, &Kr));
-  double *b = calloc((size_t)nr, sizeof *b), *v = calloc((size_t)nr, sizeof *v);
-  double *g = calloc((size_t)nr, sizeof *g), *u = calloc((size_t)n, sizeof *u);
-  unsigned char *con = calloc((size_t)nr, 1);
-  for (fcm_index a = 0; a < fcm_mesh_num_nodes(m); a++) {
-    int boundary = 0;
-    for (int d = 0; d < 3; d++)
-      boundary |= X[3 * a + d] == 0.0 || X[3 * a + d] == 1.0;
-    const fcm_index d0 = fcm_space_node_dof(s, a);
-    for (fcm_index k = 0; boundary && d0 >= 0 && k < 3 * fcm_space_node_copies(s, a); k++)
-      if (free_dof[d0 + k] >= 0) con[free_dof[d0 + k]] = 1, g[free_dof[d0 + k]] = ue[d0 + k];
-  }
-  fcm__eliminate_marked(Kr, b, con, g);
-  TEST_OK(ctx, direct_solve(ctx, Kr, b, v));
-  TEST_OK(ctx, fcm_csr_apply(T, 1.0, v, 0.0, u));
+  const fcm_index n = fcm_space_num_dofs(s);
+  double *u = calloc((size_t)n, sizeof *u);
+  octree_patch_solve(ctx, s, K, T, free_dof, ue, u);
   *err_all = *err_side0 = 0.0;
   for (fcm_index i = 0; i < n; i++) {
     *err_all = fmax(*err_all, fabs(u[i] - ue[i]));
     if (side[i / 3] == 0) *err_side0 = fmax(*err_side0, fabs(u[i]));
   }
-  free(b), free(v), free(g), free(u), free(con);
-  fcm_csr_destroy(&Kr);
+  free(u);
 }
 
 /* The pieces of cell c (volumes sorted, at most 8) and their volumes by side. */
@@ -252,32 +232,19 @@ static void against_uniform(fcm_ctx *ctx, fcm_element_type type, const fcm_geome
 int main(int argc, char **argv)
 {
   fcm_ctx *ctx = NULL;
-  fcm_mesh *mesh = NULL;
-  fcm_geometry *body = NULL;
-  fcm_surface *cut = NULL;
-  fcm_cell_rules *rules = NULL, *cut_rules = NULL;
-  fcm_space *space = NULL;
   fcm_csr *K = NULL, *T = NULL;
   fcm_element_type type;
   if (argc != 2 || fcm_element_type_from_name(argv[1], &type) != FCM_OK) return 2;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
-  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, clo[3] = {-0.2, -0.2, -0.2},
-               chi[3] = {1.2, 1.2, 1.2};
-  const fcm_index n2[3] = {2, 2, 2};
-  TEST_OK(ctx, fcm_geometry_create_box(ctx, lo, hi, n2, &body));
-  TEST_OK(ctx, fcm_surface_create_plane(ctx, cut_p, cut_n, clo, chi, &cut));
   /* levels 0-2 in a slab the cut crosses: level transitions on both sides of the cut */
-  fcm_octree_options o = fcm_octree_options_default();
-  o.region_level = 2;
-  memcpy(o.region_hi, (double[3]){1.0, 0.3, 0.6}, sizeof o.region_hi);
-  TEST_OK(ctx, fcm_mesh_create_octree(ctx, type, lo, hi, n2, &o, &mesh));
-  TEST_TRUE(fcm_mesh_max_level(mesh) == 2 && fcm_mesh_num_hanging(mesh) > 0);
+  octree_cut_case t;
+  octree_cut_case_create(ctx, type, 2, cut_p, cut_n, fcm_space_options_default().constrain_ratio,
+                         &t);
+  const fcm_mesh *mesh = t.mesh;
+  const fcm_space *space = t.space;
+  const fcm_cell_rules *cut_rules = t.cut_rules;
   fcm_cell_rules_options ro = fcm_cell_rules_options_default();
   ro.stabilization.mode = FCM_STABILIZATION_OFF;
-  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, body, &ro, &rules));
-  TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, body, rules, cut, &cut_rules));
-  TEST_OK(ctx, fcm_space_create_embedded(ctx, mesh, cut_rules, &space));
-  TEST_TRUE(fcm_space_num_bodies(space) == 2);
 
   const fcm_index nd = fcm_space_num_dofs(space);
   fcm_index *free_dof = malloc(sizeof *free_dof * (size_t)nd);
@@ -285,7 +252,7 @@ int main(int argc, char **argv)
   double *ue = calloc((size_t)nd, sizeof *ue);
   TEST_OK(ctx, fcm_space_hanging_matrix_create(space, free_dof, &T));
   /* hanging copies on both sides of the cut */
-  fcm_index hang[2] = {0, 0}, ncol = 0;
+  fcm_index hang[2] = {0, 0};
   copy_sides(space, cut_rules, side, ue);
   for (fcm_index r = 0; r < nd / 3; r++) {
     TEST_TRUE(side[r] >= 0);
@@ -293,14 +260,7 @@ int main(int argc, char **argv)
   }
   TEST_TRUE(hang[0] > 0 && hang[1] > 0);
   /* T reproduces each side's affine field from the free copies */
-  fcm_csr_get_size(T, NULL, &ncol, NULL);
-  double *uf = calloc((size_t)ncol, sizeof *uf), *ut = calloc((size_t)nd, sizeof *ut);
-  for (fcm_index i = 0; i < nd; i++)
-    if (free_dof[i] >= 0) uf[free_dof[i]] = ue[i];
-  TEST_OK(ctx, fcm_csr_apply(T, 1.0, uf, 0.0, ut));
-  double err = 0.0;
-  for (fcm_index i = 0; i < nd; i++)
-    err = fmax(err, fabs(ut[i] - ue[i]));
+  const double err = octree_t_error(ctx, T, free_dof, ue, nd, NULL);
   TEST_NEAR(err, 0.0, 0.0, 1e-13);
 
   /* patch test across the hanging nodes, then one side pulled and the other at rest */
@@ -308,11 +268,11 @@ int main(int argc, char **argv)
   TEST_OK(ctx, fcm_space_matrix_create(space, &K));
   TEST_OK(ctx, fcm_assemble_stiffness(space, &mat, NULL, K));
   double err_all = 0.0, err0 = 0.0;
-  patch_solve(ctx, space, K, T, free_dof, side, ue, &err_all, &err0);
+  patch_errors(ctx, space, K, T, free_dof, side, ue, &err_all, &err0);
   TEST_NEAR(err_all, 0.0, 0.0, 1e-7);
   rest = 1;
   copy_sides(space, cut_rules, side, ue);
-  patch_solve(ctx, space, K, T, free_dof, side, ue, &err_all, &err0);
+  patch_errors(ctx, space, K, T, free_dof, side, ue, &err_all, &err0);
   TEST_NEAR(err_all, 0.0, 0.0, 1e-7);
   TEST_NEAR(err0, 0.0, 0.0, 1e-12);
   if (getenv("FCM_TEST_VERBOSE"))
@@ -321,17 +281,12 @@ int main(int argc, char **argv)
            argv[1], (long long)fcm_mesh_num_cells(mesh), (long long)fcm_mesh_num_hanging(mesh),
            (long long)nd, (long long)hang[0], (long long)hang[1], err_all, err0);
 
-  against_uniform(ctx, type, body, cut, &ro);
+  against_uniform(ctx, type, t.body, t.cut, &ro);
 
-  free(free_dof), free(side), free(ue), free(uf), free(ut);
+  free(free_dof), free(side), free(ue);
   fcm_csr_destroy(&K);
   fcm_csr_destroy(&T);
-  fcm_space_destroy(&space);
-  fcm_cell_rules_destroy(&cut_rules);
-  fcm_cell_rules_destroy(&rules);
-  fcm_surface_destroy(&cut);
-  fcm_geometry_destroy(&body);
-  fcm_mesh_destroy(&mesh);
+  octree_cut_case_destroy(&t);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();

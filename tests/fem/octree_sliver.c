@@ -14,8 +14,7 @@
  *   a rotation, a translation), side 0 (which holds the slivers: exact for translations) in a
  *   translation, prescribed on the box-boundary copies, reproduced at every copy (1e-9);
  * - a short dynamic run under gravity steps, and its displacement stays in the range of T. */
-#include "fem/fem_impl.h"
-#include "fem_util.h"
+#include "octree_cut_util.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -87,53 +86,17 @@ static void copy_values(const fcm_space *s, const fcm_cell_rules *R, int *side, 
   }
 }
 
-/* The largest |T u_free - ue| over the copies (only[r] != 0 hanging copies: `only`). */
-static double t_error(fcm_ctx *ctx, const fcm_csr *T, const fcm_index *free_dof, const double *ue,
-                      fcm_index nd, const unsigned char *only)
-{
-  fcm_index ncol = 0;
-  fcm_csr_get_size(T, NULL, &ncol, NULL);
-  double *uf = calloc((size_t)ncol, sizeof *uf), *ut = calloc((size_t)nd, sizeof *ut);
-  for (fcm_index i = 0; i < nd; i++)
-    if (free_dof[i] >= 0) uf[free_dof[i]] = ue[i];
-  TEST_OK(ctx, fcm_csr_apply(T, 1.0, uf, 0.0, ut));
-  double err = 0.0;
-  for (fcm_index i = 0; i < nd; i++)
-    if (!only || (only[i / 3] && free_dof[i] < 0)) err = fmax(err, fabs(ut[i] - ue[i]));
-  free(uf), free(ut);
-  return err;
-}
-
-/* The static solve of T^T K T v = 0 with ue prescribed on the free copies of box-boundary
- * nodes; the largest error of u = T v against ue. */
-static double patch_solve(fcm_ctx *ctx, const fcm_space *s, const fcm_csr *K, const fcm_csr *T,
+/* The patch solve's largest error against ue. */
+static double patch_error(fcm_ctx *ctx, const fcm_space *s, const fcm_csr *K, const fcm_csr *T,
                           const fcm_index *free_dof, const double *ue)
 {
-  const fcm_mesh *m = fcm_space_mesh(s);
-  const double *X = fcm_mesh_coords(m);
-  fcm_index n = 0, nr = 0;
-  fcm_csr_get_size(T, &n, &nr, NULL);
-  fcm_csr *Kr = NULL;
-  TEST_OK(ctx, fcm_csr_create_ptap(ctx, K, T, &Kr));
-  double *b = calloc((size_t)nr, sizeof *b), *v = calloc((size_t)nr, sizeof *v);
-  double *g = calloc((size_t)nr, sizeof *g), *u = calloc((size_t)n, sizeof *u);
-  unsigned char *con = calloc((size_t)nr, 1);
-  for (fcm_index a = 0; a < fcm_mesh_num_nodes(m); a++) {
-    int boundary = 0;
-    for (int d = 0; d < 3; d++)
-      boundary |= X[3 * a + d] == 0.0 || X[3 * a + d] == 1.0;
-    const fcm_index d0 = fcm_space_node_dof(s, a);
-    for (fcm_index k = 0; boundary && d0 >= 0 && k < 3 * fcm_space_node_copies(s, a); k++)
-      if (free_dof[d0 + k] >= 0) con[free_dof[d0 + k]] = 1, g[free_dof[d0 + k]] = ue[d0 + k];
-  }
-  fcm__eliminate_marked(Kr, b, con, g);
-  TEST_OK(ctx, direct_solve(ctx, Kr, b, v));
-  TEST_OK(ctx, fcm_csr_apply(T, 1.0, v, 0.0, u));
+  const fcm_index n = fcm_space_num_dofs(s);
+  double *u = calloc((size_t)n, sizeof *u);
+  octree_patch_solve(ctx, s, K, T, free_dof, ue, u);
   double err = 0.0;
   for (fcm_index i = 0; i < n; i++)
     err = fmax(err, fabs(u[i] - ue[i]));
-  free(b), free(v), free(g), free(u), free(con);
-  fcm_csr_destroy(&Kr);
+  free(u);
   return err;
 }
 
@@ -186,7 +149,7 @@ static void dynamic_run(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *T,
     umax = fmax(umax, fabs(u[i]));
   }
   TEST_TRUE(umax > 1e-3 && umax < 0.1);
-  const double err = t_error(ctx, T, free_dof, u, nd, NULL);
+  const double err = octree_t_error(ctx, T, free_dof, u, nd, NULL);
   TEST_NEAR(err, 0.0, 0.0, 1e-13 * umax);
   fcm_integrator_destroy(&integ);
 }
@@ -194,34 +157,17 @@ static void dynamic_run(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *T,
 int main(int argc, char **argv)
 {
   fcm_ctx *ctx = NULL;
-  fcm_mesh *mesh = NULL;
-  fcm_geometry *body = NULL;
-  fcm_surface *cut = NULL;
-  fcm_cell_rules *rules = NULL, *cut_rules = NULL;
-  fcm_space *space = NULL;
   fcm_csr *K = NULL, *T = NULL;
   fcm_element_type type;
   if (argc != 2 || fcm_element_type_from_name(argv[1], &type) != FCM_OK) return 2;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
-  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, clo[3] = {-0.2, -0.2, -0.2},
-               chi[3] = {1.2, 1.2, 1.2}, cp[3] = {cut_x, 0.5, 0.5}, cn[3] = {1.0, 0.0, 0.0};
-  const fcm_index n2[3] = {2, 2, 2};
-  TEST_OK(ctx, fcm_geometry_create_box(ctx, lo, hi, n2, &body));
-  TEST_OK(ctx, fcm_surface_create_plane(ctx, cp, cn, clo, chi, &cut));
   /* levels 0-3 in a slab the cut crosses: hanging nodes on the planes x = 1/2 .. 3/4 */
-  fcm_octree_options o = fcm_octree_options_default();
-  o.region_level = 3;
-  memcpy(o.region_hi, (double[3]){1.0, 0.3, 0.6}, sizeof o.region_hi);
-  TEST_OK(ctx, fcm_mesh_create_octree(ctx, type, lo, hi, n2, &o, &mesh));
-  TEST_TRUE(fcm_mesh_num_hanging(mesh) > 0);
-  fcm_cell_rules_options ro = fcm_cell_rules_options_default();
-  ro.stabilization.mode = FCM_STABILIZATION_OFF;
-  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, body, &ro, &rules));
-  TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, body, rules, cut, &cut_rules));
-  fcm_space_options so = fcm_space_options_default();
-  so.constrain_ratio = 1e-3;
-  TEST_OK(ctx, fcm_space_create_embedded_with(ctx, mesh, cut_rules, &so, &space));
-  TEST_TRUE(fcm_space_num_bodies(space) == 2);
+  const double cp[3] = {cut_x, 0.5, 0.5}, cn[3] = {1.0, 0.0, 0.0};
+  octree_cut_case t;
+  octree_cut_case_create(ctx, type, 3, cp, cn, 1e-3, &t);
+  const fcm_mesh *mesh = t.mesh;
+  const fcm_space *space = t.space;
+  const fcm_cell_rules *cut_rules = t.cut_rules;
   fcm_index at_hanging = 0, in_coarse = 0;
   TEST_TRUE(fcm_space_num_constrained_copies(space) > 0);
   count_slivers(space, &at_hanging, &in_coarse);
@@ -240,11 +186,11 @@ int main(int argc, char **argv)
     if (free_dof[3 * r] < 0) hang[side[r]]++;
   }
   TEST_TRUE(hang[0] > 0 && hang[1] > 0);
-  const double err_tr = t_error(ctx, T, free_dof, ue, nd, NULL);
+  const double err_tr = octree_t_error(ctx, T, free_dof, ue, nd, NULL);
   TEST_NEAR(err_tr, 0.0, 0.0, 1e-12);
   affine0 = 1;
   copy_values(space, cut_rules, side, ue, away);
-  const double err_aff = t_error(ctx, T, free_dof, ue, nd, away);
+  const double err_aff = octree_t_error(ctx, T, free_dof, ue, nd, away);
   TEST_NEAR(err_aff, 0.0, 0.0, 1e-12);
 
   fcm_material mat = {FCM_MATERIAL_LINEAR, 1.0, 0.3, 1.0};
@@ -252,7 +198,7 @@ int main(int argc, char **argv)
   TEST_OK(ctx, fcm_assemble_stiffness(space, &mat, NULL, K));
   affine0 = 0;
   copy_values(space, cut_rules, side, ue, away);
-  const double err_patch = patch_solve(ctx, space, K, T, free_dof, ue);
+  const double err_patch = patch_error(ctx, space, K, T, free_dof, ue);
   TEST_NEAR(err_patch, 0.0, 0.0, 1e-9);
   printf("%s: %lld cells, %lld hanging pairs, %lld DOFs, %lld constrained copies (slots: %lld at "
          "hanging nodes, %lld in coarse cells), hanging copies %lld | %lld; T error: "
@@ -266,12 +212,7 @@ int main(int argc, char **argv)
   free(free_dof), free(side), free(ue), free(away);
   fcm_csr_destroy(&K);
   fcm_csr_destroy(&T);
-  fcm_space_destroy(&space);
-  fcm_cell_rules_destroy(&cut_rules);
-  fcm_cell_rules_destroy(&rules);
-  fcm_surface_destroy(&cut);
-  fcm_geometry_destroy(&body);
-  fcm_mesh_destroy(&mesh);
+  octree_cut_case_destroy(&t);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();

@@ -167,6 +167,34 @@ static inline void contact_fd(fcm_ctx *ctx, fcm_integrator *I, fcm_index n, doub
   free(fp), free(fm), free(Td);
 }
 
+/* At u (force f0, Newton matrix T there): along three random directions (rnd() in each
+ * entry) the force against central differences of the energy (relative 1e-6) and d^T T d >= 0,
+ * then T symmetric (1e-12); `what` and `pairs` label the printed lines. */
+static inline void contact_fd_directions(fcm_ctx *ctx, fcm_integrator *I, fcm_index n, double *u,
+                                         const double *f0, const fcm_csr *T, double e, int trial,
+                                         const char *what, long long pairs, double (*rnd)(void))
+{
+  double *d = calloc((size_t)n, sizeof *d), *Td = calloc((size_t)n, sizeof *Td);
+  for (int dir = 0; dir < 3; dir++) {
+    double ee = 0.0, et = 0.0, dTd = 0.0, dn = 0.0;
+    for (fcm_index i = 0; i < n; i++)
+      d[i] = rnd();
+    contact_fd(ctx, I, n, u, d, 0.0, 1e-7, f0, NULL, &ee, &et);
+    TEST_OK(ctx, fcm_csr_apply(T, 1.0, d, 0.0, Td));
+    for (fcm_index i = 0; i < n; i++)
+      dTd += d[i] * Td[i], dn += d[i] * d[i];
+    printf("fd trial %d dir %d: energy %.6g J, %lld %s, relative error of the force %.3g, "
+           "d^T T d / |d|^2 = %.4g\n",
+           trial, dir, e, pairs, what, ee, dTd / dn);
+    if (!(ee <= 1e-6)) TEST_FAIL_("force against differences: relative error %.3g", ee);
+    if (!(dTd >= 0.0)) TEST_FAIL_("Newton matrix not positive semidefinite: %.3g", dTd);
+  }
+  double asym = 1.0;
+  TEST_OK(ctx, fcm_csr_asymmetry(T, &asym));
+  TEST_TRUE(asym <= 1e-12);
+  free(d), free(Td);
+}
+
 /* The time of one fcm_integrator_contact_eval() (energy, force, Newton matrix T) at u and t
  * per embedded-surface point of the rules, printed (not asserted: lib/docs/contact.md). */
 static inline void contact_eval_cost(fcm_ctx *ctx, fcm_integrator *I, const problem *p,
