@@ -20,9 +20,9 @@ typedef struct corot_store {
   double *K;           /* num_elems x cb, or NULL */
   unsigned char *have; /* num_elems: K of element e is built */
   size_t cb;
-  double lambda, mu;    /* the Lame parameters K was built with */
-  double dT[3 * 20];    /* reference gradients at the element's centroid (cell_rule rows) */
-  fcm_index last_built; /* elements built by the last fcm__assembly_corot_prepare() */
+  double lambda, mu; /* the Lame parameters K was built with */
+  double dT[3 * 20]; /* reference gradients at the element's centroid (cell_rule rows) */
+  fcm_index built;   /* element matrices built since the workspace's creation */
 } corot_store;
 
 /* Everything an assembly writes besides its outputs. The standard rule of each

@@ -72,7 +72,7 @@ static fcm_status store_build(fcm_assembly_workspace *ws, const tabulation *t)
       built++;
     }
   }
-  c->last_built = built;
+  c->built += built;
   FCM_CHECK(bad < 0, ws->ctx, FCM_ERR_GEOMETRY,
             "assembly: cell %lld has det J = %g <= 0 at a quadrature point (inverted or "
             "degenerate %s)",
@@ -131,5 +131,5 @@ cleanup:
 
 fcm_index fcm__assembly_corot_built(const fcm_assembly_workspace *ws)
 {
-  return ws->corot.last_built;
+  return ws->corot.built;
 }

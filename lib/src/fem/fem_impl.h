@@ -382,8 +382,9 @@ fcm_status fcm__assembly_linear_blocks(fcm_assembly_workspace *ws, const fcm_lin
 fcm_status fcm__assembly_corot_inherit(fcm_assembly_workspace *ws,
                                        const fcm_assembly_workspace *old, const fcm_index *same);
 
-/* Elements whose corotated linear stiffness the last hyperelastic assembly through ws built
- * (the others were kept). (corot_store.c) */
+/* Element stiffness matrices of the corotated linear model that the hyperelastic assemblies
+ * through ws have integrated since its creation (kept ones taken over a cut not counted).
+ * (corot_store.c) */
 FCM_COMPONENT_API fcm_index fcm__assembly_corot_built(const fcm_assembly_workspace *ws);
 
 /* The authentic quadrature points (fictitious stabilization points of cut cells left out) with
