@@ -401,9 +401,36 @@ static cell_result volume_cell(const fcm_space *s, const pass *ps, fcm_index e, 
       memcpy(w->ue + 3 * a, kd->u + ed[a], 3 * sizeof(double));
   }
   if (kd->kind == KERNEL_COROT_LINEAR)
-    return fcm__corot_kernel(kd, kd->corot_K + (size_t)e * kd->corot_cb, kd->corot_dT, nn, w);
+    return fcm__corot_kernel(kd, kd->corot_K + (size_t)e * kd->corot_cb,
+                             kd->corot_G + (size_t)e * 3 * nn, nn, w);
   cell_rule r = get_cell_rule(s, ps->tab, ps->kind, e, w);
   return fcm__cell_kernel(kd, &r, nn, w);
+}
+
+void fcm__assembly_mean_gradients(const fcm_space *s, const tabulation *t, fcm_index e, scratch *w,
+                                  double *gbar)
+{
+  const int nn = s->nn;
+  const size_t rows = 3 * (size_t)fcm__kernel_na(nn);
+  fcm_mesh_cell_coords(s->mesh, s->elem_cell[e], w->X);
+  cell_rule r = get_cell_rule(s, t, FCM_RULE_STIFFNESS, e, w);
+  memset(gbar, 0, sizeof *gbar * 3 * (size_t)nn);
+  for (int all = 0; all < 2; all++) { /* authentic points; without any, all points */
+    double vol = 0.0;
+    for (int q = 0; q < r.nq; q++) {
+      if (!all && r.fict && r.fict[q]) continue;
+      const double det = fcm__kernel_point_gradients(nn, w->X, r.dT + q * rows, w->g);
+      if (!(det > 0.0)) continue;
+      vol += r.w[q] * det;
+      for (int k = 0; k < 3 * nn; k++)
+        gbar[k] += r.w[q] * det * w->g[k];
+    }
+    if (vol > 0.0) {
+      for (int k = 0; k < 3 * nn; k++)
+        gbar[k] /= vol;
+      return;
+    }
+  }
 }
 
 cell_result fcm__assembly_element_kernel(const fcm_space *s, const tabulation *t,

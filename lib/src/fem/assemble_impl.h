@@ -14,14 +14,14 @@ typedef struct tabulation {
 } tabulation;
 
 /* The element-corotated linear model's linear element stiffness matrices (upper node blocks,
- * cb doubles per element), built on first use for the elements whose have[e] is 0 and kept
- * across assemblies (and across a cut, for the elements it leaves: corot_store.c). */
+ * cb doubles per element) and mean gradients, built on first use for the elements whose have[e] is
+ * 0 and kept across assemblies (and across a cut, for the elements it leaves: corot_store.c). */
 typedef struct corot_store {
   double *K;           /* num_elems x cb, or NULL */
   unsigned char *have; /* num_elems: K of element e is built */
   size_t cb;
   double lambda, mu; /* the Lame parameters K was built with */
-  double dT[3 * 20]; /* reference gradients at the element's centroid (cell_rule rows) */
+  double *G;         /* num_elems x 3 nn: the elements' mean shape function gradients */
   fcm_index built;   /* element matrices built since the workspace's creation */
 } corot_store;
 
@@ -50,6 +50,12 @@ fcm_status fcm__assembly_tabulation(fcm_assembly_workspace *ws, fcm_rule_kind ki
  * the kernel's integrand) into w->Ke / w->fe. */
 cell_result fcm__assembly_element_kernel(const fcm_space *s, const tabulation *t,
                                          const kernel_data *kd, fcm_index e, scratch *w);
+
+/* The mean physical gradients gbar (nn x 3, node-major) of element e's shape functions over
+ * the authentic points of its stiffness rule (all its points when it has none): F averaged
+ * over the element's material is I + sum_a u_a gbar_a^T. */
+void fcm__assembly_mean_gradients(const fcm_space *s, const tabulation *t, fcm_index e, scratch *w,
+                                  double *gbar);
 
 /* Build the element-corotated model's missing element stiffness matrices for the Lame
  * parameters of mat (all of them when those differ from the kept ones) and point kd's

@@ -1,20 +1,26 @@
 /* The element-corotated linear kernel (FCM_MATERIAL_COROTATED_LINEAR; Dick et al. 2011 §5,
  * stiffness warping): one element's energy, force and tangent from its linear stiffness K
  * (kept by the assembly workspace) and one rotation R, the polar rotation of the deformation
- * gradient F at the element's centroid.
+ * gradient F averaged over the element's material (its authentic quadrature points; on an
+ * affine element that is F at the centroid). In a cut cell the fictitious part's nodes move
+ * almost freely: F at the centroid, which may lie there, would turn the material by the
+ * fictitious part's motion, which also slows Newton's convergence (below).
  *
  * With x_a = X_a + u_a, c and c' the means of the nodes X_a and x_a (Dick's centres of mass)
  * and y_a = R^T (x_a - c'), the element's displacement in its rotated frame is
  * d_a = y_a - (X_a - c) and its energy E = 1/2 d^T K d (K ignores translations: the centring
- * changes E only by rounding, and keeps a rigid motion's d at rounding level). The force is E's
- * exact gradient: with F = R S (S symmetric), dR = R [w]x and [w]x S + S [w]x = [(tr S I - S) w]x =
- * skew part of 2 R^T dF, so that dE/dx_b = R ((K d)_b - z x g_b),  z = (tr S I - S)^{-1} m,  m =
- * sum_a y_a x (K d)_a, g_b the physical gradient of node b's shape function at the centroid (F =
- * sum_a x_a g_a^T). m is the moment of the element's elastic forces in its rotated frame; it is of
- * second order in d (K's rigid rotations carry no force), so the z term is the small correction
- * that makes the force a gradient (Dick's warped force R K d drops it). The tangent is the warped
- * [R] K [R]^T (the terms of dR/dx dropped, as Dick does): symmetric positive semi-definite,
- * so Newton's direction is a descent direction of E and its line search applies unchanged. */
+ * changes E only by rounding, and keeps a rigid motion's d at rounding level). The force is
+ * E's exact gradient: with F = R S (S symmetric), dR = R [w]x and
+ * [w]x S + S [w]x = [(tr S I - S) w]x = the skew part of 2 R^T dF, so that
+ *   dE/dx_b = R ((K d)_b - z x g_b),  z = (tr S I - S)^{-1} m,  m = sum_a y_a x (K d)_a,
+ * g_b the mean physical gradient of node b's shape function (F = sum_a x_a g_a^T). m is the
+ * moment of the element's elastic forces in its rotated frame, of second order in d (K's rigid
+ * rotations carry no force): the z term is the small correction that makes the force a
+ * gradient (Dick's warped force R K d drops it). The tangent is the warped [R] K [R]^T (the
+ * terms of dR/dx, of the order of the element's stress, dropped as Dick does): symmetric
+ * positive semi-definite, so Newton's direction is a descent direction of E and its line
+ * search applies unchanged; Newton converges linearly then, at a rate of the order of the
+ * strains. */
 #include "fem/kernels_impl.h"
 #include "la/mat3.h"
 
@@ -101,22 +107,17 @@ static void warp_blocks(int nn, const double *Kp, const double R[9], double *Kt)
   }
 }
 
-cell_result fcm__corot_kernel(const kernel_data *kd, const double *Kp, const double *dTc, int nn,
+cell_result fcm__corot_kernel(const kernel_data *kd, const double *Kp, const double *gbar, int nn,
                               scratch *w)
 {
   cell_result res = {0.0, 1.0, 0, 0};
-  const double det = fcm__kernel_point_gradients(nn, w->X, dTc, w->g);
-  if (!(det > 0.0)) {
-    res.bad_det = det;
-    return res;
-  }
   double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, c[3] = {0, 0, 0}, cu[3] = {0, 0, 0};
   for (int a = 0; a < nn; a++)
     for (int i = 0; i < 3; i++) {
       c[i] += w->X[3 * a + i] / nn;
       cu[i] += w->ue[3 * a + i] / nn;
       for (int j = 0; j < 3; j++)
-        F[3 * i + j] += w->ue[3 * a + i] * w->g[3 * a + j];
+        F[3 * i + j] += w->ue[3 * a + i] * gbar[3 * a + j];
     }
   polar pr;
   const double *R = pr.R;
@@ -151,7 +152,7 @@ cell_result fcm__corot_kernel(const kernel_data *kd, const double *Kp, const dou
     solve_spin(&pr, m, z);
     for (int a = 0; a < nn; a++) {
       double t[3], v[3];
-      cross(z, w->g + 3 * a, t);
+      cross(z, gbar + 3 * a, t);
       for (int i = 0; i < 3; i++)
         v[i] = Kd[3 * a + i] - t[i];
       fcm__mat3_mulv(R, v, w->fe + 3 * a);

@@ -1,6 +1,7 @@
 /* The element-corotated linear model's store of element matrices: each element's linear
  * stiffness K_e = int B^T D B on its own rule (a cut cell's piece rule with its fictitious
- * points, as the linear stiffness assembly integrates it), built once and kept in the
+ * points, as the linear stiffness assembly integrates it) and its shape functions' mean
+ * gradients over its material (corot.c), built once and kept in the
  * assembly workspace; a cut's workspace takes the matrices of the elements the cut leaves as
  * they were from the workspace before the cut and builds only the others. */
 #include "fem/assemble_impl.h"
@@ -12,32 +13,22 @@ void fcm__assembly_corot_free(fcm_assembly_workspace *ws)
 {
   fcm__free(ws->ctx, ws->corot.K);
   fcm__free(ws->ctx, ws->corot.have);
+  fcm__free(ws->ctx, ws->corot.G);
+  ws->corot.G = NULL;
   ws->corot.K = NULL;
   ws->corot.have = NULL;
 }
 
-/* Allocate the store (nothing built) and tabulate the reference gradients at the centroid,
- * the mean of the element's corners. */
+/* Allocate the store (nothing built). */
 static fcm_status store_alloc(fcm_assembly_workspace *ws)
 {
   fcm_status st = FCM_OK;
   const fcm_space *s = ws->space;
   corot_store *c = &ws->corot;
-  const fcm_element_info *info = fcm_element_get_info(s->type);
-  const double *ref = fcm_element_ref_nodes(s->type);
-  FCM_CHECK(info && ref && 3 * fcm__kernel_na(s->nn) <= (int)(sizeof c->dT / sizeof c->dT[0]),
-            ws->ctx, FCM_ERR_UNSUPPORTED,
-            "corotated_linear: element type %d has no reference nodes or too many nodes",
-            (int)s->type);
   c->cb = 9 * (size_t)s->nn * (size_t)(s->nn + 1) / 2;
   FCM_ALLOC_RAW(ws->ctx, (size_t)s->num_elems * c->cb + 1, c->K);
+  FCM_ALLOC_RAW(ws->ctx, (size_t)s->num_elems * 3 * s->nn + 1, c->G);
   FCM_ALLOC(ws->ctx, (size_t)s->num_elems + 1, c->have);
-  double xi[3] = {0, 0, 0}, dN[3 * FCM_ELEMENT_MAX_NODES];
-  for (int a = 0; a < info->num_corners; a++)
-    for (int k = 0; k < 3; k++)
-      xi[k] += ref[3 * a + k] / info->num_corners;
-  fcm_element_eval_grad(s->type, xi, dN);
-  fcm__kernel_rows(s->nn, dN, c->dT);
 cleanup:
   return st;
 }
@@ -68,6 +59,7 @@ static fcm_status store_build(fcm_assembly_workspace *ws, const tabulation *t)
         continue;
       }
       memcpy(c->K + (size_t)e * c->cb, w->Ke, sizeof(double) * c->cb);
+      fcm__assembly_mean_gradients(s, t, e, w, c->G + (size_t)e * 3 * s->nn);
       c->have[e] = 1;
       built++;
     }
@@ -102,7 +94,7 @@ fcm_status fcm__assembly_corot_prepare(fcm_assembly_workspace *ws, const fcm_mat
   FCM_TRY(ctx, store_build(ws, t));
   kd->corot_K = c->K;
   kd->corot_cb = c->cb;
-  kd->corot_dT = c->dT;
+  kd->corot_G = c->G;
 cleanup:
   return st;
 }
@@ -119,11 +111,13 @@ fcm_status fcm__assembly_corot_inherit(fcm_assembly_workspace *ws,
   if (!c->K) FCM_TRY(ctx, store_alloc(ws));
   c->lambda = o->lambda;
   c->mu = o->mu;
+  const size_t g = 3 * (size_t)ws->space->nn;
   for (fcm_index e = 0; e < ws->space->num_elems; e++) {
     const fcm_index f = same[e];
     c->have[e] = f >= 0 && o->have[f];
-    if (c->have[e])
-      memcpy(c->K + (size_t)e * c->cb, o->K + (size_t)f * o->cb, sizeof(double) * c->cb);
+    if (!c->have[e]) continue;
+    memcpy(c->K + (size_t)e * c->cb, o->K + (size_t)f * o->cb, sizeof(double) * c->cb);
+    memcpy(c->G + (size_t)e * g, o->G + (size_t)f * g, sizeof(double) * g);
   }
 cleanup:
   return st;

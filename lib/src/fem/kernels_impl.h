@@ -62,11 +62,10 @@ typedef struct kernel_data {
   fcm_fictitious_model fictitious; /* model at fictitious points (hyperelastic) */
   fcm_material_params mat_psd;     /* *mat with project_psd = 1 */
   /* KERNEL_COROT_LINEAR: the elements' linear stiffness matrices (upper node blocks, cb
-   * doubles each, by element id) and the reference gradients at the element's centroid as
-   * the rows of a cell_rule's dT */
+   * doubles each, by element id) and mean shape function gradients (3 nn each) */
   const double *corot_K;
   size_t corot_cb;
-  const double *corot_dT;
+  const double *corot_G;
 } kernel_data;
 
 /* Per-thread scratch of a kernel; ld = fcm__kernel_ld(nn) (the padded row length of the
@@ -120,8 +119,8 @@ cell_result fcm__cell_kernel(const kernel_data *kd, const cell_rule *r, int nn, 
 /* The element-corotated linear kernel (corot.c): energy, force w->fe (when kd->want_force) and
  * tangent w->Ke (upper node blocks, when kd->want_tangent) of the element with the nodal
  * coordinates w->X and displacement w->ue, its linear stiffness Kp (upper node blocks) and
- * the reference gradients dTc at its centroid (rows of a cell_rule's dT). */
-cell_result fcm__corot_kernel(const kernel_data *kd, const double *Kp, const double *dTc, int nn,
+ * the mean physical gradients gbar (nn x 3) of its shape functions over its material. */
+cell_result fcm__corot_kernel(const kernel_data *kd, const double *Kp, const double *gbar, int nn,
                               scratch *w);
 
 /* The full element matrix Ke (3nn x 3nn, row-major) from its upper node blocks Kp. */
