@@ -1,5 +1,6 @@
 /* The element-corotated linear model (FCM_MATERIAL_COROTATED_LINEAR), run for every element
- * type on a distorted mesh:
+ * type on a distorted mesh and on an embedded ball (cut cells: fictitious points, F averaged
+ * over the material):
  *  - at u = 0 the tangent is the linear stiffness K (to 1e-12) and force and energy vanish; at
  *    a small displacement the force is K u up to the second order;
  *  - a rigid motion (rotation by 1.2 rad and a translation) has zero energy and force (to 1e-12
@@ -58,17 +59,11 @@ static void rotate(const fcm_space *s, const fcm_mesh *m, const double Q[9], con
   }
 }
 
-int main(int argc, char **argv)
+/* Every check on one space (mesh: its background mesh). */
+static void check_space(fcm_space *space, const fcm_mesh *mesh)
 {
-  fcm_mesh *mesh = NULL;
-  fcm_space *space = NULL;
   fcm_csr *K = NULL, *T = NULL;
   fcm_assembly_workspace *ws = NULL;
-  fcm_element_type type;
-  if (argc != 2 || fcm_element_type_from_name(argv[1], &type) != FCM_OK) return 2;
-  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
-  TEST_OK(ctx, distorted_box(ctx, type, 2, 0.2, &mesh));
-  TEST_OK(ctx, fcm_space_create(ctx, mesh, NULL, &space));
   TEST_OK(ctx, fcm_assembly_workspace_create(space, NULL, &ws));
   const fcm_index n = fcm_space_num_dofs(space);
   double *u = calloc((size_t)n, sizeof *u), *du = calloc((size_t)n, sizeof *du);
@@ -189,8 +184,34 @@ int main(int argc, char **argv)
   fcm_assembly_workspace_destroy(&ws);
   fcm_csr_destroy(&K);
   fcm_csr_destroy(&T);
+}
+
+int main(int argc, char **argv)
+{
+  fcm_mesh *mesh = NULL, *grid = NULL;
+  fcm_space *space = NULL, *embedded = NULL;
+  fcm_geometry *ball = NULL;
+  fcm_cell_rules *rules = NULL;
+  fcm_element_type type;
+  if (argc != 2 || fcm_element_type_from_name(argv[1], &type) != FCM_OK) return 2;
+  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  TEST_OK(ctx, distorted_box(ctx, type, 2, 0.2, &mesh));
+  TEST_OK(ctx, fcm_space_create(ctx, mesh, NULL, &space));
+  if (space) check_space(space, mesh);
+  /* an embedded ball: cut cells with their fictitious points and the material-averaged F */
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, c[3] = {0.52, 0.49, 0.47};
+  const fcm_index nc[3] = {3, 3, 3};
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, nc, &grid));
+  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c, 0.4, 2, &ball));
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, grid, ball, NULL, &rules));
+  TEST_OK(ctx, fcm_space_create_embedded(ctx, grid, rules, &embedded));
+  if (embedded) check_space(embedded, grid);
   fcm_space_destroy(&space);
+  fcm_space_destroy(&embedded);
+  fcm_cell_rules_destroy(&rules);
+  fcm_geometry_destroy(&ball);
   fcm_mesh_destroy(&mesh);
+  fcm_mesh_destroy(&grid);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
 }
