@@ -21,13 +21,13 @@
 const cutbench_paper cutbench_papers[ROW_COUNT] = {
     {"dick-bunny3", "Dick 2011 Table 1", "Bunny 3", "5.48k -> 8.27k hexahedra", 5480, 1, 0.0286,
      0.0928, 0, 0.5, "1 core of a 2.8 GHz Xeon X5560; corotated linear; 3 V-cycles", "hex8",
-     "corotated", 1},
+     "corotated_linear", 1},
     {"dick-bunny2", "Dick 2011 Table 1", "Bunny 2", "26.1k -> 42.4k hexahedra", 26100, 1, 0.143,
      0.498, 0, 0.5, "1 core of a 2.8 GHz Xeon X5560; corotated linear; 3 V-cycles", "hex8",
-     "corotated", 0},
+     "corotated_linear", 0},
     {"dick-bunny", "Dick 2011 Table 1", "Bunny", "118k -> 197k hexahedra", 118000, 1, 0.693, 2.42,
-     0, 0.5, "1 core of a 2.8 GHz Xeon X5560; corotated linear; 3 V-cycles", "hex8", "corotated",
-     0},
+     0, 0.5, "1 core of a 2.8 GHz Xeon X5560; corotated linear; 3 V-cycles", "hex8",
+     "corotated_linear", 0},
     {"koschier-bunny", "Koschier 2017 sec. 7", "bunny: groove carved then peeled",
      "5326 -> 9432 DOFs", 5326, 0, 0.646, 1.375, 0, 0.1,
      "i7-6700HQ 4 cores; implicit Euler; StVK (cut: 47 % of a step)", "hex8", "snh", 1},
@@ -507,7 +507,7 @@ int cutbench_write_scene(cutbench_row_id row, const cutbench_model *m, const cha
              "about %.0f active cells, corotated linear, its base held under gravity; a grid of "
              "six square blades is pushed down into it in four steps (one cut per step).",
              p->model, target);
-    scene_head(&t, name, desc, m, body, sc->h, "corotated", 1e5, 0.4, solver, 0.01, sc->steps);
+    scene_head(&t, name, desc, m, body, sc->h, p->material, 1e5, 0.4, solver, 0.01, sc->steps);
     cutbench_put(&t, "    {\"gravity\": {\"acceleration\": [0, -9.81, 0]}},\n");
     cutbench_put(
         &t,

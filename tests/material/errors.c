@@ -39,7 +39,7 @@ int main(void)
   m = good, m.density = -3.0;
   TEST_ERR(ctx, fcm_material_validate(ctx, &m), FCM_ERR_ARG, "density = -3 must be non-negative");
   m = good, m.model = (fcm_material_model)7;
-  TEST_ERR(ctx, fcm_material_validate(ctx, &m), FCM_ERR_ARG, "model = 7 out of range [0, 4)");
+  TEST_ERR(ctx, fcm_material_validate(ctx, &m), FCM_ERR_ARG, "model = 7 out of range [0, 5)");
   m.model = (fcm_material_model)-1;
   TEST_ERR(ctx, fcm_material_setup(ctx, &m, &p), FCM_ERR_ARG, "model = -1");
   TEST_ERR(ctx, fcm_material_validate(ctx, NULL), FCM_ERR_ARG, "NULL");
@@ -66,7 +66,7 @@ int main(void)
 
   /* Names. */
   fcm_material_model model = FCM_MATERIAL_LINEAR;
-  const char *names[] = {"linear", "stvk", "corotated", "snh"};
+  const char *names[] = {"linear", "stvk", "corotated", "snh", "corotated_linear"};
   for (int k = 0; k < FCM_MATERIAL_COUNT; k++) {
     TEST_TRUE(strcmp(fcm_material_model_name((fcm_material_model)k), names[k]) == 0);
     TEST_OK(ctx, fcm_material_model_parse(ctx, names[k], &model));

@@ -23,12 +23,20 @@ extern "C" {
  * - STABLE_NEO_HOOKEAN (Smith et al. 2018): Psi = mu'/2 (I_C - 3) - mu'/2 log(I_C + 1)
  *   + lambda'/2 (J - alpha)^2, mu' = 4 mu/3, lambda' = lambda + 5 mu/6,
  *   alpha = 1 + 3 mu'/(4 lambda'); P = mu' (1 - 1/(I_C + 1)) F + lambda' (J - alpha) cof F.
- *   Psi(I) = lambda'/2 (1 - alpha)^2 - mu'/2 log 4 is a constant, not zero. */
+ *   Psi(I) = lambda'/2 (1 - alpha)^2 - mu'/2 log 4 is a constant, not zero.
+ * - COROTATED_LINEAR (element-corotated linear elasticity, stiffness warping; Dick et al.
+ *   2011 §5): the assembly gives each element its linear stiffness K_e (kept across steps)
+ *   and one rotation R_e, the polar rotation of F at the element's centroid: element energy
+ *   1/2 d^T K_e d, d = [R_e]^T x_e - X_e, its exact gradient as the force and the warped
+ *   [R_e] K_e [R_e]^T as the tangent (lib/docs/time_integration.md). At a single point
+ *   (fcm_material_eval(), stress output) it is the COROTATED model: the same energy with R
+ *   taken per point. */
 typedef enum fcm_material_model {
   FCM_MATERIAL_LINEAR = 0,
   FCM_MATERIAL_STVK,
   FCM_MATERIAL_COROTATED,
   FCM_MATERIAL_STABLE_NEO_HOOKEAN,
+  FCM_MATERIAL_COROTATED_LINEAR,
   FCM_MATERIAL_COUNT
 } fcm_material_model;
 
@@ -54,12 +62,12 @@ typedef struct fcm_material_params {
                           change it at any time. */
 } fcm_material_params;
 
-/** Canonical name of a model ("linear", "stvk", "corotated", "snh"), or NULL for an
- * invalid value. Static string; thread safe. */
+/** Canonical name of a model ("linear", "stvk", "corotated", "snh", "corotated_linear"), or NULL
+ * for an invalid value. Static string; thread safe. */
 FCM_API const char *fcm_material_model_name(fcm_material_model model);
 
-/** Model of a name (case-sensitive): "linear", "stvk", "corotated", "snh" or
- * "stable_neo_hookean".
+/** Model of a name (case-sensitive): "linear", "stvk", "corotated", "snh",
+ * "stable_neo_hookean" or "corotated_linear".
  * @param[in]  ctx   context for the error message (may be NULL)
  * @param[in]  name  the name
  * @param[out] model the model; unchanged on failure

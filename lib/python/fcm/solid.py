@@ -14,6 +14,7 @@ class MaterialModel(enum.IntEnum):
     STVK = 1
     COROTATED = 2
     STABLE_NEO_HOOKEAN = 3
+    COROTATED_LINEAR = 4
 
 
 class Material(namedtuple("Material", "model young poisson density")):

@@ -4,7 +4,7 @@
  * colour by colour in parallel (deterministic for any thread count). The space is
  * only read; rules, tabulations and scratch live in an fcm_assembly_workspace. */
 #include "embed/embed_impl.h"
-#include "fem/kernels_impl.h"
+#include "fem/assemble_impl.h"
 #include "la/mat3.h"
 
 #include <math.h>
@@ -38,14 +38,6 @@ fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type, fcm_ru
 cleanup:
   return st;
 }
-
-/* Shape values and reference gradients (by component, kernels_impl.h) of the element at the
- * standard rule's points. */
-typedef struct tabulation {
-  fcm_rule *rule;
-  cell_rule r;
-  double *N, *dT, *dQ;
-} tabulation;
 
 static fcm_status tabulate(const fcm_space *s, fcm_rule_kind kind, int strength, tabulation *t)
 {
@@ -251,22 +243,6 @@ cleanup:
 
 /* ------------------------------------------------------------------ workspace */
 
-/* Everything an assembly writes besides its outputs. The standard rule of each
- * integrand is tabulated on first use and kept; scratch and per-cell energies are
- * allocated at creation, so repeated assembly allocates nothing. */
-struct fcm_assembly_workspace {
-  fcm_ctx *ctx;
-  const fcm_space *space;
-  fcm_assembly_options opts;
-  tabulation tab[2];   /* standard rules: [0] stiffness, [1] mass */
-  int tabulated[2];    /* tab[i] is built */
-  int nthreads;        /* threads the scratch serves (the context's count at creation) */
-  double *mem;         /* per-thread element buffers */
-  scratch *sc;         /* nthreads views into mem */
-  double *cell_energy; /* num_elems: energy per element of the last hyperelastic assembly */
-  int *cell_inverted;  /* num_elems: its authentic points with det F <= 0 per element */
-};
-
 fcm_status fcm_assembly_workspace_create(const fcm_space *space, const fcm_assembly_options *opts,
                                          fcm_assembly_workspace **out)
 {
@@ -308,13 +284,13 @@ void fcm_assembly_workspace_destroy(fcm_assembly_workspace **wsp)
   fcm__free(ws->ctx, ws->sc);
   fcm__free(ws->ctx, ws->cell_energy);
   fcm__free(ws->ctx, ws->cell_inverted);
+  fcm__assembly_corot_free(ws);
   fcm__free(ws->ctx, ws);
   *wsp = NULL;
 }
 
-/* The tabulated standard rule of `kind` (stiffness or mass), built on first use. */
-static fcm_status workspace_tabulation(fcm_assembly_workspace *ws, fcm_rule_kind kind,
-                                       const tabulation **t)
+fcm_status fcm__assembly_tabulation(fcm_assembly_workspace *ws, fcm_rule_kind kind,
+                                    const tabulation **t)
 {
   fcm_status st = FCM_OK;
   int i = kind == FCM_RULE_MASS ? 1 : 0;
@@ -424,8 +400,48 @@ static cell_result volume_cell(const fcm_space *s, const pass *ps, fcm_index e, 
     for (int a = 0; a < nn; a++)
       memcpy(w->ue + 3 * a, kd->u + ed[a], 3 * sizeof(double));
   }
+  if (kd->kind == KERNEL_COROT_LINEAR)
+    return fcm__corot_kernel(kd, kd->corot_K + (size_t)e * kd->corot_cb,
+                             kd->corot_G + (size_t)e * 3 * nn, nn, w);
   cell_rule r = get_cell_rule(s, ps->tab, ps->kind, e, w);
   return fcm__cell_kernel(kd, &r, nn, w);
+}
+
+void fcm__assembly_mean_gradients(const fcm_space *s, const tabulation *t, fcm_index e, scratch *w,
+                                  double *gbar)
+{
+  const int nn = s->nn;
+  const size_t rows = 3 * (size_t)fcm__kernel_na(nn);
+  fcm_mesh_cell_coords(s->mesh, s->elem_cell[e], w->X);
+  cell_rule r = get_cell_rule(s, t, FCM_RULE_STIFFNESS, e, w);
+  memset(gbar, 0, sizeof *gbar * 3 * (size_t)nn);
+  for (int all = 0; all < 2; all++) { /* authentic points; without any, all points */
+    double vol = 0.0;
+    for (int q = 0; q < r.nq; q++) {
+      if (!all && r.fict && r.fict[q]) continue;
+      const double det = fcm__kernel_point_gradients(nn, w->X, r.dT + q * rows, w->g);
+      if (!(det > 0.0)) continue;
+      vol += r.w[q] * det;
+      for (int k = 0; k < 3 * nn; k++)
+        gbar[k] += r.w[q] * det * w->g[k];
+    }
+    if (vol > 0.0) {
+      for (int k = 0; k < 3 * nn; k++)
+        gbar[k] /= vol;
+      return;
+    }
+  }
+}
+
+cell_result fcm__assembly_element_kernel(const fcm_space *s, const tabulation *t,
+                                         const kernel_data *kd, fcm_index e, scratch *w)
+{
+  pass ps;
+  memset(&ps, 0, sizeof ps);
+  ps.kd = kd;
+  ps.tab = t;
+  ps.kind = kd->kind == KERNEL_MASS ? FCM_RULE_MASS : FCM_RULE_STIFFNESS;
+  return volume_cell(s, &ps, e, w);
 }
 
 /* Local element le of the pass into the pass's outputs; 0 (with res) when its det J is not
@@ -535,7 +551,7 @@ static fcm_status run_volume_pass(fcm_assembly_workspace *ws, const kernel_data 
             "(add FCM_RULES_%s to fcm_cell_rules_options.kinds)",
             kd->kind == KERNEL_MASS ? "mass matrix" : "stiffness / force integral",
             fcm_rule_kind_name(ps.kind), ps.kind == FCM_RULE_MASS ? "MASS" : "STIFFNESS");
-  FCM_TRY(ws->ctx, workspace_tabulation(ws, ps.kind, &ps.tab));
+  FCM_TRY(ws->ctx, fcm__assembly_tabulation(ws, ps.kind, &ps.tab));
   ps.kd = kd;
   ps.vals = vals;
   ps.vec = vec;
@@ -714,6 +730,10 @@ fcm_status fcm_assembly_workspace_hyperelastic(fcm_assembly_workspace *ws,
   kd.fictitious = ws->opts.fictitious;
   kd.mat_psd = *mat;
   kd.mat_psd.project_psd = 1;
+  if (mat->model == FCM_MATERIAL_COROTATED_LINEAR) {
+    kd.kind = KERNEL_COROT_LINEAR;
+    FCM_TRY(ctx, fcm__assembly_corot_prepare(ws, mat, &kd));
+  }
   FCM_TRY(ctx, run_volume_pass(ws, &kd, tangent ? fcm_csr_values(tangent) : NULL, force,
                                ws->cell_energy, NULL));
   if (energy) { /* summed in element order: independent of the thread count */
@@ -773,68 +793,6 @@ int fcm__assembly_inverted_point(fcm_assembly_workspace *ws, fcm_index elem, con
   return 0;
 }
 
-/* ------------------------------------------------------------------ one-shot forms */
-
-/* One linear term through a workspace that lives for this call only. */
-static fcm_status linear_once(const fcm_space *s, const fcm_assembly_options *opts,
-                              fcm_linear_term term, const fcm_material *material,
-                              const double *accel, fcm_field_fn field, void *user, fcm_csr *A,
-                              double *f)
-{
-  fcm_status st = FCM_OK;
-  fcm_assembly_workspace *ws = NULL;
-  fcm_linear_form form = {term, material, accel, field, user};
-  FCM_TRY(s->ctx, fcm_assembly_workspace_create(s, opts, &ws));
-  FCM_TRY(s->ctx, fcm_assembly_workspace_linear(ws, &form, A, f));
-cleanup:
-  fcm_assembly_workspace_destroy(&ws);
-  return st;
-}
-
-fcm_status fcm_assemble_stiffness(const fcm_space *s, const fcm_material *mat,
-                                  const fcm_assembly_options *opts, fcm_csr *A)
-{
-  return linear_once(s, opts, FCM_LINEAR_STIFFNESS, mat, NULL, NULL, NULL, A, NULL);
-}
-
-fcm_status fcm_assemble_mass(const fcm_space *s, const fcm_material *mat,
-                             const fcm_assembly_options *opts, fcm_csr *A)
-{
-  return linear_once(s, opts, FCM_LINEAR_MASS, mat, NULL, NULL, NULL, A, NULL);
-}
-
-fcm_status fcm_assemble_body_force(const fcm_space *s, const fcm_material *mat,
-                                   const double accel[3], const fcm_assembly_options *opts,
-                                   double *f)
-{
-  return linear_once(s, opts, FCM_LINEAR_BODY_FORCE, mat, accel, NULL, NULL, NULL, f);
-}
-
-fcm_status fcm_assemble_body_force_field(const fcm_space *s, fcm_field_fn field, void *user,
-                                         const fcm_assembly_options *opts, double *f)
-{
-  return linear_once(s, opts, FCM_LINEAR_BODY_FORCE_FIELD, NULL, NULL, field, user, NULL, f);
-}
-
-fcm_status fcm_assemble_surface_traction(const fcm_space *s, fcm_field_fn traction, void *user,
-                                         double *f)
-{
-  return linear_once(s, NULL, FCM_LINEAR_SURFACE_TRACTION, NULL, NULL, traction, user, NULL, f);
-}
-
-fcm_status fcm_assemble_hyperelastic(const fcm_space *s, const fcm_material_params *mat,
-                                     const double *u, const fcm_assembly_options *opts,
-                                     double *energy, double *force, fcm_csr *tangent)
-{
-  fcm_status st = FCM_OK;
-  fcm_assembly_workspace *ws = NULL;
-  FCM_TRY(s->ctx, fcm_assembly_workspace_create(s, opts, &ws));
-  FCM_TRY(s->ctx, fcm_assembly_workspace_hyperelastic(ws, mat, u, energy, force, tangent));
-cleanup:
-  fcm_assembly_workspace_destroy(&ws);
-  return st;
-}
-
 /* ------------------------------------------------------------------ one element */
 
 fcm_status fcm__assembly_element_linear(fcm_assembly_workspace *ws, const fcm_linear_form *form,
@@ -886,7 +844,7 @@ fcm_status fcm__assembly_element_linear(fcm_assembly_workspace *ws, const fcm_li
   FCM_CHECK(!s->rules || fcm_cell_rules_has_kind(s->rules, ps.kind), ctx, FCM_ERR_ARG,
             "element assembly: the space's cell rules have no %s rules",
             fcm_rule_kind_name(ps.kind));
-  FCM_TRY(ctx, workspace_tabulation(ws, ps.kind, &ps.tab));
+  FCM_TRY(ctx, fcm__assembly_tabulation(ws, ps.kind, &ps.tab));
   ps.kd = &kd;
   scratch *w = ws->sc;
   cell_result res = volume_cell(s, &ps, elem, w);

@@ -373,6 +373,20 @@ fcm_status fcm__assembly_linear_blocks(fcm_assembly_workspace *ws, const fcm_lin
                                        fcm_csr *A, double *f, const fcm_index *same,
                                        const double *blocks_in, double *blocks_out);
 
+/* The element-corotated linear model (FCM_MATERIAL_COROTATED_LINEAR) keeps each element's linear
+ * stiffness matrix in the workspace; after a cut, ws (on the cut space) takes those of the
+ * elements with same[e] >= 0 (fcm__space_cut_same_elements()) from old (on the space before
+ * the cut) instead of integrating them again at its first hyperelastic assembly. Nothing to
+ * take (old has none, another element type): FCM_OK, nothing taken.
+ * @return FCM_OK, FCM_ERR_ARG (NULL), FCM_ERR_ALLOC. (corot_store.c) */
+fcm_status fcm__assembly_corot_inherit(fcm_assembly_workspace *ws,
+                                       const fcm_assembly_workspace *old, const fcm_index *same);
+
+/* Element stiffness matrices of the corotated linear model that the hyperelastic assemblies
+ * through ws have integrated since its creation (kept ones taken over a cut not counted).
+ * (corot_store.c) */
+FCM_COMPONENT_API fcm_index fcm__assembly_corot_built(const fcm_assembly_workspace *ws);
+
 /* The authentic quadrature points (fictitious stabilization points of cut cells left out) with
  * J = det F <= 0 in the last hyperelastic assembly through ws
  * (fcm_assembly_workspace_hyperelastic(), any of its outputs), summed over the local elements (a

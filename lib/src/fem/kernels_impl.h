@@ -43,10 +43,11 @@ static inline void fcm__kernel_rows(int nn, const double *dN, double *dT)
 
 /* What a kernel computes for one cell. */
 typedef enum kernel_kind {
-  KERNEL_STIFFNESS,   /* linear elastic K */
-  KERNEL_MASS,        /* consistent mass */
-  KERNEL_BODY_FORCE,  /* rho * accel, or a force density field */
-  KERNEL_HYPERELASTIC /* energy, internal force and tangent at a displacement */
+  KERNEL_STIFFNESS,    /* linear elastic K */
+  KERNEL_MASS,         /* consistent mass */
+  KERNEL_BODY_FORCE,   /* rho * accel, or a force density field */
+  KERNEL_HYPERELASTIC, /* energy, internal force and tangent at a displacement */
+  KERNEL_COROT_LINEAR  /* the same of the element-corotated linear model (corot.c) */
 } kernel_kind;
 
 typedef struct kernel_data {
@@ -60,6 +61,11 @@ typedef struct kernel_data {
   int want_force, want_tangent;
   fcm_fictitious_model fictitious; /* model at fictitious points (hyperelastic) */
   fcm_material_params mat_psd;     /* *mat with project_psd = 1 */
+  /* KERNEL_COROT_LINEAR: the elements' linear stiffness matrices (upper node blocks, cb
+   * doubles each, by element id) and mean shape function gradients (3 nn each) */
+  const double *corot_K;
+  size_t corot_cb;
+  const double *corot_G;
 } kernel_data;
 
 /* Per-thread scratch of a kernel; ld = fcm__kernel_ld(nn) (the padded row length of the
@@ -109,6 +115,13 @@ void fcm__kernel_scratch_init(int nn, size_t mq, double *mem, scratch *w);
  * (fcm__kernel_unpack() spreads them into the full matrix). fe is zero after a matrix kernel.
  * Built for several instruction sets, selected at run time. */
 cell_result fcm__cell_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w);
+
+/* The element-corotated linear kernel (corot.c): energy, force w->fe (when kd->want_force) and
+ * tangent w->Ke (upper node blocks, when kd->want_tangent) of the element with the nodal
+ * coordinates w->X and displacement w->ue, its linear stiffness Kp (upper node blocks) and
+ * the mean physical gradients gbar (nn x 3) of its shape functions over its material. */
+cell_result fcm__corot_kernel(const kernel_data *kd, const double *Kp, const double *gbar, int nn,
+                              scratch *w);
 
 /* The full element matrix Ke (3nn x 3nn, row-major) from its upper node blocks Kp. */
 void fcm__kernel_unpack(int nn, const double *Kp, double *Ke);

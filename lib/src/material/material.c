@@ -7,7 +7,8 @@
  * alpha = 1 + 3 mu'/(4 lambda') makes the rest state stress free. */
 #include "material/material_impl.h"
 
-static const char *const model_names[FCM_MATERIAL_COUNT] = {"linear", "stvk", "corotated", "snh"};
+static const char *const model_names[FCM_MATERIAL_COUNT] = {"linear", "stvk", "corotated", "snh",
+                                                            "corotated_linear"};
 
 const char *fcm_material_model_name(fcm_material_model model)
 {
@@ -29,7 +30,7 @@ fcm_status fcm_material_model_parse(fcm_ctx *ctx, const char *name, fcm_material
     }
   FCM_CHECK(0, ctx, FCM_ERR_ARG,
             "material: unknown model \"%s\" (valid: linear, stvk, corotated, snh, "
-            "stable_neo_hookean)",
+            "stable_neo_hookean, corotated_linear)",
             name);
 cleanup:
   return st;

@@ -180,6 +180,7 @@ static inline void fcm__material_eval(const fcm_material_params *p, const double
     fcm__material_snh(p->snh_mu, p->snh_lambda, F, psi, P, project ? NULL : dPdF);
     break;
   case FCM_MATERIAL_COROTATED:
+  case FCM_MATERIAL_COROTATED_LINEAR: /* at a point: the corotated model */
     fcm__material_eval_svd(p, F, psi, P, dPdF);
     return;
   default:

@@ -98,6 +98,7 @@ void fcm__material_eval_svd(const fcm_material_params *p, const double F[9], dou
   fcm__mat3_svd(F, U, s, V);
   switch (p->model) {
   case FCM_MATERIAL_COROTATED:
+  case FCM_MATERIAL_COROTATED_LINEAR: /* at a point: the corotated model */
     corotated(p->mu, p->lambda, s, &d);
     break;
   case FCM_MATERIAL_STVK:

@@ -6,11 +6,14 @@
 
 #include <string.h>
 
-static const char *const model_names[] = {"linear", "stvk", "corotated", "snh",
-                                          "stable_neo_hookean"};
-static const fcm_material_model model_values[] = {
-    FCM_MATERIAL_LINEAR, FCM_MATERIAL_STVK, FCM_MATERIAL_COROTATED, FCM_MATERIAL_STABLE_NEO_HOOKEAN,
-    FCM_MATERIAL_STABLE_NEO_HOOKEAN};
+static const char *const model_names[] = {
+    "linear", "stvk", "corotated", "snh", "stable_neo_hookean", "corotated_linear"};
+static const fcm_material_model model_values[] = {FCM_MATERIAL_LINEAR,
+                                                  FCM_MATERIAL_STVK,
+                                                  FCM_MATERIAL_COROTATED,
+                                                  FCM_MATERIAL_STABLE_NEO_HOOKEAN,
+                                                  FCM_MATERIAL_STABLE_NEO_HOOKEAN,
+                                                  FCM_MATERIAL_COROTATED_LINEAR};
 static const char *const shape_names[] = {"box", "ball", "hemisphere", "hollow_ball", "tube"};
 
 /* ---------------------------------------------------------------- background */

@@ -500,6 +500,9 @@ static fcm_status setup_storage(fcm_integrator *I)
   else
     FCM_TRY(ctx, fcm__space_matrix_create_rows(I->space, &I->H));
   FCM_TRY(ctx, fcm_assembly_workspace_create(I->space, &I->opts.assembly, &I->aws));
+  /* after a cut: the corotated linear model's element matrices the cut leaves valid */
+  if (I->cut_old && I->cut_same)
+    FCM_TRY(ctx, fcm__assembly_corot_inherit(I->aws, I->cut_old->aws, I->cut_same));
 cleanup:
   return st;
 }

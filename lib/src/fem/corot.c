@@ -1,0 +1,163 @@
+/* The element-corotated linear kernel (FCM_MATERIAL_COROTATED_LINEAR; Dick et al. 2011 §5,
+ * stiffness warping): one element's energy, force and tangent from its linear stiffness K
+ * (kept by the assembly workspace) and one rotation R, the polar rotation of the deformation
+ * gradient F averaged over the element's material (its authentic quadrature points; on an
+ * affine element that is F at the centroid). In a cut cell the fictitious part's nodes move
+ * almost freely: F at the centroid, which may lie there, would turn the material by the
+ * fictitious part's motion, which also slows Newton's convergence (below).
+ *
+ * With x_a = X_a + u_a, c and c' the means of the nodes X_a and x_a (Dick's centres of mass)
+ * and y_a = R^T (x_a - c'), the element's displacement in its rotated frame is
+ * d_a = y_a - (X_a - c) and its energy E = 1/2 d^T K d (K ignores translations: the centring
+ * changes E only by rounding, and keeps a rigid motion's d at rounding level). The force is
+ * E's exact gradient: with F = R S (S symmetric), dR = R [w]x and
+ * [w]x S + S [w]x = [(tr S I - S) w]x = the skew part of 2 R^T dF, so that
+ *   dE/dx_b = R ((K d)_b - z x g_b),  z = (tr S I - S)^{-1} m,  m = sum_a y_a x (K d)_a,
+ * g_b the mean physical gradient of node b's shape function (F = sum_a x_a g_a^T). m is the
+ * moment of the element's elastic forces in its rotated frame, of second order in d (K's rigid
+ * rotations carry no force): the z term is the small correction that makes the force a
+ * gradient (Dick's warped force R K d drops it). The tangent is the warped [R] K [R]^T (the
+ * terms of dR/dx, of the order of the element's stress, dropped as Dick does): symmetric
+ * positive semi-definite, so Newton's direction is a descent direction of E and its line
+ * search applies unchanged; Newton converges linearly then, at a rate of the order of the
+ * strains. */
+#include "fem/kernels_impl.h"
+#include "la/mat3.h"
+
+#include <math.h>
+#include <string.h>
+
+/* Floor of the eigenvalues s_i + s_j of tr S I - S (signed singular values: >= 0; zero where
+ * R is not differentiable, e.g. F = -I), as the corotated material's twist floor. */
+#define COROT_FLOOR FCM__COROTATED_TWIST_FLOOR
+
+/* y = K d for the symmetric element matrix given by its upper node blocks Kp. */
+static void packed_matvec(int nn, const double *Kp, const double *d, double *y)
+{
+  memset(y, 0, sizeof *y * 3 * (size_t)nn);
+  for (int a = 0; a < nn; a++) {
+    const double *da = d + 3 * a;
+    double *ya = y + 3 * a;
+    for (int b = a; b < nn; b++, Kp += 9) {
+      const double *db = d + 3 * b;
+      ya[0] += Kp[0] * db[0] + Kp[1] * db[1] + Kp[2] * db[2];
+      ya[1] += Kp[3] * db[0] + Kp[4] * db[1] + Kp[5] * db[2];
+      ya[2] += Kp[6] * db[0] + Kp[7] * db[1] + Kp[8] * db[2];
+      if (b == a) continue;
+      double *yb = y + 3 * b;
+      yb[0] += Kp[0] * da[0] + Kp[3] * da[1] + Kp[6] * da[2];
+      yb[1] += Kp[1] * da[0] + Kp[4] * da[1] + Kp[7] * da[2];
+      yb[2] += Kp[2] * da[0] + Kp[5] * da[1] + Kp[8] * da[2];
+    }
+  }
+}
+
+static void cross(const double a[3], const double b[3], double c[3])
+{
+  c[0] = a[1] * b[2] - a[2] * b[1];
+  c[1] = a[2] * b[0] - a[0] * b[2];
+  c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* The rotation-variant SVD F = U diag(s) V^T (s signed) and R = U V^T. */
+typedef struct polar {
+  double R[9], V[9], s[3];
+} polar;
+
+/* The polar rotation of F into p; 0 for a non-finite F. */
+static int polar_rotation(const double F[9], polar *p)
+{
+  double U[9];
+  if (fcm__mat3_svd(F, U, p->s, p->V) < 0) return 0;
+  const double *V = p->V;
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      p->R[3 * i + j] =
+          U[3 * i] * V[3 * j] + U[3 * i + 1] * V[3 * j + 1] + U[3 * i + 2] * V[3 * j + 2];
+  return 1;
+}
+
+/* z = (tr S I - S)^{-1} m with S = V diag(s) V^T: tr S I - S = V diag(s1 + s2, s0 + s2,
+ * s0 + s1) V^T, its eigenvalues floored at COROT_FLOOR. */
+static void solve_spin(const polar *p, const double m[3], double z[3])
+{
+  const double *s = p->s;
+  const double e[3] = {FCM_MAX(s[1] + s[2], COROT_FLOOR), FCM_MAX(s[0] + s[2], COROT_FLOOR),
+                       FCM_MAX(s[0] + s[1], COROT_FLOOR)};
+  double t[3];
+  fcm__mat3_tmulv(p->V, m, t); /* V^T m */
+  for (int k = 0; k < 3; k++)
+    t[k] /= e[k];
+  fcm__mat3_mulv(p->V, t, z);
+}
+
+/* The element's upper node blocks R K_ab R^T into Kt. */
+static void warp_blocks(int nn, const double *Kp, const double R[9], double *Kt)
+{
+  const int nb = nn * (nn + 1) / 2;
+  for (int k = 0; k < nb; k++, Kp += 9, Kt += 9) {
+    double T[9]; /* K_ab R^T */
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++)
+        T[3 * i + j] =
+            Kp[3 * i] * R[3 * j] + Kp[3 * i + 1] * R[3 * j + 1] + Kp[3 * i + 2] * R[3 * j + 2];
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++)
+        Kt[3 * i + j] = R[3 * i] * T[j] + R[3 * i + 1] * T[3 + j] + R[3 * i + 2] * T[6 + j];
+  }
+}
+
+cell_result fcm__corot_kernel(const kernel_data *kd, const double *Kp, const double *gbar, int nn,
+                              scratch *w)
+{
+  cell_result res = {0.0, 1.0, 0, 0};
+  double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, c[3] = {0, 0, 0}, cu[3] = {0, 0, 0};
+  for (int a = 0; a < nn; a++)
+    for (int i = 0; i < 3; i++) {
+      c[i] += w->X[3 * a + i] / nn;
+      cu[i] += w->ue[3 * a + i] / nn;
+      for (int j = 0; j < 3; j++)
+        F[3 * i + j] += w->ue[3 * a + i] * gbar[3 * a + j];
+    }
+  polar pr;
+  const double *R = pr.R;
+  if (!polar_rotation(F, &pr)) {
+    res.nonfinite = 1;
+    return res;
+  }
+  if (fcm__mat3_det(F) <= 0.0) res.inverted = 1;
+  double *d = w->FT, *Kd = w->fe, y[3 * FCM_ELEMENT_MAX_NODES];
+  for (int a = 0; a < nn; a++) {
+    double xa[3];
+    for (int i = 0; i < 3; i++)
+      xa[i] = w->X[3 * a + i] - c[i] + (w->ue[3 * a + i] - cu[i]);
+    fcm__mat3_tmulv(R, xa, y + 3 * a);
+    for (int i = 0; i < 3; i++)
+      d[3 * a + i] = y[3 * a + i] - (w->X[3 * a + i] - c[i]);
+  }
+  packed_matvec(nn, Kp, d, Kd);
+  double E = 0.0, m[3] = {0, 0, 0};
+  for (int a = 0; a < nn; a++) {
+    double t[3];
+    cross(y + 3 * a, Kd + 3 * a, t);
+    for (int i = 0; i < 3; i++) {
+      E += d[3 * a + i] * Kd[3 * a + i];
+      m[i] += t[i];
+    }
+  }
+  res.energy = 0.5 * E;
+  if (!isfinite(res.energy)) res.nonfinite = 1;
+  if (kd->want_force) {
+    double z[3];
+    solve_spin(&pr, m, z);
+    for (int a = 0; a < nn; a++) {
+      double t[3], v[3];
+      cross(z, gbar + 3 * a, t);
+      for (int i = 0; i < 3; i++)
+        v[i] = Kd[3 * a + i] - t[i];
+      fcm__mat3_mulv(R, v, w->fe + 3 * a);
+    }
+  }
+  if (kd->want_tangent) warp_blocks(nn, Kp, R, w->Ke);
+  return res;
+}
