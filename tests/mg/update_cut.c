@@ -7,10 +7,12 @@
  * it, the third cuts off a corner), each time from the previous hierarchy detached from its
  * matrix and space, which are destroyed first as in a simulation. A hierarchy created from
  * one on the same space and matrix keeps everything: every plan, row order, block smoother
- * and the coarsest analysis. Tet4 and Tet10 have no multigrid (fcm_mg_create() needs a box
- * grid). */
+ * and the coarsest analysis. fcm_mg_setup() (new values, every step) makes no allocation
+ * through the context (CHOLMOD's numeric factorization of the coarsest level allocates through
+ * its own). Tet4 and Tet10 have no multigrid (fcm_mg_create() needs a box grid). */
 #include "mg/levels_impl.h"
 #include "mg_util.h"
+#include "test_alloc.h"
 
 #include <stdio.h>
 
@@ -68,23 +70,32 @@ static int same_hierarchy(const fcm_mg *a, const fcm_mg *b)
     const mg_level *A = &a->lev[l], *B = &b->lev[l];
     const char *what = NULL;
     const fcm_index n = A->n;
-    if (A->n != B->n) what = "size";
-    else if (!same_bytes(A->inactive, B->inactive, (size_t)n)) what = "inactive rows";
-    else if (!same_csr(fcm__mg_level_matrix(A), fcm__mg_level_matrix(B))) what = "matrix";
-    else if (!same_bytes(A->diag, B->diag, sizeof *A->diag * (size_t)n)) what = "diagonal";
-    else if (!same_bytes(A->dinv, B->dinv, sizeof *A->dinv * (size_t)n)) what = "1 / diagonal";
-    else if (!same_blocks(A->blk, B->blk)) what = "block smoother";
-    else if (!same_slabs(&A->rows, &B->rows, n)) what = "row slabs";
+    if (A->n != B->n)
+      what = "size";
+    else if (!same_bytes(A->inactive, B->inactive, (size_t)n))
+      what = "inactive rows";
+    else if (!same_csr(fcm__mg_level_matrix(A), fcm__mg_level_matrix(B)))
+      what = "matrix";
+    else if (!same_bytes(A->diag, B->diag, sizeof *A->diag * (size_t)n))
+      what = "diagonal";
+    else if (!same_bytes(A->dinv, B->dinv, sizeof *A->dinv * (size_t)n))
+      what = "1 / diagonal";
+    else if (!same_blocks(A->blk, B->blk))
+      what = "block smoother";
+    else if (!same_slabs(&A->rows, &B->rows, n))
+      what = "row slabs";
     else if (A->blk && !same_slabs(&A->blocks, &B->blocks, fcm__schwarz_num_blocks(A->blk)))
       what = "block slabs";
     else if (l > 0) {
       fcm_index nz = 0;
       fcm_csr_get_size(A->Aown, NULL, NULL, &nz);
-      if (!same_bytes(A->tpos, B->tpos, sizeof *A->tpos * (size_t)nz)) what = "transposed positions";
+      if (!same_bytes(A->tpos, B->tpos, sizeof *A->tpos * (size_t)nz))
+        what = "transposed positions";
     }
     if (!what && l + 1 < a->nlev) {
       const fcm_index nz = A->P_ptr[n];
-      if (B->P_ptr[n] != nz || !same_bytes(A->P_ptr, B->P_ptr, sizeof *A->P_ptr * (size_t)(n + 1)) ||
+      if (B->P_ptr[n] != nz ||
+          !same_bytes(A->P_ptr, B->P_ptr, sizeof *A->P_ptr * (size_t)(n + 1)) ||
           !same_bytes(A->P_col, B->P_col, sizeof *A->P_col * (size_t)nz) ||
           !same_bytes(A->P_val, B->P_val, sizeof *A->P_val * (size_t)nz))
         what = "prolongation";
@@ -112,8 +123,8 @@ static void run(fcm_ctx *ctx, fcm_mg *mg, const problem *p, double *out)
   ko.rtol = 1e-9;
   fcm_krylov_info ki;
   memset(out + 3 * n, 0, sizeof *out * (size_t)n);
-  TEST_OK(ctx, fcm_cg_solve(ctx, n, fcm_csr_operator, p->A, fcm_mg_operator, mg, p->b,
-                            out + 3 * n, &ko, &ki));
+  TEST_OK(ctx, fcm_cg_solve(ctx, n, fcm_csr_operator, p->A, fcm_mg_operator, mg, p->b, out + 3 * n,
+                            &ko, &ki));
 }
 
 /* The space and clamped matrix of `rules` (mesh and geometry borrowed from base). */
@@ -136,6 +147,8 @@ static void problem_drop(problem *p)
 }
 
 /* Compare the hierarchy created from *old (consumed) with a fresh one on p; the kept parts. */
+static failing counter = {0, -1}; /* the allocator of the test's context, counting */
+
 static fcm_mg *compare(fcm_ctx *ctx, fcm_mg **old, const problem *p, const fcm_mg_options *o,
                        const char *what, fcm__mg_kept *kept)
 {
@@ -157,6 +170,9 @@ static fcm_mg *compare(fcm_ctx *ctx, fcm_mg **old, const problem *p, const fcm_m
          same_run ? "identical" : "DIFFER");
   TEST_TRUE(same);
   TEST_TRUE(same_run);
+  const long long before = counter.count;
+  TEST_OK(ctx, fcm_mg_setup(updated));
+  TEST_TRUE(counter.count == before);
   free(x1);
   free(x2);
   fcm_mg_destroy(&fresh);
@@ -220,8 +236,8 @@ static void cut_sequence(fcm_ctx *ctx, fcm_element_type type, int cycle_index)
 
 int main(void)
 {
-  fcm_ctx *ctx = NULL;
-  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  fcm_ctx *ctx = failing_ctx(&counter);
+  TEST_TRUE(ctx != NULL);
   cut_sequence(ctx, FCM_ELEMENT_HEX8, 1);
   cut_sequence(ctx, FCM_ELEMENT_HEX8, 2);
   cut_sequence(ctx, FCM_ELEMENT_HEX20, 1);
