@@ -87,9 +87,17 @@ int main(void)
     /* at least 40 failing rounds: the loop did exercise the builders */
     alloc_loop(ctx, &fl, t ? "hex20 hierarchy" : "hex8 hierarchy", run_round, NULL, &r, 40,
                1000000);
-    if (t == 0) /* the parts kept are the same kinds on Hex20 */
-      alloc_loop(ctx, &fl, "hex8 hierarchy from another", run_from_round, NULL, &r, 40, 1000000);
     free(x);
+    problem_free(&p);
+  }
+  {
+    /* a smaller Hex8 hemisphere: each round builds three hierarchies (the parts kept are the
+     * same kinds on Hex20) */
+    problem p;
+    problem_hemisphere_of(ctx0, FCM_ELEMENT_HEX8, 4, 1, fcm_space_options_default().constrain_ratio,
+                          &p);
+    mg_round r = {ctx, &p, NULL};
+    alloc_loop(ctx, &fl, "hex8 hierarchy from another", run_from_round, NULL, &r, 40, 1000000);
     problem_free(&p);
   }
   {
