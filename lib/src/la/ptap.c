@@ -23,8 +23,8 @@ struct fcm__ptap {
 };
 
 /* Sort a[0 .. n) ascending (distinct values: a row's columns): quicksort on the median of
- * three down to short runs, then insertion sort. qsort()'s calls through a comparison pointer
- * took half of the pattern's time on the multigrid's Galerkin products. */
+ * three down to short runs, then insertion sort: qsort() calls its comparison through a
+ * pointer, half of the pattern's time on the multigrid's Galerkin products. */
 static void sort_ints(int *a, fcm_index n)
 {
   while (n > 16) {
