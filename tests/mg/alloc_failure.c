@@ -2,8 +2,11 @@
  * building the hierarchy (cut hemisphere on Hex8 and Hex20 grids: pieces, links, the grown
  * cell graph, the p-level, the block smoother; the hemisphere on a Hex8 octree: the coarser
  * octrees, their spaces and constraints, the nested prolongations), the Galerkin
- * patterns, the level info and a CG + MG solve gives FCM_ERR_ALLOC and leaks nothing, until
+ * patterns, the level info, a CG + MG solve, and a hierarchy created from another
+ * (fcm__mg_create_from() on Hex8, keeping everything, then detached) gives FCM_ERR_ALLOC and
+ * leaks nothing, until
  * everything succeeds. */
+#include "mg/mg_impl.h"
 #include "mg_util.h"
 #include "alloc_loop.h"
 
@@ -28,6 +31,26 @@ done:
   return st;
 }
 
+/* A hierarchy created from another on the same space and matrix (keeping every part), then
+ * from that one detached. */
+static fcm_status run_from(fcm_ctx *ctx, problem *p)
+{
+  fcm_status st = FCM_OK;
+  fcm_mg *old = NULL, *mg = NULL;
+  fcm_mg_options o = fcm_mg_options_default();
+  o.coarse_dofs = 10;
+  if ((st = fcm_mg_create(ctx, p->space, p->A, &o, &old))) goto done;
+  if ((st = fcm__mg_create_from(ctx, &old, p->space, p->A, &o, &mg))) goto done;
+  if (old) st = FCM_ERR_INTERNAL;
+  old = mg, mg = NULL;
+  fcm__mg_detach(old);
+  if ((st = fcm__mg_create_from(ctx, &old, p->space, p->A, &o, &mg))) goto done;
+done:
+  fcm_mg_destroy(&old);
+  fcm_mg_destroy(&mg);
+  return st;
+}
+
 typedef struct mg_round {
   fcm_ctx *ctx;
   problem *p;
@@ -38,6 +61,12 @@ static fcm_status run_round(void *user)
 {
   mg_round *r = user;
   return run(r->ctx, r->p, r->x);
+}
+
+static fcm_status run_from_round(void *user)
+{
+  mg_round *r = user;
+  return run_from(r->ctx, r->p);
 }
 
 int main(void)
@@ -59,6 +88,16 @@ int main(void)
     alloc_loop(ctx, &fl, t ? "hex20 hierarchy" : "hex8 hierarchy", run_round, NULL, &r, 40,
                1000000);
     free(x);
+    problem_free(&p);
+  }
+  {
+    /* a smaller Hex8 hemisphere: each round builds three hierarchies (the parts kept are the
+     * same kinds on Hex20) */
+    problem p;
+    problem_hemisphere_of(ctx0, FCM_ELEMENT_HEX8, 4, 1, fcm_space_options_default().constrain_ratio,
+                          &p);
+    mg_round r = {ctx, &p, NULL};
+    alloc_loop(ctx, &fl, "hex8 hierarchy from another", run_from_round, NULL, &r, 40, 1000000);
     problem_free(&p);
   }
   {

@@ -13,6 +13,8 @@ fcm_add_test(mg_convergence_hemisphere_hex20_long tests/mg/convergence.c
 fcm_add_test(mg_bodies tests/mg/bodies.c)
 fcm_add_test(mg_threads tests/mg/threads.c)
 fcm_add_test(mg_setup_values tests/mg/setup_values.c)
+fcm_add_test(mg_update_cut tests/mg/update_cut.c)
+fcm_add_test(mg_update_bench tests/mg/update_bench.c ARGS 32 5 LABELS bench)
 fcm_add_test(mg_slabs tests/mg/slabs.c)
 fcm_add_test(mg_alloc_failure tests/mg/alloc_failure.c)
 fcm_add_test(mg_bench tests/mg/bench.c ARGS cube 8 16 LABELS bench)

@@ -94,6 +94,7 @@ struct fcm_mg {
   double *blk_r, *blk_dx;   /* blk_max entries each, per thread */
   fcm_mesh *oct_mesh[32];   /* octree hierarchies: the coarser octrees of levels 1, 2, ... */
   fcm_space *oct_space[32]; /* and their spaces */
+  fcm__mg_kept kept;        /* what fcm__mg_create_from() took from the earlier hierarchy */
 };
 
 /* Threads of a parallel region: the context's now, at most those of the creation (scratch). */
@@ -182,8 +183,10 @@ fcm_status fcm__mg_level_colors(fcm_mg *m, mg_level *L);
  * blocks, a coarser level's corner blocks. CSR over the blocks, allocated here. */
 fcm_status fcm__mg_level_blocks(fcm_mg *m, int l, fcm_index *nb, fcm_index **ptr, fcm_index **dofs);
 
-/* The block smoothers of every level but the coarsest, from the current level matrices. */
-fcm_status fcm__mg_block_smoothers_create(fcm_mg *m);
+/* The block smoothers of every level but the coarsest, from the current level matrices;
+ * with `old` (NULL: none), a level l with same[l] (its pattern is old's) takes old's block
+ * smoother where its blocks are old's (fcm__mg_keep_blocks()). */
+fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned char *same);
 
 /* One smoothing step with the pointwise smoother of m's options, by the team of the enclosing
  * parallel region (no barrier at the end). */
@@ -192,5 +195,33 @@ void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x);
 /* A symmetric block Gauss-Seidel sweep over the level's blocks, by the team of the enclosing
  * parallel region (no barrier at the end). */
 void fcm__mg_block_smooth(const fcm_mg *m, const mg_level *L, const double *b, double *x);
+
+/* ---- update.c: the parts fcm__mg_create_from() takes from an earlier hierarchy `old` (each
+ * moved out of old, which is destroyed afterwards) */
+
+/* May m (options set, hierarchy built) take anything from old (NULL: no)? The same options
+ * and thread count, neither an octree hierarchy. */
+int fcm__mg_reuse_allowed(const fcm_mg *old, const fcm_mg *m);
+
+/* Has level l of m the size and matrix pattern of old's level l (level 0: old not detached)? */
+int fcm__mg_level_same(const fcm_mg *old, const fcm_mg *m, int l);
+
+/* With level l's pattern the same as old's: take old's Galerkin plan of level l, P_l and level
+ * l + 1's matrix (pattern), diagonal and transposed positions when P_l and the size of level
+ * l + 1 are old's (1), else nothing (0). */
+int fcm__mg_keep_plan(fcm_mg *old, fcm_mg *m, int l);
+
+/* With level l's pattern the same as old's: take old's row slabs and colours of level l. */
+void fcm__mg_keep_orders(fcm_mg *old, fcm_mg *m, int l);
+
+/* With the coarsest pattern the same as old's (same_coarsest) and as many levels: take old's
+ * coarsest solver with its symbolic analysis (1), else nothing (0). */
+int fcm__mg_keep_analysis(fcm_mg *old, fcm_mg *m, int same_coarsest);
+
+/* With level l's pattern the same as old's: when its blocks (nb, ptr, dofs) are old's, take
+ * old's block smoother and block slabs and set the smoother up on the level matrix
+ * (*kept = 1), else nothing (*kept = 0). @return FCM_OK or the setup's failure. */
+fcm_status fcm__mg_keep_blocks(fcm_mg *old, fcm_mg *m, int l, fcm_index nb, const fcm_index *ptr,
+                               const fcm_index *dofs, int *kept);
 
 #endif /* FCM_MG_LEVELS_IMPL_H */

@@ -174,13 +174,10 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
-                         const fcm_mg_options *opts, fcm_mg **mg)
+/* The options resolved (omega) and validated. */
+static fcm_status check_options(fcm_ctx *ctx, const fcm_mg_options *opts, fcm_mg_options *out)
 {
   fcm_status st = FCM_OK;
-  fcm_mg *m = NULL;
-  FCM_CHECK(ctx && space && A && mg, ctx, FCM_ERR_ARG, "mg_create: NULL argument");
-  *mg = NULL;
   fcm_mg_options o = opts ? *opts : fcm_mg_options_default();
   FCM_CHECK(o.smoother >= 0 && o.smoother < FCM_MG_SMOOTHER_COUNT, ctx, FCM_ERR_ARG,
             "mg_create: smoother = %d is not a fcm_mg_smoother", (int)o.smoother);
@@ -198,6 +195,55 @@ fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
             "mg_create: max_levels = %d outside [1, 32]", o.max_levels);
   FCM_CHECK(o.coarse_dofs >= 1, ctx, FCM_ERR_ARG, "mg_create: coarse_dofs = %lld must be >= 1",
             (long long)o.coarse_dofs);
+  *out = o;
+cleanup:
+  return st;
+}
+
+/* The levels' Galerkin plans and patterns, row orders and the coarsest analysis (keeping
+ * old's where fcm__mg_create_from() may; same[l]: level l's pattern is old's). */
+static fcm_status create_patterns(fcm_mg *m, fcm_mg *old, unsigned char *same)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  const fcm_mg_options o = m->opts;
+  int kept_above = 0; /* the plan of the finer level was kept: this level's pattern is old's */
+  for (int l = 0; l < m->nlev; l++) {
+    mg_level *L = &m->lev[l];
+    FCM_ALLOC(ctx, L->n + 1, L->x);
+    FCM_ALLOC(ctx, L->n + 1, L->b);
+    FCM_ALLOC(ctx, L->n + 1, L->r);
+    same[l] = (unsigned char)(old && (kept_above || fcm__mg_level_same(old, m, l)));
+    kept_above = l + 1 < m->nlev && same[l] && fcm__mg_keep_plan(old, m, l);
+    if (l + 1 < m->nlev && !kept_above) FCM_TRY(ctx, galerkin_pattern(m, l));
+    if (same[l]) fcm__mg_keep_orders(old, m, l);
+  }
+  if (o.smoother == FCM_MG_SMOOTHER_SGS_COLORED)
+    for (int l = 0; l + 1 < m->nlev; l++)
+      if (!m->lev[l].color_ptr) FCM_TRY(ctx, fcm__mg_level_colors(m, &m->lev[l]));
+  if (o.smoother == FCM_MG_SMOOTHER_SGS)
+    for (int l = 0; l + 1 < m->nlev; l++)
+      if (!m->lev[l].rows.ptr) FCM_TRY(ctx, fcm__mg_row_slabs(m, &m->lev[l]));
+  if (!(old && fcm__mg_keep_analysis(old, m, same[m->nlev - 1]))) {
+    mg_level *Lc = &m->lev[m->nlev - 1];
+    FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, fcm__mg_level_matrix(Lc), &m->direct));
+    FCM_TRY(ctx, fcm_direct_analyze(m->direct));
+  }
+cleanup:
+  return st;
+}
+
+/* fcm_mg_create(), keeping the parts of old (NULL: none) fcm__mg_create_from() may. */
+static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, const fcm_space *space, const fcm_csr *A,
+                            const fcm_mg_options *opts, fcm_mg **mg)
+{
+  fcm_status st = FCM_OK;
+  fcm_mg *m = NULL;
+  unsigned char same[32] = {0};
+  FCM_CHECK(ctx && space && A && mg, ctx, FCM_ERR_ARG, "mg_create: NULL argument");
+  *mg = NULL;
+  fcm_mg_options o;
+  FCM_TRY(ctx, check_options(ctx, opts, &o));
   fcm_index nr = 0, nc = 0;
   fcm_csr_get_size(A, &nr, &nc, NULL);
   FCM_CHECK(nr == fcm_space_num_dofs(space) && nc == nr, ctx, FCM_ERR_ARG,
@@ -212,31 +258,30 @@ fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
   m->opts = o;
   m->nt = fcm_ctx_num_threads(ctx);
   FCM_TRY(ctx, fcm__mg_build_hierarchy(m, A, NULL));
+  if (!fcm__mg_reuse_allowed(old, m)) old = NULL;
   FCM_TRY(ctx, level_diag(m, &m->lev[0]));
-  for (int l = 0; l < m->nlev; l++) {
-    mg_level *L = &m->lev[l];
-    FCM_ALLOC(ctx, L->n + 1, L->x);
-    FCM_ALLOC(ctx, L->n + 1, L->b);
-    FCM_ALLOC(ctx, L->n + 1, L->r);
-    if (l + 1 < m->nlev) FCM_TRY(ctx, galerkin_pattern(m, l));
-  }
-  if (o.smoother == FCM_MG_SMOOTHER_SGS_COLORED)
-    for (int l = 0; l + 1 < m->nlev; l++)
-      if (!m->lev[l].color_ptr) FCM_TRY(ctx, fcm__mg_level_colors(m, &m->lev[l]));
-  if (o.smoother == FCM_MG_SMOOTHER_SGS)
-    for (int l = 0; l + 1 < m->nlev; l++)
-      FCM_TRY(ctx, fcm__mg_row_slabs(m, &m->lev[l]));
-  {
-    mg_level *Lc = &m->lev[m->nlev - 1];
-    FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, fcm__mg_level_matrix(Lc), &m->direct));
-    FCM_TRY(ctx, fcm_direct_analyze(m->direct));
-  }
+  FCM_TRY(ctx, create_patterns(m, old, same));
   FCM_TRY(ctx, fcm_mg_setup(m));
-  if (o.block_smoothing) FCM_TRY(ctx, fcm__mg_block_smoothers_create(m)); /* set up as created */
+  if (o.block_smoothing) /* set up as created */
+    FCM_TRY(ctx, fcm__mg_block_smoothers_create(m, old, same));
   *mg = m;
   m = NULL;
 cleanup:
   fcm_mg_destroy(&m);
+  return st;
+}
+
+fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
+                         const fcm_mg_options *opts, fcm_mg **mg)
+{
+  return mg_create(ctx, NULL, space, A, opts, mg);
+}
+
+fcm_status fcm__mg_create_from(fcm_ctx *ctx, fcm_mg **old, const fcm_space *space, const fcm_csr *A,
+                               const fcm_mg_options *opts, fcm_mg **mg)
+{
+  const fcm_status st = mg_create(ctx, old ? *old : NULL, space, A, opts, mg);
+  if (old) fcm_mg_destroy(old);
   return st;
 }
 

@@ -51,4 +51,31 @@ FCM_COMPONENT_API void fcm__mg_transfers_destroy(fcm_ctx *ctx, fcm__mg_transfers
 fcm_status fcm__mg_slabs_check(const fcm_mg *mg, int level, fcm_index *row_slabs,
                                fcm_index *block_slabs);
 
+/* What fcm__mg_create_from() took from the earlier hierarchy (zero for fcm_mg_create()). */
+typedef struct fcm__mg_kept {
+  int plans;           /* levels whose Galerkin plan, coarse pattern and positions were kept */
+  int row_orders;      /* levels whose SGS row slabs were kept */
+  int block_smoothers; /* levels whose block smoother and block slabs were kept */
+  int analysis;        /* 1: the coarsest level's symbolic analysis was kept */
+} fcm__mg_kept;
+
+/* fcm_mg_create(ctx, space, A, opts, mg), taking from *old (NULL or *old == NULL: nothing)
+ * the parts whose inputs are unchanged: the result, and every level's data, are those of
+ * fcm_mg_create() bit for bit (lib/src/mg/update.c lists the parts and what each is compared
+ * on). Reads only the arrays *old owns, and its level-0 matrix unless detached
+ * (fcm__mg_detach()): that matrix must then still be alive, its pattern unchanged. *old is
+ * destroyed (*old = NULL) whatever the result. Octree hierarchies, and options or thread
+ * counts other than old's, keep nothing. @return as fcm_mg_create(). */
+FCM_COMPONENT_API fcm_status fcm__mg_create_from(fcm_ctx *ctx, fcm_mg **old, const fcm_space *space,
+                                                 const fcm_csr *A, const fcm_mg_options *opts,
+                                                 fcm_mg **mg);
+
+/* Forget the level-0 matrix and the space of m (they may be destroyed now): m stays usable
+ * only as the `old` of fcm__mg_create_from(), which then keeps nothing of level 0 itself
+ * (its plan needs level 0's pattern). Accepts NULL. */
+FCM_COMPONENT_API void fcm__mg_detach(fcm_mg *m);
+
+/* What m's creation kept (all zero for NULL). */
+FCM_COMPONENT_API void fcm__mg_get_kept(const fcm_mg *m, fcm__mg_kept *kept);
+
 #endif /* FCM_MG_IMPL_H */

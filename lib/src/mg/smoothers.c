@@ -525,7 +525,7 @@ fcm_status fcm__mg_level_blocks(fcm_mg *m, int l, fcm_index *nb, fcm_index **ptr
   return blocks_coarse(m, &m->lev[l], nb, ptr, dofs);
 }
 
-fcm_status fcm__mg_block_smoothers_create(fcm_mg *m)
+fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned char *same)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
@@ -535,7 +535,10 @@ fcm_status fcm__mg_block_smoothers_create(fcm_mg *m)
     FCM_TRY(ctx, fcm__mg_level_blocks(m, l, &nb, &ptr, &dofs));
     for (fcm_index k = 0; k < nb; k++)
       m->blk_max = FCM_MAX(m->blk_max, ptr[k + 1] - ptr[k]);
-    if (nb > 0) {
+    int kept = 0;
+    if (nb > 0 && old && same[l])
+      FCM_TRY(ctx, fcm__mg_keep_blocks(old, m, l, nb, ptr, dofs, &kept));
+    if (nb > 0 && !kept) {
       FCM_TRY(ctx, fcm_schwarz_create(ctx, fcm__mg_level_matrix(L), nb, ptr, dofs, NULL, &L->blk));
       FCM_TRY(ctx, block_slabs(m, L));
     }

@@ -9,6 +9,7 @@
 #include "sim/sim_impl.h"
 #include "fem/fem_impl.h"
 #include "la/la_impl.h"
+#include "mg/mg_impl.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -291,24 +292,28 @@ static fcm_status mg_soft(fcm_integrator *I, fcm_status s, fcm_step_reason *reas
   return s;
 }
 
-/* The hierarchy on A with A's current values: fcm_mg_create() at first use and when the
- * matrix or the active constraints changed (the eliminated rows are the multigrid's Dirichlet
- * boundary), else fcm_mg_setup() (Galerkin matrices and the coarsest factorization only). A
- * setup that finds other eliminated rows (a row whose coupling vanished numerically) builds
- * the hierarchy again. */
+/* The hierarchy on A with A's current values: created at first use and when the matrix or
+ * the active constraints changed (the eliminated rows are the multigrid's Dirichlet boundary),
+ * else fcm_mg_setup() (Galerkin matrices and the coarsest factorization only). A setup that
+ * finds other eliminated rows (a row whose coupling vanished numerically) builds the hierarchy
+ * again. A hierarchy built again takes what is unchanged from the earlier one
+ * (fcm__mg_create_from(): the same bits as fcm_mg_create()), which forgets its matrix first
+ * when that is another one (it may be gone). */
 static fcm_status mg_prepare(fcm_integrator *I, const fcm_csr *A, fcm_step_reason *reason)
 {
   fcm_status s = FCM_OK;
-  if (I->mg && (I->mg_A != A || I->mg_con != I->key_con)) fcm_mg_destroy(&I->mg);
+  fcm_mg *old = NULL;
+  if (I->mg && (I->mg_A != A || I->mg_con != I->key_con)) old = I->mg, I->mg = NULL;
   if (I->mg) {
     s = fcm_mg_setup(I->mg);
     if (s == FCM_ERR_ARG) {
       fcm_ctx_error_clear(I->ctx);
-      fcm_mg_destroy(&I->mg);
+      old = I->mg, I->mg = NULL;
     }
   }
   if (!I->mg) {
-    s = fcm_mg_create(I->ctx, I->space, A, &I->opts.multigrid, &I->mg);
+    if (I->mg_A != A) fcm__mg_detach(old);
+    s = fcm__mg_create_from(I->ctx, &old, I->space, A, &I->opts.multigrid, &I->mg);
     I->mg_A = A;
     I->mg_con = I->key_con;
   }
