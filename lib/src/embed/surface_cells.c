@@ -18,7 +18,7 @@
 
 /* Boundary points kept per moment, the finer grid's factor on a retry, the largest grid per
  * axis. */
-enum { BOUNDARY_PER_MOMENT = 1, GROW = 4, ATTEMPTS = 4, GRID_MAX = 64 };
+enum { BOUNDARY_PER_MOMENT = 1, GROW = 4, ATTEMPTS = 4, GRID_MAX = 64, SIGNED_PER_BOUNDARY = 2 };
 
 /* Absolute moment residual accepted, per unit of the material box's reference volume: ten times
  * the moments' own rounding. */
@@ -105,7 +105,7 @@ static size_t piece_points(const build *B, const fcm__embed_ws *ws)
  * of a tet rule on the tets of a fan of each of its parts (a positive rule of the part) and
  * the points of its signed rule inside the piece (they lie on columns through the material). */
 static fcm_status piece_candidates(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
-                                   int *count)
+                                   int nsigned, int *count)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
@@ -137,7 +137,10 @@ static fcm_status piece_candidates(const build *B, const fcm__embed_cell *cell, 
       }
     }
   }
-  for (size_t i = 0; i < ws->sr->n; i++) {
+  /* at most nsr of the signed rule's points, spread over the list: each costs a line query */
+  const size_t nsr = FCM_MIN(ws->sr->n, (size_t)nsigned);
+  for (size_t l = 0; l < nsr; l++) {
+    const size_t i = l * ws->sr->n / nsr;
     double *xi = ws->cand_x + 3 * (size_t)*count;
     int in;
     memcpy(xi, ws->sr->x + 3 * i, 3 * sizeof *xi);
@@ -220,7 +223,7 @@ static fcm_status grid_candidates(const build *B, const fcm__embed_cell *cell, f
     memcpy(ws->cand_x + 3 * (size_t)*count, ws->bnd->x + 3 * j, 3 * sizeof(double));
     *count += in_piece(cell, ws, ws->cand_x + 3 * (size_t)*count) != 0;
   }
-  if (nx) FCM_TRY(ctx, piece_candidates(B, cell, ws, count));
+  if (nx) FCM_TRY(ctx, piece_candidates(B, cell, ws, SIGNED_PER_BOUNDARY * nbnd, count));
 cleanup:
   fcm__free(ctx, z);
   fcm__free(ctx, where);
