@@ -2,13 +2,15 @@
  * ball cut by a tilted plane through its middle (cells the body fills split in two: pieces the
  * body fills, whose candidates need no inside test, beside pieces at the boundary), a plane
  * 1e-4 of a cell off a grid plane and tilted (thin slivers, whose first candidates often miss
- * their moments and whose fits retry on finer ones or fall back to the volume path), and a
- * plane cutting a cap near the ball's top (small pieces at the boundary). For every piece and
- * kind: every monomial of reference coordinates up to the rule's strength as the volume path's
- * (the same ball as tets) to TOL of the reference cell's volume; weights positive and finite;
- * at most M = (m + 1)(m + 2)(m + 3) / 6 points unless the cell fell back to the volume path
- * (counted); every point inside the reference cell, inside the ball and on its piece's side of
- * every plane cut so far. Hex8 and Tet4 backgrounds. */
+ * their moments and whose fits retry on finer ones or fall back to the volume path), a plane
+ * cutting a cap near the ball's top (small pieces at the boundary), then a faceted
+ * half-cylinder groove into the top (pieces of up to dozens of convex parts, whose retries take
+ * a bounded share of their thousands of tet points). For every piece and kind: every monomial
+ * of reference coordinates up to the rule's strength as the volume path's (the same ball as
+ * tets) to TOL of the reference cell's volume; weights positive and finite; at most
+ * M = (m + 1)(m + 2)(m + 3) / 6 points unless the cell fell back to the volume path (counted);
+ * every point inside the reference cell, inside the ball and on its piece's side of every plane
+ * cut so far. Hex8 and Tet4 backgrounds. */
 #include "fcm/embed.h"
 #include "fcm/surface.h"
 #include "test.h"
@@ -212,6 +214,31 @@ static void surface_of(const fcm_geometry *g, fcm_geometry **gs)
   free(y);
 }
 
+/* A half-cylinder groove of radius r along x (the lower half of the cylinder about the line
+ * y = y0, z = z0), faceted into nseg strips: an open surface that splits the cells it crosses
+ * into many parts. */
+static void groove(double y0, double z0, double r, int nseg, fcm_surface **cut)
+{
+  double *x = malloc(6 * (size_t)(nseg + 1) * sizeof *x);
+  fcm_index *t = malloc(6 * (size_t)nseg * sizeof *t);
+  for (int i = 0; i <= nseg; i++) {
+    const double a =
+        3.14159265358979323846 * (1.0 + (double)i / nseg); /* pi .. 2 pi: the lower half */
+    for (int e = 0; e < 2; e++) {
+      double *v = x + 3 * (2 * i + e);
+      v[0] = e ? 1.2 : -1.2, v[1] = y0 + r * cos(a), v[2] = z0 + r * sin(a);
+    }
+  }
+  for (int i = 0; i < nseg; i++) {
+    const fcm_index a = 2 * i, b = 2 * i + 1, c = 2 * i + 2, d = 2 * i + 3;
+    t[6 * i] = a, t[6 * i + 1] = c, t[6 * i + 2] = d;
+    t[6 * i + 3] = a, t[6 * i + 4] = d, t[6 * i + 5] = b;
+  }
+  TEST_OK(ctx, fcm_surface_create(ctx, 2 * (nseg + 1), x, 2 * nseg, t, cut));
+  free(x);
+  free(t);
+}
+
 static void run(fcm_element_type type, int nc)
 {
   const char *name = type == FCM_ELEMENT_TET4 ? "tet4" : "hex8";
@@ -236,10 +263,13 @@ static void run(fcm_element_type type, int nc)
                                {{0.0, 0.0, 0.86}, {0.1, -0.05, 1}}};
   const char *names[NUM_KNIVES] = {"plane", "sliver plane", "cap"};
   const double blo[3] = {-1.05, -1.05, -1.05}, bhi[3] = {1.05, 1.05, 1.05};
-  for (int k = 0; k < NUM_KNIVES; k++) {
+  for (int k = 0; k <= NUM_KNIVES; k++) {
     fcm_surface *cut = NULL;
     fcm_cell_rules *nv = NULL, *ns = NULL;
-    TEST_OK(ctx, fcm_surface_create_plane(ctx, K[k].p, K[k].n, blo, bhi, &cut));
+    if (k < NUM_KNIVES)
+      TEST_OK(ctx, fcm_surface_create_plane(ctx, K[k].p, K[k].n, blo, bhi, &cut));
+    else
+      groove(0.1, 0.95, 0.45, 40, &cut);
     TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, gv, rv, cut, &nv));
     TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, gs, rs, cut, &ns));
     fcm_surface_destroy(&cut);
@@ -247,10 +277,11 @@ static void run(fcm_element_type type, int nc)
     fcm_cell_rules_destroy(&rs);
     rv = nv, rs = ns;
     char what[64];
-    snprintf(what, sizeof what, "%s, %s", name, names[k]);
+    snprintf(what, sizeof what, "%s, %s", name, k < NUM_KNIVES ? names[k] : "groove");
     const fcm_cell_rules_stats *S = fcm_cell_rules_get_stats(rs);
     int unbounded;
-    const double worst = compare(mesh, rv, rs, K, k + 1, 0, what, &unbounded);
+    const double worst =
+        compare(mesh, rv, rs, K, k < NUM_KNIVES ? k + 1 : NUM_KNIVES, 0, what, &unbounded);
     /* a piece above M points only in a cell that fell back to the volume path */
     TEST_TRUE_MSG(unbounded <= 2 * FCM_RULE_KIND_COUNT * S->num_surface_fallbacks,
                   "%s: %d pieces' rules above M points, %lld cells on the volume path", what,
