@@ -94,3 +94,9 @@ fcm_add_test(embed_cut_surface_quadratic tests/embed/cut_surface.c ARGS quadrati
 # A cutting scene on a surface file: no Gmsh phase, the same DOFs and centre of mass (1e-12) as
 # the volume path, the largest displacement within 1 %.
 fcm_add_test(embed_cut_surface_scene tests/embed/cut_surface_scene.c)
+# The fitted rules of a cut's pieces on a body given by its surface alone (a faceted ball cut by
+# a plane through its middle, a plane 1e-4 of a cell off a grid plane, a cap, a faceted groove
+# making pieces of many parts): every monomial up to the strength as the volume path's (1e-12
+# |K_ref|), positive weights, at most M points unless the cell fell back to the volume path,
+# every point in the cell, the ball and on its piece's side of every plane; Hex8 and Tet4.
+fcm_add_test(embed_cut_fit tests/embed/cut_fit.c)

@@ -121,7 +121,7 @@ typedef struct fcm__embed_ws {
   const struct fcm__parts *cand_parts; /* non-NULL: candidates inside piece cand_piece only */
   int cand_piece;
   /* the face planes of that piece's parts, part after part: a count c, the part's tolerance,
-   * then c planes (n, d) */
+   * 1 when the body fills the part (else 0), then c planes (n, d) */
   double *cand_pl;
   size_t cand_npl, cand_plcap;
   size_t cand_cap;

@@ -14,11 +14,13 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdint.h>
 #include <string.h>
 
 /* Boundary points kept per moment, the finer grid's factor on a retry, the largest grid per
- * axis. */
-enum { BOUNDARY_PER_MOMENT = 1, GROW = 4, ATTEMPTS = 4, GRID_MAX = 64 };
+ * axis, the piece's points (of each set of piece_candidates()) per boundary point on a retry
+ * before the last, which takes them all. */
+enum { BOUNDARY_PER_MOMENT = 1, GROW = 4, ATTEMPTS = 4, GRID_MAX = 64, PIECE_PER_BOUNDARY = 2 };
 
 /* Absolute moment residual accepted, per unit of the material box's reference volume: ten times
  * the moments' own rounding. */
@@ -54,7 +56,8 @@ cleanup:
 }
 
 /* Whether the reference point xi lies in piece ws->cand_piece of ws->cand_parts (in one of
- * its parts, within the part's tolerance); 1 without a piece to test. */
+ * its parts, within the part's tolerance): 0 outside, 2 in a part the body fills, 1 in
+ * another; 1 without a piece to test. */
 static int in_piece(const fcm__embed_cell *cell, const fcm__embed_ws *ws, const double xi[3])
 {
   if (!ws->cand_parts) return 1;
@@ -63,17 +66,21 @@ static int in_piece(const fcm__embed_cell *cell, const fcm__embed_ws *ws, const 
   fcm__mat3_mulv(cell->A, s, x);
   for (int d = 0; d < 3; d++)
     x[d] += cell->X[d];
-  for (size_t k = 0; k < ws->cand_npl;) {
+  int found = 0;
+  for (size_t k = 0; k < ws->cand_npl;) { /* per part: faces c, tolerance, full, c planes */
     const size_t c = (size_t)ws->cand_pl[k];
-    const double tol = ws->cand_pl[k + 1], *pl = ws->cand_pl + k + 2;
+    const double tol = ws->cand_pl[k + 1], *pl = ws->cand_pl + k + 3;
     size_t f = 0;
     while (f < c &&
            pl[4 * f] * x[0] + pl[4 * f + 1] * x[1] + pl[4 * f + 2] * x[2] - pl[4 * f + 3] <= tol)
       f++;
-    if (f == c) return 1;
-    k += 2 + 4 * c;
+    if (f == c) {
+      if (ws->cand_pl[k + 2] != 0.0) return 2;
+      found = 1;
+    }
+    k += 3 + 4 * c;
   }
-  return 0;
+  return found;
 }
 
 /* The tet rule whose points piece_candidates() takes: the strongest built. */
@@ -98,9 +105,11 @@ static size_t piece_points(const build *B, const fcm__embed_ws *ws)
 
 /* Candidates of a small or thin piece that the grid misses, those inside the body: the points
  * of a tet rule on the tets of a fan of each of its parts (a positive rule of the part) and
- * the points of its signed rule inside the piece (they lie on columns through the material). */
+ * the points of its signed rule inside the piece (they lie on columns through the material);
+ * of each set at most cap, spread over it (a piece of many parts has 10^5 tet points, and each
+ * point outside a part the body fills costs a line query). */
 static fcm_status piece_candidates(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
-                                   int *count)
+                                   size_t cap, int *count)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
@@ -108,37 +117,44 @@ static fcm_status piece_candidates(const build *B, const fcm__embed_cell *cell, 
   const fcm_rule *rule = piece_rule(B);
   const int nq = fcm_rule_num_points(rule);
   const double *eta = fcm_rule_points(rule);
+  const size_t all = piece_points(B, ws) - ws->sr->n, keep = FCM_MIN(all, cap);
   double *tets = NULL, *vol = NULL;
+  size_t g = 0; /* the tet points' running number, of all */
   FCM_ALLOC(ctx, 12 * FCM__POLY_MAX_FACES * FCM__POLY_MAX_FV, tets);
   FCM_ALLOC(ctx, FCM__POLY_MAX_FACES * FCM__POLY_MAX_FV, vol);
-  for (size_t j = 0; j < P->n; j++) {
+  for (size_t j = 0; j < P->n && keep > 0; j++) {
     if (P->piece[j] != ws->cand_piece) continue;
-    const int nt = fcm__geom_poly_tets(P->poly + j, tets, vol);
+    const int nt = fcm__geom_poly_tets(P->poly + j, tets, vol), full = fcm__embed_part_full(P, j);
     for (int t = 0; t < nt; t++) {
       const double *T = tets + 12 * t;
-      if (!(vol[t] > 0.0)) continue;
-      for (int q = 0; q < nq; q++) {
+      for (int q = 0; q < nq; q++, g++) {
+        if (!(vol[t] > 0.0) || (g + 1) * keep / all == g * keep / all) continue;
         const double *e = eta + 3 * q;
         double x[3], det;
-        int in;
+        int in = 1;
         for (int d = 0; d < 3; d++)
           x[d] =
               T[d] + e[0] * (T[3 + d] - T[d]) + e[1] * (T[6 + d] - T[d]) + e[2] * (T[9 + d] - T[d]);
         double *xi = ws->cand_x + 3 * (size_t)*count;
         FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, x, xi, &det));
-        FCM_TRY(ctx, fcm__embed_inside_line(ctx, B->geom, B->tri_tree, cell, xi[0], xi[1], 1,
-                                            xi + 2, &in, &ws->cand, ws->cr));
+        if (P->whole || !full)
+          FCM_TRY(ctx, fcm__embed_inside_line(ctx, B->geom, B->tri_tree, cell, xi[0], xi[1], 1,
+                                              xi + 2, &in, &ws->cand, ws->cr));
         *count += in == 1;
       }
     }
   }
-  for (size_t i = 0; i < ws->sr->n; i++) {
+  const size_t nsr = FCM_MIN(ws->sr->n, cap);
+  for (size_t l = 0; l < nsr; l++) {
+    const size_t i = l * ws->sr->n / nsr;
     double *xi = ws->cand_x + 3 * (size_t)*count;
-    int in;
+    int in = 1;
     memcpy(xi, ws->sr->x + 3 * i, 3 * sizeof *xi);
-    if (!in_piece(cell, ws, xi)) continue;
-    FCM_TRY(ctx, fcm__embed_inside_line(ctx, B->geom, B->tri_tree, cell, xi[0], xi[1], 1, xi + 2,
-                                        &in, &ws->cand, ws->cr));
+    const int where = in_piece(cell, ws, xi);
+    if (!where) continue; /* (the signed rule's points of other pieces) */
+    if (where == 1)
+      FCM_TRY(ctx, fcm__embed_inside_line(ctx, B->geom, B->tri_tree, cell, xi[0], xi[1], 1, xi + 2,
+                                          &in, &ws->cand, ws->cr));
     *count += in == 1;
   }
 cleanup:
@@ -147,21 +163,10 @@ cleanup:
   return st;
 }
 
-/* Candidates into ws->cand_x (*count of them): the points of an (n + 1)^3 grid over box, its
- * faces included, that lie inside the reference cell and the body, and up to nbnd of the
- * vertices and centroids of the boundary triangles' parts in the cell (ws->bnd). Points on the
- * material's boundary let the fit reach moments that interior points alone cannot (a
- * measure's spread). */
-static fcm_status grid_candidates(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
-                                  const double box[6], int n, int nbnd, int extra, int *count)
+/* Room for `need` candidates in ws->cand_x and ws->cand_in. */
+static fcm_status cand_room(fcm_ctx *ctx, fcm__embed_ws *ws, size_t need)
 {
   fcm_status st = FCM_OK;
-  fcm_ctx *ctx = B->ctx;
-  const int tet = cell->info->shape == FCM_SHAPE_TET, np = n + 1;
-  const size_t nx = extra ? piece_points(B, ws) : 0;
-  const size_t need = (size_t)np * (size_t)np * (size_t)np + ws->bnd->n + nx;
-  double h[3], *z = NULL;
-  *count = 0;
   if (need > ws->cand_cap) {
     void *x = ws->cand_x, *in = ws->cand_in;
     FCM_TRY(ctx, fcm__resize(ctx, &x, 3 * ws->cand_cap, 3 * need, sizeof(double)));
@@ -170,7 +175,29 @@ static fcm_status grid_candidates(const build *B, const fcm__embed_cell *cell, f
     ws->cand_in = in;
     ws->cand_cap = need;
   }
+cleanup:
+  return st;
+}
+
+/* Candidates into ws->cand_x (*count of them): the points of an (n + 1)^3 grid over box, its
+ * faces included, that lie inside the reference cell and the body, up to nbnd of the
+ * vertices and centroids of the boundary triangles' parts in the cell (ws->bnd), and with
+ * extra > 0 up to extra of each of piece_candidates()' sets. Points on the material's boundary
+ * let the fit reach moments that interior points alone cannot (a measure's spread). */
+static fcm_status grid_candidates(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
+                                  const double box[6], int n, int nbnd, size_t extra, int *count)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const int tet = cell->info->shape == FCM_SHAPE_TET, np = n + 1;
+  const size_t nx = extra ? piece_points(B, ws) : 0;
+  const size_t need = (size_t)np * (size_t)np * (size_t)np + ws->bnd->n + nx;
+  double h[3], *z = NULL;
+  int *where = NULL;
+  *count = 0;
+  FCM_TRY(ctx, cand_room(ctx, ws, need));
   FCM_ALLOC(ctx, (size_t)np, z);
+  FCM_ALLOC(ctx, (size_t)np, where);
   for (int d = 0; d < 3; d++)
     h[d] = (box[3 + d] - box[d]) / n;
   for (int k = 0; k < np; k++)
@@ -179,13 +206,22 @@ static fcm_status grid_candidates(const build *B, const fcm__embed_cell *cell, f
     for (int j = 0; j < np; j++) {
       const double a = i == n ? box[3] : box[0] + i * h[0], b = j == n ? box[4] : box[1] + j * h[1];
       if (tet && a + b + z[0] > 1.0) continue;
-      FCM_TRY(ctx, fcm__embed_inside_line(ctx, B->geom, B->tri_tree, cell, a, b, np, z, ws->cand_in,
-                                          &ws->cand, ws->cr));
+      /* the column's points in the piece first: the body's line query only where one of them
+       * lies in a part the body does not fill */
+      int query = 0, any = 0;
       for (int k = 0; k < np; k++) {
-        if (ws->cand_in[k] != 1 || (tet && a + b + z[k] > 1.0)) continue;
-        double *x = ws->cand_x + 3 * (size_t)*count;
+        const double x[3] = {a, b, z[k]};
+        where[k] = tet && a + b + z[k] > 1.0 ? 0 : in_piece(cell, ws, x);
+        query |= where[k] == 1, any |= where[k] != 0;
+      }
+      if (!any) continue;
+      if (query)
+        FCM_TRY(ctx, fcm__embed_inside_line(ctx, B->geom, B->tri_tree, cell, a, b, np, z,
+                                            ws->cand_in, &ws->cand, ws->cr));
+      for (int k = 0; k < np; k++) {
+        if (!where[k] || (query && ws->cand_in[k] != 1)) continue;
+        double *x = ws->cand_x + 3 * (size_t)(*count)++;
         x[0] = a, x[1] = b, x[2] = z[k];
-        *count += in_piece(cell, ws, x);
       }
     }
   /* at most nb of them, spread over the list (a finely triangulated surface has many) */
@@ -193,11 +229,12 @@ static fcm_status grid_candidates(const build *B, const fcm__embed_cell *cell, f
   for (size_t i = 0; i < nb; i++) {
     const size_t j = i * ws->bnd->n / nb;
     memcpy(ws->cand_x + 3 * (size_t)*count, ws->bnd->x + 3 * j, 3 * sizeof(double));
-    *count += in_piece(cell, ws, ws->cand_x + 3 * (size_t)*count);
+    *count += in_piece(cell, ws, ws->cand_x + 3 * (size_t)*count) != 0;
   }
-  if (nx) FCM_TRY(ctx, piece_candidates(B, cell, ws, count));
+  if (nx) FCM_TRY(ctx, piece_candidates(B, cell, ws, extra, count));
 cleanup:
   fcm__free(ctx, z);
+  fcm__free(ctx, where);
   return st;
 }
 
@@ -348,14 +385,24 @@ fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     left += todo[k] = B->tet_rule[k] != NULL;
   /* each kind on the first grid, then the kinds that failed on the finer ones: a kind's rules
-   * do not depend on the other kind */
+   * do not depend on the other kind. A grid capped at GRID_MAX with all the boundary points
+   * and the piece's points gives the candidates of the attempt before, on which the kinds left
+   * failed: the attempts end there. */
+  int last_n = -1, last_nb = -1;
+  size_t last_x = 0;
   for (int attempt = 0, grow = 1; attempt < ATTEMPTS && left > 0; attempt++, grow *= GROW) {
     const double target = fcm__fit_candidates_per_moment(mmax) * Mmax * grow;
-    const int n = grid_size(box, vref, target);
+    const int n = grid_size(box, vref, target), nbnd = BOUNDARY_PER_MOMENT * Mmax * grow;
+    const int nb = (int)FCM_MIN(ws->bnd->n, (size_t)nbnd);
+    const size_t extra = attempt == 0 || !ws->cand_parts ? 0
+                         : attempt == ATTEMPTS - 1       ? SIZE_MAX
+                                                         : (size_t)PIECE_PER_BOUNDARY * nbnd;
+    const size_t xkey = extra ? FCM_MIN(extra, piece_points(B, ws)) : 0; /* what extra takes */
     int count;
+    if (attempt > 0 && n == last_n && nb == last_nb && xkey == last_x) break;
+    last_n = n, last_nb = nb, last_x = xkey;
     FCM_TRY(ctx, check_fit_memory(B, cell, ws, n, Mmax));
-    FCM_TRY(ctx, grid_candidates(B, cell, ws, box, n, BOUNDARY_PER_MOMENT * Mmax * grow,
-                                 attempt > 0 && ws->cand_parts, &count));
+    FCM_TRY(ctx, grid_candidates(B, cell, ws, box, n, nbnd, extra, &count));
     /* the kinds' bases on the candidates, evaluated once at the highest strength left */
     int mtop = 0;
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
@@ -491,9 +538,9 @@ fcm_status fcm__embed_surface_cut_piece(const build *B, const fcm_cell_rules *R,
       FCM_TRY(ctx, fcm__material_poly(ctx, P->mat, P->poly + j, &B->mq, cell, ws->sr, &v));
     fcm__plane pl[FCM__POLY_MAX_FACES];
     const int c = fcm__embed_part_planes(P, j, pl);
-    if (ws->cand_npl + 2 + 4 * (size_t)c > ws->cand_plcap) {
+    if (ws->cand_npl + 3 + 4 * (size_t)c > ws->cand_plcap) {
       size_t cap = ws->cand_plcap ? 2 * ws->cand_plcap : 1024;
-      while (cap < ws->cand_npl + 2 + 4 * (size_t)c)
+      while (cap < ws->cand_npl + 3 + 4 * (size_t)c)
         cap *= 2;
       void *q = ws->cand_pl;
       FCM_TRY(ctx, fcm__resize(ctx, &q, ws->cand_npl, cap, sizeof(double)));
@@ -502,6 +549,7 @@ fcm_status fcm__embed_surface_cut_piece(const build *B, const fcm_cell_rules *R,
     }
     ws->cand_pl[ws->cand_npl++] = c;
     ws->cand_pl[ws->cand_npl++] = P->tol[j];
+    ws->cand_pl[ws->cand_npl++] = !P->whole && fcm__embed_part_full(P, j);
     for (int f = 0; f < c; f++) {
       memcpy(ws->cand_pl + ws->cand_npl, pl[f].n, 3 * sizeof(double));
       ws->cand_pl[ws->cand_npl + 3] = pl[f].d;
