@@ -490,7 +490,15 @@ static fcm_status newton_direction(fcm_integrator *I, double h, int predictor, d
     *reason = FCM_STEP_NONE;
     I->kept = 0;
   }
-  FCM_TRY(I->ctx, build_system(I, h, predictor, 0, reason, stats));
+  /* an exact tangent found not positive definite (linsolve.c) earlier in this substep: the
+   * projected one from then on, without trying the exact one first */
+  if (!I->h_indefinite) FCM_TRY(I->ctx, build_system(I, h, predictor, 0, reason, stats));
+  if (I->h_indefinite && (*reason == FCM_STEP_NONE || *reason == FCM_STEP_LINEAR_SOLVER_FAILED)) {
+    projected = 1;
+    *reason = FCM_STEP_NONE;
+    stats->projection_fallbacks++;
+    FCM_TRY(I->ctx, build_system(I, h, predictor, 1, reason, stats));
+  }
   if (*reason == FCM_STEP_NONE) FCM_TRY(I->ctx, direction(I, predictor, reason, its, stats));
   if (*reason == FCM_STEP_LINEAR_SOLVER_FAILED && I->bcon_active > 0 && !I->opts.project_psd) {
     /* Boundary constraints: far from rest the exact Hessian of the Nitsche terms (penalty
@@ -628,6 +636,7 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
   int met = 0;
   *reason = FCM_STEP_NONE;
   I->solve_stalled = 0;
+  I->h_indefinite = 0;
   if (I->mg_acc) memset(I->mg_acc, 0, sizeof *I->mg_acc * (size_t)I->n);
 
   if (o->tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE) rep_free = norm_free(I, I->Ma);
