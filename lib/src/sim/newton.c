@@ -570,7 +570,8 @@ static fcm_status line_search(fcm_integrator *I, double h, int predictor, int la
     if (predictor)
       for (fcm_index j = 0; j < I->nact; j++)
         I->ut[I->act_dof[j]] = I->act_val[j];
-    lr->speculative = !I->linear && !last && bt == 0 && !kept_usable(I, h);
+    /* not once the exact tangent was found indefinite: the next one is the projected one */
+    lr->speculative = !I->linear && !last && bt == 0 && !kept_usable(I, h) && !I->h_indefinite;
     FCM_TRY(I->ctx, evaluate(I, h, I->ut, lr->speculative, I->fint_t, I->g_t, trial, stats));
     if (trial->finite) {
       lr->rt = norm_free(I, I->g_t);
