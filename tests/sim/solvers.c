@@ -4,9 +4,9 @@
  * (2) Stable Neo-Hookean: the factorization is redone per Newton update, the analysis
  * stays 1 over 20 steps. (3) A uniformly compressed SNH body (F = 0.5 I) with a large
  * step and no tangent projection has an indefinite Newton matrix: CHOLMOD reports "not
- * positive definite", UMFPACK takes over (counted; a second analysis), and the step still
- * converges; with projection on CHOLMOD never fails. Every fallback is logged once at
- * FCM_LOG_WARNING through the ctx's log callback, naming UMFPACK; no fallback, no warning. */
+ * positive definite", the Newton loop takes the PSD-projected tangent for the rest of the
+ * step (counted as projection fallbacks; no UMFPACK, no second analysis, no warning), and
+ * the step still converges; with projection on CHOLMOD never fails. */
 #include "sim_util.h"
 
 static fcm_status make(fcm_ctx *ctx, fcm_space *space, const fcm_material *mat,
