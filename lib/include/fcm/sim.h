@@ -90,7 +90,8 @@ FCM_API const char *fcm_time_scheme_name(fcm_time_scheme scheme);
 
 /** Linear solver of the Newton systems. */
 typedef enum fcm_linear_solver {
-  FCM_LINEAR_DIRECT = 0, /**< CHOLMOD; on "not positive definite" UMFPACK */
+  FCM_LINEAR_DIRECT = 0, /**< CHOLMOD; on "not positive definite" the PSD-projected tangent
+                              (dynamic steps) or UMFPACK (static steps, PSD matrices) */
   FCM_LINEAR_CG = 1,     /**< preconditioned CG (SPD systems) */
   FCM_LINEAR_MINRES = 2, /**< preconditioned MINRES (symmetric, possibly indefinite) */
   /** Cut-aware geometric multigrid cycles as the solver (fcm/mg.h, options `multigrid`):
@@ -354,7 +355,8 @@ typedef struct fcm_step_info {
   double inverted_det;            /**< J there (<= 0; 0 when none) */
   int tangent_assemblies;         /**< tangent assemblies (Newton and damping matrices) */
   int factorizations;             /**< numeric factorizations or preconditioner setups */
-  int direct_fallbacks;           /**< CHOLMOD "not positive definite" -> UMFPACK */
+  int direct_fallbacks;           /**< CHOLMOD "not positive definite" -> UMFPACK (static
+                                       steps; a dynamic step's exact tangent: projected) */
   int projection_fallbacks;       /**< non-descent directions recomputed with PSD tangents */
   int reused_factorizations;      /**< iterations solved with a kept factorization
                                        (fcm_integrator_options.reuse_factorization) */

@@ -33,6 +33,14 @@ typedef struct chol {
   cholmod_factor *L;         /* symbolic after analyze, numeric after factor */
   SuiteSparse_long *given;   /* n: the ordering to analyze with (NULL: CHOLMOD's own) */
   cholmod_dense *X, *Y, *E;  /* solve workspaces, allocated once by cholmod_l_solve2 */
+  /* the lower triangle of P A P^T (P: the analysis's ordering) as CHOLMOD's supernodal
+   * numeric factorization reads it, made once per analysis: S's values are gathered from A's
+   * through smap (entry k of S is A's entry smap[k]) instead of CHOLMOD transposing A into a
+   * new matrix at every factorization */
+  SuiteSparse_long *sp, *si, *smap;
+  SuiteSparse_long *diag; /* n: the position of each row's diagonal entry in A (-1: none) */
+  double *sx;
+  cholmod_sparse S;
   fcm_index n;
 } chol;
 
@@ -69,6 +77,11 @@ static void chol_destroy(fcm_ctx *ctx, void *impl)
   fcm__free(ctx, h->ap);
   fcm__free(ctx, h->ai);
   fcm__free(ctx, h->given);
+  fcm__free(ctx, h->sp);
+  fcm__free(ctx, h->si);
+  fcm__free(ctx, h->smap);
+  fcm__free(ctx, h->diag);
+  fcm__free(ctx, h->sx);
   fcm__free(ctx, h);
 }
 
@@ -84,6 +97,12 @@ static fcm_status chol_create(fcm_ctx *ctx, const fcm_csr *A, void **impl)
     h->ap[i] = (SuiteSparse_long)A->row_ptr[i];
   for (fcm_index p = 0; p < A->nnz; p++)
     h->ai[p] = (SuiteSparse_long)A->col_idx[p];
+  FCM_ALLOC(ctx, FCM_MAX(A->nrows, 1), h->diag);
+  for (fcm_index i = 0; i < A->nrows; i++) {
+    h->diag[i] = -1;
+    for (SuiteSparse_long q = h->ap[i]; q < h->ap[i + 1]; q++)
+      if (h->ai[q] == (SuiteSparse_long)i) h->diag[i] = q;
+  }
   FCM_CHECK(cholmod_l_start(&h->c), ctx, FCM_ERR_INTERNAL, "cholmod start: failed with status %d",
             h->c.status);
   h->started = 1;
@@ -91,6 +110,12 @@ static fcm_status chol_create(fcm_ctx *ctx, const fcm_csr *A, void **impl)
   h->c.error_handler = NULL;
   h->c.supernodal = CHOLMOD_SUPERNODAL;
   h->c.quick_return_if_not_posdef = 1; /* a failed factor is discarded anyway */
+  /* AMD and METIS both, the one with the smaller factor kept: CHOLMOD's default tries METIS
+   * only when AMD's factor is dense, and on the FCM systems of 3-D bodies cut into parts it
+   * kept AMD's with 26 % more flops (lib/docs/cutting.md) */
+  h->c.nmethods = 2;
+  h->c.method[0].ordering = CHOLMOD_AMD;
+  h->c.method[1].ordering = CHOLMOD_METIS;
 
   cholmod_sparse *S = &h->A;
   S->nrow = (size_t)A->nrows;
@@ -168,9 +193,7 @@ static double min_pivot_ratio(const chol *h, const double *values, fcm_index *co
       piv = L->is_ll ? d * d : d;
     }
     const fcm_index p = perm ? (fcm_index)perm[j] : j;
-    double app = 0.0;
-    for (SuiteSparse_long q = h->ap[p]; q < h->ap[p + 1]; q++)
-      if (h->ai[q] == (SuiteSparse_long)p) app = values[q];
+    const double app = h->diag[p] >= 0 ? values[h->diag[p]] : 0.0;
     const double r = app > 0.0 ? piv / app : (piv > 0.0 ? HUGE_VAL : 0.0);
     if (r < best) {
       best = r;
@@ -180,19 +203,94 @@ static double min_pivot_ratio(const chol *h, const double *values, fcm_index *co
   return best;
 }
 
+/* S = tril(P A P^T) of the entries CHOLMOD reads (A's CSR rows as columns, the entries with
+ * row <= column: stype +1), column by column in A's order: what cholmod_l_factorize() would
+ * pass to the supernodal numeric factorization, up to the order within a column. */
+static fcm_status permuted_lower(fcm_ctx *ctx, chol *h)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index n = h->n;
+  const SuiteSparse_long *perm = h->L->Perm, *ap = h->ap, *ai = h->ai;
+  SuiteSparse_long *pinv = NULL, *next = NULL;
+  FCM_ALLOC(ctx, n, pinv);
+  FCM_ALLOC(ctx, n + 1, next);
+  FCM_ALLOC(ctx, n + 1, h->sp);
+  for (fcm_index k = 0; k < n; k++)
+    pinv[perm ? perm[k] : k] = (SuiteSparse_long)k;
+  SuiteSparse_long m = 0;
+  for (fcm_index j = 0; j < n; j++)
+    for (SuiteSparse_long q = ap[j]; q < ap[j + 1]; q++)
+      if (ai[q] <= (SuiteSparse_long)j) {
+        const SuiteSparse_long a = pinv[ai[q]], b = pinv[j];
+        h->sp[(a < b ? a : b) + 1]++;
+        m++;
+      }
+  for (fcm_index k = 0; k < n; k++)
+    h->sp[k + 1] += h->sp[k];
+  FCM_ALLOC(ctx, FCM_MAX(m, 1), h->si);
+  FCM_ALLOC(ctx, FCM_MAX(m, 1), h->smap);
+  FCM_ALLOC(ctx, FCM_MAX(m, 1), h->sx);
+  memcpy(next, h->sp, sizeof *next * (size_t)(n + 1));
+  for (fcm_index j = 0; j < n; j++)
+    for (SuiteSparse_long q = ap[j]; q < ap[j + 1]; q++)
+      if (ai[q] <= (SuiteSparse_long)j) {
+        const SuiteSparse_long a = pinv[ai[q]], b = pinv[j];
+        const SuiteSparse_long e = next[a < b ? a : b]++;
+        h->si[e] = a < b ? b : a;
+        h->smap[e] = q;
+      }
+  cholmod_sparse *S = &h->S;
+  memset(S, 0, sizeof *S);
+  S->nrow = S->ncol = (size_t)n;
+  S->nzmax = (size_t)FCM_MAX(m, 1);
+  S->p = h->sp;
+  S->i = h->si;
+  S->x = h->sx;
+  S->stype = -1;
+  S->itype = CHOLMOD_LONG;
+  S->xtype = CHOLMOD_REAL;
+  S->dtype = CHOLMOD_DOUBLE;
+  S->sorted = 0;
+  S->packed = 1;
+cleanup:
+  fcm__free(ctx, pinv);
+  fcm__free(ctx, next);
+  return st;
+}
+
+/* The numeric factorization: through the kept S (permuted_lower()) and CHOLMOD's supernodal
+ * numeric step for a supernodal analysis, else cholmod_l_factorize(). */
+static fcm_status numeric(fcm_ctx *ctx, chol *h, const double *values, int *ok)
+{
+  fcm_status st = FCM_OK;
+  if (!h->L->is_super) {
+    h->A.x = (void *)values; /* read only: cholmod_l_factorize does not write A */
+    h->A.xtype = CHOLMOD_REAL;
+    *ok = cholmod_l_factorize(&h->A, h->L, &h->c);
+    h->A.x = NULL;
+    h->A.xtype = CHOLMOD_PATTERN;
+    return FCM_OK;
+  }
+  if (!h->sp) FCM_TRY(ctx, permuted_lower(ctx, h));
+  for (SuiteSparse_long k = 0, m = h->sp[h->n]; k < m; k++)
+    h->sx[k] = values[h->smap[k]];
+  double beta[2] = {0.0, 0.0};
+  *ok = cholmod_l_super_numeric(&h->S, NULL, beta, h->L, &h->c);
+cleanup:
+  return st;
+}
+
 static fcm_status chol_factor(fcm_ctx *ctx, void *impl, const double *values, fcm_direct_info *info)
 {
   fcm_status st = FCM_OK;
   chol *h = impl;
-  h->A.x = (void *)values; /* read only: cholmod_l_factorize does not write A */
-  h->A.xtype = CHOLMOD_REAL;
   h->c.status = CHOLMOD_OK;
   const int dynamic = omp_get_dynamic(); /* a data-environment setting: this thread's only */
   omp_set_dynamic(1);
-  int ok = cholmod_l_factorize(&h->A, h->L, &h->c);
+  int ok = 0;
+  st = numeric(ctx, h, values, &ok);
   omp_set_dynamic(dynamic);
-  h->A.x = NULL;
-  h->A.xtype = CHOLMOD_PATTERN;
+  FCM_TRY(ctx, st);
   if (h->c.status == CHOLMOD_NOT_POSDEF) {
     /* L->minor is the failing column in the permuted order; report the original. */
     size_t k = h->L->minor;

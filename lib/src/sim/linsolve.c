@@ -1,5 +1,6 @@
 /* sim: the linear solves of the Newton steps — CHOLMOD with UMFPACK as the fallback when
- * the matrix is not positive definite (symbolic analyses kept for the whole run), CG /
+ * the matrix is not positive definite (a dynamic step's exact tangent: the Newton loop takes
+ * the projected one instead; symbolic analyses kept for the whole run), CG /
  * MINRES with Jacobi, block Jacobi, additive Schwarz or multigrid preconditioning
  * (lib/METHOD.md §7), the preconditioner built from a PSD tangent by default
  * (preconditioner_tangent), or multigrid cycles as the solver (SPD Newton matrices). One
@@ -100,6 +101,15 @@ static fcm_status factor_direct(fcm_integrator *I, fcm_step_reason *reason, sim_
     fcm_direct_info di;
     fcm_direct_get_info(I->chol, &di);
     if (di.failed_column < 0) return singular_or_retry(I, reason); /* rank deficient */
+    if (I->key_h > 0.0 && !I->h_psd && !I->linear) {
+      /* An exact tangent of a dynamic step that is not positive definite: its Newton
+       * direction need not descend, and an LU factorization costs several Cholesky ones.
+       * The PSD-projected tangent is SPD there (M/h^2 > 0): the Newton loop takes it. */
+      I->h_indefinite = 1;
+      fcm_ctx_error_clear(ctx);
+      *reason = FCM_STEP_LINEAR_SOLVER_FAILED;
+      return FCM_OK;
+    }
     /* Not positive definite: LU with partial pivoting on the same matrix. */
     stats->direct_fallbacks++;
     I->total_fallbacks++;

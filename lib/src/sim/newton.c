@@ -490,7 +490,15 @@ static fcm_status newton_direction(fcm_integrator *I, double h, int predictor, d
     *reason = FCM_STEP_NONE;
     I->kept = 0;
   }
-  FCM_TRY(I->ctx, build_system(I, h, predictor, 0, reason, stats));
+  /* an exact tangent found not positive definite (linsolve.c) earlier in this substep: the
+   * projected one from then on, without trying the exact one first */
+  if (!I->h_indefinite) FCM_TRY(I->ctx, build_system(I, h, predictor, 0, reason, stats));
+  if (I->h_indefinite && (*reason == FCM_STEP_NONE || *reason == FCM_STEP_LINEAR_SOLVER_FAILED)) {
+    projected = 1;
+    *reason = FCM_STEP_NONE;
+    stats->projection_fallbacks++;
+    FCM_TRY(I->ctx, build_system(I, h, predictor, 1, reason, stats));
+  }
   if (*reason == FCM_STEP_NONE) FCM_TRY(I->ctx, direction(I, predictor, reason, its, stats));
   if (*reason == FCM_STEP_LINEAR_SOLVER_FAILED && I->bcon_active > 0 && !I->opts.project_psd) {
     /* Boundary constraints: far from rest the exact Hessian of the Nitsche terms (penalty
@@ -562,7 +570,8 @@ static fcm_status line_search(fcm_integrator *I, double h, int predictor, int la
     if (predictor)
       for (fcm_index j = 0; j < I->nact; j++)
         I->ut[I->act_dof[j]] = I->act_val[j];
-    lr->speculative = !I->linear && !last && bt == 0 && !kept_usable(I, h);
+    /* not once the exact tangent was found indefinite: the next one is the projected one */
+    lr->speculative = !I->linear && !last && bt == 0 && !kept_usable(I, h) && !I->h_indefinite;
     FCM_TRY(I->ctx, evaluate(I, h, I->ut, lr->speculative, I->fint_t, I->g_t, trial, stats));
     if (trial->finite) {
       lr->rt = norm_free(I, I->g_t);
@@ -628,6 +637,7 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
   int met = 0;
   *reason = FCM_STEP_NONE;
   I->solve_stalled = 0;
+  I->h_indefinite = 0;
   if (I->mg_acc) memset(I->mg_acc, 0, sizeof *I->mg_acc * (size_t)I->n);
 
   if (o->tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE) rep_free = norm_free(I, I->Ma);

@@ -204,8 +204,11 @@ struct fcm_integrator {
   /* matrices (space pattern) */
   fcm_csr *M, *H, *D, *H0; /* mass, Newton matrix, damping (or NULL), pristine copy (linear);
                               with a backend M, D, H and H0 are this process's partial ones */
-  fcm_csr *Hpc, *K0;    /* preconditioner matrix, linear stiffness at rest (created on first use) */
-  int h_psd;            /* H holds a PSD tangent (set with H by newton.c) */
+  fcm_csr *Hpc, *K0; /* preconditioner matrix, linear stiffness at rest (created on first use) */
+  int h_psd;         /* H holds a PSD tangent (set with H by newton.c) */
+  /* CHOLMOD found H, the exact tangent of a dynamic step, not positive definite (linsolve.c):
+   * newton.c takes the PSD-projected tangent, SPD with M/h^2, instead of an LU factorization */
+  int h_indefinite;
   double *Ma;           /* M a_rep (n) */
   double rep_norm_full; /* ||M a_rep|| over all DOFs */
 
