@@ -402,36 +402,6 @@ static void uf_union(int *uf, int a, int b)
     uf[a] = b;
 }
 
-/* Whether parts i and j share a face of positive area that does not lie on a cut triangle;
- * fp holds every part's face planes (FCM__POLY_MAX_FACES each; zero normal: no area). */
-static int parts_connected(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
-                           const fcm__parts *P, const fcm__plane *fp, size_t ntri, size_t i,
-                           size_t j)
-{
-  const fcm__poly *a = P->poly + i, *b = P->poly + j;
-  const double mtol = MATCH_RTOL * cell->size, atol = AREA_RTOL * cell->size * cell->size;
-  double xa[3 * FCM__POLY_MAX_FV], xb[3 * FCM__POLY_MAX_FV];
-  for (int fa = 0; fa < a->nf; fa++) {
-    const fcm__plane *pa = fp + i * FCM__POLY_MAX_FACES + fa;
-    if (pa->n[0] == 0.0 && pa->n[1] == 0.0 && pa->n[2] == 0.0) continue;
-    int na = -1; /* face a's vertices, gathered once a face of b faces it */
-    for (int fb = 0; fb < b->nf; fb++) {
-      const fcm__plane *pb = fp + j * FCM__POLY_MAX_FACES + fb;
-      if (fcm__vec3_dot(pa->n, pb->n) > -0.5) continue;
-      if (na < 0) na = fcm__embed_face_coords(a, fa, xa);
-      if (!points_on_plane(xa, na, pb, mtol)) continue;
-      const int nb = fcm__embed_face_coords(b, fb, xb);
-      if (!points_on_plane(xb, nb, pa, mtol)) continue;
-      if (fcm__embed_linked(xa, na, a->x[0], a->nv, xb, nb, b->x[0], b->nv, pb->n, mtol, atol, tris,
-                            P->tcand.ids, ntri) &&
-          (!P->mat || fcm__embed_part_full(P, i) || fcm__embed_part_full(P, j) ||
-           fcm__embed_overlap_material(ctx, P->mat, cell, xa, na, xb, nb, pb->n)))
-        return 1;
-    }
-  }
-  return 0;
-}
-
 void fcm__embed_parts_compact(fcm__parts *P)
 {
   size_t kept = 0;
@@ -478,17 +448,192 @@ cleanup:
   return st;
 }
 
-/* A part's box by its lower x (then its index: qsort is not stable). */
-typedef struct box_key {
-  double x;
-  size_t i;
-} box_key;
+/* The faces of positive area of a cell's parts, grouped by their planes: two faces can meet
+ * only when the vertices of each lie within the tolerance of the other's plane, and those of a
+ * face lie near few of the cell's planes (the cell's faces, the cut triangles' planes and edge
+ * planes, the boundary triangles': every face lies on one), so each face is compared with the
+ * faces of the planes it lies on, not with every face of every part near it. Faces whose
+ * planes are equal up to orientation form a group; the distance of a point to a plane and its
+ * negation are the same number, so the test against the group's plane is the test against
+ * each of its faces' planes, bit for bit. */
+typedef struct face_set {
+  size_t n;        /* faces */
+  int *part, *nx;  /* per face: its part, its vertex count */
+  size_t *x0;      /* its first coordinate in x */
+  fcm__plane *pl;  /* its plane as its part stores it */
+  double *x;       /* the faces' vertices */
+  int *order;      /* the faces by group, then orientation, then part */
+  size_t *goff;    /* group g: order[goff[g] .. goff[g + 1]) */
+  size_t *gneg;    /* its first face facing opposite its plane gpl[g] */
+  fcm__plane *gpl; /* the group's plane (the orientation of its first face) */
+  int *grp;        /* per face: its group */
+  size_t ng;       /* groups */
+} face_set;
 
-static int cmp_box_key(const void *a, const void *b)
+static void face_set_free(fcm_ctx *ctx, face_set *F)
 {
-  const box_key *p = a, *q = b;
-  if (p->x != q->x) return p->x < q->x ? -1 : 1;
-  return (p->i > q->i) - (p->i < q->i);
+  fcm__free(ctx, F->part);
+  fcm__free(ctx, F->nx);
+  fcm__free(ctx, F->x0);
+  fcm__free(ctx, F->pl);
+  fcm__free(ctx, F->x);
+  fcm__free(ctx, F->order);
+  fcm__free(ctx, F->goff);
+  fcm__free(ctx, F->gneg);
+  fcm__free(ctx, F->gpl);
+  fcm__free(ctx, F->grp);
+}
+
+/* The sign that orients plane p canonically (its first nonzero normal component positive). */
+static double plane_sign(const fcm__plane *p)
+{
+  for (int d = 0; d < 3; d++)
+    if (p->n[d] != 0.0) return p->n[d] > 0.0 ? 1.0 : -1.0;
+  return 1.0;
+}
+
+/* A face's sort key: its plane oriented canonically, its orientation against that, its part
+ * and its index. */
+typedef struct face_key {
+  double k[4];
+  double sign;
+  int part, face;
+} face_key;
+
+/* Faces by their canonical plane, then by orientation (as the plane first), then by part. */
+static int cmp_face(const void *pa, const void *pb)
+{
+  const face_key *p = pa, *q = pb;
+  for (int d = 0; d < 4; d++)
+    if (p->k[d] != q->k[d]) return p->k[d] < q->k[d] ? -1 : 1;
+  if (p->sign != q->sign) return p->sign > q->sign ? -1 : 1;
+  if (p->part != q->part) return p->part < q->part ? -1 : 1;
+  return (p->face > q->face) - (p->face < q->face);
+}
+
+static int same_plane(const fcm__plane *p, const fcm__plane *q)
+{
+  const double sp = plane_sign(p), sq = plane_sign(q);
+  return sp * p->n[0] == sq * q->n[0] && sp * p->n[1] == sq * q->n[1] &&
+         sp * p->n[2] == sq * q->n[2] && sp * p->d == sq * q->d;
+}
+
+/* Gather the faces of P's parts with positive area and a finite plane (a face without either
+ * matches no face: its distances are not within any tolerance) and group them. */
+static fcm_status faces_build(fcm_ctx *ctx, const fcm__parts *P, face_set *F)
+{
+  fcm_status st = FCM_OK;
+  face_key *keys = NULL;
+  size_t nf = 0, nv = 0;
+  for (size_t i = 0; i < P->n; i++) {
+    nf += (size_t)P->poly[i].nf;
+    for (int f = 0; f < P->poly[i].nf; f++)
+      nv += (size_t)P->poly[i].fn[f];
+  }
+  FCM_ALLOC_RAW(ctx, nf + 1, F->part);
+  FCM_ALLOC_RAW(ctx, nf + 1, F->nx);
+  FCM_ALLOC_RAW(ctx, nf + 1, F->x0);
+  FCM_ALLOC_RAW(ctx, nf + 1, F->pl);
+  FCM_ALLOC_RAW(ctx, 3 * nv + 1, F->x);
+  FCM_ALLOC_RAW(ctx, nf + 1, F->order);
+  FCM_ALLOC_RAW(ctx, nf + 1, F->grp);
+  size_t xn = 0;
+  for (size_t i = 0; i < P->n; i++)
+    for (int f = 0; f < P->poly[i].nf; f++) {
+      fcm__plane pl;
+      if (!fcm__embed_face_plane(P->poly + i, f, &pl)) continue;
+      if (!(isfinite(pl.n[0]) && isfinite(pl.n[1]) && isfinite(pl.n[2]) && isfinite(pl.d)))
+        continue;
+      F->part[F->n] = (int)i, F->pl[F->n] = pl, F->x0[F->n] = xn;
+      F->nx[F->n] = fcm__embed_face_coords(P->poly + i, f, F->x + xn);
+      xn += 3 * (size_t)F->nx[F->n];
+      F->n++;
+    }
+  FCM_ALLOC_RAW(ctx, F->n + 1, keys);
+  for (size_t k = 0; k < F->n; k++) {
+    const fcm__plane *p = F->pl + k;
+    const double sg = plane_sign(p);
+    face_key *fk = keys + k;
+    for (int d = 0; d < 3; d++)
+      fk->k[d] = sg * p->n[d];
+    fk->k[3] = sg * p->d, fk->sign = sg, fk->part = F->part[k], fk->face = (int)k;
+  }
+  qsort(keys, F->n, sizeof *keys, cmp_face);
+  for (size_t k = 0; k < F->n; k++)
+    F->order[k] = keys[k].face;
+  FCM_ALLOC_RAW(ctx, F->n + 1, F->goff);
+  FCM_ALLOC_RAW(ctx, F->n + 1, F->gneg);
+  FCM_ALLOC_RAW(ctx, F->n + 1, F->gpl);
+  for (size_t k = 0; k < F->n; k++) {
+    const fcm__plane *p = F->pl + F->order[k];
+    if (k == 0 || !same_plane(p, F->pl + F->order[k - 1])) {
+      F->goff[F->ng] = F->gneg[F->ng] = k;
+      F->gpl[F->ng++] = *p;
+    }
+    const size_t g = F->ng - 1;
+    if (plane_sign(p) == plane_sign(F->gpl + g)) F->gneg[g] = k + 1;
+    F->grp[F->order[k]] = (int)g;
+  }
+  F->goff[F->ng] = F->n;
+cleanup:
+  fcm__free(ctx, keys);
+  return st;
+}
+
+/* Whether face a (of part i) and face b (of part j > i) facing it share an area that does
+ * not lie on a cut triangle and holds material (a body given by its surface); a's vertices
+ * lie within mtol of b's plane. */
+static int faces_linked(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
+                        size_t ntri, const fcm__parts *P, const face_set *F, size_t a, size_t b)
+{
+  const double mtol = MATCH_RTOL * cell->size, atol = AREA_RTOL * cell->size * cell->size;
+  const int i = F->part[a], j = F->part[b];
+  const double *xa = F->x + F->x0[a], *xb = F->x + F->x0[b];
+  const int na = F->nx[a], nb = F->nx[b];
+  if (!points_on_plane(xb, nb, F->pl + a, mtol)) return 0;
+  const fcm__poly *pa = P->poly + i, *pb = P->poly + j;
+  return fcm__embed_linked(xa, na, pa->x[0], pa->nv, xb, nb, pb->x[0], pb->nv, F->pl[b].n, mtol,
+                           atol, tris, P->tcand.ids, ntri) &&
+         (!P->mat || fcm__embed_part_full(P, (size_t)i) || fcm__embed_part_full(P, (size_t)j) ||
+          fcm__embed_overlap_material(ctx, P->mat, cell, xa, na, xb, nb, F->pl[b].n));
+}
+
+/* Join the parts whose boxes meet and that share a face of positive area not lying on a cut
+ * triangle (with material, for a body given by its surface): face a of part i against the
+ * faces b of parts j > i on the planes a lies on, facing it (their normals at more than 120
+ * degrees). The components do not depend on the order the pairs are joined in. */
+static void join_parts(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
+                       size_t ntri, fcm__parts *P, const face_set *F, const double *box)
+{
+  const double mtol = MATCH_RTOL * cell->size;
+  for (size_t a = 0; a < F->n; a++) {
+    const int i = F->part[a];
+    const fcm__plane *pa = F->pl + a;
+    const double *bi = box + 6 * (size_t)i;
+    for (size_t g = 0; g < F->ng; g++) {
+      const double s = fcm__vec3_dot(pa->n, F->gpl[g].n);
+      size_t k0, k1; /* the faces of the group facing a: normal -pa's side of the group's */
+      if (s <= -0.5)
+        k0 = F->goff[g], k1 = F->gneg[g];
+      else if (-s <= -0.5)
+        k0 = F->gneg[g], k1 = F->goff[g + 1];
+      else
+        continue;
+      if (k0 == k1 || F->part[F->order[k1 - 1]] <= i) continue;
+      if (!points_on_plane(F->x + F->x0[a], F->nx[a], F->gpl + g, mtol)) continue;
+      for (size_t k = k0; k < k1; k++) {
+        const size_t b = (size_t)F->order[k];
+        const int j = F->part[b];
+        if (j <= i) continue;
+        const double *bj = box + 6 * (size_t)j;
+        int apart = 0;
+        for (int d = 0; d < 3; d++)
+          apart |= bi[d] > bj[3 + d] || bj[d] > bi[3 + d];
+        if (apart || uf_find(P->uf, i) == uf_find(P->uf, j)) continue;
+        if (faces_linked(ctx, cell, tris, ntri, P, F, a, b)) uf_union(P->uf, i, j);
+      }
+    }
+  }
 }
 
 fcm_status fcm__embed_parts_components(fcm_ctx *ctx, const fcm__embed_cell *cell,
@@ -497,8 +642,7 @@ fcm_status fcm__embed_parts_components(fcm_ctx *ctx, const fcm__embed_cell *cell
 {
   fcm_status st = FCM_OK;
   double *box = NULL;
-  box_key *order = NULL;
-  fcm__plane *fp = NULL;
+  face_set F = {0};
   if (P->n > P->ufcap) {
     void *u = P->uf;
     FCM_TRY(ctx, fcm__resize(ctx, &u, 0, P->n, sizeof(int)));
@@ -506,14 +650,8 @@ fcm_status fcm__embed_parts_components(fcm_ctx *ctx, const fcm__embed_cell *cell
     P->ufcap = P->n;
   }
   FCM_ALLOC_RAW(ctx, 6 * P->n + 1, box);
-  FCM_ALLOC_RAW(ctx, P->n + 1, order);
-  FCM_ALLOC(ctx, FCM__POLY_MAX_FACES * P->n + 1, fp);
   const double mtol = MATCH_RTOL * cell->size;
   for (size_t i = 0; i < P->n; i++) {
-    for (int f = 0; f < P->poly[i].nf; f++) {
-      fcm__plane *pl = fp + i * FCM__POLY_MAX_FACES + f;
-      if (!fcm__embed_face_plane(P->poly + i, f, pl)) pl->n[0] = pl->n[1] = pl->n[2] = 0.0;
-    }
     P->uf[i] = (int)i;
     double *bi = box + 6 * i;
     for (int d = 0; d < 3; d++)
@@ -524,22 +662,8 @@ fcm_status fcm__embed_parts_components(fcm_ctx *ctx, const fcm__embed_cell *cell
         bi[3 + d] = fmax(bi[3 + d], P->poly[i].x[v][d] + mtol);
       }
   }
-  /* the pairs whose boxes meet, swept along x (the components, numbered by their lowest part,
-   * do not depend on the order the pairs are joined in) */
-  for (size_t i = 0; i < P->n; i++)
-    order[i].x = box[6 * i], order[i].i = i;
-  qsort(order, P->n, sizeof *order, cmp_box_key);
-  for (size_t a = 0; a < P->n; a++)
-    for (size_t b = a + 1; b < P->n; b++) {
-      if (order[b].x > box[6 * order[a].i + 3]) break; /* the rest start beyond a's box */
-      const size_t i = FCM_MIN(order[a].i, order[b].i), j = FCM_MAX(order[a].i, order[b].i);
-      const double *bi = box + 6 * i, *bj = box + 6 * j;
-      int apart = 0;
-      for (int d = 1; d < 3; d++)
-        apart |= bi[d] > bj[3 + d] || bj[d] > bi[3 + d];
-      if (apart || uf_find(P->uf, (int)i) == uf_find(P->uf, (int)j)) continue;
-      if (parts_connected(ctx, cell, tris, P, fp, ntri, i, j)) uf_union(P->uf, (int)i, (int)j);
-    }
+  FCM_TRY(ctx, faces_build(ctx, P, &F));
+  join_parts(ctx, cell, tris, ntri, P, &F, box);
   if (P->mat) FCM_TRY(ctx, fcm__material_status(P->mat));
   int np = 0;
   for (size_t i = 0; i < P->n; i++) {
@@ -549,8 +673,7 @@ fcm_status fcm__embed_parts_components(fcm_ctx *ctx, const fcm__embed_cell *cell
   *count = np;
 cleanup:
   fcm__free(ctx, box);
-  fcm__free(ctx, order);
-  fcm__free(ctx, fp);
+  face_set_free(ctx, &F);
   return st;
 }
 
