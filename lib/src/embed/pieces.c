@@ -281,6 +281,40 @@ int fcm__embed_face_coords(const fcm__poly *p, int f, double *x)
   return p->fn[f];
 }
 
+/* The area of polygon x (m vertices). */
+static double polygon_area(const double *x, int m)
+{
+  double n[3] = {0, 0, 0};
+  for (int k = 0; k < m; k++) {
+    const double *p = x + 3 * k, *q = x + 3 * ((k + 1) % m);
+    n[0] += (p[1] - q[1]) * (p[2] + q[2]);
+    n[1] += (p[2] - q[2]) * (p[0] + q[0]);
+    n[2] += (p[0] - q[0]) * (p[1] + q[1]);
+  }
+  return 0.5 * sqrt(fcm__vec3_dot(n, n));
+}
+
+/* The plane of edge p, q of a face with normal nrm, outward (zero normal: a point edge). */
+static fcm__plane edge_plane(const double p[3], const double q[3], const double nrm[3])
+{
+  fcm__plane pl = {{0, 0, 0}, 0};
+  double e[3], mm[3];
+  for (int d = 0; d < 3; d++)
+    e[d] = q[d] - p[d];
+  fcm__vec3_cross(e, nrm, mm);
+  const double lm = sqrt(fcm__vec3_dot(mm, mm));
+  if (!(lm > 0.0)) return pl;
+  for (int d = 0; d < 3; d++)
+    pl.n[d] = mm[d] / lm;
+  pl.d = fcm__vec3_dot(pl.n, p);
+  return pl;
+}
+
+static int zero_plane(const fcm__plane *pl)
+{
+  return pl->n[0] == 0.0 && pl->n[1] == 0.0 && pl->n[2] == 0.0;
+}
+
 double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
                           const double nb_normal[3], double tol, double *overlap, int *num_overlap)
 {
@@ -290,30 +324,13 @@ double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
   memcpy(x, a, 3 * (size_t)na * sizeof *x);
   int m = na;
   for (int k = 0; k < nb && m >= 3; k++) {
-    const double *p = b + 3 * k, *q = b + 3 * ((k + 1) % nb);
-    double e[3], mm[3];
-    for (int d = 0; d < 3; d++)
-      e[d] = q[d] - p[d];
-    fcm__vec3_cross(e, nb_normal, mm);
-    const double lm = sqrt(fcm__vec3_dot(mm, mm));
-    if (!(lm > 0.0)) continue;
-    fcm__plane pl;
-    for (int d = 0; d < 3; d++)
-      pl.n[d] = mm[d] / lm;
-    pl.d = fcm__vec3_dot(pl.n, p);
-    m = fcm__geom_polygon_clip(x, m, FCM__POLY_MAX_VERTS, &pl, tol, 1, work);
+    const fcm__plane pl = edge_plane(b + 3 * k, b + 3 * ((k + 1) % nb), nb_normal);
+    if (!zero_plane(&pl)) m = fcm__geom_polygon_clip(x, m, FCM__POLY_MAX_VERTS, &pl, tol, 1, work);
   }
   if (m < 3) return 0.0;
-  double n[3] = {0, 0, 0};
-  for (int k = 0; k < m; k++) {
-    const double *p = x + 3 * k, *q = x + 3 * ((k + 1) % m);
-    n[0] += (p[1] - q[1]) * (p[2] + q[2]);
-    n[1] += (p[2] - q[2]) * (p[0] + q[0]);
-    n[2] += (p[0] - q[0]) * (p[1] + q[1]);
-  }
   if (overlap) memcpy(overlap, x, 3 * (size_t)m * sizeof *x);
   if (num_overlap) *num_overlap = m;
-  return 0.5 * sqrt(fcm__vec3_dot(n, n));
+  return polygon_area(x, m);
 }
 
 /* Whether point x lies on one of the triangles within tol. */
@@ -359,13 +376,14 @@ static int part_side(const double *v, int nv, const fcm__plane *pl, double tol)
   return 0;
 }
 
-int fcm__embed_linked(const double *a, int na, const double *va, int nva, const double *b, int nb,
-                      const double *vb, int nvb, const double nb_normal[3], double tol, double atol,
-                      const fcm__cut_tri *tris, const fcm_index *ids, size_t n)
+/* Whether the parts with vertices va (nva) and vb (nvb) whose faces overlap in the polygon x
+ * (m vertices, of more than the area that counts) join: the overlap does not lie on a cut
+ * triangle, or they lie on the same side of each it lies on. */
+static int overlap_linked(const double *x, int m, const double *va, int nva, const double *vb,
+                          int nvb, double tol, const fcm__cut_tri *tris, const fcm_index *ids,
+                          size_t n)
 {
-  double x[3 * FCM__POLY_MAX_VERTS], c[3] = {0, 0, 0};
-  int m = 0;
-  if (fcm__embed_overlap(a, na, b, nb, nb_normal, tol, x, &m) <= atol) return 0;
+  double c[3] = {0, 0, 0};
   const double ctol = ON_CUT_FACTOR * tol;
   if (!fcm__embed_on_cut(tris, ids, n, x, m, ctol)) return 1;
   for (int k = 0; k < m; k++)
@@ -382,6 +400,16 @@ int fcm__embed_linked(const double *a, int na, const double *va, int nva, const 
     if (!(sa * sb > 0 || (sa == 0 && sb == 0))) return 0;
   }
   return 1;
+}
+
+int fcm__embed_linked(const double *a, int na, const double *va, int nva, const double *b, int nb,
+                      const double *vb, int nvb, const double nb_normal[3], double tol, double atol,
+                      const fcm__cut_tri *tris, const fcm_index *ids, size_t n)
+{
+  double x[3 * FCM__POLY_MAX_VERTS];
+  int m = 0;
+  if (fcm__embed_overlap(a, na, b, nb, nb_normal, tol, x, &m) <= atol) return 0;
+  return overlap_linked(x, m, va, nva, vb, nvb, tol, tris, ids, n);
 }
 
 static int uf_find(int *uf, int a)
@@ -462,6 +490,9 @@ typedef struct face_set {
   size_t *x0;      /* its first coordinate in x */
   fcm__plane *pl;  /* its plane as its part stores it */
   double *x;       /* the faces' vertices */
+  fcm__plane *ep;  /* per vertex k of a face: the plane of its edge k, k + 1 through the face's
+                      normal, outward, as fcm__embed_overlap() makes it (zero: none) */
+  double *r;       /* per face: the largest magnitude of its vertices' coordinates */
   int *order;      /* the faces by group, then orientation, then part */
   size_t *goff;    /* group g: order[goff[g] .. goff[g + 1]) */
   size_t *gneg;    /* its first face facing opposite its plane gpl[g] */
@@ -477,6 +508,8 @@ static void face_set_free(fcm_ctx *ctx, face_set *F)
   fcm__free(ctx, F->x0);
   fcm__free(ctx, F->pl);
   fcm__free(ctx, F->x);
+  fcm__free(ctx, F->ep);
+  fcm__free(ctx, F->r);
   fcm__free(ctx, F->order);
   fcm__free(ctx, F->goff);
   fcm__free(ctx, F->gneg);
@@ -518,6 +551,41 @@ static int same_plane(const fcm__plane *p, const fcm__plane *q)
          sp * p->n[2] == sq * q->n[2] && sp * p->d == sq * q->d;
 }
 
+/* The edge planes of face f (F->ep) and the magnitude of its coordinates (F->r). */
+static void edge_planes(face_set *F, size_t f)
+{
+  const int m = F->nx[f];
+  const double *x = F->x + F->x0[f];
+  double r = 0.0;
+  for (int k = 0; k < m; k++) {
+    for (int d = 0; d < 3; d++)
+      r = fmax(r, fabs(x[3 * k + d]));
+    F->ep[F->x0[f] / 3 + (size_t)k] = edge_plane(x + 3 * k, x + 3 * ((k + 1) % m), F->pl[f].n);
+  }
+  F->r[f] = r;
+}
+
+/* Whether the vertices of face a all lie beyond one edge plane of face b by more than twice
+ * tol (plus the rounding of points of the size of theirs): then clipping a by b's edge planes
+ * (fcm__embed_overlap()) leaves nothing, whatever the planes before that one clipped (their
+ * points lie between a's, beyond it by more than tol), and the faces do not meet. */
+static int faces_apart(const face_set *F, size_t a, size_t b, double tol)
+{
+  const int na = F->nx[a], nb = F->nx[b];
+  const double *xa = F->x + F->x0[a];
+  const fcm__plane *ep = F->ep + F->x0[b] / 3;
+  const double lim = 2.0 * tol + 1e-12 * fmax(F->r[a], F->r[b]);
+  if (na < 3 || nb < 3) return 0;
+  for (int k = 0; k < nb; k++) {
+    if (zero_plane(ep + k)) continue;
+    int v = 0;
+    while (v < na && fcm__vec3_dot(ep[k].n, xa + 3 * v) - ep[k].d > lim)
+      v++;
+    if (v == na) return 1;
+  }
+  return 0;
+}
+
 /* Gather the faces of P's parts with positive area and a finite plane (a face without either
  * matches no face: its distances are not within any tolerance) and group them. */
 static fcm_status faces_build(fcm_ctx *ctx, const fcm__parts *P, face_set *F)
@@ -535,6 +603,8 @@ static fcm_status faces_build(fcm_ctx *ctx, const fcm__parts *P, face_set *F)
   FCM_ALLOC_RAW(ctx, nf + 1, F->x0);
   FCM_ALLOC_RAW(ctx, nf + 1, F->pl);
   FCM_ALLOC_RAW(ctx, 3 * nv + 1, F->x);
+  FCM_ALLOC_RAW(ctx, nv + 1, F->ep);
+  FCM_ALLOC_RAW(ctx, nf + 1, F->r);
   FCM_ALLOC_RAW(ctx, nf + 1, F->order);
   FCM_ALLOC_RAW(ctx, nf + 1, F->grp);
   size_t xn = 0;
@@ -546,6 +616,7 @@ static fcm_status faces_build(fcm_ctx *ctx, const fcm__parts *P, face_set *F)
         continue;
       F->part[F->n] = (int)i, F->pl[F->n] = pl, F->x0[F->n] = xn;
       F->nx[F->n] = fcm__embed_face_coords(P->poly + i, f, F->x + xn);
+      edge_planes(F, F->n);
       xn += 3 * (size_t)F->nx[F->n];
       F->n++;
     }
@@ -590,10 +661,19 @@ static int faces_linked(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cu
   const int i = F->part[a], j = F->part[b];
   const double *xa = F->x + F->x0[a], *xb = F->x + F->x0[b];
   const int na = F->nx[a], nb = F->nx[b];
-  if (!points_on_plane(xb, nb, F->pl + a, mtol)) return 0;
+  if (!points_on_plane(xb, nb, F->pl + a, mtol) || faces_apart(F, a, b, mtol)) return 0;
+  /* fcm__embed_linked() on b's edge planes made once */
+  double x[3 * FCM__POLY_MAX_VERTS], work[3 * FCM__POLY_MAX_VERTS];
+  const fcm__plane *ep = F->ep + F->x0[b] / 3;
+  int m = na;
+  if (na < 3 || nb < 3 || na > FCM__POLY_MAX_VERTS) return 0;
+  memcpy(x, xa, 3 * (size_t)na * sizeof *x);
+  for (int k = 0; k < nb && m >= 3; k++)
+    if (!zero_plane(ep + k))
+      m = fcm__geom_polygon_clip(x, m, FCM__POLY_MAX_VERTS, ep + k, mtol, 1, work);
+  if (m < 3 || polygon_area(x, m) <= atol) return 0;
   const fcm__poly *pa = P->poly + i, *pb = P->poly + j;
-  return fcm__embed_linked(xa, na, pa->x[0], pa->nv, xb, nb, pb->x[0], pb->nv, F->pl[b].n, mtol,
-                           atol, tris, P->tcand.ids, ntri) &&
+  return overlap_linked(x, m, pa->x[0], pa->nv, pb->x[0], pb->nv, mtol, tris, P->tcand.ids, ntri) &&
          (!P->mat || fcm__embed_part_full(P, (size_t)i) || fcm__embed_part_full(P, (size_t)j) ||
           fcm__embed_overlap_material(ctx, P->mat, cell, xa, na, xb, nb, F->pl[b].n));
 }
