@@ -497,7 +497,6 @@ typedef struct face_set {
   size_t *goff;    /* group g: order[goff[g] .. goff[g + 1]) */
   size_t *gneg;    /* its first face facing opposite its plane gpl[g] */
   fcm__plane *gpl; /* the group's plane (the orientation of its first face) */
-  int *grp;        /* per face: its group */
   size_t ng;       /* groups */
 } face_set;
 
@@ -514,7 +513,6 @@ static void face_set_free(fcm_ctx *ctx, face_set *F)
   fcm__free(ctx, F->goff);
   fcm__free(ctx, F->gneg);
   fcm__free(ctx, F->gpl);
-  fcm__free(ctx, F->grp);
 }
 
 /* The sign that orients plane p canonically (its first nonzero normal component positive). */
@@ -606,7 +604,6 @@ static fcm_status faces_build(fcm_ctx *ctx, const fcm__parts *P, face_set *F)
   FCM_ALLOC_RAW(ctx, nv + 1, F->ep);
   FCM_ALLOC_RAW(ctx, nf + 1, F->r);
   FCM_ALLOC_RAW(ctx, nf + 1, F->order);
-  FCM_ALLOC_RAW(ctx, nf + 1, F->grp);
   size_t xn = 0;
   for (size_t i = 0; i < P->n; i++)
     for (int f = 0; f < P->poly[i].nf; f++) {
@@ -643,7 +640,6 @@ static fcm_status faces_build(fcm_ctx *ctx, const fcm__parts *P, face_set *F)
     }
     const size_t g = F->ng - 1;
     if (plane_sign(p) == plane_sign(F->gpl + g)) F->gneg[g] = k + 1;
-    F->grp[F->order[k]] = (int)g;
   }
   F->goff[F->ng] = F->n;
 cleanup:
