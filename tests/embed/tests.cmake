@@ -81,6 +81,11 @@ fcm_add_test(embed_cut_bench tests/embed/cut_bench.c LABELS bench TIMEOUT 3600)
 # rules those of the reference or, kept, of the rules extended); cuts that change nothing
 # integrate nothing and leave every rule bit-identical.
 fcm_add_test(embed_cut_keep tests/embed/cut_keep.c)
+# The parts' connectivity inside a cell: a part touching another only along an edge stays
+# apart, cuts across the cell, as coplanar triangles and on its face; random cuts (near the
+# cell's and each other's planes, coplanar neighbours, ending inside): the components equal the
+# pairwise face-by-face definition's, numbering included.
+fcm_add_test(embed_parts_links tests/embed/parts_links.c)
 # The rules file for other codes read back: bitwise the accessors' rules piece by piece (with
 # and without a cut), exact volumes and monomials, a closed surface rule (sum w n = 0,
 # sum w x.n = 3 V), bad arguments refused leaving no temporary and the old file intact.

@@ -281,6 +281,40 @@ int fcm__embed_face_coords(const fcm__poly *p, int f, double *x)
   return p->fn[f];
 }
 
+/* The area of polygon x (m vertices). */
+static double polygon_area(const double *x, int m)
+{
+  double n[3] = {0, 0, 0};
+  for (int k = 0; k < m; k++) {
+    const double *p = x + 3 * k, *q = x + 3 * ((k + 1) % m);
+    n[0] += (p[1] - q[1]) * (p[2] + q[2]);
+    n[1] += (p[2] - q[2]) * (p[0] + q[0]);
+    n[2] += (p[0] - q[0]) * (p[1] + q[1]);
+  }
+  return 0.5 * sqrt(fcm__vec3_dot(n, n));
+}
+
+/* The plane of edge p, q of a face with normal nrm, outward (zero normal: a point edge). */
+static fcm__plane edge_plane(const double p[3], const double q[3], const double nrm[3])
+{
+  fcm__plane pl = {{0, 0, 0}, 0};
+  double e[3], mm[3];
+  for (int d = 0; d < 3; d++)
+    e[d] = q[d] - p[d];
+  fcm__vec3_cross(e, nrm, mm);
+  const double lm = sqrt(fcm__vec3_dot(mm, mm));
+  if (!(lm > 0.0)) return pl;
+  for (int d = 0; d < 3; d++)
+    pl.n[d] = mm[d] / lm;
+  pl.d = fcm__vec3_dot(pl.n, p);
+  return pl;
+}
+
+static int zero_plane(const fcm__plane *pl)
+{
+  return pl->n[0] == 0.0 && pl->n[1] == 0.0 && pl->n[2] == 0.0;
+}
+
 double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
                           const double nb_normal[3], double tol, double *overlap, int *num_overlap)
 {
@@ -290,30 +324,13 @@ double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
   memcpy(x, a, 3 * (size_t)na * sizeof *x);
   int m = na;
   for (int k = 0; k < nb && m >= 3; k++) {
-    const double *p = b + 3 * k, *q = b + 3 * ((k + 1) % nb);
-    double e[3], mm[3];
-    for (int d = 0; d < 3; d++)
-      e[d] = q[d] - p[d];
-    fcm__vec3_cross(e, nb_normal, mm);
-    const double lm = sqrt(fcm__vec3_dot(mm, mm));
-    if (!(lm > 0.0)) continue;
-    fcm__plane pl;
-    for (int d = 0; d < 3; d++)
-      pl.n[d] = mm[d] / lm;
-    pl.d = fcm__vec3_dot(pl.n, p);
-    m = fcm__geom_polygon_clip(x, m, FCM__POLY_MAX_VERTS, &pl, tol, 1, work);
+    const fcm__plane pl = edge_plane(b + 3 * k, b + 3 * ((k + 1) % nb), nb_normal);
+    if (!zero_plane(&pl)) m = fcm__geom_polygon_clip(x, m, FCM__POLY_MAX_VERTS, &pl, tol, 1, work);
   }
   if (m < 3) return 0.0;
-  double n[3] = {0, 0, 0};
-  for (int k = 0; k < m; k++) {
-    const double *p = x + 3 * k, *q = x + 3 * ((k + 1) % m);
-    n[0] += (p[1] - q[1]) * (p[2] + q[2]);
-    n[1] += (p[2] - q[2]) * (p[0] + q[0]);
-    n[2] += (p[0] - q[0]) * (p[1] + q[1]);
-  }
   if (overlap) memcpy(overlap, x, 3 * (size_t)m * sizeof *x);
   if (num_overlap) *num_overlap = m;
-  return 0.5 * sqrt(fcm__vec3_dot(n, n));
+  return polygon_area(x, m);
 }
 
 /* Whether point x lies on one of the triangles within tol. */
@@ -359,13 +376,14 @@ static int part_side(const double *v, int nv, const fcm__plane *pl, double tol)
   return 0;
 }
 
-int fcm__embed_linked(const double *a, int na, const double *va, int nva, const double *b, int nb,
-                      const double *vb, int nvb, const double nb_normal[3], double tol, double atol,
-                      const fcm__cut_tri *tris, const fcm_index *ids, size_t n)
+/* Whether the parts with vertices va (nva) and vb (nvb) whose faces overlap in the polygon x
+ * (m vertices, of more than the area that counts) join: the overlap does not lie on a cut
+ * triangle, or they lie on the same side of each it lies on. */
+static int overlap_linked(const double *x, int m, const double *va, int nva, const double *vb,
+                          int nvb, double tol, const fcm__cut_tri *tris, const fcm_index *ids,
+                          size_t n)
 {
-  double x[3 * FCM__POLY_MAX_VERTS], c[3] = {0, 0, 0};
-  int m = 0;
-  if (fcm__embed_overlap(a, na, b, nb, nb_normal, tol, x, &m) <= atol) return 0;
+  double c[3] = {0, 0, 0};
   const double ctol = ON_CUT_FACTOR * tol;
   if (!fcm__embed_on_cut(tris, ids, n, x, m, ctol)) return 1;
   for (int k = 0; k < m; k++)
@@ -384,6 +402,16 @@ int fcm__embed_linked(const double *a, int na, const double *va, int nva, const 
   return 1;
 }
 
+int fcm__embed_linked(const double *a, int na, const double *va, int nva, const double *b, int nb,
+                      const double *vb, int nvb, const double nb_normal[3], double tol, double atol,
+                      const fcm__cut_tri *tris, const fcm_index *ids, size_t n)
+{
+  double x[3 * FCM__POLY_MAX_VERTS];
+  int m = 0;
+  if (fcm__embed_overlap(a, na, b, nb, nb_normal, tol, x, &m) <= atol) return 0;
+  return overlap_linked(x, m, va, nva, vb, nvb, tol, tris, ids, n);
+}
+
 static int uf_find(int *uf, int a)
 {
   while (uf[a] != a) {
@@ -400,36 +428,6 @@ static void uf_union(int *uf, int a, int b)
     uf[b] = a;
   else if (b < a)
     uf[a] = b;
-}
-
-/* Whether parts i and j share a face of positive area that does not lie on a cut triangle;
- * fp holds every part's face planes (FCM__POLY_MAX_FACES each; zero normal: no area). */
-static int parts_connected(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
-                           const fcm__parts *P, const fcm__plane *fp, size_t ntri, size_t i,
-                           size_t j)
-{
-  const fcm__poly *a = P->poly + i, *b = P->poly + j;
-  const double mtol = MATCH_RTOL * cell->size, atol = AREA_RTOL * cell->size * cell->size;
-  double xa[3 * FCM__POLY_MAX_FV], xb[3 * FCM__POLY_MAX_FV];
-  for (int fa = 0; fa < a->nf; fa++) {
-    const fcm__plane *pa = fp + i * FCM__POLY_MAX_FACES + fa;
-    if (pa->n[0] == 0.0 && pa->n[1] == 0.0 && pa->n[2] == 0.0) continue;
-    int na = -1; /* face a's vertices, gathered once a face of b faces it */
-    for (int fb = 0; fb < b->nf; fb++) {
-      const fcm__plane *pb = fp + j * FCM__POLY_MAX_FACES + fb;
-      if (fcm__vec3_dot(pa->n, pb->n) > -0.5) continue;
-      if (na < 0) na = fcm__embed_face_coords(a, fa, xa);
-      if (!points_on_plane(xa, na, pb, mtol)) continue;
-      const int nb = fcm__embed_face_coords(b, fb, xb);
-      if (!points_on_plane(xb, nb, pa, mtol)) continue;
-      if (fcm__embed_linked(xa, na, a->x[0], a->nv, xb, nb, b->x[0], b->nv, pb->n, mtol, atol, tris,
-                            P->tcand.ids, ntri) &&
-          (!P->mat || fcm__embed_part_full(P, i) || fcm__embed_part_full(P, j) ||
-           fcm__embed_overlap_material(ctx, P->mat, cell, xa, na, xb, nb, pb->n)))
-        return 1;
-    }
-  }
-  return 0;
 }
 
 void fcm__embed_parts_compact(fcm__parts *P)
@@ -478,17 +476,240 @@ cleanup:
   return st;
 }
 
-/* A part's box by its lower x (then its index: qsort is not stable). */
-typedef struct box_key {
-  double x;
-  size_t i;
-} box_key;
+/* The faces of positive area of a cell's parts, grouped by their planes: two faces can meet
+ * only when the vertices of each lie within the tolerance of the other's plane, and those of a
+ * face lie near few of the cell's planes (the cell's faces, the cut triangles' planes and edge
+ * planes, the boundary triangles': every face lies on one), so each face is compared with the
+ * faces of the planes it lies on, not with every face of every part near it. Faces whose
+ * planes are equal up to orientation form a group; the distance of a point to a plane and its
+ * negation are the same number, so the test against the group's plane is the test against
+ * each of its faces' planes, bit for bit. */
+typedef struct face_set {
+  size_t n;        /* faces */
+  int *part, *nx;  /* per face: its part, its vertex count */
+  size_t *x0;      /* its first coordinate in x */
+  fcm__plane *pl;  /* its plane as its part stores it */
+  double *x;       /* the faces' vertices */
+  fcm__plane *ep;  /* per vertex k of a face: the plane of its edge k, k + 1 through the face's
+                      normal, outward, as fcm__embed_overlap() makes it (zero: none) */
+  double *r;       /* per face: the largest magnitude of its vertices' coordinates */
+  int *order;      /* the faces by group, then orientation, then part */
+  size_t *goff;    /* group g: order[goff[g] .. goff[g + 1]) */
+  size_t *gneg;    /* its first face facing opposite its plane gpl[g] */
+  fcm__plane *gpl; /* the group's plane (the orientation of its first face) */
+  size_t ng;       /* groups */
+} face_set;
 
-static int cmp_box_key(const void *a, const void *b)
+static void face_set_free(fcm_ctx *ctx, face_set *F)
 {
-  const box_key *p = a, *q = b;
-  if (p->x != q->x) return p->x < q->x ? -1 : 1;
-  return (p->i > q->i) - (p->i < q->i);
+  fcm__free(ctx, F->part);
+  fcm__free(ctx, F->nx);
+  fcm__free(ctx, F->x0);
+  fcm__free(ctx, F->pl);
+  fcm__free(ctx, F->x);
+  fcm__free(ctx, F->ep);
+  fcm__free(ctx, F->r);
+  fcm__free(ctx, F->order);
+  fcm__free(ctx, F->goff);
+  fcm__free(ctx, F->gneg);
+  fcm__free(ctx, F->gpl);
+}
+
+/* The sign that orients plane p canonically (its first nonzero normal component positive). */
+static double plane_sign(const fcm__plane *p)
+{
+  for (int d = 0; d < 3; d++)
+    if (p->n[d] != 0.0) return p->n[d] > 0.0 ? 1.0 : -1.0;
+  return 1.0;
+}
+
+/* A face's sort key: its plane oriented canonically, its orientation against that, its part
+ * and its index. */
+typedef struct face_key {
+  double k[4];
+  double sign;
+  int part, face;
+} face_key;
+
+/* Faces by their canonical plane, then by orientation (as the plane first), then by part. */
+static int cmp_face(const void *pa, const void *pb)
+{
+  const face_key *p = pa, *q = pb;
+  for (int d = 0; d < 4; d++)
+    if (p->k[d] != q->k[d]) return p->k[d] < q->k[d] ? -1 : 1;
+  if (p->sign != q->sign) return p->sign > q->sign ? -1 : 1;
+  if (p->part != q->part) return p->part < q->part ? -1 : 1;
+  return (p->face > q->face) - (p->face < q->face);
+}
+
+static int same_plane(const fcm__plane *p, const fcm__plane *q)
+{
+  const double sp = plane_sign(p), sq = plane_sign(q);
+  return sp * p->n[0] == sq * q->n[0] && sp * p->n[1] == sq * q->n[1] &&
+         sp * p->n[2] == sq * q->n[2] && sp * p->d == sq * q->d;
+}
+
+/* The edge planes of face f (F->ep) and the magnitude of its coordinates (F->r). */
+static void edge_planes(face_set *F, size_t f)
+{
+  const int m = F->nx[f];
+  const double *x = F->x + F->x0[f];
+  double r = 0.0;
+  for (int k = 0; k < m; k++) {
+    for (int d = 0; d < 3; d++)
+      r = fmax(r, fabs(x[3 * k + d]));
+    F->ep[F->x0[f] / 3 + (size_t)k] = edge_plane(x + 3 * k, x + 3 * ((k + 1) % m), F->pl[f].n);
+  }
+  F->r[f] = r;
+}
+
+/* Whether the vertices of face a all lie beyond one edge plane of face b by more than twice
+ * tol (plus the rounding of points of the size of theirs): then clipping a by b's edge planes
+ * (fcm__embed_overlap()) leaves nothing, whatever the planes before that one clipped (their
+ * points lie between a's, beyond it by more than tol), and the faces do not meet. */
+static int faces_apart(const face_set *F, size_t a, size_t b, double tol)
+{
+  const int na = F->nx[a], nb = F->nx[b];
+  const double *xa = F->x + F->x0[a];
+  const fcm__plane *ep = F->ep + F->x0[b] / 3;
+  const double lim = 2.0 * tol + 1e-12 * fmax(F->r[a], F->r[b]);
+  if (na < 3 || nb < 3) return 0;
+  for (int k = 0; k < nb; k++) {
+    if (zero_plane(ep + k)) continue;
+    int v = 0;
+    while (v < na && fcm__vec3_dot(ep[k].n, xa + 3 * v) - ep[k].d > lim)
+      v++;
+    if (v == na) return 1;
+  }
+  return 0;
+}
+
+/* Gather the faces of P's parts with positive area and a finite plane (a face without either
+ * matches no face: its distances are not within any tolerance) and group them. */
+static fcm_status faces_build(fcm_ctx *ctx, const fcm__parts *P, face_set *F)
+{
+  fcm_status st = FCM_OK;
+  face_key *keys = NULL;
+  size_t nf = 0, nv = 0;
+  for (size_t i = 0; i < P->n; i++) {
+    nf += (size_t)P->poly[i].nf;
+    for (int f = 0; f < P->poly[i].nf; f++)
+      nv += (size_t)P->poly[i].fn[f];
+  }
+  FCM_ALLOC_RAW(ctx, nf + 1, F->part);
+  FCM_ALLOC_RAW(ctx, nf + 1, F->nx);
+  FCM_ALLOC_RAW(ctx, nf + 1, F->x0);
+  FCM_ALLOC_RAW(ctx, nf + 1, F->pl);
+  FCM_ALLOC_RAW(ctx, 3 * nv + 1, F->x);
+  FCM_ALLOC_RAW(ctx, nv + 1, F->ep);
+  FCM_ALLOC_RAW(ctx, nf + 1, F->r);
+  FCM_ALLOC_RAW(ctx, nf + 1, F->order);
+  size_t xn = 0;
+  for (size_t i = 0; i < P->n; i++)
+    for (int f = 0; f < P->poly[i].nf; f++) {
+      fcm__plane pl;
+      if (!fcm__embed_face_plane(P->poly + i, f, &pl)) continue;
+      if (!(isfinite(pl.n[0]) && isfinite(pl.n[1]) && isfinite(pl.n[2]) && isfinite(pl.d)))
+        continue;
+      F->part[F->n] = (int)i, F->pl[F->n] = pl, F->x0[F->n] = xn;
+      F->nx[F->n] = fcm__embed_face_coords(P->poly + i, f, F->x + xn);
+      edge_planes(F, F->n);
+      xn += 3 * (size_t)F->nx[F->n];
+      F->n++;
+    }
+  FCM_ALLOC_RAW(ctx, F->n + 1, keys);
+  for (size_t k = 0; k < F->n; k++) {
+    const fcm__plane *p = F->pl + k;
+    const double sg = plane_sign(p);
+    face_key *fk = keys + k;
+    for (int d = 0; d < 3; d++)
+      fk->k[d] = sg * p->n[d];
+    fk->k[3] = sg * p->d, fk->sign = sg, fk->part = F->part[k], fk->face = (int)k;
+  }
+  qsort(keys, F->n, sizeof *keys, cmp_face);
+  for (size_t k = 0; k < F->n; k++)
+    F->order[k] = keys[k].face;
+  FCM_ALLOC_RAW(ctx, F->n + 1, F->goff);
+  FCM_ALLOC_RAW(ctx, F->n + 1, F->gneg);
+  FCM_ALLOC_RAW(ctx, F->n + 1, F->gpl);
+  for (size_t k = 0; k < F->n; k++) {
+    const fcm__plane *p = F->pl + F->order[k];
+    if (k == 0 || !same_plane(p, F->pl + F->order[k - 1])) {
+      F->goff[F->ng] = F->gneg[F->ng] = k;
+      F->gpl[F->ng++] = *p;
+    }
+    const size_t g = F->ng - 1;
+    if (plane_sign(p) == plane_sign(F->gpl + g)) F->gneg[g] = k + 1;
+  }
+  F->goff[F->ng] = F->n;
+cleanup:
+  fcm__free(ctx, keys);
+  return st;
+}
+
+/* Whether face a (of part i) and face b (of part j > i) facing it share an area that does
+ * not lie on a cut triangle and holds material (a body given by its surface); a's vertices
+ * lie within mtol of b's plane. */
+static int faces_linked(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
+                        size_t ntri, const fcm__parts *P, const face_set *F, size_t a, size_t b)
+{
+  const double mtol = MATCH_RTOL * cell->size, atol = AREA_RTOL * cell->size * cell->size;
+  const int i = F->part[a], j = F->part[b];
+  const double *xa = F->x + F->x0[a], *xb = F->x + F->x0[b];
+  const int na = F->nx[a], nb = F->nx[b];
+  if (!points_on_plane(xb, nb, F->pl + a, mtol) || faces_apart(F, a, b, mtol)) return 0;
+  /* fcm__embed_linked() on b's edge planes made once */
+  double x[3 * FCM__POLY_MAX_VERTS], work[3 * FCM__POLY_MAX_VERTS];
+  const fcm__plane *ep = F->ep + F->x0[b] / 3;
+  int m = na;
+  if (na < 3 || nb < 3 || na > FCM__POLY_MAX_VERTS) return 0;
+  memcpy(x, xa, 3 * (size_t)na * sizeof *x);
+  for (int k = 0; k < nb && m >= 3; k++)
+    if (!zero_plane(ep + k))
+      m = fcm__geom_polygon_clip(x, m, FCM__POLY_MAX_VERTS, ep + k, mtol, 1, work);
+  if (m < 3 || polygon_area(x, m) <= atol) return 0;
+  const fcm__poly *pa = P->poly + i, *pb = P->poly + j;
+  return overlap_linked(x, m, pa->x[0], pa->nv, pb->x[0], pb->nv, mtol, tris, P->tcand.ids, ntri) &&
+         (!P->mat || fcm__embed_part_full(P, (size_t)i) || fcm__embed_part_full(P, (size_t)j) ||
+          fcm__embed_overlap_material(ctx, P->mat, cell, xa, na, xb, nb, F->pl[b].n));
+}
+
+/* Join the parts whose boxes meet and that share a face of positive area not lying on a cut
+ * triangle (with material, for a body given by its surface): face a of part i against the
+ * faces b of parts j > i on the planes a lies on, facing it (their normals at more than 120
+ * degrees). The components do not depend on the order the pairs are joined in. */
+static void join_parts(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
+                       size_t ntri, fcm__parts *P, const face_set *F, const double *box)
+{
+  const double mtol = MATCH_RTOL * cell->size;
+  for (size_t a = 0; a < F->n; a++) {
+    const int i = F->part[a];
+    const fcm__plane *pa = F->pl + a;
+    const double *bi = box + 6 * (size_t)i;
+    for (size_t g = 0; g < F->ng; g++) {
+      const double s = fcm__vec3_dot(pa->n, F->gpl[g].n);
+      size_t k0, k1; /* the faces of the group facing a: normal -pa's side of the group's */
+      if (s <= -0.5)
+        k0 = F->goff[g], k1 = F->gneg[g];
+      else if (-s <= -0.5)
+        k0 = F->gneg[g], k1 = F->goff[g + 1];
+      else
+        continue;
+      if (k0 == k1 || F->part[F->order[k1 - 1]] <= i) continue;
+      if (!points_on_plane(F->x + F->x0[a], F->nx[a], F->gpl + g, mtol)) continue;
+      for (size_t k = k0; k < k1; k++) {
+        const size_t b = (size_t)F->order[k];
+        const int j = F->part[b];
+        if (j <= i) continue;
+        const double *bj = box + 6 * (size_t)j;
+        int apart = 0;
+        for (int d = 0; d < 3; d++)
+          apart |= bi[d] > bj[3 + d] || bj[d] > bi[3 + d];
+        if (apart || uf_find(P->uf, i) == uf_find(P->uf, j)) continue;
+        if (faces_linked(ctx, cell, tris, ntri, P, F, a, b)) uf_union(P->uf, i, j);
+      }
+    }
+  }
 }
 
 fcm_status fcm__embed_parts_components(fcm_ctx *ctx, const fcm__embed_cell *cell,
@@ -497,8 +718,7 @@ fcm_status fcm__embed_parts_components(fcm_ctx *ctx, const fcm__embed_cell *cell
 {
   fcm_status st = FCM_OK;
   double *box = NULL;
-  box_key *order = NULL;
-  fcm__plane *fp = NULL;
+  face_set F = {0};
   if (P->n > P->ufcap) {
     void *u = P->uf;
     FCM_TRY(ctx, fcm__resize(ctx, &u, 0, P->n, sizeof(int)));
@@ -506,14 +726,8 @@ fcm_status fcm__embed_parts_components(fcm_ctx *ctx, const fcm__embed_cell *cell
     P->ufcap = P->n;
   }
   FCM_ALLOC_RAW(ctx, 6 * P->n + 1, box);
-  FCM_ALLOC_RAW(ctx, P->n + 1, order);
-  FCM_ALLOC(ctx, FCM__POLY_MAX_FACES * P->n + 1, fp);
   const double mtol = MATCH_RTOL * cell->size;
   for (size_t i = 0; i < P->n; i++) {
-    for (int f = 0; f < P->poly[i].nf; f++) {
-      fcm__plane *pl = fp + i * FCM__POLY_MAX_FACES + f;
-      if (!fcm__embed_face_plane(P->poly + i, f, pl)) pl->n[0] = pl->n[1] = pl->n[2] = 0.0;
-    }
     P->uf[i] = (int)i;
     double *bi = box + 6 * i;
     for (int d = 0; d < 3; d++)
@@ -524,22 +738,8 @@ fcm_status fcm__embed_parts_components(fcm_ctx *ctx, const fcm__embed_cell *cell
         bi[3 + d] = fmax(bi[3 + d], P->poly[i].x[v][d] + mtol);
       }
   }
-  /* the pairs whose boxes meet, swept along x (the components, numbered by their lowest part,
-   * do not depend on the order the pairs are joined in) */
-  for (size_t i = 0; i < P->n; i++)
-    order[i].x = box[6 * i], order[i].i = i;
-  qsort(order, P->n, sizeof *order, cmp_box_key);
-  for (size_t a = 0; a < P->n; a++)
-    for (size_t b = a + 1; b < P->n; b++) {
-      if (order[b].x > box[6 * order[a].i + 3]) break; /* the rest start beyond a's box */
-      const size_t i = FCM_MIN(order[a].i, order[b].i), j = FCM_MAX(order[a].i, order[b].i);
-      const double *bi = box + 6 * i, *bj = box + 6 * j;
-      int apart = 0;
-      for (int d = 1; d < 3; d++)
-        apart |= bi[d] > bj[3 + d] || bj[d] > bi[3 + d];
-      if (apart || uf_find(P->uf, (int)i) == uf_find(P->uf, (int)j)) continue;
-      if (parts_connected(ctx, cell, tris, P, fp, ntri, i, j)) uf_union(P->uf, (int)i, (int)j);
-    }
+  FCM_TRY(ctx, faces_build(ctx, P, &F));
+  join_parts(ctx, cell, tris, ntri, P, &F, box);
   if (P->mat) FCM_TRY(ctx, fcm__material_status(P->mat));
   int np = 0;
   for (size_t i = 0; i < P->n; i++) {
@@ -549,8 +749,7 @@ fcm_status fcm__embed_parts_components(fcm_ctx *ctx, const fcm__embed_cell *cell
   *count = np;
 cleanup:
   fcm__free(ctx, box);
-  fcm__free(ctx, order);
-  fcm__free(ctx, fp);
+  face_set_free(ctx, &F);
   return st;
 }
 
