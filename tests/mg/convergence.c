@@ -65,6 +65,9 @@ int main(int argc, char **argv)
     if (getenv("FCM_TEST_MG_LEVELS")) o.max_levels = atoi(getenv("FCM_TEST_MG_LEVELS"));
     if (getenv("FCM_TEST_MG_SMOOTHER"))
       o.smoother = (fcm_mg_smoother)atoi(getenv("FCM_TEST_MG_SMOOTHER"));
+    /* the finest level's block set (fcm_mg_blocks) and the one-way block sweeps */
+    if (getenv("FCM_TEST_MG_BLOCKS")) o.blocks = (fcm_mg_blocks)atoi(getenv("FCM_TEST_MG_BLOCKS"));
+    if (getenv("FCM_TEST_MG_BLOCK_SWEEP")) o.block_sweep = atoi(getenv("FCM_TEST_MG_BLOCK_SWEEP"));
     fcm_mg *mg = NULL;
     TEST_OK(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &mg));
     if (!mg) {

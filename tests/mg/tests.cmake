@@ -28,3 +28,9 @@ fcm_add_test(mg_octree_cut_hex20 tests/mg/octree.c ARGS cut_hex20 1 2)
 fcm_add_test(mg_octree_cut_hex20_deep tests/mg/octree.c ARGS cut_hex20 1 3 LABELS slow
              TIMEOUT 1800)
 set_tests_properties(mg_octree_cut_hex20_deep PROPERTIES ENVIRONMENT FCM_TEST_MG_CYCLE=2)
+# the one-way block sweeps, and with the vertex blocks alone (the cheapest block set)
+fcm_add_test(mg_convergence_cut_oneway tests/mg/convergence.c ARGS cut 8 16)
+set_tests_properties(mg_convergence_cut_oneway PROPERTIES ENVIRONMENT FCM_TEST_MG_BLOCK_SWEEP=1)
+fcm_add_test(mg_convergence_cut_vertex_oneway tests/mg/convergence.c ARGS cut 8 16)
+set_tests_properties(mg_convergence_cut_vertex_oneway PROPERTIES
+                     ENVIRONMENT "FCM_TEST_MG_BLOCKS=1;FCM_TEST_MG_BLOCK_SWEEP=1")

@@ -2,16 +2,23 @@
  * with every smoother, on the uncut cube (n = 16: colours of more than 256 rows, smoothed
  * in parallel) and on the cut hemisphere; fcm_mg_setup() with the same values reproduces
  * the same iterates; the preconditioner is symmetric (V- and W-cycle, every smoother:
- * v^T M u = u^T M v to 1e-12 relative); argument errors are reported. */
+ * v^T M u = u^T M v to 1e-12 relative; also with the one-way block sweeps); argument errors
+ * are reported. */
 #include "mg_util.h"
 
 #include <omp.h>
+
+/* the block options of solve() and of the symmetry check (fcm_mg_options.blocks, block_sweep) */
+static fcm_mg_blocks blocks = FCM_MG_BLOCKS_ALL;
+static int block_sweep = 0;
 
 static double *solve(fcm_ctx *ctx, problem *p, fcm_mg_smoother sm, int threads, int resetup)
 {
   omp_set_num_threads(threads);
   fcm_mg_options o = fcm_mg_options_default();
   o.smoother = sm;
+  o.blocks = blocks;
+  o.block_sweep = block_sweep;
   o.omega = sm == FCM_MG_SMOOTHER_JACOBI ? fcm_mg_smoother_omega(sm) : 1.2;
   o.coarse_dofs = 100;
   fcm_mg *mg = NULL;
@@ -41,11 +48,14 @@ int main(void)
       problem_cube(ctx, 16, &p);
     else
       problem_hemisphere(ctx, 8, 1, &p);
-    /* symmetry of the preconditioner */
-    for (int sm = 0; sm < FCM_MG_SMOOTHER_COUNT; sm++)
+    /* symmetry of the preconditioner; SGS also with the one-way block sweeps, all blocks and
+     * the vertex blocks alone (sm = FCM_MG_SMOOTHER_COUNT, COUNT + 1) */
+    for (int sm = 0; sm < FCM_MG_SMOOTHER_COUNT + 2; sm++)
       for (int cyc = 1; cyc <= 2; cyc++) {
         fcm_mg_options o = fcm_mg_options_default();
-        o.smoother = (fcm_mg_smoother)sm;
+        o.smoother = sm < FCM_MG_SMOOTHER_COUNT ? (fcm_mg_smoother)sm : FCM_MG_SMOOTHER_SGS;
+        o.block_sweep = sm >= FCM_MG_SMOOTHER_COUNT;
+        o.blocks = sm == FCM_MG_SMOOTHER_COUNT + 1 ? FCM_MG_BLOCKS_VERTEX : FCM_MG_BLOCKS_ALL;
         o.omega = sm == FCM_MG_SMOOTHER_JACOBI ? fcm_mg_smoother_omega(sm) : 1.3;
         o.cycle_index = cyc;
         o.coarse_dofs = 100;
@@ -82,6 +92,15 @@ int main(void)
       TEST_TRUE(memcmp(x1, x3, sizeof *x1 * (size_t)p.n) == 0);
       free(x1), free(x2), free(x3);
     }
+    /* the one-way block sweeps (all blocks, then the vertex blocks alone) */
+    for (int k = 0; k < 2; k++) {
+      blocks = k ? FCM_MG_BLOCKS_VERTEX : FCM_MG_BLOCKS_ALL, block_sweep = 1;
+      double *x1 = solve(ctx, &p, FCM_MG_SMOOTHER_SGS, 1, 0);
+      double *x2 = solve(ctx, &p, FCM_MG_SMOOTHER_SGS, 2, 0);
+      TEST_TRUE(memcmp(x1, x2, sizeof *x1 * (size_t)p.n) == 0);
+      free(x1), free(x2);
+      blocks = FCM_MG_BLOCKS_ALL, block_sweep = 0;
+    }
     if (kind == 0) {
       /* errors */
       fcm_mg *mg = NULL;
@@ -92,6 +111,12 @@ int main(void)
       o.smoother = FCM_MG_SMOOTHER_JACOBI;
       o.omega = 1.5;
       TEST_ERR(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &mg), FCM_ERR_ARG, "omega");
+      o = fcm_mg_options_default();
+      o.blocks = FCM_MG_BLOCKS_COUNT;
+      TEST_ERR(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &mg), FCM_ERR_ARG, "blocks");
+      o = fcm_mg_options_default();
+      o.block_sweep = 2;
+      TEST_ERR(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &mg), FCM_ERR_ARG, "block_sweep");
       o = fcm_mg_options_default();
       o.max_levels = 0;
       TEST_ERR(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &mg), FCM_ERR_ARG, "max_levels");

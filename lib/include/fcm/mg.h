@@ -41,6 +41,19 @@ typedef enum fcm_mg_smoother {
   FCM_MG_SMOOTHER_COUNT
 } fcm_mg_smoother;
 
+/** The finest level's blocks of the block smoother (fcm_mg_options.block_smoothing); the
+ * coarser levels' blocks are the same for all. */
+typedef enum fcm_mg_blocks {
+  /** The vertex blocks of the cut cells' grid vertices, then the element blocks of the cut
+   * cells (default). */
+  FCM_MG_BLOCKS_ALL = 0,
+  /** The vertex blocks only (on Hex8 3 DOFs a copy of the vertex: the cheapest set). */
+  FCM_MG_BLOCKS_VERTEX = 1,
+  /** The cut cells' element blocks only. */
+  FCM_MG_BLOCKS_ELEMENT = 2,
+  FCM_MG_BLOCKS_COUNT
+} fcm_mg_blocks;
+
 /** Options of fcm_mg_create(); initialize with fcm_mg_options_default(). */
 typedef struct fcm_mg_options {
   fcm_mg_smoother smoother; /**< default FCM_MG_SMOOTHER_SGS */
@@ -82,6 +95,12 @@ typedef struct fcm_mg_options {
                                  linearly dependent, which pointwise smoothing cannot resolve
                                  (the Hex20 V-cycle stalls near 0.95 without it, the hollow
                                  ball's grows with n); 0: pointwise smoothing only */
+  fcm_mg_blocks blocks;     /**< the finest level's blocks (default FCM_MG_BLOCKS_ALL) */
+  int block_sweep;          /**< 0 (default): each block smoothing is a symmetric block
+                                 Gauss-Seidel sweep (forward, then backward); 1: one way,
+                                 forward before the coarse correction and backward after it
+                                 (the cycle stays symmetric, half the block work, a weaker
+                                 smoothing) */
 } fcm_mg_options;
 
 /** Defaults as documented on each member. */

@@ -23,7 +23,7 @@ static void pre_smooth(const fcm_mg *m, mg_level *L, mg_level *C, const double *
     fcm__mg_smooth(m, L, b, x);
   if (L->blk && m->opts.pre_smooth > 0) {
 #pragma omp barrier
-    fcm__mg_block_smooth(m, L, b, x);
+    fcm__mg_block_smooth(m, L, b, x, 0);
   }
 #pragma omp barrier
 #pragma omp for schedule(static)
@@ -52,7 +52,7 @@ static void post_smooth(const fcm_mg *m, mg_level *L, const mg_level *C, const d
     x[i] += sum;
   }
   if (L->blk && m->opts.post_smooth > 0) {
-    fcm__mg_block_smooth(m, L, b, x);
+    fcm__mg_block_smooth(m, L, b, x, 1);
 #pragma omp barrier
   }
   for (int s = 0; s < m->opts.post_smooth; s++)

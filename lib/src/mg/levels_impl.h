@@ -194,7 +194,7 @@ void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x);
 
 /* A symmetric block Gauss-Seidel sweep over the level's blocks, by the team of the enclosing
  * parallel region (no barrier at the end). */
-void fcm__mg_block_smooth(const fcm_mg *m, const mg_level *L, const double *b, double *x);
+void fcm__mg_block_smooth(const fcm_mg *m, const mg_level *L, const double *b, double *x, int post);
 
 /* ---- update.c: the parts fcm__mg_create_from() takes from an earlier hierarchy `old` (each
  * moved out of old, which is destroyed afterwards) */

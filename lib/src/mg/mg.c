@@ -34,6 +34,8 @@ fcm_mg_options fcm_mg_options_default(void)
   o.max_levels = 20;
   o.coarse_dofs = 2000;
   o.block_smoothing = 1;
+  o.blocks = FCM_MG_BLOCKS_ALL;
+  o.block_sweep = 0;
   return o;
 }
 
@@ -195,6 +197,10 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_mg_options *opts, fcm_mg
             "mg_create: max_levels = %d outside [1, 32]", o.max_levels);
   FCM_CHECK(o.coarse_dofs >= 1, ctx, FCM_ERR_ARG, "mg_create: coarse_dofs = %lld must be >= 1",
             (long long)o.coarse_dofs);
+  FCM_CHECK(o.blocks >= 0 && o.blocks < FCM_MG_BLOCKS_COUNT, ctx, FCM_ERR_ARG,
+            "mg_create: blocks = %d is not a fcm_mg_blocks", (int)o.blocks);
+  FCM_CHECK(o.block_sweep == 0 || o.block_sweep == 1, ctx, FCM_ERR_ARG,
+            "mg_create: block_sweep = %d is neither 0 (symmetric) nor 1 (one way)", o.block_sweep);
   *out = o;
 cleanup:
   return st;

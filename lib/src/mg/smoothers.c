@@ -355,9 +355,11 @@ static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_ou
   for (fcm_index i = 0; i < np; i++)
     if (i == 0 || pairs[2 * i] != pairs[2 * nu - 2] || pairs[2 * i + 1] != pairs[2 * nu - 1])
       pairs[2 * nu] = pairs[2 * i], pairs[2 * nu + 1] = pairs[2 * i + 1], nu++;
+  if (m->opts.blocks == FCM_MG_BLOCKS_ELEMENT) nu = 0;
   for (fcm_index i = 0; i < nu; i++)
     nb += i == 0 || pairs[2 * i] != pairs[2 * i - 2];
-  FCM_TRY(ctx, fcm_space_cell_blocks(sp, m->cut_cell, &neb, &ned, NULL, NULL));
+  if (m->opts.blocks != FCM_MG_BLOCKS_VERTEX)
+    FCM_TRY(ctx, fcm_space_cell_blocks(sp, m->cut_cell, &neb, &ned, NULL, NULL));
   FCM_ALLOC(ctx, nb + neb + 1, ptr);
   FCM_ALLOC(ctx, 3 * nu + ned + 1, dofs);
   for (fcm_index i = 0, k = 0; i < nu; i++) {
@@ -366,9 +368,11 @@ static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_ou
       dofs[3 * i + d] = 3 * pairs[2 * i + 1] + d;
   }
   ptr[nb] = 3 * nu;
-  FCM_TRY(ctx, fcm_space_cell_blocks(sp, m->cut_cell, &neb, &ned, ptr + nb, dofs + 3 * nu));
-  for (fcm_index k = nb; k <= nb + neb; k++) /* offsets after the vertex blocks */
-    ptr[k] += 3 * nu;
+  if (neb > 0) {
+    FCM_TRY(ctx, fcm_space_cell_blocks(sp, m->cut_cell, &neb, &ned, ptr + nb, dofs + 3 * nu));
+    for (fcm_index k = nb; k <= nb + neb; k++) /* offsets after the vertex blocks */
+      ptr[k] += 3 * nu;
+  }
   nb += neb;
   if (fcm_mesh_num_hanging(mesh) > 0) FCM_TRY(ctx, blocks_masters(ctx, sp, &nb, ptr, &dofs));
   *nb_out = nb, *ptr_out = ptr, *dofs_out = dofs;
@@ -697,14 +701,36 @@ static void block_slab(const sweep_args *a, fcm_index s, int back)
   }
 }
 
-/* A symmetric block Gauss-Seidel sweep over the level's blocks (forward, then backward) in
- * the slab order of the blocks (symmetric_sweep()). */
-void fcm__mg_block_smooth(const fcm_mg *m, const mg_level *L, const double *b, double *x)
+/* One way through the slab order S by the team: forward, the slabs of the colour swept first
+ * and then the other's (a barrier between); backward, the reverse, its adjoint. No barrier at
+ * the end. */
+static void one_way_sweep(const slab_order *S,
+                          void (*slab)(const sweep_args *a, fcm_index s, int back),
+                          const sweep_args *a, int back)
+{
+  const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+  for (int pass = 0; pass < 2; pass++) {
+    const int c = (pass == 0) != back ? S->first : 1 - S->first;
+    if (pass == 1) {
+#pragma omp barrier
+    }
+    for (fcm_index k = c; k < S->nslab; k += 2)
+      if (slab_mine(S, k, t, nt)) slab(a, k, back);
+  }
+}
+
+/* A block Gauss-Seidel sweep over the level's blocks in their slab order: symmetric (forward,
+ * then backward; symmetric_sweep()), or with block_sweep one way, forward before the coarse
+ * correction (post = 0) and backward after it (post = 1). */
+void fcm__mg_block_smooth(const fcm_mg *m, const mg_level *L, const double *b, double *x, int post)
 {
   const size_t t = (size_t)omp_get_thread_num();
   const sweep_args a = {
       L, 0.0, b, x, m->blk_r + t * (size_t)m->blk_max, m->blk_dx + t * (size_t)m->blk_max};
-  symmetric_sweep(&L->blocks, block_slab, &a);
+  if (m->opts.block_sweep)
+    one_way_sweep(&L->blocks, block_slab, &a, post);
+  else
+    symmetric_sweep(&L->blocks, block_slab, &a);
 }
 
 /* ------------------------------------------------------------------ slab check */

@@ -48,7 +48,8 @@ int fcm__mg_reuse_allowed(const fcm_mg *old, const fcm_mg *m)
   return a->smoother == b->smoother && a->omega == b->omega && a->pre_smooth == b->pre_smooth &&
          a->post_smooth == b->post_smooth && a->cycle_index == b->cycle_index &&
          a->max_levels == b->max_levels && a->coarse_dofs == b->coarse_dofs &&
-         a->block_smoothing == b->block_smoothing;
+         a->block_smoothing == b->block_smoothing && a->blocks == b->blocks &&
+         a->block_sweep == b->block_sweep;
 }
 
 int fcm__mg_level_same(const fcm_mg *old, const fcm_mg *m, int l)

@@ -9,6 +9,10 @@
 
 static const char *const cycle_names[] = {"v", "w"};
 static const int cycle_values[] = {1, 2};
+static const char *const blocks_names[] = {"all", "vertex", "element"};
+static const int blocks_values[] = {FCM_MG_BLOCKS_ALL, FCM_MG_BLOCKS_VERTEX, FCM_MG_BLOCKS_ELEMENT};
+static const char *const block_sweep_names[] = {"symmetric", "one_way"};
+static const int block_sweep_values[] = {0, 1};
 /* background elements the multigrid supports (fcm_mg_create()) */
 static const fcm_element_type multigrid_elements[] = {FCM_ELEMENT_HEX8, FCM_ELEMENT_HEX20};
 
@@ -70,8 +74,9 @@ static fcm_status read_multigrid(fcm__scene_parser *p, const fcm__json *mg,
                                  fcm_integrator_options *s)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"smoother", "omega",       "pre_smooth",     "post_smooth",
-                                     "cycle",    "coarse_dofs", "block_smoothing"};
+  static const char *const keys[] = {"smoother",        "omega",  "pre_smooth",
+                                     "post_smooth",     "cycle",  "coarse_dofs",
+                                     "block_smoothing", "blocks", "block_sweep"};
   fcm_mg_options *m = &s->multigrid;
   size_t old = SCENE_ENTER(p, "multigrid");
   long long coarse = (long long)m->coarse_dofs;
@@ -94,6 +99,9 @@ static fcm_status read_multigrid(fcm__scene_parser *p, const fcm__json *mg,
   FCM_TRY(p->ctx, fcm__scene_read_int(p, mg, "coarse_dofs", 0, 1, 1000000000, &coarse));
   m->coarse_dofs = (fcm_index)coarse;
   FCM_TRY(p->ctx, fcm__scene_read_bool(p, mg, "block_smoothing", 0, &m->block_smoothing));
+  SCENE_READ_CHOICE_AS(p, mg, "blocks", 0, blocks_names, blocks_values, m->blocks);
+  SCENE_READ_CHOICE_AS(p, mg, "block_sweep", 0, block_sweep_names, block_sweep_values,
+                       m->block_sweep);
   SCENE_CHECK(m->pre_smooth + m->post_smooth >= 1, p, FCM_ERR_ARG,
               "pre_smooth = %d and post_smooth = %d: at least one smoothing step is needed",
               m->pre_smooth, m->post_smooth);
