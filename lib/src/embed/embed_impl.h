@@ -581,6 +581,24 @@ fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm
                                   const double base[3], fcm__idbuf *buf, fcm__crossings *cr,
                                   fcm__srule *s);
 
+/* *clear: no boundary triangle's box comes within the rounding distance of the line queries
+ * (fcm__embed_moment_rule()) of the affine cell's box: the cell lies wholly inside or wholly
+ * outside the body, far enough from its boundary that every line through it decides alike.
+ * buf is scratch. */
+fcm_status fcm__embed_cell_clear(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                 const fcm__embed_cell *cell, fcm__idbuf *buf, int *clear);
+
+/* fcm__embed_moment_rule() of a clear cell (fcm__embed_cell_clear()), the same bits, without
+ * its line query where *winding is known: the body's winding number about the cell (1 inside,
+ * 0 outside; FCM__WINDING_UNKNOWN: not known, then found by the line query and stored). Clear
+ * cells that share a point share it. */
+#define FCM__WINDING_UNKNOWN (-1000)
+fcm_status fcm__embed_moment_rule_clear(fcm_ctx *ctx, const fcm_geometry *g,
+                                        const fcm_aabb_tree *tree, const fcm__embed_cell *cell,
+                                        const fcm__moment_quad *q, const double base[3],
+                                        fcm__idbuf *buf, fcm__crossings *cr, int *winding,
+                                        fcm__srule *s);
+
 /* The winding number of the body's boundary around the points (a, b, z[i]) (reference
  * coordinates of `cell`, affine), i < n, into inside[i]: 1 inside the body, 0 outside, decided
  * consistently for points on the boundary. Same errors and scratch as above. */

@@ -401,16 +401,15 @@ cleanup:
 
 /* ---------------------------------------------------------------- lines through the body */
 
-/* Boundary triangles that may cross the reference line base + t dir (any t): the tree's
- * boxes met by the physical segment that covers the geometry's bounding box, widened by the
- * distance the rounding of the map to reference coordinates can move a triangle across the
- * line: about eps cond(A) times the distance to the cell (a sliver tet of a fan has cond(A)
- * up to 1e12, and a triangle the reference line crosses can then miss a tighter segment). */
-static fcm_status line_candidates(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
-                                  const fcm__embed_cell *cell, const double base[3],
-                                  const double dir[3], fcm__idbuf *buf)
+/* The physical segment that covers the reference line base + t dir (any t) over the
+ * geometry's bounding box, and the distance the rounding of the map to reference coordinates
+ * can move a triangle across the line: about eps cond(A) times the distance to the cell (a
+ * sliver tet of a fan has cond(A) up to 1e12, and a triangle the reference line crosses can
+ * then miss a tighter segment). */
+static void line_segment(const fcm_geometry *g, const fcm__embed_cell *cell, const double base[3],
+                         const double dir[3], double p0[3], double p1[3], double *pad)
 {
-  double p[3], v[3], p0[3], p1[3], far = 0.0;
+  double p[3], v[3], far = 0.0;
   const double x0[3] = {base[0] - cell->xi0[0], base[1] - cell->xi0[1], base[2] - cell->xi0[2]};
   fcm__mat3_mulv(cell->A, x0, p);
   fcm__mat3_mulv(cell->A, dir, v);
@@ -432,7 +431,18 @@ static fcm_status line_candidates(fcm_ctx *ctx, const fcm_geometry *g, const fcm
   for (int k = 0; k < 9; k++)
     na += cell->A[k] * cell->A[k], ni += cell->Ainv[k] * cell->Ainv[k];
   const double rel = 1e-9 + 64.0 * DBL_EPSILON * sqrt(na * ni);
-  return fcm__geom_tree_segment(ctx, tree, p0, p1, rel * (far + cell->size), buf);
+  *pad = rel * (far + cell->size);
+}
+
+/* Boundary triangles that may cross the reference line base + t dir (any t): the tree's
+ * boxes met by line_segment(), widened by its rounding distance. */
+static fcm_status line_candidates(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                  const fcm__embed_cell *cell, const double base[3],
+                                  const double dir[3], fcm__idbuf *buf)
+{
+  double p0[3], p1[3], pad;
+  line_segment(g, cell, base, dir, p0, p1, &pad);
+  return fcm__geom_tree_segment(ctx, tree, p0, p1, pad, buf);
 }
 
 /* The crossings of the body's boundary with the line {l1 = 0, l2 = 0} (base + t dir), as
@@ -553,10 +563,21 @@ cleanup:
   return st;
 }
 
-fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
-                                  const fcm__embed_cell *cell, const fcm__moment_quad *q,
-                                  const double base[3], fcm__idbuf *buf, fcm__crossings *cr,
-                                  fcm__srule *s)
+/* The cell's exit edge as a reference line: from the exit facet's corner (xi_3 = lo) to the
+ * cell corner. */
+static void exit_line(int tet, double base[3], double dir[3])
+{
+  base[0] = tet ? 0.0 : 1.0, base[1] = 1.0, base[2] = 0.0;
+  dir[0] = 0.0, dir[1] = tet ? -1.0 : 0.0, dir[2] = 1.0;
+}
+
+/* fcm__embed_moment_rule(), with the sum of the signs of the exit edge line's crossings at
+ * and beyond the cell corner (*corner) and the number of its crossings inside the edge
+ * (*inner). */
+static fcm_status moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                              const fcm__embed_cell *cell, const fcm__moment_quad *q,
+                              const double base[3], fcm__idbuf *buf, fcm__crossings *cr,
+                              fcm__srule *s, int *corner, int *inner)
 {
   fcm_status st = FCM_OK;
   ref_cell r;
@@ -566,6 +587,7 @@ fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm
     for (int d = 0; d < 3; d++)
       r.c[d] = fmax(r.lo, base[d]);
   s->n = 0;
+  *corner = *inner = 0;
   FCM_CHECK(cell->affine, ctx, FCM_ERR_INTERNAL,
             "embed: background cell %lld is not affine (surface moments need an affine map)",
             (long long)cell->id);
@@ -578,8 +600,9 @@ fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm
     FCM_TRY(ctx, add_segment(ctx, q, &r, &T, s));
   }
   /* level 1: the exit edge, from the exit facet's corner (xi_3 = lo) to the cell corner */
-  const double lbase[3] = {tet ? 0.0 : 1.0, 1.0, 0.0}, dir[3] = {0.0, tet ? -1.0 : 0.0, 1.0};
-  int sum, corner = 0;
+  double lbase[3], dir[3];
+  int sum;
+  exit_line(tet, lbase, dir);
   FCM_TRY(ctx, line_candidates(ctx, g, tree, cell, lbase, dir, buf));
   FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &r.exit1, &r.exit2, cr, &sum));
   FCM_CHECK(sum == 0, ctx, FCM_ERR_GEOMETRY,
@@ -588,12 +611,66 @@ fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm
             (long long)cell->id, sum);
   for (size_t k = 0; k < cr->n; k++) {
     const double z = cr->z[k];
-    if (z >= 1.0)
-      corner += cr->sign[k];
-    else if (z > r.lo)
+    if (z >= 1.0) {
+      *corner += cr->sign[k];
+    } else if (z > r.lo) {
       FCM_TRY(ctx, add_edge(ctx, q, &r, z, cr->sign[k], s));
+      ++*inner;
+    }
   }
-  if (corner) FCM_TRY(ctx, add_edge(ctx, q, &r, 1.0, corner, s));
+  if (*corner) FCM_TRY(ctx, add_edge(ctx, q, &r, 1.0, *corner, s));
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                  const fcm__embed_cell *cell, const fcm__moment_quad *q,
+                                  const double base[3], fcm__idbuf *buf, fcm__crossings *cr,
+                                  fcm__srule *s)
+{
+  int corner, inner;
+  return moment_rule(ctx, g, tree, cell, q, base, buf, cr, s, &corner, &inner);
+}
+
+fcm_status fcm__embed_cell_clear(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                 const fcm__embed_cell *cell, fcm__idbuf *buf, int *clear)
+{
+  fcm_status st = FCM_OK;
+  double lbase[3], dir[3], p0[3], p1[3], pad, lo[3], hi[3];
+  exit_line(cell->info->shape == FCM_SHAPE_TET, lbase, dir);
+  line_segment(g, cell, lbase, dir, p0, p1, &pad);
+  for (int d = 0; d < 3; d++)
+    lo[d] = cell->lo[d] - pad, hi[d] = cell->hi[d] + pad;
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, lo, hi, buf));
+  *clear = buf->n == 0;
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_moment_rule_clear(fcm_ctx *ctx, const fcm_geometry *g,
+                                        const fcm_aabb_tree *tree, const fcm__embed_cell *cell,
+                                        const fcm__moment_quad *q, const double base[3],
+                                        fcm__idbuf *buf, fcm__crossings *cr, int *winding,
+                                        fcm__srule *s)
+{
+  fcm_status st = FCM_OK;
+  const int orient = cell->detA > 0.0 ? 1 : -1; /* the map turns the surface inside out */
+  if (*winding == FCM__WINDING_UNKNOWN) {
+    int corner, inner;
+    FCM_TRY(ctx, moment_rule(ctx, g, tree, cell, q, base, buf, cr, s, &corner, &inner));
+    if (inner == 0) *winding = orient * corner; /* else not clear after all: as it is */
+    goto cleanup;
+  }
+  ref_cell r;
+  ref_cell_init(cell->info->shape == FCM_SHAPE_TET, &r);
+  if (base)
+    for (int d = 0; d < 3; d++)
+      r.c[d] = fmax(r.lo, base[d]);
+  s->n = 0;
+  FCM_CHECK(cell->affine, ctx, FCM_ERR_INTERNAL,
+            "embed: background cell %lld is not affine (surface moments need an affine map)",
+            (long long)cell->id);
+  if (*winding) FCM_TRY(ctx, add_edge(ctx, q, &r, 1.0, orient * *winding, s));
 cleanup:
   return st;
 }
