@@ -260,8 +260,7 @@ static fcm_status tri_cells(fcm_embedded_surface *es, fcm_index t, fcm__idbuf *i
  * (qcell), for every triangle that a cut crosses (crosses) or with a vertex that may lie on one
  * (maybe): a superset of those it clips, sorted. */
 static fcm_status preclip_pairs(fcm_embedded_surface *es, const unsigned char *crosses,
-                                const unsigned char *maybe, const unsigned char *qcell,
-                                preclip *pc)
+                                const unsigned char *maybe, const unsigned char *qcell, preclip *pc)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = es->ctx;
