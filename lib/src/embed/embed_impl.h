@@ -551,11 +551,25 @@ fcm_status fcm__srule_room(fcm_ctx *ctx, fcm__srule *s, size_t more);
 
 void fcm__srule_free(fcm_ctx *ctx, fcm__srule *s);
 
-/* Crossings of a line with the boundary: xi_3 values and signs (+1 leaving the body). */
+/* Boxes (physical) that no boundary triangle comes within `pad` of, and the body's winding
+ * number about them (1 inside): fcm__embed_inside_line() answers a point in one without a line
+ * query of its own. */
+enum { FCM__CLEAR_BOXES = 8 };
+typedef struct fcm__clear_box {
+  double lo[3], hi[3], pad;
+  int winding;
+} fcm__clear_box;
+
+/* Crossings of a line with the boundary: xi_3 values and signs (+1 leaving the body); and the
+ * clear boxes the inside tests with this scratch found lately, for boundary triangles `tree`
+ * (zeroed: none). */
 typedef struct fcm__crossings {
   double *z;
   int *sign;
   size_t n, cap;
+  const fcm_aabb_tree *tree;
+  fcm__clear_box clear[FCM__CLEAR_BOXES];
+  int nclear, next;
 } fcm__crossings;
 
 void fcm__crossings_free(fcm_ctx *ctx, fcm__crossings *c);

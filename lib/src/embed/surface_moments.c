@@ -485,6 +485,66 @@ void fcm__crossings_free(fcm_ctx *ctx, fcm__crossings *c)
   fcm__free(ctx, c->sign);
   c->z = NULL, c->sign = NULL;
   c->n = c->cap = 0;
+  c->tree = NULL;
+  c->nclear = c->next = 0;
+}
+
+/* A clear box of half-width this x the cell's size is looked for around a point whose inside
+ * test finds none: the later points in it (a part's quadrature points, a fit's candidates) take
+ * its winding number. */
+#define CLEAR_BOX_RSIZE 0.25
+
+/* The point (a, b, z) of the cell in physical coordinates. */
+static void to_physical(const fcm__embed_cell *cell, double a, double b, double z, double x[3])
+{
+  const double d[3] = {a - cell->xi0[0], b - cell->xi0[1], z - cell->xi0[2]};
+  fcm__mat3_mulv(cell->A, d, x);
+  for (int k = 0; k < 3; k++)
+    x[k] += cell->X[k];
+}
+
+/* A clear box of cr's that holds x for queries of rounding distance pad; NULL: none. */
+static const fcm__clear_box *clear_box_find(const fcm__crossings *cr, const fcm_aabb_tree *tree,
+                                            const double x[3], double pad)
+{
+  if (cr->tree != tree) return NULL;
+  for (int i = 0; i < cr->nclear; i++) {
+    const fcm__clear_box *c = cr->clear + i;
+    if (pad <= c->pad && c->lo[0] <= x[0] && x[0] <= c->hi[0] && c->lo[1] <= x[1] &&
+        x[1] <= c->hi[1] && c->lo[2] <= x[2] && x[2] <= c->hi[2])
+      return c;
+  }
+  return NULL;
+}
+
+/* Keep a box around x with winding number w, of half-width up to r, that no boundary
+ * triangle's box (the tree's) comes within pad of: the triangles' boxes near x bound it. */
+static fcm_status clear_box_add(fcm_ctx *ctx, const fcm_aabb_tree *tree, const double x[3],
+                                double r, double pad, int w, fcm__idbuf *buf, fcm__crossings *cr)
+{
+  fcm_status st = FCM_OK;
+  double lo[3], hi[3], h = r;
+  for (int d = 0; d < 3; d++)
+    lo[d] = x[d] - r - pad, hi[d] = x[d] + r + pad;
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, lo, hi, buf));
+  for (size_t k = 0; k < buf->n; k++) { /* the box's distance from x (max norm), less pad */
+    const double *b = tree->boxes + 6 * buf->ids[k];
+    double dist = 0.0;
+    for (int d = 0; d < 3; d++)
+      dist = fmax(dist, fmax(b[d] - x[d], x[d] - b[3 + d]));
+    h = fmin(h, dist - pad);
+  }
+  if (!(h > 0.0)) goto cleanup;
+  if (cr->tree != tree) cr->tree = tree, cr->nclear = cr->next = 0;
+  fcm__clear_box *c = cr->clear + cr->next;
+  cr->next = (cr->next + 1) % FCM__CLEAR_BOXES;
+  cr->nclear = FCM_MIN(cr->nclear + 1, FCM__CLEAR_BOXES);
+  for (int d = 0; d < 3; d++)
+    c->lo[d] = x[d] - h, c->hi[d] = x[d] + h;
+  c->pad = pad;
+  c->winding = w;
+cleanup:
+  return st;
 }
 
 fcm_status fcm__embed_inside_line(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
@@ -494,8 +554,21 @@ fcm_status fcm__embed_inside_line(fcm_ctx *ctx, const fcm_geometry *g, const fcm
   fcm_status st = FCM_OK;
   const double base[3] = {a, b, 0.0}, dir[3] = {0.0, 0.0, 1.0};
   const lin l1 = mk(-a, 1, 0, 0), l2 = mk(-b, 0, 1, 0);
+  const int orient = cell->detA > 0.0 ? 1 : -1; /* the map turns the surface inside out */
+  double x[3], p0[3], p1[3], pad;
   int sum;
-  FCM_TRY(ctx, line_candidates(ctx, g, tree, cell, base, dir, buf));
+  /* a point with no boundary triangle within the line's rounding distance has the winding
+   * number of any point it sees without crossing the boundary: that of a clear box holding it */
+  line_segment(g, cell, base, dir, p0, p1, &pad);
+  if (n == 1) {
+    to_physical(cell, a, b, z[0], x);
+    const fcm__clear_box *c = clear_box_find(cr, tree, x, pad);
+    if (c) {
+      inside[0] = orient * c->winding;
+      return FCM_OK;
+    }
+  }
+  FCM_TRY(ctx, fcm__geom_tree_segment(ctx, tree, p0, p1, pad, buf));
   FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &l1, &l2, cr, &sum));
   FCM_CHECK(sum == 0, ctx, FCM_ERR_GEOMETRY,
             "embed: background cell %lld: a line through the body crosses its boundary %d more "
@@ -507,6 +580,9 @@ fcm_status fcm__embed_inside_line(fcm_ctx *ctx, const fcm_geometry *g, const fcm
       if (cr->z[k] >= z[i]) w += cr->sign[k];
     inside[i] = w;
   }
+  if (n == 1)
+    FCM_TRY(ctx, clear_box_add(ctx, tree, x, CLEAR_BOX_RSIZE * cell->size, 2.0 * pad,
+                               orient * inside[0], buf, cr));
 cleanup:
   return st;
 }
