@@ -9,7 +9,10 @@
  * - per whole cell: the volume equals the cell's own surface moments (fcm__material_cell)
  *   within 1e-12 of the cell's volume, and the two halves of a cut cell add up to it;
  * - the shortcut is taken (more than a fifth of the tets are clear) and not everywhere (some
- *   tets are near the boundary), so both paths are exercised. */
+ *   tets are near the boundary), so both paths are exercised;
+ * - the inside test of single points (fcm__embed_inside_line) with a scratch that keeps clear
+ *   boxes answers as with a fresh scratch each time, on points of every part's fan tets (as a
+ *   fit's candidates), and takes a kept box's answer for more than half of them. */
 #include "embed/embed_impl.h"
 #include "element/element_impl.h"
 #include "la/mat3.h"
@@ -64,9 +67,10 @@ static void reference(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *
   static double tets[12 * FCM__POLY_MAX_FACES * FCM__POLY_MAX_FV];
   static double vol[FCM__POLY_MAX_FACES * FCM__POLY_MAX_FV];
   fcm__idbuf buf = {NULL, 0, 0};
-  fcm__crossings cr = {NULL, NULL, 0, 0};
+  fcm__crossings cr;
   fcm__srule s = {NULL, NULL, 0, 0};
   double sum = 0.0;
+  memset(&cr, 0, sizeof cr);
   out->n = 0;
   const int nt = p->nf ? fcm__geom_poly_tets(p, tets, vol) : 0;
   for (int i = 0; i < nt; i++) {
@@ -95,6 +99,49 @@ static void reference(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *
   fcm__geom_idbuf_free(ctx, &buf);
   fcm__crossings_free(ctx, &cr);
   fcm__srule_free(ctx, &s);
+}
+
+/* Inside tests of points spread over the fan tets of p (cell's reference coordinates), with
+ * the kept scratch cr against a fresh one each time. */
+static void inside_points(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                          const fcm__poly *p, const fcm__embed_cell *cell, fcm__crossings *cr,
+                          long *points, long *kept, const char *what)
+{
+  static double tets[12 * FCM__POLY_MAX_FACES * FCM__POLY_MAX_FV];
+  static double vol[FCM__POLY_MAX_FACES * FCM__POLY_MAX_FV];
+  static const double bary[5][4] = {{0.25, 0.25, 0.25, 0.25},
+                                    {0.55, 0.15, 0.15, 0.15},
+                                    {0.15, 0.55, 0.15, 0.15},
+                                    {0.15, 0.15, 0.55, 0.15},
+                                    {0.15, 0.15, 0.15, 0.55}};
+  fcm__idbuf buf = {NULL, 0, 0};
+  const int nt = p->nf ? fcm__geom_poly_tets(p, tets, vol) : 0;
+  for (int i = 0; i < nt; i++)
+    for (int j = 0; j < 5; j++) {
+      double x[3] = {0, 0, 0}, xi[3], det;
+      for (int a = 0; a < 4; a++)
+        for (int d = 0; d < 3; d++)
+          x[d] += bary[j][a] * tets[12 * i + 3 * a + d];
+      int in_box = 0, in_kept = -1, in_fresh = -2;
+      for (int k = 0; k < cr->nclear && cr->tree == tree; k++) {
+        const fcm__clear_box *c = cr->clear + k;
+        in_box |= c->lo[0] <= x[0] && x[0] <= c->hi[0] && c->lo[1] <= x[1] && x[1] <= c->hi[1] &&
+                  c->lo[2] <= x[2] && x[2] <= c->hi[2];
+      }
+      fcm__crossings fresh;
+      memset(&fresh, 0, sizeof fresh);
+      CHECK_OK(fcm__embed_to_reference(ctx, cell, x, xi, &det));
+      CHECK_OK(
+          fcm__embed_inside_line(ctx, g, tree, cell, xi[0], xi[1], 1, xi + 2, &in_kept, &buf, cr));
+      CHECK_OK(fcm__embed_inside_line(ctx, g, tree, cell, xi[0], xi[1], 1, xi + 2, &in_fresh, &buf,
+                                      &fresh));
+      fcm__crossings_free(ctx, &fresh);
+      CHECK(in_kept == in_fresh, "%s, cell %lld: inside test %d with kept boxes, %d without", what,
+            (long long)cell->id, in_kept, in_fresh);
+      ++*points;
+      *kept += in_box;
+    }
+  fcm__geom_idbuf_free(ctx, &buf);
 }
 
 /* Part p of cell: fcm__material_poly against the reference, bit for bit. */
@@ -129,11 +176,14 @@ static void run(fcm_ctx *ctx, const fcm_geometry *g, const char *what)
   fcm__material *m = NULL;
   fcm__moment_quad q;
   fcm__srule a = {NULL, NULL, 0, 0}, b = {NULL, NULL, 0, 0};
+  fcm__crossings cr;
+  long points = 0, kept = 0;
   fcm_aabb_tree *tree = NULL;
   double *boxes = NULL;
   fcm_index nb;
   tally t = {0, 0, 0, 0.0};
   memset(&q, 0, sizeof q);
+  memset(&cr, 0, sizeof cr);
   CHECK_OK(fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, n, &mesh));
   CHECK_OK(fcm__material_create(ctx, g, &m));
   CHECK_OK(fcm__moment_quad_create(ctx, DEGREE, &q));
@@ -167,6 +217,7 @@ static void run(fcm_ctx *ctx, const fcm_geometry *g, const char *what)
       CHECK(fcm__geom_poly_clip(&half, &pl, 1e-12 * cell.size, &scratch) == 0,
             "%s, cell %lld: clipping failed", what, (long long)c);
       halves += compare_part(ctx, m, g, tree, &half, &q, &cell, &a, &b, &t, what);
+      inside_points(ctx, g, tree, &half, &cell, &cr, &points, &kept, what);
     }
     t.worst = fmax(t.worst, fabs(halves - vcell) / cell.volume);
   }
@@ -179,6 +230,11 @@ static void run(fcm_ctx *ctx, const fcm_geometry *g, const char *what)
   CHECK(5 * t.clear > t.tets, "%s: only %ld of %ld tets clear: the shortcut is not exercised", what,
         t.clear, t.tets);
   CHECK(t.clear < t.tets, "%s: every tet clear: the reference path is not exercised", what);
+  printf("  %-24s %ld inside tests, %ld in a kept clear box\n", "", points, kept);
+  CHECK(2 * kept > points, "%s: %ld of %ld points in a kept box: the shortcut is not exercised",
+        what, kept, points);
+  CHECK(kept < points, "%s: every point in a kept box", what);
+  fcm__crossings_free(ctx, &cr);
   fcm__srule_free(ctx, &a);
   fcm__srule_free(ctx, &b);
   fcm__moment_quad_free(ctx, &q);
