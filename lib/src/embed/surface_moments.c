@@ -434,17 +434,6 @@ static void line_segment(const fcm_geometry *g, const fcm__embed_cell *cell, con
   *pad = rel * (far + cell->size);
 }
 
-/* Boundary triangles that may cross the reference line base + t dir (any t): the tree's
- * boxes met by line_segment(), widened by its rounding distance. */
-static fcm_status line_candidates(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
-                                  const fcm__embed_cell *cell, const double base[3],
-                                  const double dir[3], fcm__idbuf *buf)
-{
-  double p0[3], p1[3], pad;
-  line_segment(g, cell, base, dir, p0, p1, &pad);
-  return fcm__geom_tree_segment(ctx, tree, p0, p1, pad, buf);
-}
-
 /* The crossings of the body's boundary with the line {l1 = 0, l2 = 0} (base + t dir), as
  * values of xi_3 with +1 (leaving the body going up in xi_3) or -1; the candidates are the
  * triangles in buf. *sum: the sum of the signs (0 for a closed surface). */
@@ -649,15 +638,18 @@ static void exit_line(int tet, double base[3], double dir[3])
 
 /* fcm__embed_moment_rule(), with the sum of the signs of the exit edge line's crossings at
  * and beyond the cell corner (*corner) and the number of its crossings inside the edge
- * (*inner). */
+ * (*inner). boxes: the corner's winding number from a clear box kept in cr where one holds
+ * it (no boundary triangle within the line's rounding distance of the corner: the crossings
+ * beyond it add up to that), else a box around it kept when it is clear. */
 static fcm_status moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
                               const fcm__embed_cell *cell, const fcm__moment_quad *q,
-                              const double base[3], fcm__idbuf *buf, fcm__crossings *cr,
+                              const double base[3], int boxes, fcm__idbuf *buf, fcm__crossings *cr,
                               fcm__srule *s, int *corner, int *inner)
 {
   fcm_status st = FCM_OK;
   ref_cell r;
   const int tet = cell->info->shape == FCM_SHAPE_TET;
+  const int orient = cell->detA > 0.0 ? 1 : -1; /* the map turns the surface inside out */
   ref_cell_init(tet, &r);
   if (base)
     for (int d = 0; d < 3; d++)
@@ -676,12 +668,21 @@ static fcm_status moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aab
     FCM_TRY(ctx, add_segment(ctx, q, &r, &T, s));
   }
   /* level 1: the exit edge, from the exit facet's corner (xi_3 = lo) to the cell corner */
-  double lbase[3], dir[3];
+  double lbase[3], dir[3], p0[3], p1[3], pad, P[3];
+  const fcm__clear_box *cb = NULL;
   int sum;
   exit_line(tet, lbase, dir);
-  FCM_TRY(ctx, line_candidates(ctx, g, tree, cell, lbase, dir, buf));
+  line_segment(g, cell, lbase, dir, p0, p1, &pad);
+  if (boxes) {
+    to_physical(cell, lbase[0] + dir[0], lbase[1] + dir[1], lbase[2] + dir[2], P);
+    cb = clear_box_find(cr, tree, P, pad);
+  }
+  if (cb) /* the crossings inside the edge only */
+    to_physical(cell, lbase[0] + r.lo * dir[0], lbase[1] + r.lo * dir[1], lbase[2] + r.lo * dir[2],
+                p0);
+  FCM_TRY(ctx, fcm__geom_tree_segment(ctx, tree, p0, cb ? P : p1, pad, buf));
   FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &r.exit1, &r.exit2, cr, &sum));
-  FCM_CHECK(sum == 0, ctx, FCM_ERR_GEOMETRY,
+  FCM_CHECK(cb || sum == 0, ctx, FCM_ERR_GEOMETRY,
             "embed: background cell %lld: its edge line crosses the body's boundary %d more "
             "times outward than inward (the boundary surface is not closed)",
             (long long)cell->id, sum);
@@ -694,7 +695,11 @@ static fcm_status moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aab
       ++*inner;
     }
   }
+  if (cb) *corner = orient * cb->winding;
   if (*corner) FCM_TRY(ctx, add_edge(ctx, q, &r, 1.0, *corner, s));
+  if (boxes && !cb)
+    FCM_TRY(ctx, clear_box_add(ctx, tree, P, CLEAR_BOX_RSIZE * cell->size, 2.0 * pad,
+                               orient * *corner, buf, cr));
 cleanup:
   return st;
 }
@@ -705,7 +710,16 @@ fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm
                                   fcm__srule *s)
 {
   int corner, inner;
-  return moment_rule(ctx, g, tree, cell, q, base, buf, cr, s, &corner, &inner);
+  return moment_rule(ctx, g, tree, cell, q, base, 0, buf, cr, s, &corner, &inner);
+}
+
+fcm_status fcm__embed_moment_rule_kept(fcm_ctx *ctx, const fcm_geometry *g,
+                                       const fcm_aabb_tree *tree, const fcm__embed_cell *cell,
+                                       const fcm__moment_quad *q, const double base[3],
+                                       fcm__idbuf *buf, fcm__crossings *cr, fcm__srule *s)
+{
+  int corner, inner;
+  return moment_rule(ctx, g, tree, cell, q, base, 1, buf, cr, s, &corner, &inner);
 }
 
 fcm_status fcm__embed_cell_clear(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
@@ -733,7 +747,7 @@ fcm_status fcm__embed_moment_rule_clear(fcm_ctx *ctx, const fcm_geometry *g,
   const int orient = cell->detA > 0.0 ? 1 : -1; /* the map turns the surface inside out */
   if (*winding == FCM__WINDING_UNKNOWN) {
     int corner, inner;
-    FCM_TRY(ctx, moment_rule(ctx, g, tree, cell, q, base, buf, cr, s, &corner, &inner));
+    FCM_TRY(ctx, moment_rule(ctx, g, tree, cell, q, base, 0, buf, cr, s, &corner, &inner));
     if (inner == 0) *winding = orient * corner; /* else not clear after all: as it is */
     goto cleanup;
   }

@@ -131,8 +131,8 @@ static fcm_status tets_material(fcm_ctx *ctx, fcm__material *m, const double *te
       FCM_TRY(ctx, fcm__embed_moment_rule_clear(ctx, m->geom, m->tree, &k, q, NULL, &m->buf, &m->cr,
                                                 &winding, &m->sr));
     } else {
-      FCM_TRY(ctx,
-              fcm__embed_moment_rule(ctx, m->geom, m->tree, &k, q, NULL, &m->buf, &m->cr, &m->sr));
+      FCM_TRY(ctx, fcm__embed_moment_rule_kept(ctx, m->geom, m->tree, &k, q, NULL, &m->buf, &m->cr,
+                                               &m->sr));
     }
     if (out) FCM_TRY(ctx, fcm__srule_room(ctx, out, m->sr.n));
     for (size_t i = 0; i < m->sr.n; i++) {
