@@ -1,8 +1,9 @@
 /* The material rule of a convex part from the surface moments of its fan tets
  * (fcm__material_poly): a tet that no boundary triangle comes near (fcm__embed_cell_clear)
  * takes the winding number found for the first such tet of its fan (they share the apex)
- * instead of a line query of its own (fcm__embed_moment_rule_clear). Parts: every cell of a
- * Hex8 grid over a ball and over a hollow ball with holes, whole and cut into two by an
+ * instead of a line query of its own (fcm__embed_moment_rule_clear), and a tet near it takes
+ * its corner's from a clear box kept from earlier tests (fcm__embed_moment_rule_kept). Parts: every
+ * cell of a Hex8 grid over a ball and over a hollow ball with holes, whole and cut into two by an
  * oblique plane. Asserts
  * - per part: the rule (points, weights, in the cell's reference coordinates) and the volume
  *   are the bits of the reference path, fcm__embed_moment_rule() on every fan tet;
