@@ -595,10 +595,11 @@ fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm
                                   const double base[3], fcm__idbuf *buf, fcm__crossings *cr,
                                   fcm__srule *s);
 
-/* fcm__embed_moment_rule(), the same bits, with the winding number about the cell's corner
- * taken from a clear box kept in cr (fcm__embed_inside_line()) where one holds it: then only
- * the crossings inside the cell's edge are looked for. Else a clear box around the corner is
- * kept when there is one. */
+/* fcm__embed_moment_rule(), the same bits, for a cell that fcm__embed_cell_clear() found not
+ * clear, with buf as it left it (the triangles near the cell: those that meet it are taken
+ * from them); the winding number about the cell's corner is taken from a clear box kept in cr
+ * (fcm__embed_inside_line()) where one holds it: then only the crossings inside the cell's
+ * edge are looked for. Else a clear box around the corner is kept when there is one. */
 fcm_status fcm__embed_moment_rule_kept(fcm_ctx *ctx, const fcm_geometry *g,
                                        const fcm_aabb_tree *tree, const fcm__embed_cell *cell,
                                        const fcm__moment_quad *q, const double base[3],

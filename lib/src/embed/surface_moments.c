@@ -638,9 +638,11 @@ static void exit_line(int tet, double base[3], double dir[3])
 
 /* fcm__embed_moment_rule(), with the sum of the signs of the exit edge line's crossings at
  * and beyond the cell corner (*corner) and the number of its crossings inside the edge
- * (*inner). boxes: the corner's winding number from a clear box kept in cr where one holds
- * it (no boundary triangle within the line's rounding distance of the corner: the crossings
- * beyond it add up to that), else a box around it kept when it is clear. */
+ * (*inner). boxes: buf holds on entry the triangles fcm__embed_cell_clear() found near the
+ * cell (those that meet it are taken from them), and the corner's winding number comes from a
+ * clear box kept in cr where one holds it (no boundary triangle within the line's rounding
+ * distance of the corner: the crossings beyond it add up to that), else a box around it is
+ * kept when it is clear. */
 static fcm_status moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
                               const fcm__embed_cell *cell, const fcm__moment_quad *q,
                               const double base[3], int boxes, fcm__idbuf *buf, fcm__crossings *cr,
@@ -659,8 +661,19 @@ static fcm_status moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aab
   FCM_CHECK(cell->affine, ctx, FCM_ERR_INTERNAL,
             "embed: background cell %lld is not affine (surface moments need an affine map)",
             (long long)cell->id);
-  /* levels 3 and 2: the triangles that meet the cell */
-  FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, cell->lo, cell->hi, buf));
+  /* levels 3 and 2: the triangles that meet the cell (as the tree's box query finds them) */
+  if (boxes) {
+    size_t n = 0;
+    for (size_t k = 0; k < buf->n; k++) {
+      const double *b = tree->boxes + 6 * buf->ids[k];
+      if (b[0] <= cell->hi[0] && cell->lo[0] <= b[3] && b[1] <= cell->hi[1] &&
+          cell->lo[1] <= b[4] && b[2] <= cell->hi[2] && cell->lo[2] <= b[5])
+        buf->ids[n++] = buf->ids[k];
+    }
+    buf->n = n;
+  } else {
+    FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, cell->lo, cell->hi, buf));
+  }
   for (size_t k = 0; k < buf->n; k++) {
     rtri T;
     load_tri(g, cell, buf->ids[k], &T);
