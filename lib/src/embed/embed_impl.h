@@ -570,6 +570,7 @@ typedef struct fcm__crossings {
   const fcm_aabb_tree *tree;
   fcm__clear_box clear[FCM__CLEAR_BOXES];
   int nclear, next;
+  int tries, found, skipped; /* the recent looks for a clear box, those that found one */
 } fcm__crossings;
 
 void fcm__crossings_free(fcm_ctx *ctx, fcm__crossings *c);
