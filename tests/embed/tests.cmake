@@ -68,6 +68,11 @@ fcm_add_test(embed_surface_moments tests/embed/surface_moments.c)
 # Surface moments and inside tests on sliver tets (cond(A) up to 1e12, as a cut part's fan
 # tets): a closed ball gives every rule (no crossing triangle left out of the candidates).
 fcm_add_test(embed_sliver_lines tests/embed/sliver_lines.c)
+# A part's surface moments whose fan tets lie clear of the boundary share one line query, and
+# clear boxes kept between inside tests answer for points and tet corners in them: the rule of
+# every part (a ball's and a hollow ball's cells, whole and halved) the bits of each tet's own
+# moment rule, inside tests as with a fresh scratch; the volumes add up to the cells' (1e-12 |K|).
+fcm_add_test(embed_clear_tets tests/embed/clear_tets.c)
 # A geometry of its boundary surface alone (volume_mesh = 0): global moments equal the exact
 # polyhedron integrals (Hex8, Tet4, Hex20), the volume beyond each side of the grid from the
 # surface equals the tets', a cut and the volume path refuse it.

@@ -551,11 +551,26 @@ fcm_status fcm__srule_room(fcm_ctx *ctx, fcm__srule *s, size_t more);
 
 void fcm__srule_free(fcm_ctx *ctx, fcm__srule *s);
 
-/* Crossings of a line with the boundary: xi_3 values and signs (+1 leaving the body). */
+/* Boxes (physical) that no boundary triangle comes within `pad` of, and the body's winding
+ * number about them (1 inside): fcm__embed_inside_line() answers a point in one without a line
+ * query of its own. */
+enum { FCM__CLEAR_BOXES = 8 };
+typedef struct fcm__clear_box {
+  double lo[3], hi[3], pad;
+  int winding;
+} fcm__clear_box;
+
+/* Crossings of a line with the boundary: xi_3 values and signs (+1 leaving the body); and the
+ * clear boxes the inside tests with this scratch found lately, for boundary triangles `tree`
+ * (zeroed: none). */
 typedef struct fcm__crossings {
   double *z;
   int *sign;
   size_t n, cap;
+  const fcm_aabb_tree *tree;
+  fcm__clear_box clear[FCM__CLEAR_BOXES];
+  int nclear, next;
+  int tries, found, skipped; /* the recent looks for a clear box, those that found one */
 } fcm__crossings;
 
 void fcm__crossings_free(fcm_ctx *ctx, fcm__crossings *c);
@@ -580,6 +595,34 @@ fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm
                                   const fcm__embed_cell *cell, const fcm__moment_quad *q,
                                   const double base[3], fcm__idbuf *buf, fcm__crossings *cr,
                                   fcm__srule *s);
+
+/* fcm__embed_moment_rule(), the same bits, for a cell that fcm__embed_cell_clear() found not
+ * clear, with buf as it left it (the triangles near the cell: those that meet it are taken
+ * from them); the winding number about the cell's corner is taken from a clear box kept in cr
+ * (fcm__embed_inside_line()) where one holds it: then only the crossings inside the cell's
+ * edge are looked for. Else a clear box around the corner is kept when there is one. */
+fcm_status fcm__embed_moment_rule_kept(fcm_ctx *ctx, const fcm_geometry *g,
+                                       const fcm_aabb_tree *tree, const fcm__embed_cell *cell,
+                                       const fcm__moment_quad *q, const double base[3],
+                                       fcm__idbuf *buf, fcm__crossings *cr, fcm__srule *s);
+
+/* *clear: no boundary triangle's box comes within the rounding distance of the line queries
+ * (fcm__embed_moment_rule()) of the affine cell's box: the cell lies wholly inside or wholly
+ * outside the body, far enough from its boundary that every line through it decides alike.
+ * buf is scratch. */
+fcm_status fcm__embed_cell_clear(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                 const fcm__embed_cell *cell, fcm__idbuf *buf, int *clear);
+
+/* fcm__embed_moment_rule() of a clear cell (fcm__embed_cell_clear()), the same bits, without
+ * its line query where *winding is known: the body's winding number about the cell (1 inside,
+ * 0 outside; FCM__WINDING_UNKNOWN: not known, then found by the line query and stored). Clear
+ * cells that share a point share it. */
+#define FCM__WINDING_UNKNOWN (-1000)
+fcm_status fcm__embed_moment_rule_clear(fcm_ctx *ctx, const fcm_geometry *g,
+                                        const fcm_aabb_tree *tree, const fcm__embed_cell *cell,
+                                        const fcm__moment_quad *q, const double base[3],
+                                        fcm__idbuf *buf, fcm__crossings *cr, int *winding,
+                                        fcm__srule *s);
 
 /* The winding number of the body's boundary around the points (a, b, z[i]) (reference
  * coordinates of `cell`, affine), i < n, into inside[i]: 1 inside the body, 0 outside, decided

@@ -401,16 +401,15 @@ cleanup:
 
 /* ---------------------------------------------------------------- lines through the body */
 
-/* Boundary triangles that may cross the reference line base + t dir (any t): the tree's
- * boxes met by the physical segment that covers the geometry's bounding box, widened by the
- * distance the rounding of the map to reference coordinates can move a triangle across the
- * line: about eps cond(A) times the distance to the cell (a sliver tet of a fan has cond(A)
- * up to 1e12, and a triangle the reference line crosses can then miss a tighter segment). */
-static fcm_status line_candidates(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
-                                  const fcm__embed_cell *cell, const double base[3],
-                                  const double dir[3], fcm__idbuf *buf)
+/* The physical segment that covers the reference line base + t dir (any t) over the
+ * geometry's bounding box, and the distance the rounding of the map to reference coordinates
+ * can move a triangle across the line: about eps cond(A) times the distance to the cell (a
+ * sliver tet of a fan has cond(A) up to 1e12, and a triangle the reference line crosses can
+ * then miss a tighter segment). */
+static void line_segment(const fcm_geometry *g, const fcm__embed_cell *cell, const double base[3],
+                         const double dir[3], double p0[3], double p1[3], double *pad)
 {
-  double p[3], v[3], p0[3], p1[3], far = 0.0;
+  double p[3], v[3], far = 0.0;
   const double x0[3] = {base[0] - cell->xi0[0], base[1] - cell->xi0[1], base[2] - cell->xi0[2]};
   fcm__mat3_mulv(cell->A, x0, p);
   fcm__mat3_mulv(cell->A, dir, v);
@@ -432,7 +431,7 @@ static fcm_status line_candidates(fcm_ctx *ctx, const fcm_geometry *g, const fcm
   for (int k = 0; k < 9; k++)
     na += cell->A[k] * cell->A[k], ni += cell->Ainv[k] * cell->Ainv[k];
   const double rel = 1e-9 + 64.0 * DBL_EPSILON * sqrt(na * ni);
-  return fcm__geom_tree_segment(ctx, tree, p0, p1, rel * (far + cell->size), buf);
+  *pad = rel * (far + cell->size);
 }
 
 /* The crossings of the body's boundary with the line {l1 = 0, l2 = 0} (base + t dir), as
@@ -475,6 +474,73 @@ void fcm__crossings_free(fcm_ctx *ctx, fcm__crossings *c)
   fcm__free(ctx, c->sign);
   c->z = NULL, c->sign = NULL;
   c->n = c->cap = 0;
+  c->tree = NULL;
+  c->nclear = c->next = 0;
+  c->tries = c->found = c->skipped = 0;
+}
+
+/* A clear box of half-width this x the cell's size is looked for around a point whose inside
+ * test finds none: the later points in it (a part's quadrature points, a fit's candidates) take
+ * its winding number. */
+#define CLEAR_BOX_RSIZE 0.25
+
+/* The point (a, b, z) of the cell in physical coordinates. */
+static void to_physical(const fcm__embed_cell *cell, double a, double b, double z, double x[3])
+{
+  const double d[3] = {a - cell->xi0[0], b - cell->xi0[1], z - cell->xi0[2]};
+  fcm__mat3_mulv(cell->A, d, x);
+  for (int k = 0; k < 3; k++)
+    x[k] += cell->X[k];
+}
+
+/* A clear box of cr's that holds x for queries of rounding distance pad; NULL: none. */
+static const fcm__clear_box *clear_box_find(const fcm__crossings *cr, const fcm_aabb_tree *tree,
+                                            const double x[3], double pad)
+{
+  if (cr->tree != tree) return NULL;
+  for (int i = 0; i < cr->nclear; i++) {
+    const fcm__clear_box *c = cr->clear + i;
+    if (pad <= c->pad && c->lo[0] <= x[0] && x[0] <= c->hi[0] && c->lo[1] <= x[1] &&
+        x[1] <= c->hi[1] && c->lo[2] <= x[2] && x[2] <= c->hi[2])
+      return c;
+  }
+  return NULL;
+}
+
+/* Keep a box around x with winding number w, of half-width up to r, that no boundary
+ * triangle's box (the tree's) comes within pad of: the triangles' boxes near x bound it.
+ * While fewer than a quarter of the recent looks found one (points inside the triangles'
+ * boxes: the query costs more than it saves), one call in 16 looks. */
+static fcm_status clear_box_add(fcm_ctx *ctx, const fcm_aabb_tree *tree, const double x[3],
+                                double r, double pad, int w, fcm__idbuf *buf, fcm__crossings *cr)
+{
+  fcm_status st = FCM_OK;
+  double lo[3], hi[3], h = r;
+  if (cr->tries >= 64 && 4 * cr->found < cr->tries && (++cr->skipped & 15) != 0) return FCM_OK;
+  if (cr->tries >= 1024) cr->tries /= 2, cr->found /= 2;
+  cr->tries++;
+  for (int d = 0; d < 3; d++)
+    lo[d] = x[d] - r - pad, hi[d] = x[d] + r + pad;
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, lo, hi, buf));
+  for (size_t k = 0; k < buf->n; k++) { /* the box's distance from x (max norm), less pad */
+    const double *b = tree->boxes + 6 * buf->ids[k];
+    double dist = 0.0;
+    for (int d = 0; d < 3; d++)
+      dist = fmax(dist, fmax(b[d] - x[d], x[d] - b[3 + d]));
+    h = fmin(h, dist - pad);
+  }
+  if (!(h > 0.0)) goto cleanup;
+  cr->found++;
+  if (cr->tree != tree) cr->tree = tree, cr->nclear = cr->next = 0;
+  fcm__clear_box *c = cr->clear + cr->next;
+  cr->next = (cr->next + 1) % FCM__CLEAR_BOXES;
+  cr->nclear = FCM_MIN(cr->nclear + 1, FCM__CLEAR_BOXES);
+  for (int d = 0; d < 3; d++)
+    c->lo[d] = x[d] - h, c->hi[d] = x[d] + h;
+  c->pad = pad;
+  c->winding = w;
+cleanup:
+  return st;
 }
 
 fcm_status fcm__embed_inside_line(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
@@ -484,8 +550,21 @@ fcm_status fcm__embed_inside_line(fcm_ctx *ctx, const fcm_geometry *g, const fcm
   fcm_status st = FCM_OK;
   const double base[3] = {a, b, 0.0}, dir[3] = {0.0, 0.0, 1.0};
   const lin l1 = mk(-a, 1, 0, 0), l2 = mk(-b, 0, 1, 0);
+  const int orient = cell->detA > 0.0 ? 1 : -1; /* the map turns the surface inside out */
+  double x[3], p0[3], p1[3], pad;
   int sum;
-  FCM_TRY(ctx, line_candidates(ctx, g, tree, cell, base, dir, buf));
+  /* a point with no boundary triangle within the line's rounding distance has the winding
+   * number of any point it sees without crossing the boundary: that of a clear box holding it */
+  line_segment(g, cell, base, dir, p0, p1, &pad);
+  if (n == 1) {
+    to_physical(cell, a, b, z[0], x);
+    const fcm__clear_box *c = clear_box_find(cr, tree, x, pad);
+    if (c) {
+      inside[0] = orient * c->winding;
+      return FCM_OK;
+    }
+  }
+  FCM_TRY(ctx, fcm__geom_tree_segment(ctx, tree, p0, p1, pad, buf));
   FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &l1, &l2, cr, &sum));
   FCM_CHECK(sum == 0, ctx, FCM_ERR_GEOMETRY,
             "embed: background cell %lld: a line through the body crosses its boundary %d more "
@@ -497,6 +576,9 @@ fcm_status fcm__embed_inside_line(fcm_ctx *ctx, const fcm_geometry *g, const fcm
       if (cr->z[k] >= z[i]) w += cr->sign[k];
     inside[i] = w;
   }
+  if (n == 1)
+    FCM_TRY(ctx, clear_box_add(ctx, tree, x, CLEAR_BOX_RSIZE * cell->size, 2.0 * pad,
+                               orient * inside[0], buf, cr));
 cleanup:
   return st;
 }
@@ -553,24 +635,52 @@ cleanup:
   return st;
 }
 
-fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
-                                  const fcm__embed_cell *cell, const fcm__moment_quad *q,
-                                  const double base[3], fcm__idbuf *buf, fcm__crossings *cr,
-                                  fcm__srule *s)
+/* The cell's exit edge as a reference line: from the exit facet's corner (xi_3 = lo) to the
+ * cell corner. */
+static void exit_line(int tet, double base[3], double dir[3])
+{
+  base[0] = tet ? 0.0 : 1.0, base[1] = 1.0, base[2] = 0.0;
+  dir[0] = 0.0, dir[1] = tet ? -1.0 : 0.0, dir[2] = 1.0;
+}
+
+/* fcm__embed_moment_rule(), with the sum of the signs of the exit edge line's crossings at
+ * and beyond the cell corner (*corner) and the number of its crossings inside the edge
+ * (*inner). boxes: buf holds on entry the triangles fcm__embed_cell_clear() found near the
+ * cell (those that meet it are taken from them), and the corner's winding number comes from a
+ * clear box kept in cr where one holds it (no boundary triangle within the line's rounding
+ * distance of the corner: the crossings beyond it add up to that), else a box around it is
+ * kept when it is clear. */
+static fcm_status moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                              const fcm__embed_cell *cell, const fcm__moment_quad *q,
+                              const double base[3], int boxes, fcm__idbuf *buf, fcm__crossings *cr,
+                              fcm__srule *s, int *corner, int *inner)
 {
   fcm_status st = FCM_OK;
   ref_cell r;
   const int tet = cell->info->shape == FCM_SHAPE_TET;
+  const int orient = cell->detA > 0.0 ? 1 : -1; /* the map turns the surface inside out */
   ref_cell_init(tet, &r);
   if (base)
     for (int d = 0; d < 3; d++)
       r.c[d] = fmax(r.lo, base[d]);
   s->n = 0;
+  *corner = *inner = 0;
   FCM_CHECK(cell->affine, ctx, FCM_ERR_INTERNAL,
             "embed: background cell %lld is not affine (surface moments need an affine map)",
             (long long)cell->id);
-  /* levels 3 and 2: the triangles that meet the cell */
-  FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, cell->lo, cell->hi, buf));
+  /* levels 3 and 2: the triangles that meet the cell (as the tree's box query finds them) */
+  if (boxes) {
+    size_t n = 0;
+    for (size_t k = 0; k < buf->n; k++) {
+      const double *b = tree->boxes + 6 * buf->ids[k];
+      if (b[0] <= cell->hi[0] && cell->lo[0] <= b[3] && b[1] <= cell->hi[1] &&
+          cell->lo[1] <= b[4] && b[2] <= cell->hi[2] && cell->lo[2] <= b[5])
+        buf->ids[n++] = buf->ids[k];
+    }
+    buf->n = n;
+  } else {
+    FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, cell->lo, cell->hi, buf));
+  }
   for (size_t k = 0; k < buf->n; k++) {
     rtri T;
     load_tri(g, cell, buf->ids[k], &T);
@@ -578,22 +688,99 @@ fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm
     FCM_TRY(ctx, add_segment(ctx, q, &r, &T, s));
   }
   /* level 1: the exit edge, from the exit facet's corner (xi_3 = lo) to the cell corner */
-  const double lbase[3] = {tet ? 0.0 : 1.0, 1.0, 0.0}, dir[3] = {0.0, tet ? -1.0 : 0.0, 1.0};
-  int sum, corner = 0;
-  FCM_TRY(ctx, line_candidates(ctx, g, tree, cell, lbase, dir, buf));
+  double lbase[3], dir[3], p0[3], p1[3], pad, P[3];
+  const fcm__clear_box *cb = NULL;
+  int sum;
+  exit_line(tet, lbase, dir);
+  line_segment(g, cell, lbase, dir, p0, p1, &pad);
+  if (boxes) {
+    to_physical(cell, lbase[0] + dir[0], lbase[1] + dir[1], lbase[2] + dir[2], P);
+    cb = clear_box_find(cr, tree, P, pad);
+  }
+  if (cb) /* the crossings inside the edge only */
+    to_physical(cell, lbase[0] + r.lo * dir[0], lbase[1] + r.lo * dir[1], lbase[2] + r.lo * dir[2],
+                p0);
+  FCM_TRY(ctx, fcm__geom_tree_segment(ctx, tree, p0, cb ? P : p1, pad, buf));
   FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &r.exit1, &r.exit2, cr, &sum));
-  FCM_CHECK(sum == 0, ctx, FCM_ERR_GEOMETRY,
+  FCM_CHECK(cb || sum == 0, ctx, FCM_ERR_GEOMETRY,
             "embed: background cell %lld: its edge line crosses the body's boundary %d more "
             "times outward than inward (the boundary surface is not closed)",
             (long long)cell->id, sum);
   for (size_t k = 0; k < cr->n; k++) {
     const double z = cr->z[k];
-    if (z >= 1.0)
-      corner += cr->sign[k];
-    else if (z > r.lo)
+    if (z >= 1.0) {
+      *corner += cr->sign[k];
+    } else if (z > r.lo) {
       FCM_TRY(ctx, add_edge(ctx, q, &r, z, cr->sign[k], s));
+      ++*inner;
+    }
   }
-  if (corner) FCM_TRY(ctx, add_edge(ctx, q, &r, 1.0, corner, s));
+  if (cb) *corner = orient * cb->winding;
+  if (*corner) FCM_TRY(ctx, add_edge(ctx, q, &r, 1.0, *corner, s));
+  if (boxes && !cb)
+    FCM_TRY(ctx, clear_box_add(ctx, tree, P, CLEAR_BOX_RSIZE * cell->size, 2.0 * pad,
+                               orient * *corner, buf, cr));
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                  const fcm__embed_cell *cell, const fcm__moment_quad *q,
+                                  const double base[3], fcm__idbuf *buf, fcm__crossings *cr,
+                                  fcm__srule *s)
+{
+  int corner, inner;
+  return moment_rule(ctx, g, tree, cell, q, base, 0, buf, cr, s, &corner, &inner);
+}
+
+fcm_status fcm__embed_moment_rule_kept(fcm_ctx *ctx, const fcm_geometry *g,
+                                       const fcm_aabb_tree *tree, const fcm__embed_cell *cell,
+                                       const fcm__moment_quad *q, const double base[3],
+                                       fcm__idbuf *buf, fcm__crossings *cr, fcm__srule *s)
+{
+  int corner, inner;
+  return moment_rule(ctx, g, tree, cell, q, base, 1, buf, cr, s, &corner, &inner);
+}
+
+fcm_status fcm__embed_cell_clear(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                 const fcm__embed_cell *cell, fcm__idbuf *buf, int *clear)
+{
+  fcm_status st = FCM_OK;
+  double lbase[3], dir[3], p0[3], p1[3], pad, lo[3], hi[3];
+  exit_line(cell->info->shape == FCM_SHAPE_TET, lbase, dir);
+  line_segment(g, cell, lbase, dir, p0, p1, &pad);
+  for (int d = 0; d < 3; d++)
+    lo[d] = cell->lo[d] - pad, hi[d] = cell->hi[d] + pad;
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, lo, hi, buf));
+  *clear = buf->n == 0;
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_moment_rule_clear(fcm_ctx *ctx, const fcm_geometry *g,
+                                        const fcm_aabb_tree *tree, const fcm__embed_cell *cell,
+                                        const fcm__moment_quad *q, const double base[3],
+                                        fcm__idbuf *buf, fcm__crossings *cr, int *winding,
+                                        fcm__srule *s)
+{
+  fcm_status st = FCM_OK;
+  const int orient = cell->detA > 0.0 ? 1 : -1; /* the map turns the surface inside out */
+  if (*winding == FCM__WINDING_UNKNOWN) {
+    int corner, inner;
+    FCM_TRY(ctx, moment_rule(ctx, g, tree, cell, q, base, 0, buf, cr, s, &corner, &inner));
+    if (inner == 0) *winding = orient * corner; /* else not clear after all: as it is */
+    goto cleanup;
+  }
+  ref_cell r;
+  ref_cell_init(cell->info->shape == FCM_SHAPE_TET, &r);
+  if (base)
+    for (int d = 0; d < 3; d++)
+      r.c[d] = fmax(r.lo, base[d]);
+  s->n = 0;
+  FCM_CHECK(cell->affine, ctx, FCM_ERR_INTERNAL,
+            "embed: background cell %lld is not affine (surface moments need an affine map)",
+            (long long)cell->id);
+  if (*winding) FCM_TRY(ctx, add_edge(ctx, q, &r, 1.0, orient * *winding, s));
 cleanup:
   return st;
 }

@@ -112,7 +112,8 @@ static fcm_status tets_material(fcm_ctx *ctx, fcm__material *m, const double *te
                                 const fcm__embed_cell *cell, fcm__srule *out, double *volume)
 {
   fcm_status st = FCM_OK;
-  double sum = 0.0;
+  double sum = 0.0, apex[3];
+  int winding = FCM__WINDING_UNKNOWN; /* about the clear tets with vertex 0 at apex */
   for (int t = 0; t < nt; t++) {
     if (vol[t] == 0.0) continue;
     fcm__embed_cell k;
@@ -120,8 +121,19 @@ static fcm_status tets_material(fcm_ctx *ctx, fcm__material *m, const double *te
     /* a fan tet flat to rounding (near-coplanar vertices of a part) holds no material that
      * counts, and its map to the unit tet is too ill-conditioned for the line crossings */
     if (!(fabs(k.detA) > FLAT_RTOL * k.size * k.size * k.size && isfinite(k.detA))) continue;
-    FCM_TRY(ctx,
-            fcm__embed_moment_rule(ctx, m->geom, m->tree, &k, q, NULL, &m->buf, &m->cr, &m->sr));
+    int clear;
+    FCM_TRY(ctx, fcm__embed_cell_clear(ctx, m->geom, m->tree, &k, &m->buf, &clear));
+    if (clear) {
+      /* wholly inside or outside: as every clear tet sharing its vertex 0 (a fan's apex) */
+      if (winding != FCM__WINDING_UNKNOWN && memcmp(apex, k.X, sizeof apex))
+        winding = FCM__WINDING_UNKNOWN;
+      memcpy(apex, k.X, sizeof apex);
+      FCM_TRY(ctx, fcm__embed_moment_rule_clear(ctx, m->geom, m->tree, &k, q, NULL, &m->buf, &m->cr,
+                                                &winding, &m->sr));
+    } else {
+      FCM_TRY(ctx, fcm__embed_moment_rule_kept(ctx, m->geom, m->tree, &k, q, NULL, &m->buf, &m->cr,
+                                               &m->sr));
+    }
     if (out) FCM_TRY(ctx, fcm__srule_room(ctx, out, m->sr.n));
     for (size_t i = 0; i < m->sr.n; i++) {
       const double w = m->sr.w[i] * k.detA;

@@ -224,19 +224,106 @@ cleanup:
   return st;
 }
 
+/* Polygons clipped ahead: those of the (cell, triangle) pairs pairs[0 .. n) (sorted), pair k's
+ * polys.x from xoff[k], polygons off[k] .. off[k + 1] of polys. */
+typedef struct preclip {
+  fcm_index *pairs;
+  size_t *off, *xoff, n;
+  fcm__embed_polys polys;
+} preclip;
+
+static void preclip_free(fcm_ctx *ctx, preclip *pc)
+{
+  fcm__free(ctx, pc->pairs);
+  fcm__free(ctx, pc->off);
+  fcm__free(ctx, pc->xoff);
+  fcm__embed_polys_free(ctx, &pc->polys);
+  memset(pc, 0, sizeof *pc);
+}
+
+/* The cells boundary triangle t touches within rounding, into ids. */
+static fcm_status tri_cells(fcm_embedded_surface *es, fcm_index t, fcm__idbuf *ids)
+{
+  double x[9], lo[3], hi[3], w = 0.0;
+  tri_coords(es, t, x);
+  for (int d = 0; d < 3; d++) {
+    lo[d] = fmin(x[d], fmin(x[3 + d], x[6 + d]));
+    hi[d] = fmax(x[d], fmax(x[3 + d], x[6 + d]));
+    w = fmax(w, hi[d] - lo[d]);
+  }
+  for (int d = 0; d < 3; d++)
+    lo[d] -= 1e-9 * w, hi[d] += 1e-9 * w;
+  return fcm__geom_tree_query(es->ctx, es->cell_tree, lo, hi, ids);
+}
+
+/* The (cell, triangle) pairs split_triangles() may clip in the cells the vertices' pieces load
+ * (qcell), for every triangle that a cut crosses (crosses) or with a vertex that may lie on one
+ * (maybe): a superset of those it clips, sorted. */
+static fcm_status preclip_pairs(fcm_embedded_surface *es, const unsigned char *crosses,
+                                const unsigned char *maybe, const unsigned char *qcell, preclip *pc)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = es->ctx;
+  fcm__idbuf ids = {NULL, 0, 0};
+  size_t cap = 0;
+  FCM_TRY(ctx, cell_tree(es));
+  for (fcm_index t = 0; t < es->nbt; t++) {
+    const fcm_index *v = es->tri0 + 3 * t;
+    if (!crosses[t] && !maybe[v[0]] && !maybe[v[1]] && !maybe[v[2]]) continue;
+    FCM_TRY(ctx, tri_cells(es, t, &ids));
+    for (size_t k = 0; k < ids.n; k++) {
+      if (!qcell[ids.ids[k]]) continue;
+      if (pc->n == cap) {
+        const size_t ncap = cap ? 2 * cap : 1024;
+        void *q = pc->pairs;
+        FCM_TRY(ctx, fcm__resize(ctx, &q, 2 * cap, 2 * ncap, sizeof(fcm_index)));
+        pc->pairs = q;
+        cap = ncap;
+      }
+      pc->pairs[2 * pc->n] = ids.ids[k], pc->pairs[2 * pc->n + 1] = t;
+      pc->n++;
+    }
+  }
+  if (pc->n > 1) qsort(pc->pairs, pc->n, 2 * sizeof *pc->pairs, cmp_pair);
+  FCM_ALLOC_RAW(ctx, pc->n + 1, pc->off);
+  FCM_ALLOC_RAW(ctx, pc->n + 1, pc->xoff);
+cleanup:
+  fcm__geom_idbuf_free(ctx, &ids);
+  return st;
+}
+
+/* Clip the pairs of cell c from *k on (the finder holds c's parts). */
+static fcm_status preclip_cell(fcm_embedded_surface *es, fcm_index c, preclip *pc, size_t *k)
+{
+  fcm_status st = FCM_OK;
+  for (; *k < pc->n && pc->pairs[2 * *k] <= c; ++*k) {
+    pc->off[*k] = pc->polys.n, pc->xoff[*k] = pc->polys.nx;
+    if (pc->pairs[2 * *k] < c) continue;
+    double x[9];
+    tri_coords(es, pc->pairs[2 * *k + 1], x);
+    FCM_TRY(es->ctx, fcm__embed_finder_clip(es->finder, c, x, &pc->polys));
+  }
+cleanup:
+  return st;
+}
+
 /* The pieces of the boundary vertices in cells that cuts split (es->elem), and which boundary
  * triangles to split: those a cut crosses and those with a vertex on a cut (parts of two
- * pieces hold it: each triangle then takes its side). split: nbt flags. */
+ * pieces hold it: each triangle then takes its side). split: nbt flags. While a cell's parts
+ * are at hand, the triangles split_triangles() may clip in it are clipped into *pc (a cell's
+ * parts cost far more than the clipping). */
 static fcm_status mark_split(fcm_embedded_surface *es, const unsigned char *changed,
-                             unsigned char *split)
+                             unsigned char *split, preclip *pc)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = es->ctx;
   const fcm_space *s = es->space;
   fcm__embed_finder *f = es->finder;
   fcm_index *pairs = NULL, *vpiece = NULL, n = 0;
-  unsigned char *on_cut = NULL;
+  unsigned char *on_cut = NULL, *maybe = NULL, *qcell = NULL;
   FCM_ALLOC(ctx, (size_t)es->nb + 1, on_cut);
+  FCM_ALLOC(ctx, (size_t)es->nb + 1, maybe);
+  FCM_ALLOC(ctx, (size_t)fcm_mesh_num_cells(es->mesh) + 1, qcell);
   FCM_ALLOC_RAW(ctx, 2 * (size_t)es->nb + 2, pairs);
   FCM_ALLOC_RAW(ctx, (size_t)es->nb + 1, vpiece);
   for (fcm_index i = 0; i < es->nb; i++) {
@@ -246,13 +333,23 @@ static fcm_status mark_split(fcm_embedded_surface *es, const unsigned char *chan
     if (es->vpiece && !changed[c] && es->vpiece[i] != -3) { /* as the last rebuild found */
       const fcm_index p = map_piece(es, c, es->vpiece[i]), e = piece_element(s, c, p);
       if (e >= 0) es->elem[i] = e;
-      on_cut[i] = p == -2;
+      on_cut[i] = maybe[i] = p == -2;
       vpiece[i] = p;
       continue;
     }
     pairs[2 * n] = c, pairs[2 * n + 1] = i, n++;
+    maybe[i] = qcell[c] = 1;
   }
+  for (fcm_index t = 0; t < es->nbt; t++) { /* the cuts' triangles alone decide */
+    double x[9];
+    int crosses;
+    tri_coords(es, t, x);
+    FCM_TRY(ctx, fcm__embed_finder_crosses(f, x, &crosses));
+    split[t] = (unsigned char)crosses;
+  }
+  FCM_TRY(ctx, preclip_pairs(es, split, maybe, qcell, pc));
   qsort(pairs, (size_t)n, 2 * sizeof *pairs, cmp_pair); /* one cell's parts made once */
+  size_t kc = 0;
   for (fcm_index k = 0; k < n; k++) {
     const fcm_index c = pairs[2 * k], i = pairs[2 * k + 1];
     fcm_index p = -1;
@@ -261,24 +358,23 @@ static fcm_status mark_split(fcm_embedded_surface *es, const unsigned char *chan
     if (e >= 0) es->elem[i] = e;
     on_cut[i] = p == -2;
     vpiece[i] = p;
+    if (k + 1 == n || pairs[2 * (k + 1)] != c) FCM_TRY(ctx, preclip_cell(es, c, pc, &kc));
   }
+  FCM_TRY(ctx, preclip_cell(es, fcm_mesh_num_cells(es->mesh), pc, &kc));
+  pc->off[pc->n] = pc->polys.n, pc->xoff[pc->n] = pc->polys.nx;
   fcm__free(ctx, es->vpiece);
   es->vpiece = vpiece;
   vpiece = NULL;
   for (fcm_index t = 0; t < es->nbt; t++) {
     const fcm_index *v = es->tri0 + 3 * t;
-    int crosses = on_cut[v[0]] || on_cut[v[1]] || on_cut[v[2]];
-    if (!crosses) {
-      double x[9];
-      tri_coords(es, t, x);
-      FCM_TRY(ctx, fcm__embed_finder_crosses(f, x, &crosses));
-    }
-    split[t] = (unsigned char)crosses;
+    split[t] |= on_cut[v[0]] || on_cut[v[1]] || on_cut[v[2]];
   }
 cleanup:
   fcm__free(ctx, pairs);
   fcm__free(ctx, vpiece);
   fcm__free(ctx, on_cut);
+  fcm__free(ctx, maybe);
+  fcm__free(ctx, qcell);
   return st;
 }
 
@@ -286,8 +382,8 @@ cleanup:
  * triangle (*src)[k] and lies in cell (*pcell)[k]. A triangle whose parts do not add up to
  * its area (it leaves the mesh) is unflagged and its parts dropped. */
 static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char *changed,
-                                  unsigned char *split, fcm__embed_polys *polys, fcm_index **src,
-                                  fcm_index **pcell)
+                                  const preclip *pre, unsigned char *split, fcm__embed_polys *polys,
+                                  fcm_index **src, fcm_index **pcell)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = es->ctx;
@@ -299,16 +395,7 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
   FCM_TRY(ctx, cell_tree(es));
   for (fcm_index t = 0; t < es->nbt; t++) {
     if (!split[t]) continue;
-    double x[9], lo[3], hi[3], w = 0.0;
-    tri_coords(es, t, x);
-    for (int d = 0; d < 3; d++) {
-      lo[d] = fmin(x[d], fmin(x[3 + d], x[6 + d]));
-      hi[d] = fmax(x[d], fmax(x[3 + d], x[6 + d]));
-      w = fmax(w, hi[d] - lo[d]);
-    }
-    for (int d = 0; d < 3; d++) /* cells the triangle touches within rounding */
-      lo[d] -= 1e-9 * w, hi[d] += 1e-9 * w;
-    FCM_TRY(ctx, fcm__geom_tree_query(ctx, es->cell_tree, lo, hi, &ids));
+    FCM_TRY(ctx, tri_cells(es, t, &ids));
     if (n + ids.n > cap) {
       size_t ncap = cap ? 2 * cap : 1024;
       while (ncap < n + ids.n)
@@ -324,17 +411,23 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
   qsort(pairs, n, 2 * sizeof *pairs, cmp_pair); /* one cell's parts made once */
   FCM_ALLOC_RAW(ctx, n + 1, poff);
   FCM_ALLOC_RAW(ctx, n + 1, xoff);
-  for (size_t k = 0, j = 0; k < n; k++) {
+  for (size_t k = 0, j = 0, jp = 0; k < n; k++) {
     const fcm_index c = pairs[2 * k], t = pairs[2 * k + 1];
     const size_t n0 = polys->n;
     poff[k] = n0, xoff[k] = polys->nx;
     while (j < es->npairs && cmp_pair(es->pairs + 2 * j, pairs + 2 * k) < 0)
       j++;
+    while (jp < pre->n && cmp_pair(pre->pairs + 2 * jp, pairs + 2 * k) < 0)
+      jp++;
     if (!changed[c] && j < es->npairs && !cmp_pair(es->pairs + 2 * j, pairs + 2 * k)) {
       size_t first_x = es->xoff[j]; /* the parts the last rebuild clipped */
       for (size_t q = es->poff[j]; q < es->poff[j + 1]; first_x += (size_t)es->polys.nv[q++])
         FCM_TRY(ctx, polys_append(ctx, polys, &es->polys, q, first_x,
                                   map_piece(es, c, es->polys.piece[q])));
+    } else if (jp < pre->n && !cmp_pair(pre->pairs + 2 * jp, pairs + 2 * k)) {
+      size_t first_x = pre->xoff[jp]; /* clipped while mark_split() had the cell's parts */
+      for (size_t q = pre->off[jp]; q < pre->off[jp + 1]; first_x += (size_t)pre->polys.nv[q++])
+        FCM_TRY(ctx, polys_append(ctx, polys, &pre->polys, q, first_x, pre->polys.piece[q]));
     } else {
       double x[9];
       tri_coords(es, t, x);
@@ -463,7 +556,9 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
   const fcm_index npieces = rules ? fcm_cell_rules_num_pieces(rules) : 0;
   unsigned char *split = NULL, *changed = NULL;
   fcm__embed_polys polys = {NULL, NULL, NULL, 0, 0, 0, 0};
+  preclip pre;
   fcm_index *src = NULL, *pcell = NULL, *order = NULL, *ppiece = NULL;
+  memset(&pre, 0, sizeof pre);
   size_t *first_x = NULL;
   fcm_index ncf = 0;
   for (fcm_index p = 0; p < npieces; p++)
@@ -482,8 +577,8 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
     FCM_TRY(ctx, fcm__embed_finder_set_rules(es->finder, rules));
     FCM_ALLOC_RAW(ctx, (size_t)rules->num_cells + 1, changed);
     FCM_TRY(ctx, changed_cells(es, changed));
-    FCM_TRY(ctx, mark_split(es, changed, split));
-    FCM_TRY(ctx, split_triangles(es, changed, split, &polys, &src, &pcell));
+    FCM_TRY(ctx, mark_split(es, changed, split, &pre));
+    FCM_TRY(ctx, split_triangles(es, changed, &pre, split, &polys, &src, &pcell));
     FCM_TRY(ctx, cache_rules(es));
   } else {
     cache_clear(es);
@@ -565,6 +660,7 @@ cleanup:
   fcm__free(ctx, first_x);
   fcm__free(ctx, ppiece);
   fcm__embed_polys_free(ctx, &polys);
+  preclip_free(ctx, &pre);
   return st;
 }
 

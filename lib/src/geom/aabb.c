@@ -161,6 +161,8 @@ typedef struct probe {
   double p0[3], d[3], pad;
 } probe;
 
+/* The segment's slab test with plain comparisons (fmin and fmax are library calls here, and
+ * a segment query visits many nodes): no operand is NaN, so the result is theirs. */
 static int probe_meets(const probe *q, const double *blo, const double *bhi)
 {
   if (!q->segment) return overlaps(blo, bhi, q->lo, q->hi);
@@ -171,12 +173,10 @@ static int probe_meets(const probe *q, const double *blo, const double *bhi)
       if (q->p0[k] < lo || q->p0[k] > hi) return 0;
       continue;
     }
-    double a = (lo - q->p0[k]) / q->d[k], b = (hi - q->p0[k]) / q->d[k];
-    if (a > b) {
-      const double c = a;
-      a = b, b = c;
-    }
-    t0 = fmax(t0, a), t1 = fmin(t1, b);
+    const double a = (lo - q->p0[k]) / q->d[k], b = (hi - q->p0[k]) / q->d[k];
+    const double amin = a < b ? a : b, bmax = a < b ? b : a;
+    if (amin > t0) t0 = amin;
+    if (bmax < t1) t1 = bmax;
     if (t0 > t1) return 0;
   }
   return 1;
