@@ -11,7 +11,12 @@
  * built in parallel (one block per thread at a time). The apply is one parallel loop over the DOFs
  * without barriers: z_i = r_i / |c_ii| outside the blocks, and inside the sum of the rows
  * for DOF i of the S_K of the blocks holding i (in ascending block order), each z_i summed
- * by one thread, so z = S r does not depend on the number of threads. */
+ * by one thread, so z = S r does not depend on the number of threads.
+ *
+ * Created for the multigrid's block smoother (fcm__schwarz_create_blocks()), a setup computes
+ * only what the block sweeps read: the S_K, and each block's rows of C packed one after the
+ * other (columns and values, in the matrix's order), so that a sweep reads a block's rows
+ * from contiguous memory; no diagonal outside the blocks, no apply. */
 #include "solve/solve_impl.h"
 
 #include <math.h>
@@ -44,6 +49,14 @@ struct fcm_schwarz {
   int *inc_row;          /* block_ptr[num_blocks] */
   unsigned char *inside; /* n: DOF belongs to a block */
   double *dinv;          /* n: 1/|c_ii| outside the blocks, 0 inside */
+  fcm_index *diag;       /* n: position of c_ii in C at creation outside the blocks (-1: none) */
+  /* Block smoother mode: no apply, no diagonal; block row q (q < block_ptr[num_blocks]) of C
+   * packed at [row_off[q], row_off[q + 1]) of pk_col / pk_val (pk_cap entries allocated). */
+  int blocks_only;
+  fcm_index *row_off;
+  int *pk_col;
+  double *pk_val;
+  size_t pk_cap;
   fcm_schwarz_info info;
   int ready;
   /* Setup scratch, allocated at creation so a setup allocates nothing: per thread (nt of
@@ -79,6 +92,10 @@ void fcm_schwarz_destroy(fcm_schwarz **P)
   fcm__free(ctx, p->inc_row);
   fcm__free(ctx, p->inside);
   fcm__free(ctx, p->dinv);
+  fcm__free(ctx, p->diag);
+  fcm__free(ctx, p->row_off);
+  fcm__free(ctx, p->pk_col);
+  fcm__free(ctx, p->pk_val);
   fcm__free(ctx, p->work);
   fcm__free(ctx, p->iwork);
   fcm__free(ctx, p->loc);
@@ -145,18 +162,17 @@ typedef struct block_stats {
 
 /* Gather C_K = R_K C R_K^T into a (m x m, column-major): each block row's matrix row is read
  * once, its columns found through loc (DOF -> block index + 1, zero outside the block, left
- * zero on return). 0 when an entry is NaN or infinite. */
-static int gather_block(const fcm_csr *C, const double *vals, int m, const fcm_index *d, int *loc,
-                        double *a)
+ * zero on return). Block row i is [off[r], off[r + 1]) of ci / vals with r = rows[i] (the
+ * matrix's rows), or r = i without rows (packed rows). 0 when an entry is NaN or infinite. */
+static int gather_block(const fcm_index *off, const fcm_index *rows, const int *ci,
+                        const double *vals, int m, const fcm_index *d, int *loc, double *a)
 {
-  const fcm_index *rp = fcm_csr_row_ptr(C);
-  const int *ci = fcm_csr_col_idx(C);
   int finite = 1;
   memset(a, 0, sizeof *a * (size_t)m * (size_t)m);
   for (int j = 0; j < m; j++)
     loc[d[j]] = j + 1;
   for (int i = 0; i < m; i++)
-    for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++) {
+    for (fcm_index r = rows ? rows[i] : i, p = off[r]; p < off[r + 1]; p++) {
       const int k = loc[ci[p]];
       if (!k) continue;
       finite &= isfinite(vals[p]) != 0;
@@ -224,7 +240,21 @@ static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *va
   const fcm_index *d = P->dofs + P->block_ptr[b];
   const int m = (int)(P->block_ptr[b + 1] - P->block_ptr[b]);
   double *S = P->S + P->s_off[b];
-  if (!gather_block(C, vals, m, d, loc, a)) {
+  const fcm_index *rp = fcm_csr_row_ptr(C);
+  const int *ci = fcm_csr_col_idx(C);
+  int finite;
+  if (P->blocks_only) {
+    const fcm_index *off = P->row_off + P->block_ptr[b];
+    for (int i = 0; i < m; i++) {
+      const size_t len = (size_t)(rp[d[i] + 1] - rp[d[i]]);
+      memcpy(P->pk_col + off[i], ci + rp[d[i]], sizeof *ci * len);
+      memcpy(P->pk_val + off[i], vals + rp[d[i]], sizeof *vals * len);
+    }
+    finite = gather_block(off, NULL, P->pk_col, P->pk_val, m, d, loc, a);
+  } else {
+    finite = gather_block(rp, d, ci, vals, m, d, loc, a);
+  }
+  if (!finite) {
     *fail = FAIL_NONFINITE;
     return FCM_ERR_NUMERIC;
   }
@@ -262,6 +292,59 @@ static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *va
   return st;
 }
 
+/* dinv outside the blocks, the diagonal at its position found at creation (searched again
+ * when the matrix's pattern moved it); fallbacks: the negative ones. */
+static fcm_status outside_diagonal(fcm_schwarz *P, const fcm_csr *C, const double *vals,
+                                   fcm_index *fallbacks)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_index *rp = fcm_csr_row_ptr(C);
+  const int *ci = fcm_csr_col_idx(C);
+  for (fcm_index i = 0; i < P->n; i++) {
+    if (P->inside[i]) {
+      P->dinv[i] = 0.0;
+      continue;
+    }
+    fcm_index p = P->diag[i];
+    if (p < rp[i] || p >= rp[i + 1] || ci[p] != i) p = P->diag[i] = fcm_csr_position(C, i, i);
+    double dii = p >= 0 ? vals[p] : 0.0;
+    FCM_CHECK(isfinite(dii), ctx, FCM_ERR_NUMERIC,
+              "schwarz: diagonal entry of row %lld (outside all blocks) is %g", (long long)i, dii);
+    FCM_CHECK(dii != 0.0, ctx, FCM_ERR_SINGULAR,
+              "schwarz: diagonal entry of row %lld (outside all blocks) is zero", (long long)i);
+    if (dii < 0.0) (*fallbacks)++;
+    P->dinv[i] = 1.0 / fabs(dii);
+  }
+cleanup:
+  return st;
+}
+
+/* The packed block rows' offsets for C's pattern (the storage grown when it needs more). */
+static fcm_status pack_offsets(fcm_schwarz *P, const fcm_csr *C)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_index *rp = fcm_csr_row_ptr(C);
+  const fcm_index rows = P->block_ptr[P->num_blocks];
+  fcm_index total = 0;
+  for (fcm_index q = 0; q < rows; q++) {
+    P->row_off[q] = total;
+    total += rp[P->dofs[q] + 1] - rp[P->dofs[q]];
+  }
+  P->row_off[rows] = total;
+  if ((size_t)total > P->pk_cap) {
+    FCM_FREE(ctx, P->pk_col);
+    FCM_FREE(ctx, P->pk_val);
+    P->pk_cap = 0;
+    FCM_ALLOC_RAW(ctx, (size_t)total, P->pk_col);
+    FCM_ALLOC_RAW(ctx, (size_t)total, P->pk_val);
+    P->pk_cap = (size_t)total;
+  }
+cleanup:
+  return st;
+}
+
 fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
 {
   fcm_status st = FCM_OK;
@@ -276,20 +359,10 @@ fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
   P->ready = 0;
   const double *vals = fcm_csr_values_read(C);
   fcm_index fallbacks = 0;
-  for (fcm_index i = 0; i < P->n; i++) {
-    if (P->inside[i]) {
-      P->dinv[i] = 0.0;
-      continue;
-    }
-    fcm_index p = fcm_csr_position(C, i, i);
-    double dii = p >= 0 ? vals[p] : 0.0;
-    FCM_CHECK(isfinite(dii), ctx, FCM_ERR_NUMERIC,
-              "schwarz: diagonal entry of row %lld (outside all blocks) is %g", (long long)i, dii);
-    FCM_CHECK(dii != 0.0, ctx, FCM_ERR_SINGULAR,
-              "schwarz: diagonal entry of row %lld (outside all blocks) is zero", (long long)i);
-    if (dii < 0.0) fallbacks++;
-    P->dinv[i] = 1.0 / fabs(dii);
-  }
+  if (P->blocks_only)
+    FCM_TRY(ctx, pack_offsets(P, C));
+  else
+    FCM_TRY(ctx, outside_diagonal(P, C, vals, &fallbacks));
 
   const fcm_index nb = P->num_blocks;
   fcm_index bad = -1, negative = 0, clamped = 0;
@@ -345,9 +418,10 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
-                              const fcm_index *block_ptr, const fcm_index *block_dofs,
-                              const fcm_schwarz_options *opts, fcm_schwarz **out)
+/* fcm_schwarz_create(); blocks_only: for the block smoother (fcm__schwarz_create_blocks()). */
+static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
+                         const fcm_index *block_ptr, const fcm_index *block_dofs,
+                         const fcm_schwarz_options *opts, int blocks_only, fcm_schwarz **out)
 {
   fcm_status st = FCM_OK;
   fcm_schwarz *P = NULL;
@@ -397,6 +471,7 @@ fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_bloc
   FCM_ALLOC(ctx, 1, P);
   P->ctx = ctx;
   P->n = nr;
+  P->blocks_only = blocks_only;
   P->opts = o;
   P->num_blocks = num_blocks;
   P->max_m = max_m;
@@ -414,6 +489,13 @@ fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_bloc
   for (fcm_index p = 0; p < total; p++) {
     P->dofs[p] = block_dofs[p];
     P->inside[block_dofs[p]] = 1;
+  }
+  if (blocks_only) {
+    FCM_ALLOC(ctx, total + 1, P->row_off);
+  } else {
+    FCM_ALLOC(ctx, nr, P->diag);
+    for (fcm_index i = 0; i < nr; i++)
+      P->diag[i] = P->inside[i] ? -1 : fcm_csr_position(C, i, i);
   }
   FCM_ALLOC(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->S);
   FCM_TRY(ctx, incidence_and_colors(P));
@@ -450,12 +532,28 @@ cleanup:
   return st;
 }
 
+fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
+                              const fcm_index *block_ptr, const fcm_index *block_dofs,
+                              const fcm_schwarz_options *opts, fcm_schwarz **out)
+{
+  return create(ctx, C, num_blocks, block_ptr, block_dofs, opts, 0, out);
+}
+
+fcm_status fcm__schwarz_create_blocks(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
+                                      const fcm_index *block_ptr, const fcm_index *block_dofs,
+                                      fcm_schwarz **out)
+{
+  return create(ctx, C, num_blocks, block_ptr, block_dofs, NULL, 1, out);
+}
+
 fcm_status fcm_schwarz_apply(const fcm_schwarz *P, const double *r, double *z)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P ? P->ctx : NULL;
   FCM_CHECK(P, ctx, FCM_ERR_ARG, "schwarz_apply: preconditioner is NULL");
   FCM_CHECK(P->ready, ctx, FCM_ERR_ARG, "schwarz_apply: the last setup failed");
+  FCM_CHECK(!P->blocks_only, ctx, FCM_ERR_ARG,
+            "schwarz_apply: the preconditioner holds a block smoother's blocks only");
   FCM_CHECK((r && z) || P->n == 0, ctx, FCM_ERR_ARG, "schwarz_apply: r or z is NULL");
   FCM_CHECK(!r || r != z, ctx, FCM_ERR_ARG, "schwarz_apply: r and z must be different arrays");
   const fcm_index n = P->n;
@@ -492,6 +590,14 @@ int fcm__schwarz_block(const fcm_schwarz *P, fcm_index k, const fcm_index **dofs
   *dofs = P->dofs + P->block_ptr[k];
   *S = P->S + P->s_off[k];
   return (int)(P->block_ptr[k + 1] - P->block_ptr[k]);
+}
+
+void fcm__schwarz_block_rows(const fcm_schwarz *P, fcm_index k, const fcm_index **off,
+                             const int **col, const double **val)
+{
+  *off = P->row_off + P->block_ptr[k];
+  *col = P->pk_col;
+  *val = P->pk_val;
 }
 
 fcm_status fcm_schwarz_operator(void *user, const double *r, double *z)
