@@ -85,8 +85,8 @@ int main(int argc, char **argv)
     fcm_mg_destroy(&cut);
   }
   const double setup = median(t[0], reps), create = median(t[1], reps);
-  printf("hemisphere n = %lld: %lld -> %lld DOFs, CPU s on 1 thread, median of %d\n",
-         (long long)n, (long long)p.n, (long long)q.n, reps);
+  printf("hemisphere n = %lld: %lld -> %lld DOFs, CPU s on 1 thread, median of %d\n", (long long)n,
+         (long long)p.n, (long long)q.n, reps);
   printf("  fcm_mg_setup                         %.4f\n", setup);
   printf("  fcm_mg_create                        %.4f (beyond the setup: %.4f)\n", create,
          create - setup);

@@ -543,7 +543,8 @@ fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned
     if (nb > 0 && old && same[l])
       FCM_TRY(ctx, fcm__mg_keep_blocks(old, m, l, nb, ptr, dofs, &kept));
     if (nb > 0 && !kept) {
-      FCM_TRY(ctx, fcm__schwarz_create_blocks(ctx, fcm__mg_level_matrix(L), nb, ptr, dofs, &L->blk));
+      FCM_TRY(ctx,
+              fcm__schwarz_create_blocks(ctx, fcm__mg_level_matrix(L), nb, ptr, dofs, &L->blk));
       FCM_TRY(ctx, block_slabs(m, L));
     }
     FCM_FREE(ctx, ptr);
@@ -676,23 +677,24 @@ void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x)
 }
 
 /* Block Gauss-Seidel over the blocks of slab s, forward or backward: x_K += S_K (b - A x)_K,
- * block after block, the block's rows of A read from their packed copy (the same entries in
- * the same order as the matrix's rows). */
+ * block after block. */
 static void block_slab(const sweep_args *a, fcm_index s, int back)
 {
   const mg_level *L = a->L;
   const double *b = a->b;
   double *x = a->x, *r = a->r, *dx = a->dx;
+  const fcm_csr *A = fcm__mg_level_matrix(L);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const double *v = fcm_csr_values_read(A);
   const fcm_index q0 = L->blocks.ptr[s], q1 = L->blocks.ptr[s + 1];
   for (fcm_index t = 0; t < q1 - q0; t++) {
     const fcm_index k = L->blocks.item[back ? q1 - 1 - t : q0 + t];
-    const fcm_index *d = NULL, *off = NULL;
-    const double *S = NULL, *v = NULL;
-    const int *ci = NULL;
+    const fcm_index *d = NULL;
+    const double *S = NULL;
     const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
-    fcm__schwarz_block_rows(L->blk, k, &off, &ci, &v);
     for (int i = 0; i < bm; i++)
-      r[i] = b[d[i]] - fcm__mg_row_dot(v, ci, off[i], off[i + 1], x);
+      r[i] = b[d[i]] - fcm__mg_row_dot(v, ci, rp[d[i]], rp[d[i] + 1], x);
     for (int i = 0; i < bm; i++)
       dx[i] = dense_dot(S + (size_t)i * (size_t)bm, r, bm);
     for (int i = 0; i < bm; i++)

@@ -14,9 +14,7 @@
  * by one thread, so z = S r does not depend on the number of threads.
  *
  * Created for the multigrid's block smoother (fcm__schwarz_create_blocks()), a setup computes
- * only what the block sweeps read: the S_K, and each block's rows of C packed one after the
- * other (columns and values, in the matrix's order), so that a sweep reads a block's rows
- * from contiguous memory; no diagonal outside the blocks, no apply. */
+ * only what the block sweeps read, the S_K: no diagonal outside the blocks, no apply. */
 #include "solve/solve_impl.h"
 
 #include <math.h>
@@ -50,13 +48,7 @@ struct fcm_schwarz {
   unsigned char *inside; /* n: DOF belongs to a block */
   double *dinv;          /* n: 1/|c_ii| outside the blocks, 0 inside */
   fcm_index *diag;       /* n: position of c_ii in C at creation outside the blocks (-1: none) */
-  /* Block smoother mode: no apply, no diagonal; block row q (q < block_ptr[num_blocks]) of C
-   * packed at [row_off[q], row_off[q + 1]) of pk_col / pk_val (pk_cap entries allocated). */
-  int blocks_only;
-  fcm_index *row_off;
-  int *pk_col;
-  double *pk_val;
-  size_t pk_cap;
+  int blocks_only;       /* the block smoother's: the S_K only (no dinv, no apply) */
   fcm_schwarz_info info;
   int ready;
   /* Setup scratch, allocated at creation so a setup allocates nothing: per thread (nt of
@@ -93,9 +85,6 @@ void fcm_schwarz_destroy(fcm_schwarz **P)
   fcm__free(ctx, p->inside);
   fcm__free(ctx, p->dinv);
   fcm__free(ctx, p->diag);
-  fcm__free(ctx, p->row_off);
-  fcm__free(ctx, p->pk_col);
-  fcm__free(ctx, p->pk_val);
   fcm__free(ctx, p->work);
   fcm__free(ctx, p->iwork);
   fcm__free(ctx, p->loc);
@@ -162,17 +151,18 @@ typedef struct block_stats {
 
 /* Gather C_K = R_K C R_K^T into a (m x m, column-major): each block row's matrix row is read
  * once, its columns found through loc (DOF -> block index + 1, zero outside the block, left
- * zero on return). Block row i is [off[r], off[r + 1]) of ci / vals with r = rows[i] (the
- * matrix's rows), or r = i without rows (packed rows). 0 when an entry is NaN or infinite. */
-static int gather_block(const fcm_index *off, const fcm_index *rows, const int *ci,
-                        const double *vals, int m, const fcm_index *d, int *loc, double *a)
+ * zero on return). 0 when an entry is NaN or infinite. */
+static int gather_block(const fcm_csr *C, const double *vals, int m, const fcm_index *d, int *loc,
+                        double *a)
 {
+  const fcm_index *rp = fcm_csr_row_ptr(C);
+  const int *ci = fcm_csr_col_idx(C);
   int finite = 1;
   memset(a, 0, sizeof *a * (size_t)m * (size_t)m);
   for (int j = 0; j < m; j++)
     loc[d[j]] = j + 1;
   for (int i = 0; i < m; i++)
-    for (fcm_index r = rows ? rows[i] : i, p = off[r]; p < off[r + 1]; p++) {
+    for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++) {
       const int k = loc[ci[p]];
       if (!k) continue;
       finite &= isfinite(vals[p]) != 0;
@@ -183,6 +173,99 @@ static int gather_block(const fcm_index *off, const fcm_index *rows, const int *
   return finite;
 }
 
+/* The three stages of cholesky_inverse() work two by two (two rows of L, two columns of X, two
+ * entries of S at a time): each entry's sum still runs over k in ascending order, as one chain
+ * of dependent operations, and two chains interleaved keep the floating-point units busy. */
+
+/* L of C_K = L L^T (row-major) from the lower triangle of a (column-major); 0 when a pivot
+ * is not positive and finite. Rows i and i + 1 go together: at each column j <= i entry
+ * (i, j) first (entry (i + 1, i) divides by L_ii, found in the same step). */
+static int cholesky_factor(int m, const double *a, double *L)
+{
+  for (int i = 0; i < m; i += 2) {
+    double *Li = L + (size_t)i * m, *Lh = i + 1 < m ? Li + m : NULL;
+    for (int j = 0; j <= i; j++) {
+      const double *Lj = L + (size_t)j * m;
+      double v = a[i + (size_t)j * m], u = Lh ? a[i + 1 + (size_t)j * m] : 0.0;
+      int k = 0;
+      if (Lh)
+        for (; k < j; k++) {
+          v -= Li[k] * Lj[k];
+          u -= Lh[k] * Lj[k];
+        }
+      else
+        for (; k < j; k++)
+          v -= Li[k] * Lj[k];
+      if (i > j) {
+        Li[j] = v / Lj[j];
+      } else {
+        if (!(v > 0.0 && isfinite(v))) return 0;
+        Li[i] = sqrt(v);
+      }
+      if (Lh) Lh[j] = u / Lj[j];
+    }
+    if (Lh) { /* the diagonal of row i + 1 */
+      double v = a[i + 1 + (size_t)(i + 1) * m];
+      for (int k = 0; k < i + 1; k++)
+        v -= Lh[k] * Lh[k];
+      if (!(v > 0.0 && isfinite(v))) return 0;
+      Lh[i + 1] = sqrt(v);
+    }
+  }
+  return 1;
+}
+
+/* X = L^{-1} (lower, row-major), columns j and j + 1 together. */
+static void cholesky_invert_factor(int m, const double *L, double *X)
+{
+  for (int j = 0; j < m; j += 2) {
+    const int h = j + 1;
+    X[(size_t)j * m + j] = 1.0 / L[(size_t)j * m + j];
+    if (h < m) {
+      X[(size_t)h * m + h] = 1.0 / L[(size_t)h * m + h];
+      double v = 0.0;
+      v -= L[(size_t)h * m + j] * X[(size_t)j * m + j];
+      X[(size_t)h * m + j] = v / L[(size_t)h * m + h];
+    }
+    for (int i = j + 2; i < m; i++) {
+      const double *Li = L + (size_t)i * m;
+      double v = 0.0, u = 0.0;
+      v -= Li[j] * X[(size_t)j * m + j];
+      for (int k = h; k < i; k++) {
+        v -= Li[k] * X[(size_t)k * m + j];
+        u -= Li[k] * X[(size_t)k * m + h];
+      }
+      X[(size_t)i * m + j] = v / Li[i];
+      X[(size_t)i * m + h] = u / Li[i];
+    }
+  }
+}
+
+/* S = X^T X (upper triangle, mirrored), entries (i, j) and (i, j + 1) together; returns
+ * ||S||_F^2 summed in the order of the entries (i, then j ascending). */
+static double cholesky_product(int m, const double *X, double *S)
+{
+  double ns = 0.0;
+  for (int i = 0; i < m; i++)
+    for (int j = i; j < m; j += 2) {
+      double v = 0.0, u = 0.0;
+      v += X[(size_t)j * m + i] * X[(size_t)j * m + j];
+      if (j + 1 < m) {
+        for (int k = j + 1; k < m; k++) {
+          v += X[(size_t)k * m + i] * X[(size_t)k * m + j];
+          u += X[(size_t)k * m + i] * X[(size_t)k * m + j + 1];
+        }
+      }
+      S[(size_t)i * m + j] = S[(size_t)j * m + i] = v;
+      ns += (i == j ? 1.0 : 2.0) * v * v;
+      if (j + 1 < m) {
+        S[(size_t)i * m + j + 1] = S[(size_t)(j + 1) * m + i] = u;
+        ns += 2.0 * u * u;
+      }
+    }
+  return ns;
+}
+
 /* S_K = C_K^{-1} through the Cholesky factor C_K = L L^T (the lower triangle of a; L and
  * X = L^{-1} row-major in lw, 2 m^2 doubles), when that factor exists and
  * ||C_K||_F ||S_K||_F <= SCHWARZ_CHOLESKY_COND / eps: then every eigenvalue lies in
@@ -191,41 +274,15 @@ static int gather_block(const fcm_index *off, const fcm_index *rows, const int *
  * cond(C_K) times the unit round-off). 0 (S_K untouched) otherwise. */
 static int cholesky_inverse(int m, const double *a, double eps, double *lw, double *S)
 {
-  double *L = lw, *X = lw + (size_t)m * m, na = 0.0, ns = 0.0;
-  for (int i = 0; i < m; i++) {
-    double *Li = L + (size_t)i * m;
+  double *L = lw, *X = lw + (size_t)m * m, na = 0.0;
+  for (int i = 0; i < m; i++)
     for (int j = 0; j <= i; j++) {
-      const double *Lj = L + (size_t)j * m;
-      double v = a[i + (size_t)j * m];
+      const double v = a[i + (size_t)j * m];
       na += (i == j ? 1.0 : 2.0) * v * v;
-      for (int k = 0; k < j; k++)
-        v -= Li[k] * Lj[k];
-      if (i > j) {
-        Li[j] = v / Lj[j];
-      } else {
-        if (!(v > 0.0 && isfinite(v))) return 0;
-        Li[i] = sqrt(v);
-      }
     }
-  }
-  for (int j = 0; j < m; j++) { /* column j of X = L^{-1} (lower) */
-    X[(size_t)j * m + j] = 1.0 / L[(size_t)j * m + j];
-    for (int i = j + 1; i < m; i++) {
-      const double *Li = L + (size_t)i * m;
-      double v = 0.0;
-      for (int k = j; k < i; k++)
-        v -= Li[k] * X[(size_t)k * m + j];
-      X[(size_t)i * m + j] = v / Li[i];
-    }
-  }
-  for (int i = 0; i < m; i++) /* S = X^T X, upper triangle, mirrored */
-    for (int j = i; j < m; j++) {
-      double v = 0.0;
-      for (int k = j; k < m; k++)
-        v += X[(size_t)k * m + i] * X[(size_t)k * m + j];
-      S[(size_t)i * m + j] = S[(size_t)j * m + i] = v;
-      ns += (i == j ? 1.0 : 2.0) * v * v;
-    }
+  if (!cholesky_factor(m, a, L)) return 0;
+  cholesky_invert_factor(m, L, X);
+  const double ns = cholesky_product(m, X, S);
   return isfinite(ns) && sqrt(na) * sqrt(ns) <= SCHWARZ_CHOLESKY_COND / eps;
 }
 
@@ -240,21 +297,7 @@ static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *va
   const fcm_index *d = P->dofs + P->block_ptr[b];
   const int m = (int)(P->block_ptr[b + 1] - P->block_ptr[b]);
   double *S = P->S + P->s_off[b];
-  const fcm_index *rp = fcm_csr_row_ptr(C);
-  const int *ci = fcm_csr_col_idx(C);
-  int finite;
-  if (P->blocks_only) {
-    const fcm_index *off = P->row_off + P->block_ptr[b];
-    for (int i = 0; i < m; i++) {
-      const size_t len = (size_t)(rp[d[i] + 1] - rp[d[i]]);
-      memcpy(P->pk_col + off[i], ci + rp[d[i]], sizeof *ci * len);
-      memcpy(P->pk_val + off[i], vals + rp[d[i]], sizeof *vals * len);
-    }
-    finite = gather_block(off, NULL, P->pk_col, P->pk_val, m, d, loc, a);
-  } else {
-    finite = gather_block(rp, d, ci, vals, m, d, loc, a);
-  }
-  if (!finite) {
+  if (!gather_block(C, vals, m, d, loc, a)) {
     *fail = FAIL_NONFINITE;
     return FCM_ERR_NUMERIC;
   }
@@ -320,31 +363,6 @@ cleanup:
   return st;
 }
 
-/* The packed block rows' offsets for C's pattern (the storage grown when it needs more). */
-static fcm_status pack_offsets(fcm_schwarz *P, const fcm_csr *C)
-{
-  fcm_status st = FCM_OK;
-  fcm_ctx *ctx = P->ctx;
-  const fcm_index *rp = fcm_csr_row_ptr(C);
-  const fcm_index rows = P->block_ptr[P->num_blocks];
-  fcm_index total = 0;
-  for (fcm_index q = 0; q < rows; q++) {
-    P->row_off[q] = total;
-    total += rp[P->dofs[q] + 1] - rp[P->dofs[q]];
-  }
-  P->row_off[rows] = total;
-  if ((size_t)total > P->pk_cap) {
-    FCM_FREE(ctx, P->pk_col);
-    FCM_FREE(ctx, P->pk_val);
-    P->pk_cap = 0;
-    FCM_ALLOC_RAW(ctx, (size_t)total, P->pk_col);
-    FCM_ALLOC_RAW(ctx, (size_t)total, P->pk_val);
-    P->pk_cap = (size_t)total;
-  }
-cleanup:
-  return st;
-}
-
 fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
 {
   fcm_status st = FCM_OK;
@@ -359,10 +377,7 @@ fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
   P->ready = 0;
   const double *vals = fcm_csr_values_read(C);
   fcm_index fallbacks = 0;
-  if (P->blocks_only)
-    FCM_TRY(ctx, pack_offsets(P, C));
-  else
-    FCM_TRY(ctx, outside_diagonal(P, C, vals, &fallbacks));
+  if (!P->blocks_only) FCM_TRY(ctx, outside_diagonal(P, C, vals, &fallbacks));
 
   const fcm_index nb = P->num_blocks;
   fcm_index bad = -1, negative = 0, clamped = 0;
@@ -490,9 +505,7 @@ static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
     P->dofs[p] = block_dofs[p];
     P->inside[block_dofs[p]] = 1;
   }
-  if (blocks_only) {
-    FCM_ALLOC(ctx, total + 1, P->row_off);
-  } else {
+  if (!blocks_only) {
     FCM_ALLOC(ctx, nr, P->diag);
     for (fcm_index i = 0; i < nr; i++)
       P->diag[i] = P->inside[i] ? -1 : fcm_csr_position(C, i, i);
@@ -590,14 +603,6 @@ int fcm__schwarz_block(const fcm_schwarz *P, fcm_index k, const fcm_index **dofs
   *dofs = P->dofs + P->block_ptr[k];
   *S = P->S + P->s_off[k];
   return (int)(P->block_ptr[k + 1] - P->block_ptr[k]);
-}
-
-void fcm__schwarz_block_rows(const fcm_schwarz *P, fcm_index k, const fcm_index **off,
-                             const int **col, const double **val)
-{
-  *off = P->row_off + P->block_ptr[k];
-  *col = P->pk_col;
-  *val = P->pk_val;
 }
 
 fcm_status fcm_schwarz_operator(void *user, const double *r, double *z)

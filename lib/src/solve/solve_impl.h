@@ -15,14 +15,10 @@
  * S_K (symmetric, row major), valid after a successful setup. */
 fcm_index fcm__schwarz_num_blocks(const fcm_schwarz *P);
 int fcm__schwarz_block(const fcm_schwarz *P, fcm_index k, const fcm_index **dofs, const double **S);
-/* fcm_schwarz_create() for a block smoother: a setup computes the S_K and packs the blocks'
- * rows of C, nothing else (no diagonal outside the blocks); fcm_schwarz_apply() refuses it. */
+/* fcm_schwarz_create() for a block smoother: a setup computes the S_K, nothing else (no
+ * diagonal outside the blocks); fcm_schwarz_apply() refuses it. */
 fcm_status fcm__schwarz_create_blocks(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
                                       const fcm_index *block_ptr, const fcm_index *block_dofs,
                                       fcm_schwarz **out);
-/* Block k's rows of C packed (a block smoother's, after a successful setup): row i of the
- * block is entries [off[i], off[i + 1]) of col and val, in the matrix's order. */
-void fcm__schwarz_block_rows(const fcm_schwarz *P, fcm_index k, const fcm_index **off,
-                             const int **col, const double **val);
 
 #endif /* FCM_SOLVE_IMPL_H */
