@@ -40,6 +40,8 @@ struct fcm_schwarz {
   fcm_index *dofs;      /* block_ptr[num_blocks] */
   size_t *s_off;        /* num_blocks + 1 offsets into S */
   double *S;            /* dense S_K, m x m each (symmetric) */
+  int *pos;             /* as S: where C_K's entry (i, j) lies in C's row dofs[i] (-1: none) */
+  unsigned char *full;  /* num_blocks: every entry of C_K is stored (pos holds them all) */
   int max_m;
   int num_colors;        /* of the block graph (statistics only) */
   fcm_index *inc_ptr;    /* n + 1: DOF i is row inc_row[q] of block inc_blk[q], q in range */
@@ -79,6 +81,8 @@ void fcm_schwarz_destroy(fcm_schwarz **P)
   fcm__free(ctx, p->dofs);
   fcm__free(ctx, p->s_off);
   fcm__free(ctx, p->S);
+  fcm__free(ctx, p->pos);
+  fcm__free(ctx, p->full);
   fcm__free(ctx, p->inc_ptr);
   fcm__free(ctx, p->inc_blk);
   fcm__free(ctx, p->inc_row);
@@ -149,16 +153,20 @@ typedef struct block_stats {
   fcm_index negative, clamped;
 } block_stats;
 
-/* Gather C_K = R_K C R_K^T into a (m x m, column-major): each block row's matrix row is read
- * once, its columns found through loc (DOF -> block index + 1, zero outside the block, left
- * zero on return). 0 when an entry is NaN or infinite. */
-static int gather_block(const fcm_csr *C, const double *vals, int m, const fcm_index *d, int *loc,
-                        double *a)
+/* Gather C_K = R_K C R_K^T into a (m x m, column-major) by scanning the block rows: each
+ * block row's matrix row is read once, its columns found through loc (DOF -> block index + 1,
+ * zero outside the block, left zero on return). Records where each entry lies in its row
+ * (pos, m x m row-major, -1: not stored) and returns whether all are stored in *full.
+ * 0 when an entry is NaN or infinite. */
+static int gather_scan(const fcm_csr *C, const double *vals, int m, const fcm_index *d, int *loc,
+                       int *pos, unsigned char *full, double *a)
 {
   const fcm_index *rp = fcm_csr_row_ptr(C);
   const int *ci = fcm_csr_col_idx(C);
-  int finite = 1;
+  int finite = 1, stored = 0;
   memset(a, 0, sizeof *a * (size_t)m * (size_t)m);
+  for (size_t e = 0; e < (size_t)m * (size_t)m; e++)
+    pos[e] = -1;
   for (int j = 0; j < m; j++)
     loc[d[j]] = j + 1;
   for (int i = 0; i < m; i++)
@@ -167,9 +175,34 @@ static int gather_block(const fcm_csr *C, const double *vals, int m, const fcm_i
       if (!k) continue;
       finite &= isfinite(vals[p]) != 0;
       a[i + (size_t)(k - 1) * m] = vals[p];
+      if (pos[(size_t)i * m + k - 1] < 0) stored++;
+      pos[(size_t)i * m + k - 1] = (int)(p - rp[d[i]]);
     }
   for (int j = 0; j < m; j++)
     loc[d[j]] = 0;
+  *full = stored == m * m;
+  return finite;
+}
+
+/* Gather C_K through the positions of a block whose entries are all stored (pos of
+ * gather_scan()), each checked against C's pattern: 1 when all finite, 0 when one is NaN or
+ * infinite, -1 (a unfinished) when C's pattern has moved an entry. */
+static int gather_known(const fcm_csr *C, const double *vals, int m, const fcm_index *d,
+                        const int *pos, double *a)
+{
+  const fcm_index *rp = fcm_csr_row_ptr(C);
+  const int *ci = fcm_csr_col_idx(C);
+  int finite = 1;
+  for (int i = 0; i < m; i++) {
+    const fcm_index r0 = rp[d[i]], len = rp[d[i] + 1] - r0;
+    const int *pi = pos + (size_t)i * m;
+    for (int j = 0; j < m; j++) {
+      const fcm_index p = r0 + pi[j];
+      if (pi[j] >= len || ci[p] != d[j]) return -1;
+      finite &= isfinite(vals[p]) != 0;
+      a[i + (size_t)j * m] = vals[p];
+    }
+  }
   return finite;
 }
 
@@ -297,7 +330,10 @@ static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *va
   const fcm_index *d = P->dofs + P->block_ptr[b];
   const int m = (int)(P->block_ptr[b + 1] - P->block_ptr[b]);
   double *S = P->S + P->s_off[b];
-  if (!gather_block(C, vals, m, d, loc, a)) {
+  int *pos = P->pos + P->s_off[b];
+  int finite = P->full[b] ? gather_known(C, vals, m, d, pos, a) : -1;
+  if (finite < 0) finite = gather_scan(C, vals, m, d, loc, pos, P->full + b, a);
+  if (!finite) {
     *fail = FAIL_NONFINITE;
     return FCM_ERR_NUMERIC;
   }
@@ -511,6 +547,8 @@ static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
       P->diag[i] = P->inside[i] ? -1 : fcm_csr_position(C, i, i);
   }
   FCM_ALLOC(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->S);
+  FCM_ALLOC(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->pos);
+  FCM_ALLOC(ctx, num_blocks + 1, P->full); /* zero: the first setup scans */
   FCM_TRY(ctx, incidence_and_colors(P));
   /* setup scratch: the eigensolver workspace of the largest need over the block sizes */
   P->nt = fcm_ctx_num_threads(ctx);
