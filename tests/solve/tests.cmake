@@ -4,6 +4,8 @@ fcm_add_test(solve_krylov_errors tests/solve/krylov_errors.c)
 fcm_add_test(solve_jacobi tests/solve/jacobi.c)
 fcm_add_test(solve_schwarz tests/solve/schwarz.c)
 fcm_add_test(solve_schwarz_space tests/solve/schwarz_space.c)
+# a setup on a matrix of another pattern: bit for bit a fresh preconditioner
+fcm_add_test(solve_schwarz_pattern tests/solve/schwarz_pattern.c)
 fcm_add_test(solve_alloc_failure tests/solve/alloc_failure.c)
 fcm_add_test(solve_threads tests/solve/threads.c)
 # CG and MINRES stop as stagnated on a singular semi-definite system whose right-hand side

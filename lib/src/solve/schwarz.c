@@ -11,7 +11,10 @@
  * built in parallel (one block per thread at a time). The apply is one parallel loop over the DOFs
  * without barriers: z_i = r_i / |c_ii| outside the blocks, and inside the sum of the rows
  * for DOF i of the S_K of the blocks holding i (in ascending block order), each z_i summed
- * by one thread, so z = S r does not depend on the number of threads. */
+ * by one thread, so z = S r does not depend on the number of threads.
+ *
+ * Created for the multigrid's block smoother (fcm__schwarz_create_blocks()), a setup computes
+ * only what the block sweeps read, the S_K: no diagonal outside the blocks, no apply. */
 #include "solve/solve_impl.h"
 
 #include <math.h>
@@ -37,6 +40,8 @@ struct fcm_schwarz {
   fcm_index *dofs;      /* block_ptr[num_blocks] */
   size_t *s_off;        /* num_blocks + 1 offsets into S */
   double *S;            /* dense S_K, m x m each (symmetric) */
+  int *pos;             /* as S: where C_K's entry (i, j) lies in C's row dofs[i] (-1: none) */
+  unsigned char *full;  /* num_blocks: every entry of C_K is stored (pos holds them all) */
   int max_m;
   int num_colors;        /* of the block graph (statistics only) */
   fcm_index *inc_ptr;    /* n + 1: DOF i is row inc_row[q] of block inc_blk[q], q in range */
@@ -44,6 +49,8 @@ struct fcm_schwarz {
   int *inc_row;          /* block_ptr[num_blocks] */
   unsigned char *inside; /* n: DOF belongs to a block */
   double *dinv;          /* n: 1/|c_ii| outside the blocks, 0 inside */
+  fcm_index *diag;       /* n: position of c_ii in C at creation outside the blocks (-1: none) */
+  int blocks_only;       /* the block smoother's: the S_K only (no dinv, no apply) */
   fcm_schwarz_info info;
   int ready;
   /* Setup scratch, allocated at creation so a setup allocates nothing: per thread (nt of
@@ -74,11 +81,14 @@ void fcm_schwarz_destroy(fcm_schwarz **P)
   fcm__free(ctx, p->dofs);
   fcm__free(ctx, p->s_off);
   fcm__free(ctx, p->S);
+  fcm__free(ctx, p->pos);
+  fcm__free(ctx, p->full);
   fcm__free(ctx, p->inc_ptr);
   fcm__free(ctx, p->inc_blk);
   fcm__free(ctx, p->inc_row);
   fcm__free(ctx, p->inside);
   fcm__free(ctx, p->dinv);
+  fcm__free(ctx, p->diag);
   fcm__free(ctx, p->work);
   fcm__free(ctx, p->iwork);
   fcm__free(ctx, p->loc);
@@ -143,16 +153,20 @@ typedef struct block_stats {
   fcm_index negative, clamped;
 } block_stats;
 
-/* Gather C_K = R_K C R_K^T into a (m x m, column-major): each block row's matrix row is read
- * once, its columns found through loc (DOF -> block index + 1, zero outside the block, left
- * zero on return). 0 when an entry is NaN or infinite. */
-static int gather_block(const fcm_csr *C, const double *vals, int m, const fcm_index *d, int *loc,
-                        double *a)
+/* Gather C_K = R_K C R_K^T into a (m x m, column-major) by scanning the block rows: each
+ * block row's matrix row is read once, its columns found through loc (DOF -> block index + 1,
+ * zero outside the block, left zero on return). Records where each entry lies in its row
+ * (pos, m x m row-major, -1: not stored) and returns whether all are stored in *full.
+ * 0 when an entry is NaN or infinite. */
+static int gather_scan(const fcm_csr *C, const double *vals, int m, const fcm_index *d, int *loc,
+                       int *pos, unsigned char *full, double *a)
 {
   const fcm_index *rp = fcm_csr_row_ptr(C);
   const int *ci = fcm_csr_col_idx(C);
-  int finite = 1;
+  int finite = 1, stored = 0;
   memset(a, 0, sizeof *a * (size_t)m * (size_t)m);
+  for (size_t e = 0; e < (size_t)m * (size_t)m; e++)
+    pos[e] = -1;
   for (int j = 0; j < m; j++)
     loc[d[j]] = j + 1;
   for (int i = 0; i < m; i++)
@@ -161,10 +175,128 @@ static int gather_block(const fcm_csr *C, const double *vals, int m, const fcm_i
       if (!k) continue;
       finite &= isfinite(vals[p]) != 0;
       a[i + (size_t)(k - 1) * m] = vals[p];
+      if (pos[(size_t)i * m + k - 1] < 0) stored++;
+      pos[(size_t)i * m + k - 1] = (int)(p - rp[d[i]]);
     }
   for (int j = 0; j < m; j++)
     loc[d[j]] = 0;
+  *full = stored == m * m;
   return finite;
+}
+
+/* Gather C_K through the positions of a block whose entries are all stored (pos of
+ * gather_scan()), each checked against C's pattern: 1 when all finite, 0 when one is NaN or
+ * infinite, -1 (a unfinished) when C's pattern has moved an entry. */
+static int gather_known(const fcm_csr *C, const double *vals, int m, const fcm_index *d,
+                        const int *pos, double *a)
+{
+  const fcm_index *rp = fcm_csr_row_ptr(C);
+  const int *ci = fcm_csr_col_idx(C);
+  int finite = 1;
+  for (int i = 0; i < m; i++) {
+    const fcm_index r0 = rp[d[i]], len = rp[d[i] + 1] - r0;
+    const int *pi = pos + (size_t)i * m;
+    for (int j = 0; j < m; j++) {
+      const fcm_index p = r0 + pi[j];
+      if (pi[j] >= len || ci[p] != d[j]) return -1;
+      finite &= isfinite(vals[p]) != 0;
+      a[i + (size_t)j * m] = vals[p];
+    }
+  }
+  return finite;
+}
+
+/* The three stages of cholesky_inverse() work two by two (two rows of L, two columns of X, two
+ * entries of S at a time): each entry's sum still runs over k in ascending order, as one chain
+ * of dependent operations, and two chains interleaved keep the floating-point units busy. */
+
+/* L of C_K = L L^T (row-major) from the lower triangle of a (column-major); 0 when a pivot
+ * is not positive and finite. Rows i and i + 1 go together: at each column j <= i entry
+ * (i, j) first (entry (i + 1, i) divides by L_ii, found in the same step). */
+static int cholesky_factor(int m, const double *a, double *L)
+{
+  for (int i = 0; i < m; i += 2) {
+    double *Li = L + (size_t)i * m, *Lh = i + 1 < m ? Li + m : NULL;
+    for (int j = 0; j <= i; j++) {
+      const double *Lj = L + (size_t)j * m;
+      double v = a[i + (size_t)j * m], u = Lh ? a[i + 1 + (size_t)j * m] : 0.0;
+      int k = 0;
+      if (Lh)
+        for (; k < j; k++) {
+          v -= Li[k] * Lj[k];
+          u -= Lh[k] * Lj[k];
+        }
+      else
+        for (; k < j; k++)
+          v -= Li[k] * Lj[k];
+      if (i > j) {
+        Li[j] = v / Lj[j];
+      } else {
+        if (!(v > 0.0 && isfinite(v))) return 0;
+        Li[i] = sqrt(v);
+      }
+      if (Lh) Lh[j] = u / Lj[j];
+    }
+    if (Lh) { /* the diagonal of row i + 1 */
+      double v = a[i + 1 + (size_t)(i + 1) * m];
+      for (int k = 0; k < i + 1; k++)
+        v -= Lh[k] * Lh[k];
+      if (!(v > 0.0 && isfinite(v))) return 0;
+      Lh[i + 1] = sqrt(v);
+    }
+  }
+  return 1;
+}
+
+/* X = L^{-1} (lower, row-major), columns j and j + 1 together. */
+static void cholesky_invert_factor(int m, const double *L, double *X)
+{
+  for (int j = 0; j < m; j += 2) {
+    const int h = j + 1;
+    X[(size_t)j * m + j] = 1.0 / L[(size_t)j * m + j];
+    if (h < m) {
+      X[(size_t)h * m + h] = 1.0 / L[(size_t)h * m + h];
+      double v = 0.0;
+      v -= L[(size_t)h * m + j] * X[(size_t)j * m + j];
+      X[(size_t)h * m + j] = v / L[(size_t)h * m + h];
+    }
+    for (int i = j + 2; i < m; i++) {
+      const double *Li = L + (size_t)i * m;
+      double v = 0.0, u = 0.0;
+      v -= Li[j] * X[(size_t)j * m + j];
+      for (int k = h; k < i; k++) {
+        v -= Li[k] * X[(size_t)k * m + j];
+        u -= Li[k] * X[(size_t)k * m + h];
+      }
+      X[(size_t)i * m + j] = v / Li[i];
+      X[(size_t)i * m + h] = u / Li[i];
+    }
+  }
+}
+
+/* S = X^T X (upper triangle, mirrored), entries (i, j) and (i, j + 1) together; returns
+ * ||S||_F^2 summed in the order of the entries (i, then j ascending). */
+static double cholesky_product(int m, const double *X, double *S)
+{
+  double ns = 0.0;
+  for (int i = 0; i < m; i++)
+    for (int j = i; j < m; j += 2) {
+      double v = 0.0, u = 0.0;
+      v += X[(size_t)j * m + i] * X[(size_t)j * m + j];
+      if (j + 1 < m) {
+        for (int k = j + 1; k < m; k++) {
+          v += X[(size_t)k * m + i] * X[(size_t)k * m + j];
+          u += X[(size_t)k * m + i] * X[(size_t)k * m + j + 1];
+        }
+      }
+      S[(size_t)i * m + j] = S[(size_t)j * m + i] = v;
+      ns += (i == j ? 1.0 : 2.0) * v * v;
+      if (j + 1 < m) {
+        S[(size_t)i * m + j + 1] = S[(size_t)(j + 1) * m + i] = u;
+        ns += 2.0 * u * u;
+      }
+    }
+  return ns;
 }
 
 /* S_K = C_K^{-1} through the Cholesky factor C_K = L L^T (the lower triangle of a; L and
@@ -175,41 +307,15 @@ static int gather_block(const fcm_csr *C, const double *vals, int m, const fcm_i
  * cond(C_K) times the unit round-off). 0 (S_K untouched) otherwise. */
 static int cholesky_inverse(int m, const double *a, double eps, double *lw, double *S)
 {
-  double *L = lw, *X = lw + (size_t)m * m, na = 0.0, ns = 0.0;
-  for (int i = 0; i < m; i++) {
-    double *Li = L + (size_t)i * m;
+  double *L = lw, *X = lw + (size_t)m * m, na = 0.0;
+  for (int i = 0; i < m; i++)
     for (int j = 0; j <= i; j++) {
-      const double *Lj = L + (size_t)j * m;
-      double v = a[i + (size_t)j * m];
+      const double v = a[i + (size_t)j * m];
       na += (i == j ? 1.0 : 2.0) * v * v;
-      for (int k = 0; k < j; k++)
-        v -= Li[k] * Lj[k];
-      if (i > j) {
-        Li[j] = v / Lj[j];
-      } else {
-        if (!(v > 0.0 && isfinite(v))) return 0;
-        Li[i] = sqrt(v);
-      }
     }
-  }
-  for (int j = 0; j < m; j++) { /* column j of X = L^{-1} (lower) */
-    X[(size_t)j * m + j] = 1.0 / L[(size_t)j * m + j];
-    for (int i = j + 1; i < m; i++) {
-      const double *Li = L + (size_t)i * m;
-      double v = 0.0;
-      for (int k = j; k < i; k++)
-        v -= Li[k] * X[(size_t)k * m + j];
-      X[(size_t)i * m + j] = v / Li[i];
-    }
-  }
-  for (int i = 0; i < m; i++) /* S = X^T X, upper triangle, mirrored */
-    for (int j = i; j < m; j++) {
-      double v = 0.0;
-      for (int k = j; k < m; k++)
-        v += X[(size_t)k * m + i] * X[(size_t)k * m + j];
-      S[(size_t)i * m + j] = S[(size_t)j * m + i] = v;
-      ns += (i == j ? 1.0 : 2.0) * v * v;
-    }
+  if (!cholesky_factor(m, a, L)) return 0;
+  cholesky_invert_factor(m, L, X);
+  const double ns = cholesky_product(m, X, S);
   return isfinite(ns) && sqrt(na) * sqrt(ns) <= SCHWARZ_CHOLESKY_COND / eps;
 }
 
@@ -224,7 +330,10 @@ static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *va
   const fcm_index *d = P->dofs + P->block_ptr[b];
   const int m = (int)(P->block_ptr[b + 1] - P->block_ptr[b]);
   double *S = P->S + P->s_off[b];
-  if (!gather_block(C, vals, m, d, loc, a)) {
+  int *pos = P->pos + P->s_off[b];
+  int finite = P->full[b] ? gather_known(C, vals, m, d, pos, a) : -1;
+  if (finite < 0) finite = gather_scan(C, vals, m, d, loc, pos, P->full + b, a);
+  if (!finite) {
     *fail = FAIL_NONFINITE;
     return FCM_ERR_NUMERIC;
   }
@@ -262,6 +371,34 @@ static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *va
   return st;
 }
 
+/* dinv outside the blocks, the diagonal at its position found at creation (searched again
+ * when the matrix's pattern moved it); fallbacks: the negative ones. */
+static fcm_status outside_diagonal(fcm_schwarz *P, const fcm_csr *C, const double *vals,
+                                   fcm_index *fallbacks)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  const fcm_index *rp = fcm_csr_row_ptr(C);
+  const int *ci = fcm_csr_col_idx(C);
+  for (fcm_index i = 0; i < P->n; i++) {
+    if (P->inside[i]) {
+      P->dinv[i] = 0.0;
+      continue;
+    }
+    fcm_index p = P->diag[i];
+    if (p < rp[i] || p >= rp[i + 1] || ci[p] != i) p = P->diag[i] = fcm_csr_position(C, i, i);
+    double dii = p >= 0 ? vals[p] : 0.0;
+    FCM_CHECK(isfinite(dii), ctx, FCM_ERR_NUMERIC,
+              "schwarz: diagonal entry of row %lld (outside all blocks) is %g", (long long)i, dii);
+    FCM_CHECK(dii != 0.0, ctx, FCM_ERR_SINGULAR,
+              "schwarz: diagonal entry of row %lld (outside all blocks) is zero", (long long)i);
+    if (dii < 0.0) (*fallbacks)++;
+    P->dinv[i] = 1.0 / fabs(dii);
+  }
+cleanup:
+  return st;
+}
+
 fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
 {
   fcm_status st = FCM_OK;
@@ -276,20 +413,7 @@ fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
   P->ready = 0;
   const double *vals = fcm_csr_values_read(C);
   fcm_index fallbacks = 0;
-  for (fcm_index i = 0; i < P->n; i++) {
-    if (P->inside[i]) {
-      P->dinv[i] = 0.0;
-      continue;
-    }
-    fcm_index p = fcm_csr_position(C, i, i);
-    double dii = p >= 0 ? vals[p] : 0.0;
-    FCM_CHECK(isfinite(dii), ctx, FCM_ERR_NUMERIC,
-              "schwarz: diagonal entry of row %lld (outside all blocks) is %g", (long long)i, dii);
-    FCM_CHECK(dii != 0.0, ctx, FCM_ERR_SINGULAR,
-              "schwarz: diagonal entry of row %lld (outside all blocks) is zero", (long long)i);
-    if (dii < 0.0) fallbacks++;
-    P->dinv[i] = 1.0 / fabs(dii);
-  }
+  if (!P->blocks_only) FCM_TRY(ctx, outside_diagonal(P, C, vals, &fallbacks));
 
   const fcm_index nb = P->num_blocks;
   fcm_index bad = -1, negative = 0, clamped = 0;
@@ -345,9 +469,10 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
-                              const fcm_index *block_ptr, const fcm_index *block_dofs,
-                              const fcm_schwarz_options *opts, fcm_schwarz **out)
+/* fcm_schwarz_create(); blocks_only: for the block smoother (fcm__schwarz_create_blocks()). */
+static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
+                         const fcm_index *block_ptr, const fcm_index *block_dofs,
+                         const fcm_schwarz_options *opts, int blocks_only, fcm_schwarz **out)
 {
   fcm_status st = FCM_OK;
   fcm_schwarz *P = NULL;
@@ -397,6 +522,7 @@ fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_bloc
   FCM_ALLOC(ctx, 1, P);
   P->ctx = ctx;
   P->n = nr;
+  P->blocks_only = blocks_only;
   P->opts = o;
   P->num_blocks = num_blocks;
   P->max_m = max_m;
@@ -415,7 +541,14 @@ fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_bloc
     P->dofs[p] = block_dofs[p];
     P->inside[block_dofs[p]] = 1;
   }
+  if (!blocks_only) {
+    FCM_ALLOC(ctx, nr, P->diag);
+    for (fcm_index i = 0; i < nr; i++)
+      P->diag[i] = P->inside[i] ? -1 : fcm_csr_position(C, i, i);
+  }
   FCM_ALLOC(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->S);
+  FCM_ALLOC(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->pos);
+  FCM_ALLOC(ctx, num_blocks + 1, P->full); /* zero: the first setup scans */
   FCM_TRY(ctx, incidence_and_colors(P));
   /* setup scratch: the eigensolver workspace of the largest need over the block sizes */
   P->nt = fcm_ctx_num_threads(ctx);
@@ -450,12 +583,28 @@ cleanup:
   return st;
 }
 
+fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
+                              const fcm_index *block_ptr, const fcm_index *block_dofs,
+                              const fcm_schwarz_options *opts, fcm_schwarz **out)
+{
+  return create(ctx, C, num_blocks, block_ptr, block_dofs, opts, 0, out);
+}
+
+fcm_status fcm__schwarz_create_blocks(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
+                                      const fcm_index *block_ptr, const fcm_index *block_dofs,
+                                      fcm_schwarz **out)
+{
+  return create(ctx, C, num_blocks, block_ptr, block_dofs, NULL, 1, out);
+}
+
 fcm_status fcm_schwarz_apply(const fcm_schwarz *P, const double *r, double *z)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P ? P->ctx : NULL;
   FCM_CHECK(P, ctx, FCM_ERR_ARG, "schwarz_apply: preconditioner is NULL");
   FCM_CHECK(P->ready, ctx, FCM_ERR_ARG, "schwarz_apply: the last setup failed");
+  FCM_CHECK(!P->blocks_only, ctx, FCM_ERR_ARG,
+            "schwarz_apply: the preconditioner holds a block smoother's blocks only");
   FCM_CHECK((r && z) || P->n == 0, ctx, FCM_ERR_ARG, "schwarz_apply: r or z is NULL");
   FCM_CHECK(!r || r != z, ctx, FCM_ERR_ARG, "schwarz_apply: r and z must be different arrays");
   const fcm_index n = P->n;

@@ -15,5 +15,10 @@
  * S_K (symmetric, row major), valid after a successful setup. */
 fcm_index fcm__schwarz_num_blocks(const fcm_schwarz *P);
 int fcm__schwarz_block(const fcm_schwarz *P, fcm_index k, const fcm_index **dofs, const double **S);
+/* fcm_schwarz_create() for a block smoother: a setup computes the S_K, nothing else (no
+ * diagonal outside the blocks); fcm_schwarz_apply() refuses it. */
+fcm_status fcm__schwarz_create_blocks(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
+                                      const fcm_index *block_ptr, const fcm_index *block_dofs,
+                                      fcm_schwarz **out);
 
 #endif /* FCM_SOLVE_IMPL_H */
