@@ -205,6 +205,12 @@ typedef struct fcm_cell_rules_stats {
   fcm_index num_tets;            /**< tets of the pieces kept (slivers excluded) */
   fcm_index num_slivers;         /**< tets dropped as slivers */
   double sliver_volume;          /**< their summed volume (not in embedded_volume) */
+  double moved_volume;           /**< volume the rules of parts that the tolerances left slightly
+                                      non-convex move: their fan tets of negative volume get no
+                                      points and the others are scaled to keep the part's volume,
+                                      so a function g is integrated over the cells this call built
+                                      with an error of at most 2 moved_volume max |g| beyond the
+                                      rules' own (0 when every part is convex to rounding) */
   unsigned kinds;                /**< the volume kinds built (FCM_RULES_* bits); a kind not
                                       built has 0 points everywhere below */
   fcm_index points_initial[FCM_RULE_KIND_COUNT];    /**< before simplification */

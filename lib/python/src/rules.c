@@ -47,6 +47,7 @@ static const fcmpy_option stats_table[] = {
     {"num_tets", 'n', 1, RS(num_tets)},
     {"num_slivers", 'n', 1, RS(num_slivers)},
     {"sliver_volume", 'd', 1, RS(sliver_volume)},
+    {"moved_volume", 'd', 1, RS(moved_volume)},
     {"kinds", 'u', 1, RS(kinds)},
     {"points_initial", 'n', FCM_RULE_KIND_COUNT, RS(points_initial)},
     {"points_simplified", 'n', FCM_RULE_KIND_COUNT, RS(points_simplified)},

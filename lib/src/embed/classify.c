@@ -558,6 +558,7 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
       sums->counts.slivers += mine.counts.slivers;
       sums->counts.surface_triangles += mine.counts.surface_triangles;
       sums->counts.sliver_volume += mine.counts.sliver_volume;
+      sums->counts.moved_volume += mine.counts.moved_volume;
       sums->counts.degenerate += mine.counts.degenerate;
       sums->counts.surface_cells += mine.counts.surface_cells;
       sums->counts.surface_fallbacks += mine.counts.surface_fallbacks;

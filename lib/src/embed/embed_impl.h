@@ -145,6 +145,7 @@ typedef struct fcm__embed_counts {
   fcm_index slivers;           /* tets dropped as slivers */
   fcm_index surface_triangles; /* clipped boundary triangles kept */
   double sliver_volume;        /* summed volume of the dropped slivers */
+  double moved_volume;         /* volume the rescaled rules of non-convex parts move */
   fcm_index degenerate;        /* cells whose cut splitting changed the parts' volume */
   fcm_index surface_cells;     /* cut cells fitted on surface moments */
   fcm_index surface_fallbacks; /* of those, cells whose fit failed (volume path instead) */
@@ -192,9 +193,10 @@ fcm_status fcm__embed_clip_cell(fcm_ctx *ctx, const fcm_geometry *geom, const fc
                                 fcm__embed_ws *ws, double *tol, double *vmin);
 
 /* Fan-tetrahedralize p and append the tets with volume > vmin to ws->tets / ws->vol; the
- * kept volume is added to *vsum, dropped slivers to *lost and *nslivers. */
+ * kept volume is added to *vsum, dropped slivers to *lost and *nslivers, and the volume that
+ * rescaling a slightly non-convex part's tets moves to *moved. */
 fcm_status fcm__embed_append_tets(fcm_ctx *ctx, fcm__embed_ws *ws, const fcm__poly *p, double vmin,
-                                  double *vsum, double *lost, fcm_index *nslivers);
+                                  double *vsum, double *lost, double *moved, fcm_index *nslivers);
 
 /* Reference coordinates xi and det J_K(xi) of the physical point x. */
 fcm_status fcm__embed_to_reference(fcm_ctx *ctx, const fcm__embed_cell *cell, const double x[3],

@@ -781,17 +781,18 @@ fcm_status fcm__embed_piece_tets(fcm_ctx *ctx, const fcm__parts *P, const int *l
                                  fcm__embed_ws *ws, fcm__embed_counts *counts, double *volume)
 {
   fcm_status st = FCM_OK;
-  double vsum = 0.0, lost = 0.0;
+  double vsum = 0.0, lost = 0.0, moved = 0.0;
   fcm_index nslivers = 0;
   ws->num_tets = 0;
   for (size_t i = 0; i < P->n; i++)
     if (label[i] == piece)
-      FCM_TRY(ctx,
-              fcm__embed_append_tets(ctx, ws, P->poly + i, P->vmin[i], &vsum, &lost, &nslivers));
+      FCM_TRY(ctx, fcm__embed_append_tets(ctx, ws, P->poly + i, P->vmin[i], &vsum, &lost, &moved,
+                                          &nslivers));
   if (counts) {
     counts->tets += (fcm_index)ws->num_tets;
     counts->slivers += nslivers;
     counts->sliver_volume += lost;
+    counts->moved_volume += moved;
   }
   *volume = vsum;
 cleanup:

@@ -323,6 +323,7 @@ void fcm__embed_gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const 
   S->num_tets = sums->counts.tets;
   S->num_slivers = sums->counts.slivers;
   S->sliver_volume = sums->counts.sliver_volume;
+  S->moved_volume = sums->counts.moved_volume;
   S->num_degenerate = sums->counts.degenerate;
   S->surface_triangles = sums->counts.surface_triangles;
   S->num_surface_cells = sums->counts.surface_cells;

@@ -344,7 +344,7 @@ fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell,
 {
   fcm_status st = FCM_OK;
   fcm__parts *Q = NULL;
-  double lost = 0.0;
+  double lost = 0.0, moved = 0.0; /* not in the statistics */
   fcm_index nslivers = 0;
   *volume = 0.0;
   ws->num_tets = 0;
@@ -353,8 +353,8 @@ fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell,
   FCM_TRY(ctx, fcm__geom_tree_query(ctx, P->mat->tree, cell->lo, cell->hi, &P->mat->buf));
   FCM_TRY(ctx, body_split(ctx, P->mat, cell, P->mat->buf.ids, P->mat->buf.n, Q));
   for (size_t i = 0; i < Q->n; i++)
-    FCM_TRY(ctx,
-            fcm__embed_append_tets(ctx, ws, Q->poly + i, Q->vmin[i], volume, &lost, &nslivers));
+    FCM_TRY(ctx, fcm__embed_append_tets(ctx, ws, Q->poly + i, Q->vmin[i], volume, &lost, &moved,
+                                        &nslivers));
 cleanup:
   if (Q) fcm__embed_parts_free(ctx, Q);
   fcm__free(ctx, Q);

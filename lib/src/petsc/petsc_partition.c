@@ -317,7 +317,7 @@ fcm_status fcm__petsc_rules_exchange(void *user, fcm_status st, unsigned char *c
   fcm_ctx *ctx = P->ctx;
   const double t0 = fcm_wtime();
   const fcm_index nc = P->num_classified;
-  enum { NCOUNT = 7 };
+  enum { NCOUNT = 8 };
   int *cnt = NULL, *displ = NULL;
   double *send = NULL, *recv = NULL, *all = NULL;
   fcm_index mine = 0;
@@ -367,7 +367,8 @@ cleanup:
                                   (double)counts->slivers,
                                   (double)counts->surface_triangles,
                                   (double)counts->degenerate,
-                                  counts->sliver_volume};
+                                  counts->sliver_volume,
+                                  counts->moved_volume};
     rc = MPI_Allgather(local, NCOUNT, MPI_DOUBLE, all, NCOUNT, MPI_DOUBLE, P->comm);
   }
   if (rc != MPI_SUCCESS) { /* MPI's default handler aborts first; with another one, give up */
@@ -386,6 +387,7 @@ cleanup:
   counts->surface_triangles = (fcm_index)sum[4];
   counts->degenerate = (fcm_index)sum[5];
   counts->sliver_volume = sum[6];
+  counts->moved_volume = sum[7];
 done:
   P->time_classify = fcm_wtime() - t0;
   fcm__free(ctx, cnt);
