@@ -9,7 +9,8 @@
 
 enum { N = 40, NB = 5 };
 static const fcm_index ptr[NB + 1] = {0, 4, 8, 12, 15, 19};
-static const fcm_index dofs[19] = {0, 1, 2, 3, 2, 3, 4, 5, 10, 11, 12, 13, 20, 22, 25, 30, 31, 32, 33};
+static const fcm_index dofs[19] = {0,  1,  2,  3,  2,  3,  4,  5,  10, 11,
+                                   12, 13, 20, 22, 25, 30, 31, 32, 33};
 
 /* Symmetric, diagonally dominant (positive definite) band matrix of half-width w, values
  * from seed. */
