@@ -11,20 +11,13 @@
  * M = (m + 1)(m + 2)(m + 3) / 6 points unless the cell fell back to the volume path (counted);
  * every point inside the reference cell, inside the ball and on its piece's side of every plane
  * cut so far. Hex8 and Tet4 backgrounds. */
-#include "fcm/embed.h"
-#include "fcm/surface.h"
-#include "test.h"
+#include "cut_util.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 static fcm_ctx *ctx;
-
-#define TEST_TRUE_MSG(cond, ...)                                                                   \
-  do {                                                                                             \
-    if (!(cond)) TEST_FAIL_(__VA_ARGS__);                                                          \
-  } while (0)
 
 /* Moment agreement relative to the reference cell's volume (as tests/embed/cut_surface.c);
  * positions: inside the cell, the ball and a plane's side to GEOM_TOL (physical, a cell is
@@ -37,25 +30,6 @@ enum { MAX_M = 84, NUM_KNIVES = 3 };
 typedef struct knife {
   double p[3], n[3];
 } knife;
-
-/* Moments of x^a y^b z^c (a + b + c <= m) of piece p's authentic points of kind k. */
-static int piece_monomials(const fcm_cell_rules *r, fcm_index p, fcm_rule_kind k, int m,
-                           double *mom)
-{
-  int n, M = 0;
-  const double *x, *w;
-  const unsigned char *fl;
-  TEST_OK(ctx, fcm_cell_rules_get_piece(r, p, k, &n, &x, &w, &fl));
-  for (int a = 0; a <= m; a++)
-    for (int b = 0; a + b <= m; b++)
-      for (int c = 0; a + b + c <= m; c++, M++) {
-        double s = 0.0;
-        for (int j = 0; j < n; j++)
-          if (!fl[j]) s += w[j] * pow(x[3 * j], a) * pow(x[3 * j + 1], b) * pow(x[3 * j + 2], c);
-        mom[M] = s;
-      }
-  return M;
-}
 
 /* The physical point of reference point xi in cell c (an axis-aligned hexahedron on [-1, 1]^3
  * or a tetrahedron on the unit simplex). */
@@ -164,12 +138,12 @@ static double compare(const fcm_mesh *mesh, const fcm_cell_rules *rv, const fcm_
       for (fcm_index q = 0; q < ks; q++) {
         const int na = check_points(mesh, rs, c, fs + q, (fcm_rule_kind)k, m, bounded, K, nk, what);
         *unbounded += na > M;
-        piece_monomials(rs, fs + q, (fcm_rule_kind)k, m, ms);
+        piece_monomials(ctx, rs, fs + q, (fcm_rule_kind)k, m, ms);
         double best = HUGE_VAL;
         int bp = -1;
         for (fcm_index p = 0; p < kv && p < 64; p++) {
           if (used[p]) continue;
-          piece_monomials(rv, fv + p, (fcm_rule_kind)k, m, mv);
+          piece_monomials(ctx, rv, fv + p, (fcm_rule_kind)k, m, mv);
           double d = 0.0;
           for (int i = 0; i < M; i++)
             d = fmax(d, fabs(mv[i] - ms[i]) / vref);
@@ -184,34 +158,6 @@ static double compare(const fcm_mesh *mesh, const fcm_cell_rules *rv, const fcm_
     }
   }
   return worst;
-}
-
-/* The boundary of g as a surface geometry without a volume mesh. */
-static void surface_of(const fcm_geometry *g, fcm_geometry **gs)
-{
-  const fcm_index nt = fcm_geometry_num_boundary_triangles(g), nv = fcm_geometry_num_nodes(g);
-  const fcm_index *t = fcm_geometry_boundary_triangles(g);
-  const double *x = fcm_geometry_coords(g);
-  fcm_index *id = malloc((size_t)nv * sizeof *id), *tv = malloc(3 * (size_t)nt * sizeof *tv), n = 0;
-  double *y = malloc(3 * (size_t)nv * sizeof *y);
-  for (fcm_index v = 0; v < nv; v++)
-    id[v] = -1;
-  for (fcm_index k = 0; k < 3 * nt; k++) {
-    if (id[t[k]] < 0) {
-      memcpy(y + 3 * n, x + 3 * t[k], 3 * sizeof *y);
-      id[t[k]] = n++;
-    }
-    tv[k] = id[t[k]];
-  }
-  fcm_surface *s = NULL;
-  TEST_OK(ctx, fcm_surface_create(ctx, n, y, nt, tv, &s));
-  fcm_surface_mesh_options mo = fcm_surface_mesh_options_default();
-  mo.volume_mesh = 0;
-  TEST_OK(ctx, fcm_geometry_create_from_surface(ctx, s, &mo, gs));
-  fcm_surface_destroy(&s);
-  free(id);
-  free(tv);
-  free(y);
 }
 
 /* A half-cylinder groove of radius r along x (the lower half of the cylinder about the line
@@ -250,7 +196,7 @@ static void run(fcm_element_type type, int nc)
   fcm_cell_rules *rv = NULL, *rs = NULL;
   TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, n, &mesh));
   TEST_OK(ctx, fcm_geometry_create_ball(ctx, c0, 1.0, 2, &gv));
-  surface_of(gv, &gs);
+  surface_of(ctx, gv, &gs);
   fcm_cell_rules_options o = fcm_cell_rules_options_default();
   o.min_fraction = 0.0;
   o.simplify_options.residual_tol = 1e-14;

@@ -13,9 +13,7 @@
  * joined by a base) whose two prongs lie in one background cell, apart there, is cut across
  * both prongs: the part of the cell beyond the cut holds two separate lumps of the body, which
  * the volume path keeps as two pieces; so must the surface path. */
-#include "fcm/embed.h"
-#include "fcm/surface.h"
-#include "test.h"
+#include "cut_util.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -23,36 +21,12 @@
 
 static fcm_ctx *ctx;
 
-#define TEST_TRUE_MSG(cond, ...)                                                                   \
-  do {                                                                                             \
-    if (!(cond)) TEST_FAIL_(__VA_ARGS__);                                                          \
-  } while (0)
-
 /* Agreement of matched pieces' moments, relative to the reference cell's volume: the fits of
  * both paths reach 1e-14 relative residual of their moments (set below), the surface moments'
  * rounding is about 1e-15. */
 #define TOL 1e-12
 
 enum { MAX_M = 455 }; /* monomials of degree <= 12 */
-
-/* Moments of x^a y^b z^c (a + b + c <= m) of piece p's authentic points of kind k. */
-static int piece_monomials(const fcm_cell_rules *r, fcm_index p, fcm_rule_kind k, int m,
-                           double *mom)
-{
-  int n, M = 0;
-  const double *x, *w;
-  const unsigned char *fl;
-  TEST_OK(ctx, fcm_cell_rules_get_piece(r, p, k, &n, &x, &w, &fl));
-  for (int a = 0; a <= m; a++)
-    for (int b = 0; a + b <= m; b++)
-      for (int c = 0; a + b + c <= m; c++, M++) {
-        double s = 0.0;
-        for (int j = 0; j < n; j++)
-          if (!fl[j]) s += w[j] * pow(x[3 * j], a) * pow(x[3 * j + 1], b) * pow(x[3 * j + 2], c);
-        mom[M] = s;
-      }
-  return M;
-}
 
 static int uf_find(fcm_index *uf, fcm_index a)
 {
@@ -114,12 +88,12 @@ static double compare(const fcm_mesh *mesh, const fcm_cell_rules *rv, const fcm_
       TEST_TRUE((m + 1) * (m + 2) * (m + 3) / 6 <= MAX_M);
       unsigned char used[64] = {0};
       for (fcm_index p = fv; p < fv + kv; p++) {
-        const int M = piece_monomials(rv, p, (fcm_rule_kind)k, m, mv);
+        const int M = piece_monomials(ctx, rv, p, (fcm_rule_kind)k, m, mv);
         double best = HUGE_VAL;
         int bq = -1;
         for (fcm_index q = 0; q < ks && q < 64; q++) {
           if (used[q]) continue;
-          piece_monomials(rs, fs + q, (fcm_rule_kind)k, m, ms);
+          piece_monomials(ctx, rs, fs + q, (fcm_rule_kind)k, m, ms);
           double d = 0.0;
           for (int i = 0; i < M; i++)
             d = fmax(d, fabs(mv[i] - ms[i]) / vref);
@@ -140,34 +114,6 @@ static double compare(const fcm_mesh *mesh, const fcm_cell_rules *rv, const fcm_
                 "path, %d on the surface",
                 what, components(mesh, rv), components(mesh, rs));
   return worst;
-}
-
-/* The boundary of g as a surface geometry without a volume mesh. */
-static void surface_of(const fcm_geometry *g, fcm_geometry **gs)
-{
-  const fcm_index nt = fcm_geometry_num_boundary_triangles(g), nv = fcm_geometry_num_nodes(g);
-  const fcm_index *t = fcm_geometry_boundary_triangles(g);
-  const double *x = fcm_geometry_coords(g);
-  fcm_index *id = malloc((size_t)nv * sizeof *id), *tv = malloc(3 * (size_t)nt * sizeof *tv), n = 0;
-  double *y = malloc(3 * (size_t)nv * sizeof *y);
-  for (fcm_index v = 0; v < nv; v++)
-    id[v] = -1;
-  for (fcm_index k = 0; k < 3 * nt; k++) {
-    if (id[t[k]] < 0) {
-      memcpy(y + 3 * n, x + 3 * t[k], 3 * sizeof *y);
-      id[t[k]] = n++;
-    }
-    tv[k] = id[t[k]];
-  }
-  fcm_surface *s = NULL;
-  TEST_OK(ctx, fcm_surface_create(ctx, n, y, nt, tv, &s));
-  fcm_surface_mesh_options mo = fcm_surface_mesh_options_default();
-  mo.volume_mesh = 0;
-  TEST_OK(ctx, fcm_geometry_create_from_surface(ctx, s, &mo, gs));
-  fcm_surface_destroy(&s);
-  free(id);
-  free(tv);
-  free(y);
 }
 
 /* A V of two half-planes from a ridge along z through (x0, y0), opening towards -x. */
@@ -193,7 +139,7 @@ static void run(fcm_element_type type)
   fcm_cell_rules *rv = NULL, *rs = NULL;
   TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, n, &mesh));
   TEST_OK(ctx, fcm_geometry_create_ball(ctx, c0, 1.0, 2, &gv));
-  surface_of(gv, &gs);
+  surface_of(ctx, gv, &gs);
   fcm_cell_rules_options o = fcm_cell_rules_options_default();
   o.min_fraction = 0.0;
   o.simplify_options.residual_tol = 1e-14;
@@ -278,7 +224,7 @@ static void run_u(fcm_element_type type)
   fcm_cell_rules *rv = NULL, *rs = NULL;
   TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, n, &mesh));
   u_body(&gv);
-  surface_of(gv, &gs);
+  surface_of(ctx, gv, &gs);
   fcm_cell_rules_options o = fcm_cell_rules_options_default();
   o.min_fraction = 0.0;
   o.simplify_options.residual_tol = 1e-14;

@@ -17,15 +17,7 @@ static const double gravity[3] = {0.0, -9.81, 0.0};
 static fcm_status hold_base(fcm_integrator *I, const fcm_mesh *mesh)
 {
   const double lo[3] = {-10, -10, -10}, hi[3] = {10, 0.05, 10};
-  fcm_index count = 0;
-  fcm_status st = fcm_mesh_nodes_in_box(ctx, mesh, lo, hi, 0.0, 0, NULL, &count);
-  if (st != FCM_OK) return st;
-  fcm_index *nodes = malloc(sizeof *nodes * (size_t)(count + 1));
-  st = fcm_mesh_nodes_in_box(ctx, mesh, lo, hi, 0.0, count, nodes, &count);
-  fcm_motion m = fcm_motion_default();
-  if (st == FCM_OK) st = fcm_integrator_add_constraint(I, count, nodes, &m, NULL);
-  free(nodes);
-  return st;
+  return hold_box(ctx, I, mesh, lo, hi);
 }
 
 static fcm_integrator *make(const fcm_space *space, const fcm_mesh *mesh,

@@ -133,6 +133,21 @@ static inline fcm_status merged_boxes(fcm_ctx *ctx, const double alo[3], const d
   return st;
 }
 
+/* Holds (fixed at rest) every node of mesh in the box [lo, hi]. */
+static inline fcm_status hold_box(fcm_ctx *ctx, fcm_integrator *I, const fcm_mesh *mesh,
+                                  const double lo[3], const double hi[3])
+{
+  fcm_index count = 0;
+  fcm_status st = fcm_mesh_nodes_in_box(ctx, mesh, lo, hi, 0.0, 0, NULL, &count);
+  if (st != FCM_OK) return st;
+  fcm_index *nodes = malloc(sizeof *nodes * (size_t)(count + 1));
+  st = fcm_mesh_nodes_in_box(ctx, mesh, lo, hi, 0.0, count, nodes, &count);
+  fcm_motion m = fcm_motion_default();
+  if (st == FCM_OK) st = fcm_integrator_add_constraint(I, count, nodes, &m, NULL);
+  free(nodes);
+  return st;
+}
+
 /* Central differences (step eps) of fcm_integrator_contact_eval() at u (restored on return)
  * and time t along d against its force f0 and Newton matrix T there (T may be NULL): the
  * relative errors of the energy's difference against f0 . d and of the force's against T d
