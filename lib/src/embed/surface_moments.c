@@ -86,6 +86,24 @@ static void ref_cell_init(int tet, ref_cell *r)
   }
 }
 
+/* An empty rule on the reference cell of `cell`, its corner point moved to base (where given:
+ * clamped to the cell's lower bounds); the cell's map must be affine. */
+static fcm_status rule_start(fcm_ctx *ctx, const fcm__embed_cell *cell, const double *base,
+                             ref_cell *r, fcm__srule *s)
+{
+  fcm_status st = FCM_OK;
+  ref_cell_init(cell->info->shape == FCM_SHAPE_TET, r);
+  if (base)
+    for (int d = 0; d < 3; d++)
+      r->c[d] = fmax(r->lo, base[d]);
+  s->n = 0;
+  FCM_CHECK(cell->affine, ctx, FCM_ERR_INTERNAL,
+            "embed: background cell %lld is not affine (surface moments need an affine map)",
+            (long long)cell->id);
+cleanup:
+  return st;
+}
+
 /* The exit facet's xi_1 at (xi_2, xi_3) and the exit edge's xi_2 at xi_3. */
 static double exit1_at(const ref_cell *r, double x2, double x3)
 {
@@ -659,15 +677,8 @@ static fcm_status moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aab
   ref_cell r;
   const int tet = cell->info->shape == FCM_SHAPE_TET;
   const int orient = cell->detA > 0.0 ? 1 : -1; /* the map turns the surface inside out */
-  ref_cell_init(tet, &r);
-  if (base)
-    for (int d = 0; d < 3; d++)
-      r.c[d] = fmax(r.lo, base[d]);
-  s->n = 0;
   *corner = *inner = 0;
-  FCM_CHECK(cell->affine, ctx, FCM_ERR_INTERNAL,
-            "embed: background cell %lld is not affine (surface moments need an affine map)",
-            (long long)cell->id);
+  FCM_TRY(ctx, rule_start(ctx, cell, base, &r, s));
   /* levels 3 and 2: the triangles that meet the cell (as the tree's box query finds them) */
   if (boxes) {
     size_t n = 0;
@@ -772,14 +783,7 @@ fcm_status fcm__embed_moment_rule_clear(fcm_ctx *ctx, const fcm_geometry *g,
     goto cleanup;
   }
   ref_cell r;
-  ref_cell_init(cell->info->shape == FCM_SHAPE_TET, &r);
-  if (base)
-    for (int d = 0; d < 3; d++)
-      r.c[d] = fmax(r.lo, base[d]);
-  s->n = 0;
-  FCM_CHECK(cell->affine, ctx, FCM_ERR_INTERNAL,
-            "embed: background cell %lld is not affine (surface moments need an affine map)",
-            (long long)cell->id);
+  FCM_TRY(ctx, rule_start(ctx, cell, base, &r, s));
   if (*winding) FCM_TRY(ctx, add_edge(ctx, q, &r, 1.0, orient * *winding, s));
 cleanup:
   return st;
