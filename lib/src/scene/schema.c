@@ -75,10 +75,12 @@ void fcm__scene_path_pop(fcm__scene_parser *p, size_t old_len)
 /* Shortest of %.15g, %.16g, %.17g that reads back as x ("inf", "-inf" for overflow). */
 static void format_number(double x, char *buf, size_t len)
 {
+  char t[32]; /* %.17g of a double takes at most 24 characters */
   for (int prec = 15; prec <= 17; prec++) {
-    const int n = snprintf(buf, len, "%.*g", prec, x);
-    if (n < 0 || (size_t)n >= len || !isfinite(x) || strtod(buf, NULL) == x) return;
+    snprintf(t, sizeof t, "%.*g", prec, x);
+    if (!isfinite(x) || strtod(t, NULL) == x) break;
   }
+  snprintf(buf, len, "%s", t);
 }
 
 void fcm__scene_describe(const fcm__json *node, char *buf, size_t len)
