@@ -26,7 +26,8 @@ extern "C" {
  *   Psi(I) = lambda'/2 (1 - alpha)^2 - mu'/2 log 4 is a constant, not zero.
  * - COROTATED_LINEAR (element-corotated linear elasticity, stiffness warping; Dick et al.
  *   2011 §5): the assembly gives each element its linear stiffness K_e (kept across steps)
- *   and one rotation R_e, the polar rotation of F at the element's centroid: element energy
+ *   and one rotation R_e, the polar rotation of F averaged over the element's material (on
+ *   an affine element F at the centroid): element energy
  *   1/2 d^T K_e d, d = [R_e]^T x_e - X_e, its exact gradient as the force and the warped
  *   [R_e] K_e [R_e]^T as the tangent (lib/docs/time_integration.md). At a single point
  *   (fcm_material_eval(), stress output) it is the COROTATED model: the same energy with R
