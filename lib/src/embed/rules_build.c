@@ -186,8 +186,9 @@ fcm_status fcm__embed_build_setup(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_
     const fcm_element_info *info = fcm_mesh_get_element_info(mesh);
     int m = 0;
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
-      kind_space(info, o, k, &B->fit_strength[k], &B->fit_axis[k]);
-      B->fit_M[k] = fcm__simplify_space_size(B->fit_strength[k], B->fit_axis[k]);
+      int axis;
+      kind_space(info, o, k, &B->fit_strength[k], &axis);
+      B->fit_M[k] = fcm__simplify_num_basis(B->fit_strength[k]);
       fcm_rule *t = NULL;
       FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TET, B->fit_strength[k], &t));
       B->fit_tet_points[k] = fcm_rule_num_points(t);

@@ -384,10 +384,13 @@ fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
   memcpy(box, mbox, sizeof box);
   *ok = 0;
   for (int d = 0; d < 3; d++)
-    if (!(box[d] < box[3 + d])) goto cleanup;     /* flat material: leave it to the volume path */
-  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) { /* built or not, as the moments' degree */
+    if (!(box[d] < box[3 + d])) goto cleanup; /* flat material: leave it to the volume path */
+  /* built or not, as the moments' degree; the candidates follow the size of the total-degree
+   * space whatever a kind's cap per variable: a smaller grid for a tensor space would change the
+   * other kind's rules fitted on the same candidates */
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     mmax = FCM_MAX(mmax, B->fit_strength[k]);
-    Mmax = FCM_MAX(Mmax, B->fit_M[k]); /* the candidates follow the largest moment space */
+    Mmax = FCM_MAX(Mmax, B->fit_M[k]);
   }
   const double vref = vol / cell->detA;
   int todo[FCM_RULE_KIND_COUNT], left = 0;
