@@ -126,20 +126,23 @@ static int scene_json(const model_input *m, double h, fcm_element_type element, 
 }
 
 /* The moments of the mass rules (authentic points) over every cell: the monomials of degree
- * <= the mass strength in the coordinates scaled to [-1, 1] over the model's bounding box, in
- * the order (a, b, c) of x^a y^b z^c with a + b + c ascending, then a descending, b descending. */
+ * <= the mass strength, and <= the rules' degree per variable in each (Hex8: Q_2), in the
+ * coordinates scaled to [-1, 1] over the model's bounding box, in the order (a, b, c) of
+ * x^a y^b z^c with a + b + c ascending, then a descending, b descending. */
 static int global_moments(const fcm_simulation *sim, const model_input *m, model_run *r)
 {
   const fcm_cell_rules *rules = fcm_simulation_cell_rules(sim);
   const fcm_mesh *mesh = fcm_space_mesh(fcm_simulation_space(sim));
-  const int s = fcm_cell_rules_strength(rules, FCM_RULE_MASS);
+  const int s = fcm_cell_rules_strength(rules, FCM_RULE_MASS),
+            qa = fcm_cell_rules_axis_degree(rules, FCM_RULE_MASS);
   if (s < 0 || s > MODELS_MAX_STRENGTH) return 0;
   const fcm_element_type type = fcm_mesh_element_type(mesh);
   int exps[MODELS_MAX_MOMENTS][3], nm = 0;
   for (int deg = 0; deg <= s; deg++)
     for (int a = deg; a >= 0; a--)
       for (int b = deg - a; b >= 0; b--)
-        exps[nm][0] = a, exps[nm][1] = b, exps[nm][2] = deg - a - b, nm++;
+        if (a <= qa && b <= qa && deg - a - b <= qa)
+          exps[nm][0] = a, exps[nm][1] = b, exps[nm][2] = deg - a - b, nm++;
   double c[3], half = 0.0;
   for (int d = 0; d < 3; d++) {
     c[d] = 0.5 * (m->lo[d] + m->hi[d]);

@@ -307,7 +307,7 @@ static int simp_setup(fcm_ctx *ctx, int m, simp_input *in)
       for (int d = 0; d < 3; d++)
         ROOFLINE_CHECK(p[3 * j + d] >= mbox[d] - 1e-12 && p[3 * j + d] <= mbox[3 + d] + 1e-12);
     }
-    c->box.m = m, c->box.num_basis = M;
+    c->box.m = m, c->box.q = m, c->box.num_basis = M;
     for (int d = 0; d < 3; d++) { /* as the surface path: the material's box -> [-1, 1] */
       c->box.scale[d] = 2.0 / (mbox[3 + d] - mbox[d]);
       c->box.shift[d] = -(mbox[d] + mbox[3 + d]) / (mbox[3 + d] - mbox[d]);

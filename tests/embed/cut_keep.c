@@ -99,8 +99,9 @@ static void check_exact(const fcm_mesh *mesh, const fcm_cell_rules *r, const cut
       }
       memset(ex, 0, sizeof ex);
       exact_polytope_add(pl, np, m, 1e-13, ex);
+      const int q = fcm_cell_rules_axis_degree(r, (fcm_rule_kind)k);
       for (int i = 0; i < exact_num_mono(m); i++)
-        TEST_NEAR(mom[i], ex[i], 0.0, ATOL);
+        if (exact_in_axis(i, q)) TEST_NEAR(mom[i], ex[i], 0.0, ATOL);
     }
   }
 }

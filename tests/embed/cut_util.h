@@ -16,17 +16,19 @@
     if (!(cond)) TEST_FAIL_(__VA_ARGS__);                                                          \
   } while (0)
 
-/* Moments of x^a y^b z^c (a + b + c <= m) of piece p's authentic points of kind k. */
+/* Moments of x^a y^b z^c (a + b + c <= m, each at most the rules' fcm_cell_rules_axis_degree())
+ * of piece p's authentic points of kind k; returns their number. */
 static inline int piece_monomials(fcm_ctx *ctx, const fcm_cell_rules *r, fcm_index p,
                                   fcm_rule_kind k, int m, double *mom)
 {
   int n, M = 0;
   const double *x, *w;
   const unsigned char *fl;
+  const int q = fcm_cell_rules_axis_degree(r, k); /* the rules' degree cap per variable */
   TEST_OK(ctx, fcm_cell_rules_get_piece(r, p, k, &n, &x, &w, &fl));
-  for (int a = 0; a <= m; a++)
-    for (int b = 0; a + b <= m; b++)
-      for (int c = 0; a + b + c <= m; c++, M++) {
+  for (int a = 0; a <= m && a <= q; a++)
+    for (int b = 0; a + b <= m && b <= q; b++)
+      for (int c = 0; a + b + c <= m && c <= q; c++, M++) {
         double s = 0.0;
         for (int j = 0; j < n; j++)
           if (!fl[j]) s += w[j] * pow(x[3 * j], a) * pow(x[3 * j + 1], b) * pow(x[3 * j + 2], c);

@@ -53,8 +53,9 @@ static void moments(const fcm_mesh *mesh, const fcm_geometry *surf, const fcm_ge
       }
       if (fcm_cell_rules_class(r, c) == FCM_CELL_CUT) TEST_TRUE(authentic <= nm);
     }
+    const int q = fcm_cell_rules_axis_degree(r, (fcm_rule_kind)kind);
     for (int k = 0; k < nm; k++)
-      TEST_NEAR(got[k], exact[k], 0, 1e-12 * absum[k] + 1e-14 * V);
+      if (exact_in_axis(k, q)) TEST_NEAR(got[k], exact[k], 0, 1e-12 * absum[k] + 1e-14 * V);
   }
   fcm_cell_rules_destroy(&r);
 }

@@ -110,3 +110,8 @@ fcm_add_test(embed_cut_surface_scene tests/embed/cut_surface_scene.c)
 # |K_ref|), positive weights, at most M points unless the cell fell back to the volume path,
 # every point in the cell, the ball and on its piece's side of every plane; Hex8 and Tet4.
 fcm_add_test(embed_cut_fit tests/embed/cut_fit.c)
+# Hex8's cut-cell mass rules on the tensor space Q_2 by default (a hollow ball cut by a plane,
+# surface and volume paths): every cut piece's Q_2 moments and 8 x 8 mass matrix as a P_6 rule
+# unsimplified on its tets (1e-12), positive weights, at most 27 points in the cell and on the
+# piece's side; explicit strength 6 gives P_6; rules of P_4 miss the mass matrix (> 1e-8).
+fcm_add_test(embed_q2_mass tests/embed/q2_mass.c)

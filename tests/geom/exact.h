@@ -44,6 +44,15 @@ static inline int exact_index(const int e[3])
   return d * (d + 1) * (d + 2) / 6 + (d - e[0]) * (d - e[0] + 1) / 2 + (d - e[0] - e[1]);
 }
 
+/* Whether monomial k (exact_index() order) has degree <= q in each variable: in the space of
+ * rules exact on total degree m with the per-variable cap q (fcm_cell_rules_axis_degree()). */
+static inline int exact_in_axis(int k, int q)
+{
+  int e[3];
+  exact_exponents(EXACT_MAX_DEG, k, e);
+  return e[0] <= q && e[1] <= q && e[2] <= q;
+}
+
 /* Values of every monomial of degree <= m at x into v. */
 static inline void exact_eval(int m, const double x[3], double *v)
 {

@@ -245,6 +245,7 @@ static void fit(fcm_ctx *ctx)
   for (int m = 2; m <= 6; m += 2) {
     fcm__cheb_box box;
     box.m = m;
+    box.q = m;
     box.num_basis = fcm__simplify_num_basis(m);
     for (int d = 0; d < 3; d++)
       box.scale[d] = 2.0, box.shift[d] = -1.0;

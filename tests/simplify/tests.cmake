@@ -21,3 +21,6 @@ fcm_add_test(simplify_stabilization tests/simplify/stabilization.c)
 fcm_add_test(simplify_bench tests/simplify/bench_simplify.c LABELS bench TIMEOUT 1800)
 fcm_add_test(simplify_names tests/simplify/names.c)
 fcm_add_test(simplify_nnls tests/simplify/nnls.c)
+# The moment space capped per variable (axis_degree; Q_2 = total degree 6, each variable 2):
+# its size, basis values and rows, blocked moments, and simplification keeping Q_2's moments.
+fcm_add_test(simplify_axis_degree tests/simplify/axis_degree.c)

@@ -69,6 +69,10 @@ typedef struct fcm_element_info {
   int vtk_cell_type;   /**< VTK cell type id: 10, 24, 12, 25 */
   int stiffness_strength; /**< default quadrature strength for stiffness and force */
   int mass_strength;      /**< default strength for the consistent mass (degree of N_i N_j) */
+  int mass_axis_degree;   /**< the default degree cap in each reference variable of the cut-cell
+                               mass rules' moment space (fcm_cell_rules_options.axis_degree):
+                               Hex8 2 (N_i N_j is trilinear times trilinear, in Q_2 ⊂ P_6: 27
+                               moments instead of 84); mass_strength for the others (no cap) */
   int num_faces;          /**< 4 or 6 */
   /** Nodes of each face, corners first in counter-clockwise order seen from
    * outside (outward normal by the right-hand rule), then mid-edge nodes. */

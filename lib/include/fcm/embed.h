@@ -110,7 +110,17 @@ typedef struct fcm_cell_rules_options {
                        only; mass rules serve the mass matrix (dynamics, Rayleigh
                        damping) and fcm_space_momentum(). The scene runner derives the
                        set from the scene (fcm/simulation.h). */
-  int strength[FCM_RULE_KIND_COUNT]; /**< per kind; FCM_DEFAULT (default): the element's */
+  int strength[FCM_RULE_KIND_COUNT];    /**< per kind; FCM_DEFAULT (default): the element's */
+  int axis_degree[FCM_RULE_KIND_COUNT]; /**< per kind, the cut-cell rules' moment space: the
+                              polynomials of total degree <= strength whose degree in each
+                              reference variable is <= axis_degree (axis_degree = k <= strength / 3:
+                              the tensor space Q_k); a value >= strength: every polynomial of
+                              total degree <= strength (P_strength), 0 ... 20; FCM_DEFAULT
+                              (default): with the element's strength the element's
+                              (fcm_element_info.mass_axis_degree for mass: Hex8 2, so Hex8's
+                              cut-cell mass rules are exact on Q_2, 27 moments instead of P_6's
+                              84; stiffness: the strength), with an explicit strength the
+                              strength (P_strength). Uncut cells keep the catalogue rule. */
   int surface_strength;  /**< FCM_DEFAULT (default): no surface rules; else the triangle rule
                               strength (the explicit request for surface rules) */
   double min_fraction;   /**< phi below this: dropped; default 1e-4 (0: drop only empty cells) */
@@ -289,6 +299,13 @@ FCM_API fcm_index fcm_cell_rules_num_cells(const fcm_cell_rules *rules);
 FCM_API fcm_element_type fcm_cell_rules_element_type(const fcm_cell_rules *rules);
 FCM_API int fcm_cell_rules_strength(const fcm_cell_rules *rules, fcm_rule_kind kind);
 FCM_API int fcm_cell_rules_surface_strength(const fcm_cell_rules *rules);
+
+/** The largest degree in each reference variable of the polynomials on which the cut-cell rules
+ * of `kind` are exact (they are exact on those of total degree <= fcm_cell_rules_strength()
+ * with this degree in each variable): the strength when the space is all of P_strength, less
+ * for a tensor space (Hex8 mass by default: 2 with strength 6, Q_2); -1 for a kind that was not
+ * built. */
+FCM_API int fcm_cell_rules_axis_degree(const fcm_cell_rules *rules, fcm_rule_kind kind);
 
 /** 1 when the rules of `kind` were built (fcm_cell_rules_options.kinds), else 0 (also for
  * NULL rules or a kind out of range). */

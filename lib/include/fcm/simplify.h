@@ -48,6 +48,13 @@ typedef struct fcm_simplify_options {
                                1 ... 256; 1: one at a time, a rank-1 update per pivot (the
                                unblocked elimination, kept to measure against); FCM_DEFAULT
                                (default): 32 (measured: lib/docs/performance.md) */
+  int axis_degree;        /**< the moments kept: those of the polynomials of total degree <=
+                               strength whose degree in each variable is <= axis_degree, so
+                               M = #{(a, b, c): a + b + c <= strength, a, b, c <= axis_degree}
+                               (axis_degree = k, strength >= 3k: the tensor space Q_k, (k+1)^3
+                               functions; a Hex8 cell's consistent mass N_i N_j lies in Q_2);
+                               0 ... 20; FCM_DEFAULT (default) or a value >= strength: every
+                               polynomial of total degree <= strength */
 } fcm_simplify_options;
 
 /** The simplified rule: a subset of the input points with new weights. */
@@ -61,7 +68,7 @@ typedef struct fcm_simplify_result {
 /** What fcm_simplify() did. Times in seconds. */
 typedef struct fcm_simplify_info {
   fcm_index n;                     /**< input points N */
-  int num_basis;                   /**< M = (m+3 choose 3) */
+  int num_basis;                   /**< M = (m+3 choose 3), fewer with axis_degree < m */
   int rank;                        /**< numerical rank of the moment matrix used last */
   fcm_index kept;                  /**< points returned */
   double residual;                 /**< max |P w - P w0| / max |P w0| of the returned rule
@@ -87,11 +94,12 @@ typedef struct fcm_simplify_info {
 } fcm_simplify_info;
 
 /** Defaults: AUTO, rank_tol 1e-13, residual_tol 1e-12, automatic iteration limit, 60 s,
- * the measured elimination block. */
+ * the measured elimination block, every degree (axis_degree FCM_DEFAULT). */
 FCM_API fcm_simplify_options fcm_simplify_options_default(void);
 
 /** Reduce a positive rule to at most M = (m+3 choose 3) of its own points with positive
- * weights reproducing every moment of total degree <= strength (lib/METHOD.md §6).
+ * weights reproducing every moment of total degree <= strength (lib/METHOD.md §6); with
+ * opts->axis_degree = q < strength only those of degree <= q in each variable, M of them.
  * Every returned rule is verified (weights > 0, count <= M, relative residual <=
  * residual_tol); if all attempts (the chosen path; a GLPK path: the other GLPK path for LP
  * or RECOMBINE, for ELIMINATE the LP up to N = 12 M and recombination above; the chosen

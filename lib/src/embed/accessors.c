@@ -98,6 +98,11 @@ int fcm_cell_rules_strength(const fcm_cell_rules *rules, fcm_rule_kind kind)
   return (int)kind >= 0 && kind < FCM_RULE_KIND_COUNT ? rules->strength[kind] : -1;
 }
 
+int fcm_cell_rules_axis_degree(const fcm_cell_rules *rules, fcm_rule_kind kind)
+{
+  return (int)kind >= 0 && kind < FCM_RULE_KIND_COUNT ? rules->axis_degree[kind] : -1;
+}
+
 fcm_cell_class fcm_cell_rules_class(const fcm_cell_rules *rules, fcm_index cell)
 {
   if (cell < 0 || cell >= rules->num_cells) return FCM_CELL_DROPPED;
@@ -328,14 +333,14 @@ void fcm_cell_rules_view(const fcm_cell_rules *rules, FILE *stream)
     if (!rules->uncut[k])
       fprintf(stream, "  %-9s not built (fcm_cell_rules_options.kinds)\n", names[k]);
     else
-      fprintf(
-          stream,
-          "  %-9s strength %d: cut-cell points %lld initial -> %lld simplified "
-          "(+%lld stabilization), total %lld; skipped %lld, fallbacks %lld, max residual %.3g\n",
-          names[k], rules->strength[k], (long long)S->points_initial[k],
-          (long long)S->points_simplified[k], (long long)S->points_stabilization[k],
-          (long long)S->points_total[k], (long long)S->simplify_skipped[k],
-          (long long)S->simplify_fallbacks[k], S->max_residual[k]);
+      fprintf(stream,
+              "  %-9s strength %d, degree <= %d per variable: cut-cell points %lld initial -> %lld "
+              "simplified (+%lld stabilization), total %lld; skipped %lld, fallbacks %lld, max "
+              "residual %.3g\n",
+              names[k], rules->strength[k], rules->axis_degree[k], (long long)S->points_initial[k],
+              (long long)S->points_simplified[k], (long long)S->points_stabilization[k],
+              (long long)S->points_total[k], (long long)S->simplify_skipped[k],
+              (long long)S->simplify_fallbacks[k], S->max_residual[k]);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     const fcm_simplify_decision *d = &S->decision[k];
     if (d->point_cost > 0.0)

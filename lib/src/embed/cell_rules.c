@@ -14,6 +14,8 @@ fcm_cell_rules_options fcm_cell_rules_options_default(void)
   o.kinds = FCM_RULES_ALL;
   o.strength[FCM_RULE_STIFFNESS] = -1;
   o.strength[FCM_RULE_MASS] = -1;
+  o.axis_degree[FCM_RULE_STIFFNESS] = FCM_DEFAULT;
+  o.axis_degree[FCM_RULE_MASS] = FCM_DEFAULT;
   o.surface_strength = -1;
   o.min_fraction = 1e-4;
   o.uncut_fraction = 1.0 - 1e-12;

@@ -101,9 +101,10 @@ fcm_status fcm__embed_finish_cell(const build *B, const fcm_cell_rules *R, piece
   const double t1 = fcm_wtime();
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     if (!B->tet_rule[k]) continue; /* a kind not built */
-    if (simp[k] && !o->fitted) {
-      FCM_TRY(ctx, simplify_rule(ctx, &opt->simplify_options, R->strength[k], &o->n[k], o->pts[k],
-                                 o->w[k], o, k));
+    if (simp[k] && !o->fitted) {   /* on the kind's moment space */
+      fcm_simplify_options so = opt->simplify_options;
+      so.axis_degree = R->axis_degree[k];
+      FCM_TRY(ctx, simplify_rule(ctx, &so, R->strength[k], &o->n[k], o->pts[k], o->w[k], o, k));
       o->nsimp[k] = o->n[k];
     }
     if (B->stabilize[k]) {

@@ -27,6 +27,7 @@ struct fcm_cell_rules {
   fcm_index num_cells;
   fcm_element_type type;
   int strength[FCM_RULE_KIND_COUNT];
+  int axis_degree[FCM_RULE_KIND_COUNT]; /* cut-cell rules' degree cap per variable (<= strength) */
   int surface_strength;
   unsigned char *cls; /* num_cells fcm_cell_class values */
   double *fraction;   /* num_cells volume fractions */

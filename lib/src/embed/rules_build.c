@@ -2,6 +2,7 @@
  * checks, the result object, what every cell reads (rules, search trees), gathering the
  * cells' output in cell order and the statistics. */
 #include "embed/rules_impl.h"
+#include "simplify/simplify_impl.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -40,6 +41,12 @@ fcm_status fcm__embed_check_options(fcm_ctx *ctx, const fcm_cell_rules_options *
     FCM_CHECK(o->strength[k] >= -1 && o->strength[k] <= smax, ctx, FCM_ERR_ARG,
               "embed: %s strength = %d outside [0, %d] (-1: element default)",
               k == FCM_RULE_MASS ? "mass" : "stiffness", o->strength[k], smax);
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    FCM_CHECK(
+        o->axis_degree[k] >= -1 && o->axis_degree[k] <= FCM_SIMPLIFY_MAX_STRENGTH, ctx, FCM_ERR_ARG,
+        "embed: %s axis_degree = %d outside [0, %d] (-1: element default; >= strength: "
+        "every polynomial of total degree <= strength)",
+        k == FCM_RULE_MASS ? "mass" : "stiffness", o->axis_degree[k], FCM_SIMPLIFY_MAX_STRENGTH);
   FCM_CHECK(o->surface_strength >= -1 && o->surface_strength <= FCM_RULE_MAX_STRENGTH, ctx,
             FCM_ERR_ARG, "embed: surface strength = %d outside [0, %d] (-1: none)",
             o->surface_strength, FCM_RULE_MAX_STRENGTH);
@@ -82,6 +89,18 @@ cleanup:
   return st;
 }
 
+/* Kind k's strength and degree cap per variable (<= the strength) from the options and the
+ * element's defaults: the element's cap only with the element's strength. */
+static void kind_space(const fcm_element_info *info, const fcm_cell_rules_options *o, int k,
+                       int *strength, int *axis)
+{
+  const int es = k == FCM_RULE_MASS ? info->mass_strength : info->stiffness_strength;
+  const int ea = k == FCM_RULE_MASS ? info->mass_axis_degree : es;
+  *strength = o->strength[k] >= 0 ? o->strength[k] : es;
+  *axis = o->axis_degree[k] >= 0 ? o->axis_degree[k] : o->strength[k] >= 0 ? *strength : ea;
+  *axis = FCM_MIN(*axis, *strength);
+}
+
 /* Phase 1a: the result object with its per-cell arrays, strengths and catalogue rules. */
 fcm_status fcm__embed_rules_alloc(fcm_ctx *ctx, const fcm_mesh *mesh,
                                   const fcm_cell_rules_options *o, fcm_cell_rules **out)
@@ -90,8 +109,6 @@ fcm_status fcm__embed_rules_alloc(fcm_ctx *ctx, const fcm_mesh *mesh,
   fcm_cell_rules *R = NULL;
   const fcm_element_info *info = fcm_mesh_get_element_info(mesh);
   const fcm_index nc = fcm_mesh_num_cells(mesh);
-  const int element_strength[FCM_RULE_KIND_COUNT] = {
-      [FCM_RULE_STIFFNESS] = info->stiffness_strength, [FCM_RULE_MASS] = info->mass_strength};
   FCM_ALLOC(ctx, 1, R);
   R->ctx = ctx;
   R->num_cells = nc;
@@ -103,9 +120,9 @@ fcm_status fcm__embed_rules_alloc(fcm_ctx *ctx, const fcm_mesh *mesh,
   R->opts = *o;
   R->stats.kinds = o->kinds;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
-    R->strength[k] = -1;
+    R->strength[k] = R->axis_degree[k] = -1;
     if (!KIND_BUILT(o->kinds, k)) continue;
-    R->strength[k] = o->strength[k] >= 0 ? o->strength[k] : element_strength[k];
+    kind_space(info, o, k, &R->strength[k], &R->axis_degree[k]);
     FCM_TRY(ctx, fcm_rule_create(ctx, info->shape, R->strength[k], &R->uncut[k]));
     FCM_ALLOC(ctx, (size_t)fcm_rule_num_points(R->uncut[k]), R->uncut_flags[k]);
   }
@@ -167,13 +184,11 @@ fcm_status fcm__embed_build_setup(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_
   if (B->surface) { /* both kinds' strengths, built or not: the rules of one kind do not
                        depend on which others are built */
     const fcm_element_info *info = fcm_mesh_get_element_info(mesh);
-    const int es[FCM_RULE_KIND_COUNT] = {
-        [FCM_RULE_STIFFNESS] = info->stiffness_strength, [FCM_RULE_MASS] = info->mass_strength};
     int m = 0;
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
-      B->fit_strength[k] = o->strength[k] >= 0 ? o->strength[k] : es[k];
-      B->fit_M[k] =
-          (B->fit_strength[k] + 1) * (B->fit_strength[k] + 2) * (B->fit_strength[k] + 3) / 6;
+      int axis;
+      kind_space(info, o, k, &B->fit_strength[k], &axis);
+      B->fit_M[k] = fcm__simplify_num_basis(B->fit_strength[k]);
       fcm_rule *t = NULL;
       FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TET, B->fit_strength[k], &t));
       B->fit_tet_points[k] = fcm_rule_num_points(t);

@@ -66,7 +66,9 @@ typedef struct build {
   int surface;                                    /* the surface path is on (tri_tree is built) */
   fcm__moment_quad mq; /* its quadratures, exact for the largest of fit_strength */
   int fit_strength[FCM_RULE_KIND_COUNT];   /* each kind's strength, built or not */
-  int fit_M[FCM_RULE_KIND_COUNT];          /* the number of moments of each kind's strength */
+  int fit_M[FCM_RULE_KIND_COUNT];          /* the number of moments of total degree <= each
+                                              kind's strength (sizes the candidates and the
+                                              path choice, whatever the cap per variable) */
   int fit_tet_points[FCM_RULE_KIND_COUNT]; /* points of the tet rule of that strength */
   int stabilize[FCM_RULE_KIND_COUNT];
   /* Cutting: the tree of R->cut_tris (NULL without cuts); region[c]: cell c shares a node

@@ -237,9 +237,12 @@ static fcm_status header_body(text *t, const fcm_cell_rules *R, const fcm_mesh *
   int first = 1;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     if (!fcm_cell_rules_has_kind(R, (fcm_rule_kind)k)) continue;
-    FCM_TRY(ctx, text_printf(t, "%s\n    \"%s\": {\"strength\": %d, \"num_points\": %lld}",
+    FCM_TRY(ctx, text_printf(t,
+                             "%s\n    \"%s\": {\"strength\": %d, \"axis_degree\": %d, "
+                             "\"num_points\": %lld}",
                              first ? "" : ",", fcm_rule_kind_name((fcm_rule_kind)k),
-                             fcm_cell_rules_strength(R, (fcm_rule_kind)k), (long long)npts[k]));
+                             fcm_cell_rules_strength(R, (fcm_rule_kind)k),
+                             fcm_cell_rules_axis_degree(R, (fcm_rule_kind)k), (long long)npts[k]));
     first = 0;
   }
   FCM_TRY(ctx, text_printf(t, "\n  },\n"));

@@ -266,12 +266,12 @@ cleanup:
   return st;
 }
 
-/* The moment basis of strength m on the material's box mapped to [-1, 1]: a basis that the
- * small material of a sliver cell does not make singular. */
-static void fit_box(const double box[6], int m, fcm__cheb_box *cb)
+/* The moment basis of strength m, degree <= q in each variable, on the material's box mapped
+ * to [-1, 1]: a basis that the small material of a sliver cell does not make singular. */
+static void fit_box(const double box[6], int m, int q, fcm__cheb_box *cb)
 {
   cb->m = m;
-  cb->num_basis = fcm__simplify_num_basis(m);
+  fcm__simplify_box_cap(cb, q);
   for (int d = 0; d < 3; d++) {
     const double a = box[d], b = box[3 + d];
     cb->scale[d] = 2.0 / (b - a);
@@ -280,29 +280,35 @@ static void fit_box(const double box[6], int m, fcm__cheb_box *cb)
 }
 
 /* Fit kind k's rule on the candidates (count of them) into o; *ok = 0 when they cannot carry
- * the moments. P: the candidates' basis at a strength >= kind k's (Ptop rows, ld Ptop), of
- * which the fit takes the leading rows, its own basis (in degree order, bit for bit). */
+ * the moments. P: the candidates' basis in top's space, which holds kind k's (top->num_basis
+ * rows, ld the same), of which the fit takes the rows of its own basis
+ * (fcm__simplify_basis_rows(): the values do not depend on the space, bit for bit). */
 static fcm_status fit_kind(const build *B, const fcm_cell_rules *R, const fcm__embed_ws *ws,
-                           const double box[6], int count, int k, const double *P, int Ptop,
-                           piece_out *o, int *ok, char *why, size_t why_len)
+                           const double box[6], int count, int k, const double *P,
+                           const fcm__cheb_box *top, piece_out *o, int *ok, char *why,
+                           size_t why_len)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
   fcm__cheb_box cb;
   fcm__fit f;
   double *mom = NULL, *work = NULL, *Pk = NULL;
+  int *rows = NULL;
   memset(&f, 0, sizeof f);
-  fit_box(box, R->strength[k], &cb);
-  const int M = cb.num_basis;
+  fit_box(box, R->strength[k], R->axis_degree[k], &cb);
+  const int M = cb.num_basis, Ptop = top->num_basis;
   const size_t ns = B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0;
   FCM_ALLOC(ctx, (size_t)M, mom);
   FCM_ALLOC(ctx, fcm__simplify_moments_scratch(cb.m), work);
   FCM_ALLOC(ctx, (size_t)M, f.idx);
   FCM_ALLOC(ctx, (size_t)M, f.w);
   if (M < Ptop && count > 0) {
+    FCM_ALLOC(ctx, (size_t)M, rows);
+    fcm__simplify_basis_rows(top, &cb, rows);
     FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)count, Pk);
     for (int j = 0; j < count; j++)
-      memcpy(Pk + (size_t)j * M, P + (size_t)j * Ptop, (size_t)M * sizeof *Pk);
+      for (int i = 0; i < M; i++)
+        Pk[(size_t)j * M + i] = P[(size_t)j * Ptop + rows[i]];
   }
   fcm__simplify_moments(&cb, (int)ws->sr->n, ws->sr->x, NULL, ws->sr->w, mom, work);
   /* the moments' rounding: about 1e-15 of the material box's reference volume */
@@ -311,8 +317,9 @@ static fcm_status fit_kind(const build *B, const fcm_cell_rules *R, const fcm__e
                                        B->o->simplify_options.residual_tol, MOMENT_ATOL * bv, &f));
   *ok = f.ok;
   if (!f.ok) {
-    snprintf(why, why_len, "%s rules of strength %d on %d candidates: %s", fcm_rule_kind_name(k),
-             cb.m, count, f.message);
+    snprintf(why, why_len,
+             "%s rules of strength %d (degree <= %d per variable) on %d candidates: %s",
+             fcm_rule_kind_name(k), cb.m, cb.q, count, f.message);
     goto cleanup;
   }
   fcm__free(ctx, o->pts[k]);
@@ -334,12 +341,13 @@ cleanup:
   fcm__free(ctx, mom);
   fcm__free(ctx, work);
   fcm__free(ctx, Pk);
+  fcm__free(ctx, rows);
   fcm__free(ctx, f.idx);
   fcm__free(ctx, f.w);
   return st;
 }
 
-/* Kind k's rule as kind j's, fitted on the same candidates at the same strength: the same
+/* Kind k's rule as kind j's, fitted on the same candidates in the same space: the same
  * moments and basis give the same fit. */
 static fcm_status copy_kind(const build *B, int j, int k, piece_out *o)
 {
@@ -376,10 +384,14 @@ fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
   memcpy(box, mbox, sizeof box);
   *ok = 0;
   for (int d = 0; d < 3; d++)
-    if (!(box[d] < box[3 + d])) goto cleanup;   /* flat material: leave it to the volume path */
-  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) /* built or not, as the moments' degree */
+    if (!(box[d] < box[3 + d])) goto cleanup; /* flat material: leave it to the volume path */
+  /* built or not, as the moments' degree; the candidates follow the size of the total-degree
+   * space whatever a kind's cap per variable: a smaller grid for a tensor space would change the
+   * other kind's rules fitted on the same candidates */
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     mmax = FCM_MAX(mmax, B->fit_strength[k]);
-  Mmax = FCM_MAX(Mmax, fcm__simplify_num_basis(mmax));
+    Mmax = FCM_MAX(Mmax, B->fit_M[k]);
+  }
   const double vref = vol / cell->detA;
   int todo[FCM_RULE_KIND_COUNT], left = 0;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
@@ -403,12 +415,13 @@ fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
     last_n = n, last_nb = nb, last_x = xkey;
     FCM_TRY(ctx, check_fit_memory(B, cell, ws, n, Mmax));
     FCM_TRY(ctx, grid_candidates(B, cell, ws, box, n, nbnd, extra, &count));
-    /* the kinds' bases on the candidates, evaluated once at the highest strength left */
-    int mtop = 0;
+    /* the kinds' bases on the candidates, evaluated once in the space of the highest strength
+     * and per-variable degree left, which holds every kind's */
+    int mtop = 0, qtop = 0;
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
-      if (todo[k]) mtop = FCM_MAX(mtop, R->strength[k]);
+      if (todo[k]) mtop = FCM_MAX(mtop, R->strength[k]), qtop = FCM_MAX(qtop, R->axis_degree[k]);
     fcm__cheb_box cb;
-    fit_box(box, mtop, &cb);
+    fit_box(box, mtop, qtop, &cb);
     fcm__free(ctx, P);
     P = NULL;
     if (count > 0) {
@@ -423,12 +436,13 @@ fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
       if (!todo[k]) continue;
       int done, same = -1;
       for (int j = 0; j < k; j++)
-        if (fitted[j] && R->strength[j] == R->strength[k]) same = j;
+        if (fitted[j] && R->strength[j] == R->strength[k] && R->axis_degree[j] == R->axis_degree[k])
+          same = j;
       if (same >= 0) {
         FCM_TRY(ctx, copy_kind(B, same, k, o));
         done = 1;
       } else {
-        FCM_TRY(ctx, fit_kind(B, R, ws, box, count, k, P, cb.num_basis, o, &done, why, why_len));
+        FCM_TRY(ctx, fit_kind(B, R, ws, box, count, k, P, &cb, o, &done, why, why_len));
       }
       if (done) todo[k] = 0, left--, fitted[k] = 1;
     }

@@ -39,6 +39,7 @@ fcm_simplify_options fcm_simplify_options_default(void)
   o.lp_iteration_limit = FCM_DEFAULT;
   o.lp_time_limit = 60.0;
   o.elimination_block = FCM_DEFAULT;
+  o.axis_degree = FCM_DEFAULT;
   return o;
 }
 
@@ -253,6 +254,11 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_simplify_options *o)
             ctx, FCM_ERR_ARG,
             "simplify: elimination_block = %d out of range [1, %d], or FCM_DEFAULT (-1: measured)",
             o->elimination_block, FCM__ELIM_BLOCK_MAX);
+  FCM_CHECK((o->axis_degree >= 0 && o->axis_degree <= FCM_SIMPLIFY_MAX_STRENGTH) ||
+                o->axis_degree == FCM_DEFAULT,
+            ctx, FCM_ERR_ARG,
+            "simplify: axis_degree = %d out of range [0, %d], or FCM_DEFAULT (-1: every degree)",
+            o->axis_degree, FCM_SIMPLIFY_MAX_STRENGTH);
 cleanup:
   return st;
 }
@@ -359,7 +365,7 @@ static fcm_status setup_attempt(simplify_run *r, int strength, const double *wei
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = r->ctx;
   fcm__attempt *a = &r->a;
-  const int M = fcm__simplify_num_basis(strength), np = r->np;
+  const int M = fcm__simplify_space_size(strength, o->axis_degree), np = r->np;
   r->scale = (double)np / total;
   FCM_CHECK(isfinite(r->scale), ctx, FCM_ERR_ARG,
             "simplify: total weight %g of %d points too small to normalize (> %g needed)", total,
@@ -382,6 +388,7 @@ static fcm_status setup_attempt(simplify_run *r, int strength, const double *wei
   a->elim_block = o->elimination_block > 0 ? o->elimination_block : FCM__ELIM_BLOCK;
   double t0 = fcm_wtime();
   fcm__simplify_box(strength, np, r->points, &a->box);
+  fcm__simplify_box_cap(&a->box, o->axis_degree);
   a->time_basis += fcm_wtime() - t0;
 cleanup:
   return st;
@@ -522,7 +529,7 @@ fcm_status fcm__simplify_hooked(fcm_ctx *ctx, int strength, fcm_index n, const d
   out->ctx = ctx;
   FCM_TRY(ctx, check_input(ctx, strength, n, points, weights, &o, force_lp_failure, &r.ni, &total));
 
-  const int M = fcm__simplify_num_basis(strength);
+  const int M = fcm__simplify_space_size(strength, o.axis_degree);
   info->n = n;
   info->num_basis = M;
   info->method_used = FCM_SIMPLIFY_AUTO;

@@ -19,12 +19,14 @@ fcm_status fcm__simplify_hooked(fcm_ctx *ctx, int strength, fcm_index n, const d
 
 /* ---- basis (basis.c) ---- */
 
-/* Tensor Chebyshev basis T_a(x^)T_b(y^)T_c(z^), a+b+c <= m, on the bounding box of a
- * point set: x^ = scale * x + shift per axis; a degenerate axis (extent at rounding
- * level) gets scale 0 and shift 1, so every polynomial is constant along it. */
+/* Tensor Chebyshev basis T_a(x^)T_b(y^)T_c(z^), a+b+c <= m and a, b, c <= q, on the bounding
+ * box of a point set: x^ = scale * x + shift per axis; a degenerate axis (extent at rounding
+ * level) gets scale 0 and shift 1, so every polynomial is constant along it. q >= m: the total
+ * degree space P_m; q = k, m = 3k: the tensor space Q_k. */
 typedef struct fcm__cheb_box {
-  int m;           /* strength */
-  int num_basis;   /* M = (m+3 choose 3) */
+  int m;           /* strength: the largest total degree */
+  int q;           /* the largest degree in each variable (<= m) */
+  int num_basis;   /* M: (m+3 choose 3) for q = m, (q+1)^3 for m >= 3q */
   double scale[3]; /* per axis */
   double shift[3];
 } fcm__cheb_box;
@@ -32,10 +34,21 @@ typedef struct fcm__cheb_box {
 /* (m+3 choose 3) for m >= 0. */
 int fcm__simplify_num_basis(int m);
 
-/* Box of the n points (n x 3, row-major) for strength m. */
+/* Number of (a, b, c) with a+b+c <= m and a, b, c <= q (q >= m or q < 0: (m+3 choose 3)). */
+int fcm__simplify_space_size(int m, int q);
+
+/* Box of the n points (n x 3, row-major) for strength m, every degree (q = m). */
 void fcm__simplify_box(int m, int n, const double *points, fcm__cheb_box *box);
 
-/* phi[0..M) at the point x[3]; ordered by total degree, then a descending, then b. */
+/* Cap box's basis at degree q in each variable (q < 0 or q >= m: none). */
+void fcm__simplify_box_cap(fcm__cheb_box *box, int q);
+
+/* The rows of sub's basis in top's (rows[0..sub->num_basis), ascending): sub's space must lie
+ * in top's (sub->m <= top->m, sub->q <= top->q); both ordered as fcm__simplify_basis_eval. */
+void fcm__simplify_basis_rows(const fcm__cheb_box *top, const fcm__cheb_box *sub, int *rows);
+
+/* phi[0..M) at the point x[3]; ordered by total degree, then a descending, then b, skipping
+ * the functions of degree above q in a variable. */
 void fcm__simplify_basis_eval(const fcm__cheb_box *box, const double *x, double *phi);
 
 /* Points per block of fcm__simplify_moments, and the fewest for which a block goes through
