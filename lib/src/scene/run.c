@@ -18,6 +18,7 @@
 #include "io/io_impl.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -437,6 +438,43 @@ cleanup:
   return st;
 }
 
+/* The cut space's integrator (part 0) and the output surface split again on that space
+ * (part 1), on two threads where the context has them: neither reads what the other writes
+ * (the surface reads the new space, its rules and the geometry; the integrator the old
+ * integrator and the new space), and each gives the bits it gives alone (the loops inside
+ * run on one thread then, and their sums do not depend on the thread count). The
+ * integrator is made on the calling thread; a distributed run makes both there, one after
+ * the other. *seconds: the integrator's wall time. */
+static fcm_status cut_integrator_and_surface(fcm_simulation *S, const fcm_space *space,
+                                             fcm_integrator **integ, double *seconds)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  fcm__loop L;
+  const int two = S->surf && !S->distributed && !fcm__integrator_distributed(S->integ, NULL) &&
+                  fcm_ctx_num_threads(ctx) > 1 && !S->cuts_in_turn;
+  fcm__loop_begin(ctx, &L);
+#pragma omp parallel num_threads(2) if (two)
+  for (int part = omp_get_thread_num(); part < 2; part += omp_get_num_threads()) {
+    if (fcm__loop_skip(&L, part)) continue;
+    fcm__loop_iter it;
+    fcm__loop_enter(&L, &it, part);
+    fcm_status ps = FCM_OK;
+    if (part == 0) {
+      const double t = fcm_wtime();
+      ps = fcm_integrator_create_cut(S->integ, space, integ);
+      *seconds = fcm_wtime() - t;
+    } else if (S->surf) {
+      ps = fcm_embedded_surface_set_space(S->surf, space);
+    }
+    fcm__loop_leave(&L, &it, ps);
+  }
+  FCM_TRY(ctx, fcm__loop_end(&L, NULL));
+  S->cuts_side_by_side += two;
+cleanup:
+  return st;
+}
+
 fcm_status fcm__sim_apply_cut(fcm_simulation *S)
 {
   fcm_status st = FCM_OK;
@@ -475,8 +513,7 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   if (fcm_cell_rules_num_pieces(rules) == fcm_cell_rules_num_pieces(S->rules) &&
       fcm_space_num_dofs(space) == fcm_space_num_dofs(S->space))
     S->c.cuts_missed++;
-  FCM_TRY(ctx, fcm_integrator_create_cut(S->integ, space, &integ));
-  S->cut_phase[2] = fcm_wtime() - t0 - S->cut_phase[0] - S->cut_phase[1];
+  FCM_TRY(ctx, cut_integrator_and_surface(S, space, &integ, &S->cut_phase[2]));
   FCM_TRY(ctx, keep_log_blocks(S, space));
   /* the new integrator counts from zero: keep the totals so far */
   S->base_factorizations = S->c.factorizations;
@@ -491,9 +528,11 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);
   S->pieces = fcm_space_num_bodies(S->space);
   S->c.pieces = S->pieces;
-  if (S->surf) FCM_TRY(ctx, fcm_embedded_surface_set_space(S->surf, S->space));
   FCM_TRY(ctx, build_log_blocks(S));
 cleanup:
+  /* a failed cut leaves the run as it was: the output surface on the space it keeps */
+  if (st != FCM_OK && S->surf && space && S->surf->space == space)
+    (void)fcm_embedded_surface_set_space(S->surf, S->space);
   if (k < S->num_cuts) S->cut_time[k] = fcm_wtime() - t0;
   st = fcm__integrator_finish(S->integ, st);
   fcm_integrator_destroy(&integ);
