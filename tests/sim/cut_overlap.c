@@ -77,7 +77,8 @@ int main(int argc, char **argv)
     const fcm_embedded_surface *a = sim[0]->surf, *b = sim[1]->surf;
     TEST_TRUE(a && b);
     if (!a || !b) goto done;
-    const fcm_index np = fcm_embedded_surface_num_points(a), nt = fcm_embedded_surface_num_triangles(a);
+    const fcm_index np = fcm_embedded_surface_num_points(a),
+                    nt = fcm_embedded_surface_num_triangles(a);
     TEST_TRUE(np == fcm_embedded_surface_num_points(b) &&
               nt == fcm_embedded_surface_num_triangles(b));
     TEST_TRUE(fcm_embedded_surface_num_split_triangles(a) > 0);
