@@ -453,24 +453,29 @@ static fcm_status cut_integrator_and_surface(fcm_simulation *S, const fcm_space 
   fcm__loop L;
   const int two = S->surf && !S->distributed && !fcm__integrator_distributed(S->integ, NULL) &&
                   fcm_ctx_num_threads(ctx) > 1 && !S->cuts_in_turn;
+  int team = 1;
   fcm__loop_begin(ctx, &L);
 #pragma omp parallel num_threads(2) if (two)
-  for (int part = omp_get_thread_num(); part < 2; part += omp_get_num_threads()) {
-    if (fcm__loop_skip(&L, part)) continue;
-    fcm__loop_iter it;
-    fcm__loop_enter(&L, &it, part);
-    fcm_status ps = FCM_OK;
-    if (part == 0) {
-      const double t = fcm_wtime();
-      ps = fcm_integrator_create_cut(S->integ, space, integ);
-      *seconds = fcm_wtime() - t;
-    } else if (S->surf) {
-      ps = fcm_embedded_surface_set_space(S->surf, space);
+  {
+    const int id = omp_get_thread_num(), nt = omp_get_num_threads();
+    if (id == 0) team = nt;
+    for (int part = id; part < 2; part += nt) {
+      if (fcm__loop_skip(&L, part)) continue;
+      fcm__loop_iter it;
+      fcm__loop_enter(&L, &it, part);
+      fcm_status ps = FCM_OK;
+      if (part == 0) {
+        const double t = fcm_wtime();
+        ps = fcm_integrator_create_cut(S->integ, space, integ);
+        *seconds = fcm_wtime() - t;
+      } else if (S->surf) {
+        ps = fcm_embedded_surface_set_space(S->surf, space);
+      }
+      fcm__loop_leave(&L, &it, ps);
     }
-    fcm__loop_leave(&L, &it, ps);
   }
   FCM_TRY(ctx, fcm__loop_end(&L, NULL));
-  S->cuts_side_by_side += two;
+  S->cuts_side_by_side += team > 1;
 cleanup:
   return st;
 }
