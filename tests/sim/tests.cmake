@@ -153,3 +153,8 @@ fcm_add_test(sim_contact_bodies_friction_slide tests/sim/contact_bodies_friction
 # Static contact between bodies: the plate holds the block's vertical translation (the clamp
 # carries both weights); beyond the threshold the step is refused.
 fcm_add_test(sim_contact_bodies_static tests/sim/contact_bodies_friction.c ARGS static)
+# A scene's cut makes its integrator and output surface on two threads: the run equals the run
+# on one thread bit for bit (state after every step, output surface, counters) over three cuts.
+foreach(el tet4 tet10 hex8 hex20)
+  fcm_add_test(sim_cut_overlap_${el} tests/sim/cut_overlap.c ARGS ${el})
+endforeach()

@@ -171,9 +171,9 @@ typedef struct fcm_simulation_counters {
   double time_cut_integrator; /**< of time_cuts: the new integrator (set-up, the mass matrix, state
                                    transfer); the new factorization or multigrid hierarchy is
                                    built by the next step (time_step_factor) */
-  double time_cut_other;      /**< of time_cuts: the rest, so the four phases add up to time_cuts:
-                                   the embedded (output and contact) surface split again by the cuts,
-                                   the log's mass blocks, the run's bookkeeping */
+  double time_cut_other;      /**< of time_cuts: the rest (the phases add up to time_cuts): the
+                                   embedded surface split again (with 2+ threads made beside the
+                                   integrator: its time beyond it), the log's mass blocks */
   double time_log; /**< seconds of the per-step log rows (mass, momentum, reactions; not part
                         of time_steps) */
   double time_setup_geometry;   /**< seconds of the set-up's background mesh and geometry (reading

@@ -431,7 +431,7 @@ struct fcm_embedded_surface {
   int32_t *flag;
   fcm_index cap_p, cap_t;
   struct fcm__embed_finder *finder; /* during a rebuild with cuts: the cut cells' pieces */
-  fcm_aabb_tree *cell_tree;         /* during a rebuild with cuts: boxes of the mesh's cells */
+  fcm_aabb_tree *cell_tree;         /* from the first rebuild with cuts: the mesh's cells' boxes */
   /* What the last rebuild with cuts found, for the next one on rules that extend its rules
    * by further cuts (surface.c: cells no new cut triangle reaches keep their answers):
    * those rules' cut triangles (copied), pieces per cell (piece_off, num cells + 1), the

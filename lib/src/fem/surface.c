@@ -649,9 +649,9 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
   es->num_split = nsplit;
 cleanup:
   if (st != FCM_OK) cache_clear(es);
-  /* the finder holds the cut cells' parts and the search trees: made per call (per cut) */
+  /* the finder holds the cut cells' parts and the search trees: made per call (per cut); the
+   * cells' tree is the mesh's, which a new space keeps (fcm_embedded_surface_set_space()) */
   fcm__embed_finder_destroy(&es->finder);
-  fcm_aabb_tree_destroy(&es->cell_tree);
   fcm__free(ctx, split);
   fcm__free(ctx, changed);
   fcm__free(ctx, src);

@@ -18,6 +18,7 @@
 #include "io/io_impl.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -437,6 +438,62 @@ cleanup:
   return st;
 }
 
+/* Part `part` of a cut's work on the cut space, as iteration `part` of loop L: 0 the
+ * integrator (*seconds: its wall time), 1 the output surface split again, 2 the log's mass
+ * blocks. */
+static void cut_part(fcm_simulation *S, fcm__loop *L, int part, const fcm_space *space,
+                     fcm_integrator **integ, double *seconds)
+{
+  fcm_status st = FCM_OK;
+  fcm__loop_iter it;
+  if (fcm__loop_skip(L, part)) return;
+  fcm__loop_enter(L, &it, part);
+  if (part == 0) {
+    const double t = fcm_wtime();
+    st = fcm_integrator_create_cut(S->integ, space, integ);
+    *seconds = fcm_wtime() - t;
+  } else if (part == 1) {
+    if (S->surf) st = fcm_embedded_surface_set_space(S->surf, space);
+  } else {
+    st = keep_log_blocks(S, space);
+  }
+  fcm__loop_leave(L, &it, st);
+}
+
+/* The parts of a cut's work on the cut space (cut_part()), on two threads where the context
+ * has them: the integrator on the calling thread, the surface on the other, the log's blocks
+ * on the first to finish. None reads what another writes (the surface reads the new space,
+ * its rules and the geometry; the integrator the old integrator and the new space; the log's
+ * blocks the two spaces' elements and mass caches, which only they write), and each gives the
+ * bits it gives alone (the loops inside run on one thread then, and give the bits they give
+ * on two). A distributed run makes them on the calling thread in turn. */
+static fcm_status cut_parts(fcm_simulation *S, const fcm_space *space, fcm_integrator **integ,
+                            double *seconds)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  fcm__loop L;
+  const int two = S->surf && !S->distributed && !fcm__integrator_distributed(S->integ, NULL) &&
+                  fcm_ctx_num_threads(ctx) > 1 && !S->cuts_in_turn;
+  int team = 1, finished = 0;
+  fcm__loop_begin(ctx, &L);
+#pragma omp parallel num_threads(2) if (two)
+  {
+    const int id = omp_get_thread_num(), nt = omp_get_num_threads();
+    if (id == 0) team = nt;
+    for (int part = id; part < 2; part += nt)
+      cut_part(S, &L, part, space, integ, seconds);
+    int first;
+#pragma omp atomic capture
+    first = finished++;
+    if (first == 0) cut_part(S, &L, 2, space, integ, seconds); /* the first thread done */
+  }
+  FCM_TRY(ctx, fcm__loop_end(&L, NULL));
+  S->cuts_side_by_side += team > 1;
+cleanup:
+  return st;
+}
+
 fcm_status fcm__sim_apply_cut(fcm_simulation *S)
 {
   fcm_status st = FCM_OK;
@@ -475,9 +532,7 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   if (fcm_cell_rules_num_pieces(rules) == fcm_cell_rules_num_pieces(S->rules) &&
       fcm_space_num_dofs(space) == fcm_space_num_dofs(S->space))
     S->c.cuts_missed++;
-  FCM_TRY(ctx, fcm_integrator_create_cut(S->integ, space, &integ));
-  S->cut_phase[2] = fcm_wtime() - t0 - S->cut_phase[0] - S->cut_phase[1];
-  FCM_TRY(ctx, keep_log_blocks(S, space));
+  FCM_TRY(ctx, cut_parts(S, space, &integ, &S->cut_phase[2]));
   /* the new integrator counts from zero: keep the totals so far */
   S->base_factorizations = S->c.factorizations;
   S->base_analyses = S->c.analyses;
@@ -491,9 +546,11 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);
   S->pieces = fcm_space_num_bodies(S->space);
   S->c.pieces = S->pieces;
-  if (S->surf) FCM_TRY(ctx, fcm_embedded_surface_set_space(S->surf, S->space));
   FCM_TRY(ctx, build_log_blocks(S));
 cleanup:
+  /* a failed cut leaves the run as it was: the output surface on the space it keeps */
+  if (st != FCM_OK && S->surf && space && S->surf->space == space)
+    (void)fcm_embedded_surface_set_space(S->surf, S->space);
   if (k < S->num_cuts) S->cut_time[k] = fcm_wtime() - t0;
   st = fcm__integrator_finish(S->integ, st);
   fcm_integrator_destroy(&integ);

@@ -104,7 +104,10 @@ struct fcm_simulation {
   double *cut_time;
   double cut_phase[3]; /* the last cut's rules, space and integrator seconds (the step adds them
                           to the counters' time_cut_*) */
-  fcm_index pieces;    /* separate bodies of the current space (fcm_space_num_bodies()) */
+  /* cuts whose integrator and output surface were made on two threads; 1 in cuts_in_turn: one
+   * after the other on every thread (the sequence the tests compare with) */
+  int cuts_side_by_side, cuts_in_turn;
+  fcm_index pieces; /* separate bodies of the current space (fcm_space_num_bodies()) */
   long long base_factorizations, base_analyses, base_fallbacks; /* of integrators before cuts */
   /* "octree": {"cuts": {"when": "cut"}}: the refinement along the cuts done when the first cut
    * applied: the time, the cells before and after, the wall time (refined 0: not yet) */

@@ -1,0 +1,125 @@
+/* A scene's cut makes the cut space's integrator, the output surface split again and the
+ * log's mass blocks on two threads when the run has them (scene/run.c): the run gives the
+ * bits of the run that makes them one after the other, each with both threads for its loops.
+ * A spinning box is cut three times (a plane across it, a second plane crossing the first in
+ * cells it split, and a slit from the top ending inside the body) in two runs on two
+ * threads, the first making each cut's parts in turn; after every step both have the same
+ * DOF count, displacement and velocity bits and the same log mass and momenta (from the mass
+ * blocks the cuts kept), and at the end the same output surface (points, elements, reference
+ * coordinates, triangles, cut flags), bodies and counters; the second made every cut side by
+ * side, the first none. Usage: sim_cut_overlap <element> */
+#include "fcm/fcm.h"
+#include "scene/run_impl.h"
+#include "fem/fem_impl.h"
+#include "test.h"
+
+#include <string.h>
+
+static int same_bits(const void *a, const void *b, size_t bytes)
+{
+  return memcmp(a, b, bytes) == 0;
+}
+
+static void scene_json(char *buf, size_t cap, const char *element, int threads)
+{
+  snprintf(
+      buf, cap,
+      "{\"version\": 1, \"name\": \"cut_overlap\","
+      " \"background\": {\"element\": \"%s\", \"box\": {\"min\": [-0.25, -0.25, -0.25],"
+      "   \"max\": [1.25, 0.75, 0.75]}, \"cells\": [6, 4, 4]},"
+      " \"geometry\": {\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [1, 0.5, 0.5],"
+      "   \"cells\": [4, 2, 2]},"
+      " \"material\": {\"model\": \"snh\", \"young\": 1e5, \"poisson\": 0.3, \"density\": 1000},"
+      " \"solver\": {\"threads\": %d},"
+      " \"time\": {\"dt\": 0.02, \"steps\": 6},"
+      " \"output\": {\"background\": false},"
+      " \"effects\": [{\"initial_velocity\": {\"angular_velocity\": [0, 0, 4]}},"
+      "  {\"cut\": {\"time\": 0.02, \"surface\": {\"plane\": {\"point\": [0.43, 0.25, 0.25],"
+      "     \"normal\": [1, 0.1, 0]}}}},"
+      "  {\"cut\": {\"time\": 0.06, \"surface\": {\"plane\": {\"point\": [0.5, 0.27, 0.25],"
+      "     \"normal\": [0.2, 1, 0.1]}}}},"
+      "  {\"cut\": {\"time\": 0.08, \"surface\": {\"rectangle\": {\"center\": [0.77, 0.5, 0.25],"
+      "     \"normal\": [1, 0, 0.05], \"axis\": [0, 1, 0], \"size\": [0.5, 0.8]}}}}]}",
+      element, threads);
+}
+
+int main(int argc, char **argv)
+{
+  const char *element = argc > 1 ? argv[1] : "hex8";
+  fcm_ctx *ctx[2] = {NULL, NULL};
+  fcm_scene *scene[2] = {NULL, NULL};
+  fcm_simulation *sim[2] = {NULL, NULL};
+  char json[4096];
+  for (int r = 0; r < 2; r++) {
+    TEST_OK(NULL, fcm_ctx_create(NULL, &ctx[r]));
+    scene_json(json, sizeof json, element, 2);
+    TEST_OK(ctx[r], fcm_scene_create_from_string(ctx[r], json, "cut_overlap.json", &scene[r]));
+    if (scene[r]) TEST_OK(ctx[r], fcm_simulation_create(ctx[r], scene[r], NULL, &sim[r]));
+  }
+  if (sim[0]) sim[0]->cuts_in_turn = 1;
+  if (!sim[0] || !sim[1]) goto done;
+  while (!fcm_simulation_done(sim[0]) && !fcm_simulation_done(sim[1])) {
+    fcm_step_info si[2];
+    for (int r = 0; r < 2; r++)
+      TEST_OK(ctx[r], fcm_simulation_step(sim[r], &si[r]));
+    const fcm_integrator *I0 = fcm_simulation_integrator(sim[0]),
+                         *I1 = fcm_simulation_integrator(sim[1]);
+    const fcm_index n = fcm_integrator_num_dofs(I0);
+    TEST_TRUE(n == fcm_integrator_num_dofs(I1));
+    if (n != fcm_integrator_num_dofs(I1)) goto done;
+    TEST_TRUE(si[0].newton_iterations == si[1].newton_iterations);
+    TEST_TRUE(same_bits(fcm_integrator_displacement(I0), fcm_integrator_displacement(I1),
+                        sizeof(double) * (size_t)n));
+    TEST_TRUE(same_bits(fcm_integrator_velocity(I0), fcm_integrator_velocity(I1),
+                        sizeof(double) * (size_t)n));
+    double q[2][7]; /* the log's mass and momenta, from the mass blocks the cuts kept */
+    for (int r = 0; r < 2; r++) {
+      const fcm_integrator *I = fcm_simulation_integrator(sim[r]);
+      TEST_OK(ctx[r], fcm_space_momentum(fcm_simulation_space(sim[r]), 1000.0,
+                                         fcm_integrator_displacement(I), fcm_integrator_velocity(I),
+                                         q[r], q[r] + 1, q[r] + 4));
+    }
+    TEST_TRUE(same_bits(q[0], q[1], sizeof q[0]));
+  }
+  TEST_TRUE(fcm_simulation_done(sim[0]) && fcm_simulation_done(sim[1]));
+  {
+    const fcm_embedded_surface *a = sim[0]->surf, *b = sim[1]->surf;
+    TEST_TRUE(a && b);
+    if (!a || !b) goto done;
+    const fcm_index np = fcm_embedded_surface_num_points(a),
+                    nt = fcm_embedded_surface_num_triangles(a);
+    TEST_TRUE(np == fcm_embedded_surface_num_points(b) &&
+              nt == fcm_embedded_surface_num_triangles(b));
+    TEST_TRUE(fcm_embedded_surface_num_split_triangles(a) > 0);
+    if (np == fcm_embedded_surface_num_points(b) && nt == fcm_embedded_surface_num_triangles(b)) {
+      TEST_TRUE(same_bits(fcm_embedded_surface_points(a), fcm_embedded_surface_points(b),
+                          3 * sizeof(double) * (size_t)np));
+      TEST_TRUE(same_bits(fcm_embedded_surface_triangles(a), fcm_embedded_surface_triangles(b),
+                          3 * sizeof(fcm_index) * (size_t)nt));
+      TEST_TRUE(same_bits(fcm_embedded_surface_cut_flags(a), fcm_embedded_surface_cut_flags(b),
+                          sizeof(int32_t) * (size_t)np));
+      TEST_TRUE(same_bits(a->elem, b->elem, sizeof(fcm_index) * (size_t)np));
+      TEST_TRUE(same_bits(a->xi, b->xi, 3 * sizeof(double) * (size_t)np));
+    }
+  }
+  {
+    fcm_simulation_counters k0, k1;
+    fcm_simulation_get_counters(sim[0], &k0);
+    fcm_simulation_get_counters(sim[1], &k1);
+    const fcm_simulation_counters *c0 = &k0, *c1 = &k1;
+    TEST_TRUE(c0->cuts == 3 && c1->cuts == 3 && c0->cuts_missed == 0 && c1->cuts_missed == 0);
+    TEST_TRUE(c0->pieces == c1->pieces && c0->pieces == 4);
+    TEST_TRUE(c0->num_dofs == c1->num_dofs && c0->cut_cells == c1->cut_cells);
+    TEST_TRUE(c0->newton_iterations == c1->newton_iterations);
+    TEST_TRUE(c1->time_cut_integrator > 0.0);
+    TEST_TRUE(sim[0]->cuts_side_by_side == 0 && sim[1]->cuts_side_by_side == 3);
+  }
+done:
+  for (int r = 0; r < 2; r++) {
+    fcm_simulation_destroy(&sim[r]);
+    fcm_scene_destroy(&scene[r]);
+    if (ctx[r]) TEST_TRUE(fcm_ctx_live_allocations(ctx[r]) == 0);
+    fcm_ctx_destroy(&ctx[r]);
+  }
+  return TEST_RESULT();
+}
