@@ -46,17 +46,20 @@ static void scene_json(char *buf, size_t cap, const char *element, int threads)
 int main(int argc, char **argv)
 {
   const char *element = argc > 1 ? argv[1] : "hex8";
+  const int threads_mode = argc > 2 && !strcmp(argv[2], "threads");
+  if (threads_mode) fcm_blas_set_num_threads(2);
   fcm_ctx *ctx[2] = {NULL, NULL};
   fcm_scene *scene[2] = {NULL, NULL};
   fcm_simulation *sim[2] = {NULL, NULL};
   char json[4096];
   for (int r = 0; r < 2; r++) {
     TEST_OK(NULL, fcm_ctx_create(NULL, &ctx[r]));
-    scene_json(json, sizeof json, element, 2);
+    scene_json(json, sizeof json, element, threads_mode ? r + 1 : 2);
     TEST_OK(ctx[r], fcm_scene_create_from_string(ctx[r], json, "cut_overlap.json", &scene[r]));
     if (scene[r]) TEST_OK(ctx[r], fcm_simulation_create(ctx[r], scene[r], NULL, &sim[r]));
   }
-  if (sim[0]) sim[0]->cuts_in_turn = 1;
+  for (int r = 0; r < (threads_mode ? 2 : 1); r++)
+    if (sim[r]) sim[r]->cuts_in_turn = 1;
   if (!sim[0] || !sim[1]) goto done;
   while (!fcm_simulation_done(sim[0]) && !fcm_simulation_done(sim[1])) {
     fcm_step_info si[2];
@@ -112,8 +115,10 @@ int main(int argc, char **argv)
     TEST_TRUE(c0->num_dofs == c1->num_dofs && c0->cut_cells == c1->cut_cells);
     TEST_TRUE(c0->newton_iterations == c1->newton_iterations);
     TEST_TRUE(c1->time_cut_integrator > 0.0);
-    TEST_TRUE(sim[0]->cuts_side_by_side == 0 && sim[1]->cuts_side_by_side == 3);
+    TEST_TRUE(sim[0]->cuts_side_by_side == 0 &&
+              sim[1]->cuts_side_by_side == (threads_mode ? 0 : 3));
   }
+  if (threads_mode) TEST_TRUE(fcm_blas_set_num_threads(0) == 2); /* restored after each build */
 done:
   for (int r = 0; r < 2; r++) {
     fcm_simulation_destroy(&sim[r]);

@@ -46,8 +46,8 @@ static fcm_status auto_finish(const build *B, const fcm_cell_rules *R, int nthre
   fcm_ctx *ctx = B->ctx;
   fcm__loop loop;
   fcm__loop_begin(ctx, &loop);
-  /* one BLAS thread inside the threads (fcm__embed_run_cells) */
-  const int blas_threads = nthreads > 1 ? fcm_blas_set_num_threads(1) : 0;
+  /* one BLAS thread inside the threads, whatever their count (fcm__embed_run_cells) */
+  const int blas_threads = fcm_blas_set_num_threads(1);
 #pragma omp parallel num_threads(nthreads)
   {
     cell_sums mine;

@@ -516,8 +516,10 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
   fcm__loop_begin(ctx, &loop);
   memset(sums, 0, sizeof *sums);
   /* the cells' dense solves run inside the threads: BLAS threads of their own would fight
-   * them for the cores (4 times slower on 2 cores), so one BLAS thread for the loop */
-  const int blas_threads = nthreads > 1 ? fcm_blas_set_num_threads(1) : 0;
+   * them for the cores (4 times slower on 2 cores), so one BLAS thread for the loop; with one
+   * thread too, since a threaded BLAS product may round differently and the rules must not
+   * depend on the thread count */
+  const int blas_threads = fcm_blas_set_num_threads(1);
 #pragma omp parallel num_threads(nthreads)
   {
     cell_sums mine;
