@@ -591,8 +591,8 @@ fcm_status fcm__embed_material_box(fcm_ctx *ctx, const fcm_geometry *g, const fc
  * from the triangles that meet the cell (surface_moments.c explains how). base (NULL: the
  * cell's lower bounds): where the antiderivative in each direction starts, valid when the
  * material lies at or above it (the lower corner of its box: the rule's points then stay in
- * the box). FCM_ERR_GEOMETRY when a line through the cell shows the surface is not closed.
- * buf and cr are scratch. */
+ * the box). The surface's closedness is the geometry's (a line's crossings are taken on its
+ * shorter half only). buf and cr are scratch. */
 fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
                                   const fcm__embed_cell *cell, const fcm__moment_quad *q,
                                   const double base[3], fcm__idbuf *buf, fcm__crossings *cr,

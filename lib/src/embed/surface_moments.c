@@ -24,8 +24,8 @@
  * an edge or a vertex counts one crossing. Where two levels' rounding disagrees (a vertex
  * within rounding of a cell plane) the integrals differ by a region of rounding size: the
  * result is continuous in the vertex positions, so no decision can make it grossly wrong. The
- * surface must be closed and consistently oriented; a line whose crossings do not sum to zero
- * says it is not. */
+ * surface must be closed and consistently oriented (the geometry checks it): a point's winding
+ * number is then the sum of the signed crossings on either half of a line through it. */
 #include "embed/embed_impl.h"
 #include "la/mat3.h"
 
@@ -452,6 +452,49 @@ static void line_segment(const fcm_geometry *g, const fcm__embed_cell *cell, con
   *pad = rel * (far + cell->size);
 }
 
+/* The half of the reference line base + t dir beyond the values [zlo, zhi] of t that is the
+ * shorter inside the geometry's bounding box (widened by pad), as a physical segment p0 -> p1
+ * with a reference length of margin at each end: 1 when it runs up (t from zlo - 1 to the
+ * box's far side), 0 when down (to zhi + 1). The crossings with the boundary on it are those
+ * at t >= zlo (up) or t <= zhi (down) of the whole line, each from a triangle whose box meets
+ * the segment: a closed surface's crossings at and beyond t sum to minus those before t, so
+ * either half gives the winding numbers along [zlo, zhi], and a line near the body's top or
+ * side visits a fraction of the tree's nodes the whole line would. */
+static int line_half(const fcm_geometry *g, const fcm__embed_cell *cell, const double base[3],
+                     const double dir[3], double zlo, double zhi, double pad, double p0[3],
+                     double p1[3])
+{
+  double p[3], v[3], up = HUGE_VAL, down = HUGE_VAL;
+  const double x0[3] = {base[0] - cell->xi0[0], base[1] - cell->xi0[1], base[2] - cell->xi0[2]};
+  fcm__mat3_mulv(cell->A, x0, p);
+  fcm__mat3_mulv(cell->A, dir, v);
+  for (int d = 0; d < 3; d++) {
+    p[d] += cell->X[d];
+    const double lo = g->lo[d] - pad, hi = g->hi[d] + pad;
+    if (v[d] > 0.0)
+      up = fmin(up, (hi - p[d]) / v[d]), down = fmin(down, (p[d] - lo) / v[d]);
+    else if (v[d] < 0.0)
+      up = fmin(up, (lo - p[d]) / v[d]), down = fmin(down, (p[d] - hi) / v[d]);
+  }
+  /* t in the box: [-down, up] (empty when the line misses it) */
+  const double top = fmax(up, zhi) + 1.0, bottom = fmin(-down, zlo) - 1.0;
+  const int is_up = !(zhi + 1.0 - bottom < top - (zlo - 1.0));
+  const double t0 = is_up ? zlo - 1.0 : bottom, t1 = is_up ? top : zhi + 1.0;
+  for (int d = 0; d < 3; d++)
+    p0[d] = p[d] + t0 * v[d], p1[d] = p[d] + t1 * v[d];
+  return is_up;
+}
+
+/* The winding number at t = z of the line whose crossings (at cr->z, signs cr->sign) were
+ * found on its half up (all at t >= z counted) or down (all at t < z counted, negated). */
+static int line_winding(const fcm__crossings *cr, int up, double z)
+{
+  int w = 0;
+  for (size_t k = 0; k < cr->n; k++)
+    if ((cr->z[k] >= z) == up) w += cr->sign[k];
+  return up ? w : -w;
+}
+
 /* The crossings of the body's boundary with the line {l1 = 0, l2 = 0} (base + t dir), as
  * values of xi_3 with +1 (leaving the body going up in xi_3) or -1; the candidates are the
  * triangles in buf. *sum: the sum of the signs (0 for a closed surface). */
@@ -582,18 +625,14 @@ fcm_status fcm__embed_inside_line(fcm_ctx *ctx, const fcm_geometry *g, const fcm
       return FCM_OK;
     }
   }
+  double zlo = z[0], zhi = z[0];
+  for (int i = 1; i < n; i++)
+    zlo = fmin(zlo, z[i]), zhi = fmax(zhi, z[i]);
+  const int up = line_half(g, cell, base, dir, zlo, zhi, pad, p0, p1);
   FCM_TRY(ctx, fcm__geom_tree_segment(ctx, tree, p0, p1, pad, buf));
   FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &l1, &l2, cr, &sum));
-  FCM_CHECK(sum == 0, ctx, FCM_ERR_GEOMETRY,
-            "embed: background cell %lld: a line through the body crosses its boundary %d more "
-            "times outward than inward (the boundary surface is not closed)",
-            (long long)cell->id, sum);
-  for (int i = 0; i < n; i++) {
-    int w = 0; /* crossings at or beyond z[i], leaving counted +1: the winding number */
-    for (size_t k = 0; k < cr->n; k++)
-      if (cr->z[k] >= z[i]) w += cr->sign[k];
-    inside[i] = w;
-  }
+  for (int i = 0; i < n; i++) /* crossings at or beyond z[i], leaving counted +1 */
+    inside[i] = line_winding(cr, up, z[i]);
   if (n == 1)
     FCM_TRY(ctx, clear_box_add(ctx, tree, x, CLEAR_BOX_RSIZE * cell->size, 2.0 * pad,
                                orient * inside[0], buf, cr));
@@ -708,25 +747,22 @@ static fcm_status moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aab
     to_physical(cell, lbase[0] + dir[0], lbase[1] + dir[1], lbase[2] + dir[2], P);
     cb = clear_box_find(cr, tree, P, pad);
   }
+  int up = 1;
   if (cb) /* the crossings inside the edge only */
     to_physical(cell, lbase[0] + r.lo * dir[0], lbase[1] + r.lo * dir[1], lbase[2] + r.lo * dir[2],
                 p0);
+  else /* the edge and the shorter half of the line beyond it */
+    up = line_half(g, cell, lbase, dir, r.lo, 1.0, pad, p0, p1);
   FCM_TRY(ctx, fcm__geom_tree_segment(ctx, tree, p0, cb ? P : p1, pad, buf));
   FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &r.exit1, &r.exit2, cr, &sum));
-  FCM_CHECK(cb || sum == 0, ctx, FCM_ERR_GEOMETRY,
-            "embed: background cell %lld: its edge line crosses the body's boundary %d more "
-            "times outward than inward (the boundary surface is not closed)",
-            (long long)cell->id, sum);
   for (size_t k = 0; k < cr->n; k++) {
     const double z = cr->z[k];
-    if (z >= 1.0) {
-      *corner += cr->sign[k];
-    } else if (z > r.lo) {
+    if (z > r.lo && z < 1.0) {
       FCM_TRY(ctx, add_edge(ctx, q, &r, z, cr->sign[k], s));
       ++*inner;
     }
   }
-  if (cb) *corner = orient * cb->winding;
+  *corner = cb ? orient * cb->winding : line_winding(cr, up, 1.0);
   if (*corner) FCM_TRY(ctx, add_edge(ctx, q, &r, 1.0, *corner, s));
   if (boxes && !cb)
     FCM_TRY(ctx, clear_box_add(ctx, tree, P, CLEAR_BOX_RSIZE * cell->size, 2.0 * pad,
