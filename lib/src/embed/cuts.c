@@ -192,8 +192,8 @@ fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new
   if (B->prev) FCM_ALLOC(ctx, (size_t)nc + 1, B->rebuild);
   if (B->prev && first_new > 0) FCM_ALLOC(ctx, (size_t)nc + 1, B->prev_region);
   for (fcm_index c = 0; c < nc; c++) {
-    fcm__embed_cell cell;
-    FCM_TRY(ctx, fcm__embed_cell_setup(ctx, mesh, c, B->o->clip_rtol, &cell));
+    fcm__embed_cell cell; /* its box only: the checks of its set-up come with its own work */
+    fcm__embed_cell_box(mesh, c, B->o->clip_rtol, &cell);
     FCM_TRY(ctx, fcm__embed_cut_candidates(ctx, B->cut_tree, &cell, &ids));
     if (ids.n == 0) continue;
     R->reached[c] = 1;

@@ -132,6 +132,11 @@ void fcm__embed_ws_free(fcm_ctx *ctx, fcm__embed_ws *ws);
 /* The surface path's part of ws (surface_cells.c). */
 void fcm__embed_surface_ws_free(fcm_ctx *ctx, fcm__embed_ws *ws);
 
+/* Gather cell `id` of `mesh` with its size, tolerance and bounding box (widened by the
+ * tolerance) only: what a search for the cut triangles near it reads. */
+void fcm__embed_cell_box(const fcm_mesh *mesh, fcm_index id, double clip_rtol,
+                         fcm__embed_cell *cell);
+
 /* Gather cell `id` of `mesh` and compute its planes, size, tolerance, volume and map.
  * FCM_ERR_GEOMETRY when the corner polyhedron has no positive volume. */
 fcm_status fcm__embed_cell_setup(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index id, double clip_rtol,
@@ -573,6 +578,16 @@ typedef struct fcm__crossings {
   fcm__clear_box clear[FCM__CLEAR_BOXES];
   int nclear, next;
   int tries, found, skipped; /* the recent looks for a clear box, those that found one */
+  /* fcm__embed_inside_column()'s cell (col_key: its id, first corner and det A): col_face 1
+   * (-1) when no boundary triangle comes near its top (bottom) face, the winding number there
+   * col_winding; 0: neither; col_n triangles that may meet it, in its reference coordinates
+   * (col_x, 9 each) with their vertex ids (col_v, 3 each) */
+  double col_key[5];
+  const fcm_aabb_tree *col_tree;
+  int col_face, col_winding;
+  size_t col_n, col_cap;
+  double *col_x;
+  fcm_index *col_v;
 } fcm__crossings;
 
 void fcm__crossings_free(fcm_ctx *ctx, fcm__crossings *c);
@@ -633,6 +648,16 @@ fcm_status fcm__embed_inside_line(fcm_ctx *ctx, const fcm_geometry *g, const fcm
                                   const fcm__embed_cell *cell, double a, double b, int n,
                                   const double *z, int *inside, fcm__idbuf *buf,
                                   fcm__crossings *cr);
+
+/* fcm__embed_inside_line(), the same answers, for the columns of one hexahedral cell in turn:
+ * where no boundary triangle comes near the cell's top (or bottom) face, the winding number
+ * is the same all over that face (one line query for the cell), and a column's points take it
+ * with the crossings between them and the face, from the triangles that meet the cell only
+ * (kept in cr for the next column). Other cells: fcm__embed_inside_line(). */
+fcm_status fcm__embed_inside_column(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                    const fcm__embed_cell *cell, double a, double b, int n,
+                                    const double *z, int *inside, fcm__idbuf *buf,
+                                    fcm__crossings *cr);
 
 /* ---------------------------------------------------------------- parts of a surface body
  * (surface_parts.c) */

@@ -216,8 +216,8 @@ static fcm_status grid_candidates(const build *B, const fcm__embed_cell *cell, f
       }
       if (!any) continue;
       if (query)
-        FCM_TRY(ctx, fcm__embed_inside_line(ctx, B->geom, B->tri_tree, cell, a, b, np, z,
-                                            ws->cand_in, &ws->cand, ws->cr));
+        FCM_TRY(ctx, fcm__embed_inside_column(ctx, B->geom, B->tri_tree, cell, a, b, np, z,
+                                              ws->cand_in, &ws->cand, ws->cr));
       for (int k = 0; k < np; k++) {
         if (!where[k] || (query && ws->cand_in[k] != 1)) continue;
         double *x = ws->cand_x + 3 * (size_t)(*count)++;

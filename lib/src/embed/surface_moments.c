@@ -533,6 +533,11 @@ void fcm__crossings_free(fcm_ctx *ctx, fcm__crossings *c)
 {
   fcm__free(ctx, c->z);
   fcm__free(ctx, c->sign);
+  fcm__free(ctx, c->col_x);
+  fcm__free(ctx, c->col_v);
+  c->col_x = NULL, c->col_v = NULL;
+  c->col_n = c->col_cap = 0;
+  c->col_tree = NULL;
   c->z = NULL, c->sign = NULL;
   c->n = c->cap = 0;
   c->tree = NULL;
@@ -636,6 +641,110 @@ fcm_status fcm__embed_inside_line(fcm_ctx *ctx, const fcm_geometry *g, const fcm
   if (n == 1)
     FCM_TRY(ctx, clear_box_add(ctx, tree, x, CLEAR_BOX_RSIZE * cell->size, 2.0 * pad,
                                orient * inside[0], buf, cr));
+cleanup:
+  return st;
+}
+
+/* The physical bounding box of the reference face xi_3 = z of a hexahedral cell. */
+static void face_box(const fcm__embed_cell *cell, double z, double lo[3], double hi[3])
+{
+  for (int d = 0; d < 3; d++)
+    lo[d] = HUGE_VAL, hi[d] = -HUGE_VAL;
+  for (int c = 0; c < 4; c++) {
+    double x[3];
+    to_physical(cell, c & 1 ? 1.0 : -1.0, c & 2 ? 1.0 : -1.0, z, x);
+    for (int d = 0; d < 3; d++)
+      lo[d] = fmin(lo[d], x[d]), hi[d] = fmax(hi[d], x[d]);
+  }
+}
+
+/* Set cr's column cache up for cell (a hexahedron): which of its top and bottom faces no
+ * boundary triangle's box comes within the lines' rounding distance of (a bound on every
+ * column's, fcm__embed_inside_line()), the winding number there, and the triangles whose
+ * boxes meet the cell widened by that distance (each crossing of a column inside the cell is
+ * on one of them). */
+static fcm_status column_cell(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                              const fcm__embed_cell *cell, fcm__idbuf *buf, fcm__crossings *cr)
+{
+  fcm_status st = FCM_OK;
+  const double key[5] = {(double)cell->id, cell->X[0], cell->X[1], cell->X[2], cell->detA};
+  if (cr->col_tree == tree && !memcmp(key, cr->col_key, sizeof key)) return FCM_OK;
+  const double base[3] = {0.0, 0.0, 0.0}, dir[3] = {0.0, 0.0, 1.0};
+  double p0[3], p1[3], pad, lo[3], hi[3];
+  cr->col_tree = NULL;
+  cr->col_face = 0;
+  cr->col_n = 0;
+  /* a column's base is within the cell's diagonal of the centre's: its rounding distance
+   * (in the distance to the geometry's far corner plus the cell size) is at most 4 times */
+  line_segment(g, cell, base, dir, p0, p1, &pad);
+  pad *= 4.0;
+  for (int side = 1; side >= -1 && !cr->col_face; side -= 2) {
+    face_box(cell, side, lo, hi);
+    for (int d = 0; d < 3; d++)
+      lo[d] -= pad, hi[d] += pad;
+    FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, lo, hi, buf));
+    if (buf->n == 0) cr->col_face = side;
+  }
+  if (cr->col_face) {
+    const double zf[2] = {cr->col_face, cr->col_face};
+    int w[2];
+    FCM_TRY(ctx, fcm__embed_inside_line(ctx, g, tree, cell, 0.0, 0.0, 2, zf, w, buf, cr));
+    cr->col_winding = w[0];
+    for (int d = 0; d < 3; d++)
+      lo[d] = cell->lo[d] - pad, hi[d] = cell->hi[d] + pad;
+    FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, lo, hi, buf));
+    if (buf->n > cr->col_cap) {
+      void *x = cr->col_x, *v = cr->col_v;
+      FCM_TRY(ctx, fcm__resize(ctx, &x, 0, 9 * buf->n, sizeof(double)));
+      cr->col_x = x;
+      FCM_TRY(ctx, fcm__resize(ctx, &v, 0, 3 * buf->n, sizeof(fcm_index)));
+      cr->col_v = v;
+      cr->col_cap = buf->n;
+    }
+    for (size_t k = 0; k < buf->n; k++) {
+      rtri T;
+      load_tri(g, cell, buf->ids[k], &T);
+      memcpy(cr->col_x + 9 * k, T.x, sizeof T.x);
+      memcpy(cr->col_v + 3 * k, T.id, sizeof T.id);
+    }
+    cr->col_n = buf->n;
+  }
+  memcpy(cr->col_key, key, sizeof key);
+  cr->col_tree = tree;
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_inside_column(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                    const fcm__embed_cell *cell, double a, double b, int n,
+                                    const double *z, int *inside, fcm__idbuf *buf,
+                                    fcm__crossings *cr)
+{
+  fcm_status st = FCM_OK;
+  if (cell->info->shape != FCM_SHAPE_HEX || !cell->affine)
+    return fcm__embed_inside_line(ctx, g, tree, cell, a, b, n, z, inside, buf, cr);
+  FCM_TRY(ctx, column_cell(ctx, g, tree, cell, buf, cr));
+  if (!cr->col_face) return fcm__embed_inside_line(ctx, g, tree, cell, a, b, n, z, inside, buf, cr);
+  const lin l1 = mk(-a, 1, 0, 0), l2 = mk(-b, 0, 1, 0);
+  const int top = cr->col_face > 0;
+  for (int i = 0; i < n; i++)
+    inside[i] = cr->col_winding;
+  /* the winding number at z: the face's, plus the crossings at or above z below the top
+   * face, or less those at or above the bottom face below z */
+  for (size_t k = 0; k < cr->col_n; k++) {
+    rtri T;
+    double P[3], Q[3], X[3];
+    memcpy(T.x, cr->col_x + 9 * k, sizeof T.x);
+    memcpy(T.id, cr->col_v + 3 * k, sizeof T.id);
+    if (!tri_segment(&T, &l1, P, Q)) continue;
+    const int sg = seg_cross(P, Q, &l2, X);
+    if (!sg) continue;
+    for (int i = 0; i < n; i++)
+      if (top && X[2] >= z[i] && X[2] < 1.0)
+        inside[i] += sg;
+      else if (!top && X[2] >= -1.0 && X[2] < z[i])
+        inside[i] -= sg;
+  }
 cleanup:
   return st;
 }
