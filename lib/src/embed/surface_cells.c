@@ -138,8 +138,8 @@ static fcm_status piece_candidates(const build *B, const fcm__embed_cell *cell, 
         double *xi = ws->cand_x + 3 * (size_t)*count;
         FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, x, xi, &det));
         if (P->whole || !full)
-          FCM_TRY(ctx, fcm__embed_inside_line(ctx, B->geom, B->tri_tree, cell, xi[0], xi[1], 1,
-                                              xi + 2, &in, &ws->cand, ws->cr));
+          FCM_TRY(ctx, fcm__embed_inside_column(ctx, B->geom, B->tri_tree, cell, xi[0], xi[1], 1,
+                                                xi + 2, &in, &ws->cand, ws->cr));
         *count += in == 1;
       }
     }
@@ -153,8 +153,8 @@ static fcm_status piece_candidates(const build *B, const fcm__embed_cell *cell, 
     const int where = in_piece(cell, ws, xi);
     if (!where) continue; /* (the signed rule's points of other pieces) */
     if (where == 1)
-      FCM_TRY(ctx, fcm__embed_inside_line(ctx, B->geom, B->tri_tree, cell, xi[0], xi[1], 1, xi + 2,
-                                          &in, &ws->cand, ws->cr));
+      FCM_TRY(ctx, fcm__embed_inside_column(ctx, B->geom, B->tri_tree, cell, xi[0], xi[1], 1,
+                                            xi + 2, &in, &ws->cand, ws->cr));
     *count += in == 1;
   }
 cleanup:

@@ -440,7 +440,8 @@ static void line_segment(const fcm_geometry *g, const fcm__embed_cell *cell, con
       const double e = ((c >> d) & 1 ? g->hi[d] : g->lo[d]) - p[d];
       r2 += e * e;
     }
-    far = fmax(far, sqrt(r2));
+    const double r = sqrt(r2);
+    far = r > far ? r : far;
   }
   const double t = far / speed + 1.0;
   for (int d = 0; d < 3; d++)
@@ -471,10 +472,10 @@ static int line_half(const fcm_geometry *g, const fcm__embed_cell *cell, const d
   for (int d = 0; d < 3; d++) {
     p[d] += cell->X[d];
     const double lo = g->lo[d] - pad, hi = g->hi[d] + pad;
-    if (v[d] > 0.0)
-      up = fmin(up, (hi - p[d]) / v[d]), down = fmin(down, (p[d] - lo) / v[d]);
-    else if (v[d] < 0.0)
-      up = fmin(up, (lo - p[d]) / v[d]), down = fmin(down, (p[d] - hi) / v[d]);
+    if (v[d] == 0.0) continue;
+    const double u = ((v[d] > 0.0 ? hi : lo) - p[d]) / v[d],
+                 w = (p[d] - (v[d] > 0.0 ? lo : hi)) / v[d];
+    up = u < up ? u : up, down = w < down ? w : down;
   }
   /* t in the box: [-down, up] (empty when the line misses it) */
   const double top = fmax(up, zhi) + 1.0, bottom = fmin(-down, zlo) - 1.0;
@@ -632,7 +633,7 @@ fcm_status fcm__embed_inside_line(fcm_ctx *ctx, const fcm_geometry *g, const fcm
   }
   double zlo = z[0], zhi = z[0];
   for (int i = 1; i < n; i++)
-    zlo = fmin(zlo, z[i]), zhi = fmax(zhi, z[i]);
+    zlo = z[i] < zlo ? z[i] : zlo, zhi = z[i] > zhi ? z[i] : zhi;
   const int up = line_half(g, cell, base, dir, zlo, zhi, pad, p0, p1);
   FCM_TRY(ctx, fcm__geom_tree_segment(ctx, tree, p0, p1, pad, buf));
   FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &l1, &l2, cr, &sum));
@@ -791,7 +792,7 @@ fcm_status fcm__embed_material_box(fcm_ctx *ctx, const fcm_geometry *g, const fc
       const double a = i ? 1.0 : r.lo, b = j ? 1.0 : r.lo, z[2] = {r.lo, 1.0};
       const int nz = tet && i + j == 1 ? 1 : 2;
       int in[2];
-      FCM_TRY(ctx, fcm__embed_inside_line(ctx, g, tree, cell, a, b, nz, z, in, buf, cr));
+      FCM_TRY(ctx, fcm__embed_inside_column(ctx, g, tree, cell, a, b, nz, z, in, buf, cr));
       for (int k = 0; k < nz; k++) {
         const double x[3] = {a, b, z[k]};
         if (in[k] == 1) grow_box(box, x);
