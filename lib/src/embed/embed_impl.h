@@ -7,6 +7,7 @@
 #include "fcm/embed.h"
 #include "fcm/quad.h"
 #include "geom/geom_impl.h"
+#include "la/mat3.h"
 
 /* A cut triangle prepared for splitting: its plane (unit normal) and the three
  * planes through its edges perpendicular to it (outward: the triangle is where all three
@@ -206,6 +207,18 @@ fcm_status fcm__embed_append_tets(fcm_ctx *ctx, fcm__embed_ws *ws, const fcm__po
 /* Reference coordinates xi and det J_K(xi) of the physical point x. */
 fcm_status fcm__embed_to_reference(fcm_ctx *ctx, const fcm__embed_cell *cell, const double x[3],
                                    double xi[3], double *det);
+
+/* fcm__embed_to_reference() of an affine cell, the same bits, inline (the moment rules map
+ * every point of their fan tets). */
+static inline void fcm__embed_to_reference_affine(const fcm__embed_cell *cell, const double x[3],
+                                                  double xi[3])
+{
+  const double r[3] = {x[0] - cell->X[0], x[1] - cell->X[1], x[2] - cell->X[2]};
+  double s[3];
+  fcm__mat3_mulv(cell->Ainv, r, s);
+  for (int d = 0; d < 3; d++)
+    xi[d] = cell->xi0[d] + s[d];
+}
 
 /* Map the tet rule `rule` onto every tet of ws and into the reference cell: writes
  * ws->num_tets * rule points to pts (x 3) and reference weights to w. */
