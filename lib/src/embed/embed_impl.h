@@ -619,8 +619,9 @@ fcm_status fcm__embed_material_box(fcm_ctx *ctx, const fcm_geometry *g, const fc
  * from the triangles that meet the cell (surface_moments.c explains how). base (NULL: the
  * cell's lower bounds): where the antiderivative in each direction starts, valid when the
  * material lies at or above it (the lower corner of its box: the rule's points then stay in
- * the box). The surface's closedness is the geometry's (a line's crossings are taken on its
- * shorter half only). buf and cr are scratch. */
+ * the box). FCM_ERR_GEOMETRY when a line through the cell shows the surface is not closed (on
+ * a tree other than the geometry's own, fcm__geom_tree(): on that one a line's shorter half is
+ * taken, the geometry closed where it was made). buf and cr are scratch. */
 fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
                                   const fcm__embed_cell *cell, const fcm__moment_quad *q,
                                   const double base[3], fcm__idbuf *buf, fcm__crossings *cr,
@@ -662,7 +663,8 @@ fcm_status fcm__embed_inside_line(fcm_ctx *ctx, const fcm_geometry *g, const fcm
                                   const double *z, int *inside, fcm__idbuf *buf,
                                   fcm__crossings *cr);
 
-/* fcm__embed_inside_line(), the same answers, for the columns of one hexahedral cell in turn:
+/* fcm__embed_inside_line(), the same answers, for the columns of one hexahedral cell in turn
+ * (on the geometry's own tree of its boundary triangles, fcm__geom_tree(), and not a subset):
  * where no boundary triangle comes near the cell's top (or bottom) face, the winding number
  * is the same all over that face (one line query for the cell), and a column's points take it
  * with the crossings between them and the face, from the triangles that meet the cell only

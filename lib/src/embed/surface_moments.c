@@ -24,8 +24,11 @@
  * an edge or a vertex counts one crossing. Where two levels' rounding disagrees (a vertex
  * within rounding of a cell plane) the integrals differ by a region of rounding size: the
  * result is continuous in the vertex positions, so no decision can make it grossly wrong. The
- * surface must be closed and consistently oriented (the geometry checks it): a point's winding
- * number is then the sum of the signed crossings on either half of a line through it. */
+ * surface must be closed and consistently oriented: a point's winding number is then the sum
+ * of the signed crossings on either half of a line through it. On the geometry's own tree of a
+ * geometry that is not a subset (closed where it was made) a line's shorter half is taken;
+ * on another tree the whole line, and crossings that do not sum to zero say the surface is not
+ * closed. */
 #include "embed/embed_impl.h"
 #include "la/mat3.h"
 
@@ -461,6 +464,15 @@ static void line_segment(const fcm_geometry *g, const fcm__embed_cell *cell, con
  * the segment: a closed surface's crossings at and beyond t sum to minus those before t, so
  * either half gives the winding numbers along [zlo, zhi], and a line near the body's top or
  * side visits a fraction of the tree's nodes the whole line would. */
+/* Whether tree is g's own tree of its boundary triangles and g not a subset of another
+ * geometry's: a closed surface (checked where the geometry was made; a subset's boundary is
+ * part of one). Lines take their shorter half on it only; on other trees the whole line, whose
+ * crossings must sum to zero. */
+static int closed_tree(const fcm_geometry *g, const fcm_aabb_tree *tree)
+{
+  return tree == g->trees[1] && !g->tri_orig;
+}
+
 static int line_half(const fcm_geometry *g, const fcm__embed_cell *cell, const double base[3],
                      const double dir[3], double zlo, double zhi, double pad, double p0[3],
                      double p1[3])
@@ -634,9 +646,14 @@ fcm_status fcm__embed_inside_line(fcm_ctx *ctx, const fcm_geometry *g, const fcm
   double zlo = z[0], zhi = z[0];
   for (int i = 1; i < n; i++)
     zlo = z[i] < zlo ? z[i] : zlo, zhi = z[i] > zhi ? z[i] : zhi;
-  const int up = line_half(g, cell, base, dir, zlo, zhi, pad, p0, p1);
+  const int half = closed_tree(g, tree);
+  const int up = half ? line_half(g, cell, base, dir, zlo, zhi, pad, p0, p1) : 1;
   FCM_TRY(ctx, fcm__geom_tree_segment(ctx, tree, p0, p1, pad, buf));
   FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &l1, &l2, cr, &sum));
+  FCM_CHECK(half || sum == 0, ctx, FCM_ERR_GEOMETRY,
+            "embed: background cell %lld: a line through the body crosses its boundary %d more "
+            "times outward than inward (the boundary surface is not closed)",
+            (long long)cell->id, sum);
   for (int i = 0; i < n; i++) /* crossings at or beyond z[i], leaving counted +1 */
     inside[i] = line_winding(cr, up, z[i]);
   if (n == 1)
@@ -722,7 +739,7 @@ fcm_status fcm__embed_inside_column(fcm_ctx *ctx, const fcm_geometry *g, const f
                                     fcm__crossings *cr)
 {
   fcm_status st = FCM_OK;
-  if (cell->info->shape != FCM_SHAPE_HEX || !cell->affine)
+  if (cell->info->shape != FCM_SHAPE_HEX || !cell->affine || !closed_tree(g, tree))
     return fcm__embed_inside_line(ctx, g, tree, cell, a, b, n, z, inside, buf, cr);
   FCM_TRY(ctx, column_cell(ctx, g, tree, cell, buf, cr));
   if (!cr->col_face) return fcm__embed_inside_line(ctx, g, tree, cell, a, b, n, z, inside, buf, cr);
@@ -858,13 +875,18 @@ static fcm_status moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aab
     cb = clear_box_find(cr, tree, P, pad);
   }
   int up = 1;
+  const int half = closed_tree(g, tree);
   if (cb) /* the crossings inside the edge only */
     to_physical(cell, lbase[0] + r.lo * dir[0], lbase[1] + r.lo * dir[1], lbase[2] + r.lo * dir[2],
                 p0);
-  else /* the edge and the shorter half of the line beyond it */
+  else if (half) /* the edge and the shorter half of the line beyond it */
     up = line_half(g, cell, lbase, dir, r.lo, 1.0, pad, p0, p1);
   FCM_TRY(ctx, fcm__geom_tree_segment(ctx, tree, p0, cb ? P : p1, pad, buf));
   FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &r.exit1, &r.exit2, cr, &sum));
+  FCM_CHECK(cb || half || sum == 0, ctx, FCM_ERR_GEOMETRY,
+            "embed: background cell %lld: its edge line crosses the body's boundary %d more "
+            "times outward than inward (the boundary surface is not closed)",
+            (long long)cell->id, sum);
   for (size_t k = 0; k < cr->n; k++) {
     const double z = cr->z[k];
     if (z > r.lo && z < 1.0) {
