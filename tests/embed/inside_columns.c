@@ -113,8 +113,9 @@ static void column(fcm_ctx *ctx, const fcm_geometry *g, const trees *tr,
     const int want = ref ? ball_answer(ref, x) : -1;
     if (want < 0) continue;
     t->checked++;
-    CHECK(in_line[i] == want, "%s, cell %lld: the point (%g, %g, %g) is %s the ball, the test says %d",
-          what, (long long)cell->id, x[0], x[1], x[2], want ? "inside" : "outside", in_line[i]);
+    CHECK(in_line[i] == want,
+          "%s, cell %lld: the point (%g, %g, %g) is %s the ball, the test says %d", what,
+          (long long)cell->id, x[0], x[1], x[2], want ? "inside" : "outside", in_line[i]);
   }
   fcm__geom_idbuf_free(ctx, &fbuf);
   fcm__crossings_free(ctx, &fresh);
