@@ -692,8 +692,9 @@ static fcm_status column_cell(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aab
   cr->col_tree = NULL;
   cr->col_face = 0;
   cr->col_n = 0;
-  /* a column's base is within the cell's diagonal of the centre's: its rounding distance
-   * (in the distance to the geometry's far corner plus the cell size) is at most 4 times */
+  /* a column's base lies within the cell's size (its box's diagonal) of the centre's, so its
+   * rounding distance (the distance to the geometry's far corner, plus the size) is at most
+   * twice the centre's: four times, with room */
   line_segment(g, cell, base, dir, p0, p1, &pad);
   pad *= 4.0;
   for (int side = 1; side >= -1 && !cr->col_face; side -= 2) {
