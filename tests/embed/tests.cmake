@@ -73,6 +73,12 @@ fcm_add_test(embed_sliver_lines tests/embed/sliver_lines.c)
 # every part (a ball's and a hollow ball's cells, whole and halved) the bits of each tet's own
 # moment rule, inside tests as with a fresh scratch; the volumes add up to the cells' (1e-12 |K|).
 fcm_add_test(embed_clear_tets tests/embed/clear_tets.c)
+# The inside test of a cell's columns (the winding number of a clear top or bottom face and the
+# cell's own triangles, kept from column to column) and of the shorter half of a line through
+# the points on the geometry's own tree, against the whole line on another tree: the same answer
+# for every point of Hex8 and Tet4 cells over a ball and a hollow ball with holes, the ball's own
+# answer away from its surface, both faces and the fallback exercised.
+fcm_add_test(embed_inside_columns tests/embed/inside_columns.c)
 # A geometry of its boundary surface alone (volume_mesh = 0): global moments equal the exact
 # polyhedron integrals (Hex8, Tet4, Hex20), the volume beyond each side of the grid from the
 # surface equals the tets', a cut and the volume path refuse it.

@@ -192,8 +192,8 @@ fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new
   if (B->prev) FCM_ALLOC(ctx, (size_t)nc + 1, B->rebuild);
   if (B->prev && first_new > 0) FCM_ALLOC(ctx, (size_t)nc + 1, B->prev_region);
   for (fcm_index c = 0; c < nc; c++) {
-    fcm__embed_cell cell;
-    FCM_TRY(ctx, fcm__embed_cell_setup(ctx, mesh, c, B->o->clip_rtol, &cell));
+    fcm__embed_cell cell; /* its box only: the checks of its set-up come with its own work */
+    fcm__embed_cell_box(mesh, c, B->o->clip_rtol, &cell);
     FCM_TRY(ctx, fcm__embed_cut_candidates(ctx, B->cut_tree, &cell, &ids));
     if (ids.n == 0) continue;
     R->reached[c] = 1;
@@ -301,6 +301,7 @@ static fcm_status face_links(const build *B, const fcm_cell_rules *R, const cell
     xa += (size_t)(ma[2] + ma[3]);
     if (ma[0] != f || ma[1] < 0) continue;
     size_t xb = 0;
+    int queried = 0; /* tc holds the cut triangles near polygon i */
     for (int j = 0; j < ob->nfp; j++) {
       const int *mb = ob->fmeta + 4 * j;
       const double *Bx = ob->fx + 3 * xb;
@@ -312,13 +313,16 @@ static fcm_status face_links(const build *B, const fcm_cell_rules *R, const cell
       for (size_t l = *nl; l-- > nl0 && !known;)
         known = (*links)[2 * l] == pa && (*links)[2 * l + 1] == pb;
       if (known) continue;
-      double lo[3], hi[3];
-      for (int d = 0; d < 3; d++) {
-        lo[d] = HUGE_VAL, hi[d] = -HUGE_VAL;
-        for (int k = 0; k < ma[2]; k++)
-          lo[d] = fmin(lo[d], A[3 * k + d] - mtol), hi[d] = fmax(hi[d], A[3 * k + d] + mtol);
+      if (!queried) {
+        double lo[3], hi[3];
+        for (int d = 0; d < 3; d++) {
+          lo[d] = HUGE_VAL, hi[d] = -HUGE_VAL;
+          for (int k = 0; k < ma[2]; k++)
+            lo[d] = fmin(lo[d], A[3 * k + d] - mtol), hi[d] = fmax(hi[d], A[3 * k + d] + mtol);
+        }
+        FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, lo, hi, tc));
+        queried = 1;
       }
-      FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, lo, hi, tc));
       if (!fcm__embed_linked(A, ma[2], A + 3 * ma[2], ma[3], Bx, mb[2], Bx + 3 * mb[2], mb[3], nbn,
                              mtol, atol, B->cut_tris, tc->ids, tc->n))
         continue;

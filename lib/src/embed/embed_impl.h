@@ -7,6 +7,7 @@
 #include "fcm/embed.h"
 #include "fcm/quad.h"
 #include "geom/geom_impl.h"
+#include "la/mat3.h"
 
 /* A cut triangle prepared for splitting: its plane (unit normal) and the three
  * planes through its edges perpendicular to it (outward: the triangle is where all three
@@ -133,6 +134,11 @@ void fcm__embed_ws_free(fcm_ctx *ctx, fcm__embed_ws *ws);
 /* The surface path's part of ws (surface_cells.c). */
 void fcm__embed_surface_ws_free(fcm_ctx *ctx, fcm__embed_ws *ws);
 
+/* Gather cell `id` of `mesh` with its size, tolerance and bounding box (widened by the
+ * tolerance) only: what a search for the cut triangles near it reads. */
+void fcm__embed_cell_box(const fcm_mesh *mesh, fcm_index id, double clip_rtol,
+                         fcm__embed_cell *cell);
+
 /* Gather cell `id` of `mesh` and compute its planes, size, tolerance, volume and map.
  * FCM_ERR_GEOMETRY when the corner polyhedron has no positive volume. */
 fcm_status fcm__embed_cell_setup(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index id, double clip_rtol,
@@ -202,6 +208,18 @@ fcm_status fcm__embed_append_tets(fcm_ctx *ctx, fcm__embed_ws *ws, const fcm__po
 /* Reference coordinates xi and det J_K(xi) of the physical point x. */
 fcm_status fcm__embed_to_reference(fcm_ctx *ctx, const fcm__embed_cell *cell, const double x[3],
                                    double xi[3], double *det);
+
+/* fcm__embed_to_reference() of an affine cell, the same bits, inline (the moment rules map
+ * every point of their fan tets). */
+static inline void fcm__embed_to_reference_affine(const fcm__embed_cell *cell, const double x[3],
+                                                  double xi[3])
+{
+  const double r[3] = {x[0] - cell->X[0], x[1] - cell->X[1], x[2] - cell->X[2]};
+  double s[3];
+  fcm__mat3_mulv(cell->Ainv, r, s);
+  for (int d = 0; d < 3; d++)
+    xi[d] = cell->xi0[d] + s[d];
+}
 
 /* Map the tet rule `rule` onto every tet of ws and into the reference cell: writes
  * ws->num_tets * rule points to pts (x 3) and reference weights to w. */
@@ -574,6 +592,16 @@ typedef struct fcm__crossings {
   fcm__clear_box clear[FCM__CLEAR_BOXES];
   int nclear, next;
   int tries, found, skipped; /* the recent looks for a clear box, those that found one */
+  /* fcm__embed_inside_column()'s cell (col_key: its id, first corner and det A): col_face 1
+   * (-1) when no boundary triangle comes near its top (bottom) face, the winding number there
+   * col_winding; 0: neither; col_n triangles that may meet it, in its reference coordinates
+   * (col_x, 9 each) with their vertex ids (col_v, 3 each) */
+  double col_key[5];
+  const fcm_aabb_tree *col_tree;
+  int col_face, col_winding;
+  size_t col_n, col_cap;
+  double *col_x;
+  fcm_index *col_v;
 } fcm__crossings;
 
 void fcm__crossings_free(fcm_ctx *ctx, fcm__crossings *c);
@@ -592,8 +620,9 @@ fcm_status fcm__embed_material_box(fcm_ctx *ctx, const fcm_geometry *g, const fc
  * from the triangles that meet the cell (surface_moments.c explains how). base (NULL: the
  * cell's lower bounds): where the antiderivative in each direction starts, valid when the
  * material lies at or above it (the lower corner of its box: the rule's points then stay in
- * the box). FCM_ERR_GEOMETRY when a line through the cell shows the surface is not closed.
- * buf and cr are scratch. */
+ * the box). FCM_ERR_GEOMETRY when a line through the cell shows the surface is not closed (on
+ * a tree other than the geometry's own, fcm__geom_tree(): on that one a line's shorter half is
+ * taken, the geometry closed where it was made). buf and cr are scratch. */
 fcm_status fcm__embed_moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
                                   const fcm__embed_cell *cell, const fcm__moment_quad *q,
                                   const double base[3], fcm__idbuf *buf, fcm__crossings *cr,
@@ -634,6 +663,17 @@ fcm_status fcm__embed_inside_line(fcm_ctx *ctx, const fcm_geometry *g, const fcm
                                   const fcm__embed_cell *cell, double a, double b, int n,
                                   const double *z, int *inside, fcm__idbuf *buf,
                                   fcm__crossings *cr);
+
+/* fcm__embed_inside_line(), the same answers, for the columns of one hexahedral cell in turn
+ * (on the geometry's own tree of its boundary triangles, fcm__geom_tree(), and not a subset):
+ * where no boundary triangle comes near the cell's top (or bottom) face, the winding number
+ * is the same all over that face (one line query for the cell), and a column's points take it
+ * with the crossings between them and the face, from the triangles that meet the cell only
+ * (kept in cr for the next column). Other cells: fcm__embed_inside_line(). */
+fcm_status fcm__embed_inside_column(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                    const fcm__embed_cell *cell, double a, double b, int n,
+                                    const double *z, int *inside, fcm__idbuf *buf,
+                                    fcm__crossings *cr);
 
 /* ---------------------------------------------------------------- parts of a surface body
  * (surface_parts.c) */

@@ -30,27 +30,34 @@ void fcm__embed_ws_free(fcm_ctx *ctx, fcm__embed_ws *ws)
   ws->num_tets = ws->tet_cap = ws->num_spts = ws->spt_cap = 0;
 }
 
-fcm_status fcm__embed_cell_setup(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index id, double clip_rtol,
-                                 fcm__embed_cell *cell)
+void fcm__embed_cell_box(const fcm_mesh *mesh, fcm_index id, double clip_rtol,
+                         fcm__embed_cell *cell)
 {
-  fcm_status st = FCM_OK;
-  fcm__poly p;
   cell->type = fcm_mesh_element_type(mesh);
   cell->info = fcm_mesh_get_element_info(mesh);
   cell->id = id;
   fcm_mesh_cell_coords(mesh, id, cell->X);
   const int nc = cell->info->num_corners;
-  cell->num_planes = fcm__geom_cell_planes(cell->info, cell->X, cell->planes);
   cell->size = fcm__element_cell_size(nc, cell->X);
   cell->tol = clip_rtol * cell->size;
   for (int d = 0; d < 3; d++) {
-    cell->lo[d] = HUGE_VAL, cell->hi[d] = -HUGE_VAL;
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
     for (int a = 0; a < nc; a++) {
-      cell->lo[d] = fmin(cell->lo[d], cell->X[3 * a + d]);
-      cell->hi[d] = fmax(cell->hi[d], cell->X[3 * a + d]);
+      const double x = cell->X[3 * a + d];
+      lo = x < lo ? x : lo, hi = x > hi ? x : hi;
     }
-    cell->lo[d] -= cell->tol, cell->hi[d] += cell->tol;
+    cell->lo[d] = lo - cell->tol, cell->hi[d] = hi + cell->tol;
   }
+}
+
+fcm_status fcm__embed_cell_setup(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index id, double clip_rtol,
+                                 fcm__embed_cell *cell)
+{
+  fcm_status st = FCM_OK;
+  fcm__poly p;
+  fcm__embed_cell_box(mesh, id, clip_rtol, cell);
+  const int nc = cell->info->num_corners;
+  cell->num_planes = fcm__geom_cell_planes(cell->info, cell->X, cell->planes);
   fcm__geom_poly_from_cell(nc == 4 ? FCM_ELEMENT_TET4 : FCM_ELEMENT_HEX8, cell->X, &p);
   cell->volume = fcm__geom_poly_volume(&p);
   FCM_CHECK(cell->volume > 0.0 && isfinite(cell->volume), ctx, FCM_ERR_GEOMETRY,

@@ -57,8 +57,10 @@ cleanup:
 
 /* Whether the reference point xi lies in piece ws->cand_piece of ws->cand_parts (in one of
  * its parts, within the part's tolerance): 0 outside, 2 in a part the body fills, 1 in
- * another; 1 without a piece to test. */
-static int in_piece(const fcm__embed_cell *cell, const fcm__embed_ws *ws, const double xi[3])
+ * another; 1 without a piece to test. A part's plane that puts the point outside moves to the
+ * front of its planes: the next point (of the same grid column, mostly) likely lies beyond it
+ * too, and the order of the tests does not change their conjunction. */
+static int in_piece(const fcm__embed_cell *cell, fcm__embed_ws *ws, const double xi[3])
 {
   if (!ws->cand_parts) return 1;
   const double s[3] = {xi[0] - cell->xi0[0], xi[1] - cell->xi0[1], xi[2] - cell->xi0[2]};
@@ -69,7 +71,8 @@ static int in_piece(const fcm__embed_cell *cell, const fcm__embed_ws *ws, const 
   int found = 0;
   for (size_t k = 0; k < ws->cand_npl;) { /* per part: faces c, tolerance, full, c planes */
     const size_t c = (size_t)ws->cand_pl[k];
-    const double tol = ws->cand_pl[k + 1], *pl = ws->cand_pl + k + 3;
+    const double tol = ws->cand_pl[k + 1];
+    double *pl = ws->cand_pl + k + 3;
     size_t f = 0;
     while (f < c &&
            pl[4 * f] * x[0] + pl[4 * f + 1] * x[1] + pl[4 * f + 2] * x[2] - pl[4 * f + 3] <= tol)
@@ -77,6 +80,11 @@ static int in_piece(const fcm__embed_cell *cell, const fcm__embed_ws *ws, const 
     if (f == c) {
       if (ws->cand_pl[k + 2] != 0.0) return 2;
       found = 1;
+    } else if (f > 0) {
+      double t[4];
+      memcpy(t, pl, sizeof t);
+      memcpy(pl, pl + 4 * f, sizeof t);
+      memcpy(pl + 4 * f, t, sizeof t);
     }
     k += 3 + 4 * c;
   }
@@ -138,8 +146,8 @@ static fcm_status piece_candidates(const build *B, const fcm__embed_cell *cell, 
         double *xi = ws->cand_x + 3 * (size_t)*count;
         FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, x, xi, &det));
         if (P->whole || !full)
-          FCM_TRY(ctx, fcm__embed_inside_line(ctx, B->geom, B->tri_tree, cell, xi[0], xi[1], 1,
-                                              xi + 2, &in, &ws->cand, ws->cr));
+          FCM_TRY(ctx, fcm__embed_inside_column(ctx, B->geom, B->tri_tree, cell, xi[0], xi[1], 1,
+                                                xi + 2, &in, &ws->cand, ws->cr));
         *count += in == 1;
       }
     }
@@ -153,8 +161,8 @@ static fcm_status piece_candidates(const build *B, const fcm__embed_cell *cell, 
     const int where = in_piece(cell, ws, xi);
     if (!where) continue; /* (the signed rule's points of other pieces) */
     if (where == 1)
-      FCM_TRY(ctx, fcm__embed_inside_line(ctx, B->geom, B->tri_tree, cell, xi[0], xi[1], 1, xi + 2,
-                                          &in, &ws->cand, ws->cr));
+      FCM_TRY(ctx, fcm__embed_inside_column(ctx, B->geom, B->tri_tree, cell, xi[0], xi[1], 1,
+                                            xi + 2, &in, &ws->cand, ws->cr));
     *count += in == 1;
   }
 cleanup:
@@ -216,8 +224,8 @@ static fcm_status grid_candidates(const build *B, const fcm__embed_cell *cell, f
       }
       if (!any) continue;
       if (query)
-        FCM_TRY(ctx, fcm__embed_inside_line(ctx, B->geom, B->tri_tree, cell, a, b, np, z,
-                                            ws->cand_in, &ws->cand, ws->cr));
+        FCM_TRY(ctx, fcm__embed_inside_column(ctx, B->geom, B->tri_tree, cell, a, b, np, z,
+                                              ws->cand_in, &ws->cand, ws->cr));
       for (int k = 0; k < np; k++) {
         if (!where[k] || (query && ws->cand_in[k] != 1)) continue;
         double *x = ws->cand_x + 3 * (size_t)(*count)++;
@@ -500,11 +508,14 @@ static fcm_status full_part_rule(const build *B, const fcm__embed_cell *cell, co
     const double *T = tets + 12 * t;
     for (int q = 0; q < nq; q++) {
       const double *e = eta + 3 * q;
-      double x[3], det;
+      double x[3], det = cell->detA;
       for (int d = 0; d < 3; d++)
         x[d] =
             T[d] + e[0] * (T[3 + d] - T[d]) + e[1] * (T[6 + d] - T[d]) + e[2] * (T[9 + d] - T[d]);
-      FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, x, s->x + 3 * s->n, &det));
+      if (cell->affine)
+        fcm__embed_to_reference_affine(cell, x, s->x + 3 * s->n);
+      else
+        FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, x, s->x + 3 * s->n, &det));
       s->w[s->n++] = l[q] * 6.0 * vol[t] / det;
     }
   }

@@ -24,8 +24,11 @@
  * an edge or a vertex counts one crossing. Where two levels' rounding disagrees (a vertex
  * within rounding of a cell plane) the integrals differ by a region of rounding size: the
  * result is continuous in the vertex positions, so no decision can make it grossly wrong. The
- * surface must be closed and consistently oriented; a line whose crossings do not sum to zero
- * says it is not. */
+ * surface must be closed and consistently oriented: a point's winding number is then the sum
+ * of the signed crossings on either half of a line through it. On the geometry's own tree of a
+ * geometry that is not a subset (closed where it was made) a line's shorter half is taken;
+ * on another tree the whole line, and crossings that do not sum to zero say the surface is not
+ * closed. */
 #include "embed/embed_impl.h"
 #include "la/mat3.h"
 
@@ -116,80 +119,6 @@ static double exit2_at(const ref_cell *r, double x3)
 }
 
 /* ---------------------------------------------------------------- the quadratures */
-
-static fcm_status unit_gauss(fcm_ctx *ctx, int degree, int *n, double **t, double **a)
-{
-  fcm_status st = FCM_OK;
-  fcm_rule *g = NULL;
-  FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_LINE, degree, &g));
-  *n = fcm_rule_num_points(g);
-  FCM_ALLOC(ctx, (size_t)*n, *t);
-  FCM_ALLOC(ctx, (size_t)*n, *a);
-  for (int i = 0; i < *n; i++) { /* [-1, 1] -> [0, 1] */
-    (*t)[i] = 0.5 * (fcm_rule_points(g)[i] + 1.0);
-    (*a)[i] = 0.5 * fcm_rule_weights(g)[i];
-  }
-cleanup:
-  fcm_rule_destroy(&g);
-  return st;
-}
-
-fcm_status fcm__moment_quad_create(fcm_ctx *ctx, int m, fcm__moment_quad *q)
-{
-  fcm_status st = FCM_OK;
-  fcm_rule *tri = NULL;
-  memset(q, 0, sizeof *q);
-  q->m = m;
-  for (int l = 0; l < 3; l++)
-    FCM_TRY(ctx, unit_gauss(ctx, m + l, q->ng + l, q->gt + l, q->ga + l));
-  FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TRI, m + 1, &tri));
-  q->nt = fcm_rule_num_points(tri);
-  FCM_ALLOC(ctx, 2 * (size_t)q->nt, q->tx);
-  FCM_ALLOC(ctx, (size_t)q->nt, q->tw);
-  memcpy(q->tx, fcm_rule_points(tri), 2 * (size_t)q->nt * sizeof *q->tx);
-  memcpy(q->tw, fcm_rule_weights(tri), (size_t)q->nt * sizeof *q->tw);
-cleanup:
-  fcm_rule_destroy(&tri);
-  if (st != FCM_OK) fcm__moment_quad_free(ctx, q);
-  return st;
-}
-
-void fcm__moment_quad_free(fcm_ctx *ctx, fcm__moment_quad *q)
-{
-  for (int l = 0; l < 3; l++) {
-    fcm__free(ctx, q->gt[l]);
-    fcm__free(ctx, q->ga[l]);
-    q->gt[l] = q->ga[l] = NULL;
-  }
-  fcm__free(ctx, q->tx);
-  fcm__free(ctx, q->tw);
-  q->tx = q->tw = NULL;
-}
-
-void fcm__srule_free(fcm_ctx *ctx, fcm__srule *s)
-{
-  fcm__free(ctx, s->x);
-  fcm__free(ctx, s->w);
-  s->x = s->w = NULL;
-  s->n = s->cap = 0;
-}
-
-fcm_status fcm__srule_room(fcm_ctx *ctx, fcm__srule *s, size_t more)
-{
-  fcm_status st = FCM_OK;
-  if (s->n + more <= s->cap) return FCM_OK;
-  size_t cap = s->cap ? s->cap : 1024;
-  while (cap < s->n + more)
-    cap *= 2;
-  void *x = s->x, *w = s->w;
-  FCM_TRY(ctx, fcm__resize(ctx, &x, 3 * s->n, 3 * cap, sizeof(double)));
-  s->x = x;
-  FCM_TRY(ctx, fcm__resize(ctx, &w, s->n, cap, sizeof(double)));
-  s->w = w;
-  s->cap = cap;
-cleanup:
-  return st;
-}
 
 /* W * F(y): F(y) = int_lo^y_1 f(t, y_2, y_3) dt (degree m in t). */
 static fcm_status add_column(fcm_ctx *ctx, const fcm__moment_quad *q, double lo, const double y[3],
@@ -440,7 +369,8 @@ static void line_segment(const fcm_geometry *g, const fcm__embed_cell *cell, con
       const double e = ((c >> d) & 1 ? g->hi[d] : g->lo[d]) - p[d];
       r2 += e * e;
     }
-    far = fmax(far, sqrt(r2));
+    const double r = sqrt(r2);
+    far = r > far ? r : far;
   }
   const double t = far / speed + 1.0;
   for (int d = 0; d < 3; d++)
@@ -450,6 +380,58 @@ static void line_segment(const fcm_geometry *g, const fcm__embed_cell *cell, con
     na += cell->A[k] * cell->A[k], ni += cell->Ainv[k] * cell->Ainv[k];
   const double rel = 1e-9 + 64.0 * DBL_EPSILON * sqrt(na * ni);
   *pad = rel * (far + cell->size);
+}
+
+/* The half of the reference line base + t dir beyond the values [zlo, zhi] of t that is the
+ * shorter inside the geometry's bounding box (widened by pad), as a physical segment p0 -> p1
+ * with a reference length of margin at each end: 1 when it runs up (t from zlo - 1 to the
+ * box's far side), 0 when down (to zhi + 1). The crossings with the boundary on it are those
+ * at t >= zlo (up) or t <= zhi (down) of the whole line, each from a triangle whose box meets
+ * the segment: a closed surface's crossings at and beyond t sum to minus those before t, so
+ * either half gives the winding numbers along [zlo, zhi], and a line near the body's top or
+ * side visits a fraction of the tree's nodes the whole line would. */
+/* Whether tree is g's own tree of its boundary triangles and g not a subset of another
+ * geometry's: a closed surface (checked where the geometry was made; a subset's boundary is
+ * part of one). Lines take their shorter half on it only; on other trees the whole line, whose
+ * crossings must sum to zero. */
+static int closed_tree(const fcm_geometry *g, const fcm_aabb_tree *tree)
+{
+  return tree == g->trees[1] && !g->tri_orig;
+}
+
+static int line_half(const fcm_geometry *g, const fcm__embed_cell *cell, const double base[3],
+                     const double dir[3], double zlo, double zhi, double pad, double p0[3],
+                     double p1[3])
+{
+  double p[3], v[3], up = HUGE_VAL, down = HUGE_VAL;
+  const double x0[3] = {base[0] - cell->xi0[0], base[1] - cell->xi0[1], base[2] - cell->xi0[2]};
+  fcm__mat3_mulv(cell->A, x0, p);
+  fcm__mat3_mulv(cell->A, dir, v);
+  for (int d = 0; d < 3; d++) {
+    p[d] += cell->X[d];
+    const double lo = g->lo[d] - pad, hi = g->hi[d] + pad;
+    if (v[d] == 0.0) continue;
+    const double u = ((v[d] > 0.0 ? hi : lo) - p[d]) / v[d],
+                 w = (p[d] - (v[d] > 0.0 ? lo : hi)) / v[d];
+    up = u < up ? u : up, down = w < down ? w : down;
+  }
+  /* t in the box: [-down, up] (empty when the line misses it) */
+  const double top = fmax(up, zhi) + 1.0, bottom = fmin(-down, zlo) - 1.0;
+  const int is_up = !(zhi + 1.0 - bottom < top - (zlo - 1.0));
+  const double t0 = is_up ? zlo - 1.0 : bottom, t1 = is_up ? top : zhi + 1.0;
+  for (int d = 0; d < 3; d++)
+    p0[d] = p[d] + t0 * v[d], p1[d] = p[d] + t1 * v[d];
+  return is_up;
+}
+
+/* The winding number at t = z of the line whose crossings (at cr->z, signs cr->sign) were
+ * found on its half up (all at t >= z counted) or down (all at t < z counted, negated). */
+static int line_winding(const fcm__crossings *cr, int up, double z)
+{
+  int w = 0;
+  for (size_t k = 0; k < cr->n; k++)
+    if ((cr->z[k] >= z) == up) w += cr->sign[k];
+  return up ? w : -w;
 }
 
 /* The crossings of the body's boundary with the line {l1 = 0, l2 = 0} (base + t dir), as
@@ -490,6 +472,11 @@ void fcm__crossings_free(fcm_ctx *ctx, fcm__crossings *c)
 {
   fcm__free(ctx, c->z);
   fcm__free(ctx, c->sign);
+  fcm__free(ctx, c->col_x);
+  fcm__free(ctx, c->col_v);
+  c->col_x = NULL, c->col_v = NULL;
+  c->col_n = c->col_cap = 0;
+  c->col_tree = NULL;
   c->z = NULL, c->sign = NULL;
   c->n = c->cap = 0;
   c->tree = NULL;
@@ -582,21 +569,127 @@ fcm_status fcm__embed_inside_line(fcm_ctx *ctx, const fcm_geometry *g, const fcm
       return FCM_OK;
     }
   }
+  double zlo = z[0], zhi = z[0];
+  for (int i = 1; i < n; i++)
+    zlo = z[i] < zlo ? z[i] : zlo, zhi = z[i] > zhi ? z[i] : zhi;
+  const int half = closed_tree(g, tree);
+  const int up = half ? line_half(g, cell, base, dir, zlo, zhi, pad, p0, p1) : 1;
   FCM_TRY(ctx, fcm__geom_tree_segment(ctx, tree, p0, p1, pad, buf));
   FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &l1, &l2, cr, &sum));
-  FCM_CHECK(sum == 0, ctx, FCM_ERR_GEOMETRY,
+  FCM_CHECK(half || sum == 0, ctx, FCM_ERR_GEOMETRY,
             "embed: background cell %lld: a line through the body crosses its boundary %d more "
             "times outward than inward (the boundary surface is not closed)",
             (long long)cell->id, sum);
-  for (int i = 0; i < n; i++) {
-    int w = 0; /* crossings at or beyond z[i], leaving counted +1: the winding number */
-    for (size_t k = 0; k < cr->n; k++)
-      if (cr->z[k] >= z[i]) w += cr->sign[k];
-    inside[i] = w;
-  }
+  for (int i = 0; i < n; i++) /* crossings at or beyond z[i], leaving counted +1 */
+    inside[i] = line_winding(cr, up, z[i]);
   if (n == 1)
     FCM_TRY(ctx, clear_box_add(ctx, tree, x, CLEAR_BOX_RSIZE * cell->size, 2.0 * pad,
                                orient * inside[0], buf, cr));
+cleanup:
+  return st;
+}
+
+/* The physical bounding box of the reference face xi_3 = z of a hexahedral cell. */
+static void face_box(const fcm__embed_cell *cell, double z, double lo[3], double hi[3])
+{
+  for (int d = 0; d < 3; d++)
+    lo[d] = HUGE_VAL, hi[d] = -HUGE_VAL;
+  for (int c = 0; c < 4; c++) {
+    double x[3];
+    to_physical(cell, c & 1 ? 1.0 : -1.0, c & 2 ? 1.0 : -1.0, z, x);
+    for (int d = 0; d < 3; d++)
+      lo[d] = fmin(lo[d], x[d]), hi[d] = fmax(hi[d], x[d]);
+  }
+}
+
+/* Set cr's column cache up for cell (a hexahedron): which of its top and bottom faces no
+ * boundary triangle's box comes within the lines' rounding distance of (a bound on every
+ * column's, fcm__embed_inside_line()), the winding number there, and the triangles whose
+ * boxes meet the cell widened by that distance (each crossing of a column inside the cell is
+ * on one of them). */
+static fcm_status column_cell(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                              const fcm__embed_cell *cell, fcm__idbuf *buf, fcm__crossings *cr)
+{
+  fcm_status st = FCM_OK;
+  const double key[5] = {(double)cell->id, cell->X[0], cell->X[1], cell->X[2], cell->detA};
+  if (cr->col_tree == tree && !memcmp(key, cr->col_key, sizeof key)) return FCM_OK;
+  const double base[3] = {0.0, 0.0, 0.0}, dir[3] = {0.0, 0.0, 1.0};
+  double p0[3], p1[3], pad, lo[3], hi[3];
+  cr->col_tree = NULL;
+  cr->col_face = 0;
+  cr->col_n = 0;
+  /* a column's base lies within the cell's size (its box's diagonal) of the centre's, so its
+   * rounding distance (the distance to the geometry's far corner, plus the size) is at most
+   * twice the centre's: four times, with room */
+  line_segment(g, cell, base, dir, p0, p1, &pad);
+  pad *= 4.0;
+  for (int side = 1; side >= -1 && !cr->col_face; side -= 2) {
+    face_box(cell, side, lo, hi);
+    for (int d = 0; d < 3; d++)
+      lo[d] -= pad, hi[d] += pad;
+    FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, lo, hi, buf));
+    if (buf->n == 0) cr->col_face = side;
+  }
+  if (cr->col_face) {
+    const double zf[2] = {cr->col_face, cr->col_face};
+    int w[2];
+    FCM_TRY(ctx, fcm__embed_inside_line(ctx, g, tree, cell, 0.0, 0.0, 2, zf, w, buf, cr));
+    cr->col_winding = w[0];
+    for (int d = 0; d < 3; d++)
+      lo[d] = cell->lo[d] - pad, hi[d] = cell->hi[d] + pad;
+    FCM_TRY(ctx, fcm__geom_tree_query(ctx, tree, lo, hi, buf));
+    if (buf->n > cr->col_cap) {
+      void *x = cr->col_x, *v = cr->col_v;
+      FCM_TRY(ctx, fcm__resize(ctx, &x, 0, 9 * buf->n, sizeof(double)));
+      cr->col_x = x;
+      FCM_TRY(ctx, fcm__resize(ctx, &v, 0, 3 * buf->n, sizeof(fcm_index)));
+      cr->col_v = v;
+      cr->col_cap = buf->n;
+    }
+    for (size_t k = 0; k < buf->n; k++) {
+      rtri T;
+      load_tri(g, cell, buf->ids[k], &T);
+      memcpy(cr->col_x + 9 * k, T.x, sizeof T.x);
+      memcpy(cr->col_v + 3 * k, T.id, sizeof T.id);
+    }
+    cr->col_n = buf->n;
+  }
+  memcpy(cr->col_key, key, sizeof key);
+  cr->col_tree = tree;
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_inside_column(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aabb_tree *tree,
+                                    const fcm__embed_cell *cell, double a, double b, int n,
+                                    const double *z, int *inside, fcm__idbuf *buf,
+                                    fcm__crossings *cr)
+{
+  fcm_status st = FCM_OK;
+  if (cell->info->shape != FCM_SHAPE_HEX || !cell->affine || !closed_tree(g, tree))
+    return fcm__embed_inside_line(ctx, g, tree, cell, a, b, n, z, inside, buf, cr);
+  FCM_TRY(ctx, column_cell(ctx, g, tree, cell, buf, cr));
+  if (!cr->col_face) return fcm__embed_inside_line(ctx, g, tree, cell, a, b, n, z, inside, buf, cr);
+  const lin l1 = mk(-a, 1, 0, 0), l2 = mk(-b, 0, 1, 0);
+  const int top = cr->col_face > 0;
+  for (int i = 0; i < n; i++)
+    inside[i] = cr->col_winding;
+  /* the winding number at z: the face's, plus the crossings at or above z below the top
+   * face, or less those at or above the bottom face below z */
+  for (size_t k = 0; k < cr->col_n; k++) {
+    rtri T;
+    double P[3], Q[3], X[3];
+    memcpy(T.x, cr->col_x + 9 * k, sizeof T.x);
+    memcpy(T.id, cr->col_v + 3 * k, sizeof T.id);
+    if (!tri_segment(&T, &l1, P, Q)) continue;
+    const int sg = seg_cross(P, Q, &l2, X);
+    if (!sg) continue;
+    for (int i = 0; i < n; i++)
+      if (top && X[2] >= z[i] && X[2] < 1.0)
+        inside[i] += sg;
+      else if (!top && X[2] >= -1.0 && X[2] < z[i])
+        inside[i] -= sg;
+  }
 cleanup:
   return st;
 }
@@ -643,7 +736,7 @@ fcm_status fcm__embed_material_box(fcm_ctx *ctx, const fcm_geometry *g, const fc
       const double a = i ? 1.0 : r.lo, b = j ? 1.0 : r.lo, z[2] = {r.lo, 1.0};
       const int nz = tet && i + j == 1 ? 1 : 2;
       int in[2];
-      FCM_TRY(ctx, fcm__embed_inside_line(ctx, g, tree, cell, a, b, nz, z, in, buf, cr));
+      FCM_TRY(ctx, fcm__embed_inside_column(ctx, g, tree, cell, a, b, nz, z, in, buf, cr));
       for (int k = 0; k < nz; k++) {
         const double x[3] = {a, b, z[k]};
         if (in[k] == 1) grow_box(box, x);
@@ -708,25 +801,27 @@ static fcm_status moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aab
     to_physical(cell, lbase[0] + dir[0], lbase[1] + dir[1], lbase[2] + dir[2], P);
     cb = clear_box_find(cr, tree, P, pad);
   }
+  int up = 1;
+  const int half = closed_tree(g, tree);
   if (cb) /* the crossings inside the edge only */
     to_physical(cell, lbase[0] + r.lo * dir[0], lbase[1] + r.lo * dir[1], lbase[2] + r.lo * dir[2],
                 p0);
+  else if (half) /* the edge and the shorter half of the line beyond it */
+    up = line_half(g, cell, lbase, dir, r.lo, 1.0, pad, p0, p1);
   FCM_TRY(ctx, fcm__geom_tree_segment(ctx, tree, p0, cb ? P : p1, pad, buf));
   FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &r.exit1, &r.exit2, cr, &sum));
-  FCM_CHECK(cb || sum == 0, ctx, FCM_ERR_GEOMETRY,
+  FCM_CHECK(cb || half || sum == 0, ctx, FCM_ERR_GEOMETRY,
             "embed: background cell %lld: its edge line crosses the body's boundary %d more "
             "times outward than inward (the boundary surface is not closed)",
             (long long)cell->id, sum);
   for (size_t k = 0; k < cr->n; k++) {
     const double z = cr->z[k];
-    if (z >= 1.0) {
-      *corner += cr->sign[k];
-    } else if (z > r.lo) {
+    if (z > r.lo && z < 1.0) {
       FCM_TRY(ctx, add_edge(ctx, q, &r, z, cr->sign[k], s));
       ++*inner;
     }
   }
-  if (cb) *corner = orient * cb->winding;
+  *corner = cb ? orient * cb->winding : line_winding(cr, up, 1.0);
   if (*corner) FCM_TRY(ctx, add_edge(ctx, q, &r, 1.0, *corner, s));
   if (boxes && !cb)
     FCM_TRY(ctx, clear_box_add(ctx, tree, P, CLEAR_BOX_RSIZE * cell->size, 2.0 * pad,

@@ -139,11 +139,14 @@ static fcm_status tets_material(fcm_ctx *ctx, fcm__material *m, const double *te
       const double w = m->sr.w[i] * k.detA;
       sum += w;
       if (!out) continue;
-      double x[3], det;
+      double x[3], det = cell->detA;
       fcm__mat3_mulv(k.A, m->sr.x + 3 * i, x);
       for (int d = 0; d < 3; d++)
         x[d] += k.X[d];
-      FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, x, out->x + 3 * out->n, &det));
+      if (cell->affine)
+        fcm__embed_to_reference_affine(cell, x, out->x + 3 * out->n);
+      else
+        FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, x, out->x + 3 * out->n, &det));
       out->w[out->n++] = w / det;
     }
   }
