@@ -88,11 +88,12 @@ cleanup:
   return st;
 }
 
-/* Pattern of C = A B (nrow rows of A, ncol columns of B), columns sorted; rows shared by nt
- * threads (each row's columns found and sorted by one thread). */
+/* Pattern of C = A B (nrow rows of A, ncol columns of B), each row's columns sorted when
+ * `sorted`, else in the order first reached (A's row order, then B's: the same for any thread
+ * count); rows shared by nt threads (each row's columns found by one thread). */
 static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fcm_index *Ap,
                                   const int *Ac, const fcm_index *Bp, const int *Bc, fcm_index ncol,
-                                  fcm_index **Cp_out, int **Cc_out)
+                                  int sorted, fcm_index **Cp_out, int **Cc_out)
 {
   fcm_status st = FCM_OK;
   fcm_index *Cp = NULL, *mark = NULL;
@@ -118,9 +119,9 @@ static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fc
             cnt++;
           }
         }
-        if (pass)
+        if (pass && sorted)
           sort_ints(Cc + base, cnt);
-        else
+        else if (!pass)
           Cp[i + 1] = cnt;
       }
     }
@@ -240,14 +241,17 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
   t->ctx = ctx, t->n = n, t->nc = nc, t->nt = nt;
   t->P_ptr = P_ptr, t->P_col = P_col, t->P_val = P_val;
   FCM_TRY(ctx, transpose(ctx, n, nc, P_ptr, P_col, P_val, &t->R_ptr, &t->R_col, &t->R_val));
+  /* A P's rows unsorted: each entry of C takes one term from each row of A P it sums, wherever
+   * that row holds the column, so C's values do not depend on the order (nor do A P's) */
   FCM_TRY(ctx, product_pattern(ctx, nt, n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), P_ptr, P_col, nc,
-                               &t->AP_ptr, &t->AP_col));
-  FCM_ALLOC(ctx, t->AP_ptr[n] + 1, t->AP_val);
+                               0, &t->AP_ptr, &t->AP_col));
+  FCM_ALLOC_RAW(ctx, t->AP_ptr[n] + 1, t->AP_val); /* every product writes all of it */
   FCM_TRY(ctx,
-          product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, &cp, &cc));
+          product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, 1, &cp, &cc));
   if (with_diagonal) FCM_TRY(ctx, add_diagonal(ctx, nc, &cp, &cc));
   FCM_ALLOC(ctx, (size_t)nt * (size_t)(nc + 1), t->spa);
-  FCM_TRY(ctx, fcm_csr_create(ctx, nc, nc, cp, cc, fcm_csr_get_kind(A), C));
+  /* rows sorted and in range by construction, symmetric with A's pattern */
+  FCM_TRY(ctx, fcm__csr_adopt_pattern(ctx, nc, nc, &cp, &cc, fcm_csr_get_kind(A), C));
   *plan = t;
   t = NULL;
 cleanup:

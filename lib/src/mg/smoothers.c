@@ -186,29 +186,33 @@ static fcm_status block_slabs(fcm_mg *m, mg_level *L)
   const fcm_index *rp = fcm_csr_row_ptr(A);
   const int *ci = fcm_csr_col_idx(A);
   const fcm_index nb = fcm__schwarz_num_blocks(L->blk), n = L->n;
-  fcm_index *pairs = NULL, *seq = NULL, *last = NULL, *reach = NULL;
+  fcm_index *first = NULL, *seq = NULL, *last = NULL, *reach = NULL;
   double *work = NULL;
-  FCM_ALLOC_RAW(ctx, 2 * nb + 1, pairs);
+  /* the blocks by their smallest DOF, ties in block order: a counting sort (stable) */
+  FCM_ALLOC_RAW(ctx, nb + 1, first);
+  FCM_ALLOC_RAW(ctx, nb + 1, seq);
+  FCM_ALLOC_RAW(ctx, nb + 1, reach);
+  FCM_ALLOC_RAW(ctx, nb + 1, work);
+  FCM_ALLOC(ctx, n + 2, last); /* first the count of each smallest DOF, then the map below */
   for (fcm_index k = 0; k < nb; k++) {
     const fcm_index *d = NULL;
     const double *S = NULL;
     const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
-    fcm_index first = n;
+    fcm_index f = n;
     for (int i = 0; i < bm; i++)
-      first = FCM_MIN(first, d[i]);
-    pairs[2 * k] = first, pairs[2 * k + 1] = k;
+      f = FCM_MIN(f, d[i]);
+    first[k] = f;
+    last[f + 1]++;
   }
-  if (nb > 0) qsort(pairs, (size_t)nb, 2 * sizeof *pairs, cmp_pair);
-  FCM_ALLOC_RAW(ctx, nb + 1, seq);
-  FCM_ALLOC_RAW(ctx, nb + 1, reach);
-  FCM_ALLOC_RAW(ctx, nb + 1, work);
-  FCM_ALLOC_RAW(ctx, n + 1, last);
+  for (fcm_index i = 0; i < n; i++)
+    last[i + 1] += last[i];
+  for (fcm_index k = 0; k < nb; k++)
+    seq[last[first[k]]++] = k;
   for (fcm_index i = 0; i < n; i++)
     last[i] = -1;
   for (fcm_index t = 0; t < nb; t++) { /* last[i]: the last position of a block holding row i */
     const fcm_index *d = NULL;
     const double *S = NULL;
-    seq[t] = pairs[2 * t + 1];
     const int bm = fcm__schwarz_block(L->blk, seq[t], &d, &S);
     for (int i = 0; i < bm; i++)
       last[d[i]] = t;
@@ -230,7 +234,7 @@ static fcm_status block_slabs(fcm_mg *m, mg_level *L)
   }
   FCM_TRY(ctx, slabs_create(ctx, nb, seq, reach, work, 0, &L->blocks));
 cleanup:
-  fcm__free(ctx, pairs);
+  fcm__free(ctx, first);
   fcm__free(ctx, seq);
   fcm__free(ctx, last);
   fcm__free(ctx, reach);
