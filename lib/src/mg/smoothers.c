@@ -575,6 +575,7 @@ typedef struct sweep_args {
   const double *b;
   double *x;
   double *r, *dx;
+  fcm__schwarz_view blk; /* block sweeps: L's blocks */
 } sweep_args;
 
 /* One symmetric Gauss-Seidel sweep in the slab order S (forward, then backward) by the team
@@ -676,7 +677,7 @@ void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x)
     }
     return;
   }
-  const sweep_args a = {L, w, b, x, NULL, NULL};
+  const sweep_args a = {L, w, b, x, NULL, NULL, {0}};
   symmetric_sweep(&L->rows, sgs_slab, &a);
 }
 
@@ -694,9 +695,9 @@ static void block_slab(const sweep_args *a, fcm_index s, int back)
   const fcm_index q0 = L->blocks.ptr[s], q1 = L->blocks.ptr[s + 1];
   for (fcm_index t = 0; t < q1 - q0; t++) {
     const fcm_index k = L->blocks.item[back ? q1 - 1 - t : q0 + t];
-    const fcm_index *d = NULL;
-    const double *S = NULL;
-    const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
+    const fcm_index *d = a->blk.dofs + a->blk.ptr[k];
+    const double *S = a->blk.S + a->blk.s_off[k];
+    const int bm = (int)(a->blk.ptr[k + 1] - a->blk.ptr[k]);
     for (int i = 0; i < bm; i++)
       r[i] = b[d[i]] - fcm__mg_row_dot(v, ci, rp[d[i]], rp[d[i] + 1], x);
     for (int i = 0; i < bm; i++)
@@ -730,8 +731,9 @@ static void one_way_sweep(const slab_order *S,
 void fcm__mg_block_smooth(const fcm_mg *m, const mg_level *L, const double *b, double *x, int post)
 {
   const size_t t = (size_t)omp_get_thread_num();
-  const sweep_args a = {
-      L, 0.0, b, x, m->blk_r + t * (size_t)m->blk_max, m->blk_dx + t * (size_t)m->blk_max};
+  sweep_args a = {
+      L, 0.0, b, x, m->blk_r + t * (size_t)m->blk_max, m->blk_dx + t * (size_t)m->blk_max, {0}};
+  fcm__schwarz_get_view(L->blk, &a.blk);
   if (m->opts.block_sweep)
     one_way_sweep(&L->blocks, block_slab, &a, post);
   else

@@ -645,6 +645,11 @@ int fcm__schwarz_block(const fcm_schwarz *P, fcm_index k, const fcm_index **dofs
   return (int)(P->block_ptr[k + 1] - P->block_ptr[k]);
 }
 
+void fcm__schwarz_get_view(const fcm_schwarz *P, fcm__schwarz_view *v)
+{
+  v->ptr = P->block_ptr, v->dofs = P->dofs, v->s_off = P->s_off, v->S = P->S;
+}
+
 fcm_status fcm_schwarz_operator(void *user, const double *r, double *z)
 {
   return fcm_schwarz_apply((const fcm_schwarz *)user, r, z);
