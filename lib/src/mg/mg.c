@@ -231,6 +231,9 @@ static fcm_status create_patterns(fcm_mg *m, fcm_mg *old, unsigned char *same)
     FCM_ALLOC(ctx, L->n + 1, L->r);
     same[l] = (unsigned char)(old && (kept_above || fcm__mg_level_same(old, m, l)));
     kept_above = l + 1 < m->nlev && same[l] && fcm__mg_keep_plan(old, m, l);
+    /* nothing of old's level l is taken now: its memory goes before this level's arrays
+     * are allocated (the allocator may give it back to them) */
+    if (old && !same[l] && l < old->nlev) fcm__mg_level_free(ctx, &old->lev[l]);
     if (l + 1 < m->nlev && !kept_above) FCM_TRY(ctx, galerkin_pattern(m, l));
     if (same[l]) fcm__mg_keep_orders(old, m, l);
   }
@@ -241,6 +244,7 @@ static fcm_status create_patterns(fcm_mg *m, fcm_mg *old, unsigned char *same)
     for (int l = 0; l + 1 < m->nlev; l++)
       if (!m->lev[l].rows.ptr) FCM_TRY(ctx, fcm__mg_row_slabs(m, &m->lev[l]));
   if (!(old && fcm__mg_keep_analysis(old, m, same[m->nlev - 1]))) {
+    if (old) fcm_direct_destroy(&old->direct); /* not taken: freed first, as above */
     mg_level *Lc = &m->lev[m->nlev - 1];
     FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, fcm__mg_level_matrix(Lc), &m->direct));
     FCM_TRY(ctx, fcm_direct_analyze(m->direct));
