@@ -69,8 +69,8 @@ static fcm_status transpose(fcm_ctx *ctx, fcm_index n, fcm_index nc, const fcm_i
   fcm_index *fill = NULL;
   const fcm_index nnz = P_ptr[n];
   FCM_ALLOC(ctx, nc + 2, *R_ptr);
-  FCM_ALLOC(ctx, nnz + 1, *R_col);
-  FCM_ALLOC(ctx, nnz + 1, *R_val);
+  FCM_ALLOC_RAW(ctx, nnz + 1, *R_col); /* written in full below */
+  FCM_ALLOC_RAW(ctx, nnz + 1, *R_val);
   FCM_ALLOC(ctx, nc + 1, fill);
   fcm_index *rp = *R_ptr;
   for (fcm_index p = 0; p < nnz; p++)
@@ -135,7 +135,7 @@ static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fc
     if (!pass) {
       for (fcm_index i = 0; i < nrow; i++)
         Cp[i + 1] += Cp[i];
-      FCM_ALLOC(ctx, Cp[nrow] + 1, Cc);
+      FCM_ALLOC_RAW(ctx, Cp[nrow] + 1, Cc); /* the second pass writes every entry */
     }
   }
   *Cp_out = Cp, *Cc_out = Cc;

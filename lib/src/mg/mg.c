@@ -165,7 +165,7 @@ static fcm_status galerkin_pattern(fcm_mg *m, int l)
      * row j along. */
     const fcm_index *cp = fcm_csr_row_ptr(C->Aown);
     const int *cc = fcm_csr_col_idx(C->Aown);
-    FCM_ALLOC(ctx, cp[C->n] + 1, C->tpos);
+    FCM_ALLOC_RAW(ctx, cp[C->n] + 1, C->tpos); /* every entry written below */
     FCM_ALLOC_RAW(ctx, C->n + 1, next);
     memcpy(next, cp, sizeof *next * (size_t)C->n);
     for (fcm_index i = 0; i < C->n; i++)
