@@ -90,46 +90,39 @@ cleanup:
 
 /* Pattern of C = A B (nrow rows of A, ncol columns of B), each row's columns sorted when
  * `sorted`, else in the order first reached (A's row order, then B's: the same for any thread
- * count); rows shared by nt threads (each row's columns found by one thread). The candidates
- * are marked without a branch on whether they were seen (most are, unpredictably): a row's
- * columns go to the thread's row buffer, each written at the row's count, which advances on
- * a new column only. */
+ * count); rows shared by nt threads (each row's columns found by one thread). */
 static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fcm_index *Ap,
                                   const int *Ac, const fcm_index *Bp, const int *Bc, fcm_index ncol,
                                   int sorted, fcm_index **Cp_out, int **Cc_out)
 {
   fcm_status st = FCM_OK;
   fcm_index *Cp = NULL, *mark = NULL;
-  int *Cc = NULL, *rows = NULL;
+  int *Cc = NULL;
   FCM_ALLOC(ctx, nrow + 1, Cp);
-  FCM_ALLOC_RAW(ctx, (size_t)nt * (size_t)ncol + 1, mark);   /* per thread: ncol entries */
-  FCM_ALLOC_RAW(ctx, (size_t)nt * (size_t)(ncol + 1), rows); /* per thread: one row */
+  FCM_ALLOC_RAW(ctx, (size_t)nt * (size_t)ncol + 1, mark); /* per thread: ncol entries */
   for (size_t j = 0; j < (size_t)nt * (size_t)ncol; j++)
     mark[j] = -1;
   for (int pass = 0; pass < 2; pass++) {
 #pragma omp parallel num_threads(nt) if (nt > 1)
     {
       fcm_index *mk = mark + (size_t)omp_get_thread_num() * (size_t)ncol;
-      int *row = rows + (size_t)omp_get_thread_num() * (size_t)(ncol + 1);
 #pragma omp for schedule(dynamic, 256)
       for (fcm_index i = 0; i < nrow; i++) {
-        const fcm_index tag = i + pass * nrow;
-        fcm_index cnt = 0;
+        fcm_index cnt = 0, base = pass ? Cp[i] : 0;
         for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
           const fcm_index k = Ac[p];
           for (fcm_index q = Bp[k]; q < Bp[k + 1]; q++) {
-            const int j = Bc[q];
-            row[cnt] = j;
-            cnt += mk[j] != tag;
-            mk[j] = tag;
+            const fcm_index j = Bc[q];
+            if (mk[j] == i + pass * nrow) continue;
+            mk[j] = i + pass * nrow;
+            if (pass) Cc[base + cnt] = (int)j;
+            cnt++;
           }
         }
-        if (pass) {
-          memcpy(Cc + Cp[i], row, sizeof *row * (size_t)cnt);
-          if (sorted) sort_ints(Cc + Cp[i], cnt);
-        } else {
+        if (pass && sorted)
+          sort_ints(Cc + base, cnt);
+        else if (!pass)
           Cp[i + 1] = cnt;
-        }
       }
     }
     if (!pass) {
@@ -144,7 +137,6 @@ cleanup:
   fcm__free(ctx, Cp);
   fcm__free(ctx, Cc);
   fcm__free(ctx, mark);
-  fcm__free(ctx, rows);
   return st;
 }
 
