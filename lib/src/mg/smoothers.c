@@ -186,7 +186,7 @@ static fcm_status block_slabs(fcm_mg *m, mg_level *L)
   const fcm_index *rp = fcm_csr_row_ptr(A);
   const int *ci = fcm_csr_col_idx(A);
   const fcm_index nb = fcm__schwarz_num_blocks(L->blk), n = L->n;
-  fcm_index *first = NULL, *seq = NULL, *last = NULL, *reach = NULL;
+  fcm_index *first = NULL, *seq = NULL, *last = NULL, *reach = NULL, *row_reach = NULL;
   double *work = NULL;
   /* the blocks by their smallest DOF, ties in block order: a counting sort (stable) */
   FCM_ALLOC_RAW(ctx, nb + 1, first);
@@ -217,6 +217,17 @@ static fcm_status block_slabs(fcm_mg *m, mg_level *L)
     for (int i = 0; i < bm; i++)
       last[d[i]] = t;
   }
+  /* the last block position a row's columns reach, once per row of a block (the blocks
+   * overlap: a cut cell's row lies in up to nine of them) */
+  FCM_ALLOC_RAW(ctx, n + 1, row_reach);
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (n > 4096)
+  for (fcm_index i = 0; i < n; i++) {
+    fcm_index r = -1;
+    if (last[i] >= 0)
+      for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+        r = FCM_MAX(r, last[ci[p]]);
+    row_reach[i] = r;
+  }
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (nb > 1024)
   for (fcm_index t = 0; t < nb; t++) {
     const fcm_index *d = NULL;
@@ -226,8 +237,7 @@ static fcm_status block_slabs(fcm_mg *m, mg_level *L)
     fcm_index r = t, entries = 0;
     for (int i = 0; i < bm; i++) {
       entries += rp[d[i] + 1] - rp[d[i]];
-      for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++)
-        r = FCM_MAX(r, last[ci[p]]);
+      r = FCM_MAX(r, row_reach[d[i]]);
     }
     reach[t] = r;
     work[k] = (double)entries + (double)bm * (double)bm;
@@ -238,6 +248,7 @@ cleanup:
   fcm__free(ctx, seq);
   fcm__free(ctx, last);
   fcm__free(ctx, reach);
+  fcm__free(ctx, row_reach);
   fcm__free(ctx, work);
   return st;
 }
