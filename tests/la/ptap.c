@@ -1,6 +1,7 @@
 /* The sparse triple product C = P^T A P (fcm__ptap) against a dense product on random sparse
  * matrices (general and symmetric A, P with empty rows and columns): C's pattern holds every
- * structurally nonzero entry (and the diagonal when asked), its values match to rounding, new
+ * structurally nonzero entry (and the diagonal when asked), sorted (and symmetric for a
+ * symmetric A), its values match to rounding, new
  * values of A give the new product, the threaded product (2 threads, pattern and values) is
  * bitwise the serial one; argument errors; allocation failures. */
 #include "alloc_loop.h"
@@ -107,8 +108,15 @@ static void check_dense(const fcm_csr *A, const sparse *P, const fcm_csr *C, int
   const fcm_index *cp = fcm_csr_row_ptr(C);
   const int *cc = fcm_csr_col_idx(C);
   for (fcm_index I = 0; I < nc; I++)
-    for (fcm_index p = cp[I]; p < cp[I + 1]; p++)
+    for (fcm_index p = cp[I]; p < cp[I + 1]; p++) {
+      /* C's pattern is taken unchecked: its rows must be strictly increasing, in range */
+      TEST_TRUE(cc[p] >= 0 && cc[p] < nc && (p == cp[I] || cc[p] > cc[p - 1]));
       stored[I * nc + cc[p]] = 1;
+    }
+  if (fcm_csr_get_kind(A) == FCM_CSR_SYMMETRIC) /* and symmetric with A's */
+    for (fcm_index I = 0; I < nc; I++)
+      for (fcm_index J = 0; J < nc; J++)
+        TEST_TRUE(stored[I * nc + J] == stored[J * nc + I]);
   for (fcm_index I = 0; I < nc; I++) {
     if (with_diagonal) TEST_TRUE(stored[I * nc + I]);
     for (fcm_index J = 0; J < nc; J++) {

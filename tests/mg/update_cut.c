@@ -241,6 +241,7 @@ int main(void)
   cut_sequence(ctx, FCM_ELEMENT_HEX8, 1);
   cut_sequence(ctx, FCM_ELEMENT_HEX8, 2);
   cut_sequence(ctx, FCM_ELEMENT_HEX20, 1);
+  cut_sequence(ctx, FCM_ELEMENT_HEX20, 2);
   fcm_ctx_destroy(&ctx);
   printf("ok\n");
   return 0;

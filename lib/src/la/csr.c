@@ -127,6 +127,34 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__csr_adopt_pattern(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols,
+                                  fcm_index **row_ptr, int **col_idx, fcm_csr_kind kind,
+                                  fcm_csr **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_csr *A = NULL;
+  FCM_CHECK(out && row_ptr && *row_ptr && col_idx && *col_idx, ctx, FCM_ERR_ARG,
+            "csr_adopt_pattern: NULL argument");
+  *out = NULL;
+  FCM_TRY(ctx, check_header(ctx, nrows, ncols, *row_ptr, kind));
+  FCM_TRY(ctx, new_handle(ctx, nrows, ncols, (*row_ptr)[nrows], kind, &A));
+  A->owned = 1;
+  A->row_ptr = A->own_row_ptr = *row_ptr;
+  A->col_idx = A->own_col_idx = *col_idx;
+  *row_ptr = NULL, *col_idx = NULL;
+  FCM__ALLOC_WITH(fcm__calloc_large, ctx, A->nnz, A->values);
+  *out = A;
+  A = NULL;
+cleanup:
+  if (row_ptr && col_idx && *row_ptr && *col_idx) {
+    fcm__free(ctx, *row_ptr);
+    fcm__free(ctx, *col_idx);
+    *row_ptr = NULL, *col_idx = NULL;
+  }
+  fcm_csr_destroy(&A);
+  return st;
+}
+
 fcm_status fcm__csr_share_pattern(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols,
                                   const fcm_index *row_ptr, const int *col_idx, fcm_csr_kind kind,
                                   fcm_csr **out)

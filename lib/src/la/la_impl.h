@@ -126,6 +126,15 @@ fcm_status fcm__csr_share_pattern(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols
                                   const fcm_index *row_ptr, const int *col_idx, fcm_csr_kind kind,
                                   fcm_csr **A);
 
+/* A matrix that takes over *row_ptr and *col_idx (arrays from fcm__calloc or fcm__malloc;
+ * set to NULL, also on failure, when they are freed), values zero. For patterns built inside
+ * the library that are already known to be valid (rows strictly increasing, in range, both
+ * triangles of an FCM_CSR_SYMMETRIC pattern): unlike fcm_csr_create() it neither copies nor
+ * checks them. (csr.c) */
+fcm_status fcm__csr_adopt_pattern(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols,
+                                  fcm_index **row_ptr, int **col_idx, fcm_csr_kind kind,
+                                  fcm_csr **A);
+
 /* The sparse triple product C = P^T A P of a square matrix A (n x n, either kind) and a
  * prolongation P (n x nc, CSR arrays: P_ptr n + 1 offsets, P_col sorted per row in [0, nc),
  * P_val), like PETSc's MatPtAP, in two phases: fcm__ptap_create() finds the patterns of A P and

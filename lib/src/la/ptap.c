@@ -69,8 +69,8 @@ static fcm_status transpose(fcm_ctx *ctx, fcm_index n, fcm_index nc, const fcm_i
   fcm_index *fill = NULL;
   const fcm_index nnz = P_ptr[n];
   FCM_ALLOC(ctx, nc + 2, *R_ptr);
-  FCM_ALLOC(ctx, nnz + 1, *R_col);
-  FCM_ALLOC(ctx, nnz + 1, *R_val);
+  FCM_ALLOC_RAW(ctx, nnz + 1, *R_col); /* written in full below */
+  FCM_ALLOC_RAW(ctx, nnz + 1, *R_val);
   FCM_ALLOC(ctx, nc + 1, fill);
   fcm_index *rp = *R_ptr;
   for (fcm_index p = 0; p < nnz; p++)
@@ -88,54 +88,140 @@ cleanup:
   return st;
 }
 
-/* Pattern of C = A B (nrow rows of A, ncol columns of B), columns sorted; rows shared by nt
- * threads (each row's columns found and sorted by one thread). */
-static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fcm_index *Ap,
-                                  const int *Ac, const fcm_index *Bp, const int *Bc, fcm_index ncol,
-                                  fcm_index **Cp_out, int **Cc_out)
+/* Rows per chunk of the symbolic product: the unit a thread takes at a time. */
+#define PATTERN_CHUNK 256
+
+/* What the threads of product_pattern() share. Each thread t appends the columns of the chunks
+ * it takes to its own buffer buf[t] (cap[t] entries, len[t] used); chunk c's columns lie at
+ * buf[thr[c]] + off[c], rows in order, and row i's count in Cp[i + 1]. */
+typedef struct pattern_work {
+  fcm_index nrow, ncol;
+  const fcm_index *Ap, *Bp;
+  const int *Ac, *Bc;
+  int sorted;
+  fcm_index *Cp;
+  fcm_index *mark, *stamp; /* per thread: ncol marks, and the stamp of its current row */
+  int *row;                /* per thread: ncol + 1 columns of the current row */
+  int **buf;
+  size_t *cap, *len;
+  int *thr;
+  size_t *off;
+} pattern_work;
+
+/* Chunk c's rows by thread t into its buffer: 1, or 0 (nothing kept) when they do not fit. A
+ * row's columns are those first reached (A's row order, then B's), sorted when asked. */
+static int pattern_chunk(pattern_work *w, int t, fcm_index c)
 {
-  fcm_status st = FCM_OK;
-  fcm_index *Cp = NULL, *mark = NULL;
-  int *Cc = NULL;
-  FCM_ALLOC(ctx, nrow + 1, Cp);
-  FCM_ALLOC_RAW(ctx, (size_t)nt * (size_t)ncol + 1, mark); /* per thread: ncol entries */
-  for (size_t j = 0; j < (size_t)nt * (size_t)ncol; j++)
-    mark[j] = -1;
-  for (int pass = 0; pass < 2; pass++) {
-#pragma omp parallel num_threads(nt) if (nt > 1)
-    {
-      fcm_index *mk = mark + (size_t)omp_get_thread_num() * (size_t)ncol;
-#pragma omp for schedule(dynamic, 256)
-      for (fcm_index i = 0; i < nrow; i++) {
-        fcm_index cnt = 0, base = pass ? Cp[i] : 0;
-        for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
-          const fcm_index k = Ac[p];
-          for (fcm_index q = Bp[k]; q < Bp[k + 1]; q++) {
-            const fcm_index j = Bc[q];
-            if (mk[j] == i + pass * nrow) continue;
-            mk[j] = i + pass * nrow;
-            if (pass) Cc[base + cnt] = (int)j;
-            cnt++;
-          }
-        }
-        if (pass)
-          sort_ints(Cc + base, cnt);
-        else
-          Cp[i + 1] = cnt;
+  fcm_index *mk = w->mark + (size_t)t * (size_t)w->ncol;
+  int *row = w->row + (size_t)t * (size_t)(w->ncol + 1);
+  const size_t off = w->len[t];
+  const fcm_index i1 = FCM_MIN(w->nrow, (c + 1) * PATTERN_CHUNK);
+  for (fcm_index i = c * PATTERN_CHUNK; i < i1; i++) {
+    const fcm_index tag = w->stamp[t]++;
+    fcm_index cnt = 0;
+    for (fcm_index p = w->Ap[i]; p < w->Ap[i + 1]; p++) {
+      const fcm_index k = w->Ac[p];
+      for (fcm_index q = w->Bp[k]; q < w->Bp[k + 1]; q++) {
+        const fcm_index j = w->Bc[q];
+        if (mk[j] == tag) continue;
+        mk[j] = tag;
+        row[cnt++] = (int)j;
       }
     }
-    if (!pass) {
-      for (fcm_index i = 0; i < nrow; i++)
-        Cp[i + 1] += Cp[i];
-      FCM_ALLOC(ctx, Cp[nrow] + 1, Cc);
+    if (w->len[t] + (size_t)cnt > w->cap[t]) {
+      w->len[t] = off;
+      return 0;
     }
+    if (w->sorted) sort_ints(row, cnt);
+    memcpy(w->buf[t] + w->len[t], row, sizeof *row * (size_t)cnt);
+    w->len[t] += (size_t)cnt;
+    w->Cp[i + 1] = cnt;
   }
-  *Cp_out = Cp, *Cc_out = Cc;
-  Cp = NULL, Cc = NULL;
+  w->thr[c] = t, w->off[c] = off;
+  return 1;
+}
+
+/* Pattern of C = A B (nrow rows of A, ncol columns of B), each row's columns sorted when
+ * `sorted`, else in the order first reached (the same for any thread count); chunks of rows
+ * shared by nt threads in one pass: a thread whose buffer is full leaves its chunks for
+ * another round after the buffer has grown. */
+static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fcm_index *Ap,
+                                  const int *Ac, const fcm_index *Bp, const int *Bc, fcm_index ncol,
+                                  int sorted, fcm_index **Cp_out, int **Cc_out)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index nchunk = (nrow + PATTERN_CHUNK - 1) / PATTERN_CHUNK;
+  fcm_index *pending = NULL, npending = nchunk;
+  unsigned char *full = NULL, *left = NULL;
+  int *Cc = NULL;
+  pattern_work w = {nrow, ncol, Ap,   Bp,   Ac,   Bc,   sorted, NULL,
+                    NULL, NULL, NULL, NULL, NULL, NULL, NULL,   NULL};
+  FCM_ALLOC(ctx, nrow + 1, w.Cp);
+  FCM_ALLOC_RAW(ctx, (size_t)nt * (size_t)ncol + 1, w.mark);
+  FCM_ALLOC(ctx, nt, w.stamp);
+  FCM_ALLOC_RAW(ctx, (size_t)nt * (size_t)(ncol + 1), w.row);
+  FCM_ALLOC(ctx, nt, w.buf);
+  FCM_ALLOC(ctx, nt, w.cap);
+  FCM_ALLOC(ctx, nt, w.len);
+  FCM_ALLOC(ctx, nt, full);
+  FCM_ALLOC_RAW(ctx, nchunk + 1, w.thr);
+  FCM_ALLOC_RAW(ctx, nchunk + 1, w.off);
+  FCM_ALLOC_RAW(ctx, nchunk + 1, pending);
+  FCM_ALLOC(ctx, nchunk + 1, left);
+  for (size_t j = 0; j < (size_t)nt * (size_t)ncol; j++)
+    w.mark[j] = -1;
+  for (fcm_index c = 0; c < nchunk; c++)
+    pending[c] = c;
+  /* a first guess of each thread's share: A's entries and a quarter (A P has about as many) */
+  for (int t = 0; t < nt; t++) {
+    w.cap[t] = (size_t)FCM_MAX(5 * (Ap[nrow] / 4) / nt, 4096);
+    FCM_ALLOC_RAW(ctx, w.cap[t], w.buf[t]);
+  }
+  while (npending > 0) {
+#pragma omp parallel num_threads(nt) if (nt > 1 && npending > 1)
+    {
+      const int t = omp_get_thread_num();
+#pragma omp for schedule(dynamic, 1)
+      for (fcm_index q = 0; q < npending; q++) {
+        left[q] = (unsigned char)(full[t] || !pattern_chunk(&w, t, pending[q]));
+        if (left[q]) full[t] = 1;
+      }
+    }
+    fcm_index nleft = 0;
+    for (fcm_index q = 0; q < npending; q++)
+      if (left[q]) pending[nleft++] = pending[q];
+    npending = nleft;
+    for (int t = 0; t < nt; t++)
+      if (full[t]) {
+        FCM_TRY(ctx, fcm__resize(ctx, (void **)&w.buf[t], w.cap[t], 2 * w.cap[t], sizeof(int)));
+        w.cap[t] *= 2, full[t] = 0;
+      }
+  }
+  for (fcm_index i = 0; i < nrow; i++)
+    w.Cp[i + 1] += w.Cp[i];
+  FCM_ALLOC_RAW(ctx, w.Cp[nrow] + 1, Cc); /* every entry copied below */
+  for (fcm_index c = 0; c < nchunk; c++) {
+    const fcm_index r0 = w.Cp[c * PATTERN_CHUNK], r1 = w.Cp[FCM_MIN(nrow, (c + 1) * PATTERN_CHUNK)];
+    memcpy(Cc + r0, w.buf[w.thr[c]] + w.off[c], sizeof *Cc * (size_t)(r1 - r0));
+  }
+  *Cp_out = w.Cp, *Cc_out = Cc;
+  w.Cp = NULL, Cc = NULL;
 cleanup:
-  fcm__free(ctx, Cp);
+  for (int t = 0; w.buf && t < nt; t++)
+    fcm__free(ctx, w.buf[t]);
+  fcm__free(ctx, w.Cp);
   fcm__free(ctx, Cc);
-  fcm__free(ctx, mark);
+  fcm__free(ctx, w.mark);
+  fcm__free(ctx, w.stamp);
+  fcm__free(ctx, w.row);
+  fcm__free(ctx, w.buf);
+  fcm__free(ctx, w.cap);
+  fcm__free(ctx, w.len);
+  fcm__free(ctx, w.thr);
+  fcm__free(ctx, w.off);
+  fcm__free(ctx, full);
+  fcm__free(ctx, pending);
+  fcm__free(ctx, left);
   return st;
 }
 
@@ -240,14 +326,17 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
   t->ctx = ctx, t->n = n, t->nc = nc, t->nt = nt;
   t->P_ptr = P_ptr, t->P_col = P_col, t->P_val = P_val;
   FCM_TRY(ctx, transpose(ctx, n, nc, P_ptr, P_col, P_val, &t->R_ptr, &t->R_col, &t->R_val));
+  /* A P's rows unsorted: each entry of C takes one term from each row of A P it sums, wherever
+   * that row holds the column, so C's values do not depend on the order (nor do A P's) */
   FCM_TRY(ctx, product_pattern(ctx, nt, n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), P_ptr, P_col, nc,
-                               &t->AP_ptr, &t->AP_col));
-  FCM_ALLOC(ctx, t->AP_ptr[n] + 1, t->AP_val);
+                               0, &t->AP_ptr, &t->AP_col));
+  FCM_ALLOC_RAW(ctx, t->AP_ptr[n] + 1, t->AP_val); /* every product writes all of it */
   FCM_TRY(ctx,
-          product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, &cp, &cc));
+          product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, 1, &cp, &cc));
   if (with_diagonal) FCM_TRY(ctx, add_diagonal(ctx, nc, &cp, &cc));
   FCM_ALLOC(ctx, (size_t)nt * (size_t)(nc + 1), t->spa);
-  FCM_TRY(ctx, fcm_csr_create(ctx, nc, nc, cp, cc, fcm_csr_get_kind(A), C));
+  /* rows sorted and in range by construction, symmetric with A's pattern */
+  FCM_TRY(ctx, fcm__csr_adopt_pattern(ctx, nc, nc, &cp, &cc, fcm_csr_get_kind(A), C));
   *plan = t;
   t = NULL;
 cleanup:

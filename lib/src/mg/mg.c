@@ -153,26 +153,36 @@ static fcm_status galerkin_pattern(fcm_mg *m, int l)
   fcm_ctx *ctx = m->ctx;
   mg_level *L = &m->lev[l], *C = &m->lev[l + 1];
   const fcm_csr *A = fcm__mg_level_matrix(L);
-  fcm_index nnz = 0;
+  fcm_index nnz = 0, *next = NULL;
   fcm_csr_get_size(A, NULL, NULL, &nnz);
   FCM_TRY(ctx, fcm__ptap_create(ctx, A, C->n, L->P_ptr, L->P_col, L->P_val, 1,
                                 nnz >= MG_PARALLEL_NNZ ? fcm__mg_team(m) : 1, &L->ptap, &C->Aown));
   fcm__ptap_transpose(L->ptap, &L->R_ptr, &L->R_col, &L->R_val);
   FCM_TRY(ctx, level_diag(m, C));
   {
-    /* the transposed positions, found once: every setup symmetrizes with them */
+    /* the transposed positions, found once: every setup symmetrizes with them. Row by row,
+     * the entries (j, i) with i < j come in ascending i, as row j stores them: next[j] walks
+     * row j along. */
     const fcm_index *cp = fcm_csr_row_ptr(C->Aown);
     const int *cc = fcm_csr_col_idx(C->Aown);
-    FCM_ALLOC(ctx, cp[C->n] + 1, C->tpos);
+    FCM_ALLOC_RAW(ctx, cp[C->n] + 1, C->tpos); /* every entry written below */
+    FCM_ALLOC_RAW(ctx, C->n + 1, next);
+    memcpy(next, cp, sizeof *next * (size_t)C->n);
     for (fcm_index i = 0; i < C->n; i++)
       for (fcm_index p = cp[i]; p < cp[i + 1]; p++) {
-        C->tpos[p] = cc[p] > i ? fcm_csr_position(C->Aown, cc[p], i) : -1;
-        FCM_CHECK(cc[p] <= i || C->tpos[p] >= 0, ctx, FCM_ERR_INTERNAL,
-                  "mg: level %d: the Galerkin pattern has (%lld, %d) but not its transpose", l + 1,
-                  (long long)i, cc[p]);
+        const fcm_index j = cc[p];
+        C->tpos[p] = -1;
+        if (j <= i) continue;
+        while (next[j] < cp[j + 1] && cc[next[j]] < i)
+          next[j]++;
+        FCM_CHECK(next[j] < cp[j + 1] && cc[next[j]] == i, ctx, FCM_ERR_INTERNAL,
+                  "mg: level %d: the Galerkin pattern has (%lld, %lld) but not its transpose",
+                  l + 1, (long long)i, (long long)j);
+        C->tpos[p] = next[j]++;
       }
   }
 cleanup:
+  fcm__free(ctx, next);
   return st;
 }
 
@@ -221,6 +231,9 @@ static fcm_status create_patterns(fcm_mg *m, fcm_mg *old, unsigned char *same)
     FCM_ALLOC(ctx, L->n + 1, L->r);
     same[l] = (unsigned char)(old && (kept_above || fcm__mg_level_same(old, m, l)));
     kept_above = l + 1 < m->nlev && same[l] && fcm__mg_keep_plan(old, m, l);
+    /* nothing of old's level l is taken now: its memory goes before this level's arrays
+     * are allocated (the allocator may give it back to them) */
+    if (old && !same[l] && l < old->nlev) fcm__mg_level_free(ctx, &old->lev[l]);
     if (l + 1 < m->nlev && !kept_above) FCM_TRY(ctx, galerkin_pattern(m, l));
     if (same[l]) fcm__mg_keep_orders(old, m, l);
   }
@@ -231,6 +244,7 @@ static fcm_status create_patterns(fcm_mg *m, fcm_mg *old, unsigned char *same)
     for (int l = 0; l + 1 < m->nlev; l++)
       if (!m->lev[l].rows.ptr) FCM_TRY(ctx, fcm__mg_row_slabs(m, &m->lev[l]));
   if (!(old && fcm__mg_keep_analysis(old, m, same[m->nlev - 1]))) {
+    if (old) fcm_direct_destroy(&old->direct); /* not taken: freed first, as above */
     mg_level *Lc = &m->lev[m->nlev - 1];
     FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, fcm__mg_level_matrix(Lc), &m->direct));
     FCM_TRY(ctx, fcm_direct_analyze(m->direct));

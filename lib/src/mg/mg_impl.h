@@ -64,8 +64,9 @@ typedef struct fcm__mg_kept {
  * fcm_mg_create() bit for bit (lib/src/mg/update.c lists the parts and what each is compared
  * on). Reads only the arrays *old owns, and its level-0 matrix unless detached
  * (fcm__mg_detach()): that matrix must then still be alive, its pattern unchanged. *old is
- * destroyed (*old = NULL) whatever the result. Octree hierarchies, and options or thread
- * counts other than old's, keep nothing. @return as fcm_mg_create(). */
+ * destroyed (*old = NULL) whatever the result; a level of *old found not to be taken is freed
+ * as soon as that is known, before the new level's arrays are allocated. Octree hierarchies, and
+ * options or thread counts other than old's, keep nothing. @return as fcm_mg_create(). */
 FCM_COMPONENT_API fcm_status fcm__mg_create_from(fcm_ctx *ctx, fcm_mg **old, const fcm_space *space,
                                                  const fcm_csr *A, const fcm_mg_options *opts,
                                                  fcm_mg **mg);

@@ -186,32 +186,47 @@ static fcm_status block_slabs(fcm_mg *m, mg_level *L)
   const fcm_index *rp = fcm_csr_row_ptr(A);
   const int *ci = fcm_csr_col_idx(A);
   const fcm_index nb = fcm__schwarz_num_blocks(L->blk), n = L->n;
-  fcm_index *pairs = NULL, *seq = NULL, *last = NULL, *reach = NULL;
+  fcm_index *first = NULL, *seq = NULL, *last = NULL, *reach = NULL, *row_reach = NULL;
   double *work = NULL;
-  FCM_ALLOC_RAW(ctx, 2 * nb + 1, pairs);
+  /* the blocks by their smallest DOF, ties in block order: a counting sort (stable) */
+  FCM_ALLOC_RAW(ctx, nb + 1, first);
+  FCM_ALLOC_RAW(ctx, nb + 1, seq);
+  FCM_ALLOC_RAW(ctx, nb + 1, reach);
+  FCM_ALLOC_RAW(ctx, nb + 1, work);
+  FCM_ALLOC(ctx, n + 2, last); /* first the count of each smallest DOF, then the map below */
   for (fcm_index k = 0; k < nb; k++) {
     const fcm_index *d = NULL;
     const double *S = NULL;
     const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
-    fcm_index first = n;
+    fcm_index f = n;
     for (int i = 0; i < bm; i++)
-      first = FCM_MIN(first, d[i]);
-    pairs[2 * k] = first, pairs[2 * k + 1] = k;
+      f = FCM_MIN(f, d[i]);
+    first[k] = f;
+    last[f + 1]++;
   }
-  if (nb > 0) qsort(pairs, (size_t)nb, 2 * sizeof *pairs, cmp_pair);
-  FCM_ALLOC_RAW(ctx, nb + 1, seq);
-  FCM_ALLOC_RAW(ctx, nb + 1, reach);
-  FCM_ALLOC_RAW(ctx, nb + 1, work);
-  FCM_ALLOC_RAW(ctx, n + 1, last);
+  for (fcm_index i = 0; i < n; i++)
+    last[i + 1] += last[i];
+  for (fcm_index k = 0; k < nb; k++)
+    seq[last[first[k]]++] = k;
   for (fcm_index i = 0; i < n; i++)
     last[i] = -1;
   for (fcm_index t = 0; t < nb; t++) { /* last[i]: the last position of a block holding row i */
     const fcm_index *d = NULL;
     const double *S = NULL;
-    seq[t] = pairs[2 * t + 1];
     const int bm = fcm__schwarz_block(L->blk, seq[t], &d, &S);
     for (int i = 0; i < bm; i++)
       last[d[i]] = t;
+  }
+  /* the last block position a row's columns reach, once per row of a block (the blocks
+   * overlap: a cut cell's row lies in up to nine of them) */
+  FCM_ALLOC_RAW(ctx, n + 1, row_reach);
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (n > 4096)
+  for (fcm_index i = 0; i < n; i++) {
+    fcm_index r = -1;
+    if (last[i] >= 0)
+      for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+        r = FCM_MAX(r, last[ci[p]]);
+    row_reach[i] = r;
   }
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (nb > 1024)
   for (fcm_index t = 0; t < nb; t++) {
@@ -222,18 +237,18 @@ static fcm_status block_slabs(fcm_mg *m, mg_level *L)
     fcm_index r = t, entries = 0;
     for (int i = 0; i < bm; i++) {
       entries += rp[d[i] + 1] - rp[d[i]];
-      for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++)
-        r = FCM_MAX(r, last[ci[p]]);
+      r = FCM_MAX(r, row_reach[d[i]]);
     }
     reach[t] = r;
     work[k] = (double)entries + (double)bm * (double)bm;
   }
   FCM_TRY(ctx, slabs_create(ctx, nb, seq, reach, work, 0, &L->blocks));
 cleanup:
-  fcm__free(ctx, pairs);
+  fcm__free(ctx, first);
   fcm__free(ctx, seq);
   fcm__free(ctx, last);
   fcm__free(ctx, reach);
+  fcm__free(ctx, row_reach);
   fcm__free(ctx, work);
   return st;
 }
@@ -571,6 +586,7 @@ typedef struct sweep_args {
   const double *b;
   double *x;
   double *r, *dx;
+  fcm__schwarz_view blk; /* block sweeps: L's blocks */
 } sweep_args;
 
 /* One symmetric Gauss-Seidel sweep in the slab order S (forward, then backward) by the team
@@ -672,7 +688,7 @@ void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x)
     }
     return;
   }
-  const sweep_args a = {L, w, b, x, NULL, NULL};
+  const sweep_args a = {L, w, b, x, NULL, NULL, {0}};
   symmetric_sweep(&L->rows, sgs_slab, &a);
 }
 
@@ -690,9 +706,9 @@ static void block_slab(const sweep_args *a, fcm_index s, int back)
   const fcm_index q0 = L->blocks.ptr[s], q1 = L->blocks.ptr[s + 1];
   for (fcm_index t = 0; t < q1 - q0; t++) {
     const fcm_index k = L->blocks.item[back ? q1 - 1 - t : q0 + t];
-    const fcm_index *d = NULL;
-    const double *S = NULL;
-    const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
+    const fcm_index *d = a->blk.dofs + a->blk.ptr[k];
+    const double *S = a->blk.S + a->blk.s_off[k];
+    const int bm = (int)(a->blk.ptr[k + 1] - a->blk.ptr[k]);
     for (int i = 0; i < bm; i++)
       r[i] = b[d[i]] - fcm__mg_row_dot(v, ci, rp[d[i]], rp[d[i] + 1], x);
     for (int i = 0; i < bm; i++)
@@ -726,8 +742,9 @@ static void one_way_sweep(const slab_order *S,
 void fcm__mg_block_smooth(const fcm_mg *m, const mg_level *L, const double *b, double *x, int post)
 {
   const size_t t = (size_t)omp_get_thread_num();
-  const sweep_args a = {
-      L, 0.0, b, x, m->blk_r + t * (size_t)m->blk_max, m->blk_dx + t * (size_t)m->blk_max};
+  sweep_args a = {
+      L, 0.0, b, x, m->blk_r + t * (size_t)m->blk_max, m->blk_dx + t * (size_t)m->blk_max, {0}};
+  fcm__schwarz_get_view(L->blk, &a.blk);
   if (m->opts.block_sweep)
     one_way_sweep(&L->blocks, block_slab, &a, post);
   else

@@ -7,7 +7,7 @@
  *   pattern of A_{l+1}, its diagonal positions and transposed positions: from the pattern of
  *   A_l, P_l (pattern and weights) and the size of level l + 1;
  * - the SGS row slabs and the colours of level l: from the pattern of A_l;
- * - the block smoother of level l (its blocks, incidence and scratch; its values are set up
+ * - the block smoother of level l (its blocks, positions and scratch; its values are set up
  *   again) and the blocks' slabs: from the blocks and the pattern of A_l;
  * - the coarsest level's symbolic analysis: from the pattern of its matrix.
  *

@@ -43,8 +43,9 @@ struct fcm_schwarz {
   int *pos;             /* as S: where C_K's entry (i, j) lies in C's row dofs[i] (-1: none) */
   unsigned char *full;  /* num_blocks: every entry of C_K is stored (pos holds them all) */
   int max_m;
-  int num_colors;        /* of the block graph (statistics only) */
-  fcm_index *inc_ptr;    /* n + 1: DOF i is row inc_row[q] of block inc_blk[q], q in range */
+  int num_colors;        /* of the block graph (statistics only; 0 when blocks_only) */
+  fcm_index *inc_ptr;    /* n + 1: DOF i is row inc_row[q] of block inc_blk[q], q in range
+                            (NULL when blocks_only, as inc_blk, inc_row and dinv) */
   fcm_index *inc_blk;    /* block_ptr[num_blocks], ascending blocks per DOF */
   int *inc_row;          /* block_ptr[num_blocks] */
   unsigned char *inside; /* n: DOF belongs to a block */
@@ -531,7 +532,7 @@ static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
   FCM_ALLOC(ctx, FCM_MAX(total, 1), P->dofs);
   FCM_ALLOC(ctx, num_blocks + 1, P->s_off);
   FCM_ALLOC(ctx, nr, P->inside);
-  FCM_ALLOC(ctx, nr, P->dinv);
+  if (!blocks_only) FCM_ALLOC(ctx, nr, P->dinv);
   for (fcm_index b = 0; b < num_blocks; b++) {
     fcm_index m = block_ptr[b + 1] - block_ptr[b];
     P->block_ptr[b + 1] = block_ptr[b + 1];
@@ -546,10 +547,11 @@ static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
     for (fcm_index i = 0; i < nr; i++)
       P->diag[i] = P->inside[i] ? -1 : fcm_csr_position(C, i, i);
   }
-  FCM_ALLOC(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->S);
-  FCM_ALLOC(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->pos);
-  FCM_ALLOC(ctx, num_blocks + 1, P->full); /* zero: the first setup scans */
-  FCM_TRY(ctx, incidence_and_colors(P));
+  /* S and pos are written in full by the first setup (below) before anything reads them */
+  FCM_ALLOC_RAW(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->S);
+  FCM_ALLOC_RAW(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->pos);
+  FCM_ALLOC(ctx, num_blocks + 1, P->full);                 /* zero: the first setup scans */
+  if (!blocks_only) FCM_TRY(ctx, incidence_and_colors(P)); /* the apply's */
   /* setup scratch: the eigensolver workspace of the largest need over the block sizes */
   P->nt = fcm_ctx_num_threads(ctx);
   for (fcm_index b = 0, m_prev = -1; b < num_blocks; b++) {
@@ -641,6 +643,11 @@ int fcm__schwarz_block(const fcm_schwarz *P, fcm_index k, const fcm_index **dofs
   *dofs = P->dofs + P->block_ptr[k];
   *S = P->S + P->s_off[k];
   return (int)(P->block_ptr[k + 1] - P->block_ptr[k]);
+}
+
+void fcm__schwarz_get_view(const fcm_schwarz *P, fcm__schwarz_view *v)
+{
+  v->ptr = P->block_ptr, v->dofs = P->dofs, v->s_off = P->s_off, v->S = P->S;
 }
 
 fcm_status fcm_schwarz_operator(void *user, const double *r, double *z)

@@ -15,6 +15,15 @@
  * S_K (symmetric, row major), valid after a successful setup. */
 fcm_index fcm__schwarz_num_blocks(const fcm_schwarz *P);
 int fcm__schwarz_block(const fcm_schwarz *P, fcm_index k, const fcm_index **dofs, const double **S);
+/* The same blocks as arrays, for sweeps that read them in their inner loop: block k's DOFs are
+ * dofs[ptr[k] .. ptr[k + 1]), its S_K starts at S + s_off[k]. The arrays stay in place for
+ * the life of P (setups rewrite S's values only). */
+typedef struct fcm__schwarz_view {
+  const fcm_index *ptr, *dofs;
+  const size_t *s_off;
+  const double *S;
+} fcm__schwarz_view;
+void fcm__schwarz_get_view(const fcm_schwarz *P, fcm__schwarz_view *v);
 /* fcm_schwarz_create() for a block smoother: a setup computes the S_K, nothing else (no
  * diagonal outside the blocks); fcm_schwarz_apply() refuses it. */
 fcm_status fcm__schwarz_create_blocks(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
