@@ -21,6 +21,9 @@ class CellRules(FcmObject):
 
     - kinds: volume rules to build, bits RULES_STIFFNESS | RULES_MASS (default both)
     - strength: per kind (stiffness, mass), DEFAULT the element's; a number sets both
+    - axis_degree: per kind, the cut-cell rules' moment space is capped at this degree in
+      each variable (DEFAULT: the element's, Hex8's mass 2, i.e. the tensor space Q2 of
+      trilinear products; an explicit strength without it means the whole total degree)
     - surface_strength: triangle rule strength of surface rules (DEFAULT: none)
     - min_fraction (1e-4), uncut_fraction (1 - 1e-12): the class thresholds
     - clip_rtol, sliver_rtol, convex_rtol: clipping, sliver and convexity tolerances
@@ -59,7 +62,8 @@ class CellRules(FcmObject):
 
     @property
     def info(self):
-        """num_cells, element_type, strength per kind, surface_strength, has_kind, num_cuts,
+        """num_cells, element_type, strength per kind, axis_degree per kind (the degree cap in
+        each variable of the cut cells' moment space), surface_strength, has_kind, num_cuts,
         num_pieces, num_links."""
         return _fcm.rules_info(self._h)
 

@@ -6,6 +6,7 @@
 static const fcmpy_option rules_table[] = {
     {"kinds", 'u', 1, RO(kinds)},
     {"strength", 'i', FCM_RULE_KIND_COUNT, RO(strength)},
+    {"axis_degree", 'i', FCM_RULE_KIND_COUNT, RO(axis_degree)},
     {"surface_strength", 'i', 1, RO(surface_strength)},
     {"min_fraction", 'd', 1, RO(min_fraction)},
     {"uncut_fraction", 'd', 1, RO(uncut_fraction)},
@@ -144,10 +145,12 @@ static PyObject *rules_info(PyObject *self, PyObject *rh)
   const fcm_cell_rules *r = fcmpy_get(rh, FCMPY_RULES);
   if (!r) return NULL;
   return Py_BuildValue(
-      "{s:L,s:i,s:(ii),s:i,s:(ii),s:i,s:L,s:L}", "num_cells",
+      "{s:L,s:i,s:(ii),s:(ii),s:i,s:(ii),s:i,s:L,s:L}", "num_cells",
       (long long)fcm_cell_rules_num_cells(r), "element_type", (int)fcm_cell_rules_element_type(r),
       "strength", fcm_cell_rules_strength(r, FCM_RULE_STIFFNESS),
-      fcm_cell_rules_strength(r, FCM_RULE_MASS), "surface_strength",
+      fcm_cell_rules_strength(r, FCM_RULE_MASS), "axis_degree",
+      fcm_cell_rules_axis_degree(r, FCM_RULE_STIFFNESS),
+      fcm_cell_rules_axis_degree(r, FCM_RULE_MASS), "surface_strength",
       fcm_cell_rules_surface_strength(r), "has_kind",
       fcm_cell_rules_has_kind(r, FCM_RULE_STIFFNESS), fcm_cell_rules_has_kind(r, FCM_RULE_MASS),
       "num_cuts", fcm_cell_rules_num_cuts(r), "num_pieces", (long long)fcm_cell_rules_num_pieces(r),

@@ -39,6 +39,26 @@ def test_box_monomials_exact(ctx, element):
         assert got == pytest.approx(box_moment(lo, hi, a), rel=1e-12, abs=1e-14), a
 
 
+def test_hex8_mass_on_q2(ctx):
+    """Hex8's cut-cell mass rules are exact on Q2 (degree <= 2 in each variable, x^2 y^2 z^2
+    included) by default, and the whole P6 with axis_degree 6; info reports the caps."""
+    lo, hi = np.array([0.13, 0.21, 0.07]), np.array([0.71, 0.93, 0.66])
+    mesh = fcm.Mesh.box(ctx, fcm.HEX8, [0, 0, 0], [1, 1, 1], [3, 3, 3])
+    body = fcm.Geometry.box(ctx, lo, hi, [2, 3, 2])
+    q2 = fcm.CellRules(ctx, mesh, body, kinds=fcm.RULES_MASS)
+    assert q2.info["strength"][fcm.MASS] == 6 and q2.info["axis_degree"][fcm.MASS] == 2
+    p6 = fcm.CellRules(ctx, mesh, body, kinds=fcm.RULES_MASS, axis_degree=[-1, 6])
+    assert p6.info["axis_degree"][fcm.MASS] == 6
+    for rules, cap in ((q2, 2), (p6, 6)):
+        x, w = authentic(rules.points(fcm.MASS))
+        for a in itertools.product(range(7), repeat=3):
+            if sum(a) > 6 or max(a) > cap:
+                continue
+            got = np.sum(w * x[:, 0] ** a[0] * x[:, 1] ** a[1] * x[:, 2] ** a[2])
+            assert got == pytest.approx(box_moment(lo, hi, a), rel=1e-12, abs=1e-14), (cap, a)
+    assert len(q2.points(fcm.MASS)["weight"]) < len(p6.points(fcm.MASS)["weight"])
+
+
 def test_ball_volume_centroid_and_surface(ctx):
     """The faceted ball: the rules' volume is the polyhedron's, its centroid the centre; the
     surface rules satisfy the divergence theorem: sum w n = 0 and sum w (x . n) = 3 V."""

@@ -1,6 +1,7 @@
 /* FCM_CELL_SIMPLIFY_AUTO: whether simplifying the cut-cell rules pays, from a deterministic
  * model of the simplification time against the assembly time of the points it removes. */
 #include "embed/rules_impl.h"
+#include "simplify/simplify_impl.h"
 #include "fcm/la.h"
 
 #include <math.h>
@@ -109,7 +110,8 @@ fcm_status fcm__embed_auto_simplify(const build *B, fcm_cell_rules *R, int nthre
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     if (!B->tet_rule[k]) continue;
     const int m = R->strength[k];
-    const double M = (double)(m + 1) * (m + 2) * (m + 3) / 6.0;
+    /* the points a simplified rule keeps: the moments of its space (Q2 for Hex8's mass) */
+    const double M = (double)fcm__simplify_space_size(m, R->axis_degree[k]);
     for (fcm_index i = 0; i < ncut; i++) {
       const fcm_index n = cut[i]->ninit[k];
       in[3 * k] += (double)n;
