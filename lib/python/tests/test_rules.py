@@ -47,7 +47,7 @@ def test_hex8_mass_on_q2(ctx):
     body = fcm.Geometry.box(ctx, lo, hi, [2, 3, 2])
     q2 = fcm.CellRules(ctx, mesh, body, kinds=fcm.RULES_MASS)
     assert q2.info["strength"][fcm.MASS] == 6 and q2.info["axis_degree"][fcm.MASS] == 2
-    p6 = fcm.CellRules(ctx, mesh, body, kinds=fcm.RULES_MASS, axis_degree=[-1, 6])
+    p6 = fcm.CellRules(ctx, mesh, body, kinds=fcm.RULES_MASS, axis_degree=[fcm.DEFAULT, 6])
     assert p6.info["axis_degree"][fcm.MASS] == 6
     for rules, cap in ((q2, 2), (p6, 6)):
         x, w = authentic(rules.points(fcm.MASS))
