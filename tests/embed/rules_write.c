@@ -145,6 +145,10 @@ static void write_and_check(const fcm_mesh *mesh, const fcm_cell_rules *r, const
   TEST_TRUE(strstr(f.header, "\"format\": \"fcm-cell-rules\"") &&
             strstr(f.header, "\"element\": \"hex8\""));
   TEST_TRUE(rf_number_after(f.header, "\"num_pieces\": ") == fcm_cell_rules_num_pieces(r));
+  /* version 2 exactly when a rule is exact on a capped space only (Hex8's mass on Q_2) */
+  const int capped =
+      fcm_cell_rules_axis_degree(r, FCM_RULE_MASS) < fcm_cell_rules_strength(r, FCM_RULE_MASS);
+  TEST_TRUE(rf_number_after(f.header, "\"version\": ") == (capped ? 2 : 1));
   check_same(&f, r, "stiffness", FCM_RULE_STIFFNESS);
   check_same(&f, r, "mass", FCM_RULE_MASS);
   check_exact(&f, r);
@@ -231,6 +235,14 @@ int main(void)
   TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, r, cut, &rc));
   TEST_TRUE(fcm_cell_rules_num_pieces(rc) > fcm_cell_rules_num_pieces(r));
   write_and_check(mesh, rc, WORK "/cut.fcmr");
+  TEST_TRUE(fcm_cell_rules_axis_degree(rc, FCM_RULE_MASS) == 2); /* the default: version 2 */
+  /* the mass rules on all of P_6 (an explicit strength): a version-1 file */
+  fcm_cell_rules *r6 = NULL;
+  o.strength[FCM_RULE_MASS] = 6;
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &o, &r6));
+  TEST_TRUE(fcm_cell_rules_axis_degree(r6, FCM_RULE_MASS) == 6);
+  write_and_check(mesh, r6, WORK "/p6.fcmr");
+  fcm_cell_rules_destroy(&r6);
   errors(mesh, r);
   fcm_surface_destroy(&cut);
   fcm_cell_rules_destroy(&rc);

@@ -73,8 +73,10 @@ public:
     data_ = 16 + hlen;
     std::istringstream hs(std::string(bytes_.data() + 16, hlen));
     boost::property_tree::read_json(hs, header_);
-    if (header_.get<std::string>("format") != "fcm-cell-rules" || header_.get<int>("version") != 1)
-      fail("not version 1 of the format");
+    // version 2 only adds a rule's axis_degree (the points integrate what they did)
+    const int version = header_.get<int>("version");
+    if (header_.get<std::string>("format") != "fcm-cell-rules" || version < 1 || version > 2)
+      fail("not version 1 or 2 of the format");
     if (data_ + header_.get<std::uint64_t>("data_bytes") != bytes_.size())
       fail("truncated (data_bytes does not match the file size)");
     for (const auto &a : header_.get_child("arrays")) {

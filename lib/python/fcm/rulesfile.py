@@ -25,7 +25,7 @@ import numpy as np
 __all__ = ["RulesFile", "RulesFileError", "read", "MAGIC", "VERSION"]
 
 MAGIC = b"FCMRULES"
-VERSION = 1  # the newest version this reader knows
+VERSION = 2  # the newest version this reader knows (2: rules with an axis_degree cap)
 
 _DTYPES = {"float64": "<f8", "int64": "<i8", "int32": "<i4", "uint8": "u1"}
 CELL_CLASSES = ("uncut", "cut", "dropped")

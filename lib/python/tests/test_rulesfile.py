@@ -7,6 +7,7 @@ The program is taken from $FCM_QUADRATURE, else from the PATH, else from a build
 beside the sources (build/); without it the tests are skipped."""
 
 import os
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -61,6 +62,16 @@ def test_header(box_rules):
     assert r.element == "hex8" and r.num_cells == 27 and r.num_pieces <= 27
     assert r.kinds == ["stiffness", "mass"] and r.has_surface
     assert r.header["rules"]["stiffness"]["strength"] == STRENGTH
+    # Hex8's mass rules are exact on Q_2 only (degree <= 2 per variable): version 2
+    mass = r.header["rules"]["mass"]
+    assert mass["axis_degree"] == 2 < mass["strength"] and r.header["version"] == 2
+
+
+@needs_program
+def test_uncapped_rules_are_version_1(tmp_path):
+    r = export(tmp_path, "p6.fcmr", "--mass-strength", "6")
+    mass = r.header["rules"]["mass"]
+    assert mass["axis_degree"] == mass["strength"] == 6 and r.header["version"] == 1
     assert "export" in r.header["description"]
     assert r["mesh/cells"].shape == (27, 8) and r["mesh/nodes"].shape == (64, 3)
 
@@ -185,7 +196,8 @@ def test_malformed_files(tmp_path, box_rules):
     refused(b"NOTRULES" + good[8:], "not an fcm rules file")
     refused(good[:-8], "truncated")
     refused(good[:12], "not an fcm rules file")
-    refused(good.replace(b'"version": 1,', b'"version": 7,', 1), "version 7 not supported")
+    refused(re.sub(rb'"version": [0-9]+,', b'"version": 7,', good, count=1),
+            "version 7 not supported")
     refused(good.replace(b'"format": "fcm-cell-rules"', b'"format": "fcm-cell-rulez"', 1),
             "format")
     hlen = int.from_bytes(good[8:16], "little")
