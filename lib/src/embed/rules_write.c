@@ -7,13 +7,13 @@
 #include <stdint.h>
 #include <string.h>
 
-#define RULES_MAGIC      "FCMRULES"
+#define RULES_MAGIC "FCMRULES"
 /* Version 2 adds a rule's "axis_degree" below its strength (a rule exact on a capped space,
  * as Hex8's mass on Q_2); a file without such a rule is written as version 1, which every
  * reader of version 1 reads right. A version-1 reader refuses version 2 instead of taking a
  * capped rule for exact on all of P_m. */
 #define RULES_VERSION_CAPPED 2
-#define RULES_MAX_ARRAYS 32 /* at most 5 per cell and piece + 2 x 6 volume + 6 surface + 2 mesh */
+#define RULES_MAX_ARRAYS     32 /* at most 5 per cell and piece + 2 x 6 volume + 6 surface + 2 mesh */
 
 /* Where an array's values come from. */
 typedef enum source {
@@ -231,10 +231,11 @@ static fcm_status header_body(text *t, const fcm_cell_rules *R, const fcm_mesh *
   int version = 1;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     if (fcm_cell_rules_has_kind(R, (fcm_rule_kind)k) &&
-        fcm_cell_rules_axis_degree(R, (fcm_rule_kind)k) < fcm_cell_rules_strength(R, (fcm_rule_kind)k))
+        fcm_cell_rules_axis_degree(R, (fcm_rule_kind)k) <
+            fcm_cell_rules_strength(R, (fcm_rule_kind)k))
       version = RULES_VERSION_CAPPED;
-  FCM_TRY(ctx, text_printf(t, "{\n  \"format\": \"fcm-cell-rules\",\n  \"version\": %d,\n",
-                           version));
+  FCM_TRY(ctx,
+          text_printf(t, "{\n  \"format\": \"fcm-cell-rules\",\n  \"version\": %d,\n", version));
   FCM_TRY(ctx, text_printf(t, "  \"byte_order\": \"little\",\n  \"element\": \"%s\",\n", ei->name));
   FCM_TRY(ctx, text_printf(t, "  \"reference_cell\": \"%s\",\n",
                            ei->shape == FCM_SHAPE_HEX ? "[-1,1]^3" : "unit tetrahedron"));
