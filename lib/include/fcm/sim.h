@@ -364,10 +364,13 @@ typedef struct fcm_step_info {
   long long total_analyses;       /**< symbolic analyses (CHOLMOD and UMFPACK) */
   long long total_factorizations; /**< numeric factorizations / preconditioner setups */
   long long total_direct_fallbacks;
-  double time_assembly; /**< seconds: energy, force, tangent and damping assembly */
-  double time_factor;   /**< seconds: factorization or preconditioner setup */
-  double time_solve;    /**< seconds: triangular or Krylov solves */
-  double time_total;    /**< seconds of the whole step */
+  long long total_multigrid_creations; /**< multigrid hierarchies created, prepared ones
+                                            (fcm_integrator_prepare_solver()) included: a
+                                            step that only sets up the values creates none */
+  double time_assembly;                /**< seconds: energy, force, tangent and damping assembly */
+  double time_factor;                  /**< seconds: factorization or preconditioner setup */
+  double time_solve;                   /**< seconds: triangular or Krylov solves */
+  double time_total;                   /**< seconds of the whole step */
 } fcm_step_info;
 
 /** A scalar function of time, e.g. the time scaling of a load. */
@@ -805,6 +808,20 @@ FCM_API fcm_status fcm_integrator_contact_eval(fcm_integrator *integ, const doub
  * Allocates; a second call is FCM_ERR_ARG. */
 FCM_API fcm_status fcm_integrator_setup(fcm_integrator *integ);
 
+/** Build the linear solver's structure for the current matrix pattern and active
+ * constraints, before the step that needs it: with FCM_LINEAR_MULTIGRID (serial, no hanging
+ * nodes) the hierarchy without matrix values (cells, copies, prolongations, Galerkin plans and
+ * coarse patterns, smoother orders, block smoothers' blocks, the coarsest symbolic analysis),
+ * so that the next step only sets up its values, as a step with an unchanged active set does;
+ * the direct solver's analysis is made by fcm_integrator_setup() already. Nothing for the
+ * other solvers, nor when the structure is there. fcm_integrator_create_cut() calls it (a
+ * cut's solver phase, timed in fcm_integrator_setup_info.solver_seconds). When the step's
+ * active set or eliminated rows differ from the prepared ones, the step builds the hierarchy
+ * again (from this one); results do not depend on whether this was called.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, not set up), errors of the hierarchy's creation
+ * (FCM_ERR_UNSUPPORTED: not a Hex8 or Hex20 box grid), FCM_ERR_ALLOC. Allocates. */
+FCM_API fcm_status fcm_integrator_prepare_solver(fcm_integrator *integ);
+
 /** Advance by one step of options.dt (static: solve the equilibrium at t + dt, ramping the
  * loads from those of the last accepted step — zero before the first — in load_steps
  * increments). A failed (sub)step is retried from its start with half the increment, at
@@ -956,6 +973,11 @@ typedef struct fcm_integrator_setup_info {
   fcm_index refine_extrapolated; /**< after fcm_integrator_create_refined(): the new DOF nodes
                                       in no active cell of the old space, whose state was
                                       extrapolated from the nearest old cell; else 0 */
+  double solver_seconds; /**< wall seconds building the linear solver's structure, which needs
+                              no matrix value: the symbolic analysis of the direct solver (in
+                              the setup) and the multigrid hierarchy prepared by
+                              fcm_integrator_prepare_solver() (fcm_integrator_create_cut()
+                              calls it) */
 } fcm_integrator_setup_info;
 
 /** Copy the setup counts out (zeros for NULL). */

@@ -470,10 +470,12 @@ cleanup:
   return st;
 }
 
-/* fcm_schwarz_create(); blocks_only: for the block smoother (fcm__schwarz_create_blocks()). */
+/* fcm_schwarz_create(); blocks_only: for the block smoother (fcm__schwarz_create_blocks()),
+ * set up now unless values_later. */
 static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
                          const fcm_index *block_ptr, const fcm_index *block_dofs,
-                         const fcm_schwarz_options *opts, int blocks_only, fcm_schwarz **out)
+                         const fcm_schwarz_options *opts, int blocks_only, int values_later,
+                         fcm_schwarz **out)
 {
   fcm_status st = FCM_OK;
   fcm_schwarz *P = NULL;
@@ -576,7 +578,7 @@ static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
   P->info.num_colors = P->num_colors;
   for (fcm_index i = 0; i < nr; i++)
     P->info.outside_dofs += !P->inside[i];
-  FCM_TRY(ctx, fcm_schwarz_setup(P, C));
+  if (!values_later) FCM_TRY(ctx, fcm_schwarz_setup(P, C));
   *out = P;
   P = NULL;
 cleanup:
@@ -589,14 +591,21 @@ fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_bloc
                               const fcm_index *block_ptr, const fcm_index *block_dofs,
                               const fcm_schwarz_options *opts, fcm_schwarz **out)
 {
-  return create(ctx, C, num_blocks, block_ptr, block_dofs, opts, 0, out);
+  return create(ctx, C, num_blocks, block_ptr, block_dofs, opts, 0, 0, out);
 }
 
 fcm_status fcm__schwarz_create_blocks(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
                                       const fcm_index *block_ptr, const fcm_index *block_dofs,
                                       fcm_schwarz **out)
 {
-  return create(ctx, C, num_blocks, block_ptr, block_dofs, NULL, 1, out);
+  return create(ctx, C, num_blocks, block_ptr, block_dofs, NULL, 1, 0, out);
+}
+
+fcm_status fcm__schwarz_create_blocks_pattern(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
+                                              const fcm_index *block_ptr,
+                                              const fcm_index *block_dofs, fcm_schwarz **out)
+{
+  return create(ctx, C, num_blocks, block_ptr, block_dofs, NULL, 1, 1, out);
 }
 
 fcm_status fcm_schwarz_apply(const fcm_schwarz *P, const double *r, double *z)
