@@ -8,12 +8,44 @@
  * the cut creates no hierarchy (total_multigrid_creations stays 1). When a constraint is
  * released between the cut and the next step, the step finds another active set and builds the
  * hierarchy again (from the prepared one), with the same bits. The direct solver's analysis
- * stays the cut's too (the step after it analyses nothing). Usage: sim_cut_prepare <element> */
+ * stays the cut's too (the step after it analyses nothing). Each allocation of the preparation
+ * failed in turn returns FCM_ERR_ALLOC and leaks nothing. Usage: sim_cut_prepare <element> */
 #include "sim_util.h"
+#include "test_alloc.h"
 
 #include <string.h>
 
 static fcm_ctx *ctx;
+static failing counter = {0, -1}; /* the context's allocator, counting */
+
+/* Fail the k-th allocation of fcm_integrator_prepare_solver() on an integrator without a
+ * hierarchy, k = 0, 1, ... until it succeeds: FCM_ERR_ALLOC, no hierarchy, nothing leaked;
+ * a call once it is built allocates nothing. */
+static void prepare_alloc_failures(fcm_integrator *I)
+{
+  const long long live = fcm_ctx_live_allocations(ctx);
+  fcm_status st = FCM_ERR_ALLOC;
+  long long k = 0;
+  for (; st != FCM_OK && k < 100000; k++) {
+    counter.count = 0, counter.fail_at = k;
+    st = fcm_integrator_prepare_solver(I);
+    if (st != FCM_OK) {
+      TEST_TRUE(st == FCM_ERR_ALLOC);
+      TEST_TRUE(fcm_integrator_multigrid(I) == NULL);
+      TEST_TRUE(fcm_ctx_live_allocations(ctx) == live);
+      fcm_ctx_error_clear(ctx);
+    }
+  }
+  counter.fail_at = -1;
+  TEST_OK(ctx, st);
+  TEST_TRUE(fcm_integrator_multigrid(I) != NULL);
+  const long long before = counter.count = 0;
+  TEST_OK(ctx, fcm_integrator_prepare_solver(I));
+  TEST_TRUE(counter.count == before);
+  printf("  prepare_solver: each of its %lld allocations failed in turn: FCM_ERR_ALLOC, nothing "
+         "leaked\n",
+         k - 1);
+}
 
 static const fcm_material mat = {FCM_MATERIAL_LINEAR, 2.0e4, 0.3, 1000.0};
 static const double gravity[3] = {0.0, -9.81, 0.0};
@@ -41,8 +73,8 @@ static void add_effects(fcm_integrator *I, const fcm_mesh *mesh, double release_
 
 /* The integrator of `space` built from scratch in the state old's cut leaves. */
 static fcm_integrator *rebuild(const fcm_integrator *old, const fcm_space *old_space,
-                               const fcm_space *space, const fcm_mesh *mesh, const fcm_integrator_options *o,
-                               double release_at)
+                               const fcm_space *space, const fcm_mesh *mesh,
+                               const fcm_integrator_options *o, double release_at)
 {
   fcm_integrator *I = NULL;
   const fcm_index n = fcm_space_num_dofs(space), n0 = fcm_integrator_num_dofs(old);
@@ -88,8 +120,7 @@ static void step_both(fcm_integrator *a, fcm_integrator *b, int steps, long long
 
 /* Step, cut, compare with a rebuild; release_at > 0: a constraint released before the step
  * after the cut. */
-static void cut_case(fcm_element_type type, fcm_linear_solver solver, int cycle_index,
-                     int release)
+static void cut_case(fcm_element_type type, fcm_linear_solver solver, int cycle_index, int release)
 {
   const double lo[3] = {-0.3, -0.3, -0.3}, hi[3] = {1.3, 0.9, 0.9};
   const double glo[3] = {0, 0, 0}, ghi[3] = {1, 0.6, 0.6};
@@ -140,6 +171,11 @@ static void cut_case(fcm_element_type type, fcm_linear_solver solver, int cycle_
     TEST_TRUE(fcm_mg_num_levels(mg) >= 3);
     TEST_TRUE(fcm_integrator_multigrid(ref) == NULL);
     step_both(cut, ref, 3, release ? 2 : 1);
+    if (cycle_index == 2) { /* a new integrator on the cut space, prepared under failures */
+      fcm_integrator *J = rebuild(I, space[0], space[1], mesh, &o, 0.0);
+      prepare_alloc_failures(J);
+      fcm_integrator_destroy(&J);
+    }
   } else {
     fcm_step_info ia;
     TEST_OK(ctx, fcm_integrator_step(cut, &ia));
@@ -161,7 +197,8 @@ int main(int argc, char **argv)
 {
   fcm_element_type type;
   if (argc != 2 || fcm_element_type_from_name(argv[1], &type) != FCM_OK) return 2;
-  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  ctx = failing_ctx(&counter);
+  TEST_TRUE(ctx != NULL);
   cut_case(type, FCM_LINEAR_MULTIGRID, 1, 0);
   cut_case(type, FCM_LINEAR_MULTIGRID, 2, 0);
   cut_case(type, FCM_LINEAR_MULTIGRID, 1, 1);
