@@ -398,8 +398,10 @@ FCM_API fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space,
  * extend the rules of old's space by one cut (fcm_cell_rules_create_cut(), then
  * fcm_space_create_embedded()). The new integrator has old's material, options, loads and
  * constraints (same callbacks and user pointers, node lists copied), is set up (mass and
- * loads assembled on the new space; the direct solver analyses the new pattern once, at the
- * first solve), and starts from old's time, step count, displacement and velocity carried
+ * loads assembled on the new space) with its linear solver's structure built for the new
+ * pattern (fcm_integrator_prepare_solver(): the direct solver's symbolic analysis, the
+ * multigrid hierarchy without values; the step after the cut sets up the values only), and
+ * starts from old's time, step count, displacement and velocity carried
  * over by fcm_space_transfer(): every new DOF copy inherits its parent copy's values, so
  * the field, the mass and the linear and angular momentum are unchanged by the cut; the
  * acceleration (when known) likewise, and the load work. A host
@@ -410,7 +412,8 @@ FCM_API fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space,
  * DOFs beside their parents (no AMD / METIS; more fill than a fresh ordering). The DOF
  * numbering is the space's own (fcm_space_create_embedded()), as without them.
  * @return FCM_OK; FCM_ERR_ARG (NULL, old not set up, unrelated space); the errors of
- *         fcm_integrator_setup(); FCM_ERR_ALLOC. Allocates. */
+ *         fcm_integrator_setup() and fcm_integrator_prepare_solver(); FCM_ERR_ALLOC.
+ *         Allocates. */
 FCM_API fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space *space,
                                              fcm_integrator **integ);
 
@@ -830,8 +833,8 @@ FCM_API fcm_status fcm_integrator_prepare_solver(fcm_integrator *integ);
  * the assembly workspace, work vectors and the direct solver's symbolic analysis come from
  * the setup; the tabulated standard rule of an integrand the setup did not assemble, the
  * Jacobi/Schwarz preconditioner and the UMFPACK fallback are made the first time they are
- * needed; the multigrid hierarchy then and again whenever the active constrained DOFs
- * change. Later steps allocate nothing through the context (test sim_step_alloc_*);
+ * needed; the multigrid hierarchy then (unless fcm_integrator_prepare_solver() built it for
+ * the same active set) and again whenever the active constrained DOFs change. Later steps allocate nothing through the context (test sim_step_alloc_*);
  * CHOLMOD's and UMFPACK's numeric factorizations allocate internally (SuiteSparse's malloc).
  * STATIC: before the first solve, and again whenever the active set of constraints changes
  * (a release), the active constraints must hold the six rigid-body modes of every body of the
