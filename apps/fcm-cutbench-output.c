@@ -37,11 +37,11 @@ static const char *yes_no(int v)
 void cutbench_print_header(void)
 {
   printf(
-      "%-15s %-11s %7s %7s %7s %3s %8s %8s %7s %7s %7s %7s %7s %8s %8s %6s %7s | %8s %8s %6s %6s "
-      "%4s %4s %9s\n",
+      "%-15s %-11s %7s %7s %7s %3s %8s %8s %7s %7s %7s %7s %7s %7s %8s %8s %6s %7s | %8s %8s %6s "
+      "%6s %4s %4s %9s\n",
       "row", "solver", "cells", "dofs0", "dofs1", "cut", "cut_s", "cut_max", "rules", "space",
-      "integ", "other", "fact", "step_s", "step_max", "newton", "linear", "paper_c", "paper_s",
-      "c/p", "s/p", "c_ok", "s_ok", "disp_diff");
+      "integ", "struct", "other", "fact", "step_s", "step_max", "newton", "linear", "paper_c",
+      "paper_s", "c/p", "s/p", "c_ok", "s_ok", "disp_diff");
   fflush(stdout);
 }
 
@@ -54,11 +54,11 @@ static void print_run(const cutbench_row *r, int k)
     printf("%-15s %-11s %s: %s\n", p->row, solver, q->skipped ? "skipped" : "FAILED", q->note);
     return;
   }
-  printf("%-15s %-11s %7lld %7lld %7lld %3d %8.4f %8.4f %7.4f %7.4f %7.4f %7.4f %7.4f %8.4f %8.4f "
-         "%6.2f %7.1f | ",
+  printf("%-15s %-11s %7lld %7lld %7lld %3d %8.4f %8.4f %7.4f %7.4f %7.4f %7.4f %7.4f %7.4f "
+         "%8.4f %8.4f %6.2f %7.1f | ",
          p->row, solver, q->cells, q->dofs_before, q->dofs_after, q->events, q->cut_mean,
-         q->cut_max, q->cut_rules, q->cut_space, q->cut_integ, q->cut_other, q->cut_factor,
-         q->step_mean, q->step_max, q->newton, q->linear);
+         q->cut_max, q->cut_rules, q->cut_space, q->cut_integ, q->cut_solver, q->cut_other,
+         q->cut_factor, q->step_mean, q->step_max, q->newton, q->linear);
   if (p->cut_s > 0.0)
     printf("%8.4f ", p->cut_s);
   else
@@ -119,8 +119,8 @@ int cutbench_print_verdicts(const cutbench_row *rows, int n)
 static const char csv_header[] =
     "row,paper,model,paper_size,element,material,solver,status,cell_size,cells,dofs_before,"
     "dofs_after,cut_events,cut_s_mean,cut_s_max,cut_rules_s,cut_space_s,cut_integrator_s,"
-    "cut_other_s,cut_factor_s,setup_s,steps,step_s_mean,step_s_max,newton_per_step,linear_per_step,"
-    "paper_cut_s,paper_step_s,paper_step_max_s,paper_machine,cut_ratio,step_ratio,"
+    "cut_solver_s,cut_other_s,cut_factor_s,setup_s,steps,step_s_mean,step_s_max,newton_per_step,"
+    "linear_per_step,paper_cut_s,paper_step_s,paper_step_max_s,paper_machine,cut_ratio,step_ratio,"
     "step_target_s,cut_ok,step_ok,disp_diff_m,disp_max_m,options,note\n";
 
 static void csv_run(FILE *f, const cutbench_row *r, int k)
@@ -134,7 +134,7 @@ static void csv_run(FILE *f, const cutbench_row *r, int k)
   cli_csv_text(f, k ? "interactive" : "defaults");
   cli_csv_text(f, ok ? "ok" : q->skipped ? "skipped" : "failed");
   cli_csv_number(f, r->h);
-  const double v[18] = {(double)q->cells,
+  const double v[19] = {(double)q->cells,
                         (double)q->dofs_before,
                         (double)q->dofs_after,
                         q->events,
@@ -143,6 +143,7 @@ static void csv_run(FILE *f, const cutbench_row *r, int k)
                         q->cut_rules,
                         q->cut_space,
                         q->cut_integ,
+                        q->cut_solver,
                         q->cut_other,
                         q->cut_factor,
                         q->setup_s,
@@ -152,7 +153,7 @@ static void csv_run(FILE *f, const cutbench_row *r, int k)
                         q->newton,
                         q->linear,
                         0};
-  for (int i = 0; i < 17; i++)
+  for (int i = 0; i < 18; i++)
     cli_csv_number(f, ok ? v[i] : -1.0);
   cli_csv_number(f, p->cut_s > 0.0 ? p->cut_s : -1.0);
   cli_csv_number(f, p->step_s);

@@ -104,8 +104,10 @@ typedef struct cutbench_run {
   int events;               /* cut events applied */
   double cut_mean, cut_max; /* one event's latency: rules + space + integrator */
   double cut_rules, cut_space, cut_integ, cut_other; /* per event, mean */
-  double cut_factor; /* the factorization (or hierarchy) of the step after a cut,
-                        mean over the events */
+  double cut_solver; /* the new linear solver's structure (analysis or hierarchy without
+                        values), per event, mean */
+  double cut_factor; /* the factorization (or the hierarchy's first set-up) of the step after
+                        a cut, mean over the events */
   long long steps;
   double step_mean, step_max; /* wall seconds of a step, the cuts before it excluded */
   double newton, linear;      /* per step, mean */

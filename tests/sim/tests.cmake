@@ -45,6 +45,11 @@ endforeach()
 foreach(el tet4 tet10 hex8 hex20)
   fcm_add_test(sim_cut_update_${el} tests/sim/cut_update.c ARGS ${el})
 endforeach()
+# A cut builds the multigrid solver's hierarchy (and the direct solver's analysis) itself: the
+# step after it sets up values only, with the bits of an integrator built from scratch.
+foreach(el hex8 hex20)
+  fcm_add_test(sim_cut_prepare_${el} tests/sim/cut_prepare.c ARGS ${el})
+endforeach()
 # The element-corotated linear model in the integrator: steps converge, a cut keeps the element
 # stiffness matrices of the elements it leaves and equals a rebuild bit for bit.
 foreach(el tet4 hex8 hex20)

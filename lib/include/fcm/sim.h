@@ -364,10 +364,13 @@ typedef struct fcm_step_info {
   long long total_analyses;       /**< symbolic analyses (CHOLMOD and UMFPACK) */
   long long total_factorizations; /**< numeric factorizations / preconditioner setups */
   long long total_direct_fallbacks;
-  double time_assembly; /**< seconds: energy, force, tangent and damping assembly */
-  double time_factor;   /**< seconds: factorization or preconditioner setup */
-  double time_solve;    /**< seconds: triangular or Krylov solves */
-  double time_total;    /**< seconds of the whole step */
+  long long total_multigrid_creations; /**< multigrid hierarchies created, prepared ones
+                                            (fcm_integrator_prepare_solver()) included: a
+                                            step that only sets up the values creates none */
+  double time_assembly;                /**< seconds: energy, force, tangent and damping assembly */
+  double time_factor;                  /**< seconds: factorization or preconditioner setup */
+  double time_solve;                   /**< seconds: triangular or Krylov solves */
+  double time_total;                   /**< seconds of the whole step */
 } fcm_step_info;
 
 /** A scalar function of time, e.g. the time scaling of a load. */
@@ -395,8 +398,10 @@ FCM_API fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space,
  * extend the rules of old's space by one cut (fcm_cell_rules_create_cut(), then
  * fcm_space_create_embedded()). The new integrator has old's material, options, loads and
  * constraints (same callbacks and user pointers, node lists copied), is set up (mass and
- * loads assembled on the new space; the direct solver analyses the new pattern once, at the
- * first solve), and starts from old's time, step count, displacement and velocity carried
+ * loads assembled on the new space) with its linear solver's structure built for the new
+ * pattern (fcm_integrator_prepare_solver(): the direct solver's symbolic analysis, the
+ * multigrid hierarchy without values; the step after the cut sets up the values only), and
+ * starts from old's time, step count, displacement and velocity carried
  * over by fcm_space_transfer(): every new DOF copy inherits its parent copy's values, so
  * the field, the mass and the linear and angular momentum are unchanged by the cut; the
  * acceleration (when known) likewise, and the load work. A host
@@ -407,7 +412,8 @@ FCM_API fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space,
  * DOFs beside their parents (no AMD / METIS; more fill than a fresh ordering). The DOF
  * numbering is the space's own (fcm_space_create_embedded()), as without them.
  * @return FCM_OK; FCM_ERR_ARG (NULL, old not set up, unrelated space); the errors of
- *         fcm_integrator_setup(); FCM_ERR_ALLOC. Allocates. */
+ *         fcm_integrator_setup() and fcm_integrator_prepare_solver(); FCM_ERR_ALLOC.
+ *         Allocates. */
 FCM_API fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space *space,
                                              fcm_integrator **integ);
 
@@ -805,6 +811,20 @@ FCM_API fcm_status fcm_integrator_contact_eval(fcm_integrator *integ, const doub
  * Allocates; a second call is FCM_ERR_ARG. */
 FCM_API fcm_status fcm_integrator_setup(fcm_integrator *integ);
 
+/** Build the linear solver's structure for the current matrix pattern and active
+ * constraints, before the step that needs it: with FCM_LINEAR_MULTIGRID (serial, no hanging
+ * nodes) the hierarchy without matrix values (cells, copies, prolongations, Galerkin plans and
+ * coarse patterns, smoother orders, block smoothers' blocks, the coarsest symbolic analysis),
+ * so that the next step only sets up its values, as a step with an unchanged active set does;
+ * the direct solver's analysis is made by fcm_integrator_setup() already. Nothing for the
+ * other solvers, nor when the structure is there. fcm_integrator_create_cut() calls it (a
+ * cut's solver phase, timed in fcm_integrator_setup_info.solver_seconds). When the step's
+ * active set or eliminated rows differ from the prepared ones, the step builds the hierarchy
+ * again (from this one); results do not depend on whether this was called.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, not set up), errors of the hierarchy's creation
+ * (FCM_ERR_UNSUPPORTED: not a Hex8 or Hex20 box grid), FCM_ERR_ALLOC. Allocates. */
+FCM_API fcm_status fcm_integrator_prepare_solver(fcm_integrator *integ);
+
 /** Advance by one step of options.dt (static: solve the equilibrium at t + dt, ramping the
  * loads from those of the last accepted step — zero before the first — in load_steps
  * increments). A failed (sub)step is retried from its start with half the increment, at
@@ -813,8 +833,8 @@ FCM_API fcm_status fcm_integrator_setup(fcm_integrator *integ);
  * the assembly workspace, work vectors and the direct solver's symbolic analysis come from
  * the setup; the tabulated standard rule of an integrand the setup did not assemble, the
  * Jacobi/Schwarz preconditioner and the UMFPACK fallback are made the first time they are
- * needed; the multigrid hierarchy then and again whenever the active constrained DOFs
- * change. Later steps allocate nothing through the context (test sim_step_alloc_*);
+ * needed; the multigrid hierarchy then (unless fcm_integrator_prepare_solver() built it for
+ * the same active set) and again whenever the active constrained DOFs change. Later steps allocate nothing through the context (test sim_step_alloc_*);
  * CHOLMOD's and UMFPACK's numeric factorizations allocate internally (SuiteSparse's malloc).
  * STATIC: before the first solve, and again whenever the active set of constraints changes
  * (a release), the active constraints must hold the six rigid-body modes of every body of the
@@ -935,7 +955,8 @@ FCM_API const fcm_csr *fcm_integrator_mass(const fcm_integrator *integ);
 
 /** The multigrid hierarchy of FCM_PRECOND_MULTIGRID or FCM_LINEAR_MULTIGRID (borrowed; for
  * fcm_mg_num_levels() and fcm_mg_get_level_info()): NULL before the first preconditioner
- * setup or solve and without multigrid. Valid until the next fcm_integrator_step() (which may
+ * setup or solve and without multigrid; after fcm_integrator_prepare_solver() the structure
+ * whose values the next step sets up (no cycle before that). Valid until the next fcm_integrator_step() (which may
  * build it again) or the integrator's destruction. */
 FCM_API const fcm_mg *fcm_integrator_multigrid(const fcm_integrator *integ);
 
@@ -956,6 +977,11 @@ typedef struct fcm_integrator_setup_info {
   fcm_index refine_extrapolated; /**< after fcm_integrator_create_refined(): the new DOF nodes
                                       in no active cell of the old space, whose state was
                                       extrapolated from the nearest old cell; else 0 */
+  double solver_seconds; /**< wall seconds building the linear solver's structure, which needs
+                              no matrix value: the symbolic analysis of the direct solver (in
+                              the setup) and the multigrid hierarchy prepared by
+                              fcm_integrator_prepare_solver() (fcm_integrator_create_cut()
+                              calls it) */
 } fcm_integrator_setup_info;
 
 /** Copy the setup counts out (zeros for NULL). */

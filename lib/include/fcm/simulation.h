@@ -169,8 +169,13 @@ typedef struct fcm_simulation_counters {
   double time_cut_rules; /**< of time_cuts: the cut cells' rules (fcm_cell_rules_create_cut()) */
   double time_cut_space; /**< of time_cuts: the new space (DOFs, element data) */
   double time_cut_integrator; /**< of time_cuts: the new integrator (set-up, the mass matrix, state
-                                   transfer); the new factorization or multigrid hierarchy is
-                                   built by the next step (time_step_factor) */
+                                   transfer), its linear solver's structure apart */
+  double time_cut_solver;     /**< of time_cuts: the new integrator's linear solver structure,
+                                   which needs no matrix value (fcm_integrator_setup_info.
+                                   solver_seconds): the direct solver's symbolic analysis, or
+                                   the multigrid hierarchy without values; the next step sets
+                                   up the values only (its time_step_factor: the numeric
+                                   factorization, Galerkin values, smoothers, coarsest factor) */
   double time_cut_other;      /**< of time_cuts: the rest (the phases add up to time_cuts): the
                                    embedded surface split again (with 2+ threads made beside the
                                    integrator: its time beyond it), the log's mass blocks */

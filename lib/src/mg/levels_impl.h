@@ -95,6 +95,7 @@ struct fcm_mg {
   fcm_mesh *oct_mesh[32];   /* octree hierarchies: the coarser octrees of levels 1, 2, ... */
   fcm_space *oct_space[32]; /* and their spaces */
   fcm__mg_kept kept;        /* what fcm__mg_create_from() took from the earlier hierarchy */
+  int values_pending; /* created on a pattern (fcm__mg_create_pattern()): no value set up yet */
 };
 
 /* Threads of a parallel region: the context's now, at most those of the creation (scratch). */

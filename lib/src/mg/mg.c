@@ -253,9 +253,11 @@ cleanup:
   return st;
 }
 
-/* fcm_mg_create(), keeping the parts of old (NULL: none) fcm__mg_create_from() may. */
+/* fcm_mg_create(), keeping the parts of old (NULL: none) fcm__mg_create_from() may; with
+ * `inactive` (fcm__mg_create_pattern()) on A's pattern alone, level 0's Dirichlet rows given,
+ * the values left to fcm_mg_setup(). */
 static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, const fcm_space *space, const fcm_csr *A,
-                            const fcm_mg_options *opts, fcm_mg **mg)
+                            const unsigned char *inactive, const fcm_mg_options *opts, fcm_mg **mg)
 {
   fcm_status st = FCM_OK;
   fcm_mg *m = NULL;
@@ -277,12 +279,13 @@ static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, const fcm_space *space, c
   m->space = space;
   m->opts = o;
   m->nt = fcm_ctx_num_threads(ctx);
-  FCM_TRY(ctx, fcm__mg_build_hierarchy(m, A, NULL));
+  m->values_pending = inactive != NULL;
+  FCM_TRY(ctx, fcm__mg_build_hierarchy(m, A, inactive));
   if (!fcm__mg_reuse_allowed(old, m)) old = NULL;
   FCM_TRY(ctx, level_diag(m, &m->lev[0]));
   FCM_TRY(ctx, create_patterns(m, old, same));
-  FCM_TRY(ctx, fcm_mg_setup(m));
-  if (o.block_smoothing) /* set up as created */
+  if (!m->values_pending) FCM_TRY(ctx, fcm_mg_setup(m));
+  if (o.block_smoothing) /* set up as created, or by the fcm_mg_setup() to come */
     FCM_TRY(ctx, fcm__mg_block_smoothers_create(m, old, same));
   *mg = m;
   m = NULL;
@@ -294,13 +297,30 @@ cleanup:
 fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
                          const fcm_mg_options *opts, fcm_mg **mg)
 {
-  return mg_create(ctx, NULL, space, A, opts, mg);
+  return mg_create(ctx, NULL, space, A, NULL, opts, mg);
 }
 
 fcm_status fcm__mg_create_from(fcm_ctx *ctx, fcm_mg **old, const fcm_space *space, const fcm_csr *A,
                                const fcm_mg_options *opts, fcm_mg **mg)
 {
-  const fcm_status st = mg_create(ctx, old ? *old : NULL, space, A, opts, mg);
+  const fcm_status st = mg_create(ctx, old ? *old : NULL, space, A, NULL, opts, mg);
+  if (old) fcm_mg_destroy(old);
+  return st;
+}
+
+fcm_status fcm__mg_create_pattern(fcm_ctx *ctx, fcm_mg **old, const fcm_space *space,
+                                  const fcm_csr *A, const unsigned char *inactive,
+                                  const fcm_mg_options *opts, fcm_mg **mg)
+{
+  fcm_status st = FCM_OK;
+  if (mg) *mg = NULL;
+  FCM_CHECK(ctx && space && A && inactive && mg, ctx, FCM_ERR_ARG,
+            "mg_create_pattern: NULL argument");
+  FCM_CHECK(fcm_mesh_num_hanging(fcm_space_mesh(space)) == 0, ctx, FCM_ERR_UNSUPPORTED,
+            "mg_create_pattern: an octree mesh's hierarchy needs the matrix values (use "
+            "fcm_mg_create())");
+  st = mg_create(ctx, old ? *old : NULL, space, A, inactive, opts, mg);
+cleanup:
   if (old) fcm_mg_destroy(old);
   return st;
 }
@@ -340,6 +360,7 @@ fcm_status fcm_mg_setup(fcm_mg *m)
   }
   FCM_TRY(ctx, fcm_direct_factor(m->direct,
                                  fcm_csr_values_read(fcm__mg_level_matrix(&m->lev[m->nlev - 1]))));
+  m->values_pending = 0;
 cleanup:
   return st;
 }

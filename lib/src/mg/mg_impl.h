@@ -71,6 +71,20 @@ FCM_COMPONENT_API fcm_status fcm__mg_create_from(fcm_ctx *ctx, fcm_mg **old, con
                                                  const fcm_csr *A, const fcm_mg_options *opts,
                                                  fcm_mg **mg);
 
+/* fcm__mg_create_from() on A's pattern alone, before its values exist: every structure of the
+ * creation (cells, copies, prolongations, Galerkin plans and coarse patterns, row orders, block
+ * smoothers' blocks and slabs, the coarsest symbolic analysis) with `inactive` (one entry per
+ * row: 1 for a row the matrix will have eliminated, no off-diagonal value) as level 0's
+ * Dirichlet rows; no value of A is read. fcm_mg_setup() with A's values must follow before
+ * anything else: it sets up the block smoothers (their first set-up), the Galerkin values and
+ * the coarsest factor, and the hierarchy is then fcm_mg_create()'s on A bit for bit; when A's
+ * eliminated rows are not `inactive` it returns FCM_ERR_ARG (create it again). *old as
+ * fcm__mg_create_from(). @return as fcm_mg_create(); FCM_ERR_UNSUPPORTED on an octree mesh. */
+FCM_COMPONENT_API fcm_status fcm__mg_create_pattern(fcm_ctx *ctx, fcm_mg **old,
+                                                    const fcm_space *space, const fcm_csr *A,
+                                                    const unsigned char *inactive,
+                                                    const fcm_mg_options *opts, fcm_mg **mg);
+
 /* Forget the level-0 matrix and the space of m (they may be destroyed now): m stays usable
  * only as the `old` of fcm__mg_create_from(), which then keeps nothing of level 0 itself
  * (its plan needs level 0's pattern). Accepts NULL. */

@@ -559,7 +559,8 @@ fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned
       FCM_TRY(ctx, fcm__mg_keep_blocks(old, m, l, nb, ptr, dofs, &kept));
     if (nb > 0 && !kept) {
       FCM_TRY(ctx,
-              fcm__schwarz_create_blocks(ctx, fcm__mg_level_matrix(L), nb, ptr, dofs, &L->blk));
+              (m->values_pending ? fcm__schwarz_create_blocks_pattern : fcm__schwarz_create_blocks)(
+                  ctx, fcm__mg_level_matrix(L), nb, ptr, dofs, &L->blk));
       FCM_TRY(ctx, block_slabs(m, L));
     }
     FCM_FREE(ctx, ptr);

@@ -129,7 +129,7 @@ fcm_status fcm__mg_keep_blocks(fcm_mg *old, fcm_mg *m, int l, fcm_index nb, cons
   memset(&O->blocks, 0, sizeof O->blocks);
   *kept = 1;
   m->kept.block_smoothers++;
-  FCM_TRY(ctx, fcm_schwarz_setup(L->blk, fcm__mg_level_matrix(L)));
+  if (!m->values_pending) FCM_TRY(ctx, fcm_schwarz_setup(L->blk, fcm__mg_level_matrix(L)));
 cleanup:
   return st;
 }

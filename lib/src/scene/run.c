@@ -439,8 +439,9 @@ cleanup:
 }
 
 /* Part `part` of a cut's work on the cut space, as iteration `part` of loop L: 0 the
- * integrator (*seconds: its wall time), 1 the output surface split again, 2 the log's mass
- * blocks. */
+ * integrator with its linear solver's structure (seconds[0]: the integrator's wall time
+ * without the solver's structure, seconds[1]: that structure's), 1 the output surface split
+ * again, 2 the log's mass blocks. */
 static void cut_part(fcm_simulation *S, fcm__loop *L, int part, const fcm_space *space,
                      fcm_integrator **integ, double *seconds)
 {
@@ -451,7 +452,10 @@ static void cut_part(fcm_simulation *S, fcm__loop *L, int part, const fcm_space 
   if (part == 0) {
     const double t = fcm_wtime();
     st = fcm_integrator_create_cut(S->integ, space, integ);
-    *seconds = fcm_wtime() - t;
+    fcm_integrator_setup_info si;
+    fcm_integrator_get_setup_info(*integ, &si);
+    seconds[1] = si.solver_seconds;
+    seconds[0] = fmax(0.0, fcm_wtime() - t - seconds[1]);
   } else if (part == 1) {
     if (S->surf) st = fcm_embedded_surface_set_space(S->surf, space);
   } else {
@@ -505,7 +509,7 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   fcm_integrator *integ = NULL;
   const double t0 = fcm_wtime();
   const int k = S->cuts_applied;
-  S->cut_phase[0] = S->cut_phase[1] = S->cut_phase[2] = 0.0;
+  S->cut_phase[0] = S->cut_phase[1] = S->cut_phase[2] = S->cut_phase[3] = 0.0;
   if (k == 0 && !S->refined && fcm_scene_get_background(S->scene)->octree_cuts_at_cut)
     FCM_TRY(ctx, refine_for_cuts(S));
   /* A distributed run (the integrator has a backend, sim_backend.h): the rules keep the
@@ -551,7 +555,7 @@ cleanup:
   /* a failed cut leaves the run as it was: the output surface on the space it keeps */
   if (st != FCM_OK && S->surf && space && S->surf->space == space)
     (void)fcm_embedded_surface_set_space(S->surf, S->space);
-  if (k < S->num_cuts) S->cut_time[k] = fcm_wtime() - t0;
+  if (k < S->num_cuts) S->cut_time[k] = fcm_wtime() - t0, S->cut_solver[k] = S->cut_phase[3];
   st = fcm__integrator_finish(S->integ, st);
   fcm_integrator_destroy(&integ);
   fcm_space_destroy(&space);
@@ -570,6 +574,7 @@ static fcm_status collect_cuts(fcm_simulation *S)
   FCM_ALLOC(ctx, (size_t)n, S->cuts);
   FCM_ALLOC(ctx, (size_t)n, S->cut_stats);
   FCM_ALLOC(ctx, (size_t)n, S->cut_time);
+  FCM_ALLOC(ctx, (size_t)n, S->cut_solver);
   for (int k = 0; k < fcm_scene_num_effects(S->scene); k++) {
     const fcm_effect *e = fcm_scene_get_effect(S->scene, k);
     if (e->type != FCM_EFFECT_CUT) continue;
@@ -790,8 +795,8 @@ void fcm_simulation_destroy(fcm_simulation **sim)
   fcm_cell_rules_destroy(&S->rules);
   fcm_geometry_destroy(&S->geom);
   fcm_mesh_destroy(&S->mesh);
-  void *arrays[] = {S->log,      S->frame_time,   S->loads,    S->cuts,     S->cut_stats,
-                    S->cut_time, S->react_effect, S->react_id, S->react_log};
+  void *arrays[] = {S->log,      S->frame_time, S->loads,        S->cuts,     S->cut_stats,
+                    S->cut_time, S->cut_solver, S->react_effect, S->react_id, S->react_log};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(ctx, arrays[k]);
   fcm__free(ctx, S);

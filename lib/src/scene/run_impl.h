@@ -102,8 +102,9 @@ struct fcm_simulation {
   fcm__auto_uses auto_uses; /* with quadrature.simplify = "auto" */
   fcm_cell_rules_stats *cut_stats;
   double *cut_time;
-  double cut_phase[3]; /* the last cut's rules, space and integrator seconds (the step adds them
-                          to the counters' time_cut_*) */
+  double *cut_solver;  /* each cut's seconds of the linear solver's structure (of cut_time) */
+  double cut_phase[4]; /* the last cut's rules, space, integrator and solver-structure seconds
+                          (the step adds them to the counters' time_cut_*) */
   /* cuts whose integrator and output surface were made on two threads; 1 in cuts_in_turn: one
    * after the other on every thread (the sequence the tests compare with) */
   int cuts_side_by_side, cuts_in_turn;

@@ -137,7 +137,9 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
       S->c.time_cut_rules += S->cut_phase[0];
       S->c.time_cut_space += S->cut_phase[1];
       S->c.time_cut_integrator += S->cut_phase[2];
-      S->c.time_cut_other += fmax(0.0, cut - S->cut_phase[0] - S->cut_phase[1] - S->cut_phase[2]);
+      S->c.time_cut_solver += S->cut_phase[3];
+      S->c.time_cut_other +=
+          fmax(0.0, cut - S->cut_phase[0] - S->cut_phase[1] - S->cut_phase[2] - S->cut_phase[3]);
     }
   }
   double t0 = fcm_wtime();

@@ -259,10 +259,10 @@ static void cut_lines(const fcm_simulation *S, FILE *f, const fcm_index *cs)
     }
     fprintf(f,
             "  cut %-5d t = %g s: %lld cells integrated again, %lld split; their points "
-            "stiffness %lld -> %lld, mass %lld -> %lld; %.3f s (rules %.3f s)\n",
+            "stiffness %lld -> %lld, mass %lld -> %lld; %.3f s (rules %.3f s, solver %.3f s)\n",
             k + 1, S->cuts[k]->cut.time, (long long)r->num_integrated, (long long)r->num_split,
             (long long)p[0], (long long)p[2], (long long)p[1], (long long)p[3], S->cut_time[k],
-            r->time_total);
+            r->time_total, S->cut_solver[k]);
   }
 }
 

@@ -244,6 +244,7 @@ struct fcm_integrator {
   const fcm_csr *mg_A;
   long long mg_con;
   long long mg_applies;
+  long long mg_creations; /* hierarchies created: prepared (pattern) and at set-ups */
   double *mg_r;
   /* multigrid_fixed_cycles: the warm start of the first Newton iteration of a (sub)step.
    * mg_acc sums the updates of the current Newton solve (n); mg_guess is the sum of the last
@@ -321,6 +322,8 @@ fcm_status fcm__sim_multigrid_validate(fcm_ctx *ctx, const fcm_integrator_option
 
 /* Symbolic analyses performed so far (CHOLMOD + UMFPACK). (linsolve.c) */
 long long fcm__sim_analyses(const fcm_integrator *I);
+/* Multigrid hierarchies the integrator created (prepared ones too). (linsolve.c) */
+long long fcm__sim_mg_creations(const fcm_integrator *I);
 
 /* External load at time t: sum_k scale_k(t) f_k into f (n). (integrator.c) */
 void fcm__sim_eval_loads(const fcm_integrator *I, double t, double *f);

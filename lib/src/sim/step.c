@@ -198,6 +198,7 @@ static void record_step_statistics(const fcm_integrator *I, const sim_stats *sta
   info->reused_factorizations = stats->reused_factorizations;
   info->inexact_solves = stats->inexact_solves;
   info->total_analyses = fcm__sim_analyses(I);
+  info->total_multigrid_creations = fcm__sim_mg_creations(I);
   info->total_factorizations = I->total_factorizations;
   info->total_direct_fallbacks = I->total_fallbacks;
   info->time_assembly = stats->time_assembly;

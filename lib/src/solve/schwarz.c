@@ -470,10 +470,41 @@ cleanup:
   return st;
 }
 
-/* fcm_schwarz_create(); blocks_only: for the block smoother (fcm__schwarz_create_blocks()). */
+/* The positions of every block's entries in C's rows, as gather_scan() finds them, from C's
+ * pattern alone (a creation without values): the first setup gathers the blocks whose entries
+ * are all stored through them (the same values as a scan), and scans the others. */
+static void scan_positions(fcm_schwarz *P, const fcm_csr *C)
+{
+  const fcm_index *rp = fcm_csr_row_ptr(C);
+  const int *ci = fcm_csr_col_idx(C);
+  int *loc = P->loc; /* thread 0's DOF map, zero between blocks */
+  for (fcm_index b = 0; b < P->num_blocks; b++) {
+    const fcm_index *d = P->dofs + P->block_ptr[b];
+    const int m = (int)(P->block_ptr[b + 1] - P->block_ptr[b]);
+    int *pos = P->pos + P->s_off[b], stored = 0;
+    for (size_t e = 0; e < (size_t)m * (size_t)m; e++)
+      pos[e] = -1;
+    for (int j = 0; j < m; j++)
+      loc[d[j]] = j + 1;
+    for (int i = 0; i < m; i++)
+      for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++) {
+        const int k = loc[ci[p]];
+        if (!k) continue;
+        if (pos[(size_t)i * m + k - 1] < 0) stored++;
+        pos[(size_t)i * m + k - 1] = (int)(p - rp[d[i]]);
+      }
+    for (int j = 0; j < m; j++)
+      loc[d[j]] = 0;
+    P->full[b] = stored == m * m;
+  }
+}
+
+/* fcm_schwarz_create(); blocks_only: for the block smoother (fcm__schwarz_create_blocks()),
+ * set up now unless values_later (the positions found from the pattern then). */
 static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
                          const fcm_index *block_ptr, const fcm_index *block_dofs,
-                         const fcm_schwarz_options *opts, int blocks_only, fcm_schwarz **out)
+                         const fcm_schwarz_options *opts, int blocks_only, int values_later,
+                         fcm_schwarz **out)
 {
   fcm_status st = FCM_OK;
   fcm_schwarz *P = NULL;
@@ -576,7 +607,10 @@ static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
   P->info.num_colors = P->num_colors;
   for (fcm_index i = 0; i < nr; i++)
     P->info.outside_dofs += !P->inside[i];
-  FCM_TRY(ctx, fcm_schwarz_setup(P, C));
+  if (values_later)
+    scan_positions(P, C);
+  else
+    FCM_TRY(ctx, fcm_schwarz_setup(P, C));
   *out = P;
   P = NULL;
 cleanup:
@@ -589,14 +623,21 @@ fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_bloc
                               const fcm_index *block_ptr, const fcm_index *block_dofs,
                               const fcm_schwarz_options *opts, fcm_schwarz **out)
 {
-  return create(ctx, C, num_blocks, block_ptr, block_dofs, opts, 0, out);
+  return create(ctx, C, num_blocks, block_ptr, block_dofs, opts, 0, 0, out);
 }
 
 fcm_status fcm__schwarz_create_blocks(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
                                       const fcm_index *block_ptr, const fcm_index *block_dofs,
                                       fcm_schwarz **out)
 {
-  return create(ctx, C, num_blocks, block_ptr, block_dofs, NULL, 1, out);
+  return create(ctx, C, num_blocks, block_ptr, block_dofs, NULL, 1, 0, out);
+}
+
+fcm_status fcm__schwarz_create_blocks_pattern(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
+                                              const fcm_index *block_ptr,
+                                              const fcm_index *block_dofs, fcm_schwarz **out)
+{
+  return create(ctx, C, num_blocks, block_ptr, block_dofs, NULL, 1, 1, out);
 }
 
 fcm_status fcm_schwarz_apply(const fcm_schwarz *P, const double *r, double *z)

@@ -29,5 +29,11 @@ void fcm__schwarz_get_view(const fcm_schwarz *P, fcm__schwarz_view *v);
 fcm_status fcm__schwarz_create_blocks(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
                                       const fcm_index *block_ptr, const fcm_index *block_dofs,
                                       fcm_schwarz **out);
+/* fcm__schwarz_create_blocks() without its set-up: C's pattern alone is read (the blocks'
+ * positions in C's rows are found from it); the first fcm_schwarz_setup() sets up the values,
+ * with the bits the creation's set-up gives. */
+fcm_status fcm__schwarz_create_blocks_pattern(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
+                                              const fcm_index *block_ptr,
+                                              const fcm_index *block_dofs, fcm_schwarz **out);
 
 #endif /* FCM_SOLVE_IMPL_H */
