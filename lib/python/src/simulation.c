@@ -77,6 +77,7 @@ const fcmpy_option fcmpy_step_table[] = {
     {"total_analyses", 'n', 1, SI(total_analyses)},
     {"total_factorizations", 'n', 1, SI(total_factorizations)},
     {"total_direct_fallbacks", 'n', 1, SI(total_direct_fallbacks)},
+    {"total_multigrid_creations", 'n', 1, SI(total_multigrid_creations)},
     {"time_assembly", 'd', 1, SI(time_assembly)},
     {"time_factor", 'd', 1, SI(time_factor)},
     {"time_solve", 'd', 1, SI(time_solve)},
