@@ -30,10 +30,12 @@
  * do not depend on the thread count. */
 typedef struct slab_order {
   fcm_index nslab;
-  int first;       /* the colour swept first */
-  fcm_index *ptr;  /* nslab + 1 offsets into item */
-  fcm_index *item; /* the items, slab after slab, ascending within a slab */
-  double *mid;     /* per slab: the midpoint of its work within its colour's, in [0, 1] */
+  int first;             /* the colour swept first */
+  fcm_index *ptr;        /* nslab + 1 offsets into item */
+  fcm_index *item;       /* the items, slab after slab, ascending within a slab */
+  double *mid;           /* per slab: the midpoint of its work within its colour's, in [0, 1] */
+  unsigned char *triple; /* row orders: per row i, 1 when i = 3k starts its copy's three rows
+                            and they share one column pattern (fcm__mg_row_dot3()) */
 } slab_order;
 
 /* Levels with at least this many stored entries share their work between the threads. */
@@ -126,6 +128,51 @@ static inline double fcm__mg_row_dot(const double *v, const int *ci, fcm_index p
   for (; p < p1; p++)
     s0 += v[p] * x[ci[p]];
   return (s0 + s1) + (s2 + s3);
+}
+
+/* The sums of fcm__mg_row_dot() over three rows of one column pattern, stored one after
+ * the other from p0 (len entries each): each row's the same operations in the same order, so
+ * the same bits, with each x[ci[p]] and ci[p] read once for the three. */
+static inline void fcm__mg_row_dot3(const double *v, const int *ci, fcm_index p0, fcm_index len,
+                                    const double *x, double out[3])
+{
+  const double *va = v + p0, *vb = va + len, *vc = vb + len;
+  const int *c = ci + p0;
+  double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
+  double b0 = 0.0, b1 = 0.0, b2 = 0.0, b3 = 0.0;
+  double c0 = 0.0, c1 = 0.0, c2 = 0.0, c3 = 0.0;
+  fcm_index j = 0;
+  for (; j + 4 <= len; j += 4) {
+    const double x0 = x[c[j]], x1 = x[c[j + 1]], x2 = x[c[j + 2]], x3 = x[c[j + 3]];
+    a0 += va[j] * x0;
+    a1 += va[j + 1] * x1;
+    a2 += va[j + 2] * x2;
+    a3 += va[j + 3] * x3;
+    b0 += vb[j] * x0;
+    b1 += vb[j + 1] * x1;
+    b2 += vb[j + 2] * x2;
+    b3 += vb[j + 3] * x3;
+    c0 += vc[j] * x0;
+    c1 += vc[j + 1] * x1;
+    c2 += vc[j + 2] * x2;
+    c3 += vc[j + 3] * x3;
+  }
+  for (; j < len; j++) {
+    const double xj = x[c[j]];
+    a0 += va[j] * xj;
+    b0 += vb[j] * xj;
+    c0 += vc[j] * xj;
+  }
+  out[0] = (a0 + a1) + (a2 + a3);
+  out[1] = (b0 + b1) + (b2 + b3);
+  out[2] = (c0 + c1) + (c2 + c3);
+}
+
+/* Whether rows i, i + 1, i + 2 may be summed by fcm__mg_row_dot3() (triple: the level's row
+ * order's flags, NULL: none may). */
+static inline int fcm__mg_is_triple(const unsigned char *triple, fcm_index i, fcm_index n)
+{
+  return triple && i + 2 < n && triple[i];
 }
 
 /* ---- hierarchy.c */

@@ -25,6 +25,7 @@ void fcm__mg_slabs_free(fcm_ctx *ctx, slab_order *S)
   fcm__free(ctx, S->ptr);
   fcm__free(ctx, S->item);
   fcm__free(ctx, S->mid);
+  fcm__free(ctx, S->triple);
   memset(S, 0, sizeof *S);
 }
 
@@ -168,6 +169,14 @@ fcm_status fcm__mg_row_slabs(fcm_mg *m, mg_level *L)
       reach[i] = FCM_MAX(reach[i], ci[p]);
   }
   FCM_TRY(ctx, slabs_create(ctx, L->n, NULL, reach, work, MG_ROW_SLABS_THICK, &L->rows));
+  FCM_ALLOC(ctx, L->n + 1, L->rows.triple);
+  for (fcm_index i = 0; i + 2 < L->n; i += 3) {
+    const fcm_index len = rp[i + 1] - rp[i];
+    int same = rp[i + 2] - rp[i + 1] == len && rp[i + 3] - rp[i + 2] == len;
+    for (fcm_index p = 0; same && p < len; p++)
+      same = ci[rp[i] + p] == ci[rp[i + 1] + p] && ci[rp[i] + p] == ci[rp[i + 2] + p];
+    L->rows.triple[i] = (unsigned char)same;
+  }
 cleanup:
   fcm__free(ctx, work);
   fcm__free(ctx, reach);
@@ -703,14 +712,29 @@ static void block_slab(const sweep_args *a, fcm_index s, int back)
   const fcm_index *rp = fcm_csr_row_ptr(A);
   const int *ci = fcm_csr_col_idx(A);
   const double *v = fcm_csr_values_read(A);
+  const unsigned char *triple = L->rows.triple;
+  const fcm_index n = L->n;
   const fcm_index q0 = L->blocks.ptr[s], q1 = L->blocks.ptr[s + 1];
   for (fcm_index t = 0; t < q1 - q0; t++) {
     const fcm_index k = L->blocks.item[back ? q1 - 1 - t : q0 + t];
     const fcm_index *d = a->blk.dofs + a->blk.ptr[k];
     const double *S = a->blk.S + a->blk.s_off[k];
     const int bm = (int)(a->blk.ptr[k + 1] - a->blk.ptr[k]);
-    for (int i = 0; i < bm; i++)
-      r[i] = b[d[i]] - fcm__mg_row_dot(v, ci, rp[d[i]], rp[d[i] + 1], x);
+    for (int i = 0; i < bm;) {
+      const fcm_index di = d[i];
+      if (i + 2 < bm && d[i + 2] == di + 2 && d[i + 1] == di + 1 &&
+          fcm__mg_is_triple(triple, di, n)) {
+        double dot[3];
+        fcm__mg_row_dot3(v, ci, rp[di], rp[di + 1] - rp[di], x, dot);
+        r[i] = b[di] - dot[0];
+        r[i + 1] = b[di + 1] - dot[1];
+        r[i + 2] = b[di + 2] - dot[2];
+        i += 3;
+      } else {
+        r[i] = b[di] - fcm__mg_row_dot(v, ci, rp[di], rp[di + 1], x);
+        i++;
+      }
+    }
     for (int i = 0; i < bm; i++)
       dx[i] = dense_dot(S + (size_t)i * (size_t)bm, r, bm);
     for (int i = 0; i < bm; i++)
