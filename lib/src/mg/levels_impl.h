@@ -19,6 +19,7 @@
 #include "solve/solve_impl.h"
 
 #include <omp.h>
+#include <string.h>
 
 /* Two-colour slab order of the items of a graph (the rows of a level matrix, or the blocks of
  * its block smoother; two items are adjacent when the update of one reads what the other
@@ -133,39 +134,43 @@ static inline double fcm__mg_row_dot(const double *v, const int *ci, fcm_index p
 /* The sums of fcm__mg_row_dot() over three rows of one column pattern, stored one after
  * the other from p0 (len entries each): each row's the same operations in the same order, so
  * the same bits, with each x[ci[p]] and ci[p] read once for the three. */
+typedef double fcm__mg_v2d __attribute__((vector_size(16)));
+
+static inline fcm__mg_v2d fcm__mg_load2(const double *p)
+{
+  fcm__mg_v2d r;
+  memcpy(&r, p, sizeof r);
+  return r;
+}
+
 static inline void fcm__mg_row_dot3(const double *v, const int *ci, fcm_index p0, fcm_index len,
                                     const double *x, double out[3])
 {
+  /* lanes (s0, s1) and (s2, s3) of each row's four partial sums: two-wide operations keep
+   * the twelve sums in registers (twelve scalars and the x's spill) */
   const double *va = v + p0, *vb = va + len, *vc = vb + len;
   const int *c = ci + p0;
-  double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
-  double b0 = 0.0, b1 = 0.0, b2 = 0.0, b3 = 0.0;
-  double c0 = 0.0, c1 = 0.0, c2 = 0.0, c3 = 0.0;
+  fcm__mg_v2d a01 = {0.0, 0.0}, a23 = a01, b01 = a01, b23 = a01, c01 = a01, c23 = a01;
   fcm_index j = 0;
   for (; j + 4 <= len; j += 4) {
-    const double x0 = x[c[j]], x1 = x[c[j + 1]], x2 = x[c[j + 2]], x3 = x[c[j + 3]];
-    a0 += va[j] * x0;
-    a1 += va[j + 1] * x1;
-    a2 += va[j + 2] * x2;
-    a3 += va[j + 3] * x3;
-    b0 += vb[j] * x0;
-    b1 += vb[j + 1] * x1;
-    b2 += vb[j + 2] * x2;
-    b3 += vb[j + 3] * x3;
-    c0 += vc[j] * x0;
-    c1 += vc[j + 1] * x1;
-    c2 += vc[j + 2] * x2;
-    c3 += vc[j + 3] * x3;
+    const fcm__mg_v2d x01 = {x[c[j]], x[c[j + 1]]}, x23 = {x[c[j + 2]], x[c[j + 3]]};
+    a01 += fcm__mg_load2(va + j) * x01;
+    a23 += fcm__mg_load2(va + j + 2) * x23;
+    b01 += fcm__mg_load2(vb + j) * x01;
+    b23 += fcm__mg_load2(vb + j + 2) * x23;
+    c01 += fcm__mg_load2(vc + j) * x01;
+    c23 += fcm__mg_load2(vc + j + 2) * x23;
   }
+  double a0 = a01[0], b0 = b01[0], c0 = c01[0];
   for (; j < len; j++) {
     const double xj = x[c[j]];
     a0 += va[j] * xj;
     b0 += vb[j] * xj;
     c0 += vc[j] * xj;
   }
-  out[0] = (a0 + a1) + (a2 + a3);
-  out[1] = (b0 + b1) + (b2 + b3);
-  out[2] = (c0 + c1) + (c2 + c3);
+  out[0] = (a0 + a01[1]) + (a23[0] + a23[1]);
+  out[1] = (b0 + b01[1]) + (b23[0] + b23[1]);
+  out[2] = (c0 + c01[1]) + (c23[0] + c23[1]);
 }
 
 /* Whether rows i, i + 1, i + 2 may be summed by fcm__mg_row_dot3() (triple: the level's row

@@ -172,9 +172,13 @@ fcm_status fcm__mg_row_slabs(fcm_mg *m, mg_level *L)
   FCM_ALLOC(ctx, L->n + 1, L->rows.triple);
   for (fcm_index i = 0; i + 2 < L->n; i += 3) {
     const fcm_index len = rp[i + 1] - rp[i];
-    int same = rp[i + 2] - rp[i + 1] == len && rp[i + 3] - rp[i + 2] == len;
-    for (fcm_index p = 0; same && p < len; p++)
+    int same = rp[i + 2] - rp[i + 1] == len && rp[i + 3] - rp[i + 2] == len, own = 0;
+    for (fcm_index p = 0; same && p < len; p++) {
       same = ci[rp[i] + p] == ci[rp[i + 1] + p] && ci[rp[i] + p] == ci[rp[i + 2] + p];
+      if (ci[rp[i] + p] == i) /* the three's own columns, one after the other */
+        own = p + 2 < len && ci[rp[i] + p + 1] == i + 1 && ci[rp[i] + p + 2] == i + 2;
+    }
+    same = same && own;
     L->rows.triple[i] = (unsigned char)same;
   }
 cleanup:
@@ -623,23 +627,61 @@ static void symmetric_sweep(const slab_order *S,
     if (slab_mine(S, k, t, nt)) slab(a, k, 1);
 }
 
-/* sum_j a[j] r[j], j < m, as fcm__mg_row_dot(). */
-static inline double dense_dot(const double *a, const double *r, int m)
+/* dx = S r for a symmetric m x m S (row major) from its lower triangle alone: row i's entries
+ * S_ij, j < i, serve dx_i and (as S_ji) dx_j, so the sweep reads half of S's cache lines;
+ * S streams from memory block after block and its reads are most of the block product's
+ * time. Two partial sums per row, the column updates in pairs. */
+static inline void sym_lower_apply(const double *S, const double *r, int m, double *dx)
 {
-  double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-  int j = 0;
-  for (; j + 4 <= m; j += 4) {
-    s0 += a[j] * r[j];
-    s1 += a[j + 1] * r[j + 1];
-    s2 += a[j + 2] * r[j + 2];
-    s3 += a[j + 3] * r[j + 3];
+  for (int i = 0; i < m; i++)
+    dx[i] = 0.0;
+  for (int i = 0; i < m; i++) {
+    const double *Si = S + (size_t)i * (size_t)m;
+    const double ri = r[i];
+    double s0 = 0.0, s1 = 0.0;
+    int j = 0;
+    for (; j + 2 <= i; j += 2) {
+      s0 += Si[j] * r[j];
+      s1 += Si[j + 1] * r[j + 1];
+      dx[j] += Si[j] * ri;
+      dx[j + 1] += Si[j + 1] * ri;
+    }
+    for (; j < i; j++) {
+      s0 += Si[j] * r[j];
+      dx[j] += Si[j] * ri;
+    }
+    dx[i] += (s0 + s1) + Si[i] * ri;
   }
-  for (; j < m; j++)
-    s0 += a[j] * r[j];
-  return (s0 + s1) + (s2 + s3);
 }
 
-/* Gauss-Seidel over the rows of slab s, forward (ascending) or backward. */
+/* Gauss-Seidel over the rows i, i + 1, i + 2 of one copy (fcm__mg_row_dot3()), in order
+ * (back: in reverse): the three sums from the x before the first update, each corrected by the
+ * earlier rows' updates through the three's own 3 x 3 block (A_(i..i+2, i..i+2), stored
+ * consecutively from the diagonal's position in each row). The same iterate as three single
+ * updates, up to the order of the sums. */
+static void sgs_triple(const mg_level *L, const double *v, const int *ci, const fcm_index *rp,
+                       fcm_index i, double w, const double *b, double *x, int back)
+{
+  const fcm_index len = rp[i + 1] - rp[i], o = L->diag[i] - rp[i];
+  const double *A0 = v + rp[i] + o, *A1 = A0 + len, *A2 = A1 + len; /* A_(i+r, i..i+2) */
+  double s[3], d0, d1, d2;
+  fcm__mg_row_dot3(v, ci, rp[i], len, x, s);
+  if (!back) {
+    d0 = w * (b[i] - s[0]) * L->dinv[i];
+    d1 = w * (b[i + 1] - (s[1] + A1[0] * d0)) * L->dinv[i + 1];
+    d2 = w * (b[i + 2] - (s[2] + (A2[0] * d0 + A2[1] * d1))) * L->dinv[i + 2];
+  } else {
+    d2 = w * (b[i + 2] - s[2]) * L->dinv[i + 2];
+    d1 = w * (b[i + 1] - (s[1] + A1[2] * d2)) * L->dinv[i + 1];
+    d0 = w * (b[i] - (s[0] + (A0[2] * d2 + A0[1] * d1))) * L->dinv[i];
+  }
+  x[i] += d0;
+  x[i + 1] += d1;
+  x[i + 2] += d2;
+}
+
+/* Gauss-Seidel over the rows of slab s, forward (ascending) or backward; a copy's three rows
+ * of one pattern together (sgs_triple()). */
 static void sgs_slab(const sweep_args *a, fcm_index s, int back)
 {
   const mg_level *L = a->L;
@@ -649,10 +691,30 @@ static void sgs_slab(const sweep_args *a, fcm_index s, int back)
   const fcm_index *rp = fcm_csr_row_ptr(A);
   const int *ci = fcm_csr_col_idx(A);
   const double *v = fcm_csr_values_read(A);
-  const fcm_index q0 = L->rows.ptr[s], q1 = L->rows.ptr[s + 1];
-  for (fcm_index t = 0; t < q1 - q0; t++) {
-    const fcm_index i = L->rows.item[back ? q1 - 1 - t : q0 + t];
-    x[i] += w * (b[i] - fcm__mg_row_dot(v, ci, rp[i], rp[i + 1], x)) * L->dinv[i];
+  const unsigned char *triple = L->rows.triple;
+  const fcm_index *item = L->rows.item, q0 = L->rows.ptr[s], q1 = L->rows.ptr[s + 1];
+  if (!back) {
+    for (fcm_index q = q0; q < q1;) {
+      const fcm_index i = item[q];
+      if (triple && q + 2 < q1 && item[q + 2] == i + 2 && triple[i]) {
+        sgs_triple(L, v, ci, rp, i, w, b, x, 0);
+        q += 3;
+      } else {
+        x[i] += w * (b[i] - fcm__mg_row_dot(v, ci, rp[i], rp[i + 1], x)) * L->dinv[i];
+        q++;
+      }
+    }
+    return;
+  }
+  for (fcm_index q = q1; q > q0;) {
+    const fcm_index i = item[q - 1];
+    if (triple && q - 3 >= q0 && i >= 2 && item[q - 3] == i - 2 && triple[i - 2]) {
+      sgs_triple(L, v, ci, rp, i - 2, w, b, x, 1);
+      q -= 3;
+    } else {
+      x[i] += w * (b[i] - fcm__mg_row_dot(v, ci, rp[i], rp[i + 1], x)) * L->dinv[i];
+      q--;
+    }
   }
 }
 
@@ -720,6 +782,10 @@ static void block_slab(const sweep_args *a, fcm_index s, int back)
     const fcm_index *d = a->blk.dofs + a->blk.ptr[k];
     const double *S = a->blk.S + a->blk.s_off[k];
     const int bm = (int)(a->blk.ptr[k + 1] - a->blk.ptr[k]);
+    /* S_K's lower triangle is fetched while the residual's rows are read */
+    for (int i = 0; i < bm; i++)
+      for (int j = 0; j <= i; j += 8)
+        __builtin_prefetch(S + (size_t)i * (size_t)bm + j, 0, 0);
     for (int i = 0; i < bm;) {
       const fcm_index di = d[i];
       if (i + 2 < bm && d[i + 2] == di + 2 && d[i + 1] == di + 1 &&
@@ -735,8 +801,7 @@ static void block_slab(const sweep_args *a, fcm_index s, int back)
         i++;
       }
     }
-    for (int i = 0; i < bm; i++)
-      dx[i] = dense_dot(S + (size_t)i * (size_t)bm, r, bm);
+    sym_lower_apply(S, r, bm, dx);
     for (int i = 0; i < bm; i++)
       x[d[i]] += dx[i];
   }
