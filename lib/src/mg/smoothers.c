@@ -600,6 +600,7 @@ typedef struct sweep_args {
   double *x;
   double *r, *dx;
   fcm__schwarz_view blk; /* block sweeps: L's blocks */
+  int plain;             /* one row at a time and full S_K products (the test hook's reference) */
 } sweep_args;
 
 /* One symmetric Gauss-Seidel sweep in the slab order S (forward, then backward) by the team
@@ -625,6 +626,22 @@ static void symmetric_sweep(const slab_order *S,
 #pragma omp barrier
   for (fcm_index k = c0; k < S->nslab; k += 2)
     if (slab_mine(S, k, t, nt)) slab(a, k, 1);
+}
+
+/* sum_j a[j] r[j], j < m, as fcm__mg_row_dot(). */
+static inline double dense_dot(const double *a, const double *r, int m)
+{
+  double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+  int j = 0;
+  for (; j + 4 <= m; j += 4) {
+    s0 += a[j] * r[j];
+    s1 += a[j + 1] * r[j + 1];
+    s2 += a[j + 2] * r[j + 2];
+    s3 += a[j + 3] * r[j + 3];
+  }
+  for (; j < m; j++)
+    s0 += a[j] * r[j];
+  return (s0 + s1) + (s2 + s3);
 }
 
 /* dx = S r for a symmetric m x m S (row major) from its lower triangle alone: row i's entries
@@ -691,7 +708,7 @@ static void sgs_slab(const sweep_args *a, fcm_index s, int back)
   const fcm_index *rp = fcm_csr_row_ptr(A);
   const int *ci = fcm_csr_col_idx(A);
   const double *v = fcm_csr_values_read(A);
-  const unsigned char *triple = L->rows.triple;
+  const unsigned char *triple = a->plain ? NULL : L->rows.triple;
   const fcm_index *item = L->rows.item, q0 = L->rows.ptr[s], q1 = L->rows.ptr[s + 1];
   if (!back) {
     for (fcm_index q = q0; q < q1;) {
@@ -759,7 +776,7 @@ void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x)
     }
     return;
   }
-  const sweep_args a = {L, w, b, x, NULL, NULL, {0}};
+  const sweep_args a = {L, w, b, x, NULL, NULL, {0}, 0};
   symmetric_sweep(&L->rows, sgs_slab, &a);
 }
 
@@ -774,7 +791,7 @@ static void block_slab(const sweep_args *a, fcm_index s, int back)
   const fcm_index *rp = fcm_csr_row_ptr(A);
   const int *ci = fcm_csr_col_idx(A);
   const double *v = fcm_csr_values_read(A);
-  const unsigned char *triple = L->rows.triple;
+  const unsigned char *triple = a->plain ? NULL : L->rows.triple;
   const fcm_index n = L->n;
   const fcm_index q0 = L->blocks.ptr[s], q1 = L->blocks.ptr[s + 1];
   for (fcm_index t = 0; t < q1 - q0; t++) {
@@ -801,7 +818,11 @@ static void block_slab(const sweep_args *a, fcm_index s, int back)
         i++;
       }
     }
-    sym_lower_apply(S, r, bm, dx);
+    if (a->plain)
+      for (int i = 0; i < bm; i++)
+        dx[i] = dense_dot(S + (size_t)i * (size_t)bm, r, bm);
+    else
+      sym_lower_apply(S, r, bm, dx);
     for (int i = 0; i < bm; i++)
       x[d[i]] += dx[i];
   }
@@ -828,16 +849,55 @@ static void one_way_sweep(const slab_order *S,
 /* A block Gauss-Seidel sweep over the level's blocks in their slab order: symmetric (forward,
  * then backward; symmetric_sweep()), or with block_sweep one way, forward before the coarse
  * correction (post = 0) and backward after it (post = 1). */
-void fcm__mg_block_smooth(const fcm_mg *m, const mg_level *L, const double *b, double *x, int post)
+static void block_smooth(const fcm_mg *m, const mg_level *L, const double *b, double *x, int post,
+                         int plain)
 {
   const size_t t = (size_t)omp_get_thread_num();
   sweep_args a = {
-      L, 0.0, b, x, m->blk_r + t * (size_t)m->blk_max, m->blk_dx + t * (size_t)m->blk_max, {0}};
+      L,   0.0,  b, x, m->blk_r + t * (size_t)m->blk_max, m->blk_dx + t * (size_t)m->blk_max,
+      {0}, plain};
   fcm__schwarz_get_view(L->blk, &a.blk);
   if (m->opts.block_sweep)
     one_way_sweep(&L->blocks, block_slab, &a, post);
   else
     symmetric_sweep(&L->blocks, block_slab, &a);
+}
+
+void fcm__mg_block_smooth(const fcm_mg *m, const mg_level *L, const double *b, double *x, int post)
+{
+  block_smooth(m, L, b, x, post, 0);
+}
+
+fcm_status fcm__mg_smooth_paths(fcm_mg *mg, int level, const double *b, const double *x,
+                                double *x_fast, double *x_plain, fcm_index *triples)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = mg ? mg->ctx : NULL;
+  FCM_CHECK(mg && b && x && x_fast && x_plain && triples, ctx, FCM_ERR_ARG,
+            "mg_smooth_paths: NULL argument");
+  FCM_CHECK(level >= 0 && level + 1 < mg->nlev, ctx, FCM_ERR_ARG,
+            "mg_smooth_paths: level %d outside [0, %d)", level, mg->nlev - 1);
+  FCM_CHECK(mg->opts.smoother == FCM_MG_SMOOTHER_SGS && mg->lev[level].rows.ptr, ctx, FCM_ERR_ARG,
+            "mg_smooth_paths: the smoother is not SGS");
+  mg_level *L = &mg->lev[level];
+  *triples = 0;
+  for (fcm_index i = 0; L->rows.triple && i < L->n; i++)
+    *triples += L->rows.triple[i];
+  memcpy(x_fast, x, sizeof *x * (size_t)L->n);
+  memcpy(x_plain, x, sizeof *x * (size_t)L->n);
+#pragma omp parallel num_threads(1)
+  {
+    const sweep_args f = {L, mg->opts.omega, b, x_fast, NULL, NULL, {0}, 0};
+    const sweep_args p = {L, mg->opts.omega, b, x_plain, NULL, NULL, {0}, 1};
+    symmetric_sweep(&L->rows, sgs_slab, &f);
+    symmetric_sweep(&L->rows, sgs_slab, &p);
+    if (L->blk) {
+      block_smooth(mg, L, b, x_fast, 0, 0);
+      block_smooth(mg, L, b, x_plain, 0, 1);
+    }
+  }
+cleanup:
+  return st;
 }
 
 /* ------------------------------------------------------------------ slab check */
