@@ -174,7 +174,7 @@ static int gather_scan(const fcm_csr *C, const double *vals, int m, const fcm_in
     for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++) {
       const int k = loc[ci[p]];
       if (!k) continue;
-      finite &= isfinite(vals[p]) != 0;
+      if (k - 1 <= i) finite &= isfinite(vals[p]) != 0;
       a[i + (size_t)(k - 1) * m] = vals[p];
       if (pos[(size_t)i * m + k - 1] < 0) stored++;
       pos[(size_t)i * m + k - 1] = (int)(p - rp[d[i]]);
@@ -185,9 +185,10 @@ static int gather_scan(const fcm_csr *C, const double *vals, int m, const fcm_in
   return finite;
 }
 
-/* Gather C_K through the positions of a block whose entries are all stored (pos of
- * gather_scan()), each checked against C's pattern: 1 when all finite, 0 when one is NaN or
- * infinite, -1 (a unfinished) when C's pattern has moved an entry. */
+/* Gather C_K's lower triangle (all that the Cholesky factor and dsyevd read) through the
+ * positions of a block whose entries are all stored (pos of gather_scan()), each checked
+ * against C's pattern: 1 when all finite, 0 when one is NaN or infinite, -1 (a unfinished)
+ * when C's pattern has moved an entry. */
 static int gather_known(const fcm_csr *C, const double *vals, int m, const fcm_index *d,
                         const int *pos, double *a)
 {
@@ -197,7 +198,7 @@ static int gather_known(const fcm_csr *C, const double *vals, int m, const fcm_i
   for (int i = 0; i < m; i++) {
     const fcm_index r0 = rp[d[i]], len = rp[d[i] + 1] - r0;
     const int *pi = pos + (size_t)i * m;
-    for (int j = 0; j < m; j++) {
+    for (int j = 0; j <= i; j++) {
       const fcm_index p = r0 + pi[j];
       if (pi[j] >= len || ci[p] != d[j]) return -1;
       finite &= isfinite(vals[p]) != 0;
@@ -211,9 +212,11 @@ static int gather_known(const fcm_csr *C, const double *vals, int m, const fcm_i
  * entries of S at a time): each entry's sum still runs over k in ascending order, as one chain
  * of dependent operations, and two chains interleaved keep the floating-point units busy. */
 
-/* L of C_K = L L^T (row-major) from the lower triangle of a (column-major); 0 when a pivot
- * is not positive and finite. Rows i and i + 1 go together: at each column j <= i entry
- * (i, j) first (entry (i + 1, i) divides by L_ii, found in the same step). */
+/* L of C_K = L L^T (row-major) from the lower triangle of a (column-major), with 1 / L_jj
+ * stored on the diagonal: the entries below it are multiplied by it, a division's latency
+ * not on each entry's chain; 0 when a pivot is not positive and finite. Rows i and i + 1 go
+ * together: at each column j <= i entry (i, j) first (entry (i + 1, i) takes 1 / L_ii, found
+ * in the same step). */
 static int cholesky_factor(int m, const double *a, double *L)
 {
   for (int i = 0; i < m; i += 2) {
@@ -231,35 +234,36 @@ static int cholesky_factor(int m, const double *a, double *L)
         for (; k < j; k++)
           v -= Li[k] * Lj[k];
       if (i > j) {
-        Li[j] = v / Lj[j];
+        Li[j] = v * Lj[j];
       } else {
         if (!(v > 0.0 && isfinite(v))) return 0;
-        Li[i] = sqrt(v);
+        Li[i] = 1.0 / sqrt(v);
       }
-      if (Lh) Lh[j] = u / Lj[j];
+      if (Lh) Lh[j] = u * Lj[j];
     }
     if (Lh) { /* the diagonal of row i + 1 */
       double v = a[i + 1 + (size_t)(i + 1) * m];
       for (int k = 0; k < i + 1; k++)
         v -= Lh[k] * Lh[k];
       if (!(v > 0.0 && isfinite(v))) return 0;
-      Lh[i + 1] = sqrt(v);
+      Lh[i + 1] = 1.0 / sqrt(v);
     }
   }
   return 1;
 }
 
-/* X = L^{-1} (lower, row-major), columns j and j + 1 together. */
+/* X = L^{-1} (lower, row-major; L with 1 / L_ii on its diagonal, cholesky_factor()),
+ * columns j and j + 1 together. */
 static void cholesky_invert_factor(int m, const double *L, double *X)
 {
   for (int j = 0; j < m; j += 2) {
     const int h = j + 1;
-    X[(size_t)j * m + j] = 1.0 / L[(size_t)j * m + j];
+    X[(size_t)j * m + j] = L[(size_t)j * m + j];
     if (h < m) {
-      X[(size_t)h * m + h] = 1.0 / L[(size_t)h * m + h];
+      X[(size_t)h * m + h] = L[(size_t)h * m + h];
       double v = 0.0;
       v -= L[(size_t)h * m + j] * X[(size_t)j * m + j];
-      X[(size_t)h * m + j] = v / L[(size_t)h * m + h];
+      X[(size_t)h * m + j] = v * L[(size_t)h * m + h];
     }
     for (int i = j + 2; i < m; i++) {
       const double *Li = L + (size_t)i * m;
@@ -269,8 +273,8 @@ static void cholesky_invert_factor(int m, const double *L, double *X)
         v -= Li[k] * X[(size_t)k * m + j];
         u -= Li[k] * X[(size_t)k * m + h];
       }
-      X[(size_t)i * m + j] = v / Li[i];
-      X[(size_t)i * m + h] = u / Li[i];
+      X[(size_t)i * m + j] = v * Li[i];
+      X[(size_t)i * m + h] = u * Li[i];
     }
   }
 }
