@@ -1,7 +1,8 @@
 /* The sparse triple product C = P^T A P (fcm__ptap) against a dense product on random sparse
  * matrices (general and symmetric A, P with empty rows and columns): C's pattern holds every
  * structurally nonzero entry (and the diagonal when asked), sorted (and symmetric for a
- * symmetric A), its values match to rounding, new
+ * symmetric A; and A of 3 x 3 blocks, whose three rows of a node share a pattern), its values
+ * match to rounding, new
  * values of A give the new product, the threaded product (2 threads, pattern and values) is
  * bitwise the serial one; argument errors; allocation failures. */
 #include "alloc_loop.h"
@@ -87,6 +88,30 @@ static fcm_csr *matrix_random(fcm_ctx *ctx, rng *r, fcm_index n, int per_row, in
   return A;
 }
 
+/* A random symmetric n x n matrix (n divisible by 3) of full 3 x 3 blocks, as a vector
+ * field's: rows 3 I, 3 I + 1, 3 I + 2 share one pattern (the product's three-row path). */
+static fcm_csr *matrix_random_blocked(fcm_ctx *ctx, rng *r, fcm_index n, int per_row)
+{
+  const fcm_index nn = n / 3, cap = 18 * nn * (per_row + 1);
+  fcm_index *ti = malloc((size_t)cap * sizeof *ti), *tj = malloc((size_t)cap * sizeof *tj);
+  double *tv = malloc((size_t)cap * sizeof *tv);
+  fcm_index t = 0;
+  for (fcm_index I = 0; I < nn; I++)
+    for (int k = 0; k <= per_row; k++) {
+      const fcm_index J = k == 0 ? I : (fcm_index)((rng_uniform(r) + 1.0) * 0.5 * (double)nn) % nn;
+      for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++) {
+          const double v = k == 0 && a == b ? 8.0 + rng_uniform(r) : rng_uniform(r);
+          ti[t] = 3 * I + a, tj[t] = 3 * J + b, tv[t++] = v;
+          ti[t] = 3 * J + b, tj[t] = 3 * I + a, tv[t++] = v;
+        }
+    }
+  fcm_csr *A = NULL;
+  TEST_OK(ctx, fcm_csr_create_triplets(ctx, n, n, t, ti, tj, tv, FCM_CSR_SYMMETRIC, &A));
+  free(ti), free(tj), free(tv);
+  return A;
+}
+
 /* max |C - P^T A P| over all entries (0 outside C's pattern must be exact), against the scale
  * of the dense product's terms; diagonal entries must be stored when with_diagonal. */
 static void check_dense(const fcm_csr *A, const sparse *P, const fcm_csr *C, int with_diagonal)
@@ -142,7 +167,9 @@ static void check_case(fcm_ctx *ctx, rng *r, fcm_index n, fcm_index nc, int symm
 {
   sparse P;
   sparse_random(r, n, nc, 3, 7, &P);
-  fcm_csr *A = matrix_random(ctx, r, n, 4, symmetric);
+  /* symmetric == 2: of 3 x 3 blocks (matrix_random_blocked()) */
+  fcm_csr *A =
+      symmetric == 2 ? matrix_random_blocked(ctx, r, n, 3) : matrix_random(ctx, r, n, 4, symmetric);
   fcm__ptap *plan1 = NULL, *plan2 = NULL;
   fcm_csr *C1 = NULL, *C2 = NULL;
   TEST_OK(ctx, fcm__ptap_create(ctx, A, nc, P.ptr, P.col, P.val, with_diagonal, 1, &plan1, &C1));
@@ -234,6 +261,8 @@ int main(void)
   check_case(ctx, &r, 40, 12, 0, 0);
   check_case(ctx, &r, 700, 150, 1, 1); /* rows enough for both threads' chunks */
   check_case(ctx, &r, 700, 150, 0, 1);
+  check_case(ctx, &r, 42, 12, 2, 1);
+  check_case(ctx, &r, 699, 150, 2, 1);
   {
     sparse P;
     sparse_random(&r, 20, 5, 2, 0, &P);

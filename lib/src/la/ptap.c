@@ -19,7 +19,7 @@ struct fcm__ptap {
   fcm_index *AP_ptr; /* A P (n x nc) */
   int *AP_col;
   double *AP_val;
-  double *spa; /* nt dense accumulators of nc + 1 doubles, zero between products */
+  double *spa; /* nt dense accumulators of 3 (nc + 1) doubles, zero between products */
 };
 
 /* Sort a[0 .. n) ascending (distinct values: a row's columns): quicksort on the median of
@@ -263,25 +263,71 @@ cleanup:
   return st;
 }
 
+/* Row i of C = A B on C's pattern into Cv, through spa (zero on entry and exit). */
+static void product_row(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
+                        const fcm_index *Bp, const int *Bc, const double *Bv, const fcm_index *Cp,
+                        const int *Cc, double *Cv, double *spa)
+{
+  for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
+    const fcm_index k = Ac[p];
+    const double a = Av[p];
+    for (fcm_index q = Bp[k]; q < Bp[k + 1]; q++)
+      spa[Bc[q]] += a * Bv[q];
+  }
+  for (fcm_index p = Cp[i]; p < Cp[i + 1]; p++) {
+    Cv[p] = spa[Cc[p]];
+    spa[Cc[p]] = 0.0;
+  }
+}
+
+/* Rows i, i + 1, i + 2 of C = A B when the three rows of A have one pattern (a node's three
+ * DOFs): each row of B read once for the three, whose sums go to spa3's interleaved slots
+ * (3 j + r: row i + r, column j; zero on entry and exit), each in product_row()'s order.
+ * 0 (nothing done) when the patterns differ. */
+static int product_triple(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
+                          const fcm_index *Bp, const int *Bc, const double *Bv, const fcm_index *Cp,
+                          const int *Cc, double *Cv, double *spa3)
+{
+  const fcm_index len = Ap[i + 1] - Ap[i];
+  if (Ap[i + 2] - Ap[i + 1] != len || Ap[i + 3] - Ap[i + 2] != len ||
+      memcmp(Ac + Ap[i], Ac + Ap[i + 1], sizeof *Ac * (size_t)len) != 0 ||
+      memcmp(Ac + Ap[i], Ac + Ap[i + 2], sizeof *Ac * (size_t)len) != 0)
+    return 0;
+  for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
+    const fcm_index k = Ac[p];
+    const double a0 = Av[p], a1 = Av[p + len], a2 = Av[p + 2 * len];
+    for (fcm_index q = Bp[k]; q < Bp[k + 1]; q++) {
+      double *t = spa3 + 3 * (size_t)Bc[q];
+      const double b = Bv[q];
+      t[0] += a0 * b;
+      t[1] += a1 * b;
+      t[2] += a2 * b;
+    }
+  }
+  for (int r = 0; r < 3; r++)
+    for (fcm_index p = Cp[i + r]; p < Cp[i + r + 1]; p++) {
+      double *t = spa3 + 3 * (size_t)Cc[p] + r;
+      Cv[p] = *t;
+      *t = 0.0;
+    }
+  return 1;
+}
+
 /* Values of C = A B on C's pattern, rows shared by the threads of the enclosing region (ends
- * with a barrier); spa: the calling thread's accumulator over B's columns (zero on entry and
- * exit). Each entry is summed in A's row order, then B's. */
+ * with a barrier), three at a time where they are a node's of one pattern (product_triple());
+ * spa: the calling thread's accumulator, 3 (B's columns + 1) doubles (zero on entry and exit).
+ * Each entry is summed in A's row order, then B's. */
 static void product_values(fcm_index nrow, const fcm_index *Ap, const int *Ac, const double *Av,
                            const fcm_index *Bp, const int *Bc, const double *Bv,
                            const fcm_index *Cp, const int *Cc, double *Cv, double *spa)
 {
-#pragma omp for schedule(dynamic, 64)
-  for (fcm_index i = 0; i < nrow; i++) {
-    for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
-      const fcm_index k = Ac[p];
-      const double a = Av[p];
-      for (fcm_index q = Bp[k]; q < Bp[k + 1]; q++)
-        spa[Bc[q]] += a * Bv[q];
-    }
-    for (fcm_index p = Cp[i]; p < Cp[i + 1]; p++) {
-      Cv[p] = spa[Cc[p]];
-      spa[Cc[p]] = 0.0;
-    }
+  const fcm_index ng = (nrow + 2) / 3;
+#pragma omp for schedule(dynamic, 22)
+  for (fcm_index g = 0; g < ng; g++) {
+    const fcm_index i = 3 * g;
+    if (i + 2 < nrow && product_triple(i, Ap, Ac, Av, Bp, Bc, Bv, Cp, Cc, Cv, spa)) continue;
+    for (fcm_index r = i; r < i + 3 && r < nrow; r++)
+      product_row(r, Ap, Ac, Av, Bp, Bc, Bv, Cp, Cc, Cv, spa);
   }
 }
 
@@ -334,7 +380,7 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
   FCM_TRY(ctx,
           product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, 1, &cp, &cc));
   if (with_diagonal) FCM_TRY(ctx, add_diagonal(ctx, nc, &cp, &cc));
-  FCM_ALLOC(ctx, (size_t)nt * (size_t)(nc + 1), t->spa);
+  FCM_ALLOC(ctx, (size_t)nt * 3 * (size_t)(nc + 1), t->spa);
   /* rows sorted and in range by construction, symmetric with A's pattern */
   FCM_TRY(ctx, fcm__csr_adopt_pattern(ctx, nc, nc, &cp, &cc, fcm_csr_get_kind(A), C));
   *plan = t;
@@ -355,7 +401,7 @@ void fcm__ptap_apply(fcm__ptap *t, const fcm_csr *A, fcm_csr *C, int nt)
   nt = nt < 1 ? 1 : nt > t->nt ? t->nt : nt;
 #pragma omp parallel num_threads(nt) if (nt > 1)
   {
-    double *spa = t->spa + (size_t)omp_get_thread_num() * (size_t)(nc + 1);
+    double *spa = t->spa + (size_t)omp_get_thread_num() * 3 * (size_t)(nc + 1);
     product_values(n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), fcm_csr_values_read(A), t->P_ptr,
                    t->P_col, t->P_val, t->AP_ptr, t->AP_col, t->AP_val, spa);
     product_values(nc, t->R_ptr, t->R_col, t->R_val, t->AP_ptr, t->AP_col, t->AP_val, cp, cc, cv,
