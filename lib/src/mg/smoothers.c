@@ -671,6 +671,52 @@ static inline void sym_lower_apply(const double *S, const double *r, int m, doub
   }
 }
 
+/* dx = X^T X r for a lower triangular m x m X (row major; fcm__schwarz_block_factor()):
+ * y = X r into r (rows descending: y_i reads r_j, j <= i, not yet overwritten), then
+ * dx = X^T y row after row; both read X's lower triangle, the second time from cache. */
+static inline void factor_apply(const double *X, double *r, int m, double *dx)
+{
+  for (int i = m - 1; i >= 0; i--) {
+    const double *Xi = X + (size_t)i * (size_t)m;
+    double s0 = 0.0, s1 = 0.0;
+    int j = 0;
+    for (; j + 2 <= i + 1; j += 2) {
+      s0 += Xi[j] * r[j];
+      s1 += Xi[j + 1] * r[j + 1];
+    }
+    if (j <= i) s0 += Xi[j] * r[j];
+    r[i] = s0 + s1;
+  }
+  for (int i = 0; i < m; i++)
+    dx[i] = 0.0;
+  for (int i = 0; i < m; i++) {
+    const double *Xi = X + (size_t)i * (size_t)m;
+    const double yi = r[i];
+    for (int j = 0; j <= i; j++)
+      dx[j] += Xi[j] * yi;
+  }
+}
+
+/* The reference of the test hook: dx = S r with S = X^T X for a factor block (each entry
+ * formed, m^3 operations), else S's rows in full. */
+static void plain_apply(const double *S, const double *r, int m, int factor, double *dx)
+{
+  for (int i = 0; i < m; i++) {
+    if (!factor) {
+      dx[i] = dense_dot(S + (size_t)i * (size_t)m, r, m);
+      continue;
+    }
+    double sum = 0.0;
+    for (int j = 0; j < m; j++) {
+      double sij = 0.0;
+      for (int k = i > j ? i : j; k < m; k++)
+        sij += S[(size_t)k * (size_t)m + i] * S[(size_t)k * (size_t)m + j];
+      sum += sij * r[j];
+    }
+    dx[i] = sum;
+  }
+}
+
 /* Gauss-Seidel over the rows i, i + 1, i + 2 of one copy (fcm__mg_row_dot3()), in order
  * (back: in reverse): the three sums from the x before the first update, each corrected by the
  * earlier rows' updates through the three's own 3 x 3 block (A_(i..i+2, i..i+2), stored
@@ -818,9 +864,11 @@ static void block_slab(const sweep_args *a, fcm_index s, int back)
         i++;
       }
     }
+    const int factor = a->blk.factor && a->blk.factor[k];
     if (a->plain)
-      for (int i = 0; i < bm; i++)
-        dx[i] = dense_dot(S + (size_t)i * (size_t)bm, r, bm);
+      plain_apply(S, r, bm, factor, dx);
+    else if (factor)
+      factor_apply(S, r, bm, dx);
     else
       sym_lower_apply(S, r, bm, dx);
     for (int i = 0; i < bm; i++)
@@ -869,18 +917,21 @@ void fcm__mg_block_smooth(const fcm_mg *m, const mg_level *L, const double *b, d
 }
 
 fcm_status fcm__mg_smooth_paths(fcm_mg *mg, int level, const double *b, const double *x,
-                                double *x_fast, double *x_plain, fcm_index *triples)
+                                double *x_fast, double *x_plain, fcm_index *triples,
+                                fcm_index *factor_blocks)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = mg ? mg->ctx : NULL;
-  FCM_CHECK(mg && b && x && x_fast && x_plain && triples, ctx, FCM_ERR_ARG,
+  FCM_CHECK(mg && b && x && x_fast && x_plain && triples && factor_blocks, ctx, FCM_ERR_ARG,
             "mg_smooth_paths: NULL argument");
   FCM_CHECK(level >= 0 && level + 1 < mg->nlev, ctx, FCM_ERR_ARG,
             "mg_smooth_paths: level %d outside [0, %d)", level, mg->nlev - 1);
   FCM_CHECK(mg->opts.smoother == FCM_MG_SMOOTHER_SGS && mg->lev[level].rows.ptr, ctx, FCM_ERR_ARG,
             "mg_smooth_paths: the smoother is not SGS");
   mg_level *L = &mg->lev[level];
-  *triples = 0;
+  *triples = 0, *factor_blocks = 0;
+  for (fcm_index k = 0; L->blk && k < fcm__schwarz_num_blocks(L->blk); k++)
+    *factor_blocks += fcm__schwarz_block_factor(L->blk, k);
   for (fcm_index i = 0; L->rows.triple && i < L->n; i++)
     *triples += L->rows.triple[i];
   memcpy(x_fast, x, sizeof *x * (size_t)L->n);

@@ -36,12 +36,14 @@ struct fcm_schwarz {
   fcm_index n;
   fcm_schwarz_options opts;
   fcm_index num_blocks;
-  fcm_index *block_ptr; /* num_blocks + 1 */
-  fcm_index *dofs;      /* block_ptr[num_blocks] */
-  size_t *s_off;        /* num_blocks + 1 offsets into S */
-  double *S;            /* dense S_K, m x m each (symmetric) */
-  int *pos;             /* as S: where C_K's entry (i, j) lies in C's row dofs[i] (-1: none) */
-  unsigned char *full;  /* num_blocks: every entry of C_K is stored (pos holds them all) */
+  fcm_index *block_ptr;  /* num_blocks + 1 */
+  fcm_index *dofs;       /* block_ptr[num_blocks] */
+  size_t *s_off;         /* num_blocks + 1 offsets into S */
+  double *S;             /* dense S_K, m x m each (symmetric) */
+  int *pos;              /* as S: where C_K's entry (i, j) lies in C's row dofs[i] (-1: none) */
+  unsigned char *full;   /* num_blocks: every entry of C_K is stored (pos holds them all) */
+  unsigned char *factor; /* blocks_only, num_blocks: S's slot holds X = L^{-1} of the Cholesky
+                            factor C_K = L L^T (lower triangle, zero above), S_K = X^T X */
   int max_m;
   int num_colors;        /* of the block graph (statistics only; 0 when blocks_only) */
   fcm_index *inc_ptr;    /* n + 1: DOF i is row inc_row[q] of block inc_blk[q], q in range
@@ -84,6 +86,7 @@ void fcm_schwarz_destroy(fcm_schwarz **P)
   fcm__free(ctx, p->S);
   fcm__free(ctx, p->pos);
   fcm__free(ctx, p->full);
+  fcm__free(ctx, p->factor);
   fcm__free(ctx, p->inc_ptr);
   fcm__free(ctx, p->inc_blk);
   fcm__free(ctx, p->inc_row);
@@ -324,6 +327,38 @@ static int cholesky_inverse(int m, const double *a, double eps, double *lw, doub
   return isfinite(ns) && sqrt(na) * sqrt(ns) <= SCHWARZ_CHOLESKY_COND / eps;
 }
 
+/* For a block smoother, whose sweeps may apply S_K = X^T X as two triangular products: X =
+ * L^{-1} into S's slot (lower triangle, zero above; *factor = 1) when the bound
+ * ||S_K||_F <= ||X||_F^2 already passes cholesky_inverse()'s test, which then needs no
+ * product; else cholesky_inverse() itself (*factor = 0). The same blocks take the Cholesky
+ * path as there. */
+static int cholesky_inverse_factor(int m, const double *a, double eps, double *lw, double *S,
+                                   unsigned char *factor)
+{
+  double *L = lw, *X = lw + (size_t)m * m, na = 0.0, nx = 0.0;
+  *factor = 0;
+  for (int i = 0; i < m; i++)
+    for (int j = 0; j <= i; j++) {
+      const double v = a[i + (size_t)j * m];
+      na += (i == j ? 1.0 : 2.0) * v * v;
+    }
+  if (!cholesky_factor(m, a, L)) return 0;
+  cholesky_invert_factor(m, L, X);
+  for (int i = 0; i < m; i++)
+    for (int j = 0; j <= i; j++)
+      nx += X[(size_t)i * m + j] * X[(size_t)i * m + j];
+  if (isfinite(nx) && sqrt(na) * nx <= SCHWARZ_CHOLESKY_COND / eps) {
+    for (int i = 0; i < m; i++) {
+      memcpy(S + (size_t)i * m, X + (size_t)i * m, sizeof *S * (size_t)(i + 1));
+      memset(S + (size_t)i * m + i + 1, 0, sizeof *S * (size_t)(m - 1 - i));
+    }
+    *factor = 1;
+    return 1;
+  }
+  const double ns = cholesky_product(m, X, S);
+  return isfinite(ns) && sqrt(na) * sqrt(ns) <= SCHWARZ_CHOLESKY_COND / eps;
+}
+
 /* Gather C_K, then S_K: by cholesky_inverse() where it applies, else by the symmetric
  * eigendecomposition with reflected and clamped eigenvalues. */
 static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *vals, fcm_index b,
@@ -342,7 +377,11 @@ static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *va
     *fail = FAIL_NONFINITE;
     return FCM_ERR_NUMERIC;
   }
-  if (cholesky_inverse(m, a, P->opts.epsilon, lw, S)) return st;
+  if (P->factor) {
+    if (cholesky_inverse_factor(m, a, P->opts.epsilon, lw, S, P->factor + b)) return st;
+  } else if (cholesky_inverse(m, a, P->opts.epsilon, lw, S)) {
+    return st;
+  }
   st = fcm__syev_work(ctx, 1, m, a, m, w, lw, P->lwork, iw, P->liwork);
   if (st != FCM_OK) {
     *fail = st == FCM_ERR_ALLOC ? FAIL_NONE : FAIL_LAPACK;
@@ -554,7 +593,8 @@ static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
   /* S and pos are written in full by the first setup (below) before anything reads them */
   FCM_ALLOC_RAW(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->S);
   FCM_ALLOC_RAW(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->pos);
-  FCM_ALLOC(ctx, num_blocks + 1, P->full);                 /* zero: the first setup scans */
+  FCM_ALLOC(ctx, num_blocks + 1, P->full); /* zero: the first setup scans */
+  if (blocks_only) FCM_ALLOC(ctx, num_blocks + 1, P->factor);
   if (!blocks_only) FCM_TRY(ctx, incidence_and_colors(P)); /* the apply's */
   /* setup scratch: the eigensolver workspace of the largest need over the block sizes */
   P->nt = fcm_ctx_num_threads(ctx);
@@ -642,6 +682,11 @@ fcm_index fcm__schwarz_num_blocks(const fcm_schwarz *P)
   return P ? P->num_blocks : 0;
 }
 
+int fcm__schwarz_block_factor(const fcm_schwarz *P, fcm_index k)
+{
+  return P->factor ? P->factor[k] : 0;
+}
+
 int fcm__schwarz_block(const fcm_schwarz *P, fcm_index k, const fcm_index **dofs, const double **S)
 {
   *dofs = P->dofs + P->block_ptr[k];
@@ -652,6 +697,7 @@ int fcm__schwarz_block(const fcm_schwarz *P, fcm_index k, const fcm_index **dofs
 void fcm__schwarz_get_view(const fcm_schwarz *P, fcm__schwarz_view *v)
 {
   v->ptr = P->block_ptr, v->dofs = P->dofs, v->s_off = P->s_off, v->S = P->S;
+  v->factor = P->factor;
 }
 
 fcm_status fcm_schwarz_operator(void *user, const double *r, double *z)
