@@ -19,7 +19,8 @@ struct fcm__ptap {
   fcm_index *AP_ptr; /* A P (n x nc) */
   int *AP_col;
   double *AP_val;
-  double *spa; /* nt dense accumulators of 3 (nc + 1) doubles, zero between products */
+  double *spa;          /* nt dense accumulators of 3 (nc + 1) doubles, zero between products */
+  unsigned char *same3; /* per group g of A's rows 3 g .. 3 g + 2: one pattern (all three) */
 };
 
 /* Sort a[0 .. n) ascending (distinct values: a row's columns): quicksort on the median of
@@ -280,19 +281,24 @@ static void product_row(fcm_index i, const fcm_index *Ap, const int *Ac, const d
   }
 }
 
+/* Whether rows i, i + 1, i + 2 (< the row count) hold one pattern. */
+static int same_pattern3(fcm_index i, const fcm_index *Ap, const int *Ac)
+{
+  const fcm_index len = Ap[i + 1] - Ap[i];
+  return Ap[i + 2] - Ap[i + 1] == len && Ap[i + 3] - Ap[i + 2] == len &&
+         memcmp(Ac + Ap[i], Ac + Ap[i + 1], sizeof *Ac * (size_t)len) == 0 &&
+         memcmp(Ac + Ap[i], Ac + Ap[i + 2], sizeof *Ac * (size_t)len) == 0;
+}
+
 /* Rows i, i + 1, i + 2 of C = A B when the three rows of A have one pattern (a node's three
  * DOFs): each row of B read once for the three, whose sums go to spa3's interleaved slots
  * (3 j + r: row i + r, column j; zero on entry and exit), each in product_row()'s order.
- * 0 (nothing done) when the patterns differ. */
-static int product_triple(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
-                          const fcm_index *Bp, const int *Bc, const double *Bv, const fcm_index *Cp,
-                          const int *Cc, double *Cv, double *spa3)
+ * The three rows must hold one pattern (same_pattern3()). */
+static void product_triple(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
+                           const fcm_index *Bp, const int *Bc, const double *Bv,
+                           const fcm_index *Cp, const int *Cc, double *Cv, double *spa3)
 {
   const fcm_index len = Ap[i + 1] - Ap[i];
-  if (Ap[i + 2] - Ap[i + 1] != len || Ap[i + 3] - Ap[i + 2] != len ||
-      memcmp(Ac + Ap[i], Ac + Ap[i + 1], sizeof *Ac * (size_t)len) != 0 ||
-      memcmp(Ac + Ap[i], Ac + Ap[i + 2], sizeof *Ac * (size_t)len) != 0)
-    return 0;
   for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
     const fcm_index k = Ac[p];
     const double a0 = Av[p], a1 = Av[p + len], a2 = Av[p + 2 * len];
@@ -310,22 +316,26 @@ static int product_triple(fcm_index i, const fcm_index *Ap, const int *Ac, const
       Cv[p] = *t;
       *t = 0.0;
     }
-  return 1;
 }
 
 /* Values of C = A B on C's pattern, rows shared by the threads of the enclosing region (ends
- * with a barrier), three at a time where they are a node's of one pattern (product_triple());
+ * with a barrier), three at a time where they are a node's of one pattern (product_triple();
+ * same3: per group of three rows whether they are, or NULL: checked here);
  * spa: the calling thread's accumulator, 3 (B's columns + 1) doubles (zero on entry and exit).
  * Each entry is summed in A's row order, then B's. */
 static void product_values(fcm_index nrow, const fcm_index *Ap, const int *Ac, const double *Av,
                            const fcm_index *Bp, const int *Bc, const double *Bv,
-                           const fcm_index *Cp, const int *Cc, double *Cv, double *spa)
+                           const fcm_index *Cp, const int *Cc, double *Cv, double *spa,
+                           const unsigned char *same3)
 {
   const fcm_index ng = (nrow + 2) / 3;
 #pragma omp for schedule(dynamic, 22)
   for (fcm_index g = 0; g < ng; g++) {
     const fcm_index i = 3 * g;
-    if (i + 2 < nrow && product_triple(i, Ap, Ac, Av, Bp, Bc, Bv, Cp, Cc, Cv, spa)) continue;
+    if (i + 2 < nrow && (same3 ? same3[g] : same_pattern3(i, Ap, Ac))) {
+      product_triple(i, Ap, Ac, Av, Bp, Bc, Bv, Cp, Cc, Cv, spa);
+      continue;
+    }
     for (fcm_index r = i; r < i + 3 && r < nrow; r++)
       product_row(r, Ap, Ac, Av, Bp, Bc, Bv, Cp, Cc, Cv, spa);
   }
@@ -343,6 +353,7 @@ void fcm__ptap_destroy(fcm__ptap **plan)
   fcm__free(ctx, t->AP_col);
   fcm__free(ctx, t->AP_val);
   fcm__free(ctx, t->spa);
+  fcm__free(ctx, t->same3);
   fcm__free(ctx, t);
   *plan = NULL;
 }
@@ -381,6 +392,9 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
           product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, 1, &cp, &cc));
   if (with_diagonal) FCM_TRY(ctx, add_diagonal(ctx, nc, &cp, &cc));
   FCM_ALLOC(ctx, (size_t)nt * 3 * (size_t)(nc + 1), t->spa);
+  FCM_ALLOC(ctx, n / 3 + 1, t->same3); /* A's pattern, which every product keeps */
+  for (fcm_index g = 0; 3 * g + 2 < n; g++)
+    t->same3[g] = (unsigned char)same_pattern3(3 * g, fcm_csr_row_ptr(A), fcm_csr_col_idx(A));
   /* rows sorted and in range by construction, symmetric with A's pattern */
   FCM_TRY(ctx, fcm__csr_adopt_pattern(ctx, nc, nc, &cp, &cc, fcm_csr_get_kind(A), C));
   *plan = t;
@@ -403,9 +417,9 @@ void fcm__ptap_apply(fcm__ptap *t, const fcm_csr *A, fcm_csr *C, int nt)
   {
     double *spa = t->spa + (size_t)omp_get_thread_num() * 3 * (size_t)(nc + 1);
     product_values(n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), fcm_csr_values_read(A), t->P_ptr,
-                   t->P_col, t->P_val, t->AP_ptr, t->AP_col, t->AP_val, spa);
+                   t->P_col, t->P_val, t->AP_ptr, t->AP_col, t->AP_val, spa, t->same3);
     product_values(nc, t->R_ptr, t->R_col, t->R_val, t->AP_ptr, t->AP_col, t->AP_val, cp, cc, cv,
-                   spa);
+                   spa, NULL);
   }
 }
 
