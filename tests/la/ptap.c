@@ -1,7 +1,8 @@
 /* The sparse triple product C = P^T A P (fcm__ptap) against a dense product on random sparse
  * matrices (general and symmetric A, P with empty rows and columns): C's pattern holds every
  * structurally nonzero entry (and the diagonal when asked), sorted (and symmetric for a
- * symmetric A; and A of 3 x 3 blocks, whose three rows of a node share a pattern), its values
+ * symmetric A; and A of 3 x 3 blocks, whose three rows of a node share a pattern, with P random
+ * or a vector field's, each node's weights for its three components), its values
  * match to rounding, new
  * values of A give the new product, the threaded product (2 threads, pattern and values) is
  * bitwise the serial one; argument errors; allocation failures. */
@@ -46,6 +47,28 @@ static void sparse_random(rng *r, fcm_index n, fcm_index m, int per_row, int emp
     S->ptr[i + 1] = q;
   }
   free(seen);
+}
+
+/* S of a node's three components: entry (I, J) of the random n/3 x m/3 node matrix at
+ * (3 I + c, 3 J + c), c = 0, 1, 2 (a vector field's prolongation). */
+static void sparse_random_nodes(rng *r, fcm_index n, fcm_index m, int per_row, int empty_every,
+                                sparse *S)
+{
+  sparse N;
+  sparse_random(r, n / 3, m / 3, per_row, empty_every, &N);
+  S->n = n, S->m = m;
+  S->ptr = calloc((size_t)n + 1, sizeof *S->ptr);
+  S->col = malloc((3 * (size_t)N.ptr[N.n] + 1) * sizeof *S->col);
+  S->val = malloc((3 * (size_t)N.ptr[N.n] + 1) * sizeof *S->val);
+  fcm_index q = 0;
+  for (fcm_index i = 0; i < n; i++) {
+    for (fcm_index p = N.ptr[i / 3]; p < N.ptr[i / 3 + 1]; p++) {
+      S->col[q] = 3 * N.col[p] + (int)(i % 3);
+      S->val[q++] = N.val[p];
+    }
+    S->ptr[i + 1] = q;
+  }
+  free(N.ptr), free(N.col), free(N.val);
 }
 
 static void sparse_free(sparse *S)
@@ -166,10 +189,14 @@ static void check_case(fcm_ctx *ctx, rng *r, fcm_index n, fcm_index nc, int symm
                        int with_diagonal)
 {
   sparse P;
-  sparse_random(r, n, nc, 3, 7, &P);
-  /* symmetric == 2: of 3 x 3 blocks (matrix_random_blocked()) */
+  /* symmetric == 2: A of 3 x 3 blocks (matrix_random_blocked()); 3: and P of a vector
+   * field's (sparse_random_nodes()) */
+  if (symmetric == 3)
+    sparse_random_nodes(r, n, nc, 3, 7, &P);
+  else
+    sparse_random(r, n, nc, 3, 7, &P);
   fcm_csr *A =
-      symmetric == 2 ? matrix_random_blocked(ctx, r, n, 3) : matrix_random(ctx, r, n, 4, symmetric);
+      symmetric >= 2 ? matrix_random_blocked(ctx, r, n, 3) : matrix_random(ctx, r, n, 4, symmetric);
   fcm__ptap *plan1 = NULL, *plan2 = NULL;
   fcm_csr *C1 = NULL, *C2 = NULL;
   TEST_OK(ctx, fcm__ptap_create(ctx, A, nc, P.ptr, P.col, P.val, with_diagonal, 1, &plan1, &C1));
@@ -263,6 +290,8 @@ int main(void)
   check_case(ctx, &r, 700, 150, 0, 1);
   check_case(ctx, &r, 42, 12, 2, 1);
   check_case(ctx, &r, 699, 150, 2, 1);
+  check_case(ctx, &r, 42, 12, 3, 1);
+  check_case(ctx, &r, 699, 150, 3, 1);
   {
     sparse P;
     sparse_random(&r, 20, 5, 2, 0, &P);
