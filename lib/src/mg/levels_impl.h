@@ -1,6 +1,6 @@
 /* mg module, private to its files: the levels of the hierarchy, the solver object and the calls
  * between creation and setup (mg.c), the hierarchy (hierarchy.c), the prolongations
- * (transfer.c), the smoothers (smoothers.c) and the cycle (cycle.c).
+ * (transfer.c), the smoothers (smoothers.c, sweeps.c) and the cycle (cycle.c).
  *
  * Data per grid level l (level 0 on Hex8, levels >= 1 on Hex20, whose level 0 has only its
  * DOFs, matrix and prolongation): cells (the first grid level: the space's elements) with a
@@ -38,6 +38,15 @@ typedef struct slab_order {
   unsigned char *triple; /* row orders: per row i, 1 when i = 3k starts its copy's three rows
                             and they share one column pattern (fcm__mg_row_dot3()) */
 } slab_order;
+
+/* Does thread t of nt run slab s? The slabs of one colour go to the threads in contiguous
+ * runs of about equal work (a slab to the thread whose share holds its work's midpoint).
+ * Affects the schedule only: the slabs of one colour are independent. */
+static inline int fcm__mg_slab_mine(const slab_order *S, fcm_index s, int t, int nt)
+{
+  const int owner = (int)(S->mid[s] * nt);
+  return (owner < nt ? owner : nt - 1) == t;
+}
 
 /* Levels with at least this many stored entries share their work between the threads. */
 #define MG_PARALLEL_NNZ 32768
@@ -239,6 +248,8 @@ fcm_status fcm__mg_level_blocks(fcm_mg *m, int l, fcm_index *nb, fcm_index **ptr
  * with `old` (NULL: none), a level l with same[l] (its pattern is old's) takes old's block
  * smoother where its blocks are old's (fcm__mg_keep_blocks()). */
 fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned char *same);
+
+/* ---- sweeps.c */
 
 /* One smoothing step with the pointwise smoother of m's options, by the team of the enclosing
  * parallel region (no barrier at the end). */
