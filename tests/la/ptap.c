@@ -1,7 +1,9 @@
 /* The sparse triple product C = P^T A P (fcm__ptap) against a dense product on random sparse
  * matrices (general and symmetric A, P with empty rows and columns): C's pattern holds every
  * structurally nonzero entry (and the diagonal when asked), sorted (and symmetric for a
- * symmetric A), its values match to rounding, new
+ * symmetric A; and A of 3 x 3 blocks, whose three rows of a node share a pattern, with P random
+ * or a vector field's, each node's weights for its three components), its values
+ * match to rounding, new
  * values of A give the new product, the threaded product (2 threads, pattern and values) is
  * bitwise the serial one; argument errors; allocation failures. */
 #include "alloc_loop.h"
@@ -47,6 +49,28 @@ static void sparse_random(rng *r, fcm_index n, fcm_index m, int per_row, int emp
   free(seen);
 }
 
+/* S of a node's three components: entry (I, J) of the random n/3 x m/3 node matrix at
+ * (3 I + c, 3 J + c), c = 0, 1, 2 (a vector field's prolongation). */
+static void sparse_random_nodes(rng *r, fcm_index n, fcm_index m, int per_row, int empty_every,
+                                sparse *S)
+{
+  sparse N;
+  sparse_random(r, n / 3, m / 3, per_row, empty_every, &N);
+  S->n = n, S->m = m;
+  S->ptr = calloc((size_t)n + 1, sizeof *S->ptr);
+  S->col = malloc((3 * (size_t)N.ptr[N.n] + 1) * sizeof *S->col);
+  S->val = malloc((3 * (size_t)N.ptr[N.n] + 1) * sizeof *S->val);
+  fcm_index q = 0;
+  for (fcm_index i = 0; i < n; i++) {
+    for (fcm_index p = N.ptr[i / 3]; p < N.ptr[i / 3 + 1]; p++) {
+      S->col[q] = 3 * N.col[p] + (int)(i % 3);
+      S->val[q++] = N.val[p];
+    }
+    S->ptr[i + 1] = q;
+  }
+  free(N.ptr), free(N.col), free(N.val);
+}
+
 static void sparse_free(sparse *S)
 {
   free(S->ptr), free(S->col), free(S->val);
@@ -83,6 +107,30 @@ static fcm_csr *matrix_random(fcm_ctx *ctx, rng *r, fcm_index n, int per_row, in
   fcm_csr *A = NULL;
   TEST_OK(ctx, fcm_csr_create_triplets(ctx, n, n, t, ti, tj, tv,
                                        symmetric ? FCM_CSR_SYMMETRIC : FCM_CSR_GENERAL, &A));
+  free(ti), free(tj), free(tv);
+  return A;
+}
+
+/* A random symmetric n x n matrix (n divisible by 3) of full 3 x 3 blocks, as a vector
+ * field's: rows 3 I, 3 I + 1, 3 I + 2 share one pattern (the product's three-row path). */
+static fcm_csr *matrix_random_blocked(fcm_ctx *ctx, rng *r, fcm_index n, int per_row)
+{
+  const fcm_index nn = n / 3, cap = 18 * nn * (per_row + 1);
+  fcm_index *ti = malloc((size_t)cap * sizeof *ti), *tj = malloc((size_t)cap * sizeof *tj);
+  double *tv = malloc((size_t)cap * sizeof *tv);
+  fcm_index t = 0;
+  for (fcm_index I = 0; I < nn; I++)
+    for (int k = 0; k <= per_row; k++) {
+      const fcm_index J = k == 0 ? I : (fcm_index)((rng_uniform(r) + 1.0) * 0.5 * (double)nn) % nn;
+      for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++) {
+          const double v = k == 0 && a == b ? 8.0 + rng_uniform(r) : rng_uniform(r);
+          ti[t] = 3 * I + a, tj[t] = 3 * J + b, tv[t++] = v;
+          ti[t] = 3 * J + b, tj[t] = 3 * I + a, tv[t++] = v;
+        }
+    }
+  fcm_csr *A = NULL;
+  TEST_OK(ctx, fcm_csr_create_triplets(ctx, n, n, t, ti, tj, tv, FCM_CSR_SYMMETRIC, &A));
   free(ti), free(tj), free(tv);
   return A;
 }
@@ -141,8 +189,14 @@ static void check_case(fcm_ctx *ctx, rng *r, fcm_index n, fcm_index nc, int symm
                        int with_diagonal)
 {
   sparse P;
-  sparse_random(r, n, nc, 3, 7, &P);
-  fcm_csr *A = matrix_random(ctx, r, n, 4, symmetric);
+  /* symmetric == 2: A of 3 x 3 blocks (matrix_random_blocked()); 3: and P of a vector
+   * field's (sparse_random_nodes()) */
+  if (symmetric == 3)
+    sparse_random_nodes(r, n, nc, 3, 7, &P);
+  else
+    sparse_random(r, n, nc, 3, 7, &P);
+  fcm_csr *A =
+      symmetric >= 2 ? matrix_random_blocked(ctx, r, n, 3) : matrix_random(ctx, r, n, 4, symmetric);
   fcm__ptap *plan1 = NULL, *plan2 = NULL;
   fcm_csr *C1 = NULL, *C2 = NULL;
   TEST_OK(ctx, fcm__ptap_create(ctx, A, nc, P.ptr, P.col, P.val, with_diagonal, 1, &plan1, &C1));
@@ -234,6 +288,10 @@ int main(void)
   check_case(ctx, &r, 40, 12, 0, 0);
   check_case(ctx, &r, 700, 150, 1, 1); /* rows enough for both threads' chunks */
   check_case(ctx, &r, 700, 150, 0, 1);
+  check_case(ctx, &r, 42, 12, 2, 1);
+  check_case(ctx, &r, 699, 150, 2, 1);
+  check_case(ctx, &r, 42, 12, 3, 1);
+  check_case(ctx, &r, 699, 150, 3, 1);
   {
     sparse P;
     sparse_random(&r, 20, 5, 2, 0, &P);

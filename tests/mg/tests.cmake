@@ -36,3 +36,4 @@ set_tests_properties(mg_convergence_cut_oneway PROPERTIES ENVIRONMENT FCM_TEST_M
 fcm_add_test(mg_convergence_cut_vertex_oneway tests/mg/convergence.c ARGS cut 8 16)
 set_tests_properties(mg_convergence_cut_vertex_oneway PROPERTIES
                      ENVIRONMENT "FCM_TEST_MG_BLOCKS=1;FCM_TEST_MG_BLOCK_SWEEP=1")
+fcm_add_test(mg_smooth_paths tests/mg/smooth_paths.c)

@@ -3,9 +3,13 @@
  * those of a preconditioner created on the new matrix. Patterns: a band of half-width 3 and
  * one of half-width 5 (every row's entries shift), both ways, and a block whose entries are
  * not all stored in the narrow band (scanned) but are in the wide one. The block smoother's
- * variant (the S_K only) gives the same S_K and refuses the apply. */
+ * variant (the S_K only) holds each of these well-conditioned blocks as the inverse X of its
+ * Cholesky factor, lower triangular with X^T X the preconditioner's S_K to rounding, and
+ * refuses the apply. */
 #include "solve/solve_impl.h"
 #include "solve_test_util.h"
+
+#include <math.h>
 
 enum { N = 40, NB = 5 };
 static const fcm_index ptr[NB + 1] = {0, 4, 8, 12, 15, 19};
@@ -78,6 +82,7 @@ int main(void)
 
   /* the block smoother's variant: the same S_K, no apply */
   TEST_OK(ctx, fcm__schwarz_create_blocks(ctx, A5, NB, ptr, dofs, &Pb));
+  int factors = 0;
   TEST_OK(ctx, fcm_schwarz_setup(Pb, A3));
   TEST_OK(ctx, fcm_schwarz_setup(P, A3));
   for (fcm_index k = 0; k < NB; k++) {
@@ -85,8 +90,24 @@ int main(void)
     const double *S1 = NULL, *S2 = NULL;
     const int m = fcm__schwarz_block(P, k, &d1, &S1);
     TEST_TRUE(fcm__schwarz_block(Pb, k, &d2, &S2) == m);
-    TEST_TRUE(memcmp(S1, S2, sizeof *S1 * (size_t)m * (size_t)m) == 0);
+    if (!fcm__schwarz_block_factor(Pb, k)) {
+      TEST_TRUE(memcmp(S1, S2, sizeof *S1 * (size_t)m * (size_t)m) == 0);
+      continue;
+    }
+    factors++; /* S2 holds X, lower triangular, with S_K = X^T X */
+    double smax = 0.0, diff = 0.0;
+    for (int i = 0; i < m; i++)
+      for (int j = 0; j < m; j++) {
+        double s = 0.0;
+        for (int q = i > j ? i : j; q < m; q++)
+          s += S2[q * m + i] * S2[q * m + j];
+        if (j > i) TEST_TRUE(S2[i * m + j] == 0.0);
+        smax = fmax(smax, fabs(S1[i * m + j]));
+        diff = fmax(diff, fabs(s - S1[i * m + j]));
+      }
+    TEST_TRUE(diff <= 1e-14 * smax);
   }
+  TEST_TRUE(factors == NB); /* every block here is well conditioned */
   double r[N] = {0}, z[N];
   TEST_ERR(ctx, fcm_schwarz_apply(Pb, r, z), FCM_ERR_ARG, "block smoother's blocks only");
 

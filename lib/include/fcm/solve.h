@@ -262,8 +262,8 @@ FCM_API fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index 
  * thread count of the creation); each block is computed by one thread, so the result does
  * not depend on the thread count.
  * @return FCM_OK, FCM_ERR_ARG (size mismatch), FCM_ERR_SINGULAR (a zero block or a zero
- * diagonal outside the blocks: named), FCM_ERR_NUMERIC (NaN/Inf in a block or on the
- * diagonal: named), FCM_ERR_LAPACK. No allocation (scratch from fcm_schwarz_create()). */
+ * diagonal outside the blocks: named), FCM_ERR_NUMERIC (NaN/Inf in a block's lower triangle,
+ * the part either inverse reads, or on the diagonal: named), FCM_ERR_LAPACK. No allocation (scratch from fcm_schwarz_create()). */
 FCM_API fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C);
 
 /** z = S r (n entries each, must not overlap). No allocation. One parallel loop over the

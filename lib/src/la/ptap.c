@@ -19,7 +19,9 @@ struct fcm__ptap {
   fcm_index *AP_ptr; /* A P (n x nc) */
   int *AP_col;
   double *AP_val;
-  double *spa; /* nt dense accumulators of nc + 1 doubles, zero between products */
+  double *spa;           /* nt dense accumulators of 3 (nc + 1) doubles, zero between products */
+  unsigned char *same3;  /* per group g of A's rows 3 g .. 3 g + 2: one pattern (all three) */
+  unsigned char *r_kind; /* per group of R's rows: KIND_SHIFTED or KIND_ROWS */
 };
 
 /* Sort a[0 .. n) ascending (distinct values: a row's columns): quicksort on the median of
@@ -263,25 +265,131 @@ cleanup:
   return st;
 }
 
+/* Row i of C = A B on C's pattern into Cv, through spa (zero on entry and exit). */
+static void product_row(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
+                        const fcm_index *Bp, const int *Bc, const double *Bv, const fcm_index *Cp,
+                        const int *Cc, double *Cv, double *spa)
+{
+  for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
+    const fcm_index k = Ac[p];
+    const double a = Av[p];
+    for (fcm_index q = Bp[k]; q < Bp[k + 1]; q++)
+      spa[Bc[q]] += a * Bv[q];
+  }
+  for (fcm_index p = Cp[i]; p < Cp[i + 1]; p++) {
+    Cv[p] = spa[Cc[p]];
+    spa[Cc[p]] = 0.0;
+  }
+}
+
+/* Whether rows i, i + 1, i + 2 (< the row count) hold one pattern. */
+static int same_pattern3(fcm_index i, const fcm_index *Ap, const int *Ac)
+{
+  const fcm_index len = Ap[i + 1] - Ap[i];
+  return Ap[i + 2] - Ap[i + 1] == len && Ap[i + 3] - Ap[i + 2] == len &&
+         memcmp(Ac + Ap[i], Ac + Ap[i + 1], sizeof *Ac * (size_t)len) == 0 &&
+         memcmp(Ac + Ap[i], Ac + Ap[i + 2], sizeof *Ac * (size_t)len) == 0;
+}
+
+/* Rows i, i + 1, i + 2 of C = A B when the three rows of A have one pattern (a node's three
+ * DOFs): each row of B read once for the three, whose sums go to spa3's interleaved slots
+ * (3 j + r: row i + r, column j; zero on entry and exit), each in product_row()'s order.
+ * The three rows must hold one pattern (same_pattern3()). */
+static void product_triple(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
+                           const fcm_index *Bp, const int *Bc, const double *Bv,
+                           const fcm_index *Cp, const int *Cc, double *Cv, double *spa3)
+{
+  const fcm_index len = Ap[i + 1] - Ap[i];
+  for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
+    const fcm_index k = Ac[p];
+    const double a0 = Av[p], a1 = Av[p + len], a2 = Av[p + 2 * len];
+    for (fcm_index q = Bp[k]; q < Bp[k + 1]; q++) {
+      double *t = spa3 + 3 * (size_t)Bc[q];
+      const double b = Bv[q];
+      t[0] += a0 * b;
+      t[1] += a1 * b;
+      t[2] += a2 * b;
+    }
+  }
+  for (int r = 0; r < 3; r++)
+    for (fcm_index p = Cp[i + r]; p < Cp[i + r + 1]; p++) {
+      double *t = spa3 + 3 * (size_t)Cc[p] + r;
+      Cv[p] = *t;
+      *t = 0.0;
+    }
+}
+
+/* Rows i, i + 1, i + 2 of C = A B when row i + r of A is row i's with each column j + r and
+ * the same values, and rows j, j + 1, j + 2 of B (j a column of row i) hold one pattern (R's
+ * rows of a coarse node, the rows of A P of a fine node): each column index of B read once for
+ * the three, into spa3 as product_triple(), each entry in product_row()'s order. */
+static void product_shifted(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
+                            const fcm_index *Bp, const int *Bc, const double *Bv,
+                            const fcm_index *Cp, const int *Cc, double *Cv, double *spa3)
+{
+  for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
+    const fcm_index k = Ac[p], len = Bp[k + 1] - Bp[k];
+    const double a = Av[p];
+    for (fcm_index q = Bp[k]; q < Bp[k + 1]; q++) {
+      double *t = spa3 + 3 * (size_t)Bc[q];
+      t[0] += a * Bv[q];
+      t[1] += a * Bv[q + len];
+      t[2] += a * Bv[q + 2 * len];
+    }
+  }
+  for (int r = 0; r < 3; r++)
+    for (fcm_index p = Cp[i + r]; p < Cp[i + r + 1]; p++) {
+      double *t = spa3 + 3 * (size_t)Cc[p] + r;
+      Cv[p] = *t;
+      *t = 0.0;
+    }
+}
+
+/* How a group of three rows of A is multiplied (product_values()). */
+enum { KIND_ROWS = 0, KIND_TRIPLE = 1, KIND_SHIFTED = 2 };
+
+/* Whether rows i, i + 1, i + 2 (< A's row count) of A = R may go by product_shifted() with
+ * B = A P, whose groups of three rows b_same3 flags as one pattern each. */
+static int shifted3(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
+                    const unsigned char *b_same3)
+{
+  const fcm_index len = Ap[i + 1] - Ap[i];
+  if (Ap[i + 2] - Ap[i + 1] != len || Ap[i + 3] - Ap[i + 2] != len) return 0;
+  for (fcm_index q = 0; q < len; q++) {
+    const fcm_index p = Ap[i] + q, p1 = Ap[i + 1] + q, p2 = Ap[i + 2] + q;
+    if (Ac[p] % 3 != 0 || !b_same3[Ac[p] / 3] || Ac[p1] != Ac[p] + 1 || Ac[p2] != Ac[p] + 2 ||
+        Av[p1] != Av[p] || Av[p2] != Av[p])
+      return 0;
+  }
+  return 1;
+}
+
 /* Values of C = A B on C's pattern, rows shared by the threads of the enclosing region (ends
- * with a barrier); spa: the calling thread's accumulator over B's columns (zero on entry and
- * exit). Each entry is summed in A's row order, then B's. */
+ * with a barrier), three at a time where they are a node's: kind per group of three rows
+ * (KIND_TRIPLE: product_triple(), KIND_SHIFTED: product_shifted(), KIND_ROWS: one at a
+ * time), or NULL: KIND_TRIPLE where the three hold one pattern, checked here;
+ * spa: the calling thread's accumulator, 3 (B's columns + 1) doubles (zero on entry and exit).
+ * Each entry is summed in A's row order, then B's. */
 static void product_values(fcm_index nrow, const fcm_index *Ap, const int *Ac, const double *Av,
                            const fcm_index *Bp, const int *Bc, const double *Bv,
-                           const fcm_index *Cp, const int *Cc, double *Cv, double *spa)
+                           const fcm_index *Cp, const int *Cc, double *Cv, double *spa,
+                           const unsigned char *kind)
 {
-#pragma omp for schedule(dynamic, 64)
-  for (fcm_index i = 0; i < nrow; i++) {
-    for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
-      const fcm_index k = Ac[p];
-      const double a = Av[p];
-      for (fcm_index q = Bp[k]; q < Bp[k + 1]; q++)
-        spa[Bc[q]] += a * Bv[q];
+  const fcm_index ng = (nrow + 2) / 3;
+#pragma omp for schedule(dynamic, 22)
+  for (fcm_index g = 0; g < ng; g++) {
+    const fcm_index i = 3 * g;
+    const int k = i + 2 >= nrow ? KIND_ROWS : kind ? kind[g] : same_pattern3(i, Ap, Ac);
+    if (k == KIND_TRIPLE) {
+      product_triple(i, Ap, Ac, Av, Bp, Bc, Bv, Cp, Cc, Cv, spa);
+      continue;
     }
-    for (fcm_index p = Cp[i]; p < Cp[i + 1]; p++) {
-      Cv[p] = spa[Cc[p]];
-      spa[Cc[p]] = 0.0;
+    if (k == KIND_SHIFTED) {
+      product_shifted(i, Ap, Ac, Av, Bp, Bc, Bv, Cp, Cc, Cv, spa);
+      continue;
     }
+    for (fcm_index r = i; r < i + 3 && r < nrow; r++)
+      product_row(r, Ap, Ac, Av, Bp, Bc, Bv, Cp, Cc, Cv, spa);
   }
 }
 
@@ -297,6 +405,8 @@ void fcm__ptap_destroy(fcm__ptap **plan)
   fcm__free(ctx, t->AP_col);
   fcm__free(ctx, t->AP_val);
   fcm__free(ctx, t->spa);
+  fcm__free(ctx, t->same3);
+  fcm__free(ctx, t->r_kind);
   fcm__free(ctx, t);
   *plan = NULL;
 }
@@ -334,7 +444,23 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
   FCM_TRY(ctx,
           product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, 1, &cp, &cc));
   if (with_diagonal) FCM_TRY(ctx, add_diagonal(ctx, nc, &cp, &cc));
-  FCM_ALLOC(ctx, (size_t)nt * (size_t)(nc + 1), t->spa);
+  FCM_ALLOC(ctx, (size_t)nt * 3 * (size_t)(nc + 1), t->spa);
+  FCM_ALLOC(ctx, n / 3 + 1, t->same3); /* A's pattern, which every product keeps */
+  for (fcm_index g = 0; 3 * g + 2 < n; g++)
+    t->same3[g] = (unsigned char)same_pattern3(3 * g, fcm_csr_row_ptr(A), fcm_csr_col_idx(A));
+  {
+    unsigned char *ap3 = NULL; /* A P's groups of three rows of one pattern */
+    FCM_ALLOC(ctx, n / 3 + 1, ap3);
+    for (fcm_index g = 0; 3 * g + 2 < n; g++)
+      ap3[g] = (unsigned char)same_pattern3(3 * g, t->AP_ptr, t->AP_col);
+    t->r_kind = fcm__calloc(ctx, (size_t)(nc / 3 + 1), 1);
+    if (t->r_kind)
+      for (fcm_index g = 0; 3 * g + 2 < nc; g++)
+        t->r_kind[g] =
+            shifted3(3 * g, t->R_ptr, t->R_col, t->R_val, ap3) ? KIND_SHIFTED : KIND_ROWS;
+    fcm__free(ctx, ap3);
+    FCM_CHECK(t->r_kind, ctx, FCM_ERR_ALLOC, "ptap_create: out of memory");
+  }
   /* rows sorted and in range by construction, symmetric with A's pattern */
   FCM_TRY(ctx, fcm__csr_adopt_pattern(ctx, nc, nc, &cp, &cc, fcm_csr_get_kind(A), C));
   *plan = t;
@@ -355,11 +481,11 @@ void fcm__ptap_apply(fcm__ptap *t, const fcm_csr *A, fcm_csr *C, int nt)
   nt = nt < 1 ? 1 : nt > t->nt ? t->nt : nt;
 #pragma omp parallel num_threads(nt) if (nt > 1)
   {
-    double *spa = t->spa + (size_t)omp_get_thread_num() * (size_t)(nc + 1);
+    double *spa = t->spa + (size_t)omp_get_thread_num() * 3 * (size_t)(nc + 1);
     product_values(n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), fcm_csr_values_read(A), t->P_ptr,
-                   t->P_col, t->P_val, t->AP_ptr, t->AP_col, t->AP_val, spa);
+                   t->P_col, t->P_val, t->AP_ptr, t->AP_col, t->AP_val, spa, t->same3);
     product_values(nc, t->R_ptr, t->R_col, t->R_val, t->AP_ptr, t->AP_col, t->AP_val, cp, cc, cv,
-                   spa);
+                   spa, t->r_kind);
   }
 }
 

@@ -26,9 +26,20 @@ static void pre_smooth(const fcm_mg *m, mg_level *L, mg_level *C, const double *
     fcm__mg_block_smooth(m, L, b, x, 0);
   }
 #pragma omp barrier
+  const unsigned char *triple = L->rows.triple;
 #pragma omp for schedule(static)
-  for (fcm_index i = 0; i < n; i++)
-    L->r[i] = b[i] - fcm__mg_row_dot(v, ci, rp[i], rp[i + 1], x);
+  for (fcm_index k = 0; k < (n + 2) / 3; k++) {
+    const fcm_index i = 3 * k;
+    if (fcm__mg_is_triple(triple, i, n)) {
+      double s[3];
+      fcm__mg_row_dot3(v, ci, rp[i], rp[i + 1] - rp[i], x, s);
+      for (int c = 0; c < 3; c++)
+        L->r[i + c] = b[i + c] - s[c];
+    } else {
+      for (fcm_index j = i; j < i + 3 && j < n; j++)
+        L->r[j] = b[j] - fcm__mg_row_dot(v, ci, rp[j], rp[j + 1], x);
+    }
+  }
 #pragma omp for schedule(static)
   for (fcm_index J = 0; J < nc; J++) {
     C->b[J] = C->inactive[J]

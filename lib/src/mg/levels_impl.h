@@ -1,6 +1,6 @@
 /* mg module, private to its files: the levels of the hierarchy, the solver object and the calls
  * between creation and setup (mg.c), the hierarchy (hierarchy.c), the prolongations
- * (transfer.c), the smoothers (smoothers.c) and the cycle (cycle.c).
+ * (transfer.c), the smoothers (smoothers.c, sweeps.c) and the cycle (cycle.c).
  *
  * Data per grid level l (level 0 on Hex8, levels >= 1 on Hex20, whose level 0 has only its
  * DOFs, matrix and prolongation): cells (the first grid level: the space's elements) with a
@@ -19,6 +19,7 @@
 #include "solve/solve_impl.h"
 
 #include <omp.h>
+#include <string.h>
 
 /* Two-colour slab order of the items of a graph (the rows of a level matrix, or the blocks of
  * its block smoother; two items are adjacent when the update of one reads what the other
@@ -30,11 +31,22 @@
  * do not depend on the thread count. */
 typedef struct slab_order {
   fcm_index nslab;
-  int first;       /* the colour swept first */
-  fcm_index *ptr;  /* nslab + 1 offsets into item */
-  fcm_index *item; /* the items, slab after slab, ascending within a slab */
-  double *mid;     /* per slab: the midpoint of its work within its colour's, in [0, 1] */
+  int first;             /* the colour swept first */
+  fcm_index *ptr;        /* nslab + 1 offsets into item */
+  fcm_index *item;       /* the items, slab after slab, ascending within a slab */
+  double *mid;           /* per slab: the midpoint of its work within its colour's, in [0, 1] */
+  unsigned char *triple; /* row orders: per row i, 1 when i = 3k starts its copy's three rows
+                            and they share one column pattern (fcm__mg_row_dot3()) */
 } slab_order;
+
+/* Does thread t of nt run slab s? The slabs of one colour go to the threads in contiguous
+ * runs of about equal work (a slab to the thread whose share holds its work's midpoint).
+ * Affects the schedule only: the slabs of one colour are independent. */
+static inline int fcm__mg_slab_mine(const slab_order *S, fcm_index s, int t, int nt)
+{
+  const int owner = (int)(S->mid[s] * nt);
+  return (owner < nt ? owner : nt - 1) == t;
+}
 
 /* Levels with at least this many stored entries share their work between the threads. */
 #define MG_PARALLEL_NNZ 32768
@@ -129,6 +141,55 @@ static inline double fcm__mg_row_dot(const double *v, const int *ci, fcm_index p
   return (s0 + s1) + (s2 + s3);
 }
 
+/* The sums of fcm__mg_row_dot() over three rows of one column pattern, stored one after
+ * the other from p0 (len entries each): each row's the same operations in the same order, so
+ * the same bits, with each x[ci[p]] and ci[p] read once for the three. */
+typedef double fcm__mg_v2d __attribute__((vector_size(16)));
+
+static inline fcm__mg_v2d fcm__mg_load2(const double *p)
+{
+  fcm__mg_v2d r;
+  memcpy(&r, p, sizeof r);
+  return r;
+}
+
+static inline void fcm__mg_row_dot3(const double *v, const int *ci, fcm_index p0, fcm_index len,
+                                    const double *x, double out[3])
+{
+  /* lanes (s0, s1) and (s2, s3) of each row's four partial sums: two-wide operations keep
+   * the twelve sums in registers (twelve scalars and the x's spill) */
+  const double *va = v + p0, *vb = va + len, *vc = vb + len;
+  const int *c = ci + p0;
+  fcm__mg_v2d a01 = {0.0, 0.0}, a23 = a01, b01 = a01, b23 = a01, c01 = a01, c23 = a01;
+  fcm_index j = 0;
+  for (; j + 4 <= len; j += 4) {
+    const fcm__mg_v2d x01 = {x[c[j]], x[c[j + 1]]}, x23 = {x[c[j + 2]], x[c[j + 3]]};
+    a01 += fcm__mg_load2(va + j) * x01;
+    a23 += fcm__mg_load2(va + j + 2) * x23;
+    b01 += fcm__mg_load2(vb + j) * x01;
+    b23 += fcm__mg_load2(vb + j + 2) * x23;
+    c01 += fcm__mg_load2(vc + j) * x01;
+    c23 += fcm__mg_load2(vc + j + 2) * x23;
+  }
+  double a0 = a01[0], b0 = b01[0], c0 = c01[0];
+  for (; j < len; j++) {
+    const double xj = x[c[j]];
+    a0 += va[j] * xj;
+    b0 += vb[j] * xj;
+    c0 += vc[j] * xj;
+  }
+  out[0] = (a0 + a01[1]) + (a23[0] + a23[1]);
+  out[1] = (b0 + b01[1]) + (b23[0] + b23[1]);
+  out[2] = (c0 + c01[1]) + (c23[0] + c23[1]);
+}
+
+/* Whether rows i, i + 1, i + 2 may be summed by fcm__mg_row_dot3() (triple: the level's row
+ * order's flags, NULL: none may). */
+static inline int fcm__mg_is_triple(const unsigned char *triple, fcm_index i, fcm_index n)
+{
+  return triple && i + 2 < n && triple[i];
+}
+
 /* ---- hierarchy.c */
 
 /* The levels of m (m->ctx, space, opts set): cells, copies, DOFs, inactive rows and the
@@ -188,6 +249,8 @@ fcm_status fcm__mg_level_blocks(fcm_mg *m, int l, fcm_index *nb, fcm_index **ptr
  * with `old` (NULL: none), a level l with same[l] (its pattern is old's) takes old's block
  * smoother where its blocks are old's (fcm__mg_keep_blocks()). */
 fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned char *same);
+
+/* ---- sweeps.c */
 
 /* One smoothing step with the pointwise smoother of m's options, by the team of the enclosing
  * parallel region (no barrier at the end). */

@@ -51,6 +51,18 @@ FCM_COMPONENT_API void fcm__mg_transfers_destroy(fcm_ctx *ctx, fcm__mg_transfers
 fcm_status fcm__mg_slabs_check(const fcm_mg *mg, int level, fcm_index *row_slabs,
                                fcm_index *block_slabs);
 
+/* Test hook: on `level` (< the number of levels - 1, SGS smoother, after a setup), one SGS step
+ * and then, where the level has blocks, one forward block sweep from x in one thread, by the
+ * sweeps the cycle runs (x_fast: a copy's three rows of one pattern summed together, S_K's
+ * lower triangle, or X^T X r where the block holds its factor's inverse X) and by the
+ * reference (x_plain: one row at a time, the full S_K, formed from X where it holds X);
+ * *triples: the copies whose three rows are summed together; *factor_blocks: the blocks
+ * holding X (fcm__schwarz_block_factor()). The two agree to rounding.
+ * @return FCM_OK, FCM_ERR_ARG (NULL, level out of range, another smoother). */
+fcm_status fcm__mg_smooth_paths(fcm_mg *mg, int level, const double *b, const double *x,
+                                double *x_fast, double *x_plain, fcm_index *triples,
+                                fcm_index *factor_blocks);
+
 /* What fcm__mg_create_from() took from the earlier hierarchy (zero for fcm_mg_create()). */
 typedef struct fcm__mg_kept {
   int plans;           /* levels whose Galerkin plan, coarse pattern and positions were kept */

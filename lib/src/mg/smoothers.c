@@ -1,7 +1,7 @@
-/* The multigrid's smoothers: pointwise symmetric Gauss-Seidel in slab order (default), in
- * multicolour order, damped Jacobi, and block Gauss-Seidel over vertex and cut-cell blocks
- * (de Prenter et al. 2020); the slab orders that let the threads share a sweep with iterates
- * that do not depend on their number, and the check of those orders. */
+/* The multigrid's smoothers' structures: the rows' colours, the slab orders that let the
+ * threads share a sweep with iterates that do not depend on their number (and the copies whose
+ * three rows share a pattern), the block smoothers' blocks over vertices and cut cells (de
+ * Prenter et al. 2020), and the check of the orders. The sweeps themselves: sweeps.c. */
 #include "mg/levels_impl.h"
 
 #include <stdlib.h>
@@ -25,6 +25,7 @@ void fcm__mg_slabs_free(fcm_ctx *ctx, slab_order *S)
   fcm__free(ctx, S->ptr);
   fcm__free(ctx, S->item);
   fcm__free(ctx, S->mid);
+  fcm__free(ctx, S->triple);
   memset(S, 0, sizeof *S);
 }
 
@@ -168,6 +169,18 @@ fcm_status fcm__mg_row_slabs(fcm_mg *m, mg_level *L)
       reach[i] = FCM_MAX(reach[i], ci[p]);
   }
   FCM_TRY(ctx, slabs_create(ctx, L->n, NULL, reach, work, MG_ROW_SLABS_THICK, &L->rows));
+  FCM_ALLOC(ctx, L->n + 1, L->rows.triple);
+  for (fcm_index i = 0; i + 2 < L->n; i += 3) {
+    const fcm_index len = rp[i + 1] - rp[i];
+    int same = rp[i + 2] - rp[i + 1] == len && rp[i + 3] - rp[i + 2] == len, own = 0;
+    for (fcm_index p = 0; same && p < len; p++) {
+      same = ci[rp[i] + p] == ci[rp[i + 1] + p] && ci[rp[i] + p] == ci[rp[i + 2] + p];
+      if (ci[rp[i] + p] == i) /* the three's own columns, one after the other */
+        own = p + 2 < len && ci[rp[i] + p + 1] == i + 1 && ci[rp[i] + p + 2] == i + 2;
+    }
+    same = same && own;
+    L->rows.triple[i] = (unsigned char)same;
+  }
 cleanup:
   fcm__free(ctx, work);
   fcm__free(ctx, reach);
@@ -251,15 +264,6 @@ cleanup:
   fcm__free(ctx, row_reach);
   fcm__free(ctx, work);
   return st;
-}
-
-/* Does thread t of nt run slab s? The slabs of one colour go to the threads in contiguous
- * runs of about equal work (a slab to the thread whose share holds its work's midpoint).
- * Affects the schedule only: the slabs of one colour are independent. */
-static int slab_mine(const slab_order *S, fcm_index s, int t, int nt)
-{
-  const int owner = (int)(S->mid[s] * nt);
-  return (owner < nt ? owner : nt - 1) == t;
 }
 
 /* ------------------------------------------------------------------ block smoothers */
@@ -572,184 +576,6 @@ cleanup:
   fcm__free(ctx, ptr);
   fcm__free(ctx, dofs);
   return st;
-}
-
-/* ------------------------------------------------------------------ sweeps */
-
-/* The sweeps run inside a parallel region of the cycle (or in a team of one, when the level is
- * too small to share; cycle.c) and end without a barrier unless said. */
-
-/* What a slab sweep works on: the level, omega (pointwise), b, x and the thread's block
- * scratch (r, dx). */
-typedef struct sweep_args {
-  const mg_level *L;
-  double w;
-  const double *b;
-  double *x;
-  double *r, *dx;
-  fcm__schwarz_view blk; /* block sweeps: L's blocks */
-} sweep_args;
-
-/* One symmetric Gauss-Seidel sweep in the slab order S (forward, then backward) by the team
- * of the enclosing region: the slabs of the colour swept first, forward; a barrier; each
- * thread's slabs of the other colour forward and at once backward (they touch no other slab
- * of their colour); a barrier; the first colour's slabs backward. The same threads run the
- * same slabs of the first colour at the start and at the end, so repeated sweeps need no
- * barrier between them; no barrier at the end. slab(a, s, back) sweeps slab s. */
-static void symmetric_sweep(const slab_order *S,
-                            void (*slab)(const sweep_args *a, fcm_index s, int back),
-                            const sweep_args *a)
-{
-  const int t = omp_get_thread_num(), nt = omp_get_num_threads();
-  const int c0 = S->first, c1 = 1 - S->first;
-  for (fcm_index k = c0; k < S->nslab; k += 2)
-    if (slab_mine(S, k, t, nt)) slab(a, k, 0);
-#pragma omp barrier
-  for (fcm_index k = c1; k < S->nslab; k += 2)
-    if (slab_mine(S, k, t, nt)) {
-      slab(a, k, 0);
-      slab(a, k, 1);
-    }
-#pragma omp barrier
-  for (fcm_index k = c0; k < S->nslab; k += 2)
-    if (slab_mine(S, k, t, nt)) slab(a, k, 1);
-}
-
-/* sum_j a[j] r[j], j < m, as fcm__mg_row_dot(). */
-static inline double dense_dot(const double *a, const double *r, int m)
-{
-  double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-  int j = 0;
-  for (; j + 4 <= m; j += 4) {
-    s0 += a[j] * r[j];
-    s1 += a[j + 1] * r[j + 1];
-    s2 += a[j + 2] * r[j + 2];
-    s3 += a[j + 3] * r[j + 3];
-  }
-  for (; j < m; j++)
-    s0 += a[j] * r[j];
-  return (s0 + s1) + (s2 + s3);
-}
-
-/* Gauss-Seidel over the rows of slab s, forward (ascending) or backward. */
-static void sgs_slab(const sweep_args *a, fcm_index s, int back)
-{
-  const mg_level *L = a->L;
-  const double w = a->w, *b = a->b;
-  double *x = a->x;
-  const fcm_csr *A = fcm__mg_level_matrix(L);
-  const fcm_index *rp = fcm_csr_row_ptr(A);
-  const int *ci = fcm_csr_col_idx(A);
-  const double *v = fcm_csr_values_read(A);
-  const fcm_index q0 = L->rows.ptr[s], q1 = L->rows.ptr[s + 1];
-  for (fcm_index t = 0; t < q1 - q0; t++) {
-    const fcm_index i = L->rows.item[back ? q1 - 1 - t : q0 + t];
-    x[i] += w * (b[i] - fcm__mg_row_dot(v, ci, rp[i], rp[i + 1], x)) * L->dinv[i];
-  }
-}
-
-/* One smoothing step. SGS: a forward then a backward sweep, S = (I - B^-1 A)(I - F^-1 A),
- * which is A-self-adjoint (B = F^T); pre- and post-smoothing both apply S, so the cycle is
- * symmetric (post-smoothing must be the adjoint of pre-smoothing: backward-then-forward
- * would not be). SGS runs in the slab order of the rows (symmetric_sweep()), the coloured
- * SGS colour after colour (a barrier each), Jacobi in two loops over the rows. */
-void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x)
-{
-  const fcm_csr *A = fcm__mg_level_matrix(L);
-  const fcm_index *rp = fcm_csr_row_ptr(A);
-  const int *ci = fcm_csr_col_idx(A);
-  const double *v = fcm_csr_values_read(A);
-  const double w = m->opts.omega;
-  const fcm_index n = L->n;
-  if (m->opts.smoother == FCM_MG_SMOOTHER_JACOBI) {
-#pragma omp for schedule(static)
-    for (fcm_index i = 0; i < n; i++) {
-      double sum = 0.0;
-      for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
-        sum += v[p] * x[ci[p]];
-      L->r[i] = b[i] - sum;
-    }
-#pragma omp for schedule(static)
-    for (fcm_index i = 0; i < n; i++)
-      x[i] += w * L->r[i] * L->dinv[i];
-    return;
-  }
-  if (m->opts.smoother == FCM_MG_SMOOTHER_SGS_COLORED) {
-    for (int t = 0; t < 2 * L->ncolor; t++) {
-      const int c = t < L->ncolor ? t : 2 * L->ncolor - 1 - t;
-      const fcm_index r0 = L->color_ptr[c], r1 = L->color_ptr[c + 1];
-#pragma omp for schedule(static)
-      for (fcm_index q = r0; q < r1; q++) {
-        const fcm_index i = L->color_rows[q];
-        double sum = b[i];
-        for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
-          sum -= v[p] * x[ci[p]];
-        x[i] += w * sum * L->dinv[i];
-      }
-    }
-    return;
-  }
-  const sweep_args a = {L, w, b, x, NULL, NULL, {0}};
-  symmetric_sweep(&L->rows, sgs_slab, &a);
-}
-
-/* Block Gauss-Seidel over the blocks of slab s, forward or backward: x_K += S_K (b - A x)_K,
- * block after block. */
-static void block_slab(const sweep_args *a, fcm_index s, int back)
-{
-  const mg_level *L = a->L;
-  const double *b = a->b;
-  double *x = a->x, *r = a->r, *dx = a->dx;
-  const fcm_csr *A = fcm__mg_level_matrix(L);
-  const fcm_index *rp = fcm_csr_row_ptr(A);
-  const int *ci = fcm_csr_col_idx(A);
-  const double *v = fcm_csr_values_read(A);
-  const fcm_index q0 = L->blocks.ptr[s], q1 = L->blocks.ptr[s + 1];
-  for (fcm_index t = 0; t < q1 - q0; t++) {
-    const fcm_index k = L->blocks.item[back ? q1 - 1 - t : q0 + t];
-    const fcm_index *d = a->blk.dofs + a->blk.ptr[k];
-    const double *S = a->blk.S + a->blk.s_off[k];
-    const int bm = (int)(a->blk.ptr[k + 1] - a->blk.ptr[k]);
-    for (int i = 0; i < bm; i++)
-      r[i] = b[d[i]] - fcm__mg_row_dot(v, ci, rp[d[i]], rp[d[i] + 1], x);
-    for (int i = 0; i < bm; i++)
-      dx[i] = dense_dot(S + (size_t)i * (size_t)bm, r, bm);
-    for (int i = 0; i < bm; i++)
-      x[d[i]] += dx[i];
-  }
-}
-
-/* One way through the slab order S by the team: forward, the slabs of the colour swept first
- * and then the other's (a barrier between); backward, the reverse, its adjoint. No barrier at
- * the end. */
-static void one_way_sweep(const slab_order *S,
-                          void (*slab)(const sweep_args *a, fcm_index s, int back),
-                          const sweep_args *a, int back)
-{
-  const int t = omp_get_thread_num(), nt = omp_get_num_threads();
-  for (int pass = 0; pass < 2; pass++) {
-    const int c = (pass == 0) != back ? S->first : 1 - S->first;
-    if (pass == 1) {
-#pragma omp barrier
-    }
-    for (fcm_index k = c; k < S->nslab; k += 2)
-      if (slab_mine(S, k, t, nt)) slab(a, k, back);
-  }
-}
-
-/* A block Gauss-Seidel sweep over the level's blocks in their slab order: symmetric (forward,
- * then backward; symmetric_sweep()), or with block_sweep one way, forward before the coarse
- * correction (post = 0) and backward after it (post = 1). */
-void fcm__mg_block_smooth(const fcm_mg *m, const mg_level *L, const double *b, double *x, int post)
-{
-  const size_t t = (size_t)omp_get_thread_num();
-  sweep_args a = {
-      L, 0.0, b, x, m->blk_r + t * (size_t)m->blk_max, m->blk_dx + t * (size_t)m->blk_max, {0}};
-  fcm__schwarz_get_view(L->blk, &a.blk);
-  if (m->opts.block_sweep)
-    one_way_sweep(&L->blocks, block_slab, &a, post);
-  else
-    symmetric_sweep(&L->blocks, block_slab, &a);
 }
 
 /* ------------------------------------------------------------------ slab check */

@@ -36,12 +36,14 @@ struct fcm_schwarz {
   fcm_index n;
   fcm_schwarz_options opts;
   fcm_index num_blocks;
-  fcm_index *block_ptr; /* num_blocks + 1 */
-  fcm_index *dofs;      /* block_ptr[num_blocks] */
-  size_t *s_off;        /* num_blocks + 1 offsets into S */
-  double *S;            /* dense S_K, m x m each (symmetric) */
-  int *pos;             /* as S: where C_K's entry (i, j) lies in C's row dofs[i] (-1: none) */
-  unsigned char *full;  /* num_blocks: every entry of C_K is stored (pos holds them all) */
+  fcm_index *block_ptr;  /* num_blocks + 1 */
+  fcm_index *dofs;       /* block_ptr[num_blocks] */
+  size_t *s_off;         /* num_blocks + 1 offsets into S */
+  double *S;             /* dense S_K, m x m each (symmetric) */
+  int *pos;              /* as S: where C_K's entry (i, j) lies in C's row dofs[i] (-1: none) */
+  unsigned char *full;   /* num_blocks: every entry of C_K is stored (pos holds them all) */
+  unsigned char *factor; /* blocks_only, num_blocks: S's slot holds X = L^{-1} of the Cholesky
+                            factor C_K = L L^T (lower triangle, zero above), S_K = X^T X */
   int max_m;
   int num_colors;        /* of the block graph (statistics only; 0 when blocks_only) */
   fcm_index *inc_ptr;    /* n + 1: DOF i is row inc_row[q] of block inc_blk[q], q in range
@@ -84,6 +86,7 @@ void fcm_schwarz_destroy(fcm_schwarz **P)
   fcm__free(ctx, p->S);
   fcm__free(ctx, p->pos);
   fcm__free(ctx, p->full);
+  fcm__free(ctx, p->factor);
   fcm__free(ctx, p->inc_ptr);
   fcm__free(ctx, p->inc_blk);
   fcm__free(ctx, p->inc_row);
@@ -174,7 +177,7 @@ static int gather_scan(const fcm_csr *C, const double *vals, int m, const fcm_in
     for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++) {
       const int k = loc[ci[p]];
       if (!k) continue;
-      finite &= isfinite(vals[p]) != 0;
+      if (k - 1 <= i) finite &= isfinite(vals[p]) != 0;
       a[i + (size_t)(k - 1) * m] = vals[p];
       if (pos[(size_t)i * m + k - 1] < 0) stored++;
       pos[(size_t)i * m + k - 1] = (int)(p - rp[d[i]]);
@@ -185,9 +188,10 @@ static int gather_scan(const fcm_csr *C, const double *vals, int m, const fcm_in
   return finite;
 }
 
-/* Gather C_K through the positions of a block whose entries are all stored (pos of
- * gather_scan()), each checked against C's pattern: 1 when all finite, 0 when one is NaN or
- * infinite, -1 (a unfinished) when C's pattern has moved an entry. */
+/* Gather C_K's lower triangle (all that the Cholesky factor and dsyevd read) through the
+ * positions of a block whose entries are all stored (pos of gather_scan()), each checked
+ * against C's pattern: 1 when all finite, 0 when one is NaN or infinite, -1 (a unfinished)
+ * when C's pattern has moved an entry. */
 static int gather_known(const fcm_csr *C, const double *vals, int m, const fcm_index *d,
                         const int *pos, double *a)
 {
@@ -197,7 +201,7 @@ static int gather_known(const fcm_csr *C, const double *vals, int m, const fcm_i
   for (int i = 0; i < m; i++) {
     const fcm_index r0 = rp[d[i]], len = rp[d[i] + 1] - r0;
     const int *pi = pos + (size_t)i * m;
-    for (int j = 0; j < m; j++) {
+    for (int j = 0; j <= i; j++) {
       const fcm_index p = r0 + pi[j];
       if (pi[j] >= len || ci[p] != d[j]) return -1;
       finite &= isfinite(vals[p]) != 0;
@@ -211,9 +215,11 @@ static int gather_known(const fcm_csr *C, const double *vals, int m, const fcm_i
  * entries of S at a time): each entry's sum still runs over k in ascending order, as one chain
  * of dependent operations, and two chains interleaved keep the floating-point units busy. */
 
-/* L of C_K = L L^T (row-major) from the lower triangle of a (column-major); 0 when a pivot
- * is not positive and finite. Rows i and i + 1 go together: at each column j <= i entry
- * (i, j) first (entry (i + 1, i) divides by L_ii, found in the same step). */
+/* L of C_K = L L^T (row-major) from the lower triangle of a (column-major), with 1 / L_jj
+ * stored on the diagonal: the entries below it are multiplied by it, a division's latency
+ * not on each entry's chain; 0 when a pivot is not positive and finite. Rows i and i + 1 go
+ * together: at each column j <= i entry (i, j) first (entry (i + 1, i) takes 1 / L_ii, found
+ * in the same step). */
 static int cholesky_factor(int m, const double *a, double *L)
 {
   for (int i = 0; i < m; i += 2) {
@@ -231,35 +237,36 @@ static int cholesky_factor(int m, const double *a, double *L)
         for (; k < j; k++)
           v -= Li[k] * Lj[k];
       if (i > j) {
-        Li[j] = v / Lj[j];
+        Li[j] = v * Lj[j];
       } else {
         if (!(v > 0.0 && isfinite(v))) return 0;
-        Li[i] = sqrt(v);
+        Li[i] = 1.0 / sqrt(v);
       }
-      if (Lh) Lh[j] = u / Lj[j];
+      if (Lh) Lh[j] = u * Lj[j];
     }
     if (Lh) { /* the diagonal of row i + 1 */
       double v = a[i + 1 + (size_t)(i + 1) * m];
       for (int k = 0; k < i + 1; k++)
         v -= Lh[k] * Lh[k];
       if (!(v > 0.0 && isfinite(v))) return 0;
-      Lh[i + 1] = sqrt(v);
+      Lh[i + 1] = 1.0 / sqrt(v);
     }
   }
   return 1;
 }
 
-/* X = L^{-1} (lower, row-major), columns j and j + 1 together. */
+/* X = L^{-1} (lower, row-major; L with 1 / L_ii on its diagonal, cholesky_factor()),
+ * columns j and j + 1 together. */
 static void cholesky_invert_factor(int m, const double *L, double *X)
 {
   for (int j = 0; j < m; j += 2) {
     const int h = j + 1;
-    X[(size_t)j * m + j] = 1.0 / L[(size_t)j * m + j];
+    X[(size_t)j * m + j] = L[(size_t)j * m + j];
     if (h < m) {
-      X[(size_t)h * m + h] = 1.0 / L[(size_t)h * m + h];
+      X[(size_t)h * m + h] = L[(size_t)h * m + h];
       double v = 0.0;
       v -= L[(size_t)h * m + j] * X[(size_t)j * m + j];
-      X[(size_t)h * m + j] = v / L[(size_t)h * m + h];
+      X[(size_t)h * m + j] = v * L[(size_t)h * m + h];
     }
     for (int i = j + 2; i < m; i++) {
       const double *Li = L + (size_t)i * m;
@@ -269,8 +276,8 @@ static void cholesky_invert_factor(int m, const double *L, double *X)
         v -= Li[k] * X[(size_t)k * m + j];
         u -= Li[k] * X[(size_t)k * m + h];
       }
-      X[(size_t)i * m + j] = v / Li[i];
-      X[(size_t)i * m + h] = u / Li[i];
+      X[(size_t)i * m + j] = v * Li[i];
+      X[(size_t)i * m + h] = u * Li[i];
     }
   }
 }
@@ -320,6 +327,38 @@ static int cholesky_inverse(int m, const double *a, double eps, double *lw, doub
   return isfinite(ns) && sqrt(na) * sqrt(ns) <= SCHWARZ_CHOLESKY_COND / eps;
 }
 
+/* For a block smoother, whose sweeps may apply S_K = X^T X as two triangular products: X =
+ * L^{-1} into S's slot (lower triangle, zero above; *factor = 1) when the bound
+ * ||S_K||_F <= ||X||_F^2 already passes cholesky_inverse()'s test, which then needs no
+ * product; else cholesky_inverse() itself (*factor = 0). The same blocks take the Cholesky
+ * path as there. */
+static int cholesky_inverse_factor(int m, const double *a, double eps, double *lw, double *S,
+                                   unsigned char *factor)
+{
+  double *L = lw, *X = lw + (size_t)m * m, na = 0.0, nx = 0.0;
+  *factor = 0;
+  for (int i = 0; i < m; i++)
+    for (int j = 0; j <= i; j++) {
+      const double v = a[i + (size_t)j * m];
+      na += (i == j ? 1.0 : 2.0) * v * v;
+    }
+  if (!cholesky_factor(m, a, L)) return 0;
+  cholesky_invert_factor(m, L, X);
+  for (int i = 0; i < m; i++)
+    for (int j = 0; j <= i; j++)
+      nx += X[(size_t)i * m + j] * X[(size_t)i * m + j];
+  if (isfinite(nx) && sqrt(na) * nx <= SCHWARZ_CHOLESKY_COND / eps) {
+    for (int i = 0; i < m; i++) {
+      memcpy(S + (size_t)i * m, X + (size_t)i * m, sizeof *S * (size_t)(i + 1));
+      memset(S + (size_t)i * m + i + 1, 0, sizeof *S * (size_t)(m - 1 - i));
+    }
+    *factor = 1;
+    return 1;
+  }
+  const double ns = cholesky_product(m, X, S);
+  return isfinite(ns) && sqrt(na) * sqrt(ns) <= SCHWARZ_CHOLESKY_COND / eps;
+}
+
 /* Gather C_K, then S_K: by cholesky_inverse() where it applies, else by the symmetric
  * eigendecomposition with reflected and clamped eigenvalues. */
 static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *vals, fcm_index b,
@@ -338,7 +377,11 @@ static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *va
     *fail = FAIL_NONFINITE;
     return FCM_ERR_NUMERIC;
   }
-  if (cholesky_inverse(m, a, P->opts.epsilon, lw, S)) return st;
+  if (P->factor) {
+    if (cholesky_inverse_factor(m, a, P->opts.epsilon, lw, S, P->factor + b)) return st;
+  } else if (cholesky_inverse(m, a, P->opts.epsilon, lw, S)) {
+    return st;
+  }
   st = fcm__syev_work(ctx, 1, m, a, m, w, lw, P->lwork, iw, P->liwork);
   if (st != FCM_OK) {
     *fail = st == FCM_ERR_ALLOC ? FAIL_NONE : FAIL_LAPACK;
@@ -581,7 +624,8 @@ static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
   /* S and pos are written in full by the first setup (below) before anything reads them */
   FCM_ALLOC_RAW(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->S);
   FCM_ALLOC_RAW(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->pos);
-  FCM_ALLOC(ctx, num_blocks + 1, P->full);                 /* zero: the first setup scans */
+  FCM_ALLOC(ctx, num_blocks + 1, P->full); /* zero: the first setup scans */
+  if (blocks_only) FCM_ALLOC(ctx, num_blocks + 1, P->factor);
   if (!blocks_only) FCM_TRY(ctx, incidence_and_colors(P)); /* the apply's */
   /* setup scratch: the eigensolver workspace of the largest need over the block sizes */
   P->nt = fcm_ctx_num_threads(ctx);
@@ -679,6 +723,11 @@ fcm_index fcm__schwarz_num_blocks(const fcm_schwarz *P)
   return P ? P->num_blocks : 0;
 }
 
+int fcm__schwarz_block_factor(const fcm_schwarz *P, fcm_index k)
+{
+  return P->factor ? P->factor[k] : 0;
+}
+
 int fcm__schwarz_block(const fcm_schwarz *P, fcm_index k, const fcm_index **dofs, const double **S)
 {
   *dofs = P->dofs + P->block_ptr[k];
@@ -689,6 +738,7 @@ int fcm__schwarz_block(const fcm_schwarz *P, fcm_index k, const fcm_index **dofs
 void fcm__schwarz_get_view(const fcm_schwarz *P, fcm__schwarz_view *v)
 {
   v->ptr = P->block_ptr, v->dofs = P->dofs, v->s_off = P->s_off, v->S = P->S;
+  v->factor = P->factor;
 }
 
 fcm_status fcm_schwarz_operator(void *user, const double *r, double *z)

@@ -15,6 +15,10 @@
  * S_K (symmetric, row major), valid after a successful setup. */
 fcm_index fcm__schwarz_num_blocks(const fcm_schwarz *P);
 int fcm__schwarz_block(const fcm_schwarz *P, fcm_index k, const fcm_index **dofs, const double **S);
+/* 1 when block k of a block smoother (fcm__schwarz_create_blocks()) holds, in S's place, the
+ * inverse X = L^{-1} of the Cholesky factor C_K = L L^T (lower triangle, zeros above), so that
+ * S_K = X^T X; 0 when it holds S_K. */
+int fcm__schwarz_block_factor(const fcm_schwarz *P, fcm_index k);
 /* The same blocks as arrays, for sweeps that read them in their inner loop: block k's DOFs are
  * dofs[ptr[k] .. ptr[k + 1]), its S_K starts at S + s_off[k]. The arrays stay in place for
  * the life of P (setups rewrite S's values only). */
@@ -22,6 +26,7 @@ typedef struct fcm__schwarz_view {
   const fcm_index *ptr, *dofs;
   const size_t *s_off;
   const double *S;
+  const unsigned char *factor; /* per block, fcm__schwarz_block_factor() (NULL: all 0) */
 } fcm__schwarz_view;
 void fcm__schwarz_get_view(const fcm_schwarz *P, fcm__schwarz_view *v);
 /* fcm_schwarz_create() for a block smoother: a setup computes the S_K, nothing else (no
