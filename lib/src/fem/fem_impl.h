@@ -248,6 +248,10 @@ static inline fcm_index fcm__space_elem_row(const fcm_space *s, fcm_index le, in
  * @return FCM_OK, FCM_ERR_ARG (NULL), FCM_ERR_ALLOC. (space.c) */
 fcm_status fcm__space_matrix_create_rows(const fcm_space *s, fcm_csr **A);
 
+/* fcm__space_matrix_create_rows() whose values take give's storage where it is large enough
+ * (fcm__csr_share_pattern_from(): give, or NULL, is then left without values). (space.c) */
+fcm_status fcm__space_matrix_create_rows_from(const fcm_space *s, fcm_csr *give, fcm_csr **A);
+
 /* y (num_dofs) = A x for A of fcm__space_matrix_create_rows() (x: num_dofs); y is zero on the
  * DOFs with no row. A full space: fcm_csr_apply(A, 1, x, 0, y) exactly (same bits). Each row is
  * summed serially (threads over rows): independent of the thread count. No allocation.

@@ -2,7 +2,8 @@
  * the element blocks of the mass matrix and the loads of the elements the cut leaves as they
  * were, and the fill-reducing ordering of the direct solver's analysis, extended by the new DOFs
  * beside the ones they split from (fem/cut_update.c), so that the new analysis computes only
- * the factor's structure. */
+ * the factor's structure; and it may take the old integrator's large arrays (the matrices'
+ * values) for its own, on pages already mapped. */
 #include "sim/sim_impl.h"
 #include "fem/fem_impl.h"
 #include "la/la_impl.h"
@@ -87,4 +88,11 @@ fcm_status fcm__sim_cut_prepare_blocks(const fcm_integrator *old, fcm_integrator
   I->setup_info.cut_kept_elements = kept;
 cleanup:
   return st;
+}
+
+void fcm__sim_cut_give_storage(const fcm_integrator *old, fcm_integrator *I)
+{
+  /* old's options name the flag (the caller's consent to old's storage going to I): old is
+   * only destroyed after the cut, so its arrays are taken although old is given const */
+  I->cut_give = old->opts.cut_reuse & FCM_CUT_REUSE_STORAGE ? (fcm_integrator *)old : NULL;
 }
