@@ -1,0 +1,142 @@
+/* A cut whose new integrator takes the old one's storage (FCM_CUT_REUSE_STORAGE) equals a cut
+ * without it bit for bit. Two integrators of one embedded box under gravity (Hex8, element-
+ * corotated linear, 3 multigrid V-cycles and one Newton iteration a step, as the interactive
+ * scenes), one with the option, are stepped and cut twice (a plane across the box, then a slit
+ * from the top face): the one with the option gets its mass and Newton matrices on the old
+ * ones' storage (the same addresses; the matrices' values are 8 MiB and more, whose room is a
+ * quarter larger than asked), the other on new storage, and the mass matrix, the gravity load,
+ * M a_rep, the state and two further steps' displacement and velocity are the same bits. The
+ * integrator that gave its storage refuses to step and to be set up again, and is destroyed. */
+#include "la/la_impl.h"
+#include "sim/sim_impl.h"
+#include "sim_util.h"
+
+#include <string.h>
+
+static fcm_ctx *ctx;
+
+static const fcm_material mat = {FCM_MATERIAL_COROTATED_LINEAR, 2.0e4, 0.3, 1000.0};
+static const double gravity[3] = {0.0, -9.81, 0.0};
+
+static int same_bits(const double *a, const double *b, fcm_index n)
+{
+  return a && b && memcmp(a, b, sizeof *a * (size_t)n) == 0;
+}
+
+static fcm_integrator *make(const fcm_space *space, const fcm_mesh *mesh, int cut_reuse)
+{
+  fcm_integrator *I = NULL;
+  fcm_integrator_options o = fcm_integrator_options_default();
+  o.dt = 0.01;
+  o.cut_reuse = cut_reuse;
+  o.linear_solver = FCM_LINEAR_MULTIGRID;
+  o.multigrid_fixed_cycles = 3;
+  o.newton_fixed_iterations = 1;
+  const double lo[3] = {-10, -10, -10}, hi[3] = {10, 0.05, 10};
+  TEST_OK(ctx, fcm_integrator_create(ctx, space, &mat, &o, &I));
+  TEST_OK(ctx, fcm_integrator_add_gravity(I, gravity, NULL, NULL));
+  TEST_OK(ctx, hold_box(ctx, I, mesh, lo, hi));
+  TEST_OK(ctx, fcm_integrator_setup(I));
+  return I;
+}
+
+/* Steps both; the displacement and velocity stay the same bits. */
+static void step_both(fcm_integrator *a, fcm_integrator *b, int steps)
+{
+  for (int s = 0; s < steps; s++) {
+    fcm_step_info ia, ib;
+    TEST_OK(ctx, fcm_integrator_step(a, &ia));
+    TEST_OK(ctx, fcm_integrator_step(b, &ib));
+    TEST_TRUE(ia.linear_iterations == ib.linear_iterations);
+  }
+  const fcm_index n = fcm_integrator_num_dofs(a);
+  TEST_TRUE(fcm_integrator_num_dofs(b) == n);
+  TEST_TRUE(same_bits(fcm_integrator_displacement(a), fcm_integrator_displacement(b), n));
+  TEST_TRUE(same_bits(fcm_integrator_velocity(a), fcm_integrator_velocity(b), n));
+}
+
+/* Cuts a (with the option) and b (without) onto `space`: a's new matrices on a's storage. */
+static void cut_both(fcm_integrator **a, fcm_integrator **b, const fcm_space *space)
+{
+  fcm_integrator *a1 = NULL, *b1 = NULL;
+  const double *am = fcm_csr_values_read((*a)->M), *ah = fcm_csr_values_read((*a)->H);
+  const double *bm = fcm_csr_values_read((*b)->M);
+  TEST_OK(ctx, fcm_integrator_create_cut(*a, space, &a1));
+  TEST_OK(ctx, fcm_integrator_create_cut(*b, space, &b1));
+  if (!a1 || !b1) goto done;
+  const fcm_index n = a1->n;
+  fcm_index nnz = 0;
+  fcm_csr_get_size(a1->M, NULL, NULL, &nnz);
+  TEST_TRUE((size_t)nnz * sizeof(double) >= (8u << 20)); /* large: a quarter more room */
+  /* a's storage taken (a is spent), b's kept by b */
+  TEST_TRUE(fcm_csr_values_read(a1->M) == am && fcm_csr_values_read(a1->H) == ah);
+  TEST_TRUE(fcm_csr_values_read((*a)->M) == NULL && fcm_csr_values_read((*a)->H) == NULL);
+  TEST_TRUE(fcm_csr_values_read((*b)->M) == bm && fcm_csr_values_read(b1->M) != bm);
+  TEST_TRUE(same_bits(fcm_csr_values_read(a1->M), fcm_csr_values_read(b1->M), nnz));
+  TEST_TRUE(same_bits(a1->loads[0].f, b1->loads[0].f, n));
+  TEST_TRUE(same_bits(a1->Ma, b1->Ma, n));
+  TEST_TRUE(same_bits(a1->u, b1->u, n) && same_bits(a1->v, b1->v, n));
+  /* the spent integrator: its state still read, no step, no new setup */
+  fcm_step_info info;
+  TEST_TRUE(fcm_integrator_time((*a)) == fcm_integrator_time(a1));
+  TEST_ERR(ctx, fcm_integrator_step(*a, &info), FCM_ERR_ARG, "fcm_integrator_setup");
+  TEST_ERR(ctx, fcm_integrator_setup(*a), FCM_ERR_ARG, "FCM_CUT_REUSE_STORAGE");
+  fcm_integrator *again = NULL;
+  TEST_ERR(ctx, fcm_integrator_create_cut(*a, space, &again), FCM_ERR_ARG, "set up");
+  TEST_TRUE(again == NULL);
+done:
+  fcm_integrator_destroy(a);
+  fcm_integrator_destroy(b);
+  *a = a1;
+  *b = b1;
+}
+
+int main(void)
+{
+  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  const long long live0 = fcm_ctx_live_allocations(ctx);
+  const double lo[3] = {-0.1, -0.1, -0.1}, hi[3] = {1.1, 0.7, 0.7};
+  const double glo[3] = {0, 0, 0}, ghi[3] = {1, 0.6, 0.6};
+  const fcm_index nc[3] = {27, 18, 18}, gn[3] = {2, 2, 2};
+  const double box_lo[3] = {-0.2, -0.2, -0.2}, box_hi[3] = {1.2, 0.8, 0.8};
+  fcm_mesh *mesh = NULL;
+  fcm_geometry *g = NULL;
+  fcm_cell_rules *rules[3] = {NULL, NULL, NULL};
+  fcm_space *space[3] = {NULL, NULL, NULL};
+  fcm_integrator *a = NULL, *b = NULL;
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, nc, &mesh));
+  TEST_OK(ctx, fcm_geometry_create_box(ctx, glo, ghi, gn, &g));
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, NULL, &rules[0]));
+  TEST_OK(ctx, fcm_space_create_embedded(ctx, mesh, rules[0], &space[0]));
+  a = make(space[0], mesh, FCM_CUT_REUSE_BLOCKS | FCM_CUT_REUSE_STORAGE);
+  b = make(space[0], mesh, FCM_CUT_REUSE_BLOCKS);
+  if (a && b) step_both(a, b, 2);
+  const double p1[3] = {0.47, 0.3, 0.3}, n1[3] = {1.0, 0.05, 0.0};
+  const double c2[3] = {0.73, 0.55, 0.3}, n2[3] = {1.0, 0.0, 0.1}, a2[3] = {0.0, 1.0, 0.0},
+               size2[2] = {0.5, 2.0};
+  for (int k = 1; k <= 2 && a && b; k++) {
+    fcm_surface *cut = NULL;
+    if (k == 1) TEST_OK(ctx, fcm_surface_create_plane(ctx, p1, n1, box_lo, box_hi, &cut));
+    if (k == 2) TEST_OK(ctx, fcm_surface_create_rectangle(ctx, c2, n2, a2, size2, &cut));
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, rules[k - 1], cut, &rules[k]));
+    fcm_surface_destroy(&cut);
+    if (!rules[k]) break;
+    TEST_OK(ctx, fcm_space_create_embedded(ctx, mesh, rules[k], &space[k]));
+    if (!space[k]) break;
+    printf("cut %d: %lld -> %lld DOFs\n", k, (long long)fcm_space_num_dofs(space[k - 1]),
+           (long long)fcm_space_num_dofs(space[k]));
+    cut_both(&a, &b, space[k]);
+    if (a && b) step_both(a, b, 2);
+  }
+  fcm_integrator_destroy(&a);
+  fcm_integrator_destroy(&b);
+  for (int k = 2; k >= 0; k--) {
+    fcm_space_destroy(&space[k]);
+    fcm_cell_rules_destroy(&rules[k]);
+  }
+  fcm_geometry_destroy(&g);
+  fcm_mesh_destroy(&mesh);
+  TEST_TRUE(fcm_ctx_live_allocations(ctx) == live0); /* nothing kept beyond the integrators */
+  fcm_ctx_destroy(&ctx);
+  return TEST_RESULT();
+}
