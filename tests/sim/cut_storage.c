@@ -4,9 +4,11 @@
  * scenes), one with the option, are stepped and cut twice (a plane across the box, then a slit
  * from the top face): the one with the option gets its mass and Newton matrices on the old
  * ones' storage (the same addresses; the matrices' values are 8 MiB and more, whose room is a
- * quarter larger than asked), the other on new storage, and the mass matrix, the gravity load,
+ * quarter larger than asked) and its corotated element matrices moved within the old store,
+ * the other on new storage, and the mass matrix, the gravity load,
  * M a_rep, the state and two further steps' displacement and velocity are the same bits. The
  * integrator that gave its storage refuses to step and to be set up again, and is destroyed. */
+#include "fem/assemble_impl.h"
 #include "la/la_impl.h"
 #include "sim/sim_impl.h"
 #include "sim_util.h"
@@ -61,6 +63,8 @@ static void cut_both(fcm_integrator **a, fcm_integrator **b, const fcm_space *sp
   fcm_integrator *a1 = NULL, *b1 = NULL;
   const double *am = fcm_csr_values_read((*a)->M), *ah = fcm_csr_values_read((*a)->H);
   const double *bm = fcm_csr_values_read((*b)->M);
+  const double *ak = (*a)->aws->corot.K, *bk = (*b)->aws->corot.K;
+  TEST_TRUE(ak && bk); /* the element matrices built by the steps */
   TEST_OK(ctx, fcm_integrator_create_cut(*a, space, &a1));
   TEST_OK(ctx, fcm_integrator_create_cut(*b, space, &b1));
   if (!a1 || !b1) goto done;
@@ -72,6 +76,9 @@ static void cut_both(fcm_integrator **a, fcm_integrator **b, const fcm_space *sp
   TEST_TRUE(fcm_csr_values_read(a1->M) == am && fcm_csr_values_read(a1->H) == ah);
   TEST_TRUE(fcm_csr_values_read((*a)->M) == NULL && fcm_csr_values_read((*a)->H) == NULL);
   TEST_TRUE(fcm_csr_values_read((*b)->M) == bm && fcm_csr_values_read(b1->M) != bm);
+  /* the corotated element matrices moved within a's store, copied from b's */
+  TEST_TRUE(a1->aws->corot.K == ak && (*a)->aws->corot.K == NULL);
+  TEST_TRUE(b1->aws->corot.K != bk && (*b)->aws->corot.K == bk);
   TEST_TRUE(same_bits(fcm_csr_values_read(a1->M), fcm_csr_values_read(b1->M), nnz));
   TEST_TRUE(same_bits(a1->loads[0].f, b1->loads[0].f, n));
   TEST_TRUE(same_bits(a1->Ma, b1->Ma, n));

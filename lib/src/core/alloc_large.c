@@ -58,20 +58,24 @@ void *fcm__calloc_large(fcm_ctx *ctx, size_t n, size_t size)
   return p;
 }
 
+void *fcm__large_take(void **from, size_t n, size_t size)
+{
+  if (!from || !*from || !size || n > SIZE_MAX / size) return NULL;
+  large_header h;
+  memcpy(&h, (unsigned char *)*from - sizeof h, sizeof h);
+  const size_t bytes = n * size;
+  if (bytes > h.capacity || bytes < h.capacity / 2) return NULL;
+  void *p = *from;
+  *from = NULL;
+  return p;
+}
+
 void *fcm__calloc_large_from(fcm_ctx *ctx, void **from, size_t n, size_t size)
 {
-  if (from && *from && size && n <= SIZE_MAX / size) {
-    large_header h;
-    memcpy(&h, (unsigned char *)*from - sizeof h, sizeof h);
-    const size_t bytes = n * size;
-    if (bytes <= h.capacity && bytes >= h.capacity / 2) {
-      void *p = *from;
-      *from = NULL;
-      memset(p, 0, bytes);
-      return p;
-    }
-  }
-  return fcm__calloc_large(ctx, n, size);
+  void *p = fcm__large_take(from, n, size);
+  if (!p) return fcm__calloc_large(ctx, n, size);
+  memset(p, 0, n * size);
+  return p;
 }
 
 void fcm__free_large(fcm_ctx *ctx, void *ptr)

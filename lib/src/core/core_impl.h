@@ -72,6 +72,11 @@ void *fcm__calloc_large(fcm_ctx *ctx, size_t n, size_t size);
  * again, on pages already mapped. Otherwise a new array, *from untouched. */
 void *fcm__calloc_large_from(fcm_ctx *ctx, void **from, size_t n, size_t size);
 
+/* *from (an array of fcm__calloc_large, or NULL) as an array of n elements, its contents as
+ * they are, when they fill at least half of its room: *from is then set to NULL. Else NULL,
+ * *from untouched. */
+void *fcm__large_take(void **from, size_t n, size_t size);
+
 /* Release memory from fcm__calloc_large; accepts NULL. */
 void fcm__free_large(fcm_ctx *ctx, void *ptr);
 

@@ -386,6 +386,14 @@ fcm_status fcm__assembly_linear_blocks(fcm_assembly_workspace *ws, const fcm_lin
 fcm_status fcm__assembly_corot_inherit(fcm_assembly_workspace *ws,
                                        const fcm_assembly_workspace *old, const fcm_index *same);
 
+/* As fcm__assembly_corot_inherit(), on old's storage where it holds ws's store (its room, a
+ * quarter above its size, fcm__large_take()) and the kept elements keep their order (same[e]
+ * increasing and <= e): their matrices are moved within it, not copied into new pages; old is
+ * left without a store (ws has taken it: old's workspace can only be destroyed). Else as
+ * fcm__assembly_corot_inherit(), old untouched. (corot_store.c) */
+fcm_status fcm__assembly_corot_take(fcm_assembly_workspace *ws, fcm_assembly_workspace *old,
+                                    const fcm_index *same);
+
 /* Element stiffness matrices of the corotated linear model that the hyperelastic assemblies
  * through ws have integrated since its creation (kept ones taken over a cut not counted).
  * (corot_store.c) */

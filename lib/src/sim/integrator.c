@@ -502,9 +502,11 @@ static fcm_status setup_storage(fcm_integrator *I)
     FCM_TRY(ctx, fcm__space_matrix_create_rows_from(I->space, I->cut_give ? I->cut_give->H : NULL,
                                                     &I->H));
   FCM_TRY(ctx, fcm_assembly_workspace_create(I->space, &I->opts.assembly, &I->aws));
-  /* after a cut: the corotated linear model's element matrices the cut leaves valid */
+  /* after a cut: the corotated linear model's element matrices the cut leaves valid (moved
+   * within the old integrator's store when it gives its storage) */
   if (I->cut_old && I->cut_same)
-    FCM_TRY(ctx, fcm__assembly_corot_inherit(I->aws, I->cut_old->aws, I->cut_same));
+    FCM_TRY(ctx, I->cut_give ? fcm__assembly_corot_take(I->aws, I->cut_give->aws, I->cut_same)
+                             : fcm__assembly_corot_inherit(I->aws, I->cut_old->aws, I->cut_same));
 cleanup:
   return st;
 }
