@@ -6,16 +6,20 @@
  * ones' storage (the same addresses; the matrices' values are 8 MiB and more, whose room is a
  * quarter larger than asked) and its corotated element matrices moved within the old store,
  * the other on new storage, and the mass matrix, the gravity load,
- * M a_rep, the state and two further steps' displacement and velocity are the same bits. The
- * integrator that gave its storage refuses to step and to be set up again, and is destroyed. */
+ * M a_rep, the state and a further step's displacement and velocity are the same bits. The
+ * integrator that gave its storage refuses to step, to be set up and to be cut again, and is
+ * destroyed. Before the first cut, the cut fails twice (an allocation in its setup, the last
+ * one of the cut): the integrator has its storage back and steps on as the other does. */
 #include "fem/assemble_impl.h"
 #include "la/la_impl.h"
 #include "sim/sim_impl.h"
 #include "sim_util.h"
+#include "test_alloc.h"
 
 #include <string.h>
 
 static fcm_ctx *ctx;
+static failing fl; /* ctx's allocator: counts, fails one allocation where armed */
 
 static const fcm_material mat = {FCM_MATERIAL_COROTATED_LINEAR, 2.0e4, 0.3, 1000.0};
 static const double gravity[3] = {0.0, -9.81, 0.0};
@@ -55,6 +59,42 @@ static void step_both(fcm_integrator *a, fcm_integrator *b, int steps)
   TEST_TRUE(fcm_integrator_num_dofs(b) == n);
   TEST_TRUE(same_bits(fcm_integrator_displacement(a), fcm_integrator_displacement(b), n));
   TEST_TRUE(same_bits(fcm_integrator_velocity(a), fcm_integrator_velocity(b), n));
+}
+
+/* A cut of a (with the option) failing at its allocation k (of n_alloc: a twin's cut made
+ * n_alloc) gives a its storage back: the same addresses, its mass matrix b's bits again, and
+ * a step of each after it the same bits (a builds its Newton and element matrices again). */
+static void cut_failing(fcm_integrator *a, fcm_integrator *b, const fcm_space *space, long long k)
+{
+  fcm_integrator *a1 = NULL;
+  const double *am = fcm_csr_values_read(a->M), *ah = fcm_csr_values_read(a->H);
+  const double *ak = a->aws->corot.K;
+  fl.count = 0;
+  fl.fail_at = k;
+  const fcm_status st = fcm_integrator_create_cut(a, space, &a1);
+  fl.fail_at = -1;
+  TEST_TRUE(st == FCM_ERR_ALLOC && a1 == NULL);
+  fcm_ctx_error_clear(ctx);
+  fcm_integrator_destroy(&a1);
+  TEST_TRUE(!a->spent && a->is_setup);
+  TEST_TRUE(fcm_csr_values_read(a->M) == am && fcm_csr_values_read(a->H) == ah);
+  TEST_TRUE(a->aws->corot.K == ak);
+  fcm_index nnz = 0;
+  fcm_csr_get_size(a->M, NULL, NULL, &nnz);
+  TEST_TRUE(same_bits(fcm_csr_values_read(a->M), fcm_csr_values_read(b->M), nnz));
+  step_both(a, b, 1);
+}
+
+/* The allocations of a successful cut of c (with the option; c is destroyed). */
+static long long cut_allocations(fcm_integrator *c, const fcm_space *space)
+{
+  fcm_integrator *c1 = NULL;
+  fl.count = 0;
+  TEST_OK(ctx, fcm_integrator_create_cut(c, space, &c1));
+  const long long n = fl.count;
+  TEST_TRUE(c1 != NULL && c->spent);
+  fcm_integrator_destroy(&c1);
+  return n;
 }
 
 /* Cuts a (with the option) and b (without) onto `space`: a's new matrices on a's storage. */
@@ -100,7 +140,8 @@ done:
 
 int main(void)
 {
-  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  ctx = failing_ctx(&fl);
+  TEST_TRUE(ctx != NULL);
   const long long live0 = fcm_ctx_live_allocations(ctx);
   const double lo[3] = {-0.1, -0.1, -0.1}, hi[3] = {1.1, 0.7, 0.7};
   const double glo[3] = {0, 0, 0}, ghi[3] = {1, 0.6, 0.6};
@@ -117,7 +158,15 @@ int main(void)
   TEST_OK(ctx, fcm_space_create_embedded(ctx, mesh, rules[0], &space[0]));
   a = make(space[0], mesh, FCM_CUT_REUSE_BLOCKS | FCM_CUT_REUSE_STORAGE);
   b = make(space[0], mesh, FCM_CUT_REUSE_BLOCKS);
-  if (a && b) step_both(a, b, 2);
+  fcm_integrator *c = make(space[0], mesh, FCM_CUT_REUSE_BLOCKS | FCM_CUT_REUSE_STORAGE);
+  if (a && b && c) {
+    step_both(a, b, 1);
+    for (int s = 0; s < 1; s++) {
+      fcm_step_info info;
+      TEST_OK(ctx, fcm_integrator_step(c, &info));
+    }
+    step_both(a, c, 0); /* c a twin of a */
+  }
   const double p1[3] = {0.47, 0.3, 0.3}, n1[3] = {1.0, 0.05, 0.0};
   const double c2[3] = {0.73, 0.55, 0.3}, n2[3] = {1.0, 0.0, 0.1}, a2[3] = {0.0, 1.0, 0.0},
                size2[2] = {0.5, 2.0};
@@ -132,11 +181,17 @@ int main(void)
     if (!space[k]) break;
     printf("cut %d: %lld -> %lld DOFs\n", k, (long long)fcm_space_num_dofs(space[k - 1]),
            (long long)fcm_space_num_dofs(space[k]));
+    if (k == 1 && c) { /* a failed cut, in the setup and at the end, before the cut */
+      const long long n_alloc = cut_allocations(c, space[k]);
+      cut_failing(a, b, space[k], n_alloc / 2);
+      cut_failing(a, b, space[k], n_alloc - 1);
+    }
     cut_both(&a, &b, space[k]);
-    if (a && b) step_both(a, b, 2);
+    if (a && b) step_both(a, b, 1);
   }
   fcm_integrator_destroy(&a);
   fcm_integrator_destroy(&b);
+  fcm_integrator_destroy(&c);
   for (int k = 2; k >= 0; k--) {
     fcm_space_destroy(&space[k]);
     fcm_cell_rules_destroy(&rules[k]);

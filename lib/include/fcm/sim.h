@@ -236,10 +236,13 @@ typedef struct fcm_integrator_options {
                       matrices take the storage of this one's where it is large enough (a
                       large matrix has a quarter more room than it needs, address space only),
                       on pages already mapped instead of new ones, whose first touch costs more
-                      than the assembly at a few hundred thousand DOFs; this integrator is then
-                      spent, after a failed cut too: it can only be destroyed (its state, time
-                      and options still read; stepping or setting it up fails with
-                      FCM_ERR_ARG). The results are the same bits. The scene runner sets
+                      than the assembly at a few hundred thousand DOFs (a serial integrator
+                      only). After a successful cut this integrator is spent: it can only be
+                      destroyed (its state, time and options still read; stepping, setting it up
+                      or cutting it fails with FCM_ERR_ARG). A failed cut gives the storage back
+                      (the mass matrix assembled again, the Newton matrix and corotated element
+                      matrices at the next step). The results are the same bits. The scene
+                      runner sets
                       FCM_CUT_REUSE_BLOCKS | FCM_CUT_REUSE_STORAGE for a scene with cuts [not a
                       scene key] */
   fcm_linear_solver linear_solver;   /**< default FCM_LINEAR_DIRECT ["method"] */
@@ -414,8 +417,8 @@ FCM_API fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space,
  * the elements whose rules the cut changed (the mass matrix and the loads are the same bits as
  * without it); FCM_CUT_REUSE_ORDERING analyses with old's CHOLMOD ordering extended by the new
  * DOFs beside their parents (no AMD / METIS; more fill than a fresh ordering);
- * FCM_CUT_REUSE_STORAGE gives old's large arrays to the new integrator (old can then only be
- * destroyed, whatever the status returned, once the arguments are checked). The DOF
+ * FCM_CUT_REUSE_STORAGE gives old's large arrays to the new integrator (on FCM_OK old can then
+ * only be destroyed; on failure old has them back and goes on). The DOF
  * numbering is the space's own (fcm_space_create_embedded()), as without them.
  * @return FCM_OK; FCM_ERR_ARG (NULL, old not set up, unrelated space); the errors of
  *         fcm_integrator_setup(); FCM_ERR_ALLOC. Allocates. */

@@ -163,6 +163,15 @@ cleanup:
   return st;
 }
 
+void fcm__assembly_corot_give_back(fcm_assembly_workspace *ws, fcm_assembly_workspace *old)
+{
+  corot_store *c = &ws->corot, *o = &old->corot;
+  if (!c->K || o->K || !o->have) return; /* old's store is its own (nothing taken) */
+  o->K = c->K, c->K = NULL;
+  if (!o->G) o->G = c->G, c->G = NULL; /* else old's mean gradients were copied, not moved */
+  memset(o->have, 0, (size_t)old->space->num_elems);
+}
+
 fcm_index fcm__assembly_corot_built(const fcm_assembly_workspace *ws)
 {
   return ws->corot.built;

@@ -394,6 +394,11 @@ fcm_status fcm__assembly_corot_inherit(fcm_assembly_workspace *ws,
 fcm_status fcm__assembly_corot_take(fcm_assembly_workspace *ws, fcm_assembly_workspace *old,
                                     const fcm_index *same);
 
+/* The store ws took from old (fcm__assembly_corot_take()) back to old after a failed cut, none
+ * of its matrices counted as built (their places moved): old builds them again at its next
+ * use, the same bits. Nothing taken: nothing done. (corot_store.c) */
+void fcm__assembly_corot_give_back(fcm_assembly_workspace *ws, fcm_assembly_workspace *old);
+
 /* Element stiffness matrices of the corotated linear model that the hyperelastic assemblies
  * through ws have integrated since its creation (kept ones taken over a cut not counted).
  * (corot_store.c) */

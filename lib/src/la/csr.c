@@ -171,6 +171,14 @@ static double *values_from(fcm_ctx *ctx, fcm_csr *give, fcm_index nnz)
   return v;
 }
 
+int fcm__csr_give_back(fcm_csr *from, fcm_csr *to)
+{
+  if (!from || !to || !from->owned || !to->owned || !from->values || to->values) return 0;
+  to->values = from->values;
+  from->values = NULL;
+  return 1;
+}
+
 fcm_status fcm__csr_share_pattern_from(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols,
                                        const fcm_index *row_ptr, const int *col_idx,
                                        fcm_csr_kind kind, fcm_csr *give, fcm_csr **out)

@@ -699,7 +699,7 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = old ? old->ctx : NULL;
-  fcm_integrator *I = NULL;
+  fcm_integrator *I = NULL, *giver = NULL;
   double *u = NULL, *v = NULL, *a = NULL;
   FCM_CHECK(integ, ctx, FCM_ERR_ARG, "integrator cut: output pointer is NULL");
   *integ = NULL;
@@ -724,8 +724,8 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   FCM_TRY(ctx, fcm__sim_cut_ordering(old, I));
   FCM_TRY(ctx, fcm__sim_cut_prepare_blocks(old, I));
   fcm__sim_cut_give_storage(old, I);
+  giver = I->cut_give;
   st = fcm_integrator_setup(I);
-  if (I->cut_give) I->cut_give->spent = 1, I->cut_give->is_setup = 0; /* gave its storage */
   I->cut_old = NULL; /* borrowed for the setup only */
   I->cut_give = NULL;
   FCM_FREE(ctx, I->cut_same);
@@ -743,7 +743,9 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   I->load_work = old->load_work;
   *integ = I;
   I = NULL;
+  if (giver) giver->spent = 1, giver->is_setup = 0; /* its storage is the new integrator's */
 cleanup:
+  if (I && giver) fcm__sim_cut_give_back(I, giver); /* failed: old goes on */
   fcm__free(ctx, u);
   fcm__free(ctx, v);
   fcm__free(ctx, a);
