@@ -160,7 +160,7 @@ typedef void (*fcm_newton_monitor_fn)(void *user, const fcm_newton_event *event)
 typedef enum fcm_cut_reuse {
   FCM_CUT_REUSE_BLOCKS = 1,   /**< element mass and load blocks of the elements a cut leaves */
   FCM_CUT_REUSE_ORDERING = 2, /**< CHOLMOD's fill-reducing ordering, extended */
-  FCM_CUT_REUSE_STORAGE = 4   /**< the large arrays themselves (the old integrator is spent) */
+  FCM_CUT_REUSE_STORAGE = 4   /**< the large arrays themselves (a cut spends the old one) */
 } fcm_cut_reuse;
 
 /** Options; initialize with fcm_integrator_options_default(). These defaults are also the
@@ -242,9 +242,8 @@ typedef struct fcm_integrator_options {
                       or cutting it fails with FCM_ERR_ARG). A failed cut gives the storage back
                       (the mass matrix assembled again, the Newton matrix and corotated element
                       matrices at the next step). The results are the same bits. The scene
-                      runner sets
-                      FCM_CUT_REUSE_BLOCKS | FCM_CUT_REUSE_STORAGE for a scene with cuts [not a
-                      scene key] */
+                      runner sets FCM_CUT_REUSE_BLOCKS | FCM_CUT_REUSE_STORAGE for a scene with
+                      cuts [not a scene key] */
   fcm_linear_solver linear_solver;   /**< default FCM_LINEAR_DIRECT ["method"] */
   fcm_direct_method direct_method;   /**< first direct method (default CHOLMOD; UMFPACK: LU only)
                                           ["direct"] */
