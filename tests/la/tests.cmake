@@ -23,3 +23,5 @@ set_tests_properties(la_blas_info_prescott PROPERTIES ENVIRONMENT
 # Large matrix values on 2 MiB boundaries (huge pages), small ones 64-byte aligned; their
 # allocation failures.
 fcm_add_test(la_csr_large tests/la/csr_large.c)
+# A matrix taking another's values storage where it fits (a cut's matrices on the old ones').
+fcm_add_test(la_csr_take tests/la/csr_take.c)

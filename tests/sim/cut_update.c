@@ -216,7 +216,7 @@ int main(int argc, char **argv)
   fcm_integrator_destroy(&plain);
   { /* a value that is no sum of the flags is refused at the setup */
     fcm_integrator_options ob = o;
-    ob.cut_reuse = 4;
+    ob.cut_reuse = 8;
     fcm_integrator *bad = NULL;
     TEST_OK(ctx, fcm_integrator_create(ctx, space[0], &mat, &ob, &bad));
     TEST_TRUE(fcm_integrator_setup(bad) == FCM_ERR_ARG);

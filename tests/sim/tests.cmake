@@ -55,6 +55,9 @@ endforeach()
 foreach(el tet4 hex8 hex20)
   fcm_add_test(sim_corot_linear_${el} tests/sim/corot_linear.c ARGS ${el})
 endforeach()
+# A cut's integrator on the old one's storage (FCM_CUT_REUSE_STORAGE) equals one on new storage
+# bit for bit (mass, load, state after steps; Hex8, corotated linear, multigrid); the giver spent.
+fcm_add_test(sim_cut_storage tests/sim/cut_storage.c)
 # Reactions of constraints: minus the assembled weight and its moment in equilibrium (an
 # embedded beam clamped by a half-space of background nodes), change of momentum minus the
 # weight in dynamics; two constraints add up.

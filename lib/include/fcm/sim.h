@@ -158,8 +158,9 @@ typedef void (*fcm_newton_monitor_fn)(void *user, const fcm_newton_event *event)
 
 /** What a cut keeps of an integrator (fcm_integrator_options.cut_reuse, flags). */
 typedef enum fcm_cut_reuse {
-  FCM_CUT_REUSE_BLOCKS = 1,  /**< element mass and load blocks of the elements a cut leaves */
-  FCM_CUT_REUSE_ORDERING = 2 /**< CHOLMOD's fill-reducing ordering, extended */
+  FCM_CUT_REUSE_BLOCKS = 1,   /**< element mass and load blocks of the elements a cut leaves */
+  FCM_CUT_REUSE_ORDERING = 2, /**< CHOLMOD's fill-reducing ordering, extended */
+  FCM_CUT_REUSE_STORAGE = 4   /**< the large arrays themselves (a cut spends the old one) */
 } fcm_cut_reuse;
 
 /** Options; initialize with fcm_integrator_options_default(). These defaults are also the
@@ -231,8 +232,18 @@ typedef struct fcm_integrator_options {
                       of a rebuild. FCM_CUT_REUSE_ORDERING: CHOLMOD's analysis after a cut takes
                       the old ordering extended by the new DOFs (no AMD / METIS): a faster
                       analysis, but a factor with more fill than a fresh ordering's
-                      (lib/docs/cutting.md). The scene runner sets FCM_CUT_REUSE_BLOCKS for a
-                      scene with cuts [not a scene key] */
+                      (lib/docs/cutting.md). FCM_CUT_REUSE_STORAGE: the new integrator's
+                      matrices take the storage of this one's where it is large enough (a
+                      large matrix has a quarter more room than it needs, address space only),
+                      on pages already mapped instead of new ones, whose first touch costs more
+                      than the assembly at a few hundred thousand DOFs (a serial integrator
+                      only). After a successful cut this integrator is spent: it can only be
+                      destroyed (its state, time and options still read; stepping, setting it up
+                      or cutting it fails with FCM_ERR_ARG). A failed cut gives the storage back
+                      (the mass matrix assembled again, the Newton matrix and corotated element
+                      matrices at the next step). The results are the same bits. The scene
+                      runner sets FCM_CUT_REUSE_BLOCKS | FCM_CUT_REUSE_STORAGE for a scene with
+                      cuts [not a scene key] */
   fcm_linear_solver linear_solver;   /**< default FCM_LINEAR_DIRECT ["method"] */
   fcm_direct_method direct_method;   /**< first direct method (default CHOLMOD; UMFPACK: LU only)
                                           ["direct"] */
@@ -409,7 +420,9 @@ FCM_API fcm_status fcm_integrator_create(fcm_ctx *ctx, const fcm_space *space,
  * With old's options' cut_reuse (fcm_cut_reuse): FCM_CUT_REUSE_BLOCKS integrates again only
  * the elements whose rules the cut changed (the mass matrix and the loads are the same bits as
  * without it); FCM_CUT_REUSE_ORDERING analyses with old's CHOLMOD ordering extended by the new
- * DOFs beside their parents (no AMD / METIS; more fill than a fresh ordering). The DOF
+ * DOFs beside their parents (no AMD / METIS; more fill than a fresh ordering);
+ * FCM_CUT_REUSE_STORAGE gives old's large arrays to the new integrator (on FCM_OK old can then
+ * only be destroyed; on failure old has them back and goes on). The DOF
  * numbering is the space's own (fcm_space_create_embedded()), as without them.
  * @return FCM_OK; FCM_ERR_ARG (NULL, old not set up, unrelated space); the errors of
  *         fcm_integrator_setup() and fcm_integrator_prepare_solver(); FCM_ERR_ALLOC.

@@ -61,9 +61,21 @@ FCM_COMPONENT_API void fcm__free(fcm_ctx *ctx, void *ptr);
 /* As fcm__calloc for large arrays that are written all over (assembled matrix values): from
  * 8 MiB on, the array starts on a 2 MiB boundary and, on Linux, is advised to transparent huge
  * pages before its zero fill touches it; smaller ones are 64-byte aligned. Counted and failing
- * like fcm__calloc (one allocation through ctx's allocator, a little larger than asked).
+ * like fcm__calloc (one allocation through ctx's allocator, a little larger than asked; from
+ * 8 MiB on, a quarter larger: room left untouched for fcm__calloc_large_from()).
  * Released with fcm__free_large only. */
 void *fcm__calloc_large(fcm_ctx *ctx, size_t n, size_t size);
+
+/* As fcm__calloc_large, on the storage of *from (an array of fcm__calloc_large, or NULL) when
+ * n elements fill at least half of its room (a large array's room is a quarter more than it
+ * was asked for): *from is then set to NULL (its owner gives it up) and the array zero filled
+ * again, on pages already mapped. Otherwise a new array, *from untouched. */
+void *fcm__calloc_large_from(fcm_ctx *ctx, void **from, size_t n, size_t size);
+
+/* *from (an array of fcm__calloc_large, or NULL) as an array of n elements, its contents as
+ * they are, when they fill at least half of its room: *from is then set to NULL. Else NULL,
+ * *from untouched. */
+void *fcm__large_take(void **from, size_t n, size_t size);
 
 /* Release memory from fcm__calloc_large; accepts NULL. */
 void fcm__free_large(fcm_ctx *ctx, void *ptr);

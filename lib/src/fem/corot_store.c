@@ -11,23 +11,24 @@
 
 void fcm__assembly_corot_free(fcm_assembly_workspace *ws)
 {
-  fcm__free(ws->ctx, ws->corot.K);
+  fcm__free_large(ws->ctx, ws->corot.K);
   fcm__free(ws->ctx, ws->corot.have);
-  fcm__free(ws->ctx, ws->corot.G);
+  fcm__free_large(ws->ctx, ws->corot.G);
   ws->corot.G = NULL;
   ws->corot.K = NULL;
   ws->corot.have = NULL;
 }
 
-/* Allocate the store (nothing built). */
+/* Allocate the store (nothing built): large arrays, with room for a cut's successor to take
+ * them (fcm__assembly_corot_take()). */
 static fcm_status store_alloc(fcm_assembly_workspace *ws)
 {
   fcm_status st = FCM_OK;
   const fcm_space *s = ws->space;
   corot_store *c = &ws->corot;
   c->cb = 9 * (size_t)s->nn * (size_t)(s->nn + 1) / 2;
-  FCM_ALLOC_RAW(ws->ctx, (size_t)s->num_elems * c->cb + 1, c->K);
-  FCM_ALLOC_RAW(ws->ctx, (size_t)s->num_elems * 3 * s->nn + 1, c->G);
+  FCM__ALLOC_WITH(fcm__calloc_large, ws->ctx, (size_t)s->num_elems * c->cb + 1, c->K);
+  FCM__ALLOC_WITH(fcm__calloc_large, ws->ctx, (size_t)s->num_elems * 3 * s->nn + 1, c->G);
   FCM_ALLOC(ws->ctx, (size_t)s->num_elems + 1, c->have);
 cleanup:
   return st;
@@ -121,6 +122,54 @@ fcm_status fcm__assembly_corot_inherit(fcm_assembly_workspace *ws,
   }
 cleanup:
   return st;
+}
+
+fcm_status fcm__assembly_corot_take(fcm_assembly_workspace *ws, fcm_assembly_workspace *old,
+                                    const fcm_index *same)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = ws ? ws->ctx : NULL;
+  FCM_CHECK(ws && old && same, ctx, FCM_ERR_ARG, "corotated_linear: NULL workspace or map");
+  corot_store *o = &old->corot, *c = &ws->corot;
+  const fcm_index ne = ws->space->num_elems;
+  const size_t g = 3 * (size_t)ws->space->nn;
+  int in_order = o->K && !c->K && ws->space->nn == old->space->nn;
+  for (fcm_index e = 0, last = -1; in_order && e < ne; e++) {
+    const fcm_index f = same[e];
+    if (f < 0 || !o->have[f]) continue;
+    in_order = f <= e && f > last; /* moved up only, so that a pass downwards moves each once */
+    last = f;
+  }
+  void *kf = in_order ? o->K : NULL, *gf = o->G;
+  double *K = fcm__large_take(&kf, (size_t)ne * o->cb + 1, sizeof *K), *G = NULL;
+  if (!K) return fcm__assembly_corot_inherit(ws, old, same); /* nothing taken */
+  FCM_ALLOC(ctx, (size_t)ne + 1, c->have);
+  G = fcm__large_take(&gf, (size_t)ne * g + 1, sizeof *G); /* else copied into a new one */
+  if (!G) FCM__ALLOC_WITH(fcm__calloc_large, ctx, (size_t)ne * g + 1, G);
+  const double *Gf = gf ? o->G : G; /* where the kept mean gradients are */
+  c->K = K, c->G = G, o->K = NULL;
+  if (!gf) o->G = NULL;
+  c->cb = o->cb;
+  c->lambda = o->lambda;
+  c->mu = o->mu;
+  for (fcm_index e = ne - 1; e >= 0; e--) {
+    const fcm_index f = same[e];
+    c->have[e] = f >= 0 && o->have[f];
+    if (!c->have[e]) continue;
+    if (f != e) memcpy(K + (size_t)e * c->cb, K + (size_t)f * c->cb, sizeof(double) * c->cb);
+    if (f != e || Gf != G) memcpy(G + (size_t)e * g, Gf + (size_t)f * g, sizeof(double) * g);
+  }
+cleanup:
+  return st;
+}
+
+void fcm__assembly_corot_give_back(fcm_assembly_workspace *ws, fcm_assembly_workspace *old)
+{
+  corot_store *c = &ws->corot, *o = &old->corot;
+  if (!c->K || o->K || !o->have) return; /* old's store is its own (nothing taken) */
+  o->K = c->K, c->K = NULL;
+  if (!o->G) o->G = c->G, c->G = NULL; /* else old's mean gradients were copied, not moved */
+  memset(o->have, 0, (size_t)old->space->num_elems);
 }
 
 fcm_index fcm__assembly_corot_built(const fcm_assembly_workspace *ws)

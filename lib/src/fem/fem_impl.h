@@ -248,6 +248,10 @@ static inline fcm_index fcm__space_elem_row(const fcm_space *s, fcm_index le, in
  * @return FCM_OK, FCM_ERR_ARG (NULL), FCM_ERR_ALLOC. (space.c) */
 fcm_status fcm__space_matrix_create_rows(const fcm_space *s, fcm_csr **A);
 
+/* fcm__space_matrix_create_rows() whose values take give's storage where it is large enough
+ * (fcm__csr_share_pattern_from(): give, or NULL, is then left without values). (space.c) */
+fcm_status fcm__space_matrix_create_rows_from(const fcm_space *s, fcm_csr *give, fcm_csr **A);
+
 /* y (num_dofs) = A x for A of fcm__space_matrix_create_rows() (x: num_dofs); y is zero on the
  * DOFs with no row. A full space: fcm_csr_apply(A, 1, x, 0, y) exactly (same bits). Each row is
  * summed serially (threads over rows): independent of the thread count. No allocation.
@@ -381,6 +385,19 @@ fcm_status fcm__assembly_linear_blocks(fcm_assembly_workspace *ws, const fcm_lin
  * @return FCM_OK, FCM_ERR_ARG (NULL), FCM_ERR_ALLOC. (corot_store.c) */
 fcm_status fcm__assembly_corot_inherit(fcm_assembly_workspace *ws,
                                        const fcm_assembly_workspace *old, const fcm_index *same);
+
+/* As fcm__assembly_corot_inherit(), on old's storage where it holds ws's store (its room, a
+ * quarter above its size, fcm__large_take()) and the kept elements keep their order (same[e]
+ * increasing and <= e): their matrices are moved within it, not copied into new pages; old is
+ * left without a store (ws has taken it: old's workspace can only be destroyed). Else as
+ * fcm__assembly_corot_inherit(), old untouched. (corot_store.c) */
+fcm_status fcm__assembly_corot_take(fcm_assembly_workspace *ws, fcm_assembly_workspace *old,
+                                    const fcm_index *same);
+
+/* The store ws took from old (fcm__assembly_corot_take()) back to old after a failed cut, none
+ * of its matrices counted as built (their places moved): old builds them again at its next
+ * use, the same bits. Nothing taken: nothing done. (corot_store.c) */
+void fcm__assembly_corot_give_back(fcm_assembly_workspace *ws, fcm_assembly_workspace *old);
 
 /* Element stiffness matrices of the corotated linear model that the hyperelastic assemblies
  * through ws have integrated since its creation (kept ones taken over a cut not counted).

@@ -314,6 +314,11 @@ fcm_index fcm__space_elem_local(const fcm_space *s, fcm_index e)
 
 fcm_status fcm__space_matrix_create_rows(const fcm_space *s, fcm_csr **A)
 {
+  return fcm__space_matrix_create_rows_from(s, NULL, A);
+}
+
+fcm_status fcm__space_matrix_create_rows_from(const fcm_space *s, fcm_csr *give, fcm_csr **A)
+{
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s ? s->ctx : NULL;
   FCM_CHECK(s && A, ctx, FCM_ERR_ARG, "space matrix (rows): NULL space or output pointer");
@@ -321,9 +326,9 @@ fcm_status fcm__space_matrix_create_rows(const fcm_space *s, fcm_csr **A)
   FCM_CHECK(s->row_ptr, ctx, FCM_ERR_ARG,
             "space matrix (rows): the local space has no topology (a failed rebuild)");
   /* the space's pattern, shared (borrowed: the space outlives the matrices made on it) */
-  FCM_TRY(ctx,
-          fcm__csr_share_pattern(ctx, fcm__space_num_rows(s), s->num_dofs, s->row_ptr, s->col_idx,
-                                 s->is_local ? FCM_CSR_GENERAL : FCM_CSR_SYMMETRIC, A));
+  FCM_TRY(ctx, fcm__csr_share_pattern_from(
+                   ctx, fcm__space_num_rows(s), s->num_dofs, s->row_ptr, s->col_idx,
+                   s->is_local ? FCM_CSR_GENERAL : FCM_CSR_SYMMETRIC, give, A));
 cleanup:
   return st;
 }

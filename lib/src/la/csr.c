@@ -159,6 +159,30 @@ fcm_status fcm__csr_share_pattern(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols
                                   const fcm_index *row_ptr, const int *col_idx, fcm_csr_kind kind,
                                   fcm_csr **out)
 {
+  return fcm__csr_share_pattern_from(ctx, nrows, ncols, row_ptr, col_idx, kind, NULL, out);
+}
+
+/* fcm__calloc_large_from() on the values of `give` (owned by it, else none to take). */
+static double *values_from(fcm_ctx *ctx, fcm_csr *give, fcm_index nnz)
+{
+  void *from = give && give->owned ? give->values : NULL;
+  double *v = fcm__calloc_large_from(ctx, &from, (size_t)nnz, sizeof *v);
+  if (give && give->owned && !from) give->values = NULL; /* taken */
+  return v;
+}
+
+int fcm__csr_give_back(fcm_csr *from, fcm_csr *to)
+{
+  if (!from || !to || !from->owned || !to->owned || !from->values || to->values) return 0;
+  to->values = from->values;
+  from->values = NULL;
+  return 1;
+}
+
+fcm_status fcm__csr_share_pattern_from(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols,
+                                       const fcm_index *row_ptr, const int *col_idx,
+                                       fcm_csr_kind kind, fcm_csr *give, fcm_csr **out)
+{
   fcm_status st = FCM_OK;
   fcm_csr *A = NULL;
   FCM_CHECK(out, ctx, FCM_ERR_ARG, "csr_share_pattern: output pointer is NULL");
@@ -168,7 +192,12 @@ fcm_status fcm__csr_share_pattern(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols
             "csr_share_pattern: col_idx is NULL with nnz = %lld", (long long)row_ptr[nrows]);
   FCM_TRY(ctx, new_handle(ctx, nrows, ncols, row_ptr[nrows], kind, &A));
   A->owned = 1; /* the values; the pattern is borrowed (own_row_ptr / own_col_idx NULL) */
-  FCM__ALLOC_WITH(fcm__calloc_large, ctx, A->nnz, A->values);
+  A->values = values_from(ctx, give, A->nnz);
+  if (!A->values) {
+    st = FCM_ERR_ALLOC;
+    fcm__trace(ctx, __FILE__, __LINE__, __func__);
+    goto cleanup;
+  }
   A->row_ptr = row_ptr;
   A->col_idx = col_idx;
   *out = A;

@@ -126,6 +126,18 @@ fcm_status fcm__csr_share_pattern(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols
                                   const fcm_index *row_ptr, const int *col_idx, fcm_csr_kind kind,
                                   fcm_csr **A);
 
+/* fcm__csr_share_pattern() whose values take the storage of give's values where it is large
+ * enough (fcm__calloc_large_from(): zero filled again); give (or NULL) is then left without
+ * values (NULL: it can only be destroyed). Else new values, give untouched. (csr.c) */
+fcm_status fcm__csr_share_pattern_from(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols,
+                                       const fcm_index *row_ptr, const int *col_idx,
+                                       fcm_csr_kind kind, fcm_csr *give, fcm_csr **A);
+
+/* The values storage `to` gave to `from` (fcm__csr_share_pattern_from()) back to `to`: 1 when
+ * given back (to's values then as from's left them, from without values: destroy only); 0 when
+ * there is nothing to give back (to has values, or from none of its own). (csr.c) */
+int fcm__csr_give_back(fcm_csr *from, fcm_csr *to);
+
 /* A matrix that takes over *row_ptr and *col_idx (arrays from fcm__calloc or fcm__malloc;
  * set to NULL, also on failure, when they are freed), values zero. For patterns built inside
  * the library that are already known to be valid (rows strictly increasing, in range, both

@@ -617,9 +617,9 @@ static fcm_status build_integrator(fcm_simulation *S)
   S->c.nonfinite_first_step = -1;
   S->c.contact_min_distance = HUGE_VAL;
   fcm_integrator_options io = integrator_options(S);
-  /* a scene with cuts: each cut integrates only the elements it changes */
+  /* a scene with cuts: each cut integrates only the elements it changes, on the old arrays */
   if (S->rules && fcm_scene_count_effects(scene, FCM_EFFECT_CUT) > 0)
-    io.cut_reuse |= FCM_CUT_REUSE_BLOCKS;
+    io.cut_reuse |= FCM_CUT_REUSE_BLOCKS | FCM_CUT_REUSE_STORAGE;
   S->c.inertia = io.kind == FCM_INTEGRATOR_BACKWARD_EULER;
   S->c.damping = io.rayleigh_mass > 0.0 || io.rayleigh_stiffness > 0.0;
   S->c.krylov = io.linear_solver == FCM_LINEAR_CG || io.linear_solver == FCM_LINEAR_MINRES;

@@ -2,7 +2,8 @@
  * the element blocks of the mass matrix and the loads of the elements the cut leaves as they
  * were, and the fill-reducing ordering of the direct solver's analysis, extended by the new DOFs
  * beside the ones they split from (fem/cut_update.c), so that the new analysis computes only
- * the factor's structure. */
+ * the factor's structure; and it may take the old integrator's large arrays (the matrices'
+ * values) for its own, on pages already mapped. */
 #include "sim/sim_impl.h"
 #include "fem/fem_impl.h"
 #include "la/la_impl.h"
@@ -87,4 +88,35 @@ fcm_status fcm__sim_cut_prepare_blocks(const fcm_integrator *old, fcm_integrator
   I->setup_info.cut_kept_elements = kept;
 cleanup:
   return st;
+}
+
+void fcm__sim_cut_give_storage(const fcm_integrator *old, fcm_integrator *I)
+{
+  /* old's options name the flag (the caller's consent to old's storage going to I): old is
+   * destroyed after a successful cut and has its storage back after a failed one, so its
+   * arrays are taken although old is given const. Serial only: giving back after a failure
+   * assembles old's mass matrix again, which a distributed run would have to agree on. */
+  const int serial =
+      !fcm__integrator_distributed(old, NULL) && !fcm__integrator_distributed(I, NULL);
+  I->cut_give =
+      (old->opts.cut_reuse & FCM_CUT_REUSE_STORAGE) && serial ? (fcm_integrator *)old : NULL;
+}
+
+void fcm__sim_cut_give_back(fcm_integrator *I, fcm_integrator *old)
+{
+  fcm_status st = FCM_OK;
+  fcm__csr_give_back(I->H, old->H); /* assembled again at old's next iteration */
+  old->h_state = SIM_H_INVALID;
+  old->kept = 0;
+  if (I->aws && old->aws) fcm__assembly_corot_give_back(I->aws, old->aws);
+  if (fcm__csr_give_back(I->M, old->M)) { /* the mass matrix, assembled again now */
+    fcm_index nnz = 0;
+    fcm_csr_get_size(old->M, NULL, NULL, &nnz);
+    memset(fcm_csr_values(old->M), 0, sizeof(double) * (size_t)nnz);
+    fcm_linear_form form = fcm_linear_form_default();
+    form.material = &old->mat;
+    form.term = FCM_LINEAR_MASS;
+    st = fcm_assembly_workspace_linear(old->aws, &form, old->M, NULL);
+  }
+  if (st != FCM_OK) old->spent = 1, old->is_setup = 0; /* without its mass matrix */
 }

@@ -409,10 +409,11 @@ static fcm_status validate_options(fcm_ctx *ctx, const fcm_integrator_options *o
             o->krylov_stagnation_window);
   FCM_CHECK(o->schwarz_theta > 0.0 && o->schwarz_theta <= 1.0, ctx, FCM_ERR_ARG,
             "integrator: schwarz_theta = %g outside (0, 1]", o->schwarz_theta);
-  FCM_CHECK(o->cut_reuse >= 0 && o->cut_reuse <= (FCM_CUT_REUSE_BLOCKS | FCM_CUT_REUSE_ORDERING),
+  FCM_CHECK(o->cut_reuse >= 0 && o->cut_reuse <= (FCM_CUT_REUSE_BLOCKS | FCM_CUT_REUSE_ORDERING |
+                                                  FCM_CUT_REUSE_STORAGE),
             ctx, FCM_ERR_ARG,
             "integrator: cut_reuse = %d is not a sum of fcm_cut_reuse flags (0 .. %d)",
-            o->cut_reuse, FCM_CUT_REUSE_BLOCKS | FCM_CUT_REUSE_ORDERING);
+            o->cut_reuse, FCM_CUT_REUSE_BLOCKS | FCM_CUT_REUSE_ORDERING | FCM_CUT_REUSE_STORAGE);
   FCM_CHECK(o->rayleigh_mass >= 0.0 && isfinite(o->rayleigh_mass), ctx, FCM_ERR_ARG,
             "integrator: rayleigh_mass = %g must be finite and >= 0", o->rayleigh_mass);
   FCM_CHECK(o->rayleigh_stiffness >= 0.0 && isfinite(o->rayleigh_stiffness), ctx, FCM_ERR_ARG,
@@ -498,11 +499,14 @@ static fcm_status setup_storage(fcm_integrator *I)
   if (I->hP)
     FCM_TRY(ctx, fcm__sim_hanging_storage(I, &I->H));
   else
-    FCM_TRY(ctx, fcm__space_matrix_create_rows(I->space, &I->H));
+    FCM_TRY(ctx, fcm__space_matrix_create_rows_from(I->space, I->cut_give ? I->cut_give->H : NULL,
+                                                    &I->H));
   FCM_TRY(ctx, fcm_assembly_workspace_create(I->space, &I->opts.assembly, &I->aws));
-  /* after a cut: the corotated linear model's element matrices the cut leaves valid */
+  /* after a cut: the corotated linear model's element matrices the cut leaves valid (moved
+   * within the old integrator's store when it gives its storage) */
   if (I->cut_old && I->cut_same)
-    FCM_TRY(ctx, fcm__assembly_corot_inherit(I->aws, I->cut_old->aws, I->cut_same));
+    FCM_TRY(ctx, I->cut_give ? fcm__assembly_corot_take(I->aws, I->cut_give->aws, I->cut_same)
+                             : fcm__assembly_corot_inherit(I->aws, I->cut_old->aws, I->cut_same));
 cleanup:
   return st;
 }
@@ -515,7 +519,8 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
   fcm_linear_form form = fcm_linear_form_default();
   form.material = &I->mat; /* linear assembly: mass and body forces */
   if (I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) {
-    FCM_TRY(ctx, fcm__space_matrix_create_rows(I->space, &I->M));
+    FCM_TRY(ctx, fcm__space_matrix_create_rows_from(I->space, I->cut_give ? I->cut_give->M : NULL,
+                                                    &I->M));
     form.term = FCM_LINEAR_MASS;
     st = fcm__sim_assemble_kept(I, &form, I->M, NULL, &I->blk_mass,
                                 I->cut_old ? I->cut_old->blk_mass : NULL);
@@ -643,6 +648,9 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
   FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
   fcm_ctx *ctx = I->ctx;
   FCM_CHECK(!I->is_setup, ctx, FCM_ERR_ARG, "integrator: already set up");
+  FCM_CHECK(!I->spent, ctx, FCM_ERR_ARG,
+            "integrator: its storage went to the integrator of a cut (FCM_CUT_REUSE_STORAGE); "
+            "it can only be destroyed");
   FCM_TRY(ctx, validate_options(ctx, &I->opts));
   if (I->opts.tolerance_mode == FCM_NEWTON_TOL_AUTO)
     I->opts.tolerance_mode = I->opts.kind == FCM_INTEGRATOR_STATIC ? FCM_NEWTON_TOL_RELATIVE
@@ -691,7 +699,7 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = old ? old->ctx : NULL;
-  fcm_integrator *I = NULL;
+  fcm_integrator *I = NULL, *giver = NULL;
   double *u = NULL, *v = NULL, *a = NULL;
   FCM_CHECK(integ, ctx, FCM_ERR_ARG, "integrator cut: output pointer is NULL");
   *integ = NULL;
@@ -715,8 +723,11 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   }
   FCM_TRY(ctx, fcm__sim_cut_ordering(old, I));
   FCM_TRY(ctx, fcm__sim_cut_prepare_blocks(old, I));
+  fcm__sim_cut_give_storage(old, I);
+  giver = I->cut_give;
   st = fcm_integrator_setup(I);
   I->cut_old = NULL; /* borrowed for the setup only */
+  I->cut_give = NULL;
   FCM_FREE(ctx, I->cut_same);
   FCM_TRY(ctx, st);
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, u);
@@ -733,7 +744,9 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   I->load_work = old->load_work;
   *integ = I;
   I = NULL;
+  if (giver) giver->spent = 1, giver->is_setup = 0; /* its storage is the new integrator's */
 cleanup:
+  if (I && giver) fcm__sim_cut_give_back(I, giver); /* failed: old goes on */
   fcm__free(ctx, u);
   fcm__free(ctx, v);
   fcm__free(ctx, a);

@@ -233,6 +233,11 @@ struct fcm_integrator {
   double *blk_mass;
   const fcm_integrator *cut_old;
   fcm_index *cut_same;
+  /* FCM_CUT_REUSE_STORAGE: during the setup after a cut, the integrator cut from, whose large
+   * arrays the new matrices take (cut_update.c); spent: this integrator gave them to a
+   * successful cut (it can only be destroyed) */
+  fcm_integrator *cut_give;
+  int spent;
   fcm_krylov *krylov;
   fcm_jacobi *jacobi;
   fcm_schwarz *schwarz;
@@ -347,6 +352,16 @@ fcm_status fcm__sim_copy_effects(const fcm_integrator *old, fcm_integrator *I);
  * setup_info.cut_kept_elements). @return as the assembly. (cut_update.c) */
 fcm_status fcm__sim_assemble_kept(fcm_integrator *I, const fcm_linear_form *form, fcm_csr *A,
                                   double *f, double **blocks, const double *old_blocks);
+
+/* After a cut with FCM_CUT_REUSE_STORAGE in old's options (before I's setup): I's setup
+ * takes old's large arrays where they are large enough (I->cut_give); else nothing. */
+void fcm__sim_cut_give_storage(const fcm_integrator *old, fcm_integrator *I);
+
+/* After a failed cut (I, not set up or not returned): the storage I took back to old, which
+ * goes on as before the cut: its mass matrix assembled again (the same bits), its Newton
+ * matrix and corotated element matrices built again at its next step. A failure of that
+ * assembly leaves old spent (FCM_ERR_ARG on a step). */
+void fcm__sim_cut_give_back(fcm_integrator *I, fcm_integrator *old);
 
 /* After a cut with FCM_CUT_REUSE_BLOCKS (before I's setup): the elements of I's space that
  * integrate as elements of old's (I->cut_same), so that the setup keeps their blocks.
