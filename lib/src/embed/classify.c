@@ -401,6 +401,7 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
     sums->time_intersect += fcm_wtime() - t0;
     goto cleanup;
   }
+  if (B->prev) FCM_TRY(ctx, fcm__embed_check_convex(ctx, B->mesh, c, opt));
   int surface = B->surface && cell.affine && !(B->cut_tree && B->region[c]);
   if (surface && opt->moments == FCM_CELL_MOMENTS_AUTO && B->geom->num_cells > 0) {
     /* auto: the surface path where the volume path would start from many points */

@@ -290,6 +290,17 @@ static void grow_box(double box[6], const double x[3])
  * its own vertices' values, as the exit facet's segments see them) into a; its count. */
 static int clip_to_cell(const ref_cell *r, const rtri *T, double *a)
 {
+  /* T wholly beyond one constraint by more than the rounding of the points that clipping by
+   * the others makes (1e-12 of the coordinates, far above it): nothing left, as the clipping
+   * below would find, without it */
+  double big = 1.0;
+  for (int i = 0; i < 9; i++)
+    big = fmax(big, fabs(T->x[i]));
+  const double margin = 1e-12 * big;
+  for (int k = 0; k < r->ncell; k++)
+    if (lin_eval(r->cell + k, T->x) > margin && lin_eval(r->cell + k, T->x + 3) > margin &&
+        lin_eval(r->cell + k, T->x + 6) > margin)
+      return 0;
   double b[3 * POLY_CAP];
   memcpy(a, T->x, sizeof T->x);
   int n = 3;
