@@ -32,8 +32,13 @@ enum { BOUNDARY_PER_MOMENT = 1, GROW = 4, ATTEMPTS = 4, GRID_MAX = 64, PIECE_PER
  * surface) often fail every attempt: on Dick's Bunny 3 row all six below 2e-3 did, at 12 to
  * 22 ms each (the fullest of them filling 1.2e-3; every piece above it fitted, the emptiest
  * 2.1e-3). The volume path gives them exact rules from the piece's tets, at a fraction of a
- * millisecond for such a slab. */
-#define PIECE_MIN_FILL 2e-3
+ * millisecond for such a slab. With the stiffness on the mass space every kind's rule is exact
+ * for its integrand, so which exact rule a piece gets changes its results at round-off only, and
+ * the slabs up to PIECE_MIN_FILL_EXACT take the volume path too: on Dick's row 10 pieces filling
+ * 2.1e-3 to 1e-2 of their box, whose fits took 2 ms each. (With the default strength-2 stiffness
+ * another rule moves the results by its quadrature error.) */
+#define PIECE_MIN_FILL       2e-3
+#define PIECE_MIN_FILL_EXACT 1e-2
 
 static fcm_status ws_surface(fcm_ctx *ctx, fcm__embed_ws *ws)
 {
@@ -592,8 +597,9 @@ fcm_status fcm__embed_surface_cut_piece(const build *B, const fcm__embed_cell *c
   ws->cand_parts = P, ws->cand_piece = piece;
   const double fill =
       o->volume / cell->detA / ((box[3] - box[0]) * (box[4] - box[1]) * (box[5] - box[2]));
-  if (fill < PIECE_MIN_FILL)
-    snprintf(why, sizeof why, "it fills %.3g of its box, below %g", fill, PIECE_MIN_FILL);
+  const double min_fill = B->o->stiffness_on_mass_space ? PIECE_MIN_FILL_EXACT : PIECE_MIN_FILL;
+  if (fill < min_fill)
+    snprintf(why, sizeof why, "it fills %.3g of its box, below %g", fill, min_fill);
   else
     st = fcm__embed_surface_piece_fit(B, cell, ws, box, o->volume, o, &ok, why, sizeof why);
   ws->cand_parts = NULL;
