@@ -759,8 +759,6 @@ cleanup:
   return st;
 }
 
-/* The cell's exit edge as a reference line: from the exit facet's corner (xi_3 = lo) to the
- * cell corner. */
 /* A corner's crossings within this of it (in the edge's parameter, the edge of length 1)
  * leave its winding number to its own line: the corner table neither keeps nor gives it. */
 #define CORNER_GAP 1e-9
@@ -809,6 +807,8 @@ static int corner_near(const fcm__crossings *cr)
   return 0;
 }
 
+/* The cell's exit edge as a reference line: from the exit facet's corner (xi_3 = lo) to the
+ * cell corner. */
 static void exit_line(int tet, double base[3], double dir[3])
 {
   base[0] = tet ? 0.0 : 1.0, base[1] = 1.0, base[2] = 0.0;
