@@ -332,7 +332,7 @@ static double area_in_box(const double *x, int n, const double p[3], double g, c
 }
 
 /* Points tried by prism_near(): the polygon's vertex mean, then its fan triangles'. */
-enum { NEAR_POINTS = 8 };
+enum { NEAR_POINTS = 4 };
 
 /* Where boundary triangles come near the prism (prism_clear() undecided): about a point p of
  * the polygon, the box inscribed in the ball that reaches the nearest boundary triangle (of
@@ -363,13 +363,13 @@ static fcm_status prism_near(fcm_ctx *ctx, fcm__material *m, const double *x, in
     for (int d = 0; d < 3; d++)
       r = fmax(r, fabs(x[3 * i + d] - c[0][d]) + h);
   for (int d = 0; d < 3; d++)
-    lo[d] = c[0][d] - 2.0 * r, hi[d] = c[0][d] + 2.0 * r;
+    lo[d] = c[0][d] - r, hi[d] = c[0][d] + r;
   FCM_TRY(ctx, fcm__geom_tree_query(ctx, m->tree, lo, hi, &m->buf));
   for (int j = 0; j < np; j++) {
     /* the triangles not queried lie farther than the query box's nearest face */
-    double q = 2.0 * r;
+    double q = r;
     for (int d = 0; d < 3; d++)
-      q = fmin(q, 2.0 * r - fabs(c[j][d] - c[0][d]));
+      q = fmin(q, r - fabs(c[j][d] - c[0][d]));
     double dd = q * q; /* the squared distance to the nearest boundary triangle, at most q^2 */
     for (size_t k = 0; k < m->buf.n; k++) {
       const fcm_index *t = G->tris + 3 * m->buf.ids[k];
