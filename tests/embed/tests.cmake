@@ -121,3 +121,9 @@ fcm_add_test(embed_cut_fit tests/embed/cut_fit.c)
 # unsimplified on its tets (1e-12), positive weights, at most 27 points in the cell and on the
 # piece's side; explicit strength 6 gives P_6; rules of P_4 miss the mass matrix (> 1e-8).
 fcm_add_test(embed_q2_mass tests/embed/q2_mass.c)
+# Hex8's cut-cell stiffness rules on the mass rules' space (stiffness_on_mass_space: Q_2), a
+# hollow ball cut by two parallel tilted planes 2e-3 apart (thin slabs on the volume path):
+# every cut piece's stiffness tensor (products of the shape functions' gradients) and mass
+# matrix as a P_6 rule unsimplified on its tets (1e-12), at most 27 positive points in the cell
+# and on the piece's sides, one fit for both kinds; the default P_2 stiffness misses (> 1e-8).
+fcm_add_test(embed_q2_stiffness tests/embed/q2_stiffness.c)

@@ -121,8 +121,17 @@ typedef struct fcm_cell_rules_options {
                               cut-cell mass rules are exact on Q_2, 27 moments instead of P_6's
                               84; stiffness: the strength), with an explicit strength the
                               strength (P_strength). Uncut cells keep the catalogue rule. */
-  int surface_strength;  /**< FCM_DEFAULT (default): no surface rules; else the triangle rule
-                              strength (the explicit request for surface rules) */
+  int stiffness_on_mass_space; /**< 1: the cut cells' stiffness rules are fitted on the mass
+                              rules' moment space (strength and axis_degree of the mass kind,
+                              built or not), which holds the stiffness integrand of every
+                              element (Hex8: Q_2, 27 moments, where the Hex8 stiffness of an
+                              affine cell lies: its cut pieces' stiffness becomes exact), and
+                              one fit serves both kinds, on candidates sized for that space;
+                              more stiffness points per piece (Hex8: up to 27 instead of 10),
+                              which pays where the stiffness is integrated once (corotated
+                              linear). 0 (default): each kind on its own space. */
+  int surface_strength;        /**< FCM_DEFAULT (default): no surface rules; else the triangle rule
+                                    strength (the explicit request for surface rules) */
   double min_fraction;   /**< phi below this: dropped; default 1e-4 (0: drop only empty cells) */
   double uncut_fraction; /**< phi at or above this: uncut; default 1 - 1e-12 */
   double clip_rtol;      /**< vertex-on-plane tolerance / the smaller of the cell diameter and the

@@ -39,8 +39,7 @@ double fcm_cell_rules_point_cost(fcm_element_type type, fcm_rule_kind kind)
 
 /* Finish the pieces list[0 .. n) in parallel (simplify the kinds that pay, stabilize);
  * the error is the lowest failing one's. */
-static fcm_status auto_finish(const build *B, const fcm_cell_rules *R, int nthreads,
-                              piece_out *const *list, fcm_index n,
+static fcm_status auto_finish(const build *B, int nthreads, piece_out *const *list, fcm_index n,
                               const int pays[FCM_RULE_KIND_COUNT], cell_sums *sums)
 {
   fcm_status st = FCM_OK;
@@ -61,7 +60,7 @@ static fcm_status auto_finish(const build *B, const fcm_cell_rules *R, int nthre
       int simp[FCM_RULE_KIND_COUNT];
       for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
         simp[k] = pays[k];
-      fcm_status s = fcm__embed_finish_cell(B, R, list[i], simp, &mine);
+      fcm_status s = fcm__embed_finish_cell(B, list[i], simp, &mine);
       fcm__loop_leave(&loop, &it, s);
     }
 #pragma omp critical(fcm_embed_auto_sum)
@@ -141,7 +140,7 @@ fcm_status fcm__embed_auto_simplify(const build *B, fcm_cell_rules *R, int nthre
     /* A cut added later decides as the rules it extends did: one object, one choice. */
     if (B->prev) pays[k] = B->prev->stats.decision[k].simplified;
   }
-  FCM_TRY(ctx, auto_finish(B, R, nthreads, cut, ncut, pays, sums));
+  FCM_TRY(ctx, auto_finish(B, nthreads, cut, ncut, pays, sums));
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     R->stats.decision[k].simplified = pays[k];
 cleanup:

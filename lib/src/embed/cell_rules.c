@@ -54,7 +54,8 @@ static fcm_status build_rules_x(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_ge
   const fcm_index nc = fcm_mesh_num_cells(mesh);
   memset(&B, 0, sizeof B);
   const double t_start = fcm_wtime();
-  for (fcm_index c = 0; c < nc; c++)
+  /* a cut checks the cells it integrates again (process_cell()): the others keep prev's */
+  for (fcm_index c = 0; c < nc && !prev; c++)
     FCM_TRY(ctx, fcm__embed_check_convex(ctx, mesh, c, o));
 
   /* 1. set-up */

@@ -345,17 +345,16 @@ static int surface_pays(const build *B, size_t candidates)
 
 /* A cut cell on the surface path: its one piece fitted on the surface moments, or, when the
  * fit fails, built by the volume path (FCM_CELL_MOMENTS_AUTO) or refused (SURFACE). */
-static fcm_status surface_rules(const build *B, const fcm_cell_rules *R,
-                                const fcm__embed_cell *cell, fcm__embed_ws *ws, const double box[6],
-                                cell_out *o, cell_sums *sums)
+static fcm_status surface_rules(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
+                                const double box[6], cell_out *o, cell_sums *sums)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
   int ok;
   double vol;
   char why[256] = "";
-  FCM_TRY(ctx, fcm__embed_surface_piece_fit(B, R, cell, ws, box, o->volume, o->pc, &ok, why,
-                                            sizeof why));
+  FCM_TRY(ctx,
+          fcm__embed_surface_piece_fit(B, cell, ws, box, o->volume, o->pc, &ok, why, sizeof why));
   sums->counts.surface_cells++;
   if (ok) goto cleanup;
   sums->counts.surface_fallbacks++;
@@ -372,7 +371,7 @@ static fcm_status surface_rules(const build *B, const fcm_cell_rules *R,
             "embed: background cell %lld: the fit on its surface moments failed and its volume "
             "mesh has no material in it (volume fraction %.3g by the surface)",
             (long long)cell->id, o->volume / cell->volume);
-  FCM_TRY(ctx, fcm__embed_map_piece(B, R, cell, ws, o->pc));
+  FCM_TRY(ctx, fcm__embed_map_piece(B, cell, ws, o->pc));
 cleanup:
   return st;
 }
@@ -402,6 +401,7 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
     sums->time_intersect += fcm_wtime() - t0;
     goto cleanup;
   }
+  if (B->prev) FCM_TRY(ctx, fcm__embed_check_convex(ctx, B->mesh, c, opt));
   int surface = B->surface && cell.affine && !(B->cut_tree && B->region[c]);
   if (surface && opt->moments == FCM_CELL_MOMENTS_AUTO && B->geom->num_cells > 0) {
     /* auto: the surface path where the volume path would start from many points */
@@ -466,19 +466,19 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
     goto cleanup;
   }
   if (cls == FCM_CELL_DROPPED) FCM_TRY(ctx, dropped_area(B, &cell, ws, o));
-  if (cls == FCM_CELL_CUT && surface) FCM_TRY(ctx, surface_rules(B, R, &cell, ws, sbox, o, sums));
+  if (cls == FCM_CELL_CUT && surface) FCM_TRY(ctx, surface_rules(B, &cell, ws, sbox, o, sums));
   if (cls == FCM_CELL_CUT && !surface) {
     for (int i = 0; i < o->np; i++) {
       double v;
       if (P && P->mat) {
         int fell;
-        FCM_TRY(ctx, fcm__embed_surface_cut_piece(B, R, &cell, ws, P, i, o->pc + i, &fell));
+        FCM_TRY(ctx, fcm__embed_surface_cut_piece(B, &cell, ws, P, i, o->pc + i, &fell));
         sums->counts.surface_cells++;
         sums->counts.surface_fallbacks += fell;
         continue;
       }
       if (P) FCM_TRY(ctx, fcm__embed_piece_tets(ctx, P, P->piece, i, ws, NULL, &v));
-      FCM_TRY(ctx, fcm__embed_map_piece(B, R, &cell, ws, o->pc + i));
+      FCM_TRY(ctx, fcm__embed_map_piece(B, &cell, ws, o->pc + i));
     }
   }
   if (B->tri_rule && cls != FCM_CELL_DROPPED) {
@@ -494,7 +494,7 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
     const int on = opt->simplify == FCM_CELL_SIMPLIFY_ON;
     const int simp[FCM_RULE_KIND_COUNT] = {on, on};
     for (int i = 0; i < o->np; i++)
-      FCM_TRY(ctx, fcm__embed_finish_cell(B, R, o->pc + i, simp, sums));
+      FCM_TRY(ctx, fcm__embed_finish_cell(B, o->pc + i, simp, sums));
   }
 cleanup:
   fcm__free(ctx, pvol);

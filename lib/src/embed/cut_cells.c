@@ -61,8 +61,8 @@ static double rule_memory_estimate(const size_t n[FCM_RULE_KIND_COUNT],
 
 /* Refuse a cell whose rule building would take more than opt->max_rule_memory bytes,
  * before anything is allocated for it. */
-static fcm_status check_rule_memory(const build *B, const fcm_cell_rules *R,
-                                    const fcm__embed_cell *cell, const fcm__embed_ws *ws)
+static fcm_status check_rule_memory(const build *B, const fcm__embed_cell *cell,
+                                    const fcm__embed_ws *ws)
 {
   fcm_status st = FCM_OK;
   const double limit = B->o->max_rule_memory;
@@ -77,7 +77,7 @@ static fcm_status check_rule_memory(const build *B, const fcm_cell_rules *R,
               "embed: background cell %lld would get %zu initial %s points (limit 2^30)",
               (long long)cell->id, n[k], k == FCM_RULE_MASS ? "mass" : "stiffness");
   const double need =
-      rule_memory_estimate(n, R->strength, B->o->simplify, B->o->simplify_options.method);
+      rule_memory_estimate(n, B->space_m, B->o->simplify, B->o->simplify_options.method);
   FCM_CHECK(limit <= 0.0 || need <= limit, B->ctx, FCM_ERR_UNSUPPORTED,
             "embed: background cell %lld holds %zu embedded tets (%zu stiffness, %zu mass "
             "points); building its rules needs about %.3g GiB, above the limit of %.3g GiB "
@@ -92,8 +92,8 @@ cleanup:
 
 /* The last step of a cut cell's piece: simplify the kinds with simp[k] set, then append the
  * stabilization points. */
-fcm_status fcm__embed_finish_cell(const build *B, const fcm_cell_rules *R, piece_out *o,
-                                  const int simp[FCM_RULE_KIND_COUNT], cell_sums *sums)
+fcm_status fcm__embed_finish_cell(const build *B, piece_out *o, const int simp[FCM_RULE_KIND_COUNT],
+                                  cell_sums *sums)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
@@ -103,8 +103,8 @@ fcm_status fcm__embed_finish_cell(const build *B, const fcm_cell_rules *R, piece
     if (!B->tet_rule[k]) continue; /* a kind not built */
     if (simp[k] && !o->fitted) {   /* on the kind's moment space */
       fcm_simplify_options so = opt->simplify_options;
-      so.axis_degree = R->axis_degree[k];
-      FCM_TRY(ctx, simplify_rule(ctx, &so, R->strength[k], &o->n[k], o->pts[k], o->w[k], o, k));
+      so.axis_degree = B->space_q[k];
+      FCM_TRY(ctx, simplify_rule(ctx, &so, B->space_m[k], &o->n[k], o->pts[k], o->w[k], o, k));
       o->nsimp[k] = o->n[k];
     }
     if (B->stabilize[k]) {
@@ -122,12 +122,12 @@ cleanup:
 }
 
 /* Map the tets in ws into piece o's initial rules of both kinds. */
-fcm_status fcm__embed_map_piece(const build *B, const fcm_cell_rules *R,
-                                const fcm__embed_cell *cell, fcm__embed_ws *ws, piece_out *o)
+fcm_status fcm__embed_map_piece(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
+                                piece_out *o)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
-  FCM_TRY(ctx, check_rule_memory(B, R, cell, ws));
+  FCM_TRY(ctx, check_rule_memory(B, cell, ws));
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     if (!B->tet_rule[k]) continue; /* a kind not built: no points */
     const size_t n0 = ws->num_tets * (size_t)fcm_rule_num_points(B->tet_rule[k]);

@@ -41,6 +41,8 @@ fcm_status fcm__embed_check_options(fcm_ctx *ctx, const fcm_cell_rules_options *
     FCM_CHECK(o->strength[k] >= -1 && o->strength[k] <= smax, ctx, FCM_ERR_ARG,
               "embed: %s strength = %d outside [0, %d] (-1: element default)",
               k == FCM_RULE_MASS ? "mass" : "stiffness", o->strength[k], smax);
+  FCM_CHECK(o->stiffness_on_mass_space == 0 || o->stiffness_on_mass_space == 1, ctx, FCM_ERR_ARG,
+            "embed: stiffness_on_mass_space = %d must be 0 or 1", o->stiffness_on_mass_space);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     FCM_CHECK(
         o->axis_degree[k] >= -1 && o->axis_degree[k] <= FCM_SIMPLIFY_MAX_STRENGTH, ctx, FCM_ERR_ARG,
@@ -158,9 +160,15 @@ fcm_status fcm__embed_build_setup(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_
   fcm_status st = FCM_OK;
   memset(B, 0, sizeof *B);
   B->ctx = ctx, B->mesh = mesh, B->geom = geom, B->o = o;
+  const fcm_element_info *einfo = fcm_mesh_get_element_info(mesh);
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    B->space_m[k] = R->strength[k], B->space_q[k] = R->axis_degree[k];
+    if (k == FCM_RULE_STIFFNESS && o->stiffness_on_mass_space)
+      kind_space(einfo, o, FCM_RULE_MASS, &B->space_m[k], &B->space_q[k]);
+  }
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     if (!KIND_BUILT(o->kinds, k)) continue; /* tet_rule[k] NULL marks a kind not built */
-    FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TET, R->strength[k], &B->tet_rule[k]));
+    FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TET, B->space_m[k], &B->tet_rule[k]));
     B->full_rule[k] = R->uncut[k];
   }
   B->stabilize[FCM_RULE_STIFFNESS] = o->stabilization.mode == FCM_STABILIZATION_MASS_STIFFNESS;
@@ -187,8 +195,12 @@ fcm_status fcm__embed_build_setup(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_
     int m = 0;
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
       int axis;
-      kind_space(info, o, k, &B->fit_strength[k], &axis);
+      kind_space(info, o, o->stiffness_on_mass_space ? FCM_RULE_MASS : k, &B->fit_strength[k],
+                 &axis);
       B->fit_M[k] = fcm__simplify_num_basis(B->fit_strength[k]);
+      B->grid_M = FCM_MAX(B->grid_M, o->stiffness_on_mass_space
+                                         ? fcm__simplify_space_size(B->fit_strength[k], axis)
+                                         : B->fit_M[k]);
       fcm_rule *t = NULL;
       FCM_TRY(ctx, fcm_rule_create(ctx, FCM_SHAPE_TET, B->fit_strength[k], &t));
       B->fit_tet_points[k] = fcm_rule_num_points(t);

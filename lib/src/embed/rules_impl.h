@@ -70,6 +70,11 @@ typedef struct build {
                                               kind's strength (sizes the candidates and the
                                               path choice, whatever the cap per variable) */
   int fit_tet_points[FCM_RULE_KIND_COUNT]; /* points of the tet rule of that strength */
+  /* The cut cells' moment space of each built kind: R's strength and axis_degree, but the
+   * stiffness's is the mass kind's with o->stiffness_on_mass_space; grid_M: the candidates'
+   * size, the largest total-degree space of the kinds (their rules then do not depend on each
+   * other's cap per variable), or with the shared space its own size. */
+  int space_m[FCM_RULE_KIND_COUNT], space_q[FCM_RULE_KIND_COUNT], grid_M;
   int stabilize[FCM_RULE_KIND_COUNT];
   /* Cutting: the tree of R->cut_tris (NULL without cuts); region[c]: cell c shares a node
    * with a cell the cuts reach (its face polygons are recorded for the links); rebuild[c]:
@@ -137,12 +142,12 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
 /* ---- cut_cells.c: the rules of a cut cell's pieces */
 
 /* Simplify the kinds with simp[k] set, then append the stabilization points. */
-fcm_status fcm__embed_finish_cell(const build *B, const fcm_cell_rules *R, piece_out *o,
-                                  const int simp[FCM_RULE_KIND_COUNT], cell_sums *sums);
+fcm_status fcm__embed_finish_cell(const build *B, piece_out *o, const int simp[FCM_RULE_KIND_COUNT],
+                                  cell_sums *sums);
 
 /* Map the tets in ws into piece o's initial rules of both kinds (after the memory check). */
-fcm_status fcm__embed_map_piece(const build *B, const fcm_cell_rules *R,
-                                const fcm__embed_cell *cell, fcm__embed_ws *ws, piece_out *o);
+fcm_status fcm__embed_map_piece(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
+                                piece_out *o);
 
 /* The surface points in ws into o, mapped to reference coordinates. */
 fcm_status fcm__embed_surface_piece(const build *B, const fcm__embed_cell *cell,
@@ -158,19 +163,18 @@ fcm_status fcm__embed_surface_volume(const build *B, const fcm__embed_cell *cell
 /* After fcm__embed_surface_volume() on the same cell (volume vol, box): piece o's rules of
  * every kind built, fitted on candidates inside the material (o->fitted); *ok = 0 (o left
  * without points, why says what failed) when the candidates cannot carry the moments. */
-fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
-                                        const fcm__embed_cell *cell, fcm__embed_ws *ws,
-                                        const double box[6], double vol, piece_out *o, int *ok,
-                                        char *why, size_t why_len);
+fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm__embed_cell *cell,
+                                        fcm__embed_ws *ws, const double box[6], double vol,
+                                        piece_out *o, int *ok, char *why, size_t why_len);
 
 /* Piece `piece` of a cell of a body without a volume mesh (P->mat, the parts split by the
  * cuts): its rules of every kind built, fitted on points inside the piece to the moments of the
  * body in its parts (o->fitted); where no fit is found (*fell_back = 1), the initial rules of
  * the volume path on its parts split by the boundary (fcm__embed_piece_body_tets()), to be
  * simplified. */
-fcm_status fcm__embed_surface_cut_piece(const build *B, const fcm_cell_rules *R,
-                                        const fcm__embed_cell *cell, fcm__embed_ws *ws,
-                                        fcm__parts *P, int piece, piece_out *o, int *fell_back);
+fcm_status fcm__embed_surface_cut_piece(const build *B, const fcm__embed_cell *cell,
+                                        fcm__embed_ws *ws, fcm__parts *P, int piece, piece_out *o,
+                                        int *fell_back);
 
 /* ---- auto_policy.c */
 

@@ -26,6 +26,20 @@ enum { BOUNDARY_PER_MOMENT = 1, GROW = 4, ATTEMPTS = 4, GRID_MAX = 64, PIECE_PER
  * the moments' own rounding. */
 #define MOMENT_ATOL 1e-14
 
+/* A cut piece filling less of its box than this takes the volume path without a fit: the
+ * finest grid (GRID_MAX^3) puts fewer than 2e-3 x 65^3 = 550 candidates in it, below the last
+ * attempts' targets, and such pieces (thin slanted slabs between a blade and the body's
+ * surface) often fail every attempt: on Dick's Bunny 3 row all six below 2e-3 did, at 12 to
+ * 22 ms each (the fullest of them filling 1.2e-3; every piece above it fitted, the emptiest
+ * 2.1e-3). The volume path gives them exact rules from the piece's tets, at a fraction of a
+ * millisecond for such a slab. With the stiffness on the mass space every kind's rule is exact
+ * for its integrand, so which exact rule a piece gets changes its results at round-off only, and
+ * the slabs up to PIECE_MIN_FILL_EXACT take the volume path too: on Dick's row 10 pieces filling
+ * 2.1e-3 to 1e-2 of their box, whose fits took 2 ms each. (With the default strength-2 stiffness
+ * another rule moves the results by its quadrature error.) */
+#define PIECE_MIN_FILL       2e-3
+#define PIECE_MIN_FILL_EXACT 1e-2
+
 static fcm_status ws_surface(fcm_ctx *ctx, fcm__embed_ws *ws)
 {
   fcm_status st = FCM_OK;
@@ -291,10 +305,9 @@ static void fit_box(const double box[6], int m, int q, fcm__cheb_box *cb)
  * the moments. P: the candidates' basis in top's space, which holds kind k's (top->num_basis
  * rows, ld the same), of which the fit takes the rows of its own basis
  * (fcm__simplify_basis_rows(): the values do not depend on the space, bit for bit). */
-static fcm_status fit_kind(const build *B, const fcm_cell_rules *R, const fcm__embed_ws *ws,
-                           const double box[6], int count, int k, const double *P,
-                           const fcm__cheb_box *top, piece_out *o, int *ok, char *why,
-                           size_t why_len)
+static fcm_status fit_kind(const build *B, const fcm__embed_ws *ws, const double box[6], int count,
+                           int k, const double *P, const fcm__cheb_box *top, piece_out *o, int *ok,
+                           char *why, size_t why_len)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
@@ -303,7 +316,7 @@ static fcm_status fit_kind(const build *B, const fcm_cell_rules *R, const fcm__e
   double *mom = NULL, *work = NULL, *Pk = NULL;
   int *rows = NULL;
   memset(&f, 0, sizeof f);
-  fit_box(box, R->strength[k], R->axis_degree[k], &cb);
+  fit_box(box, B->space_m[k], B->space_q[k], &cb);
   const int M = cb.num_basis, Ptop = top->num_basis;
   const size_t ns = B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0;
   FCM_ALLOC(ctx, (size_t)M, mom);
@@ -380,26 +393,25 @@ cleanup:
   return st;
 }
 
-fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
-                                        const fcm__embed_cell *cell, fcm__embed_ws *ws,
-                                        const double mbox[6], double vol, piece_out *o, int *ok,
-                                        char *why, size_t why_len)
+fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm__embed_cell *cell,
+                                        fcm__embed_ws *ws, const double mbox[6], double vol,
+                                        piece_out *o, int *ok, char *why, size_t why_len)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
   double box[6], *P = NULL, *work = NULL;
-  int Mmax = 1, mmax = 0;
+  int mmax = 0;
   memcpy(box, mbox, sizeof box);
   *ok = 0;
   for (int d = 0; d < 3; d++)
     if (!(box[d] < box[3 + d])) goto cleanup; /* flat material: leave it to the volume path */
   /* built or not, as the moments' degree; the candidates follow the size of the total-degree
-   * space whatever a kind's cap per variable: a smaller grid for a tensor space would change the
-   * other kind's rules fitted on the same candidates */
-  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+   * space whatever a kind's cap per variable (a smaller grid for a tensor space would change the
+   * other kind's rules fitted on the same candidates), or with the stiffness on the mass space
+   * (one space for both kinds) that space's own size (B->grid_M) */
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     mmax = FCM_MAX(mmax, B->fit_strength[k]);
-    Mmax = FCM_MAX(Mmax, B->fit_M[k]);
-  }
+  const int Mmax = FCM_MAX(1, B->grid_M);
   const double vref = vol / cell->detA;
   int todo[FCM_RULE_KIND_COUNT], left = 0;
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
@@ -427,7 +439,7 @@ fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
      * and per-variable degree left, which holds every kind's */
     int mtop = 0, qtop = 0;
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
-      if (todo[k]) mtop = FCM_MAX(mtop, R->strength[k]), qtop = FCM_MAX(qtop, R->axis_degree[k]);
+      if (todo[k]) mtop = FCM_MAX(mtop, B->space_m[k]), qtop = FCM_MAX(qtop, B->space_q[k]);
     fcm__cheb_box cb;
     fit_box(box, mtop, qtop, &cb);
     fcm__free(ctx, P);
@@ -444,13 +456,12 @@ fcm_status fcm__embed_surface_piece_fit(const build *B, const fcm_cell_rules *R,
       if (!todo[k]) continue;
       int done, same = -1;
       for (int j = 0; j < k; j++)
-        if (fitted[j] && R->strength[j] == R->strength[k] && R->axis_degree[j] == R->axis_degree[k])
-          same = j;
+        if (fitted[j] && B->space_m[j] == B->space_m[k] && B->space_q[j] == B->space_q[k]) same = j;
       if (same >= 0) {
         FCM_TRY(ctx, copy_kind(B, same, k, o));
         done = 1;
       } else {
-        FCM_TRY(ctx, fit_kind(B, R, ws, box, count, k, P, &cb, o, &done, why, why_len));
+        FCM_TRY(ctx, fit_kind(B, ws, box, count, k, P, &cb, o, &done, why, why_len));
       }
       if (done) todo[k] = 0, left--, fitted[k] = 1;
     }
@@ -525,9 +536,9 @@ cleanup:
   return st;
 }
 
-fcm_status fcm__embed_surface_cut_piece(const build *B, const fcm_cell_rules *R,
-                                        const fcm__embed_cell *cell, fcm__embed_ws *ws,
-                                        fcm__parts *P, int piece, piece_out *o, int *fell_back)
+fcm_status fcm__embed_surface_cut_piece(const build *B, const fcm__embed_cell *cell,
+                                        fcm__embed_ws *ws, fcm__parts *P, int piece, piece_out *o,
+                                        int *fell_back)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
@@ -584,7 +595,13 @@ fcm_status fcm__embed_surface_cut_piece(const build *B, const fcm_cell_rules *R,
   for (int d = 0; d < 3 && touched; d++) /* the material's own box where the surface bounds it */
     box[d] = fmax(box[d], mbox[d]), box[3 + d] = fmin(box[3 + d], mbox[3 + d]);
   ws->cand_parts = P, ws->cand_piece = piece;
-  st = fcm__embed_surface_piece_fit(B, R, cell, ws, box, o->volume, o, &ok, why, sizeof why);
+  const double fill =
+      o->volume / cell->detA / ((box[3] - box[0]) * (box[4] - box[1]) * (box[5] - box[2]));
+  const double min_fill = B->o->stiffness_on_mass_space ? PIECE_MIN_FILL_EXACT : PIECE_MIN_FILL;
+  if (fill < min_fill)
+    snprintf(why, sizeof why, "it fills %.3g of its box, below %g", fill, min_fill);
+  else
+    st = fcm__embed_surface_piece_fit(B, cell, ws, box, o->volume, o, &ok, why, sizeof why);
   ws->cand_parts = NULL;
   FCM_TRY(ctx, st);
   if (!ok) { /* a thin or small piece: its parts split by the boundary triangles, the volume path */
@@ -594,7 +611,7 @@ fcm_status fcm__embed_surface_cut_piece(const build *B, const fcm_cell_rules *R,
               "carries its surface moments (volume %.3g; %s), and splitting it by the boundary "
               "triangles leaves no material",
               (long long)cell->id, piece, o->volume, why);
-    FCM_TRY(ctx, fcm__embed_map_piece(B, R, cell, ws, o));
+    FCM_TRY(ctx, fcm__embed_map_piece(B, cell, ws, o));
     *fell_back = 1;
   }
 cleanup:

@@ -290,6 +290,17 @@ static void grow_box(double box[6], const double x[3])
  * its own vertices' values, as the exit facet's segments see them) into a; its count. */
 static int clip_to_cell(const ref_cell *r, const rtri *T, double *a)
 {
+  /* T wholly beyond one constraint by more than the rounding of the points that clipping by
+   * the others makes (1e-12 of the coordinates, far above it): nothing left, as the clipping
+   * below would find, without it */
+  double big = 1.0;
+  for (int i = 0; i < 9; i++)
+    big = fmax(big, fabs(T->x[i]));
+  const double margin = 1e-12 * big;
+  for (int k = 0; k < r->ncell; k++)
+    if (lin_eval(r->cell + k, T->x) > margin && lin_eval(r->cell + k, T->x + 3) > margin &&
+        lin_eval(r->cell + k, T->x + 6) > margin)
+      return 0;
   double b[3 * POLY_CAP];
   memcpy(a, T->x, sizeof T->x);
   int n = 3;
@@ -480,6 +491,7 @@ void fcm__crossings_free(fcm_ctx *ctx, fcm__crossings *c)
   c->z = NULL, c->sign = NULL;
   c->n = c->cap = 0;
   c->tree = NULL;
+  c->corner_tree = NULL;
   c->nclear = c->next = 0;
   c->tries = c->found = c->skipped = 0;
 }
@@ -794,23 +806,29 @@ static fcm_status moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aab
   /* level 1: the exit edge, from the exit facet's corner (xi_3 = lo) to the cell corner */
   double lbase[3], dir[3], p0[3], p1[3], pad, P[3];
   const fcm__clear_box *cb = NULL;
-  int sum;
+  int sum, known = 0, kw = 0;
   exit_line(tet, lbase, dir);
   line_segment(g, cell, lbase, dir, p0, p1, &pad);
   if (boxes) {
     to_physical(cell, lbase[0] + dir[0], lbase[1] + dir[1], lbase[2] + dir[2], P);
     cb = clear_box_find(cr, tree, P, pad);
+    known = !cb && fcm__embed_corner_find(cr, tree, P, &kw);
   }
-  int up = 1;
+  int up = 1, edge = cb || known;
   const int half = closed_tree(g, tree);
-  if (cb) /* the crossings inside the edge only */
-    to_physical(cell, lbase[0] + r.lo * dir[0], lbase[1] + r.lo * dir[1], lbase[2] + r.lo * dir[2],
-                p0);
-  else if (half) /* the edge and the shorter half of the line beyond it */
-    up = line_half(g, cell, lbase, dir, r.lo, 1.0, pad, p0, p1);
-  FCM_TRY(ctx, fcm__geom_tree_segment(ctx, tree, p0, cb ? P : p1, pad, buf));
-  FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &r.exit1, &r.exit2, cr, &sum));
-  FCM_CHECK(cb || half || sum == 0, ctx, FCM_ERR_GEOMETRY,
+  for (int pass = 0;; pass++) {
+    if (pass) line_segment(g, cell, lbase, dir, p0, p1, &pad);
+    if (edge) /* the crossings inside the edge only */
+      to_physical(cell, lbase[0] + r.lo * dir[0], lbase[1] + r.lo * dir[1],
+                  lbase[2] + r.lo * dir[2], p0);
+    else if (half) /* the edge and the shorter half of the line beyond it */
+      up = line_half(g, cell, lbase, dir, r.lo, 1.0, pad, p0, p1);
+    FCM_TRY(ctx, fcm__geom_tree_segment(ctx, tree, p0, edge ? P : p1, pad, buf));
+    FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &r.exit1, &r.exit2, cr, &sum));
+    if (!known || !fcm__embed_corner_near(cr)) break;
+    known = edge = 0; /* a crossing at the corner: its own line decides */
+  }
+  FCM_CHECK(edge || half || sum == 0, ctx, FCM_ERR_GEOMETRY,
             "embed: background cell %lld: its edge line crosses the body's boundary %d more "
             "times outward than inward (the boundary surface is not closed)",
             (long long)cell->id, sum);
@@ -821,9 +839,11 @@ static fcm_status moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aab
       ++*inner;
     }
   }
-  *corner = cb ? orient * cb->winding : line_winding(cr, up, 1.0);
+  *corner = cb ? orient * cb->winding : known ? orient * kw : line_winding(cr, up, 1.0);
   if (*corner) FCM_TRY(ctx, add_edge(ctx, q, &r, 1.0, *corner, s));
-  if (boxes && !cb)
+  if (boxes && !edge && !fcm__embed_corner_near(cr))
+    fcm__embed_corner_keep(cr, tree, P, orient * *corner);
+  if (boxes && !edge)
     FCM_TRY(ctx, clear_box_add(ctx, tree, P, CLEAR_BOX_RSIZE * cell->size, 2.0 * pad,
                                orient * *corner, buf, cr));
 cleanup:

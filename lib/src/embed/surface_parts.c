@@ -247,6 +247,156 @@ cleanup:
   return st;
 }
 
+/* The polygon (n vertices x 3, in place, room for n + 6) clipped to the box lo..hi; its count. */
+static int polygon_in_box(double *x, int n, const double lo[3], const double hi[3])
+{
+  double y[3 * (FCM__POLY_MAX_VERTS + 6)];
+  for (int f = 0; f < 6 && n > 0; f++) {
+    const int d = f % 3;
+    const double s = f < 3 ? 1.0 : -1.0, b = f < 3 ? hi[d] : -lo[d]; /* keep s x_d <= b */
+    int k = 0;
+    for (int i = 0; i < n; i++) {
+      const double *p = x + 3 * i, *q = x + 3 * ((i + 1) % n);
+      const double vp = s * p[d] - b, vq = s * q[d] - b;
+      if (vp <= 0.0) memcpy(y + 3 * k++, p, 3 * sizeof *p);
+      if ((vp <= 0.0) != (vq <= 0.0)) {
+        const double t = vp / (vp - vq);
+        for (int e = 0; e < 3; e++)
+          y[3 * k + e] = p[e] + t * (q[e] - p[e]);
+        k++;
+      }
+    }
+    memcpy(x, y, 3 * (size_t)k * sizeof *x);
+    n = k;
+  }
+  return n;
+}
+
+/* The squared distance from p to the triangle (a, b, c) (Ericson, Real-Time Collision
+ * Detection, 5.1.5: the closest point by the Voronoi regions of the vertices and edges). */
+static double tri_dist2(const double p[3], const double a[3], const double b[3], const double c[3])
+{
+  double ab[3], ac[3], ap[3], bp[3], cp[3], q[3];
+  for (int d = 0; d < 3; d++)
+    ab[d] = b[d] - a[d], ac[d] = c[d] - a[d], ap[d] = p[d] - a[d], bp[d] = p[d] - b[d],
+    cp[d] = p[d] - c[d];
+  const double d1 = fcm__vec3_dot(ab, ap), d2 = fcm__vec3_dot(ac, ap);
+  const double d3 = fcm__vec3_dot(ab, bp), d4 = fcm__vec3_dot(ac, bp);
+  const double d5 = fcm__vec3_dot(ab, cp), d6 = fcm__vec3_dot(ac, cp);
+  const double vc = d1 * d4 - d3 * d2, vb = d5 * d2 - d1 * d6, va = d3 * d6 - d5 * d4;
+  double u = 0.0, v = 0.0; /* q = a + u ab + v ac */
+  if (d1 <= 0.0 && d2 <= 0.0)
+    u = v = 0.0;
+  else if (d3 >= 0.0 && d4 <= d3)
+    u = 1.0, v = 0.0;
+  else if (d6 >= 0.0 && d5 <= d6)
+    u = 0.0, v = 1.0;
+  else if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0)
+    u = d1 / (d1 - d3), v = 0.0;
+  else if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0)
+    u = 0.0, v = d2 / (d2 - d6);
+  else if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6)); /* on edge bc */
+    u = 1.0 - w, v = w;
+  } else {
+    const double den = 1.0 / (va + vb + vc);
+    u = vb * den, v = vc * den;
+  }
+  for (int d = 0; d < 3; d++)
+    q[d] = a[d] + u * ab[d] + v * ac[d] - p[d];
+  return fcm__vec3_dot(q, q);
+}
+
+/* The area of the polygon x (n vertices) whose prism (half-height h along the unit normal nrm)
+ * lies in the box of half-width g about p; y: scratch of n + 6 vertices. */
+static double area_in_box(const double *x, int n, const double p[3], double g, const double nrm[3],
+                          double h, double *y)
+{
+  double lo[3], hi[3], a[3] = {0.0, 0.0, 0.0};
+  for (int d = 0; d < 3; d++) {
+    const double w = g - h * fabs(nrm[d]);
+    if (!(w > 0.0)) return 0.0;
+    lo[d] = p[d] - w, hi[d] = p[d] + w;
+  }
+  memcpy(y, x, 3 * (size_t)n * sizeof *x);
+  const int k = polygon_in_box(y, n, lo, hi);
+  for (int i = 1; i + 1 < k; i++) {
+    double e1[3], e2[3], t[3];
+    for (int d = 0; d < 3; d++)
+      e1[d] = y[3 * i + d] - y[d], e2[d] = y[3 * (i + 1) + d] - y[d];
+    fcm__vec3_cross(e1, e2, t);
+    for (int d = 0; d < 3; d++)
+      a[d] += 0.5 * t[d];
+  }
+  return fcm__vec3_norm(a);
+}
+
+/* Points tried by prism_near(): the polygon's vertex mean, then its fan triangles'. */
+enum { NEAR_POINTS = 4 };
+
+/* Where boundary triangles come near the prism (prism_clear() undecided): about a point p of
+ * the polygon, the box inscribed in the ball that reaches the nearest boundary triangle (of
+ * those whose boxes meet a box about the polygon; those beyond it are farther than its faces)
+ * holds no boundary, so when the body holds p it fills the box, and the prism over the polygon's
+ * part whose prism stays in the box is material. Where that part's area is above twice atol the
+ * moments would find the overlap covered (their rounding is far below the factor two): *sure = 1.
+ * Tried at NEAR_POINTS points; else *sure = 0 (the moments decide). x: the polygon (n vertices),
+ * nrm its unit normal, h the prism's half-height. */
+static fcm_status prism_near(fcm_ctx *ctx, fcm__material *m, const double *x, int n,
+                             const double nrm[3], double h, double atol, fcm_index id, int *sure)
+{
+  fcm_status st = FCM_OK;
+  double c[NEAR_POINTS][3], g[NEAR_POINTS], r = 0.0, lo[3], hi[3];
+  double y[3 * (FCM__POLY_MAX_VERTS + 6)];
+  const fcm_geometry *G = m->geom;
+  *sure = 0;
+  if (n > FCM__POLY_MAX_VERTS) return FCM_OK;
+  const int np = FCM_MIN(NEAR_POINTS, n - 1);
+  memset(c, 0, sizeof c);
+  for (int i = 0; i < n; i++)
+    for (int d = 0; d < 3; d++)
+      c[0][d] += x[3 * i + d] / n;
+  for (int j = 1; j < np; j++)
+    for (int d = 0; d < 3; d++)
+      c[j][d] = (x[d] + x[3 * j + d] + x[3 * (j + 1) + d]) / 3.0;
+  for (int i = 0; i < n; i++)
+    for (int d = 0; d < 3; d++)
+      r = fmax(r, fabs(x[3 * i + d] - c[0][d]) + h);
+  for (int d = 0; d < 3; d++)
+    lo[d] = c[0][d] - r, hi[d] = c[0][d] + r;
+  FCM_TRY(ctx, fcm__geom_tree_query(ctx, m->tree, lo, hi, &m->buf));
+  for (int j = 0; j < np; j++) {
+    /* the triangles not queried lie farther than the query box's nearest face */
+    double q = r;
+    for (int d = 0; d < 3; d++)
+      q = fmin(q, r - fabs(c[j][d] - c[0][d]));
+    double dd = q * q; /* the squared distance to the nearest boundary triangle, at most q^2 */
+    for (size_t k = 0; k < m->buf.n; k++) {
+      const fcm_index *t = G->tris + 3 * m->buf.ids[k];
+      dd = fmin(dd,
+                tri_dist2(c[j], G->coords + 3 * t[0], G->coords + 3 * t[1], G->coords + 3 * t[2]));
+    }
+    /* the box inscribed in the ball of that radius, its rounding (1e-9 of it) left out */
+    g[j] = (1.0 - 1e-9) * sqrt(dd / 3.0);
+  }
+  for (int j = 0; j < np && !*sure; j++) {
+    if (!(g[j] > 0.0) || !(area_in_box(x, n, c[j], g[j], nrm, h, y) > 2.0 * atol)) continue;
+    double T[12]; /* the body's winding number at c[j]: a small tet with its corner there */
+    for (int v = 0; v < 4; v++)
+      for (int d = 0; d < 3; d++)
+        T[3 * v + d] = c[j][d] + (v == d + 1 ? 0.5 * g[j] : 0.0);
+    fcm__embed_cell kc;
+    tet_cell(T, id, &kc);
+    const double z = 0.0;
+    int in = 0;
+    FCM_TRY(ctx, fcm__embed_inside_line(ctx, m->geom, m->tree, &kc, 0.0, 0.0, 1, &z, &in, &m->buf,
+                                        &m->cr));
+    *sure = in != 0;
+  }
+cleanup:
+  return st;
+}
+
 int fcm__material_on_face(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
                           const double *x, int n, const double nrm[3], double h, double atol)
 {
@@ -272,6 +422,7 @@ int fcm__material_on_face(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell 
   }
   int sure = 0;
   FCM_TRY(ctx, prism_clear(ctx, m, m->tets, 3 * (n - 2), h, atol, cell->id, &sure));
+  if (!sure && m->buf.n > 0) FCM_TRY(ctx, prism_near(ctx, m, x, n, nrm, h, atol, cell->id, &sure));
   if (sure) return sure > 0;
   FCM_TRY(ctx, tets_material(ctx, m, m->tets, m->vol, 3 * (n - 2), &m->q0, cell, NULL, &v));
 cleanup:

@@ -21,9 +21,16 @@ static const fcm_element_type multigrid_elements[] = {FCM_ELEMENT_HEX8, FCM_ELEM
 fcm_status fcm__scene_read_quadrature(fcm__scene_parser *p, const fcm__json *root)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {
-      "stiffness_strength", "mass_strength", "surface_strength",    "simplify", "simplify_method",
-      "stabilization",      "min_fraction",  "max_rule_memory_gib", "moments"};
+  static const char *const keys[] = {"stiffness_strength",
+                                     "mass_strength",
+                                     "surface_strength",
+                                     "simplify",
+                                     "simplify_method",
+                                     "stabilization",
+                                     "min_fraction",
+                                     "max_rule_memory_gib",
+                                     "moments",
+                                     "stiffness_on_mass_space"};
   static const char *const skeys[] = {"mode", "alpha"};
   fcm_cell_rules_options *q = &p->scene->quadrature.rules;
   const fcm__json *o = NULL, *stab = NULL;
@@ -38,6 +45,8 @@ fcm_status fcm__scene_read_quadrature(fcm__scene_parser *p, const fcm__json *roo
   SCENE_READ_INT(p, o, "stiffness_strength", 0, 0, 20, q->strength[FCM_RULE_STIFFNESS]);
   SCENE_READ_INT(p, o, "mass_strength", 0, 0, 20, q->strength[FCM_RULE_MASS]);
   SCENE_READ_INT(p, o, "surface_strength", 0, 0, 20, q->surface_strength);
+  FCM_TRY(p->ctx,
+          fcm__scene_read_bool(p, o, "stiffness_on_mass_space", 0, &q->stiffness_on_mass_space));
   {
     int simplify = (int)q->simplify;
     FCM_TRY(p->ctx, fcm__scene_read_bool_or_word(p, o, "simplify", 0, "auto",
