@@ -848,7 +848,8 @@ FCM_API fcm_status fcm_integrator_prepare_solver(fcm_integrator *integ);
  * Jacobi/Schwarz preconditioner and the UMFPACK fallback are made the first time they are
  * needed; the multigrid hierarchy then (unless fcm_integrator_prepare_solver() built it for
  * the same active set) and again whenever the active constrained DOFs change. Later steps
- * allocate nothing through the context (test sim_step_alloc_*); CHOLMOD's and UMFPACK's numeric factorizations allocate internally (SuiteSparse's malloc).
+ * allocate nothing through the context (test sim_step_alloc_*); CHOLMOD's and UMFPACK's
+ * numeric factorizations allocate internally (SuiteSparse's malloc).
  * STATIC: before the first solve, and again whenever the active set of constraints changes
  * (a release), the active constraints must hold the six rigid-body modes of every body of the
  * space (fcm_space_num_bodies(): cuts separate bodies); a body is held by its constrained
