@@ -970,8 +970,8 @@ FCM_API const fcm_csr *fcm_integrator_mass(const fcm_integrator *integ);
 /** The multigrid hierarchy of FCM_PRECOND_MULTIGRID or FCM_LINEAR_MULTIGRID (borrowed; for
  * fcm_mg_num_levels() and fcm_mg_get_level_info()): NULL before the first preconditioner
  * setup or solve and without multigrid; after fcm_integrator_prepare_solver() the structure
- * whose values the next step sets up (no cycle before that). Valid until the next fcm_integrator_step() (which may
- * build it again) or the integrator's destruction. */
+ * whose values the next step sets up (no cycle before that). Valid until the next
+ * fcm_integrator_step() (which may build it again) or the integrator's destruction. */
 FCM_API const fcm_mg *fcm_integrator_multigrid(const fcm_integrator *integ);
 
 /** What fcm_integrator_setup() assembled (all 0 before the setup). */
