@@ -258,12 +258,12 @@ FCM_API fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index 
  * reflection and clamping, S_K = V diag(s) V^T; a block that is positive definite with
  * eps ||C_K||_F ||C_K^{-1}||_F <= 1e-3 (no eigenvalue near the clamp) is C_K^{-1} through its
  * Cholesky factor instead, the same matrix to rounding of order cond(C_K) times the unit
- * round-off. Parallel over blocks (OpenMP, at most the
- * thread count of the creation); each block is computed by one thread, so the result does
- * not depend on the thread count.
+ * round-off. Parallel over blocks (OpenMP, at most the thread count of the creation); each
+ * block is computed by one thread, so the result does not depend on the thread count.
  * @return FCM_OK, FCM_ERR_ARG (size mismatch), FCM_ERR_SINGULAR (a zero block or a zero
  * diagonal outside the blocks: named), FCM_ERR_NUMERIC (NaN/Inf in a block's lower triangle,
- * the part either inverse reads, or on the diagonal: named), FCM_ERR_LAPACK. No allocation (scratch from fcm_schwarz_create()). */
+ * the part either inverse reads, or on the diagonal: named), FCM_ERR_LAPACK. No allocation
+ * (scratch from fcm_schwarz_create()). */
 FCM_API fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C);
 
 /** z = S r (n entries each, must not overlap). No allocation. One parallel loop over the
