@@ -10,8 +10,9 @@
  * (fcm__ptap, la), pattern once, values again in fcm_mg_setup(); CHOLMOD solves the coarsest
  * level. Smoothers (smoothers.c, their sweeps in sweeps.c): SGS in slab order (default), SGS
  * in multicolour order and damped Jacobi, plus block Gauss-Seidel (block_smoothing); the cycle
- * (cycle.c): V- or W-cycle as a solver and as a symmetric CG preconditioner. Every part is deterministic for any
- * thread count. Convergence and thread measurements: lib/docs/multigrid_threads.md. */
+ * (cycle.c): V- or W-cycle as a solver and as a symmetric CG preconditioner. Every part is
+ * deterministic for any thread count. Convergence and thread measurements:
+ * lib/docs/multigrid_threads.md. */
 #include "mg/levels_impl.h"
 
 #include <math.h>
