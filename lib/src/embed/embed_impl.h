@@ -576,9 +576,6 @@ void fcm__srule_free(fcm_ctx *ctx, fcm__srule *s);
  * number about them (1 inside): fcm__embed_inside_line() answers a point in one without a line
  * query of its own. */
 enum { FCM__CLEAR_BOXES = 8, FCM__CORNERS = 256 };
-/* A corner's crossings within this of it (in the edge's parameter, the edge of length 1)
- * leave its winding number to its own line: the corner table neither keeps nor gives it. */
-#define FCM__CORNER_GAP 1e-9
 typedef struct fcm__clear_box {
   double lo[3], hi[3], pad;
   int winding;
@@ -615,19 +612,6 @@ typedef struct fcm__crossings {
 } fcm__crossings;
 
 void fcm__crossings_free(fcm_ctx *ctx, fcm__crossings *c);
-
-/* The winding number kept in cr for the point x (bit for bit) with triangles tree: 1 and *w,
- * or 0 (surface_corners.c). */
-int fcm__embed_corner_find(const fcm__crossings *cr, const fcm_aabb_tree *tree, const double x[3],
-                           int *w);
-
-/* Keep winding number w for the point x (replacing the entry of its slot). */
-void fcm__embed_corner_keep(fcm__crossings *cr, const fcm_aabb_tree *tree, const double x[3],
-                            int w);
-
-/* Whether a crossing in cr (a cell's exit edge line, its corner at z = 1) lies within
- * FCM__CORNER_GAP of the corner: its winding number is then left to its own line. */
-int fcm__embed_corner_near(const fcm__crossings *cr);
 
 /* *touched: some boundary triangle of g (tree: their boxes) has a part inside the affine
  * `cell`; then box (lo[3], hi[3], reference coordinates) bounds the material in the cell: those
