@@ -575,7 +575,7 @@ void fcm__srule_free(fcm_ctx *ctx, fcm__srule *s);
 /* Boxes (physical) that no boundary triangle comes within `pad` of, and the body's winding
  * number about them (1 inside): fcm__embed_inside_line() answers a point in one without a line
  * query of its own. */
-enum { FCM__CLEAR_BOXES = 8, FCM__CORNERS = 256 };
+enum { FCM__CLEAR_BOXES = 8 };
 typedef struct fcm__clear_box {
   double lo[3], hi[3], pad;
   int winding;
@@ -602,13 +602,6 @@ typedef struct fcm__crossings {
   size_t col_n, col_cap;
   double *col_x;
   fcm_index *col_v;
-  /* the winding numbers of recent cell corners (fcm__embed_moment_rule_kept()) that no
-   * crossing of their edge line came near, for boundary triangles corner_tree: a table by the
-   * corner's bits (corner_used[i]: entry i holds corner_x[i]) */
-  const fcm_aabb_tree *corner_tree;
-  double corner_x[FCM__CORNERS][3];
-  int corner_w[FCM__CORNERS];
-  unsigned char corner_used[FCM__CORNERS];
 } fcm__crossings;
 
 void fcm__crossings_free(fcm_ctx *ctx, fcm__crossings *c);

@@ -34,7 +34,6 @@
 
 #include <float.h>
 #include <math.h>
-#include <stdint.h>
 #include <string.h>
 
 /* An affine function s(xi) = c0 + c . xi of reference coordinates; "above" when s >= 0. */
@@ -492,7 +491,6 @@ void fcm__crossings_free(fcm_ctx *ctx, fcm__crossings *c)
   c->z = NULL, c->sign = NULL;
   c->n = c->cap = 0;
   c->tree = NULL;
-  c->corner_tree = NULL;
   c->nclear = c->next = 0;
   c->tries = c->found = c->skipped = 0;
 }
@@ -759,54 +757,6 @@ cleanup:
   return st;
 }
 
-/* A corner's crossings within this of it (in the edge's parameter, the edge of length 1)
- * leave its winding number to its own line: the corner table neither keeps nor gives it. */
-#define CORNER_GAP 1e-9
-
-/* The corner table's entry for x (its bits hashed). */
-static size_t corner_slot(const double x[3])
-{
-  uint64_t h = 1469598103934665603u;
-  for (int d = 0; d < 3; d++) {
-    uint64_t b;
-    memcpy(&b, x + d, sizeof b);
-    h = (h ^ b) * 1099511628211u;
-    h ^= h >> 29;
-  }
-  return (size_t)(h % FCM__CORNERS);
-}
-
-/* The winding number kept for the point x (bit for bit) with triangles tree: 1 and *w, or 0. */
-static int corner_find(const fcm__crossings *cr, const fcm_aabb_tree *tree, const double x[3],
-                       int *w)
-{
-  const size_t i = corner_slot(x);
-  if (cr->corner_tree != tree || !cr->corner_used[i] || memcmp(cr->corner_x[i], x, 3 * sizeof *x))
-    return 0;
-  *w = cr->corner_w[i];
-  return 1;
-}
-
-static void corner_keep(fcm__crossings *cr, const fcm_aabb_tree *tree, const double x[3], int w)
-{
-  if (cr->corner_tree != tree) {
-    memset(cr->corner_used, 0, sizeof cr->corner_used);
-    cr->corner_tree = tree;
-  }
-  const size_t i = corner_slot(x);
-  memcpy(cr->corner_x[i], x, 3 * sizeof *x);
-  cr->corner_w[i] = w;
-  cr->corner_used[i] = 1;
-}
-
-/* Whether a crossing in cr lies within CORNER_GAP of the corner (z = 1). */
-static int corner_near(const fcm__crossings *cr)
-{
-  for (size_t k = 0; k < cr->n; k++)
-    if (fabs(cr->z[k] - 1.0) <= CORNER_GAP) return 1;
-  return 0;
-}
-
 /* The cell's exit edge as a reference line: from the exit facet's corner (xi_3 = lo) to the
  * cell corner. */
 static void exit_line(int tet, double base[3], double dir[3])
@@ -855,29 +805,23 @@ static fcm_status moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aab
   /* level 1: the exit edge, from the exit facet's corner (xi_3 = lo) to the cell corner */
   double lbase[3], dir[3], p0[3], p1[3], pad, P[3];
   const fcm__clear_box *cb = NULL;
-  int sum, known = 0, kw = 0;
+  int sum;
   exit_line(tet, lbase, dir);
   line_segment(g, cell, lbase, dir, p0, p1, &pad);
   if (boxes) {
     to_physical(cell, lbase[0] + dir[0], lbase[1] + dir[1], lbase[2] + dir[2], P);
     cb = clear_box_find(cr, tree, P, pad);
-    known = !cb && corner_find(cr, tree, P, &kw);
   }
-  int up = 1, edge = cb || known;
+  int up = 1;
   const int half = closed_tree(g, tree);
-  for (int pass = 0;; pass++) {
-    if (pass) line_segment(g, cell, lbase, dir, p0, p1, &pad);
-    if (edge) /* the crossings inside the edge only */
-      to_physical(cell, lbase[0] + r.lo * dir[0], lbase[1] + r.lo * dir[1],
-                  lbase[2] + r.lo * dir[2], p0);
-    else if (half) /* the edge and the shorter half of the line beyond it */
-      up = line_half(g, cell, lbase, dir, r.lo, 1.0, pad, p0, p1);
-    FCM_TRY(ctx, fcm__geom_tree_segment(ctx, tree, p0, edge ? P : p1, pad, buf));
-    FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &r.exit1, &r.exit2, cr, &sum));
-    if (!known || !corner_near(cr)) break;
-    known = edge = 0; /* a crossing at the corner: its own line decides */
-  }
-  FCM_CHECK(edge || half || sum == 0, ctx, FCM_ERR_GEOMETRY,
+  if (cb) /* the crossings inside the edge only */
+    to_physical(cell, lbase[0] + r.lo * dir[0], lbase[1] + r.lo * dir[1], lbase[2] + r.lo * dir[2],
+                p0);
+  else if (half) /* the edge and the shorter half of the line beyond it */
+    up = line_half(g, cell, lbase, dir, r.lo, 1.0, pad, p0, p1);
+  FCM_TRY(ctx, fcm__geom_tree_segment(ctx, tree, p0, cb ? P : p1, pad, buf));
+  FCM_TRY(ctx, line_crossings(ctx, g, cell, buf, &r.exit1, &r.exit2, cr, &sum));
+  FCM_CHECK(cb || half || sum == 0, ctx, FCM_ERR_GEOMETRY,
             "embed: background cell %lld: its edge line crosses the body's boundary %d more "
             "times outward than inward (the boundary surface is not closed)",
             (long long)cell->id, sum);
@@ -888,10 +832,9 @@ static fcm_status moment_rule(fcm_ctx *ctx, const fcm_geometry *g, const fcm_aab
       ++*inner;
     }
   }
-  *corner = cb ? orient * cb->winding : known ? orient * kw : line_winding(cr, up, 1.0);
+  *corner = cb ? orient * cb->winding : line_winding(cr, up, 1.0);
   if (*corner) FCM_TRY(ctx, add_edge(ctx, q, &r, 1.0, *corner, s));
-  if (boxes && !edge && !corner_near(cr)) corner_keep(cr, tree, P, orient * *corner);
-  if (boxes && !edge)
+  if (boxes && !cb)
     FCM_TRY(ctx, clear_box_add(ctx, tree, P, CLEAR_BOX_RSIZE * cell->size, 2.0 * pad,
                                orient * *corner, buf, cr));
 cleanup:
