@@ -24,6 +24,10 @@ class CellRules(FcmObject):
     - axis_degree: per kind, the cut-cell rules' moment space is capped at this degree in
       each variable (DEFAULT: the element's, Hex8's mass 2, i.e. the tensor space Q2 of
       trilinear products; an explicit strength without it means the whole total degree)
+    - stiffness_on_mass_space: 1 fits the cut cells' stiffness rules on the mass rules' space
+      (Hex8: Q2, where an affine cell's stiffness integrand lies: exact, one fit for both
+      kinds, up to 27 stiffness points a piece; for a stiffness integrated once, as the
+      corotated linear model's); 0 (default) each kind on its own space
     - surface_strength: triangle rule strength of surface rules (DEFAULT: none)
     - min_fraction (1e-4), uncut_fraction (1 - 1e-12): the class thresholds
     - clip_rtol, sliver_rtol, convex_rtol: clipping, sliver and convexity tolerances

@@ -7,6 +7,7 @@ static const fcmpy_option rules_table[] = {
     {"kinds", 'u', 1, RO(kinds)},
     {"strength", 'i', FCM_RULE_KIND_COUNT, RO(strength)},
     {"axis_degree", 'i', FCM_RULE_KIND_COUNT, RO(axis_degree)},
+    {"stiffness_on_mass_space", 'i', 1, RO(stiffness_on_mass_space)},
     {"surface_strength", 'i', 1, RO(surface_strength)},
     {"min_fraction", 'd', 1, RO(min_fraction)},
     {"uncut_fraction", 'd', 1, RO(uncut_fraction)},

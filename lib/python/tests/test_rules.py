@@ -59,6 +59,28 @@ def test_hex8_mass_on_q2(ctx):
     assert len(q2.points(fcm.MASS)["weight"]) < len(p6.points(fcm.MASS)["weight"])
 
 
+def test_hex8_stiffness_on_mass_space(ctx):
+    """With stiffness_on_mass_space the cut cells' stiffness rules are fitted on Q2 (where the
+    trilinear gradients' products lie): exact there; by default fewer points, exact on P2 only
+    (the control misses Q2's moments)."""
+    lo, hi = np.array([0.13, 0.21, 0.07]), np.array([0.71, 0.93, 0.66])
+    mesh = fcm.Mesh.box(ctx, fcm.HEX8, [0, 0, 0], [1, 1, 1], [3, 3, 3])
+    body = fcm.Geometry.box(ctx, lo, hi, [2, 3, 2])
+    one = fcm.CellRules(ctx, mesh, body, stiffness_on_mass_space=1)
+    two = fcm.CellRules(ctx, mesh, body)
+    errors = []
+    for rules in (one, two):
+        x, w = authentic(rules.points(fcm.STIFFNESS))
+        err = 0.0
+        for a in ((2, 2, 2), (2, 1, 2), (0, 2, 2), (2, 2, 0)):  # in Q2, not in P2
+            exact = box_moment(lo, hi, a)
+            got = np.sum(w * x[:, 0] ** a[0] * x[:, 1] ** a[1] * x[:, 2] ** a[2])
+            err = max(err, abs(got - exact) / abs(exact))
+        errors.append(err)
+    assert errors[0] < 1e-12 and errors[1] > 1e-6, errors
+    assert len(two.points(fcm.STIFFNESS)["weight"]) < len(one.points(fcm.STIFFNESS)["weight"])
+
+
 def test_ball_volume_centroid_and_surface(ctx):
     """The faceted ball: the rules' volume is the polyhedron's, its centroid the centre; the
     surface rules satisfy the divergence theorem: sum w n = 0 and sum w (x . n) = 3 V."""
