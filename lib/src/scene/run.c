@@ -641,6 +641,9 @@ static fcm_status build_integrator(fcm_simulation *S)
   }
   if (S->config) FCM_TRY(ctx, fcm__integrator_attach_backend(S->integ, S->config->backend));
   FCM_TRY(ctx, fcm_integrator_setup(S->integ));
+  /* the multigrid hierarchy's structure is the set-up's, as the analysis of the direct solver
+   * is: the first step sets up its values as every later step does */
+  FCM_TRY(ctx, fcm_integrator_prepare_solver(S->integ));
   {
     fcm_integrator_setup_info si;
     fcm_integrator_get_setup_info(S->integ, &si);
