@@ -161,14 +161,14 @@ typedef struct block_stats {
  * block row's matrix row is read once, its columns found through loc (DOF -> block index + 1,
  * zero outside the block, left zero on return). Records where each entry lies in its row
  * (pos, m x m row-major, -1: not stored) and returns whether all are stored in *full.
- * 0 when an entry is NaN or infinite. */
+ * 0 when an entry is NaN or infinite. vals and a NULL: the positions from C's pattern only. */
 static int gather_scan(const fcm_csr *C, const double *vals, int m, const fcm_index *d, int *loc,
                        int *pos, unsigned char *full, double *a)
 {
   const fcm_index *rp = fcm_csr_row_ptr(C);
   const int *ci = fcm_csr_col_idx(C);
   int finite = 1, stored = 0;
-  memset(a, 0, sizeof *a * (size_t)m * (size_t)m);
+  if (a) memset(a, 0, sizeof *a * (size_t)m * (size_t)m);
   for (size_t e = 0; e < (size_t)m * (size_t)m; e++)
     pos[e] = -1;
   for (int j = 0; j < m; j++)
@@ -177,8 +177,10 @@ static int gather_scan(const fcm_csr *C, const double *vals, int m, const fcm_in
     for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++) {
       const int k = loc[ci[p]];
       if (!k) continue;
-      if (k - 1 <= i) finite &= isfinite(vals[p]) != 0;
-      a[i + (size_t)(k - 1) * m] = vals[p];
+      if (a) {
+        if (k - 1 <= i) finite &= isfinite(vals[p]) != 0;
+        a[i + (size_t)(k - 1) * m] = vals[p];
+      }
       if (pos[(size_t)i * m + k - 1] < 0) stored++;
       pos[(size_t)i * m + k - 1] = (int)(p - rp[d[i]]);
     }
@@ -518,28 +520,9 @@ cleanup:
  * are all stored through them (the same values as a scan), and scans the others. */
 static void scan_positions(fcm_schwarz *P, const fcm_csr *C)
 {
-  const fcm_index *rp = fcm_csr_row_ptr(C);
-  const int *ci = fcm_csr_col_idx(C);
-  int *loc = P->loc; /* thread 0's DOF map, zero between blocks */
-  for (fcm_index b = 0; b < P->num_blocks; b++) {
-    const fcm_index *d = P->dofs + P->block_ptr[b];
-    const int m = (int)(P->block_ptr[b + 1] - P->block_ptr[b]);
-    int *pos = P->pos + P->s_off[b], stored = 0;
-    for (size_t e = 0; e < (size_t)m * (size_t)m; e++)
-      pos[e] = -1;
-    for (int j = 0; j < m; j++)
-      loc[d[j]] = j + 1;
-    for (int i = 0; i < m; i++)
-      for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++) {
-        const int k = loc[ci[p]];
-        if (!k) continue;
-        if (pos[(size_t)i * m + k - 1] < 0) stored++;
-        pos[(size_t)i * m + k - 1] = (int)(p - rp[d[i]]);
-      }
-    for (int j = 0; j < m; j++)
-      loc[d[j]] = 0;
-    P->full[b] = stored == m * m;
-  }
+  for (fcm_index b = 0; b < P->num_blocks; b++) /* thread 0's DOF map, zero between blocks */
+    gather_scan(C, NULL, (int)(P->block_ptr[b + 1] - P->block_ptr[b]), P->dofs + P->block_ptr[b],
+                P->loc, P->pos + P->s_off[b], &P->full[b], NULL);
 }
 
 /* fcm_schwarz_create(); blocks_only: for the block smoother (fcm__schwarz_create_blocks()),
