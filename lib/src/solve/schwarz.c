@@ -314,10 +314,16 @@ static double cholesky_product(int m, const double *X, double *S)
  * ||C_K||_F ||S_K||_F <= SCHWARZ_CHOLESKY_COND / eps: then every eigenvalue lies in
  * (eps lambda_max / 1000, lambda_max] up to rounding, none is negative or clamped, and the
  * eigen-inverse of build_block() is the same C_K^{-1} (both to rounding of order
- * cond(C_K) times the unit round-off). 0 (S_K untouched) otherwise. */
-static int cholesky_inverse(int m, const double *a, double eps, double *lw, double *S)
+ * cond(C_K) times the unit round-off). 0 (S_K untouched) otherwise.
+ * factor non-NULL (a block smoother, whose sweeps may apply S_K = X^T X as two triangular
+ * products): X itself into S's slot (lower triangle, zero above; *factor = 1) when the bound
+ * ||S_K||_F <= ||X||_F^2 already passes the test, which then needs no product; else S_K as
+ * without it (*factor = 0). The same blocks take the Cholesky path either way. */
+static int cholesky_inverse(int m, const double *a, double eps, double *lw, double *S,
+                            unsigned char *factor)
 {
   double *L = lw, *X = lw + (size_t)m * m, na = 0.0;
+  if (factor) *factor = 0;
   for (int i = 0; i < m; i++)
     for (int j = 0; j <= i; j++) {
       const double v = a[i + (size_t)j * m];
@@ -325,37 +331,19 @@ static int cholesky_inverse(int m, const double *a, double eps, double *lw, doub
     }
   if (!cholesky_factor(m, a, L)) return 0;
   cholesky_invert_factor(m, L, X);
-  const double ns = cholesky_product(m, X, S);
-  return isfinite(ns) && sqrt(na) * sqrt(ns) <= SCHWARZ_CHOLESKY_COND / eps;
-}
-
-/* For a block smoother, whose sweeps may apply S_K = X^T X as two triangular products: X =
- * L^{-1} into S's slot (lower triangle, zero above; *factor = 1) when the bound
- * ||S_K||_F <= ||X||_F^2 already passes cholesky_inverse()'s test, which then needs no
- * product; else cholesky_inverse() itself (*factor = 0). The same blocks take the Cholesky
- * path as there. */
-static int cholesky_inverse_factor(int m, const double *a, double eps, double *lw, double *S,
-                                   unsigned char *factor)
-{
-  double *L = lw, *X = lw + (size_t)m * m, na = 0.0, nx = 0.0;
-  *factor = 0;
-  for (int i = 0; i < m; i++)
-    for (int j = 0; j <= i; j++) {
-      const double v = a[i + (size_t)j * m];
-      na += (i == j ? 1.0 : 2.0) * v * v;
+  if (factor) {
+    double nx = 0.0;
+    for (int i = 0; i < m; i++)
+      for (int j = 0; j <= i; j++)
+        nx += X[(size_t)i * m + j] * X[(size_t)i * m + j];
+    if (isfinite(nx) && sqrt(na) * nx <= SCHWARZ_CHOLESKY_COND / eps) {
+      for (int i = 0; i < m; i++) {
+        memcpy(S + (size_t)i * m, X + (size_t)i * m, sizeof *S * (size_t)(i + 1));
+        memset(S + (size_t)i * m + i + 1, 0, sizeof *S * (size_t)(m - 1 - i));
+      }
+      *factor = 1;
+      return 1;
     }
-  if (!cholesky_factor(m, a, L)) return 0;
-  cholesky_invert_factor(m, L, X);
-  for (int i = 0; i < m; i++)
-    for (int j = 0; j <= i; j++)
-      nx += X[(size_t)i * m + j] * X[(size_t)i * m + j];
-  if (isfinite(nx) && sqrt(na) * nx <= SCHWARZ_CHOLESKY_COND / eps) {
-    for (int i = 0; i < m; i++) {
-      memcpy(S + (size_t)i * m, X + (size_t)i * m, sizeof *S * (size_t)(i + 1));
-      memset(S + (size_t)i * m + i + 1, 0, sizeof *S * (size_t)(m - 1 - i));
-    }
-    *factor = 1;
-    return 1;
   }
   const double ns = cholesky_product(m, X, S);
   return isfinite(ns) && sqrt(na) * sqrt(ns) <= SCHWARZ_CHOLESKY_COND / eps;
@@ -379,11 +367,7 @@ static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *va
     *fail = FAIL_NONFINITE;
     return FCM_ERR_NUMERIC;
   }
-  if (P->factor) {
-    if (cholesky_inverse_factor(m, a, P->opts.epsilon, lw, S, P->factor + b)) return st;
-  } else if (cholesky_inverse(m, a, P->opts.epsilon, lw, S)) {
-    return st;
-  }
+  if (cholesky_inverse(m, a, P->opts.epsilon, lw, S, P->factor ? P->factor + b : NULL)) return st;
   st = fcm__syev_work(ctx, 1, m, a, m, w, lw, P->lwork, iw, P->liwork);
   if (st != FCM_OK) {
     *fail = st == FCM_ERR_ALLOC ? FAIL_NONE : FAIL_LAPACK;
