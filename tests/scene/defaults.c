@@ -4,7 +4,8 @@
  * added here), a scene that writes every key with the value the library's default has parses
  * to the same structs, and one that names a multigrid smoother alone keeps the default relaxation
  * omega = 0, the smoother's own (fcm_mg_smoother_omega(), resolved by fcm_mg_create()), while a
- * written omega is kept as written. */
+ * written omega is kept as written. The element-corotated model's quadrature default differs
+ * (stiffness rules on the mass space). */
 #include "fcm/fcm.h"
 #include "test.h"
 
@@ -164,6 +165,23 @@ int main(void)
   snprintf(json, sizeof json, "%s, \"solver\": {\"multigrid\": {\"smoother\": \"sgs_colored\"}}}",
            head);
   check_smoother(ctx, json, FCM_MG_SMOOTHER_SGS_COLORED, 0.0);
+  /* The element-corotated model integrates the stiffness once: its default fits the cut
+   * cells' stiffness rules on the mass space; a written false is kept. */
+  static const char *const corot =
+      "{\"background\": {\"element\": \"hex8\", \"box\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1]},"
+      " \"cells\": [2, 2, 2]}, \"material\": {\"model\": \"corotated_linear\", \"young\": 1e6,"
+      " \"poisson\": 0.3}";
+  for (int written = -1; written <= 1; written++) {
+    if (written < 0)
+      snprintf(json, sizeof json, "%s}", corot);
+    else
+      snprintf(json, sizeof json, "%s, \"quadrature\": {\"stiffness_on_mass_space\": %s}}", corot,
+               written ? "true" : "false");
+    fcm_scene *s = NULL;
+    TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "corotated.json", &s));
+    if (s) TEST_TRUE(fcm_scene_get_quadrature(s)->rules.stiffness_on_mass_space == (written != 0));
+    fcm_scene_destroy(&s);
+  }
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
 }

@@ -45,6 +45,9 @@ fcm_status fcm__scene_read_quadrature(fcm__scene_parser *p, const fcm__json *roo
   SCENE_READ_INT(p, o, "stiffness_strength", 0, 0, 20, q->strength[FCM_RULE_STIFFNESS]);
   SCENE_READ_INT(p, o, "mass_strength", 0, 0, 20, q->strength[FCM_RULE_MASS]);
   SCENE_READ_INT(p, o, "surface_strength", 0, 0, 20, q->surface_strength);
+  /* A model that integrates the stiffness once (element-corotated) pays for the larger
+   * stiffness rules only at set-up and at cuts, and gets the cut cells' stiffness exact. */
+  q->stiffness_on_mass_space = p->scene->material.model == FCM_MATERIAL_COROTATED_LINEAR;
   FCM_TRY(p->ctx,
           fcm__scene_read_bool(p, o, "stiffness_on_mass_space", 0, &q->stiffness_on_mass_space));
   {
