@@ -96,6 +96,9 @@ struct fcm_space {
    * neighbouring cells follow each other and their matrix rows are still in cache
    * (assemble.c). */
   int num_block_colors;
+  /* Copy graph rows fcm__space_build_topology_cut() took from the space before the cut (0: the
+   * topology was built anew) */
+  fcm_index cut_kept_rows;
   fcm_index *block_color_ptr;
   fcm_index *block_list;
   fcm_index *block_elems; /* num_local_elems */
@@ -145,6 +148,17 @@ FCM_COMPONENT_API fcm_status fcm__space_create_local(fcm_ctx *ctx, const fcm_mes
                                                      const fcm_space_options *opts,
                                                      const unsigned char *cell_mask,
                                                      fcm_space **out);
+
+/* fcm_space_create_embedded_with(ctx, mesh, rules, opts, out) after a cut: rules made by
+ * fcm_cell_rules_create_cut() from the rules of `from` (a full space on the same mesh), whose
+ * topology the new space patches where the cut left it (fcm__space_build_topology_cut()). The
+ * same space bit for bit (every array); from may be NULL, local or unrelated: a space built
+ * anew. `from` is only read and may be destroyed afterwards. @return as
+ * fcm_space_create_embedded_with(). (space.c) */
+FCM_COMPONENT_API fcm_status fcm__space_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                                   const fcm_cell_rules *rules,
+                                                   const fcm_space_options *opts,
+                                                   const fcm_space *from, fcm_space **out);
 
 /* Rebuild the topology of a local space for the cells flagged in cell_mask (NULL: none); the
  * numbering is unchanged. On failure the space has no local elements (and the error). FCM_ERR_ARG
@@ -337,6 +351,14 @@ fcm_status fcm__space_constrain_copies(fcm_space *s, double ratio, const fcm_ind
  * elements of the cells flagged in cell_mask (local); replaces any earlier one.
  * (topology.c) */
 fcm_status fcm__space_build_topology(fcm_space *s, int local, const unsigned char *cell_mask);
+
+/* fcm__space_build_topology(s, 0, NULL) for a cut space s (full) from `from`, the full space
+ * before the cut (s's rules made from from's by fcm_cell_rules_create_cut()): the graph rows
+ * of the copies the cut left as they were (same elements, each the only child of its parent)
+ * are from's rows mapped to the children, the offsets of their elements from's; the rest and
+ * the colours are made as there. The same arrays bit for bit. Anything else (from NULL or
+ * local, not a cut pair): fcm__space_build_topology(s, 0, NULL). (topology.c) */
+fcm_status fcm__space_build_topology_cut(fcm_space *s, const fcm_space *from);
 
 /* Release the topology. (topology.c) */
 void fcm__space_free_topology(fcm_space *s);

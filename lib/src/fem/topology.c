@@ -105,9 +105,9 @@ cleanup:
   return st;
 }
 
-/* Scalar pattern from the copy graph (the three rows of each local copy; global columns), and
- * the offsets of the local elements (and, for a local space, their copies' local positions). */
-static fcm_status build_pattern(fcm_space *s, const fcm_index *g2l)
+/* The scalar pattern's rows from the copy graph (the three rows of each local copy; global
+ * columns). */
+static fcm_status build_pattern_rows(fcm_space *s)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
@@ -126,22 +126,40 @@ static fcm_status build_pattern(fcm_space *s, const fcm_index *g2l)
         for (int j = 0; j < 3; j++)
           *cols++ = (int)(3 * s->node_adj[e] + j);
     }
+cleanup:
+  return st;
+}
+
+/* The offsets of local element el at its node a: the position of each of its copies in the
+ * graph row of the copy at node a (ka its local position). */
+static void node_offsets(const fcm_space *s, fcm_index el, int a, fcm_index ka)
+{
+  const fcm_index *ed = s->elem_dof + local_elem(s, el) * s->nn;
+  int *off = s->elem_off + ((size_t)el * s->nn + a) * s->nn;
+  const fcm_index *row = s->node_adj + s->node_ptr[ka];
+  const size_t len = (size_t)(s->node_ptr[ka + 1] - s->node_ptr[ka]);
+  for (int b = 0; b < s->nn; b++) {
+    fcm_index kb = ed[b] / 3;
+    const fcm_index *hit = bsearch(&kb, row, len, sizeof *row, cmp_index);
+    off[b] = hit ? (int)(hit - row) : -1; /* every copy of the element is in the row */
+  }
+}
+
+/* Scalar pattern from the copy graph, and the offsets of the local elements (and, for a local
+ * space, their copies' local positions). */
+static fcm_status build_pattern(fcm_space *s, const fcm_index *g2l)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  FCM_TRY(ctx, build_pattern_rows(s));
   FCM_ALLOC(ctx, (size_t)s->num_local_elems * s->nn * s->nn + 1, s->elem_off);
   if (g2l) FCM_ALLOC(ctx, (size_t)s->num_local_elems * s->nn + 1, s->elem_lcopy);
   for (fcm_index el = 0; el < s->num_local_elems; el++) {
     const fcm_index *ed = s->elem_dof + local_elem(s, el) * s->nn;
-    int *off = s->elem_off + (size_t)el * s->nn * s->nn;
     for (int a = 0; a < s->nn; a++) {
       fcm_index ka = g2l ? g2l[ed[a] / 3] : ed[a] / 3;
       if (g2l) s->elem_lcopy[(size_t)el * s->nn + a] = (int)ka;
-      const fcm_index *row = s->node_adj + s->node_ptr[ka];
-      size_t len = (size_t)(s->node_ptr[ka + 1] - s->node_ptr[ka]);
-      for (int b = 0; b < s->nn; b++) {
-        fcm_index kb = ed[b] / 3;
-        const fcm_index *hit = bsearch(&kb, row, len, sizeof *row, cmp_index);
-        FCM_ASSERT(hit != NULL, ctx);
-        off[a * s->nn + b] = (int)(hit - row);
-      }
+      node_offsets(s, el, a, ka);
     }
   }
 cleanup:
@@ -347,6 +365,7 @@ void fcm__space_free_topology(fcm_space *s)
   s->cell_local = NULL;
   s->block_color_ptr = s->block_list = s->block_elems = NULL;
   s->num_colors = s->num_block_colors = 0;
+  s->cut_kept_rows = 0;
   s->num_local_copies = s->num_local_elems = 0;
 }
 
@@ -400,6 +419,220 @@ fcm_status fcm__space_build_topology(fcm_space *s, int local, const unsigned cha
 cleanup:
   if (st != FCM_OK) fcm__space_free_topology(s);
   fcm__free(ctx, g2l);
+  fcm__free(ctx, cptr);
+  fcm__free(ctx, cinc);
+  return st;
+}
+
+/* ---- The topology of a cut space patched from the space before the cut. Element e of the cut
+ * space is "kept" when its cell has as many elements in both spaces, its parent element sits at
+ * the same place among them, and at every node it uses the only child of the copy its parent
+ * uses there (the same constraint flags): the cut did not touch it. A copy k is kept when it has
+ * a parent p with no other child, every element using it is kept, and as many elements use k
+ * as use p: its elements are then exactly the children of p's, so its graph row is p's row with
+ * every copy replaced by its child (a kept element's copies all have single children). */
+
+/* What the patch reads besides the two spaces: the parent of each new copy, the only child of
+ * each old copy (-1: none or several), the kept flags of the new elements and copies. */
+typedef struct cut_map {
+  fcm_index *parent, *child, *old_uses;
+  unsigned char *elem_kept, *copy_kept; /* copy_kept 2: kept and its mapped row sorted as is */
+} cut_map;
+
+/* Elements using each copy of s (each element once, as build_copy_incidence() counts). */
+static void count_uses(const fcm_space *s, fcm_index *uses)
+{
+  const int nn = s->nn;
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    const fcm_index *ed = s->elem_dof + e * nn;
+    for (int a = 0; a < nn; a++) {
+      int dup = 0;
+      for (int b = 0; b < a && !dup; b++)
+        dup = ed[b] / 3 == ed[a] / 3;
+      if (!dup) uses[ed[a] / 3]++;
+    }
+  }
+}
+
+/* The kept flags of the elements of s (after the cut) against from's. */
+static void mark_kept_elements(const fcm_space *from, const fcm_space *s, cut_map *m)
+{
+  const int nn = s->nn;
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    const fcm_index c = s->elem_cell[e], fe = fcm__space_cut_parent_elem(from, s, e);
+    int kept =
+        fe >= 0 &&
+        from->cell_elem[c + 1] - from->cell_elem[c] == s->cell_elem[c + 1] - s->cell_elem[c] &&
+        fe - from->cell_elem[c] == e - s->cell_elem[c];
+    for (int a = 0; a < nn && kept; a++) {
+      const fcm_index k = s->elem_dof[e * nn + a] / 3, p = from->elem_dof[fe * nn + a] / 3;
+      const int con = s->elem_con ? s->elem_con[e * nn + a] : 0,
+                fcon = from->elem_con ? from->elem_con[fe * nn + a] : 0;
+      kept = con == fcon && m->parent[k] == p && m->child[p] == k;
+    }
+    m->elem_kept[e] = (unsigned char)kept;
+  }
+}
+
+/* The parents, children and kept flags of the cut space s against from. */
+static fcm_status build_cut_map(const fcm_space *from, const fcm_space *s, const fcm_index *cptr,
+                                const fcm_index *cinc, cut_map *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ncopy = s->num_dofs / 3, nold = from->num_dofs / 3;
+  FCM_ALLOC(ctx, ncopy + 1, m->parent);
+  FCM_ALLOC(ctx, nold + 1, m->child);
+  FCM_ALLOC(ctx, nold + 1, m->old_uses);
+  FCM_ALLOC(ctx, s->num_elems + 1, m->elem_kept);
+  FCM_ALLOC(ctx, ncopy + 1, m->copy_kept);
+  FCM_TRY(ctx, fcm__space_cut_parents(from, s, m->parent));
+  for (fcm_index p = 0; p < nold; p++)
+    m->child[p] = -1;
+  for (fcm_index k = 0; k < ncopy; k++) {
+    const fcm_index p = m->parent[k];
+    if (p >= 0) m->child[p] = m->child[p] == -1 ? k : -2; /* -2: several children */
+  }
+  mark_kept_elements(from, s, m);
+  count_uses(from, m->old_uses);
+  for (fcm_index k = 0; k < ncopy; k++) {
+    const fcm_index p = m->parent[k];
+    int kept = p >= 0 && m->child[p] == k && cptr[k + 1] - cptr[k] == m->old_uses[p];
+    for (fcm_index i = cptr[k]; i < cptr[k + 1] && kept; i++)
+      kept = m->elem_kept[cinc[i]];
+    m->copy_kept[k] = (unsigned char)kept;
+  }
+cleanup:
+  return st;
+}
+
+static void free_cut_map(fcm_ctx *ctx, cut_map *m)
+{
+  fcm__free(ctx, m->parent);
+  fcm__free(ctx, m->child);
+  fcm__free(ctx, m->old_uses);
+  fcm__free(ctx, m->elem_kept);
+  fcm__free(ctx, m->copy_kept);
+}
+
+/* The copy graph of the cut space: a kept copy's row is its parent's row mapped to the
+ * children (sorted again only where the map reorders it: copy_kept 1); the others' rows are
+ * made from their elements as build_node_graph() makes them. */
+static fcm_status patch_node_graph(fcm_space *s, const fcm_space *from, const fcm_index *cptr,
+                                   const fcm_index *cinc, cut_map *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ncopy = s->num_local_copies, nn = s->nn;
+  fcm_index *mark = NULL;
+  FCM_ALLOC(ctx, ncopy + 1, mark);
+  FCM_ALLOC(ctx, ncopy + 1, s->node_ptr);
+  for (int pass = 0; pass < 2; pass++) {
+    for (fcm_index k = 0; k < ncopy; k++)
+      mark[k] = -1;
+    for (fcm_index k = 0; k < ncopy; k++) {
+      fcm_index cnt = 0, base = pass ? s->node_ptr[k] : 0;
+      if (m->copy_kept[k]) {
+        const fcm_index p = m->parent[k], *row = from->node_adj + from->node_ptr[p];
+        cnt = from->node_ptr[p + 1] - from->node_ptr[p];
+        if (!pass) {
+          s->node_ptr[k + 1] = cnt;
+          continue;
+        }
+        int sorted = 1;
+        for (fcm_index i = 0; i < cnt; i++) {
+          FCM_CHECK(m->child[row[i]] >= 0, ctx, FCM_ERR_INTERNAL,
+                    "cut space: copy %lld is kept but its neighbour %lld before the cut has "
+                    "no single child",
+                    (long long)k, (long long)row[i]);
+          s->node_adj[base + i] = m->child[row[i]];
+          sorted &= i == 0 || s->node_adj[base + i] > s->node_adj[base + i - 1];
+        }
+        if (!sorted) qsort(s->node_adj + base, (size_t)cnt, sizeof *s->node_adj, cmp_index);
+        m->copy_kept[k] = (unsigned char)(sorted ? 2 : 1);
+        s->cut_kept_rows++;
+        continue;
+      }
+      for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++) {
+        const fcm_index e = cinc[i];
+        for (int b = 0; b < nn; b++) {
+          const fcm_index q = s->elem_dof[e * nn + b] / 3;
+          if (mark[q] == k) continue;
+          mark[q] = k;
+          if (pass) s->node_adj[base + cnt] = q;
+          cnt++;
+        }
+      }
+      if (pass)
+        qsort(s->node_adj + base, (size_t)cnt, sizeof *s->node_adj, cmp_index);
+      else
+        s->node_ptr[k + 1] = cnt;
+    }
+    if (!pass) {
+      for (fcm_index k = 0; k < ncopy; k++)
+        s->node_ptr[k + 1] += s->node_ptr[k];
+      FCM_ALLOC(ctx, s->node_ptr[ncopy] + 1, s->node_adj);
+    }
+  }
+cleanup:
+  fcm__free(ctx, mark);
+  return st;
+}
+
+/* The offsets of the cut space's elements: a kept element's at a node whose copy's row is its
+ * parent's in the same order are its parent element's; the others are looked up. */
+static fcm_status patch_offsets(fcm_space *s, const fcm_space *from, const cut_map *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const int nn = s->nn;
+  FCM_ALLOC(ctx, (size_t)s->num_elems * nn * nn + 1, s->elem_off);
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    const fcm_index fe = m->elem_kept[e] ? fcm__space_cut_parent_elem(from, s, e) : -1;
+    for (int a = 0; a < nn; a++) {
+      const fcm_index k = s->elem_dof[e * nn + a] / 3;
+      if (fe >= 0 && m->copy_kept[k] == 2)
+        memcpy(s->elem_off + ((size_t)e * nn + a) * nn, from->elem_off + ((size_t)fe * nn + a) * nn,
+               sizeof(int) * (size_t)nn);
+      else
+        node_offsets(s, e, a, k);
+    }
+  }
+cleanup:
+  return st;
+}
+
+/* 1 when from is a full space whose topology s (full, after a cut) can patch. */
+static int can_patch(const fcm_space *from, const fcm_space *s)
+{
+  if (!from || from->is_local || s->is_local || !from->node_ptr || !from->elem_off ||
+      from->nn != s->nn || from->mesh != s->mesh || !from->rules || !s->rules)
+    return 0;
+  return fcm_cell_rules_parent_num_pieces(s->rules) == fcm_cell_rules_num_pieces(from->rules) &&
+         fcm_cell_rules_parent_num_pieces(s->rules) > 0;
+}
+
+fcm_status fcm__space_build_topology_cut(fcm_space *s, const fcm_space *from)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  fcm_index *cptr = NULL, *cinc = NULL;
+  cut_map m;
+  memset(&m, 0, sizeof m);
+  if (!can_patch(from, s)) return fcm__space_build_topology(s, 0, NULL);
+  fcm__space_free_topology(s);
+  s->num_local_elems = s->num_elems;
+  s->num_local_copies = s->num_dofs / 3;
+  FCM_TRY(ctx, build_copy_incidence(s, NULL, &cptr, &cinc));
+  FCM_TRY(ctx, build_cut_map(from, s, cptr, cinc, &m));
+  FCM_TRY(ctx, patch_node_graph(s, from, cptr, cinc, &m));
+  FCM_TRY(ctx, build_pattern_rows(s));
+  FCM_TRY(ctx, patch_offsets(s, from, &m));
+  FCM_TRY(ctx, build_colors(s, NULL, cptr, cinc));
+  FCM_TRY(ctx, build_block_colors(s, NULL, cptr, cinc));
+cleanup:
+  if (st != FCM_OK) fcm__space_free_topology(s);
+  free_cut_map(ctx, &m);
   fcm__free(ctx, cptr);
   fcm__free(ctx, cinc);
   return st;
