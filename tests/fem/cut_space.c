@@ -3,9 +3,10 @@
  * plane, a partial rectangle from the top face ending inside the body, a plane across the first
  * into cells already cut), each cut space patched from the patched one before it; once with the
  * default constraint ratio and once with a large one that constrains tiny copies (Koschier). The
- * patch must take graph rows from the space before the cut (a tenth at least: not rebuild them), and a space
- * before the cut with one stale offset gives a different space (the offsets are taken, and the
- * comparison sees them). Usage: fem_cut_space <element> */
+ * patch must take graph rows from the space before the cut (a tenth at least: not rebuild them),
+ * and a space before the cut with one stale offset, or two entries of its block order swapped,
+ * gives a different space (the offsets and the order are taken, and the comparison sees them).
+ * Usage: fem_cut_space <element> */
 #include "fem/fem_impl.h"
 #include "test.h"
 
@@ -108,6 +109,18 @@ static fcm_index run(const fcm_mesh *mesh, const fcm_geometry *g, double ratio)
         off[e0 * nn2 + 1] = keep;
         fcm_space_destroy(&stale);
       }
+      /* the block order is taken from the space before the cut (its active cells are the
+       * same): two of its entries swapped show in the patch */
+      fcm_index *order = space[k - 1]->block_elems;
+      const fcm_index b0 = order[0], b1 = order[ne - 1];
+      TEST_TRUE(space[k - 1]->elem_cell[b0] != space[k - 1]->elem_cell[b1]);
+      order[0] = b1, order[ne - 1] = b0;
+      fcm_space *swapped = NULL;
+      TEST_OK(ctx, fcm__space_create_cut(ctx, mesh, rules[k], &so, space[k - 1], &swapped));
+      TEST_TRUE(swapped && !same(swapped->block_elems, fresh->block_elems, (size_t)fresh->num_elems,
+                                 sizeof(fcm_index)));
+      order[0] = b0, order[ne - 1] = b1;
+      fcm_space_destroy(&swapped);
     }
     fcm_space_destroy(&fresh);
   }

@@ -288,11 +288,42 @@ cleanup:
   return st;
 }
 
+/* build_block_order() of a full space s after a cut from the full space `from` whose active cells
+ * are s's: the cells' centres and their box are the same, so the Morton keys are, and the
+ * elements of a cell (one key, ascending positions) follow each other in both orders; the cut
+ * only changes how many elements each cell has. So each run of a cell's elements in from's
+ * order becomes the run of its elements in s. *done = 0 (nothing made) when the active cells
+ * differ. */
+static fcm_status patch_block_order(fcm_space *s, const fcm_space *from, int *done)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *order = NULL, j = 0;
+  *done = 0;
+  if (from->num_cells != s->num_cells || !from->block_elems || from->local_elem || s->local_elem ||
+      memcmp(from->active, s->active, (size_t)s->num_cells) != 0)
+    return FCM_OK;
+  FCM_ALLOC_RAW(s->ctx, s->num_elems + 1, order);
+  for (fcm_index i = 0; i < from->num_elems; i++) {
+    const fcm_index fe = from->block_elems[i], c = from->elem_cell[fe];
+    if (fe != from->cell_elem[c]) continue; /* the cell's run was written at its first */
+    for (fcm_index e = s->cell_elem[c]; e < s->cell_elem[c + 1] && j < s->num_elems; e++)
+      order[j++] = e;
+  }
+  if (j == s->num_elems) { /* every active cell has elements in both */
+    s->block_elems = order;
+    order = NULL;
+    *done = 1;
+  }
+cleanup:
+  fcm__free(s->ctx, order);
+  return st;
+}
+
 /* Greedy colouring of the blocks of FCM__SPACE_BLOCK consecutive entries of block_elems: a
  * block takes the smallest colour not used by a block with an element sharing a copy with one
  * of its own. */
 static fcm_status build_block_colors(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
-                                     const fcm_index *cinc)
+                                     const fcm_index *cinc, const fcm_space *from)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
@@ -300,7 +331,9 @@ static fcm_status build_block_colors(fcm_space *s, const fcm_index *g2l, const f
   int *color = NULL, ncol = 0;
   fcm_index *forbid = NULL, *fill = NULL, *block_of = NULL;
   enum { MAX_COLORS = 4096 };
-  FCM_TRY(ctx, build_block_order(s));
+  int patched = 0;
+  if (from) FCM_TRY(ctx, patch_block_order(s, from, &patched));
+  if (!patched) FCM_TRY(ctx, build_block_order(s));
   FCM_ALLOC(ctx, ne + 1, block_of);
   for (fcm_index j = 0; j < ne; j++)
     block_of[s->block_elems[j]] = j / FCM__SPACE_BLOCK;
@@ -415,7 +448,7 @@ fcm_status fcm__space_build_topology(fcm_space *s, int local, const unsigned cha
   FCM_TRY(ctx, build_node_graph(s, g2l, cptr, cinc));
   FCM_TRY(ctx, build_pattern(s, g2l));
   FCM_TRY(ctx, build_colors(s, g2l, cptr, cinc));
-  FCM_TRY(ctx, build_block_colors(s, g2l, cptr, cinc));
+  FCM_TRY(ctx, build_block_colors(s, g2l, cptr, cinc, NULL));
 cleanup:
   if (st != FCM_OK) fcm__space_free_topology(s);
   fcm__free(ctx, g2l);
@@ -629,7 +662,7 @@ fcm_status fcm__space_build_topology_cut(fcm_space *s, const fcm_space *from)
   FCM_TRY(ctx, build_pattern_rows(s));
   FCM_TRY(ctx, patch_offsets(s, from, &m));
   FCM_TRY(ctx, build_colors(s, NULL, cptr, cinc));
-  FCM_TRY(ctx, build_block_colors(s, NULL, cptr, cinc));
+  FCM_TRY(ctx, build_block_colors(s, NULL, cptr, cinc, from));
 cleanup:
   if (st != FCM_OK) fcm__space_free_topology(s);
   free_cut_map(ctx, &m);
