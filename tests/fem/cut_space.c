@@ -121,6 +121,20 @@ static fcm_index run(const fcm_mesh *mesh, const fcm_geometry *g, double ratio)
                                  sizeof(fcm_index)));
       order[0] = b0, order[ne - 1] = b1;
       fcm_space_destroy(&swapped);
+      /* the colours of the elements away from the cut are taken too: the first elements of
+       * colours 0 and 1 (at the corner at the origin) swapped show in the patch; the third cut
+       * runs along the body within reach of every element */
+      fcm_index *ce = space[k - 1]->color_elems, *cp = space[k - 1]->color_ptr;
+      TEST_TRUE(space[k - 1]->num_colors > 1);
+      if (k < 3 && space[k - 1]->num_colors > 1) {
+        const fcm_index c0 = ce[cp[0]], c1 = ce[cp[1]];
+        ce[cp[0]] = c1, ce[cp[1]] = c0;
+        TEST_OK(ctx, fcm__space_create_cut(ctx, mesh, rules[k], &so, space[k - 1], &swapped));
+        TEST_TRUE(swapped && !same(swapped->color_elems, fresh->color_elems,
+                                   (size_t)fresh->num_elems, sizeof(fcm_index)));
+        ce[cp[0]] = c0, ce[cp[1]] = c1;
+        fcm_space_destroy(&swapped);
+      }
     }
     fcm_space_destroy(&fresh);
   }

@@ -193,6 +193,11 @@ fcm_index fcm__space_cut_parent_elem(const fcm_space *from, const fcm_space *to,
  * @return FCM_OK, FCM_ERR_ARG (NULL, not a cut pair), FCM_ERR_INTERNAL. */
 fcm_status fcm__space_cut_parents(const fcm_space *from, const fcm_space *to, fcm_index *parent);
 
+/* fcm__space_cut_parents() that also gives parent_elem[e] (num_elems(to) entries; may be NULL):
+ * fcm__space_cut_parent_elem(from, to, e), looked up once per element. */
+fcm_status fcm__space_cut_parents_with(const fcm_space *from, const fcm_space *to,
+                                       fcm_index *parent, fcm_index *parent_elem);
+
 /* same[e] (num_elems(to) entries): the element of `from` that element e of `to` integrates
  * exactly as (same cell and class; an uncut cell, or the same points, weights and flags of
  * every rule kind and the same surface rule, compared bit by bit, as its parent piece's), -1

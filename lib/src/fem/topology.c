@@ -166,40 +166,13 @@ cleanup:
   return st;
 }
 
-/* Greedy colouring of the local elements: an element takes the smallest colour not used by an
- * element sharing a copy (elements sharing a node but using different copies of it may share a
- * colour). color_elems holds local element positions (a full space: element ids). */
-static fcm_status build_colors(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
-                               const fcm_index *cinc)
+/* The colour lists (color_ptr, color_elems) of the colours color[le] of the local elements. */
+static fcm_status color_lists(fcm_space *s, const int *color, int ncol)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
   const fcm_index ne = s->num_local_elems;
-  int *color = NULL, ncol = 0;
-  fcm_index *forbid = NULL, *fill = NULL;
-  enum { MAX_COLORS = 4096 };
-  FCM_ALLOC(ctx, ne + 1, color);
-  FCM_ALLOC(ctx, MAX_COLORS, forbid);
-  for (int k = 0; k < MAX_COLORS; k++)
-    forbid[k] = -1;
-  for (fcm_index e = 0; e < ne; e++)
-    color[e] = -1;
-  for (fcm_index e = 0; e < ne; e++) {
-    const fcm_index *ed = s->elem_dof + local_elem(s, e) * s->nn;
-    for (int a = 0; a < s->nn; a++) {
-      const fcm_index k = g2l ? g2l[ed[a] / 3] : ed[a] / 3;
-      for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++)
-        if (color[cinc[i]] >= 0) forbid[color[cinc[i]]] = e;
-    }
-    int k = 0;
-    while (k < MAX_COLORS && forbid[k] == e)
-      k++;
-    FCM_CHECK(k < MAX_COLORS, ctx, FCM_ERR_UNSUPPORTED,
-              "space: cell %lld needs more than %d colours (a node shared by too many cells)",
-              (long long)s->elem_cell[local_elem(s, e)], MAX_COLORS);
-    color[e] = k;
-    ncol = FCM_MAX(ncol, k + 1);
-  }
+  fcm_index *fill = NULL;
   s->num_colors = ncol;
   FCM_ALLOC(ctx, ncol + 1, s->color_ptr);
   for (fcm_index e = 0; e < ne; e++)
@@ -211,9 +184,60 @@ static fcm_status build_colors(fcm_space *s, const fcm_index *g2l, const fcm_ind
   for (fcm_index e = 0; e < ne; e++)
     s->color_elems[s->color_ptr[color[e]] + fill[color[e]]++] = e;
 cleanup:
+  fcm__free(ctx, fill);
+  return st;
+}
+
+enum { MAX_COLORS = 4096 };
+
+/* The greedy colour of local element e: the smallest colour no element sharing a copy with it
+ * has yet (color[] -1 for the elements not coloured yet); forbid holds MAX_COLORS marks. */
+static fcm_status greedy_color(const fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
+                               const fcm_index *cinc, fcm_index e, int *color, fcm_index *forbid)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index *ed = s->elem_dof + local_elem(s, e) * s->nn;
+  for (int a = 0; a < s->nn; a++) {
+    const fcm_index k = g2l ? g2l[ed[a] / 3] : ed[a] / 3;
+    for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++)
+      if (color[cinc[i]] >= 0) forbid[color[cinc[i]]] = e;
+  }
+  int k = 0;
+  while (k < MAX_COLORS && forbid[k] == e)
+    k++;
+  FCM_CHECK(k < MAX_COLORS, s->ctx, FCM_ERR_UNSUPPORTED,
+            "space: cell %lld needs more than %d colours (a node shared by too many cells)",
+            (long long)s->elem_cell[local_elem(s, e)], MAX_COLORS);
+  color[e] = k;
+cleanup:
+  return st;
+}
+
+/* Greedy colouring of the local elements: an element takes the smallest colour not used by an
+ * element sharing a copy (elements sharing a node but using different copies of it may share a
+ * colour). color_elems holds local element positions (a full space: element ids). */
+static fcm_status build_colors(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
+                               const fcm_index *cinc)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ne = s->num_local_elems;
+  int *color = NULL, ncol = 0;
+  fcm_index *forbid = NULL;
+  FCM_ALLOC(ctx, ne + 1, color);
+  FCM_ALLOC(ctx, MAX_COLORS, forbid);
+  for (int k = 0; k < MAX_COLORS; k++)
+    forbid[k] = -1;
+  for (fcm_index e = 0; e < ne; e++)
+    color[e] = -1;
+  for (fcm_index e = 0; e < ne; e++) {
+    FCM_TRY(ctx, greedy_color(s, g2l, cptr, cinc, e, color, forbid));
+    ncol = FCM_MAX(ncol, color[e] + 1);
+  }
+  FCM_TRY(ctx, color_lists(s, color, ncol));
+cleanup:
   fcm__free(ctx, color);
   fcm__free(ctx, forbid);
-  fcm__free(ctx, fill);
   return st;
 }
 
@@ -330,7 +354,6 @@ static fcm_status build_block_colors(fcm_space *s, const fcm_index *g2l, const f
   const fcm_index ne = s->num_local_elems, nb = (ne + FCM__SPACE_BLOCK - 1) / FCM__SPACE_BLOCK;
   int *color = NULL, ncol = 0;
   fcm_index *forbid = NULL, *fill = NULL, *block_of = NULL;
-  enum { MAX_COLORS = 4096 };
   int patched = 0;
   if (from) FCM_TRY(ctx, patch_block_order(s, from, &patched));
   if (!patched) FCM_TRY(ctx, build_block_order(s));
@@ -468,6 +491,7 @@ cleanup:
 /* What the patch reads besides the two spaces: the parent of each new copy, the only child of
  * each old copy (-1: none or several), the kept flags of the new elements and copies. */
 typedef struct cut_map {
+  fcm_index *parent_elem; /* the element of from holding each new element's parent piece */
   fcm_index *parent, *child, *old_uses;
   unsigned char *elem_kept, *copy_kept; /* copy_kept 2: kept and its mapped row sorted as is */
 } cut_map;
@@ -492,7 +516,7 @@ static void mark_kept_elements(const fcm_space *from, const fcm_space *s, cut_ma
 {
   const int nn = s->nn;
   for (fcm_index e = 0; e < s->num_elems; e++) {
-    const fcm_index c = s->elem_cell[e], fe = fcm__space_cut_parent_elem(from, s, e);
+    const fcm_index c = s->elem_cell[e], fe = m->parent_elem[e];
     int kept =
         fe >= 0 &&
         from->cell_elem[c + 1] - from->cell_elem[c] == s->cell_elem[c + 1] - s->cell_elem[c] &&
@@ -519,7 +543,8 @@ static fcm_status build_cut_map(const fcm_space *from, const fcm_space *s, const
   FCM_ALLOC(ctx, nold + 1, m->old_uses);
   FCM_ALLOC(ctx, s->num_elems + 1, m->elem_kept);
   FCM_ALLOC(ctx, ncopy + 1, m->copy_kept);
-  FCM_TRY(ctx, fcm__space_cut_parents(from, s, m->parent));
+  FCM_ALLOC(ctx, s->num_elems + 1, m->parent_elem);
+  FCM_TRY(ctx, fcm__space_cut_parents_with(from, s, m->parent, m->parent_elem));
   for (fcm_index p = 0; p < nold; p++)
     m->child[p] = -1;
   for (fcm_index k = 0; k < ncopy; k++) {
@@ -541,6 +566,7 @@ cleanup:
 
 static void free_cut_map(fcm_ctx *ctx, cut_map *m)
 {
+  fcm__free(ctx, m->parent_elem);
   fcm__free(ctx, m->parent);
   fcm__free(ctx, m->child);
   fcm__free(ctx, m->old_uses);
@@ -621,7 +647,7 @@ static fcm_status patch_offsets(fcm_space *s, const fcm_space *from, const cut_m
   const int nn = s->nn;
   FCM_ALLOC(ctx, (size_t)s->num_elems * nn * nn + 1, s->elem_off);
   for (fcm_index e = 0; e < s->num_elems; e++) {
-    const fcm_index fe = m->elem_kept[e] ? fcm__space_cut_parent_elem(from, s, e) : -1;
+    const fcm_index fe = m->elem_kept[e] ? m->parent_elem[e] : -1;
     for (int a = 0; a < nn; a++) {
       const fcm_index k = s->elem_dof[e * nn + a] / 3;
       if (fe >= 0 && m->copy_kept[k] == 2)
@@ -632,6 +658,61 @@ static fcm_status patch_offsets(fcm_space *s, const fcm_space *from, const cut_m
     }
   }
 cleanup:
+  return st;
+}
+
+/* The element colouring of the cut space, greedy_color() only where it may differ from the
+ * space before the cut. An element whose copies are all kept has the children of its parent's
+ * neighbours for neighbours, in the same order; while none of those before it has another
+ * colour than its parent's, the greedy colouring gives it its parent's colour. So the other
+ * elements are coloured anew, and with them the elements sharing a copy with an element whose
+ * colour is not its parent's (or that has no parent). */
+static fcm_status patch_colors(fcm_space *s, const fcm_space *from, const fcm_index *cptr,
+                               const fcm_index *cinc, const cut_map *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ne = s->num_elems;
+  const int nn = s->nn;
+  int *color = NULL, *old = NULL, ncol = 0;
+  unsigned char *dirty = NULL;
+  fcm_index *forbid = NULL;
+  FCM_ALLOC(ctx, ne + 1, color);
+  FCM_ALLOC(ctx, ne + 1, dirty);
+  FCM_ALLOC(ctx, from->num_elems + 1, old);
+  FCM_ALLOC(ctx, MAX_COLORS, forbid);
+  for (int k = 0; k < MAX_COLORS; k++)
+    forbid[k] = -1;
+  for (int c = 0; c < from->num_colors; c++)
+    for (fcm_index i = from->color_ptr[c]; i < from->color_ptr[c + 1]; i++)
+      old[from->color_elems[i]] = c;
+  for (fcm_index e = 0; e < ne; e++) {
+    int stable = m->elem_kept[e];
+    for (int a = 0; a < nn && stable; a++)
+      stable = m->copy_kept[s->elem_dof[e * nn + a] / 3] != 0;
+    dirty[e] = (unsigned char)!stable;
+    color[e] = -1;
+  }
+  for (fcm_index e = 0; e < ne; e++) {
+    const int prev = m->elem_kept[e] ? old[m->parent_elem[e]] : -1;
+    if (dirty[e]) {
+      FCM_TRY(ctx, greedy_color(s, NULL, cptr, cinc, e, color, forbid));
+      for (int a = 0; a < nn && color[e] != prev; a++) {
+        const fcm_index k = s->elem_dof[e * nn + a] / 3;
+        for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++)
+          dirty[cinc[i]] = 1;
+      }
+    } else {
+      color[e] = prev;
+    }
+    ncol = FCM_MAX(ncol, color[e] + 1);
+  }
+  FCM_TRY(ctx, color_lists(s, color, ncol));
+cleanup:
+  fcm__free(ctx, color);
+  fcm__free(ctx, dirty);
+  fcm__free(ctx, old);
+  fcm__free(ctx, forbid);
   return st;
 }
 
@@ -661,7 +742,7 @@ fcm_status fcm__space_build_topology_cut(fcm_space *s, const fcm_space *from)
   FCM_TRY(ctx, patch_node_graph(s, from, cptr, cinc, &m));
   FCM_TRY(ctx, build_pattern_rows(s));
   FCM_TRY(ctx, patch_offsets(s, from, &m));
-  FCM_TRY(ctx, build_colors(s, NULL, cptr, cinc));
+  FCM_TRY(ctx, patch_colors(s, from, cptr, cinc, &m));
   FCM_TRY(ctx, build_block_colors(s, NULL, cptr, cinc, from));
 cleanup:
   if (st != FCM_OK) fcm__space_free_topology(s);
