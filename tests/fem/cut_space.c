@@ -12,6 +12,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static fcm_ctx *ctx;
@@ -154,6 +155,69 @@ static fcm_index run(const fcm_mesh *mesh, const fcm_geometry *g, double ratio)
   return constrained;
 }
 
+/* The chain of cut spaces made with fcm__space_create_cut_take(): each the fresh space's bits,
+ * its columns in the block of the space before it where they fit (that space has none then and
+ * makes no matrix), and a cut space destroyed before it keeps its block gives it back with the
+ * columns as they were. Returns the cuts whose space took the block. */
+static int run_take(const fcm_mesh *mesh, const fcm_geometry *g)
+{
+  const fcm_space_options so = fcm_space_options_default();
+  fcm_cell_rules *rules[4] = {NULL, NULL, NULL, NULL};
+  fcm_space *space[4] = {NULL, NULL, NULL, NULL};
+  int taken = 0;
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, NULL, &rules[0]));
+  TEST_OK(ctx, fcm_space_create_embedded_with(ctx, mesh, rules[0], &so, &space[0]));
+  const double box_lo[3] = {-0.2, -0.2, -0.2}, box_hi[3] = {1.2, 0.8, 0.8};
+  const double p1[3] = {0.47, 0.3, 0.3}, n1[3] = {1.0, 0.05, 0.0};
+  const double c2[3] = {0.73, 0.55, 0.3}, n2[3] = {1.0, 0.0, 0.1}, a2[3] = {0.0, 1.0, 0.0},
+               size2[2] = {0.5, 2.0};
+  const double p3[3] = {0.5, 0.33, 0.3}, n3[3] = {0.04, 1.0, 0.02};
+  for (int k = 1; k <= 3 && space[k - 1]; k++) {
+    fcm_surface *cut = NULL;
+    fcm_space *fresh = NULL, *gone = NULL, *prev = space[k - 1];
+    if (k == 1) TEST_OK(ctx, fcm_surface_create_plane(ctx, p1, n1, box_lo, box_hi, &cut));
+    if (k == 2) TEST_OK(ctx, fcm_surface_create_rectangle(ctx, c2, n2, a2, size2, &cut));
+    if (k == 3) TEST_OK(ctx, fcm_surface_create_plane(ctx, p3, n3, box_lo, box_hi, &cut));
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, rules[k - 1], cut, &rules[k]));
+    fcm_surface_destroy(&cut);
+    if (!rules[k]) break;
+    TEST_OK(ctx, fcm_space_create_embedded_with(ctx, mesh, rules[k], &so, &fresh));
+    const int *block = prev->col_idx;
+    const size_t nnz = (size_t)prev->row_ptr[prev->num_dofs];
+    int *cols = malloc(sizeof *cols * (nnz + 1));
+    memcpy(cols, block, sizeof *cols * nnz);
+    /* a cut space destroyed (a failed cut): the block and its columns back */
+    TEST_OK(ctx, fcm__space_create_cut_take(ctx, mesh, rules[k], &so, prev, &gone));
+    TEST_TRUE(gone && same_space(gone, fresh));
+    const int took = gone && gone->col_from == prev;
+    if (took) TEST_TRUE(gone->col_idx == block && prev->col_idx == NULL);
+    fcm_space_destroy(&gone);
+    TEST_TRUE(prev->col_idx == block && same(prev->col_idx, cols, nnz, sizeof *cols));
+    /* the cut space kept */
+    TEST_OK(ctx, fcm__space_create_cut_take(ctx, mesh, rules[k], &so, prev, &space[k]));
+    if (space[k] && fresh) {
+      TEST_TRUE(same_space(space[k], fresh));
+      TEST_TRUE((space[k]->col_idx == block) == took);
+      if (took) {
+        fcm_csr *A = NULL;
+        TEST_ERR(ctx, fcm_space_matrix_create(prev, &A), FCM_ERR_ARG, "pattern went to");
+        TEST_TRUE(A == NULL);
+        taken++;
+      }
+      fcm__space_cut_keep(space[k]);
+      printf("take cut %d: %lld -> %lld DOFs, block %s\n", k, (long long)prev->num_dofs,
+             (long long)space[k]->num_dofs, took ? "taken" : "new");
+    }
+    free(cols);
+    fcm_space_destroy(&fresh);
+  }
+  for (int k = 3; k >= 0; k--) {
+    fcm_space_destroy(&space[k]);
+    fcm_cell_rules_destroy(&rules[k]);
+  }
+  return taken;
+}
+
 int main(int argc, char **argv)
 {
   fcm_element_type type;
@@ -167,7 +231,8 @@ int main(int argc, char **argv)
   TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, nc, &mesh));
   TEST_OK(ctx, fcm_geometry_create_box(ctx, glo, ghi, gn, &g));
   run(mesh, g, fcm_space_options_default().constrain_ratio);
-  TEST_TRUE(run(mesh, g, 0.2) > 0); /* tiny copies constrained */
+  TEST_TRUE(run(mesh, g, 0.2) > 0);  /* tiny copies constrained */
+  TEST_TRUE(run_take(mesh, g) >= 2); /* the third cut adds more than the room */
   fcm_geometry_destroy(&g);
   fcm_mesh_destroy(&mesh);
   fcm_ctx_destroy(&ctx);

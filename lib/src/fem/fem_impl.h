@@ -74,6 +74,11 @@ struct fcm_space {
    * DOFs) per neighbour. A full space's is the n x n pattern. */
   fcm_index *row_ptr; /* 3 num_local_copies + 1 */
   int *col_idx;
+  /* col_idx's block holds col_cap entries (room for a later cut's pattern to take it over:
+   * fcm__space_create_cut_take()); col_from: the space whose block this one took, until
+   * fcm__space_cut_keep() (NULL otherwise) */
+  size_t col_cap;
+  struct fcm_space *col_from;
   /* Per local element le, nn x nn offsets: the position of copy b in copy a's row of the copy
    * graph, so entry (3ka+i, 3kb+j) lives at row_ptr[3ka+i] + 3 off[a][b] + j (ka the local
    * position of copy a). */
@@ -159,6 +164,18 @@ FCM_COMPONENT_API fcm_status fcm__space_create_cut(fcm_ctx *ctx, const fcm_mesh 
                                                    const fcm_cell_rules *rules,
                                                    const fcm_space_options *opts,
                                                    const fcm_space *from, fcm_space **out);
+
+/* fcm__space_create_cut() that also takes from's columns block (the pattern's col_idx, never
+ * read by the patch) for its own pattern where it fits (a cut adds a few per cent of the
+ * entries; a block has a quarter more room than its first pattern): no first touch of new
+ * pages. from then has no pattern: no matrix may be made on it, and the matrices made on it
+ * before (which borrow its pattern) may not be used, until fcm__space_cut_give_back(*out) (or
+ * destroying *out) gives it back; after fcm__space_cut_keep(*out) from can only be destroyed.
+ * The same space bit for bit. (space.c) */
+FCM_COMPONENT_API fcm_status fcm__space_create_cut_take(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                                        const fcm_cell_rules *rules,
+                                                        const fcm_space_options *opts,
+                                                        fcm_space *from, fcm_space **out);
 
 /* Rebuild the topology of a local space for the cells flagged in cell_mask (NULL: none); the
  * numbering is unchanged. On failure the space has no local elements (and the error). FCM_ERR_ARG
@@ -363,7 +380,17 @@ fcm_status fcm__space_build_topology(fcm_space *s, int local, const unsigned cha
  * are from's rows mapped to the children, the offsets of their elements from's; the rest and
  * the colours are made as there. The same arrays bit for bit. Anything else (from NULL or
  * local, not a cut pair): fcm__space_build_topology(s, 0, NULL). (topology.c) */
-fcm_status fcm__space_build_topology_cut(fcm_space *s, const fcm_space *from);
+fcm_status fcm__space_build_topology_cut(fcm_space *s, const fcm_space *from, fcm_space *give);
+
+/* The columns block s took from the space before the cut (fcm__space_create_cut_take()) back
+ * to that space, its pattern written again (the same bits); nothing when s took none. A
+ * failed cut calls it before anything uses the old space's matrices again; destroying s does
+ * it too. (topology.c) */
+FCM_COMPONENT_API void fcm__space_cut_give_back(fcm_space *s);
+
+/* The cut succeeded: s keeps the columns block it took (the space before the cut has none and
+ * is only destroyed). (topology.c) */
+FCM_COMPONENT_API void fcm__space_cut_keep(fcm_space *s);
 
 /* Release the topology. (topology.c) */
 void fcm__space_free_topology(fcm_space *s);

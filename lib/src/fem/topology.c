@@ -105,9 +105,24 @@ cleanup:
   return st;
 }
 
+/* The column indices of the scalar pattern's rows (row_ptr made): three per neighbour in the
+ * copy graph. */
+static void fill_columns(fcm_space *s)
+{
+  const fcm_index nact = s->num_local_copies;
+  for (fcm_index k = 0; k < nact; k++)
+    for (int i = 0; i < 3; i++) {
+      int *cols = s->col_idx + s->row_ptr[3 * k + i];
+      for (fcm_index e = s->node_ptr[k]; e < s->node_ptr[k + 1]; e++)
+        for (int j = 0; j < 3; j++)
+          *cols++ = (int)(3 * s->node_adj[e] + j);
+    }
+}
+
 /* The scalar pattern's rows from the copy graph (the three rows of each local copy; global
- * columns). */
-static fcm_status build_pattern_rows(fcm_space *s)
+ * columns), the columns in give's block when it fits (holds them and is at most twice their
+ * size: give is left without columns, s->col_from names it), else in a new one with room. */
+static fcm_status build_pattern_rows(fcm_space *s, fcm_space *give)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
@@ -118,14 +133,18 @@ static fcm_status build_pattern_rows(fcm_space *s)
     for (int i = 0; i < 3; i++)
       s->row_ptr[3 * k + i + 1] = s->row_ptr[3 * k + i] + 3 * deg;
   }
-  FCM_ALLOC(ctx, s->row_ptr[nrow], s->col_idx);
-  for (fcm_index k = 0; k < nact; k++)
-    for (int i = 0; i < 3; i++) {
-      int *cols = s->col_idx + s->row_ptr[3 * k + i];
-      for (fcm_index e = s->node_ptr[k]; e < s->node_ptr[k + 1]; e++)
-        for (int j = 0; j < 3; j++)
-          *cols++ = (int)(3 * s->node_adj[e] + j);
-    }
+  const size_t nnz = (size_t)s->row_ptr[nrow];
+  if (give && give->col_idx && !give->col_from && nnz <= give->col_cap &&
+      nnz >= give->col_cap / 2) {
+    s->col_idx = give->col_idx, s->col_cap = give->col_cap, s->col_from = give;
+    give->col_idx = NULL, give->col_cap = 0;
+  } else {
+    /* a quarter more room for a later cut's larger pattern (fcm__space_create_cut_take()):
+     * address space only, for a large block, until that pattern fills it */
+    s->col_cap = nnz + nnz / 4;
+    FCM_ALLOC_RAW(ctx, s->col_cap + 1, s->col_idx); /* every used entry is written below */
+  }
+  fill_columns(s);
 cleanup:
   return st;
 }
@@ -151,7 +170,7 @@ static fcm_status build_pattern(fcm_space *s, const fcm_index *g2l)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
-  FCM_TRY(ctx, build_pattern_rows(s));
+  FCM_TRY(ctx, build_pattern_rows(s, NULL));
   FCM_ALLOC(ctx, (size_t)s->num_local_elems * s->nn * s->nn + 1, s->elem_off);
   if (g2l) FCM_ALLOC(ctx, (size_t)s->num_local_elems * s->nn + 1, s->elem_lcopy);
   for (fcm_index el = 0; el < s->num_local_elems; el++) {
@@ -406,10 +425,26 @@ cleanup:
   return st;
 }
 
-/* Release the topology (copy graph, pattern, offsets, colours, local lists). */
+void fcm__space_cut_give_back(fcm_space *s)
+{
+  fcm_space *from = s ? s->col_from : NULL;
+  if (!from) return;
+  from->col_idx = s->col_idx, from->col_cap = s->col_cap;
+  s->col_idx = NULL, s->col_cap = 0, s->col_from = NULL;
+  fill_columns(from); /* its rows as they were: the same bits */
+}
+
+void fcm__space_cut_keep(fcm_space *s)
+{
+  if (s) s->col_from = NULL;
+}
+
+/* Release the topology (copy graph, pattern, offsets, colours, local lists); columns taken from
+ * another space go back to it. */
 void fcm__space_free_topology(fcm_space *s)
 {
   fcm_ctx *ctx = s->ctx;
+  fcm__space_cut_give_back(s);
   void *arrays[] = {s->node_ptr,   s->node_adj,        s->row_ptr,     s->col_idx,    s->elem_off,
                     s->elem_lcopy, s->color_ptr,       s->color_elems, s->local_copy, s->local_elem,
                     s->cell_local, s->block_color_ptr, s->block_list,  s->block_elems};
@@ -422,6 +457,7 @@ void fcm__space_free_topology(fcm_space *s)
   s->block_color_ptr = s->block_list = s->block_elems = NULL;
   s->num_colors = s->num_block_colors = 0;
   s->cut_kept_rows = 0;
+  s->col_cap = 0;
   s->num_local_copies = s->num_local_elems = 0;
 }
 
@@ -726,7 +762,7 @@ static int can_patch(const fcm_space *from, const fcm_space *s)
          fcm_cell_rules_parent_num_pieces(s->rules) > 0;
 }
 
-fcm_status fcm__space_build_topology_cut(fcm_space *s, const fcm_space *from)
+fcm_status fcm__space_build_topology_cut(fcm_space *s, const fcm_space *from, fcm_space *give)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
@@ -740,7 +776,7 @@ fcm_status fcm__space_build_topology_cut(fcm_space *s, const fcm_space *from)
   FCM_TRY(ctx, build_copy_incidence(s, NULL, &cptr, &cinc));
   FCM_TRY(ctx, build_cut_map(from, s, cptr, cinc, &m));
   FCM_TRY(ctx, patch_node_graph(s, from, cptr, cinc, &m));
-  FCM_TRY(ctx, build_pattern_rows(s));
+  FCM_TRY(ctx, build_pattern_rows(s, give == from ? give : NULL));
   FCM_TRY(ctx, patch_offsets(s, from, &m));
   FCM_TRY(ctx, patch_colors(s, from, cptr, cinc, &m));
   FCM_TRY(ctx, build_block_colors(s, NULL, cptr, cinc, from));
