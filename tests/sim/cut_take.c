@@ -82,8 +82,8 @@ static long long cut_allocations(fcm_integrator *c, fcm_space *from, const fcm_m
 /* A cut of a (with the option) onto a space that took the columns of a's space, failing at
  * allocation k: a's space has its columns back (the same address and bits) and a its storage;
  * its mass matrix is b's bits again and a step of each after it the same bits. */
-static void cut_failing(fcm_integrator *a, fcm_integrator *b, fcm_space *from,
-                        const fcm_mesh *mesh, const fcm_cell_rules *rules, long long k)
+static void cut_failing(fcm_integrator *a, fcm_integrator *b, fcm_space *from, const fcm_mesh *mesh,
+                        const fcm_cell_rules *rules, long long k)
 {
   fcm_integrator *a1 = NULL;
   fcm_space *t = NULL;
