@@ -524,8 +524,9 @@ cleanup:
  * as use p: its elements are then exactly the children of p's, so its graph row is p's row with
  * every copy replaced by its child (a kept element's copies all have single children). */
 
-/* What the patch reads besides the two spaces: the parent of each new copy, the only child of
- * each old copy (-1: none or several), the kept flags of the new elements and copies. */
+/* What the patch reads besides the two spaces: the parent element of each new element, the
+ * parent of each new copy, the only child of each old copy (-1: none, -2: several), the
+ * elements using each old copy, the kept flags of the new elements and copies. */
 typedef struct cut_map {
   fcm_index *parent_elem; /* the element of from holding each new element's parent piece */
   fcm_index *parent, *child, *old_uses;
