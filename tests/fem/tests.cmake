@@ -68,6 +68,11 @@ endforeach()
 foreach(el tet4 tet10 hex8 hex20)
   fcm_add_test(fem_cut_surface_${el} tests/fem/cut_surface.c ARGS ${el})
 endforeach()
+# A cut space patched from the space before the cut (graph rows, offsets) equals one built anew,
+# every array bit for bit, over three cuts, with and without constrained tiny copies.
+foreach(el tet4 tet10 hex8 hex20)
+  fcm_add_test(fem_cut_space_${el} tests/fem/cut_space.c ARGS ${el})
+endforeach()
 # Octree backgrounds: continuity through the hanging-node constraints and patch tests across
 # hanging nodes (affine fields; quadratic ones for Hex20).
 foreach(el hex8 hex20)

@@ -58,6 +58,10 @@ endforeach()
 # A cut's integrator on the old one's storage (FCM_CUT_REUSE_STORAGE) equals one on new storage
 # bit for bit (mass, load, state after steps; Hex8, corotated linear, multigrid); the giver spent.
 fcm_add_test(sim_cut_storage tests/sim/cut_storage.c)
+# A cut space in the pattern storage of the space before it, with the integrator's storage taken:
+# the bits of a cut onto a new space; a failed cut gives the columns back before the old
+# integrator assembles its mass matrix again.
+fcm_add_test(sim_cut_take tests/sim/cut_take.c)
 # Reactions of constraints: minus the assembled weight and its moment in equilibrium (an
 # embedded beam clamped by a half-space of background nodes), change of momentum minus the
 # weight in dynamics; two constraints add up.

@@ -37,6 +37,12 @@ fcm_index fcm__space_cut_parent_elem(const fcm_space *from, const fcm_space *to,
 
 fcm_status fcm__space_cut_parents(const fcm_space *from, const fcm_space *to, fcm_index *parent)
 {
+  return fcm__space_cut_parents_with(from, to, parent, NULL);
+}
+
+fcm_status fcm__space_cut_parents_with(const fcm_space *from, const fcm_space *to,
+                                       fcm_index *parent, fcm_index *parent_elem)
+{
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = to ? to->ctx : NULL;
   FCM_TRY(ctx, fcm__space_check_cut_pair(from, to, "cut parents"));
@@ -50,6 +56,7 @@ fcm_status fcm__space_cut_parents(const fcm_space *from, const fcm_space *to, fc
               "cut parents: element %lld (cell %lld) has its parent piece outside the cell's "
               "pieces in the source",
               (long long)e, (long long)to->elem_cell[e]);
+    if (parent_elem) parent_elem[e] = fe;
     for (int a = 0; a < nn; a++) {
       const fcm_index k = to->elem_dof[e * nn + a] / 3;
       /* a constrained place holds another copy, which its own elements name */

@@ -74,6 +74,11 @@ struct fcm_space {
    * DOFs) per neighbour. A full space's is the n x n pattern. */
   fcm_index *row_ptr; /* 3 num_local_copies + 1 */
   int *col_idx;
+  /* col_idx's block holds col_cap entries (room for a later cut's pattern to take it over:
+   * fcm__space_create_cut_take()); col_from: the space whose block this one took, until
+   * fcm__space_cut_keep() (NULL otherwise) */
+  size_t col_cap;
+  struct fcm_space *col_from;
   /* Per local element le, nn x nn offsets: the position of copy b in copy a's row of the copy
    * graph, so entry (3ka+i, 3kb+j) lives at row_ptr[3ka+i] + 3 off[a][b] + j (ka the local
    * position of copy a). */
@@ -96,6 +101,9 @@ struct fcm_space {
    * neighbouring cells follow each other and their matrix rows are still in cache
    * (assemble.c). */
   int num_block_colors;
+  /* Copy graph rows fcm__space_build_topology_cut() took from the space before the cut (0: the
+   * topology was built anew) */
+  fcm_index cut_kept_rows;
   fcm_index *block_color_ptr;
   fcm_index *block_list;
   fcm_index *block_elems; /* num_local_elems */
@@ -146,6 +154,29 @@ FCM_COMPONENT_API fcm_status fcm__space_create_local(fcm_ctx *ctx, const fcm_mes
                                                      const unsigned char *cell_mask,
                                                      fcm_space **out);
 
+/* fcm_space_create_embedded_with(ctx, mesh, rules, opts, out) after a cut: rules made by
+ * fcm_cell_rules_create_cut() from the rules of `from` (a full space on the same mesh), whose
+ * topology the new space patches where the cut left it (fcm__space_build_topology_cut()). The
+ * same space bit for bit (every array); from may be NULL, local or unrelated: a space built
+ * anew. `from` is only read and may be destroyed afterwards. @return as
+ * fcm_space_create_embedded_with(). (space.c) */
+FCM_COMPONENT_API fcm_status fcm__space_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                                   const fcm_cell_rules *rules,
+                                                   const fcm_space_options *opts,
+                                                   const fcm_space *from, fcm_space **out);
+
+/* fcm__space_create_cut() that also takes from's columns block (the pattern's col_idx, never
+ * read by the patch) for its own pattern where it fits (a cut adds a few per cent of the
+ * entries; a block has a quarter more room than its first pattern): no first touch of new
+ * pages. from then has no pattern: no matrix may be made on it, and the matrices made on it
+ * before (which borrow its pattern) may not be used, until fcm__space_cut_give_back(*out) (or
+ * destroying *out) gives it back; after fcm__space_cut_keep(*out) from can only be destroyed.
+ * The same space bit for bit. (space.c) */
+FCM_COMPONENT_API fcm_status fcm__space_create_cut_take(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                                        const fcm_cell_rules *rules,
+                                                        const fcm_space_options *opts,
+                                                        fcm_space *from, fcm_space **out);
+
 /* Rebuild the topology of a local space for the cells flagged in cell_mask (NULL: none); the
  * numbering is unchanged. On failure the space has no local elements (and the error). FCM_ERR_ARG
  * for a full space. (space.c) */
@@ -178,6 +209,11 @@ fcm_index fcm__space_cut_parent_elem(const fcm_space *from, const fcm_space *to,
  * element in element order); -1 for none (a cut space has none). No allocation.
  * @return FCM_OK, FCM_ERR_ARG (NULL, not a cut pair), FCM_ERR_INTERNAL. */
 fcm_status fcm__space_cut_parents(const fcm_space *from, const fcm_space *to, fcm_index *parent);
+
+/* fcm__space_cut_parents() that also gives parent_elem[e] (num_elems(to) entries; may be NULL):
+ * fcm__space_cut_parent_elem(from, to, e), looked up once per element. */
+fcm_status fcm__space_cut_parents_with(const fcm_space *from, const fcm_space *to,
+                                       fcm_index *parent, fcm_index *parent_elem);
 
 /* same[e] (num_elems(to) entries): the element of `from` that element e of `to` integrates
  * exactly as (same cell and class; an uncut cell, or the same points, weights and flags of
@@ -337,6 +373,24 @@ fcm_status fcm__space_constrain_copies(fcm_space *s, double ratio, const fcm_ind
  * elements of the cells flagged in cell_mask (local); replaces any earlier one.
  * (topology.c) */
 fcm_status fcm__space_build_topology(fcm_space *s, int local, const unsigned char *cell_mask);
+
+/* fcm__space_build_topology(s, 0, NULL) for a cut space s (full) from `from`, the full space
+ * before the cut (s's rules made from from's by fcm_cell_rules_create_cut()): the graph rows
+ * of the copies the cut left as they were (same elements, each the only child of its parent)
+ * are from's rows mapped to the children, the offsets of their elements from's; the rest and
+ * the colours are made as there. The same arrays bit for bit. Anything else (from NULL or
+ * local, not a cut pair): fcm__space_build_topology(s, 0, NULL). (topology.c) */
+fcm_status fcm__space_build_topology_cut(fcm_space *s, const fcm_space *from, fcm_space *give);
+
+/* The columns block s took from the space before the cut (fcm__space_create_cut_take()) back
+ * to that space, its pattern written again (the same bits); nothing when s took none. A
+ * failed cut calls it before anything uses the old space's matrices again; destroying s does
+ * it too. (topology.c) */
+FCM_COMPONENT_API void fcm__space_cut_give_back(fcm_space *s);
+
+/* The cut succeeded: s keeps the columns block it took (the space before the cut has none and
+ * is only destroyed). (topology.c) */
+FCM_COMPONENT_API void fcm__space_cut_keep(fcm_space *s);
 
 /* Release the topology. (topology.c) */
 void fcm__space_free_topology(fcm_space *s);

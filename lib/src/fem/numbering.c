@@ -87,8 +87,16 @@ fcm_status fcm__space_build_copies(fcm_space *s, const fcm_index *inc_ptr, const
   const fcm_index *cells = fcm_mesh_cells(s->mesh);
   const fcm_index nl = s->rules ? fcm_cell_rules_num_links(s->rules) : 0;
   const fcm_index *links = s->rules ? fcm_cell_rules_links(s->rules) : NULL;
-  fcm_index *uf = NULL, *comp = NULL, *pos = NULL, ncopy = 0, maxdeg = 0;
+  fcm_index *uf = NULL, *comp = NULL, *pos = NULL, *link_ptr = NULL, ncopy = 0, maxdeg = 0;
+  const fcm_index npieces = s->rules ? fcm_cell_rules_num_pieces(s->rules) : 0;
   FCM_ALLOC(ctx, s->num_nodes, s->node_ncopy);
+  /* links (p, q) sorted by p: those of piece p are [link_ptr[p], link_ptr[p + 1]) */
+  FCM_ALLOC(ctx, npieces + 1, link_ptr);
+  for (fcm_index p = 0, l = 0; p <= npieces; p++) {
+    while (l < nl && links[2 * l] < p)
+      l++;
+    link_ptr[p] = l;
+  }
   for (fcm_index n = 0; n < s->num_nodes; n++)
     maxdeg = FCM_MAX(maxdeg, inc_ptr[n + 1] - inc_ptr[n]);
   FCM_ALLOC(ctx, maxdeg + 1, uf);
@@ -118,17 +126,9 @@ fcm_status fcm__space_build_copies(fcm_space *s, const fcm_index *inc_ptr, const
     fcm_index k = 1;
     if (split) {
       for (fcm_index i = 0; i < deg; i++) {
-        /* links (p, q) with p the piece of this element: binary search for the first */
+        /* links (p, q) with p the piece of this element */
         const fcm_index p = s->elem_piece[inc[i0 + i]];
-        fcm_index lo = 0, hi = nl;
-        while (lo < hi) {
-          const fcm_index mid = lo + (hi - lo) / 2;
-          if (links[2 * mid] < p)
-            lo = mid + 1;
-          else
-            hi = mid;
-        }
-        for (fcm_index l = lo; l < nl && links[2 * l] == p; l++) {
+        for (fcm_index l = link_ptr[p]; l < link_ptr[p + 1]; l++) {
           /* the element of piece q: pieces and elements of a cell are in the same order */
           const fcm_index q = links[2 * l + 1];
           const fcm_index cq = fcm_cell_rules_piece_cell(s->rules, q);
@@ -165,6 +165,7 @@ cleanup:
   fcm__free(ctx, uf);
   fcm__free(ctx, comp);
   fcm__free(ctx, pos);
+  fcm__free(ctx, link_ptr);
   return st;
 }
 

@@ -9,11 +9,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Shared by fcm_space_create(), fcm_space_create_embedded() and fcm__space_create_local()
- * (local != 0: the topology of the cells flagged in cell_mask only). */
+/* Shared by fcm_space_create(), fcm_space_create_embedded(), fcm__space_create_local() (local
+ * != 0: the topology of the cells flagged in cell_mask only) and fcm__space_create_cut() (from:
+ * the space before the cut, whose topology the new one patches). */
 static fcm_status space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigned char *cell_active,
                                const fcm_cell_rules *rules, const fcm_space_options *opts,
-                               int local, const unsigned char *cell_mask, fcm_space **out)
+                               int local, const unsigned char *cell_mask, const fcm_space *from,
+                               fcm_space *give, fcm_space **out)
 {
   fcm_status st = FCM_OK;
   fcm_space *s = NULL;
@@ -63,7 +65,10 @@ static fcm_status space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigne
   FCM_FREE(ctx, inc_ptr);
   FCM_FREE(ctx, inc);
   s->is_local = local;
-  FCM_TRY(ctx, fcm__space_build_topology(s, local, cell_mask));
+  if (from && !local)
+    FCM_TRY(ctx, fcm__space_build_topology_cut(s, from, give));
+  else
+    FCM_TRY(ctx, fcm__space_build_topology(s, local, cell_mask));
   FCM_TRY(ctx, fcm_element_standard_rule(ctx, s->type, FCM_RULE_MASS, FCM_DEFAULT, &s->mass_rule));
   FCM_ALLOC(ctx, 1, s->mass_cache);
   *out = s;
@@ -78,7 +83,7 @@ cleanup:
 fcm_status fcm_space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigned char *cell_active,
                             fcm_space **out)
 {
-  return space_create(ctx, mesh, cell_active, NULL, NULL, 0, NULL, out);
+  return space_create(ctx, mesh, cell_active, NULL, NULL, 0, NULL, NULL, NULL, out);
 }
 
 fcm_space_options fcm_space_options_default(void)
@@ -123,7 +128,33 @@ fcm_status fcm_space_create_embedded_with(fcm_ctx *ctx, const fcm_mesh *mesh,
   FCM_CHECK(out, ctx, FCM_ERR_ARG, "space: output pointer is NULL");
   *out = NULL;
   FCM_TRY(ctx, check_embedded(ctx, mesh, rules, opts));
-  FCM_TRY(ctx, space_create(ctx, mesh, NULL, rules, opts, 0, NULL, out));
+  FCM_TRY(ctx, space_create(ctx, mesh, NULL, rules, opts, 0, NULL, NULL, NULL, out));
+cleanup:
+  return st;
+}
+
+fcm_status fcm__space_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_cell_rules *rules,
+                                 const fcm_space_options *opts, const fcm_space *from,
+                                 fcm_space **out)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(out, ctx, FCM_ERR_ARG, "cut space: output pointer is NULL");
+  *out = NULL;
+  FCM_TRY(ctx, check_embedded(ctx, mesh, rules, opts));
+  FCM_TRY(ctx, space_create(ctx, mesh, NULL, rules, opts, 0, NULL, from, NULL, out));
+cleanup:
+  return st;
+}
+
+fcm_status fcm__space_create_cut_take(fcm_ctx *ctx, const fcm_mesh *mesh,
+                                      const fcm_cell_rules *rules, const fcm_space_options *opts,
+                                      fcm_space *from, fcm_space **out)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(out, ctx, FCM_ERR_ARG, "cut space: output pointer is NULL");
+  *out = NULL;
+  FCM_TRY(ctx, check_embedded(ctx, mesh, rules, opts));
+  FCM_TRY(ctx, space_create(ctx, mesh, NULL, rules, opts, 0, NULL, from, from, out));
 cleanup:
   return st;
 }
@@ -142,7 +173,8 @@ fcm_status fcm__space_create_local(fcm_ctx *ctx, const fcm_mesh *mesh,
               "which cells are active)");
     FCM_TRY(ctx, check_embedded(ctx, mesh, rules, opts));
   }
-  FCM_TRY(ctx, space_create(ctx, mesh, cell_active, rules, rules ? opts : NULL, 1, cell_mask, out));
+  FCM_TRY(ctx, space_create(ctx, mesh, cell_active, rules, rules ? opts : NULL, 1, cell_mask, NULL,
+                            NULL, out));
 cleanup:
   return st;
 }
@@ -287,10 +319,22 @@ void fcm__space_memory(const fcm_space *s, double *numbering, double *topology)
                 (s->is_local ? I * (nl + nle) + nc + (double)sizeof(int) * nn * nle : 0.0);
 }
 
+/* FCM_OK when s has its pattern's columns; else FCM_ERR_ARG: a cut space took them. */
+static fcm_status check_pattern(const fcm_space *s, const char *what)
+{
+  if (s->col_idx || !s->row_ptr || s->row_ptr[fcm__space_num_rows(s)] == 0) return FCM_OK;
+  return fcm__error(s->ctx, FCM_ERR_ARG, __FILE__, __LINE__, __func__,
+                    "%s: the space's pattern went to the space of a cut "
+                    "(fcm__space_create_cut_take()); it can only be destroyed, or get its "
+                    "pattern back from that space (fcm__space_cut_give_back())",
+                    what);
+}
+
 fcm_status fcm_space_matrix_create(const fcm_space *s, fcm_csr **A)
 {
   fcm_status st = FCM_OK;
   FCM_TRY(s->ctx, fcm__space_check_full(s, "space matrix"));
+  FCM_TRY(s->ctx, check_pattern(s, "space matrix"));
   FCM_TRY(s->ctx, fcm_csr_create(s->ctx, s->num_dofs, s->num_dofs, s->row_ptr, s->col_idx,
                                  FCM_CSR_SYMMETRIC, A));
 cleanup:
@@ -325,6 +369,7 @@ fcm_status fcm__space_matrix_create_rows_from(const fcm_space *s, fcm_csr *give,
   *A = NULL;
   FCM_CHECK(s->row_ptr, ctx, FCM_ERR_ARG,
             "space matrix (rows): the local space has no topology (a failed rebuild)");
+  FCM_TRY(ctx, check_pattern(s, "space matrix (rows)"));
   /* the space's pattern, shared (borrowed: the space outlives the matrices made on it) */
   FCM_TRY(ctx, fcm__csr_share_pattern_from(
                    ctx, fcm__space_num_rows(s), s->num_dofs, s->row_ptr, s->col_idx,

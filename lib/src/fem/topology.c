@@ -105,9 +105,24 @@ cleanup:
   return st;
 }
 
-/* Scalar pattern from the copy graph (the three rows of each local copy; global columns), and
- * the offsets of the local elements (and, for a local space, their copies' local positions). */
-static fcm_status build_pattern(fcm_space *s, const fcm_index *g2l)
+/* The column indices of the scalar pattern's rows (row_ptr made): three per neighbour in the
+ * copy graph. */
+static void fill_columns(fcm_space *s)
+{
+  const fcm_index nact = s->num_local_copies;
+  for (fcm_index k = 0; k < nact; k++)
+    for (int i = 0; i < 3; i++) {
+      int *cols = s->col_idx + s->row_ptr[3 * k + i];
+      for (fcm_index e = s->node_ptr[k]; e < s->node_ptr[k + 1]; e++)
+        for (int j = 0; j < 3; j++)
+          *cols++ = (int)(3 * s->node_adj[e] + j);
+    }
+}
+
+/* The scalar pattern's rows from the copy graph (the three rows of each local copy; global
+ * columns), the columns in give's block when it fits (holds them and is at most twice their
+ * size: give is left without columns, s->col_from names it), else in a new one with room. */
+static fcm_status build_pattern_rows(fcm_space *s, fcm_space *give)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
@@ -118,32 +133,101 @@ static fcm_status build_pattern(fcm_space *s, const fcm_index *g2l)
     for (int i = 0; i < 3; i++)
       s->row_ptr[3 * k + i + 1] = s->row_ptr[3 * k + i] + 3 * deg;
   }
-  FCM_ALLOC(ctx, s->row_ptr[nrow], s->col_idx);
-  for (fcm_index k = 0; k < nact; k++)
-    for (int i = 0; i < 3; i++) {
-      int *cols = s->col_idx + s->row_ptr[3 * k + i];
-      for (fcm_index e = s->node_ptr[k]; e < s->node_ptr[k + 1]; e++)
-        for (int j = 0; j < 3; j++)
-          *cols++ = (int)(3 * s->node_adj[e] + j);
-    }
+  const size_t nnz = (size_t)s->row_ptr[nrow];
+  if (give && give->col_idx && !give->col_from && nnz <= give->col_cap &&
+      nnz >= give->col_cap / 2) {
+    s->col_idx = give->col_idx, s->col_cap = give->col_cap, s->col_from = give;
+    give->col_idx = NULL, give->col_cap = 0;
+  } else {
+    /* a quarter more room for a later cut's larger pattern (fcm__space_create_cut_take()):
+     * address space only, for a large block, until that pattern fills it */
+    s->col_cap = nnz + nnz / 4;
+    FCM_ALLOC_RAW(ctx, s->col_cap + 1, s->col_idx); /* every used entry is written below */
+  }
+  fill_columns(s);
+cleanup:
+  return st;
+}
+
+/* The offsets of local element el at its node a: the position of each of its copies in the
+ * graph row of the copy at node a (ka its local position). */
+static void node_offsets(const fcm_space *s, fcm_index el, int a, fcm_index ka)
+{
+  const fcm_index *ed = s->elem_dof + local_elem(s, el) * s->nn;
+  int *off = s->elem_off + ((size_t)el * s->nn + a) * s->nn;
+  const fcm_index *row = s->node_adj + s->node_ptr[ka];
+  const size_t len = (size_t)(s->node_ptr[ka + 1] - s->node_ptr[ka]);
+  for (int b = 0; b < s->nn; b++) {
+    fcm_index kb = ed[b] / 3;
+    const fcm_index *hit = bsearch(&kb, row, len, sizeof *row, cmp_index);
+    off[b] = hit ? (int)(hit - row) : -1; /* every copy of the element is in the row */
+  }
+}
+
+/* Scalar pattern from the copy graph, and the offsets of the local elements (and, for a local
+ * space, their copies' local positions). */
+static fcm_status build_pattern(fcm_space *s, const fcm_index *g2l)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  FCM_TRY(ctx, build_pattern_rows(s, NULL));
   FCM_ALLOC(ctx, (size_t)s->num_local_elems * s->nn * s->nn + 1, s->elem_off);
   if (g2l) FCM_ALLOC(ctx, (size_t)s->num_local_elems * s->nn + 1, s->elem_lcopy);
   for (fcm_index el = 0; el < s->num_local_elems; el++) {
     const fcm_index *ed = s->elem_dof + local_elem(s, el) * s->nn;
-    int *off = s->elem_off + (size_t)el * s->nn * s->nn;
     for (int a = 0; a < s->nn; a++) {
       fcm_index ka = g2l ? g2l[ed[a] / 3] : ed[a] / 3;
       if (g2l) s->elem_lcopy[(size_t)el * s->nn + a] = (int)ka;
-      const fcm_index *row = s->node_adj + s->node_ptr[ka];
-      size_t len = (size_t)(s->node_ptr[ka + 1] - s->node_ptr[ka]);
-      for (int b = 0; b < s->nn; b++) {
-        fcm_index kb = ed[b] / 3;
-        const fcm_index *hit = bsearch(&kb, row, len, sizeof *row, cmp_index);
-        FCM_ASSERT(hit != NULL, ctx);
-        off[a * s->nn + b] = (int)(hit - row);
-      }
+      node_offsets(s, el, a, ka);
     }
   }
+cleanup:
+  return st;
+}
+
+/* The colour lists (color_ptr, color_elems) of the colours color[le] of the local elements. */
+static fcm_status color_lists(fcm_space *s, const int *color, int ncol)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ne = s->num_local_elems;
+  fcm_index *fill = NULL;
+  s->num_colors = ncol;
+  FCM_ALLOC(ctx, ncol + 1, s->color_ptr);
+  for (fcm_index e = 0; e < ne; e++)
+    s->color_ptr[color[e] + 1]++;
+  for (int k = 0; k < ncol; k++)
+    s->color_ptr[k + 1] += s->color_ptr[k];
+  FCM_ALLOC(ctx, s->color_ptr[ncol] + 1, s->color_elems);
+  FCM_ALLOC(ctx, ncol + 1, fill);
+  for (fcm_index e = 0; e < ne; e++)
+    s->color_elems[s->color_ptr[color[e]] + fill[color[e]]++] = e;
+cleanup:
+  fcm__free(ctx, fill);
+  return st;
+}
+
+enum { MAX_COLORS = 4096 };
+
+/* The greedy colour of local element e: the smallest colour no element sharing a copy with it
+ * has yet (color[] -1 for the elements not coloured yet); forbid holds MAX_COLORS marks. */
+static fcm_status greedy_color(const fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
+                               const fcm_index *cinc, fcm_index e, int *color, fcm_index *forbid)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index *ed = s->elem_dof + local_elem(s, e) * s->nn;
+  for (int a = 0; a < s->nn; a++) {
+    const fcm_index k = g2l ? g2l[ed[a] / 3] : ed[a] / 3;
+    for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++)
+      if (color[cinc[i]] >= 0) forbid[color[cinc[i]]] = e;
+  }
+  int k = 0;
+  while (k < MAX_COLORS && forbid[k] == e)
+    k++;
+  FCM_CHECK(k < MAX_COLORS, s->ctx, FCM_ERR_UNSUPPORTED,
+            "space: cell %lld needs more than %d colours (a node shared by too many cells)",
+            (long long)s->elem_cell[local_elem(s, e)], MAX_COLORS);
+  color[e] = k;
 cleanup:
   return st;
 }
@@ -158,8 +242,7 @@ static fcm_status build_colors(fcm_space *s, const fcm_index *g2l, const fcm_ind
   fcm_ctx *ctx = s->ctx;
   const fcm_index ne = s->num_local_elems;
   int *color = NULL, ncol = 0;
-  fcm_index *forbid = NULL, *fill = NULL;
-  enum { MAX_COLORS = 4096 };
+  fcm_index *forbid = NULL;
   FCM_ALLOC(ctx, ne + 1, color);
   FCM_ALLOC(ctx, MAX_COLORS, forbid);
   for (int k = 0; k < MAX_COLORS; k++)
@@ -167,35 +250,13 @@ static fcm_status build_colors(fcm_space *s, const fcm_index *g2l, const fcm_ind
   for (fcm_index e = 0; e < ne; e++)
     color[e] = -1;
   for (fcm_index e = 0; e < ne; e++) {
-    const fcm_index *ed = s->elem_dof + local_elem(s, e) * s->nn;
-    for (int a = 0; a < s->nn; a++) {
-      const fcm_index k = g2l ? g2l[ed[a] / 3] : ed[a] / 3;
-      for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++)
-        if (color[cinc[i]] >= 0) forbid[color[cinc[i]]] = e;
-    }
-    int k = 0;
-    while (k < MAX_COLORS && forbid[k] == e)
-      k++;
-    FCM_CHECK(k < MAX_COLORS, ctx, FCM_ERR_UNSUPPORTED,
-              "space: cell %lld needs more than %d colours (a node shared by too many cells)",
-              (long long)s->elem_cell[local_elem(s, e)], MAX_COLORS);
-    color[e] = k;
-    ncol = FCM_MAX(ncol, k + 1);
+    FCM_TRY(ctx, greedy_color(s, g2l, cptr, cinc, e, color, forbid));
+    ncol = FCM_MAX(ncol, color[e] + 1);
   }
-  s->num_colors = ncol;
-  FCM_ALLOC(ctx, ncol + 1, s->color_ptr);
-  for (fcm_index e = 0; e < ne; e++)
-    s->color_ptr[color[e] + 1]++;
-  for (int k = 0; k < ncol; k++)
-    s->color_ptr[k + 1] += s->color_ptr[k];
-  FCM_ALLOC(ctx, s->color_ptr[ncol] + 1, s->color_elems);
-  FCM_ALLOC(ctx, ncol + 1, fill);
-  for (fcm_index e = 0; e < ne; e++)
-    s->color_elems[s->color_ptr[color[e]] + fill[color[e]]++] = e;
+  FCM_TRY(ctx, color_lists(s, color, ncol));
 cleanup:
   fcm__free(ctx, color);
   fcm__free(ctx, forbid);
-  fcm__free(ctx, fill);
   return st;
 }
 
@@ -270,19 +331,51 @@ cleanup:
   return st;
 }
 
+/* build_block_order() of a full space s after a cut from the full space `from` whose active cells
+ * are s's: the cells' centres and their box are the same, so the Morton keys are, and the
+ * elements of a cell (one key, ascending positions) follow each other in both orders; the cut
+ * only changes how many elements each cell has. So each run of a cell's elements in from's
+ * order becomes the run of its elements in s. *done = 0 (nothing made) when the active cells
+ * differ. */
+static fcm_status patch_block_order(fcm_space *s, const fcm_space *from, int *done)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *order = NULL, j = 0;
+  *done = 0;
+  if (from->num_cells != s->num_cells || !from->block_elems || from->local_elem || s->local_elem ||
+      memcmp(from->active, s->active, (size_t)s->num_cells) != 0)
+    return FCM_OK;
+  FCM_ALLOC_RAW(s->ctx, s->num_elems + 1, order);
+  for (fcm_index i = 0; i < from->num_elems; i++) {
+    const fcm_index fe = from->block_elems[i], c = from->elem_cell[fe];
+    if (fe != from->cell_elem[c]) continue; /* the cell's run was written at its first */
+    for (fcm_index e = s->cell_elem[c]; e < s->cell_elem[c + 1] && j < s->num_elems; e++)
+      order[j++] = e;
+  }
+  if (j == s->num_elems) { /* every active cell has elements in both */
+    s->block_elems = order;
+    order = NULL;
+    *done = 1;
+  }
+cleanup:
+  fcm__free(s->ctx, order);
+  return st;
+}
+
 /* Greedy colouring of the blocks of FCM__SPACE_BLOCK consecutive entries of block_elems: a
  * block takes the smallest colour not used by a block with an element sharing a copy with one
  * of its own. */
 static fcm_status build_block_colors(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
-                                     const fcm_index *cinc)
+                                     const fcm_index *cinc, const fcm_space *from)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
   const fcm_index ne = s->num_local_elems, nb = (ne + FCM__SPACE_BLOCK - 1) / FCM__SPACE_BLOCK;
   int *color = NULL, ncol = 0;
   fcm_index *forbid = NULL, *fill = NULL, *block_of = NULL;
-  enum { MAX_COLORS = 4096 };
-  FCM_TRY(ctx, build_block_order(s));
+  int patched = 0;
+  if (from) FCM_TRY(ctx, patch_block_order(s, from, &patched));
+  if (!patched) FCM_TRY(ctx, build_block_order(s));
   FCM_ALLOC(ctx, ne + 1, block_of);
   for (fcm_index j = 0; j < ne; j++)
     block_of[s->block_elems[j]] = j / FCM__SPACE_BLOCK;
@@ -332,10 +425,26 @@ cleanup:
   return st;
 }
 
-/* Release the topology (copy graph, pattern, offsets, colours, local lists). */
+void fcm__space_cut_give_back(fcm_space *s)
+{
+  fcm_space *from = s ? s->col_from : NULL;
+  if (!from) return;
+  from->col_idx = s->col_idx, from->col_cap = s->col_cap;
+  s->col_idx = NULL, s->col_cap = 0, s->col_from = NULL;
+  fill_columns(from); /* its rows as they were: the same bits */
+}
+
+void fcm__space_cut_keep(fcm_space *s)
+{
+  if (s) s->col_from = NULL;
+}
+
+/* Release the topology (copy graph, pattern, offsets, colours, local lists); columns taken from
+ * another space go back to it. */
 void fcm__space_free_topology(fcm_space *s)
 {
   fcm_ctx *ctx = s->ctx;
+  fcm__space_cut_give_back(s);
   void *arrays[] = {s->node_ptr,   s->node_adj,        s->row_ptr,     s->col_idx,    s->elem_off,
                     s->elem_lcopy, s->color_ptr,       s->color_elems, s->local_copy, s->local_elem,
                     s->cell_local, s->block_color_ptr, s->block_list,  s->block_elems};
@@ -347,6 +456,8 @@ void fcm__space_free_topology(fcm_space *s)
   s->cell_local = NULL;
   s->block_color_ptr = s->block_list = s->block_elems = NULL;
   s->num_colors = s->num_block_colors = 0;
+  s->cut_kept_rows = 0;
+  s->col_cap = 0;
   s->num_local_copies = s->num_local_elems = 0;
 }
 
@@ -396,10 +507,283 @@ fcm_status fcm__space_build_topology(fcm_space *s, int local, const unsigned cha
   FCM_TRY(ctx, build_node_graph(s, g2l, cptr, cinc));
   FCM_TRY(ctx, build_pattern(s, g2l));
   FCM_TRY(ctx, build_colors(s, g2l, cptr, cinc));
-  FCM_TRY(ctx, build_block_colors(s, g2l, cptr, cinc));
+  FCM_TRY(ctx, build_block_colors(s, g2l, cptr, cinc, NULL));
 cleanup:
   if (st != FCM_OK) fcm__space_free_topology(s);
   fcm__free(ctx, g2l);
+  fcm__free(ctx, cptr);
+  fcm__free(ctx, cinc);
+  return st;
+}
+
+/* ---- The topology of a cut space patched from the space before the cut. Element e of the cut
+ * space is "kept" when its cell has as many elements in both spaces, its parent element sits at
+ * the same place among them, and at every node it uses the only child of the copy its parent
+ * uses there (the same constraint flags): the cut did not touch it. A copy k is kept when it has
+ * a parent p with no other child, every element using it is kept, and as many elements use k
+ * as use p: its elements are then exactly the children of p's, so its graph row is p's row with
+ * every copy replaced by its child (a kept element's copies all have single children). */
+
+/* What the patch reads besides the two spaces: the parent element of each new element, the
+ * parent of each new copy, the only child of each old copy (-1: none, -2: several), the
+ * elements using each old copy, the kept flags of the new elements and copies. */
+typedef struct cut_map {
+  fcm_index *parent_elem; /* the element of from holding each new element's parent piece */
+  fcm_index *parent, *child, *old_uses;
+  unsigned char *elem_kept, *copy_kept; /* copy_kept 2: kept and its mapped row sorted as is */
+} cut_map;
+
+/* Elements using each copy of s (each element once, as build_copy_incidence() counts). */
+static void count_uses(const fcm_space *s, fcm_index *uses)
+{
+  const int nn = s->nn;
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    const fcm_index *ed = s->elem_dof + e * nn;
+    for (int a = 0; a < nn; a++) {
+      int dup = 0;
+      for (int b = 0; b < a && !dup; b++)
+        dup = ed[b] / 3 == ed[a] / 3;
+      if (!dup) uses[ed[a] / 3]++;
+    }
+  }
+}
+
+/* The kept flags of the elements of s (after the cut) against from's. */
+static void mark_kept_elements(const fcm_space *from, const fcm_space *s, cut_map *m)
+{
+  const int nn = s->nn;
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    const fcm_index c = s->elem_cell[e], fe = m->parent_elem[e];
+    int kept =
+        fe >= 0 &&
+        from->cell_elem[c + 1] - from->cell_elem[c] == s->cell_elem[c + 1] - s->cell_elem[c] &&
+        fe - from->cell_elem[c] == e - s->cell_elem[c];
+    for (int a = 0; a < nn && kept; a++) {
+      const fcm_index k = s->elem_dof[e * nn + a] / 3, p = from->elem_dof[fe * nn + a] / 3;
+      const int con = s->elem_con ? s->elem_con[e * nn + a] : 0,
+                fcon = from->elem_con ? from->elem_con[fe * nn + a] : 0;
+      kept = con == fcon && m->parent[k] == p && m->child[p] == k;
+    }
+    m->elem_kept[e] = (unsigned char)kept;
+  }
+}
+
+/* The parents, children and kept flags of the cut space s against from. */
+static fcm_status build_cut_map(const fcm_space *from, const fcm_space *s, const fcm_index *cptr,
+                                const fcm_index *cinc, cut_map *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ncopy = s->num_dofs / 3, nold = from->num_dofs / 3;
+  FCM_ALLOC(ctx, ncopy + 1, m->parent);
+  FCM_ALLOC(ctx, nold + 1, m->child);
+  FCM_ALLOC(ctx, nold + 1, m->old_uses);
+  FCM_ALLOC(ctx, s->num_elems + 1, m->elem_kept);
+  FCM_ALLOC(ctx, ncopy + 1, m->copy_kept);
+  FCM_ALLOC(ctx, s->num_elems + 1, m->parent_elem);
+  FCM_TRY(ctx, fcm__space_cut_parents_with(from, s, m->parent, m->parent_elem));
+  for (fcm_index p = 0; p < nold; p++)
+    m->child[p] = -1;
+  for (fcm_index k = 0; k < ncopy; k++) {
+    const fcm_index p = m->parent[k];
+    if (p >= 0) m->child[p] = m->child[p] == -1 ? k : -2; /* -2: several children */
+  }
+  mark_kept_elements(from, s, m);
+  count_uses(from, m->old_uses);
+  for (fcm_index k = 0; k < ncopy; k++) {
+    const fcm_index p = m->parent[k];
+    int kept = p >= 0 && m->child[p] == k && cptr[k + 1] - cptr[k] == m->old_uses[p];
+    for (fcm_index i = cptr[k]; i < cptr[k + 1] && kept; i++)
+      kept = m->elem_kept[cinc[i]];
+    m->copy_kept[k] = (unsigned char)kept;
+  }
+cleanup:
+  return st;
+}
+
+static void free_cut_map(fcm_ctx *ctx, cut_map *m)
+{
+  fcm__free(ctx, m->parent_elem);
+  fcm__free(ctx, m->parent);
+  fcm__free(ctx, m->child);
+  fcm__free(ctx, m->old_uses);
+  fcm__free(ctx, m->elem_kept);
+  fcm__free(ctx, m->copy_kept);
+}
+
+/* The copy graph of the cut space: a kept copy's row is its parent's row mapped to the
+ * children (sorted again only where the map reorders it: copy_kept 1); the others' rows are
+ * made from their elements as build_node_graph() makes them. */
+static fcm_status patch_node_graph(fcm_space *s, const fcm_space *from, const fcm_index *cptr,
+                                   const fcm_index *cinc, cut_map *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ncopy = s->num_local_copies, nn = s->nn;
+  fcm_index *mark = NULL;
+  FCM_ALLOC(ctx, ncopy + 1, mark);
+  FCM_ALLOC(ctx, ncopy + 1, s->node_ptr);
+  for (int pass = 0; pass < 2; pass++) {
+    for (fcm_index k = 0; k < ncopy; k++)
+      mark[k] = -1;
+    for (fcm_index k = 0; k < ncopy; k++) {
+      fcm_index cnt = 0, base = pass ? s->node_ptr[k] : 0;
+      if (m->copy_kept[k]) {
+        const fcm_index p = m->parent[k], *row = from->node_adj + from->node_ptr[p];
+        cnt = from->node_ptr[p + 1] - from->node_ptr[p];
+        if (!pass) {
+          s->node_ptr[k + 1] = cnt;
+          continue;
+        }
+        int sorted = 1;
+        for (fcm_index i = 0; i < cnt; i++) {
+          FCM_CHECK(m->child[row[i]] >= 0, ctx, FCM_ERR_INTERNAL,
+                    "cut space: copy %lld is kept but its neighbour %lld before the cut has "
+                    "no single child",
+                    (long long)k, (long long)row[i]);
+          s->node_adj[base + i] = m->child[row[i]];
+          sorted &= i == 0 || s->node_adj[base + i] > s->node_adj[base + i - 1];
+        }
+        if (!sorted) qsort(s->node_adj + base, (size_t)cnt, sizeof *s->node_adj, cmp_index);
+        m->copy_kept[k] = (unsigned char)(sorted ? 2 : 1);
+        s->cut_kept_rows++;
+        continue;
+      }
+      for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++) {
+        const fcm_index e = cinc[i];
+        for (int b = 0; b < nn; b++) {
+          const fcm_index q = s->elem_dof[e * nn + b] / 3;
+          if (mark[q] == k) continue;
+          mark[q] = k;
+          if (pass) s->node_adj[base + cnt] = q;
+          cnt++;
+        }
+      }
+      if (pass)
+        qsort(s->node_adj + base, (size_t)cnt, sizeof *s->node_adj, cmp_index);
+      else
+        s->node_ptr[k + 1] = cnt;
+    }
+    if (!pass) {
+      for (fcm_index k = 0; k < ncopy; k++)
+        s->node_ptr[k + 1] += s->node_ptr[k];
+      FCM_ALLOC(ctx, s->node_ptr[ncopy] + 1, s->node_adj);
+    }
+  }
+cleanup:
+  fcm__free(ctx, mark);
+  return st;
+}
+
+/* The offsets of the cut space's elements: a kept element's at a node whose copy's row is its
+ * parent's in the same order are its parent element's; the others are looked up. */
+static fcm_status patch_offsets(fcm_space *s, const fcm_space *from, const cut_map *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const int nn = s->nn;
+  FCM_ALLOC(ctx, (size_t)s->num_elems * nn * nn + 1, s->elem_off);
+  for (fcm_index e = 0; e < s->num_elems; e++) {
+    const fcm_index fe = m->elem_kept[e] ? m->parent_elem[e] : -1;
+    for (int a = 0; a < nn; a++) {
+      const fcm_index k = s->elem_dof[e * nn + a] / 3;
+      if (fe >= 0 && m->copy_kept[k] == 2)
+        memcpy(s->elem_off + ((size_t)e * nn + a) * nn, from->elem_off + ((size_t)fe * nn + a) * nn,
+               sizeof(int) * (size_t)nn);
+      else
+        node_offsets(s, e, a, k);
+    }
+  }
+cleanup:
+  return st;
+}
+
+/* The element colouring of the cut space, greedy_color() only where it may differ from the
+ * space before the cut. An element whose copies are all kept has the children of its parent's
+ * neighbours for neighbours, in the same order; while none of those before it has another
+ * colour than its parent's, the greedy colouring gives it its parent's colour. So the other
+ * elements are coloured anew, and with them the elements sharing a copy with an element whose
+ * colour is not its parent's (or that has no parent). */
+static fcm_status patch_colors(fcm_space *s, const fcm_space *from, const fcm_index *cptr,
+                               const fcm_index *cinc, const cut_map *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ne = s->num_elems;
+  const int nn = s->nn;
+  int *color = NULL, *old = NULL, ncol = 0;
+  unsigned char *dirty = NULL;
+  fcm_index *forbid = NULL;
+  FCM_ALLOC(ctx, ne + 1, color);
+  FCM_ALLOC(ctx, ne + 1, dirty);
+  FCM_ALLOC(ctx, from->num_elems + 1, old);
+  FCM_ALLOC(ctx, MAX_COLORS, forbid);
+  for (int k = 0; k < MAX_COLORS; k++)
+    forbid[k] = -1;
+  for (int c = 0; c < from->num_colors; c++)
+    for (fcm_index i = from->color_ptr[c]; i < from->color_ptr[c + 1]; i++)
+      old[from->color_elems[i]] = c;
+  for (fcm_index e = 0; e < ne; e++) {
+    int stable = m->elem_kept[e];
+    for (int a = 0; a < nn && stable; a++)
+      stable = m->copy_kept[s->elem_dof[e * nn + a] / 3] != 0;
+    dirty[e] = (unsigned char)!stable;
+    color[e] = -1;
+  }
+  for (fcm_index e = 0; e < ne; e++) {
+    const int prev = m->elem_kept[e] ? old[m->parent_elem[e]] : -1;
+    if (dirty[e]) {
+      FCM_TRY(ctx, greedy_color(s, NULL, cptr, cinc, e, color, forbid));
+      for (int a = 0; a < nn && color[e] != prev; a++) {
+        const fcm_index k = s->elem_dof[e * nn + a] / 3;
+        for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++)
+          dirty[cinc[i]] = 1;
+      }
+    } else {
+      color[e] = prev;
+    }
+    ncol = FCM_MAX(ncol, color[e] + 1);
+  }
+  FCM_TRY(ctx, color_lists(s, color, ncol));
+cleanup:
+  fcm__free(ctx, color);
+  fcm__free(ctx, dirty);
+  fcm__free(ctx, old);
+  fcm__free(ctx, forbid);
+  return st;
+}
+
+/* 1 when from is a full space whose topology s (full, after a cut) can patch. */
+static int can_patch(const fcm_space *from, const fcm_space *s)
+{
+  if (!from || from->is_local || s->is_local || !from->node_ptr || !from->elem_off ||
+      from->nn != s->nn || from->mesh != s->mesh || !from->rules || !s->rules)
+    return 0;
+  return fcm_cell_rules_parent_num_pieces(s->rules) == fcm_cell_rules_num_pieces(from->rules) &&
+         fcm_cell_rules_parent_num_pieces(s->rules) > 0;
+}
+
+fcm_status fcm__space_build_topology_cut(fcm_space *s, const fcm_space *from, fcm_space *give)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  fcm_index *cptr = NULL, *cinc = NULL;
+  cut_map m;
+  memset(&m, 0, sizeof m);
+  if (!can_patch(from, s)) return fcm__space_build_topology(s, 0, NULL);
+  fcm__space_free_topology(s);
+  s->num_local_elems = s->num_elems;
+  s->num_local_copies = s->num_dofs / 3;
+  FCM_TRY(ctx, build_copy_incidence(s, NULL, &cptr, &cinc));
+  FCM_TRY(ctx, build_cut_map(from, s, cptr, cinc, &m));
+  FCM_TRY(ctx, patch_node_graph(s, from, cptr, cinc, &m));
+  FCM_TRY(ctx, build_pattern_rows(s, give == from ? give : NULL));
+  FCM_TRY(ctx, patch_offsets(s, from, &m));
+  FCM_TRY(ctx, patch_colors(s, from, cptr, cinc, &m));
+  FCM_TRY(ctx, build_block_colors(s, NULL, cptr, cinc, from));
+cleanup:
+  if (st != FCM_OK) fcm__space_free_topology(s);
+  free_cut_map(ctx, &m);
   fcm__free(ctx, cptr);
   fcm__free(ctx, cinc);
   return st;

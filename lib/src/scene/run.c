@@ -527,9 +527,13 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   S->cut_phase[0] = fcm_wtime() - t0;
   S->cut_stats[k] = *fcm_cell_rules_get_stats(rules);
   S->c.cut_cells += S->cut_stats[k].num_integrated;
-  FCM_TRY(ctx,
-          create_space(S, rules, fcm__integrator_distributed(S->integ, NULL) ? rules->own : NULL,
-                       &space));
+  if (fcm__integrator_distributed(S->integ, NULL)) {
+    FCM_TRY(ctx, create_space(S, rules, rules->own, &space));
+  } else { /* fcm_space_create_embedded()'s space, its topology patched from the last one's
+              and its pattern in the last one's storage (given back if the cut fails) */
+    const fcm_space_options so = fcm_space_options_default();
+    FCM_TRY(ctx, fcm__space_create_cut_take(ctx, S->mesh, rules, &so, S->space, &space));
+  }
   S->cut_phase[1] = fcm_wtime() - t0 - S->cut_phase[0];
   /* missed: no cell got a new piece and no node a new copy (a cut along cell faces adds copies
    * without splitting any cell) */
@@ -541,6 +545,7 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   S->base_factorizations = S->c.factorizations;
   S->base_analyses = S->c.analyses;
   S->base_fallbacks = S->c.direct_fallbacks;
+  fcm__space_cut_keep(space); /* the last space's pattern is the new one's for good */
   fcm_integrator_destroy(&S->integ);
   fcm_space_destroy(&S->space);
   fcm_cell_rules_destroy(&S->rules);

@@ -105,6 +105,9 @@ void fcm__sim_cut_give_storage(const fcm_integrator *old, fcm_integrator *I)
 void fcm__sim_cut_give_back(fcm_integrator *I, fcm_integrator *old)
 {
   fcm_status st = FCM_OK;
+  /* the pattern's columns the cut space took from old's space (fcm__space_create_cut_take())
+   * go back first: old's matrices name them. The cut space is its owner's to destroy next. */
+  if (I->space->col_from == old->space) fcm__space_cut_give_back((fcm_space *)I->space);
   fcm__csr_give_back(I->H, old->H); /* assembled again at old's next iteration */
   old->h_state = SIM_H_INVALID;
   old->kept = 0;

@@ -1,0 +1,240 @@
+/* A cut space patched from the space before the cut (fcm__space_create_cut()) equals the space
+ * built anew on the same rules, every array bit for bit. An embedded box is cut three times (a
+ * plane, a partial rectangle from the top face ending inside the body, a plane across the first
+ * into cells already cut), each cut space patched from the patched one before it; once with the
+ * default constraint ratio and once with a large one that constrains tiny copies (Koschier). The
+ * patch must take graph rows from the space before the cut (a tenth at least: not rebuild them),
+ * and a space before the cut with one stale offset, or two entries of its block order swapped,
+ * gives a different space (the offsets and the order are taken, and the comparison sees them).
+ * Usage: fem_cut_space <element> */
+#include "fem/fem_impl.h"
+#include "test.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static fcm_ctx *ctx;
+
+/* 1 when the n items of size sz at a and b hold the same bits. */
+static int same(const void *a, const void *b, size_t n, size_t sz)
+{
+  return n == 0 || (a && b && memcmp(a, b, n * sz) == 0);
+}
+
+/* Every array of the two full spaces: numbering, graph, pattern, offsets, colours, blocks. */
+static int same_space(const fcm_space *a, const fcm_space *b)
+{
+  const size_t I = sizeof(fcm_index), nn = (size_t)a->nn;
+  const size_t nc = (size_t)a->num_cells, np = (size_t)a->num_nodes, ne = (size_t)a->num_elems;
+  const size_t ncopy = (size_t)a->num_dofs / 3, nb = (ne + FCM__SPACE_BLOCK - 1) / FCM__SPACE_BLOCK;
+  if (a->nn != b->nn || a->num_dofs != b->num_dofs || a->num_elems != b->num_elems ||
+      a->num_constrained != b->num_constrained || a->num_colors != b->num_colors ||
+      a->num_block_colors != b->num_block_colors || a->max_cut_points != b->max_cut_points ||
+      !a->elem_con != !b->elem_con || a->num_local_copies != b->num_local_copies ||
+      a->num_local_elems != b->num_local_elems)
+    return 0;
+  int ok = same(a->active, b->active, nc, 1) && same(a->node_dof, b->node_dof, np, I) &&
+           same(a->node_ncopy, b->node_ncopy, np, I) &&
+           same(a->cell_elem, b->cell_elem, nc + 1, I) && same(a->elem_cell, b->elem_cell, ne, I) &&
+           same(a->elem_piece, b->elem_piece, ne, I) && same(a->elem_dof, b->elem_dof, ne * nn, I);
+  ok = ok && (!a->elem_con || same(a->elem_con, b->elem_con, ne * nn, 1));
+  ok = ok && same(a->node_ptr, b->node_ptr, ncopy + 1, I) &&
+       same(a->node_adj, b->node_adj, (size_t)a->node_ptr[ncopy], I);
+  ok = ok && same(a->row_ptr, b->row_ptr, 3 * ncopy + 1, I) &&
+       same(a->col_idx, b->col_idx, (size_t)a->row_ptr[3 * ncopy], sizeof(int));
+  ok = ok && same(a->elem_off, b->elem_off, ne * nn * nn, sizeof(int));
+  ok = ok && same(a->color_ptr, b->color_ptr, (size_t)a->num_colors + 1, I) &&
+       same(a->color_elems, b->color_elems, ne, I);
+  ok = ok && same(a->block_color_ptr, b->block_color_ptr, (size_t)a->num_block_colors + 1, I) &&
+       same(a->block_list, b->block_list, nb, I) && same(a->block_elems, b->block_elems, ne, I);
+  return ok && !a->local_elem && !b->local_elem && !a->elem_lcopy && !b->elem_lcopy;
+}
+
+/* The three cuts on the box, each space patched from the last; ratio: the constraint ratio.
+ * Returns the constrained copies of the last space. */
+static fcm_index run(const fcm_mesh *mesh, const fcm_geometry *g, double ratio)
+{
+  fcm_space_options so = fcm_space_options_default();
+  so.constrain_ratio = ratio;
+  fcm_cell_rules *rules[4] = {NULL, NULL, NULL, NULL};
+  fcm_space *space[4] = {NULL, NULL, NULL, NULL};
+  fcm_index constrained = 0;
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, NULL, &rules[0]));
+  TEST_OK(ctx, fcm_space_create_embedded_with(ctx, mesh, rules[0], &so, &space[0]));
+  const double box_lo[3] = {-0.2, -0.2, -0.2}, box_hi[3] = {1.2, 0.8, 0.8};
+  const double p1[3] = {0.47, 0.3, 0.3}, n1[3] = {1.0, 0.05, 0.0};
+  const double c2[3] = {0.73, 0.55, 0.3}, n2[3] = {1.0, 0.0, 0.1}, a2[3] = {0.0, 1.0, 0.0},
+               size2[2] = {0.5, 2.0};
+  const double p3[3] = {0.5, 0.33, 0.3}, n3[3] = {0.04, 1.0, 0.02};
+  for (int k = 1; k <= 3 && space[k - 1]; k++) {
+    fcm_surface *cut = NULL;
+    fcm_space *fresh = NULL;
+    if (k == 1) TEST_OK(ctx, fcm_surface_create_plane(ctx, p1, n1, box_lo, box_hi, &cut));
+    if (k == 2) TEST_OK(ctx, fcm_surface_create_rectangle(ctx, c2, n2, a2, size2, &cut));
+    if (k == 3) TEST_OK(ctx, fcm_surface_create_plane(ctx, p3, n3, box_lo, box_hi, &cut));
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, rules[k - 1], cut, &rules[k]));
+    fcm_surface_destroy(&cut);
+    if (!rules[k]) break;
+    TEST_OK(ctx, fcm__space_create_cut(ctx, mesh, rules[k], &so, space[k - 1], &space[k]));
+    TEST_OK(ctx, fcm_space_create_embedded_with(ctx, mesh, rules[k], &so, &fresh));
+    if (space[k] && fresh) {
+      const fcm_index rows = space[k]->num_dofs / 3;
+      printf("ratio %g cut %d: %lld -> %lld DOFs, %lld constrained, %lld of %lld rows kept\n",
+             ratio, k, (long long)space[k - 1]->num_dofs, (long long)space[k]->num_dofs,
+             (long long)space[k]->num_constrained, (long long)space[k]->cut_kept_rows,
+             (long long)rows);
+      TEST_TRUE(space[k]->num_dofs > space[k - 1]->num_dofs);
+      TEST_TRUE(same_space(space[k], fresh));
+      /* the patch took rows away from the cut and made the cut's own anew */
+      TEST_TRUE(space[k]->cut_kept_rows >= rows / 10 && space[k]->cut_kept_rows < rows);
+      TEST_TRUE(fresh->cut_kept_rows == 0);
+      constrained = space[k]->num_constrained;
+      /* a stale offset of a kept element in the space before the cut shows in the patch */
+      int *off = space[k - 1]->elem_off;
+      const fcm_index ne = space[k - 1]->num_elems;
+      fcm_index e0 = -1;
+      double best = HUGE_VAL, X[3 * FCM_ELEMENT_MAX_NODES];
+      for (fcm_index e = 0; e < ne; e++) { /* the element nearest the origin, far from the cuts */
+        fcm_mesh_cell_coords(mesh, space[k - 1]->elem_cell[e], X);
+        if (X[0] + X[1] + X[2] < best) best = X[0] + X[1] + X[2], e0 = e;
+      }
+      TEST_TRUE(e0 >= 0);
+      if (e0 >= 0) {
+        fcm_space *stale = NULL;
+        const int nn2 = space[k - 1]->nn * space[k - 1]->nn, keep = off[e0 * nn2 + 1];
+        off[e0 * nn2 + 1] = keep + 1;
+        TEST_OK(ctx, fcm__space_create_cut(ctx, mesh, rules[k], &so, space[k - 1], &stale));
+        TEST_TRUE(stale && !same_space(stale, fresh));
+        off[e0 * nn2 + 1] = keep;
+        fcm_space_destroy(&stale);
+      }
+      /* the block order is taken from the space before the cut (its active cells are the
+       * same): two of its entries swapped show in the patch */
+      fcm_index *order = space[k - 1]->block_elems;
+      const fcm_index b0 = order[0], b1 = order[ne - 1];
+      TEST_TRUE(space[k - 1]->elem_cell[b0] != space[k - 1]->elem_cell[b1]);
+      order[0] = b1, order[ne - 1] = b0;
+      fcm_space *swapped = NULL;
+      TEST_OK(ctx, fcm__space_create_cut(ctx, mesh, rules[k], &so, space[k - 1], &swapped));
+      TEST_TRUE(swapped && !same(swapped->block_elems, fresh->block_elems, (size_t)fresh->num_elems,
+                                 sizeof(fcm_index)));
+      order[0] = b0, order[ne - 1] = b1;
+      fcm_space_destroy(&swapped);
+      /* the colours of the elements away from the cut are taken too: the first elements of
+       * colours 0 and 1 (at the corner at the origin) swapped show in the patch; the third cut
+       * runs along the body within reach of every element */
+      fcm_index *ce = space[k - 1]->color_elems, *cp = space[k - 1]->color_ptr;
+      TEST_TRUE(space[k - 1]->num_colors > 1);
+      if (k < 3 && space[k - 1]->num_colors > 1) {
+        const fcm_index c0 = ce[cp[0]], c1 = ce[cp[1]];
+        ce[cp[0]] = c1, ce[cp[1]] = c0;
+        TEST_OK(ctx, fcm__space_create_cut(ctx, mesh, rules[k], &so, space[k - 1], &swapped));
+        TEST_TRUE(swapped && !same(swapped->color_elems, fresh->color_elems,
+                                   (size_t)fresh->num_elems, sizeof(fcm_index)));
+        ce[cp[0]] = c0, ce[cp[1]] = c1;
+        fcm_space_destroy(&swapped);
+      }
+    }
+    fcm_space_destroy(&fresh);
+  }
+  /* an unrelated space before (the rules of the same cut, not their parent): built anew */
+  if (space[2] && rules[3]) {
+    fcm_space *s = NULL, *fresh = NULL;
+    TEST_OK(ctx, fcm__space_create_cut(ctx, mesh, rules[2], &so, space[2], &s));
+    TEST_OK(ctx, fcm_space_create_embedded_with(ctx, mesh, rules[2], &so, &fresh));
+    TEST_TRUE(s && fresh && s->cut_kept_rows == 0 && same_space(s, fresh));
+    fcm_space_destroy(&s);
+    fcm_space_destroy(&fresh);
+  }
+  for (int k = 3; k >= 0; k--) {
+    fcm_space_destroy(&space[k]);
+    fcm_cell_rules_destroy(&rules[k]);
+  }
+  return constrained;
+}
+
+/* The chain of cut spaces made with fcm__space_create_cut_take(): each the fresh space's bits,
+ * its columns in the block of the space before it where they fit (that space has none then and
+ * makes no matrix), and a cut space destroyed before it keeps its block gives it back with the
+ * columns as they were. Returns the cuts whose space took the block. */
+static int run_take(const fcm_mesh *mesh, const fcm_geometry *g)
+{
+  const fcm_space_options so = fcm_space_options_default();
+  fcm_cell_rules *rules[4] = {NULL, NULL, NULL, NULL};
+  fcm_space *space[4] = {NULL, NULL, NULL, NULL};
+  int taken = 0;
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, NULL, &rules[0]));
+  TEST_OK(ctx, fcm_space_create_embedded_with(ctx, mesh, rules[0], &so, &space[0]));
+  const double box_lo[3] = {-0.2, -0.2, -0.2}, box_hi[3] = {1.2, 0.8, 0.8};
+  const double p1[3] = {0.47, 0.3, 0.3}, n1[3] = {1.0, 0.05, 0.0};
+  const double c2[3] = {0.73, 0.55, 0.3}, n2[3] = {1.0, 0.0, 0.1}, a2[3] = {0.0, 1.0, 0.0},
+               size2[2] = {0.5, 2.0};
+  const double p3[3] = {0.5, 0.33, 0.3}, n3[3] = {0.04, 1.0, 0.02};
+  for (int k = 1; k <= 3 && space[k - 1]; k++) {
+    fcm_surface *cut = NULL;
+    fcm_space *fresh = NULL, *gone = NULL, *prev = space[k - 1];
+    if (k == 1) TEST_OK(ctx, fcm_surface_create_plane(ctx, p1, n1, box_lo, box_hi, &cut));
+    if (k == 2) TEST_OK(ctx, fcm_surface_create_rectangle(ctx, c2, n2, a2, size2, &cut));
+    if (k == 3) TEST_OK(ctx, fcm_surface_create_plane(ctx, p3, n3, box_lo, box_hi, &cut));
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, rules[k - 1], cut, &rules[k]));
+    fcm_surface_destroy(&cut);
+    if (!rules[k]) break;
+    TEST_OK(ctx, fcm_space_create_embedded_with(ctx, mesh, rules[k], &so, &fresh));
+    const int *block = prev->col_idx;
+    const size_t nnz = (size_t)prev->row_ptr[prev->num_dofs];
+    int *cols = malloc(sizeof *cols * (nnz + 1));
+    memcpy(cols, block, sizeof *cols * nnz);
+    /* a cut space destroyed (a failed cut): the block and its columns back */
+    TEST_OK(ctx, fcm__space_create_cut_take(ctx, mesh, rules[k], &so, prev, &gone));
+    TEST_TRUE(gone && same_space(gone, fresh));
+    const int took = gone && gone->col_from == prev;
+    if (took) TEST_TRUE(gone->col_idx == block && prev->col_idx == NULL);
+    fcm_space_destroy(&gone);
+    TEST_TRUE(prev->col_idx == block && same(prev->col_idx, cols, nnz, sizeof *cols));
+    /* the cut space kept */
+    TEST_OK(ctx, fcm__space_create_cut_take(ctx, mesh, rules[k], &so, prev, &space[k]));
+    if (space[k] && fresh) {
+      TEST_TRUE(same_space(space[k], fresh));
+      TEST_TRUE((space[k]->col_idx == block) == took);
+      if (took) {
+        fcm_csr *A = NULL;
+        TEST_ERR(ctx, fcm_space_matrix_create(prev, &A), FCM_ERR_ARG, "pattern went to");
+        TEST_TRUE(A == NULL);
+        taken++;
+      }
+      fcm__space_cut_keep(space[k]);
+      printf("take cut %d: %lld -> %lld DOFs, block %s\n", k, (long long)prev->num_dofs,
+             (long long)space[k]->num_dofs, took ? "taken" : "new");
+    }
+    free(cols);
+    fcm_space_destroy(&fresh);
+  }
+  for (int k = 3; k >= 0; k--) {
+    fcm_space_destroy(&space[k]);
+    fcm_cell_rules_destroy(&rules[k]);
+  }
+  return taken;
+}
+
+int main(int argc, char **argv)
+{
+  fcm_element_type type;
+  if (argc != 2 || fcm_element_type_from_name(argv[1], &type) != FCM_OK) return 2;
+  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  const double lo[3] = {-0.3, -0.3, -0.3}, hi[3] = {1.3, 0.9, 0.9};
+  const double glo[3] = {0, 0, 0}, ghi[3] = {1, 0.6, 0.6};
+  const fcm_index nc[3] = {10, 8, 8}, gn[3] = {2, 2, 2};
+  fcm_mesh *mesh = NULL;
+  fcm_geometry *g = NULL;
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, nc, &mesh));
+  TEST_OK(ctx, fcm_geometry_create_box(ctx, glo, ghi, gn, &g));
+  run(mesh, g, fcm_space_options_default().constrain_ratio);
+  TEST_TRUE(run(mesh, g, 0.2) > 0);  /* tiny copies constrained */
+  TEST_TRUE(run_take(mesh, g) >= 2); /* the third cut adds more than the room */
+  fcm_geometry_destroy(&g);
+  fcm_mesh_destroy(&mesh);
+  fcm_ctx_destroy(&ctx);
+  return TEST_RESULT();
+}
