@@ -90,17 +90,20 @@ cleanup:
   return st;
 }
 
-/* Rows per chunk of the symbolic product: the unit a thread takes at a time. */
-#define PATTERN_CHUNK 256
+/* Rows per chunk of the symbolic product: the unit a thread takes at a time (a multiple of 3,
+ * so that a node's three rows lie in one chunk). */
+#define PATTERN_CHUNK 255
 
 /* What the threads of product_pattern() share. Each thread t appends the columns of the chunks
- * it takes to its own buffer buf[t] (cap[t] entries, len[t] used); chunk c's columns lie at
- * buf[thr[c]] + off[c], rows in order, and row i's count in Cp[i + 1]. */
+ * it takes to its own buffer buf[t] (cap[t] entries, len[t] used); chunk c's rows, but those
+ * repeating the row before (dup), lie at buf[thr[c]] + off[c], rows in order, and row i's count
+ * in Cp[i + 1]. */
 typedef struct pattern_work {
   fcm_index nrow, ncol;
   const fcm_index *Ap, *Bp;
   const int *Ac, *Bc;
   int sorted;
+  const unsigned char *dup; /* per row (NULL: none): its pattern is the row before's */
   fcm_index *Cp;
   fcm_index *mark, *stamp; /* per thread: ncol marks, and the stamp of its current row */
   int *row;                /* per thread: ncol + 1 columns of the current row */
@@ -110,17 +113,29 @@ typedef struct pattern_work {
   size_t *off;
 } pattern_work;
 
+/* Is row i of chunk c the row before's pattern (both in the chunk)? */
+static int pattern_dup(const pattern_work *w, fcm_index c, fcm_index i)
+{
+  return w->dup && i > c * PATTERN_CHUNK && w->dup[i];
+}
+
 /* Chunk c's rows by thread t into its buffer: 1, or 0 (nothing kept) when they do not fit. A
- * row's columns are those first reached (A's row order, then B's), sorted when asked. */
+ * row's columns are those first reached (A's row order, then B's), sorted when asked; a row
+ * repeating the row before is counted, not stored. */
 static int pattern_chunk(pattern_work *w, int t, fcm_index c)
 {
   fcm_index *mk = w->mark + (size_t)t * (size_t)w->ncol;
   int *row = w->row + (size_t)t * (size_t)(w->ncol + 1);
   const size_t off = w->len[t];
   const fcm_index i1 = FCM_MIN(w->nrow, (c + 1) * PATTERN_CHUNK);
+  fcm_index cnt = 0;
   for (fcm_index i = c * PATTERN_CHUNK; i < i1; i++) {
+    if (pattern_dup(w, c, i)) {
+      w->Cp[i + 1] = cnt;
+      continue;
+    }
     const fcm_index tag = w->stamp[t]++;
-    fcm_index cnt = 0;
+    cnt = 0;
     for (fcm_index p = w->Ap[i]; p < w->Ap[i + 1]; p++) {
       const fcm_index k = w->Ac[p];
       for (fcm_index q = w->Bp[k]; q < w->Bp[k + 1]; q++) {
@@ -143,20 +158,39 @@ static int pattern_chunk(pattern_work *w, int t, fcm_index c)
   return 1;
 }
 
+/* Chunk c's columns from its buffer into Cc (Cp summed), the repeated rows copied. */
+static void pattern_gather(const pattern_work *w, fcm_index c, int *Cc)
+{
+  const int *from = w->buf[w->thr[c]] + w->off[c];
+  const fcm_index i1 = FCM_MIN(w->nrow, (c + 1) * PATTERN_CHUNK);
+  for (fcm_index i = c * PATTERN_CHUNK; i < i1; i++) {
+    const fcm_index len = w->Cp[i + 1] - w->Cp[i];
+    if (pattern_dup(w, c, i)) {
+      memcpy(Cc + w->Cp[i], Cc + w->Cp[i - 1], sizeof *Cc * (size_t)len);
+    } else {
+      memcpy(Cc + w->Cp[i], from, sizeof *Cc * (size_t)len);
+      from += len;
+    }
+  }
+}
+
 /* Pattern of C = A B (nrow rows of A, ncol columns of B), each row's columns sorted when
- * `sorted`, else in the order first reached (the same for any thread count); chunks of rows
- * shared by nt threads in one pass: a thread whose buffer is full leaves its chunks for
+ * `sorted`, else in the order first reached (the same for any thread count); dup (NULL: none)
+ * flags the rows whose pattern is the row before's (A's rows and the rows of B they reach
+ * giving the same columns in the same order), which are copied instead of computed. Chunks of
+ * rows shared by nt threads in one pass: a thread whose buffer is full leaves its chunks for
  * another round after the buffer has grown. */
 static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fcm_index *Ap,
                                   const int *Ac, const fcm_index *Bp, const int *Bc, fcm_index ncol,
-                                  int sorted, fcm_index **Cp_out, int **Cc_out)
+                                  int sorted, const unsigned char *dup, fcm_index **Cp_out,
+                                  int **Cc_out)
 {
   fcm_status st = FCM_OK;
   const fcm_index nchunk = (nrow + PATTERN_CHUNK - 1) / PATTERN_CHUNK;
   fcm_index *pending = NULL, npending = nchunk;
   unsigned char *full = NULL, *left = NULL;
   int *Cc = NULL;
-  pattern_work w = {nrow, ncol, Ap,   Bp,   Ac,   Bc,   sorted, NULL,
+  pattern_work w = {nrow, ncol, Ap,   Bp,   Ac,   Bc,   sorted, dup, NULL,
                     NULL, NULL, NULL, NULL, NULL, NULL, NULL,   NULL};
   FCM_ALLOC(ctx, nrow + 1, w.Cp);
   FCM_ALLOC_RAW(ctx, (size_t)nt * (size_t)ncol + 1, w.mark);
@@ -202,10 +236,9 @@ static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fc
   for (fcm_index i = 0; i < nrow; i++)
     w.Cp[i + 1] += w.Cp[i];
   FCM_ALLOC_RAW(ctx, w.Cp[nrow] + 1, Cc); /* every entry copied below */
-  for (fcm_index c = 0; c < nchunk; c++) {
-    const fcm_index r0 = w.Cp[c * PATTERN_CHUNK], r1 = w.Cp[FCM_MIN(nrow, (c + 1) * PATTERN_CHUNK)];
-    memcpy(Cc + r0, w.buf[w.thr[c]] + w.off[c], sizeof *Cc * (size_t)(r1 - r0));
-  }
+#pragma omp parallel for num_threads(nt) schedule(static) if (nt > 1 && nchunk > 1)
+  for (fcm_index c = 0; c < nchunk; c++)
+    pattern_gather(&w, c, Cc);
   *Cp_out = w.Cp, *Cc_out = Cc;
   w.Cp = NULL, Cc = NULL;
 cleanup:
@@ -349,7 +382,8 @@ static void product_shifted(fcm_index i, const fcm_index *Ap, const int *Ac, con
 enum { KIND_ROWS = 0, KIND_TRIPLE = 1, KIND_SHIFTED = 2 };
 
 /* Whether rows i, i + 1, i + 2 (< A's row count) of A = R may go by product_shifted() with
- * B = A P, whose groups of three rows b_same3 flags as one pattern each. */
+ * B = A P, whose groups of three rows b_same3 flags as one pattern each; Av NULL: the
+ * pattern's part of the test alone (the three rows of A B then have one pattern). */
 static int shifted3(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
                     const unsigned char *b_same3)
 {
@@ -358,7 +392,7 @@ static int shifted3(fcm_index i, const fcm_index *Ap, const int *Ac, const doubl
   for (fcm_index q = 0; q < len; q++) {
     const fcm_index p = Ap[i] + q, p1 = Ap[i + 1] + q, p2 = Ap[i + 2] + q;
     if (Ac[p] % 3 != 0 || !b_same3[Ac[p] / 3] || Ac[p1] != Ac[p] + 1 || Ac[p2] != Ac[p] + 2 ||
-        Av[p1] != Av[p] || Av[p2] != Av[p])
+        (Av && (Av[p1] != Av[p] || Av[p2] != Av[p])))
       return 0;
   }
   return 1;
@@ -419,6 +453,7 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
   fcm__ptap *t = NULL;
   fcm_index *cp = NULL;
   int *cc = NULL;
+  unsigned char *dup = NULL, *ap3 = NULL;
   FCM_CHECK(ctx && A && P_ptr && (P_ptr[0] == 0) && plan && C && nc >= 0 && nt >= 1, ctx,
             FCM_ERR_ARG, "ptap_create: NULL argument, nc = %lld < 0 or nt = %d < 1", (long long)nc,
             nt);
@@ -436,31 +471,35 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
   t->ctx = ctx, t->n = n, t->nc = nc, t->nt = nt;
   t->P_ptr = P_ptr, t->P_col = P_col, t->P_val = P_val;
   FCM_TRY(ctx, transpose(ctx, n, nc, P_ptr, P_col, P_val, &t->R_ptr, &t->R_col, &t->R_val));
+  /* the node's three rows of one pattern in A: every product keeps A's pattern */
+  FCM_ALLOC(ctx, n / 3 + 1, t->same3);
+  for (fcm_index g = 0; 3 * g + 2 < n; g++)
+    t->same3[g] = (unsigned char)same_pattern3(3 * g, fcm_csr_row_ptr(A), fcm_csr_col_idx(A));
+  FCM_ALLOC(ctx, FCM_MAX(n, nc) + 1, dup);
+  for (fcm_index g = 0; 3 * g + 2 < n; g++)
+    dup[3 * g + 1] = dup[3 * g + 2] = t->same3[g];
   /* A P's rows unsorted: each entry of C takes one term from each row of A P it sums, wherever
    * that row holds the column, so C's values do not depend on the order (nor do A P's) */
   FCM_TRY(ctx, product_pattern(ctx, nt, n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), P_ptr, P_col, nc,
-                               0, &t->AP_ptr, &t->AP_col));
+                               0, dup, &t->AP_ptr, &t->AP_col));
   FCM_ALLOC_RAW(ctx, t->AP_ptr[n] + 1, t->AP_val); /* every product writes all of it */
-  FCM_TRY(ctx,
-          product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, 1, &cp, &cc));
+  /* A P's groups of three rows of one pattern: those of A's (the same columns in the same
+   * order, dup above) and any other whose rows agree */
+  FCM_ALLOC(ctx, n / 3 + 1, ap3);
+  for (fcm_index g = 0; 3 * g + 2 < n; g++)
+    ap3[g] = (unsigned char)(t->same3[g] || same_pattern3(3 * g, t->AP_ptr, t->AP_col));
+  /* R's rows 3 J + 1 and 3 J + 2 reach the same columns as row 3 J where they are its rows
+   * shifted by one and two to rows of A P of one pattern */
+  memset(dup, 0, (size_t)FCM_MAX(n, nc) + 1);
+  for (fcm_index g = 0; 3 * g + 2 < nc; g++)
+    dup[3 * g + 1] = dup[3 * g + 2] = (unsigned char)shifted3(3 * g, t->R_ptr, t->R_col, NULL, ap3);
+  FCM_TRY(ctx, product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, 1, dup,
+                               &cp, &cc));
   if (with_diagonal) FCM_TRY(ctx, add_diagonal(ctx, nc, &cp, &cc));
   FCM_ALLOC(ctx, (size_t)nt * 3 * (size_t)(nc + 1), t->spa);
-  FCM_ALLOC(ctx, n / 3 + 1, t->same3); /* A's pattern, which every product keeps */
-  for (fcm_index g = 0; 3 * g + 2 < n; g++)
-    t->same3[g] = (unsigned char)same_pattern3(3 * g, fcm_csr_row_ptr(A), fcm_csr_col_idx(A));
-  {
-    unsigned char *ap3 = NULL; /* A P's groups of three rows of one pattern */
-    FCM_ALLOC(ctx, n / 3 + 1, ap3);
-    for (fcm_index g = 0; 3 * g + 2 < n; g++)
-      ap3[g] = (unsigned char)same_pattern3(3 * g, t->AP_ptr, t->AP_col);
-    t->r_kind = fcm__calloc(ctx, (size_t)(nc / 3 + 1), 1);
-    if (t->r_kind)
-      for (fcm_index g = 0; 3 * g + 2 < nc; g++)
-        t->r_kind[g] =
-            shifted3(3 * g, t->R_ptr, t->R_col, t->R_val, ap3) ? KIND_SHIFTED : KIND_ROWS;
-    fcm__free(ctx, ap3);
-    FCM_CHECK(t->r_kind, ctx, FCM_ERR_ALLOC, "ptap_create: out of memory");
-  }
+  FCM_ALLOC(ctx, (size_t)(nc / 3 + 1), t->r_kind);
+  for (fcm_index g = 0; 3 * g + 2 < nc; g++)
+    t->r_kind[g] = shifted3(3 * g, t->R_ptr, t->R_col, t->R_val, ap3) ? KIND_SHIFTED : KIND_ROWS;
   /* rows sorted and in range by construction, symmetric with A's pattern */
   FCM_TRY(ctx, fcm__csr_adopt_pattern(ctx, nc, nc, &cp, &cc, fcm_csr_get_kind(A), C));
   *plan = t;
@@ -468,6 +507,8 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
 cleanup:
   fcm__free(ctx, cp);
   fcm__free(ctx, cc);
+  fcm__free(ctx, dup);
+  fcm__free(ctx, ap3);
   fcm__ptap_destroy(&t);
   return st;
 }

@@ -150,6 +150,9 @@ cleanup:
   return st;
 }
 
+/* Blocks above which the scan of their positions is shared by the threads. */
+#define SCAN_PARALLEL_BLOCKS 256
+
 /* Why one block failed during the parallel setup. */
 typedef enum block_fail { FAIL_NONE, FAIL_NONFINITE, FAIL_ZERO, FAIL_LAPACK } block_fail;
 
@@ -501,12 +504,19 @@ cleanup:
 
 /* The positions of every block's entries in C's rows, as gather_scan() finds them, from C's
  * pattern alone (a creation without values): the first setup gathers the blocks whose entries
- * are all stored through them (the same values as a scan), and scans the others. */
+ * are all stored through them (the same values as a scan), and scans the others. Blocks shared
+ * by the threads, each with its DOF map (zero between blocks). */
 static void scan_positions(fcm_schwarz *P, const fcm_csr *C)
 {
-  for (fcm_index b = 0; b < P->num_blocks; b++) /* thread 0's DOF map, zero between blocks */
-    gather_scan(C, NULL, (int)(P->block_ptr[b + 1] - P->block_ptr[b]), P->dofs + P->block_ptr[b],
-                P->loc, P->pos + P->s_off[b], &P->full[b], NULL);
+  const fcm_index nb = P->num_blocks;
+#pragma omp parallel num_threads(P->nt) if (P->nt > 1 && nb > SCAN_PARALLEL_BLOCKS)
+  {
+    int *loc = P->loc + (size_t)P->n * (size_t)omp_get_thread_num();
+#pragma omp for schedule(dynamic, 64)
+    for (fcm_index b = 0; b < nb; b++)
+      gather_scan(C, NULL, (int)(P->block_ptr[b + 1] - P->block_ptr[b]), P->dofs + P->block_ptr[b],
+                  loc, P->pos + P->s_off[b], &P->full[b], NULL);
+  }
 }
 
 /* fcm_schwarz_create(); blocks_only: for the block smoother (fcm__schwarz_create_blocks()),
