@@ -500,7 +500,8 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc,
   FCM_TRY(ctx, transpose(ctx, n, nc, P_ptr, P_col, P_val, &t->R_ptr, &t->R_col, &t->R_val));
   /* the node's three rows of one pattern in A: every product keeps A's pattern */
   FCM_ALLOC(ctx, n / 3 + 1, t->same3);
-  for (fcm_index g = 0; 3 * g + 2 < n; g++)
+#pragma omp parallel for num_threads(nt) schedule(static) if (nt > 1 && n > 4096)
+  for (fcm_index g = 0; g < n / 3; g++)
     t->same3[g] = (unsigned char)same_pattern3(3 * g, fcm_csr_row_ptr(A), fcm_csr_col_idx(A));
   FCM_ALLOC(ctx, FCM_MAX(n, nc) + 1, dup);
   for (fcm_index g = 0; 3 * g + 2 < n; g++)
@@ -513,7 +514,8 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc,
   /* A P's groups of three rows of one pattern: those of A's (the same columns in the same
    * order, dup above) and any other whose rows agree */
   FCM_ALLOC(ctx, n / 3 + 1, ap3);
-  for (fcm_index g = 0; 3 * g + 2 < n; g++)
+#pragma omp parallel for num_threads(nt) schedule(static) if (nt > 1 && n > 4096)
+  for (fcm_index g = 0; g < n / 3; g++)
     ap3[g] = (unsigned char)(t->same3[g] || same_pattern3(3 * g, t->AP_ptr, t->AP_col));
   /* R's rows 3 J + 1 and 3 J + 2 reach the same columns as row 3 J where they are its rows
    * shifted by one and two to rows of A P of one pattern */

@@ -155,13 +155,16 @@ fcm_status fcm__mg_row_slabs(fcm_mg *m, mg_level *L)
   fcm_index *reach = NULL;
   FCM_ALLOC_RAW(ctx, L->n + 1, work);
   FCM_ALLOC_RAW(ctx, L->n + 1, reach);
-  for (fcm_index i = 0; i < L->n; i++) { /* a row's columns ascend: its last reaches furthest */
+  const fcm_index n = L->n;
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (n > 4096)
+  for (fcm_index i = 0; i < n; i++) { /* a row's columns ascend: its last reaches furthest */
     work[i] = (double)(rp[i + 1] - rp[i]);
     reach[i] = rp[i + 1] > rp[i] ? FCM_MAX(i, (fcm_index)ci[rp[i + 1] - 1]) : i;
   }
   FCM_TRY(ctx, slabs_create(ctx, L->n, NULL, reach, work, MG_ROW_SLABS_THICK, &L->rows));
   FCM_ALLOC(ctx, L->n + 1, L->rows.triple);
-  for (fcm_index i = 0; i + 2 < L->n; i += 3) {
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (n > 4096)
+  for (fcm_index i = 0; i < n - 2; i += 3) {
     /* the three rows one pattern, the three's own columns one after the other (diag[i]) */
     const fcm_index len = rp[i + 1] - rp[i], p = L->diag[i] - rp[i];
     const int same = rp[i + 2] - rp[i + 1] == len && rp[i + 3] - rp[i + 2] == len && p + 2 < len &&
