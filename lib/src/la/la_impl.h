@@ -169,18 +169,6 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
                             const int *P_col, const double *P_val, int with_diagonal, int nt,
                             fcm__ptap **plan, fcm_csr **C);
 
-/* fcm__ptap_create() with the pattern of A P (the plan's largest array) on the storage of
- * *spare_ap (NULL or *spare_ap NULL: none; an array of fcm__ptap_give_pattern()) where it fits,
- * which sets *spare_ap = NULL; a spare not taken stays the caller's (fcm__free_large()). */
-fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc,
-                                 const fcm_index *P_ptr, const int *P_col, const double *P_val,
-                                 int with_diagonal, int nt, void **spare_ap, fcm__ptap **plan,
-                                 fcm_csr **C);
-
-/* The storage of the plan's pattern of A P, given up for a later plan's (the plan must be
- * destroyed next, unused); NULL for NULL. */
-void *fcm__ptap_give_pattern(fcm__ptap *plan);
-
 /* C's values = P^T A P for A's current values, on `nt` threads (clamped to [1, the plan's]).
  * A has the pattern given to fcm__ptap_create(), C is the matrix it created. Allocates
  * nothing; one call at a time per plan. */

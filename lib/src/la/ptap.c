@@ -179,12 +179,11 @@ static void pattern_gather(const pattern_work *w, fcm_index c, int *Cc)
  * flags the rows whose pattern is the row before's (A's rows and the rows of B they reach
  * giving the same columns in the same order), which are copied instead of computed. Chunks of
  * rows shared by nt threads in one pass: a thread whose buffer is full leaves its chunks for
- * another round after the buffer has grown. With `spare` (NULL: *Cc_out from fcm__malloc()),
- * *Cc_out is a large array (fcm__free_large()) on the storage of *spare where it fits. */
+ * another round after the buffer has grown. */
 static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fcm_index *Ap,
                                   const int *Ac, const fcm_index *Bp, const int *Bc, fcm_index ncol,
-                                  int sorted, const unsigned char *dup, void **spare,
-                                  fcm_index **Cp_out, int **Cc_out)
+                                  int sorted, const unsigned char *dup, fcm_index **Cp_out,
+                                  int **Cc_out)
 {
   fcm_status st = FCM_OK;
   const fcm_index nchunk = (nrow + PATTERN_CHUNK - 1) / PATTERN_CHUNK;
@@ -236,13 +235,7 @@ static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fc
   }
   for (fcm_index i = 0; i < nrow; i++)
     w.Cp[i + 1] += w.Cp[i];
-  if (spare) { /* every entry copied below */
-    Cc = fcm__large_take(spare, (size_t)w.Cp[nrow] + 1, sizeof *Cc);
-    if (!Cc) Cc = fcm__calloc_large(ctx, (size_t)w.Cp[nrow] + 1, sizeof *Cc);
-    FCM_CHECK(Cc, ctx, FCM_ERR_ALLOC, "ptap_create: out of memory");
-  } else {
-    FCM_ALLOC_RAW(ctx, w.Cp[nrow] + 1, Cc);
-  }
+  FCM_ALLOC_RAW(ctx, w.Cp[nrow] + 1, Cc); /* every entry copied below */
 #pragma omp parallel for num_threads(nt) schedule(static) if (nt > 1 && nchunk > 1)
   for (fcm_index c = 0; c < nchunk; c++)
     pattern_gather(&w, c, Cc);
@@ -252,10 +245,7 @@ cleanup:
   for (int t = 0; w.buf && t < nt; t++)
     fcm__free(ctx, w.buf[t]);
   fcm__free(ctx, w.Cp);
-  if (spare)
-    fcm__free_large(ctx, Cc);
-  else
-    fcm__free(ctx, Cc);
+  fcm__free(ctx, Cc);
   fcm__free(ctx, w.mark);
   fcm__free(ctx, w.stamp);
   fcm__free(ctx, w.row);
@@ -446,7 +436,7 @@ void fcm__ptap_destroy(fcm__ptap **plan)
   fcm__free(ctx, t->R_col);
   fcm__free(ctx, t->R_val);
   fcm__free(ctx, t->AP_ptr);
-  fcm__free_large(ctx, t->AP_col);
+  fcm__free(ctx, t->AP_col);
   fcm__free(ctx, t->AP_val);
   fcm__free(ctx, t->spa);
   fcm__free(ctx, t->same3);
@@ -459,23 +449,6 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
                             const int *P_col, const double *P_val, int with_diagonal, int nt,
                             fcm__ptap **plan, fcm_csr **C)
 {
-  return fcm__ptap_create_from(ctx, A, nc, P_ptr, P_col, P_val, with_diagonal, nt, NULL, plan, C);
-}
-
-void *fcm__ptap_give_pattern(fcm__ptap *plan)
-{
-  if (!plan) return NULL;
-  void *ap = plan->AP_col;
-  plan->AP_col = NULL;
-  return ap;
-}
-
-fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc,
-                                 const fcm_index *P_ptr, const int *P_col, const double *P_val,
-                                 int with_diagonal, int nt, void **spare_ap, fcm__ptap **plan,
-                                 fcm_csr **C)
-{
-  void *none = NULL;
   fcm_status st = FCM_OK;
   fcm__ptap *t = NULL;
   fcm_index *cp = NULL;
@@ -509,7 +482,7 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc,
   /* A P's rows unsorted: each entry of C takes one term from each row of A P it sums, wherever
    * that row holds the column, so C's values do not depend on the order (nor do A P's) */
   FCM_TRY(ctx, product_pattern(ctx, nt, n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), P_ptr, P_col, nc,
-                               0, dup, spare_ap ? spare_ap : &none, &t->AP_ptr, &t->AP_col));
+                               0, dup, &t->AP_ptr, &t->AP_col));
   FCM_ALLOC_RAW(ctx, t->AP_ptr[n] + 1, t->AP_val); /* every product writes all of it */
   /* A P's groups of three rows of one pattern: those of A's (the same columns in the same
    * order, dup above) and any other whose rows agree */
@@ -523,7 +496,7 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc,
   for (fcm_index g = 0; 3 * g + 2 < nc; g++)
     dup[3 * g + 1] = dup[3 * g + 2] = (unsigned char)shifted3(3 * g, t->R_ptr, t->R_col, NULL, ap3);
   FCM_TRY(ctx, product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, 1, dup,
-                               NULL, &cp, &cc));
+                               &cp, &cc));
   if (with_diagonal) FCM_TRY(ctx, add_diagonal(ctx, nc, &cp, &cc));
   FCM_ALLOC(ctx, (size_t)nt * 3 * (size_t)(nc + 1), t->spa);
   FCM_ALLOC(ctx, (size_t)(nc / 3 + 1), t->r_kind);

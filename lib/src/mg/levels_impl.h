@@ -108,10 +108,6 @@ struct fcm_mg {
   fcm_space *oct_space[32]; /* and their spaces */
   fcm__mg_kept kept;        /* what fcm__mg_create_from() took from the earlier hierarchy */
   int values_pending; /* created on a pattern (fcm__mg_create_pattern()): no value set up yet */
-  /* during fcm__mg_create_from(): the storage of the Galerkin plans of the earlier hierarchy's
-   * levels that are not taken, for the new plans' pattern of A_l P_l (their largest array):
-   * pages already mapped instead of fresh ones (fcm__free_large() what is left) */
-  void *spare_ap[32];
 };
 
 /* Threads of a parallel region: the context's now, at most those of the creation (scratch). */

@@ -48,7 +48,6 @@ void fcm_mg_destroy(fcm_mg **mg)
     fcm__mg_level_free(m->ctx, &m->lev[l]);
   fcm_direct_destroy(&m->direct);
   for (int l = 0; l < 32; l++) {
-    fcm__free_large(m->ctx, m->spare_ap[l]);
     fcm_space_destroy(&m->oct_space[l]);
     fcm_mesh_destroy(&m->oct_mesh[l]);
   }
@@ -162,11 +161,8 @@ static fcm_status galerkin_pattern(fcm_mg *m, int l)
   const fcm_csr *A = fcm__mg_level_matrix(L);
   fcm_index nnz = 0, *next = NULL;
   fcm_csr_get_size(A, NULL, NULL, &nnz);
-  FCM_TRY(ctx, fcm__ptap_create_from(ctx, A, C->n, L->P_ptr, L->P_col, L->P_val, 1,
-                                     nnz >= MG_PARALLEL_NNZ ? fcm__mg_team(m) : 1, &m->spare_ap[l],
-                                     &L->ptap, &C->Aown));
-  fcm__free_large(ctx, m->spare_ap[l]); /* not taken: too small or too large */
-  m->spare_ap[l] = NULL;
+  FCM_TRY(ctx, fcm__ptap_create(ctx, A, C->n, L->P_ptr, L->P_col, L->P_val, 1,
+                                nnz >= MG_PARALLEL_NNZ ? fcm__mg_team(m) : 1, &L->ptap, &C->Aown));
   fcm__ptap_transpose(L->ptap, &L->R_ptr, &L->R_col, &L->R_val);
   FCM_TRY(ctx, level_diag(m, C));
   {
@@ -242,12 +238,8 @@ static fcm_status create_patterns(fcm_mg *m, fcm_mg *old, unsigned char *same)
     same[l] = (unsigned char)(old && (kept_above || fcm__mg_level_same(old, m, l)));
     kept_above = l + 1 < m->nlev && same[l] && fcm__mg_keep_plan(old, m, l);
     /* nothing of old's level l is taken now: its memory goes before this level's arrays
-     * are allocated (the allocator may give it back to them), but for its plan's pattern of
-     * A_l P_l, whose storage the new plan takes where it fits (its pages mapped already) */
-    if (old && !same[l] && l < old->nlev) {
-      m->spare_ap[l] = fcm__ptap_give_pattern(old->lev[l].ptap);
-      fcm__mg_level_free(ctx, &old->lev[l]);
-    }
+     * are allocated (the allocator may give it back to them) */
+    if (old && !same[l] && l < old->nlev) fcm__mg_level_free(ctx, &old->lev[l]);
     if (l + 1 < m->nlev && !kept_above) FCM_TRY(ctx, galerkin_pattern(m, l));
     if (same[l]) fcm__mg_keep_orders(old, m, l);
   }
@@ -301,10 +293,6 @@ static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, const fcm_space *space, c
   if (!m->values_pending) FCM_TRY(ctx, fcm_mg_setup(m));
   if (o.block_smoothing) /* set up as created, or by the fcm_mg_setup() to come */
     FCM_TRY(ctx, fcm__mg_block_smoothers_create(m, old, same));
-  for (int l = 0; l < 32; l++) { /* the spares not taken */
-    fcm__free_large(ctx, m->spare_ap[l]);
-    m->spare_ap[l] = NULL;
-  }
   *mg = m;
   m = NULL;
 cleanup:
