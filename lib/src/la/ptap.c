@@ -103,7 +103,9 @@ typedef struct pattern_work {
   const fcm_index *Ap, *Bp;
   const int *Ac, *Bc;
   int sorted;
-  const unsigned char *dup; /* per row (NULL: none): its pattern is the row before's */
+  const unsigned char *dup;   /* per row (NULL: none): its pattern is the row before's */
+  const unsigned char *bnode; /* per node g of B's rows (NULL: none): rows 3 g + 1, 3 g + 2 are
+                                 row 3 g's with each column + 1, + 2, which are 3 G */
   fcm_index *Cp;
   fcm_index *mark, *stamp; /* per thread: ncol marks, and the stamp of its current row */
   int *row;                /* per thread: ncol + 1 columns of the current row */
@@ -117,6 +119,43 @@ typedef struct pattern_work {
 static int pattern_dup(const pattern_work *w, fcm_index c, fcm_index i)
 {
   return w->dup && i > c * PATTERN_CHUNK && w->dup[i];
+}
+
+/* Does row i of A go by row_by_nodes()? Its columns a node's three after the other's, each node
+ * with rows of B shifted per component (bnode). */
+static int row_of_nodes(const pattern_work *w, fcm_index i)
+{
+  const fcm_index p0 = w->Ap[i], p1 = w->Ap[i + 1];
+  if (!w->bnode || (p1 - p0) % 3 != 0) return 0;
+  for (fcm_index p = p0; p < p1; p += 3) {
+    const fcm_index k = w->Ac[p];
+    if (k % 3 != 0 || w->Ac[p + 1] != k + 1 || w->Ac[p + 2] != k + 2 || !w->bnode[k / 3]) return 0;
+  }
+  return 1;
+}
+
+/* Row i's columns as the plain loop finds them (first reached, A's row order, then B's), a
+ * node at a time: the new columns 3 G of row 3 k of B, then their 3 G + 1 (row 3 k + 1 reaches
+ * them in that order, and 3 G + 1 is new exactly where 3 G was: every node of the row adds a
+ * column's three together), then 3 G + 2. Marks the columns 3 G only. */
+static fcm_index row_by_nodes(const pattern_work *w, fcm_index i, fcm_index *mk, fcm_index tag,
+                              int *row)
+{
+  fcm_index cnt = 0;
+  for (fcm_index p = w->Ap[i]; p < w->Ap[i + 1]; p += 3) {
+    const fcm_index k = w->Ac[p], start = cnt;
+    for (fcm_index q = w->Bp[k]; q < w->Bp[k + 1]; q++) {
+      const fcm_index j = w->Bc[q];
+      if (mk[j] == tag) continue;
+      mk[j] = tag;
+      row[cnt++] = (int)j;
+    }
+    const fcm_index added = cnt - start;
+    for (int c = 1; c < 3; c++)
+      for (fcm_index t = 0; t < added; t++)
+        row[cnt++] = row[start + t] + c;
+  }
+  return cnt;
 }
 
 /* Chunk c's rows by thread t into its buffer: 1, or 0 (nothing kept) when they do not fit. A
@@ -136,7 +175,9 @@ static int pattern_chunk(pattern_work *w, int t, fcm_index c)
     }
     const fcm_index tag = w->stamp[t]++;
     cnt = 0;
-    for (fcm_index p = w->Ap[i]; p < w->Ap[i + 1]; p++) {
+    const int by_nodes = row_of_nodes(w, i);
+    if (by_nodes) cnt = row_by_nodes(w, i, mk, tag, row);
+    for (fcm_index p = w->Ap[i]; p < w->Ap[i + 1] && !by_nodes; p++) {
       const fcm_index k = w->Ac[p];
       for (fcm_index q = w->Bp[k]; q < w->Bp[k + 1]; q++) {
         const fcm_index j = w->Bc[q];
@@ -177,21 +218,29 @@ static void pattern_gather(const pattern_work *w, fcm_index c, int *Cc)
 /* Pattern of C = A B (nrow rows of A, ncol columns of B), each row's columns sorted when
  * `sorted`, else in the order first reached (the same for any thread count); dup (NULL: none)
  * flags the rows whose pattern is the row before's (A's rows and the rows of B they reach
- * giving the same columns in the same order), which are copied instead of computed. Chunks of
+ * giving the same columns in the same order), which are copied instead of computed; bnode
+ * (NULL: none) the nodes whose rows of B are shifted per component (row_by_nodes()). Chunks of
  * rows shared by nt threads in one pass: a thread whose buffer is full leaves its chunks for
  * another round after the buffer has grown. */
 static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fcm_index *Ap,
                                   const int *Ac, const fcm_index *Bp, const int *Bc, fcm_index ncol,
-                                  int sorted, const unsigned char *dup, fcm_index **Cp_out,
-                                  int **Cc_out)
+                                  int sorted, const unsigned char *dup, const unsigned char *bnode,
+                                  fcm_index **Cp_out, int **Cc_out)
 {
   fcm_status st = FCM_OK;
   const fcm_index nchunk = (nrow + PATTERN_CHUNK - 1) / PATTERN_CHUNK;
   fcm_index *pending = NULL, npending = nchunk;
   unsigned char *full = NULL, *left = NULL;
   int *Cc = NULL;
-  pattern_work w = {nrow, ncol, Ap,   Bp,   Ac,   Bc,   sorted, dup, NULL,
-                    NULL, NULL, NULL, NULL, NULL, NULL, NULL,   NULL};
+  pattern_work w = {.nrow = nrow,
+                    .ncol = ncol,
+                    .Ap = Ap,
+                    .Bp = Bp,
+                    .Ac = Ac,
+                    .Bc = Bc,
+                    .sorted = sorted,
+                    .dup = dup,
+                    .bnode = bnode};
   FCM_ALLOC(ctx, nrow + 1, w.Cp);
   FCM_ALLOC_RAW(ctx, (size_t)nt * (size_t)ncol + 1, w.mark);
   FCM_ALLOC(ctx, nt, w.stamp);
@@ -383,7 +432,8 @@ enum { KIND_ROWS = 0, KIND_TRIPLE = 1, KIND_SHIFTED = 2 };
 
 /* Whether rows i, i + 1, i + 2 (< A's row count) of A = R may go by product_shifted() with
  * B = A P, whose groups of three rows b_same3 flags as one pattern each; Av NULL: the
- * pattern's part of the test alone (the three rows of A B then have one pattern). */
+ * pattern's part of the test alone (the three rows of A B then have one pattern); b_same3
+ * NULL: the three rows' columns alone (row i + r is row i's with each column + r, all 3 G). */
 static int shifted3(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
                     const unsigned char *b_same3)
 {
@@ -391,8 +441,8 @@ static int shifted3(fcm_index i, const fcm_index *Ap, const int *Ac, const doubl
   if (Ap[i + 2] - Ap[i + 1] != len || Ap[i + 3] - Ap[i + 2] != len) return 0;
   for (fcm_index q = 0; q < len; q++) {
     const fcm_index p = Ap[i] + q, p1 = Ap[i + 1] + q, p2 = Ap[i + 2] + q;
-    if (Ac[p] % 3 != 0 || !b_same3[Ac[p] / 3] || Ac[p1] != Ac[p] + 1 || Ac[p2] != Ac[p] + 2 ||
-        (Av && (Av[p1] != Av[p] || Av[p2] != Av[p])))
+    if (Ac[p] % 3 != 0 || (b_same3 && !b_same3[Ac[p] / 3]) || Ac[p1] != Ac[p] + 1 ||
+        Ac[p2] != Ac[p] + 2 || (Av && (Av[p1] != Av[p] || Av[p2] != Av[p])))
       return 0;
   }
   return 1;
@@ -453,7 +503,7 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
   fcm__ptap *t = NULL;
   fcm_index *cp = NULL;
   int *cc = NULL;
-  unsigned char *dup = NULL, *ap3 = NULL;
+  unsigned char *dup = NULL, *ap3 = NULL, *pnode = NULL;
   FCM_CHECK(ctx && A && P_ptr && (P_ptr[0] == 0) && plan && C && nc >= 0 && nt >= 1, ctx,
             FCM_ERR_ARG, "ptap_create: NULL argument, nc = %lld < 0 or nt = %d < 1", (long long)nc,
             nt);
@@ -479,10 +529,13 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
   FCM_ALLOC(ctx, FCM_MAX(n, nc) + 1, dup);
   for (fcm_index g = 0; 3 * g + 2 < n; g++)
     dup[3 * g + 1] = dup[3 * g + 2] = t->same3[g];
+  FCM_ALLOC(ctx, n / 3 + 1, pnode); /* P's rows of a node shifted per component */
+  for (fcm_index g = 0; 3 * g + 2 < n; g++)
+    pnode[g] = (unsigned char)shifted3(3 * g, P_ptr, P_col, NULL, NULL);
   /* A P's rows unsorted: each entry of C takes one term from each row of A P it sums, wherever
    * that row holds the column, so C's values do not depend on the order (nor do A P's) */
   FCM_TRY(ctx, product_pattern(ctx, nt, n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), P_ptr, P_col, nc,
-                               0, dup, &t->AP_ptr, &t->AP_col));
+                               0, dup, pnode, &t->AP_ptr, &t->AP_col));
   FCM_ALLOC_RAW(ctx, t->AP_ptr[n] + 1, t->AP_val); /* every product writes all of it */
   /* A P's groups of three rows of one pattern: those of A's (the same columns in the same
    * order, dup above) and any other whose rows agree */
@@ -496,7 +549,7 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
   for (fcm_index g = 0; 3 * g + 2 < nc; g++)
     dup[3 * g + 1] = dup[3 * g + 2] = (unsigned char)shifted3(3 * g, t->R_ptr, t->R_col, NULL, ap3);
   FCM_TRY(ctx, product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, 1, dup,
-                               &cp, &cc));
+                               NULL, &cp, &cc));
   if (with_diagonal) FCM_TRY(ctx, add_diagonal(ctx, nc, &cp, &cc));
   FCM_ALLOC(ctx, (size_t)nt * 3 * (size_t)(nc + 1), t->spa);
   FCM_ALLOC(ctx, (size_t)(nc / 3 + 1), t->r_kind);
@@ -511,6 +564,7 @@ cleanup:
   fcm__free(ctx, cc);
   fcm__free(ctx, dup);
   fcm__free(ctx, ap3);
+  fcm__free(ctx, pnode);
   fcm__ptap_destroy(&t);
   return st;
 }
