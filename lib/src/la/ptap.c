@@ -103,9 +103,12 @@ typedef struct pattern_work {
   const fcm_index *Ap, *Bp;
   const int *Ac, *Bc;
   int sorted;
-  const unsigned char *dup;   /* per row (NULL: none): its pattern is the row before's */
-  const unsigned char *bnode; /* per node g of B's rows (NULL: none): rows 3 g + 1, 3 g + 2 are
-                                 row 3 g's with each column + 1, + 2, which are 3 G */
+  const unsigned char *dup;     /* per row (NULL: none): its pattern is the row before's */
+  const unsigned char *bnode;   /* per node g of B's rows (NULL: none): rows 3 g + 1, 3 g + 2 are
+                                   row 3 g's with each column + 1, + 2, which are 3 G */
+  const unsigned char *bclosed; /* per row of B (NULL: none): its columns come as 3 G, 3 G + 1,
+                                   3 G + 2 together */
+  unsigned char *closed;        /* per row of C (NULL: not recorded): found by row_by_nodes() */
   fcm_index *Cp;
   fcm_index *mark, *stamp; /* per thread: ncol marks, and the stamp of its current row */
   int *row;                /* per thread: ncol + 1 columns of the current row */
@@ -158,6 +161,39 @@ static fcm_index row_by_nodes(const pattern_work *w, fcm_index i, fcm_index *mk,
   return cnt;
 }
 
+/* Does row i of A (sorted output) go by row_by_closed()? Every row of B it reaches closed. */
+static int row_of_closed(const pattern_work *w, fcm_index i)
+{
+  if (!w->bclosed || !w->sorted) return 0;
+  for (fcm_index p = w->Ap[i]; p < w->Ap[i + 1]; p++)
+    if (!w->bclosed[w->Ac[p]]) return 0;
+  return 1;
+}
+
+/* Row i's columns sorted when every row of B it reaches holds a node's three columns together:
+ * the nodes' first columns 3 G reached, sorted, each followed by 3 G + 1 and 3 G + 2 (the plain
+ * loop's set, in order). Marks the columns 3 G only. */
+static fcm_index row_by_closed(const pattern_work *w, fcm_index i, fcm_index *mk, fcm_index tag,
+                               int *row)
+{
+  fcm_index cnt = 0;
+  for (fcm_index p = w->Ap[i]; p < w->Ap[i + 1]; p++) {
+    const fcm_index k = w->Ac[p];
+    for (fcm_index q = w->Bp[k]; q < w->Bp[k + 1]; q++) {
+      const fcm_index j = w->Bc[q];
+      if (j % 3 != 0 || mk[j] == tag) continue;
+      mk[j] = tag;
+      row[cnt++] = (int)j;
+    }
+  }
+  sort_ints(row, cnt);
+  for (fcm_index t = cnt - 1; t >= 0; t--) { /* from the back: row[t] read before overwritten */
+    const int j = row[t];
+    row[3 * t] = j, row[3 * t + 1] = j + 1, row[3 * t + 2] = j + 2;
+  }
+  return 3 * cnt;
+}
+
 /* Chunk c's rows by thread t into its buffer: 1, or 0 (nothing kept) when they do not fit. A
  * row's columns are those first reached (A's row order, then B's), sorted when asked; a row
  * repeating the row before is counted, not stored. */
@@ -171,13 +207,16 @@ static int pattern_chunk(pattern_work *w, int t, fcm_index c)
   for (fcm_index i = c * PATTERN_CHUNK; i < i1; i++) {
     if (pattern_dup(w, c, i)) {
       w->Cp[i + 1] = cnt;
+      if (w->closed) w->closed[i] = w->closed[i - 1];
       continue;
     }
     const fcm_index tag = w->stamp[t]++;
     cnt = 0;
-    const int by_nodes = row_of_nodes(w, i);
+    const int by_nodes = row_of_nodes(w, i), by_closed = !by_nodes && row_of_closed(w, i);
+    if (w->closed) w->closed[i] = (unsigned char)by_nodes;
     if (by_nodes) cnt = row_by_nodes(w, i, mk, tag, row);
-    for (fcm_index p = w->Ap[i]; p < w->Ap[i + 1] && !by_nodes; p++) {
+    if (by_closed) cnt = row_by_closed(w, i, mk, tag, row);
+    for (fcm_index p = w->Ap[i]; p < w->Ap[i + 1] && !by_nodes && !by_closed; p++) {
       const fcm_index k = w->Ac[p];
       for (fcm_index q = w->Bp[k]; q < w->Bp[k + 1]; q++) {
         const fcm_index j = w->Bc[q];
@@ -190,7 +229,7 @@ static int pattern_chunk(pattern_work *w, int t, fcm_index c)
       w->len[t] = off;
       return 0;
     }
-    if (w->sorted) sort_ints(row, cnt);
+    if (w->sorted && !by_closed) sort_ints(row, cnt);
     memcpy(w->buf[t] + w->len[t], row, sizeof *row * (size_t)cnt);
     w->len[t] += (size_t)cnt;
     w->Cp[i + 1] = cnt;
@@ -219,12 +258,15 @@ static void pattern_gather(const pattern_work *w, fcm_index c, int *Cc)
  * `sorted`, else in the order first reached (the same for any thread count); dup (NULL: none)
  * flags the rows whose pattern is the row before's (A's rows and the rows of B they reach
  * giving the same columns in the same order), which are copied instead of computed; bnode
- * (NULL: none) the nodes whose rows of B are shifted per component (row_by_nodes()). Chunks of
+ * (NULL: none) the nodes whose rows of B are shifted per component (row_by_nodes()), whose
+ * rows of C are recorded in `closed` (NULL: not recorded; nrow bytes); bclosed (NULL: none)
+ * such rows of B (row_by_closed()). Chunks of
  * rows shared by nt threads in one pass: a thread whose buffer is full leaves its chunks for
  * another round after the buffer has grown. */
 static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fcm_index *Ap,
                                   const int *Ac, const fcm_index *Bp, const int *Bc, fcm_index ncol,
                                   int sorted, const unsigned char *dup, const unsigned char *bnode,
+                                  unsigned char *closed, const unsigned char *bclosed,
                                   fcm_index **Cp_out, int **Cc_out)
 {
   fcm_status st = FCM_OK;
@@ -240,7 +282,9 @@ static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fc
                     .Bc = Bc,
                     .sorted = sorted,
                     .dup = dup,
-                    .bnode = bnode};
+                    .bnode = bnode,
+                    .bclosed = bclosed,
+                    .closed = closed};
   FCM_ALLOC(ctx, nrow + 1, w.Cp);
   FCM_ALLOC_RAW(ctx, (size_t)nt * (size_t)ncol + 1, w.mark);
   FCM_ALLOC(ctx, nt, w.stamp);
@@ -503,7 +547,7 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
   fcm__ptap *t = NULL;
   fcm_index *cp = NULL;
   int *cc = NULL;
-  unsigned char *dup = NULL, *ap3 = NULL, *pnode = NULL;
+  unsigned char *dup = NULL, *ap3 = NULL, *pnode = NULL, *closed = NULL;
   FCM_CHECK(ctx && A && P_ptr && (P_ptr[0] == 0) && plan && C && nc >= 0 && nt >= 1, ctx,
             FCM_ERR_ARG, "ptap_create: NULL argument, nc = %lld < 0 or nt = %d < 1", (long long)nc,
             nt);
@@ -529,13 +573,14 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
   FCM_ALLOC(ctx, FCM_MAX(n, nc) + 1, dup);
   for (fcm_index g = 0; 3 * g + 2 < n; g++)
     dup[3 * g + 1] = dup[3 * g + 2] = t->same3[g];
+  FCM_ALLOC(ctx, n + 1, closed);    /* the rows of A P found a node at a time */
   FCM_ALLOC(ctx, n / 3 + 1, pnode); /* P's rows of a node shifted per component */
   for (fcm_index g = 0; 3 * g + 2 < n; g++)
     pnode[g] = (unsigned char)shifted3(3 * g, P_ptr, P_col, NULL, NULL);
   /* A P's rows unsorted: each entry of C takes one term from each row of A P it sums, wherever
    * that row holds the column, so C's values do not depend on the order (nor do A P's) */
   FCM_TRY(ctx, product_pattern(ctx, nt, n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), P_ptr, P_col, nc,
-                               0, dup, pnode, &t->AP_ptr, &t->AP_col));
+                               0, dup, pnode, closed, NULL, &t->AP_ptr, &t->AP_col));
   FCM_ALLOC_RAW(ctx, t->AP_ptr[n] + 1, t->AP_val); /* every product writes all of it */
   /* A P's groups of three rows of one pattern: those of A's (the same columns in the same
    * order, dup above) and any other whose rows agree */
@@ -549,7 +594,7 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
   for (fcm_index g = 0; 3 * g + 2 < nc; g++)
     dup[3 * g + 1] = dup[3 * g + 2] = (unsigned char)shifted3(3 * g, t->R_ptr, t->R_col, NULL, ap3);
   FCM_TRY(ctx, product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, 1, dup,
-                               NULL, &cp, &cc));
+                               NULL, NULL, closed, &cp, &cc));
   if (with_diagonal) FCM_TRY(ctx, add_diagonal(ctx, nc, &cp, &cc));
   FCM_ALLOC(ctx, (size_t)nt * 3 * (size_t)(nc + 1), t->spa);
   FCM_ALLOC(ctx, (size_t)(nc / 3 + 1), t->r_kind);
@@ -565,6 +610,7 @@ cleanup:
   fcm__free(ctx, dup);
   fcm__free(ctx, ap3);
   fcm__free(ctx, pnode);
+  fcm__free(ctx, closed);
   fcm__ptap_destroy(&t);
   return st;
 }
