@@ -90,17 +90,25 @@ cleanup:
   return st;
 }
 
-/* Rows per chunk of the symbolic product: the unit a thread takes at a time. */
-#define PATTERN_CHUNK 256
+/* Rows per chunk of the symbolic product: the unit a thread takes at a time (a multiple of 3,
+ * so that a node's three rows lie in one chunk). */
+#define PATTERN_CHUNK 255
 
 /* What the threads of product_pattern() share. Each thread t appends the columns of the chunks
- * it takes to its own buffer buf[t] (cap[t] entries, len[t] used); chunk c's columns lie at
- * buf[thr[c]] + off[c], rows in order, and row i's count in Cp[i + 1]. */
+ * it takes to its own buffer buf[t] (cap[t] entries, len[t] used); chunk c's rows, but those
+ * repeating the row before (dup), lie at buf[thr[c]] + off[c], rows in order, and row i's count
+ * in Cp[i + 1]. */
 typedef struct pattern_work {
   fcm_index nrow, ncol;
   const fcm_index *Ap, *Bp;
   const int *Ac, *Bc;
   int sorted;
+  const unsigned char *dup;     /* per row (NULL: none): its pattern is the row before's */
+  const unsigned char *bnode;   /* per node g of B's rows (NULL: none): rows 3 g + 1, 3 g + 2 are
+                                   row 3 g's with each column + 1, + 2, which are 3 G */
+  const unsigned char *bclosed; /* per row of B (NULL: none): its columns come as 3 G, 3 G + 1,
+                                   3 G + 2 together */
+  unsigned char *closed;        /* per row of C (NULL: not recorded): found by row_by_nodes() */
   fcm_index *Cp;
   fcm_index *mark, *stamp; /* per thread: ncol marks, and the stamp of its current row */
   int *row;                /* per thread: ncol + 1 columns of the current row */
@@ -110,18 +118,105 @@ typedef struct pattern_work {
   size_t *off;
 } pattern_work;
 
+/* Is row i of chunk c the row before's pattern (both in the chunk)? */
+static int pattern_dup(const pattern_work *w, fcm_index c, fcm_index i)
+{
+  return w->dup && i > c * PATTERN_CHUNK && w->dup[i];
+}
+
+/* Does row i of A go by row_by_nodes()? Its columns a node's three after the other's, each node
+ * with rows of B shifted per component (bnode). */
+static int row_of_nodes(const pattern_work *w, fcm_index i)
+{
+  const fcm_index p0 = w->Ap[i], p1 = w->Ap[i + 1];
+  if (!w->bnode || (p1 - p0) % 3 != 0) return 0;
+  for (fcm_index p = p0; p < p1; p += 3) {
+    const fcm_index k = w->Ac[p];
+    if (k % 3 != 0 || w->Ac[p + 1] != k + 1 || w->Ac[p + 2] != k + 2 || !w->bnode[k / 3]) return 0;
+  }
+  return 1;
+}
+
+/* Row i's columns as the plain loop finds them (first reached, A's row order, then B's), a
+ * node at a time: the new columns 3 G of row 3 k of B, then their 3 G + 1 (row 3 k + 1 reaches
+ * them in that order, and 3 G + 1 is new exactly where 3 G was: every node of the row adds a
+ * column's three together), then 3 G + 2. Marks the columns 3 G only. */
+static fcm_index row_by_nodes(const pattern_work *w, fcm_index i, fcm_index *mk, fcm_index tag,
+                              int *row)
+{
+  fcm_index cnt = 0;
+  for (fcm_index p = w->Ap[i]; p < w->Ap[i + 1]; p += 3) {
+    const fcm_index k = w->Ac[p], start = cnt;
+    for (fcm_index q = w->Bp[k]; q < w->Bp[k + 1]; q++) {
+      const fcm_index j = w->Bc[q];
+      if (mk[j] == tag) continue;
+      mk[j] = tag;
+      row[cnt++] = (int)j;
+    }
+    const fcm_index added = cnt - start;
+    for (int c = 1; c < 3; c++)
+      for (fcm_index t = 0; t < added; t++)
+        row[cnt++] = row[start + t] + c;
+  }
+  return cnt;
+}
+
+/* Does row i of A (sorted output) go by row_by_closed()? Every row of B it reaches closed. */
+static int row_of_closed(const pattern_work *w, fcm_index i)
+{
+  if (!w->bclosed || !w->sorted) return 0;
+  for (fcm_index p = w->Ap[i]; p < w->Ap[i + 1]; p++)
+    if (!w->bclosed[w->Ac[p]]) return 0;
+  return 1;
+}
+
+/* Row i's columns sorted when every row of B it reaches holds a node's three columns together:
+ * the nodes' first columns 3 G reached, sorted, each followed by 3 G + 1 and 3 G + 2 (the plain
+ * loop's set, in order). Marks the columns 3 G only. */
+static fcm_index row_by_closed(const pattern_work *w, fcm_index i, fcm_index *mk, fcm_index tag,
+                               int *row)
+{
+  fcm_index cnt = 0;
+  for (fcm_index p = w->Ap[i]; p < w->Ap[i + 1]; p++) {
+    const fcm_index k = w->Ac[p];
+    for (fcm_index q = w->Bp[k]; q < w->Bp[k + 1]; q++) {
+      const fcm_index j = w->Bc[q];
+      if (j % 3 != 0 || mk[j] == tag) continue;
+      mk[j] = tag;
+      row[cnt++] = (int)j;
+    }
+  }
+  sort_ints(row, cnt);
+  for (fcm_index t = cnt - 1; t >= 0; t--) { /* from the back: row[t] read before overwritten */
+    const int j = row[t];
+    row[3 * t] = j, row[3 * t + 1] = j + 1, row[3 * t + 2] = j + 2;
+  }
+  return 3 * cnt;
+}
+
 /* Chunk c's rows by thread t into its buffer: 1, or 0 (nothing kept) when they do not fit. A
- * row's columns are those first reached (A's row order, then B's), sorted when asked. */
+ * row's columns are those first reached (A's row order, then B's), sorted when asked; a row
+ * repeating the row before is counted, not stored. */
 static int pattern_chunk(pattern_work *w, int t, fcm_index c)
 {
   fcm_index *mk = w->mark + (size_t)t * (size_t)w->ncol;
   int *row = w->row + (size_t)t * (size_t)(w->ncol + 1);
   const size_t off = w->len[t];
   const fcm_index i1 = FCM_MIN(w->nrow, (c + 1) * PATTERN_CHUNK);
+  fcm_index cnt = 0;
   for (fcm_index i = c * PATTERN_CHUNK; i < i1; i++) {
+    if (pattern_dup(w, c, i)) {
+      w->Cp[i + 1] = cnt;
+      if (w->closed) w->closed[i] = w->closed[i - 1];
+      continue;
+    }
     const fcm_index tag = w->stamp[t]++;
-    fcm_index cnt = 0;
-    for (fcm_index p = w->Ap[i]; p < w->Ap[i + 1]; p++) {
+    cnt = 0;
+    const int by_nodes = row_of_nodes(w, i), by_closed = !by_nodes && row_of_closed(w, i);
+    if (w->closed) w->closed[i] = (unsigned char)by_nodes;
+    if (by_nodes) cnt = row_by_nodes(w, i, mk, tag, row);
+    if (by_closed) cnt = row_by_closed(w, i, mk, tag, row);
+    for (fcm_index p = w->Ap[i]; p < w->Ap[i + 1] && !by_nodes && !by_closed; p++) {
       const fcm_index k = w->Ac[p];
       for (fcm_index q = w->Bp[k]; q < w->Bp[k + 1]; q++) {
         const fcm_index j = w->Bc[q];
@@ -134,7 +229,7 @@ static int pattern_chunk(pattern_work *w, int t, fcm_index c)
       w->len[t] = off;
       return 0;
     }
-    if (w->sorted) sort_ints(row, cnt);
+    if (w->sorted && !by_closed) sort_ints(row, cnt);
     memcpy(w->buf[t] + w->len[t], row, sizeof *row * (size_t)cnt);
     w->len[t] += (size_t)cnt;
     w->Cp[i + 1] = cnt;
@@ -143,21 +238,53 @@ static int pattern_chunk(pattern_work *w, int t, fcm_index c)
   return 1;
 }
 
+/* Chunk c's columns from its buffer into Cc (Cp summed), the repeated rows copied. */
+static void pattern_gather(const pattern_work *w, fcm_index c, int *Cc)
+{
+  const int *from = w->buf[w->thr[c]] + w->off[c];
+  const fcm_index i1 = FCM_MIN(w->nrow, (c + 1) * PATTERN_CHUNK);
+  for (fcm_index i = c * PATTERN_CHUNK; i < i1; i++) {
+    const fcm_index len = w->Cp[i + 1] - w->Cp[i];
+    if (pattern_dup(w, c, i)) {
+      memcpy(Cc + w->Cp[i], Cc + w->Cp[i - 1], sizeof *Cc * (size_t)len);
+    } else {
+      memcpy(Cc + w->Cp[i], from, sizeof *Cc * (size_t)len);
+      from += len;
+    }
+  }
+}
+
 /* Pattern of C = A B (nrow rows of A, ncol columns of B), each row's columns sorted when
- * `sorted`, else in the order first reached (the same for any thread count); chunks of rows
- * shared by nt threads in one pass: a thread whose buffer is full leaves its chunks for
+ * `sorted`, else in the order first reached (the same for any thread count); dup (NULL: none)
+ * flags the rows whose pattern is the row before's (A's rows and the rows of B they reach
+ * giving the same columns in the same order), which are copied instead of computed; bnode
+ * (NULL: none) the nodes whose rows of B are shifted per component (row_by_nodes()), whose
+ * rows of C are recorded in `closed` (NULL: not recorded; nrow bytes); bclosed (NULL: none)
+ * such rows of B (row_by_closed()). Chunks of
+ * rows shared by nt threads in one pass: a thread whose buffer is full leaves its chunks for
  * another round after the buffer has grown. */
 static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fcm_index *Ap,
                                   const int *Ac, const fcm_index *Bp, const int *Bc, fcm_index ncol,
-                                  int sorted, fcm_index **Cp_out, int **Cc_out)
+                                  int sorted, const unsigned char *dup, const unsigned char *bnode,
+                                  unsigned char *closed, const unsigned char *bclosed,
+                                  fcm_index **Cp_out, int **Cc_out)
 {
   fcm_status st = FCM_OK;
   const fcm_index nchunk = (nrow + PATTERN_CHUNK - 1) / PATTERN_CHUNK;
   fcm_index *pending = NULL, npending = nchunk;
   unsigned char *full = NULL, *left = NULL;
   int *Cc = NULL;
-  pattern_work w = {nrow, ncol, Ap,   Bp,   Ac,   Bc,   sorted, NULL,
-                    NULL, NULL, NULL, NULL, NULL, NULL, NULL,   NULL};
+  pattern_work w = {.nrow = nrow,
+                    .ncol = ncol,
+                    .Ap = Ap,
+                    .Bp = Bp,
+                    .Ac = Ac,
+                    .Bc = Bc,
+                    .sorted = sorted,
+                    .dup = dup,
+                    .bnode = bnode,
+                    .bclosed = bclosed,
+                    .closed = closed};
   FCM_ALLOC(ctx, nrow + 1, w.Cp);
   FCM_ALLOC_RAW(ctx, (size_t)nt * (size_t)ncol + 1, w.mark);
   FCM_ALLOC(ctx, nt, w.stamp);
@@ -202,10 +329,9 @@ static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fc
   for (fcm_index i = 0; i < nrow; i++)
     w.Cp[i + 1] += w.Cp[i];
   FCM_ALLOC_RAW(ctx, w.Cp[nrow] + 1, Cc); /* every entry copied below */
-  for (fcm_index c = 0; c < nchunk; c++) {
-    const fcm_index r0 = w.Cp[c * PATTERN_CHUNK], r1 = w.Cp[FCM_MIN(nrow, (c + 1) * PATTERN_CHUNK)];
-    memcpy(Cc + r0, w.buf[w.thr[c]] + w.off[c], sizeof *Cc * (size_t)(r1 - r0));
-  }
+#pragma omp parallel for num_threads(nt) schedule(static) if (nt > 1 && nchunk > 1)
+  for (fcm_index c = 0; c < nchunk; c++)
+    pattern_gather(&w, c, Cc);
   *Cp_out = w.Cp, *Cc_out = Cc;
   w.Cp = NULL, Cc = NULL;
 cleanup:
@@ -349,7 +475,9 @@ static void product_shifted(fcm_index i, const fcm_index *Ap, const int *Ac, con
 enum { KIND_ROWS = 0, KIND_TRIPLE = 1, KIND_SHIFTED = 2 };
 
 /* Whether rows i, i + 1, i + 2 (< A's row count) of A = R may go by product_shifted() with
- * B = A P, whose groups of three rows b_same3 flags as one pattern each. */
+ * B = A P, whose groups of three rows b_same3 flags as one pattern each; Av NULL: the
+ * pattern's part of the test alone (the three rows of A B then have one pattern); b_same3
+ * NULL: the three rows' columns alone (row i + r is row i's with each column + r, all 3 G). */
 static int shifted3(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
                     const unsigned char *b_same3)
 {
@@ -357,8 +485,8 @@ static int shifted3(fcm_index i, const fcm_index *Ap, const int *Ac, const doubl
   if (Ap[i + 2] - Ap[i + 1] != len || Ap[i + 3] - Ap[i + 2] != len) return 0;
   for (fcm_index q = 0; q < len; q++) {
     const fcm_index p = Ap[i] + q, p1 = Ap[i + 1] + q, p2 = Ap[i + 2] + q;
-    if (Ac[p] % 3 != 0 || !b_same3[Ac[p] / 3] || Ac[p1] != Ac[p] + 1 || Ac[p2] != Ac[p] + 2 ||
-        Av[p1] != Av[p] || Av[p2] != Av[p])
+    if (Ac[p] % 3 != 0 || (b_same3 && !b_same3[Ac[p] / 3]) || Ac[p1] != Ac[p] + 1 ||
+        Ac[p2] != Ac[p] + 2 || (Av && (Av[p1] != Av[p] || Av[p2] != Av[p])))
       return 0;
   }
   return 1;
@@ -419,6 +547,7 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
   fcm__ptap *t = NULL;
   fcm_index *cp = NULL;
   int *cc = NULL;
+  unsigned char *dup = NULL, *ap3 = NULL, *pnode = NULL, *closed = NULL;
   FCM_CHECK(ctx && A && P_ptr && (P_ptr[0] == 0) && plan && C && nc >= 0 && nt >= 1, ctx,
             FCM_ERR_ARG, "ptap_create: NULL argument, nc = %lld < 0 or nt = %d < 1", (long long)nc,
             nt);
@@ -436,31 +565,41 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
   t->ctx = ctx, t->n = n, t->nc = nc, t->nt = nt;
   t->P_ptr = P_ptr, t->P_col = P_col, t->P_val = P_val;
   FCM_TRY(ctx, transpose(ctx, n, nc, P_ptr, P_col, P_val, &t->R_ptr, &t->R_col, &t->R_val));
+  /* the node's three rows of one pattern in A: every product keeps A's pattern */
+  FCM_ALLOC(ctx, n / 3 + 1, t->same3);
+#pragma omp parallel for num_threads(nt) schedule(static) if (nt > 1 && n > 4096)
+  for (fcm_index g = 0; g < n / 3; g++)
+    t->same3[g] = (unsigned char)same_pattern3(3 * g, fcm_csr_row_ptr(A), fcm_csr_col_idx(A));
+  FCM_ALLOC(ctx, FCM_MAX(n, nc) + 1, dup);
+  for (fcm_index g = 0; 3 * g + 2 < n; g++)
+    dup[3 * g + 1] = dup[3 * g + 2] = t->same3[g];
+  FCM_ALLOC(ctx, n + 1, closed);    /* the rows of A P found a node at a time */
+  FCM_ALLOC(ctx, n / 3 + 1, pnode); /* P's rows of a node shifted per component */
+  for (fcm_index g = 0; 3 * g + 2 < n; g++)
+    pnode[g] = (unsigned char)shifted3(3 * g, P_ptr, P_col, NULL, NULL);
   /* A P's rows unsorted: each entry of C takes one term from each row of A P it sums, wherever
    * that row holds the column, so C's values do not depend on the order (nor do A P's) */
   FCM_TRY(ctx, product_pattern(ctx, nt, n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), P_ptr, P_col, nc,
-                               0, &t->AP_ptr, &t->AP_col));
+                               0, dup, pnode, closed, NULL, &t->AP_ptr, &t->AP_col));
   FCM_ALLOC_RAW(ctx, t->AP_ptr[n] + 1, t->AP_val); /* every product writes all of it */
-  FCM_TRY(ctx,
-          product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, 1, &cp, &cc));
+  /* A P's groups of three rows of one pattern: those of A's (the same columns in the same
+   * order, dup above) and any other whose rows agree */
+  FCM_ALLOC(ctx, n / 3 + 1, ap3);
+#pragma omp parallel for num_threads(nt) schedule(static) if (nt > 1 && n > 4096)
+  for (fcm_index g = 0; g < n / 3; g++)
+    ap3[g] = (unsigned char)(t->same3[g] || same_pattern3(3 * g, t->AP_ptr, t->AP_col));
+  /* R's rows 3 J + 1 and 3 J + 2 reach the same columns as row 3 J where they are its rows
+   * shifted by one and two to rows of A P of one pattern */
+  memset(dup, 0, (size_t)FCM_MAX(n, nc) + 1);
+  for (fcm_index g = 0; 3 * g + 2 < nc; g++)
+    dup[3 * g + 1] = dup[3 * g + 2] = (unsigned char)shifted3(3 * g, t->R_ptr, t->R_col, NULL, ap3);
+  FCM_TRY(ctx, product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, 1, dup,
+                               NULL, NULL, closed, &cp, &cc));
   if (with_diagonal) FCM_TRY(ctx, add_diagonal(ctx, nc, &cp, &cc));
   FCM_ALLOC(ctx, (size_t)nt * 3 * (size_t)(nc + 1), t->spa);
-  FCM_ALLOC(ctx, n / 3 + 1, t->same3); /* A's pattern, which every product keeps */
-  for (fcm_index g = 0; 3 * g + 2 < n; g++)
-    t->same3[g] = (unsigned char)same_pattern3(3 * g, fcm_csr_row_ptr(A), fcm_csr_col_idx(A));
-  {
-    unsigned char *ap3 = NULL; /* A P's groups of three rows of one pattern */
-    FCM_ALLOC(ctx, n / 3 + 1, ap3);
-    for (fcm_index g = 0; 3 * g + 2 < n; g++)
-      ap3[g] = (unsigned char)same_pattern3(3 * g, t->AP_ptr, t->AP_col);
-    t->r_kind = fcm__calloc(ctx, (size_t)(nc / 3 + 1), 1);
-    if (t->r_kind)
-      for (fcm_index g = 0; 3 * g + 2 < nc; g++)
-        t->r_kind[g] =
-            shifted3(3 * g, t->R_ptr, t->R_col, t->R_val, ap3) ? KIND_SHIFTED : KIND_ROWS;
-    fcm__free(ctx, ap3);
-    FCM_CHECK(t->r_kind, ctx, FCM_ERR_ALLOC, "ptap_create: out of memory");
-  }
+  FCM_ALLOC(ctx, (size_t)(nc / 3 + 1), t->r_kind);
+  for (fcm_index g = 0; 3 * g + 2 < nc; g++)
+    t->r_kind[g] = shifted3(3 * g, t->R_ptr, t->R_col, t->R_val, ap3) ? KIND_SHIFTED : KIND_ROWS;
   /* rows sorted and in range by construction, symmetric with A's pattern */
   FCM_TRY(ctx, fcm__csr_adopt_pattern(ctx, nc, nc, &cp, &cc, fcm_csr_get_kind(A), C));
   *plan = t;
@@ -468,6 +607,10 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
 cleanup:
   fcm__free(ctx, cp);
   fcm__free(ctx, cc);
+  fcm__free(ctx, dup);
+  fcm__free(ctx, ap3);
+  fcm__free(ctx, pnode);
+  fcm__free(ctx, closed);
   fcm__ptap_destroy(&t);
   return st;
 }

@@ -24,12 +24,6 @@ static void uf_union(fcm_index *uf, fcm_index a, fcm_index b)
   if (a != b) uf[FCM_MAX(a, b)] = FCM_MIN(a, b);
 }
 
-static int cmp_index(const void *a, const void *b)
-{
-  const fcm_index x = *(const fcm_index *)a, y = *(const fcm_index *)b;
-  return (x > y) - (x < y);
-}
-
 void fcm__mg_level_free(fcm_ctx *ctx, mg_level *L)
 {
   fcm__free(ctx, L->ijk);
@@ -99,7 +93,13 @@ static fcm_status graph_from_edges(fcm_ctx *ctx, fcm_index ncell, fcm_index nedg
   fcm_index out = 0;
   for (fcm_index c = 0; c < ncell; c++) {
     const fcm_index s = ptr[c], e = ptr[c + 1];
-    qsort(adj + s, (size_t)(e - s), sizeof *adj, cmp_index);
+    for (fcm_index i = s + 1; i < e; i++) { /* a few neighbours: insertion sort */
+      const fcm_index v = adj[i];
+      fcm_index j = i;
+      for (; j > s && adj[j - 1] > v; j--)
+        adj[j] = adj[j - 1];
+      adj[j] = v;
+    }
     ptr[c] = out;
     for (fcm_index i = s; i < e; i++)
       if (i == s || adj[i] != adj[i - 1]) adj[out++] = adj[i];

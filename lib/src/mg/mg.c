@@ -117,11 +117,16 @@ static fcm_status level_diag(fcm_mg *m, mg_level *L)
   const fcm_csr *A = fcm__mg_level_matrix(L);
   if (!L->diag) FCM_ALLOC(ctx, L->n + 1, L->diag);
   if (!L->dinv) FCM_ALLOC(ctx, L->n + 1, L->dinv);
-  for (fcm_index i = 0; i < L->n; i++) {
+  const fcm_index n = L->n;
+  fcm_index bad = n; /* the first row without one */
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static)                             \
+    reduction(min                                                                                  \
+              : bad) if (n > 4096)
+  for (fcm_index i = 0; i < n; i++) {
     L->diag[i] = fcm_csr_position(A, i, i);
-    FCM_CHECK(L->diag[i] >= 0, ctx, FCM_ERR_ARG, "mg: row %lld has no diagonal entry",
-              (long long)i);
+    if (L->diag[i] < 0 && i < bad) bad = i;
   }
+  FCM_CHECK(bad == n, ctx, FCM_ERR_ARG, "mg: row %lld has no diagonal entry", (long long)bad);
 cleanup:
   return st;
 }

@@ -13,13 +13,6 @@ static int cmp_index(const void *a, const void *b)
   return (x > y) - (x < y);
 }
 
-/* Pairs of fcm_index, lexicographically. */
-static int cmp_pair(const void *a, const void *b)
-{
-  const fcm_index *x = a, *y = b;
-  return x[0] != y[0] ? (x[0] > y[0]) - (x[0] < y[0]) : (x[1] > y[1]) - (x[1] < y[1]);
-}
-
 void fcm__mg_slabs_free(fcm_ctx *ctx, slab_order *S)
 {
   fcm__free(ctx, S->ptr);
@@ -162,23 +155,22 @@ fcm_status fcm__mg_row_slabs(fcm_mg *m, mg_level *L)
   fcm_index *reach = NULL;
   FCM_ALLOC_RAW(ctx, L->n + 1, work);
   FCM_ALLOC_RAW(ctx, L->n + 1, reach);
-  for (fcm_index i = 0; i < L->n; i++) {
+  const fcm_index n = L->n;
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (n > 4096)
+  for (fcm_index i = 0; i < n; i++) { /* a row's columns ascend: its last reaches furthest */
     work[i] = (double)(rp[i + 1] - rp[i]);
-    reach[i] = i;
-    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
-      reach[i] = FCM_MAX(reach[i], ci[p]);
+    reach[i] = rp[i + 1] > rp[i] ? FCM_MAX(i, (fcm_index)ci[rp[i + 1] - 1]) : i;
   }
   FCM_TRY(ctx, slabs_create(ctx, L->n, NULL, reach, work, MG_ROW_SLABS_THICK, &L->rows));
   FCM_ALLOC(ctx, L->n + 1, L->rows.triple);
-  for (fcm_index i = 0; i + 2 < L->n; i += 3) {
-    const fcm_index len = rp[i + 1] - rp[i];
-    int same = rp[i + 2] - rp[i + 1] == len && rp[i + 3] - rp[i + 2] == len, own = 0;
-    for (fcm_index p = 0; same && p < len; p++) {
-      same = ci[rp[i] + p] == ci[rp[i + 1] + p] && ci[rp[i] + p] == ci[rp[i + 2] + p];
-      if (ci[rp[i] + p] == i) /* the three's own columns, one after the other */
-        own = p + 2 < len && ci[rp[i] + p + 1] == i + 1 && ci[rp[i] + p + 2] == i + 2;
-    }
-    same = same && own;
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (n > 4096)
+  for (fcm_index i = 0; i < n - 2; i += 3) {
+    /* the three rows one pattern, the three's own columns one after the other (diag[i]) */
+    const fcm_index len = rp[i + 1] - rp[i], p = L->diag[i] - rp[i];
+    const int same = rp[i + 2] - rp[i + 1] == len && rp[i + 3] - rp[i + 2] == len && p + 2 < len &&
+                     ci[rp[i] + p + 1] == i + 1 && ci[rp[i] + p + 2] == i + 2 &&
+                     !memcmp(ci + rp[i], ci + rp[i + 1], sizeof *ci * (size_t)len) &&
+                     !memcmp(ci + rp[i], ci + rp[i + 2], sizeof *ci * (size_t)len);
     L->rows.triple[i] = (unsigned char)same;
   }
 cleanup:
@@ -325,6 +317,40 @@ cleanup:
   return st;
 }
 
+/* Sort the pairs (v, k) (v < nv) lexicographically: a counting sort by v, then each v's few
+ * pairs by k (*pairs replaced). */
+static fcm_status sort_pairs(fcm_ctx *ctx, fcm_index np, fcm_index nv, fcm_index **pairs)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *start = NULL, *out = NULL;
+  const fcm_index *in = *pairs;
+  FCM_ALLOC(ctx, nv + 2, start);
+  FCM_ALLOC_RAW(ctx, 2 * np + 1, out); /* every pair placed below */
+  for (fcm_index i = 0; i < np; i++)
+    start[in[2 * i] + 2]++;
+  for (fcm_index v = 0; v < nv; v++)
+    start[v + 2] += start[v + 1];
+  for (fcm_index i = 0; i < np; i++) { /* start[v + 1]: the next place of v's pairs */
+    const fcm_index q = start[in[2 * i] + 1]++;
+    out[2 * q] = in[2 * i], out[2 * q + 1] = in[2 * i + 1];
+  }
+  for (fcm_index v = 0; v < nv; v++) /* v's pairs: [start[v], start[v + 1]) */
+    for (fcm_index i = start[v] + 1; i < start[v + 1]; i++) {
+      const fcm_index k = out[2 * i + 1];
+      fcm_index j = i;
+      for (; j > start[v] && out[2 * j - 1] > k; j--)
+        out[2 * j + 1] = out[2 * j - 1];
+      out[2 * j + 1] = k;
+    }
+  fcm__free(ctx, *pairs);
+  *pairs = out;
+  out = NULL;
+cleanup:
+  fcm__free(ctx, start);
+  fcm__free(ctx, out);
+  return st;
+}
+
 /* Block smoothers (block_smoothing). Level 0: one block per grid vertex of the cut cells
  * (de Prenter et al. 2020): the DOFs of the copies whose support lies in the vertex's patch
  * of 8 cells, the vertex's own and (Hex20) those of the mid-edge nodes of the edges at the
@@ -370,7 +396,7 @@ static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_ou
           pairs[2 * np] = v, pairs[2 * np + 1] = ed[info->edge_nodes[j][2]] / 3, np++;
     }
   }
-  if (np > 0) qsort(pairs, (size_t)np, 2 * sizeof *pairs, cmp_pair);
+  FCM_TRY(ctx, sort_pairs(ctx, np, nnode, &pairs));
   for (fcm_index i = 0; i < np; i++)
     if (i == 0 || pairs[2 * i] != pairs[2 * nu - 2] || pairs[2 * i + 1] != pairs[2 * nu - 1])
       pairs[2 * nu] = pairs[2 * i], pairs[2 * nu + 1] = pairs[2 * i + 1], nu++;

@@ -150,6 +150,9 @@ cleanup:
   return st;
 }
 
+/* Blocks above which the scan of their positions is shared by the threads. */
+#define SCAN_PARALLEL_BLOCKS 256
+
 /* Why one block failed during the parallel setup. */
 typedef enum block_fail { FAIL_NONE, FAIL_NONFINITE, FAIL_ZERO, FAIL_LAPACK } block_fail;
 
@@ -499,14 +502,60 @@ cleanup:
   return st;
 }
 
+/* gather_scan()'s positions (pos, *full) from C's pattern alone. Where block rows i, i + 1,
+ * i + 2 are a node's three DOFs (d[i] = 3 k, d[i + 1] = 3 k + 1, d[i + 2] = 3 k + 2) and C's
+ * three rows hold one pattern, rows i + 1 and i + 2 of pos are row i's (a position is counted
+ * from its row's start): the scan reads row i only. */
+static void scan_pattern(const fcm_csr *C, int m, const fcm_index *d, int *loc, int *pos,
+                         unsigned char *full)
+{
+  const fcm_index *rp = fcm_csr_row_ptr(C);
+  const int *ci = fcm_csr_col_idx(C);
+  int stored = 0;
+  for (size_t e = 0; e < (size_t)m * (size_t)m; e++)
+    pos[e] = -1;
+  for (int j = 0; j < m; j++)
+    loc[d[j]] = j + 1;
+  for (int i = 0; i < m; i++) {
+    int *row = pos + (size_t)i * m, cnt = 0;
+    const fcm_index r = d[i], len = rp[r + 1] - rp[r];
+    for (fcm_index p = rp[r]; p < rp[r + 1]; p++) {
+      const int k = loc[ci[p]];
+      if (!k) continue;
+      cnt += row[k - 1] < 0;
+      row[k - 1] = (int)(p - rp[r]);
+    }
+    stored += cnt;
+    if (r % 3 == 0 && i + 2 < m && d[i + 1] == r + 1 && d[i + 2] == r + 2 &&
+        rp[r + 2] - rp[r + 1] == len && rp[r + 3] - rp[r + 2] == len &&
+        !memcmp(ci + rp[r], ci + rp[r + 1], sizeof *ci * (size_t)len) &&
+        !memcmp(ci + rp[r], ci + rp[r + 2], sizeof *ci * (size_t)len)) {
+      memcpy(row + m, row, sizeof *row * (size_t)m);
+      memcpy(row + 2 * m, row, sizeof *row * (size_t)m);
+      stored += 2 * cnt;
+      i += 2;
+    }
+  }
+  for (int j = 0; j < m; j++)
+    loc[d[j]] = 0;
+  *full = stored == m * m;
+}
+
 /* The positions of every block's entries in C's rows, as gather_scan() finds them, from C's
  * pattern alone (a creation without values): the first setup gathers the blocks whose entries
- * are all stored through them (the same values as a scan), and scans the others. */
+ * are all stored through them (the same values as a scan), and scans the others. Blocks shared
+ * by the threads, each with its DOF map (zero between blocks). */
 static void scan_positions(fcm_schwarz *P, const fcm_csr *C)
 {
-  for (fcm_index b = 0; b < P->num_blocks; b++) /* thread 0's DOF map, zero between blocks */
-    gather_scan(C, NULL, (int)(P->block_ptr[b + 1] - P->block_ptr[b]), P->dofs + P->block_ptr[b],
-                P->loc, P->pos + P->s_off[b], &P->full[b], NULL);
+  const fcm_index nb = P->num_blocks;
+#pragma omp parallel num_threads(P->nt) if (P->nt > 1 && nb > SCAN_PARALLEL_BLOCKS)
+  {
+    int *loc = P->loc + (size_t)P->n * (size_t)omp_get_thread_num();
+#pragma omp for schedule(dynamic, 64)
+    for (fcm_index b = 0; b < nb; b++)
+      scan_pattern(C, (int)(P->block_ptr[b + 1] - P->block_ptr[b]), P->dofs + P->block_ptr[b], loc,
+                   P->pos + P->s_off[b], &P->full[b]);
+  }
 }
 
 /* fcm_schwarz_create(); blocks_only: for the block smoother (fcm__schwarz_create_blocks()),

@@ -1,0 +1,259 @@
+/* The hierarchy a cut prepares (fcm__mg_create_pattern() from the hierarchy before the cut,
+ * detached, on the new matrix's pattern, then fcm_mg_setup() with the values) after each cut of
+ * a sequence equals the one fcm_mg_create() builds on the new space and matrix, bit for bit
+ * (every level's matrix, pattern and values, its inactive rows, and two cycles, memcmp), and
+ * its structure equals references computed here the plain way, independently of the
+ * creation's shortcuts (a node's repeated rows copied, sorted rows' last columns, the block
+ * positions read once for a node's three rows, storage taken from the earlier hierarchy):
+ * each coarse level's pattern is the structural pattern of P^T A P with the diagonal (a dense
+ * table), the rows' groups of three of one pattern are those a full comparison finds, and the
+ * row and block slabs are sound (fcm__mg_slabs_check()). The embedded hemisphere of mg_util.h,
+ * Hex8 and Hex20, V- and W-cycles, cut three times (partial planes: the first splits the top,
+ * the second crosses it, the third cuts off a corner). */
+#include "mg/levels_impl.h"
+#include "mg_util.h"
+
+#include <math.h>
+#include <stdio.h>
+
+/* The rows of A without an off-diagonal value: those the elimination decoupled. */
+static unsigned char *eliminated(const fcm_csr *A, fcm_index n)
+{
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const double *v = fcm_csr_values_read(A);
+  unsigned char *in = calloc((size_t)n + 1, 1);
+  for (fcm_index i = 0; i < n; i++) {
+    int off = 0;
+    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+      off |= ci[p] != i && v[p] != 0.0;
+    in[i] = (unsigned char)!off;
+  }
+  return in;
+}
+
+/* A matrix of A's pattern, every value NaN (a value read before the setup shows). */
+static fcm_csr *nan_copy(fcm_ctx *ctx, const problem *p)
+{
+  fcm_csr *P = NULL;
+  fcm_index nnz = 0;
+  TEST_OK(ctx, fcm_space_matrix_create(p->space, &P));
+  fcm_csr_get_size(P, NULL, NULL, &nnz);
+  double *v = fcm_csr_values(P);
+  for (fcm_index k = 0; k < nnz; k++)
+    v[k] = NAN;
+  return P;
+}
+
+/* Two cycles, the second from the first's output: 2 n values. */
+static void cycles(fcm_ctx *ctx, fcm_mg *mg, const problem *p, double *out)
+{
+  const fcm_index n = p->n;
+  TEST_OK(ctx, fcm_mg_operator(mg, p->b, out));
+  for (int k = 1; k < 2; k++)
+    TEST_OK(ctx, fcm_mg_operator(mg, out + (k - 1) * n, out + k * n));
+}
+
+/* Same levels, level matrices, inactive rows and cycle output bits. */
+static int same_mg(fcm_ctx *ctx, fcm_mg *a, fcm_mg *b, const problem *p)
+{
+  int same = a->nlev == b->nlev;
+  for (int l = 0; same && l < a->nlev; l++) {
+    const fcm_csr *A = fcm__mg_level_matrix(&a->lev[l]), *B = fcm__mg_level_matrix(&b->lev[l]);
+    fcm_index na = 0, za = 0, nb = 0, zb = 0;
+    fcm_csr_get_size(A, &na, NULL, &za);
+    fcm_csr_get_size(B, &nb, NULL, &zb);
+    same = na == nb && za == zb &&
+           !memcmp(fcm_csr_row_ptr(A), fcm_csr_row_ptr(B), sizeof(fcm_index) * (size_t)(na + 1)) &&
+           !memcmp(fcm_csr_col_idx(A), fcm_csr_col_idx(B), sizeof(int) * (size_t)za) &&
+           !memcmp(fcm_csr_values_read(A), fcm_csr_values_read(B), sizeof(double) * (size_t)za) &&
+           !memcmp(a->lev[l].inactive, b->lev[l].inactive, (size_t)na);
+    if (!same) printf("  level %d differs\n", l);
+  }
+  const size_t bytes = sizeof(double) * 2 * (size_t)p->n;
+  double *x1 = malloc(bytes), *x2 = malloc(bytes);
+  cycles(ctx, a, p, x1);
+  cycles(ctx, b, p, x2);
+  int finite = 1;
+  for (fcm_index i = 0; i < 2 * p->n; i++)
+    finite &= isfinite(x1[i]) != 0;
+  same = same && finite && memcmp(x1, x2, bytes) == 0;
+  free(x1);
+  free(x2);
+  return same;
+}
+
+/* Is level l + 1's pattern exactly the structural pattern of P_l^T A_l P_l with the diagonal?
+ * A dense table of the coarse entries reached. */
+static int galerkin_pattern_exact(const fcm_mg *mg, int l)
+{
+  const mg_level *L = &mg->lev[l], *C = &mg->lev[l + 1];
+  const fcm_csr *A = fcm__mg_level_matrix(L), *Ac = fcm__mg_level_matrix(C);
+  const fcm_index *rp = fcm_csr_row_ptr(A), *cp = fcm_csr_row_ptr(Ac);
+  const int *ci = fcm_csr_col_idx(A), *cc = fcm_csr_col_idx(Ac);
+  const size_t nc = (size_t)C->n;
+  unsigned char *hit = calloc(nc * nc + 1, 1);
+  for (size_t I = 0; I < nc; I++)
+    hit[I * nc + I] = 1;
+  for (fcm_index i = 0; i < L->n; i++)
+    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+      for (fcm_index a = L->P_ptr[i]; a < L->P_ptr[i + 1]; a++)
+        for (fcm_index b = L->P_ptr[ci[p]]; b < L->P_ptr[ci[p] + 1]; b++)
+          hit[(size_t)L->P_col[a] * nc + (size_t)L->P_col[b]] = 1;
+  int same = 1;
+  for (size_t I = 0; I < nc && same; I++) {
+    fcm_index count = 0;
+    for (size_t J = 0; J < nc; J++)
+      count += hit[I * nc + J];
+    same = count == cp[I + 1] - cp[I];
+    for (fcm_index q = cp[I]; q < cp[I + 1] && same; q++)
+      same = hit[I * nc + (size_t)cc[q]] && (q == cp[I] || cc[q] > cc[q - 1]);
+    if (!same) printf("  level %d: coarse row %zu is not P^T A P's\n", l + 1, I);
+  }
+  free(hit);
+  return same;
+}
+
+/* Are the row order's groups of three (triple) those a full comparison of the rows finds? */
+static int triples_exact(const fcm_mg *mg, int l)
+{
+  const mg_level *L = &mg->lev[l];
+  if (!L->rows.triple) return 1;
+  const fcm_csr *A = fcm__mg_level_matrix(L);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  int same = 1, groups = 0;
+  for (fcm_index i = 0; i + 2 < L->n && same; i += 3) {
+    const fcm_index len = rp[i + 1] - rp[i];
+    int t = rp[i + 2] - rp[i + 1] == len && rp[i + 3] - rp[i + 2] == len, own = 0;
+    for (fcm_index q = 0; t && q < len; q++) {
+      t = ci[rp[i] + q] == ci[rp[i + 1] + q] && ci[rp[i] + q] == ci[rp[i + 2] + q];
+      if (ci[rp[i] + q] == i)
+        own = q + 2 < len && ci[rp[i] + q + 1] == i + 1 && ci[rp[i] + q + 2] == i + 2;
+    }
+    t = t && own;
+    groups += t;
+    same = L->rows.triple[i] == t;
+    if (!same)
+      printf("  level %d: rows %lld..+2 flagged %d, are %d\n", l, (long long)i, L->rows.triple[i],
+             t);
+  }
+  return same && groups > 0;
+}
+
+/* The space and clamped matrix of `rules` (mesh and geometry borrowed from base). */
+static void problem_on(fcm_ctx *ctx, const problem *base, const fcm_cell_rules *rules, problem *p)
+{
+  memset(p, 0, sizeof *p);
+  p->mesh = base->mesh;
+  TEST_OK(ctx, fcm_space_create_embedded(ctx, p->mesh, rules, &p->space));
+  finish_space(ctx, p, 0);
+  const double flo[3] = {-2, 0, -2}, fhi[3] = {2, 0, 2};
+  clamp_box(ctx, p, flo, fhi);
+}
+
+static void problem_drop(problem *p)
+{
+  fcm_csr_destroy(&p->A);
+  fcm_space_destroy(&p->space);
+  free(p->b);
+  memset(p, 0, sizeof *p);
+}
+
+/* The hierarchy prepared from *old (consumed; detached) on p's pattern, then set up, against
+ * fcm_mg_create() and the references. Returns the prepared one and its pattern matrix. */
+static fcm_mg *prepare_and_compare(fcm_ctx *ctx, fcm_mg **old, const problem *p,
+                                   const fcm_mg_options *o, const char *what, fcm_csr **pattern)
+{
+  fcm_mg *prep = NULL, *fresh = NULL;
+  unsigned char *inactive = eliminated(p->A, p->n);
+  *pattern = nan_copy(ctx, p);
+  TEST_OK(ctx, fcm__mg_create_pattern(ctx, old, p->space, *pattern, inactive, o, &prep));
+  TEST_TRUE(*old == NULL);
+  memcpy(fcm_csr_values(*pattern), fcm_csr_values_read(p->A),
+         sizeof(double) * (size_t)fcm_csr_row_ptr(p->A)[p->n]);
+  TEST_OK(ctx, fcm_mg_setup(prep));
+  TEST_OK(ctx, fcm_mg_create(ctx, p->space, p->A, o, &fresh));
+  const int same = same_mg(ctx, prep, fresh, p);
+  int exact = 1, nblk = 0;
+  for (int l = 0; l + 1 < prep->nlev; l++) {
+    fcm_index row_slabs = 0, block_slabs = 0;
+    exact &= galerkin_pattern_exact(prep, l) && triples_exact(prep, l);
+    TEST_OK(ctx, fcm__mg_slabs_check(prep, l, &row_slabs, &block_slabs));
+    nblk += prep->lev[l].blk != NULL;
+  }
+  printf("%s: %d levels, %lld DOFs, %d levels with block smoothers; prepared from the hierarchy "
+         "before %s fcm_mg_create(), structure %s the references\n",
+         what, fcm_mg_num_levels(prep), (long long)p->n, nblk, same ? "equals" : "DIFFERS from",
+         exact ? "equals" : "DIFFERS from");
+  TEST_TRUE(fcm_mg_num_levels(prep) >= 3 && nblk > 0);
+  TEST_TRUE(same);
+  TEST_TRUE(exact);
+  fcm_mg_destroy(&fresh);
+  free(inactive);
+  return prep;
+}
+
+/* The cut sequence on `type`, a V-cycle and a W-cycle hierarchy carried along it. */
+static void cut_sequence(fcm_ctx *ctx, fcm_element_type type)
+{
+  const char *name = type == FCM_ELEMENT_HEX8 ? "hex8" : "hex20";
+  problem base;
+  problem_hemisphere_of(ctx, type, 8, 0, fcm_space_options_default().constrain_ratio, &base);
+  fcm_mg_options o[2] = {fcm_mg_options_default(), fcm_mg_options_default()};
+  fcm_mg *mg[2] = {NULL, NULL};
+  fcm_csr *pattern[2] = {NULL, NULL};
+  char what[96];
+  for (int c = 0; c < 2; c++) {
+    o[c].coarse_dofs = 100;
+    o[c].cycle_index = c + 1;
+    snprintf(what, sizeof what, "%s, cycle %d, before the cuts", name, c + 1);
+    mg[c] = prepare_and_compare(ctx, &mg[c], &base, &o[c], what, &pattern[c]);
+  }
+  const double pt[3][3] = {{0.05, 0, 0}, {0, 0, 0.13}, {0.5, 0.5, 0.5}};
+  const double nrm[3][3] = {{1, 0, 0}, {0, 0.2, 1}, {1, 1, 1}};
+  const double blo[3][3] = {{-0.1, 0.4, -2}, {-2, 0.6, -0.5}, {-2, -2, -2}};
+  const double bhi[3][3] = {{0.2, 2, 2}, {2, 2, 0.5}, {2, 2, 2}};
+  const fcm_cell_rules *prev = base.rules0;
+  fcm_cell_rules *rules[3] = {NULL, NULL, NULL};
+  problem cur;
+  memset(&cur, 0, sizeof cur);
+  for (int k = 0; k < 3; k++) {
+    fcm_surface *s = NULL;
+    TEST_OK(ctx, fcm_surface_create_plane(ctx, pt[k], nrm[k], blo[k], bhi[k], &s));
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, base.mesh, base.geom, prev, s, &rules[k]));
+    fcm_surface_destroy(&s);
+    prev = rules[k];
+    for (int c = 0; c < 2; c++) { /* as a cut: the old matrix and space go first */
+      fcm__mg_detach(mg[c]);
+      fcm_csr_destroy(&pattern[c]);
+    }
+    problem_drop(&cur);
+    problem next;
+    problem_on(ctx, &base, rules[k], &next);
+    for (int c = 0; c < 2; c++) {
+      snprintf(what, sizeof what, "%s, cycle %d, cut %d", name, c + 1, k + 1);
+      mg[c] = prepare_and_compare(ctx, &mg[c], &next, &o[c], what, &pattern[c]);
+    }
+    cur = next;
+  }
+  for (int c = 0; c < 2; c++) {
+    fcm_mg_destroy(&mg[c]);
+    fcm_csr_destroy(&pattern[c]);
+  }
+  problem_drop(&cur);
+  for (int k = 0; k < 3; k++)
+    fcm_cell_rules_destroy(&rules[k]);
+  problem_free(&base);
+}
+
+int main(void)
+{
+  fcm_ctx *ctx = NULL;
+  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  cut_sequence(ctx, FCM_ELEMENT_HEX8);
+  cut_sequence(ctx, FCM_ELEMENT_HEX20);
+  fcm_ctx_destroy(&ctx);
+  printf("ok\n");
+  return 0;
+}
