@@ -757,6 +757,13 @@ fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__p
  * volume up to rounding). */
 int fcm__embed_part_full(const fcm__parts *P, size_t i);
 
+/* Whether the convex polyhedron p (a part of affine cell) is a box in cell's reference
+ * coordinates: 8 vertices, each at a corner of their reference bounding box lo..hi within
+ * 1e-13 of the reference cell's size, every corner taken once (a part of a box cell that cuts
+ * along the grid's axes split). */
+fcm_status fcm__embed_part_box(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__poly *p,
+                               double lo[3], double hi[3], int *is_box);
+
 /* The planes of the faces with area of part i of P into pl (room for FCM__POLY_MAX_FACES);
  * their count. */
 int fcm__embed_part_planes(const fcm__parts *P, size_t i, fcm__plane *pl);

@@ -539,44 +539,6 @@ cleanup:
   return st;
 }
 
-/* A part's box in reference coordinates (lo[3], hi[3]) when it is one: 8 vertices, each at a
- * corner of their bounding box within BOX_RTOL of the reference cell's size (2), every corner
- * taken once. A part of an axis-aligned box cell that the cuts split by planes along the grid's
- * axes is one. */
-#define BOX_RTOL 1e-13
-
-static fcm_status part_box(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__poly *p,
-                           double lo[3], double hi[3], int *is_box)
-{
-  fcm_status st = FCM_OK;
-  double xi[8][3], det;
-  unsigned seen = 0;
-  *is_box = 0;
-  if (p->nv != 8 || p->nf != 6) return FCM_OK;
-  for (int d = 0; d < 3; d++)
-    lo[d] = HUGE_VAL, hi[d] = -HUGE_VAL;
-  for (int a = 0; a < 8; a++) {
-    FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, p->x[a], xi[a], &det));
-    for (int d = 0; d < 3; d++)
-      lo[d] = fmin(lo[d], xi[a][d]), hi[d] = fmax(hi[d], xi[a][d]);
-  }
-  const double tol = 2.0 * BOX_RTOL;
-  for (int d = 0; d < 3; d++)
-    if (!(hi[d] - lo[d] > 2.0 * tol)) return FCM_OK;
-  for (int a = 0; a < 8; a++) {
-    unsigned corner = 0;
-    for (int d = 0; d < 3; d++) {
-      if (xi[a][d] - lo[d] <= tol) continue;
-      if (hi[d] - xi[a][d] > tol) return FCM_OK;
-      corner |= 1u << d;
-    }
-    seen |= 1u << corner;
-  }
-  *is_box = seen == 0xffu;
-cleanup:
-  return st;
-}
-
 /* The rules of a piece whose parts the body fills and which are boxes in reference
  * coordinates, without a fit: the 2-point Gauss rule per axis on each box (8 points, positive,
  * inside), exact for degree 3 in each variable, so on every kind's space when no kind's space
@@ -596,7 +558,7 @@ static fcm_status box_piece_rule(const build *B, const fcm__embed_cell *cell, co
     if (P->piece[j] != piece) continue;
     int is_box;
     if (nb == FCM__BOX_PIECE_PARTS || !fcm__embed_part_full(P, j)) return FCM_OK;
-    FCM_TRY(ctx, part_box(ctx, cell, P->poly + j, lo[nb], hi[nb], &is_box));
+    FCM_TRY(ctx, fcm__embed_part_box(ctx, cell, P->poly + j, lo[nb], hi[nb], &is_box));
     if (!is_box) return FCM_OK;
     nb++;
   }

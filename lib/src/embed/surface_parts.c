@@ -155,6 +155,119 @@ cleanup:
   return st;
 }
 
+/* A part's box in reference coordinates within this fraction of the reference cell's size (2):
+ * see fcm__embed_part_box(). */
+#define BOX_RTOL 1e-13
+
+fcm_status fcm__embed_part_box(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__poly *p,
+                               double lo[3], double hi[3], int *is_box)
+{
+  fcm_status st = FCM_OK;
+  double xi[8][3], det;
+  unsigned seen = 0;
+  *is_box = 0;
+  if (p->nv != 8 || p->nf != 6 || !cell->affine) return FCM_OK;
+  for (int d = 0; d < 3; d++)
+    lo[d] = HUGE_VAL, hi[d] = -HUGE_VAL;
+  for (int a = 0; a < 8; a++) {
+    FCM_TRY(ctx, fcm__embed_to_reference(ctx, cell, p->x[a], xi[a], &det));
+    for (int d = 0; d < 3; d++)
+      lo[d] = fmin(lo[d], xi[a][d]), hi[d] = fmax(hi[d], xi[a][d]);
+  }
+  const double tol = 2.0 * BOX_RTOL;
+  for (int d = 0; d < 3; d++)
+    if (!(hi[d] - lo[d] > 2.0 * tol)) return FCM_OK;
+  for (int a = 0; a < 8; a++) {
+    unsigned corner = 0;
+    for (int d = 0; d < 3; d++) {
+      if (xi[a][d] - lo[d] <= tol) continue;
+      if (hi[d] - xi[a][d] > tol) return FCM_OK;
+      corner |= 1u << d;
+    }
+    seen |= 1u << corner;
+  }
+  *is_box = seen == 0xffu;
+cleanup:
+  return st;
+}
+
+/* The box lo..hi of cell's reference coordinates (cell affine) as an affine Hex8 cell of its
+ * own: its reference cube's point eta is cell's c + h eta (c, h: the box's centre and half
+ * sides). */
+static void box_cell(const fcm__embed_cell *cell, const double lo[3], const double hi[3],
+                     fcm__embed_cell *k)
+{
+  static const int corner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                                   {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  double h[3];
+  k->type = FCM_ELEMENT_HEX8;
+  k->info = fcm_element_get_info(FCM_ELEMENT_HEX8);
+  k->id = cell->id;
+  k->num_planes = 0;
+  for (int d = 0; d < 3; d++)
+    h[d] = 0.5 * (hi[d] - lo[d]);
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      k->A[3 * i + j] = cell->A[3 * i + j] * h[j];
+  for (int d = 0; d < 3; d++) {
+    k->xi0[d] = -1.0;
+    k->lo[d] = HUGE_VAL, k->hi[d] = -HUGE_VAL;
+  }
+  for (int a = 0; a < 8; a++) { /* the corners, VTK order */
+    const double xi[3] = {corner[a][0] ? hi[0] : lo[0], corner[a][1] ? hi[1] : lo[1],
+                          corner[a][2] ? hi[2] : lo[2]};
+    const double r[3] = {xi[0] - cell->xi0[0], xi[1] - cell->xi0[1], xi[2] - cell->xi0[2]};
+    double *x = k->X + 3 * a;
+    fcm__mat3_mulv(cell->A, r, x);
+    for (int d = 0; d < 3; d++) {
+      x[d] += cell->X[d];
+      k->lo[d] = fmin(k->lo[d], x[d]), k->hi[d] = fmax(k->hi[d], x[d]);
+    }
+  }
+  k->detA = fcm__mat3_inv(k->A, k->Ainv);
+  k->affine = 1;
+  k->size = fcm__element_cell_size(8, k->X);
+  k->tol = 0.0;
+  k->volume = fabs(k->detA) * 8.0;
+}
+
+/* tets_material() on the box lo..hi of cell's reference coordinates as one Hex8 cell: one
+ * moment rule instead of one per fan tet (a box of 6 faces has 12), each boundary triangle
+ * clipped once, one exit facet and edge. */
+static fcm_status box_material(fcm_ctx *ctx, fcm__material *m, const double lo[3],
+                               const double hi[3], const fcm__moment_quad *q,
+                               const fcm__embed_cell *cell, fcm__srule *out, double *volume)
+{
+  fcm_status st = FCM_OK;
+  fcm__embed_cell k;
+  double sum = 0.0, c[3], h[3];
+  int clear, winding = FCM__WINDING_UNKNOWN;
+  box_cell(cell, lo, hi, &k);
+  for (int d = 0; d < 3; d++)
+    c[d] = 0.5 * (lo[d] + hi[d]), h[d] = 0.5 * (hi[d] - lo[d]);
+  FCM_TRY(ctx, fcm__embed_cell_clear(ctx, m->geom, m->tree, &k, &m->buf, &clear));
+  if (clear)
+    FCM_TRY(ctx, fcm__embed_moment_rule_clear(ctx, m->geom, m->tree, &k, q, NULL, &m->buf, &m->cr,
+                                              &winding, &m->sr));
+  else
+    FCM_TRY(ctx, fcm__embed_moment_rule_kept(ctx, m->geom, m->tree, &k, q, NULL, &m->buf, &m->cr,
+                                             &m->sr));
+  if (out) FCM_TRY(ctx, fcm__srule_room(ctx, out, m->sr.n));
+  for (size_t i = 0; i < m->sr.n; i++) {
+    const double w = m->sr.w[i] * k.detA;
+    sum += w;
+    if (!out) continue;
+    const double *e = m->sr.x + 3 * i;
+    double *x = out->x + 3 * out->n;
+    for (int d = 0; d < 3; d++)
+      x[d] = c[d] + h[d] * e[d];
+    out->w[out->n++] = w / cell->detA;
+  }
+  *volume = sum;
+cleanup:
+  return st;
+}
+
 /* Room for nt tets in m. */
 static fcm_status tets_room(fcm_ctx *ctx, fcm__material *m, int nt)
 {
@@ -175,8 +288,13 @@ fcm_status fcm__material_poly(fcm_ctx *ctx, fcm__material *m, const fcm__poly *p
                               fcm__srule *out, double *volume)
 {
   fcm_status st = FCM_OK;
+  int is_box = 0;
+  double lo[3], hi[3];
   *volume = 0.0;
   if (p->nf == 0) return FCM_OK;
+  if (cell->info->num_corners == 8)
+    FCM_TRY(ctx, fcm__embed_part_box(ctx, cell, p, lo, hi, &is_box));
+  if (is_box) return box_material(ctx, m, lo, hi, q ? q : &m->q0, cell, out, volume);
   FCM_TRY(ctx, tets_room(ctx, m, fcm__geom_poly_num_tets(p)));
   const int nt = fcm__geom_poly_tets(p, m->tets, m->vol);
   FCM_TRY(ctx, tets_material(ctx, m, m->tets, m->vol, nt, q ? q : &m->q0, cell, out, volume));
