@@ -4,10 +4,10 @@
  * the reference coordinates is not a box of x), cut by a plane along the grid's x = const
  * reference planes, a rectangle along its y = const planes that ends inside cells (a crack tip:
  * pieces of four box parts, more points than M, which are fitted) and, in a second run, also by
- * a tilted plane (parts that are not boxes). With the stiffness on the mass space, a piece the body fills made of boxes
- * takes the 2-point Gauss rule on each (no fit), and a box part at the body's surface takes
- * its material moments as one Hex8 cell of its own (fcm__material_poly). The reference: the
- * volume path unsimplified at mass strength 6 on the ball's tets. Asserts
+ * a tilted plane (parts that are not boxes). With the stiffness on the mass space, a piece the body
+ * fills made of boxes takes the 2-point Gauss rule on each (no fit), and a box part at the body's
+ * surface takes its material moments as one Hex8 cell of its own (fcm__material_poly). The
+ * reference: the volume path unsimplified at mass strength 6 on the ball's tets. Asserts
  * - every cut piece's stiffness tensor (sum w det J dN_a/dxi_i dN_b/dxi_j) and 8 x 8 mass
  *   matrix equal the reference's within 1e-12 of their largest entries, positive weights,
  *   at most 27 points, every point in the cell and on one side of each cut;

@@ -144,6 +144,11 @@ void fcm__embed_cell_box(const fcm_mesh *mesh, fcm_index id, double clip_rtol,
 fcm_status fcm__embed_cell_setup(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index id, double clip_rtol,
                                  fcm__embed_cell *cell);
 
+/* fcm__embed_cell_setup()'s first part: the cell's corners, size, tolerance, box and volume
+ * (not its planes or map): what a cell whose rules are copied needs. */
+fcm_status fcm__embed_cell_setup_volume(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index id,
+                                        double clip_rtol, fcm__embed_cell *cell);
+
 /* Counters of the per-cell kernels (summed over cells into the statistics). */
 typedef struct fcm__embed_counts {
   fcm_index candidates;        /* (background cell, embedded cell) pairs from the tree */
