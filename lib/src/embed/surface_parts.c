@@ -231,6 +231,28 @@ static void box_cell(const fcm__embed_cell *cell, const double lo[3], const doub
   k->volume = fabs(k->detA) * 8.0;
 }
 
+/* The body's signed rule of degree q->m on the affine cell k alone, into m->sr (k's reference
+ * coordinates), and its volume, as tets_material() takes each tet's. */
+static fcm_status one_cell_material(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *k,
+                                    const fcm__moment_quad *q, double *volume)
+{
+  fcm_status st = FCM_OK;
+  double sum = 0.0;
+  int clear, winding = FCM__WINDING_UNKNOWN;
+  FCM_TRY(ctx, fcm__embed_cell_clear(ctx, m->geom, m->tree, k, &m->buf, &clear));
+  if (clear)
+    FCM_TRY(ctx, fcm__embed_moment_rule_clear(ctx, m->geom, m->tree, k, q, NULL, &m->buf, &m->cr,
+                                              &winding, &m->sr));
+  else
+    FCM_TRY(ctx, fcm__embed_moment_rule_kept(ctx, m->geom, m->tree, k, q, NULL, &m->buf, &m->cr,
+                                             &m->sr));
+  for (size_t i = 0; i < m->sr.n; i++)
+    sum += m->sr.w[i] * k->detA;
+  *volume = sum;
+cleanup:
+  return st;
+}
+
 /* tets_material() on the box lo..hi of cell's reference coordinates as one Hex8 cell: one
  * moment rule instead of one per fan tet (a box of 6 faces has 12), each boundary triangle
  * clipped once, one exit facet and edge. */
@@ -240,30 +262,20 @@ static fcm_status box_material(fcm_ctx *ctx, fcm__material *m, const double lo[3
 {
   fcm_status st = FCM_OK;
   fcm__embed_cell k;
-  double sum = 0.0, c[3], h[3];
-  int clear, winding = FCM__WINDING_UNKNOWN;
+  double c[3], h[3];
   box_cell(cell, lo, hi, &k);
   for (int d = 0; d < 3; d++)
     c[d] = 0.5 * (lo[d] + hi[d]), h[d] = 0.5 * (hi[d] - lo[d]);
-  FCM_TRY(ctx, fcm__embed_cell_clear(ctx, m->geom, m->tree, &k, &m->buf, &clear));
-  if (clear)
-    FCM_TRY(ctx, fcm__embed_moment_rule_clear(ctx, m->geom, m->tree, &k, q, NULL, &m->buf, &m->cr,
-                                              &winding, &m->sr));
-  else
-    FCM_TRY(ctx, fcm__embed_moment_rule_kept(ctx, m->geom, m->tree, &k, q, NULL, &m->buf, &m->cr,
-                                             &m->sr));
-  if (out) FCM_TRY(ctx, fcm__srule_room(ctx, out, m->sr.n));
+  FCM_TRY(ctx, one_cell_material(ctx, m, &k, q, volume));
+  if (!out) goto cleanup;
+  FCM_TRY(ctx, fcm__srule_room(ctx, out, m->sr.n));
   for (size_t i = 0; i < m->sr.n; i++) {
-    const double w = m->sr.w[i] * k.detA;
-    sum += w;
-    if (!out) continue;
     const double *e = m->sr.x + 3 * i;
     double *x = out->x + 3 * out->n;
     for (int d = 0; d < 3; d++)
       x[d] = c[d] + h[d] * e[d];
-    out->w[out->n++] = w / cell->detA;
+    out->w[out->n++] = m->sr.w[i] * k.detA / cell->detA;
   }
-  *volume = sum;
 cleanup:
   return st;
 }
@@ -515,6 +527,46 @@ cleanup:
   return st;
 }
 
+/* The prism of half-height h along the unit normal nrm on the polygon x (n vertices) as one
+ * affine Hex8 cell k, when the polygon is a parallelogram (4 vertices, x0 + x2 = x1 + x3 within
+ * 1e-12 of its extent) and the prism not flat: then 1; else 0 (its fan's tets instead). */
+static int prism_cell(const double *x, int n, const double nrm[3], double h, fcm_index id,
+                      fcm__embed_cell *k)
+{
+  double ext = 0.0;
+  if (n != 4) return 0;
+  for (int i = 1; i < 4; i++)
+    for (int d = 0; d < 3; d++)
+      ext = fmax(ext, fabs(x[3 * i + d] - x[d]));
+  for (int d = 0; d < 3; d++)
+    if (!(fabs(x[d] + x[6 + d] - x[3 + d] - x[9 + d]) <= 1e-12 * ext)) return 0;
+  k->type = FCM_ELEMENT_HEX8;
+  k->info = fcm_element_get_info(FCM_ELEMENT_HEX8);
+  k->id = id;
+  k->num_planes = 0;
+  for (int d = 0; d < 3; d++) {
+    k->A[3 * d] = 0.5 * (x[3 + d] - x[d]);
+    k->A[3 * d + 1] = 0.5 * (x[9 + d] - x[d]);
+    k->A[3 * d + 2] = h * nrm[d];
+    k->xi0[d] = -1.0;
+    k->lo[d] = HUGE_VAL, k->hi[d] = -HUGE_VAL;
+  }
+  for (int a = 0; a < 8; a++) { /* VTK order: the polygon below, then above */
+    const double s = a < 4 ? -h : h;
+    for (int d = 0; d < 3; d++) {
+      const double v = x[3 * (a % 4) + d] + s * nrm[d];
+      k->X[3 * a + d] = v;
+      k->lo[d] = fmin(k->lo[d], v), k->hi[d] = fmax(k->hi[d], v);
+    }
+  }
+  k->detA = fcm__mat3_inv(k->A, k->Ainv);
+  k->affine = 1;
+  k->size = fcm__element_cell_size(8, k->X);
+  k->tol = 0.0;
+  k->volume = fabs(k->detA) * 8.0;
+  return fabs(k->detA) > FLAT_RTOL * k->size * k->size * k->size && isfinite(k->detA);
+}
+
 int fcm__material_on_face(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
                           const double *x, int n, const double nrm[3], double h, double atol)
 {
@@ -542,7 +594,11 @@ int fcm__material_on_face(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell 
   FCM_TRY(ctx, prism_clear(ctx, m, m->tets, 3 * (n - 2), h, atol, cell->id, &sure));
   if (!sure && m->buf.n > 0) FCM_TRY(ctx, prism_near(ctx, m, x, n, nrm, h, atol, cell->id, &sure));
   if (sure) return sure > 0;
-  FCM_TRY(ctx, tets_material(ctx, m, m->tets, m->vol, 3 * (n - 2), &m->q0, cell, NULL, &v));
+  fcm__embed_cell k;
+  if (prism_cell(x, n, nrm, h, cell->id, &k))
+    FCM_TRY(ctx, one_cell_material(ctx, m, &k, &m->q0, &v));
+  else
+    FCM_TRY(ctx, tets_material(ctx, m, m->tets, m->vol, 3 * (n - 2), &m->q0, cell, NULL, &v));
 cleanup:
   if (st != FCM_OK) {
     if (m->st == FCM_OK) m->st = st;
