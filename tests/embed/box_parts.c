@@ -14,7 +14,12 @@
  * - Gauss box rules occur (8 points per box, on one or more boxes) and pieces fitted on the
  *   surface moments occur too; no Gauss rule without the stiffness on the mass space;
  * - a weight of the Gauss rule off by a factor (the control: 1 + 1e-6 on one piece's rule)
- *   breaks the mass check, so the check tells an exact rule from a wrong one. */
+ *   breaks the mass check, so the check tells an exact rule from a wrong one;
+ * - the face overlaps' material test (fcm__material_on_face) on parallelograms across the
+ *   ball's surfaces, whose prism is one Hex8 cell, answers as on the same polygon given with
+ *   a fifth vertex on an edge (its prism's fan tets), with a threshold of 0.3 of the area
+ *   (so the moments decide where the surface crosses), both answers occurring. */
+#include "embed/embed_impl.h"
 #include "fcm/fcm.h"
 #include "test.h"
 
@@ -223,6 +228,53 @@ static fcm_mesh *sheared_grid(void)
   return mesh;
 }
 
+/* fcm__material_on_face() on parallelograms (a Hex8 prism) against the same polygons with a
+ * fifth vertex on their first edge (the fan's tets), on planes z = const across g. */
+static void overlap_prisms(const fcm_geometry *g)
+{
+  fcm__material *m = NULL;
+  fcm_mesh *one = NULL;
+  fcm__embed_cell cell;
+  const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, nrm[3] = {0.0, 0.0, 1.0};
+  const fcm_index n1[3] = {1, 1, 1};
+  long tests = 0, covered = 0, differ = 0;
+  TEST_OK(ctx, fcm__material_create(ctx, g, &m));
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, n1, &one));
+  if (!m || !one) goto done;
+  TEST_OK(ctx, fcm__embed_cell_setup(ctx, one, 0, 1e-12, &cell));
+  const double sz = 0.17, h = 1e-6;
+  for (int iz = 0; iz < 5; iz++)
+    for (int iy = 0; iy < 14; iy++)
+      for (int ix = 0; ix < 14; ix++) {
+        const double z = -0.8 + 0.37 * iz, x0 = -1.15 + 0.165 * ix, y0 = -1.12 + 0.163 * iy;
+        const double e1[3] = {sz, 0.0, 0.0}, e2[3] = {0.3 * sz, sz, 0.0};
+        double p[4][3], q[5][3];
+        for (int d = 0; d < 3; d++) {
+          p[0][d] = (d == 0 ? x0 : d == 1 ? y0 : z);
+          p[1][d] = p[0][d] + e1[d];
+          p[2][d] = p[0][d] + e1[d] + e2[d];
+          p[3][d] = p[0][d] + e2[d];
+        }
+        memcpy(q[0], p[0], sizeof p[0]);
+        for (int d = 0; d < 3; d++)
+          q[1][d] = 0.5 * (p[0][d] + p[1][d]);
+        memcpy(q[2], p[1], 3 * sizeof p[0]);
+        const double atol = 0.3 * sz * sz;
+        const int a = fcm__material_on_face(ctx, m, &cell, &p[0][0], 4, nrm, h, atol);
+        const int b = fcm__material_on_face(ctx, m, &cell, &q[0][0], 5, nrm, h, atol);
+        TEST_OK(ctx, fcm__material_status(m));
+        tests++;
+        covered += a;
+        differ += a != b;
+      }
+  printf("face overlaps: %ld parallelograms, %ld covered, %ld answers differ from the fan's\n",
+         tests, covered, differ);
+  TEST_TRUE(differ == 0 && covered > 0 && covered < tests);
+done:
+  fcm__material_destroy(ctx, &m);
+  fcm_mesh_destroy(&one);
+}
+
 int main(void)
 {
   TEST_OK(NULL, fcm_ctx_create(NULL, &ctx));
@@ -240,6 +292,7 @@ int main(void)
   fcm_surface_destroy(&s);
   fcm_mesh *mesh = sheared_grid();
   if (!mesh || !surf) return TEST_RESULT();
+  overlap_prisms(surf);
   for (int ncut = 2; ncut <= 3; ncut++) {
     fcm_cell_rules *ref = cut_rules(mesh, tets, FCM_CELL_MOMENTS_VOLUME, 0, 6, 0, ncut);
     fcm_cell_rules *rs = cut_rules(mesh, surf, FCM_CELL_MOMENTS_SURFACE, 1, FCM_DEFAULT, 1, ncut);
