@@ -769,6 +769,19 @@ int fcm__embed_part_full(const fcm__parts *P, size_t i);
 fcm_status fcm__embed_part_box(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__poly *p,
                                double lo[3], double hi[3], int *is_box);
 
+/* The box lo..hi of the reference coordinates of the affine cell as an affine Hex8 cell k of
+ * its own: k's reference point eta is cell's c + h eta (c, h: the box's centre and half
+ * sides). */
+void fcm__embed_box_cell(const fcm__embed_cell *cell, const double lo[3], const double hi[3],
+                         fcm__embed_cell *k);
+
+/* The prism of half-height h along the unit normal nrm on the polygon x (n vertices) as one
+ * affine Hex8 cell k (id: the cell that names the errors), when the polygon is a parallelogram
+ * (4 vertices, x0 + x2 = x1 + x3 within 1e-12 of its extent) and the prism not flat: then 1;
+ * else 0. */
+int fcm__embed_prism_cell(const double *x, int n, const double nrm[3], double h, fcm_index id,
+                          fcm__embed_cell *k);
+
 /* The planes of the faces with area of part i of P into pl (room for FCM__POLY_MAX_FACES);
  * their count. */
 int fcm__embed_part_planes(const fcm__parts *P, size_t i, fcm__plane *pl);
