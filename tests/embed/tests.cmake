@@ -127,3 +127,10 @@ fcm_add_test(embed_q2_mass tests/embed/q2_mass.c)
 # matrix as a P_6 rule unsimplified on its tets (1e-12), at most 27 positive points in the cell
 # and on the piece's sides, one fit for both kinds; the default P_2 stiffness misses (> 1e-8).
 fcm_add_test(embed_q2_stiffness tests/embed/q2_stiffness.c)
+# Cut pieces made of boxes of the cell's reference coordinates (a hollow ball in a sheared Hex8
+# grid cut along its reference planes, a crack ending inside cells, then a tilted plane), with
+# the stiffness on the mass space: the filled pieces' Gauss rules on their boxes and the box
+# parts' material moments as one Hex8 cell; every cut piece's stiffness tensor and mass matrix
+# as a P_6 rule unsimplified on its tets (1e-12); a weight off by 1e-6 fails the check; the face
+# overlaps' material test on parallelograms (one Hex8 prism) answers as on their fan's tets.
+fcm_add_test(embed_box_parts tests/embed/box_parts.c)

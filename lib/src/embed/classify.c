@@ -394,8 +394,13 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   const int own = !opt->cell_mask || opt->cell_mask[c]; /* 0: classified, no points */
   const double t0 = fcm_wtime();
   double sbox[6];
-  FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
-  if (!integrate && (!B->region[c] || (B->same_links && B->same_links[c]))) { /* no new work */
+  const int no_work = !integrate && (!B->region[c] || (B->same_links && B->same_links[c]));
+  /* a cell whose rules are copied needs its volume only, but a dropped one its surface share */
+  if (no_work && !(own && B->prev->cls[c] == FCM_CELL_DROPPED))
+    FCM_TRY(ctx, fcm__embed_cell_setup_volume(ctx, B->mesh, c, opt->clip_rtol, &cell));
+  else
+    FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
+  if (no_work) {
     FCM_TRY(ctx, keep_cell(B, R, &cell, o));
     if (own && R->cls[c] == FCM_CELL_DROPPED) FCM_TRY(ctx, dropped_area(B, &cell, ws, o));
     sums->time_intersect += fcm_wtime() - t0;

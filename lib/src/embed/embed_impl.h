@@ -144,6 +144,11 @@ void fcm__embed_cell_box(const fcm_mesh *mesh, fcm_index id, double clip_rtol,
 fcm_status fcm__embed_cell_setup(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index id, double clip_rtol,
                                  fcm__embed_cell *cell);
 
+/* fcm__embed_cell_setup()'s first part: the cell's corners, size, tolerance, box and volume
+ * (not its planes or map): what a cell whose rules are copied needs. */
+fcm_status fcm__embed_cell_setup_volume(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index id,
+                                        double clip_rtol, fcm__embed_cell *cell);
+
 /* Counters of the per-cell kernels (summed over cells into the statistics). */
 typedef struct fcm__embed_counts {
   fcm_index candidates;        /* (background cell, embedded cell) pairs from the tree */
@@ -756,6 +761,26 @@ fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__p
 /* Surface body: whether part i lies wholly inside the body (its material, P->mvol, is its
  * volume up to rounding). */
 int fcm__embed_part_full(const fcm__parts *P, size_t i);
+
+/* Whether the convex polyhedron p (a part of affine cell) is a box in cell's reference
+ * coordinates: 8 vertices, each at a corner of their reference bounding box lo..hi within
+ * 1e-13 of the reference cell's size, every corner taken once (a part of a box cell that cuts
+ * along the grid's axes split). */
+fcm_status fcm__embed_part_box(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__poly *p,
+                               double lo[3], double hi[3], int *is_box);
+
+/* The box lo..hi of the reference coordinates of the affine cell as an affine Hex8 cell k of
+ * its own: k's reference point eta is cell's c + h eta (c, h: the box's centre and half
+ * sides). */
+void fcm__embed_box_cell(const fcm__embed_cell *cell, const double lo[3], const double hi[3],
+                         fcm__embed_cell *k);
+
+/* The prism of half-height h along the unit normal nrm on the polygon x (n vertices) as one
+ * affine Hex8 cell k (id: the cell that names the errors), when the polygon is a parallelogram
+ * (4 vertices, x0 + x2 = x1 + x3 within 1e-12 of its extent) and the prism not flat: then 1;
+ * else 0. */
+int fcm__embed_prism_cell(const double *x, int n, const double nrm[3], double h, fcm_index id,
+                          fcm__embed_cell *k);
 
 /* The planes of the faces with area of part i of P into pl (room for FCM__POLY_MAX_FACES);
  * their count. */

@@ -50,19 +50,28 @@ void fcm__embed_cell_box(const fcm_mesh *mesh, fcm_index id, double clip_rtol,
   }
 }
 
-fcm_status fcm__embed_cell_setup(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index id, double clip_rtol,
-                                 fcm__embed_cell *cell)
+fcm_status fcm__embed_cell_setup_volume(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index id,
+                                        double clip_rtol, fcm__embed_cell *cell)
 {
   fcm_status st = FCM_OK;
   fcm__poly p;
   fcm__embed_cell_box(mesh, id, clip_rtol, cell);
   const int nc = cell->info->num_corners;
-  cell->num_planes = fcm__geom_cell_planes(cell->info, cell->X, cell->planes);
-  fcm__geom_poly_from_cell(nc == 4 ? FCM_ELEMENT_TET4 : FCM_ELEMENT_HEX8, cell->X, &p);
+  fcm__geom_poly_from_cell_shape(nc == 4 ? FCM_ELEMENT_TET4 : FCM_ELEMENT_HEX8, cell->X, &p);
   cell->volume = fcm__geom_poly_volume(&p);
   FCM_CHECK(cell->volume > 0.0 && isfinite(cell->volume), ctx, FCM_ERR_GEOMETRY,
             "embed: background cell %lld (%s) has corner-polyhedron volume %g (must be positive)",
             (long long)id, cell->info->name, cell->volume);
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_cell_setup(fcm_ctx *ctx, const fcm_mesh *mesh, fcm_index id, double clip_rtol,
+                                 fcm__embed_cell *cell)
+{
+  fcm_status st = FCM_OK;
+  FCM_TRY(ctx, fcm__embed_cell_setup_volume(ctx, mesh, id, clip_rtol, cell));
+  cell->num_planes = fcm__geom_cell_planes(cell->info, cell->X, cell->planes);
   cell->affine = fcm_element_is_affine(cell->type, cell->X, 1e-13);
   if (cell->affine) {
     fcm__element_corner_affine(cell->type, cell->X, cell->A, cell->xi0);

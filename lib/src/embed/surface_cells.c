@@ -20,6 +20,9 @@
 /* Boundary points kept per moment, the finer grid's factor on a retry, the largest grid per
  * axis, the piece's points (of each set of piece_candidates()) per boundary point on a retry
  * before the last, which takes them all. */
+/* The most parts of a piece that box_piece_rule() takes (8 points each). */
+#define FCM__BOX_PIECE_PARTS 3
+
 enum { BOUNDARY_PER_MOMENT = 1, GROW = 4, ATTEMPTS = 4, GRID_MAX = 64, PIECE_PER_BOUNDARY = 2 };
 
 /* Absolute moment residual accepted, per unit of the material box's reference volume: ten times
@@ -536,6 +539,70 @@ cleanup:
   return st;
 }
 
+/* The rules of a piece whose parts the body fills and which are boxes in reference
+ * coordinates, without a fit: the 2-point Gauss rule per axis on each box (8 points, positive,
+ * inside), exact for degree 3 in each variable, so on every kind's space when no kind's space
+ * holds a degree above 3 in a variable and the points fit in each kind's M. Taken only with the
+ * stiffness on the mass space, where every kind's rule is exact for its integrand: another exact
+ * rule changes the results at round-off. *ok = 0: not such a piece (o untouched). */
+static fcm_status box_piece_rule(const build *B, const fcm__embed_cell *cell, const fcm__parts *P,
+                                 int piece, piece_out *o, int *ok)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  double lo[FCM__BOX_PIECE_PARTS][3], hi[FCM__BOX_PIECE_PARTS][3];
+  int nb = 0;
+  *ok = 0;
+  if (!B->o->stiffness_on_mass_space || P->whole || cell->info->num_corners != 8) return FCM_OK;
+  for (size_t j = 0; j < P->n; j++) {
+    if (P->piece[j] != piece) continue;
+    int is_box;
+    if (nb == FCM__BOX_PIECE_PARTS || !fcm__embed_part_full(P, j)) return FCM_OK;
+    FCM_TRY(ctx, fcm__embed_part_box(ctx, cell, P->poly + j, lo[nb], hi[nb], &is_box));
+    if (!is_box) return FCM_OK;
+    nb++;
+  }
+  if (nb == 0) return FCM_OK;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    if (!B->tet_rule[k]) continue;
+    fcm__cheb_box cb;
+    const double unit[6] = {-1, -1, -1, 1, 1, 1};
+    fit_box(unit, B->space_m[k], B->space_q[k], &cb);
+    if (FCM_MIN(B->space_m[k], B->space_q[k]) > 3 || 8 * nb > cb.num_basis) return FCM_OK;
+  }
+  const double g = 1.0 / sqrt(3.0);
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    if (!B->tet_rule[k]) continue;
+    const size_t n = 8 * (size_t)nb,
+                 ns = B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0;
+    fcm__free(ctx, o->pts[k]);
+    fcm__free(ctx, o->w[k]);
+    fcm__free(ctx, o->flag[k]);
+    o->pts[k] = o->w[k] = NULL;
+    o->flag[k] = NULL;
+    FCM_ALLOC(ctx, 3 * (n + ns), o->pts[k]);
+    FCM_ALLOC(ctx, n + ns, o->w[k]);
+    FCM_ALLOC(ctx, n + ns, o->flag[k]);
+    for (int b = 0; b < nb; b++) {
+      double c[3], h[3];
+      for (int d = 0; d < 3; d++)
+        c[d] = 0.5 * (lo[b][d] + hi[b][d]), h[d] = 0.5 * (hi[b][d] - lo[b][d]);
+      for (int i = 0; i < 8; i++) {
+        double *x = o->pts[k] + 3 * (8 * (size_t)b + (size_t)i);
+        for (int d = 0; d < 3; d++)
+          x[d] = c[d] + ((i >> d) & 1 ? g : -g) * h[d];
+        o->w[k][8 * b + i] = h[0] * h[1] * h[2];
+      }
+    }
+    o->n[k] = o->nsimp[k] = o->ninit[k] = (int)n;
+    o->residual[k] = 0.0;
+  }
+  o->fitted = 1;
+  *ok = 1;
+cleanup:
+  return st;
+}
+
 fcm_status fcm__embed_surface_cut_piece(const build *B, const fcm__embed_cell *cell,
                                         fcm__embed_ws *ws, fcm__parts *P, int piece, piece_out *o,
                                         int *fell_back)
@@ -551,6 +618,8 @@ fcm_status fcm__embed_surface_cut_piece(const build *B, const fcm__embed_cell *c
             "body without a volume mesh take their moments from its surface, which needs an "
             "affine cell",
             (long long)cell->id);
+  FCM_TRY(ctx, box_piece_rule(B, cell, P, piece, o, &ok));
+  if (ok) return FCM_OK;
   FCM_TRY(ctx, ws_surface(ctx, ws));
   FCM_TRY(ctx, fcm__embed_material_box(ctx, B->geom, B->tri_tree, cell, &ws->cand, ws->cr, ws->bnd,
                                        mbox, &touched));

@@ -297,14 +297,22 @@ static int clip_to_cell(const ref_cell *r, const rtri *T, double *a)
   for (int i = 0; i < 9; i++)
     big = fmax(big, fabs(T->x[i]));
   const double margin = 1e-12 * big;
-  for (int k = 0; k < r->ncell; k++)
-    if (lin_eval(r->cell + k, T->x) > margin && lin_eval(r->cell + k, T->x + 3) > margin &&
-        lin_eval(r->cell + k, T->x + 6) > margin)
-      return 0;
+  unsigned inside = 0; /* bit k: every vertex strictly inside constraint k */
+  for (int k = 0; k < r->ncell; k++) {
+    const double v0 = lin_eval(r->cell + k, T->x), v1 = lin_eval(r->cell + k, T->x + 3),
+                 v2 = lin_eval(r->cell + k, T->x + 6);
+    if (v0 > margin && v1 > margin && v2 > margin) return 0;
+    inside |= (unsigned)(v0 < -margin && v1 < -margin && v2 < -margin) << k;
+  }
+  /* clipping by a constraint every vertex of T lies inside by more than margin keeps the
+   * polygon vertex for vertex: its vertices are T's and points on T's edges, whose values
+   * (between two of T's, below -margin) the rounding of the points and of the constraint's
+   * value (about 1e-16 of the coordinates) cannot bring to 0 */
   double b[3 * POLY_CAP];
   memcpy(a, T->x, sizeof T->x);
   int n = 3;
   for (int k = 0; k < r->ncell && n >= 3; k++) {
+    if (inside >> k & 1u) continue;
     n = clip_polygon(a, n, r->cell + k, b);
     memcpy(a, b, 3 * (size_t)n * sizeof *a);
   }

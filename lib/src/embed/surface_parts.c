@@ -155,6 +155,55 @@ cleanup:
   return st;
 }
 
+/* The body's signed rule of degree q->m on the affine cell k alone, into m->sr (k's reference
+ * coordinates), and its volume, as tets_material() takes each tet's. */
+static fcm_status one_cell_material(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *k,
+                                    const fcm__moment_quad *q, double *volume)
+{
+  fcm_status st = FCM_OK;
+  double sum = 0.0;
+  int clear, winding = FCM__WINDING_UNKNOWN;
+  FCM_TRY(ctx, fcm__embed_cell_clear(ctx, m->geom, m->tree, k, &m->buf, &clear));
+  if (clear)
+    FCM_TRY(ctx, fcm__embed_moment_rule_clear(ctx, m->geom, m->tree, k, q, NULL, &m->buf, &m->cr,
+                                              &winding, &m->sr));
+  else
+    FCM_TRY(ctx, fcm__embed_moment_rule_kept(ctx, m->geom, m->tree, k, q, NULL, &m->buf, &m->cr,
+                                             &m->sr));
+  for (size_t i = 0; i < m->sr.n; i++)
+    sum += m->sr.w[i] * k->detA;
+  *volume = sum;
+cleanup:
+  return st;
+}
+
+/* tets_material() on the box lo..hi of cell's reference coordinates as one Hex8 cell: one
+ * moment rule instead of one per fan tet (a box of 6 faces has 12), each boundary triangle
+ * clipped once, one exit facet and edge. */
+static fcm_status box_material(fcm_ctx *ctx, fcm__material *m, const double lo[3],
+                               const double hi[3], const fcm__moment_quad *q,
+                               const fcm__embed_cell *cell, fcm__srule *out, double *volume)
+{
+  fcm_status st = FCM_OK;
+  fcm__embed_cell k;
+  double c[3], h[3];
+  fcm__embed_box_cell(cell, lo, hi, &k);
+  for (int d = 0; d < 3; d++)
+    c[d] = 0.5 * (lo[d] + hi[d]), h[d] = 0.5 * (hi[d] - lo[d]);
+  FCM_TRY(ctx, one_cell_material(ctx, m, &k, q, volume));
+  if (!out) goto cleanup;
+  FCM_TRY(ctx, fcm__srule_room(ctx, out, m->sr.n));
+  for (size_t i = 0; i < m->sr.n; i++) {
+    const double *e = m->sr.x + 3 * i;
+    double *x = out->x + 3 * out->n;
+    for (int d = 0; d < 3; d++)
+      x[d] = c[d] + h[d] * e[d];
+    out->w[out->n++] = m->sr.w[i] * k.detA / cell->detA;
+  }
+cleanup:
+  return st;
+}
+
 /* Room for nt tets in m. */
 static fcm_status tets_room(fcm_ctx *ctx, fcm__material *m, int nt)
 {
@@ -175,8 +224,13 @@ fcm_status fcm__material_poly(fcm_ctx *ctx, fcm__material *m, const fcm__poly *p
                               fcm__srule *out, double *volume)
 {
   fcm_status st = FCM_OK;
+  int is_box = 0;
+  double lo[3], hi[3];
   *volume = 0.0;
   if (p->nf == 0) return FCM_OK;
+  if (cell->info->num_corners == 8)
+    FCM_TRY(ctx, fcm__embed_part_box(ctx, cell, p, lo, hi, &is_box));
+  if (is_box) return box_material(ctx, m, lo, hi, q ? q : &m->q0, cell, out, volume);
   FCM_TRY(ctx, tets_room(ctx, m, fcm__geom_poly_num_tets(p)));
   const int nt = fcm__geom_poly_tets(p, m->tets, m->vol);
   FCM_TRY(ctx, tets_material(ctx, m, m->tets, m->vol, nt, q ? q : &m->q0, cell, out, volume));
@@ -424,7 +478,11 @@ int fcm__material_on_face(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell 
   FCM_TRY(ctx, prism_clear(ctx, m, m->tets, 3 * (n - 2), h, atol, cell->id, &sure));
   if (!sure && m->buf.n > 0) FCM_TRY(ctx, prism_near(ctx, m, x, n, nrm, h, atol, cell->id, &sure));
   if (sure) return sure > 0;
-  FCM_TRY(ctx, tets_material(ctx, m, m->tets, m->vol, 3 * (n - 2), &m->q0, cell, NULL, &v));
+  fcm__embed_cell k;
+  if (fcm__embed_prism_cell(x, n, nrm, h, cell->id, &k))
+    FCM_TRY(ctx, one_cell_material(ctx, m, &k, &m->q0, &v));
+  else
+    FCM_TRY(ctx, tets_material(ctx, m, m->tets, m->vol, 3 * (n - 2), &m->q0, cell, NULL, &v));
 cleanup:
   if (st != FCM_OK) {
     if (m->st == FCM_OK) m->st = st;

@@ -17,6 +17,12 @@
 
 void fcm__geom_poly_from_cell(fcm_element_type type, const double *X, fcm__poly *p)
 {
+  fcm__geom_poly_from_cell_shape(type, X, p);
+  fcm__geom_cell_planes(fcm_element_get_info(type), X, p->fp);
+}
+
+void fcm__geom_poly_from_cell_shape(fcm_element_type type, const double *X, fcm__poly *p)
+{
   const fcm_element_info *info = fcm_element_get_info(type);
   p->nv = info->num_corners;
   for (int a = 0; a < p->nv; a++)
@@ -28,7 +34,6 @@ void fcm__geom_poly_from_cell(fcm_element_type type, const double *X, fcm__poly 
     for (int k = 0; k < p->fn[f]; k++)
       p->fv[f][k] = info->face_nodes[f][k];
   }
-  fcm__geom_cell_planes(info, X, p->fp);
 }
 
 int fcm__geom_cell_planes(const fcm_element_info *info, const double *X, fcm__plane *planes)

@@ -153,6 +153,10 @@ typedef struct fcm__poly {
  * fcm__geom_cell_planes(). */
 void fcm__geom_poly_from_cell(fcm_element_type type, const double *X, fcm__poly *p);
 
+/* fcm__geom_poly_from_cell() without the faces' planes (p->fp left as it is): what
+ * fcm__geom_poly_volume() and fcm__geom_poly_tets() need. */
+void fcm__geom_poly_from_cell_shape(fcm_element_type type, const double *X, fcm__poly *p);
+
 /* Outward half-spaces of the planar faces of a convex cell from its corners (Newell
  * normal, through the face-corner centroid). Returns the number of planes (4 or 6);
  * a degenerate face (zero normal) gets n = 0, d = 0 (never clips). */
