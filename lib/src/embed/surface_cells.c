@@ -371,6 +371,22 @@ cleanup:
   return st;
 }
 
+/* Room for n points of kind k's rule in o, its previous arrays freed. */
+static fcm_status kind_alloc(fcm_ctx *ctx, piece_out *o, int k, size_t n)
+{
+  fcm_status st = FCM_OK;
+  fcm__free(ctx, o->pts[k]);
+  fcm__free(ctx, o->w[k]);
+  fcm__free(ctx, o->flag[k]);
+  o->pts[k] = o->w[k] = NULL;
+  o->flag[k] = NULL;
+  FCM_ALLOC(ctx, 3 * n, o->pts[k]);
+  FCM_ALLOC(ctx, n, o->w[k]);
+  FCM_ALLOC(ctx, n, o->flag[k]);
+cleanup:
+  return st;
+}
+
 /* Kind k's rule as kind j's, fitted on the same candidates in the same space: the same
  * moments and basis give the same fit. */
 static fcm_status copy_kind(const build *B, int j, int k, piece_out *o)
@@ -379,14 +395,7 @@ static fcm_status copy_kind(const build *B, int j, int k, piece_out *o)
   fcm_ctx *ctx = B->ctx;
   const size_t n = (size_t)o->n[j],
                ns = B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0;
-  fcm__free(ctx, o->pts[k]);
-  fcm__free(ctx, o->w[k]);
-  fcm__free(ctx, o->flag[k]);
-  o->pts[k] = o->w[k] = NULL;
-  o->flag[k] = NULL;
-  FCM_ALLOC(ctx, 3 * (n + ns), o->pts[k]);
-  FCM_ALLOC(ctx, n + ns, o->w[k]);
-  FCM_ALLOC(ctx, n + ns, o->flag[k]);
+  FCM_TRY(ctx, kind_alloc(ctx, o, k, n + ns));
   memcpy(o->pts[k], o->pts[j], 3 * n * sizeof(double));
   memcpy(o->w[k], o->w[j], n * sizeof(double));
   o->n[k] = o->nsimp[k] = o->n[j];
@@ -575,14 +584,7 @@ static fcm_status box_piece_rule(const build *B, const fcm__embed_cell *cell, co
     if (!B->tet_rule[k]) continue;
     const size_t n = 8 * (size_t)nb,
                  ns = B->stabilize[k] ? (size_t)fcm_rule_num_points(B->full_rule[k]) : 0;
-    fcm__free(ctx, o->pts[k]);
-    fcm__free(ctx, o->w[k]);
-    fcm__free(ctx, o->flag[k]);
-    o->pts[k] = o->w[k] = NULL;
-    o->flag[k] = NULL;
-    FCM_ALLOC(ctx, 3 * (n + ns), o->pts[k]);
-    FCM_ALLOC(ctx, n + ns, o->w[k]);
-    FCM_ALLOC(ctx, n + ns, o->flag[k]);
+    FCM_TRY(ctx, kind_alloc(ctx, o, k, n + ns));
     for (int b = 0; b < nb; b++) {
       double c[3], h[3];
       for (int d = 0; d < 3; d++)

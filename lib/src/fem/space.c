@@ -133,30 +133,32 @@ cleanup:
   return st;
 }
 
-fcm_status fcm__space_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_cell_rules *rules,
-                                 const fcm_space_options *opts, const fcm_space *from,
-                                 fcm_space **out)
+/* The cut space patched from `from`, writing its columns in take's (NULL: its own). */
+static fcm_status create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_cell_rules *rules,
+                             const fcm_space_options *opts, const fcm_space *from, fcm_space *take,
+                             fcm_space **out)
 {
   fcm_status st = FCM_OK;
   FCM_CHECK(out, ctx, FCM_ERR_ARG, "cut space: output pointer is NULL");
   *out = NULL;
   FCM_TRY(ctx, check_embedded(ctx, mesh, rules, opts));
-  FCM_TRY(ctx, space_create(ctx, mesh, NULL, rules, opts, 0, NULL, from, NULL, out));
+  FCM_TRY(ctx, space_create(ctx, mesh, NULL, rules, opts, 0, NULL, from, take, out));
 cleanup:
   return st;
+}
+
+fcm_status fcm__space_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_cell_rules *rules,
+                                 const fcm_space_options *opts, const fcm_space *from,
+                                 fcm_space **out)
+{
+  return create_cut(ctx, mesh, rules, opts, from, NULL, out);
 }
 
 fcm_status fcm__space_create_cut_take(fcm_ctx *ctx, const fcm_mesh *mesh,
                                       const fcm_cell_rules *rules, const fcm_space_options *opts,
                                       fcm_space *from, fcm_space **out)
 {
-  fcm_status st = FCM_OK;
-  FCM_CHECK(out, ctx, FCM_ERR_ARG, "cut space: output pointer is NULL");
-  *out = NULL;
-  FCM_TRY(ctx, check_embedded(ctx, mesh, rules, opts));
-  FCM_TRY(ctx, space_create(ctx, mesh, NULL, rules, opts, 0, NULL, from, from, out));
-cleanup:
-  return st;
+  return create_cut(ctx, mesh, rules, opts, from, from, out);
 }
 
 fcm_status fcm__space_create_local(fcm_ctx *ctx, const fcm_mesh *mesh,

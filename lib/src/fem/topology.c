@@ -63,6 +63,28 @@ cleanup:
   return st;
 }
 
+/* The row of local copy k in the copy graph: the ranks (global) of the copies sharing a local
+ * element with it, sorted into row when row is not NULL; returns their number. mark[] (per
+ * local copy) holds k for the copies seen. */
+static fcm_index copy_row(const fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
+                          const fcm_index *cinc, fcm_index k, fcm_index *mark, fcm_index *row)
+{
+  const fcm_index nn = s->nn;
+  fcm_index cnt = 0;
+  for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++) {
+    const fcm_index e = local_elem(s, cinc[i]);
+    for (int b = 0; b < nn; b++) {
+      const fcm_index m = s->elem_dof[e * nn + b] / 3, lm = g2l ? g2l[m] : m;
+      if (mark[lm] == k) continue;
+      mark[lm] = k;
+      if (row) row[cnt] = m;
+      cnt++;
+    }
+  }
+  if (row) qsort(row, (size_t)cnt, sizeof *row, cmp_index);
+  return cnt;
+}
+
 /* Copy graph over the local topology: for each local copy, the ranks (global) of the copies
  * sharing a local element with it, sorted. */
 static fcm_status build_node_graph(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
@@ -70,7 +92,7 @@ static fcm_status build_node_graph(fcm_space *s, const fcm_index *g2l, const fcm
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
-  const fcm_index ncopy = s->num_local_copies, nn = s->nn;
+  const fcm_index ncopy = s->num_local_copies;
   fcm_index *mark = NULL;
   FCM_ALLOC(ctx, ncopy + 1, mark);
   FCM_ALLOC(ctx, ncopy + 1, s->node_ptr);
@@ -78,21 +100,9 @@ static fcm_status build_node_graph(fcm_space *s, const fcm_index *g2l, const fcm
     for (fcm_index k = 0; k < ncopy; k++)
       mark[k] = -1;
     for (fcm_index k = 0; k < ncopy; k++) {
-      fcm_index cnt = 0, base = pass ? s->node_ptr[k] : 0;
-      for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++) {
-        const fcm_index e = local_elem(s, cinc[i]);
-        for (int b = 0; b < nn; b++) {
-          const fcm_index m = s->elem_dof[e * nn + b] / 3, lm = g2l ? g2l[m] : m;
-          if (mark[lm] == k) continue;
-          mark[lm] = k;
-          if (pass) s->node_adj[base + cnt] = m;
-          cnt++;
-        }
-      }
-      if (pass)
-        qsort(s->node_adj + base, (size_t)cnt, sizeof *s->node_adj, cmp_index);
-      else
-        s->node_ptr[k + 1] = cnt;
+      const fcm_index cnt =
+          copy_row(s, g2l, cptr, cinc, k, mark, pass ? s->node_adj + s->node_ptr[k] : NULL);
+      if (!pass) s->node_ptr[k + 1] = cnt;
     }
     if (!pass) {
       for (fcm_index k = 0; k < ncopy; k++)
@@ -619,7 +629,7 @@ static fcm_status patch_node_graph(fcm_space *s, const fcm_space *from, const fc
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
-  const fcm_index ncopy = s->num_local_copies, nn = s->nn;
+  const fcm_index ncopy = s->num_local_copies;
   fcm_index *mark = NULL;
   FCM_ALLOC(ctx, ncopy + 1, mark);
   FCM_ALLOC(ctx, ncopy + 1, s->node_ptr);
@@ -649,20 +659,8 @@ static fcm_status patch_node_graph(fcm_space *s, const fcm_space *from, const fc
         s->cut_kept_rows++;
         continue;
       }
-      for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++) {
-        const fcm_index e = cinc[i];
-        for (int b = 0; b < nn; b++) {
-          const fcm_index q = s->elem_dof[e * nn + b] / 3;
-          if (mark[q] == k) continue;
-          mark[q] = k;
-          if (pass) s->node_adj[base + cnt] = q;
-          cnt++;
-        }
-      }
-      if (pass)
-        qsort(s->node_adj + base, (size_t)cnt, sizeof *s->node_adj, cmp_index);
-      else
-        s->node_ptr[k + 1] = cnt;
+      cnt = copy_row(s, NULL, cptr, cinc, k, mark, pass ? s->node_adj + base : NULL);
+      if (!pass) s->node_ptr[k + 1] = cnt;
     }
     if (!pass) {
       for (fcm_index k = 0; k < ncopy; k++)
