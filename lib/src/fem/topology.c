@@ -86,34 +86,12 @@ static fcm_index copy_row(const fcm_space *s, const fcm_index *g2l, const fcm_in
 }
 
 /* Copy graph over the local topology: for each local copy, the ranks (global) of the copies
- * sharing a local element with it, sorted. */
-static fcm_status build_node_graph(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
-                                   const fcm_index *cinc)
-{
-  fcm_status st = FCM_OK;
-  fcm_ctx *ctx = s->ctx;
-  const fcm_index ncopy = s->num_local_copies;
-  fcm_index *mark = NULL;
-  FCM_ALLOC(ctx, ncopy + 1, mark);
-  FCM_ALLOC(ctx, ncopy + 1, s->node_ptr);
-  for (int pass = 0; pass < 2; pass++) {
-    for (fcm_index k = 0; k < ncopy; k++)
-      mark[k] = -1;
-    for (fcm_index k = 0; k < ncopy; k++) {
-      const fcm_index cnt =
-          copy_row(s, g2l, cptr, cinc, k, mark, pass ? s->node_adj + s->node_ptr[k] : NULL);
-      if (!pass) s->node_ptr[k + 1] = cnt;
-    }
-    if (!pass) {
-      for (fcm_index k = 0; k < ncopy; k++)
-        s->node_ptr[k + 1] += s->node_ptr[k];
-      FCM_ALLOC(ctx, s->node_ptr[ncopy] + 1, s->node_adj);
-    }
-  }
-cleanup:
-  fcm__free(ctx, mark);
-  return st;
-}
+ * sharing a local element with it, sorted; with a cut map m (a cut space patched from `from`)
+ * a kept copy's row is its parent's row mapped to the children (sorted again only where the
+ * map reorders it: copy_kept 1). */
+struct cut_map;
+static fcm_status node_graph(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
+                             const fcm_index *cinc, const fcm_space *from, struct cut_map *m);
 
 /* The column indices of the scalar pattern's rows (row_ptr made): three per neighbour in the
  * copy graph. */
@@ -514,7 +492,7 @@ fcm_status fcm__space_build_topology(fcm_space *s, int local, const unsigned cha
     s->num_local_copies = ncopy;
   }
   FCM_TRY(ctx, build_copy_incidence(s, g2l, &cptr, &cinc));
-  FCM_TRY(ctx, build_node_graph(s, g2l, cptr, cinc));
+  FCM_TRY(ctx, node_graph(s, g2l, cptr, cinc, NULL, NULL));
   FCM_TRY(ctx, build_pattern(s, g2l));
   FCM_TRY(ctx, build_colors(s, g2l, cptr, cinc));
   FCM_TRY(ctx, build_block_colors(s, g2l, cptr, cinc, NULL));
@@ -621,11 +599,8 @@ static void free_cut_map(fcm_ctx *ctx, cut_map *m)
   fcm__free(ctx, m->copy_kept);
 }
 
-/* The copy graph of the cut space: a kept copy's row is its parent's row mapped to the
- * children (sorted again only where the map reorders it: copy_kept 1); the others' rows are
- * made from their elements as build_node_graph() makes them. */
-static fcm_status patch_node_graph(fcm_space *s, const fcm_space *from, const fcm_index *cptr,
-                                   const fcm_index *cinc, cut_map *m)
+static fcm_status node_graph(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
+                             const fcm_index *cinc, const fcm_space *from, cut_map *m)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
@@ -638,7 +613,7 @@ static fcm_status patch_node_graph(fcm_space *s, const fcm_space *from, const fc
       mark[k] = -1;
     for (fcm_index k = 0; k < ncopy; k++) {
       fcm_index cnt = 0, base = pass ? s->node_ptr[k] : 0;
-      if (m->copy_kept[k]) {
+      if (m && m->copy_kept[k]) {
         const fcm_index p = m->parent[k], *row = from->node_adj + from->node_ptr[p];
         cnt = from->node_ptr[p + 1] - from->node_ptr[p];
         if (!pass) {
@@ -659,7 +634,7 @@ static fcm_status patch_node_graph(fcm_space *s, const fcm_space *from, const fc
         s->cut_kept_rows++;
         continue;
       }
-      cnt = copy_row(s, NULL, cptr, cinc, k, mark, pass ? s->node_adj + base : NULL);
+      cnt = copy_row(s, g2l, cptr, cinc, k, mark, pass ? s->node_adj + base : NULL);
       if (!pass) s->node_ptr[k + 1] = cnt;
     }
     if (!pass) {
@@ -774,7 +749,7 @@ fcm_status fcm__space_build_topology_cut(fcm_space *s, const fcm_space *from, fc
   s->num_local_copies = s->num_dofs / 3;
   FCM_TRY(ctx, build_copy_incidence(s, NULL, &cptr, &cinc));
   FCM_TRY(ctx, build_cut_map(from, s, cptr, cinc, &m));
-  FCM_TRY(ctx, patch_node_graph(s, from, cptr, cinc, &m));
+  FCM_TRY(ctx, node_graph(s, NULL, cptr, cinc, from, &m));
   FCM_TRY(ctx, build_pattern_rows(s, give == from ? give : NULL));
   FCM_TRY(ctx, patch_offsets(s, from, &m));
   FCM_TRY(ctx, patch_colors(s, from, cptr, cinc, &m));
