@@ -83,8 +83,8 @@ void fcm_schwarz_destroy(fcm_schwarz **P)
   fcm__free(ctx, p->block_ptr);
   fcm__free(ctx, p->dofs);
   fcm__free(ctx, p->s_off);
-  fcm__free(ctx, p->S);
-  fcm__free(ctx, p->pos);
+  fcm__free_large(ctx, p->S);
+  fcm__free_large(ctx, p->pos);
   fcm__free(ctx, p->full);
   fcm__free(ctx, p->factor);
   fcm__free(ctx, p->inc_ptr);
@@ -318,11 +318,14 @@ static double cholesky_product(int m, const double *X, double *S)
  * factor non-NULL (a block smoother, whose sweeps may apply S_K = X^T X as two triangular
  * products): X itself into S's slot (lower triangle, zero above; *factor = 1) when the bound
  * ||S_K||_F <= ||X||_F^2 already passes the test, which then needs no product; else S_K as
- * without it (*factor = 0). The same blocks take the Cholesky path either way. */
+ * without it (*factor = 0). The same blocks take the Cholesky path either way. The zeros
+ * above the diagonal are written only when the slot did not hold X before (*factor = 0 on
+ * entry): a setup after a setup writes X's triangle alone. */
 static int cholesky_inverse(int m, const double *a, double eps, double *lw, double *S,
                             unsigned char *factor)
 {
   double *L = lw, *X = lw + (size_t)m * m, na = 0.0;
+  const int was_factor = factor && *factor; /* S's slot zero above the diagonal already */
   if (factor) *factor = 0;
   for (int i = 0; i < m; i++)
     for (int j = 0; j <= i; j++) {
@@ -339,7 +342,7 @@ static int cholesky_inverse(int m, const double *a, double eps, double *lw, doub
     if (isfinite(nx) && sqrt(na) * nx <= SCHWARZ_CHOLESKY_COND / eps) {
       for (int i = 0; i < m; i++) {
         memcpy(S + (size_t)i * m, X + (size_t)i * m, sizeof *S * (size_t)(i + 1));
-        memset(S + (size_t)i * m + i + 1, 0, sizeof *S * (size_t)(m - 1 - i));
+        if (!was_factor) memset(S + (size_t)i * m + i + 1, 0, sizeof *S * (size_t)(m - 1 - i));
       }
       *factor = 1;
       return 1;
@@ -588,9 +591,12 @@ static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
     for (fcm_index i = 0; i < nr; i++)
       P->diag[i] = P->inside[i] ? -1 : fcm_csr_position(C, i, i);
   }
-  /* S and pos are written in full by the first setup (below) before anything reads them */
-  FCM_ALLOC_RAW(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->S);
-  FCM_ALLOC_RAW(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->pos);
+  /* S and pos are written in full by the first setup (below) before anything reads them; on
+   * huge pages where large (fcm__calloc_large()): a block's rows of S and pos lie on pages of
+   * their own, and every sweep and setup visits all of them, tens of megabytes after a few
+   * cuts, which with 4 KiB pages miss the TLB on most blocks */
+  FCM__ALLOC_WITH(fcm__calloc_large, ctx, FCM_MAX(P->s_off[num_blocks], 1), P->S);
+  FCM__ALLOC_WITH(fcm__calloc_large, ctx, FCM_MAX(P->s_off[num_blocks], 1), P->pos);
   FCM_ALLOC(ctx, num_blocks + 1, P->full); /* zero: the first setup scans */
   if (blocks_only) FCM_ALLOC(ctx, num_blocks + 1, P->factor);
   if (!blocks_only) FCM_TRY(ctx, incidence_and_colors(P)); /* the apply's */
