@@ -403,7 +403,7 @@ void fcm__ptap_destroy(fcm__ptap **plan)
   fcm__free(ctx, t->R_val);
   fcm__free(ctx, t->AP_ptr);
   fcm__free(ctx, t->AP_col);
-  fcm__free_large(ctx, t->AP_val);
+  fcm__free(ctx, t->AP_val);
   fcm__free(ctx, t->spa);
   fcm__free(ctx, t->same3);
   fcm__free(ctx, t->r_kind);
@@ -440,9 +440,7 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
    * that row holds the column, so C's values do not depend on the order (nor do A P's) */
   FCM_TRY(ctx, product_pattern(ctx, nt, n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), P_ptr, P_col, nc,
                                0, &t->AP_ptr, &t->AP_col));
-  /* every product writes all of it; on huge pages where large (fcm__calloc_large()): tens of
-   * megabytes on the finest level, written and read again at every product */
-  FCM__ALLOC_WITH(fcm__calloc_large, ctx, t->AP_ptr[n] + 1, t->AP_val);
+  FCM_ALLOC_RAW(ctx, t->AP_ptr[n] + 1, t->AP_val); /* every product writes all of it */
   FCM_TRY(ctx,
           product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, 1, &cp, &cc));
   if (with_diagonal) FCM_TRY(ctx, add_diagonal(ctx, nc, &cp, &cc));

@@ -83,8 +83,8 @@ void fcm_schwarz_destroy(fcm_schwarz **P)
   fcm__free(ctx, p->block_ptr);
   fcm__free(ctx, p->dofs);
   fcm__free(ctx, p->s_off);
-  fcm__free_large(ctx, p->S);
-  fcm__free_large(ctx, p->pos);
+  fcm__free(ctx, p->S);
+  fcm__free(ctx, p->pos);
   fcm__free(ctx, p->full);
   fcm__free(ctx, p->factor);
   fcm__free(ctx, p->inc_ptr);
@@ -591,12 +591,9 @@ static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
     for (fcm_index i = 0; i < nr; i++)
       P->diag[i] = P->inside[i] ? -1 : fcm_csr_position(C, i, i);
   }
-  /* S and pos are written in full by the first setup (below) before anything reads them; on
-   * huge pages where large (fcm__calloc_large()): a block's rows of S and pos lie on pages of
-   * their own, and every sweep and setup visits all of them, tens of megabytes after a few
-   * cuts, which with 4 KiB pages miss the TLB on most blocks */
-  FCM__ALLOC_WITH(fcm__calloc_large, ctx, FCM_MAX(P->s_off[num_blocks], 1), P->S);
-  FCM__ALLOC_WITH(fcm__calloc_large, ctx, FCM_MAX(P->s_off[num_blocks], 1), P->pos);
+  /* S and pos are written in full by the first setup (below) before anything reads them */
+  FCM_ALLOC_RAW(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->S);
+  FCM_ALLOC_RAW(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->pos);
   FCM_ALLOC(ctx, num_blocks + 1, P->full); /* zero: the first setup scans */
   if (blocks_only) FCM_ALLOC(ctx, num_blocks + 1, P->factor);
   if (!blocks_only) FCM_TRY(ctx, incidence_and_colors(P)); /* the apply's */
