@@ -6,6 +6,8 @@ fcm_add_test(solve_schwarz tests/solve/schwarz.c)
 fcm_add_test(solve_schwarz_space tests/solve/schwarz_space.c)
 # a setup on a matrix of another pattern: bit for bit a fresh preconditioner
 fcm_add_test(solve_schwarz_pattern tests/solve/schwarz_pattern.c)
+# the block smoother's blocks factored four at a time: bit for bit one at a time
+fcm_add_test(solve_schwarz_batch tests/solve/schwarz_batch.c)
 fcm_add_test(solve_alloc_failure tests/solve/alloc_failure.c)
 fcm_add_test(solve_threads tests/solve/threads.c)
 # CG and MINRES stop as stagnated on a singular semi-definite system whose right-hand side

@@ -37,6 +37,10 @@ typedef struct slab_order {
   double *mid;           /* per slab: the midpoint of its work within its colour's, in [0, 1] */
   unsigned char *triple; /* row orders: per row i, 1 when i = 3k starts its copy's three rows
                             and they share one column pattern (fcm__mg_row_dot3()) */
+  fcm_index lead, tail;  /* row orders of three slabs, the thin middle one swept first: the
+                            first rows of slab 0, coupled with no row of slab 1, that a team of
+                            two sweeps forward beside slab 1's forward sweep (lead) and backward
+                            beside its backward sweep (tail); whole copies, 0: none */
 } slab_order;
 
 /* Does thread t of nt run slab s? The slabs of one colour go to the threads in contiguous

@@ -70,6 +70,60 @@ cleanup:
  * the threads' work; fewer when the coupling reaches far in the sequence. */
 #define MG_SLABS 16
 
+/* Colours of at most this many slabs are shared between two threads by the best split. */
+#define MG_SPLIT_MAX 16
+
+/* The larger of the two threads' works when the slabs of colour c whose bits are set in `set`
+ * (bit j: the colour's j-th slab) go to the second thread; w: the slabs' works. */
+static double split_max(fcm_index ns, int c, const double *w, unsigned set)
+{
+  double t[2] = {0.0, 0.0};
+  for (fcm_index k = c, j = 0; k < ns; k += 2, j++)
+    t[(set >> j) & 1u] += w[k];
+  return FCM_MAX(t[0], t[1]);
+}
+
+/* S->mid of the slabs of colour c from their works w: the midpoint of each slab's work within
+ * its colour's, so that the threads take contiguous runs of about equal work
+ * (fcm__mg_slab_mine()). Where the colour has at most MG_SPLIT_MAX slabs and another split of
+ * them between two threads leaves the busier one at least 1 % less work than the runs do, the
+ * two sets of that split take [0, 1/2) and [1/2, 1) instead, each slab at its midpoint within
+ * its set's work. The slabs of one colour are independent: the split changes which thread
+ * sweeps a slab, not the iterate. */
+static void slabs_share(slab_order *S, int c, const double *w)
+{
+  const fcm_index ns = S->nslab;
+  fcm_index m = 0;
+  double tot = 0.0, before = 0.0;
+  unsigned runs = 0; /* the second thread's slabs in the contiguous runs (two threads) */
+  for (fcm_index k = c; k < ns; k += 2, m++)
+    tot += w[k];
+  for (fcm_index k = c, j = 0; k < ns; k += 2, j++) {
+    S->mid[k] = tot > 0.0 ? (before + 0.5 * w[k]) / tot : 0.0;
+    if (S->mid[k] >= 0.5) runs |= 1u << j;
+    before += w[k];
+  }
+  if (m < 2 || m > MG_SPLIT_MAX) return;
+  const double runs_max = split_max(ns, c, w, runs);
+  unsigned best = runs;
+  double best_max = runs_max;
+  for (unsigned set = 1; set + 1u < (1u << m); set++) {
+    const double t = split_max(ns, c, w, set);
+    if (t < best_max) best_max = t, best = set;
+  }
+  if (best_max > 0.99 * runs_max) return;
+  for (unsigned half = 0; half < 2; half++) {
+    double sum = 0.0, acc = 0.0;
+    for (fcm_index k = c, j = 0; k < ns; k += 2, j++)
+      if (((best >> j) & 1u) == half) sum += w[k];
+    for (fcm_index k = c, j = 0; k < ns; k += 2, j++)
+      if (((best >> j) & 1u) == half) {
+        S->mid[k] = 0.5 * half + (sum > 0.0 ? 0.5 * (acc + 0.5 * w[k]) / sum : 0.0);
+        acc += w[k];
+      }
+  }
+}
+
 /* The slab order (see slab_order) of n items with per-item work (>= 0), in the sequence `seq`
  * (n items; NULL: ascending), given reach[t] >= t: the furthest sequence position of an item
  * adjacent (symmetrically) to the item at position t. Cut so that slab s + 2 starts past
@@ -83,6 +137,7 @@ static fcm_status slabs_create(fcm_ctx *ctx, fcm_index n, const fcm_index *seq,
 {
   fcm_status st = FCM_OK;
   fcm_index *cut = NULL;
+  double *sw = NULL; /* per slab: its work */
   fcm__mg_slabs_free(ctx, S);
   FCM_ALLOC_RAW(ctx, n + 2, cut);
   double total = 0.0;
@@ -116,22 +171,16 @@ static fcm_status slabs_create(fcm_ctx *ctx, fcm_index n, const fcm_index *seq,
     S->ptr[k] = cut[k];
   for (fcm_index q = 0; q < n; q++)
     S->item[q] = seq ? seq[q] : q;
+  FCM_ALLOC(ctx, ns + 1, sw);
   for (fcm_index k = 0; k < ns; k++)
     for (fcm_index q = cut[k]; q < cut[k + 1]; q++)
-      S->mid[k] += work[S->item[q]]; /* the slab's work, for now */
-  for (int c = 0; c < 2; c++) {
-    double tot = 0.0, before = 0.0;
-    for (fcm_index k = c; k < ns; k += 2)
-      tot += S->mid[k];
-    for (fcm_index k = c; k < ns; k += 2) {
-      const double w = S->mid[k];
-      S->mid[k] = tot > 0.0 ? (before + 0.5 * w) / tot : 0.0;
-      before += w;
-    }
-  }
+      sw[k] += work[S->item[q]];
+  for (int c = 0; c < 2; c++)
+    slabs_share(S, c, sw);
 cleanup:
   if (st) fcm__mg_slabs_free(ctx, S);
   fcm__free(ctx, cut);
+  fcm__free(ctx, sw);
   return st;
 }
 
@@ -143,6 +192,35 @@ cleanup:
  * numbers the corner nodes before the mid-edge nodes; its rows couple far apart in row order
  * and stay in one slab (sequential). */
 #define MG_ROW_SLABS_THICK 2
+
+/* lead and tail of a row order (slab_order): in a sweep by two threads, one sweeps the thin
+ * slab 1 alone before and after the thick slabs, the other thick slab 0 and the third slab 2
+ * between them; the first rows of slab 0 that reach no row of slab 1 can be swept beside the
+ * thin slab instead (their updates neither read nor write its rows, so the iterate is the
+ * same). As many as make slab 0's thread's share between the barriers that of slab 2's
+ * (w = W_0 - W_2, at most W_1, stored entries), cut at a copy's first row (row 0 starts slab 0,
+ * so the copies' triples stay whole). */
+static void row_slabs_lead(fcm_index n, const fcm_index *reach, const double *work, slab_order *S)
+{
+  S->lead = S->tail = 0;
+  if (S->nslab != 3 || S->first != 1) return;
+  double w[3] = {0.0, 0.0, 0.0};
+  for (int k = 0; k < 3; k++)
+    for (fcm_index q = S->ptr[k]; q < S->ptr[k + 1]; q++)
+      w[k] += work[S->item[q]];
+  const double want = FCM_MIN(w[1], w[0] - w[2]);
+  double acc = 0.0;
+  fcm_index cut = 0;
+  for (fcm_index i = 0; i < S->ptr[1] && i < n; i++) {
+    if (reach[i] >= S->ptr[1]) break; /* row i couples with the thin slab */
+    acc += work[i];
+    if (i % 3 == 2) {
+      if (acc > want) break;
+      cut = i + 1;
+    }
+  }
+  S->lead = S->tail = cut;
+}
 
 fcm_status fcm__mg_row_slabs(fcm_mg *m, mg_level *L)
 {
@@ -162,6 +240,7 @@ fcm_status fcm__mg_row_slabs(fcm_mg *m, mg_level *L)
     reach[i] = rp[i + 1] > rp[i] ? FCM_MAX(i, (fcm_index)ci[rp[i + 1] - 1]) : i;
   }
   FCM_TRY(ctx, slabs_create(ctx, L->n, NULL, reach, work, MG_ROW_SLABS_THICK, &L->rows));
+  row_slabs_lead(L->n, reach, work, &L->rows);
   FCM_ALLOC(ctx, L->n + 1, L->rows.triple);
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (n > 4096)
   for (fcm_index i = 0; i < n - 2; i += 3) {

@@ -162,9 +162,9 @@ static void sgs_triple(const mg_level *L, const double *v, const int *ci, const 
   x[i + 2] += d2;
 }
 
-/* Gauss-Seidel over the rows of slab s, forward (ascending) or backward; a copy's three rows
- * of one pattern together (sgs_triple()). */
-static void sgs_slab(const sweep_args *a, fcm_index s, int back)
+/* Gauss-Seidel over the rows at positions [q0, q1) of the row order, forward (ascending) or
+ * backward; a copy's three rows of one pattern together (sgs_triple()). */
+static void sgs_range(const sweep_args *a, fcm_index q0, fcm_index q1, int back)
 {
   const mg_level *L = a->L;
   const double w = a->w, *b = a->b;
@@ -174,7 +174,7 @@ static void sgs_slab(const sweep_args *a, fcm_index s, int back)
   const int *ci = fcm_csr_col_idx(A);
   const double *v = fcm_csr_values_read(A);
   const unsigned char *triple = a->plain ? NULL : L->rows.triple;
-  const fcm_index *item = L->rows.item, q0 = L->rows.ptr[s], q1 = L->rows.ptr[s + 1];
+  const fcm_index *item = L->rows.item;
   if (!back) {
     for (fcm_index q = q0; q < q1;) {
       const fcm_index i = item[q];
@@ -198,6 +198,47 @@ static void sgs_slab(const sweep_args *a, fcm_index s, int back)
       q--;
     }
   }
+}
+
+/* Gauss-Seidel over the rows of slab s (sgs_range()). */
+static void sgs_slab(const sweep_args *a, fcm_index s, int back)
+{
+  sgs_range(a, a->L->rows.ptr[s], a->L->rows.ptr[s + 1], back);
+}
+
+/* symmetric_sweep() of a row order of three slabs by a team of two, slab 0 thread 0's and
+ * slabs 1 (thin, swept first) and 2 thread 1's, the first rows of slab 0 (lead, tail;
+ * slab_order) swept while thread 1 sweeps slab 1: the same updates in the same order where
+ * they touch one another, so the same iterate, and between the barriers each thread about half
+ * of the work instead of thread 0 idle while slab 1 is swept. Repeated sweeps need no barrier
+ * between them: the rows thread 0 sweeps beside slab 1 reach none of its rows. */
+static void row_sweep_split(const slab_order *S, const sweep_args *a)
+{
+  const fcm_index p0 = S->ptr[0], p1 = S->ptr[1];
+  if (omp_get_thread_num() == 0) {
+    sgs_range(a, p0, p0 + S->lead, 0);
+#pragma omp barrier
+    sgs_range(a, p0 + S->lead, p1, 0);
+    sgs_range(a, p0 + S->tail, p1, 1);
+#pragma omp barrier
+    sgs_range(a, p0, p0 + S->tail, 1);
+    return;
+  }
+  sgs_slab(a, 1, 0);
+#pragma omp barrier
+  sgs_slab(a, 2, 0);
+  sgs_slab(a, 2, 1);
+#pragma omp barrier
+  sgs_slab(a, 1, 1);
+}
+
+/* Does row_sweep_split() apply to S in the enclosing team: three slabs, the thin one first,
+ * a lead, two threads owning the slabs as it assumes? */
+static int row_split_applies(const slab_order *S)
+{
+  return S->nslab == 3 && S->first == 1 && S->lead > 0 && omp_get_num_threads() == 2 &&
+         fcm__mg_slab_mine(S, 0, 0, 2) && fcm__mg_slab_mine(S, 1, 1, 2) &&
+         fcm__mg_slab_mine(S, 2, 1, 2);
 }
 
 /* One smoothing step. SGS: a forward then a backward sweep, S = (I - B^-1 A)(I - F^-1 A),
@@ -242,7 +283,10 @@ void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x)
     return;
   }
   const sweep_args a = {L, w, b, x, NULL, NULL, {0}, 0};
-  symmetric_sweep(&L->rows, sgs_slab, &a);
+  if (row_split_applies(&L->rows))
+    row_sweep_split(&L->rows, &a);
+  else
+    symmetric_sweep(&L->rows, sgs_slab, &a);
 }
 
 /* Block Gauss-Seidel over the blocks of slab s, forward or backward: x_K += S_K (b - A x)_K,

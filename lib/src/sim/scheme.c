@@ -111,12 +111,16 @@ void fcm__sim_set_base(const fcm_integrator *I, double h, fcm_csr *A)
   fcm_index nnz = 0;
   fcm_csr_get_size(A, NULL, NULL, &nnz);
   double *v = fcm_csr_values(A);
+  const int nt = fcm_ctx_num_threads(I->ctx);
   if (h > 0.0) {
+    /* entry by entry, the same values with any thread count; tens of megabytes every step */
     const double *mv = fcm_csr_values_read(I->M), a = fcm__sim_mass_coeff(I, h);
+#pragma omp parallel for num_threads(nt) schedule(static) if (nnz > 65536)
     for (fcm_index e = 0; e < nnz; e++)
       v[e] = a * mv[e];
     if (I->D) {
       const double *dv = fcm_csr_values_read(I->D), hd = fcm__sim_damp_length(I, h);
+#pragma omp parallel for num_threads(nt) schedule(static) if (nnz > 65536)
       for (fcm_index e = 0; e < nnz; e++)
         v[e] += dv[e] / hd;
     }

@@ -16,6 +16,7 @@
  * Created for the multigrid's block smoother (fcm__schwarz_create_blocks()), a setup computes
  * only what the block sweeps read, the S_K: no diagonal outside the blocks, no apply. */
 #include "solve/solve_impl.h"
+#include "core/multiversion.h"
 
 #include <math.h>
 #include <omp.h>
@@ -62,6 +63,7 @@ struct fcm_schwarz {
    * n ints of the gather's DOF map (zero between blocks). */
   int nt;
   size_t per_thread, lwork, liwork;
+  size_t scalar_work; /* the per-thread doubles build_block() uses; build_batch()'s after them */
   double *work;
   int *iwork;
   int *loc;
@@ -195,10 +197,10 @@ static int gather_scan(const fcm_csr *C, const double *vals, int m, const fcm_in
 
 /* Gather C_K's lower triangle (all that the Cholesky factor and dsyevd read) through the
  * positions of a block whose entries are all stored (pos of gather_scan()), each checked
- * against C's pattern: 1 when all finite, 0 when one is NaN or infinite, -1 (a unfinished)
- * when C's pattern has moved an entry. */
+ * against C's pattern, entry (i, j) into a[(i + j m) stride]: 1 when all finite, 0 when one is
+ * NaN or infinite, -1 (a unfinished) when C's pattern has moved an entry. */
 static int gather_known(const fcm_csr *C, const double *vals, int m, const fcm_index *d,
-                        const int *pos, double *a)
+                        const int *pos, double *a, size_t stride)
 {
   const fcm_index *rp = fcm_csr_row_ptr(C);
   const int *ci = fcm_csr_col_idx(C);
@@ -210,7 +212,7 @@ static int gather_known(const fcm_csr *C, const double *vals, int m, const fcm_i
       const fcm_index p = r0 + pi[j];
       if (pi[j] >= len || ci[p] != d[j]) return -1;
       finite &= isfinite(vals[p]) != 0;
-      a[i + (size_t)j * m] = vals[p];
+      a[(i + (size_t)j * m) * stride] = vals[p];
     }
   }
   return finite;
@@ -321,11 +323,14 @@ static double cholesky_product(int m, const double *X, double *S)
  * factor non-NULL (a block smoother, whose sweeps may apply S_K = X^T X as two triangular
  * products): X itself into S's slot (lower triangle, zero above; *factor = 1) when the bound
  * ||S_K||_F <= ||X||_F^2 already passes the test, which then needs no product; else S_K as
- * without it (*factor = 0). The same blocks take the Cholesky path either way. */
+ * without it (*factor = 0). The same blocks take the Cholesky path either way. The zeros
+ * above the diagonal are written only when the slot did not hold X before (*factor = 0 on
+ * entry): a setup after a setup writes X's triangle alone. */
 static int cholesky_inverse(int m, const double *a, double eps, double *lw, double *S,
                             unsigned char *factor)
 {
   double *L = lw, *X = lw + (size_t)m * m, na = 0.0;
+  const int was_factor = factor && *factor; /* S's slot zero above the diagonal already */
   if (factor) *factor = 0;
   for (int i = 0; i < m; i++)
     for (int j = 0; j <= i; j++) {
@@ -342,7 +347,7 @@ static int cholesky_inverse(int m, const double *a, double eps, double *lw, doub
     if (isfinite(nx) && sqrt(na) * nx <= SCHWARZ_CHOLESKY_COND / eps) {
       for (int i = 0; i < m; i++) {
         memcpy(S + (size_t)i * m, X + (size_t)i * m, sizeof *S * (size_t)(i + 1));
-        memset(S + (size_t)i * m + i + 1, 0, sizeof *S * (size_t)(m - 1 - i));
+        if (!was_factor) memset(S + (size_t)i * m + i + 1, 0, sizeof *S * (size_t)(m - 1 - i));
       }
       *factor = 1;
       return 1;
@@ -350,6 +355,132 @@ static int cholesky_inverse(int m, const double *a, double eps, double *lw, doub
   }
   const double ns = cholesky_product(m, X, S);
   return isfinite(ns) && sqrt(na) * sqrt(ns) <= SCHWARZ_CHOLESKY_COND / eps;
+}
+
+/* Four blocks of one size at once, one in each lane of a vector: cholesky_factor(),
+ * cholesky_invert_factor() and cholesky_inverse()'s test written with vectors of four, each
+ * lane the same operations in the same order as one block alone (ISO C evaluation, no
+ * contraction), so the same bits; four independent chains of dependent operations per
+ * instruction instead of two. Arrays of a batch interleave the lanes: entry e of lane q at
+ * 4 e + q. */
+typedef double v4d __attribute__((vector_size(4 * sizeof(double)), aligned(sizeof(double))));
+#define BATCH 4
+
+/* *r = 1 / sqrt(v) in each lane; bit q of *bad set where v's lane q is not positive and
+ * finite. */
+static inline __attribute__((always_inline)) void inv_sqrt4(const v4d *v, v4d *r, unsigned *bad)
+{
+  for (int q = 0; q < BATCH; q++) {
+    if (!((*v)[q] > 0.0 && isfinite((*v)[q]))) *bad |= 1u << q;
+    (*r)[q] = 1.0 / sqrt((*v)[q]);
+  }
+}
+
+/* cholesky_factor() of four blocks; the lanes whose factor does not exist in *bad. */
+static inline __attribute__((always_inline)) void cholesky_factor4(int m, const v4d *a, v4d *L,
+                                                                   unsigned *bad)
+{
+  const v4d zero = {0.0, 0.0, 0.0, 0.0};
+  for (int i = 0; i < m; i += 2) {
+    v4d *Li = L + (size_t)i * m, *Lh = i + 1 < m ? Li + m : NULL;
+    for (int j = 0; j <= i; j++) {
+      const v4d *Lj = L + (size_t)j * m;
+      v4d v = a[i + (size_t)j * m], u = Lh ? a[i + 1 + (size_t)j * m] : zero;
+      int k = 0;
+      if (Lh)
+        for (; k < j; k++) {
+          v -= Li[k] * Lj[k];
+          u -= Lh[k] * Lj[k];
+        }
+      else
+        for (; k < j; k++)
+          v -= Li[k] * Lj[k];
+      if (i > j)
+        Li[j] = v * Lj[j];
+      else
+        inv_sqrt4(&v, &Li[i], bad);
+      if (Lh) Lh[j] = u * Lj[j];
+    }
+    if (Lh) {
+      v4d v = a[i + 1 + (size_t)(i + 1) * m];
+      for (int k = 0; k < i + 1; k++)
+        v -= Lh[k] * Lh[k];
+      inv_sqrt4(&v, &Lh[i + 1], bad);
+    }
+  }
+}
+
+/* cholesky_invert_factor() of four blocks. */
+static inline __attribute__((always_inline)) void cholesky_invert_factor4(int m, const v4d *L,
+                                                                          v4d *X)
+{
+  const v4d zero = {0.0, 0.0, 0.0, 0.0};
+  for (int j = 0; j < m; j += 2) {
+    const int h = j + 1;
+    X[(size_t)j * m + j] = L[(size_t)j * m + j];
+    if (h < m) {
+      X[(size_t)h * m + h] = L[(size_t)h * m + h];
+      v4d v = zero;
+      v -= L[(size_t)h * m + j] * X[(size_t)j * m + j];
+      X[(size_t)h * m + j] = v * L[(size_t)h * m + h];
+    }
+    for (int i = j + 2; i < m; i++) {
+      const v4d *Li = L + (size_t)i * m;
+      v4d v = zero, u = zero;
+      v -= Li[j] * X[(size_t)j * m + j];
+      for (int k = h; k < i; k++) {
+        v -= Li[k] * X[(size_t)k * m + j];
+        u -= Li[k] * X[(size_t)k * m + h];
+      }
+      X[(size_t)i * m + j] = v * Li[i];
+      X[(size_t)i * m + h] = u * Li[i];
+    }
+  }
+}
+
+/* The block smoother's blocks b .. b + 3 (one size m, all entries stored) by the factor path
+ * of cholesky_inverse() at once: each lane's X into its S slot where its factor exists and
+ * passes the test with the bound ||S_K||_F <= ||X||_F^2; the lanes done in the result's bits
+ * (the others, and all when a gather is not clean, to build_block() as before). w: 12 m^2
+ * doubles of the thread's scratch. Compiled for the CPU's vector width where the build makes
+ * per-CPU clones (core/multiversion.h: the same roundings). */
+FCM_MULTIVERSION_CLONES
+static unsigned build_batch(fcm_schwarz *P, const fcm_csr *C, const double *vals, fcm_index b,
+                            int m, double *w)
+{
+  const size_t mm = (size_t)m * (size_t)m;
+  v4d *a = (v4d *)w, *L = a + mm, *X = L + mm;
+  for (int q = 0; q < BATCH; q++)
+    if (gather_known(C, vals, m, P->dofs + P->block_ptr[b + q], P->pos + P->s_off[b + q], w + q,
+                     BATCH) != 1)
+      return 0;
+  unsigned bad = 0, done = 0;
+  cholesky_factor4(m, a, L, &bad);
+  if (bad == (1u << BATCH) - 1u) return 0;
+  cholesky_invert_factor4(m, L, X);
+  v4d na = {0.0, 0.0, 0.0, 0.0}, nx = na;
+  for (int i = 0; i < m; i++)
+    for (int j = 0; j <= i; j++) {
+      const v4d v = a[i + (size_t)j * m];
+      na += (i == j ? 1.0 : 2.0) * v * v;
+    }
+  for (int i = 0; i < m; i++)
+    for (int j = 0; j <= i; j++)
+      nx += X[(size_t)i * m + j] * X[(size_t)i * m + j];
+  const double limit = SCHWARZ_CHOLESKY_COND / P->opts.epsilon;
+  for (int q = 0; q < BATCH; q++) {
+    if ((bad >> q) & 1u || !(isfinite(nx[q]) && sqrt(na[q]) * nx[q] <= limit)) continue;
+    double *S = P->S + P->s_off[b + q];
+    const int was_factor = P->factor[b + q]; /* zeros above the diagonal already */
+    for (int i = 0; i < m; i++) {
+      for (int j = 0; j <= i; j++)
+        S[(size_t)i * m + j] = X[(size_t)i * m + j][q];
+      if (!was_factor) memset(S + (size_t)i * m + i + 1, 0, sizeof *S * (size_t)(m - 1 - i));
+    }
+    P->factor[b + q] = 1;
+    done |= 1u << q;
+  }
+  return done;
 }
 
 /* Gather C_K, then S_K: by cholesky_inverse() where it applies, else by the symmetric
@@ -364,7 +495,7 @@ static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *va
   const int m = (int)(P->block_ptr[b + 1] - P->block_ptr[b]);
   double *S = P->S + P->s_off[b];
   int *pos = P->pos + P->s_off[b];
-  int finite = P->full[b] ? gather_known(C, vals, m, d, pos, a) : -1;
+  int finite = P->full[b] ? gather_known(C, vals, m, d, pos, a, 1) : -1;
   if (finite < 0) finite = gather_scan(C, vals, m, d, loc, pos, P->full + b, a);
   if (!finite) {
     *fail = FAIL_NONFINITE;
@@ -460,19 +591,29 @@ fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
     double *lw = w + P->max_m;
     int *iw = P->iwork + P->liwork * (size_t)t;
     int *loc = P->loc + (size_t)P->n * (size_t)t;
+    const fcm_index ng = (nb + BATCH - 1) / BATCH;
 #pragma omp for schedule(dynamic, 1)
-    for (fcm_index b = 0; b < nb; b++) {
-      block_stats bs = {0, 0};
-      block_fail fail = FAIL_NONE;
-      fcm_status s = build_block(P, C, vals, b, loc, a, w, lw, iw, &bs, &fail);
-      negative += bs.negative;
-      clamped += bs.clamped;
-      if (s != FCM_OK) {
+    for (fcm_index g = 0; g < ng; g++) {
+      const fcm_index b0 = BATCH * g, b1 = FCM_MIN(nb, b0 + BATCH);
+      const int m = (int)(P->block_ptr[b0 + 1] - P->block_ptr[b0]);
+      int same = P->factor && b1 - b0 == BATCH;
+      for (fcm_index b = b0; same && b < b1; b++)
+        same = P->full[b] && P->block_ptr[b + 1] - P->block_ptr[b] == m;
+      const unsigned done = same ? build_batch(P, C, vals, b0, m, a + P->scalar_work) : 0u;
+      for (fcm_index b = b0; b < b1; b++) {
+        if ((done >> (b - b0)) & 1u) continue;
+        block_stats bs = {0, 0};
+        block_fail fail = FAIL_NONE;
+        fcm_status s = build_block(P, C, vals, b, loc, a, w, lw, iw, &bs, &fail);
+        negative += bs.negative;
+        clamped += bs.clamped;
+        if (s != FCM_OK) {
 #pragma omp critical(fcm_schwarz_bad)
-        if (bad < 0 || b < bad) {
-          bad = b;
-          bad_st = s;
-          bad_fail = fail;
+          if (bad < 0 || b < bad) {
+            bad = b;
+            bad_st = s;
+            bad_fail = fail;
+          }
         }
       }
     }
@@ -656,6 +797,8 @@ static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
   }
   P->lwork = FCM_MAX(P->lwork, 2 * (size_t)max_m * (size_t)max_m);
   P->per_thread = (size_t)max_m * (size_t)max_m + (size_t)max_m + P->lwork;
+  P->scalar_work = P->per_thread;
+  if (blocks_only) P->per_thread += 3 * BATCH * (size_t)max_m * (size_t)max_m; /* build_batch() */
   if (num_blocks > 0) {
     FCM_ALLOC(ctx, P->per_thread * (size_t)P->nt, P->work);
     FCM_ALLOC(ctx, P->liwork * (size_t)P->nt, P->iwork);
