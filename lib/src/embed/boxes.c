@@ -8,10 +8,6 @@
 
 #include <math.h>
 
-/* A tet or cell whose 6 x volume is below this fraction of its size cubed is flat (as
- * surface_parts.c skips its fan tets). */
-#define FLAT_RTOL 1e-12
-
 /* A part's box in reference coordinates within this fraction of the reference cell's size (2):
  * see fcm__embed_part_box(). */
 #define BOX_RTOL 1e-13
@@ -43,7 +39,10 @@ fcm_status fcm__embed_part_box(fcm_ctx *ctx, const fcm__embed_cell *cell, const 
     }
     seen |= 1u << corner;
   }
-  *is_box = seen == 0xffu;
+  if (seen == 0xffu) { /* a flat box keeps its fan tets, which skip flat ones */
+    fcm__embed_cell k;
+    *is_box = fcm__embed_box_cell(cell, lo, hi, &k);
+  }
 cleanup:
   return st;
 }
@@ -51,8 +50,8 @@ cleanup:
 /* The box lo..hi of cell's reference coordinates (cell affine) as an affine Hex8 cell of its
  * own: its reference cube's point eta is cell's c + h eta (c, h: the box's centre and half
  * sides). */
-void fcm__embed_box_cell(const fcm__embed_cell *cell, const double lo[3], const double hi[3],
-                         fcm__embed_cell *k)
+int fcm__embed_box_cell(const fcm__embed_cell *cell, const double lo[3], const double hi[3],
+                        fcm__embed_cell *k)
 {
   static const int corner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
                                    {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
@@ -86,6 +85,7 @@ void fcm__embed_box_cell(const fcm__embed_cell *cell, const double lo[3], const 
   k->size = fcm__element_cell_size(8, k->X);
   k->tol = 0.0;
   k->volume = fabs(k->detA) * 8.0;
+  return fcm__embed_cell_solid(k);
 }
 
 /* The prism of half-height h along the unit normal nrm on the polygon x (n vertices) as one
@@ -125,5 +125,5 @@ int fcm__embed_prism_cell(const double *x, int n, const double nrm[3], double h,
   k->size = fcm__element_cell_size(8, k->X);
   k->tol = 0.0;
   k->volume = fabs(k->detA) * 8.0;
-  return fabs(k->detA) > FLAT_RTOL * k->size * k->size * k->size && isfinite(k->detA);
+  return fcm__embed_cell_solid(k);
 }

@@ -9,6 +9,8 @@
 #include "geom/geom_impl.h"
 #include "la/mat3.h"
 
+#include <math.h>
+
 /* A cut triangle prepared for splitting: its plane (unit normal) and the three
  * planes through its edges perpendicular to it (outward: the triangle is where all three
  * are <= 0); lo/hi its bounding box; `cut` the cut surface it came from. */
@@ -765,15 +767,25 @@ int fcm__embed_part_full(const fcm__parts *P, size_t i);
 /* Whether the convex polyhedron p (a part of affine cell) is a box in cell's reference
  * coordinates: 8 vertices, each at a corner of their reference bounding box lo..hi within
  * 1e-13 of the reference cell's size, every corner taken once (a part of a box cell that cuts
- * along the grid's axes split). */
+ * along the grid's axes split), and the box not flat (fcm__embed_box_cell()). */
 fcm_status fcm__embed_part_box(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__poly *p,
                                double lo[3], double hi[3], int *is_box);
 
+/* A tet or cell whose 6 x volume is below this fraction of its size cubed is flat: its map is
+ * too ill-conditioned for line crossings (fan tets skip it, a box or prism keeps its fan). */
+#define FCM__EMBED_FLAT_RTOL 1e-12
+
+/* Whether the affine cell k (detA and size set) is not flat. */
+static inline int fcm__embed_cell_solid(const fcm__embed_cell *k)
+{
+  return fabs(k->detA) > FCM__EMBED_FLAT_RTOL * k->size * k->size * k->size && isfinite(k->detA);
+}
+
 /* The box lo..hi of the reference coordinates of the affine cell as an affine Hex8 cell k of
  * its own: k's reference point eta is cell's c + h eta (c, h: the box's centre and half
- * sides). */
-void fcm__embed_box_cell(const fcm__embed_cell *cell, const double lo[3], const double hi[3],
-                         fcm__embed_cell *k);
+ * sides). Returns 1, or 0 when k is flat. */
+int fcm__embed_box_cell(const fcm__embed_cell *cell, const double lo[3], const double hi[3],
+                        fcm__embed_cell *k);
 
 /* The prism of half-height h along the unit normal nrm on the polygon x (n vertices) as one
  * affine Hex8 cell k (id: the cell that names the errors), when the polygon is a parallelogram

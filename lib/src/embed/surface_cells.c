@@ -17,12 +17,12 @@
 #include <stdint.h>
 #include <string.h>
 
-/* Boundary points kept per moment, the finer grid's factor on a retry, the largest grid per
- * axis, the piece's points (of each set of piece_candidates()) per boundary point on a retry
- * before the last, which takes them all. */
 /* The most parts of a piece that box_piece_rule() takes (8 points each). */
 #define FCM__BOX_PIECE_PARTS 3
 
+/* Boundary points kept per moment, the finer grid's factor on a retry, the largest grid per
+ * axis, the piece's points (of each set of piece_candidates()) per boundary point on a retry
+ * before the last, which takes them all. */
 enum { BOUNDARY_PER_MOMENT = 1, GROW = 4, ATTEMPTS = 4, GRID_MAX = 64, PIECE_PER_BOUNDARY = 2 };
 
 /* Absolute moment residual accepted, per unit of the material box's reference volume: ten times

@@ -77,9 +77,6 @@ fcm_status fcm__material_status(fcm__material *m)
 /* A part whose material is within this fraction of its volume lies wholly inside the body. */
 #define FULL_RTOL 1e-12
 
-/* A tet whose 6 x volume is below this fraction of its size cubed is flat (skipped). */
-#define FLAT_RTOL 1e-12
-
 /* Tet (c, a, b, e) (12 doubles) as an affine Tet4 cell: node 0 at xi = 0. */
 static void tet_cell(const double *T, fcm_index id, fcm__embed_cell *k)
 {
@@ -120,7 +117,7 @@ static fcm_status tets_material(fcm_ctx *ctx, fcm__material *m, const double *te
     tet_cell(tets + 12 * t, cell->id, &k);
     /* a fan tet flat to rounding (near-coplanar vertices of a part) holds no material that
      * counts, and its map to the unit tet is too ill-conditioned for the line crossings */
-    if (!(fabs(k.detA) > FLAT_RTOL * k.size * k.size * k.size && isfinite(k.detA))) continue;
+    if (!fcm__embed_cell_solid(&k)) continue;
     int clear;
     FCM_TRY(ctx, fcm__embed_cell_clear(ctx, m->geom, m->tree, &k, &m->buf, &clear));
     if (clear) {
@@ -187,7 +184,7 @@ static fcm_status box_material(fcm_ctx *ctx, fcm__material *m, const double lo[3
   fcm_status st = FCM_OK;
   fcm__embed_cell k;
   double c[3], h[3];
-  fcm__embed_box_cell(cell, lo, hi, &k);
+  (void)fcm__embed_box_cell(cell, lo, hi, &k); /* not flat: fcm__embed_part_box() */
   for (int d = 0; d < 3; d++)
     c[d] = 0.5 * (lo[d] + hi[d]), h[d] = 0.5 * (hi[d] - lo[d]);
   FCM_TRY(ctx, one_cell_material(ctx, m, &k, q, volume));
@@ -282,7 +279,7 @@ static fcm_status prism_clear(fcm_ctx *ctx, fcm__material *m, const double *tets
   if (m->buf.n > 0) goto cleanup;
   for (int t = 0; t < nt; t++) { /* the tets tets_material() would count */
     tet_cell(tets + 12 * t, id, &k);
-    if (!(fabs(k.detA) > FLAT_RTOL * k.size * k.size * k.size && isfinite(k.detA))) continue;
+    if (!fcm__embed_cell_solid(&k)) continue;
     if (first < 0) first = t;
     v += fabs(k.detA) / 6.0;
   }

@@ -157,8 +157,10 @@ FCM_COMPONENT_API fcm_status fcm__space_create_local(fcm_ctx *ctx, const fcm_mes
 /* fcm_space_create_embedded_with(ctx, mesh, rules, opts, out) after a cut: rules made by
  * fcm_cell_rules_create_cut() from the rules of `from` (a full space on the same mesh), whose
  * topology the new space patches where the cut left it (fcm__space_build_topology_cut()). The
- * same space bit for bit (every array); from may be NULL, local or unrelated: a space built
- * anew. `from` is only read and may be destroyed afterwards. @return as
+ * same space bit for bit (every array); with from NULL or local the space is built anew, and
+ * otherwise from must be the space on the rules the cut started from (another space on rules
+ * with as many pieces fails with FCM_ERR_INTERNAL). `from` is only read and may be destroyed
+ * afterwards. @return as
  * fcm_space_create_embedded_with(). (space.c) */
 FCM_COMPONENT_API fcm_status fcm__space_create_cut(fcm_ctx *ctx, const fcm_mesh *mesh,
                                                    const fcm_cell_rules *rules,
@@ -171,7 +173,8 @@ FCM_COMPONENT_API fcm_status fcm__space_create_cut(fcm_ctx *ctx, const fcm_mesh 
  * pages. from then has no pattern: no matrix may be made on it, and the matrices made on it
  * before (which borrow its pattern) may not be used, until fcm__space_cut_give_back(*out) (or
  * destroying *out) gives it back; after fcm__space_cut_keep(*out) from can only be destroyed.
- * The same space bit for bit. (space.c) */
+ * from must outlive *out until one of the two (the give-back writes into from). The same
+ * space bit for bit. (space.c) */
 FCM_COMPONENT_API fcm_status fcm__space_create_cut_take(fcm_ctx *ctx, const fcm_mesh *mesh,
                                                         const fcm_cell_rules *rules,
                                                         const fcm_space_options *opts,

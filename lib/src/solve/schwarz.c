@@ -441,7 +441,7 @@ static inline __attribute__((always_inline)) void cholesky_invert_factor4(int m,
 /* The block smoother's blocks b .. b + 3 (one size m, all entries stored) by the factor path
  * of cholesky_inverse() at once: each lane's X into its S slot where its factor exists and
  * passes the test with the bound ||S_K||_F <= ||X||_F^2; the lanes done in the result's bits
- * (the others, and all when a gather is not clean, to build_block() as before). w: 12 m^2
+ * (the others, and all when a gather is not clean, to build_block()). w: 12 m^2
  * doubles of the thread's scratch. Compiled for the CPU's vector width where the build makes
  * per-CPU clones (core/multiversion.h: the same roundings). */
 FCM_MULTIVERSION_CLONES
