@@ -47,6 +47,18 @@ cleanup:
   return st;
 }
 
+/* The affine Hex8 cell k's map (A, X and the box set): its inverse, size and volume; 1, or 0
+ * when k is flat. */
+static int finish_cell(fcm__embed_cell *k)
+{
+  k->detA = fcm__mat3_inv(k->A, k->Ainv);
+  k->affine = 1;
+  k->size = fcm__element_cell_size(8, k->X);
+  k->tol = 0.0;
+  k->volume = fabs(k->detA) * 8.0;
+  return fcm__embed_cell_solid(k);
+}
+
 /* The box lo..hi of cell's reference coordinates (cell affine) as an affine Hex8 cell of its
  * own: its reference cube's point eta is cell's c + h eta (c, h: the box's centre and half
  * sides). */
@@ -80,12 +92,7 @@ int fcm__embed_box_cell(const fcm__embed_cell *cell, const double lo[3], const d
       k->lo[d] = fmin(k->lo[d], x[d]), k->hi[d] = fmax(k->hi[d], x[d]);
     }
   }
-  k->detA = fcm__mat3_inv(k->A, k->Ainv);
-  k->affine = 1;
-  k->size = fcm__element_cell_size(8, k->X);
-  k->tol = 0.0;
-  k->volume = fabs(k->detA) * 8.0;
-  return fcm__embed_cell_solid(k);
+  return finish_cell(k);
 }
 
 /* The prism of half-height h along the unit normal nrm on the polygon x (n vertices) as one
@@ -120,10 +127,5 @@ int fcm__embed_prism_cell(const double *x, int n, const double nrm[3], double h,
       k->lo[d] = fmin(k->lo[d], v), k->hi[d] = fmax(k->hi[d], v);
     }
   }
-  k->detA = fcm__mat3_inv(k->A, k->Ainv);
-  k->affine = 1;
-  k->size = fcm__element_cell_size(8, k->X);
-  k->tol = 0.0;
-  k->volume = fabs(k->detA) * 8.0;
-  return fcm__embed_cell_solid(k);
+  return finish_cell(k);
 }
