@@ -172,7 +172,9 @@ static double *read_array(const char *path, const char *parent, const char *name
   return out;
 }
 
-static void plain(fcm_element_type type)
+/* `name`: the element's, so that the tests of the four elements, which may run at once, write
+ * apart. */
+static void plain(fcm_element_type type, const char *name)
 {
   fcm_mesh *mesh = NULL;
   fcm_space *space = NULL;
@@ -202,25 +204,28 @@ static void plain(fcm_element_type type)
   const fcm_material mat = {FCM_MATERIAL_STVK, 2.0e5, 0.3, 1000.0};
   double s0[6], vm0, sed0;
   analytic(&mat, s0, &vm0, &sed0);
-  TEST_TRUE(vr_mkdir("fem_fields_out"));
-  TEST_OK(ctx, fcm_space_write_vtu(space, &mat, u, NULL, "fem_fields_out/bg.vtu"));
+  char dir[64], vtu[80];
+  snprintf(dir, sizeof dir, "fem_fields_out_%s", name);
+  snprintf(vtu, sizeof vtu, "%s/bg.vtu", dir);
+  TEST_TRUE(vr_mkdir(dir));
+  TEST_OK(ctx, fcm_space_write_vtu(space, &mat, u, NULL, vtu));
   size_t n = 0;
-  double *pts = read_array("fem_fields_out/bg.vtu", "Points", NULL, &n);
+  double *pts = read_array(vtu, "Points", NULL, &n);
   TEST_TRUE(pts && n == 3 * (size_t)nn && !memcmp(pts, X, n * sizeof *pts));
   free(pts);
-  double *disp = read_array("fem_fields_out/bg.vtu", "PointData", "displacement", &n);
+  double *disp = read_array(vtu, "PointData", "displacement", &n);
   TEST_TRUE(disp && n == 3 * (size_t)nn && !memcmp(disp, nf, n * sizeof *disp));
   free(disp);
-  double *sv = read_array("fem_fields_out/bg.vtu", "CellData", "stress", &n);
+  double *sv = read_array(vtu, "CellData", "stress", &n);
   TEST_TRUE(sv && n == 6 * (size_t)fcm_mesh_num_cells(mesh));
   for (size_t c = 0; sv && c < n / 6; c++)
     for (int k = 0; k < 6; k++)
       TEST_NEAR(sv[6 * c + k], s0[k], 0, 1e-10 * vm0);
   free(sv);
-  double *vv = read_array("fem_fields_out/bg.vtu", "CellData", "von_mises", &n);
+  double *vv = read_array(vtu, "CellData", "von_mises", &n);
   TEST_TRUE(vv && n == (size_t)fcm_mesh_num_cells(mesh) && fabs(vv[0] - vm0) <= 1e-10 * vm0);
   free(vv);
-  vr_rmdir("fem_fields_out");
+  vr_rmdir(dir);
   /* errors name what is wrong */
   const double xi0[3] = {0, 0, 0};
   TEST_ERR(ctx, fcm_space_element_stress(space, &mat, -1, xi0, u, NULL, NULL, NULL), FCM_ERR_ARG,
@@ -235,7 +240,7 @@ done:
 }
 
 /* A ball in a grid: cut cells average exactly; the surface is written at reference positions. */
-static void embedded(fcm_element_type type)
+static void embedded(fcm_element_type type, const char *name)
 {
   fcm_mesh *mesh = NULL;
   fcm_geometry *ball = NULL;
@@ -274,19 +279,22 @@ static void embedded(fcm_element_type type)
     }
   /* the file: reference positions and the displacement (not deformed points) */
   const fcm_material mat = {FCM_MATERIAL_LINEAR, 2.0e5, 0.3, 1000.0};
-  TEST_TRUE(vr_mkdir("fem_fields_surf"));
-  TEST_OK(ctx, fcm_embedded_surface_write_vtu(es, &mat, u, "fem_fields_surf/s.vtu"));
+  char dir[64], vtu[80];
+  snprintf(dir, sizeof dir, "fem_fields_surf_%s", name);
+  snprintf(vtu, sizeof vtu, "%s/s.vtu", dir);
+  TEST_TRUE(vr_mkdir(dir));
+  TEST_OK(ctx, fcm_embedded_surface_write_vtu(es, &mat, u, vtu));
   size_t n = 0;
-  double *pts = read_array("fem_fields_surf/s.vtu", "Points", NULL, &n);
+  double *pts = read_array(vtu, "Points", NULL, &n);
   TEST_TRUE(pts && n == 3 * (size_t)np && !memcmp(pts, P, n * sizeof *pts));
   free(pts);
-  double *disp = read_array("fem_fields_surf/s.vtu", "PointData", "displacement", &n);
+  double *disp = read_array(vtu, "PointData", "displacement", &n);
   TEST_TRUE(disp && n == 3 * (size_t)np && !memcmp(disp, d, n * sizeof *disp));
   free(disp);
-  double *sed = read_array("fem_fields_surf/s.vtu", "PointData", "strain_energy_density", &n);
+  double *sed = read_array(vtu, "PointData", "strain_energy_density", &n);
   TEST_TRUE(sed && n == (size_t)np);
   free(sed);
-  vr_rmdir("fem_fields_surf");
+  vr_rmdir(dir);
   free(u), free(d), free(x);
 done:
   fcm_embedded_surface_destroy(&es);
@@ -428,8 +436,8 @@ int main(int argc, char **argv)
   fcm_element_type type;
   if (argc < 2 || fcm_element_type_from_name(argv[1], &type) != FCM_OK) return 2;
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
-  plain(type);
-  embedded(type);
+  plain(type, argv[1]);
+  embedded(type, argv[1]);
   cut(type);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
