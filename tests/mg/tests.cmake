@@ -19,6 +19,7 @@ fcm_add_test(mg_prepare tests/mg/prepare.c)
 fcm_add_test(mg_prepare_cut tests/mg/prepare_cut.c)
 # carried over a cut: the Galerkin plans' rows the cut left taken from the hierarchy before it
 fcm_add_test(mg_carry_cut tests/mg/carry_cut.c)
+fcm_add_test(mg_carry_bench tests/mg/carry_bench.c ARGS 32 5 LABELS bench)
 fcm_add_test(mg_update_bench tests/mg/update_bench.c ARGS 32 5 LABELS bench)
 fcm_add_test(mg_slabs tests/mg/slabs.c)
 fcm_add_test(mg_alloc_failure tests/mg/alloc_failure.c)

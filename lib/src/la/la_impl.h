@@ -179,10 +179,12 @@ typedef struct fcm__ptap_prior {
   const fcm__ptap *plan; /* made with the same with_diagonal */
   const fcm_csr *C;      /* its product (the pattern is read) */
   /* the old A's pattern: CSR rows (A_ptr, A_col), or with A_col NULL a copy graph (A_ptr,
-   * A_adj): row i holds 3 j, 3 j + 1, 3 j + 2 for each j of graph row i / 3 */
+   * A_adj): row i holds 3 j, 3 j + 1, 3 j + 2 for each j of graph row i / 3; then the new A's
+   * pattern must be the copy graph (G_ptr, G_adj) alike (it is compared a copy at a time) */
   const fcm_index *A_ptr;
   const int *A_col;
   const fcm_index *A_adj;
+  const fcm_index *G_ptr, *G_adj;
   const fcm_index *row_old, *row_new;   /* A's rows: new -> old, old -> new (-1: none) */
   const fcm_index *crow_old, *crow_new; /* C's rows (P's columns) alike */
 } fcm__ptap_prior;

@@ -648,8 +648,10 @@ typedef struct carry_work {
   const int *Ac, *Pc, *Rc, *APc;
   int *Cc;
   unsigned char *prow, *keep, *ckeep; /* rows of P, A P and C that are the old ones mapped */
+  const unsigned char *same3;         /* the new plan's */
+  unsigned char *cdup;                /* per group of C's rows: R's rows shifted (their rows of
+                                         A P of one pattern): one pattern before the diagonal */
   fcm_index n, nc;
-  int with_diagonal;
 } carry_work;
 
 /* Is row i of P the old row mapped (the same positions)? */
@@ -690,6 +692,25 @@ static int carry_arow(const carry_work *w, fcm_index i)
   return 1;
 }
 
+/* Copy-graph mode (A_col NULL): are copy k's three rows of A the old copy's rows mapped (its
+ * graph rows compared, a copy at a time), reaching only rows of P that are (prow)? */
+static int carry_acopy(const carry_work *w, fcm_index k)
+{
+  const fcm__ptap_prior *pr = w->pr;
+  const fcm_index *ro = pr->row_old + 3 * k;
+  if (ro[0] < 0 || ro[0] % 3 != 0 || ro[1] != ro[0] + 1 || ro[2] != ro[0] + 2) return 0;
+  const fcm_index g = ro[0] / 3, deg = pr->A_ptr[g + 1] - pr->A_ptr[g];
+  if (pr->G_ptr[k + 1] - pr->G_ptr[k] != deg) return 0;
+  const fcm_index *adj = pr->A_adj + pr->A_ptr[g], *nadj = pr->G_adj + pr->G_ptr[k];
+  for (fcm_index q = 0; q < deg; q++) {
+    const fcm_index j = nadj[q];
+    if (3 * j != pr->row_new[3 * adj[q]] || !w->prow[3 * j] || !w->prow[3 * j + 1] ||
+        !w->prow[3 * j + 2])
+      return 0;
+  }
+  return 1;
+}
+
 /* Row i of A P the plain way (columns first reached, A's row order, then P's): the count, the
  * columns into out (NULL: counted only). */
 static fcm_index carry_ap_plain(const carry_work *w, fcm_index i, fcm_index *mk, fcm_index tag,
@@ -707,8 +728,9 @@ static fcm_index carry_ap_plain(const carry_work *w, fcm_index i, fcm_index *mk,
   return cnt;
 }
 
-/* Row I of C the plain way (the columns of the rows of A P that row I of R reaches, and the
- * diagonal where asked), sorted into out (NULL: counted only). */
+/* Row I of C the plain way (the columns of the rows of A P that row I of R reaches; the
+ * diagonal is added afterwards, as fcm__ptap_create() does), sorted into out (NULL: counted
+ * only). */
 static fcm_index carry_c_plain(const carry_work *w, fcm_index I, fcm_index *mk, fcm_index tag,
                                int *out)
 {
@@ -721,10 +743,6 @@ static fcm_index carry_c_plain(const carry_work *w, fcm_index I, fcm_index *mk, 
       if (out) out[cnt] = j;
       cnt++;
     }
-  if (w->with_diagonal && mk[I] != tag) {
-    if (out) out[cnt] = (int)I;
-    cnt++;
-  }
   if (out) sort_ints(out, cnt);
   return cnt;
 }
@@ -762,13 +780,27 @@ static void carry_rows(carry_work *w, int stage, int pass, fcm_index *ptr, int *
                        int nt)
 {
   const fcm_index nrow = stage ? w->nc : w->n, base = (2 * stage + pass) * (w->n + w->nc);
+  unsigned char *keep = stage ? w->ckeep : w->keep;
+  const unsigned char *dup3 = stage ? w->cdup : w->same3;
 #pragma omp parallel num_threads(nt) if (nt > 1 && nrow > 4096)
   {
     fcm_index *m = mk + (size_t)omp_get_thread_num() * (size_t)(w->nc + 1);
-#pragma omp for schedule(dynamic, 256)
+    /* chunks of whole nodes: a node's rows 3 k + 1, 3 k + 2 follow row 3 k in one thread */
+#pragma omp for schedule(dynamic, 255)
     for (fcm_index i = 0; i < nrow; i++) {
-      unsigned char *keep = stage ? w->ckeep : w->keep;
-      if (!pass) keep[i] = (unsigned char)(stage ? carry_crow(w, i) : carry_arow(w, i));
+      if (!pass && stage) keep[i] = (unsigned char)carry_crow(w, i);
+      if (!pass && !stage)
+        keep[i] = (unsigned char)(w->pr->A_col ? carry_arow(w, i)
+                                  : i % 3 == 0 ? i + 2 < nrow && carry_acopy(w, i / 3)
+                                               : keep[i - 1]);
+      /* the row before's columns: A P's rows of a node of one pattern in A, C's rows of R's
+       * shifted rows (computed ones, before their diagonal) */
+      if (i % 3 != 0 && dup3[i / 3] && (!stage || (!keep[i] && !keep[i - 1]))) {
+        if (!pass) ptr[i + 1] = ptr[i];
+        if (pass)
+          memcpy(col + ptr[i], col + ptr[i - 1], sizeof *col * (size_t)(ptr[i] - ptr[i - 1]));
+        continue;
+      }
       const fcm_index io = stage ? w->pr->crow_old[i] : w->pr->row_old[i];
       int *out = pass ? col + ptr[i] : NULL;
       if (keep[i] && !stage) {
@@ -803,11 +835,11 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
   fcm_index *cp = NULL, *mk = NULL;
   int *cc = NULL;
   unsigned char *ap3 = NULL;
-  carry_work w = {.pr = prior, .nc = nc, .with_diagonal = with_diagonal};
+  carry_work w = {.pr = prior, .nc = nc};
   FCM_CHECK(ctx && prior && prior->plan && prior->C && prior->A_ptr &&
-                (prior->A_col || prior->A_adj) && prior->row_old && prior->row_new &&
-                prior->crow_old && prior->crow_new && A && P_ptr && P_ptr[0] == 0 && plan && C &&
-                nc >= 0 && nt >= 1,
+                (prior->A_col || (prior->A_adj && prior->G_ptr && prior->G_adj)) &&
+                prior->row_old && prior->row_new && prior->crow_old && prior->crow_new && A &&
+                P_ptr && P_ptr[0] == 0 && plan && C && nc >= 0 && nt >= 1,
             ctx, FCM_ERR_ARG, "ptap_create_from: NULL argument, nc = %lld < 0 or nt = %d < 1",
             (long long)nc, nt);
   *plan = NULL, *C = NULL;
@@ -834,11 +866,13 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
   FCM_ALLOC_RAW(ctx, (size_t)nt * (size_t)(nc + 1), mk);
   for (size_t j = 0; j < (size_t)nt * (size_t)(nc + 1); j++)
     mk[j] = -1;
+  w.same3 = t->same3;
 #pragma omp parallel num_threads(nt) if (nt > 1 && n > 4096)
   {
+    /* copy-graph mode: A's three rows of a copy hold one pattern */
 #pragma omp for schedule(static) nowait
     for (fcm_index g = 0; g < n / 3; g++)
-      t->same3[g] = (unsigned char)same_pattern3(3 * g, w.Ap, w.Ac);
+      t->same3[g] = (unsigned char)(!prior->A_col || same_pattern3(3 * g, w.Ap, w.Ac));
 #pragma omp for schedule(static)
     for (fcm_index i = 0; i < n; i++)
       w.prow[i] = (unsigned char)carry_prow(&w, i);
@@ -853,10 +887,15 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
   for (fcm_index g = 0; g < n / 3; g++)
     ap3[g] = (unsigned char)(t->same3[g] || same_pattern3(3 * g, t->AP_ptr, t->AP_col));
   w.APp = t->AP_ptr, w.APc = t->AP_col;
+  FCM_ALLOC(ctx, nc / 3 + 1, w.cdup);
+  for (fcm_index g = 0; 3 * g + 2 < nc; g++)
+    w.cdup[g] = (unsigned char)shifted3(3 * g, t->R_ptr, t->R_col, NULL, ap3);
   FCM_ALLOC(ctx, nc + 1, cp);
   carry_rows(&w, 1, 0, cp, NULL, mk, nt);
   FCM_ALLOC_RAW(ctx, cp[nc] + 1, cc);
   carry_rows(&w, 1, 1, cp, cc, mk, nt);
+  /* the rows taken hold theirs (the prior's plan was made with the same with_diagonal) */
+  if (with_diagonal) FCM_TRY(ctx, add_diagonal(ctx, nc, &cp, &cc));
   FCM_ALLOC(ctx, (size_t)nt * 3 * (size_t)(nc + 1), t->spa);
   FCM_ALLOC(ctx, (size_t)(nc / 3 + 1), t->r_kind);
   for (fcm_index g = 0; 3 * g + 2 < nc; g++)
@@ -879,6 +918,7 @@ cleanup:
   fcm__free(ctx, w.prow);
   fcm__free(ctx, w.keep);
   fcm__free(ctx, w.ckeep);
+  fcm__free(ctx, w.cdup);
   fcm__ptap_destroy(&t);
   return st;
 }

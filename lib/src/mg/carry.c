@@ -77,8 +77,7 @@ fcm_status fcm__mg_carry_maps(fcm_mg *m, mg_carry *c)
   c->nlev = 0;
   if (old->oct_mesh[1] || m->oct_mesh[1] || no != fcm_space_num_dofs(c->old_space)) return FCM_OK;
   FCM_ALLOC(ctx, n / 3 + 1, old_copy);
-  FCM_TRY(ctx,
-          fcm__space_cut_copy_map(c->old_space, m->space, old_copy, &c->graph_ptr, &c->graph_adj));
+  FCM_TRY(ctx, fcm__space_cut_copy_map(c->old_space, m->space, old_copy, c->graph));
   FCM_ALLOC(ctx, n + 1, c->row_old[0]);
   FCM_ALLOC(ctx, no + 1, c->row_new[0]);
   for (fcm_index i = 0; i < no; i++)
@@ -109,7 +108,8 @@ int fcm__mg_carry_prior(const fcm_mg *m, const mg_carry *c, int l, fcm__ptap_pri
   pr->plan = O->ptap;
   pr->C = OC->Aown;
   if (l == 0) {
-    pr->A_ptr = c->graph_ptr, pr->A_adj = c->graph_adj;
+    pr->A_ptr = c->graph[0], pr->A_adj = c->graph[1];
+    pr->G_ptr = c->graph[2], pr->G_adj = c->graph[3];
   } else {
     pr->A_ptr = fcm_csr_row_ptr(O->Aown), pr->A_col = fcm_csr_col_idx(O->Aown);
   }

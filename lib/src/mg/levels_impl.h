@@ -296,14 +296,14 @@ fcm_status fcm__mg_keep_blocks(fcm_mg *old, fcm_mg *m, int l, fcm_index nb, cons
 
 /* The hierarchy before the cut (read only) and, per level l < nlev, the maps between its
  * rows and the new hierarchy's: row_old[l] (new rows) the old row, row_new[l] (old rows) the
- * new row, -1 for none; injective, each the other's inverse. graph_ptr/adj: the copy graph
- * of the space before the cut (level 0's pattern before the cut). */
+ * new row, -1 for none; injective, each the other's inverse. graph: the copy graphs of the
+ * spaces before and after the cut (level 0's patterns). */
 typedef struct mg_carry {
   const fcm_mg *old;
   const fcm_space *old_space;
   int nlev;
   fcm_index *row_old[32], *row_new[32];
-  const fcm_index *graph_ptr, *graph_adj;
+  const fcm_index *graph[4]; /* fcm__space_cut_copy_map()'s */
 } mg_carry;
 
 /* The maps of c (old, old_space set) for m (hierarchy built); nlev 0 where nothing maps (an
