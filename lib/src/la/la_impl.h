@@ -180,7 +180,8 @@ typedef struct fcm__ptap_prior {
   const fcm_csr *C;      /* its product (the pattern is read) */
   /* the old A's pattern: CSR rows (A_ptr, A_col), or with A_col NULL a copy graph (A_ptr,
    * A_adj): row i holds 3 j, 3 j + 1, 3 j + 2 for each j of graph row i / 3; then the new A's
-   * pattern must be the copy graph (G_ptr, G_adj) alike (it is compared a copy at a time) */
+   * pattern must be the copy graph (G_ptr, G_adj) alike (it is compared a copy at a time) and
+   * the maps of A's rows must map a copy's three rows together (3 k + c to 3 k' + c) */
   const fcm_index *A_ptr;
   const int *A_col;
   const fcm_index *A_adj;

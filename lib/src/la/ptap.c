@@ -703,9 +703,9 @@ static int carry_acopy(const carry_work *w, fcm_index k)
   if (pr->G_ptr[k + 1] - pr->G_ptr[k] != deg) return 0;
   const fcm_index *adj = pr->A_adj + pr->A_ptr[g], *nadj = pr->G_adj + pr->G_ptr[k];
   for (fcm_index q = 0; q < deg; q++) {
-    const fcm_index j = nadj[q];
-    if (3 * j != pr->row_new[3 * adj[q]] || !w->prow[3 * j] || !w->prow[3 * j + 1] ||
-        !w->prow[3 * j + 2])
+    const fcm_index j = nadj[q], *rn = pr->row_new + 3 * adj[q];
+    if (rn[0] != 3 * j || rn[1] != 3 * j + 1 || rn[2] != 3 * j + 2 || !w->prow[3 * j] ||
+        !w->prow[3 * j + 1] || !w->prow[3 * j + 2])
       return 0;
   }
   return 1;
