@@ -179,3 +179,29 @@ cleanup:
   fcm__free(ctx, child);
   return st;
 }
+
+fcm_status fcm__space_cut_copy_map(const fcm_space *from, const fcm_space *to, fcm_index *old_copy,
+                                   const fcm_index *graphs[4])
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = to ? to->ctx : NULL;
+  fcm_index *children = NULL;
+  FCM_TRY(ctx, fcm__space_check_cut_pair(from, to, "cut copy map"));
+  FCM_CHECK(old_copy && graphs, ctx, FCM_ERR_ARG, "cut copy map: NULL output");
+  FCM_CHECK(!from->local_elem && !to->local_elem && from->node_ptr && from->node_adj &&
+                to->node_ptr && to->node_adj,
+            ctx, FCM_ERR_ARG,
+            "cut copy map: both spaces must be full spaces with their copy graphs");
+  const fcm_index nold = from->num_dofs / 3, nnew = to->num_dofs / 3;
+  FCM_ALLOC(ctx, nold + 1, children);
+  FCM_TRY(ctx, fcm__space_cut_parents(from, to, old_copy));
+  for (fcm_index k = 0; k < nnew; k++)
+    if (old_copy[k] >= 0) children[old_copy[k]]++;
+  for (fcm_index k = 0; k < nnew; k++)
+    if (old_copy[k] >= 0 && children[old_copy[k]] != 1) old_copy[k] = -1;
+  graphs[0] = from->node_ptr, graphs[1] = from->node_adj;
+  graphs[2] = to->node_ptr, graphs[3] = to->node_adj;
+cleanup:
+  fcm__free(ctx, children);
+  return st;
+}

@@ -237,6 +237,17 @@ fcm_status fcm__space_cut_same_elements(const fcm_space *from, const fcm_space *
 fcm_status fcm__space_cut_ordering(const fcm_space *from, const fcm_space *to,
                                    const fcm_index *old_perm, fcm_index *perm);
 
+/* What a hierarchy carried over a cut reads of the spaces (mg/carry.c): old_copy[k]
+ * (num_dofs(to) / 3 entries) the copy of `from` of which copy k of `to` is the only child
+ * (fcm__space_cut_parents()), -1 where k has no parent or its parent has other children;
+ * graphs: from's copy graph (node_ptr, node_adj: the columns of its matrices' rows, a copy at
+ * a time) and to's, borrowed while the spaces live. Both spaces full. Allocates O(copies of
+ * from) scratch. @return FCM_OK, FCM_ERR_ARG (NULL, not a cut pair, a local space),
+ * FCM_ERR_ALLOC, FCM_ERR_INTERNAL. */
+FCM_COMPONENT_API fcm_status fcm__space_cut_copy_map(const fcm_space *from, const fcm_space *to,
+                                                     fcm_index *old_copy,
+                                                     const fcm_index *graphs[4]);
+
 /* ---- Matrices over a space's rows (a local space: its local copies' rows, global columns).
  * A full space: rows are DOFs, local element positions are element ids, every function below
  * is the full space's own (same arrays, same bits). */

@@ -169,6 +169,36 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
                             const int *P_col, const double *P_val, int with_diagonal, int nt,
                             fcm__ptap **plan, fcm_csr **C);
 
+/* What fcm__ptap_create_from() takes over: the plan and product of an earlier A and P (a
+ * hierarchy's level before a cut) and the maps between the old and new numberings. A row of
+ * A P whose row of A and the rows of P it reaches are the old ones with every index mapped
+ * (the same positions) is the old row mapped; a row of C whose row of R is the old one mapped,
+ * reaching only such rows of A P, is the old row mapped (sorted). The maps must be injective,
+ * each the other's inverse where >= 0. */
+typedef struct fcm__ptap_prior {
+  const fcm__ptap *plan; /* made with the same with_diagonal */
+  const fcm_csr *C;      /* its product (the pattern is read) */
+  /* the old A's pattern: CSR rows (A_ptr, A_col), or with A_col NULL a copy graph (A_ptr,
+   * A_adj): row i holds 3 j, 3 j + 1, 3 j + 2 for each j of graph row i / 3; then the new A's
+   * pattern must be the copy graph (G_ptr, G_adj) alike (it is compared a copy at a time) and
+   * the maps of A's rows must map a copy's three rows together (3 k + c to 3 k' + c) */
+  const fcm_index *A_ptr;
+  const int *A_col;
+  const fcm_index *A_adj;
+  const fcm_index *G_ptr, *G_adj;
+  const fcm_index *row_old, *row_new;   /* A's rows: new -> old, old -> new (-1: none) */
+  const fcm_index *crow_old, *crow_new; /* C's rows (P's columns) alike */
+} fcm__ptap_prior;
+
+/* fcm__ptap_create() with the rows of A P and C that `prior` shows unchanged (the inputs
+ * compared entry by entry through the maps) taken over mapped instead of computed: the same
+ * plan and C bit for bit. taken (may be NULL): the rows of A P and of C taken over.
+ * @return as fcm__ptap_create(). */
+fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, const fcm_csr *A,
+                                 fcm_index nc, const fcm_index *P_ptr, const int *P_col,
+                                 const double *P_val, int with_diagonal, int nt, fcm__ptap **plan,
+                                 fcm_csr **C, fcm_index taken[2]);
+
 /* C's values = P^T A P for A's current values, on `nt` threads (clamped to [1, the plan's]).
  * A has the pattern given to fcm__ptap_create(), C is the matrix it created. Allocates
  * nothing; one call at a time per plan. */

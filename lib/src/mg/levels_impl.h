@@ -292,4 +292,27 @@ int fcm__mg_keep_analysis(fcm_mg *old, fcm_mg *m, int same_coarsest);
 fcm_status fcm__mg_keep_blocks(fcm_mg *old, fcm_mg *m, int l, fcm_index nb, const fcm_index *ptr,
                                const fcm_index *dofs, int *kept);
 
+/* ---- carry.c: a hierarchy carried over a cut (fcm__mg_create_pattern_cut()) */
+
+/* The hierarchy before the cut (read only) and, per level l < nlev, the maps between its
+ * rows and the new hierarchy's: row_old[l] (new rows) the old row, row_new[l] (old rows) the
+ * new row, -1 for none; injective, each the other's inverse. graph: the copy graphs of the
+ * spaces before and after the cut (level 0's patterns). */
+typedef struct mg_carry {
+  const fcm_mg *old;
+  const fcm_space *old_space;
+  int nlev;
+  fcm_index *row_old[32], *row_new[32];
+  const fcm_index *graph[4]; /* fcm__space_cut_copy_map()'s */
+} mg_carry;
+
+/* The maps of c (old, old_space set) for m (hierarchy built); nlev 0 where nothing maps (an
+ * octree hierarchy, level 0 not the old space's). */
+fcm_status fcm__mg_carry_maps(fcm_mg *m, mg_carry *c);
+
+/* The prior of level l's Galerkin plan (1), or 0 where c (NULL: none) has none. */
+int fcm__mg_carry_prior(const fcm_mg *m, const mg_carry *c, int l, fcm__ptap_prior *pr);
+
+void fcm__mg_carry_free(fcm_ctx *ctx, mg_carry *c);
+
 #endif /* FCM_MG_LEVELS_IMPL_H */

@@ -153,16 +153,26 @@ cleanup:
 /* The Galerkin product's plan and pattern of level l + 1 (from level l's matrix pattern and
  * P_l), with every diagonal entry (rows of empty columns); the restriction R_l = P_l^T the
  * plan holds. */
-static fcm_status galerkin_pattern(fcm_mg *m, int l)
+static fcm_status galerkin_pattern(fcm_mg *m, int l, const mg_carry *carry)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
   mg_level *L = &m->lev[l], *C = &m->lev[l + 1];
   const fcm_csr *A = fcm__mg_level_matrix(L);
-  fcm_index nnz = 0, *next = NULL;
+  fcm_index nnz = 0, *next = NULL, taken[2] = {0, 0};
   fcm_csr_get_size(A, NULL, NULL, &nnz);
-  FCM_TRY(ctx, fcm__ptap_create(ctx, A, C->n, L->P_ptr, L->P_col, L->P_val, 1,
-                                nnz >= MG_PARALLEL_NNZ ? fcm__mg_team(m) : 1, &L->ptap, &C->Aown));
+  const int nt = nnz >= MG_PARALLEL_NNZ ? fcm__mg_team(m) : 1;
+  fcm__ptap_prior prior;
+  if (fcm__mg_carry_prior(m, carry, l, &prior)) {
+    FCM_TRY(ctx, fcm__ptap_create_from(ctx, &prior, A, C->n, L->P_ptr, L->P_col, L->P_val, 1, nt,
+                                       &L->ptap, &C->Aown, taken));
+    m->kept.carried_plans++;
+    m->kept.carried_ap_rows += taken[0];
+    m->kept.carried_coarse_rows += taken[1];
+  } else {
+    FCM_TRY(ctx, fcm__ptap_create(ctx, A, C->n, L->P_ptr, L->P_col, L->P_val, 1, nt, &L->ptap,
+                                  &C->Aown));
+  }
   fcm__ptap_transpose(L->ptap, &L->R_ptr, &L->R_col, &L->R_val);
   FCM_TRY(ctx, level_diag(m, C));
   {
@@ -224,7 +234,8 @@ cleanup:
 
 /* The levels' Galerkin plans and patterns, row orders and the coarsest analysis (keeping
  * old's where fcm__mg_create_from() may; same[l]: level l's pattern is old's). */
-static fcm_status create_patterns(fcm_mg *m, fcm_mg *old, unsigned char *same)
+static fcm_status create_patterns(fcm_mg *m, fcm_mg *old, const mg_carry *carry,
+                                  unsigned char *same)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
@@ -240,7 +251,7 @@ static fcm_status create_patterns(fcm_mg *m, fcm_mg *old, unsigned char *same)
     /* nothing of old's level l is taken now: its memory goes before this level's arrays
      * are allocated (the allocator may give it back to them) */
     if (old && !same[l] && l < old->nlev) fcm__mg_level_free(ctx, &old->lev[l]);
-    if (l + 1 < m->nlev && !kept_above) FCM_TRY(ctx, galerkin_pattern(m, l));
+    if (l + 1 < m->nlev && !kept_above) FCM_TRY(ctx, galerkin_pattern(m, l, carry));
     if (same[l]) fcm__mg_keep_orders(old, m, l);
   }
   if (o.smoother == FCM_MG_SMOOTHER_SGS_COLORED)
@@ -262,8 +273,9 @@ cleanup:
 /* fcm_mg_create(), keeping the parts of old (NULL: none) fcm__mg_create_from() may; with
  * `inactive` (fcm__mg_create_pattern()) on A's pattern alone, level 0's Dirichlet rows given,
  * the values left to fcm_mg_setup(). */
-static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, const fcm_space *space, const fcm_csr *A,
-                            const unsigned char *inactive, const fcm_mg_options *opts, fcm_mg **mg)
+static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, mg_carry *carry, const fcm_space *space,
+                            const fcm_csr *A, const unsigned char *inactive,
+                            const fcm_mg_options *opts, fcm_mg **mg)
 {
   fcm_status st = FCM_OK;
   fcm_mg *m = NULL;
@@ -289,7 +301,8 @@ static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, const fcm_space *space, c
   FCM_TRY(ctx, fcm__mg_build_hierarchy(m, A, inactive));
   if (!fcm__mg_reuse_allowed(old, m)) old = NULL;
   FCM_TRY(ctx, level_diag(m, &m->lev[0]));
-  FCM_TRY(ctx, create_patterns(m, old, same));
+  if (carry && carry->old) FCM_TRY(ctx, fcm__mg_carry_maps(m, carry));
+  FCM_TRY(ctx, create_patterns(m, old, carry, same));
   if (!m->values_pending) FCM_TRY(ctx, fcm_mg_setup(m));
   if (o.block_smoothing) /* set up as created, or by the fcm_mg_setup() to come */
     FCM_TRY(ctx, fcm__mg_block_smoothers_create(m, old, same));
@@ -303,13 +316,13 @@ cleanup:
 fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
                          const fcm_mg_options *opts, fcm_mg **mg)
 {
-  return mg_create(ctx, NULL, space, A, NULL, opts, mg);
+  return mg_create(ctx, NULL, NULL, space, A, NULL, opts, mg);
 }
 
 fcm_status fcm__mg_create_from(fcm_ctx *ctx, fcm_mg **old, const fcm_space *space, const fcm_csr *A,
                                const fcm_mg_options *opts, fcm_mg **mg)
 {
-  const fcm_status st = mg_create(ctx, old ? *old : NULL, space, A, NULL, opts, mg);
+  const fcm_status st = mg_create(ctx, old ? *old : NULL, NULL, space, A, NULL, opts, mg);
   if (old) fcm_mg_destroy(old);
   return st;
 }
@@ -325,9 +338,30 @@ fcm_status fcm__mg_create_pattern(fcm_ctx *ctx, fcm_mg **old, const fcm_space *s
   FCM_CHECK(fcm_mesh_num_hanging(fcm_space_mesh(space)) == 0, ctx, FCM_ERR_UNSUPPORTED,
             "mg_create_pattern: an octree mesh's hierarchy needs the matrix values (use "
             "fcm_mg_create())");
-  st = mg_create(ctx, old ? *old : NULL, space, A, inactive, opts, mg);
+  st = mg_create(ctx, old ? *old : NULL, NULL, space, A, inactive, opts, mg);
 cleanup:
   if (old) fcm_mg_destroy(old);
+  return st;
+}
+
+fcm_status fcm__mg_create_pattern_cut(fcm_ctx *ctx, const fcm_mg *old, const fcm_space *old_space,
+                                      const fcm_space *space, const fcm_csr *A,
+                                      const unsigned char *inactive, const fcm_mg_options *opts,
+                                      fcm_mg **mg)
+{
+  fcm_status st = FCM_OK;
+  mg_carry carry;
+  memset(&carry, 0, sizeof carry);
+  if (mg) *mg = NULL;
+  FCM_CHECK(ctx && space && A && inactive && mg && (!old || old_space), ctx, FCM_ERR_ARG,
+            "mg_create_pattern_cut: NULL argument (old_space is needed with old)");
+  FCM_CHECK(fcm_mesh_num_hanging(fcm_space_mesh(space)) == 0, ctx, FCM_ERR_UNSUPPORTED,
+            "mg_create_pattern_cut: an octree mesh's hierarchy needs the matrix values (use "
+            "fcm_mg_create())");
+  carry.old = old, carry.old_space = old_space;
+  st = mg_create(ctx, NULL, &carry, space, A, inactive, opts, mg);
+cleanup:
+  fcm__mg_carry_free(ctx, &carry);
   return st;
 }
 

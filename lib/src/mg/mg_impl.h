@@ -69,6 +69,10 @@ typedef struct fcm__mg_kept {
   int row_orders;      /* levels whose SGS row slabs were kept */
   int block_smoothers; /* levels whose block smoother and block slabs were kept */
   int analysis;        /* 1: the coarsest level's symbolic analysis was kept */
+  /* fcm__mg_create_pattern_cut(): the levels whose Galerkin plan took rows from the hierarchy
+   * before the cut, and the rows of A P and of the coarse patterns taken, all levels */
+  int carried_plans;
+  fcm_index carried_ap_rows, carried_coarse_rows;
 } fcm__mg_kept;
 
 /* fcm_mg_create(ctx, space, A, opts, mg), taking from *old (NULL or *old == NULL: nothing)
@@ -96,6 +100,19 @@ FCM_COMPONENT_API fcm_status fcm__mg_create_pattern(fcm_ctx *ctx, fcm_mg **old,
                                                     const fcm_space *space, const fcm_csr *A,
                                                     const unsigned char *inactive,
                                                     const fcm_mg_options *opts, fcm_mg **mg);
+
+/* fcm__mg_create_pattern() (no old hierarchy to consume) for the space `space` made by a cut
+ * of `old_space`, taking rows of the Galerkin plans from `old`, the hierarchy of old_space
+ * (NULL: none), which is only read and stays usable: old's level-0 matrix must have had
+ * old_space's pattern (fcm_space_matrix_create()); that matrix may be gone, old_space must
+ * live. The result is fcm__mg_create_pattern()'s bit for bit (lib/src/mg/carry.c: what is
+ * taken and how it is checked); fcm__mg_get_kept() counts what was taken. @return as
+ * fcm__mg_create_pattern(); FCM_ERR_ARG also when space is not a cut of old_space. */
+FCM_COMPONENT_API fcm_status fcm__mg_create_pattern_cut(fcm_ctx *ctx, const fcm_mg *old,
+                                                        const fcm_space *old_space,
+                                                        const fcm_space *space, const fcm_csr *A,
+                                                        const unsigned char *inactive,
+                                                        const fcm_mg_options *opts, fcm_mg **mg);
 
 /* Forget the level-0 matrix and the space of m (they may be destroyed now): m stays usable
  * only as the `old` of fcm__mg_create_from(), which then keeps nothing of level 0 itself

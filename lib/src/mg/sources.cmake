@@ -1,3 +1,3 @@
 list(APPEND FCM_SOURCES lib/src/mg/mg.c lib/src/mg/hierarchy.c lib/src/mg/transfer.c lib/src/mg/octree.c
      lib/src/mg/smoothers.c lib/src/mg/sweeps.c lib/src/mg/cycle.c
-     lib/src/mg/update.c)
+     lib/src/mg/update.c lib/src/mg/carry.c)

@@ -740,7 +740,8 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
     FCM_TRY(ctx, fcm_space_transfer(old->space, space, old->a, a));
     FCM_TRY(ctx, fcm_integrator_set_acceleration(I, a));
   }
-  FCM_TRY(ctx, fcm_integrator_prepare_solver(I)); /* the solver's structure, part of the cut */
+  /* the solver's structure, part of the cut: what the cut left of old's hierarchy taken */
+  FCM_TRY(ctx, fcm__sim_prepare_solver_cut(I, old));
   I->load_work = old->load_work;
   *integ = I;
   I = NULL;

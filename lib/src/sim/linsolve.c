@@ -351,7 +351,7 @@ static void predicted_eliminated(const fcm_integrator *I, unsigned char *inactiv
 /* FCM_LINEAR_MULTIGRID on a serial space without hanging nodes: the hierarchy on H's pattern
  * with the active set of the current time (fcm__mg_create_pattern()), for the first set-up
  * (mg_prepare(): fcm_mg_setup() when that active set holds at the step). */
-static fcm_status mg_structure(fcm_integrator *I)
+static fcm_status mg_structure(fcm_integrator *I, const fcm_integrator *from)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = I->ctx;
@@ -365,7 +365,13 @@ static fcm_status mg_structure(fcm_integrator *I)
   if (old && I->mg_A != I->H) fcm__mg_detach(old);
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, inactive);
   predicted_eliminated(I, inactive);
-  st = fcm__mg_create_pattern(ctx, &old, I->space, I->H, inactive, &I->opts.multigrid, &I->mg);
+  /* a cut's: old's hierarchy, made on its Newton matrix (the space's pattern), read */
+  const fcm_mg *carry = from && from->mg && from->mg_A == from->H ? from->mg : NULL;
+  if (carry && !old)
+    st = fcm__mg_create_pattern_cut(ctx, carry, from->space, I->space, I->H, inactive,
+                                    &I->opts.multigrid, &I->mg);
+  else
+    st = fcm__mg_create_pattern(ctx, &old, I->space, I->H, inactive, &I->opts.multigrid, &I->mg);
   I->mg_A = I->mg ? I->H : NULL;
   I->mg_con = I->con_version;
   I->mg_creations += I->mg != NULL;
@@ -383,17 +389,27 @@ long long fcm__sim_mg_creations(const fcm_integrator *I)
   return I->mg_creations;
 }
 
-fcm_status fcm_integrator_prepare_solver(fcm_integrator *I)
+static fcm_status prepare_solver(fcm_integrator *I, const fcm_integrator *from)
 {
   fcm_status st = FCM_OK;
   FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator prepare_solver: NULL integrator");
   FCM_CHECK(I->is_setup, I->ctx, FCM_ERR_ARG,
             "integrator prepare_solver: the integrator must be set up (fcm_integrator_setup())");
   const double t0 = fcm_wtime();
-  st = mg_structure(I);
+  st = mg_structure(I, from);
   I->setup_info.solver_seconds += fcm_wtime() - t0;
 cleanup:
   return st;
+}
+
+fcm_status fcm_integrator_prepare_solver(fcm_integrator *I)
+{
+  return prepare_solver(I, NULL);
+}
+
+fcm_status fcm__sim_prepare_solver_cut(fcm_integrator *I, const fcm_integrator *old)
+{
+  return prepare_solver(I, old);
 }
 
 /* Preconditioner set-up: the hierarchy on the preconditioner's matrix P. Once built on Hpc

@@ -330,6 +330,11 @@ long long fcm__sim_analyses(const fcm_integrator *I);
 /* Multigrid hierarchies the integrator created (prepared ones too). (linsolve.c) */
 long long fcm__sim_mg_creations(const fcm_integrator *I);
 
+/* fcm_integrator_prepare_solver() of the integrator a cut made from `old` (on the space before
+ * the cut): the multigrid hierarchy's structure takes what the cut left from old's hierarchy
+ * (fcm__mg_create_pattern_cut(); the same bits), which is only read. (linsolve.c) */
+fcm_status fcm__sim_prepare_solver_cut(fcm_integrator *I, const fcm_integrator *old);
+
 /* External load at time t: sum_k scale_k(t) f_k into f (n). (integrator.c) */
 void fcm__sim_eval_loads(const fcm_integrator *I, double t, double *f);
 

@@ -1,0 +1,119 @@
+/* A hierarchy carried over a cut (fcm__mg_create_pattern_cut()): the new hierarchy's cells,
+ * copies and prolongations are built anew (they are cheap), and each level's Galerkin plan
+ * takes the rows of A P and of the coarse pattern that the cut left from the hierarchy before
+ * the cut, through maps from the old numbering of each level to the new one; every row taken
+ * is checked entry by entry against its inputs (fcm__ptap_create_from()), so the result is
+ * fcm_mg_create()'s bit for bit whatever the maps are.
+ *
+ * The maps: level 0's from the space (a copy of the new space that is the only child of a copy
+ * before the cut: fcm__space_cut_copy_map()); level l + 1's from level l's and the two
+ * prolongations: a fine row that maps, with as many entries in P_l before and after, pairs its
+ * coarse columns position by position; a coarse row paired with two different ones, or two
+ * old rows paired with one new row, map to nothing. */
+#include "fem/fem_impl.h"
+#include "mg/levels_impl.h"
+
+#include <string.h>
+
+void fcm__mg_carry_free(fcm_ctx *ctx, mg_carry *c)
+{
+  for (int l = 0; l < 32; l++) {
+    fcm__free(ctx, c->row_old[l]);
+    fcm__free(ctx, c->row_new[l]);
+  }
+  memset(c->row_old, 0, sizeof c->row_old);
+  memset(c->row_new, 0, sizeof c->row_new);
+  c->nlev = 0;
+}
+
+/* Level l + 1's maps from level l's and the prolongations P_l of old and m. */
+static fcm_status coarse_map(fcm_mg *m, mg_carry *c, int l)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  const mg_level *O = &c->old->lev[l], *L = &m->lev[l];
+  const fcm_index no = c->old->lev[l + 1].n, nn = m->lev[l + 1].n;
+  fcm_index *cand = NULL, *back = NULL;
+  FCM_ALLOC(ctx, no + 1, cand);
+  FCM_ALLOC(ctx, nn + 1, back);
+  for (fcm_index o = 0; o < no; o++)
+    cand[o] = -1;
+  for (fcm_index i = 0; i < nn; i++)
+    back[i] = -1;
+  const fcm_index *ro = c->row_old[l];
+  for (fcm_index i = 0; i < L->n; i++) {
+    const fcm_index io = ro[i];
+    if (io < 0) continue;
+    const fcm_index len = L->P_ptr[i + 1] - L->P_ptr[i];
+    if (O->P_ptr[io + 1] - O->P_ptr[io] != len) continue;
+    for (fcm_index q = 0; q < len; q++) {
+      const fcm_index o = O->P_col[O->P_ptr[io] + q], w = L->P_col[L->P_ptr[i] + q];
+      cand[o] = cand[o] == -1 || cand[o] == w ? w : -2;
+    }
+  }
+  for (fcm_index o = 0; o < no; o++)
+    if (cand[o] >= 0) back[cand[o]] = back[cand[o]] == -1 ? o : -2;
+  for (fcm_index o = 0; o < no; o++)
+    if (cand[o] >= 0 && back[cand[o]] != o) cand[o] = -1;
+  for (fcm_index i = 0; i < nn; i++)
+    if (back[i] < 0) back[i] = -1;
+  for (fcm_index o = 0; o < no; o++)
+    if (cand[o] < 0) cand[o] = -1;
+  c->row_new[l + 1] = cand, c->row_old[l + 1] = back;
+  cand = back = NULL;
+cleanup:
+  fcm__free(ctx, cand);
+  fcm__free(ctx, back);
+  return st;
+}
+
+fcm_status fcm__mg_carry_maps(fcm_mg *m, mg_carry *c)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  fcm_index *old_copy = NULL;
+  const fcm_mg *old = c->old;
+  const fcm_index n = m->lev[0].n, no = old->lev[0].n;
+  c->nlev = 0;
+  if (old->oct_mesh[1] || m->oct_mesh[1] || no != fcm_space_num_dofs(c->old_space)) return FCM_OK;
+  FCM_ALLOC(ctx, n / 3 + 1, old_copy);
+  FCM_TRY(ctx, fcm__space_cut_copy_map(c->old_space, m->space, old_copy, c->graph));
+  FCM_ALLOC(ctx, n + 1, c->row_old[0]);
+  FCM_ALLOC(ctx, no + 1, c->row_new[0]);
+  for (fcm_index i = 0; i < no; i++)
+    c->row_new[0][i] = -1;
+  for (fcm_index i = 0; i < n; i++) {
+    const fcm_index k = old_copy[i / 3];
+    c->row_old[0][i] = k >= 0 ? 3 * k + i % 3 : -1;
+    if (k >= 0) c->row_new[0][3 * k + i % 3] = i;
+  }
+  c->nlev = 1;
+  const int nl = FCM_MIN(m->nlev, old->nlev);
+  for (int l = 0; l + 1 < nl; l++) {
+    if (!old->lev[l].P_ptr || !m->lev[l].P_ptr) break;
+    FCM_TRY(ctx, coarse_map(m, c, l));
+    c->nlev = l + 2;
+  }
+cleanup:
+  fcm__free(ctx, old_copy);
+  return st;
+}
+
+int fcm__mg_carry_prior(const fcm_mg *m, const mg_carry *c, int l, fcm__ptap_prior *pr)
+{
+  if (!c || l + 1 >= c->nlev) return 0;
+  const mg_level *O = &c->old->lev[l], *OC = &c->old->lev[l + 1];
+  if (!O->ptap || !OC->Aown || m->lev[l + 1].n <= 0) return 0;
+  memset(pr, 0, sizeof *pr);
+  pr->plan = O->ptap;
+  pr->C = OC->Aown;
+  if (l == 0) {
+    pr->A_ptr = c->graph[0], pr->A_adj = c->graph[1];
+    pr->G_ptr = c->graph[2], pr->G_adj = c->graph[3];
+  } else {
+    pr->A_ptr = fcm_csr_row_ptr(O->Aown), pr->A_col = fcm_csr_col_idx(O->Aown);
+  }
+  pr->row_old = c->row_old[l], pr->row_new = c->row_new[l];
+  pr->crow_old = c->row_old[l + 1], pr->crow_new = c->row_new[l + 1];
+  return 1;
+}

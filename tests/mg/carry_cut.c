@@ -1,0 +1,274 @@
+/* A hierarchy carried over a cut (fcm__mg_create_pattern_cut(): the Galerkin plans' rows the
+ * cut left taken from the hierarchy before it, which is only read) equals, after each cut of a
+ * sequence of three, the one fcm_mg_create() builds on the new space and matrix bit for bit
+ * (every level's pattern, values and inactive rows, and two cycles, memcmp); each coarse
+ * pattern is the structural pattern of P^T A P with the diagonal (a dense table); most rows
+ * were taken (the counts of fcm__mg_get_kept()). The cut spaces take the old space's pattern
+ * (fcm__space_create_cut_take()) and the old level-0 matrix is gone before the carry, as in an
+ * integrator's cut. Before each cut, a carry whose allocations fail (several places) returns
+ * FCM_ERR_ALLOC, leaks nothing and leaves the old hierarchy as it was (its cycles' bits). The
+ * embedded hemisphere of mg_util.h, Hex8 and Hex20, V- and W-cycles. */
+#include "fem/fem_impl.h"
+#include "mg/levels_impl.h"
+#include "mg_util.h"
+#include "test_alloc.h"
+
+#include <math.h>
+#include <stdio.h>
+
+/* The rows of A without an off-diagonal value: those the elimination decoupled. */
+static unsigned char *eliminated(const fcm_csr *A, fcm_index n)
+{
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const double *v = fcm_csr_values_read(A);
+  unsigned char *in = calloc((size_t)n + 1, 1);
+  for (fcm_index i = 0; i < n; i++) {
+    int off = 0;
+    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+      off |= ci[p] != i && v[p] != 0.0;
+    in[i] = (unsigned char)!off;
+  }
+  return in;
+}
+
+/* Two cycles, the second from the first's output: 2 n values. */
+static void cycles(fcm_ctx *ctx, fcm_mg *mg, const problem *p, double *out)
+{
+  TEST_OK(ctx, fcm_mg_operator(mg, p->b, out));
+  TEST_OK(ctx, fcm_mg_operator(mg, out, out + p->n));
+}
+
+/* Same levels, level matrices, inactive rows and cycle output bits. */
+static int same_mg(fcm_ctx *ctx, fcm_mg *a, fcm_mg *b, const problem *p)
+{
+  int same = a->nlev == b->nlev;
+  for (int l = 0; same && l < a->nlev; l++) {
+    const fcm_csr *A = fcm__mg_level_matrix(&a->lev[l]), *B = fcm__mg_level_matrix(&b->lev[l]);
+    fcm_index na = 0, za = 0, nb = 0, zb = 0;
+    fcm_csr_get_size(A, &na, NULL, &za);
+    fcm_csr_get_size(B, &nb, NULL, &zb);
+    same = na == nb && za == zb &&
+           !memcmp(fcm_csr_row_ptr(A), fcm_csr_row_ptr(B), sizeof(fcm_index) * (size_t)(na + 1)) &&
+           !memcmp(fcm_csr_col_idx(A), fcm_csr_col_idx(B), sizeof(int) * (size_t)za) &&
+           !memcmp(fcm_csr_values_read(A), fcm_csr_values_read(B), sizeof(double) * (size_t)za) &&
+           !memcmp(a->lev[l].inactive, b->lev[l].inactive, (size_t)na);
+    if (!same) printf("  level %d differs\n", l);
+  }
+  const size_t bytes = sizeof(double) * 2 * (size_t)p->n;
+  double *x1 = malloc(bytes), *x2 = malloc(bytes);
+  cycles(ctx, a, p, x1);
+  cycles(ctx, b, p, x2);
+  int finite = 1;
+  for (fcm_index i = 0; i < 2 * p->n; i++)
+    finite &= isfinite(x1[i]) != 0;
+  same = same && finite && memcmp(x1, x2, bytes) == 0;
+  free(x1);
+  free(x2);
+  return same;
+}
+
+/* Is level l + 1's pattern exactly the structural pattern of P_l^T A_l P_l with the diagonal? */
+static int galerkin_pattern_exact(const fcm_mg *mg, int l)
+{
+  const mg_level *L = &mg->lev[l], *C = &mg->lev[l + 1];
+  const fcm_csr *A = fcm__mg_level_matrix(L), *Ac = fcm__mg_level_matrix(C);
+  const fcm_index *rp = fcm_csr_row_ptr(A), *cp = fcm_csr_row_ptr(Ac);
+  const int *ci = fcm_csr_col_idx(A), *cc = fcm_csr_col_idx(Ac);
+  const size_t nc = (size_t)C->n;
+  unsigned char *hit = calloc(nc * nc + 1, 1);
+  for (size_t I = 0; I < nc; I++)
+    hit[I * nc + I] = 1;
+  for (fcm_index i = 0; i < L->n; i++)
+    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+      for (fcm_index a = L->P_ptr[i]; a < L->P_ptr[i + 1]; a++)
+        for (fcm_index b = L->P_ptr[ci[p]]; b < L->P_ptr[ci[p] + 1]; b++)
+          hit[(size_t)L->P_col[a] * nc + (size_t)L->P_col[b]] = 1;
+  int same = 1;
+  for (size_t I = 0; I < nc && same; I++) {
+    fcm_index count = 0;
+    for (size_t J = 0; J < nc; J++)
+      count += hit[I * nc + J];
+    same = count == cp[I + 1] - cp[I];
+    for (fcm_index q = cp[I]; q < cp[I + 1] && same; q++)
+      same = hit[I * nc + (size_t)cc[q]] && (q == cp[I] || cc[q] > cc[q - 1]);
+    if (!same) printf("  level %d: coarse row %zu is not P^T A P's\n", l + 1, I);
+  }
+  free(hit);
+  return same;
+}
+
+/* The space of `rules` made by a cut of `from` (its pattern taken), its clamped matrix. */
+static void problem_cut(fcm_ctx *ctx, const problem *base, const fcm_cell_rules *rules,
+                        fcm_space *from, problem *p)
+{
+  memset(p, 0, sizeof *p);
+  p->mesh = base->mesh;
+  fcm_space_options so = fcm_space_options_default();
+  TEST_OK(ctx, fcm__space_create_cut_take(ctx, p->mesh, rules, &so, from, &p->space));
+  finish_space(ctx, p, 0);
+  const double flo[3] = {-2, 0, -2}, fhi[3] = {2, 0, 2};
+  clamp_box(ctx, p, flo, fhi);
+}
+
+static void problem_drop(problem *p)
+{
+  fcm_csr_destroy(&p->A);
+  fcm_space_destroy(&p->space);
+  free(p->b);
+  memset(p, 0, sizeof *p);
+}
+
+/* The hierarchy carried from old (NULL: none; on prev's space) to p's pattern, then set up,
+ * against fcm_mg_create() and the reference pattern; *pattern: its level-0 matrix. */
+static fcm_mg *carry_and_compare(fcm_ctx *ctx, const fcm_mg *old, const fcm_space *prev,
+                                 const problem *p, const fcm_mg_options *o, const char *what,
+                                 fcm_csr **pattern)
+{
+  fcm_mg *prep = NULL, *fresh = NULL;
+  unsigned char *inactive = eliminated(p->A, p->n);
+  TEST_OK(ctx, fcm_space_matrix_create(p->space, pattern));
+  TEST_OK(ctx, fcm__mg_create_pattern_cut(ctx, old, prev, p->space, *pattern, inactive, o, &prep));
+  memcpy(fcm_csr_values(*pattern), fcm_csr_values_read(p->A),
+         sizeof(double) * (size_t)fcm_csr_row_ptr(p->A)[p->n]);
+  TEST_OK(ctx, fcm_mg_setup(prep));
+  TEST_OK(ctx, fcm_mg_create(ctx, p->space, p->A, o, &fresh));
+  const int same = same_mg(ctx, prep, fresh, p);
+  int exact = 1;
+  fcm_index coarse_rows = 0;
+  for (int l = 0; l + 1 < prep->nlev; l++) {
+    fcm_index row_slabs = 0, block_slabs = 0;
+    exact &= galerkin_pattern_exact(prep, l);
+    TEST_OK(ctx, fcm__mg_slabs_check(prep, l, &row_slabs, &block_slabs));
+    coarse_rows += prep->lev[l + 1].n;
+  }
+  fcm__mg_kept k;
+  fcm__mg_get_kept(prep, &k);
+  printf("%s: %d levels, %lld DOFs; plans carried %d, rows of A P taken %lld of %lld, coarse "
+         "rows %lld of %lld; %s fcm_mg_create(), structure %s the references\n",
+         what, fcm_mg_num_levels(prep), (long long)p->n, k.carried_plans,
+         (long long)k.carried_ap_rows,
+         (long long)(coarse_rows - prep->lev[prep->nlev - 1].n + p->n),
+         (long long)k.carried_coarse_rows, (long long)coarse_rows, same ? "equals" : "DIFFERS from",
+         exact ? "equals" : "DIFFERS from");
+  TEST_TRUE(fcm_mg_num_levels(prep) >= 3);
+  TEST_TRUE(same);
+  TEST_TRUE(exact);
+  if (old) { /* rows taken on every level both have (the body is small: a cut reaches much) */
+    TEST_TRUE(k.carried_plans == FCM_MIN(old->nlev, prep->nlev) - 1);
+    TEST_TRUE(k.carried_ap_rows > p->n / 3);
+    TEST_TRUE(k.carried_coarse_rows > coarse_rows / 5);
+  }
+  fcm_mg_destroy(&fresh);
+  free(inactive);
+  return prep;
+}
+
+/* Carries from old whose allocations fail at several places: FCM_ERR_ALLOC, nothing leaked,
+ * old's cycles as before. */
+static void failing_carries(fcm_ctx *ctx, fcm_mg *old, const problem *cur, const problem *next,
+                            const fcm_mg_options *o)
+{
+  failing fl = {0, -1};
+  fcm_ctx *fctx = failing_ctx(&fl);
+  TEST_TRUE(fctx != NULL);
+  const size_t bytes = sizeof(double) * 2 * (size_t)cur->n;
+  double *x0 = malloc(bytes), *x1 = malloc(bytes);
+  cycles(ctx, old, cur, x0);
+  unsigned char *inactive = eliminated(next->A, next->n);
+  fcm_mg *mg = NULL;
+  /* the number of allocations of a carry that succeeds */
+  TEST_OK(fctx, fcm__mg_create_pattern_cut(fctx, old, cur->space, next->space, next->A, inactive, o,
+                                           &mg));
+  const long long total = fl.count;
+  fcm_mg_destroy(&mg);
+  const long long live = fcm_ctx_live_allocations(fctx);
+  int failures = 0;
+  for (int q = 0; q < 6; q++) {
+    fl.count = 0, fl.fail_at = q * total / 6 + 1;
+    const fcm_status st =
+        fcm__mg_create_pattern_cut(fctx, old, cur->space, next->space, next->A, inactive, o, &mg);
+    fl.fail_at = -1;
+    failures += st == FCM_ERR_ALLOC && mg == NULL;
+    fcm_ctx_error_clear(fctx);
+    TEST_TRUE(fcm_ctx_live_allocations(fctx) == live);
+  }
+  TEST_TRUE(failures == 6);
+  cycles(ctx, old, cur, x1);
+  TEST_TRUE(memcmp(x0, x1, bytes) == 0);
+  free(inactive);
+  free(x0);
+  free(x1);
+  fcm_ctx_destroy(&fctx);
+}
+
+/* The cut sequence on `type`, a V-cycle and a W-cycle hierarchy carried along it. */
+static void cut_sequence(fcm_ctx *ctx, fcm_element_type type)
+{
+  const char *name = type == FCM_ELEMENT_HEX8 ? "hex8" : "hex20";
+  problem base;
+  problem_hemisphere_of(ctx, type, 8, 0, fcm_space_options_default().constrain_ratio, &base);
+  fcm_mg_options o[2] = {fcm_mg_options_default(), fcm_mg_options_default()};
+  fcm_mg *mg[2] = {NULL, NULL};
+  fcm_csr *pattern[2] = {NULL, NULL};
+  char what[96];
+  for (int c = 0; c < 2; c++) {
+    o[c].coarse_dofs = 100;
+    o[c].cycle_index = c + 1;
+    snprintf(what, sizeof what, "%s, cycle %d, before the cuts", name, c + 1);
+    mg[c] = carry_and_compare(ctx, NULL, NULL, &base, &o[c], what, &pattern[c]);
+  }
+  const double pt[3][3] = {{0.05, 0, 0}, {0, 0, 0.13}, {0.5, 0.5, 0.5}};
+  const double nrm[3][3] = {{1, 0, 0}, {0, 0.2, 1}, {1, 1, 1}};
+  const double blo[3][3] = {{-0.1, 0.4, -2}, {-2, 0.6, -0.5}, {-2, -2, -2}};
+  const double bhi[3][3] = {{0.2, 2, 2}, {2, 2, 0.5}, {2, 2, 2}};
+  const fcm_cell_rules *prev = base.rules0;
+  fcm_cell_rules *rules[3] = {NULL, NULL, NULL};
+  problem cur = base; /* the base's space and matrix first, then each cut's */
+  int cur_is_base = 1;
+  for (int k = 0; k < 3; k++) {
+    fcm_surface *s = NULL;
+    TEST_OK(ctx, fcm_surface_create_plane(ctx, pt[k], nrm[k], blo[k], bhi[k], &s));
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, base.mesh, base.geom, prev, s, &rules[k]));
+    fcm_surface_destroy(&s);
+    prev = rules[k];
+    problem next;
+    problem_cut(ctx, &base, rules[k], cur.space, &next);
+    failing_carries(ctx, mg[0], &cur, &next, &o[0]);
+    for (int c = 0; c < 2; c++) { /* as a cut: the old level-0 matrix goes first */
+      fcm__mg_detach(mg[c]);
+      fcm_csr_destroy(&pattern[c]);
+      fcm_mg *carried = NULL;
+      snprintf(what, sizeof what, "%s, cycle %d, cut %d", name, c + 1, k + 1);
+      carried = carry_and_compare(ctx, mg[c], cur.space, &next, &o[c], what, &pattern[c]);
+      fcm_mg_destroy(&mg[c]);
+      mg[c] = carried;
+    }
+    fcm__space_cut_keep(next.space); /* the cut holds: the old space is destroyed next */
+    if (cur_is_base) {
+      base.space = NULL, base.A = NULL, base.b = NULL; /* now cur's, dropped below */
+      cur_is_base = 0;
+    }
+    problem_drop(&cur);
+    cur = next;
+  }
+  for (int c = 0; c < 2; c++) {
+    fcm_mg_destroy(&mg[c]);
+    fcm_csr_destroy(&pattern[c]);
+  }
+  problem_drop(&cur);
+  for (int k = 0; k < 3; k++)
+    fcm_cell_rules_destroy(&rules[k]);
+  problem_free(&base);
+}
+
+int main(void)
+{
+  fcm_ctx *ctx = NULL;
+  TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
+  cut_sequence(ctx, FCM_ELEMENT_HEX8);
+  cut_sequence(ctx, FCM_ELEMENT_HEX20);
+  fcm_ctx_destroy(&ctx);
+  printf("ok\n");
+  return 0;
+}
