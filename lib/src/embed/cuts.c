@@ -296,14 +296,14 @@ static fcm_status face_links(const build *B, const fcm_cell_rules *R, const cell
   const size_t nl0 = *nl; /* the links of this pair of cells start here */
   size_t xa = 0;
   for (int i = 0; i < oa->nfp; i++) {
-    const int *ma = oa->fmeta + 4 * i;
+    const int *ma = oa->fmeta + FCM__EMBED_FMETA * i;
     const double *A = oa->fx + 3 * xa;
     xa += (size_t)(ma[2] + ma[3]);
     if (ma[0] != f || ma[1] < 0) continue;
     size_t xb = 0;
     int queried = 0; /* tc holds the cut triangles near polygon i */
     for (int j = 0; j < ob->nfp; j++) {
-      const int *mb = ob->fmeta + 4 * j;
+      const int *mb = ob->fmeta + FCM__EMBED_FMETA * j;
       const double *Bx = ob->fx + 3 * xb;
       xb += (size_t)(mb[2] + mb[3]);
       if (mb[0] != f2 || mb[1] < 0) continue;
@@ -327,7 +327,9 @@ static fcm_status face_links(const build *B, const fcm_cell_rules *R, const cell
                              mtol, atol, B->cut_tris, tc->ids, tc->n))
         continue;
       if (!earlier_link(B, ca, cb, out[ca].pc[qa].parent, out[cb].pc[qb].parent)) continue;
-      if (mat && !fcm__embed_overlap_material(ctx, mat, cell, A, ma[2], Bx, mb[2], nbn)) continue;
+      if (mat && !fcm__embed_overlap_material_full(ctx, mat, cell, A, ma[2], Bx, mb[2], nbn,
+                                                   ma[4] || mb[4]))
+        continue;
       if (mat) FCM_TRY(ctx, fcm__material_status(mat));
       FCM_TRY(ctx, push_link(ctx, pa, pb, links, nl, cap));
     }

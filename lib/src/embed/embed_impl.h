@@ -288,6 +288,9 @@ int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double 
 fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsigned char *inner,
                                       fcm_index *ref);
 
+/* The ints per face polygon in fcm__parts' and cell_out's fmeta. */
+#define FCM__EMBED_FMETA 5
+
 /* Convex parts of the embedded geometry inside one background cell and the material piece
  * of each: the clipped embedded cells, split by the cut triangles that reach the cell. */
 typedef struct fcm__parts {
@@ -301,8 +304,9 @@ typedef struct fcm__parts {
   fcm__poly w[3], scratch; /* splitting workspace */
   fcm__idbuf tcand;        /* cut triangles reaching the cell, ascending */
   /* Polygons of part faces lying on the cell's faces (fcm__embed_face_polygons): polygon i
-   * is on cell face fmeta[4i], belongs to piece fmeta[4i+1], has fmeta[4i+2] vertices and its
-   * part fmeta[4i+3]: stored consecutively in fx (x 3), the polygon's then its part's. */
+   * is on cell face fmeta[F i], belongs to piece fmeta[F i+1], has fmeta[F i+2] vertices and
+   * its part fmeta[F i+3], stored consecutively in fx (x 3), the polygon's then its part's;
+   * fmeta[F i+4] is 1 where the body fills the part (F = FCM__EMBED_FMETA). */
   double *fx;
   int *fmeta;
   size_t nfx, capfx, nfp, capfp;
@@ -715,6 +719,14 @@ fcm_status fcm__material_status(fcm__material *m);
 int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
                                 const double *a, int na, const double *b, int nb,
                                 const double nb_normal[3]);
+
+/* fcm__embed_overlap_material() where `full` says whether the body fills one of the two parts
+ * (fcm__embed_part_full()): then the half of the prism on that part's side is material, and an
+ * overlap of more than 4 times the area threshold is covered without the moments (their
+ * answer, half the prism at least, is above twice the threshold). */
+int fcm__embed_overlap_material_full(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
+                                     const double *a, int na, const double *b, int nb,
+                                     const double nb_normal[3], int full);
 
 /* Split every part of P by triangle t (its plane and edge planes, as a cut's) and drop the
  * emptied ones. */

@@ -28,6 +28,9 @@ typedef struct piece_out {
   double residual[FCM_RULE_KIND_COUNT];
   double tsimp[FCM_RULE_KIND_COUNT]; /* fcm_simplify's time_total */
   unsigned char copied; /* rules copied from the rules being extended (not counted as built) */
+  /* pts, w, flag, spts, sw, snrm, stri (borrowed) and cfxi (cf_borrowed) point into the rules
+   * being extended: read only, not freed */
+  unsigned char borrowed, cf_borrowed;
   unsigned char fitted; /* rules fitted on surface moments (at most M points: not simplified) */
   int parent;    /* the piece of the same cell in the rules being extended that holds this one */
   int component; /* its number among the cell's components before empty ones were dropped */

@@ -16,6 +16,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <stdio.h> /* TEMP */
 
 struct fcm__material {
   const fcm_geometry *geom;
@@ -497,12 +498,40 @@ int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const fcm__embed
                                 const double *a, int na, const double *b, int nb,
                                 const double nb_normal[3])
 {
-  const double size = cell->size;
+  return fcm__embed_overlap_material_full(ctx, m, cell, a, na, b, nb, nb_normal, 0);
+}
+
+/* The area of the planar polygon x (n vertices). */
+static double polygon_area(const double *x, int n)
+{
+  double a[3] = {0.0, 0.0, 0.0};
+  for (int i = 1; i + 1 < n; i++) {
+    double e1[3], e2[3], t[3];
+    for (int d = 0; d < 3; d++)
+      e1[d] = x[3 * i + d] - x[d], e2[d] = x[3 * (i + 1) + d] - x[d];
+    fcm__vec3_cross(e1, e2, t);
+    for (int d = 0; d < 3; d++)
+      a[d] += 0.5 * t[d];
+  }
+  return fcm__vec3_norm(a);
+}
+
+int fcm__embed_overlap_material_full(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
+                                     const double *a, int na, const double *b, int nb,
+                                     const double nb_normal[3], int full)
+{
+  const double size = cell->size, atol = FACE_AREA_RTOL * size * size;
   double x[3 * FCM__POLY_MAX_VERTS];
   int n = 0;
   fcm__embed_overlap(a, na, b, nb, nb_normal, FCM__EMBED_MATCH_RTOL * size, x, &n);
-  return fcm__material_on_face(ctx, m, cell, x, n, nb_normal, PRISM_RTOL * size,
-                               FACE_AREA_RTOL * size * size);
+  if (full && n >= 3 && polygon_area(x, n) > 4.0 * atol) {
+    if (getenv("R6CHK")) { /* TEMP */
+      int r = fcm__material_on_face(ctx, m, cell, x, n, nb_normal, PRISM_RTOL * size, atol);
+      fprintf(stderr, "R6CHK %d\n", r);
+    }
+    return 1;
+  }
+  return fcm__material_on_face(ctx, m, cell, x, n, nb_normal, PRISM_RTOL * size, atol);
 }
 
 /* Split the parts of Q by the boundary triangles ids (n; all that reach inside the parts), each
