@@ -16,7 +16,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <stdio.h> /* TEMP */
 
 struct fcm__material {
   const fcm_geometry *geom;
@@ -524,13 +523,7 @@ int fcm__embed_overlap_material_full(fcm_ctx *ctx, fcm__material *m, const fcm__
   double x[3 * FCM__POLY_MAX_VERTS];
   int n = 0;
   fcm__embed_overlap(a, na, b, nb, nb_normal, FCM__EMBED_MATCH_RTOL * size, x, &n);
-  if (full && n >= 3 && polygon_area(x, n) > 4.0 * atol) {
-    if (getenv("R6CHK")) { /* TEMP */
-      int r = fcm__material_on_face(ctx, m, cell, x, n, nb_normal, PRISM_RTOL * size, atol);
-      fprintf(stderr, "R6CHK %d\n", r);
-    }
-    return 1;
-  }
+  if (full && n >= 3 && polygon_area(x, n) > 4.0 * atol) return 1;
   return fcm__material_on_face(ctx, m, cell, x, n, nb_normal, PRISM_RTOL * size, atol);
 }
 
