@@ -366,6 +366,13 @@ int fcm__embed_clip_to_part_flat(const fcm__parts *P, size_t i, double *x, int n
  * with area (<= 0 inside). */
 double fcm__embed_part_excess(const fcm__parts *P, size_t i, const double x[3]);
 
+/* fcm__embed_clip_to_part() and fcm__embed_part_excess() on the part's planes pl (np of them,
+ * from fcm__embed_part_planes(); tol: the part's clipping tolerance), the same results, for
+ * many polygons or points against one part. */
+int fcm__embed_clip_to_planes(const fcm__plane *pl, int np, double tol, double *x, int n, int cap,
+                              const double nrm[3], double *work);
+double fcm__embed_planes_excess(const fcm__plane *pl, int np, const double x[3]);
+
 /* ---------------------------------------------------------------- pieces of output points
  * (piece_locate.c) Where points and triangles of the embedded geometry's boundary lie among
  * the material pieces of cut-cell rules, for output of the embedded surface: the convex parts

@@ -683,9 +683,10 @@ static double tri_area2(const fcm_geometry *g, fcm_index t)
 }
 
 /* Join the components of the kept triangles (m->uf) whose material a path inside the body and
- * the part links: from a point of one triangle a short step inwards, straight to such a point
- * of the other's, crossing no boundary triangle. Up to 4 triangles of each component try. */
-static void join_through_body(fcm__material *m, const fcm__parts *P, size_t i, int nk, double tol)
+ * the part (its planes pl, np of them) links: from a point of one triangle a short step
+ * inwards, straight to such a point of the other's, crossing no boundary triangle. Up to 4
+ * triangles of each component try. */
+static void join_through_body(fcm__material *m, const fcm__plane *pl, int np, int nk, double tol)
 {
   enum { TRIES = 4 };
   int *tried = m->edges; /* per component root (the edges are no longer needed) */
@@ -703,7 +704,8 @@ static void join_through_body(fcm__material *m, const fcm__parts *P, size_t i, i
         x[0][d] = cs[d], x[1][d] = cs[d] - hs * cs[3 + d];
         x[3][d] = ct[d], x[2][d] = ct[d] - ht * ct[3 + d];
       }
-      if (!(fcm__embed_part_excess(P, i, x[1]) < -tol && fcm__embed_part_excess(P, i, x[2]) < -tol))
+      if (!(fcm__embed_planes_excess(pl, np, x[1]) < -tol &&
+            fcm__embed_planes_excess(pl, np, x[2]) < -tol))
         continue;
       if (path_clear(m, nk, (const double(*)[3])x, s, t))
         m->uf[lump_find(m->uf, s)] = lump_find(m->uf, t);
@@ -752,12 +754,12 @@ static fcm_status one_lump(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell
     for (int d = 0; d < 3; d++)
       u[d] = x[3 + d] - x[d], v[d] = x[6 + d] - x[d];
     fcm__vec3_cross(u, v, nrm);
-    const int n = fcm__embed_clip_to_part(P, i, x, 3, FCM__POLY_MAX_VERTS, nrm, work);
+    const int n = fcm__embed_clip_to_planes(pl, np, P->tol[i], x, 3, FCM__POLY_MAX_VERTS, nrm, work);
     if (n < 3) continue;
     for (int a = 0; a < n; a++)
       for (int d = 0; d < 3; d++)
         c[d] += x[3 * a + d] / n;
-    if (!(fcm__embed_part_excess(P, i, c) < -tol)) continue;
+    if (!(fcm__embed_planes_excess(pl, np, c) < -tol)) continue;
     for (int a = 0; a < 3; a++, ne++) {
       const int p = (int)tv[a], q = (int)tv[(a + 1) % 3];
       m->edges[3 * ne] = FCM_MIN(p, q), m->edges[3 * ne + 1] = FCM_MAX(p, q);
@@ -779,7 +781,7 @@ static fcm_status one_lump(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell
       continue;
     m->uf[lump_find(m->uf, a[2])] = lump_find(m->uf, b[2]);
   }
-  join_through_body(m, P, i, nk, tol);
+  join_through_body(m, pl, np, nk, tol);
   for (int t = 1; t < nk && *one; t++)
     *one = lump_find(m->uf, t) == lump_find(m->uf, 0);
 cleanup:
