@@ -47,6 +47,7 @@ void fcm_cell_rules_destroy(fcm_cell_rules **rules)
   fcm__free(ctx, R->cut_tris);
   fcm__free(ctx, R->links);
   fcm__free(ctx, R->reached);
+  fcm__free(ctx, R->cell_mvol);
   fcm__free(ctx, R->soff);
   fcm__free(ctx, R->cfoff);
   fcm__free(ctx, R->cfxi);

@@ -190,6 +190,12 @@ fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new
   R->reached = NULL;
   FCM_ALLOC(ctx, (size_t)nc + 1, R->reached);
   if (B->prev) FCM_ALLOC(ctx, (size_t)nc + 1, B->rebuild);
+  if (B->geom->num_cells == 0) { /* the whole cells' material, kept from cut to cut */
+    FCM_ALLOC(ctx, (size_t)nc + 1, R->cell_mvol);
+    for (fcm_index c = 0; c < nc; c++)
+      R->cell_mvol[c] = B->prev && B->prev->cell_mvol ? B->prev->cell_mvol[c] : NAN;
+    B->cell_mvol = R->cell_mvol;
+  }
   if (B->prev && first_new > 0) FCM_ALLOC(ctx, (size_t)nc + 1, B->prev_region);
   for (fcm_index c = 0; c < nc; c++) {
     fcm__embed_cell cell; /* its box only: the checks of its set-up come with its own work */

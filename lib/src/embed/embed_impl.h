@@ -77,6 +77,10 @@ struct fcm_cell_rules {
    * node with such a cell is in the links' region, so the links between the pieces of a
    * node's support are all known when one of its cells is reached. */
   unsigned char *reached;
+  /* cell_mvol[c]: a body given by its surface alone, the body's volume in cell c as the cut
+   * cells' split measures it (fcm__parts' whole_mvol), kept from cut to cut; NaN where not
+   * measured yet (NULL without cuts). */
+  double *cell_mvol;
   /* piece_parent[p]: the piece of the rules this object extends that holds piece p (-1
    * for rules made by fcm_cell_rules_create()); prev_num_pieces: how many that object had.
    * piece_component[p]: the number of piece p among the connected components of its cell's
@@ -319,6 +323,9 @@ typedef struct fcm__parts {
   struct fcm__material *mat;
   double *mvol;
   int whole; /* with mat: the one part is the cell itself, unsplit */
+  /* with mat: the body's volume in the whole cell; NaN: not known, fcm__embed_drop_dry()
+   * measures it (the caller sets it before fcm__embed_cell_parts() and reads it after) */
+  double whole_mvol;
 } fcm__parts;
 
 void fcm__embed_parts_free(fcm_ctx *ctx, fcm__parts *P);
@@ -775,8 +782,9 @@ fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell,
                                       int piece, fcm__embed_ws *ws, double *volume);
 
 /* Surface body (P->mat): the body's volume in each part into P->mvol where it is not known
- * (0: not computed; < 0: a piece of a part wholly inside the body, its own volume); parts with
- * no more than their vmin are dropped. Nothing without P->mat. */
+ * (0: not computed; < 0: a piece of a part wholly inside the body, its own volume; the whole
+ * cell: P->whole_mvol where known, else measured into it); parts with no more than their vmin
+ * are dropped. Nothing without P->mat. */
 fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P);
 
 /* Surface body: whether part i lies wholly inside the body (its material, P->mvol, is its

@@ -88,6 +88,7 @@ typedef struct build {
   fcm_aabb_tree *cut_tree;
   const fcm__cut_tri *cut_tris;
   unsigned char *region, *rebuild, *prev_region, *same_links;
+  double *cell_mvol; /* R->cell_mvol for a body given by its surface, else NULL */
   const fcm_cell_rules *prev;
   fcm_index first_new; /* cut triangles from here on are new (those of the cut being added) */
   int keep; /* cuts: keep the cells the new cut leaves unchanged, and the links of cells it does

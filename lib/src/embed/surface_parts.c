@@ -846,10 +846,13 @@ fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__p
       if (P->mvol[i] < 0.0) P->mvol[i] = fcm__geom_poly_volume(P->poly + i);
       continue;
     }
-    if (P->whole && cell->affine)
+    if (P->whole && !isnan(P->whole_mvol))
+      P->mvol[i] = P->whole_mvol; /* measured so at an earlier cut */
+    else if (P->whole && cell->affine)
       FCM_TRY(ctx, fcm__material_cell(ctx, P->mat, NULL, cell, NULL, P->mvol + i));
     else
       FCM_TRY(ctx, fcm__material_poly(ctx, P->mat, P->poly + i, NULL, cell, NULL, P->mvol + i));
+    if (P->whole) P->whole_mvol = P->mvol[i];
     if (!(P->mvol[i] > P->vmin[i])) P->poly[i].nv = P->poly[i].nf = 0;
   }
   fcm__embed_parts_compact(P);
