@@ -534,6 +534,15 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
   fcm_index done = 0;
   double last = fcm_wtime();
   fcm__loop loop;
+  fcm_index *order = NULL; /* a cut: the cells it integrates again first (the threads' shares
+                              end together), then the others; each cell's work is its own */
+  if (B->rebuild) {
+    FCM_ALLOC(ctx, (size_t)nc + 1, order);
+    fcm_index n = 0;
+    for (int pass = 0; pass < 2; pass++)
+      for (fcm_index c = 0; c < nc; c++)
+        if ((B->rebuild[c] != 0) == (pass == 0)) order[n++] = c;
+  }
   fcm__loop_begin(ctx, &loop);
   memset(sums, 0, sizeof *sums);
   /* the cells' dense solves run inside the threads: BLAS threads of their own would fight
@@ -547,7 +556,8 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
     memset(&mine, 0, sizeof mine);
     fcm__embed_ws *ws = NULL;
 #pragma omp for schedule(dynamic, 1)
-    for (fcm_index c = 0; c < nc; c++) {
+    for (fcm_index i = 0; i < nc; i++) {
+      const fcm_index c = order ? order[i] : i;
       if (fcm__loop_skip(&loop, c)) continue;
       fcm__loop_iter it;
       fcm__loop_enter(&loop, &it, c);
@@ -594,5 +604,6 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
   FCM_TRY(ctx, fcm__loop_end(&loop, NULL));
   if (opt->progress) opt->progress(nc, nc, opt->progress_user);
 cleanup:
+  fcm__free(ctx, order);
   return st;
 }

@@ -163,6 +163,42 @@ cleanup:
   return st;
 }
 
+/* reached_cells(): the bits of a cell the cuts reach */
+enum { REACH = 1, REACH_EARLIER = 2, REACH_NEW = 4 };
+
+/* Per cell, in parallel, into hit: 0 where no cut triangle's box meets the cell's (widened by
+ * twice the match tolerance), else REACH, with REACH_EARLIER when a triangle before first_new
+ * does, REACH_NEW when one from first_new on does. */
+static fcm_status reached_cells(const build *B, fcm_index first_new, unsigned char *hit)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_index nc = fcm_mesh_num_cells(B->mesh);
+  fcm__loop loop;
+  fcm__loop_begin(ctx, &loop);
+#pragma omp parallel num_threads(fcm_ctx_num_threads(ctx))
+  {
+    fcm__idbuf ids = {NULL, 0, 0};
+#pragma omp for schedule(static)
+    for (fcm_index c = 0; c < nc; c++) {
+      if (fcm__loop_skip(&loop, c)) continue;
+      fcm__loop_iter it;
+      fcm__loop_enter(&loop, &it, c);
+      fcm__embed_cell cell; /* its box only: the checks of its set-up come with its own work */
+      fcm__embed_cell_box(B->mesh, c, B->o->clip_rtol, &cell);
+      const fcm_status s = fcm__embed_cut_candidates(ctx, B->cut_tree, &cell, &ids);
+      if (s == FCM_OK && ids.n > 0) /* ids ascending: the earlier cuts' triangles first */
+        hit[c] = (unsigned char)(REACH | (ids.ids[0] < first_new ? REACH_EARLIER : 0) |
+                                 (ids.ids[ids.n - 1] >= first_new ? REACH_NEW : 0));
+      fcm__loop_leave(&loop, &it, s);
+    }
+    fcm__geom_idbuf_free(ctx, &ids);
+  }
+  FCM_TRY(ctx, fcm__loop_end(&loop, NULL));
+cleanup:
+  return st;
+}
+
 /* Phase 1c (cuts only): the tree of R's cut triangles, the region (cells sharing a node with
  * a cell the cuts reach) and, when extending `prev` by the triangles from first_new on,
  * the cells to integrate (those the new triangles reach). */
@@ -176,7 +212,6 @@ fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new
   const fcm_index *cells = fcm_mesh_cells(mesh);
   double *boxes = NULL;
   unsigned char *node_hit = NULL; /* 1: a cell the cuts reach holds the node; 2: the earlier */
-  fcm__idbuf ids = {NULL, 0, 0};
   FCM_ALLOC(ctx, 6 * (size_t)R->num_cut_tris + 6, boxes);
   for (fcm_index t = 0; t < R->num_cut_tris; t++) {
     memcpy(boxes + 6 * t, R->cut_tris[t].lo, 3 * sizeof(double));
@@ -197,15 +232,14 @@ fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new
     B->cell_mvol = R->cell_mvol;
   }
   if (B->prev && first_new > 0) FCM_ALLOC(ctx, (size_t)nc + 1, B->prev_region);
+  FCM_TRY(ctx, reached_cells(B, first_new, R->reached));
   for (fcm_index c = 0; c < nc; c++) {
-    fcm__embed_cell cell; /* its box only: the checks of its set-up come with its own work */
-    fcm__embed_cell_box(mesh, c, B->o->clip_rtol, &cell);
-    FCM_TRY(ctx, fcm__embed_cut_candidates(ctx, B->cut_tree, &cell, &ids));
-    if (ids.n == 0) continue;
+    const unsigned char h = R->reached[c];
+    if (!h) continue;
+    for (int a = 0; a < npc; a++)
+      node_hit[cells[(size_t)npc * c + a]] |= (unsigned char)(h & REACH_EARLIER ? 3 : 1);
+    if (B->rebuild && h & REACH_NEW) B->rebuild[c] = 1;
     R->reached[c] = 1;
-    for (int a = 0; a < npc; a++) /* ids ascending: the earlier cuts' triangles first */
-      node_hit[cells[(size_t)npc * c + a]] |= (unsigned char)(ids.ids[0] < first_new ? 3 : 1);
-    if (B->rebuild && ids.ids[ids.n - 1] >= first_new) B->rebuild[c] = 1;
   }
   for (fcm_index c = 0; c < nc; c++)
     for (int a = 0; a < npc; a++) {
@@ -218,7 +252,6 @@ fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new
 cleanup:
   fcm__free(ctx, boxes);
   fcm__free(ctx, node_hit);
-  fcm__geom_idbuf_free(ctx, &ids);
   return st;
 }
 
