@@ -412,8 +412,9 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   double sbox[6];
   const int no_work = !integrate && (!B->region[c] || (B->same_links && B->same_links[c]));
   const double t0 = no_work ? 0.0 : fcm_wtime(); /* a copied cell's time is not counted */
-  /* a cell whose rules are copied needs its volume only, but a dropped one its surface share */
-  if (no_work && !(own && B->prev->cls[c] == FCM_CELL_DROPPED))
+  /* a cell whose rules are copied needs its volume only, but a dropped one its surface share
+   * where surface rules are built */
+  if (no_work && !(own && B->prev->cls[c] == FCM_CELL_DROPPED && B->tri_rule))
     FCM_TRY(ctx, fcm__embed_cell_setup_volume(ctx, B->mesh, c, opt->clip_rtol, &cell));
   else
     FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
