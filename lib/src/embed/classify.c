@@ -411,15 +411,21 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   const int own = !opt->cell_mask || opt->cell_mask[c]; /* 0: classified, no points */
   double sbox[6];
   const int no_work = !integrate && (!B->region[c] || (B->same_links && B->same_links[c]));
+  /* a region cell the new cut does not reach, with the face polygons the earlier cut kept */
+  const int kept_faces =
+      !integrate && !no_work && B->keep && B->prev->face_nfp && B->prev->face_nfp[c] >= 0;
   const double t0 = no_work ? 0.0 : fcm_wtime(); /* a copied cell's time is not counted */
   /* a cell whose rules are copied needs its volume only, but a dropped one its surface share
    * where surface rules are built */
-  if (no_work && !(own && B->prev->cls[c] == FCM_CELL_DROPPED && B->tri_rule))
+  if ((no_work || kept_faces) && !(own && B->prev->cls[c] == FCM_CELL_DROPPED && B->tri_rule))
     FCM_TRY(ctx, fcm__embed_cell_setup_volume(ctx, B->mesh, c, opt->clip_rtol, &cell));
   else
     FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
-  if (no_work) {
+  if (no_work || kept_faces) {
     FCM_TRY(ctx, keep_cell(B, R, &cell, 1, o));
+    if (kept_faces)
+      FCM_TRY(ctx, fcm__embed_copy_face_polygons(ctx, B->prev, c, &o->fmeta, &o->fx, &o->nfp));
+    o->fp_keep = (unsigned char)kept_faces;
     if (own && R->cls[c] == FCM_CELL_DROPPED) FCM_TRY(ctx, dropped_area(B, &cell, ws, o));
     goto cleanup;
   }
@@ -446,6 +452,7 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
     }
     int kept;
     FCM_TRY(ctx, keep_region_cell(B, R, &cell, P, integrate, o, &kept));
+    o->fp_keep = (unsigned char)(kept && !integrate); /* parts split in one pass */
     if (kept) {
       if (own && R->cls[c] == FCM_CELL_DROPPED) FCM_TRY(ctx, dropped_area(B, &cell, ws, o));
       sums->counts.kept += integrate;

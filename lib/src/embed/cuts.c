@@ -478,6 +478,59 @@ cleanup:
   return st;
 }
 
+/* The coordinates in a face polygon list (nfp polygons, meta): each polygon's and its part's
+ * vertices, 3 each. */
+static size_t face_coords(const int *meta, int nfp)
+{
+  size_t n = 0;
+  for (int i = 0; i < nfp; i++)
+    n += (size_t)(meta[FCM__EMBED_FMETA * i + 2] + meta[FCM__EMBED_FMETA * i + 3]);
+  return 3 * n;
+}
+
+fcm_status fcm__embed_copy_face_polygons(fcm_ctx *ctx, const fcm_cell_rules *Q, fcm_index c,
+                                         int **meta, double **x, int *nfp)
+{
+  fcm_status st = FCM_OK;
+  const int n = Q->face_nfp[c];
+  *nfp = n;
+  *meta = NULL, *x = NULL;
+  if (n <= 0) return FCM_OK;
+  const size_t nx = face_coords(Q->face_meta[c], n);
+  FCM__ALLOC_WITH(fcm__malloc, ctx, FCM__EMBED_FMETA * (size_t)n, *meta);
+  FCM__ALLOC_WITH(fcm__malloc, ctx, nx, *x);
+  memcpy(*meta, Q->face_meta[c], FCM__EMBED_FMETA * (size_t)n * sizeof **meta);
+  memcpy(*x, Q->face_x[c], nx * sizeof **x);
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_keep_face_polygons(const build *B, fcm_cell_rules *R, cell_out *out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_index nc = R->num_cells;
+  const fcm_cell_rules *Q = B->prev;
+  if (!B->keep || !B->rebuild) return FCM_OK;
+  FCM_ALLOC(ctx, (size_t)nc + 1, R->face_nfp);
+  FCM_ALLOC(ctx, (size_t)nc + 1, R->face_meta);
+  FCM_ALLOC(ctx, (size_t)nc + 1, R->face_x);
+  for (fcm_index c = 0; c < nc; c++) {
+    cell_out *o = out + c;
+    R->face_nfp[c] = -1;
+    if (o->fp_keep) { /* moved: out no longer frees them */
+      R->face_nfp[c] = o->nfp;
+      R->face_meta[c] = o->fmeta, R->face_x[c] = o->fx;
+      o->fmeta = NULL, o->fx = NULL;
+    } else if (!B->rebuild[c] && Q->face_nfp && Q->face_nfp[c] >= 0) {
+      FCM_TRY(ctx, fcm__embed_copy_face_polygons(ctx, Q, c, R->face_meta + c, R->face_x + c,
+                                                 R->face_nfp + c));
+    }
+  }
+cleanup:
+  return st;
+}
+
 /* Phase 3b (cuts only): the links between pieces of face-neighbouring region cells: a
  * polygon of one cell's piece on the shared face overlaps a polygon of the other cell's
  * piece with positive area, and the overlap does not lie on a cut triangle, and

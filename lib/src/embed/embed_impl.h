@@ -81,6 +81,13 @@ struct fcm_cell_rules {
    * cells' split measures it (fcm__parts' whole_mvol), kept from cut to cut; NaN where not
    * measured yet (NULL without cuts). */
   double *cell_mvol;
+  /* face_nfp[c] >= 0: cell c's face polygons (face_meta[c], FCM__EMBED_FMETA ints each, and
+   * face_x[c]: fcm__parts' fmeta and fx) made from the cuts' triangles that reach it in one
+   * pass, as a cut that does not reach it makes them again; -1: none kept (NULL without
+   * cuts). */
+  int *face_nfp;
+  int **face_meta;
+  double **face_x;
   /* piece_parent[p]: the piece of the rules this object extends that holds piece p (-1
    * for rules made by fcm_cell_rules_create()); prev_num_pieces: how many that object had.
    * piece_component[p]: the number of piece p among the connected components of its cell's

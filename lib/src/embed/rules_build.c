@@ -229,8 +229,7 @@ static void gather_cell(fcm_cell_rules *R, const cell_out *o, fcm_index c)
       memcpy(R->weights[k] + o0, q->w[k], n * sizeof(double));
       memcpy(R->flags[k] + o0, q->flag[k], n);
     }
-    if (q->ncf)
-      memcpy(R->cfxi + 9 * R->cfoff[p], q->cfxi, 9 * (size_t)q->ncf * sizeof(double));
+    if (q->ncf) memcpy(R->cfxi + 9 * R->cfoff[p], q->cfxi, 9 * (size_t)q->ncf * sizeof(double));
     const size_t n = (size_t)q->ns, o0 = (size_t)R->soff[p];
     if (!n) continue;
     memcpy(R->spoints + 3 * o0, q->spts, 3 * n * sizeof(double));

@@ -50,10 +50,13 @@ typedef struct cell_out {
   piece_out *pc;
   double volume;
   double dropped_area; /* a dropped cell's share of the embedded surface (surface rules on) */
-  int nfp; /* face polygons: meta (face, piece, vertices, part vertices) x nfp, coordinates fx
-              (the polygon's, then its part's) */
+  int nfp;             /* face polygons: meta (FCM__EMBED_FMETA each) x nfp, coordinates fx (the
+                          polygon's, then its part's) */
   int *fmeta;
   double *fx;
+  /* the face polygons come from the parts of the earlier cuts' triangles alone, split in one
+   * pass (a region cell no new triangle reaches): the rules keep them for the next cut */
+  unsigned char fp_keep;
 } cell_out;
 
 /* Everything the per-cell work reads; the trees and rules are owned (fcm__embed_build_release). */
@@ -203,5 +206,14 @@ fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new
 
 /* Phase 3b (cuts only): the links between pieces of face-neighbouring region cells. */
 fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell_out *out);
+
+/* Phase 3c (cuts only): the face polygons R keeps for the next cut (fcm_cell_rules'
+ * face_nfp): those of the cells out marks fp_keep (moved from out), and the earlier rules'
+ * of the cells the new cut does not reach. */
+fcm_status fcm__embed_keep_face_polygons(const build *B, fcm_cell_rules *R, cell_out *out);
+
+/* Copies of cell c's face polygons that Q keeps (Q->face_nfp[c] >= 0): *nfp of them. */
+fcm_status fcm__embed_copy_face_polygons(fcm_ctx *ctx, const fcm_cell_rules *Q, fcm_index c,
+                                         int **meta, double **x, int *nfp);
 
 #endif /* FCM_EMBED_RULES_IMPL_H */

@@ -754,7 +754,8 @@ static fcm_status one_lump(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell
     for (int d = 0; d < 3; d++)
       u[d] = x[3 + d] - x[d], v[d] = x[6 + d] - x[d];
     fcm__vec3_cross(u, v, nrm);
-    const int n = fcm__embed_clip_to_planes(pl, np, P->tol[i], x, 3, FCM__POLY_MAX_VERTS, nrm, work);
+    const int n =
+        fcm__embed_clip_to_planes(pl, np, P->tol[i], x, 3, FCM__POLY_MAX_VERTS, nrm, work);
     if (n < 3) continue;
     for (int a = 0; a < n; a++)
       for (int d = 0; d < 3; d++)
