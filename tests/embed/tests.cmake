@@ -134,3 +134,9 @@ fcm_add_test(embed_q2_stiffness tests/embed/q2_stiffness.c)
 # as a P_6 rule unsimplified on its tets (1e-12); a weight off by 1e-6 fails the check; the face
 # overlaps' material test on parallelograms (one Hex8 prism) answers as on their fan's tets.
 fcm_add_test(embed_box_parts tests/embed/box_parts.c)
+# What a cut keeps from the rules it extends (a surface body): the whole cells' material
+# volumes, the face polygons of region cells no new cut reaches and the copied cells' rules
+# give the rules of the same cuts made from stripped rules bit for bit, over five cuts (blades
+# along the grid, overlapping regions, a tilted plane); a kept volume off by 1e-3 changes them;
+# every kept face polygon of a part the body fills is covered by the prism's moments.
+fcm_add_test(embed_cut_reuse tests/embed/cut_reuse.c)

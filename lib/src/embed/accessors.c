@@ -47,6 +47,14 @@ void fcm_cell_rules_destroy(fcm_cell_rules **rules)
   fcm__free(ctx, R->cut_tris);
   fcm__free(ctx, R->links);
   fcm__free(ctx, R->reached);
+  fcm__free(ctx, R->cell_mvol);
+  for (fcm_index c = 0; R->face_nfp && c < R->num_cells; c++) {
+    fcm__free(ctx, R->face_meta[c]);
+    fcm__free(ctx, R->face_x[c]);
+  }
+  fcm__free(ctx, R->face_nfp);
+  fcm__free(ctx, R->face_meta);
+  fcm__free(ctx, R->face_x);
   fcm__free(ctx, R->soff);
   fcm__free(ctx, R->cfoff);
   fcm__free(ctx, R->cfxi);

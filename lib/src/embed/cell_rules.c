@@ -78,6 +78,7 @@ static fcm_status build_rules_x(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_ge
   /* 3. gather, 4. statistics */
   FCM_TRY(ctx, fcm__embed_gather_rules(ctx, R, out, prev));
   if (B.cut_tree) FCM_TRY(ctx, fcm__embed_gather_links(&B, R, out));
+  if (B.cut_tree) FCM_TRY(ctx, fcm__embed_keep_face_polygons(&B, R, out));
   fcm__embed_gather_stats(R, geom, out, &sums, nthreads);
   FCM_TRY(ctx, fcm__embed_outside(ctx, mesh, geom, &R->stats));
   if (o->simplify != FCM_CELL_SIMPLIFY_AUTO)

@@ -11,20 +11,25 @@
 
 static void piece_out_free(fcm_ctx *ctx, piece_out *o)
 {
-  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+  for (int k = 0; k < FCM_RULE_KIND_COUNT && !o->borrowed; k++) {
     fcm__free(ctx, o->pts[k]);
     fcm__free(ctx, o->w[k]);
     fcm__free(ctx, o->flag[k]);
+  }
+  if (!o->borrowed) {
+    fcm__free(ctx, o->spts);
+    fcm__free(ctx, o->sw);
+    fcm__free(ctx, o->snrm);
+    fcm__free(ctx, o->stri);
+  }
+  if (!o->cf_borrowed) fcm__free(ctx, o->cfxi);
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     o->pts[k] = o->w[k] = NULL;
     o->flag[k] = NULL;
   }
-  fcm__free(ctx, o->spts);
-  fcm__free(ctx, o->sw);
-  fcm__free(ctx, o->snrm);
-  fcm__free(ctx, o->stri);
-  fcm__free(ctx, o->cfxi);
   o->spts = o->sw = o->snrm = o->cfxi = NULL;
   o->stri = NULL;
+  o->borrowed = o->cf_borrowed = 0;
 }
 
 void fcm__embed_cell_out_free(fcm_ctx *ctx, cell_out *o)
@@ -55,8 +60,24 @@ cleanup:
   return st;
 }
 
-/* Copy the rules of cell c from the previous rules object (a cell no new cut reaches). */
-static fcm_status copy_cell(const build *B, fcm_index c, cell_out *o)
+/* An array of n items of `size` bytes at src: borrowed (*dst = src) or copied. */
+static fcm_status take(fcm_ctx *ctx, int borrow, const void *src, size_t n, size_t size, void *dst)
+{
+  fcm_status st = FCM_OK;
+  unsigned char *p = (unsigned char *)src; /* borrowed arrays are read only (piece_out) */
+  if (!borrow && n) {
+    FCM__ALLOC_WITH(fcm__malloc, ctx, n * size, p);
+    memcpy(p, src, n * size);
+  }
+  memcpy(dst, &p, sizeof p);
+cleanup:
+  return st;
+}
+
+/* The rules of cell c from the previous rules object (a cell no new cut reaches): with borrow,
+ * the pieces' arrays point into it (the gathering copies them once, from there); else copies
+ * (the AUTO choice may simplify them in place). */
+static fcm_status copy_cell(const build *B, fcm_index c, int borrow, cell_out *o)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
@@ -68,35 +89,26 @@ static fcm_status copy_cell(const build *B, fcm_index c, cell_out *o)
     po->volume = Q->piece_volume[p];
     po->component = Q->piece_component[p];
     po->copied = 1;
+    po->borrowed = po->cf_borrowed = (unsigned char)borrow;
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
       const size_t a = (size_t)Q->off[k][p], n = (size_t)Q->off[k][p + 1] - a;
       if (n) {
-        FCM_ALLOC(ctx, 3 * n, po->pts[k]);
-        FCM_ALLOC(ctx, n, po->w[k]);
-        FCM_ALLOC(ctx, n, po->flag[k]);
-        memcpy(po->pts[k], Q->points[k] + 3 * a, 3 * n * sizeof(double));
-        memcpy(po->w[k], Q->weights[k] + a, n * sizeof(double));
-        memcpy(po->flag[k], Q->flags[k] + a, n);
+        FCM_TRY(ctx, take(ctx, borrow, Q->points[k] + 3 * a, 3 * n, sizeof(double), &po->pts[k]));
+        FCM_TRY(ctx, take(ctx, borrow, Q->weights[k] + a, n, sizeof(double), &po->w[k]));
+        FCM_TRY(ctx, take(ctx, borrow, Q->flags[k] + a, n, 1, &po->flag[k]));
       }
       po->n[k] = po->ninit[k] = po->nsimp[k] = (int)n;
     }
     const size_t a = (size_t)Q->soff[p], n = (size_t)Q->soff[p + 1] - a;
     if (n) {
-      FCM_ALLOC(ctx, 3 * n, po->spts);
-      FCM_ALLOC(ctx, n, po->sw);
-      FCM_ALLOC(ctx, 3 * n, po->snrm);
-      FCM_ALLOC(ctx, n, po->stri);
-      memcpy(po->spts, Q->spoints + 3 * a, 3 * n * sizeof(double));
-      memcpy(po->sw, Q->sweights + a, n * sizeof(double));
-      memcpy(po->snrm, Q->snormals + 3 * a, 3 * n * sizeof(double));
-      memcpy(po->stri, Q->stris + a, n * sizeof(fcm_index));
+      FCM_TRY(ctx, take(ctx, borrow, Q->spoints + 3 * a, 3 * n, sizeof(double), &po->spts));
+      FCM_TRY(ctx, take(ctx, borrow, Q->sweights + a, n, sizeof(double), &po->sw));
+      FCM_TRY(ctx, take(ctx, borrow, Q->snormals + 3 * a, 3 * n, sizeof(double), &po->snrm));
+      FCM_TRY(ctx, take(ctx, borrow, Q->stris + a, n, sizeof(fcm_index), &po->stri));
     }
     po->ns = (int)n;
     const size_t c0 = (size_t)Q->cfoff[p], nc = (size_t)Q->cfoff[p + 1] - c0;
-    if (nc) {
-      FCM_ALLOC(ctx, 9 * nc, po->cfxi);
-      memcpy(po->cfxi, Q->cfxi + 9 * c0, 9 * nc * sizeof(double));
-    }
+    if (nc) FCM_TRY(ctx, take(ctx, borrow, Q->cfxi + 9 * c0, 9 * nc, sizeof(double), &po->cfxi));
     po->ncf = (int)nc;
   }
 cleanup:
@@ -126,7 +138,7 @@ cleanup:
 }
 
 static fcm_status keep_cell(const build *B, fcm_cell_rules *R, const fcm__embed_cell *cell,
-                            cell_out *o)
+                            int borrow, cell_out *o)
 {
   fcm_status st = FCM_OK;
   const fcm_cell_rules *Q = B->prev;
@@ -138,7 +150,7 @@ static fcm_status keep_cell(const build *B, fcm_cell_rules *R, const fcm__embed_
           fcm__embed_cell_out_pieces(B->ctx, o, (int)(Q->piece_off[c + 1] - Q->piece_off[c])));
   for (int i = 0; i < o->np; i++)
     o->pc[i].parent = i;
-  FCM_TRY(B->ctx, copy_cell(B, c, o));
+  FCM_TRY(B->ctx, copy_cell(B, c, borrow, o));
 cleanup:
   return st;
 }
@@ -206,8 +218,11 @@ static fcm_status cell_pieces(const build *B, const fcm__embed_cell *cell, fcm__
   fcm_ctx *ctx = B->ctx;
   const fcm_cell_rules_options *opt = B->o;
   fcm__parts *P = ws->parts;
+  double *known = B->cell_mvol ? B->cell_mvol + cell->id : NULL; /* one writer per cell */
+  P->whole_mvol = known ? *known : NAN;
   FCM_TRY(ctx, fcm__embed_cell_parts(ctx, B->geom, B->tree, cell, opt->clip_rtol, opt->sliver_rtol,
                                      ws, P, &sums->counts));
+  if (known) *known = P->whole_mvol;
   FCM_TRY(ctx, fcm__embed_cut_candidates(ctx, B->cut_tree, cell, &P->tcand));
   if (P->tcand.n > 0) {
     FCM_TRY(ctx, fcm__embed_cell_pieces(ctx, cell, B->cut_tris, B->first_new, P));
@@ -305,11 +320,13 @@ static fcm_status keep_region_cell(const build *B, fcm_cell_rules *R, const fcm_
             "%lld",
             (long long)c, P->num_pieces, (long long)had);
   if (integrate && !(B->prev && B->keep && pieces_unchanged(B, c, P))) return FCM_OK;
-  FCM_TRY(ctx, keep_cell(B, R, cell, o));
+  /* AUTO simplifies the pieces of the cells integrated again in place: those are copies */
+  FCM_TRY(ctx, keep_cell(B, R, cell, !integrate || B->o->simplify != FCM_CELL_SIMPLIFY_AUTO, o));
   for (int i = 0; integrate && i < o->np; i++) {
-    fcm__free(ctx, o->pc[i].cfxi);
+    if (!o->pc[i].cf_borrowed) fcm__free(ctx, o->pc[i].cfxi);
     o->pc[i].cfxi = NULL;
     o->pc[i].ncf = 0;
+    o->pc[i].cf_borrowed = 0;
   }
   if (integrate && P->tcand.n > 0) FCM_TRY(ctx, piece_cut_faces(B, cell, P, o));
   *kept = 1;
@@ -392,18 +409,24 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   fcm__parts *P = NULL;
   const int integrate = !B->rebuild || B->rebuild[c];
   const int own = !opt->cell_mask || opt->cell_mask[c]; /* 0: classified, no points */
-  const double t0 = fcm_wtime();
   double sbox[6];
   const int no_work = !integrate && (!B->region[c] || (B->same_links && B->same_links[c]));
-  /* a cell whose rules are copied needs its volume only, but a dropped one its surface share */
-  if (no_work && !(own && B->prev->cls[c] == FCM_CELL_DROPPED))
+  /* a region cell the new cut does not reach, with the face polygons the earlier cut kept */
+  const int kept_faces =
+      !integrate && !no_work && B->keep && B->prev->face_nfp && B->prev->face_nfp[c] >= 0;
+  const double t0 = no_work ? 0.0 : fcm_wtime(); /* a copied cell's time is not counted */
+  /* a cell whose rules are copied needs its volume only, but a dropped one its surface share
+   * where surface rules are built */
+  if ((no_work || kept_faces) && !(own && B->prev->cls[c] == FCM_CELL_DROPPED && B->tri_rule))
     FCM_TRY(ctx, fcm__embed_cell_setup_volume(ctx, B->mesh, c, opt->clip_rtol, &cell));
   else
     FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
-  if (no_work) {
-    FCM_TRY(ctx, keep_cell(B, R, &cell, o));
+  if (no_work || kept_faces) {
+    FCM_TRY(ctx, keep_cell(B, R, &cell, 1, o));
+    if (kept_faces)
+      FCM_TRY(ctx, fcm__embed_copy_face_polygons(ctx, B->prev, c, &o->fmeta, &o->fx, &o->nfp));
+    o->fp_keep = (unsigned char)kept_faces;
     if (own && R->cls[c] == FCM_CELL_DROPPED) FCM_TRY(ctx, dropped_area(B, &cell, ws, o));
-    sums->time_intersect += fcm_wtime() - t0;
     goto cleanup;
   }
   if (B->prev) FCM_TRY(ctx, fcm__embed_check_convex(ctx, B->mesh, c, opt));
@@ -421,14 +444,15 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
       vol += pvol[i];
     FCM_TRY(ctx, fcm__embed_face_polygons(ctx, &cell, P));
     if (P->nfp > 0) {
-      FCM_ALLOC(ctx, 4 * P->nfp, o->fmeta);
+      FCM_ALLOC(ctx, FCM__EMBED_FMETA * P->nfp, o->fmeta);
       FCM_ALLOC(ctx, 3 * P->nfx, o->fx);
-      memcpy(o->fmeta, P->fmeta, 4 * P->nfp * sizeof(int));
+      memcpy(o->fmeta, P->fmeta, FCM__EMBED_FMETA * P->nfp * sizeof(int));
       memcpy(o->fx, P->fx, 3 * P->nfx * sizeof(double));
       o->nfp = (int)P->nfp;
     }
     int kept;
     FCM_TRY(ctx, keep_region_cell(B, R, &cell, P, integrate, o, &kept));
+    o->fp_keep = (unsigned char)(kept && !integrate); /* parts split in one pass */
     if (kept) {
       if (own && R->cls[c] == FCM_CELL_DROPPED) FCM_TRY(ctx, dropped_area(B, &cell, ws, o));
       sums->counts.kept += integrate;
@@ -518,6 +542,15 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
   fcm_index done = 0;
   double last = fcm_wtime();
   fcm__loop loop;
+  fcm_index *order = NULL; /* a cut: the cells it integrates again first (the threads' shares
+                              end together), then the others; each cell's work is its own */
+  if (B->rebuild) {
+    FCM_ALLOC(ctx, (size_t)nc + 1, order);
+    fcm_index n = 0;
+    for (int pass = 0; pass < 2; pass++)
+      for (fcm_index c = 0; c < nc; c++)
+        if ((B->rebuild[c] != 0) == (pass == 0)) order[n++] = c;
+  }
   fcm__loop_begin(ctx, &loop);
   memset(sums, 0, sizeof *sums);
   /* the cells' dense solves run inside the threads: BLAS threads of their own would fight
@@ -531,7 +564,8 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
     memset(&mine, 0, sizeof mine);
     fcm__embed_ws *ws = NULL;
 #pragma omp for schedule(dynamic, 1)
-    for (fcm_index c = 0; c < nc; c++) {
+    for (fcm_index i = 0; i < nc; i++) {
+      const fcm_index c = order ? order[i] : i;
       if (fcm__loop_skip(&loop, c)) continue;
       fcm__loop_iter it;
       fcm__loop_enter(&loop, &it, c);
@@ -578,5 +612,6 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
   FCM_TRY(ctx, fcm__loop_end(&loop, NULL));
   if (opt->progress) opt->progress(nc, nc, opt->progress_user);
 cleanup:
+  fcm__free(ctx, order);
   return st;
 }

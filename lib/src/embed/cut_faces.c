@@ -212,7 +212,8 @@ fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, f
         if (P->nfp + 1 > P->capfp) {
           const size_t cap = P->capfp ? 2 * P->capfp : 64;
           void *q = P->fmeta;
-          FCM_TRY(ctx, fcm__resize(ctx, &q, 4 * P->nfp, 4 * cap, sizeof(int)));
+          FCM_TRY(ctx, fcm__resize(ctx, &q, FCM__EMBED_FMETA * P->nfp, FCM__EMBED_FMETA * cap,
+                                   sizeof(int)));
           P->fmeta = q;
           P->capfp = cap;
         }
@@ -227,10 +228,12 @@ fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, f
         }
         fcm__embed_face_coords(p, f, P->fx + 3 * P->nfx);
         memcpy(P->fx + 3 * (P->nfx + m), p->x[0], 3 * (size_t)p->nv * sizeof(double));
-        P->fmeta[4 * P->nfp] = g;
-        P->fmeta[4 * P->nfp + 1] = P->piece[i];
-        P->fmeta[4 * P->nfp + 2] = (int)m;
-        P->fmeta[4 * P->nfp + 3] = p->nv;
+        int *meta = P->fmeta + FCM__EMBED_FMETA * P->nfp;
+        meta[0] = g;
+        meta[1] = P->piece[i];
+        meta[2] = (int)m;
+        meta[3] = p->nv;
+        meta[4] = P->mat && P->piece[i] >= 0 && fcm__embed_part_full(P, i);
         P->nfp++;
         P->nfx += mv;
         break;

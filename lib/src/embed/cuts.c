@@ -163,6 +163,42 @@ cleanup:
   return st;
 }
 
+/* reached_cells(): the bits of a cell the cuts reach */
+enum { REACH = 1, REACH_EARLIER = 2, REACH_NEW = 4 };
+
+/* Per cell, in parallel, into hit: 0 where no cut triangle's box meets the cell's (widened by
+ * twice the match tolerance), else REACH, with REACH_EARLIER when a triangle before first_new
+ * does, REACH_NEW when one from first_new on does. */
+static fcm_status reached_cells(const build *B, fcm_index first_new, unsigned char *hit)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_index nc = fcm_mesh_num_cells(B->mesh);
+  fcm__loop loop;
+  fcm__loop_begin(ctx, &loop);
+#pragma omp parallel num_threads(fcm_ctx_num_threads(ctx))
+  {
+    fcm__idbuf ids = {NULL, 0, 0};
+#pragma omp for schedule(static)
+    for (fcm_index c = 0; c < nc; c++) {
+      if (fcm__loop_skip(&loop, c)) continue;
+      fcm__loop_iter it;
+      fcm__loop_enter(&loop, &it, c);
+      fcm__embed_cell cell; /* its box only: the checks of its set-up come with its own work */
+      fcm__embed_cell_box(B->mesh, c, B->o->clip_rtol, &cell);
+      const fcm_status s = fcm__embed_cut_candidates(ctx, B->cut_tree, &cell, &ids);
+      if (s == FCM_OK && ids.n > 0) /* ids ascending: the earlier cuts' triangles first */
+        hit[c] = (unsigned char)(REACH | (ids.ids[0] < first_new ? REACH_EARLIER : 0) |
+                                 (ids.ids[ids.n - 1] >= first_new ? REACH_NEW : 0));
+      fcm__loop_leave(&loop, &it, s);
+    }
+    fcm__geom_idbuf_free(ctx, &ids);
+  }
+  FCM_TRY(ctx, fcm__loop_end(&loop, NULL));
+cleanup:
+  return st;
+}
+
 /* Phase 1c (cuts only): the tree of R's cut triangles, the region (cells sharing a node with
  * a cell the cuts reach) and, when extending `prev` by the triangles from first_new on,
  * the cells to integrate (those the new triangles reach). */
@@ -176,7 +212,6 @@ fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new
   const fcm_index *cells = fcm_mesh_cells(mesh);
   double *boxes = NULL;
   unsigned char *node_hit = NULL; /* 1: a cell the cuts reach holds the node; 2: the earlier */
-  fcm__idbuf ids = {NULL, 0, 0};
   FCM_ALLOC(ctx, 6 * (size_t)R->num_cut_tris + 6, boxes);
   for (fcm_index t = 0; t < R->num_cut_tris; t++) {
     memcpy(boxes + 6 * t, R->cut_tris[t].lo, 3 * sizeof(double));
@@ -190,16 +225,21 @@ fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new
   R->reached = NULL;
   FCM_ALLOC(ctx, (size_t)nc + 1, R->reached);
   if (B->prev) FCM_ALLOC(ctx, (size_t)nc + 1, B->rebuild);
+  if (B->geom->num_cells == 0) { /* the whole cells' material, kept from cut to cut */
+    FCM_ALLOC(ctx, (size_t)nc + 1, R->cell_mvol);
+    for (fcm_index c = 0; c < nc; c++)
+      R->cell_mvol[c] = B->prev && B->prev->cell_mvol ? B->prev->cell_mvol[c] : NAN;
+    B->cell_mvol = R->cell_mvol;
+  }
   if (B->prev && first_new > 0) FCM_ALLOC(ctx, (size_t)nc + 1, B->prev_region);
+  FCM_TRY(ctx, reached_cells(B, first_new, R->reached));
   for (fcm_index c = 0; c < nc; c++) {
-    fcm__embed_cell cell; /* its box only: the checks of its set-up come with its own work */
-    fcm__embed_cell_box(mesh, c, B->o->clip_rtol, &cell);
-    FCM_TRY(ctx, fcm__embed_cut_candidates(ctx, B->cut_tree, &cell, &ids));
-    if (ids.n == 0) continue;
+    const unsigned char h = R->reached[c];
+    if (!h) continue;
+    for (int a = 0; a < npc; a++)
+      node_hit[cells[(size_t)npc * c + a]] |= (unsigned char)(h & REACH_EARLIER ? 3 : 1);
+    if (B->rebuild && h & REACH_NEW) B->rebuild[c] = 1;
     R->reached[c] = 1;
-    for (int a = 0; a < npc; a++) /* ids ascending: the earlier cuts' triangles first */
-      node_hit[cells[(size_t)npc * c + a]] |= (unsigned char)(ids.ids[0] < first_new ? 3 : 1);
-    if (B->rebuild && ids.ids[ids.n - 1] >= first_new) B->rebuild[c] = 1;
   }
   for (fcm_index c = 0; c < nc; c++)
     for (int a = 0; a < npc; a++) {
@@ -212,7 +252,6 @@ fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new
 cleanup:
   fcm__free(ctx, boxes);
   fcm__free(ctx, node_hit);
-  fcm__geom_idbuf_free(ctx, &ids);
   return st;
 }
 
@@ -296,14 +335,14 @@ static fcm_status face_links(const build *B, const fcm_cell_rules *R, const cell
   const size_t nl0 = *nl; /* the links of this pair of cells start here */
   size_t xa = 0;
   for (int i = 0; i < oa->nfp; i++) {
-    const int *ma = oa->fmeta + 4 * i;
+    const int *ma = oa->fmeta + FCM__EMBED_FMETA * i;
     const double *A = oa->fx + 3 * xa;
     xa += (size_t)(ma[2] + ma[3]);
     if (ma[0] != f || ma[1] < 0) continue;
     size_t xb = 0;
     int queried = 0; /* tc holds the cut triangles near polygon i */
     for (int j = 0; j < ob->nfp; j++) {
-      const int *mb = ob->fmeta + 4 * j;
+      const int *mb = ob->fmeta + FCM__EMBED_FMETA * j;
       const double *Bx = ob->fx + 3 * xb;
       xb += (size_t)(mb[2] + mb[3]);
       if (mb[0] != f2 || mb[1] < 0) continue;
@@ -327,7 +366,9 @@ static fcm_status face_links(const build *B, const fcm_cell_rules *R, const cell
                              mtol, atol, B->cut_tris, tc->ids, tc->n))
         continue;
       if (!earlier_link(B, ca, cb, out[ca].pc[qa].parent, out[cb].pc[qb].parent)) continue;
-      if (mat && !fcm__embed_overlap_material(ctx, mat, cell, A, ma[2], Bx, mb[2], nbn)) continue;
+      if (mat && !fcm__embed_overlap_material_full(ctx, mat, cell, A, ma[2], Bx, mb[2], nbn,
+                                                   ma[4] || mb[4]))
+        continue;
       if (mat) FCM_TRY(ctx, fcm__material_status(mat));
       FCM_TRY(ctx, push_link(ctx, pa, pb, links, nl, cap));
     }
@@ -434,6 +475,59 @@ cleanup:
     fcm__free(ctx, cl[c]);
   fcm__free(ctx, cl);
   fcm__free(ctx, cn);
+  return st;
+}
+
+/* The coordinates in a face polygon list (nfp polygons, meta): each polygon's and its part's
+ * vertices, 3 each. */
+static size_t face_coords(const int *meta, int nfp)
+{
+  size_t n = 0;
+  for (int i = 0; i < nfp; i++)
+    n += (size_t)(meta[FCM__EMBED_FMETA * i + 2] + meta[FCM__EMBED_FMETA * i + 3]);
+  return 3 * n;
+}
+
+fcm_status fcm__embed_copy_face_polygons(fcm_ctx *ctx, const fcm_cell_rules *Q, fcm_index c,
+                                         int **meta, double **x, int *nfp)
+{
+  fcm_status st = FCM_OK;
+  const int n = Q->face_nfp[c];
+  *nfp = n;
+  *meta = NULL, *x = NULL;
+  if (n <= 0) return FCM_OK;
+  const size_t nx = face_coords(Q->face_meta[c], n);
+  FCM__ALLOC_WITH(fcm__malloc, ctx, FCM__EMBED_FMETA * (size_t)n, *meta);
+  FCM__ALLOC_WITH(fcm__malloc, ctx, nx, *x);
+  memcpy(*meta, Q->face_meta[c], FCM__EMBED_FMETA * (size_t)n * sizeof **meta);
+  memcpy(*x, Q->face_x[c], nx * sizeof **x);
+cleanup:
+  return st;
+}
+
+fcm_status fcm__embed_keep_face_polygons(const build *B, fcm_cell_rules *R, cell_out *out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_index nc = R->num_cells;
+  const fcm_cell_rules *Q = B->prev;
+  if (!B->keep || !B->rebuild) return FCM_OK;
+  FCM_ALLOC(ctx, (size_t)nc + 1, R->face_nfp);
+  FCM_ALLOC(ctx, (size_t)nc + 1, R->face_meta);
+  FCM_ALLOC(ctx, (size_t)nc + 1, R->face_x);
+  for (fcm_index c = 0; c < nc; c++) {
+    cell_out *o = out + c;
+    R->face_nfp[c] = -1;
+    if (o->fp_keep) { /* moved: out no longer frees them */
+      R->face_nfp[c] = o->nfp;
+      R->face_meta[c] = o->fmeta, R->face_x[c] = o->fx;
+      o->fmeta = NULL, o->fx = NULL;
+    } else if (!B->rebuild[c] && Q->face_nfp && Q->face_nfp[c] >= 0) {
+      FCM_TRY(ctx, fcm__embed_copy_face_polygons(ctx, Q, c, R->face_meta + c, R->face_x + c,
+                                                 R->face_nfp + c));
+    }
+  }
+cleanup:
   return st;
 }
 

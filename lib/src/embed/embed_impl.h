@@ -77,6 +77,17 @@ struct fcm_cell_rules {
    * node with such a cell is in the links' region, so the links between the pieces of a
    * node's support are all known when one of its cells is reached. */
   unsigned char *reached;
+  /* cell_mvol[c]: a body given by its surface alone, the body's volume in cell c as the cut
+   * cells' split measures it (fcm__parts' whole_mvol), kept from cut to cut; NaN where not
+   * measured yet (NULL without cuts). */
+  double *cell_mvol;
+  /* face_nfp[c] >= 0: cell c's face polygons (face_meta[c], FCM__EMBED_FMETA ints each, and
+   * face_x[c]: fcm__parts' fmeta and fx) made from the cuts' triangles that reach it in one
+   * pass, as a cut that does not reach it makes them again; -1: none kept (NULL without
+   * cuts). */
+  int *face_nfp;
+  int **face_meta;
+  double **face_x;
   /* piece_parent[p]: the piece of the rules this object extends that holds piece p (-1
    * for rules made by fcm_cell_rules_create()); prev_num_pieces: how many that object had.
    * piece_component[p]: the number of piece p among the connected components of its cell's
@@ -288,6 +299,9 @@ int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double 
 fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsigned char *inner,
                                       fcm_index *ref);
 
+/* The ints per face polygon in fcm__parts' and cell_out's fmeta. */
+#define FCM__EMBED_FMETA 5
+
 /* Convex parts of the embedded geometry inside one background cell and the material piece
  * of each: the clipped embedded cells, split by the cut triangles that reach the cell. */
 typedef struct fcm__parts {
@@ -301,8 +315,9 @@ typedef struct fcm__parts {
   fcm__poly w[3], scratch; /* splitting workspace */
   fcm__idbuf tcand;        /* cut triangles reaching the cell, ascending */
   /* Polygons of part faces lying on the cell's faces (fcm__embed_face_polygons): polygon i
-   * is on cell face fmeta[4i], belongs to piece fmeta[4i+1], has fmeta[4i+2] vertices and its
-   * part fmeta[4i+3]: stored consecutively in fx (x 3), the polygon's then its part's. */
+   * is on cell face fmeta[F i], belongs to piece fmeta[F i+1], has fmeta[F i+2] vertices and
+   * its part fmeta[F i+3], stored consecutively in fx (x 3), the polygon's then its part's;
+   * fmeta[F i+4] is 1 where the body fills the part (F = FCM__EMBED_FMETA). */
   double *fx;
   int *fmeta;
   size_t nfx, capfx, nfp, capfp;
@@ -315,6 +330,9 @@ typedef struct fcm__parts {
   struct fcm__material *mat;
   double *mvol;
   int whole; /* with mat: the one part is the cell itself, unsplit */
+  /* with mat: the body's volume in the whole cell; NaN: not known, fcm__embed_drop_dry()
+   * measures it (the caller sets it before fcm__embed_cell_parts() and reads it after) */
+  double whole_mvol;
 } fcm__parts;
 
 void fcm__embed_parts_free(fcm_ctx *ctx, fcm__parts *P);
@@ -361,6 +379,13 @@ int fcm__embed_clip_to_part_flat(const fcm__parts *P, size_t i, double *x, int n
 /* How far x lies outside part i of P: the largest signed distance to the planes of its faces
  * with area (<= 0 inside). */
 double fcm__embed_part_excess(const fcm__parts *P, size_t i, const double x[3]);
+
+/* fcm__embed_clip_to_part() and fcm__embed_part_excess() on the part's planes pl (np of them,
+ * from fcm__embed_part_planes(); tol: the part's clipping tolerance), the same results, for
+ * many polygons or points against one part. */
+int fcm__embed_clip_to_planes(const fcm__plane *pl, int np, double tol, double *x, int n, int cap,
+                              const double nrm[3], double *work);
+double fcm__embed_planes_excess(const fcm__plane *pl, int np, const double x[3]);
 
 /* ---------------------------------------------------------------- pieces of output points
  * (piece_locate.c) Where points and triangles of the embedded geometry's boundary lie among
@@ -716,6 +741,14 @@ int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const fcm__embed
                                 const double *a, int na, const double *b, int nb,
                                 const double nb_normal[3]);
 
+/* fcm__embed_overlap_material() where `full` says whether the body fills one of the two parts
+ * (fcm__embed_part_full()): then the half of the prism on that part's side is material, and an
+ * overlap of more than 4 times the area threshold is covered without the moments (their
+ * answer, half the prism at least, is above twice the threshold). */
+int fcm__embed_overlap_material_full(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
+                                     const double *a, int na, const double *b, int nb,
+                                     const double nb_normal[3], int full);
+
 /* Split every part of P by triangle t (its plane and edge planes, as a cut's) and drop the
  * emptied ones. */
 /* Split part i of P by triangle t (as fcm__embed_parts_split does each part): its pieces in slot
@@ -756,8 +789,9 @@ fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell,
                                       int piece, fcm__embed_ws *ws, double *volume);
 
 /* Surface body (P->mat): the body's volume in each part into P->mvol where it is not known
- * (0: not computed; < 0: a piece of a part wholly inside the body, its own volume); parts with
- * no more than their vmin are dropped. Nothing without P->mat. */
+ * (0: not computed; < 0: a piece of a part wholly inside the body, its own volume; the whole
+ * cell: P->whole_mvol where known, else measured into it); parts with no more than their vmin
+ * are dropped. Nothing without P->mat. */
 fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P);
 
 /* Surface body: whether part i lies wholly inside the body (its material, P->mvol, is its

@@ -132,6 +132,7 @@ static fcm_status load_cell(fcm__embed_finder *f, fcm_index c, int parts)
   if (!parts || f->has_parts) goto cleanup;
   if (!f->P) FCM_ALLOC(ctx, 1, f->P);
   fcm__parts *P = f->P;
+  P->whole_mvol = R->cell_mvol ? R->cell_mvol[c] : NAN;
   FCM_TRY(ctx, fcm__embed_cell_parts(ctx, f->geom, f->tree, &f->C, R->opts.clip_rtol,
                                      R->opts.sliver_rtol, &f->ws, P, NULL));
   P->tcand.n = 0;

@@ -830,6 +830,22 @@ int fcm__embed_part_planes(const fcm__parts *P, size_t i, fcm__plane *pl)
   return n;
 }
 
+int fcm__embed_clip_to_planes(const fcm__plane *pl, int np, double tol, double *x, int n, int cap,
+                              const double nrm[3], double *work)
+{
+  for (int f = 0; f < np && n >= 3; f++)
+    n = fcm__geom_polygon_clip(x, n, cap, pl + f, tol, fcm__vec3_dot(nrm, pl[f].n) > 0.0, work);
+  return n;
+}
+
+double fcm__embed_planes_excess(const fcm__plane *pl, int np, const double x[3])
+{
+  double e = -HUGE_VAL;
+  for (int f = 0; f < np; f++)
+    e = fmax(e, fcm__vec3_dot(pl[f].n, x) - pl[f].d);
+  return e;
+}
+
 double fcm__embed_part_excess(const fcm__parts *P, size_t i, const double x[3])
 {
   const fcm__poly *p = P->poly + i;

@@ -215,6 +215,30 @@ cleanup:
 }
 
 /* Phase 3: concatenate the pieces' volume and surface rules in cell order. */
+/* Cell c's pieces' rules, surface rules and cut faces from o into R's arrays (their offsets
+ * set). */
+static void gather_cell(fcm_cell_rules *R, const cell_out *o, fcm_index c)
+{
+  for (int i = 0; i < o->np; i++) {
+    const piece_out *q = o->pc + i;
+    const fcm_index p = R->piece_off[c] + i;
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+      const size_t n = (size_t)(R->off[k][p + 1] - R->off[k][p]), o0 = (size_t)R->off[k][p];
+      if (!n) continue;
+      memcpy(R->points[k] + 3 * o0, q->pts[k], 3 * n * sizeof(double));
+      memcpy(R->weights[k] + o0, q->w[k], n * sizeof(double));
+      memcpy(R->flags[k] + o0, q->flag[k], n);
+    }
+    if (q->ncf) memcpy(R->cfxi + 9 * R->cfoff[p], q->cfxi, 9 * (size_t)q->ncf * sizeof(double));
+    const size_t n = (size_t)q->ns, o0 = (size_t)R->soff[p];
+    if (!n) continue;
+    memcpy(R->spoints + 3 * o0, q->spts, 3 * n * sizeof(double));
+    memcpy(R->sweights + o0, q->sw, n * sizeof(double));
+    memcpy(R->snormals + 3 * o0, q->snrm, 3 * n * sizeof(double));
+    memcpy(R->stris + o0, q->stri, n * sizeof(fcm_index));
+  }
+}
+
 fcm_status fcm__embed_gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_out *out,
                                    const fcm_cell_rules *prev)
 {
@@ -252,49 +276,25 @@ fcm_status fcm__embed_gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_o
     FCM_ALLOC(ctx, 3 * tot, R->points[k]);
     FCM_ALLOC(ctx, tot, R->weights[k]);
     FCM_ALLOC(ctx, tot, R->flags[k]);
-    for (fcm_index c = 0; c < nc; c++)
-      for (int i = 0; i < out[c].np; i++) {
-        const fcm_index p = R->piece_off[c] + i;
-        const size_t n = (size_t)(off[p + 1] - off[p]), o0 = (size_t)off[p];
-        if (!n) continue;
-        memcpy(R->points[k] + 3 * o0, out[c].pc[i].pts[k], 3 * n * sizeof(double));
-        memcpy(R->weights[k] + o0, out[c].pc[i].w[k], n * sizeof(double));
-        memcpy(R->flags[k] + o0, out[c].pc[i].flag[k], n);
-      }
   }
   FCM_ALLOC(ctx, (size_t)np + 1, R->cfoff);
-  for (fcm_index c = 0; c < nc; c++)
-    for (int i = 0; i < out[c].np; i++) {
-      const fcm_index p = R->piece_off[c] + i;
-      R->cfoff[p + 1] = R->cfoff[p] + out[c].pc[i].ncf;
-    }
-  FCM_ALLOC(ctx, 9 * (size_t)R->cfoff[np] + 1, R->cfxi);
-  for (fcm_index c = 0; c < nc; c++)
-    for (int i = 0; i < out[c].np; i++)
-      if (out[c].pc[i].ncf)
-        memcpy(R->cfxi + 9 * R->cfoff[R->piece_off[c] + i], out[c].pc[i].cfxi,
-               9 * (size_t)out[c].pc[i].ncf * sizeof(double));
   R->soff[0] = 0;
   for (fcm_index c = 0; c < nc; c++)
     for (int i = 0; i < out[c].np; i++) {
       const fcm_index p = R->piece_off[c] + i;
+      R->cfoff[p + 1] = R->cfoff[p] + out[c].pc[i].ncf;
       R->soff[p + 1] = R->soff[p] + out[c].pc[i].ns;
     }
+  FCM_ALLOC(ctx, 9 * (size_t)R->cfoff[np] + 1, R->cfxi);
   const size_t tot = (size_t)R->soff[np];
   FCM_ALLOC(ctx, 3 * tot, R->spoints);
   FCM_ALLOC(ctx, tot, R->sweights);
   FCM_ALLOC(ctx, 3 * tot, R->snormals);
   FCM_ALLOC(ctx, tot, R->stris);
+  /* the copies, each cell's into its own ranges */
+#pragma omp parallel for schedule(dynamic, 256) num_threads(fcm_ctx_num_threads(ctx))
   for (fcm_index c = 0; c < nc; c++)
-    for (int i = 0; i < out[c].np; i++) {
-      const piece_out *o = out[c].pc + i;
-      const size_t n = (size_t)o->ns, o0 = (size_t)R->soff[R->piece_off[c] + i];
-      if (!n) continue;
-      memcpy(R->spoints + 3 * o0, o->spts, 3 * n * sizeof(double));
-      memcpy(R->sweights + o0, o->sw, n * sizeof(double));
-      memcpy(R->snormals + 3 * o0, o->snrm, 3 * n * sizeof(double));
-      memcpy(R->stris + o0, o->stri, n * sizeof(fcm_index));
-    }
+    gather_cell(R, out + c, c);
 cleanup:
   return st;
 }

@@ -28,6 +28,9 @@ typedef struct piece_out {
   double residual[FCM_RULE_KIND_COUNT];
   double tsimp[FCM_RULE_KIND_COUNT]; /* fcm_simplify's time_total */
   unsigned char copied; /* rules copied from the rules being extended (not counted as built) */
+  /* pts, w, flag, spts, sw, snrm, stri (borrowed) and cfxi (cf_borrowed) point into the rules
+   * being extended: read only, not freed */
+  unsigned char borrowed, cf_borrowed;
   unsigned char fitted; /* rules fitted on surface moments (at most M points: not simplified) */
   int parent;    /* the piece of the same cell in the rules being extended that holds this one */
   int component; /* its number among the cell's components before empty ones were dropped */
@@ -47,10 +50,13 @@ typedef struct cell_out {
   piece_out *pc;
   double volume;
   double dropped_area; /* a dropped cell's share of the embedded surface (surface rules on) */
-  int nfp; /* face polygons: meta (face, piece, vertices, part vertices) x nfp, coordinates fx
-              (the polygon's, then its part's) */
+  int nfp;             /* face polygons: meta (FCM__EMBED_FMETA each) x nfp, coordinates fx (the
+                          polygon's, then its part's) */
   int *fmeta;
   double *fx;
+  /* the face polygons come from the parts of the earlier cuts' triangles alone, split in one
+   * pass (a region cell no new triangle reaches): the rules keep them for the next cut */
+  unsigned char fp_keep;
 } cell_out;
 
 /* Everything the per-cell work reads; the trees and rules are owned (fcm__embed_build_release). */
@@ -85,6 +91,7 @@ typedef struct build {
   fcm_aabb_tree *cut_tree;
   const fcm__cut_tri *cut_tris;
   unsigned char *region, *rebuild, *prev_region, *same_links;
+  double *cell_mvol; /* R->cell_mvol for a body given by its surface, else NULL */
   const fcm_cell_rules *prev;
   fcm_index first_new; /* cut triangles from here on are new (those of the cut being added) */
   int keep; /* cuts: keep the cells the new cut leaves unchanged, and the links of cells it does
@@ -199,5 +206,14 @@ fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new
 
 /* Phase 3b (cuts only): the links between pieces of face-neighbouring region cells. */
 fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell_out *out);
+
+/* Phase 3c (cuts only): the face polygons R keeps for the next cut (fcm_cell_rules'
+ * face_nfp): those of the cells out marks fp_keep (moved from out), and the earlier rules'
+ * of the cells the new cut does not reach. */
+fcm_status fcm__embed_keep_face_polygons(const build *B, fcm_cell_rules *R, cell_out *out);
+
+/* Copies of cell c's face polygons that Q keeps (Q->face_nfp[c] >= 0): *nfp of them. */
+fcm_status fcm__embed_copy_face_polygons(fcm_ctx *ctx, const fcm_cell_rules *Q, fcm_index c,
+                                         int **meta, double **x, int *nfp);
 
 #endif /* FCM_EMBED_RULES_IMPL_H */

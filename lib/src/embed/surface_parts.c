@@ -497,12 +497,34 @@ int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const fcm__embed
                                 const double *a, int na, const double *b, int nb,
                                 const double nb_normal[3])
 {
-  const double size = cell->size;
+  return fcm__embed_overlap_material_full(ctx, m, cell, a, na, b, nb, nb_normal, 0);
+}
+
+/* The area of the planar polygon x (n vertices). */
+static double polygon_area(const double *x, int n)
+{
+  double a[3] = {0.0, 0.0, 0.0};
+  for (int i = 1; i + 1 < n; i++) {
+    double e1[3], e2[3], t[3];
+    for (int d = 0; d < 3; d++)
+      e1[d] = x[3 * i + d] - x[d], e2[d] = x[3 * (i + 1) + d] - x[d];
+    fcm__vec3_cross(e1, e2, t);
+    for (int d = 0; d < 3; d++)
+      a[d] += 0.5 * t[d];
+  }
+  return fcm__vec3_norm(a);
+}
+
+int fcm__embed_overlap_material_full(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
+                                     const double *a, int na, const double *b, int nb,
+                                     const double nb_normal[3], int full)
+{
+  const double size = cell->size, atol = FACE_AREA_RTOL * size * size;
   double x[3 * FCM__POLY_MAX_VERTS];
   int n = 0;
   fcm__embed_overlap(a, na, b, nb, nb_normal, FCM__EMBED_MATCH_RTOL * size, x, &n);
-  return fcm__material_on_face(ctx, m, cell, x, n, nb_normal, PRISM_RTOL * size,
-                               FACE_AREA_RTOL * size * size);
+  if (full && n >= 3 && polygon_area(x, n) > 4.0 * atol) return 1;
+  return fcm__material_on_face(ctx, m, cell, x, n, nb_normal, PRISM_RTOL * size, atol);
 }
 
 /* Split the parts of Q by the boundary triangles ids (n; all that reach inside the parts), each
@@ -661,9 +683,10 @@ static double tri_area2(const fcm_geometry *g, fcm_index t)
 }
 
 /* Join the components of the kept triangles (m->uf) whose material a path inside the body and
- * the part links: from a point of one triangle a short step inwards, straight to such a point
- * of the other's, crossing no boundary triangle. Up to 4 triangles of each component try. */
-static void join_through_body(fcm__material *m, const fcm__parts *P, size_t i, int nk, double tol)
+ * the part (its planes pl, np of them) links: from a point of one triangle a short step
+ * inwards, straight to such a point of the other's, crossing no boundary triangle. Up to 4
+ * triangles of each component try. */
+static void join_through_body(fcm__material *m, const fcm__plane *pl, int np, int nk, double tol)
 {
   enum { TRIES = 4 };
   int *tried = m->edges; /* per component root (the edges are no longer needed) */
@@ -681,7 +704,8 @@ static void join_through_body(fcm__material *m, const fcm__parts *P, size_t i, i
         x[0][d] = cs[d], x[1][d] = cs[d] - hs * cs[3 + d];
         x[3][d] = ct[d], x[2][d] = ct[d] - ht * ct[3 + d];
       }
-      if (!(fcm__embed_part_excess(P, i, x[1]) < -tol && fcm__embed_part_excess(P, i, x[2]) < -tol))
+      if (!(fcm__embed_planes_excess(pl, np, x[1]) < -tol &&
+            fcm__embed_planes_excess(pl, np, x[2]) < -tol))
         continue;
       if (path_clear(m, nk, (const double(*)[3])x, s, t))
         m->uf[lump_find(m->uf, s)] = lump_find(m->uf, t);
@@ -730,12 +754,13 @@ static fcm_status one_lump(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell
     for (int d = 0; d < 3; d++)
       u[d] = x[3 + d] - x[d], v[d] = x[6 + d] - x[d];
     fcm__vec3_cross(u, v, nrm);
-    const int n = fcm__embed_clip_to_part(P, i, x, 3, FCM__POLY_MAX_VERTS, nrm, work);
+    const int n =
+        fcm__embed_clip_to_planes(pl, np, P->tol[i], x, 3, FCM__POLY_MAX_VERTS, nrm, work);
     if (n < 3) continue;
     for (int a = 0; a < n; a++)
       for (int d = 0; d < 3; d++)
         c[d] += x[3 * a + d] / n;
-    if (!(fcm__embed_part_excess(P, i, c) < -tol)) continue;
+    if (!(fcm__embed_planes_excess(pl, np, c) < -tol)) continue;
     for (int a = 0; a < 3; a++, ne++) {
       const int p = (int)tv[a], q = (int)tv[(a + 1) % 3];
       m->edges[3 * ne] = FCM_MIN(p, q), m->edges[3 * ne + 1] = FCM_MAX(p, q);
@@ -757,7 +782,7 @@ static fcm_status one_lump(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell
       continue;
     m->uf[lump_find(m->uf, a[2])] = lump_find(m->uf, b[2]);
   }
-  join_through_body(m, P, i, nk, tol);
+  join_through_body(m, pl, np, nk, tol);
   for (int t = 1; t < nk && *one; t++)
     *one = lump_find(m->uf, t) == lump_find(m->uf, 0);
 cleanup:
@@ -822,10 +847,13 @@ fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__p
       if (P->mvol[i] < 0.0) P->mvol[i] = fcm__geom_poly_volume(P->poly + i);
       continue;
     }
-    if (P->whole && cell->affine)
+    if (P->whole && !isnan(P->whole_mvol))
+      P->mvol[i] = P->whole_mvol; /* measured so at an earlier cut */
+    else if (P->whole && cell->affine)
       FCM_TRY(ctx, fcm__material_cell(ctx, P->mat, NULL, cell, NULL, P->mvol + i));
     else
       FCM_TRY(ctx, fcm__material_poly(ctx, P->mat, P->poly + i, NULL, cell, NULL, P->mvol + i));
+    if (P->whole) P->whole_mvol = P->mvol[i];
     if (!(P->mvol[i] > P->vmin[i])) P->poly[i].nv = P->poly[i].nf = 0;
   }
   fcm__embed_parts_compact(P);
