@@ -137,6 +137,8 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   fcm__free(ctx, I->cut_ordering);
   fcm__free(ctx, I->blk_mass);
   fcm__free(ctx, I->cut_same);
+  fcm__free(ctx, I->cut_rows);
+  fcm__free(ctx, I->cut_dirty);
   fcm_csr_destroy(&I->M);
   fcm_csr_destroy(&I->H);
   fcm_csr_destroy(&I->D);
@@ -519,8 +521,7 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
   fcm_linear_form form = fcm_linear_form_default();
   form.material = &I->mat; /* linear assembly: mass and body forces */
   if (I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) {
-    FCM_TRY(ctx, fcm__space_matrix_create_rows_from(I->space, I->cut_give ? I->cut_give->M : NULL,
-                                                    &I->M));
+    FCM_TRY(ctx, fcm__sim_cut_mass_matrix(I, &I->M)); /* after a cut: the kept rows taken */
     form.term = FCM_LINEAR_MASS;
     st = fcm__sim_assemble_kept(I, &form, I->M, NULL, &I->blk_mass,
                                 I->cut_old ? I->cut_old->blk_mass : NULL);
@@ -532,6 +533,7 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
   for (int k = 0; k < I->num_loads; k++) {
     sim_load *l = &I->loads[k];
     FCM_ALLOC(ctx, I->n, l->f);
+    if (I->cut_rows) fcm__sim_cut_load(I, k, l->f);
     form.accel = l->accel;
     form.field = l->field;
     form.user = l->field_user;
@@ -729,6 +731,8 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   I->cut_old = NULL; /* borrowed for the setup only */
   I->cut_give = NULL;
   FCM_FREE(ctx, I->cut_same);
+  FCM_FREE(ctx, I->cut_rows);
+  FCM_FREE(ctx, I->cut_dirty);
   FCM_TRY(ctx, st);
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, u);
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, v);

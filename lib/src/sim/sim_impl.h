@@ -289,6 +289,14 @@ struct fcm_integrator {
   fcm__backend backend;
   unsigned char *owned;            /* n: the backend's owned DOFs (a copy of backend.owned) */
   const struct sim_solver *solver; /* the linear solver of the Newton systems (linsolve.c) */
+
+  /* During the setup after a cut (cut_update.c, fcm__sim_cut_prepare_blocks()): per copy, the
+   * copy of cut_old's space whose rows of the mass matrix and entries of the loads this
+   * integrator's take (-1: summed again; cut_dirty flags those); NULL: every row summed.
+   * cut_kept_copies: the copies taken at the last cut. */
+  fcm_index *cut_rows;
+  unsigned char *cut_dirty;
+  fcm_index cut_kept_copies;
 };
 
 enum { SIM_H_INVALID = 0, SIM_H_TANGENT = 1, SIM_H_SYSTEM = 2 };
@@ -352,6 +360,15 @@ fcm_status fcm__sim_copy_effects(const fcm_integrator *old, fcm_integrator *I);
  * setup_info.cut_kept_elements). @return as the assembly. (cut_update.c) */
 fcm_status fcm__sim_assemble_kept(fcm_integrator *I, const fcm_linear_form *form, fcm_csr *A,
                                   double *f, double **blocks, const double *old_blocks);
+
+/* During the setup after a cut with I->cut_rows: the mass matrix on I's space, its rows of the
+ * kept copies (I->cut_rows) old's rows, moved within old's values where I takes them
+ * (I->cut_give), else copied from old's; the other rows zero, to be summed by
+ * fcm__sim_assemble_kept() (which sums only those while I->cut_rows is set). (cut_update.c) */
+fcm_status fcm__sim_cut_mass_matrix(fcm_integrator *I, fcm_csr **M);
+
+/* The same for load k's vector f (zero on entry): the kept copies' entries old's. */
+void fcm__sim_cut_load(const fcm_integrator *I, int k, double *f);
 
 /* After a cut with FCM_CUT_REUSE_STORAGE in old's options (before I's setup): I's setup
  * takes old's large arrays where they are large enough (I->cut_give); else nothing. */
