@@ -219,6 +219,34 @@ static void scatter_matrix(const fcm_space *s, fcm_index le, const double *Kp, d
   }
 }
 
+/* scatter_matrix() of a mass element given by its packed block (block_pack(): the h of each
+ * upper node block h I): the same bits, since the blocks' other six entries are zeros that add
+ * nothing to the matrix's (which hold sums of zeros, +0.0, there); only the three diagonal
+ * entries of each node pair are added to. rows: as there. */
+static void scatter_mass(const fcm_space *s, fcm_index le, const double *blk, double *vals,
+                         const unsigned char *rows)
+{
+  const int nn = s->nn;
+  const int *off = s->elem_off + (size_t)le * nn * nn;
+  for (int a = 0; a < nn; a++) {
+    const fcm_index da = fcm__space_elem_row(s, le, a);
+    if (rows && !rows[da / 3]) continue;
+    double *r0 = vals + s->row_ptr[da], *r1 = vals + s->row_ptr[da + 1];
+    double *r2 = vals + s->row_ptr[da + 2];
+    const int *oa = off + a * nn;
+    const double *h = blk + a; /* b < a: block (b, a) at b nn - b (b - 1) / 2 + a - b */
+    for (int b = 0; b < a; b++) {
+      const int x = 3 * oa[b];
+      r0[x] += *h, r1[x + 1] += *h, r2[x + 2] += *h;
+      h += nn - b - 1;
+    }
+    for (int b = a; b < nn; b++, h++) { /* b >= a: block (a, b) */
+      const int x = 3 * oa[b];
+      r0[x] += *h, r1[x + 1] += *h, r2[x + 2] += *h;
+    }
+  }
+}
+
 /* Add the element vector of element e into the global vector (rows non-NULL: at the copies
  * it flags only). */
 static void scatter_vector(const fcm_space *s, fcm_index e, const double *fe, double *vec,
@@ -471,15 +499,22 @@ static int pass_element(const fcm_space *s, const pass *ps, fcm_index le, fcm_in
   /* another process's element (a distributed run's ghost): no points, nothing to add */
   if (!fcm__space_owns(s, s->elem_cell[c])) return 1;
   const fcm_index same = ps->keep_same ? ps->keep_same[c] : -1;
+  if (same >= 0 && ps->vals && ps->keep_out) { /* a mass block kept: scattered as packed */
+    const double *in = ps->keep_in + (size_t)same * ps->bs;
+    double *out = ps->keep_out + (size_t)c * ps->bs;
+    if (out != in) memcpy(out, in, sizeof(double) * (size_t)ps->bs);
+    if (touches_rows(s, c, ps->rows)) scatter_mass(s, le, out, ps->vals, ps->rows);
+    return 1;
+  }
   if (same >= 0 && !touches_rows(s, c, ps->rows)) {
-    if (ps->keep_out)
+    if (ps->keep_out && ps->keep_out + (size_t)c * ps->bs != ps->keep_in + (size_t)same * ps->bs)
       memcpy(ps->keep_out + (size_t)c * ps->bs, ps->keep_in + (size_t)same * ps->bs,
              sizeof(double) * (size_t)ps->bs);
     return 1;
   }
   if (same >= 0) {
     block_unpack(s->nn, ps, ps->keep_in + (size_t)same * ps->bs, w);
-    if (ps->keep_out)
+    if (ps->keep_out && ps->keep_out + (size_t)c * ps->bs != ps->keep_in + (size_t)same * ps->bs)
       memcpy(ps->keep_out + (size_t)c * ps->bs, ps->keep_in + (size_t)same * ps->bs,
              sizeof(double) * (size_t)ps->bs);
     /* an element without surface points adds nothing (as surface_cell() says below) */

@@ -60,16 +60,48 @@ static int keeps_blocks(const fcm_integrator *I)
          !fcm__integrator_distributed(I, NULL);
 }
 
+/* The old blocks *give (an array of fcm__calloc_large()) as I's blocks, each kept element's
+ * moved to its own place (same[e] <= e, ascending over the kept elements: a pass downwards
+ * moves each once), *give then NULL; NULL (nothing taken) when they are not in that order or
+ * the array's room does not fit. */
+static double *take_blocks(const fcm_integrator *I, int bs, double **give)
+{
+  const fcm_index ne = I->space->num_elems, *same = I->cut_same;
+  int in_order = give && *give && same;
+  for (fcm_index e = 0, last = -1; in_order && e < ne; e++)
+    if (same[e] >= 0) in_order = same[e] <= e && same[e] > last, last = same[e];
+  void *from = in_order ? *give : NULL;
+  double *b = fcm__large_take(&from, (size_t)ne * bs + 1, sizeof *b);
+  if (!b) return NULL;
+  *give = NULL;
+  for (fcm_index e = ne - 1; e >= 0; e--)
+    if (same[e] >= 0 && same[e] != e)
+      memmove(b + (size_t)e * bs, b + (size_t)same[e] * bs, sizeof *b * (size_t)bs);
+  return b;
+}
+
 fcm_status fcm__sim_assemble_kept(fcm_integrator *I, const fcm_linear_form *form, fcm_csr *A,
-                                  double *f, double **blocks, const double *old_blocks)
+                                  double *f, double **blocks, const double *old_blocks,
+                                  double **give)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = I->ctx;
   if (!keeps_blocks(I)) return fcm_assembly_workspace_linear(I->aws, form, A, f);
   const int bs = fcm__assembly_block_size(I->space, form->term);
+  const fcm_index ne = I->space->num_elems;
   const fcm_index *same = I->cut_same && old_blocks ? I->cut_same : NULL;
-  FCM_FREE(ctx, *blocks);
-  FCM_ALLOC_RAW(ctx, (size_t)I->space->num_elems * bs + 1, *blocks);
+  fcm__free_large(ctx, *blocks);
+  *blocks = same && I->cut_give ? take_blocks(I, bs, give) : NULL;
+  if (*blocks) { /* in place: each kept element reads its own block */
+    if (!I->cut_self) {
+      FCM_ALLOC_RAW(ctx, (size_t)ne + 1, I->cut_self);
+      for (fcm_index e = 0; e < ne; e++)
+        I->cut_self[e] = same[e] >= 0 ? e : -1;
+    }
+    same = I->cut_self, old_blocks = *blocks;
+  } else {
+    FCM__ALLOC_WITH(fcm__calloc_large, ctx, (size_t)ne * bs + 1, *blocks);
+  }
   FCM_TRY(ctx, fcm__assembly_linear_blocks_rows(I->aws, form, A, f, same, old_blocks, *blocks,
                                                 I->cut_rows ? I->cut_dirty : NULL));
 cleanup:

@@ -108,7 +108,7 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   fcm_ctx *ctx = I->ctx;
   for (int k = 0; k < I->num_loads; k++) {
     fcm__free(ctx, I->loads[k].f);
-    fcm__free(ctx, I->loads[k].blk);
+    fcm__free_large(ctx, I->loads[k].blk);
   }
   fcm__free(ctx, I->loads);
   for (int k = 0; k < I->num_cons; k++)
@@ -135,10 +135,11 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   fcm__free(ctx, I->schwarz_flag);
   fcm__free(ctx, I->owned);
   fcm__free(ctx, I->cut_ordering);
-  fcm__free(ctx, I->blk_mass);
+  fcm__free_large(ctx, I->blk_mass);
   fcm__free(ctx, I->cut_same);
   fcm__free(ctx, I->cut_rows);
   fcm__free(ctx, I->cut_dirty);
+  fcm__free(ctx, I->cut_self);
   fcm_csr_destroy(&I->M);
   fcm_csr_destroy(&I->H);
   fcm_csr_destroy(&I->D);
@@ -524,7 +525,8 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
     FCM_TRY(ctx, fcm__sim_cut_mass_matrix(I, &I->M)); /* after a cut: the kept rows taken */
     form.term = FCM_LINEAR_MASS;
     st = fcm__sim_assemble_kept(I, &form, I->M, NULL, &I->blk_mass,
-                                I->cut_old ? I->cut_old->blk_mass : NULL);
+                                I->cut_old ? I->cut_old->blk_mass : NULL,
+                                I->cut_give ? &I->cut_give->blk_mass : NULL);
     /* with a backend M stays this process's partial mass matrix (its cells' part; never
      * summed: every use sums a product, fem/fem_backend.h); agree on the status only */
     FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, NULL));
@@ -541,7 +543,8 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
                 : l->kind == SIM_LOAD_BODY  ? FCM_LINEAR_BODY_FORCE_FIELD
                                             : FCM_LINEAR_SURFACE_TRACTION;
     st = fcm__sim_assemble_kept(I, &form, NULL, l->f, &l->blk,
-                                I->cut_old ? I->cut_old->loads[k].blk : NULL);
+                                I->cut_old ? I->cut_old->loads[k].blk : NULL,
+                                I->cut_give ? &I->cut_give->loads[k].blk : NULL);
     FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, l->f));
     if (l->kind == SIM_LOAD_TRACTION)
       I->setup_info.traction_assemblies++;
@@ -733,6 +736,7 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   FCM_FREE(ctx, I->cut_same);
   FCM_FREE(ctx, I->cut_rows);
   FCM_FREE(ctx, I->cut_dirty);
+  FCM_FREE(ctx, I->cut_self);
   FCM_TRY(ctx, st);
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, u);
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, v);
