@@ -406,6 +406,20 @@ cleanup:
   return st;
 }
 
+void fcm__csr_apply_rows(const fcm_csr *A, const double *x, double *y, const unsigned char *rows3)
+{
+  const fcm_index *rp = A->row_ptr;
+  const int *ci = A->col_idx;
+  const double *v = A->values;
+  for (fcm_index i = 0; i < A->nrows; i++) {
+    if (!rows3[i / 3]) continue;
+    double s = 0.0; /* fcm_csr_apply()'s sum, term by term */
+    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+      s += v[p] * x[ci[p]];
+    y[i] = s;
+  }
+}
+
 fcm_status fcm_csr_asymmetry(const fcm_csr *A, double *rel_asymmetry)
 {
   fcm_status st = FCM_OK;

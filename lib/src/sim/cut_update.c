@@ -181,6 +181,21 @@ cleanup:
   return st;
 }
 
+int fcm__sim_cut_rep_force(fcm_integrator *I)
+{
+  const double *old = I->cut_old ? I->cut_old->Ma : NULL;
+  if (!I->cut_rows || !old || !I->M) return 0;
+  const fcm_index ncopy = I->space->num_dofs / 3;
+  for (fcm_index c = 0; c < ncopy; c++) {
+    const fcm_index p = I->cut_rows[c];
+    if (p >= 0)
+      I->Ma[3 * c] = old[3 * p], I->Ma[3 * c + 1] = old[3 * p + 1],
+                I->Ma[3 * c + 2] = old[3 * p + 2];
+  }
+  fcm__csr_apply_rows(I->M, I->w1, I->Ma, I->cut_dirty);
+  return 1;
+}
+
 void fcm__sim_cut_load(const fcm_integrator *I, int k, double *f)
 {
   const double *of = I->cut_old->loads[k].f;

@@ -569,8 +569,9 @@ static fcm_status setup_representative_force(fcm_integrator *I)
   if (I->M) {
     for (fcm_index i = 0; i < n; i++)
       I->w1[i] = a[i % 3];
-    /* with a backend: the partial product, summed (n doubles) */
-    st = fcm__space_matrix_apply(I->space, I->M, I->w1, I->Ma);
+    /* with a backend: the partial product, summed (n doubles); after a cut: the rows the
+     * cut left, old's */
+    if (!fcm__sim_cut_rep_force(I)) st = fcm__space_matrix_apply(I->space, I->M, I->w1, I->Ma);
     FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, I->Ma));
   } else {
     const sim_load *same = NULL;

@@ -375,6 +375,11 @@ fcm_status fcm__sim_assemble_kept(fcm_integrator *I, const fcm_linear_form *form
  * fcm__sim_assemble_kept() (which sums only those while I->cut_rows is set). (cut_update.c) */
 fcm_status fcm__sim_cut_mass_matrix(fcm_integrator *I, fcm_csr **M);
 
+/* The same for M a_rep (I->Ma, from I->M and I->w1 = a_rep at every node): the kept copies'
+ * entries old's (their rows of M are old's, in the same order), the others M's products; 0
+ * (nothing done) without cut rows. (cut_update.c) */
+int fcm__sim_cut_rep_force(fcm_integrator *I);
+
 /* The same for load k's vector f (zero on entry): the kept copies' entries old's. */
 void fcm__sim_cut_load(const fcm_integrator *I, int k, double *f);
 
