@@ -174,3 +174,9 @@ endforeach()
 # (the cut cells' rules use one BLAS thread inside their loops whatever the run's count;
 # Hex20's mass fits are large enough for a threaded BLAS product to round differently).
 fcm_add_test(sim_cut_threads_hex20 tests/sim/cut_overlap.c ARGS hex20 threads)
+# The integrator of a cut onto a patched space takes the mass rows and load entries the cut
+# leaves from the old integrator (moved within its storage, or copied) and equals one built from
+# scratch bit for bit, over three cuts; a failed cut leaves the old one going on.
+foreach(el tet4 tet10 hex8 hex20)
+  fcm_add_test(sim_cut_rows_${el} tests/sim/cut_rows.c ARGS ${el})
+endforeach()

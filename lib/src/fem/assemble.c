@@ -189,13 +189,14 @@ static int scatter_ahead(const fcm_space *s, const double *vals)
  * (a fifth of a Hex20 stiffness assembly of 16^3 cells: lib/docs/performance.md); with
  * far >= 0, the offsets and rows of local element `far` that those prefetches will read. */
 static void scatter_matrix(const fcm_space *s, fcm_index le, const double *Kp, double *vals,
-                           fcm_index next, fcm_index far)
+                           fcm_index next, fcm_index far, const unsigned char *rows)
 {
   const int nn = s->nn;
   if (far >= 0) prefetch_layout(s, far);
   const int *off = s->elem_off + (size_t)le * nn * nn;
   for (int a = 0; a < nn; a++) {
     const fcm_index da = fcm__space_elem_row(s, le, a);
+    if (rows && !rows[da / 3]) continue; /* a row the pass leaves as it is */
     double *r0 = vals + s->row_ptr[da], *r1 = vals + s->row_ptr[da + 1];
     double *r2 = vals + s->row_ptr[da + 2];
     if (next >= 0) prefetch_rows(s, next, a, vals);
@@ -218,13 +219,53 @@ static void scatter_matrix(const fcm_space *s, fcm_index le, const double *Kp, d
   }
 }
 
-/* Add the element vector of element e into the global vector. */
-static void scatter_vector(const fcm_space *s, fcm_index e, const double *fe, double *vec)
+/* scatter_matrix() of a mass element given by its packed block (block_pack(): the h of each
+ * upper node block h I): the same bits, since the blocks' other six entries are zeros that add
+ * nothing to the matrix's (which hold sums of zeros, +0.0, there); only the three diagonal
+ * entries of each node pair are added to. rows: as there. */
+static void scatter_mass(const fcm_space *s, fcm_index le, const double *blk, double *vals,
+                         const unsigned char *rows)
+{
+  const int nn = s->nn;
+  const int *off = s->elem_off + (size_t)le * nn * nn;
+  for (int a = 0; a < nn; a++) {
+    const fcm_index da = fcm__space_elem_row(s, le, a);
+    if (rows && !rows[da / 3]) continue;
+    double *r0 = vals + s->row_ptr[da], *r1 = vals + s->row_ptr[da + 1];
+    double *r2 = vals + s->row_ptr[da + 2];
+    const int *oa = off + a * nn;
+    const double *h = blk + a; /* b < a: block (b, a) at b nn - b (b - 1) / 2 + a - b */
+    for (int b = 0; b < a; b++) {
+      const int x = 3 * oa[b];
+      r0[x] += *h, r1[x + 1] += *h, r2[x + 2] += *h;
+      h += nn - b - 1;
+    }
+    for (int b = a; b < nn; b++, h++) { /* b >= a: block (a, b) */
+      const int x = 3 * oa[b];
+      r0[x] += *h, r1[x + 1] += *h, r2[x + 2] += *h;
+    }
+  }
+}
+
+/* Add the element vector of element e into the global vector (rows non-NULL: at the copies
+ * it flags only). */
+static void scatter_vector(const fcm_space *s, fcm_index e, const double *fe, double *vec,
+                           const unsigned char *rows)
 {
   const fcm_index *ed = s->elem_dof + e * s->nn;
   for (int a = 0; a < s->nn; a++)
-    for (int i = 0; i < 3; i++)
+    for (int i = 0; i < 3 && (!rows || rows[ed[a] / 3]); i++)
       vec[ed[a] + i] += fe[3 * a + i];
+}
+
+/* 1 when element e of the full space s uses a copy that rows flags (rows NULL: 1). */
+static int touches_rows(const fcm_space *s, fcm_index e, const unsigned char *rows)
+{
+  if (!rows) return 1;
+  const fcm_index *ed = s->elem_dof + e * s->nn;
+  for (int a = 0; a < s->nn; a++)
+    if (rows[ed[a] / 3]) return 1;
+  return 0;
 }
 
 /* Per-thread scratch for `nthreads` threads. */
@@ -330,6 +371,9 @@ typedef struct pass {
   const fcm_index *keep_same;
   const double *keep_in;
   double *keep_out;
+  /* non-NULL (full space, kept blocks): the copies whose rows (matrix) or entries (vector) the
+   * pass sums; an element using none of them only passes its block to keep_out */
+  const unsigned char *rows;
 } pass;
 
 /* An element block of fcm__assembly_linear_blocks(): a mass matrix's upper node blocks are
@@ -455,9 +499,22 @@ static int pass_element(const fcm_space *s, const pass *ps, fcm_index le, fcm_in
   /* another process's element (a distributed run's ghost): no points, nothing to add */
   if (!fcm__space_owns(s, s->elem_cell[c])) return 1;
   const fcm_index same = ps->keep_same ? ps->keep_same[c] : -1;
+  if (same >= 0 && ps->vals && ps->keep_out) { /* a mass block kept: scattered as packed */
+    const double *in = ps->keep_in + (size_t)same * ps->bs;
+    double *out = ps->keep_out + (size_t)c * ps->bs;
+    if (out != in) memcpy(out, in, sizeof(double) * (size_t)ps->bs);
+    if (touches_rows(s, c, ps->rows)) scatter_mass(s, le, out, ps->vals, ps->rows);
+    return 1;
+  }
+  if (same >= 0 && !touches_rows(s, c, ps->rows)) {
+    if (ps->keep_out && ps->keep_out + (size_t)c * ps->bs != ps->keep_in + (size_t)same * ps->bs)
+      memcpy(ps->keep_out + (size_t)c * ps->bs, ps->keep_in + (size_t)same * ps->bs,
+             sizeof(double) * (size_t)ps->bs);
+    return 1;
+  }
   if (same >= 0) {
     block_unpack(s->nn, ps, ps->keep_in + (size_t)same * ps->bs, w);
-    if (ps->keep_out)
+    if (ps->keep_out && ps->keep_out + (size_t)c * ps->bs != ps->keep_in + (size_t)same * ps->bs)
       memcpy(ps->keep_out + (size_t)c * ps->bs, ps->keep_in + (size_t)same * ps->bs,
              sizeof(double) * (size_t)ps->bs);
     /* an element without surface points adds nothing (as surface_cell() says below) */
@@ -475,8 +532,8 @@ static int pass_element(const fcm_space *s, const pass *ps, fcm_index le, fcm_in
     if (ps->cell_inverted) ps->cell_inverted[c] = res->inverted;
   }
   if (ps->keep_out && same < 0) block_pack(s->nn, ps, w, ps->keep_out + (size_t)c * ps->bs);
-  if (ps->vals) scatter_matrix(s, le, w->Ke, ps->vals, next, far);
-  if (ps->vec) scatter_vector(s, c, w->fe, ps->vec);
+  if (ps->vals) scatter_matrix(s, le, w->Ke, ps->vals, next, far, ps->rows);
+  if (ps->vec) scatter_vector(s, c, w->fe, ps->vec, ps->rows);
   return 1;
 }
 
@@ -619,6 +676,14 @@ fcm_status fcm__assembly_linear_blocks(fcm_assembly_workspace *ws, const fcm_lin
                                        fcm_csr *A, double *f, const fcm_index *same,
                                        const double *blocks_in, double *blocks_out)
 {
+  return fcm__assembly_linear_blocks_rows(ws, form, A, f, same, blocks_in, blocks_out, NULL);
+}
+
+fcm_status fcm__assembly_linear_blocks_rows(fcm_assembly_workspace *ws, const fcm_linear_form *form,
+                                            fcm_csr *A, double *f, const fcm_index *same,
+                                            const double *blocks_in, double *blocks_out,
+                                            const unsigned char *rows)
+{
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = ws ? ws->ctx : NULL;
   pass keep;
@@ -637,6 +702,7 @@ fcm_status fcm__assembly_linear_blocks(fcm_assembly_workspace *ws, const fcm_lin
   keep.keep_same = same;
   keep.keep_in = blocks_in;
   keep.keep_out = blocks_out;
+  keep.rows = rows;
   FCM_TRY(ctx, linear_impl(ws, form, A, f, &keep));
 cleanup:
   return st;

@@ -114,6 +114,17 @@ struct fcm_space {
   int max_cut_points;
   fcm_rule *mass_rule; /* the standard mass rule of full cells (fcm_space_momentum()) */
   fcm__space_mass_cache *mass_cache; /* fcm_space_momentum()'s element mass blocks */
+  /* A space patched from the one before its cut (fcm__space_build_topology_cut()): per copy k,
+   * the copy p of cut_from whose matrix rows and vector entries receive exactly the terms of
+   * k's, element by element (each element of k the child of one of p's, at the same nodes), in
+   * the same order of the assembly's visit (blocks by colour, then within a block), and whose
+   * rows map entry by entry onto k's; -1 otherwise. Where the elements' terms are the same
+   * bits, k's rows and entries are then p's bits (fcm__space_cut_rows()). NULL when the
+   * topology was built anew. cut_from is compared only, never read through (it may be gone);
+   * cut_from_dofs and cut_from_elems are its sizes, checked beside it. */
+  fcm_index *cut_row_from;
+  const struct fcm_space *cut_from;
+  fcm_index cut_from_dofs, cut_from_elems;
 };
 
 /* A space whose numbering (node_dof, node_ncopy, elements, cell_elem, num_dofs, constrained
@@ -301,6 +312,10 @@ fcm_status fcm__space_matrix_create_rows(const fcm_space *s, fcm_csr **A);
 /* fcm__space_matrix_create_rows() whose values take give's storage where it is large enough
  * (fcm__csr_share_pattern_from(): give, or NULL, is then left without values). (space.c) */
 fcm_status fcm__space_matrix_create_rows_from(const fcm_space *s, fcm_csr *give, fcm_csr **A);
+/* The same, whose values, when taken from give, keep give's contents (*taken 1; the caller
+ * writes every entry: fcm__space_cut_rows()); else zero (*taken 0). (space.c) */
+fcm_status fcm__space_matrix_create_rows_keep(const fcm_space *s, fcm_csr *give, fcm_csr **A,
+                                              int *taken);
 
 /* y (num_dofs) = A x for A of fcm__space_matrix_create_rows() (x: num_dofs); y is zero on the
  * DOFs with no row. A full space: fcm_csr_apply(A, 1, x, 0, y) exactly (same bits). Each row is
@@ -431,6 +446,15 @@ FCM_COMPONENT_API fcm_status fcm__assembly_element_linear(fcm_assembly_workspace
  * for the mass (its upper node blocks are multiples of the identity), 3 nn for the force
  * terms, 0 for the stiffness (not kept). */
 int fcm__assembly_block_size(const fcm_space *s, fcm_linear_term term);
+
+/* fcm__assembly_linear_blocks() summing only the rows (matrix) or entries (vector) of the
+ * copies rows flags (NULL: all): the others are left as they are, and an element that uses
+ * none of the flagged copies and takes its block from blocks_in only passes it to blocks_out.
+ * The flagged rows receive the same terms in the same order as in a whole assembly. (assemble.c) */
+fcm_status fcm__assembly_linear_blocks_rows(fcm_assembly_workspace *ws, const fcm_linear_form *form,
+                                            fcm_csr *A, double *f, const fcm_index *same,
+                                            const double *blocks_in, double *blocks_out,
+                                            const unsigned char *rows);
 
 /* fcm_assembly_workspace_linear() (mass, body force, body-force field, surface traction; a full
  * space) keeping element blocks: element e with same[e] >= 0 (same NULL: none) takes its block

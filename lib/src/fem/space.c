@@ -365,7 +365,14 @@ fcm_status fcm__space_matrix_create_rows(const fcm_space *s, fcm_csr **A)
 
 fcm_status fcm__space_matrix_create_rows_from(const fcm_space *s, fcm_csr *give, fcm_csr **A)
 {
+  return fcm__space_matrix_create_rows_keep(s, give, A, NULL);
+}
+
+fcm_status fcm__space_matrix_create_rows_keep(const fcm_space *s, fcm_csr *give, fcm_csr **A,
+                                              int *taken)
+{
   fcm_status st = FCM_OK;
+  if (taken) *taken = 0;
   fcm_ctx *ctx = s ? s->ctx : NULL;
   FCM_CHECK(s && A, ctx, FCM_ERR_ARG, "space matrix (rows): NULL space or output pointer");
   *A = NULL;
@@ -373,9 +380,9 @@ fcm_status fcm__space_matrix_create_rows_from(const fcm_space *s, fcm_csr *give,
             "space matrix (rows): the local space has no topology (a failed rebuild)");
   FCM_TRY(ctx, check_pattern(s, "space matrix (rows)"));
   /* the space's pattern, shared (borrowed: the space outlives the matrices made on it) */
-  FCM_TRY(ctx, fcm__csr_share_pattern_from(
+  FCM_TRY(ctx, fcm__csr_share_pattern_keep(
                    ctx, fcm__space_num_rows(s), s->num_dofs, s->row_ptr, s->col_idx,
-                   s->is_local ? FCM_CSR_GENERAL : FCM_CSR_SYMMETRIC, give, A));
+                   s->is_local ? FCM_CSR_GENERAL : FCM_CSR_SYMMETRIC, give, A, taken));
 cleanup:
   return st;
 }

@@ -433,9 +433,10 @@ void fcm__space_free_topology(fcm_space *s)
 {
   fcm_ctx *ctx = s->ctx;
   fcm__space_cut_give_back(s);
-  void *arrays[] = {s->node_ptr,   s->node_adj,        s->row_ptr,     s->col_idx,    s->elem_off,
-                    s->elem_lcopy, s->color_ptr,       s->color_elems, s->local_copy, s->local_elem,
-                    s->cell_local, s->block_color_ptr, s->block_list,  s->block_elems};
+  void *arrays[] = {s->node_ptr,   s->node_adj,    s->row_ptr,     s->col_idx,
+                    s->elem_off,   s->elem_lcopy,  s->color_ptr,   s->color_elems,
+                    s->local_copy, s->local_elem,  s->cell_local,  s->block_color_ptr,
+                    s->block_list, s->block_elems, s->cut_row_from};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
     fcm__free(ctx, arrays[i]);
   s->node_ptr = s->node_adj = s->row_ptr = s->local_copy = s->local_elem = NULL;
@@ -443,6 +444,8 @@ void fcm__space_free_topology(fcm_space *s)
   s->col_idx = s->elem_off = s->elem_lcopy = NULL;
   s->cell_local = NULL;
   s->block_color_ptr = s->block_list = s->block_elems = NULL;
+  s->cut_row_from = NULL, s->cut_from = NULL;
+  s->cut_from_dofs = s->cut_from_elems = 0;
   s->num_colors = s->num_block_colors = 0;
   s->cut_kept_rows = 0;
   s->col_cap = 0;
@@ -726,6 +729,72 @@ cleanup:
   return st;
 }
 
+/* rank[e]: the position of element e in the assembly's visit of the full space s (colour by
+ * colour, the blocks of a colour in order, each block's elements in order). Two elements
+ * adding to one matrix entry share a copy, so they lie in one block or in blocks of different
+ * colours: their terms are summed in the order of their ranks. */
+static void visit_ranks(const fcm_space *s, fcm_index *rank)
+{
+  fcm_index r = 0;
+  for (int c = 0; c < s->num_block_colors; c++)
+    for (fcm_index k = s->block_color_ptr[c]; k < s->block_color_ptr[c + 1]; k++) {
+      const fcm_index first = s->block_list[k] * FCM__SPACE_BLOCK;
+      const fcm_index last = FCM_MIN(s->num_local_elems, first + FCM__SPACE_BLOCK);
+      for (fcm_index j = first; j < last; j++)
+        rank[s->block_elems[j]] = r++;
+    }
+}
+
+/* 1 when the elements of copy k (cinc[i0..i1), each kept) are visited in the same order as
+ * their parent elements: sorted by their ranks in s, their parents' ranks in from ascend. */
+static int same_visit(const fcm_index *cinc, fcm_index i0, fcm_index i1, const fcm_index *rank,
+                      const fcm_index *old_rank, const cut_map *m, fcm_index *buf)
+{
+  const fcm_index n = i1 - i0;
+  for (fcm_index i = 0; i < n; i++) { /* insertion sort by the new rank (a few elements) */
+    const fcm_index e = cinc[i0 + i];
+    fcm_index j = i;
+    for (; j > 0 && rank[buf[j - 1]] > rank[e]; j--)
+      buf[j] = buf[j - 1];
+    buf[j] = e;
+  }
+  for (fcm_index i = 1; i < n; i++)
+    if (old_rank[m->parent_elem[buf[i]]] <= old_rank[m->parent_elem[buf[i - 1]]]) return 0;
+  return 1;
+}
+
+/* s->cut_row_from: the copies whose rows are their parents' in the same order (copy_kept 2)
+ * and whose elements keep their parents' order of visit. */
+static fcm_status mark_cut_rows(fcm_space *s, const fcm_space *from, const fcm_index *cptr,
+                                const fcm_index *cinc, const cut_map *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ncopy = s->num_dofs / 3;
+  fcm_index *rank = NULL, *old_rank = NULL, *buf = NULL, most = 1;
+  for (fcm_index k = 0; k < ncopy; k++)
+    most = FCM_MAX(most, cptr[k + 1] - cptr[k]);
+  FCM_ALLOC_RAW(ctx, (size_t)s->num_elems + 1, rank);
+  FCM_ALLOC_RAW(ctx, (size_t)from->num_elems + 1, old_rank);
+  FCM_ALLOC_RAW(ctx, (size_t)most, buf);
+  FCM_ALLOC_RAW(ctx, (size_t)ncopy + 1, s->cut_row_from);
+  visit_ranks(s, rank);
+  visit_ranks(from, old_rank);
+  for (fcm_index k = 0; k < ncopy; k++)
+    s->cut_row_from[k] =
+        m->copy_kept[k] == 2 && same_visit(cinc, cptr[k], cptr[k + 1], rank, old_rank, m, buf)
+            ? m->parent[k]
+            : -1;
+  s->cut_from = from;
+  s->cut_from_dofs = from->num_dofs;
+  s->cut_from_elems = from->num_elems;
+cleanup:
+  fcm__free(ctx, rank);
+  fcm__free(ctx, old_rank);
+  fcm__free(ctx, buf);
+  return st;
+}
+
 /* 1 when from is a full space whose topology s (full, after a cut) can patch. */
 static int can_patch(const fcm_space *from, const fcm_space *s)
 {
@@ -754,6 +823,7 @@ fcm_status fcm__space_build_topology_cut(fcm_space *s, const fcm_space *from, fc
   FCM_TRY(ctx, patch_offsets(s, from, &m));
   FCM_TRY(ctx, patch_colors(s, from, cptr, cinc, &m));
   FCM_TRY(ctx, build_block_colors(s, NULL, cptr, cinc, from));
+  FCM_TRY(ctx, mark_cut_rows(s, from, cptr, cinc, &m));
 cleanup:
   if (st != FCM_OK) fcm__space_free_topology(s);
   free_cut_map(ctx, &m);

@@ -183,8 +183,16 @@ fcm_status fcm__csr_share_pattern_from(fcm_ctx *ctx, fcm_index nrows, fcm_index 
                                        const fcm_index *row_ptr, const int *col_idx,
                                        fcm_csr_kind kind, fcm_csr *give, fcm_csr **out)
 {
+  return fcm__csr_share_pattern_keep(ctx, nrows, ncols, row_ptr, col_idx, kind, give, out, NULL);
+}
+
+fcm_status fcm__csr_share_pattern_keep(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols,
+                                       const fcm_index *row_ptr, const int *col_idx,
+                                       fcm_csr_kind kind, fcm_csr *give, fcm_csr **out, int *taken)
+{
   fcm_status st = FCM_OK;
   fcm_csr *A = NULL;
+  if (taken) *taken = 0;
   FCM_CHECK(out, ctx, FCM_ERR_ARG, "csr_share_pattern: output pointer is NULL");
   *out = NULL;
   FCM_TRY(ctx, check_header(ctx, nrows, ncols, row_ptr, kind));
@@ -192,7 +200,12 @@ fcm_status fcm__csr_share_pattern_from(fcm_ctx *ctx, fcm_index nrows, fcm_index 
             "csr_share_pattern: col_idx is NULL with nnz = %lld", (long long)row_ptr[nrows]);
   FCM_TRY(ctx, new_handle(ctx, nrows, ncols, row_ptr[nrows], kind, &A));
   A->owned = 1; /* the values; the pattern is borrowed (own_row_ptr / own_col_idx NULL) */
-  A->values = values_from(ctx, give, A->nnz);
+  if (taken && give && give->owned) { /* the contents kept */
+    void *from = give->values;
+    A->values = fcm__large_take(&from, (size_t)A->nnz, sizeof *A->values);
+    if (A->values) give->values = NULL, *taken = 1;
+  }
+  if (!A->values) A->values = values_from(ctx, give, A->nnz);
   if (!A->values) {
     st = FCM_ERR_ALLOC;
     fcm__trace(ctx, __FILE__, __LINE__, __func__);
@@ -391,6 +404,20 @@ fcm_status fcm_csr_apply(const fcm_csr *A, double alpha, const double *x, double
   }
 cleanup:
   return st;
+}
+
+void fcm__csr_apply_rows(const fcm_csr *A, const double *x, double *y, const unsigned char *rows3)
+{
+  const fcm_index *rp = A->row_ptr;
+  const int *ci = A->col_idx;
+  const double *v = A->values;
+  for (fcm_index i = 0; i < A->nrows; i++) {
+    if (!rows3[i / 3]) continue;
+    double s = 0.0; /* fcm_csr_apply()'s sum, term by term */
+    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+      s += v[p] * x[ci[p]];
+    y[i] = s;
+  }
 }
 
 fcm_status fcm_csr_asymmetry(const fcm_csr *A, double *rel_asymmetry)

@@ -138,6 +138,16 @@ fcm_status fcm__csr_share_pattern_from(fcm_ctx *ctx, fcm_index nrows, fcm_index 
  * there is nothing to give back (to has values, or from none of its own). (csr.c) */
 int fcm__csr_give_back(fcm_csr *from, fcm_csr *to);
 
+/* y = A x (fcm_csr_apply() with alpha 1, beta 0: the same bits) at the rows i whose
+ * rows3[i / 3] is set; the other entries of y are left as they are. Serial. (csr.c) */
+void fcm__csr_apply_rows(const fcm_csr *A, const double *x, double *y, const unsigned char *rows3);
+
+/* fcm__csr_share_pattern_from() that leaves taken values as give held them (*taken 1: the
+ * caller writes every entry); new values are zero filled (*taken 0). (csr.c) */
+fcm_status fcm__csr_share_pattern_keep(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols,
+                                       const fcm_index *row_ptr, const int *col_idx,
+                                       fcm_csr_kind kind, fcm_csr *give, fcm_csr **A, int *taken);
+
 /* A matrix that takes over *row_ptr and *col_idx (arrays from fcm__calloc or fcm__malloc;
  * set to NULL, also on failure, when they are freed), values zero. For patterns built inside
  * the library that are already known to be valid (rows strictly increasing, in range, both

@@ -108,7 +108,7 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   fcm_ctx *ctx = I->ctx;
   for (int k = 0; k < I->num_loads; k++) {
     fcm__free(ctx, I->loads[k].f);
-    fcm__free(ctx, I->loads[k].blk);
+    fcm__free_large(ctx, I->loads[k].blk);
   }
   fcm__free(ctx, I->loads);
   for (int k = 0; k < I->num_cons; k++)
@@ -135,8 +135,11 @@ void fcm_integrator_destroy(fcm_integrator **integ)
   fcm__free(ctx, I->schwarz_flag);
   fcm__free(ctx, I->owned);
   fcm__free(ctx, I->cut_ordering);
-  fcm__free(ctx, I->blk_mass);
+  fcm__free_large(ctx, I->blk_mass);
   fcm__free(ctx, I->cut_same);
+  fcm__free(ctx, I->cut_rows);
+  fcm__free(ctx, I->cut_dirty);
+  fcm__free(ctx, I->cut_self);
   fcm_csr_destroy(&I->M);
   fcm_csr_destroy(&I->H);
   fcm_csr_destroy(&I->D);
@@ -519,11 +522,11 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
   fcm_linear_form form = fcm_linear_form_default();
   form.material = &I->mat; /* linear assembly: mass and body forces */
   if (I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) {
-    FCM_TRY(ctx, fcm__space_matrix_create_rows_from(I->space, I->cut_give ? I->cut_give->M : NULL,
-                                                    &I->M));
+    FCM_TRY(ctx, fcm__sim_cut_mass_matrix(I, &I->M)); /* after a cut: the kept rows taken */
     form.term = FCM_LINEAR_MASS;
     st = fcm__sim_assemble_kept(I, &form, I->M, NULL, &I->blk_mass,
-                                I->cut_old ? I->cut_old->blk_mass : NULL);
+                                I->cut_old ? I->cut_old->blk_mass : NULL,
+                                I->cut_give ? &I->cut_give->blk_mass : NULL);
     /* with a backend M stays this process's partial mass matrix (its cells' part; never
      * summed: every use sums a product, fem/fem_backend.h); agree on the status only */
     FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, NULL));
@@ -532,6 +535,7 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
   for (int k = 0; k < I->num_loads; k++) {
     sim_load *l = &I->loads[k];
     FCM_ALLOC(ctx, I->n, l->f);
+    if (I->cut_rows) fcm__sim_cut_load(I, k, l->f);
     form.accel = l->accel;
     form.field = l->field;
     form.user = l->field_user;
@@ -539,7 +543,8 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
                 : l->kind == SIM_LOAD_BODY  ? FCM_LINEAR_BODY_FORCE_FIELD
                                             : FCM_LINEAR_SURFACE_TRACTION;
     st = fcm__sim_assemble_kept(I, &form, NULL, l->f, &l->blk,
-                                I->cut_old ? I->cut_old->loads[k].blk : NULL);
+                                I->cut_old ? I->cut_old->loads[k].blk : NULL,
+                                I->cut_give ? &I->cut_give->loads[k].blk : NULL);
     FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, l->f));
     if (l->kind == SIM_LOAD_TRACTION)
       I->setup_info.traction_assemblies++;
@@ -564,8 +569,9 @@ static fcm_status setup_representative_force(fcm_integrator *I)
   if (I->M) {
     for (fcm_index i = 0; i < n; i++)
       I->w1[i] = a[i % 3];
-    /* with a backend: the partial product, summed (n doubles) */
-    st = fcm__space_matrix_apply(I->space, I->M, I->w1, I->Ma);
+    /* with a backend: the partial product, summed (n doubles); after a cut: the rows the
+     * cut left, old's */
+    if (!fcm__sim_cut_rep_force(I)) st = fcm__space_matrix_apply(I->space, I->M, I->w1, I->Ma);
     FCM_TRY(ctx, fcm__sim_reduce(I, st, NULL, 0, I->Ma));
   } else {
     const sim_load *same = NULL;
@@ -729,6 +735,9 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   I->cut_old = NULL; /* borrowed for the setup only */
   I->cut_give = NULL;
   FCM_FREE(ctx, I->cut_same);
+  FCM_FREE(ctx, I->cut_rows);
+  FCM_FREE(ctx, I->cut_dirty);
+  FCM_FREE(ctx, I->cut_self);
   FCM_TRY(ctx, st);
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, u);
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, v);

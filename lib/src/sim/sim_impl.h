@@ -289,6 +289,17 @@ struct fcm_integrator {
   fcm__backend backend;
   unsigned char *owned;            /* n: the backend's owned DOFs (a copy of backend.owned) */
   const struct sim_solver *solver; /* the linear solver of the Newton systems (linsolve.c) */
+
+  /* During the setup after a cut (cut_update.c, fcm__sim_cut_prepare_blocks()): per copy, the
+   * copy of cut_old's space whose rows of the mass matrix and entries of the loads this
+   * integrator's take (-1: summed again; cut_dirty flags those); NULL: every row summed.
+   * cut_kept_copies: the copies taken at the last cut. */
+  fcm_index *cut_rows;
+  unsigned char *cut_dirty;
+  fcm_index cut_kept_copies;
+  /* during that setup, where blocks are taken in place (cut_update.c): each kept element
+   * itself, -1 for the others */
+  fcm_index *cut_self;
 };
 
 enum { SIM_H_INVALID = 0, SIM_H_TANGENT = 1, SIM_H_SYSTEM = 2 };
@@ -352,11 +363,30 @@ fcm_status fcm__sim_copy_effects(const fcm_integrator *old, fcm_integrator *I);
 
 /* fcm_assembly_workspace_linear() on I's space of the mass (blocks = &I->blk_mass, old_blocks
  * the cut integrator's) or a load (its blk, the old load's): with FCM_CUT_REUSE_BLOCKS on a
- * full serial embedded space, keeping the element blocks in *blocks and, during the setup after
- * a cut, taking those of the elements the cut left from old_blocks (counted in
- * setup_info.cut_kept_elements). @return as the assembly. (cut_update.c) */
+ * full serial embedded space, keeping the element blocks in *blocks (an array of
+ * fcm__calloc_large()) and, during the setup after a cut, taking those of the elements the cut
+ * left from old_blocks (counted in setup_info.cut_kept_elements). give: where the old
+ * integrator gives its storage (I->cut_give), its field holding old_blocks, whose array then
+ * becomes *blocks with the kept blocks moved in place where it can (the field left NULL: the
+ * old integrator's next cut, after a failed one, integrates every element); else NULL.
+ * @return as the assembly. (cut_update.c) */
 fcm_status fcm__sim_assemble_kept(fcm_integrator *I, const fcm_linear_form *form, fcm_csr *A,
-                                  double *f, double **blocks, const double *old_blocks);
+                                  double *f, double **blocks, const double *old_blocks,
+                                  double **give);
+
+/* During the setup after a cut with I->cut_rows: the mass matrix on I's space, its rows of the
+ * kept copies (I->cut_rows) old's rows, moved within old's values where I takes them
+ * (I->cut_give), else copied from old's; the other rows zero, to be summed by
+ * fcm__sim_assemble_kept() (which sums only those while I->cut_rows is set). (cut_update.c) */
+fcm_status fcm__sim_cut_mass_matrix(fcm_integrator *I, fcm_csr **M);
+
+/* The same for M a_rep (I->Ma, from I->M and I->w1 = a_rep at every node): the kept copies'
+ * entries old's (their rows of M are old's, in the same order), the others M's products; 0
+ * (nothing done) without cut rows. (cut_update.c) */
+int fcm__sim_cut_rep_force(fcm_integrator *I);
+
+/* The same for load k's vector f (zero on entry): the kept copies' entries old's. */
+void fcm__sim_cut_load(const fcm_integrator *I, int k, double *f);
 
 /* After a cut with FCM_CUT_REUSE_STORAGE in old's options (before I's setup): I's setup
  * takes old's large arrays where they are large enough (I->cut_give); else nothing. */
