@@ -1,0 +1,292 @@
+/* A Galerkin plan's rows taken over from a prior plan through a cut's renumbering
+ * (fcm__ptap_create_from()): only the rows the cut changed are computed. */
+#include "la/ptap_impl.h"
+
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* What the rows taken over read: the prior, the new A and P, the old plan. */
+typedef struct carry_work {
+  const fcm__ptap_prior *pr;
+  const fcm__ptap *old;
+  const fcm_index *Ap, *Pp, *Rp, *APp, *Cp;
+  const int *Ac, *Pc, *Rc, *APc;
+  int *Cc;
+  unsigned char *prow, *keep, *ckeep; /* rows of P, A P and C that are the old ones mapped */
+  const unsigned char *same3;         /* the new plan's */
+  unsigned char *cdup;                /* per group of C's rows: R's rows shifted (their rows of
+                                         A P of one pattern): one pattern before the diagonal */
+  fcm_index n, nc;
+} carry_work;
+
+/* Is row i of P the old row mapped (the same positions)? */
+static int carry_prow(const carry_work *w, fcm_index i)
+{
+  const fcm_index io = w->pr->row_old[i];
+  if (io < 0) return 0;
+  const fcm_index *op = w->old->P_ptr, len = w->Pp[i + 1] - w->Pp[i];
+  if (op[io + 1] - op[io] != len) return 0;
+  const int *oc = w->old->P_col + op[io], *nc = w->Pc + w->Pp[i];
+  for (fcm_index q = 0; q < len; q++)
+    if (nc[q] != w->pr->crow_new[oc[q]]) return 0;
+  return 1;
+}
+
+/* Is row i of A the old row mapped, reaching only rows of P that are (prow)? */
+static int carry_arow(const carry_work *w, fcm_index i)
+{
+  const fcm__ptap_prior *pr = w->pr;
+  const fcm_index io = pr->row_old[i], p0 = w->Ap[i], len = w->Ap[i + 1] - p0;
+  if (io < 0) return 0;
+  const int *ac = w->Ac + p0;
+  if (pr->A_col) {
+    if (pr->A_ptr[io + 1] - pr->A_ptr[io] != len) return 0;
+    const int *oc = pr->A_col + pr->A_ptr[io];
+    for (fcm_index q = 0; q < len; q++)
+      if (ac[q] != pr->row_new[oc[q]] || !w->prow[ac[q]]) return 0;
+    return 1;
+  }
+  const fcm_index g = io / 3, deg = pr->A_ptr[g + 1] - pr->A_ptr[g];
+  if (3 * deg != len) return 0;
+  const fcm_index *adj = pr->A_adj + pr->A_ptr[g];
+  for (fcm_index q = 0; q < deg; q++)
+    for (int c = 0; c < 3; c++) {
+      const int j = ac[3 * q + c];
+      if (j != pr->row_new[3 * adj[q] + c] || !w->prow[j]) return 0;
+    }
+  return 1;
+}
+
+/* Copy-graph mode (A_col NULL): are copy k's three rows of A the old copy's rows mapped (its
+ * graph rows compared, a copy at a time), reaching only rows of P that are (prow)? */
+static int carry_acopy(const carry_work *w, fcm_index k)
+{
+  const fcm__ptap_prior *pr = w->pr;
+  const fcm_index *ro = pr->row_old + 3 * k;
+  if (ro[0] < 0 || ro[0] % 3 != 0 || ro[1] != ro[0] + 1 || ro[2] != ro[0] + 2) return 0;
+  const fcm_index g = ro[0] / 3, deg = pr->A_ptr[g + 1] - pr->A_ptr[g];
+  if (pr->G_ptr[k + 1] - pr->G_ptr[k] != deg) return 0;
+  const fcm_index *adj = pr->A_adj + pr->A_ptr[g], *nadj = pr->G_adj + pr->G_ptr[k];
+  for (fcm_index q = 0; q < deg; q++) {
+    const fcm_index j = nadj[q], *rn = pr->row_new + 3 * adj[q];
+    if (rn[0] != 3 * j || rn[1] != 3 * j + 1 || rn[2] != 3 * j + 2 || !w->prow[3 * j] ||
+        !w->prow[3 * j + 1] || !w->prow[3 * j + 2])
+      return 0;
+  }
+  return 1;
+}
+
+/* Row i of A P the plain way (columns first reached, A's row order, then P's): the count, the
+ * columns into out (NULL: counted only). */
+static fcm_index carry_ap_plain(const carry_work *w, fcm_index i, fcm_index *mk, fcm_index tag,
+                                int *out)
+{
+  fcm_index cnt = 0;
+  for (fcm_index p = w->Ap[i]; p < w->Ap[i + 1]; p++)
+    for (fcm_index q = w->Pp[w->Ac[p]]; q < w->Pp[w->Ac[p] + 1]; q++) {
+      const int j = w->Pc[q];
+      if (mk[j] == tag) continue;
+      mk[j] = tag;
+      if (out) out[cnt] = j;
+      cnt++;
+    }
+  return cnt;
+}
+
+/* Row I of C the plain way (the columns of the rows of A P that row I of R reaches; the
+ * diagonal is added afterwards, as fcm__ptap_create() does), sorted into out (NULL: counted
+ * only). */
+static fcm_index carry_c_plain(const carry_work *w, fcm_index I, fcm_index *mk, fcm_index tag,
+                               int *out)
+{
+  fcm_index cnt = 0;
+  for (fcm_index p = w->Rp[I]; p < w->Rp[I + 1]; p++)
+    for (fcm_index q = w->APp[w->Rc[p]]; q < w->APp[w->Rc[p] + 1]; q++) {
+      const int j = w->APc[q];
+      if (mk[j] == tag) continue;
+      mk[j] = tag;
+      if (out) out[cnt] = j;
+      cnt++;
+    }
+  if (out) fcm__ptap_sort_ints(out, cnt);
+  return cnt;
+}
+
+/* Is row I of C the old row mapped: its row of R the old one mapped, every row of A P it
+ * reaches taken over (keep)? */
+static int carry_crow(const carry_work *w, fcm_index I)
+{
+  const fcm__ptap_prior *pr = w->pr;
+  const fcm_index Io = pr->crow_old[I], len = w->Rp[I + 1] - w->Rp[I];
+  if (Io < 0 || w->old->R_ptr[Io + 1] - w->old->R_ptr[Io] != len) return 0;
+  const int *oc = w->old->R_col + w->old->R_ptr[Io], *rc = w->Rc + w->Rp[I];
+  for (fcm_index q = 0; q < len; q++)
+    if (rc[q] != pr->row_new[oc[q]] || !w->keep[rc[q]]) return 0;
+  return 1;
+}
+
+/* Row I of C taken over: the old row mapped, sorted. */
+static void carry_c_taken(const carry_work *w, fcm_index I, int *out)
+{
+  const fcm_index Io = w->pr->crow_old[I], *op = fcm_csr_row_ptr(w->pr->C);
+  const int *oc = fcm_csr_col_idx(w->pr->C) + op[Io];
+  const fcm_index len = op[Io + 1] - op[Io];
+  int sorted = 1;
+  for (fcm_index q = 0; q < len; q++) {
+    out[q] = (int)w->pr->crow_new[oc[q]];
+    sorted &= q == 0 || out[q] > out[q - 1];
+  }
+  if (!sorted) fcm__ptap_sort_ints(out, len);
+}
+
+/* The rows of A P (stage 0) or of C (stage 1): which are taken over, their counts (pass 0) and
+ * columns (pass 1) into ptr / col, by nt threads, marks mk (nt x nc, -1 on the first call). */
+static void carry_rows(carry_work *w, int stage, int pass, fcm_index *ptr, int *col, fcm_index *mk,
+                       int nt)
+{
+  const fcm_index nrow = stage ? w->nc : w->n, base = (2 * stage + pass) * (w->n + w->nc);
+  unsigned char *keep = stage ? w->ckeep : w->keep;
+  const unsigned char *dup3 = stage ? w->cdup : w->same3;
+#pragma omp parallel num_threads(nt) if (nt > 1 && nrow > 4096)
+  {
+    fcm_index *m = mk + (size_t)omp_get_thread_num() * (size_t)(w->nc + 1);
+    /* chunks of whole nodes: a node's rows 3 k + 1, 3 k + 2 follow row 3 k in one thread */
+#pragma omp for schedule(dynamic, 255)
+    for (fcm_index i = 0; i < nrow; i++) {
+      if (!pass && stage) keep[i] = (unsigned char)carry_crow(w, i);
+      if (!pass && !stage)
+        keep[i] = (unsigned char)(w->pr->A_col ? carry_arow(w, i)
+                                  : i % 3 == 0 ? i + 2 < nrow && carry_acopy(w, i / 3)
+                                               : keep[i - 1]);
+      /* the row before's columns: A P's rows of a node of one pattern in A, C's rows of R's
+       * shifted rows (computed ones, before their diagonal) */
+      if (i % 3 != 0 && dup3[i / 3] && (!stage || (!keep[i] && !keep[i - 1]))) {
+        if (!pass) ptr[i + 1] = ptr[i];
+        if (pass)
+          memcpy(col + ptr[i], col + ptr[i - 1], sizeof *col * (size_t)(ptr[i] - ptr[i - 1]));
+        continue;
+      }
+      const fcm_index io = stage ? w->pr->crow_old[i] : w->pr->row_old[i];
+      int *out = pass ? col + ptr[i] : NULL;
+      if (keep[i] && !stage) {
+        const fcm_index *op = w->old->AP_ptr;
+        const fcm_index len = op[io + 1] - op[io];
+        for (fcm_index q = 0; q < len && out; q++)
+          out[q] = (int)w->pr->crow_new[w->old->AP_col[op[io] + q]];
+        if (!pass) ptr[i + 1] = len;
+      } else if (keep[i]) {
+        const fcm_index *op = fcm_csr_row_ptr(w->pr->C);
+        if (out) carry_c_taken(w, i, out);
+        if (!pass) ptr[i + 1] = op[io + 1] - op[io];
+      } else {
+        const fcm_index cnt =
+            stage ? carry_c_plain(w, i, m, base + i, out) : carry_ap_plain(w, i, m, base + i, out);
+        if (!pass) ptr[i + 1] = cnt;
+      }
+    }
+  }
+  if (!pass)
+    for (fcm_index i = 0; i < nrow; i++)
+      ptr[i + 1] += ptr[i];
+}
+
+fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, const fcm_csr *A,
+                                 fcm_index nc, const fcm_index *P_ptr, const int *P_col,
+                                 const double *P_val, int with_diagonal, int nt, fcm__ptap **plan,
+                                 fcm_csr **C, fcm_index taken[2])
+{
+  fcm_status st = FCM_OK;
+  fcm__ptap *t = NULL;
+  fcm_index *cp = NULL, *mk = NULL;
+  int *cc = NULL;
+  unsigned char *ap3 = NULL;
+  carry_work w = {.pr = prior, .nc = nc};
+  FCM_CHECK(ctx && prior && prior->plan && prior->C && prior->A_ptr &&
+                (prior->A_col || (prior->A_adj && prior->G_ptr && prior->G_adj)) &&
+                prior->row_old && prior->row_new && prior->crow_old && prior->crow_new && A &&
+                P_ptr && P_ptr[0] == 0 && plan && C && nc >= 0 && nt >= 1,
+            ctx, FCM_ERR_ARG, "ptap_create_from: NULL argument, nc = %lld < 0 or nt = %d < 1",
+            (long long)nc, nt);
+  *plan = NULL, *C = NULL;
+  fcm_index n = 0, ncol = 0;
+  fcm_csr_get_size(A, &n, &ncol, NULL);
+  FCM_CHECK(n == ncol, ctx, FCM_ERR_ARG, "ptap_create_from: A is %lld x %lld, not square",
+            (long long)n, (long long)ncol);
+  for (fcm_index p = 0; p < P_ptr[n]; p++)
+    FCM_CHECK(P_col[p] >= 0 && P_col[p] < nc, ctx, FCM_ERR_ARG,
+              "ptap_create_from: P entry %lld has column %d outside [0, %lld)", (long long)p,
+              P_col[p], (long long)nc);
+  t = fcm__calloc(ctx, 1, sizeof *t);
+  FCM_CHECK(t, ctx, FCM_ERR_ALLOC, "ptap_create_from: out of memory");
+  t->ctx = ctx, t->n = n, t->nc = nc, t->nt = nt;
+  t->P_ptr = P_ptr, t->P_col = P_col, t->P_val = P_val;
+  FCM_TRY(ctx, fcm__ptap_transpose_pattern(ctx, n, nc, P_ptr, P_col, P_val, &t->R_ptr, &t->R_col,
+                                           &t->R_val));
+  FCM_ALLOC(ctx, n / 3 + 1, t->same3);
+  w.old = prior->plan, w.n = n;
+  w.Ap = fcm_csr_row_ptr(A), w.Ac = fcm_csr_col_idx(A), w.Pp = P_ptr, w.Pc = P_col;
+  w.Rp = t->R_ptr, w.Rc = t->R_col;
+  FCM_ALLOC(ctx, n + 1, w.prow);
+  FCM_ALLOC(ctx, n + 1, w.keep);
+  FCM_ALLOC(ctx, nc + 1, w.ckeep);
+  FCM_ALLOC_RAW(ctx, (size_t)nt * (size_t)(nc + 1), mk);
+  for (size_t j = 0; j < (size_t)nt * (size_t)(nc + 1); j++)
+    mk[j] = -1;
+  w.same3 = t->same3;
+#pragma omp parallel num_threads(nt) if (nt > 1 && n > 4096)
+  {
+    /* copy-graph mode: A's three rows of a copy hold one pattern */
+#pragma omp for schedule(static) nowait
+    for (fcm_index g = 0; g < n / 3; g++)
+      t->same3[g] = (unsigned char)(!prior->A_col || fcm__ptap_same_pattern3(3 * g, w.Ap, w.Ac));
+#pragma omp for schedule(static)
+    for (fcm_index i = 0; i < n; i++)
+      w.prow[i] = (unsigned char)carry_prow(&w, i);
+  }
+  FCM_ALLOC(ctx, n + 1, t->AP_ptr);
+  carry_rows(&w, 0, 0, t->AP_ptr, NULL, mk, nt);
+  FCM_ALLOC_RAW(ctx, t->AP_ptr[n] + 1, t->AP_col); /* every entry written below */
+  carry_rows(&w, 0, 1, t->AP_ptr, t->AP_col, mk, nt);
+  FCM_ALLOC_RAW(ctx, t->AP_ptr[n] + 1, t->AP_val); /* every product writes all of it */
+  FCM_ALLOC(ctx, n / 3 + 1, ap3);
+#pragma omp parallel for num_threads(nt) schedule(static) if (nt > 1 && n > 4096)
+  for (fcm_index g = 0; g < n / 3; g++)
+    ap3[g] = (unsigned char)(t->same3[g] || fcm__ptap_same_pattern3(3 * g, t->AP_ptr, t->AP_col));
+  w.APp = t->AP_ptr, w.APc = t->AP_col;
+  FCM_ALLOC(ctx, nc / 3 + 1, w.cdup);
+  for (fcm_index g = 0; 3 * g + 2 < nc; g++)
+    w.cdup[g] = (unsigned char)fcm__ptap_shifted3(3 * g, t->R_ptr, t->R_col, NULL, ap3);
+  FCM_ALLOC(ctx, nc + 1, cp);
+  carry_rows(&w, 1, 0, cp, NULL, mk, nt);
+  FCM_ALLOC_RAW(ctx, cp[nc] + 1, cc);
+  carry_rows(&w, 1, 1, cp, cc, mk, nt);
+  /* the rows taken hold theirs (the prior's plan was made with the same with_diagonal) */
+  if (with_diagonal) FCM_TRY(ctx, fcm__ptap_add_diagonal(ctx, nc, &cp, &cc));
+  FCM_ALLOC(ctx, (size_t)nt * 3 * (size_t)(nc + 1), t->spa);
+  FCM_ALLOC(ctx, (size_t)(nc / 3 + 1), t->r_kind);
+  for (fcm_index g = 0; 3 * g + 2 < nc; g++)
+    t->r_kind[g] =
+        fcm__ptap_shifted3(3 * g, t->R_ptr, t->R_col, t->R_val, ap3) ? KIND_SHIFTED : KIND_ROWS;
+  if (taken) {
+    taken[0] = taken[1] = 0;
+    for (fcm_index i = 0; i < n; i++)
+      taken[0] += w.keep[i];
+    for (fcm_index I = 0; I < nc; I++)
+      taken[1] += w.ckeep[I];
+  }
+  FCM_TRY(ctx, fcm__csr_adopt_pattern(ctx, nc, nc, &cp, &cc, fcm_csr_get_kind(A), C));
+  *plan = t;
+  t = NULL;
+cleanup:
+  fcm__free(ctx, cp);
+  fcm__free(ctx, cc);
+  fcm__free(ctx, mk);
+  fcm__free(ctx, ap3);
+  fcm__free(ctx, w.prow);
+  fcm__free(ctx, w.keep);
+  fcm__free(ctx, w.ckeep);
+  fcm__free(ctx, w.cdup);
+  fcm__ptap_destroy(&t);
+  return st;
+}

@@ -1,0 +1,44 @@
+/* The Galerkin product's plan (ptap.c) shared with the plans taken over from a prior one
+ * (ptap_carry.c). */
+#ifndef FCM_LA_PTAP_IMPL_H
+#define FCM_LA_PTAP_IMPL_H
+
+#include "la/la_impl.h"
+
+struct fcm__ptap {
+  fcm_ctx *ctx;
+  fcm_index n, nc; /* A is n x n, P n x nc */
+  int nt;          /* the most threads fcm__ptap_apply() may use */
+  const fcm_index *P_ptr;
+  const int *P_col;
+  const double *P_val;
+  fcm_index *R_ptr; /* R = P^T (nc x n), rows ascending in their columns */
+  int *R_col;
+  double *R_val;
+  fcm_index *AP_ptr; /* A P (n x nc) */
+  int *AP_col;
+  double *AP_val;
+  double *spa;           /* nt dense accumulators of 3 (nc + 1) doubles, zero between products */
+  unsigned char *same3;  /* per group g of A's rows 3 g .. 3 g + 2: one pattern (all three) */
+  unsigned char *r_kind; /* per group of R's rows: KIND_SHIFTED or KIND_ROWS */
+};
+
+/* How a group of three rows of A is multiplied (product_values()). */
+enum { KIND_ROWS = 0, KIND_TRIPLE = 1, KIND_SHIFTED = 2 };
+
+/* Sort a[0 .. n) ascending (distinct values). */
+void fcm__ptap_sort_ints(int *a, fcm_index n);
+/* R = P^T: row J of R lists the rows i of P with a column J, ascending. */
+fcm_status fcm__ptap_transpose_pattern(fcm_ctx *ctx, fcm_index n, fcm_index nc,
+                                       const fcm_index *P_ptr, const int *P_col,
+                                       const double *P_val, fcm_index **R_ptr, int **R_col,
+                                       double **R_val);
+/* The missing diagonal entries inserted into a square pattern with sorted rows. */
+fcm_status fcm__ptap_add_diagonal(fcm_ctx *ctx, fcm_index n, fcm_index **ptr, int **col);
+/* Whether rows i, i + 1, i + 2 hold one pattern. */
+int fcm__ptap_same_pattern3(fcm_index i, const fcm_index *Ap, const int *Ac);
+/* Whether rows i .. i + 2 of A may be multiplied as one row shifted (ptap.c says when). */
+int fcm__ptap_shifted3(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
+                       const unsigned char *b_same3);
+
+#endif
