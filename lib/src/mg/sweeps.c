@@ -3,6 +3,7 @@
  * Jacobi, and block Gauss-Seidel over the level's blocks (S_K from its lower triangle, or
  * X^T (X r) where a block holds the inverse X of its Cholesky factor); the test hook that
  * checks them against one row at a time. */
+#include "core/multiversion.h"
 #include "mg/levels_impl.h"
 
 #include <string.h>
@@ -90,12 +91,50 @@ static inline void sym_lower_apply(const double *S, const double *r, int m, doub
   }
 }
 
+/* y_i = sum_(j <= i) X_ij r_j for rows i0 .. i0 + 3 of a lower triangular X (row major,
+ * m x m), each row's sum as two partial sums (s0 over the even j, s1 over the odd j, in
+ * ascending order), into y[0..3]: the four rows' chains run side by side. */
+static inline void factor_rows4(const double *X, const double *r, int m, int i0, double y[4])
+{
+  const double *Xr[4];
+  fcm__mg_v2d acc[4];
+  for (int k = 0; k < 4; k++) {
+    Xr[k] = X + (size_t)(i0 + k) * (size_t)m;
+    acc[k] = (fcm__mg_v2d){0.0, 0.0};
+  }
+  int j = 0;
+  for (; j + 2 <= i0 + 1; j += 2) { /* the pairs every row of the four has */
+    const fcm__mg_v2d rj = fcm__mg_load2(r + j);
+    for (int k = 0; k < 4; k++)
+      acc[k] += fcm__mg_load2(Xr[k] + j) * rj;
+  }
+  for (int k = 0; k < 4; k++) {
+    const int i = i0 + k;
+    double s0 = acc[k][0], s1 = acc[k][1];
+    int jk = j;
+    for (; jk + 2 <= i + 1; jk += 2) {
+      s0 += Xr[k][jk] * r[jk];
+      s1 += Xr[k][jk + 1] * r[jk + 1];
+    }
+    if (jk <= i) s0 += Xr[k][jk] * r[jk];
+    y[k] = s0 + s1;
+  }
+}
+
 /* dx = X^T X r for a lower triangular m x m X (row major; fcm__schwarz_block_factor()):
- * y = X r into r (rows descending: y_i reads r_j, j <= i, not yet overwritten), then
- * dx = X^T y row after row; both read X's lower triangle, the second time from cache. */
+ * y = X r into r (rows descending, four at a time: y_i reads r_j, j <= i, not yet
+ * overwritten), then dx = X^T y two rows of X at a time, each dx_j's sum over i ascending;
+ * both read X's lower triangle, the second time from cache. */
 static inline void factor_apply(const double *X, double *r, int m, double *dx)
 {
-  for (int i = m - 1; i >= 0; i--) {
+  int i = m - 1;
+  for (; i >= 3; i -= 4) {
+    double y[4];
+    factor_rows4(X, r, m, i - 3, y);
+    for (int k = 0; k < 4; k++)
+      r[i - 3 + k] = y[k];
+  }
+  for (; i >= 0; i--) {
     const double *Xi = X + (size_t)i * (size_t)m;
     double s0 = 0.0, s1 = 0.0;
     int j = 0;
@@ -106,13 +145,20 @@ static inline void factor_apply(const double *X, double *r, int m, double *dx)
     if (j <= i) s0 += Xi[j] * r[j];
     r[i] = s0 + s1;
   }
-  for (int i = 0; i < m; i++)
-    dx[i] = 0.0;
-  for (int i = 0; i < m; i++) {
-    const double *Xi = X + (size_t)i * (size_t)m;
-    const double yi = r[i];
-    for (int j = 0; j <= i; j++)
-      dx[j] += Xi[j] * yi;
+  for (int j = 0; j < m; j++)
+    dx[j] = 0.0;
+  int k = 0;
+  for (; k + 2 <= m; k += 2) {
+    const double *Xa = X + (size_t)k * (size_t)m, *Xb = Xa + m;
+    const double ya = r[k], yb = r[k + 1];
+    for (int j = 0; j <= k; j++)
+      dx[j] = (dx[j] + Xa[j] * ya) + Xb[j] * yb;
+    dx[k + 1] += Xb[k + 1] * yb;
+  }
+  if (k < m) {
+    const double *Xa = X + (size_t)k * (size_t)m;
+    for (int j = 0; j <= k; j++)
+      dx[j] += Xa[j] * r[k];
   }
 }
 
@@ -141,8 +187,9 @@ static void plain_apply(const double *S, const double *r, int m, int factor, dou
  * earlier rows' updates through the three's own 3 x 3 block (A_(i..i+2, i..i+2), stored
  * consecutively from the diagonal's position in each row). The same iterate as three single
  * updates, up to the order of the sums. */
-static void sgs_triple(const mg_level *L, const double *v, const int *ci, const fcm_index *rp,
-                       fcm_index i, double w, const double *b, double *x, int back)
+static inline void sgs_triple(const mg_level *L, const double *v, const int *ci,
+                              const fcm_index *rp, fcm_index i, double w, const double *b,
+                              double *x, int back)
 {
   const fcm_index len = rp[i + 1] - rp[i], o = L->diag[i] - rp[i];
   const double *A0 = v + rp[i] + o, *A1 = A0 + len, *A2 = A1 + len; /* A_(i+r, i..i+2) */
@@ -164,6 +211,7 @@ static void sgs_triple(const mg_level *L, const double *v, const int *ci, const 
 
 /* Gauss-Seidel over the rows at positions [q0, q1) of the row order, forward (ascending) or
  * backward; a copy's three rows of one pattern together (sgs_triple()). */
+FCM_MULTIVERSION_CLONES
 static void sgs_range(const sweep_args *a, fcm_index q0, fcm_index q1, int back)
 {
   const mg_level *L = a->L;
@@ -291,6 +339,7 @@ void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x)
 
 /* Block Gauss-Seidel over the blocks of slab s, forward or backward: x_K += S_K (b - A x)_K,
  * block after block. */
+FCM_MULTIVERSION_CLONES
 static void block_slab(const sweep_args *a, fcm_index s, int back)
 {
   const mg_level *L = a->L;
