@@ -1,8 +1,9 @@
 /* The multigrid's sweeps, inside the cycle's parallel regions: pointwise symmetric Gauss-Seidel
  * in slab order (a copy's three rows of one pattern together), multicolour SGS, damped
  * Jacobi, and block Gauss-Seidel over the level's blocks (S_K from its lower triangle, or
- * X^T (X r) where a block holds the inverse X of its Cholesky factor); the test hook that
- * checks them against one row at a time. */
+ * X^T (X r) where a block holds the inverse X of its Cholesky factor, both packed by rows:
+ * row i from FCM__SCHWARZ_PACKED(i, 0)); the test hook that checks them against one row at a
+ * time. */
 #include "core/multiversion.h"
 #include "mg/levels_impl.h"
 
@@ -48,32 +49,16 @@ static void symmetric_sweep(const slab_order *S,
     if (fcm__mg_slab_mine(S, k, t, nt)) slab(a, k, 1);
 }
 
-/* sum_j a[j] r[j], j < m, as fcm__mg_row_dot(). */
-static inline double dense_dot(const double *a, const double *r, int m)
-{
-  double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-  int j = 0;
-  for (; j + 4 <= m; j += 4) {
-    s0 += a[j] * r[j];
-    s1 += a[j + 1] * r[j + 1];
-    s2 += a[j + 2] * r[j + 2];
-    s3 += a[j + 3] * r[j + 3];
-  }
-  for (; j < m; j++)
-    s0 += a[j] * r[j];
-  return (s0 + s1) + (s2 + s3);
-}
-
-/* dx = S r for a symmetric m x m S (row major) from its lower triangle alone: row i's entries
- * S_ij, j < i, serve dx_i and (as S_ji) dx_j, so the sweep reads half of S's cache lines;
- * S streams from memory block after block and its reads are most of the block product's
- * time. Two partial sums per row, the column updates in pairs. */
+/* dx = S r for a symmetric m x m S from its lower triangle alone (packed): row i's entries
+ * S_ij, j < i, serve dx_i and (as S_ji) dx_j; S streams from memory block after block and
+ * its reads are most of the block product's time. Two partial sums per row, the column
+ * updates in pairs. */
 static inline void sym_lower_apply(const double *S, const double *r, int m, double *dx)
 {
   for (int i = 0; i < m; i++)
     dx[i] = 0.0;
   for (int i = 0; i < m; i++) {
-    const double *Si = S + (size_t)i * (size_t)m;
+    const double *Si = S + FCM__SCHWARZ_PACKED(i, 0);
     const double ri = r[i];
     double s0 = 0.0, s1 = 0.0;
     int j = 0;
@@ -91,15 +76,15 @@ static inline void sym_lower_apply(const double *S, const double *r, int m, doub
   }
 }
 
-/* y_i = sum_(j <= i) X_ij r_j for rows i0 .. i0 + 3 of a lower triangular X (row major,
- * m x m), each row's sum as two partial sums (s0 over the even j, s1 over the odd j, in
- * ascending order), into y[0..3]: the four rows' chains run side by side. */
-static inline void factor_rows4(const double *X, const double *r, int m, int i0, double y[4])
+/* y_i = sum_(j <= i) X_ij r_j for rows i0 .. i0 + 3 of a lower triangular X (packed), each
+ * row's sum as two partial sums (s0 over the even j, s1 over the odd j, in ascending order),
+ * into y[0..3]: the four rows' chains run side by side. */
+static inline void factor_rows4(const double *X, const double *r, int i0, double y[4])
 {
   const double *Xr[4];
   fcm__mg_v2d acc[4];
   for (int k = 0; k < 4; k++) {
-    Xr[k] = X + (size_t)(i0 + k) * (size_t)m;
+    Xr[k] = X + FCM__SCHWARZ_PACKED(i0 + k, 0);
     acc[k] = (fcm__mg_v2d){0.0, 0.0};
   }
   int j = 0;
@@ -121,7 +106,7 @@ static inline void factor_rows4(const double *X, const double *r, int m, int i0,
   }
 }
 
-/* dx = X^T X r for a lower triangular m x m X (row major; fcm__schwarz_block_factor()):
+/* dx = X^T X r for a lower triangular m x m X (packed; fcm__schwarz_block_factor()):
  * y = X r into r (rows descending, four at a time: y_i reads r_j, j <= i, not yet
  * overwritten), then dx = X^T y two rows of X at a time, each dx_j's sum over i ascending;
  * both read X's lower triangle, the second time from cache. */
@@ -130,12 +115,12 @@ static inline void factor_apply(const double *X, double *r, int m, double *dx)
   int i = m - 1;
   for (; i >= 3; i -= 4) {
     double y[4];
-    factor_rows4(X, r, m, i - 3, y);
+    factor_rows4(X, r, i - 3, y);
     for (int k = 0; k < 4; k++)
       r[i - 3 + k] = y[k];
   }
   for (; i >= 0; i--) {
-    const double *Xi = X + (size_t)i * (size_t)m;
+    const double *Xi = X + FCM__SCHWARZ_PACKED(i, 0);
     double s0 = 0.0, s1 = 0.0;
     int j = 0;
     for (; j + 2 <= i + 1; j += 2) {
@@ -149,33 +134,38 @@ static inline void factor_apply(const double *X, double *r, int m, double *dx)
     dx[j] = 0.0;
   int k = 0;
   for (; k + 2 <= m; k += 2) {
-    const double *Xa = X + (size_t)k * (size_t)m, *Xb = Xa + m;
+    const double *Xa = X + FCM__SCHWARZ_PACKED(k, 0), *Xb = Xa + k + 1;
     const double ya = r[k], yb = r[k + 1];
     for (int j = 0; j <= k; j++)
       dx[j] = (dx[j] + Xa[j] * ya) + Xb[j] * yb;
     dx[k + 1] += Xb[k + 1] * yb;
   }
   if (k < m) {
-    const double *Xa = X + (size_t)k * (size_t)m;
+    const double *Xa = X + FCM__SCHWARZ_PACKED(k, 0);
     for (int j = 0; j <= k; j++)
       dx[j] += Xa[j] * r[k];
   }
 }
 
+/* Entry (i, j) of the symmetric S whose lower triangle T holds packed. */
+static inline double sym_entry(const double *T, int i, int j)
+{
+  return i >= j ? T[FCM__SCHWARZ_PACKED(i, j)] : T[FCM__SCHWARZ_PACKED(j, i)];
+}
+
 /* The reference of the test hook: dx = S r with S = X^T X for a factor block (each entry
- * formed, m^3 operations), else S's rows in full. */
+ * formed, m^3 operations), else each of S's rows in full, one entry at a time. */
 static void plain_apply(const double *S, const double *r, int m, int factor, double *dx)
 {
   for (int i = 0; i < m; i++) {
-    if (!factor) {
-      dx[i] = dense_dot(S + (size_t)i * (size_t)m, r, m);
-      continue;
-    }
     double sum = 0.0;
     for (int j = 0; j < m; j++) {
       double sij = 0.0;
-      for (int k = i > j ? i : j; k < m; k++)
-        sij += S[(size_t)k * (size_t)m + i] * S[(size_t)k * (size_t)m + j];
+      if (!factor)
+        sij = sym_entry(S, i, j);
+      else
+        for (int k = i > j ? i : j; k < m; k++)
+          sij += S[FCM__SCHWARZ_PACKED(k, i)] * S[FCM__SCHWARZ_PACKED(k, j)];
       sum += sij * r[j];
     }
     dx[i] = sum;
@@ -358,9 +348,8 @@ static void block_slab(const sweep_args *a, fcm_index s, int back)
     const double *S = a->blk.S + a->blk.s_off[k];
     const int bm = (int)(a->blk.ptr[k + 1] - a->blk.ptr[k]);
     /* S_K's lower triangle is fetched while the residual's rows are read */
-    for (int i = 0; i < bm; i++)
-      for (int j = 0; j <= i; j += 8)
-        __builtin_prefetch(S + (size_t)i * (size_t)bm + j, 0, 0);
+    for (size_t e = 0; e < FCM__SCHWARZ_PACKED(bm, 0); e += 8)
+      __builtin_prefetch(S + e, 0, 0);
     for (int i = 0; i < bm;) {
       const fcm_index di = d[i];
       if (i + 2 < bm && d[i + 2] == di + 2 && d[i + 1] == di + 1 &&
