@@ -451,3 +451,13 @@ fcm_status fcm__mg_smooth_paths(fcm_mg *mg, int level, const double *b, const do
 cleanup:
   return st;
 }
+
+void fcm__mg_block_apply_paths(const double *S, int m, int factor, double *r, double *dx_fast,
+                               double *dx_plain)
+{
+  plain_apply(S, r, m, factor, dx_plain);
+  if (factor)
+    factor_apply(S, r, m, dx_fast);
+  else
+    sym_lower_apply(S, r, m, dx_fast);
+}
