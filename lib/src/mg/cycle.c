@@ -34,7 +34,7 @@ static void pre_smooth(const fcm_mg *m, mg_level *L, mg_level *C, const double *
     const fcm_index i = 3 * k;
     if (fcm__mg_is_triple(triple, i, n)) {
       double s[3];
-      fcm__mg_row_dot3(v, ci, rp[i], rp[i + 1] - rp[i], x, s);
+      fcm__mg_row_dot3(v, ci, rp[i], rp[i + 1] - rp[i], triple[i] == FCM__MG_TRIPLE_NODES, x, s);
       for (int c = 0; c < 3; c++)
         L->r[i + c] = b[i + c] - s[c];
     } else {

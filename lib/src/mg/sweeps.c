@@ -53,7 +53,8 @@ static void symmetric_sweep(const slab_order *S,
  * S_ij, j < i, serve dx_i and (as S_ji) dx_j; S streams from memory block after block and
  * its reads are most of the block product's time. Two partial sums per row, the column
  * updates in pairs. */
-static inline void sym_lower_apply(const double *S, const double *r, int m, double *dx)
+static inline __attribute__((always_inline)) void sym_lower_apply(const double *S, const double *r,
+                                                                  int m, double *dx)
 {
   for (int i = 0; i < m; i++)
     dx[i] = 0.0;
@@ -79,7 +80,8 @@ static inline void sym_lower_apply(const double *S, const double *r, int m, doub
 /* y_i = sum_(j <= i) X_ij r_j for rows i0 .. i0 + 3 of a lower triangular X (packed), each
  * row's sum as two partial sums (s0 over the even j, s1 over the odd j, in ascending order),
  * into y[0..3]: the four rows' chains run side by side. */
-static inline void factor_rows4(const double *X, const double *r, int i0, double y[4])
+static inline __attribute__((always_inline)) void factor_rows4(const double *X, const double *r,
+                                                               int i0, double y[4])
 {
   const double *Xr[4];
   fcm__mg_v2d acc[4];
@@ -110,7 +112,8 @@ static inline void factor_rows4(const double *X, const double *r, int i0, double
  * y = X r into r (rows descending, four at a time: y_i reads r_j, j <= i, not yet
  * overwritten), then dx = X^T y two rows of X at a time, each dx_j's sum over i ascending;
  * both read X's lower triangle, the second time from cache. */
-static inline void factor_apply(const double *X, double *r, int m, double *dx)
+static inline __attribute__((always_inline)) void factor_apply(const double *X, double *r, int m,
+                                                               double *dx)
 {
   int i = m - 1;
   for (; i >= 3; i -= 4) {
@@ -177,14 +180,15 @@ static void plain_apply(const double *S, const double *r, int m, int factor, dou
  * earlier rows' updates through the three's own 3 x 3 block (A_(i..i+2, i..i+2), stored
  * consecutively from the diagonal's position in each row). The same iterate as three single
  * updates, up to the order of the sums. */
-static inline void sgs_triple(const mg_level *L, const double *v, const int *ci,
-                              const fcm_index *rp, fcm_index i, double w, const double *b,
-                              double *x, int back)
+static inline __attribute__((always_inline)) void sgs_triple(const mg_level *L, const double *v,
+                                                             const int *ci, const fcm_index *rp,
+                                                             fcm_index i, double w, const double *b,
+                                                             double *x, int back)
 {
   const fcm_index len = rp[i + 1] - rp[i], o = L->diag[i] - rp[i];
   const double *A0 = v + rp[i] + o, *A1 = A0 + len, *A2 = A1 + len; /* A_(i+r, i..i+2) */
   double s[3], d0, d1, d2;
-  fcm__mg_row_dot3(v, ci, rp[i], len, x, s);
+  fcm__mg_row_dot3(v, ci, rp[i], len, L->rows.triple[i] == FCM__MG_TRIPLE_NODES, x, s);
   if (!back) {
     d0 = w * (b[i] - s[0]) * L->dinv[i];
     d1 = w * (b[i + 1] - (s[1] + A1[0] * d0)) * L->dinv[i + 1];
@@ -355,7 +359,8 @@ static void block_slab(const sweep_args *a, fcm_index s, int back)
       if (i + 2 < bm && d[i + 2] == di + 2 && d[i + 1] == di + 1 &&
           fcm__mg_is_triple(triple, di, n)) {
         double dot[3];
-        fcm__mg_row_dot3(v, ci, rp[di], rp[di + 1] - rp[di], x, dot);
+        fcm__mg_row_dot3(v, ci, rp[di], rp[di + 1] - rp[di], triple[di] == FCM__MG_TRIPLE_NODES, x,
+                         dot);
         r[i] = b[di] - dot[0];
         r[i + 1] = b[di + 1] - dot[1];
         r[i + 2] = b[di + 2] - dot[2];
@@ -434,7 +439,7 @@ fcm_status fcm__mg_smooth_paths(fcm_mg *mg, int level, const double *b, const do
   for (fcm_index k = 0; L->blk && k < fcm__schwarz_num_blocks(L->blk); k++)
     *factor_blocks += fcm__schwarz_block_factor(L->blk, k);
   for (fcm_index i = 0; L->rows.triple && i < L->n; i++)
-    *triples += L->rows.triple[i];
+    *triples += L->rows.triple[i] != 0;
   memcpy(x_fast, x, sizeof *x * (size_t)L->n);
   memcpy(x_plain, x, sizeof *x * (size_t)L->n);
 #pragma omp parallel num_threads(1)
