@@ -5,9 +5,8 @@
  * triangle, or X^T (X r) where the block holds the inverse X of its Cholesky factor) give the
  * iterate of the reference (a row at a time, the full S_K) to rounding,
  * with the block sweep symmetric and one way. Most copies of level 0 take the three-row path,
- * and the sweeps move x by far more than the tolerance. The cut hemisphere's X blocks have
- * sizes of every remainder modulo four (the X r product takes four rows at a time, then the
- * rest one by one) and of either parity (X^T y takes two rows at a time). */
+ * and the sweeps move x by far more than the tolerance. The X blocks' sizes modulo four are
+ * printed (the X r product takes four rows at a time; mg_block_apply covers every size). */
 #include "mg/levels_impl.h"
 #include "mg_util.h"
 
