@@ -114,7 +114,8 @@ static int galerkin_pattern_exact(const fcm_mg *mg, int l)
   return same;
 }
 
-/* Are the row order's groups of three (triple) those a full comparison of the rows finds? */
+/* Are the row order's groups of three (triple) those a full comparison of the rows finds, and
+ * flagged FCM__MG_TRIPLE_NODES exactly where their columns come in whole nodes? */
 static int triples_exact(const fcm_mg *mg, int l)
 {
   const mg_level *L = &mg->lev[l];
@@ -133,6 +134,10 @@ static int triples_exact(const fcm_mg *mg, int l)
     }
     t = t && own;
     groups += t;
+    int nodes = t && len % 3 == 0;
+    for (fcm_index q = rp[i]; nodes && q < rp[i + 1]; q += 3)
+      nodes = ci[q] % 3 == 0 && ci[q + 1] == ci[q] + 1 && ci[q + 2] == ci[q] + 2;
+    t = !t ? 0 : nodes ? FCM__MG_TRIPLE_NODES : FCM__MG_TRIPLE;
     same = L->rows.triple[i] == t;
     if (!same)
       printf("  level %d: rows %lld..+2 flagged %d, are %d\n", l, (long long)i, L->rows.triple[i],

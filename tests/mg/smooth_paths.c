@@ -5,8 +5,9 @@
  * triangle, or X^T (X r) where the block holds the inverse X of its Cholesky factor) give the
  * iterate of the reference (a row at a time, the full S_K) to rounding,
  * with the block sweep symmetric and one way. Most copies of level 0 take the three-row path,
- * and the sweeps move x by far more than the tolerance. */
-#include "mg/mg_impl.h"
+ * and the sweeps move x by far more than the tolerance. The X blocks' sizes modulo four are
+ * printed (the X r product takes four rows at a time; mg_block_apply covers every size). */
+#include "mg/levels_impl.h"
 #include "mg_util.h"
 
 #include <math.h>
@@ -47,6 +48,17 @@ static void check(fcm_ctx *ctx, const problem *p, int block_sweep, int cut)
     TEST_TRUE(isfinite(diff) && diff <= 1e-12 * size);
     TEST_TRUE(move > 1e6 * diff && move > 0.0);
     if (l == 0) TEST_TRUE(3 * triples >= n / 2 && (factors > 0) == cut);
+    if (cut) {
+      int rem[4] = {0, 0, 0, 0};
+      for (fcm_index k = 0; k < fcm__schwarz_num_blocks(mg->lev[l].blk); k++) {
+        const fcm_index *d = NULL;
+        const double *S = NULL;
+        const int m = fcm__schwarz_block(mg->lev[l].blk, k, &d, &S);
+        if (m > 4 && fcm__schwarz_block_factor(mg->lev[l].blk, k)) rem[m % 4]++;
+      }
+      printf("level %d: X blocks of more than 4 DOFs by size mod 4: %d, %d, %d, %d\n", l, rem[0],
+             rem[1], rem[2], rem[3]);
+    }
     free(b);
     free(x);
     free(xf);

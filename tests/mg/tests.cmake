@@ -41,5 +41,6 @@ fcm_add_test(mg_convergence_cut_vertex_oneway tests/mg/convergence.c ARGS cut 8 
 set_tests_properties(mg_convergence_cut_vertex_oneway PROPERTIES
                      ENVIRONMENT "FCM_TEST_MG_BLOCKS=1;FCM_TEST_MG_BLOCK_SWEEP=1")
 fcm_add_test(mg_smooth_paths tests/mg/smooth_paths.c)
+fcm_add_test(mg_block_apply tests/mg/block_apply.c)
 # two threads' pointwise sweeps with slab 0's lead beside the thin slab, against one thread
 fcm_add_test(mg_row_split tests/mg/row_split.c)

@@ -53,7 +53,8 @@ static int same_blocks(const fcm_schwarz *a, const fcm_schwarz *b)
     const double *Sa = NULL, *Sb = NULL;
     const int ma = fcm__schwarz_block(a, k, &da, &Sa), mb = fcm__schwarz_block(b, k, &db, &Sb);
     if (ma != mb || !same_bytes(da, db, sizeof *da * (size_t)ma) ||
-        !same_bytes(Sa, Sb, sizeof *Sa * (size_t)ma * (size_t)ma))
+        fcm__schwarz_slot_size(a, k) != fcm__schwarz_slot_size(b, k) ||
+        !same_bytes(Sa, Sb, sizeof *Sa * fcm__schwarz_slot_size(a, k)))
       return 0;
   }
   return 1;

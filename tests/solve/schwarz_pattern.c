@@ -90,18 +90,20 @@ int main(void)
     const double *S1 = NULL, *S2 = NULL;
     const int m = fcm__schwarz_block(P, k, &d1, &S1);
     TEST_TRUE(fcm__schwarz_block(Pb, k, &d2, &S2) == m);
-    if (!fcm__schwarz_block_factor(Pb, k)) {
-      TEST_TRUE(memcmp(S1, S2, sizeof *S1 * (size_t)m * (size_t)m) == 0);
+    if (!fcm__schwarz_block_factor(Pb, k)) { /* S_K's lower triangle, packed */
+      for (int i = 0; i < m; i++)
+        for (int j = 0; j <= i; j++)
+          TEST_TRUE(S2[FCM__SCHWARZ_PACKED(i, j)] == S1[i * m + j]);
       continue;
     }
-    factors++; /* S2 holds X, lower triangular, with S_K = X^T X */
+    factors++; /* S2 holds X's lower triangle (packed), with S_K = X^T X */
+    TEST_TRUE(fcm__schwarz_slot_size(Pb, k) == (size_t)(m * (m + 1) / 2));
     double smax = 0.0, diff = 0.0;
     for (int i = 0; i < m; i++)
       for (int j = 0; j < m; j++) {
         double s = 0.0;
         for (int q = i > j ? i : j; q < m; q++)
-          s += S2[q * m + i] * S2[q * m + j];
-        if (j > i) TEST_TRUE(S2[i * m + j] == 0.0);
+          s += S2[FCM__SCHWARZ_PACKED(q, i)] * S2[FCM__SCHWARZ_PACKED(q, j)];
         smax = fmax(smax, fabs(S1[i * m + j]));
         diff = fmax(diff, fabs(s - S1[i * m + j]));
       }

@@ -6,12 +6,14 @@
  * sequential stretch and then waits to be woken: on shared cores a woken thread may wait a
  * whole time slice for a core. The functions below run inside such a region (or in a team of
  * one, when the level is too small to share) and end without a barrier unless said. */
+#include "core/multiversion.h"
 #include "mg/levels_impl.h"
 
 #include <math.h>
 #include <string.h>
 
 /* Pre-smoothing, then r = b - A x and the coarse right-hand side R r (coarse guess 0). */
+FCM_MULTIVERSION_CLONES
 static void pre_smooth(const fcm_mg *m, mg_level *L, mg_level *C, const double *b, double *x)
 {
   const fcm_csr *A = fcm__mg_level_matrix(L);
@@ -32,7 +34,7 @@ static void pre_smooth(const fcm_mg *m, mg_level *L, mg_level *C, const double *
     const fcm_index i = 3 * k;
     if (fcm__mg_is_triple(triple, i, n)) {
       double s[3];
-      fcm__mg_row_dot3(v, ci, rp[i], rp[i + 1] - rp[i], x, s);
+      fcm__mg_row_dot3(v, ci, rp[i], rp[i + 1] - rp[i], triple[i] == FCM__MG_TRIPLE_NODES, x, s);
       for (int c = 0; c < 3; c++)
         L->r[i + c] = b[i + c] - s[c];
     } else {

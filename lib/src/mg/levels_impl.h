@@ -35,8 +35,10 @@ typedef struct slab_order {
   fcm_index *ptr;        /* nslab + 1 offsets into item */
   fcm_index *item;       /* the items, slab after slab, ascending within a slab */
   double *mid;           /* per slab: the midpoint of its work within its colour's, in [0, 1] */
-  unsigned char *triple; /* row orders: per row i, 1 when i = 3k starts its copy's three rows
-                            and they share one column pattern (fcm__mg_row_dot3()) */
+  unsigned char *triple; /* row orders: per row i, nonzero when i = 3k starts its copy's three
+                            rows and they share one column pattern (fcm__mg_row_dot3()):
+                            FCM__MG_TRIPLE, or FCM__MG_TRIPLE_NODES when the columns come in
+                            whole nodes */
   fcm_index lead, tail;  /* row orders of three slabs, the thin middle one swept first: the
                             first rows of slab 0, coupled with no row of slab 1, that a team of
                             two sweeps forward beside slab 1's forward sweep (lead) and backward
@@ -129,8 +131,8 @@ static inline const fcm_csr *fcm__mg_level_matrix(const mg_level *L)
 /* sum_p v[p] x[ci[p]] over p in [p0, p1) in four interleaved partial sums: the smoothers'
  * and residuals' time is these sums, and one sequential chain of additions would wait on each
  * addition. */
-static inline double fcm__mg_row_dot(const double *v, const int *ci, fcm_index p0, fcm_index p1,
-                                     const double *x)
+static inline __attribute__((always_inline)) double
+fcm__mg_row_dot(const double *v, const int *ci, fcm_index p0, fcm_index p1, const double *x)
 {
   double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
   fcm_index p = p0;
@@ -157,8 +159,24 @@ static inline fcm__mg_v2d fcm__mg_load2(const double *p)
   return r;
 }
 
-static inline void fcm__mg_row_dot3(const double *v, const int *ci, fcm_index p0, fcm_index len,
-                                    const double *x, double out[3])
+/* The four columns from j on, whose x are x01 and x23, added into the three rows' sums. */
+#define FCM__MG_DOT3_STEP(j, x01, x23)                                                             \
+  do {                                                                                             \
+    a01 += fcm__mg_load2(va + (j)) * (x01);                                                        \
+    a23 += fcm__mg_load2(va + (j) + 2) * (x23);                                                    \
+    b01 += fcm__mg_load2(vb + (j)) * (x01);                                                        \
+    b23 += fcm__mg_load2(vb + (j) + 2) * (x23);                                                    \
+    c01 += fcm__mg_load2(vc + (j)) * (x01);                                                        \
+    c23 += fcm__mg_load2(vc + (j) + 2) * (x23);                                                    \
+  } while (0)
+
+/* nodes: the columns come in whole nodes (3 k, 3 k + 1, 3 k + 2, one after the other; the row
+ * order's triple flag FCM__MG_TRIPLE_NODES): four nodes' twelve columns take four column
+ * indices and their x in pairs of neighbours, the same operations on the same values. */
+static inline __attribute__((always_inline)) void fcm__mg_row_dot3(const double *v, const int *ci,
+                                                                   fcm_index p0, fcm_index len,
+                                                                   int nodes, const double *x,
+                                                                   double out[3])
 {
   /* lanes (s0, s1) and (s2, s3) of each row's four partial sums: two-wide operations keep
    * the twelve sums in registers (twelve scalars and the x's spill) */
@@ -166,6 +184,14 @@ static inline void fcm__mg_row_dot3(const double *v, const int *ci, fcm_index p0
   const int *c = ci + p0;
   fcm__mg_v2d a01 = {0.0, 0.0}, a23 = a01, b01 = a01, b23 = a01, c01 = a01, c23 = a01;
   fcm_index j = 0;
+  if (nodes)
+    for (; j + 12 <= len; j += 12) {
+      const double *x0 = x + c[j], *x1 = x + c[j + 3], *x2 = x + c[j + 6], *x3 = x + c[j + 9];
+      const fcm__mg_v2d u0 = {x0[2], x1[0]}, u1 = {x2[2], x3[0]};
+      FCM__MG_DOT3_STEP(j, fcm__mg_load2(x0), u0);
+      FCM__MG_DOT3_STEP(j + 4, fcm__mg_load2(x1 + 1), fcm__mg_load2(x2));
+      FCM__MG_DOT3_STEP(j + 8, u1, fcm__mg_load2(x3 + 1));
+    }
   for (; j + 4 <= len; j += 4) {
     const fcm__mg_v2d x01 = {x[c[j]], x[c[j + 1]]}, x23 = {x[c[j + 2]], x[c[j + 3]]};
     a01 += fcm__mg_load2(va + j) * x01;
@@ -186,6 +212,13 @@ static inline void fcm__mg_row_dot3(const double *v, const int *ci, fcm_index p0
   out[1] = (b0 + b01[1]) + (b23[0] + b23[1]);
   out[2] = (c0 + c01[1]) + (c23[0] + c23[1]);
 }
+
+#undef FCM__MG_DOT3_STEP
+
+/* slab_order.triple: rows i .. i + 2 share one pattern (FCM__MG_TRIPLE), whose columns come in
+ * whole nodes too (FCM__MG_TRIPLE_NODES, fcm__mg_row_dot3()'s nodes). */
+#define FCM__MG_TRIPLE       1
+#define FCM__MG_TRIPLE_NODES 2
 
 /* Whether rows i, i + 1, i + 2 may be summed by fcm__mg_row_dot3() (triple: the level's row
  * order's flags, NULL: none may). */

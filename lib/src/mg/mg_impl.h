@@ -62,6 +62,11 @@ fcm_status fcm__mg_slabs_check(const fcm_mg *mg, int level, fcm_index *row_slabs
 fcm_status fcm__mg_smooth_paths(fcm_mg *mg, int level, const double *b, const double *x,
                                 double *x_fast, double *x_plain, fcm_index *triples,
                                 fcm_index *factor_blocks);
+/* Test hook: dx = S r for one block's slot (S: m (m + 1) / 2 doubles, a lower triangle packed
+ * by rows; factor: S holds X with S_K = X^T X, else S_K's triangle) by the block sweeps'
+ * product (dx_fast; r is overwritten) and by the reference (dx_plain, each entry formed). */
+void fcm__mg_block_apply_paths(const double *S, int m, int factor, double *r, double *dx_fast,
+                               double *dx_plain);
 
 /* What fcm__mg_create_from() took from the earlier hierarchy (zero for fcm_mg_create()). */
 typedef struct fcm__mg_kept {

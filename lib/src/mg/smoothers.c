@@ -250,7 +250,10 @@ fcm_status fcm__mg_row_slabs(fcm_mg *m, mg_level *L)
                      ci[rp[i] + p + 1] == i + 1 && ci[rp[i] + p + 2] == i + 2 &&
                      !memcmp(ci + rp[i], ci + rp[i + 1], sizeof *ci * (size_t)len) &&
                      !memcmp(ci + rp[i], ci + rp[i + 2], sizeof *ci * (size_t)len);
-    L->rows.triple[i] = (unsigned char)same;
+    int nodes = same && len % 3 == 0;
+    for (fcm_index q = rp[i]; nodes && q < rp[i + 1]; q += 3)
+      nodes = ci[q] % 3 == 0 && ci[q + 1] == ci[q] + 1 && ci[q + 2] == ci[q] + 2;
+    L->rows.triple[i] = (unsigned char)(!same ? 0 : nodes ? FCM__MG_TRIPLE_NODES : FCM__MG_TRIPLE);
   }
 cleanup:
   fcm__free(ctx, work);

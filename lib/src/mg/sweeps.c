@@ -1,8 +1,10 @@
 /* The multigrid's sweeps, inside the cycle's parallel regions: pointwise symmetric Gauss-Seidel
  * in slab order (a copy's three rows of one pattern together), multicolour SGS, damped
  * Jacobi, and block Gauss-Seidel over the level's blocks (S_K from its lower triangle, or
- * X^T (X r) where a block holds the inverse X of its Cholesky factor); the test hook that
- * checks them against one row at a time. */
+ * X^T (X r) where a block holds the inverse X of its Cholesky factor, both packed by rows:
+ * row i from FCM__SCHWARZ_PACKED(i, 0)); the test hook that checks them against one row at a
+ * time. */
+#include "core/multiversion.h"
 #include "mg/levels_impl.h"
 
 #include <string.h>
@@ -47,32 +49,17 @@ static void symmetric_sweep(const slab_order *S,
     if (fcm__mg_slab_mine(S, k, t, nt)) slab(a, k, 1);
 }
 
-/* sum_j a[j] r[j], j < m, as fcm__mg_row_dot(). */
-static inline double dense_dot(const double *a, const double *r, int m)
-{
-  double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-  int j = 0;
-  for (; j + 4 <= m; j += 4) {
-    s0 += a[j] * r[j];
-    s1 += a[j + 1] * r[j + 1];
-    s2 += a[j + 2] * r[j + 2];
-    s3 += a[j + 3] * r[j + 3];
-  }
-  for (; j < m; j++)
-    s0 += a[j] * r[j];
-  return (s0 + s1) + (s2 + s3);
-}
-
-/* dx = S r for a symmetric m x m S (row major) from its lower triangle alone: row i's entries
- * S_ij, j < i, serve dx_i and (as S_ji) dx_j, so the sweep reads half of S's cache lines;
- * S streams from memory block after block and its reads are most of the block product's
- * time. Two partial sums per row, the column updates in pairs. */
-static inline void sym_lower_apply(const double *S, const double *r, int m, double *dx)
+/* dx = S r for a symmetric m x m S from its lower triangle alone (packed): row i's entries
+ * S_ij, j < i, serve dx_i and (as S_ji) dx_j; S streams from memory block after block and
+ * its reads are most of the block product's time. Two partial sums per row, the column
+ * updates in pairs. */
+static inline __attribute__((always_inline)) void sym_lower_apply(const double *S, const double *r,
+                                                                  int m, double *dx)
 {
   for (int i = 0; i < m; i++)
     dx[i] = 0.0;
   for (int i = 0; i < m; i++) {
-    const double *Si = S + (size_t)i * (size_t)m;
+    const double *Si = S + FCM__SCHWARZ_PACKED(i, 0);
     const double ri = r[i];
     double s0 = 0.0, s1 = 0.0;
     int j = 0;
@@ -90,13 +77,53 @@ static inline void sym_lower_apply(const double *S, const double *r, int m, doub
   }
 }
 
-/* dx = X^T X r for a lower triangular m x m X (row major; fcm__schwarz_block_factor()):
- * y = X r into r (rows descending: y_i reads r_j, j <= i, not yet overwritten), then
- * dx = X^T y row after row; both read X's lower triangle, the second time from cache. */
-static inline void factor_apply(const double *X, double *r, int m, double *dx)
+/* y_i = sum_(j <= i) X_ij r_j for rows i0 .. i0 + 3 of a lower triangular X (packed), each
+ * row's sum as two partial sums (s0 over the even j, s1 over the odd j, in ascending order),
+ * into y[0..3]: the four rows' chains run side by side. */
+static inline __attribute__((always_inline)) void factor_rows4(const double *X, const double *r,
+                                                               int i0, double y[4])
 {
-  for (int i = m - 1; i >= 0; i--) {
-    const double *Xi = X + (size_t)i * (size_t)m;
+  const double *Xr[4];
+  fcm__mg_v2d acc[4];
+  for (int k = 0; k < 4; k++) {
+    Xr[k] = X + FCM__SCHWARZ_PACKED(i0 + k, 0);
+    acc[k] = (fcm__mg_v2d){0.0, 0.0};
+  }
+  int j = 0;
+  for (; j + 2 <= i0 + 1; j += 2) { /* the pairs every row of the four has */
+    const fcm__mg_v2d rj = fcm__mg_load2(r + j);
+    for (int k = 0; k < 4; k++)
+      acc[k] += fcm__mg_load2(Xr[k] + j) * rj;
+  }
+  for (int k = 0; k < 4; k++) {
+    const int i = i0 + k;
+    double s0 = acc[k][0], s1 = acc[k][1];
+    int jk = j;
+    for (; jk + 2 <= i + 1; jk += 2) {
+      s0 += Xr[k][jk] * r[jk];
+      s1 += Xr[k][jk + 1] * r[jk + 1];
+    }
+    if (jk <= i) s0 += Xr[k][jk] * r[jk];
+    y[k] = s0 + s1;
+  }
+}
+
+/* dx = X^T X r for a lower triangular m x m X (packed; fcm__schwarz_block_factor()):
+ * y = X r into r (rows descending, four at a time: y_i reads r_j, j <= i, not yet
+ * overwritten), then dx = X^T y two rows of X at a time, each dx_j's sum over i ascending;
+ * both read X's lower triangle, the second time from cache. */
+static inline __attribute__((always_inline)) void factor_apply(const double *X, double *r, int m,
+                                                               double *dx)
+{
+  int i = m - 1;
+  for (; i >= 3; i -= 4) {
+    double y[4];
+    factor_rows4(X, r, i - 3, y);
+    for (int k = 0; k < 4; k++)
+      r[i - 3 + k] = y[k];
+  }
+  for (; i >= 0; i--) {
+    const double *Xi = X + FCM__SCHWARZ_PACKED(i, 0);
     double s0 = 0.0, s1 = 0.0;
     int j = 0;
     for (; j + 2 <= i + 1; j += 2) {
@@ -106,30 +133,42 @@ static inline void factor_apply(const double *X, double *r, int m, double *dx)
     if (j <= i) s0 += Xi[j] * r[j];
     r[i] = s0 + s1;
   }
-  for (int i = 0; i < m; i++)
-    dx[i] = 0.0;
-  for (int i = 0; i < m; i++) {
-    const double *Xi = X + (size_t)i * (size_t)m;
-    const double yi = r[i];
-    for (int j = 0; j <= i; j++)
-      dx[j] += Xi[j] * yi;
+  for (int j = 0; j < m; j++)
+    dx[j] = 0.0;
+  int k = 0;
+  for (; k + 2 <= m; k += 2) {
+    const double *Xa = X + FCM__SCHWARZ_PACKED(k, 0), *Xb = Xa + k + 1;
+    const double ya = r[k], yb = r[k + 1];
+    for (int j = 0; j <= k; j++)
+      dx[j] = (dx[j] + Xa[j] * ya) + Xb[j] * yb;
+    dx[k + 1] += Xb[k + 1] * yb;
+  }
+  if (k < m) {
+    const double *Xa = X + FCM__SCHWARZ_PACKED(k, 0);
+    for (int j = 0; j <= k; j++)
+      dx[j] += Xa[j] * r[k];
   }
 }
 
+/* Entry (i, j) of the symmetric S whose lower triangle T holds packed. */
+static inline double sym_entry(const double *T, int i, int j)
+{
+  return i >= j ? T[FCM__SCHWARZ_PACKED(i, j)] : T[FCM__SCHWARZ_PACKED(j, i)];
+}
+
 /* The reference of the test hook: dx = S r with S = X^T X for a factor block (each entry
- * formed, m^3 operations), else S's rows in full. */
+ * formed, m^3 operations), else each of S's rows in full, one entry at a time. */
 static void plain_apply(const double *S, const double *r, int m, int factor, double *dx)
 {
   for (int i = 0; i < m; i++) {
-    if (!factor) {
-      dx[i] = dense_dot(S + (size_t)i * (size_t)m, r, m);
-      continue;
-    }
     double sum = 0.0;
     for (int j = 0; j < m; j++) {
       double sij = 0.0;
-      for (int k = i > j ? i : j; k < m; k++)
-        sij += S[(size_t)k * (size_t)m + i] * S[(size_t)k * (size_t)m + j];
+      if (!factor)
+        sij = sym_entry(S, i, j);
+      else
+        for (int k = i > j ? i : j; k < m; k++)
+          sij += S[FCM__SCHWARZ_PACKED(k, i)] * S[FCM__SCHWARZ_PACKED(k, j)];
       sum += sij * r[j];
     }
     dx[i] = sum;
@@ -141,13 +180,15 @@ static void plain_apply(const double *S, const double *r, int m, int factor, dou
  * earlier rows' updates through the three's own 3 x 3 block (A_(i..i+2, i..i+2), stored
  * consecutively from the diagonal's position in each row). The same iterate as three single
  * updates, up to the order of the sums. */
-static void sgs_triple(const mg_level *L, const double *v, const int *ci, const fcm_index *rp,
-                       fcm_index i, double w, const double *b, double *x, int back)
+static inline __attribute__((always_inline)) void sgs_triple(const mg_level *L, const double *v,
+                                                             const int *ci, const fcm_index *rp,
+                                                             fcm_index i, double w, const double *b,
+                                                             double *x, int back)
 {
   const fcm_index len = rp[i + 1] - rp[i], o = L->diag[i] - rp[i];
   const double *A0 = v + rp[i] + o, *A1 = A0 + len, *A2 = A1 + len; /* A_(i+r, i..i+2) */
   double s[3], d0, d1, d2;
-  fcm__mg_row_dot3(v, ci, rp[i], len, x, s);
+  fcm__mg_row_dot3(v, ci, rp[i], len, L->rows.triple[i] == FCM__MG_TRIPLE_NODES, x, s);
   if (!back) {
     d0 = w * (b[i] - s[0]) * L->dinv[i];
     d1 = w * (b[i + 1] - (s[1] + A1[0] * d0)) * L->dinv[i + 1];
@@ -164,6 +205,7 @@ static void sgs_triple(const mg_level *L, const double *v, const int *ci, const 
 
 /* Gauss-Seidel over the rows at positions [q0, q1) of the row order, forward (ascending) or
  * backward; a copy's three rows of one pattern together (sgs_triple()). */
+FCM_MULTIVERSION_CLONES
 static void sgs_range(const sweep_args *a, fcm_index q0, fcm_index q1, int back)
 {
   const mg_level *L = a->L;
@@ -291,6 +333,7 @@ void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x)
 
 /* Block Gauss-Seidel over the blocks of slab s, forward or backward: x_K += S_K (b - A x)_K,
  * block after block. */
+FCM_MULTIVERSION_CLONES
 static void block_slab(const sweep_args *a, fcm_index s, int back)
 {
   const mg_level *L = a->L;
@@ -309,15 +352,15 @@ static void block_slab(const sweep_args *a, fcm_index s, int back)
     const double *S = a->blk.S + a->blk.s_off[k];
     const int bm = (int)(a->blk.ptr[k + 1] - a->blk.ptr[k]);
     /* S_K's lower triangle is fetched while the residual's rows are read */
-    for (int i = 0; i < bm; i++)
-      for (int j = 0; j <= i; j += 8)
-        __builtin_prefetch(S + (size_t)i * (size_t)bm + j, 0, 0);
+    for (size_t e = 0; e < FCM__SCHWARZ_PACKED(bm, 0); e += 8)
+      __builtin_prefetch(S + e, 0, 0);
     for (int i = 0; i < bm;) {
       const fcm_index di = d[i];
       if (i + 2 < bm && d[i + 2] == di + 2 && d[i + 1] == di + 1 &&
           fcm__mg_is_triple(triple, di, n)) {
         double dot[3];
-        fcm__mg_row_dot3(v, ci, rp[di], rp[di + 1] - rp[di], x, dot);
+        fcm__mg_row_dot3(v, ci, rp[di], rp[di + 1] - rp[di], triple[di] == FCM__MG_TRIPLE_NODES, x,
+                         dot);
         r[i] = b[di] - dot[0];
         r[i + 1] = b[di + 1] - dot[1];
         r[i + 2] = b[di + 2] - dot[2];
@@ -396,7 +439,7 @@ fcm_status fcm__mg_smooth_paths(fcm_mg *mg, int level, const double *b, const do
   for (fcm_index k = 0; L->blk && k < fcm__schwarz_num_blocks(L->blk); k++)
     *factor_blocks += fcm__schwarz_block_factor(L->blk, k);
   for (fcm_index i = 0; L->rows.triple && i < L->n; i++)
-    *triples += L->rows.triple[i];
+    *triples += L->rows.triple[i] != 0;
   memcpy(x_fast, x, sizeof *x * (size_t)L->n);
   memcpy(x_plain, x, sizeof *x * (size_t)L->n);
 #pragma omp parallel num_threads(1)
@@ -412,4 +455,14 @@ fcm_status fcm__mg_smooth_paths(fcm_mg *mg, int level, const double *b, const do
   }
 cleanup:
   return st;
+}
+
+void fcm__mg_block_apply_paths(const double *S, int m, int factor, double *r, double *dx_fast,
+                               double *dx_plain)
+{
+  plain_apply(S, r, m, factor, dx_plain);
+  if (factor)
+    factor_apply(S, r, m, dx_fast);
+  else
+    sym_lower_apply(S, r, m, dx_fast);
 }

@@ -40,11 +40,14 @@ struct fcm_schwarz {
   fcm_index *block_ptr;  /* num_blocks + 1 */
   fcm_index *dofs;       /* block_ptr[num_blocks] */
   size_t *s_off;         /* num_blocks + 1 offsets into S */
-  double *S;             /* dense S_K, m x m each (symmetric) */
-  int *pos;              /* as S: where C_K's entry (i, j) lies in C's row dofs[i] (-1: none) */
+  double *S;             /* S_K: m x m each (symmetric); a block smoother's (blocks_only) the
+                            lower triangle packed by rows (FCM__SCHWARZ_PACKED) */
+  size_t *pos_off;       /* num_blocks + 1 offsets into pos */
+  int *pos;              /* m x m each: where C_K's entry (i, j) lies in C's row dofs[i] (-1:
+                            none) */
   unsigned char *full;   /* num_blocks: every entry of C_K is stored (pos holds them all) */
   unsigned char *factor; /* blocks_only, num_blocks: S's slot holds X = L^{-1} of the Cholesky
-                            factor C_K = L L^T (lower triangle, zero above), S_K = X^T X */
+                            factor C_K = L L^T (its lower triangle), S_K = X^T X */
   int max_m;
   int num_colors;        /* of the block graph (statistics only; 0 when blocks_only) */
   fcm_index *inc_ptr;    /* n + 1: DOF i is row inc_row[q] of block inc_blk[q], q in range
@@ -85,6 +88,7 @@ void fcm_schwarz_destroy(fcm_schwarz **P)
   fcm__free(ctx, p->block_ptr);
   fcm__free(ctx, p->dofs);
   fcm__free(ctx, p->s_off);
+  fcm__free(ctx, p->pos_off);
   fcm__free(ctx, p->S);
   fcm__free(ctx, p->pos);
   fcm__free(ctx, p->full);
@@ -314,23 +318,28 @@ static double cholesky_product(int m, const double *X, double *S)
   return ns;
 }
 
+/* The lower triangle of the symmetric m x m T (row major) packed by rows into S. */
+static void pack_lower(int m, const double *T, double *S)
+{
+  for (int i = 0; i < m; i++)
+    memcpy(S + FCM__SCHWARZ_PACKED(i, 0), T + (size_t)i * m, sizeof *S * (size_t)(i + 1));
+}
+
 /* S_K = C_K^{-1} through the Cholesky factor C_K = L L^T (the lower triangle of a; L and
  * X = L^{-1} row-major in lw, 2 m^2 doubles), when that factor exists and
  * ||C_K||_F ||S_K||_F <= SCHWARZ_CHOLESKY_COND / eps: then every eigenvalue lies in
  * (eps lambda_max / 1000, lambda_max] up to rounding, none is negative or clamped, and the
  * eigen-inverse of build_block() is the same C_K^{-1} (both to rounding of order
- * cond(C_K) times the unit round-off). 0 (S_K untouched) otherwise.
- * factor non-NULL (a block smoother, whose sweeps may apply S_K = X^T X as two triangular
- * products): X itself into S's slot (lower triangle, zero above; *factor = 1) when the bound
- * ||S_K||_F <= ||X||_F^2 already passes the test, which then needs no product; else S_K as
- * without it (*factor = 0). The same blocks take the Cholesky path either way. The zeros
- * above the diagonal are written only when the slot did not hold X before (*factor = 0 on
- * entry): a setup after a setup writes X's triangle alone. */
+ * cond(C_K) times the unit round-off). 0 (S_K not written) otherwise.
+ * factor non-NULL (a block smoother, whose slot holds a lower triangle packed by rows and
+ * whose sweeps may apply S_K = X^T X as two triangular products): X's triangle into S's slot
+ * (*factor = 1) when the bound ||S_K||_F <= ||X||_F^2 already passes the test, which then
+ * needs no product; else S_K's lower triangle (*factor = 0). The same blocks take the Cholesky
+ * path either way. */
 static int cholesky_inverse(int m, const double *a, double eps, double *lw, double *S,
                             unsigned char *factor)
 {
   double *L = lw, *X = lw + (size_t)m * m, na = 0.0;
-  const int was_factor = factor && *factor; /* S's slot zero above the diagonal already */
   if (factor) *factor = 0;
   for (int i = 0; i < m; i++)
     for (int j = 0; j <= i; j++) {
@@ -345,16 +354,16 @@ static int cholesky_inverse(int m, const double *a, double eps, double *lw, doub
       for (int j = 0; j <= i; j++)
         nx += X[(size_t)i * m + j] * X[(size_t)i * m + j];
     if (isfinite(nx) && sqrt(na) * nx <= SCHWARZ_CHOLESKY_COND / eps) {
-      for (int i = 0; i < m; i++) {
-        memcpy(S + (size_t)i * m, X + (size_t)i * m, sizeof *S * (size_t)(i + 1));
-        if (!was_factor) memset(S + (size_t)i * m + i + 1, 0, sizeof *S * (size_t)(m - 1 - i));
-      }
+      pack_lower(m, X, S);
       *factor = 1;
       return 1;
     }
   }
-  const double ns = cholesky_product(m, X, S);
-  return isfinite(ns) && sqrt(na) * sqrt(ns) <= SCHWARZ_CHOLESKY_COND / eps;
+  double *T = factor ? L : S; /* a packed slot's S_K formed in L's place (L is done with) */
+  const double ns = cholesky_product(m, X, T);
+  const int ok = isfinite(ns) && sqrt(na) * sqrt(ns) <= SCHWARZ_CHOLESKY_COND / eps;
+  if (ok && factor) pack_lower(m, T, S);
+  return ok;
 }
 
 /* Four blocks of one size at once, one in each lane of a vector: cholesky_factor(),
@@ -451,7 +460,7 @@ static unsigned build_batch(fcm_schwarz *P, const fcm_csr *C, const double *vals
   const size_t mm = (size_t)m * (size_t)m;
   v4d *a = (v4d *)w, *L = a + mm, *X = L + mm;
   for (int q = 0; q < BATCH; q++)
-    if (gather_known(C, vals, m, P->dofs + P->block_ptr[b + q], P->pos + P->s_off[b + q], w + q,
+    if (gather_known(C, vals, m, P->dofs + P->block_ptr[b + q], P->pos + P->pos_off[b + q], w + q,
                      BATCH) != 1)
       return 0;
   unsigned bad = 0, done = 0;
@@ -471,12 +480,9 @@ static unsigned build_batch(fcm_schwarz *P, const fcm_csr *C, const double *vals
   for (int q = 0; q < BATCH; q++) {
     if ((bad >> q) & 1u || !(isfinite(nx[q]) && sqrt(na[q]) * nx[q] <= limit)) continue;
     double *S = P->S + P->s_off[b + q];
-    const int was_factor = P->factor[b + q]; /* zeros above the diagonal already */
-    for (int i = 0; i < m; i++) {
+    for (int i = 0; i < m; i++)
       for (int j = 0; j <= i; j++)
-        S[(size_t)i * m + j] = X[(size_t)i * m + j][q];
-      if (!was_factor) memset(S + (size_t)i * m + i + 1, 0, sizeof *S * (size_t)(m - 1 - i));
-    }
+        S[FCM__SCHWARZ_PACKED(i, j)] = X[(size_t)i * m + j][q];
     P->factor[b + q] = 1;
     done |= 1u << q;
   }
@@ -494,7 +500,7 @@ static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *va
   const fcm_index *d = P->dofs + P->block_ptr[b];
   const int m = (int)(P->block_ptr[b + 1] - P->block_ptr[b]);
   double *S = P->S + P->s_off[b];
-  int *pos = P->pos + P->s_off[b];
+  int *pos = P->pos + P->pos_off[b];
   int finite = P->full[b] ? gather_known(C, vals, m, d, pos, a, 1) : -1;
   if (finite < 0) finite = gather_scan(C, vals, m, d, loc, pos, P->full + b, a);
   if (!finite) {
@@ -524,13 +530,16 @@ static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *va
       bs->clamped++;
     }
   }
-  /* S_K = V diag(s) V^T, upper triangle computed, mirrored */
+  /* S_K = V diag(s) V^T, upper triangle computed, mirrored (packed: the lower triangle) */
   for (int i = 0; i < m; i++)
     for (int j = i; j < m; j++) {
       double s = 0.0;
       for (int k = 0; k < m; k++)
         s += a[i + (size_t)k * m] * w[k] * a[j + (size_t)k * m];
-      S[(size_t)i * m + j] = S[(size_t)j * m + i] = s;
+      if (P->blocks_only)
+        S[FCM__SCHWARZ_PACKED(j, i)] = s;
+      else
+        S[(size_t)i * m + j] = S[(size_t)j * m + i] = s;
     }
   return st;
 }
@@ -695,7 +704,7 @@ static void scan_positions(fcm_schwarz *P, const fcm_csr *C)
 #pragma omp for schedule(dynamic, 64)
     for (fcm_index b = 0; b < nb; b++)
       scan_pattern(C, (int)(P->block_ptr[b + 1] - P->block_ptr[b]), P->dofs + P->block_ptr[b], loc,
-                   P->pos + P->s_off[b], &P->full[b]);
+                   P->pos + P->pos_off[b], &P->full[b]);
   }
 }
 
@@ -762,12 +771,15 @@ static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
   FCM_ALLOC(ctx, num_blocks + 1, P->block_ptr);
   FCM_ALLOC(ctx, FCM_MAX(total, 1), P->dofs);
   FCM_ALLOC(ctx, num_blocks + 1, P->s_off);
+  FCM_ALLOC(ctx, num_blocks + 1, P->pos_off);
   FCM_ALLOC(ctx, nr, P->inside);
   if (!blocks_only) FCM_ALLOC(ctx, nr, P->dinv);
   for (fcm_index b = 0; b < num_blocks; b++) {
     fcm_index m = block_ptr[b + 1] - block_ptr[b];
     P->block_ptr[b + 1] = block_ptr[b + 1];
-    P->s_off[b + 1] = P->s_off[b] + (size_t)m * (size_t)m;
+    P->s_off[b + 1] =
+        P->s_off[b] + (blocks_only ? FCM__SCHWARZ_PACKED(m, 0) : (size_t)m * (size_t)m);
+    P->pos_off[b + 1] = P->pos_off[b] + (size_t)m * (size_t)m;
   }
   for (fcm_index p = 0; p < total; p++) {
     P->dofs[p] = block_dofs[p];
@@ -780,7 +792,7 @@ static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
   }
   /* S and pos are written in full by the first setup (below) before anything reads them */
   FCM_ALLOC_RAW(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->S);
-  FCM_ALLOC_RAW(ctx, FCM_MAX(P->s_off[num_blocks], 1), P->pos);
+  FCM_ALLOC_RAW(ctx, FCM_MAX(P->pos_off[num_blocks], 1), P->pos);
   FCM_ALLOC(ctx, num_blocks + 1, P->full); /* zero: the first setup scans */
   if (blocks_only) FCM_ALLOC(ctx, num_blocks + 1, P->factor);
   if (!blocks_only) FCM_TRY(ctx, incidence_and_colors(P)); /* the apply's */
@@ -885,6 +897,11 @@ fcm_index fcm__schwarz_num_blocks(const fcm_schwarz *P)
 int fcm__schwarz_block_factor(const fcm_schwarz *P, fcm_index k)
 {
   return P->factor ? P->factor[k] : 0;
+}
+
+size_t fcm__schwarz_slot_size(const fcm_schwarz *P, fcm_index k)
+{
+  return P->s_off[k + 1] - P->s_off[k];
 }
 
 int fcm__schwarz_block(const fcm_schwarz *P, fcm_index k, const fcm_index **dofs, const double **S)

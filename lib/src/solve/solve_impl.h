@@ -11,17 +11,23 @@
 #define FCM__SOLVE_PARALLEL_MIN 4096
 
 /* Blocks of an additive Schwarz preconditioner, for smoothers that sweep them one after the
- * other (mg): the number of blocks, and block k's size m, its DOFs and its dense m x m
- * S_K (symmetric, row major), valid after a successful setup. */
+ * other (mg): the number of blocks, and block k's size m, its DOFs and its S_K (symmetric),
+ * valid after a successful setup: dense m x m, row major, or for a block smoother
+ * (fcm__schwarz_create_blocks()) its lower triangle packed by rows, entry (i, j), j <= i, at
+ * FCM__SCHWARZ_PACKED(i, j) (m (m + 1) / 2 doubles: a sweep reads each cache line of the slot,
+ * and the slots of a level take half the memory). fcm__schwarz_slot_size(): the doubles of
+ * block k's slot. */
+#define FCM__SCHWARZ_PACKED(i, j) ((size_t)(i) * ((size_t)(i) + 1) / 2 + (size_t)(j))
 fcm_index fcm__schwarz_num_blocks(const fcm_schwarz *P);
 int fcm__schwarz_block(const fcm_schwarz *P, fcm_index k, const fcm_index **dofs, const double **S);
+size_t fcm__schwarz_slot_size(const fcm_schwarz *P, fcm_index k);
 /* 1 when block k of a block smoother (fcm__schwarz_create_blocks()) holds, in S's place, the
- * inverse X = L^{-1} of the Cholesky factor C_K = L L^T (lower triangle, zeros above), so that
- * S_K = X^T X; 0 when it holds S_K. */
+ * inverse X = L^{-1} of the Cholesky factor C_K = L L^T (its lower triangle, packed), so that
+ * S_K = X^T X; 0 when it holds S_K (its lower triangle, packed). */
 int fcm__schwarz_block_factor(const fcm_schwarz *P, fcm_index k);
 /* The same blocks as arrays, for sweeps that read them in their inner loop: block k's DOFs are
- * dofs[ptr[k] .. ptr[k + 1]), its S_K starts at S + s_off[k]. The arrays stay in place for
- * the life of P (setups rewrite S's values only). */
+ * dofs[ptr[k] .. ptr[k + 1]), its slot (as fcm__schwarz_block()'s) starts at S + s_off[k]. The
+ * arrays stay in place for the life of P (setups rewrite S's values only). */
 typedef struct fcm__schwarz_view {
   const fcm_index *ptr, *dofs;
   const size_t *s_off;
