@@ -246,7 +246,9 @@ void fcm__sim_cut_give_back(fcm_integrator *I, fcm_integrator *old)
   if (I->space->col_from == old->space) fcm__space_cut_give_back((fcm_space *)I->space);
   fcm__csr_give_back(I->H, old->H); /* assembled again at old's next iteration */
   old->h_state = SIM_H_INVALID;
-  old->kept = 0;
+  /* the kept factorization stays: the direct solver holds its factor and its copy of the
+   * factored values (fcm_direct), none of them given; a backend solves with H itself */
+  if (old->backend.factor) old->kept = 0;
   if (I->aws && old->aws) fcm__assembly_corot_give_back(I->aws, old->aws);
   if (fcm__csr_give_back(I->M, old->M)) { /* the mass matrix, assembled again now */
     fcm_index nnz = 0;

@@ -394,8 +394,9 @@ void fcm__sim_cut_give_storage(const fcm_integrator *old, fcm_integrator *I);
 
 /* After a failed cut (I, not set up or not returned): the storage I took back to old, which
  * goes on as before the cut: its mass matrix assembled again (the same bits), its Newton
- * matrix and corotated element matrices built again at its next step. A failure of that
- * assembly leaves old spent (FCM_ERR_ARG on a step). */
+ * matrix and corotated element matrices built again at its next step (the direct solver's
+ * kept factorization, held apart from them, still used). A failure of that assembly leaves
+ * old spent (FCM_ERR_ARG on a step). */
 void fcm__sim_cut_give_back(fcm_integrator *I, fcm_integrator *old);
 
 /* After a cut with FCM_CUT_REUSE_BLOCKS (before I's setup): the elements of I's space that
