@@ -86,5 +86,5 @@ int main(int argc, char **argv)
   fcm_surface_destroy(&s);
   problem_free(&base);
   fcm_ctx_destroy(&ctx);
-  return 0;
+  return TEST_RESULT();
 }

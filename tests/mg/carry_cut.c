@@ -6,8 +6,11 @@
  * were taken (the counts of fcm__mg_get_kept()). The cut spaces take the old space's pattern
  * (fcm__space_create_cut_take()) and the old level-0 matrix is gone before the carry, as in an
  * integrator's cut. Before each cut, a carry whose allocations fail (several places) returns
- * FCM_ERR_ALLOC, leaks nothing and leaves the old hierarchy as it was (its cycles' bits). The
- * embedded hemisphere of mg_util.h, Hex8 and Hex20, V- and W-cycles. */
+ * FCM_ERR_ALLOC, leaks nothing and leaves the old hierarchy as it was (its cycles' bits). A
+ * carry whose preconditions fail (the old hierarchy made on another space, or on a matrix
+ * not of its space's pattern; the new matrix not of its space's pattern) takes nothing and
+ * gives the plain hierarchy, without an error. The embedded hemisphere of mg_util.h, Hex8 and
+ * Hex20, V- and W-cycles. */
 #include "fem/fem_impl.h"
 #include "mg/levels_impl.h"
 #include "mg_util.h"
@@ -202,6 +205,77 @@ static void failing_carries(fcm_ctx *ctx, fcm_mg *old, const problem *cur, const
   fcm_ctx_destroy(&fctx);
 }
 
+/* A without its stored zeros off the diagonal (the clamped rows' and columns'): the same
+ * operator on a pattern that is not the space's. */
+static fcm_csr *zeros_dropped(fcm_ctx *ctx, const fcm_csr *A)
+{
+  fcm_index n = 0, nnz = 0, m = 0;
+  fcm_csr *B = NULL;
+  fcm_csr_get_size(A, &n, NULL, &nnz);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const double *v = fcm_csr_values_read(A);
+  fcm_index *ri = malloc(sizeof *ri * (size_t)(nnz + 1)),
+            *cj = malloc(sizeof *cj * (size_t)(nnz + 1));
+  double *w = malloc(sizeof *w * (size_t)(nnz + 1));
+  for (fcm_index i = 0; i < n; i++)
+    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+      if (ci[p] == i || v[p] != 0.0) ri[m] = i, cj[m] = ci[p], w[m++] = v[p];
+  TEST_TRUE(m < nnz);
+  TEST_OK(ctx, fcm_csr_create_triplets(ctx, n, n, m, ri, cj, w, FCM_CSR_SYMMETRIC, &B));
+  free(ri);
+  free(cj);
+  free(w);
+  return B;
+}
+
+/* Hierarchies of cur's numbering that must not be carried: made on another space of cur's
+ * rules (olds[0], its pattern) and on cur's space with a matrix of another pattern (olds[1]). Made
+ * before the cut takes cur's pattern; mats[] their matrices, spaces[0] the other space. */
+static void uncarriable(fcm_ctx *ctx, const problem *cur, const fcm_cell_rules *rules,
+                        const fcm_mg_options *o, fcm_mg *olds[2], fcm_csr *mats[2],
+                        fcm_space **other)
+{
+  fcm_space_options so = fcm_space_options_default();
+  unsigned char *inactive = eliminated(cur->A, cur->n);
+  TEST_OK(ctx, fcm_space_create_embedded_with(ctx, cur->mesh, rules, &so, other));
+  TEST_TRUE(fcm_space_num_dofs(*other) == cur->n);
+  TEST_OK(ctx, fcm_space_matrix_create(*other, &mats[0]));
+  mats[1] = zeros_dropped(ctx, cur->A);
+  TEST_OK(ctx, fcm__mg_create_pattern(ctx, NULL, *other, mats[0], inactive, o, &olds[0]));
+  TEST_OK(ctx, fcm__mg_create_pattern(ctx, NULL, cur->space, mats[1], inactive, o, &olds[1]));
+  free(inactive);
+}
+
+/* Carries whose preconditions fail: from olds[] (uncarriable()), and from `old` (carriable)
+ * onto next's matrix on another pattern. Each gives fcm_mg_create()'s hierarchy on its
+ * matrix with nothing taken, and no error. */
+static void plain_carries(fcm_ctx *ctx, fcm_mg *const olds[2], const fcm_mg *old,
+                          const problem *cur, const problem *next, const fcm_mg_options *o)
+{
+  unsigned char *inactive = eliminated(next->A, next->n);
+  fcm_csr *dropped = zeros_dropped(ctx, next->A);
+  fcm_mg *fresh[2] = {NULL, NULL};
+  TEST_OK(ctx, fcm_mg_create(ctx, next->space, next->A, o, &fresh[0]));
+  TEST_OK(ctx, fcm_mg_create(ctx, next->space, dropped, o, &fresh[1]));
+  for (int q = 0; q < 3; q++) {
+    fcm_mg *mg = NULL;
+    fcm_csr *A = q < 2 ? next->A : dropped;
+    TEST_OK(ctx, fcm__mg_create_pattern_cut(ctx, q < 2 ? olds[q] : old, cur->space, next->space, A,
+                                            inactive, o, &mg));
+    TEST_OK(ctx, fcm_mg_setup(mg));
+    fcm__mg_kept k;
+    fcm__mg_get_kept(mg, &k);
+    TEST_TRUE(k.carried_plans == 0 && k.carried_ap_rows == 0 && k.carried_coarse_rows == 0);
+    TEST_TRUE(same_mg(ctx, mg, fresh[q == 2], next));
+    fcm_mg_destroy(&mg);
+  }
+  fcm_mg_destroy(&fresh[0]);
+  fcm_mg_destroy(&fresh[1]);
+  fcm_csr_destroy(&dropped);
+  free(inactive);
+}
+
 /* The cut sequence on `type`, a V-cycle and a W-cycle hierarchy carried along it. */
 static void cut_sequence(fcm_ctx *ctx, fcm_element_type type)
 {
@@ -231,10 +305,20 @@ static void cut_sequence(fcm_ctx *ctx, fcm_element_type type)
     TEST_OK(ctx, fcm_surface_create_plane(ctx, pt[k], nrm[k], blo[k], bhi[k], &s));
     TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, base.mesh, base.geom, prev, s, &rules[k]));
     fcm_surface_destroy(&s);
+    fcm_mg *olds[2] = {NULL, NULL};
+    fcm_csr *mats[2] = {NULL, NULL};
+    fcm_space *other = NULL;
+    if (k == 0) uncarriable(ctx, &cur, prev, &o[0], olds, mats, &other);
     prev = rules[k];
     problem next;
     problem_cut(ctx, &base, rules[k], cur.space, &next);
     failing_carries(ctx, mg[0], &cur, &next, &o[0]);
+    if (k == 0) plain_carries(ctx, olds, mg[0], &cur, &next, &o[0]);
+    for (int q = 0; q < 2; q++) {
+      fcm_mg_destroy(&olds[q]);
+      fcm_csr_destroy(&mats[q]);
+    }
+    fcm_space_destroy(&other);
     for (int c = 0; c < 2; c++) { /* as a cut: the old level-0 matrix goes first */
       fcm__mg_detach(mg[c]);
       fcm_csr_destroy(&pattern[c]);
@@ -270,5 +354,5 @@ int main(void)
   cut_sequence(ctx, FCM_ELEMENT_HEX20);
   fcm_ctx_destroy(&ctx);
   printf("ok\n");
-  return 0;
+  return TEST_RESULT();
 }

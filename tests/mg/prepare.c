@@ -163,5 +163,5 @@ int main(void)
   prepare_case(ctx, FCM_ELEMENT_HEX20, 2);
   fcm_ctx_destroy(&ctx);
   printf("ok\n");
-  return 0;
+  return TEST_RESULT();
 }

@@ -114,6 +114,9 @@ struct fcm_mg {
   fcm_space *oct_space[32]; /* and their spaces */
   fcm__mg_kept kept;        /* what fcm__mg_create_from() took from the earlier hierarchy */
   int values_pending; /* created on a pattern (fcm__mg_create_pattern()): no value set up yet */
+  /* the space whose pattern level 0's matrix had at creation (fcm__mg_pattern_of()), NULL
+   * for none; kept by fcm__mg_detach(), only compared */
+  const fcm_space *pattern_of;
 };
 
 /* Threads of a parallel region: the context's now, at most those of the creation (scratch). */
@@ -339,8 +342,15 @@ typedef struct mg_carry {
   const fcm_index *graph[4]; /* fcm__space_cut_copy_map()'s */
 } mg_carry;
 
-/* The maps of c (old, old_space set) for m (hierarchy built); nlev 0 where nothing maps (an
- * octree hierarchy, level 0 not the old space's). */
+/* The space when A has the space's pattern (row_ptr and col_idx the space's arrays, shared,
+ * or the same values: fcm_space_matrix_create()), else NULL. O(1) when shared, else one
+ * comparison of the pattern. */
+const fcm_space *fcm__mg_pattern_of(const fcm_space *space, const fcm_csr *A);
+
+/* The maps of c (old, old_space set) for m (hierarchy built); nlev 0, no error, where the
+ * carry's preconditions fail (fcm__mg_create_pattern_cut()): an octree hierarchy, old not
+ * made on old_space's pattern, m not on its space's, the spaces not a full cut pair.
+ * @return FCM_OK, FCM_ERR_ALLOC, FCM_ERR_INTERNAL. */
 fcm_status fcm__mg_carry_maps(fcm_mg *m, mg_carry *c);
 
 /* The prior of level l's Galerkin plan (1), or 0 where c (NULL: none) has none. */

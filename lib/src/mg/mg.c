@@ -298,6 +298,7 @@ static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, mg_carry *carry, const fc
   m->opts = o;
   m->nt = fcm_ctx_num_threads(ctx);
   m->values_pending = inactive != NULL;
+  m->pattern_of = fcm__mg_pattern_of(space, A);
   FCM_TRY(ctx, fcm__mg_build_hierarchy(m, A, inactive));
   if (!fcm__mg_reuse_allowed(old, m)) old = NULL;
   FCM_TRY(ctx, level_diag(m, &m->lev[0]));
