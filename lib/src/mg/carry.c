@@ -51,7 +51,7 @@ static int carry_possible(const fcm_mg *m, const mg_carry *c)
 
 void fcm__mg_carry_free(fcm_ctx *ctx, mg_carry *c)
 {
-  for (int l = 0; l < 32; l++) {
+  for (int l = 0; l < MG_MAX_LEVELS; l++) {
     fcm__free(ctx, c->row_old[l]);
     fcm__free(ctx, c->row_new[l]);
   }
