@@ -218,7 +218,9 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
   w.same3 = t->same3;
 #pragma omp parallel num_threads(nt) if (nt > 1 && n > 4096)
   {
-    /* copy-graph mode: A's three rows of a copy hold one pattern */
+    /* copy-graph mode: A's pattern is the copy graph G (the prior's precondition, which the
+     * caller guarantees: fcm__mg_create_pattern_cut() checks that A has its space's pattern),
+     * so a copy's three rows hold one pattern */
 #pragma omp for schedule(static) nowait
     for (fcm_index g = 0; g < n / 3; g++)
       t->same3[g] = (unsigned char)(!prior->A_col || fcm__ptap_same_pattern3(3 * g, w.Ap, w.Ac));
