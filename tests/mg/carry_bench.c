@@ -6,24 +6,10 @@
  * only, for a profiler). */
 #include "fem/fem_impl.h"
 #include "mg/levels_impl.h"
+#include "mg_compare.h"
 #include "mg_util.h"
 
 #include <stdio.h>
-
-static unsigned char *eliminated(const fcm_csr *A, fcm_index n)
-{
-  const fcm_index *rp = fcm_csr_row_ptr(A);
-  const int *ci = fcm_csr_col_idx(A);
-  const double *v = fcm_csr_values_read(A);
-  unsigned char *in = calloc((size_t)n + 1, 1);
-  for (fcm_index i = 0; i < n; i++) {
-    int off = 0;
-    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
-      off |= ci[p] != i && v[p] != 0.0;
-    in[i] = (unsigned char)!off;
-  }
-  return in;
-}
 
 int main(int argc, char **argv)
 {
@@ -53,7 +39,7 @@ int main(int argc, char **argv)
   finish_space(ctx, &next, 0);
   const double flo[3] = {-2, 0, -2}, fhi[3] = {2, 0, 2};
   clamp_box(ctx, &next, flo, fhi);
-  unsigned char *inactive = eliminated(next.A, next.n);
+  unsigned char *inactive = mgc_eliminated(next.A, next.n);
   double best[2] = {1e30, 1e30};
   fcm__mg_kept kept;
   memset(&kept, 0, sizeof kept);
@@ -86,5 +72,5 @@ int main(int argc, char **argv)
   fcm_surface_destroy(&s);
   problem_free(&base);
   fcm_ctx_destroy(&ctx);
-  return 0;
+  return TEST_RESULT();
 }

@@ -6,97 +6,19 @@
  * were taken (the counts of fcm__mg_get_kept()). The cut spaces take the old space's pattern
  * (fcm__space_create_cut_take()) and the old level-0 matrix is gone before the carry, as in an
  * integrator's cut. Before each cut, a carry whose allocations fail (several places) returns
- * FCM_ERR_ALLOC, leaks nothing and leaves the old hierarchy as it was (its cycles' bits). The
- * embedded hemisphere of mg_util.h, Hex8 and Hex20, V- and W-cycles. */
+ * FCM_ERR_ALLOC, leaks nothing and leaves the old hierarchy as it was (its cycles' bits). A
+ * carry whose preconditions fail (the old hierarchy made on another space, or on a matrix
+ * not of its space's pattern; the new matrix not of its space's pattern) takes nothing and
+ * gives the plain hierarchy, without an error. The embedded hemisphere of mg_util.h, Hex8 and
+ * Hex20, V- and W-cycles. */
 #include "fem/fem_impl.h"
 #include "mg/levels_impl.h"
+#include "mg_compare.h"
 #include "mg_util.h"
 #include "test_alloc.h"
 
 #include <math.h>
 #include <stdio.h>
-
-/* The rows of A without an off-diagonal value: those the elimination decoupled. */
-static unsigned char *eliminated(const fcm_csr *A, fcm_index n)
-{
-  const fcm_index *rp = fcm_csr_row_ptr(A);
-  const int *ci = fcm_csr_col_idx(A);
-  const double *v = fcm_csr_values_read(A);
-  unsigned char *in = calloc((size_t)n + 1, 1);
-  for (fcm_index i = 0; i < n; i++) {
-    int off = 0;
-    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
-      off |= ci[p] != i && v[p] != 0.0;
-    in[i] = (unsigned char)!off;
-  }
-  return in;
-}
-
-/* Two cycles, the second from the first's output: 2 n values. */
-static void cycles(fcm_ctx *ctx, fcm_mg *mg, const problem *p, double *out)
-{
-  TEST_OK(ctx, fcm_mg_operator(mg, p->b, out));
-  TEST_OK(ctx, fcm_mg_operator(mg, out, out + p->n));
-}
-
-/* Same levels, level matrices, inactive rows and cycle output bits. */
-static int same_mg(fcm_ctx *ctx, fcm_mg *a, fcm_mg *b, const problem *p)
-{
-  int same = a->nlev == b->nlev;
-  for (int l = 0; same && l < a->nlev; l++) {
-    const fcm_csr *A = fcm__mg_level_matrix(&a->lev[l]), *B = fcm__mg_level_matrix(&b->lev[l]);
-    fcm_index na = 0, za = 0, nb = 0, zb = 0;
-    fcm_csr_get_size(A, &na, NULL, &za);
-    fcm_csr_get_size(B, &nb, NULL, &zb);
-    same = na == nb && za == zb &&
-           !memcmp(fcm_csr_row_ptr(A), fcm_csr_row_ptr(B), sizeof(fcm_index) * (size_t)(na + 1)) &&
-           !memcmp(fcm_csr_col_idx(A), fcm_csr_col_idx(B), sizeof(int) * (size_t)za) &&
-           !memcmp(fcm_csr_values_read(A), fcm_csr_values_read(B), sizeof(double) * (size_t)za) &&
-           !memcmp(a->lev[l].inactive, b->lev[l].inactive, (size_t)na);
-    if (!same) printf("  level %d differs\n", l);
-  }
-  const size_t bytes = sizeof(double) * 2 * (size_t)p->n;
-  double *x1 = malloc(bytes), *x2 = malloc(bytes);
-  cycles(ctx, a, p, x1);
-  cycles(ctx, b, p, x2);
-  int finite = 1;
-  for (fcm_index i = 0; i < 2 * p->n; i++)
-    finite &= isfinite(x1[i]) != 0;
-  same = same && finite && memcmp(x1, x2, bytes) == 0;
-  free(x1);
-  free(x2);
-  return same;
-}
-
-/* Is level l + 1's pattern exactly the structural pattern of P_l^T A_l P_l with the diagonal? */
-static int galerkin_pattern_exact(const fcm_mg *mg, int l)
-{
-  const mg_level *L = &mg->lev[l], *C = &mg->lev[l + 1];
-  const fcm_csr *A = fcm__mg_level_matrix(L), *Ac = fcm__mg_level_matrix(C);
-  const fcm_index *rp = fcm_csr_row_ptr(A), *cp = fcm_csr_row_ptr(Ac);
-  const int *ci = fcm_csr_col_idx(A), *cc = fcm_csr_col_idx(Ac);
-  const size_t nc = (size_t)C->n;
-  unsigned char *hit = calloc(nc * nc + 1, 1);
-  for (size_t I = 0; I < nc; I++)
-    hit[I * nc + I] = 1;
-  for (fcm_index i = 0; i < L->n; i++)
-    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
-      for (fcm_index a = L->P_ptr[i]; a < L->P_ptr[i + 1]; a++)
-        for (fcm_index b = L->P_ptr[ci[p]]; b < L->P_ptr[ci[p] + 1]; b++)
-          hit[(size_t)L->P_col[a] * nc + (size_t)L->P_col[b]] = 1;
-  int same = 1;
-  for (size_t I = 0; I < nc && same; I++) {
-    fcm_index count = 0;
-    for (size_t J = 0; J < nc; J++)
-      count += hit[I * nc + J];
-    same = count == cp[I + 1] - cp[I];
-    for (fcm_index q = cp[I]; q < cp[I + 1] && same; q++)
-      same = hit[I * nc + (size_t)cc[q]] && (q == cp[I] || cc[q] > cc[q - 1]);
-    if (!same) printf("  level %d: coarse row %zu is not P^T A P's\n", l + 1, I);
-  }
-  free(hit);
-  return same;
-}
 
 /* The space of `rules` made by a cut of `from` (its pattern taken), its clamped matrix. */
 static void problem_cut(fcm_ctx *ctx, const problem *base, const fcm_cell_rules *rules,
@@ -126,31 +48,32 @@ static fcm_mg *carry_and_compare(fcm_ctx *ctx, const fcm_mg *old, const fcm_spac
                                  fcm_csr **pattern)
 {
   fcm_mg *prep = NULL, *fresh = NULL;
-  unsigned char *inactive = eliminated(p->A, p->n);
+  unsigned char *inactive = mgc_eliminated(p->A, p->n);
   TEST_OK(ctx, fcm_space_matrix_create(p->space, pattern));
   TEST_OK(ctx, fcm__mg_create_pattern_cut(ctx, old, prev, p->space, *pattern, inactive, o, &prep));
   memcpy(fcm_csr_values(*pattern), fcm_csr_values_read(p->A),
          sizeof(double) * (size_t)fcm_csr_row_ptr(p->A)[p->n]);
   TEST_OK(ctx, fcm_mg_setup(prep));
   TEST_OK(ctx, fcm_mg_create(ctx, p->space, p->A, o, &fresh));
-  const int same = same_mg(ctx, prep, fresh, p);
+  const int same = mgc_same(ctx, prep, fresh, p->b, p->n, 2);
   int exact = 1;
   fcm_index coarse_rows = 0;
   for (int l = 0; l + 1 < prep->nlev; l++) {
     fcm_index row_slabs = 0, block_slabs = 0;
-    exact &= galerkin_pattern_exact(prep, l);
+    exact &= mgc_galerkin_exact(prep, l);
     TEST_OK(ctx, fcm__mg_slabs_check(prep, l, &row_slabs, &block_slabs));
     coarse_rows += prep->lev[l + 1].n;
   }
   fcm__mg_kept k;
   fcm__mg_get_kept(prep, &k);
-  printf("%s: %d levels, %lld DOFs; plans carried %d, rows of A P taken %lld of %lld, coarse "
-         "rows %lld of %lld; %s fcm_mg_create(), structure %s the references\n",
-         what, fcm_mg_num_levels(prep), (long long)p->n, k.carried_plans,
-         (long long)k.carried_ap_rows,
-         (long long)(coarse_rows - prep->lev[prep->nlev - 1].n + p->n),
-         (long long)k.carried_coarse_rows, (long long)coarse_rows, same ? "equals" : "DIFFERS from",
-         exact ? "equals" : "DIFFERS from");
+  if (getenv("FCM_TEST_VERBOSE"))
+    printf("%s: %d levels, %lld DOFs; plans carried %d, rows of A P taken %lld of %lld, coarse "
+           "rows %lld of %lld; %s fcm_mg_create(), structure %s the references\n",
+           what, fcm_mg_num_levels(prep), (long long)p->n, k.carried_plans,
+           (long long)k.carried_ap_rows,
+           (long long)(coarse_rows - prep->lev[prep->nlev - 1].n + p->n),
+           (long long)k.carried_coarse_rows, (long long)coarse_rows,
+           same ? "equals" : "DIFFERS from", exact ? "equals" : "DIFFERS from");
   TEST_TRUE(fcm_mg_num_levels(prep) >= 3);
   TEST_TRUE(same);
   TEST_TRUE(exact);
@@ -174,8 +97,8 @@ static void failing_carries(fcm_ctx *ctx, fcm_mg *old, const problem *cur, const
   TEST_TRUE(fctx != NULL);
   const size_t bytes = sizeof(double) * 2 * (size_t)cur->n;
   double *x0 = malloc(bytes), *x1 = malloc(bytes);
-  cycles(ctx, old, cur, x0);
-  unsigned char *inactive = eliminated(next->A, next->n);
+  mgc_cycles(ctx, old, cur->b, cur->n, 2, x0);
+  unsigned char *inactive = mgc_eliminated(next->A, next->n);
   fcm_mg *mg = NULL;
   /* the number of allocations of a carry that succeeds */
   TEST_OK(fctx, fcm__mg_create_pattern_cut(fctx, old, cur->space, next->space, next->A, inactive, o,
@@ -194,12 +117,83 @@ static void failing_carries(fcm_ctx *ctx, fcm_mg *old, const problem *cur, const
     TEST_TRUE(fcm_ctx_live_allocations(fctx) == live);
   }
   TEST_TRUE(failures == 6);
-  cycles(ctx, old, cur, x1);
+  mgc_cycles(ctx, old, cur->b, cur->n, 2, x1);
   TEST_TRUE(memcmp(x0, x1, bytes) == 0);
   free(inactive);
   free(x0);
   free(x1);
   fcm_ctx_destroy(&fctx);
+}
+
+/* A without its stored zeros off the diagonal (the clamped rows' and columns'): the same
+ * operator on a pattern that is not the space's. */
+static fcm_csr *zeros_dropped(fcm_ctx *ctx, const fcm_csr *A)
+{
+  fcm_index n = 0, nnz = 0, m = 0;
+  fcm_csr *B = NULL;
+  fcm_csr_get_size(A, &n, NULL, &nnz);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const double *v = fcm_csr_values_read(A);
+  fcm_index *ri = malloc(sizeof *ri * (size_t)(nnz + 1)),
+            *cj = malloc(sizeof *cj * (size_t)(nnz + 1));
+  double *w = malloc(sizeof *w * (size_t)(nnz + 1));
+  for (fcm_index i = 0; i < n; i++)
+    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+      if (ci[p] == i || v[p] != 0.0) ri[m] = i, cj[m] = ci[p], w[m++] = v[p];
+  TEST_TRUE(m < nnz);
+  TEST_OK(ctx, fcm_csr_create_triplets(ctx, n, n, m, ri, cj, w, FCM_CSR_SYMMETRIC, &B));
+  free(ri);
+  free(cj);
+  free(w);
+  return B;
+}
+
+/* Hierarchies of cur's numbering that must not be carried: made on another space of cur's
+ * rules (olds[0], its pattern) and on cur's space with a matrix of another pattern (olds[1]). Made
+ * before the cut takes cur's pattern; mats[] their matrices, spaces[0] the other space. */
+static void uncarriable(fcm_ctx *ctx, const problem *cur, const fcm_cell_rules *rules,
+                        const fcm_mg_options *o, fcm_mg *olds[2], fcm_csr *mats[2],
+                        fcm_space **other)
+{
+  fcm_space_options so = fcm_space_options_default();
+  unsigned char *inactive = mgc_eliminated(cur->A, cur->n);
+  TEST_OK(ctx, fcm_space_create_embedded_with(ctx, cur->mesh, rules, &so, other));
+  TEST_TRUE(fcm_space_num_dofs(*other) == cur->n);
+  TEST_OK(ctx, fcm_space_matrix_create(*other, &mats[0]));
+  mats[1] = zeros_dropped(ctx, cur->A);
+  TEST_OK(ctx, fcm__mg_create_pattern(ctx, NULL, *other, mats[0], inactive, o, &olds[0]));
+  TEST_OK(ctx, fcm__mg_create_pattern(ctx, NULL, cur->space, mats[1], inactive, o, &olds[1]));
+  free(inactive);
+}
+
+/* Carries whose preconditions fail: from olds[] (uncarriable()), and from `old` (carriable)
+ * onto next's matrix on another pattern. Each gives fcm_mg_create()'s hierarchy on its
+ * matrix with nothing taken, and no error. */
+static void plain_carries(fcm_ctx *ctx, fcm_mg *const olds[2], const fcm_mg *old,
+                          const problem *cur, const problem *next, const fcm_mg_options *o)
+{
+  unsigned char *inactive = mgc_eliminated(next->A, next->n);
+  fcm_csr *dropped = zeros_dropped(ctx, next->A);
+  fcm_mg *fresh[2] = {NULL, NULL};
+  TEST_OK(ctx, fcm_mg_create(ctx, next->space, next->A, o, &fresh[0]));
+  TEST_OK(ctx, fcm_mg_create(ctx, next->space, dropped, o, &fresh[1]));
+  for (int q = 0; q < 3; q++) {
+    fcm_mg *mg = NULL;
+    fcm_csr *A = q < 2 ? next->A : dropped;
+    TEST_OK(ctx, fcm__mg_create_pattern_cut(ctx, q < 2 ? olds[q] : old, cur->space, next->space, A,
+                                            inactive, o, &mg));
+    TEST_OK(ctx, fcm_mg_setup(mg));
+    fcm__mg_kept k;
+    fcm__mg_get_kept(mg, &k);
+    TEST_TRUE(k.carried_plans == 0 && k.carried_ap_rows == 0 && k.carried_coarse_rows == 0);
+    TEST_TRUE(mgc_same(ctx, mg, fresh[q == 2], next->b, next->n, 2));
+    fcm_mg_destroy(&mg);
+  }
+  fcm_mg_destroy(&fresh[0]);
+  fcm_mg_destroy(&fresh[1]);
+  fcm_csr_destroy(&dropped);
+  free(inactive);
 }
 
 /* The cut sequence on `type`, a V-cycle and a W-cycle hierarchy carried along it. */
@@ -231,10 +225,20 @@ static void cut_sequence(fcm_ctx *ctx, fcm_element_type type)
     TEST_OK(ctx, fcm_surface_create_plane(ctx, pt[k], nrm[k], blo[k], bhi[k], &s));
     TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, base.mesh, base.geom, prev, s, &rules[k]));
     fcm_surface_destroy(&s);
+    fcm_mg *olds[2] = {NULL, NULL};
+    fcm_csr *mats[2] = {NULL, NULL};
+    fcm_space *other = NULL;
+    if (k == 0) uncarriable(ctx, &cur, prev, &o[0], olds, mats, &other);
     prev = rules[k];
     problem next;
     problem_cut(ctx, &base, rules[k], cur.space, &next);
     failing_carries(ctx, mg[0], &cur, &next, &o[0]);
+    if (k == 0) plain_carries(ctx, olds, mg[0], &cur, &next, &o[0]);
+    for (int q = 0; q < 2; q++) {
+      fcm_mg_destroy(&olds[q]);
+      fcm_csr_destroy(&mats[q]);
+    }
+    fcm_space_destroy(&other);
     for (int c = 0; c < 2; c++) { /* as a cut: the old level-0 matrix goes first */
       fcm__mg_detach(mg[c]);
       fcm_csr_destroy(&pattern[c]);
@@ -269,6 +273,5 @@ int main(void)
   cut_sequence(ctx, FCM_ELEMENT_HEX8);
   cut_sequence(ctx, FCM_ELEMENT_HEX20);
   fcm_ctx_destroy(&ctx);
-  printf("ok\n");
-  return 0;
+  return TEST_RESULT();
 }

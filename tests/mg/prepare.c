@@ -8,26 +8,11 @@
  * coarsest analysis and still gives the same bits. Given other Dirichlet rows than the
  * matrix's eliminated ones, the setup refuses (FCM_ERR_ARG: create it again). */
 #include "mg/levels_impl.h"
+#include "mg_compare.h"
 #include "mg_util.h"
 
 #include <math.h>
 #include <stdio.h>
-
-/* The rows of A without an off-diagonal value: those the elimination decoupled. */
-static unsigned char *eliminated(const fcm_csr *A, fcm_index n)
-{
-  const fcm_index *rp = fcm_csr_row_ptr(A);
-  const int *ci = fcm_csr_col_idx(A);
-  const double *v = fcm_csr_values_read(A);
-  unsigned char *in = calloc((size_t)n + 1, 1);
-  for (fcm_index i = 0; i < n; i++) {
-    int off = 0;
-    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
-      off |= ci[p] != i && v[p] != 0.0;
-    in[i] = (unsigned char)!off;
-  }
-  return in;
-}
 
 /* A matrix of A's pattern, every value NaN. */
 static fcm_csr *nan_copy(fcm_ctx *ctx, const problem *p)
@@ -49,44 +34,6 @@ static void copy_values(const fcm_csr *from, fcm_csr *to)
   memcpy(fcm_csr_values(to), fcm_csr_values_read(from), sizeof(double) * (size_t)nnz);
 }
 
-/* Five cycles, each from the last output: 5 n values. */
-static void cycles(fcm_ctx *ctx, fcm_mg *mg, const problem *p, double *out)
-{
-  const fcm_index n = p->n;
-  TEST_OK(ctx, fcm_mg_operator(mg, p->b, out));
-  for (int k = 1; k < 5; k++)
-    TEST_OK(ctx, fcm_mg_operator(mg, out + (k - 1) * n, out + k * n));
-}
-
-/* Same levels, level matrices and cycle output bits. */
-static int same_mg(fcm_ctx *ctx, fcm_mg *a, fcm_mg *b, const problem *p)
-{
-  int same = a->nlev == b->nlev;
-  for (int l = 0; same && l < a->nlev; l++) {
-    const fcm_csr *A = fcm__mg_level_matrix(&a->lev[l]), *B = fcm__mg_level_matrix(&b->lev[l]);
-    fcm_index na = 0, za = 0, nb = 0, zb = 0;
-    fcm_csr_get_size(A, &na, NULL, &za);
-    fcm_csr_get_size(B, &nb, NULL, &zb);
-    same = na == nb && za == zb &&
-           !memcmp(fcm_csr_row_ptr(A), fcm_csr_row_ptr(B), sizeof(fcm_index) * (size_t)(na + 1)) &&
-           !memcmp(fcm_csr_col_idx(A), fcm_csr_col_idx(B), sizeof(int) * (size_t)za) &&
-           !memcmp(fcm_csr_values_read(A), fcm_csr_values_read(B), sizeof(double) * (size_t)za) &&
-           !memcmp(a->lev[l].inactive, b->lev[l].inactive, (size_t)na);
-    if (!same) printf("  level %d differs\n", l);
-  }
-  const size_t bytes = sizeof(double) * 5 * (size_t)p->n;
-  double *x1 = malloc(bytes), *x2 = malloc(bytes);
-  cycles(ctx, a, p, x1);
-  cycles(ctx, b, p, x2);
-  int finite = 1;
-  for (fcm_index i = 0; i < 5 * p->n; i++)
-    finite &= isfinite(x1[i]) != 0;
-  same = same && finite && memcmp(x1, x2, bytes) == 0;
-  free(x1);
-  free(x2);
-  return same;
-}
-
 static void prepare_case(fcm_ctx *ctx, fcm_element_type type, int cycle_index)
 {
   const char *name = type == FCM_ELEMENT_HEX8 ? "hex8" : "hex20";
@@ -95,7 +42,7 @@ static void prepare_case(fcm_ctx *ctx, fcm_element_type type, int cycle_index)
   fcm_mg_options o = fcm_mg_options_default();
   o.coarse_dofs = 100;
   o.cycle_index = cycle_index;
-  unsigned char *inactive = eliminated(p.A, p.n);
+  unsigned char *inactive = mgc_eliminated(p.A, p.n);
   fcm_csr *P = nan_copy(ctx, &p);
   fcm_mg *prep = NULL, *fresh = NULL;
   TEST_OK(ctx, fcm__mg_create_pattern(ctx, NULL, p.space, P, inactive, &o, &prep));
@@ -107,7 +54,7 @@ static void prepare_case(fcm_ctx *ctx, fcm_element_type type, int cycle_index)
   for (int l = 0; l < fresh->nlev; l++)
     nblk += fresh->lev[l].blk != NULL;
   TEST_TRUE(nblk > 0); /* the cut cells' block smoothers are part of the comparison */
-  const int same = same_mg(ctx, prep, fresh, &p);
+  const int same = mgc_same(ctx, prep, fresh, p.b, p.n, 5);
   printf("%s, cycle %d: %d levels, %lld DOFs, %d levels with block smoothers; prepared then set "
          "up %s fcm_mg_create()\n",
          name, cycle_index, fcm_mg_num_levels(fresh), (long long)p.n, nblk,
@@ -126,7 +73,7 @@ static void prepare_case(fcm_ctx *ctx, fcm_element_type type, int cycle_index)
   TEST_TRUE(kept.block_smoothers == nblk && kept.analysis == 1);
   copy_values(p.A, P2);
   TEST_OK(ctx, fcm_mg_setup(again));
-  const int same_again = same_mg(ctx, again, fresh, &p);
+  const int same_again = mgc_same(ctx, again, fresh, p.b, p.n, 5);
   printf("%s, cycle %d: from the earlier hierarchy (kept %d plans, %d block smoothers, analysis "
          "%d): %s\n",
          name, cycle_index, kept.plans, kept.block_smoothers, kept.analysis,
@@ -163,5 +110,5 @@ int main(void)
   prepare_case(ctx, FCM_ELEMENT_HEX20, 2);
   fcm_ctx_destroy(&ctx);
   printf("ok\n");
-  return 0;
+  return TEST_RESULT();
 }

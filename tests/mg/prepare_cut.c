@@ -11,26 +11,11 @@
  * Hex8 and Hex20, V- and W-cycles, cut three times (partial planes: the first splits the top,
  * the second crosses it, the third cuts off a corner). */
 #include "mg/levels_impl.h"
+#include "mg_compare.h"
 #include "mg_util.h"
 
 #include <math.h>
 #include <stdio.h>
-
-/* The rows of A without an off-diagonal value: those the elimination decoupled. */
-static unsigned char *eliminated(const fcm_csr *A, fcm_index n)
-{
-  const fcm_index *rp = fcm_csr_row_ptr(A);
-  const int *ci = fcm_csr_col_idx(A);
-  const double *v = fcm_csr_values_read(A);
-  unsigned char *in = calloc((size_t)n + 1, 1);
-  for (fcm_index i = 0; i < n; i++) {
-    int off = 0;
-    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
-      off |= ci[p] != i && v[p] != 0.0;
-    in[i] = (unsigned char)!off;
-  }
-  return in;
-}
 
 /* A matrix of A's pattern, every value NaN (a value read before the setup shows). */
 static fcm_csr *nan_copy(fcm_ctx *ctx, const problem *p)
@@ -43,75 +28,6 @@ static fcm_csr *nan_copy(fcm_ctx *ctx, const problem *p)
   for (fcm_index k = 0; k < nnz; k++)
     v[k] = NAN;
   return P;
-}
-
-/* Two cycles, the second from the first's output: 2 n values. */
-static void cycles(fcm_ctx *ctx, fcm_mg *mg, const problem *p, double *out)
-{
-  const fcm_index n = p->n;
-  TEST_OK(ctx, fcm_mg_operator(mg, p->b, out));
-  for (int k = 1; k < 2; k++)
-    TEST_OK(ctx, fcm_mg_operator(mg, out + (k - 1) * n, out + k * n));
-}
-
-/* Same levels, level matrices, inactive rows and cycle output bits. */
-static int same_mg(fcm_ctx *ctx, fcm_mg *a, fcm_mg *b, const problem *p)
-{
-  int same = a->nlev == b->nlev;
-  for (int l = 0; same && l < a->nlev; l++) {
-    const fcm_csr *A = fcm__mg_level_matrix(&a->lev[l]), *B = fcm__mg_level_matrix(&b->lev[l]);
-    fcm_index na = 0, za = 0, nb = 0, zb = 0;
-    fcm_csr_get_size(A, &na, NULL, &za);
-    fcm_csr_get_size(B, &nb, NULL, &zb);
-    same = na == nb && za == zb &&
-           !memcmp(fcm_csr_row_ptr(A), fcm_csr_row_ptr(B), sizeof(fcm_index) * (size_t)(na + 1)) &&
-           !memcmp(fcm_csr_col_idx(A), fcm_csr_col_idx(B), sizeof(int) * (size_t)za) &&
-           !memcmp(fcm_csr_values_read(A), fcm_csr_values_read(B), sizeof(double) * (size_t)za) &&
-           !memcmp(a->lev[l].inactive, b->lev[l].inactive, (size_t)na);
-    if (!same) printf("  level %d differs\n", l);
-  }
-  const size_t bytes = sizeof(double) * 2 * (size_t)p->n;
-  double *x1 = malloc(bytes), *x2 = malloc(bytes);
-  cycles(ctx, a, p, x1);
-  cycles(ctx, b, p, x2);
-  int finite = 1;
-  for (fcm_index i = 0; i < 2 * p->n; i++)
-    finite &= isfinite(x1[i]) != 0;
-  same = same && finite && memcmp(x1, x2, bytes) == 0;
-  free(x1);
-  free(x2);
-  return same;
-}
-
-/* Is level l + 1's pattern exactly the structural pattern of P_l^T A_l P_l with the diagonal?
- * A dense table of the coarse entries reached. */
-static int galerkin_pattern_exact(const fcm_mg *mg, int l)
-{
-  const mg_level *L = &mg->lev[l], *C = &mg->lev[l + 1];
-  const fcm_csr *A = fcm__mg_level_matrix(L), *Ac = fcm__mg_level_matrix(C);
-  const fcm_index *rp = fcm_csr_row_ptr(A), *cp = fcm_csr_row_ptr(Ac);
-  const int *ci = fcm_csr_col_idx(A), *cc = fcm_csr_col_idx(Ac);
-  const size_t nc = (size_t)C->n;
-  unsigned char *hit = calloc(nc * nc + 1, 1);
-  for (size_t I = 0; I < nc; I++)
-    hit[I * nc + I] = 1;
-  for (fcm_index i = 0; i < L->n; i++)
-    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
-      for (fcm_index a = L->P_ptr[i]; a < L->P_ptr[i + 1]; a++)
-        for (fcm_index b = L->P_ptr[ci[p]]; b < L->P_ptr[ci[p] + 1]; b++)
-          hit[(size_t)L->P_col[a] * nc + (size_t)L->P_col[b]] = 1;
-  int same = 1;
-  for (size_t I = 0; I < nc && same; I++) {
-    fcm_index count = 0;
-    for (size_t J = 0; J < nc; J++)
-      count += hit[I * nc + J];
-    same = count == cp[I + 1] - cp[I];
-    for (fcm_index q = cp[I]; q < cp[I + 1] && same; q++)
-      same = hit[I * nc + (size_t)cc[q]] && (q == cp[I] || cc[q] > cc[q - 1]);
-    if (!same) printf("  level %d: coarse row %zu is not P^T A P's\n", l + 1, I);
-  }
-  free(hit);
-  return same;
 }
 
 /* Are the row order's groups of three (triple) those a full comparison of the rows finds, and
@@ -171,7 +87,7 @@ static fcm_mg *prepare_and_compare(fcm_ctx *ctx, fcm_mg **old, const problem *p,
                                    const fcm_mg_options *o, const char *what, fcm_csr **pattern)
 {
   fcm_mg *prep = NULL, *fresh = NULL;
-  unsigned char *inactive = eliminated(p->A, p->n);
+  unsigned char *inactive = mgc_eliminated(p->A, p->n);
   *pattern = nan_copy(ctx, p);
   TEST_OK(ctx, fcm__mg_create_pattern(ctx, old, p->space, *pattern, inactive, o, &prep));
   TEST_TRUE(*old == NULL);
@@ -179,11 +95,11 @@ static fcm_mg *prepare_and_compare(fcm_ctx *ctx, fcm_mg **old, const problem *p,
          sizeof(double) * (size_t)fcm_csr_row_ptr(p->A)[p->n]);
   TEST_OK(ctx, fcm_mg_setup(prep));
   TEST_OK(ctx, fcm_mg_create(ctx, p->space, p->A, o, &fresh));
-  const int same = same_mg(ctx, prep, fresh, p);
+  const int same = mgc_same(ctx, prep, fresh, p->b, p->n, 2);
   int exact = 1, nblk = 0;
   for (int l = 0; l + 1 < prep->nlev; l++) {
     fcm_index row_slabs = 0, block_slabs = 0;
-    exact &= galerkin_pattern_exact(prep, l) && triples_exact(prep, l);
+    exact &= mgc_galerkin_exact(prep, l) && triples_exact(prep, l);
     TEST_OK(ctx, fcm__mg_slabs_check(prep, l, &row_slabs, &block_slabs));
     nblk += prep->lev[l].blk != NULL;
   }
@@ -260,5 +176,5 @@ int main(void)
   cut_sequence(ctx, FCM_ELEMENT_HEX20);
   fcm_ctx_destroy(&ctx);
   printf("ok\n");
-  return 0;
+  return TEST_RESULT();
 }

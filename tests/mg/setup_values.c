@@ -97,5 +97,5 @@ int main(void)
   }
   fcm_ctx_destroy(&ctx);
   printf("ok\n");
-  return 0;
+  return TEST_RESULT();
 }

@@ -245,5 +245,5 @@ int main(void)
   cut_sequence(ctx, FCM_ELEMENT_HEX20, 2);
   fcm_ctx_destroy(&ctx);
   printf("ok\n");
-  return 0;
+  return TEST_RESULT();
 }

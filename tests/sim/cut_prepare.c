@@ -205,5 +205,5 @@ int main(int argc, char **argv)
   cut_case(type, FCM_LINEAR_DIRECT, 1, 0);
   fcm_ctx_destroy(&ctx);
   printf("ok\n");
-  return 0;
+  return TEST_RESULT();
 }

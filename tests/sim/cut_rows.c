@@ -73,7 +73,8 @@ static void compare_fresh(const fcm_integrator *old, const fcm_integrator *c, co
   TEST_TRUE(same_bits(c->Ma, f->Ma, n));
   TEST_TRUE(same_bits(c->u, f->u, n) && same_bits(c->v, f->v, n));
   /* the patch ran: some copies' rows taken, the cut's neighbourhood summed again */
-  printf("  copies taken %lld of %lld\n", (long long)c->cut_kept_copies, (long long)(n / 3));
+  if (getenv("FCM_TEST_VERBOSE"))
+    printf("  copies taken %lld of %lld\n", (long long)c->cut_kept_copies, (long long)(n / 3));
   TEST_TRUE(c->cut_kept_copies > 0 && c->cut_kept_copies < n / 3);
   free(u);
   free(v);
@@ -200,8 +201,9 @@ int main(int argc, char **argv)
     TEST_OK(ctx, fcm__space_create_cut(ctx, mesh, rules[k], &so, sb[k - 1], &sb[k]));
     if (!sa[k] || !sb[k]) break;
     TEST_TRUE(sa[k]->cut_row_from != NULL && sb[k]->cut_row_from != NULL);
-    printf("cut %d: %lld -> %lld DOFs\n", k, (long long)fcm_space_num_dofs(sa[k - 1]),
-           (long long)fcm_space_num_dofs(sa[k]));
+    if (getenv("FCM_TEST_VERBOSE"))
+      printf("cut %d: %lld -> %lld DOFs\n", k, (long long)fcm_space_num_dofs(sa[k - 1]),
+             (long long)fcm_space_num_dofs(sa[k]));
     if (k == 2) {
       const int nt = fcm_ctx_num_threads(ctx);
       TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 1));
@@ -229,7 +231,8 @@ int main(int argc, char **argv)
     if (a && b) step_both(a, b);
   }
   /* the element blocks moved within a's arrays at some cut (a few per cent more elements) */
-  printf("element blocks moved in place at %d of 3 cuts\n", moved_in_place);
+  if (getenv("FCM_TEST_VERBOSE"))
+    printf("element blocks moved in place at %d of 3 cuts\n", moved_in_place);
   TEST_TRUE(moved_in_place > 0);
   fcm_integrator_destroy(&a);
   fcm_integrator_destroy(&b);

@@ -15,9 +15,9 @@
 #include <sys/mman.h>
 #endif
 
-/* The huge page size aimed at, and the smallest array given one (below it the padding and
- * a partly used last page cost more than the few TLB entries saved). */
-enum { HUGE_PAGE = 2 << 20, LARGE_MIN = 8 << 20, SMALL_ALIGN = 64 };
+/* The huge page size aimed at; the smallest array given one is FCM__LARGE_MIN (below it the
+ * padding and a partly used last page cost more than the few TLB entries saved). */
+enum { HUGE_PAGE = 2 << 20, SMALL_ALIGN = 64 };
 
 /* Kept just before the caller's array: the block from ctx's allocator and the room from the
  * array's start on. */
@@ -34,7 +34,7 @@ void *fcm__calloc_large(fcm_ctx *ctx, size_t n, size_t size)
     return NULL;
   }
   const size_t bytes = n * size;
-  const size_t align = bytes >= LARGE_MIN ? HUGE_PAGE : SMALL_ALIGN;
+  const size_t align = bytes >= FCM__LARGE_MIN ? HUGE_PAGE : SMALL_ALIGN;
   const size_t capacity = align == HUGE_PAGE && bytes <= SIZE_MAX / 2 ? bytes + bytes / 4 : bytes;
   /* The block from ctx's allocator holds the caller's array on an `align` boundary and, just
    * before it, its header for fcm__free_large() and fcm__calloc_large_from(). */

@@ -58,6 +58,10 @@ FCM_COMPONENT_API void *fcm__malloc(fcm_ctx *ctx, size_t n, size_t size);
 /* Release memory from fcm__calloc or fcm__malloc; accepts NULL. */
 FCM_COMPONENT_API void fcm__free(fcm_ctx *ctx, void *ptr);
 
+/* Arrays of at least this many bytes get huge-page alignment and a quarter more room from
+ * fcm__calloc_large(); smaller ones neither. */
+#define FCM__LARGE_MIN ((size_t)8 << 20)
+
 /* As fcm__calloc for large arrays that are written all over (assembled matrix values): from
  * 8 MiB on, the array starts on a 2 MiB boundary and, on Linux, is advised to transparent huge
  * pages before its zero fill touches it; smaller ones are 64-byte aligned. Counted and failing

@@ -11,34 +11,6 @@
 #include <omp.h>
 #include <string.h>
 
-fcm_assembly_options fcm_assembly_options_default(void)
-{
-  fcm_assembly_options o = {FCM_DEFAULT, FCM_DEFAULT, FCM_FICTITIOUS_PROJECTED};
-  return o;
-}
-
-fcm_status fcm_element_standard_rule(fcm_ctx *ctx, fcm_element_type type, fcm_rule_kind kind,
-                                     int strength, fcm_rule **rule)
-{
-  fcm_status st = FCM_OK;
-  const fcm_element_info *info = fcm_element_get_info(type);
-  FCM_CHECK(info, ctx, FCM_ERR_ARG, "standard rule: invalid element type %d", (int)type);
-  FCM_CHECK(kind == FCM_RULE_STIFFNESS || kind == FCM_RULE_MASS, ctx, FCM_ERR_ARG,
-            "standard rule: invalid rule kind %d", (int)kind);
-  FCM_CHECK(strength >= 0 || strength == FCM_DEFAULT, ctx, FCM_ERR_ARG,
-            "standard rule: strength = %d must be >= 0, or FCM_DEFAULT (-1)", strength);
-  if (strength >= 0)
-    FCM_TRY(ctx, fcm_rule_create(ctx, info->shape, strength, rule));
-  else if (info->shape == FCM_SHAPE_HEX) /* order+1 points per direction: strength 2*order+1 */
-    FCM_TRY(ctx, fcm_rule_create_computed(ctx, info->shape, 2 * info->order + 1, rule));
-  else
-    FCM_TRY(ctx, fcm_rule_create(
-                     ctx, info->shape,
-                     kind == FCM_RULE_MASS ? info->mass_strength : info->stiffness_strength, rule));
-cleanup:
-  return st;
-}
-
 static fcm_status tabulate(const fcm_space *s, fcm_rule_kind kind, int strength, tabulation *t)
 {
   fcm_status st = FCM_OK;
@@ -488,6 +460,16 @@ cell_result fcm__assembly_element_kernel(const fcm_space *s, const tabulation *t
   return volume_cell(s, &ps, e, w);
 }
 
+/* Element c's kept block (keep_in's block `same`) into keep_out (when given) unless in place;
+ * the block. */
+static const double *keep_block(const pass *ps, fcm_index c, fcm_index same)
+{
+  const double *in = ps->keep_in + (size_t)same * ps->bs;
+  double *out = ps->keep_out ? ps->keep_out + (size_t)c * ps->bs : NULL;
+  if (out && out != in) memcpy(out, in, sizeof(double) * (size_t)ps->bs);
+  return out ? out : in;
+}
+
 /* Local element le of the pass into the pass's outputs; 0 (with res) when its det J is not
  * positive somewhere or the material returned NaN or infinity: nothing is scattered then.
  * next: an element the thread takes after le (its matrix entries are prefetched), or -1;
@@ -500,23 +482,17 @@ static int pass_element(const fcm_space *s, const pass *ps, fcm_index le, fcm_in
   if (!fcm__space_owns(s, s->elem_cell[c])) return 1;
   const fcm_index same = ps->keep_same ? ps->keep_same[c] : -1;
   if (same >= 0 && ps->vals && ps->keep_out) { /* a mass block kept: scattered as packed */
-    const double *in = ps->keep_in + (size_t)same * ps->bs;
-    double *out = ps->keep_out + (size_t)c * ps->bs;
-    if (out != in) memcpy(out, in, sizeof(double) * (size_t)ps->bs);
+    const double *out = keep_block(ps, c, same);
     if (touches_rows(s, c, ps->rows)) scatter_mass(s, le, out, ps->vals, ps->rows);
     return 1;
   }
   if (same >= 0 && !touches_rows(s, c, ps->rows)) {
-    if (ps->keep_out && ps->keep_out + (size_t)c * ps->bs != ps->keep_in + (size_t)same * ps->bs)
-      memcpy(ps->keep_out + (size_t)c * ps->bs, ps->keep_in + (size_t)same * ps->bs,
-             sizeof(double) * (size_t)ps->bs);
+    keep_block(ps, c, same);
     return 1;
   }
   if (same >= 0) {
     block_unpack(s->nn, ps, ps->keep_in + (size_t)same * ps->bs, w);
-    if (ps->keep_out && ps->keep_out + (size_t)c * ps->bs != ps->keep_in + (size_t)same * ps->bs)
-      memcpy(ps->keep_out + (size_t)c * ps->bs, ps->keep_in + (size_t)same * ps->bs,
-             sizeof(double) * (size_t)ps->bs);
+    keep_block(ps, c, same);
     /* an element without surface points adds nothing (as surface_cell() says below) */
     if (ps->traction && !piece_has_surface(s, c)) return 1;
   } else if (ps->traction) {
@@ -641,14 +617,6 @@ cleanup:
 
 /* ------------------------------------------------------------------ entry points */
 
-fcm_linear_form fcm_linear_form_default(void)
-{
-  fcm_linear_form f;
-  memset(&f, 0, sizeof f);
-  f.term = FCM_LINEAR_STIFFNESS;
-  return f;
-}
-
 static fcm_status linear_impl(fcm_assembly_workspace *ws, const fcm_linear_form *form, fcm_csr *A,
                               double *f, const pass *keep);
 
@@ -656,20 +624,6 @@ fcm_status fcm_assembly_workspace_linear(fcm_assembly_workspace *ws, const fcm_l
                                          fcm_csr *A, double *f)
 {
   return linear_impl(ws, form, A, f, NULL);
-}
-
-int fcm__assembly_block_size(const fcm_space *s, fcm_linear_term term)
-{
-  switch (term) {
-  case FCM_LINEAR_MASS:
-    return s->nn * (s->nn + 1) / 2;
-  case FCM_LINEAR_BODY_FORCE:
-  case FCM_LINEAR_BODY_FORCE_FIELD:
-  case FCM_LINEAR_SURFACE_TRACTION:
-    return 3 * s->nn;
-  default:
-    return 0;
-  }
 }
 
 fcm_status fcm__assembly_linear_blocks(fcm_assembly_workspace *ws, const fcm_linear_form *form,

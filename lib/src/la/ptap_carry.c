@@ -33,28 +33,16 @@ static int carry_prow(const carry_work *w, fcm_index i)
   return 1;
 }
 
-/* Is row i of A the old row mapped, reaching only rows of P that are (prow)? */
+/* CSR-row mode (A_col set): is row i of A the old row mapped, reaching only rows of P that
+ * are (prow)? */
 static int carry_arow(const carry_work *w, fcm_index i)
 {
   const fcm__ptap_prior *pr = w->pr;
   const fcm_index io = pr->row_old[i], p0 = w->Ap[i], len = w->Ap[i + 1] - p0;
-  if (io < 0) return 0;
-  const int *ac = w->Ac + p0;
-  if (pr->A_col) {
-    if (pr->A_ptr[io + 1] - pr->A_ptr[io] != len) return 0;
-    const int *oc = pr->A_col + pr->A_ptr[io];
-    for (fcm_index q = 0; q < len; q++)
-      if (ac[q] != pr->row_new[oc[q]] || !w->prow[ac[q]]) return 0;
-    return 1;
-  }
-  const fcm_index g = io / 3, deg = pr->A_ptr[g + 1] - pr->A_ptr[g];
-  if (3 * deg != len) return 0;
-  const fcm_index *adj = pr->A_adj + pr->A_ptr[g];
-  for (fcm_index q = 0; q < deg; q++)
-    for (int c = 0; c < 3; c++) {
-      const int j = ac[3 * q + c];
-      if (j != pr->row_new[3 * adj[q] + c] || !w->prow[j]) return 0;
-    }
+  if (io < 0 || pr->A_ptr[io + 1] - pr->A_ptr[io] != len) return 0;
+  const int *ac = w->Ac + p0, *oc = pr->A_col + pr->A_ptr[io];
+  for (fcm_index q = 0; q < len; q++)
+    if (ac[q] != pr->row_new[oc[q]] || !w->prow[ac[q]]) return 0;
   return 1;
 }
 
@@ -77,39 +65,23 @@ static int carry_acopy(const carry_work *w, fcm_index k)
   return 1;
 }
 
-/* Row i of A P the plain way (columns first reached, A's row order, then P's): the count, the
- * columns into out (NULL: counted only). */
-static fcm_index carry_ap_plain(const carry_work *w, fcm_index i, fcm_index *mk, fcm_index tag,
-                                int *out)
+/* Row i of the pattern of X Y the plain way (columns first reached, X's row order, then
+ * Y's): the count, the columns into out (NULL: counted only), sorted when `sort`. Row i of A P
+ * (X = A, Y = P), and row I of C (X = R, Y = A P, sorted; the diagonal is added afterwards,
+ * as fcm__ptap_create() does). */
+static fcm_index carry_plain(const fcm_index *Xp, const int *Xc, const fcm_index *Yp, const int *Yc,
+                             fcm_index i, fcm_index *mk, fcm_index tag, int *out, int sort)
 {
   fcm_index cnt = 0;
-  for (fcm_index p = w->Ap[i]; p < w->Ap[i + 1]; p++)
-    for (fcm_index q = w->Pp[w->Ac[p]]; q < w->Pp[w->Ac[p] + 1]; q++) {
-      const int j = w->Pc[q];
+  for (fcm_index p = Xp[i]; p < Xp[i + 1]; p++)
+    for (fcm_index q = Yp[Xc[p]]; q < Yp[Xc[p] + 1]; q++) {
+      const int j = Yc[q];
       if (mk[j] == tag) continue;
       mk[j] = tag;
       if (out) out[cnt] = j;
       cnt++;
     }
-  return cnt;
-}
-
-/* Row I of C the plain way (the columns of the rows of A P that row I of R reaches; the
- * diagonal is added afterwards, as fcm__ptap_create() does), sorted into out (NULL: counted
- * only). */
-static fcm_index carry_c_plain(const carry_work *w, fcm_index I, fcm_index *mk, fcm_index tag,
-                               int *out)
-{
-  fcm_index cnt = 0;
-  for (fcm_index p = w->Rp[I]; p < w->Rp[I + 1]; p++)
-    for (fcm_index q = w->APp[w->Rc[p]]; q < w->APp[w->Rc[p] + 1]; q++) {
-      const int j = w->APc[q];
-      if (mk[j] == tag) continue;
-      mk[j] = tag;
-      if (out) out[cnt] = j;
-      cnt++;
-    }
-  if (out) fcm__ptap_sort_ints(out, cnt);
+  if (out && sort) fcm__ptap_sort_ints(out, cnt);
   return cnt;
 }
 
@@ -181,7 +153,8 @@ static void carry_rows(carry_work *w, int stage, int pass, fcm_index *ptr, int *
         if (!pass) ptr[i + 1] = op[io + 1] - op[io];
       } else {
         const fcm_index cnt =
-            stage ? carry_c_plain(w, i, m, base + i, out) : carry_ap_plain(w, i, m, base + i, out);
+            stage ? carry_plain(w->Rp, w->Rc, w->APp, w->APc, i, m, base + i, out, 1)
+                  : carry_plain(w->Ap, w->Ac, w->Pp, w->Pc, i, m, base + i, out, 0);
         if (!pass) ptr[i + 1] = cnt;
       }
     }
@@ -202,12 +175,21 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
   int *cc = NULL;
   unsigned char *ap3 = NULL;
   carry_work w = {.pr = prior, .nc = nc};
-  FCM_CHECK(ctx && prior && prior->plan && prior->C && prior->A_ptr &&
-                (prior->A_col || (prior->A_adj && prior->G_ptr && prior->G_adj)) &&
-                prior->row_old && prior->row_new && prior->crow_old && prior->crow_new && A &&
-                P_ptr && P_ptr[0] == 0 && plan && C && nc >= 0 && nt >= 1,
-            ctx, FCM_ERR_ARG, "ptap_create_from: NULL argument, nc = %lld < 0 or nt = %d < 1",
+  FCM_CHECK(ctx && prior && A && P_ptr && P_ptr[0] == 0 && plan && C && nc >= 0 && nt >= 1, ctx,
+            FCM_ERR_ARG,
+            "ptap_create_from: NULL argument, P_ptr[0] != 0, nc = %lld < 0 or nt = %d < 1",
             (long long)nc, nt);
+  {
+    const char *missing = !prior->plan                                        ? "plan"
+                          : !prior->C                                         ? "C"
+                          : !prior->A_ptr                                     ? "A_ptr"
+                          : !prior->A_col && !prior->A_adj                    ? "A_col or A_adj"
+                          : !prior->A_col && (!prior->G_ptr || !prior->G_adj) ? "G_ptr / G_adj"
+                          : !prior->row_old || !prior->row_new                ? "row_old / row_new"
+                          : !prior->crow_old || !prior->crow_new ? "crow_old / crow_new"
+                                                                 : NULL;
+    FCM_CHECK(!missing, ctx, FCM_ERR_ARG, "ptap_create_from: the prior's %s is NULL", missing);
+  }
   *plan = NULL, *C = NULL;
   fcm_index n = 0, ncol = 0;
   fcm_csr_get_size(A, &n, &ncol, NULL);
@@ -236,7 +218,9 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
   w.same3 = t->same3;
 #pragma omp parallel num_threads(nt) if (nt > 1 && n > 4096)
   {
-    /* copy-graph mode: A's three rows of a copy hold one pattern */
+    /* copy-graph mode: A's pattern is the copy graph G (the prior's precondition, which the
+     * caller guarantees: fcm__mg_create_pattern_cut() checks that A has its space's pattern),
+     * so a copy's three rows hold one pattern */
 #pragma omp for schedule(static) nowait
     for (fcm_index g = 0; g < n / 3; g++)
       t->same3[g] = (unsigned char)(!prior->A_col || fcm__ptap_same_pattern3(3 * g, w.Ap, w.Ac));

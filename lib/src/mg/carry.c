@@ -3,7 +3,10 @@
  * takes the rows of A P and of the coarse pattern that the cut left from the hierarchy before
  * the cut, through maps from the old numbering of each level to the new one; every row taken
  * is checked entry by entry against its inputs (fcm__ptap_create_from()), so the result is
- * fcm_mg_create()'s bit for bit whatever the maps are.
+ * fcm__mg_create_pattern()'s bit for bit whatever the maps are, provided level 0's matrices
+ * have their spaces' patterns (the old one at its creation, the new one now: level 0's rows
+ * are compared through the two spaces' copy graphs, not the matrices). Where that, or any
+ * other precondition, fails nothing is carried (the plain creation), without an error.
  *
  * The maps: level 0's from the space (a copy of the new space that is the only child of a copy
  * before the cut: fcm__space_cut_copy_map()); level l + 1's from level l's and the two
@@ -15,9 +18,40 @@
 
 #include <string.h>
 
+const fcm_space *fcm__mg_pattern_of(const fcm_space *space, const fcm_csr *A)
+{
+  if (!space || !A || space->is_local || !space->row_ptr || !space->col_idx) return NULL;
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  if (rp == space->row_ptr && ci == space->col_idx) return space; /* shared (borrowed) */
+  fcm_index n = 0;
+  fcm_csr_get_size(A, &n, NULL, NULL);
+  if (n != space->num_dofs || memcmp(rp, space->row_ptr, sizeof *rp * (size_t)(n + 1)) != 0 ||
+      memcmp(ci, space->col_idx, sizeof *ci * (size_t)rp[n]) != 0)
+    return NULL;
+  return space;
+}
+
+/* May level 0 be mapped: both hierarchies grid ones on their spaces' patterns (old on
+ * old_space's), the spaces full and a cut pair with their copy graphs
+ * (fcm__space_cut_copy_map()'s preconditions, tested without recording an error)? */
+static int carry_possible(const fcm_mg *m, const mg_carry *c)
+{
+  const fcm_mg *old = c->old;
+  const fcm_space *from = c->old_space, *to = m->space;
+  if (!from || !to || old->oct_mesh[1] || m->oct_mesh[1]) return 0;
+  if (old->pattern_of != from || m->pattern_of != to) return 0;
+  if (old->lev[0].n != fcm_space_num_dofs(from) || m->lev[0].n != fcm_space_num_dofs(to)) return 0;
+  if (from->mesh != to->mesh || !from->rules || !to->rules || from->local_elem || to->local_elem ||
+      !from->node_ptr || !from->node_adj || !to->node_ptr || !to->node_adj)
+    return 0;
+  const fcm_index pieces = fcm_cell_rules_parent_num_pieces(to->rules);
+  return pieces > 0 && pieces == fcm_cell_rules_num_pieces(from->rules);
+}
+
 void fcm__mg_carry_free(fcm_ctx *ctx, mg_carry *c)
 {
-  for (int l = 0; l < 32; l++) {
+  for (int l = 0; l < MG_MAX_LEVELS; l++) {
     fcm__free(ctx, c->row_old[l]);
     fcm__free(ctx, c->row_new[l]);
   }
@@ -75,7 +109,7 @@ fcm_status fcm__mg_carry_maps(fcm_mg *m, mg_carry *c)
   const fcm_mg *old = c->old;
   const fcm_index n = m->lev[0].n, no = old->lev[0].n;
   c->nlev = 0;
-  if (old->oct_mesh[1] || m->oct_mesh[1] || no != fcm_space_num_dofs(c->old_space)) return FCM_OK;
+  if (!carry_possible(m, c)) return FCM_OK;
   FCM_ALLOC(ctx, n / 3 + 1, old_copy);
   FCM_TRY(ctx, fcm__space_cut_copy_map(c->old_space, m->space, old_copy, c->graph));
   FCM_ALLOC(ctx, n + 1, c->row_old[0]);

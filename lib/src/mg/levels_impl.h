@@ -57,6 +57,9 @@ static inline int fcm__mg_slab_mine(const slab_order *S, fcm_index s, int t, int
 /* Levels with at least this many stored entries share their work between the threads. */
 #define MG_PARALLEL_NNZ 32768
 
+/* The most levels a hierarchy has (fcm_mg_options.max_levels <= it). */
+#define MG_MAX_LEVELS 32
+
 typedef struct mg_level {
   fcm_index grid[3];  /* cells per axis */
   fcm_index ncell;    /* cells (level 0: elements) */
@@ -104,16 +107,20 @@ struct fcm_mg {
   const fcm_space *space;
   fcm_mg_options opts;
   int nlev;
-  mg_level lev[32];
+  mg_level lev[MG_MAX_LEVELS];
   fcm_direct *direct;
-  unsigned char *cut_cell;  /* per mesh cell: cut by the geometry or a cut surface, or split */
-  fcm_index blk_max;        /* largest block of the block smoothers */
-  int nt;                   /* threads at creation: the most any parallel region uses */
-  double *blk_r, *blk_dx;   /* blk_max entries each, per thread */
-  fcm_mesh *oct_mesh[32];   /* octree hierarchies: the coarser octrees of levels 1, 2, ... */
-  fcm_space *oct_space[32]; /* and their spaces */
-  fcm__mg_kept kept;        /* what fcm__mg_create_from() took from the earlier hierarchy */
+  unsigned char *cut_cell; /* per mesh cell: cut by the geometry or a cut surface, or split */
+  fcm_index blk_max;       /* largest block of the block smoothers */
+  int nt;                  /* threads at creation: the most any parallel region uses */
+  double *blk_r, *blk_dx;  /* blk_max entries each, per thread */
+  fcm_mesh
+      *oct_mesh[MG_MAX_LEVELS]; /* octree hierarchies: the coarser octrees of levels 1, 2, ... */
+  fcm_space *oct_space[MG_MAX_LEVELS]; /* and their spaces */
+  fcm__mg_kept kept;  /* what fcm__mg_create_from() took from the earlier hierarchy */
   int values_pending; /* created on a pattern (fcm__mg_create_pattern()): no value set up yet */
+  /* the space whose pattern level 0's matrix had at creation (fcm__mg_pattern_of()), NULL
+   * for none; kept by fcm__mg_detach(), only compared */
+  const fcm_space *pattern_of;
 };
 
 /* Threads of a parallel region: the context's now, at most those of the creation (scratch). */
@@ -335,12 +342,19 @@ typedef struct mg_carry {
   const fcm_mg *old;
   const fcm_space *old_space;
   int nlev;
-  fcm_index *row_old[32], *row_new[32];
+  fcm_index *row_old[MG_MAX_LEVELS], *row_new[MG_MAX_LEVELS];
   const fcm_index *graph[4]; /* fcm__space_cut_copy_map()'s */
 } mg_carry;
 
-/* The maps of c (old, old_space set) for m (hierarchy built); nlev 0 where nothing maps (an
- * octree hierarchy, level 0 not the old space's). */
+/* The space when A has the space's pattern (row_ptr and col_idx the space's arrays, shared,
+ * or the same values: fcm_space_matrix_create()), else NULL. O(1) when shared, else one
+ * comparison of the pattern. */
+const fcm_space *fcm__mg_pattern_of(const fcm_space *space, const fcm_csr *A);
+
+/* The maps of c (old, old_space set) for m (hierarchy built); nlev 0, no error, where the
+ * carry's preconditions fail (fcm__mg_create_pattern_cut()): an octree hierarchy, old not
+ * made on old_space's pattern, m not on its space's, the spaces not a full cut pair.
+ * @return FCM_OK, FCM_ERR_ALLOC, FCM_ERR_INTERNAL. */
 fcm_status fcm__mg_carry_maps(fcm_mg *m, mg_carry *c);
 
 /* The prior of level l's Galerkin plan (1), or 0 where c (NULL: none) has none. */

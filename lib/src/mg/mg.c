@@ -44,10 +44,10 @@ void fcm_mg_destroy(fcm_mg **mg)
 {
   if (!mg || !*mg) return;
   fcm_mg *m = *mg;
-  for (int l = 0; l < 32; l++)
+  for (int l = 0; l < MG_MAX_LEVELS; l++)
     fcm__mg_level_free(m->ctx, &m->lev[l]);
   fcm_direct_destroy(&m->direct);
-  for (int l = 0; l < 32; l++) {
+  for (int l = 0; l < MG_MAX_LEVELS; l++) {
     fcm_space_destroy(&m->oct_space[l]);
     fcm_mesh_destroy(&m->oct_mesh[l]);
   }
@@ -219,8 +219,8 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_mg_options *opts, fcm_mg
             o.post_smooth);
   FCM_CHECK(o.cycle_index == 1 || o.cycle_index == 2, ctx, FCM_ERR_ARG,
             "mg_create: cycle_index = %d is neither 1 (V-cycle) nor 2 (W-cycle)", o.cycle_index);
-  FCM_CHECK(o.max_levels >= 1 && o.max_levels <= 32, ctx, FCM_ERR_ARG,
-            "mg_create: max_levels = %d outside [1, 32]", o.max_levels);
+  FCM_CHECK(o.max_levels >= 1 && o.max_levels <= MG_MAX_LEVELS, ctx, FCM_ERR_ARG,
+            "mg_create: max_levels = %d outside [1, %d]", o.max_levels, MG_MAX_LEVELS);
   FCM_CHECK(o.coarse_dofs >= 1, ctx, FCM_ERR_ARG, "mg_create: coarse_dofs = %lld must be >= 1",
             (long long)o.coarse_dofs);
   FCM_CHECK(o.blocks >= 0 && o.blocks < FCM_MG_BLOCKS_COUNT, ctx, FCM_ERR_ARG,
@@ -279,7 +279,7 @@ static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, mg_carry *carry, const fc
 {
   fcm_status st = FCM_OK;
   fcm_mg *m = NULL;
-  unsigned char same[32] = {0};
+  unsigned char same[MG_MAX_LEVELS] = {0};
   FCM_CHECK(ctx && space && A && mg, ctx, FCM_ERR_ARG, "mg_create: NULL argument");
   *mg = NULL;
   fcm_mg_options o;
@@ -298,6 +298,7 @@ static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, mg_carry *carry, const fc
   m->opts = o;
   m->nt = fcm_ctx_num_threads(ctx);
   m->values_pending = inactive != NULL;
+  m->pattern_of = fcm__mg_pattern_of(space, A);
   FCM_TRY(ctx, fcm__mg_build_hierarchy(m, A, inactive));
   if (!fcm__mg_reuse_allowed(old, m)) old = NULL;
   FCM_TRY(ctx, level_diag(m, &m->lev[0]));
@@ -450,8 +451,8 @@ fcm_status fcm__mg_transfers_create(fcm_ctx *ctx, const fcm_space *space,
   unsigned char *none = NULL;
   FCM_CHECK(ctx && space && out, ctx, FCM_ERR_ARG, "mg_transfers: NULL argument");
   *out = NULL;
-  FCM_CHECK(max_levels >= 1 && max_levels <= 32, ctx, FCM_ERR_ARG,
-            "mg_transfers: max_levels = %d outside [1, 32]", max_levels);
+  FCM_CHECK(max_levels >= 1 && max_levels <= MG_MAX_LEVELS, ctx, FCM_ERR_ARG,
+            "mg_transfers: max_levels = %d outside [1, %d]", max_levels, MG_MAX_LEVELS);
   FCM_CHECK(coarse_dofs >= 1, ctx, FCM_ERR_ARG, "mg_transfers: coarse_dofs = %lld must be >= 1",
             (long long)coarse_dofs);
   const fcm_index n0 = fcm_space_num_dofs(space);

@@ -108,11 +108,14 @@ FCM_COMPONENT_API fcm_status fcm__mg_create_pattern(fcm_ctx *ctx, fcm_mg **old,
 
 /* fcm__mg_create_pattern() (no old hierarchy to consume) for the space `space` made by a cut
  * of `old_space`, taking rows of the Galerkin plans from `old`, the hierarchy of old_space
- * (NULL: none), which is only read and stays usable: old's level-0 matrix must have had
- * old_space's pattern (fcm_space_matrix_create()); that matrix may be gone, old_space must
- * live. The result is fcm__mg_create_pattern()'s bit for bit (lib/src/mg/carry.c: what is
- * taken and how it is checked); fcm__mg_get_kept() counts what was taken. @return as
- * fcm__mg_create_pattern(); FCM_ERR_ARG also when space is not a cut of old_space. */
+ * (NULL: none), which is only read and stays usable. Rows are taken only when old's level-0
+ * matrix had old_space's pattern at old's creation and A has space's (row_ptr and col_idx
+ * those of the space: fcm_space_matrix_create()), both grid hierarchies, and space is a
+ * cut of old_space (full spaces); otherwise nothing is taken and the result is the plain
+ * creation, without an error. old's level-0 matrix may be gone, old_space must live. The
+ * result is fcm__mg_create_pattern()'s bit for bit (lib/src/mg/carry.c: what is taken and
+ * how it is checked); fcm__mg_get_kept() counts what was taken. @return as
+ * fcm__mg_create_pattern(). */
 FCM_COMPONENT_API fcm_status fcm__mg_create_pattern_cut(fcm_ctx *ctx, const fcm_mg *old,
                                                         const fcm_space *old_space,
                                                         const fcm_space *space, const fcm_csr *A,

@@ -60,8 +60,6 @@ static int keeps_blocks(const fcm_integrator *I)
          !fcm__integrator_distributed(I, NULL);
 }
 
-enum { BLOCKS_ROOM = 8 << 20 }; /* bytes from which fcm__calloc_large() adds room itself */
-
 /* The old blocks *give (an array of fcm__calloc_large()) as I's blocks, each kept element's
  * moved to its own place (same[e] <= e, ascending over the kept elements: a pass downwards
  * moves each once), *give then NULL; NULL (nothing taken) when they are not in that order or
@@ -101,9 +99,9 @@ fcm_status fcm__sim_assemble_kept(fcm_integrator *I, const fcm_linear_form *form
         I->cut_self[e] = same[e] >= 0 ? e : -1;
     }
     same = I->cut_self, old_blocks = *blocks;
-  } else { /* below 8 MiB fcm__calloc_large() gives no room: a quarter more asked for, so that
-              the next cut's blocks fit in place (take_blocks()) */
-    const size_t n = (size_t)ne * bs + 1, room = n * sizeof **blocks < BLOCKS_ROOM ? n / 4 : 0;
+  } else { /* below FCM__LARGE_MIN fcm__calloc_large() gives no room: a quarter more asked for,
+              so that the next cut's blocks fit in place (take_blocks()) */
+    const size_t n = (size_t)ne * bs + 1, room = n * sizeof **blocks < FCM__LARGE_MIN ? n / 4 : 0;
     FCM__ALLOC_WITH(fcm__calloc_large, ctx, n + room, *blocks);
   }
   FCM_TRY(ctx, fcm__assembly_linear_blocks_rows(I->aws, form, A, f, same, old_blocks, *blocks,
