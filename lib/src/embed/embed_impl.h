@@ -742,7 +742,8 @@ int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const fcm__embed
                                 const double nb_normal[3]);
 
 /* fcm__embed_overlap_material() where `full` says whether the body fills one of the two parts
- * (fcm__embed_part_full()): then the half of the prism on that part's side is material, and an
+ * to a depth of 4 prism half-heights at least (fcm__embed_part_face_full()): then the half of
+ * the prism on that part's side is material, and an
  * overlap of more than 4 times the area threshold is covered without the moments (their
  * answer, half the prism at least, is above twice the threshold). */
 int fcm__embed_overlap_material_full(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
@@ -797,6 +798,12 @@ fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__p
 /* Surface body: whether part i lies wholly inside the body (its material, P->mvol, is its
  * volume up to rounding). */
 int fcm__embed_part_full(const fcm__parts *P, size_t i);
+
+/* fcm__embed_part_full() for the face-link shortcut (fcm__embed_overlap_material_full()) on a
+ * face of unit normal nrm: the part is full and reaches at least 4 prism half-heights along nrm,
+ * so the half of the prism on its side is material (a thinner full slab holds less). size: the
+ * cell's. */
+int fcm__embed_part_face_full(const fcm__parts *P, size_t i, const double nrm[3], double size);
 
 /* Whether the convex polyhedron p (a part of affine cell) is a box in cell's reference
  * coordinates: 8 vertices, each at a corner of their reference bounding box lo..hi within

@@ -17,6 +17,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The prism's half-height and the area that counts as material on a face, relative to the
+ * cell size (and its square): far above the surface moments' rounding (1e-15 of the prism). */
+#define PRISM_RTOL     1e-6
+#define FACE_AREA_RTOL 1e-9
+
 struct fcm__material {
   const fcm_geometry *geom;
   const fcm_aabb_tree *tree; /* the boundary triangles' */
@@ -488,11 +493,6 @@ cleanup:
   return fabs(v) / (2.0 * h) > atol;
 }
 
-/* The prism's half-height and the area that counts as material on a face, relative to the
- * cell size (and its square): far above the surface moments' rounding (1e-15 of the prism). */
-#define PRISM_RTOL     1e-6
-#define FACE_AREA_RTOL 1e-9
-
 int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
                                 const double *a, int na, const double *b, int nb,
                                 const double nb_normal[3])
@@ -836,6 +836,18 @@ cleanup:
 int fcm__embed_part_full(const fcm__parts *P, size_t i)
 {
   return P->mvol[i] < 0.0 || P->mvol[i] >= (1.0 - FULL_RTOL) * fcm__geom_poly_volume(P->poly + i);
+}
+
+int fcm__embed_part_face_full(const fcm__parts *P, size_t i, const double nrm[3], double size)
+{
+  if (!fcm__embed_part_full(P, i)) return 0;
+  const fcm__poly *p = P->poly + i;
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (int a = 0; a < p->nv; a++) {
+    const double s = fcm__vec3_dot(nrm, p->x[a]);
+    lo = fmin(lo, s), hi = fmax(hi, s);
+  }
+  return hi - lo >= 4.0 * PRISM_RTOL * size;
 }
 
 fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P)
