@@ -219,10 +219,8 @@ static fcm_status cell_pieces(const build *B, const fcm__embed_cell *cell, fcm__
   const fcm_cell_rules_options *opt = B->o;
   fcm__parts *P = ws->parts;
   double *known = B->cell_mvol ? B->cell_mvol + cell->id : NULL; /* one writer per cell */
-  P->whole_mvol = known ? *known : NAN;
   FCM_TRY(ctx, fcm__embed_cell_parts(ctx, B->geom, B->tree, cell, opt->clip_rtol, opt->sliver_rtol,
-                                     ws, P, &sums->counts));
-  if (known) *known = P->whole_mvol;
+                                     ws, P, known, &sums->counts));
   FCM_TRY(ctx, fcm__embed_cut_candidates(ctx, B->cut_tree, cell, &P->tcand));
   if (P->tcand.n > 0) {
     FCM_TRY(ctx, fcm__embed_cell_pieces(ctx, cell, B->cut_tris, B->first_new, P));

@@ -850,7 +850,8 @@ int fcm__embed_part_face_full(const fcm__parts *P, size_t i, const double nrm[3]
   return hi - lo >= 4.0 * PRISM_RTOL * size;
 }
 
-fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P)
+fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P,
+                               double *whole_mvol)
 {
   fcm_status st = FCM_OK;
   if (!P->mat) return FCM_OK;
@@ -859,13 +860,13 @@ fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__p
       if (P->mvol[i] < 0.0) P->mvol[i] = fcm__geom_poly_volume(P->poly + i);
       continue;
     }
-    if (P->whole && !isnan(P->whole_mvol))
-      P->mvol[i] = P->whole_mvol; /* measured so at an earlier cut */
+    if (P->whole && whole_mvol && !isnan(*whole_mvol))
+      P->mvol[i] = *whole_mvol; /* measured so at an earlier cut */
     else if (P->whole && cell->affine)
       FCM_TRY(ctx, fcm__material_cell(ctx, P->mat, NULL, cell, NULL, P->mvol + i));
     else
       FCM_TRY(ctx, fcm__material_poly(ctx, P->mat, P->poly + i, NULL, cell, NULL, P->mvol + i));
-    if (P->whole) P->whole_mvol = P->mvol[i];
+    if (P->whole && whole_mvol) *whole_mvol = P->mvol[i];
     if (!(P->mvol[i] > P->vmin[i])) P->poly[i].nv = P->poly[i].nf = 0;
   }
   fcm__embed_parts_compact(P);
