@@ -391,6 +391,31 @@ cleanup:
   return st;
 }
 
+/* Cell c of process_cell() whose rules are copied from the rules being extended, with its face
+ * polygons where kept_faces (a region cell the new cut does not reach); own: as there. No clock
+ * is read: a copied cell's time is not counted. */
+static fcm_status copy_prev_cell(const build *B, fcm_cell_rules *R, fcm_index c, int own,
+                                 int kept_faces, fcm__embed_ws *ws, cell_out *o)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_cell_rules_options *opt = B->o;
+  fcm__embed_cell cell;
+  /* a cell whose rules are copied needs its volume only, but a dropped one its surface share
+   * where surface rules are built */
+  if (!(own && B->prev->cls[c] == FCM_CELL_DROPPED && B->tri_rule))
+    FCM_TRY(ctx, fcm__embed_cell_setup_volume(ctx, B->mesh, c, opt->clip_rtol, &cell));
+  else
+    FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
+  FCM_TRY(ctx, keep_cell(B, R, &cell, 1, o));
+  if (kept_faces)
+    FCM_TRY(ctx, fcm__embed_copy_face_polygons(ctx, B->prev, c, &o->fmeta, &o->fx, &o->nfp));
+  o->fp_keep = (unsigned char)kept_faces;
+  if (own && R->cls[c] == FCM_CELL_DROPPED) FCM_TRY(ctx, dropped_area(B, &cell, ws, o));
+cleanup:
+  return st;
+}
+
 /* Intersect, classify and build the rules of background cell c into o (the thread's own
  * buffers); R->cls[c] and R->fraction[c] are written here (one writer per cell). Cells the
  * cuts reach are split into material pieces first; each piece then takes the
@@ -412,21 +437,9 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   /* a region cell the new cut does not reach, with the face polygons the earlier cut kept */
   const int kept_faces =
       !integrate && !no_work && B->keep && B->prev->face_nfp && B->prev->face_nfp[c] >= 0;
-  const double t0 = no_work ? 0.0 : fcm_wtime(); /* a copied cell's time is not counted */
-  /* a cell whose rules are copied needs its volume only, but a dropped one its surface share
-   * where surface rules are built */
-  if ((no_work || kept_faces) && !(own && B->prev->cls[c] == FCM_CELL_DROPPED && B->tri_rule))
-    FCM_TRY(ctx, fcm__embed_cell_setup_volume(ctx, B->mesh, c, opt->clip_rtol, &cell));
-  else
-    FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
-  if (no_work || kept_faces) {
-    FCM_TRY(ctx, keep_cell(B, R, &cell, 1, o));
-    if (kept_faces)
-      FCM_TRY(ctx, fcm__embed_copy_face_polygons(ctx, B->prev, c, &o->fmeta, &o->fx, &o->nfp));
-    o->fp_keep = (unsigned char)kept_faces;
-    if (own && R->cls[c] == FCM_CELL_DROPPED) FCM_TRY(ctx, dropped_area(B, &cell, ws, o));
-    goto cleanup;
-  }
+  if (no_work || kept_faces) return copy_prev_cell(B, R, c, own, kept_faces, ws, o);
+  const double t0 = fcm_wtime();
+  FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
   if (B->prev) FCM_TRY(ctx, fcm__embed_check_convex(ctx, B->mesh, c, opt));
   int surface = B->surface && cell.affine && !(B->cut_tree && B->region[c]);
   if (surface && opt->moments == FCM_CELL_MOMENTS_AUTO && B->geom->num_cells > 0) {
