@@ -363,28 +363,34 @@ static double tri_dist2(const double p[3], const double a[3], const double b[3],
   return fcm__vec3_dot(q, q);
 }
 
+/* The area of the planar polygon x (n vertices). */
+static double polygon_area(const double *x, int n)
+{
+  double a[3] = {0.0, 0.0, 0.0};
+  for (int i = 1; i + 1 < n; i++) {
+    double e1[3], e2[3], t[3];
+    for (int d = 0; d < 3; d++)
+      e1[d] = x[3 * i + d] - x[d], e2[d] = x[3 * (i + 1) + d] - x[d];
+    fcm__vec3_cross(e1, e2, t);
+    for (int d = 0; d < 3; d++)
+      a[d] += 0.5 * t[d];
+  }
+  return fcm__vec3_norm(a);
+}
+
 /* The area of the polygon x (n vertices) whose prism (half-height h along the unit normal nrm)
  * lies in the box of half-width g about p; y: scratch of n + 6 vertices. */
 static double area_in_box(const double *x, int n, const double p[3], double g, const double nrm[3],
                           double h, double *y)
 {
-  double lo[3], hi[3], a[3] = {0.0, 0.0, 0.0};
+  double lo[3], hi[3];
   for (int d = 0; d < 3; d++) {
     const double w = g - h * fabs(nrm[d]);
     if (!(w > 0.0)) return 0.0;
     lo[d] = p[d] - w, hi[d] = p[d] + w;
   }
   memcpy(y, x, 3 * (size_t)n * sizeof *x);
-  const int k = polygon_in_box(y, n, lo, hi);
-  for (int i = 1; i + 1 < k; i++) {
-    double e1[3], e2[3], t[3];
-    for (int d = 0; d < 3; d++)
-      e1[d] = y[3 * i + d] - y[d], e2[d] = y[3 * (i + 1) + d] - y[d];
-    fcm__vec3_cross(e1, e2, t);
-    for (int d = 0; d < 3; d++)
-      a[d] += 0.5 * t[d];
-  }
-  return fcm__vec3_norm(a);
+  return polygon_area(y, polygon_in_box(y, n, lo, hi));
 }
 
 /* Points tried by prism_near(): the polygon's vertex mean, then its fan triangles'. */
@@ -498,21 +504,6 @@ int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const fcm__embed
                                 const double nb_normal[3])
 {
   return fcm__embed_overlap_material_full(ctx, m, cell, a, na, b, nb, nb_normal, 0);
-}
-
-/* The area of the planar polygon x (n vertices). */
-static double polygon_area(const double *x, int n)
-{
-  double a[3] = {0.0, 0.0, 0.0};
-  for (int i = 1; i + 1 < n; i++) {
-    double e1[3], e2[3], t[3];
-    for (int d = 0; d < 3; d++)
-      e1[d] = x[3 * i + d] - x[d], e2[d] = x[3 * (i + 1) + d] - x[d];
-    fcm__vec3_cross(e1, e2, t);
-    for (int d = 0; d < 3; d++)
-      a[d] += 0.5 * t[d];
-  }
-  return fcm__vec3_norm(a);
 }
 
 int fcm__embed_overlap_material_full(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
