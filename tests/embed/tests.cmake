@@ -92,6 +92,9 @@ fcm_add_test(embed_cut_bench tests/embed/cut_bench.c LABELS bench TIMEOUT 3600)
 # rules those of the reference or, kept, of the rules extended); cuts that change nothing
 # integrate nothing and leave every rule bit-identical.
 fcm_add_test(embed_cut_keep tests/embed/cut_keep.c)
+# The same under FCM_CELL_SIMPLIFY_AUTO (the cut cells finished after all are built): the cells a
+# cut keeps are not finished again.
+fcm_add_test(embed_cut_keep_auto tests/embed/cut_keep.c ARGS auto)
 # The parts' connectivity inside a cell: a part touching another only along an edge stays
 # apart, cuts across the cell, as coplanar triangles and on its face; random cuts (near the
 # cell's and each other's planes, coplanar neighbours, ending inside): the components equal the

@@ -75,8 +75,8 @@ cleanup:
 }
 
 /* The rules of cell c from the previous rules object (a cell no new cut reaches): with borrow,
- * the pieces' arrays point into it (the gathering copies them once, from there); else copies
- * (the AUTO choice may simplify them in place). */
+ * the pieces' arrays point into it (the gathering copies them once, from there); else copies.
+ * Either way the pieces are marked copied: finished already, never finished again. */
 static fcm_status copy_cell(const build *B, fcm_index c, int borrow, cell_out *o)
 {
   fcm_status st = FCM_OK;
@@ -318,8 +318,8 @@ static fcm_status keep_region_cell(const build *B, fcm_cell_rules *R, const fcm_
             "%lld",
             (long long)c, P->num_pieces, (long long)had);
   if (integrate && !(B->prev && B->keep && pieces_unchanged(B, c, P))) return FCM_OK;
-  /* AUTO simplifies the pieces of the cells integrated again in place: those are copies */
-  FCM_TRY(ctx, keep_cell(B, R, cell, !integrate || B->o->simplify != FCM_CELL_SIMPLIFY_AUTO, o));
+  /* borrowed: kept pieces are finished already, AUTO skips them (copied) */
+  FCM_TRY(ctx, keep_cell(B, R, cell, 1, o));
   for (int i = 0; integrate && i < o->np; i++) {
     if (!o->pc[i].cf_borrowed) fcm__free(ctx, o->pc[i].cfxi);
     o->pc[i].cfxi = NULL;
