@@ -143,3 +143,7 @@ fcm_add_test(embed_box_parts tests/embed/box_parts.c)
 # along the grid, overlapping regions, a tilted plane); a kept volume off by 1e-3 changes them;
 # every kept face polygon of a part the body fills is covered by the prism's moments.
 fcm_add_test(embed_cut_reuse tests/embed/cut_reuse.c)
+# The face-link shortcut's full-part flag needs the part's depth along the face normal: full
+# slabs of the unit cell thinner than 4 prism half-heights are not flagged on the face they
+# lie on, thicker ones are; parts not full never are.
+fcm_add_test(embed_face_full tests/embed/face_full.c)
