@@ -12,7 +12,10 @@
  *     kept, bit-identical to the rules being extended;
  *   - the plane beside the body and the plane along the grid plane integrate no cell, keep the
  *     cells they reach, and leave every rule bit-identical; the latter gives the pieces along
- *     it cut faces and leaves no link across it. */
+ *     it cut faces and leaves no link across it.
+ * With the argument "auto", the same under FCM_CELL_SIMPLIFY_AUTO (which finishes the cut cells
+ * after all are built: the kept ones must not be finished again); the bound of M authentic
+ * points holds where it simplified. */
 #include "embed/embed_impl.h"
 #include "fcm/fcm.h"
 #include "../geom/exact.h"
