@@ -139,6 +139,7 @@ static void check_full_faces(const fcm_mesh *mesh, const fcm_geometry *g, const 
 int main(void)
 {
   TEST_OK(NULL, fcm_ctx_create(NULL, &ctx));
+  const int verbose = getenv("FCM_TEST_VERBOSE") != NULL;
   const double c0[3] = {0.05, -0.03, 0.02}, lo[3] = {-1.2, -1.1, -1.1}, hi[3] = {1.1, 1.2, 1.15};
   const fcm_index n[3] = {8, 8, 7};
   fcm_geometry *tets = NULL, *surf = NULL;
@@ -194,18 +195,21 @@ int main(void)
       f += a->face_nfp && a->face_nfp[c] >= 0;
     }
     volumes += v, faces += f;
-    printf("cut %d: %lld pieces, %lld links; %ld whole cells' volumes and %ld cells' face "
-           "polygons kept; the same rules as from stripped rules: %s\n",
-           k + 1, (long long)a->num_pieces, (long long)a->num_links, v, f, same ? "yes" : "NO");
+    if (verbose)
+      printf("cut %d: %lld pieces, %lld links; %ld whole cells' volumes and %ld cells' face "
+             "polygons kept; the same rules as from stripped rules: %s\n",
+             k + 1, (long long)a->num_pieces, (long long)a->num_links, v, f, same ? "yes" : "NO");
     TEST_TRUE(same);
     check_full_faces(mesh, surf, a, &full, &full_cov, &other, &other_open);
   }
-  printf("cells that may take kept face polygons: %ld; the control (volumes off by 1e-3) changes "
-         "the rules: %s\n",
-         reused, control_differs ? "yes" : "NO");
-  printf("kept face polygons of filled parts: %ld, covered by the prism's moments: %ld; of other "
-         "parts: %ld, not covered: %ld\n",
-         full, full_cov, other, other_open);
+  if (verbose) {
+    printf("cells that may take kept face polygons: %ld; the control (volumes off by 1e-3) "
+           "changes the rules: %s\n",
+           reused, control_differs ? "yes" : "NO");
+    printf("kept face polygons of filled parts: %ld, covered by the prism's moments: %ld; of "
+           "other parts: %ld, not covered: %ld\n",
+           full, full_cov, other, other_open);
+  }
   TEST_TRUE(volumes > 0 && faces > 0 && reused > 0);
   TEST_TRUE(control_differs);
   TEST_TRUE(full > 0 && full_cov == full && other_open > 0);

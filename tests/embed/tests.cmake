@@ -92,6 +92,9 @@ fcm_add_test(embed_cut_bench tests/embed/cut_bench.c LABELS bench TIMEOUT 3600)
 # rules those of the reference or, kept, of the rules extended); cuts that change nothing
 # integrate nothing and leave every rule bit-identical.
 fcm_add_test(embed_cut_keep tests/embed/cut_keep.c)
+# The same under FCM_CELL_SIMPLIFY_AUTO (the cut cells finished after all are built): the cells a
+# cut keeps are not finished again.
+fcm_add_test(embed_cut_keep_auto tests/embed/cut_keep.c ARGS auto)
 # The parts' connectivity inside a cell: a part touching another only along an edge stays
 # apart, cuts across the cell, as coplanar triangles and on its face; random cuts (near the
 # cell's and each other's planes, coplanar neighbours, ending inside): the components equal the
@@ -140,3 +143,7 @@ fcm_add_test(embed_box_parts tests/embed/box_parts.c)
 # along the grid, overlapping regions, a tilted plane); a kept volume off by 1e-3 changes them;
 # every kept face polygon of a part the body fills is covered by the prism's moments.
 fcm_add_test(embed_cut_reuse tests/embed/cut_reuse.c)
+# The face-link shortcut's full-part flag needs the part's depth along the face normal: full
+# slabs of the unit cell thinner than 4 prism half-heights are not flagged on the face they
+# lie on, thicker ones are; parts not full never are.
+fcm_add_test(embed_face_full tests/embed/face_full.c)

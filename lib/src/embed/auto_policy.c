@@ -89,8 +89,8 @@ fcm_status fcm__embed_auto_simplify(const build *B, fcm_cell_rules *R, int nthre
   piece_out **cut = NULL;
   fcm_index ncut = 0;
   int pays[FCM_RULE_KIND_COUNT] = {0, 0};
-  /* the cut cells integrated here (with a cell_mask: this process's only; the others have
-   * no points) */
+  /* the pieces of the cut cells integrated here (with a cell_mask: this process's only; the
+   * others have no points), not those a cut copies from the rules it extends: finished there */
 #define AUTO_CELL(c)                                                                               \
   (R->cls[c] == FCM_CELL_CUT && (!B->rebuild || B->rebuild[c]) &&                                  \
    (!opt->cell_mask || opt->cell_mask[c]))
@@ -101,7 +101,7 @@ fcm_status fcm__embed_auto_simplify(const build *B, fcm_cell_rules *R, int nthre
   for (fcm_index c = 0; c < nc; c++)
     if (AUTO_CELL(c))
       for (int i = 0; i < out[c].np; i++)
-        cut[ncut++] = out[c].pc + i;
+        if (!out[c].pc[i].copied) cut[ncut++] = out[c].pc + i;
 #undef AUTO_CELL
   /* the choice's inputs per kind: points, modelled simplification time, points kept */
   double in[3 * FCM_RULE_KIND_COUNT];

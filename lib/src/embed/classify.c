@@ -60,27 +60,11 @@ cleanup:
   return st;
 }
 
-/* An array of n items of `size` bytes at src: borrowed (*dst = src) or copied. */
-static fcm_status take(fcm_ctx *ctx, int borrow, const void *src, size_t n, size_t size, void *dst)
+/* The rules of cell c from the previous rules object (a cell no new cut reaches), borrowed: the
+ * pieces' arrays point into it, read only (the gathering copies them once, from there), and
+ * the pieces are marked copied (finished already, never finished again). */
+static void copy_cell(const build *B, fcm_index c, cell_out *o)
 {
-  fcm_status st = FCM_OK;
-  unsigned char *p = (unsigned char *)src; /* borrowed arrays are read only (piece_out) */
-  if (!borrow && n) {
-    FCM__ALLOC_WITH(fcm__malloc, ctx, n * size, p);
-    memcpy(p, src, n * size);
-  }
-  memcpy(dst, &p, sizeof p);
-cleanup:
-  return st;
-}
-
-/* The rules of cell c from the previous rules object (a cell no new cut reaches): with borrow,
- * the pieces' arrays point into it (the gathering copies them once, from there); else copies
- * (the AUTO choice may simplify them in place). */
-static fcm_status copy_cell(const build *B, fcm_index c, int borrow, cell_out *o)
-{
-  fcm_status st = FCM_OK;
-  fcm_ctx *ctx = B->ctx;
   const fcm_cell_rules *Q = B->prev;
   const fcm_index p0 = Q->piece_off[c], np = Q->piece_off[c + 1] - p0;
   for (fcm_index i = 0; i < np; i++) {
@@ -89,34 +73,30 @@ static fcm_status copy_cell(const build *B, fcm_index c, int borrow, cell_out *o
     po->volume = Q->piece_volume[p];
     po->component = Q->piece_component[p];
     po->copied = 1;
-    po->borrowed = po->cf_borrowed = (unsigned char)borrow;
+    po->borrowed = po->cf_borrowed = 1;
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
       const size_t a = (size_t)Q->off[k][p], n = (size_t)Q->off[k][p + 1] - a;
       if (n) {
-        FCM_TRY(ctx, take(ctx, borrow, Q->points[k] + 3 * a, 3 * n, sizeof(double), &po->pts[k]));
-        FCM_TRY(ctx, take(ctx, borrow, Q->weights[k] + a, n, sizeof(double), &po->w[k]));
-        FCM_TRY(ctx, take(ctx, borrow, Q->flags[k] + a, n, 1, &po->flag[k]));
+        po->pts[k] = Q->points[k] + 3 * a;
+        po->w[k] = Q->weights[k] + a;
+        po->flag[k] = Q->flags[k] + a;
       }
       po->n[k] = po->ninit[k] = po->nsimp[k] = (int)n;
     }
     const size_t a = (size_t)Q->soff[p], n = (size_t)Q->soff[p + 1] - a;
     if (n) {
-      FCM_TRY(ctx, take(ctx, borrow, Q->spoints + 3 * a, 3 * n, sizeof(double), &po->spts));
-      FCM_TRY(ctx, take(ctx, borrow, Q->sweights + a, n, sizeof(double), &po->sw));
-      FCM_TRY(ctx, take(ctx, borrow, Q->snormals + 3 * a, 3 * n, sizeof(double), &po->snrm));
-      FCM_TRY(ctx, take(ctx, borrow, Q->stris + a, n, sizeof(fcm_index), &po->stri));
+      po->spts = Q->spoints + 3 * a;
+      po->sw = Q->sweights + a;
+      po->snrm = Q->snormals + 3 * a;
+      po->stri = Q->stris + a;
     }
     po->ns = (int)n;
     const size_t c0 = (size_t)Q->cfoff[p], nc = (size_t)Q->cfoff[p + 1] - c0;
-    if (nc) FCM_TRY(ctx, take(ctx, borrow, Q->cfxi + 9 * c0, 9 * nc, sizeof(double), &po->cfxi));
+    if (nc) po->cfxi = Q->cfxi + 9 * c0;
     po->ncf = (int)nc;
   }
-cleanup:
-  return st;
 }
 
-/* Keep cell c as the rules being extended have it (the new cut leaves it unchanged): its
- * class, fraction, pieces and rules bit for bit, cut faces included. */
 /* A dropped cell's share of the embedded surface into o->dropped_area: the area its surface
  * rule would have had (the same clipping, so that the kept and dropped cells' areas add up to
  * the surface's). Only when surface rules are built; the cell's own points are not kept. */
@@ -137,8 +117,10 @@ cleanup:
   return st;
 }
 
+/* Keep cell c as the rules being extended have it (the new cut leaves it unchanged): its
+ * class, fraction, pieces and rules bit for bit, cut faces included. */
 static fcm_status keep_cell(const build *B, fcm_cell_rules *R, const fcm__embed_cell *cell,
-                            int borrow, cell_out *o)
+                            cell_out *o)
 {
   fcm_status st = FCM_OK;
   const fcm_cell_rules *Q = B->prev;
@@ -150,7 +132,7 @@ static fcm_status keep_cell(const build *B, fcm_cell_rules *R, const fcm__embed_
           fcm__embed_cell_out_pieces(B->ctx, o, (int)(Q->piece_off[c + 1] - Q->piece_off[c])));
   for (int i = 0; i < o->np; i++)
     o->pc[i].parent = i;
-  FCM_TRY(B->ctx, copy_cell(B, c, borrow, o));
+  copy_cell(B, c, o);
 cleanup:
   return st;
 }
@@ -219,10 +201,8 @@ static fcm_status cell_pieces(const build *B, const fcm__embed_cell *cell, fcm__
   const fcm_cell_rules_options *opt = B->o;
   fcm__parts *P = ws->parts;
   double *known = B->cell_mvol ? B->cell_mvol + cell->id : NULL; /* one writer per cell */
-  P->whole_mvol = known ? *known : NAN;
   FCM_TRY(ctx, fcm__embed_cell_parts(ctx, B->geom, B->tree, cell, opt->clip_rtol, opt->sliver_rtol,
-                                     ws, P, &sums->counts));
-  if (known) *known = P->whole_mvol;
+                                     ws, P, known, &sums->counts));
   FCM_TRY(ctx, fcm__embed_cut_candidates(ctx, B->cut_tree, cell, &P->tcand));
   if (P->tcand.n > 0) {
     FCM_TRY(ctx, fcm__embed_cell_pieces(ctx, cell, B->cut_tris, B->first_new, P));
@@ -320,8 +300,8 @@ static fcm_status keep_region_cell(const build *B, fcm_cell_rules *R, const fcm_
             "%lld",
             (long long)c, P->num_pieces, (long long)had);
   if (integrate && !(B->prev && B->keep && pieces_unchanged(B, c, P))) return FCM_OK;
-  /* AUTO simplifies the pieces of the cells integrated again in place: those are copies */
-  FCM_TRY(ctx, keep_cell(B, R, cell, !integrate || B->o->simplify != FCM_CELL_SIMPLIFY_AUTO, o));
+  /* finished already: AUTO skips these pieces (copied) */
+  FCM_TRY(ctx, keep_cell(B, R, cell, o));
   for (int i = 0; integrate && i < o->np; i++) {
     if (!o->pc[i].cf_borrowed) fcm__free(ctx, o->pc[i].cfxi);
     o->pc[i].cfxi = NULL;
@@ -393,6 +373,31 @@ cleanup:
   return st;
 }
 
+/* Cell c of process_cell() whose rules are copied from the rules being extended, with its face
+ * polygons where kept_faces (a region cell the new cut does not reach); own: as there. No clock
+ * is read: a copied cell's time is not counted. */
+static fcm_status copy_prev_cell(const build *B, fcm_cell_rules *R, fcm_index c, int own,
+                                 int kept_faces, fcm__embed_ws *ws, cell_out *o)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = B->ctx;
+  const fcm_cell_rules_options *opt = B->o;
+  fcm__embed_cell cell;
+  /* a cell whose rules are copied needs its volume only, but a dropped one its surface share
+   * where surface rules are built */
+  if (!(own && B->prev->cls[c] == FCM_CELL_DROPPED && B->tri_rule))
+    FCM_TRY(ctx, fcm__embed_cell_setup_volume(ctx, B->mesh, c, opt->clip_rtol, &cell));
+  else
+    FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
+  FCM_TRY(ctx, keep_cell(B, R, &cell, o));
+  if (kept_faces)
+    FCM_TRY(ctx, fcm__embed_copy_face_polygons(ctx, B->prev, c, &o->fmeta, &o->fx, &o->nfp));
+  o->fp_keep = (unsigned char)kept_faces;
+  if (own && R->cls[c] == FCM_CELL_DROPPED) FCM_TRY(ctx, dropped_area(B, &cell, ws, o));
+cleanup:
+  return st;
+}
+
 /* Intersect, classify and build the rules of background cell c into o (the thread's own
  * buffers); R->cls[c] and R->fraction[c] are written here (one writer per cell). Cells the
  * cuts reach are split into material pieces first; each piece then takes the
@@ -414,21 +419,9 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   /* a region cell the new cut does not reach, with the face polygons the earlier cut kept */
   const int kept_faces =
       !integrate && !no_work && B->keep && B->prev->face_nfp && B->prev->face_nfp[c] >= 0;
-  const double t0 = no_work ? 0.0 : fcm_wtime(); /* a copied cell's time is not counted */
-  /* a cell whose rules are copied needs its volume only, but a dropped one its surface share
-   * where surface rules are built */
-  if ((no_work || kept_faces) && !(own && B->prev->cls[c] == FCM_CELL_DROPPED && B->tri_rule))
-    FCM_TRY(ctx, fcm__embed_cell_setup_volume(ctx, B->mesh, c, opt->clip_rtol, &cell));
-  else
-    FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
-  if (no_work || kept_faces) {
-    FCM_TRY(ctx, keep_cell(B, R, &cell, 1, o));
-    if (kept_faces)
-      FCM_TRY(ctx, fcm__embed_copy_face_polygons(ctx, B->prev, c, &o->fmeta, &o->fx, &o->nfp));
-    o->fp_keep = (unsigned char)kept_faces;
-    if (own && R->cls[c] == FCM_CELL_DROPPED) FCM_TRY(ctx, dropped_area(B, &cell, ws, o));
-    goto cleanup;
-  }
+  if (no_work || kept_faces) return copy_prev_cell(B, R, c, own, kept_faces, ws, o);
+  const double t0 = fcm_wtime();
+  FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
   if (B->prev) FCM_TRY(ctx, fcm__embed_check_convex(ctx, B->mesh, c, opt));
   int surface = B->surface && cell.affine && !(B->cut_tree && B->region[c]);
   if (surface && opt->moments == FCM_CELL_MOMENTS_AUTO && B->geom->num_cells > 0) {

@@ -99,6 +99,10 @@ fcm_status fcm__embed_finish_cell(const build *B, piece_out *o, const int simp[F
   fcm_ctx *ctx = B->ctx;
   const fcm_cell_rules_options *opt = B->o;
   const double t1 = fcm_wtime();
+  /* the points are written in place: never those of the rules being extended */
+  FCM_CHECK(
+      !o->borrowed, ctx, FCM_ERR_INTERNAL,
+      "cell rules: finishing a piece whose points are borrowed from the rules being extended");
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
     if (!B->tet_rule[k]) continue; /* a kind not built */
     if (simp[k] && !o->fitted) {   /* on the kind's moment space */

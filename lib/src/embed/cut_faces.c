@@ -233,7 +233,7 @@ fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, f
         meta[1] = P->piece[i];
         meta[2] = (int)m;
         meta[3] = p->nv;
-        meta[4] = P->mat && P->piece[i] >= 0 && fcm__embed_part_full(P, i);
+        meta[4] = P->mat && P->piece[i] >= 0 && fcm__embed_part_face_full(P, i, cp->n, cell->size);
         P->nfp++;
         P->nfx += mv;
         break;

@@ -226,6 +226,8 @@ fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new
   FCM_ALLOC(ctx, (size_t)nc + 1, R->reached);
   if (B->prev) FCM_ALLOC(ctx, (size_t)nc + 1, B->rebuild);
   if (B->geom->num_cells == 0) { /* the whole cells' material, kept from cut to cut */
+    fcm__free(ctx, R->cell_mvol);
+    R->cell_mvol = NULL;
     FCM_ALLOC(ctx, (size_t)nc + 1, R->cell_mvol);
     for (fcm_index c = 0; c < nc; c++)
       R->cell_mvol[c] = B->prev && B->prev->cell_mvol ? B->prev->cell_mvol[c] : NAN;
@@ -493,14 +495,15 @@ fcm_status fcm__embed_copy_face_polygons(fcm_ctx *ctx, const fcm_cell_rules *Q, 
 {
   fcm_status st = FCM_OK;
   const int n = Q->face_nfp[c];
-  *nfp = n;
   *meta = NULL, *x = NULL;
+  *nfp = n <= 0 ? n : 0; /* n once the copies are made */
   if (n <= 0) return FCM_OK;
   const size_t nx = face_coords(Q->face_meta[c], n);
   FCM__ALLOC_WITH(fcm__malloc, ctx, FCM__EMBED_FMETA * (size_t)n, *meta);
   FCM__ALLOC_WITH(fcm__malloc, ctx, nx, *x);
   memcpy(*meta, Q->face_meta[c], FCM__EMBED_FMETA * (size_t)n * sizeof **meta);
   memcpy(*x, Q->face_x[c], nx * sizeof **x);
+  *nfp = n;
 cleanup:
   return st;
 }

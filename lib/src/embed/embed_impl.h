@@ -330,18 +330,18 @@ typedef struct fcm__parts {
   struct fcm__material *mat;
   double *mvol;
   int whole; /* with mat: the one part is the cell itself, unsplit */
-  /* with mat: the body's volume in the whole cell; NaN: not known, fcm__embed_drop_dry()
-   * measures it (the caller sets it before fcm__embed_cell_parts() and reads it after) */
-  double whole_mvol;
 } fcm__parts;
 
 void fcm__embed_parts_free(fcm_ctx *ctx, fcm__parts *P);
 
 /* Clip every candidate embedded cell by the cell's planes (as fcm__embed_cell_tets) and keep
- * the non-empty convex parts in P (P->n of them, every piece 0). counts->parts is added. */
+ * the non-empty convex parts in P (P->n of them, every piece 0). counts->parts is added.
+ * whole_mvol (NULL: none): with a geometry without a volume mesh, the body's volume in the whole
+ * cell, in and out (fcm__embed_drop_dry()). */
 fcm_status fcm__embed_cell_parts(fcm_ctx *ctx, const fcm_geometry *geom, const fcm_aabb_tree *tree,
                                  const fcm__embed_cell *cell, double clip_rtol, double sliver_rtol,
-                                 fcm__embed_ws *ws, fcm__parts *P, fcm__embed_counts *counts);
+                                 fcm__embed_ws *ws, fcm__parts *P, double *whole_mvol,
+                                 fcm__embed_counts *counts);
 
 /* Split the parts by the planes and edge planes of the cut triangles tris[P->tcand] that
  * reach them, then group them into material pieces: two parts connect when they share a
@@ -742,7 +742,8 @@ int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const fcm__embed
                                 const double nb_normal[3]);
 
 /* fcm__embed_overlap_material() where `full` says whether the body fills one of the two parts
- * (fcm__embed_part_full()): then the half of the prism on that part's side is material, and an
+ * to a depth of 4 prism half-heights at least (fcm__embed_part_face_full()): then the half of
+ * the prism on that part's side is material, and an
  * overlap of more than 4 times the area threshold is covered without the moments (their
  * answer, half the prism at least, is above twice the threshold). */
 int fcm__embed_overlap_material_full(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
@@ -790,13 +791,20 @@ fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell,
 
 /* Surface body (P->mat): the body's volume in each part into P->mvol where it is not known
  * (0: not computed; < 0: a piece of a part wholly inside the body, its own volume; the whole
- * cell: P->whole_mvol where known, else measured into it); parts with no more than their vmin
- * are dropped. Nothing without P->mat. */
-fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P);
+ * cell: *whole_mvol where known (not NaN), else measured, and stored there unless whole_mvol is
+ * NULL); parts with no more than their vmin are dropped. Nothing without P->mat. */
+fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P,
+                               double *whole_mvol);
 
 /* Surface body: whether part i lies wholly inside the body (its material, P->mvol, is its
  * volume up to rounding). */
 int fcm__embed_part_full(const fcm__parts *P, size_t i);
+
+/* fcm__embed_part_full() for the face-link shortcut (fcm__embed_overlap_material_full()) on a
+ * face of unit normal nrm: the part is full and reaches at least 4 prism half-heights along nrm,
+ * so the half of the prism on its side is material (a thinner full slab holds less). size: the
+ * cell's. */
+int fcm__embed_part_face_full(const fcm__parts *P, size_t i, const double nrm[3], double size);
 
 /* Whether the convex polyhedron p (a part of affine cell) is a box in cell's reference
  * coordinates: 8 vertices, each at a corner of their reference bounding box lo..hi within

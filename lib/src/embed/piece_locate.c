@@ -132,9 +132,9 @@ static fcm_status load_cell(fcm__embed_finder *f, fcm_index c, int parts)
   if (!parts || f->has_parts) goto cleanup;
   if (!f->P) FCM_ALLOC(ctx, 1, f->P);
   fcm__parts *P = f->P;
-  P->whole_mvol = R->cell_mvol ? R->cell_mvol[c] : NAN;
+  double whole_mvol = R->cell_mvol ? R->cell_mvol[c] : NAN; /* R's stays as it is */
   FCM_TRY(ctx, fcm__embed_cell_parts(ctx, f->geom, f->tree, &f->C, R->opts.clip_rtol,
-                                     R->opts.sliver_rtol, &f->ws, P, NULL));
+                                     R->opts.sliver_rtol, &f->ws, P, &whole_mvol, NULL));
   P->tcand.n = 0;
   if (f->cut_tree) FCM_TRY(ctx, fcm__embed_cut_candidates(ctx, f->cut_tree, &f->C, &P->tcand));
   if (P->tcand.n > 0) FCM_TRY(ctx, fcm__embed_cell_pieces(ctx, &f->C, R->cut_tris, 0, P));

@@ -114,7 +114,8 @@ cleanup:
 
 fcm_status fcm__embed_cell_parts(fcm_ctx *ctx, const fcm_geometry *geom, const fcm_aabb_tree *tree,
                                  const fcm__embed_cell *cell, double clip_rtol, double sliver_rtol,
-                                 fcm__embed_ws *ws, fcm__parts *P, fcm__embed_counts *counts)
+                                 fcm__embed_ws *ws, fcm__parts *P, double *whole_mvol,
+                                 fcm__embed_counts *counts)
 {
   fcm_status st = FCM_OK;
   fcm_index nparts = 0;
@@ -127,7 +128,7 @@ fcm_status fcm__embed_cell_parts(fcm_ctx *ctx, const fcm_geometry *geom, const f
     FCM_TRY(ctx,
             fcm__embed_parts_put(ctx, P, 0, &ws->poly, cell->tol, sliver_rtol * cell->volume, 0));
     P->whole = 1;
-    FCM_TRY(ctx, fcm__embed_drop_dry(ctx, cell, P));
+    FCM_TRY(ctx, fcm__embed_drop_dry(ctx, cell, P, whole_mvol));
     if (counts) counts->parts += (fcm_index)P->n;
     P->num_pieces = P->num_parents = P->n > 0;
     return FCM_OK;
@@ -469,7 +470,7 @@ static fcm_status split_parts(fcm_ctx *ctx, const fcm__embed_cell *cell, const f
     after += fcm__geom_poly_volume(P->poly + i);
   *change = fabs(after - before);
   if (k1 > k0) {
-    FCM_TRY(ctx, fcm__embed_drop_dry(ctx, cell, P));
+    FCM_TRY(ctx, fcm__embed_drop_dry(ctx, cell, P, NULL));
     FCM_TRY(ctx, fcm__embed_split_lumps(ctx, cell, P));
   }
 cleanup:

@@ -214,7 +214,6 @@ cleanup:
   return st;
 }
 
-/* Phase 3: concatenate the pieces' volume and surface rules in cell order. */
 /* Cell c's pieces' rules, surface rules and cut faces from o into R's arrays (their offsets
  * set). */
 static void gather_cell(fcm_cell_rules *R, const cell_out *o, fcm_index c)
@@ -239,6 +238,7 @@ static void gather_cell(fcm_cell_rules *R, const cell_out *o, fcm_index c)
   }
 }
 
+/* Phase 3: concatenate the pieces' volume and surface rules in cell order. */
 fcm_status fcm__embed_gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_out *out,
                                    const fcm_cell_rules *prev)
 {

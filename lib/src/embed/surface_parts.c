@@ -17,6 +17,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The prism's half-height and the area that counts as material on a face, relative to the
+ * cell size (and its square): far above the surface moments' rounding (1e-15 of the prism). */
+#define PRISM_RTOL     1e-6
+#define FACE_AREA_RTOL 1e-9
+
 struct fcm__material {
   const fcm_geometry *geom;
   const fcm_aabb_tree *tree; /* the boundary triangles' */
@@ -358,28 +363,34 @@ static double tri_dist2(const double p[3], const double a[3], const double b[3],
   return fcm__vec3_dot(q, q);
 }
 
+/* The area of the planar polygon x (n vertices). */
+static double polygon_area(const double *x, int n)
+{
+  double a[3] = {0.0, 0.0, 0.0};
+  for (int i = 1; i + 1 < n; i++) {
+    double e1[3], e2[3], t[3];
+    for (int d = 0; d < 3; d++)
+      e1[d] = x[3 * i + d] - x[d], e2[d] = x[3 * (i + 1) + d] - x[d];
+    fcm__vec3_cross(e1, e2, t);
+    for (int d = 0; d < 3; d++)
+      a[d] += 0.5 * t[d];
+  }
+  return fcm__vec3_norm(a);
+}
+
 /* The area of the polygon x (n vertices) whose prism (half-height h along the unit normal nrm)
  * lies in the box of half-width g about p; y: scratch of n + 6 vertices. */
 static double area_in_box(const double *x, int n, const double p[3], double g, const double nrm[3],
                           double h, double *y)
 {
-  double lo[3], hi[3], a[3] = {0.0, 0.0, 0.0};
+  double lo[3], hi[3];
   for (int d = 0; d < 3; d++) {
     const double w = g - h * fabs(nrm[d]);
     if (!(w > 0.0)) return 0.0;
     lo[d] = p[d] - w, hi[d] = p[d] + w;
   }
   memcpy(y, x, 3 * (size_t)n * sizeof *x);
-  const int k = polygon_in_box(y, n, lo, hi);
-  for (int i = 1; i + 1 < k; i++) {
-    double e1[3], e2[3], t[3];
-    for (int d = 0; d < 3; d++)
-      e1[d] = y[3 * i + d] - y[d], e2[d] = y[3 * (i + 1) + d] - y[d];
-    fcm__vec3_cross(e1, e2, t);
-    for (int d = 0; d < 3; d++)
-      a[d] += 0.5 * t[d];
-  }
-  return fcm__vec3_norm(a);
+  return polygon_area(y, polygon_in_box(y, n, lo, hi));
 }
 
 /* Points tried by prism_near(): the polygon's vertex mean, then its fan triangles'. */
@@ -488,31 +499,11 @@ cleanup:
   return fabs(v) / (2.0 * h) > atol;
 }
 
-/* The prism's half-height and the area that counts as material on a face, relative to the
- * cell size (and its square): far above the surface moments' rounding (1e-15 of the prism). */
-#define PRISM_RTOL     1e-6
-#define FACE_AREA_RTOL 1e-9
-
 int fcm__embed_overlap_material(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
                                 const double *a, int na, const double *b, int nb,
                                 const double nb_normal[3])
 {
   return fcm__embed_overlap_material_full(ctx, m, cell, a, na, b, nb, nb_normal, 0);
-}
-
-/* The area of the planar polygon x (n vertices). */
-static double polygon_area(const double *x, int n)
-{
-  double a[3] = {0.0, 0.0, 0.0};
-  for (int i = 1; i + 1 < n; i++) {
-    double e1[3], e2[3], t[3];
-    for (int d = 0; d < 3; d++)
-      e1[d] = x[3 * i + d] - x[d], e2[d] = x[3 * (i + 1) + d] - x[d];
-    fcm__vec3_cross(e1, e2, t);
-    for (int d = 0; d < 3; d++)
-      a[d] += 0.5 * t[d];
-  }
-  return fcm__vec3_norm(a);
 }
 
 int fcm__embed_overlap_material_full(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
@@ -838,7 +829,20 @@ int fcm__embed_part_full(const fcm__parts *P, size_t i)
   return P->mvol[i] < 0.0 || P->mvol[i] >= (1.0 - FULL_RTOL) * fcm__geom_poly_volume(P->poly + i);
 }
 
-fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P)
+int fcm__embed_part_face_full(const fcm__parts *P, size_t i, const double nrm[3], double size)
+{
+  if (!fcm__embed_part_full(P, i)) return 0;
+  const fcm__poly *p = P->poly + i;
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (int a = 0; a < p->nv; a++) {
+    const double s = fcm__vec3_dot(nrm, p->x[a]);
+    lo = fmin(lo, s), hi = fmax(hi, s);
+  }
+  return hi - lo >= 4.0 * PRISM_RTOL * size;
+}
+
+fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P,
+                               double *whole_mvol)
 {
   fcm_status st = FCM_OK;
   if (!P->mat) return FCM_OK;
@@ -847,13 +851,13 @@ fcm_status fcm__embed_drop_dry(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__p
       if (P->mvol[i] < 0.0) P->mvol[i] = fcm__geom_poly_volume(P->poly + i);
       continue;
     }
-    if (P->whole && !isnan(P->whole_mvol))
-      P->mvol[i] = P->whole_mvol; /* measured so at an earlier cut */
+    if (P->whole && whole_mvol && !isnan(*whole_mvol))
+      P->mvol[i] = *whole_mvol; /* measured so at an earlier cut */
     else if (P->whole && cell->affine)
       FCM_TRY(ctx, fcm__material_cell(ctx, P->mat, NULL, cell, NULL, P->mvol + i));
     else
       FCM_TRY(ctx, fcm__material_poly(ctx, P->mat, P->poly + i, NULL, cell, NULL, P->mvol + i));
-    if (P->whole) P->whole_mvol = P->mvol[i];
+    if (P->whole && whole_mvol) *whole_mvol = P->mvol[i];
     if (!(P->mvol[i] > P->vmin[i])) P->poly[i].nv = P->poly[i].nf = 0;
   }
   fcm__embed_parts_compact(P);
