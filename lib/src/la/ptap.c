@@ -519,6 +519,52 @@ void fcm__ptap_destroy(fcm__ptap **plan)
   *plan = NULL;
 }
 
+fcm_status fcm__ptap_begin(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const fcm_index *P_ptr,
+                           const int *P_col, const double *P_val, int nt, const char *who,
+                           fcm__ptap **plan)
+{
+  fcm_status st = FCM_OK;
+  fcm__ptap *t = NULL;
+  fcm_index n = 0, ncol = 0;
+  fcm_csr_get_size(A, &n, &ncol, NULL);
+  FCM_CHECK(n == ncol, ctx, FCM_ERR_ARG, "%s: A is %lld x %lld, not square", who, (long long)n,
+            (long long)ncol);
+  for (fcm_index p = 0; p < P_ptr[n]; p++)
+    FCM_CHECK(P_col[p] >= 0 && P_col[p] < nc, ctx, FCM_ERR_ARG,
+              "%s: P entry %lld has column %d outside [0, %lld)", who, (long long)p, P_col[p],
+              (long long)nc);
+  t = fcm__calloc(ctx, 1, sizeof *t);
+  FCM_CHECK(t, ctx, FCM_ERR_ALLOC, "%s: out of memory", who);
+  t->ctx = ctx, t->n = n, t->nc = nc, t->nt = nt;
+  t->P_ptr = P_ptr, t->P_col = P_col, t->P_val = P_val;
+  FCM_TRY(ctx, fcm__ptap_transpose_pattern(ctx, n, nc, P_ptr, P_col, P_val, &t->R_ptr, &t->R_col,
+                                           &t->R_val));
+  FCM_ALLOC(ctx, n / 3 + 1, t->same3);
+  *plan = t;
+  t = NULL;
+cleanup:
+  fcm__ptap_destroy(&t);
+  return st;
+}
+
+fcm_status fcm__ptap_finish(fcm__ptap *t, const fcm_csr *A, const unsigned char *ap3,
+                            int with_diagonal, fcm_index **cp, int **cc, fcm_csr **C)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = t->ctx;
+  const fcm_index nc = t->nc;
+  if (with_diagonal) FCM_TRY(ctx, fcm__ptap_add_diagonal(ctx, nc, cp, cc));
+  FCM_ALLOC(ctx, (size_t)t->nt * 3 * (size_t)(nc + 1), t->spa);
+  FCM_ALLOC(ctx, (size_t)(nc / 3 + 1), t->r_kind);
+  for (fcm_index g = 0; 3 * g + 2 < nc; g++)
+    t->r_kind[g] =
+        fcm__ptap_shifted3(3 * g, t->R_ptr, t->R_col, t->R_val, ap3) ? KIND_SHIFTED : KIND_ROWS;
+  /* rows sorted and in range by construction, symmetric with A's pattern */
+  FCM_TRY(ctx, fcm__csr_adopt_pattern(ctx, nc, nc, cp, cc, fcm_csr_get_kind(A), C));
+cleanup:
+  return st;
+}
+
 fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const fcm_index *P_ptr,
                             const int *P_col, const double *P_val, int with_diagonal, int nt,
                             fcm__ptap **plan, fcm_csr **C)
@@ -532,22 +578,9 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
             FCM_ERR_ARG, "ptap_create: NULL argument, nc = %lld < 0 or nt = %d < 1", (long long)nc,
             nt);
   *plan = NULL, *C = NULL;
-  fcm_index n = 0, ncol = 0;
-  fcm_csr_get_size(A, &n, &ncol, NULL);
-  FCM_CHECK(n == ncol, ctx, FCM_ERR_ARG, "ptap_create: A is %lld x %lld, not square", (long long)n,
-            (long long)ncol);
-  for (fcm_index p = 0; p < P_ptr[n]; p++)
-    FCM_CHECK(P_col[p] >= 0 && P_col[p] < nc, ctx, FCM_ERR_ARG,
-              "ptap_create: P entry %lld has column %d outside [0, %lld)", (long long)p, P_col[p],
-              (long long)nc);
-  t = fcm__calloc(ctx, 1, sizeof *t);
-  FCM_CHECK(t, ctx, FCM_ERR_ALLOC, "ptap_create: out of memory");
-  t->ctx = ctx, t->n = n, t->nc = nc, t->nt = nt;
-  t->P_ptr = P_ptr, t->P_col = P_col, t->P_val = P_val;
-  FCM_TRY(ctx, fcm__ptap_transpose_pattern(ctx, n, nc, P_ptr, P_col, P_val, &t->R_ptr, &t->R_col,
-                                           &t->R_val));
+  FCM_TRY(ctx, fcm__ptap_begin(ctx, A, nc, P_ptr, P_col, P_val, nt, "ptap_create", &t));
+  const fcm_index n = t->n;
   /* the node's three rows of one pattern in A: every product keeps A's pattern */
-  FCM_ALLOC(ctx, n / 3 + 1, t->same3);
 #pragma omp parallel for num_threads(nt) schedule(static) if (nt > 1 && n > 4096)
   for (fcm_index g = 0; g < n / 3; g++)
     t->same3[g] =
@@ -578,14 +611,7 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
         (unsigned char)fcm__ptap_shifted3(3 * g, t->R_ptr, t->R_col, NULL, ap3);
   FCM_TRY(ctx, product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, 1, dup,
                                NULL, NULL, closed, &cp, &cc));
-  if (with_diagonal) FCM_TRY(ctx, fcm__ptap_add_diagonal(ctx, nc, &cp, &cc));
-  FCM_ALLOC(ctx, (size_t)nt * 3 * (size_t)(nc + 1), t->spa);
-  FCM_ALLOC(ctx, (size_t)(nc / 3 + 1), t->r_kind);
-  for (fcm_index g = 0; 3 * g + 2 < nc; g++)
-    t->r_kind[g] =
-        fcm__ptap_shifted3(3 * g, t->R_ptr, t->R_col, t->R_val, ap3) ? KIND_SHIFTED : KIND_ROWS;
-  /* rows sorted and in range by construction, symmetric with A's pattern */
-  FCM_TRY(ctx, fcm__csr_adopt_pattern(ctx, nc, nc, &cp, &cc, fcm_csr_get_kind(A), C));
+  FCM_TRY(ctx, fcm__ptap_finish(t, A, ap3, with_diagonal, &cp, &cc, C));
   *plan = t;
   t = NULL;
 cleanup:

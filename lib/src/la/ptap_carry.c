@@ -191,21 +191,8 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
     FCM_CHECK(!missing, ctx, FCM_ERR_ARG, "ptap_create_from: the prior's %s is NULL", missing);
   }
   *plan = NULL, *C = NULL;
-  fcm_index n = 0, ncol = 0;
-  fcm_csr_get_size(A, &n, &ncol, NULL);
-  FCM_CHECK(n == ncol, ctx, FCM_ERR_ARG, "ptap_create_from: A is %lld x %lld, not square",
-            (long long)n, (long long)ncol);
-  for (fcm_index p = 0; p < P_ptr[n]; p++)
-    FCM_CHECK(P_col[p] >= 0 && P_col[p] < nc, ctx, FCM_ERR_ARG,
-              "ptap_create_from: P entry %lld has column %d outside [0, %lld)", (long long)p,
-              P_col[p], (long long)nc);
-  t = fcm__calloc(ctx, 1, sizeof *t);
-  FCM_CHECK(t, ctx, FCM_ERR_ALLOC, "ptap_create_from: out of memory");
-  t->ctx = ctx, t->n = n, t->nc = nc, t->nt = nt;
-  t->P_ptr = P_ptr, t->P_col = P_col, t->P_val = P_val;
-  FCM_TRY(ctx, fcm__ptap_transpose_pattern(ctx, n, nc, P_ptr, P_col, P_val, &t->R_ptr, &t->R_col,
-                                           &t->R_val));
-  FCM_ALLOC(ctx, n / 3 + 1, t->same3);
+  FCM_TRY(ctx, fcm__ptap_begin(ctx, A, nc, P_ptr, P_col, P_val, nt, "ptap_create_from", &t));
+  const fcm_index n = t->n;
   w.old = prior->plan, w.n = n;
   w.Ap = fcm_csr_row_ptr(A), w.Ac = fcm_csr_col_idx(A), w.Pp = P_ptr, w.Pc = P_col;
   w.Rp = t->R_ptr, w.Rc = t->R_col;
@@ -246,12 +233,7 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
   FCM_ALLOC_RAW(ctx, cp[nc] + 1, cc);
   carry_rows(&w, 1, 1, cp, cc, mk, nt);
   /* the rows taken hold theirs (the prior's plan was made with the same with_diagonal) */
-  if (with_diagonal) FCM_TRY(ctx, fcm__ptap_add_diagonal(ctx, nc, &cp, &cc));
-  FCM_ALLOC(ctx, (size_t)nt * 3 * (size_t)(nc + 1), t->spa);
-  FCM_ALLOC(ctx, (size_t)(nc / 3 + 1), t->r_kind);
-  for (fcm_index g = 0; 3 * g + 2 < nc; g++)
-    t->r_kind[g] =
-        fcm__ptap_shifted3(3 * g, t->R_ptr, t->R_col, t->R_val, ap3) ? KIND_SHIFTED : KIND_ROWS;
+  FCM_TRY(ctx, fcm__ptap_finish(t, A, ap3, with_diagonal, &cp, &cc, C));
   if (taken) {
     taken[0] = taken[1] = 0;
     for (fcm_index i = 0; i < n; i++)
@@ -259,7 +241,6 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
     for (fcm_index I = 0; I < nc; I++)
       taken[1] += w.ckeep[I];
   }
-  FCM_TRY(ctx, fcm__csr_adopt_pattern(ctx, nc, nc, &cp, &cc, fcm_csr_get_kind(A), C));
   *plan = t;
   t = NULL;
 cleanup:

@@ -41,4 +41,14 @@ int fcm__ptap_same_pattern3(fcm_index i, const fcm_index *Ap, const int *Ac);
 int fcm__ptap_shifted3(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
                        const unsigned char *b_same3);
 
+/* A plan's start: A square, P's columns in [0, nc), R = P^T, same3 allocated (unset); `who`
+ * names the caller in the messages. */
+fcm_status fcm__ptap_begin(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const fcm_index *P_ptr,
+                           const int *P_col, const double *P_val, int nt, const char *who,
+                           fcm__ptap **plan);
+/* A plan's end from C's pattern (cp, cc; adopted by *C on success) and A P's groups of one
+ * pattern ap3: the diagonal added when asked, the accumulators and R's row kinds. */
+fcm_status fcm__ptap_finish(fcm__ptap *t, const fcm_csr *A, const unsigned char *ap3,
+                            int with_diagonal, fcm_index **cp, int **cc, fcm_csr **C);
+
 #endif
