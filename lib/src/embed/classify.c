@@ -383,12 +383,18 @@ static fcm_status copy_prev_cell(const build *B, fcm_cell_rules *R, fcm_index c,
   fcm_ctx *ctx = B->ctx;
   const fcm_cell_rules_options *opt = B->o;
   fcm__embed_cell cell;
-  /* a cell whose rules are copied needs its volume only, but a dropped one its surface share
-   * where surface rules are built */
-  if (!(own && B->prev->cls[c] == FCM_CELL_DROPPED && B->tri_rule))
-    FCM_TRY(ctx, fcm__embed_cell_setup_volume(ctx, B->mesh, c, opt->clip_rtol, &cell));
-  else
+  double *known = R->cell_volume ? R->cell_volume + c : NULL; /* one writer per cell */
+  /* a cell whose rules are copied needs its volume only (kept from an earlier cut), but a
+   * dropped one its surface share where surface rules are built */
+  if (own && B->prev->cls[c] == FCM_CELL_DROPPED && B->tri_rule) {
     FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
+  } else if (known && !isnan(*known)) {
+    cell.id = c;
+    cell.volume = *known;
+  } else {
+    FCM_TRY(ctx, fcm__embed_cell_setup_volume(ctx, B->mesh, c, opt->clip_rtol, &cell));
+  }
+  if (known) *known = cell.volume;
   FCM_TRY(ctx, keep_cell(B, R, &cell, o));
   if (kept_faces)
     FCM_TRY(ctx, fcm__embed_copy_face_polygons(ctx, B->prev, c, &o->fmeta, &o->fx, &o->nfp));
@@ -422,6 +428,7 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   if (no_work || kept_faces) return copy_prev_cell(B, R, c, own, kept_faces, ws, o);
   const double t0 = fcm_wtime();
   FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
+  if (R->cell_volume) R->cell_volume[c] = cell.volume;
   if (B->prev) FCM_TRY(ctx, fcm__embed_check_convex(ctx, B->mesh, c, opt));
   int surface = B->surface && cell.affine && !(B->cut_tree && B->region[c]);
   if (surface && opt->moments == FCM_CELL_MOMENTS_AUTO && B->geom->num_cells > 0) {

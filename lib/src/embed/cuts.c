@@ -233,6 +233,11 @@ fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new
       R->cell_mvol[c] = B->prev && B->prev->cell_mvol ? B->prev->cell_mvol[c] : NAN;
     B->cell_mvol = R->cell_mvol;
   }
+  fcm__free(ctx, R->cell_volume);
+  R->cell_volume = NULL;
+  FCM_ALLOC(ctx, (size_t)nc + 1, R->cell_volume);
+  for (fcm_index c = 0; c < nc; c++)
+    R->cell_volume[c] = B->prev && B->prev->cell_volume ? B->prev->cell_volume[c] : NAN;
   if (B->prev && first_new > 0) FCM_ALLOC(ctx, (size_t)nc + 1, B->prev_region);
   FCM_TRY(ctx, reached_cells(B, first_new, R->reached));
   for (fcm_index c = 0; c < nc; c++) {

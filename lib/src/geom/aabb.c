@@ -182,6 +182,23 @@ static int probe_meets(const probe *q, const double *blo, const double *bhi)
   return 1;
 }
 
+/* The ids ascending (distinct ids: any sort gives the same order). Most queries find a few
+ * items: those are sorted in place by insertion, without qsort's calls per comparison. */
+static void sort_ids(fcm_index *ids, size_t n)
+{
+  if (n > 32) {
+    qsort(ids, n, sizeof *ids, cmp_index);
+    return;
+  }
+  for (size_t i = 1; i < n; i++) {
+    const fcm_index v = ids[i];
+    size_t j = i;
+    for (; j > 0 && ids[j - 1] > v; j--)
+      ids[j] = ids[j - 1];
+    ids[j] = v;
+  }
+}
+
 static fcm_status traverse(fcm_ctx *ctx, const fcm_aabb_tree *t, const probe *q, fcm__idbuf *buf)
 {
   fcm_status st = FCM_OK;
@@ -214,7 +231,7 @@ static fcm_status traverse(fcm_ctx *ctx, const fcm_aabb_tree *t, const probe *q,
       buf->ids[buf->n++] = id;
     }
   }
-  if (buf->n > 1) qsort(buf->ids, buf->n, sizeof *buf->ids, cmp_index);
+  sort_ids(buf->ids, buf->n);
 cleanup:
   return st;
 }
