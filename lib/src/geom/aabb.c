@@ -187,14 +187,9 @@ static inline int probe_meets(const probe *q, const double *blo, const double *b
   return 1;
 }
 
-/* The ids ascending (distinct ids: any sort gives the same order). Most queries find a few
- * items: those are sorted in place by insertion, without qsort's calls per comparison. */
-static void sort_ids(fcm_index *ids, size_t n)
+/* ids[0..n) ascending by insertion (few ids). */
+static void insertion_sort(fcm_index *ids, size_t n)
 {
-  if (n > 32) {
-    qsort(ids, n, sizeof *ids, cmp_index);
-    return;
-  }
   for (size_t i = 1; i < n; i++) {
     const fcm_index v = ids[i];
     size_t j = i;
@@ -202,6 +197,48 @@ static void sort_ids(fcm_index *ids, size_t n)
       ids[j] = ids[j - 1];
     ids[j] = v;
   }
+}
+
+/* The ids ascending (distinct ids: any sort gives the same order), without qsort's call per
+ * comparison: a quicksort on the median of three, insertion below 24 ids, qsort for a range
+ * that went deeper than twice log2 n (no quadratic case). */
+static void sort_ids(fcm_index *ids, size_t n)
+{
+  int limit = 0;
+  for (size_t m = n; m > 1; m >>= 1)
+    limit += 2;
+  while (n > 24) {
+    if (limit-- == 0) {
+      qsort(ids, n, sizeof *ids, cmp_index);
+      return;
+    }
+    fcm_index *a = ids, *m = ids + n / 2, *z = ids + n - 1, t;
+    if (*m < *a) t = *m, *m = *a, *a = t;
+    if (*z < *m) {
+      t = *z, *z = *m, *m = t;
+      if (*m < *a) t = *m, *m = *a, *a = t;
+    }
+    const fcm_index piv = *m;
+    size_t i = 0, j = n - 1;
+    for (;;) { /* Hoare: [0, j] <= piv <= [j + 1, n) */
+      while (ids[i] < piv)
+        i++;
+      while (ids[j] > piv)
+        j--;
+      if (i >= j) break;
+      t = ids[i], ids[i] = ids[j], ids[j] = t;
+      i++, j--;
+    }
+    const size_t left = j + 1; /* the smaller side recursively, the larger in the loop */
+    if (left < n - left) {
+      sort_ids(ids, left);
+      ids += left, n -= left;
+    } else {
+      sort_ids(ids + left, n - left);
+      n = left;
+    }
+  }
+  insertion_sort(ids, n);
 }
 
 /* The items whose boxes q meets, ascending, into buf. Children are tested before they are
