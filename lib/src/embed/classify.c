@@ -531,6 +531,38 @@ cleanup:
   return st;
 }
 
+/* One cell of fcm__embed_run_cells() on the calling thread (its workspace *ws made by its
+ * first cell), with the progress report. */
+static void run_cell(const build *B, fcm_cell_rules *R, fcm_index c, fcm__embed_ws **ws,
+                     cell_out *out, cell_sums *mine, fcm__loop *loop,
+                     const fcm_cell_rules_options *opt, fcm_index *done, double *last)
+{
+  fcm_ctx *ctx = B->ctx;
+  const fcm_index nc = R->num_cells;
+  if (fcm__loop_skip(loop, c)) return;
+  fcm__loop_iter it;
+  fcm__loop_enter(loop, &it, c);
+  fcm_status s = FCM_OK;
+  if (!*ws) { /* the thread's workspace, made by its first cell */
+    *ws = fcm__calloc(ctx, 1, sizeof **ws);
+    if (!*ws) s = FCM_ERR_ALLOC;
+  }
+  const int remote = B->remote && B->remote[c]; /* classified by another process */
+  if (s == FCM_OK && !remote) s = process_cell(B, R, c, *ws, out + c, mine);
+  fcm__loop_leave(loop, &it, s);
+  if (opt->progress) { /* counted by all threads, reported by the calling one */
+#pragma omp atomic
+    (*done)++;
+    if (omp_get_thread_num() == 0 && fcm_wtime() - *last >= opt->progress_interval) {
+      fcm_index now;
+#pragma omp atomic read
+      now = *done;
+      opt->progress(now, nc, opt->progress_user);
+      *last = fcm_wtime();
+    }
+  }
+}
+
 /* Phase 2: every cell in parallel into its own cell_out; thread sums into *sums. An error
  * is that of the lowest failing cell, whatever the thread count. */
 fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads, cell_out *out,
@@ -539,17 +571,20 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
   const fcm_index nc = R->num_cells;
-  fcm_index done = 0;
+  fcm_index done = 0, first = nc;
   double last = fcm_wtime();
   fcm__loop loop;
   fcm_index *order = NULL; /* a cut: the cells it integrates again first (the threads' shares
-                              end together), then the others; each cell's work is its own */
+                              end together), one at a time, then the others, whose rules are
+                              copied, in chunks (one cell is less work than taking it) */
   if (B->rebuild) {
     FCM_ALLOC(ctx, (size_t)nc + 1, order);
     fcm_index n = 0;
-    for (int pass = 0; pass < 2; pass++)
+    for (int pass = 0; pass < 2; pass++) {
       for (fcm_index c = 0; c < nc; c++)
         if ((B->rebuild[c] != 0) == (pass == 0)) order[n++] = c;
+      if (pass == 0) first = n;
+    }
   }
   fcm__loop_begin(ctx, &loop);
   memset(sums, 0, sizeof *sums);
@@ -563,32 +598,12 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
     cell_sums mine;
     memset(&mine, 0, sizeof mine);
     fcm__embed_ws *ws = NULL;
-#pragma omp for schedule(dynamic, 1)
-    for (fcm_index i = 0; i < nc; i++) {
-      const fcm_index c = order ? order[i] : i;
-      if (fcm__loop_skip(&loop, c)) continue;
-      fcm__loop_iter it;
-      fcm__loop_enter(&loop, &it, c);
-      fcm_status s = FCM_OK;
-      if (!ws) { /* the thread's workspace, made by its first cell */
-        ws = fcm__calloc(ctx, 1, sizeof *ws);
-        if (!ws) s = FCM_ERR_ALLOC;
-      }
-      const int remote = B->remote && B->remote[c]; /* classified by another process */
-      if (s == FCM_OK && !remote) s = process_cell(B, R, c, ws, out + c, &mine);
-      fcm__loop_leave(&loop, &it, s);
-      if (opt->progress) { /* counted by all threads, reported by the calling one */
-#pragma omp atomic
-        done++;
-        if (omp_get_thread_num() == 0 && fcm_wtime() - last >= opt->progress_interval) {
-          fcm_index now;
-#pragma omp atomic read
-          now = done;
-          opt->progress(now, nc, opt->progress_user);
-          last = fcm_wtime();
-        }
-      }
-    }
+#pragma omp for schedule(dynamic, 1) nowait
+    for (fcm_index i = 0; i < first; i++)
+      run_cell(B, R, order ? order[i] : i, &ws, out, &mine, &loop, opt, &done, &last);
+#pragma omp for schedule(dynamic, 64)
+    for (fcm_index i = first; i < nc; i++)
+      run_cell(B, R, order[i], &ws, out, &mine, &loop, opt, &done, &last);
     if (ws) fcm__embed_ws_free(ctx, ws);
     fcm__free(ctx, ws);
 #pragma omp critical(fcm_embed_sum)
