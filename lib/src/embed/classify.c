@@ -421,7 +421,12 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   const int integrate = !B->rebuild || B->rebuild[c];
   const int own = !opt->cell_mask || opt->cell_mask[c]; /* 0: classified, no points */
   double sbox[6];
-  const int no_work = !integrate && (!B->region[c] || (B->same_links && B->same_links[c]));
+  /* a cell the new cut does not reach needs no work outside the region, where its links with
+   * every region neighbour are kept, or where it has no pieces (the links skip such a cell: its
+   * face polygons would be read by no cut until one reaches it and makes them again) */
+  const int no_work =
+      !integrate && (!B->region[c] || (B->same_links && B->same_links[c]) ||
+                     (B->keep && B->prev && B->prev->piece_off[c + 1] == B->prev->piece_off[c]));
   /* a region cell the new cut does not reach, with the face polygons the earlier cut kept */
   const int kept_faces =
       !integrate && !no_work && B->keep && B->prev->face_nfp && B->prev->face_nfp[c] >= 0;
