@@ -14,6 +14,8 @@
  *   cuts, and cells that take them occur;
  * - a kept volume off by 1e-3 (the control) changes the next cut's rules, and a kept cell
  *   volume off by 1e-3 its embedded volume;
+ * - the links equal those of the cut without its shortcuts (fcm__cell_rules_create_cut_keep()
+ *   with keep = 0: every region cell split for its face polygons, those without pieces too);
  * - the face overlaps' shortcut: every kept face polygon of a part the body fills (fmeta's
  *   flag), larger than 4 times the area threshold, is covered by the body by the prism's
  *   moments (fcm__material_on_face()), as the links take it without them; polygons of other
@@ -199,7 +201,20 @@ int main(void)
       reused += a->face_nfp[c] >= 0 && a->reached && !a->reached[c];
     for (fcm_index c = 0; k > 0 && a->cell_volume && c < a->num_cells; c++)
       volumes_kept += !isnan(a->cell_volume[c]);
+    fcm_cell_rules *plain = NULL;
+    {
+      fcm_surface *ps = NULL;
+      const blade *bl = blades + k;
+      TEST_OK(ctx, fcm_surface_create_plane(ctx, bl->p, bl->n, bl->lo, bl->hi, &ps));
+      if (ps) TEST_OK(ctx, fcm__cell_rules_create_cut_keep(ctx, mesh, surf, a, ps, 0, &plain));
+      fcm_surface_destroy(&ps);
+    }
     fcm_cell_rules *na = next_cut(mesh, surf, a, k);
+    const int same_links_plain =
+        plain && na && plain->num_links == na->num_links &&
+        same_array(plain->links, na->links, 2 * (size_t)na->num_links * sizeof(fcm_index));
+    fcm_cell_rules_destroy(&plain);
+    TEST_TRUE(same_links_plain);
     strip(b);
     fcm_cell_rules *nb = next_cut(mesh, surf, b, k);
     fcm_cell_rules_destroy(&a);
